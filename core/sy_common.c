@@ -1,0 +1,70 @@
+/* sy_common.c — result strings, error formatting, clock and terminal checks (see sy_common.h). */
+#include "sy_common.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+const char *sy_result_str(sy_result r)
+{
+    switch (r) {
+    case SY_OK: return "ok";
+    case SY_ERR_INVALID_ARGUMENT: return "invalid argument";
+    case SY_ERR_INVALID_HANDLE: return "invalid handle";
+    case SY_ERR_OUT_OF_MEMORY: return "out of memory";
+    case SY_ERR_IO: return "i/o error";
+    case SY_ERR_PARSE: return "malformed input";
+    case SY_ERR_UNSUPPORTED: return "unsupported";
+    case SY_ERR_LIMIT: return "limit exceeded";
+    case SY_ERR_NOT_FOUND: return "not found";
+    case SY_ERR_BACKEND: return "back-end failure";
+    case SY_ERR_PROTOCOL: return "protocol violation";
+    default: return "unknown error";
+    }
+}
+
+sy_result sy_error_set(sy_error *err, sy_result code, const char *fmt, ...)
+{
+    if (err) {
+        err->code = code;
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err->message, sizeof err->message, fmt, ap);
+        va_end(ap);
+    }
+    return code;
+}
+
+void sy_error_prefix(sy_error *err, const char *fmt, ...)
+{
+    if (!err) return;
+    char prefix[SY_ERROR_MESSAGE_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(prefix, sizeof prefix, fmt, ap);
+    va_end(ap);
+    char old[SY_ERROR_MESSAGE_MAX];
+    memcpy(old, err->message, sizeof old);
+    old[sizeof old - 1] = '\0';
+    size_t n = strlen(prefix);
+    if (n > sizeof err->message - 3) n = sizeof err->message - 3;
+    memcpy(err->message, prefix, n);
+    err->message[n] = ':';
+    err->message[n + 1] = ' ';
+    size_t room = sizeof err->message - (n + 2) - 1;
+    size_t m = strlen(old);
+    if (m > room) m = room;
+    memcpy(err->message + n + 2, old, m);
+    err->message[n + 2 + m] = '\0';
+}
+
+double sy_time_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+bool sy_is_terminal(int fd) { return isatty(fd) == 1; }

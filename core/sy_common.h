@@ -1,0 +1,92 @@
+/* sy_common.h — result codes, error messages and checked arithmetic shared by every Switchyard
+ * layer above the back-ends (core, mediators, formats, apps).
+ *
+ * Error convention: every fallible call returns a sy_result (SY_OK == 0) and, when the caller passed
+ * a sy_error*, fills it with the code and a human-readable message naming the object / file / place
+ * and the reason. The error pointer may be NULL. There is no sticky or global error state.
+ *
+ * Thread-safety: everything here is pure or works on caller-owned memory. */
+#ifndef SY_COMMON_H
+#define SY_COMMON_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum sy_result {
+    SY_OK = 0,
+    SY_ERR_INVALID_ARGUMENT = 1, /* a caller passed something the API does not accept */
+    SY_ERR_INVALID_HANDLE = 2,   /* stale or foreign handle */
+    SY_ERR_OUT_OF_MEMORY = 3,
+    SY_ERR_IO = 4,               /* file or socket could not be read or written */
+    SY_ERR_PARSE = 5,            /* input data is malformed (file, message) */
+    SY_ERR_UNSUPPORTED = 6,      /* well-formed but uses something we do not implement */
+    SY_ERR_LIMIT = 7,            /* a size or count exceeds a configured limit / would overflow */
+    SY_ERR_NOT_FOUND = 8,        /* named thing (file, camera, back-end) does not exist */
+    SY_ERR_BACKEND = 9,          /* a back-end library reported a failure */
+    SY_ERR_PROTOCOL = 10,        /* network peer violated the protocol */
+    SY_RESULT_MAX_ENUM = 0x7fffffff
+} sy_result;
+
+#define SY_ERROR_MESSAGE_MAX 512
+
+/* A result plus its message. Zero-initialise before first use ({0}). */
+typedef struct sy_error {
+    sy_result code;
+    char message[SY_ERROR_MESSAGE_MAX];
+} sy_error;
+
+/* Human-readable name of a result code ("invalid argument", ...). Static storage. */
+const char *sy_result_str(sy_result r);
+
+/* Records code + printf-style message in *err (if err is not NULL) and returns code, so that
+ * call sites read `return sy_error_set(err, SY_ERR_PARSE, "%s: ...", path);`. */
+sy_result sy_error_set(sy_error *err, sy_result code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* Prepends "prefix: " to an existing message (adds context while an error travels up). */
+void sy_error_prefix(sy_error *err, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* ---- checked arithmetic: return false on overflow, *out untouched then ---- */
+static inline bool sy_size_add(size_t a, size_t b, size_t *out)
+{
+    if (a > SIZE_MAX - b) return false;
+    *out = a + b;
+    return true;
+}
+
+static inline bool sy_size_mul(size_t a, size_t b, size_t *out)
+{
+    if (a != 0 && b > SIZE_MAX / a) return false;
+    *out = a * b;
+    return true;
+}
+
+/* a*b+c, all checked. */
+static inline bool sy_size_mad(size_t a, size_t b, size_t c, size_t *out)
+{
+    size_t t;
+    return sy_size_mul(a, b, &t) && sy_size_add(t, c, out);
+}
+
+/* Monotonic wall clock in seconds (for timings and progress only). */
+double sy_time_now(void);
+
+/* true when fd refers to a terminal: long jobs print progress only then. */
+bool sy_is_terminal(int fd);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_COMMON_H */
