@@ -1,0 +1,26 @@
+# .ci/deps.sh — sourced by run.sh and test.sh: installs the Debian packages the build needs (only
+# when one is missing) and configures + builds with CMake (Ninja when present).
+SY_PACKAGES="cmake ninja-build gcc g++ pkg-config libembree-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
+ libopenexr-dev libpng-dev libxxhash-dev"
+
+sy_install_deps() {
+  local missing=()
+  for p in $SY_PACKAGES; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "installing missing packages: ${missing[*]}"
+    local sudo=""
+    [ "$(id -u)" -eq 0 ] || sudo="sudo"
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  fi
+}
+
+sy_configure_build() {
+  local dir=$1; shift
+  local gen=()
+  command -v ninja >/dev/null 2>&1 && gen=(-G Ninja)
+  cmake -S . -B "$dir" "${gen[@]}" "$@" >/dev/null
+  cmake --build "$dir" -j "$(nproc 2>/dev/null || echo 2)"
+}

@@ -1,0 +1,335 @@
+/* sy_rt.h — public API of the Embree ray-tracing back-end (backends/rt).
+ *
+ * A standalone renderer library with its own small scene API, exactly like a third-party renderer:
+ * it knows nothing about the Switchyard scene graph. A mediator (mediators/rt) translates the core
+ * scene into these objects and keeps them in sync incrementally.
+ *
+ * Object model
+ *   sy_rt_device   owns everything: Embree device, top-level scene, object pools, worker threads.
+ *   sy_rt_mesh     a prototype triangle mesh (its own Embree scene / BLAS). Data is copied.
+ *   sy_rt_instance a mesh placed in the world with a transform and a material; either an Embree
+ *                  instance of the mesh's BLAS, or (SY_RT_INSTANCE_BAKED) world-space triangles
+ *                  merged into the top-level BVH.
+ *   sy_rt_material glTF 2.0 metallic-roughness material (+ emission, transmission, IOR, alpha).
+ *   sy_rt_texture  8-bit (sRGB or linear) or float texture with its sampler.
+ *   sy_rt_light    punctual light (point, spot, directional; KHR_lights_punctual units).
+ *   Emissive instances become area lights automatically at sy_rt_commit().
+ *
+ * Handles are one-field structs holding index + generation; id 0 is never valid. A destroyed
+ * object's handle becomes stale and every call given it returns SY_RT_ERROR_INVALID_HANDLE.
+ * References between objects are by handle and resolved at render time: an instance whose material
+ * is stale renders with the default material, a material whose texture is stale ignores it.
+ * A mesh stays alive internally until its last instance is destroyed (destroy order is free).
+ *
+ * Set, then commit, then render: every create/update/destroy stages a change; sy_rt_commit()
+ * publishes them (top-level BVH commit, area-light list rebuild when needed). sy_rt_render() on a
+ * device with uncommitted changes fails with SY_RT_ERROR_INVALID_OPERATION.
+ *
+ * Errors: every fallible call returns a sy_rt_result (SY_RT_OK == 0) and, when err != NULL and
+ * err_len > 0, writes a NUL-terminated message naming the object, parameter and reason. There is no
+ * sticky or global error state. Embree's own error messages are captured and returned by the call
+ * that caused them.
+ *
+ * Thread-safety: one device may be used by one thread at a time (the API does not lock). Several
+ * devices are independent. sy_rt_render() itself runs multithreaded over tiles.
+ *
+ * Conventions (shared by every Switchyard back-end): right-handed world, Y up, metres. Cameras look
+ * down local -Z with +Y up. Matrices are 4x4 column-major float[16] (glTF): m[12..14] = translation.
+ * Image row 0 is the top row; pixel (x, y) covers [x, x+1) x [y, y+1), its centre is (x+0.5, y+0.5).
+ * Colour is linear Rec.709 RGB radiance, RGBA premultiplied. Depth is the linear distance along the
+ * camera's viewing axis (metres, positive), +INFINITY where nothing was hit.
+ */
+#ifndef SY_RT_H
+#define SY_RT_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* >>results */
+
+typedef enum sy_rt_result {
+    SY_RT_OK = 0,
+    SY_RT_ERROR_INVALID_ARGUMENT = 1,  /* a desc or parameter the API does not accept */
+    SY_RT_ERROR_INVALID_HANDLE = 2,    /* stale, foreign or zero handle */
+    SY_RT_ERROR_OUT_OF_MEMORY = 3,
+    SY_RT_ERROR_LIMIT = 4,             /* a count or size would overflow or exceeds a pool limit */
+    SY_RT_ERROR_EMBREE = 5,            /* Embree reported an error (message included) */
+    SY_RT_ERROR_UNSUPPORTED = 6,       /* well-formed request this back-end does not implement */
+    SY_RT_ERROR_INVALID_OPERATION = 7, /* e.g. rendering with uncommitted changes */
+    SY_RT_ERROR_CANCELLED = 8,         /* the progress callback asked to stop */
+    SY_RT_ERROR_SYSTEM = 9,            /* an OS call (thread creation) failed */
+    SY_RT_RESULT_MAX_ENUM = 0x7fffffff
+} sy_rt_result;
+
+/* Short name of a result code ("invalid argument", ...). Static storage. */
+const char *sy_rt_result_str(sy_rt_result r);
+
+/* >>handles */
+
+typedef struct sy_rt_device sy_rt_device;
+typedef struct sy_rt_mesh { uint32_t id; } sy_rt_mesh;
+typedef struct sy_rt_instance { uint32_t id; } sy_rt_instance;
+typedef struct sy_rt_material { uint32_t id; } sy_rt_material;
+typedef struct sy_rt_texture { uint32_t id; } sy_rt_texture;
+typedef struct sy_rt_light { uint32_t id; } sy_rt_light;
+
+/* >>device */
+
+typedef struct sy_rt_device_desc {
+    uint32_t thread_count; /* render and Embree build threads; 0 = all online cores */
+} sy_rt_device_desc;
+
+/* Creates a device. desc may be NULL (defaults). Ownership: *out belongs to the caller, who
+ * releases it with sy_rt_device_destroy (which destroys every object it still holds). */
+sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **out,
+                                 char *err, size_t err_len);
+/* Destroys the device and all its objects. NULL is a no-op. */
+void sy_rt_device_destroy(sy_rt_device *dev);
+
+/* Publishes all staged changes (BLAS/TLAS commits, area-light list when instances or materials
+ * changed). Must be called before sy_rt_render after any change. */
+sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len);
+
+/* Live object counts, for leak diagnostics and tests. */
+typedef struct sy_rt_stats {
+    uint32_t meshes, instances, materials, textures, lights;
+    uint32_t area_light_triangles; /* emissive triangles in the committed area-light list */
+} sy_rt_stats;
+void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out);
+
+/* >>mesh */
+
+/* Triangle mesh. Ownership: every array is COPIED; the caller may free its arrays after the call.
+ * Positions are required and must be finite. Optional arrays are NULL when absent; when present
+ * they hold vertex_count elements. Without indices the mesh is a non-indexed triangle list and
+ * vertex_count must equal 3 * triangle_count. With indices there are 3 * triangle_count indices
+ * and every index must be < vertex_count. */
+typedef struct sy_rt_mesh_desc {
+    const float *positions;  /* float3 x vertex_count (required) */
+    const float *normals;    /* float3 x vertex_count or NULL (then geometric normals) */
+    const float *uv[2];      /* float2 x vertex_count per texture-coordinate set, or NULL */
+    const float *colors;     /* float4 RGBA x vertex_count (linear) or NULL (then white) */
+    const uint32_t *indices; /* 3 x triangle_count or NULL */
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+} sy_rt_mesh_desc;
+
+sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *desc, sy_rt_mesh *out,
+                               char *err, size_t err_len);
+/* Invalidates the handle; the data is freed once no instance uses it any more. */
+sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh, char *err, size_t err_len);
+
+/* >>texture */
+
+typedef enum sy_rt_texel_format {
+    SY_RT_TEXEL_UNORM8 = 1,      /* 8-bit linear */
+    SY_RT_TEXEL_UNORM8_SRGB = 2, /* 8-bit; RGB channels sRGB-encoded, alpha linear */
+    SY_RT_TEXEL_FLOAT32 = 3,     /* 32-bit float, linear */
+    SY_RT_TEXEL_FORMAT_MAX_ENUM = 0x7fffffff
+} sy_rt_texel_format;
+
+typedef enum sy_rt_wrap {
+    SY_RT_WRAP_REPEAT = 0,
+    SY_RT_WRAP_CLAMP = 1,
+    SY_RT_WRAP_MIRROR = 2,
+    SY_RT_WRAP_MAX_ENUM = 0x7fffffff
+} sy_rt_wrap;
+
+typedef enum sy_rt_filter {
+    SY_RT_FILTER_LINEAR = 0,
+    SY_RT_FILTER_NEAREST = 1,
+    SY_RT_FILTER_MAX_ENUM = 0x7fffffff
+} sy_rt_filter;
+
+/* Texture. Pixels are row-major, row 0 = top row (glTF uv (0,0) is the top-left corner), channels
+ * interleaved: 1 = grey, 2 = grey+alpha, 3 = RGB, 4 = RGBA. Ownership: pixels are COPIED. */
+typedef struct sy_rt_texture_desc {
+    uint32_t width, height, channels; /* channels 1..4 */
+    sy_rt_texel_format format;
+    const void *pixels; /* uint8_t or float, width*height*channels elements */
+    sy_rt_wrap wrap_s, wrap_t;
+    sy_rt_filter filter;
+} sy_rt_texture_desc;
+
+sy_rt_result sy_rt_texture_create(sy_rt_device *dev, const sy_rt_texture_desc *desc,
+                                  sy_rt_texture *out, char *err, size_t err_len);
+sy_rt_result sy_rt_texture_destroy(sy_rt_device *dev, sy_rt_texture tex, char *err, size_t err_len);
+
+/* >>material */
+
+typedef enum sy_rt_alpha_mode {
+    SY_RT_ALPHA_OPAQUE = 0,
+    SY_RT_ALPHA_MASK = 1,  /* cut out where alpha < alpha_cutoff (also for shadow rays) */
+    SY_RT_ALPHA_BLEND = 2, /* camera/secondary rays blend with what is behind; shadows opaque */
+    SY_RT_ALPHA_MODE_MAX_ENUM = 0x7fffffff
+} sy_rt_alpha_mode;
+
+/* A texture reference: a zero handle means "no texture". */
+typedef struct sy_rt_texture_ref {
+    sy_rt_texture texture;
+    uint32_t texcoord; /* texture-coordinate set, 0 or 1 */
+} sy_rt_texture_ref;
+
+/* glTF 2.0 metallic-roughness material. Fill it with sy_rt_material_desc_init (glTF defaults),
+ * then set what differs. */
+typedef struct sy_rt_material_desc {
+    float base_color[4];            /* linear RGBA factor (default 1,1,1,1) */
+    sy_rt_texture_ref base_color_texture;
+    float metallic, roughness;      /* factors (default 1, 1) */
+    sy_rt_texture_ref metallic_roughness_texture; /* G = roughness, B = metallic */
+    float emissive[3];              /* radiance: emissiveFactor * emissiveStrength (default 0) */
+    sy_rt_texture_ref emissive_texture;
+    sy_rt_texture_ref normal_texture;
+    float normal_scale;             /* default 1 */
+    float specular;                 /* KHR_materials_specular factor (default 1; 0 = pure Lambert) */
+    float transmission;             /* KHR_materials_transmission factor (default 0) */
+    float ior;                      /* default 1.5 */
+    sy_rt_alpha_mode alpha_mode;    /* default opaque */
+    float alpha_cutoff;             /* default 0.5 */
+    bool double_sided;              /* default false: emitters emit from the front side only */
+    bool unlit;                     /* KHR_materials_unlit: pixel = base colour */
+} sy_rt_material_desc;
+
+void sy_rt_material_desc_init(sy_rt_material_desc *desc);
+sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc *desc,
+                                   sy_rt_material *out, char *err, size_t err_len);
+sy_rt_result sy_rt_material_update(sy_rt_device *dev, sy_rt_material mat,
+                                   const sy_rt_material_desc *desc, char *err, size_t err_len);
+sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat, char *err, size_t err_len);
+
+/* >>instance */
+
+enum {
+    /* Static geometry: transformed to world space and merged into the top-level BVH. Moving it
+     * re-transforms just its triangles (and rebuilds the top-level BVH at commit). */
+    SY_RT_INSTANCE_BAKED = 1u << 0,
+    /* Not rendered and casts no shadows (also no area light); toggle with set_visible. */
+    SY_RT_INSTANCE_HIDDEN = 1u << 1,
+};
+
+typedef struct sy_rt_instance_desc {
+    sy_rt_mesh mesh;
+    float transform[16]; /* object-to-world, column-major; must be finite and invertible */
+    sy_rt_material material; /* zero/stale = default grey material */
+    uint32_t flags;          /* SY_RT_INSTANCE_* */
+} sy_rt_instance_desc;
+
+sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc *desc,
+                                   sy_rt_instance *out, char *err, size_t err_len);
+/* Cheap for non-baked instances (rtcSetGeometryTransform + top-level recommit, no BLAS rebuild). */
+sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst,
+                                          const float transform[16], char *err, size_t err_len);
+sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst,
+                                         sy_rt_material material, char *err, size_t err_len);
+sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, bool visible,
+                                        char *err, size_t err_len);
+sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst, char *err, size_t err_len);
+
+/* >>light */
+
+typedef enum sy_rt_light_type {
+    SY_RT_LIGHT_POINT = 1,
+    SY_RT_LIGHT_SPOT = 2,
+    SY_RT_LIGHT_DIRECTIONAL = 3,
+    SY_RT_LIGHT_TYPE_MAX_ENUM = 0x7fffffff
+} sy_rt_light_type;
+
+/* Punctual light in world space (KHR_lights_punctual units). Point/spot: intensity in candela,
+ * irradiance at distance d is color * intensity / d^2 (times the range window when range > 0).
+ * Directional: intensity in lux. direction is the direction the light travels (the light node's
+ * -Z axis in world space); it need not be normalised. */
+typedef struct sy_rt_light_desc {
+    sy_rt_light_type type;
+    float color[3];
+    float intensity;
+    float position[3];  /* point, spot */
+    float direction[3]; /* spot, directional */
+    float range;        /* point, spot; 0 = infinite */
+    float inner_cone_angle, outer_cone_angle; /* spot, radians, 0 <= inner < outer <= pi/2 */
+} sy_rt_light_desc;
+
+sy_rt_result sy_rt_light_create(sy_rt_device *dev, const sy_rt_light_desc *desc, sy_rt_light *out,
+                                char *err, size_t err_len);
+sy_rt_result sy_rt_light_update(sy_rt_device *dev, sy_rt_light light, const sy_rt_light_desc *desc,
+                                char *err, size_t err_len);
+sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light, char *err, size_t err_len);
+
+/* >>background */
+
+typedef enum sy_rt_background_mode {
+    SY_RT_BACKGROUND_NONE = 0,  /* transparent: colour 0, alpha 0 (secondary rays see black) */
+    SY_RT_BACKGROUND_COLOR = 1, /* constant radiance, alpha 1 */
+    SY_RT_BACKGROUND_MODE_MAX_ENUM = 0x7fffffff
+} sy_rt_background_mode;
+
+typedef struct sy_rt_background {
+    sy_rt_background_mode mode;
+    float color[3];
+} sy_rt_background;
+
+/* Default: SY_RT_BACKGROUND_NONE. Takes effect at the next commit. */
+sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg, char *err,
+                                  size_t err_len);
+
+/* >>render */
+
+typedef enum sy_rt_projection {
+    SY_RT_PROJECTION_PERSPECTIVE = 0,
+    SY_RT_PROJECTION_ORTHOGRAPHIC = 1,
+    SY_RT_PROJECTION_MAX_ENUM = 0x7fffffff
+} sy_rt_projection;
+
+/* Camera. window = {left, right, bottom, top}: for perspective the image-plane window at distance
+ * 1 in front of the camera (tangents of the half-angles, so symmetric and off-axis/stereo frusta are
+ * the same code), for orthographic the window in camera units. Geometry nearer than near_clip or
+ * farther than far_clip (0 = infinite) along the viewing axis is not seen by camera rays. */
+typedef struct sy_rt_camera {
+    float camera_to_world[16]; /* column-major; camera looks down local -Z, +Y up */
+    sy_rt_projection projection;
+    float window[4];
+    float near_clip, far_clip;
+} sy_rt_camera;
+
+typedef enum sy_rt_integrator {
+    SY_RT_INTEGRATOR_PRIMARY = 1, /* primary rays only, eye-light shading (benchmarks, debugging) */
+    SY_RT_INTEGRATOR_WHITTED = 2, /* direct light + hard shadows + mirror reflection/refraction */
+    /* reserved: 3 = path tracer, 4 = coverage */
+    SY_RT_INTEGRATOR_MAX_ENUM = 0x7fffffff
+} sy_rt_integrator;
+
+/* Progress report; return false from the callback to cancel the render. Called from worker
+ * threads, serialised (never two calls at once). */
+typedef struct sy_rt_progress {
+    uint32_t tiles_done, tiles_total;
+} sy_rt_progress;
+typedef bool (*sy_rt_progress_fn)(const sy_rt_progress *progress, void *user_data);
+
+typedef struct sy_rt_render_desc {
+    sy_rt_integrator integrator;
+    uint32_t image_width, image_height; /* the full image the camera window maps onto */
+    uint32_t x, y, width, height;       /* sub-rectangle to fill (row 0 = top) */
+    uint32_t max_depth;                 /* recursion depth for reflection/refraction; 0 = 8 */
+    uint32_t area_light_samples;        /* fixed light samples per pixel; 0 = 16 */
+    uint32_t seed;                      /* decorrelates sample patterns; same seed = same image */
+    sy_rt_progress_fn progress;         /* optional */
+    void *progress_user_data;
+} sy_rt_render_desc;
+
+/* Renders the sub-rectangle. rgba: width*height*4 floats (required); depth: width*height floats
+ * or NULL. Row 0 of both buffers is the top row of the sub-rectangle. Deterministic: a pixel's
+ * value depends only on the scene, the camera, its full-image coordinates and the render desc's
+ * integrator/max_depth/area_light_samples/seed, so tiles and sub-rectangles stitch bit-identically. */
+sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera,
+                          const sy_rt_render_desc *desc, float *rgba, float *depth, char *err,
+                          size_t err_len);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SY_RT_H */

@@ -1,0 +1,164 @@
+/* sy_rt_device.h — internal state of the ray-tracing back-end: the device, the handle pools and
+ * the per-object structs shared by the scene, texture, render and integrator modules, plus the
+ * error helpers every entry point uses. Not part of the public API (see sy_rt.h). */
+#ifndef SY_RT_DEVICE_H
+#define SY_RT_DEVICE_H
+
+#include "sy_rt.h"
+#include "sy_rt_math.h"
+
+#include <embree3/rtcore.h>
+#include <pthread.h>
+#include <stdarg.h>
+
+/* >>pool: index + generation handles. id = generation << SY_RT_INDEX_BITS | (index + 1). */
+#define SY_RT_INDEX_BITS 22u
+#define SY_RT_INDEX_MASK ((1u << SY_RT_INDEX_BITS) - 1u)
+#define SY_RT_POOL_MAX (SY_RT_INDEX_MASK - 1u) /* most live objects per type */
+#define SY_RT_GEN_MASK ((1u << (32u - SY_RT_INDEX_BITS)) - 1u)
+
+typedef struct sy_rt_pool {
+    void **items;       /* slot -> object or NULL */
+    uint32_t *gens;     /* slot -> current generation (1..SY_RT_GEN_MASK) */
+    uint32_t *free_idx; /* stack of free slots */
+    uint32_t count;     /* slots in use or on the free stack */
+    uint32_t cap;
+    uint32_t free_count;
+    uint32_t live;
+} sy_rt_pool;
+
+/* Stores item in a slot; *id_out gets its handle. Returns false when out of memory or full. */
+bool sy_rt_pool_insert(sy_rt_pool *p, void *item, uint32_t *id_out);
+/* Object for id, or NULL for a zero, stale or foreign id. */
+void *sy_rt_pool_get(const sy_rt_pool *p, uint32_t id);
+/* Frees the slot of a valid id (bumps its generation) and returns its object (NULL if invalid). */
+void *sy_rt_pool_remove(sy_rt_pool *p, uint32_t id);
+void sy_rt_pool_free(sy_rt_pool *p);
+
+/* >>objects */
+
+typedef struct sy_rt_mesh_data {
+    RTCScene scene;       /* BLAS holding geom as geometry 0 */
+    RTCGeometry geom;
+    const float *positions;  /* Embree-owned vertex buffer, float3 */
+    const uint32_t *indices; /* Embree-owned index buffer, 3 per triangle */
+    float *normals, *uv[2], *colors; /* own copies or NULL */
+    uint32_t vertex_count, triangle_count;
+    uint32_t refs;        /* 1 for the live handle + 1 per instance */
+    bool filter_on;       /* alpha filter installed on geom */
+    bool want_filter;     /* scratch for sy_rt_commit: some instance needs the filter */
+} sy_rt_mesh_data;
+
+typedef struct sy_rt_material_data {
+    sy_rt_material_desc desc;
+    bool emissive;  /* emissive factor non-zero */
+    bool masked;    /* alpha mode MASK: needs the Embree alpha filter */
+} sy_rt_material_data;
+
+typedef struct sy_rt_instance_data {
+    sy_rt_mesh_data *mesh;     /* holds a reference */
+    sy_rt_material material;   /* resolved at render time */
+    uint32_t flags;
+    float xf[16];              /* object-to-world */
+    float nrm[9];              /* inverse transpose of the upper 3x3, row-major */
+    RTCGeometry geom;          /* instance geometry or baked triangle geometry in the top scene */
+    unsigned top_id;           /* geometry id in the top scene */
+    float *baked_positions;    /* baked: Embree vertex buffer (world space) */
+    bool filter_on;            /* baked: alpha filter installed */
+} sy_rt_instance_data;
+
+typedef struct sy_rt_light_data {
+    sy_rt_light_desc desc;
+} sy_rt_light_data;
+
+/* A committed punctual light, precomputed for shading. */
+typedef struct sy_rt_punctual {
+    sy_rt_light_type type;
+    sy_rt_v3 radiant;   /* color * intensity */
+    sy_rt_v3 position;
+    sy_rt_v3 direction; /* unit, direction of travel */
+    float range;
+    float cone_scale, cone_offset; /* spot: attenuation = clamp(cos*scale + offset)^2 */
+} sy_rt_punctual;
+
+/* One emissive world-space triangle of the area-light list. */
+typedef struct sy_rt_area_tri {
+    sy_rt_v3 p0, e1, e2;        /* world position of vertex 0 and edges to vertices 1, 2 */
+    sy_rt_v3 normal;            /* unit geometric normal, front side (glTF winding) */
+    float area;
+    const sy_rt_instance_data *inst; /* for the emissive texture lookup */
+    uint32_t prim;
+    bool double_sided;
+} sy_rt_area_tri;
+
+struct sy_rt_device {
+    RTCDevice rtc;
+    RTCScene top;
+    uint32_t thread_count;
+
+    /* Embree error callback output; read back by the call that triggered it. */
+    pthread_mutex_t rtc_err_lock;
+    char rtc_msg[256];
+
+    sy_rt_pool meshes, instances, materials, textures, lights;
+
+    /* top-scene geometry id -> instance (for hit lookup); NULL where unused */
+    sy_rt_instance_data **top_map;
+    uint32_t top_map_cap;
+
+    sy_rt_background background_staged, background;
+
+    bool dirty;          /* anything changed since the last commit */
+    bool top_dirty;      /* top scene needs rtcCommitScene */
+    bool area_dirty;     /* area-light list needs a rebuild */
+    bool filters_dirty;  /* alpha filters may need (un)installing */
+    bool punctual_dirty; /* punctual light array needs a rebuild */
+
+    /* committed light data used while rendering */
+    sy_rt_punctual *punctual;
+    uint32_t punctual_count;
+    sy_rt_area_tri *area;
+    float *area_cdf;     /* area_count + 1 entries, cdf[0] = 0, cdf[n] = 1 */
+    uint32_t area_count;
+    float area_power;    /* total emitted power proxy (luminance * area * sides) */
+
+    sy_rt_material_data default_material;
+    float srgb_lut[256]; /* sRGB 8-bit -> linear */
+};
+
+/* >>errors */
+
+/* Writes a printf-style message to err (if non-NULL, err_len > 0) and returns r. */
+sy_rt_result sy_rt_fail(char *err, size_t err_len, sy_rt_result r, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+/* Returns SY_RT_OK, or SY_RT_ERROR_EMBREE with "what: <embree message>" when Embree recorded an
+ * error since the last check. */
+sy_rt_result sy_rt_check_embree(sy_rt_device *dev, char *err, size_t err_len, const char *what);
+
+/* Checked size arithmetic: false on overflow. */
+static inline bool sy_rt_size_mul(size_t a, size_t b, size_t *out)
+{
+    if (a != 0 && b > SIZE_MAX / a) return false;
+    *out = a * b;
+    return true;
+}
+
+/* Lookups used at render time; NULL for invalid handles. */
+static inline const sy_rt_material_data *sy_rt_material_lookup(const sy_rt_device *dev, sy_rt_material m)
+{
+    const sy_rt_material_data *d = (const sy_rt_material_data *)sy_rt_pool_get(&dev->materials, m.id);
+    return d ? d : &dev->default_material;
+}
+
+/* The instance a hit belongs to (instance id for Embree instances, geometry id for baked). */
+static inline const sy_rt_instance_data *sy_rt_hit_instance(const sy_rt_device *dev, unsigned geom_id,
+                                                            unsigned inst_id)
+{
+    unsigned top = inst_id != RTC_INVALID_GEOMETRY_ID ? inst_id : geom_id;
+    return top < dev->top_map_cap ? dev->top_map[top] : NULL;
+}
+
+#endif /* SY_RT_DEVICE_H */

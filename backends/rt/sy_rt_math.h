@@ -1,0 +1,68 @@
+/* sy_rt_math.h — small inline float3 / matrix helpers used inside the ray-tracing back-end.
+ * Header-only; internal to backends/rt (the public API uses plain float arrays). */
+#ifndef SY_RT_MATH_H
+#define SY_RT_MATH_H
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+typedef struct sy_rt_v3 { float x, y, z; } sy_rt_v3;
+
+static inline sy_rt_v3 v3(float x, float y, float z) { sy_rt_v3 r = {x, y, z}; return r; }
+static inline sy_rt_v3 v3_load(const float *p) { return v3(p[0], p[1], p[2]); }
+static inline sy_rt_v3 v3_add(sy_rt_v3 a, sy_rt_v3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline sy_rt_v3 v3_sub(sy_rt_v3 a, sy_rt_v3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline sy_rt_v3 v3_mul(sy_rt_v3 a, sy_rt_v3 b) { return v3(a.x * b.x, a.y * b.y, a.z * b.z); }
+static inline sy_rt_v3 v3_scale(sy_rt_v3 a, float s) { return v3(a.x * s, a.y * s, a.z * s); }
+static inline sy_rt_v3 v3_madd(sy_rt_v3 a, sy_rt_v3 b, float s) { return v3(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s); }
+static inline float v3_dot(sy_rt_v3 a, sy_rt_v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline sy_rt_v3 v3_cross(sy_rt_v3 a, sy_rt_v3 b)
+{
+    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline float v3_length(sy_rt_v3 a) { return sqrtf(v3_dot(a, a)); }
+/* Normalises a; returns (0,0,0) for a zero-length vector. */
+static inline sy_rt_v3 v3_normalize(sy_rt_v3 a)
+{
+    float l2 = v3_dot(a, a);
+    return l2 > 0.0f ? v3_scale(a, 1.0f / sqrtf(l2)) : v3(0.0f, 0.0f, 0.0f);
+}
+static inline float v3_max_abs(sy_rt_v3 a) { return fmaxf(fabsf(a.x), fmaxf(fabsf(a.y), fabsf(a.z))); }
+static inline bool v3_is_zero(sy_rt_v3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
+static inline float v3_luminance(sy_rt_v3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+static inline float sy_rt_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+/* Column-major 4x4 (glTF): point and direction transforms. */
+static inline sy_rt_v3 m4_point(const float *m, sy_rt_v3 p)
+{
+    return v3(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12],
+              m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
+              m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]);
+}
+static inline sy_rt_v3 m4_dir(const float *m, sy_rt_v3 d)
+{
+    return v3(m[0] * d.x + m[4] * d.y + m[8] * d.z,
+              m[1] * d.x + m[5] * d.y + m[9] * d.z,
+              m[2] * d.x + m[6] * d.y + m[10] * d.z);
+}
+/* 3x3 row-major matrix times vector (used for the normal matrix). */
+static inline sy_rt_v3 m3_mul(const float *n, sy_rt_v3 v)
+{
+    return v3(n[0] * v.x + n[1] * v.y + n[2] * v.z,
+              n[3] * v.x + n[4] * v.y + n[5] * v.z,
+              n[6] * v.x + n[7] * v.y + n[8] * v.z);
+}
+
+/* 32-bit integer hash (lowbias32 by Chris Wellons), for per-pixel sample rotations. */
+static inline uint32_t sy_rt_hash32(uint32_t x)
+{
+    x ^= x >> 16; x *= 0x7feb352dU;
+    x ^= x >> 15; x *= 0x846ca68bU;
+    x ^= x >> 16;
+    return x;
+}
+/* Maps 32 random bits to a float in [0, 1). */
+static inline float sy_rt_u01(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+
+#endif /* SY_RT_MATH_H */

@@ -1,0 +1,41 @@
+/* sy_rt_render.h — per-frame render state shared by the integrators and the benchmark: the
+ * validated camera with its primary-ray generator, the output rectangle, and the tile scheduler
+ * (pthreads + atomic tile counter, progress and cancellation). Internal to backends/rt. */
+#ifndef SY_RT_RENDER_H
+#define SY_RT_RENDER_H
+
+#include "sy_rt_device.h"
+
+#define SY_RT_TILE_SIZE 16u
+
+typedef struct sy_rt_frame {
+    const sy_rt_device *dev;
+    sy_rt_projection projection;
+    float window[4];
+    sy_rt_v3 cam_pos, cam_x, cam_y, cam_z; /* camera-to-world columns */
+    sy_rt_v3 forward;                      /* unit viewing axis (-Z in world) */
+    float near_clip, far_clip;
+    uint32_t image_width, image_height;
+    uint32_t x, y, width, height;          /* output rectangle in full-image pixels */
+    sy_rt_integrator integrator;
+    uint32_t max_depth, light_samples, seed;
+    float *rgba, *depth;                   /* output, row 0 = top of the rectangle */
+} sy_rt_frame;
+
+/* Validates camera and desc and fills a frame (output pointers included). */
+sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_rt_camera *cam,
+                              const sy_rt_render_desc *desc, float *rgba, float *depth, char *err, size_t err_len);
+
+/* Camera ray through the centre of full-image pixel (px, py). The direction is not normalised:
+ * `*axial` receives the viewing-axis distance per unit of t (depth = t * axial), and tnear/tfar
+ * implement the near/far clip planes. */
+void sy_rt_frame_ray(const sy_rt_frame *f, uint32_t px, uint32_t py, struct RTCRay *ray, float *axial);
+
+/* Renders one tile: pixels [x0, x1) x [y0, y1) in full-image coordinates. */
+typedef void (*sy_rt_tile_fn)(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1);
+
+/* Runs fn over all tiles of the frame's rectangle on dev->thread_count threads. */
+sy_rt_result sy_rt_run_tiles(const sy_rt_frame *f, sy_rt_tile_fn fn, void *user, sy_rt_progress_fn progress,
+                             void *progress_user, char *err, size_t err_len);
+
+#endif /* SY_RT_RENDER_H */

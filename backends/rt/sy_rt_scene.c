@@ -1,0 +1,712 @@
+/* sy_rt_scene.c — meshes (one Embree BLAS each), instances (Embree instances or baked world-space
+ * geometry in the top-level scene), materials, punctual lights, and sy_rt_commit, which publishes
+ * staged changes: alpha filters, top-level BVH, area-light list and punctual-light array. */
+#include "sy_rt_scene.h"
+#include "sy_rt_surface.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define FAIL(r, ...) sy_rt_fail(err, err_len, (r), __VA_ARGS__)
+
+/* >>mesh */
+
+static void mesh_free(sy_rt_mesh_data *m)
+{
+    if (!m) return;
+    if (m->geom) rtcReleaseGeometry(m->geom);
+    if (m->scene) rtcReleaseScene(m->scene);
+    free(m->normals);
+    free(m->uv[0]);
+    free(m->uv[1]);
+    free(m->colors);
+    free(m);
+}
+
+static void mesh_unref(sy_rt_mesh_data *m)
+{
+    if (m && --m->refs == 0) mesh_free(m);
+}
+
+/* Copies n floats, rejecting non-finite values. */
+static sy_rt_result copy_finite(const float *src, size_t n, float **dst, const char *what, char *err, size_t err_len)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(src[i]))
+            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: %s[%zu] = %g is not finite", what, i, (double)src[i]);
+    size_t bytes;
+    if (!sy_rt_size_mul(n, sizeof(float), &bytes)) return FAIL(SY_RT_ERROR_LIMIT, "mesh: %s too large", what);
+    *dst = malloc(bytes ? bytes : 1);
+    if (!*dst) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: cannot allocate %s (%zu bytes)", what, bytes);
+    memcpy(*dst, src, bytes);
+    return SY_RT_OK;
+}
+
+/* All structural checks of a mesh desc, before anything is allocated. */
+static sy_rt_result validate_mesh_desc(const sy_rt_mesh_desc *d, char *err, size_t err_len)
+{
+    if (!d->positions) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: positions is NULL");
+    if (d->vertex_count == 0 || d->triangle_count == 0)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: empty (vertex_count %u, triangle_count %u)",
+                    d->vertex_count, d->triangle_count);
+    if (d->triangle_count > UINT32_MAX / 3u)
+        return FAIL(SY_RT_ERROR_LIMIT, "mesh: triangle_count %u exceeds %u", d->triangle_count, UINT32_MAX / 3u);
+    size_t corners = (size_t)d->triangle_count * 3u;
+    if (!d->indices && d->vertex_count != corners)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT,
+                    "mesh: non-indexed mesh needs vertex_count == 3 * triangle_count (%u != %zu)",
+                    d->vertex_count, corners);
+    if (d->indices)
+        for (size_t i = 0; i < corners; ++i)
+            if (d->indices[i] >= d->vertex_count)
+                return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: indices[%zu] = %u is not < vertex_count %u",
+                            i, d->indices[i], d->vertex_count);
+    size_t n3 = (size_t)d->vertex_count * 3u;
+    for (size_t i = 0; i < n3; ++i)
+        if (!isfinite(d->positions[i]))
+            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: positions[%zu] (vertex %zu) = %g is not finite",
+                        i, i / 3u, (double)d->positions[i]);
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *d, sy_rt_mesh *out, char *err, size_t err_len)
+{
+    if (!dev || !d || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: NULL argument");
+    out->id = 0;
+    sy_rt_result r = validate_mesh_desc(d, err, err_len);
+    if (r != SY_RT_OK) return r;
+
+    sy_rt_mesh_data *m = calloc(1, sizeof *m);
+    if (!m) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
+    m->refs = 1;
+    m->vertex_count = d->vertex_count;
+    m->triangle_count = d->triangle_count;
+    size_t vc = d->vertex_count;
+    if (d->normals && (r = copy_finite(d->normals, vc * 3u, &m->normals, "normals", err, err_len)) != SY_RT_OK) goto fail;
+    if (d->uv[0] && (r = copy_finite(d->uv[0], vc * 2u, &m->uv[0], "uv[0]", err, err_len)) != SY_RT_OK) goto fail;
+    if (d->uv[1] && (r = copy_finite(d->uv[1], vc * 2u, &m->uv[1], "uv[1]", err, err_len)) != SY_RT_OK) goto fail;
+    if (d->colors && (r = copy_finite(d->colors, vc * 4u, &m->colors, "colors", err, err_len)) != SY_RT_OK) goto fail;
+
+    m->geom = rtcNewGeometry(dev->rtc, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!m->geom) { r = sy_rt_check_embree(dev, err, err_len, "mesh: rtcNewGeometry"); goto fail; }
+    /* rtcSetNewGeometryBuffer pads vertex buffers as Embree's SIMD loads require. */
+    float *pos = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                         3 * sizeof(float), d->vertex_count);
+    uint32_t *idx = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                            3 * sizeof(uint32_t), d->triangle_count);
+    if (!pos || !idx) {
+        r = sy_rt_check_embree(dev, err, err_len, "mesh: allocating Embree buffers");
+        if (r == SY_RT_OK) r = FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: allocating Embree buffers failed");
+        goto fail;
+    }
+    memcpy(pos, d->positions, vc * 3u * sizeof(float));
+    size_t corners = (size_t)d->triangle_count * 3u;
+    if (d->indices) memcpy(idx, d->indices, corners * sizeof(uint32_t));
+    else for (size_t i = 0; i < corners; ++i) idx[i] = (uint32_t)i;
+    m->positions = pos;
+    m->indices = idx;
+    rtcSetGeometryUserData(m->geom, dev);
+    rtcCommitGeometry(m->geom);
+    m->scene = rtcNewScene(dev->rtc);
+    if (m->scene) {
+        rtcSetSceneBuildQuality(m->scene, RTC_BUILD_QUALITY_HIGH);
+        rtcAttachGeometryByID(m->scene, m->geom, 0);
+        rtcCommitScene(m->scene);
+    }
+    if ((r = sy_rt_check_embree(dev, err, err_len, "mesh: building BLAS")) != SY_RT_OK) goto fail;
+    if (!m->scene) { r = FAIL(SY_RT_ERROR_EMBREE, "mesh: rtcNewScene failed"); goto fail; }
+    if (!sy_rt_pool_insert(&dev->meshes, m, &out->id)) { r = FAIL(SY_RT_ERROR_LIMIT, "mesh: pool full or out of memory"); goto fail; }
+    dev->dirty = true;
+    return SY_RT_OK;
+fail:
+    mesh_free(m);
+    return r;
+}
+
+sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh, char *err, size_t err_len)
+{
+    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh destroy: NULL device");
+    sy_rt_mesh_data *m = sy_rt_pool_remove(&dev->meshes, mesh.id);
+    if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "mesh destroy: stale handle 0x%08x", mesh.id);
+    mesh_unref(m); /* instances keep it alive until they go */
+    dev->dirty = true;
+    return SY_RT_OK;
+}
+
+/* >>material */
+
+void sy_rt_material_desc_init(sy_rt_material_desc *d)
+{
+    memset(d, 0, sizeof *d);
+    d->base_color[0] = d->base_color[1] = d->base_color[2] = d->base_color[3] = 1.0f;
+    d->metallic = 1.0f;
+    d->roughness = 1.0f;
+    d->normal_scale = 1.0f;
+    d->specular = 1.0f;
+    d->ior = 1.5f;
+    d->alpha_mode = SY_RT_ALPHA_OPAQUE;
+    d->alpha_cutoff = 0.5f;
+}
+
+static sy_rt_result validate_texref(const sy_rt_device *dev, sy_rt_texture_ref t, const char *name, char *err, size_t err_len)
+{
+    if (t.texture.id != 0 && !sy_rt_pool_get(&dev->textures, t.texture.id))
+        return FAIL(SY_RT_ERROR_INVALID_HANDLE, "material: %s handle 0x%08x is stale", name, t.texture.id);
+    if (t.texcoord > 1) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material: %s.texcoord = %u, expected 0 or 1", name, t.texcoord);
+    return SY_RT_OK;
+}
+
+static sy_rt_result validate_material(const sy_rt_device *dev, const sy_rt_material_desc *d, char *err, size_t err_len)
+{
+    const struct { const char *name; float v, lo, hi; } ranges[] = {
+        {"base_color[0]", d->base_color[0], 0.0f, INFINITY}, {"base_color[1]", d->base_color[1], 0.0f, INFINITY},
+        {"base_color[2]", d->base_color[2], 0.0f, INFINITY}, {"base_color[3]", d->base_color[3], 0.0f, 1.0f},
+        {"metallic", d->metallic, 0.0f, 1.0f}, {"roughness", d->roughness, 0.0f, 1.0f},
+        {"emissive[0]", d->emissive[0], 0.0f, INFINITY}, {"emissive[1]", d->emissive[1], 0.0f, INFINITY},
+        {"emissive[2]", d->emissive[2], 0.0f, INFINITY}, {"normal_scale", d->normal_scale, -INFINITY, INFINITY},
+        {"specular", d->specular, 0.0f, 1.0f}, {"transmission", d->transmission, 0.0f, 1.0f},
+        {"ior", d->ior, 1.0f, INFINITY}, {"alpha_cutoff", d->alpha_cutoff, 0.0f, 1.0f},
+    };
+    for (size_t i = 0; i < sizeof ranges / sizeof ranges[0]; ++i)
+        if (!isfinite(ranges[i].v) || ranges[i].v < ranges[i].lo || ranges[i].v > ranges[i].hi)
+            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material: %s = %g is outside [%g, %g]", ranges[i].name,
+                        (double)ranges[i].v, (double)ranges[i].lo, (double)ranges[i].hi);
+    if ((unsigned)d->alpha_mode > SY_RT_ALPHA_BLEND)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material: unknown alpha_mode %d", (int)d->alpha_mode);
+    sy_rt_result r;
+    if ((r = validate_texref(dev, d->base_color_texture, "base_color_texture", err, err_len)) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->metallic_roughness_texture, "metallic_roughness_texture", err, err_len)) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->emissive_texture, "emissive_texture", err, err_len)) != SY_RT_OK) return r;
+    return validate_texref(dev, d->normal_texture, "normal_texture", err, err_len);
+}
+
+static void material_set(sy_rt_material_data *m, const sy_rt_material_desc *d)
+{
+    m->desc = *d;
+    m->emissive = d->emissive[0] > 0.0f || d->emissive[1] > 0.0f || d->emissive[2] > 0.0f;
+    m->masked = d->alpha_mode == SY_RT_ALPHA_MASK;
+}
+
+sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc *d, sy_rt_material *out, char *err, size_t err_len)
+{
+    if (!dev || !d || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material: NULL argument");
+    out->id = 0;
+    sy_rt_result r = validate_material(dev, d, err, err_len);
+    if (r != SY_RT_OK) return r;
+    sy_rt_material_data *m = calloc(1, sizeof *m);
+    if (!m) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "material: out of memory");
+    material_set(m, d);
+    if (!sy_rt_pool_insert(&dev->materials, m, &out->id)) {
+        free(m);
+        return FAIL(SY_RT_ERROR_LIMIT, "material: pool full or out of memory");
+    }
+    dev->dirty = true;
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_material_update(sy_rt_device *dev, sy_rt_material mat, const sy_rt_material_desc *d, char *err, size_t err_len)
+{
+    if (!dev || !d) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material update: NULL argument");
+    sy_rt_material_data *m = sy_rt_pool_get(&dev->materials, mat.id);
+    if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "material update: stale handle 0x%08x", mat.id);
+    sy_rt_result r = validate_material(dev, d, err, err_len);
+    if (r != SY_RT_OK) return r;
+    bool was_emissive = m->emissive, was_masked = m->masked;
+    bool emission_changed = memcmp(m->desc.emissive, d->emissive, sizeof d->emissive) != 0 ||
+                            m->desc.double_sided != d->double_sided;
+    material_set(m, d);
+    if (was_emissive != m->emissive || (m->emissive && emission_changed)) dev->area_dirty = true;
+    if (was_masked != m->masked) dev->filters_dirty = true;
+    dev->dirty = true;
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat, char *err, size_t err_len)
+{
+    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material destroy: NULL device");
+    sy_rt_material_data *m = sy_rt_pool_remove(&dev->materials, mat.id);
+    if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "material destroy: stale handle 0x%08x", mat.id);
+    /* Instances using it fall back to the default material, which is neither emissive nor masked. */
+    if (m->emissive) dev->area_dirty = true;
+    if (m->masked) dev->filters_dirty = true;
+    free(m);
+    dev->dirty = true;
+    return SY_RT_OK;
+}
+
+/* >>instance */
+
+/* Checks that xf is finite and invertible and computes the normal matrix (inverse transpose of
+ * the upper 3x3, row-major). */
+static sy_rt_result normal_matrix(const float *xf, float nrm[9], char *err, size_t err_len)
+{
+    for (int i = 0; i < 16; ++i)
+        if (!isfinite(xf[i])) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance: transform[%d] = %g is not finite", i, (double)xf[i]);
+    double a[3][3];
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) a[r][c] = xf[c * 4 + r];
+    double C[3][3] = {
+        {a[1][1] * a[2][2] - a[1][2] * a[2][1], -(a[1][0] * a[2][2] - a[1][2] * a[2][0]), a[1][0] * a[2][1] - a[1][1] * a[2][0]},
+        {-(a[0][1] * a[2][2] - a[0][2] * a[2][1]), a[0][0] * a[2][2] - a[0][2] * a[2][0], -(a[0][0] * a[2][1] - a[0][1] * a[2][0])},
+        {a[0][1] * a[1][2] - a[0][2] * a[1][1], -(a[0][0] * a[1][2] - a[0][2] * a[1][0]), a[0][0] * a[1][1] - a[0][1] * a[1][0]},
+    };
+    double det = a[0][0] * C[0][0] + a[0][1] * C[0][1] + a[0][2] * C[0][2];
+    double scale = 0.0;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) scale = fmax(scale, fabs(a[r][c]));
+    if (!(fabs(det) > 1e-30 * scale * scale * scale) || scale == 0.0)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance: transform is singular (det %g)", det);
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) nrm[r * 3 + c] = (float)(C[r][c] / det);
+    return SY_RT_OK;
+}
+
+static bool instance_emissive(const sy_rt_device *dev, const sy_rt_instance_data *in)
+{
+    return !(in->flags & SY_RT_INSTANCE_HIDDEN) && sy_rt_material_lookup(dev, in->material)->emissive;
+}
+
+static bool instance_masked(const sy_rt_device *dev, const sy_rt_instance_data *in)
+{
+    return sy_rt_material_lookup(dev, in->material)->masked;
+}
+
+/* Writes the world-space positions of a baked instance. */
+static void bake_positions(sy_rt_instance_data *in)
+{
+    const sy_rt_mesh_data *m = in->mesh;
+    for (uint32_t i = 0; i < m->vertex_count; ++i) {
+        sy_rt_v3 p = m4_point(in->xf, v3_load(m->positions + 3u * i));
+        in->baked_positions[3u * i + 0] = p.x;
+        in->baked_positions[3u * i + 1] = p.y;
+        in->baked_positions[3u * i + 2] = p.z;
+    }
+}
+
+static bool top_map_set(sy_rt_device *dev, unsigned id, sy_rt_instance_data *in)
+{
+    if (id >= dev->top_map_cap) {
+        uint32_t ncap = dev->top_map_cap ? dev->top_map_cap : 64u;
+        while (ncap <= id) {
+            if (ncap > UINT32_MAX / 2u) return false;
+            ncap *= 2u;
+        }
+        sy_rt_instance_data **map = realloc(dev->top_map, (size_t)ncap * sizeof *map);
+        if (!map) return false;
+        memset(map + dev->top_map_cap, 0, (size_t)(ncap - dev->top_map_cap) * sizeof *map);
+        dev->top_map = map;
+        dev->top_map_cap = ncap;
+    }
+    dev->top_map[id] = in;
+    return true;
+}
+
+static void instance_free(sy_rt_device *dev, sy_rt_instance_data *in)
+{
+    if (in->geom) {
+        if (in->top_id != RTC_INVALID_GEOMETRY_ID) {
+            rtcDetachGeometry(dev->top, in->top_id);
+            if (in->top_id < dev->top_map_cap) dev->top_map[in->top_id] = NULL;
+        }
+        rtcReleaseGeometry(in->geom);
+    }
+    mesh_unref(in->mesh);
+    free(in);
+}
+
+sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc *d, sy_rt_instance *out, char *err, size_t err_len)
+{
+    if (!dev || !d || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance: NULL argument");
+    out->id = 0;
+    sy_rt_mesh_data *mesh = sy_rt_pool_get(&dev->meshes, d->mesh.id);
+    if (!mesh) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance: mesh handle 0x%08x is stale", d->mesh.id);
+    if (d->material.id != 0 && !sy_rt_pool_get(&dev->materials, d->material.id))
+        return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance: material handle 0x%08x is stale", d->material.id);
+    if (d->flags & ~(uint32_t)(SY_RT_INSTANCE_BAKED | SY_RT_INSTANCE_HIDDEN))
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance: unknown flags 0x%x", d->flags);
+    float nrm[9];
+    sy_rt_result r = normal_matrix(d->transform, nrm, err, err_len);
+    if (r != SY_RT_OK) return r;
+
+    sy_rt_instance_data *in = calloc(1, sizeof *in);
+    if (!in) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance: out of memory");
+    in->mesh = mesh;
+    mesh->refs++;
+    in->material = d->material;
+    in->flags = d->flags;
+    in->top_id = RTC_INVALID_GEOMETRY_ID;
+    memcpy(in->xf, d->transform, sizeof in->xf);
+    memcpy(in->nrm, nrm, sizeof in->nrm);
+
+    if (d->flags & SY_RT_INSTANCE_BAKED) {
+        in->geom = rtcNewGeometry(dev->rtc, RTC_GEOMETRY_TYPE_TRIANGLE);
+        if (in->geom) {
+            in->baked_positions = rtcSetNewGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), mesh->vertex_count);
+            /* The index buffer is shared with the mesh, which this instance keeps alive. */
+            rtcSetSharedGeometryBuffer(in->geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh->indices, 0,
+                                       3 * sizeof(uint32_t), mesh->triangle_count);
+            if (in->baked_positions) bake_positions(in);
+            rtcSetGeometryUserData(in->geom, dev);
+        }
+    } else {
+        in->geom = rtcNewGeometry(dev->rtc, RTC_GEOMETRY_TYPE_INSTANCE);
+        if (in->geom) {
+            rtcSetGeometryInstancedScene(in->geom, mesh->scene);
+            rtcSetGeometryTransform(in->geom, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, in->xf);
+        }
+    }
+    if (in->geom) {
+        if (d->flags & SY_RT_INSTANCE_HIDDEN) rtcDisableGeometry(in->geom);
+        rtcCommitGeometry(in->geom);
+        in->top_id = rtcAttachGeometry(dev->top, in->geom);
+    }
+    if ((r = sy_rt_check_embree(dev, err, err_len, "instance: creating geometry")) != SY_RT_OK) goto fail;
+    if (!in->geom || ((d->flags & SY_RT_INSTANCE_BAKED) && !in->baked_positions) || in->top_id == RTC_INVALID_GEOMETRY_ID) {
+        r = FAIL(SY_RT_ERROR_EMBREE, "instance: Embree geometry creation failed");
+        goto fail;
+    }
+    if (!top_map_set(dev, in->top_id, in)) { r = FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance: out of memory"); goto fail; }
+    if (!sy_rt_pool_insert(&dev->instances, in, &out->id)) { r = FAIL(SY_RT_ERROR_LIMIT, "instance: pool full or out of memory"); goto fail; }
+    if (instance_emissive(dev, in)) dev->area_dirty = true;
+    if (instance_masked(dev, in)) dev->filters_dirty = true;
+    dev->dirty = dev->top_dirty = true;
+    return SY_RT_OK;
+fail:
+    instance_free(dev, in);
+    dev->dirty = dev->top_dirty = true;
+    return r;
+}
+
+sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst, const float transform[16], char *err, size_t err_len)
+{
+    if (!dev || !transform) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_transform: NULL argument");
+    sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
+    if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_transform: stale handle 0x%08x", inst.id);
+    float nrm[9];
+    sy_rt_result r = normal_matrix(transform, nrm, err, err_len);
+    if (r != SY_RT_OK) return r;
+    memcpy(in->xf, transform, sizeof in->xf);
+    memcpy(in->nrm, nrm, sizeof in->nrm);
+    if (in->flags & SY_RT_INSTANCE_BAKED) {
+        bake_positions(in);
+        rtcUpdateGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    } else {
+        rtcSetGeometryTransform(in->geom, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, in->xf);
+    }
+    rtcCommitGeometry(in->geom);
+    if (instance_emissive(dev, in)) dev->area_dirty = true;
+    dev->dirty = dev->top_dirty = true;
+    return sy_rt_check_embree(dev, err, err_len, "instance set_transform");
+}
+
+sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst, sy_rt_material material, char *err, size_t err_len)
+{
+    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_material: NULL device");
+    sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
+    if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_material: stale handle 0x%08x", inst.id);
+    if (material.id != 0 && !sy_rt_pool_get(&dev->materials, material.id))
+        return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_material: material handle 0x%08x is stale", material.id);
+    bool was_emissive = instance_emissive(dev, in), was_masked = instance_masked(dev, in);
+    in->material = material;
+    if (was_emissive || instance_emissive(dev, in)) dev->area_dirty = true;
+    if (was_masked != instance_masked(dev, in)) dev->filters_dirty = true;
+    dev->dirty = true;
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, bool visible, char *err, size_t err_len)
+{
+    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_visible: NULL device");
+    sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
+    if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_visible: stale handle 0x%08x", inst.id);
+    bool is_visible = !(in->flags & SY_RT_INSTANCE_HIDDEN);
+    if (is_visible == visible) return SY_RT_OK;
+    if (visible) {
+        in->flags &= ~(uint32_t)SY_RT_INSTANCE_HIDDEN;
+        rtcEnableGeometry(in->geom);
+    } else {
+        in->flags |= SY_RT_INSTANCE_HIDDEN;
+        rtcDisableGeometry(in->geom);
+    }
+    if (sy_rt_material_lookup(dev, in->material)->emissive) dev->area_dirty = true;
+    if (instance_masked(dev, in)) dev->filters_dirty = true;
+    dev->dirty = dev->top_dirty = true;
+    return sy_rt_check_embree(dev, err, err_len, "instance set_visible");
+}
+
+sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst, char *err, size_t err_len)
+{
+    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance destroy: NULL device");
+    sy_rt_instance_data *in = sy_rt_pool_remove(&dev->instances, inst.id);
+    if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance destroy: stale handle 0x%08x", inst.id);
+    if (instance_emissive(dev, in)) dev->area_dirty = true;
+    if (instance_masked(dev, in)) dev->filters_dirty = true;
+    instance_free(dev, in);
+    dev->dirty = dev->top_dirty = true;
+    return sy_rt_check_embree(dev, err, err_len, "instance destroy");
+}
+
+/* >>light */
+
+static sy_rt_result validate_light(const sy_rt_light_desc *d, char *err, size_t err_len)
+{
+    if (d->type != SY_RT_LIGHT_POINT && d->type != SY_RT_LIGHT_SPOT && d->type != SY_RT_LIGHT_DIRECTIONAL)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: unknown type %d", (int)d->type);
+    const float *vals[] = {d->color, d->position, d->direction};
+    const char *names[] = {"color", "position", "direction"};
+    for (int a = 0; a < 3; ++a)
+        for (int k = 0; k < 3; ++k)
+            if (!isfinite(vals[a][k]))
+                return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: %s[%d] is not finite", names[a], k);
+    for (int k = 0; k < 3; ++k)
+        if (d->color[k] < 0.0f) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: color[%d] is negative", k);
+    if (!isfinite(d->intensity) || d->intensity < 0.0f)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: intensity %g is not a finite non-negative value", (double)d->intensity);
+    if (!isfinite(d->range) || d->range < 0.0f)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: range %g is not finite and >= 0", (double)d->range);
+    if (d->type != SY_RT_LIGHT_POINT && v3_is_zero(v3_load(d->direction)))
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: direction is zero");
+    if (d->type == SY_RT_LIGHT_SPOT &&
+        !(d->inner_cone_angle >= 0.0f && d->inner_cone_angle <= d->outer_cone_angle && d->outer_cone_angle <= 1.5707964f))
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: spot cone angles need 0 <= inner (%g) <= outer (%g) <= pi/2",
+                    (double)d->inner_cone_angle, (double)d->outer_cone_angle);
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_light_create(sy_rt_device *dev, const sy_rt_light_desc *d, sy_rt_light *out, char *err, size_t err_len)
+{
+    if (!dev || !d || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: NULL argument");
+    out->id = 0;
+    sy_rt_result r = validate_light(d, err, err_len);
+    if (r != SY_RT_OK) return r;
+    sy_rt_light_data *l = calloc(1, sizeof *l);
+    if (!l) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "light: out of memory");
+    l->desc = *d;
+    if (!sy_rt_pool_insert(&dev->lights, l, &out->id)) {
+        free(l);
+        return FAIL(SY_RT_ERROR_LIMIT, "light: pool full or out of memory");
+    }
+    dev->dirty = dev->punctual_dirty = true;
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_light_update(sy_rt_device *dev, sy_rt_light light, const sy_rt_light_desc *d, char *err, size_t err_len)
+{
+    if (!dev || !d) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light update: NULL argument");
+    sy_rt_light_data *l = sy_rt_pool_get(&dev->lights, light.id);
+    if (!l) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "light update: stale handle 0x%08x", light.id);
+    sy_rt_result r = validate_light(d, err, err_len);
+    if (r != SY_RT_OK) return r;
+    l->desc = *d;
+    dev->dirty = dev->punctual_dirty = true;
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light, char *err, size_t err_len)
+{
+    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light destroy: NULL device");
+    sy_rt_light_data *l = sy_rt_pool_remove(&dev->lights, light.id);
+    if (!l) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "light destroy: stale handle 0x%08x", light.id);
+    free(l);
+    dev->dirty = dev->punctual_dirty = true;
+    return SY_RT_OK;
+}
+
+/* >>commit */
+
+static void set_filter(RTCGeometry g, bool on)
+{
+    rtcSetGeometryIntersectFilterFunction(g, on ? sy_rt_alpha_filter : NULL);
+    rtcSetGeometryOccludedFilterFunction(g, on ? sy_rt_alpha_filter : NULL);
+    rtcCommitGeometry(g);
+}
+
+/* Installs the alpha-mask filter exactly where a visible masked material needs it, so opaque
+ * geometry never pays for a filter call. A mesh's BLAS is shared by its instances, so it gets the
+ * filter when any of its instances is masked (the filter then checks the hit's instance). */
+static void update_filters(sy_rt_device *dev)
+{
+    for (uint32_t i = 0; i < dev->meshes.count; ++i)
+        if (dev->meshes.items[i]) ((sy_rt_mesh_data *)dev->meshes.items[i])->want_filter = false;
+    /* Meshes whose handle was destroyed but that instances still hold are reached via instances. */
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        sy_rt_instance_data *in = dev->instances.items[i];
+        if (in) in->mesh->want_filter = false;
+    }
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        sy_rt_instance_data *in = dev->instances.items[i];
+        if (!in) continue;
+        bool want = instance_masked(dev, in);
+        if (in->flags & SY_RT_INSTANCE_BAKED) {
+            if (want != in->filter_on) {
+                set_filter(in->geom, want);
+                in->filter_on = want;
+                dev->top_dirty = true;
+            }
+        } else if (want) {
+            in->mesh->want_filter = true;
+        }
+    }
+    for (uint32_t pass = 0; pass < 2; ++pass) {
+        const sy_rt_pool *pool = pass == 0 ? &dev->meshes : &dev->instances;
+        for (uint32_t i = 0; i < pool->count; ++i) {
+            if (!pool->items[i]) continue;
+            sy_rt_mesh_data *m = pass == 0 ? pool->items[i] : ((sy_rt_instance_data *)pool->items[i])->mesh;
+            if (m->want_filter == m->filter_on) continue;
+            set_filter(m->geom, m->want_filter);
+            rtcCommitScene(m->scene);
+            m->filter_on = m->want_filter;
+            dev->top_dirty = true;
+        }
+    }
+}
+
+static sy_rt_result rebuild_area_lights(sy_rt_device *dev, char *err, size_t err_len)
+{
+    size_t n = 0;
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        const sy_rt_instance_data *in = dev->instances.items[i];
+        if (in && instance_emissive(dev, in)) n += in->mesh->triangle_count;
+    }
+    free(dev->area);
+    free(dev->area_cdf);
+    dev->area = NULL;
+    dev->area_cdf = NULL;
+    dev->area_count = 0;
+    dev->area_power = 0.0f;
+    if (n == 0) return SY_RT_OK;
+    if (n > UINT32_MAX - 1u) return FAIL(SY_RT_ERROR_LIMIT, "commit: %zu emissive triangles exceed the limit", n);
+    dev->area = malloc(n * sizeof *dev->area);
+    double *cdf = malloc((n + 1u) * sizeof *cdf);
+    dev->area_cdf = malloc((n + 1u) * sizeof *dev->area_cdf);
+    if (!dev->area || !cdf || !dev->area_cdf) {
+        free(cdf);
+        free(dev->area);
+        free(dev->area_cdf);
+        dev->area = NULL;
+        dev->area_cdf = NULL;
+        return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "commit: cannot allocate the area-light list (%zu triangles)", n);
+    }
+    uint32_t count = 0;
+    cdf[0] = 0.0;
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        const sy_rt_instance_data *in = dev->instances.items[i];
+        if (!in || !instance_emissive(dev, in)) continue;
+        const sy_rt_material_data *mat = sy_rt_material_lookup(dev, in->material);
+        float lum = v3_luminance(v3_load(mat->desc.emissive));
+        if (!(lum > 0.0f)) lum = fmaxf(mat->desc.emissive[0], fmaxf(mat->desc.emissive[1], mat->desc.emissive[2]));
+        const sy_rt_mesh_data *m = in->mesh;
+        for (uint32_t t = 0; t < m->triangle_count; ++t) {
+            const uint32_t *ix = m->indices + 3u * t;
+            sy_rt_v3 o0 = v3_load(m->positions + 3u * ix[0]), o1 = v3_load(m->positions + 3u * ix[1]),
+                     o2 = v3_load(m->positions + 3u * ix[2]);
+            sy_rt_v3 p0 = m4_point(in->xf, o0), p1 = m4_point(in->xf, o1), p2 = m4_point(in->xf, o2);
+            sy_rt_area_tri *a = &dev->area[count];
+            a->p0 = p0;
+            a->e1 = v3_sub(p1, p0);
+            a->e2 = v3_sub(p2, p0);
+            a->area = 0.5f * v3_length(v3_cross(a->e1, a->e2));
+            /* glTF front side: object-space winding normal through the normal matrix. */
+            a->normal = v3_normalize(m3_mul(in->nrm, v3_cross(v3_sub(o1, o0), v3_sub(o2, o0))));
+            if (!(a->area > 0.0f) || v3_is_zero(a->normal)) continue; /* degenerate: emits nothing */
+            a->inst = in;
+            a->prim = t;
+            a->double_sided = mat->desc.double_sided;
+            cdf[count + 1] = cdf[count] + (double)lum * a->area * (a->double_sided ? 2.0 : 1.0);
+            count++;
+        }
+    }
+    double total = cdf[count];
+    if (count == 0 || !(total > 0.0)) {
+        free(cdf);
+        free(dev->area);
+        free(dev->area_cdf);
+        dev->area = NULL;
+        dev->area_cdf = NULL;
+        return SY_RT_OK;
+    }
+    for (uint32_t i = 0; i <= count; ++i) dev->area_cdf[i] = (float)(cdf[i] / total);
+    dev->area_cdf[count] = 1.0f;
+    free(cdf);
+    dev->area_count = count;
+    dev->area_power = (float)total;
+    return SY_RT_OK;
+}
+
+static sy_rt_result rebuild_punctual(sy_rt_device *dev, char *err, size_t err_len)
+{
+    free(dev->punctual);
+    dev->punctual = NULL;
+    dev->punctual_count = 0;
+    uint32_t n = dev->lights.live;
+    if (n == 0) return SY_RT_OK;
+    dev->punctual = malloc((size_t)n * sizeof *dev->punctual);
+    if (!dev->punctual) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "commit: cannot allocate %u lights", n);
+    for (uint32_t i = 0; i < dev->lights.count; ++i) {
+        const sy_rt_light_data *l = dev->lights.items[i];
+        if (!l) continue;
+        const sy_rt_light_desc *d = &l->desc;
+        sy_rt_punctual *p = &dev->punctual[dev->punctual_count++];
+        p->type = d->type;
+        p->radiant = v3_scale(v3_load(d->color), d->intensity);
+        p->position = v3_load(d->position);
+        p->direction = v3_normalize(v3_load(d->direction));
+        p->range = d->range;
+        /* KHR_lights_punctual reference falloff between the outer and inner cone. */
+        float cos_outer = cosf(d->outer_cone_angle), cos_inner = cosf(d->inner_cone_angle);
+        p->cone_scale = 1.0f / fmaxf(0.001f, cos_inner - cos_outer);
+        p->cone_offset = -cos_outer * p->cone_scale;
+    }
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len)
+{
+    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "commit: NULL device");
+    if (!dev->dirty) return SY_RT_OK;
+    sy_rt_result r;
+    if (dev->filters_dirty) {
+        update_filters(dev);
+        if ((r = sy_rt_check_embree(dev, err, err_len, "commit: alpha filters")) != SY_RT_OK) return r;
+        dev->filters_dirty = false;
+    }
+    if (dev->top_dirty) {
+        rtcCommitScene(dev->top);
+        if ((r = sy_rt_check_embree(dev, err, err_len, "commit: top-level scene")) != SY_RT_OK) return r;
+        dev->top_dirty = false;
+    }
+    if (dev->area_dirty) {
+        if ((r = rebuild_area_lights(dev, err, err_len)) != SY_RT_OK) return r;
+        dev->area_dirty = false;
+    }
+    if (dev->punctual_dirty) {
+        if ((r = rebuild_punctual(dev, err, err_len)) != SY_RT_OK) return r;
+        dev->punctual_dirty = false;
+    }
+    dev->background = dev->background_staged;
+    dev->dirty = false;
+    return SY_RT_OK;
+}
+
+void sy_rt_scene_release_all(sy_rt_device *dev)
+{
+    for (uint32_t i = 0; i < dev->instances.count; ++i)
+        if (dev->instances.items[i]) instance_free(dev, dev->instances.items[i]);
+    for (uint32_t i = 0; i < dev->meshes.count; ++i)
+        if (dev->meshes.items[i]) mesh_unref(dev->meshes.items[i]);
+    for (uint32_t i = 0; i < dev->materials.count; ++i) free(dev->materials.items[i]);
+    for (uint32_t i = 0; i < dev->lights.count; ++i) free(dev->lights.items[i]);
+    sy_rt_pool_free(&dev->instances);
+    sy_rt_pool_free(&dev->meshes);
+    sy_rt_pool_free(&dev->materials);
+    sy_rt_pool_free(&dev->lights);
+    free(dev->top_map);
+    free(dev->punctual);
+    free(dev->area);
+    free(dev->area_cdf);
+    dev->top_map = NULL;
+    dev->punctual = NULL;
+    dev->area = NULL;
+    dev->area_cdf = NULL;
+}

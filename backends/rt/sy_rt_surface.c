@@ -1,0 +1,158 @@
+/* sy_rt_surface.c — hit-point evaluation shared by every integrator: attribute interpolation
+ * from the mesh's own arrays, normal transforms (the instance's inverse transpose), tangent frames
+ * from uv derivatives for normal maps, texture lookups, and the alpha-mask filter. */
+#include "sy_rt_surface.h"
+#include "sy_rt_texture.h"
+
+/* Barycentric interpolation of an attribute with `n` floats per vertex. */
+static void interp(const float *a, uint32_t n, const uint32_t *ix, float w0, float w1, float w2, float *out)
+{
+    for (uint32_t k = 0; k < n; ++k)
+        out[k] = a[n * ix[0] + k] * w0 + a[n * ix[1] + k] * w1 + a[n * ix[2] + k] * w2;
+}
+
+/* Texture coordinates of both sets (zeros for an absent set). */
+static void fetch_uv(const sy_rt_mesh_data *m, const uint32_t *ix, float w0, float w1, float w2, float uv[2][2])
+{
+    for (int s = 0; s < 2; ++s) {
+        if (m->uv[s]) interp(m->uv[s], 2, ix, w0, w1, w2, uv[s]);
+        else uv[s][0] = uv[s][1] = 0.0f;
+    }
+}
+
+static float base_alpha(const sy_rt_device *dev, const sy_rt_material_data *mat, const sy_rt_mesh_data *m,
+                        const uint32_t *ix, float w0, float w1, float w2, float uv[2][2], sy_rt_v3 *rgb)
+{
+    const sy_rt_material_desc *d = &mat->desc;
+    float c[4] = {d->base_color[0], d->base_color[1], d->base_color[2], d->base_color[3]};
+    float t[4];
+    if (sy_rt_texture_sample_ref(dev, d->base_color_texture.texture, uv[d->base_color_texture.texcoord][0],
+                                 uv[d->base_color_texture.texcoord][1], t))
+        for (int k = 0; k < 4; ++k) c[k] *= t[k];
+    if (m->colors) {
+        float vc[4];
+        interp(m->colors, 4, ix, w0, w1, w2, vc);
+        for (int k = 0; k < 4; ++k) c[k] *= vc[k];
+    }
+    if (rgb) *rgb = v3(c[0], c[1], c[2]);
+    return c[3];
+}
+
+float sy_rt_surface_alpha(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u, float v)
+{
+    const sy_rt_mesh_data *m = inst->mesh;
+    const uint32_t *ix = m->indices + 3u * prim;
+    float w0 = 1.0f - u - v, uv[2][2];
+    fetch_uv(m, ix, w0, u, v, uv);
+    return base_alpha(dev, sy_rt_material_lookup(dev, inst->material), m, ix, w0, u, v, uv, NULL);
+}
+
+sy_rt_v3 sy_rt_surface_emission(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u, float v)
+{
+    const sy_rt_material_desc *d = &sy_rt_material_lookup(dev, inst->material)->desc;
+    sy_rt_v3 e = v3_load(d->emissive);
+    if (d->emissive_texture.texture.id == 0) return e;
+    const sy_rt_mesh_data *m = inst->mesh;
+    const uint32_t *ix = m->indices + 3u * prim;
+    float uv[2][2], t[4];
+    fetch_uv(m, ix, 1.0f - u - v, u, v, uv);
+    const float *c = uv[d->emissive_texture.texcoord];
+    if (sy_rt_texture_sample_ref(dev, d->emissive_texture.texture, c[0], c[1], t)) e = v3_mul(e, v3(t[0], t[1], t[2]));
+    return e;
+}
+
+/* Perturbs the (front-side) shading normal n with the material's normal map. The tangent frame
+ * comes from the triangle's uv derivatives (as glTF viewers do without stored tangents). */
+static sy_rt_v3 apply_normal_map(const sy_rt_device *dev, const sy_rt_instance_data *inst, const uint32_t *ix,
+                                 const float uv_set[2][2], sy_rt_v3 n)
+{
+    const sy_rt_material_desc *d = &sy_rt_material_lookup(dev, inst->material)->desc;
+    const sy_rt_mesh_data *m = inst->mesh;
+    uint32_t s = d->normal_texture.texcoord;
+    if (!m->uv[s]) return n;
+    float t[4];
+    if (!sy_rt_texture_sample_ref(dev, d->normal_texture.texture, uv_set[s][0], uv_set[s][1], t)) return n;
+    const float *uv = m->uv[s];
+    sy_rt_v3 p0 = v3_load(m->positions + 3u * ix[0]);
+    sy_rt_v3 dp1 = v3_sub(v3_load(m->positions + 3u * ix[1]), p0), dp2 = v3_sub(v3_load(m->positions + 3u * ix[2]), p0);
+    float du1 = uv[2 * ix[1]] - uv[2 * ix[0]], dv1 = uv[2 * ix[1] + 1] - uv[2 * ix[0] + 1];
+    float du2 = uv[2 * ix[2]] - uv[2 * ix[0]], dv2 = uv[2 * ix[2] + 1] - uv[2 * ix[0] + 1];
+    float det = du1 * dv2 - du2 * dv1;
+    if (!(fabsf(det) > 1e-20f)) return n;
+    float inv = 1.0f / det;
+    sy_rt_v3 dpdu = m4_dir(inst->xf, v3_scale(v3_sub(v3_scale(dp1, dv2), v3_scale(dp2, dv1)), inv));
+    sy_rt_v3 dpdv = m4_dir(inst->xf, v3_scale(v3_sub(v3_scale(dp2, du1), v3_scale(dp1, du2)), inv));
+    sy_rt_v3 tg = v3_normalize(v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu))));
+    if (v3_is_zero(tg)) return n;
+    sy_rt_v3 bt = v3_cross(n, tg);
+    /* Texture "up" (+Y) points to decreasing v in glTF; flip for mirrored uv layouts. */
+    if (v3_dot(bt, dpdv) > 0.0f) bt = v3_scale(bt, -1.0f);
+    float x = (t[0] * 2.0f - 1.0f) * d->normal_scale, y = (t[1] * 2.0f - 1.0f) * d->normal_scale, z = t[2] * 2.0f - 1.0f;
+    sy_rt_v3 r = v3_normalize(v3_add(v3_add(v3_scale(tg, x), v3_scale(bt, y)), v3_scale(n, z)));
+    return v3_is_zero(r) ? n : r;
+}
+
+void sy_rt_surface_fetch(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u, float v,
+                         sy_rt_v3 dir, sy_rt_surface *s)
+{
+    const sy_rt_mesh_data *m = inst->mesh;
+    const sy_rt_material_data *mat = sy_rt_material_lookup(dev, inst->material);
+    const sy_rt_material_desc *d = &mat->desc;
+    const uint32_t *ix = m->indices + 3u * prim;
+    float w0 = 1.0f - u - v, w1 = u, w2 = v;
+    s->inst = inst;
+    s->mat = mat;
+
+    sy_rt_v3 o0 = v3_load(m->positions + 3u * ix[0]), o1 = v3_load(m->positions + 3u * ix[1]),
+             o2 = v3_load(m->positions + 3u * ix[2]);
+    sy_rt_v3 po = v3_add(v3_add(v3_scale(o0, w0), v3_scale(o1, w1)), v3_scale(o2, w2));
+    s->p = m4_point(inst->xf, po);
+    s->ng = v3_normalize(m3_mul(inst->nrm, v3_cross(v3_sub(o1, o0), v3_sub(o2, o0))));
+    s->front = v3_dot(s->ng, dir) < 0.0f;
+    s->ng_facing = s->front ? s->ng : v3_scale(s->ng, -1.0f);
+
+    sy_rt_v3 n = s->ng;
+    if (m->normals) {
+        float nn[3];
+        interp(m->normals, 3, ix, w0, w1, w2, nn);
+        sy_rt_v3 ns = v3_normalize(m3_mul(inst->nrm, v3_load(nn)));
+        if (!v3_is_zero(ns)) n = ns;
+    }
+    float uv[2][2];
+    fetch_uv(m, ix, w0, w1, w2, uv);
+    if (d->normal_texture.texture.id != 0) n = apply_normal_map(dev, inst, ix, (const float(*)[2])uv, n);
+    /* Shade the side the ray sees (double-sided, or interiors seen through openings). */
+    s->ns = s->front ? n : v3_scale(n, -1.0f);
+
+    s->alpha = base_alpha(dev, mat, m, ix, w0, w1, w2, uv, &s->base);
+    s->metallic = d->metallic;
+    s->roughness = d->roughness;
+    float t[4];
+    const sy_rt_texture_ref *mr = &d->metallic_roughness_texture;
+    if (sy_rt_texture_sample_ref(dev, mr->texture, uv[mr->texcoord][0], uv[mr->texcoord][1], t)) {
+        s->roughness *= t[1];
+        s->metallic *= t[2];
+    }
+    s->emission = v3_load(d->emissive);
+    const sy_rt_texture_ref *em = &d->emissive_texture;
+    if (mat->emissive && sy_rt_texture_sample_ref(dev, em->texture, uv[em->texcoord][0], uv[em->texcoord][1], t))
+        s->emission = v3_mul(s->emission, v3(t[0], t[1], t[2]));
+}
+
+void sy_rt_alpha_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    const sy_rt_device *dev = args->geometryUserPtr;
+    const unsigned N = args->N;
+    const float *hf = (const float *)args->hit;
+    const unsigned *hu = (const unsigned *)args->hit;
+    for (unsigned i = 0; i < N; ++i) {
+        if (args->valid[i] != -1) continue;
+        float u = hf[3 * N + i], v = hf[4 * N + i];
+        unsigned prim = hu[5 * N + i], geom = hu[6 * N + i], inst_id = hu[7 * N + i];
+        const sy_rt_instance_data *in = sy_rt_hit_instance(dev, geom, inst_id);
+        if (!in) continue;
+        const sy_rt_material_data *mat = sy_rt_material_lookup(dev, in->material);
+        if (!mat->masked) continue;
+        if (sy_rt_surface_alpha(dev, in, prim, u, v) < mat->desc.alpha_cutoff) args->valid[i] = 0;
+    }
+}

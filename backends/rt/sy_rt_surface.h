@@ -1,0 +1,39 @@
+/* sy_rt_surface.h — evaluation of the surface at a ray hit: interpolated vertex attributes,
+ * world-space geometric and shading normals (vertex normals, normal map), and the material
+ * inputs with their textures applied (base colour * vertex colour, metallic/roughness, emission,
+ * alpha). Also the Embree filter that cuts out alpha-masked surfaces. Internal to backends/rt. */
+#ifndef SY_RT_SURFACE_H
+#define SY_RT_SURFACE_H
+
+#include "sy_rt_device.h"
+
+typedef struct sy_rt_surface {
+    const sy_rt_instance_data *inst;
+    const sy_rt_material_data *mat;
+    sy_rt_v3 p;         /* world-space hit position */
+    sy_rt_v3 ng;        /* unit geometric normal on the front side (glTF winding) */
+    sy_rt_v3 ns;        /* unit shading normal, turned to the side the ray came from */
+    sy_rt_v3 ng_facing; /* ng turned to the side the ray came from */
+    bool front;         /* the ray hit the front side */
+    sy_rt_v3 base;      /* base colour factor * texture * vertex colour (linear RGB) */
+    float alpha;
+    float metallic, roughness;
+    sy_rt_v3 emission;  /* radiance */
+} sy_rt_surface;
+
+/* Evaluates the surface of triangle prim of instance inst at Embree barycentrics (u, v), hit by
+ * a ray with direction dir (any length). */
+void sy_rt_surface_fetch(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u,
+                         float v, sy_rt_v3 dir, sy_rt_surface *s);
+
+/* Coverage alpha of a point (factor * texture alpha * vertex alpha). */
+float sy_rt_surface_alpha(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u, float v);
+
+/* Emission radiance at a point of an emissive instance (factor * emissive texture). */
+sy_rt_v3 sy_rt_surface_emission(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u, float v);
+
+/* Embree intersect/occluded filter: rejects hits on alpha-masked materials below the cutoff.
+ * geometryUserPtr is the device. */
+void sy_rt_alpha_filter(const struct RTCFilterFunctionNArguments *args);
+
+#endif /* SY_RT_SURFACE_H */

@@ -1,0 +1,28 @@
+/* sy_rt_texture.h — textures of the ray-tracing back-end: storage of 8-bit (sRGB/linear) and
+ * float texels with their sampler, and the bilinear/nearest lookup with repeat/clamp/mirror wrap
+ * used by the integrators. Internal to backends/rt. */
+#ifndef SY_RT_TEXTURE_H
+#define SY_RT_TEXTURE_H
+
+#include "sy_rt_device.h"
+
+typedef struct sy_rt_texture_data {
+    uint32_t width, height, channels;
+    sy_rt_texel_format format;
+    void *pixels;           /* own copy: uint8_t or float */
+    const float *srgb_lut;  /* device LUT for SY_RT_TEXEL_UNORM8_SRGB, else NULL */
+    sy_rt_wrap wrap_s, wrap_t;
+    sy_rt_filter filter;
+} sy_rt_texture_data;
+
+/* Samples at glTF texture coordinates (u, v), (0,0) = top-left of the image. out = linear RGBA
+ * (grey is replicated to RGB, missing alpha is 1). */
+void sy_rt_texture_sample(const sy_rt_texture_data *tex, float u, float v, float out[4]);
+
+/* Looks up tex in dev and samples it; returns false (out untouched) for a zero/stale handle. */
+bool sy_rt_texture_sample_ref(const sy_rt_device *dev, sy_rt_texture tex, float u, float v, float out[4]);
+
+/* Frees a texture object (pool removal is the caller's). */
+void sy_rt_texture_free(sy_rt_texture_data *tex);
+
+#endif /* SY_RT_TEXTURE_H */

@@ -1,0 +1,547 @@
+/* sy_fields.c — field tables of every object type and the generic deep copy / free / compare
+ * operations they drive; change list building blocks (push, sort, merge). See sy_fields.h. */
+#include "sy_fields.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* >>tables */
+#define F(T, member, k) {#member, (uint16_t)offsetof(T, member), (uint16_t)sizeof(((T *)0)->member), k}
+
+static const sy_field_desc node_fields[SY_NODE_FIELD_COUNT] = {
+    F(sy_node_data, name, SY_FK_STRING),    F(sy_node_data, transform, SY_FK_POD),
+    F(sy_node_data, children, SY_FK_BLOB),  F(sy_node_data, mesh, SY_FK_POD),
+    F(sy_node_data, light, SY_FK_POD),      F(sy_node_data, camera, SY_FK_POD),
+    F(sy_node_data, flags, SY_FK_POD),
+};
+static const sy_field_desc mesh_fields[SY_MESH_FIELD_COUNT] = {
+    F(sy_mesh_data, name, SY_FK_STRING),
+    F(sy_mesh_data, primitives, SY_FK_PRIMS),
+};
+static const sy_field_desc material_fields[SY_MATERIAL_FIELD_COUNT] = {
+    F(sy_material_data, name, SY_FK_STRING),
+    F(sy_material_data, base_color, SY_FK_POD),
+    F(sy_material_data, base_color_texture, SY_FK_POD),
+    F(sy_material_data, metallic, SY_FK_POD),
+    F(sy_material_data, roughness, SY_FK_POD),
+    F(sy_material_data, metallic_roughness_texture, SY_FK_POD),
+    F(sy_material_data, normal_texture, SY_FK_POD),
+    F(sy_material_data, occlusion_texture, SY_FK_POD),
+    F(sy_material_data, emissive, SY_FK_POD),
+    F(sy_material_data, emissive_strength, SY_FK_POD),
+    F(sy_material_data, emissive_texture, SY_FK_POD),
+    F(sy_material_data, alpha_mode, SY_FK_POD),
+    F(sy_material_data, alpha_cutoff, SY_FK_POD),
+    F(sy_material_data, double_sided, SY_FK_POD),
+    F(sy_material_data, transmission, SY_FK_POD),
+    F(sy_material_data, transmission_texture, SY_FK_POD),
+    F(sy_material_data, ior, SY_FK_POD),
+    F(sy_material_data, unlit, SY_FK_POD),
+};
+static const sy_field_desc texture_fields[SY_TEXTURE_FIELD_COUNT] = {
+    F(sy_texture_data, name, SY_FK_STRING),
+    F(sy_texture_data, info, SY_FK_POD),
+    F(sy_texture_data, pixels, SY_FK_BLOB),
+    F(sy_texture_data, sampler, SY_FK_POD),
+};
+static const sy_field_desc light_fields[SY_LIGHT_FIELD_COUNT] = {
+    F(sy_light_data, name, SY_FK_STRING),      F(sy_light_data, type, SY_FK_POD),
+    F(sy_light_data, color, SY_FK_POD),        F(sy_light_data, intensity, SY_FK_POD),
+    F(sy_light_data, range, SY_FK_POD),        F(sy_light_data, inner_cone, SY_FK_POD),
+    F(sy_light_data, outer_cone, SY_FK_POD),
+};
+static const sy_field_desc camera_fields[SY_CAMERA_FIELD_COUNT] = {
+    F(sy_camera_data, name, SY_FK_STRING), F(sy_camera_data, projection, SY_FK_POD),
+    F(sy_camera_data, yfov, SY_FK_POD),    F(sy_camera_data, aspect, SY_FK_POD),
+    F(sy_camera_data, znear, SY_FK_POD),   F(sy_camera_data, zfar, SY_FK_POD),
+    F(sy_camera_data, xmag, SY_FK_POD),    F(sy_camera_data, ymag, SY_FK_POD),
+};
+static const sy_field_desc background_fields[SY_BACKGROUND_FIELD_COUNT] = {
+    F(sy_background_data, name, SY_FK_STRING),
+    F(sy_background_data, color, SY_FK_POD),
+    F(sy_background_data, environment, SY_FK_POD),
+    F(sy_background_data, intensity, SY_FK_POD),
+};
+#undef F
+
+#define TEXREF_NONE {{0}, 0, 1.0f, {0.0f, 0.0f}, 0.0f, {1.0f, 1.0f}}
+static const sy_node_data node_defaults = {
+    .transform = {.mode = SY_TRANSFORM_TRS,
+                  .rotation = {0, 0, 0, 1},
+                  .scale = {1, 1, 1},
+                  .matrix = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}},
+    .flags = SY_NODE_VISIBLE,
+};
+static const sy_mesh_data mesh_defaults = {0};
+static const sy_material_data material_defaults = {
+    .base_color = {1, 1, 1, 1},
+    .base_color_texture = TEXREF_NONE,
+    .metallic = 1.0f,
+    .roughness = 1.0f,
+    .metallic_roughness_texture = TEXREF_NONE,
+    .normal_texture = TEXREF_NONE,
+    .occlusion_texture = TEXREF_NONE,
+    .emissive_strength = 1.0f,
+    .emissive_texture = TEXREF_NONE,
+    .alpha_mode = SY_ALPHA_OPAQUE,
+    .alpha_cutoff = 0.5f,
+    .transmission_texture = TEXREF_NONE,
+    .ior = 1.5f,
+};
+static const sy_texture_data texture_defaults = {
+    .sampler = {SY_WRAP_REPEAT, SY_WRAP_REPEAT, SY_FILTER_LINEAR, SY_FILTER_LINEAR},
+};
+static const sy_light_data light_defaults = {
+    .type = SY_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 1.0f, .outer_cone = 0.78539816f};
+static const sy_camera_data camera_defaults = {
+    .projection = SY_PROJECTION_PERSPECTIVE, .yfov = 0.8f, .znear = 0.01f, .xmag = 1.0f, .ymag = 1.0f};
+static const sy_background_data background_defaults = {.color = {0, 0, 0, 1}, .intensity = 1.0f};
+
+#define T(name, D, fields, defaults) {name, sizeof(D), fields, sizeof fields / sizeof fields[0], &defaults}
+static const sy_type_desc type_descs[SY_TYPE_COUNT] = {
+    [SY_TYPE_TEXTURE] = T("texture", sy_texture_data, texture_fields, texture_defaults),
+    [SY_TYPE_MATERIAL] = T("material", sy_material_data, material_fields, material_defaults),
+    [SY_TYPE_MESH] = T("mesh", sy_mesh_data, mesh_fields, mesh_defaults),
+    [SY_TYPE_LIGHT] = T("light", sy_light_data, light_fields, light_defaults),
+    [SY_TYPE_CAMERA] = T("camera", sy_camera_data, camera_fields, camera_defaults),
+    [SY_TYPE_BACKGROUND] = T("background", sy_background_data, background_fields, background_defaults),
+    [SY_TYPE_NODE] = T("node", sy_node_data, node_fields, node_defaults),
+};
+#undef T
+
+const sy_type_desc *sy__type_desc(uint32_t type)
+{
+    if (type == SY_TYPE_NONE || type >= SY_TYPE_COUNT) return NULL;
+    return &type_descs[type];
+}
+
+uint64_t sy__type_full_mask(uint32_t type)
+{
+    const sy_type_desc *td = sy__type_desc(type);
+    if (!td) return 0;
+    return ((1ull << td->field_count) - 1ull) | SY_BIT(SY_FIELD_ATTACHMENTS);
+}
+
+const char *sy_object_type_name(sy_object_type t)
+{
+    const sy_type_desc *td = sy__type_desc(t);
+    return td ? td->name : "unknown";
+}
+
+const void *sy_object_defaults(sy_object_type t)
+{
+    const sy_type_desc *td = sy__type_desc(t);
+    return td ? td->defaults : NULL;
+}
+
+/* >>generic field operations */
+static void *field_ptr(const sy_type_desc *td, uint32_t f, const void *data)
+{
+    return (char *)data + td->fields[f].offset;
+}
+
+static void prims_free(sy_primitive_list *l)
+{
+    for (uint32_t i = 0; i < l->count; ++i) {
+        sy_primitive *p = &l->items[i];
+        sy_blob_release(p->positions);
+        sy_blob_release(p->normals);
+        sy_blob_release(p->tangents);
+        sy_blob_release(p->texcoords0);
+        sy_blob_release(p->texcoords1);
+        sy_blob_release(p->colors);
+        sy_blob_release(p->indices);
+    }
+    free(l->items);
+    l->items = NULL;
+    l->count = 0;
+}
+
+static bool prims_copy(sy_primitive_list *dst, const sy_primitive_list *src)
+{
+    dst->items = NULL;
+    dst->count = 0;
+    if (src->count == 0) return true;
+    dst->items = malloc(sizeof(sy_primitive) * src->count);
+    if (!dst->items) return false;
+    memcpy(dst->items, src->items, sizeof(sy_primitive) * src->count);
+    for (uint32_t i = 0; i < src->count; ++i) {
+        sy_primitive *p = &dst->items[i];
+        sy_blob_retain(p->positions);
+        sy_blob_retain(p->normals);
+        sy_blob_retain(p->tangents);
+        sy_blob_retain(p->texcoords0);
+        sy_blob_retain(p->texcoords1);
+        sy_blob_retain(p->colors);
+        sy_blob_retain(p->indices);
+    }
+    dst->count = src->count;
+    return true;
+}
+
+static bool blob_same(const sy_blob *a, const sy_blob *b)
+{
+    if (a == b) return true;
+    if (!a || !b) return false;
+    return sy_blob_size(a) == sy_blob_size(b) && sy_hash_equal(sy_blob_hash(a), sy_blob_hash(b));
+}
+
+static void field_free(const sy_type_desc *td, uint32_t f, void *data)
+{
+    void *p = field_ptr(td, f, data);
+    switch (td->fields[f].kind) {
+    case SY_FK_STRING:
+        free(*(char **)p);
+        *(char **)p = NULL;
+        break;
+    case SY_FK_BLOB:
+        sy_blob_release(*(sy_blob **)p);
+        *(sy_blob **)p = NULL;
+        break;
+    case SY_FK_PRIMS: prims_free((sy_primitive_list *)p); break;
+    default: break;
+    }
+}
+
+void *sy__data_new(uint32_t type)
+{
+    const sy_type_desc *td = sy__type_desc(type);
+    if (!td) return NULL;
+    void *d = malloc(td->data_size);
+    if (d) memcpy(d, td->defaults, td->data_size); /* defaults own nothing */
+    return d;
+}
+
+void sy__data_free(uint32_t type, void *data)
+{
+    const sy_type_desc *td = sy__type_desc(type);
+    if (!td || !data) return;
+    for (uint32_t f = 0; f < td->field_count; ++f) field_free(td, f, data);
+    free(data);
+}
+
+bool sy__field_copy(uint32_t type, uint32_t f, void *dst, const void *src)
+{
+    const sy_type_desc *td = sy__type_desc(type);
+    void *d = field_ptr(td, f, dst);
+    const void *s = field_ptr(td, f, src);
+    switch (td->fields[f].kind) {
+    case SY_FK_STRING: {
+        const char *str = *(char *const *)s;
+        char *copy = NULL;
+        if (str) {
+            copy = strdup(str);
+            if (!copy) return false;
+        }
+        free(*(char **)d);
+        *(char **)d = copy;
+        return true;
+    }
+    case SY_FK_BLOB: {
+        sy_blob *b = sy_blob_retain(*(sy_blob *const *)s);
+        sy_blob_release(*(sy_blob **)d);
+        *(sy_blob **)d = b;
+        return true;
+    }
+    case SY_FK_PRIMS: {
+        sy_primitive_list copy;
+        if (!prims_copy(&copy, (const sy_primitive_list *)s)) return false;
+        prims_free((sy_primitive_list *)d);
+        *(sy_primitive_list *)d = copy;
+        return true;
+    }
+    default: memmove(d, s, td->fields[f].size); return true;
+    }
+}
+
+bool sy__field_equal(uint32_t type, uint32_t f, const void *a, const void *b)
+{
+    const sy_type_desc *td = sy__type_desc(type);
+    const void *pa = field_ptr(td, f, a);
+    const void *pb = field_ptr(td, f, b);
+    switch (td->fields[f].kind) {
+    case SY_FK_STRING: {
+        const char *sa = *(char *const *)pa, *sb = *(char *const *)pb;
+        if (!sa || !sb) return sa == sb;
+        return strcmp(sa, sb) == 0;
+    }
+    case SY_FK_BLOB: return blob_same(*(sy_blob *const *)pa, *(sy_blob *const *)pb);
+    case SY_FK_PRIMS: {
+        const sy_primitive_list *la = pa, *lb = pb;
+        if (la->count != lb->count) return false;
+        for (uint32_t i = 0; i < la->count; ++i) {
+            const sy_primitive *x = &la->items[i], *y = &lb->items[i];
+            if (!blob_same(x->positions, y->positions) || !blob_same(x->normals, y->normals) ||
+                !blob_same(x->tangents, y->tangents) || !blob_same(x->texcoords0, y->texcoords0) ||
+                !blob_same(x->texcoords1, y->texcoords1) || !blob_same(x->colors, y->colors) ||
+                !blob_same(x->indices, y->indices) || x->material.id != y->material.id)
+                return false;
+        }
+        return true;
+    }
+    default: return memcmp(pa, pb, td->fields[f].size) == 0;
+    }
+}
+
+size_t sy__field_heap_bytes(uint32_t type, uint32_t f, const void *data)
+{
+    const sy_type_desc *td = sy__type_desc(type);
+    const void *p = field_ptr(td, f, data);
+    switch (td->fields[f].kind) {
+    case SY_FK_STRING: {
+        const char *s = *(char *const *)p;
+        return s ? strlen(s) + 1 : 0;
+    }
+    case SY_FK_PRIMS: return ((const sy_primitive_list *)p)->count * sizeof(sy_primitive);
+    default: return 0;
+    }
+}
+
+/* >>attachments */
+void sy__attachments_free(sy_attachment *a, uint32_t n)
+{
+    if (!a) return;
+    for (uint32_t i = 0; i < n; ++i) {
+        free(a[i].key);
+        if (a[i].kind == SY_ATTACH_STRING) free(a[i].value.s);
+        if (a[i].kind == SY_ATTACH_BLOB) sy_blob_release(a[i].value.blob);
+    }
+    free(a);
+}
+
+bool sy__attachments_copy(const sy_attachment *src, uint32_t n, sy_attachment **dst_out)
+{
+    *dst_out = NULL;
+    if (n == 0) return true;
+    sy_attachment *d = calloc(n, sizeof *d);
+    if (!d) return false;
+    for (uint32_t i = 0; i < n; ++i) {
+        d[i].kind = src[i].kind;
+        d[i].value = src[i].value;
+        d[i].key = strdup(src[i].key ? src[i].key : "");
+        bool ok = d[i].key != NULL;
+        if (src[i].kind == SY_ATTACH_STRING) {
+            d[i].value.s = strdup(src[i].value.s ? src[i].value.s : "");
+            ok = ok && d[i].value.s;
+        } else if (src[i].kind == SY_ATTACH_BLOB) {
+            sy_blob_retain(d[i].value.blob);
+        }
+        if (!ok) {
+            sy__attachments_free(d, i + 1);
+            return false;
+        }
+    }
+    *dst_out = d;
+    return true;
+}
+
+bool sy__attachments_equal(const sy_attachment *a, uint32_t na, const sy_attachment *b, uint32_t nb)
+{
+    if (na != nb) return false;
+    for (uint32_t i = 0; i < na; ++i) {
+        if (strcmp(a[i].key, b[i].key) != 0 || a[i].kind != b[i].kind) return false;
+        switch (a[i].kind) {
+        case SY_ATTACH_INT:
+            if (a[i].value.i != b[i].value.i) return false;
+            break;
+        case SY_ATTACH_FLOAT:
+            if (memcmp(&a[i].value.f, &b[i].value.f, sizeof(double)) != 0) return false;
+            break;
+        case SY_ATTACH_VEC4:
+            if (memcmp(a[i].value.v, b[i].value.v, sizeof a[i].value.v) != 0) return false;
+            break;
+        case SY_ATTACH_STRING:
+            if (strcmp(a[i].value.s, b[i].value.s) != 0) return false;
+            break;
+        case SY_ATTACH_BLOB:
+            if (!blob_same(a[i].value.blob, b[i].value.blob)) return false;
+            break;
+        default: return false;
+        }
+    }
+    return true;
+}
+
+/* >>change lists */
+sy_changes *sy__changes_new(uint64_t first_frame, uint64_t last_frame, bool snapshot)
+{
+    sy_changes *c = calloc(1, sizeof *c);
+    if (!c) return NULL;
+    atomic_init(&c->refs, 1);
+    c->first_frame = first_frame;
+    c->last_frame = last_frame;
+    c->snapshot = snapshot;
+    c->bytes = sizeof *c;
+    return c;
+}
+
+sy_result sy__changes_push(sy_changes *c, uint32_t type, uint32_t id, uint32_t flags, uint64_t mask,
+                           const void *src_data, const sy_attachment *att, uint32_t natt, sy_error *err)
+{
+    const sy_type_desc *td = sy__type_desc(type);
+    if (!td) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "change list: unknown object type %u", type);
+    if (c->count == c->capacity) {
+        uint32_t ncap = c->capacity ? c->capacity * 2 : 16;
+        if (ncap <= c->capacity) return sy_error_set(err, SY_ERR_LIMIT, "change list: too many entries");
+        sy_change *ne = realloc(c->entries, sizeof(sy_change) * ncap);
+        if (!ne) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list: out of memory");
+        c->entries = ne;
+        c->capacity = ncap;
+    }
+    sy_change *e = &c->entries[c->count];
+    memset(e, 0, sizeof *e);
+    e->type = type;
+    e->id = id;
+    e->flags = flags;
+    e->mask = mask & sy__type_full_mask(type);
+    if (!(flags & SY_CHANGE_DESTROYED)) {
+        void *d = sy__data_new(type);
+        if (!d) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list: out of memory");
+        for (uint32_t f = 0; f < td->field_count; ++f) {
+            if (!(e->mask & SY_BIT(f))) continue;
+            if (!sy__field_copy(type, f, d, src_data)) {
+                sy__data_free(type, d);
+                return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list: out of memory");
+            }
+            c->bytes += sy__field_heap_bytes(type, f, d);
+        }
+        if (e->mask & SY_BIT(SY_FIELD_ATTACHMENTS)) {
+            sy_attachment *a;
+            if (!sy__attachments_copy(att, natt, &a)) {
+                sy__data_free(type, d);
+                return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list: out of memory");
+            }
+            e->attachments = a;
+            e->attachment_count = natt;
+            c->bytes += natt * sizeof(sy_attachment);
+        }
+        e->data = d;
+        c->bytes += td->data_size;
+    } else {
+        e->mask = 0;
+    }
+    c->bytes += sizeof *e;
+    c->count++;
+    return SY_OK;
+}
+
+static int change_order(const void *pa, const void *pb)
+{
+    const sy_change *a = pa, *b = pb;
+    int da = (a->flags & SY_CHANGE_DESTROYED) ? 0 : 1, db = (b->flags & SY_CHANGE_DESTROYED) ? 0 : 1;
+    if (da != db) return da - db;
+    if (a->type != b->type) return a->type < b->type ? -1 : 1;
+    if (a->id != b->id) return a->id < b->id ? -1 : 1;
+    return 0;
+}
+
+void sy__changes_sort(sy_changes *c)
+{
+    if (c->count > 1) qsort(c->entries, c->count, sizeof(sy_change), change_order);
+}
+
+/* Merge: an open-addressing map from (type, id) to the output entry index. */
+typedef struct merge_map {
+    uint64_t *keys; /* 0 = empty (type is never 0) */
+    uint32_t *vals;
+    size_t capacity;
+} merge_map;
+
+static uint64_t mix64(uint64_t x)
+{
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdull;
+    x ^= x >> 33;
+    return x;
+}
+
+sy_result sy__changes_merge(sy_changes *const *lists, uint32_t n, sy_changes **out, sy_error *err)
+{
+    *out = NULL;
+    size_t total = 0;
+    for (uint32_t i = 0; i < n; ++i) total += lists[i]->count;
+    uint64_t first = n ? lists[0]->first_frame : 0, last = n ? lists[n - 1]->last_frame : 0;
+    sy_changes *c = sy__changes_new(first, last, n && lists[0]->snapshot);
+    merge_map m = {0};
+    m.capacity = 16;
+    while (m.capacity < total * 2) m.capacity *= 2;
+    m.keys = calloc(m.capacity, sizeof *m.keys);
+    m.vals = calloc(m.capacity, sizeof *m.vals);
+    sy_result r = SY_OK;
+    if (!c || !m.keys || !m.vals) {
+        r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list merge: out of memory");
+        goto fail;
+    }
+    for (uint32_t li = 0; li < n; ++li) {
+        const sy_changes *src = lists[li];
+        for (uint32_t ei = 0; ei < src->count; ++ei) {
+            const sy_change *s = &src->entries[ei];
+            uint64_t key = ((uint64_t)s->type << 32) | s->id;
+            size_t h = (size_t)mix64(key) & (m.capacity - 1);
+            while (m.keys[h] && m.keys[h] != key) h = (h + 1) & (m.capacity - 1);
+            if (!m.keys[h]) {
+                r = sy__changes_push(c, s->type, s->id, s->flags, s->mask, s->data, s->attachments,
+                                     s->attachment_count, err);
+                if (r != SY_OK) goto fail;
+                m.keys[h] = key;
+                m.vals[h] = c->count - 1;
+                continue;
+            }
+            sy_change *d = &c->entries[m.vals[h]];
+            if (s->flags & SY_CHANGE_DESTROYED) {
+                /* created and destroyed within the range: the consumer never needs to know */
+                bool was_created = (d->flags & SY_CHANGE_CREATED) != 0;
+                sy__data_free(d->type, (void *)d->data);
+                sy__attachments_free((sy_attachment *)d->attachments, d->attachment_count);
+                d->data = NULL;
+                d->attachments = NULL;
+                d->attachment_count = 0;
+                d->mask = 0;
+                d->flags = was_created ? 0xffffffffu /* dropped below */ : SY_CHANGE_DESTROYED;
+                continue;
+            }
+            d->flags |= s->flags;
+            if (!d->data) {
+                d->data = sy__data_new(d->type);
+                if (!d->data) {
+                    r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list merge: out of memory");
+                    goto fail;
+                }
+            }
+            const sy_type_desc *td = sy__type_desc(s->type);
+            for (uint32_t f = 0; f < td->field_count; ++f)
+                if ((s->mask & SY_BIT(f)) && !sy__field_copy(s->type, f, (void *)d->data, s->data)) {
+                    r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list merge: out of memory");
+                    goto fail;
+                }
+            if (s->mask & SY_BIT(SY_FIELD_ATTACHMENTS)) {
+                sy_attachment *a;
+                if (!sy__attachments_copy(s->attachments, s->attachment_count, &a)) {
+                    r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list merge: out of memory");
+                    goto fail;
+                }
+                sy__attachments_free((sy_attachment *)d->attachments, d->attachment_count);
+                d->attachments = a;
+                d->attachment_count = s->attachment_count;
+            }
+            d->mask |= s->mask;
+        }
+    }
+    /* drop entries of objects created and destroyed within the range */
+    uint32_t w = 0;
+    for (uint32_t i = 0; i < c->count; ++i) {
+        if (c->entries[i].flags == 0xffffffffu) continue;
+        c->entries[w++] = c->entries[i];
+    }
+    c->count = w;
+    sy__changes_sort(c);
+    free(m.keys);
+    free(m.vals);
+    *out = c;
+    return SY_OK;
+fail:
+    free(m.keys);
+    free(m.vals);
+    sy_changes_release(c);
+    return r;
+}

@@ -1,0 +1,157 @@
+/* sy_math.c — 4x4 matrices (column-major), TRS composition, inversion and bounds (see sy_math.h). */
+#include "sy_math.h"
+
+#include <math.h>
+#include <string.h>
+
+sy_mat4 sy_mat4_identity(void)
+{
+    sy_mat4 r = {{0}};
+    r.m[0] = r.m[5] = r.m[10] = r.m[15] = 1.0f;
+    return r;
+}
+
+sy_mat4 sy_mat4_mul(const sy_mat4 *a, const sy_mat4 *b)
+{
+    sy_mat4 r;
+    for (int c = 0; c < 4; ++c)
+        for (int row = 0; row < 4; ++row) {
+            float s = 0.0f;
+            for (int k = 0; k < 4; ++k) s += a->m[k * 4 + row] * b->m[c * 4 + k];
+            r.m[c * 4 + row] = s;
+        }
+    return r;
+}
+
+sy_mat4 sy_mat4_from_trs(const float t[3], const float q[4], const float s[3])
+{
+    float x = q[0], y = q[1], z = q[2], w = q[3];
+    sy_mat4 r;
+    r.m[0] = (1 - 2 * (y * y + z * z)) * s[0];
+    r.m[1] = (2 * (x * y + z * w)) * s[0];
+    r.m[2] = (2 * (x * z - y * w)) * s[0];
+    r.m[3] = 0;
+    r.m[4] = (2 * (x * y - z * w)) * s[1];
+    r.m[5] = (1 - 2 * (x * x + z * z)) * s[1];
+    r.m[6] = (2 * (y * z + x * w)) * s[1];
+    r.m[7] = 0;
+    r.m[8] = (2 * (x * z + y * w)) * s[2];
+    r.m[9] = (2 * (y * z - x * w)) * s[2];
+    r.m[10] = (1 - 2 * (x * x + y * y)) * s[2];
+    r.m[11] = 0;
+    r.m[12] = t[0];
+    r.m[13] = t[1];
+    r.m[14] = t[2];
+    r.m[15] = 1;
+    return r;
+}
+
+bool sy_mat4_invert(const sy_mat4 *a, sy_mat4 *out)
+{
+    const float *m = a->m;
+    float inv[16];
+    inv[0] = m[5] * m[10] * m[15] - m[5] * m[11] * m[14] - m[9] * m[6] * m[15] + m[9] * m[7] * m[14] +
+             m[13] * m[6] * m[11] - m[13] * m[7] * m[10];
+    inv[4] = -m[4] * m[10] * m[15] + m[4] * m[11] * m[14] + m[8] * m[6] * m[15] - m[8] * m[7] * m[14] -
+             m[12] * m[6] * m[11] + m[12] * m[7] * m[10];
+    inv[8] = m[4] * m[9] * m[15] - m[4] * m[11] * m[13] - m[8] * m[5] * m[15] + m[8] * m[7] * m[13] +
+             m[12] * m[5] * m[11] - m[12] * m[7] * m[9];
+    inv[12] = -m[4] * m[9] * m[14] + m[4] * m[10] * m[13] + m[8] * m[5] * m[14] - m[8] * m[6] * m[13] -
+              m[12] * m[5] * m[10] + m[12] * m[6] * m[9];
+    inv[1] = -m[1] * m[10] * m[15] + m[1] * m[11] * m[14] + m[9] * m[2] * m[15] - m[9] * m[3] * m[14] -
+             m[13] * m[2] * m[11] + m[13] * m[3] * m[10];
+    inv[5] = m[0] * m[10] * m[15] - m[0] * m[11] * m[14] - m[8] * m[2] * m[15] + m[8] * m[3] * m[14] +
+             m[12] * m[2] * m[11] - m[12] * m[3] * m[10];
+    inv[9] = -m[0] * m[9] * m[15] + m[0] * m[11] * m[13] + m[8] * m[1] * m[15] - m[8] * m[3] * m[13] -
+             m[12] * m[1] * m[11] + m[12] * m[3] * m[9];
+    inv[13] = m[0] * m[9] * m[14] - m[0] * m[10] * m[13] - m[8] * m[1] * m[14] + m[8] * m[2] * m[13] +
+              m[12] * m[1] * m[10] - m[12] * m[2] * m[9];
+    inv[2] = m[1] * m[6] * m[15] - m[1] * m[7] * m[14] - m[5] * m[2] * m[15] + m[5] * m[3] * m[14] +
+             m[13] * m[2] * m[7] - m[13] * m[3] * m[6];
+    inv[6] = -m[0] * m[6] * m[15] + m[0] * m[7] * m[14] + m[4] * m[2] * m[15] - m[4] * m[3] * m[14] -
+             m[12] * m[2] * m[7] + m[12] * m[3] * m[6];
+    inv[10] = m[0] * m[5] * m[15] - m[0] * m[7] * m[13] - m[4] * m[1] * m[15] + m[4] * m[3] * m[13] +
+              m[12] * m[1] * m[7] - m[12] * m[3] * m[5];
+    inv[14] = -m[0] * m[5] * m[14] + m[0] * m[6] * m[13] + m[4] * m[1] * m[14] - m[4] * m[2] * m[13] -
+              m[12] * m[1] * m[6] + m[12] * m[2] * m[5];
+    inv[3] = -m[1] * m[6] * m[11] + m[1] * m[7] * m[10] + m[5] * m[2] * m[11] - m[5] * m[3] * m[10] -
+             m[9] * m[2] * m[7] + m[9] * m[3] * m[6];
+    inv[7] = m[0] * m[6] * m[11] - m[0] * m[7] * m[10] - m[4] * m[2] * m[11] + m[4] * m[3] * m[10] +
+             m[8] * m[2] * m[7] - m[8] * m[3] * m[6];
+    inv[11] = -m[0] * m[5] * m[11] + m[0] * m[7] * m[9] + m[4] * m[1] * m[11] - m[4] * m[3] * m[9] -
+              m[8] * m[1] * m[7] + m[8] * m[3] * m[5];
+    inv[15] = m[0] * m[5] * m[10] - m[0] * m[6] * m[9] - m[4] * m[1] * m[10] + m[4] * m[2] * m[9] +
+              m[8] * m[1] * m[6] - m[8] * m[2] * m[5];
+    float det = m[0] * inv[0] + m[1] * inv[4] + m[2] * inv[8] + m[3] * inv[12];
+    if (det == 0.0f || !isfinite(det)) {
+        *out = sy_mat4_identity();
+        return false;
+    }
+    float r = 1.0f / det;
+    for (int i = 0; i < 16; ++i) out->m[i] = inv[i] * r;
+    return true;
+}
+
+void sy_mat4_transform_point(const sy_mat4 *a, const float p[3], float out[3])
+{
+    const float *m = a->m;
+    float x = m[0] * p[0] + m[4] * p[1] + m[8] * p[2] + m[12];
+    float y = m[1] * p[0] + m[5] * p[1] + m[9] * p[2] + m[13];
+    float z = m[2] * p[0] + m[6] * p[1] + m[10] * p[2] + m[14];
+    out[0] = x, out[1] = y, out[2] = z;
+}
+
+void sy_mat4_transform_dir(const sy_mat4 *a, const float d[3], float out[3])
+{
+    const float *m = a->m;
+    float x = m[0] * d[0] + m[4] * d[1] + m[8] * d[2];
+    float y = m[1] * d[0] + m[5] * d[1] + m[9] * d[2];
+    float z = m[2] * d[0] + m[6] * d[1] + m[10] * d[2];
+    out[0] = x, out[1] = y, out[2] = z;
+}
+
+bool sy_mat4_is_finite(const sy_mat4 *a)
+{
+    for (int i = 0; i < 16; ++i)
+        if (!isfinite(a->m[i])) return false;
+    return true;
+}
+
+bool sy_mat4_equal(const sy_mat4 *a, const sy_mat4 *b) { return memcmp(a->m, b->m, sizeof a->m) == 0; }
+
+sy_bounds sy_bounds_empty(void)
+{
+    sy_bounds b = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    return b;
+}
+
+bool sy_bounds_is_empty(const sy_bounds *b) { return !(b->min[0] <= b->max[0]); }
+
+void sy_bounds_add_point(sy_bounds *b, const float p[3])
+{
+    for (int i = 0; i < 3; ++i) {
+        if (p[i] < b->min[i]) b->min[i] = p[i];
+        if (p[i] > b->max[i]) b->max[i] = p[i];
+    }
+}
+
+void sy_bounds_add_bounds(sy_bounds *b, const sy_bounds *o)
+{
+    if (sy_bounds_is_empty(o)) return;
+    sy_bounds_add_point(b, o->min);
+    sy_bounds_add_point(b, o->max);
+}
+
+sy_bounds sy_bounds_transform(const sy_bounds *b, const sy_mat4 *m)
+{
+    sy_bounds r = sy_bounds_empty();
+    if (sy_bounds_is_empty(b)) return r;
+    for (int i = 0; i < 8; ++i) {
+        float p[3] = {(i & 1) ? b->max[0] : b->min[0], (i & 2) ? b->max[1] : b->min[1],
+                      (i & 4) ? b->max[2] : b->min[2]};
+        float q[3];
+        sy_mat4_transform_point(m, p, q);
+        sy_bounds_add_point(&r, q);
+    }
+    return r;
+}

@@ -1,0 +1,406 @@
+/* sy_mediator.c — layers, camera views, back-end parameters, the mediator registry, contexts and
+ * the context pool (see sy_mediator.h). */
+#include "sy_mediator.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* >>layers */
+sy_result sy_layer_create(uint32_t width, uint32_t height, sy_layer *out, sy_error *err)
+{
+    memset(out, 0, sizeof *out);
+    size_t n, bytes4, bytes1;
+    if (width == 0 || height == 0 || width > 65536 || height > 65536 || !sy_size_mul(width, height, &n) ||
+        !sy_size_mul(n, 4 * sizeof(float), &bytes4) || !sy_size_mul(n, sizeof(float), &bytes1))
+        return sy_error_set(err, SY_ERR_LIMIT, "layer: bad size %ux%u", width, height);
+    out->rgba = malloc(bytes4);
+    out->depth = malloc(bytes1);
+    if (!out->rgba || !out->depth) {
+        sy_layer_destroy(out);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "layer: out of memory for %ux%u", width, height);
+    }
+    out->width = width;
+    out->height = height;
+    sy_layer_clear(out);
+    return SY_OK;
+}
+
+void sy_layer_destroy(sy_layer *l)
+{
+    if (!l) return;
+    free(l->rgba);
+    free(l->depth);
+    memset(l, 0, sizeof *l);
+}
+
+void sy_layer_clear(sy_layer *l)
+{
+    size_t n = (size_t)l->width * l->height;
+    memset(l->rgba, 0, n * 4 * sizeof(float));
+    for (size_t i = 0; i < n; ++i) l->depth[i] = INFINITY;
+}
+
+size_t sy_layer_count_nonfinite(const sy_layer *l)
+{
+    size_t n = (size_t)l->width * l->height, bad = 0;
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(l->rgba[4 * i]) || !isfinite(l->rgba[4 * i + 1]) || !isfinite(l->rgba[4 * i + 2]) ||
+            !isfinite(l->rgba[4 * i + 3]))
+            bad++;
+    return bad;
+}
+
+/* >>camera views */
+sy_camera_view sy_camera_view_make(const sy_camera_data *cam, const sy_mat4 *world, float image_aspect)
+{
+    sy_camera_view v;
+    memset(&v, 0, sizeof v);
+    v.camera_to_world = *world;
+    v.projection = cam->projection;
+    v.znear = cam->znear;
+    v.zfar = cam->zfar;
+    if (!(image_aspect > 0.0f)) image_aspect = 1.0f;
+    if (cam->projection == SY_PROJECTION_ORTHOGRAPHIC) {
+        float ym = cam->ymag > 0.0f ? cam->ymag : 1.0f;
+        v.window[0] = -ym * image_aspect;
+        v.window[1] = ym * image_aspect;
+        v.window[2] = -ym;
+        v.window[3] = ym;
+    } else {
+        float t = tanf(cam->yfov * 0.5f);
+        v.window[0] = -t * image_aspect;
+        v.window[1] = t * image_aspect;
+        v.window[2] = -t;
+        v.window[3] = t;
+    }
+    return v;
+}
+
+sy_camera_view sy_camera_view_frame_bounds(const sy_bounds *b, float image_aspect)
+{
+    float c[3] = {0, 0, 0}, r = 1.0f;
+    if (!sy_bounds_is_empty(b)) {
+        float ext2 = 0.0f;
+        for (int i = 0; i < 3; ++i) {
+            c[i] = 0.5f * (b->min[i] + b->max[i]);
+            float e = 0.5f * (b->max[i] - b->min[i]);
+            ext2 += e * e;
+        }
+        r = sqrtf(ext2);
+        if (!(r > 1e-6f)) r = 1.0f;
+    }
+    sy_camera_data cam = *(const sy_camera_data *)sy_object_defaults(SY_TYPE_CAMERA);
+    cam.yfov = 0.7853982f;
+    float half = cam.yfov * 0.5f;
+    if (image_aspect < 1.0f) half = atanf(tanf(half) * image_aspect); /* fit the narrower side */
+    float dist = r / sinf(half) * 1.05f;
+    /* look from the front, slightly above: direction (0, sin 20deg, cos 20deg) */
+    float dir[3] = {0.0f, 0.34202f, 0.93969f};
+    float eye[3] = {c[0] + dir[0] * dist, c[1] + dir[1] * dist, c[2] + dir[2] * dist};
+    /* camera basis: z = dir (camera looks down -z), x = up x z normalised, y = z x x */
+    float z[3] = {dir[0], dir[1], dir[2]};
+    float x[3] = {z[2], 0.0f, -z[0]}; /* (0,1,0) x z */
+    float xl = sqrtf(x[0] * x[0] + x[2] * x[2]);
+    if (xl < 1e-6f) x[0] = 1.0f, x[2] = 0.0f, xl = 1.0f;
+    x[0] /= xl, x[2] /= xl;
+    float y[3] = {z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]};
+    sy_mat4 m = {{x[0], x[1], x[2], 0, y[0], y[1], y[2], 0, z[0], z[1], z[2], 0, eye[0], eye[1], eye[2], 1}};
+    cam.znear = dist - r > 1e-3f ? (dist - r) * 0.5f : 1e-3f;
+    return sy_camera_view_make(&cam, &m, image_aspect);
+}
+
+/* >>params */
+sy_result sy_params_set(sy_params *p, const char *key, const char *value, sy_error *err)
+{
+    if (!key[0] || strlen(key) >= sizeof p->items[0].key)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameter '%s': bad key", key);
+    if (strlen(value) >= sizeof p->items[0].value)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameter '%s': value too long", key);
+    uint32_t i = 0;
+    while (i < p->count && strcmp(p->items[i].key, key) != 0) i++;
+    if (i == p->count) {
+        if (p->count == SY_PARAMS_MAX)
+            return sy_error_set(err, SY_ERR_LIMIT, "parameter '%s': more than %d parameters", key, SY_PARAMS_MAX);
+        p->count++;
+        strcpy(p->items[i].key, key);
+    }
+    strcpy(p->items[i].value, value);
+    return SY_OK;
+}
+
+sy_result sy_params_parse(const char *text, sy_params *out, sy_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!text) return SY_OK;
+    const char *p = text;
+    while (*p) {
+        const char *end = strchr(p, ',');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        char item[160];
+        if (len >= sizeof item) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameters: item too long in '%s'", text);
+        memcpy(item, p, len);
+        item[len] = '\0';
+        if (len) {
+            char *eq = strchr(item, '=');
+            if (!eq || eq == item)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameters: '%s' is not key=value", item);
+            *eq = '\0';
+            sy_result r = sy_params_set(out, item, eq + 1, err);
+            if (r != SY_OK) return r;
+        }
+        p += len;
+        if (*p == ',') p++;
+    }
+    return SY_OK;
+}
+
+const char *sy_params_get(const sy_params *p, const char *key)
+{
+    if (!p) return NULL;
+    for (uint32_t i = 0; i < p->count; ++i)
+        if (strcmp(p->items[i].key, key) == 0) return p->items[i].value;
+    return NULL;
+}
+
+sy_result sy_params_get_int(const sy_params *p, const char *key, long def, long min, long max, long *out, sy_error *err)
+{
+    const char *v = sy_params_get(p, key);
+    *out = def;
+    if (!v) return SY_OK;
+    char *end;
+    errno = 0;
+    long x = strtol(v, &end, 10);
+    if (errno || end == v || *end || x < min || x > max)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameter %s=%s: expected an integer in [%ld, %ld]", key, v,
+                            min, max);
+    *out = x;
+    return SY_OK;
+}
+
+sy_result sy_params_get_float(const sy_params *p, const char *key, double def, double min, double max, double *out,
+                              sy_error *err)
+{
+    const char *v = sy_params_get(p, key);
+    *out = def;
+    if (!v) return SY_OK;
+    char *end;
+    double x = strtod(v, &end);
+    if (end == v || *end || !isfinite(x) || x < min || x > max)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameter %s=%s: expected a number in [%g, %g]", key, v, min,
+                            max);
+    *out = x;
+    return SY_OK;
+}
+
+bool sy_params_equal(const sy_params *a, const sy_params *b)
+{
+    if (a->count != b->count) return false;
+    for (uint32_t i = 0; i < a->count; ++i) {
+        const char *v = sy_params_get(b, a->items[i].key);
+        if (!v || strcmp(v, a->items[i].value) != 0) return false;
+    }
+    return true;
+}
+
+/* >>registry (the one process-wide table) */
+#define REGISTRY_MAX 32
+static pthread_mutex_t g_registry_lock = PTHREAD_MUTEX_INITIALIZER;
+static const sy_mediator_class *g_registry[REGISTRY_MAX];
+static uint32_t g_registry_count;
+
+sy_result sy_mediator_register(const sy_mediator_class *cls, sy_error *err)
+{
+    if (!cls || !cls->name || !cls->create || !cls->destroy || !cls->sync || !cls->render)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mediator register: incomplete class");
+    sy_result r = SY_OK;
+    pthread_mutex_lock(&g_registry_lock);
+    for (uint32_t i = 0; i < g_registry_count; ++i)
+        if (strcmp(g_registry[i]->name, cls->name) == 0) {
+            r = g_registry[i] == cls ? SY_OK
+                                     : sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                                    "mediator register: '%s' is already registered", cls->name);
+            pthread_mutex_unlock(&g_registry_lock);
+            return r;
+        }
+    if (g_registry_count == REGISTRY_MAX) r = sy_error_set(err, SY_ERR_LIMIT, "mediator register: registry full");
+    else g_registry[g_registry_count++] = cls;
+    pthread_mutex_unlock(&g_registry_lock);
+    return r;
+}
+
+const sy_mediator_class *sy_mediator_find(const char *name)
+{
+    const sy_mediator_class *found = NULL;
+    pthread_mutex_lock(&g_registry_lock);
+    for (uint32_t i = 0; i < g_registry_count && !found; ++i)
+        if (strcmp(g_registry[i]->name, name) == 0) found = g_registry[i];
+    pthread_mutex_unlock(&g_registry_lock);
+    return found;
+}
+
+uint32_t sy_mediator_count(void)
+{
+    pthread_mutex_lock(&g_registry_lock);
+    uint32_t n = g_registry_count;
+    pthread_mutex_unlock(&g_registry_lock);
+    return n;
+}
+
+const sy_mediator_class *sy_mediator_at(uint32_t i)
+{
+    pthread_mutex_lock(&g_registry_lock);
+    const sy_mediator_class *c = i < g_registry_count ? g_registry[i] : NULL;
+    pthread_mutex_unlock(&g_registry_lock);
+    return c;
+}
+
+/* >>contexts */
+struct sy_context {
+    int refs;
+    const sy_mediator_class *cls;
+    void *state;
+    sy_scene *scene;
+    uint32_t consumer;
+    uint32_t root;
+    sy_params params;
+    double last_sync_seconds, last_render_seconds;
+};
+
+sy_result sy_context_create(sy_scene *scene, const char *backend, const sy_params *params, uint32_t root_node_id,
+                            sy_context **out, sy_error *err)
+{
+    *out = NULL;
+    const sy_mediator_class *cls = sy_mediator_find(backend);
+    if (!cls) {
+        char names[256] = "";
+        for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
+            size_t l = strlen(names);
+            snprintf(names + l, sizeof names - l, "%s%s", l ? ", " : "", sy_mediator_at(i)->name);
+        }
+        return sy_error_set(err, SY_ERR_NOT_FOUND, "back-end '%s' is not registered (available: %s)", backend,
+                            names[0] ? names : "none");
+    }
+    sy_context *c = calloc(1, sizeof *c);
+    if (!c) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "context: out of memory");
+    c->refs = 1;
+    c->cls = cls;
+    c->scene = scene;
+    c->root = root_node_id;
+    if (params) c->params = *params;
+    sy_mediator_create_args args = {root_node_id, &c->params};
+    sy_result r = cls->create(&args, &c->state, err);
+    if (r == SY_OK) r = sy_scene_consumer_add(scene, &c->consumer, err);
+    if (r != SY_OK) {
+        if (c->state) cls->destroy(c->state);
+        free(c);
+        return r;
+    }
+    *out = c;
+    return SY_OK;
+}
+
+sy_context *sy_context_retain(sy_context *c)
+{
+    if (c) c->refs++;
+    return c;
+}
+
+void sy_context_release(sy_context *c)
+{
+    if (!c || --c->refs > 0) return;
+    sy_scene_consumer_remove(c->scene, c->consumer);
+    c->cls->destroy(c->state);
+    free(c);
+}
+
+sy_result sy_context_sync(sy_context *c, sy_error *err)
+{
+    double t0 = sy_time_now();
+    sy_changes *ch = NULL;
+    sy_result r = sy_scene_consumer_pull(c->scene, c->consumer, &ch, err);
+    if (r == SY_OK && sy_changes_count(ch)) {
+        r = c->cls->sync(c->state, ch, err);
+        if (r != SY_OK) sy_error_prefix(err, "%s sync", c->cls->name);
+    }
+    sy_changes_release(ch);
+    c->last_sync_seconds = sy_time_now() - t0;
+    return r;
+}
+
+sy_result sy_context_render(sy_context *c, const sy_render_request *req, sy_layer *layer, sy_error *err)
+{
+    if (req->rect_w != layer->width || req->rect_h != layer->height || req->rect_w == 0 || req->rect_h == 0 ||
+        req->rect_x > req->full_width || req->rect_w > req->full_width - req->rect_x ||
+        req->rect_y > req->full_height || req->rect_h > req->full_height - req->rect_y)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "render: rectangle %ux%u+%u+%u does not fit the image %ux%u or the layer %ux%u", req->rect_w,
+                            req->rect_h, req->rect_x, req->rect_y, req->full_width, req->full_height, layer->width,
+                            layer->height);
+    double t0 = sy_time_now();
+    sy_result r = c->cls->render(c->state, req, layer, err);
+    if (r != SY_OK) sy_error_prefix(err, "%s render", c->cls->name);
+    c->last_render_seconds = sy_time_now() - t0;
+    return r;
+}
+
+const sy_mediator_class *sy_context_class(const sy_context *c) { return c->cls; }
+void *sy_context_state(const sy_context *c) { return c->state; }
+
+void sy_context_stats(const sy_context *c, sy_mediator_stats *out)
+{
+    memset(out, 0, sizeof *out);
+    if (c->cls->stats) c->cls->stats(c->state, out);
+    out->last_sync_seconds = c->last_sync_seconds;
+    out->last_render_seconds = c->last_render_seconds;
+}
+
+/* >>pool */
+struct sy_context_pool {
+    sy_context **items;
+    uint32_t count, capacity;
+};
+
+sy_result sy_context_pool_create(sy_context_pool **out, sy_error *err)
+{
+    *out = calloc(1, sizeof **out);
+    return *out ? SY_OK : sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "context pool: out of memory");
+}
+
+void sy_context_pool_destroy(sy_context_pool *p)
+{
+    if (!p) return;
+    for (uint32_t i = 0; i < p->count; ++i) sy_context_release(p->items[i]);
+    free(p->items);
+    free(p);
+}
+
+sy_result sy_context_pool_get(sy_context_pool *p, sy_scene *scene, const char *backend, const sy_params *params,
+                              uint32_t root_node_id, sy_context **out, sy_error *err)
+{
+    static const sy_params empty;
+    if (!params) params = &empty;
+    for (uint32_t i = 0; i < p->count; ++i) {
+        sy_context *c = p->items[i];
+        if (c->scene == scene && c->root == root_node_id && strcmp(c->cls->name, backend) == 0 &&
+            sy_params_equal(&c->params, params)) {
+            *out = c;
+            return SY_OK;
+        }
+    }
+    if (p->count == p->capacity) {
+        uint32_t nc = p->capacity ? p->capacity * 2 : 4;
+        sy_context **ni = realloc(p->items, sizeof *ni * nc);
+        if (!ni) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "context pool: out of memory");
+        p->items = ni;
+        p->capacity = nc;
+    }
+    sy_result r = sy_context_create(scene, backend, params, root_node_id, out, err);
+    if (r == SY_OK) p->items[p->count++] = *out;
+    return r;
+}
+
+uint32_t sy_context_pool_size(const sy_context_pool *p) { return p->count; }

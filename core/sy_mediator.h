@@ -1,0 +1,159 @@
+/* sy_mediator.h — the one small interface between core and every back-end: mediator classes
+ * (a vtable registered by name), render requests, RGBA float + depth layers, and reference-counted
+ * contexts (back-end instance + its adapted scene) shared by every viewport that shows the same
+ * scene with the same back-end.
+ *
+ * A mediator translates the core scene into its back-end's own scene and keeps it in sync from
+ * change lists; it never reads the live sy_scene (the application may already be editing the next
+ * frame). A back-end only ever sees "fill this rectangle of pixels for this camera".
+ *
+ * Ownership: layers are owned by whoever created them (sy_layer_create / sy_layer_destroy).
+ * Contexts are reference counted; sy_context_pool owns a reference to each cached context.
+ * Thread-safety: the registry is safe to use from any thread (mutex). A context and a pool are
+ * single-threaded: sync and render of one context must not run concurrently. */
+#ifndef SY_MEDIATOR_H
+#define SY_MEDIATOR_H
+
+#include "sy_changes.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- layers ---- */
+typedef struct sy_layer {
+    uint32_t width, height;
+    float *rgba;  /* width*height*4, linear premultiplied, row 0 = top */
+    float *depth; /* width*height, linear distance along the view axis, +INFINITY = nothing */
+} sy_layer;
+
+/* Allocates a layer cleared to transparent black and +INFINITY depth. */
+sy_result sy_layer_create(uint32_t width, uint32_t height, sy_layer *out, sy_error *err);
+void sy_layer_destroy(sy_layer *l); /* frees the buffers, zeroes the struct */
+void sy_layer_clear(sy_layer *l);
+/* Counts pixels with a non-finite colour component (tests: must be zero). */
+size_t sy_layer_count_nonfinite(const sy_layer *l);
+
+/* ---- camera and render requests ---- */
+typedef struct sy_camera_view {
+    sy_mat4 camera_to_world; /* the camera looks down its local -Z, +Y up */
+    uint32_t projection;     /* sy_projection */
+    /* Image-plane window {left, right, bottom, top}: for perspective in tangent space at distance 1
+     * (symmetric and off-axis frusta alike), for orthographic in camera units. The full image maps
+     * onto this window; pixel (x, y) has its centre at (x + 0.5, y + 0.5), row 0 at the top. */
+    float window[4];
+    float znear, zfar; /* zfar 0 = infinite */
+} sy_camera_view;
+
+/* Camera view for a camera object at a world matrix, for an image of the given aspect
+ * (width / height). The image aspect wins over the camera's own aspect, keeping yfov / ymag. */
+sy_camera_view sy_camera_view_make(const sy_camera_data *cam, const sy_mat4 *world, float image_aspect);
+/* A perspective view (yfov 45 degrees) looking at the bounds from +Z/+Y, framing all of it. */
+sy_camera_view sy_camera_view_frame_bounds(const sy_bounds *b, float image_aspect);
+
+typedef struct sy_progress {
+    uint64_t done, total; /* units of work (tiles, samples) */
+} sy_progress;
+typedef void (*sy_progress_fn)(void *user, const sy_progress *p);
+
+typedef struct sy_render_request {
+    sy_camera_view camera;
+    uint32_t full_width, full_height; /* the whole image */
+    uint32_t rect_x, rect_y, rect_w, rect_h; /* sub-rectangle to fill; the layer is rect_w x rect_h */
+    uint32_t sample_first, sample_count; /* progressive back-ends: samples to add; 0 count = default */
+    uint32_t background_id; /* sy_background handle id, 0 = the back-end's default (black) */
+    uint32_t seed;
+    sy_progress_fn progress; /* optional, called from the rendering thread(s) serially */
+    void *progress_user;
+} sy_render_request;
+
+/* ---- parameters: "key=value" pairs given to a back-end ---- */
+#define SY_PARAMS_MAX 16
+typedef struct sy_params {
+    uint32_t count;
+    struct {
+        char key[32];
+        char value[96];
+    } items[SY_PARAMS_MAX];
+} sy_params;
+
+/* Parses "k=v,k=v" (NULL or "" = empty). Errors name the offending item. */
+sy_result sy_params_parse(const char *text, sy_params *out, sy_error *err);
+sy_result sy_params_set(sy_params *p, const char *key, const char *value, sy_error *err);
+const char *sy_params_get(const sy_params *p, const char *key); /* NULL when absent */
+/* Typed getters: default when absent; SY_ERR_INVALID_ARGUMENT naming the key when malformed or
+ * outside [min, max]. */
+sy_result sy_params_get_int(const sy_params *p, const char *key, long def, long min, long max, long *out,
+                            sy_error *err);
+sy_result sy_params_get_float(const sy_params *p, const char *key, double def, double min, double max,
+                              double *out, sy_error *err);
+bool sy_params_equal(const sy_params *a, const sy_params *b);
+
+/* ---- mediator classes ---- */
+typedef enum sy_mediator_caps {
+    SY_CAP_DEPTH = 1u << 0,       /* fills the depth layer */
+    SY_CAP_PROGRESSIVE = 1u << 1, /* accumulates samples across render calls */
+    SY_CAP_TILES = 1u << 2,       /* renders any sub-rectangle exactly like the full image */
+} sy_mediator_caps;
+
+typedef struct sy_mediator_create_args {
+    uint32_t root_node_id; /* 0 = every root of the scene */
+    const sy_params *params;
+} sy_mediator_create_args;
+
+typedef struct sy_mediator_stats {
+    uint64_t samples;        /* progressive: samples accumulated per pixel so far */
+    double last_sync_seconds, last_render_seconds;
+} sy_mediator_stats;
+
+typedef struct sy_mediator_class {
+    const char *name; /* "whitted", "pathtracer", "raster", ... */
+    uint32_t caps;    /* sy_mediator_caps */
+    sy_result (*create)(const sy_mediator_create_args *args, void **state_out, sy_error *err);
+    void (*destroy)(void *state);
+    /* Applies a change list (the first one is a snapshot). */
+    sy_result (*sync)(void *state, const sy_changes *changes, sy_error *err);
+    /* Fills layer (rect_w x rect_h) for the request. */
+    sy_result (*render)(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err);
+    void (*stats)(void *state, sy_mediator_stats *out); /* optional */
+} sy_mediator_class;
+
+/* Registry (process-wide; the one piece of global state). The class must outlive the process's
+ * use of it (a static const struct). Registering a name twice replaces nothing and fails. */
+sy_result sy_mediator_register(const sy_mediator_class *cls, sy_error *err);
+const sy_mediator_class *sy_mediator_find(const char *name);
+uint32_t sy_mediator_count(void);
+const sy_mediator_class *sy_mediator_at(uint32_t i);
+
+/* ---- contexts ---- */
+typedef struct sy_context sy_context;
+
+/* Creates a context: a consumer on the scene plus the mediator's state. Caller owns one ref. */
+sy_result sy_context_create(sy_scene *scene, const char *backend, const sy_params *params, uint32_t root_node_id,
+                            sy_context **out, sy_error *err);
+sy_context *sy_context_retain(sy_context *c);
+void sy_context_release(sy_context *c); /* the last release destroys the mediator state */
+/* Pulls everything committed since the last sync and hands it to the mediator. Cost is
+ * proportional to the changes. */
+sy_result sy_context_sync(sy_context *c, sy_error *err);
+sy_result sy_context_render(sy_context *c, const sy_render_request *req, sy_layer *layer, sy_error *err);
+const sy_mediator_class *sy_context_class(const sy_context *c);
+/* The mediator's own state (for the mediator module's diagnostics functions). Borrowed. */
+void *sy_context_state(const sy_context *c);
+void sy_context_stats(const sy_context *c, sy_mediator_stats *out);
+
+/* A cache of contexts keyed by (scene, back-end, parameters, root): viewports showing the same
+ * scene with the same back-end share one context, so the scene is converted once and switching
+ * back to a back-end is instant. */
+typedef struct sy_context_pool sy_context_pool;
+sy_result sy_context_pool_create(sy_context_pool **out, sy_error *err);
+void sy_context_pool_destroy(sy_context_pool *p); /* releases the pool's references */
+/* Returns a borrowed context (valid while the pool lives), creating it on first use. */
+sy_result sy_context_pool_get(sy_context_pool *p, sy_scene *scene, const char *backend, const sy_params *params,
+                              uint32_t root_node_id, sy_context **out, sy_error *err);
+uint32_t sy_context_pool_size(const sy_context_pool *p);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_MEDIATOR_H */

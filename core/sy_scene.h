@@ -1,0 +1,448 @@
+/* sy_scene.h — the application-side scene graph: typed object pools with generation-checked
+ * handles, field setters that record changes, attachments, node DAG with world matrices and
+ * bounds, and commit into change lists (see sy_changes.h for reading them).
+ *
+ * Object types: node, mesh, material, texture, light, camera, background. Each type has a plain
+ * data struct (sy_node_data, ...) and an enumerated list of fields, one bit each. Setters are the
+ * only way to change a field; each marks it dirty. sy_scene_commit() seals the dirty set into one
+ * change list (a frame). Consumers (mediator contexts, cluster connections) pull everything since
+ * their own cursor, merged; the log is compacted once every consumer has passed it.
+ *
+ * Handles: one-field structs {uint32_t id}; id = generation << SY_HANDLE_INDEX_BITS | index.
+ * id 0 is never valid. A destroyed object's slot gets a new generation when reused, so a stale
+ * handle is detected (SY_ERR_INVALID_HANDLE), never dereferenced. Overflow policy: a slot whose
+ * generation reaches its maximum is retired and never reused.
+ *
+ * Ownership: the scene owns every object and everything stored in fields (strings are copied,
+ * blobs retained). Getters return borrowed pointers valid until the next modification of that
+ * object or the destruction of the scene.
+ * Thread-safety: a scene is single-writer: all calls on one scene must be serialised by the
+ * caller. Change lists pulled from it (sy_changes) are immutable and self-contained and may be
+ * read from any thread while the application edits the scene for the next frame. */
+#ifndef SY_SCENE_H
+#define SY_SCENE_H
+
+#include "sy_blob.h"
+#include "sy_common.h"
+#include "sy_math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SY_HANDLE_INDEX_BITS 22u
+#define SY_HANDLE_INDEX_MASK ((1u << SY_HANDLE_INDEX_BITS) - 1u)
+#define SY_HANDLE_MAX_GENERATION ((1u << (32u - SY_HANDLE_INDEX_BITS)) - 1u)
+
+typedef struct sy_scene sy_scene;
+typedef struct sy_node { uint32_t id; } sy_node;
+typedef struct sy_mesh { uint32_t id; } sy_mesh;
+typedef struct sy_material { uint32_t id; } sy_material; /* id 0: the default material */
+typedef struct sy_texture { uint32_t id; } sy_texture;
+typedef struct sy_light { uint32_t id; } sy_light;
+typedef struct sy_camera { uint32_t id; } sy_camera;
+typedef struct sy_background { uint32_t id; } sy_background;
+
+typedef enum sy_object_type {
+    SY_TYPE_NONE = 0,
+    SY_TYPE_TEXTURE = 1, /* order = dependency order: referenced types first */
+    SY_TYPE_MATERIAL = 2,
+    SY_TYPE_MESH = 3,
+    SY_TYPE_LIGHT = 4,
+    SY_TYPE_CAMERA = 5,
+    SY_TYPE_BACKGROUND = 6,
+    SY_TYPE_NODE = 7,
+    SY_TYPE_COUNT = 8
+} sy_object_type;
+
+const char *sy_object_type_name(sy_object_type t); /* "node", "mesh", ... */
+
+#define SY_BIT(field) (1ull << (field))
+/* Fields common to every type. */
+#define SY_FIELD_NAME 0u         /* char *name (copied; may be NULL) */
+#define SY_FIELD_ATTACHMENTS 63u /* the attachment set (see below) */
+
+/* ---------------------------------------------------------------- node */
+typedef enum sy_transform_mode { SY_TRANSFORM_TRS = 0, SY_TRANSFORM_MATRIX = 1 } sy_transform_mode;
+
+typedef struct sy_transform {
+    uint32_t mode;         /* sy_transform_mode */
+    float translation[3];  /* TRS (valid when mode == TRS) */
+    float rotation[4];     /* unit quaternion x, y, z, w */
+    float scale[3];
+    sy_mat4 matrix;        /* always valid: the local matrix (from TRS when mode == TRS) */
+} sy_transform;
+
+typedef enum sy_node_flags {
+    SY_NODE_VISIBLE = 1u << 0,
+    SY_NODE_STATIC = 1u << 1,   /* hint: transform rarely changes (merge into a static BVH) */
+    SY_NODE_ANIMATED = 1u << 2, /* hint: transform or mesh changes often */
+} sy_node_flags;
+
+enum sy_node_field {
+    SY_NODE_NAME = 0,
+    SY_NODE_TRANSFORM = 1, /* sy_transform */
+    SY_NODE_CHILDREN = 2,  /* sy_blob* of uint32 node ids (NULL = none) */
+    SY_NODE_MESH = 3,      /* sy_mesh */
+    SY_NODE_LIGHT = 4,     /* sy_light */
+    SY_NODE_CAMERA = 5,    /* sy_camera */
+    SY_NODE_FLAGS = 6,     /* uint32 sy_node_flags */
+    SY_NODE_FIELD_COUNT = 7
+};
+
+typedef struct sy_node_data {
+    char *name;
+    sy_transform transform;
+    sy_blob *children; /* uint32 node ids; use sy_node_children() to read */
+    sy_mesh mesh;
+    sy_light light;
+    sy_camera camera;
+    uint32_t flags;
+} sy_node_data;
+
+/* ---------------------------------------------------------------- mesh */
+/* One triangle-list primitive. Fixed vertex formats; every present attribute has vertex_count
+ * elements: positions float[3] (required), normals float[3], tangents float[4], texcoords float[2],
+ * colors float[4] (linear RGBA), indices uint32[3 * triangle_count] (NULL: non-indexed, vertex_count
+ * must be a multiple of 3). */
+typedef struct sy_primitive {
+    sy_blob *positions;
+    sy_blob *normals;
+    sy_blob *tangents;
+    sy_blob *texcoords0;
+    sy_blob *texcoords1;
+    sy_blob *colors;
+    sy_blob *indices;
+    sy_material material; /* {0}: default material */
+} sy_primitive;
+
+enum sy_mesh_field {
+    SY_MESH_NAME = 0,
+    SY_MESH_PRIMITIVES = 1, /* sy_primitive_list */
+    SY_MESH_FIELD_COUNT = 2
+};
+
+typedef struct sy_primitive_list {
+    sy_primitive *items;
+    uint32_t count;
+} sy_primitive_list;
+
+typedef struct sy_mesh_data {
+    char *name;
+    sy_primitive_list primitives;
+} sy_mesh_data;
+
+uint32_t sy_primitive_vertex_count(const sy_primitive *p);
+uint32_t sy_primitive_triangle_count(const sy_primitive *p);
+
+/* ---------------------------------------------------------------- material (glTF 2.0 metallic-roughness) */
+typedef enum sy_alpha_mode { SY_ALPHA_OPAQUE = 0, SY_ALPHA_MASK = 1, SY_ALPHA_BLEND = 2 } sy_alpha_mode;
+
+typedef struct sy_texture_ref {
+    sy_texture texture; /* {0}: none */
+    uint32_t texcoord;  /* which texcoord set (0 or 1) */
+    float scale;        /* normal scale / occlusion strength; 1 otherwise */
+    float offset[2];    /* KHR_texture_transform: uv' = T(offset) R(rotation) S(uv_scale) uv */
+    float rotation;
+    float uv_scale[2];
+} sy_texture_ref;
+
+enum sy_material_field {
+    SY_MATERIAL_NAME = 0,
+    SY_MATERIAL_BASE_COLOR = 1,          /* float[4] linear RGBA factor */
+    SY_MATERIAL_BASE_COLOR_TEXTURE = 2,  /* sy_texture_ref */
+    SY_MATERIAL_METALLIC = 3,            /* float */
+    SY_MATERIAL_ROUGHNESS = 4,           /* float */
+    SY_MATERIAL_METALLIC_ROUGHNESS_TEXTURE = 5,
+    SY_MATERIAL_NORMAL_TEXTURE = 6,
+    SY_MATERIAL_OCCLUSION_TEXTURE = 7,
+    SY_MATERIAL_EMISSIVE = 8,            /* float[3] factor */
+    SY_MATERIAL_EMISSIVE_STRENGTH = 9,   /* float (KHR_materials_emissive_strength) */
+    SY_MATERIAL_EMISSIVE_TEXTURE = 10,
+    SY_MATERIAL_ALPHA_MODE = 11,         /* uint32 sy_alpha_mode */
+    SY_MATERIAL_ALPHA_CUTOFF = 12,       /* float */
+    SY_MATERIAL_DOUBLE_SIDED = 13,       /* uint32 0/1 */
+    SY_MATERIAL_TRANSMISSION = 14,       /* float (KHR_materials_transmission) */
+    SY_MATERIAL_TRANSMISSION_TEXTURE = 15,
+    SY_MATERIAL_IOR = 16,                /* float (KHR_materials_ior) */
+    SY_MATERIAL_UNLIT = 17,              /* uint32 0/1 (KHR_materials_unlit) */
+    SY_MATERIAL_FIELD_COUNT = 18
+};
+
+typedef struct sy_material_data {
+    char *name;
+    float base_color[4];
+    sy_texture_ref base_color_texture;
+    float metallic;
+    float roughness;
+    sy_texture_ref metallic_roughness_texture;
+    sy_texture_ref normal_texture;
+    sy_texture_ref occlusion_texture;
+    float emissive[3];
+    float emissive_strength;
+    sy_texture_ref emissive_texture;
+    uint32_t alpha_mode;
+    float alpha_cutoff;
+    uint32_t double_sided;
+    float transmission;
+    sy_texture_ref transmission_texture;
+    float ior;
+    uint32_t unlit;
+} sy_material_data;
+
+/* ---------------------------------------------------------------- texture */
+typedef enum sy_pixel_format {
+    SY_PIXEL_U8_SRGB = 1,   /* 8-bit, sRGB-encoded colour (alpha linear) */
+    SY_PIXEL_U8_LINEAR = 2, /* 8-bit, linear data (normals, metallic-roughness) */
+    SY_PIXEL_F32 = 3,       /* float, linear */
+} sy_pixel_format;
+
+typedef enum sy_wrap { SY_WRAP_REPEAT = 0, SY_WRAP_CLAMP = 1, SY_WRAP_MIRROR = 2 } sy_wrap;
+typedef enum sy_filter { SY_FILTER_LINEAR = 0, SY_FILTER_NEAREST = 1 } sy_filter;
+
+typedef struct sy_image_info {
+    uint32_t width, height;
+    uint32_t channels; /* 1..4 */
+    uint32_t format;   /* sy_pixel_format */
+} sy_image_info;
+
+typedef struct sy_sampler {
+    uint32_t wrap_s, wrap_t;         /* sy_wrap */
+    uint32_t min_filter, mag_filter; /* sy_filter */
+} sy_sampler;
+
+enum sy_texture_field {
+    SY_TEXTURE_NAME = 0,
+    SY_TEXTURE_INFO = 1,    /* sy_image_info */
+    SY_TEXTURE_PIXELS = 2,  /* sy_blob*: rows top to bottom, channels interleaved */
+    SY_TEXTURE_SAMPLER = 3, /* sy_sampler */
+    SY_TEXTURE_FIELD_COUNT = 4
+};
+
+typedef struct sy_texture_data {
+    char *name;
+    sy_image_info info;
+    sy_blob *pixels;
+    sy_sampler sampler;
+} sy_texture_data;
+
+/* ---------------------------------------------------------------- light (KHR_lights_punctual) */
+typedef enum sy_light_type { SY_LIGHT_POINT = 0, SY_LIGHT_SPOT = 1, SY_LIGHT_DIRECTIONAL = 2 } sy_light_type;
+
+enum sy_light_field {
+    SY_LIGHT_NAME = 0,
+    SY_LIGHT_TYPE = 1,       /* uint32 sy_light_type */
+    SY_LIGHT_COLOR = 2,      /* float[3] linear */
+    SY_LIGHT_INTENSITY = 3,  /* float: candela (point, spot), lux (directional) */
+    SY_LIGHT_RANGE = 4,      /* float, 0 = infinite */
+    SY_LIGHT_INNER_CONE = 5, /* float radians */
+    SY_LIGHT_OUTER_CONE = 6, /* float radians */
+    SY_LIGHT_FIELD_COUNT = 7
+};
+
+typedef struct sy_light_data {
+    char *name;
+    uint32_t type;
+    float color[3];
+    float intensity;
+    float range;
+    float inner_cone;
+    float outer_cone;
+} sy_light_data;
+
+/* ---------------------------------------------------------------- camera */
+typedef enum sy_projection { SY_PROJECTION_PERSPECTIVE = 0, SY_PROJECTION_ORTHOGRAPHIC = 1 } sy_projection;
+
+enum sy_camera_field {
+    SY_CAMERA_NAME = 0,
+    SY_CAMERA_PROJECTION = 1, /* uint32 sy_projection */
+    SY_CAMERA_YFOV = 2,       /* float radians (perspective) */
+    SY_CAMERA_ASPECT = 3,     /* float width/height; 0 = from the image */
+    SY_CAMERA_ZNEAR = 4,      /* float */
+    SY_CAMERA_ZFAR = 5,       /* float; 0 = infinite */
+    SY_CAMERA_XMAG = 6,       /* float half width (orthographic) */
+    SY_CAMERA_YMAG = 7,       /* float half height (orthographic) */
+    SY_CAMERA_FIELD_COUNT = 8
+};
+
+typedef struct sy_camera_data {
+    char *name;
+    uint32_t projection;
+    float yfov;
+    float aspect;
+    float znear;
+    float zfar;
+    float xmag;
+    float ymag;
+} sy_camera_data;
+
+/* ---------------------------------------------------------------- background */
+enum sy_background_field {
+    SY_BACKGROUND_NAME = 0,
+    SY_BACKGROUND_COLOR = 1,       /* float[4] linear RGBA, premultiplied; alpha 0 = transparent */
+    SY_BACKGROUND_ENVIRONMENT = 2, /* sy_texture (equirectangular), {0} = none */
+    SY_BACKGROUND_INTENSITY = 3,   /* float multiplier for the environment */
+    SY_BACKGROUND_FIELD_COUNT = 4
+};
+
+typedef struct sy_background_data {
+    char *name;
+    float color[4];
+    sy_texture environment;
+    float intensity;
+} sy_background_data;
+
+/* ---------------------------------------------------------------- attachments */
+typedef enum sy_attachment_kind {
+    SY_ATTACH_INT = 1,
+    SY_ATTACH_FLOAT = 2,
+    SY_ATTACH_VEC4 = 3,
+    SY_ATTACH_STRING = 4,
+    SY_ATTACH_BLOB = 5,
+} sy_attachment_kind;
+
+/* A named, typed value on any object (back-end specific extensions). Mediators that understand
+ * a key use it; others ignore it. */
+typedef struct sy_attachment {
+    char *key;
+    uint32_t kind; /* sy_attachment_kind */
+    union {
+        int64_t i;
+        double f;
+        float v[4];
+        char *s;
+        sy_blob *blob;
+    } value;
+} sy_attachment;
+
+/* ---------------------------------------------------------------- scene */
+sy_result sy_scene_create(sy_scene **out, sy_error *err);
+void sy_scene_destroy(sy_scene *s); /* NULL-safe; releases everything */
+
+/* Default field values of a type (glTF defaults): const sy_node_data* etc. Static storage. */
+const void *sy_object_defaults(sy_object_type t);
+
+/* Create an object with default field values (name copied, may be NULL). */
+sy_result sy_node_create(sy_scene *s, const char *name, sy_node *out, sy_error *err);
+sy_result sy_mesh_create(sy_scene *s, const char *name, sy_mesh *out, sy_error *err);
+sy_result sy_material_create(sy_scene *s, const char *name, sy_material *out, sy_error *err);
+sy_result sy_texture_create(sy_scene *s, const char *name, sy_texture *out, sy_error *err);
+sy_result sy_light_create(sy_scene *s, const char *name, sy_light *out, sy_error *err);
+sy_result sy_camera_create(sy_scene *s, const char *name, sy_camera *out, sy_error *err);
+sy_result sy_background_create(sy_scene *s, const char *name, sy_background *out, sy_error *err);
+/* Generic form: *id_out receives the new handle id. */
+sy_result sy_object_create(sy_scene *s, sy_object_type t, const char *name, uint32_t *id_out, sy_error *err);
+
+/* Destroys the object. References to it elsewhere (a node's mesh, a child list) are NOT removed:
+ * readers treat a stale reference as absent. */
+sy_result sy_object_destroy(sy_scene *s, sy_object_type t, uint32_t id, sy_error *err);
+
+bool sy_object_is_valid(const sy_scene *s, sy_object_type t, uint32_t id);
+/* Borrowed pointer to the data struct (sy_node_data* for SY_TYPE_NODE, ...) or NULL if stale. */
+const void *sy_object_get(const sy_scene *s, sy_object_type t, uint32_t id);
+/* Iteration over live objects of a type in slot order: start with prev_id 0; returns 0 at the end. */
+uint32_t sy_scene_next(const sy_scene *s, sy_object_type t, uint32_t prev_id);
+uint32_t sy_scene_count(const sy_scene *s, sy_object_type t);
+
+/* Generic setter: value points to the field's type as listed in the field enums (for strings a
+ * `const char *`, for blob fields a `sy_blob *` (retained, may be NULL), for SY_MESH_PRIMITIVES a
+ * `sy_primitive_list`). Validates the value; marks the field dirty when it differs. */
+sy_result sy_object_set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32_t field, const void *value,
+                              sy_error *err);
+
+/* Typed setters (thin wrappers over sy_object_set_field). */
+sy_result sy_node_set_trs(sy_scene *s, sy_node n, const float t[3], const float r[4], const float sc[3], sy_error *err);
+sy_result sy_node_set_matrix(sy_scene *s, sy_node n, const sy_mat4 *m, sy_error *err);
+/* Replaces the child list. Refuses stale children and cycles (a node below itself). */
+sy_result sy_node_set_children(sy_scene *s, sy_node n, const sy_node *children, uint32_t count, sy_error *err);
+sy_result sy_node_add_child(sy_scene *s, sy_node parent, sy_node child, sy_error *err);
+sy_result sy_node_set_mesh(sy_scene *s, sy_node n, sy_mesh m, sy_error *err);
+sy_result sy_node_set_light(sy_scene *s, sy_node n, sy_light l, sy_error *err);
+sy_result sy_node_set_camera(sy_scene *s, sy_node n, sy_camera c, sy_error *err);
+sy_result sy_node_set_flags(sy_scene *s, sy_node n, uint32_t flags, sy_error *err);
+/* Retains every blob; validates sizes and index ranges of every primitive. */
+sy_result sy_mesh_set_primitives(sy_scene *s, sy_mesh m, const sy_primitive *prims, uint32_t count, sy_error *err);
+/* Sets every field of the struct (name included); only fields that differ are marked dirty. */
+sy_result sy_material_set(sy_scene *s, sy_material m, const sy_material_data *d, sy_error *err);
+sy_result sy_light_set(sy_scene *s, sy_light l, const sy_light_data *d, sy_error *err);
+sy_result sy_camera_set(sy_scene *s, sy_camera c, const sy_camera_data *d, sy_error *err);
+sy_result sy_background_set(sy_scene *s, sy_background b, const sy_background_data *d, sy_error *err);
+/* Validates that the blob holds width*height*channels elements of the format. Retains pixels. */
+sy_result sy_texture_set_image(sy_scene *s, sy_texture t, const sy_image_info *info, sy_blob *pixels, sy_error *err);
+sy_result sy_texture_set_sampler(sy_scene *s, sy_texture t, const sy_sampler *smp, sy_error *err);
+
+/* Typed getters: borrowed, NULL for a stale handle. */
+const sy_node_data *sy_node_get(const sy_scene *s, sy_node n);
+const sy_mesh_data *sy_mesh_get(const sy_scene *s, sy_mesh m);
+const sy_material_data *sy_material_get(const sy_scene *s, sy_material m); /* {0}: defaults */
+const sy_texture_data *sy_texture_get(const sy_scene *s, sy_texture t);
+const sy_light_data *sy_light_get(const sy_scene *s, sy_light l);
+const sy_camera_data *sy_camera_get(const sy_scene *s, sy_camera c);
+const sy_background_data *sy_background_get(const sy_scene *s, sy_background b);
+
+/* Child ids of a node data struct (borrowed from the children blob); count may be 0. */
+const uint32_t *sy_node_children(const sy_node_data *d, uint32_t *count_out);
+
+/* Attachments. set replaces an attachment with the same key (key and strings copied, blob
+ * retained); remove returns SY_ERR_NOT_FOUND when absent. get returns a borrowed array. */
+sy_result sy_object_set_attachment(sy_scene *s, sy_object_type t, uint32_t id, const sy_attachment *a,
+                                   sy_error *err);
+sy_result sy_object_remove_attachment(sy_scene *s, sy_object_type t, uint32_t id, const char *key, sy_error *err);
+const sy_attachment *sy_object_attachments(const sy_scene *s, sy_object_type t, uint32_t id, uint32_t *count_out);
+const sy_attachment *sy_object_find_attachment(const sy_scene *s, sy_object_type t, uint32_t id, const char *key);
+
+/* ---- graph queries (valid as of the last commit; recomputed incrementally for dirty subtrees) ----
+ * In a DAG a node reached along several paths has several world placements; these queries follow
+ * each node's primary parent (its first parent), which is the only placement in a tree. */
+uint32_t sy_node_parent_count(const sy_scene *s, sy_node n);
+sy_node sy_node_parent(const sy_scene *s, sy_node n, uint32_t i);
+sy_result sy_node_world_matrix(const sy_scene *s, sy_node n, sy_mat4 *out, sy_error *err);
+/* World-space bounds of the node's subtree (its mesh and all descendants), primary path. */
+sy_result sy_node_world_bounds(const sy_scene *s, sy_node n, sy_bounds *out, sy_error *err);
+/* Local bounds of a mesh (all primitives). */
+sy_result sy_mesh_bounds(const sy_scene *s, sy_mesh m, sy_bounds *out, sy_error *err);
+/* World bounds of every root (nodes without parents) together. */
+sy_bounds sy_scene_world_bounds(const sy_scene *s);
+
+/* Statistic: nodes whose world matrix was recomputed by the last commit. */
+uint32_t sy_scene_last_commit_world_updates(const sy_scene *s);
+
+/* ---- commit and consumers (see sy_changes.h for the change list type) ---- */
+typedef struct sy_changes sy_changes;
+
+/* Seals the changes since the last commit into one change list and recomputes world matrices
+ * and bounds of dirty subtrees. Returns the new frame number (first commit: 1) in *frame_out. */
+sy_result sy_scene_commit(sy_scene *s, uint64_t *frame_out, sy_error *err);
+uint64_t sy_scene_frame(const sy_scene *s); /* last committed frame (0 before the first) */
+bool sy_scene_has_pending(const sy_scene *s); /* uncommitted changes exist */
+
+/* Adds a consumer. Its first pull returns a snapshot (a change list creating every live object
+ * with all fields) of the last committed state, merged with anything after. If uncommitted
+ * changes exist when it is added, the snapshot is taken at the next commit (pulls before then
+ * return empty lists). */
+sy_result sy_scene_consumer_add(sy_scene *s, uint32_t *consumer_out, sy_error *err);
+void sy_scene_consumer_remove(sy_scene *s, uint32_t consumer);
+/* Everything committed since this consumer's last pull, merged into one change list (one entry
+ * per object). Ownership: the caller owns *out and releases it with sy_changes_release. */
+sy_result sy_scene_consumer_pull(sy_scene *s, uint32_t consumer, sy_changes **out, sy_error *err);
+/* Number of sealed change lists still held in the log (for tests of compaction). */
+uint32_t sy_scene_log_length(const sy_scene *s);
+/* Bytes held by the change log (entry structs and copied values, not shared blob payloads). */
+size_t sy_scene_log_bytes(const sy_scene *s);
+
+/* A change list creating every live (committed) object with all its fields. Caller owns *out. */
+sy_result sy_scene_snapshot(sy_scene *s, sy_changes **out, sy_error *err);
+
+/* Replica side: apply a change list (local or deserialised) to this scene. Objects are created
+ * with the exact handle ids of the change list; the applied changes are recorded like local ones,
+ * so this scene's own consumers see them after its next commit. */
+sy_result sy_scene_apply(sy_scene *s, const sy_changes *changes, sy_error *err);
+
+/* Deep comparison of every live object, field and attachment (blobs by content hash). Returns
+ * true when equal; otherwise false and a description of the first difference in err->message. */
+bool sy_scene_equal(const sy_scene *a, const sy_scene *b, sy_error *diff);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_SCENE_H */

@@ -1,0 +1,256 @@
+/* sy_viewport.c — windows, viewports, stereo frusta and layer compositing (see sy_viewport.h). */
+#include "sy_viewport.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct sy_viewport {
+    sy_viewport_desc desc; /* backend/params point at the copies below */
+    char *backend;
+    char *params_text;
+    sy_params params;
+    bool active;
+};
+
+struct sy_window {
+    uint32_t width, height;
+    sy_viewport **viewports;
+    uint32_t count, capacity;
+};
+
+sy_result sy_window_create(uint32_t width, uint32_t height, sy_window **out, sy_error *err)
+{
+    *out = NULL;
+    if (width == 0 || height == 0 || width > 65536 || height > 65536)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "window: bad size %ux%u", width, height);
+    sy_window *w = calloc(1, sizeof *w);
+    if (!w) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "window: out of memory");
+    w->width = width;
+    w->height = height;
+    *out = w;
+    return SY_OK;
+}
+
+static void viewport_free(sy_viewport *v)
+{
+    if (!v) return;
+    free(v->backend);
+    free(v->params_text);
+    free(v);
+}
+
+void sy_window_destroy(sy_window *w)
+{
+    if (!w) return;
+    for (uint32_t i = 0; i < w->count; ++i) viewport_free(w->viewports[i]);
+    free(w->viewports);
+    free(w);
+}
+
+sy_result sy_window_resize(sy_window *w, uint32_t width, uint32_t height, sy_error *err)
+{
+    if (width == 0 || height == 0 || width > 65536 || height > 65536)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "window: bad size %ux%u", width, height);
+    w->width = width;
+    w->height = height;
+    return SY_OK;
+}
+
+void sy_window_size(const sy_window *w, uint32_t *width, uint32_t *height)
+{
+    *width = w->width;
+    *height = w->height;
+}
+
+sy_result sy_viewport_set_backend(sy_viewport *v, const char *backend, const char *params, sy_error *err)
+{
+    if (!backend || !backend[0]) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "viewport: no back-end name");
+    sy_params parsed;
+    sy_result r = sy_params_parse(params, &parsed, err);
+    if (r != SY_OK) return r;
+    char *b = strdup(backend), *p = params ? strdup(params) : NULL;
+    if (!b || (params && !p)) {
+        free(b);
+        free(p);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "viewport: out of memory");
+    }
+    free(v->backend);
+    free(v->params_text);
+    v->backend = b;
+    v->params_text = p;
+    v->params = parsed;
+    v->desc.backend = v->backend;
+    v->desc.params = v->params_text;
+    return SY_OK;
+}
+
+sy_result sy_window_add_viewport(sy_window *w, const sy_viewport_desc *desc, sy_viewport **out, sy_error *err)
+{
+    *out = NULL;
+    if (desc->eye > SY_EYE_RIGHT || desc->composite > SY_COMPOSITE_ALPHA_OVER)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "viewport: bad eye %u or composite mode %u", desc->eye,
+                            desc->composite);
+    sy_viewport *v = calloc(1, sizeof *v);
+    if (!v) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "viewport: out of memory");
+    v->desc = *desc;
+    if (v->desc.eye_separation == 0.0f) v->desc.eye_separation = 0.065f;
+    if (v->desc.zero_parallax == 0.0f) v->desc.zero_parallax = 2.0f;
+    v->active = !desc->inactive;
+    sy_result r = sy_viewport_set_backend(v, desc->backend, desc->params, err);
+    if (r != SY_OK) {
+        viewport_free(v);
+        return r;
+    }
+    if (w->count == w->capacity) {
+        uint32_t nc = w->capacity ? w->capacity * 2 : 4;
+        sy_viewport **nv = realloc(w->viewports, sizeof *nv * nc);
+        if (!nv) {
+            viewport_free(v);
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "viewport: out of memory");
+        }
+        w->viewports = nv;
+        w->capacity = nc;
+    }
+    w->viewports[w->count++] = v;
+    *out = v;
+    return SY_OK;
+}
+
+uint32_t sy_window_viewport_count(const sy_window *w) { return w->count; }
+sy_viewport *sy_window_viewport(const sy_window *w, uint32_t i) { return i < w->count ? w->viewports[i] : NULL; }
+void sy_viewport_set_active(sy_viewport *v, bool active) { v->active = active; }
+bool sy_viewport_active(const sy_viewport *v) { return v->active; }
+void sy_viewport_set_camera(sy_viewport *v, sy_node camera) { v->desc.camera = camera; }
+const char *sy_viewport_backend(const sy_viewport *v) { return v->backend; }
+
+static void viewport_rect(const sy_viewport *v, uint32_t ww, uint32_t wh, uint32_t r[4])
+{
+    r[0] = v->desc.x < ww ? v->desc.x : ww;
+    r[1] = v->desc.y < wh ? v->desc.y : wh;
+    r[2] = v->desc.width ? v->desc.width : ww;
+    r[3] = v->desc.height ? v->desc.height : wh;
+    if (r[2] > ww - r[0]) r[2] = ww - r[0];
+    if (r[3] > wh - r[1]) r[3] = wh - r[1];
+}
+
+sy_camera_view sy_camera_view_eye(const sy_camera_view *mono, uint32_t eye, float separation, float zero_parallax)
+{
+    sy_camera_view v = *mono;
+    if (eye == SY_EYE_MONO) return v;
+    float side = eye == SY_EYE_LEFT ? -0.5f : 0.5f;
+    float shift = side * separation;
+    const float *m = mono->camera_to_world.m;
+    /* move the eye along the camera's local X axis */
+    for (int i = 0; i < 3; ++i) v.camera_to_world.m[12 + i] += m[i] * shift;
+    if (mono->projection == SY_PROJECTION_PERSPECTIVE && zero_parallax > 0.0f) {
+        /* skew: the window seen from the shifted eye must cover the same rectangle at zero_parallax */
+        float d = shift / zero_parallax;
+        v.window[0] -= d;
+        v.window[1] -= d;
+    }
+    return v;
+}
+
+sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, uint32_t ww, uint32_t wh,
+                                  sy_camera_view *out, sy_error *err)
+{
+    uint32_t r[4];
+    viewport_rect(v, ww, wh, r);
+    float aspect = r[3] ? (float)r[2] / (float)r[3] : 1.0f;
+    sy_camera_view mono;
+    if (v->desc.camera.id) {
+        const sy_node_data *nd = sy_node_get(scene, v->desc.camera);
+        const sy_camera_data *cd = nd ? sy_camera_get(scene, nd->camera) : NULL;
+        if (!cd) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "viewport: camera node %#x has no camera", v->desc.camera.id);
+        sy_mat4 world;
+        sy_result res = sy_node_world_matrix(scene, v->desc.camera, &world, err);
+        if (res != SY_OK) return res;
+        mono = sy_camera_view_make(cd, &world, aspect);
+    } else {
+        sy_bounds b;
+        if (v->desc.root.id) {
+            sy_result res = sy_node_world_bounds(scene, v->desc.root, &b, err);
+            if (res != SY_OK) return res;
+        } else {
+            b = sy_scene_world_bounds(scene);
+        }
+        mono = sy_camera_view_frame_bounds(&b, aspect);
+    }
+    *out = sy_camera_view_eye(&mono, v->desc.eye, v->desc.eye_separation, v->desc.zero_parallax);
+    return SY_OK;
+}
+
+void sy_layer_composite(sy_layer *dst, const sy_layer *src, uint32_t x, uint32_t y, uint32_t mode)
+{
+    if (x >= dst->width || y >= dst->height) return;
+    uint32_t w = src->width < dst->width - x ? src->width : dst->width - x;
+    uint32_t h = src->height < dst->height - y ? src->height : dst->height - y;
+    for (uint32_t j = 0; j < h; ++j)
+        for (uint32_t i = 0; i < w; ++i) {
+            size_t si = (size_t)j * src->width + i, di = (size_t)(y + j) * dst->width + (x + i);
+            const float *s = src->rgba + 4 * si;
+            float *d = dst->rgba + 4 * di;
+            float sd = src->depth[si];
+            switch (mode) {
+            case SY_COMPOSITE_DEPTH:
+                if (sd < dst->depth[di]) {
+                    memcpy(d, s, 4 * sizeof(float));
+                    dst->depth[di] = sd;
+                }
+                break;
+            case SY_COMPOSITE_ALPHA_OVER: {
+                float k = 1.0f - s[3];
+                for (int c = 0; c < 4; ++c) d[c] = s[c] + d[c] * k;
+                if (s[3] > 0.0f && sd < dst->depth[di]) dst->depth[di] = sd;
+                break;
+            }
+            default:
+                memcpy(d, s, 4 * sizeof(float));
+                dst->depth[di] = sd;
+                break;
+            }
+        }
+}
+
+sy_result sy_window_render(sy_window *w, sy_scene *scene, sy_context_pool *pool, const sy_window_render_opts *opts,
+                           sy_layer *out, sy_error *err)
+{
+    static const sy_window_render_opts defaults;
+    if (!opts) opts = &defaults;
+    if (out->width != w->width || out->height != w->height)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "window render: layer %ux%u for a %ux%u window", out->width,
+                            out->height, w->width, w->height);
+    sy_layer_clear(out);
+    sy_result r = SY_OK;
+    for (uint32_t i = 0; i < w->count && r == SY_OK; ++i) {
+        sy_viewport *v = w->viewports[i];
+        if (!v->active) continue;
+        uint32_t rect[4];
+        viewport_rect(v, w->width, w->height, rect);
+        if (!rect[2] || !rect[3]) continue;
+        sy_context *ctx;
+        r = sy_context_pool_get(pool, scene, v->backend, &v->params, v->desc.root.id, &ctx, err);
+        if (r == SY_OK) r = sy_context_sync(ctx, err);
+        sy_render_request req;
+        memset(&req, 0, sizeof req);
+        if (r == SY_OK) r = sy_viewport_camera_view(v, scene, w->width, w->height, &req.camera, err);
+        if (r != SY_OK) break;
+        req.full_width = rect[2];
+        req.full_height = rect[3];
+        req.rect_w = rect[2];
+        req.rect_h = rect[3];
+        req.sample_count = opts->sample_count;
+        req.background_id = v->desc.background.id;
+        req.seed = opts->seed;
+        req.progress = opts->progress;
+        req.progress_user = opts->progress_user;
+        sy_layer layer;
+        r = sy_layer_create(rect[2], rect[3], &layer, err);
+        if (r != SY_OK) break;
+        r = sy_context_render(ctx, &req, &layer, err);
+        if (r == SY_OK) sy_layer_composite(out, &layer, rect[0], rect[1], v->desc.composite);
+        sy_layer_destroy(&layer);
+    }
+    return r;
+}

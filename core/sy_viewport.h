@@ -1,0 +1,91 @@
+/* sy_viewport.h — windows, viewports and compositing.
+ *
+ * A window has a size and an ordered list of viewports (back to front). A viewport has a
+ * rectangle in the window, a root node, a camera node, an optional background, a back-end name
+ * and parameters, an eye (mono / left / right), an active flag and a composite mode. Rendering a
+ * window syncs and renders each active viewport into an RGBA float + depth layer, then composites
+ * them in order (replace, depth-composite or alpha-over), so different back-ends share one image.
+ * Stereo is two viewports with off-axis frusta computed here from the eye separation and the
+ * zero-parallax distance; back-ends never know.
+ *
+ * Ownership: the window owns its viewports (sy_window_destroy frees them); contexts come from a
+ * caller-owned sy_context_pool. Thread-safety: single-threaded, like the scene it renders. */
+#ifndef SY_VIEWPORT_H
+#define SY_VIEWPORT_H
+
+#include "sy_mediator.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum sy_eye { SY_EYE_MONO = 0, SY_EYE_LEFT = 1, SY_EYE_RIGHT = 2 } sy_eye;
+
+typedef enum sy_composite {
+    SY_COMPOSITE_REPLACE = 0,    /* the viewport's pixels replace what is below */
+    SY_COMPOSITE_DEPTH = 1,      /* per pixel, the nearer depth wins */
+    SY_COMPOSITE_ALPHA_OVER = 2, /* premultiplied "over" the pixels below */
+} sy_composite;
+
+typedef struct sy_viewport_desc {
+    uint32_t x, y, width, height; /* rectangle in the window, row 0 = top; 0 size = whole window */
+    sy_node root;                 /* {0}: every root of the scene */
+    sy_node camera;               /* a node carrying a camera; {0}: frame the root's bounds */
+    sy_background background;     /* {0}: black */
+    const char *backend;          /* registered mediator name (copied) */
+    const char *params;           /* "k=v,k=v" for the back-end (copied), may be NULL */
+    uint32_t eye;                 /* sy_eye */
+    float eye_separation;         /* metres, for stereo (default 0.065 when 0) */
+    float zero_parallax;          /* metres, distance of the screen plane (default 2 when 0) */
+    uint32_t composite;           /* sy_composite */
+    bool inactive;                /* created inactive */
+} sy_viewport_desc;
+
+typedef struct sy_window sy_window;
+typedef struct sy_viewport sy_viewport;
+
+sy_result sy_window_create(uint32_t width, uint32_t height, sy_window **out, sy_error *err);
+void sy_window_destroy(sy_window *w);
+sy_result sy_window_resize(sy_window *w, uint32_t width, uint32_t height, sy_error *err);
+void sy_window_size(const sy_window *w, uint32_t *width, uint32_t *height);
+
+/* Appends a viewport on top of the existing ones. The pointer is owned by the window. */
+sy_result sy_window_add_viewport(sy_window *w, const sy_viewport_desc *desc, sy_viewport **out, sy_error *err);
+uint32_t sy_window_viewport_count(const sy_window *w);
+sy_viewport *sy_window_viewport(const sy_window *w, uint32_t i);
+
+void sy_viewport_set_active(sy_viewport *v, bool active);
+bool sy_viewport_active(const sy_viewport *v);
+/* Switches the back-end (cached contexts make switching back instant). */
+sy_result sy_viewport_set_backend(sy_viewport *v, const char *backend, const char *params, sy_error *err);
+void sy_viewport_set_camera(sy_viewport *v, sy_node camera);
+const char *sy_viewport_backend(const sy_viewport *v);
+
+/* The camera view a viewport renders with (its camera node's world matrix as of the last commit,
+ * or a view framing the root's bounds), with the eye's off-axis frustum applied. */
+sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, uint32_t window_width,
+                                  uint32_t window_height, sy_camera_view *out, sy_error *err);
+
+/* Off-axis stereo: shifts the camera along its local X by -/+ separation/2 and skews the window
+ * so that the plane at zero_parallax coincides for both eyes. MONO returns the view unchanged. */
+sy_camera_view sy_camera_view_eye(const sy_camera_view *mono, uint32_t eye, float separation, float zero_parallax);
+
+/* Composites src (a viewport's layer) into dst at (x, y) with the given mode. */
+void sy_layer_composite(sy_layer *dst, const sy_layer *src, uint32_t x, uint32_t y, uint32_t mode);
+
+typedef struct sy_window_render_opts {
+    uint32_t seed;
+    uint32_t sample_count; /* progressive back-ends: samples to add this call; 0 = default */
+    sy_progress_fn progress;
+    void *progress_user;
+} sy_window_render_opts;
+
+/* Syncs and renders every active viewport and composites into out (window-sized; created by the
+ * caller with sy_layer_create). */
+sy_result sy_window_render(sy_window *w, sy_scene *scene, sy_context_pool *pool, const sy_window_render_opts *opts,
+                           sy_layer *out, sy_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_VIEWPORT_H */

@@ -1,0 +1,16 @@
+# formats/gltf.cmake — the glTF 2.0 loader in sy_formats: a C loader (sy_gltf.c) over a small C++17
+# shim around tinygltf (sy_gltf_shim.cpp, the only C++ in formats/). Included at the end of
+# formats/CMakeLists.txt.
+target_sources(sy_formats PRIVATE
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf.c
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_shim.cpp
+)
+# Debian's tinygltf exports TinyGLTF::TinyGLTF; accept the lower-case spelling too.
+if(TARGET TinyGLTF::tinygltf)
+  set(SY_TINYGLTF_TARGET TinyGLTF::tinygltf)
+else()
+  set(SY_TINYGLTF_TARGET TinyGLTF::TinyGLTF)
+endif()
+# stb_image: the shim decodes images itself (dimension limit before allocation).
+pkg_check_modules(SY_STB REQUIRED IMPORTED_TARGET stb)
+target_link_libraries(sy_formats PRIVATE ${SY_TINYGLTF_TARGET} PkgConfig::SY_STB)

@@ -1,0 +1,117 @@
+/* sy_exr.h — OpenEXR output of render layers (colour, depth, feature AOVs) and input of any
+ * scanline or tiled OpenEXR image (reference renders, environment maps), on the OpenEXR C core API.
+ *
+ * Conventions (see ../shared/DESIGN.md): pixel (x, y) with row 0 at the TOP, which is also the EXR
+ * orientation (y grows downwards in the data window). Colour stays linear scene-referred; depth is
+ * linear distance with +INFINITY for "nothing hit", stored as FLOAT so it survives exactly.
+ *
+ * Files are written through sy_atomic_file (temp file, fsync, rename): a failed write leaves no
+ * file and no partial file, and an existing target stays untouched.
+ *
+ * The reader treats its input as untrusted: malformed, truncated or hostile files give an error
+ * naming the file and the reason, never a crash; sizes are capped (SY_EXR_MAX_*) with checked
+ * arithmetic before anything is allocated from them.
+ *
+ * Thread-safety: no shared mutable state; distinct calls may run concurrently on distinct files.
+ * A sy_exr_image is plain data; reading it from several threads at once is safe. */
+#ifndef SY_EXR_H
+#define SY_EXR_H
+
+#include "sy_common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Limits applied by the reader (and the writer, for symmetry). */
+#define SY_EXR_MAX_SIDE 65536                 /* pixels per side of the data window */
+#define SY_EXR_MAX_PIXELS (1u << 28)          /* width * height */
+#define SY_EXR_MAX_CHANNELS 1024
+#define SY_EXR_MAX_SAMPLES ((size_t)1 << 30)  /* width * height * channels (4 GiB of floats) */
+
+/* Storage type of a channel in the file. Values match nothing outside this header. */
+typedef enum sy_exr_pixel_type {
+    SY_EXR_PIXEL_FLOAT = 0, /* 32-bit float: exact (the default) */
+    SY_EXR_PIXEL_HALF = 1,  /* 16-bit float: 11 significant bits, max 65504, keeps +-INF */
+    SY_EXR_PIXEL_UINT = 2,  /* 32-bit unsigned integer: reported by the reader, not written */
+    SY_EXR_PIXEL_MAX_ENUM = 0x7fffffff
+} sy_exr_pixel_type;
+
+/* Lossless compressions only: render outputs are reference data. */
+typedef enum sy_exr_compression {
+    SY_EXR_COMPRESSION_DEFAULT = 0, /* = ZIP */
+    SY_EXR_COMPRESSION_NONE = 1,
+    SY_EXR_COMPRESSION_RLE = 2,
+    SY_EXR_COMPRESSION_ZIPS = 3,    /* zlib, one scanline per chunk */
+    SY_EXR_COMPRESSION_ZIP = 4,     /* zlib, 16 scanlines per chunk */
+    SY_EXR_COMPRESSION_PIZ = 5,     /* wavelet + Huffman, good for noisy images */
+    SY_EXR_COMPRESSION_MAX_ENUM = 0x7fffffff
+} sy_exr_compression;
+
+/* One channel to write. The value of pixel (x, y) is
+ *     data[((size_t)y * width + x) * pixel_stride + offset]
+ * so an interleaved RGBA buffer gives four channels with the same data, pixel_stride 4 and
+ * offsets 0..3, and a separate plane gives pixel_stride 1, offset 0.
+ * Ownership: data is borrowed for the duration of the write call only. */
+typedef struct sy_exr_channel_desc {
+    const char *name;       /* "R", "G", "B", "A", "Z", "albedo.R", ... (1..255 bytes, unique) */
+    const float *data;
+    size_t pixel_stride;    /* in floats; 0 means 1 */
+    size_t offset;          /* in floats, added to every pixel's index */
+    sy_exr_pixel_type type; /* FLOAT (default) or HALF */
+} sy_exr_channel_desc;
+
+/* A single-part scanline image to write; zero-initialised fields mean the defaults. */
+typedef struct sy_exr_write_desc {
+    int width, height;              /* 1..SY_EXR_MAX_SIDE each */
+    sy_exr_compression compression; /* default ZIP */
+    const sy_exr_channel_desc *channels;
+    int channel_count;              /* 1..SY_EXR_MAX_CHANNELS */
+} sy_exr_write_desc;
+
+/* Writes desc to path (temp file + rename). Channels may be given in any order (the file stores
+ * them sorted by name). Errors name the file and the reason.
+ * Ownership: borrows everything in desc for the duration of the call. */
+sy_result sy_exr_write(const char *path, const sy_exr_write_desc *desc, sy_error *err);
+
+/* Convenience for a render layer: rgba is w*h interleaved premultiplied linear RGBA floats, row 0 at
+ * the top, written as channels R, G, B, A of type color_type (HALF or FLOAT); depth, when not NULL,
+ * is w*h floats written as channel Z, always FLOAT (so +INFINITY and metres survive exactly).
+ * ZIP compression. */
+sy_result sy_exr_write_rgba(const char *path, int width, int height, const float *rgba, const float *depth,
+                            sy_exr_pixel_type color_type, sy_error *err);
+
+/* One channel of a read image. */
+typedef struct sy_exr_plane {
+    char *name;                   /* as in the file, NUL-terminated */
+    sy_exr_pixel_type stored_type; /* how the file stored it (HALF, FLOAT or UINT) */
+    float *data;                  /* width * height floats, row 0 at the top; UINT converted to float */
+} sy_exr_plane;
+
+/* A decoded image: the data window of the first part, level 0 of a tiled part. */
+typedef struct sy_exr_image {
+    int width, height;          /* data window size */
+    int origin_x, origin_y;     /* data window minimum (usually 0, 0) */
+    int channel_count;
+    sy_exr_plane *channels;     /* sorted by name, as the file lists them */
+} sy_exr_image;
+
+/* Reads the first part of the OpenEXR file at path (scanline or tiled; HALF, FLOAT and UINT
+ * channels) into float planes. Multi-part files: only part 0 is read. Deep images and sub-sampled
+ * channels give SY_ERR_UNSUPPORTED; damaged files SY_ERR_PARSE; a missing file SY_ERR_NOT_FOUND;
+ * sizes beyond SY_EXR_MAX_* SY_ERR_LIMIT.
+ * Ownership: on success the caller owns *out and releases it with sy_exr_image_free; on failure
+ * *out is NULL. */
+sy_result sy_exr_read(const char *path, sy_exr_image **out, sy_error *err);
+
+/* The plane of the channel called name (exact, case-sensitive match), or NULL if there is none.
+ * Ownership: the pointer belongs to img and lives until sy_exr_image_free. */
+const float *sy_exr_image_channel(const sy_exr_image *img, const char *name);
+
+/* Releases img and everything it owns. NULL is a no-op. */
+void sy_exr_image_free(sy_exr_image *img);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_EXR_H */

@@ -1,0 +1,61 @@
+/* sy_file.h — whole-file reading with a size limit, and atomic (temp-then-rename) file output.
+ *
+ * Every file reader in formats/ goes through sy_file_read_all so that a size limit is always applied
+ * to untrusted input, and every writer goes through sy_atomic_file so that a failed write never
+ * leaves half a file behind: the data goes to "<path>.tmp-XXXXXX" in the target's directory, is
+ * flushed and fsync'ed, and only then renamed over the target. Until the rename an existing target
+ * stays untouched.
+ *
+ * Errors name the file and the reason (see core/sy_common.h).
+ * Thread-safety: no shared state; distinct handles may be used from distinct threads. One
+ * sy_atomic_file must not be used from two threads at once. */
+#ifndef SY_FILE_H
+#define SY_FILE_H
+
+#include "sy_common.h"
+
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Reads the whole file at `path` into a fresh buffer.
+ * Refuses (SY_ERR_LIMIT) files larger than max_bytes, without reading them. A missing file gives
+ * SY_ERR_NOT_FOUND, anything else that cannot be read (a directory, an I/O error) SY_ERR_IO.
+ * The buffer holds *size_out bytes followed by one extra '\0' byte (handy for text formats); it is
+ * never NULL on success, even for an empty file.
+ * Ownership: on success the caller owns *data_out and releases it with free(); on failure
+ * *data_out is NULL and *size_out is 0. */
+sy_result sy_file_read_all(const char *path, size_t max_bytes, void **data_out, size_t *size_out,
+                           sy_error *err);
+
+/* An output file in progress. Zero-initialise ({0}) before sy_atomic_file_begin; the fields are
+ * readable by the caller, never to be changed by it. */
+typedef struct sy_atomic_file {
+    FILE *fp;       /* write the content here (or through fd, not both at once) */
+    int fd;         /* the descriptor behind fp, for positional writers (pwrite) */
+    char *path;     /* the final target path (owned copy) */
+    char *tmp_path; /* the temporary file in the same directory (owned) */
+} sy_atomic_file;
+
+/* Creates the temporary file "<path>.tmp-XXXXXX" (mode 0666 minus the umask) and opens it for
+ * binary writing. Fails with a message naming the path when the directory does not exist or is not
+ * writable; nothing is created then.
+ * Ownership: on success *af holds resources that exactly one of sy_atomic_file_commit or
+ * sy_atomic_file_abort releases. On failure *af is left zeroed and needs no cleanup. */
+sy_result sy_atomic_file_begin(const char *path, sy_atomic_file *af, sy_error *err);
+
+/* Flushes, fsyncs and closes the temporary file, then renames it over the target (and fsyncs the
+ * directory, best effort). On any failure the temporary file is removed and an existing target is
+ * left as it was. Always releases the handle (*af is zeroed afterwards, success or not). */
+sy_result sy_atomic_file_commit(sy_atomic_file *af, sy_error *err);
+
+/* Closes and removes the temporary file; the target is untouched. Safe on a zeroed, committed or
+ * already aborted handle (does nothing then). *af is zeroed afterwards. */
+void sy_atomic_file_abort(sy_atomic_file *af);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_FILE_H */

@@ -1,0 +1,98 @@
+/* sy_gltf.h — glTF 2.0 loader: reads .gltf (embedded data: URIs or external files) and .glb and
+ * adds its default scene to a sy_scene through the public scene API.
+ *
+ * What is created: one texture per (glTF texture, role) actually used by a material — colour roles
+ * (base colour, emissive) as SY_PIXEL_U8_SRGB, data roles (normal, metallic-roughness, occlusion,
+ * transmission) as SY_PIXEL_U8_LINEAR; one material per glTF material; one mesh per glTF mesh (a mesh
+ * used by several nodes stays one sy_mesh: instancing); one camera / light per glTF camera /
+ * KHR_lights_punctual light; one node per glTF node reached from the loaded glTF scene, plus one
+ * new root node (named after the glTF scene, "scene <index>" when unnamed) whose children are the
+ * scene's root nodes. Every created node has SY_NODE_VISIBLE. EXT_mesh_gpu_instancing expands into
+ * one child node per instance, all referencing the same sy_mesh.
+ *
+ * Supported: node TRS / matrix; triangle lists, strips and fans (strips and fans become lists;
+ * POINTS / LINES primitives are skipped with a warning); attributes POSITION, NORMAL, TANGENT,
+ * TEXCOORD_0/1, COLOR_0 of any glTF component type (normalized integers scaled) including sparse
+ * accessors; glTF metallic-roughness materials with KHR_materials_emissive_strength,
+ * KHR_materials_transmission, KHR_materials_ior, KHR_materials_unlit, KHR_texture_transform;
+ * images decoded by stb_image (PNG, JPEG, ...) into 8-bit RGB or RGBA (16-bit images are rounded,
+ * grey images expanded to RGBA) with sampler wrap / filter; perspective and orthographic cameras;
+ * KHR_lights_punctual; KHR_mesh_quantization; EXT_mesh_gpu_instancing. Skins, morph targets and
+ * animations are ignored (one warning each).
+ *
+ * Untrusted input: the whole document is validated (indices, accessor / bufferView / buffer ranges
+ * with checked arithmetic, GLB container, index values, node graph must be a forest, limits,
+ * extensionsRequired) before the first object is created. On any failure nothing the call created
+ * remains in the scene (objects created so far are destroyed; the scene's pending change set may
+ * still list them as created-and-destroyed) and err names the file, the glTF element and the
+ * problem, e.g. "Box.gltf: accessors[3]: count 1000000 * stride 12 exceeds bufferView 2 length 768".
+ *
+ * Ownership: the scene owns every created object. *info_out (if given) holds malloc()ed arrays the
+ * caller releases with sy_gltf_info_free (also after a failed load; it is zeroed then).
+ * Thread-safety: no global state. A load writes to `scene`, so calls on one scene must be serialised
+ * like any other scene modification; loads into distinct scenes may run in parallel. */
+#ifndef SY_GLTF_H
+#define SY_GLTF_H
+
+#include "sy_common.h"
+#include "sy_scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Limits for untrusted files. Zero-initialise ({0}) for the defaults given per field. */
+typedef struct sy_gltf_options {
+    size_t max_file_bytes;      /* .gltf / .glb and every external file; 0 = 2 GiB (max 4 GiB - 1) */
+    size_t max_vertices;        /* per primitive; 0 = 1 << 28 */
+    size_t max_indices;         /* per primitive, after strip / fan conversion; 0 = 1 << 28 */
+    uint64_t max_image_pixels;  /* width * height per image; 0 = 1 << 26 */
+    size_t max_instances;       /* EXT_mesh_gpu_instancing instances per node; 0 = 1 << 20 */
+    uint32_t max_json_depth;    /* nesting of JSON arrays / objects; 0 = 64 */
+    int32_t scene_index;        /* glTF scene to load; 0 = the file's default (see below) */
+    bool use_scene_index;       /* true: load scenes[scene_index] instead of the default */
+} sy_gltf_options;
+
+#define SY_GLTF_MAX_WARNINGS 32 /* messages kept; warning_count counts them all */
+
+/* What the file contains (the whole file, not only the loaded scene). */
+typedef struct sy_gltf_counts {
+    uint32_t nodes, meshes, primitives, triangles, materials, textures, images, lights, cameras;
+    uint32_t skipped_primitives; /* points / lines / without POSITION */
+} sy_gltf_counts;
+
+typedef struct sy_gltf_info {
+    sy_node root;              /* the new node whose children are the glTF scene's root nodes */
+    int32_t scene_index;       /* glTF scene loaded; -1: none given, all parentless nodes used */
+    sy_node *camera_nodes;     /* nodes with a camera, in glTF node order (malloc()ed) */
+    uint32_t camera_node_count;
+    char **warnings;           /* up to SY_GLTF_MAX_WARNINGS messages (malloc()ed) */
+    uint32_t warning_count;    /* total number of warnings (may exceed the stored ones) */
+    uint32_t stored_warning_count;
+    sy_gltf_counts counts;
+} sy_gltf_info;
+
+/* Loads the glTF file at `path` into `scene`. The default glTF scene is `scene` of the file, else
+ * scenes[0], else (no scenes) all parentless nodes. opts NULL = defaults; info_out and err may be
+ * NULL. Result codes: SY_ERR_NOT_FOUND (file or external file missing), SY_ERR_IO, SY_ERR_PARSE
+ * (malformed), SY_ERR_LIMIT (an option's limit or arithmetic overflow), SY_ERR_UNSUPPORTED
+ * (extensionsRequired names an unsupported extension), SY_ERR_OUT_OF_MEMORY. */
+sy_result sy_gltf_load(const char *path, sy_scene *scene, const sy_gltf_options *opts, sy_gltf_info *info_out,
+                       sy_error *err);
+
+/* Frees the arrays in *info and zeroes it. NULL-safe. */
+void sy_gltf_info_free(sy_gltf_info *info);
+
+/* Picks a camera node for a command-line style selector: a decimal index into info->camera_nodes,
+ * else the first camera node whose node name or camera name equals `selector`. SY_ERR_NOT_FOUND
+ * (message lists the available cameras) when nothing matches. */
+sy_result sy_gltf_find_camera(const sy_scene *scene, const sy_gltf_info *info, const char *selector, sy_node *out,
+                              sy_error *err);
+
+/* Names of the extensions this loader supports (for "extensionsRequired"), NULL-terminated. */
+const char *const *sy_gltf_supported_extensions(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_GLTF_H */

@@ -1,0 +1,533 @@
+// sy_gltf_shim.cpp — parses glTF with tinygltf and exposes the result as the plain C structs of
+// sy_gltf_shim.h. Parsing only: all cross-reference and range validation happens in sy_gltf.c.
+// Every entry point catches every exception; nothing C++ leaks through the C interface.
+#include "sy_gltf_shim.h"
+
+#include "sy_file.h"
+
+#include <tiny_gltf.h>
+
+#include <stb_image.h>
+
+#include <sys/stat.h>
+
+#include <climits>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct LoadContext {
+    std::string prefix;            // external files must start with this ("" = anything)
+    size_t max_file_bytes = 0;
+    uint64_t max_image_pixels = 0;
+    tinygltf::Model *model = nullptr;
+    sy_result fs_result = SY_OK;   // first file-system failure category
+    std::string fs_message;
+};
+
+// >>file-system callbacks: lookups confined to the glTF's directory, reads size-limited.
+bool fs_file_exists(const std::string &path, void *user)
+{
+    const LoadContext *ctx = static_cast<const LoadContext *>(user);
+    if (!ctx->prefix.empty() && path.compare(0, ctx->prefix.size(), ctx->prefix) != 0) return false;
+    struct stat st;
+    return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+std::string fs_expand(const std::string &path, void *) { return path; } // no shell expansion
+
+bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
+{
+    LoadContext *ctx = static_cast<LoadContext *>(user);
+    void *data = nullptr;
+    size_t size = 0;
+    sy_error e = {};
+    sy_result r = sy_file_read_all(path.c_str(), ctx->max_file_bytes, &data, &size, &e);
+    if (r != SY_OK) {
+        if (ctx->fs_result == SY_OK) {
+            ctx->fs_result = r;
+            ctx->fs_message = e.message;
+        }
+        if (err) *err = e.message;
+        return false;
+    }
+    try {
+        const unsigned char *p = static_cast<const unsigned char *>(data);
+        out->assign(p, p + size);
+    } catch (...) {
+        free(data);
+        throw;
+    }
+    free(data);
+    return true;
+}
+
+bool fs_write(std::string *err, const std::string &, const std::vector<unsigned char> &, void *)
+{
+    if (err) *err = "writing is not supported";
+    return false;
+}
+
+// >>image decoding: dimensions checked against the limit before stb allocates anything.
+bool load_image(tinygltf::Image *image, const int image_idx, std::string *err, std::string *, int, int,
+                const unsigned char *bytes, int size, void *user)
+{
+    LoadContext *ctx = static_cast<LoadContext *>(user);
+    const std::string where = "images[" + std::to_string(image_idx) + "]";
+    size_t len = size > 0 ? size_t(size) : 0;
+    if (image->bufferView >= 0) {
+        // tinygltf computed `bytes` from the bufferView without checking it against its buffer.
+        const tinygltf::Model &m = *ctx->model;
+        if (size_t(image->bufferView) >= m.bufferViews.size()) {
+            if (err) *err += where + ": bufferView " + std::to_string(image->bufferView) + " out of range\n";
+            return false;
+        }
+        const tinygltf::BufferView &bv = m.bufferViews[size_t(image->bufferView)];
+        if (bv.buffer < 0 || size_t(bv.buffer) >= m.buffers.size()) {
+            if (err) *err += where + ": bufferView buffer index out of range\n";
+            return false;
+        }
+        const std::vector<unsigned char> &data = m.buffers[size_t(bv.buffer)].data;
+        if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset) {
+            if (err)
+                *err += where + ": bufferView " + std::to_string(image->bufferView) + " (offset " +
+                        std::to_string(bv.byteOffset) + ", length " + std::to_string(bv.byteLength) +
+                        ") exceeds buffer " + std::to_string(bv.buffer) + " length " + std::to_string(data.size()) +
+                        "\n";
+            return false;
+        }
+        bytes = data.data() + bv.byteOffset;
+        len = bv.byteLength;
+    }
+    if (len == 0 || len > size_t(INT_MAX)) {
+        if (err) *err += where + ": image data is empty or larger than 2 GiB\n";
+        return false;
+    }
+    int w = 0, h = 0, comp = 0;
+    if (!stbi_info_from_memory(bytes, int(len), &w, &h, &comp) || w < 1 || h < 1 || comp < 1 || comp > 4) {
+        const char *why = stbi_failure_reason();
+        if (err) *err += where + ": cannot decode image (" + std::string(why ? why : "unknown format") + ")\n";
+        return false;
+    }
+    if (uint64_t(w) * uint64_t(h) > ctx->max_image_pixels) {
+        if (err)
+            *err += where + ": image " + std::to_string(w) + "x" + std::to_string(h) + " exceeds the limit of " +
+                    std::to_string(ctx->max_image_pixels) + " pixels\n";
+        return false;
+    }
+    const int req = comp <= 2 ? 4 : comp; // grey / grey+alpha become RGBA
+    const size_t n = size_t(w) * size_t(h) * size_t(req);
+    int w2 = 0, h2 = 0, c2 = 0;
+    bool is16 = stbi_is_16_bit_from_memory(bytes, int(len)) != 0;
+    image->image.resize(n);
+    if (is16) {
+        stbi_us *p = stbi_load_16_from_memory(bytes, int(len), &w2, &h2, &c2, req);
+        if (p && (w2 != w || h2 != h)) { stbi_image_free(p); p = nullptr; }
+        if (!p) {
+            image->image.clear();
+            const char *why = stbi_failure_reason();
+            if (err) *err += where + ": cannot decode image (" + std::string(why ? why : "unknown") + ")\n";
+            return false;
+        }
+        for (size_t i = 0; i < n; i++) image->image[i] = (unsigned char)((uint32_t(p[i]) * 255u + 32767u) / 65535u);
+        stbi_image_free(p);
+    } else {
+        stbi_uc *p = stbi_load_from_memory(bytes, int(len), &w2, &h2, &c2, req);
+        if (p && (w2 != w || h2 != h)) { stbi_image_free(p); p = nullptr; }
+        if (!p) {
+            image->image.clear();
+            const char *why = stbi_failure_reason();
+            if (err) *err += where + ": cannot decode image (" + std::string(why ? why : "unknown") + ")\n";
+            return false;
+        }
+        memcpy(image->image.data(), p, n);
+        stbi_image_free(p);
+    }
+    image->width = w;
+    image->height = h;
+    image->component = req;
+    image->bits = is16 ? 16 : 8; // source depth; the pixels are always 8-bit
+    image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    return true;
+}
+
+// >>JSON value helpers (tinygltf::Value asserts on type misuse: check before every Get)
+const tinygltf::Value *member(const tinygltf::Value &v, const char *key)
+{
+    if (!v.IsObject() || !v.Has(key)) return nullptr;
+    return &v.Get(key);
+}
+
+double number(const tinygltf::Value &v, const char *key, double def)
+{
+    const tinygltf::Value *m = member(v, key);
+    return (m && m->IsNumber()) ? m->GetNumberAsDouble() : def;
+}
+
+int32_t integer(const tinygltf::Value &v, const char *key, int32_t def)
+{
+    const tinygltf::Value *m = member(v, key);
+    if (!m || !m->IsNumber()) return def;
+    double d = m->GetNumberAsDouble();
+    if (!(d >= double(INT32_MIN) && d <= double(INT32_MAX))) return INT32_MIN; // out of range: caught later
+    return int32_t(d);
+}
+
+const tinygltf::Value *extension(const tinygltf::ExtensionMap &ext, const char *name)
+{
+    auto it = ext.find(name);
+    return it == ext.end() ? nullptr : &it->second;
+}
+
+void read_transform(const tinygltf::ExtensionMap &ext, sy_gltf_shim_texinfo *t)
+{
+    t->offset[0] = t->offset[1] = 0.0;
+    t->rotation = 0.0;
+    t->uv_scale[0] = t->uv_scale[1] = 1.0;
+    t->transform_texcoord = -1;
+    const tinygltf::Value *tt = extension(ext, "KHR_texture_transform");
+    if (!tt || !tt->IsObject()) return;
+    t->has_transform = 1;
+    const tinygltf::Value *off = member(*tt, "offset");
+    if (off && off->IsArray() && off->ArrayLen() == 2 && off->Get(0).IsNumber() && off->Get(1).IsNumber()) {
+        t->offset[0] = off->Get(0).GetNumberAsDouble();
+        t->offset[1] = off->Get(1).GetNumberAsDouble();
+    }
+    const tinygltf::Value *sc = member(*tt, "scale");
+    if (sc && sc->IsArray() && sc->ArrayLen() == 2 && sc->Get(0).IsNumber() && sc->Get(1).IsNumber()) {
+        t->uv_scale[0] = sc->Get(0).GetNumberAsDouble();
+        t->uv_scale[1] = sc->Get(1).GetNumberAsDouble();
+    }
+    t->rotation = number(*tt, "rotation", 0.0);
+    t->transform_texcoord = integer(*tt, "texCoord", -1);
+}
+
+template <typename Info> sy_gltf_shim_texinfo texinfo(const Info &in, double scale)
+{
+    sy_gltf_shim_texinfo t = {};
+    t.index = in.index;
+    t.texcoord = in.texCoord;
+    t.scale = scale;
+    read_transform(in.extensions, &t);
+    return t;
+}
+
+// Texture info given as a raw JSON value (inside material extensions).
+sy_gltf_shim_texinfo texinfo_value(const tinygltf::Value *v)
+{
+    sy_gltf_shim_texinfo t = {};
+    t.index = -1;
+    t.scale = 1.0;
+    t.offset[0] = t.offset[1] = 0.0;
+    t.uv_scale[0] = t.uv_scale[1] = 1.0;
+    t.transform_texcoord = -1;
+    if (!v || !v->IsObject()) return t;
+    t.index = integer(*v, "index", -1);
+    t.texcoord = integer(*v, "texCoord", 0);
+    const tinygltf::Value *ext = member(*v, "extensions");
+    if (ext && ext->IsObject()) {
+        tinygltf::ExtensionMap map;
+        for (const std::string &k : ext->Keys()) map[k] = ext->Get(k);
+        read_transform(map, &t);
+    }
+    return t;
+}
+
+int32_t components_of(int type)
+{
+    switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    case TINYGLTF_TYPE_MAT2: return 4;
+    case TINYGLTF_TYPE_MAT3: return 9;
+    case TINYGLTF_TYPE_MAT4: return 16;
+    default: return 0;
+    }
+}
+
+std::string one_line(std::string s)
+{
+    while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+    for (char &c : s)
+        if (c == '\n') c = ';';
+    return s;
+}
+
+} // namespace
+
+// The document: the C view plus the C++ storage it points into (doc.internal points back here).
+struct sy_gltf_shim_impl {
+    sy_gltf_doc doc = {};
+    tinygltf::Model model;
+    std::vector<sy_gltf_shim_buffer> buffers;
+    std::vector<sy_gltf_shim_view> views;
+    std::vector<sy_gltf_shim_accessor> accessors;
+    std::vector<std::vector<sy_gltf_shim_primitive>> prims;
+    std::vector<sy_gltf_shim_mesh> meshes;
+    std::vector<sy_gltf_shim_material> materials;
+    std::vector<sy_gltf_shim_texture> textures;
+    std::vector<sy_gltf_shim_sampler> samplers;
+    std::vector<sy_gltf_shim_image> images;
+    std::vector<sy_gltf_shim_camera> cameras;
+    std::vector<sy_gltf_shim_light> lights;
+    std::vector<std::vector<int32_t>> node_children;
+    std::vector<sy_gltf_shim_node> nodes;
+    std::vector<std::vector<int32_t>> scene_nodes;
+    std::vector<sy_gltf_shim_scene> scenes;
+    std::vector<const char *> ext_required;
+    std::string warnings;
+};
+
+static void fill_doc(sy_gltf_shim_impl *d)
+{
+    const tinygltf::Model &m = d->model;
+    for (const tinygltf::Buffer &b : m.buffers) d->buffers.push_back({b.data.data(), b.data.size()});
+    for (const tinygltf::BufferView &v : m.bufferViews)
+        d->views.push_back({int32_t(v.buffer), v.byteOffset, v.byteLength, v.byteStride});
+    for (const tinygltf::Accessor &a : m.accessors) {
+        sy_gltf_shim_accessor c = {};
+        c.name = a.name.c_str();
+        c.buffer_view = a.bufferView;
+        c.byte_offset = a.byteOffset;
+        c.component_type = a.componentType;
+        c.components = components_of(a.type);
+        c.is_matrix = a.type == TINYGLTF_TYPE_MAT2 || a.type == TINYGLTF_TYPE_MAT3 || a.type == TINYGLTF_TYPE_MAT4;
+        c.normalized = a.normalized;
+        c.count = a.count;
+        c.sparse = a.sparse.isSparse;
+        if (a.sparse.isSparse) {
+            c.sparse_count = a.sparse.count;
+            c.sparse_indices_view = a.sparse.indices.bufferView;
+            c.sparse_indices_offset = a.sparse.indices.byteOffset;
+            c.sparse_indices_type = a.sparse.indices.componentType;
+            c.sparse_values_view = a.sparse.values.bufferView;
+            c.sparse_values_offset = a.sparse.values.byteOffset;
+        }
+        d->accessors.push_back(c);
+    }
+    for (const tinygltf::Mesh &mesh : m.meshes) {
+        std::vector<sy_gltf_shim_primitive> ps;
+        for (const tinygltf::Primitive &p : mesh.primitives) {
+            sy_gltf_shim_primitive c = {};
+            c.mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+            c.indices = p.indices;
+            c.material = p.material;
+            auto attr = [&](const char *name) {
+                auto it = p.attributes.find(name);
+                return it == p.attributes.end() ? -1 : int32_t(it->second);
+            };
+            c.position = attr("POSITION");
+            c.normal = attr("NORMAL");
+            c.tangent = attr("TANGENT");
+            c.texcoord0 = attr("TEXCOORD_0");
+            c.texcoord1 = attr("TEXCOORD_1");
+            c.color0 = attr("COLOR_0");
+            c.has_targets = !p.targets.empty();
+            ps.push_back(c);
+        }
+        d->prims.push_back(std::move(ps));
+    }
+    for (size_t i = 0; i < m.meshes.size(); i++)
+        d->meshes.push_back({m.meshes[i].name.c_str(), d->prims[i].data(), d->prims[i].size()});
+    for (const tinygltf::Material &mat : m.materials) {
+        sy_gltf_shim_material c = {};
+        c.name = mat.name.c_str();
+        const tinygltf::PbrMetallicRoughness &pbr = mat.pbrMetallicRoughness;
+        c.base_color_count = int32_t(pbr.baseColorFactor.size());
+        for (size_t k = 0; k < 4; k++) c.base_color[k] = k < pbr.baseColorFactor.size() ? pbr.baseColorFactor[k] : 1.0;
+        c.metallic = pbr.metallicFactor;
+        c.roughness = pbr.roughnessFactor;
+        c.base_color_texture = texinfo(pbr.baseColorTexture, 1.0);
+        c.metallic_roughness_texture = texinfo(pbr.metallicRoughnessTexture, 1.0);
+        c.normal_texture = texinfo(mat.normalTexture, mat.normalTexture.scale);
+        c.occlusion_texture = texinfo(mat.occlusionTexture, mat.occlusionTexture.strength);
+        c.emissive_texture = texinfo(mat.emissiveTexture, 1.0);
+        c.emissive_count = int32_t(mat.emissiveFactor.size());
+        for (size_t k = 0; k < 3; k++) c.emissive[k] = k < mat.emissiveFactor.size() ? mat.emissiveFactor[k] : 0.0;
+        c.alpha_mode = mat.alphaMode.c_str();
+        c.alpha_cutoff = mat.alphaCutoff;
+        c.double_sided = mat.doubleSided;
+        c.emissive_strength = 1.0;
+        c.ior = 1.5;
+        c.transmission_texture = texinfo_value(nullptr);
+        if (const tinygltf::Value *e = extension(mat.extensions, "KHR_materials_emissive_strength"))
+            c.emissive_strength = number(*e, "emissiveStrength", 1.0);
+        if (const tinygltf::Value *e = extension(mat.extensions, "KHR_materials_transmission")) {
+            c.transmission = number(*e, "transmissionFactor", 0.0);
+            c.transmission_texture = texinfo_value(member(*e, "transmissionTexture"));
+        }
+        if (const tinygltf::Value *e = extension(mat.extensions, "KHR_materials_ior")) c.ior = number(*e, "ior", 1.5);
+        c.unlit = extension(mat.extensions, "KHR_materials_unlit") != nullptr;
+        d->materials.push_back(c);
+    }
+    for (const tinygltf::Texture &t : m.textures) d->textures.push_back({t.name.c_str(), t.source, t.sampler});
+    for (const tinygltf::Sampler &s : m.samplers) d->samplers.push_back({s.minFilter, s.magFilter, s.wrapS, s.wrapT});
+    for (const tinygltf::Image &im : m.images) {
+        sy_gltf_shim_image c = {};
+        c.name = im.name.c_str();
+        c.uri = im.uri.c_str();
+        if (!im.image.empty() && im.width > 0 && im.height > 0 && (im.component == 3 || im.component == 4) &&
+            im.image.size() == size_t(im.width) * size_t(im.height) * size_t(im.component)) {
+            c.pixels = im.image.data();
+            c.width = uint32_t(im.width);
+            c.height = uint32_t(im.height);
+            c.channels = uint32_t(im.component);
+            c.source_bits = uint32_t(im.bits);
+            c.problem = "";
+        } else {
+            c.problem = im.uri.empty() ? "image data could not be loaded"
+                                       : "external image file not found or unreadable";
+        }
+        d->images.push_back(c);
+    }
+    for (const tinygltf::Camera &cam : m.cameras) {
+        sy_gltf_shim_camera c = {};
+        c.name = cam.name.c_str();
+        c.type = cam.type.c_str();
+        c.yfov = cam.perspective.yfov;
+        c.aspect = cam.perspective.aspectRatio;
+        c.znear = cam.perspective.znear;
+        c.zfar = cam.perspective.zfar;
+        c.xmag = cam.orthographic.xmag;
+        c.ymag = cam.orthographic.ymag;
+        c.oznear = cam.orthographic.znear;
+        c.ozfar = cam.orthographic.zfar;
+        d->cameras.push_back(c);
+    }
+    for (const tinygltf::Light &l : m.lights) {
+        sy_gltf_shim_light c = {};
+        c.name = l.name.c_str();
+        c.type = l.type.c_str();
+        c.color_count = int32_t(l.color.size());
+        for (size_t k = 0; k < 3; k++) c.color[k] = k < l.color.size() ? l.color[k] : 1.0;
+        c.intensity = l.intensity;
+        c.range = l.range;
+        c.inner_cone = l.spot.innerConeAngle;
+        c.outer_cone = l.spot.outerConeAngle;
+        d->lights.push_back(c);
+    }
+    for (const tinygltf::Node &n : m.nodes) d->node_children.emplace_back(n.children.begin(), n.children.end());
+    for (size_t i = 0; i < m.nodes.size(); i++) {
+        const tinygltf::Node &n = m.nodes[i];
+        sy_gltf_shim_node c = {};
+        c.name = n.name.c_str();
+        c.mesh = n.mesh;
+        c.camera = n.camera;
+        c.skin = n.skin;
+        c.light = -1;
+        if (const tinygltf::Value *e = extension(n.extensions, "KHR_lights_punctual")) c.light = integer(*e, "light", -1);
+        c.inst_translation = c.inst_rotation = c.inst_scale = -1;
+        if (const tinygltf::Value *e = extension(n.extensions, "EXT_mesh_gpu_instancing")) {
+            c.instancing = 1;
+            if (const tinygltf::Value *a = member(*e, "attributes")) {
+                c.inst_translation = integer(*a, "TRANSLATION", -1);
+                c.inst_rotation = integer(*a, "ROTATION", -1);
+                c.inst_scale = integer(*a, "SCALE", -1);
+            }
+        }
+        c.children = d->node_children[i].data();
+        c.child_count = d->node_children[i].size();
+        c.matrix = n.matrix.data();
+        c.matrix_count = n.matrix.size();
+        c.translation = n.translation.data();
+        c.translation_count = n.translation.size();
+        c.rotation = n.rotation.data();
+        c.rotation_count = n.rotation.size();
+        c.scale = n.scale.data();
+        c.scale_count = n.scale.size();
+        c.has_weights = !n.weights.empty();
+        d->nodes.push_back(c);
+    }
+    for (const tinygltf::Scene &s : m.scenes) d->scene_nodes.emplace_back(s.nodes.begin(), s.nodes.end());
+    for (size_t i = 0; i < m.scenes.size(); i++)
+        d->scenes.push_back({m.scenes[i].name.c_str(), d->scene_nodes[i].data(), d->scene_nodes[i].size()});
+    for (const std::string &s : m.extensionsRequired) d->ext_required.push_back(s.c_str());
+
+    sy_gltf_doc &c = d->doc;
+    c.buffers = d->buffers.data();         c.buffer_count = d->buffers.size();
+    c.views = d->views.data();             c.view_count = d->views.size();
+    c.accessors = d->accessors.data();     c.accessor_count = d->accessors.size();
+    c.meshes = d->meshes.data();           c.mesh_count = d->meshes.size();
+    c.materials = d->materials.data();     c.material_count = d->materials.size();
+    c.textures = d->textures.data();       c.texture_count = d->textures.size();
+    c.samplers = d->samplers.data();       c.sampler_count = d->samplers.size();
+    c.images = d->images.data();           c.image_count = d->images.size();
+    c.cameras = d->cameras.data();         c.camera_count = d->cameras.size();
+    c.lights = d->lights.data();           c.light_count = d->lights.size();
+    c.nodes = d->nodes.data();             c.node_count = d->nodes.size();
+    c.scenes = d->scenes.data();           c.scene_count = d->scenes.size();
+    c.default_scene = m.defaultScene;
+    c.extensions_required = d->ext_required.data();
+    c.extensions_required_count = d->ext_required.size();
+    c.skin_count = m.skins.size();
+    c.animation_count = m.animations.size();
+    c.warnings = d->warnings.c_str();
+    c.internal = d;
+}
+
+extern "C" sy_result sy_gltf_shim_parse(const uint8_t *bytes, size_t size, bool binary, const char *base_dir,
+                                        const sy_gltf_shim_limits *limits, sy_gltf_doc **out, sy_error *err)
+{
+    if (out) *out = nullptr;
+    if (!bytes || !out || !limits || !base_dir) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "invalid argument");
+    if (size > UINT_MAX) return sy_error_set(err, SY_ERR_LIMIT, "file larger than 4 GiB");
+    sy_gltf_shim_impl *d = nullptr;
+    try {
+        d = new sy_gltf_shim_impl();
+        LoadContext ctx;
+        ctx.max_file_bytes = limits->max_file_bytes;
+        ctx.max_image_pixels = limits->max_image_pixels;
+        ctx.model = &d->model;
+        std::string base = base_dir;
+        if (!base.empty()) {
+            ctx.prefix = base.back() == '/' ? base : base + "/";
+        }
+        tinygltf::TinyGLTF loader;
+        tinygltf::FsCallbacks fs = {};
+        fs.FileExists = fs_file_exists;
+        fs.ExpandFilePath = fs_expand;
+        fs.ReadWholeFile = fs_read;
+        fs.WriteWholeFile = fs_write;
+        fs.user_data = &ctx;
+        loader.SetFsCallbacks(fs);
+        loader.SetImageLoader(load_image, &ctx);
+        std::string terr, twarn;
+        bool ok = binary ? loader.LoadBinaryFromMemory(&d->model, &terr, &twarn, bytes, unsigned(size), base)
+                         : loader.LoadASCIIFromString(&d->model, &terr, &twarn, reinterpret_cast<const char *>(bytes),
+                                                      unsigned(size), base);
+        if (!ok) {
+            sy_result code = SY_ERR_PARSE;
+            if (ctx.fs_result != SY_OK) code = ctx.fs_result;
+            else if (terr.find("File not found") != std::string::npos) code = SY_ERR_NOT_FOUND;
+            else if (terr.find("exceeds the limit") != std::string::npos) code = SY_ERR_LIMIT;
+            std::string msg = one_line(terr);
+            if (msg.empty()) msg = "tinygltf failed without a message";
+            delete d;
+            return sy_error_set(err, code, "%s", msg.c_str());
+        }
+        d->warnings = one_line(twarn);
+        fill_doc(d);
+        *out = &d->doc;
+        return SY_OK;
+    } catch (const std::bad_alloc &) {
+        delete d;
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory while parsing glTF");
+    } catch (const std::exception &e) {
+        delete d;
+        return sy_error_set(err, SY_ERR_PARSE, "%s", e.what());
+    } catch (...) {
+        delete d;
+        return sy_error_set(err, SY_ERR_PARSE, "unknown exception while parsing glTF");
+    }
+}
+
+extern "C" void sy_gltf_shim_free(sy_gltf_doc *doc)
+{
+    if (doc) delete static_cast<sy_gltf_shim_impl *>(doc->internal);
+}

@@ -1,0 +1,200 @@
+/* sy_gltf_shim.h — C view of a glTF 2.0 document parsed by tinygltf (the only C++ in formats/).
+ *
+ * The shim does the parsing only: JSON -> plain C structs, external and data: URI buffers/images
+ * loaded, images decoded (stb_image) into 8-bit pixels. It does NOT validate cross references or
+ * accessor ranges: every index in these structs is untrusted and must be range-checked by the
+ * caller (formats/sy_gltf.c does, in one validation pass, before it creates anything).
+ *
+ * The GLB container must be validated by the caller before sy_gltf_shim_parse is called with
+ * binary = true (tinygltf 2.7 does not check every chunk bound itself).
+ *
+ * External files are looked up relative to base_dir only (never the working directory) and are
+ * read through sy_file_read_all with limits->max_file_bytes. Images are refused before decoding
+ * when width*height exceeds limits->max_image_pixels.
+ *
+ * Ownership: sy_gltf_shim_parse returns a document owned by the caller, released with
+ * sy_gltf_shim_free (NULL-safe). Every pointer inside (names, arrays, buffer bytes, pixels) is
+ * borrowed from the document and valid until it is freed.
+ * Thread-safety: no shared state; distinct documents may be parsed and read on distinct threads.
+ * Exceptions never cross this interface (everything is caught and turned into a sy_result). */
+#ifndef SY_GLTF_SHIM_H
+#define SY_GLTF_SHIM_H
+
+#include "sy_common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct sy_gltf_shim_limits {
+    size_t max_file_bytes;     /* external buffer / image files */
+    uint64_t max_image_pixels; /* width * height of one decoded image */
+} sy_gltf_shim_limits;
+
+typedef struct sy_gltf_shim_buffer {
+    const uint8_t *data;
+    size_t size;
+} sy_gltf_shim_buffer;
+
+typedef struct sy_gltf_shim_view {
+    int32_t buffer; /* untrusted index */
+    size_t byte_offset;
+    size_t byte_length;
+    size_t byte_stride; /* 0 = tightly packed */
+} sy_gltf_shim_view;
+
+typedef struct sy_gltf_shim_accessor {
+    const char *name;
+    int32_t buffer_view; /* -1: all zeros (sparse may override) */
+    size_t byte_offset;
+    int32_t component_type; /* 5120..5126 (5130 = tinygltf's double, not glTF) */
+    int32_t components;     /* 1, 2, 3, 4, 4 (MAT2), 9, 16; 0 unknown */
+    int32_t is_matrix;
+    int32_t normalized;
+    size_t count;
+    int32_t sparse;           /* 0/1 */
+    int32_t sparse_count;     /* untrusted */
+    int32_t sparse_indices_view;
+    int32_t sparse_indices_offset;
+    int32_t sparse_indices_type;
+    int32_t sparse_values_view;
+    int32_t sparse_values_offset;
+} sy_gltf_shim_accessor;
+
+typedef struct sy_gltf_shim_primitive {
+    int32_t mode; /* 0..6 (default 4) */
+    int32_t indices;
+    int32_t material;
+    int32_t position, normal, tangent, texcoord0, texcoord1, color0; /* accessor index or -1 */
+    int32_t has_targets; /* morph targets present (ignored) */
+} sy_gltf_shim_primitive;
+
+typedef struct sy_gltf_shim_mesh {
+    const char *name;
+    const sy_gltf_shim_primitive *primitives;
+    size_t primitive_count;
+} sy_gltf_shim_mesh;
+
+typedef struct sy_gltf_shim_texinfo {
+    int32_t index;    /* texture index or -1 */
+    int32_t texcoord;
+    double scale;     /* normal scale / occlusion strength; 1 otherwise */
+    int32_t has_transform; /* KHR_texture_transform */
+    double offset[2];
+    double rotation;
+    double uv_scale[2];
+    int32_t transform_texcoord; /* -1 when the extension does not override texCoord */
+} sy_gltf_shim_texinfo;
+
+typedef struct sy_gltf_shim_material {
+    const char *name;
+    double base_color[4];
+    double metallic, roughness;
+    sy_gltf_shim_texinfo base_color_texture, metallic_roughness_texture;
+    sy_gltf_shim_texinfo normal_texture, occlusion_texture, emissive_texture;
+    double emissive[3];
+    const char *alpha_mode; /* "OPAQUE", "MASK", "BLEND" or anything from the file */
+    double alpha_cutoff;
+    int32_t double_sided;
+    double emissive_strength; /* 1 when the extension is absent */
+    double transmission;
+    sy_gltf_shim_texinfo transmission_texture;
+    double ior; /* 1.5 when absent */
+    int32_t unlit;
+    int32_t base_color_count, emissive_count; /* array lengths found in the file */
+} sy_gltf_shim_material;
+
+typedef struct sy_gltf_shim_texture {
+    const char *name;
+    int32_t source;  /* image index or -1 */
+    int32_t sampler; /* sampler index or -1 */
+} sy_gltf_shim_texture;
+
+typedef struct sy_gltf_shim_sampler {
+    int32_t min_filter, mag_filter; /* -1: unspecified */
+    int32_t wrap_s, wrap_t;
+} sy_gltf_shim_sampler;
+
+typedef struct sy_gltf_shim_image {
+    const char *name;
+    const char *uri; /* "" for data: URIs and bufferView images */
+    /* Decoded 8-bit pixels, rows top to bottom; channels 3 (RGB) or 4 (RGBA): grey and grey+alpha
+     * images are expanded to RGBA, 16-bit images rounded to 8 bits. NULL when the image could not be
+     * loaded (then `problem` says why). */
+    const uint8_t *pixels;
+    uint32_t width, height, channels;
+    uint32_t source_bits; /* 8 or 16 */
+    const char *problem;
+} sy_gltf_shim_image;
+
+typedef struct sy_gltf_shim_camera {
+    const char *name;
+    const char *type; /* "perspective", "orthographic" or anything from the file */
+    double yfov, aspect, znear, zfar; /* perspective */
+    double xmag, ymag, oznear, ozfar; /* orthographic */
+} sy_gltf_shim_camera;
+
+typedef struct sy_gltf_shim_light {
+    const char *name;
+    const char *type; /* "point", "spot", "directional" or anything from the file */
+    double color[3];
+    int32_t color_count;
+    double intensity, range;
+    double inner_cone, outer_cone;
+} sy_gltf_shim_light;
+
+typedef struct sy_gltf_shim_node {
+    const char *name;
+    int32_t mesh, camera, light, skin; /* -1: none */
+    const int32_t *children;
+    size_t child_count;
+    const double *matrix;      size_t matrix_count;      /* 0 or 16 expected */
+    const double *translation; size_t translation_count; /* 0 or 3 */
+    const double *rotation;    size_t rotation_count;    /* 0 or 4 */
+    const double *scale;       size_t scale_count;       /* 0 or 3 */
+    int32_t has_weights;
+    /* EXT_mesh_gpu_instancing: accessor indices or -1 */
+    int32_t instancing; /* extension present */
+    int32_t inst_translation, inst_rotation, inst_scale;
+} sy_gltf_shim_node;
+
+typedef struct sy_gltf_shim_scene {
+    const char *name;
+    const int32_t *nodes;
+    size_t node_count;
+} sy_gltf_shim_scene;
+
+typedef struct sy_gltf_doc {
+    const sy_gltf_shim_buffer *buffers;     size_t buffer_count;
+    const sy_gltf_shim_view *views;         size_t view_count;
+    const sy_gltf_shim_accessor *accessors; size_t accessor_count;
+    const sy_gltf_shim_mesh *meshes;        size_t mesh_count;
+    const sy_gltf_shim_material *materials; size_t material_count;
+    const sy_gltf_shim_texture *textures;   size_t texture_count;
+    const sy_gltf_shim_sampler *samplers;   size_t sampler_count;
+    const sy_gltf_shim_image *images;       size_t image_count;
+    const sy_gltf_shim_camera *cameras;     size_t camera_count;
+    const sy_gltf_shim_light *lights;       size_t light_count;
+    const sy_gltf_shim_node *nodes;         size_t node_count;
+    const sy_gltf_shim_scene *scenes;       size_t scene_count;
+    int32_t default_scene; /* -1: none given */
+    const char *const *extensions_required; size_t extensions_required_count;
+    size_t skin_count, animation_count;
+    const char *warnings; /* tinygltf's warning text, "" when none */
+    void *internal;       /* private to the shim */
+} sy_gltf_doc;
+
+/* Parses `size` bytes: glTF JSON (binary = false) or a validated GLB container (binary = true).
+ * base_dir: directory that external URIs are relative to ("" = current directory).
+ * On failure: SY_ERR_PARSE (invalid JSON / glTF), SY_ERR_NOT_FOUND or SY_ERR_IO (external files),
+ * SY_ERR_LIMIT, SY_ERR_OUT_OF_MEMORY; err holds tinygltf's reason without the file name (the caller
+ * prefixes it). *out is NULL then. */
+sy_result sy_gltf_shim_parse(const uint8_t *bytes, size_t size, bool binary, const char *base_dir,
+                             const sy_gltf_shim_limits *limits, sy_gltf_doc **out, sy_error *err);
+
+void sy_gltf_shim_free(sy_gltf_doc *doc);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_GLTF_SHIM_H */

@@ -1,0 +1,231 @@
+/* sy_png.c — 8-bit sRGB PNG writer (tone mapping + OETF), simplified-API reader and colour helpers
+ * (see sy_png.h). libpng reports errors by longjmp; every setjmp lives in a function whose own
+ * locals are not modified after it, and the per-pixel work happens in helpers it calls. */
+#include "sy_png.h"
+
+#include "sy_file.h"
+
+#include <png.h>
+
+#include <errno.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- >>colour helpers ---- */
+
+float sy_srgb_encode(float linear)
+{
+    if (!(linear > 0.0f)) return 0.0f; /* also NaN */
+    if (linear >= 1.0f) return 1.0f;
+    if (linear <= 0.0031308f) return 12.92f * linear;
+    return 1.055f * powf(linear, 1.0f / 2.4f) - 0.055f;
+}
+
+float sy_srgb_decode(float encoded)
+{
+    if (!(encoded > 0.0f)) return 0.0f;
+    if (encoded >= 1.0f) return 1.0f;
+    if (encoded <= 0.04045f) return encoded / 12.92f;
+    return powf((encoded + 0.055f) / 1.055f, 2.4f);
+}
+
+float sy_tonemap_apply(sy_tonemap op, float x)
+{
+    if (!(x > 0.0f)) return 0.0f; /* negative, zero and NaN */
+    if (isinf(x)) return 1.0f;
+    float y;
+    switch (op) {
+    case SY_TONEMAP_REINHARD: y = x / (1.0f + x); break;
+    case SY_TONEMAP_ACES: y = (x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f); break;
+    case SY_TONEMAP_CLAMP:
+    default: y = x; break;
+    }
+    if (!(y > 0.0f)) return 0.0f;
+    return y < 1.0f ? y : 1.0f;
+}
+
+static uint8_t quantize8(float v01) { return (uint8_t)(v01 * 255.0f + 0.5f); }
+
+/* Pixel conversion with the exposure scale already computed. */
+static void encode_pixel(const float *in, float scale, sy_tonemap op, uint8_t *out)
+{
+    float a = in[3];
+    float inv = a > 0.0f ? 1.0f / a : 0.0f; /* alpha 0 (or NaN): nothing to show, colour 0 */
+    for (int c = 0; c < 3; ++c) {
+        float v = in[c] * inv * scale;
+        out[c] = quantize8(sy_srgb_encode(sy_tonemap_apply(op, v)));
+    }
+    float ac = a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f;
+    out[3] = quantize8(ac);
+}
+
+void sy_png_encode_pixel(const float rgba_premultiplied[4], const sy_png_options *opts, uint8_t out[4])
+{
+    float stops = opts ? opts->exposure_stops : 0.0f;
+    sy_tonemap op = opts ? opts->tonemap : SY_TONEMAP_CLAMP;
+    encode_pixel(rgba_premultiplied, exp2f(stops), op, out);
+}
+
+/* ---- >>writer ---- */
+
+typedef struct png_write_job {
+    FILE *fp;
+    int width, height;
+    const float *rgba;
+    float scale;
+    sy_tonemap op;
+    uint8_t *row; /* width * 4 bytes */
+    char msg[256];
+} png_write_job;
+
+static void on_png_error(png_structp png, png_const_charp msg)
+{
+    png_write_job *job = png_get_error_ptr(png);
+    if (job && job->msg[0] == '\0') snprintf(job->msg, sizeof job->msg, "%s", msg ? msg : "libpng error");
+    png_longjmp(png, 1);
+}
+
+static void on_png_warning(png_structp png, png_const_charp msg)
+{
+    (void)png; /* warnings do not fail a write; nothing to report */
+    (void)msg;
+}
+
+/* Everything that may longjmp after the header is set up; called from write_png_stream. */
+static void write_png_body(png_structp png, png_infop info, png_write_job *job)
+{
+    png_init_io(png, job->fp);
+    png_set_IHDR(png, info, (png_uint_32)job->width, (png_uint_32)job->height, 8, PNG_COLOR_TYPE_RGB_ALPHA,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_write_info(png, info);
+    for (int y = 0; y < job->height; ++y) {
+        const float *src = job->rgba + (size_t)y * (size_t)job->width * 4u;
+        for (int x = 0; x < job->width; ++x) encode_pixel(src + (size_t)x * 4u, job->scale, job->op, job->row + (size_t)x * 4u);
+        png_write_row(png, job->row);
+    }
+    png_write_end(png, NULL);
+}
+
+/* Returns true on success; on failure job->msg says why. */
+static bool write_png_stream(png_write_job *job)
+{
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, job, on_png_error, on_png_warning);
+    if (!png) {
+        snprintf(job->msg, sizeof job->msg, "cannot create the libpng writer");
+        return false;
+    }
+    png_infop info = png_create_info_struct(png);
+    if (!info) {
+        png_destroy_write_struct(&png, NULL);
+        snprintf(job->msg, sizeof job->msg, "cannot create the libpng info struct");
+        return false;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        return false;
+    }
+    write_png_body(png, info, job);
+    png_destroy_write_struct(&png, &info);
+    return true;
+}
+
+sy_result sy_png_write(const char *path, int width, int height, const float *rgba, const sy_png_options *opts,
+                       sy_error *err)
+{
+    if (!path || !rgba)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_png_write: path and pixel data are required");
+    if (width < 1 || height < 1 || width > SY_PNG_MAX_SIDE || height > SY_PNG_MAX_SIDE ||
+        (size_t)width * (size_t)height > SY_PNG_MAX_PIXELS)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: image size %dx%d outside 1..%d per side / %u pixels",
+                            path, width, height, SY_PNG_MAX_SIDE, SY_PNG_MAX_PIXELS);
+    sy_png_options o = opts ? *opts : (sy_png_options){0};
+    if (!isfinite(o.exposure_stops) || fabsf(o.exposure_stops) > 64.0f)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: exposure %g stops is not a finite value in [-64, 64]",
+                            path, (double)o.exposure_stops);
+    if (o.tonemap != SY_TONEMAP_CLAMP && o.tonemap != SY_TONEMAP_REINHARD && o.tonemap != SY_TONEMAP_ACES)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: unknown tone-mapping operator %d", path, (int)o.tonemap);
+
+    png_write_job job = {
+        .width = width,
+        .height = height,
+        .rgba = rgba,
+        .scale = exp2f(o.exposure_stops),
+        .op = o.tonemap,
+    };
+    job.row = malloc((size_t)width * 4u);
+    if (!job.row) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: cannot allocate a %d-pixel row", path, width);
+
+    sy_atomic_file af = {0};
+    sy_result rc = sy_atomic_file_begin(path, &af, err);
+    if (rc != SY_OK) {
+        free(job.row);
+        return rc;
+    }
+    job.fp = af.fp;
+    bool ok = write_png_stream(&job);
+    free(job.row);
+    if (!ok) {
+        sy_atomic_file_abort(&af);
+        return sy_error_set(err, SY_ERR_IO, "%s: PNG encoding failed: %s", path, job.msg);
+    }
+    return sy_atomic_file_commit(&af, err);
+}
+
+/* ---- >>reader ---- */
+
+sy_result sy_png_read_rgba8(const char *path, int *width_out, int *height_out, uint8_t **pixels_out, sy_error *err)
+{
+    if (width_out) *width_out = 0;
+    if (height_out) *height_out = 0;
+    if (pixels_out) *pixels_out = NULL;
+    if (!path || !width_out || !height_out || !pixels_out)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_png_read_rgba8: path and outputs are required");
+
+    FILE *fp = fopen(path, "rb");
+    if (!fp) {
+        int e = errno;
+        return sy_error_set(err, e == ENOENT ? SY_ERR_NOT_FOUND : SY_ERR_IO, "%s: cannot open: %s", path, strerror(e));
+    }
+    png_image image;
+    memset(&image, 0, sizeof image);
+    image.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_stdio(&image, fp)) {
+        sy_result rc = sy_error_set(err, SY_ERR_PARSE, "%s: not a readable PNG: %s", path, image.message);
+        png_image_free(&image);
+        fclose(fp);
+        return rc;
+    }
+    if (image.width < 1 || image.height < 1 || image.width > SY_PNG_MAX_SIDE || image.height > SY_PNG_MAX_SIDE ||
+        (size_t)image.width * (size_t)image.height > SY_PNG_MAX_PIXELS) {
+        sy_result rc = sy_error_set(err, SY_ERR_LIMIT, "%s: PNG of %ux%u exceeds %d per side / %u pixels", path,
+                                    (unsigned)image.width, (unsigned)image.height, SY_PNG_MAX_SIDE, SY_PNG_MAX_PIXELS);
+        png_image_free(&image);
+        fclose(fp);
+        return rc;
+    }
+    image.format = PNG_FORMAT_RGBA;
+    size_t bytes = (size_t)image.width * (size_t)image.height * 4u; /* <= 2^30 by the limits above */
+    uint8_t *pixels = malloc(bytes);
+    if (!pixels) {
+        png_image_free(&image);
+        fclose(fp);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: cannot allocate %zu bytes", path, bytes);
+    }
+    if (!png_image_finish_read(&image, NULL, pixels, 0, NULL)) {
+        sy_result rc = sy_error_set(err, SY_ERR_PARSE, "%s: PNG decoding failed: %s", path, image.message);
+        png_image_free(&image);
+        fclose(fp);
+        free(pixels);
+        return rc;
+    }
+    png_image_free(&image);
+    fclose(fp);
+    *width_out = (int)image.width;
+    *height_out = (int)image.height;
+    *pixels_out = pixels;
+    return SY_OK;
+}

@@ -1,0 +1,68 @@
+/* sy_png.h — display-referred 8-bit PNG output of a linear render layer (exposure, tone mapping,
+ * sRGB encoding), an 8-bit RGBA PNG reader for tests and tools, and the small colour helpers
+ * (sRGB OETF / EOTF, tone-mapping operators) other modules reuse.
+ *
+ * Input layers follow ../shared/DESIGN.md: w*h interleaved RGBA floats, linear scene-referred,
+ * alpha PREMULTIPLIED, row 0 at the TOP. The writer un-premultiplies, applies exposure and the
+ * tone-mapping operator per channel, clamps to [0, 1], encodes with the exact piecewise sRGB OETF
+ * and rounds to 8 bits; alpha is stored linearly (straight, not premultiplied, as PNG requires).
+ * The file carries sRGB, gAMA and cHRM chunks and is written through sy_atomic_file (temp file,
+ * fsync, rename), so a failure leaves no partial file.
+ *
+ * Thread-safety: no shared mutable state; every function may be called concurrently. */
+#ifndef SY_PNG_H
+#define SY_PNG_H
+
+#include "sy_common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SY_PNG_MAX_SIDE 65536            /* pixels per side, both directions */
+#define SY_PNG_MAX_PIXELS (1u << 28)     /* width * height */
+
+typedef enum sy_tonemap {
+    SY_TONEMAP_CLAMP = 0,    /* plain clamp to [0, 1] (the default) */
+    SY_TONEMAP_REINHARD = 1, /* x / (1 + x) */
+    SY_TONEMAP_ACES = 2,     /* Narkowicz 2015 ACES filmic fit, then clamp */
+    SY_TONEMAP_MAX_ENUM = 0x7fffffff
+} sy_tonemap;
+
+/* Zero-initialised ({0}) means: exposure 0 stops, SY_TONEMAP_CLAMP. */
+typedef struct sy_png_options {
+    float exposure_stops; /* colour is multiplied by 2^exposure_stops before tone mapping */
+    sy_tonemap tonemap;
+} sy_png_options;
+
+/* Exact piecewise sRGB OETF: linear [0, 1] -> encoded [0, 1]; input is clamped to [0, 1], NaN gives 0. */
+float sy_srgb_encode(float linear);
+
+/* Exact inverse (EOTF): encoded [0, 1] -> linear [0, 1]; input is clamped to [0, 1], NaN gives 0. */
+float sy_srgb_decode(float encoded);
+
+/* Applies the operator to one linear, non-negative channel value; returns a value in [0, 1].
+ * Negative values and NaN give 0; +INFINITY gives 1. An unknown operator behaves as CLAMP. */
+float sy_tonemap_apply(sy_tonemap op, float linear);
+
+/* Converts one premultiplied linear RGBA pixel to 8-bit straight-alpha sRGB exactly as
+ * sy_png_write does (opts may be NULL for the defaults). */
+void sy_png_encode_pixel(const float rgba_premultiplied[4], const sy_png_options *opts, uint8_t out[4]);
+
+/* Writes w x h pixels (rgba: w*h*4 floats, premultiplied linear, row 0 on top) as an 8-bit RGBA
+ * sRGB PNG at path. opts may be NULL (defaults). Errors name the file and the reason.
+ * Ownership: borrows rgba and opts for the duration of the call. */
+sy_result sy_png_write(const char *path, int width, int height, const float *rgba, const sy_png_options *opts,
+                       sy_error *err);
+
+/* Reads any PNG as 8-bit straight-alpha RGBA (sRGB-encoded bytes as stored, row 0 on top) through
+ * libpng's simplified API. Sizes beyond SY_PNG_MAX_* give SY_ERR_LIMIT; malformed files SY_ERR_PARSE.
+ * Ownership: on success the caller owns *pixels_out (w*h*4 bytes) and frees it with free(); on
+ * failure *pixels_out is NULL and the sizes are 0. */
+sy_result sy_png_read_rgba8(const char *path, int *width_out, int *height_out, uint8_t **pixels_out,
+                            sy_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_PNG_H */

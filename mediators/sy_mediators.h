@@ -1,0 +1,18 @@
+/* sy_mediators.h — registers every mediator class built into this library (whitted, and the
+ * others as they are added) in core's registry. Applications call it once at start-up.
+ * Thread-safety: safe to call repeatedly and from any thread (registration is idempotent). */
+#ifndef SY_MEDIATORS_H
+#define SY_MEDIATORS_H
+
+#include "sy_common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+sy_result sy_mediators_register_builtin(sy_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_MEDIATORS_H */

@@ -1,0 +1,130 @@
+/* test_util.h — tiny helpers shared by the tests in tests/formats: checks that count failures,
+ * a private scratch directory, and small file utilities. Test-only; header-only on purpose. */
+#ifndef SY_TEST_UTIL_H
+#define SY_TEST_UTIL_H
+
+#include <dirent.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static int g_failures;
+
+/* snprintf into a char array, aborting on truncation (test paths must never be cut short). */
+#define PATHF(buf, ...)                                                                  \
+    do {                                                                                 \
+        if (snprintf(buf, sizeof buf, __VA_ARGS__) >= (int)sizeof buf) {                \
+            fprintf(stderr, "%s:%d: path too long\n", __FILE__, __LINE__);               \
+            abort();                                                                     \
+        }                                                                                \
+    } while (0)
+
+#define CHECK(cond, ...)                                                                 \
+    do {                                                                                 \
+        if (!(cond)) {                                                                   \
+            ++g_failures;                                                                \
+            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #cond);     \
+            fprintf(stderr, __VA_ARGS__);                                                \
+            fputc('\n', stderr);                                                         \
+        }                                                                                \
+    } while (0)
+
+/* Creates a fresh scratch directory under $TMPDIR (or /tmp); path written to buf. */
+static void make_scratch_dir(char *buf, size_t n, const char *tag)
+{
+    const char *base = getenv("TMPDIR");
+    if (!base || !*base) base = "/tmp";
+    if (snprintf(buf, n, "%s/sy_%s_XXXXXX", base, tag) >= (int)n || !mkdtemp(buf)) {
+        fprintf(stderr, "cannot create a scratch directory %s: %s\n", buf, strerror(errno));
+        exit(1);
+    }
+}
+
+/* Removes the plain files in dir, then dir itself (scratch directories are flat). */
+static void remove_scratch_dir(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d) {
+        struct dirent *e;
+        char p[4096];
+        while ((e = readdir(d)) != NULL) {
+            if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue;
+            PATHF(p, "%s/%s", dir, e->d_name);
+            if (unlink(p) != 0) rmdir(p);
+        }
+        closedir(d);
+    }
+    rmdir(dir);
+}
+
+/* Number of entries in dir whose name contains needle. */
+static int count_entries_containing(const char *dir, const char *needle)
+{
+    int n = 0;
+    DIR *d = opendir(dir);
+    if (!d) return -1;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL)
+        if (strstr(e->d_name, needle)) ++n;
+    closedir(d);
+    return n;
+}
+
+static int path_exists(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0;
+}
+
+static int write_bytes(const char *path, const void *data, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return -1;
+    size_t w = n ? fwrite(data, 1, n, f) : 0;
+    int rc = (w == n && fclose(f) == 0) ? 0 : -1;
+    if (w != n) fclose(f);
+    return rc;
+}
+
+/* Reads a whole small file; caller frees. NULL on failure. */
+static unsigned char *slurp(const char *path, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    size_t cap = 1 << 16, len = 0;
+    unsigned char *b = malloc(cap);
+    for (;;) {
+        if (!b) break;
+        if (len == cap) {
+            unsigned char *nb = realloc(b, cap * 2);
+            if (!nb) {
+                free(b);
+                b = NULL;
+                break;
+            }
+            b = nb;
+            cap *= 2;
+        }
+        size_t r = fread(b + len, 1, cap - len, f);
+        if (r == 0) break;
+        len += r;
+    }
+    fclose(f);
+    *n = len;
+    return b;
+}
+
+static int finish_tests(const char *name)
+{
+    if (g_failures) {
+        fprintf(stderr, "%s: %d check(s) failed\n", name, g_failures);
+        return 1;
+    }
+    printf("%s: all checks passed\n", name);
+    return 0;
+}
+
+#endif /* SY_TEST_UTIL_H */

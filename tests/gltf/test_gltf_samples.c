@@ -1,0 +1,337 @@
+/* test_gltf_samples.c — loads every glTF sample model of the shared test data and checks counts,
+ * a few values read from the models' JSON, variant equality (glTF / glTF-Binary / glTF-Embedded
+ * give deep-equal scenes) and the Cornell box. Usage: test_gltf_samples TESTDATA_DIR.
+ * Exits 77 (skipped) when the test data is absent. */
+#include "sy_gltf.h"
+
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+static int g_failures = 0, g_checks = 0;
+
+#define CHECK(cond, ...)                                                                                               \
+    do {                                                                                                               \
+        g_checks++;                                                                                                    \
+        if (!(cond)) {                                                                                                 \
+            g_failures++;                                                                                              \
+            fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond);                                            \
+            fprintf(stderr, __VA_ARGS__);                                                                              \
+            fputc('\n', stderr);                                                                                       \
+        }                                                                                                              \
+    } while (0)
+
+static bool near(double a, double b, double eps) { return fabs(a - b) <= eps; }
+
+typedef struct loaded {
+    sy_scene *scene;
+    sy_gltf_info info;
+    sy_result r;
+    sy_error err;
+} loaded;
+
+static loaded load(const char *path)
+{
+    loaded l;
+    memset(&l, 0, sizeof l);
+    if (sy_scene_create(&l.scene, &l.err) != SY_OK) {
+        fprintf(stderr, "scene create: %s\n", l.err.message);
+        exit(1);
+    }
+    l.r = sy_gltf_load(path, l.scene, NULL, &l.info, &l.err);
+    if (l.r == SY_OK) {
+        uint64_t frame;
+        sy_error e = {0};
+        if (sy_scene_commit(l.scene, &frame, &e) != SY_OK) {
+            fprintf(stderr, "%s: commit failed: %s\n", path, e.message);
+            l.r = e.code ? e.code : SY_ERR_INVALID_ARGUMENT;
+        }
+    }
+    return l;
+}
+
+static void unload(loaded *l)
+{
+    sy_gltf_info_free(&l->info);
+    sy_scene_destroy(l->scene);
+    l->scene = NULL;
+}
+
+static const sy_material_data *material_named(const sy_scene *s, const char *name)
+{
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_MATERIAL, 0); id; id = sy_scene_next(s, SY_TYPE_MATERIAL, id)) {
+        const sy_material_data *m = sy_material_get(s, (sy_material){id});
+        if (m && m->name && !strcmp(m->name, name)) return m;
+    }
+    return NULL;
+}
+
+/* Generic checks for every loaded file: objects in the scene agree with the file's counts. */
+static void check_generic(const char *path, loaded *l)
+{
+    const sy_gltf_counts *c = &l->info.counts;
+    CHECK(sy_scene_count(l->scene, SY_TYPE_MESH) == c->meshes, "%s: meshes %u vs %u", path,
+          sy_scene_count(l->scene, SY_TYPE_MESH), c->meshes);
+    CHECK(sy_scene_count(l->scene, SY_TYPE_MATERIAL) == c->materials, "%s: materials", path);
+    CHECK(sy_scene_count(l->scene, SY_TYPE_CAMERA) == c->cameras, "%s: cameras", path);
+    CHECK(sy_scene_count(l->scene, SY_TYPE_LIGHT) == c->lights, "%s: lights", path);
+    CHECK(sy_scene_count(l->scene, SY_TYPE_TEXTURE) <= 2 * c->textures, "%s: textures", path);
+    CHECK(sy_node_get(l->scene, l->info.root) != NULL, "%s: root node", path);
+    CHECK(sy_scene_count(l->scene, SY_TYPE_NODE) >= 1, "%s: nodes", path);
+    /* every node visible */
+    for (uint32_t id = sy_scene_next(l->scene, SY_TYPE_NODE, 0); id; id = sy_scene_next(l->scene, SY_TYPE_NODE, id)) {
+        const sy_node_data *n = sy_node_get(l->scene, (sy_node){id});
+        CHECK(n && (n->flags & SY_NODE_VISIBLE), "%s: node %u not visible", path, id);
+    }
+    /* triangles in the scene's meshes = reported triangles */
+    uint64_t tris = 0;
+    for (uint32_t id = sy_scene_next(l->scene, SY_TYPE_MESH, 0); id; id = sy_scene_next(l->scene, SY_TYPE_MESH, id)) {
+        const sy_mesh_data *m = sy_mesh_get(l->scene, (sy_mesh){id});
+        for (uint32_t p = 0; m && p < m->primitives.count; p++) tris += sy_primitive_triangle_count(&m->primitives.items[p]);
+    }
+    CHECK(tris == c->triangles, "%s: triangles %llu vs %u", path, (unsigned long long)tris, c->triangles);
+    sy_bounds b;
+    sy_error e = {0};
+    CHECK(sy_node_world_bounds(l->scene, l->info.root, &b, &e) == SY_OK, "%s: bounds: %s", path, e.message);
+}
+
+/* Checks of values read from the models' JSON. */
+static void check_specific(const char *model, const char *path, loaded *l)
+{
+    const sy_gltf_counts *c = &l->info.counts;
+    sy_scene *s = l->scene;
+    if (!strcmp(model, "Box")) {
+        CHECK(c->meshes == 1 && c->primitives == 1 && c->triangles == 12, "%s: counts %u/%u/%u", path, c->meshes,
+              c->primitives, c->triangles);
+        sy_bounds b;
+        sy_error e = {0};
+        CHECK(sy_node_world_bounds(s, l->info.root, &b, &e) == SY_OK, "%s", e.message);
+        for (int k = 0; k < 3; k++)
+            CHECK(near(b.min[k], -0.5, 1e-5) && near(b.max[k], 0.5, 1e-5), "%s: bounds axis %d: %g..%g", path, k,
+                  b.min[k], b.max[k]);
+    } else if (!strcmp(model, "Cameras")) {
+        CHECK(c->cameras == 2 && l->info.camera_node_count == 2, "%s: cameras", path);
+        if (l->info.camera_node_count == 2) {
+            const sy_node_data *n0 = sy_node_get(s, l->info.camera_nodes[0]);
+            const sy_node_data *n1 = sy_node_get(s, l->info.camera_nodes[1]);
+            const sy_camera_data *c0 = n0 ? sy_camera_get(s, n0->camera) : NULL;
+            const sy_camera_data *c1 = n1 ? sy_camera_get(s, n1->camera) : NULL;
+            CHECK(c0 && c0->projection == SY_PROJECTION_PERSPECTIVE && near(c0->yfov, 0.7, 1e-6) &&
+                      near(c0->aspect, 1.0, 1e-6) && near(c0->znear, 0.01, 1e-6) && near(c0->zfar, 100, 1e-4),
+                  "%s: camera 0", path);
+            CHECK(c1 && c1->projection == SY_PROJECTION_ORTHOGRAPHIC && near(c1->xmag, 1, 1e-6) && near(c1->ymag, 1, 1e-6),
+                  "%s: camera 1", path);
+        }
+    } else if (!strcmp(model, "SimpleInstancing")) {
+        CHECK(c->meshes == 1 && sy_scene_count(s, SY_TYPE_MESH) == 1, "%s: one mesh", path);
+        /* glTF node + 125 instances + root */
+        CHECK(sy_scene_count(s, SY_TYPE_NODE) == 127, "%s: nodes %u", path, sy_scene_count(s, SY_TYPE_NODE));
+        uint32_t mesh_id = sy_scene_next(s, SY_TYPE_MESH, 0), users = 0;
+        for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id)) {
+            const sy_node_data *n = sy_node_get(s, (sy_node){id});
+            if (n && n->mesh.id) {
+                users++;
+                CHECK(n->mesh.id == mesh_id, "%s: shared mesh", path);
+            }
+        }
+        CHECK(users == 125, "%s: %u nodes use the mesh", path, users);
+    } else if (!strcmp(model, "LightsPunctualLamp")) {
+        CHECK(c->lights == 5 && sy_scene_count(s, SY_TYPE_LIGHT) == 5, "%s: lights", path);
+        bool found = false;
+        for (uint32_t id = sy_scene_next(s, SY_TYPE_LIGHT, 0); id; id = sy_scene_next(s, SY_TYPE_LIGHT, id)) {
+            const sy_light_data *ld = sy_light_get(s, (sy_light){id});
+            if (ld && ld->name && !strcmp(ld->name, "Point")) {
+                found = true;
+                CHECK(ld->type == SY_LIGHT_POINT && near(ld->intensity, 15, 1e-5) && near(ld->color[0], 1, 1e-6) &&
+                          near(ld->color[1], 0.6318749785423279, 1e-6) && near(ld->color[2], 0.23909975588321689, 1e-6),
+                      "%s: light Point", path);
+            }
+            if (ld && ld->name && !strcmp(ld->name, "Point.002"))
+                CHECK(near(ld->intensity, 1.5, 1e-6) && ld->color[0] == 1 && ld->color[1] == 1, "%s: default colour", path);
+        }
+        CHECK(found, "%s: light 'Point'", path);
+        /* KHR_materials_transmission is used by one material */
+        bool transmissive = false;
+        for (uint32_t id = sy_scene_next(s, SY_TYPE_MATERIAL, 0); id; id = sy_scene_next(s, SY_TYPE_MATERIAL, id)) {
+            const sy_material_data *m = sy_material_get(s, (sy_material){id});
+            transmissive = transmissive || (m && m->transmission > 0);
+        }
+        CHECK(transmissive, "%s: transmission", path);
+    } else if (!strcmp(model, "EmissiveStrengthTest")) {
+        const char *names[] = {"Emit1", "Emit2", "Emit4", "Emit8", "Emit16"};
+        const float strength[] = {1, 2, 4, 8, 16};
+        for (int k = 0; k < 5; k++) {
+            const sy_material_data *m = material_named(s, names[k]);
+            CHECK(m && near(m->emissive_strength, strength[k], 1e-6) && near(m->emissive[0], 0.1, 1e-6) &&
+                      near(m->emissive[1], 0.5, 1e-6) && near(m->emissive[2], 0.9, 1e-6),
+                  "%s: material %s", path, names[k]);
+        }
+    } else if (!strcmp(model, "MeshPrimitiveModes")) {
+        /* 3 triangle primitives: 18 indices = 6, strip of 6 = 4, fan of 8 = 6; 4 point/line ones skipped */
+        CHECK(c->primitives == 7 && c->skipped_primitives == 4 && c->triangles == 16, "%s: %u/%u/%u", path,
+              c->primitives, c->skipped_primitives, c->triangles);
+        CHECK(l->info.warning_count >= 4, "%s: warnings %u", path, l->info.warning_count);
+    } else if (!strcmp(model, "DamagedHelmet")) {
+        CHECK(sy_scene_count(s, SY_TYPE_TEXTURE) == 5, "%s: textures", path);
+        const sy_material_data *m = sy_material_get(s, (sy_material){sy_scene_next(s, SY_TYPE_MATERIAL, 0)});
+        const sy_texture_data *bc = m ? sy_texture_get(s, m->base_color_texture.texture) : NULL;
+        const sy_texture_data *em = m ? sy_texture_get(s, m->emissive_texture.texture) : NULL;
+        const sy_texture_data *nm = m ? sy_texture_get(s, m->normal_texture.texture) : NULL;
+        const sy_texture_data *mr = m ? sy_texture_get(s, m->metallic_roughness_texture.texture) : NULL;
+        const sy_texture_data *ao = m ? sy_texture_get(s, m->occlusion_texture.texture) : NULL;
+        CHECK(bc && bc->info.format == SY_PIXEL_U8_SRGB && em && em->info.format == SY_PIXEL_U8_SRGB, "%s: colour roles", path);
+        CHECK(nm && nm->info.format == SY_PIXEL_U8_LINEAR && mr && mr->info.format == SY_PIXEL_U8_LINEAR && ao &&
+                  ao->info.format == SY_PIXEL_U8_LINEAR,
+              "%s: data roles", path);
+        CHECK(bc && bc->info.width == 2048 && bc->info.height == 2048 && bc->pixels, "%s: base colour size", path);
+    } else if (!strcmp(model, "UnlitTest")) {
+        uint32_t unlit = 0;
+        for (uint32_t id = sy_scene_next(s, SY_TYPE_MATERIAL, 0); id; id = sy_scene_next(s, SY_TYPE_MATERIAL, id))
+            unlit += sy_material_get(s, (sy_material){id})->unlit;
+        CHECK(unlit == 2, "%s: unlit materials %u", path, unlit);
+    } else if (!strcmp(model, "TextureTransformTest")) {
+        bool any = false;
+        for (uint32_t id = sy_scene_next(s, SY_TYPE_MATERIAL, 0); id; id = sy_scene_next(s, SY_TYPE_MATERIAL, id)) {
+            const sy_material_data *m = sy_material_get(s, (sy_material){id});
+            any = any || m->base_color_texture.rotation != 0 || m->base_color_texture.offset[0] != 0 ||
+                  m->base_color_texture.uv_scale[0] != 1;
+        }
+        CHECK(any, "%s: KHR_texture_transform values", path);
+    }
+}
+
+static bool ends_with(const char *s, const char *suffix)
+{
+    size_t a = strlen(s), b = strlen(suffix);
+    return a >= b && !strcmp(s + a - b, suffix);
+}
+
+/* First file with the suffix in dir; returns false if none. */
+static bool find_file(const char *dir, const char *suffix, char *out, size_t n)
+{
+    DIR *d = opendir(dir);
+    if (!d) return false;
+    struct dirent *e;
+    bool found = false;
+    while (!found && (e = readdir(d)))
+        if (ends_with(e->d_name, suffix)) {
+            int w = snprintf(out, n, "%s/%s", dir, e->d_name);
+            found = w > 0 && (size_t)w < n;
+        }
+    closedir(d);
+    return found;
+}
+
+static int cmp_str(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
+
+static void test_cornell(const char *root)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/cornell/cornell_box.gltf", root);
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        printf("SKIP cornell: %s absent\n", path);
+        return;
+    }
+    loaded l = load(path);
+    CHECK(l.r == SY_OK, "%s: %s", path, l.err.message);
+    if (l.r == SY_OK) {
+        check_generic(path, &l);
+        CHECK(l.info.counts.meshes == 8 && sy_scene_count(l.scene, SY_TYPE_MESH) == 8, "cornell: 8 meshes");
+        const sy_material_data *m = material_named(l.scene, "light");
+        CHECK(m != NULL, "cornell: material 'light'");
+        if (m) {
+            const float want[3] = {17, 12, 4};
+            for (int k = 0; k < 3; k++)
+                CHECK(near(m->emissive[k] * m->emissive_strength, want[k], 1e-4), "cornell: emission %d = %g", k,
+                      m->emissive[k] * m->emissive_strength);
+        }
+        sy_node cam;
+        sy_error e = {0};
+        CHECK(sy_gltf_find_camera(l.scene, &l.info, "camera", &cam, &e) == SY_OK, "cornell: camera: %s", e.message);
+        const sy_node_data *nd = sy_node_get(l.scene, cam);
+        const sy_camera_data *cd = nd ? sy_camera_get(l.scene, nd->camera) : NULL;
+        CHECK(nd && nd->name && !strcmp(nd->name, "camera"), "cornell: camera node name");
+        CHECK(cd && near(cd->yfov, 2 * atan(12.5 / 35), 1e-6), "cornell: yfov %g", cd ? cd->yfov : -1.0);
+        sy_node cam0;
+        CHECK(sy_gltf_find_camera(l.scene, &l.info, "0", &cam0, &e) == SY_OK && cam0.id == cam.id, "cornell: index 0");
+        CHECK(sy_gltf_find_camera(l.scene, &l.info, "nope", &cam0, &e) == SY_ERR_NOT_FOUND &&
+                  strstr(e.message, "camera") != NULL,
+              "cornell: unknown camera");
+    }
+    unload(&l);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: %s TESTDATA_DIR\n", argv[0]);
+        return 2;
+    }
+    char gdir[1024];
+    snprintf(gdir, sizeof gdir, "%s/gltf", argv[1]);
+    DIR *d = opendir(gdir);
+    if (!d) {
+        printf("SKIP: test data directory %s is absent\n", gdir);
+        return 77;
+    }
+    char *models[256];
+    size_t nmodels = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) && nmodels < 256)
+        if (e->d_name[0] != '.' && e->d_name[0] != '_') models[nmodels++] = strdup(e->d_name);
+    closedir(d);
+    qsort(models, nmodels, sizeof(char *), cmp_str);
+
+    long blobs_before = sy_blob_live_count();
+    unsigned files = 0, loaded_ok = 0, compared = 0;
+    const char *variants[3][2] = {{"glTF", ".gltf"}, {"glTF-Binary", ".glb"}, {"glTF-Embedded", ".gltf"}};
+    for (size_t m = 0; m < nmodels; m++) {
+        loaded first;
+        bool have_first = false;
+        char first_path[1100] = "";
+        for (int v = 0; v < 3; v++) {
+            char dir[1024], path[1100];
+            int w = snprintf(dir, sizeof dir, "%s/%s/%s", gdir, models[m], variants[v][0]);
+            if (w < 0 || (size_t)w >= sizeof dir) continue;
+            if (!find_file(dir, variants[v][1], path, sizeof path)) continue;
+            files++;
+            loaded l = load(path);
+            CHECK(l.r == SY_OK, "%s: %s", path, l.err.message);
+            if (l.r != SY_OK) {
+                unload(&l);
+                continue;
+            }
+            loaded_ok++;
+            check_generic(path, &l);
+            check_specific(models[m], path, &l);
+            printf("ok %-70s nodes %3u meshes %3u prims %3u tris %7u mats %3u tex %2u img %2u lights %u cams %u warn %u\n",
+                   path + strlen(gdir) + 1, l.info.counts.nodes, l.info.counts.meshes, l.info.counts.primitives,
+                   l.info.counts.triangles, l.info.counts.materials, l.info.counts.textures, l.info.counts.images,
+                   l.info.counts.lights, l.info.counts.cameras, l.info.warning_count);
+            for (uint32_t w = 0; w < l.info.stored_warning_count; w++) printf("   warning: %s\n", l.info.warnings[w]);
+            if (!have_first) {
+                first = l;
+                have_first = true;
+                memcpy(first_path, path, sizeof path);
+            } else {
+                sy_error diff = {0};
+                bool eq = sy_scene_equal(first.scene, l.scene, &diff);
+                CHECK(eq, "%s vs %s: %s", first_path, path, diff.message);
+                compared++;
+                unload(&l);
+            }
+        }
+        if (have_first) unload(&first);
+        free(models[m]);
+    }
+    test_cornell(argv[1]);
+    CHECK(sy_blob_live_count() == blobs_before, "blob leak: %ld live, %ld before", sy_blob_live_count(), blobs_before);
+    CHECK(files >= 30, "only %u sample files found", files);
+    printf("%u sample files, %u loaded, %u variant comparisons, %d/%d checks failed\n", files, loaded_ok, compared,
+           g_failures, g_checks);
+    return g_failures ? 1 : 0;
+}

@@ -1,0 +1,181 @@
+/* rt_test.h — helpers shared by the backends/rt tests: a CHECK macro that reports file:line and
+ * fails the test, and small builders for quads, transforms, cameras and renders using only the
+ * public sy_rt API. */
+#ifndef RT_TEST_H
+#define RT_TEST_H
+
+#include "sy_rt.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define RT_SKIP 77
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static int rt_failures;
+
+/* Records a failure with its location; the test continues so one run reports every problem. */
+#define CHECK(cond, ...)                                                               \
+    do {                                                                               \
+        if (!(cond)) {                                                                 \
+            fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond); \
+            fprintf(stderr, __VA_ARGS__);                                              \
+            fputc('\n', stderr);                                                       \
+            rt_failures++;                                                             \
+        }                                                                              \
+    } while (0)
+
+/* A call that must succeed; aborts the test (returns 1 from main's helper chain) otherwise. */
+#define MUST(call)                                                                                 \
+    do {                                                                                           \
+        char must_err_[256] = "";                                                                  \
+        sy_rt_result must_r_ = (call);                                                             \
+        if (must_r_ != SY_RT_OK) {                                                                 \
+            fprintf(stderr, "%s:%d: %s failed: %s: %s\n", __FILE__, __LINE__, #call,             \
+                    sy_rt_result_str(must_r_), must_err_);                                         \
+            exit(1);                                                                               \
+        }                                                                                          \
+        (void)must_err_;                                                                           \
+    } while (0)
+/* Use ERR as the err/err_len arguments inside MUST(...). */
+#define ERR must_err_, sizeof must_err_
+
+static inline bool rt_near(double a, double b, double rel)
+{
+    return fabs(a - b) <= rel * fmax(fabs(a), fabs(b)) + 1e-12;
+}
+
+static inline void rt_identity(float m[16])
+{
+    memset(m, 0, 16 * sizeof(float));
+    m[0] = m[5] = m[10] = m[15] = 1.0f;
+}
+
+static inline void rt_translation(float m[16], float x, float y, float z)
+{
+    rt_identity(m);
+    m[12] = x;
+    m[13] = y;
+    m[14] = z;
+}
+
+/* Rotation by angle (radians) about the Y axis, then translation. */
+static inline void rt_rot_y(float m[16], float angle, float tx, float ty, float tz)
+{
+    rt_identity(m);
+    m[0] = cosf(angle);
+    m[2] = -sinf(angle);
+    m[8] = sinf(angle);
+    m[10] = cosf(angle);
+    m[12] = tx;
+    m[13] = ty;
+    m[14] = tz;
+}
+
+/* A quad [-h, h]^2 in the XY plane at z = 0, facing +Z (counter-clockwise), with normals and uv
+ * (uv (0,0) at the top-left corner (-h, +h)). */
+static inline sy_rt_mesh rt_quad(sy_rt_device *dev, float h)
+{
+    const float pos[] = {-h, -h, 0, h, -h, 0, h, h, 0, -h, h, 0};
+    const float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    const float uv[] = {0, 1, 1, 1, 1, 0, 0, 0};
+    const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+    sy_rt_mesh_desc d = {.positions = pos, .normals = nrm, .uv = {uv, NULL}, .indices = idx,
+                         .vertex_count = 4, .triangle_count = 2};
+    sy_rt_mesh m;
+    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    return m;
+}
+
+static inline sy_rt_instance rt_place(sy_rt_device *dev, sy_rt_mesh mesh, const float xf[16], sy_rt_material mat,
+                                      uint32_t flags)
+{
+    sy_rt_instance_desc d = {.mesh = mesh, .material = mat, .flags = flags};
+    memcpy(d.transform, xf, sizeof d.transform);
+    sy_rt_instance inst;
+    MUST(sy_rt_instance_create(dev, &d, &inst, ERR));
+    return inst;
+}
+
+static inline sy_rt_material rt_emitter(sy_rt_device *dev, float r, float g, float b)
+{
+    sy_rt_material_desc d;
+    sy_rt_material_desc_init(&d);
+    d.emissive[0] = r;
+    d.emissive[1] = g;
+    d.emissive[2] = b;
+    sy_rt_material m;
+    MUST(sy_rt_material_create(dev, &d, &m, ERR));
+    return m;
+}
+
+/* Pure Lambert material (no specular lobe). */
+static inline sy_rt_material rt_lambert(sy_rt_device *dev, float r, float g, float b)
+{
+    sy_rt_material_desc d;
+    sy_rt_material_desc_init(&d);
+    d.base_color[0] = r;
+    d.base_color[1] = g;
+    d.base_color[2] = b;
+    d.metallic = 0.0f;
+    d.specular = 0.0f;
+    sy_rt_material m;
+    MUST(sy_rt_material_create(dev, &d, &m, ERR));
+    return m;
+}
+
+/* Perspective camera at (0, 0, z) looking down -Z with a symmetric window of half-tangent t. */
+static inline sy_rt_camera rt_camera(float z, float t)
+{
+    sy_rt_camera c;
+    memset(&c, 0, sizeof c);
+    rt_translation(c.camera_to_world, 0.0f, 0.0f, z);
+    c.projection = SY_RT_PROJECTION_PERSPECTIVE;
+    c.window[0] = -t;
+    c.window[1] = t;
+    c.window[2] = -t;
+    c.window[3] = t;
+    c.near_clip = 0.01f;
+    return c;
+}
+
+static inline sy_rt_render_desc rt_desc(sy_rt_integrator integ, uint32_t w, uint32_t h)
+{
+    sy_rt_render_desc d = {.integrator = integ, .image_width = w, .image_height = h, .width = w, .height = h};
+    return d;
+}
+
+/* Renders the desc's rectangle into freshly allocated buffers (caller frees both). */
+static inline void rt_render(sy_rt_device *dev, const sy_rt_camera *cam, const sy_rt_render_desc *d, float **rgba,
+                             float **depth)
+{
+    size_t n = (size_t)d->width * d->height;
+    *rgba = malloc(n * 4 * sizeof(float));
+    *depth = malloc(n * sizeof(float));
+    if (!*rgba || !*depth) {
+        fprintf(stderr, "out of memory\n");
+        exit(1);
+    }
+    MUST(sy_rt_render(dev, cam, d, *rgba, *depth, ERR));
+}
+
+static inline sy_rt_device *rt_device(void)
+{
+    sy_rt_device *dev = NULL;
+    sy_rt_device_desc dd = {0};
+    MUST(sy_rt_device_create(&dd, &dev, ERR));
+    return dev;
+}
+
+static inline int rt_finish(const char *name)
+{
+    if (rt_failures) fprintf(stderr, "%s: %d check(s) failed\n", name, rt_failures);
+    else printf("%s: ok\n", name);
+    return rt_failures ? 1 : 0;
+}
+
+#endif /* RT_TEST_H */

@@ -1,0 +1,150 @@
+/* test_rt_instances.c — incremental scene updates: set_transform moves an instance in the image
+ * (Embree instance and baked), set_visible hides it, destroying it removes it, a shared mesh is
+ * instanced twice, material changes are picked up, and the area-light list follows emissive
+ * instances (moving an emitter changes what it lights). */
+#include "rt_test.h"
+
+#define W 40
+
+/* Mean column of pixels showing the emitter colour (0, 1, 0); -1 when none; count in *n. */
+static double green_centroid(const float *rgba, int *n)
+{
+    double sum = 0;
+    *n = 0;
+    for (int y = 0; y < W; ++y)
+        for (int x = 0; x < W; ++x) {
+            const float *c = rgba + 4 * (y * W + x);
+            if (c[0] == 0.0f && c[1] == 1.0f && c[2] == 0.0f) {
+                sum += x + 0.5;
+                ++*n;
+            }
+        }
+    return *n ? sum / *n : -1.0;
+}
+
+static double render_centroid(sy_rt_device *dev, int *n)
+{
+    sy_rt_camera cam = rt_camera(5.0f, 0.5f); /* 40 px over 5 m: 8 px per metre */
+    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
+    float *rgba, *depth;
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    double c = green_centroid(rgba, n);
+    free(rgba);
+    free(depth);
+    return c;
+}
+
+static void test_move_hide_destroy(uint32_t flags)
+{
+    sy_rt_device *dev = rt_device();
+    sy_rt_mesh q = rt_quad(dev, 0.5f);
+    sy_rt_material green = rt_emitter(dev, 0.0f, 1.0f, 0.0f);
+    float xf[16];
+    rt_translation(xf, -1.0f, 0.0f, 0.0f);
+    sy_rt_instance inst = rt_place(dev, q, xf, green, flags);
+    MUST(sy_rt_commit(dev, ERR));
+    int n;
+    double c0 = render_centroid(dev, &n);
+    CHECK(n == 64 && fabs(c0 - 12.0) < 1e-9, "flags %u: emitter at x=-1: %d px centred at column %g (expected 64 at 12)", flags, n, c0);
+
+    rt_translation(xf, 1.0f, 0.0f, 0.0f);
+    MUST(sy_rt_instance_set_transform(dev, inst, xf, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    double c1 = render_centroid(dev, &n);
+    CHECK(n == 64 && fabs(c1 - c0 - 16.0) < 1e-9, "flags %u: moved 2 m = 16 px: centroid %g -> %g", flags, c0, c1);
+
+    MUST(sy_rt_instance_set_visible(dev, inst, false, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    render_centroid(dev, &n);
+    CHECK(n == 0, "flags %u: hidden instance still visible (%d px)", flags, n);
+    MUST(sy_rt_instance_set_visible(dev, inst, true, ERR));
+
+    /* A second instance of the same mesh. */
+    rt_translation(xf, -1.0f, 0.0f, 0.0f);
+    sy_rt_instance second = rt_place(dev, q, xf, green, flags ^ SY_RT_INSTANCE_BAKED);
+    MUST(sy_rt_commit(dev, ERR));
+    double c2 = render_centroid(dev, &n);
+    CHECK(n == 128 && fabs(c2 - 20.0) < 1e-9, "flags %u: two instances: %d px centred at %g", flags, n, c2);
+
+    MUST(sy_rt_instance_destroy(dev, inst, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    double c3 = render_centroid(dev, &n);
+    CHECK(n == 64 && fabs(c3 - 12.0) < 1e-9, "flags %u: after destroy: %d px at %g", flags, n, c3);
+
+    /* Material change: the remaining instance turns red. */
+    MUST(sy_rt_instance_set_material(dev, second, rt_emitter(dev, 1.0f, 0.0f, 0.0f), ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    render_centroid(dev, &n);
+    CHECK(n == 0, "flags %u: material change ignored", flags);
+    MUST(sy_rt_instance_destroy(dev, second, ERR));
+    MUST(sy_rt_mesh_destroy(dev, q, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_stats st;
+    sy_rt_device_stats(dev, &st);
+    CHECK(st.instances == 0 && st.meshes == 0 && st.area_light_triangles == 0, "stats %u %u %u", st.instances, st.meshes,
+          st.area_light_triangles);
+    sy_rt_device_destroy(dev);
+}
+
+/* Radiance of the floor's centre pixel under a downward-facing emitter at height h. */
+static float floor_centre(sy_rt_device *dev)
+{
+    sy_rt_camera cam = rt_camera(0.5f, 0.05f);
+    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, 9, 9);
+    float *rgba, *depth;
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    float v = rgba[4 * (4 * 9 + 4)];
+    free(rgba);
+    free(depth);
+    return v;
+}
+
+static void test_area_light_follows(void)
+{
+    sy_rt_device *dev = rt_device();
+    float xf[16];
+    rt_identity(xf);
+    rt_place(dev, rt_quad(dev, 10.0f), xf, rt_lambert(dev, 0.8f, 0.8f, 0.8f), 0);
+    sy_rt_material_desc md;
+    sy_rt_material_desc_init(&md);
+    md.emissive[0] = md.emissive[1] = md.emissive[2] = 5.0f;
+    sy_rt_material em;
+    MUST(sy_rt_material_create(dev, &md, &em, ERR));
+    float lamp[16];
+    rt_rot_y(lamp, (float)M_PI, 0.0f, 0.0f, 1.0f);
+    sy_rt_instance li = rt_place(dev, rt_quad(dev, 0.2f), lamp, em, 0);
+    MUST(sy_rt_commit(dev, ERR));
+    float v1 = floor_centre(dev);
+    /* Small source: irradiance ~ Le * A / d^2 at distance 1; Lambert * 0.8 / pi. */
+    double approx1 = 0.8 / M_PI * 5.0 * 0.16 / 1.0;
+    CHECK(rt_near(v1, approx1, 0.05), "lamp at 1 m: %g, expected about %g", v1, approx1);
+    rt_rot_y(lamp, (float)M_PI, 0.0f, 0.0f, 2.0f);
+    MUST(sy_rt_instance_set_transform(dev, li, lamp, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    float v2 = floor_centre(dev);
+    CHECK(rt_near(v2, v1 / 4.0, 0.05), "lamp moved to 2 m: %g, expected about %g (inverse square)", v2, v1 / 4.0);
+    /* Emission doubled through a material update. */
+    md.emissive[0] = md.emissive[1] = md.emissive[2] = 10.0f;
+    MUST(sy_rt_material_update(dev, em, &md, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    float v3 = floor_centre(dev);
+    CHECK(rt_near(v3, 2.0 * v2, 1e-5), "emission doubled: %g, expected %g", v3, 2.0 * v2);
+    /* Double-sided emitter facing away still lights the floor; single-sided does not. */
+    rt_rot_y(lamp, 0.0f, 0.0f, 0.0f, 2.0f);
+    MUST(sy_rt_instance_set_transform(dev, li, lamp, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    CHECK(floor_centre(dev) == 0.0f, "single-sided emitter facing away lights the floor");
+    md.double_sided = true;
+    MUST(sy_rt_material_update(dev, em, &md, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    CHECK(rt_near(floor_centre(dev), v3, 1e-5), "double-sided emitter: %g, expected %g", floor_centre(dev), v3);
+    sy_rt_device_destroy(dev);
+}
+
+int main(void)
+{
+    test_move_hide_destroy(0);
+    test_move_hide_destroy(SY_RT_INSTANCE_BAKED);
+    test_area_light_follows();
+    return rt_finish("test_rt_instances");
+}

@@ -1,0 +1,361 @@
+/* test_rt_whitted.c — radiometry of the Whitted integrator against analytic values: visible
+ * emitters, Lambert under point / spot / directional lights, an area light (rectangle form
+ * factor), hard shadows where the geometry says, mirror reflection, glass transmission with
+ * Fresnel, alpha-mask cut-outs and textured unlit materials. */
+#include "rt_test.h"
+
+#define W 33
+#define CAM_Z 5.0f
+#define TAN 0.5f
+
+/* Plane z = 0 point seen by pixel (px, py) of the standard camera. */
+static void pixel_point(int px, int py, float cam_z, double *x, double *y)
+{
+    double sx = -TAN + (px + 0.5) / W * 2.0 * TAN, sy = TAN - (py + 0.5) / W * 2.0 * TAN;
+    *x = cam_z * sx;
+    *y = cam_z * sy;
+}
+
+static const float *px_at(const float *rgba, int x, int y) { return rgba + 4 * (y * W + x); }
+
+static void test_emitter_exact(void)
+{
+    sy_rt_device *dev = rt_device();
+    float xf[16];
+    rt_identity(xf);
+    sy_rt_instance inst = rt_place(dev, rt_quad(dev, 1.0f), xf, rt_emitter(dev, 17, 12, 4), 0);
+    (void)inst;
+    sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 100, .position = {0, 0, 2}};
+    sy_rt_light l;
+    MUST(sy_rt_light_create(dev, &ld, &l, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_camera cam = rt_camera(CAM_Z, TAN);
+    for (int integ = SY_RT_INTEGRATOR_PRIMARY; integ <= SY_RT_INTEGRATOR_WHITTED; ++integ) {
+        sy_rt_render_desc rd = rt_desc((sy_rt_integrator)integ, W, W);
+        float *rgba, *depth;
+        rt_render(dev, &cam, &rd, &rgba, &depth);
+        const float *c = px_at(rgba, 16, 16);
+        CHECK(c[0] == 17.0f && c[1] == 12.0f && c[2] == 4.0f && c[3] == 1.0f, "integrator %d: emitter %g %g %g %g", integ,
+              c[0], c[1], c[2], c[3]);
+        CHECK(fabsf(depth[16 * W + 16] - CAM_Z) < 1e-5f, "depth %g", depth[16 * W + 16]);
+        const float *bg = px_at(rgba, 0, 0);
+        CHECK(bg[0] == 0 && bg[1] == 0 && bg[2] == 0 && bg[3] == 0, "transparent background %g %g %g %g", bg[0], bg[1], bg[2], bg[3]);
+        CHECK(isinf(depth[0]) && depth[0] > 0, "background depth %g", depth[0]);
+        free(rgba);
+        free(depth);
+    }
+    /* A coloured background is radiance with alpha 1. */
+    sy_rt_background bgd = {SY_RT_BACKGROUND_COLOR, {0.25f, 0.5f, 2.0f}};
+    MUST(sy_rt_set_background(dev, &bgd, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
+    float *rgba, *depth;
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    const float *bg = px_at(rgba, 0, 0);
+    CHECK(bg[0] == 0.25f && bg[1] == 0.5f && bg[2] == 2.0f && bg[3] == 1.0f, "background %g %g %g %g", bg[0], bg[1], bg[2], bg[3]);
+    free(rgba);
+    free(depth);
+    sy_rt_device_destroy(dev);
+}
+
+static void test_point_and_directional(void)
+{
+    const float albedo[3] = {0.5f, 0.6f, 0.7f};
+    for (int kind = 0; kind < 3; ++kind) {
+        sy_rt_device *dev = rt_device();
+        float xf[16];
+        rt_identity(xf);
+        rt_place(dev, rt_quad(dev, 10.0f), xf, rt_lambert(dev, albedo[0], albedo[1], albedo[2]), 0);
+        const double I = 10.0, lz = 2.0, lx = 0.3;
+        sy_rt_light_desc ld = {.color = {1.0f, 0.5f, 0.25f}, .intensity = (float)I};
+        if (kind == 0) {
+            ld.type = SY_RT_LIGHT_POINT;
+            ld.position[0] = (float)lx;
+            ld.position[2] = (float)lz;
+        } else if (kind == 1) {
+            ld.type = SY_RT_LIGHT_DIRECTIONAL;
+            ld.direction[0] = -1.0f;
+            ld.direction[2] = -1.0f;
+        } else {
+            /* Spot pointing straight down: full intensity inside the inner cone, none outside the outer. */
+            ld.type = SY_RT_LIGHT_SPOT;
+            ld.position[2] = (float)lz;
+            ld.direction[2] = -1.0f;
+            ld.inner_cone_angle = 0.3f;
+            ld.outer_cone_angle = 0.4f;
+        }
+        sy_rt_light l;
+        MUST(sy_rt_light_create(dev, &ld, &l, ERR));
+        MUST(sy_rt_commit(dev, ERR));
+        sy_rt_camera cam = rt_camera(CAM_Z, TAN);
+        sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
+        float *rgba, *depth;
+        rt_render(dev, &cam, &rd, &rgba, &depth);
+        int checked = 0;
+        for (int py = 0; py < W; py += 4)
+            for (int px = 0; px < W; px += 4) {
+                double x, y, E;
+                pixel_point(px, py, CAM_Z, &x, &y);
+                if (kind == 0) {
+                    double dx = lx - x, dy = -y, d2 = dx * dx + dy * dy + lz * lz;
+                    E = I / d2 * (lz / sqrt(d2));
+                } else if (kind == 1) {
+                    E = I * sqrt(0.5);
+                } else {
+                    double d2 = x * x + y * y + lz * lz, cosang = lz / sqrt(d2);
+                    double t = (cosang - cos(0.4)) / (cos(0.3) - cos(0.4));
+                    if (t > 0.98 && t < 1.02) continue; /* float rounding at the inner cone edge */
+                    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+                    E = I / d2 * cosang * t * t;
+                }
+                const float *c = px_at(rgba, px, py);
+                for (int k = 0; k < 3; ++k) {
+                    double expect = albedo[k] / M_PI * ld.color[k] * E;
+                    CHECK(rt_near(c[k], expect, 1e-3) || (expect == 0 && c[k] == 0), "light kind %d pixel (%d,%d)[%d] = %.7g, expected %.7g",
+                          kind, px, py, k, c[k], expect);
+                }
+                CHECK(c[3] == 1.0f, "alpha %g", c[3]);
+                checked++;
+            }
+        CHECK(checked > 40, "only %d pixels checked", checked);
+        free(rgba);
+        free(depth);
+        sy_rt_device_destroy(dev);
+    }
+}
+
+/* Irradiance at a point under the centre of a parallel Lambertian square [-s, s]^2 of radiance
+ * le at height c: four corner rectangles, E = pi * le * F. */
+static double square_irradiance(double le, double s, double c)
+{
+    double X = s / c, Y = s / c;
+    double F = 1.0 / (2.0 * M_PI) * (X / sqrt(1 + X * X) * atan(Y / sqrt(1 + X * X)) + Y / sqrt(1 + Y * Y) * atan(X / sqrt(1 + Y * Y)));
+    return 4.0 * M_PI * le * F;
+}
+
+static void test_area_light(void)
+{
+    sy_rt_device *dev = rt_device();
+    float xf[16];
+    rt_identity(xf);
+    const float albedo = 0.8f, le = 3.0f;
+    rt_place(dev, rt_quad(dev, 10.0f), xf, rt_lambert(dev, albedo, albedo, albedo), 0);
+    /* Emitter at z = 1 facing down (rotated 180 degrees about Y), behind the camera at z = 0.5. */
+    float em[16];
+    rt_rot_y(em, (float)M_PI, 0.0f, 0.0f, 1.0f);
+    rt_place(dev, rt_quad(dev, 0.5f), em, rt_emitter(dev, le, le, le), 0);
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_camera cam = rt_camera(0.5f, 0.05f);
+    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
+    rd.area_light_samples = 256;
+    float *rgba, *depth;
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    double expect = albedo / M_PI * square_irradiance(le, 0.5, 1.0);
+    const float *c = px_at(rgba, 16, 16);
+    CHECK(rt_near(c[0], expect, 0.01), "area light: centre %.6g, expected %.6g", c[0], expect);
+    /* Default 16 samples: still within a few percent, and smooth (no sample noise) pixel to pixel. */
+    rd.area_light_samples = 0;
+    free(rgba);
+    free(depth);
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    c = px_at(rgba, 16, 16);
+    CHECK(rt_near(c[0], expect, 0.05), "area light (16 samples): centre %.6g, expected %.6g", c[0], expect);
+    free(rgba);
+    free(depth);
+    sy_rt_device_destroy(dev);
+}
+
+static void test_hard_shadow(void)
+{
+    sy_rt_device *dev = rt_device();
+    float xf[16];
+    rt_identity(xf);
+    rt_place(dev, rt_quad(dev, 10.0f), xf, rt_lambert(dev, 0.8f, 0.8f, 0.8f), 0);
+    float bx[16];
+    rt_translation(bx, 0.0f, 0.0f, 2.0f);
+    rt_place(dev, rt_quad(dev, 0.25f), bx, rt_lambert(dev, 0.8f, 0.8f, 0.8f), 0);
+    sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10, .position = {0, 0, 4}};
+    sy_rt_light l;
+    MUST(sy_rt_light_create(dev, &ld, &l, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_camera cam = rt_camera(CAM_Z, 0.15f);
+    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, 64, 64);
+    float *rgba, *depth;
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    int shadowed = 0, lit = 0;
+    for (int py = 0; py < 64; ++py)
+        for (int px = 0; px < 64; ++px) {
+            double sx = -0.15 + (px + 0.5) / 64 * 0.3, sy = 0.15 - (py + 0.5) / 64 * 0.3;
+            if (fabs(3 * sx) < 0.25 + 1e-3 && fabs(3 * sy) < 0.25 + 1e-3) continue; /* blocker itself */
+            double x = 5 * sx, y = 5 * sy; /* plane point; its segment to the light crosses z = 2 at half */
+            double mx = fabs(x / 2), my = fabs(y / 2);
+            if (fabs(mx - 0.25) < 1e-3 || fabs(my - 0.25) < 1e-3) continue; /* on the shadow edge */
+            bool in_shadow = mx < 0.25 && my < 0.25;
+            float v = rgba[4 * (py * 64 + px)];
+            if (in_shadow) {
+                CHECK(v == 0.0f, "pixel (%d,%d) should be in shadow, got %g", px, py, v);
+                shadowed++;
+            } else {
+                CHECK(v > 0.01f, "pixel (%d,%d) should be lit, got %g", px, py, v);
+                lit++;
+            }
+        }
+    CHECK(shadowed > 50 && lit > 500, "shadowed %d lit %d", shadowed, lit);
+    free(rgba);
+    free(depth);
+    sy_rt_device_destroy(dev);
+}
+
+static void test_mirror(void)
+{
+    sy_rt_device *dev = rt_device();
+    float xf[16];
+    rt_identity(xf);
+    sy_rt_material_desc md;
+    sy_rt_material_desc_init(&md);
+    md.base_color[0] = 0.9f;
+    md.base_color[1] = 0.8f;
+    md.base_color[2] = 0.7f;
+    md.metallic = 1.0f;
+    md.roughness = 0.0f;
+    sy_rt_material mirror;
+    MUST(sy_rt_material_create(dev, &md, &mirror, ERR));
+    rt_place(dev, rt_quad(dev, 10.0f), xf, mirror, 0);
+    /* Emitter behind the camera (z = 8) facing the mirror. */
+    float em[16];
+    rt_rot_y(em, (float)M_PI, 0.0f, 0.0f, 8.0f);
+    rt_place(dev, rt_quad(dev, 20.0f), em, rt_emitter(dev, 2.0f, 3.0f, 4.0f), 0);
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_camera cam = rt_camera(CAM_Z, TAN);
+    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
+    float *rgba, *depth;
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    const float *c = px_at(rgba, 16, 16);
+    CHECK(c[0] == 0.9f * 2.0f && c[1] == 0.8f * 3.0f && c[2] == 0.7f * 4.0f, "mirror %g %g %g", c[0], c[1], c[2]);
+    CHECK(fabsf(depth[16 * W + 16] - CAM_Z) < 1e-5f, "mirror depth is the mirror's, got %g", depth[16 * W + 16]);
+    /* max_depth 1: no recursion, the mirror is black. */
+    rd.max_depth = 1;
+    free(rgba);
+    free(depth);
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    c = px_at(rgba, 16, 16);
+    CHECK(c[0] == 0.0f && c[3] == 1.0f, "mirror at max_depth 1: %g alpha %g", c[0], c[3]);
+    free(rgba);
+    free(depth);
+    sy_rt_device_destroy(dev);
+}
+
+static void test_glass(void)
+{
+    sy_rt_device *dev = rt_device();
+    sy_rt_material_desc md;
+    sy_rt_material_desc_init(&md);
+    md.metallic = 0.0f;
+    md.roughness = 0.0f;
+    md.transmission = 1.0f;
+    md.ior = 1.5f;
+    sy_rt_material glass;
+    MUST(sy_rt_material_create(dev, &md, &glass, ERR));
+    sy_rt_mesh q = rt_quad(dev, 3.0f);
+    float front[16], back[16], em[16];
+    rt_identity(front);
+    rt_rot_y(back, (float)M_PI, 0.0f, 0.0f, -0.5f); /* back face of the slab, facing -Z */
+    rt_translation(em, 0.0f, 0.0f, -2.0f);
+    rt_place(dev, q, front, glass, 0);
+    rt_place(dev, q, back, glass, SY_RT_INSTANCE_BAKED);
+    rt_place(dev, rt_quad(dev, 10.0f), em, rt_emitter(dev, 1.0f, 2.0f, 4.0f), 0);
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_camera cam = rt_camera(CAM_Z, TAN);
+    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
+    float *rgba, *depth;
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    double F = pow((1.5 - 1.0) / (1.5 + 1.0), 2.0);
+    double T = (1 - F) * (1 - F) / (1 - F * F); /* both faces plus inter-reflections */
+    const float *c = px_at(rgba, 16, 16);
+    CHECK(rt_near(c[0], 1.0 * T, 1e-4) && rt_near(c[1], 2.0 * T, 1e-4) && rt_near(c[2], 4.0 * T, 1e-4),
+          "glass %.7g %.7g %.7g, expected %.7g * (1,2,4)", c[0], c[1], c[2], T);
+    /* max_depth 2: camera ray + one refraction reach only the back face: black. max_depth 3: (1-F)^2. */
+    rd.max_depth = 3;
+    free(rgba);
+    free(depth);
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    c = px_at(rgba, 16, 16);
+    CHECK(rt_near(c[0], (1 - F) * (1 - F), 1e-5), "glass depth 3: %.7g expected %.7g", c[0], (1 - F) * (1 - F));
+    free(rgba);
+    free(depth);
+    sy_rt_device_destroy(dev);
+}
+
+static void test_alpha_mask_and_texture(void)
+{
+    sy_rt_device *dev = rt_device();
+    /* 2x1 sRGB texture: left texel red (alpha 255), right texel grey 128 (alpha 0). */
+    const uint8_t px[] = {255, 0, 0, 255, 128, 128, 128, 0};
+    sy_rt_texture_desc td = {.width = 2, .height = 1, .channels = 4, .format = SY_RT_TEXEL_UNORM8_SRGB, .pixels = px,
+                             .wrap_s = SY_RT_WRAP_CLAMP, .wrap_t = SY_RT_WRAP_CLAMP, .filter = SY_RT_FILTER_NEAREST};
+    sy_rt_texture tex;
+    MUST(sy_rt_texture_create(dev, &td, &tex, ERR));
+    sy_rt_material_desc md;
+    sy_rt_material_desc_init(&md);
+    md.unlit = true;
+    md.base_color[1] = 0.5f;
+    md.base_color_texture.texture = tex;
+    md.alpha_mode = SY_RT_ALPHA_MASK;
+    sy_rt_material cut;
+    MUST(sy_rt_material_create(dev, &md, &cut, ERR));
+    float xf[16], em[16];
+    rt_identity(xf);
+    rt_translation(em, 0.0f, 0.0f, -1.0f);
+    sy_rt_mesh q = rt_quad(dev, 1.0f);
+    /* Once instanced, once baked: the filter must work for both. */
+    float left[16], right[16];
+    rt_translation(left, 0.0f, 1.0f, 0.0f);
+    rt_translation(right, 0.0f, -1.0f, 0.0f);
+    rt_place(dev, q, left, cut, 0);
+    rt_place(dev, q, right, cut, SY_RT_INSTANCE_BAKED);
+    rt_place(dev, rt_quad(dev, 10.0f), em, rt_emitter(dev, 0.0f, 0.0f, 5.0f), 0);
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_camera cam = rt_camera(CAM_Z, TAN);
+    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
+    for (int integ = SY_RT_INTEGRATOR_PRIMARY; integ <= SY_RT_INTEGRATOR_WHITTED; ++integ) {
+        rd.integrator = (sy_rt_integrator)integ;
+        float *rgba, *depth;
+        rt_render(dev, &cam, &rd, &rgba, &depth);
+        /* Pixels 12 and 20 of rows 10 and 22 sit on the left (x -0.53) and right (x +0.68) halves. */
+        for (int row = 10; row <= 22; row += 12) {
+            const float *l = px_at(rgba, 12, row), *r = px_at(rgba, 20, row);
+            if (integ == SY_RT_INTEGRATOR_WHITTED)
+                CHECK(l[0] == 1.0f && l[1] == 0.0f && l[2] == 0.0f, "row %d: unlit red texel * factor: %g %g %g", row, l[0], l[1], l[2]);
+            CHECK(fabsf(depth[row * W + 12] - CAM_Z) < 1e-5f, "row %d: masked quad depth %g", row, depth[row * W + 12]);
+            CHECK(r[0] == 0.0f && r[1] == 0.0f && r[2] == 5.0f, "row %d: cut-out shows the emitter: %g %g %g", row, r[0], r[1], r[2]);
+            CHECK(fabsf(depth[row * W + 20] - (CAM_Z + 1.0f)) < 1e-5f, "row %d: depth through cut-out %g", row, depth[row * W + 20]);
+        }
+        free(rgba);
+        free(depth);
+    }
+    /* Opaque again: the grey right half appears as 128 sRGB * (1, 0.5, 1). */
+    md.alpha_mode = SY_RT_ALPHA_OPAQUE;
+    MUST(sy_rt_material_update(dev, cut, &md, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    rd.integrator = SY_RT_INTEGRATOR_WHITTED;
+    float *rgba, *depth;
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    const float *r = px_at(rgba, 20, 10);
+    double g = pow((128 / 255.0 + 0.055) / 1.055, 2.4);
+    CHECK(rt_near(r[0], g, 1e-6) && rt_near(r[1], 0.5 * g, 1e-6), "opaque grey %g %g expected %g", r[0], r[1], g);
+    free(rgba);
+    free(depth);
+    sy_rt_device_destroy(dev);
+}
+
+int main(void)
+{
+    test_emitter_exact();
+    test_point_and_directional();
+    test_area_light();
+    test_hard_shadow();
+    test_mirror();
+    test_glass();
+    test_alpha_mask_and_texture();
+    return rt_finish("test_rt_whitted");
+}
