@@ -6,5 +6,5 @@ set -euo pipefail
 cd "$(dirname "$0")"
 . .ci/deps.sh
 sy_install_deps
-sy_configure_build build -DCMAKE_BUILD_TYPE=Release
-./build/apps/sy demo "$@"
+sy_configure_build build-release sy -- -DCMAKE_BUILD_TYPE=Release
+./build-release/apps/sy demo "$@"

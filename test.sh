@@ -6,8 +6,8 @@ cd "$(dirname "$0")"
 . .ci/deps.sh
 sy_install_deps
 jobs=$(nproc 2>/dev/null || echo 2)
-sy_configure_build build -DCMAKE_BUILD_TYPE=RelWithDebInfo
+sy_configure_build build -- -DCMAKE_BUILD_TYPE=RelWithDebInfo
 ctest --test-dir build --output-on-failure -j "$jobs"
-sy_configure_build build-asan -DCMAKE_BUILD_TYPE=Debug -DSY_SANITIZE=ON
+sy_configure_build build-asan -- -DCMAKE_BUILD_TYPE=Debug -DSY_SANITIZE=ON
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-asan --output-on-failure -j "$jobs"

@@ -17,10 +17,14 @@ sy_install_deps() {
   fi
 }
 
+# sy_configure_build DIR [TARGET] -- CMAKE_ARGS...: configure DIR and build TARGET (default: all).
 sy_configure_build() {
   local dir=$1; shift
+  local target=()
+  if [ $# -gt 0 ] && [ "$1" != "--" ]; then target=(--target "$1"); shift; fi
+  [ "${1:-}" = "--" ] && shift
   local gen=()
   command -v ninja >/dev/null 2>&1 && gen=(-G Ninja)
   cmake -S . -B "$dir" "${gen[@]}" "$@" >/dev/null
-  cmake --build "$dir" -j "$(nproc 2>/dev/null || echo 2)"
+  cmake --build "$dir" "${target[@]}" -j "$(nproc 2>/dev/null || echo 2)"
 }

@@ -44,7 +44,48 @@ static void loaded_free(loaded *l)
     memset(l, 0, sizeof *l);
 }
 
-static sy_result load(const char *path, const char *camera_sel, loaded *out, sy_error *err)
+/* A file without a camera gets one framing its bounds (as a real camera node, so every back-end
+ * sees the same view); a file without punctual lights gets a directional headlight from that
+ * camera, so that it is not black in the ray tracers. Both are reported on stderr. */
+static sy_result add_defaults(loaded *ld, sy_error *err)
+{
+    sy_scene *s = ld->scene;
+    sy_result r = SY_OK;
+    sy_mat4 cam_world;
+    if (!ld->camera.id) {
+        sy_bounds b;
+        if ((r = sy_node_world_bounds(s, ld->root, &b, err))) return r;
+        sy_camera_view v = sy_camera_view_frame_bounds(&b, 1.0f);
+        sy_camera cam;
+        sy_camera_data cd = *(const sy_camera_data *)sy_object_defaults(SY_TYPE_CAMERA);
+        cd.yfov = 2.0f * atanf(v.window[3]);
+        cd.znear = v.znear;
+        if ((r = sy_camera_create(s, "default camera", &cam, err)) || (r = sy_camera_set(s, cam, &cd, err)) ||
+            (r = sy_node_create(s, "default camera", &ld->camera, err)) ||
+            (r = sy_node_set_matrix(s, ld->camera, &v.camera_to_world, err)) ||
+            (r = sy_node_set_camera(s, ld->camera, cam, err)))
+            return r;
+        cam_world = v.camera_to_world;
+    } else if ((r = sy_node_world_matrix(s, ld->camera, &cam_world, err))) {
+        return r;
+    }
+    if (sy_scene_count(s, SY_TYPE_LIGHT) == 0) {
+        fprintf(stderr, "sy: note: the scene has no lights; adding a directional headlight\n");
+        sy_light l;
+        sy_node n;
+        sy_light_data ld2 = *(const sy_light_data *)sy_object_defaults(SY_TYPE_LIGHT);
+        ld2.type = SY_LIGHT_DIRECTIONAL;
+        ld2.intensity = 3.0f;
+        /* under the root (identity for glTF), so the mediator's root filter sees it */
+        if ((r = sy_light_create(s, "headlight", &l, err)) || (r = sy_light_set(s, l, &ld2, err)) ||
+            (r = sy_node_create(s, "headlight", &n, err)) || (r = sy_node_set_matrix(s, n, &cam_world, err)) ||
+            (r = sy_node_set_light(s, n, l, err)) || (r = sy_node_add_child(s, ld->root, n, err)))
+            return r;
+    }
+    return sy_scene_commit(s, NULL, err);
+}
+
+static sy_result load(const char *path, const char *camera_sel, bool defaults, loaded *out, sy_error *err)
 {
     memset(out, 0, sizeof *out);
     sy_result r = sy_scene_create(&out->scene, err);
@@ -70,6 +111,7 @@ static sy_result load(const char *path, const char *camera_sel, loaded *out, sy_
         }
     }
     if (r == SY_OK) r = sy_scene_commit(out->scene, NULL, err);
+    if (r == SY_OK && out->is_gltf && defaults) r = add_defaults(out, err);
     if (r != SY_OK) loaded_free(out);
     return r;
 }
@@ -186,7 +228,7 @@ static int cmd_info(int argc, char **argv)
     if (argc != 1) return usage();
     sy_error err = {0};
     loaded ld;
-    if (load(argv[0], NULL, &ld, &err) != SY_OK) return fail(&err);
+    if (load(argv[0], NULL, false, &ld, &err) != SY_OK) return fail(&err);
     sy_bounds b;
     sy_node_world_bounds(ld.scene, ld.root, &b, NULL);
     /* counts of what was loaded into the scene (less the synthetic root node) */
@@ -254,8 +296,12 @@ static int cmd_render(int argc, char **argv)
     }
     if (!scene || !backend || !outp) return usage();
     sy_error err = {0};
+    if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) { /* before any loading or rendering */
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);
+        return fail(&err);
+    }
     loaded ld;
-    if (load(scene, camera, &ld, &err) != SY_OK) return fail(&err);
+    if (load(scene, camera, true, &ld, &err) != SY_OK) return fail(&err);
     /* default size: 512 high, width from the camera's aspect ratio when it has one */
     float aspect = 1.0f;
     const sy_node_data *cn = ld.camera.id ? sy_node_get(ld.scene, ld.camera) : NULL;
@@ -303,7 +349,7 @@ static int cmd_demo(int argc, char **argv)
     }
     sy_error err = {0};
     loaded ld;
-    if (load("demo", NULL, &ld, &err) != SY_OK) return fail(&err);
+    if (load("demo", NULL, true, &ld, &err) != SY_OK) return fail(&err);
     sy_context_pool *pool = NULL;
     sy_result r = sy_context_pool_create(&pool, &err);
     printf("demo scene: %u nodes, %u meshes, %u materials, %ux%u\n", sy_scene_count(ld.scene, SY_TYPE_NODE),
@@ -361,7 +407,7 @@ static int cmd_bench(int argc, char **argv)
     if (!strcmp(argv[0], "sync")) return sy_bench_sync(nodes, tris, repeats ? repeats : 50, &err) == SY_OK ? 0 : fail(&err);
     if (!strcmp(argv[0], "rays")) {
         loaded ld;
-        if (load(scene ? scene : "demo", NULL, &ld, &err) != SY_OK) return fail(&err);
+        if (load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return fail(&err);
         sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .backend = "whitted"};
         sy_result r = sy_bench_rays(ld.scene, &vd, w, h, repeats ? repeats : 5, &err);
         loaded_free(&ld);

@@ -792,8 +792,9 @@ sy_result sy_object_set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32
             trs_fixed.matrix = sy_mat4_from_trs(trs_fixed.translation, trs_fixed.rotation, trs_fixed.scale);
         value = &trs_fixed;
     }
-    sy_result r = validate_field(s, t, id, field, value, err);
-    if (r != SY_OK) return r;
+    if (t == SY_TYPE_MESH && field == SY_MESH_PRIMITIVES && ((const sy_primitive_list *)value)->count &&
+        !((const sy_primitive_list *)value)->items)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh: NULL primitives");
     /* Build a source struct holding the value at the field's offset (the generic copy reads it there). */
     unsigned char src[sizeof(sy_material_data) > sizeof(sy_node_data) ? sizeof(sy_material_data) : sizeof(sy_node_data)];
     _Static_assert(sizeof(sy_texture_data) <= sizeof src && sizeof(sy_mesh_data) <= sizeof src &&
@@ -802,7 +803,11 @@ sy_result sy_object_set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32
                    "scratch buffer too small");
     const sy_field_desc *fd = &td->fields[field];
     memcpy(src + fd->offset, value, fd->size);
+    /* The no-op test comes before validation: re-setting the value a field already holds succeeds
+     * even when it names an object destroyed since (stale references are kept, read as absent). */
     if (sy__field_equal(t, field, sl->data, src)) return SY_OK;
+    sy_result r = validate_field(s, t, id, field, value, err);
+    if (r != SY_OK) return r;
 
     sy_blob *old_children = NULL;
     uint32_t old_mesh = 0;
@@ -932,9 +937,13 @@ sy_result sy_node_add_child(sy_scene *s, sy_node parent, sy_node child, sy_error
     const uint32_t *ch = sy_node_children(d, &nc);
     sy_node *list = malloc(sizeof *list * ((size_t)nc + 1));
     if (!list) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "add child: out of memory");
-    for (uint32_t i = 0; i < nc; ++i) list[i].id = ch[i];
-    list[nc] = child;
-    sy_result r = sy_node_set_children(s, parent, list, nc + 1, err);
+    /* children destroyed since stay in the list as stale ids (readers skip them); drop them here,
+     * or the new list would be refused for holding a stale child */
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < nc; ++i)
+        if (lookup(s, SY_TYPE_NODE, ch[i])) list[n++].id = ch[i];
+    list[n] = child;
+    sy_result r = sy_node_set_children(s, parent, list, n + 1, err);
     free(list);
     return r;
 }
@@ -967,8 +976,10 @@ sy_result sy_mesh_set_primitives(sy_scene *s, sy_mesh m, const sy_primitive *pri
 static sy_result set_all(sy_scene *s, uint32_t t, uint32_t id, const void *d, sy_error *err)
 {
     const sy_type_desc *td = sy__type_desc(t);
-    if (!lookup(s, t, id)) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "set: stale or invalid %s handle %#x", td->name, id);
+    slot *sl = lookup(s, t, id);
+    if (!sl) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "set: stale or invalid %s handle %#x", td->name, id);
     for (uint32_t f = 0; f < td->field_count; ++f) {
+        if (sy__field_equal(t, f, sl->data, d)) continue; /* unchanged: may hold a stale reference */
         sy_result r = validate_field(s, t, id, f, (const char *)d + td->fields[f].offset, err);
         if (r != SY_OK) return r;
     }
@@ -1407,11 +1418,45 @@ size_t sy_scene_log_bytes(const sy_scene *s)
 }
 
 /* >>apply (replica) */
+static int key_order(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* A snapshot lists every object of the source: on a replica that already holds state (a
+ * consumer resynchronising), destroy what the snapshot does not list with exactly that id. */
+static sy_result resync_destroy_unlisted(sy_scene *s, const sy_changes *changes, sy_error *err)
+{
+    uint32_t n = sy_changes_count(changes);
+    uint64_t *keys = malloc(sizeof *keys * (n ? n : 1));
+    if (!keys) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "apply snapshot: out of memory");
+    uint32_t nk = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        const sy_change *e = sy_changes_get(changes, i);
+        if (!(e->flags & SY_CHANGE_DESTROYED)) keys[nk++] = ((uint64_t)e->type << 32) | e->id;
+    }
+    qsort(keys, nk, sizeof *keys, key_order);
+    sy_result r = SY_OK;
+    for (uint32_t t = 1; t < SY_TYPE_COUNT && r == SY_OK; ++t) {
+        uint32_t id = sy_scene_next(s, t, 0);
+        while (id && r == SY_OK) {
+            uint32_t next = sy_scene_next(s, t, id);
+            uint64_t key = ((uint64_t)t << 32) | id;
+            if (!bsearch(&key, keys, nk, sizeof *keys, key_order)) r = sy_object_destroy(s, t, id, err);
+            id = next;
+        }
+    }
+    free(keys);
+    return r;
+}
+
 sy_result sy_scene_apply(sy_scene *s, const sy_changes *changes, sy_error *err)
 {
     sy_result r = SY_OK;
     uint32_t n = sy_changes_count(changes);
     s->applying = true;
+    if (sy_changes_is_snapshot(changes)) r = resync_destroy_unlisted(s, changes, err);
     /* pass 1: destructions; pass 2: creations; pass 3: field values (references may point at
      * objects created later in the list, hence the separate passes) */
     for (uint32_t i = 0; i < n && r == SY_OK; ++i) {

@@ -202,7 +202,7 @@ typedef enum sy_filter { SY_FILTER_LINEAR = 0, SY_FILTER_NEAREST = 1 } sy_filter
 
 typedef struct sy_image_info {
     uint32_t width, height;
-    uint32_t channels; /* 1..4 */
+    uint32_t channels; /* 1 = grey (used for R, G and B), 2 = grey + alpha, 3 = RGB, 4 = RGBA */
     uint32_t format;   /* sy_pixel_format */
 } sy_image_info;
 

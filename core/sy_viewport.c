@@ -2,6 +2,7 @@
 #include "sy_viewport.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -66,6 +67,15 @@ void sy_window_size(const sy_window *w, uint32_t *width, uint32_t *height)
 sy_result sy_viewport_set_backend(sy_viewport *v, const char *backend, const char *params, sy_error *err)
 {
     if (!backend || !backend[0]) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "viewport: no back-end name");
+    if (!sy_mediator_find(backend)) { /* fail now, keeping the current back-end, not at the next render */
+        char names[256] = "";
+        for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
+            size_t l = strlen(names);
+            snprintf(names + l, sizeof names - l, "%s%s", l ? ", " : "", sy_mediator_at(i)->name);
+        }
+        return sy_error_set(err, SY_ERR_NOT_FOUND, "viewport: back-end '%s' is not registered (available: %s)", backend,
+                            names[0] ? names : "none");
+    }
     sy_params parsed;
     sy_result r = sy_params_parse(params, &parsed, err);
     if (r != SY_OK) return r;

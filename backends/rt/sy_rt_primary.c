@@ -1,7 +1,13 @@
-/* sy_rt_primary.c — the primary-ray integrator: one coherent rtcIntersect1 per pixel and eye-light
- * shading from the shared surface evaluation. */
+/* sy_rt_primary.c — the primary-ray integrator: coherent ray packets (rtcIntersect16 over 4x4 pixel
+ * blocks aligned to the full-image pixel grid, so a pixel always shares its packet with the same
+ * neighbours whatever the tile or sub-rectangle; lanes outside the tile are masked off) and the
+ * lean eye-light shading of sy_rt_surface_eyelight. */
 #include "sy_rt_primary.h"
 #include "sy_rt_surface.h"
+
+#define PKT_W 4u
+#define PKT_H 4u
+#define PKT_N (PKT_W * PKT_H)
 
 void sy_rt_primary_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
 {
@@ -11,39 +17,58 @@ void sy_rt_primary_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t 
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     const sy_rt_background *bg = &dev->background;
-    float bg_alpha = bg->mode == SY_RT_BACKGROUND_COLOR ? 1.0f : 0.0f;
-    for (uint32_t py = y0; py < y1; ++py) {
-        for (uint32_t px = x0; px < x1; ++px) {
-            struct RTCRayHit rh;
-            float axial;
-            sy_rt_frame_ray(f, px, py, &rh.ray, &axial);
-            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            rtcIntersect1(dev->top, &ctx, &rh);
-            size_t o = (size_t)(py - f->y) * f->width + (px - f->x);
-            float *c = f->rgba + 4u * o;
-            const sy_rt_instance_data *in = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID
-                                                ? NULL : sy_rt_hit_instance(dev, rh.hit.geomID, rh.hit.instID[0]);
-            if (!in) {
-                c[0] = bg_alpha * bg->color[0];
-                c[1] = bg_alpha * bg->color[1];
-                c[2] = bg_alpha * bg->color[2];
-                c[3] = bg_alpha;
-                if (f->depth) f->depth[o] = INFINITY;
-                continue;
+    const float bg_alpha = bg->mode == SY_RT_BACKGROUND_COLOR ? 1.0f : 0.0f;
+    const float bg_rgba[4] = {bg_alpha * bg->color[0], bg_alpha * bg->color[1], bg_alpha * bg->color[2], bg_alpha};
+    float *const depth = f->depth;
+    const uint32_t bx0 = x0 - x0 % PKT_W, by0 = y0 - y0 % PKT_H;
+    for (uint32_t by = by0; by < y1; by += PKT_H) {
+        for (uint32_t bx = bx0; bx < x1; bx += PKT_W) {
+            struct RTCRayHit16 rh;
+            _Alignas(64) int valid[PKT_N];
+            float axial[PKT_N];
+            for (uint32_t k = 0; k < PKT_N; ++k) {
+                uint32_t px = bx + k % PKT_W, py = by + k / PKT_W;
+                struct RTCRay r;
+                bool on = px >= x0 && px < x1 && py >= y0 && py < y1;
+                valid[k] = on ? -1 : 0;
+                if (on) {
+                    sy_rt_frame_ray(f, px, py, &r, &axial[k]);
+                } else {
+                    r = (struct RTCRay){.tnear = 0.0f, .tfar = -INFINITY, .mask = 0xffffffffu, .dir_z = -1.0f};
+                    axial[k] = 1.0f;
+                }
+                rh.ray.org_x[k] = r.org_x; rh.ray.org_y[k] = r.org_y; rh.ray.org_z[k] = r.org_z;
+                rh.ray.dir_x[k] = r.dir_x; rh.ray.dir_y[k] = r.dir_y; rh.ray.dir_z[k] = r.dir_z;
+                rh.ray.tnear[k] = r.tnear; rh.ray.tfar[k] = r.tfar;
+                rh.ray.time[k] = r.time; rh.ray.mask[k] = r.mask;
+                rh.ray.id[k] = r.id; rh.ray.flags[k] = r.flags;
+                rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+                rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
             }
-            sy_rt_v3 dir = v3(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
-            sy_rt_surface s;
-            sy_rt_surface_fetch(dev, in, rh.hit.primID, rh.hit.u, rh.hit.v, dir, &s);
-            sy_rt_v3 col;
-            if (s.mat->emissive) col = s.emission;
-            else if (s.mat->desc.unlit) col = s.base;
-            else col = v3_scale(s.base, fabsf(v3_dot(s.ns, v3_normalize(dir))));
-            c[0] = col.x;
-            c[1] = col.y;
-            c[2] = col.z;
-            c[3] = 1.0f;
-            if (f->depth) f->depth[o] = rh.ray.tfar * axial;
+            rtcIntersect16(valid, dev->top, &ctx, &rh);
+            for (uint32_t k = 0; k < PKT_N; ++k) {
+                if (!valid[k]) continue;
+                uint32_t px = bx + k % PKT_W, py = by + k / PKT_W;
+                size_t o = (size_t)(py - f->y) * f->width + (px - f->x);
+                float *c = f->rgba + 4u * o;
+                const sy_rt_instance_data *in = rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID
+                                                    ? NULL : sy_rt_hit_instance(dev, rh.hit.geomID[k], rh.hit.instID[0][k]);
+                if (!in) {
+                    c[0] = bg_rgba[0];
+                    c[1] = bg_rgba[1];
+                    c[2] = bg_rgba[2];
+                    c[3] = bg_rgba[3];
+                    if (depth) depth[o] = INFINITY;
+                    continue;
+                }
+                sy_rt_v3 dir = v3(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]);
+                sy_rt_v3 col = sy_rt_surface_eyelight(dev, in, rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k], dir);
+                c[0] = col.x;
+                c[1] = col.y;
+                c[2] = col.z;
+                c[3] = 1.0f;
+                if (depth) depth[o] = rh.ray.tfar[k] * axial[k];
+            }
         }
     }
 }

@@ -156,3 +156,51 @@ void sy_rt_alpha_filter(const struct RTCFilterFunctionNArguments *args)
         if (sy_rt_surface_alpha(dev, in, prim, u, v) < mat->desc.alpha_cutoff) args->valid[i] = 0;
     }
 }
+
+sy_rt_v3 sy_rt_surface_eyelight(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u,
+                                float v, sy_rt_v3 dir)
+{
+    const sy_rt_mesh_data *m = inst->mesh;
+    const sy_rt_material_data *mat = sy_rt_material_lookup(dev, inst->material);
+    const sy_rt_material_desc *d = &mat->desc;
+    const uint32_t *ix = m->indices + 3u * prim;
+    float w0 = 1.0f - u - v, w1 = u, w2 = v;
+    float uv[2][2];
+    if (mat->emissive) {
+        sy_rt_v3 e = v3_load(d->emissive);
+        const sy_rt_texture_ref *em = &d->emissive_texture;
+        if (em->texture.id != 0) {
+            float t[4];
+            fetch_uv(m, ix, w0, w1, w2, uv);
+            if (sy_rt_texture_sample_ref(dev, em->texture, uv[em->texcoord][0], uv[em->texcoord][1], t))
+                e = v3_mul(e, v3(t[0], t[1], t[2]));
+        }
+        return e;
+    }
+    /* Only the texture-coordinate sets a texture of this material reads (same arithmetic as fetch_uv). */
+    bool need[2] = {false, false};
+    if (d->base_color_texture.texture.id != 0) need[d->base_color_texture.texcoord & 1u] = true;
+    if (!d->unlit && d->normal_texture.texture.id != 0) need[d->normal_texture.texcoord & 1u] = true;
+    for (int k = 0; k < 2; ++k) {
+        if (need[k] && m->uv[k]) interp(m->uv[k], 2, ix, w0, w1, w2, uv[k]);
+        else uv[k][0] = uv[k][1] = 0.0f;
+    }
+    sy_rt_v3 base;
+    (void)base_alpha(dev, mat, m, ix, w0, w1, w2, uv, &base);
+    if (d->unlit) return base;
+
+    sy_rt_v3 o0 = v3_load(m->positions + 3u * ix[0]), o1 = v3_load(m->positions + 3u * ix[1]),
+             o2 = v3_load(m->positions + 3u * ix[2]);
+    sy_rt_v3 ng = v3_normalize(m3_mul(inst->nrm, v3_cross(v3_sub(o1, o0), v3_sub(o2, o0))));
+    bool front = v3_dot(ng, dir) < 0.0f;
+    sy_rt_v3 n = ng;
+    if (m->normals) {
+        float nn[3];
+        interp(m->normals, 3, ix, w0, w1, w2, nn);
+        sy_rt_v3 ns = v3_normalize(m3_mul(inst->nrm, v3_load(nn)));
+        if (!v3_is_zero(ns)) n = ns;
+    }
+    if (d->normal_texture.texture.id != 0) n = apply_normal_map(dev, inst, ix, (const float(*)[2])uv, n);
+    sy_rt_v3 ns = front ? n : v3_scale(n, -1.0f);
+    return v3_scale(base, fabsf(v3_dot(ns, v3_normalize(dir))));
+}

@@ -26,6 +26,12 @@ typedef struct sy_rt_surface {
 void sy_rt_surface_fetch(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u,
                          float v, sy_rt_v3 dir, sy_rt_surface *s);
 
+/* Eye-light colour of the PRIMARY integrator at a hit, bit-identical to shading the full
+ * sy_rt_surface_fetch result (emission for emitters, base colour for unlit materials, otherwise
+ * base colour * |cos(shading normal, ray)|), but evaluating only what that needs. */
+sy_rt_v3 sy_rt_surface_eyelight(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u,
+                                float v, sy_rt_v3 dir);
+
 /* Coverage alpha of a point (factor * texture alpha * vertex alpha). */
 float sy_rt_surface_alpha(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u, float v);
 

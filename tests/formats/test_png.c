@@ -54,7 +54,7 @@ typedef struct px_case {
     float in[4];      /* premultiplied linear */
     sy_png_options o; /* options for this pixel's image */
     int want[4];      /* -1: compute from want_lin */
-    double want_lin[3];
+    double want_lin[4];
 } px_case;
 
 /* Writes a 1xN image per option set and reads it back. */

@@ -1,0 +1,181 @@
+#!/usr/bin/env bash
+# cli_test.sh SY TESTDATA TMPDIR — tests of the `sy` command line tool (integration_cli).
+#   - sy info Box.gltf: JSON counts meshes/primitives/triangles/materials = 1/1/12/1, bounds +-0.5
+#   - sy render (cornell, whitted) to PNG and EXR: exit 0, files with the right signature and size
+#   - bad inputs (missing file, truncated GLB, garbage .gltf, unknown back-end, output in a missing
+#     directory, unknown output extension): non-zero exit, the offending name in stderr, and no
+#     output file nor temporary file left behind
+#   - sy bench sync / sy bench rays on small sizes: exit 0 and their result lines (no thresholds)
+#   - sy demo -o DIR -w 64 -h 36: demo_whitted.png / .exr written
+# The parts that need ../shared/testdata run only when it is present; when it is absent the rest
+# still runs and the test then exits 77 (skipped) naming what was missing.
+set -u
+SY=$1
+DATA=$2
+TMP=$3
+fails=0
+missing=""
+
+rm -rf "$TMP"
+mkdir -p "$TMP"
+
+fail() {
+    echo "FAIL: $*" >&2
+    fails=$((fails + 1))
+}
+
+# run NAME CMD...: runs a command with stdout/stderr captured in $TMP/NAME.{out,err}; sets $rc.
+run() {
+    local name=$1
+    shift
+    "$@" >"$TMP/$name.out" 2>"$TMP/$name.err"
+    rc=$?
+}
+
+# magic FILE HEX: the file starts with these bytes
+magic() {
+    [ "$(head -c $((${#2} / 2)) "$1" | od -An -tx1 | tr -d ' \n')" = "$2" ]
+}
+
+# u32be FILE OFFSET: big-endian 32-bit integer
+u32be() {
+    local b
+    b=($(od -An -tu1 -j "$2" -N 4 "$1"))
+    echo $(((b[0] << 24) | (b[1] << 16) | (b[2] << 8) | b[3]))
+}
+
+# expect_error NAME NEEDLE OUTDIR CMD...: CMD must fail, mention NEEDLE on stderr, and leave OUTDIR
+# (a fresh directory holding only the command's outputs) empty.
+expect_error() {
+    local name=$1 needle=$2 outdir=$3
+    shift 3
+    run "$name" "$@"
+    if [ "$rc" -eq 0 ]; then fail "$name: exit status 0 for a bad input"; fi
+    if [ "$rc" -ge 128 ]; then fail "$name: killed by a signal (status $rc)"; fi
+    if ! grep -qF -- "$needle" "$TMP/$name.err"; then
+        fail "$name: stderr does not name '$needle': $(cat "$TMP/$name.err")"
+    fi
+    if [ -n "$(ls -A "$outdir")" ]; then fail "$name: left files behind: $(ls -A "$outdir")"; fi
+    echo "ok: $name -> status $rc: $(head -n 3 "$TMP/$name.err" | tr '\n' ' ')"
+}
+
+BOX="$DATA/gltf/Box/glTF/Box.gltf"
+GLB="$DATA/gltf/Box/glTF-Binary/Box.glb"
+CORNELL="$DATA/cornell/cornell_box.gltf"
+
+# ---------------------------------------------------------------- without test data
+run backends "$SY" backends
+[ "$rc" -eq 0 ] && grep -q '^whitted' "$TMP/backends.out" || fail "sy backends does not list whitted"
+
+# garbage bytes named bad.gltf
+mkdir -p "$TMP/in" "$TMP/o_garbage"
+printf 'this is not glTF \000\377\376 {{{' >"$TMP/in/bad.gltf"
+expect_error garbage bad.gltf "$TMP/o_garbage" "$SY" render "$TMP/in/bad.gltf" -b whitted -o "$TMP/o_garbage/x.png"
+mkdir -p "$TMP/o_garbage_info"
+expect_error garbage_info bad.gltf "$TMP/o_garbage_info" "$SY" info "$TMP/in/bad.gltf"
+
+# a missing input file
+mkdir -p "$TMP/o_missing"
+expect_error missing no_such_scene.gltf "$TMP/o_missing" "$SY" render "$TMP/in/no_such_scene.gltf" -b whitted \
+    -o "$TMP/o_missing/x.png"
+
+# unknown back-end, output in a missing directory, unknown extension (on the built-in scene)
+mkdir -p "$TMP/o_backend"
+expect_error backend no-such-backend "$TMP/o_backend" "$SY" render demo -b no-such-backend -w 16 -h 16 \
+    -o "$TMP/o_backend/x.png"
+grep -q whitted "$TMP/backend.err" || fail "unknown back-end: the message does not list the available ones"
+mkdir -p "$TMP/o_nodir"
+expect_error nodir "$TMP/o_nodir/missing_dir/x.png" "$TMP/o_nodir" "$SY" render demo -b whitted -w 16 -h 16 \
+    -o "$TMP/o_nodir/missing_dir/x.png"
+mkdir -p "$TMP/o_ext"
+expect_error extension x.jpg "$TMP/o_ext" "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_ext/x.jpg"
+
+# benchmarks on small sizes: exit status and result lines only (speed is not tested here)
+run bench_sync "$SY" bench sync --nodes 200 --tris 48 --repeats 5
+if [ "$rc" -ne 0 ]; then fail "bench sync: status $rc: $(cat "$TMP/bench_sync.err")"; fi
+grep -Eq 'ratio full / incremental +[0-9.]+ x' "$TMP/bench_sync.out" || fail "bench sync: no ratio line"
+grep -Eq 'placements recomputed +1$' "$TMP/bench_sync.out" || fail "bench sync: a leaf move did not re-place exactly 1"
+grep -Eq '^sy bench sync: 200 nodes' "$TMP/bench_sync.out" || fail "bench sync: wrong node count"
+cat "$TMP/bench_sync.out"
+run bench_rays "$SY" bench rays demo -w 64 -h 64 --repeats 2
+if [ "$rc" -ne 0 ]; then fail "bench rays: status $rc: $(cat "$TMP/bench_rays.err")"; fi
+grep -Eq 'raw Embree rtcIntersect1 +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fail "bench rays: no raw line"
+grep -Eq 'whitted back-end \(primary\) +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fail "bench rays: no ours line"
+grep -Eq 'overhead +-?[0-9.]+ %' "$TMP/bench_rays.out" || fail "bench rays: no overhead (ratio) line"
+cat "$TMP/bench_rays.out"
+
+# demo
+run demo "$SY" demo -o "$TMP/demo" -w 64 -h 36
+if [ "$rc" -ne 0 ]; then fail "demo: status $rc: $(cat "$TMP/demo.err")"; fi
+if [ -f "$TMP/demo/demo_whitted.png" ] && magic "$TMP/demo/demo_whitted.png" 89504e470d0a1a0a; then
+    [ "$(u32be "$TMP/demo/demo_whitted.png" 16)x$(u32be "$TMP/demo/demo_whitted.png" 20)" = 64x36 ] ||
+        fail "demo: PNG is not 64x36"
+else
+    fail "demo: demo_whitted.png missing or not a PNG"
+fi
+[ -f "$TMP/demo/demo_whitted.exr" ] && magic "$TMP/demo/demo_whitted.exr" 762f3101 ||
+    fail "demo: demo_whitted.exr missing or not an OpenEXR file"
+
+# ---------------------------------------------------------------- with test data
+if [ -f "$BOX" ] && [ -f "$GLB" ]; then
+    run info "$SY" info "$BOX"
+    if [ "$rc" -ne 0 ]; then fail "info Box.gltf: status $rc: $(cat "$TMP/info.err")"; fi
+    # the top-level counts are indented by two spaces (the "loaded" object is on one line)
+    for kv in '"meshes": 1,' '"primitives": 1,' '"triangles": 12,' '"materials": 1,'; do
+        grep -qxF "  $kv" "$TMP/info.out" || fail "info Box.gltf: no line '$kv'"
+    done
+    grep -qF '"bounds": {"min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]}' "$TMP/info.out" ||
+        fail "info Box.gltf: bounds are not +-0.5: $(grep bounds "$TMP/info.out")"
+    head -c 1 "$TMP/info.out" | grep -q '{' && tail -n 1 "$TMP/info.out" | grep -qx '}' ||
+        fail "info Box.gltf: output is not one JSON object"
+
+    mkdir -p "$TMP/o_trunc"
+    head -c 100 "$GLB" >"$TMP/in/truncated.glb"
+    expect_error truncated truncated.glb "$TMP/o_trunc" "$SY" render "$TMP/in/truncated.glb" -b whitted \
+        -o "$TMP/o_trunc/x.png"
+    mkdir -p "$TMP/o_trunc_exr"
+    expect_error truncated_exr truncated.glb "$TMP/o_trunc_exr" "$SY" render "$TMP/in/truncated.glb" -b whitted \
+        -o "$TMP/o_trunc_exr/x.exr"
+    mkdir -p "$TMP/o_box_backend"
+    expect_error box_backend nosuch "$TMP/o_box_backend" "$SY" render "$BOX" -b nosuch -o "$TMP/o_box_backend/x.png"
+else
+    missing="$missing $BOX $GLB"
+fi
+
+if [ -f "$CORNELL" ]; then
+    mkdir -p "$TMP/render"
+    run render_png "$SY" render "$CORNELL" -b whitted -w 96 -h 96 -o "$TMP/render/cornell.png"
+    if [ "$rc" -ne 0 ]; then fail "render cornell png: status $rc: $(cat "$TMP/render_png.err")"; fi
+    if [ -f "$TMP/render/cornell.png" ] && magic "$TMP/render/cornell.png" 89504e470d0a1a0a; then
+        [ "$(u32be "$TMP/render/cornell.png" 16)x$(u32be "$TMP/render/cornell.png" 20)" = 96x96 ] ||
+            fail "render cornell: PNG is not 96x96"
+    else
+        fail "render cornell: no PNG written"
+    fi
+    run render_exr "$SY" render "$CORNELL" -b whitted -w 64 -o "$TMP/render/cornell.exr"
+    if [ "$rc" -ne 0 ]; then fail "render cornell exr: status $rc: $(cat "$TMP/render_exr.err")"; fi
+    [ -f "$TMP/render/cornell.exr" ] && magic "$TMP/render/cornell.exr" 762f3101 || fail "render cornell: no EXR written"
+    # exactly the two outputs, no temporary files
+    [ "$(ls -A "$TMP/render" | sort | tr '\n' ' ')" = "cornell.exr cornell.png " ] ||
+        fail "render cornell: unexpected files: $(ls -A "$TMP/render")"
+    # an existing output stays untouched when a later render fails
+    cp "$TMP/render/cornell.png" "$TMP/in/before.png"
+    run render_fail "$SY" render "$TMP/in/bad.gltf" -b whitted -o "$TMP/render/cornell.png"
+    [ "$rc" -ne 0 ] && cmp -s "$TMP/in/before.png" "$TMP/render/cornell.png" ||
+        fail "a failed render changed an existing output file"
+    echo "ok: render cornell -> $(cat "$TMP/render_png.out")"
+else
+    missing="$missing $CORNELL"
+fi
+
+if [ "$fails" -ne 0 ]; then
+    echo "integration_cli: $fails failure(s)" >&2
+    exit 1
+fi
+if [ -n "$missing" ]; then
+    echo "SKIP: test data not found:$missing (the parts without test data passed)"
+    exit 77
+fi
+echo "integration_cli: all checks passed"
+rm -rf "$TMP"
+exit 0

@@ -1,0 +1,202 @@
+/* it_util.h — small helpers shared by the integration tests: checks that report file:line and
+ * keep going (the test fails at the end), test-data lookup with the "skip = exit 77" rule, scratch
+ * directories, and scene-building shortcuts (unlit quads, camera views by hand). */
+#ifndef IT_UTIL_H
+#define IT_UTIL_H
+
+#include "sy_mediator.h"
+#include "sy_mediators.h"
+#include "sy_scene.h"
+#include "sy_viewport.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static int it_failures;
+
+#define CHECK(cond)                                                                                                  \
+    do {                                                                                                             \
+        if (!(cond)) {                                                                                               \
+            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond);                                 \
+            it_failures++;                                                                                           \
+        }                                                                                                            \
+    } while (0)
+
+#define CHECKF(cond, ...)                                                                                            \
+    do {                                                                                                             \
+        if (!(cond)) {                                                                                               \
+            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #cond);                                 \
+            fprintf(stderr, __VA_ARGS__);                                                                            \
+            fputc('\n', stderr);                                                                                     \
+            it_failures++;                                                                                           \
+        }                                                                                                            \
+    } while (0)
+
+/* A call returning sy_result that must succeed; aborts the test on failure (later steps depend on it). */
+#define MUST(call)                                                                                                   \
+    do {                                                                                                             \
+        sy_error must_err_ = {0};                                                                                    \
+        sy_error *err = &must_err_;                                                                                  \
+        sy_result must_r_ = (call);                                                                                  \
+        if (must_r_ != SY_OK) {                                                                                      \
+            fprintf(stderr, "%s:%d: %s failed: %s (%s)\n", __FILE__, __LINE__, #call, must_err_.message,            \
+                    sy_result_str(must_r_));                                                                         \
+            exit(1);                                                                                                 \
+        }                                                                                                            \
+    } while (0)
+
+static inline int it_finish(const char *name)
+{
+    if (it_failures) {
+        fprintf(stderr, "%s: %d check(s) failed\n", name, it_failures);
+        return 1;
+    }
+    printf("%s: all checks passed\n", name);
+    return 0;
+}
+
+static inline void it_register(void)
+{
+    sy_error e = {0};
+    if (sy_mediators_register_builtin(&e) != SY_OK) {
+        fprintf(stderr, "sy_mediators_register_builtin: %s\n", e.message);
+        exit(1);
+    }
+}
+
+/* Path of a test-data file, or exit 77 (skipped) with the reason when it is absent. */
+static inline const char *it_testdata(const char *rel, char *buf, size_t size)
+{
+    snprintf(buf, size, "%s/%s", SY_TESTDATA_DIR, rel);
+    if (access(buf, R_OK) != 0) {
+        printf("SKIP: test data %s not found (SY_TESTDATA_DIR=%s)\n", buf, SY_TESTDATA_DIR);
+        exit(77);
+    }
+    return buf;
+}
+
+/* Blob from a copy of memory; aborts on failure. */
+static inline sy_blob *it_blob(const void *data, size_t size)
+{
+    sy_blob *b = NULL;
+    MUST(sy_blob_create_copy(data, size, &b, err));
+    return b;
+}
+
+/* A square in the z=0 plane facing +Z, centred at (cx, cy) of half-size h. */
+static inline sy_primitive it_quad_prim(float cx, float cy, float h, sy_material mat)
+{
+    const float pos[12] = {cx - h, cy - h, 0, cx + h, cy - h, 0, cx + h, cy + h, 0, cx - h, cy + h, 0};
+    const float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    sy_primitive p = {0};
+    p.positions = it_blob(pos, sizeof pos);
+    p.normals = it_blob(nrm, sizeof nrm);
+    p.indices = it_blob(idx, sizeof idx);
+    p.material = mat;
+    return p;
+}
+
+static inline void it_prim_release(sy_primitive *p)
+{
+    sy_blob_release(p->positions);
+    sy_blob_release(p->normals);
+    sy_blob_release(p->indices);
+}
+
+/* A mesh of `count` quads (one primitive each) given as (cx, cy, h) triples. */
+static inline sy_mesh it_quad_mesh(sy_scene *s, const char *name, const float (*quads)[3], const sy_material *mats,
+                            uint32_t count)
+{
+    sy_primitive prims[8];
+    sy_mesh m;
+    MUST(sy_mesh_create(s, name, &m, err));
+    for (uint32_t i = 0; i < count; ++i) prims[i] = it_quad_prim(quads[i][0], quads[i][1], quads[i][2], mats[i]);
+    MUST(sy_mesh_set_primitives(s, m, prims, count, err));
+    for (uint32_t i = 0; i < count; ++i) it_prim_release(&prims[i]);
+    return m;
+}
+
+/* An unlit material: the Whitted tracer shows exactly its base colour. */
+static inline sy_material it_unlit(sy_scene *s, const char *name, float r, float g, float b)
+{
+    sy_material m;
+    MUST(sy_material_create(s, name, &m, err));
+    sy_material_data d = *sy_material_get(s, m);
+    d.name = (char *)name;
+    d.base_color[0] = r, d.base_color[1] = g, d.base_color[2] = b, d.base_color[3] = 1.0f;
+    d.unlit = 1;
+    MUST(sy_material_set(s, m, &d, err));
+    return m;
+}
+
+static inline void it_set_translation(sy_scene *s, sy_node n, float x, float y, float z)
+{
+    const float t[3] = {x, y, z}, q[4] = {0, 0, 0, 1}, one[3] = {1, 1, 1};
+    MUST(sy_node_set_trs(s, n, t, q, one, err));
+}
+
+/* Perspective view from (0, 0, dist) looking down -Z with a symmetric window of half-size tan_half. */
+static inline sy_camera_view it_view_down_z(float dist, float tan_half)
+{
+    sy_camera_view v;
+    memset(&v, 0, sizeof v);
+    v.camera_to_world = sy_mat4_identity();
+    v.camera_to_world.m[14] = dist;
+    v.projection = SY_PROJECTION_PERSPECTIVE;
+    v.window[0] = -tan_half, v.window[1] = tan_half, v.window[2] = -tan_half, v.window[3] = tan_half;
+    v.znear = 0.01f;
+    v.zfar = 0.0f;
+    return v;
+}
+
+/* Continuous pixel coordinates of world point p seen through view v on a w x h image (row 0 on
+ * top), computed by hand from the view's definition. Returns false behind the camera. */
+static inline bool it_project(const sy_camera_view *v, const float p[3], uint32_t w, uint32_t h, float *px, float *py)
+{
+    *px = *py = NAN;
+    sy_mat4 inv;
+    if (!sy_mat4_invert(&v->camera_to_world, &inv)) return false;
+    float c[3];
+    sy_mat4_transform_point(&inv, p, c);
+    float tx, ty;
+    if (v->projection == SY_PROJECTION_PERSPECTIVE) {
+        if (c[2] >= 0.0f) return false;
+        tx = c[0] / -c[2];
+        ty = c[1] / -c[2];
+    } else {
+        tx = c[0];
+        ty = c[1];
+    }
+    *px = (tx - v->window[0]) / (v->window[1] - v->window[0]) * (float)w;
+    *py = (v->window[3] - ty) / (v->window[3] - v->window[2]) * (float)h;
+    return true;
+}
+
+static inline const float *it_px(const sy_layer *l, uint32_t x, uint32_t y) { return l->rgba + 4 * ((size_t)y * l->width + x); }
+
+static inline bool it_px_is(const sy_layer *l, uint32_t x, uint32_t y, float r, float g, float b, float a)
+{
+    const float *p = it_px(l, x, y);
+    return p[0] == r && p[1] == g && p[2] == b && p[3] == a;
+}
+
+/* Bitwise equality of one pixel (colour and depth) of two equally sized layers. */
+static inline bool it_px_same(const sy_layer *a, const sy_layer *b, uint32_t x, uint32_t y)
+{
+    size_t i = (size_t)y * a->width + x;
+    return memcmp(a->rgba + 4 * i, b->rgba + 4 * i, 4 * sizeof(float)) == 0 &&
+           memcmp(a->depth + i, b->depth + i, sizeof(float)) == 0;
+}
+
+static inline bool it_layers_identical(const sy_layer *a, const sy_layer *b)
+{
+    size_t n = (size_t)a->width * a->height;
+    return a->width == b->width && a->height == b->height && memcmp(a->rgba, b->rgba, n * 4 * sizeof(float)) == 0 &&
+           memcmp(a->depth, b->depth, n * sizeof(float)) == 0;
+}
+
+#endif /* IT_UTIL_H */
