@@ -16,4 +16,10 @@ sy_result sy_bench_sync(uint32_t nodes, uint32_t tris, uint32_t repeats, sy_erro
 sy_result sy_bench_rays(sy_scene *scene, const sy_viewport_desc *vd, uint32_t width, uint32_t height, uint32_t repeats,
                         sy_error *err);
 
+/* Viewport costs on the demo scene: compositing two 1920x1080 layers (depth and alpha-over, one
+ * core), switching a viewport's back-end away and back (the second switch must not translate the
+ * scene again: reported as sync times), and stereo (side-by-side) cost per eye against mono for
+ * every registered back-end, at width x height per eye. */
+sy_result sy_bench_viewports(uint32_t width, uint32_t height, uint32_t repeats, sy_error *err);
+
 #endif /* SY_BENCH_H */

@@ -11,6 +11,7 @@
  * SCENE is a .gltf / .glb file or the word "demo" (the built-in scene). Errors go to stderr with
  * the file and the reason; the exit code is non-zero (1 = usage, 2 = failure). */
 #include "sy_bench.h"
+#include "sy_compose.h"
 #include "sy_demo.h"
 #include "sy_exr.h"
 #include "sy_gltf.h"
@@ -45,8 +46,9 @@ static void loaded_free(loaded *l)
 }
 
 /* A file without a camera gets one framing its bounds (as a real camera node, so every back-end
- * sees the same view); a file without punctual lights gets a directional headlight from that
- * camera, so that it is not black in the ray tracers. Both are reported on stderr. */
+ * sees the same view); a file with neither punctual lights nor emissive materials gets a
+ * directional headlight from that camera, so that it is not black. The headlight is reported on
+ * stderr. */
 static sy_result add_defaults(loaded *ld, sy_error *err)
 {
     sy_scene *s = ld->scene;
@@ -69,7 +71,12 @@ static sy_result add_defaults(loaded *ld, sy_error *err)
     } else if ((r = sy_node_world_matrix(s, ld->camera, &cam_world, err))) {
         return r;
     }
-    if (sy_scene_count(s, SY_TYPE_LIGHT) == 0) {
+    bool emissive = false;
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_MATERIAL, 0); id && !emissive; id = sy_scene_next(s, SY_TYPE_MATERIAL, id)) {
+        const sy_material_data *m = sy_object_get(s, SY_TYPE_MATERIAL, id);
+        emissive = m->emissive_strength * (m->emissive[0] + m->emissive[1] + m->emissive[2]) > 0.0f;
+    }
+    if (sy_scene_count(s, SY_TYPE_LIGHT) == 0 && !emissive) {
         fprintf(stderr, "sy: note: the scene has no lights; adding a directional headlight\n");
         sy_light l;
         sy_node n;
@@ -193,9 +200,12 @@ static int usage(void)
             "  sy info SCENE\n"
             "  sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]\n"
             "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]\n"
+            "            [--stereo sbs|tb|anaglyph|separate] [--eye-sep M] [--zero-parallax M]\n"
+            "            [--overlay FILE[:BACKEND]] [--composite depth|over|replace]\n"
             "  sy demo [-o DIR] [-w W] [-h H]\n"
             "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"
             "  sy bench rays [SCENE] [-w W] [-h H] [--repeats R]\n"
+            "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
             "  sy backends\n"
             "SCENE: a .gltf/.glb file, or 'demo' for the built-in scene\n");
     return 1;
@@ -266,11 +276,57 @@ static int cmd_info(int argc, char **argv)
     return 0;
 }
 
+/* NAME.EXT -> NAME_left.EXT and NAME_right.EXT */
+static sy_result eye_paths(const char *outp, char *lp, char *rp, size_t n, sy_error *err)
+{
+    const char *dot = strrchr(outp, '.');
+    size_t stem = dot ? (size_t)(dot - outp) : strlen(outp);
+    if ((size_t)snprintf(lp, n, "%.*s_left%s", (int)stem, outp, dot ? dot : "") >= n ||
+        (size_t)snprintf(rp, n, "%.*s_right%s", (int)stem, outp, dot ? dot : "") >= n)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: path too long", outp);
+    return SY_OK;
+}
+
+/* --overlay FILE[:BACKEND]: loads FILE into the same scene under its own root and layers it over
+ * the main viewport with the --composite mode (depth, over, replace). */
+static sy_result add_overlay(loaded *ld, const char *arg, const char *composite, sy_compose_spec *spec, sy_error *err)
+{
+    char path[4096];
+    const char *colon = strrchr(arg, ':');
+    const char *backend = colon && colon[1] && !strchr(colon, '/') ? colon + 1 : NULL;
+    size_t n = backend ? (size_t)(colon - arg) : strlen(arg);
+    if (n >= sizeof path) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--overlay: path too long");
+    memcpy(path, arg, n);
+    path[n] = '\0';
+    if (!strcmp(composite, "depth")) spec->overlay_composite = SY_COMPOSITE_DEPTH;
+    else if (!strcmp(composite, "over")) spec->overlay_composite = SY_COMPOSITE_ALPHA_OVER;
+    else if (!strcmp(composite, "replace")) spec->overlay_composite = SY_COMPOSITE_REPLACE;
+    else return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--composite %s: expected depth, over or replace", composite);
+    if (!backend) backend = sy_mediator_find("raster") ? "raster" : spec->backend;
+    if (!sy_mediator_find(backend)) return sy_error_set(err, SY_ERR_NOT_FOUND, "--overlay %s: back-end '%s' is not registered", arg, backend);
+    sy_gltf_info info = {0};
+    sy_result r = sy_gltf_load(path, ld->scene, NULL, &info, err);
+    if (r == SY_OK) r = sy_scene_commit(ld->scene, NULL, err);
+    if (r != SY_OK) {
+        sy_gltf_info_free(&info);
+        sy_error_prefix(err, "overlay");
+        return r;
+    }
+    spec->has_overlay = true;
+    spec->overlay_root = info.root;
+    spec->overlay_backend = backend;
+    sy_gltf_info_free(&info);
+    return SY_OK;
+}
+
 static int cmd_render(int argc, char **argv)
 {
     const char *scene = NULL, *backend = NULL, *outp = NULL, *camera = NULL, *params = NULL;
+    const char *overlay = NULL, *composite = "depth";
     uint32_t w = 0, h = 0;
     out_opts oo = {0};
+    sy_compose_spec spec = {.eye_separation = 0.065f, .zero_parallax = 2.0f};
+    sy_error perr = {0};
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
@@ -288,7 +344,13 @@ static int cmd_render(int argc, char **argv)
             const char *t = argv[++i];
             oo.png.tonemap = !strcmp(t, "aces") ? SY_TONEMAP_ACES : !strcmp(t, "reinhard") ? SY_TONEMAP_REINHARD
                                                                                            : SY_TONEMAP_CLAMP;
-        } else if (a[0] != '-' && !scene) scene = a;
+        } else if (!strcmp(a, "--stereo") && has) {
+            if (sy_stereo_mode_parse(argv[++i], &spec.stereo, &perr) != SY_OK) return fail(&perr);
+        } else if (!strcmp(a, "--eye-sep") && has) spec.eye_separation = strtof(argv[++i], NULL);
+        else if (!strcmp(a, "--zero-parallax") && has) spec.zero_parallax = strtof(argv[++i], NULL);
+        else if (!strcmp(a, "--overlay") && has) overlay = argv[++i];
+        else if (!strcmp(a, "--composite") && has) composite = argv[++i];
+        else if (a[0] != '-' && !scene) scene = a;
         else {
             fprintf(stderr, "sy render: unknown or incomplete option '%s'\n", a);
             return usage();
@@ -314,17 +376,36 @@ static int cmd_render(int argc, char **argv)
     if (!w) w = 1;
     if (!h) h = 1;
     sy_context_pool *pool = NULL;
-    sy_layer img = {0};
+    sy_layer img = {0}, img_right = {0};
     double secs = 0;
-    sy_result r = sy_context_pool_create(&pool, &err);
-    if (r == SY_OK) r = render_scene(&ld, backend, params, w, h, pool, &img, &secs, &err);
+    spec.backend = backend;
+    spec.params = params;
+    spec.root = ld.root;
+    spec.camera = ld.camera;
+    spec.background = ld.background;
+    sy_result r = overlay ? add_overlay(&ld, overlay, composite, &spec, &err) : SY_OK;
+    if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
+    progress_state ps = {backend, sy_time_now(), 0, sy_is_terminal(2)};
+    sy_window_render_opts ro = {.progress = progress_cb, .progress_user = &ps};
+    double t0 = sy_time_now();
+    if (r == SY_OK) r = sy_compose_render(ld.scene, pool, &spec, w, h, &ro, &img, &img_right, &err);
+    secs = sy_time_now() - t0;
     if (r == SY_OK) {
-        size_t bad = sy_layer_count_nonfinite(&img);
+        size_t bad = sy_layer_count_nonfinite(&img) + (img_right.rgba ? sy_layer_count_nonfinite(&img_right) : 0);
         if (bad) fprintf(stderr, "sy render: warning: %zu pixels are not finite\n", bad);
-        r = write_image(outp, &img, &oo, &err);
+        if (spec.stereo == SY_STEREO_SEPARATE) {
+            char lp[4096], rp[4096];
+            r = eye_paths(outp, lp, rp, sizeof lp, &err);
+            if (r == SY_OK) r = write_image(lp, &img, &oo, &err);
+            if (r == SY_OK) r = write_image(rp, &img_right, &oo, &err);
+            if (r == SY_OK) printf("%s, %s: %ux%u per eye, %s, %.3f s\n", lp, rp, w, h, backend, secs);
+        } else {
+            r = write_image(outp, &img, &oo, &err);
+            if (r == SY_OK) printf("%s: %ux%u, %s, %.3f s\n", outp, img.width, img.height, backend, secs);
+        }
     }
-    if (r == SY_OK) printf("%s: %ux%u, %s, %.3f s\n", outp, w, h, backend, secs);
     sy_layer_destroy(&img);
+    sy_layer_destroy(&img_right);
     sy_context_pool_destroy(pool);
     loaded_free(&ld);
     return r == SY_OK ? 0 : fail(&err);
@@ -405,6 +486,10 @@ static int cmd_bench(int argc, char **argv)
     }
     sy_error err = {0};
     if (!strcmp(argv[0], "sync")) return sy_bench_sync(nodes, tris, repeats ? repeats : 50, &err) == SY_OK ? 0 : fail(&err);
+    if (!strcmp(argv[0], "viewports"))
+        return sy_bench_viewports(w == 512 ? 480 : w, h == 512 ? 270 : h, repeats ? repeats : 5, &err) == SY_OK
+                   ? 0
+                   : fail(&err);
     if (!strcmp(argv[0], "rays")) {
         loaded ld;
         if (load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return fail(&err);

@@ -191,36 +191,43 @@ sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, u
     return SY_OK;
 }
 
+/* One row per mode, the mode switch outside the pixel loops. */
+static void composite_row(float *restrict d, float *restrict dd, const float *restrict s, const float *restrict sd,
+                          uint32_t w, uint32_t mode)
+{
+    switch (mode) {
+    case SY_COMPOSITE_DEPTH:
+        for (uint32_t i = 0; i < w; ++i)
+            if (sd[i] < dd[i]) {
+                memcpy(d + 4 * i, s + 4 * i, 4 * sizeof(float));
+                dd[i] = sd[i];
+            }
+        break;
+    case SY_COMPOSITE_ALPHA_OVER:
+        for (uint32_t i = 0; i < w; ++i) {
+            float a = s[4 * i + 3];
+            if (a == 0.0f && s[4 * i] == 0.0f && s[4 * i + 1] == 0.0f && s[4 * i + 2] == 0.0f) continue;
+            float k = 1.0f - a;
+            for (int c = 0; c < 4; ++c) d[4 * i + c] = s[4 * i + c] + d[4 * i + c] * k;
+            if (a > 0.0f && sd[i] < dd[i]) dd[i] = sd[i];
+        }
+        break;
+    default:
+        memcpy(d, s, (size_t)w * 4 * sizeof(float));
+        memcpy(dd, sd, (size_t)w * sizeof(float));
+        break;
+    }
+}
+
 void sy_layer_composite(sy_layer *dst, const sy_layer *src, uint32_t x, uint32_t y, uint32_t mode)
 {
     if (x >= dst->width || y >= dst->height) return;
     uint32_t w = src->width < dst->width - x ? src->width : dst->width - x;
     uint32_t h = src->height < dst->height - y ? src->height : dst->height - y;
-    for (uint32_t j = 0; j < h; ++j)
-        for (uint32_t i = 0; i < w; ++i) {
-            size_t si = (size_t)j * src->width + i, di = (size_t)(y + j) * dst->width + (x + i);
-            const float *s = src->rgba + 4 * si;
-            float *d = dst->rgba + 4 * di;
-            float sd = src->depth[si];
-            switch (mode) {
-            case SY_COMPOSITE_DEPTH:
-                if (sd < dst->depth[di]) {
-                    memcpy(d, s, 4 * sizeof(float));
-                    dst->depth[di] = sd;
-                }
-                break;
-            case SY_COMPOSITE_ALPHA_OVER: {
-                float k = 1.0f - s[3];
-                for (int c = 0; c < 4; ++c) d[c] = s[c] + d[c] * k;
-                if (s[3] > 0.0f && sd < dst->depth[di]) dst->depth[di] = sd;
-                break;
-            }
-            default:
-                memcpy(d, s, 4 * sizeof(float));
-                dst->depth[di] = sd;
-                break;
-            }
-        }
+    for (uint32_t j = 0; j < h; ++j) {
+        size_t si = (size_t)j * src->width, di = (size_t)(y + j) * dst->width + x;
+        composite_row(dst->rgba + 4 * di, dst->depth + di, src->rgba + 4 * si, src->depth + si, w, mode);
+    }
 }
 
 sy_result sy_window_render(sy_window *w, sy_scene *scene, sy_context_pool *pool, const sy_window_render_opts *opts,
@@ -259,8 +266,12 @@ sy_result sy_window_render(sy_window *w, sy_scene *scene, sy_context_pool *pool,
         r = sy_layer_create(rect[2], rect[3], &layer, err);
         if (r != SY_OK) break;
         r = sy_context_render(ctx, &req, &layer, err);
-        if (r == SY_OK) sy_layer_composite(out, &layer, rect[0], rect[1], v->desc.composite);
+        if (r == SY_OK) {
+            sy_layer_post_apply(&layer, &v->desc.post);
+            sy_layer_composite(out, &layer, rect[0], rect[1], v->desc.composite);
+        }
         sy_layer_destroy(&layer);
     }
+    if (r == SY_OK) sy_layer_post_apply(out, &opts->post);
     return r;
 }

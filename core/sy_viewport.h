@@ -14,6 +14,7 @@
 #define SY_VIEWPORT_H
 
 #include "sy_mediator.h"
+#include "sy_post.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -39,6 +40,7 @@ typedef struct sy_viewport_desc {
     float zero_parallax;          /* metres, distance of the screen plane (default 2 when 0) */
     uint32_t composite;           /* sy_composite */
     bool inactive;                /* created inactive */
+    sy_post_desc post;            /* applied to this viewport's layer before compositing */
 } sy_viewport_desc;
 
 typedef struct sy_window sy_window;
@@ -78,6 +80,7 @@ typedef struct sy_window_render_opts {
     uint32_t sample_count; /* progressive back-ends: samples to add this call; 0 = default */
     sy_progress_fn progress;
     void *progress_user;
+    sy_post_desc post; /* applied to the composited window image */
 } sy_window_render_opts;
 
 /* Syncs and renders every active viewport and composites into out (window-sized; created by the

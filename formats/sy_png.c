@@ -16,37 +16,6 @@
 
 /* ---- >>colour helpers ---- */
 
-float sy_srgb_encode(float linear)
-{
-    if (!(linear > 0.0f)) return 0.0f; /* also NaN */
-    if (linear >= 1.0f) return 1.0f;
-    if (linear <= 0.0031308f) return 12.92f * linear;
-    return 1.055f * powf(linear, 1.0f / 2.4f) - 0.055f;
-}
-
-float sy_srgb_decode(float encoded)
-{
-    if (!(encoded > 0.0f)) return 0.0f;
-    if (encoded >= 1.0f) return 1.0f;
-    if (encoded <= 0.04045f) return encoded / 12.92f;
-    return powf((encoded + 0.055f) / 1.055f, 2.4f);
-}
-
-float sy_tonemap_apply(sy_tonemap op, float x)
-{
-    if (!(x > 0.0f)) return 0.0f; /* negative, zero and NaN */
-    if (isinf(x)) return 1.0f;
-    float y;
-    switch (op) {
-    case SY_TONEMAP_REINHARD: y = x / (1.0f + x); break;
-    case SY_TONEMAP_ACES: y = (x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f); break;
-    case SY_TONEMAP_CLAMP:
-    default: y = x; break;
-    }
-    if (!(y > 0.0f)) return 0.0f;
-    return y < 1.0f ? y : 1.0f;
-}
-
 static uint8_t quantize8(float v01) { return (uint8_t)(v01 * 255.0f + 0.5f); }
 
 /* Pixel conversion with the exposure scale already computed. */

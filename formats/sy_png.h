@@ -14,6 +14,7 @@
 #define SY_PNG_H
 
 #include "sy_common.h"
+#include "sy_post.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -22,28 +23,13 @@ extern "C" {
 #define SY_PNG_MAX_SIDE 65536            /* pixels per side, both directions */
 #define SY_PNG_MAX_PIXELS (1u << 28)     /* width * height */
 
-typedef enum sy_tonemap {
-    SY_TONEMAP_CLAMP = 0,    /* plain clamp to [0, 1] (the default) */
-    SY_TONEMAP_REINHARD = 1, /* x / (1 + x) */
-    SY_TONEMAP_ACES = 2,     /* Narkowicz 2015 ACES filmic fit, then clamp */
-    SY_TONEMAP_MAX_ENUM = 0x7fffffff
-} sy_tonemap;
+/* sy_tonemap, sy_srgb_encode/decode and sy_tonemap_apply live in core/sy_post.h. */
 
 /* Zero-initialised ({0}) means: exposure 0 stops, SY_TONEMAP_CLAMP. */
 typedef struct sy_png_options {
     float exposure_stops; /* colour is multiplied by 2^exposure_stops before tone mapping */
     sy_tonemap tonemap;
 } sy_png_options;
-
-/* Exact piecewise sRGB OETF: linear [0, 1] -> encoded [0, 1]; input is clamped to [0, 1], NaN gives 0. */
-float sy_srgb_encode(float linear);
-
-/* Exact inverse (EOTF): encoded [0, 1] -> linear [0, 1]; input is clamped to [0, 1], NaN gives 0. */
-float sy_srgb_decode(float encoded);
-
-/* Applies the operator to one linear, non-negative channel value; returns a value in [0, 1].
- * Negative values and NaN give 0; +INFINITY gives 1. An unknown operator behaves as CLAMP. */
-float sy_tonemap_apply(sy_tonemap op, float linear);
 
 /* Converts one premultiplied linear RGBA pixel to 8-bit straight-alpha sRGB exactly as
  * sy_png_write does (opts may be NULL for the defaults). */

@@ -7,6 +7,9 @@
 #     output file nor temporary file left behind
 #   - sy bench sync / sy bench rays on small sizes: exit 0 and their result lines (no thresholds)
 #   - sy demo -o DIR -w 64 -h 36: demo_whitted.png / .exr written
+#   - --stereo sbs / tb / anaglyph / separate: output sizes and per-eye files; bad stereo parameters
+#     and overlays (negative separation, zero parallax 0, unknown mode, missing file, unknown
+#     back-end) fail naming the problem and write nothing
 # The parts that need ../shared/testdata run only when it is present; when it is absent the rest
 # still runs and the test then exits 77 (skipped) naming what was missing.
 set -u
@@ -115,6 +118,35 @@ else
 fi
 [ -f "$TMP/demo/demo_whitted.exr" ] && magic "$TMP/demo/demo_whitted.exr" 762f3101 ||
     fail "demo: demo_whitted.exr missing or not an OpenEXR file"
+
+# stereo layouts and overlays on the demo scene (sizes per layout, files per eye, bad parameters)
+mkdir -p "$TMP/stereo"
+run st_sbs "$SY" render demo -b whitted -w 40 -h 30 --stereo sbs -o "$TMP/stereo/sbs.png"
+[ "$rc" -eq 0 ] && [ "$(u32be "$TMP/stereo/sbs.png" 16)x$(u32be "$TMP/stereo/sbs.png" 20)" = 80x30 ] ||
+    fail "stereo sbs: expected an 80x30 PNG (status $rc: $(cat "$TMP/st_sbs.err"))"
+run st_tb "$SY" render demo -b whitted -w 40 -h 30 --stereo tb -o "$TMP/stereo/tb.png"
+[ "$rc" -eq 0 ] && [ "$(u32be "$TMP/stereo/tb.png" 16)x$(u32be "$TMP/stereo/tb.png" 20)" = 40x60 ] ||
+    fail "stereo tb: expected a 40x60 PNG"
+run st_ana "$SY" render demo -b whitted -w 40 -h 30 --stereo anaglyph -o "$TMP/stereo/ana.png"
+[ "$rc" -eq 0 ] && [ "$(u32be "$TMP/stereo/ana.png" 16)x$(u32be "$TMP/stereo/ana.png" 20)" = 40x30 ] ||
+    fail "stereo anaglyph: expected a 40x30 PNG"
+run st_sep "$SY" render demo -b whitted -w 40 -h 30 --stereo separate -o "$TMP/stereo/eye.exr"
+[ "$rc" -eq 0 ] && [ -f "$TMP/stereo/eye_left.exr" ] && [ -f "$TMP/stereo/eye_right.exr" ] &&
+    [ ! -e "$TMP/stereo/eye.exr" ] || fail "stereo separate: expected eye_left.exr and eye_right.exr only"
+if [ -f "$TMP/stereo/eye_left.exr" ] && cmp -s "$TMP/stereo/eye_left.exr" "$TMP/stereo/eye_right.exr"; then
+    fail "stereo separate: both eyes are identical"
+fi
+mkdir -p "$TMP/o_stereo"
+expect_error stereo_sep eye-sep "$TMP/o_stereo" "$SY" render demo -b whitted -w 8 -h 8 --stereo sbs --eye-sep -0.1 \
+    -o "$TMP/o_stereo/x.png"
+expect_error stereo_zp zero-parallax "$TMP/o_stereo" "$SY" render demo -b whitted -w 8 -h 8 --stereo sbs \
+    --zero-parallax 0 -o "$TMP/o_stereo/x.png"
+expect_error stereo_mode wobble "$TMP/o_stereo" "$SY" render demo -b whitted -w 8 -h 8 --stereo wobble \
+    -o "$TMP/o_stereo/x.png"
+expect_error overlay_missing no_such_overlay.gltf "$TMP/o_stereo" "$SY" render demo -b whitted -w 8 -h 8 \
+    --overlay "$TMP/in/no_such_overlay.gltf" -o "$TMP/o_stereo/x.png"
+expect_error overlay_backend nosuchbackend "$TMP/o_stereo" "$SY" render demo -b whitted -w 8 -h 8 \
+    --overlay "$TMP/in/bad.gltf:nosuchbackend" -o "$TMP/o_stereo/x.png"
 
 # ---------------------------------------------------------------- with test data
 if [ -f "$BOX" ] && [ -f "$GLB" ]; then
