@@ -3,6 +3,7 @@
 
 #include "sy_compose.h"
 #include "sy_demo.h"
+#include "sy_mediator_raster.h"
 #include "sy_mediator_rt.h"
 
 #include <math.h>
@@ -177,5 +178,815 @@ sy_result sy_bench_viewports(uint32_t width, uint32_t height, uint32_t repeats, 
     printf("  contexts in the pool: %u (one per back-end: both eyes share one)\n", sy_context_pool_size(pool));
     sy_context_pool_destroy(pool);
     sy_scene_destroy(s);
+    return r;
+}
+
+/* >>bench raster: our frame against the floor (the same buffers, trivial shader), transform
+ * latency and uploads per frame, for one scene. */
+static double median_of(double *t, uint32_t n)
+{
+    qsort(t, n, sizeof *t, cmp_double);
+    return t[n / 2];
+}
+
+static sy_result bench_raster_scene(const char *label, sy_scene *scene, const sy_viewport_desc *vd, sy_node moved,
+                                    uint32_t width, uint32_t height, uint32_t repeats, sy_error *err)
+{
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_context *ctx = NULL;
+    sy_layer layer = {0};
+    sy_camera_view view;
+    sy_params params;
+    double *t = calloc(repeats, sizeof *t);
+    sy_result r = t ? sy_window_create(width, height, &win, err) : sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench: out of memory");
+    if (r == SY_OK) r = sy_window_add_viewport(win, vd, &vp, err);
+    if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, width, height, &view, err);
+    if (r == SY_OK) r = sy_params_parse(vd->params, &params, err);
+    if (r == SY_OK) r = sy_context_create(scene, "raster", &params, vd->root.id, &ctx, err);
+    double t0 = sy_time_now();
+    if (r == SY_OK) r = sy_context_sync(ctx, err);
+    double t_sync = sy_time_now() - t0;
+    if (r == SY_OK) r = sy_layer_create(width, height, &layer, err);
+    sy_render_request rq = {.camera = view, .full_width = width, .full_height = height, .rect_w = width, .rect_h = height,
+                            .background_id = vd->background.id};
+    void *st = ctx ? sy_context_state(ctx) : NULL;
+    double ours = 0, floor_t = 0, latency = 0;
+    sy_mediator_raster_counters first = {0}, steady = {0}, moved_c = {0};
+    if (r == SY_OK) r = sy_context_render(ctx, &rq, &layer, err); /* warm-up: first frame, shadow maps, shaders */
+    if (r == SY_OK) sy_mediator_raster_counters_get(st, &first);
+    for (uint32_t i = 0; i < repeats && r == SY_OK; ++i) {
+        double a = sy_time_now();
+        r = sy_context_render(ctx, &rq, &layer, err);
+        t[i] = sy_time_now() - a;
+    }
+    if (r == SY_OK) {
+        ours = median_of(t, repeats);
+        sy_mediator_raster_counters_get(st, &steady);
+        r = sy_mediator_raster_render_floor(st, &rq, &layer, err);
+    }
+    for (uint32_t i = 0; i < repeats && r == SY_OK; ++i) {
+        double a = sy_time_now();
+        r = sy_mediator_raster_render_floor(st, &rq, &layer, err);
+        t[i] = sy_time_now() - a;
+    }
+    if (r == SY_OK) floor_t = median_of(t, repeats);
+    for (uint32_t i = 0; i < repeats && r == SY_OK; ++i) {
+        static const float q[4] = {0, 0, 0, 1}, one[3] = {1, 1, 1};
+        float tr[3] = {0.001f * (float)(i + 1), 0.0f, 0.0f};
+        double a = sy_time_now();
+        r = sy_node_set_trs(scene, moved, tr, q, one, err);
+        if (r == SY_OK) r = sy_scene_commit(scene, NULL, err);
+        if (r == SY_OK) r = sy_context_sync(ctx, err);
+        if (r == SY_OK) r = sy_context_render(ctx, &rq, &layer, err);
+        t[i] = sy_time_now() - a;
+    }
+    if (r == SY_OK) {
+        latency = median_of(t, repeats);
+        sy_mediator_raster_counters_get(st, &moved_c);
+        printf("  %s: %llu triangles, %u meshes, %u instances, %ux%u, %u MSAA samples, %u shadow maps\n", label,
+               (unsigned long long)moved_c.triangles_drawn, moved_c.meshes, moved_c.instances, width, height,
+               moved_c.msaa_samples, moved_c.shadow_maps);
+        printf("    first sync (upload)            %10.2f ms  (%llu vertex/index buffers, %llu textures)\n", t_sync * 1e3,
+               (unsigned long long)first.total_vertex_buffer_uploads, (unsigned long long)first.total_texture_uploads);
+        printf("    frame (median of %u)           %10.2f ms\n", repeats, ours * 1e3);
+        printf("    floor: same buffers, trivial   %10.2f ms\n", floor_t * 1e3);
+        printf("    ratio frame / floor            %10.2f x   (goal <= 1.5 for the geometry-bound scene)\n",
+               ours / floor_t);
+        printf("    transform change -> frame done %10.2f ms  (commit + sync + render, median)\n", latency * 1e3);
+        printf("    uploads per steady frame       %10llu buffers, %llu textures, %llu uniform blocks\n",
+               (unsigned long long)steady.vertex_buffer_uploads, (unsigned long long)steady.texture_uploads,
+               (unsigned long long)steady.uniform_buffer_uploads);
+        printf("    uploads per moved frame        %10llu buffers, %llu textures, %llu uniform blocks, %llu model matrices\n",
+               (unsigned long long)moved_c.vertex_buffer_uploads, (unsigned long long)moved_c.texture_uploads,
+               (unsigned long long)moved_c.uniform_buffer_uploads, (unsigned long long)moved_c.model_matrix_updates);
+    }
+    sy_layer_destroy(&layer);
+    sy_context_release(ctx);
+    sy_window_destroy(win);
+    free(t);
+    return r;
+}
+
+sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
+                          uint32_t height, uint32_t repeats, sy_error *err)
+{
+    sy_viewport_desc d = *vd;
+    if (!d.params) d.params = "gl=osmesa";
+    sy_params p;
+    sy_result r = sy_params_parse(d.params, &p, err);
+    if (r != SY_OK) return r;
+    const char *gl = sy_params_get(&p, "gl");
+    printf("sy bench raster: %s\n", gl ? gl : "osmesa");
+    r = bench_raster_scene(label, scene, &d, d.root, width, height, repeats, err);
+    /* generated geometry-bound scene: 100 meshes x 10000 triangles */
+    sy_scene *s = NULL;
+    sy_node root = {0}, leaf = {0};
+    if (r == SY_OK) r = sy_scene_create(&s, err);
+    if (r == SY_OK) r = sy_demo_bench_scene(s, 1, 100, 10000, &root, &leaf, err);
+    if (r == SY_OK) r = sy_scene_commit(s, NULL, err);
+    sy_viewport_desc g = {.root = root, .backend = "raster", .params = d.params};
+    if (r == SY_OK) r = bench_raster_scene("generated 1M triangles", s, &g, leaf, width, height, repeats, err);
+    sy_scene_destroy(s);
+    return r;
+}
+
+/* >>bench load (formats, issue 6) ------------------------------------------------------------ */
+#include "sy_file.h"
+#include "sy_gltf.h"
+#include "sy_gltf_shim.h"
+
+#include <dirent.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static int cmp_cstr(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
+
+/* Resident set of this process in KiB (/proc/self/statm), 0 when unknown. */
+static long rss_now_kib(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    long size = 0, res = 0;
+    if (f) {
+        if (fscanf(f, "%ld %ld", &size, &res) != 2) res = 0;
+        fclose(f);
+    }
+    return res * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+/* Peak RSS growth (KiB) of one sy_gltf_load in a forked child: the child's high-water mark minus
+ * its resident size at the start, so the parent's own footprint does not count. -1 on failure. */
+static long load_peak_kib(const char *path)
+{
+    int fds[2];
+    if (pipe(fds) != 0) return -1;
+    pid_t pid = fork();
+    if (pid < 0) {
+        close(fds[0]);
+        close(fds[1]);
+        return -1;
+    }
+    if (pid == 0) {
+        close(fds[0]);
+        long base = rss_now_kib(), peak = -1;
+        sy_scene *s;
+        sy_gltf_info info = {0};
+        if (sy_scene_create(&s, NULL) == SY_OK && sy_gltf_load(path, s, NULL, &info, NULL) == SY_OK) {
+            struct rusage ru;
+            getrusage(RUSAGE_SELF, &ru);
+            peak = ru.ru_maxrss - base;
+        }
+        ssize_t w = write(fds[1], &peak, sizeof peak);
+        _exit(w == (ssize_t)sizeof peak ? 0 : 1);
+    }
+    close(fds[1]);
+    long peak = -1;
+    if (read(fds[0], &peak, sizeof peak) != (ssize_t)sizeof peak) peak = -1;
+    close(fds[0]);
+    int status;
+    waitpid(pid, &status, 0);
+    return peak;
+}
+
+/* Bytes the load reads: the file plus, for .gltf, the other files of its directory (buffers,
+ * images; a sample variant directory holds exactly one model). */
+static double input_bytes(const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) return 0;
+    double total = (double)st.st_size;
+    size_t n = strlen(path);
+    if (n < 5 || strcmp(path + n - 5, ".gltf") != 0) return total;
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    if (slash) *slash = '\0';
+    else snprintf(dir, sizeof dir, ".");
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    while (d && (e = readdir(d)) != NULL) {
+        char p[8192];
+        snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
+        if (strcmp(p, path) != 0 && e->d_name[0] != '.' && stat(p, &st) == 0 && S_ISREG(st.st_mode))
+            total += (double)st.st_size;
+    }
+    if (d) closedir(d);
+    return total;
+}
+
+static sy_result bench_one_load(const char *label, const char *path, uint32_t repeats, sy_error *err)
+{
+    double *tp = malloc(repeats * sizeof(double)), *tl = malloc(repeats * sizeof(double));
+    sy_result r = (tp && tl) ? SY_OK : sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench load: out of memory");
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    if (slash) slash[1] = '\0';
+    else dir[0] = '\0';
+    size_t n = strlen(path);
+    bool binary = n > 4 && !strcmp(path + n - 4, ".glb");
+    sy_gltf_shim_limits lim = {(size_t)2 << 30, (uint64_t)1 << 26};
+    uint32_t tris = 0;
+    for (uint32_t k = 0; r == SY_OK && k < repeats; k++) {
+        /* tinygltf alone: read + parse (buffers, image decoding), nothing else */
+        double t0 = sy_time_now();
+        void *bytes = NULL;
+        size_t size = 0;
+        r = sy_file_read_all(path, (size_t)2 << 30, &bytes, &size, err);
+        if (r == SY_OK) r = sy_gltf_shim_parse_only(bytes, size, binary, dir, &lim, err);
+        free(bytes);
+        tp[k] = sy_time_now() - t0;
+        if (r) break;
+        /* the whole loader: read, parse, validate, convert, create the scene objects */
+        sy_scene *s = NULL;
+        sy_gltf_info info = {0};
+        if ((r = sy_scene_create(&s, err))) break;
+        t0 = sy_time_now();
+        r = sy_gltf_load(path, s, NULL, &info, err);
+        tl[k] = sy_time_now() - t0;
+        tris = info.counts.triangles;
+        sy_gltf_info_free(&info);
+        sy_scene_destroy(s);
+    }
+    if (r == SY_OK) {
+        qsort(tp, repeats, sizeof(double), cmp_double);
+        qsort(tl, repeats, sizeof(double), cmp_double);
+        double parse = tp[repeats / 2], load = tl[repeats / 2], bytes = input_bytes(path);
+        long peak = load_peak_kib(path);
+        printf("%-34s %9.2f %9u %10.2f %10.2f %7.2fx %9.1f %7.2fx\n", label, bytes / 1048576.0, tris, parse * 1e3,
+               load * 1e3, parse > 0 ? load / parse : 0.0, peak >= 0 ? (double)peak / 1024.0 : -1.0,
+               peak >= 0 && bytes > 0 ? (double)peak * 1024.0 / bytes : 0.0);
+        fflush(stdout);
+    } else {
+        sy_error_prefix(err, "%s", label);
+    }
+    free(tp);
+    free(tl);
+    return r;
+}
+
+/* A .glb with a (grid + 1)^2-vertex grid of 2 * grid^2 triangles: POSITION, NORMAL, TEXCOORD_0,
+ * uint32 indices; written through sy_atomic_file. */
+static sy_result write_grid_glb(const char *path, uint32_t grid, sy_error *err)
+{
+    size_t nv = (size_t)(grid + 1) * (grid + 1), ni = (size_t)grid * grid * 6;
+    size_t pos_b = nv * 12, nrm_b = nv * 12, uv_b = nv * 8, idx_b = ni * 4, bin = pos_b + nrm_b + uv_b + idx_b;
+    uint8_t *b = malloc(bin);
+    if (!b) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench load: out of memory");
+    float *pos = (float *)b, *nrm = (float *)(b + pos_b), *uv = (float *)(b + pos_b + nrm_b);
+    uint32_t *idx = (uint32_t *)(b + pos_b + nrm_b + uv_b);
+    for (uint32_t y = 0; y <= grid; y++)
+        for (uint32_t x = 0; x <= grid; x++) {
+            size_t v = (size_t)y * (grid + 1) + x;
+            float fx = (float)x / (float)grid, fy = (float)y / (float)grid;
+            pos[3 * v] = fx; pos[3 * v + 1] = 0.05f * sinf(12.0f * fx) * cosf(9.0f * fy); pos[3 * v + 2] = fy;
+            nrm[3 * v] = 0; nrm[3 * v + 1] = 1; nrm[3 * v + 2] = 0;
+            uv[2 * v] = fx; uv[2 * v + 1] = fy;
+        }
+    size_t k = 0;
+    for (uint32_t y = 0; y < grid; y++)
+        for (uint32_t x = 0; x < grid; x++) {
+            uint32_t a = y * (grid + 1) + x, c = a + grid + 1;
+            idx[k++] = a; idx[k++] = c; idx[k++] = a + 1;
+            idx[k++] = a + 1; idx[k++] = c; idx[k++] = c + 1;
+        }
+    char json[2048];
+    int jn = snprintf(json, sizeof json,
+        "{\"asset\":{\"version\":\"2.0\",\"generator\":\"sy bench load\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+        "\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,"
+        "\"TEXCOORD_0\":2},\"indices\":3}]}],\"buffers\":[{\"byteLength\":%zu}],\"bufferViews\":["
+        "{\"buffer\":0,\"byteOffset\":0,\"byteLength\":%zu},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu},"
+        "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\",\"min\":[0,-0.05,0],"
+        "\"max\":[1,0.05,1]},{\"bufferView\":1,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\"},"
+        "{\"bufferView\":2,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC2\"},"
+        "{\"bufferView\":3,\"componentType\":5125,\"count\":%zu,\"type\":\"SCALAR\"}]}",
+        bin, pos_b, pos_b, nrm_b, pos_b + nrm_b, uv_b, pos_b + nrm_b + uv_b, idx_b, nv, nv, nv, ni);
+    while (jn % 4) json[jn++] = ' ';
+    uint32_t hdr[5] = {0x46546C67u, 2, (uint32_t)(12 + 8 + jn + 8 + bin), (uint32_t)jn, 0x4E4F534Au};
+    uint32_t bhdr[2] = {(uint32_t)bin, 0x004E4942u};
+    sy_atomic_file af = {0};
+    sy_result r = sy_atomic_file_begin(path, &af, err);
+    if (r == SY_OK) {
+        if (fwrite(hdr, 4, 5, af.fp) != 5 || fwrite(json, 1, (size_t)jn, af.fp) != (size_t)jn ||
+            fwrite(bhdr, 4, 2, af.fp) != 2 || fwrite(b, 1, bin, af.fp) != bin) {
+            sy_atomic_file_abort(&af);
+            r = sy_error_set(err, SY_ERR_IO, "%s: write failed", path);
+        } else {
+            r = sy_atomic_file_commit(&af, err);
+        }
+    }
+    free(b);
+    return r;
+}
+
+sy_result sy_bench_load(const char *data_dir, uint32_t tris, uint32_t repeats, sy_error *err)
+{
+    printf("sy bench load: median of %u loads; 'tinygltf' = read + tinygltf parse alone (buffers, images decoded),\n"
+           "'sy load' = sy_gltf_load into a fresh scene; peak = RSS growth of one load in a forked child\n\n",
+           (unsigned)repeats);
+    printf("%-34s %9s %9s %10s %10s %8s %9s %8s\n", "model", "file MB", "tris", "tinygltf", "sy load", "ratio",
+           "peak MB", "peak/file");
+    printf("%-34s %9s %9s %10s %10s %8s %9s %8s\n", "", "", "", "ms", "ms", "", "", "");
+    sy_result r = SY_OK;
+    DIR *d = opendir(data_dir);
+    if (!d) {
+        printf("(no sample models: %s not found)\n", data_dir);
+    } else {
+        char **names = NULL;
+        size_t count = 0, cap = 0;
+        struct dirent *e;
+        while ((e = readdir(d)) != NULL) {
+            if (e->d_name[0] == '.' || e->d_name[0] == '_') continue;
+            if (count == cap) {
+                cap = cap ? cap * 2 : 64;
+                char **nn = realloc(names, cap * sizeof *nn);
+                if (!nn) break;
+                names = nn;
+            }
+            names[count] = strdup(e->d_name);
+            if (names[count]) count++;
+        }
+        closedir(d);
+        qsort(names, count, sizeof *names, cmp_cstr);
+        for (size_t i = 0; i < count && r == SY_OK; i++) {
+            /* one variant per model: the binary one when present */
+            static const char *const variants[][2] = {{"glTF-Binary", ".glb"}, {"glTF", ".gltf"}};
+            char path[4096];
+            bool found = false;
+            for (int v = 0; v < 2 && !found; v++) {
+                snprintf(path, sizeof path, "%s/%s/%s/%s%s", data_dir, names[i], variants[v][0], names[i], variants[v][1]);
+                struct stat st;
+                found = stat(path, &st) == 0;
+            }
+            if (found) r = bench_one_load(names[i], path, repeats, err);
+        }
+        for (size_t i = 0; i < count; i++) free(names[i]);
+        free(names);
+    }
+    if (r != SY_OK) return r;
+    /* generated model */
+    char dir[] = "/tmp/sy_bench_load_XXXXXX", path[128];
+    if (!mkdtemp(dir)) return sy_error_set(err, SY_ERR_IO, "bench load: cannot create a temporary directory");
+    snprintf(path, sizeof path, "%s/grid.glb", dir);
+    uint32_t grid = (uint32_t)ceil(sqrt((double)tris / 2.0));
+    char label[64];
+    snprintf(label, sizeof label, "generated grid (%u tris)", 2 * grid * grid);
+    r = write_grid_glb(path, grid, err);
+    if (r == SY_OK) r = bench_one_load(label, path, repeats, err);
+    unlink(path);
+    rmdir(dir);
+    return r;
+}
+
+/* >>pathtracer (issue 3): samples/s and Mrays/s of the path tracer next to the Whitted back-end on
+ * the same scene, and the restart latency after a transform change. */
+static sy_result pt_bench_frame(sy_window *win, sy_scene *scene, sy_context_pool *pool, uint32_t samples, sy_layer *out,
+                                double *secs, sy_error *err)
+{
+    sy_window_render_opts ro = {.sample_count = samples};
+    double t0 = sy_time_now();
+    sy_result r = sy_window_render(win, scene, pool, &ro, out, err);
+    *secs = sy_time_now() - t0;
+    return r;
+}
+
+sy_result sy_bench_pathtracer(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
+                              uint32_t height, uint32_t passes, sy_error *err)
+{
+    sy_window *win_w = NULL, *win_p = NULL;
+    sy_viewport *vp;
+    sy_context_pool *pool = NULL;
+    sy_layer img = {0};
+    double *t = calloc(passes, sizeof *t), whitted = INFINITY, first = 0, t_dummy;
+    sy_viewport_desc dw = *vd, dp = *vd;
+    dw.backend = "whitted";
+    dp.backend = "pathtracer";
+    sy_result r = t ? sy_window_create(width, height, &win_w, err) : sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench: out of memory");
+    if (r == SY_OK) r = sy_window_create(width, height, &win_p, err);
+    if (r == SY_OK) r = sy_window_add_viewport(win_w, &dw, &vp, err);
+    if (r == SY_OK) r = sy_window_add_viewport(win_p, &dp, &vp, err);
+    if (r == SY_OK) r = sy_context_pool_create(&pool, err);
+    if (r == SY_OK) r = sy_layer_create(width, height, &img, err);
+    /* Whitted: best of 3 frames after a warm-up (translation is not timed) */
+    for (uint32_t i = 0; i < 4 && r == SY_OK; ++i) {
+        double s;
+        r = pt_bench_frame(win_w, scene, pool, 0, &img, &s, err);
+        if (i) whitted = fmin(whitted, s);
+    }
+    /* path tracer: warm-up pass, then `passes` passes of 1 sample per pixel */
+    if (r == SY_OK) r = pt_bench_frame(win_p, scene, pool, 1, &img, &t_dummy, err);
+    sy_context *ctx = NULL;
+    sy_params pp = {0};
+    if (r == SY_OK) r = sy_context_pool_get(pool, scene, "pathtracer", &pp, vd->root.id, &ctx, err);
+    uint64_t rays = 0;
+    for (uint32_t i = 0; i < passes && r == SY_OK; ++i) {
+        r = pt_bench_frame(win_p, scene, pool, 1, &img, &t[i], err);
+        sy_mediator_rt_counters c;
+        sy_mediator_rt_counters_get(sy_context_state(ctx), &c);
+        rays += c.last_render_rays;
+    }
+    double total = 0;
+    for (uint32_t i = 0; i < passes; ++i) total += t[i];
+    /* restart latency: move the first node with a mesh a little, then time sync + the first pass */
+    uint32_t moved = 0;
+    for (uint32_t id = sy_scene_next(scene, SY_TYPE_NODE, 0); id && !moved; id = sy_scene_next(scene, SY_TYPE_NODE, id)) {
+        const sy_node_data *nd = sy_object_get(scene, SY_TYPE_NODE, id);
+        if (nd->mesh.id) moved = id;
+    }
+    sy_mediator_stats st = {0};
+    if (r == SY_OK && moved) {
+        sy_node n = {moved};
+        sy_mat4 m = sy_node_get(scene, n)->transform.matrix;
+        m.m[13] += 0.01f;
+        r = sy_node_set_matrix(scene, n, &m, err);
+        if (r == SY_OK) r = sy_scene_commit(scene, NULL, err);
+        if (r == SY_OK) r = pt_bench_frame(win_p, scene, pool, 1, &img, &first, err);
+        if (r == SY_OK) sy_context_stats(ctx, &st);
+    }
+    if (r == SY_OK) {
+        qsort(t, passes, sizeof *t, cmp_double);
+        double med = t[passes / 2], px = (double)width * height;
+        printf("%s, %ux%u:\n", label, width, height);
+        printf("  whitted                 %8.3f s/frame  %8.2f frames/s\n", whitted, 1.0 / whitted);
+        printf("  pathtracer (1 spp pass) %8.3f s/pass   %8.2f samples/s (spp)  %7.2f Msamples/s  %7.2f Mrays/s  "
+               "(%.1f rays/sample, %u passes)\n",
+               med, passes / total, px * passes / total * 1e-6, (double)rays / total * 1e-6, (double)rays / (px * passes),
+               passes);
+        printf("  pass / whitted frame    %8.2f x\n", med / whitted);
+        if (moved)
+            printf("  restart after a transform change: first new pass %.3f s = %.2f x one pass (samples after it: %llu)\n",
+                   first, first / med, (unsigned long long)st.samples);
+    }
+    free(t);
+    sy_layer_destroy(&img);
+    sy_context_pool_destroy(pool);
+    sy_window_destroy(win_w);
+    sy_window_destroy(win_p);
+    return r;
+}
+
+/* ---- sy bench filters (issue 7): noise-reduction filters of backends/filters ---------------- */
+#include "sy_filter_adaptive.h"
+#include "sy_filter_atrous.h"
+#include "sy_filter_jbu.h"
+#include "sy_filter_metrics.h"
+#include "sy_filter_pixel.h"
+#include "sy_filter_radiance.h"
+#include "sy_filter_synth.h"
+#include "sy_png.h"
+
+#include <time.h>
+
+static double fb_cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+enum { FB_NONE, FB_PIXEL, FB_PIXEL_BRUTE, FB_RADIANCE, FB_ATROUS, FB_JBU, FB_ADAPTIVE, FB_COUNT };
+static const char *const fb_names[FB_COUNT] = {"none", "pixel", "pixel-brute", "radiance", "atrous", "jbu", "adaptive"};
+
+static sy_result fb_fail(sy_error *err, const sy_filter_error *fe, const char *what)
+{
+    return sy_error_set(err, fe->status == SY_FILTER_ERROR_OUT_OF_MEMORY ? SY_ERR_OUT_OF_MEMORY : SY_ERR_BACKEND,
+                        "bench filters: %s: %s", what, fe->message);
+}
+
+/* one filter application; pixel filters: a forced pass of *keep (created on first use, as a
+ * viewport keeps its filter object between frames) */
+static sy_filter_status fb_apply(int m, const sy_filter_frame *f, uint32_t threads, float *out, sy_filter_pixel **keep,
+                                 sy_filter_error *fe)
+{
+    sy_filter_status s = SY_FILTER_OK;
+    if (m == FB_PIXEL || m == FB_PIXEL_BRUTE) {
+        sy_filter_pixel_params p;
+        sy_filter_pixel_params_default(&p);
+        p.threads = threads;
+        if (m == FB_PIXEL_BRUTE) p.kernel = SY_FILTER_PIXEL_BRUTE, p.aa_recovery = false;
+        if (!*keep) s = sy_filter_pixel_create(&p, keep, fe);
+        if (!s) s = sy_filter_pixel_set_params(*keep, &p, fe);
+        if (!s) s = sy_filter_pixel_run(*keep, f, (uint32_t)f->spp_uniform, true, out, NULL, fe);
+    } else if (m == FB_ATROUS) {
+        sy_filter_atrous_params p;
+        sy_filter_atrous_params_default(&p);
+        p.threads = threads;
+        s = sy_filter_atrous(&p, f, out, NULL, fe);
+    } else if (m == FB_JBU) {
+        sy_filter_jbu_params p;
+        sy_filter_jbu_params_default(&p);
+        p.threads = threads;
+        s = sy_filter_jbu(&p, f, out, NULL, fe);
+    } else if (m == FB_ADAPTIVE) {
+        sy_filter_adaptive_params p;
+        sy_filter_adaptive_params_default(&p);
+        p.threads = threads;
+        s = sy_filter_adaptive(&p, f, out, NULL, NULL, fe);
+    } else {
+        size_t n = (size_t)f->width * f->height;
+        for (size_t i = 0; i < n; ++i)
+            for (int c = 0; c < 4; ++c) out[4 * i + c] = c < 3 ? f->color[4 * i + c] : 1.0f;
+    }
+    return s;
+}
+
+static double fb_median(double *v, uint32_t n)
+{
+    qsort(v, n, sizeof *v, cmp_double);
+    return v[n / 2];
+}
+
+sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, const char *png_path, sy_error *err)
+{
+    sy_filter_error fe = {0};
+    sy_filter_synth *syn = NULL;
+    if (sy_filter_synth_create(width, height, 12345, &syn, &fe)) return fb_fail(err, &fe, "surrogate");
+    size_t n = (size_t)width * height;
+    float *out = malloc(4 * n * sizeof(float));
+    double *t = calloc(repeats, sizeof *t);
+    sy_result r = out && t ? SY_OK : sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench filters: out of memory");
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    printf("sy bench filters: analytic render surrogate (two Lambertian planes, depth step, checker texture, smooth\n"
+           "indirect light with a shadow edge, Exp(1) path noise), %ux%u, %ld cores\n\n", width, height, cores);
+    /* 1. cost per filtered frame at 4 spp (median of repeats; all cores, then one thread) */
+    for (int k = 0; k < 4 && r == SY_OK; ++k) sy_filter_synth_step(syn);
+    sy_filter_frame f = sy_filter_synth_frame(syn);
+    printf("filter time per frame at 4 spp (median of %u; wall time, and the CPU time the process used, which\n"
+           "does not grow when other processes load the machine):\n", repeats);
+    printf("  %-12s %12s %12s %12s %9s\n", "method", "all cores ms", "CPU ms", "1 thread ms", "speed-up");
+    double t_pixel = 0;
+    for (int m = FB_PIXEL; m < FB_COUNT && r == SY_OK; ++m) {
+        double med[2] = {0, 0}, cpu = 0;
+        for (int th = 0; th < 2 && r == SY_OK; ++th) {
+            uint32_t reps = m == FB_PIXEL_BRUTE ? 1 : repeats;
+            sy_filter_pixel *keep = NULL;
+            if ((m == FB_PIXEL || m == FB_PIXEL_BRUTE) && fb_apply(m, &f, th ? 1 : 0, out, &keep, &fe)) /* warm-up */
+                r = fb_fail(err, &fe, fb_names[m]);
+            double c0 = fb_cpu_now();
+            for (uint32_t i = 0; i < reps && r == SY_OK; ++i) {
+                double a = sy_time_now();
+                if (m == FB_RADIANCE) {
+                    sy_filter_radiance_params p;
+                    sy_filter_radiance_params_default(&p);
+                    p.threads = th ? 1 : 0;
+                    p.warmup_frames = 0; /* the variance-driven radius of frame 4 */
+                    sy_filter_radiance *rf = NULL;
+                    sy_filter_radiance_input in = sy_filter_synth_rf_input(syn);
+                    if (sy_filter_radiance_create(&p, &rf, &fe) ||
+                        sy_filter_radiance_frame(rf, &in, out, NULL, &fe))
+                        r = fb_fail(err, &fe, fb_names[m]);
+                    sy_filter_radiance_destroy(rf);
+                } else if (fb_apply(m, &f, th ? 1 : 0, out, &keep, &fe))
+                    r = fb_fail(err, &fe, fb_names[m]);
+                t[i] = sy_time_now() - a;
+            }
+            if (th == 0) cpu = (fb_cpu_now() - c0) / reps;
+            sy_filter_pixel_destroy(keep);
+            med[th] = fb_median(t, reps);
+        }
+        if (m == FB_PIXEL) t_pixel = med[0];
+        printf("  %-12s %12.2f %12.2f %12.2f %8.2fx\n", fb_names[m], med[0] * 1e3, cpu * 1e3, med[1] * 1e3,
+               med[1] / med[0]);
+    }
+    if (r == SY_OK)
+        printf("  fast pixel filter: %.1f ms per filtered frame (target < 50 ms at 640x480 on 2 cores;\n"
+               "  on an otherwise idle machine wall time ~ CPU ms / cores)\n\n", t_pixel * 1e3);
+    /* 2. quality against the converged image, progressive: every method sees the same samples */
+    static const uint32_t spps[] = {1, 4, 16, 64, 256};
+    enum { NS = sizeof spps / sizeof spps[0] };
+    uint32_t scale = (width + 319) / 320, tw = width / scale, th = height / scale;
+    size_t sheet_w = (size_t)tw * (FB_COUNT + 1), sheet_h = (size_t)th * NS;
+    float *sheet = png_path ? calloc(sheet_w * sheet_h * 4, sizeof(float)) : NULL;
+    if (png_path && !sheet && r == SY_OK) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench filters: out of memory");
+    sy_filter_pixel *pf = NULL;
+    sy_filter_radiance *rf = NULL;
+    sy_filter_pixel_params pp;
+    sy_filter_pixel_params_default(&pp);
+    pp.schedule_start = 1; /* filter frames 1, 2, 4, 8, ...: every checkpoint below is a filter frame */
+    float *rf_out = malloc(4 * n * sizeof(float)), *pix_out = malloc(4 * n * sizeof(float));
+    if (r == SY_OK && (!rf_out || !pix_out)) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench filters: out of memory");
+    if (r == SY_OK && (sy_filter_pixel_create(&pp, &pf, &fe) || sy_filter_radiance_create(NULL, &rf, &fe)))
+        r = fb_fail(err, &fe, "create");
+    const float *ref = sy_filter_synth_reference(syn);
+    if (r == SY_OK) {
+        printf("quality against the converged image (RMSE / relMSE / SSIM; pixel: 2^i schedule from frame 1;\n"
+               "radiance: filtered every frame; others applied at the checkpoint):\n");
+        printf("  %5s %-12s %9s %9s %7s %10s %9s\n", "spp", "method", "RMSE", "relMSE", "SSIM", "relMSE/PT", "ms");
+    }
+    sy_filter_synth_reset(syn);
+    uint32_t si = 0;
+    double rf_ms = 0, px_ms = 0;
+    for (uint32_t k = 1; k <= spps[NS - 1] && r == SY_OK; ++k) {
+        sy_filter_synth_step(syn);
+        f = sy_filter_synth_frame(syn);
+        sy_filter_radiance_input in = sy_filter_synth_rf_input(syn);
+        sy_filter_stats st;
+        if (sy_filter_radiance_frame(rf, &in, rf_out, &st, &fe)) {
+            r = fb_fail(err, &fe, "radiance");
+            break;
+        }
+        rf_ms = st.seconds * 1e3;
+        if (sy_filter_pixel_run(pf, &f, k, false, pix_out, &st, &fe)) {
+            r = fb_fail(err, &fe, "pixel");
+            break;
+        }
+        px_ms = st.seconds * 1e3;
+        if (k != spps[si]) continue;
+        double base_rel = 0;
+        for (int m = 0; m < FB_COUNT && r == SY_OK; ++m) {
+            const float *img = out;
+            double ms = 0;
+            if (m == FB_RADIANCE) img = rf_out, ms = rf_ms;
+            else if (m == FB_PIXEL) img = pix_out, ms = px_ms;
+            else {
+                double a = sy_time_now();
+                if (m == FB_PIXEL_BRUTE && width * height > 400000u) continue;
+                sy_filter_pixel *once = NULL;
+                if (fb_apply(m, &f, 0, out, &once, &fe)) r = fb_fail(err, &fe, fb_names[m]);
+                sy_filter_pixel_destroy(once);
+                ms = (sy_time_now() - a) * 1e3;
+            }
+            sy_filter_metrics mt;
+            if (r == SY_OK && sy_filter_metrics_compute(img, ref, width, height, 4, &mt, &fe))
+                r = fb_fail(err, &fe, "metrics");
+            if (r != SY_OK) break;
+            if (m == FB_NONE) base_rel = mt.relmse;
+            printf("  %5u %-12s %9.5f %9.5f %7.4f %9.2fx %9.1f\n", k, fb_names[m], mt.rmse, mt.relmse, mt.ssim,
+                   mt.relmse > 0 ? base_rel / mt.relmse : 0.0, ms);
+            for (uint32_t y = 0; sheet && y < th; ++y) /* tile: box-downscaled image */
+                for (uint32_t x = 0; x < tw; ++x)
+                    for (int c = 0; c < 4; ++c) {
+                        double acc = 0;
+                        for (uint32_t dy = 0; dy < scale; ++dy)
+                            for (uint32_t dx = 0; dx < scale; ++dx)
+                                acc += img[4 * ((size_t)(y * scale + dy) * width + x * scale + dx) + c];
+                        sheet[4 * ((si * (size_t)th + y) * sheet_w + (size_t)m * tw + x) + c] =
+                            c == 3 ? 1.0f : (float)(acc / (scale * scale));
+                    }
+        }
+        for (uint32_t y = 0; sheet && y < th; ++y)
+            for (uint32_t x = 0; x < tw; ++x)
+                for (int c = 0; c < 4; ++c)
+                    sheet[4 * ((si * (size_t)th + y) * sheet_w + (size_t)FB_COUNT * tw + x) + c] =
+                        ref[4 * ((size_t)(y * scale) * width + x * scale) + c];
+        ++si;
+    }
+    if (r == SY_OK && sheet) {
+        r = sy_png_write(png_path, (int)sheet_w, (int)sheet_h, sheet, NULL, err);
+        if (r == SY_OK)
+            printf("\ncontact sheet %s: rows = spp 1, 4, 16, 64, 256; columns = none, pixel, pixel-brute (blank above\n"
+                   "400k pixels), radiance, atrous, jbu, adaptive, reference\n", png_path);
+    }
+    sy_filter_pixel_destroy(pf);
+    sy_filter_radiance_destroy(rf);
+    free(rf_out), free(pix_out), free(sheet), free(out), free(t);
+    sy_filter_synth_destroy(syn);
+    return r;
+}
+
+/* ---- sy bench filters SCENE: the same comparison on the path tracer's real buffers ---------- */
+#include "sy_exr.h"
+
+sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
+                                 uint32_t height, const char *reference_exr, const char *png_path, sy_error *err)
+{
+    sy_filter_error fe = {0};
+    sy_exr_image *refimg = NULL;
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_context_pool *pool = NULL;
+    sy_layer img = {0};
+    sy_viewport_desc dp = *vd;
+    dp.backend = "pathtracer";
+    size_t n = (size_t)width * height;
+    float *ref = malloc(4 * n * sizeof(float)), *out = malloc(4 * n * sizeof(float)), *pos = malloc(3 * n * sizeof(float));
+    float *pix_out = malloc(4 * n * sizeof(float));
+    sy_result r = ref && out && pos && pix_out ? SY_OK : sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench filters: out of memory");
+    if (r == SY_OK) r = sy_exr_read(reference_exr, &refimg, err);
+    if (r == SY_OK && (refimg->width != (int)width || refimg->height != (int)height))
+        r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "bench filters: reference %s is %dx%d, the render %ux%u",
+                         reference_exr, refimg->width, refimg->height, width, height);
+    const float *rc[3] = {NULL, NULL, NULL};
+    if (r == SY_OK) {
+        rc[0] = sy_exr_image_channel(refimg, "R"), rc[1] = sy_exr_image_channel(refimg, "G");
+        rc[2] = sy_exr_image_channel(refimg, "B");
+        if (!rc[0] || !rc[1] || !rc[2])
+            r = sy_error_set(err, SY_ERR_PARSE, "bench filters: reference %s has no R, G, B channels", reference_exr);
+    }
+    for (size_t i = 0; r == SY_OK && i < n; ++i)
+        for (int c = 0; c < 4; ++c) ref[4 * i + c] = c < 3 ? rc[c][i] : 1.0f;
+    /* camera: world matrix and vertical field of view, for positions and the headlight */
+    float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, yfov = 0.0f;
+    if (r == SY_OK && vd->camera.id) {
+        sy_mat4 w;
+        const sy_node_data *nd = sy_node_get(scene, vd->camera);
+        const sy_camera_data *cd = nd && nd->camera.id ? sy_camera_get(scene, nd->camera) : NULL;
+        if (cd && cd->yfov > 0.0f && sy_node_world_matrix(scene, vd->camera, &w, err) == SY_OK) {
+            memcpy(m, w.m, sizeof m);
+            yfov = cd->yfov;
+        }
+    }
+    if (r == SY_OK && yfov <= 0.0f)
+        r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "bench filters: %s needs a perspective camera node", label);
+    if (r == SY_OK) r = sy_window_create(width, height, &win, err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, &dp, &vp, err);
+    if (r == SY_OK) r = sy_context_pool_create(&pool, err);
+    if (r == SY_OK) r = sy_layer_create(width, height, &img, err);
+    sy_filter_pixel *pf = NULL;
+    sy_filter_pixel_params pp;
+    sy_filter_pixel_params_default(&pp);
+    pp.schedule_start = 1;
+    if (r == SY_OK && sy_filter_pixel_create(&pp, &pf, &fe)) r = fb_fail(err, &fe, "pixel");
+    static const uint32_t spps[] = {1, 4, 16, 64, 256};
+    enum { NS = sizeof spps / sizeof spps[0] };
+    uint32_t methods[] = {FB_NONE, FB_PIXEL, FB_PIXEL_BRUTE, FB_ATROUS, FB_JBU, FB_ADAPTIVE};
+    enum { NM = sizeof methods / sizeof methods[0] };
+    size_t sheet_w = (size_t)width * (NM + 1), sheet_h = (size_t)height * NS;
+    float *sheet = png_path && r == SY_OK ? calloc(sheet_w * sheet_h * 4, sizeof(float)) : NULL;
+    if (r == SY_OK && png_path && !sheet) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench filters: out of memory");
+    if (r == SY_OK) {
+        printf("%s, %ux%u, path tracer buffers against %s (radiance filtering needs the integrator's\n"
+               "sample hook and is not measured here):\n", label, width, height, reference_exr);
+        printf("  %5s %-12s %9s %9s %7s %10s %9s\n", "spp", "method", "RMSE", "relMSE", "SSIM", "relMSE/PT", "ms");
+    }
+    sy_context *ctx = NULL;
+    sy_params none = {0};
+    double pass_s = 0, t_pixel_ms = 0;
+    uint32_t si = 0;
+    for (uint32_t k = 1; k <= spps[NS - 1] && r == SY_OK; ++k) {
+        double s;
+        r = pt_bench_frame(win, scene, pool, 1, &img, &s, err);
+        pass_s += s;
+        if (r == SY_OK && !ctx) r = sy_context_pool_get(pool, scene, "pathtracer", &none, vd->root.id, &ctx, err);
+        sy_mediator_rt_aovs a = {0};
+        if (r == SY_OK) r = sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err);
+        if (r == SY_OK && (a.width != width || a.height != height))
+            r = sy_error_set(err, SY_ERR_BACKEND, "bench filters: feature buffers are %ux%u, expected %ux%u", a.width,
+                             a.height, width, height);
+        if (r == SY_OK && sy_filter_position_from_depth(width, height, m, yfov, a.planes[4], pos, &fe))
+            r = fb_fail(err, &fe, "positions");
+        sy_filter_frame f = {.width = width, .height = height, .color_channels = 4, .variance_channels = 3,
+                             .color = a.planes[0], .variance = a.planes[1], .albedo = a.planes[2],
+                             .normal = a.planes[3], .depth = a.planes[4], .position = pos, .direct = a.planes[5],
+                             .indirect = a.planes[6], .spp_uniform = (float)(a.samples ? a.samples : k), .has_camera = true,
+                             .camera_position = {m[12], m[13], m[14]}};
+        sy_filter_stats st;
+        if (r == SY_OK && sy_filter_pixel_run(pf, &f, k, false, pix_out, &st, &fe)) r = fb_fail(err, &fe, "pixel");
+        if (r == SY_OK && st.filter_pass && k >= 4) t_pixel_ms = st.seconds * 1e3;
+        if (r == SY_OK && k == spps[si]) {
+            double base_rel = 0;
+            for (int mi = 0; mi < NM && r == SY_OK; ++mi) {
+                int meth = (int)methods[mi];
+                const float *im = out;
+                double ms = meth == FB_PIXEL ? st.seconds * 1e3 : 0;
+                if (meth == FB_PIXEL)
+                    im = pix_out;
+                else {
+                    sy_filter_pixel *once = NULL;
+                    double t0 = sy_time_now();
+                    if (fb_apply(meth, &f, 0, out, &once, &fe)) r = fb_fail(err, &fe, fb_names[meth]);
+                    ms = (sy_time_now() - t0) * 1e3;
+                    sy_filter_pixel_destroy(once);
+                }
+                sy_filter_metrics mt;
+                if (r == SY_OK && sy_filter_metrics_compute(im, ref, width, height, 4, &mt, &fe))
+                    r = fb_fail(err, &fe, "metrics");
+                if (r != SY_OK) break;
+                if (meth == FB_NONE) base_rel = mt.relmse;
+                printf("  %5u %-12s %9.5f %9.5f %7.4f %9.2fx %9.1f\n", k, fb_names[meth], mt.rmse, mt.relmse, mt.ssim,
+                       mt.relmse > 0 ? base_rel / mt.relmse : 0.0, ms);
+                for (uint32_t y = 0; sheet && y < height; ++y)
+                    for (uint32_t x = 0; x < width; ++x) { /* opaque: uncovered background shows black */
+                        float *d = sheet + 4 * ((si * (size_t)height + y) * sheet_w + (size_t)mi * width + x);
+                        const float *sp = im + 4 * ((size_t)y * width + x);
+                        d[0] = sp[0], d[1] = sp[1], d[2] = sp[2], d[3] = 1.0f;
+                    }
+            }
+            for (uint32_t y = 0; sheet && y < height; ++y)
+                memcpy(sheet + 4 * ((si * (size_t)height + y) * sheet_w + (size_t)NM * width), ref + 4 * (size_t)y * width,
+                       4 * width * sizeof(float));
+            ++si;
+        }
+        sy_mediator_rt_aovs_free(&a);
+    }
+    if (r == SY_OK)
+        printf("  path tracing: %.1f ms per 1-spp pass; fast pixel filter pass %.1f ms = %.2f x one pass\n",
+               pass_s / spps[NS - 1] * 1e3, t_pixel_ms, t_pixel_ms / (pass_s / spps[NS - 1] * 1e3));
+    if (r == SY_OK && sheet) {
+        r = sy_png_write(png_path, (int)sheet_w, (int)sheet_h, sheet, NULL, err);
+        if (r == SY_OK)
+            printf("  contact sheet %s: rows = spp 1, 4, 16, 64, 256; columns = none, pixel, pixel-brute, atrous,\n"
+                   "  jbu, adaptive, reference\n", png_path);
+    }
+    sy_filter_pixel_destroy(pf);
+    free(sheet), free(ref), free(out), free(pos), free(pix_out);
+    if (refimg) sy_exr_image_free(refimg);
+    sy_layer_destroy(&img);
+    sy_context_pool_destroy(pool);
+    sy_window_destroy(win);
     return r;
 }

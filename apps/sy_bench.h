@@ -22,4 +22,39 @@ sy_result sy_bench_rays(sy_scene *scene, const sy_viewport_desc *vd, uint32_t wi
  * every registered back-end, at width x height per eye. */
 sy_result sy_bench_viewports(uint32_t width, uint32_t height, uint32_t repeats, sy_error *err);
 
+/* Rasterizer on OSMesa (or gl=... in vd->params): median frame time of the scene in vd and of a
+ * generated 1M-triangle scene (100 meshes) at width x height against the floor (the same buffers
+ * drawn with a trivial shader into the same targets), the time from a transform change to the
+ * next finished frame, and GL uploads per frame. */
+sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
+                          uint32_t height, uint32_t repeats, sy_error *err);
+
+/* glTF loading (formats): for each sample model under data_dir (one variant per model, binary when
+ * present) and for a generated .glb of about `tris` triangles (written to a temporary directory),
+ * the median time of tinygltf's parse alone next to the whole sy_gltf_load (our translation
+ * overhead as a ratio) over `repeats` runs, and the peak RSS growth of one load (forked child)
+ * relative to the bytes read. A missing data_dir only skips the sample models. */
+sy_result sy_bench_load(const char *data_dir, uint32_t tris, uint32_t repeats, sy_error *err);
+
+/* Path tracer (issue 3): samples per second (1-spp passes over width x height, median and mean of
+ * `passes`), Mrays/s (closest-hit + shadow rays) and the Whitted back-end's frame time on the same
+ * scene and viewport, then the restart latency: the time of the first pass after a transform
+ * change (sync included) against one pass. All threads. */
+sy_result sy_bench_pathtracer(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
+                              uint32_t height, uint32_t passes, sy_error *err);
+
+/* Noise-reduction filters (issue 7, backends/filters) on the analytic render surrogate
+ * (sy_filter_synth.h) at width x height: filter time per frame at 4 spp for every method (median
+ * of `repeats`, all cores and one thread), then RMSE / relMSE / SSIM against the converged image
+ * at 1, 4, 16, 64, 256 spp with every method fed the same progressive samples; png_path (may be
+ * NULL) receives the contact sheet (rows = spp, columns = methods + reference). */
+sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, const char *png_path, sy_error *err);
+
+/* The same comparison on the path tracer's feature buffers for the view of vd (its camera node
+ * gives positions and the headlight), against the linear RGB reference EXR of the same size
+ * (e.g. the Cycles Cornell box): 1..256 passes of 1 spp, metrics at 1, 4, 16, 64, 256 spp, the
+ * path-tracing pass time and the fast pixel filter's cost as a ratio to it; optional sheet. */
+sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
+                                 uint32_t height, const char *reference_exr, const char *png_path, sy_error *err);
+
 #endif /* SY_BENCH_H */

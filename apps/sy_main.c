@@ -3,21 +3,36 @@
  *   sy info SCENE                       JSON summary (counts, bounds) of a glTF file
  *   sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]
  *             [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]
+ *             with -b pathtracer: [--spp N | --time SECONDS] [--aov] [--env MAP.exr] [--env-intensity X]
+ *             [--background R,G,B]
+ *             [--gl osmesa|egl|glfw]  (raster back-end's GL context provider)
  *   sy demo [-o DIR] [-w W] [-h H]      render the built-in demo scene with every back-end
  *   sy bench sync [--nodes N] [--tris T] [--repeats R]
  *   sy bench rays [SCENE] [-w W] [-h H] [--repeats R]
+ *   sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params k=v,...]
+ *   sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]
+ *   sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]
  *   sy backends                         list registered back-ends
+ *   sy serve [--listen URL] [--secret-file F] [--output OUT]   render server (apps/sy_cluster_cli.c)
+ *   sy render ... --cluster URL[,URL...]|FILE.conf [--cluster-mode MODE]   render on servers
+ *   sy bench cluster [-w W] [-h H]
  *
- * SCENE is a .gltf / .glb file or the word "demo" (the built-in scene). Errors go to stderr with
+ * SCENE is a .gltf / .glb / .x3d file or the word "demo" (the built-in scene). Errors go to stderr with
  * the file and the reason; the exit code is non-zero (1 = usage, 2 = failure). */
 #include "sy_bench.h"
+#include "sy_cluster_cli.h"
 #include "sy_compose.h"
+#ifdef SY_HAVE_GLFW
+#include "sy_view.h"
+#endif
 #include "sy_demo.h"
 #include "sy_exr.h"
 #include "sy_gltf.h"
+#include "sy_mediator_rt.h"
 #include "sy_mediators.h"
 #include "sy_png.h"
 #include "sy_viewport.h"
+#include "sy_x3d.h"
 
 #include <errno.h>
 #include <math.h>
@@ -36,11 +51,14 @@ typedef struct loaded {
     sy_background background;
     sy_gltf_info gltf;
     bool is_gltf;
+    sy_x3d_info x3d; /* .x3d files (is_x3d) */
+    bool is_x3d;
 } loaded;
 
 static void loaded_free(loaded *l)
 {
     sy_gltf_info_free(&l->gltf);
+    sy_x3d_info_free(&l->x3d);
     sy_scene_destroy(l->scene);
     memset(l, 0, sizeof *l);
 }
@@ -107,6 +125,16 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
             if (camera_sel && strcmp(camera_sel, "0") != 0 && strcmp(camera_sel, "camera") != 0)
                 r = sy_error_set(err, SY_ERR_NOT_FOUND, "demo: no camera '%s' (available: 0 \"camera\")", camera_sel);
         }
+    } else if (strlen(path) > 4 && !strcasecmp(path + strlen(path) - 4, ".x3d")) {
+        out->is_x3d = true;
+        r = sy_x3d_load(path, out->scene, NULL, &out->x3d, err);
+        if (r == SY_OK) {
+            out->root = out->x3d.root;
+            out->background = out->x3d.background;
+            if (camera_sel) r = sy_x3d_find_camera(out->scene, &out->x3d, camera_sel, &out->camera, err);
+            else if (out->x3d.camera_node_count) out->camera = out->x3d.camera_nodes[0];
+            if (r != SY_OK) sy_error_prefix(err, "%s", path);
+        }
     } else {
         out->is_gltf = true;
         r = sy_gltf_load(path, out->scene, NULL, &out->gltf, err);
@@ -118,9 +146,18 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
         }
     }
     if (r == SY_OK) r = sy_scene_commit(out->scene, NULL, err);
-    if (r == SY_OK && out->is_gltf && defaults) r = add_defaults(out, err);
+    if (r == SY_OK && (out->is_gltf || out->is_x3d) && defaults) r = add_defaults(out, err);
     if (r != SY_OK) loaded_free(out);
     return r;
+}
+
+/* X3D Viewpoint fieldOfView covers the smaller image side: adapt yfov to the output size. */
+static void fit_x3d_cameras(loaded *ld, uint32_t w, uint32_t h)
+{
+    sy_error e = {0};
+    if (sy_x3d_fit_cameras(ld->scene, &ld->x3d, (float)w / (float)h, &e) != SY_OK ||
+        sy_scene_commit(ld->scene, NULL, &e) != SY_OK)
+        fprintf(stderr, "sy: warning: viewpoint field of view not adapted: %s\n", e.message);
 }
 
 /* >>progress (terminal only) */
@@ -186,6 +223,210 @@ static sy_result render_scene(loaded *ld, const char *backend, const char *param
     return r;
 }
 
+/* >>progressive (path tracer): sample budget, environment, feature buffers */
+typedef struct pt_opts {
+    uint32_t spp;         /* 0 = default (64 unless a time budget is given) */
+    double time_budget;   /* seconds, 0 = none */
+    bool aov;             /* write feature buffers as extra EXR channels */
+    const char *env;      /* equirectangular EXR environment */
+    float env_intensity;
+    bool has_bg;
+    float bg[3];          /* constant background radiance (a uniform environment for the path tracer) */
+} pt_opts;
+
+/* True when `sy render` names a progressive back-end (-b pathtracer): cmd_render_progressive
+ * handles it (mono viewport, passes until --spp or --time, --aov, --env). */
+static bool render_wants_progressive(int argc, char **argv)
+{
+    for (int i = 0; i + 1 < argc; ++i)
+        if (!strcmp(argv[i], "-b")) {
+            const sy_mediator_class *c = sy_mediator_find(argv[i + 1]);
+            return c && (c->caps & SY_CAP_PROGRESSIVE);
+        }
+    return false;
+}
+
+/* Reads an equirectangular EXR (R, G, B or Y channels) into a float RGB texture and makes it the
+ * environment (and/or sets the background colour) of the viewport's background object. */
+static sy_result setup_environment(loaded *ld, const pt_opts *po, sy_error *err)
+{
+    if (!po->env && !po->has_bg) return SY_OK;
+    sy_scene *s = ld->scene;
+    sy_background_data bd = *(const sy_background_data *)sy_object_defaults(SY_TYPE_BACKGROUND);
+    if (ld->background.id) bd = *sy_background_get(s, ld->background);
+    bd.name = NULL;
+    if (po->has_bg) {
+        for (int k = 0; k < 3; ++k) bd.color[k] = po->bg[k];
+        bd.color[3] = 1.0f;
+    }
+    sy_result r = SY_OK;
+    if (po->env) {
+        sy_exr_image *img = NULL;
+        if ((r = sy_exr_read(po->env, &img, err)) != SY_OK) {
+            sy_error_prefix(err, "environment");
+            return r;
+        }
+        const float *ch[3] = {sy_exr_image_channel(img, "R"), sy_exr_image_channel(img, "G"), sy_exr_image_channel(img, "B")};
+        const float *y = sy_exr_image_channel(img, "Y");
+        if (!ch[0] || !ch[1] || !ch[2]) {
+            if (!y) {
+                sy_exr_image_free(img);
+                return sy_error_set(err, SY_ERR_PARSE, "environment %s: no R, G, B (or Y) channels", po->env);
+            }
+            ch[0] = ch[1] = ch[2] = y;
+        }
+        size_t n = (size_t)img->width * (size_t)img->height;
+        float *px = malloc(n * 3 * sizeof *px);
+        if (!px) {
+            sy_exr_image_free(img);
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "environment %s: out of memory", po->env);
+        }
+        for (size_t i = 0; i < n && r == SY_OK; ++i)
+            for (int k = 0; k < 3; ++k) {
+                float v = ch[k][i];
+                if (!isfinite(v) || v < 0.0f)
+                    r = sy_error_set(err, SY_ERR_PARSE, "environment %s: pixel (%zu, %zu) has a %s value %g", po->env,
+                                     i % (size_t)img->width, i / (size_t)img->width,
+                                     isfinite(v) ? "negative" : "non-finite", (double)v);
+                px[i * 3 + (size_t)k] = v;
+            }
+        sy_image_info info = {(uint32_t)img->width, (uint32_t)img->height, 3, SY_PIXEL_F32};
+        sy_exr_image_free(img);
+        sy_blob *blob = NULL;
+        if (r == SY_OK) r = sy_blob_create_take(px, n * 3 * sizeof *px, &blob, err);
+        if (r != SY_OK) {
+            free(px);
+            return r;
+        }
+        sy_texture tex;
+        sy_sampler smp = {SY_WRAP_REPEAT, SY_WRAP_CLAMP, SY_FILTER_LINEAR, SY_FILTER_LINEAR};
+        if ((r = sy_texture_create(s, "environment", &tex, err)) == SY_OK &&
+            (r = sy_texture_set_image(s, tex, &info, blob, err)) == SY_OK)
+            r = sy_texture_set_sampler(s, tex, &smp, err);
+        sy_blob_release(blob);
+        if (r != SY_OK) return r;
+        bd.environment = tex;
+        bd.intensity = po->env_intensity;
+    }
+    if (!ld->background.id && (r = sy_background_create(s, "background", &ld->background, err)) != SY_OK) return r;
+    if ((r = sy_background_set(s, ld->background, &bd, err)) != SY_OK) return r;
+    return sy_scene_commit(s, NULL, err);
+}
+
+typedef struct pt_progress {
+    double start;
+    uint64_t done, total; /* samples per pixel; total 0 = time budget */
+    double budget;
+} pt_progress;
+
+static void pt_progress_print(const pt_progress *p, bool final)
+{
+    double el = sy_time_now() - p->start, rate = el > 0 ? (double)p->done / el : 0;
+    if (final) {
+        fprintf(stderr, "\r%*s\r", 78, "");
+    } else if (p->total) {
+        double eta = rate > 0 ? (double)(p->total - p->done) / rate : 0;
+        fprintf(stderr, "\rpathtracer: %llu/%llu samples, %.2f samples/s, %.1f s, ETA %.1f s   ",
+                (unsigned long long)p->done, (unsigned long long)p->total, rate, el, eta);
+    } else {
+        fprintf(stderr, "\rpathtracer: %llu samples, %.2f samples/s, %.1f s, ETA %.1f s   ", (unsigned long long)p->done,
+                rate, el, fmax(0.0, p->budget - el));
+    }
+    fflush(stderr);
+}
+
+/* Renders a progressive back-end in passes until the sample count or the time budget is reached.
+ * *samples_out gets the samples per pixel accumulated; *ctx_out the (pool-owned) context. */
+static sy_result render_progressive(loaded *ld, const char *backend, const char *params, uint32_t w, uint32_t h,
+                                    const pt_opts *po, sy_context_pool *pool, sy_layer *out, double *seconds,
+                                    uint64_t *samples_out, sy_context **ctx_out, sy_error *err)
+{
+    sy_window *win = NULL;
+    sy_viewport *vp;
+    sy_result r = sy_window_create(w, h, &win, err);
+    sy_viewport_desc vd = {
+        .root = ld->root, .camera = ld->camera, .background = ld->background, .backend = backend, .params = params};
+    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
+    if (r == SY_OK) r = sy_layer_create(w, h, out, err);
+    sy_params pp;
+    if (r == SY_OK) r = sy_params_parse(params, &pp, err);
+    uint64_t target = po->spp ? po->spp : (po->time_budget > 0 ? 0 : 64);
+    pt_progress pr = {sy_time_now(), 0, target, po->time_budget};
+    bool tty = sy_is_terminal(2);
+    double t0 = sy_time_now(), last_print = 0;
+    uint32_t chunk = 1;
+    while (r == SY_OK) {
+        uint64_t left = target ? target - pr.done : UINT32_MAX;
+        uint32_t n = (uint32_t)(left < chunk ? left : chunk);
+        double p0 = sy_time_now();
+        sy_window_render_opts ro = {.sample_count = n};
+        r = sy_window_render(win, ld->scene, pool, &ro, out, err);
+        if (r != SY_OK) break;
+        pr.done += n;
+        double now = sy_time_now(), pass = (now - p0) / n;
+        if (tty && now - last_print > 0.1) {
+            pt_progress_print(&pr, false);
+            last_print = now;
+        }
+        if (target && pr.done >= target) break;
+        if (po->time_budget > 0 && now - t0 + pass > po->time_budget) break;
+        /* passes of about a quarter of a second: responsive progress, little overhead */
+        double want = pass > 0 ? 0.25 / pass : 64;
+        chunk = want < 1 ? 1 : want > 1024 ? 1024 : (uint32_t)want;
+        if (po->time_budget > 0) {
+            double rest = (po->time_budget - (now - t0)) / (pass > 0 ? pass : 1e-3);
+            if (rest < chunk) chunk = rest < 1 ? 1 : (uint32_t)rest;
+        }
+    }
+    *seconds = sy_time_now() - t0;
+    if (tty) pt_progress_print(&pr, true);
+    sy_context *ctx = NULL;
+    if (r == SY_OK) r = sy_context_pool_get(pool, ld->scene, backend, &pp, ld->root.id, &ctx, err);
+    if (r == SY_OK) {
+        sy_mediator_stats st = {0};
+        sy_context_stats(ctx, &st);
+        *samples_out = st.samples;
+        *ctx_out = ctx;
+    }
+    sy_window_destroy(win);
+    return r;
+}
+
+/* Writes colour + depth and the path tracer's feature buffers as channels of one EXR:
+ * R G B A Z, variance.{R,G,B}, albedo.{R,G,B}, normal.{X,Y,Z}, direct.{R,G,B}, indirect.{R,G,B}. */
+static sy_result write_aov_exr(const char *path, sy_context *ctx, bool half, sy_error *err)
+{
+    if (strcmp(sy_context_class(ctx)->name, "pathtracer") != 0)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--aov: back-end %s has no feature buffers",
+                            sy_context_class(ctx)->name);
+    sy_mediator_rt_aovs a;
+    sy_result r = sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err);
+    if (r != SY_OK) return r;
+    sy_exr_channel_desc ch[32];
+    int n = 0;
+    static const char *const rgba[4] = {"R", "G", "B", "A"}, *const rgb[3] = {"R", "G", "B"}, *const xyz[3] = {"X", "Y", "Z"};
+    char names[SY_MEDIATOR_RT_AOV_COUNT][3][32];
+    sy_exr_pixel_type ct = half ? SY_EXR_PIXEL_HALF : SY_EXR_PIXEL_FLOAT;
+    for (uint32_t k = 0; k < SY_MEDIATOR_RT_AOV_COUNT; ++k) {
+        uint32_t c = sy_mediator_rt_aov_channels(k);
+        const char *name = sy_mediator_rt_aov_name(k);
+        if (!strcmp(name, "color")) {
+            for (uint32_t i = 0; i < 4; ++i) ch[n++] = (sy_exr_channel_desc){rgba[i], a.planes[k], 4, i, ct};
+        } else if (!strcmp(name, "depth")) {
+            ch[n++] = (sy_exr_channel_desc){"Z", a.planes[k], 1, 0, SY_EXR_PIXEL_FLOAT};
+        } else {
+            for (uint32_t i = 0; i < c && i < 3; ++i) {
+                snprintf(names[k][i], sizeof names[k][i], "%s.%s", name, !strcmp(name, "normal") ? xyz[i] : rgb[i]);
+                ch[n++] = (sy_exr_channel_desc){names[k][i], a.planes[k], c, i, ct};
+            }
+        }
+    }
+    sy_exr_write_desc wd = {.width = (int)a.width, .height = (int)a.height, .channels = ch, .channel_count = n};
+    r = sy_exr_write(path, &wd, err);
+    sy_mediator_rt_aovs_free(&a);
+    return r;
+}
+
 /* >>commands */
 static int fail(const sy_error *e)
 {
@@ -200,14 +441,28 @@ static int usage(void)
             "  sy info SCENE\n"
             "  sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]\n"
             "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]\n"
+            "            [--gl osmesa|egl|glfw]   (-b raster: the GL context provider)\n"
             "            [--stereo sbs|tb|anaglyph|separate] [--eye-sep M] [--zero-parallax M]\n"
             "            [--overlay FILE[:BACKEND]] [--composite depth|over|replace]\n"
+            "  sy render SCENE -b pathtracer -o OUT.exr|png [--spp N | --time SECONDS] [--aov]\n"
+            "            [--env MAP.exr] [--env-intensity X] [--background R,G,B] (+ the options above)\n"
             "  sy demo [-o DIR] [-w W] [-h H]\n"
+            "  sy view SCENE [-b BACKEND] [-w W] [-h H] [--camera C] [--overlay FILE[:BACKEND]]\n"
+            "          [--frames N --screenshot OUT.png]\n"
             "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"
             "  sy bench rays [SCENE] [-w W] [-h H] [--repeats R]\n"
+            "  sy bench pathtracer [SCENE] [-w W] [-h H] [--repeats PASSES]\n"
+            "  sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]\n"
+            "  sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params gl=egl,msaa=4]\n"
             "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
+            "  sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]\n"
             "  sy backends\n"
-            "SCENE: a .gltf/.glb file, or 'demo' for the built-in scene\n");
+            "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
+            "  sy render SCENE -b BACKEND -o OUT --cluster URL[,URL...]|FILE.conf\n"
+            "            [--cluster-mode sort-first|balanced|cooperative|multi-display|stereo] [--secret-file F]\n"
+            "            [--tls-ca PEM] [--timeout-ms MS] [--frames N] [--spp N]\n"
+            "  sy bench cluster [-w W] [-h H]\n"
+            "SCENE: a .gltf/.glb/.x3d file, or 'demo' for the built-in scene\n");
     return 1;
 }
 
@@ -271,6 +526,10 @@ static int cmd_info(int argc, char **argv)
         printf(i ? ", " : "");
         json_string(stdout, ld.gltf.warnings[i]);
     }
+    for (uint32_t i = 0; i < ld.x3d.stored_warning_count; ++i) {
+        printf(i ? ", " : "");
+        json_string(stdout, ld.x3d.warnings[i]);
+    }
     printf("]\n}\n");
     loaded_free(&ld);
     return 0;
@@ -319,14 +578,28 @@ static sy_result add_overlay(loaded *ld, const char *arg, const char *composite,
     return SY_OK;
 }
 
+static int cmd_render_progressive(int argc, char **argv);
+
+/* `--gl PROVIDER` (raster back-end): appended to the back-end parameters as gl=PROVIDER. */
+static const char *render_gl_params(const char *params, const char *provider, char *buf, size_t len)
+{
+    snprintf(buf, len, "%s%sgl=%s", params ? params : "", params && *params ? "," : "", provider);
+    return buf;
+}
+
 static int cmd_render(int argc, char **argv)
 {
+    if (render_wants_progressive(argc, argv) && !sy_cluster_cli_requested(argc, argv))
+        return cmd_render_progressive(argc, argv);
     const char *scene = NULL, *backend = NULL, *outp = NULL, *camera = NULL, *params = NULL;
+    const char *gl_provider = NULL;
     const char *overlay = NULL, *composite = "depth";
     uint32_t w = 0, h = 0;
     out_opts oo = {0};
     sy_compose_spec spec = {.eye_separation = 0.065f, .zero_parallax = 2.0f};
     sy_error perr = {0};
+    sy_cluster_cli_opts clo = {0};
+    bool clbad = false;
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
@@ -338,6 +611,7 @@ static int cmd_render(int argc, char **argv)
             if (!parse_u32(argv[++i], 1, 16384, &h)) return usage();
         } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
         else if (!strcmp(a, "--params") && has) params = argv[++i];
+        else if (!strcmp(a, "--gl") && has) gl_provider = argv[++i]; /* raster: gl=... parameter */
         else if (!strcmp(a, "--half")) oo.half = true;
         else if (!strcmp(a, "--exposure") && has) oo.png.exposure_stops = strtof(argv[++i], NULL);
         else if (!strcmp(a, "--tonemap") && has) {
@@ -350,13 +624,17 @@ static int cmd_render(int argc, char **argv)
         else if (!strcmp(a, "--zero-parallax") && has) spec.zero_parallax = strtof(argv[++i], NULL);
         else if (!strcmp(a, "--overlay") && has) overlay = argv[++i];
         else if (!strcmp(a, "--composite") && has) composite = argv[++i];
-        else if (a[0] != '-' && !scene) scene = a;
+        else if (sy_cluster_cli_option(argc, argv, &i, &clo, &clbad)) { /* --cluster ... (sy_cluster_cli.c) */
+            if (clbad) return usage();
+        } else if (a[0] != '-' && !scene) scene = a;
         else {
             fprintf(stderr, "sy render: unknown or incomplete option '%s'\n", a);
             return usage();
         }
     }
     if (!scene || !backend || !outp) return usage();
+    char gl_params[256];
+    if (gl_provider) params = render_gl_params(params, gl_provider, gl_params, sizeof gl_params);
     sy_error err = {0};
     if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) { /* before any loading or rendering */
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);
@@ -375,6 +653,7 @@ static int cmd_render(int argc, char **argv)
     else if (!h) h = (uint32_t)lroundf((float)w / aspect);
     if (!w) w = 1;
     if (!h) h = 1;
+    if (ld.is_x3d) fit_x3d_cameras(&ld, w, h); /* X3D fieldOfView is the smaller side's angle */
     sy_context_pool *pool = NULL;
     sy_layer img = {0}, img_right = {0};
     double secs = 0;
@@ -388,9 +667,15 @@ static int cmd_render(int argc, char **argv)
     progress_state ps = {backend, sy_time_now(), 0, sy_is_terminal(2)};
     sy_window_render_opts ro = {.progress = progress_cb, .progress_user = &ps};
     double t0 = sy_time_now();
-    if (r == SY_OK) r = sy_compose_render(ld.scene, pool, &spec, w, h, &ro, &img, &img_right, &err);
+    if (r == SY_OK && clo.cluster) {
+        sy_viewport_desc cvd = {.root = ld.root, .camera = ld.camera, .background = ld.background, .backend = backend,
+                                .params = params, .eye_separation = spec.eye_separation, .zero_parallax = spec.zero_parallax};
+        r = sy_cluster_cli_render(&clo, ld.scene, &cvd, w, h, &img, &secs, &err);
+    } else if (r == SY_OK) r = sy_compose_render(ld.scene, pool, &spec, w, h, &ro, &img, &img_right, &err);
     secs = sy_time_now() - t0;
-    if (r == SY_OK) {
+    if (r == SY_OK && clo.cluster && !img.rgba) {
+        printf("multi-display: %ux%u wall presented by the servers, %s, %.3f s\n", w, h, backend, secs);
+    } else if (r == SY_OK) {
         size_t bad = sy_layer_count_nonfinite(&img) + (img_right.rgba ? sy_layer_count_nonfinite(&img_right) : 0);
         if (bad) fprintf(stderr, "sy render: warning: %zu pixels are not finite\n", bad);
         if (spec.stereo == SY_STEREO_SEPARATE) {
@@ -406,6 +691,96 @@ static int cmd_render(int argc, char **argv)
     }
     sy_layer_destroy(&img);
     sy_layer_destroy(&img_right);
+    sy_context_pool_destroy(pool);
+    loaded_free(&ld);
+    return r == SY_OK ? 0 : fail(&err);
+}
+
+/* `sy render` with a progressive back-end: one mono viewport rendered in passes. */
+static int cmd_render_progressive(int argc, char **argv)
+{
+    const char *scene = NULL, *backend = NULL, *outp = NULL, *camera = NULL, *params = NULL;
+    uint32_t w = 0, h = 0;
+    out_opts oo = {0};
+    pt_opts po = {.env_intensity = 1.0f};
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        bool has = i + 1 < argc;
+        char *end = NULL;
+        if (!strcmp(a, "-b") && has) backend = argv[++i];
+        else if (!strcmp(a, "-o") && has) outp = argv[++i];
+        else if (!strcmp(a, "-w") && has) {
+            if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
+        } else if (!strcmp(a, "-h") && has) {
+            if (!parse_u32(argv[++i], 1, 16384, &h)) return usage();
+        } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
+        else if (!strcmp(a, "--params") && has) params = argv[++i];
+        else if (!strcmp(a, "--half")) oo.half = true;
+        else if (!strcmp(a, "--exposure") && has) oo.png.exposure_stops = strtof(argv[++i], NULL);
+        else if (!strcmp(a, "--tonemap") && has) {
+            const char *t = argv[++i];
+            oo.png.tonemap = !strcmp(t, "aces") ? SY_TONEMAP_ACES : !strcmp(t, "reinhard") ? SY_TONEMAP_REINHARD
+                                                                                           : SY_TONEMAP_CLAMP;
+        } else if (!strcmp(a, "--spp") && has) {
+            if (!parse_u32(argv[++i], 1, 1u << 24, &po.spp)) return usage();
+        } else if (!strcmp(a, "--time") && has) {
+            po.time_budget = strtod(argv[++i], &end);
+            if (*end || !(po.time_budget > 0) || !isfinite(po.time_budget)) return usage();
+        } else if (!strcmp(a, "--aov")) po.aov = true;
+        else if (!strcmp(a, "--env") && has) po.env = argv[++i];
+        else if (!strcmp(a, "--env-intensity") && has) {
+            po.env_intensity = strtof(argv[++i], &end);
+            if (*end || !isfinite(po.env_intensity) || po.env_intensity < 0) return usage();
+        } else if (!strcmp(a, "--background") && has) {
+            if (sscanf(argv[++i], "%f,%f,%f", &po.bg[0], &po.bg[1], &po.bg[2]) != 3 || !isfinite(po.bg[0]) ||
+                !isfinite(po.bg[1]) || !isfinite(po.bg[2]) || po.bg[0] < 0 || po.bg[1] < 0 || po.bg[2] < 0)
+                return usage();
+            po.has_bg = true;
+        } else if (a[0] != '-' && !scene) scene = a;
+        else {
+            fprintf(stderr, "sy render: unknown or incomplete option '%s' (with a progressive back-end)\n", a);
+            return usage();
+        }
+    }
+    if (!scene || !backend || !outp) return usage();
+    sy_error err = {0};
+    if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);
+        return fail(&err);
+    }
+    if (po.aov && !ends_with(outp, ".exr")) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: --aov needs an .exr output", outp);
+        return fail(&err);
+    }
+    loaded ld;
+    if (load(scene, camera, true, &ld, &err) != SY_OK) return fail(&err);
+    float aspect = 1.0f;
+    const sy_node_data *cn = ld.camera.id ? sy_node_get(ld.scene, ld.camera) : NULL;
+    const sy_camera_data *cd = cn ? sy_camera_get(ld.scene, cn->camera) : NULL;
+    if (cd && cd->aspect > 0) aspect = cd->aspect;
+    if (!w && !h) h = 512, w = (uint32_t)lroundf(512 * aspect);
+    else if (!w) w = (uint32_t)lroundf((float)h * aspect);
+    else if (!h) h = (uint32_t)lroundf((float)w / aspect);
+    if (!w) w = 1;
+    if (!h) h = 1;
+    if (ld.is_x3d) fit_x3d_cameras(&ld, w, h); /* X3D fieldOfView is the smaller side's angle */
+    sy_context_pool *pool = NULL;
+    sy_context *ctx = NULL;
+    sy_layer img = {0};
+    double secs = 0;
+    uint64_t samples = 0;
+    sy_result r = sy_context_pool_create(&pool, &err);
+    if (r == SY_OK) r = setup_environment(&ld, &po, &err);
+    if (r == SY_OK) r = render_progressive(&ld, backend, params, w, h, &po, pool, &img, &secs, &samples, &ctx, &err);
+    if (r == SY_OK) {
+        size_t bad = sy_layer_count_nonfinite(&img);
+        if (bad) fprintf(stderr, "sy render: warning: %zu pixels are not finite\n", bad);
+        r = po.aov ? write_aov_exr(outp, ctx, oo.half, &err) : write_image(outp, &img, &oo, &err);
+    }
+    if (r == SY_OK)
+        printf("%s: %ux%u, %s, %llu samples per pixel, %.3f s (%.2f samples/s)\n", outp, w, h, backend,
+               (unsigned long long)samples, secs, secs > 0 ? (double)samples / secs : 0.0);
+    sy_layer_destroy(&img);
     sy_context_pool_destroy(pool);
     loaded_free(&ld);
     return r == SY_OK ? 0 : fail(&err);
@@ -454,6 +829,51 @@ static int cmd_demo(int argc, char **argv)
     return r == SY_OK ? 0 : fail(&err);
 }
 
+#ifdef SY_HAVE_GLFW
+static int cmd_view(int argc, char **argv)
+{
+    const char *scene = NULL, *backend = "whitted", *camera = NULL, *overlay = NULL, *composite = "depth",
+               *shot = NULL;
+    uint32_t w = 960, h = 540, frames = 0;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        bool has = i + 1 < argc;
+        if (!strcmp(a, "-b") && has) backend = argv[++i];
+        else if (!strcmp(a, "-w") && has) {
+            if (!parse_u32(argv[++i], 16, 16384, &w)) return usage();
+        } else if (!strcmp(a, "-h") && has) {
+            if (!parse_u32(argv[++i], 16, 16384, &h)) return usage();
+        } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
+        else if (!strcmp(a, "--overlay") && has) overlay = argv[++i];
+        else if (!strcmp(a, "--composite") && has) composite = argv[++i];
+        else if (!strcmp(a, "--frames") && has) {
+            if (!parse_u32(argv[++i], 1, 1000000, &frames)) return usage();
+        } else if (!strcmp(a, "--screenshot") && has) shot = argv[++i];
+        else if (a[0] != '-' && !scene) scene = a;
+        else return usage();
+    }
+    if (!scene) return usage();
+    sy_error err = {0};
+    if (!sy_mediator_find(backend)) {
+        sy_error_set(&err, SY_ERR_NOT_FOUND, "back-end '%s' is not registered (see sy backends)", backend);
+        return fail(&err);
+    }
+    loaded ld;
+    if (load(scene, camera, true, &ld, &err) != SY_OK) return fail(&err);
+    sy_view_args va = {.scene = ld.scene, .backend = backend, .width = w, .height = h, .frames = frames, .screenshot = shot};
+    va.spec.root = ld.root;
+    va.spec.camera = ld.camera;
+    va.spec.background = ld.background;
+    va.spec.eye_separation = 0.065f;
+    va.spec.zero_parallax = 2.0f;
+    va.spec.backend = backend;
+    sy_result r = overlay ? add_overlay(&ld, overlay, composite, &va.spec, &err) : SY_OK;
+    if (r == SY_OK) r = sy_view_run(&va, &err);
+    loaded_free(&ld);
+    return r == SY_OK ? 0 : fail(&err);
+}
+#endif
+
 static int cmd_backends(void)
 {
     for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
@@ -464,14 +884,87 @@ static int cmd_backends(void)
     return 0;
 }
 
+/* sy bench raster [SCENE] [-w W -h H] [--repeats R] [--params k=v]: default 1280x720 on OSMesa. */
+static int cmd_bench_raster(const char *scene, uint32_t w, uint32_t h, uint32_t repeats, const char *params)
+{
+    sy_error err = {0};
+    loaded ld;
+    if (load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return fail(&err);
+    sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .background = ld.background, .backend = "raster",
+                           .params = params};
+    sy_result r = sy_bench_raster(ld.scene, &vd, scene ? scene : "demo", w == 512 ? 1280 : w, h == 512 ? 720 : h,
+                                  repeats ? repeats : 10, &err);
+    loaded_free(&ld);
+    return r == SY_OK ? 0 : fail(&err);
+}
+
+/* sy bench pathtracer [SCENE] [-w W -h H] [--repeats PASSES]: the Cornell box and DamagedHelmet
+ * (under a uniform grey environment) from ../shared/testdata unless a scene is given. */
+static int cmd_bench_pathtracer(const char *scene, uint32_t w, uint32_t h, uint32_t passes)
+{
+    static const char *const defaults[2] = {"../shared/testdata/cornell/cornell_box.gltf",
+                                            "../shared/testdata/gltf/DamagedHelmet/glTF/DamagedHelmet.gltf"};
+    const char *list[2] = {scene ? scene : defaults[0], scene ? NULL : defaults[1]};
+    sy_error err = {0};
+    printf("sy bench pathtracer: %u threads (all cores), 1 sample per pixel per pass\n", (unsigned)sysconf(_SC_NPROCESSORS_ONLN));
+    for (int i = 0; i < 2 && list[i]; ++i) {
+        loaded ld;
+        if (load(list[i], NULL, true, &ld, &err) != SY_OK) return fail(&err);
+        pt_opts po = {.has_bg = i == 1, .bg = {0.8f, 0.8f, 0.8f}, .env_intensity = 1.0f};
+        sy_result r = setup_environment(&ld, &po, &err);
+        sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .background = ld.background};
+        if (r == SY_OK) r = sy_bench_pathtracer(ld.scene, &vd, list[i], w, h, passes ? passes : 8, &err);
+        loaded_free(&ld);
+        if (r != SY_OK) return fail(&err);
+    }
+    return 0;
+}
+
+/* sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W -h H] [--repeats R] (issue 7):
+ * without SCENE the analytic surrogate at 640x480; with it the path tracer's buffers at the
+ * reference's size (default 256x256). */
+static int cmd_bench_filters(int argc, char **argv)
+{
+    const char *scene = NULL, *sheet = NULL, *reference = NULL;
+    uint32_t w = 0, h = 0, repeats = 5;
+    for (int i = 0; i < argc; ++i) {
+        bool has = i + 1 < argc;
+        if (!strcmp(argv[i], "-w") && has) {
+            if (!parse_u32(argv[++i], 8, 16384, &w)) return usage();
+        } else if (!strcmp(argv[i], "-h") && has) {
+            if (!parse_u32(argv[++i], 8, 16384, &h)) return usage();
+        } else if (!strcmp(argv[i], "--repeats") && has) {
+            if (!parse_u32(argv[++i], 1, 1000, &repeats)) return usage();
+        } else if (!strcmp(argv[i], "--reference") && has) reference = argv[++i];
+        else if (argv[i][0] != '-' && ends_with(argv[i], ".png") && !sheet) sheet = argv[i];
+        else if (argv[i][0] != '-' && !scene) scene = argv[i];
+        else return usage();
+    }
+    sy_error err = {0};
+    if (!scene) return sy_bench_filters(w ? w : 640, h ? h : 480, repeats, sheet, &err) == SY_OK ? 0 : fail(&err);
+    if (!reference) {
+        fprintf(stderr, "sy bench filters %s: --reference REF.exr (the converged image) is required\n", scene);
+        return 2;
+    }
+    loaded ld;
+    if (load(scene, NULL, true, &ld, &err) != SY_OK) return fail(&err);
+    sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .backend = "pathtracer"};
+    sy_result r = sy_bench_filters_scene(ld.scene, &vd, scene, w ? w : 256, h ? h : 256, reference, sheet, &err);
+    loaded_free(&ld);
+    return r == SY_OK ? 0 : fail(&err);
+}
+
 static int cmd_bench(int argc, char **argv)
 {
     if (argc < 1) return usage();
+    if (!strcmp(argv[0], "filters")) return cmd_bench_filters(argc - 1, argv + 1);
+    if (!strcmp(argv[0], "cluster")) return sy_cmd_bench_cluster(argc - 1, argv + 1);
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
-    const char *scene = NULL;
+    const char *scene = NULL, *params = NULL;
     for (int i = 1; i < argc; ++i) {
         bool has = i + 1 < argc;
-        if (!strcmp(argv[i], "--nodes") && has) {
+        if (!strcmp(argv[i], "--params") && has) params = argv[++i]; /* bench raster */
+        else if (!strcmp(argv[i], "--nodes") && has) {
             if (!parse_u32(argv[++i], 1, 1u << 22, &nodes)) return usage();
         } else if (!strcmp(argv[i], "--tris") && has) {
             if (!parse_u32(argv[++i], 12, 1u << 20, &tris)) return usage();
@@ -490,6 +983,11 @@ static int cmd_bench(int argc, char **argv)
         return sy_bench_viewports(w == 512 ? 480 : w, h == 512 ? 270 : h, repeats ? repeats : 5, &err) == SY_OK
                    ? 0
                    : fail(&err);
+    if (!strcmp(argv[0], "raster")) return cmd_bench_raster(scene, w, h, repeats, params);
+    if (!strcmp(argv[0], "pathtracer")) return cmd_bench_pathtracer(scene, w, h, repeats);
+    if (!strcmp(argv[0], "load")) /* SCENE = the glTF sample directory; --tris: generated model (default 1M) */
+        return sy_bench_load(scene ? scene : "../shared/testdata/gltf", tris == 100 ? 1000000 : tris,
+                             repeats ? repeats : 3, &err) == SY_OK ? 0 : fail(&err);
     if (!strcmp(argv[0], "rays")) {
         loaded ld;
         if (load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return fail(&err);
@@ -512,6 +1010,10 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "demo")) return cmd_demo(argc - 2, argv + 2);
     if (!strcmp(cmd, "bench")) return cmd_bench(argc - 2, argv + 2);
     if (!strcmp(cmd, "backends")) return cmd_backends();
+    if (!strcmp(cmd, "serve")) return sy_cmd_serve(argc - 2, argv + 2);
+#ifdef SY_HAVE_GLFW
+    if (!strcmp(cmd, "view")) return cmd_view(argc - 2, argv + 2);
+#endif
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
         usage();
         return 0;

@@ -8,6 +8,7 @@
 
 #include "sy_file.h"
 #include "sy_gltf_shim.h"
+#include "sy_mesh_util.h"
 
 #include <errno.h>
 #include <math.h>
@@ -484,11 +485,11 @@ static sy_result validate_doc(loader *L)
             (r = check_index(L, d->textures[i].sampler, d->sampler_count, true, "textures[%zu]", i, "sampler", "samplers")))
             return r;
     }
-    for (size_t i = 0; i < d->image_count; i++) {
+    for (size_t i = 0; i < d->image_count; i++) { /* a bad image is local: its textures go missing */
         const sy_gltf_shim_image *im = &d->images[i];
         if (!im->pixels) {
-            if (im->uri[0]) return fail(L, SY_ERR_NOT_FOUND, "images[%zu] ('%s'): %s", i, im->uri, im->problem);
-            return fail(L, SY_ERR_PARSE, "images[%zu]: %s", i, im->problem);
+            if (im->uri[0]) warn(L, "images[%zu] ('%s'): %s; textures using it are missing", i, im->uri, im->problem);
+            else warn(L, "images[%zu]: %s; textures using it are missing", i, im->problem);
         }
     }
     for (size_t i = 0; i < d->camera_count; i++) {
@@ -706,6 +707,7 @@ static sy_result get_texture(loader *L, const sy_gltf_shim_texinfo *ti, int role
             return SY_OK;
         }
         const sy_gltf_shim_image *im = &d->images[tex->source];
+        if (!im->pixels) return SY_OK; /* warned in validate_doc */
         sy_result r;
         if (!L->image_blobs[tex->source]) {
             size_t bytes = (size_t)im->width * im->height * im->channels; /* fits: the shim allocated it */
@@ -963,6 +965,23 @@ static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *
         release_primitive(out);
         return r;
     }
+    /* glTF 2.0: without NORMAL the client computes flat normals; a normal map without TANGENT
+     * needs generated tangents (sy_mesh_util: MikkTSpace-style angle-weighted accumulation). */
+    if (!out->normals && (r = sy_prim_make_flat_normals(out, &L->err))) {
+        release_primitive(out);
+        return fail(L, r, "meshes[%zu].primitives[%zu]: flat normals: %s", m, p, L->err.message);
+    }
+    if (!out->tangents && pr->material >= 0 && d->materials[pr->material].normal_texture.index >= 0) {
+        const sy_gltf_shim_texinfo *nt = &d->materials[pr->material].normal_texture;
+        int32_t tc = nt->transform_texcoord >= 0 ? nt->transform_texcoord : nt->texcoord;
+        if (tc != 1) tc = 0;
+        if (!(tc ? out->texcoords1 : out->texcoords0)) {
+            warn(L, "meshes[%zu].primitives[%zu]: normal map without TEXCOORD_%d; tangents not generated", m, p, (int)tc);
+        } else if ((r = sy_prim_generate_tangents(out, (uint32_t)tc, &L->err))) {
+            release_primitive(out);
+            return fail(L, r, "meshes[%zu].primitives[%zu]: tangents: %s", m, p, L->err.message);
+        }
+    }
     out->material = pr->material >= 0 ? L->materials[pr->material] : (sy_material){0};
     *used = true;
     *tris = (uint32_t)tcount;
@@ -1141,6 +1160,47 @@ done:
     return r;
 }
 
+/* The first frame of animations[0]: for every channel targeting node ni's translation, rotation
+ * or scale, the sampler's first output value (the value at its first keyframe; for CUBICSPLINE the
+ * middle element of the first triple) replaces the node's static value. Bad channels are warned
+ * and skipped (local). */
+static sy_result first_frame(loader *L, size_t ni, float t[3], float q[4], float s[3], bool *animated)
+{
+    const sy_gltf_doc *d = L->doc;
+    for (size_t c = 0; c < d->channel_count; c++) {
+        const sy_gltf_shim_channel *ch = &d->channels[c];
+        if (ch->node != (int32_t)ni || ch->path < 0) continue;
+        size_t comps = ch->path == 1 ? 4 : 3;
+        if (ch->output < 0 || (size_t)ch->output >= d->accessor_count) {
+            warn(L, "animations[0].channels[%zu]: invalid sampler output; ignored", c);
+            continue;
+        }
+        const sy_gltf_shim_accessor *a = &d->accessors[ch->output];
+        size_t at = ch->cubic ? 1 : 0;
+        if ((size_t)a->components != comps || a->is_matrix || a->count <= at) {
+            warn(L, "animations[0].channels[%zu]: output accessor %d is not %zu-component with a first value; ignored",
+                 c, (int)ch->output, comps);
+            continue;
+        }
+        float *v;
+        sy_result r = read_floats(L, (size_t)ch->output, comps, &v);
+        if (r) return r;
+        const float *x = v + at * comps;
+        bool finite = true;
+        for (size_t k = 0; k < comps; k++) finite = finite && isfinite(x[k]);
+        if (finite && comps == 4 && !(x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3] > 1e-12f)) finite = false;
+        if (!finite) {
+            warn(L, "animations[0].channels[%zu]: non-finite first value (or zero quaternion); ignored", c);
+        } else {
+            float *dst = ch->path == 0 ? t : ch->path == 1 ? q : s;
+            memcpy(dst, x, comps * sizeof(float));
+            *animated = true;
+        }
+        free(v);
+    }
+    return SY_OK;
+}
+
 static sy_result create_nodes(loader *L, const int32_t *roots, size_t root_count, const char *root_name)
 {
     const sy_gltf_doc *d = L->doc;
@@ -1183,12 +1243,16 @@ static sy_result create_nodes(loader *L, const int32_t *roots, size_t root_count
                 r = context(L, r, where);
                 goto done;
             }
-        } else if (n->translation_count || n->rotation_count || n->scale_count) {
+        } else {
             float t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
             for (size_t k = 0; k < n->translation_count; k++) t[k] = (float)n->translation[k];
             for (size_t k = 0; k < n->rotation_count; k++) q[k] = (float)n->rotation[k];
             for (size_t k = 0; k < n->scale_count; k++) s[k] = (float)n->scale[k];
-            if ((r = set_trs(L, h, t, q, s, where))) goto done;
+            bool animated = false;
+            if ((r = first_frame(L, i, t, q, s, &animated))) goto done;
+            if ((n->translation_count || n->rotation_count || n->scale_count || animated) &&
+                (r = set_trs(L, h, t, q, s, where)))
+                goto done;
         }
         if (n->mesh >= 0 && !n->instancing && (r = sy_node_set_mesh(L->scene, h, L->meshes[n->mesh], &L->err))) {
             r = context(L, r, where);
@@ -1318,7 +1382,9 @@ static sy_result load_doc(loader *L)
         !(L->textures = xcalloc(L, d->texture_count * 2 + 2, sizeof(sy_texture), &r)) ||
         !(L->image_blobs = xcalloc(L, d->image_count + 1, sizeof(sy_blob *), &r)))
         return r;
-    if (d->animation_count) warn(L, "%zu animations ignored", d->animation_count);
+    if (d->animation_count)
+        warn(L, "%zu animation(s): nodes are placed at the first frame of animations[0], the rest is ignored",
+             d->animation_count);
 
     /* dependency order: textures (on demand) + materials, meshes, lights, cameras, nodes */
     for (size_t i = 0; i < d->material_count; i++)

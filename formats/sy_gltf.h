@@ -17,8 +17,10 @@
  * KHR_materials_transmission, KHR_materials_ior, KHR_materials_unlit, KHR_texture_transform;
  * images decoded by stb_image (PNG, JPEG, ...) into 8-bit RGB or RGBA (16-bit images are rounded,
  * grey images expanded to RGBA) with sampler wrap / filter; perspective and orthographic cameras;
- * KHR_lights_punctual; KHR_mesh_quantization; EXT_mesh_gpu_instancing. Skins, morph targets and
- * animations are ignored (one warning each).
+ * KHR_lights_punctual; KHR_mesh_quantization; EXT_mesh_gpu_instancing. Animated nodes are placed
+ * at the first frame of animations[0] (first keyframe value of each translation / rotation / scale
+ * channel); skinned meshes are shown in their bind pose (skins ignored) and morph targets ignored
+ * (one warning each).
  *
  * Untrusted input: the whole document is validated (indices, accessor / bufferView / buffer ranges
  * with checked arithmetic, GLB container, index values, node graph must be a forest, limits,
@@ -26,6 +28,9 @@
  * remains in the scene (objects created so far are destroyed; the scene's pending change set may
  * still list them as created-and-destroyed) and err names the file, the glTF element and the
  * problem, e.g. "Box.gltf: accessors[3]: count 1000000 * stride 12 exceeds bufferView 2 length 768".
+ * An image that is missing, over max_image_pixels or cannot be decoded is local: a warning, and the textures using it are
+ * absent (the rest loads). Primitives without NORMAL get flat normals (de-indexed, as glTF requires);
+ * normal-mapped primitives without TANGENT get generated tangents (sy_mesh_util.h).
  *
  * Ownership: the scene owns every created object. *info_out (if given) holds malloc()ed arrays the
  * caller releases with sy_gltf_info_free (also after a failed load; it is zeroed then).
@@ -46,7 +51,7 @@ typedef struct sy_gltf_options {
     size_t max_file_bytes;      /* .gltf / .glb and every external file; 0 = 2 GiB (max 4 GiB - 1) */
     size_t max_vertices;        /* per primitive; 0 = 1 << 28 */
     size_t max_indices;         /* per primitive, after strip / fan conversion; 0 = 1 << 28 */
-    uint64_t max_image_pixels;  /* width * height per image; 0 = 1 << 26 */
+    uint64_t max_image_pixels;  /* width * height per image (larger ones: missing, warned); 0 = 1 << 26 */
     size_t max_instances;       /* EXT_mesh_gpu_instancing instances per node; 0 = 1 << 20 */
     uint32_t max_json_depth;    /* nesting of JSON arrays / objects; 0 = 64 */
     int32_t scene_index;        /* glTF scene to load; 0 = the file's default (see below) */

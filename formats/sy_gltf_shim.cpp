@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <new>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,7 @@ struct LoadContext {
     tinygltf::Model *model = nullptr;
     sy_result fs_result = SY_OK;   // first file-system failure category
     std::string fs_message;
+    std::map<int, std::string> image_problems; // images that failed to decode (local: missing texture)
 };
 
 // >>file-system callbacks: lookups confined to the glTF's directory, reads size-limited.
@@ -110,14 +112,15 @@ bool load_image(tinygltf::Image *image, const int image_idx, std::string *err, s
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(bytes, int(len), &w, &h, &comp) || w < 1 || h < 1 || comp < 1 || comp > 4) {
         const char *why = stbi_failure_reason();
-        if (err) *err += where + ": cannot decode image (" + std::string(why ? why : "unknown format") + ")\n";
-        return false;
+        ctx->image_problems[image_idx] = "cannot decode image (" + std::string(why ? why : "unknown format") + ")";
+        image->image.clear();
+        return true; // a bad image is local: the texture goes missing with a warning
     }
-    if (uint64_t(w) * uint64_t(h) > ctx->max_image_pixels) {
-        if (err)
-            *err += where + ": image " + std::to_string(w) + "x" + std::to_string(h) + " exceeds the limit of " +
-                    std::to_string(ctx->max_image_pixels) + " pixels\n";
-        return false;
+    if (uint64_t(w) * uint64_t(h) > ctx->max_image_pixels) { // refused before decoding; local like a bad image
+        ctx->image_problems[image_idx] = "image " + std::to_string(w) + "x" + std::to_string(h) +
+                                         " exceeds the limit of " + std::to_string(ctx->max_image_pixels) + " pixels";
+        image->image.clear();
+        return true;
     }
     const int req = comp <= 2 ? 4 : comp; // grey / grey+alpha become RGBA
     const size_t n = size_t(w) * size_t(h) * size_t(req);
@@ -130,8 +133,8 @@ bool load_image(tinygltf::Image *image, const int image_idx, std::string *err, s
         if (!p) {
             image->image.clear();
             const char *why = stbi_failure_reason();
-            if (err) *err += where + ": cannot decode image (" + std::string(why ? why : "unknown") + ")\n";
-            return false;
+            ctx->image_problems[image_idx] = "cannot decode image (" + std::string(why ? why : "unknown") + ")";
+            return true;
         }
         for (size_t i = 0; i < n; i++) image->image[i] = (unsigned char)((uint32_t(p[i]) * 255u + 32767u) / 65535u);
         stbi_image_free(p);
@@ -141,8 +144,8 @@ bool load_image(tinygltf::Image *image, const int image_idx, std::string *err, s
         if (!p) {
             image->image.clear();
             const char *why = stbi_failure_reason();
-            if (err) *err += where + ": cannot decode image (" + std::string(why ? why : "unknown") + ")\n";
-            return false;
+            ctx->image_problems[image_idx] = "cannot decode image (" + std::string(why ? why : "unknown") + ")";
+            return true;
         }
         memcpy(image->image.data(), p, n);
         stbi_image_free(p);
@@ -264,6 +267,7 @@ std::string one_line(std::string s)
 // The document: the C view plus the C++ storage it points into (doc.internal points back here).
 struct sy_gltf_shim_impl {
     sy_gltf_doc doc = {};
+    std::map<int, std::string> image_problems;
     tinygltf::Model model;
     std::vector<sy_gltf_shim_buffer> buffers;
     std::vector<sy_gltf_shim_view> views;
@@ -280,6 +284,7 @@ struct sy_gltf_shim_impl {
     std::vector<sy_gltf_shim_node> nodes;
     std::vector<std::vector<int32_t>> scene_nodes;
     std::vector<sy_gltf_shim_scene> scenes;
+    std::vector<sy_gltf_shim_channel> channels;
     std::vector<const char *> ext_required;
     std::string warnings;
 };
@@ -370,6 +375,7 @@ static void fill_doc(sy_gltf_shim_impl *d)
     for (const tinygltf::Sampler &s : m.samplers) d->samplers.push_back({s.minFilter, s.magFilter, s.wrapS, s.wrapT});
     for (const tinygltf::Image &im : m.images) {
         sy_gltf_shim_image c = {};
+        auto problem = d->image_problems.find(int(d->images.size()));
         c.name = im.name.c_str();
         c.uri = im.uri.c_str();
         if (!im.image.empty() && im.width > 0 && im.height > 0 && (im.component == 3 || im.component == 4) &&
@@ -381,8 +387,9 @@ static void fill_doc(sy_gltf_shim_impl *d)
             c.source_bits = uint32_t(im.bits);
             c.problem = "";
         } else {
-            c.problem = im.uri.empty() ? "image data could not be loaded"
-                                       : "external image file not found or unreadable";
+            c.problem = problem != d->image_problems.end() ? problem->second.c_str()
+                        : im.uri.empty()                  ? "image data could not be loaded"
+                                                          : "external image file not found or unreadable";
         }
         d->images.push_back(c);
     }
@@ -467,6 +474,22 @@ static void fill_doc(sy_gltf_shim_impl *d)
     c.extensions_required_count = d->ext_required.size();
     c.skin_count = m.skins.size();
     c.animation_count = m.animations.size();
+    if (!m.animations.empty()) {
+        const tinygltf::Animation &a = m.animations[0];
+        for (const tinygltf::AnimationChannel &ch : a.channels) {
+            sy_gltf_shim_channel k = {};
+            k.node = ch.target_node;
+            k.path = ch.target_path == "translation" ? 0 : ch.target_path == "rotation" ? 1 : ch.target_path == "scale" ? 2 : -1;
+            k.output = -1;
+            if (ch.sampler >= 0 && size_t(ch.sampler) < a.samplers.size()) {
+                k.output = a.samplers[size_t(ch.sampler)].output;
+                k.cubic = a.samplers[size_t(ch.sampler)].interpolation == "CUBICSPLINE";
+            }
+            d->channels.push_back(k);
+        }
+    }
+    c.channels = d->channels.data();
+    c.channel_count = d->channels.size();
     c.warnings = d->warnings.c_str();
     c.internal = d;
 }
@@ -512,6 +535,7 @@ extern "C" sy_result sy_gltf_shim_parse(const uint8_t *bytes, size_t size, bool 
             return sy_error_set(err, code, "%s", msg.c_str());
         }
         d->warnings = one_line(twarn);
+        d->image_problems = std::move(ctx.image_problems);
         fill_doc(d);
         *out = &d->doc;
         return SY_OK;
@@ -530,4 +554,41 @@ extern "C" sy_result sy_gltf_shim_parse(const uint8_t *bytes, size_t size, bool 
 extern "C" void sy_gltf_shim_free(sy_gltf_doc *doc)
 {
     if (doc) delete static_cast<sy_gltf_shim_impl *>(doc->internal);
+}
+
+extern "C" sy_result sy_gltf_shim_parse_only(const uint8_t *bytes, size_t size, bool binary, const char *base_dir,
+                                             const sy_gltf_shim_limits *limits, sy_error *err)
+{
+    if (!bytes || !limits || !base_dir) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "invalid argument");
+    if (size > UINT_MAX) return sy_error_set(err, SY_ERR_LIMIT, "file larger than 4 GiB");
+    try {
+        tinygltf::Model model;
+        LoadContext ctx;
+        ctx.max_file_bytes = limits->max_file_bytes;
+        ctx.max_image_pixels = limits->max_image_pixels;
+        ctx.model = &model;
+        std::string base = base_dir;
+        if (!base.empty()) ctx.prefix = base.back() == '/' ? base : base + "/";
+        tinygltf::TinyGLTF loader;
+        tinygltf::FsCallbacks fs = {};
+        fs.FileExists = fs_file_exists;
+        fs.ExpandFilePath = fs_expand;
+        fs.ReadWholeFile = fs_read;
+        fs.WriteWholeFile = fs_write;
+        fs.user_data = &ctx;
+        loader.SetFsCallbacks(fs);
+        loader.SetImageLoader(load_image, &ctx);
+        std::string terr, twarn;
+        bool ok = binary ? loader.LoadBinaryFromMemory(&model, &terr, &twarn, bytes, unsigned(size), base)
+                         : loader.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char *>(bytes),
+                                                      unsigned(size), base);
+        if (!ok) return sy_error_set(err, ctx.fs_result != SY_OK ? ctx.fs_result : SY_ERR_PARSE, "%s", one_line(terr).c_str());
+        return SY_OK;
+    } catch (const std::bad_alloc &) {
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory while parsing glTF");
+    } catch (const std::exception &e) {
+        return sy_error_set(err, SY_ERR_PARSE, "%s", e.what());
+    } catch (...) {
+        return sy_error_set(err, SY_ERR_PARSE, "unknown exception while parsing glTF");
+    }
 }

@@ -164,6 +164,15 @@ typedef struct sy_gltf_shim_scene {
     size_t node_count;
 } sy_gltf_shim_scene;
 
+/* One channel of animations[0] (the first frame of the first animation is what a static load
+ * shows). Indices are untrusted. */
+typedef struct sy_gltf_shim_channel {
+    int32_t node;   /* target node, -1 none */
+    int32_t path;   /* 0 translation, 1 rotation, 2 scale, -1 anything else (weights) */
+    int32_t output; /* sampler output accessor, -1 when the sampler index is invalid */
+    int32_t cubic;  /* CUBICSPLINE: outputs are (in-tangent, value, out-tangent) triples */
+} sy_gltf_shim_channel;
+
 typedef struct sy_gltf_doc {
     const sy_gltf_shim_buffer *buffers;     size_t buffer_count;
     const sy_gltf_shim_view *views;         size_t view_count;
@@ -180,6 +189,7 @@ typedef struct sy_gltf_doc {
     int32_t default_scene; /* -1: none given */
     const char *const *extensions_required; size_t extensions_required_count;
     size_t skin_count, animation_count;
+    const sy_gltf_shim_channel *channels;   size_t channel_count; /* of animations[0] */
     const char *warnings; /* tinygltf's warning text, "" when none */
     void *internal;       /* private to the shim */
 } sy_gltf_doc;
@@ -193,6 +203,12 @@ sy_result sy_gltf_shim_parse(const uint8_t *bytes, size_t size, bool binary, con
                              const sy_gltf_shim_limits *limits, sy_gltf_doc **out, sy_error *err);
 
 void sy_gltf_shim_free(sy_gltf_doc *doc);
+
+/* Benchmark aid (`sy bench load`): runs tinygltf's parser exactly as sy_gltf_shim_parse does
+ * (same file callbacks, buffers loaded, images decoded under the same limits) and discards the
+ * result without building the C view, so callers can time tinygltf alone. Same result codes. */
+sy_result sy_gltf_shim_parse_only(const uint8_t *bytes, size_t size, bool binary, const char *base_dir,
+                                  const sy_gltf_shim_limits *limits, sy_error *err);
 
 #ifdef __cplusplus
 }

@@ -99,6 +99,7 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len);
 typedef struct sy_rt_stats {
     uint32_t meshes, instances, materials, textures, lights;
     uint32_t area_light_triangles; /* emissive triangles in the committed area-light list */
+    uint64_t version; /* bumped by every commit that published a change (accumulation restarts) */
 } sy_rt_stats;
 void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out);
 
@@ -276,6 +277,17 @@ typedef struct sy_rt_background {
 sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg, char *err,
                                   size_t err_len);
 
+/* Environment light: an equirectangular (latitude-longitude) texture times intensity, seen by rays
+ * that leave the scene instead of the background colour (alpha 1). Direction d (unit, world) maps
+ * to u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, so the image centre is seen looking
+ * down -Z and row 0 is straight up (+Y). The PATHTRACER importance-samples it (piecewise-constant
+ * distribution over the texels, luminance x sin(theta)); WHITTED shows it on misses.
+ * A zero texture handle removes the environment (the background colour applies again). The
+ * texture must stay alive while it is set (a destroyed texture renders as no environment).
+ * intensity must be finite and >= 0. Takes effect at the next commit. */
+sy_rt_result sy_rt_set_environment(sy_rt_device *dev, sy_rt_texture texture, float intensity, char *err,
+                                   size_t err_len);
+
 /* >>render */
 
 typedef enum sy_rt_projection {
@@ -298,7 +310,8 @@ typedef struct sy_rt_camera {
 typedef enum sy_rt_integrator {
     SY_RT_INTEGRATOR_PRIMARY = 1, /* primary rays only, eye-light shading (benchmarks, debugging) */
     SY_RT_INTEGRATOR_WHITTED = 2, /* direct light + hard shadows + mirror reflection/refraction */
-    /* reserved: 3 = path tracer, 4 = coverage */
+    SY_RT_INTEGRATOR_PATHTRACER = 3, /* progressive path tracer (needs a sy_rt_accum, see below) */
+    /* reserved: 4 = coverage */
     SY_RT_INTEGRATOR_MAX_ENUM = 0x7fffffff
 } sy_rt_integrator;
 
@@ -309,15 +322,22 @@ typedef struct sy_rt_progress {
 } sy_rt_progress;
 typedef bool (*sy_rt_progress_fn)(const sy_rt_progress *progress, void *user_data);
 
+typedef struct sy_rt_accum sy_rt_accum;
+
 typedef struct sy_rt_render_desc {
     sy_rt_integrator integrator;
     uint32_t image_width, image_height; /* the full image the camera window maps onto */
     uint32_t x, y, width, height;       /* sub-rectangle to fill (row 0 = top) */
-    uint32_t max_depth;                 /* recursion depth for reflection/refraction; 0 = 8 */
+    uint32_t max_depth;                 /* WHITTED: recursion depth for reflection/refraction;
+                                         * PATHTRACER: most bounces (scattering events) per path;
+                                         * 0 = 8 */
     uint32_t area_light_samples;        /* fixed light samples per pixel; 0 = 16 */
     uint32_t seed;                      /* decorrelates sample patterns; same seed = same image */
     sy_rt_progress_fn progress;         /* optional */
     void *progress_user_data;
+    /* PATHTRACER only: */
+    sy_rt_accum *accum;                 /* required: accumulation of this rectangle (width x height) */
+    uint32_t samples;                   /* samples per pixel to add in this call; 0 = 1 */
 } sy_rt_render_desc;
 
 /* Renders the sub-rectangle. rgba: width*height*4 floats (required); depth: width*height floats
@@ -327,6 +347,52 @@ typedef struct sy_rt_render_desc {
 sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera,
                           const sy_rt_render_desc *desc, float *rgba, float *depth, char *err,
                           size_t err_len);
+
+/* >>progressive accumulation (PATHTRACER)
+ *
+ * A sy_rt_accum holds the running per-pixel estimates of one rectangle: colour (RGBA mean),
+ * Welford running variance, and the feature buffers (AOVs). sy_rt_render with the PATHTRACER
+ * integrator adds desc->samples samples per pixel to desc->accum (sample indices continue from
+ * sy_rt_accum_samples), then, when rgba/depth are given, writes the current estimate into them
+ * (rgba may be NULL for this integrator). Every sample of pixel (x, y) with index i depends only on
+ * the scene, the camera, the full-image coordinates, i, max_depth and seed, and samples are added
+ * in index order, so N calls of 1 sample equal 1 call of N samples bit for bit, and sub-rectangles
+ * stitch exactly. Restarting (after a visible scene change) is sy_rt_accum_reset.
+ *
+ * Sampling: Sobol (0,2)-sequence in 4-dimensional padded sets, Owen-scrambled per pixel with the
+ * hash-based nested uniform scramble (Burley 2020); pixel samples are uniform over the pixel (box
+ * filter of 1 pixel). A sample whose radiance is not finite (NaN/Inf) is dropped and counted; the
+ * buffers never receive a non-finite value.
+ *
+ * Ownership: the caller owns the accum; it is not tied to a device. Thread-safety: an accum is used
+ * by one render call at a time. */
+sy_rt_result sy_rt_accum_create(uint32_t width, uint32_t height, sy_rt_accum **out, char *err, size_t err_len);
+void sy_rt_accum_destroy(sy_rt_accum *accum); /* NULL is a no-op */
+void sy_rt_accum_reset(sy_rt_accum *accum);   /* back to 0 samples */
+uint32_t sy_rt_accum_samples(const sy_rt_accum *accum);
+void sy_rt_accum_size(const sy_rt_accum *accum, uint32_t *width, uint32_t *height);
+/* Samples dropped since the last reset because their radiance was NaN or infinite. */
+uint64_t sy_rt_accum_nonfinite(const sy_rt_accum *accum);
+/* Rays (closest-hit and shadow) traced by the last render call into this accum (benchmarks). */
+uint64_t sy_rt_accum_last_rays(const sy_rt_accum *accum);
+
+/* Feature buffers. Row 0 is the top row of the rectangle; all values are finite except DEPTH
+ * (+INFINITY where no sample hit anything). */
+typedef enum sy_rt_aov {
+    SY_RT_AOV_COLOR = 0,    /* 4 ch: mean RGBA radiance, premultiplied (alpha = coverage) */
+    SY_RT_AOV_VARIANCE = 1, /* 3 ch: variance of the colour mean per channel, s^2 / n (Welford) */
+    SY_RT_AOV_ALBEDO = 2,   /* 3 ch: base colour at the first non-specular hit (0 on a miss) */
+    SY_RT_AOV_NORMAL = 3,   /* 3 ch: world shading normal there, facing the camera (mean) */
+    SY_RT_AOV_DEPTH = 4,    /* 1 ch: mean camera-axis distance of the first hit */
+    SY_RT_AOV_DIRECT = 5,   /* 3 ch: emission seen directly + light reaching the first hit directly */
+    SY_RT_AOV_INDIRECT = 6, /* 3 ch: the rest; DIRECT + INDIRECT = COLOR (RGB) */
+    SY_RT_AOV_COUNT = 7,
+    SY_RT_AOV_MAX_ENUM = 0x7fffffff
+} sy_rt_aov;
+uint32_t sy_rt_aov_channels(sy_rt_aov aov); /* 0 for an unknown value */
+const char *sy_rt_aov_name(sy_rt_aov aov);  /* "color", "variance", ... ; NULL if unknown */
+/* Copies one feature buffer into out (width * height * channels floats, interleaved). */
+sy_rt_result sy_rt_accum_read(const sy_rt_accum *accum, sy_rt_aov aov, float *out, char *err, size_t err_len);
 
 #ifdef __cplusplus
 }

@@ -212,6 +212,7 @@ void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out)
     out->textures = dev->textures.live;
     out->lights = dev->lights.live;
     out->area_light_triangles = dev->area_count;
+    out->version = dev->version;
 }
 
 sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg, char *err, size_t err_len)

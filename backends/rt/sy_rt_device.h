@@ -109,6 +109,7 @@ struct sy_rt_device {
     sy_rt_background background_staged, background;
 
     bool dirty;          /* anything changed since the last commit */
+    uint64_t version;    /* commits that published a change */
     bool top_dirty;      /* top scene needs rtcCommitScene */
     bool area_dirty;     /* area-light list needs a rebuild */
     bool filters_dirty;  /* alpha filters may need (un)installing */
@@ -121,6 +122,16 @@ struct sy_rt_device {
     float *area_cdf;     /* area_count + 1 entries, cdf[0] = 0, cdf[n] = 1 */
     uint32_t area_count;
     float area_power;    /* total emitted power proxy (luminance * area * sides) */
+    /* Vose alias table over the same triangles and weights (path tracer: O(1) selection) */
+    float *area_alias_prob;
+    uint32_t *area_alias_idx;
+
+    /* environment (sy_rt_set_environment): staged values and the committed importance-sampling
+     * distribution (sy_rt_lights.h) */
+    sy_rt_texture env_texture_staged, env_texture;
+    float env_intensity_staged, env_intensity;
+    bool env_dirty;
+    struct sy_rt_env_dist *env_dist;
 
     sy_rt_material_data default_material;
     float srgb_lut[256]; /* sRGB 8-bit -> linear */

@@ -2,6 +2,7 @@
  * arbitrary image-plane window, so off-axis stereo frusta are the same code), and the tile
  * scheduler that runs an integrator over the requested rectangle on all threads. */
 #include "sy_rt_render.h"
+#include "sy_rt_pathtracer.h"
 #include "sy_rt_primary.h"
 #include "sy_rt_whitted.h"
 
@@ -29,7 +30,8 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
         (cam->far_clip > 0.0f && cam->far_clip <= cam->near_clip))
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: clip range near %g far %g is invalid (0 <= near < far, far 0 = infinite)",
                     (double)cam->near_clip, (double)cam->far_clip);
-    if (d->integrator != SY_RT_INTEGRATOR_PRIMARY && d->integrator != SY_RT_INTEGRATOR_WHITTED)
+    if (d->integrator != SY_RT_INTEGRATOR_PRIMARY && d->integrator != SY_RT_INTEGRATOR_WHITTED &&
+        d->integrator != SY_RT_INTEGRATOR_PATHTRACER)
         return FAIL(SY_RT_ERROR_UNSUPPORTED, "render: integrator %d is not implemented", (int)d->integrator);
     if (d->image_width == 0 || d->image_height == 0)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: image size %ux%u is empty", d->image_width, d->image_height);
@@ -40,7 +42,7 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
     size_t n;
     if (!sy_rt_size_mul(d->width, d->height, &n) || !sy_rt_size_mul(n, 4u * sizeof(float), &n))
         return FAIL(SY_RT_ERROR_LIMIT, "render: %ux%u rectangle overflows size_t", d->width, d->height);
-    if (!rgba) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: rgba is NULL");
+    if (!rgba && d->integrator != SY_RT_INTEGRATOR_PATHTRACER) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: rgba is NULL");
 
     const float *m = cam->camera_to_world;
     f->dev = dev;
@@ -71,9 +73,14 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
 
 void sy_rt_frame_ray(const sy_rt_frame *f, uint32_t px, uint32_t py, struct RTCRay *ray, float *axial)
 {
+    sy_rt_frame_ray_at(f, (float)px + 0.5f, (float)py + 0.5f, ray, axial);
+}
+
+void sy_rt_frame_ray_at(const sy_rt_frame *f, float fx, float fy, struct RTCRay *ray, float *axial)
+{
     const float *w = f->window;
-    float sx = w[0] + ((float)px + 0.5f) / (float)f->image_width * (w[1] - w[0]);
-    float sy = w[3] - ((float)py + 0.5f) / (float)f->image_height * (w[3] - w[2]);
+    float sx = w[0] + fx / (float)f->image_width * (w[1] - w[0]);
+    float sy = w[3] - fy / (float)f->image_height * (w[3] - w[2]);
     sy_rt_v3 org, dir;
     if (f->projection == SY_RT_PROJECTION_PERSPECTIVE) {
         org = f->cam_pos;
@@ -178,6 +185,7 @@ sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera, const s
     sy_rt_frame f;
     sy_rt_result r = sy_rt_frame_init(&f, dev, camera, desc, rgba, depth, err, err_len);
     if (r != SY_RT_OK) return r;
+    if (desc->integrator == SY_RT_INTEGRATOR_PATHTRACER) return sy_rt_pathtracer_render(&f, desc, err, err_len);
     sy_rt_tile_fn fn = desc->integrator == SY_RT_INTEGRATOR_PRIMARY ? sy_rt_primary_tile : sy_rt_whitted_tile;
     return sy_rt_run_tiles(&f, fn, NULL, desc->progress, desc->progress_user_data, err, err_len);
 }

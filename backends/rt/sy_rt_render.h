@@ -30,6 +30,9 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
  * `*axial` receives the viewing-axis distance per unit of t (depth = t * axial), and tnear/tfar
  * implement the near/far clip planes. */
 void sy_rt_frame_ray(const sy_rt_frame *f, uint32_t px, uint32_t py, struct RTCRay *ray, float *axial);
+/* The same through an arbitrary full-image point (fx, fy) (pixel (x, y) covers [x, x+1) x [y, y+1));
+ * sy_rt_frame_ray(px, py) is sy_rt_frame_ray_at(px + 0.5, py + 0.5). */
+void sy_rt_frame_ray_at(const sy_rt_frame *f, float fx, float fy, struct RTCRay *ray, float *axial);
 
 /* Renders one tile: pixels [x0, x1) x [y0, y1) in full-image coordinates. */
 typedef void (*sy_rt_tile_fn)(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1);

@@ -2,6 +2,7 @@
  * geometry in the top-level scene), materials, punctual lights, and sy_rt_commit, which publishes
  * staged changes: alpha filters, top-level BVH, area-light list and punctual-light array. */
 #include "sy_rt_scene.h"
+#include "sy_rt_lights.h"
 #include "sy_rt_surface.h"
 
 #include <stdlib.h>
@@ -575,6 +576,7 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev, char *err, size_t err
     dev->area_cdf = NULL;
     dev->area_count = 0;
     dev->area_power = 0.0f;
+    (void)sy_rt_alias_build(dev, NULL, 0); /* frees the old table */
     if (n == 0) return SY_RT_OK;
     if (n > UINT32_MAX - 1u) return FAIL(SY_RT_ERROR_LIMIT, "commit: %zu emissive triangles exceed the limit", n);
     dev->area = malloc(n * sizeof *dev->area);
@@ -628,7 +630,17 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev, char *err, size_t err
     }
     for (uint32_t i = 0; i <= count; ++i) dev->area_cdf[i] = (float)(cdf[i] / total);
     dev->area_cdf[count] = 1.0f;
+    /* path tracer: alias table over the same weights (cdf[] becomes the weights in place) */
+    for (uint32_t i = 0; i < count; ++i) cdf[i] = cdf[i + 1] - cdf[i];
+    bool alias_ok = sy_rt_alias_build(dev, cdf, count);
     free(cdf);
+    if (!alias_ok) {
+        free(dev->area);
+        free(dev->area_cdf);
+        dev->area = NULL;
+        dev->area_cdf = NULL;
+        return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "commit: cannot allocate the area-light alias table (%u triangles)", count);
+    }
     dev->area_count = count;
     dev->area_power = (float)total;
     return SY_RT_OK;
@@ -685,7 +697,12 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len)
         dev->punctual_dirty = false;
     }
     dev->background = dev->background_staged;
+    if (dev->env_dirty) {
+        if ((r = sy_rt_env_rebuild(dev, err, err_len)) != SY_RT_OK) return r;
+        dev->env_dirty = false;
+    }
     dev->dirty = false;
+    dev->version++;
     return SY_RT_OK;
 }
 
@@ -705,6 +722,11 @@ void sy_rt_scene_release_all(sy_rt_device *dev)
     free(dev->punctual);
     free(dev->area);
     free(dev->area_cdf);
+    free(dev->area_alias_prob);
+    free(dev->area_alias_idx);
+    dev->area_alias_prob = NULL;
+    dev->area_alias_idx = NULL;
+    sy_rt_env_free(dev);
     dev->top_map = NULL;
     dev->punctual = NULL;
     dev->area = NULL;

@@ -16,6 +16,7 @@
  * hash of the full-image pixel, the seed and the recursion depth. The pattern never changes between
  * frames, so the image is deterministic. */
 #include "sy_rt_whitted.h"
+#include "sy_rt_lights.h"
 #include "sy_rt_surface.h"
 
 #define INV_PI 0.31830988618f
@@ -266,6 +267,14 @@ static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float
         if (bg->mode == SY_RT_BACKGROUND_COLOR) {
             r.rgb = v3_load(bg->color);
             r.a = 1.0f;
+        }
+        if (c->dev->env_dist) { /* an environment map replaces the colour */
+            sy_rt_env env;
+            sy_rt_env_get(c->dev, &env);
+            if (env.mode == 2) {
+                r.rgb = sy_rt_env_eval(&env, v3_normalize(dir));
+                r.a = 1.0f;
+            }
         }
         if (t_hit) *t_hit = INFINITY;
         return r;

@@ -53,7 +53,21 @@ typedef struct light_m {
 typedef struct bg_m {
     uint32_t id;
     float color[4];
+    uint32_t environment; /* core texture id, 0 = none */
+    float intensity;
 } bg_m;
+
+/* Path tracer: one accumulation per distinct request (camera, sizes, rectangle, background, seed);
+ * a few are kept so that viewports sharing this context (stereo eyes, tiles) do not evict each
+ * other. A slot restarts when the device published a change since its last pass. */
+#define ACCUM_SLOTS 4
+typedef struct accum_slot {
+    sy_rt_accum *acc;
+    sy_camera_view camera;
+    uint32_t full_w, full_h, rect[4], bg, seed;
+    uint64_t version;  /* device version the accumulation belongs to */
+    uint64_t last_use;
+} accum_slot;
 
 typedef struct placement {
     sy_mat4 world;
@@ -81,6 +95,7 @@ typedef struct rt_state {
     uint32_t root;
     uint32_t integrator;
     uint32_t max_depth, light_samples;
+    float specular; /* "specular" parameter: KHR_materials_specular factor given to every material */
     tex_m *tex;
     uint32_t tex_cap;
     mat_m *mat;
@@ -101,6 +116,9 @@ typedef struct rt_state {
     bool needs_commit;
     sy_mediator_rt_counters counters;
     uint64_t frames_rendered;
+    accum_slot slots[ACCUM_SLOTS]; /* path tracer only */
+    int last_slot;                 /* slot of the last render, -1 = none */
+    uint64_t use_clock;
 } rt_state;
 
 static bool grow(void **arr, uint32_t *cap, size_t elem, uint32_t index)
@@ -180,6 +198,7 @@ static sy_result material_upload(rt_state *st, mat_m *m, sy_error *err)
     d.normal_scale = m->d.normal_texture.scale;
     d.transmission = m->d.transmission;
     d.ior = m->d.ior >= 1.0f ? m->d.ior : 1.5f;
+    d.specular = st->specular;
     d.alpha_mode = (sy_rt_alpha_mode)m->d.alpha_mode;
     d.alpha_cutoff = m->d.alpha_cutoff;
     d.double_sided = m->d.double_sided != 0;
@@ -221,6 +240,8 @@ static sy_result texture_upload(rt_state *st, tex_m *t, sy_error *err)
     };
     sy_rt_result r = sy_rt_texture_create(st->dev, &d, &t->rt, e, sizeof e);
     if (r != SY_RT_OK) return rt_fail(err, r, "texture", e);
+    const bg_m *cb = LOOKUP(st, bg, bg_cap, st->current_bg);
+    if (cb && cb->environment == t->id) st->bg_applied = false; /* new back-end texture for the environment */
     /* materials referring to this texture get the new back-end handle */
     for (uint32_t i = 0; i < st->mat_cap; ++i) {
         mat_m *m = &st->mat[i];
@@ -581,9 +602,17 @@ static sy_result apply_entry(rt_state *st, const sy_change *e, sy_error *err)
             b = &st->bg[idx];
             memset(b, 0, sizeof *b);
             b->id = e->id;
-            memcpy(b->color, ((const sy_background_data *)sy_object_defaults(SY_TYPE_BACKGROUND))->color, sizeof b->color);
+            const sy_background_data *def = sy_object_defaults(SY_TYPE_BACKGROUND);
+            memcpy(b->color, def->color, sizeof b->color);
+            b->environment = def->environment.id;
+            b->intensity = def->intensity;
         }
-        if (e->mask & SY_BIT(SY_BACKGROUND_COLOR)) memcpy(b->color, ((const sy_background_data *)e->data)->color, sizeof b->color);
+        const sy_background_data *bd = e->data;
+        if (e->mask & SY_BIT(SY_BACKGROUND_COLOR)) memcpy(b->color, bd->color, sizeof b->color);
+        if (e->mask & SY_BIT(SY_BACKGROUND_ENVIRONMENT)) b->environment = bd->environment.id;
+        if (e->mask & SY_BIT(SY_BACKGROUND_INTENSITY)) b->intensity = bd->intensity;
+        if (!(e->mask & (SY_BIT(SY_BACKGROUND_COLOR) | SY_BIT(SY_BACKGROUND_ENVIRONMENT) | SY_BIT(SY_BACKGROUND_INTENSITY))))
+            return SY_OK; /* name or attachments only: nothing visible */
         if (st->current_bg == e->id) st->bg_applied = false;
         return SY_OK;
     }
@@ -781,6 +810,66 @@ sy_result sy_mediator_rt_bench_rays(void *state, const sy_camera_view *view, uin
     return SY_OK;
 }
 
+/* >>pathtracer accumulation */
+static bool same_view(const sy_camera_view *a, const sy_camera_view *b)
+{
+    return !memcmp(a->camera_to_world.m, b->camera_to_world.m, sizeof a->camera_to_world.m) &&
+           a->projection == b->projection && !memcmp(a->window, b->window, sizeof a->window) && a->znear == b->znear &&
+           a->zfar == b->zfar;
+}
+
+/* Picks (or recycles) the accumulation slot of a request and restarts it when the scene, the
+ * camera or anything else about the request changed; sets st->last_slot. */
+static sy_result pt_slot(rt_state *st, const sy_render_request *req, sy_error *err)
+{
+    sy_rt_stats ds;
+    sy_rt_device_stats(st->dev, &ds);
+    const uint32_t rect[4] = {req->rect_x, req->rect_y, req->rect_w, req->rect_h};
+    int found = -1, lru = 0;
+    for (int i = 0; i < ACCUM_SLOTS; ++i) {
+        accum_slot *a = &st->slots[i];
+        if (a->acc && a->full_w == req->full_width && a->full_h == req->full_height && !memcmp(a->rect, rect, sizeof rect) &&
+            a->bg == req->background_id && a->seed == req->seed && same_view(&a->camera, &req->camera)) {
+            found = i;
+            break;
+        }
+        if (!a->acc || (st->slots[lru].acc && a->last_use < st->slots[lru].last_use)) lru = i;
+    }
+    accum_slot *a;
+    if (found >= 0) {
+        a = &st->slots[found];
+        if (a->version != ds.version) { /* something visible changed since the last pass */
+            sy_rt_accum_reset(a->acc);
+            st->counters.accum_restarts++;
+        }
+    } else {
+        found = lru;
+        a = &st->slots[found];
+        uint32_t w = 0, h = 0;
+        sy_rt_accum_size(a->acc, &w, &h);
+        if (!a->acc || w != req->rect_w || h != req->rect_h) {
+            char e[ERRLEN];
+            sy_rt_accum_destroy(a->acc);
+            a->acc = NULL;
+            sy_rt_result r = sy_rt_accum_create(req->rect_w, req->rect_h, &a->acc, e, sizeof e);
+            if (r != SY_RT_OK) return rt_fail(err, r, "accumulation buffer", e);
+        } else {
+            sy_rt_accum_reset(a->acc);
+        }
+        if (st->last_slot >= 0) st->counters.accum_restarts++;
+        a->camera = req->camera;
+        a->full_w = req->full_width;
+        a->full_h = req->full_height;
+        memcpy(a->rect, rect, sizeof rect);
+        a->bg = req->background_id;
+        a->seed = req->seed;
+    }
+    a->version = ds.version;
+    a->last_use = ++st->use_clock;
+    st->last_slot = found;
+    return SY_OK;
+}
+
 static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     rt_state *st = state;
@@ -788,12 +877,14 @@ static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *
     /* background: the request names it; the device keeps the last one applied */
     if (!st->bg_applied || st->current_bg != req->background_id) {
         const bg_m *b = LOOKUP(st, bg, bg_cap, req->background_id);
-        sy_rt_background bg = {SY_RT_BACKGROUND_NONE, {0, 0, 0}};
+        sy_rt_background bg = {.mode = SY_RT_BACKGROUND_NONE};
         if (b && b->color[3] > 0.0f) {
             bg.mode = SY_RT_BACKGROUND_COLOR;
             memcpy(bg.color, b->color, sizeof bg.color);
         }
         sy_rt_result r = sy_rt_set_background(st->dev, &bg, e, sizeof e);
+        if (r == SY_RT_OK) r = sy_rt_set_environment(st->dev, b ? rt_texture_of(st, b->environment) : (sy_rt_texture){0},
+                                                     b ? b->intensity : 1.0f, e, sizeof e);
         if (r == SY_RT_OK) r = sy_rt_commit(st->dev, e, sizeof e);
         if (r != SY_RT_OK) return rt_fail(err, r, "background", e);
         st->current_bg = req->background_id;
@@ -816,8 +907,15 @@ static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *
         .progress = req->progress ? progress_cb : NULL,
         .progress_user_data = &pb,
     };
+    if (st->integrator == SY_RT_INTEGRATOR_PATHTRACER) {
+        sy_result pr = pt_slot(st, req, err);
+        if (pr != SY_OK) return pr;
+        d.accum = st->slots[st->last_slot].acc;
+        d.samples = req->sample_count ? req->sample_count : 1u;
+    }
     sy_rt_result r = sy_rt_render(st->dev, &cam, &d, layer->rgba, layer->depth, e, sizeof e);
     if (r != SY_RT_OK) return rt_fail(err, r, "render", e);
+    if (d.accum) st->counters.last_render_rays = sy_rt_accum_last_rays(d.accum);
     st->frames_rendered++;
     return SY_OK;
 }
@@ -835,6 +933,7 @@ static void rt_destroy(void *state)
     }
     for (uint32_t i = 0; i < st->light_cap; ++i) free(st->light[i].users);
     for (uint32_t i = 0; i < st->tex_cap; ++i) sy_blob_release(st->tex[i].pixels);
+    for (int i = 0; i < ACCUM_SLOTS; ++i) sy_rt_accum_destroy(st->slots[i].acc);
     sy_rt_device_destroy(st->dev);
     free(st->tex);
     free(st->mat);
@@ -851,10 +950,13 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
 {
     *state_out = NULL;
     long max_depth, light_samples, threads;
+    double specular;
     sy_result r;
-    if ((r = sy_params_get_int(args->params, "max_depth", 8, 1, 64, &max_depth, err)) ||
+    if ((r = sy_params_get_int(args->params, "max_depth", integrator == SY_RT_INTEGRATOR_PATHTRACER ? 64 : 8, 1,
+                               integrator == SY_RT_INTEGRATOR_PATHTRACER ? 1024 : 64, &max_depth, err)) ||
         (r = sy_params_get_int(args->params, "light_samples", 16, 1, 1024, &light_samples, err)) ||
-        (r = sy_params_get_int(args->params, "threads", 0, 0, 1024, &threads, err)))
+        (r = sy_params_get_int(args->params, "threads", 0, 0, 1024, &threads, err)) ||
+        (r = sy_params_get_float(args->params, "specular", 1.0, 0.0, 1.0, &specular, err)))
         return r;
     rt_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt mediator: out of memory");
@@ -869,6 +971,8 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     st->integrator = integrator;
     st->max_depth = (uint32_t)max_depth;
     st->light_samples = (uint32_t)light_samples;
+    st->specular = (float)specular;
+    st->last_slot = -1;
     *state_out = st;
     return SY_OK;
 }
@@ -882,7 +986,63 @@ static void rt_stats(void *state, sy_mediator_stats *out)
 {
     rt_state *st = state;
     out->samples = st->frames_rendered ? 1 : 0;
+    if (st->integrator == SY_RT_INTEGRATOR_PATHTRACER)
+        out->samples = st->last_slot >= 0 ? sy_rt_accum_samples(st->slots[st->last_slot].acc) : 0;
 }
+
+static sy_result pathtracer_create(const sy_mediator_create_args *args, void **state_out, sy_error *err)
+{
+    return rt_create_common(args, SY_RT_INTEGRATOR_PATHTRACER, state_out, err);
+}
+
+static const sy_mediator_class pathtracer_class = {
+    .name = "pathtracer",
+    .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES,
+    .create = pathtracer_create,
+    .destroy = rt_destroy,
+    .sync = rt_sync,
+    .render = rt_render,
+    .stats = rt_stats,
+};
+
+const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtracer_class; }
+
+sy_result sy_mediator_rt_aovs_get(void *state, sy_mediator_rt_aovs *out, sy_error *err)
+{
+    rt_state *st = state;
+    memset(out, 0, sizeof *out);
+    if (st->integrator != SY_RT_INTEGRATOR_PATHTRACER || st->last_slot < 0)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "AOVs: this context has no path-traced render yet");
+    const sy_rt_accum *acc = st->slots[st->last_slot].acc;
+    sy_rt_accum_size(acc, &out->width, &out->height);
+    out->samples = sy_rt_accum_samples(acc);
+    out->nonfinite_samples = sy_rt_accum_nonfinite(acc);
+    size_t px = (size_t)out->width * out->height;
+    for (int k = 0; k < SY_RT_AOV_COUNT; ++k) {
+        float *buf = malloc(px * sy_rt_aov_channels((sy_rt_aov)k) * sizeof(float));
+        char e[ERRLEN];
+        if (!buf) {
+            sy_mediator_rt_aovs_free(out);
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "AOVs: out of memory (%ux%u)", out->width, out->height);
+        }
+        out->planes[k] = buf;
+        sy_rt_result r = sy_rt_accum_read(acc, (sy_rt_aov)k, buf, e, sizeof e);
+        if (r != SY_RT_OK) {
+            sy_mediator_rt_aovs_free(out);
+            return rt_fail(err, r, "AOVs", e);
+        }
+    }
+    return SY_OK;
+}
+
+void sy_mediator_rt_aovs_free(sy_mediator_rt_aovs *a)
+{
+    for (int k = 0; k < SY_MEDIATOR_RT_AOV_COUNT; ++k) free(a->planes[k]);
+    memset(a, 0, sizeof *a);
+}
+
+const char *sy_mediator_rt_aov_name(uint32_t index) { return sy_rt_aov_name((sy_rt_aov)index); }
+uint32_t sy_mediator_rt_aov_channels(uint32_t index) { return sy_rt_aov_channels((sy_rt_aov)index); }
 
 static const sy_mediator_class whitted_class = {
     .name = "whitted",

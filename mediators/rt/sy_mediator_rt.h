@@ -1,15 +1,17 @@
 /* sy_mediator_rt.h — the mediator between the core scene and the Embree back-end (backends/rt).
  *
- * One Embree scene adapter serving several integrators: the "whitted" class registered here (and
- * later "pathtracer" and "coverage") share this adapter; only the integrator chosen at render
+ * One Embree scene adapter serving several integrators: the "whitted" and "pathtracer" classes
+ * registered here (and later "coverage") share this adapter; only the integrator chosen at render
  * time differs. The adapter keeps a mirror of the node graph built from change lists, flattens it
  * (one world transform per geometry placement; a DAG node reached along k paths gets k placements),
  * bakes geometry of nodes flagged SY_NODE_STATIC whose mesh is used once into the top-level BVH,
  * instances everything else (shared meshes are one BLAS), and syncs incrementally: a transform
  * change re-places the node's subtree only (rtcSetGeometryTransform, no BLAS rebuild).
  *
- * Parameters (sy_params): max_depth (1..64, default 8), light_samples (1..1024, default 16),
- * threads (0 = all cores).
+ * Parameters (sy_params): max_depth (1..64, default 8; pathtracer 1..1024, default 64),
+ * light_samples (1..1024, default 16), threads (0 = all cores), specular (0..1, default 1: the
+ * KHR_materials_specular factor of every material; 1 is glTF's dielectric F0 = 0.04 layer, 0 makes
+ * dielectrics pure Lambertian, e.g. to match a Lambertian reference render).
  *
  * Ownership/thread-safety: as any mediator (see core/sy_mediator.h). */
 #ifndef SY_MEDIATOR_RT_H
@@ -23,12 +25,40 @@ extern "C" {
 
 /* The Whitted ray tracer class ("whitted"). Static storage. */
 const sy_mediator_class *sy_mediator_rt_whitted_class(void);
+/* The progressive path tracer class ("pathtracer"; caps PROGRESSIVE | DEPTH | TILES) on the same
+ * adapter. Each render adds req->sample_count samples per pixel (0 = 1) to an accumulation kept per
+ * distinct request (camera view, image size, rectangle, background, seed; up to 4 at once, least
+ * recently used recycled). The accumulation restarts when the request's camera differs from the
+ * last one or when a sync changed anything the back-end sees (transforms of placed geometry or
+ * lights, meshes, materials, textures, lights, the background); changes nobody sees (attachments,
+ * names, a camera no request uses) keep it. sy_mediator_stats.samples = samples so far of the last
+ * render. req->sample_first is ignored: samples are numbered by the accumulation itself, and a
+ * different req->seed gives an independent stream (cooperative cluster rendering relies on that).
+ * Parameters: max_depth (bounces, 1..1024, default 64), specular, threads. */
+const sy_mediator_class *sy_mediator_rt_pathtracer_class(void);
+
+/* Feature buffers of the last path-traced render of a context (its rectangle), as separate planes
+ * indexed like the back-end's sy_rt_aov: 0 colour RGBA (4 channels), 1 variance of the colour mean
+ * RGB (Welford), 2 albedo and 3 normal of the first non-specular hit, 4 depth (1), 5 direct and
+ * 6 indirect radiance (3 each). Ownership: the caller frees with sy_mediator_rt_aovs_free. */
+#define SY_MEDIATOR_RT_AOV_COUNT 7
+typedef struct sy_mediator_rt_aovs {
+    uint32_t width, height, samples;
+    uint64_t nonfinite_samples; /* samples replaced by zero because they were NaN/Inf */
+    float *planes[SY_MEDIATOR_RT_AOV_COUNT]; /* width*height*channels floats each, row 0 = top */
+} sy_mediator_rt_aovs;
+sy_result sy_mediator_rt_aovs_get(void *state, sy_mediator_rt_aovs *out, sy_error *err);
+void sy_mediator_rt_aovs_free(sy_mediator_rt_aovs *aovs);
+const char *sy_mediator_rt_aov_name(uint32_t index);   /* "color", "variance", "albedo", ... */
+uint32_t sy_mediator_rt_aov_channels(uint32_t index);  /* 4, 3, 3, 3, 1, 3, 3 */
 
 /* Counters of the adapter, for tests and benchmarks. */
 typedef struct sy_mediator_rt_counters {
     uint32_t instances, baked_instances, meshes, materials, textures, lights;
     uint32_t last_sync_placements; /* node placements recomputed by the last sync */
     uint32_t last_sync_entries;    /* change entries handled by the last sync */
+    uint32_t accum_restarts;       /* path tracer: accumulations restarted (not counting the first) */
+    uint64_t last_render_rays;     /* path tracer: rays traced by the last render */
 } sy_mediator_rt_counters;
 /* state is the mediator state of a context whose class is one of this adapter's classes. */
 void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out);

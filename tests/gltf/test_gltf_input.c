@@ -189,6 +189,25 @@ static void bad_json_case(const char *name, const char *json_fmt, sy_result code
     expect_fail(name, path, NULL, code, substr);
 }
 
+static void local_image_case(const char *name, const char *json_fmt, const char *substr)
+{
+    char path[512], fname[128];
+    std_buffer b = standard_buffer();
+    snprintf(fname, sizeof fname, "%s.gltf", name);
+    write_gltf(fname, json_fmt, &b, sizeof b, path);
+    sy_scene *s = NULL;
+    if (sy_scene_create(&s, NULL) != SY_OK) exit(1);
+    sy_gltf_info info;
+    sy_error e = {0};
+    sy_result r = sy_gltf_load(path, s, NULL, &info, &e);
+    bool warned = false;
+    for (uint32_t k = 0; r == SY_OK && k < info.stored_warning_count; k++) warned |= strstr(info.warnings[k], substr) != NULL;
+    CHECK(r == SY_OK && warned, "%s: loads with a warning naming '%s' (%s)", name, substr, e.message);
+    CHECK(sy_scene_count(s, SY_TYPE_TEXTURE) == 0 && sy_scene_count(s, SY_TYPE_MESH) > 0, "%s: no texture, mesh loaded", name);
+    sy_gltf_info_free(&info);
+    sy_scene_destroy(s);
+}
+
 static void test_bad_json(void)
 {
     bad_json_case("truncated_json", "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}", SY_ERR_PARSE, "invalid glTF");
@@ -253,10 +272,11 @@ static void test_bad_json(void)
                   SY_ERR_PARSE, "alphaMode 'SOMETIMES'");
     bad_json_case("bad_camera", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, SCENES, ",\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":-1,\"znear\":0.1}}]"),
                   SY_ERR_PARSE, "cameras[0]: yfov");
-    bad_json_case("missing_image", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, SCENES, ",\"images\":[{\"uri\":\"missing.png\"}]"),
-                  SY_ERR_NOT_FOUND, "images[0] ('missing.png')");
-    bad_json_case("corrupt_image", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, SCENES, ",\"images\":[{\"uri\":\"data:image/png;base64,AAAAAAAAAAAAAAAA\"}]"),
-                  SY_ERR_PARSE, "images[0]: cannot decode image");
+    /* a bad image is local (issue 6): the load succeeds, its textures go missing with a warning */
+    local_image_case("missing_image", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, SCENES, ",\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"missing.png\"}]"),
+                     "images[0] ('missing.png')");
+    local_image_case("corrupt_image", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, SCENES, ",\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,AAAAAAAAAAAAAAAA\"}]"),
+                     "images[0]: cannot decode image");
     bad_json_case("image_view_range", DOC(BUF, "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6},{\"buffer\":0,\"byteOffset\":40,\"byteLength\":4000}]", ACCS, MESHES, MATS, NODES, SCENES, ",\"images\":[{\"bufferView\":2,\"mimeType\":\"image/png\"}]"),
                   SY_ERR_PARSE, "exceeds buffer 0 length 44");
     bad_json_case("missing_buffer", "{" ASSET ",\"buffers\":[{\"byteLength\":44,\"uri\":\"missing.bin\"}]}", SY_ERR_NOT_FOUND, "missing.bin");
@@ -291,7 +311,19 @@ static void test_bad_data(void)
     write_gltf("image_limit.gltf", json, &b, sizeof b, path);
     opt = (sy_gltf_options){0};
     opt.max_image_pixels = 3;
-    expect_fail("max_image_pixels", path, &opt, SY_ERR_LIMIT, "image 2x2 exceeds the limit of 3 pixels");
+    { /* an image over the limit is refused before decoding and is local: a missing texture + warning */
+        sy_scene *s = NULL;
+        if (sy_scene_create(&s, NULL) != SY_OK) exit(1);
+        sy_gltf_info info;
+        sy_error e = {0};
+        sy_result r = sy_gltf_load(path, s, &opt, &info, &e);
+        bool warned = false;
+        for (uint32_t k = 0; r == SY_OK && k < info.stored_warning_count; k++)
+            warned |= strstr(info.warnings[k], "image 2x2 exceeds the limit of 3 pixels") != NULL;
+        CHECK(r == SY_OK && warned, "max_image_pixels: loads with a warning (%s)", e.message);
+        sy_gltf_info_free(&info);
+        sy_scene_destroy(s);
+    }
 
     sprintf(path, "%s/does_not_exist.gltf", g_dir);
     expect_fail("missing_file", path, NULL, SY_ERR_NOT_FOUND, "does_not_exist.gltf");
@@ -358,6 +390,36 @@ static void test_valid(void)
     char path[512];
     sy_scene *s = NULL;
 
+    /* animations[0]: a static load places nodes at the first frame (LINEAR: first output value;
+     * CUBICSPLINE: the value of the first (in-tangent, value, out-tangent) triple) */
+    {
+        float data[2 + 6 + 12] = {0, 1, 1, 2, 3, 4, 5, 6, /* cubic scale: */ 9, 9, 9, 2, 2, 2, 9, 9, 9, 0, 0, 0};
+        const char *fmt = "{" ASSET ",\"buffers\":[{\"byteLength\":80,\"uri\":\"%s\"}],"
+                          "\"bufferViews\":[{\"buffer\":0,\"byteLength\":80}],"
+                          "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},"
+                          "{\"bufferView\":0,\"byteOffset\":8,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"},"
+                          "{\"bufferView\":0,\"byteOffset\":32,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"}],"
+                          "\"nodes\":[{\"name\":\"moved\",\"translation\":[7,7,7]}],"
+                          "\"animations\":[{\"samplers\":[{\"input\":0,\"output\":1},{\"input\":0,\"output\":2,\"interpolation\":\"CUBICSPLINE\"}],"
+                          "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}},"
+                          "{\"sampler\":1,\"target\":{\"node\":0,\"path\":\"scale\"}}]}]}";
+        write_gltf("anim.gltf", fmt, data, sizeof data, path);
+        outcome o = run(path, NULL, &s);
+        CHECK(o.r == SY_OK, "anim.gltf: %s", o.err.message);
+        if (o.r == SY_OK) {
+            const sy_node_data *nd = NULL;
+            for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id)) {
+                const sy_node_data *x = sy_node_get(s, (sy_node){id});
+                if (x->name && !strcmp(x->name, "moved")) nd = x;
+            }
+            CHECK(nd && nd->transform.translation[0] == 1 && nd->transform.translation[2] == 3,
+                  "first frame translation (1, 2, 3), not the static (7, 7, 7)");
+            CHECK(nd && nd->transform.scale[0] == 2 && nd->transform.scale[2] == 2, "CUBICSPLINE first value (2, 2, 2)");
+        }
+        sy_scene_destroy(s);
+        s = NULL;
+    }
+
     /* strip and fan over 4 non-indexed vertices, plus a sparse POSITION accessor without bufferView */
     {
         float pos[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
@@ -392,8 +454,13 @@ static void test_valid(void)
                     continue;
                 }
                 const uint32_t *want = !strcmp(m->name, "strip") ? want_strip : want_fan;
-                CHECK(p->indices && sy_blob_size(p->indices) == 6 * sizeof(uint32_t), "%s: 2 triangles", m->name);
-                if (p->indices) CHECK(!memcmp(sy_blob_data(p->indices), want, 24), "%s: winding", m->name);
+                /* no NORMAL: flat normals, so the triangles are de-indexed (3 own vertices each) */
+                CHECK(!p->indices && sy_primitive_vertex_count(p) == 6 && p->normals, "%s: 2 flat-shaded triangles",
+                      m->name);
+                const float *f = blob_f(p->positions), *n = blob_f(p->normals);
+                for (int k = 0; f && k < 6 && sy_primitive_vertex_count(p) == 6; k++)
+                    CHECK(!memcmp(f + 3 * k, pos + 3 * want[k], 12), "%s: winding, corner %d", m->name, k);
+                if (n) CHECK(fabsf(n[2]) == 1.0f && n[5] == n[2] && fabsf(n[17]) == 1.0f, "%s: flat normals along z", m->name);
             }
         }
         sy_scene_destroy(s);

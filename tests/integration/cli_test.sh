@@ -7,6 +7,8 @@
 #     output file nor temporary file left behind
 #   - sy bench sync / sy bench rays on small sizes: exit 0 and their result lines (no thresholds)
 #   - sy demo -o DIR -w 64 -h 36: demo_whitted.png / .exr written
+#   - -b pathtracer: --spp with --aov (EXR with feature channels), --time; a non-EXR --env fails
+#     naming the file
 #   - --stereo sbs / tb / anaglyph / separate: output sizes and per-eye files; bad stereo parameters
 #     and overlays (negative separation, zero parallax 0, unknown mode, missing file, unknown
 #     back-end) fail naming the problem and write nothing
@@ -199,6 +201,18 @@ if [ -f "$CORNELL" ]; then
 else
     missing="$missing $CORNELL"
 fi
+
+# ---------------------------------------------------------------- path tracer (issue 3), demo scene
+grep -q '^pathtracer depth progressive tiles' "$TMP/backends.out" || fail "sy backends does not list pathtracer"
+mkdir -p "$TMP/pt" "$TMP/o_ptenv"
+run pt_spp "$SY" render demo -b pathtracer --spp 2 -w 32 -h 24 --aov -o "$TMP/pt/pt.exr"
+[ "$rc" -eq 0 ] && magic "$TMP/pt/pt.exr" 762f3101 && grep -q '2 samples per pixel' "$TMP/pt_spp.out" &&
+    grep -aq 'albedo.R' "$TMP/pt/pt.exr" && grep -aq 'indirect.B' "$TMP/pt/pt.exr" ||
+    fail "pathtracer --spp 2 --aov: status $rc, $(cat "$TMP/pt_spp.err")"
+run pt_time "$SY" render demo -b pathtracer --time 0.3 -w 16 -h 16 --background 0.5,0.5,0.5 -o "$TMP/pt/pt.png"
+[ "$rc" -eq 0 ] && magic "$TMP/pt/pt.png" 89504e47 || fail "pathtracer --time: status $rc, $(cat "$TMP/pt_time.err")"
+expect_error pt_env bad.gltf "$TMP/o_ptenv" "$SY" render demo -b pathtracer --spp 1 -w 8 -h 8 \
+    --env "$TMP/in/bad.gltf" -o "$TMP/o_ptenv/x.exr"
 
 if [ "$fails" -ne 0 ]; then
     echo "integration_cli: $fails failure(s)" >&2

@@ -1,0 +1,429 @@
+/* sy_view.c — the interactive viewer: GLFW input/display thread + a render thread that owns the
+ * scene (see sy_view.h). */
+#include "sy_view.h"
+
+#include "sy_png.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GL/gl.h>
+#include <GLFW/glfw3.h>
+
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct orbit {
+    float target[3];
+    float yaw, pitch, dist;
+} orbit;
+
+typedef struct viewer {
+    const sy_view_args *args;
+    sy_node cam_node; /* the viewer's own top-level camera node */
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    /* input thread -> render thread (under mu) */
+    sy_mat4 cam;
+    uint64_t req_version;
+    uint32_t backend; /* index into the registry */
+    bool overlay;
+    uint32_t stereo;
+    uint32_t w, h;
+    bool quit;
+    /* render thread -> input thread (under mu) */
+    uint8_t *img;
+    uint32_t img_w, img_h;
+    uint64_t img_version;
+    double frame_ms, sync_ms;
+    uint64_t spp;
+    char status[160];
+    sy_error error;
+    bool failed;
+} viewer;
+
+/* >>camera maths */
+static void orbit_matrix(const orbit *o, sy_mat4 *m)
+{
+    float cp = cosf(o->pitch), back[3] = {cp * sinf(o->yaw), sinf(o->pitch), cp * cosf(o->yaw)};
+    float pos[3] = {o->target[0] + back[0] * o->dist, o->target[1] + back[1] * o->dist, o->target[2] + back[2] * o->dist};
+    float x[3] = {back[2], 0.0f, -back[0]}; /* up x z */
+    float xl = sqrtf(x[0] * x[0] + x[2] * x[2]);
+    if (xl < 1e-6f) x[0] = 1.0f, x[2] = 0.0f, xl = 1.0f;
+    x[0] /= xl, x[2] /= xl;
+    float y[3] = {back[1] * x[2] - back[2] * x[1], back[2] * x[0] - back[0] * x[2], back[0] * x[1] - back[1] * x[0]};
+    sy_mat4 r = {{x[0], x[1], x[2], 0, y[0], y[1], y[2], 0, back[0], back[1], back[2], 0, pos[0], pos[1], pos[2], 1}};
+    *m = r;
+}
+
+static void orbit_from_matrix(const sy_mat4 *m, const sy_bounds *b, orbit *o)
+{
+    float pos[3] = {m->m[12], m->m[13], m->m[14]}, back[3] = {m->m[8], m->m[9], m->m[10]};
+    float bl = sqrtf(back[0] * back[0] + back[1] * back[1] + back[2] * back[2]);
+    for (int i = 0; i < 3; ++i) back[i] = bl > 0 ? back[i] / bl : (i == 2);
+    float d = 1.0f;
+    if (!sy_bounds_is_empty(b)) {
+        float c[3], along = 0;
+        for (int i = 0; i < 3; ++i) c[i] = 0.5f * (b->min[i] + b->max[i]), along -= (c[i] - pos[i]) * back[i];
+        if (along > 1e-3f) d = along;
+    }
+    o->dist = d;
+    for (int i = 0; i < 3; ++i) o->target[i] = pos[i] - back[i] * d;
+    o->pitch = asinf(back[1] < -1 ? -1 : back[1] > 1 ? 1 : back[1]);
+    o->yaw = atan2f(back[0], back[2]);
+}
+
+/* >>render thread */
+static void *render_main(void *p)
+{
+    viewer *v = p;
+    const sy_view_args *a = v->args;
+    sy_context_pool *pool = NULL;
+    sy_error err = {0};
+    if (sy_context_pool_create(&pool, &err) != SY_OK) goto fail_unlocked;
+    uint64_t seen = 0;
+    sy_mat4 cam_applied;
+    memset(&cam_applied, 0, sizeof cam_applied);
+    bool refine = false;
+    for (;;) {
+        pthread_mutex_lock(&v->mu);
+        while (!v->quit && seen == v->req_version && !refine) pthread_cond_wait(&v->cv, &v->mu);
+        if (v->quit) {
+            pthread_mutex_unlock(&v->mu);
+            break;
+        }
+        seen = v->req_version;
+        sy_mat4 cam = v->cam;
+        uint32_t bi = v->backend, stereo = v->stereo, w = v->w, h = v->h;
+        bool overlay = v->overlay;
+        pthread_mutex_unlock(&v->mu);
+
+        const sy_mediator_class *cls = sy_mediator_at(bi);
+        if (!cls) cls = sy_mediator_at(0);
+        if (!sy_mat4_equal(&cam, &cam_applied)) {
+            if (sy_node_set_matrix(a->scene, v->cam_node, &cam, &err) != SY_OK ||
+                sy_scene_commit(a->scene, NULL, &err) != SY_OK)
+                goto fail_unlocked;
+            cam_applied = cam;
+        }
+        sy_compose_spec spec = a->spec;
+        spec.backend = cls->name;
+        spec.params = NULL;
+        spec.camera = v->cam_node;
+        spec.has_overlay = a->spec.has_overlay && overlay;
+        spec.stereo = stereo;
+        uint32_t ew = stereo == SY_STEREO_SBS ? (w / 2 ? w / 2 : 1) : w;
+        sy_layer img = {0}, right = {0};
+        double t0 = sy_time_now();
+        sy_window_render_opts ro = {.sample_count = 1};
+        sy_result r = sy_compose_render(a->scene, pool, &spec, ew, h, &ro, &img, &right, &err);
+        double ms = (sy_time_now() - t0) * 1e3;
+        sy_layer_destroy(&right);
+        if (r != SY_OK) {
+            /* a back-end that fails is reported; the viewer keeps running with the others */
+            pthread_mutex_lock(&v->mu);
+            snprintf(v->status, sizeof v->status, "%s failed: %.100s", cls->name, err.message);
+            v->img_version++;
+            pthread_mutex_unlock(&v->mu);
+            refine = false;
+            continue;
+        }
+        sy_post_desc post = {.enabled = true, .tonemap = SY_TONEMAP_ACES, .srgb = true};
+        sy_layer_post_apply(&img, &post);
+        size_t n = (size_t)img.width * img.height;
+        uint8_t *bytes = malloc(n * 4);
+        if (bytes)
+            for (size_t i = 0; i < n * 4; ++i) {
+                float x = img.rgba[i];
+                if ((i & 3) != 3 && img.rgba[(i | 3)] > 0.0f) x /= img.rgba[(i | 3)]; /* straight for display */
+                bytes[i] = (uint8_t)(x <= 0.0f ? 0 : x >= 1.0f ? 255 : (int)(x * 255.0f + 0.5f));
+            }
+        sy_context *ctx = NULL;
+        sy_mediator_stats st = {0};
+        if (sy_context_pool_get(pool, a->scene, cls->name, NULL, a->spec.root.id, &ctx, &err) == SY_OK)
+            sy_context_stats(ctx, &st);
+        pthread_mutex_lock(&v->mu);
+        free(v->img);
+        v->img = bytes;
+        v->img_w = bytes ? img.width : 0;
+        v->img_h = bytes ? img.height : 0;
+        v->frame_ms = ms;
+        v->sync_ms = st.last_sync_seconds * 1e3;
+        v->spp = st.samples;
+        snprintf(v->status, sizeof v->status, "%s", cls->name);
+        v->img_version++;
+        pthread_mutex_unlock(&v->mu);
+        sy_layer_destroy(&img);
+        /* progressive back-ends keep refining a resting mono view */
+        refine = (cls->caps & SY_CAP_PROGRESSIVE) && stereo == SY_STEREO_NONE && st.samples < 65536;
+    }
+    sy_context_pool_destroy(pool);
+    return NULL;
+fail_unlocked:
+    pthread_mutex_lock(&v->mu);
+    v->error = err;
+    v->failed = true;
+    v->img_version++;
+    pthread_mutex_unlock(&v->mu);
+    sy_context_pool_destroy(pool);
+    return NULL;
+}
+
+/* >>input */
+typedef struct input {
+    viewer *v;
+    orbit o, home;
+    double mx, my;
+    int drag; /* 0 none, 1 orbit, 2 pan */
+    bool changed;
+} input;
+
+static void post_request(viewer *v, const input *in)
+{
+    pthread_mutex_lock(&v->mu);
+    orbit_matrix(&in->o, &v->cam);
+    v->req_version++;
+    pthread_cond_signal(&v->cv);
+    pthread_mutex_unlock(&v->mu);
+}
+
+static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
+{
+    (void)scancode, (void)mods;
+    input *in = glfwGetWindowUserPointer(w);
+    viewer *v = in->v;
+    if (action != GLFW_PRESS) return;
+    if (key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(w, GLFW_TRUE);
+    else if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && (uint32_t)(key - GLFW_KEY_1) < sy_mediator_count()) {
+        pthread_mutex_lock(&v->mu);
+        v->backend = (uint32_t)(key - GLFW_KEY_1);
+        v->req_version++;
+        pthread_cond_signal(&v->cv);
+        pthread_mutex_unlock(&v->mu);
+    } else if (key == GLFW_KEY_O || key == GLFW_KEY_T) {
+        pthread_mutex_lock(&v->mu);
+        if (key == GLFW_KEY_O) v->overlay = !v->overlay;
+        else v->stereo = v->stereo == SY_STEREO_NONE ? SY_STEREO_SBS : v->stereo == SY_STEREO_SBS ? SY_STEREO_ANAGLYPH
+                                                                                                   : SY_STEREO_NONE;
+        v->req_version++;
+        pthread_cond_signal(&v->cv);
+        pthread_mutex_unlock(&v->mu);
+    } else if (key == GLFW_KEY_R) {
+        in->o = in->home;
+        in->changed = true;
+    }
+}
+
+static void on_button(GLFWwindow *w, int button, int action, int mods)
+{
+    (void)mods;
+    input *in = glfwGetWindowUserPointer(w);
+    glfwGetCursorPos(w, &in->mx, &in->my);
+    if (action == GLFW_RELEASE) in->drag = 0;
+    else in->drag = button == GLFW_MOUSE_BUTTON_LEFT ? 1 : 2;
+}
+
+static void on_cursor(GLFWwindow *w, double x, double y)
+{
+    input *in = glfwGetWindowUserPointer(w);
+    double dx = x - in->mx, dy = y - in->my;
+    in->mx = x, in->my = y;
+    if (!in->drag) return;
+    if (in->drag == 1) {
+        in->o.yaw -= (float)dx * 0.008f;
+        in->o.pitch += (float)dy * 0.008f;
+        if (in->o.pitch > 1.55f) in->o.pitch = 1.55f;
+        if (in->o.pitch < -1.55f) in->o.pitch = -1.55f;
+    } else {
+        sy_mat4 m;
+        orbit_matrix(&in->o, &m);
+        float k = in->o.dist * 0.0015f;
+        for (int i = 0; i < 3; ++i) in->o.target[i] += (-(float)dx * m.m[i] + (float)dy * m.m[4 + i]) * k;
+    }
+    in->changed = true;
+}
+
+static void on_scroll(GLFWwindow *w, double dx, double dy)
+{
+    (void)dx;
+    input *in = glfwGetWindowUserPointer(w);
+    in->o.dist *= powf(0.9f, (float)dy);
+    if (in->o.dist < 1e-3f) in->o.dist = 1e-3f;
+    in->changed = true;
+}
+
+static void fly(GLFWwindow *w, input *in, float dt)
+{
+    sy_mat4 m;
+    orbit_matrix(&in->o, &m);
+    float speed = in->o.dist * 0.8f * dt, mv[3] = {0, 0, 0};
+    if (glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) mv[2] -= 1;
+    if (glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS) mv[2] += 1;
+    if (glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS) mv[0] -= 1;
+    if (glfwGetKey(w, GLFW_KEY_D) == GLFW_PRESS) mv[0] += 1;
+    if (glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS) mv[1] += 1;
+    if (glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS) mv[1] -= 1;
+    if (mv[0] == 0 && mv[1] == 0 && mv[2] == 0) return;
+    for (int i = 0; i < 3; ++i)
+        in->o.target[i] += speed * (mv[0] * m.m[i] + mv[2] * m.m[8 + i]) + speed * mv[1] * (i == 1 ? 1.0f : 0.0f);
+    in->changed = true;
+}
+
+static sy_result write_screenshot(const char *path, int w, int h, sy_error *err)
+{
+    size_t n = (size_t)w * h;
+    uint8_t *px = malloc(n * 4);
+    float *f = malloc(n * 4 * sizeof(float));
+    sy_result r = SY_OK;
+    if (!px || !f) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "screenshot: out of memory");
+    if (r == SY_OK) {
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadBuffer(GL_BACK);
+        glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        for (int y = 0; y < h; ++y) /* GL rows are bottom-up; the window shows sRGB bytes */
+            for (int x = 0; x < w * 4; ++x) {
+                float b = px[(size_t)(h - 1 - y) * w * 4 + x] / 255.0f;
+                f[(size_t)y * w * 4 + x] = (x & 3) == 3 ? 1.0f : sy_srgb_decode(b);
+            }
+        r = sy_png_write(path, w, h, f, NULL, err);
+    }
+    free(px);
+    free(f);
+    return r;
+}
+
+sy_result sy_view_run(const sy_view_args *args, sy_error *err)
+{
+    if (!glfwInit()) {
+        const char *desc = NULL;
+        glfwGetError(&desc);
+        return sy_error_set(err, SY_ERR_BACKEND, "view: GLFW could not start (%s); is there a display? try xvfb-run",
+                            desc ? desc : "no reason given");
+    }
+    GLFWwindow *win = glfwCreateWindow((int)args->width, (int)args->height, "sy view", NULL, NULL);
+    if (!win) {
+        const char *desc = NULL;
+        glfwGetError(&desc);
+        glfwTerminate();
+        return sy_error_set(err, SY_ERR_BACKEND, "view: cannot open a window: %s", desc ? desc : "unknown reason");
+    }
+    glfwMakeContextCurrent(win);
+    glfwSwapInterval(1);
+
+    viewer v;
+    memset(&v, 0, sizeof v);
+    v.args = args;
+    pthread_mutex_init(&v.mu, NULL);
+    pthread_cond_init(&v.cv, NULL);
+    for (uint32_t i = 0; i < sy_mediator_count(); ++i)
+        if (!strcmp(sy_mediator_at(i)->name, args->backend)) v.backend = i;
+    v.overlay = true;
+
+    /* the viewer's own camera node: same camera object, top level, world = local */
+    sy_result r = SY_OK;
+    input in = {.v = &v};
+    sy_mat4 world = sy_mat4_identity();
+    const sy_node_data *cn = args->spec.camera.id ? sy_node_get(args->scene, args->spec.camera) : NULL;
+    sy_bounds b;
+    if (sy_node_world_bounds(args->scene, args->spec.root, &b, NULL) != SY_OK) b = sy_scene_world_bounds(args->scene);
+    if (cn) sy_node_world_matrix(args->scene, args->spec.camera, &world, NULL);
+    else world = sy_camera_view_frame_bounds(&b, (float)args->width / (float)args->height).camera_to_world;
+    if ((r = sy_node_create(args->scene, "viewer camera", &v.cam_node, err)) ||
+        (cn && (r = sy_node_set_camera(args->scene, v.cam_node, cn->camera, err))) ||
+        (!cn && (r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: the scene has no camera")))) {
+        glfwDestroyWindow(win);
+        glfwTerminate();
+        return r;
+    }
+    orbit_from_matrix(&world, &b, &in.o);
+    in.home = in.o;
+    int fbw, fbh;
+    glfwGetFramebufferSize(win, &fbw, &fbh);
+    v.w = (uint32_t)fbw, v.h = (uint32_t)fbh;
+    orbit_matrix(&in.o, &v.cam);
+    v.req_version = 1;
+
+    pthread_t th;
+    if (pthread_create(&th, NULL, render_main, &v) != 0) {
+        glfwDestroyWindow(win);
+        glfwTerminate();
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "view: cannot start the render thread");
+    }
+    glfwSetWindowUserPointer(win, &in);
+    glfwSetKeyCallback(win, on_key);
+    glfwSetMouseButtonCallback(win, on_button);
+    glfwSetCursorPosCallback(win, on_cursor);
+    glfwSetScrollCallback(win, on_scroll);
+
+    uint64_t shown = 0, displayed = 0;
+    double last = glfwGetTime();
+    uint8_t *img = NULL;
+    uint32_t iw = 0, ih = 0;
+    while (!glfwWindowShouldClose(win)) {
+        glfwWaitEventsTimeout(1.0 / 60.0);
+        double now = glfwGetTime();
+        fly(win, &in, (float)(now - last));
+        last = now;
+        glfwGetFramebufferSize(win, &fbw, &fbh);
+        pthread_mutex_lock(&v.mu);
+        if ((uint32_t)fbw != v.w || (uint32_t)fbh != v.h) {
+            v.w = fbw > 0 ? (uint32_t)fbw : 1, v.h = fbh > 0 ? (uint32_t)fbh : 1;
+            v.req_version++;
+            pthread_cond_signal(&v.cv);
+        }
+        bool fresh = v.img_version != shown;
+        if (fresh) {
+            shown = v.img_version;
+            if (v.img) {
+                free(img);
+                img = malloc((size_t)v.img_w * v.img_h * 4);
+                if (img) memcpy(img, v.img, (size_t)v.img_w * v.img_h * 4);
+                iw = img ? v.img_w : 0, ih = img ? v.img_h : 0;
+            }
+            char title[256];
+            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms | %llu spp | sync %.2f ms%s", v.status,
+                     v.frame_ms, (unsigned long long)v.spp, v.sync_ms,
+                     v.stereo == SY_STEREO_SBS ? " | stereo sbs" : v.stereo == SY_STEREO_ANAGLYPH ? " | anaglyph" : "");
+            glfwSetWindowTitle(win, title);
+        }
+        bool failed = v.failed;
+        pthread_mutex_unlock(&v.mu);
+        if (failed) break;
+        if (in.changed) {
+            in.changed = false;
+            post_request(&v, &in);
+        }
+        glViewport(0, 0, fbw, fbh);
+        glClearColor(0, 0, 0, 1);
+        glClear(GL_COLOR_BUFFER_BIT);
+        if (img && iw && ih) {
+            glRasterPos2f(-1.0f, 1.0f);
+            glPixelZoom((float)fbw / (float)iw, -(float)fbh / (float)ih);
+            glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+            glDrawPixels((GLsizei)iw, (GLsizei)ih, GL_RGBA, GL_UNSIGNED_BYTE, img);
+        }
+        if (img) displayed++; /* frames shown, fresh or not */
+        if (args->frames && displayed >= args->frames) {
+            if (args->screenshot) r = write_screenshot(args->screenshot, fbw, fbh, err);
+            glfwSetWindowShouldClose(win, GLFW_TRUE);
+        }
+        glfwSwapBuffers(win);
+    }
+    pthread_mutex_lock(&v.mu);
+    v.quit = true;
+    pthread_cond_signal(&v.cv);
+    pthread_mutex_unlock(&v.mu);
+    pthread_join(th, NULL);
+    if (v.failed && r == SY_OK) {
+        *err = v.error;
+        r = v.error.code ? v.error.code : SY_ERR_BACKEND;
+    }
+    free(img);
+    free(v.img);
+    pthread_mutex_destroy(&v.mu);
+    pthread_cond_destroy(&v.cv);
+    glfwDestroyWindow(win);
+    glfwTerminate();
+    return r;
+}

@@ -1,0 +1,28 @@
+/* sy_view.h — `sy view SCENE`: the interactive viewer (GLFW window).
+ *
+ * Orbit (left drag), pan (right or middle drag), zoom (wheel), fly (W A S D, Q E up/down); keys 1-9
+ * pick a registered back-end live, O toggles the overlay layer, T cycles stereo modes (mono,
+ * side-by-side, anaglyph), R resets the camera, Esc quits. The window title is the heads-up line:
+ * back-end, frame time, samples per pixel, sync time. Rendering runs on its own thread, which owns
+ * the scene (the input thread only posts camera poses and switches), so the window stays
+ * responsive while a slow back-end renders and always shows the last complete image; a
+ * progressive back-end keeps refining while the camera rests and restarts when it moves.
+ *
+ * Thread-safety: runs the whole viewer; call from the main thread (GLFW requires it). */
+#ifndef SY_VIEW_H
+#define SY_VIEW_H
+
+#include "sy_compose.h"
+
+typedef struct sy_view_args {
+    sy_scene *scene;        /* owned by the caller; used only by the render thread while running */
+    sy_compose_spec spec;   /* root, camera, background, overlay (backend is chosen live) */
+    const char *backend;    /* initial back-end */
+    uint32_t width, height; /* initial window size */
+    uint32_t frames;        /* > 0: quit after this many displayed frames (automated runs) */
+    const char *screenshot; /* optional PNG of the window's last frame, written at exit */
+} sy_view_args;
+
+sy_result sy_view_run(const sy_view_args *args, sy_error *err);
+
+#endif /* SY_VIEW_H */

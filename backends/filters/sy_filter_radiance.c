@@ -1,0 +1,351 @@
+/* sy_filter_radiance.c — radiance filtering (Schwenk 2013 ch. 4), see sy_filter_radiance.h.
+ * Section numbers refer to ../shared/notes/filters-spec.md. */
+#include "sy_filter_radiance.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define PI_F 3.14159265358979f
+
+struct sy_filter_radiance {
+    sy_filter_radiance_params p;
+    uint32_t w, h, k;
+    float *accum;  /* 3/px running mean of the filtered estimate */
+    float *ptacc;  /* 3/px running mean of plain PT (unbiased buffer) */
+    float *svar;   /* 1/px smoothed variance of the last frame */
+    float *svar2;  /* 1/px next */
+    float *alpha;  /* 1/px AO factor of the last frame */
+    float *alpha2;
+    float *radius; /* 1/px kernel radius (px) of the last frame, 0 = correction phase */
+    uint8_t *phase; /* 1 = correction */
+};
+
+void sy_filter_radiance_params_default(sy_filter_radiance_params *p)
+{
+    /* [GAP spec §2.4/§6.6]: no default T_u in the text; 0.01 = the pixel filter's threshold (about
+     * one JND of relative noise). Warm-up: 4 frames (text: "usually 4-8") with r_w1 = 8 px (cost grows with r^2: ~200 taps). */
+    *p = (sy_filter_radiance_params){.threshold = 0.01f, .warmup_frames = 4, .warmup_radius = 8.0f,
+                                     .max_radius = 24.0f, .kernel = SY_FILTER_RF_EPANECHNIKOV,
+                                     .ambient_occlusion = true, .prism_thickness = 0.25f, .grazing_epsilon = 0.1f,
+                                     .glossy_limit = 128.0f, .specular_limit = 4096.0f, .unbiased_switch = false,
+                                     .threads = 0};
+}
+
+sy_filter_status sy_filter_radiance_params_check(const sy_filter_radiance_params *p, sy_filter_error *err)
+{
+    sy_filter_status s;
+    if (!p) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: params is NULL");
+    if ((s = sy_filter_check_positive(p->threshold, "radiance filter: threshold T_u", err))) return s;
+    if (p->warmup_frames > 64)
+        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: warmup_frames = %u: at most 64",
+                              p->warmup_frames);
+    if ((s = sy_filter_check_positive(p->warmup_radius, "radiance filter: warmup_radius", err))) return s;
+    if ((s = sy_filter_check_range(p->max_radius, 1.0f, 128.0f, "radiance filter: max_radius", err))) return s;
+    if ((unsigned)p->kernel > SY_FILTER_RF_GAUSSIAN)
+        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: kernel = %d: unknown",
+                              (int)p->kernel);
+    if ((s = sy_filter_check_positive(p->prism_thickness, "radiance filter: prism_thickness", err))) return s;
+    if ((s = sy_filter_check_positive(p->grazing_epsilon, "radiance filter: grazing_epsilon", err))) return s;
+    if ((s = sy_filter_check_nonnegative(p->glossy_limit, "radiance filter: glossy_limit", err))) return s;
+    if ((s = sy_filter_check_nonnegative(p->specular_limit, "radiance filter: specular_limit", err))) return s;
+    if (p->threads > SY_FILTER_MAX_THREADS)
+        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: threads = %u: at most %u",
+                              p->threads, SY_FILTER_MAX_THREADS);
+    return SY_FILTER_OK;
+}
+
+static inline float dot3(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+void sy_filter_rf_bsdf_default(const sy_filter_rf_shading *s, const float wi[3], float f_cos[3], float *pdf,
+                               void *user)
+{
+    (void)user;
+    float cn = dot3(s->normal, wi), co = dot3(s->normal, s->wo);
+    f_cos[0] = f_cos[1] = f_cos[2] = 0.0f;
+    *pdf = 0.0f;
+    if (cn <= 0.0f || co <= 0.0f) return;
+    float ld = sy_filter_luminance(s->diffuse), ls = s->exponent > 0.0f ? sy_filter_luminance(s->specular) : 0.0f;
+    float ps = ld + ls > 0.0f ? ls / (ld + ls) : 0.0f;
+    float hv[3] = {wi[0] + s->wo[0], wi[1] + s->wo[1], wi[2] + s->wo[2]};
+    float hl = sqrtf(dot3(hv, hv));
+    float nh = 0.0f, oh = 1.0f;
+    if (hl > 0.0f) {
+        for (int c = 0; c < 3; ++c) hv[c] /= hl;
+        nh = fmaxf(dot3(s->normal, hv), 0.0f);
+        oh = fmaxf(dot3(s->wo, hv), 1e-6f);
+    }
+    float lobe = ps > 0.0f ? powf(nh, s->exponent) : 0.0f;
+    for (int c = 0; c < 3; ++c)
+        f_cos[c] = (s->diffuse[c] / PI_F + s->specular[c] * (s->exponent + 2.0f) / (2.0f * PI_F) * lobe) * cn;
+    *pdf = (1.0f - ps) * cn / PI_F + ps * (s->exponent + 1.0f) / (2.0f * PI_F) * lobe * nh / (4.0f * oh);
+}
+
+static float kernel_w(sy_filter_rf_kernel k, float t2)
+{
+    switch (k) {
+    case SY_FILTER_RF_EPANECHNIKOV: return 1.0f - t2;
+    case SY_FILTER_RF_SILVERMAN: return (1.0f - t2) * (1.0f - t2);
+    case SY_FILTER_RF_UNIFORM: return 1.0f;
+    case SY_FILTER_RF_GAUSSIAN: return sy_filter_expneg(4.5f * t2);
+    }
+    return 1.0f - t2;
+}
+
+/* [GAP spec §2.4 kernel-shape compensation]: match the effective sample count (sum w)^2 / sum w^2
+ * of the weighted disc to M_k ([DERIVED] factors of the notes). */
+static float kernel_scale(sy_filter_rf_kernel k)
+{
+    switch (k) {
+    case SY_FILTER_RF_EPANECHNIKOV: return 1.1547f;
+    case SY_FILTER_RF_SILVERMAN: return 1.3416f;
+    case SY_FILTER_RF_UNIFORM: return 1.0f;
+    case SY_FILTER_RF_GAUSSIAN: return 1.52f;
+    }
+    return 1.0f;
+}
+
+static bool finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+static bool shading_ok(const sy_filter_rf_shading *s)
+{
+    return (s->flags & SY_FILTER_RF_VALID) && finite3(s->position) && finite3(s->normal) && finite3(s->wo) &&
+           finite3(s->ray_dir) && isfinite(s->path_length) && finite3(s->throughput) && finite3(s->diffuse) &&
+           finite3(s->specular) && isfinite(s->exponent) && finite3(s->direct) && finite3(s->pt_indirect) &&
+           isfinite(s->variance);
+}
+
+static bool sample_ok(const sy_filter_rf_sample *s)
+{
+    return (s->flags & SY_FILTER_RF_VALID) && finite3(s->position) && finite3(s->normal) && finite3(s->wi) &&
+           finite3(s->radiance) && !isnan(s->hit_distance);
+}
+
+typedef struct rctx {
+    sy_filter_radiance *rf;
+    const sy_filter_radiance_input *in;
+    const uint8_t *sok; /* sample finite + valid */
+    const uint8_t *hok; /* shading finite + valid */
+    sy_filter_rf_bsdf_fn bsdf;
+} rctx;
+
+static void rf_rows(void *vctx, uint32_t y0, uint32_t y1)
+{
+    rctx *c = vctx;
+    sy_filter_radiance *rf = c->rf;
+    const sy_filter_radiance_params *p = &rf->p;
+    const sy_filter_radiance_input *in = c->in;
+    int w = (int)rf->w, h = (int)rf->h;
+    float k = (float)rf->k;
+    for (int y = (int)y0; y < (int)y1; ++y)
+        for (int x = 0; x < w; ++x) {
+            size_t j = (size_t)y * w + x;
+            const sy_filter_rf_shading *sh = in->shading + j;
+            float est[3], pt[3];
+            rf->svar2[j] = 0.0f;
+            rf->alpha2[j] = 1.0f;
+            rf->radius[j] = 0.0f;
+            rf->phase[j] = 1;
+            if (!c->hok[j]) { /* background or bad shading data: the low-variance part only */
+                bool dok = finite3(sh->direct);
+                for (int q = 0; q < 3; ++q) est[q] = pt[q] = dok ? sh->direct[q] : 0.0f;
+                goto accumulate;
+            }
+            for (int q = 0; q < 3; ++q) pt[q] = sh->direct[q] + (c->sok[j] ? sh->pt_indirect[q] : 0.0f);
+            float var = rf->k > 1 ? rf->svar[j] : fmaxf(sh->variance, 0.0f);
+            rf->svar2[j] = var;
+            /* radius: warm-up schedule, then the variance-driven one (Eqs. 4.1, 4.2, 4.14) */
+            float r;
+            if (rf->k <= p->warmup_frames) {
+                r = p->warmup_radius / sqrtf(k);
+            } else {
+                /* L_b = direct + filtered indirect: the running mean; before any accumulation this
+                 * frame's own estimate */
+                float lb = sy_filter_luminance(rf->k > 1 ? rf->accum + 3 * j : pt);
+                float u = var / fmaxf(lb * lb, 1e-8f);
+                float Mk = u / ((2.0f * k - 1.0f) * p->threshold);
+                r = sqrtf(Mk / PI_F) * kernel_scale(p->kernel); /* [DERIVED] circular footprint */
+            }
+            if (p->ambient_occlusion) r *= rf->alpha[j];
+            if (r > p->max_radius) r = p->max_radius;
+            bool nofilter = (sh->flags & SY_FILTER_RF_NO_FILTER) || sh->exponent > p->specular_limit;
+            if (r < 1.0f || nofilter) { /* correction phase: plain path tracing */
+                memcpy(est, pt, sizeof est);
+                goto accumulate;
+            }
+            rf->phase[j] = 0;
+            rf->radius[j] = r;
+            /* kernel projection, geometric construction (Eqs. 4.19-4.21) */
+            const float *N0 = sh->normal, *D = sh->ray_dir, *P0 = sh->position;
+            float dn = dot3(D, N0);
+            float aD[3] = {D[0] - dn * N0[0], D[1] - dn * N0[1], D[2] - dn * N0[2]};
+            float la = sqrtf(dot3(aD, aD));
+            if (la < 1e-6f) { /* D parallel to N0: any tangent */
+                float t[3] = {fabsf(N0[0]) < 0.9f ? 1.0f : 0.0f, fabsf(N0[0]) < 0.9f ? 0.0f : 1.0f, 0.0f};
+                float tn = dot3(t, N0);
+                aD[0] = t[0] - tn * N0[0], aD[1] = t[1] - tn * N0[1], aD[2] = t[2] - tn * N0[2];
+                la = sqrtf(dot3(aD, aD));
+            }
+            for (int q = 0; q < 3; ++q) aD[q] /= la;
+            float aS[3] = {aD[1] * N0[2] - aD[2] * N0[1], aD[2] * N0[0] - aD[0] * N0[2], aD[0] * N0[1] - aD[1] * N0[0]};
+            float rS = r * in->pixel_angle * fmaxf(sh->path_length, 1e-6f);
+            float rD = rS / fmaxf(p->grazing_epsilon, fabsf(dn));
+            /* [GAP spec §2.6 delta]: prism half thickness = prism_thickness * r_S */
+            float delta = p->prism_thickness * rS;
+            float inv_rS = 1.0f / rS, inv_rD = 1.0f / rD;
+            bool use_nu = sh->exponent > p->glossy_limit;
+            int R = (int)ceilf(r);
+            double acc[3] = {0, 0, 0}, W = 0, Wv = 0, accv = 0, inv_hd = 0;
+            uint32_t nh = 0;
+            for (int dy = -R; dy <= R; ++dy) {
+                int yy = y + dy;
+                if (yy < 0 || yy >= h) continue;
+                for (int dx = -R; dx <= R; ++dx) {
+                    int xx = x + dx;
+                    if (xx < 0 || xx >= w) continue;
+                    size_t i = (size_t)yy * w + xx;
+                    if (!c->sok[i]) continue;
+                    const sy_filter_rf_sample *sm = in->samples + i;
+                    float d[3] = {sm->position[0] - P0[0], sm->position[1] - P0[1], sm->position[2] - P0[2]};
+                    float off = dot3(d, N0);
+                    if (fabsf(off) > delta) continue;
+                    float u = dot3(d, aD) * inv_rD, v = dot3(d, aS) * inv_rS, t2 = u * u + v * v;
+                    if (t2 >= 1.0f) continue;
+                    float ks = kernel_w(p->kernel, t2);
+                    if (c->hok[i]) accv += ks * in->shading[i].variance, Wv += ks; /* unmodified kernel */
+                    if (p->ambient_occlusion && sm->hit_distance > 0.0f) inv_hd += 1.0 / sm->hit_distance, ++nh;
+                    float nu = 1.0f;
+                    if (use_nu) { /* Eq. 4.9 */
+                        float cn = dot3(sm->normal, N0);
+                        nu = cn > 0.0f ? powf(cn, sh->exponent) : 0.0f;
+                    }
+                    float wt = ks * nu;
+                    if (wt <= 0.0f) continue;
+                    float fc[3], pdf;
+                    c->bsdf(sh, sm->wi, fc, &pdf, in->bsdf_user);
+                    W += wt;
+                    if (!(pdf > 0.0f) || !finite3(fc)) continue; /* direction the owner never samples */
+                    for (int q = 0; q < 3; ++q) acc[q] += wt * fc[q] / pdf * sm->radiance[q]; /* Eq. 4.10 */
+                }
+            }
+            if (Wv > 0) rf->svar2[j] = (float)(accv / Wv);
+            if (p->ambient_occlusion && nh > 0) {
+                /* [GAP spec §2.2 AO formula]: alpha = clamp(harmonic mean hit distance / kernel
+                 * world radius, 0.25, 1), gathered in this loop and applied next frame */
+                float hm = (float)((double)nh / inv_hd), a = hm / rS;
+                rf->alpha2[j] = a < 0.25f ? 0.25f : a > 1.0f ? 1.0f : a;
+            }
+            if (W <= 0) {
+                memcpy(est, pt, sizeof est);
+            } else {
+                /* [GAP spec §2.2 specular-chain throughput]: the filtered incident estimate is
+                 * multiplied by the pixel's own chain throughput */
+                for (int q = 0; q < 3; ++q) est[q] = sh->direct[q] + sh->throughput[q] * (float)(acc[q] / W);
+            }
+        accumulate:
+            for (int q = 0; q < 3; ++q) {
+                rf->accum[3 * j + q] += (est[q] - rf->accum[3 * j + q]) / k;
+                rf->ptacc[3 * j + q] += (pt[q] - rf->ptacc[3 * j + q]) / k;
+            }
+        }
+}
+
+void sy_filter_radiance_destroy(sy_filter_radiance *rf)
+{
+    if (!rf) return;
+    free(rf->accum), free(rf->ptacc), free(rf->svar), free(rf->svar2), free(rf->alpha), free(rf->alpha2);
+    free(rf->radius), free(rf->phase);
+    free(rf);
+}
+
+sy_filter_status sy_filter_radiance_create(const sy_filter_radiance_params *p, sy_filter_radiance **out,
+                                           sy_filter_error *err)
+{
+    if (!out) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: out is NULL");
+    *out = NULL;
+    sy_filter_radiance_params d;
+    if (!p) sy_filter_radiance_params_default(&d), p = &d;
+    sy_filter_status s = sy_filter_radiance_params_check(p, err);
+    if (s) return s;
+    sy_filter_radiance *rf = calloc(1, sizeof *rf);
+    if (!rf) return sy_filter_fail(err, SY_FILTER_ERROR_OUT_OF_MEMORY, "radiance filter: out of memory");
+    rf->p = *p;
+    *out = rf;
+    return SY_FILTER_OK;
+}
+
+void sy_filter_radiance_reset(sy_filter_radiance *rf)
+{
+    if (rf) rf->k = 0;
+}
+
+const float *sy_filter_radiance_radius(const sy_filter_radiance *rf) { return rf && rf->k ? rf->radius : NULL; }
+uint32_t sy_filter_radiance_frame_index(const sy_filter_radiance *rf) { return rf ? rf->k : 0; }
+
+sy_filter_status sy_filter_radiance_frame(sy_filter_radiance *rf, const sy_filter_radiance_input *in, float *out,
+                                          sy_filter_stats *stats, sy_filter_error *err)
+{
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    if (!rf || !in || !out) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: NULL argument");
+    if (in->width == 0 || in->height == 0 || in->width > SY_FILTER_MAX_SIDE || in->height > SY_FILTER_MAX_SIDE)
+        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: image size %ux%u outside 1..%u",
+                              in->width, in->height, SY_FILTER_MAX_SIDE);
+    if (!in->shading || !in->samples)
+        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: shading or samples buffer is NULL");
+    sy_filter_status s = sy_filter_check_positive(in->pixel_angle, "radiance filter: pixel_angle", err);
+    if (s) return s;
+    size_t n = (size_t)in->width * in->height;
+    if (rf->w != in->width || rf->h != in->height || !rf->accum) {
+        free(rf->accum), free(rf->ptacc), free(rf->svar), free(rf->svar2), free(rf->alpha), free(rf->alpha2);
+        free(rf->radius), free(rf->phase);
+        rf->accum = malloc(3 * n * sizeof(float)), rf->ptacc = malloc(3 * n * sizeof(float));
+        rf->svar = malloc(n * sizeof(float)), rf->svar2 = malloc(n * sizeof(float));
+        rf->alpha = malloc(n * sizeof(float)), rf->alpha2 = malloc(n * sizeof(float));
+        rf->radius = malloc(n * sizeof(float)), rf->phase = malloc(n);
+        rf->w = rf->h = 0, rf->k = 0;
+        if (!rf->accum || !rf->ptacc || !rf->svar || !rf->svar2 || !rf->alpha || !rf->alpha2 || !rf->radius || !rf->phase)
+            return sy_filter_fail(err, SY_FILTER_ERROR_OUT_OF_MEMORY, "radiance filter: out of memory for %ux%u",
+                                  in->width, in->height);
+        rf->w = in->width, rf->h = in->height;
+    }
+    if (rf->k == 0) {
+        memset(rf->accum, 0, 3 * n * sizeof(float));
+        memset(rf->ptacc, 0, 3 * n * sizeof(float));
+        for (size_t i = 0; i < n; ++i) rf->svar[i] = 0.0f, rf->alpha[i] = 1.0f;
+    }
+    uint8_t *ok = malloc(2 * n);
+    if (!ok) return sy_filter_fail(err, SY_FILTER_ERROR_OUT_OF_MEMORY, "radiance filter: out of memory");
+    uint64_t bad = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const sy_filter_rf_shading *sh = in->shading + i;
+        const sy_filter_rf_sample *sm = in->samples + i;
+        ok[i] = sample_ok(sm);
+        ok[n + i] = shading_ok(sh);
+        bool bad_i = ((sm->flags & SY_FILTER_RF_VALID) && !ok[i]) || ((sh->flags & SY_FILTER_RF_VALID) && !ok[n + i]);
+        bad += bad_i;
+        if (bad_i) ok[i] = 0, ok[n + i] = 0; /* a pixel with any NaN/Inf neither gives nor gathers */
+    }
+    rf->k++;
+    rctx c = {.rf = rf, .in = in, .sok = ok, .hok = ok + n, .bsdf = in->bsdf ? in->bsdf : sy_filter_rf_bsdf_default};
+    s = sy_filter_parallel_rows(rf->p.threads, rf->h, rf_rows, &c, err);
+    free(ok);
+    if (s) return s;
+    float *t = rf->svar;
+    rf->svar = rf->svar2, rf->svar2 = t;
+    t = rf->alpha, rf->alpha = rf->alpha2, rf->alpha2 = t;
+    uint64_t corr = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const float *src = (rf->p.unbiased_switch && rf->phase[i]) ? rf->ptacc + 3 * i : rf->accum + 3 * i;
+        out[4 * i + 0] = src[0], out[4 * i + 1] = src[1], out[4 * i + 2] = src[2], out[4 * i + 3] = 1.0f;
+        corr += rf->phase[i];
+    }
+    if (stats) {
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        *stats = (sy_filter_stats){.nonfinite_samples = bad, .filtered_pixels = n - corr, .filter_pass = true,
+                                   .mean_blend = (double)corr / (double)n,
+                                   .seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec)};
+    }
+    return SY_FILTER_OK;
+}

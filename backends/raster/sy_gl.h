@@ -1,0 +1,258 @@
+/* sy_gl.h — public API of the OpenGL 3.3 core rasterizer back-end (backends/raster).
+ *
+ * A standalone renderer library with its own small scene API (meshes, textures, materials,
+ * instances, punctual lights, background), like a third-party renderer: it knows nothing about
+ * the Switchyard scene graph. A mediator (mediators/raster) translates the core scene into these
+ * objects and keeps them in sync incrementally.
+ *
+ * Context providers (chosen per device): OSMesa (headless software rendering through Mesa's
+ * llvmpipe; the default that always works), EGL (headless: an EGL device when a GPU driver
+ * offers one, else Mesa's surfaceless platform) and GLFW (a real window; rendering goes to an
+ * offscreen framebuffer and is also shown in the window). The same renderer code runs on all
+ * three: GL entry points are loaded through the provider's GetProcAddress into a table (no
+ * GL library is linked, so OSMesa, EGL and GLX never fight over the global gl* symbols).
+ *
+ * Object model
+ *   sy_gl_device    owns the GL context and every object; one per thread at a time.
+ *   sy_gl_mesh      vertex + index buffers (VBO/IBO), uploaded once at creation.
+ *   sy_gl_texture   RGBA8 / sRGB8_ALPHA8 / RGBA32F texture with mipmaps and its sampler state.
+ *   sy_gl_material  glTF metallic-roughness material; one uniform buffer (UBO) per material.
+ *   sy_gl_instance  a mesh placed with a model matrix and a material.
+ *   sy_gl_light     point / spot / directional light (KHR_lights_punctual units); directional and
+ *                   spot lights cast shadow-mapped shadows.
+ *
+ * Handles are one-field structs holding index + generation; id 0 is never valid; stale handles
+ * give SY_GL_ERROR_INVALID_HANDLE. References between objects are resolved at render time: an
+ * instance whose material is stale renders with the default material.
+ *
+ * Shading (the same BSDF as backends/rt's Whitted integrator for direct light): Lambert
+ * base*(1-metallic)*(1-transmission)/pi plus GGX with height-correlated Smith visibility and
+ * Schlick Fresnel, F0 = mix(((ior-1)/(ior+1))^2 * specular, base, metallic); point/spot intensity
+ * in candela (irradiance I/d^2 times the glTF range window), directional in lux, spot cone
+ * falloff clamp((cos - cos_outer)/(cos_inner - cos_outer))^2. Emissive materials are pure
+ * emitters: a visible front side (both sides when double-sided) shows exactly its emissive
+ * radiance. Unlit materials show their base colour. An ambient term lights every surface with
+ * the background colour as a uniform environment (base*(1-metallic) + F0) * occlusion; a
+ * transparent background gives no ambient light.
+ *
+ * Output: sy_gl_render fills RGBA float (linear, premultiplied, row 0 = top) and depth (linear
+ * distance along the viewing axis, +INFINITY where nothing was drawn) for a sub-rectangle of the
+ * full image; pixel (x, y) has its centre at (x + 0.5, y + 0.5) like the ray tracers. With MSAA,
+ * colour is the average of the samples and depth the nearest covered sample.
+ *
+ * Errors: every fallible call returns sy_gl_result (SY_GL_OK == 0) and writes a NUL-terminated
+ * message naming the object, the provider or the GL call, and the reason into err (when non-NULL).
+ * Warnings (a texture downscaled to the GL limit, a clamped MSAA count) go to the desc's log
+ * callback. Thread-safety: a device is used by one thread at a time (its context is made current
+ * on that thread by every call); a GLFW device must be created, used and destroyed on the main
+ * thread (GLFW's rule for windows and events). OSMesa and EGL devices work from any thread. Conventions: column-major float[16] matrices (glTF), right-handed,
+ * Y up, cameras look down local -Z. */
+#ifndef SY_GL_H
+#define SY_GL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum sy_gl_result {
+    SY_GL_OK = 0,
+    SY_GL_ERROR_INVALID_ARGUMENT = 1,
+    SY_GL_ERROR_INVALID_HANDLE = 2,
+    SY_GL_ERROR_OUT_OF_MEMORY = 3,
+    SY_GL_ERROR_LIMIT = 4,
+    SY_GL_ERROR_NO_CONTEXT = 5, /* the provider could not give a GL 3.3 core context */
+    SY_GL_ERROR_GL = 6,         /* a GL call or shader compile failed (log included) */
+    SY_GL_RESULT_MAX_ENUM = 0x7fffffff
+} sy_gl_result;
+
+typedef enum sy_gl_provider {
+    SY_GL_PROVIDER_OSMESA = 0,
+    SY_GL_PROVIDER_EGL = 1,
+    SY_GL_PROVIDER_GLFW = 2,
+    SY_GL_PROVIDER_MAX_ENUM = 0x7fffffff
+} sy_gl_provider;
+
+/* "osmesa", "egl", "glfw". Static storage. */
+const char *sy_gl_provider_name(sy_gl_provider p);
+/* Parses a provider name; false when unknown. */
+bool sy_gl_provider_parse(const char *name, sy_gl_provider *out);
+
+typedef struct sy_gl_device sy_gl_device;
+typedef struct sy_gl_mesh { uint32_t id; } sy_gl_mesh;
+typedef struct sy_gl_texture { uint32_t id; } sy_gl_texture;
+typedef struct sy_gl_material { uint32_t id; } sy_gl_material;
+typedef struct sy_gl_instance { uint32_t id; } sy_gl_instance;
+typedef struct sy_gl_light { uint32_t id; } sy_gl_light;
+
+typedef void (*sy_gl_log_fn)(void *user, const char *message);
+
+typedef struct sy_gl_device_desc {
+    sy_gl_provider provider;
+    uint32_t msaa;             /* samples per pixel: 0/1 = none, else clamped to GL_MAX_SAMPLES (warning) */
+    uint32_t shadow_map_size;  /* texels per side; 0 = 2048 */
+    uint32_t max_texture_size; /* 0 = GL_MAX_TEXTURE_SIZE; smaller values force downscaling */
+    uint32_t window_width, window_height; /* GLFW window size; 0 = 640 x 480 */
+    sy_gl_log_fn log;          /* warnings; NULL = silent */
+    void *log_user;
+} sy_gl_device_desc;
+
+/* Creates the context and the renderer. On a missing provider (no EGL device/display, no X
+ * display for GLFW) fails with SY_GL_ERROR_NO_CONTEXT and a message naming the provider and
+ * suggesting the OSMesa fallback. *out is owned by the caller (sy_gl_device_destroy). */
+sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **out, char *err, size_t err_len);
+void sy_gl_device_destroy(sy_gl_device *dev); /* destroys every object; NULL is a no-op */
+/* "OpenGL 4.5 (Core Profile) Mesa 22.3.6 on llvmpipe (...)". Borrowed, valid while dev lives. */
+const char *sy_gl_device_info(const sy_gl_device *dev);
+
+/* Upload counters. Every call that sends data to GL counts: buffer uploads (glBufferData /
+ * glBufferSubData of vertex, index and uniform buffers) and texture uploads (glTexImage2D per
+ * level). `frame` holds what happened between the end of the previous sy_gl_render and the end of
+ * the last one (object updates + the frame itself); `total` everything since creation. */
+typedef struct sy_gl_upload_counts {
+    uint64_t vertex_buffer_uploads, vertex_bytes; /* VBO + IBO */
+    uint64_t uniform_buffer_uploads, uniform_bytes; /* material and light UBOs */
+    uint64_t texture_uploads, texture_bytes;
+    uint64_t model_matrix_updates; /* instance transforms set (no GL upload until drawn) */
+} sy_gl_upload_counts;
+typedef struct sy_gl_stats {
+    uint32_t meshes, textures, materials, instances, lights;
+    uint32_t msaa_samples;       /* effective */
+    uint32_t shadow_maps;        /* rendered in the last frame */
+    uint64_t triangles_drawn;    /* last frame, main pass */
+    uint64_t draw_calls;         /* last frame, all passes */
+    sy_gl_upload_counts frame, total;
+} sy_gl_stats;
+void sy_gl_device_stats(const sy_gl_device *dev, sy_gl_stats *out);
+
+/* >>mesh: arrays are uploaded to GL at creation (one VBO per attribute + one IBO) and not kept. */
+typedef struct sy_gl_mesh_desc {
+    const float *positions;  /* float3 x vertex_count (required, finite) */
+    const float *normals;    /* float3 or NULL (flat normals) */
+    const float *uv[2];      /* float2 or NULL */
+    const float *colors;     /* float4 linear RGBA or NULL (white) */
+    const uint32_t *indices; /* 3 x triangle_count or NULL (then vertex_count == 3 x triangle_count) */
+    uint32_t vertex_count, triangle_count;
+} sy_gl_mesh_desc;
+sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *desc, sy_gl_mesh *out, char *err,
+                               size_t err_len);
+sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh);
+
+/* >>texture: row 0 = top (glTF uv (0,0)); 1 = grey, 2 = grey+alpha, 3 = RGB, 4 = RGBA. Copied
+ * to GL (with mipmaps); sizes beyond the GL limit are box-downscaled with a warning. */
+typedef enum sy_gl_texel_format {
+    SY_GL_TEXEL_UNORM8 = 1,
+    SY_GL_TEXEL_UNORM8_SRGB = 2, /* RGB sRGB-encoded, alpha linear (GL_SRGB8_ALPHA8) */
+    SY_GL_TEXEL_FLOAT32 = 3,
+    SY_GL_TEXEL_FORMAT_MAX_ENUM = 0x7fffffff
+} sy_gl_texel_format;
+typedef enum sy_gl_wrap { SY_GL_WRAP_REPEAT = 0, SY_GL_WRAP_CLAMP = 1, SY_GL_WRAP_MIRROR = 2 } sy_gl_wrap;
+typedef struct sy_gl_texture_desc {
+    uint32_t width, height, channels;
+    sy_gl_texel_format format;
+    const void *pixels;
+    sy_gl_wrap wrap_s, wrap_t;
+    bool nearest; /* nearest magnification (else linear); minification is always mipmapped */
+} sy_gl_texture_desc;
+sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *desc, sy_gl_texture *out, char *err,
+                                  size_t err_len);
+sy_gl_result sy_gl_texture_destroy(sy_gl_device *dev, sy_gl_texture tex);
+
+/* >>material */
+typedef enum sy_gl_alpha_mode { SY_GL_ALPHA_OPAQUE = 0, SY_GL_ALPHA_MASK = 1, SY_GL_ALPHA_BLEND = 2 } sy_gl_alpha_mode;
+typedef struct sy_gl_texture_ref {
+    sy_gl_texture texture; /* zero = none */
+    uint32_t texcoord;     /* 0 or 1 */
+} sy_gl_texture_ref;
+typedef struct sy_gl_material_desc {
+    float base_color[4];
+    sy_gl_texture_ref base_color_texture;
+    float metallic, roughness;
+    sy_gl_texture_ref metallic_roughness_texture; /* G = roughness, B = metallic */
+    float emissive[3]; /* radiance: emissiveFactor * emissiveStrength */
+    sy_gl_texture_ref emissive_texture;
+    sy_gl_texture_ref normal_texture;
+    float normal_scale;
+    sy_gl_texture_ref occlusion_texture; /* R channel, ambient term only */
+    float occlusion_strength;
+    float specular, transmission, ior;
+    sy_gl_alpha_mode alpha_mode;
+    float alpha_cutoff;
+    bool double_sided, unlit;
+} sy_gl_material_desc;
+void sy_gl_material_desc_init(sy_gl_material_desc *desc); /* glTF defaults */
+sy_gl_result sy_gl_material_create(sy_gl_device *dev, const sy_gl_material_desc *desc, sy_gl_material *out,
+                                   char *err, size_t err_len);
+/* One UBO update. */
+sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const sy_gl_material_desc *desc,
+                                   char *err, size_t err_len);
+sy_gl_result sy_gl_material_destroy(sy_gl_device *dev, sy_gl_material mat);
+
+/* >>instance */
+typedef struct sy_gl_instance_desc {
+    sy_gl_mesh mesh;
+    sy_gl_material material;
+    float transform[16]; /* object-to-world, finite and invertible */
+    bool hidden;
+} sy_gl_instance_desc;
+sy_gl_result sy_gl_instance_create(sy_gl_device *dev, const sy_gl_instance_desc *desc, sy_gl_instance *out,
+                                   char *err, size_t err_len);
+/* Updates the model matrix only (no GL upload). */
+sy_gl_result sy_gl_instance_set_transform(sy_gl_device *dev, sy_gl_instance inst, const float transform[16],
+                                          char *err, size_t err_len);
+sy_gl_result sy_gl_instance_set_material(sy_gl_device *dev, sy_gl_instance inst, sy_gl_material mat);
+sy_gl_result sy_gl_instance_set_visible(sy_gl_device *dev, sy_gl_instance inst, bool visible);
+sy_gl_result sy_gl_instance_destroy(sy_gl_device *dev, sy_gl_instance inst);
+
+/* >>light (world space; direction = where the light travels, need not be normalised) */
+typedef enum sy_gl_light_type { SY_GL_LIGHT_POINT = 1, SY_GL_LIGHT_SPOT = 2, SY_GL_LIGHT_DIRECTIONAL = 3 } sy_gl_light_type;
+typedef struct sy_gl_light_desc {
+    sy_gl_light_type type;
+    float color[3], intensity;
+    float position[3], direction[3];
+    float range; /* 0 = infinite */
+    float inner_cone_angle, outer_cone_angle;
+    bool no_shadow;
+} sy_gl_light_desc;
+#define SY_GL_MAX_LIGHTS 32
+#define SY_GL_MAX_SHADOW_MAPS 4 /* the first spot/directional lights get shadow maps */
+sy_gl_result sy_gl_light_create(sy_gl_device *dev, const sy_gl_light_desc *desc, sy_gl_light *out, char *err,
+                                size_t err_len);
+sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_gl_light_desc *desc, char *err,
+                                size_t err_len);
+sy_gl_result sy_gl_light_destroy(sy_gl_device *dev, sy_gl_light light);
+
+/* Background: transparent (alpha 0, no ambient) when has_color is false, else constant radiance
+ * with alpha 1 that also lights the scene as an ambient environment. */
+void sy_gl_set_background(sy_gl_device *dev, bool has_color, const float color[3]);
+
+/* >>render */
+typedef struct sy_gl_camera {
+    float camera_to_world[16];
+    bool orthographic;
+    float window[4]; /* {left, right, bottom, top}: tangent space at distance 1 (perspective) or camera units */
+    float near_clip, far_clip; /* far 0 = infinite */
+} sy_gl_camera;
+typedef struct sy_gl_render_desc {
+    uint32_t image_width, image_height;
+    uint32_t x, y, width, height; /* sub-rectangle, row 0 = top */
+} sy_gl_render_desc;
+/* Renders and reads back: rgba (width*height*4 floats) and depth (width*height, may be NULL). */
+sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *desc, float *rgba,
+                          float *depth, char *err, size_t err_len);
+/* GLFW provider: true once the user asked to close the window (false for other providers). */
+bool sy_gl_window_should_close(sy_gl_device *dev);
+
+/* >>bench: the floor — draws every visible instance's buffers with a trivial shader (one
+ * colour, no lighting, no shadows, no MSAA) into the same targets, then reads back like
+ * sy_gl_render. */
+sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *desc,
+                                float *rgba, char *err, size_t err_len);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_GL_H */

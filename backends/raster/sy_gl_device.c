@@ -1,0 +1,1505 @@
+/* sy_gl_device.c — the rasterizer: object pools, uploads (counted), shadow maps, the main PBR
+ * pass with sorted alpha blending, MSAA resolve and read-back into the shared layer conventions
+ * (see sy_gl.h).
+ *
+ * Sections: >>pools  >>math  >>device  >>mesh  >>texture  >>material  >>instance/light  >>render */
+#include "sy_gl.h"
+#include "sy_gl_context.h"
+#include "sy_gl_shaders.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define IDX_BITS 20u
+#define IDX_MASK ((1u << IDX_BITS) - 1u)
+#define SHADOW_SIZE_DEFAULT 2048u
+enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_COUNT };
+enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1 };
+
+static sy_gl_result fail(char *err, size_t len, sy_gl_result r, const char *fmt, ...)
+{
+    if (err && len) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, len, fmt, ap);
+        va_end(ap);
+    }
+    return r;
+}
+
+/* >>pools: every object struct starts with {id, gen}; id 0 = free slot. */
+typedef struct slot_head {
+    uint32_t id, gen;
+} slot_head;
+
+typedef struct pool {
+    void *items;
+    uint32_t count, cap, live;
+    size_t elem;
+} pool;
+
+static void *pool_at(const pool *p, uint32_t i) { return (char *)p->items + (size_t)i * p->elem; }
+
+static void *pool_get(const pool *p, uint32_t id)
+{
+    uint32_t i = id & IDX_MASK;
+    if (!id || i >= p->count) return NULL;
+    slot_head *h = pool_at(p, i);
+    return h->id == id ? h : NULL;
+}
+
+static void *pool_alloc(pool *p)
+{
+    uint32_t i = 1; /* slot 0 unused, so ids are never 0 */
+    for (; i < p->count; ++i)
+        if (((slot_head *)pool_at(p, i))->id == 0) break;
+    if (i >= IDX_MASK) return NULL;
+    if (i >= p->count) {
+        if (i >= p->cap) {
+            uint32_t nc = p->cap ? p->cap * 2 : 64;
+            void *n = realloc(p->items, p->elem * nc);
+            if (!n) return NULL;
+            memset((char *)n + p->elem * p->cap, 0, p->elem * (nc - p->cap));
+            p->items = n;
+            p->cap = nc;
+        }
+        p->count = i + 1;
+    }
+    slot_head *h = pool_at(p, i);
+    uint32_t gen = (h->gen + 1u) & ((1u << (32 - IDX_BITS)) - 1u);
+    if (!gen) gen = 1;
+    memset(h, 0, p->elem);
+    h->gen = gen;
+    h->id = (gen << IDX_BITS) | i;
+    p->live++;
+    return h;
+}
+
+static void pool_free(pool *p, void *item)
+{
+    slot_head *h = item;
+    uint32_t gen = h->gen;
+    memset(h, 0, p->elem);
+    h->gen = gen;
+    p->live--;
+}
+
+typedef struct mesh_o {
+    slot_head h;
+    GLuint vao, vbo[1], ibo;
+    uint32_t vertex_count, triangle_count;
+    bool has_normals, indexed, has_attr[5];
+    float bmin[3], bmax[3];
+} mesh_o;
+
+typedef struct tex_o {
+    slot_head h;
+    GLuint tex;
+} tex_o;
+
+typedef struct mat_o {
+    slot_head h;
+    GLuint ubo;
+    sy_gl_material_desc d;
+} mat_o;
+
+typedef struct inst_o {
+    slot_head h;
+    sy_gl_mesh mesh;
+    sy_gl_material material;
+    float model[16], normal_mat[9];
+    bool mirror, visible;
+} inst_o;
+
+typedef struct light_o {
+    slot_head h;
+    sy_gl_light_desc d;
+} light_o;
+
+typedef struct targets {
+    uint32_t w, h, samples;
+    GLuint fbo, color, depthlin, depth_rb;
+    GLuint rfbo, rcolor, rdepthlin; /* resolve targets when samples > 1 */
+} targets;
+
+struct sy_gl_device {
+    sy_gl_context *ctx;
+    const sy_gl_fns *gl;
+    char info[256];
+    sy_gl_log_fn log;
+    void *log_user;
+    uint32_t msaa, max_tex, shadow_size;
+    pool meshes, textures, materials, instances, lights;
+    GLuint prog_resolve, prog_floor;
+    struct { /* [mask * 2 + lean]: mask = alpha-masked (the only variants with discard), lean = mesh
+              * without uv1 and colours (fewer varyings) */
+        GLuint prog;
+        GLint model, normal_mat, view, proj, cam_pos, cam_fwd, ortho, mirror, has_normals;
+    } pm[4];
+    struct {
+        GLuint prog;
+        GLint model, lightvp;
+    } ps[2];
+    struct {
+        GLint samples;
+    } ur;
+    struct {
+        GLint model, view, proj;
+    } uf;
+    GLuint default_ubo, lights_ubo, white_tex, flat_normal_tex, empty_vao;
+    GLuint shadow_tex, shadow_fbo;
+    targets t;
+    bool lights_dirty;
+    bool has_bg;
+    float bg[3];
+    bool warned_lights;
+    sy_gl_upload_counts counts, frame, mark;
+    uint32_t shadow_maps;
+    uint64_t tris, draws;
+    float *scratch;
+    size_t scratch_len;
+};
+
+static void warn(sy_gl_device *dev, const char *fmt, ...)
+{
+    if (!dev->log) return;
+    char msg[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    dev->log(dev->log_user, msg);
+}
+
+const char *sy_gl_provider_name(sy_gl_provider p)
+{
+    switch (p) {
+    case SY_GL_PROVIDER_OSMESA: return "osmesa";
+    case SY_GL_PROVIDER_EGL: return "egl";
+    case SY_GL_PROVIDER_GLFW: return "glfw";
+    default: return "unknown";
+    }
+}
+
+bool sy_gl_provider_parse(const char *name, sy_gl_provider *out)
+{
+    for (int i = 0; i < 3; ++i)
+        if (name && !strcmp(name, sy_gl_provider_name((sy_gl_provider)i))) {
+            *out = (sy_gl_provider)i;
+            return true;
+        }
+    return false;
+}
+
+/* >>math (column-major 4x4) */
+static void m4_mul(const float *a, const float *b, float *o)
+{
+    float r[16];
+    for (int c = 0; c < 4; ++c)
+        for (int row = 0; row < 4; ++row) {
+            float s = 0.0f;
+            for (int k = 0; k < 4; ++k) s += a[k * 4 + row] * b[c * 4 + k];
+            r[c * 4 + row] = s;
+        }
+    memcpy(o, r, sizeof r);
+}
+
+static bool m4_invert(const float *m, float *out)
+{
+    double inv[16], det;
+    inv[0] = m[5] * m[10] * m[15] - m[5] * m[11] * m[14] - m[9] * m[6] * m[15] + m[9] * m[7] * m[14] + m[13] * m[6] * m[11] - m[13] * m[7] * m[10];
+    inv[4] = -m[4] * m[10] * m[15] + m[4] * m[11] * m[14] + m[8] * m[6] * m[15] - m[8] * m[7] * m[14] - m[12] * m[6] * m[11] + m[12] * m[7] * m[10];
+    inv[8] = m[4] * m[9] * m[15] - m[4] * m[11] * m[13] - m[8] * m[5] * m[15] + m[8] * m[7] * m[13] + m[12] * m[5] * m[11] - m[12] * m[7] * m[9];
+    inv[12] = -m[4] * m[9] * m[14] + m[4] * m[10] * m[13] + m[8] * m[5] * m[14] - m[8] * m[6] * m[13] - m[12] * m[5] * m[10] + m[12] * m[6] * m[9];
+    inv[1] = -m[1] * m[10] * m[15] + m[1] * m[11] * m[14] + m[9] * m[2] * m[15] - m[9] * m[3] * m[14] - m[13] * m[2] * m[11] + m[13] * m[3] * m[10];
+    inv[5] = m[0] * m[10] * m[15] - m[0] * m[11] * m[14] - m[8] * m[2] * m[15] + m[8] * m[3] * m[14] + m[12] * m[2] * m[11] - m[12] * m[3] * m[10];
+    inv[9] = -m[0] * m[9] * m[15] + m[0] * m[11] * m[13] + m[8] * m[1] * m[15] - m[8] * m[3] * m[13] - m[12] * m[1] * m[11] + m[12] * m[3] * m[9];
+    inv[13] = m[0] * m[9] * m[14] - m[0] * m[10] * m[13] - m[8] * m[1] * m[14] + m[8] * m[2] * m[13] + m[12] * m[1] * m[10] - m[12] * m[2] * m[9];
+    inv[2] = m[1] * m[6] * m[15] - m[1] * m[7] * m[14] - m[5] * m[2] * m[15] + m[5] * m[3] * m[14] + m[13] * m[2] * m[7] - m[13] * m[3] * m[6];
+    inv[6] = -m[0] * m[6] * m[15] + m[0] * m[7] * m[14] + m[4] * m[2] * m[15] - m[4] * m[3] * m[14] - m[12] * m[2] * m[7] + m[12] * m[3] * m[6];
+    inv[10] = m[0] * m[5] * m[15] - m[0] * m[7] * m[13] - m[4] * m[1] * m[15] + m[4] * m[3] * m[13] + m[12] * m[1] * m[7] - m[12] * m[3] * m[5];
+    inv[14] = -m[0] * m[5] * m[14] + m[0] * m[6] * m[13] + m[4] * m[1] * m[14] - m[4] * m[2] * m[13] - m[12] * m[1] * m[6] + m[12] * m[2] * m[5];
+    inv[3] = -m[1] * m[6] * m[11] + m[1] * m[7] * m[10] + m[5] * m[2] * m[11] - m[5] * m[3] * m[10] - m[9] * m[2] * m[7] + m[9] * m[3] * m[6];
+    inv[7] = m[0] * m[6] * m[11] - m[0] * m[7] * m[10] - m[4] * m[2] * m[11] + m[4] * m[3] * m[10] + m[8] * m[2] * m[7] - m[8] * m[3] * m[6];
+    inv[11] = -m[0] * m[5] * m[11] + m[0] * m[7] * m[9] + m[4] * m[1] * m[11] - m[4] * m[3] * m[9] - m[8] * m[1] * m[7] + m[8] * m[3] * m[5];
+    inv[15] = m[0] * m[5] * m[10] - m[0] * m[6] * m[9] - m[4] * m[1] * m[10] + m[4] * m[2] * m[9] + m[8] * m[1] * m[6] - m[8] * m[2] * m[5];
+    det = m[0] * inv[0] + m[1] * inv[4] + m[2] * inv[8] + m[3] * inv[12];
+    if (!(fabs(det) > 1e-30) || !isfinite(det)) return false;
+    for (int i = 0; i < 16; ++i) out[i] = (float)(inv[i] / det);
+    return true;
+}
+
+static void v3_norm(float *v)
+{
+    float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (l > 0.0f)
+        for (int i = 0; i < 3; ++i) v[i] /= l;
+}
+
+static void cross3(const float *a, const float *b, float *o)
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* World-to-light view looking from eye along dir. */
+static void look_along(const float *eye, const float *dir, float *view)
+{
+    float z[3] = {-dir[0], -dir[1], -dir[2]}, up[3] = {0, 1, 0}, x[3], y[3];
+    v3_norm(z);
+    if (fabsf(z[1]) > 0.99f) {
+        up[1] = 0;
+        up[2] = 1;
+    }
+    cross3(up, z, x);
+    v3_norm(x);
+    cross3(z, x, y);
+    float m[16] = {x[0], y[0], z[0], 0, x[1], y[1], z[1], 0, x[2], y[2], z[2], 0, 0, 0, 0, 1};
+    for (int i = 0; i < 3; ++i) m[12 + i] = -(m[i] * eye[0] + m[4 + i] * eye[1] + m[8 + i] * eye[2]);
+    memcpy(view, m, sizeof m);
+}
+
+/* Projection from an image-plane window (tangent space at distance 1, or camera units for ortho). */
+static void projection(bool ortho, double l, double r, double b, double t, double n, double f, float *p)
+{
+    memset(p, 0, 16 * sizeof *p);
+    if (ortho) {
+        p[0] = (float)(2.0 / (r - l));
+        p[12] = (float)(-(r + l) / (r - l));
+        p[5] = (float)(2.0 / (t - b));
+        p[13] = (float)(-(t + b) / (t - b));
+        p[10] = (float)(-2.0 / (f - n));
+        p[14] = (float)(-(f + n) / (f - n));
+        p[15] = 1.0f;
+        return;
+    }
+    p[0] = (float)(2.0 / (r - l));
+    p[8] = (float)((r + l) / (r - l));
+    p[5] = (float)(2.0 / (t - b));
+    p[9] = (float)((t + b) / (t - b));
+    p[11] = -1.0f;
+    if (f > 0.0) {
+        p[10] = (float)(-(f + n) / (f - n));
+        p[14] = (float)(-2.0 * f * n / (f - n));
+    } else { /* infinite far plane */
+        p[10] = -1.0f;
+        p[14] = (float)(-2.0 * n);
+    }
+}
+
+static void count_buffer(sy_gl_device *dev, bool uniform, size_t bytes)
+{
+    if (uniform) {
+        dev->counts.uniform_buffer_uploads++;
+        dev->counts.uniform_bytes += bytes;
+    } else {
+        dev->counts.vertex_buffer_uploads++;
+        dev->counts.vertex_bytes += bytes;
+    }
+}
+
+static sy_gl_result gl_check(sy_gl_device *dev, const char *where, char *err, size_t len)
+{
+    GLenum e = dev->gl->GetError();
+    if (e == GL_NO_ERROR) return SY_GL_OK;
+    while (dev->gl->GetError() != GL_NO_ERROR) {
+    }
+    return fail(err, len, e == GL_OUT_OF_MEMORY ? SY_GL_ERROR_OUT_OF_MEMORY : SY_GL_ERROR_GL,
+                "%s: OpenGL error 0x%04x (%s)", where, (unsigned)e, sy_gl_provider_name(sy_gl_context_provider(dev->ctx)));
+}
+
+static sy_gl_result current(sy_gl_device *dev, char *err, size_t len)
+{
+    if (!sy_gl_context_make_current(dev->ctx))
+        return fail(err, len, SY_GL_ERROR_NO_CONTEXT, "%s: cannot make the GL context current",
+                    sy_gl_provider_name(sy_gl_context_provider(dev->ctx)));
+    return SY_GL_OK;
+}
+
+/* >>device */
+static GLuint make_tex1(const sy_gl_fns *gl, const unsigned char rgba[4])
+{
+    GLuint t;
+    gl->GenTextures(1, &t);
+    gl->BindTexture(GL_TEXTURE_2D, t);
+    gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    return t;
+}
+
+typedef struct mat_block {
+    float base[4], emissive[4], mrna[4], oist[4];
+    int32_t modes[4], tex[4], tex2[4];
+} mat_block;
+
+static void material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b)
+{
+    memset(b, 0, sizeof *b);
+    memcpy(b->base, d->base_color, sizeof b->base);
+    memcpy(b->emissive, d->emissive, sizeof d->emissive);
+    b->mrna[0] = d->metallic;
+    b->mrna[1] = d->roughness;
+    b->mrna[2] = d->normal_scale;
+    b->mrna[3] = d->alpha_cutoff;
+    b->oist[0] = d->occlusion_strength;
+    b->oist[1] = d->ior >= 1.0f ? d->ior : 1.5f;
+    b->oist[2] = d->specular;
+    b->oist[3] = d->transmission;
+    b->modes[0] = (int32_t)d->alpha_mode;
+    b->modes[1] = d->unlit;
+    b->modes[2] = d->double_sided;
+    b->modes[3] = d->emissive[0] > 0.0f || d->emissive[1] > 0.0f || d->emissive[2] > 0.0f;
+    const sy_gl_texture_ref *refs[5] = {&d->base_color_texture, &d->metallic_roughness_texture, &d->normal_texture,
+                                        &d->occlusion_texture, &d->emissive_texture};
+    for (int i = 0; i < 5; ++i) {
+        int32_t v = pool_get(&dev->textures, refs[i]->texture.id) ? (int32_t)(refs[i]->texcoord & 1u) : -1;
+        if (i < 4) b->tex[i] = v;
+        else b->tex2[0] = v;
+    }
+}
+
+static void bind_samplers(const sy_gl_fns *gl, GLuint prog)
+{
+    static const char *names[UNIT_COUNT] = {"t_base", "t_mr", "t_nrm", "t_occ", "t_emis", "t_shadow"};
+    gl->UseProgram(prog);
+    for (int i = 0; i < UNIT_COUNT; ++i) {
+        GLint loc = gl->GetUniformLocation(prog, names[i]);
+        if (loc >= 0) gl->Uniform1i(loc, i);
+    }
+    GLuint b = gl->GetUniformBlockIndex(prog, "Material");
+    if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_MATERIAL);
+    b = gl->GetUniformBlockIndex(prog, "Lights");
+    if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_LIGHTS);
+}
+
+#define LIGHTS_FLOATS 600 /* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes */
+
+sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **out, char *err, size_t err_len)
+{
+    *out = NULL;
+    sy_gl_device_desc dd = {0};
+    if (desc) dd = *desc;
+    sy_gl_device *dev = calloc(1, sizeof *dev);
+    if (!dev) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "GL device: out of memory");
+    dev->log = dd.log;
+    dev->log_user = dd.log_user;
+    dev->meshes.elem = sizeof(mesh_o);
+    dev->textures.elem = sizeof(tex_o);
+    dev->materials.elem = sizeof(mat_o);
+    dev->instances.elem = sizeof(inst_o);
+    dev->lights.elem = sizeof(light_o);
+    sy_gl_result r = sy_gl_context_create(dd.provider, dd.window_width, dd.window_height, &dev->ctx, err, err_len);
+    if (r != SY_GL_OK) {
+        free(dev);
+        return r;
+    }
+    const sy_gl_fns *gl = dev->gl = sy_gl_context_fns(dev->ctx);
+    snprintf(dev->info, sizeof dev->info, "OpenGL %s on %s (%s)", (const char *)gl->GetString(GL_VERSION),
+             (const char *)gl->GetString(GL_RENDERER), sy_gl_provider_name(dd.provider));
+    GLint max_samples = 1, max_tex = 2048;
+    gl->GetIntegerv(GL_MAX_SAMPLES, &max_samples);
+    gl->GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
+    dev->msaa = dd.msaa > 1 ? dd.msaa : 1;
+    if (dev->msaa > (uint32_t)max_samples) {
+        warn(dev, "raster: %u MSAA samples requested, the GL context allows %d; using %d", dev->msaa, max_samples,
+             max_samples);
+        dev->msaa = (uint32_t)(max_samples > 1 ? max_samples : 1);
+    }
+    dev->max_tex = (uint32_t)max_tex;
+    if (dd.max_texture_size && dd.max_texture_size < dev->max_tex) dev->max_tex = dd.max_texture_size;
+    dev->shadow_size = dd.shadow_map_size ? dd.shadow_map_size : SHADOW_SIZE_DEFAULT;
+    if (dev->shadow_size > (uint32_t)max_tex) dev->shadow_size = (uint32_t)max_tex;
+    static const char *const defs[4] = {NULL, "#define SY_LEAN 1\n", "#define SY_MASK 1\n",
+                                        "#define SY_MASK 1\n#define SY_LEAN 1\n"};
+    static const char *const names[4] = {"main", "main (lean)", "main (alpha mask)", "main (alpha mask, lean)"};
+    for (int v = 0; v < 4 && r == SY_GL_OK; ++v)
+        r = sy_gl_program_build(gl, names[v], sy_gl_main_vs, sy_gl_main_fs, defs[v], &dev->pm[v].prog, err, err_len);
+    for (int v = 0; v < 2 && r == SY_GL_OK; ++v)
+        r = sy_gl_program_build(gl, v ? "shadow (alpha mask)" : "shadow", sy_gl_shadow_vs, sy_gl_shadow_fs, defs[2 * v],
+                                &dev->ps[v].prog, err, err_len);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "resolve", sy_gl_resolve_vs, sy_gl_resolve_fs, NULL, &dev->prog_resolve, err, err_len);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "floor", sy_gl_floor_vs, sy_gl_floor_fs, NULL, &dev->prog_floor, err, err_len);
+    if (r != SY_GL_OK) {
+        sy_gl_device_destroy(dev);
+        return r;
+    }
+    for (int v = 0; v < 4; ++v) {
+        GLuint p = dev->pm[v].prog;
+        dev->pm[v].model = gl->GetUniformLocation(p, "u_model");
+        dev->pm[v].normal_mat = gl->GetUniformLocation(p, "u_normal_mat");
+        dev->pm[v].view = gl->GetUniformLocation(p, "u_view");
+        dev->pm[v].proj = gl->GetUniformLocation(p, "u_proj");
+        dev->pm[v].cam_pos = gl->GetUniformLocation(p, "u_cam_pos");
+        dev->pm[v].cam_fwd = gl->GetUniformLocation(p, "u_cam_fwd");
+        dev->pm[v].ortho = gl->GetUniformLocation(p, "u_ortho");
+        dev->pm[v].mirror = gl->GetUniformLocation(p, "u_mirror");
+        dev->pm[v].has_normals = gl->GetUniformLocation(p, "u_has_normals");
+        bind_samplers(gl, p);
+    }
+    for (int v = 0; v < 2; ++v) {
+        dev->ps[v].model = gl->GetUniformLocation(dev->ps[v].prog, "u_model");
+        dev->ps[v].lightvp = gl->GetUniformLocation(dev->ps[v].prog, "u_lightvp");
+        bind_samplers(gl, dev->ps[v].prog);
+    }
+    gl->UseProgram(dev->prog_resolve);
+    gl->Uniform1i(gl->GetUniformLocation(dev->prog_resolve, "t_color"), 0);
+    gl->Uniform1i(gl->GetUniformLocation(dev->prog_resolve, "t_depth"), 1);
+    dev->ur.samples = gl->GetUniformLocation(dev->prog_resolve, "u_samples");
+    dev->uf.model = gl->GetUniformLocation(dev->prog_floor, "u_model");
+    dev->uf.view = gl->GetUniformLocation(dev->prog_floor, "u_view");
+    dev->uf.proj = gl->GetUniformLocation(dev->prog_floor, "u_proj");
+
+    static const unsigned char white[4] = {255, 255, 255, 255}, flat[4] = {128, 128, 255, 255};
+    dev->white_tex = make_tex1(gl, white);
+    dev->flat_normal_tex = make_tex1(gl, flat);
+    sy_gl_material_desc md;
+    sy_gl_material_desc_init(&md);
+    mat_block mb;
+    material_block(dev, &md, &mb);
+    gl->GenBuffers(1, &dev->default_ubo);
+    gl->BindBuffer(GL_UNIFORM_BUFFER, dev->default_ubo);
+    gl->BufferData(GL_UNIFORM_BUFFER, sizeof mb, &mb, GL_STATIC_DRAW);
+    gl->GenBuffers(1, &dev->lights_ubo);
+    gl->BindBuffer(GL_UNIFORM_BUFFER, dev->lights_ubo);
+    gl->BufferData(GL_UNIFORM_BUFFER, LIGHTS_FLOATS * sizeof(float), NULL, GL_DYNAMIC_DRAW);
+    gl->GenVertexArrays(1, &dev->empty_vao);
+    /* shadow maps: one depth texture array, compared in the shader (hardware PCF) */
+    gl->GenTextures(1, &dev->shadow_tex);
+    gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->shadow_tex);
+    gl->TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT32F, (GLsizei)dev->shadow_size, (GLsizei)dev->shadow_size,
+                   SY_GL_MAX_SHADOW_MAPS, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    static const float border[4] = {1, 1, 1, 1};
+    gl->TexParameterfv(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_BORDER_COLOR, border);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    gl->GenFramebuffers(1, &dev->shadow_fbo);
+    dev->lights_dirty = true;
+    if ((r = gl_check(dev, "GL device setup", err, err_len)) != SY_GL_OK) {
+        sy_gl_device_destroy(dev);
+        return r;
+    }
+    *out = dev;
+    return SY_GL_OK;
+}
+
+static void targets_free(sy_gl_device *dev, targets *t)
+{
+    const sy_gl_fns *gl = dev->gl;
+    GLuint fb[2] = {t->fbo, t->rfbo}, tx[4] = {t->color, t->depthlin, t->rcolor, t->rdepthlin};
+    gl->DeleteFramebuffers(2, fb);
+    gl->DeleteTextures(4, tx);
+    gl->DeleteRenderbuffers(1, &t->depth_rb);
+    memset(t, 0, sizeof *t);
+}
+
+void sy_gl_device_destroy(sy_gl_device *dev)
+{
+    if (!dev) return;
+    if (dev->ctx && sy_gl_context_make_current(dev->ctx) && dev->gl) {
+        const sy_gl_fns *gl = dev->gl;
+        for (uint32_t i = 0; i < dev->meshes.count; ++i) {
+            mesh_o *m = pool_at(&dev->meshes, i);
+            if (!m->h.id) continue;
+            gl->DeleteBuffers(1, m->vbo);
+            gl->DeleteBuffers(1, &m->ibo);
+            gl->DeleteVertexArrays(1, &m->vao);
+        }
+        for (uint32_t i = 0; i < dev->textures.count; ++i) {
+            tex_o *t = pool_at(&dev->textures, i);
+            if (t->h.id) gl->DeleteTextures(1, &t->tex);
+        }
+        for (uint32_t i = 0; i < dev->materials.count; ++i) {
+            mat_o *m = pool_at(&dev->materials, i);
+            if (m->h.id) gl->DeleteBuffers(1, &m->ubo);
+        }
+        targets_free(dev, &dev->t);
+        GLuint progs[8] = {dev->pm[0].prog, dev->pm[1].prog, dev->pm[2].prog, dev->pm[3].prog,
+                           dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor};
+        for (int i = 0; i < 8; ++i)
+            if (progs[i]) gl->DeleteProgram(progs[i]);
+        GLuint bufs[2] = {dev->default_ubo, dev->lights_ubo}, texs[3] = {dev->white_tex, dev->flat_normal_tex, dev->shadow_tex};
+        gl->DeleteBuffers(2, bufs);
+        gl->DeleteTextures(3, texs);
+        gl->DeleteFramebuffers(1, &dev->shadow_fbo);
+        gl->DeleteVertexArrays(1, &dev->empty_vao);
+    }
+    sy_gl_context_destroy(dev->ctx);
+    free(dev->meshes.items);
+    free(dev->textures.items);
+    free(dev->materials.items);
+    free(dev->instances.items);
+    free(dev->lights.items);
+    free(dev->scratch);
+    free(dev);
+}
+
+const char *sy_gl_device_info(const sy_gl_device *dev) { return dev->info; }
+
+void sy_gl_device_stats(const sy_gl_device *dev, sy_gl_stats *out)
+{
+    memset(out, 0, sizeof *out);
+    out->meshes = dev->meshes.live;
+    out->textures = dev->textures.live;
+    out->materials = dev->materials.live;
+    out->instances = dev->instances.live;
+    out->lights = dev->lights.live;
+    out->msaa_samples = dev->msaa;
+    out->shadow_maps = dev->shadow_maps;
+    out->triangles_drawn = dev->tris;
+    out->draw_calls = dev->draws;
+    out->frame = dev->frame;
+    out->total = dev->counts;
+}
+
+/* Geometry moved, appeared or vanished: shadow maps (and their frusta, fitted to the scene bounds)
+ * must be redrawn, which happens with the lights-block update at the next frame. Without
+ * shadow-casting lights nothing needs to be redone. */
+static void geometry_changed(sy_gl_device *dev)
+{
+    if (dev->shadow_maps > 0) dev->lights_dirty = true;
+}
+
+/* >>mesh */
+sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_gl_mesh *out, char *err,
+                               size_t err_len)
+{
+    out->id = 0;
+    if (!d || !d->positions || d->vertex_count == 0 || d->triangle_count == 0)
+        return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: positions and a non-zero vertex and triangle count are required");
+    if (d->triangle_count > UINT32_MAX / 3u)
+        return fail(err, err_len, SY_GL_ERROR_LIMIT, "mesh: %u triangles exceed the index range", d->triangle_count);
+    if (!d->indices && d->vertex_count != 3u * d->triangle_count)
+        return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT,
+                    "mesh: without indices vertex_count (%u) must be 3 x triangle_count (%u)", d->vertex_count,
+                    d->triangle_count);
+    float bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < d->vertex_count; ++i)
+        for (int k = 0; k < 3; ++k) {
+            float v = d->positions[3u * i + k];
+            if (!isfinite(v)) return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: position %u is not finite", i);
+            bmin[k] = fminf(bmin[k], v);
+            bmax[k] = fmaxf(bmax[k], v);
+        }
+    if (d->indices)
+        for (uint32_t i = 0; i < 3u * d->triangle_count; ++i)
+            if (d->indices[i] >= d->vertex_count)
+                return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: index %u = %u is out of range (%u vertices)",
+                            i, d->indices[i], d->vertex_count);
+    sy_gl_result r = current(dev, err, err_len);
+    if (r != SY_GL_OK) return r;
+    mesh_o *m = pool_alloc(&dev->meshes);
+    if (!m) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
+    const sy_gl_fns *gl = dev->gl;
+    m->vertex_count = d->vertex_count;
+    m->triangle_count = d->triangle_count;
+    memcpy(m->bmin, bmin, sizeof bmin);
+    memcpy(m->bmax, bmax, sizeof bmax);
+    gl->GenVertexArrays(1, &m->vao);
+    gl->BindVertexArray(m->vao);
+    /* one interleaved vertex buffer (present attributes only) + one index buffer */
+    const float *arrays[5] = {d->positions, d->normals, d->uv[0], d->uv[1], d->colors};
+    static const int comps[5] = {3, 3, 2, 2, 4};
+    int stride = 0, offs[5];
+    for (int a = 0; a < 5; ++a) {
+        offs[a] = stride;
+        if (arrays[a]) stride += comps[a];
+    }
+    size_t bytes = (size_t)d->vertex_count * (size_t)stride * sizeof(float);
+    float *vb = malloc(bytes);
+    if (!vb) {
+        pool_free(&dev->meshes, m);
+        return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory (%u vertices)", d->vertex_count);
+    }
+    for (uint32_t i = 0; i < d->vertex_count; ++i)
+        for (int a = 0; a < 5; ++a)
+            if (arrays[a]) memcpy(vb + (size_t)i * stride + offs[a], arrays[a] + (size_t)i * comps[a], comps[a] * sizeof(float));
+    gl->GenBuffers(1, &m->vbo[0]);
+    gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
+    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, vb, GL_STATIC_DRAW);
+    count_buffer(dev, false, bytes);
+    free(vb);
+    for (int a = 0; a < 5; ++a) {
+        m->has_attr[a] = arrays[a] != NULL;
+        if (!arrays[a]) continue;
+        gl->EnableVertexAttribArray((GLuint)a);
+        gl->VertexAttribPointer((GLuint)a, comps[a], GL_FLOAT, GL_FALSE, stride * (GLsizei)sizeof(float),
+                                (const void *)(uintptr_t)(offs[a] * sizeof(float)));
+    }
+    m->has_normals = d->normals != NULL;
+    if (d->indices) {
+        size_t bytes = (size_t)d->triangle_count * 3u * sizeof(uint32_t);
+        gl->GenBuffers(1, &m->ibo);
+        gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, m->ibo);
+        gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)bytes, d->indices, GL_STATIC_DRAW);
+        count_buffer(dev, false, bytes);
+        m->indexed = true;
+    }
+    gl->BindVertexArray(0);
+    r = gl_check(dev, "mesh upload", err, err_len);
+    if (r != SY_GL_OK) {
+        sy_gl_mesh h = {m->h.id};
+        sy_gl_mesh_destroy(dev, h);
+        return r;
+    }
+    out->id = m->h.id;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh)
+{
+    mesh_o *m = pool_get(&dev->meshes, mesh.id);
+    if (!m) return SY_GL_ERROR_INVALID_HANDLE;
+    if (current(dev, NULL, 0) == SY_GL_OK) {
+        dev->gl->DeleteBuffers(1, m->vbo);
+        dev->gl->DeleteBuffers(1, &m->ibo);
+        dev->gl->DeleteVertexArrays(1, &m->vao);
+    }
+    pool_free(&dev->meshes, m);
+    geometry_changed(dev);
+    return SY_GL_OK;
+}
+
+/* >>texture */
+/* Halves an RGBA float image (box filter; odd edges clamp). */
+static void halve(const float *src, uint32_t w, uint32_t h, float *dst, uint32_t *ow, uint32_t *oh)
+{
+    uint32_t nw = w > 1 ? w / 2 : 1, nh = h > 1 ? h / 2 : 1;
+    for (uint32_t y = 0; y < nh; ++y)
+        for (uint32_t x = 0; x < nw; ++x)
+            for (int c = 0; c < 4; ++c) {
+                uint32_t x0 = x * 2 < w ? x * 2 : w - 1, x1 = x * 2 + 1 < w ? x * 2 + 1 : w - 1;
+                uint32_t y0 = y * 2 < h ? y * 2 : h - 1, y1 = y * 2 + 1 < h ? y * 2 + 1 : h - 1;
+                dst[((size_t)y * nw + x) * 4 + c] =
+                    0.25f * (src[((size_t)y0 * w + x0) * 4 + c] + src[((size_t)y0 * w + x1) * 4 + c] +
+                             src[((size_t)y1 * w + x0) * 4 + c] + src[((size_t)y1 * w + x1) * 4 + c]);
+            }
+    *ow = nw;
+    *oh = nh;
+}
+
+static float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
+static float linear_to_srgb(float c) { return c <= 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f; }
+
+sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d, sy_gl_texture *out, char *err,
+                                  size_t err_len)
+{
+    out->id = 0;
+    if (!d || !d->pixels || d->width == 0 || d->height == 0 || d->channels < 1 || d->channels > 4)
+        return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "texture: needs pixels, a non-zero size and 1..4 channels");
+    if (d->format != SY_GL_TEXEL_UNORM8 && d->format != SY_GL_TEXEL_UNORM8_SRGB && d->format != SY_GL_TEXEL_FLOAT32)
+        return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "texture: unknown texel format %d", (int)d->format);
+    size_t n = (size_t)d->width * d->height;
+    if (n / d->width != d->height || n > ((size_t)1 << 32))
+        return fail(err, err_len, SY_GL_ERROR_LIMIT, "texture: %ux%u is too large", d->width, d->height);
+    bool is_float = d->format == SY_GL_TEXEL_FLOAT32, srgb = d->format == SY_GL_TEXEL_UNORM8_SRGB;
+    bool downscale = d->width > dev->max_tex || d->height > dev->max_tex;
+    const unsigned char *u8 = d->pixels;
+    const float *f32 = d->pixels;
+    uint32_t ch = d->channels, w = d->width, h = d->height;
+    float *img = NULL;          /* RGBA float: float textures, and 8-bit ones that need downscaling */
+    unsigned char *img8 = NULL; /* RGBA8: 8-bit textures within the limit (no conversion) */
+    if (!is_float && !downscale) {
+        img8 = malloc(n * 4);
+        if (!img8) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (%ux%u)", d->width, d->height);
+        for (size_t i = 0; i < n; ++i) {
+            const unsigned char *s = u8 + i * ch;
+            unsigned char *o = img8 + i * 4;
+            if (ch <= 2) o[0] = o[1] = o[2] = s[0], o[3] = ch == 2 ? s[1] : 255;
+            else o[0] = s[0], o[1] = s[1], o[2] = s[2], o[3] = ch == 4 ? s[3] : 255;
+        }
+    } else {
+        /* expand to RGBA (grey -> rgb, grey+alpha -> rgb+a) in float, filter in linear space */
+        img = malloc(n * 4 * sizeof *img);
+        if (!img) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (%ux%u)", d->width, d->height);
+        for (size_t i = 0; i < n; ++i) {
+            float v[4] = {0, 0, 0, 1};
+            for (uint32_t c = 0; c < ch; ++c) v[c] = is_float ? f32[i * ch + c] : (float)u8[i * ch + c] / 255.0f;
+            if (ch <= 2) {
+                if (ch == 2) v[3] = v[1];
+                v[1] = v[2] = v[0];
+            }
+            if (srgb)
+                for (int c = 0; c < 3; ++c) v[c] = srgb_to_linear(v[c]);
+            memcpy(img + i * 4, v, sizeof v);
+        }
+    }
+    if (downscale) {
+        uint32_t ow = w, oh = h;
+        while (w > dev->max_tex || h > dev->max_tex) {
+            float *nimg = malloc((size_t)(w > 1 ? w / 2 : 1) * (h > 1 ? h / 2 : 1) * 4 * sizeof *nimg);
+            if (!nimg) {
+                free(img);
+                return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory while downscaling");
+            }
+            halve(img, w, h, nimg, &w, &h);
+            free(img);
+            img = nimg;
+        }
+        warn(dev, "raster: texture %ux%u exceeds the GL limit of %u texels per side; downscaled to %ux%u", ow, oh,
+             dev->max_tex, w, h);
+    }
+    sy_gl_result r = current(dev, err, err_len);
+    tex_o *t = r == SY_GL_OK ? pool_alloc(&dev->textures) : NULL;
+    if (r == SY_GL_OK && !t) r = fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory");
+    size_t count = (size_t)w * h;
+    if (r == SY_GL_OK && !is_float && !img8) { /* downscaled 8-bit: back to bytes */
+        img8 = malloc(count * 4);
+        if (!img8) r = fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory");
+        for (size_t i = 0; img8 && i < count * 4; ++i) {
+            float v = img[i];
+            if (srgb && (i & 3u) != 3u) v = linear_to_srgb(v);
+            v = v < 0.0f ? 0.0f : v > 1.0f ? 1.0f : v;
+            img8[i] = (unsigned char)lrintf(v * 255.0f);
+        }
+    }
+    if (r != SY_GL_OK) {
+        if (t) pool_free(&dev->textures, t);
+        free(img);
+        free(img8);
+        return r;
+    }
+    const sy_gl_fns *gl = dev->gl;
+    gl->GenTextures(1, &t->tex);
+    gl->BindTexture(GL_TEXTURE_2D, t->tex);
+    gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    if (is_float) {
+        gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, (GLsizei)w, (GLsizei)h, 0, GL_RGBA, GL_FLOAT, img);
+        dev->counts.texture_bytes += count * 16;
+    } else {
+        gl->TexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, (GLsizei)w, (GLsizei)h, 0, GL_RGBA,
+                       GL_UNSIGNED_BYTE, img8);
+        dev->counts.texture_bytes += count * 4;
+    }
+    free(img);
+    free(img8);
+    dev->counts.texture_uploads++;
+    gl->GenerateMipmap(GL_TEXTURE_2D);
+    static const GLint wraps[3] = {GL_REPEAT, GL_CLAMP_TO_EDGE, GL_MIRRORED_REPEAT};
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wraps[(unsigned)d->wrap_s < 3u ? d->wrap_s : 0]);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wraps[(unsigned)d->wrap_t < 3u ? d->wrap_t : 0]);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, d->nearest ? GL_NEAREST : GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, d->nearest ? GL_NEAREST_MIPMAP_LINEAR : GL_LINEAR_MIPMAP_LINEAR);
+    r = gl_check(dev, "texture upload", err, err_len);
+    if (r != SY_GL_OK) {
+        sy_gl_texture_destroy(dev, (sy_gl_texture){t->h.id});
+        return r;
+    }
+    out->id = t->h.id;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_texture_destroy(sy_gl_device *dev, sy_gl_texture tex)
+{
+    tex_o *t = pool_get(&dev->textures, tex.id);
+    if (!t) return SY_GL_ERROR_INVALID_HANDLE;
+    if (current(dev, NULL, 0) == SY_GL_OK) dev->gl->DeleteTextures(1, &t->tex);
+    pool_free(&dev->textures, t);
+    return SY_GL_OK;
+}
+
+/* >>material */
+void sy_gl_material_desc_init(sy_gl_material_desc *d)
+{
+    memset(d, 0, sizeof *d);
+    for (int i = 0; i < 4; ++i) d->base_color[i] = 1.0f;
+    d->metallic = d->roughness = 1.0f;
+    d->normal_scale = 1.0f;
+    d->occlusion_strength = 1.0f;
+    d->specular = 1.0f;
+    d->ior = 1.5f;
+    d->alpha_cutoff = 0.5f;
+}
+
+static sy_gl_result material_check(const sy_gl_material_desc *d, char *err, size_t len)
+{
+    const float *v[] = {d->base_color, d->base_color + 1, d->base_color + 2, d->base_color + 3, &d->metallic,
+                        &d->roughness, d->emissive, d->emissive + 1, d->emissive + 2, &d->normal_scale,
+                        &d->occlusion_strength, &d->specular, &d->transmission, &d->ior, &d->alpha_cutoff};
+    for (size_t i = 0; i < sizeof v / sizeof v[0]; ++i)
+        if (!isfinite(*v[i])) return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "material: parameter %zu is not finite", i);
+    if ((unsigned)d->alpha_mode > 2u)
+        return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "material: unknown alpha mode %d", (int)d->alpha_mode);
+    return SY_GL_OK;
+}
+
+static void material_upload(sy_gl_device *dev, mat_o *m, bool create)
+{
+    mat_block b;
+    material_block(dev, &m->d, &b);
+    const sy_gl_fns *gl = dev->gl;
+    gl->BindBuffer(GL_UNIFORM_BUFFER, m->ubo);
+    if (create) gl->BufferData(GL_UNIFORM_BUFFER, sizeof b, &b, GL_DYNAMIC_DRAW);
+    else gl->BufferSubData(GL_UNIFORM_BUFFER, 0, sizeof b, &b);
+    count_buffer(dev, true, sizeof b);
+}
+
+sy_gl_result sy_gl_material_create(sy_gl_device *dev, const sy_gl_material_desc *d, sy_gl_material *out, char *err,
+                                   size_t err_len)
+{
+    out->id = 0;
+    sy_gl_result r = material_check(d, err, err_len);
+    if (r == SY_GL_OK) r = current(dev, err, err_len);
+    if (r != SY_GL_OK) return r;
+    mat_o *m = pool_alloc(&dev->materials);
+    if (!m) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "material: out of memory");
+    m->d = *d;
+    dev->gl->GenBuffers(1, &m->ubo);
+    material_upload(dev, m, true);
+    out->id = m->h.id;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const sy_gl_material_desc *d, char *err,
+                                   size_t err_len)
+{
+    mat_o *m = pool_get(&dev->materials, mat.id);
+    if (!m) return fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "material update: stale handle %u", mat.id);
+    sy_gl_result r = material_check(d, err, err_len);
+    if (r == SY_GL_OK) r = current(dev, err, err_len);
+    if (r != SY_GL_OK) return r;
+    bool shadows = m->d.alpha_mode == SY_GL_ALPHA_MASK || d->alpha_mode == SY_GL_ALPHA_MASK ||
+                   memcmp(m->d.emissive, d->emissive, sizeof d->emissive) != 0;
+    m->d = *d;
+    material_upload(dev, m, false);
+    if (shadows) geometry_changed(dev); /* shadow casters changed */
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_material_destroy(sy_gl_device *dev, sy_gl_material mat)
+{
+    mat_o *m = pool_get(&dev->materials, mat.id);
+    if (!m) return SY_GL_ERROR_INVALID_HANDLE;
+    if (current(dev, NULL, 0) == SY_GL_OK) dev->gl->DeleteBuffers(1, &m->ubo);
+    pool_free(&dev->materials, m);
+    return SY_GL_OK;
+}
+
+/* >>instance/light */
+static bool set_model(inst_o *in, const float *t)
+{
+    float inv[16];
+    for (int i = 0; i < 16; ++i)
+        if (!isfinite(t[i])) return false;
+    if (!m4_invert(t, inv)) return false;
+    memcpy(in->model, t, sizeof in->model);
+    /* normal matrix = inverse transpose of the upper 3x3 */
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) in->normal_mat[c * 3 + r] = inv[r * 4 + c];
+    float det = t[0] * (t[5] * t[10] - t[9] * t[6]) - t[4] * (t[1] * t[10] - t[9] * t[2]) + t[8] * (t[1] * t[6] - t[5] * t[2]);
+    in->mirror = det < 0.0f;
+    return true;
+}
+
+sy_gl_result sy_gl_instance_create(sy_gl_device *dev, const sy_gl_instance_desc *d, sy_gl_instance *out, char *err,
+                                   size_t err_len)
+{
+    out->id = 0;
+    if (!pool_get(&dev->meshes, d->mesh.id))
+        return fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "instance: mesh handle %u is stale", d->mesh.id);
+    inst_o tmp;
+    if (!set_model(&tmp, d->transform))
+        return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "instance: transform is not finite and invertible");
+    inst_o *in = pool_alloc(&dev->instances);
+    if (!in) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "instance: out of memory");
+    set_model(in, d->transform);
+    in->mesh = d->mesh;
+    in->material = d->material;
+    in->visible = !d->hidden;
+    dev->counts.model_matrix_updates++;
+    geometry_changed(dev);
+    out->id = in->h.id;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_instance_set_transform(sy_gl_device *dev, sy_gl_instance inst, const float t[16], char *err,
+                                          size_t err_len)
+{
+    inst_o *in = pool_get(&dev->instances, inst.id);
+    if (!in) return fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "instance transform: stale handle %u", inst.id);
+    if (!set_model(in, t))
+        return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "instance transform: not finite and invertible");
+    dev->counts.model_matrix_updates++;
+    geometry_changed(dev);
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_instance_set_material(sy_gl_device *dev, sy_gl_instance inst, sy_gl_material mat)
+{
+    inst_o *in = pool_get(&dev->instances, inst.id);
+    if (!in) return SY_GL_ERROR_INVALID_HANDLE;
+    in->material = mat;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_instance_set_visible(sy_gl_device *dev, sy_gl_instance inst, bool visible)
+{
+    inst_o *in = pool_get(&dev->instances, inst.id);
+    if (!in) return SY_GL_ERROR_INVALID_HANDLE;
+    if (in->visible != visible) geometry_changed(dev);
+    in->visible = visible;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_instance_destroy(sy_gl_device *dev, sy_gl_instance inst)
+{
+    inst_o *in = pool_get(&dev->instances, inst.id);
+    if (!in) return SY_GL_ERROR_INVALID_HANDLE;
+    pool_free(&dev->instances, in);
+    geometry_changed(dev);
+    return SY_GL_OK;
+}
+
+static sy_gl_result light_check(const sy_gl_light_desc *d, char *err, size_t len)
+{
+    if (d->type != SY_GL_LIGHT_POINT && d->type != SY_GL_LIGHT_SPOT && d->type != SY_GL_LIGHT_DIRECTIONAL)
+        return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "light: unknown type %d", (int)d->type);
+    const float *v[] = {d->color, d->color + 1, d->color + 2, &d->intensity, d->position, d->position + 1,
+                        d->position + 2, d->direction, d->direction + 1, d->direction + 2, &d->range,
+                        &d->inner_cone_angle, &d->outer_cone_angle};
+    for (size_t i = 0; i < sizeof v / sizeof v[0]; ++i)
+        if (!isfinite(*v[i])) return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "light: parameter %zu is not finite", i);
+    if (d->type != SY_GL_LIGHT_POINT && !(fabsf(d->direction[0]) + fabsf(d->direction[1]) + fabsf(d->direction[2]) > 0.0f))
+        return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "light: zero direction");
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_light_create(sy_gl_device *dev, const sy_gl_light_desc *d, sy_gl_light *out, char *err,
+                                size_t err_len)
+{
+    out->id = 0;
+    sy_gl_result r = light_check(d, err, err_len);
+    if (r != SY_GL_OK) return r;
+    light_o *l = pool_alloc(&dev->lights);
+    if (!l) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "light: out of memory");
+    l->d = *d;
+    dev->lights_dirty = true;
+    out->id = l->h.id;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_gl_light_desc *d, char *err,
+                                size_t err_len)
+{
+    light_o *l = pool_get(&dev->lights, light.id);
+    if (!l) return fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "light update: stale handle %u", light.id);
+    sy_gl_result r = light_check(d, err, err_len);
+    if (r != SY_GL_OK) return r;
+    l->d = *d;
+    dev->lights_dirty = true;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_light_destroy(sy_gl_device *dev, sy_gl_light light)
+{
+    light_o *l = pool_get(&dev->lights, light.id);
+    if (!l) return SY_GL_ERROR_INVALID_HANDLE;
+    pool_free(&dev->lights, l);
+    dev->lights_dirty = true;
+    return SY_GL_OK;
+}
+
+void sy_gl_set_background(sy_gl_device *dev, bool has_color, const float color[3])
+{
+    bool same = dev->has_bg == has_color && (!has_color || !memcmp(dev->bg, color, sizeof dev->bg));
+    if (same) return;
+    dev->has_bg = has_color;
+    if (has_color) memcpy(dev->bg, color, sizeof dev->bg);
+    dev->lights_dirty = true;
+}
+
+bool sy_gl_window_should_close(sy_gl_device *dev) { return sy_gl_context_should_close(dev->ctx); }
+
+/* >>render */
+static void scene_bounds(const sy_gl_device *dev, float *c, float *radius)
+{
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        const inst_o *in = pool_at(&dev->instances, i);
+        if (!in->h.id || !in->visible) continue;
+        const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
+        if (!m) continue;
+        for (int k = 0; k < 8; ++k) {
+            float p[3] = {k & 1 ? m->bmax[0] : m->bmin[0], k & 2 ? m->bmax[1] : m->bmin[1], k & 4 ? m->bmax[2] : m->bmin[2]};
+            for (int a = 0; a < 3; ++a) {
+                float v = in->model[a] * p[0] + in->model[4 + a] * p[1] + in->model[8 + a] * p[2] + in->model[12 + a];
+                lo[a] = fminf(lo[a], v);
+                hi[a] = fmaxf(hi[a], v);
+            }
+        }
+    }
+    if (!(lo[0] <= hi[0])) {
+        c[0] = c[1] = c[2] = 0.0f;
+        *radius = 1.0f;
+        return;
+    }
+    float r2 = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        c[a] = 0.5f * (lo[a] + hi[a]);
+        r2 += 0.25f * (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    }
+    *radius = fmaxf(sqrtf(r2), 1e-3f);
+}
+
+typedef struct frame_state {
+    float shadow_vp[SY_GL_MAX_SHADOW_MAPS][16];
+    uint32_t shadow_count;
+} frame_state;
+
+/* Lights UBO (+ shadow matrices from the scene bounds). One upload. */
+static void lights_upload(sy_gl_device *dev, frame_state *fs)
+{
+    float blk[LIGHTS_FLOATS];
+    memset(blk, 0, sizeof blk);
+    int32_t *ib = (int32_t *)(void *)blk;
+    float c[3], R;
+    scene_bounds(dev, c, &R);
+    uint32_t n = 0, ns = 0;
+    for (uint32_t i = 0; i < dev->lights.count; ++i) {
+        const light_o *l = pool_at(&dev->lights, i);
+        if (!l->h.id) continue;
+        if (n == SY_GL_MAX_LIGHTS) {
+            if (!dev->warned_lights)
+                warn(dev, "raster: more than %d lights; the rest are ignored", SY_GL_MAX_LIGHTS);
+            dev->warned_lights = true;
+            break;
+        }
+        const sy_gl_light_desc *d = &l->d;
+        float *o = blk + 88 + 16 * n;
+        float dir[3] = {d->direction[0], d->direction[1], d->direction[2]};
+        v3_norm(dir);
+        memcpy(o, d->position, 3 * sizeof(float));
+        o[3] = (float)d->type;
+        memcpy(o + 4, dir, sizeof dir);
+        o[7] = d->range;
+        for (int k = 0; k < 3; ++k) o[8 + k] = d->color[k] * d->intensity;
+        float ci = cosf(d->inner_cone_angle), co = cosf(d->outer_cone_angle);
+        o[12] = 1.0f / fmaxf(0.001f, ci - co);
+        o[13] = -co * o[12];
+        o[14] = -1.0f;
+        if (d->type != SY_GL_LIGHT_POINT && !d->no_shadow && ns < SY_GL_MAX_SHADOW_MAPS) {
+            float view[16], proj[16];
+            float S = (float)dev->shadow_size;
+            if (d->type == SY_GL_LIGHT_DIRECTIONAL) {
+                float eye[3] = {c[0] - dir[0] * 2.0f * R, c[1] - dir[1] * 2.0f * R, c[2] - dir[2] * 2.0f * R};
+                look_along(eye, dir, view);
+                projection(true, -R, R, -R, R, 0.5 * R, 3.5 * R, proj);
+                blk[72 + 4 * ns] = 1.5f * 2.0f * R / S;
+                blk[72 + 4 * ns + 1] = 0.0f;
+            } else {
+                float half = fminf(d->outer_cone_angle + 0.01f, 1.48f), t = tanf(half);
+                float dc = sqrtf((d->position[0] - c[0]) * (d->position[0] - c[0]) +
+                                 (d->position[1] - c[1]) * (d->position[1] - c[1]) +
+                                 (d->position[2] - c[2]) * (d->position[2] - c[2]));
+                double far = dc + R, nearp = fmax(1e-3 * far, 1e-4);
+                look_along(d->position, dir, view);
+                projection(false, -t, t, -t, t, nearp, far, proj);
+                blk[72 + 4 * ns] = 1.5f * 2.0f * t / S;
+                blk[72 + 4 * ns + 1] = 1.0f;
+            }
+            m4_mul(proj, view, fs->shadow_vp[ns]);
+            memcpy(blk + 8 + 16 * ns, fs->shadow_vp[ns], 16 * sizeof(float));
+            o[14] = (float)ns;
+            ns++;
+        }
+        n++;
+    }
+    ib[0] = (int32_t)n;
+    if (dev->has_bg) {
+        memcpy(blk + 4, dev->bg, 3 * sizeof(float));
+        blk[7] = 1.0f;
+    }
+    fs->shadow_count = ns;
+    dev->gl->BindBuffer(GL_UNIFORM_BUFFER, dev->lights_ubo);
+    dev->gl->BufferSubData(GL_UNIFORM_BUFFER, 0, sizeof blk, blk);
+    count_buffer(dev, true, sizeof blk);
+}
+
+static void draw_mesh(sy_gl_device *dev, const mesh_o *m)
+{
+    const sy_gl_fns *gl = dev->gl;
+    gl->BindVertexArray(m->vao);
+    if (!m->has_attr[1]) gl->VertexAttrib4f(1, 0, 0, 1, 0);
+    if (!m->has_attr[2]) gl->VertexAttrib4f(2, 0, 0, 0, 0);
+    if (!m->has_attr[3]) gl->VertexAttrib4f(3, 0, 0, 0, 0);
+    if (!m->has_attr[4]) gl->VertexAttrib4f(4, 1, 1, 1, 1);
+    if (m->indexed) gl->DrawElements(GL_TRIANGLES, (GLsizei)(3u * m->triangle_count), GL_UNSIGNED_INT, NULL);
+    else gl->DrawArrays(GL_TRIANGLES, 0, (GLsizei)(3u * m->triangle_count));
+    dev->draws++;
+}
+
+static const mat_o *bind_material(sy_gl_device *dev, sy_gl_material id, bool all_textures)
+{
+    const sy_gl_fns *gl = dev->gl;
+    const mat_o *m = pool_get(&dev->materials, id.id);
+    gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_MATERIAL, m ? m->ubo : dev->default_ubo);
+    if (!m) return NULL;
+    const sy_gl_texture_ref *refs[5] = {&m->d.base_color_texture, &m->d.metallic_roughness_texture,
+                                        &m->d.normal_texture, &m->d.occlusion_texture, &m->d.emissive_texture};
+    for (int i = 0; i < (all_textures ? 5 : 1); ++i) {
+        const tex_o *t = pool_get(&dev->textures, refs[i]->texture.id);
+        gl->ActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        gl->BindTexture(GL_TEXTURE_2D, t ? t->tex : i == UNIT_NRM ? dev->flat_normal_tex : dev->white_tex);
+    }
+    return m;
+}
+
+static void render_shadows(sy_gl_device *dev, const frame_state *fs)
+{
+    const sy_gl_fns *gl = dev->gl;
+    gl->BindFramebuffer(GL_FRAMEBUFFER, dev->shadow_fbo);
+    gl->DrawBuffer(GL_NONE);
+    gl->ReadBuffer(GL_NONE);
+    gl->Viewport(0, 0, (GLsizei)dev->shadow_size, (GLsizei)dev->shadow_size);
+    gl->Enable(GL_DEPTH_TEST);
+    gl->DepthFunc(GL_LESS);
+    gl->DepthMask(GL_TRUE);
+    gl->Disable(GL_BLEND);
+    gl->Enable(GL_POLYGON_OFFSET_FILL);
+    gl->PolygonOffset(1.5f, 4.0f);
+    for (uint32_t s = 0; s < fs->shadow_count; ++s) {
+        gl->FramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, dev->shadow_tex, 0, (GLint)s);
+        gl->Clear(GL_DEPTH_BUFFER_BIT);
+        for (int v = 0; v < 2; ++v) {
+            gl->UseProgram(dev->ps[v].prog);
+            gl->UniformMatrix4fv(dev->ps[v].lightvp, 1, GL_FALSE, fs->shadow_vp[s]);
+            for (uint32_t i = 0; i < dev->instances.count; ++i) {
+                const inst_o *in = pool_at(&dev->instances, i);
+                if (!in->h.id || !in->visible) continue;
+                const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
+                const mat_o *mt = pool_get(&dev->materials, in->material.id);
+                if (!m || (mt && mt->d.alpha_mode == SY_GL_ALPHA_MASK) != (v == 1)) continue;
+                if (mt && (mt->d.emissive[0] > 0.0f || mt->d.emissive[1] > 0.0f || mt->d.emissive[2] > 0.0f))
+                    continue; /* emitters are lights in the ray tracers: they cast no shadow there either */
+                bind_material(dev, in->material, false);
+                gl->UniformMatrix4fv(dev->ps[v].model, 1, GL_FALSE, in->model);
+                draw_mesh(dev, m);
+            }
+        }
+    }
+    gl->Disable(GL_POLYGON_OFFSET_FILL);
+    dev->shadow_maps = fs->shadow_count;
+}
+
+static void frame_end(sy_gl_device *dev)
+{
+    const uint64_t *now = (const uint64_t *)&dev->counts, *mark = (const uint64_t *)&dev->mark;
+    uint64_t *fr = (uint64_t *)&dev->frame;
+    for (size_t i = 0; i < sizeof dev->counts / sizeof(uint64_t); ++i) fr[i] = now[i] - mark[i];
+    dev->mark = dev->counts;
+}
+
+static sy_gl_result targets_ensure(sy_gl_device *dev, uint32_t w, uint32_t h, char *err, size_t len)
+{
+    targets *t = &dev->t;
+    if (t->fbo && t->w == w && t->h == h && t->samples == dev->msaa) return SY_GL_OK;
+    targets_free(dev, t);
+    const sy_gl_fns *gl = dev->gl;
+    t->w = w;
+    t->h = h;
+    t->samples = dev->msaa;
+    GLenum target = t->samples > 1 ? GL_TEXTURE_2D_MULTISAMPLE : GL_TEXTURE_2D;
+    gl->GenFramebuffers(1, &t->fbo);
+    gl->BindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    GLuint *texs[2] = {&t->color, &t->depthlin};
+    GLenum fmts[2] = {GL_RGBA32F, GL_R32F};
+    for (int i = 0; i < 2; ++i) {
+        gl->GenTextures(1, texs[i]);
+        gl->BindTexture(target, *texs[i]);
+        if (t->samples > 1)
+            gl->TexImage2DMultisample(target, (GLsizei)t->samples, fmts[i], (GLsizei)w, (GLsizei)h, GL_TRUE);
+        else {
+            gl->TexImage2D(target, 0, (GLint)fmts[i], (GLsizei)w, (GLsizei)h, 0, i ? GL_RED : GL_RGBA, GL_FLOAT, NULL);
+            gl->TexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+            gl->TexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        }
+        gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, target, *texs[i], 0);
+    }
+    gl->GenRenderbuffers(1, &t->depth_rb);
+    gl->BindRenderbuffer(GL_RENDERBUFFER, t->depth_rb);
+    gl->RenderbufferStorageMultisample(GL_RENDERBUFFER, t->samples > 1 ? (GLsizei)t->samples : 0, GL_DEPTH_COMPONENT32F,
+                                       (GLsizei)w, (GLsizei)h);
+    gl->FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t->depth_rb);
+    GLenum st = gl->CheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (st != GL_FRAMEBUFFER_COMPLETE)
+        return fail(err, len, SY_GL_ERROR_GL, "render target %ux%u (%u samples): framebuffer incomplete (0x%04x)", w, h,
+                    t->samples, (unsigned)st);
+    if (t->samples > 1) {
+        gl->GenFramebuffers(1, &t->rfbo);
+        gl->BindFramebuffer(GL_FRAMEBUFFER, t->rfbo);
+        GLuint *rt[2] = {&t->rcolor, &t->rdepthlin};
+        for (int i = 0; i < 2; ++i) {
+            gl->GenTextures(1, rt[i]);
+            gl->BindTexture(GL_TEXTURE_2D, *rt[i]);
+            gl->TexImage2D(GL_TEXTURE_2D, 0, (GLint)fmts[i], (GLsizei)w, (GLsizei)h, 0, i ? GL_RED : GL_RGBA, GL_FLOAT, NULL);
+            gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+            gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+            gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, *rt[i], 0);
+        }
+        st = gl->CheckFramebufferStatus(GL_FRAMEBUFFER);
+        if (st != GL_FRAMEBUFFER_COMPLETE)
+            return fail(err, len, SY_GL_ERROR_GL, "resolve target %ux%u: framebuffer incomplete (0x%04x)", w, h, (unsigned)st);
+    }
+    return gl_check(dev, "render targets", err, len);
+}
+
+typedef struct view_setup {
+    float view[16], proj[16], cam_pos[3], cam_fwd[3];
+    bool ortho;
+} view_setup;
+
+static sy_gl_result view_make(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, view_setup *v,
+                              char *err, size_t len)
+{
+    const float *w = cam->window;
+    for (int i = 0; i < 4; ++i)
+        if (!isfinite(w[i])) return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: camera window[%d] is not finite", i);
+    if (!(w[0] < w[1]) || !(w[2] < w[3]))
+        return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: camera window needs left < right and bottom < top");
+    if (!isfinite(cam->near_clip) || cam->near_clip < 0.0f || !isfinite(cam->far_clip) || cam->far_clip < 0.0f ||
+        (cam->far_clip > 0.0f && cam->far_clip <= cam->near_clip))
+        return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: clip range near %g far %g is invalid",
+                    (double)cam->near_clip, (double)cam->far_clip);
+    if (d->image_width == 0 || d->image_height == 0 || d->width == 0 || d->height == 0 ||
+        d->x > d->image_width || d->width > d->image_width - d->x || d->y > d->image_height ||
+        d->height > d->image_height - d->y)
+        return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: rectangle %u,%u %ux%u is outside the %ux%u image",
+                    d->x, d->y, d->width, d->height, d->image_width, d->image_height);
+    if (!m4_invert(cam->camera_to_world, v->view))
+        return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: camera matrix is not invertible");
+    memcpy(v->cam_pos, cam->camera_to_world + 12, sizeof v->cam_pos);
+    for (int i = 0; i < 3; ++i) v->cam_fwd[i] = -cam->camera_to_world[8 + i];
+    v3_norm(v->cam_fwd);
+    v->ortho = cam->orthographic;
+    /* the sub-rectangle's own window of the full-image plane: pixel centres stay where they are */
+    double l = w[0], r = w[1], b = w[2], t = w[3], W = d->image_width, H = d->image_height;
+    double l2 = l + (r - l) * d->x / W, r2 = l + (r - l) * (d->x + d->width) / W;
+    double t2 = t - (t - b) * d->y / H, b2 = t - (t - b) * (d->y + d->height) / H;
+    float c[3], R;
+    scene_bounds(dev, c, &R);
+    double dist = 0.0;
+    for (int i = 0; i < 3; ++i) dist += (double)(c[i] - v->cam_pos[i]) * v->cam_fwd[i];
+    double n = cam->near_clip, f = cam->far_clip;
+    if (!v->ortho && n <= 0.0) n = fmax(1e-5 * (fabs(dist) + R), 1e-6);
+    if (v->ortho && f <= 0.0) f = fmax(dist + 2.0 * R, n + 1.0);
+    projection(v->ortho, l2, r2, b2, t2, n, f, v->proj);
+    return SY_GL_OK;
+}
+
+static int cmp_far_first(const void *a, const void *b)
+{
+    const float *x = a, *y = b;
+    return x[0] < y[0] ? 1 : x[0] > y[0] ? -1 : 0;
+}
+
+static void begin_target(sy_gl_device *dev)
+{
+    const sy_gl_fns *gl = dev->gl;
+    gl->BindFramebuffer(GL_FRAMEBUFFER, dev->t.fbo);
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    gl->DrawBuffers(2, bufs);
+    gl->Viewport(0, 0, (GLsizei)dev->t.w, (GLsizei)dev->t.h);
+    gl->ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    gl->DepthMask(GL_TRUE);
+    float bg[4] = {0, 0, 0, 0};
+    if (dev->has_bg) {
+        memcpy(bg, dev->bg, 3 * sizeof(float));
+        bg[3] = 1.0f;
+    }
+    const float inf[4] = {INFINITY, 0, 0, 0}, one = 1.0f;
+    gl->ClearBufferfv(GL_COLOR, 0, bg);
+    gl->ClearBufferfv(GL_COLOR, 1, inf);
+    gl->ClearBufferfv(GL_DEPTH, 0, &one);
+    gl->Enable(GL_DEPTH_TEST);
+    gl->DepthFunc(GL_LESS);
+    gl->Disable(GL_CULL_FACE); /* the ray tracers see both sides of every triangle */
+    gl->Disable(GL_BLEND);
+    if (dev->t.samples > 1) gl->Enable(GL_MULTISAMPLE);
+}
+
+/* Resolves (MSAA) and reads the target back into the caller's arrays, flipping rows. */
+static sy_gl_result finish_target(sy_gl_device *dev, float *rgba, float *depth, char *err, size_t len)
+{
+    const sy_gl_fns *gl = dev->gl;
+    targets *t = &dev->t;
+    GLuint read_fbo = t->fbo;
+    if (t->samples > 1) {
+        gl->BindFramebuffer(GL_FRAMEBUFFER, t->rfbo);
+        static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+        gl->DrawBuffers(2, bufs);
+        gl->Disable(GL_DEPTH_TEST);
+        gl->Disable(GL_BLEND);
+        gl->UseProgram(dev->prog_resolve);
+        gl->Uniform1i(dev->ur.samples, (GLint)t->samples);
+        gl->ActiveTexture(GL_TEXTURE0);
+        gl->BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t->color);
+        gl->ActiveTexture(GL_TEXTURE1);
+        gl->BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t->depthlin);
+        gl->BindVertexArray(dev->empty_vao);
+        gl->DrawArrays(GL_TRIANGLES, 0, 3);
+        read_fbo = t->rfbo;
+    }
+    size_t n = (size_t)t->w * t->h;
+    if (dev->scratch_len < n * 4) {
+        float *s = realloc(dev->scratch, n * 4 * sizeof *s);
+        if (!s) return fail(err, len, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory for read-back");
+        dev->scratch = s;
+        dev->scratch_len = n * 4;
+    }
+    gl->BindFramebuffer(GL_FRAMEBUFFER, read_fbo);
+    gl->PixelStorei(GL_PACK_ALIGNMENT, 4);
+    gl->ReadBuffer(GL_COLOR_ATTACHMENT0);
+    gl->ReadPixels(0, 0, (GLsizei)t->w, (GLsizei)t->h, GL_RGBA, GL_FLOAT, dev->scratch);
+    size_t row = (size_t)t->w * 4;
+    for (uint32_t y = 0; y < t->h; ++y) memcpy(rgba + row * y, dev->scratch + row * (t->h - 1 - y), row * sizeof(float));
+    if (depth) {
+        gl->ReadBuffer(GL_COLOR_ATTACHMENT1);
+        gl->ReadPixels(0, 0, (GLsizei)t->w, (GLsizei)t->h, GL_RED, GL_FLOAT, dev->scratch);
+        for (uint32_t y = 0; y < t->h; ++y)
+            memcpy(depth + (size_t)t->w * y, dev->scratch + (size_t)t->w * (t->h - 1 - y), t->w * sizeof(float));
+    }
+    sy_gl_result r = gl_check(dev, "render read-back", err, len);
+    if (r != SY_GL_OK) return r;
+    sy_gl_context_present(dev->ctx, read_fbo, t->w, t->h);
+    return SY_GL_OK;
+}
+
+static int mesh_lean(const mesh_o *m) { return !m->has_attr[3] && !m->has_attr[4]; }
+
+static void draw_instance(sy_gl_device *dev, int v, const inst_o *in, const mesh_o *m)
+{
+    const sy_gl_fns *gl = dev->gl;
+    bind_material(dev, in->material, true);
+    gl->UniformMatrix4fv(dev->pm[v].model, 1, GL_FALSE, in->model);
+    gl->UniformMatrix3fv(dev->pm[v].normal_mat, 1, GL_FALSE, in->normal_mat);
+    gl->Uniform1i(dev->pm[v].mirror, in->mirror);
+    gl->Uniform1i(dev->pm[v].has_normals, m->has_normals);
+    draw_mesh(dev, m);
+    dev->tris += m->triangle_count;
+}
+
+sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, float *rgba,
+                          float *depth, char *err, size_t err_len)
+{
+    view_setup v;
+    sy_gl_result r = current(dev, err, err_len);
+    if (r == SY_GL_OK) r = view_make(dev, cam, d, &v, err, err_len);
+    if (r == SY_GL_OK) r = targets_ensure(dev, d->width, d->height, err, err_len);
+    if (r != SY_GL_OK) return r;
+    const sy_gl_fns *gl = dev->gl;
+    dev->tris = dev->draws = 0;
+    static frame_state fs_zero;
+    frame_state fs = fs_zero;
+    if (dev->lights_dirty) {
+        lights_upload(dev, &fs);
+        if (fs.shadow_count) render_shadows(dev, &fs);
+        else dev->shadow_maps = 0;
+        dev->lights_dirty = false;
+    }
+    begin_target(dev);
+    for (int pv = 0; pv < 4; ++pv) {
+        gl->UseProgram(dev->pm[pv].prog);
+        gl->UniformMatrix4fv(dev->pm[pv].view, 1, GL_FALSE, v.view);
+        gl->UniformMatrix4fv(dev->pm[pv].proj, 1, GL_FALSE, v.proj);
+        gl->Uniform3fv(dev->pm[pv].cam_pos, 1, v.cam_pos);
+        gl->Uniform3fv(dev->pm[pv].cam_fwd, 1, v.cam_fwd);
+        gl->Uniform1i(dev->pm[pv].ortho, v.ortho);
+    }
+    gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_LIGHTS, dev->lights_ubo);
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_SHADOW);
+    gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->shadow_tex);
+    /* opaque, then alpha-masked (the discard variant), then blended back to front with depth
+     * writes off */
+    float *blend = NULL;
+    uint32_t nblend = 0;
+    int bound = -1;
+    for (int pass = 0; pass < 2; ++pass) {
+        for (uint32_t i = 0; i < dev->instances.count; ++i) {
+            const inst_o *in = pool_at(&dev->instances, i);
+            if (!in->h.id || !in->visible) continue;
+            const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
+            if (!m) continue;
+            const mat_o *mt = pool_get(&dev->materials, in->material.id);
+            sy_gl_alpha_mode mode = mt ? mt->d.alpha_mode : SY_GL_ALPHA_OPAQUE;
+            if (mode == SY_GL_ALPHA_BLEND) {
+                if (pass == 1) continue;
+                if (!blend && !(blend = malloc(sizeof(float) * 2 * dev->instances.count)))
+                    return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory");
+                float z = 0.0f;
+                for (int a = 0; a < 3; ++a) {
+                    float wv = in->model[12 + a];
+                    for (int k = 0; k < 3; ++k) wv += in->model[4 * k + a] * 0.5f * (m->bmin[k] + m->bmax[k]);
+                    z += (wv - v.cam_pos[a]) * v.cam_fwd[a];
+                }
+                blend[2 * nblend] = z;
+                memcpy(&blend[2 * nblend + 1], &i, sizeof i);
+                nblend++;
+                continue;
+            }
+            if ((mode == SY_GL_ALPHA_MASK) != (pass == 1)) continue;
+            int pv = pass * 2 + mesh_lean(m);
+            if (pv != bound) gl->UseProgram(dev->pm[pv].prog);
+            bound = pv;
+            draw_instance(dev, pv, in, m);
+        }
+    }
+    if (nblend) {
+        qsort(blend, nblend, 2 * sizeof(float), cmp_far_first);
+        gl->Enable(GL_BLEND);
+        gl->Disablei(GL_BLEND, 1); /* linear depth: the last (nearest) blended surface wins */
+        gl->BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA); /* premultiplied over */
+        gl->DepthMask(GL_FALSE);
+        for (uint32_t k = 0; k < nblend; ++k) {
+            uint32_t i;
+            memcpy(&i, &blend[2 * k + 1], sizeof i);
+            const inst_o *in = pool_at(&dev->instances, i);
+            const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
+            int pv = mesh_lean(m);
+            if (pv != bound) gl->UseProgram(dev->pm[pv].prog);
+            bound = pv;
+            draw_instance(dev, pv, in, m);
+        }
+        gl->DepthMask(GL_TRUE);
+        gl->Disable(GL_BLEND);
+    }
+    free(blend);
+    r = finish_target(dev, rgba, depth, err, err_len);
+    frame_end(dev);
+    return r;
+}
+
+sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, float *rgba,
+                                char *err, size_t err_len)
+{
+    view_setup v;
+    sy_gl_result r = current(dev, err, err_len);
+    if (r == SY_GL_OK) r = view_make(dev, cam, d, &v, err, err_len);
+    if (r == SY_GL_OK) r = targets_ensure(dev, d->width, d->height, err, err_len);
+    if (r != SY_GL_OK) return r;
+    const sy_gl_fns *gl = dev->gl;
+    dev->tris = dev->draws = 0;
+    begin_target(dev);
+    gl->UseProgram(dev->prog_floor);
+    gl->UniformMatrix4fv(dev->uf.view, 1, GL_FALSE, v.view);
+    gl->UniformMatrix4fv(dev->uf.proj, 1, GL_FALSE, v.proj);
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        const inst_o *in = pool_at(&dev->instances, i);
+        if (!in->h.id || !in->visible) continue;
+        const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
+        if (!m) continue;
+        gl->UniformMatrix4fv(dev->uf.model, 1, GL_FALSE, in->model);
+        draw_mesh(dev, m);
+        dev->tris += m->triangle_count;
+    }
+    r = finish_target(dev, rgba, NULL, err, err_len);
+    frame_end(dev);
+    return r;
+}

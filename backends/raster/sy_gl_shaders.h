@@ -1,0 +1,20 @@
+/* sy_gl_shaders.h — internal: GLSL 3.30 core sources of the rasterizer's programs (main PBR
+ * pass, shadow pass, MSAA resolve, benchmark floor) and the compile/link helper that returns the
+ * driver's info log on failure. */
+#ifndef SY_GL_SHADERS_H
+#define SY_GL_SHADERS_H
+
+#include "sy_gl_context.h"
+
+extern const char *const sy_gl_main_vs, *const sy_gl_main_fs;
+extern const char *const sy_gl_shadow_vs, *const sy_gl_shadow_fs;
+extern const char *const sy_gl_resolve_vs, *const sy_gl_resolve_fs;
+extern const char *const sy_gl_floor_vs, *const sy_gl_floor_fs;
+
+/* Compiles and links; fs_defines (NULL = none, e.g. "#define SY_MASK 1\n") is inserted after the
+ * #version line of both stages. On failure returns SY_GL_ERROR_GL with "<name> shader: <stage> compile
+ * failed: <log>" (or link log) in err. */
+sy_gl_result sy_gl_program_build(const sy_gl_fns *gl, const char *name, const char *vs, const char *fs,
+                                 const char *fs_defines, GLuint *out, char *err, size_t err_len);
+
+#endif /* SY_GL_SHADERS_H */

@@ -1,0 +1,196 @@
+/* sy_rt_bsdf.c — glTF metallic-roughness BSDF for the path tracer (see sy_rt_bsdf.h). */
+#include "sy_rt_bsdf.h"
+
+#define PI_F 3.14159265358979f
+#define INV_PI 0.31830988618f
+
+static float maxc(sy_rt_v3 v) { return fmaxf(v.x, fmaxf(v.y, v.z)); }
+static float schlick1(float f0, float c)
+{
+    float m = 1.0f - sy_rt_clampf(c, 0.0f, 1.0f), m2 = m * m;
+    return f0 + (1.0f - f0) * m2 * m2 * m;
+}
+static sy_rt_v3 schlick3(sy_rt_v3 f0, float c)
+{
+    float m = 1.0f - sy_rt_clampf(c, 0.0f, 1.0f), m2 = m * m, m5 = m2 * m2 * m;
+    return v3(f0.x + (1.0f - f0.x) * m5, f0.y + (1.0f - f0.y) * m5, f0.z + (1.0f - f0.z) * m5);
+}
+
+/* Exact Fresnel reflectance of a dielectric interface; eta = n_incident / n_transmitted. */
+static float fresnel_dielectric(float ci, float eta, float *ct_out)
+{
+    float st2 = eta * eta * (1.0f - ci * ci);
+    if (st2 >= 1.0f) {
+        *ct_out = 0.0f;
+        return 1.0f;
+    }
+    float ct = sqrtf(1.0f - st2);
+    float rs = (eta * ci - ct) / (eta * ci + ct), rp = (ci - eta * ct) / (ci + eta * ct);
+    *ct_out = ct;
+    return 0.5f * (rs * rs + rp * rp);
+}
+
+static float ggx_d(float a2, float nh)
+{
+    float d = nh * nh * (a2 - 1.0f) + 1.0f;
+    return a2 * INV_PI / (d * d);
+}
+static float ggx_lambda(float a2, float c)
+{
+    c = fabsf(c);
+    if (c >= 1.0f) return 0.0f;
+    float t2 = (1.0f - c * c) / fmaxf(c * c, 1e-12f);
+    return 0.5f * (-1.0f + sqrtf(1.0f + a2 * t2));
+}
+
+static sy_rt_v3 to_local(const sy_rt_bsdf *b, sy_rt_v3 v) { return v3(v3_dot(v, b->t), v3_dot(v, b->b), v3_dot(v, b->n)); }
+static sy_rt_v3 to_world(const sy_rt_bsdf *b, sy_rt_v3 v)
+{
+    return v3_add(v3_add(v3_scale(b->t, v.x), v3_scale(b->b, v.y)), v3_scale(b->n, v.z));
+}
+
+/* Visible-normal sample of an isotropic GGX (Heitz 2018), local frame, wo.z > 0. */
+static sy_rt_v3 sample_vndf(float a, sy_rt_v3 wo, float u1, float u2)
+{
+    sy_rt_v3 vh = v3_normalize(v3(a * wo.x, a * wo.y, wo.z));
+    float l2 = vh.x * vh.x + vh.y * vh.y;
+    sy_rt_v3 t1 = l2 > 0.0f ? v3_scale(v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(l2)) : v3(1.0f, 0.0f, 0.0f);
+    sy_rt_v3 t2 = v3_cross(vh, t1);
+    float r = sqrtf(u1), phi = 2.0f * PI_F * u2;
+    float p1 = r * cosf(phi), p2 = r * sinf(phi);
+    float s = 0.5f * (1.0f + vh.z);
+    p2 = (1.0f - s) * sqrtf(fmaxf(0.0f, 1.0f - p1 * p1)) + s * p2;
+    sy_rt_v3 nh = v3_add(v3_add(v3_scale(t1, p1), v3_scale(t2, p2)), v3_scale(vh, sqrtf(fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
+    return v3_normalize(v3(a * nh.x, a * nh.y, fmaxf(1e-7f, nh.z)));
+}
+
+void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
+{
+    const sy_rt_material_desc *d = &s->mat->desc;
+    b->ng = s->ng_facing;
+    b->n = s->ns;
+    if (v3_dot(b->n, wo) <= 1e-6f) b->n = s->ng_facing; /* shading normal facing away from the viewer */
+    /* orthonormal basis (Duff et al. 2017) */
+    sy_rt_v3 n = b->n;
+    float sign = copysignf(1.0f, n.z), a = -1.0f / (sign + n.z), bb = n.x * n.y * a;
+    b->t = v3(1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
+    b->b = v3(bb, sign + n.y * n.y * a, -n.y);
+    b->base = v3(sy_rt_clampf(s->base.x, 0.0f, 1.0f), sy_rt_clampf(s->base.y, 0.0f, 1.0f), sy_rt_clampf(s->base.z, 0.0f, 1.0f));
+    b->front = s->front;
+    float metallic = sy_rt_clampf(s->metallic, 0.0f, 1.0f), trans = sy_rt_clampf(d->transmission, 0.0f, 1.0f);
+    float rough = sy_rt_clampf(s->roughness, 0.0f, 1.0f);
+    b->delta = rough < SY_RT_BSDF_DELTA_ROUGHNESS;
+    b->alpha = fmaxf(rough * rough, 1e-4f);
+    b->ior = d->ior >= 1.0f ? d->ior : 1.5f;
+    float r = (b->ior - 1.0f) / (b->ior + 1.0f);
+    b->f0d = r * r;
+    b->spec = sy_rt_clampf(d->specular, 0.0f, 1.0f);
+    b->w_metal = metallic;
+    b->w_diel = (1.0f - metallic) * (1.0f - trans);
+    b->w_trans = (1.0f - metallic) * trans;
+    float fd = b->spec * schlick1(b->f0d, v3_dot(b->n, wo));
+    b->q_metal = b->w_metal;
+    b->q_spec = b->w_diel * fd;
+    b->q_diff = b->w_diel * (1.0f - fd) * maxc(b->base);
+    b->q_trans = b->w_trans;
+    float sum = b->q_metal + b->q_spec + b->q_diff + b->q_trans;
+    if (sum > 0.0f) {
+        b->q_metal /= sum, b->q_spec /= sum, b->q_diff /= sum, b->q_trans /= sum;
+    } else {
+        b->q_metal = b->q_spec = b->q_diff = b->q_trans = 0.0f;
+    }
+}
+
+sy_rt_v3 sy_rt_bsdf_eval(const sy_rt_bsdf *b, sy_rt_v3 wo, sy_rt_v3 wi, float *pdf)
+{
+    *pdf = 0.0f;
+    float nl = v3_dot(b->n, wi), nv = v3_dot(b->n, wo);
+    if (nl <= 0.0f || nv <= 0.0f || v3_dot(b->ng, wi) <= 0.0f) return v3(0.0f, 0.0f, 0.0f);
+    sy_rt_v3 h = v3_normalize(v3_add(wo, wi));
+    float vh = fmaxf(v3_dot(wo, h), 0.0f);
+    float fd = b->spec * schlick1(b->f0d, vh);
+    sy_rt_v3 f = v3_scale(b->base, b->w_diel * (1.0f - fd) * INV_PI);
+    float p = b->q_diff * nl * INV_PI;
+    if (!b->delta && (b->q_metal > 0.0f || b->q_spec > 0.0f)) {
+        float a2 = b->alpha * b->alpha, nh = fmaxf(v3_dot(b->n, h), 0.0f);
+        float D = ggx_d(a2, nh);
+        float lv = ggx_lambda(a2, nv), ll = ggx_lambda(a2, nl);
+        float common = D / (1.0f + lv + ll) / (4.0f * nl * nv);
+        f = v3_add(f, v3_scale(schlick3(b->base, vh), b->w_metal * common));
+        f = v3_add(f, v3_scale(v3(1.0f, 1.0f, 1.0f), b->w_diel * fd * common));
+        p += (b->q_metal + b->q_spec) * D / (1.0f + lv) / (4.0f * nv);
+    }
+    *pdf = p;
+    return v3_scale(f, nl);
+}
+
+bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], sy_rt_bsdf_sample *out)
+{
+    float u0 = u[0];
+    float nv = v3_dot(b->n, wo);
+    out->specular = false;
+    out->transmit = false;
+    out->pdf = 0.0f;
+    if (nv <= 0.0f) return false;
+    sy_rt_v3 wol = to_local(b, wo);
+    int lobe; /* 0 metal, 1 spec, 2 diffuse, 3 transmission */
+    float lo;
+    if (u0 < b->q_metal) lobe = 0, lo = 0.0f;
+    else if (u0 < b->q_metal + b->q_spec) lobe = 1, lo = b->q_metal;
+    else if (u0 < b->q_metal + b->q_spec + b->q_diff) lobe = 2, lo = b->q_metal + b->q_spec;
+    else if (b->q_trans > 0.0f) lobe = 3, lo = 1.0f - b->q_trans;
+    else return false;
+    if (lobe == 3) {
+        float ut = sy_rt_clampf((u0 - lo) / b->q_trans, 0.0f, 0.99999994f);
+        float a2 = b->alpha * b->alpha;
+        sy_rt_v3 h = b->delta ? b->n : to_world(b, sample_vndf(b->alpha, wol, u[1], u[2]));
+        float ci = v3_dot(wo, h);
+        if (ci <= 0.0f) return false;
+        float eta = b->front ? 1.0f / b->ior : b->ior, ct;
+        float F = fresnel_dielectric(ci, eta, &ct);
+        sy_rt_v3 wi;
+        if (ut < F) {
+            wi = v3_sub(v3_scale(h, 2.0f * ci), wo);
+            if (v3_dot(b->ng, wi) <= 0.0f || v3_dot(b->n, wi) <= 0.0f) return false;
+            out->weight = v3(1.0f, 1.0f, 1.0f);
+        } else {
+            wi = v3_normalize(v3_add(v3_scale(wo, -eta), v3_scale(h, eta * ci - ct)));
+            if (v3_dot(b->ng, wi) >= 0.0f) return false;
+            out->weight = b->base;
+            out->transmit = true;
+        }
+        float g = 1.0f;
+        if (!b->delta) {
+            float lv = ggx_lambda(a2, nv), ll = ggx_lambda(a2, v3_dot(b->n, wi));
+            g = (1.0f + lv) / (1.0f + lv + ll);
+        }
+        out->weight = v3_scale(out->weight, g * b->w_trans / b->q_trans);
+        out->wi = wi;
+        out->specular = true;
+        return true;
+    }
+    if (b->delta && lobe != 2) {
+        sy_rt_v3 wi = v3_sub(v3_scale(b->n, 2.0f * nv), wo);
+        if (v3_dot(b->ng, wi) <= 0.0f) return false;
+        out->wi = wi;
+        out->specular = true;
+        out->weight = lobe == 0 ? v3_scale(schlick3(b->base, nv), b->w_metal / b->q_metal)
+                                : v3_scale(v3(1.0f, 1.0f, 1.0f), b->w_diel * b->spec * schlick1(b->f0d, nv) / b->q_spec);
+        return true;
+    }
+    sy_rt_v3 wi;
+    if (lobe == 2) {
+        float r = sqrtf(u[1]), phi = 2.0f * PI_F * u[2];
+        wi = to_world(b, v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[1]))));
+    } else {
+        sy_rt_v3 h = to_world(b, sample_vndf(b->alpha, wol, u[1], u[2]));
+        wi = v3_sub(v3_scale(h, 2.0f * v3_dot(wo, h)), wo);
+    }
+    float pdf;
+    sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf);
+    if (!(pdf > 0.0f)) return false;
+    out->wi = wi;
+    out->weight = v3_scale(f, 1.0f / pdf);
+    out->pdf = pdf;
+    return true;
+}

@@ -1,0 +1,58 @@
+/* sy_rt_bsdf.h — the path tracer's BSDF: the glTF 2.0 metallic-roughness model as a physically
+ * based, energy-conserving mixture of
+ *   - metal:       GGX microfacet reflection (Smith height-correlated masking-shadowing, Schlick
+ *                  Fresnel with F0 = base colour), weight metallic;
+ *   - dielectric:  GGX specular with F = specular * Schlick(F0 = ((ior-1)/(ior+1))^2) over Lambert
+ *                  diffuse scaled by (1 - F), weight (1 - metallic)(1 - transmission);
+ *   - transmission: solid dielectric with exact Fresnel, reflection or refraction through a GGX
+ *                  microfacet (tinted by the base colour), weight (1 - metallic) transmission.
+ * Roughness below SY_RT_BSDF_DELTA_ROUGHNESS is a perfect mirror / smooth interface (delta lobes).
+ * Lobes with a finite density ("evaluable") take part in next-event estimation and MIS; delta lobes
+ * and the transmission lobe are sampled only. Sampling picks one lobe by its estimated albedo and
+ * GGX directions come from the distribution of visible normals (Heitz 2018).
+ * Internal to backends/rt. */
+#ifndef SY_RT_BSDF_H
+#define SY_RT_BSDF_H
+
+#include "sy_rt_surface.h"
+
+#define SY_RT_BSDF_DELTA_ROUGHNESS 0.03f
+
+typedef struct sy_rt_bsdf {
+    sy_rt_v3 n, t, b;   /* shading frame; n faces the incoming ray's side */
+    sy_rt_v3 ng;        /* geometric normal on the same side */
+    sy_rt_v3 base;
+    float alpha;        /* GGX alpha = roughness^2 */
+    bool delta;         /* roughness below the delta threshold */
+    bool front;         /* the ray arrived on the front side (for the refraction ratio) */
+    float ior, f0d;     /* dielectric F0 = ((ior - 1) / (ior + 1))^2 */
+    float spec;         /* KHR_materials_specular factor: scales the dielectric Fresnel term */
+    float w_metal, w_diel, w_trans;
+    float q_metal, q_spec, q_diff, q_trans; /* lobe selection probabilities (sum 1 or all 0) */
+} sy_rt_bsdf;
+
+/* Builds the BSDF of a surface hit seen from direction wo (unit, away from the surface). */
+void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo);
+
+/* True when some lobe has a finite density (worth a light sample). */
+static inline bool sy_rt_bsdf_evaluable(const sy_rt_bsdf *b)
+{
+    return b->q_diff > 0.0f || (!b->delta && (b->q_metal > 0.0f || b->q_spec > 0.0f));
+}
+
+/* f(wo, wi) * |cos(n, wi)| of the evaluable lobes, and their mixture pdf (solid angle) in *pdf. */
+sy_rt_v3 sy_rt_bsdf_eval(const sy_rt_bsdf *b, sy_rt_v3 wo, sy_rt_v3 wi, float *pdf);
+
+typedef struct sy_rt_bsdf_sample {
+    sy_rt_v3 wi;
+    sy_rt_v3 weight;  /* f * cos / pdf (throughput multiplier) */
+    float pdf;        /* mixture pdf of the evaluable lobes for MIS; 0 for delta/transmission */
+    bool specular;    /* delta or transmission lobe: no MIS, no next-event estimate possible */
+    bool transmit;    /* wi goes to the other side of the surface */
+} sy_rt_bsdf_sample;
+
+/* Samples a direction from u[0] (lobe choice, reused), u[1], u[2]. Returns false when the path
+ * ends (no lobe, direction below the surface). */
+bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], sy_rt_bsdf_sample *out);
+
+#endif /* SY_RT_BSDF_H */

@@ -1,0 +1,272 @@
+/* sy_rt_lights.c — alias table over emissive triangles, environment distribution and sampling,
+ * sy_rt_set_environment (see sy_rt_lights.h). */
+#include "sy_rt_lights.h"
+#include "sy_rt_texture.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define PI_F 3.14159265358979f
+
+/* >>alias (Vose 1991): every slot holds a probability and an alias; picking is one uniform number. */
+bool sy_rt_alias_build(sy_rt_device *dev, const double *w, uint32_t n)
+{
+    free(dev->area_alias_prob);
+    free(dev->area_alias_idx);
+    dev->area_alias_prob = NULL;
+    dev->area_alias_idx = NULL;
+    if (n == 0) return true;
+    float *prob = malloc((size_t)n * sizeof *prob);
+    uint32_t *alias = malloc((size_t)n * sizeof *alias);
+    double *scaled = malloc((size_t)n * sizeof *scaled);
+    uint32_t *small = malloc((size_t)n * sizeof *small), *large = malloc((size_t)n * sizeof *large);
+    if (!prob || !alias || !scaled || !small || !large) {
+        free(prob), free(alias), free(scaled), free(small), free(large);
+        return false;
+    }
+    double total = 0.0;
+    for (uint32_t i = 0; i < n; ++i) total += w[i];
+    uint32_t ns = 0, nl = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        scaled[i] = total > 0.0 ? w[i] * (double)n / total : 1.0;
+        alias[i] = i;
+        if (scaled[i] < 1.0) small[ns++] = i;
+        else large[nl++] = i;
+    }
+    while (ns && nl) {
+        uint32_t s = small[--ns], l = large[--nl];
+        prob[s] = (float)scaled[s];
+        alias[s] = l;
+        scaled[l] = (scaled[l] + scaled[s]) - 1.0;
+        if (scaled[l] < 1.0) small[ns++] = l;
+        else large[nl++] = l;
+    }
+    while (nl) prob[large[--nl]] = 1.0f;
+    while (ns) prob[small[--ns]] = 1.0f; /* rounding leftovers */
+    free(scaled), free(small), free(large);
+    dev->area_alias_prob = prob;
+    dev->area_alias_idx = alias;
+    return true;
+}
+
+uint32_t sy_rt_alias_pick(const sy_rt_device *dev, float u)
+{
+    uint32_t n = dev->area_count;
+    float x = u * (float)n;
+    uint32_t i = (uint32_t)x;
+    if (i >= n) i = n - 1u;
+    float frac = x - (float)i;
+    return frac < dev->area_alias_prob[i] ? i : dev->area_alias_idx[i];
+}
+
+float sy_rt_emission_weight(const sy_rt_material_data *mat)
+{
+    float lum = v3_luminance(v3_load(mat->desc.emissive));
+    if (!(lum > 0.0f)) lum = fmaxf(mat->desc.emissive[0], fmaxf(mat->desc.emissive[1], mat->desc.emissive[2]));
+    return lum;
+}
+
+float sy_rt_area_pdf(const sy_rt_device *dev, const sy_rt_instance_data *inst)
+{
+    if (!dev->area_count || !(dev->area_power > 0.0f)) return 0.0f;
+    const sy_rt_material_data *mat = sy_rt_material_lookup(dev, inst->material);
+    return sy_rt_emission_weight(mat) * (mat->desc.double_sided ? 2.0f : 1.0f) / dev->area_power;
+}
+
+/* >>environment */
+sy_rt_result sy_rt_set_environment(sy_rt_device *dev, sy_rt_texture texture, float intensity, char *err,
+                                   size_t err_len)
+{
+    if (!dev) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "environment: NULL device");
+    if (!isfinite(intensity) || intensity < 0.0f)
+        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT,
+                          "environment: intensity %g is not a finite non-negative number", (double)intensity);
+    if (texture.id && !sy_rt_pool_get(&dev->textures, texture.id))
+        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_HANDLE, "environment: texture %u is not a live texture",
+                          texture.id);
+    dev->env_texture_staged = texture;
+    dev->env_intensity_staged = intensity;
+    dev->env_dirty = dev->dirty = true;
+    return SY_RT_OK;
+}
+
+void sy_rt_env_free(sy_rt_device *dev)
+{
+    if (dev->env_dist) {
+        free(dev->env_dist->marginal);
+        free(dev->env_dist->conditional);
+        free(dev->env_dist->texel_pdf);
+        free(dev->env_dist);
+    }
+    dev->env_dist = NULL;
+}
+
+sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev, char *err, size_t err_len)
+{
+    sy_rt_env_free(dev);
+    dev->env_texture = dev->env_texture_staged;
+    dev->env_intensity = dev->env_intensity_staged;
+    const sy_rt_texture_data *t = sy_rt_pool_get(&dev->textures, dev->env_texture.id);
+    if (!t) return SY_RT_OK;
+    uint32_t w = t->width, h = t->height;
+    size_t n = (size_t)w * h;
+    sy_rt_env_dist *d = calloc(1, sizeof *d);
+    float *lum = malloc(n * sizeof *lum);
+    if (d) {
+        d->width = w;
+        d->height = h;
+        d->marginal = malloc(((size_t)h + 1u) * sizeof *d->marginal);
+        d->conditional = malloc((size_t)h * ((size_t)w + 1u) * sizeof *d->conditional);
+        d->texel_pdf = malloc(n * sizeof *d->texel_pdf);
+    }
+    if (!d || !lum || !d->marginal || !d->conditional || !d->texel_pdf) {
+        free(lum);
+        dev->env_dist = d;
+        sy_rt_env_free(dev);
+        return sy_rt_fail(err, err_len, SY_RT_ERROR_OUT_OF_MEMORY, "commit: environment %ux%u: out of memory", w, h);
+    }
+    for (uint32_t y = 0; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) {
+            float c[4];
+            sy_rt_texture_sample(t, ((float)x + 0.5f) / (float)w, ((float)y + 0.5f) / (float)h, c);
+            float l = v3_luminance(v3(c[0], c[1], c[2]));
+            lum[(size_t)y * w + x] = isfinite(l) && l > 0.0f ? l : 0.0f;
+        }
+    /* Weight of a texel: the largest luminance of it and its 4 neighbours (bilinear lookups reach
+     * them), times sin(theta) of the row, plus a small floor so that no direction has pdf 0. */
+    double total = 0.0;
+    double *rows = malloc((size_t)h * sizeof *rows);
+    if (!rows) {
+        free(lum);
+        dev->env_dist = d;
+        sy_rt_env_free(dev);
+        return sy_rt_fail(err, err_len, SY_RT_ERROR_OUT_OF_MEMORY, "commit: environment: out of memory");
+    }
+    double lsum = 0.0;
+    for (size_t i = 0; i < n; ++i) lsum += lum[i];
+    float floor_w = (float)(lsum / (double)n * 1e-3) + 1e-12f;
+    for (uint32_t y = 0; y < h; ++y) {
+        float s = sinf(PI_F * ((float)y + 0.5f) / (float)h);
+        float *cdf = d->conditional + (size_t)y * (w + 1u);
+        double acc = 0.0;
+        cdf[0] = 0.0f;
+        for (uint32_t x = 0; x < w; ++x) {
+            float m = lum[(size_t)y * w + x];
+            m = fmaxf(m, lum[(size_t)y * w + (x + 1u) % w]);
+            m = fmaxf(m, lum[(size_t)y * w + (x + w - 1u) % w]);
+            if (y > 0) m = fmaxf(m, lum[(size_t)(y - 1u) * w + x]);
+            if (y + 1u < h) m = fmaxf(m, lum[(size_t)(y + 1u) * w + x]);
+            double wt = (double)(m + floor_w) * s;
+            d->texel_pdf[(size_t)y * w + x] = (float)wt;
+            acc += wt;
+            cdf[x + 1u] = (float)acc;
+        }
+        for (uint32_t x = 1; x <= w; ++x) cdf[x] = acc > 0.0 ? (float)(cdf[x] / acc) : (float)x / (float)w;
+        cdf[w] = 1.0f;
+        rows[y] = acc;
+        total += acc;
+    }
+    double acc = 0.0;
+    d->marginal[0] = 0.0f;
+    for (uint32_t y = 0; y < h; ++y) {
+        acc += rows[y];
+        d->marginal[y + 1u] = (float)(acc / total);
+    }
+    d->marginal[h] = 1.0f;
+    for (size_t i = 0; i < n; ++i) d->texel_pdf[i] = (float)(d->texel_pdf[i] / total);
+    free(rows);
+    free(lum);
+    dev->env_dist = d;
+    return SY_RT_OK;
+}
+
+void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env)
+{
+    memset(env, 0, sizeof *env);
+    const sy_rt_texture_data *t = dev->env_dist ? sy_rt_pool_get(&dev->textures, dev->env_texture.id) : NULL;
+    if (t) {
+        env->mode = 2;
+        env->tex = t;
+        env->intensity = dev->env_intensity;
+        env->dist = dev->env_dist;
+        return;
+    }
+    if (dev->background.mode == SY_RT_BACKGROUND_COLOR && !v3_is_zero(v3_load(dev->background.color))) {
+        env->mode = 1;
+        env->color = v3_load(dev->background.color);
+    }
+}
+
+static void dir_to_uv(sy_rt_v3 d, float *u, float *v)
+{
+    float phi = atan2f(d.x, -d.z);
+    *u = 0.5f + phi * (0.5f / PI_F);
+    *v = acosf(sy_rt_clampf(d.y, -1.0f, 1.0f)) * (1.0f / PI_F);
+}
+
+sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d)
+{
+    if (env->mode == 1) return env->color;
+    if (env->mode != 2) return v3(0.0f, 0.0f, 0.0f);
+    float u, v, c[4];
+    dir_to_uv(d, &u, &v);
+    sy_rt_texture_sample(env->tex, u, v, c);
+    sy_rt_v3 r = v3_scale(v3(c[0], c[1], c[2]), env->intensity);
+    return (isfinite(r.x) && isfinite(r.y) && isfinite(r.z)) ? v3(fmaxf(r.x, 0.0f), fmaxf(r.y, 0.0f), fmaxf(r.z, 0.0f))
+                                                             : v3(0.0f, 0.0f, 0.0f);
+}
+
+float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d)
+{
+    if (env->mode == 1) return 1.0f / (4.0f * PI_F);
+    if (env->mode != 2) return 0.0f;
+    const sy_rt_env_dist *e = env->dist;
+    float u, v;
+    dir_to_uv(d, &u, &v);
+    uint32_t x = (uint32_t)(u * (float)e->width), y = (uint32_t)(v * (float)e->height);
+    if (x >= e->width) x = e->width - 1u;
+    if (y >= e->height) y = e->height - 1u;
+    float st = sqrtf(fmaxf(0.0f, 1.0f - d.y * d.y)); /* sin(theta) of d itself: the density in u, v is uniform */
+    if (!(st > 0.0f)) return 0.0f;
+    /* texel solid angle = (2 pi / w) (pi / h) sin(theta) */
+    return e->texel_pdf[(size_t)y * e->width + x] * (float)e->width * (float)e->height / (2.0f * PI_F * PI_F * st);
+}
+
+/* Index i with cdf[i] <= u < cdf[i+1] in a CDF of n + 1 entries. */
+static uint32_t cdf_find(const float *cdf, uint32_t n, float u)
+{
+    uint32_t lo = 0, hi = n;
+    while (lo + 1u < hi) {
+        uint32_t mid = (lo + hi) / 2u;
+        if (cdf[mid] <= u) lo = mid;
+        else hi = mid;
+    }
+    while (lo + 1u < n && !(cdf[lo + 1u] > cdf[lo])) ++lo; /* skip empty cells */
+    return lo;
+}
+
+float sy_rt_env_sample(const sy_rt_env *env, float u1, float u2, sy_rt_v3 *d, sy_rt_v3 *radiance)
+{
+    if (env->mode == 1) {
+        float z = 1.0f - 2.0f * u1, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * PI_F * u2;
+        *d = v3(r * cosf(phi), z, r * sinf(phi));
+        *radiance = env->color;
+        return 1.0f / (4.0f * PI_F);
+    }
+    if (env->mode != 2) return 0.0f;
+    const sy_rt_env_dist *e = env->dist;
+    uint32_t y = cdf_find(e->marginal, e->height, u2);
+    const float *row = e->conditional + (size_t)y * (e->width + 1u);
+    uint32_t x = cdf_find(row, e->width, u1);
+    float dy = e->marginal[y + 1u] - e->marginal[y], dx = row[x + 1u] - row[x];
+    float fy = dy > 0.0f ? (u2 - e->marginal[y]) / dy : 0.5f, fx = dx > 0.0f ? (u1 - row[x]) / dx : 0.5f;
+    float u = ((float)x + sy_rt_clampf(fx, 0.0f, 1.0f)) / (float)e->width;
+    float v = ((float)y + sy_rt_clampf(fy, 0.0f, 1.0f)) / (float)e->height;
+    float theta = v * PI_F, phi = (u - 0.5f) * 2.0f * PI_F;
+    float st = sinf(theta);
+    if (!(st > 0.0f)) return 0.0f;
+    /* inverse of dir_to_uv: phi = atan2(x, -z) */
+    *d = v3(st * sinf(phi), cosf(theta), -st * cosf(phi));
+    *radiance = sy_rt_env_eval(env, *d);
+    return e->texel_pdf[(size_t)y * e->width + x] * (float)e->width * (float)e->height / (2.0f * PI_F * PI_F * st);
+}

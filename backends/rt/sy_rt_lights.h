@@ -1,0 +1,54 @@
+/* sy_rt_lights.h — light sampling support of the path tracer: the Vose alias table over the
+ * emissive triangles (selection by power in O(1), whatever their number), the environment light
+ * (equirectangular texture x intensity, or the constant background colour as a uniform
+ * environment) with its importance-sampling distribution, and the area-light pdf of a hit point.
+ * Built at sy_rt_commit; read-only while rendering. Internal to backends/rt. */
+#ifndef SY_RT_LIGHTS_H
+#define SY_RT_LIGHTS_H
+
+#include "sy_rt_device.h"
+
+/* Piecewise-constant 2D distribution over the texels of an environment map. */
+typedef struct sy_rt_env_dist {
+    uint32_t width, height;
+    float *marginal;    /* height + 1 entries: CDF over rows */
+    float *conditional; /* height x (width + 1): CDF over the texels of each row */
+    float *texel_pdf;   /* width x height: probability of each texel (sums to 1) */
+} sy_rt_env_dist;
+
+/* (Re)builds dev->area_alias_* from per-triangle weights (n entries, total > 0). Returns false when
+ * out of memory (tables left NULL). */
+bool sy_rt_alias_build(sy_rt_device *dev, const double *weights, uint32_t n);
+/* Picks an area triangle with probability weight / total from one uniform number in [0, 1). */
+uint32_t sy_rt_alias_pick(const sy_rt_device *dev, float u);
+
+/* Rebuilds dev->env_dist for the committed environment (NULL when there is none). */
+sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev, char *err, size_t err_len);
+void sy_rt_env_free(sy_rt_device *dev);
+
+/* Environment as seen by the integrators. mode: 0 none, 1 constant colour (uniform sphere
+ * sampling), 2 texture (importance sampled). */
+typedef struct sy_rt_env {
+    int mode;
+    sy_rt_v3 color;                 /* mode 1 */
+    const struct sy_rt_texture_data *tex; /* mode 2 */
+    float intensity;
+    const sy_rt_env_dist *dist;     /* mode 2 */
+} sy_rt_env;
+
+/* Resolves the committed environment of dev (texture lookups happen once per frame). */
+void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env);
+/* Radiance arriving from direction d (unit). */
+sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d);
+/* Solid-angle pdf of sampling direction d with sy_rt_env_sample. */
+float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d);
+/* Samples a direction from two uniform numbers; returns its pdf (0 = failed) and radiance. */
+float sy_rt_env_sample(const sy_rt_env *env, float u1, float u2, sy_rt_v3 *d, sy_rt_v3 *radiance);
+
+/* Area-measure pdf with which the alias table + uniform point selection picks a point on an
+ * emissive instance (the same value for every point of the instance's non-degenerate triangles). */
+float sy_rt_area_pdf(const sy_rt_device *dev, const sy_rt_instance_data *inst);
+/* The power proxy of an emissive material (luminance of the factor, or its largest channel). */
+float sy_rt_emission_weight(const sy_rt_material_data *mat);
+
+#endif /* SY_RT_LIGHTS_H */

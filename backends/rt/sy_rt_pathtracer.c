@@ -1,0 +1,347 @@
+/* sy_rt_pathtracer.c — the progressive path tracer (see sy_rt_pathtracer.h).
+ *
+ * Per sample: a camera ray through a uniformly jittered point of the pixel (box filter of one
+ * pixel); emissive surfaces emit (emissive x strength, textured) and also scatter with their BSDF
+ * (a black, non-specular emitter such as the Cornell light shows exactly its emission; textured
+ * emitters such as DamagedHelmet's need the reflection too); at every vertex emission is added with its MIS weight (the previous vertex's BSDF pdf
+ * against the light-selection pdf), one light sample is taken (light category uniformly among
+ * area / environment / punctual, an emissive triangle by power through the alias table, a uniform
+ * point on it), then the BSDF is sampled. max_depth bounds the number of scattering events;
+ * Russian roulette (survival = min(0.95, max throughput)) starts after three. Alpha-blended
+ * surfaces are crossed stochastically with probability 1 - alpha.
+ *
+ * Random numbers: 4D set 0 = pixel jitter + alpha decisions of the camera segment; per bounce k
+ * set 1 + 2k = light sample, set 2 + 2k = BSDF sample + roulette. */
+#include "sy_rt_pathtracer.h"
+#include "sy_rt_accum.h"
+#include "sy_rt_bsdf.h"
+#include "sy_rt_lights.h"
+#include "sy_rt_sampler.h"
+
+#include <stdatomic.h>
+#include <string.h>
+
+typedef struct pt_job {
+    sy_rt_accum *acc;
+    uint32_t first, count;
+    sy_rt_sobol sobol;
+    sy_rt_env env;
+    uint32_t categories;     /* light categories present */
+    bool has_area, has_env, has_punctual;
+    bool env_opaque;         /* misses are opaque (a background colour or environment is set) */
+} pt_job;
+
+typedef struct pt_ctx {
+    const sy_rt_frame *f;
+    const sy_rt_device *dev;
+    const pt_job *job;
+    struct RTCIntersectContext ictx;
+    uint64_t rays;
+} pt_ctx;
+
+static float ray_eps(sy_rt_v3 p) { return 1e-4f * (1.0f + v3_max_abs(p)); }
+static float maxc(sy_rt_v3 v) { return fmaxf(v.x, fmaxf(v.y, v.z)); }
+static float power_heuristic(float a, float b)
+{
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+static bool unoccluded(pt_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar)
+{
+    struct RTCRay r;
+    r.org_x = org.x; r.org_y = org.y; r.org_z = org.z;
+    r.dir_x = dir.x; r.dir_y = dir.y; r.dir_z = dir.z;
+    r.tnear = 0.0f;
+    r.tfar = tfar;
+    r.time = 0.0f;
+    r.mask = 0xffffffffu;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(c->dev->top, &c->ictx, &r);
+    c->rays++;
+    return r.tfar >= 0.0f;
+}
+
+/* One light sample from the shading point: returns f * Le * cos * MIS weight / pdf (visibility
+ * included). */
+static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo, const float u[4])
+{
+    const pt_job *j = c->job;
+    const sy_rt_device *dev = c->dev;
+    sy_rt_v3 zero = v3(0.0f, 0.0f, 0.0f);
+    float x = u[0] * (float)j->categories;
+    uint32_t cat = (uint32_t)x;
+    if (cat >= j->categories) cat = j->categories - 1u;
+    float ur = sy_rt_clampf(x - (float)cat, 0.0f, 0.99999994f);
+    float p_cat = 1.0f / (float)j->categories;
+    /* category order: area, environment, punctual (only those present) */
+    int kind = -1;
+    uint32_t k = 0;
+    if (j->has_area && k++ == cat) kind = 0;
+    else if (j->has_env && k++ == cat) kind = 1;
+    else if (j->has_punctual) kind = 2;
+    sy_rt_v3 p_off = v3_madd(s->p, b->ng, ray_eps(s->p));
+    if (kind == 0) {
+        const sy_rt_area_tri *t = &dev->area[sy_rt_alias_pick(dev, ur)];
+        float su = sqrtf(u[1]), bu = su * (1.0f - u[2]), bv = su * u[2];
+        sy_rt_v3 q = v3_add(t->p0, v3_add(v3_scale(t->e1, bu), v3_scale(t->e2, bv)));
+        sy_rt_v3 wi = v3_sub(q, s->p);
+        float d2 = v3_dot(wi, wi);
+        if (!(d2 > 0.0f)) return zero;
+        float d = sqrtf(d2);
+        wi = v3_scale(wi, 1.0f / d);
+        float cos_l = -v3_dot(t->normal, wi);
+        if (t->double_sided) cos_l = fabsf(cos_l);
+        if (!(cos_l > 1e-7f)) return zero;
+        float pdf_b;
+        sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
+        if (v3_is_zero(f)) return zero;
+        float pdf_l = sy_rt_area_pdf(dev, t->inst) * d2 / cos_l * p_cat;
+        if (!(pdf_l > 0.0f)) return zero;
+        float tmax = d - ray_eps(q) - ray_eps(s->p);
+        if (tmax > 0.0f && !unoccluded(c, p_off, wi, tmax)) return zero;
+        sy_rt_v3 le = sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv);
+        return v3_scale(v3_mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l);
+    }
+    if (kind == 1) {
+        sy_rt_v3 wi, le;
+        float pdf_l = sy_rt_env_sample(&j->env, ur, u[1], &wi, &le) * p_cat;
+        if (!(pdf_l > 0.0f) || v3_is_zero(le)) return zero;
+        float pdf_b;
+        sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
+        if (v3_is_zero(f)) return zero;
+        if (!unoccluded(c, p_off, wi, INFINITY)) return zero;
+        return v3_scale(v3_mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l);
+    }
+    if (kind == 2) {
+        uint32_t n = dev->punctual_count, i = (uint32_t)(ur * (float)n);
+        if (i >= n) i = n - 1u;
+        const sy_rt_punctual *l = &dev->punctual[i];
+        sy_rt_v3 wi, e;
+        float tmax;
+        if (l->type == SY_RT_LIGHT_DIRECTIONAL) {
+            wi = v3_scale(l->direction, -1.0f);
+            e = l->radiant;
+            tmax = INFINITY;
+        } else {
+            wi = v3_sub(l->position, s->p);
+            float d2 = v3_dot(wi, wi);
+            if (!(d2 > 0.0f)) return zero;
+            float d = sqrtf(d2);
+            wi = v3_scale(wi, 1.0f / d);
+            float att = 1.0f / d2;
+            if (l->range > 0.0f) {
+                float xr = d / l->range, w = sy_rt_clampf(1.0f - xr * xr * xr * xr, 0.0f, 1.0f);
+                att *= w * w;
+            }
+            if (l->type == SY_RT_LIGHT_SPOT) {
+                float a = sy_rt_clampf(-v3_dot(l->direction, wi) * l->cone_scale + l->cone_offset, 0.0f, 1.0f);
+                att *= a * a;
+            }
+            if (!(att > 0.0f)) return zero;
+            e = v3_scale(l->radiant, att);
+            tmax = d - ray_eps(s->p);
+        }
+        float pdf_b;
+        sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
+        if (v3_is_zero(f)) return zero;
+        if (!unoccluded(c, p_off, wi, tmax)) return zero;
+        return v3_scale(v3_mul(f, e), (float)n / p_cat);
+    }
+    return zero;
+}
+
+static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy_rt_pt_sample *out)
+{
+    const sy_rt_frame *f = c->f;
+    const sy_rt_device *dev = c->dev;
+    const pt_job *j = c->job;
+    uint32_t pseed = sy_rt_hash32(px ^ sy_rt_hash32(py ^ sy_rt_hash32(f->seed ^ 0x5bd1e995u)));
+    float cam[4];
+    sy_rt_sobol_sample4(&j->sobol, pseed, 0u, index, cam);
+    struct RTCRay ray;
+    float axial;
+    sy_rt_frame_ray_at(f, (float)px + cam[0], (float)py + cam[1], &ray, &axial);
+    (void)axial;
+    sy_rt_v3 org = v3(ray.org_x, ray.org_y, ray.org_z), dir = v3(ray.dir_x, ray.dir_y, ray.dir_z);
+    float tnear = ray.tnear, tfar = ray.tfar;
+    /* extra decorrelated bits for alpha-blend decisions */
+    uint32_t rng = sy_rt_hash32(pseed ^ sy_rt_hash32(index + 0x2545f491u));
+
+    sy_rt_v3 beta = v3(1.0f, 1.0f, 1.0f), L = v3(0.0f, 0.0f, 0.0f), direct = L;
+    bool specular = true, features = false, first = true;
+    float pdf_prev = 0.0f;
+    uint32_t bounce = 0, crossings = 0;
+    out->alpha = 0.0f;
+    out->depth = INFINITY;
+    out->albedo = out->normal = v3(0.0f, 0.0f, 0.0f);
+    float p_area_sel = j->has_area ? 1.0f / (float)j->categories : 0.0f;
+    float p_env_sel = j->has_env ? 1.0f / (float)j->categories : 0.0f;
+
+    for (;;) {
+        struct RTCRayHit rh;
+        rh.ray.org_x = org.x; rh.ray.org_y = org.y; rh.ray.org_z = org.z;
+        rh.ray.dir_x = dir.x; rh.ray.dir_y = dir.y; rh.ray.dir_z = dir.z;
+        rh.ray.tnear = tnear;
+        rh.ray.tfar = tfar;
+        rh.ray.time = 0.0f;
+        rh.ray.mask = 0xffffffffu;
+        rh.ray.id = 0;
+        rh.ray.flags = 0;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(dev->top, &c->ictx, &rh);
+        c->rays++;
+        const sy_rt_instance_data *in =
+            rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? NULL : sy_rt_hit_instance(dev, rh.hit.geomID, rh.hit.instID[0]);
+        float dlen = v3_length(dir);
+        sy_rt_v3 d = v3_scale(dir, 1.0f / dlen);
+        if (!in) {
+            if (first) out->alpha = j->env_opaque ? 1.0f : 0.0f;
+            if (j->env.mode) {
+                sy_rt_v3 le = sy_rt_env_eval(&j->env, d);
+                float w = specular ? 1.0f : power_heuristic(pdf_prev, sy_rt_env_pdf(&j->env, d) * p_env_sel);
+                sy_rt_v3 contrib = v3_scale(v3_mul(beta, le), w);
+                L = v3_add(L, contrib);
+                if (bounce <= 1u) direct = v3_add(direct, contrib);
+            }
+            break;
+        }
+        sy_rt_surface s;
+        sy_rt_surface_fetch(dev, in, rh.hit.primID, rh.hit.u, rh.hit.v, d, &s);
+        if (s.mat->desc.alpha_mode == SY_RT_ALPHA_BLEND && s.alpha < 1.0f) {
+            rng = sy_rt_hash32(rng + 0x9e3779b9u);
+            if (sy_rt_u01(rng) >= sy_rt_clampf(s.alpha, 0.0f, 1.0f)) { /* pass through */
+                if (++crossings > 64u) break;
+                org = v3_madd(s.p, s.ng_facing, -ray_eps(s.p));
+                dir = d;
+                tnear = 0.0f;
+                tfar = INFINITY;
+                continue;
+            }
+        }
+        if (first) {
+            out->alpha = 1.0f;
+            out->depth = v3_dot(v3_sub(s.p, f->cam_pos), f->forward);
+            first = false;
+        }
+        if (s.mat->emissive && (s.front || s.mat->desc.double_sided)) {
+            float w = 1.0f;
+            if (!specular) {
+                float dist = rh.ray.tfar * dlen, cos_l = fabsf(v3_dot(s.ng, d));
+                float pdf_l = cos_l > 0.0f ? sy_rt_area_pdf(dev, in) * dist * dist / cos_l * p_area_sel : 0.0f;
+                w = power_heuristic(pdf_prev, pdf_l);
+            }
+            sy_rt_v3 contrib = v3_scale(v3_mul(beta, s.emission), w);
+            L = v3_add(L, contrib);
+            if (bounce <= 1u) direct = v3_add(direct, contrib);
+        }
+        if (s.mat->desc.unlit) {
+            sy_rt_v3 contrib = v3_mul(beta, s.base);
+            L = v3_add(L, contrib);
+            if (bounce == 0u) direct = v3_add(direct, contrib);
+            if (!features) out->albedo = s.base, out->normal = s.ns, features = true;
+            break;
+        }
+        if (bounce >= f->max_depth) break;
+        sy_rt_v3 wo = v3_scale(d, -1.0f);
+        sy_rt_bsdf b;
+        sy_rt_bsdf_init(&b, &s, wo);
+        bool evaluable = sy_rt_bsdf_evaluable(&b);
+        if (!features && (evaluable || b.q_metal + b.q_spec + b.q_diff + b.q_trans == 0.0f)) {
+            out->albedo = b.base;
+            out->normal = b.n;
+            features = true;
+        }
+        float ul[4], ub[4];
+        sy_rt_sobol_sample4(&j->sobol, pseed, 1u + 2u * bounce, index, ul);
+        sy_rt_sobol_sample4(&j->sobol, pseed, 2u + 2u * bounce, index, ub);
+        if (evaluable && j->categories) {
+            sy_rt_v3 contrib = v3_mul(beta, sample_light(c, &b, &s, wo, ul));
+            L = v3_add(L, contrib);
+            if (bounce == 0u) direct = v3_add(direct, contrib);
+        }
+        sy_rt_bsdf_sample bs;
+        if (!sy_rt_bsdf_sample_dir(&b, wo, ub, &bs)) break;
+        beta = v3_mul(beta, bs.weight);
+        specular = bs.specular;
+        pdf_prev = bs.pdf;
+        bounce++;
+        if (bounce >= 3u) {
+            float q = fminf(0.95f, maxc(beta));
+            if (!(ub[3] < q)) break;
+            beta = v3_scale(beta, 1.0f / q);
+        }
+        if (v3_is_zero(beta)) break;
+        org = v3_madd(s.p, b.ng, bs.transmit ? -ray_eps(s.p) : ray_eps(s.p));
+        dir = bs.wi;
+        tnear = 0.0f;
+        tfar = INFINITY;
+    }
+    out->color = L;
+    out->direct = direct;
+}
+
+static void pt_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
+{
+    pt_job *j = user;
+    pt_ctx c;
+    c.f = f;
+    c.dev = f->dev;
+    c.job = j;
+    rtcInitIntersectContext(&c.ictx);
+    c.rays = 0;
+    uint64_t bad = 0;
+    for (uint32_t py = y0; py < y1; ++py)
+        for (uint32_t px = x0; px < x1; ++px) {
+            float *rec = j->acc->data + ((size_t)(py - f->y) * f->width + (px - f->x)) * SY_RT_ACC_STRIDE;
+            for (uint32_t k = 0; k < j->count; ++k) {
+                sy_rt_pt_sample s;
+                trace_sample(&c, px, py, j->first + k, &s);
+                if (!sy_rt_accum_add(rec, j->first + k + 1u, &s)) bad++;
+            }
+        }
+    if (bad) atomic_fetch_add(&j->acc->nonfinite, bad);
+    atomic_fetch_add(&j->acc->rays, c.rays);
+}
+
+sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_desc *desc, char *err, size_t err_len)
+{
+    sy_rt_accum *acc = desc->accum;
+    if (!acc) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "render: the path tracer needs an accum");
+    if (acc->width != f->width || acc->height != f->height)
+        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT,
+                          "render: accum is %ux%u but the rectangle is %ux%u", acc->width, acc->height, f->width, f->height);
+    uint32_t count = desc->samples ? desc->samples : 1u;
+    if (count > UINT32_MAX - 1u - acc->samples)
+        return sy_rt_fail(err, err_len, SY_RT_ERROR_LIMIT, "render: %u + %u samples per pixel overflow", acc->samples, count);
+    pt_job j;
+    memset(&j, 0, sizeof j);
+    j.acc = acc;
+    j.first = acc->samples;
+    j.count = count;
+    sy_rt_sobol_init(&j.sobol);
+    sy_rt_env_get(f->dev, &j.env);
+    j.has_area = f->dev->area_count > 0 && f->dev->area_alias_prob;
+    j.has_env = j.env.mode != 0;
+    j.has_punctual = f->dev->punctual_count > 0;
+    j.categories = (uint32_t)j.has_area + (uint32_t)j.has_env + (uint32_t)j.has_punctual;
+    j.env_opaque = j.env.mode == 2 || f->dev->background.mode == SY_RT_BACKGROUND_COLOR;
+    atomic_store(&acc->rays, 0u);
+    sy_rt_result r = sy_rt_run_tiles(f, pt_tile, &j, desc->progress, desc->progress_user_data, err, err_len);
+    if (r == SY_RT_ERROR_CANCELLED) {
+        /* Tiles that ran hold more samples than the others: the accumulation is inconsistent. */
+        sy_rt_accum_reset(acc);
+        return r;
+    }
+    if (r != SY_RT_OK) return r;
+    acc->samples += count;
+    size_t n = (size_t)f->width * f->height;
+    for (size_t i = 0; i < n; ++i) {
+        const float *rec = acc->data + i * SY_RT_ACC_STRIDE;
+        if (f->rgba) memcpy(f->rgba + 4u * i, rec + SY_RT_ACC_COLOR, 4u * sizeof(float));
+        if (f->depth) f->depth[i] = rec[SY_RT_ACC_HITS] > 0.0f ? rec[SY_RT_ACC_DEPTH] : INFINITY;
+    }
+    return SY_RT_OK;
+}

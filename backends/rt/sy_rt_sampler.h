@@ -1,0 +1,25 @@
+/* sy_rt_sampler.h — the path tracer's low-discrepancy sampler: the first four Sobol dimensions
+ * (Joe-Kuo direction numbers) as padded 4-dimensional sets, each Owen-scrambled per pixel and per
+ * set with the hash-based nested uniform scramble, and the sample index shuffled the same way
+ * (Burley, "Practical Hash-based Owen Scrambling", JCGT 2020). Every pixel gets a decorrelated,
+ * stratified sequence; the same (pixel seed, set, index) always gives the same point.
+ * Header + source; internal to backends/rt; plain data, thread-safe to share read-only. */
+#ifndef SY_RT_SAMPLER_H
+#define SY_RT_SAMPLER_H
+
+#include <stdint.h>
+
+typedef struct sy_rt_sobol {
+    uint32_t v[4][32];       /* direction numbers of dimensions 0..3 */
+    uint32_t t[4][4][256];   /* per dimension and index byte: XOR of the byte's direction numbers */
+} sy_rt_sobol;
+
+void sy_rt_sobol_init(sy_rt_sobol *s);
+
+/* Point `index` of the 4D set `set` for the pixel whose seed is pixel_seed; out in [0, 1)^4. */
+void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, uint32_t index, float out[4]);
+
+/* Unscrambled 32-bit Sobol value of dimension dim (0..3) at index (tests). */
+uint32_t sy_rt_sobol_raw(const sy_rt_sobol *s, uint32_t index, uint32_t dim);
+
+#endif /* SY_RT_SAMPLER_H */

@@ -1,0 +1,1622 @@
+/* sy_cluster.c — render server and cluster client over nng (see sy_cluster.h, docs/PROTOCOL.md). */
+#include "sy_cluster.h"
+
+#include <nng/nng.h>
+#include <nng/protocol/reqrep0/rep.h>
+#include <nng/protocol/reqrep0/req.h>
+#include <nng/supplemental/tls/tls.h>
+#include <nng/transport/tcp/tcp.h>
+#include <sodium.h>
+#include <zstd.h>
+
+#include <arpa/inet.h>
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "sy_viewport.h"
+
+/* ---- shared helpers ---- */
+static void log_line(sy_cluster_log_fn fn, void *user, const char *prefix, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static void log_line(sy_cluster_log_fn fn, void *user, const char *prefix, const char *fmt, ...)
+{
+    char line[768];
+    int n = snprintf(line, sizeof line, "%s: ", prefix);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line + n, sizeof line - (size_t)n, fmt, ap);
+    va_end(ap);
+    if (fn) fn(user, line);
+    else fprintf(stderr, "%s\n", line);
+}
+
+/* strlcpy: copies what fits, always terminates */
+static void copy_str(char *dst, size_t cap, const char *src)
+{
+    size_t n = strlen(src);
+    if (n >= cap) n = cap - 1;
+    memcpy(dst, src, n);
+    dst[n] = 0;
+}
+
+static bool crypto_ready(void)
+{
+    return sodium_init() >= 0;
+}
+
+/* HMAC-SHA512-256(key, label || a || b) */
+static void mac3(uint8_t out[32], const uint8_t *key, size_t key_len, const char *label, const uint8_t *a,
+                 const uint8_t *b)
+{
+    crypto_auth_hmacsha512256_state st;
+    crypto_auth_hmacsha512256_init(&st, key, key_len);
+    crypto_auth_hmacsha512256_update(&st, (const unsigned char *)label, strlen(label));
+    crypto_auth_hmacsha512256_update(&st, a, SY_CLUSTER_NONCE_SIZE);
+    crypto_auth_hmacsha512256_update(&st, b, SY_CLUSTER_NONCE_SIZE);
+    crypto_auth_hmacsha512256_final(&st, out);
+}
+
+static void frame_tag(uint8_t out[32], const uint8_t key[32], const uint8_t *frame, size_t n)
+{
+    crypto_auth_hmacsha512256_state st;
+    crypto_auth_hmacsha512256_init(&st, key, 32);
+    crypto_auth_hmacsha512256_update(&st, frame, n);
+    crypto_auth_hmacsha512256_final(&st, out);
+}
+
+/* Encodes msg (seq filled by caller), tagging with key when key != NULL. */
+static sy_result encode_frame(sy_cluster_msg *msg, const uint8_t *key, sy_cluster_buf *out, sy_error *err)
+{
+    out->size = 0;
+    sy_result r = sy_cluster_encode(msg, key ? SY_CLUSTER_FLAG_TAGGED : 0, out, err);
+    if (r || !key) return r;
+    uint8_t tag[32];
+    frame_tag(tag, key, out->data, out->size);
+    if (out->size + 32 > out->cap) {
+        uint8_t *d = realloc(out->data, out->size + 32);
+        if (!d) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
+        out->data = d;
+        out->cap = out->size + 32;
+    }
+    memcpy(out->data + out->size, tag, 32);
+    out->size += 32;
+    return SY_OK;
+}
+
+/* Checks the frame's tag (when key) and sequence number, then decodes. */
+static sy_result decode_frame(const uint8_t *data, size_t size, const uint8_t *key, uint64_t expect_seq,
+                              size_t max_message, sy_cluster_msg *out, sy_error *err)
+{
+    sy_cluster_limits lim = {max_message};
+    sy_cluster_header h;
+    sy_result r = sy_cluster_decode_header(data, size, &lim, &h, err);
+    if (r) return r;
+    bool tagged = (h.flags & SY_CLUSTER_FLAG_TAGGED) != 0;
+    if (key && !tagged)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "cluster %s: message is not authenticated (no tag)",
+                            sy_cluster_msg_type_name(h.type));
+    if (key) {
+        uint8_t tag[32];
+        frame_tag(tag, key, data, size - 32);
+        if (crypto_verify_32(tag, data + size - 32) != 0)
+            return sy_error_set(err, SY_ERR_PROTOCOL, "cluster %s: authentication tag does not match",
+                                sy_cluster_msg_type_name(h.type));
+    }
+    if (h.seq != expect_seq)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "cluster %s: sequence number %llu, expected %llu (replay or loss)",
+                            sy_cluster_msg_type_name(h.type), (unsigned long long)h.seq,
+                            (unsigned long long)expect_seq);
+    return sy_cluster_decode(data, size, &lim, out, err);
+}
+
+static bool sockaddr_is_loopback(const nng_sockaddr *sa)
+{
+    if (sa->s_family == NNG_AF_INET) return (ntohl(sa->s_in.sa_addr) >> 24) == 127;
+    if (sa->s_family == NNG_AF_INET6) {
+        static const uint8_t lo6[16] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1};
+        return memcmp(sa->s_in6.sa_addr, lo6, 16) == 0;
+    }
+    return sa->s_family == NNG_AF_INPROC || sa->s_family == NNG_AF_IPC;
+}
+
+static void sockaddr_str(const nng_sockaddr *sa, char *buf, size_t n)
+{
+    if (sa->s_family == NNG_AF_INET) {
+        char a[INET_ADDRSTRLEN];
+        struct in_addr ia = {sa->s_in.sa_addr};
+        inet_ntop(AF_INET, &ia, a, sizeof a);
+        snprintf(buf, n, "%s:%u", a, (unsigned)ntohs(sa->s_in.sa_port));
+    } else if (sa->s_family == NNG_AF_INET6) {
+        char a[INET6_ADDRSTRLEN];
+        inet_ntop(AF_INET6, sa->s_in6.sa_addr, a, sizeof a);
+        snprintf(buf, n, "[%s]:%u", a, (unsigned)ntohs(sa->s_in6.sa_port));
+    } else snprintf(buf, n, "local peer");
+}
+
+/* ---- tile codec ---- */
+sy_result sy_cluster_tile_encode(const sy_layer *tile, bool depth, sy_cluster_buf *out, sy_error *err)
+{
+    size_t px = (size_t)tile->width * tile->height, ch = depth ? 5 : 4, raw = px * ch * 4;
+    uint8_t *shuf = malloc(raw ? raw : 1);
+    if (!shuf) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster tile: out of memory (%zu bytes)", raw);
+    /* channel planes and byte shuffle in one pass: byte k of float j of the plane sequence goes to
+     * shuf[k * nf + j], where j = channel * px + pixel */
+    size_t nf = raw / 4;
+    uint8_t *b0 = shuf, *b1 = shuf + nf, *b2 = shuf + 2 * nf, *b3 = shuf + 3 * nf;
+    for (size_t c = 0; c < ch; ++c) {
+        const float *src = c < 4 ? tile->rgba + c : tile->depth;
+        size_t stride = c < 4 ? 4 : 1, base = c * px;
+        for (size_t i = 0; i < px; ++i) {
+            uint32_t v;
+            memcpy(&v, &src[i * stride], 4);
+            b0[base + i] = (uint8_t)v;
+            b1[base + i] = (uint8_t)(v >> 8);
+            b2[base + i] = (uint8_t)(v >> 16);
+            b3[base + i] = (uint8_t)(v >> 24);
+        }
+    }
+    size_t bound = ZSTD_compressBound(raw);
+    out->size = 0;
+    if (bound > out->cap) {
+        uint8_t *d = realloc(out->data, bound);
+        if (!d) {
+            free(shuf);
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster tile: out of memory");
+        }
+        out->data = d;
+        out->cap = bound;
+    }
+    size_t n = ZSTD_compress(out->data, bound, shuf, raw, 1);
+    free(shuf);
+    if (ZSTD_isError(n)) return sy_error_set(err, SY_ERR_BACKEND, "cluster tile: zstd: %s", ZSTD_getErrorName(n));
+    out->size = n;
+    return SY_OK;
+}
+
+sy_result sy_cluster_tile_decode(const sy_cluster_tile *t, sy_layer *dst, uint32_t dx, uint32_t dy, sy_error *err)
+{
+    const sy_cluster_rect *r = &t->rect;
+    if (t->encoding != SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD)
+        return sy_error_set(err, SY_ERR_UNSUPPORTED, "cluster tile: unknown encoding %u", t->encoding);
+    if (dx > dst->width || dy > dst->height || r->w > dst->width - dx || r->h > dst->height - dy)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "cluster tile %ux%u at %u,%u does not fit the %ux%u image", r->w,
+                            r->h, dx, dy, dst->width, dst->height);
+    size_t px = (size_t)r->w * r->h, raw = (size_t)t->raw_size;
+    if (raw != px * t->channels * 4) return sy_error_set(err, SY_ERR_PROTOCOL, "cluster tile: raw size mismatch");
+    unsigned long long fs = ZSTD_getFrameContentSize(t->data, t->data_size);
+    if (fs != raw)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "cluster tile %u,%u: compressed frame announces %llu bytes, expected %zu",
+                            r->x, r->y, fs, raw);
+    uint8_t *shuf = malloc(raw ? raw : 1);
+    if (!shuf) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster tile: out of memory");
+    size_t n = ZSTD_decompress(shuf, raw, t->data, t->data_size);
+    if (ZSTD_isError(n) || n != raw) {
+        free(shuf);
+        return sy_error_set(err, SY_ERR_PROTOCOL, "cluster tile %u,%u: corrupt compressed data (%s)", r->x, r->y,
+                            ZSTD_isError(n) ? ZSTD_getErrorName(n) : "short");
+    }
+    /* unshuffle straight into the destination rows */
+    size_t nf = raw / 4;
+    const uint8_t *b0 = shuf, *b1 = shuf + nf, *b2 = shuf + 2 * nf, *b3 = shuf + 3 * nf;
+    for (size_t c = 0; c < t->channels; ++c) {
+        if (c == 4 && !dst->depth) break;
+        size_t base = c * px;
+        for (uint32_t y = 0; y < r->h; ++y) {
+            size_t row = base + (size_t)y * r->w, o = (size_t)(dy + y) * dst->width + dx;
+            float *out = c < 4 ? dst->rgba + o * 4 + c : dst->depth + o;
+            size_t stride = c < 4 ? 4 : 1;
+            for (uint32_t x = 0; x < r->w; ++x) {
+                size_t j = row + x;
+                uint32_t v = (uint32_t)b0[j] | ((uint32_t)b1[j] << 8) | ((uint32_t)b2[j] << 16) | ((uint32_t)b3[j] << 24);
+                memcpy(&out[x * stride], &v, 4);
+            }
+        }
+    }
+    free(shuf);
+    return SY_OK;
+}
+
+/* ---- secrets ---- */
+sy_result sy_cluster_secret_load(const char *path, uint8_t **out, size_t *len, sy_error *err)
+{
+    *out = NULL;
+    *len = 0;
+    uint8_t *buf = NULL;
+    size_t n = 0;
+    if (!path) {
+        const char *env = getenv("SY_CLUSTER_SECRET");
+        if (!env) return SY_OK;
+        n = strlen(env);
+        buf = malloc(n + 1);
+        if (!buf) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "secret: out of memory");
+        memcpy(buf, env, n);
+        path = "$SY_CLUSTER_SECRET";
+    } else {
+        FILE *f = fopen(path, "rb");
+        if (!f) return sy_error_set(err, SY_ERR_IO, "%s: cannot open secret file: %s", path, strerror(errno));
+        struct stat st;
+        if (fstat(fileno(f), &st) == 0 && (st.st_mode & 077)) {
+            fclose(f);
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "%s: secret file is readable by group or others (chmod 600 it)", path);
+        }
+        buf = malloc(4097);
+        if (!buf) {
+            fclose(f);
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "secret: out of memory");
+        }
+        n = fread(buf, 1, 4097, f);
+        fclose(f);
+        if (n > 4096) {
+            free(buf);
+            return sy_error_set(err, SY_ERR_LIMIT, "%s: secret longer than 4096 bytes", path);
+        }
+    }
+    while (n && (buf[n - 1] == '\n' || buf[n - 1] == '\r')) --n;
+    if (n == 0) {
+        free(buf);
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: the secret is empty", path);
+    }
+    *out = buf;
+    *len = n;
+    return SY_OK;
+}
+
+/* A PEM file (certificate or key) as a string, at most 1 MiB. */
+static sy_result read_pem(const char *path, char **out, sy_error *err)
+{
+    *out = NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) return sy_error_set(err, SY_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    char *buf = malloc((1u << 20) + 1);
+    size_t n = buf ? fread(buf, 1, 1u << 20, f) : 0;
+    bool more = buf && fgetc(f) != EOF;
+    fclose(f);
+    if (!buf) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    if (more || n == 0 || memchr(buf, 0, n)) {
+        free(buf);
+        return sy_error_set(err, SY_ERR_PARSE, "%s: not a PEM file (empty, binary or over 1 MiB)", path);
+    }
+    buf[n] = 0;
+    *out = buf;
+    return SY_OK;
+}
+
+/* ---- modes ---- */
+static const char *mode_names[] = {"sort-first", "balanced", "cooperative", "multi-display", "stereo"};
+
+bool sy_cluster_mode_parse(const char *name, uint32_t *out)
+{
+    for (uint32_t i = 0; i < 5; ++i)
+        if (!strcmp(name, mode_names[i])) {
+            *out = i;
+            return true;
+        }
+    return false;
+}
+
+const char *sy_cluster_mode_name(uint32_t mode)
+{
+    return mode < 5 ? mode_names[mode] : "?";
+}
+
+/* ======================================================================== server */
+typedef struct session {
+    bool used;
+    uint32_t pipe_id;
+    int state; /* 0: expects HELLO, 1: expects AUTH, 2: authenticated */
+    uint8_t cnonce[32], snonce[32], key[32];
+    bool tagged;
+    uint64_t recv_seq, send_seq;
+    char peer[80];
+    double last_active;
+    sy_scene *scene;
+    sy_blob_store *blobs;
+    sy_context_pool *pool;
+    uint64_t frame;
+    sy_layer present; /* multi-display: the tile held for the swap barrier */
+    uint32_t present_x, present_y, present_fw, present_fh;
+    uint64_t present_frame;
+    bool has_present;
+} session;
+
+struct sy_cluster_server {
+    sy_cluster_server_opts o;
+    uint8_t *secret;
+    nng_socket sock;
+    nng_listener listener;
+    nng_tls_config *tls;
+    int port;
+    size_t max_message;
+    session *sessions;
+    uint32_t max_sessions;
+    pthread_mutex_t lock; /* guards removed[] (filled by nng's pipe callback thread) */
+    uint32_t removed[256];
+    uint32_t removed_count;
+    char name[SY_CLUSTER_NAME_MAX];
+};
+
+#define SLOG(s, ...) log_line((s)->o.log, (s)->o.log_user, "sy serve", __VA_ARGS__)
+
+static void session_reset(session *se)
+{
+    sy_layer_destroy(&se->present);
+    sy_context_pool_destroy(se->pool);
+    sy_scene_destroy(se->scene);
+    sy_blob_store_destroy(se->blobs);
+    memset(se, 0, sizeof *se);
+}
+
+static void pipe_removed(nng_pipe p, nng_pipe_ev ev, void *user)
+{
+    (void)ev;
+    sy_cluster_server *s = user;
+    pthread_mutex_lock(&s->lock);
+    if (s->removed_count < 256) s->removed[s->removed_count++] = (uint32_t)nng_pipe_id(p);
+    pthread_mutex_unlock(&s->lock);
+}
+
+sy_result sy_cluster_server_create(const sy_cluster_server_opts *opts, sy_cluster_server **out, sy_error *err)
+{
+    *out = NULL;
+    if (!crypto_ready()) return sy_error_set(err, SY_ERR_BACKEND, "sy serve: libsodium failed to initialise");
+    sy_cluster_server *s = calloc(1, sizeof *s);
+    if (!s) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "sy serve: out of memory");
+    s->o = *opts;
+    const char *url = opts->listen_url ? opts->listen_url : SY_CLUSTER_DEFAULT_URL;
+    copy_str(s->name, sizeof s->name, opts->name ? opts->name : "sy serve");
+    s->max_sessions = opts->max_sessions ? opts->max_sessions : 16;
+    s->max_message = opts->max_message ? opts->max_message : SY_CLUSTER_DEFAULT_MAX_MESSAGE;
+    pthread_mutex_init(&s->lock, NULL);
+    s->sessions = calloc(s->max_sessions, sizeof *s->sessions);
+    if (opts->secret_len) {
+        s->secret = malloc(opts->secret_len);
+        if (s->secret) memcpy(s->secret, opts->secret, opts->secret_len);
+    }
+    if (!s->sessions || (opts->secret_len && !s->secret)) {
+        sy_cluster_server_destroy(s);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "sy serve: out of memory");
+    }
+    s->o.secret = s->secret;
+    int rv;
+    bool tls = strncmp(url, "tls+tcp://", 10) == 0;
+    if ((rv = nng_rep0_open(&s->sock)) != 0) {
+        free(s->sessions);
+        free(s->secret);
+        free(s);
+        return sy_error_set(err, SY_ERR_IO, "sy serve: cannot open socket: %s", nng_strerror(rv));
+    }
+    nng_socket_set_ms(s->sock, NNG_OPT_RECVTIMEO, 100);
+    nng_socket_set_ms(s->sock, NNG_OPT_SENDTIMEO, 10000);
+    nng_socket_set_size(s->sock, NNG_OPT_RECVMAXSZ, s->max_message);
+    nng_pipe_notify(s->sock, NNG_PIPE_EV_REM_POST, pipe_removed, s);
+    if ((rv = nng_listener_create(&s->listener, s->sock, url)) != 0) {
+        sy_cluster_server_destroy(s);
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy serve: %s: %s", url, nng_strerror(rv));
+    }
+    if (tls) {
+        if (!opts->tls_cert_file || !opts->tls_key_file) {
+            sy_cluster_server_destroy(s);
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy serve: %s: TLS needs --tls-cert and --tls-key", url);
+        }
+        char *cert = NULL, *key = NULL;
+        sy_result fr = read_pem(opts->tls_cert_file, &cert, err);
+        if (fr == SY_OK) fr = read_pem(opts->tls_key_file, &key, err);
+        if (fr != SY_OK) {
+            free(cert);
+            sy_cluster_server_destroy(s);
+            return fr;
+        }
+        rv = nng_tls_config_alloc(&s->tls, NNG_TLS_MODE_SERVER);
+        if (rv == 0) rv = nng_tls_config_own_cert(s->tls, cert, key, NULL);
+        if (key) sodium_memzero(key, strlen(key));
+        free(cert);
+        free(key);
+        if (rv != 0 || (rv = nng_listener_set_ptr(s->listener, NNG_OPT_TLS_CONFIG, s->tls)) != 0) {
+            sy_cluster_server_destroy(s);
+            return sy_error_set(err, rv == NNG_ENOTSUP ? SY_ERR_UNSUPPORTED : SY_ERR_INVALID_ARGUMENT,
+                                "sy serve: TLS with %s / %s: %s", opts->tls_cert_file, opts->tls_key_file,
+                                nng_strerror(rv));
+        }
+    }
+    if ((rv = nng_listener_start(s->listener, 0)) != 0) {
+        sy_cluster_server_destroy(s);
+        return sy_error_set(err, SY_ERR_IO, "sy serve: cannot listen on %s: %s", url, nng_strerror(rv));
+    }
+    nng_sockaddr la;
+    memset(&la, 0, sizeof la);
+    nng_listener_get_addr(s->listener, NNG_OPT_LOCADDR, &la);
+    if (!s->secret && !sockaddr_is_loopback(&la)) {
+        sy_cluster_server_destroy(s);
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "sy serve: %s is not a loopback address; a shared secret (--secret-file or "
+                            "SY_CLUSTER_SECRET) is required to listen there",
+                            url);
+    }
+    nng_listener_get_int(s->listener, NNG_OPT_TCP_BOUND_PORT, &s->port);
+    *out = s;
+    return SY_OK;
+}
+
+int sy_cluster_server_port(const sy_cluster_server *s)
+{
+    return s->port;
+}
+
+void sy_cluster_server_destroy(sy_cluster_server *s)
+{
+    if (!s) return;
+    nng_close(s->sock);
+    if (s->tls) nng_tls_config_free(s->tls);
+    for (uint32_t i = 0; s->sessions && i < s->max_sessions; ++i)
+        if (s->sessions[i].used) session_reset(&s->sessions[i]);
+    free(s->sessions);
+    if (s->secret) sodium_memzero(s->secret, s->o.secret_len);
+    free(s->secret);
+    pthread_mutex_destroy(&s->lock);
+    free(s);
+}
+
+static session *session_for(sy_cluster_server *s, nng_pipe p)
+{
+    uint32_t id = (uint32_t)nng_pipe_id(p);
+    session *free_slot = NULL, *oldest = NULL;
+    for (uint32_t i = 0; i < s->max_sessions; ++i) {
+        session *se = &s->sessions[i];
+        if (se->used && se->pipe_id == id) return se;
+        if (!se->used && !free_slot) free_slot = se;
+        /* evict unauthenticated sessions before authenticated ones, then the longest idle */
+        if (se->used && (!oldest || (se->state != 2 && oldest->state == 2) ||
+                         ((se->state == 2) == (oldest->state == 2) && se->last_active < oldest->last_active)))
+            oldest = se;
+    }
+    if (!free_slot) {
+        SLOG(s, "%s: session evicted (idle longest; %u sessions max)", oldest->peer, s->max_sessions);
+        session_reset(oldest);
+        free_slot = oldest;
+    }
+    free_slot->used = true;
+    free_slot->pipe_id = id;
+    nng_sockaddr sa;
+    memset(&sa, 0, sizeof sa);
+    nng_pipe_get_addr(p, NNG_OPT_REMADDR, &sa);
+    sockaddr_str(&sa, free_slot->peer, sizeof free_slot->peer);
+    return free_slot;
+}
+
+/* Builds the reply to one request in *reply (type set); returns non-OK with err for ERROR. */
+static sy_result handle_render(sy_cluster_server *s, session *se, const sy_cluster_msg *m, sy_cluster_msg *reply,
+                               sy_cluster_buf *payload, sy_error *err)
+{
+    const __typeof__(m->u.render) *q = &m->u.render;
+    if (!se->scene) return sy_error_set(err, SY_ERR_PROTOCOL, "RENDER before any scene was sent");
+    if (!sy_mediator_find(q->backend))
+        return sy_error_set(err, SY_ERR_NOT_FOUND, "back-end '%s' is not registered on %s", q->backend, s->name);
+    if ((q->flags & SY_CLUSTER_RENDER_PRESENT) && q->tile_count != 1)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "a present (multi-display) request needs exactly one tile");
+    uint64_t pixels = 0;
+    for (uint32_t i = 0; i < q->tile_count; ++i) pixels += (uint64_t)q->tiles[i].w * q->tiles[i].h;
+    if (pixels > SY_CLUSTER_MAX_REQUEST_PIXELS)
+        return sy_error_set(err, SY_ERR_LIMIT, "RENDER asks for %llu pixels, more than the %u a request may hold",
+                            (unsigned long long)pixels, SY_CLUSTER_MAX_REQUEST_PIXELS);
+    sy_params params;
+    sy_result r = sy_params_parse(q->params, &params, err);
+    sy_context *ctx = NULL;
+    if (r == SY_OK) r = sy_context_pool_get(se->pool, se->scene, q->backend, &params, q->root_id, &ctx, err);
+    double t0 = sy_time_now();
+    if (r == SY_OK) r = sy_context_sync(ctx, err);
+    double t1 = sy_time_now();
+    if (r) return r;
+    sy_cluster_tile *tiles = calloc(q->tile_count, sizeof *tiles);
+    size_t *offsets = calloc(q->tile_count, sizeof *offsets);
+    if (!tiles || !offsets) {
+        free(tiles);
+        free(offsets);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+    }
+    bool depth = (q->flags & SY_CLUSTER_RENDER_DEPTH) != 0;
+    sy_cluster_buf enc = {0};
+    for (uint32_t i = 0; i < q->tile_count && r == SY_OK; ++i) {
+        const sy_cluster_rect *tr = &q->tiles[i];
+        sy_layer l = {0};
+        r = sy_layer_create(tr->w, tr->h, &l, err);
+        sy_render_request req = {.camera = q->camera,
+                                 .full_width = q->full_width,
+                                 .full_height = q->full_height,
+                                 .rect_x = tr->x,
+                                 .rect_y = tr->y,
+                                 .rect_w = tr->w,
+                                 .rect_h = tr->h,
+                                 .sample_first = q->sample_first,
+                                 .sample_count = q->sample_count,
+                                 .background_id = q->background_id,
+                                 .seed = q->seed};
+        if (r == SY_OK) r = sy_context_render(ctx, &req, &l, err);
+        if (r == SY_OK && (q->flags & SY_CLUSTER_RENDER_PRESENT)) {
+            sy_layer_destroy(&se->present);
+            se->present = l;
+            memset(&l, 0, sizeof l);
+            se->present_x = tr->x;
+            se->present_y = tr->y;
+            se->present_fw = q->full_width;
+            se->present_fh = q->full_height;
+            se->present_frame = q->frame;
+            se->has_present = true;
+        } else if (r == SY_OK) {
+            r = sy_cluster_tile_encode(&l, depth, &enc, err);
+            if (r == SY_OK) {
+                size_t off = payload->size;
+                size_t need = payload->size + enc.size;
+                if (need > payload->cap) {
+                    uint8_t *d = realloc(payload->data, need * 2);
+                    if (!d) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+                    else payload->data = d, payload->cap = need * 2;
+                }
+                if (r == SY_OK) {
+                    memcpy(payload->data + payload->size, enc.data, enc.size);
+                    payload->size = need;
+                    offsets[i] = off;
+                    tiles[i] = (sy_cluster_tile){*tr, SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD, depth ? 5u : 4u,
+                                                 (uint64_t)tr->w * tr->h * (depth ? 5u : 4u) * 4u, NULL,
+                                                 (uint32_t)enc.size};
+                }
+            }
+        }
+        sy_layer_destroy(&l);
+    }
+    sy_cluster_buf_free(&enc);
+    double t2 = sy_time_now();
+    if (r) {
+        free(tiles);
+        free(offsets);
+        return r;
+    }
+    uint32_t n = (q->flags & SY_CLUSTER_RENDER_PRESENT) ? 0 : q->tile_count;
+    for (uint32_t i = 0; i < n; ++i) tiles[i].data = payload->data + offsets[i];
+    free(offsets);
+    sy_mediator_stats st = {0};
+    sy_context_stats(ctx, &st);
+    reply->header.type = SY_CLUSTER_TILES;
+    reply->u.tiles.frame = q->frame;
+    reply->u.tiles.job = q->job;
+    reply->u.tiles.sync_seconds = t1 - t0;
+    reply->u.tiles.render_seconds = t2 - t1;
+    reply->u.tiles.samples = (sy_context_class(ctx)->caps & SY_CAP_PROGRESSIVE) && st.samples ? st.samples
+                                                                                           : (q->sample_count ? q->sample_count : 1);
+    reply->u.tiles.tile_count = n;
+    reply->u.tiles.tiles = tiles; /* freed by the caller */
+    return SY_OK;
+}
+
+static sy_result handle_scene(sy_cluster_server *s, session *se, const sy_cluster_msg *m, sy_cluster_msg *reply,
+                              sy_error *err)
+{
+    (void)s;
+    bool snap = (m->u.scene.flags & SY_CLUSTER_SCENE_SNAPSHOT) != 0;
+    if (!snap && !se->scene) return sy_error_set(err, SY_ERR_PROTOCOL, "the first SCENE must be a snapshot");
+    sy_result r = SY_OK;
+    if (snap || !se->blobs) {
+        /* a snapshot replaces the replica (and its contexts); blobs stay cached by hash */
+        sy_layer_destroy(&se->present);
+        se->has_present = false;
+        sy_context_pool_destroy(se->pool);
+        sy_scene_destroy(se->scene);
+        se->pool = NULL;
+        se->scene = NULL;
+        if (!se->blobs) r = sy_blob_store_create(&se->blobs, err);
+        if (r == SY_OK) r = sy_scene_create(&se->scene, err);
+        if (r == SY_OK) r = sy_context_pool_create(&se->pool, err);
+        if (r) return r;
+    }
+    sy_changes *ch = NULL;
+    r = sy_changes_deserialize(m->u.scene.changes, m->u.scene.changes_size, se->blobs, NULL, &ch, err);
+    if (r == SY_OK) r = sy_scene_apply(se->scene, ch, err);
+    if (r == SY_OK) r = sy_scene_commit(se->scene, NULL, err);
+    sy_changes_release(ch);
+    if (r) {
+        /* the replica may be partly updated: drop it, the client must start from a snapshot */
+        sy_context_pool_destroy(se->pool);
+        sy_scene_destroy(se->scene);
+        se->pool = NULL;
+        se->scene = NULL;
+        sy_error_prefix(err, "scene for frame %llu rejected (replica dropped, send a snapshot)",
+                        (unsigned long long)m->u.scene.frame);
+        return r;
+    }
+    se->frame = m->u.scene.frame;
+    uint32_t objects = 0;
+    for (uint32_t t = 0; t < SY_TYPE_COUNT; ++t) objects += sy_scene_count(se->scene, (sy_object_type)t);
+    reply->header.type = SY_CLUSTER_SCENE_ACK;
+    reply->u.ack.frame = se->frame;
+    reply->u.ack.objects = objects;
+    return SY_OK;
+}
+
+/* Processes one request frame; fills *out with the encoded reply. */
+static void serve_one(sy_cluster_server *s, nng_msg *in, sy_cluster_buf *out)
+{
+    session *se = session_for(s, nng_msg_get_pipe(in));
+    se->last_active = sy_time_now();
+    const uint8_t *data = nng_msg_body(in);
+    size_t size = nng_msg_len(in);
+    sy_error err = {0};
+    sy_cluster_msg m, reply;
+    memset(&reply, 0, sizeof reply);
+    sy_cluster_buf payload = {0};
+    bool drop_session = false;
+    sy_result r = decode_frame(data, size, se->tagged ? se->key : NULL, se->recv_seq + 1, s->max_message, &m, &err);
+    if (r) {
+        drop_session = se->state != 2 || r == SY_ERR_PROTOCOL;
+    } else {
+        se->recv_seq = m.header.seq;
+        uint32_t t = m.header.type;
+        if (t == SY_CLUSTER_HELLO) {
+            if (se->state != 0) {
+                r = sy_error_set(&err, SY_ERR_PROTOCOL, "HELLO in the middle of a session");
+                drop_session = true;
+            } else {
+                nng_sockaddr sa;
+                memset(&sa, 0, sizeof sa);
+                nng_pipe_get_addr(nng_msg_get_pipe(in), NNG_OPT_REMADDR, &sa);
+                if (!s->secret && !sockaddr_is_loopback(&sa)) {
+                    r = sy_error_set(&err, SY_ERR_PROTOCOL, "server has no secret and accepts loopback peers only");
+                    drop_session = true;
+                } else {
+                    memcpy(se->cnonce, m.u.hello.nonce, 32);
+                    randombytes_buf(se->snonce, 32);
+                    reply.header.type = SY_CLUSTER_CHALLENGE;
+                    memcpy(reply.u.hello.nonce, se->snonce, 32);
+                    reply.u.hello.flags = s->secret ? 1u : 0u;
+                    copy_str(reply.u.hello.name, sizeof reply.u.hello.name, s->name);
+                    se->state = s->secret ? 1 : 2;
+                    SLOG(s, "%s: hello from '%s'%s", se->peer, m.u.hello.name, s->secret ? "" : " (no secret, loopback)");
+                }
+            }
+        } else if (t == SY_CLUSTER_AUTH && se->state == 1) {
+            uint8_t expect[32];
+            mac3(expect, s->secret, s->o.secret_len, "SYCP-client", se->snonce, se->cnonce);
+            if (crypto_verify_32(expect, m.u.auth.mac) != 0) {
+                r = sy_error_set(&err, SY_ERR_PROTOCOL, "authentication failed: wrong secret");
+                drop_session = true;
+            } else {
+                reply.header.type = SY_CLUSTER_WELCOME;
+                mac3(reply.u.auth.mac, s->secret, s->o.secret_len, "SYCP-server", se->cnonce, se->snonce);
+                se->state = 2;
+                SLOG(s, "%s: authenticated", se->peer);
+            }
+        } else if (se->state != 2) {
+            r = sy_error_set(&err, SY_ERR_PROTOCOL, "%s before authentication", sy_cluster_msg_type_name(t));
+            drop_session = true;
+        } else if (t == SY_CLUSTER_SCENE) {
+            r = handle_scene(s, se, &m, &reply, &err);
+        } else if (t == SY_CLUSTER_RENDER) {
+            r = handle_render(s, se, &m, &reply, &payload, &err);
+        } else if (t == SY_CLUSTER_SWAP) {
+            if (!se->has_present || se->present_frame != m.u.ack.frame)
+                r = sy_error_set(&err, SY_ERR_PROTOCOL, "SWAP for frame %llu without a rendered tile",
+                                 (unsigned long long)m.u.ack.frame);
+            else if (s->o.present)
+                r = s->o.present(s->o.present_user, se->present_frame, &se->present, se->present_x, se->present_y,
+                                 se->present_fw, se->present_fh, &err);
+            if (r == SY_OK) {
+                reply.header.type = SY_CLUSTER_SWAP_ACK;
+                reply.u.ack.frame = m.u.ack.frame;
+            }
+        } else if (t == SY_CLUSTER_BYE) {
+            reply.header.type = SY_CLUSTER_BYE;
+            SLOG(s, "%s: bye", se->peer);
+        } else {
+            r = sy_error_set(&err, SY_ERR_PROTOCOL, "unexpected %s from a client", sy_cluster_msg_type_name(t));
+        }
+        sy_cluster_msg_free(&m);
+    }
+    if (r) {
+        SLOG(s, "%s: rejected: %s%s", se->peer, err.message, drop_session ? " (session reset)" : "");
+        memset(&reply, 0, sizeof reply);
+        reply.header.type = SY_CLUSTER_ERROR;
+        reply.u.error.code = (uint32_t)r;
+        copy_str(reply.u.error.reason, sizeof reply.u.error.reason, err.message);
+    }
+    /* reply keys: handshake replies are untagged; once authenticated with a secret, tagged */
+    const uint8_t *key = (se->state == 2 && se->tagged) ? se->key : NULL;
+    reply.header.seq = ++se->send_seq;
+    sy_error e2 = {0};
+    if (encode_frame(&reply, key, out, &e2) != SY_OK) {
+        SLOG(s, "%s: cannot encode reply: %s", se->peer, e2.message);
+        out->size = 0;
+    }
+    if (reply.header.type == SY_CLUSTER_TILES) free(reply.u.tiles.tiles);
+    sy_cluster_buf_free(&payload);
+    if (reply.header.type == SY_CLUSTER_WELCOME) {
+        /* from now on both directions carry tags under the session key */
+        uint8_t k[32];
+        mac3(k, s->secret, s->o.secret_len, "SYCP-session", se->cnonce, se->snonce);
+        memcpy(se->key, k, 32);
+        se->tagged = true;
+    }
+    if (drop_session || reply.header.type == SY_CLUSTER_BYE) {
+        char peer[80];
+        memcpy(peer, se->peer, sizeof peer);
+        uint32_t pid = se->pipe_id;
+        session_reset(se);
+        se->used = true; /* keep the slot for this pipe: a new HELLO starts over */
+        se->pipe_id = pid;
+        memcpy(se->peer, peer, sizeof peer);
+    }
+}
+
+sy_result sy_cluster_server_run(sy_cluster_server *s, sy_error *err)
+{
+    double start = sy_time_now();
+    sy_cluster_buf out = {0};
+    SLOG(s, "listening on %s (port %d)%s", s->o.listen_url ? s->o.listen_url : SY_CLUSTER_DEFAULT_URL, s->port,
+         s->secret ? ", shared-secret authentication" : ", no secret: loopback peers only");
+    for (;;) {
+        if (s->o.stop && *s->o.stop) break;
+        if (s->o.max_lifetime_s > 0 && sy_time_now() - start > s->o.max_lifetime_s) {
+            SLOG(s, "maximum lifetime of %.0f s reached, stopping", s->o.max_lifetime_s);
+            break;
+        }
+        pthread_mutex_lock(&s->lock);
+        uint32_t removed[256], nrem = s->removed_count;
+        memcpy(removed, s->removed, nrem * sizeof *removed);
+        s->removed_count = 0;
+        pthread_mutex_unlock(&s->lock);
+        for (uint32_t k = 0; k < nrem; ++k)
+            for (uint32_t i = 0; i < s->max_sessions; ++i)
+                if (s->sessions[i].used && s->sessions[i].pipe_id == removed[k]) {
+                    SLOG(s, "%s: disconnected", s->sessions[i].peer);
+                    session_reset(&s->sessions[i]);
+                }
+        nng_msg *in = NULL;
+        int rv = nng_recvmsg(s->sock, &in, 0);
+        if (rv == NNG_ETIMEDOUT) continue;
+        if (rv != 0) {
+            sy_cluster_buf_free(&out);
+            if (rv == NNG_ECLOSED) return SY_OK;
+            return sy_error_set(err, SY_ERR_IO, "sy serve: receive failed: %s", nng_strerror(rv));
+        }
+        serve_one(s, in, &out);
+        nng_msg_free(in);
+        if (out.size) {
+            rv = nng_send(s->sock, out.data, out.size, 0);
+            if (rv != 0) SLOG(s, "reply not sent: %s", nng_strerror(rv));
+        }
+    }
+    sy_cluster_buf_free(&out);
+    return SY_OK;
+}
+
+/* ======================================================================== client */
+typedef struct hashset {
+    sy_hash128 *keys; /* lo == hi == 0 marks an empty slot (a zero hash is never real in practice) */
+    size_t cap, count;
+} hashset;
+
+static bool hs_has(const hashset *h, sy_hash128 k)
+{
+    if (!h->cap) return false;
+    for (size_t i = (size_t)(k.lo % h->cap);; i = (i + 1) % h->cap) {
+        if (!h->keys[i].lo && !h->keys[i].hi) return false;
+        if (sy_hash_equal(h->keys[i], k)) return true;
+    }
+}
+
+static bool hs_add(hashset *h, sy_hash128 k)
+{
+    if (hs_has(h, k)) return true;
+    if ((h->count + 1) * 2 > h->cap) {
+        size_t nc = h->cap ? h->cap * 2 : 64;
+        sy_hash128 *nk = calloc(nc, sizeof *nk);
+        if (!nk) return false;
+        hashset n2 = {nk, nc, 0};
+        for (size_t i = 0; i < h->cap; ++i)
+            if (h->keys[i].lo || h->keys[i].hi) {
+                size_t j = (size_t)(h->keys[i].lo % nc);
+                while (nk[j].lo || nk[j].hi) j = (j + 1) % nc;
+                nk[j] = h->keys[i];
+                n2.count++;
+            }
+        free(h->keys);
+        *h = n2;
+    }
+    size_t j = (size_t)(k.lo % h->cap);
+    while (h->keys[j].lo || h->keys[j].hi) j = (j + 1) % h->cap;
+    h->keys[j] = k;
+    h->count++;
+    return true;
+}
+
+static void hs_clear(hashset *h)
+{
+    free(h->keys);
+    memset(h, 0, sizeof *h);
+}
+
+typedef struct conn {
+    char url[256];
+    nng_socket sock;
+    bool open, live, fresh; /* fresh: connected during this frame (needs a snapshot) */
+    bool has_consumer;
+    uint32_t consumer;
+    uint64_t send_seq, recv_seq;
+    uint8_t key[32];
+    bool tagged;
+    char backend[SY_CLUSTER_BACKEND_MAX]; /* "" = the frame's back-end */
+    sy_cluster_rect wall;        /* multi-display tile; w == 0: column i of n */
+    hashset sent;                /* blob hashes sent on this connection */
+    hashset pending;             /* hashes serialised into the pending scene message */
+    sy_cluster_buf scene_msg;    /* encoded SCENE for this frame (0 size = none) */
+    double last_seconds;         /* last render time, for balanced mode */
+    uint32_t last_rows;
+    uint64_t bytes_sent, bytes_received;
+    char error[SY_ERROR_MESSAGE_MAX];
+} conn;
+
+struct sy_cluster_client {
+    sy_cluster_client_opts o;
+    sy_scene *scene;
+    uint8_t *secret;
+    conn *conns;
+    uint32_t n;
+    uint64_t frame;
+    uint32_t coop_next; /* cooperative: first sample index of the next frame (ranges never repeat) */
+    size_t max_message;
+    uint32_t timeout_ms, connect_timeout_ms;
+    char *tls_ca; /* owned copy of the CA file path */
+};
+
+#define CLOG(c, ...) log_line((c)->o.log, (c)->o.log_user, "sy cluster", __VA_ARGS__)
+
+static void conn_close(conn *k)
+{
+    if (k->open) nng_close(k->sock);
+    k->open = k->live = k->tagged = false;
+    hs_clear(&k->sent);
+    hs_clear(&k->pending);
+}
+
+/* One request/reply exchange. *reply borrows *raw (free with nng_msg_free + sy_cluster_msg_free). */
+static sy_result conn_call(sy_cluster_client *c, conn *k, sy_cluster_msg *req, const sy_cluster_buf *preencoded,
+                           uint32_t expect, sy_cluster_msg *reply, nng_msg **raw, sy_error *err)
+{
+    *raw = NULL;
+    sy_cluster_buf buf = {0};
+    const sy_cluster_buf *b = preencoded;
+    sy_result r = SY_OK;
+    if (!b) {
+        req->header.seq = ++k->send_seq;
+        r = encode_frame(req, k->tagged ? k->key : NULL, &buf, err);
+        b = &buf;
+    }
+    int rv = r ? 0 : nng_send(k->sock, b->data, b->size, 0);
+    if (!r && rv) r = sy_error_set(err, SY_ERR_IO, "%s: send failed: %s", k->url, nng_strerror(rv));
+    if (!r) k->bytes_sent += b->size;
+    sy_cluster_buf_free(&buf);
+    if (r) return r;
+    rv = nng_recvmsg(k->sock, raw, 0);
+    if (rv)
+        return sy_error_set(err, SY_ERR_IO, "%s: %s", k->url,
+                            rv == NNG_ETIMEDOUT ? "no reply before the deadline" : nng_strerror(rv));
+    k->bytes_received += nng_msg_len(*raw);
+    r = decode_frame(nng_msg_body(*raw), nng_msg_len(*raw), k->tagged ? k->key : NULL, k->recv_seq + 1,
+                     c->max_message, reply, err);
+    if (r) {
+        sy_error_prefix(err, "%s", k->url);
+    } else {
+        k->recv_seq = reply->header.seq;
+        if (reply->header.type == SY_CLUSTER_ERROR) {
+            r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: server rejected the request: %s", k->url, reply->u.error.reason);
+        } else if (reply->header.type != expect) {
+            r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: expected %s, got %s", k->url, sy_cluster_msg_type_name(expect),
+                             sy_cluster_msg_type_name(reply->header.type));
+        }
+        if (r) sy_cluster_msg_free(reply);
+    }
+    if (r) {
+        nng_msg_free(*raw);
+        *raw = NULL;
+    }
+    return r;
+}
+
+static sy_result conn_connect(sy_cluster_client *c, conn *k, sy_error *err)
+{
+    conn_close(k);
+    k->send_seq = k->recv_seq = 0;
+    int rv = nng_req0_open(&k->sock);
+    if (rv) return sy_error_set(err, SY_ERR_IO, "%s: cannot open socket: %s", k->url, nng_strerror(rv));
+    k->open = true;
+    nng_socket_set_ms(k->sock, NNG_OPT_RECVTIMEO, (nng_duration)c->connect_timeout_ms);
+    nng_socket_set_ms(k->sock, NNG_OPT_SENDTIMEO, (nng_duration)c->connect_timeout_ms);
+    nng_socket_set_ms(k->sock, NNG_OPT_REQ_RESENDTIME, NNG_DURATION_INFINITE);
+    nng_socket_set_size(k->sock, NNG_OPT_RECVMAXSZ, c->max_message);
+    nng_dialer d;
+    if ((rv = nng_dialer_create(&d, k->sock, k->url)) != 0) {
+        conn_close(k);
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: %s", k->url, nng_strerror(rv));
+    }
+    if (!strncmp(k->url, "tls+tcp://", 10)) {
+        if (!c->o.tls_ca_file) {
+            conn_close(k);
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: a TLS server needs --tls-ca", k->url);
+        }
+        /* the certificate must be valid for the host named in the URL */
+        char host[256];
+        const char *h = k->url + 10, *end = strrchr(h, ':');
+        size_t hn = end ? (size_t)(end - h) : strlen(h);
+        if (hn && h[0] == '[' && h[hn - 1] == ']') h++, hn -= 2;
+        if (hn >= sizeof host) hn = sizeof host - 1;
+        memcpy(host, h, hn);
+        host[hn] = 0;
+        nng_tls_config *cfg = NULL;
+        if ((rv = nng_tls_config_alloc(&cfg, NNG_TLS_MODE_CLIENT)) != 0 ||
+            (rv = nng_tls_config_ca_file(cfg, c->o.tls_ca_file)) != 0 ||
+            (rv = nng_tls_config_auth_mode(cfg, NNG_TLS_AUTH_MODE_REQUIRED)) != 0 ||
+            (rv = nng_tls_config_server_name(cfg, host)) != 0 || (rv = nng_dialer_set_ptr(d, NNG_OPT_TLS_CONFIG, cfg)) != 0) {
+            if (cfg) nng_tls_config_free(cfg);
+            conn_close(k);
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: TLS with CA %s: %s", k->url, c->o.tls_ca_file,
+                                nng_strerror(rv));
+        }
+        nng_tls_config_free(cfg); /* the dialer holds its own reference */
+    }
+    if ((rv = nng_dialer_start(d, 0)) != 0) {
+        conn_close(k);
+        return sy_error_set(err, SY_ERR_IO, "%s: cannot connect: %s", k->url, nng_strerror(rv));
+    }
+    sy_cluster_msg m, rep;
+    memset(&m, 0, sizeof m);
+    m.header.type = SY_CLUSTER_HELLO;
+    uint8_t cnonce[32];
+    randombytes_buf(cnonce, 32);
+    memcpy(m.u.hello.nonce, cnonce, 32);
+    snprintf(m.u.hello.name, sizeof m.u.hello.name, "sy client");
+    nng_msg *raw = NULL;
+    sy_result r = conn_call(c, k, &m, NULL, SY_CLUSTER_CHALLENGE, &rep, &raw, err);
+    if (r == SY_OK) {
+        bool need = rep.u.hello.flags & 1u;
+        uint8_t snonce[32];
+        memcpy(snonce, rep.u.hello.nonce, 32);
+        sy_cluster_msg_free(&rep);
+        nng_msg_free(raw);
+        if (need && !c->secret)
+            r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: server requires a shared secret (SY_CLUSTER_SECRET or --secret-file)",
+                             k->url);
+        else if (!need && c->secret)
+            r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: server does not authenticate but a secret was given; refusing",
+                             k->url);
+        else if (need) {
+            memset(&m, 0, sizeof m);
+            m.header.type = SY_CLUSTER_AUTH;
+            mac3(m.u.auth.mac, c->secret, c->o.secret_len, "SYCP-client", snonce, cnonce);
+            r = conn_call(c, k, &m, NULL, SY_CLUSTER_WELCOME, &rep, &raw, err);
+            if (r == SY_OK) {
+                uint8_t expect[32];
+                mac3(expect, c->secret, c->o.secret_len, "SYCP-server", cnonce, snonce);
+                if (crypto_verify_32(expect, rep.u.auth.mac) != 0)
+                    r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: the server's proof does not match (wrong secret or impostor)",
+                                     k->url);
+                sy_cluster_msg_free(&rep);
+                nng_msg_free(raw);
+                mac3(k->key, c->secret, c->o.secret_len, "SYCP-session", cnonce, snonce);
+                k->tagged = true;
+            }
+        }
+    }
+    if (r) {
+        conn_close(k);
+        return r;
+    }
+    nng_socket_set_ms(k->sock, NNG_OPT_RECVTIMEO, (nng_duration)c->timeout_ms);
+    nng_socket_set_ms(k->sock, NNG_OPT_SENDTIMEO, (nng_duration)c->timeout_ms);
+    k->live = true;
+    k->fresh = true;
+    return SY_OK;
+}
+
+sy_result sy_cluster_client_create(sy_scene *scene, const sy_cluster_client_opts *opts, sy_cluster_client **out,
+                                   sy_error *err)
+{
+    *out = NULL;
+    if (!crypto_ready()) return sy_error_set(err, SY_ERR_BACKEND, "cluster: libsodium failed to initialise");
+    if (!opts->url_count || opts->url_count > SY_CLUSTER_MAX_SERVERS)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster: between 1 and %u server URLs needed, got %u",
+                            SY_CLUSTER_MAX_SERVERS, opts->url_count);
+    sy_cluster_client *c = calloc(1, sizeof *c);
+    if (!c) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
+    c->o = *opts;
+    c->scene = scene;
+    c->n = opts->url_count;
+    c->timeout_ms = opts->timeout_ms ? opts->timeout_ms : 60000;
+    c->connect_timeout_ms = opts->connect_timeout_ms ? opts->connect_timeout_ms : 5000;
+    c->max_message = opts->max_message ? opts->max_message : SY_CLUSTER_DEFAULT_MAX_MESSAGE;
+    c->conns = calloc(c->n, sizeof *c->conns);
+    if (opts->secret_len) {
+        c->secret = malloc(opts->secret_len);
+        if (c->secret) memcpy(c->secret, opts->secret, opts->secret_len);
+    }
+    if (!c->conns || (opts->secret_len && !c->secret)) {
+        sy_cluster_client_destroy(c);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
+    }
+    c->o.urls = NULL;
+    if (opts->tls_ca_file) {
+        c->tls_ca = strdup(opts->tls_ca_file);
+        if (!c->tls_ca) {
+            sy_cluster_client_destroy(c);
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
+        }
+    }
+    c->o.tls_ca_file = c->tls_ca;
+    uint32_t live = 0;
+    sy_error first = {0};
+    for (uint32_t i = 0; i < c->n; ++i) {
+        conn *k = &c->conns[i];
+        if (strlen(opts->urls[i]) >= sizeof k->url) {
+            sy_cluster_client_destroy(c);
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster: URL %u is too long", i);
+        }
+        copy_str(k->url, sizeof k->url, opts->urls[i]);
+        if (opts->backends && opts->backends[i]) {
+            if (strlen(opts->backends[i]) >= sizeof k->backend) {
+                sy_cluster_client_destroy(c);
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster: back-end name of server %u is too long", i);
+            }
+            copy_str(k->backend, sizeof k->backend, opts->backends[i]);
+        }
+        if (opts->wall_tiles) k->wall = opts->wall_tiles[i];
+        sy_error e = {0};
+        if (conn_connect(c, k, &e) == SY_OK) live++;
+        else {
+            CLOG(c, "%s", e.message);
+            copy_str(k->error, sizeof k->error, e.message);
+            if (!first.code) first = e;
+        }
+    }
+    if (!live) {
+        sy_cluster_client_destroy(c);
+        return sy_error_set(err, first.code ? first.code : SY_ERR_IO, "cluster: no server reachable: %s", first.message);
+    }
+    *out = c;
+    return SY_OK;
+}
+
+uint32_t sy_cluster_client_live(const sy_cluster_client *c)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < c->n; ++i) n += c->conns[i].live;
+    return n;
+}
+
+void sy_cluster_client_set_timeout(sy_cluster_client *c, uint32_t timeout_ms)
+{
+    c->timeout_ms = timeout_ms ? timeout_ms : 60000;
+    for (uint32_t i = 0; i < c->n; ++i)
+        if (c->conns[i].live) {
+            nng_socket_set_ms(c->conns[i].sock, NNG_OPT_RECVTIMEO, (nng_duration)c->timeout_ms);
+            nng_socket_set_ms(c->conns[i].sock, NNG_OPT_SENDTIMEO, (nng_duration)c->timeout_ms);
+        }
+}
+
+void sy_cluster_client_destroy(sy_cluster_client *c)
+{
+    if (!c) return;
+    for (uint32_t i = 0; c->conns && i < c->n; ++i) {
+        conn *k = &c->conns[i];
+        if (k->live) {
+            nng_socket_set_ms(k->sock, NNG_OPT_RECVTIMEO, 1000);
+            sy_cluster_msg m, rep;
+            memset(&m, 0, sizeof m);
+            m.header.type = SY_CLUSTER_BYE;
+            nng_msg *raw = NULL;
+            sy_error e = {0};
+            if (conn_call(c, k, &m, NULL, SY_CLUSTER_BYE, &rep, &raw, &e) == SY_OK) {
+                sy_cluster_msg_free(&rep);
+                nng_msg_free(raw);
+            }
+        }
+        conn_close(k);
+        sy_cluster_buf_free(&k->scene_msg);
+        if (k->has_consumer) sy_scene_consumer_remove(c->scene, k->consumer);
+    }
+    free(c->tls_ca);
+    if (c->secret) sodium_memzero(c->secret, c->o.secret_len);
+    free(c->secret);
+    free(c->conns);
+    free(c);
+}
+
+/* ---- per-frame work ---- */
+typedef struct work_item {
+    uint32_t eye; /* index into the frame's views: 0 mono / left, 1 right */
+    sy_cluster_rect rect;
+    uint32_t sample_first, sample_count;
+    int owner;
+    bool done;
+} work_item;
+
+typedef struct frame_ctx {
+    sy_cluster_client *c;
+    const sy_cluster_frame *f;
+    sy_camera_view views[2];
+    uint32_t eye_ids[2];
+    sy_layer *out;
+    sy_layer *accum; /* cooperative: one full layer per connection */
+    uint64_t *accum_samples;
+    work_item *items;
+    uint32_t item_count;
+    double *server_seconds;
+} frame_ctx;
+
+typedef struct thread_arg {
+    frame_ctx *fc;
+    uint32_t conn;
+    bool send_scene;
+    bool failed;
+} thread_arg;
+
+static bool blob_send_cb(void *user, const sy_blob *b)
+{
+    conn *k = user;
+    sy_hash128 h = sy_blob_hash(b);
+    if (hs_has(&k->sent, h)) return false;
+    hs_add(&k->pending, h);
+    return true;
+}
+
+static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, sy_error *err)
+{
+    sy_cluster_client *c = fc->c;
+    const sy_cluster_frame *f = fc->f;
+    sy_cluster_msg m, rep;
+    memset(&m, 0, sizeof m);
+    m.header.type = SY_CLUSTER_RENDER;
+    __typeof__(m.u.render) *q = &m.u.render;
+    q->frame = c->frame;
+    q->job = (uint32_t)(it - fc->items);
+    q->flags = (f->depth ? SY_CLUSTER_RENDER_DEPTH : 0) | (f->mode == SY_CLUSTER_MULTI_DISPLAY ? SY_CLUSTER_RENDER_PRESENT : 0);
+    copy_str(q->backend, sizeof q->backend, k->backend[0] ? k->backend : f->backend);
+    copy_str(q->params, sizeof q->params, f->params ? f->params : "");
+    q->root_id = f->root_id;
+    q->background_id = f->background_id;
+    q->seed = f->seed;
+    /* cooperative: a back-end that numbers samples by its own accumulation (and ignores
+     * sample_first) still draws an independent stream per server when each server has its own
+     * seed; the seed stays the same across frames, so the server keeps accumulating */
+    if (f->mode == SY_CLUSTER_COOPERATIVE) q->seed = f->seed + idx * 2654435761u;
+    q->eye = fc->eye_ids[it->eye];
+    q->sample_first = it->sample_first;
+    q->sample_count = it->sample_count;
+    q->full_width = f->width;
+    q->full_height = f->height;
+    q->camera = fc->views[it->eye];
+    q->tile_count = 1;
+    q->tiles = &it->rect;
+    nng_msg *raw = NULL;
+    sy_result r = conn_call(c, k, &m, NULL, SY_CLUSTER_TILES, &rep, &raw, err);
+    if (r) return r;
+    const __typeof__(rep.u.tiles) *t = &rep.u.tiles;
+    uint32_t expect_tiles = f->mode == SY_CLUSTER_MULTI_DISPLAY ? 0 : 1;
+    if (t->frame != c->frame || t->job != q->job || t->tile_count != expect_tiles)
+        r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: reply for frame %llu job %u with %u tiles does not match the request",
+                         k->url, (unsigned long long)t->frame, t->job, t->tile_count);
+    if (!r && expect_tiles) {
+        const sy_cluster_tile *tl = &t->tiles[0];
+        if (memcmp(&tl->rect, &it->rect, sizeof tl->rect) != 0)
+            r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: tile rectangle differs from the request", k->url);
+        else if (f->mode == SY_CLUSTER_COOPERATIVE) {
+            r = sy_cluster_tile_decode(tl, &fc->accum[idx], tl->rect.x, tl->rect.y, err);
+            if (!r) fc->accum_samples[idx] = t->samples;
+        } else {
+            uint32_t ox = it->eye * f->width;
+            r = sy_cluster_tile_decode(tl, fc->out, tl->rect.x + ox, tl->rect.y, err);
+        }
+    }
+    if (!r) {
+        fc->server_seconds[idx] += t->sync_seconds + t->render_seconds;
+        k->last_seconds = t->render_seconds;
+        k->last_rows = it->rect.h;
+    }
+    sy_cluster_msg_free(&rep);
+    nng_msg_free(raw);
+    return r;
+}
+
+static void *conn_thread(void *p)
+{
+    thread_arg *a = p;
+    frame_ctx *fc = a->fc;
+    sy_cluster_client *c = fc->c;
+    conn *k = &c->conns[a->conn];
+    sy_error err = {0};
+    sy_result r = SY_OK;
+    if (a->send_scene && k->scene_msg.size) {
+        sy_cluster_msg rep;
+        nng_msg *raw = NULL;
+        r = conn_call(c, k, NULL, &k->scene_msg, SY_CLUSTER_SCENE_ACK, &rep, &raw, &err);
+        if (r == SY_OK) {
+            sy_cluster_msg_free(&rep);
+            nng_msg_free(raw);
+        }
+    }
+    for (uint32_t i = 0; r == SY_OK && i < fc->item_count; ++i) {
+        work_item *it = &fc->items[i];
+        if (it->owner != (int)a->conn || it->done) continue;
+        r = run_item(fc, k, a->conn, it, &err);
+        if (r == SY_OK) it->done = true;
+    }
+    if (r) {
+        a->failed = true;
+        copy_str(k->error, sizeof k->error, err.message);
+    }
+    return NULL;
+}
+
+/* Runs every live connection's items in parallel; returns the number of connections that failed. */
+static uint32_t run_round(frame_ctx *fc, bool send_scene)
+{
+    sy_cluster_client *c = fc->c;
+    thread_arg args[SY_CLUSTER_MAX_SERVERS];
+    pthread_t th[SY_CLUSTER_MAX_SERVERS];
+    bool started[SY_CLUSTER_MAX_SERVERS] = {0};
+    for (uint32_t i = 0; i < c->n; ++i) {
+        args[i] = (thread_arg){fc, i, send_scene, false};
+        if (!c->conns[i].live) continue;
+        bool has_work = send_scene && c->conns[i].scene_msg.size;
+        for (uint32_t j = 0; j < fc->item_count && !has_work; ++j)
+            has_work = fc->items[j].owner == (int)i && !fc->items[j].done;
+        if (!has_work) continue;
+        started[i] = pthread_create(&th[i], NULL, conn_thread, &args[i]) == 0;
+        if (!started[i]) conn_thread(&args[i]);
+    }
+    uint32_t failed = 0;
+    for (uint32_t i = 0; i < c->n; ++i) {
+        if (started[i]) pthread_join(th[i], NULL);
+        if (args[i].failed) {
+            conn *k = &c->conns[i];
+            CLOG(c, "%s: dropped for this frame: %s", k->url, k->error);
+            conn_close(k);
+            if (k->has_consumer) sy_scene_consumer_remove(c->scene, k->consumer);
+            k->has_consumer = false;
+            failed++;
+        }
+    }
+    return failed;
+}
+
+/* Gives every unfinished item to live connections (splitting strips among them). */
+static sy_result reassign(frame_ctx *fc, uint32_t *reassigned, sy_error *err)
+{
+    sy_cluster_client *c = fc->c;
+    uint32_t live[SY_CLUSTER_MAX_SERVERS], nl = 0;
+    for (uint32_t i = 0; i < c->n; ++i)
+        if (c->conns[i].live) live[nl++] = i;
+    uint32_t pending = 0;
+    for (uint32_t j = 0; j < fc->item_count; ++j) pending += !fc->items[j].done;
+    if (!pending) return SY_OK;
+    if (!nl) {
+        char why[SY_ERROR_MESSAGE_MAX] = "";
+        for (uint32_t i = 0; i < c->n; ++i)
+            if (c->conns[i].error[0]) {
+                copy_str(why, sizeof why, c->conns[i].error);
+                break;
+            }
+        return sy_error_set(err, SY_ERR_IO, "cluster: every server failed this frame (%s)", why);
+    }
+    if (fc->f->mode == SY_CLUSTER_MULTI_DISPLAY) {
+        /* a wall tile belongs to its display: it cannot be shown elsewhere */
+        for (uint32_t j = 0; j < fc->item_count; ++j) fc->items[j].done = true;
+        return SY_OK;
+    }
+    uint32_t cur = fc->item_count;
+    work_item *items = realloc(fc->items, (cur + (size_t)pending * nl) * sizeof *items);
+    if (!items) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
+    fc->items = items;
+    uint32_t rr = 0;
+    for (uint32_t j = 0; j < cur; ++j) {
+        work_item it = fc->items[j];
+        if (it.done) continue;
+        fc->items[j].done = true; /* replaced by the new items */
+        (*reassigned)++;
+        if (fc->f->mode == SY_CLUSTER_COOPERATIVE || it.rect.h < nl) {
+            it.owner = (int)live[rr++ % nl];
+            fc->items[fc->item_count++] = it;
+            continue;
+        }
+        for (uint32_t s = 0; s < nl; ++s) {
+            work_item sub = it;
+            uint32_t y0 = it.rect.y + (uint32_t)((uint64_t)it.rect.h * s / nl);
+            uint32_t y1 = it.rect.y + (uint32_t)((uint64_t)it.rect.h * (s + 1) / nl);
+            sub.rect.y = y0;
+            sub.rect.h = y1 - y0;
+            sub.owner = (int)live[s];
+            fc->items[fc->item_count++] = sub;
+        }
+    }
+    return SY_OK;
+}
+
+/* Splits items larger than a request may be (SY_CLUSTER_MAX_REQUEST_PIXELS) into row bands for
+ * the same server. Multi-display tiles are presented whole and are never split. */
+static sy_result split_large_items(frame_ctx *fc, sy_error *err)
+{
+    uint32_t extra = 0;
+    for (uint32_t j = 0; j < fc->item_count; ++j) {
+        uint64_t px = (uint64_t)fc->items[j].rect.w * fc->items[j].rect.h;
+        extra += (uint32_t)((px + SY_CLUSTER_MAX_REQUEST_PIXELS - 1) / SY_CLUSTER_MAX_REQUEST_PIXELS) - 1;
+    }
+    if (!extra) return SY_OK;
+    work_item *items = realloc(fc->items, ((size_t)fc->item_count + extra) * sizeof *items);
+    if (!items) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
+    fc->items = items;
+    uint32_t n = fc->item_count;
+    for (uint32_t j = 0; j < n; ++j) {
+        work_item it = fc->items[j];
+        uint32_t rows = SY_CLUSTER_MAX_REQUEST_PIXELS / it.rect.w; /* w <= 16384, so rows >= 4096 */
+        if ((uint64_t)it.rect.w * it.rect.h <= SY_CLUSTER_MAX_REQUEST_PIXELS) continue;
+        fc->items[j].rect.h = rows;
+        for (uint32_t y = rows; y < it.rect.h; y += rows) {
+            work_item band = it;
+            band.rect.y = it.rect.y + y;
+            band.rect.h = it.rect.h - y < rows ? it.rect.h - y : rows;
+            fc->items[fc->item_count++] = band;
+        }
+    }
+    return SY_OK;
+}
+
+/* Splits rows [0, h) into n strips with the given weights (each at least one row when h >= n). */
+static void split_rows(uint32_t h, uint32_t n, const double *w, uint32_t *starts)
+{
+    double total = 0;
+    for (uint32_t i = 0; i < n; ++i) total += w[i];
+    double acc = 0;
+    starts[0] = 0;
+    for (uint32_t i = 1; i < n; ++i) {
+        acc += w[i - 1];
+        uint32_t y = (uint32_t)llround((double)h * acc / total);
+        if (y < starts[i - 1] + (h >= n ? 1 : 0)) y = starts[i - 1] + (h >= n ? 1 : 0);
+        if (h >= n && y > h - (n - i)) y = h - (n - i);
+        if (y > h) y = h;
+        starts[i] = y;
+    }
+    starts[n] = h;
+}
+
+sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame *f, sy_layer *out,
+                                   sy_cluster_frame_stats *stats, sy_error *err)
+{
+    double t0 = sy_time_now();
+    sy_cluster_frame_stats st;
+    memset(&st, 0, sizeof st);
+    if (f->mode > SY_CLUSTER_STEREO || !f->backend || f->width < 1 || f->height < 1 ||
+        f->width > SY_CLUSTER_MAX_IMAGE || f->height > SY_CLUSTER_MAX_IMAGE)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster render: bad mode, back-end or image size");
+    uint32_t out_w = f->mode == SY_CLUSTER_STEREO ? 2 * f->width : f->width;
+    if (f->mode != SY_CLUSTER_MULTI_DISPLAY && (!out || out->width != out_w || out->height != f->height))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster render: output layer must be %ux%u", out_w, f->height);
+    c->frame++;
+    uint64_t sent0 = 0, recv0 = 0;
+    for (uint32_t i = 0; i < c->n; ++i) sent0 += c->conns[i].bytes_sent, recv0 += c->conns[i].bytes_received;
+    /* 1. reconnect servers that are down (they will get a snapshot) */
+    for (uint32_t i = 0; i < c->n; ++i) {
+        conn *k = &c->conns[i];
+        k->fresh = false;
+        if (!k->live) {
+            sy_error e = {0};
+            if (conn_connect(c, k, &e) == SY_OK) CLOG(c, "%s: (re)connected, sending a snapshot", k->url);
+            else copy_str(k->error, sizeof k->error, e.message);
+        }
+    }
+    /* 2. change lists: every live connection pulls from its own consumer (a new one = snapshot) */
+    sy_result r = SY_OK;
+    for (uint32_t i = 0; i < c->n && r == SY_OK; ++i) {
+        conn *k = &c->conns[i];
+        k->scene_msg.size = 0;
+        if (!k->live) continue;
+        bool snapshot = false;
+        if (!k->has_consumer) {
+            r = sy_scene_consumer_add(c->scene, &k->consumer, err);
+            if (r) break;
+            k->has_consumer = true;
+            snapshot = true;
+        }
+        sy_changes *ch = NULL;
+        r = sy_scene_consumer_pull(c->scene, k->consumer, &ch, err);
+        if (r) break;
+        snapshot = snapshot || sy_changes_is_snapshot(ch);
+        if (snapshot || sy_changes_count(ch) > 0) {
+            void *data = NULL;
+            size_t size = 0;
+            hs_clear(&k->pending);
+            r = sy_changes_serialize(ch, blob_send_cb, k, &data, &size, err);
+            if (r == SY_OK && size > UINT32_MAX - 1024)
+                r = sy_error_set(err, SY_ERR_LIMIT, "cluster: change list of %zu bytes is too large", size);
+            if (r == SY_OK) {
+                sy_cluster_msg m;
+                memset(&m, 0, sizeof m);
+                m.header.type = SY_CLUSTER_SCENE;
+                m.header.seq = ++k->send_seq;
+                m.u.scene.frame = c->frame;
+                m.u.scene.flags = snapshot ? SY_CLUSTER_SCENE_SNAPSHOT : 0;
+                m.u.scene.changes = data;
+                m.u.scene.changes_size = (uint32_t)size;
+                r = encode_frame(&m, k->tagged ? k->key : NULL, &k->scene_msg, err);
+                st.scene_bytes += k->scene_msg.size;
+                /* the blobs count as sent once the message goes out; a failed connection clears the set */
+                for (size_t j = 0; r == SY_OK && j < k->pending.cap; ++j)
+                    if (k->pending.keys[j].lo || k->pending.keys[j].hi) hs_add(&k->sent, k->pending.keys[j]);
+            }
+            free(data);
+        }
+        sy_changes_release(ch);
+    }
+    if (r) return r;
+    /* 3. work items */
+    uint32_t live[SY_CLUSTER_MAX_SERVERS], nl = 0;
+    for (uint32_t i = 0; i < c->n; ++i)
+        if (c->conns[i].live) live[nl++] = i;
+    if (!nl) return sy_error_set(err, SY_ERR_IO, "cluster: no server is reachable (%s)", c->conns[0].error);
+    frame_ctx fc = {.c = c, .f = f, .out = out};
+    fc.views[0] = f->camera;
+    fc.eye_ids[0] = SY_EYE_MONO;
+    if (f->mode == SY_CLUSTER_STEREO) {
+        float sep = f->eye_separation > 0 ? f->eye_separation : 0.065f, zp = f->zero_parallax > 0 ? f->zero_parallax : 2.0f;
+        fc.views[0] = sy_camera_view_eye(&f->camera, SY_EYE_LEFT, sep, zp);
+        fc.views[1] = sy_camera_view_eye(&f->camera, SY_EYE_RIGHT, sep, zp);
+        fc.eye_ids[0] = SY_EYE_LEFT;
+        fc.eye_ids[1] = SY_EYE_RIGHT;
+    }
+    fc.items = calloc((size_t)nl * 2 + 2, sizeof *fc.items);
+    fc.server_seconds = calloc(c->n, sizeof *fc.server_seconds);
+    if (f->mode == SY_CLUSTER_COOPERATIVE) {
+        fc.accum = calloc(c->n, sizeof *fc.accum);
+        fc.accum_samples = calloc(c->n, sizeof *fc.accum_samples);
+    }
+    if (!fc.items || !fc.server_seconds || (f->mode == SY_CLUSTER_COOPERATIVE && (!fc.accum || !fc.accum_samples)))
+        r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
+    uint32_t spp = f->samples ? f->samples : (f->mode == SY_CLUSTER_COOPERATIVE ? 16 : 0);
+    if (r == SY_OK) {
+        if (f->mode == SY_CLUSTER_COOPERATIVE) {
+            for (uint32_t s = 0; s < nl && r == SY_OK; ++s) {
+                r = sy_layer_create(f->width, f->height, &fc.accum[live[s]], err);
+                fc.items[fc.item_count++] =
+                    (work_item){0, {0, 0, f->width, f->height}, c->coop_next + s * spp, spp, (int)live[s], false};
+            }
+            if ((uint64_t)c->coop_next + (uint64_t)nl * spp > UINT32_MAX - SY_CLUSTER_MAX_SAMPLES)
+                r = sy_error_set(err, SY_ERR_LIMIT, "cluster: the cooperative sample index would overflow");
+            c->coop_next += nl * spp;
+        } else if (f->mode == SY_CLUSTER_STEREO) {
+            uint32_t groups = nl >= 2 ? 2 : 1;
+            for (uint32_t eye = 0; eye < 2; ++eye) {
+                uint32_t members[SY_CLUSTER_MAX_SERVERS], nm = 0;
+                for (uint32_t s = 0; s < nl; ++s)
+                    if (groups == 1 || s % 2 == eye) members[nm++] = live[s];
+                double w[SY_CLUSTER_MAX_SERVERS];
+                uint32_t starts[SY_CLUSTER_MAX_SERVERS + 1];
+                for (uint32_t s = 0; s < nm; ++s) w[s] = 1;
+                uint32_t parts = nm < f->height ? nm : f->height;
+                split_rows(f->height, parts, w, starts);
+                for (uint32_t s = 0; s < parts; ++s)
+                    fc.items[fc.item_count++] =
+                        (work_item){eye, {0, starts[s], f->width, starts[s + 1] - starts[s]}, 0, spp, (int)members[s], false};
+            }
+        } else if (f->mode == SY_CLUSTER_MULTI_DISPLAY) {
+            /* a wall: server i owns its configured tile, else column i of n */
+            for (uint32_t i = 0; i < c->n && r == SY_OK; ++i) {
+                uint32_t x0 = (uint32_t)((uint64_t)f->width * i / c->n), x1 = (uint32_t)((uint64_t)f->width * (i + 1) / c->n);
+                sy_cluster_rect t = {x0, 0, x1 - x0, f->height}, wt = c->conns[i].wall;
+                if (wt.w) {
+                    if (wt.h == 0 || wt.x >= f->width || wt.y >= f->height || wt.w > f->width - wt.x ||
+                        wt.h > f->height - wt.y)
+                        r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                         "cluster: wall tile %ux%u at %u,%u of %s lies outside the %ux%u wall", wt.w, wt.h,
+                                         wt.x, wt.y, c->conns[i].url, f->width, f->height);
+                    t = wt;
+                }
+                if (r == SY_OK && t.w > 0 && c->conns[i].live)
+                    fc.items[fc.item_count++] = (work_item){0, t, 0, spp, (int)i, false};
+            }
+        } else {
+            double w[SY_CLUSTER_MAX_SERVERS];
+            uint32_t starts[SY_CLUSTER_MAX_SERVERS + 1];
+            for (uint32_t s = 0; s < nl; ++s) {
+                conn *k = &c->conns[live[s]];
+                w[s] = 1.0;
+                if (f->mode == SY_CLUSTER_BALANCED && k->last_seconds > 0 && k->last_rows > 0)
+                    w[s] = (double)k->last_rows / k->last_seconds; /* rows per second */
+            }
+            if (f->mode == SY_CLUSTER_BALANCED) {
+                bool all = true;
+                for (uint32_t s = 0; s < nl; ++s) all = all && c->conns[live[s]].last_seconds > 0;
+                if (!all)
+                    for (uint32_t s = 0; s < nl; ++s) w[s] = 1.0;
+            }
+            uint32_t parts = nl < f->height ? nl : f->height;
+            split_rows(f->height, parts, w, starts);
+            for (uint32_t s = 0; s < parts; ++s)
+                if (starts[s + 1] > starts[s])
+                    fc.items[fc.item_count++] =
+                        (work_item){0, {0, starts[s], f->width, starts[s + 1] - starts[s]}, 0, spp, (int)live[s], false};
+        }
+    }
+    if (r == SY_OK && f->mode != SY_CLUSTER_MULTI_DISPLAY) r = split_large_items(&fc, err);
+    /* 4. rounds: scene + work, then failed work to the survivors, until done */
+    bool first = true;
+    for (uint32_t round = 0; r == SY_OK && round <= c->n; ++round) {
+        st.servers_failed += run_round(&fc, first);
+        first = false;
+        r = reassign(&fc, &st.reassigned, err);
+        bool left = false;
+        for (uint32_t j = 0; j < fc.item_count; ++j) left = left || !fc.items[j].done;
+        if (!left) break;
+        if (round == c->n) r = sy_error_set(err, SY_ERR_IO, "cluster: work left after %u rounds", round + 1);
+    }
+    /* 5. cooperative: merge the accumulations weighted by their sample counts */
+    if (r == SY_OK && f->mode == SY_CLUSTER_COOPERATIVE) {
+        uint64_t total = 0;
+        for (uint32_t i = 0; i < c->n; ++i)
+            if (fc.accum[i].rgba && fc.accum_samples[i]) total += fc.accum_samples[i];
+        if (!total) r = sy_error_set(err, SY_ERR_IO, "cluster: no server returned samples");
+        size_t px = (size_t)f->width * f->height;
+        for (size_t p = 0; r == SY_OK && p < px; ++p) {
+            double acc[4] = {0, 0, 0, 0};
+            float depth = INFINITY;
+            for (uint32_t i = 0; i < c->n; ++i) {
+                if (!fc.accum[i].rgba || !fc.accum_samples[i]) continue;
+                double wgt = (double)fc.accum_samples[i];
+                for (int ch = 0; ch < 4; ++ch) acc[ch] += wgt * fc.accum[i].rgba[p * 4 + ch];
+                if (fc.accum[i].depth[p] < depth) depth = fc.accum[i].depth[p];
+            }
+            for (int ch = 0; ch < 4; ++ch) out->rgba[p * 4 + ch] = (float)(acc[ch] / (double)total);
+            if (out->depth) out->depth[p] = depth;
+        }
+        st.samples = total;
+    }
+    /* 6. multi-display: the swap barrier, once every display holds its tile */
+    if (r == SY_OK && f->mode == SY_CLUSTER_MULTI_DISPLAY) {
+        for (uint32_t i = 0; i < c->n; ++i) {
+            conn *k = &c->conns[i];
+            if (!k->live) continue;
+            sy_cluster_msg m, rep;
+            memset(&m, 0, sizeof m);
+            m.header.type = SY_CLUSTER_SWAP;
+            m.u.ack.frame = c->frame;
+            nng_msg *raw = NULL;
+            sy_error e = {0};
+            if (conn_call(c, k, &m, NULL, SY_CLUSTER_SWAP_ACK, &rep, &raw, &e) == SY_OK) {
+                sy_cluster_msg_free(&rep);
+                nng_msg_free(raw);
+            } else {
+                CLOG(c, "%s: swap failed: %s", k->url, e.message);
+                conn_close(k);
+                if (k->has_consumer) sy_scene_consumer_remove(c->scene, k->consumer);
+                k->has_consumer = false;
+                st.servers_failed++;
+            }
+        }
+    }
+    for (uint32_t i = 0; i < c->n; ++i) {
+        if (fc.server_seconds && fc.server_seconds[i] > st.max_server_seconds) st.max_server_seconds = fc.server_seconds[i];
+        if (fc.accum) sy_layer_destroy(&fc.accum[i]);
+        st.bytes_sent += c->conns[i].bytes_sent;
+        st.bytes_received += c->conns[i].bytes_received;
+    }
+    st.bytes_sent -= sent0;
+    st.bytes_received -= recv0;
+    free(fc.accum);
+    free(fc.accum_samples);
+    free(fc.items);
+    free(fc.server_seconds);
+    st.servers_live = sy_cluster_client_live(c);
+    st.seconds = sy_time_now() - t0;
+    if (stats) *stats = st;
+    return r;
+}

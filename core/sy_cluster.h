@@ -1,0 +1,159 @@
+/* sy_cluster.h — cluster rendering over sockets: the render server (`sy serve`) and the client
+ * that drives a set of servers from the application's scene. Transport: nng req/rep over TCP
+ * (optionally TLS via nng's mbedTLS), authentication: HMAC-SHA512-256 challenge-response with a
+ * shared secret (libsodium), then every message tagged with a per-session key; tiles compressed
+ * with zstd. The wire format is in sy_cluster_proto.h and docs/PROTOCOL.md.
+ *
+ * This module is built as its own library (sy_cluster) so that sy_core stays free of nng,
+ * libsodium and zstd; it uses only core headers (scene, change lists, mediator contexts).
+ *
+ * Server: holds one session per connected client (replica scene fed by change lists, blob store,
+ * context pool) and renders with the mediators registered in the process. It serves requests one
+ * at a time (renders themselves use every core through the back-ends); a bad message or a failed
+ * authentication is answered with ERROR, logged with the peer's address and the reason, and the
+ * server keeps serving.
+ *
+ * Client: one connection per server URL; each connection is a scene consumer (its first sync is a
+ * snapshot), sends blobs it has not sent on that connection before, and renders its share of each
+ * frame. A server that fails or misses the deadline is disconnected and its work is given to the
+ * others within the same frame; it is retried at the next frame and then starts from a snapshot.
+ * Every socket operation has a timeout, so no call blocks forever.
+ *
+ * Ownership: the server and client own everything they allocate; the client borrows the scene
+ * (which must outlive it). Thread-safety: a server or client object is used from one thread at a
+ * time (the client runs internal threads per frame and joins them before returning). */
+#ifndef SY_CLUSTER_H
+#define SY_CLUSTER_H
+
+#include "sy_cluster_proto.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SY_CLUSTER_DEFAULT_URL "tcp://127.0.0.1:5750"
+#define SY_CLUSTER_MAX_SERVERS 64u
+#define SY_CLUSTER_MAX_REQUEST_PIXELS (1u << 26) /* tile pixels per RENDER (an 8192^2 image) */
+
+/* Receives one log line (no trailing newline). NULL = lines go to stderr. */
+typedef void (*sy_cluster_log_fn)(void *user, const char *line);
+
+/* Multi-display: shows / writes the server's tile of frame `frame` (layer = the tile, placed at
+ * (x, y) of a full_width x full_height wall). Called at the swap barrier. */
+typedef sy_result (*sy_cluster_present_fn)(void *user, uint64_t frame, const sy_layer *tile, uint32_t x, uint32_t y,
+                                           uint32_t full_width, uint32_t full_height, sy_error *err);
+
+/* ---- server ---- */
+typedef struct sy_cluster_server_opts {
+    const char *listen_url;   /* NULL = SY_CLUSTER_DEFAULT_URL; "tcp://127.0.0.1:0" = any free port */
+    const uint8_t *secret;    /* shared secret; NULL / 0 bytes = no authentication, loopback only */
+    size_t secret_len;
+    const char *tls_cert_file, *tls_key_file; /* both for tls+tcp:// URLs (PEM) */
+    const char *name;         /* reported to clients; NULL = "sy serve" */
+    uint32_t max_sessions;    /* 0 = 16 */
+    size_t max_message;       /* 0 = SY_CLUSTER_DEFAULT_MAX_MESSAGE */
+    sy_cluster_log_fn log;
+    void *log_user;
+    sy_cluster_present_fn present; /* NULL: SWAP only acknowledges */
+    void *present_user;
+    volatile int *stop;       /* polled every 100 ms; non-zero ends sy_cluster_server_run */
+    double max_lifetime_s;    /* > 0: run returns after this many seconds (tests) */
+} sy_cluster_server_opts;
+
+typedef struct sy_cluster_server sy_cluster_server;
+
+/* Listens. Refuses a non-loopback address without a secret, and TLS URLs without cert + key. */
+sy_result sy_cluster_server_create(const sy_cluster_server_opts *opts, sy_cluster_server **out, sy_error *err);
+/* The TCP port actually bound (useful with port 0). */
+int sy_cluster_server_port(const sy_cluster_server *s);
+/* Serves until *opts.stop becomes non-zero or max_lifetime_s passes. */
+sy_result sy_cluster_server_run(sy_cluster_server *s, sy_error *err);
+void sy_cluster_server_destroy(sy_cluster_server *s); /* NULL-safe */
+
+/* ---- client ---- */
+typedef struct sy_cluster_client_opts {
+    const char *const *urls; /* one per server, at most SY_CLUSTER_MAX_SERVERS */
+    uint32_t url_count;
+    const uint8_t *secret;   /* must match the servers'; NULL = servers without a secret only */
+    size_t secret_len;
+    const char *tls_ca_file; /* CA for tls+tcp:// servers (verified); NULL = no TLS */
+    uint32_t timeout_ms;     /* deadline per request (render, scene); 0 = 60000 */
+    uint32_t connect_timeout_ms; /* handshake; 0 = 5000 */
+    size_t max_message;      /* 0 = SY_CLUSTER_DEFAULT_MAX_MESSAGE */
+    sy_cluster_log_fn log;
+    void *log_user;
+    /* Optional, url_count entries each: a back-end per server (NULL entry = the frame's; e.g. a
+     * raster preview node beside path tracers), and the wall tile each server owns in
+     * multi-display mode ({0} entry = column i of n). */
+    const char *const *backends;
+    const sy_cluster_rect *wall_tiles;
+} sy_cluster_client_opts;
+
+typedef struct sy_cluster_client sy_cluster_client;
+
+typedef enum sy_cluster_mode {
+    SY_CLUSTER_SORT_FIRST = 0,    /* servers render horizontal strips of one image, client composites */
+    SY_CLUSTER_BALANCED = 1,      /* strip heights follow each server's last render speed */
+    SY_CLUSTER_COOPERATIVE = 2,   /* servers render disjoint sample ranges of every pixel; merged */
+    SY_CLUSTER_MULTI_DISPLAY = 3, /* each server renders and presents its column of a wall; swap barrier */
+    SY_CLUSTER_STEREO = 4,        /* left eye on even servers, right eye on odd ones; side by side */
+} sy_cluster_mode;
+
+/* "sort-first" -> SY_CLUSTER_SORT_FIRST, ...; false when unknown. */
+bool sy_cluster_mode_parse(const char *name, uint32_t *out);
+const char *sy_cluster_mode_name(uint32_t mode);
+
+typedef struct sy_cluster_frame {
+    uint32_t mode;           /* sy_cluster_mode */
+    const char *backend;     /* registered on the servers */
+    const char *params;      /* "k=v,..." or NULL */
+    uint32_t root_id, background_id;
+    sy_camera_view camera;   /* mono view; stereo derives both eyes from it */
+    uint32_t width, height;  /* per eye */
+    uint32_t samples;        /* cooperative: samples per server per frame (0 = 16); others: per request */
+    uint32_t seed;
+    bool depth;              /* fetch depth too */
+    float eye_separation, zero_parallax; /* stereo (0 = defaults 0.065 / 2) */
+} sy_cluster_frame;
+
+typedef struct sy_cluster_frame_stats {
+    uint32_t servers_live;   /* connected after the frame */
+    uint32_t servers_failed; /* failed or missed the deadline during this frame */
+    uint32_t reassigned;     /* work items given to another server */
+    uint64_t scene_bytes;    /* SCENE frames sent this frame (all servers) */
+    uint64_t bytes_sent, bytes_received; /* everything on the wire this frame */
+    uint64_t samples;        /* cooperative: merged samples per pixel */
+    double seconds;          /* whole frame on the client */
+    double max_server_seconds; /* slowest server's sync + render time */
+} sy_cluster_frame_stats;
+
+/* Creates the client and connects to every server it can reach (unreachable ones are retried at
+ * each frame). Fails only on bad options or when no server could be reached. */
+sy_result sy_cluster_client_create(sy_scene *scene, const sy_cluster_client_opts *opts, sy_cluster_client **out,
+                                   sy_error *err);
+/* Renders one frame: syncs the scene's committed changes to every live server, renders the
+ * frame's work and merges it into out (width x height, or 2*width x height side by side in stereo;
+ * created by the caller with sy_layer_create). Multi-display leaves out untouched. */
+sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame *f, sy_layer *out,
+                                   sy_cluster_frame_stats *stats, sy_error *err);
+uint32_t sy_cluster_client_live(const sy_cluster_client *c);
+/* Changes the per-request deadline (0 = 60000 ms) for the following frames. */
+void sy_cluster_client_set_timeout(sy_cluster_client *c, uint32_t timeout_ms);
+void sy_cluster_client_destroy(sy_cluster_client *c); /* says BYE to live servers; NULL-safe */
+
+/* Reads a shared secret: the file's bytes less trailing newlines (or $SY_CLUSTER_SECRET when path
+ * is NULL). *out is malloc()ed (NULL with *len 0 when there is none). Refuses empty secrets and
+ * files readable by group or others. */
+sy_result sy_cluster_secret_load(const char *path, uint8_t **out, size_t *len, sy_error *err);
+
+/* Tile codec (exposed for tests and benchmarks): encodes rect (x, y, w, h) of a layer that is
+ * w x h (tile-local) into float planes, byte-shuffled, zstd level 1. */
+sy_result sy_cluster_tile_encode(const sy_layer *tile, bool depth, sy_cluster_buf *out, sy_error *err);
+/* Decodes an untrusted tile into dst at (dx, dy) (dst must contain the rectangle). */
+sy_result sy_cluster_tile_decode(const sy_cluster_tile *t, sy_layer *dst, uint32_t dx, uint32_t dy, sy_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SY_CLUSTER_H */

@@ -1,0 +1,177 @@
+/* sy_cluster_proto.h — the cluster wire protocol: message encoder and decoder, pure (no sockets,
+ * no crypto, no compression), so that it can be fuzzed and tested alone. The transport
+ * (core/sy_cluster.c, nng + libsodium + zstd) frames, authenticates and compresses around it.
+ * Every message is documented in docs/PROTOCOL.md.
+ *
+ * Frame: a 24-byte little-endian header {magic "SYCP", version, type, flags, body size, sequence},
+ * the body, then (flag SY_CLUSTER_FLAG_TAGGED) a 32-byte authentication tag computed by the
+ * transport over header + body. The decoder checks the magic, the version, the type, that the body
+ * size matches the frame exactly, and every field of the body (lengths against what remains,
+ * counts against limits, rectangles inside the image, floats finite) before anything is used.
+ *
+ * Ownership: encoders append to a caller-owned sy_cluster_buf (free with sy_cluster_buf_free).
+ * A decoded sy_cluster_msg borrows byte ranges of the input buffer (changes payload, tile data),
+ * so the input must outlive it; arrays it allocates are freed by sy_cluster_msg_free.
+ * Thread-safety: pure functions on caller-owned memory. */
+#ifndef SY_CLUSTER_PROTO_H
+#define SY_CLUSTER_PROTO_H
+
+#include "sy_mediator.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SY_CLUSTER_MAGIC 0x50435953u /* "SYCP" little endian */
+#define SY_CLUSTER_VERSION 1u
+#define SY_CLUSTER_HEADER_SIZE 24u
+#define SY_CLUSTER_TAG_SIZE 32u
+#define SY_CLUSTER_NONCE_SIZE 32u
+#define SY_CLUSTER_NAME_MAX 64u      /* peer names, incl. NUL */
+#define SY_CLUSTER_BACKEND_MAX 32u   /* back-end names, incl. NUL */
+#define SY_CLUSTER_PARAMS_MAX 1024u  /* "k=v,..." parameter text, incl. NUL */
+#define SY_CLUSTER_REASON_MAX 256u   /* error reasons, incl. NUL */
+#define SY_CLUSTER_MAX_TILES 4096u   /* tiles per render request / reply */
+#define SY_CLUSTER_MAX_IMAGE 16384u  /* image width / height */
+#define SY_CLUSTER_MAX_SAMPLES (1u << 20)
+#define SY_CLUSTER_DEFAULT_MAX_MESSAGE ((size_t)1 << 30)
+
+typedef enum sy_cluster_msg_type {
+    SY_CLUSTER_HELLO = 1,     /* client -> server: nonce, name */
+    SY_CLUSTER_CHALLENGE = 2, /* server -> client: nonce, auth required, name */
+    SY_CLUSTER_AUTH = 3,      /* client -> server: proof (HMAC over both nonces) */
+    SY_CLUSTER_WELCOME = 4,   /* server -> client: server proof */
+    SY_CLUSTER_SCENE = 5,     /* client -> server: serialised change list for a frame */
+    SY_CLUSTER_SCENE_ACK = 6, /* server -> client: applied */
+    SY_CLUSTER_RENDER = 7,    /* client -> server: render request with tiles */
+    SY_CLUSTER_TILES = 8,     /* server -> client: compressed tiles + timings */
+    SY_CLUSTER_SWAP = 9,      /* client -> server: swap barrier (multi-display) */
+    SY_CLUSTER_SWAP_ACK = 10, /* server -> client: presented */
+    SY_CLUSTER_BYE = 11,      /* either way: end of session */
+    SY_CLUSTER_ERROR = 12,    /* server -> client: request rejected, with reason */
+    SY_CLUSTER_MSG_TYPE_MAX = 12
+} sy_cluster_msg_type;
+
+typedef enum sy_cluster_frame_flags {
+    SY_CLUSTER_FLAG_TAGGED = 1u << 0, /* a 32-byte authentication tag follows the body */
+} sy_cluster_frame_flags;
+
+typedef enum sy_cluster_scene_flags {
+    SY_CLUSTER_SCENE_SNAPSHOT = 1u << 0, /* replace the replica: start from an empty scene */
+} sy_cluster_scene_flags;
+
+typedef enum sy_cluster_render_flags {
+    SY_CLUSTER_RENDER_DEPTH = 1u << 0,   /* send the depth channel too */
+    SY_CLUSTER_RENDER_PRESENT = 1u << 1, /* keep the tiles on the server for SWAP (multi-display) */
+} sy_cluster_render_flags;
+
+typedef enum sy_cluster_encoding {
+    SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD = 1, /* float32 planes, byte-shuffled, zstd */
+} sy_cluster_encoding;
+
+typedef struct sy_cluster_rect {
+    uint32_t x, y, w, h;
+} sy_cluster_rect;
+
+typedef struct sy_cluster_header {
+    uint32_t magic;
+    uint16_t version, type;
+    uint32_t flags;     /* sy_cluster_frame_flags */
+    uint32_t body_size;
+    uint64_t seq;       /* per direction, starts at 1, strictly increasing */
+} sy_cluster_header;
+
+typedef struct sy_cluster_tile {
+    sy_cluster_rect rect;
+    uint32_t encoding; /* sy_cluster_encoding */
+    uint32_t channels; /* 4 (RGBA) or 5 (RGBA + depth) */
+    uint64_t raw_size; /* rect.w * rect.h * channels * 4, checked */
+    const uint8_t *data; /* compressed bytes (borrowed from the input / caller) */
+    uint32_t data_size;
+} sy_cluster_tile;
+
+typedef struct sy_cluster_msg {
+    sy_cluster_header header;
+    union {
+        struct { /* HELLO, CHALLENGE */
+            uint8_t nonce[SY_CLUSTER_NONCE_SIZE];
+            uint32_t flags; /* CHALLENGE: bit 0 = authentication required */
+            char name[SY_CLUSTER_NAME_MAX];
+        } hello;
+        struct { /* AUTH, WELCOME */
+            uint8_t mac[SY_CLUSTER_TAG_SIZE];
+        } auth;
+        struct { /* SCENE */
+            uint64_t frame;
+            uint32_t flags; /* sy_cluster_scene_flags */
+            const uint8_t *changes; /* sy_changes wire format (borrowed) */
+            uint32_t changes_size;
+        } scene;
+        struct { /* SCENE_ACK, SWAP, SWAP_ACK */
+            uint64_t frame;
+            uint32_t objects; /* SCENE_ACK: live objects in the replica */
+        } ack;
+        struct { /* RENDER */
+            uint64_t frame;
+            uint32_t job;
+            uint32_t flags; /* sy_cluster_render_flags */
+            char backend[SY_CLUSTER_BACKEND_MAX];
+            char params[SY_CLUSTER_PARAMS_MAX];
+            uint32_t root_id, background_id, seed, eye;
+            uint32_t sample_first, sample_count;
+            uint32_t full_width, full_height;
+            sy_camera_view camera;
+            uint32_t tile_count;
+            sy_cluster_rect *tiles; /* allocated by the decoder; caller's array when encoding */
+        } render;
+        struct { /* TILES */
+            uint64_t frame;
+            uint32_t job;
+            double sync_seconds, render_seconds;
+            uint64_t samples; /* per-pixel samples accumulated in what is sent (progressive) */
+            uint32_t tile_count;
+            sy_cluster_tile *tiles; /* allocated by the decoder; caller's array when encoding */
+        } tiles;
+        struct { /* ERROR */
+            uint32_t code; /* sy_result */
+            char reason[SY_CLUSTER_REASON_MAX];
+        } error;
+    } u;
+} sy_cluster_msg;
+
+/* Growable output buffer. Zero-initialise ({0}). */
+typedef struct sy_cluster_buf {
+    uint8_t *data;
+    size_t size, cap;
+} sy_cluster_buf;
+void sy_cluster_buf_free(sy_cluster_buf *b);
+
+/* Appends one complete frame (header + body) for msg (its header.type and header.seq are used;
+ * magic, version and body size are filled in). flags may contain SY_CLUSTER_FLAG_TAGGED: the caller
+ * then appends the tag itself (SY_CLUSTER_TAG_SIZE bytes) after computing it over the frame.
+ * Strings longer than their limits and out-of-range values are rejected, never truncated. */
+sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluster_buf *out, sy_error *err);
+
+typedef struct sy_cluster_limits {
+    size_t max_message; /* 0 = SY_CLUSTER_DEFAULT_MAX_MESSAGE */
+} sy_cluster_limits;
+
+/* Parses and checks only the header of an untrusted frame: magic, version, known type, body size
+ * consistent with size (including the tag when flagged). */
+sy_result sy_cluster_decode_header(const void *data, size_t size, const sy_cluster_limits *limits,
+                                   sy_cluster_header *out, sy_error *err);
+
+/* Decodes an untrusted frame completely (header + body; the tag, if any, is not verified here).
+ * On success the caller releases *out with sy_cluster_msg_free. Errors name the message type, the
+ * byte offset and the reason. */
+sy_result sy_cluster_decode(const void *data, size_t size, const sy_cluster_limits *limits, sy_cluster_msg *out,
+                            sy_error *err);
+void sy_cluster_msg_free(sy_cluster_msg *m); /* frees decoder allocations; NULL-safe */
+
+const char *sy_cluster_msg_type_name(uint32_t type); /* "HELLO", ..., "?" */
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SY_CLUSTER_PROTO_H */

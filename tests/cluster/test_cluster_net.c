@@ -1,0 +1,676 @@
+/* test_cluster_net.c — cluster rendering end to end with render servers as separate processes on
+ * 127.0.0.1 (random free ports): sort-first / balanced / stereo images equal a local whitted render
+ * bit for bit, the cooperative merge equals the exact mean of all samples (with the "coop_test"
+ * progressive double), wrong secrets are rejected with a logged reason, garbage / truncated /
+ * oversized / wrong-version / out-of-order messages and change lists naming unknown handles are
+ * rejected while the server keeps serving correct images, and a killed or stalled server loses its
+ * tiles to the others within the same frame and rejoins with a snapshot.
+ *
+ *   test_cluster_net SERVER_EXE WORK_DIR
+ * Every server is started with --max-lifetime and stopped with SIGTERM (SIGKILL after 5 s), and
+ * every wait is bounded, so nothing outlives the test. */
+#include "../core/check.h"
+#include "coop_double.h"
+#include "sy_cluster.h"
+#include "sy_demo.h"
+#include "sy_mediators.h"
+#include "sy_viewport.h"
+
+#include <nng/nng.h>
+#include <nng/protocol/reqrep0/req.h>
+
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+static const char *g_exe, *g_dir;
+static int g_serial;
+
+typedef struct server {
+    pid_t pid;
+    int port;
+    int serial;
+    char url[64];
+    char log[512];
+} server;
+
+static void sleep_ms(int ms)
+{
+    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}
+
+/* port 0 = any free port */
+static int start_server(const char *secret, int port, server *out)
+{
+    char pf[512], listen[64];
+    snprintf(pf, sizeof pf, "%s/port%d", g_dir, ++g_serial);
+    snprintf(out->log, sizeof out->log, "%s/server%d.log", g_dir, g_serial);
+    snprintf(listen, sizeof listen, "tcp://127.0.0.1:%d", port);
+    unlink(pf);
+    pid_t pid = fork();
+    CHECK(pid >= 0);
+    if (pid == 0) {
+        int fd = open(out->log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd >= 0) dup2(fd, 2);
+        char present[512];
+        snprintf(present, sizeof present, "%s/present%d.raw", g_dir, g_serial);
+        if (secret)
+            execl(g_exe, g_exe, "--port-file", pf, "--listen", listen, "--secret", secret, "--max-lifetime", "120",
+                  "--present", present, (char *)NULL);
+        else execl(g_exe, g_exe, "--port-file", pf, "--listen", listen, "--max-lifetime", "120", "--present", present,
+                   (char *)NULL);
+        _exit(127);
+    }
+    out->pid = pid;
+    out->serial = g_serial;
+    for (int i = 0; i < 400; ++i) { /* at most 20 s (ASan builds start slowly) */
+        FILE *f = fopen(pf, "r");
+        int p = 0;
+        if (f) {
+            if (fscanf(f, "%d", &p) != 1) p = 0;
+            fclose(f);
+        }
+        if (p > 0) {
+            out->port = p;
+            snprintf(out->url, sizeof out->url, "tcp://127.0.0.1:%d", p);
+            return 0;
+        }
+        int st;
+        if (waitpid(pid, &st, WNOHANG) == pid) {
+            fprintf(stderr, "server exited early, see %s\n", out->log);
+            out->pid = 0;
+            return 1;
+        }
+        sleep_ms(50);
+    }
+    fprintf(stderr, "server did not report its port\n");
+    return 1;
+}
+
+static void stop_server(server *s)
+{
+    if (s->pid <= 0) return;
+    kill(s->pid, SIGCONT);
+    kill(s->pid, SIGTERM);
+    for (int i = 0; i < 100; ++i) {
+        if (waitpid(s->pid, NULL, WNOHANG) == s->pid) {
+            s->pid = 0;
+            return;
+        }
+        sleep_ms(50);
+    }
+    kill(s->pid, SIGKILL);
+    waitpid(s->pid, NULL, 0);
+    s->pid = 0;
+}
+
+static bool log_contains(const server *s, const char *needle)
+{
+    for (int i = 0; i < 40; ++i) { /* the server may still be writing */
+        FILE *f = fopen(s->log, "r");
+        if (f) {
+            static char buf[1 << 16];
+            size_t n = fread(buf, 1, sizeof buf - 1, f);
+            fclose(f);
+            buf[n] = 0;
+            if (strstr(buf, needle)) return true;
+        }
+        sleep_ms(50);
+    }
+    return false;
+}
+
+/* ---- the scene and local references ---- */
+typedef struct fixture {
+    sy_scene *scene;
+    sy_demo_info d;
+    sy_context_pool *pool;
+    uint32_t w, h;
+} fixture;
+
+static sy_cluster_client *connect_all(fixture *fx, server *s, uint32_t n, const char *secret, uint32_t timeout_ms,
+                                      sy_error *e);
+static sy_cluster_frame make_frame(fixture *fx, uint32_t mode, const char *backend, const sy_camera_view *view);
+
+static int local_render_spp(fixture *fx, const char *backend, uint32_t eye, uint32_t spp, uint32_t seed, sy_layer *out,
+                            sy_camera_view *view)
+{
+    sy_error e = {0};
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_viewport_desc vd = {.root = fx->d.root, .camera = fx->d.camera, .background = fx->d.background,
+                           .backend = backend, .eye = eye};
+    CHECK_OK(sy_window_create(fx->w, fx->h, &win, &e), e);
+    CHECK_OK(sy_window_add_viewport(win, &vd, &vp, &e), e);
+    if (view) {
+        sy_viewport_desc mono = vd;
+        sy_viewport *mv = NULL;
+        mono.eye = SY_EYE_MONO;
+        mono.inactive = true;
+        CHECK_OK(sy_window_add_viewport(win, &mono, &mv, &e), e);
+        CHECK_OK(sy_viewport_camera_view(mv, fx->scene, fx->w, fx->h, view, &e), e);
+    }
+    CHECK_OK(sy_layer_create(fx->w, fx->h, out, &e), e);
+    sy_window_render_opts ro = {.sample_count = spp, .seed = seed};
+    sy_context_pool *pool = fx->pool;
+    if (spp) CHECK_OK(sy_context_pool_create(&pool, &e), e); /* a fresh accumulation */
+    CHECK_OK(sy_window_render(win, fx->scene, pool, &ro, out, &e), e);
+    if (pool != fx->pool) sy_context_pool_destroy(pool);
+    sy_window_destroy(win);
+    return 0;
+}
+
+static int local_render(fixture *fx, const char *backend, uint32_t eye, sy_layer *out, sy_camera_view *view)
+{
+    return local_render_spp(fx, backend, eye, 0, 0, out, view);
+}
+
+static double rms_diff(const sy_layer *a, const sy_layer *b)
+{
+    double s = 0;
+    size_t n = (size_t)a->width * a->height;
+    for (size_t i = 0; i < n * 4; ++i) {
+        if (i % 4 == 3) continue;
+        double d = (double)a->rgba[i] - b->rgba[i];
+        s += d * d;
+    }
+    return sqrt(s / (double)(n * 3));
+}
+
+static double mean_rgb(const sy_layer *a)
+{
+    double s = 0;
+    size_t n = (size_t)a->width * a->height;
+    for (size_t i = 0; i < n * 4; ++i)
+        if (i % 4 != 3) s += a->rgba[i];
+    return s / (double)(n * 3);
+}
+
+/* The real path tracer: 2 servers x 8 samples merged vs local renders. Same mean within noise, and
+ * the merged error against a 64-sample reference is that of 16 samples, not of 8. */
+static int test_cooperative_pathtracer(fixture *fx, server *s)
+{
+    if (!sy_mediator_find("pathtracer")) {
+        printf("cooperative pathtracer: skipped (no 'pathtracer' back-end registered)\n");
+        return 0;
+    }
+    sy_error e = {0};
+    sy_layer ref = {0}, l8 = {0}, l16 = {0}, out = {0};
+    sy_camera_view view;
+    if (local_render_spp(fx, "pathtracer", SY_EYE_MONO, 64, 1000, &ref, &view)) return 1;
+    if (local_render_spp(fx, "pathtracer", SY_EYE_MONO, 8, 7, &l8, NULL)) return 1;
+    if (local_render_spp(fx, "pathtracer", SY_EYE_MONO, 16, 7, &l16, NULL)) return 1;
+    sy_cluster_client *c = connect_all(fx, s, 2, "s3cret", 60000, &e);
+    CHECK_MSG(c != NULL, "%s", e.message);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
+    sy_cluster_frame f = make_frame(fx, SY_CLUSTER_COOPERATIVE, "pathtracer", &view);
+    f.samples = 8;
+    sy_cluster_frame_stats st;
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK(st.samples == 16);
+    CHECK(sy_layer_count_nonfinite(&out) == 0);
+    double mr = mean_rgb(&ref), mc = mean_rgb(&out);
+    double e8 = rms_diff(&l8, &ref), e16 = rms_diff(&l16, &ref), ec = rms_diff(&out, &ref);
+    printf("cooperative pathtracer: mean %.5f vs reference %.5f; rms error 8 spp %.5f, 16 spp %.5f, merged 2x8 %.5f\n",
+           mc, mr, e8, e16, ec);
+    CHECK_MSG(fabs(mc - mr) < 0.03 * mr + 1e-4, "merged mean %g vs %g", mc, mr);
+    CHECK_MSG(ec < 0.5 * (e8 + e16) * 1.15 && ec < e8, "merged error %g is not that of 16 samples (8: %g, 16: %g)", ec,
+              e8, e16);
+    /* the next frame keeps accumulating on both servers: 32 samples, a smaller error */
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    double ec2 = rms_diff(&out, &ref);
+    printf("cooperative pathtracer: second frame %llu samples, rms error %.5f\n", (unsigned long long)st.samples, ec2);
+    CHECK(st.samples == 32 && ec2 < ec);
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&ref);
+    sy_layer_destroy(&l8);
+    sy_layer_destroy(&l16);
+    sy_layer_destroy(&out);
+    return 0;
+}
+
+static bool same_region(const sy_layer *a, uint32_t ax, const sy_layer *b, uint32_t w, uint32_t h)
+{
+    for (uint32_t y = 0; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) {
+            size_t ia = (size_t)y * a->width + ax + x, ib = (size_t)y * b->width + x;
+            if (memcmp(&a->rgba[ia * 4], &b->rgba[ib * 4], 16) != 0) {
+                fprintf(stderr, "pixel %u,%u differs: %g %g %g %g vs %g %g %g %g\n", x, y, a->rgba[ia * 4],
+                        a->rgba[ia * 4 + 1], a->rgba[ia * 4 + 2], a->rgba[ia * 4 + 3], b->rgba[ib * 4],
+                        b->rgba[ib * 4 + 1], b->rgba[ib * 4 + 2], b->rgba[ib * 4 + 3]);
+                return false;
+            }
+            if (memcmp(&a->depth[ia], &b->depth[ib], 4) != 0) {
+                fprintf(stderr, "depth %u,%u differs\n", x, y);
+                return false;
+            }
+        }
+    return true;
+}
+
+static sy_cluster_client *connect_all(fixture *fx, server *s, uint32_t n, const char *secret, uint32_t timeout_ms,
+                                      sy_error *e)
+{
+    const char *urls[8];
+    for (uint32_t i = 0; i < n; ++i) urls[i] = s[i].url;
+    sy_cluster_client_opts co = {.urls = urls,
+                                 .url_count = n,
+                                 .secret = (const uint8_t *)secret,
+                                 .secret_len = secret ? strlen(secret) : 0,
+                                 .timeout_ms = timeout_ms,
+                                 .connect_timeout_ms = 3000};
+    sy_cluster_client *c = NULL;
+    if (sy_cluster_client_create(fx->scene, &co, &c, e) != SY_OK) return NULL;
+    return c;
+}
+
+static sy_cluster_frame make_frame(fixture *fx, uint32_t mode, const char *backend, const sy_camera_view *view)
+{
+    sy_cluster_frame f = {.mode = mode, .backend = backend, .root_id = fx->d.root.id,
+                          .background_id = fx->d.background.id, .camera = *view, .width = fx->w, .height = fx->h,
+                          .depth = true};
+    return f;
+}
+
+/* ---- tests ---- */
+static int test_sort_first_balanced_stereo(fixture *fx, server *s)
+{
+    sy_error e = {0};
+    sy_layer ref = {0}, left = {0}, right = {0}, out = {0}, st_out = {0};
+    sy_camera_view view;
+    if (local_render(fx, "whitted", SY_EYE_MONO, &ref, &view)) return 1;
+    if (local_render(fx, "whitted", SY_EYE_LEFT, &left, NULL)) return 1;
+    if (local_render(fx, "whitted", SY_EYE_RIGHT, &right, NULL)) return 1;
+    sy_cluster_client *c = connect_all(fx, s, 3, "s3cret", 30000, &e);
+    CHECK_MSG(c != NULL, "%s", e.message);
+    CHECK(sy_cluster_client_live(c) == 3);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
+    sy_cluster_frame f = make_frame(fx, SY_CLUSTER_SORT_FIRST, "whitted", &view);
+    sy_cluster_frame_stats st;
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK(st.servers_live == 3 && st.servers_failed == 0 && st.scene_bytes > 1000);
+    CHECK_MSG(same_region(&out, 0, &ref, fx->w, fx->h), "sort-first differs from the local render");
+    /* balanced: strip heights move with the measured times; the image never changes */
+    f.mode = SY_CLUSTER_BALANCED;
+    for (int i = 0; i < 3; ++i) {
+        sy_layer_clear(&out);
+        CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+        CHECK(st.scene_bytes == 0); /* nothing changed: no scene traffic */
+        CHECK_MSG(same_region(&out, 0, &ref, fx->w, fx->h), "balanced frame %d differs", i);
+    }
+    /* stereo: left eye on servers 0 and 2, right eye on server 1; side by side */
+    f.mode = SY_CLUSTER_STEREO;
+    CHECK_OK(sy_layer_create(2 * fx->w, fx->h, &st_out, &e), e);
+    CHECK_OK(sy_cluster_client_render(c, &f, &st_out, &st, &e), e);
+    CHECK_MSG(same_region(&st_out, 0, &left, fx->w, fx->h), "left eye differs");
+    CHECK_MSG(same_region(&st_out, fx->w, &right, fx->w, fx->h), "right eye differs");
+    CHECK(!same_region(&left, 0, &right, fx->w, fx->h));
+    /* multi-display: server i presents column i at the swap barrier, equal to that crop of the
+     * local render */
+    f.mode = SY_CLUSTER_MULTI_DISPLAY;
+    CHECK_OK(sy_cluster_client_render(c, &f, NULL, &st, &e), e);
+    CHECK(st.servers_failed == 0 && st.bytes_received < 4096); /* no pixels travel back */
+    for (int i = 0; i < 3; ++i) {
+        char path[600];
+        snprintf(path, sizeof path, "%s/present%d.raw", g_dir, s[i].serial);
+        FILE *pf = fopen(path, "rb");
+        CHECK_MSG(pf != NULL, "%s was not presented", path);
+        uint32_t hd[5];
+        CHECK(fread(hd, 4, 5, pf) == 5);
+        uint32_t x0 = fx->w * (uint32_t)i / 3, x1 = fx->w * (uint32_t)(i + 1) / 3;
+        CHECK_MSG(hd[1] == x0 && hd[2] == 0 && hd[3] == x1 - x0 && hd[4] == fx->h, "tile %u,%u %ux%u", hd[1], hd[2],
+                  hd[3], hd[4]);
+        size_t n = (size_t)hd[3] * hd[4] * 4;
+        float *px = malloc(n * 4);
+        CHECK(px && fread(px, 4, n, pf) == n);
+        fclose(pf);
+        for (uint32_t y = 0; y < hd[4]; ++y)
+            CHECK_MSG(memcmp(px + (size_t)y * hd[3] * 4, ref.rgba + ((size_t)y * fx->w + x0) * 4, (size_t)hd[3] * 16) == 0,
+                      "wall tile %d row %u differs from the local render", i, y);
+        free(px);
+    }
+    /* a one-transform change travels as a small change list and shows up in the image */
+    sy_mat4 m;
+    CHECK_OK(sy_node_world_matrix(fx->scene, fx->d.camera, &m, &e), e);
+    m.m[12] += 0.05f;
+    CHECK_OK(sy_node_set_matrix(fx->scene, fx->d.camera, &m, &e), e);
+    CHECK_OK(sy_scene_commit(fx->scene, NULL, &e), e);
+    f.mode = SY_CLUSTER_SORT_FIRST;
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK_MSG(st.scene_bytes > 0 && st.scene_bytes < 3 * 256, "one-transform change cost %llu bytes for 3 servers",
+              (unsigned long long)st.scene_bytes);
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&ref);
+    sy_layer_destroy(&left);
+    sy_layer_destroy(&right);
+    sy_layer_destroy(&out);
+    sy_layer_destroy(&st_out);
+    return 0;
+}
+
+static int test_cooperative(fixture *fx, server *s)
+{
+    sy_error e = {0};
+    sy_layer out = {0};
+    sy_camera_view view = sy_camera_view_frame_bounds(&(sy_bounds){{-1, -1, -1}, {1, 1, 1}}, 1.0f);
+    sy_cluster_client *c = connect_all(fx, s, 2, "s3cret", 30000, &e);
+    CHECK_MSG(c != NULL, "%s", e.message);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
+    sy_cluster_frame f = make_frame(fx, SY_CLUSTER_COOPERATIVE, "coop_test", &view);
+    f.samples = 8;
+    sy_cluster_frame_stats st;
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK(st.samples == 16);
+    /* the merged image is the mean over samples 0..15 of every pixel: disjoint ranges, exact weights */
+    double maxerr = 0;
+    for (uint32_t y = 0; y < fx->h; ++y)
+        for (uint32_t x = 0; x < fx->w; ++x) {
+            double sum = 0;
+            for (uint32_t k = 0; k < 16; ++k) sum += coop_double_sample(x, y, k);
+            double d = fabs(out.rgba[((size_t)y * fx->w + x) * 4] - sum / 16.0);
+            if (d > maxerr) maxerr = d;
+        }
+    CHECK_MSG(maxerr < 1e-6, "cooperative merge off by %g", maxerr);
+    /* a second frame adds new, disjoint samples (32 in all) */
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK(st.samples == 32);
+    maxerr = 0;
+    for (uint32_t y = 0; y < fx->h; y += 7)
+        for (uint32_t x = 0; x < fx->w; x += 5) {
+            double sum = 0;
+            for (uint32_t k = 0; k < 32; ++k) sum += coop_double_sample(x, y, k);
+            double d = fabs(out.rgba[((size_t)y * fx->w + x) * 4] - sum / 32.0);
+            if (d > maxerr) maxerr = d;
+        }
+    CHECK_MSG(maxerr < 1e-6, "second cooperative frame off by %g", maxerr);
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&out);
+    return 0;
+}
+
+static int test_auth(fixture *fx, server *s)
+{
+    sy_error e = {0};
+    sy_cluster_client *c = connect_all(fx, s, 1, "wrong", 5000, &e);
+    CHECK(c == NULL);
+    CHECK_MSG(strstr(e.message, "wrong secret") != NULL, "%s", e.message);
+    CHECK(log_contains(s, "rejected: authentication failed: wrong secret"));
+    c = connect_all(fx, s, 1, NULL, 5000, &e);
+    CHECK(c == NULL);
+    CHECK_MSG(strstr(e.message, "requires a shared secret") != NULL, "%s", e.message);
+    return 0;
+}
+
+/* one raw request on a fresh req socket; returns the ERROR reason (or "" for another reply) */
+static int raw_exchange(const server *s, const void *data, size_t size, char *reason, size_t cap)
+{
+    nng_socket sock;
+    CHECK(nng_req0_open(&sock) == 0);
+    nng_socket_set_ms(sock, NNG_OPT_RECVTIMEO, 10000);
+    nng_socket_set_ms(sock, NNG_OPT_SENDTIMEO, 10000);
+    CHECK(nng_dial(sock, s->url, NULL, 0) == 0);
+    CHECK(nng_send(sock, (void *)data, size, 0) == 0);
+    void *buf = NULL;
+    size_t n = 0;
+    int rv = nng_recv(sock, &buf, &n, NNG_FLAG_ALLOC);
+    CHECK_MSG(rv == 0, "no reply: %s", nng_strerror(rv));
+    sy_cluster_msg m;
+    sy_error e = {0};
+    CHECK_OK(sy_cluster_decode(buf, n, NULL, &m, &e), e);
+    snprintf(reason, cap, "%s", m.header.type == SY_CLUSTER_ERROR ? m.u.error.reason : "");
+    sy_cluster_msg_free(&m);
+    nng_free(buf, n);
+    nng_close(sock);
+    return 0;
+}
+
+/* HELLO then one more message on the same socket (no secret: no tags) */
+static int raw_session(const server *s, const sy_cluster_msg *second, char *reason, size_t cap)
+{
+    nng_socket sock;
+    CHECK(nng_req0_open(&sock) == 0);
+    nng_socket_set_ms(sock, NNG_OPT_RECVTIMEO, 10000);
+    CHECK(nng_dial(sock, s->url, NULL, 0) == 0);
+    sy_error e = {0};
+    sy_cluster_msg hello;
+    memset(&hello, 0, sizeof hello);
+    hello.header.type = SY_CLUSTER_HELLO;
+    hello.header.seq = 1;
+    strcpy(hello.u.hello.name, "raw test");
+    sy_cluster_buf b = {0};
+    CHECK_OK(sy_cluster_encode(&hello, 0, &b, &e), e);
+    CHECK(nng_send(sock, b.data, b.size, 0) == 0);
+    void *buf = NULL;
+    size_t n = 0;
+    CHECK(nng_recv(sock, &buf, &n, NNG_FLAG_ALLOC) == 0);
+    nng_free(buf, n);
+    b.size = 0;
+    CHECK_OK(sy_cluster_encode(second, 0, &b, &e), e);
+    CHECK(nng_send(sock, b.data, b.size, 0) == 0);
+    CHECK(nng_recv(sock, &buf, &n, NNG_FLAG_ALLOC) == 0);
+    sy_cluster_msg m;
+    CHECK_OK(sy_cluster_decode(buf, n, NULL, &m, &e), e);
+    snprintf(reason, cap, "%s", m.header.type == SY_CLUSTER_ERROR ? m.u.error.reason : "");
+    sy_cluster_msg_free(&m);
+    nng_free(buf, n);
+    sy_cluster_buf_free(&b);
+    nng_close(sock);
+    return 0;
+}
+
+static int test_bad_messages(fixture *fx, server *s)
+{
+    char why[SY_CLUSTER_REASON_MAX];
+    uint8_t garbage[100];
+    for (int i = 0; i < 100; ++i) garbage[i] = (uint8_t)(i * 37 + 11);
+    if (raw_exchange(s, garbage, sizeof garbage, why, sizeof why)) return 1;
+    CHECK_MSG(strstr(why, "magic"), "%s", why);
+    /* a valid HELLO, truncated; with a lying size; with version 2 */
+    sy_error e = {0};
+    sy_cluster_msg hello;
+    memset(&hello, 0, sizeof hello);
+    hello.header.type = SY_CLUSTER_HELLO;
+    hello.header.seq = 1;
+    sy_cluster_buf b = {0};
+    CHECK_OK(sy_cluster_encode(&hello, 0, &b, &e), e);
+    if (raw_exchange(s, b.data, b.size - 3, why, sizeof why)) return 1;
+    CHECK_MSG(strstr(why, "announces"), "%s", why);
+    b.data[12] = 0xFF, b.data[13] = 0xFF, b.data[14] = 0xFF, b.data[15] = 0x7F;
+    if (raw_exchange(s, b.data, b.size, why, sizeof why)) return 1;
+    CHECK_MSG(strstr(why, "announces"), "%s", why);
+    b.size = 0;
+    CHECK_OK(sy_cluster_encode(&hello, 0, &b, &e), e);
+    b.data[4] = 2;
+    if (raw_exchange(s, b.data, b.size, why, sizeof why)) return 1;
+    CHECK_MSG(strstr(why, "version 2"), "%s", why);
+    /* requests out of order: RENDER before HELLO; RENDER before any scene; non-snapshot first scene */
+    sy_cluster_msg r;
+    memset(&r, 0, sizeof r);
+    r.header.type = SY_CLUSTER_BYE;
+    r.header.seq = 1;
+    b.size = 0;
+    CHECK_OK(sy_cluster_encode(&r, 0, &b, &e), e);
+    if (raw_exchange(s, b.data, b.size, why, sizeof why)) return 1;
+    CHECK_MSG(strstr(why, "before authentication"), "%s", why);
+    sy_cluster_rect tile = {0, 0, 4, 4};
+    r.header.type = SY_CLUSTER_RENDER;
+    r.header.seq = 2;
+    strcpy(r.u.render.backend, "whitted");
+    r.u.render.full_width = r.u.render.full_height = 8;
+    r.u.render.camera = sy_camera_view_frame_bounds(&(sy_bounds){{-1, -1, -1}, {1, 1, 1}}, 1.0f);
+    r.u.render.tile_count = 1;
+    r.u.render.tiles = &tile;
+    if (raw_session(s, &r, why, sizeof why)) return 1;
+    CHECK_MSG(strstr(why, "before any scene"), "%s", why);
+    /* change lists naming unknown handles: an update of a node the replica never saw */
+    sy_scene *other = NULL;
+    sy_node n;
+    uint32_t consumer;
+    sy_changes *ch = NULL;
+    CHECK_OK(sy_scene_create(&other, &e), e);
+    CHECK_OK(sy_node_create(other, "n", &n, &e), e);
+    CHECK_OK(sy_scene_commit(other, NULL, &e), e);
+    CHECK_OK(sy_scene_consumer_add(other, &consumer, &e), e);
+    CHECK_OK(sy_scene_consumer_pull(other, consumer, &ch, &e), e);
+    sy_changes_release(ch);
+    CHECK_OK(sy_node_set_flags(other, n, SY_NODE_STATIC, &e), e);
+    CHECK_OK(sy_scene_commit(other, NULL, &e), e);
+    CHECK_OK(sy_scene_consumer_pull(other, consumer, &ch, &e), e);
+    void *data = NULL;
+    size_t size = 0;
+    CHECK_OK(sy_changes_serialize(ch, NULL, NULL, &data, &size, &e), e);
+    sy_changes_release(ch);
+    sy_scene_destroy(other);
+    sy_cluster_msg sc;
+    memset(&sc, 0, sizeof sc);
+    sc.header.type = SY_CLUSTER_SCENE;
+    sc.header.seq = 2;
+    sc.u.scene.frame = 1;
+    sc.u.scene.changes = data;
+    sc.u.scene.changes_size = (uint32_t)size;
+    if (raw_session(s, &sc, why, sizeof why)) return 1;
+    CHECK_MSG(strstr(why, "snapshot"), "%s", why);
+    sc.u.scene.flags = SY_CLUSTER_SCENE_SNAPSHOT;
+    if (raw_session(s, &sc, why, sizeof why)) return 1;
+    CHECK_MSG(why[0] && strstr(why, "rejected"), "unknown handle accepted: '%s'", why);
+    /* and garbage inside a SCENE */
+    memset(data, 0xAB, size);
+    if (raw_session(s, &sc, why, sizeof why)) return 1;
+    CHECK_MSG(why[0] != 0, "garbage change list accepted");
+    free(data);
+    sy_cluster_buf_free(&b);
+    CHECK(log_contains(s, "rejected: cluster message: bad magic"));
+    CHECK(log_contains(s, "protocol version 2"));
+    /* the server still renders correct images for a well-behaved client */
+    sy_layer ref = {0}, out = {0};
+    sy_camera_view view;
+    if (local_render(fx, "whitted", SY_EYE_MONO, &ref, &view)) return 1;
+    sy_cluster_client *c = connect_all(fx, s, 1, NULL, 30000, &e);
+    CHECK_MSG(c != NULL, "%s", e.message);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
+    sy_cluster_frame f = make_frame(fx, SY_CLUSTER_SORT_FIRST, "whitted", &view);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, NULL, &e), e);
+    CHECK(same_region(&out, 0, &ref, fx->w, fx->h));
+    /* an unknown back-end is refused by name */
+    f.backend = "no_such_backend";
+    CHECK(sy_cluster_client_render(c, &f, &out, NULL, &e) != SY_OK);
+    CHECK_MSG(strstr(e.message, "no_such_backend"), "%s", e.message);
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&ref);
+    sy_layer_destroy(&out);
+    return 0;
+}
+
+static int test_faults(fixture *fx, server *s)
+{
+    sy_error e = {0};
+    sy_layer ref = {0}, out = {0};
+    sy_camera_view view;
+    if (local_render(fx, "whitted", SY_EYE_MONO, &ref, &view)) return 1;
+    /* generous deadlines for frames that must succeed (sanitizer builds on a loaded machine), a
+     * short one where a server is meant to miss it */
+    sy_cluster_client *c = connect_all(fx, s, 2, "s3cret", 30000, &e);
+    CHECK_MSG(c != NULL, "%s", e.message);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
+    sy_cluster_frame f = make_frame(fx, SY_CLUSTER_SORT_FIRST, "whitted", &view);
+    sy_cluster_frame_stats st;
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK(st.servers_failed == 0);
+    /* server 1 dies: its strip goes to server 0 within the same frame */
+    int port1 = s[1].port;
+    kill(s[1].pid, SIGKILL);
+    waitpid(s[1].pid, NULL, 0);
+    s[1].pid = 0;
+    sy_cluster_client_set_timeout(c, 3000);
+    sy_layer_clear(&out);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK_MSG(st.servers_failed == 1 && st.reassigned >= 1 && st.servers_live == 1, "failed %u reassigned %u live %u",
+              st.servers_failed, st.reassigned, st.servers_live);
+    CHECK_MSG(same_region(&out, 0, &ref, fx->w, fx->h), "image after a server died differs");
+    /* it comes back on the same port: reconnect + snapshot at the next frame */
+    int started = 1;
+    for (int i = 0; i < 20 && started; ++i) {
+        started = start_server("s3cret", port1, &s[1]);
+        if (started) sleep_ms(200);
+    }
+    CHECK(started == 0);
+    sy_cluster_client_set_timeout(c, 30000);
+    sy_layer_clear(&out);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK_MSG(st.servers_live == 2 && st.servers_failed == 0 && st.scene_bytes > 1000, "live %u failed %u scene %llu",
+              st.servers_live, st.servers_failed, (unsigned long long)st.scene_bytes);
+    CHECK(same_region(&out, 0, &ref, fx->w, fx->h));
+    /* server 0 stalls (SIGSTOP): it misses the 2 s deadline and loses its strip to server 1 */
+    kill(s[0].pid, SIGSTOP);
+    sy_cluster_client_set_timeout(c, 3000);
+    sy_layer_clear(&out);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK_MSG(st.servers_failed == 1 && st.reassigned >= 1, "failed %u reassigned %u", st.servers_failed, st.reassigned);
+    CHECK(same_region(&out, 0, &ref, fx->w, fx->h));
+    kill(s[0].pid, SIGCONT);
+    /* every server gone: a clear error, never a hang */
+    stop_server(&s[0]);
+    stop_server(&s[1]);
+    CHECK(sy_cluster_client_render(c, &f, &out, &st, &e) != SY_OK);
+    CHECK_MSG(strstr(e.message, "no server") || strstr(e.message, "every server"), "%s", e.message);
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&ref);
+    sy_layer_destroy(&out);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 3) {
+        fprintf(stderr, "usage: test_cluster_net SERVER_EXE WORK_DIR\n");
+        return 2;
+    }
+    g_exe = argv[1];
+    g_dir = argv[2];
+    mkdir(g_dir, 0755);
+    signal(SIGPIPE, SIG_IGN);
+    sy_error e = {0};
+    if (sy_mediators_register_builtin(&e) || coop_double_register(&e)) {
+        fprintf(stderr, "%s\n", e.message);
+        return 1;
+    }
+    fixture fx = {.w = 96, .h = 64};
+    if (sy_scene_create(&fx.scene, &e) || sy_demo_build(fx.scene, &fx.d, &e) || sy_scene_commit(fx.scene, NULL, &e) ||
+        sy_context_pool_create(&fx.pool, &e)) {
+        fprintf(stderr, "%s\n", e.message);
+        return 1;
+    }
+    server s[4];
+    memset(s, 0, sizeof s);
+    int failed = 0;
+    if (start_server("s3cret", 0, &s[0]) || start_server("s3cret", 0, &s[1]) || start_server("s3cret", 0, &s[2]) ||
+        start_server(NULL, 0, &s[3])) {
+        failed = 1;
+    } else {
+        int r;
+        failed += r = test_sort_first_balanced_stereo(&fx, s);
+        printf("sort-first / balanced / stereo: %s\n", r ? "FAILED" : "ok");
+        failed += r = test_cooperative(&fx, s);
+        printf("cooperative merge: %s\n", r ? "FAILED" : "ok");
+        failed += r = test_cooperative_pathtracer(&fx, s);
+        printf("cooperative pathtracer: %s\n", r ? "FAILED" : "ok");
+        failed += r = test_auth(&fx, &s[2]);
+        printf("authentication: %s\n", r ? "FAILED" : "ok");
+        failed += r = test_bad_messages(&fx, &s[3]);
+        printf("bad messages: %s\n", r ? "FAILED" : "ok");
+        failed += r = test_faults(&fx, s);
+        printf("faults: %s\n", r ? "FAILED" : "ok");
+    }
+    for (int i = 0; i < 4; ++i) stop_server(&s[i]);
+    sy_context_pool_destroy(fx.pool);
+    sy_scene_destroy(fx.scene);
+    if (failed) fprintf(stderr, "test_cluster_net: %d group(s) failed (server logs in %s)\n", failed, g_dir);
+    return failed ? 1 : 0;
+}

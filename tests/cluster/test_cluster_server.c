@@ -1,0 +1,82 @@
+/* test_cluster_server.c — a render server process for the cluster tests: the built-in mediators
+ * plus the "coop_test" double, served through core/sy_cluster.c exactly as `sy serve` does.
+ *   test_cluster_server --port-file F [--listen URL] [--secret S] [--max-lifetime SECONDS] [--present RAW]
+ * Stops on SIGTERM / SIGINT or after --max-lifetime (default 120 s), so nothing outlives a test. */
+#include "coop_double.h"
+#include "sy_cluster.h"
+#include "sy_mediators.h"
+
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static volatile int g_stop;
+
+/* multi-display: the presented tile as a raw dump (u32 frame, x, y, w, h, then w*h*4 floats) */
+static sy_result present_raw(void *user, uint64_t frame, const sy_layer *tile, uint32_t x, uint32_t y, uint32_t fw,
+                             uint32_t fh, sy_error *err)
+{
+    (void)fw, (void)fh;
+    const char *path = user;
+    char tmp[4200];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *f = fopen(tmp, "wb");
+    uint32_t hd[5] = {(uint32_t)frame, x, y, tile->width, tile->height};
+    size_t n = (size_t)tile->width * tile->height * 4;
+    if (!f || fwrite(hd, 4, 5, f) != 5 || fwrite(tile->rgba, 4, n, f) != n || fclose(f) != 0 || rename(tmp, path) != 0)
+        return sy_error_set(err, SY_ERR_IO, "%s: cannot write the presented tile", path);
+    return SY_OK;
+}
+static void on_signal(int s)
+{
+    (void)s;
+    g_stop = 1;
+}
+
+int main(int argc, char **argv)
+{
+    sy_cluster_server_opts o = {.listen_url = "tcp://127.0.0.1:0", .max_lifetime_s = 120, .stop = &g_stop};
+    const char *port_file = NULL, *secret = NULL;
+    for (int i = 1; i + 1 < argc; i += 2) {
+        if (!strcmp(argv[i], "--port-file")) port_file = argv[i + 1];
+        else if (!strcmp(argv[i], "--listen")) o.listen_url = argv[i + 1];
+        else if (!strcmp(argv[i], "--secret")) secret = argv[i + 1];
+        else if (!strcmp(argv[i], "--max-lifetime")) o.max_lifetime_s = atof(argv[i + 1]);
+        else if (!strcmp(argv[i], "--present")) {
+            o.present = present_raw;
+            o.present_user = argv[i + 1];
+        }
+    }
+    if (secret) {
+        o.secret = (const uint8_t *)secret;
+        o.secret_len = strlen(secret);
+    }
+    signal(SIGTERM, on_signal);
+    signal(SIGINT, on_signal);
+    signal(SIGPIPE, SIG_IGN);
+    sy_error e = {0};
+    if (sy_mediators_register_builtin(&e) || coop_double_register(&e)) {
+        fprintf(stderr, "test_cluster_server: %s\n", e.message);
+        return 2;
+    }
+    sy_cluster_server *s = NULL;
+    if (sy_cluster_server_create(&o, &s, &e)) {
+        fprintf(stderr, "test_cluster_server: %s\n", e.message);
+        return 2;
+    }
+    if (port_file) {
+        char tmp[4096];
+        snprintf(tmp, sizeof tmp, "%s.tmp", port_file);
+        FILE *f = fopen(tmp, "w");
+        if (!f || fprintf(f, "%d\n", sy_cluster_server_port(s)) < 0 || fclose(f) != 0 || rename(tmp, port_file) != 0) {
+            fprintf(stderr, "test_cluster_server: cannot write %s\n", port_file);
+            sy_cluster_server_destroy(s);
+            return 2;
+        }
+    }
+    sy_result r = sy_cluster_server_run(s, &e);
+    sy_cluster_server_destroy(s);
+    if (r) fprintf(stderr, "test_cluster_server: %s\n", e.message);
+    return r ? 2 : 0;
+}

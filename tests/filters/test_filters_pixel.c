@@ -1,0 +1,277 @@
+/* test_filters_pixel.c — pixel filtering (backends/filters/sy_filter_pixel.h) on synthetic data
+ * with known answers: convergence of a noisy constant, no bleeding across depth/albedo steps,
+ * consistency of the blend operator, r = 1/n for equal weights, NaN isolation, parameter
+ * rejection, and relMSE reduction >= 4x at a 4-spp noise level. */
+#include "sy_filter_pixel.h"
+#include "synth.h"
+
+#include <string.h>
+
+static float *run(sy_filter_pixel_params *p, const sy_filter_frame *f, uint32_t frame, sy_filter_stats *st)
+{
+    sy_filter_pixel *pf = NULL;
+    sy_filter_error err = {0};
+    CHECK(sy_filter_pixel_create(p, &pf, &err) == SY_FILTER_OK);
+    float *out = malloc((size_t)f->width * f->height * 4 * sizeof(float));
+    CHECK(out);
+    if (sy_filter_pixel_run(pf, f, frame, true, out, st, &err) != SY_FILTER_OK) {
+        fprintf(stderr, "run: %s\n", err.message);
+        exit(1);
+    }
+    sy_filter_pixel_destroy(pf);
+    return out;
+}
+
+static void test_params(void)
+{
+    sy_filter_pixel_params p;
+    sy_filter_error err = {0};
+    sy_filter_pixel *pf = NULL;
+    sy_filter_pixel_params_default(&p);
+    CHECK(sy_filter_pixel_params_check(&p, &err) == SY_FILTER_OK);
+    p.threshold = -0.1f;
+    CHECK(sy_filter_pixel_create(&p, &pf, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT && !pf);
+    CHECK(strstr(err.message, "threshold") != NULL);
+    sy_filter_pixel_params_default(&p);
+    p.sigma_s = 0.0f;
+    CHECK(sy_filter_pixel_params_check(&p, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT && strstr(err.message, "sigma_s"));
+    sy_filter_pixel_params_default(&p);
+    p.sigma_c = 0.0f;
+    CHECK(sy_filter_pixel_params_check(&p, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT && strstr(err.message, "sigma_c"));
+    sy_filter_pixel_params_default(&p);
+    p.sigma_d = NAN;
+    CHECK(sy_filter_pixel_params_check(&p, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT && strstr(err.message, "sigma_d"));
+    sy_filter_pixel_params_default(&p);
+    p.schedule_start = 3;
+    CHECK(sy_filter_pixel_params_check(&p, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    sy_filter_pixel_params_default(&p);
+    CHECK(sy_filter_pixel_scheduled(&p, 4) && sy_filter_pixel_scheduled(&p, 8) && sy_filter_pixel_scheduled(&p, 1024));
+    CHECK(!sy_filter_pixel_scheduled(&p, 1) && !sy_filter_pixel_scheduled(&p, 2) && !sy_filter_pixel_scheduled(&p, 6));
+    /* a frame without required buffers is rejected, naming the buffer */
+    CHECK(sy_filter_pixel_create(&p, &pf, &err) == SY_FILTER_OK);
+    sy_filter_frame f = {.width = 4, .height = 4, .color_channels = 4, .variance_channels = 1, .spp_uniform = 1};
+    float out[64];
+    CHECK(sy_filter_pixel_run(pf, &f, 4, false, out, NULL, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(err.message, "color") != NULL);
+    sy_filter_pixel_destroy(pf);
+}
+
+static void test_blend_factor(void)
+{
+    /* case 2: u <= t -> exactly 1; case 1: even L_f misses t -> 0; case 3 in (0,1) and meets t */
+    CHECK(sy_filter_blend_factor(0.005f, 0.001f, 0.01f, 0.0f) == 1.0f);
+    CHECK(sy_filter_blend_factor(0.0f, 0.0f, 0.01f, 0.0f) == 1.0f);
+    CHECK(sy_filter_blend_factor(1.0f, 0.5f, 0.01f, 0.0f) == 0.0f);
+    float u = 0.1f, f = 0.002f, t = 0.01f, s = sy_filter_blend_factor(u, f, t, 0.0f);
+    CHECK(s > 0.0f && s < 1.0f);
+    CHECK(fabsf(s * s * u + (1 - s) * (1 - s) * f - t) < 1e-5f); /* on the constraint boundary */
+    /* continuity at u = t */
+    CHECK(fabsf(sy_filter_blend_factor(t * 1.0001f, 0.1f * t, t, 0.0f) - 1.0f) < 0.01f);
+}
+
+/* a noisy constant converges to the constant; at low variance the output IS the unfiltered value */
+static void test_constant_and_consistency(void)
+{
+    const uint32_t w = 64, h = 48;
+    size_t n = (size_t)w * h;
+    float *col = malloc(4 * n * sizeof(float)), *var = malloc(n * sizeof(float)), *alb = malloc(3 * n * sizeof(float)),
+          *dep = malloc(n * sizeof(float));
+    CHECK(col && var && alb && dep);
+    uint64_t rng = 7;
+    for (int kernel = 0; kernel < 2; ++kernel) {
+        for (float spp = 4; spp <= 4096; spp *= 8) {
+            double sd = 0.5 / sqrt(spp); /* per-sample relative sd 1 around 0.5 */
+            for (size_t i = 0; i < n; ++i) {
+                for (int c = 0; c < 3; ++c) col[4 * i + c] = 0.5f + (float)(sd * synth_gauss(&rng));
+                col[4 * i + 3] = 1.0f;
+                var[i] = (float)(sd * sd);
+                alb[3 * i] = alb[3 * i + 1] = alb[3 * i + 2] = 0.6f;
+                dep[i] = 3.0f;
+            }
+            sy_filter_frame f = {.width = w, .height = h, .color_channels = 4, .variance_channels = 1, .color = col,
+                                 .variance = var, .albedo = alb, .depth = dep, .spp_uniform = spp};
+            sy_filter_pixel_params p;
+            sy_filter_pixel_params_default(&p);
+            p.kernel = (sy_filter_pixel_kernel)kernel;
+            p.spike_withholding = false;
+            p.threads = 2;
+            sy_filter_stats st;
+            float *out = run(&p, &f, (uint32_t)spp, &st);
+            double e = 0, eu = 0;
+            for (size_t i = 0; i < n; ++i) {
+                double d = out[4 * i] - 0.5, du = col[4 * i] - 0.5;
+                e += d * d, eu += du * du;
+            }
+            e = sqrt(e / n), eu = sqrt(eu / n);
+            printf("kernel %d spp %5.0f: rmse filtered %.5f unfiltered %.5f mean s %.3f\n", kernel, spp, e, eu,
+                   st.mean_blend);
+            CHECK(e <= eu * 1.0001 + 1e-9);
+            /* the blend keeps the perceived variance near t: sd <= ~sqrt(t) * 0.5 (plus estimate noise) */
+            CHECK(e <= 1.5 * sqrt(p.threshold) * 0.5);
+            if (spp == 4) CHECK(e < eu / 3.0);
+            /* consistency: perceived variance (sd/0.5)^2 = 1/spp <= t = 0.01 from 100 spp on:
+             * s = 1 and the output equals the unfiltered value exactly */
+            if (spp >= 256) {
+                CHECK(st.mean_blend == 1.0);
+                for (size_t i = 0; i < n; ++i)
+                    for (int c = 0; c < 3; ++c) CHECK(out[4 * i + c] == col[4 * i + c]);
+            }
+            free(out);
+        }
+    }
+    free(col), free(var), free(alb), free(dep);
+}
+
+/* r of n equal weights = 1/n: 3x1 image, sigma_s huge, identical range values */
+static void test_reduction_factor(void)
+{
+    float col[12] = {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1}, var[3] = {1, 1, 1}, alb[9] = {.5f, .5f, .5f, .5f, .5f, .5f, .5f, .5f, .5f},
+          dep[3] = {1, 1, 1};
+    sy_filter_frame f = {.width = 3, .height = 1, .color_channels = 4, .variance_channels = 1, .color = col,
+                         .variance = var, .albedo = alb, .depth = dep, .spp_uniform = 1};
+    sy_filter_pixel_params p;
+    sy_filter_pixel_params_default(&p);
+    p.sigma_s = 1000.0f, p.adaptive_width = false, p.aa_recovery = false;
+    for (int kernel = 0; kernel < 2; ++kernel) {
+        p.kernel = (sy_filter_pixel_kernel)kernel;
+        sy_filter_pixel *pf = NULL;
+        sy_filter_error err = {0};
+        CHECK(sy_filter_pixel_create(&p, &pf, &err) == SY_FILTER_OK);
+        float out[12];
+        CHECK(sy_filter_pixel_run(pf, &f, 4, true, out, NULL, &err) == SY_FILTER_OK);
+        const float *r = sy_filter_pixel_reduction(pf), *lf = sy_filter_pixel_filtered(pf);
+        CHECK(r && lf);
+        for (int i = 0; i < 3; ++i) {
+            printf("kernel %d pixel %d: r = %.6f, L_f = %.4f %.4f %.4f\n", kernel, i, r[i], lf[3 * i], lf[3 * i + 1],
+                   lf[3 * i + 2]);
+            CHECK(fabsf(r[i] - 1.0f / 3.0f) < 2e-3f);
+            for (int c = 0; c < 3; ++c) CHECK(fabsf(lf[3 * i + c] - 1.0f / 3.0f) < 2e-3f);
+        }
+        sy_filter_pixel_destroy(pf);
+    }
+}
+
+/* no bleeding across a depth step and across an albedo (range colour) step */
+static void test_edges(void)
+{
+    const uint32_t w = 80, h = 40;
+    size_t n = (size_t)w * h;
+    float *col = malloc(4 * n * sizeof(float)), *var = malloc(n * sizeof(float)), *alb = malloc(3 * n * sizeof(float)),
+          *dep = malloc(n * sizeof(float));
+    CHECK(col && var && alb && dep);
+    for (int which = 0; which < 2; ++which)
+        for (int kernel = 0; kernel < 2; ++kernel) {
+            uint64_t rng = 99;
+            for (uint32_t y = 0; y < h; ++y)
+                for (uint32_t x = 0; x < w; ++x) {
+                    size_t i = (size_t)y * w + x;
+                    bool right = x >= w / 2;
+                    float m = right ? 0.8f : 0.1f;
+                    for (int c = 0; c < 3; ++c) col[4 * i + c] = m + 0.3f * m * (float)synth_gauss(&rng);
+                    col[4 * i + 3] = 1;
+                    var[i] = 0.09f * m * m;
+                    float a = which == 1 && right ? 0.9f : 0.4f; /* albedo step (range colour) */
+                    alb[3 * i] = alb[3 * i + 1] = alb[3 * i + 2] = a;
+                    dep[i] = which == 0 && right ? 8.0f : 2.0f; /* or depth step */
+                }
+            sy_filter_frame f = {.width = w, .height = h, .color_channels = 4, .variance_channels = 1, .color = col,
+                                 .variance = var, .albedo = alb, .depth = dep, .spp_uniform = 4};
+            sy_filter_pixel_params p;
+            sy_filter_pixel_params_default(&p);
+            p.kernel = (sy_filter_pixel_kernel)kernel;
+            p.threshold = 0.0f; /* pure filtered output */
+            p.spike_withholding = false;
+            float *out = run(&p, &f, 4, NULL);
+            double left = 0, rightv = 0;
+            for (uint32_t y = 0; y < h; ++y) left += out[4 * ((size_t)y * w + w / 2 - 1)], rightv += out[4 * ((size_t)y * w + w / 2)];
+            left /= h, rightv /= h;
+            printf("%s step, kernel %d: column left of edge %.4f (0.1), right %.4f (0.8)\n", which ? "albedo" : "depth",
+                   kernel, left, rightv);
+            CHECK(fabs(left - 0.1) < 0.02 && fabs(rightv - 0.8) < 0.06);
+            free(out);
+        }
+    free(col), free(var), free(alb), free(dep);
+}
+
+/* NaN/Inf pixels are counted and do not spread; their own output is finite */
+static void test_nan(void)
+{
+    synth s;
+    synth_init(&s, 48, 32, 5);
+    synth_render(&s, 4, 1.0f);
+    sy_filter_frame f = synth_frame(&s, 4);
+    sy_filter_pixel_params p;
+    sy_filter_pixel_params_default(&p);
+    sy_filter_stats st;
+    float *ref = run(&p, &f, 4, &st);
+    CHECK(st.nonfinite_samples == 0);
+    size_t bad = 10 * 48 + 10;
+    s.indirect[3 * bad] = NAN, s.color[4 * bad] = NAN;
+    s.indirect[3 * (bad + 20) + 1] = INFINITY, s.color[4 * (bad + 20) + 1] = INFINITY;
+    float *out = run(&p, &f, 4, &st);
+    printf("nan test: %llu non-finite pixels reported\n", (unsigned long long)st.nonfinite_samples);
+    CHECK(st.nonfinite_samples == 2);
+    for (size_t i = 0; i < 48 * 32; ++i)
+        for (int c = 0; c < 4; ++c) CHECK(isfinite(out[4 * i + c]));
+    /* far pixels are unaffected; the bad pixels show plausible (filtered) values */
+    CHECK(out[0] == ref[0]);
+    CHECK(fabsf(out[4 * bad] - s.truth[4 * bad]) < 0.3f);
+    free(ref), free(out);
+    synth_free(&s);
+}
+
+/* image quality on the analytic surrogate: relMSE reduction >= 4x at 4 spp */
+static void test_quality(void)
+{
+    synth s;
+    synth_init(&s, 160, 120, 11);
+    synth_render(&s, 4, 1.0f);
+    sy_filter_frame f = synth_frame(&s, 4);
+    size_t n = (size_t)s.w * s.h;
+    double base = rel_mse(s.color, s.truth, n);
+    for (int kernel = 0; kernel < 2; ++kernel) {
+        sy_filter_pixel_params p;
+        sy_filter_pixel_params_default(&p);
+        p.kernel = (sy_filter_pixel_kernel)kernel;
+        sy_filter_stats st;
+        float *out = run(&p, &f, 4, &st);
+        double e = rel_mse(out, s.truth, n);
+        printf("quality, kernel %d: relMSE unfiltered %.5f filtered %.5f (%.1fx), mean s %.3f\n", kernel, base, e,
+               base / e, st.mean_blend);
+        CHECK(base / e >= 4.0);
+        free(out);
+    }
+    synth_free(&s);
+}
+
+/* range buffer: albedo x ((1 - w) + w |n . v|), depth in A, misses clamped */
+static void test_range_compose(void)
+{
+    float alb[6] = {0.5f, 0.4f, 0.2f, 0.5f, 0.4f, 0.2f}, nrm[6] = {0, 0, 1, 1, 0, 0}, pos[6] = {0, 0, -2, 0, 0, -2};
+    float dep[2] = {2.0f, INFINITY}, cam[3] = {0, 0, 0}, out[8];
+    sy_filter_frame f = {.width = 2, .height = 1, .albedo = alb, .normal = nrm, .position = pos, .depth = dep,
+                         .spp_uniform = 1};
+    sy_filter_error err = {0};
+    CHECK(sy_filter_range_compose(&f, cam, 0.5f, out, &err) == SY_FILTER_OK);
+    for (int c = 0; c < 3; ++c) {
+        CHECK(fabsf(out[c] - alb[c]) < 1e-6f);              /* facing the headlight: full */
+        CHECK(fabsf(out[4 + c] - 0.5f * alb[c]) < 1e-6f);   /* grazing: ambient half only */
+    }
+    CHECK(out[3] == 2.0f && out[7] == 1e18f);
+    CHECK(sy_filter_range_compose(&f, cam, 1.5f, out, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT &&
+          strstr(err.message, "headlight_weight"));
+}
+
+int main(void)
+{
+    test_params();
+    test_range_compose();
+    test_blend_factor();
+    test_reduction_factor();
+    test_constant_and_consistency();
+    test_edges();
+    test_nan();
+    test_quality();
+    printf("filters pixel: ok\n");
+    return 0;
+}

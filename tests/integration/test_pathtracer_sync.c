@@ -1,0 +1,189 @@
+/* test_pathtracer_sync.c — accumulation restart semantics of the "pathtracer" mediator class.
+ *
+ * A scene (emissive quad, grey quad, point light, a camera node in use and one nobody uses, a
+ * background) is rendered one sample per call through a window; sy_mediator_stats.samples must
+ *   - grow by the request's sample_count on each render (0 = 1);
+ *   - restart (back to the new pass's count) after: a transform of a node with geometry, a
+ *     material change, a light change, a background change, the request's camera changing
+ *     (moving the viewport's camera node), a new mesh;
+ *   - NOT restart after: an attachment change, moving the camera no viewport uses.
+ * The image after a restart equals a fresh context's image of the changed scene bit for bit (no
+ * stale samples), AOVs come back for the viewport rectangle, and nothing is non-finite. */
+#include "it_util.h"
+#include "sy_mediator_rt.h"
+
+typedef struct fixture {
+    sy_scene *s;
+    sy_node root, geo, lamp_node, cam_node, spare_cam;
+    sy_material grey, glow;
+    sy_light lamp;
+    sy_background bg;
+    sy_window *win;
+    sy_context_pool *pool;
+    sy_layer img;
+} fixture;
+
+static uint64_t render(fixture *fx, uint32_t n)
+{
+    sy_window_render_opts ro = {.sample_count = n, .seed = 9};
+    MUST(sy_window_render(fx->win, fx->s, fx->pool, &ro, &fx->img, err));
+    sy_context *ctx;
+    MUST(sy_context_pool_get(fx->pool, fx->s, "pathtracer", NULL, fx->root.id, &ctx, err));
+    sy_mediator_stats st;
+    sy_context_stats(ctx, &st);
+    return st.samples;
+}
+
+static void commit(fixture *fx) { MUST(sy_scene_commit(fx->s, NULL, err)); }
+
+static sy_node camera_node(sy_scene *s, const char *name, float z)
+{
+    sy_camera c;
+    MUST(sy_camera_create(s, name, &c, err));
+    sy_camera_data cd = *sy_camera_get(s, c);
+    cd.name = (char *)name;
+    cd.yfov = 0.8f;
+    cd.znear = 0.01f;
+    MUST(sy_camera_set(s, c, &cd, err));
+    sy_node n;
+    MUST(sy_node_create(s, name, &n, err));
+    MUST(sy_node_set_camera(s, n, c, err));
+    it_set_translation(s, n, 0, 0, z);
+    return n;
+}
+
+static void build(fixture *fx)
+{
+    memset(fx, 0, sizeof *fx);
+    MUST(sy_scene_create(&fx->s, err));
+    sy_scene *s = fx->s;
+    MUST(sy_node_create(s, "root", &fx->root, err));
+    MUST(sy_material_create(s, "grey", &fx->grey, err));
+    MUST(sy_material_create(s, "glow", &fx->glow, err));
+    sy_material_data md = *sy_material_get(s, fx->glow);
+    md.name = "glow";
+    md.emissive[0] = md.emissive[1] = md.emissive[2] = 1.0f;
+    md.emissive_strength = 3.0f;
+    MUST(sy_material_set(s, fx->glow, &md, err));
+    const float quads[2][3] = {{0, 0, 1.0f}, {0.6f, 0.6f, 0.2f}};
+    const sy_material mats[2] = {fx->grey, fx->glow};
+    sy_mesh mesh = it_quad_mesh(s, "quads", quads, mats, 2);
+    MUST(sy_node_create(s, "geo", &fx->geo, err));
+    MUST(sy_node_set_mesh(s, fx->geo, mesh, err));
+    MUST(sy_light_create(s, "lamp", &fx->lamp, err));
+    MUST(sy_node_create(s, "lamp", &fx->lamp_node, err));
+    MUST(sy_node_set_light(s, fx->lamp_node, fx->lamp, err));
+    it_set_translation(s, fx->lamp_node, 0, 0, 1);
+    fx->cam_node = camera_node(s, "cam", 3.0f);
+    fx->spare_cam = camera_node(s, "spare", 5.0f);
+    MUST(sy_node_add_child(s, fx->root, fx->geo, err));
+    MUST(sy_node_add_child(s, fx->root, fx->lamp_node, err));
+    MUST(sy_node_add_child(s, fx->root, fx->cam_node, err));
+    MUST(sy_node_add_child(s, fx->root, fx->spare_cam, err));
+    MUST(sy_background_create(s, "bg", &fx->bg, err));
+    sy_background_data bd = *sy_background_get(s, fx->bg);
+    bd.name = "bg";
+    bd.color[0] = 0.1f, bd.color[1] = 0.2f, bd.color[2] = 0.3f, bd.color[3] = 1.0f;
+    MUST(sy_background_set(s, fx->bg, &bd, err));
+    commit(fx);
+    MUST(sy_window_create(32, 24, &fx->win, err));
+    sy_viewport *vp;
+    sy_viewport_desc vd = {.root = fx->root, .camera = fx->cam_node, .background = fx->bg, .backend = "pathtracer"};
+    MUST(sy_window_add_viewport(fx->win, &vd, &vp, err));
+    MUST(sy_context_pool_create(&fx->pool, err));
+    MUST(sy_layer_create(32, 24, &fx->img, err));
+}
+
+static void destroy(fixture *fx)
+{
+    sy_layer_destroy(&fx->img);
+    sy_context_pool_destroy(fx->pool);
+    sy_window_destroy(fx->win);
+    sy_scene_destroy(fx->s);
+}
+
+int main(void)
+{
+    it_register();
+    fixture fx;
+    build(&fx);
+    sy_scene *s = fx.s;
+    CHECK(render(&fx, 0) == 1);
+    CHECK(render(&fx, 1) == 2);
+    CHECK(render(&fx, 3) == 5);
+    CHECK(sy_layer_count_nonfinite(&fx.img) == 0);
+
+    /* invisible: attachment, name, the unused camera */
+    sy_attachment att = {.key = "pt.hint", .kind = SY_ATTACH_INT, .value.i = 3};
+    MUST(sy_object_set_attachment(s, SY_TYPE_NODE, fx.geo.id, &att, err));
+    commit(&fx);
+    CHECKF(render(&fx, 1) == 6, "an attachment change restarted the accumulation");
+    it_set_translation(s, fx.spare_cam, 1, 2, 7);
+    commit(&fx);
+    CHECKF(render(&fx, 1) == 7, "moving a camera no viewport uses restarted the accumulation");
+
+    /* visible changes restart */
+    it_set_translation(s, fx.geo, 0.1f, 0, 0);
+    commit(&fx);
+    CHECKF(render(&fx, 2) == 2, "a transform change did not restart");
+    /* the restarted image equals a fresh context's render of the changed scene */
+    float *after = malloc(32 * 24 * 4 * sizeof(float));
+    memcpy(after, fx.img.rgba, 32 * 24 * 4 * sizeof(float));
+    {
+        sy_context_pool *p2;
+        MUST(sy_context_pool_create(&p2, err));
+        sy_layer l2;
+        MUST(sy_layer_create(32, 24, &l2, err));
+        sy_window_render_opts ro = {.sample_count = 2, .seed = 9};
+        MUST(sy_window_render(fx.win, s, p2, &ro, &l2, err));
+        CHECKF(!memcmp(l2.rgba, after, 32 * 24 * 4 * sizeof(float)), "restarted image differs from a fresh render");
+        sy_layer_destroy(&l2);
+        sy_context_pool_destroy(p2);
+    }
+    free(after);
+
+    sy_material_data md = *sy_material_get(s, fx.grey);
+    md.base_color[0] = 0.3f;
+    MUST(sy_material_set(s, fx.grey, &md, err));
+    commit(&fx);
+    CHECKF(render(&fx, 1) == 1, "a material change did not restart");
+    CHECK(render(&fx, 1) == 2);
+
+    sy_light_data ld = *sy_light_get(s, fx.lamp);
+    ld.intensity = 5.0f;
+    MUST(sy_light_set(s, fx.lamp, &ld, err));
+    commit(&fx);
+    CHECKF(render(&fx, 1) == 1, "a light change did not restart");
+    CHECK(render(&fx, 1) == 2);
+
+    sy_background_data bd = *sy_background_get(s, fx.bg);
+    bd.color[1] = 0.7f;
+    MUST(sy_background_set(s, fx.bg, &bd, err));
+    commit(&fx);
+    CHECKF(render(&fx, 1) == 1, "a background change did not restart");
+    CHECK(render(&fx, 1) == 2);
+
+    it_set_translation(s, fx.cam_node, 0, 0.2f, 3);
+    commit(&fx);
+    CHECKF(render(&fx, 1) == 1, "moving the viewport's camera did not restart");
+    CHECK(render(&fx, 1) == 2);
+
+    /* AOVs of the viewport rectangle */
+    sy_context *ctx;
+    MUST(sy_context_pool_get(fx.pool, s, "pathtracer", NULL, fx.root.id, &ctx, err));
+    sy_mediator_rt_aovs a;
+    MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
+    CHECK(a.width == 32 && a.height == 24 && a.samples == 2 && a.nonfinite_samples == 0);
+    CHECK(!memcmp(a.planes[0], fx.img.rgba, 32 * 24 * 4 * sizeof(float)));
+    sy_mediator_rt_aovs_free(&a);
+    sy_mediator_rt_counters cn;
+    sy_mediator_rt_counters_get(sy_context_state(ctx), &cn);
+    CHECKF(cn.accum_restarts == 5, "restarts counted: %u", cn.accum_restarts);
+    /* the Whitted context rejects the AOV request */
+    sy_context *wc;
+    MUST(sy_context_pool_get(fx.pool, s, "whitted", NULL, fx.root.id, &wc, err));
+    sy_error e = {0};
+    CHECK(sy_mediator_rt_aovs_get(sy_context_state(wc), &a, &e) != SY_OK && e.message[0]);
+    destroy(&fx);
+    return it_finish("integration_pathtracer_sync");
+}

@@ -1,0 +1,295 @@
+/* test_gl_backend.c — the OpenGL rasterizer back-end alone, through its public API (sy_gl.h):
+ * exact emission and linear depth, pixel-centre edges and sub-rectangles, Lambert + directional
+ * shadow and spot falloff against analytic values, sorted premultiplied alpha blending, alpha
+ * mask, sRGB textures and downscaling with a warning, upload counters, shader-compile logs and the
+ * "no display" error. argv[1] = provider (osmesa default; egl / glfw are skipped with the reason
+ * when the machine cannot give such a context). */
+#include "sy_gl.h"
+#include "sy_gl_shaders.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int failures;
+#define CHECK(c, ...)                                                                                  \
+    do {                                                                                               \
+        if (!(c)) {                                                                                    \
+            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #c);                      \
+            fprintf(stderr, __VA_ARGS__);                                                              \
+            fputc('\n', stderr);                                                                       \
+            failures++;                                                                                \
+        }                                                                                              \
+    } while (0)
+#define MUST(call)                                                                                     \
+    do {                                                                                               \
+        sy_gl_result r_ = (call);                                                                      \
+        if (r_ != SY_GL_OK) {                                                                          \
+            fprintf(stderr, "%s:%d: %s failed (%d): %s\n", __FILE__, __LINE__, #call, (int)r_, e);     \
+            exit(1);                                                                                   \
+        }                                                                                              \
+    } while (0)
+
+#define N 64
+#define PI_F 3.14159265358979f
+static char e[4096];
+static int warnings;
+static char last_warning[512];
+static void on_log(void *u, const char *m)
+{
+    (void)u;
+    warnings++;
+    snprintf(last_warning, sizeof last_warning, "%s", m);
+}
+
+static sy_gl_mesh quad(sy_gl_device *d, const float *p4 /* 4 corners xyz */, const float n[3])
+{
+    float nrm[12];
+    for (int i = 0; i < 4; ++i) memcpy(nrm + 3 * i, n, 3 * sizeof(float));
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    sy_gl_mesh_desc md = {.positions = p4, .normals = nrm, .uv = {uv, NULL}, .indices = idx, .vertex_count = 4, .triangle_count = 2};
+    sy_gl_mesh m;
+    MUST(sy_gl_mesh_create(d, &md, &m, e, sizeof e));
+    return m;
+}
+
+static sy_gl_instance place(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat)
+{
+    sy_gl_instance_desc id = {.mesh = m, .material = mat, .transform = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
+    sy_gl_instance in;
+    MUST(sy_gl_instance_create(d, &id, &in, e, sizeof e));
+    return in;
+}
+
+static sy_gl_material material(sy_gl_device *d, float r, float g, float b, float a, bool unlit, sy_gl_alpha_mode mode)
+{
+    sy_gl_material_desc md;
+    sy_gl_material_desc_init(&md);
+    md.base_color[0] = r, md.base_color[1] = g, md.base_color[2] = b, md.base_color[3] = a;
+    md.unlit = unlit;
+    md.alpha_mode = mode;
+    md.metallic = 0.0f;
+    md.specular = 0.0f; /* pure Lambert */
+    sy_gl_material h;
+    MUST(sy_gl_material_create(d, &md, &h, e, sizeof e));
+    return h;
+}
+
+static float rgba[N * N * 4], depth[N * N];
+static const sy_gl_render_desc full = {N, N, 0, 0, N, N};
+
+static void render(sy_gl_device *d, const sy_gl_camera *cam) { MUST(sy_gl_render(d, cam, &full, rgba, depth, e, sizeof e)); }
+static const float *px(int x, int y) { return rgba + 4 * (y * N + x); }
+
+static bool near_(float a, float b, float tol) { return fabsf(a - b) <= tol * fmaxf(1.0f, fabsf(b)); }
+
+int main(int argc, char **argv)
+{
+    sy_gl_provider prov = SY_GL_PROVIDER_OSMESA;
+    if (argc > 1 && !sy_gl_provider_parse(argv[1], &prov)) {
+        fprintf(stderr, "unknown provider %s\n", argv[1]);
+        return 2;
+    }
+    sy_gl_device *d;
+    sy_gl_device_desc dd = {.provider = prov, .msaa = 1, .shadow_map_size = 1024, .max_texture_size = 4, .log = on_log};
+    sy_gl_result cr = sy_gl_device_create(&dd, &d, e, sizeof e);
+    if (cr == SY_GL_ERROR_NO_CONTEXT && prov != SY_GL_PROVIDER_OSMESA) {
+        printf("SKIP: no %s context on this machine: %s\n", sy_gl_provider_name(prov), e);
+        return 77;
+    }
+    MUST(cr);
+    printf("%s\n", sy_gl_device_info(d));
+
+    /* 1. emission is radiance, depth is the axial distance; edges at pixel centres */
+    sy_gl_camera cam = {.camera_to_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, .window = {-1, 1, -1, 1}, .near_clip = 0.1f};
+    /* x in [-0.9, 1.3], y in [-0.6, 1.2] at z = -3 */
+    const float q1[12] = {-0.9f, -0.6f, -3, 1.3f, -0.6f, -3, 1.3f, 1.2f, -3, -0.9f, 1.2f, -3};
+    const float nz[3] = {0, 0, 1};
+    sy_gl_mesh mq = quad(d, q1, nz);
+    sy_gl_material_desc emd;
+    sy_gl_material_desc_init(&emd);
+    emd.emissive[0] = 17, emd.emissive[1] = 12, emd.emissive[2] = 4;
+    sy_gl_material em;
+    MUST(sy_gl_material_create(d, &emd, &em, e, sizeof e));
+    sy_gl_instance iq = place(d, mq, em);
+    render(d, &cam);
+    const float *c = px(30, 30);
+    CHECK(c[0] == 17.0f && c[1] == 12.0f && c[2] == 4.0f && c[3] == 1.0f, "emitter pixel %g %g %g %g", c[0], c[1], c[2], c[3]);
+    CHECK(near_(depth[30 * N + 30], 3.0f, 1e-5f), "depth %g (want 3)", depth[30 * N + 30]);
+    CHECK(px(0, 0)[3] == 0.0f && isinf(depth[0]) && depth[0] > 0, "background alpha %g depth %g", px(0, 0)[3], depth[0]);
+    /* x tangent [-0.3, 0.4333] -> columns 22..45; y tangent [-0.2, 0.4] -> rows 19..37 */
+    CHECK(px(21, 30)[3] == 0.0f && px(22, 30)[3] == 1.0f && px(45, 30)[3] == 1.0f && px(46, 30)[3] == 0.0f,
+          "column edges %g %g %g %g", px(21, 30)[3], px(22, 30)[3], px(45, 30)[3], px(46, 30)[3]);
+    CHECK(px(30, 18)[3] == 0.0f && px(30, 19)[3] == 1.0f && px(30, 37)[3] == 1.0f && px(30, 38)[3] == 0.0f,
+          "row edges %g %g %g %g", px(30, 18)[3], px(30, 19)[3], px(30, 37)[3], px(30, 38)[3]);
+
+    /* 2. a sub-rectangle is exactly the crop of the full image */
+    {
+        static float sub[40 * 30 * 4], subd[40 * 30];
+        sy_gl_render_desc rd = {N, N, 16, 8, 40, 30};
+        MUST(sy_gl_render(d, &cam, &rd, sub, subd, e, sizeof e));
+        int bad = 0;
+        for (int y = 0; y < 30; ++y)
+            for (int x = 0; x < 40; ++x) {
+                const float *a = sub + 4 * (y * 40 + x), *b = px(16 + x, 8 + y);
+                if (a[3] != b[3] || fabsf(a[0] - b[0]) > 1e-5f) bad++;
+            }
+        CHECK(bad == 0, "%d sub-rectangle pixels differ from the full image", bad);
+    }
+
+    /* 3. transform only: no vertex data uploaded, one model-matrix update */
+    sy_gl_stats st;
+    sy_gl_device_stats(d, &st);
+    CHECK(st.total.vertex_buffer_uploads == 2, "vertex uploads so far %llu (one interleaved vertex buffer + indices)",
+          (unsigned long long)st.total.vertex_buffer_uploads);
+    float moved[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.1f, 0, 0, 1};
+    MUST(sy_gl_instance_set_transform(d, iq, moved, e, sizeof e));
+    render(d, &cam);
+    sy_gl_device_stats(d, &st);
+    CHECK(st.frame.vertex_buffer_uploads == 0 && st.frame.vertex_bytes == 0 && st.frame.texture_uploads == 0,
+          "transform-only frame uploaded %llu vertex buffers", (unsigned long long)st.frame.vertex_buffer_uploads);
+    CHECK(st.frame.model_matrix_updates == 1, "model matrix updates %llu", (unsigned long long)st.frame.model_matrix_updates);
+    CHECK(px(22, 30)[3] == 0.0f && px(46, 30)[3] == 1.0f, "the quad did not move right");
+    MUST(sy_gl_material_update(d, em, &emd, e, sizeof e));
+    render(d, &cam);
+    sy_gl_device_stats(d, &st);
+    CHECK(st.frame.uniform_buffer_uploads == 1 && st.frame.vertex_buffer_uploads == 0, "material change: %llu UBO, %llu VBO uploads",
+          (unsigned long long)st.frame.uniform_buffer_uploads, (unsigned long long)st.frame.vertex_buffer_uploads);
+    MUST(sy_gl_instance_destroy(d, iq));
+
+    /* 4. sorted, premultiplied alpha blending (nearest created first), and an alpha-masked cut-out */
+    {
+        const float near_q[12] = {-1, -1, -2, 1, -1, -2, 1, 1, -2, -1, 1, -2};
+        const float far_q[12] = {-1, -1, -4, 1, -1, -4, 1, 1, -4, -1, 1, -4};
+        sy_gl_mesh mn = quad(d, near_q, nz), mf = quad(d, far_q, nz);
+        sy_gl_instance a = place(d, mn, material(d, 1, 0, 0, 0.5f, true, SY_GL_ALPHA_BLEND));
+        sy_gl_instance b = place(d, mf, material(d, 0, 0, 1, 0.5f, true, SY_GL_ALPHA_BLEND));
+        render(d, &cam);
+        c = px(32, 32);
+        CHECK(near_(c[0], 0.5f, 1e-5f) && c[1] == 0.0f && near_(c[2], 0.25f, 1e-5f) && near_(c[3], 0.75f, 1e-5f),
+              "blend %g %g %g %g (want 0.5 0 0.25 0.75)", c[0], c[1], c[2], c[3]);
+        CHECK(near_(depth[32 * N + 32], 2.0f, 1e-5f), "blend depth %g (want the nearest surface, 2)", depth[32 * N + 32]);
+        MUST(sy_gl_instance_destroy(d, a));
+        MUST(sy_gl_instance_destroy(d, b));
+        sy_gl_instance m = place(d, mn, material(d, 1, 1, 1, 0.3f, true, SY_GL_ALPHA_MASK));
+        render(d, &cam);
+        CHECK(px(32, 32)[3] == 0.0f && isinf(depth[32 * N + 32]), "masked-out quad is visible (alpha %g)", px(32, 32)[3]);
+        MUST(sy_gl_instance_destroy(d, m));
+    }
+
+    /* 5. sRGB texture, downscaled to max_texture_size = 4 with a warning */
+    {
+        unsigned char tex[8 * 8 * 3];
+        memset(tex, 188, sizeof tex);
+        sy_gl_texture_desc td = {.width = 8, .height = 8, .channels = 3, .format = SY_GL_TEXEL_UNORM8_SRGB, .pixels = tex};
+        sy_gl_texture t;
+        int w0 = warnings;
+        MUST(sy_gl_texture_create(d, &td, &t, e, sizeof e));
+        CHECK(warnings == w0 + 1 && strstr(last_warning, "downscaled to 4x4"), "warning: '%s'", last_warning);
+        sy_gl_material_desc md;
+        sy_gl_material_desc_init(&md);
+        md.unlit = true;
+        md.base_color_texture.texture = t;
+        sy_gl_material mt;
+        MUST(sy_gl_material_create(d, &md, &mt, e, sizeof e));
+        const float near_q[12] = {-1, -1, -2, 1, -1, -2, 1, 1, -2, -1, 1, -2};
+        sy_gl_instance it = place(d, quad(d, near_q, nz), mt);
+        render(d, &cam);
+        float want = powf((188.0f / 255.0f + 0.055f) / 1.055f, 2.4f);
+        CHECK(near_(px(32, 32)[0], want, 0.01f), "sRGB texel %g (want %g)", px(32, 32)[0], want);
+        MUST(sy_gl_instance_destroy(d, it));
+        sy_gl_stats s2;
+        sy_gl_device_stats(d, &s2);
+        CHECK(s2.total.texture_uploads == 1, "texture uploads %llu", (unsigned long long)s2.total.texture_uploads);
+    }
+
+    /* 6. Lambert under a directional light, with a shadow from an occluder; then a spot light */
+    {
+        sy_gl_camera top = {.camera_to_world = {1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 5, 0, 1}, .window = {-0.6f, 0.6f, -0.6f, 0.6f}, .near_clip = 0.1f};
+        const float floor_q[12] = {-5, 0, 5, 5, 0, 5, 5, 0, -5, -5, 0, -5};
+        const float occ_q[12] = {-0.5f, 1, 0.5f, 0.5f, 1, 0.5f, 0.5f, 1, -0.5f, -0.5f, 1, -0.5f};
+        const float ny[3] = {0, 1, 0};
+        sy_gl_material grey = material(d, 0.5f, 0.5f, 0.5f, 1, false, SY_GL_ALPHA_OPAQUE);
+        sy_gl_instance fl = place(d, quad(d, floor_q, ny), grey);
+        sy_gl_instance oc = place(d, quad(d, occ_q, ny), grey);
+        sy_gl_light_desc ld = {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3, .direction = {1, -1, 0}};
+        sy_gl_light l;
+        MUST(sy_gl_light_create(d, &ld, &l, e, sizeof e));
+        render(d, &top);
+        float lit = 3.0f * sqrtf(0.5f) * 0.5f / PI_F;
+        /* world x = -2 -> column 10, x = +1 -> column 42 (row 31 ~ z = 0) */
+        CHECK(near_(px(10, 31)[0], lit, 0.01f), "lit floor %g (want %g)", px(10, 31)[0], lit);
+        CHECK(px(42, 31)[0] < 0.05f * lit, "shadowed floor %g (lit %g)", px(42, 31)[0], lit);
+        sy_gl_device_stats(d, &st);
+        CHECK(st.shadow_maps == 1, "shadow maps %u", st.shadow_maps);
+        MUST(sy_gl_light_destroy(d, l));
+        MUST(sy_gl_instance_destroy(d, oc));
+        /* spot at (0, 2, 0) pointing down: I / d^2 under it, zero beyond the outer cone */
+        sy_gl_light_desc sd = {.type = SY_GL_LIGHT_SPOT, .color = {1, 1, 1}, .intensity = 10, .position = {0, 2, 0},
+                               .direction = {0, -1, 0}, .inner_cone_angle = 0.2f, .outer_cone_angle = 0.4f};
+        MUST(sy_gl_light_create(d, &sd, &l, e, sizeof e));
+        render(d, &top);
+        /* pixel (31, 31) centre: x = z = -0.5/64*1.2*5 */
+        float x = (31.5f / N * 1.2f - 0.6f) * 5.0f, r2 = 2 * x * x, dist2 = r2 + 4.0f, cosl = 2.0f / sqrtf(dist2);
+        float want = 10.0f / dist2 * cosl * 0.5f / PI_F;
+        CHECK(near_(px(31, 31)[0], want, 0.01f), "spot centre %g (want %g)", px(31, 31)[0], want);
+        /* world x = 1.2: angle atan(0.6) = 0.54 > outer 0.4 -> dark; column (1.2/5 + 0.6)/1.2*64 = 44.8 */
+        CHECK(px(44, 31)[0] == 0.0f && px(44, 31)[3] == 1.0f, "outside the cone %g", px(44, 31)[0]);
+        /* between inner and outer: x = 0.6 (angle 0.29) -> column 38.4 => pixel 38 centre */
+        float x2 = (38.5f / N * 1.2f - 0.6f) * 5.0f, z2 = x;
+        float dd2 = x2 * x2 + z2 * z2 + 4.0f, dl = sqrtf(dd2), cd = 2.0f / dl;
+        float ci = cosf(0.2f), co = cosf(0.4f), s = fminf(fmaxf((cd - co) / (ci - co), 0.0f), 1.0f);
+        float want2 = 10.0f / dd2 * s * s * cd * 0.5f / PI_F;
+        CHECK(near_(px(38, 31)[0], want2, 0.02f), "spot penumbra %g (want %g)", px(38, 31)[0], want2);
+        MUST(sy_gl_light_destroy(d, l));
+        MUST(sy_gl_instance_destroy(d, fl));
+    }
+    sy_gl_device_destroy(d);
+
+    /* 7. MSAA: interior pixels stay exact, edge pixels get partial coverage, background stays empty */
+    {
+        sy_gl_device_desc md = {.provider = prov, .msaa = 4, .shadow_map_size = 256};
+        MUST(sy_gl_device_create(&md, &d, e, sizeof e));
+        sy_gl_mesh m = quad(d, q1, nz);
+        MUST(sy_gl_material_create(d, &emd, &em, e, sizeof e));
+        place(d, m, em);
+        render(d, &cam);
+        c = px(30, 30);
+        CHECK(c[0] == 17.0f && c[1] == 12.0f && c[2] == 4.0f && c[3] == 1.0f, "MSAA interior %g %g %g %g", c[0], c[1], c[2], c[3]);
+        CHECK(near_(depth[30 * N + 30], 3.0f, 1e-5f), "MSAA depth %g", depth[30 * N + 30]);
+        /* column 22 is partly covered (the edge crosses it at 22.4) */
+        float a22 = px(22, 30)[3];
+        CHECK(a22 > 0.0f && a22 < 1.0f && px(20, 30)[3] == 0.0f && isinf(depth[30 * N + 20]), "MSAA edge alpha %g", a22);
+        CHECK(near_(px(22, 30)[0], 17.0f * a22, 1e-5f), "MSAA edge is not premultiplied: %g vs alpha %g", px(22, 30)[0], a22);
+        sy_gl_device_stats(d, &st);
+        CHECK(st.msaa_samples == 4, "msaa samples %u", st.msaa_samples);
+        sy_gl_device_destroy(d);
+    }
+
+    if (prov == SY_GL_PROVIDER_OSMESA) {
+        /* 8. shader compile failures return the driver's log */
+        sy_gl_context *ctx;
+        MUST(sy_gl_context_create(SY_GL_PROVIDER_OSMESA, 0, 0, &ctx, e, sizeof e));
+        GLuint p = 0;
+        sy_gl_result r = sy_gl_program_build(sy_gl_context_fns(ctx), "broken", sy_gl_floor_vs,
+                                             "#version 330 core\nout vec4 o; void main() { o = undefined_name; }\n", NULL, &p, e, sizeof e);
+        CHECK(r == SY_GL_ERROR_GL && strstr(e, "broken shader: fragment compile failed") && strstr(e, "undefined_name"),
+              "compile failure message: %s", e);
+        sy_gl_context_destroy(ctx);
+        /* 9. no display: GLFW names itself and the fallback */
+        unsetenv("DISPLAY");
+        unsetenv("WAYLAND_DISPLAY");
+        sy_gl_device_desc gd = {.provider = SY_GL_PROVIDER_GLFW};
+        r = sy_gl_device_create(&gd, &d, e, sizeof e);
+        CHECK(r == SY_GL_ERROR_NO_CONTEXT && strstr(e, "glfw") && strstr(e, "--gl osmesa"), "no-display error: %s", e);
+        if (r == SY_GL_OK) sy_gl_device_destroy(d);
+    }
+    if (failures) {
+        fprintf(stderr, "test_gl_backend (%s): %d check(s) failed\n", sy_gl_provider_name(prov), failures);
+        return 1;
+    }
+    printf("test_gl_backend (%s): all checks passed\n", sy_gl_provider_name(prov));
+    return 0;
+}

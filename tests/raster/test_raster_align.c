@@ -1,0 +1,78 @@
+/* test_raster_align.c — the pixel alignment contract between the rasterizer and the ray tracers:
+ * the same scene and camera give the same silhouettes. For sample models (Box, Duck, the Cornell
+ * box, DamagedHelmet) at 256x256 the object masks (alpha > 0) of raster (single sample per pixel,
+ * at the pixel centre like the ray tracer) and whitted renders overlap with IoU >= 0.99, and where
+ * both see a surface their linear depths agree. */
+#include "it_util.h"
+#include "sy_gltf.h"
+
+#define S 256
+
+typedef struct model {
+    const char *path, *camera; /* camera NULL = the viewport frames the scene's bounds */
+} model;
+
+static void render(sy_scene *scene, const sy_gltf_info *info, sy_node cam, const char *backend, const char *params,
+                   sy_layer *img)
+{
+    sy_context_pool *pool;
+    sy_window *win;
+    sy_viewport *vp;
+    MUST(sy_context_pool_create(&pool, err));
+    MUST(sy_window_create(S, S, &win, err));
+    sy_viewport_desc vd = {.root = info->root, .camera = cam, .backend = backend, .params = params};
+    MUST(sy_window_add_viewport(win, &vd, &vp, err));
+    MUST(sy_layer_create(S, S, img, err));
+    MUST(sy_window_render(win, scene, pool, NULL, img, err));
+    sy_window_destroy(win);
+    sy_context_pool_destroy(pool);
+}
+
+static void check_model(const model *m)
+{
+    char buf[1024];
+    const char *path = it_testdata(m->path, buf, sizeof buf);
+    sy_scene *scene;
+    MUST(sy_scene_create(&scene, err));
+    sy_gltf_info info;
+    MUST(sy_gltf_load(path, scene, NULL, &info, err));
+    sy_node cam = {0};
+    if (m->camera) MUST(sy_gltf_find_camera(scene, &info, m->camera, &cam, err));
+    MUST(sy_scene_commit(scene, NULL, err));
+    sy_layer a, b;
+    render(scene, &info, cam, "raster", "msaa=1,shadow_map_size=256", &a);
+    render(scene, &info, cam, "whitted", "light_samples=1,max_depth=1", &b);
+    uint32_t inter = 0, uni = 0, depth_bad = 0;
+    for (uint32_t i = 0; i < S * S; ++i) {
+        bool ma = a.rgba[4 * i + 3] > 0.0f, mb = b.rgba[4 * i + 3] > 0.0f;
+        inter += ma && mb;
+        uni += ma || mb;
+        if (ma && mb) {
+            float da = a.depth[i], db = b.depth[i];
+            if (!(fabsf(da - db) <= 2e-3f * db)) depth_bad++;
+        }
+    }
+    double iou = uni ? (double)inter / uni : 1.0;
+    printf("%-40s IoU %.5f (%u / %u pixels), depth mismatches %u\n", m->path, iou, inter, uni, depth_bad);
+    CHECKF(uni > 1000, "%s: only %u covered pixels", m->path, uni);
+    CHECKF(iou >= 0.99, "%s: silhouette IoU %.5f < 0.99", m->path, iou);
+    CHECKF(depth_bad <= inter / 100, "%s: %u of %u shared pixels differ in depth by more than 0.2%%", m->path, depth_bad, inter);
+    CHECK(sy_layer_count_nonfinite(&a) == 0);
+    sy_layer_destroy(&a);
+    sy_layer_destroy(&b);
+    sy_gltf_info_free(&info);
+    sy_scene_destroy(scene);
+}
+
+int main(void)
+{
+    it_register();
+    static const model models[] = {
+        {"gltf/Box/glTF/Box.gltf", NULL},
+        {"gltf/Duck/glTF/Duck.gltf", NULL},
+        {"cornell/cornell_box.gltf", "camera"},
+        {"gltf/DamagedHelmet/glTF/DamagedHelmet.gltf", NULL},
+    };
+    for (size_t i = 0; i < sizeof models / sizeof models[0]; ++i) check_model(&models[i]);
+    return it_finish("raster_align");
+}

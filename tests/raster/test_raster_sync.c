@@ -1,0 +1,170 @@
+/* test_raster_sync.c — the raster mediator through core: incremental sync from change lists
+ * (a transform-only change uploads no vertex data, a material change is one uniform-buffer update,
+ * a new mesh one upload of its buffers), exact emission of the Cornell light (17 12 4) in the float
+ * layer, and parameter errors. */
+#include "it_util.h"
+#include "sy_gltf.h"
+#include "sy_mediator_raster.h"
+
+#define W 64
+#define H 64
+
+static void render(sy_context *ctx, const sy_camera_view *v, sy_layer *img)
+{
+    sy_render_request rq = {.camera = *v, .full_width = W, .full_height = H, .rect_w = W, .rect_h = H};
+    MUST(sy_context_sync(ctx, err));
+    MUST(sy_context_render(ctx, &rq, img, err));
+}
+
+static void incremental(void)
+{
+    sy_scene *s;
+    MUST(sy_scene_create(&s, err));
+    sy_material lit;
+    MUST(sy_material_create(s, "lit", &lit, err));
+    sy_material unlit = it_unlit(s, "red", 1, 0, 0);
+    const float q[2][3] = {{-0.5f, 0, 0.4f}, {0.6f, 0, 0.3f}};
+    sy_material mats[1] = {lit};
+    sy_mesh ma = it_quad_mesh(s, "a", &q[0], mats, 1);
+    mats[0] = unlit;
+    sy_mesh mb = it_quad_mesh(s, "b", &q[1], mats, 1);
+    sy_node root, na, nb, nl;
+    MUST(sy_node_create(s, "root", &root, err));
+    MUST(sy_node_create(s, "a", &na, err));
+    MUST(sy_node_create(s, "b", &nb, err));
+    MUST(sy_node_create(s, "light", &nl, err));
+    MUST(sy_node_set_mesh(s, na, ma, err));
+    MUST(sy_node_set_mesh(s, nb, mb, err));
+    sy_light l;
+    MUST(sy_light_create(s, "sun", &l, err));
+    sy_light_data ld = *sy_light_get(s, l);
+    ld.type = SY_LIGHT_DIRECTIONAL;
+    ld.intensity = 2.0f;
+    MUST(sy_light_set(s, l, &ld, err));
+    MUST(sy_node_set_light(s, nl, l, err));
+    MUST(sy_node_add_child(s, root, na, err));
+    MUST(sy_node_add_child(s, root, nb, err));
+    MUST(sy_node_add_child(s, root, nl, err));
+    MUST(sy_scene_commit(s, NULL, err));
+
+    sy_params p;
+    MUST(sy_params_parse("msaa=1,shadow_map_size=256", &p, err));
+    sy_context *ctx;
+    MUST(sy_context_create(s, "raster", &p, root.id, &ctx, err));
+    void *st = sy_context_state(ctx);
+    sy_camera_view v = it_view_down_z(3.0f, 0.5f);
+    sy_layer img, img2;
+    MUST(sy_layer_create(W, H, &img, err));
+    MUST(sy_layer_create(W, H, &img2, err));
+    render(ctx, &v, &img);
+    sy_mediator_raster_counters c;
+    sy_mediator_raster_counters_get(st, &c);
+    CHECKF(c.meshes == 2 && c.instances == 2 && c.lights == 1, "meshes %u instances %u lights %u", c.meshes, c.instances, c.lights);
+    CHECKF(c.vertex_buffer_uploads == 4, "first frame vertex uploads %llu (2 x vertex + index buffer)",
+           (unsigned long long)c.vertex_buffer_uploads);
+    float pa[3] = {-0.5f, 0, 0}, x, y;
+    it_project(&v, pa, W, H, &x, &y);
+    const float *red = it_px(&img, (uint32_t)(0.6f / 0.5f / 3.0f * W / 2 + W / 2), H / 2);
+    CHECKF(red[0] == 1.0f && red[1] == 0.0f && red[3] == 1.0f, "unlit quad %g %g %g %g", red[0], red[1], red[2], red[3]);
+    float before = it_px(&img, (uint32_t)x, (uint32_t)y)[0];
+    CHECKF(before > 0.0f, "lit quad is black");
+
+    /* transform only: one model-matrix update per moved instance, no vertex data */
+    it_set_translation(s, na, 0, 0.05f, 0);
+    MUST(sy_scene_commit(s, NULL, err));
+    render(ctx, &v, &img2);
+    sy_mediator_raster_counters_get(st, &c);
+    CHECKF(c.vertex_buffer_uploads == 0 && c.vertex_bytes == 0 && c.texture_uploads == 0,
+           "transform-only change uploaded %llu vertex buffers (%llu bytes)", (unsigned long long)c.vertex_buffer_uploads,
+           (unsigned long long)c.vertex_bytes);
+    CHECKF(c.model_matrix_updates == 1 && c.last_sync_placements == 1, "model matrices %llu, placements %u",
+           (unsigned long long)c.model_matrix_updates, c.last_sync_placements);
+    CHECK(!it_layers_identical(&img, &img2));
+
+    /* material change: one uniform-buffer update */
+    sy_material_data md = *sy_material_get(s, lit);
+    md.base_color[1] = 0.25f;
+    MUST(sy_material_set(s, lit, &md, err));
+    MUST(sy_scene_commit(s, NULL, err));
+    render(ctx, &v, &img2);
+    sy_mediator_raster_counters_get(st, &c);
+    CHECKF(c.uniform_buffer_uploads == 1 && c.vertex_buffer_uploads == 0 && c.model_matrix_updates == 0,
+           "material change: %llu UBO, %llu VBO, %llu matrices", (unsigned long long)c.uniform_buffer_uploads,
+           (unsigned long long)c.vertex_buffer_uploads, (unsigned long long)c.model_matrix_updates);
+
+    /* a new mesh: one upload of its buffers */
+    const float q3[1][3] = {{0, 0.7f, 0.1f}};
+    mats[0] = unlit;
+    sy_mesh mc = it_quad_mesh(s, "c", q3, mats, 1);
+    sy_node nc;
+    MUST(sy_node_create(s, "c", &nc, err));
+    MUST(sy_node_set_mesh(s, nc, mc, err));
+    MUST(sy_node_add_child(s, root, nc, err));
+    MUST(sy_scene_commit(s, NULL, err));
+    render(ctx, &v, &img2);
+    sy_mediator_raster_counters_get(st, &c);
+    CHECKF(c.vertex_buffer_uploads == 2 && c.meshes == 3 && c.instances == 3, "new mesh: %llu vertex uploads, %u meshes",
+           (unsigned long long)c.vertex_buffer_uploads, c.meshes);
+
+    /* unknown provider / malformed parameters */
+    sy_context *bad = NULL;
+    sy_params bp;
+    MUST(sy_params_parse("gl=vulkan", &bp, err));
+    sy_error e = {0};
+    CHECK(sy_context_create(s, "raster", &bp, root.id, &bad, &e) != SY_OK && strstr(e.message, "gl=vulkan"));
+    MUST(sy_params_parse("msaa=0", &bp, err));
+    CHECK(sy_context_create(s, "raster", &bp, root.id, &bad, &e) != SY_OK && strstr(e.message, "msaa"));
+
+    sy_layer_destroy(&img);
+    sy_layer_destroy(&img2);
+    sy_context_release(ctx);
+    sy_scene_destroy(s);
+}
+
+static void cornell(void)
+{
+    char buf[1024];
+    const char *path = it_testdata("cornell/cornell_box.gltf", buf, sizeof buf);
+    sy_scene *scene;
+    MUST(sy_scene_create(&scene, err));
+    sy_gltf_info info;
+    MUST(sy_gltf_load(path, scene, NULL, &info, err));
+    sy_node cam;
+    MUST(sy_gltf_find_camera(scene, &info, "camera", &cam, err));
+    MUST(sy_scene_commit(scene, NULL, err));
+    sy_context_pool *pool;
+    sy_window *win;
+    sy_viewport *vp;
+    MUST(sy_context_pool_create(&pool, err));
+    MUST(sy_window_create(W, H, &win, err));
+    sy_viewport_desc vd = {.root = info.root, .camera = cam, .backend = "raster", .params = "msaa=4,shadow_map_size=512"};
+    MUST(sy_window_add_viewport(win, &vd, &vp, err));
+    sy_layer img;
+    MUST(sy_layer_create(W, H, &img, err));
+    MUST(sy_window_render(win, scene, pool, NULL, &img, err));
+    uint32_t exact = 0;
+    for (uint32_t i = 0; i < W * H; ++i) {
+        const float *p = img.rgba + 4 * i;
+        if (p[0] == 17.0f && p[1] == 12.0f && p[2] == 4.0f && p[3] == 1.0f) exact++;
+        CHECKF(p[0] <= 17.0f && p[1] <= 12.0f && p[2] <= 4.0f, "pixel %u brighter than the light: %g %g %g", i, p[0], p[1], p[2]);
+        if (!(p[0] <= 17.0f)) break;
+    }
+    CHECKF(exact >= 4, "only %u pixels show exactly the light's radiance 17 12 4", exact);
+    CHECK(sy_layer_count_nonfinite(&img) == 0);
+    const float *mid = it_px(&img, W / 2, H / 2);
+    float dmid = img.depth[(H / 2) * W + W / 2];
+    CHECKF(mid[3] == 1.0f && isfinite(dmid) && dmid > 0.0f, "centre alpha %g depth %g", mid[3], dmid);
+    sy_layer_destroy(&img);
+    sy_window_destroy(win);
+    sy_context_pool_destroy(pool);
+    sy_gltf_info_free(&info);
+    sy_scene_destroy(scene);
+}
+
+int main(void)
+{
+    it_register();
+    incremental();
+    cornell();
+    return it_finish("raster_sync");
+}

@@ -1,0 +1,464 @@
+/* test_rt_pathtracer.c — the PATHTRACER integrator through the public sy_rt API.
+ *
+ * Energy and unbiasedness (analytic answers):
+ *   - white furnace: a closed Lambertian sphere of albedo 1 (flat facets, no specular lobe) inside a
+ *     constant environment L returns L (whole-sphere mean within 1 %, per channel; the
+ *     environment is sampled by next-event estimation with MIS, so this checks both strategies);
+ *   - the same with an equirectangular environment texture of constant value x intensity;
+ *   - GGX metal with F0 = 1 (base 1, metallic 1, roughness 0.5 = alpha 0.25): single-scattering
+ *     microfacets lose the energy of multiple scattering and never gain any. Independent numerical
+ *     integration of the directional albedo E(mu) (height-correlated Smith) averaged over the
+ *     sphere's disk (weight 2 mu) gives 0.88, so the mean must lie in [0.86 L, 0.91 L];
+ *   - a smooth glass sphere (transmission 1, IOR 1.5, base 1) in the furnace returns L within 1 %
+ *     (reflection, refraction and total internal reflection conserve energy);
+ *   - integrating spheres (see test_integrating_sphere): half emitter / half reflector, and a point
+ *     light at the centre; analytic multi-bounce answers within 1 %, plus the direct/indirect
+ *     split of the AOVs;
+ *   - importance-sampled environment map (nearest filter, random texels + one bright "sun" texel)
+ *     over a white Lambertian ground quad: the pixel value equals (1/pi) * the cosine-weighted
+ *     integral of the map over the upper hemisphere, computed here by brute force (within 2 %).
+ * Determinism and tiling: same seed = bit-identical; 4 calls of 1 sample = 1 call of 4; the four
+ * quadrants rendered separately stitch bit-identically; another seed differs.
+ * Bad input: degenerate triangles and a zero-area emitter give no non-finite value and no
+ * dropped sample. */
+#include "rt_test.h"
+
+#define PI_F 3.14159265358979f
+
+/* UV sphere of radius r at the origin, outward counter-clockwise winding, flat (no normals). */
+static sy_rt_mesh make_sphere(sy_rt_device *dev, float r, uint32_t seg, uint32_t rings)
+{
+    uint32_t nv = (seg + 1) * (rings + 1), nt = seg * rings * 2;
+    float *pos = malloc(nv * 3 * sizeof *pos);
+    uint32_t *idx = malloc(nt * 3 * sizeof *idx), t = 0;
+    for (uint32_t j = 0; j <= rings; ++j)
+        for (uint32_t i = 0; i <= seg; ++i) {
+            float th = PI_F * (float)j / (float)rings, ph = 2.0f * PI_F * (float)i / (float)seg;
+            float *p = pos + 3 * (j * (seg + 1) + i);
+            p[0] = r * sinf(th) * cosf(ph);
+            p[1] = r * cosf(th);
+            p[2] = -r * sinf(th) * sinf(ph);
+        }
+    for (uint32_t j = 0; j < rings; ++j)
+        for (uint32_t i = 0; i < seg; ++i) {
+            uint32_t a = j * (seg + 1) + i, b = a + seg + 1;
+            /* (a, b, a+1) and (a+1, b, b+1) face outward for this parameterisation */
+            idx[3 * t] = a, idx[3 * t + 1] = b, idx[3 * t + 2] = a + 1, ++t;
+            idx[3 * t] = a + 1, idx[3 * t + 1] = b, idx[3 * t + 2] = b + 1, ++t;
+        }
+    sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = nv, .triangle_count = nt};
+    sy_rt_mesh m;
+    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    free(pos);
+    free(idx);
+    return m;
+}
+
+typedef struct img {
+    uint32_t w, h;
+    float *rgba, *depth;
+    sy_rt_accum *acc;
+} img;
+
+static img pt_render(sy_rt_device *dev, const sy_rt_camera *cam, uint32_t w, uint32_t h, uint32_t spp, uint32_t seed,
+                     uint32_t max_depth)
+{
+    img r = {w, h, malloc((size_t)w * h * 4 * sizeof(float)), malloc((size_t)w * h * sizeof(float)), NULL};
+    MUST(sy_rt_accum_create(w, h, &r.acc, ERR));
+    sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, w, h);
+    d.accum = r.acc;
+    d.samples = spp;
+    d.seed = seed;
+    d.max_depth = max_depth;
+    MUST(sy_rt_render(dev, cam, &d, r.rgba, r.depth, ERR));
+    return r;
+}
+
+static void img_free(img *i)
+{
+    free(i->rgba);
+    free(i->depth);
+    sy_rt_accum_destroy(i->acc);
+}
+
+static size_t count_nonfinite(const img *i)
+{
+    size_t n = 0;
+    for (size_t k = 0; k < (size_t)i->w * i->h * 4; ++k) n += !isfinite(i->rgba[k]);
+    return n;
+}
+
+/* Mean colour over pixels whose depth is finite (the object) or all pixels (object = false). */
+static void mean_rgb(const img *i, bool object, double out[3])
+{
+    double s[3] = {0, 0, 0};
+    size_t n = 0;
+    for (size_t k = 0; k < (size_t)i->w * i->h; ++k) {
+        if (object && !isfinite(i->depth[k])) continue;
+        for (int c = 0; c < 3; ++c) s[c] += i->rgba[4 * k + (size_t)c];
+        n++;
+    }
+    for (int c = 0; c < 3; ++c) out[c] = n ? s[c] / (double)n : 0.0;
+}
+
+static void furnace_case(const char *name, const sy_rt_material_desc *md, double lo, double hi, bool env_texture)
+{
+    sy_rt_device *dev = rt_device();
+    const float L[3] = {0.25f, 0.5f, 1.0f};
+    if (env_texture) {
+        /* constant map of value L / 2 at intensity 2 */
+        float px[8 * 4 * 3];
+        for (int k = 0; k < 8 * 4; ++k) px[3 * k] = L[0] / 2, px[3 * k + 1] = L[1] / 2, px[3 * k + 2] = L[2] / 2;
+        sy_rt_texture_desc td = {.width = 8, .height = 4, .channels = 3, .format = SY_RT_TEXEL_FLOAT32, .pixels = px,
+                                 .wrap_t = SY_RT_WRAP_CLAMP};
+        sy_rt_texture tex;
+        MUST(sy_rt_texture_create(dev, &td, &tex, ERR));
+        MUST(sy_rt_set_environment(dev, tex, 2.0f, ERR));
+    } else {
+        sy_rt_background bg = {.mode = SY_RT_BACKGROUND_COLOR, .color = {L[0], L[1], L[2]}};
+        MUST(sy_rt_set_background(dev, &bg, ERR));
+    }
+    sy_rt_material mat;
+    MUST(sy_rt_material_create(dev, md, &mat, ERR));
+    float id[16];
+    rt_identity(id);
+    rt_place(dev, make_sphere(dev, 1.0f, 64, 32), id, mat, 0);
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_camera cam = rt_camera(3.0f, 0.4f);
+    img im = pt_render(dev, &cam, 48, 48, 64, 1, 64);
+    double m[3];
+    mean_rgb(&im, true, m);
+    for (int c = 0; c < 3; ++c)
+        CHECK(m[c] >= lo * L[c] && m[c] <= hi * L[c], "%s: channel %d mean %.5f, expected [%.4f, %.4f]", name, c, m[c],
+              lo * L[c], hi * L[c]);
+    printf("%s: mean/L = %.4f %.4f %.4f\n", name, m[0] / L[0], m[1] / L[1], m[2] / L[2]);
+    CHECK(count_nonfinite(&im) == 0 && sy_rt_accum_nonfinite(im.acc) == 0, "%s: non-finite values", name);
+    img_free(&im);
+    sy_rt_device_destroy(dev);
+}
+
+static void test_furnaces(void)
+{
+    sy_rt_material_desc d;
+    sy_rt_material_desc_init(&d);
+    d.metallic = 0.0f;
+    d.specular = 0.0f; /* pure Lambert, albedo 1 */
+    furnace_case("furnace lambert", &d, 0.99, 1.01, false);
+    furnace_case("furnace lambert, environment map", &d, 0.99, 1.01, true);
+    sy_rt_material_desc_init(&d);
+    d.metallic = 1.0f;
+    d.roughness = 0.5f;
+    furnace_case("furnace GGX metal F0=1", &d, 0.86, 0.91, false);
+    sy_rt_material_desc_init(&d);
+    d.metallic = 0.0f;
+    d.roughness = 0.0f;
+    d.transmission = 1.0f;
+    d.ior = 1.5f;
+    furnace_case("furnace smooth glass", &d, 0.99, 1.01, false);
+}
+
+/* Area of the triangles of a mesh description (for form factors). */
+static double sphere_part(sy_rt_device *dev, float r, uint32_t seg, uint32_t rings, uint32_t j0, uint32_t j1,
+                          sy_rt_material mat)
+{
+    uint32_t nv = (seg + 1) * (rings + 1), nt = seg * (j1 - j0) * 2, t = 0;
+    float *pos = malloc(nv * 3 * sizeof *pos);
+    uint32_t *idx = malloc(nt * 3 * sizeof *idx);
+    for (uint32_t j = 0; j <= rings; ++j)
+        for (uint32_t i = 0; i <= seg; ++i) {
+            float th = PI_F * (float)j / (float)rings, ph = 2.0f * PI_F * (float)i / (float)seg;
+            float *p = pos + 3 * (j * (seg + 1) + i);
+            p[0] = r * sinf(th) * cosf(ph), p[1] = r * cosf(th), p[2] = -r * sinf(th) * sinf(ph);
+        }
+    double area = 0;
+    for (uint32_t j = j0; j < j1; ++j)
+        for (uint32_t i = 0; i < seg; ++i) {
+            uint32_t a = j * (seg + 1) + i, b = a + seg + 1;
+            uint32_t tri[2][3] = {{a, b, a + 1}, {a + 1, b, b + 1}};
+            for (int k = 0; k < 2; ++k, ++t) {
+                const float *p0 = pos + 3 * tri[k][0], *p1 = pos + 3 * tri[k][1], *p2 = pos + 3 * tri[k][2];
+                double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]}, e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+                double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2], cz = e1[0] * e2[1] - e1[1] * e2[0];
+                area += 0.5 * sqrt(cx * cx + cy * cy + cz * cz);
+                memcpy(idx + 3 * t, tri[k], sizeof tri[k]);
+            }
+        }
+    sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = nv, .triangle_count = nt};
+    sy_rt_mesh m;
+    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    float id[16];
+    rt_identity(id);
+    rt_place(dev, m, id, mat, 0);
+    free(pos);
+    free(idx);
+    return area;
+}
+
+/* Integrating spheres (inside a sphere the form factor from any wall element to a wall region is
+ * the region's area / the sphere's area, and a point light at the centre irradiates the wall
+ * uniformly with I / R^2):
+ *   (a) lower half a double-sided emitter of radiance E (1024 triangles, alias-table sampled),
+ *       upper half Lambertian with albedo a = 0.6: the upper wall has L = a f E / (1 - a (1 - f))
+ *       with f = emitting area fraction;
+ *   (b) a closed Lambertian sphere (a = 0.5, R = 2) with a point light of intensity I at its
+ *       centre: L = a I / (pi R^2 (1 - a)).
+ * Both need every bounce, unbiased Russian roulette and correct light pdfs and MIS weights. */
+static void test_integrating_sphere(void)
+{
+    sy_rt_device *dev = rt_device();
+    sy_rt_material_desc d;
+    sy_rt_material_desc_init(&d);
+    d.base_color[0] = d.base_color[1] = d.base_color[2] = 0.0f;
+    d.specular = 0.0f; /* a black, non-reflecting emitter */
+    d.emissive[0] = 1.0f, d.emissive[1] = 2.0f, d.emissive[2] = 0.5f;
+    d.double_sided = true;
+    sy_rt_material glow;
+    MUST(sy_rt_material_create(dev, &d, &glow, ERR));
+    const float a = 0.6f;
+    double up = sphere_part(dev, 2.0f, 64, 32, 0, 16, rt_lambert(dev, a, a, a));
+    double down = sphere_part(dev, 2.0f, 64, 32, 16, 32, glow);
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_stats st;
+    sy_rt_device_stats(dev, &st);
+    CHECK(st.area_light_triangles >= 64 * 16 * 2 - 64 && st.area_light_triangles <= 64 * 16 * 2,
+          "area triangles %u (the pole triangles are degenerate and skipped)", st.area_light_triangles);
+    double fe = down / (up + down), k = a * fe / (1.0 - a * (1.0 - fe));
+    /* camera at the centre looking up (+Y): sees only the reflecting half */
+    sy_rt_camera cam = rt_camera(0.0f, 1.0f);
+    memset(cam.camera_to_world, 0, sizeof cam.camera_to_world);
+    cam.camera_to_world[0] = 1.0f;
+    cam.camera_to_world[6] = 1.0f;  /* camera y -> world +z */
+    cam.camera_to_world[9] = -1.0f; /* camera z -> world -y: looks up */
+    cam.camera_to_world[15] = 1.0f;
+    img im = pt_render(dev, &cam, 24, 24, 64, 7, 64);
+    double m[3];
+    mean_rgb(&im, false, m);
+    for (int c = 0; c < 3; ++c)
+        CHECK(fabs(m[c] / (k * d.emissive[c]) - 1.0) < 0.01, "integrating sphere (a) channel %d: %.5f, expected %.5f", c,
+              m[c], k * d.emissive[c]);
+    printf("integrating sphere, emissive half: mean / expected = %.4f %.4f %.4f\n", m[0] / (k * d.emissive[0]),
+           m[1] / (k * d.emissive[1]), m[2] / (k * d.emissive[2]));
+    /* direct lighting only (max_depth 1): a f E; the AOVs split the full render into direct a f E
+     * and indirect (the rest) */
+    img im1 = pt_render(dev, &cam, 24, 24, 64, 7, 1);
+    mean_rgb(&im1, false, m);
+    CHECK(fabs(m[1] / (a * fe * d.emissive[1]) - 1.0) < 0.01, "max_depth 1: %.5f, expected %.5f", m[1], a * fe * d.emissive[1]);
+    float *dir = malloc(24 * 24 * 3 * sizeof(float)), *ind = malloc(24 * 24 * 3 * sizeof(float));
+    MUST(sy_rt_accum_read(im.acc, SY_RT_AOV_DIRECT, dir, ERR));
+    MUST(sy_rt_accum_read(im.acc, SY_RT_AOV_INDIRECT, ind, ERR));
+    double sd = 0, si = 0;
+    for (int i = 0; i < 24 * 24; ++i) sd += dir[3 * i + 1], si += ind[3 * i + 1];
+    sd /= 24 * 24, si /= 24 * 24;
+    double ed = a * fe * d.emissive[1], ei = k * d.emissive[1] - ed;
+    CHECK(fabs(sd / ed - 1.0) < 0.01 && fabs(si / ei - 1.0) < 0.02, "direct %.4f (%.4f), indirect %.4f (%.4f)", sd, ed, si, ei);
+    free(dir);
+    free(ind);
+    img_free(&im);
+    img_free(&im1);
+    sy_rt_device_destroy(dev);
+
+    dev = rt_device();
+    sphere_part(dev, 2.0f, 64, 32, 0, 32, rt_lambert(dev, 0.5f, 0.5f, 0.5f));
+    sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1.0f, 0.5f, 0.25f}, .intensity = 10.0f};
+    sy_rt_light l;
+    MUST(sy_rt_light_create(dev, &ld, &l, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    im = pt_render(dev, &cam, 24, 24, 64, 11, 64);
+    mean_rgb(&im, false, m);
+    for (int c = 0; c < 3; ++c) {
+        double e = 0.5 * ld.intensity * ld.color[c] / (M_PI * 4.0 * 0.5);
+        CHECK(fabs(m[c] / e - 1.0) < 0.01, "integrating sphere (b) channel %d: %.5f, expected %.5f", c, m[c], e);
+    }
+    printf("integrating sphere, point light: mean / expected = %.4f\n", m[0] / (0.5 * 10.0 / (M_PI * 2.0)));
+    img_free(&im);
+    sy_rt_device_destroy(dev);
+}
+
+static void test_env_importance(void)
+{
+    sy_rt_device *dev = rt_device();
+    enum { EW = 32, EH = 16 };
+    static float px[EW * EH * 3];
+    uint32_t s = 12345;
+    for (int k = 0; k < EW * EH * 3; ++k) {
+        s = s * 1664525u + 1013904223u;
+        px[k] = (float)(s >> 8) / 16777216.0f * 0.2f;
+    }
+    int sun = (3 * EW + 20) * 3; /* row 3: about 40 degrees above the horizon */
+    px[sun] = 400.0f, px[sun + 1] = 300.0f, px[sun + 2] = 200.0f;
+    sy_rt_texture_desc td = {.width = EW, .height = EH, .channels = 3, .format = SY_RT_TEXEL_FLOAT32, .pixels = px,
+                             .wrap_t = SY_RT_WRAP_CLAMP, .filter = SY_RT_FILTER_NEAREST};
+    sy_rt_texture tex;
+    MUST(sy_rt_texture_create(dev, &td, &tex, ERR));
+    MUST(sy_rt_set_environment(dev, tex, 1.0f, ERR));
+    /* ground: a big white Lambertian quad facing +Y at y = 0 */
+    float xf[16];
+    rt_identity(xf);
+    xf[0] = 100.0f;
+    xf[5] = 0.0f, xf[6] = -100.0f; /* local y -> world -z */
+    xf[9] = 1.0f, xf[10] = 0.0f;   /* local z -> world +y */
+    rt_place(dev, rt_quad(dev, 1.0f), xf, rt_lambert(dev, 1.0f, 1.0f, 1.0f), 0);
+    MUST(sy_rt_commit(dev, ERR));
+    /* camera 1 m above the ground looking straight down, narrow view */
+    sy_rt_camera cam = rt_camera(0.0f, 0.05f);
+    memset(cam.camera_to_world, 0, sizeof cam.camera_to_world);
+    cam.camera_to_world[0] = 1.0f;
+    cam.camera_to_world[6] = -1.0f; /* camera y -> world -z */
+    cam.camera_to_world[9] = 1.0f;  /* camera z -> world +y (looks down -y) */
+    cam.camera_to_world[13] = 1.0f;
+    cam.camera_to_world[15] = 1.0f;
+    img im = pt_render(dev, &cam, 8, 8, 256, 3, 1);
+    double m[3];
+    mean_rgb(&im, false, m);
+    /* expected: (1/pi) * sum over the upper hemisphere of Le * cos(theta) dOmega (fine grid) */
+    double e[3] = {0, 0, 0};
+    const int N = 2048, M = 1024;
+    for (int j = 0; j < M / 2; ++j)
+        for (int i = 0; i < N; ++i) {
+            double v = (j + 0.5) / M, u = (i + 0.5) / N, th = v * M_PI, ph = (u - 0.5) * 2.0 * M_PI;
+            double dy = cos(th), dom = (2.0 * M_PI / N) * (M_PI / M) * sin(th);
+            int tx = (int)(u * EW), ty = (int)(v * EH);
+            (void)ph;
+            for (int c = 0; c < 3; ++c) e[c] += px[(ty * EW + tx) * 3 + c] * dy * dom / M_PI;
+        }
+    for (int c = 0; c < 3; ++c)
+        CHECK(fabs(m[c] / e[c] - 1.0) < 0.02, "env importance channel %d: %.5f, expected %.5f", c, m[c], e[c]);
+    printf("environment map: mean / expected = %.4f %.4f %.4f\n", m[0] / e[0], m[1] / e[1], m[2] / e[2]);
+    img_free(&im);
+    sy_rt_device_destroy(dev);
+}
+
+/* A small scene with every light type, glossy and rough materials. */
+static sy_rt_device *mixed_scene(void)
+{
+    sy_rt_device *dev = rt_device();
+    float xf[16];
+    rt_rot_y(xf, 0.3f, 0.0f, 0.0f, -1.0f);
+    sy_rt_material_desc d;
+    sy_rt_material_desc_init(&d);
+    d.roughness = 0.3f;
+    d.metallic = 0.5f;
+    sy_rt_material glossy;
+    MUST(sy_rt_material_create(dev, &d, &glossy, ERR));
+    rt_place(dev, rt_quad(dev, 1.0f), xf, glossy, 0);
+    rt_translation(xf, 0.3f, 0.2f, 0.0f);
+    rt_place(dev, make_sphere(dev, 0.3f, 16, 8), xf, rt_lambert(dev, 0.8f, 0.3f, 0.2f), 0);
+    rt_translation(xf, -0.5f, 0.8f, 0.5f);
+    rt_place(dev, rt_quad(dev, 0.2f), xf, rt_emitter(dev, 5.0f, 5.0f, 4.0f), 0);
+    sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 2.0f, .position = {0.5f, 1.0f, 1.0f}};
+    sy_rt_light l;
+    MUST(sy_rt_light_create(dev, &ld, &l, ERR));
+    sy_rt_background bg = {.mode = SY_RT_BACKGROUND_COLOR, .color = {0.1f, 0.1f, 0.2f}};
+    MUST(sy_rt_set_background(dev, &bg, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    return dev;
+}
+
+static void test_determinism_and_tiles(void)
+{
+    sy_rt_device *dev = mixed_scene();
+    sy_rt_camera cam = rt_camera(2.5f, 0.6f);
+    const uint32_t W = 32;
+    img a = pt_render(dev, &cam, W, W, 4, 42, 8), b = pt_render(dev, &cam, W, W, 4, 42, 8);
+    CHECK(!memcmp(a.rgba, b.rgba, W * W * 4 * sizeof(float)), "same seed must give the same image");
+    img c = pt_render(dev, &cam, W, W, 4, 43, 8);
+    CHECK(memcmp(a.rgba, c.rgba, W * W * 4 * sizeof(float)) != 0, "another seed must change the noise");
+    /* 4 calls of 1 sample */
+    img p = pt_render(dev, &cam, W, W, 1, 42, 8);
+    for (int k = 0; k < 3; ++k) {
+        sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, W, W);
+        d.accum = p.acc;
+        d.samples = 1;
+        d.seed = 42;
+        d.max_depth = 8;
+        MUST(sy_rt_render(dev, &cam, &d, p.rgba, p.depth, ERR));
+    }
+    CHECK(sy_rt_accum_samples(p.acc) == 4, "accum has %u samples", sy_rt_accum_samples(p.acc));
+    CHECK(!memcmp(a.rgba, p.rgba, W * W * 4 * sizeof(float)), "4 x 1 sample must equal 1 x 4 samples bit for bit");
+    /* quadrants */
+    size_t diff = 0;
+    for (uint32_t q = 0; q < 4; ++q) {
+        uint32_t x0 = (q % 2) * (W / 2), y0 = (q / 2) * (W / 2), hw = W / 2;
+        sy_rt_accum *acc;
+        MUST(sy_rt_accum_create(hw, hw, &acc, ERR));
+        float *rgba = malloc(hw * hw * 4 * sizeof(float));
+        sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, W, W);
+        d.x = x0, d.y = y0, d.width = hw, d.height = hw;
+        d.accum = acc;
+        d.samples = 4;
+        d.seed = 42;
+        d.max_depth = 8;
+        MUST(sy_rt_render(dev, &cam, &d, rgba, NULL, ERR));
+        for (uint32_t y = 0; y < hw; ++y)
+            diff += memcmp(rgba + 4 * y * hw, a.rgba + 4 * ((y0 + y) * W + x0), hw * 4 * sizeof(float)) != 0;
+        free(rgba);
+        sy_rt_accum_destroy(acc);
+    }
+    CHECK(diff == 0, "%zu quadrant rows differ from the full image", diff);
+    CHECK(count_nonfinite(&a) == 0, "non-finite pixels in the mixed scene");
+    /* variance AOV: finite, non-negative, not all zero */
+    float *var = malloc(W * W * 3 * sizeof(float));
+    MUST(sy_rt_accum_read(a.acc, SY_RT_AOV_VARIANCE, var, ERR));
+    size_t bad = 0, pos = 0;
+    for (size_t k = 0; k < W * W * 3; ++k) bad += !(isfinite(var[k]) && var[k] >= 0.0f), pos += var[k] > 0.0f;
+    CHECK(bad == 0 && pos > 0, "variance AOV: %zu bad, %zu positive", bad, pos);
+    free(var);
+    /* accumulation validation */
+    sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, W, W);
+    char e[256] = "";
+    CHECK(sy_rt_render(dev, &cam, &d, a.rgba, NULL, e, sizeof e) == SY_RT_ERROR_INVALID_ARGUMENT, "no accum accepted");
+    d.accum = p.acc;
+    d.width = W / 2;
+    CHECK(sy_rt_render(dev, &cam, &d, a.rgba, NULL, e, sizeof e) == SY_RT_ERROR_INVALID_ARGUMENT && strstr(e, "accum"),
+          "accum size mismatch accepted: %s", e);
+    img_free(&a);
+    img_free(&b);
+    img_free(&c);
+    img_free(&p);
+    sy_rt_device_destroy(dev);
+}
+
+static void test_degenerate(void)
+{
+    sy_rt_device *dev = rt_device();
+    /* a mesh with degenerate triangles (repeated vertex, collinear) next to a good one, all emissive,
+     * plus a zero-area emitter */
+    const float pos[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0, 3, 0, 0};
+    const uint32_t idx[] = {0, 1, 2, 0, 0, 1, 1, 3, 4, 2, 2, 2};
+    sy_rt_mesh_desc md = {.positions = pos, .indices = idx, .vertex_count = 5, .triangle_count = 4};
+    sy_rt_mesh m;
+    MUST(sy_rt_mesh_create(dev, &md, &m, ERR));
+    float xf[16];
+    rt_translation(xf, -0.5f, -0.5f, -1.0f);
+    rt_place(dev, m, xf, rt_emitter(dev, 2.0f, 2.0f, 2.0f), 0);
+    const float zpos[] = {0.2f, 0.2f, 0, 0.2f, 0.2f, 0, 0.2f, 0.2f, 0};
+    sy_rt_mesh_desc zd = {.positions = zpos, .vertex_count = 3, .triangle_count = 1};
+    sy_rt_mesh zm;
+    MUST(sy_rt_mesh_create(dev, &zd, &zm, ERR));
+    rt_place(dev, zm, xf, rt_emitter(dev, 1e6f, 1e6f, 1e6f), 0);
+    rt_translation(xf, 0.0f, 0.0f, -2.0f);
+    rt_place(dev, rt_quad(dev, 3.0f), xf, rt_lambert(dev, 0.7f, 0.7f, 0.7f), 0);
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_stats st;
+    sy_rt_device_stats(dev, &st);
+    CHECK(st.area_light_triangles == 1, "only the good emissive triangle is a light (got %u)", st.area_light_triangles);
+    sy_rt_camera cam = rt_camera(1.0f, 0.8f);
+    img im = pt_render(dev, &cam, 32, 32, 8, 5, 8);
+    CHECK(count_nonfinite(&im) == 0, "%zu non-finite values", count_nonfinite(&im));
+    CHECK(sy_rt_accum_nonfinite(im.acc) == 0, "%llu samples dropped", (unsigned long long)sy_rt_accum_nonfinite(im.acc));
+    double mm[3];
+    mean_rgb(&im, true, mm);
+    CHECK(mm[0] > 0.0, "the lit quad shows light");
+    img_free(&im);
+    sy_rt_device_destroy(dev);
+}
+
+int main(void)
+{
+    test_furnaces();
+    test_integrating_sphere();
+    test_env_importance();
+    test_determinism_and_tiles();
+    test_degenerate();
+    return rt_finish("rt_pathtracer");
+}
