@@ -234,18 +234,6 @@ typedef struct pt_opts {
     float bg[3];          /* constant background radiance (a uniform environment for the path tracer) */
 } pt_opts;
 
-/* True when `sy render` names a progressive back-end (-b pathtracer): cmd_render_progressive
- * handles it (mono viewport, passes until --spp or --time, --aov, --env). */
-static bool render_wants_progressive(int argc, char **argv)
-{
-    for (int i = 0; i + 1 < argc; ++i)
-        if (!strcmp(argv[i], "-b")) {
-            const sy_mediator_class *c = sy_mediator_find(argv[i + 1]);
-            return c && (c->caps & SY_CAP_PROGRESSIVE);
-        }
-    return false;
-}
-
 /* Reads an equirectangular EXR (R, G, B or Y channels) into a float RGB texture and makes it the
  * environment (and/or sets the background colour) of the viewport's background object. */
 static sy_result setup_environment(loaded *ld, const pt_opts *po, sy_error *err)
@@ -335,21 +323,16 @@ static void pt_progress_print(const pt_progress *p, bool final)
     fflush(stderr);
 }
 
-/* Renders a progressive back-end in passes until the sample count or the time budget is reached.
- * *samples_out gets the samples per pixel accumulated; *ctx_out the (pool-owned) context. */
-static sy_result render_progressive(loaded *ld, const char *backend, const char *params, uint32_t w, uint32_t h,
-                                    const pt_opts *po, sy_context_pool *pool, sy_layer *out, double *seconds,
+/* Renders a progressive back-end in passes until the sample count or the time budget is reached,
+ * through the same window composition as a single-pass render (overlays and stereo included).
+ * *out / *out_right get the final images; *samples_out the samples per pixel accumulated by the
+ * main back-end; *ctx_out its (pool-owned) context. */
+static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uint32_t w, uint32_t h, const pt_opts *po,
+                                    sy_context_pool *pool, sy_layer *out, sy_layer *out_right, double *seconds,
                                     uint64_t *samples_out, sy_context **ctx_out, sy_error *err)
 {
-    sy_window *win = NULL;
-    sy_viewport *vp;
-    sy_result r = sy_window_create(w, h, &win, err);
-    sy_viewport_desc vd = {
-        .root = ld->root, .camera = ld->camera, .background = ld->background, .backend = backend, .params = params};
-    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
-    if (r == SY_OK) r = sy_layer_create(w, h, out, err);
     sy_params pp;
-    if (r == SY_OK) r = sy_params_parse(params, &pp, err);
+    sy_result r = sy_params_parse(spec->params, &pp, err);
     uint64_t target = po->spp ? po->spp : (po->time_budget > 0 ? 0 : 64);
     pt_progress pr = {sy_time_now(), 0, target, po->time_budget};
     bool tty = sy_is_terminal(2);
@@ -360,7 +343,9 @@ static sy_result render_progressive(loaded *ld, const char *backend, const char 
         uint32_t n = (uint32_t)(left < chunk ? left : chunk);
         double p0 = sy_time_now();
         sy_window_render_opts ro = {.sample_count = n};
-        r = sy_window_render(win, ld->scene, pool, &ro, out, err);
+        sy_layer_destroy(out);
+        sy_layer_destroy(out_right);
+        r = sy_compose_render(ld->scene, pool, spec, w, h, &ro, out, out_right, err);
         if (r != SY_OK) break;
         pr.done += n;
         double now = sy_time_now(), pass = (now - p0) / n;
@@ -381,14 +366,13 @@ static sy_result render_progressive(loaded *ld, const char *backend, const char 
     *seconds = sy_time_now() - t0;
     if (tty) pt_progress_print(&pr, true);
     sy_context *ctx = NULL;
-    if (r == SY_OK) r = sy_context_pool_get(pool, ld->scene, backend, &pp, ld->root.id, &ctx, err);
+    if (r == SY_OK) r = sy_context_pool_get(pool, ld->scene, spec->backend, &pp, ld->root.id, &ctx, err);
     if (r == SY_OK) {
         sy_mediator_stats st = {0};
         sy_context_stats(ctx, &st);
         *samples_out = st.samples;
         *ctx_out = ctx;
     }
-    sy_window_destroy(win);
     return r;
 }
 
@@ -578,8 +562,6 @@ static sy_result add_overlay(loaded *ld, const char *arg, const char *composite,
     return SY_OK;
 }
 
-static int cmd_render_progressive(int argc, char **argv);
-
 /* `--gl PROVIDER` (raster back-end): appended to the back-end parameters as gl=PROVIDER. */
 static const char *render_gl_params(const char *params, const char *provider, char *buf, size_t len)
 {
@@ -589,8 +571,6 @@ static const char *render_gl_params(const char *params, const char *provider, ch
 
 static int cmd_render(int argc, char **argv)
 {
-    if (render_wants_progressive(argc, argv) && !sy_cluster_cli_requested(argc, argv))
-        return cmd_render_progressive(argc, argv);
     const char *scene = NULL, *backend = NULL, *outp = NULL, *camera = NULL, *params = NULL;
     const char *gl_provider = NULL;
     const char *overlay = NULL, *composite = "depth";
@@ -600,10 +580,31 @@ static int cmd_render(int argc, char **argv)
     sy_error perr = {0};
     sy_cluster_cli_opts clo = {0};
     bool clbad = false;
+    pt_opts po = {.env_intensity = 1.0f};
+    bool progressive_opts = false; /* --spp / --time / --aov given */
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
+        char *end = NULL;
         if (!strcmp(a, "-b") && has) backend = argv[++i];
+        else if (!strcmp(a, "--spp") && has) {
+            if (!parse_u32(argv[++i], 1, 1u << 24, &po.spp)) return usage();
+            progressive_opts = true;
+        } else if (!strcmp(a, "--time") && has) {
+            po.time_budget = strtod(argv[++i], &end);
+            if (*end || !(po.time_budget > 0) || !isfinite(po.time_budget)) return usage();
+            progressive_opts = true;
+        } else if (!strcmp(a, "--aov")) po.aov = progressive_opts = true;
+        else if (!strcmp(a, "--env") && has) po.env = argv[++i];
+        else if (!strcmp(a, "--env-intensity") && has) {
+            po.env_intensity = strtof(argv[++i], &end);
+            if (*end || !isfinite(po.env_intensity) || po.env_intensity < 0) return usage();
+        } else if (!strcmp(a, "--background") && has) {
+            if (sscanf(argv[++i], "%f,%f,%f", &po.bg[0], &po.bg[1], &po.bg[2]) != 3 || !isfinite(po.bg[0]) ||
+                !isfinite(po.bg[1]) || !isfinite(po.bg[2]) || po.bg[0] < 0 || po.bg[1] < 0 || po.bg[2] < 0)
+                return usage();
+            po.has_bg = true;
+        }
         else if (!strcmp(a, "-o") && has) outp = argv[++i];
         else if (!strcmp(a, "-w") && has) {
             if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
@@ -632,12 +633,25 @@ static int cmd_render(int argc, char **argv)
             return usage();
         }
     }
+    if (po.spp) clo.samples = po.spp; /* --spp also sets the cluster's cooperative sample count */
     if (!scene || !backend || !outp) return usage();
     char gl_params[256];
     if (gl_provider) params = render_gl_params(params, gl_provider, gl_params, sizeof gl_params);
     sy_error err = {0};
     if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) { /* before any loading or rendering */
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);
+        return fail(&err);
+    }
+    const sy_mediator_class *bcls = sy_mediator_find(backend);
+    bool progressive = bcls && (bcls->caps & SY_CAP_PROGRESSIVE) && !clo.cluster;
+    if (progressive_opts && bcls && !(bcls->caps & SY_CAP_PROGRESSIVE) && !clo.cluster) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--spp, --time and --aov need a progressive back-end; '%s' is not",
+                     backend);
+        return fail(&err);
+    }
+    if (po.aov && (!ends_with(outp, ".exr") || spec.stereo != SY_STEREO_NONE || overlay || clo.cluster)) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: --aov needs an .exr output of a local mono render without overlay",
+                     outp);
         return fail(&err);
     }
     loaded ld;
@@ -664,10 +678,19 @@ static int cmd_render(int argc, char **argv)
     spec.background = ld.background;
     sy_result r = overlay ? add_overlay(&ld, overlay, composite, &spec, &err) : SY_OK;
     if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
+    if (r == SY_OK && (po.env || po.has_bg)) {
+        r = setup_environment(&ld, &po, &err);
+        spec.background = ld.background;
+    }
     progress_state ps = {backend, sy_time_now(), 0, sy_is_terminal(2)};
     sy_window_render_opts ro = {.progress = progress_cb, .progress_user = &ps};
     double t0 = sy_time_now();
-    if (r == SY_OK && clo.cluster) {
+    uint64_t samples = 0;
+    sy_context *pctx = NULL;
+    if (r == SY_OK && progressive) {
+        r = render_progressive(&ld, &spec, w, h, &po, pool, &img, &img_right, &secs, &samples, &pctx, &err);
+        t0 = sy_time_now() - secs;
+    } else if (r == SY_OK && clo.cluster) {
         sy_viewport_desc cvd = {.root = ld.root, .camera = ld.camera, .background = ld.background, .backend = backend,
                                 .params = params, .eye_separation = spec.eye_separation, .zero_parallax = spec.zero_parallax};
         r = sy_cluster_cli_render(&clo, ld.scene, &cvd, w, h, &img, &secs, &err);
@@ -685,102 +708,15 @@ static int cmd_render(int argc, char **argv)
             if (r == SY_OK) r = write_image(rp, &img_right, &oo, &err);
             if (r == SY_OK) printf("%s, %s: %ux%u per eye, %s, %.3f s\n", lp, rp, w, h, backend, secs);
         } else {
-            r = write_image(outp, &img, &oo, &err);
-            if (r == SY_OK) printf("%s: %ux%u, %s, %.3f s\n", outp, img.width, img.height, backend, secs);
+            r = po.aov ? write_aov_exr(outp, pctx, oo.half, &err) : write_image(outp, &img, &oo, &err);
+            if (r == SY_OK && progressive)
+                printf("%s: %ux%u, %s, %llu samples per pixel, %.3f s (%.2f samples/s)\n", outp, img.width, img.height,
+                       backend, (unsigned long long)samples, secs, secs > 0 ? (double)samples / secs : 0.0);
+            else if (r == SY_OK) printf("%s: %ux%u, %s, %.3f s\n", outp, img.width, img.height, backend, secs);
         }
     }
     sy_layer_destroy(&img);
     sy_layer_destroy(&img_right);
-    sy_context_pool_destroy(pool);
-    loaded_free(&ld);
-    return r == SY_OK ? 0 : fail(&err);
-}
-
-/* `sy render` with a progressive back-end: one mono viewport rendered in passes. */
-static int cmd_render_progressive(int argc, char **argv)
-{
-    const char *scene = NULL, *backend = NULL, *outp = NULL, *camera = NULL, *params = NULL;
-    uint32_t w = 0, h = 0;
-    out_opts oo = {0};
-    pt_opts po = {.env_intensity = 1.0f};
-    for (int i = 0; i < argc; ++i) {
-        const char *a = argv[i];
-        bool has = i + 1 < argc;
-        char *end = NULL;
-        if (!strcmp(a, "-b") && has) backend = argv[++i];
-        else if (!strcmp(a, "-o") && has) outp = argv[++i];
-        else if (!strcmp(a, "-w") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
-        } else if (!strcmp(a, "-h") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &h)) return usage();
-        } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
-        else if (!strcmp(a, "--params") && has) params = argv[++i];
-        else if (!strcmp(a, "--half")) oo.half = true;
-        else if (!strcmp(a, "--exposure") && has) oo.png.exposure_stops = strtof(argv[++i], NULL);
-        else if (!strcmp(a, "--tonemap") && has) {
-            const char *t = argv[++i];
-            oo.png.tonemap = !strcmp(t, "aces") ? SY_TONEMAP_ACES : !strcmp(t, "reinhard") ? SY_TONEMAP_REINHARD
-                                                                                           : SY_TONEMAP_CLAMP;
-        } else if (!strcmp(a, "--spp") && has) {
-            if (!parse_u32(argv[++i], 1, 1u << 24, &po.spp)) return usage();
-        } else if (!strcmp(a, "--time") && has) {
-            po.time_budget = strtod(argv[++i], &end);
-            if (*end || !(po.time_budget > 0) || !isfinite(po.time_budget)) return usage();
-        } else if (!strcmp(a, "--aov")) po.aov = true;
-        else if (!strcmp(a, "--env") && has) po.env = argv[++i];
-        else if (!strcmp(a, "--env-intensity") && has) {
-            po.env_intensity = strtof(argv[++i], &end);
-            if (*end || !isfinite(po.env_intensity) || po.env_intensity < 0) return usage();
-        } else if (!strcmp(a, "--background") && has) {
-            if (sscanf(argv[++i], "%f,%f,%f", &po.bg[0], &po.bg[1], &po.bg[2]) != 3 || !isfinite(po.bg[0]) ||
-                !isfinite(po.bg[1]) || !isfinite(po.bg[2]) || po.bg[0] < 0 || po.bg[1] < 0 || po.bg[2] < 0)
-                return usage();
-            po.has_bg = true;
-        } else if (a[0] != '-' && !scene) scene = a;
-        else {
-            fprintf(stderr, "sy render: unknown or incomplete option '%s' (with a progressive back-end)\n", a);
-            return usage();
-        }
-    }
-    if (!scene || !backend || !outp) return usage();
-    sy_error err = {0};
-    if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) {
-        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);
-        return fail(&err);
-    }
-    if (po.aov && !ends_with(outp, ".exr")) {
-        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: --aov needs an .exr output", outp);
-        return fail(&err);
-    }
-    loaded ld;
-    if (load(scene, camera, true, &ld, &err) != SY_OK) return fail(&err);
-    float aspect = 1.0f;
-    const sy_node_data *cn = ld.camera.id ? sy_node_get(ld.scene, ld.camera) : NULL;
-    const sy_camera_data *cd = cn ? sy_camera_get(ld.scene, cn->camera) : NULL;
-    if (cd && cd->aspect > 0) aspect = cd->aspect;
-    if (!w && !h) h = 512, w = (uint32_t)lroundf(512 * aspect);
-    else if (!w) w = (uint32_t)lroundf((float)h * aspect);
-    else if (!h) h = (uint32_t)lroundf((float)w / aspect);
-    if (!w) w = 1;
-    if (!h) h = 1;
-    if (ld.is_x3d) fit_x3d_cameras(&ld, w, h); /* X3D fieldOfView is the smaller side's angle */
-    sy_context_pool *pool = NULL;
-    sy_context *ctx = NULL;
-    sy_layer img = {0};
-    double secs = 0;
-    uint64_t samples = 0;
-    sy_result r = sy_context_pool_create(&pool, &err);
-    if (r == SY_OK) r = setup_environment(&ld, &po, &err);
-    if (r == SY_OK) r = render_progressive(&ld, backend, params, w, h, &po, pool, &img, &secs, &samples, &ctx, &err);
-    if (r == SY_OK) {
-        size_t bad = sy_layer_count_nonfinite(&img);
-        if (bad) fprintf(stderr, "sy render: warning: %zu pixels are not finite\n", bad);
-        r = po.aov ? write_aov_exr(outp, ctx, oo.half, &err) : write_image(outp, &img, &oo, &err);
-    }
-    if (r == SY_OK)
-        printf("%s: %ux%u, %s, %llu samples per pixel, %.3f s (%.2f samples/s)\n", outp, w, h, backend,
-               (unsigned long long)samples, secs, secs > 0 ? (double)samples / secs : 0.0);
-    sy_layer_destroy(&img);
     sy_context_pool_destroy(pool);
     loaded_free(&ld);
     return r == SY_OK ? 0 : fail(&err);

@@ -311,7 +311,7 @@ typedef enum sy_rt_integrator {
     SY_RT_INTEGRATOR_PRIMARY = 1, /* primary rays only, eye-light shading (benchmarks, debugging) */
     SY_RT_INTEGRATOR_WHITTED = 2, /* direct light + hard shadows + mirror reflection/refraction */
     SY_RT_INTEGRATOR_PATHTRACER = 3, /* progressive path tracer (needs a sy_rt_accum, see below) */
-    /* reserved: 4 = coverage */
+    SY_RT_INTEGRATOR_COVERAGE = 4, /* object ids per pixel, no shading: use sy_rt_coverage() */
     SY_RT_INTEGRATOR_MAX_ENUM = 0x7fffffff
 } sy_rt_integrator;
 
@@ -393,6 +393,16 @@ uint32_t sy_rt_aov_channels(sy_rt_aov aov); /* 0 for an unknown value */
 const char *sy_rt_aov_name(sy_rt_aov aov);  /* "color", "variance", ... ; NULL if unknown */
 /* Copies one feature buffer into out (width * height * channels floats, interleaved). */
 sy_rt_result sy_rt_accum_read(const sy_rt_accum *accum, sy_rt_aov aov, float *out, char *err, size_t err_len);
+
+/* >>coverage
+ *
+ * Per-pixel visibility for culling services: ids (width * height of the desc's rectangle, row 0 =
+ * top) receives, for the ray through each pixel centre, the handle id of the nearest visible
+ * (not hidden) instance hit, or 0 where nothing is hit; alpha-masked holes are seen through like
+ * in the other integrators. depth may be NULL. The desc's integrator field is ignored (coverage),
+ * as are max_depth, area_light_samples and seed. Deterministic and tile-stitchable. */
+sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
+                            uint32_t *ids, float *depth, char *err, size_t err_len);
 
 #ifdef __cplusplus
 }

@@ -65,6 +65,7 @@ typedef struct sy_rt_instance_data {
     unsigned top_id;           /* geometry id in the top scene */
     float *baked_positions;    /* baked: Embree vertex buffer (world space) */
     bool filter_on;            /* baked: alpha filter installed */
+    uint32_t handle;           /* this instance's own handle id (coverage output) */
 } sy_rt_instance_data;
 
 typedef struct sy_rt_light_data {

@@ -31,7 +31,7 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: clip range near %g far %g is invalid (0 <= near < far, far 0 = infinite)",
                     (double)cam->near_clip, (double)cam->far_clip);
     if (d->integrator != SY_RT_INTEGRATOR_PRIMARY && d->integrator != SY_RT_INTEGRATOR_WHITTED &&
-        d->integrator != SY_RT_INTEGRATOR_PATHTRACER)
+        d->integrator != SY_RT_INTEGRATOR_PATHTRACER && d->integrator != SY_RT_INTEGRATOR_COVERAGE)
         return FAIL(SY_RT_ERROR_UNSUPPORTED, "render: integrator %d is not implemented", (int)d->integrator);
     if (d->image_width == 0 || d->image_height == 0)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: image size %ux%u is empty", d->image_width, d->image_height);
@@ -42,7 +42,7 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
     size_t n;
     if (!sy_rt_size_mul(d->width, d->height, &n) || !sy_rt_size_mul(n, 4u * sizeof(float), &n))
         return FAIL(SY_RT_ERROR_LIMIT, "render: %ux%u rectangle overflows size_t", d->width, d->height);
-    if (!rgba && d->integrator != SY_RT_INTEGRATOR_PATHTRACER) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: rgba is NULL");
+    if (!rgba && d->integrator != SY_RT_INTEGRATOR_PATHTRACER && d->integrator != SY_RT_INTEGRATOR_COVERAGE) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: rgba is NULL");
 
     const float *m = cam->camera_to_world;
     f->dev = dev;
@@ -186,6 +186,8 @@ sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera, const s
     sy_rt_result r = sy_rt_frame_init(&f, dev, camera, desc, rgba, depth, err, err_len);
     if (r != SY_RT_OK) return r;
     if (desc->integrator == SY_RT_INTEGRATOR_PATHTRACER) return sy_rt_pathtracer_render(&f, desc, err, err_len);
+    if (desc->integrator == SY_RT_INTEGRATOR_COVERAGE)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: the coverage integrator writes ids: use sy_rt_coverage");
     sy_rt_tile_fn fn = desc->integrator == SY_RT_INTEGRATOR_PRIMARY ? sy_rt_primary_tile : sy_rt_whitted_tile;
     return sy_rt_run_tiles(&f, fn, NULL, desc->progress, desc->progress_user_data, err, err_len);
 }

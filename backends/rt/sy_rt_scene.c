@@ -369,6 +369,7 @@ sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc 
     }
     if (!top_map_set(dev, in->top_id, in)) { r = FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance: out of memory"); goto fail; }
     if (!sy_rt_pool_insert(&dev->instances, in, &out->id)) { r = FAIL(SY_RT_ERROR_LIMIT, "instance: pool full or out of memory"); goto fail; }
+    in->handle = out->id;
     if (instance_emissive(dev, in)) dev->area_dirty = true;
     if (instance_masked(dev, in)) dev->filters_dirty = true;
     dev->dirty = dev->top_dirty = true;

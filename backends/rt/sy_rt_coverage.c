@@ -1,0 +1,43 @@
+/* sy_rt_coverage.c — per-pixel object ids for culling services (see sy_rt.h, >>coverage). */
+#include "sy_rt_coverage.h"
+
+#include <math.h>
+
+#define FAIL(code, ...) sy_rt_fail(err, err_len, code, __VA_ARGS__)
+
+void sy_rt_coverage_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
+{
+    uint32_t *ids = user;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    for (uint32_t py = y0; py < y1; ++py)
+        for (uint32_t px = x0; px < x1; ++px) {
+            struct RTCRayHit rh;
+            float axial;
+            sy_rt_frame_ray(f, px, py, &rh.ray, &axial);
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(f->dev->top, &ctx, &rh);
+            size_t o = (size_t)(py - f->y) * f->width + (px - f->x);
+            const sy_rt_instance_data *in = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID
+                                                ? NULL
+                                                : sy_rt_hit_instance(f->dev, rh.hit.geomID, rh.hit.instID[0]);
+            ids[o] = in ? in->handle : 0;
+            if (f->depth) f->depth[o] = in ? rh.ray.tfar * axial : INFINITY;
+        }
+}
+
+sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
+                            uint32_t *ids, float *depth, char *err, size_t err_len)
+{
+    if (!dev || !camera || !desc || !ids) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "coverage: NULL argument");
+    if (dev->dirty)
+        return FAIL(SY_RT_ERROR_INVALID_OPERATION, "coverage: the device has uncommitted changes; call sy_rt_commit first");
+    sy_rt_render_desc d = *desc;
+    d.integrator = SY_RT_INTEGRATOR_COVERAGE;
+    sy_rt_frame f;
+    sy_rt_result r = sy_rt_frame_init(&f, dev, camera, &d, NULL, depth, err, err_len);
+    if (r != SY_RT_OK) return r;
+    return sy_rt_run_tiles(&f, sy_rt_coverage_tile, ids, desc->progress, desc->progress_user_data, err, err_len);
+}

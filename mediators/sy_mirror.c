@@ -1,0 +1,702 @@
+/* sy_mirror.c — the scene mirror shared by the mediators (see sy_mirror.h).
+ *
+ * Sections: >>tables (id-indexed mirrors)  >>textures/materials/meshes  >>nodes and placements
+ * >>entries  >>sync  >>lifetime */
+#include "sy_mirror.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define IDX(id) ((id) & SY_HANDLE_INDEX_MASK)
+
+/* >>tables: every mirror is an array indexed by the handle's slot index, holding the full id so
+ * a stale id never matches. */
+typedef struct tex_m {
+    uint32_t id;
+    sy_image_info info;
+    sy_sampler sampler;
+    sy_blob *pixels;
+    uint32_t handle;
+} tex_m;
+
+typedef struct mat_m {
+    uint32_t id;
+    sy_material_data d; /* POD fields only (name not kept) */
+    uint32_t handle;
+} mat_m;
+
+typedef struct prim_m {
+    uint32_t handle;
+    uint32_t material; /* core material id */
+} prim_m;
+
+typedef struct mesh_m {
+    uint32_t id;
+    prim_m *prims;
+    uint32_t prim_count;
+    uint32_t *users; /* node ids */
+    uint32_t user_count, user_capacity;
+} mesh_m;
+
+typedef struct light_m {
+    uint32_t id;
+    sy_light_data d;
+    uint32_t *users;
+    uint32_t user_count, user_capacity;
+} light_m;
+
+typedef struct placement {
+    sy_mat4 world;
+    bool visible;
+    uint32_t *inst; /* one per primitive of the node's mesh */
+    uint32_t inst_count;
+    uint32_t light;
+} placement;
+
+typedef struct node_m {
+    uint32_t id;
+    sy_mat4 local;
+    uint32_t *children;
+    uint32_t child_count;
+    uint32_t mesh, light, flags;
+    uint32_t *parents;
+    uint32_t parent_count, parent_capacity;
+    placement *pl;
+    uint32_t pl_count;
+    uint32_t visit; /* sync epoch */
+} node_m;
+
+struct sy_mirror {
+    const char *name;
+    uint32_t root;
+    const sy_mirror_callbacks *cb;
+    void *user;
+    tex_m *tex;
+    uint32_t tex_cap;
+    mat_m *mat;
+    uint32_t mat_cap;
+    mesh_m *mesh;
+    uint32_t mesh_cap;
+    light_m *light;
+    uint32_t light_cap;
+    sy_mirror_background *bg;
+    uint32_t bg_cap;
+    node_m *node;
+    uint32_t node_cap;
+    uint32_t *dirty; /* node ids to re-place */
+    uint32_t dirty_count, dirty_capacity;
+    uint32_t epoch;
+    sy_mirror_sync_stats *stats; /* of the running sync */
+};
+
+static bool grow(void **arr, uint32_t *cap, size_t elem, uint32_t index)
+{
+    if (index < *cap) return true;
+    uint32_t nc = *cap ? *cap : 64;
+    while (nc <= index) nc *= 2;
+    void *n = realloc(*arr, elem * nc);
+    if (!n) return false;
+    memset((char *)n + elem * *cap, 0, elem * (nc - *cap));
+    *arr = n;
+    *cap = nc;
+    return true;
+}
+
+#define LOOKUP(st_, arr_, cap_, id_) ((id_) && IDX(id_) < (st_)->cap_ && (st_)->arr_[IDX(id_)].id == (id_) ? &(st_)->arr_[IDX(id_)] : NULL)
+
+static bool push_u32(uint32_t **items, uint32_t *count, uint32_t *cap, uint32_t v)
+{
+    if (*count == *cap) {
+        uint32_t nc = *cap ? *cap * 2 : 4;
+        uint32_t *n = realloc(*items, sizeof *n * nc);
+        if (!n) return false;
+        *items = n;
+        *cap = nc;
+    }
+    (*items)[(*count)++] = v;
+    return true;
+}
+
+static void remove_u32(uint32_t *items, uint32_t *count, uint32_t v)
+{
+    for (uint32_t i = 0; i < *count; ++i)
+        if (items[i] == v) {
+            items[i] = items[--*count];
+            return;
+        }
+}
+
+static void mark_node_dirty(sy_mirror *st, uint32_t id)
+{
+    push_u32(&st->dirty, &st->dirty_count, &st->dirty_capacity, id);
+}
+
+static void release(sy_mirror *st, sy_mirror_kind kind, uint32_t handle)
+{
+    sy_mirror_release_args a = {kind, handle};
+    st->cb->release(st->user, &a);
+}
+
+static void notify(sy_mirror *st, sy_object_type type, uint32_t id, bool destroyed)
+{
+    sy_mirror_object_args a = {type, id, destroyed};
+    if (st->cb->object_changed) st->cb->object_changed(st->user, &a);
+}
+
+static sy_result oom(const sy_mirror *st, sy_error *err)
+{
+    return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", st->name);
+}
+
+/* >>textures */
+static sy_result material_upload(sy_mirror *st, mat_m *m, sy_error *err)
+{
+    sy_mirror_material_args a = {m->id, &m->d, &m->handle};
+    return st->cb->material_set(st->user, &a, err);
+}
+
+static bool material_uses_texture(const sy_material_data *d, uint32_t tex)
+{
+    return d->base_color_texture.texture.id == tex || d->metallic_roughness_texture.texture.id == tex ||
+           d->normal_texture.texture.id == tex || d->emissive_texture.texture.id == tex ||
+           d->occlusion_texture.texture.id == tex;
+}
+
+static sy_result texture_upload(sy_mirror *st, tex_m *t, sy_error *err)
+{
+    if (t->handle) release(st, SY_MIRROR_TEXTURE, t->handle);
+    t->handle = 0;
+    size_t elem = t->info.format == SY_PIXEL_F32 ? 4 : 1, need;
+    if (!t->pixels || t->info.width == 0 || t->info.height == 0 ||
+        !sy_size_mul((size_t)t->info.width * t->info.height, (size_t)t->info.channels * elem, &need) ||
+        sy_blob_size(t->pixels) != need)
+        return SY_OK; /* incomplete texture: materials render without it */
+    sy_mirror_texture_args a = {t->id, &t->info, &t->sampler, sy_blob_data(t->pixels), &t->handle};
+    sy_result r = st->cb->texture_set(st->user, &a, err);
+    if (r != SY_OK) return r;
+    notify(st, SY_TYPE_TEXTURE, t->id, false);
+    /* materials referring to this texture get the new back-end handle */
+    for (uint32_t i = 0; i < st->mat_cap; ++i) {
+        mat_m *m = &st->mat[i];
+        if (m->id && m->handle && material_uses_texture(&m->d, t->id)) {
+            sy_result rr = material_upload(st, m, err);
+            if (rr != SY_OK) return rr;
+        }
+    }
+    return SY_OK;
+}
+
+/* >>meshes */
+static void mesh_free_prims(sy_mirror *st, mesh_m *m)
+{
+    for (uint32_t i = 0; i < m->prim_count; ++i)
+        if (m->prims[i].handle) release(st, SY_MIRROR_PRIMITIVE, m->prims[i].handle);
+    free(m->prims);
+    m->prims = NULL;
+    m->prim_count = 0;
+}
+
+static sy_result mesh_upload(sy_mirror *st, mesh_m *m, const sy_primitive_list *pl, sy_error *err)
+{
+    mesh_free_prims(st, m);
+    if (pl->count == 0) return SY_OK;
+    m->prims = calloc(pl->count, sizeof *m->prims);
+    if (!m->prims) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: mesh: out of memory", st->name);
+    m->prim_count = pl->count;
+    for (uint32_t i = 0; i < pl->count; ++i) {
+        const sy_primitive *p = &pl->items[i];
+        m->prims[i].material = p->material.id;
+        if (sy_primitive_triangle_count(p) == 0) continue;
+        sy_mirror_primitive_args a = {m->id, i, p, &m->prims[i].handle};
+        sy_result r = st->cb->primitive_set(st->user, &a, err);
+        if (r != SY_OK) return r;
+    }
+    return SY_OK;
+}
+
+/* >>nodes and placements */
+static void drop_instances(sy_mirror *st, placement *p)
+{
+    for (uint32_t i = 0; i < p->inst_count; ++i)
+        if (p->inst[i]) release(st, SY_MIRROR_INSTANCE, p->inst[i]);
+    free(p->inst);
+    p->inst = NULL;
+    p->inst_count = 0;
+}
+
+static void placement_clear(sy_mirror *st, placement *p)
+{
+    drop_instances(st, p);
+    if (p->light) release(st, SY_MIRROR_LIGHT, p->light);
+    p->light = 0;
+}
+
+/* Brings a placement's instances and light in line with the node's mesh/light and the world
+ * matrix; only what changed is touched. */
+static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool mesh_changed, sy_error *err)
+{
+    placement *p = &n->pl[index];
+    const mesh_m *m = LOOKUP(st, mesh, mesh_cap, n->mesh);
+    uint32_t want = m ? m->prim_count : 0;
+    bool visible = p->visible && (n->flags & SY_NODE_VISIBLE);
+    if (mesh_changed || want != p->inst_count) {
+        drop_instances(st, p);
+        if (want) {
+            p->inst = calloc(want, sizeof *p->inst);
+            if (!p->inst) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: instances: out of memory", st->name);
+            p->inst_count = want;
+            bool bake = (n->flags & SY_NODE_STATIC) && m->user_count == 1 && n->pl_count == 1;
+            for (uint32_t i = 0; i < want; ++i) {
+                if (!m->prims[i].handle) continue;
+                const mat_m *mm = LOOKUP(st, mat, mat_cap, m->prims[i].material);
+                sy_mirror_instance_args a = {n->id, index, m->prims[i].handle, mm ? mm->handle : 0u,
+                                             &p->world, visible, bake, &p->inst[i]};
+                sy_result r = st->cb->instance_set(st->user, &a, err);
+                if (r != SY_OK) return r;
+            }
+        }
+    } else {
+        for (uint32_t i = 0; i < p->inst_count; ++i) {
+            if (!p->inst[i]) continue;
+            sy_mirror_instance_args a = {n->id, index, 0, 0, &p->world, visible, false, &p->inst[i]};
+            sy_result r = st->cb->instance_set(st->user, &a, err);
+            if (r != SY_OK) return r;
+        }
+    }
+    const light_m *l = LOOKUP(st, light, light_cap, n->light);
+    if (l && visible) {
+        sy_mirror_light_args a = {.node = n->id, .placement = index, .light = &l->d, .handle = &p->light};
+        float o[3] = {0, 0, 0}, z[3] = {0, 0, -1};
+        sy_mat4_transform_point(&p->world, o, a.position);
+        sy_mat4_transform_dir(&p->world, z, a.direction);
+        sy_result r = st->cb->light_set(st->user, &a, err);
+        if (r != SY_OK) return r;
+    } else if (p->light) {
+        release(st, SY_MIRROR_LIGHT, p->light);
+        p->light = 0;
+    }
+    return SY_OK;
+}
+
+/* Recomputes the placements of node id and of its whole subtree (children first use their
+ * parents' new placements). mesh_changed forces new instances for the first node. */
+static sy_result replace_subtree(sy_mirror *st, uint32_t id, bool mesh_changed, sy_error *err)
+{
+    uint32_t *stack = NULL, count = 0, cap = 0;
+    sy_result r = SY_OK;
+    push_u32(&stack, &count, &cap, id);
+    bool first = true;
+    while (count && r == SY_OK) {
+        uint32_t nid = stack[--count];
+        node_m *n = LOOKUP(st, node, node_cap, nid);
+        if (!n) continue;
+        /* placements from the parents' placements (a DAG node gets one per path) */
+        uint32_t want = 0;
+        bool is_root = st->root ? nid == st->root : n->parent_count == 0;
+        if (is_root) want = 1;
+        else
+            for (uint32_t i = 0; i < n->parent_count; ++i) {
+                node_m *pn = LOOKUP(st, node, node_cap, n->parents[i]);
+                if (pn) want += pn->pl_count;
+            }
+        if (want != n->pl_count) {
+            for (uint32_t i = want; i < n->pl_count; ++i) placement_clear(st, &n->pl[i]);
+            placement *np = realloc(n->pl, sizeof *np * (want ? want : 1));
+            if (!np) {
+                r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: placements: out of memory", st->name);
+                break;
+            }
+            for (uint32_t i = n->pl_count; i < want; ++i) memset(&np[i], 0, sizeof np[i]);
+            n->pl = np;
+            n->pl_count = want;
+        }
+        uint32_t k = 0;
+        if (is_root) {
+            n->pl[0].world = n->local;
+            n->pl[0].visible = true;
+        } else {
+            for (uint32_t i = 0; i < n->parent_count; ++i) {
+                node_m *pn = LOOKUP(st, node, node_cap, n->parents[i]);
+                if (!pn) continue;
+                for (uint32_t j = 0; j < pn->pl_count; ++j, ++k) {
+                    n->pl[k].world = sy_mat4_mul(&pn->pl[j].world, &n->local);
+                    n->pl[k].visible = pn->pl[j].visible && (pn->flags & SY_NODE_VISIBLE);
+                }
+            }
+        }
+        for (uint32_t i = 0; i < n->pl_count && r == SY_OK; ++i) r = placement_sync(st, n, i, first && mesh_changed, err);
+        st->stats->placements += n->pl_count;
+        n->visit = st->epoch;
+        first = false;
+        for (uint32_t c = 0; c < n->child_count; ++c) push_u32(&stack, &count, &cap, n->children[c]);
+    }
+    free(stack);
+    return r;
+}
+
+static void node_free(sy_mirror *st, node_m *n)
+{
+    for (uint32_t i = 0; i < n->pl_count; ++i) placement_clear(st, &n->pl[i]);
+    free(n->pl);
+    free(n->children);
+    free(n->parents);
+    memset(n, 0, sizeof *n);
+}
+
+static void set_children(sy_mirror *st, node_m *n, const uint32_t *ch, uint32_t count)
+{
+    for (uint32_t i = 0; i < n->child_count; ++i) {
+        node_m *c = LOOKUP(st, node, node_cap, n->children[i]);
+        if (c) {
+            remove_u32(c->parents, &c->parent_count, n->id);
+            mark_node_dirty(st, c->id);
+        }
+    }
+    free(n->children);
+    n->children = NULL;
+    n->child_count = 0;
+    if (count) {
+        n->children = malloc(sizeof *n->children * count);
+        if (n->children) {
+            memcpy(n->children, ch, sizeof *ch * count);
+            n->child_count = count;
+        }
+    }
+    for (uint32_t i = 0; i < n->child_count; ++i) {
+        node_m *c = LOOKUP(st, node, node_cap, n->children[i]);
+        if (c) {
+            push_u32(&c->parents, &c->parent_count, &c->parent_capacity, n->id);
+            mark_node_dirty(st, c->id);
+        }
+    }
+}
+
+static node_m *node_add(sy_mirror *st, uint32_t id)
+{
+    if (!grow((void **)&st->node, &st->node_cap, sizeof *st->node, IDX(id))) return NULL;
+    node_m *n = &st->node[IDX(id)];
+    memset(n, 0, sizeof *n);
+    n->id = id;
+    n->local = sy_mat4_identity();
+    n->flags = SY_NODE_VISIBLE;
+    return n;
+}
+
+/* >>entries */
+static sy_result apply_texture(sy_mirror *st, const sy_change *e, bool destroyed, sy_error *err)
+{
+    tex_m *t = LOOKUP(st, tex, tex_cap, e->id);
+    if (destroyed) {
+        if (t) {
+            if (t->handle) release(st, SY_MIRROR_TEXTURE, t->handle);
+            sy_blob_release(t->pixels);
+            memset(t, 0, sizeof *t);
+        }
+        return SY_OK;
+    }
+    if (!t) {
+        if (!grow((void **)&st->tex, &st->tex_cap, sizeof *st->tex, IDX(e->id))) return oom(st, err);
+        t = &st->tex[IDX(e->id)];
+        memset(t, 0, sizeof *t);
+        t->id = e->id;
+    }
+    const sy_texture_data *d = e->data;
+    if (e->mask & SY_BIT(SY_TEXTURE_INFO)) t->info = d->info;
+    if (e->mask & SY_BIT(SY_TEXTURE_SAMPLER)) t->sampler = d->sampler;
+    if (e->mask & SY_BIT(SY_TEXTURE_PIXELS)) {
+        sy_blob_release(t->pixels);
+        t->pixels = sy_blob_retain(d->pixels);
+    }
+    if (e->mask & (SY_BIT(SY_TEXTURE_INFO) | SY_BIT(SY_TEXTURE_SAMPLER) | SY_BIT(SY_TEXTURE_PIXELS)))
+        return texture_upload(st, t, err);
+    return SY_OK;
+}
+
+static sy_result apply_material(sy_mirror *st, const sy_change *e, bool destroyed, sy_error *err)
+{
+    mat_m *m = LOOKUP(st, mat, mat_cap, e->id);
+    if (destroyed) {
+        if (m) {
+            if (m->handle) release(st, SY_MIRROR_MATERIAL, m->handle);
+            memset(m, 0, sizeof *m);
+            notify(st, SY_TYPE_MATERIAL, e->id, true);
+        }
+        return SY_OK;
+    }
+    if (m && !(e->flags & SY_CHANGE_CREATED)) {
+        /* partial material update: merge masked fields into the mirror */
+        const sy_material_data *d = e->data;
+        sy_material_data merged = m->d;
+#define TAKE(bit, member) if (e->mask & SY_BIT(bit)) memcpy(&merged.member, &d->member, sizeof merged.member)
+        TAKE(SY_MATERIAL_BASE_COLOR, base_color);
+        TAKE(SY_MATERIAL_BASE_COLOR_TEXTURE, base_color_texture);
+        TAKE(SY_MATERIAL_METALLIC, metallic);
+        TAKE(SY_MATERIAL_ROUGHNESS, roughness);
+        TAKE(SY_MATERIAL_METALLIC_ROUGHNESS_TEXTURE, metallic_roughness_texture);
+        TAKE(SY_MATERIAL_NORMAL_TEXTURE, normal_texture);
+        TAKE(SY_MATERIAL_OCCLUSION_TEXTURE, occlusion_texture);
+        TAKE(SY_MATERIAL_EMISSIVE, emissive);
+        TAKE(SY_MATERIAL_EMISSIVE_STRENGTH, emissive_strength);
+        TAKE(SY_MATERIAL_EMISSIVE_TEXTURE, emissive_texture);
+        TAKE(SY_MATERIAL_ALPHA_MODE, alpha_mode);
+        TAKE(SY_MATERIAL_ALPHA_CUTOFF, alpha_cutoff);
+        TAKE(SY_MATERIAL_DOUBLE_SIDED, double_sided);
+        TAKE(SY_MATERIAL_TRANSMISSION, transmission);
+        TAKE(SY_MATERIAL_TRANSMISSION_TEXTURE, transmission_texture);
+        TAKE(SY_MATERIAL_IOR, ior);
+        TAKE(SY_MATERIAL_UNLIT, unlit);
+#undef TAKE
+        m->d = merged;
+        if (e->mask & ~(SY_BIT(SY_MATERIAL_NAME) | SY_BIT(SY_FIELD_ATTACHMENTS))) return material_upload(st, m, err);
+        return SY_OK;
+    }
+    if (!m) {
+        if (!grow((void **)&st->mat, &st->mat_cap, sizeof *st->mat, IDX(e->id))) return oom(st, err);
+        m = &st->mat[IDX(e->id)];
+        memset(m, 0, sizeof *m);
+        m->id = e->id;
+    }
+    /* a creation (or the first sight of a material) carries every field */
+    m->d = *(const sy_material_data *)e->data;
+    m->d.name = NULL; /* not owned by the mirror */
+    if (e->mask == SY_BIT(SY_MATERIAL_NAME) || e->mask == SY_BIT(SY_FIELD_ATTACHMENTS)) return SY_OK;
+    return material_upload(st, m, err);
+}
+
+static sy_result apply_mesh(sy_mirror *st, const sy_change *e, bool destroyed, sy_error *err)
+{
+    mesh_m *m = LOOKUP(st, mesh, mesh_cap, e->id);
+    if (destroyed) {
+        if (m) {
+            for (uint32_t i = 0; i < m->user_count; ++i) mark_node_dirty(st, m->users[i]);
+            mesh_free_prims(st, m);
+            free(m->users);
+            memset(m, 0, sizeof *m);
+        }
+        return SY_OK;
+    }
+    if (!m) {
+        if (!grow((void **)&st->mesh, &st->mesh_cap, sizeof *st->mesh, IDX(e->id))) return oom(st, err);
+        m = &st->mesh[IDX(e->id)];
+        memset(m, 0, sizeof *m);
+        m->id = e->id;
+    }
+    if (e->mask & SY_BIT(SY_MESH_PRIMITIVES)) {
+        sy_result r = mesh_upload(st, m, &((const sy_mesh_data *)e->data)->primitives, err);
+        if (r != SY_OK) return r;
+        /* users need new instances: drop the old ones, then re-place the users */
+        for (uint32_t i = 0; i < m->user_count; ++i) {
+            node_m *n = LOOKUP(st, node, node_cap, m->users[i]);
+            if (n)
+                for (uint32_t k = 0; k < n->pl_count; ++k) drop_instances(st, &n->pl[k]);
+            mark_node_dirty(st, m->users[i]);
+        }
+    }
+    return SY_OK;
+}
+
+static sy_result apply_light(sy_mirror *st, const sy_change *e, bool destroyed, sy_error *err)
+{
+    light_m *l = LOOKUP(st, light, light_cap, e->id);
+    if (destroyed) {
+        if (l) {
+            for (uint32_t i = 0; i < l->user_count; ++i) mark_node_dirty(st, l->users[i]);
+            free(l->users);
+            memset(l, 0, sizeof *l);
+        }
+        return SY_OK;
+    }
+    if (!l) {
+        if (!grow((void **)&st->light, &st->light_cap, sizeof *st->light, IDX(e->id))) return oom(st, err);
+        l = &st->light[IDX(e->id)];
+        memset(l, 0, sizeof *l);
+        l->id = e->id;
+        l->d = *(const sy_light_data *)sy_object_defaults(SY_TYPE_LIGHT);
+    }
+    const sy_light_data *d = e->data;
+    if (e->mask & SY_BIT(SY_LIGHT_TYPE)) l->d.type = d->type;
+    if (e->mask & SY_BIT(SY_LIGHT_COLOR)) memcpy(l->d.color, d->color, sizeof d->color);
+    if (e->mask & SY_BIT(SY_LIGHT_INTENSITY)) l->d.intensity = d->intensity;
+    if (e->mask & SY_BIT(SY_LIGHT_RANGE)) l->d.range = d->range;
+    if (e->mask & SY_BIT(SY_LIGHT_INNER_CONE)) l->d.inner_cone = d->inner_cone;
+    if (e->mask & SY_BIT(SY_LIGHT_OUTER_CONE)) l->d.outer_cone = d->outer_cone;
+    for (uint32_t i = 0; i < l->user_count; ++i) mark_node_dirty(st, l->users[i]);
+    return SY_OK;
+}
+
+static sy_result apply_background(sy_mirror *st, const sy_change *e, bool destroyed, sy_error *err)
+{
+    sy_mirror_background *b = LOOKUP(st, bg, bg_cap, e->id);
+    if (destroyed) {
+        if (b) memset(b, 0, sizeof *b);
+        notify(st, SY_TYPE_BACKGROUND, e->id, true);
+        return SY_OK;
+    }
+    if (!b) {
+        if (!grow((void **)&st->bg, &st->bg_cap, sizeof *st->bg, IDX(e->id))) return oom(st, err);
+        b = &st->bg[IDX(e->id)];
+        memset(b, 0, sizeof *b);
+        b->id = e->id;
+        const sy_background_data *def = sy_object_defaults(SY_TYPE_BACKGROUND);
+        memcpy(b->color, def->color, sizeof b->color);
+        b->environment = def->environment.id;
+        b->intensity = def->intensity;
+    }
+    const sy_background_data *bd = e->data;
+    if (e->mask & SY_BIT(SY_BACKGROUND_COLOR)) memcpy(b->color, bd->color, sizeof b->color);
+    if (e->mask & SY_BIT(SY_BACKGROUND_ENVIRONMENT)) b->environment = bd->environment.id;
+    if (e->mask & SY_BIT(SY_BACKGROUND_INTENSITY)) b->intensity = bd->intensity;
+    if (e->mask & (SY_BIT(SY_BACKGROUND_COLOR) | SY_BIT(SY_BACKGROUND_ENVIRONMENT) | SY_BIT(SY_BACKGROUND_INTENSITY)))
+        notify(st, SY_TYPE_BACKGROUND, e->id, false); /* not for name or attachments: nothing visible */
+    return SY_OK;
+}
+
+static sy_result apply_node(sy_mirror *st, const sy_change *e, bool destroyed, sy_error *err)
+{
+    node_m *n = LOOKUP(st, node, node_cap, e->id);
+    if (destroyed) {
+        if (n) {
+            for (uint32_t i = 0; i < n->child_count; ++i) {
+                node_m *c = LOOKUP(st, node, node_cap, n->children[i]);
+                if (c) {
+                    remove_u32(c->parents, &c->parent_count, n->id);
+                    mark_node_dirty(st, c->id);
+                }
+            }
+            mesh_m *m = LOOKUP(st, mesh, mesh_cap, n->mesh);
+            if (m) remove_u32(m->users, &m->user_count, n->id);
+            light_m *l = LOOKUP(st, light, light_cap, n->light);
+            if (l) remove_u32(l->users, &l->user_count, n->id);
+            node_free(st, n);
+            st->stats->nodes_destroyed++;
+        }
+        return SY_OK;
+    }
+    if (!n && !(n = node_add(st, e->id))) return oom(st, err);
+    const sy_node_data *d = e->data;
+    bool dirty = (e->flags & SY_CHANGE_CREATED) != 0;
+    if (e->mask & SY_BIT(SY_NODE_TRANSFORM)) {
+        n->local = d->transform.matrix;
+        dirty = true;
+    }
+    if (e->mask & SY_BIT(SY_NODE_FLAGS)) {
+        n->flags = d->flags;
+        dirty = true;
+    }
+    if (e->mask & SY_BIT(SY_NODE_MESH)) {
+        mesh_m *om = LOOKUP(st, mesh, mesh_cap, n->mesh), *nm = LOOKUP(st, mesh, mesh_cap, d->mesh.id);
+        if (om) remove_u32(om->users, &om->user_count, n->id);
+        if (nm) push_u32(&nm->users, &nm->user_count, &nm->user_capacity, n->id);
+        n->mesh = d->mesh.id;
+        for (uint32_t k = 0; k < n->pl_count; ++k) drop_instances(st, &n->pl[k]); /* force new instances */
+        dirty = true;
+    }
+    if (e->mask & SY_BIT(SY_NODE_LIGHT)) {
+        light_m *ol = LOOKUP(st, light, light_cap, n->light), *nl = LOOKUP(st, light, light_cap, d->light.id);
+        if (ol) remove_u32(ol->users, &ol->user_count, n->id);
+        if (nl) push_u32(&nl->users, &nl->user_count, &nl->user_capacity, n->id);
+        n->light = d->light.id;
+        dirty = true;
+    }
+    if (e->mask & SY_BIT(SY_NODE_CHILDREN)) {
+        uint32_t nc;
+        const uint32_t *ch = sy_node_children(d, &nc);
+        set_children(st, n, ch, nc);
+        dirty = true;
+    }
+    if (dirty) mark_node_dirty(st, n->id);
+    return SY_OK;
+}
+
+static sy_result apply_entry(sy_mirror *st, const sy_change *e, sy_error *err)
+{
+    bool destroyed = (e->flags & SY_CHANGE_DESTROYED) != 0;
+    switch (e->type) {
+    case SY_TYPE_TEXTURE: return apply_texture(st, e, destroyed, err);
+    case SY_TYPE_MATERIAL: return apply_material(st, e, destroyed, err);
+    case SY_TYPE_MESH: return apply_mesh(st, e, destroyed, err);
+    case SY_TYPE_LIGHT: return apply_light(st, e, destroyed, err);
+    case SY_TYPE_BACKGROUND: return apply_background(st, e, destroyed, err);
+    case SY_TYPE_NODE: return apply_node(st, e, destroyed, err);
+    default: return SY_OK;
+    }
+}
+
+/* >>sync */
+sy_result sy_mirror_sync(sy_mirror *st, const sy_changes *changes, sy_mirror_sync_stats *stats, sy_error *err)
+{
+    sy_mirror_sync_stats local;
+    if (!stats) stats = &local;
+    memset(stats, 0, sizeof *stats);
+    stats->entries = sy_changes_count(changes);
+    st->stats = stats;
+    sy_result r = SY_OK;
+    /* Entries come ordered: destructions, then textures, materials, meshes, lights, cameras,
+     * backgrounds, nodes; so every reference is resolvable when a node is placed. Nodes are
+     * first all mirrored (children may precede parents), then re-placed. */
+    for (uint32_t i = 0; i < sy_changes_count(changes); ++i) {
+        const sy_change *e = sy_changes_get(changes, i);
+        if (e->type != SY_TYPE_NODE || !(e->flags & SY_CHANGE_CREATED)) continue;
+        if (LOOKUP(st, node, node_cap, e->id)) continue;
+        if (!node_add(st, e->id)) {
+            st->stats = NULL;
+            return oom(st, err);
+        }
+    }
+    for (uint32_t i = 0; i < sy_changes_count(changes) && r == SY_OK; ++i) r = apply_entry(st, sy_changes_get(changes, i), err);
+    st->epoch++;
+    for (uint32_t i = 0; i < st->dirty_count && r == SY_OK; ++i) {
+        node_m *n = LOOKUP(st, node, node_cap, st->dirty[i]);
+        if (!n || n->visit == st->epoch) continue; /* already re-placed through an ancestor */
+        r = replace_subtree(st, n->id, false, err);
+    }
+    st->dirty_count = 0;
+    st->stats = NULL;
+    return r;
+}
+
+uint32_t sy_mirror_texture_handle(const sy_mirror *st, uint32_t texture_id)
+{
+    const tex_m *t = LOOKUP(st, tex, tex_cap, texture_id);
+    return t ? t->handle : 0u;
+}
+
+const sy_mirror_background *sy_mirror_background_get(const sy_mirror *st, uint32_t background_id)
+{
+    return LOOKUP(st, bg, bg_cap, background_id);
+}
+
+/* >>lifetime */
+sy_result sy_mirror_create(const sy_mirror_desc *desc, sy_mirror **out, sy_error *err)
+{
+    *out = NULL;
+    sy_mirror *st = calloc(1, sizeof *st);
+    if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", desc->name ? desc->name : "mirror");
+    st->name = desc->name ? desc->name : "mirror";
+    st->root = desc->root_node_id;
+    st->cb = desc->callbacks;
+    st->user = desc->user;
+    *out = st;
+    return SY_OK;
+}
+
+void sy_mirror_destroy(sy_mirror *st)
+{
+    if (!st) return;
+    for (uint32_t i = 0; i < st->node_cap; ++i)
+        if (st->node[i].id) node_free(st, &st->node[i]);
+    for (uint32_t i = 0; i < st->mesh_cap; ++i) {
+        mesh_free_prims(st, &st->mesh[i]);
+        free(st->mesh[i].users);
+    }
+    for (uint32_t i = 0; i < st->light_cap; ++i) free(st->light[i].users);
+    for (uint32_t i = 0; i < st->tex_cap; ++i) sy_blob_release(st->tex[i].pixels);
+    free(st->tex);
+    free(st->mat);
+    free(st->mesh);
+    free(st->light);
+    free(st->bg);
+    free(st->node);
+    free(st->dirty);
+    free(st);
+}

@@ -1,0 +1,140 @@
+/* sy_mirror.h — the back-end-independent scene mirror shared by the mediators.
+ *
+ * A mediator never reads the live scene: it keeps a mirror built from change lists. This module
+ * is that mirror: id-indexed tables of textures, materials, meshes, lights, backgrounds and nodes
+ * (a stale id never matches), the node graph (children and parents; a DAG node reached along k
+ * paths gets k placements, each one world matrix and a visibility), the mesh/light user lists and
+ * the dirty tracking that re-places only the subtrees a sync touched. It talks to the back-end only
+ * through a const table of callbacks on 32-bit back-end handles (0 = none): it creates, updates and
+ * releases textures, materials, mesh primitives, one instance per primitive per placement and one
+ * light per visible placement of a node with a light, in the same order for every back-end.
+ *
+ * Ownership: the mirror owns its tables and retains texture pixel blobs; back-end objects belong
+ * to the back-end and are released through the release callback (sy_mirror_destroy releases the
+ * instances, lights and mesh primitives it still holds, so call it before destroying the device;
+ * texture and material handles are left to the device's destruction).
+ * Thread-safety: none; one mirror is used by one mediator state at a time. */
+#ifndef SY_MIRROR_H
+#define SY_MIRROR_H
+
+#include "sy_mediator.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct sy_mirror sy_mirror;
+
+/* Complete texture (pixels match the info): create one back-end texture into *handle. */
+typedef struct sy_mirror_texture_args {
+    uint32_t id;
+    const sy_image_info *info;
+    const sy_sampler *sampler;
+    const void *pixels;
+    uint32_t *handle; /* out */
+} sy_mirror_texture_args;
+
+/* Material data (merged, name NULL): create (*handle == 0) or update the back-end material. */
+typedef struct sy_mirror_material_args {
+    uint32_t id;
+    const sy_material_data *data;
+    uint32_t *handle; /* in/out */
+} sy_mirror_material_args;
+
+/* One primitive of a mesh that has triangles: create its back-end mesh into *handle. */
+typedef struct sy_mirror_primitive_args {
+    uint32_t mesh_id, index;
+    const sy_primitive *primitive;
+    uint32_t *handle; /* out */
+} sy_mirror_primitive_args;
+
+/* One instance of one placement: *handle == 0: create it from mesh/material/world/flags;
+ * otherwise update its world matrix and visibility. */
+typedef struct sy_mirror_instance_args {
+    uint32_t node, placement;
+    uint32_t mesh, material; /* back-end handles (material 0 = none) */
+    const sy_mat4 *world;
+    bool visible;
+    bool baked; /* SY_NODE_STATIC node, mesh used once, one placement: may be baked into the scene */
+    uint32_t *handle; /* in/out */
+} sy_mirror_instance_args;
+
+/* The light of one visible placement: create (*handle == 0) or update. */
+typedef struct sy_mirror_light_args {
+    uint32_t node, placement;
+    const sy_light_data *light;
+    float position[3], direction[3]; /* world space; direction = the node's -Z */
+    uint32_t *handle; /* in/out */
+} sy_mirror_light_args;
+
+typedef enum sy_mirror_kind {
+    SY_MIRROR_TEXTURE,
+    SY_MIRROR_MATERIAL,
+    SY_MIRROR_PRIMITIVE,
+    SY_MIRROR_INSTANCE,
+    SY_MIRROR_LIGHT,
+} sy_mirror_kind;
+
+/* A back-end object the mirror no longer uses (handle != 0). */
+typedef struct sy_mirror_release_args {
+    sy_mirror_kind kind;
+    uint32_t handle;
+} sy_mirror_release_args;
+
+/* Notification: type SY_TYPE_TEXTURE: a new back-end texture was made for id; SY_TYPE_MATERIAL
+ * (destroyed): a mirrored material is gone; SY_TYPE_BACKGROUND: a background's colour,
+ * environment or intensity changed, or it was destroyed (also when it was never mirrored). */
+typedef struct sy_mirror_object_args {
+    sy_object_type type;
+    uint32_t id;
+    bool destroyed;
+} sy_mirror_object_args;
+
+/* The back-end side. Every entry but object_changed is required. Failing callbacks set err and
+ * stop the sync (the mirror stays consistent: a later sync may retry). */
+typedef struct sy_mirror_callbacks {
+    sy_result (*texture_set)(void *user, const sy_mirror_texture_args *a, sy_error *err);
+    sy_result (*material_set)(void *user, const sy_mirror_material_args *a, sy_error *err);
+    sy_result (*primitive_set)(void *user, const sy_mirror_primitive_args *a, sy_error *err);
+    sy_result (*instance_set)(void *user, const sy_mirror_instance_args *a, sy_error *err);
+    sy_result (*light_set)(void *user, const sy_mirror_light_args *a, sy_error *err);
+    void (*release)(void *user, const sy_mirror_release_args *a);
+    void (*object_changed)(void *user, const sy_mirror_object_args *a); /* optional */
+} sy_mirror_callbacks;
+
+typedef struct sy_mirror_desc {
+    const char *name;       /* error prefix, e.g. "raster mediator" */
+    uint32_t root_node_id;  /* 0 = every parentless node is a root */
+    const sy_mirror_callbacks *callbacks; /* static storage */
+    void *user;
+} sy_mirror_desc;
+
+/* What one sync did. */
+typedef struct sy_mirror_sync_stats {
+    uint32_t entries;         /* change entries handled */
+    uint32_t placements;      /* node placements recomputed */
+    uint32_t nodes_destroyed; /* mirrored nodes removed */
+} sy_mirror_sync_stats;
+
+/* A mirrored background (defaults for fields never set). */
+typedef struct sy_mirror_background {
+    uint32_t id;
+    float color[4];
+    uint32_t environment; /* core texture id, 0 = none */
+    float intensity;
+} sy_mirror_background;
+
+sy_result sy_mirror_create(const sy_mirror_desc *desc, sy_mirror **out, sy_error *err);
+void sy_mirror_destroy(sy_mirror *m);
+/* Applies a change list (ordered as sy_changes delivers it), then re-places dirty subtrees.
+ * stats may be NULL; it is filled also when the sync fails. */
+sy_result sy_mirror_sync(sy_mirror *m, const sy_changes *changes, sy_mirror_sync_stats *stats, sy_error *err);
+/* Back-end handle of a mirrored texture (0 = unknown or incomplete). */
+uint32_t sy_mirror_texture_handle(const sy_mirror *m, uint32_t texture_id);
+/* Mirrored background or NULL. Borrowed until the next sync. */
+const sy_mirror_background *sy_mirror_background_get(const sy_mirror *m, uint32_t background_id);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_MIRROR_H */

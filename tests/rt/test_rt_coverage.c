@@ -1,0 +1,81 @@
+/* test_rt_coverage.c — the coverage integrator (sy_rt_coverage): per-pixel ids of the nearest
+ * visible instance. Expected ids are computed independently by intersecting each pixel-centre
+ * ray with the two axis-aligned quads analytically (nearer quad wins). */
+#include "rt_test.h"
+
+#define W 100
+#define H 80
+
+/* Pixel-centre ray of rt_camera(z=5, t) for image W x H (window aspect scaled on x). */
+static uint32_t expected_id(int px, int py, float t, uint32_t id_far, uint32_t id_near, bool near_visible)
+{
+    float sx = t * (float)W / (float)H;
+    float u = -sx + 2.0f * sx * ((float)px + 0.5f) / (float)W;
+    float v = t - 2.0f * t * ((float)py + 0.5f) / (float)H;
+    /* near quad: h = 0.25 at z = 1 centred at (0.503, 0.0037) (distance 4); far: h = 0.5 at z = 0 */
+    float xn = 4.0f * u, yn = 4.0f * v;
+    if (near_visible && fabsf(xn - 0.503f) < 0.25f && fabsf(yn - 0.0037f) < 0.25f) return id_near;
+    float xf = 5.0f * u, yf = 5.0f * v;
+    if (fabsf(xf) < 0.5f && fabsf(yf) < 0.5f) return id_far;
+    return 0;
+}
+
+int main(void)
+{
+    sy_rt_device *dev = rt_device();
+    sy_rt_mesh big = rt_quad(dev, 0.5f), small = rt_quad(dev, 0.25f);
+    sy_rt_material m = rt_lambert(dev, 0.5f, 0.5f, 0.5f);
+    float xf[16];
+    rt_translation(xf, 0, 0, 0);
+    sy_rt_instance far_q = rt_place(dev, big, xf, m, 0);
+    rt_translation(xf, 0.503f, 0.0037f, 1); /* edges off the pixel centres */
+    sy_rt_instance near_q = rt_place(dev, small, xf, m, SY_RT_INSTANCE_BAKED);
+    MUST(sy_rt_commit(dev, ERR));
+    float t = 0.2f;
+    sy_rt_camera cam = rt_camera(5.0f, t);
+    cam.window[0] = -t * (float)W / (float)H;
+    cam.window[1] = t * (float)W / (float)H;
+    sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, H); /* integrator is ignored */
+    uint32_t ids[W * H], part[W * H];
+    float depth[W * H];
+    MUST(sy_rt_coverage(dev, &cam, &d, ids, depth, ERR));
+    int wrong = 0, n_far = 0, n_near = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            uint32_t want = expected_id(x, y, t, far_q.id, near_q.id, true), got = ids[y * W + x];
+            if (got != want) wrong++;
+            n_far += got == far_q.id, n_near += got == near_q.id;
+            if (got == near_q.id) CHECK(fabsf(depth[y * W + x] - 4.0f) < 1e-4f, "near depth %g", depth[y * W + x]);
+            if (got == 0) CHECK(isinf(depth[y * W + x]), "miss depth %g", depth[y * W + x]);
+        }
+    CHECK(wrong == 0, "%d pixels with the wrong id", wrong);
+    CHECK(n_far > 0 && n_near > 0, "both objects covered: far %d near %d", n_far, n_near);
+    printf("coverage: far quad %d px, near quad %d px\n", n_far, n_near);
+
+    /* a sub-rectangle equals the crop of the full image */
+    sy_rt_render_desc sub = d;
+    sub.x = 37, sub.y = 21, sub.width = 41, sub.height = 33;
+    MUST(sy_rt_coverage(dev, &cam, &sub, part, NULL, ERR));
+    int diff = 0;
+    for (uint32_t y = 0; y < sub.height; ++y)
+        for (uint32_t x = 0; x < sub.width; ++x) diff += part[y * sub.width + x] != ids[(y + sub.y) * W + x + sub.x];
+    CHECK(diff == 0, "%d sub-rectangle pixels differ from the full image", diff);
+
+    /* hiding the near quad uncovers the far one behind it */
+    MUST(sy_rt_instance_set_visible(dev, near_q, false, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_coverage(dev, &cam, &d, ids, NULL, ERR));
+    wrong = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) wrong += ids[y * W + x] != expected_id(x, y, t, far_q.id, near_q.id, false);
+    CHECK(wrong == 0, "%d pixels wrong with the near quad hidden", wrong);
+
+    /* uncommitted changes and NULL output are refused with a message */
+    char msg[256] = "";
+    MUST(sy_rt_instance_set_visible(dev, near_q, true, ERR));
+    CHECK(sy_rt_coverage(dev, &cam, &d, ids, NULL, msg, sizeof msg) == SY_RT_ERROR_INVALID_OPERATION, "%s", msg);
+    MUST(sy_rt_commit(dev, ERR));
+    CHECK(sy_rt_coverage(dev, &cam, &d, NULL, NULL, msg, sizeof msg) == SY_RT_ERROR_INVALID_ARGUMENT, "%s", msg);
+    sy_rt_device_destroy(dev);
+    return rt_finish("rt_coverage");
+}
