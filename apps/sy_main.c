@@ -440,6 +440,7 @@ static int usage(void)
             "  sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params gl=egl,msaa=4]\n"
             "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
             "  sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]\n"
+            "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy backends\n"
             "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
             "  sy render SCENE -b BACKEND -o OUT --cluster URL[,URL...]|FILE.conf\n"
@@ -810,6 +811,66 @@ static int cmd_view(int argc, char **argv)
 }
 #endif
 
+/* `sy coverage SCENE`: which objects the camera sees and how many pixels each covers (occlusion
+ * included), most first, as JSON: a culling service for clients that load only what is visible. */
+static int cmd_coverage(int argc, char **argv)
+{
+    const char *scene = NULL, *camera = NULL;
+    uint32_t w = 512, h = 512, top = 0;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        bool has = i + 1 < argc;
+        if (!strcmp(a, "-w") && has) {
+            if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
+        } else if (!strcmp(a, "-h") && has) {
+            if (!parse_u32(argv[++i], 1, 16384, &h)) return usage();
+        } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
+        else if (!strcmp(a, "--top") && has) {
+            if (!parse_u32(argv[++i], 1, 1u << 30, &top)) return usage();
+        } else if (a[0] != '-' && !scene) scene = a;
+        else return usage();
+    }
+    if (!scene) return usage();
+    sy_error err = {0};
+    loaded ld;
+    if (load(scene, camera, true, &ld, &err) != SY_OK) return fail(&err);
+    if (ld.is_x3d) fit_x3d_cameras(&ld, w, h);
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_context *ctx = NULL;
+    sy_camera_view view;
+    sy_mediator_rt_coverage_entry *e = NULL;
+    uint32_t n = 0;
+    sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .backend = "coverage"};
+    sy_result r = sy_window_create(w, h, &win, &err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, &err);
+    if (r == SY_OK) r = sy_viewport_camera_view(vp, ld.scene, w, h, &view, &err);
+    if (r == SY_OK) r = sy_context_create(ld.scene, "coverage", NULL, ld.root.id, &ctx, &err);
+    if (r == SY_OK) r = sy_context_sync(ctx, &err);
+    if (r == SY_OK) r = sy_mediator_rt_coverage(sy_context_state(ctx), &view, w, h, &e, &n, &err);
+    if (r == SY_OK) {
+        uint64_t covered = 0;
+        for (uint32_t i = 0; i < n; ++i) covered += e[i].pixels;
+        printf("{\n  \"file\": ");
+        json_string(stdout, scene);
+        printf(",\n  \"width\": %u,\n  \"height\": %u,\n  \"covered_pixels\": %llu,\n  \"objects\": [", w, h,
+               (unsigned long long)covered);
+        uint32_t shown = top && top < n ? top : n;
+        for (uint32_t i = 0; i < shown; ++i) {
+            const sy_node_data *nd = sy_object_get(ld.scene, SY_TYPE_NODE, e[i].node_id);
+            printf("%s\n    {\"node\": %u, \"name\": ", i ? "," : "", e[i].node_id);
+            json_string(stdout, nd && nd->name ? nd->name : "");
+            printf(", \"pixels\": %u, \"fraction\": %.6f}", e[i].pixels, (double)e[i].pixels / ((double)w * h));
+        }
+        printf("\n  ]\n}\n");
+    }
+    free(e);
+    sy_context_release(ctx);
+    sy_window_destroy(win);
+    loaded_free(&ld);
+    return r == SY_OK ? 0 : fail(&err);
+}
+
 static int cmd_backends(void)
 {
     for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
@@ -946,6 +1007,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "demo")) return cmd_demo(argc - 2, argv + 2);
     if (!strcmp(cmd, "bench")) return cmd_bench(argc - 2, argv + 2);
     if (!strcmp(cmd, "backends")) return cmd_backends();
+    if (!strcmp(cmd, "coverage")) return cmd_coverage(argc - 2, argv + 2);
     if (!strcmp(cmd, "serve")) return sy_cmd_serve(argc - 2, argv + 2);
 #ifdef SY_HAVE_GLFW
     if (!strcmp(cmd, "view")) return cmd_view(argc - 2, argv + 2);

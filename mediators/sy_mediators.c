@@ -9,5 +9,6 @@ sy_result sy_mediators_register_builtin(sy_error *err)
     sy_result r = sy_mediator_register(sy_mediator_rt_whitted_class(), err);
     if (r == SY_OK) r = sy_mediator_register(sy_mediator_rt_pathtracer_class(), err);
     if (r == SY_OK) r = sy_mediator_register(sy_mediator_raster_class(), err);
+    if (r == SY_OK) r = sy_mediator_register(sy_mediator_rt_coverage_class(), err);
     return r;
 }

@@ -42,7 +42,34 @@ typedef struct rt_state {
     accum_slot slots[ACCUM_SLOTS]; /* path tracer only */
     int last_slot;                 /* slot of the last render, -1 = none */
     uint64_t use_clock;
+    uint32_t *inst_node;           /* back-end instance slot index -> core node id (coverage) */
+    uint32_t inst_node_cap;
 } rt_state;
+
+#define RT_HANDLE_INDEX(h) ((h) & 0x3fffffu) /* backends/rt handles: 22-bit slot index */
+
+/* Remembers which node an instance belongs to (node 0 forgets it). */
+static void inst_node_set(rt_state *st, uint32_t handle, uint32_t node)
+{
+    uint32_t i = RT_HANDLE_INDEX(handle);
+    if (i >= st->inst_node_cap) {
+        if (!node) return;
+        uint32_t nc = st->inst_node_cap ? st->inst_node_cap : 256;
+        while (nc <= i) nc *= 2;
+        uint32_t *n = realloc(st->inst_node, sizeof *n * nc);
+        if (!n) return; /* coverage then reports this instance as unknown (node 0) */
+        memset(n + st->inst_node_cap, 0, sizeof *n * (nc - st->inst_node_cap));
+        st->inst_node = n;
+        st->inst_node_cap = nc;
+    }
+    st->inst_node[i] = node;
+}
+
+static uint32_t inst_node_get(const rt_state *st, uint32_t handle)
+{
+    uint32_t i = RT_HANDLE_INDEX(handle);
+    return handle && i < st->inst_node_cap ? st->inst_node[i] : 0;
+}
 
 static sy_result rt_fail(sy_error *err, sy_rt_result r, const char *what, const char *msg)
 {
@@ -142,6 +169,7 @@ static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_er
         memcpy(d.transform, a->world->m, sizeof d.transform);
         r = sy_rt_instance_create(st->dev, &d, &h, e, sizeof e);
         *a->handle = h.id;
+        if (r == SY_RT_OK) inst_node_set(st, h.id, a->node);
         return r == SY_RT_OK ? SY_OK : rt_fail(err, r, "instance", e);
     }
     r = sy_rt_instance_set_transform(st->dev, h, a->world->m, e, sizeof e);
@@ -178,7 +206,10 @@ static void cb_release(void *user, const sy_mirror_release_args *a)
     case SY_MIRROR_TEXTURE: sy_rt_texture_destroy(st->dev, (sy_rt_texture){a->handle}, NULL, 0); break;
     case SY_MIRROR_MATERIAL: sy_rt_material_destroy(st->dev, (sy_rt_material){a->handle}, NULL, 0); break;
     case SY_MIRROR_PRIMITIVE: sy_rt_mesh_destroy(st->dev, (sy_rt_mesh){a->handle}, NULL, 0); break;
-    case SY_MIRROR_INSTANCE: sy_rt_instance_destroy(st->dev, (sy_rt_instance){a->handle}, NULL, 0); break;
+    case SY_MIRROR_INSTANCE:
+        inst_node_set(st, a->handle, 0);
+        sy_rt_instance_destroy(st->dev, (sy_rt_instance){a->handle}, NULL, 0);
+        break;
     case SY_MIRROR_LIGHT: sy_rt_light_destroy(st->dev, (sy_rt_light){a->handle}, NULL, 0); break;
     }
 }
@@ -332,6 +363,107 @@ static sy_result pt_slot(rt_state *st, const sy_render_request *req, sy_error *e
     return SY_OK;
 }
 
+/* Coverage as an image: every object gets a stable colour from its node id (for viewing and
+ * layering); sy_mediator_rt_coverage gives the numbers. */
+static sy_result coverage_render(rt_state *st, const sy_rt_camera *cam, const sy_rt_render_desc *d, sy_layer *layer,
+                                 sy_error *err)
+{
+    char e[ERRLEN];
+    size_t n = (size_t)d->width * d->height;
+    uint32_t *ids = malloc(n * sizeof *ids);
+    if (!ids) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "coverage: out of memory");
+    sy_rt_result r = sy_rt_coverage(st->dev, cam, d, ids, layer->depth, e, sizeof e);
+    if (r == SY_RT_OK)
+        for (size_t i = 0; i < n; ++i) {
+            uint32_t node = inst_node_get(st, ids[i]);
+            float *c = layer->rgba + 4 * i;
+            if (!ids[i]) {
+                c[0] = c[1] = c[2] = c[3] = 0.0f;
+                continue;
+            }
+            uint32_t hsh = node * 2654435761u;
+            c[0] = 0.2f + 0.8f * (float)(hsh & 255u) / 255.0f;
+            c[1] = 0.2f + 0.8f * (float)((hsh >> 8) & 255u) / 255.0f;
+            c[2] = 0.2f + 0.8f * (float)((hsh >> 16) & 255u) / 255.0f;
+            c[3] = 1.0f;
+        }
+    free(ids);
+    return r == SY_RT_OK ? SY_OK : rt_fail(err, r, "coverage", e);
+}
+
+static int coverage_order(const void *pa, const void *pb)
+{
+    const sy_mediator_rt_coverage_entry *a = pa, *b = pb;
+    if (a->pixels != b->pixels) return a->pixels > b->pixels ? -1 : 1;
+    return a->node_id < b->node_id ? -1 : a->node_id > b->node_id;
+}
+
+sy_result sy_mediator_rt_coverage(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
+                                  sy_mediator_rt_coverage_entry **entries_out, uint32_t *count_out, sy_error *err)
+{
+    rt_state *st = state;
+    *entries_out = NULL;
+    *count_out = 0;
+    char e[ERRLEN];
+    sy_rt_camera cam;
+    camera_of(view, &cam);
+    sy_rt_render_desc d = {.image_width = width, .image_height = height, .width = width, .height = height};
+    size_t n;
+    if (!sy_size_mul(width, height, &n) || n == 0) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "coverage: bad size %ux%u", width, height);
+    uint32_t *ids = malloc(n * sizeof *ids);
+    if (!ids) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "coverage: out of memory for %ux%u", width, height);
+    if (st->needs_commit) {
+        sy_rt_result cr = sy_rt_commit(st->dev, e, sizeof e);
+        if (cr != SY_RT_OK) {
+            free(ids);
+            return rt_fail(err, cr, "commit", e);
+        }
+        st->needs_commit = false;
+    }
+    sy_rt_result r = sy_rt_coverage(st->dev, &cam, &d, ids, NULL, e, sizeof e);
+    if (r != SY_RT_OK) {
+        free(ids);
+        return rt_fail(err, r, "coverage", e);
+    }
+    /* count pixels per node */
+    for (size_t i = 0; i < n; ++i) ids[i] = inst_node_get(st, ids[i]);
+    sy_mediator_rt_coverage_entry *out = NULL;
+    uint32_t m = 0, cap = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (!ids[i]) continue;
+        uint32_t k = 0;
+        /* few distinct objects per view in practice; a linear scan with move-to-front stays cheap */
+        while (k < m && out[k].node_id != ids[i]) k++;
+        if (k == m) {
+            if (m == cap) {
+                uint32_t nc = cap ? cap * 2 : 64;
+                sy_mediator_rt_coverage_entry *no = realloc(out, sizeof *no * nc);
+                if (!no) {
+                    free(out);
+                    free(ids);
+                    return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "coverage: out of memory");
+                }
+                out = no;
+                cap = nc;
+            }
+            out[m].node_id = ids[i];
+            out[m].pixels = 0;
+            m++;
+        }
+        out[k].pixels++;
+        if (k > 0) { /* move to front */
+            sy_mediator_rt_coverage_entry t = out[k];
+            out[k] = out[0];
+            out[0] = t;
+        }
+    }
+    free(ids);
+    if (m > 1) qsort(out, m, sizeof *out, coverage_order);
+    *entries_out = out;
+    *count_out = m;
+    return SY_OK;
+}
+
 static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     rt_state *st = state;
@@ -369,6 +501,7 @@ static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *
         .progress = req->progress ? progress_cb : NULL,
         .progress_user_data = &pb,
     };
+    if (st->integrator == SY_RT_INTEGRATOR_COVERAGE) return coverage_render(st, &cam, &d, layer, err);
     if (st->integrator == SY_RT_INTEGRATOR_PATHTRACER) {
         sy_result pr = pt_slot(st, req, err);
         if (pr != SY_OK) return pr;
@@ -390,6 +523,7 @@ static void rt_destroy(void *state)
     sy_mirror_destroy(st->mirror); /* releases instances, lights and meshes while the device lives */
     for (int i = 0; i < ACCUM_SLOTS; ++i) sy_rt_accum_destroy(st->slots[i].acc);
     sy_rt_device_destroy(st->dev);
+    free(st->inst_node);
     free(st);
 }
 
@@ -508,6 +642,23 @@ static const sy_mediator_class whitted_class = {
 };
 
 const sy_mediator_class *sy_mediator_rt_whitted_class(void) { return &whitted_class; }
+
+static sy_result coverage_create(const sy_mediator_create_args *args, void **state_out, sy_error *err)
+{
+    return rt_create_common(args, SY_RT_INTEGRATOR_COVERAGE, state_out, err);
+}
+
+static const sy_mediator_class coverage_class = {
+    .name = "coverage",
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES,
+    .create = coverage_create,
+    .destroy = rt_destroy,
+    .sync = rt_sync,
+    .render = rt_render,
+    .stats = rt_stats,
+};
+
+const sy_mediator_class *sy_mediator_rt_coverage_class(void) { return &coverage_class; }
 
 void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out)
 {

@@ -1,7 +1,7 @@
 /* sy_mediator_rt.h — the mediator between the core scene and the Embree back-end (backends/rt).
  *
  * One Embree scene adapter serving several integrators: the "whitted" and "pathtracer" classes
- * registered here (and later "coverage") share this adapter; only the integrator chosen at render
+ * registered here and "coverage" share this adapter; only the integrator chosen at render
  * time differs. The adapter keeps a mirror of the node graph built from change lists, flattens it
  * (one world transform per geometry placement; a DAG node reached along k paths gets k placements),
  * bakes geometry of nodes flagged SY_NODE_STATIC whose mesh is used once into the top-level BVH,
@@ -25,6 +25,20 @@ extern "C" {
 
 /* The Whitted ray tracer class ("whitted"). Static storage. */
 const sy_mediator_class *sy_mediator_rt_whitted_class(void);
+/* The coverage class ("coverage"): no shading; the layer shows every visible object in a stable
+ * colour derived from its node id (alpha 1 where covered) with depth. A culling service: which
+ * objects a camera sees and how many pixels each covers, with occlusion. */
+const sy_mediator_class *sy_mediator_rt_coverage_class(void);
+
+typedef struct sy_mediator_rt_coverage_entry {
+    uint32_t node_id; /* the core node whose placement covers the pixels */
+    uint32_t pixels;
+} sy_mediator_rt_coverage_entry;
+/* Per-node pixel coverage (ray through every pixel centre, nearest visible object) for the view
+ * at width x height, sorted by pixels, most first. Works on any context of this adapter (whitted,
+ * pathtracer, coverage). Ownership: *entries_out is malloc()ed, the caller frees it. */
+sy_result sy_mediator_rt_coverage(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
+                                  sy_mediator_rt_coverage_entry **entries_out, uint32_t *count_out, sy_error *err);
 /* The progressive path tracer class ("pathtracer"; caps PROGRESSIVE | DEPTH | TILES) on the same
  * adapter. Each render adds req->sample_count samples per pixel (0 = 1) to an accumulation kept per
  * distinct request (camera view, image size, rectangle, background, seed; up to 4 at once, least

@@ -177,6 +177,22 @@ else
 fi
 
 if [ -f "$CORNELL" ]; then
+    # coverage (culling service): the 8 Cornell objects, most pixels first, pixel counts adding up
+    run coverage "$SY" coverage "$CORNELL" -w 128 -h 128
+    if [ "$rc" -ne 0 ]; then fail "coverage: status $rc: $(cat "$TMP/coverage.err")"; fi
+    [ "$(grep -c '"node":' "$TMP/coverage.out")" = 8 ] || fail "coverage: expected the 8 Cornell objects"
+    grep -q '"name": "light"' "$TMP/coverage.out" || fail "coverage: the light is not listed"
+    px=($(grep -o '"pixels": [0-9]*' "$TMP/coverage.out" | grep -o '[0-9]*$'))
+    total=$(grep -o '"covered_pixels": [0-9]*' "$TMP/coverage.out" | grep -o '[0-9]*$')
+    sum=0
+    prev=999999999
+    for p in "${px[@]}"; do
+        sum=$((sum + p))
+        [ "$p" -le "$prev" ] || fail "coverage: objects not sorted by pixels"
+        prev=$p
+    done
+    [ "$sum" = "$total" ] && [ "$total" -gt 0 ] && [ "$total" -le 16384 ] || fail "coverage: pixel counts do not add up"
+
     mkdir -p "$TMP/render"
     run render_png "$SY" render "$CORNELL" -b whitted -w 96 -h 96 -o "$TMP/render/cornell.png"
     if [ "$rc" -ne 0 ]; then fail "render cornell png: status $rc: $(cat "$TMP/render_png.err")"; fi
