@@ -177,6 +177,14 @@ else
 fi
 
 if [ -f "$CORNELL" ]; then
+    # layered hybrid rendering: path-traced Cornell box under a rasterised overlay, depth-composited
+    if [ -f "$BOX" ]; then
+        mkdir -p "$TMP/hybrid"
+        run hybrid "$SY" render "$CORNELL" -b pathtracer --spp 2 -w 32 -h 32 --overlay "$BOX:raster" \
+            --composite depth -o "$TMP/hybrid/h.exr"
+        [ "$rc" -eq 0 ] && magic "$TMP/hybrid/h.exr" 762f3101 ||
+            fail "hybrid pathtracer + raster overlay: status $rc: $(cat "$TMP/hybrid.err")"
+    fi
     # coverage (culling service): the 8 Cornell objects, most pixels first, pixel counts adding up
     run coverage "$SY" coverage "$CORNELL" -w 128 -h 128
     if [ "$rc" -ne 0 ]; then fail "coverage: status $rc: $(cat "$TMP/coverage.err")"; fi

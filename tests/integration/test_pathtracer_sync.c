@@ -7,7 +7,8 @@
  *     material change, a light change, a background change, the request's camera changing
  *     (moving the viewport's camera node), a new mesh;
  *   - NOT restart after: an attachment change, moving the camera no viewport uses.
- * The image after a restart equals a fresh context's image of the changed scene bit for bit (no
+ * Switching the viewport to whitted and back resumes the accumulation (cached context, nothing
+ * changed). The image after a restart equals a fresh context's image of the changed scene bit for bit (no
  * stale samples), AOVs come back for the viewport rectangle, and nothing is non-finite. */
 #include "it_util.h"
 #include "sy_mediator_rt.h"
@@ -168,6 +169,22 @@ int main(void)
     CHECKF(render(&fx, 1) == 1, "moving the viewport's camera did not restart");
     CHECK(render(&fx, 1) == 2);
 
+    /* runtime switching: away to whitted and back; the cached path tracer context resumes its
+     * accumulation because nothing changed meanwhile */
+    sy_viewport *vp = sy_window_viewport(fx.win, 0);
+    MUST(sy_viewport_set_backend(vp, "whitted", NULL, err));
+    {
+        sy_window_render_opts ro = {.seed = 9};
+        MUST(sy_window_render(fx.win, s, fx.pool, &ro, &fx.img, err));
+    }
+    MUST(sy_viewport_set_backend(vp, "pathtracer", NULL, err));
+    CHECKF(render(&fx, 1) == 3, "switching back to the path tracer did not resume its accumulation");
+    CHECKF(render(&fx, 1) == 4, "accumulation after switching back");
+    it_set_translation(s, fx.cam_node, 0, 0.2f, 3.5f);
+    commit(&fx);
+    CHECK(render(&fx, 1) == 1);
+    CHECK(render(&fx, 1) == 2);
+
     /* AOVs of the viewport rectangle */
     sy_context *ctx;
     MUST(sy_context_pool_get(fx.pool, s, "pathtracer", NULL, fx.root.id, &ctx, err));
@@ -178,7 +195,7 @@ int main(void)
     sy_mediator_rt_aovs_free(&a);
     sy_mediator_rt_counters cn;
     sy_mediator_rt_counters_get(sy_context_state(ctx), &cn);
-    CHECKF(cn.accum_restarts == 5, "restarts counted: %u", cn.accum_restarts);
+    CHECKF(cn.accum_restarts == 6, "restarts counted: %u", cn.accum_restarts);
     /* the Whitted context rejects the AOV request */
     sy_context *wc;
     MUST(sy_context_pool_get(fx.pool, s, "whitted", NULL, fx.root.id, &wc, err));
