@@ -4,7 +4,7 @@
  *   sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]
  *             [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]
  *             with -b pathtracer: [--spp N | --time SECONDS] [--aov] [--env MAP.exr] [--env-intensity X]
- *             [--background R,G,B]
+ *             [--background R,G,B] [--filter none|pixel|atrous|jbu|adaptive [--threshold T]]
  *             [--gl osmesa|egl|glfw]  (raster back-end's GL context provider)
  *   sy demo [-o DIR] [-w W] [-h H]      render the built-in demo scene with every back-end
  *   sy bench sync [--nodes N] [--tris T] [--repeats R]
@@ -430,9 +430,10 @@ static int usage(void)
             "            [--overlay FILE[:BACKEND]] [--composite depth|over|replace]\n"
             "  sy render SCENE -b pathtracer -o OUT.exr|png [--spp N | --time SECONDS] [--aov]\n"
             "            [--env MAP.exr] [--env-intensity X] [--background R,G,B] (+ the options above)\n"
+            "            [--filter none|pixel|atrous|jbu|adaptive] [--threshold T]   (display filter)\n"
             "  sy demo [-o DIR] [-w W] [-h H]\n"
             "  sy view SCENE [-b BACKEND] [-w W] [-h H] [--camera C] [--overlay FILE[:BACKEND]]\n"
-            "          [--frames N --screenshot OUT.png]\n"
+            "          [--frames N --screenshot OUT.png] [--filter none|pixel|atrous|jbu|adaptive] [--threshold T]\n"
             "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"
             "  sy bench rays [SCENE] [-w W] [-h H] [--repeats R]\n"
             "  sy bench pathtracer [SCENE] [-w W] [-h H] [--repeats PASSES]\n"
@@ -570,10 +571,22 @@ static const char *render_gl_params(const char *params, const char *provider, ch
     return buf;
 }
 
+/* `--filter NAME [--threshold T]` (path tracer display filter): appended to the back-end
+ * parameters as filter=NAME,threshold=T; the mediator validates them (sy_mediator_rt.h). */
+static const char *render_filter_params(const char *params, const char *filter, const char *threshold, char *buf,
+                                        size_t len)
+{
+    snprintf(buf, len, "%s%s%s%s%s%s", params ? params : "", params && *params ? "," : "", filter ? "filter=" : "",
+             filter ? filter : "", filter && threshold ? "," : "", threshold ? "threshold=" : "");
+    if (threshold) strncat(buf, threshold, len - strlen(buf) - 1);
+    return buf;
+}
+
 static int cmd_render(int argc, char **argv)
 {
     const char *scene = NULL, *backend = NULL, *outp = NULL, *camera = NULL, *params = NULL;
     const char *gl_provider = NULL;
+    const char *filter = NULL, *threshold = NULL; /* --filter / --threshold (path tracer) */
     const char *overlay = NULL, *composite = "depth";
     uint32_t w = 0, h = 0;
     out_opts oo = {0};
@@ -614,6 +627,8 @@ static int cmd_render(int argc, char **argv)
         } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
         else if (!strcmp(a, "--params") && has) params = argv[++i];
         else if (!strcmp(a, "--gl") && has) gl_provider = argv[++i]; /* raster: gl=... parameter */
+        else if (!strcmp(a, "--filter") && has) filter = argv[++i];       /* pathtracer: filter=... */
+        else if (!strcmp(a, "--threshold") && has) threshold = argv[++i]; /* pathtracer: threshold=... */
         else if (!strcmp(a, "--half")) oo.half = true;
         else if (!strcmp(a, "--exposure") && has) oo.png.exposure_stops = strtof(argv[++i], NULL);
         else if (!strcmp(a, "--tonemap") && has) {
@@ -638,7 +653,14 @@ static int cmd_render(int argc, char **argv)
     if (!scene || !backend || !outp) return usage();
     char gl_params[256];
     if (gl_provider) params = render_gl_params(params, gl_provider, gl_params, sizeof gl_params);
+    char filter_params[512];
+    if (filter || threshold) params = render_filter_params(params, filter, threshold, filter_params, sizeof filter_params);
     sy_error err = {0};
+    if ((filter || threshold) && (strcmp(backend, "pathtracer") != 0 || clo.cluster)) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--filter and --threshold need a local -b pathtracer render (got -b %s%s)",
+                     backend, clo.cluster ? " with --cluster: tiles would be filtered separately" : "");
+        return fail(&err);
+    }
     if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) { /* before any loading or rendering */
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);
         return fail(&err);
@@ -714,6 +736,14 @@ static int cmd_render(int argc, char **argv)
                 printf("%s: %ux%u, %s, %llu samples per pixel, %.3f s (%.2f samples/s)\n", outp, img.width, img.height,
                        backend, (unsigned long long)samples, secs, secs > 0 ? (double)samples / secs : 0.0);
             else if (r == SY_OK) printf("%s: %ux%u, %s, %.3f s\n", outp, img.width, img.height, backend, secs);
+            if (r == SY_OK && progressive && filter && pctx) { /* the display filter's report (issue 7) */
+                sy_mediator_rt_filter_info fi;
+                sy_mediator_rt_filter_info_get(sy_context_state(pctx), &fi);
+                printf("filter %s: threshold %g, last filter %.1f ms, last pass at %u spp, mean blend %.3f, "
+                       "NaN/Inf: %llu pixels, %llu samples\n",
+                       fi.name, (double)fi.threshold, fi.seconds * 1e3, fi.last_pass_samples, fi.mean_blend,
+                       (unsigned long long)fi.nonfinite_pixels, (unsigned long long)fi.nonfinite_samples);
+            }
         }
     }
     sy_layer_destroy(&img);
@@ -771,6 +801,8 @@ static int cmd_view(int argc, char **argv)
 {
     const char *scene = NULL, *backend = "whitted", *camera = NULL, *overlay = NULL, *composite = "depth",
                *shot = NULL;
+    const char *view_filter = NULL; /* --filter: initial path tracer display filter */
+    float view_threshold = 0.0f;    /* --threshold (0 = default) */
     uint32_t w = 960, h = 540, frames = 0;
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
@@ -786,7 +818,12 @@ static int cmd_view(int argc, char **argv)
         else if (!strcmp(a, "--frames") && has) {
             if (!parse_u32(argv[++i], 1, 1000000, &frames)) return usage();
         } else if (!strcmp(a, "--screenshot") && has) shot = argv[++i];
-        else if (a[0] != '-' && !scene) scene = a;
+        else if (!strcmp(a, "--filter") && has) view_filter = argv[++i];
+        else if (!strcmp(a, "--threshold") && has) {
+            char *end = NULL;
+            view_threshold = strtof(argv[++i], &end);
+            if (*end || !isfinite(view_threshold) || view_threshold < 0) return usage();
+        } else if (a[0] != '-' && !scene) scene = a;
         else return usage();
     }
     if (!scene) return usage();
@@ -798,6 +835,8 @@ static int cmd_view(int argc, char **argv)
     loaded ld;
     if (load(scene, camera, true, &ld, &err) != SY_OK) return fail(&err);
     sy_view_args va = {.scene = ld.scene, .backend = backend, .width = w, .height = h, .frames = frames, .screenshot = shot};
+    va.filter = view_filter;
+    va.threshold = view_threshold;
     va.spec.root = ld.root;
     va.spec.camera = ld.camera;
     va.spec.background = ld.background;

@@ -2,6 +2,7 @@
  * scene (see sy_view.h). */
 #include "sy_view.h"
 
+#include "sy_mediator_rt.h"
 #include "sy_png.h"
 
 #define GLFW_INCLUDE_NONE
@@ -32,6 +33,9 @@ typedef struct viewer {
     uint32_t stereo;
     uint32_t w, h;
     bool quit;
+    uint32_t filter;        /* path tracer display filter: index into view_filters (key F) */
+    float threshold;        /* its threshold (keys [ and ]) */
+    uint64_t filter_version;
     /* render thread -> input thread (under mu) */
     uint8_t *img;
     uint32_t img_w, img_h;
@@ -39,6 +43,7 @@ typedef struct viewer {
     double frame_ms, sync_ms;
     uint64_t spp;
     char status[160];
+    char filter_status[96];
     sy_error error;
     bool failed;
 } viewer;
@@ -74,6 +79,46 @@ static void orbit_from_matrix(const sy_mat4 *m, const sy_bounds *b, orbit *o)
     o->yaw = atan2f(back[0], back[2]);
 }
 
+/* Display filters of the path tracer the F key cycles through (sy_mediator_rt_set_filter). */
+static const char *const view_filters[] = {"none", "pixel", "atrous", "jbu", "adaptive"};
+#define VIEW_FILTER_COUNT (sizeof view_filters / sizeof view_filters[0])
+
+/* Render thread: applies the requested filter to the path tracer's context when it changed (or the
+ * context is new); fills status (empty for other back-ends). Errors go to status, not fatal. */
+static void view_apply_filter(sy_context_pool *pool, const sy_view_args *a, const sy_mediator_class *cls,
+                              uint32_t filter, float threshold, uint64_t version, void **applied_state,
+                              uint64_t *applied_version, char *status, size_t len)
+{
+    status[0] = 0;
+    if (strcmp(cls->name, "pathtracer") != 0) return;
+    sy_context *ctx = NULL;
+    sy_error err = {0};
+    if (sy_context_pool_get(pool, a->scene, cls->name, NULL, a->spec.root.id, &ctx, &err) != SY_OK) {
+        snprintf(status, len, " | filter: %.80s", err.message);
+        return;
+    }
+    void *state = sy_context_state(ctx);
+    if (state != *applied_state || version != *applied_version) {
+        sy_params opts = {0};
+        char t[32];
+        snprintf(t, sizeof t, "%g", (double)threshold);
+        if (sy_params_set(&opts, "threshold", t, &err) != SY_OK ||
+            sy_mediator_rt_set_filter(state, view_filters[filter % VIEW_FILTER_COUNT], &opts, &err) != SY_OK) {
+            snprintf(status, len, " | filter: %.80s", err.message);
+            return;
+        }
+        *applied_state = state;
+        *applied_version = version;
+    }
+    sy_mediator_rt_filter_info fi;
+    sy_mediator_rt_filter_info_get(state, &fi);
+    if (strcmp(fi.name, "none") != 0)
+        snprintf(status, len, " | filter %s t=%g %.1f ms%s", fi.name, (double)fi.threshold, fi.seconds * 1e3,
+                 fi.nonfinite_pixels ? " | NaN/Inf pixels!" : "");
+    else
+        snprintf(status, len, " | filter none");
+}
+
 /* >>render thread */
 static void *render_main(void *p)
 {
@@ -86,6 +131,9 @@ static void *render_main(void *p)
     sy_mat4 cam_applied;
     memset(&cam_applied, 0, sizeof cam_applied);
     bool refine = false;
+    void *filter_state = NULL;
+    uint64_t filter_applied = 0;
+    char fstatus[96] = "";
     for (;;) {
         pthread_mutex_lock(&v->mu);
         while (!v->quit && seen == v->req_version && !refine) pthread_cond_wait(&v->cv, &v->mu);
@@ -97,6 +145,9 @@ static void *render_main(void *p)
         sy_mat4 cam = v->cam;
         uint32_t bi = v->backend, stereo = v->stereo, w = v->w, h = v->h;
         bool overlay = v->overlay;
+        uint32_t filter = v->filter;
+        float threshold = v->threshold;
+        uint64_t filter_version = v->filter_version;
         pthread_mutex_unlock(&v->mu);
 
         const sy_mediator_class *cls = sy_mediator_at(bi);
@@ -116,6 +167,8 @@ static void *render_main(void *p)
         uint32_t ew = stereo == SY_STEREO_SBS ? (w / 2 ? w / 2 : 1) : w;
         sy_layer img = {0}, right = {0};
         double t0 = sy_time_now();
+        view_apply_filter(pool, a, cls, filter, threshold, filter_version, &filter_state, &filter_applied, fstatus,
+                          sizeof fstatus);
         sy_window_render_opts ro = {.sample_count = 1};
         sy_result r = sy_compose_render(a->scene, pool, &spec, ew, h, &ro, &img, &right, &err);
         double ms = (sy_time_now() - t0) * 1e3;
@@ -152,6 +205,7 @@ static void *render_main(void *p)
         v->sync_ms = st.last_sync_seconds * 1e3;
         v->spp = st.samples;
         snprintf(v->status, sizeof v->status, "%s", cls->name);
+        snprintf(v->filter_status, sizeof v->filter_status, "%s", fstatus);
         v->img_version++;
         pthread_mutex_unlock(&v->mu);
         sy_layer_destroy(&img);
@@ -206,6 +260,17 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         if (key == GLFW_KEY_O) v->overlay = !v->overlay;
         else v->stereo = v->stereo == SY_STEREO_NONE ? SY_STEREO_SBS : v->stereo == SY_STEREO_SBS ? SY_STEREO_ANAGLYPH
                                                                                                    : SY_STEREO_NONE;
+        v->req_version++;
+        pthread_cond_signal(&v->cv);
+        pthread_mutex_unlock(&v->mu);
+    } else if (key == GLFW_KEY_F || key == GLFW_KEY_LEFT_BRACKET || key == GLFW_KEY_RIGHT_BRACKET) {
+        /* path tracer display filter: F cycles it, [ ] halve / double the threshold (live: the
+         * render thread applies it to its context, the accumulation keeps its samples) */
+        pthread_mutex_lock(&v->mu);
+        if (key == GLFW_KEY_F) v->filter = (v->filter + 1) % (uint32_t)VIEW_FILTER_COUNT;
+        else if (key == GLFW_KEY_LEFT_BRACKET && v->threshold > 1e-6f) v->threshold *= 0.5f;
+        else if (key == GLFW_KEY_RIGHT_BRACKET && v->threshold < 1e3f) v->threshold *= 2.0f;
+        v->filter_version++;
         v->req_version++;
         pthread_cond_signal(&v->cv);
         pthread_mutex_unlock(&v->mu);
@@ -295,6 +360,19 @@ static sy_result write_screenshot(const char *path, int w, int h, sy_error *err)
 
 sy_result sy_view_run(const sy_view_args *args, sy_error *err)
 {
+    uint32_t filter0 = 0;
+    if (args->filter) { /* the initial display filter, checked before any window opens */
+        while (filter0 < VIEW_FILTER_COUNT && strcmp(view_filters[filter0], args->filter) != 0) filter0++;
+        if (filter0 == VIEW_FILTER_COUNT)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "view: unknown filter '%s' (expected none, pixel, atrous, jbu or adaptive%s)", args->filter,
+                                strcmp(args->filter, "radiance") ? ""
+                                                                 : "; radiance needs the integrator's stored-sample hook, "
+                                                                   "not available yet");
+    }
+    if (!(args->threshold >= 0.0f) || !isfinite(args->threshold))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: threshold %g must be a finite value >= 0",
+                            (double)args->threshold);
     if (!glfwInit()) {
         const char *desc = NULL;
         glfwGetError(&desc);
@@ -343,6 +421,8 @@ sy_result sy_view_run(const sy_view_args *args, sy_error *err)
     v.w = (uint32_t)fbw, v.h = (uint32_t)fbh;
     orbit_matrix(&in.o, &v.cam);
     v.req_version = 1;
+    v.threshold = args->threshold > 0.0f ? args->threshold : 0.01f; /* the pixel filter's default t */
+    v.filter = filter0;
 
     pthread_t th;
     if (pthread_create(&th, NULL, render_main, &v) != 0) {
@@ -360,6 +440,7 @@ sy_result sy_view_run(const sy_view_args *args, sy_error *err)
     double last = glfwGetTime();
     uint8_t *img = NULL;
     uint32_t iw = 0, ih = 0;
+    char title[512] = "sy view";
     while (!glfwWindowShouldClose(win)) {
         glfwWaitEventsTimeout(1.0 / 60.0);
         double now = glfwGetTime();
@@ -381,10 +462,10 @@ sy_result sy_view_run(const sy_view_args *args, sy_error *err)
                 if (img) memcpy(img, v.img, (size_t)v.img_w * v.img_h * 4);
                 iw = img ? v.img_w : 0, ih = img ? v.img_h : 0;
             }
-            char title[256];
-            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms | %llu spp | sync %.2f ms%s", v.status,
+            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms | %llu spp | sync %.2f ms%s%s", v.status,
                      v.frame_ms, (unsigned long long)v.spp, v.sync_ms,
-                     v.stereo == SY_STEREO_SBS ? " | stereo sbs" : v.stereo == SY_STEREO_ANAGLYPH ? " | anaglyph" : "");
+                     v.stereo == SY_STEREO_SBS ? " | stereo sbs" : v.stereo == SY_STEREO_ANAGLYPH ? " | anaglyph" : "",
+                     v.filter_status);
             glfwSetWindowTitle(win, title);
         }
         bool failed = v.failed;
@@ -406,6 +487,7 @@ sy_result sy_view_run(const sy_view_args *args, sy_error *err)
         if (img) displayed++; /* frames shown, fresh or not */
         if (args->frames && displayed >= args->frames) {
             if (args->screenshot) r = write_screenshot(args->screenshot, fbw, fbh, err);
+            if (!glfwWindowShouldClose(win)) printf("%s\n", title); /* automated runs: the last heads-up line */
             glfwSetWindowShouldClose(win, GLFW_TRUE);
         }
         glfwSwapBuffers(win);

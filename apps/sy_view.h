@@ -2,7 +2,10 @@
  *
  * Orbit (left drag), pan (right or middle drag), zoom (wheel), fly (W A S D, Q E up/down); keys 1-9
  * pick a registered back-end live, O toggles the overlay layer, T cycles stereo modes (mono,
- * side-by-side, anaglyph), R resets the camera, Esc quits. The window title is the heads-up line:
+ * side-by-side, anaglyph), R resets the camera, Esc quits. With the path tracer, F cycles the display
+ * filter (none, pixel, atrous, jbu, adaptive) and [ / ] halve / double its threshold (default 0.01),
+ * live and without restarting the accumulation; the title shows the filter, threshold and its time.
+ * With --frames the last title line is printed to stdout at exit (automated runs). The window title is the heads-up line:
  * back-end, frame time, samples per pixel, sync time. Rendering runs on its own thread, which owns
  * the scene (the input thread only posts camera poses and switches), so the window stays
  * responsive while a slow back-end renders and always shows the last complete image; a
@@ -21,6 +24,9 @@ typedef struct sy_view_args {
     uint32_t width, height; /* initial window size */
     uint32_t frames;        /* > 0: quit after this many displayed frames (automated runs) */
     const char *screenshot; /* optional PNG of the window's last frame, written at exit */
+    const char *filter;     /* initial path tracer display filter (NULL = "none"): none, pixel, atrous,
+                               jbu or adaptive; anything else is refused before a window opens */
+    float threshold;        /* its initial threshold (0 = the default 0.01; must be >= 0) */
 } sy_view_args;
 
 sy_result sy_view_run(const sy_view_args *args, sy_error *err);

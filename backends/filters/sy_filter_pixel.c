@@ -649,8 +649,9 @@ static void blend_rows(void *vctx, uint32_t y0, uint32_t y1)
         o[3] = in->color_channels == 4 ? in->color[4 * i + 3] : 1.0f;
         if (!isfinite(o[3])) o[3] = 1.0f;
         bool own_ok = pf->ok[i];
-        if (!pf->have_pass) {
-            for (int c = 0; c < 3; ++c) o[c] = own_ok ? lv[c] + hv[c] : 0.0f;
+        const float *col = in->color + (size_t)in->color_channels * i;
+        if (!pf->have_pass) { /* the unfiltered estimate itself (bit-exact, not LV + HV rounded) */
+            for (int c = 0; c < 3; ++c) o[c] = own_ok ? col[c] : 0.0f;
             continue;
         }
         const float *lf = pf->lf + 4 * i;
@@ -669,6 +670,10 @@ static void blend_rows(void *vctx, uint32_t y0, uint32_t y1)
         float cov = p->use_covariance ? pf->a0[i] * lf[3] / pf->npass[i] / lb2 : 0.0f;
         float s = sy_filter_blend_factor(u, f, p->threshold, cov);
         pf->s[i] = s;
+        if (s >= 1.0f) { /* converged under the threshold: exactly the unfiltered estimate */
+            for (int c = 0; c < 3; ++c) o[c] = col[c];
+            continue;
+        }
         for (int c = 0; c < 3; ++c) {
             float lu = hv[c];
             /* Eq. 3.18 spike withholding; [GAP spec 1.10(c)]: per RGB channel, and only while the

@@ -125,6 +125,21 @@ typedef struct targets {
     GLuint rfbo, rcolor, rdepthlin; /* resolve targets when samples > 1 */
 } targets;
 
+/* Main-pass shader variant bits (the SY_* defines of sy_gl_shaders.c). */
+enum {
+    VAR_LEAN = 1,     /* mesh without uv1 and colours */
+    VAR_MASK = 2,     /* alpha mask: the only variants with discard */
+    VAR_TEX = 4,      /* the material samples a texture */
+    VAR_NMAP = 8,     /* ... a normal map (only with VAR_TEX and lighting) */
+    VAR_LIGHTS = 16,  /* punctual lights present */
+    VAR_AMBIENT = 32, /* background ambient */
+    VAR_SHADOW = 64,  /* shadow maps (only with VAR_LIGHTS) */
+    VAR_NL_SHIFT = 7, /* bits 7-9: the light count when 1..VAR_NL_MAX (a loop the compiler unrolls, with
+                       * constant uniform-block offsets), 0 = read from the Lights block */
+    VAR_NL_MAX = 7,
+    VAR_COUNT = 1024
+};
+
 struct sy_gl_device {
     sy_gl_context *ctx;
     const sy_gl_fns *gl;
@@ -134,11 +149,14 @@ struct sy_gl_device {
     uint32_t msaa, max_tex, shadow_size;
     pool meshes, textures, materials, instances, lights;
     GLuint prog_resolve, prog_floor;
-    struct { /* [mask * 2 + lean]: mask = alpha-masked (the only variants with discard), lean = mesh
-              * without uv1 and colours (fewer varyings) */
+    struct { /* main-pass variants, built on first use, indexed by VAR_* bits (main_program) */
         GLuint prog;
-        GLint model, normal_mat, view, proj, cam_pos, cam_fwd, ortho, mirror, has_normals;
-    } pm[4];
+        GLint model, normal_mat, mvp, cam_pos, cam_fwd, ortho, ortho_z, mirror, has_normals;
+        uint64_t frame; /* the frame whose view uniforms it holds */
+    } pm[VAR_COUNT];
+    uint64_t frame_no;
+    uint32_t light_count, shadow_count; /* as uploaded by lights_upload: they pick the variants */
+    bool ambient;
     struct {
         GLuint prog;
         GLint model, lightvp;
@@ -377,6 +395,51 @@ static void bind_samplers(const sy_gl_fns *gl, GLuint prog)
     if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_LIGHTS);
 }
 
+/* Drops variant bits that cannot matter, so that equivalent draws share one program. */
+static int variant_normalize(int v)
+{
+    if (!(v & (VAR_LIGHTS | VAR_AMBIENT)) || !(v & VAR_TEX)) v &= ~VAR_NMAP;
+    if (!(v & VAR_LIGHTS)) v &= ~(VAR_SHADOW | (7 << VAR_NL_SHIFT));
+    return v;
+}
+
+/* The main program for variant bits v, built and cached on first use; 0 with err set when the
+ * driver rejects it. */
+static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
+{
+    v = variant_normalize(v);
+    if (dev->pm[v].prog) return dev->pm[v].prog;
+    static const char *const names[7] = {"LEAN", "MASK", "TEX", "NMAP", "LIGHTS", "AMBIENT", "SHADOW"};
+    char defs[256] = "", name[128] = "main";
+    size_t dl = 0, nl = strlen(name);
+    for (int b = 0; b < 7; ++b) {
+        if (!(v & (1 << b))) continue;
+        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_%s 1\n", names[b]);
+        nl += (size_t)snprintf(name + nl, sizeof name - nl, " %s", names[b]);
+    }
+    int nlights = (v >> VAR_NL_SHIFT) & 7;
+    if (nlights) {
+        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_NLIGHTS %d\n", nlights);
+        nl += (size_t)snprintf(name + nl, sizeof name - nl, " (%d lights)", nlights);
+    }
+    const sy_gl_fns *gl = dev->gl;
+    GLuint p = 0;
+    if (sy_gl_program_build(gl, name, sy_gl_main_vs, sy_gl_main_fs, defs, &p, err, err_len) != SY_GL_OK) return 0;
+    dev->pm[v].prog = p;
+    dev->pm[v].model = gl->GetUniformLocation(p, "u_model");
+    dev->pm[v].normal_mat = gl->GetUniformLocation(p, "u_normal_mat");
+    dev->pm[v].mvp = gl->GetUniformLocation(p, "u_mvp");
+    dev->pm[v].cam_pos = gl->GetUniformLocation(p, "u_cam_pos");
+    dev->pm[v].cam_fwd = gl->GetUniformLocation(p, "u_cam_fwd");
+    dev->pm[v].ortho = gl->GetUniformLocation(p, "u_ortho");
+    dev->pm[v].ortho_z = gl->GetUniformLocation(p, "u_ortho_z");
+    dev->pm[v].mirror = gl->GetUniformLocation(p, "u_mirror");
+    dev->pm[v].has_normals = gl->GetUniformLocation(p, "u_has_normals");
+    dev->pm[v].frame = 0;
+    bind_samplers(gl, p);
+    return p;
+}
+
 #define LIGHTS_FLOATS 600 /* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes */
 
 sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **out, char *err, size_t err_len)
@@ -416,9 +479,9 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     if (dev->shadow_size > (uint32_t)max_tex) dev->shadow_size = (uint32_t)max_tex;
     static const char *const defs[4] = {NULL, "#define SY_LEAN 1\n", "#define SY_MASK 1\n",
                                         "#define SY_MASK 1\n#define SY_LEAN 1\n"};
-    static const char *const names[4] = {"main", "main (lean)", "main (alpha mask)", "main (alpha mask, lean)"};
-    for (int v = 0; v < 4 && r == SY_GL_OK; ++v)
-        r = sy_gl_program_build(gl, names[v], sy_gl_main_vs, sy_gl_main_fs, defs[v], &dev->pm[v].prog, err, err_len);
+    /* the fullest main variant now, so that a shader the driver rejects fails here */
+    if (!main_program(dev, VAR_TEX | VAR_NMAP | VAR_LIGHTS | VAR_AMBIENT | VAR_SHADOW | VAR_MASK, err, err_len))
+        r = SY_GL_ERROR_GL;
     for (int v = 0; v < 2 && r == SY_GL_OK; ++v)
         r = sy_gl_program_build(gl, v ? "shadow (alpha mask)" : "shadow", sy_gl_shadow_vs, sy_gl_shadow_fs, defs[2 * v],
                                 &dev->ps[v].prog, err, err_len);
@@ -427,19 +490,6 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     if (r != SY_GL_OK) {
         sy_gl_device_destroy(dev);
         return r;
-    }
-    for (int v = 0; v < 4; ++v) {
-        GLuint p = dev->pm[v].prog;
-        dev->pm[v].model = gl->GetUniformLocation(p, "u_model");
-        dev->pm[v].normal_mat = gl->GetUniformLocation(p, "u_normal_mat");
-        dev->pm[v].view = gl->GetUniformLocation(p, "u_view");
-        dev->pm[v].proj = gl->GetUniformLocation(p, "u_proj");
-        dev->pm[v].cam_pos = gl->GetUniformLocation(p, "u_cam_pos");
-        dev->pm[v].cam_fwd = gl->GetUniformLocation(p, "u_cam_fwd");
-        dev->pm[v].ortho = gl->GetUniformLocation(p, "u_ortho");
-        dev->pm[v].mirror = gl->GetUniformLocation(p, "u_mirror");
-        dev->pm[v].has_normals = gl->GetUniformLocation(p, "u_has_normals");
-        bind_samplers(gl, p);
     }
     for (int v = 0; v < 2; ++v) {
         dev->ps[v].model = gl->GetUniformLocation(dev->ps[v].prog, "u_model");
@@ -522,9 +572,10 @@ void sy_gl_device_destroy(sy_gl_device *dev)
             if (m->h.id) gl->DeleteBuffers(1, &m->ubo);
         }
         targets_free(dev, &dev->t);
-        GLuint progs[8] = {dev->pm[0].prog, dev->pm[1].prog, dev->pm[2].prog, dev->pm[3].prog,
-                           dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor};
-        for (int i = 0; i < 8; ++i)
+        for (int v = 0; v < VAR_COUNT; ++v)
+            if (dev->pm[v].prog) gl->DeleteProgram(dev->pm[v].prog);
+        GLuint progs[4] = {dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor};
+        for (int i = 0; i < 4; ++i)
             if (progs[i]) gl->DeleteProgram(progs[i]);
         GLuint bufs[2] = {dev->default_ubo, dev->lights_ubo}, texs[3] = {dev->white_tex, dev->flat_normal_tex, dev->shadow_tex};
         gl->DeleteBuffers(2, bufs);
@@ -1118,6 +1169,9 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
         blk[7] = 1.0f;
     }
     fs->shadow_count = ns;
+    dev->light_count = n;
+    dev->shadow_count = ns;
+    dev->ambient = dev->has_bg;
     dev->gl->BindBuffer(GL_UNIFORM_BUFFER, dev->lights_ubo);
     dev->gl->BufferSubData(GL_UNIFORM_BUFFER, 0, sizeof blk, blk);
     count_buffer(dev, true, sizeof blk);
@@ -1374,17 +1428,83 @@ static sy_gl_result finish_target(sy_gl_device *dev, float *rgba, float *depth, 
 
 static int mesh_lean(const mesh_o *m) { return !m->has_attr[3] && !m->has_attr[4]; }
 
-static void draw_instance(sy_gl_device *dev, int v, const inst_o *in, const mesh_o *m)
+/* The variant bits for one draw: mesh attributes, material textures and mode, frame lighting. */
+static int draw_variant(const sy_gl_device *dev, const mesh_o *m, const mat_o *mt)
+{
+    int v = mesh_lean(m) ? VAR_LEAN : 0;
+    if (dev->light_count) v |= VAR_LIGHTS;
+    if (dev->light_count && dev->light_count <= VAR_NL_MAX) v |= (int)dev->light_count << VAR_NL_SHIFT;
+    if (dev->ambient) v |= VAR_AMBIENT;
+    if (dev->shadow_count) v |= VAR_SHADOW;
+    if (!mt) return v;
+    if (mt->d.alpha_mode == SY_GL_ALPHA_MASK) v |= VAR_MASK;
+    const sy_gl_texture_ref *refs[5] = {&mt->d.base_color_texture, &mt->d.metallic_roughness_texture,
+                                        &mt->d.normal_texture, &mt->d.occlusion_texture, &mt->d.emissive_texture};
+    for (int i = 0; i < 5; ++i)
+        if (pool_get(&dev->textures, refs[i]->texture.id)) v |= i == UNIT_NRM ? VAR_TEX | VAR_NMAP : VAR_TEX;
+    return variant_normalize(v);
+}
+
+typedef struct draw_ctx {
+    const view_setup *v;
+    float viewproj[16], ortho_z[3]; /* orthographic proj[10], proj[14] (and 0) */
+    int bound;
+} draw_ctx;
+
+/* Binds the variant's program (building it on first use) and, once per frame, its view uniforms. */
+static sy_gl_result use_variant(sy_gl_device *dev, draw_ctx *dc, int pv, char *err, size_t err_len)
+{
+    if (pv == dc->bound) return SY_GL_OK;
+    const sy_gl_fns *gl = dev->gl;
+    GLuint p = main_program(dev, pv, err, err_len);
+    if (!p) return SY_GL_ERROR_GL;
+    gl->UseProgram(p);
+    dc->bound = pv;
+    if (dev->pm[pv].frame != dev->frame_no) {
+        dev->pm[pv].frame = dev->frame_no;
+        gl->Uniform3fv(dev->pm[pv].cam_pos, 1, dc->v->cam_pos);
+        gl->Uniform3fv(dev->pm[pv].cam_fwd, 1, dc->v->cam_fwd);
+        gl->Uniform1i(dev->pm[pv].ortho, dc->v->ortho);
+        gl->Uniform3fv(dev->pm[pv].ortho_z, 1, dc->ortho_z);
+    }
+    return SY_GL_OK;
+}
+
+static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const mesh_o *m, const mat_o *mt,
+                                  char *err, size_t err_len)
 {
     const sy_gl_fns *gl = dev->gl;
-    bind_material(dev, in->material, true);
-    gl->UniformMatrix4fv(dev->pm[v].model, 1, GL_FALSE, in->model);
-    gl->UniformMatrix3fv(dev->pm[v].normal_mat, 1, GL_FALSE, in->normal_mat);
-    gl->Uniform1i(dev->pm[v].mirror, in->mirror);
-    gl->Uniform1i(dev->pm[v].has_normals, m->has_normals);
+    int pv = draw_variant(dev, m, mt);
+    sy_gl_result r = use_variant(dev, dc, pv, err, err_len);
+    if (r != SY_GL_OK) return r;
+    bind_material(dev, in->material, (pv & VAR_TEX) != 0);
+    float mvp[16];
+    m4_mul(dc->viewproj, in->model, mvp);
+    gl->UniformMatrix4fv(dev->pm[pv].mvp, 1, GL_FALSE, mvp);
+    if (pv & (VAR_LIGHTS | VAR_AMBIENT)) {
+        gl->UniformMatrix4fv(dev->pm[pv].model, 1, GL_FALSE, in->model);
+        gl->UniformMatrix3fv(dev->pm[pv].normal_mat, 1, GL_FALSE, in->normal_mat);
+        gl->Uniform1i(dev->pm[pv].has_normals, m->has_normals);
+    }
+    gl->Uniform1i(dev->pm[pv].mirror, in->mirror);
     draw_mesh(dev, m);
     dev->tris += m->triangle_count;
+    return SY_GL_OK;
 }
+
+/* Distance of an instance's bounding-box centre along the view direction. */
+static float view_distance(const inst_o *in, const mesh_o *m, const view_setup *v)
+{
+    float z = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        float wv = in->model[12 + a];
+        for (int k = 0; k < 3; ++k) wv += in->model[4 * k + a] * 0.5f * (m->bmin[k] + m->bmax[k]);
+        z += (wv - v->cam_pos[a]) * v->cam_fwd[a];
+    }
+    return z;
+}
+
+static int cmp_near_first(const void *a, const void *b) { return -cmp_far_first(a, b); }
 
 sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, float *rgba,
                           float *depth, char *err, size_t err_len)
@@ -1396,6 +1516,7 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
     dev->tris = dev->draws = 0;
+    dev->frame_no++;
     static frame_state fs_zero;
     frame_state fs = fs_zero;
     if (dev->lights_dirty) {
@@ -1405,73 +1526,52 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         dev->lights_dirty = false;
     }
     begin_target(dev);
-    for (int pv = 0; pv < 4; ++pv) {
-        gl->UseProgram(dev->pm[pv].prog);
-        gl->UniformMatrix4fv(dev->pm[pv].view, 1, GL_FALSE, v.view);
-        gl->UniformMatrix4fv(dev->pm[pv].proj, 1, GL_FALSE, v.proj);
-        gl->Uniform3fv(dev->pm[pv].cam_pos, 1, v.cam_pos);
-        gl->Uniform3fv(dev->pm[pv].cam_fwd, 1, v.cam_fwd);
-        gl->Uniform1i(dev->pm[pv].ortho, v.ortho);
-    }
+    draw_ctx dc = {.v = &v, .ortho_z = {v.proj[10], v.proj[14], 0.0f}, .bound = -1};
+    m4_mul(v.proj, v.view, dc.viewproj);
     gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_LIGHTS, dev->lights_ubo);
     gl->ActiveTexture(GL_TEXTURE0 + UNIT_SHADOW);
     gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->shadow_tex);
-    /* opaque, then alpha-masked (the discard variant), then blended back to front with depth
-     * writes off */
-    float *blend = NULL;
-    uint32_t nblend = 0;
-    int bound = -1;
-    for (int pass = 0; pass < 2; ++pass) {
-        for (uint32_t i = 0; i < dev->instances.count; ++i) {
-            const inst_o *in = pool_at(&dev->instances, i);
-            if (!in->h.id || !in->visible) continue;
-            const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
-            if (!m) continue;
-            const mat_o *mt = pool_get(&dev->materials, in->material.id);
-            sy_gl_alpha_mode mode = mt ? mt->d.alpha_mode : SY_GL_ALPHA_OPAQUE;
-            if (mode == SY_GL_ALPHA_BLEND) {
-                if (pass == 1) continue;
-                if (!blend && !(blend = malloc(sizeof(float) * 2 * dev->instances.count)))
-                    return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory");
-                float z = 0.0f;
-                for (int a = 0; a < 3; ++a) {
-                    float wv = in->model[12 + a];
-                    for (int k = 0; k < 3; ++k) wv += in->model[4 * k + a] * 0.5f * (m->bmin[k] + m->bmax[k]);
-                    z += (wv - v.cam_pos[a]) * v.cam_fwd[a];
-                }
-                blend[2 * nblend] = z;
-                memcpy(&blend[2 * nblend + 1], &i, sizeof i);
-                nblend++;
-                continue;
-            }
-            if ((mode == SY_GL_ALPHA_MASK) != (pass == 1)) continue;
-            int pv = pass * 2 + mesh_lean(m);
-            if (pv != bound) gl->UseProgram(dev->pm[pv].prog);
-            bound = pv;
-            draw_instance(dev, pv, in, m);
-        }
+    /* opaque near to far (early depth tests reject hidden fragments before shading), then
+     * alpha-masked (the discard variant) near to far, then blended far to near with depth writes
+     * off. Each list holds (view distance, instance index) pairs. */
+    uint32_t cap = dev->instances.count ? dev->instances.count : 1, nl[3] = {0, 0, 0};
+    float *lists = malloc(sizeof(float) * 2 * 3 * cap);
+    if (!lists) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory");
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        const inst_o *in = pool_at(&dev->instances, i);
+        if (!in->h.id || !in->visible) continue;
+        const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
+        if (!m) continue;
+        const mat_o *mt = pool_get(&dev->materials, in->material.id);
+        sy_gl_alpha_mode mode = mt ? mt->d.alpha_mode : SY_GL_ALPHA_OPAQUE;
+        int li = mode == SY_GL_ALPHA_BLEND ? 2 : mode == SY_GL_ALPHA_MASK ? 1 : 0;
+        float *e = lists + 2 * ((size_t)li * cap + nl[li]++);
+        e[0] = view_distance(in, m, &v);
+        memcpy(&e[1], &i, sizeof i);
     }
-    if (nblend) {
-        qsort(blend, nblend, 2 * sizeof(float), cmp_far_first);
-        gl->Enable(GL_BLEND);
-        gl->Disablei(GL_BLEND, 1); /* linear depth: the last (nearest) blended surface wins */
-        gl->BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA); /* premultiplied over */
-        gl->DepthMask(GL_FALSE);
-        for (uint32_t k = 0; k < nblend; ++k) {
+    for (int li = 0; li < 3 && r == SY_GL_OK; ++li) {
+        float *list = lists + 2 * (size_t)li * cap;
+        qsort(list, nl[li], 2 * sizeof(float), li == 2 ? cmp_far_first : cmp_near_first);
+        if (li == 2 && nl[li]) {
+            gl->Enable(GL_BLEND);
+            gl->Disablei(GL_BLEND, 1); /* linear depth: the last (nearest) blended surface wins */
+            gl->BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA); /* premultiplied over */
+            gl->DepthMask(GL_FALSE);
+        }
+        for (uint32_t k = 0; k < nl[li] && r == SY_GL_OK; ++k) {
             uint32_t i;
-            memcpy(&i, &blend[2 * k + 1], sizeof i);
+            memcpy(&i, &list[2 * k + 1], sizeof i);
             const inst_o *in = pool_at(&dev->instances, i);
-            const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
-            int pv = mesh_lean(m);
-            if (pv != bound) gl->UseProgram(dev->pm[pv].prog);
-            bound = pv;
-            draw_instance(dev, pv, in, m);
+            r = draw_instance(dev, &dc, in, pool_get(&dev->meshes, in->mesh.id), pool_get(&dev->materials, in->material.id),
+                              err, err_len);
         }
-        gl->DepthMask(GL_TRUE);
-        gl->Disable(GL_BLEND);
+        if (li == 2 && nl[li]) {
+            gl->DepthMask(GL_TRUE);
+            gl->Disable(GL_BLEND);
+        }
     }
-    free(blend);
-    r = finish_target(dev, rgba, depth, err, err_len);
+    free(lists);
+    if (r == SY_GL_OK) r = finish_target(dev, rgba, depth, err, err_len);
     frame_end(dev);
     return r;
 }

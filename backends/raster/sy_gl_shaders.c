@@ -8,24 +8,52 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Vertex attributes: 0 position, 1 normal, 2 uv0, 3 uv1, 4 colour. */
+/* Vertex attributes: 0 position, 1 normal, 2 uv0, 3 uv1, 4 colour. Variant defines (see
+ * sy_gl_device.c main_program): SY_LEAN (no uv1 / colours), SY_MASK (alpha mask: discard), SY_TEX
+ * (the material has a texture: uv varyings), SY_NMAP (normal map), SY_LIGHTS (punctual lights),
+ * SY_AMBIENT (background ambient), SY_SHADOW (shadow maps), SY_NLIGHTS (a constant light count:
+ * the loop unrolls with constant uniform-block offsets). Every varying costs set-up per
+ * triangle and interpolation per fragment in a software rasterizer, so a variant interpolates only
+ * what it reads; unlit variants (no lights, no ambient) need no position or normal at all. */
+#define SY_GL_VARIANT_PRELUDE                                 \
+    "#if defined(SY_LIGHTS) || defined(SY_AMBIENT)\n"         \
+    "#define SY_LIT 1\n"                                      \
+    "#endif\n"                                                \
+    "#if defined(SY_TEX) && !defined(SY_LEAN)\n"              \
+    "#define SY_UV1 1\n"                                      \
+    "#endif\n"
+
 const char *const sy_gl_main_vs =
-    "#version 330 core\n"
+    "#version 330 core\n" SY_GL_VARIANT_PRELUDE
     "layout(location=0) in vec3 a_pos; layout(location=1) in vec3 a_nrm; layout(location=2) in vec2 a_uv0;\n"
     "layout(location=3) in vec2 a_uv1; layout(location=4) in vec4 a_col;\n"
-    "uniform mat4 u_model; uniform mat3 u_normal_mat; uniform mat4 u_view; uniform mat4 u_proj;\n"
-    "out vec3 v_wpos; out vec3 v_nrm; out vec2 v_uv0; out float v_vz;\n"
-    /* SY_LEAN: meshes without a second uv set and vertex colours interpolate fewer varyings */
+    "uniform mat4 u_model; uniform mat3 u_normal_mat; uniform mat4 u_mvp;\n" /* u_mvp = proj * view * model (CPU) */
+    "#ifdef SY_LIT\n"
+    "out vec3 v_wpos; out vec3 v_nrm;\n"
+    "#endif\n"
+    "#ifdef SY_TEX\n"
+    "out vec2 v_uv0;\n"
+    "#endif\n"
+    "#ifdef SY_UV1\n"
+    "out vec2 v_uv1;\n"
+    "#endif\n"
     "#ifndef SY_LEAN\n"
-    "out vec2 v_uv1; out vec4 v_col;\n"
+    "out vec4 v_col;\n"
     "#endif\n"
     "void main() {\n"
-    "  vec4 w = u_model * vec4(a_pos, 1.0); v_wpos = w.xyz; v_nrm = u_normal_mat * a_nrm;\n"
-    "  v_uv0 = a_uv0; vec4 e = u_view * w; v_vz = -e.z;\n"
-    "#ifndef SY_LEAN\n"
-    "  v_uv1 = a_uv1; v_col = a_col;\n"
+    "#ifdef SY_LIT\n"
+    "  v_wpos = (u_model * vec4(a_pos, 1.0)).xyz; v_nrm = u_normal_mat * a_nrm;\n"
     "#endif\n"
-    "  gl_Position = u_proj * e;\n"
+    "#ifdef SY_TEX\n"
+    "  v_uv0 = a_uv0;\n"
+    "#endif\n"
+    "#ifdef SY_UV1\n"
+    "  v_uv1 = a_uv1;\n"
+    "#endif\n"
+    "#ifndef SY_LEAN\n"
+    "  v_col = a_col;\n"
+    "#endif\n"
+    "  gl_Position = u_mvp * vec4(a_pos, 1.0);\n"
     "}\n";
 
 #define SY_GL_MATERIAL_BLOCK                                                                                 \
@@ -36,23 +64,36 @@ const char *const sy_gl_main_vs =
     "vec2 uvset(int s, vec2 a, vec2 b) { return s == 1 ? b : a; }\n"
 
 const char *const sy_gl_main_fs =
-    "#version 330 core\n" SY_GL_MATERIAL_BLOCK
+    "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_MATERIAL_BLOCK
     "struct Light { vec4 pos_type; vec4 dir_range; vec4 radiant; vec4 cone; };\n"
     "layout(std140) uniform Lights { ivec4 l_count; vec4 l_ambient; mat4 l_shadow_mat[4]; vec4 l_shadow[4];\n"
     "  Light l_lights[32]; };\n"
     "uniform sampler2DArrayShadow t_shadow;\n"
     "uniform vec3 u_cam_pos; uniform vec3 u_cam_fwd; uniform bool u_ortho; uniform bool u_mirror;\n"
-    "uniform bool u_has_normals;\n"
-    "in vec3 v_wpos; in vec3 v_nrm; in vec2 v_uv0; in float v_vz;\n"
-    "#ifdef SY_LEAN\n"
-    "const vec2 v_uv1 = vec2(0.0); const vec4 v_col = vec4(1.0);\n" /* absent sets read as 0, as in backends/rt */
+    "uniform bool u_has_normals; uniform vec3 u_ortho_z;\n" /* orthographic: proj[10], proj[14] */
+    "#ifdef SY_LIT\n"
+    "in vec3 v_wpos; in vec3 v_nrm;\n"
+    "#endif\n"
+    "#ifdef SY_TEX\n"
+    "in vec2 v_uv0;\n"
     "#else\n"
-    "in vec2 v_uv1; in vec4 v_col;\n"
+    "const vec2 v_uv0 = vec2(0.0);\n"
+    "#endif\n"
+    "#ifdef SY_UV1\n"
+    "in vec2 v_uv1;\n"
+    "#else\n"
+    "const vec2 v_uv1 = vec2(0.0);\n" /* absent sets read as 0, as in backends/rt */
+    "#endif\n"
+    "#ifdef SY_LEAN\n"
+    "const vec4 v_col = vec4(1.0);\n"
+    "#else\n"
+    "in vec4 v_col;\n"
     "#endif\n"
     "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
     "const float INV_PI = 0.31830988618;\n"
     "vec3 schlick(vec3 f0, float c) { float m = 1.0 - clamp(c, 0.0, 1.0); float m5 = m*m*m*m*m;\n"
     "  return f0 + (vec3(1.0) - f0) * m5; }\n"
+    "#ifdef SY_SHADOW\n"
     "float shadow_vis(int si, vec3 p, vec3 ngf) {\n"
     "  vec4 sp = l_shadow[si]; vec4 c0 = l_shadow_mat[si] * vec4(p, 1.0); if (c0.w <= 0.0) return 1.0;\n"
     "  float off = sp.x * (sp.y > 0.5 ? c0.w : 1.0);\n"
@@ -62,28 +103,37 @@ const char *const sy_gl_main_fs =
     "  for (int y = -1; y <= 1; ++y) for (int x = -1; x <= 1; ++x)\n"
     "    s += texture(t_shadow, vec4(q.xy + vec2(x, y) * ts, float(si), q.z));\n"
     "  return s / 9.0; }\n"
+    "#endif\n"
     "void main() {\n"
     "  vec2 uv[2] = vec2[2](v_uv0, v_uv1);\n"
     "  vec4 base = m_base * v_col;\n"
+    "#ifdef SY_TEX\n"
     "  if (m_tex.x >= 0) base *= texture(t_base, uv[m_tex.x]);\n"
+    "#endif\n"
     "  float alpha = base.a;\n"
     "#ifdef SY_MASK\n"
     "  if (alpha < m_mrna.w) discard;\n" /* discard only in this variant: it disables early depth tests */
     "#endif\n"
     "  if (m_modes.x != 2) alpha = 1.0;\n"
     "  bool front = gl_FrontFacing != u_mirror;\n"
-    "  vec3 dpx = dFdx(v_wpos), dpy = dFdy(v_wpos);\n"
-    "  vec3 wo = u_ortho ? -u_cam_fwd : normalize(u_cam_pos - v_wpos);\n"
-    "  vec3 ngf = normalize(cross(dpx, dpy)); if (dot(ngf, wo) < 0.0) ngf = -ngf;\n"
-    "  if (any(isnan(ngf))) ngf = wo;\n"
     "  vec3 L = vec3(0.0);\n"
     "  if (m_modes.w != 0 && (front || m_modes.z != 0)) {\n"
-    "    L = m_emissive.rgb; if (m_tex2.x >= 0) L *= texture(t_emis, uv[m_tex2.x]).rgb;\n"
+    "    L = m_emissive.rgb;\n"
+    "#ifdef SY_TEX\n"
+    "    if (m_tex2.x >= 0) L *= texture(t_emis, uv[m_tex2.x]).rgb;\n"
+    "#endif\n"
     "  } else if (m_modes.y != 0) {\n"
     "    L = base.rgb;\n"
-    "  } else {\n"
+    "  }\n"
+    "#ifdef SY_LIT\n" /* without lights and ambient a surface that is neither emissive nor unlit is black */
+    "  else {\n"
+    "    vec3 dpx = dFdx(v_wpos), dpy = dFdy(v_wpos);\n"
+    "    vec3 wo = u_ortho ? -u_cam_fwd : normalize(u_cam_pos - v_wpos);\n"
+    "    vec3 ngf = normalize(cross(dpx, dpy)); if (dot(ngf, wo) < 0.0) ngf = -ngf;\n"
+    "    if (any(isnan(ngf))) ngf = wo;\n"
     "    vec3 n = front ? ngf : -ngf;\n"
     "    if (u_has_normals) { vec3 sn = normalize(v_nrm); if (!any(isnan(sn))) n = sn; }\n"
+    "#ifdef SY_NMAP\n"
     "    if (m_tex.z >= 0) {\n"
     "      vec2 t = uv[m_tex.z]; vec2 dtx = dFdx(t), dty = dFdy(t);\n"
     "      vec3 pp2 = cross(dpy, n), pp1 = cross(n, dpx);\n"
@@ -96,16 +146,23 @@ const char *const sy_gl_main_fs =
     "        if (dot(r, r) > 0.0) n = normalize(r);\n"
     "      }\n"
     "    }\n"
+    "#endif\n"
     "    vec3 ns = front ? n : -n;\n"
     "    float metallic = m_mrna.x, rough = m_mrna.y;\n"
+    "#ifdef SY_TEX\n"
     "    if (m_tex.y >= 0) { vec4 t = texture(t_mr, uv[m_tex.y]); rough *= t.g; metallic *= t.b; }\n"
+    "#endif\n"
     "    float ior = m_oist.y, spec = m_oist.z, trans = m_oist.w;\n"
     "    float r0 = (ior - 1.0) / (ior + 1.0); float f0d = r0 * r0 * spec;\n"
     "    vec3 f0 = vec3(f0d) * (1.0 - metallic) + base.rgb * metallic;\n"
     "    vec3 kd = base.rgb * (1.0 - metallic) * (1.0 - trans);\n"
     "    float a = max(rough * rough, 1e-4), a2 = a * a;\n"
     "    float nv = max(dot(ns, wo), 1e-4);\n"
-    "    for (int i = 0; i < l_count.x; ++i) {\n"
+    "#ifdef SY_LIGHTS\n"
+    "#ifndef SY_NLIGHTS\n"
+    "#define SY_NLIGHTS l_count.x\n"
+    "#endif\n"
+    "    for (int i = 0; i < SY_NLIGHTS; ++i) {\n"
     "      Light l = l_lights[i]; int type = int(l.pos_type.w); vec3 wi, e;\n"
     "      if (type == 3) { wi = -l.dir_range.xyz; e = l.radiant.rgb; }\n"
     "      else {\n"
@@ -116,8 +173,12 @@ const char *const sy_gl_main_fs =
     "        if (!(att > 0.0)) continue; e = l.radiant.rgb * att;\n"
     "      }\n"
     "      float cs = dot(ns, wi); if (cs <= 0.0 || dot(ngf, wi) <= 0.0) continue;\n"
+    "#ifdef SY_SHADOW\n"
     "      int si = int(l.cone.z); float vis = si >= 0 ? shadow_vis(si, v_wpos, ngf) : 1.0;\n"
     "      if (vis <= 0.0) continue;\n"
+    "#else\n"
+    "      float vis = 1.0;\n"
+    "#endif\n"
     "      vec3 f = kd * INV_PI;\n"
     "      if (rough > 0.0 && any(greaterThan(f0, vec3(0.0)))) {\n"
     "        vec3 h = normalize(wi + wo); float nl = cs, nh = max(dot(ns, h), 0.0);\n"
@@ -127,13 +188,20 @@ const char *const sy_gl_main_fs =
     "      }\n"
     "      L += e * f * cs * vis;\n"
     "    }\n"
-    "    if (l_ambient.w > 0.0) {\n"
-    "      float ao = 1.0; if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, uv[m_tex.w]).r - 1.0);\n"
-    "      L += l_ambient.rgb * (kd + schlick(f0, nv)) * ao;\n"
-    "    }\n"
+    "#endif\n"
+    "#ifdef SY_AMBIENT\n"
+    "    float ao = 1.0;\n"
+    "#ifdef SY_TEX\n"
+    "    if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, uv[m_tex.w]).r - 1.0);\n"
+    "#endif\n"
+    "    L += l_ambient.rgb * (kd + schlick(f0, nv)) * ao;\n"
+    "#endif\n"
     "  }\n"
+    "#endif\n"
     "  o_color = vec4(L * alpha, alpha);\n"
-    "  o_depth = v_vz;\n"
+    /* linear view depth from the window coordinates: 1/w_clip = 1/z_view in perspective, the
+     * inverse depth mapping in orthographic views; one varying less */
+    "  o_depth = u_ortho ? -((gl_FragCoord.z * 2.0 - 1.0) - u_ortho_z.y) / u_ortho_z.x : 1.0 / gl_FragCoord.w;\n"
     "}\n";
 
 const char *const sy_gl_shadow_vs =

@@ -8,6 +8,11 @@
 #include "sy_rt_bench.h"
 #include "sy_mirror.h"
 
+#include "sy_filter_adaptive.h"
+#include "sy_filter_atrous.h"
+#include "sy_filter_jbu.h"
+#include "sy_filter_pixel.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,7 +29,29 @@ typedef struct accum_slot {
     uint32_t full_w, full_h, rect[4], bg, seed;
     uint64_t version;  /* device version the accumulation belongs to */
     uint64_t last_use;
+    sy_filter_pixel *pixel;  /* pixel-filter state of this accumulation (display filter "pixel") */
+    uint32_t pass_samples;   /* sample count of its last filter pass, 0 = none since the restart */
 } accum_slot;
+
+/* Display filter of the path tracer (backends/filters), applied to the returned layer only: the
+ * accumulation never sees it, so changing it never restarts sampling. */
+typedef enum pt_filter_kind {
+    PT_FILTER_NONE,
+    PT_FILTER_PIXEL,
+    PT_FILTER_ATROUS,
+    PT_FILTER_JBU,
+    PT_FILTER_ADAPTIVE,
+    PT_FILTER_KIND_COUNT
+} pt_filter_kind;
+static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel", "atrous", "jbu", "adaptive"};
+
+typedef struct pt_filter_cfg {
+    pt_filter_kind kind;
+    sy_filter_pixel_params pixel;       /* threshold shared with adaptive */
+    sy_filter_atrous_params atrous;
+    sy_filter_jbu_params jbu;
+    sy_filter_adaptive_params adaptive;
+} pt_filter_cfg;
 
 /* The scene mirror (textures, materials, meshes, lights, backgrounds, nodes and placements) is
  * mediators/sy_mirror; this adapter turns its callbacks into Embree back-end calls. */
@@ -44,6 +71,10 @@ typedef struct rt_state {
     uint64_t use_clock;
     uint32_t *inst_node;           /* back-end instance slot index -> core node id (coverage) */
     uint32_t inst_node_cap;
+    pt_filter_cfg filter;          /* path tracer display filter */
+    float *fbuf[SY_RT_AOV_COUNT + 1]; /* filter inputs: the AOV planes + world positions */
+    size_t fbuf_px;                /* pixels the fbuf planes hold */
+    sy_mediator_rt_filter_info finfo; /* last filtered frame */
 } rt_state;
 
 #define RT_HANDLE_INDEX(h) ((h) & 0x3fffffu) /* backends/rt handles: 22-bit slot index */
@@ -334,6 +365,8 @@ static sy_result pt_slot(rt_state *st, const sy_render_request *req, sy_error *e
         if (a->version != ds.version) { /* something visible changed since the last pass */
             sy_rt_accum_reset(a->acc);
             st->counters.accum_restarts++;
+            sy_filter_pixel_reset(a->pixel);
+            a->pass_samples = 0;
         }
     } else {
         found = lru;
@@ -350,6 +383,8 @@ static sy_result pt_slot(rt_state *st, const sy_render_request *req, sy_error *e
             sy_rt_accum_reset(a->acc);
         }
         if (st->last_slot >= 0) st->counters.accum_restarts++;
+        sy_filter_pixel_reset(a->pixel);
+        a->pass_samples = 0;
         a->camera = req->camera;
         a->full_w = req->full_width;
         a->full_h = req->full_height;
@@ -464,6 +499,214 @@ sy_result sy_mediator_rt_coverage(void *state, const sy_camera_view *view, uint3
     return SY_OK;
 }
 
+/* >>display filters
+ * The path tracer's layer can be filtered for display (backends/filters) from the accumulation's
+ * feature buffers. Parameters (creation and sy_mediator_rt_set_filter): filter, threshold, sigma_s,
+ * sigma_c, sigma_d, filter_kernel, filter_iterations, filter_start, atrous_iterations, jbu_factor. */
+static sy_result filter_fail(sy_error *err, const sy_filter_error *fe)
+{
+    return sy_error_set(err, fe->status == SY_FILTER_ERROR_OUT_OF_MEMORY ? SY_ERR_OUT_OF_MEMORY : SY_ERR_INVALID_ARGUMENT,
+                        "pathtracer filter: %s", fe->message);
+}
+
+static void filter_cfg_default(pt_filter_cfg *c, uint32_t threads)
+{
+    memset(c, 0, sizeof *c);
+    c->kind = PT_FILTER_NONE;
+    sy_filter_pixel_params_default(&c->pixel);
+    sy_filter_atrous_params_default(&c->atrous);
+    sy_filter_jbu_params_default(&c->jbu);
+    sy_filter_adaptive_params_default(&c->adaptive);
+    c->adaptive.threshold = c->pixel.threshold;
+    if (threads > SY_FILTER_MAX_THREADS) threads = SY_FILTER_MAX_THREADS;
+    c->pixel.threads = c->atrous.threads = c->jbu.threads = c->adaptive.threads = threads;
+}
+
+/* New configuration = *base with the filter `name` (NULL: p's "filter", absent: unchanged) and the
+ * keys present in p (absent keys keep base's values). Validated as a whole; *base unchanged on error. */
+static sy_result filter_cfg_apply(pt_filter_cfg *base, const char *name, const sy_params *p_in, sy_error *err)
+{
+    static const sy_params empty;
+    const sy_params *p = p_in ? p_in : &empty;
+    pt_filter_cfg c = *base;
+    const char *nm = name ? name : sy_params_get(p, "filter");
+    if (nm) {
+        int k = -1;
+        for (int i = 0; i < PT_FILTER_KIND_COUNT; ++i)
+            if (!strcmp(nm, pt_filter_names[i])) k = i;
+        if (k < 0 && !strcmp(nm, "radiance"))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "pathtracer: filter=radiance is not available: needs the integrator's stored-sample hook "
+                                "(per-pixel incident radiance at the first non-specular hit), which the path tracer "
+                                "does not provide yet");
+        if (k < 0)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "pathtracer: unknown filter '%s' (expected none, pixel, atrous, jbu or adaptive)", nm);
+        c.kind = (pt_filter_kind)k;
+    }
+    double v;
+    long l;
+    sy_result r;
+    if ((r = sy_params_get_float(p, "threshold", c.pixel.threshold, 0.0, 1e6, &v, err))) return r;
+    c.pixel.threshold = c.adaptive.threshold = (float)v;
+    if ((r = sy_params_get_float(p, "sigma_s", c.pixel.sigma_s, 0.0, 1000.0, &v, err))) return r;
+    c.pixel.sigma_s = (float)v;
+    if ((r = sy_params_get_float(p, "sigma_c", c.pixel.sigma_c, 0.0, 1e6, &v, err))) return r;
+    c.pixel.sigma_c = (float)v;
+    if ((r = sy_params_get_float(p, "sigma_d", c.pixel.sigma_d, 0.0, 1e9, &v, err))) return r;
+    c.pixel.sigma_d = (float)v;
+    const char *kern = sy_params_get(p, "filter_kernel");
+    if (kern) {
+        if (!strcmp(kern, "separable")) c.pixel.kernel = SY_FILTER_PIXEL_SEPARABLE;
+        else if (!strcmp(kern, "brute")) c.pixel.kernel = SY_FILTER_PIXEL_BRUTE;
+        else
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "parameter filter_kernel=%s: expected separable or brute", kern);
+    }
+    if ((r = sy_params_get_int(p, "filter_iterations", c.pixel.iterations, 1, 8, &l, err))) return r;
+    c.pixel.iterations = (uint32_t)l;
+    if ((r = sy_params_get_int(p, "filter_start", c.pixel.schedule_start, 1, 1L << 30, &l, err))) return r;
+    c.pixel.schedule_start = (uint32_t)l;
+    if ((r = sy_params_get_int(p, "atrous_iterations", c.atrous.iterations, 1, 10, &l, err))) return r;
+    c.atrous.iterations = (uint32_t)l;
+    if ((r = sy_params_get_int(p, "jbu_factor", c.jbu.factor, 1, 64, &l, err))) return r;
+    c.jbu.factor = (uint32_t)l;
+    sy_filter_error fe = {0};
+    if (sy_filter_pixel_params_check(&c.pixel, &fe) || sy_filter_atrous_params_check(&c.atrous, &fe) ||
+        sy_filter_jbu_params_check(&c.jbu, &fe) ||
+        (c.kind == PT_FILTER_ADAPTIVE && sy_filter_adaptive_params_check(&c.adaptive, &fe)))
+        return filter_fail(err, &fe);
+    *base = c;
+    return SY_OK;
+}
+
+sy_result sy_mediator_rt_set_filter(void *state, const char *name, const sy_params *opts, sy_error *err)
+{
+    rt_state *st = state;
+    if (st->integrator != SY_RT_INTEGRATOR_PATHTRACER)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "set filter: only the pathtracer class has display filters");
+    pt_filter_cfg c = st->filter;
+    sy_result r = filter_cfg_apply(&c, name, opts, err);
+    if (r != SY_OK) return r;
+    /* Only the threshold acts on the blend alone; anything else invalidates the filtered buffers,
+     * which are recomputed at the next frame (the accumulation itself is never touched). */
+    sy_filter_pixel_params a = st->filter.pixel, b = c.pixel;
+    a.threshold = b.threshold = 0.0f;
+    bool refilter = c.kind != st->filter.kind || memcmp(&a, &b, sizeof a) != 0;
+    for (int i = 0; i < ACCUM_SLOTS; ++i) {
+        accum_slot *s = &st->slots[i];
+        if (!s->pixel) continue;
+        sy_filter_error fe = {0};
+        if (sy_filter_pixel_set_params(s->pixel, &c.pixel, &fe)) return filter_fail(err, &fe);
+        if (refilter) {
+            sy_filter_pixel_reset(s->pixel);
+            s->pass_samples = 0;
+        }
+    }
+    st->filter = c;
+    return SY_OK;
+}
+
+void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out)
+{
+    rt_state *st = state;
+    *out = st->finfo;
+    out->name = pt_filter_names[st->filter.kind];
+    out->threshold = st->filter.pixel.threshold;
+}
+
+/* World positions of the first hits of the rectangle's pixels from the camera-axis depth (the
+ * a-trous guide and the headlight of the pixel filter's range buffer); misses go 1e18 away. */
+static void filter_positions(const sy_render_request *req, const float *depth, float *pos)
+{
+    const sy_camera_view *v = &req->camera;
+    const float *m = v->camera_to_world.m;
+    bool ortho = v->projection == SY_PROJECTION_ORTHOGRAPHIC;
+    for (uint32_t y = 0; y < req->rect_h; ++y)
+        for (uint32_t x = 0; x < req->rect_w; ++x) {
+            size_t i = (size_t)y * req->rect_w + x;
+            float u = v->window[0] + (v->window[1] - v->window[0]) * ((float)(req->rect_x + x) + 0.5f) / (float)req->full_width;
+            float w = v->window[3] - (v->window[3] - v->window[2]) * ((float)(req->rect_y + y) + 0.5f) / (float)req->full_height;
+            float d = depth[i];
+            if (!isfinite(d)) d = 1e18f;
+            float c[3] = {ortho ? u : u * d, ortho ? w : w * d, -d};
+            for (int k = 0; k < 3; ++k) pos[3 * i + k] = m[k] * c[0] + m[4 + k] * c[1] + m[8 + k] * c[2] + m[12 + k];
+        }
+}
+
+/* Filters the layer the path tracer just wrote (rectangle of the slot st->last_slot). */
+static sy_result filter_layer(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err)
+{
+    accum_slot *a = &st->slots[st->last_slot];
+    size_t n = (size_t)req->rect_w * req->rect_h;
+    if (n > st->fbuf_px) {
+        for (int k = 0; k <= SY_RT_AOV_COUNT; ++k) {
+            free(st->fbuf[k]);
+            st->fbuf[k] = malloc(n * (k < SY_RT_AOV_COUNT ? sy_rt_aov_channels((sy_rt_aov)k) : 3u) * sizeof(float));
+        }
+        st->fbuf_px = n;
+        for (int k = 0; k <= SY_RT_AOV_COUNT; ++k)
+            if (!st->fbuf[k]) {
+                st->fbuf_px = 0;
+                return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "pathtracer filter: out of memory for %ux%u", req->rect_w,
+                                    req->rect_h);
+            }
+    }
+    char e[ERRLEN];
+    for (int k = 0; k < SY_RT_AOV_COUNT; ++k) {
+        sy_rt_result rr = sy_rt_accum_read(a->acc, (sy_rt_aov)k, st->fbuf[k], e, sizeof e);
+        if (rr != SY_RT_OK) return rt_fail(err, rr, "pathtracer filter: feature buffers", e);
+    }
+    filter_positions(req, st->fbuf[SY_RT_AOV_DEPTH], st->fbuf[SY_RT_AOV_COUNT]);
+    uint32_t samples = sy_rt_accum_samples(a->acc);
+    const float *m = req->camera.camera_to_world.m;
+    sy_filter_frame f = {
+        .width = req->rect_w,
+        .height = req->rect_h,
+        .color_channels = 4,
+        .variance_channels = 3,
+        .color = st->fbuf[SY_RT_AOV_COLOR],
+        .variance = st->fbuf[SY_RT_AOV_VARIANCE],
+        .albedo = st->fbuf[SY_RT_AOV_ALBEDO],
+        .normal = st->fbuf[SY_RT_AOV_NORMAL],
+        .depth = st->fbuf[SY_RT_AOV_DEPTH],
+        .position = st->fbuf[SY_RT_AOV_COUNT],
+        .direct = st->fbuf[SY_RT_AOV_DIRECT],
+        .indirect = st->fbuf[SY_RT_AOV_INDIRECT],
+        .spp_uniform = (float)samples,
+        .has_camera = req->camera.projection != SY_PROJECTION_ORTHOGRAPHIC,
+        .camera_position = {m[12], m[13], m[14]},
+    };
+    sy_filter_stats fs = {0};
+    sy_filter_error fe = {0};
+    sy_filter_status s = SY_FILTER_OK;
+    switch (st->filter.kind) {
+    case PT_FILTER_PIXEL: {
+        if (!a->pixel && (s = sy_filter_pixel_create(&st->filter.pixel, &a->pixel, &fe))) break;
+        /* a pass whenever the count reached the next power of two of the schedule (a render may
+         * add several samples at once and step over 2^i) */
+        uint64_t next = st->filter.pixel.schedule_start;
+        while (next <= a->pass_samples) next *= 2;
+        s = sy_filter_pixel_run(a->pixel, &f, samples, samples >= next, layer->rgba, &fs, &fe);
+        if (!s && fs.filter_pass) a->pass_samples = samples;
+        break;
+    }
+    case PT_FILTER_ATROUS: s = sy_filter_atrous(&st->filter.atrous, &f, layer->rgba, &fs, &fe); break;
+    case PT_FILTER_JBU: s = sy_filter_jbu(&st->filter.jbu, &f, layer->rgba, &fs, &fe); break;
+    case PT_FILTER_ADAPTIVE: s = sy_filter_adaptive(&st->filter.adaptive, &f, layer->rgba, NULL, &fs, &fe); break;
+    default: break;
+    }
+    if (s) return filter_fail(err, &fe);
+    st->finfo.nonfinite_pixels = fs.nonfinite_samples;
+    st->finfo.nonfinite_samples = sy_rt_accum_nonfinite(a->acc);
+    st->finfo.seconds = fs.seconds;
+    st->finfo.filter_pass = fs.filter_pass;
+    st->finfo.mean_blend = fs.mean_blend;
+    st->finfo.last_pass_samples = a->pass_samples;
+    st->finfo.frames++;
+    return SY_OK;
+}
+
 static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     rt_state *st = state;
@@ -512,6 +755,7 @@ static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *
     if (r != SY_RT_OK) return rt_fail(err, r, "render", e);
     if (d.accum) st->counters.last_render_rays = sy_rt_accum_last_rays(d.accum);
     st->frames_rendered++;
+    if (d.accum && st->filter.kind != PT_FILTER_NONE) return filter_layer(st, req, layer, err);
     return SY_OK;
 }
 
@@ -521,7 +765,11 @@ static void rt_destroy(void *state)
     rt_state *st = state;
     if (!st) return;
     sy_mirror_destroy(st->mirror); /* releases instances, lights and meshes while the device lives */
-    for (int i = 0; i < ACCUM_SLOTS; ++i) sy_rt_accum_destroy(st->slots[i].acc);
+    for (int i = 0; i < ACCUM_SLOTS; ++i) {
+        sy_rt_accum_destroy(st->slots[i].acc);
+        sy_filter_pixel_destroy(st->slots[i].pixel);
+    }
+    for (int k = 0; k <= SY_RT_AOV_COUNT; ++k) free(st->fbuf[k]);
     sy_rt_device_destroy(st->dev);
     free(st->inst_node);
     free(st);
@@ -560,6 +808,11 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     st->light_samples = (uint32_t)light_samples;
     st->specular = (float)specular;
     st->last_slot = -1;
+    filter_cfg_default(&st->filter, (uint32_t)threads);
+    if (integrator == SY_RT_INTEGRATOR_PATHTRACER && (r = filter_cfg_apply(&st->filter, NULL, args->params, err)) != SY_OK) {
+        rt_destroy(st);
+        return r;
+    }
     *state_out = st;
     return SY_OK;
 }

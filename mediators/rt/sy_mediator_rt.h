@@ -66,6 +66,38 @@ void sy_mediator_rt_aovs_free(sy_mediator_rt_aovs *aovs);
 const char *sy_mediator_rt_aov_name(uint32_t index);   /* "color", "variance", "albedo", ... */
 uint32_t sy_mediator_rt_aov_channels(uint32_t index);  /* 4, 3, 3, 3, 1, 3, 3 */
 
+/* Display filter of the path tracer (backends/filters), applied per viewport to the layer the path
+ * tracer returns, computed from the accumulation's feature buffers; per accumulation slot (the
+ * pixel filter's state restarts with the slot's accumulation). Display-only: changing the filter
+ * or its options never restarts the accumulation. Parameters (at creation, the initial value):
+ *   filter=none|pixel|atrous|jbu|adaptive (default none; "radiance" is refused: it needs the
+ *     integrator's stored-sample hook, which does not exist yet)
+ *   threshold=T   perceived-variance threshold t of the pixel filter's blend and of the adaptive
+ *                 preview (default 0.01, >= 0; adaptive needs > 0)
+ *   sigma_s (pixels, default 8), sigma_c (virtual-flash colour, default 0.02), sigma_d (depth, scene
+ *   units, default 2): the pixel filter's cross-bilateral kernel (> 0)
+ *   filter_kernel=separable|brute (default separable), filter_iterations (1..8, default 3),
+ *   filter_start (first filter pass at this sample count, a power of two, default 4; then at every
+ *   power of two), atrous_iterations (1..10, default 5), jbu_factor (1..64, default 4).
+ * sy_mediator_rt_set_filter changes it live: name (NULL = opts' "filter" or unchanged) and the keys
+ * present in opts (NULL = none; absent keys keep their values). Only the threshold keeps the pixel
+ * filter's filtered buffer; any other change recomputes it at the next frame. On error nothing
+ * changes. Thread-safety: like render (the thread that renders the context). */
+sy_result sy_mediator_rt_set_filter(void *state, const char *name, const sy_params *opts, sy_error *err);
+
+typedef struct sy_mediator_rt_filter_info {
+    const char *name;           /* current filter ("none", "pixel", ...), static storage */
+    float threshold;            /* current threshold */
+    uint64_t frames;            /* filtered frames so far */
+    uint64_t nonfinite_pixels;  /* last filtered frame: NaN/Inf input pixels kept out of neighbourhoods */
+    uint64_t nonfinite_samples; /* last filtered accumulation: NaN/Inf samples the back-end replaced by 0 */
+    double seconds;             /* last filter call's wall time */
+    bool filter_pass;           /* pixel: a filter pass ran in the last frame */
+    double mean_blend;          /* pixel: mean blend factor s (1 = unfiltered everywhere) */
+    uint32_t last_pass_samples; /* pixel: sample count of the last filter pass (0 = none yet) */
+} sy_mediator_rt_filter_info;
+void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out);
+
 /* Counters of the adapter, for tests and benchmarks. */
 typedef struct sy_mediator_rt_counters {
     uint32_t instances, baked_instances, meshes, materials, textures, lights;

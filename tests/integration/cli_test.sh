@@ -8,6 +8,8 @@
 #   - sy bench sync / sy bench rays on small sizes: exit 0 and their result lines (no thresholds)
 #   - sy demo -o DIR -w 64 -h 36: demo_whitted.png / .exr written
 #   - -b pathtracer: --spp with --aov (EXR with feature channels), --time; a non-EXR --env fails
+#   - -b pathtracer --filter pixel --threshold T writes an image; --filter bogus / radiance and a
+#     negative threshold fail naming the problem
 #     naming the file
 #   - --stereo sbs / tb / anaglyph / separate: output sizes and per-eye files; bad stereo parameters
 #     and overlays (negative separation, zero parallax 0, unknown mode, missing file, unknown
@@ -237,6 +239,19 @@ run pt_time "$SY" render demo -b pathtracer --time 0.3 -w 16 -h 16 --background 
 [ "$rc" -eq 0 ] && magic "$TMP/pt/pt.png" 89504e47 || fail "pathtracer --time: status $rc, $(cat "$TMP/pt_time.err")"
 expect_error pt_env bad.gltf "$TMP/o_ptenv" "$SY" render demo -b pathtracer --spp 1 -w 8 -h 8 \
     --env "$TMP/in/bad.gltf" -o "$TMP/o_ptenv/x.exr"
+
+# ---------------------------------------------------------------- path tracer display filters (issue 7)
+mkdir -p "$TMP/o_ptfilter"
+run pt_filter "$SY" render demo -b pathtracer --spp 4 -w 32 -h 24 --filter pixel --threshold 0.02 -o "$TMP/pt/filtered.png"
+[ "$rc" -eq 0 ] && magic "$TMP/pt/filtered.png" 89504e47 &&
+    grep -q '^filter pixel: threshold 0.02, .*last pass at 4 spp.*NaN/Inf: 0 pixels' "$TMP/pt_filter.out" ||
+    fail "pathtracer --filter pixel: status $rc, $(cat "$TMP/pt_filter.out" "$TMP/pt_filter.err")"
+expect_error pt_filter_bad bogus "$TMP/o_ptfilter" "$SY" render demo -b pathtracer --spp 1 -w 8 -h 8 \
+    --filter bogus -o "$TMP/o_ptfilter/x.png"
+expect_error pt_filter_radiance "stored-sample hook" "$TMP/o_ptfilter" "$SY" render demo -b pathtracer --spp 1 -w 8 -h 8 \
+    --filter radiance -o "$TMP/o_ptfilter/x.png"
+expect_error pt_filter_threshold threshold "$TMP/o_ptfilter" "$SY" render demo -b pathtracer --spp 1 -w 8 -h 8 \
+    --filter pixel --threshold -1 -o "$TMP/o_ptfilter/x.png"
 
 if [ "$fails" -ne 0 ]; then
     echo "integration_cli: $fails failure(s)" >&2

@@ -30,6 +30,20 @@ fi
     echo "FAIL: the viewer's window does not show the rendered image"
     exit 1
 }
+# the path tracer with its pixel display filter (issue 7): applied on the render thread's context
+timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b pathtracer --filter pixel --threshold 0.02 \
+    -w 64 -h 48 --frames 6 --screenshot "$TMP/view_filter.png" >"$TMP/view_filter.out" 2>"$TMP/view_filter.err"
+rc=$?
+if [ $rc -ne 0 ] || [ ! -s "$TMP/view_filter.png" ] || ! grep -q "filter pixel t=0.02" "$TMP/view_filter.out"; then
+    echo "FAIL: sy view -b pathtracer --filter pixel: status $rc: $(cat "$TMP/view_filter.out" "$TMP/view_filter.err")"
+    exit 1
+fi
+# an unknown filter is refused before any window opens, naming it
+if "$SY" view demo -b pathtracer --filter bogus --frames 1 2>"$TMP/badf.err"; then
+    echo "FAIL: sy view accepted an unknown filter"
+    exit 1
+fi
+grep -q bogus "$TMP/badf.err" || { echo "FAIL: the error does not name the filter"; exit 1; }
 # a back-end that does not exist is refused before any window opens
 if "$SY" view demo -b nosuchbackend --frames 1 2>"$TMP/bad.err"; then
     echo "FAIL: sy view accepted an unknown back-end"
