@@ -49,18 +49,8 @@ static float power_heuristic(float a, float b)
 
 static bool unoccluded(pt_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar)
 {
-    struct RTCRay r;
-    r.org_x = org.x; r.org_y = org.y; r.org_z = org.z;
-    r.dir_x = dir.x; r.dir_y = dir.y; r.dir_z = dir.z;
-    r.tnear = 0.0f;
-    r.tfar = tfar;
-    r.time = 0.0f;
-    r.mask = 0xffffffffu;
-    r.id = 0;
-    r.flags = 0;
-    rtcOccluded1(c->dev->top, &c->ictx, &r);
     c->rays++;
-    return r.tfar >= 0.0f;
+    return sy_rt_segment_clear(c->dev, &c->ictx, org, dir, tfar);
 }
 
 /* One light sample from the shading point: returns f * Le * cos * MIS weight / pdf (visibility

@@ -34,6 +34,24 @@ void sy_rt_frame_ray(const sy_rt_frame *f, uint32_t px, uint32_t py, struct RTCR
  * sy_rt_frame_ray(px, py) is sy_rt_frame_ray_at(px + 0.5, py + 0.5). */
 void sy_rt_frame_ray_at(const sy_rt_frame *f, float fx, float fy, struct RTCRay *ray, float *axial);
 
+/* Shadow / visibility ray shared by the integrators: true when nothing in the top scene blocks
+ * org + t*dir for t in (0, tfar). Alpha-mask filters installed on geometry apply. */
+static inline bool sy_rt_segment_clear(const sy_rt_device *dev, struct RTCIntersectContext *ctx, sy_rt_v3 org,
+                                       sy_rt_v3 dir, float tfar)
+{
+    struct RTCRay r;
+    r.org_x = org.x, r.org_y = org.y, r.org_z = org.z;
+    r.dir_x = dir.x, r.dir_y = dir.y, r.dir_z = dir.z;
+    r.tnear = 0.0f;
+    r.tfar = tfar;
+    r.time = 0.0f;
+    r.mask = 0xffffffffu;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(dev->top, ctx, &r);
+    return r.tfar >= 0.0f;
+}
+
 /* Renders one tile: pixels [x0, x1) x [y0, y1) in full-image coordinates. */
 typedef void (*sy_rt_tile_fn)(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1);
 

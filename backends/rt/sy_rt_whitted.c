@@ -35,17 +35,7 @@ static float ray_eps(sy_rt_v3 p) { return 1e-4f * (1.0f + v3_max_abs(p)); }
 /* True when nothing blocks the segment org + t*dir, t in (0, tfar). */
 static bool visible(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar)
 {
-    struct RTCRay r;
-    r.org_x = org.x; r.org_y = org.y; r.org_z = org.z;
-    r.dir_x = dir.x; r.dir_y = dir.y; r.dir_z = dir.z;
-    r.tnear = 0.0f;
-    r.tfar = tfar;
-    r.time = 0.0f;
-    r.mask = 0xffffffffu;
-    r.id = 0;
-    r.flags = 0;
-    rtcOccluded1(c->dev->top, &c->ictx, &r);
-    return r.tfar >= 0.0f;
+    return sy_rt_segment_clear(c->dev, &c->ictx, org, dir, tfar);
 }
 
 /* Specular reflectance at normal incidence of the dielectric part. */
