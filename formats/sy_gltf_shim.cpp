@@ -494,6 +494,41 @@ static void fill_doc(sy_gltf_shim_impl *d)
     c.internal = d;
 }
 
+// Runs tinygltf on the bytes with our file-system and image callbacks (confined, size-limited).
+// On success *model is filled and twarn holds tinygltf's warnings. C++ exceptions propagate to the
+// caller's catch blocks; tinygltf failures are classified into a sy_result with its message.
+static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, const char *base_dir,
+                              const sy_gltf_shim_limits *limits, tinygltf::Model *model, LoadContext *ctx,
+                              std::string *twarn, sy_error *err)
+{
+    ctx->max_file_bytes = limits->max_file_bytes;
+    ctx->max_image_pixels = limits->max_image_pixels;
+    ctx->model = model;
+    std::string base = base_dir;
+    if (!base.empty()) ctx->prefix = base.back() == '/' ? base : base + "/";
+    tinygltf::TinyGLTF loader;
+    tinygltf::FsCallbacks fs = {};
+    fs.FileExists = fs_file_exists;
+    fs.ExpandFilePath = fs_expand;
+    fs.ReadWholeFile = fs_read;
+    fs.WriteWholeFile = fs_write;
+    fs.user_data = ctx;
+    loader.SetFsCallbacks(fs);
+    loader.SetImageLoader(load_image, ctx);
+    std::string terr;
+    bool ok = binary ? loader.LoadBinaryFromMemory(model, &terr, twarn, bytes, unsigned(size), base)
+                     : loader.LoadASCIIFromString(model, &terr, twarn, reinterpret_cast<const char *>(bytes),
+                                                  unsigned(size), base);
+    if (ok) return SY_OK;
+    sy_result code = SY_ERR_PARSE;
+    if (ctx->fs_result != SY_OK) code = ctx->fs_result;
+    else if (terr.find("File not found") != std::string::npos) code = SY_ERR_NOT_FOUND;
+    else if (terr.find("exceeds the limit") != std::string::npos) code = SY_ERR_LIMIT;
+    std::string msg = one_line(terr);
+    if (msg.empty()) msg = "tinygltf failed without a message";
+    return sy_error_set(err, code, "%s", msg.c_str());
+}
+
 extern "C" sy_result sy_gltf_shim_parse(const uint8_t *bytes, size_t size, bool binary, const char *base_dir,
                                         const sy_gltf_shim_limits *limits, sy_gltf_doc **out, sy_error *err)
 {
@@ -504,35 +539,11 @@ extern "C" sy_result sy_gltf_shim_parse(const uint8_t *bytes, size_t size, bool 
     try {
         d = new sy_gltf_shim_impl();
         LoadContext ctx;
-        ctx.max_file_bytes = limits->max_file_bytes;
-        ctx.max_image_pixels = limits->max_image_pixels;
-        ctx.model = &d->model;
-        std::string base = base_dir;
-        if (!base.empty()) {
-            ctx.prefix = base.back() == '/' ? base : base + "/";
-        }
-        tinygltf::TinyGLTF loader;
-        tinygltf::FsCallbacks fs = {};
-        fs.FileExists = fs_file_exists;
-        fs.ExpandFilePath = fs_expand;
-        fs.ReadWholeFile = fs_read;
-        fs.WriteWholeFile = fs_write;
-        fs.user_data = &ctx;
-        loader.SetFsCallbacks(fs);
-        loader.SetImageLoader(load_image, &ctx);
-        std::string terr, twarn;
-        bool ok = binary ? loader.LoadBinaryFromMemory(&d->model, &terr, &twarn, bytes, unsigned(size), base)
-                         : loader.LoadASCIIFromString(&d->model, &terr, &twarn, reinterpret_cast<const char *>(bytes),
-                                                      unsigned(size), base);
-        if (!ok) {
-            sy_result code = SY_ERR_PARSE;
-            if (ctx.fs_result != SY_OK) code = ctx.fs_result;
-            else if (terr.find("File not found") != std::string::npos) code = SY_ERR_NOT_FOUND;
-            else if (terr.find("exceeds the limit") != std::string::npos) code = SY_ERR_LIMIT;
-            std::string msg = one_line(terr);
-            if (msg.empty()) msg = "tinygltf failed without a message";
+        std::string twarn;
+        sy_result r = run_tinygltf(bytes, size, binary, base_dir, limits, &d->model, &ctx, &twarn, err);
+        if (r != SY_OK) {
             delete d;
-            return sy_error_set(err, code, "%s", msg.c_str());
+            return r;
         }
         d->warnings = one_line(twarn);
         d->image_problems = std::move(ctx.image_problems);
@@ -564,25 +575,9 @@ extern "C" sy_result sy_gltf_shim_parse_only(const uint8_t *bytes, size_t size, 
     try {
         tinygltf::Model model;
         LoadContext ctx;
-        ctx.max_file_bytes = limits->max_file_bytes;
-        ctx.max_image_pixels = limits->max_image_pixels;
-        ctx.model = &model;
-        std::string base = base_dir;
-        if (!base.empty()) ctx.prefix = base.back() == '/' ? base : base + "/";
-        tinygltf::TinyGLTF loader;
-        tinygltf::FsCallbacks fs = {};
-        fs.FileExists = fs_file_exists;
-        fs.ExpandFilePath = fs_expand;
-        fs.ReadWholeFile = fs_read;
-        fs.WriteWholeFile = fs_write;
-        fs.user_data = &ctx;
-        loader.SetFsCallbacks(fs);
-        loader.SetImageLoader(load_image, &ctx);
-        std::string terr, twarn;
-        bool ok = binary ? loader.LoadBinaryFromMemory(&model, &terr, &twarn, bytes, unsigned(size), base)
-                         : loader.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char *>(bytes),
-                                                      unsigned(size), base);
-        if (!ok) return sy_error_set(err, ctx.fs_result != SY_OK ? ctx.fs_result : SY_ERR_PARSE, "%s", one_line(terr).c_str());
+        std::string twarn;
+        sy_result r = run_tinygltf(bytes, size, binary, base_dir, limits, &model, &ctx, &twarn, err);
+        if (r != SY_OK) return r;
         return SY_OK;
     } catch (const std::bad_alloc &) {
         return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory while parsing glTF");

@@ -171,20 +171,8 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
 
     for (;;) {
         struct RTCRayHit rh;
-        rh.ray.org_x = org.x; rh.ray.org_y = org.y; rh.ray.org_z = org.z;
-        rh.ray.dir_x = dir.x; rh.ray.dir_y = dir.y; rh.ray.dir_z = dir.z;
-        rh.ray.tnear = tnear;
-        rh.ray.tfar = tfar;
-        rh.ray.time = 0.0f;
-        rh.ray.mask = 0xffffffffu;
-        rh.ray.id = 0;
-        rh.ray.flags = 0;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(dev->top, &c->ictx, &rh);
+        const sy_rt_instance_data *in = sy_rt_intersect(dev, &c->ictx, org, dir, tnear, tfar, &rh);
         c->rays++;
-        const sy_rt_instance_data *in =
-            rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? NULL : sy_rt_hit_instance(dev, rh.hit.geomID, rh.hit.instID[0]);
         float dlen = v3_length(dir);
         sy_rt_v3 d = v3_scale(dir, 1.0f / dlen);
         if (!in) {

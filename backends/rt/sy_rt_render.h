@@ -52,6 +52,27 @@ static inline bool sy_rt_segment_clear(const sy_rt_device *dev, struct RTCInters
     return r.tfar >= 0.0f;
 }
 
+/* Nearest hit of org + t*dir, t in [tnear, tfar], in the top scene: fills *rh and returns the
+ * instance hit, or NULL for a miss. */
+static inline const sy_rt_instance_data *sy_rt_intersect(const sy_rt_device *dev, struct RTCIntersectContext *ctx,
+                                                         sy_rt_v3 org, sy_rt_v3 dir, float tnear, float tfar,
+                                                         struct RTCRayHit *rh)
+{
+    rh->ray.org_x = org.x, rh->ray.org_y = org.y, rh->ray.org_z = org.z;
+    rh->ray.dir_x = dir.x, rh->ray.dir_y = dir.y, rh->ray.dir_z = dir.z;
+    rh->ray.tnear = tnear;
+    rh->ray.tfar = tfar;
+    rh->ray.time = 0.0f;
+    rh->ray.mask = 0xffffffffu;
+    rh->ray.id = 0;
+    rh->ray.flags = 0;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(dev->top, ctx, rh);
+    return rh->hit.geomID == RTC_INVALID_GEOMETRY_ID ? NULL
+                                                     : sy_rt_hit_instance(dev, rh->hit.geomID, rh->hit.instID[0]);
+}
+
 /* Renders one tile: pixels [x0, x1) x [y0, y1) in full-image coordinates. */
 typedef void (*sy_rt_tile_fn)(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1);
 

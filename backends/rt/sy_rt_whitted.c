@@ -238,19 +238,7 @@ static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float
                     struct RTCIntersectContext *ictx, float *t_hit)
 {
     struct RTCRayHit rh;
-    rh.ray.org_x = org.x; rh.ray.org_y = org.y; rh.ray.org_z = org.z;
-    rh.ray.dir_x = dir.x; rh.ray.dir_y = dir.y; rh.ray.dir_z = dir.z;
-    rh.ray.tnear = tnear;
-    rh.ray.tfar = tfar;
-    rh.ray.time = 0.0f;
-    rh.ray.mask = 0xffffffffu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(c->dev->top, ictx, &rh);
-    const sy_rt_instance_data *in = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID
-                                        ? NULL : sy_rt_hit_instance(c->dev, rh.hit.geomID, rh.hit.instID[0]);
+    const sy_rt_instance_data *in = sy_rt_intersect(c->dev, ictx, org, dir, tnear, tfar, &rh);
     if (!in) {
         const sy_rt_background *bg = &c->dev->background;
         rgba_t r = {v3(0.0f, 0.0f, 0.0f), 0.0f};
