@@ -196,7 +196,7 @@ static sy_result bench_raster_scene(const char *label, sy_scene *scene, const sy
     sy_viewport *vp = NULL;
     sy_context *ctx = NULL;
     sy_layer layer = {0};
-    sy_camera_view view;
+    sy_camera_view view = {0};
     sy_params params;
     double *t = calloc(repeats, sizeof *t);
     sy_result r = t ? sy_window_create(width, height, &win, err) : sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench: out of memory");
@@ -727,6 +727,40 @@ static double fb_median(double *v, uint32_t n)
     return v[n / 2];
 }
 
+/* Median wall time of one 1-spp path-tracing pass of the built-in demo scene at width x height (after
+ * a warm-up pass that includes the translation): the yardstick the pixel filter's cost is given in. */
+static sy_result fb_pt_pass(uint32_t width, uint32_t height, uint32_t repeats, double *secs, sy_error *err)
+{
+    sy_scene *s = NULL;
+    sy_demo_info demo;
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_context_pool *pool = NULL;
+    sy_layer img = {0};
+    double *t = calloc(repeats, sizeof *t), warm;
+    sy_result r = t ? sy_scene_create(&s, err) : sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench filters: out of memory");
+    if (r == SY_OK) r = sy_demo_build(s, &demo, err);
+    if (r == SY_OK) r = sy_scene_commit(s, NULL, err);
+    sy_viewport_desc vd = {.root = demo.root, .camera = demo.camera, .background = demo.background,
+                           .backend = "pathtracer"};
+    if (r == SY_OK) r = sy_window_create(width, height, &win, err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
+    if (r == SY_OK) r = sy_context_pool_create(&pool, err);
+    if (r == SY_OK) r = sy_layer_create(width, height, &img, err);
+    if (r == SY_OK) r = pt_bench_frame(win, s, pool, 1, &img, &warm, err);
+    for (uint32_t i = 0; i < repeats && r == SY_OK; ++i) r = pt_bench_frame(win, s, pool, 1, &img, &t[i], err);
+    if (r == SY_OK) {
+        qsort(t, repeats, sizeof *t, cmp_double);
+        *secs = t[repeats / 2];
+    }
+    sy_layer_destroy(&img);
+    sy_context_pool_destroy(pool);
+    sy_window_destroy(win);
+    sy_scene_destroy(s);
+    free(t);
+    return r;
+}
+
 sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, const char *png_path, sy_error *err)
 {
     sy_filter_error fe = {0};
@@ -781,7 +815,13 @@ sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, co
     }
     if (r == SY_OK)
         printf("  fast pixel filter: %.1f ms per filtered frame (target < 50 ms at 640x480 on 2 cores;\n"
-               "  on an otherwise idle machine wall time ~ CPU ms / cores)\n\n", t_pixel * 1e3);
+               "  on an otherwise idle machine wall time ~ CPU ms / cores)\n", t_pixel * 1e3);
+    double pt_pass = 0;
+    if (r == SY_OK) r = fb_pt_pass(width, height, repeats, &pt_pass, err);
+    if (r == SY_OK)
+        printf("  path tracing (demo scene, %ux%u, all cores): %.1f ms per 1-spp pass (median of %u);\n"
+               "  fast pixel filter = %.2f x one path-tracing pass at 1 spp\n\n", width, height, pt_pass * 1e3,
+               repeats, t_pixel / pt_pass);
     /* 2. quality against the converged image, progressive: every method sees the same samples */
     static const uint32_t spps[] = {1, 4, 16, 64, 256};
     enum { NS = sizeof spps / sizeof spps[0] };
@@ -886,9 +926,18 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
     sy_window *win = NULL;
     sy_viewport *vp = NULL;
     sy_context_pool *pool = NULL;
-    sy_layer img = {0};
-    sy_viewport_desc dp = *vd;
+    sy_layer img = {0}, img_rf = {0};
+    sy_viewport_desc dp = *vd, dp_rf;
     dp.backend = "pathtracer";
+    /* radiance filtering is no display filter: it needs the path tracer's stored-sample hook, so it
+     * runs in its own viewport (filter=radiance), on the same samples (same seed, deterministic) */
+    char rf_params[512];
+    snprintf(rf_params, sizeof rf_params, "%s%sfilter=radiance", vd->params ? vd->params : "",
+             vd->params && *vd->params ? "," : "");
+    dp_rf = dp;
+    dp_rf.params = rf_params;
+    sy_window *win_rf = NULL;
+    sy_viewport *vp_rf = NULL;
     size_t n = (size_t)width * height;
     float *ref = malloc(4 * n * sizeof(float)), *out = malloc(4 * n * sizeof(float)), *pos = malloc(3 * n * sizeof(float));
     float *pix_out = malloc(4 * n * sizeof(float));
@@ -921,8 +970,11 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
         r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "bench filters: %s needs a perspective camera node", label);
     if (r == SY_OK) r = sy_window_create(width, height, &win, err);
     if (r == SY_OK) r = sy_window_add_viewport(win, &dp, &vp, err);
+    if (r == SY_OK) r = sy_window_create(width, height, &win_rf, err);
+    if (r == SY_OK) r = sy_window_add_viewport(win_rf, &dp_rf, &vp_rf, err);
     if (r == SY_OK) r = sy_context_pool_create(&pool, err);
     if (r == SY_OK) r = sy_layer_create(width, height, &img, err);
+    if (r == SY_OK) r = sy_layer_create(width, height, &img_rf, err);
     sy_filter_pixel *pf = NULL;
     sy_filter_pixel_params pp;
     sy_filter_pixel_params_default(&pp);
@@ -930,25 +982,33 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
     if (r == SY_OK && sy_filter_pixel_create(&pp, &pf, &fe)) r = fb_fail(err, &fe, "pixel");
     static const uint32_t spps[] = {1, 4, 16, 64, 256};
     enum { NS = sizeof spps / sizeof spps[0] };
-    uint32_t methods[] = {FB_NONE, FB_PIXEL, FB_PIXEL_BRUTE, FB_ATROUS, FB_JBU, FB_ADAPTIVE};
+    uint32_t methods[] = {FB_NONE, FB_PIXEL, FB_PIXEL_BRUTE, FB_RADIANCE, FB_ATROUS, FB_JBU, FB_ADAPTIVE};
     enum { NM = sizeof methods / sizeof methods[0] };
     size_t sheet_w = (size_t)width * (NM + 1), sheet_h = (size_t)height * NS;
     float *sheet = png_path && r == SY_OK ? calloc(sheet_w * sheet_h * 4, sizeof(float)) : NULL;
     if (r == SY_OK && png_path && !sheet) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench filters: out of memory");
     if (r == SY_OK) {
-        printf("%s, %ux%u, path tracer buffers against %s (radiance filtering needs the integrator's\n"
-               "sample hook and is not measured here):\n", label, width, height, reference_exr);
+        printf("%s, %ux%u, path tracer buffers against %s (radiance: the path tracer's stored-sample\n"
+               "hook, filtered every 1-spp pass, same samples; pixel: 2^i schedule from frame 1):\n", label, width,
+               height, reference_exr);
         printf("  %5s %-12s %9s %9s %7s %10s %9s\n", "spp", "method", "RMSE", "relMSE", "SSIM", "relMSE/PT", "ms");
     }
-    sy_context *ctx = NULL;
-    sy_params none = {0};
-    double pass_s = 0, t_pixel_ms = 0;
+    sy_context *ctx = NULL, *ctx_rf = NULL;
+    sy_params none = {0}, rfp = {0};
+    if (r == SY_OK) r = sy_params_parse(rf_params, &rfp, err);
+    double pass_s = 0, t_pixel_ms = 0, rf_pass_s = 0, t_rf_ms = 0;
     uint32_t si = 0;
     for (uint32_t k = 1; k <= spps[NS - 1] && r == SY_OK; ++k) {
         double s;
         r = pt_bench_frame(win, scene, pool, 1, &img, &s, err);
         pass_s += s;
         if (r == SY_OK && !ctx) r = sy_context_pool_get(pool, scene, "pathtracer", &none, vd->root.id, &ctx, err);
+        if (r == SY_OK) r = pt_bench_frame(win_rf, scene, pool, 1, &img_rf, &s, err); /* pass + radiance frame */
+        rf_pass_s += s;
+        if (r == SY_OK && !ctx_rf) r = sy_context_pool_get(pool, scene, "pathtracer", &rfp, vd->root.id, &ctx_rf, err);
+        sy_mediator_rt_filter_info rfi = {0};
+        if (r == SY_OK) sy_mediator_rt_filter_info_get(sy_context_state(ctx_rf), &rfi);
+        if (r == SY_OK && k == 4) t_rf_ms = rfi.seconds * 1e3;
         sy_mediator_rt_aovs a = {0};
         if (r == SY_OK) r = sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err);
         if (r == SY_OK && (a.width != width || a.height != height))
@@ -969,9 +1029,11 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
             for (int mi = 0; mi < NM && r == SY_OK; ++mi) {
                 int meth = (int)methods[mi];
                 const float *im = out;
-                double ms = meth == FB_PIXEL ? st.seconds * 1e3 : 0;
+                double ms = meth == FB_PIXEL ? st.seconds * 1e3 : meth == FB_RADIANCE ? rfi.seconds * 1e3 : 0;
                 if (meth == FB_PIXEL)
                     im = pix_out;
+                else if (meth == FB_RADIANCE)
+                    im = img_rf.rgba;
                 else {
                     sy_filter_pixel *once = NULL;
                     double t0 = sy_time_now();
@@ -1000,20 +1062,26 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
         }
         sy_mediator_rt_aovs_free(&a);
     }
-    if (r == SY_OK)
+    if (r == SY_OK) {
+        double pass_ms = pass_s / spps[NS - 1] * 1e3;
         printf("  path tracing: %.1f ms per 1-spp pass; fast pixel filter pass at 4 spp %.1f ms = %.2f x one pass\n",
-               pass_s / spps[NS - 1] * 1e3, t_pixel_ms, t_pixel_ms / (pass_s / spps[NS - 1] * 1e3));
+               pass_ms, t_pixel_ms, t_pixel_ms / pass_ms);
+        printf("  radiance filtering: %.1f ms per 1-spp pass with records + filter frame (frame 4: filter %.1f ms = "
+               "%.2f x one plain pass)\n", rf_pass_s / spps[NS - 1] * 1e3, t_rf_ms, t_rf_ms / pass_ms);
+    }
     if (r == SY_OK && sheet) {
         r = sy_png_write(png_path, (int)sheet_w, (int)sheet_h, sheet, NULL, err);
         if (r == SY_OK)
-            printf("  contact sheet %s: rows = spp 1, 4, 16, 64, 256; columns = none, pixel, pixel-brute, atrous,\n"
-                   "  jbu, adaptive, reference\n", png_path);
+            printf("  contact sheet %s: rows = spp 1, 4, 16, 64, 256; columns = none, pixel, pixel-brute, radiance,\n"
+                   "  atrous, jbu, adaptive, reference\n", png_path);
     }
     sy_filter_pixel_destroy(pf);
     free(sheet), free(ref), free(out), free(pos), free(pix_out);
     if (refimg) sy_exr_image_free(refimg);
     sy_layer_destroy(&img);
+    sy_layer_destroy(&img_rf);
     sy_context_pool_destroy(pool);
     sy_window_destroy(win);
+    sy_window_destroy(win_rf);
     return r;
 }

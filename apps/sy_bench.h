@@ -53,7 +53,9 @@ sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, co
 /* The same comparison on the path tracer's feature buffers for the view of vd (its camera node
  * gives positions and the headlight), against the linear RGB reference EXR of the same size
  * (e.g. the Cycles Cornell box): 1..256 passes of 1 spp, metrics at 1, 4, 16, 64, 256 spp, the
- * path-tracing pass time and the fast pixel filter's cost as a ratio to it; optional sheet. */
+ * path-tracing pass time and the fast pixel filter's cost as a ratio to it; optional sheet. The
+ * radiance filter runs on the path tracer's stored-sample hook in a second viewport of the same
+ * view (filter=radiance, same seed: the same samples), one filter frame per 1-spp pass. */
 sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
                                  uint32_t height, const char *reference_exr, const char *png_path, sy_error *err);
 

@@ -90,10 +90,15 @@ int sy_cmd_serve(int argc, char **argv)
         else if (!strcmp(a, "--name") && has) o.name = argv[++i];
         else if (!strcmp(a, "--max-sessions") && has) o.max_sessions = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(a, "--max-lifetime") && has) o.max_lifetime_s = strtod(argv[++i], NULL);
+        else if (!strcmp(a, "--blob-cache-mb") && has) o.blob_cache_bytes = (size_t)strtoul(argv[++i], NULL, 10) << 20;
+        else if (!strcmp(a, "--max-objects") && has) o.max_objects = (uint32_t)strtoul(argv[++i], NULL, 10);
+        else if (!strcmp(a, "--auth-backoff-ms") && has) o.auth_backoff_ms = (uint32_t)strtoul(argv[++i], NULL, 10);
         else {
             fprintf(stderr,
                     "usage: sy serve [--listen tcp://HOST:PORT|tls+tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png]\n"
                     "                [--port-file F] [--tls-cert PEM --tls-key PEM] [--name NAME] [--max-sessions N]\n"
+                    "                [--blob-cache-mb N (1024)] [--max-objects N per type (1048576)]\n"
+                    "                [--auth-backoff-ms MS (250, doubled per failed authentication)]\n"
                     "                [--max-lifetime SECONDS]\n"
                     "  the secret comes from --secret-file or $SY_CLUSTER_SECRET; without one only loopback is allowed\n");
             return 1;
@@ -136,6 +141,12 @@ bool sy_cluster_cli_option(int argc, char **argv, int *i, sy_cluster_cli_opts *o
 {
     const char *a = argv[*i];
     bool has = *i + 1 < argc;
+    if (!strcmp(a, "--cluster-pixels")) { /* float (bit-exact) | half (binary16 tiles) */
+        if (!has || (strcmp(argv[*i + 1], "float") && strcmp(argv[*i + 1], "half"))) *bad = true;
+        else o->half_pixels = !strcmp(argv[*i + 1], "half");
+        *i += has;
+        return true;
+    }
     const char *names[] = {"--cluster", "--cluster-mode", "--secret-file", "--tls-ca", "--timeout-ms", "--frames", "--spp"};
     int which = -1;
     for (int k = 0; k < 7; ++k)
@@ -170,12 +181,31 @@ bool sy_cluster_cli_option(int argc, char **argv, int *i, sy_cluster_cli_opts *o
     return true;
 }
 
+/* Parses the four values of a configuration line's `tile X Y W H` (tok[0..3]). */
+static sy_result parse_conf_tile(char **tok, const char *path, uint32_t line, sy_cluster_rect *out, sy_error *err)
+{
+    uint32_t v[4];
+    for (int k = 0; k < 4; ++k) {
+        char *end;
+        errno = 0;
+        unsigned long x = strtoul(tok[k], &end, 10);
+        if (errno || *end || end == tok[k] || x > 16384)
+            return sy_error_set(err, SY_ERR_PARSE, "%s:%u: tile values must be 0..16384", path, line);
+        v[k] = (uint32_t)x;
+    }
+    if (!v[2] || !v[3]) return sy_error_set(err, SY_ERR_PARSE, "%s:%u: empty tile", path, line);
+    *out = (sy_cluster_rect){v[0], v[1], v[2], v[3]};
+    return SY_OK;
+}
+
 /* A cluster configuration file (`--cluster FILE`), one directive per line, '#' comments:
  *   mode sort-first|balanced|cooperative|multi-display|stereo
  *   server URL [backend NAME] [tile X Y W H]
+ *   viewer full | viewer tile X Y W H     (sy view, multi-display: what the client's window shows)
  * The tokens are stored in *text (owned by the caller) and pointed to from the arrays. */
 static sy_result parse_conf(const char *path, char **text, const char **urls, const char **backends,
-                            sy_cluster_rect *tiles, uint32_t *n, const char **mode, sy_error *err)
+                            sy_cluster_rect *tiles, uint32_t *n, const char **mode, sy_cluster_rect *viewer,
+                            sy_error *err)
 {
     void *data = NULL;
     size_t size = 0;
@@ -215,25 +245,23 @@ static sy_result parse_conf(const char *path, char **text, const char **urls, co
                     backends[*n] = tok[i + 1];
                     i += 2;
                 } else if (!strcmp(tok[i], "tile") && i + 4 < nt) {
-                    uint32_t v[4];
-                    for (int k = 0; k < 4; ++k) {
-                        char *end;
-                        errno = 0;
-                        unsigned long x = strtoul(tok[i + 1 + k], &end, 10);
-                        if (errno || *end || end == tok[i + 1 + k] || x > 16384)
-                            return sy_error_set(err, SY_ERR_PARSE, "%s:%u: tile values must be 0..16384", path, line);
-                        v[k] = (uint32_t)x;
-                    }
-                    if (!v[2] || !v[3]) return sy_error_set(err, SY_ERR_PARSE, "%s:%u: empty tile", path, line);
-                    tiles[*n] = (sy_cluster_rect){v[0], v[1], v[2], v[3]};
+                    sy_result tr = parse_conf_tile(tok + i + 1, path, line, &tiles[*n], err);
+                    if (tr) return tr;
                     i += 5;
                 } else {
                     return sy_error_set(err, SY_ERR_PARSE, "%s:%u: unknown server option '%s'", path, line, tok[i]);
                 }
             }
             (*n)++;
+        } else if (!strcmp(tok[0], "viewer") && nt == 2 && !strcmp(tok[1], "full")) {
+            memset(viewer, 0, sizeof *viewer);
+        } else if (!strcmp(tok[0], "viewer") && nt == 6 && !strcmp(tok[1], "tile")) {
+            sy_result tr = parse_conf_tile(tok + 2, path, line, viewer, err);
+            if (tr) return tr;
         } else {
-            return sy_error_set(err, SY_ERR_PARSE, "%s:%u: expected 'mode NAME' or 'server URL [backend NAME] [tile X Y W H]'",
+            return sy_error_set(err, SY_ERR_PARSE,
+                                "%s:%u: expected 'mode NAME', 'server URL [backend NAME] [tile X Y W H]' or "
+                                "'viewer full|tile X Y W H'",
                                 path, line);
         }
     }
@@ -241,16 +269,17 @@ static sy_result parse_conf(const char *path, char **text, const char **urls, co
     return SY_OK;
 }
 
-sy_result sy_cluster_cli_render(const sy_cluster_cli_opts *o, sy_scene *scene, const sy_viewport_desc *vd, uint32_t w,
-                                uint32_t h, sy_layer *out, double *seconds, sy_error *err)
+sy_result sy_cluster_cli_connect(const sy_cluster_cli_opts *o, sy_scene *scene, sy_cluster_cli_client *out,
+                                 sy_error *err)
 {
+    memset(out, 0, sizeof *out);
     const char *urls[SY_CLUSTER_MAX_SERVERS], *backends[SY_CLUSTER_MAX_SERVERS] = {0}, *conf_mode = NULL;
     sy_cluster_rect tiles[SY_CLUSTER_MAX_SERVERS];
     memset(tiles, 0, sizeof tiles);
     uint32_t n = 0;
     char *list = NULL;
     if (!strstr(o->cluster, "://")) { /* a configuration file */
-        sy_result cr = parse_conf(o->cluster, &list, urls, backends, tiles, &n, &conf_mode, err);
+        sy_result cr = parse_conf(o->cluster, &list, urls, backends, tiles, &n, &conf_mode, &out->viewer_tile, err);
         if (cr) {
             free(list);
             return cr;
@@ -275,22 +304,39 @@ sy_result sy_cluster_cli_render(const sy_cluster_cli_opts *o, sy_scene *scene, c
     uint8_t *secret = NULL;
     size_t secret_len = 0;
     sy_result r = sy_cluster_secret_load(o->secret_file, &secret, &secret_len, err);
-    sy_window *win = NULL;
-    sy_viewport *vp = NULL;
-    sy_cluster_client *c = NULL;
-    sy_camera_view view;
-    if (r == SY_OK) r = sy_window_create(w, h, &win, err);
-    if (r == SY_OK) r = sy_window_add_viewport(win, vd, &vp, err);
-    if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, err);
     sy_cluster_client_opts co = {.urls = urls,
                                  .url_count = n,
                                  .secret = secret,
                                  .secret_len = secret_len,
                                  .tls_ca_file = o->tls_ca,
                                  .timeout_ms = o->timeout_ms,
+                                 .connect_timeout_ms = o->connect_timeout_ms,
+                                 .log = o->log,
+                                 .log_user = o->log_user,
                                  .backends = backends,
                                  .wall_tiles = tiles};
-    if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &c, err);
+    /* the client copies the URLs, back-end names, wall tiles and the secret */
+    if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &out->client, err);
+    out->mode = mode;
+    out->servers = n;
+    free(secret);
+    free(list);
+    return r;
+}
+
+sy_result sy_cluster_cli_render(const sy_cluster_cli_opts *o, sy_scene *scene, const sy_viewport_desc *vd, uint32_t w,
+                                uint32_t h, sy_layer *out, double *seconds, sy_error *err)
+{
+    sy_cluster_cli_client cc;
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_camera_view view;
+    sy_result r = sy_cluster_cli_connect(o, scene, &cc, err);
+    sy_cluster_client *c = cc.client;
+    uint32_t mode = cc.mode, n = cc.servers;
+    if (r == SY_OK) r = sy_window_create(w, h, &win, err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, vd, &vp, err);
+    if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, err);
     if (r == SY_OK && mode != SY_CLUSTER_MULTI_DISPLAY)
         r = sy_layer_create(mode == SY_CLUSTER_STEREO ? 2 * w : w, h, out, err);
     sy_cluster_frame f = {.mode = mode,
@@ -303,6 +349,7 @@ sy_result sy_cluster_cli_render(const sy_cluster_cli_opts *o, sy_scene *scene, c
                           .height = h,
                           .samples = o->samples,
                           .depth = true,
+                          .half = o->half_pixels,
                           .eye_separation = vd->eye_separation,
                           .zero_parallax = vd->zero_parallax};
     double t0 = sy_time_now();
@@ -323,8 +370,6 @@ sy_result sy_cluster_cli_render(const sy_cluster_cli_opts *o, sy_scene *scene, c
     *seconds = sy_time_now() - t0;
     sy_cluster_client_destroy(c);
     sy_window_destroy(win);
-    free(secret);
-    free(list);
     return r;
 }
 
@@ -399,56 +444,187 @@ static bool count_none(void *user, const sy_blob *b)
     return false;
 }
 
-/* samples per second of cooperative path tracing with the given servers */
-static sy_result coop_rate(sy_scene *scene, const sy_viewport_desc *vd, child_server *srv, uint32_t n, uint32_t w,
-                           uint32_t h, double *rate, sy_error *err)
+/* CPU seconds (user + system) a process has used so far, from /proc/PID/stat; < 0 when unknown. */
+static double proc_cpu_seconds(pid_t pid)
 {
+    char path[64], buf[1024];
+    snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+    FILE *f = fopen(path, "r");
+    if (!f) return -1.0;
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = 0;
+    const char *p = strrchr(buf, ')'); /* the command name may hold spaces and parentheses */
+    unsigned long ut = 0, st = 0;
+    if (!p || sscanf(p + 1, " %*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %lu %lu", &ut, &st) != 2) return -1.0;
+    return (double)(ut + st) / (double)sysconf(_SC_CLK_TCK);
+}
+
+/* One cooperative measurement: merged samples per pixel per second on the first n servers. */
+typedef struct coop_run {
+    double rate;       /* merged samples per pixel per second */
+    double seconds;    /* wall time measured */
+    double cpu[2];     /* each server's CPU seconds in that time (< 0: unknown) */
+    uint64_t samples;  /* merged samples per pixel added in that time */
+    uint32_t frames;
+} coop_run;
+
+/* Cooperative path tracing on the first n servers with a fresh client (snapshot + translation in a
+ * warm-up frame that is not counted), spf samples per server and frame, frames until at least
+ * min_seconds have passed (and at least 3). *spf == 0: calibrated here from a 4-sample frame so
+ * that a frame takes about 0.4 s (the client's per-frame transfer and merge stay small next to
+ * the rendering), and returned for the other runs. */
+static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const child_server *srv, uint32_t n,
+                              uint32_t w, uint32_t h, uint32_t *spf, double min_seconds, coop_run *out, sy_error *err)
+{
+    memset(out, 0, sizeof *out);
     const char *urls[2] = {srv[0].url, n > 1 ? srv[1].url : NULL};
     sy_cluster_client_opts co = {.urls = urls, .url_count = n, .timeout_ms = 120000};
     sy_cluster_client *c = NULL;
     sy_window *win = NULL;
     sy_viewport *vp = NULL;
     sy_camera_view view;
-    sy_layer out = {0};
+    sy_layer out_img = {0};
     sy_result r = sy_window_create(w, h, &win, err);
     if (r == SY_OK) r = sy_window_add_viewport(win, vd, &vp, err);
     if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, err);
     if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &c, err);
-    if (r == SY_OK) r = sy_layer_create(w, h, &out, err);
+    if (r == SY_OK) r = sy_layer_create(w, h, &out_img, err);
     sy_cluster_frame f = {.mode = SY_CLUSTER_COOPERATIVE, .backend = "pathtracer", .root_id = vd->root.id,
-                          .camera = view, .width = w, .height = h, .samples = 4};
-    sy_cluster_frame_stats st;
-    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &out, &st, err); /* warm-up: snapshot + translation */
-    uint64_t samples = 0;
-    double t0 = sy_time_now(), server = 0;
-    for (int i = 0; i < 3 && r == SY_OK; ++i) {
-        r = sy_cluster_client_render(c, &f, &out, &st, err);
-        samples += (uint64_t)f.samples * n;
-        server += st.max_server_seconds;
+                          .background_id = vd->background.id, .camera = view, .width = w, .height = h, .samples = 4};
+    sy_cluster_frame_stats st = {0};
+    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &out_img, &st, err); /* warm-up: snapshot + translation */
+    if (r == SY_OK && !*spf) {
+        double t = sy_time_now();
+        r = sy_cluster_client_render(c, &f, &out_img, &st, err);
+        t = sy_time_now() - t;
+        double k = t > 0 ? 0.4 / t : 256.0;
+        *spf = k >= 256.0 ? 1024u : k <= 1.0 ? 4u : (uint32_t)(4.0 * k + 0.5);
     }
-    double secs = sy_time_now() - t0;
-    *rate = (double)samples / secs;
-    if (r == SY_OK)
-        printf("    %u server(s): %llu samples per pixel in %.3f s (slowest server busy %.3f s)\n", n,
-               (unsigned long long)samples, secs, server);
-    sy_layer_destroy(&out);
+    f.samples = *spf;
+    uint64_t s0 = st.samples;
+    double cpu0[2] = {proc_cpu_seconds(srv[0].pid), n > 1 ? proc_cpu_seconds(srv[1].pid) : -1.0};
+    double t0 = sy_time_now();
+    while (r == SY_OK && (out->frames < 3 || sy_time_now() - t0 < min_seconds)) {
+        r = sy_cluster_client_render(c, &f, &out_img, &st, err);
+        out->frames++;
+        if (r == SY_OK && st.servers_live != n)
+            r = sy_error_set(err, SY_ERR_IO, "bench: a server dropped out of the cooperative measurement");
+    }
+    out->seconds = sy_time_now() - t0;
+    out->samples = st.samples - s0;
+    out->rate = out->seconds > 0 ? (double)out->samples / out->seconds : 0;
+    for (uint32_t i = 0; i < 2; ++i) {
+        double now = i < n ? proc_cpu_seconds(srv[i].pid) : -1.0;
+        out->cpu[i] = now >= 0 && cpu0[i] >= 0 ? now - cpu0[i] : -1.0;
+    }
+    sy_layer_destroy(&out_img);
     sy_cluster_client_destroy(c);
     sy_window_destroy(win);
     return r;
 }
 
+/* Cooperative path tracing, 2 servers pinned to one core each vs 1 server: `rounds` interleaved
+ * rounds (the order alternates, so a drift in the machine's load hits both sides alike); the
+ * speed-up is best 2-server rate / best 1-server rate, each round's ratio printed beside it.
+ * Each server's CPU time shows how much of its core it got: on a machine shared with other work
+ * the wall-clock ratio drops, while samples per server CPU-second (the cost of cooperating: the
+ * sample split, transfers, merging, waiting for the other server) stay comparable. */
+static sy_result bench_coop(sy_scene *scene, const sy_viewport_desc *vd, const child_server *srv, uint32_t rounds,
+                            bool pinned, sy_error *err)
+{
+    const uint32_t w = 320, h = 180;
+    const double min_seconds = 1.5;
+    uint32_t spf = 0;
+    double best[2] = {0, 0}, eff[2] = {0, 0}; /* samples per pixel per second; per server CPU-second */
+    sy_result r = SY_OK;
+    printf("  cooperative pathtracer %ux%u, servers %s, %u interleaved rounds of >= %.1f s per side:\n", w, h,
+           pinned ? "pinned to cores 0 and 1" : "not pinned (1 core)", rounds, min_seconds);
+    for (uint32_t round = 0; round < rounds && r == SY_OK; ++round) {
+        coop_run run[2];
+        for (uint32_t k = 0; k < 2 && r == SY_OK; ++k) {
+            uint32_t n = (round & 1) ? 2 - k : 1 + k; /* 1,2 / 2,1 / 1,2 ... */
+            r = coop_measure(scene, vd, srv, n, w, h, &spf, min_seconds, &run[n - 1], err);
+            if (r == SY_OK && run[n - 1].rate > best[n - 1]) best[n - 1] = run[n - 1].rate;
+            double cpu = run[n - 1].cpu[0] + (n > 1 ? run[n - 1].cpu[1] : 0.0);
+            if (r == SY_OK && run[n - 1].cpu[0] >= 0 && (n < 2 || run[n - 1].cpu[1] >= 0) && cpu > 0 &&
+                (double)run[n - 1].samples / cpu > eff[n - 1])
+                eff[n - 1] = (double)run[n - 1].samples / cpu;
+        }
+        if (r == SY_OK)
+            printf("    round %u (%u spp per server and frame): 1 server %.1f spp/s (busy %.2f s CPU of %.2f s); "
+                   "2 servers %.1f spp/s (busy %.2f + %.2f s CPU of %.2f s): %.2fx\n",
+                   round + 1, spf, run[0].rate, run[0].cpu[0], run[0].seconds, run[1].rate, run[1].cpu[0], run[1].cpu[1],
+                   run[1].seconds, run[0].rate > 0 ? run[1].rate / run[0].rate : 0.0);
+    }
+    if (r == SY_OK)
+        printf("  cooperative speed-up (best of %u): 1 server %.1f spp/s, 2 servers %.1f spp/s: %.2fx (target >= 1.8x)\n",
+               rounds, best[0], best[1], best[0] > 0 ? best[1] / best[0] : 0.0);
+    if (r == SY_OK && eff[0] > 0 && eff[1] > 0)
+        printf("  per server CPU-second (best of %u): 1 server %.1f spp, 2 servers %.1f spp (%.0f%% efficiency): "
+               "2 x %.2f = %.2fx with each server's core to itself\n",
+               rounds, eff[0], eff[1], 100.0 * eff[1] / eff[0], eff[1] / eff[0], 2.0 * eff[1] / eff[0]);
+    return r;
+}
+
+/* Protocol 2 figures: bytes of binary16 tiles vs float32 on the same frame and the half codec's
+ * ratio on the frame's pixels; the snapshot a second client with the same model sends (the
+ * servers' blob cache answers its hashes) vs the first client's. */
+static sy_result bench_half_and_blob_cache(sy_scene *scene, const sy_cluster_client_opts *co, sy_cluster_client *c,
+                                           const sy_cluster_frame *f, sy_layer *out,
+                                           const sy_cluster_frame_stats *first, sy_error *err)
+{
+    sy_cluster_frame hf = *f;
+    sy_cluster_frame_stats sf = {0}, sh = {0}, s2 = {0};
+    sy_result r = sy_cluster_client_render(c, f, out, &sf, err);
+    hf.half = true;
+    if (r == SY_OK) r = sy_cluster_client_render(c, &hf, out, &sh, err);
+    if (r == SY_OK)
+        printf("  half tiles (--cluster-pixels half) %ux%u RGBA: %.2f MB back per frame vs %.2f MB float32 (%.2fx fewer)\n",
+               f->width, f->height, (double)sh.bytes_received / 1e6, (double)sf.bytes_received / 1e6,
+               (double)sf.bytes_received / (double)sh.bytes_received);
+    sy_cluster_buf enc = {0};
+    double te = sy_time_now();
+    if (r == SY_OK) r = sy_cluster_tile_encode_as(out, true, SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD, &enc, err);
+    te = sy_time_now() - te;
+    uint64_t raw16 = (uint64_t)out->width * out->height * 10;
+    sy_cluster_tile t = {{0, 0, out->width, out->height}, SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD, 5, raw16, enc.data,
+                         (uint32_t)enc.size};
+    double td = sy_time_now();
+    if (r == SY_OK) r = sy_cluster_tile_decode(&t, out, 0, 0, err);
+    td = sy_time_now() - td;
+    if (r == SY_OK)
+        printf("  tile codec RGBA+Z half: %.1f MB float32 -> %.1f MB binary16 -> %.2f MB zstd (%.1fx of float32, %.1fx "
+               "of the half planes); encode %.0f MB/s, decode %.0f MB/s (float32-equivalent bytes, one core)\n",
+               (double)raw16 * 2 / 1e6, (double)raw16 / 1e6, (double)enc.size / 1e6, (double)raw16 * 2 / (double)enc.size,
+               (double)raw16 / (double)enc.size, (double)raw16 * 2 / te / 1e6, (double)raw16 * 2 / td / 1e6);
+    sy_cluster_buf_free(&enc);
+    sy_cluster_client *c2 = NULL;
+    if (r == SY_OK) r = sy_cluster_client_create(scene, co, &c2, err);
+    if (r == SY_OK) r = sy_cluster_client_render(c2, f, out, &s2, err);
+    if (r == SY_OK)
+        printf("  snapshot of a second client with the same model (per server): %llu bytes, %llu of them blob payloads; "
+               "first client %llu bytes, %llu of them blob payloads (%.0fx less)\n",
+               (unsigned long long)(s2.scene_bytes / 2), (unsigned long long)(s2.blob_bytes / 2),
+               (unsigned long long)(first->scene_bytes / 2), (unsigned long long)(first->blob_bytes / 2),
+               (double)first->scene_bytes / (double)(s2.scene_bytes ? s2.scene_bytes : 1));
+    sy_cluster_client_destroy(c2);
+    return r;
+}
+
 int sy_cmd_bench_cluster(int argc, char **argv)
 {
-    uint32_t w = 1920, h = 1080;
+    uint32_t w = 1920, h = 1080, rounds = 3;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "-w") && i + 1 < argc) w = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "-h") && i + 1 < argc) h = (uint32_t)strtoul(argv[++i], NULL, 10);
+        else if (!strcmp(argv[i], "--repeats") && i + 1 < argc) rounds = (uint32_t)strtoul(argv[++i], NULL, 10);
         else {
-            fprintf(stderr, "usage: sy bench cluster [-w W] [-h H]\n");
+            fprintf(stderr, "usage: sy bench cluster [-w W] [-h H] [--repeats ROUNDS]\n");
             return 1;
         }
     }
-    if (w < 1 || h < 1 || w > 16384 || h > 16384) return 1;
+    if (w < 1 || h < 1 || w > 16384 || h > 16384 || rounds < 1 || rounds > 100) return 1;
     signal(SIGPIPE, SIG_IGN);
     sy_error err = {0};
     sy_scene *scene = NULL;
@@ -475,6 +651,12 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     sy_changes_release(snap);
     if (r == SY_OK) r = spawn_server(ncpu >= 2 ? 0 : -1, &srv[0], &err);
     if (r == SY_OK) r = spawn_server(ncpu >= 2 ? 1 : -1, &srv[1], &err);
+    if (r == SY_OK && ncpu >= 3) { /* the client keeps off the servers' cores where it can */
+        cpu_set_t set;
+        CPU_ZERO(&set);
+        for (long i = 2; i < ncpu && i < CPU_SETSIZE; ++i) CPU_SET((int)i, &set);
+        sched_setaffinity(0, sizeof set, &set);
+    }
     const char *urls[2] = {srv[0].url, srv[1].url};
     sy_cluster_client_opts co = {.urls = urls, .url_count = 2, .timeout_ms = 120000};
     const char *backend = sy_mediator_find("raster") ? "raster" : "whitted";
@@ -509,8 +691,8 @@ int sy_cmd_bench_cluster(int argc, char **argv)
         bytes += (double)(s.bytes_sent + s.bytes_received);
     }
     if (r == SY_OK) {
-        printf("sy bench cluster: demo scene, 2 servers on loopback (pinned to cores 0 and 1: %s)\n",
-               ncpu >= 2 ? "yes" : "no, 1 core");
+        printf("sy bench cluster: demo scene, 2 servers on loopback (pinned to cores 0 and 1: %s; client on %s)\n",
+               ncpu >= 2 ? "yes" : "no, 1 core", ncpu >= 3 ? "the other cores" : "any core");
         printf("  snapshot on the wire (first frame, per server): %llu bytes; serialised scene %zu bytes "
                "(%zu structure + %zu blob payload)\n",
                (unsigned long long)(s1.scene_bytes / 2), with_blobs, without, with_blobs - without);
@@ -519,6 +701,30 @@ int sy_cmd_bench_cluster(int argc, char **argv)
         printf("  sort-first %s %ux%u: frame %.4f s, protocol overhead %.4f s/frame (%.1f%% of the frame), "
                "%.2f MB on the wire per frame (zstd float tiles)\n",
                backend, w, h, frame / reps, over / reps, 100.0 * over / frame, bytes / reps / 1e6);
+    }
+    /* per-request latency L of the scaling model: tiny sort-first frames, where rendering and
+     * pixels cost next to nothing; what the client spends beyond the slowest server */
+    if (r == SY_OK) {
+        sy_layer tiny = {0};
+        sy_cluster_frame tf = f;
+        tf.width = 64, tf.height = 36;
+        double lat_min = 1e30, lat_sum = 0, frame_sum = 0;
+        const int lat_n = 30;
+        r = sy_layer_create(tf.width, tf.height, &tiny, &err);
+        for (int i = -1; i < lat_n && r == SY_OK; ++i) { /* i = -1: warm-up (a new image size) */
+            sy_cluster_frame_stats s;
+            r = sy_cluster_client_render(c, &tf, &tiny, &s, &err);
+            double l = s.seconds - s.max_server_seconds;
+            if (r == SY_OK && i >= 0) {
+                lat_sum += l, frame_sum += s.seconds;
+                if (l < lat_min) lat_min = l;
+            }
+        }
+        if (r == SY_OK)
+            printf("  request latency (64x36 sort-first frames, 2 servers in parallel, %d frames): L = %.2f ms min, %.2f ms "
+                   "mean beyond the slowest server (whole frame %.2f ms mean)\n",
+                   lat_n, lat_min * 1e3, lat_sum / lat_n * 1e3, frame_sum / lat_n * 1e3);
+        sy_layer_destroy(&tiny);
     }
     /* codec constants for the scaling model (docs/ARCHITECTURE.md): compression and decompression
      * throughput of the final frame's pixels (RGBA + depth float32) on this core */
@@ -539,18 +745,13 @@ int sy_cmd_bench_cluster(int argc, char **argv)
                    w, h, raw / 1e6, (double)enc.size / 1e6, raw / (double)enc.size, raw / te / 1e6, raw / td / 1e6);
         sy_cluster_buf_free(&enc);
     }
+    if (r == SY_OK) r = bench_half_and_blob_cache(scene, &co, c, &f, &out, &s1, &err);
     sy_layer_destroy(&out);
     sy_cluster_client_destroy(c);
     c = NULL;
     /* cooperative path tracing: 2 pinned servers vs 1 */
     if (r == SY_OK && sy_mediator_find("pathtracer")) {
-        double one = 0, two = 0;
-        r = coop_rate(scene, &vd, srv, 1, 320, 180, &one, &err);
-        if (r == SY_OK) r = coop_rate(scene, &vd, srv, 2, 320, 180, &two, &err);
-        if (r == SY_OK)
-            printf("  cooperative pathtracer 320x180: 1 server %.1f samples/s, 2 servers %.1f samples/s: %.2fx "
-                   "(target >= 1.8x)\n",
-                   one, two, two / one);
+        r = bench_coop(scene, &vd, srv, rounds, ncpu >= 2, &err);
     } else if (r == SY_OK) {
         printf("  cooperative: skipped (no 'pathtracer' back-end registered in this build)\n");
     }

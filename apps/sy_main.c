@@ -4,7 +4,7 @@
  *   sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]
  *             [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]
  *             with -b pathtracer: [--spp N | --time SECONDS] [--aov] [--env MAP.exr] [--env-intensity X]
- *             [--background R,G,B] [--filter none|pixel|atrous|jbu|adaptive [--threshold T]]
+ *             [--background R,G,B] [--filter none|pixel|atrous|jbu|adaptive|radiance [--threshold T]]
  *             [--gl osmesa|egl|glfw]  (raster back-end's GL context provider)
  *   sy demo [-o DIR] [-w W] [-h H]      render the built-in demo scene with every back-end
  *   sy bench sync [--nodes N] [--tris T] [--repeats R]
@@ -15,7 +15,8 @@
  *   sy backends                         list registered back-ends
  *   sy serve [--listen URL] [--secret-file F] [--output OUT]   render server (apps/sy_cluster_cli.c)
  *   sy render ... --cluster URL[,URL...]|FILE.conf [--cluster-mode MODE]   render on servers
- *   sy bench cluster [-w W] [-h H]
+ *   sy view ... --cluster URL[,URL...]|FILE.conf [--cluster-mode MODE]     the viewer on servers
+ *   sy bench cluster [-w W] [-h H] [--repeats ROUNDS]
  *
  * SCENE is a .gltf / .glb / .x3d file or the word "demo" (the built-in scene). Errors go to stderr with
  * the file and the reason; the exit code is non-zero (1 = usage, 2 = failure). */
@@ -432,10 +433,13 @@ static int usage(void)
             "            [--overlay FILE[:BACKEND]] [--composite depth|over|replace]\n"
             "  sy render SCENE -b pathtracer -o OUT.exr|png [--spp N | --time SECONDS] [--aov]\n"
             "            [--env MAP.exr] [--env-intensity X] [--background R,G,B] (+ the options above)\n"
-            "            [--filter none|pixel|atrous|jbu|adaptive] [--threshold T]   (display filter)\n"
+            "            [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]   (display filter)\n"
             "  sy demo [-o DIR] [-w W] [-h H]\n"
             "  sy view SCENE [-b BACKEND] [-w W] [-h H] [--camera C] [--overlay FILE[:BACKEND]]\n"
-            "          [--frames N --screenshot OUT.png] [--filter none|pixel|atrous|jbu|adaptive] [--threshold T]\n"
+            "          [--frames N --screenshot OUT.png] [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]\n"
+            "          [--keys KEYS]   (automated runs: press these keys one frame after another, e.g. F]F[)\n"
+            "          [--cluster URL[,URL...]|FILE.conf [--cluster-mode MODE] [--secret-file F] [--timeout-ms MS]\n"
+            "           [--spp SAMPLES_PER_SERVER_AND_FRAME]]   (the same cluster options as sy render)\n"
             "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"
             "  sy bench rays [SCENE] [-w W] [-h H] [--repeats R]\n"
             "  sy bench pathtracer [SCENE] [-w W] [-h H] [--repeats PASSES]\n"
@@ -448,8 +452,8 @@ static int usage(void)
             "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
             "  sy render SCENE -b BACKEND -o OUT --cluster URL[,URL...]|FILE.conf\n"
             "            [--cluster-mode sort-first|balanced|cooperative|multi-display|stereo] [--secret-file F]\n"
-            "            [--tls-ca PEM] [--timeout-ms MS] [--frames N] [--spp N]\n"
-            "  sy bench cluster [-w W] [-h H]\n"
+            "            [--tls-ca PEM] [--timeout-ms MS] [--frames N] [--spp N] [--cluster-pixels float|half]\n"
+            "  sy bench cluster [-w W] [-h H] [--repeats ROUNDS]\n"
             "SCENE: a .gltf/.glb/.x3d file, or 'demo' for the built-in scene\n");
     return 1;
 }
@@ -808,7 +812,10 @@ static int cmd_view(int argc, char **argv)
                *shot = NULL;
     const char *view_filter = NULL; /* --filter: initial path tracer display filter */
     float view_threshold = 0.0f;    /* --threshold (0 = default) */
+    const char *view_keys = NULL;   /* --keys: scripted key presses (tests) */
     uint32_t w = 960, h = 540, frames = 0;
+    sy_cluster_cli_opts clo = {0}; /* --cluster ... (sy_cluster_cli.c; --frames is the viewer's own) */
+    bool clbad = false;
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
@@ -827,7 +834,10 @@ static int cmd_view(int argc, char **argv)
         else if (!strcmp(a, "--threshold") && has) {
             char *end = NULL;
             view_threshold = strtof(argv[++i], &end);
-            if (*end || !isfinite(view_threshold) || view_threshold < 0) return usage();
+            if (*end || end == argv[i]) return usage(); /* range: sy_view_run says why */
+        } else if (!strcmp(a, "--keys") && has) view_keys = argv[++i];
+        else if (sy_cluster_cli_option(argc, argv, &i, &clo, &clbad)) {
+            if (clbad) return usage();
         } else if (a[0] != '-' && !scene) scene = a;
         else return usage();
     }
@@ -842,6 +852,8 @@ static int cmd_view(int argc, char **argv)
     sy_view_args va = {.scene = ld.scene, .backend = backend, .width = w, .height = h, .frames = frames, .screenshot = shot};
     va.filter = view_filter;
     va.threshold = view_threshold;
+    va.keys = view_keys;
+    va.cluster = clo.cluster ? &clo : NULL;
     va.spec.root = ld.root;
     va.spec.camera = ld.camera;
     va.spec.background = ld.background;

@@ -9,19 +9,24 @@
 #include <GL/gl.h>
 #include <GLFW/glfw3.h>
 
+#include <ctype.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 typedef struct orbit {
     float target[3];
     float yaw, pitch, dist;
 } orbit;
 
+typedef struct view_cluster view_cluster;
+
 typedef struct viewer {
     const sy_view_args *args;
+    view_cluster *cluster; /* sy view --cluster: used by the render thread only; NULL = local */
     sy_node cam_node; /* the viewer's own top-level camera node */
     pthread_mutex_t mu;
     pthread_cond_t cv;
@@ -40,9 +45,10 @@ typedef struct viewer {
     uint8_t *img;
     uint32_t img_w, img_h;
     uint64_t img_version;
+    uint64_t img_req;       /* the req_version the image answers (scripted --keys wait for it) */
     double frame_ms, sync_ms;
     uint64_t spp;
-    char status[160];
+    char status[256];
     char filter_status[96];
     sy_error error;
     bool failed;
@@ -80,7 +86,7 @@ static void orbit_from_matrix(const sy_mat4 *m, const sy_bounds *b, orbit *o)
 }
 
 /* Display filters of the path tracer the F key cycles through (sy_mediator_rt_set_filter). */
-static const char *const view_filters[] = {"none", "pixel", "atrous", "jbu", "adaptive"};
+static const char *const view_filters[] = {"none", "pixel", "atrous", "jbu", "adaptive", "radiance"};
 #define VIEW_FILTER_COUNT (sizeof view_filters / sizeof view_filters[0])
 
 /* Render thread: applies the requested filter to the path tracer's context when it changed (or the
@@ -117,6 +123,147 @@ static void view_apply_filter(sy_context_pool *pool, const sy_view_args *a, cons
                  fi.nonfinite_pixels ? " | NaN/Inf pixels!" : "");
     else
         snprintf(status, len, " | filter none");
+}
+
+/* >>cluster (`sy view --cluster`): the render thread drives render servers through the cluster
+ * client (core/sy_cluster.h) instead of local contexts. Camera moves are committed scene changes
+ * that the client sends as change lists; the deadline of each request adapts to the frame time. */
+struct view_cluster {
+    sy_cluster_cli_client cc;
+    uint32_t wall_w, wall_h; /* multi-display: the wall (-w x -h); the window may show only a tile */
+    sy_window *win; /* one viewport: the viewer's camera node, for sy_viewport_camera_view */
+    sy_viewport *vp;
+    bool fixed_timeout;    /* --timeout-ms given */
+    uint32_t timeout_ms;   /* current per-request deadline */
+    sy_camera_view last_view;
+    const char *last_backend;
+    uint32_t last_w, last_h;
+    uint32_t passes;       /* frames since the last restart (camera, back-end or size changed) */
+    uint64_t samples;      /* samples per pixel requested since the last restart (not cooperative) */
+    char log[128];         /* the client's last log line (a server dropped, a reconnect) */
+};
+
+/* Client log lines (called on the thread that calls the client: the render thread). */
+static void view_cluster_log(void *user, const char *line)
+{
+    view_cluster *vc = user;
+    fprintf(stderr, "%s\n", line);
+    const char *prefix = "sy cluster: "; /* the title has little room */
+    snprintf(vc->log, sizeof vc->log, "%s", strncmp(line, prefix, strlen(prefix)) ? line : line + strlen(prefix));
+}
+
+/* Connects before any window opens, so a bad option, secret or address fails right away. */
+static sy_result view_cluster_open(const sy_view_args *a, view_cluster **out, sy_error *err)
+{
+    view_cluster *vc = calloc(1, sizeof *vc);
+    if (!vc) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "view: out of memory");
+    sy_cluster_cli_opts o = *a->cluster;
+    o.log = view_cluster_log;
+    o.log_user = vc;
+    if (!o.connect_timeout_ms) o.connect_timeout_ms = 2000; /* a stalled server costs at most this per frame */
+    vc->fixed_timeout = o.timeout_ms != 0;
+    vc->timeout_ms = o.timeout_ms ? o.timeout_ms : 60000; /* the first frame: snapshot + translation */
+    o.timeout_ms = vc->timeout_ms;
+    sy_result r = sy_cluster_cli_connect(&o, a->scene, &vc->cc, err);
+    if (r == SY_OK && vc->cc.mode == SY_CLUSTER_MULTI_DISPLAY && vc->cc.viewer_tile.w) {
+        const sy_cluster_rect *t = &vc->cc.viewer_tile;
+        if (t->x >= a->width || t->y >= a->height || t->w > a->width - t->x || t->h > a->height - t->y)
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: viewer tile %ux%u at %u,%u lies outside the %ux%u wall (-w, -h)",
+                             t->w, t->h, t->x, t->y, a->width, a->height);
+    }
+    if (r) {
+        sy_cluster_client_destroy(vc->cc.client);
+        free(vc);
+        return r;
+    }
+    vc->wall_w = a->width, vc->wall_h = a->height;
+    *out = vc;
+    return SY_OK;
+}
+
+static void view_cluster_close(view_cluster *vc)
+{
+    if (!vc) return;
+    sy_cluster_client_destroy(vc->cc.client);
+    sy_window_destroy(vc->win);
+    free(vc);
+}
+
+/* Multi-display: the window's own picture of the wall, rendered locally with the same back-end
+ * (the whole wall, or the configured viewer tile: an exact crop, as the servers' tiles are). */
+static sy_result view_cluster_local(view_cluster *vc, const sy_view_args *a, sy_context_pool *pool, const char *backend,
+                                    const sy_camera_view *view, uint32_t fw, uint32_t fh, sy_layer *img, sy_error *err)
+{
+    sy_cluster_rect t = vc->cc.viewer_tile.w ? vc->cc.viewer_tile : (sy_cluster_rect){0, 0, fw, fh};
+    sy_context *ctx = NULL;
+    sy_result r = sy_context_pool_get(pool, a->scene, backend, NULL, a->spec.root.id, &ctx, err);
+    if (r == SY_OK) r = sy_context_sync(ctx, err);
+    if (r == SY_OK) r = sy_layer_create(t.w, t.h, img, err);
+    sy_render_request req = {.camera = *view, .full_width = fw, .full_height = fh, .rect_x = t.x, .rect_y = t.y,
+                             .rect_w = t.w, .rect_h = t.h, .sample_count = 1, .background_id = a->spec.background.id};
+    if (r == SY_OK) r = sy_context_render(ctx, &req, img, err);
+    return r;
+}
+
+/* One cluster frame of w x h (the window; multi-display: the -w x -h wall) into *img. Fills the
+ * heads-up status, the merged samples per pixel and whether to keep refining. */
+static sy_result view_cluster_frame(view_cluster *vc, const sy_view_args *a, sy_context_pool *pool, sy_node cam,
+                                    const sy_mediator_class *cls, uint32_t w, uint32_t h, sy_layer *img, uint64_t *spp,
+                                    bool *refine, char *status, size_t len, sy_error *err)
+{
+    uint32_t mode = vc->cc.mode;
+    bool progressive = (cls->caps & SY_CAP_PROGRESSIVE) != 0;
+    uint32_t fw = mode == SY_CLUSTER_MULTI_DISPLAY ? vc->wall_w : mode == SY_CLUSTER_STEREO ? (w / 2 ? w / 2 : 1) : w;
+    uint32_t fh = mode == SY_CLUSTER_MULTI_DISPLAY ? vc->wall_h : h;
+    sy_result r = SY_OK;
+    if (!vc->win) {
+        sy_viewport_desc vd = {.root = a->spec.root, .camera = cam, .background = a->spec.background, .backend = cls->name};
+        r = sy_window_create(fw, fh, &vc->win, err);
+        if (r == SY_OK) r = sy_window_add_viewport(vc->win, &vd, &vc->vp, err);
+    }
+    sy_camera_view view;
+    if (r == SY_OK) r = sy_window_resize(vc->win, fw, fh, err);
+    if (r == SY_OK) r = sy_viewport_camera_view(vc->vp, a->scene, fw, fh, &view, err);
+    if (r) return r;
+    if (memcmp(&view, &vc->last_view, sizeof view) != 0 || vc->last_backend != cls->name || vc->last_w != fw ||
+        vc->last_h != fh) { /* the servers restart their accumulations too */
+        vc->last_view = view, vc->last_backend = cls->name, vc->last_w = fw, vc->last_h = fh;
+        vc->passes = 0;
+        vc->samples = 0;
+    }
+    /* progressive: 1, 2, 4, 8, then 16 samples per server and frame after a restart (--spp: fixed) */
+    uint32_t per = a->cluster->samples ? a->cluster->samples : 1u << (vc->passes < 4 ? vc->passes : 4);
+    sy_cluster_frame f = {.mode = mode, .backend = cls->name, .root_id = a->spec.root.id,
+                          .background_id = a->spec.background.id, .camera = view, .width = fw, .height = fh,
+                          .samples = per, .eye_separation = a->spec.eye_separation, .zero_parallax = a->spec.zero_parallax,
+                          .half = a->cluster->half_pixels};
+    if (mode == SY_CLUSTER_MULTI_DISPLAY) r = view_cluster_local(vc, a, pool, cls->name, &view, fw, fh, img, err);
+    else r = sy_layer_create(mode == SY_CLUSTER_STEREO ? 2 * fw : fw, fh, img, err);
+    if (!vc->fixed_timeout) sy_cluster_client_set_timeout(vc->cc.client, vc->timeout_ms);
+    sy_cluster_frame_stats st = {0};
+    if (r == SY_OK) r = sy_cluster_client_render(vc->cc.client, &f, mode == SY_CLUSTER_MULTI_DISPLAY ? NULL : img, &st, err);
+    uint32_t live = sy_cluster_client_live(vc->cc.client);
+    if (r) {
+        sy_layer_destroy(img);
+        snprintf(status, len, "cluster %s: %u/%u servers alive", sy_cluster_mode_name(mode), live, vc->cc.servers);
+        vc->timeout_ms = vc->timeout_ms < 30000 ? 2 * vc->timeout_ms : 60000;
+        struct timespec pause = {0, 250000000}; /* every server down: retry a few times a second */
+        nanosleep(&pause, NULL);
+        return r;
+    }
+    /* deadline for the next frame: generous next to this frame's time, doubled after a failure
+     * (a server that rejoins needs a snapshot and a first translation) */
+    double next = st.servers_failed ? 2.0 * vc->timeout_ms : 1000.0 + 4000.0 * st.seconds;
+    vc->timeout_ms = next > 60000.0 ? 60000u : next < 1000.0 ? 1000u : (uint32_t)next;
+    vc->passes++;
+    vc->samples += per;
+    *spp = mode == SY_CLUSTER_COOPERATIVE ? st.samples : progressive ? vc->samples : 1;
+    *refine = progressive && *spp < 65536;
+    int n = snprintf(status, len, "cluster %s: %s | %u/%u servers alive | slowest server %.1f ms",
+                     sy_cluster_mode_name(mode), cls->name, live, vc->cc.servers, st.max_server_seconds * 1e3);
+    if (n > 0 && (size_t)n < len && live < vc->cc.servers && vc->log[0])
+        snprintf(status + n, len - (size_t)n, " | %s", vc->log);
+    return SY_OK;
 }
 
 /* >>render thread */
@@ -167,19 +314,29 @@ static void *render_main(void *p)
         uint32_t ew = stereo == SY_STEREO_SBS ? (w / 2 ? w / 2 : 1) : w;
         sy_layer img = {0}, right = {0};
         double t0 = sy_time_now();
-        view_apply_filter(pool, a, cls, filter, threshold, filter_version, &filter_state, &filter_applied, fstatus,
-                          sizeof fstatus);
-        sy_window_render_opts ro = {.sample_count = 1};
-        sy_result r = sy_compose_render(a->scene, pool, &spec, ew, h, &ro, &img, &right, &err);
+        uint64_t cl_spp = 0; /* sy view --cluster: view_cluster_frame's results */
+        bool cl_refine = false;
+        char cl_status[sizeof v->status] = "";
+        sy_result r;
+        if (v->cluster) {
+            r = view_cluster_frame(v->cluster, a, pool, v->cam_node, cls, w, h, &img, &cl_spp, &cl_refine, cl_status,
+                                   sizeof cl_status, &err);
+        } else {
+            view_apply_filter(pool, a, cls, filter, threshold, filter_version, &filter_state, &filter_applied, fstatus,
+                              sizeof fstatus);
+            sy_window_render_opts ro = {.sample_count = 1};
+            r = sy_compose_render(a->scene, pool, &spec, ew, h, &ro, &img, &right, &err);
+        }
         double ms = (sy_time_now() - t0) * 1e3;
         sy_layer_destroy(&right);
         if (r != SY_OK) {
             /* a back-end that fails is reported; the viewer keeps running with the others */
             pthread_mutex_lock(&v->mu);
-            snprintf(v->status, sizeof v->status, "%s failed: %.100s", cls->name, err.message);
+            snprintf(v->status, sizeof v->status, "%.60s%s%.24s failed: %.60s", cl_status, cl_status[0] ? " | " : "",
+                     cls->name, err.message);
             v->img_version++;
             pthread_mutex_unlock(&v->mu);
-            refine = false;
+            refine = v->cluster != NULL; /* cluster: retry, the servers may come back */
             continue;
         }
         sy_post_desc post = {.enabled = true, .tonemap = SY_TONEMAP_ACES, .srgb = true};
@@ -194,7 +351,8 @@ static void *render_main(void *p)
             }
         sy_context *ctx = NULL;
         sy_mediator_stats st = {0};
-        if (sy_context_pool_get(pool, a->scene, cls->name, NULL, a->spec.root.id, &ctx, &err) == SY_OK)
+        if (v->cluster) st.samples = cl_spp; /* no local context in cluster mode */
+        else if (sy_context_pool_get(pool, a->scene, cls->name, NULL, a->spec.root.id, &ctx, &err) == SY_OK)
             sy_context_stats(ctx, &st);
         pthread_mutex_lock(&v->mu);
         free(v->img);
@@ -204,13 +362,14 @@ static void *render_main(void *p)
         v->frame_ms = ms;
         v->sync_ms = st.last_sync_seconds * 1e3;
         v->spp = st.samples;
-        snprintf(v->status, sizeof v->status, "%s", cls->name);
+        snprintf(v->status, sizeof v->status, "%s", v->cluster ? cl_status : cls->name);
         snprintf(v->filter_status, sizeof v->filter_status, "%s", fstatus);
         v->img_version++;
+        v->img_req = seen;
         pthread_mutex_unlock(&v->mu);
         sy_layer_destroy(&img);
         /* progressive back-ends keep refining a resting mono view */
-        refine = (cls->caps & SY_CAP_PROGRESSIVE) && stereo == SY_STEREO_NONE && st.samples < 65536;
+        refine = v->cluster ? cl_refine : (cls->caps & SY_CAP_PROGRESSIVE) && stereo == SY_STEREO_NONE && st.samples < 65536;
     }
     sy_context_pool_destroy(pool);
     return NULL;
@@ -358,18 +517,20 @@ static sy_result write_screenshot(const char *path, int w, int h, sy_error *err)
     return r;
 }
 
-sy_result sy_view_run(const sy_view_args *args, sy_error *err)
+static sy_result view_run(const sy_view_args *args, view_cluster *cluster, sy_error *err)
 {
     uint32_t filter0 = 0;
     if (args->filter) { /* the initial display filter, checked before any window opens */
         while (filter0 < VIEW_FILTER_COUNT && strcmp(view_filters[filter0], args->filter) != 0) filter0++;
         if (filter0 == VIEW_FILTER_COUNT)
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "view: unknown filter '%s' (expected none, pixel, atrous, jbu or adaptive%s)", args->filter,
-                                strcmp(args->filter, "radiance") ? ""
-                                                                 : "; radiance needs the integrator's stored-sample hook, "
-                                                                   "not available yet");
+                                "view: unknown filter '%s' (expected none, pixel, atrous, jbu, adaptive or radiance)",
+                                args->filter);
     }
+    for (const char *k = args->keys; k && *k; ++k)
+        if (!isalnum((unsigned char)*k) && *k != '[' && *k != ']')
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: --keys: '%c' is not a key (letters, digits, [ and ])",
+                                *k);
     if (!(args->threshold >= 0.0f) || !isfinite(args->threshold))
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: threshold %g must be a finite value >= 0",
                             (double)args->threshold);
@@ -392,6 +553,7 @@ sy_result sy_view_run(const sy_view_args *args, sy_error *err)
     viewer v;
     memset(&v, 0, sizeof v);
     v.args = args;
+    v.cluster = cluster;
     pthread_mutex_init(&v.mu, NULL);
     pthread_cond_init(&v.cv, NULL);
     for (uint32_t i = 0; i < sy_mediator_count(); ++i)
@@ -441,6 +603,9 @@ sy_result sy_view_run(const sy_view_args *args, sy_error *err)
     uint8_t *img = NULL;
     uint32_t iw = 0, ih = 0;
     char title[512] = "sy view";
+    const char *keys = args->keys; /* scripted key presses, one per answered frame */
+    char key_last = 0;
+    uint64_t key_req = 0;
     while (!glfwWindowShouldClose(win)) {
         glfwWaitEventsTimeout(1.0 / 60.0);
         double now = glfwGetTime();
@@ -468,9 +633,20 @@ sy_result sy_view_run(const sy_view_args *args, sy_error *err)
                      v.filter_status);
             glfwSetWindowTitle(win, title);
         }
-        bool failed = v.failed;
+        bool failed = v.failed, answered = fresh && v.img_req >= key_req;
         pthread_mutex_unlock(&v.mu);
         if (failed) break;
+        if (answered && key_last) { /* scripted --keys: the heads-up line once the key took effect */
+            printf("sy view: after key %c: %s\n", key_last, title);
+            key_last = 0;
+        }
+        if (answered && keys && *keys) { /* the next scripted key, through the keyboard handler */
+            key_last = *keys++;
+            on_key(win, toupper((unsigned char)key_last), 0, GLFW_PRESS, 0);
+            pthread_mutex_lock(&v.mu);
+            key_req = v.req_version;
+            pthread_mutex_unlock(&v.mu);
+        }
         if (in.changed) {
             in.changed = false;
             post_request(&v, &in);
@@ -484,10 +660,11 @@ sy_result sy_view_run(const sy_view_args *args, sy_error *err)
             glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
             glDrawPixels((GLsizei)iw, (GLsizei)ih, GL_RGBA, GL_UNSIGNED_BYTE, img);
         }
-        if (img) displayed++; /* frames shown, fresh or not */
+        if (img && !key_last && !(keys && *keys)) displayed++; /* frames shown (after scripted keys) */
         if (args->frames && displayed >= args->frames) {
             if (args->screenshot) r = write_screenshot(args->screenshot, fbw, fbh, err);
             if (!glfwWindowShouldClose(win)) printf("%s\n", title); /* automated runs: the last heads-up line */
+            fflush(stdout); /* before any exit-time check (a sanitizer's) can end the process */
             glfwSetWindowShouldClose(win, GLFW_TRUE);
         }
         glfwSwapBuffers(win);
@@ -507,5 +684,17 @@ sy_result sy_view_run(const sy_view_args *args, sy_error *err)
     pthread_cond_destroy(&v.cv);
     glfwDestroyWindow(win);
     glfwTerminate();
+    return r;
+}
+
+sy_result sy_view_run(const sy_view_args *args, sy_error *err)
+{
+    view_cluster *vc = NULL; /* sy view --cluster: connected before the window opens */
+    sy_result r = args->cluster ? view_cluster_open(args, &vc, err) : SY_OK;
+    sy_view_args a = *args;
+    if (vc && vc->cc.mode == SY_CLUSTER_MULTI_DISPLAY && vc->cc.viewer_tile.w) /* a window of the tile's size */
+        a.width = vc->cc.viewer_tile.w, a.height = vc->cc.viewer_tile.h;
+    if (r == SY_OK) r = view_run(&a, vc, err);
+    view_cluster_close(vc);
     return r;
 }

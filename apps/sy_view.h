@@ -11,10 +11,22 @@
  * responsive while a slow back-end renders and always shows the last complete image; a
  * progressive back-end keeps refining while the camera rests and restarts when it moves.
  *
+ * Cluster (--cluster URL[,URL...]|FILE.conf, --cluster-mode ...): the render thread sends the
+ * camera moves as scene changes and render requests to `sy serve` processes and shows the merged
+ * image (sort-first / balanced: bit-identical to a local render; cooperative: the servers' sample
+ * ranges merged, refined while the camera rests; stereo: both eyes side by side). Each request has
+ * a deadline (--timeout-ms, else adaptive: 1 s + 4x the last frame, doubled after a failure), so
+ * a dead or stalled server is dropped and its work given to the others; the title shows the mode,
+ * the servers alive, the frame time, spp and the last server failure. Multi-display: the servers
+ * present the wall (-w x -h) at the swap barrier, and the window shows the whole wall rendered
+ * locally with the same back-end, or the configuration's 'viewer tile X Y W H'. The overlay and
+ * the path tracer display filter are local-only (not used with --cluster).
+ *
  * Thread-safety: runs the whole viewer; call from the main thread (GLFW requires it). */
 #ifndef SY_VIEW_H
 #define SY_VIEW_H
 
+#include "sy_cluster_cli.h"
 #include "sy_compose.h"
 
 typedef struct sy_view_args {
@@ -27,6 +39,10 @@ typedef struct sy_view_args {
     const char *filter;     /* initial path tracer display filter (NULL = "none"): none, pixel, atrous,
                                jbu or adaptive; anything else is refused before a window opens */
     float threshold;        /* its initial threshold (0 = the default 0.01; must be >= 0) */
+    const char *keys;       /* automated runs: keys pressed one at a time through the keyboard handler,
+                               each once the frame answering the previous one is shown (letters, digits,
+                               [ ]); the heads-up line after each is printed; --frames counts after them */
+    const sy_cluster_cli_opts *cluster; /* non-NULL: render on these servers (sy view --cluster) */
 } sy_view_args;
 
 sy_result sy_view_run(const sy_view_args *args, sy_error *err);

@@ -349,6 +349,62 @@ static bool r_blobref(reader *r, sy_blob *const *blobs, uint32_t nblobs, sy_blob
     return true;
 }
 
+/* The header: magic, version, flags, counts checked against the limit and the message size. */
+static bool r_header(reader *r, size_t max_entries, uint16_t *flags, uint64_t *first, uint64_t *last,
+                     uint32_t *nentries, uint32_t *nblobs)
+{
+    uint32_t magic;
+    uint16_t version;
+    if (!r_u32(r, &magic, "header") || !r_u16(r, &version, "header") || !r_u16(r, flags, "header") ||
+        !r_u64(r, first, "header") || !r_u64(r, last, "header") || !r_u32(r, nentries, "header") ||
+        !r_u32(r, nblobs, "header"))
+        return false;
+    if (magic != SY_CHANGES_WIRE_MAGIC) return r_fail(r, SY_ERR_PARSE, "wrong magic (not a change list)");
+    if (version != SY_CHANGES_WIRE_VERSION) {
+        r->pos = 4;
+        return r_fail(r, SY_ERR_UNSUPPORTED, "unsupported wire version");
+    }
+    if (*flags & ~1u) return r_fail(r, SY_ERR_PARSE, "unknown header flags");
+    if (*nentries > max_entries) return r_fail(r, SY_ERR_LIMIT, "entry count exceeds the limit");
+    /* Each blob record takes at least 25 bytes and each entry 16: cheap sanity before allocating. */
+    if (*nblobs > (r->size - r->pos) / 25 || *nentries > (r->size - r->pos) / 16)
+        return r_fail(r, SY_ERR_PARSE, "counts larger than the message can hold");
+    return true;
+}
+
+/* One blob table record up to its payload (left unread; checked to lie inside the message). */
+static bool r_blob_record(reader *r, size_t max_blob, sy_hash128 *h, uint64_t *bsize, uint8_t *has)
+{
+    if (!r_u64(r, &h->lo, "blob hash") || !r_u64(r, &h->hi, "blob hash") || !r_u64(r, bsize, "blob size") ||
+        !r_u8(r, has, "blob flag"))
+        return false;
+    if (*bsize > max_blob) return r_fail(r, SY_ERR_LIMIT, "blob larger than the limit");
+    if (*has > 1) return r_fail(r, SY_ERR_PARSE, "bad blob payload flag");
+    if (*has && *bsize > r->size - r->pos) return r_fail(r, SY_ERR_PARSE, "blob payload runs past the end of the message");
+    return true;
+}
+
+sy_result sy_changes_blob_refs(const void *data, size_t size, const sy_changes_limits *limits, sy_blob_ref_fn fn,
+                               void *user, sy_error *err)
+{
+    size_t max_entries = (limits && limits->max_entries) ? limits->max_entries : ((size_t)1 << 22);
+    size_t max_blob = (limits && limits->max_blob_bytes) ? limits->max_blob_bytes : ((size_t)1 << 30);
+    reader r = {data, size, 0, err, SY_OK};
+    uint32_t nentries, nblobs;
+    uint16_t flags;
+    uint64_t first, last;
+    if (!r_header(&r, max_entries, &flags, &first, &last, &nentries, &nblobs)) return r.code;
+    for (uint32_t i = 0; i < nblobs; ++i) {
+        sy_hash128 h;
+        uint64_t bsize;
+        uint8_t has;
+        if (!r_blob_record(&r, max_blob, &h, &bsize, &has)) return r.code;
+        if (has) r.pos += (size_t)bsize;
+        else fn(user, h, bsize);
+    }
+    return SY_OK;
+}
+
 sy_result sy_changes_deserialize(const void *data, size_t size, sy_blob_store *store, const sy_changes_limits *limits,
                                  sy_changes **out, sy_error *err)
 {
@@ -364,35 +420,10 @@ sy_result sy_changes_deserialize(const void *data, size_t size, sy_blob_store *s
     sy_attachment *atts = NULL;
     uint32_t natts = 0;
 
-    uint32_t magic, nentries, nblobs;
-    uint16_t version, flags;
+    uint32_t nentries, nblobs;
+    uint16_t flags;
     uint64_t first, last;
-    if (!r_u32(&r, &magic, "header") || !r_u16(&r, &version, "header") || !r_u16(&r, &flags, "header") ||
-        !r_u64(&r, &first, "header") || !r_u64(&r, &last, "header") || !r_u32(&r, &nentries, "header") ||
-        !r_u32(&r, &nblobs, "header"))
-        goto fail;
-    if (magic != SY_CHANGES_WIRE_MAGIC) {
-        r_fail(&r, SY_ERR_PARSE, "wrong magic (not a change list)");
-        goto fail;
-    }
-    if (version != SY_CHANGES_WIRE_VERSION) {
-        r.pos = 4;
-        r_fail(&r, SY_ERR_UNSUPPORTED, "unsupported wire version");
-        goto fail;
-    }
-    if (flags & ~1u) {
-        r_fail(&r, SY_ERR_PARSE, "unknown header flags");
-        goto fail;
-    }
-    if (nentries > max_entries) {
-        r_fail(&r, SY_ERR_LIMIT, "entry count exceeds the limit");
-        goto fail;
-    }
-    /* Each blob record takes at least 25 bytes and each entry 16: cheap sanity before allocating. */
-    if (nblobs > (size - r.pos) / 25 || nentries > (size - r.pos) / 16) {
-        r_fail(&r, SY_ERR_PARSE, "counts larger than the message can hold");
-        goto fail;
-    }
+    if (!r_header(&r, max_entries, &flags, &first, &last, &nentries, &nblobs)) goto fail;
     blobs = calloc(nblobs ? nblobs : 1, sizeof *blobs);
     c = sy__changes_new(first, last, flags & 1u);
     if (!blobs || !c) {
@@ -403,22 +434,8 @@ sy_result sy_changes_deserialize(const void *data, size_t size, sy_blob_store *s
         sy_hash128 h;
         uint64_t bsize;
         uint8_t has;
-        if (!r_u64(&r, &h.lo, "blob hash") || !r_u64(&r, &h.hi, "blob hash") || !r_u64(&r, &bsize, "blob size") ||
-            !r_u8(&r, &has, "blob flag"))
-            goto fail;
-        if (bsize > max_blob) {
-            r_fail(&r, SY_ERR_LIMIT, "blob larger than the limit");
-            goto fail;
-        }
-        if (has > 1) {
-            r_fail(&r, SY_ERR_PARSE, "bad blob payload flag");
-            goto fail;
-        }
+        if (!r_blob_record(&r, max_blob, &h, &bsize, &has)) goto fail;
         if (has) {
-            if (bsize > r.size - r.pos) {
-                r_fail(&r, SY_ERR_PARSE, "blob payload runs past the end of the message");
-                goto fail;
-            }
             if (!sy_hash_equal(sy_hash_bytes(r.p + r.pos, (size_t)bsize), h)) {
                 r_fail(&r, SY_ERR_PROTOCOL, "blob payload does not match its hash");
                 goto fail;

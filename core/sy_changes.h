@@ -78,6 +78,13 @@ typedef struct sy_changes_limits {
 sy_result sy_changes_deserialize(const void *data, size_t size, sy_blob_store *store, const sy_changes_limits *limits,
                                  sy_changes **out, sy_error *err);
 
+/* Lists the blobs an untrusted serialised change list names by hash only (payload not inline):
+ * fn(user, hash, size) per blob table record. Checks the header and the blob table (not the
+ * entries), so a receiver can find the blobs it lacks before decoding the list. */
+typedef void (*sy_blob_ref_fn)(void *user, sy_hash128 hash, uint64_t size);
+sy_result sy_changes_blob_refs(const void *data, size_t size, const sy_changes_limits *limits, sy_blob_ref_fn fn,
+                               void *user, sy_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 
 #include "sy_viewport.h"
 
@@ -125,33 +126,47 @@ static bool sockaddr_is_loopback(const nng_sockaddr *sa)
     return sa->s_family == NNG_AF_INPROC || sa->s_family == NNG_AF_IPC;
 }
 
-static void sockaddr_str(const nng_sockaddr *sa, char *buf, size_t n)
+/* "1.2.3.4:port" / "[::1]:port"; with_port false: the host alone (the key of the back-off table) */
+static void sockaddr_str(const nng_sockaddr *sa, bool with_port, char *buf, size_t n)
 {
     if (sa->s_family == NNG_AF_INET) {
         char a[INET_ADDRSTRLEN];
         struct in_addr ia = {sa->s_in.sa_addr};
         inet_ntop(AF_INET, &ia, a, sizeof a);
-        snprintf(buf, n, "%s:%u", a, (unsigned)ntohs(sa->s_in.sa_port));
+        if (with_port) snprintf(buf, n, "%s:%u", a, (unsigned)ntohs(sa->s_in.sa_port));
+        else snprintf(buf, n, "%s", a);
     } else if (sa->s_family == NNG_AF_INET6) {
         char a[INET6_ADDRSTRLEN];
         inet_ntop(AF_INET6, sa->s_in6.sa_addr, a, sizeof a);
-        snprintf(buf, n, "[%s]:%u", a, (unsigned)ntohs(sa->s_in6.sa_port));
+        if (with_port) snprintf(buf, n, "[%s]:%u", a, (unsigned)ntohs(sa->s_in6.sa_port));
+        else snprintf(buf, n, "%s", a);
     } else snprintf(buf, n, "local peer");
 }
 
 /* ---- tile codec ---- */
-sy_result sy_cluster_tile_encode(const sy_layer *tile, bool depth, sy_cluster_buf *out, sy_error *err)
+sy_result sy_cluster_tile_encode_as(const sy_layer *tile, bool depth, uint32_t encoding, sy_cluster_buf *out,
+                                    sy_error *err)
 {
-    size_t px = (size_t)tile->width * tile->height, ch = depth ? 5 : 4, raw = px * ch * 4;
+    uint32_t vb = sy_cluster_encoding_bytes(encoding);
+    if (!vb) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster tile: unknown encoding %u", encoding);
+    size_t px = (size_t)tile->width * tile->height, ch = depth ? 5 : 4, raw = px * ch * vb;
     uint8_t *shuf = malloc(raw ? raw : 1);
     if (!shuf) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster tile: out of memory (%zu bytes)", raw);
-    /* channel planes and byte shuffle in one pass: byte k of float j of the plane sequence goes to
-     * shuf[k * nf + j], where j = channel * px + pixel */
-    size_t nf = raw / 4;
-    uint8_t *b0 = shuf, *b1 = shuf + nf, *b2 = shuf + 2 * nf, *b3 = shuf + 3 * nf;
+    /* channel planes and byte shuffle in one pass: byte k of value j of the plane sequence goes to
+     * shuf[k * nv + j], where j = channel * px + pixel */
+    size_t nv = raw / vb;
+    uint8_t *b0 = shuf, *b1 = shuf + nv, *b2 = vb == 4 ? shuf + 2 * nv : NULL, *b3 = vb == 4 ? shuf + 3 * nv : NULL;
     for (size_t c = 0; c < ch; ++c) {
         const float *src = c < 4 ? tile->rgba + c : tile->depth;
         size_t stride = c < 4 ? 4 : 1, base = c * px;
+        if (vb == 2) {
+            for (size_t i = 0; i < px; ++i) {
+                uint16_t v = sy_cluster_half_from_float(src[i * stride]);
+                b0[base + i] = (uint8_t)v;
+                b1[base + i] = (uint8_t)(v >> 8);
+            }
+            continue;
+        }
         for (size_t i = 0; i < px; ++i) {
             uint32_t v;
             memcpy(&v, &src[i * stride], 4);
@@ -179,16 +194,21 @@ sy_result sy_cluster_tile_encode(const sy_layer *tile, bool depth, sy_cluster_bu
     return SY_OK;
 }
 
+sy_result sy_cluster_tile_encode(const sy_layer *tile, bool depth, sy_cluster_buf *out, sy_error *err)
+{
+    return sy_cluster_tile_encode_as(tile, depth, SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD, out, err);
+}
+
 sy_result sy_cluster_tile_decode(const sy_cluster_tile *t, sy_layer *dst, uint32_t dx, uint32_t dy, sy_error *err)
 {
     const sy_cluster_rect *r = &t->rect;
-    if (t->encoding != SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD)
-        return sy_error_set(err, SY_ERR_UNSUPPORTED, "cluster tile: unknown encoding %u", t->encoding);
+    uint32_t vb = sy_cluster_encoding_bytes(t->encoding);
+    if (!vb) return sy_error_set(err, SY_ERR_UNSUPPORTED, "cluster tile: unknown encoding %u", t->encoding);
     if (dx > dst->width || dy > dst->height || r->w > dst->width - dx || r->h > dst->height - dy)
         return sy_error_set(err, SY_ERR_PROTOCOL, "cluster tile %ux%u at %u,%u does not fit the %ux%u image", r->w,
                             r->h, dx, dy, dst->width, dst->height);
     size_t px = (size_t)r->w * r->h, raw = (size_t)t->raw_size;
-    if (raw != px * t->channels * 4) return sy_error_set(err, SY_ERR_PROTOCOL, "cluster tile: raw size mismatch");
+    if (raw != px * t->channels * vb) return sy_error_set(err, SY_ERR_PROTOCOL, "cluster tile: raw size mismatch");
     unsigned long long fs = ZSTD_getFrameContentSize(t->data, t->data_size);
     if (fs != raw)
         return sy_error_set(err, SY_ERR_PROTOCOL, "cluster tile %u,%u: compressed frame announces %llu bytes, expected %zu",
@@ -202,8 +222,8 @@ sy_result sy_cluster_tile_decode(const sy_cluster_tile *t, sy_layer *dst, uint32
                             ZSTD_isError(n) ? ZSTD_getErrorName(n) : "short");
     }
     /* unshuffle straight into the destination rows */
-    size_t nf = raw / 4;
-    const uint8_t *b0 = shuf, *b1 = shuf + nf, *b2 = shuf + 2 * nf, *b3 = shuf + 3 * nf;
+    size_t nv = raw / vb;
+    const uint8_t *b0 = shuf, *b1 = shuf + nv, *b2 = vb == 4 ? shuf + 2 * nv : NULL, *b3 = vb == 4 ? shuf + 3 * nv : NULL;
     for (size_t c = 0; c < t->channels; ++c) {
         if (c == 4 && !dst->depth) break;
         size_t base = c * px;
@@ -213,6 +233,10 @@ sy_result sy_cluster_tile_decode(const sy_cluster_tile *t, sy_layer *dst, uint32
             size_t stride = c < 4 ? 4 : 1;
             for (uint32_t x = 0; x < r->w; ++x) {
                 size_t j = row + x;
+                if (vb == 2) {
+                    out[x * stride] = sy_cluster_half_to_float((uint16_t)(b0[j] | (b1[j] << 8)));
+                    continue;
+                }
                 uint32_t v = (uint32_t)b0[j] | ((uint32_t)b1[j] << 8) | ((uint32_t)b2[j] << 16) | ((uint32_t)b3[j] << 24);
                 memcpy(&out[x * stride], &v, 4);
             }
@@ -307,6 +331,167 @@ const char *sy_cluster_mode_name(uint32_t mode)
 }
 
 /* ======================================================================== server */
+/* Blob cache shared by every session (and outliving them): hash -> blob, least recently used
+ * evicted first once the payload bytes exceed the budget. A replica keeps its own references, so
+ * eviction never takes data from a live scene; it only means a later SCENE naming the blob makes
+ * the server ask for it again. */
+typedef struct cache_entry {
+    sy_blob *blob;
+    sy_hash128 hash;
+    struct cache_entry *chain, *older, *newer;
+} cache_entry;
+
+typedef struct blob_cache {
+    cache_entry **buckets;
+    size_t nbuckets, count, bytes, budget;
+    cache_entry *newest, *oldest;
+    uint64_t evictions;
+} blob_cache;
+
+static cache_entry **cache_slot(blob_cache *c, sy_hash128 h)
+{
+    cache_entry **p = &c->buckets[(size_t)(h.lo ^ h.hi) & (c->nbuckets - 1)];
+    while (*p && !sy_hash_equal((*p)->hash, h)) p = &(*p)->chain;
+    return p;
+}
+
+static void cache_unlink_lru(blob_cache *c, cache_entry *e)
+{
+    if (e->older) e->older->newer = e->newer;
+    else c->oldest = e->newer;
+    if (e->newer) e->newer->older = e->older;
+    else c->newest = e->older;
+    e->older = e->newer = NULL;
+}
+
+static void cache_push_newest(blob_cache *c, cache_entry *e)
+{
+    e->older = c->newest;
+    e->newer = NULL;
+    if (c->newest) c->newest->newer = e;
+    c->newest = e;
+    if (!c->oldest) c->oldest = e;
+}
+
+/* Borrowed blob (marked most recently used) or NULL. */
+static sy_blob *cache_get(blob_cache *c, sy_hash128 h)
+{
+    if (!c->nbuckets) return NULL;
+    cache_entry *e = *cache_slot(c, h);
+    if (!e) return NULL;
+    cache_unlink_lru(c, e);
+    cache_push_newest(c, e);
+    return e->blob;
+}
+
+static void cache_evict_oldest(blob_cache *c)
+{
+    cache_entry *e = c->oldest;
+    cache_entry **p = cache_slot(c, e->hash);
+    *p = e->chain;
+    cache_unlink_lru(c, e);
+    c->bytes -= sy_blob_size(e->blob);
+    c->count--;
+    c->evictions++;
+    sy_blob_release(e->blob);
+    free(e);
+}
+
+/* Caches a reference to b (a blob larger than the whole budget is not cached). */
+static void cache_put(blob_cache *c, sy_blob *b)
+{
+    size_t size = sy_blob_size(b);
+    if (size > c->budget || cache_get(c, sy_blob_hash(b))) return;
+    if (c->count + 1 > c->nbuckets) { /* grow and rehash: load factor <= 1 */
+        size_t nb = c->nbuckets ? c->nbuckets * 2 : 256;
+        cache_entry **nbk = calloc(nb, sizeof *nbk);
+        if (!nbk) return; /* a cache that cannot grow just does not cache */
+        for (size_t i = 0; i < c->nbuckets; ++i)
+            for (cache_entry *e = c->buckets[i], *next; e; e = next) {
+                next = e->chain;
+                size_t j = (size_t)(e->hash.lo ^ e->hash.hi) & (nb - 1);
+                e->chain = nbk[j];
+                nbk[j] = e;
+            }
+        free(c->buckets);
+        c->buckets = nbk;
+        c->nbuckets = nb;
+    }
+    cache_entry *e = calloc(1, sizeof *e);
+    if (!e) return;
+    e->blob = sy_blob_retain(b);
+    e->hash = sy_blob_hash(b);
+    cache_entry **p = cache_slot(c, e->hash);
+    *p = e;
+    cache_push_newest(c, e);
+    c->count++;
+    c->bytes += size;
+    while (c->bytes > c->budget && c->oldest != e) cache_evict_oldest(c);
+}
+
+static void cache_free(blob_cache *c)
+{
+    while (c->oldest) cache_evict_oldest(c);
+    free(c->buckets);
+    memset(c, 0, sizeof *c);
+}
+
+/* Failed authentications per address (host, without the port): a bounded table. After the n-th
+ * failure in a row the address is refused (HELLO answered with ERROR) for backoff * 2^(n-1), at
+ * most max(60 s, backoff); a success forgets the address; a full table reuses the entry whose
+ * refusal ended longest ago. */
+typedef struct auth_fail {
+    char host[48];
+    uint32_t failures;
+    double until, last;
+} auth_fail;
+
+static auth_fail *auth_find(auth_fail *t, const char *host)
+{
+    for (uint32_t i = 0; i < SY_CLUSTER_AUTH_TABLE; ++i)
+        if (t[i].failures && !strcmp(t[i].host, host)) return &t[i];
+    return NULL;
+}
+
+/* Seconds the host must still wait (0 = not refused). */
+static double auth_refused_for(auth_fail *t, const char *host, double now)
+{
+    auth_fail *a = auth_find(t, host);
+    return a && a->until > now ? a->until - now : 0;
+}
+
+/* Records a failure; returns the refusal window in seconds. */
+static double auth_failed(auth_fail *t, const char *host, double now, uint32_t backoff_ms)
+{
+    auth_fail *a = auth_find(t, host);
+    if (a && now - a->last > 600) a->failures = 0; /* ten quiet minutes: start over */
+    if (!a) {
+        a = &t[0];
+        for (uint32_t i = 0; i < SY_CLUSTER_AUTH_TABLE; ++i) {
+            if (!t[i].failures) {
+                a = &t[i];
+                break;
+            }
+            if (t[i].until < a->until) a = &t[i];
+        }
+        memset(a, 0, sizeof *a);
+        copy_str(a->host, sizeof a->host, host);
+    }
+    a->failures++;
+    double base = backoff_ms / 1000.0, cap = base > 60 ? base : 60;
+    double wait = base * (double)(1u << (a->failures - 1 < 16 ? a->failures - 1 : 16));
+    if (wait > cap) wait = cap;
+    a->last = now;
+    a->until = now + wait;
+    return wait;
+}
+
+static void auth_succeeded(auth_fail *t, const char *host)
+{
+    auth_fail *a = auth_find(t, host);
+    if (a) memset(a, 0, sizeof *a);
+}
+
 typedef struct session {
     bool used;
     uint32_t pipe_id;
@@ -314,17 +499,31 @@ typedef struct session {
     uint8_t cnonce[32], snonce[32], key[32];
     bool tagged;
     uint64_t recv_seq, send_seq;
-    char peer[80];
+    char peer[80], host[48];
     double last_active;
     sy_scene *scene;
-    sy_blob_store *blobs;
     sy_context_pool *pool;
     uint64_t frame;
     sy_layer present; /* multi-display: the tile held for the swap barrier */
     uint32_t present_x, present_y, present_fw, present_fh;
     uint64_t present_frame;
     bool has_present;
+    /* a SCENE waiting for the blobs the server asked for (BLOB_REQUEST -> BLOBS) */
+    uint8_t *pending;
+    uint32_t pending_size, pending_flags;
+    uint64_t pending_frame;
+    sy_blob_store *pending_blobs;  /* every blob the pending SCENE names, as found or received */
+    sy_cluster_blob_ref *missing;  /* requested and not yet received (data unused) */
+    uint32_t missing_count;
 } session;
+
+/* A request handed from an I/O worker to the serving thread and its reply handed back. */
+typedef struct io_job {
+    nng_msg *in;
+    sy_cluster_buf out;
+    bool done;
+    struct io_job *next;
+} io_job;
 
 struct sy_cluster_server {
     sy_cluster_server_opts o;
@@ -340,16 +539,34 @@ struct sy_cluster_server {
     uint32_t removed[256];
     uint32_t removed_count;
     char name[SY_CLUSTER_NAME_MAX];
+    blob_cache cache;
+    auth_fail auth[SY_CLUSTER_AUTH_TABLE];
+    /* I/O workers (one nng rep0 context each) queue requests for the serving thread */
+    pthread_mutex_t qlock;
+    pthread_cond_t qcond, dcond;
+    io_job *qhead, *qtail;
+    bool stopping;
 };
 
 #define SLOG(s, ...) log_line((s)->o.log, (s)->o.log_user, "sy serve", __VA_ARGS__)
 
+static void pending_drop(session *se)
+{
+    free(se->pending);
+    free(se->missing);
+    sy_blob_store_destroy(se->pending_blobs);
+    se->pending = NULL;
+    se->missing = NULL;
+    se->pending_blobs = NULL;
+    se->pending_size = se->missing_count = 0;
+}
+
 static void session_reset(session *se)
 {
+    pending_drop(se);
     sy_layer_destroy(&se->present);
     sy_context_pool_destroy(se->pool);
     sy_scene_destroy(se->scene);
-    sy_blob_store_destroy(se->blobs);
     memset(se, 0, sizeof *se);
 }
 
@@ -374,6 +591,14 @@ sy_result sy_cluster_server_create(const sy_cluster_server_opts *opts, sy_cluste
     s->max_sessions = opts->max_sessions ? opts->max_sessions : 16;
     s->max_message = opts->max_message ? opts->max_message : SY_CLUSTER_DEFAULT_MAX_MESSAGE;
     pthread_mutex_init(&s->lock, NULL);
+    pthread_mutex_init(&s->qlock, NULL);
+    pthread_cond_init(&s->qcond, NULL);
+    pthread_cond_init(&s->dcond, NULL);
+    s->cache.budget = opts->blob_cache_bytes ? opts->blob_cache_bytes : SY_CLUSTER_DEFAULT_BLOB_CACHE;
+    if (!s->o.max_objects) s->o.max_objects = SY_CLUSTER_DEFAULT_MAX_OBJECTS;
+    if (!s->o.auth_backoff_ms) s->o.auth_backoff_ms = 250;
+    if (!s->o.io_workers) s->o.io_workers = 8;
+    if (s->o.io_workers > 64) s->o.io_workers = 64;
     s->sessions = calloc(s->max_sessions, sizeof *s->sessions);
     if (opts->secret_len) {
         s->secret = malloc(opts->secret_len);
@@ -389,11 +614,13 @@ sy_result sy_cluster_server_create(const sy_cluster_server_opts *opts, sy_cluste
     if ((rv = nng_rep0_open(&s->sock)) != 0) {
         free(s->sessions);
         free(s->secret);
+        pthread_mutex_destroy(&s->lock);
+        pthread_mutex_destroy(&s->qlock);
+        pthread_cond_destroy(&s->qcond);
+        pthread_cond_destroy(&s->dcond);
         free(s);
         return sy_error_set(err, SY_ERR_IO, "sy serve: cannot open socket: %s", nng_strerror(rv));
     }
-    nng_socket_set_ms(s->sock, NNG_OPT_RECVTIMEO, 100);
-    nng_socket_set_ms(s->sock, NNG_OPT_SENDTIMEO, 10000);
     nng_socket_set_size(s->sock, NNG_OPT_RECVMAXSZ, s->max_message);
     nng_pipe_notify(s->sock, NNG_PIPE_EV_REM_POST, pipe_removed, s);
     if ((rv = nng_listener_create(&s->listener, s->sock, url)) != 0) {
@@ -457,9 +684,13 @@ void sy_cluster_server_destroy(sy_cluster_server *s)
     for (uint32_t i = 0; s->sessions && i < s->max_sessions; ++i)
         if (s->sessions[i].used) session_reset(&s->sessions[i]);
     free(s->sessions);
+    cache_free(&s->cache);
     if (s->secret) sodium_memzero(s->secret, s->o.secret_len);
     free(s->secret);
     pthread_mutex_destroy(&s->lock);
+    pthread_mutex_destroy(&s->qlock);
+    pthread_cond_destroy(&s->qcond);
+    pthread_cond_destroy(&s->dcond);
     free(s);
 }
 
@@ -486,7 +717,8 @@ static session *session_for(sy_cluster_server *s, nng_pipe p)
     nng_sockaddr sa;
     memset(&sa, 0, sizeof sa);
     nng_pipe_get_addr(p, NNG_OPT_REMADDR, &sa);
-    sockaddr_str(&sa, free_slot->peer, sizeof free_slot->peer);
+    sockaddr_str(&sa, true, free_slot->peer, sizeof free_slot->peer);
+    sockaddr_str(&sa, false, free_slot->host, sizeof free_slot->host);
     return free_slot;
 }
 
@@ -521,6 +753,8 @@ static sy_result handle_render(sy_cluster_server *s, session *se, const sy_clust
         return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory");
     }
     bool depth = (q->flags & SY_CLUSTER_RENDER_DEPTH) != 0;
+    uint32_t encoding = (q->flags & SY_CLUSTER_RENDER_HALF) ? SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD : SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD;
+    uint32_t vb = sy_cluster_encoding_bytes(encoding);
     sy_cluster_buf enc = {0};
     for (uint32_t i = 0; i < q->tile_count && r == SY_OK; ++i) {
         const sy_cluster_rect *tr = &q->tiles[i];
@@ -549,7 +783,7 @@ static sy_result handle_render(sy_cluster_server *s, session *se, const sy_clust
             se->present_frame = q->frame;
             se->has_present = true;
         } else if (r == SY_OK) {
-            r = sy_cluster_tile_encode(&l, depth, &enc, err);
+            r = sy_cluster_tile_encode_as(&l, depth, encoding, &enc, err);
             if (r == SY_OK) {
                 size_t off = payload->size;
                 size_t need = payload->size + enc.size;
@@ -562,8 +796,8 @@ static sy_result handle_render(sy_cluster_server *s, session *se, const sy_clust
                     memcpy(payload->data + payload->size, enc.data, enc.size);
                     payload->size = need;
                     offsets[i] = off;
-                    tiles[i] = (sy_cluster_tile){*tr, SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD, depth ? 5u : 4u,
-                                                 (uint64_t)tr->w * tr->h * (depth ? 5u : 4u) * 4u, NULL,
+                    tiles[i] = (sy_cluster_tile){*tr, encoding, depth ? 5u : 4u,
+                                                 (uint64_t)tr->w * tr->h * (depth ? 5u : 4u) * vb, NULL,
                                                  (uint32_t)enc.size};
                 }
             }
@@ -594,28 +828,26 @@ static sy_result handle_render(sy_cluster_server *s, session *se, const sy_clust
     return SY_OK;
 }
 
-static sy_result handle_scene(sy_cluster_server *s, session *se, const sy_cluster_msg *m, sy_cluster_msg *reply,
-                              sy_error *err)
+/* Applies a complete SCENE (every blob it names is in blobs or inline). A snapshot replaces the
+ * replica (and its contexts); a failure drops the replica, so the client must send a snapshot. */
+static sy_result apply_scene(sy_cluster_server *s, session *se, const uint8_t *changes, uint32_t size, uint32_t flags,
+                             uint64_t frame, sy_blob_store *blobs, sy_cluster_msg *reply, sy_error *err)
 {
-    (void)s;
-    bool snap = (m->u.scene.flags & SY_CLUSTER_SCENE_SNAPSHOT) != 0;
-    if (!snap && !se->scene) return sy_error_set(err, SY_ERR_PROTOCOL, "the first SCENE must be a snapshot");
     sy_result r = SY_OK;
-    if (snap || !se->blobs) {
-        /* a snapshot replaces the replica (and its contexts); blobs stay cached by hash */
+    if ((flags & SY_CLUSTER_SCENE_SNAPSHOT) || !se->scene) {
         sy_layer_destroy(&se->present);
         se->has_present = false;
         sy_context_pool_destroy(se->pool);
         sy_scene_destroy(se->scene);
         se->pool = NULL;
         se->scene = NULL;
-        if (!se->blobs) r = sy_blob_store_create(&se->blobs, err);
-        if (r == SY_OK) r = sy_scene_create(&se->scene, err);
+        r = sy_scene_create(&se->scene, err);
         if (r == SY_OK) r = sy_context_pool_create(&se->pool, err);
         if (r) return r;
+        sy_scene_set_apply_limit(se->scene, s->o.max_objects);
     }
     sy_changes *ch = NULL;
-    r = sy_changes_deserialize(m->u.scene.changes, m->u.scene.changes_size, se->blobs, NULL, &ch, err);
+    r = sy_changes_deserialize(changes, size, blobs, NULL, &ch, err);
     if (r == SY_OK) r = sy_scene_apply(se->scene, ch, err);
     if (r == SY_OK) r = sy_scene_commit(se->scene, NULL, err);
     sy_changes_release(ch);
@@ -625,17 +857,137 @@ static sy_result handle_scene(sy_cluster_server *s, session *se, const sy_cluste
         sy_scene_destroy(se->scene);
         se->pool = NULL;
         se->scene = NULL;
-        sy_error_prefix(err, "scene for frame %llu rejected (replica dropped, send a snapshot)",
-                        (unsigned long long)m->u.scene.frame);
+        sy_error_prefix(err, "scene for frame %llu rejected (replica dropped, send a snapshot)", (unsigned long long)frame);
         return r;
     }
-    se->frame = m->u.scene.frame;
+    se->frame = frame;
     uint32_t objects = 0;
     for (uint32_t t = 0; t < SY_TYPE_COUNT; ++t) objects += sy_scene_count(se->scene, (sy_object_type)t);
     reply->header.type = SY_CLUSTER_SCENE_ACK;
     reply->u.ack.frame = se->frame;
     reply->u.ack.objects = objects;
     return SY_OK;
+}
+
+typedef struct ref_scan {
+    blob_cache *cache;
+    session *se;
+    uint32_t cap;
+    bool oom;
+} ref_scan;
+
+/* sy_changes_blob_refs callback: a blob named by hash is taken from the cache or requested */
+static void scan_ref(void *user, sy_hash128 h, uint64_t size)
+{
+    ref_scan *rs = user;
+    session *se = rs->se;
+    sy_blob *b = cache_get(rs->cache, h);
+    if (b && sy_blob_size(b) == size) {
+        sy_error e = {0};
+        if (sy_blob_store_put(se->pending_blobs, b, &e) != SY_OK) rs->oom = true;
+        return;
+    }
+    if (se->missing_count == rs->cap) {
+        uint32_t nc = rs->cap ? rs->cap * 2 : 64;
+        sy_cluster_blob_ref *m = realloc(se->missing, nc * sizeof *m);
+        if (!m) {
+            rs->oom = true;
+            return;
+        }
+        se->missing = m;
+        rs->cap = nc;
+    }
+    se->missing[se->missing_count++] = (sy_cluster_blob_ref){h, size, NULL};
+}
+
+/* Asks for the blobs still missing (at most SY_CLUSTER_MAX_BLOBS per request). */
+static void request_missing(session *se, sy_cluster_msg *reply)
+{
+    reply->header.type = SY_CLUSTER_BLOB_REQUEST;
+    reply->u.blobs.frame = se->pending_frame;
+    reply->u.blobs.count = se->missing_count < SY_CLUSTER_MAX_BLOBS ? se->missing_count : SY_CLUSTER_MAX_BLOBS;
+    reply->u.blobs.blobs = se->missing; /* borrowed: the reply is encoded before the session changes */
+}
+
+static sy_result handle_scene(sy_cluster_server *s, session *se, const sy_cluster_msg *m, sy_cluster_msg *reply,
+                              sy_error *err)
+{
+    bool snap = (m->u.scene.flags & SY_CLUSTER_SCENE_SNAPSHOT) != 0;
+    pending_drop(se); /* a new SCENE replaces one still waiting for blobs */
+    if (!snap && !se->scene) return sy_error_set(err, SY_ERR_PROTOCOL, "the first SCENE must be a snapshot");
+    sy_result r = sy_blob_store_create(&se->pending_blobs, err);
+    ref_scan rs = {&s->cache, se, 0, false};
+    if (r == SY_OK) r = sy_changes_blob_refs(m->u.scene.changes, m->u.scene.changes_size, NULL, scan_ref, &rs, err);
+    if (r == SY_OK && rs.oom) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory for the blob list");
+    if (r == SY_OK && se->missing_count) { /* keep the list until the blobs arrive */
+        se->pending = malloc(m->u.scene.changes_size ? m->u.scene.changes_size : 1);
+        if (!se->pending) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory for a pending scene");
+        else {
+            memcpy(se->pending, m->u.scene.changes, m->u.scene.changes_size);
+            se->pending_size = m->u.scene.changes_size;
+            se->pending_flags = m->u.scene.flags;
+            se->pending_frame = m->u.scene.frame;
+            uint64_t bytes = 0;
+            for (uint32_t i = 0; i < se->missing_count; ++i) bytes += se->missing[i].size;
+            SLOG(s, "%s: frame %llu: asking for %u blob(s), %llu bytes, not in the cache (%zu blobs, %zu bytes cached)",
+                 se->peer, (unsigned long long)se->pending_frame, se->missing_count, (unsigned long long)bytes,
+                 s->cache.count, s->cache.bytes);
+            request_missing(se, reply);
+            return SY_OK;
+        }
+    }
+    if (r == SY_OK)
+        r = apply_scene(s, se, m->u.scene.changes, m->u.scene.changes_size, m->u.scene.flags, m->u.scene.frame,
+                        se->pending_blobs, reply, err);
+    else sy_error_prefix(err, "scene for frame %llu rejected", (unsigned long long)m->u.scene.frame);
+    pending_drop(se);
+    return r;
+}
+
+/* BLOBS: every payload must be one the server asked for and match its hash; then the pending
+ * SCENE applies (or the rest is asked for). Any mismatch drops the pending SCENE. */
+static sy_result handle_blobs(sy_cluster_server *s, session *se, const sy_cluster_msg *m, sy_cluster_msg *reply,
+                              sy_error *err)
+{
+    const __typeof__(m->u.blobs) *q = &m->u.blobs;
+    sy_result r = SY_OK;
+    if (!se->pending) return sy_error_set(err, SY_ERR_PROTOCOL, "BLOBS without a SCENE waiting for them");
+    if (q->frame != se->pending_frame)
+        r = sy_error_set(err, SY_ERR_PROTOCOL, "BLOBS for frame %llu, the pending scene is for frame %llu",
+                         (unsigned long long)q->frame, (unsigned long long)se->pending_frame);
+    for (uint32_t i = 0; i < q->count && r == SY_OK; ++i) {
+        const sy_cluster_blob_ref *b = &q->blobs[i];
+        uint32_t k = 0;
+        while (k < se->missing_count && !sy_hash_equal(se->missing[k].hash, b->hash)) k++;
+        if (k == se->missing_count)
+            r = sy_error_set(err, SY_ERR_PROTOCOL, "blob %016llx%016llx was not requested (or sent twice)",
+                             (unsigned long long)b->hash.hi, (unsigned long long)b->hash.lo);
+        else if (b->size != se->missing[k].size)
+            r = sy_error_set(err, SY_ERR_PROTOCOL, "blob %016llx%016llx has %llu bytes, the scene names %llu",
+                             (unsigned long long)b->hash.hi, (unsigned long long)b->hash.lo,
+                             (unsigned long long)b->size, (unsigned long long)se->missing[k].size);
+        else if (!sy_hash_equal(sy_hash_bytes(b->data, (size_t)b->size), b->hash))
+            r = sy_error_set(err, SY_ERR_PROTOCOL, "blob %016llx%016llx: payload does not match its hash",
+                             (unsigned long long)b->hash.hi, (unsigned long long)b->hash.lo);
+        sy_blob *blob = NULL;
+        if (r == SY_OK) r = sy_blob_create_copy(b->data, (size_t)b->size, &blob, err);
+        if (r == SY_OK) r = sy_blob_store_put(se->pending_blobs, blob, err);
+        if (r == SY_OK) {
+            cache_put(&s->cache, blob);
+            se->missing[k] = se->missing[--se->missing_count];
+        }
+        sy_blob_release(blob);
+    }
+    if (r == SY_OK && se->missing_count) {
+        request_missing(se, reply);
+        return SY_OK;
+    }
+    if (r == SY_OK)
+        r = apply_scene(s, se, se->pending, se->pending_size, se->pending_flags, se->pending_frame, se->pending_blobs,
+                        reply, err);
+    else sy_error_prefix(err, "scene for frame %llu rejected", (unsigned long long)se->pending_frame);
+    pending_drop(se);
+    return r;
 }
 
 /* Processes one request frame; fills *out with the encoded reply. */
@@ -664,8 +1016,14 @@ static void serve_one(sy_cluster_server *s, nng_msg *in, sy_cluster_buf *out)
                 nng_sockaddr sa;
                 memset(&sa, 0, sizeof sa);
                 nng_pipe_get_addr(nng_msg_get_pipe(in), NNG_OPT_REMADDR, &sa);
+                double wait = s->secret ? auth_refused_for(s->auth, se->host, sy_time_now()) : 0;
                 if (!s->secret && !sockaddr_is_loopback(&sa)) {
                     r = sy_error_set(&err, SY_ERR_PROTOCOL, "server has no secret and accepts loopback peers only");
+                    drop_session = true;
+                } else if (wait > 0) {
+                    r = sy_error_set(&err, SY_ERR_PROTOCOL,
+                                     "throttled: too many failed authentications from %s, retry in %.0f ms", se->host,
+                                     ceil(wait * 1000));
                     drop_session = true;
                 } else {
                     memcpy(se->cnonce, m.u.hello.nonce, 32);
@@ -682,9 +1040,12 @@ static void serve_one(sy_cluster_server *s, nng_msg *in, sy_cluster_buf *out)
             uint8_t expect[32];
             mac3(expect, s->secret, s->o.secret_len, "SYCP-client", se->snonce, se->cnonce);
             if (crypto_verify_32(expect, m.u.auth.mac) != 0) {
-                r = sy_error_set(&err, SY_ERR_PROTOCOL, "authentication failed: wrong secret");
+                double wait = auth_failed(s->auth, se->host, sy_time_now(), s->o.auth_backoff_ms);
+                r = sy_error_set(&err, SY_ERR_PROTOCOL, "authentication failed: wrong secret (%s refused for %.0f ms)",
+                                 se->host, wait * 1000);
                 drop_session = true;
             } else {
+                auth_succeeded(s->auth, se->host);
                 reply.header.type = SY_CLUSTER_WELCOME;
                 mac3(reply.u.auth.mac, s->secret, s->o.secret_len, "SYCP-server", se->cnonce, se->snonce);
                 se->state = 2;
@@ -695,6 +1056,8 @@ static void serve_one(sy_cluster_server *s, nng_msg *in, sy_cluster_buf *out)
             drop_session = true;
         } else if (t == SY_CLUSTER_SCENE) {
             r = handle_scene(s, se, &m, &reply, &err);
+        } else if (t == SY_CLUSTER_BLOBS) {
+            r = handle_blobs(s, se, &m, &reply, &err);
         } else if (t == SY_CLUSTER_RENDER) {
             r = handle_render(s, se, &m, &reply, &payload, &err);
         } else if (t == SY_CLUSTER_SWAP) {
@@ -751,94 +1114,135 @@ static void serve_one(sy_cluster_server *s, nng_msg *in, sy_cluster_buf *out)
     }
 }
 
+/* One I/O worker: receives on its own rep0 context, hands the request to the serving thread, sends
+ * the reply. Receives and sends of different peers overlap, so a peer that is slow to send or to
+ * read never holds the others; requests are still served one at a time, in arrival order, on the
+ * serving thread (mediators and their GL contexts stay on one thread). */
+static void *io_worker(void *p)
+{
+    sy_cluster_server *s = p;
+    nng_ctx ctx;
+    nng_aio *aio = NULL;
+    int rv = nng_ctx_open(&ctx, s->sock);
+    if (rv == 0 && (rv = nng_aio_alloc(&aio, NULL, NULL)) != 0) nng_ctx_close(ctx);
+    if (rv) {
+        SLOG(s, "I/O worker not started: %s", nng_strerror(rv));
+        return NULL;
+    }
+    io_job job;
+    memset(&job, 0, sizeof job);
+    for (;;) {
+        nng_aio_set_timeout(aio, 100);
+        nng_ctx_recv(ctx, aio);
+        nng_aio_wait(aio);
+        rv = nng_aio_result(aio);
+        pthread_mutex_lock(&s->qlock);
+        bool stop = s->stopping;
+        pthread_mutex_unlock(&s->qlock);
+        if (rv == 0 && stop) nng_msg_free(nng_aio_get_msg(aio));
+        if (stop || rv == NNG_ECLOSED) break;
+        if (rv) continue; /* timeout (poll the stop flag) or a failed receive of one peer */
+        job.in = nng_aio_get_msg(aio);
+        job.done = false;
+        job.next = NULL;
+        pthread_mutex_lock(&s->qlock);
+        if (s->qtail) s->qtail->next = &job;
+        else s->qhead = &job;
+        s->qtail = &job;
+        pthread_cond_signal(&s->qcond);
+        while (!job.done) pthread_cond_wait(&s->dcond, &s->qlock);
+        pthread_mutex_unlock(&s->qlock);
+        nng_msg_free(job.in);
+        nng_msg *rep = NULL;
+        if (!job.out.size) continue;
+        if ((rv = nng_msg_alloc(&rep, 0)) == 0 && (rv = nng_msg_append(rep, job.out.data, job.out.size)) == 0) {
+            nng_aio_set_msg(aio, rep);
+            nng_aio_set_timeout(aio, 10000);
+            nng_ctx_send(ctx, aio);
+            nng_aio_wait(aio);
+            if ((rv = nng_aio_result(aio)) == 0) rep = NULL; /* nng owns it now */
+        }
+        if (rep) nng_msg_free(rep);
+        if (rv) SLOG(s, "reply not sent: %s", nng_strerror(rv));
+    }
+    sy_cluster_buf_free(&job.out);
+    nng_aio_free(aio);
+    nng_ctx_close(ctx);
+    return NULL;
+}
+
+/* Frees the sessions of connections nng reported closed. */
+static void reap_sessions(sy_cluster_server *s)
+{
+    pthread_mutex_lock(&s->lock);
+    uint32_t removed[256], nrem = s->removed_count;
+    memcpy(removed, s->removed, nrem * sizeof *removed);
+    s->removed_count = 0;
+    pthread_mutex_unlock(&s->lock);
+    for (uint32_t k = 0; k < nrem; ++k)
+        for (uint32_t i = 0; i < s->max_sessions; ++i)
+            if (s->sessions[i].used && s->sessions[i].pipe_id == removed[k]) {
+                SLOG(s, "%s: disconnected", s->sessions[i].peer);
+                session_reset(&s->sessions[i]);
+            }
+}
+
 sy_result sy_cluster_server_run(sy_cluster_server *s, sy_error *err)
 {
     double start = sy_time_now();
-    sy_cluster_buf out = {0};
-    SLOG(s, "listening on %s (port %d)%s", s->o.listen_url ? s->o.listen_url : SY_CLUSTER_DEFAULT_URL, s->port,
-         s->secret ? ", shared-secret authentication" : ", no secret: loopback peers only");
+    SLOG(s, "listening on %s (port %d)%s; blob cache %zu MiB, %u I/O workers",
+         s->o.listen_url ? s->o.listen_url : SY_CLUSTER_DEFAULT_URL, s->port,
+         s->secret ? ", shared-secret authentication" : ", no secret: loopback peers only", s->cache.budget >> 20,
+         s->o.io_workers);
+    pthread_t th[64];
+    uint32_t nth = 0;
+    s->stopping = false;
+    for (uint32_t i = 0; i < s->o.io_workers; ++i)
+        if (pthread_create(&th[nth], NULL, io_worker, s) == 0) nth++;
+    if (!nth) return sy_error_set(err, SY_ERR_IO, "sy serve: cannot start any I/O thread");
     for (;;) {
         if (s->o.stop && *s->o.stop) break;
         if (s->o.max_lifetime_s > 0 && sy_time_now() - start > s->o.max_lifetime_s) {
             SLOG(s, "maximum lifetime of %.0f s reached, stopping", s->o.max_lifetime_s);
             break;
         }
-        pthread_mutex_lock(&s->lock);
-        uint32_t removed[256], nrem = s->removed_count;
-        memcpy(removed, s->removed, nrem * sizeof *removed);
-        s->removed_count = 0;
-        pthread_mutex_unlock(&s->lock);
-        for (uint32_t k = 0; k < nrem; ++k)
-            for (uint32_t i = 0; i < s->max_sessions; ++i)
-                if (s->sessions[i].used && s->sessions[i].pipe_id == removed[k]) {
-                    SLOG(s, "%s: disconnected", s->sessions[i].peer);
-                    session_reset(&s->sessions[i]);
-                }
-        nng_msg *in = NULL;
-        int rv = nng_recvmsg(s->sock, &in, 0);
-        if (rv == NNG_ETIMEDOUT) continue;
-        if (rv != 0) {
-            sy_cluster_buf_free(&out);
-            if (rv == NNG_ECLOSED) return SY_OK;
-            return sy_error_set(err, SY_ERR_IO, "sy serve: receive failed: %s", nng_strerror(rv));
+        reap_sessions(s);
+        pthread_mutex_lock(&s->qlock);
+        if (!s->qhead) {
+            struct timespec ts;
+            clock_gettime(CLOCK_REALTIME, &ts);
+            ts.tv_nsec += 100000000L;
+            if (ts.tv_nsec >= 1000000000L) ts.tv_sec++, ts.tv_nsec -= 1000000000L;
+            pthread_cond_timedwait(&s->qcond, &s->qlock, &ts);
         }
-        serve_one(s, in, &out);
-        nng_msg_free(in);
-        if (out.size) {
-            rv = nng_send(s->sock, out.data, out.size, 0);
-            if (rv != 0) SLOG(s, "reply not sent: %s", nng_strerror(rv));
+        io_job *job = s->qhead;
+        if (job) {
+            s->qhead = job->next;
+            if (!s->qhead) s->qtail = NULL;
         }
+        pthread_mutex_unlock(&s->qlock);
+        if (!job) continue;
+        reap_sessions(s); /* a request may come after its connection's close was reported */
+        serve_one(s, job->in, &job->out);
+        pthread_mutex_lock(&s->qlock);
+        job->done = true;
+        pthread_cond_broadcast(&s->dcond);
+        pthread_mutex_unlock(&s->qlock);
     }
-    sy_cluster_buf_free(&out);
+    pthread_mutex_lock(&s->qlock);
+    s->stopping = true;
+    for (io_job *j = s->qhead; j; j = j->next) {
+        j->out.size = 0;
+        j->done = true;
+    }
+    s->qhead = s->qtail = NULL;
+    pthread_cond_broadcast(&s->dcond);
+    pthread_mutex_unlock(&s->qlock);
+    for (uint32_t i = 0; i < nth; ++i) pthread_join(th[i], NULL);
     return SY_OK;
 }
 
 /* ======================================================================== client */
-typedef struct hashset {
-    sy_hash128 *keys; /* lo == hi == 0 marks an empty slot (a zero hash is never real in practice) */
-    size_t cap, count;
-} hashset;
-
-static bool hs_has(const hashset *h, sy_hash128 k)
-{
-    if (!h->cap) return false;
-    for (size_t i = (size_t)(k.lo % h->cap);; i = (i + 1) % h->cap) {
-        if (!h->keys[i].lo && !h->keys[i].hi) return false;
-        if (sy_hash_equal(h->keys[i], k)) return true;
-    }
-}
-
-static bool hs_add(hashset *h, sy_hash128 k)
-{
-    if (hs_has(h, k)) return true;
-    if ((h->count + 1) * 2 > h->cap) {
-        size_t nc = h->cap ? h->cap * 2 : 64;
-        sy_hash128 *nk = calloc(nc, sizeof *nk);
-        if (!nk) return false;
-        hashset n2 = {nk, nc, 0};
-        for (size_t i = 0; i < h->cap; ++i)
-            if (h->keys[i].lo || h->keys[i].hi) {
-                size_t j = (size_t)(h->keys[i].lo % nc);
-                while (nk[j].lo || nk[j].hi) j = (j + 1) % nc;
-                nk[j] = h->keys[i];
-                n2.count++;
-            }
-        free(h->keys);
-        *h = n2;
-    }
-    size_t j = (size_t)(k.lo % h->cap);
-    while (h->keys[j].lo || h->keys[j].hi) j = (j + 1) % h->cap;
-    h->keys[j] = k;
-    h->count++;
-    return true;
-}
-
-static void hs_clear(hashset *h)
-{
-    free(h->keys);
-    memset(h, 0, sizeof *h);
-}
-
 typedef struct conn {
     char url[256];
     nng_socket sock;
@@ -850,9 +1254,10 @@ typedef struct conn {
     bool tagged;
     char backend[SY_CLUSTER_BACKEND_MAX]; /* "" = the frame's back-end */
     sy_cluster_rect wall;        /* multi-display tile; w == 0: column i of n */
-    hashset sent;                /* blob hashes sent on this connection */
-    hashset pending;             /* hashes serialised into the pending scene message */
+    sy_blob_store *offered;      /* the blobs this frame's SCENE names (by hash), for the server's BLOB_REQUEST */
     sy_cluster_buf scene_msg;    /* encoded SCENE for this frame (0 size = none) */
+    bool offer_failed;           /* out of memory while keeping a blob */
+    uint64_t blob_frames_bytes, blob_payload_bytes; /* BLOBS sent (frames / payloads), cumulative */
     double last_seconds;         /* last render time, for balanced mode */
     uint32_t last_rows;
     uint64_t bytes_sent, bytes_received;
@@ -878,8 +1283,6 @@ static void conn_close(conn *k)
 {
     if (k->open) nng_close(k->sock);
     k->open = k->live = k->tagged = false;
-    hs_clear(&k->sent);
-    hs_clear(&k->pending);
 }
 
 /* One request/reply exchange. *reply borrows *raw (free with nng_msg_free + sy_cluster_msg_free). */
@@ -913,7 +1316,8 @@ static sy_result conn_call(sy_cluster_client *c, conn *k, sy_cluster_msg *req, c
         k->recv_seq = reply->header.seq;
         if (reply->header.type == SY_CLUSTER_ERROR) {
             r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: server rejected the request: %s", k->url, reply->u.error.reason);
-        } else if (reply->header.type != expect) {
+        } else if (reply->header.type != expect &&
+                   !(expect == SY_CLUSTER_SCENE_ACK && reply->header.type == SY_CLUSTER_BLOB_REQUEST)) {
             r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: expected %s, got %s", k->url, sy_cluster_msg_type_name(expect),
                              sy_cluster_msg_type_name(reply->header.type));
         }
@@ -1124,6 +1528,7 @@ void sy_cluster_client_destroy(sy_cluster_client *c)
         }
         conn_close(k);
         sy_cluster_buf_free(&k->scene_msg);
+        sy_blob_store_destroy(k->offered);
         if (k->has_consumer) sy_scene_consumer_remove(c->scene, k->consumer);
     }
     free(c->tls_ca);
@@ -1162,13 +1567,14 @@ typedef struct thread_arg {
     bool failed;
 } thread_arg;
 
+/* Change lists name every blob by hash only; the blob is kept to answer the server's request.
+ * (The store only retains the immutable blob: the cast drops the const of the borrowed pointer.) */
 static bool blob_send_cb(void *user, const sy_blob *b)
 {
     conn *k = user;
-    sy_hash128 h = sy_blob_hash(b);
-    if (hs_has(&k->sent, h)) return false;
-    hs_add(&k->pending, h);
-    return true;
+    sy_error e = {0};
+    if (sy_blob_store_put(k->offered, (sy_blob *)b, &e) != SY_OK) k->offer_failed = true;
+    return false;
 }
 
 static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, sy_error *err)
@@ -1181,7 +1587,8 @@ static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, s
     __typeof__(m.u.render) *q = &m.u.render;
     q->frame = c->frame;
     q->job = (uint32_t)(it - fc->items);
-    q->flags = (f->depth ? SY_CLUSTER_RENDER_DEPTH : 0) | (f->mode == SY_CLUSTER_MULTI_DISPLAY ? SY_CLUSTER_RENDER_PRESENT : 0);
+    q->flags = (f->depth ? SY_CLUSTER_RENDER_DEPTH : 0) | (f->mode == SY_CLUSTER_MULTI_DISPLAY ? SY_CLUSTER_RENDER_PRESENT : 0) |
+               (f->half ? SY_CLUSTER_RENDER_HALF : 0);
     copy_str(q->backend, sizeof q->backend, k->backend[0] ? k->backend : f->backend);
     copy_str(q->params, sizeof q->params, f->params ? f->params : "");
     q->root_id = f->root_id;
@@ -1229,6 +1636,55 @@ static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, s
     return r;
 }
 
+/* Sends the frame's SCENE; while the server answers BLOB_REQUEST, sends the blobs it names (BLOBS
+ * messages of at most a quarter of the message limit each, at least one blob) until SCENE_ACK. */
+static sy_result send_scene(sy_cluster_client *c, conn *k, sy_error *err)
+{
+    sy_cluster_msg rep;
+    nng_msg *raw = NULL;
+    sy_result r = conn_call(c, k, NULL, &k->scene_msg, SY_CLUSTER_SCENE_ACK, &rep, &raw, err);
+    for (uint32_t rounds = 0; r == SY_OK && rep.header.type == SY_CLUSTER_BLOB_REQUEST; ++rounds) {
+        const __typeof__(rep.u.blobs) *q = &rep.u.blobs;
+        sy_cluster_blob_ref *refs = calloc(q->count, sizeof *refs);
+        sy_cluster_msg m;
+        memset(&m, 0, sizeof m);
+        m.header.type = SY_CLUSTER_BLOBS;
+        m.u.blobs.frame = c->frame;
+        m.u.blobs.blobs = refs;
+        uint64_t bytes = 0, budget = c->max_message / 4;
+        if (!refs) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
+        else if (q->frame != c->frame || rounds > SY_CLUSTER_MAX_BLOBS)
+            r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: blob request for frame %llu during frame %llu", k->url,
+                             (unsigned long long)q->frame, (unsigned long long)c->frame);
+        for (uint32_t i = 0; r == SY_OK && i < q->count; ++i) {
+            const sy_blob *b = k->offered ? sy_blob_store_get(k->offered, q->blobs[i].hash) : NULL;
+            if (!b || sy_blob_size(b) != q->blobs[i].size) {
+                r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: server asked for blob %016llx%016llx, which the scene does not name",
+                                 k->url, (unsigned long long)q->blobs[i].hash.hi, (unsigned long long)q->blobs[i].hash.lo);
+                break;
+            }
+            if (m.u.blobs.count && bytes + sy_blob_size(b) > budget) break; /* the rest in the next BLOBS */
+            refs[m.u.blobs.count++] = (sy_cluster_blob_ref){q->blobs[i].hash, sy_blob_size(b), sy_blob_data(b)};
+            bytes += sy_blob_size(b);
+        }
+        sy_cluster_msg_free(&rep);
+        nng_msg_free(raw);
+        raw = NULL;
+        if (r == SY_OK) {
+            uint64_t before = k->bytes_sent;
+            r = conn_call(c, k, &m, NULL, SY_CLUSTER_SCENE_ACK, &rep, &raw, err);
+            k->blob_frames_bytes += k->bytes_sent - before;
+            k->blob_payload_bytes += bytes;
+        }
+        free(refs);
+    }
+    if (r == SY_OK) {
+        sy_cluster_msg_free(&rep);
+        nng_msg_free(raw);
+    }
+    return r;
+}
+
 static void *conn_thread(void *p)
 {
     thread_arg *a = p;
@@ -1237,15 +1693,7 @@ static void *conn_thread(void *p)
     conn *k = &c->conns[a->conn];
     sy_error err = {0};
     sy_result r = SY_OK;
-    if (a->send_scene && k->scene_msg.size) {
-        sy_cluster_msg rep;
-        nng_msg *raw = NULL;
-        r = conn_call(c, k, NULL, &k->scene_msg, SY_CLUSTER_SCENE_ACK, &rep, &raw, &err);
-        if (r == SY_OK) {
-            sy_cluster_msg_free(&rep);
-            nng_msg_free(raw);
-        }
-    }
+    if (a->send_scene && k->scene_msg.size) r = send_scene(c, k, &err);
     for (uint32_t i = 0; r == SY_OK && i < fc->item_count; ++i) {
         work_item *it = &fc->items[i];
         if (it->owner != (int)a->conn || it->done) continue;
@@ -1404,7 +1852,11 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster render: output layer must be %ux%u", out_w, f->height);
     c->frame++;
     uint64_t sent0 = 0, recv0 = 0;
-    for (uint32_t i = 0; i < c->n; ++i) sent0 += c->conns[i].bytes_sent, recv0 += c->conns[i].bytes_received;
+    uint64_t blobf0 = 0, blobp0 = 0;
+    for (uint32_t i = 0; i < c->n; ++i) {
+        sent0 += c->conns[i].bytes_sent, recv0 += c->conns[i].bytes_received;
+        blobf0 += c->conns[i].blob_frames_bytes, blobp0 += c->conns[i].blob_payload_bytes;
+    }
     /* 1. reconnect servers that are down (they will get a snapshot) */
     for (uint32_t i = 0; i < c->n; ++i) {
         conn *k = &c->conns[i];
@@ -1432,11 +1884,15 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
         r = sy_scene_consumer_pull(c->scene, k->consumer, &ch, err);
         if (r) break;
         snapshot = snapshot || sy_changes_is_snapshot(ch);
+        sy_blob_store_destroy(k->offered);
+        k->offered = NULL;
+        k->offer_failed = false;
         if (snapshot || sy_changes_count(ch) > 0) {
             void *data = NULL;
             size_t size = 0;
-            hs_clear(&k->pending);
-            r = sy_changes_serialize(ch, blob_send_cb, k, &data, &size, err);
+            r = sy_blob_store_create(&k->offered, err);
+            if (r == SY_OK) r = sy_changes_serialize(ch, blob_send_cb, k, &data, &size, err);
+            if (r == SY_OK && k->offer_failed) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
             if (r == SY_OK && size > UINT32_MAX - 1024)
                 r = sy_error_set(err, SY_ERR_LIMIT, "cluster: change list of %zu bytes is too large", size);
             if (r == SY_OK) {
@@ -1450,9 +1906,6 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
                 m.u.scene.changes_size = (uint32_t)size;
                 r = encode_frame(&m, k->tagged ? k->key : NULL, &k->scene_msg, err);
                 st.scene_bytes += k->scene_msg.size;
-                /* the blobs count as sent once the message goes out; a failed connection clears the set */
-                for (size_t j = 0; r == SY_OK && j < k->pending.cap; ++j)
-                    if (k->pending.keys[j].lo || k->pending.keys[j].hi) hs_add(&k->sent, k->pending.keys[j]);
             }
             free(data);
         }
@@ -1608,9 +2061,15 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
         if (fc.accum) sy_layer_destroy(&fc.accum[i]);
         st.bytes_sent += c->conns[i].bytes_sent;
         st.bytes_received += c->conns[i].bytes_received;
+        st.scene_bytes += c->conns[i].blob_frames_bytes;
+        st.blob_bytes += c->conns[i].blob_payload_bytes;
+        sy_blob_store_destroy(c->conns[i].offered); /* the frame's blobs are on the servers now */
+        c->conns[i].offered = NULL;
     }
     st.bytes_sent -= sent0;
     st.bytes_received -= recv0;
+    st.scene_bytes -= blobf0;
+    st.blob_bytes -= blobp0;
     free(fc.accum);
     free(fc.accum_samples);
     free(fc.items);

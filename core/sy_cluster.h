@@ -7,15 +7,19 @@
  * This module is built as its own library (sy_cluster) so that sy_core stays free of nng,
  * libsodium and zstd; it uses only core headers (scene, change lists, mediator contexts).
  *
- * Server: holds one session per connected client (replica scene fed by change lists, blob store,
- * context pool) and renders with the mediators registered in the process. It serves requests one
- * at a time (renders themselves use every core through the back-ends); a bad message or a failed
+ * Server: holds one session per connected client (replica scene fed by change lists, context
+ * pool) and a blob cache shared by all sessions (keyed by content hash, LRU under a byte budget,
+ * outliving sessions), and renders with the mediators registered in the process. I/O runs on
+ * several nng rep0 contexts at once (a slow, stalled or garbage-sending peer holds only its own);
+ * requests are served one at a time on the thread that calls sy_cluster_server_run (renders use
+ * every core through the back-ends; mediators stay on one thread). A bad message or a failed
  * authentication is answered with ERROR, logged with the peer's address and the reason, and the
- * server keeps serving.
+ * server keeps serving; failed authentications refuse the address for an exponentially growing
+ * time; replicas refuse change lists naming slot indices beyond max_objects.
  *
  * Client: one connection per server URL; each connection is a scene consumer (its first sync is a
- * snapshot), sends blobs it has not sent on that connection before, and renders its share of each
- * frame. A server that fails or misses the deadline is disconnected and its work is given to the
+ * snapshot), names blobs by hash and sends only those the server asks for (BLOB_REQUEST), and
+ * renders its share of each frame (float32 tiles, or binary16 with sy_cluster_frame.half). A server that fails or misses the deadline is disconnected and its work is given to the
  * others within the same frame; it is retried at the next frame and then starts from a snapshot.
  * Every socket operation has a timeout, so no call blocks forever.
  *
@@ -34,6 +38,9 @@ extern "C" {
 #define SY_CLUSTER_DEFAULT_URL "tcp://127.0.0.1:5750"
 #define SY_CLUSTER_MAX_SERVERS 64u
 #define SY_CLUSTER_MAX_REQUEST_PIXELS (1u << 26) /* tile pixels per RENDER (an 8192^2 image) */
+#define SY_CLUSTER_DEFAULT_BLOB_CACHE ((size_t)1024 << 20) /* 1 GiB of blob payloads per server */
+#define SY_CLUSTER_DEFAULT_MAX_OBJECTS (1u << 20) /* replica slots per object type */
+#define SY_CLUSTER_AUTH_TABLE 256u /* addresses remembered for authentication back-off */
 
 /* Receives one log line (no trailing newline). NULL = lines go to stderr. */
 typedef void (*sy_cluster_log_fn)(void *user, const char *line);
@@ -58,6 +65,11 @@ typedef struct sy_cluster_server_opts {
     void *present_user;
     volatile int *stop;       /* polled every 100 ms; non-zero ends sy_cluster_server_run */
     double max_lifetime_s;    /* > 0: run returns after this many seconds (tests) */
+    size_t blob_cache_bytes;  /* blob cache shared by all sessions, LRU (0 = SY_CLUSTER_DEFAULT_BLOB_CACHE) */
+    uint32_t max_objects;     /* replica policy: slot index limit per object type (0 = SY_CLUSTER_DEFAULT_MAX_OBJECTS) */
+    uint32_t auth_backoff_ms; /* refusal window after a failed authentication from an address, doubled per
+                                 further failure up to 60 s or this value (0 = 250) */
+    uint32_t io_workers;      /* concurrent receive/send contexts (0 = 8) */
 } sy_cluster_server_opts;
 
 typedef struct sy_cluster_server sy_cluster_server;
@@ -113,6 +125,7 @@ typedef struct sy_cluster_frame {
     uint32_t samples;        /* cooperative: samples per server per frame (0 = 16); others: per request */
     uint32_t seed;
     bool depth;              /* fetch depth too */
+    bool half;               /* tiles as binary16 (display walls, previews); false = float32, bit-exact */
     float eye_separation, zero_parallax; /* stereo (0 = defaults 0.065 / 2) */
 } sy_cluster_frame;
 
@@ -120,7 +133,8 @@ typedef struct sy_cluster_frame_stats {
     uint32_t servers_live;   /* connected after the frame */
     uint32_t servers_failed; /* failed or missed the deadline during this frame */
     uint32_t reassigned;     /* work items given to another server */
-    uint64_t scene_bytes;    /* SCENE frames sent this frame (all servers) */
+    uint64_t scene_bytes;    /* SCENE and BLOBS frames sent this frame (all servers) */
+    uint64_t blob_bytes;     /* blob payload bytes among them (only blobs a server asked for) */
     uint64_t bytes_sent, bytes_received; /* everything on the wire this frame */
     uint64_t samples;        /* cooperative: merged samples per pixel */
     double seconds;          /* whole frame on the client */
@@ -146,8 +160,12 @@ void sy_cluster_client_destroy(sy_cluster_client *c); /* says BYE to live server
  * files readable by group or others. */
 sy_result sy_cluster_secret_load(const char *path, uint8_t **out, size_t *len, sy_error *err);
 
-/* Tile codec (exposed for tests and benchmarks): encodes rect (x, y, w, h) of a layer that is
- * w x h (tile-local) into float planes, byte-shuffled, zstd level 1. */
+/* Tile codec (exposed for tests and benchmarks): encodes a tile-sized layer (RGBA [+ depth]) into
+ * planes of the encoding's values (SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD: float32, lossless;
+ * SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD: binary16, round to nearest even), byte-shuffled, zstd level 1.
+ * sy_cluster_tile_encode = the float32 encoding. */
+sy_result sy_cluster_tile_encode_as(const sy_layer *tile, bool depth, uint32_t encoding, sy_cluster_buf *out,
+                                    sy_error *err);
 sy_result sy_cluster_tile_encode(const sy_layer *tile, bool depth, sy_cluster_buf *out, sy_error *err);
 /* Decodes an untrusted tile into dst at (dx, dy) (dst must contain the rectangle). */
 sy_result sy_cluster_tile_decode(const sy_cluster_tile *t, sy_layer *dst, uint32_t dx, uint32_t dy, sy_error *err);

@@ -95,7 +95,8 @@ static void put_u32_at(uint8_t *p, uint32_t v)
 const char *sy_cluster_msg_type_name(uint32_t type)
 {
     static const char *names[] = {"?",     "HELLO", "CHALLENGE", "AUTH", "WELCOME",  "SCENE", "SCENE_ACK",
-                                  "RENDER", "TILES", "SWAP",      "SWAP_ACK", "BYE", "ERROR"};
+                                  "RENDER", "TILES", "SWAP",      "SWAP_ACK", "BYE", "ERROR", "BLOB_REQUEST",
+                                  "BLOBS"};
     return type <= SY_CLUSTER_MSG_TYPE_MAX ? names[type] : "?";
 }
 
@@ -215,6 +216,22 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
             return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode ERROR: reason too long");
         w_u32(&w, msg->u.error.code);
         w_str(&w, msg->u.error.reason);
+    } else if (t == SY_CLUSTER_BLOB_REQUEST || t == SY_CLUSTER_BLOBS) {
+        const __typeof__(msg->u.blobs) *q = &msg->u.blobs;
+        if (q->count < 1 || q->count > SY_CLUSTER_MAX_BLOBS)
+            return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode %s: %u blobs (1..%u)", tn,
+                                                   q->count, SY_CLUSTER_MAX_BLOBS);
+        w_u64(&w, q->frame);
+        w_u32(&w, q->count);
+        for (uint32_t i = 0; i < q->count; ++i) {
+            w_u64(&w, q->blobs[i].hash.lo);
+            w_u64(&w, q->blobs[i].hash.hi);
+            w_u64(&w, q->blobs[i].size);
+            if (t == SY_CLUSTER_BLOBS) {
+                if (q->blobs[i].size > SIZE_MAX) w.failed = true;
+                else w_bytes(&w, q->blobs[i].data, (size_t)q->blobs[i].size);
+            }
+        }
     } /* BYE: empty body */
     if (w.failed) {
         out->size = start;
@@ -340,6 +357,7 @@ void sy_cluster_msg_free(sy_cluster_msg *m)
     if (!m) return;
     if (m->header.type == SY_CLUSTER_RENDER) free(m->u.render.tiles);
     if (m->header.type == SY_CLUSTER_TILES) free(m->u.tiles.tiles);
+    if (m->header.type == SY_CLUSTER_BLOB_REQUEST || m->header.type == SY_CLUSTER_BLOBS) free(m->u.blobs.blobs);
     memset(m, 0, sizeof *m);
 }
 
@@ -377,7 +395,7 @@ sy_result sy_cluster_decode(const void *data, size_t size, const sy_cluster_limi
         q->frame = rd_u64(&rd);
         q->job = rd_u32(&rd);
         q->flags = rd_u32(&rd);
-        if (!rd.r && (q->flags & ~(uint32_t)(SY_CLUSTER_RENDER_DEPTH | SY_CLUSTER_RENDER_PRESENT)))
+        if (!rd.r && (q->flags & ~(uint32_t)(SY_CLUSTER_RENDER_DEPTH | SY_CLUSTER_RENDER_PRESENT | SY_CLUSTER_RENDER_HALF)))
             rd_fail(&rd, SY_ERR_PARSE, "unknown render flags");
         rd_str(&rd, q->backend, SY_CLUSTER_BACKEND_MAX, "back-end name");
         rd_str(&rd, q->params, SY_CLUSTER_PARAMS_MAX, "parameters");
@@ -454,7 +472,8 @@ sy_result sy_cluster_decode(const void *data, size_t size, const sy_cluster_limi
                 rd_fail(&rd, SY_ERR_PARSE, "tile rectangle empty or outside 16384x16384");
                 break;
             }
-            if (tl->encoding != SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD) {
+            uint32_t vb = sy_cluster_encoding_bytes(tl->encoding);
+            if (!vb) {
                 rd_fail(&rd, SY_ERR_UNSUPPORTED, "unknown tile encoding");
                 break;
             }
@@ -462,7 +481,7 @@ sy_result sy_cluster_decode(const void *data, size_t size, const sy_cluster_limi
                 rd_fail(&rd, SY_ERR_PARSE, "tile channels must be 4 or 5");
                 break;
             }
-            if (tl->raw_size != (uint64_t)tl->rect.w * tl->rect.h * tl->channels * 4u) {
+            if (tl->raw_size != (uint64_t)tl->rect.w * tl->rect.h * tl->channels * vb) {
                 rd_fail(&rd, SY_ERR_PARSE, "tile raw size does not match its rectangle");
                 break;
             }
@@ -472,6 +491,31 @@ sy_result sy_cluster_decode(const void *data, size_t size, const sy_cluster_limi
     } else if (t == SY_CLUSTER_ERROR) {
         m.u.error.code = rd_u32(&rd);
         rd_str(&rd, m.u.error.reason, SY_CLUSTER_REASON_MAX, "reason");
+    } else if (t == SY_CLUSTER_BLOB_REQUEST || t == SY_CLUSTER_BLOBS) {
+        __typeof__(m.u.blobs) *q = &m.u.blobs;
+        q->frame = rd_u64(&rd);
+        q->count = rd_u32(&rd);
+        if (!rd.r) {
+            if (q->count < 1 || q->count > SY_CLUSTER_MAX_BLOBS) rd_fail(&rd, SY_ERR_LIMIT, "blob count outside 1..1048576");
+            else if ((size_t)q->count * 24 > rd.size - rd.pos) rd_fail(&rd, SY_ERR_PARSE, "truncated blob list");
+        }
+        if (!rd.r) {
+            q->blobs = calloc(q->count, sizeof *q->blobs);
+            if (!q->blobs) rd_fail(&rd, SY_ERR_OUT_OF_MEMORY, "out of memory for the blob list");
+        }
+        for (uint32_t i = 0; !rd.r && i < q->count; ++i) {
+            sy_cluster_blob_ref *b = &q->blobs[i];
+            b->hash.lo = rd_u64(&rd);
+            b->hash.hi = rd_u64(&rd);
+            b->size = rd_u64(&rd);
+            if (rd.r || t != SY_CLUSTER_BLOBS) continue;
+            if (b->size > rd.size - rd.pos) {
+                rd_fail(&rd, SY_ERR_PARSE, "blob payload runs past the end of the message");
+                break;
+            }
+            b->data = rd.p + rd.pos;
+            rd_bytes(&rd, NULL, (size_t)b->size);
+        }
     }
     if (!rd.r && rd.pos != rd.size) rd_fail(&rd, SY_ERR_PARSE, "trailing bytes after the body");
     if (rd.r) {
@@ -480,4 +524,53 @@ sy_result sy_cluster_decode(const void *data, size_t size, const sy_cluster_limi
     }
     *out = m;
     return SY_OK;
+}
+
+/* ---- tile encodings and binary16 ---- */
+uint32_t sy_cluster_encoding_bytes(uint32_t encoding)
+{
+    return encoding == SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD ? 4u : encoding == SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD ? 2u : 0u;
+}
+
+/* q = integer part of mant / 2^shift (1 <= shift <= 31), rounded to nearest, ties to even */
+static uint32_t shift_rne(uint32_t mant, uint32_t shift)
+{
+    uint32_t q = mant >> shift, rem = mant & ((1u << shift) - 1u), halfway = 1u << (shift - 1u);
+    if (rem > halfway || (rem == halfway && (q & 1u))) q++;
+    return q;
+}
+
+uint16_t sy_cluster_half_from_float(float f)
+{
+    uint32_t x;
+    memcpy(&x, &f, 4);
+    uint32_t sign = (x >> 16) & 0x8000u, ax = x & 0x7fffffffu;
+    if (ax >= 0x7f800000u) { /* inf, NaN: keep the top 10 payload bits, force the quiet bit */
+        if (ax == 0x7f800000u) return (uint16_t)(sign | 0x7c00u);
+        return (uint16_t)(sign | 0x7c00u | 0x200u | ((ax >> 13) & 0x3ffu));
+    }
+    if (ax >= 0x477ff000u) return (uint16_t)(sign | 0x7c00u); /* >= 65520: the tie above 65504 goes to inf */
+    uint32_t exp = ax >> 23, mant = (ax & 0x7fffffu) | 0x800000u;
+    if (exp < 113) { /* below 2^-14: a subnormal half, in units of 2^-24: mant * 2^(exp - 126) */
+        if (exp < 102) return (uint16_t)sign; /* below 2^-25: rounds to zero */
+        return (uint16_t)(sign | shift_rne(mant, 126u - exp)); /* 0x400 = the smallest normal, encoded right */
+    }
+    /* normal: the rounding carry runs into the exponent, which is the correct next value */
+    return (uint16_t)(sign | shift_rne(((exp - 112u) << 23) | (ax & 0x7fffffu), 13u));
+}
+
+float sy_cluster_half_to_float(uint16_t h)
+{
+    uint32_t sign = (uint32_t)(h & 0x8000u) << 16, exp = (h >> 10) & 0x1fu, mant = h & 0x3ffu, bits;
+    if (exp == 0x1fu) bits = sign | 0x7f800000u | (mant << 13);
+    else if (exp) bits = sign | ((exp + 112u) << 23) | (mant << 13);
+    else if (!mant) bits = sign;
+    else { /* subnormal: normalise */
+        uint32_t e = 113;
+        while (!(mant & 0x400u)) mant <<= 1, e--;
+        bits = sign | (e << 23) | ((mant & 0x3ffu) << 13);
+    }
+    float f;
+    memcpy(&f, &bits, 4);
+    return f;
 }

@@ -23,7 +23,7 @@ extern "C" {
 #endif
 
 #define SY_CLUSTER_MAGIC 0x50435953u /* "SYCP" little endian */
-#define SY_CLUSTER_VERSION 1u
+#define SY_CLUSTER_VERSION 2u
 #define SY_CLUSTER_HEADER_SIZE 24u
 #define SY_CLUSTER_TAG_SIZE 32u
 #define SY_CLUSTER_NONCE_SIZE 32u
@@ -34,6 +34,7 @@ extern "C" {
 #define SY_CLUSTER_MAX_TILES 4096u   /* tiles per render request / reply */
 #define SY_CLUSTER_MAX_IMAGE 16384u  /* image width / height */
 #define SY_CLUSTER_MAX_SAMPLES (1u << 20)
+#define SY_CLUSTER_MAX_BLOBS (1u << 20)   /* blob references per BLOB_REQUEST / BLOBS */
 #define SY_CLUSTER_DEFAULT_MAX_MESSAGE ((size_t)1 << 30)
 
 typedef enum sy_cluster_msg_type {
@@ -49,7 +50,9 @@ typedef enum sy_cluster_msg_type {
     SY_CLUSTER_SWAP_ACK = 10, /* server -> client: presented */
     SY_CLUSTER_BYE = 11,      /* either way: end of session */
     SY_CLUSTER_ERROR = 12,    /* server -> client: request rejected, with reason */
-    SY_CLUSTER_MSG_TYPE_MAX = 12
+    SY_CLUSTER_BLOB_REQUEST = 13, /* server -> client: the blobs (by hash) a SCENE needs that the server lacks */
+    SY_CLUSTER_BLOBS = 14,    /* client -> server: requested blob payloads (each checked against its hash) */
+    SY_CLUSTER_MSG_TYPE_MAX = 14
 } sy_cluster_msg_type;
 
 typedef enum sy_cluster_frame_flags {
@@ -63,11 +66,22 @@ typedef enum sy_cluster_scene_flags {
 typedef enum sy_cluster_render_flags {
     SY_CLUSTER_RENDER_DEPTH = 1u << 0,   /* send the depth channel too */
     SY_CLUSTER_RENDER_PRESENT = 1u << 1, /* keep the tiles on the server for SWAP (multi-display) */
+    SY_CLUSTER_RENDER_HALF = 1u << 2,    /* send tiles as binary16 planes (SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD) */
 } sy_cluster_render_flags;
 
 typedef enum sy_cluster_encoding {
-    SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD = 1, /* float32 planes, byte-shuffled, zstd */
+    SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD = 1, /* float32 planes, byte-shuffled, zstd (lossless) */
+    SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD = 2, /* IEEE binary16 planes (round to nearest even), byte-shuffled, zstd */
 } sy_cluster_encoding;
+
+/* Bytes per channel value of a tile encoding (4 or 2); 0 for an unknown encoding. */
+uint32_t sy_cluster_encoding_bytes(uint32_t encoding);
+
+/* IEEE 754 binary32 <-> binary16. To half: round to nearest, ties to even; overflow (|x| >= 65520)
+ * gives +-inf, values below half the smallest subnormal give +-0, NaN stays NaN (quieted, sign and
+ * the top payload bits kept). To float: exact (every half is a float). Pure; any thread. */
+uint16_t sy_cluster_half_from_float(float f);
+float sy_cluster_half_to_float(uint16_t h);
 
 typedef struct sy_cluster_rect {
     uint32_t x, y, w, h;
@@ -89,6 +103,13 @@ typedef struct sy_cluster_tile {
     const uint8_t *data; /* compressed bytes (borrowed from the input / caller) */
     uint32_t data_size;
 } sy_cluster_tile;
+
+/* One blob in BLOB_REQUEST (data NULL) or BLOBS (data = size payload bytes, borrowed). */
+typedef struct sy_cluster_blob_ref {
+    sy_hash128 hash; /* XXH3-128 of the payload (sy_hash_bytes) */
+    uint64_t size;
+    const uint8_t *data;
+} sy_cluster_blob_ref;
 
 typedef struct sy_cluster_msg {
     sy_cluster_header header;
@@ -136,6 +157,11 @@ typedef struct sy_cluster_msg {
             uint32_t code; /* sy_result */
             char reason[SY_CLUSTER_REASON_MAX];
         } error;
+        struct { /* BLOB_REQUEST, BLOBS */
+            uint64_t frame; /* the SCENE's frame */
+            uint32_t count; /* BLOB_REQUEST: 1..SY_CLUSTER_MAX_BLOBS; BLOBS: 1..SY_CLUSTER_MAX_BLOBS */
+            sy_cluster_blob_ref *blobs; /* allocated by the decoder; caller's array when encoding */
+        } blobs;
     } u;
 } sy_cluster_msg;
 

@@ -64,6 +64,7 @@ struct sy_scene {
     pool pools[SY_TYPE_COUNT];
     dirty_rec *dirty;
     uint32_t dirty_count, dirty_capacity;
+    uint32_t dirty_dropped; /* records of objects created and destroyed in this frame (no change) */
     uint64_t frame;
     sy_changes **log; /* sealed lists, oldest first */
     uint32_t log_count, log_capacity;
@@ -73,6 +74,7 @@ struct sy_scene {
     uint32_t epoch;
     uint32_t last_world_updates;
     bool applying; /* replica apply: references may be stale, cycles checked afterwards */
+    uint32_t apply_max_slots; /* replica policy: highest slot index + 1 a change list may create (0 = none) */
 };
 
 static bool list_push(id_list *l, uint32_t v)
@@ -697,6 +699,9 @@ static sy_result object_create_at(sy_scene *s, uint32_t t, uint32_t id, sy_error
     pool *p = &s->pools[t];
     uint32_t idx = id_index(id), gen = id_generation(id);
     if (idx == 0 || gen == 0) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "create %s %#x: invalid id", td->name, id);
+    if (s->applying && s->apply_max_slots && idx >= s->apply_max_slots)
+        return sy_error_set(err, SY_ERR_LIMIT, "create %s %#x: slot index %u exceeds this replica's limit of %u", td->name,
+                            id, idx, s->apply_max_slots);
     if (idx >= p->count) {
         if (!pool_grow(p, idx + 1)) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "create %s: out of memory", td->name);
         for (uint32_t i = p->count; i < idx; ++i) free_list_push(p, i);
@@ -848,6 +853,7 @@ sy_result sy_object_destroy(sy_scene *s, sy_object_type t, uint32_t id, sy_error
     /* record the destruction (or drop a creation nobody has seen) */
     if (sl->dirty_pos) {
         dirty_rec *rec = &s->dirty[sl->dirty_pos - 1];
+        if (rec->flags & SY_CHANGE_CREATED) s->dirty_dropped++;
         rec->flags = (rec->flags & SY_CHANGE_CREATED) ? DIRTY_DROPPED : SY_CHANGE_DESTROYED;
     } else if (!mark_dirty(s, t, id, sl, 0, SY_CHANGE_DESTROYED)) {
         return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "destroy: out of memory");
@@ -1050,6 +1056,18 @@ uint32_t sy_primitive_triangle_count(const sy_primitive *p)
     return p->indices ? (uint32_t)(sy_blob_size(p->indices) / 12) : sy_primitive_vertex_count(p) / 3;
 }
 
+bool sy_texture_ref_matrix(const sy_texture_ref *r, float m[6])
+{
+    /* KHR_texture_transform (ratified): uv' = offset + R (uv_scale * uv), R = [cos sin; -sin cos]
+     * (GLSL mat3(cos, -sin, 0, sin, cos, 0, 0, 0, 1)); the Khronos TextureTransformTest model's
+     * markers confirm the direction (tests/integration/test_texture_transform.c). */
+    float c = cosf(r->rotation), s = sinf(r->rotation);
+    m[0] = c * r->uv_scale[0], m[1] = s * r->uv_scale[1], m[2] = r->offset[0];
+    m[3] = -s * r->uv_scale[0], m[4] = c * r->uv_scale[1], m[5] = r->offset[1];
+    return r->offset[0] != 0.0f || r->offset[1] != 0.0f || r->rotation != 0.0f || r->uv_scale[0] != 1.0f ||
+           r->uv_scale[1] != 1.0f;
+}
+
 /* >>attachments */
 static sy_result set_attachments(sy_scene *s, uint32_t t, uint32_t id, slot *sl, sy_attachment *a, uint32_t n,
                                  sy_error *err)
@@ -1236,7 +1254,7 @@ static sy_result build_snapshot(sy_scene *s, sy_changes **out, sy_error *err)
 sy_result sy_scene_snapshot(sy_scene *s, sy_changes **out, sy_error *err)
 {
     *out = NULL;
-    if (s->dirty_count)
+    if (sy_scene_has_pending(s))
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "snapshot: the scene has uncommitted changes; commit first");
     return build_snapshot(s, out, err);
 }
@@ -1284,6 +1302,7 @@ sy_result sy_scene_commit(sy_scene *s, uint64_t *frame_out, sy_error *err)
         sl->dirty_pos = 0;
     }
     s->dirty_count = 0;
+    s->dirty_dropped = 0;
     if (r != SY_OK) {
         /* The frame's changes cannot be delivered: consumers must resynchronise from a snapshot. */
         sy_changes_release(c);
@@ -1329,7 +1348,7 @@ sy_result sy_scene_commit(sy_scene *s, uint64_t *frame_out, sy_error *err)
 }
 
 uint64_t sy_scene_frame(const sy_scene *s) { return s->frame; }
-bool sy_scene_has_pending(const sy_scene *s) { return s->dirty_count != 0; }
+bool sy_scene_has_pending(const sy_scene *s) { return s->dirty_count > s->dirty_dropped; }
 
 sy_result sy_scene_consumer_add(sy_scene *s, uint32_t *consumer_out, sy_error *err)
 {
@@ -1346,7 +1365,7 @@ sy_result sy_scene_consumer_add(sy_scene *s, uint32_t *consumer_out, sy_error *e
     consumer *c = &s->consumers[i];
     memset(c, 0, sizeof *c);
     c->used = true;
-    if (s->dirty_count) {
+    if (sy_scene_has_pending(s)) {
         c->needs_snapshot = true;
     } else {
         sy_result r = build_snapshot(s, &c->snapshot, err);
@@ -1449,6 +1468,11 @@ static sy_result resync_destroy_unlisted(sy_scene *s, const sy_changes *changes,
     }
     free(keys);
     return r;
+}
+
+void sy_scene_set_apply_limit(sy_scene *s, uint32_t max_slots)
+{
+    s->apply_max_slots = max_slots;
 }
 
 sy_result sy_scene_apply(sy_scene *s, const sy_changes *changes, sy_error *err)

@@ -146,6 +146,9 @@ typedef struct sy_texture_ref {
     float rotation;
     float uv_scale[2];
 } sy_texture_ref;
+/* The texture-coordinate transform of r as a row-major 2x3 affine matrix (u' = m0 u + m1 v + m2,
+ * v' = m3 u + m4 v + m5); returns false when it is the identity. */
+bool sy_texture_ref_matrix(const sy_texture_ref *r, float m[6]);
 
 enum sy_material_field {
     SY_MATERIAL_NAME = 0,
@@ -437,6 +440,11 @@ sy_result sy_scene_snapshot(sy_scene *s, sy_changes **out, sy_error *err);
  * with the exact handle ids of the change list; the applied changes are recorded like local ones,
  * so this scene's own consumers see them after its next commit. */
 sy_result sy_scene_apply(sy_scene *s, const sy_changes *changes, sy_error *err);
+/* Replica policy for untrusted change lists: sy_scene_apply refuses (SY_ERR_LIMIT, naming the
+ * type, the index and the limit) to create an object whose slot index is max_slots or more, so a
+ * message cannot make a pool grow to millions of slots. 0 (the default) = no limit beyond the
+ * handle format's SY_HANDLE_INDEX_MASK. Objects created locally are not affected. */
+void sy_scene_set_apply_limit(sy_scene *s, uint32_t max_slots);
 
 /* Deep comparison of every live object, field and attachment (blobs by content hash). Returns
  * true when equal; otherwise false and a description of the first difference in err->message. */

@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -98,9 +99,13 @@ static bool finite_n(const float *p, uint32_t n)
 
 uint64_t sy_filter_scan_finite(const sy_filter_frame *f, uint32_t need, uint8_t *mask)
 {
-    size_t n = (size_t)f->width * f->height;
+    return sy_filter_scan_finite_rows(f, need, mask, 0, f->height);
+}
+
+uint64_t sy_filter_scan_finite_rows(const sy_filter_frame *f, uint32_t need, uint8_t *mask, uint32_t y0, uint32_t y1)
+{
     uint64_t bad = 0;
-    for (size_t i = 0; i < n; ++i) {
+    for (size_t i = (size_t)y0 * f->width; i < (size_t)y1 * f->width; ++i) {
         bool ok = true;
         if ((need & SY_FILTER_NEED_COLOR) && f->color) ok = ok && finite_n(f->color + i * f->color_channels, 3);
         if ((need & SY_FILTER_NEED_VARIANCE) && f->variance)
@@ -211,4 +216,115 @@ sy_filter_status sy_filter_parallel_rows(uint32_t threads, uint32_t rows, sy_fil
     (void)failed; /* degraded to fewer threads, never an incomplete image */
     (void)err;
     return SY_FILTER_OK;
+}
+
+/* ---- persistent worker pool ---------------------------------------------------------------- */
+
+struct sy_filter_pool {
+    pthread_mutex_t mu;
+    pthread_cond_t go, done;
+    uint32_t threads;  /* asked for (including the caller) */
+    uint32_t started;  /* workers actually running */
+    uint64_t gen;      /* bumped per job */
+    uint32_t busy;     /* workers still in the current job */
+    bool quit;
+    sy_filter_rows_fn fn;
+    void *ctx;
+    uint32_t rows, chunk;
+    atomic_uint next; /* next unclaimed row */
+    pthread_t tids[SY_FILTER_MAX_THREADS];
+};
+
+static void pool_work(sy_filter_pool *p)
+{
+    for (;;) {
+        uint32_t y0 = atomic_fetch_add(&p->next, p->chunk);
+        if (y0 >= p->rows) return;
+        uint32_t y1 = p->rows - y0 < p->chunk ? p->rows : y0 + p->chunk;
+        p->fn(p->ctx, y0, y1);
+    }
+}
+
+static void *pool_main(void *arg)
+{
+    sy_filter_pool *p = arg;
+    uint64_t seen = 0;
+    pthread_mutex_lock(&p->mu);
+    for (;;) {
+        while (!p->quit && p->gen == seen) pthread_cond_wait(&p->go, &p->mu);
+        if (p->quit) break;
+        seen = p->gen;
+        pthread_mutex_unlock(&p->mu);
+        pool_work(p);
+        pthread_mutex_lock(&p->mu);
+        if (--p->busy == 0) pthread_cond_signal(&p->done);
+    }
+    pthread_mutex_unlock(&p->mu);
+    return NULL;
+}
+
+sy_filter_status sy_filter_pool_create(uint32_t threads, sy_filter_pool **out, sy_filter_error *err)
+{
+    if (!out) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "worker pool: out is NULL");
+    *out = NULL;
+    if (threads == 0) threads = sy_filter_default_threads();
+    if (threads > SY_FILTER_MAX_THREADS)
+        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "worker pool: threads = %u: at most %u", threads,
+                              SY_FILTER_MAX_THREADS);
+    sy_filter_pool *p = calloc(1, sizeof *p);
+    if (!p) return sy_filter_fail(err, SY_FILTER_ERROR_OUT_OF_MEMORY, "worker pool: out of memory");
+    if (pthread_mutex_init(&p->mu, NULL)) return free(p), sy_filter_fail(err, SY_FILTER_ERROR_THREADS, "worker pool: mutex");
+    if (pthread_cond_init(&p->go, NULL)) {
+        pthread_mutex_destroy(&p->mu), free(p);
+        return sy_filter_fail(err, SY_FILTER_ERROR_THREADS, "worker pool: condition variable");
+    }
+    if (pthread_cond_init(&p->done, NULL)) {
+        pthread_cond_destroy(&p->go), pthread_mutex_destroy(&p->mu), free(p);
+        return sy_filter_fail(err, SY_FILTER_ERROR_THREADS, "worker pool: condition variable");
+    }
+    p->threads = threads;
+    atomic_init(&p->next, 0);
+    for (uint32_t t = 1; t < threads; ++t) {
+        if (pthread_create(&p->tids[p->started], NULL, pool_main, p) != 0) break; /* fewer threads, same result */
+        ++p->started;
+    }
+    *out = p;
+    return SY_FILTER_OK;
+}
+
+void sy_filter_pool_destroy(sy_filter_pool *p)
+{
+    if (!p) return;
+    pthread_mutex_lock(&p->mu);
+    p->quit = true;
+    pthread_cond_broadcast(&p->go);
+    pthread_mutex_unlock(&p->mu);
+    for (uint32_t t = 0; t < p->started; ++t) pthread_join(p->tids[t], NULL);
+    pthread_cond_destroy(&p->done), pthread_cond_destroy(&p->go), pthread_mutex_destroy(&p->mu);
+    free(p);
+}
+
+uint32_t sy_filter_pool_threads(const sy_filter_pool *p) { return p ? p->threads : 0; }
+
+void sy_filter_pool_rows(sy_filter_pool *p, uint32_t rows, sy_filter_rows_fn fn, void *ctx)
+{
+    if (!rows) return;
+    if (!p || p->started == 0 || rows < 2) {
+        fn(ctx, 0, rows);
+        return;
+    }
+    /* about 16 chunks per thread: the phases end together even when another process takes a core
+     * for a while (claiming a chunk is one atomic add) */
+    uint32_t chunk = rows / (16 * (p->started + 1));
+    pthread_mutex_lock(&p->mu);
+    p->fn = fn, p->ctx = ctx, p->rows = rows, p->chunk = chunk ? chunk : 1;
+    atomic_store(&p->next, 0);
+    p->busy = p->started;
+    ++p->gen;
+    pthread_cond_broadcast(&p->go);
+    pthread_mutex_unlock(&p->mu);
+    pool_work(p);
+    pthread_mutex_lock(&p->mu);
+    while (p->busy) pthread_cond_wait(&p->done, &p->mu);
+    pthread_mutex_unlock(&p->mu);
 }

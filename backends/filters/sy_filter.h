@@ -145,4 +145,20 @@ sy_filter_status sy_filter_parallel_rows(uint32_t threads, uint32_t rows, sy_fil
                                          sy_filter_error *err);
 uint32_t sy_filter_default_threads(void);
 
+/* Persistent worker pool: threads are created once (by the filter object that owns the pool) and
+ * reused for every row-parallel phase of every frame; no global state. run_rows hands out chunks
+ * of rows dynamically (a busy core takes fewer), the calling thread works too, and it returns
+ * when every row is done. Results never depend on the split (rows are independent).
+ * Ownership: the creator owns the pool. Thread-safety: one run_rows at a time per pool. A thread
+ * that cannot be started leaves a smaller pool (never an incomplete result). */
+typedef struct sy_filter_pool sy_filter_pool;
+/* threads = total threads including the caller (0 = online CPU count). */
+sy_filter_status sy_filter_pool_create(uint32_t threads, sy_filter_pool **out, sy_filter_error *err);
+void sy_filter_pool_destroy(sy_filter_pool *pool);
+uint32_t sy_filter_pool_threads(const sy_filter_pool *pool); /* the count asked for at creation */
+void sy_filter_pool_rows(sy_filter_pool *pool, uint32_t rows, sy_filter_rows_fn fn, void *ctx);
+
+/* sy_filter_scan_finite for rows [y0, y1) only (the mask is indexed by pixel as there). */
+uint64_t sy_filter_scan_finite_rows(const sy_filter_frame *f, uint32_t need, uint8_t *mask, uint32_t y0, uint32_t y1);
+
 #endif /* SY_FILTER_H */

@@ -12,7 +12,9 @@
  * headlight).
  * Output: RGBA float, alpha copied from colour (1 for 3-channel colour).
  *
- * Ownership: sy_filter_pixel owns its state buffers (filtered HV, smoothed variance, r, s).
+ * Ownership: sy_filter_pixel owns its state buffers (filtered HV, smoothed variance, r, s) and a
+ * worker pool (sy_filter_pool) of params.threads threads, started at the first run and kept until
+ * destroy (rebuilt when params.threads changes). The output does not depend on the thread count.
  * Thread-safety: one object per thread at a time; runs on params.threads threads internally. */
 #ifndef SY_FILTER_PIXEL_H
 #define SY_FILTER_PIXEL_H

@@ -154,7 +154,10 @@ static void rf_rows(void *vctx, uint32_t y0, uint32_t y1)
             }
             for (int q = 0; q < 3; ++q) pt[q] = sh->direct[q] + (c->sok[j] ? sh->pt_indirect[q] : 0.0f);
             float var = rf->k > 1 ? rf->svar[j] : fmaxf(sh->variance, 0.0f);
-            rf->svar2[j] = var;
+            /* next frame's variance: smoothed over this frame's kernel below; a pixel that gathers
+             * nothing (correction phase) keeps its own current running estimate, so a variance
+             * estimate that was low early on is refreshed instead of frozen */
+            rf->svar2[j] = fmaxf(sh->variance, 0.0f);
             /* radius: warm-up schedule, then the variance-driven one (Eqs. 4.1, 4.2, 4.14) */
             float r;
             if (rf->k <= p->warmup_frames) {
@@ -283,6 +286,50 @@ void sy_filter_radiance_reset(sy_filter_radiance *rf)
 const float *sy_filter_radiance_radius(const sy_filter_radiance *rf) { return rf && rf->k ? rf->radius : NULL; }
 uint32_t sy_filter_radiance_frame_index(const sy_filter_radiance *rf) { return rf ? rf->k : 0; }
 
+/* (Re)allocates the per-pixel state for width x height; a size change resets (k = 0). */
+static sy_filter_status rf_alloc(sy_filter_radiance *rf, uint32_t width, uint32_t height, sy_filter_error *err)
+{
+    if (rf->w == width && rf->h == height && rf->accum) return SY_FILTER_OK;
+    size_t n = (size_t)width * height;
+    free(rf->accum), free(rf->ptacc), free(rf->svar), free(rf->svar2), free(rf->alpha), free(rf->alpha2);
+    free(rf->radius), free(rf->phase);
+    rf->accum = malloc(3 * n * sizeof(float)), rf->ptacc = malloc(3 * n * sizeof(float));
+    rf->svar = malloc(n * sizeof(float)), rf->svar2 = malloc(n * sizeof(float));
+    rf->alpha = malloc(n * sizeof(float)), rf->alpha2 = malloc(n * sizeof(float));
+    rf->radius = malloc(n * sizeof(float)), rf->phase = malloc(n);
+    rf->w = rf->h = 0, rf->k = 0;
+    if (!rf->accum || !rf->ptacc || !rf->svar || !rf->svar2 || !rf->alpha || !rf->alpha2 || !rf->radius || !rf->phase)
+        return sy_filter_fail(err, SY_FILTER_ERROR_OUT_OF_MEMORY, "radiance filter: out of memory for %ux%u", width,
+                              height);
+    rf->w = width, rf->h = height;
+    return SY_FILTER_OK;
+}
+
+sy_filter_status sy_filter_radiance_seed(sy_filter_radiance *rf, uint32_t width, uint32_t height, const float *mean,
+                                         uint32_t channels, const float *variance, uint32_t frames,
+                                         sy_filter_error *err)
+{
+    if (!rf || !mean || !variance || frames == 0 || (channels != 3 && channels != 4))
+        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT,
+                              "radiance filter: seed needs mean, variance, 3 or 4 channels and frames >= 1");
+    if (width == 0 || height == 0 || width > SY_FILTER_MAX_SIDE || height > SY_FILTER_MAX_SIDE)
+        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: seed size %ux%u outside 1..%u",
+                              width, height, SY_FILTER_MAX_SIDE);
+    sy_filter_status s = rf_alloc(rf, width, height, err);
+    if (s) return s;
+    size_t n = (size_t)width * height;
+    for (size_t i = 0; i < n; ++i) {
+        for (int q = 0; q < 3; ++q) {
+            float v = mean[channels * i + (size_t)q];
+            rf->accum[3 * i + q] = rf->ptacc[3 * i + q] = isfinite(v) ? v : 0.0f;
+        }
+        rf->svar[i] = isfinite(variance[i]) && variance[i] > 0.0f ? variance[i] : 0.0f;
+        rf->alpha[i] = 1.0f, rf->radius[i] = 0.0f, rf->phase[i] = 1;
+    }
+    rf->k = frames;
+    return SY_FILTER_OK;
+}
+
 sy_filter_status sy_filter_radiance_frame(sy_filter_radiance *rf, const sy_filter_radiance_input *in, float *out,
                                           sy_filter_stats *stats, sy_filter_error *err)
 {
@@ -297,19 +344,7 @@ sy_filter_status sy_filter_radiance_frame(sy_filter_radiance *rf, const sy_filte
     sy_filter_status s = sy_filter_check_positive(in->pixel_angle, "radiance filter: pixel_angle", err);
     if (s) return s;
     size_t n = (size_t)in->width * in->height;
-    if (rf->w != in->width || rf->h != in->height || !rf->accum) {
-        free(rf->accum), free(rf->ptacc), free(rf->svar), free(rf->svar2), free(rf->alpha), free(rf->alpha2);
-        free(rf->radius), free(rf->phase);
-        rf->accum = malloc(3 * n * sizeof(float)), rf->ptacc = malloc(3 * n * sizeof(float));
-        rf->svar = malloc(n * sizeof(float)), rf->svar2 = malloc(n * sizeof(float));
-        rf->alpha = malloc(n * sizeof(float)), rf->alpha2 = malloc(n * sizeof(float));
-        rf->radius = malloc(n * sizeof(float)), rf->phase = malloc(n);
-        rf->w = rf->h = 0, rf->k = 0;
-        if (!rf->accum || !rf->ptacc || !rf->svar || !rf->svar2 || !rf->alpha || !rf->alpha2 || !rf->radius || !rf->phase)
-            return sy_filter_fail(err, SY_FILTER_ERROR_OUT_OF_MEMORY, "radiance filter: out of memory for %ux%u",
-                                  in->width, in->height);
-        rf->w = in->width, rf->h = in->height;
-    }
+    if ((s = rf_alloc(rf, in->width, in->height, err))) return s;
     if (rf->k == 0) {
         memset(rf->accum, 0, 3 * n * sizeof(float));
         memset(rf->ptacc, 0, 3 * n * sizeof(float));

@@ -18,6 +18,8 @@
  *                         vertices + emitter hits, times the throughput AFTER the first bounce),
  *                         NOT multiplied by P0's BSDF*cos and NOT divided by its pdf.
  * So for the pixel's own sample: pt_indirect = throughput * f(wi, wo) cos / pdf(wi) * radiance.
+ * The Embree path tracer provides this hook as per-pixel path records (backends/rt sy_rt.h
+ * ">>path records"); mediators/rt/sy_radiance_hook.c converts them and passes its BSDF.
  *
  * Ownership: sy_filter_radiance owns its accumulation state; inputs are borrowed per call.
  * Thread-safety: one object per thread at a time; runs multithreaded internally. */
@@ -113,6 +115,15 @@ void sy_filter_radiance_reset(sy_filter_radiance *rf);
  * the correction phase. */
 sy_filter_status sy_filter_radiance_frame(sy_filter_radiance *rf, const sy_filter_radiance_input *in, float *out_rgba,
                                           sy_filter_stats *stats, sy_filter_error *err);
+/* Resume on top of an existing progressive estimate of `frames` (>= 1) samples per pixel, e.g.
+ * when the filter is switched on while the path tracer keeps accumulating: the running means
+ * (filtered and plain) start at mean (width*height*channels, channels 3 or 4, RGB used), the
+ * smoothed per-sample variance at variance (width*height, luminance, absolute units) and the frame
+ * counter at k = frames, so the next frame is k + 1 with target variance (2k + 1) T_u. Non-finite
+ * inputs are taken as 0. */
+sy_filter_status sy_filter_radiance_seed(sy_filter_radiance *rf, uint32_t width, uint32_t height, const float *mean,
+                                         uint32_t channels, const float *variance, uint32_t frames,
+                                         sy_filter_error *err);
 /* Diagnostics of the last frame: kernel radius in pixels per pixel (0 = correction phase). */
 const float *sy_filter_radiance_radius(const sy_filter_radiance *rf);
 uint32_t sy_filter_radiance_frame_index(const sy_filter_radiance *rf);

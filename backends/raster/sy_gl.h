@@ -166,6 +166,8 @@ typedef enum sy_gl_alpha_mode { SY_GL_ALPHA_OPAQUE = 0, SY_GL_ALPHA_MASK = 1, SY
 typedef struct sy_gl_texture_ref {
     sy_gl_texture texture; /* zero = none */
     uint32_t texcoord;     /* 0 or 1 */
+    bool transformed;      /* false: identity; true: uv' = transform (row-major 2x3 affine) x (uv, 1) */
+    float transform[6];    /* KHR_texture_transform; finite */
 } sy_gl_texture_ref;
 typedef struct sy_gl_material_desc {
     float base_color[4];

@@ -353,6 +353,7 @@ static GLuint make_tex1(const sy_gl_fns *gl, const unsigned char rgba[4])
 typedef struct mat_block {
     float base[4], emissive[4], mrna[4], oist[4];
     int32_t modes[4], tex[4], tex2[4];
+    float xf[10][4]; /* per texture slot (base, mr, nrm, occ, emis) two rows of its uv transform */
 } mat_block;
 
 static void material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b)
@@ -378,6 +379,9 @@ static void material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
         int32_t v = pool_get(&dev->textures, refs[i]->texture.id) ? (int32_t)(refs[i]->texcoord & 1u) : -1;
         if (i < 4) b->tex[i] = v;
         else b->tex2[0] = v;
+        const float id[6] = {1, 0, 0, 0, 1, 0}, *m = refs[i]->transformed ? refs[i]->transform : id;
+        memcpy(b->xf[2 * i], m, 3 * sizeof(float));
+        memcpy(b->xf[2 * i + 1], m + 3, 3 * sizeof(float));
     }
 }
 
@@ -879,6 +883,12 @@ static sy_gl_result material_check(const sy_gl_material_desc *d, char *err, size
         if (!isfinite(*v[i])) return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "material: parameter %zu is not finite", i);
     if ((unsigned)d->alpha_mode > 2u)
         return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "material: unknown alpha mode %d", (int)d->alpha_mode);
+    const sy_gl_texture_ref *refs[5] = {&d->base_color_texture, &d->metallic_roughness_texture, &d->normal_texture,
+                                        &d->occlusion_texture, &d->emissive_texture};
+    for (int i = 0; i < 5; ++i)
+        for (int k = 0; refs[i]->transformed && k < 6; ++k)
+            if (!isfinite(refs[i]->transform[k]))
+                return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "material: texture %d transform[%d] is not finite", i, k);
     return SY_GL_OK;
 }
 

@@ -59,9 +59,10 @@ const char *const sy_gl_main_vs =
 #define SY_GL_MATERIAL_BLOCK                                                                                 \
     "layout(std140) uniform Material {\n"                                                                    \
     "  vec4 m_base; vec4 m_emissive; vec4 m_mrna; vec4 m_oist; ivec4 m_modes; ivec4 m_tex; ivec4 m_tex2;\n" \
+    "  vec4 m_xf[10];\n" /* uv transform rows per slot: base, mr, nrm, occ, emis */                          \
     "};\n"                                                                                                   \
     "uniform sampler2D t_base, t_mr, t_nrm, t_occ, t_emis;\n"                                                \
-    "vec2 uvset(int s, vec2 a, vec2 b) { return s == 1 ? b : a; }\n"
+    "vec2 tuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_xf[2*k].xyz, h), dot(m_xf[2*k+1].xyz, h)); }\n"
 
 const char *const sy_gl_main_fs =
     "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_MATERIAL_BLOCK
@@ -108,7 +109,7 @@ const char *const sy_gl_main_fs =
     "  vec2 uv[2] = vec2[2](v_uv0, v_uv1);\n"
     "  vec4 base = m_base * v_col;\n"
     "#ifdef SY_TEX\n"
-    "  if (m_tex.x >= 0) base *= texture(t_base, uv[m_tex.x]);\n"
+    "  if (m_tex.x >= 0) base *= texture(t_base, tuv(0, uv[m_tex.x]));\n"
     "#endif\n"
     "  float alpha = base.a;\n"
     "#ifdef SY_MASK\n"
@@ -120,7 +121,7 @@ const char *const sy_gl_main_fs =
     "  if (m_modes.w != 0 && (front || m_modes.z != 0)) {\n"
     "    L = m_emissive.rgb;\n"
     "#ifdef SY_TEX\n"
-    "    if (m_tex2.x >= 0) L *= texture(t_emis, uv[m_tex2.x]).rgb;\n"
+    "    if (m_tex2.x >= 0) L *= texture(t_emis, tuv(4, uv[m_tex2.x])).rgb;\n"
     "#endif\n"
     "  } else if (m_modes.y != 0) {\n"
     "    L = base.rgb;\n"
@@ -135,7 +136,7 @@ const char *const sy_gl_main_fs =
     "    if (u_has_normals) { vec3 sn = normalize(v_nrm); if (!any(isnan(sn))) n = sn; }\n"
     "#ifdef SY_NMAP\n"
     "    if (m_tex.z >= 0) {\n"
-    "      vec2 t = uv[m_tex.z]; vec2 dtx = dFdx(t), dty = dFdy(t);\n"
+    "      vec2 t = tuv(2, uv[m_tex.z]); vec2 dtx = dFdx(t), dty = dFdy(t);\n"
     "      vec3 pp2 = cross(dpy, n), pp1 = cross(n, dpx);\n"
     "      vec3 dpdu = pp2 * dtx.x + pp1 * dty.x, dpdv = pp2 * dtx.y + pp1 * dty.y;\n"
     "      vec3 tg = dpdu - n * dot(n, dpdu);\n"
@@ -150,7 +151,7 @@ const char *const sy_gl_main_fs =
     "    vec3 ns = front ? n : -n;\n"
     "    float metallic = m_mrna.x, rough = m_mrna.y;\n"
     "#ifdef SY_TEX\n"
-    "    if (m_tex.y >= 0) { vec4 t = texture(t_mr, uv[m_tex.y]); rough *= t.g; metallic *= t.b; }\n"
+    "    if (m_tex.y >= 0) { vec4 t = texture(t_mr, tuv(1, uv[m_tex.y])); rough *= t.g; metallic *= t.b; }\n"
     "#endif\n"
     "    float ior = m_oist.y, spec = m_oist.z, trans = m_oist.w;\n"
     "    float r0 = (ior - 1.0) / (ior + 1.0); float f0d = r0 * r0 * spec;\n"
@@ -192,7 +193,7 @@ const char *const sy_gl_main_fs =
     "#ifdef SY_AMBIENT\n"
     "    float ao = 1.0;\n"
     "#ifdef SY_TEX\n"
-    "    if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, uv[m_tex.w]).r - 1.0);\n"
+    "    if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, tuv(3, uv[m_tex.w])).r - 1.0);\n"
     "#endif\n"
     "    L += l_ambient.rgb * (kd + schlick(f0, nv)) * ao;\n"
     "#endif\n"
@@ -217,7 +218,7 @@ const char *const sy_gl_shadow_fs =
     "void main() {\n"
     "#ifdef SY_MASK\n"
     "  float a = m_base.a * v_a; vec2 uv[2] = vec2[2](v_uv0, v_uv1);\n"
-    "  if (m_tex.x >= 0) a *= texture(t_base, uv[m_tex.x]).a;\n"
+    "  if (m_tex.x >= 0) a *= texture(t_base, tuv(0, uv[m_tex.x])).a;\n"
     "  if (a < m_mrna.w) discard;\n"
     "#endif\n"
     "}\n";

@@ -170,10 +170,15 @@ typedef enum sy_rt_alpha_mode {
     SY_RT_ALPHA_MODE_MAX_ENUM = 0x7fffffff
 } sy_rt_alpha_mode;
 
-/* A texture reference: a zero handle means "no texture". */
+/* A texture reference: a zero handle means "no texture". With `transformed` set, the
+ * texture-coordinate set is mapped through the 2x3 affine `transform` (row-major:
+ * u' = t[0] u + t[1] v + t[2], v' = t[3] u + t[4] v + t[5]; glTF KHR_texture_transform) before the
+ * lookup; all entries must be finite. */
 typedef struct sy_rt_texture_ref {
     sy_rt_texture texture;
     uint32_t texcoord; /* texture-coordinate set, 0 or 1 */
+    bool transformed;  /* default false: identity */
+    float transform[6];
 } sy_rt_texture_ref;
 
 /* glTF 2.0 metallic-roughness material. Fill it with sy_rt_material_desc_init (glTF defaults),
@@ -338,6 +343,8 @@ typedef struct sy_rt_render_desc {
     /* PATHTRACER only: */
     sy_rt_accum *accum;                 /* required: accumulation of this rectangle (width x height) */
     uint32_t samples;                   /* samples per pixel to add in this call; 0 = 1 */
+    struct sy_rt_pt_record *records;    /* optional: width * height path records (see >>path records);
+                                         * NULL = none (no cost) */
 } sy_rt_render_desc;
 
 /* Renders the sub-rectangle. rgba: width*height*4 floats (required); depth: width*height floats
@@ -393,6 +400,49 @@ uint32_t sy_rt_aov_channels(sy_rt_aov aov); /* 0 for an unknown value */
 const char *sy_rt_aov_name(sy_rt_aov aov);  /* "color", "variance", ... ; NULL if unknown */
 /* Copies one feature buffer into out (width * height * channels floats, interleaved). */
 sy_rt_result sy_rt_accum_read(const sy_rt_accum *accum, sy_rt_aov aov, float *out, char *err, size_t err_len);
+
+/* >>path records (PATHTRACER): the stored-sample hook of radiance filtering
+ *
+ * With desc->records set, the path tracer writes one record per pixel of the rectangle (row 0 =
+ * top) describing the LAST sample it traced for that pixel in this call (a radiance filter calls
+ * with samples = 1: one path per pixel and frame). A path is split at P0, the first vertex where
+ * it sampled a non-specular (finite-density) BSDF lobe; perfect mirrors and refractions before it
+ * are followed stochastically (reflect OR refract, as the path tracer always does):
+ *   color     = the sample's radiance (what the accumulation received, before any NaN check)
+ *             = prefix + throughput * f_cos(wi) / pdf(wi) * incident
+ *   prefix    = everything the path gathered before sampling wi at P0: emission seen along the
+ *               specular chain and at P0, next-event estimates at the chain's vertices and at P0
+ *   incident  = radiance arriving at P0 along wi as estimated by the rest of the path (NEE at
+ *               later vertices, emitter and environment hits with their MIS weights, Russian
+ *               roulette), NOT multiplied by P0's f * cos / pdf and NOT by the chain throughput.
+ * Without SY_RT_RECORD_P0 (a miss, an emitter or unlit surface that ends the path, a path that
+ * ended before P0) only color == prefix is meaningful. Values are raw: a NaN/Inf sample shows as
+ * such here (the accumulation replaces it by zero and counts it). sy_rt_pt_record_bsdf evaluates
+ * P0's BSDF for any direction, so a filter can re-shade a neighbour's incident sample with this
+ * pixel's own material, normal and wo. Ownership: caller-owned array; plain data. */
+enum { SY_RT_RECORD_P0 = 1u << 0 };
+#define SY_RT_RECORD_BSDF_FLOATS 18
+typedef struct sy_rt_pt_record {
+    float color[3], prefix[3];
+    float position[3];   /* P0, world */
+    float normal[3];     /* unit shading normal at P0, on the side wo comes from */
+    float wo[3];         /* unit, from P0 toward the previous vertex */
+    float ray_dir[3];    /* unit direction of the ray segment that reached P0 */
+    float path_length;   /* camera -> P0 along the (specular) chain, world units */
+    float throughput[3]; /* camera -> P0 along the chain (1 without specular bounces) */
+    float wi[3];         /* unit direction sampled at P0 (toward the incoming light) */
+    float incident[3];   /* radiance estimate arriving at P0 along wi (see above) */
+    float hit_distance;  /* length of the ray along wi; +INFINITY when it escaped or was not traced */
+    float glossy_exponent; /* Blinn-Phong exponent equivalent to P0's GGX lobes (2 / alpha^2 - 2) when
+                              they are sampled with probability >= 1/4, else 0 (diffuse-dominated) */
+    uint32_t flags;      /* SY_RT_RECORD_P0 */
+    float bsdf[SY_RT_RECORD_BSDF_FLOATS]; /* opaque: P0's BSDF for sy_rt_pt_record_bsdf */
+} sy_rt_pt_record;
+
+/* f(wo, wi) * |n . wi| of P0's BSDF (RGB, the lobes with a finite density) and the solid-angle pdf
+ * with which the path tracer samples wi there (the same mixture it used for the record's own wi).
+ * Zero for a record without SY_RT_RECORD_P0. wi is unit, world space. Thread-safe (pure). */
+void sy_rt_pt_record_bsdf(const sy_rt_pt_record *record, const float wi[3], float f_cos[3], float *pdf);
 
 /* >>coverage
  *

@@ -1,6 +1,8 @@
 /* sy_rt_bsdf.c — glTF metallic-roughness BSDF for the path tracer (see sy_rt_bsdf.h). */
 #include "sy_rt_bsdf.h"
 
+#include <string.h>
+
 #define PI_F 3.14159265358979f
 #define INV_PI 0.31830988618f
 
@@ -193,4 +195,35 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
     out->weight = v3_scale(f, 1.0f / pdf);
     out->pdf = pdf;
     return true;
+}
+
+/* >>path records: the BSDF of P0 travels in the record (sy_rt.h) */
+void sy_rt_bsdf_pack(const sy_rt_bsdf *b, float o[SY_RT_RECORD_BSDF_FLOATS])
+{
+    const float v[SY_RT_RECORD_BSDF_FLOATS] = {b->n.x,   b->n.y,   b->n.z,      b->ng.x,     b->ng.y,     b->ng.z,
+                                               b->base.x, b->base.y, b->base.z, b->alpha,    b->delta ? 1.0f : 0.0f,
+                                               b->f0d,   b->spec,  b->w_metal,  b->w_diel,   b->q_metal,  b->q_spec,
+                                               b->q_diff};
+    memcpy(o, v, sizeof v);
+}
+
+void sy_rt_pt_record_bsdf(const sy_rt_pt_record *r, const float wi[3], float f_cos[3], float *pdf)
+{
+    f_cos[0] = f_cos[1] = f_cos[2] = 0.0f;
+    *pdf = 0.0f;
+    if (!(r->flags & SY_RT_RECORD_P0)) return;
+    const float *p = r->bsdf;
+    sy_rt_bsdf b;
+    memset(&b, 0, sizeof b);
+    b.n = v3(p[0], p[1], p[2]);
+    b.ng = v3(p[3], p[4], p[5]);
+    b.base = v3(p[6], p[7], p[8]);
+    b.alpha = p[9];
+    b.delta = p[10] != 0.0f;
+    b.f0d = p[11], b.spec = p[12], b.w_metal = p[13], b.w_diel = p[14];
+    b.q_metal = p[15], b.q_spec = p[16], b.q_diff = p[17];
+    float q;
+    sy_rt_v3 f = sy_rt_bsdf_eval(&b, v3(r->wo[0], r->wo[1], r->wo[2]), v3(wi[0], wi[1], wi[2]), &q);
+    f_cos[0] = f.x, f_cos[1] = f.y, f_cos[2] = f.z;
+    *pdf = q;
 }

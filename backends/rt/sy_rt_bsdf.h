@@ -55,4 +55,8 @@ typedef struct sy_rt_bsdf_sample {
  * ends (no lobe, direction below the surface). */
 bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], sy_rt_bsdf_sample *out);
 
+/* Packs what sy_rt_bsdf_eval needs into a path record's opaque bsdf floats (sy_rt.h
+ * >>path records); sy_rt_pt_record_bsdf unpacks and evaluates it. */
+void sy_rt_bsdf_pack(const sy_rt_bsdf *b, float out[SY_RT_RECORD_BSDF_FLOATS]);
+
 #endif /* SY_RT_BSDF_H */

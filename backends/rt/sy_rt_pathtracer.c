@@ -10,6 +10,11 @@
  * Russian roulette (survival = min(0.95, max throughput)) starts after three. Alpha-blended
  * surfaces are crossed stochastically with probability 1 - alpha.
  *
+ * Path records (desc->records, the radiance filter's stored-sample hook, sy_rt.h): the path is
+ * split at P0, the first vertex that sampled a non-specular lobe; a second throughput beta_s,
+ * started there, gathers the incident estimate along P0's sampled direction. Without records the
+ * extra work is a few untaken branches.
+ *
  * Random numbers: 4D set 0 = pixel jitter + alpha decisions of the camera segment; per bounce k
  * set 1 + 2k = light sample, set 2 + 2k = BSDF sample + roulette. */
 #include "sy_rt_pathtracer.h"
@@ -23,6 +28,7 @@
 
 typedef struct pt_job {
     sy_rt_accum *acc;
+    sy_rt_pt_record *records; /* optional path records of the rectangle (sy_rt.h >>path records) */
     uint32_t first, count;
     sy_rt_sobol sobol;
     sy_rt_env env;
@@ -142,7 +148,23 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
     return zero;
 }
 
-static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy_rt_pt_sample *out)
+/* Records P0 of a path (sy_rt.h >>path records): the vertex where the first non-specular lobe was
+ * sampled, with everything gathered so far as the prefix. */
+static void record_p0(sy_rt_pt_record *rec, const sy_rt_surface *s, const sy_rt_bsdf *b, sy_rt_v3 wo, sy_rt_v3 d,
+                      float path_len, sy_rt_v3 beta, sy_rt_v3 prefix, sy_rt_v3 wi)
+{
+    const sy_rt_v3 v[7] = {prefix, s->p, b->n, wo, d, beta, wi};
+    float *dst[7] = {rec->prefix, rec->position, rec->normal, rec->wo, rec->ray_dir, rec->throughput, rec->wi};
+    for (int i = 0; i < 7; ++i) dst[i][0] = v[i].x, dst[i][1] = v[i].y, dst[i][2] = v[i].z;
+    rec->path_length = path_len;
+    rec->glossy_exponent = !b->delta && b->q_metal + b->q_spec >= 0.25f ? 2.0f / (b->alpha * b->alpha) - 2.0f : 0.0f;
+    sy_rt_bsdf_pack(b, rec->bsdf);
+    rec->flags = SY_RT_RECORD_P0;
+}
+
+/* Traces one path; rec (NULL = not requested) receives its record. */
+static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy_rt_pt_sample *out,
+                         sy_rt_pt_record *rec)
 {
     const sy_rt_frame *f = c->f;
     const sy_rt_device *dev = c->dev;
@@ -168,6 +190,12 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
     out->albedo = out->normal = v3(0.0f, 0.0f, 0.0f);
     float p_area_sel = j->has_area ? 1.0f / (float)j->categories : 0.0f;
     float p_env_sel = j->has_env ? 1.0f / (float)j->categories : 0.0f;
+    /* path record: after P0 every contribution x (before the path throughput) also goes into the
+     * incident estimate with the throughput beta_s gathered after P0 */
+    bool after_p0 = false, want_hit = false;
+    sy_rt_v3 beta_s = v3(0.0f, 0.0f, 0.0f), incident = beta_s;
+    float path_len = 0.0f;
+    if (rec) rec->flags = 0, rec->hit_distance = INFINITY;
 
     for (;;) {
         struct RTCRayHit rh;
@@ -175,6 +203,10 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
         c->rays++;
         float dlen = v3_length(dir);
         sy_rt_v3 d = v3_scale(dir, 1.0f / dlen);
+        if (rec) {
+            if (want_hit) rec->hit_distance = in ? rh.ray.tfar * dlen : INFINITY, want_hit = false;
+            if (!after_p0 && in) path_len += rh.ray.tfar * dlen;
+        }
         if (!in) {
             if (first) out->alpha = j->env_opaque ? 1.0f : 0.0f;
             if (j->env.mode) {
@@ -182,6 +214,7 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
                 float w = specular ? 1.0f : power_heuristic(pdf_prev, sy_rt_env_pdf(&j->env, d) * p_env_sel);
                 sy_rt_v3 contrib = v3_scale(v3_mul(beta, le), w);
                 L = v3_add(L, contrib);
+                if (after_p0) incident = v3_add(incident, v3_scale(v3_mul(beta_s, le), w));
                 if (bounce <= 1u) direct = v3_add(direct, contrib);
             }
             break;
@@ -213,11 +246,13 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
             }
             sy_rt_v3 contrib = v3_scale(v3_mul(beta, s.emission), w);
             L = v3_add(L, contrib);
+            if (after_p0) incident = v3_add(incident, v3_scale(v3_mul(beta_s, s.emission), w));
             if (bounce <= 1u) direct = v3_add(direct, contrib);
         }
         if (s.mat->desc.unlit) {
             sy_rt_v3 contrib = v3_mul(beta, s.base);
             L = v3_add(L, contrib);
+            if (after_p0) incident = v3_add(incident, v3_mul(beta_s, s.base));
             if (bounce == 0u) direct = v3_add(direct, contrib);
             if (!features) out->albedo = s.base, out->normal = s.ns, features = true;
             break;
@@ -236,12 +271,20 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
         sy_rt_sobol_sample4(&j->sobol, pseed, 1u + 2u * bounce, index, ul);
         sy_rt_sobol_sample4(&j->sobol, pseed, 2u + 2u * bounce, index, ub);
         if (evaluable && j->categories) {
-            sy_rt_v3 contrib = v3_mul(beta, sample_light(c, &b, &s, wo, ul));
+            sy_rt_v3 le = sample_light(c, &b, &s, wo, ul), contrib = v3_mul(beta, le);
             L = v3_add(L, contrib);
+            if (after_p0) incident = v3_add(incident, v3_mul(beta_s, le));
             if (bounce == 0u) direct = v3_add(direct, contrib);
         }
         sy_rt_bsdf_sample bs;
         if (!sy_rt_bsdf_sample_dir(&b, wo, ub, &bs)) break;
+        if (after_p0) {
+            beta_s = v3_mul(beta_s, bs.weight);
+        } else if (rec && !bs.specular) {
+            record_p0(rec, &s, &b, wo, d, path_len, beta, L, bs.wi);
+            after_p0 = want_hit = true;
+            beta_s = v3(1.0f, 1.0f, 1.0f);
+        }
         beta = v3_mul(beta, bs.weight);
         specular = bs.specular;
         pdf_prev = bs.pdf;
@@ -250,6 +293,7 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
             float q = fminf(0.95f, maxc(beta));
             if (!(ub[3] < q)) break;
             beta = v3_scale(beta, 1.0f / q);
+            beta_s = v3_scale(beta_s, 1.0f / q);
         }
         if (v3_is_zero(beta)) break;
         org = v3_madd(s.p, b.ng, bs.transmit ? -ray_eps(s.p) : ray_eps(s.p));
@@ -259,6 +303,12 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
     }
     out->color = L;
     out->direct = direct;
+    if (rec) {
+        const sy_rt_v3 pre = after_p0 ? v3(rec->prefix[0], rec->prefix[1], rec->prefix[2]) : L;
+        rec->color[0] = L.x, rec->color[1] = L.y, rec->color[2] = L.z;
+        rec->prefix[0] = pre.x, rec->prefix[1] = pre.y, rec->prefix[2] = pre.z;
+        rec->incident[0] = incident.x, rec->incident[1] = incident.y, rec->incident[2] = incident.z;
+    }
 }
 
 static void pt_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
@@ -273,10 +323,12 @@ static void pt_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, 
     uint64_t bad = 0;
     for (uint32_t py = y0; py < y1; ++py)
         for (uint32_t px = x0; px < x1; ++px) {
-            float *rec = j->acc->data + ((size_t)(py - f->y) * f->width + (px - f->x)) * SY_RT_ACC_STRIDE;
+            size_t pix = (size_t)(py - f->y) * f->width + (px - f->x);
+            float *rec = j->acc->data + pix * SY_RT_ACC_STRIDE;
+            sy_rt_pt_record *prec = j->records ? j->records + pix : NULL;
             for (uint32_t k = 0; k < j->count; ++k) {
                 sy_rt_pt_sample s;
-                trace_sample(&c, px, py, j->first + k, &s);
+                trace_sample(&c, px, py, j->first + k, &s, k + 1u == j->count ? prec : NULL);
                 if (!sy_rt_accum_add(rec, j->first + k + 1u, &s)) bad++;
             }
         }
@@ -297,6 +349,7 @@ sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_de
     pt_job j;
     memset(&j, 0, sizeof j);
     j.acc = acc;
+    j.records = desc->records;
     j.first = acc->samples;
     j.count = count;
     sy_rt_sobol_init(&j.sobol);

@@ -154,6 +154,10 @@ static sy_rt_result validate_texref(const sy_rt_device *dev, sy_rt_texture_ref t
     if (t.texture.id != 0 && !sy_rt_pool_get(&dev->textures, t.texture.id))
         return FAIL(SY_RT_ERROR_INVALID_HANDLE, "material: %s handle 0x%08x is stale", name, t.texture.id);
     if (t.texcoord > 1) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material: %s.texcoord = %u, expected 0 or 1", name, t.texcoord);
+    if (t.transformed)
+        for (int k = 0; k < 6; ++k)
+            if (!isfinite(t.transform[k]))
+                return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material: %s.transform[%d] is not finite", name, k);
     return SY_RT_OK;
 }
 

@@ -26,8 +26,7 @@ static float base_alpha(const sy_rt_device *dev, const sy_rt_material_data *mat,
     const sy_rt_material_desc *d = &mat->desc;
     float c[4] = {d->base_color[0], d->base_color[1], d->base_color[2], d->base_color[3]};
     float t[4];
-    if (sy_rt_texture_sample_ref(dev, d->base_color_texture.texture, uv[d->base_color_texture.texcoord][0],
-                                 uv[d->base_color_texture.texcoord][1], t))
+    if (sy_rt_texture_sample_ref(dev, &d->base_color_texture, (const float(*)[2])uv, t))
         for (int k = 0; k < 4; ++k) c[k] *= t[k];
     if (m->colors) {
         float vc[4];
@@ -56,8 +55,7 @@ sy_rt_v3 sy_rt_surface_emission(const sy_rt_device *dev, const sy_rt_instance_da
     const uint32_t *ix = m->indices + 3u * prim;
     float uv[2][2], t[4];
     fetch_uv(m, ix, 1.0f - u - v, u, v, uv);
-    const float *c = uv[d->emissive_texture.texcoord];
-    if (sy_rt_texture_sample_ref(dev, d->emissive_texture.texture, c[0], c[1], t)) e = v3_mul(e, v3(t[0], t[1], t[2]));
+    if (sy_rt_texture_sample_ref(dev, &d->emissive_texture, (const float(*)[2])uv, t)) e = v3_mul(e, v3(t[0], t[1], t[2]));
     return e;
 }
 
@@ -71,12 +69,18 @@ static sy_rt_v3 apply_normal_map(const sy_rt_device *dev, const sy_rt_instance_d
     uint32_t s = d->normal_texture.texcoord;
     if (!m->uv[s]) return n;
     float t[4];
-    if (!sy_rt_texture_sample_ref(dev, d->normal_texture.texture, uv_set[s][0], uv_set[s][1], t)) return n;
+    if (!sy_rt_texture_sample_ref(dev, &d->normal_texture, uv_set, t)) return n;
     const float *uv = m->uv[s];
     sy_rt_v3 p0 = v3_load(m->positions + 3u * ix[0]);
     sy_rt_v3 dp1 = v3_sub(v3_load(m->positions + 3u * ix[1]), p0), dp2 = v3_sub(v3_load(m->positions + 3u * ix[2]), p0);
     float du1 = uv[2 * ix[1]] - uv[2 * ix[0]], dv1 = uv[2 * ix[1] + 1] - uv[2 * ix[0] + 1];
     float du2 = uv[2 * ix[2]] - uv[2 * ix[0]], dv2 = uv[2 * ix[2] + 1] - uv[2 * ix[0] + 1];
+    if (d->normal_texture.transformed) { /* derivatives of the transformed coordinates (linear part) */
+        const float *x = d->normal_texture.transform;
+        float a1 = x[0] * du1 + x[1] * dv1, b1 = x[3] * du1 + x[4] * dv1;
+        float a2 = x[0] * du2 + x[1] * dv2, b2 = x[3] * du2 + x[4] * dv2;
+        du1 = a1, dv1 = b1, du2 = a2, dv2 = b2;
+    }
     float det = du1 * dv2 - du2 * dv1;
     if (!(fabsf(det) > 1e-20f)) return n;
     float inv = 1.0f / det;
@@ -129,13 +133,13 @@ void sy_rt_surface_fetch(const sy_rt_device *dev, const sy_rt_instance_data *ins
     s->roughness = d->roughness;
     float t[4];
     const sy_rt_texture_ref *mr = &d->metallic_roughness_texture;
-    if (sy_rt_texture_sample_ref(dev, mr->texture, uv[mr->texcoord][0], uv[mr->texcoord][1], t)) {
+    if (sy_rt_texture_sample_ref(dev, mr, (const float(*)[2])uv, t)) {
         s->roughness *= t[1];
         s->metallic *= t[2];
     }
     s->emission = v3_load(d->emissive);
     const sy_rt_texture_ref *em = &d->emissive_texture;
-    if (mat->emissive && sy_rt_texture_sample_ref(dev, em->texture, uv[em->texcoord][0], uv[em->texcoord][1], t))
+    if (mat->emissive && sy_rt_texture_sample_ref(dev, em, (const float(*)[2])uv, t))
         s->emission = v3_mul(s->emission, v3(t[0], t[1], t[2]));
 }
 
@@ -172,7 +176,7 @@ sy_rt_v3 sy_rt_surface_eyelight(const sy_rt_device *dev, const sy_rt_instance_da
         if (em->texture.id != 0) {
             float t[4];
             fetch_uv(m, ix, w0, w1, w2, uv);
-            if (sy_rt_texture_sample_ref(dev, em->texture, uv[em->texcoord][0], uv[em->texcoord][1], t))
+            if (sy_rt_texture_sample_ref(dev, em, (const float(*)[2])uv, t))
                 e = v3_mul(e, v3(t[0], t[1], t[2]));
         }
         return e;

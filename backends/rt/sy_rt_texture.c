@@ -139,11 +139,27 @@ void sy_rt_texture_sample(const sy_rt_texture_data *t, float u, float v, float o
     }
 }
 
-bool sy_rt_texture_sample_ref(const sy_rt_device *dev, sy_rt_texture tex, float u, float v, float out[4])
+void sy_rt_texture_ref_uv(const sy_rt_texture_ref *ref, const float uv[2][2], float out[2])
 {
-    if (tex.id == 0) return false;
-    const sy_rt_texture_data *t = sy_rt_pool_get(&dev->textures, tex.id);
+    const float *c = uv[ref->texcoord & 1u];
+    if (!ref->transformed) {
+        out[0] = c[0];
+        out[1] = c[1];
+        return;
+    }
+    const float *m = ref->transform;
+    out[0] = m[0] * c[0] + m[1] * c[1] + m[2];
+    out[1] = m[3] * c[0] + m[4] * c[1] + m[5];
+}
+
+bool sy_rt_texture_sample_ref(const sy_rt_device *dev, const sy_rt_texture_ref *ref, const float uv[2][2],
+                              float out[4])
+{
+    if (ref->texture.id == 0) return false;
+    const sy_rt_texture_data *t = sy_rt_pool_get(&dev->textures, ref->texture.id);
     if (!t) return false;
-    sy_rt_texture_sample(t, u, v, out);
+    float c[2];
+    sy_rt_texture_ref_uv(ref, uv, c);
+    sy_rt_texture_sample(t, c[0], c[1], out);
     return true;
 }

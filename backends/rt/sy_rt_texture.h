@@ -19,8 +19,13 @@ typedef struct sy_rt_texture_data {
  * (grey is replicated to RGB, missing alpha is 1). */
 void sy_rt_texture_sample(const sy_rt_texture_data *tex, float u, float v, float out[4]);
 
-/* Looks up tex in dev and samples it; returns false (out untouched) for a zero/stale handle. */
-bool sy_rt_texture_sample_ref(const sy_rt_device *dev, sy_rt_texture tex, float u, float v, float out[4]);
+/* Looks up ref's texture in dev and samples it at ref's texture-coordinate set of uv (both sets of
+ * the hit point), through ref's transform; returns false (out untouched) for a zero/stale handle. */
+bool sy_rt_texture_sample_ref(const sy_rt_device *dev, const sy_rt_texture_ref *ref, const float uv[2][2],
+                              float out[4]);
+
+/* The texture coordinates ref reads at a hit point with coordinate sets uv (transform applied). */
+void sy_rt_texture_ref_uv(const sy_rt_texture_ref *ref, const float uv[2][2], float out[2]);
 
 /* Frees a texture object (pool removal is the caller's). */
 void sy_rt_texture_free(sy_rt_texture_data *tex);

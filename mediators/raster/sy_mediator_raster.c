@@ -32,7 +32,8 @@ static sy_result gl_fail(sy_error *err, sy_gl_result r, const char *what, const 
 /* >>mirror callbacks */
 static sy_gl_texture_ref texref(const raster_state *st, const sy_texture_ref *r)
 {
-    sy_gl_texture_ref o = {{sy_mirror_texture_handle(st->mirror, r->texture.id)}, r->texcoord};
+    sy_gl_texture_ref o = {{sy_mirror_texture_handle(st->mirror, r->texture.id)}, r->texcoord, false, {0}};
+    o.transformed = sy_texture_ref_matrix(r, o.transform);
     return o;
 }
 

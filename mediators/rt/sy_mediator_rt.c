@@ -12,6 +12,7 @@
 #include "sy_filter_atrous.h"
 #include "sy_filter_jbu.h"
 #include "sy_filter_pixel.h"
+#include "sy_radiance_hook.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -31,6 +32,7 @@ typedef struct accum_slot {
     uint64_t last_use;
     sy_filter_pixel *pixel;  /* pixel-filter state of this accumulation (display filter "pixel") */
     uint32_t pass_samples;   /* sample count of its last filter pass, 0 = none since the restart */
+    sy_radiance_hook *radiance; /* radiance-filter state of this accumulation (display filter "radiance") */
 } accum_slot;
 
 /* Display filter of the path tracer (backends/filters), applied to the returned layer only: the
@@ -41,9 +43,11 @@ typedef enum pt_filter_kind {
     PT_FILTER_ATROUS,
     PT_FILTER_JBU,
     PT_FILTER_ADAPTIVE,
+    PT_FILTER_RADIANCE, /* not a display filter: it needs the path records of every 1-spp pass */
     PT_FILTER_KIND_COUNT
 } pt_filter_kind;
-static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel", "atrous", "jbu", "adaptive"};
+static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel", "atrous", "jbu", "adaptive",
+                                                                   "radiance"};
 
 typedef struct pt_filter_cfg {
     pt_filter_kind kind;
@@ -51,6 +55,7 @@ typedef struct pt_filter_cfg {
     sy_filter_atrous_params atrous;
     sy_filter_jbu_params jbu;
     sy_filter_adaptive_params adaptive;
+    sy_filter_radiance_params radiance; /* threshold T_u = the shared threshold */
 } pt_filter_cfg;
 
 /* The scene mirror (textures, materials, meshes, lights, backgrounds, nodes and placements) is
@@ -110,7 +115,8 @@ static sy_result rt_fail(sy_error *err, sy_rt_result r, const char *what, const 
 /* >>mirror callbacks */
 static sy_rt_texture_ref texref(const rt_state *st, const sy_texture_ref *r)
 {
-    sy_rt_texture_ref o = {{sy_mirror_texture_handle(st->mirror, r->texture.id)}, r->texcoord};
+    sy_rt_texture_ref o = {{sy_mirror_texture_handle(st->mirror, r->texture.id)}, r->texcoord, false, {0}};
+    o.transformed = sy_texture_ref_matrix(r, o.transform);
     return o;
 }
 
@@ -277,6 +283,9 @@ static sy_result rt_sync(void *state, const sy_changes *changes, sy_error *err)
     st->counters.last_sync_placements = ms.placements;
     st->counters.last_sync_entries = ms.entries;
     if (ms.placements || ms.nodes_destroyed) st->needs_commit = true;
+    /* sy_rt_commit is a no-op on a clean device; a texture or material that no placement uses
+     * (yet) dirties the device too, and an uncommitted device refuses to render */
+    if (r == SY_OK && ms.entries) st->needs_commit = true;
     if (r == SY_OK && st->needs_commit) {
         char e[ERRLEN];
         sy_rt_result rr = sy_rt_commit(st->dev, e, sizeof e);
@@ -366,6 +375,7 @@ static sy_result pt_slot(rt_state *st, const sy_render_request *req, sy_error *e
             sy_rt_accum_reset(a->acc);
             st->counters.accum_restarts++;
             sy_filter_pixel_reset(a->pixel);
+            sy_radiance_hook_reset(a->radiance);
             a->pass_samples = 0;
         }
     } else {
@@ -384,6 +394,7 @@ static sy_result pt_slot(rt_state *st, const sy_render_request *req, sy_error *e
         }
         if (st->last_slot >= 0) st->counters.accum_restarts++;
         sy_filter_pixel_reset(a->pixel);
+        sy_radiance_hook_reset(a->radiance);
         a->pass_samples = 0;
         a->camera = req->camera;
         a->full_w = req->full_width;
@@ -518,8 +529,45 @@ static void filter_cfg_default(pt_filter_cfg *c, uint32_t threads)
     sy_filter_jbu_params_default(&c->jbu);
     sy_filter_adaptive_params_default(&c->adaptive);
     c->adaptive.threshold = c->pixel.threshold;
+    sy_filter_radiance_params_default(&c->radiance);
+    c->radiance.threshold = c->pixel.threshold;
     if (threads > SY_FILTER_MAX_THREADS) threads = SY_FILTER_MAX_THREADS;
-    c->pixel.threads = c->atrous.threads = c->jbu.threads = c->adaptive.threads = threads;
+    c->pixel.threads = c->atrous.threads = c->jbu.threads = c->adaptive.threads = c->radiance.threads = threads;
+}
+
+/* The radiance filter's own keys (rf_*), present ones only; ranges as sy_filter_radiance_params. */
+static sy_result radiance_cfg_apply(sy_filter_radiance_params *rp, const sy_params *p, sy_error *err)
+{
+    static const char *const kernels[] = {"epanechnikov", "silverman", "uniform", "gaussian"};
+    double v;
+    long l;
+    sy_result r;
+    if ((r = sy_params_get_int(p, "rf_warmup_frames", rp->warmup_frames, 0, 64, &l, err))) return r;
+    rp->warmup_frames = (uint32_t)l;
+    const struct { const char *key; float *v; double lo, hi; } fl[] = {
+        {"rf_warmup_radius", &rp->warmup_radius, 0.0, 128.0},     {"rf_max_radius", &rp->max_radius, 1.0, 128.0},
+        {"rf_prism_thickness", &rp->prism_thickness, 0.0, 100.0}, {"rf_grazing_epsilon", &rp->grazing_epsilon, 0.0, 1.0},
+        {"rf_glossy_limit", &rp->glossy_limit, 0.0, 1e9},         {"rf_specular_limit", &rp->specular_limit, 0.0, 1e9}};
+    for (size_t i = 0; i < sizeof fl / sizeof fl[0]; ++i) {
+        if ((r = sy_params_get_float(p, fl[i].key, *fl[i].v, fl[i].lo, fl[i].hi, &v, err))) return r;
+        *fl[i].v = (float)v;
+    }
+    const struct { const char *key; bool *v; } bl[] = {{"rf_ao", &rp->ambient_occlusion}, {"rf_unbiased", &rp->unbiased_switch}};
+    for (size_t i = 0; i < sizeof bl / sizeof bl[0]; ++i) {
+        if ((r = sy_params_get_int(p, bl[i].key, *bl[i].v, 0, 1, &l, err))) return r;
+        *bl[i].v = l != 0;
+    }
+    const char *kern = sy_params_get(p, "rf_kernel");
+    if (kern) {
+        int k = -1;
+        for (int i = 0; i < 4; ++i)
+            if (!strcmp(kern, kernels[i])) k = i;
+        if (k < 0)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "parameter rf_kernel=%s: expected epanechnikov, silverman, uniform or gaussian", kern);
+        rp->kernel = (sy_filter_rf_kernel)k;
+    }
+    return SY_OK;
 }
 
 /* New configuration = *base with the filter `name` (NULL: p's "filter", absent: unchanged) and the
@@ -534,21 +582,17 @@ static sy_result filter_cfg_apply(pt_filter_cfg *base, const char *name, const s
         int k = -1;
         for (int i = 0; i < PT_FILTER_KIND_COUNT; ++i)
             if (!strcmp(nm, pt_filter_names[i])) k = i;
-        if (k < 0 && !strcmp(nm, "radiance"))
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "pathtracer: filter=radiance is not available: needs the integrator's stored-sample hook "
-                                "(per-pixel incident radiance at the first non-specular hit), which the path tracer "
-                                "does not provide yet");
         if (k < 0)
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "pathtracer: unknown filter '%s' (expected none, pixel, atrous, jbu or adaptive)", nm);
+                                "pathtracer: unknown filter '%s' (expected none, pixel, atrous, jbu, adaptive or radiance)",
+                                nm);
         c.kind = (pt_filter_kind)k;
     }
     double v;
     long l;
     sy_result r;
     if ((r = sy_params_get_float(p, "threshold", c.pixel.threshold, 0.0, 1e6, &v, err))) return r;
-    c.pixel.threshold = c.adaptive.threshold = (float)v;
+    c.pixel.threshold = c.adaptive.threshold = c.radiance.threshold = (float)v;
     if ((r = sy_params_get_float(p, "sigma_s", c.pixel.sigma_s, 0.0, 1000.0, &v, err))) return r;
     c.pixel.sigma_s = (float)v;
     if ((r = sy_params_get_float(p, "sigma_c", c.pixel.sigma_c, 0.0, 1e6, &v, err))) return r;
@@ -571,10 +615,15 @@ static sy_result filter_cfg_apply(pt_filter_cfg *base, const char *name, const s
     c.atrous.iterations = (uint32_t)l;
     if ((r = sy_params_get_int(p, "jbu_factor", c.jbu.factor, 1, 64, &l, err))) return r;
     c.jbu.factor = (uint32_t)l;
+    if ((r = radiance_cfg_apply(&c.radiance, p, err))) return r;
+    /* the rf_* options are checked whatever the filter; T_u = threshold only matters for radiance */
+    sy_filter_radiance_params rq = c.radiance;
+    if (c.kind != PT_FILTER_RADIANCE && !(rq.threshold > 0.0f)) rq.threshold = 0.01f;
     sy_filter_error fe = {0};
     if (sy_filter_pixel_params_check(&c.pixel, &fe) || sy_filter_atrous_params_check(&c.atrous, &fe) ||
         sy_filter_jbu_params_check(&c.jbu, &fe) ||
-        (c.kind == PT_FILTER_ADAPTIVE && sy_filter_adaptive_params_check(&c.adaptive, &fe)))
+        (c.kind == PT_FILTER_ADAPTIVE && sy_filter_adaptive_params_check(&c.adaptive, &fe)) ||
+        sy_filter_radiance_params_check(&rq, &fe))
         return filter_fail(err, &fe);
     *base = c;
     return SY_OK;
@@ -603,6 +652,13 @@ sy_result sy_mediator_rt_set_filter(void *state, const char *name, const sy_para
             s->pass_samples = 0;
         }
     }
+    /* radiance: a switch to it or new options while it is on recreate the filter, which then
+     * resumes from the accumulation (sy_radiance_hook.h); other filters leave its state alone */
+    bool rf_changed = c.kind == PT_FILTER_RADIANCE &&
+                      (c.kind != st->filter.kind || memcmp(&st->filter.radiance, &c.radiance, sizeof c.radiance) != 0);
+    for (int i = 0; i < ACCUM_SLOTS && rf_changed; ++i)
+        if (st->slots[i].radiance && (r = sy_radiance_hook_set_params(st->slots[i].radiance, &c.radiance, err)) != SY_OK)
+            return r;
     st->filter = c;
     return SY_OK;
 }
@@ -634,10 +690,9 @@ static void filter_positions(const sy_render_request *req, const float *depth, f
         }
 }
 
-/* Filters the layer the path tracer just wrote (rectangle of the slot st->last_slot). */
-static sy_result filter_layer(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err)
+/* Reads the slot's feature buffers (rect_w x rect_h) into st->fbuf (the filters' inputs). */
+static sy_result filter_read_aovs(rt_state *st, const accum_slot *a, const sy_render_request *req, sy_error *err)
 {
-    accum_slot *a = &st->slots[st->last_slot];
     size_t n = (size_t)req->rect_w * req->rect_h;
     if (n > st->fbuf_px) {
         for (int k = 0; k <= SY_RT_AOV_COUNT; ++k) {
@@ -657,6 +712,15 @@ static sy_result filter_layer(rt_state *st, const sy_render_request *req, sy_lay
         sy_rt_result rr = sy_rt_accum_read(a->acc, (sy_rt_aov)k, st->fbuf[k], e, sizeof e);
         if (rr != SY_RT_OK) return rt_fail(err, rr, "pathtracer filter: feature buffers", e);
     }
+    return SY_OK;
+}
+
+/* Filters the layer the path tracer just wrote (rectangle of the slot st->last_slot). */
+static sy_result filter_layer(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err)
+{
+    accum_slot *a = &st->slots[st->last_slot];
+    sy_result rd = filter_read_aovs(st, a, req, err);
+    if (rd != SY_OK) return rd;
     filter_positions(req, st->fbuf[SY_RT_AOV_DEPTH], st->fbuf[SY_RT_AOV_COUNT]);
     uint32_t samples = sy_rt_accum_samples(a->acc);
     const float *m = req->camera.camera_to_world.m;
@@ -707,6 +771,63 @@ static sy_result filter_layer(rt_state *st, const sy_render_request *req, sy_lay
     return SY_OK;
 }
 
+/* >>radiance filter: not a display filter. Every sample of the request is its own 1-spp pass whose
+ * path records (the path tracer's stored-sample hook) feed one frame of the radiance filter
+ * (sy_radiance_hook.h); the accumulation still receives every sample, so "none" and the other
+ * filters show the same samples, and a switch to "radiance" resumes from the accumulation. */
+static sy_result radiance_render(rt_state *st, const sy_render_request *req, const sy_rt_camera *cam,
+                                 sy_rt_render_desc *d, sy_layer *layer, sy_error *err)
+{
+    accum_slot *a = &st->slots[st->last_slot];
+    sy_result r;
+    if (!a->radiance && (r = sy_radiance_hook_create(&st->filter.radiance, &a->radiance, err)) != SY_OK) return r;
+    sy_rt_pt_record *recs;
+    if ((r = sy_radiance_hook_records(a->radiance, req->rect_w, req->rect_h, &recs, err)) != SY_OK) return r;
+    const sy_camera_view *v = &req->camera;
+    bool ortho = v->projection == SY_PROJECTION_ORTHOGRAPHIC;
+    sy_radiance_hook_frame_desc fd = {.pixel_angle = (v->window[3] - v->window[2]) / (float)req->full_height,
+                                      .orthographic = ortho};
+    uint32_t prior = sy_rt_accum_samples(a->acc);
+    if (sy_radiance_hook_frame_index(a->radiance) == 0 && prior > 0) { /* resume on the accumulation */
+        if ((r = filter_read_aovs(st, a, req, err)) != SY_OK) return r;
+        fd.prior_samples = prior;
+        fd.prior_color = st->fbuf[SY_RT_AOV_COLOR];
+        fd.prior_color_channels = 4;
+        fd.prior_variance = st->fbuf[SY_RT_AOV_VARIANCE];
+        fd.prior_direct = st->fbuf[SY_RT_AOV_DIRECT];
+    }
+    uint32_t count = d->samples;
+    double secs = 0.0;
+    uint64_t bad = 0, rays = 0;
+    sy_filter_stats fs = {0};
+    char e[ERRLEN];
+    for (uint32_t i = 0; i < count; ++i) {
+        bool last = i + 1 == count;
+        d->samples = 1;
+        d->records = recs;
+        sy_rt_result rr = sy_rt_render(st->dev, cam, d, last ? layer->rgba : NULL, last ? layer->depth : NULL, e, sizeof e);
+        if (rr != SY_RT_OK) {
+            sy_radiance_hook_reset(a->radiance);
+            return rt_fail(err, rr, "render", e);
+        }
+        rays += sy_rt_accum_last_rays(d->accum);
+        if ((r = sy_radiance_hook_frame(a->radiance, &fd, last ? layer->rgba : NULL, &fs, err)) != SY_OK) return r;
+        fd.prior_samples = 0;
+        secs += fs.seconds;
+        bad += fs.nonfinite_samples;
+    }
+    st->counters.last_render_rays = rays;
+    st->frames_rendered++;
+    st->finfo.nonfinite_pixels = bad;
+    st->finfo.nonfinite_samples = sy_rt_accum_nonfinite(a->acc);
+    st->finfo.seconds = secs;
+    st->finfo.filter_pass = true;
+    st->finfo.mean_blend = fs.mean_blend; /* share of pixels in the correction phase (plain PT) */
+    st->finfo.last_pass_samples = sy_rt_accum_samples(a->acc);
+    st->finfo.frames += count;
+    return SY_OK;
+}
+
 static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     rt_state *st = state;
@@ -750,6 +871,7 @@ static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *
         if (pr != SY_OK) return pr;
         d.accum = st->slots[st->last_slot].acc;
         d.samples = req->sample_count ? req->sample_count : 1u;
+        if (st->filter.kind == PT_FILTER_RADIANCE) return radiance_render(st, req, &cam, &d, layer, err);
     }
     sy_rt_result r = sy_rt_render(st->dev, &cam, &d, layer->rgba, layer->depth, e, sizeof e);
     if (r != SY_RT_OK) return rt_fail(err, r, "render", e);
@@ -768,6 +890,7 @@ static void rt_destroy(void *state)
     for (int i = 0; i < ACCUM_SLOTS; ++i) {
         sy_rt_accum_destroy(st->slots[i].acc);
         sy_filter_pixel_destroy(st->slots[i].pixel);
+        sy_radiance_hook_destroy(st->slots[i].radiance);
     }
     for (int k = 0; k <= SY_RT_AOV_COUNT; ++k) free(st->fbuf[k]);
     sy_rt_device_destroy(st->dev);

@@ -70,10 +70,20 @@ uint32_t sy_mediator_rt_aov_channels(uint32_t index);  /* 4, 3, 3, 3, 1, 3, 3 */
  * tracer returns, computed from the accumulation's feature buffers; per accumulation slot (the
  * pixel filter's state restarts with the slot's accumulation). Display-only: changing the filter
  * or its options never restarts the accumulation. Parameters (at creation, the initial value):
- *   filter=none|pixel|atrous|jbu|adaptive (default none; "radiance" is refused: it needs the
- *     integrator's stored-sample hook, which does not exist yet)
- *   threshold=T   perceived-variance threshold t of the pixel filter's blend and of the adaptive
- *                 preview (default 0.01, >= 0; adaptive needs > 0)
+ *   filter=none|pixel|atrous|jbu|adaptive|radiance (default none). "radiance" (Schwenk 2013 ch. 4)
+ *     is not a pure display filter: it runs on the path tracer's stored-sample hook (per-pixel path
+ *     records, sy_radiance_hook.h); every sample of a request is its own 1-spp pass and filter
+ *     frame, the accumulation still receives every sample, and switching to it resumes from the
+ *     accumulation (seeded with its mean and variance)
+ *   threshold=T   perceived-variance threshold t of the pixel filter's blend, of the adaptive
+ *                 preview and the radiance filter's T_u (default 0.01, >= 0; adaptive and radiance
+ *                 need > 0)
+ *   rf_warmup_frames (0..64, default 4), rf_warmup_radius (pixels, > 0, default 8), rf_max_radius
+ *   (1..128, default 24), rf_kernel=epanechnikov|silverman|uniform|gaussian, rf_ao=0|1 (default 1),
+ *   rf_prism_thickness (prism half thickness / tangent extent, > 0, default 0.25),
+ *   rf_grazing_epsilon (> 0, default 0.1), rf_glossy_limit (default 128), rf_specular_limit
+ *   (default 4096), rf_unbiased=0|1 (show the plain path-traced mean in the correction phase,
+ *   default 0): the radiance filter's options, checked whatever the filter
  *   sigma_s (pixels, default 8), sigma_c (virtual-flash colour, default 0.02), sigma_d (depth, scene
  *   units, default 2): the pixel filter's cross-bilateral kernel (> 0)
  *   filter_kernel=separable|brute (default separable), filter_iterations (1..8, default 3),
@@ -89,11 +99,13 @@ typedef struct sy_mediator_rt_filter_info {
     const char *name;           /* current filter ("none", "pixel", ...), static storage */
     float threshold;            /* current threshold */
     uint64_t frames;            /* filtered frames so far */
-    uint64_t nonfinite_pixels;  /* last filtered frame: NaN/Inf input pixels kept out of neighbourhoods */
+    uint64_t nonfinite_pixels;  /* last filtered frame: NaN/Inf input pixels kept out of neighbourhoods
+                                   (radiance: NaN/Inf path records over the last render's passes) */
     uint64_t nonfinite_samples; /* last filtered accumulation: NaN/Inf samples the back-end replaced by 0 */
-    double seconds;             /* last filter call's wall time */
+    double seconds;             /* last filter call's wall time (radiance: its frames in the last render) */
     bool filter_pass;           /* pixel: a filter pass ran in the last frame */
-    double mean_blend;          /* pixel: mean blend factor s (1 = unfiltered everywhere) */
+    double mean_blend;          /* pixel: mean blend factor s (1 = unfiltered everywhere); radiance:
+                                   share of pixels in the correction phase (plain path tracing) */
     uint32_t last_pass_samples; /* pixel: sample count of the last filter pass (0 = none yet) */
 } sy_mediator_rt_filter_info;
 void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out);

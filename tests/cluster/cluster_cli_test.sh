@@ -41,6 +41,15 @@ grep -q "wrong secret" "$W/bad.err" || fail "client error does not name the reas
 for _ in $(seq 1 40); do grep -q "authentication failed: wrong secret" "$W/a.log" && break; sleep 0.05; done
 grep -q "authentication failed: wrong secret" "$W/a.log" || fail "server did not log the rejection"
 [ ! -e "$W/x.exr" ] || fail "an output file was written after a refused connection"
+sleep 0.3 # the servers refuse this address for 250 ms after a failed authentication (--auth-backoff-ms)
+
+# half-float tiles: accepted by the option parser and the servers; a bad value is a usage error
+"$SY" render demo -b whitted -w 120 -h 80 -o "$W/half.exr" --cluster "$URLS" --secret-file "$W/secret" \
+  --cluster-pixels half 2> "$W/client3.log" > /dev/null || fail "cluster render with --cluster-pixels half"
+[ -s "$W/half.exr" ] || fail "no image from the half-float cluster render"
+if "$SY" render demo -b whitted -o "$W/y.exr" --cluster "$URLS" --cluster-pixels double 2> /dev/null; then
+  fail "--cluster-pixels double was accepted"
+fi
 
 # multi-display: each server writes its column at the swap barrier
 "$SY" render demo -b whitted -w 120 -h 80 -o "$W/unused.exr" --cluster "$URLS" --secret-file "$W/secret" \

@@ -4,7 +4,10 @@
  * progressive double), wrong secrets are rejected with a logged reason, garbage / truncated /
  * oversized / wrong-version / out-of-order messages and change lists naming unknown handles are
  * rejected while the server keeps serving correct images, and a killed or stalled server loses its
- * tiles to the others within the same frame and rejoins with a snapshot.
+ * tiles to the others within the same frame and rejoins with a snapshot. Protocol 2: the blob cache
+ * (a returning client sends no payload; LRU eviction under a small budget), BLOB_REQUEST / BLOBS
+ * (wrong, unrequested and unexpected payloads), half tiles, the replica slot limit, two clients
+ * beside garbage / stalled / never-reading peers, and the authentication back-off.
  *
  *   test_cluster_net SERVER_EXE WORK_DIR
  * Every server is started with --max-lifetime and stopped with SIGTERM (SIGKILL after 5 s), and
@@ -19,11 +22,15 @@
 #include <nng/nng.h>
 #include <nng/protocol/reqrep0/req.h>
 
+#include <arpa/inet.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <netinet/in.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -46,8 +53,8 @@ static void sleep_ms(int ms)
     nanosleep(&ts, NULL);
 }
 
-/* port 0 = any free port */
-static int start_server(const char *secret, int port, server *out)
+/* port 0 = any free port; extra: NULL or up to 4 more "--option", "value" words, NULL-terminated */
+static int start_server_args(const char *secret, int port, const char *const *extra, server *out)
 {
     char pf[512], listen[64];
     snprintf(pf, sizeof pf, "%s/port%d", g_dir, ++g_serial);
@@ -61,11 +68,11 @@ static int start_server(const char *secret, int port, server *out)
         if (fd >= 0) dup2(fd, 2);
         char present[512];
         snprintf(present, sizeof present, "%s/present%d.raw", g_dir, g_serial);
-        if (secret)
-            execl(g_exe, g_exe, "--port-file", pf, "--listen", listen, "--secret", secret, "--max-lifetime", "120",
-                  "--present", present, (char *)NULL);
-        else execl(g_exe, g_exe, "--port-file", pf, "--listen", listen, "--max-lifetime", "120", "--present", present,
-                   (char *)NULL);
+        const char *args[24] = {g_exe, "--port-file", pf, "--listen", listen, "--max-lifetime", "120", "--present", present};
+        int n = 9;
+        if (secret) args[n++] = "--secret", args[n++] = secret;
+        for (int k = 0; extra && extra[k] && k < 8; ++k) args[n++] = extra[k];
+        execv(g_exe, (char *const *)args);
         _exit(127);
     }
     out->pid = pid;
@@ -92,6 +99,11 @@ static int start_server(const char *secret, int port, server *out)
     }
     fprintf(stderr, "server did not report its port\n");
     return 1;
+}
+
+static int start_server(const char *secret, int port, server *out)
+{
+    return start_server_args(secret, port, NULL, out);
 }
 
 static void stop_server(server *s)
@@ -395,16 +407,17 @@ static int test_cooperative(fixture *fx, server *s)
     return 0;
 }
 
-static int test_auth(fixture *fx, server *s)
+static int test_auth(fixture *fx, server *all)
 {
+    server *s = &all[2];
     sy_error e = {0};
-    sy_cluster_client *c = connect_all(fx, s, 1, "wrong", 5000, &e);
+    sy_cluster_client *c = connect_all(fx, s, 1, NULL, 5000, &e);
+    CHECK(c == NULL);
+    CHECK_MSG(strstr(e.message, "requires a shared secret") != NULL, "%s", e.message);
+    c = connect_all(fx, s, 1, "wrong", 5000, &e); /* (this address is then refused for 250 ms) */
     CHECK(c == NULL);
     CHECK_MSG(strstr(e.message, "wrong secret") != NULL, "%s", e.message);
     CHECK(log_contains(s, "rejected: authentication failed: wrong secret"));
-    c = connect_all(fx, s, 1, NULL, 5000, &e);
-    CHECK(c == NULL);
-    CHECK_MSG(strstr(e.message, "requires a shared secret") != NULL, "%s", e.message);
     return 0;
 }
 
@@ -431,42 +444,78 @@ static int raw_exchange(const server *s, const void *data, size_t size, char *re
     return 0;
 }
 
-/* HELLO then one more message on the same socket (no secret: no tags) */
-static int raw_session(const server *s, const sy_cluster_msg *second, char *reason, size_t cap)
+/* A HELLO as a raw client sends it first (sequence 1, untagged). */
+static sy_cluster_msg hello_msg(void)
+{
+    sy_cluster_msg m;
+    memset(&m, 0, sizeof m);
+    m.header.type = SY_CLUSTER_HELLO;
+    m.header.seq = 1;
+    strcpy(m.u.hello.name, "raw test");
+    return m;
+}
+
+static int send_frame(nng_socket sock, const sy_cluster_msg *m)
+{
+    sy_error e = {0};
+    sy_cluster_buf b = {0};
+    CHECK_OK(sy_cluster_encode(m, 0, &b, &e), e);
+    CHECK(nng_send(sock, b.data, b.size, 0) == 0);
+    sy_cluster_buf_free(&b);
+    return 0;
+}
+
+/* Sends one untagged frame; *type / why = the reply's type and ERROR reason ("" for another reply). */
+static int raw_call(nng_socket sock, const sy_cluster_msg *m, uint32_t *type, char *why, size_t cap)
+{
+    if (send_frame(sock, m)) return 1;
+    sy_error e = {0};
+    void *buf = NULL;
+    size_t n = 0;
+    CHECK(nng_recv(sock, &buf, &n, NNG_FLAG_ALLOC) == 0);
+    sy_cluster_msg r;
+    CHECK_OK(sy_cluster_decode(buf, n, NULL, &r, &e), e);
+    if (type) *type = r.header.type;
+    snprintf(why, cap, "%s", r.header.type == SY_CLUSTER_ERROR ? r.u.error.reason : "");
+    sy_cluster_msg_free(&r);
+    nng_free(buf, n);
+    return 0;
+}
+
+/* A raw session on a server without a secret (no tags): HELLO, then msgs[0..n) in turn (their
+ * sequence numbers are set here); types[i] / reasons[i] = reply i's type and ERROR reason ("" for
+ * another reply). */
+static int raw_steps(const server *s, sy_cluster_msg *msgs, int n, uint32_t *types, char (*reasons)[SY_CLUSTER_REASON_MAX])
 {
     nng_socket sock;
     CHECK(nng_req0_open(&sock) == 0);
     nng_socket_set_ms(sock, NNG_OPT_RECVTIMEO, 10000);
     CHECK(nng_dial(sock, s->url, NULL, 0) == 0);
-    sy_error e = {0};
-    sy_cluster_msg hello;
-    memset(&hello, 0, sizeof hello);
-    hello.header.type = SY_CLUSTER_HELLO;
-    hello.header.seq = 1;
-    strcpy(hello.u.hello.name, "raw test");
-    sy_cluster_buf b = {0};
-    CHECK_OK(sy_cluster_encode(&hello, 0, &b, &e), e);
-    CHECK(nng_send(sock, b.data, b.size, 0) == 0);
-    void *buf = NULL;
-    size_t n = 0;
-    CHECK(nng_recv(sock, &buf, &n, NNG_FLAG_ALLOC) == 0);
-    nng_free(buf, n);
-    b.size = 0;
-    CHECK_OK(sy_cluster_encode(second, 0, &b, &e), e);
-    CHECK(nng_send(sock, b.data, b.size, 0) == 0);
-    CHECK(nng_recv(sock, &buf, &n, NNG_FLAG_ALLOC) == 0);
-    sy_cluster_msg m;
-    CHECK_OK(sy_cluster_decode(buf, n, NULL, &m, &e), e);
-    snprintf(reason, cap, "%s", m.header.type == SY_CLUSTER_ERROR ? m.u.error.reason : "");
-    sy_cluster_msg_free(&m);
-    nng_free(buf, n);
-    sy_cluster_buf_free(&b);
+    sy_cluster_msg hello = hello_msg();
+    char why[SY_CLUSTER_REASON_MAX];
+    if (raw_call(sock, &hello, NULL, why, sizeof why)) return 1;
+    for (int i = 0; i < n; ++i) {
+        msgs[i].header.seq = (uint64_t)i + 2;
+        if (raw_call(sock, &msgs[i], &types[i], reasons[i], SY_CLUSTER_REASON_MAX)) return 1;
+    }
     nng_close(sock);
     return 0;
 }
 
-static int test_bad_messages(fixture *fx, server *s)
+/* HELLO then one more message on the same socket (no secret: no tags) */
+static int raw_session(const server *s, const sy_cluster_msg *second, char *reason, size_t cap)
 {
+    sy_cluster_msg m = *second;
+    uint32_t type;
+    char why[1][SY_CLUSTER_REASON_MAX];
+    if (raw_steps(s, &m, 1, &type, why)) return 1;
+    snprintf(reason, cap, "%s", why[0]);
+    return 0;
+}
+
+static int test_bad_messages(fixture *fx, server *all)
+{
+    server *s = &all[3];
     char why[SY_CLUSTER_REASON_MAX];
     uint8_t garbage[100];
     for (int i = 0; i < 100; ++i) garbage[i] = (uint8_t)(i * 37 + 11);
@@ -487,9 +536,9 @@ static int test_bad_messages(fixture *fx, server *s)
     CHECK_MSG(strstr(why, "announces"), "%s", why);
     b.size = 0;
     CHECK_OK(sy_cluster_encode(&hello, 0, &b, &e), e);
-    b.data[4] = 2;
+    b.data[4] = 1; /* a version-1 peer */
     if (raw_exchange(s, b.data, b.size, why, sizeof why)) return 1;
-    CHECK_MSG(strstr(why, "version 2"), "%s", why);
+    CHECK_MSG(strstr(why, "version 1, this peer speaks 2"), "%s", why);
     /* requests out of order: RENDER before HELLO; RENDER before any scene; non-snapshot first scene */
     sy_cluster_msg r;
     memset(&r, 0, sizeof r);
@@ -547,7 +596,7 @@ static int test_bad_messages(fixture *fx, server *s)
     free(data);
     sy_cluster_buf_free(&b);
     CHECK(log_contains(s, "rejected: cluster message: bad magic"));
-    CHECK(log_contains(s, "protocol version 2"));
+    CHECK(log_contains(s, "protocol version 1"));
     /* the server still renders correct images for a well-behaved client */
     sy_layer ref = {0}, out = {0};
     sy_camera_view view;
@@ -565,6 +614,399 @@ static int test_bad_messages(fixture *fx, server *s)
     sy_cluster_client_destroy(c);
     sy_layer_destroy(&ref);
     sy_layer_destroy(&out);
+    return 0;
+}
+
+/* ---- protocol 2: blob requests, half tiles, replica limits, several clients, auth back-off ---- */
+
+/* The common start of a sort-first test: the local whitted reference (and its view), an output
+ * layer, the frame, and a client of the first n servers (NULL with the reason printed). */
+static sy_cluster_client *sort_first_setup(fixture *fx, server *s, uint32_t n, const char *secret, sy_layer *ref,
+                                           sy_layer *out, sy_cluster_frame *f)
+{
+    sy_error e = {0};
+    sy_camera_view view;
+    if (local_render(fx, "whitted", SY_EYE_MONO, ref, &view) || sy_layer_create(fx->w, fx->h, out, &e) != SY_OK) {
+        fprintf(stderr, "setup: %s\n", e.message);
+        return NULL;
+    }
+    *f = make_frame(fx, SY_CLUSTER_SORT_FIRST, "whitted", &view);
+    sy_cluster_client *c = connect_all(fx, s, n, secret, 30000, &e);
+    if (!c) fprintf(stderr, "setup: %s\n", e.message);
+    return c;
+}
+
+/* A reconnecting client (and a second one with the same model) resends no blob payload: the
+ * server's cache answers the snapshot's hashes; the image stays bit-identical. */
+static int test_blob_cache(fixture *fx, server *s)
+{
+    sy_error e = {0};
+    sy_layer ref = {0}, out = {0};
+    sy_cluster_frame f;
+    sy_cluster_frame_stats st1, st2;
+    /* s[0] has seen the demo scene's blobs already (first test); server s[1] too. A new client: */
+    sy_cluster_client *c = sort_first_setup(fx, s, 1, "s3cret", &ref, &out, &f);
+    CHECK(c != NULL);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st1, &e), e);
+    sy_cluster_client_destroy(c);
+    c = connect_all(fx, s, 1, "s3cret", 30000, &e); /* and once more: a reconnect */
+    CHECK_MSG(c != NULL, "%s", e.message);
+    sy_layer_clear(&out);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st2, &e), e);
+    printf("blob cache: snapshot of a returning client %llu bytes, %llu of them blob payloads\n",
+           (unsigned long long)st2.scene_bytes, (unsigned long long)st2.blob_bytes);
+    CHECK_MSG(st1.blob_bytes == 0 && st2.blob_bytes == 0, "blob payloads resent: %llu, %llu",
+              (unsigned long long)st1.blob_bytes, (unsigned long long)st2.blob_bytes);
+    CHECK(st2.scene_bytes > 0 && st2.scene_bytes < 64 * 1024);
+    CHECK(same_region(&out, 0, &ref, fx->w, fx->h));
+    /* a new texture (no material uses it: the image stays the same): only its payload travels,
+     * once; then it goes away again */
+    sy_texture tex;
+    uint8_t px[4 * 4 * 4];
+    for (int i = 0; i < 64; ++i) px[i] = (uint8_t)(i * 13 + 7);
+    sy_blob *pb = NULL;
+    CHECK_OK(sy_blob_create_copy(px, sizeof px, &pb, &e), e);
+    CHECK_OK(sy_texture_create(fx->scene, "blob-cache-test", &tex, &e), e);
+    sy_image_info ii = {4, 4, 4, SY_PIXEL_U8_LINEAR};
+    CHECK_OK(sy_texture_set_image(fx->scene, tex, &ii, pb, &e), e);
+    sy_blob_release(pb);
+    CHECK_OK(sy_scene_commit(fx->scene, NULL, &e), e);
+    sy_layer_clear(&out);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st2, &e), e);
+    CHECK_MSG(st2.blob_bytes == sizeof px, "new texture: %llu payload bytes sent", (unsigned long long)st2.blob_bytes);
+    CHECK(same_region(&out, 0, &ref, fx->w, fx->h));
+    CHECK_OK(sy_object_destroy(fx->scene, SY_TYPE_TEXTURE, tex.id, &e), e);
+    CHECK_OK(sy_scene_commit(fx->scene, NULL, &e), e);
+    sy_layer_clear(&out);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st2, &e), e);
+    CHECK(st2.blob_bytes == 0 && same_region(&out, 0, &ref, fx->w, fx->h));
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&ref);
+    sy_layer_destroy(&out);
+    return 0;
+}
+
+static bool no_payloads(void *user, const sy_blob *b)
+{
+    (void)user, (void)b;
+    return false;
+}
+
+/* A blob cache smaller than the model: the first client sends every payload, a second one only
+ * what the LRU evicted (at least the model minus the budget, less than all of it); both images
+ * stay exact (a replica never depends on the cache). */
+static int test_blob_eviction(fixture *fx, server *unused)
+{
+    (void)unused;
+    const uint32_t budget = 50000;
+    char bs[16];
+    snprintf(bs, sizeof bs, "%u", budget);
+    const char *extra[] = {"--blob-cache-bytes", bs, NULL};
+    server sv;
+    memset(&sv, 0, sizeof sv);
+    if (start_server_args(NULL, 0, extra, &sv)) return 1;
+    sy_error e = {0};
+    sy_layer ref = {0}, out = {0};
+    sy_camera_view view;
+    if (local_render(fx, "whitted", SY_EYE_MONO, &ref, &view)) return 1;
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
+    sy_cluster_frame f = make_frame(fx, SY_CLUSTER_SORT_FIRST, "whitted", &view);
+    sy_cluster_frame_stats st[2];
+    for (int i = 0; i < 2; ++i) {
+        sy_cluster_client *c = connect_all(fx, &sv, 1, NULL, 30000, &e);
+        CHECK_MSG(c != NULL, "%s", e.message);
+        sy_layer_clear(&out);
+        CHECK_OK(sy_cluster_client_render(c, &f, &out, &st[i], &e), e);
+        CHECK(same_region(&out, 0, &ref, fx->w, fx->h));
+        sy_cluster_client_destroy(c);
+    }
+    printf("blob eviction: cache of %u bytes, first client sent %llu payload bytes, second %llu\n", budget,
+           (unsigned long long)st[0].blob_bytes, (unsigned long long)st[1].blob_bytes);
+    CHECK(st[0].blob_bytes > 2 * budget);
+    CHECK(st[1].blob_bytes >= st[0].blob_bytes - budget && st[1].blob_bytes < st[0].blob_bytes);
+    stop_server(&sv);
+    sy_layer_destroy(&ref);
+    sy_layer_destroy(&out);
+    return 0;
+}
+
+/* A snapshot of a one-texture scene serialised with its blob by hash only. */
+static int texture_snapshot(const uint8_t *px, size_t n, void **data, size_t *size, sy_hash128 *hash)
+{
+    sy_error e = {0};
+    sy_scene *sc = NULL;
+    sy_texture t;
+    sy_blob *b = NULL;
+    sy_changes *ch = NULL;
+    CHECK_OK(sy_scene_create(&sc, &e), e);
+    CHECK_OK(sy_texture_create(sc, "t", &t, &e), e);
+    CHECK_OK(sy_blob_create_copy(px, n, &b, &e), e);
+    *hash = sy_blob_hash(b);
+    sy_image_info ii = {(uint32_t)n / 4, 1, 4, SY_PIXEL_U8_LINEAR};
+    CHECK_OK(sy_texture_set_image(sc, t, &ii, b, &e), e);
+    sy_blob_release(b);
+    CHECK_OK(sy_scene_commit(sc, NULL, &e), e);
+    CHECK_OK(sy_scene_snapshot(sc, &ch, &e), e);
+    CHECK_OK(sy_changes_serialize(ch, no_payloads, NULL, data, size, &e), e);
+    sy_changes_release(ch);
+    sy_scene_destroy(sc);
+    return 0;
+}
+
+/* BLOB_REQUEST / BLOBS on the wire: the server names exactly the missing hash, refuses a wrong
+ * payload, a blob it did not ask for and BLOBS without a pending scene, and accepts the right one. */
+static int test_blob_requests(fixture *fx, server *s)
+{
+    (void)fx;
+    uint8_t px[64];
+    for (int i = 0; i < 64; ++i) px[i] = (uint8_t)(i * 29 + 3 + (int)getpid());
+    void *data = NULL;
+    size_t size = 0;
+    sy_hash128 h;
+    if (texture_snapshot(px, sizeof px, &data, &size, &h)) return 1;
+    sy_cluster_msg m[3];
+    memset(m, 0, sizeof m);
+    m[0].header.type = SY_CLUSTER_SCENE;
+    m[0].u.scene = (__typeof__(m[0].u.scene)){5, SY_CLUSTER_SCENE_SNAPSHOT, data, (uint32_t)size};
+    uint8_t wrong[64];
+    memcpy(wrong, px, 64);
+    wrong[17] ^= 1;
+    sy_cluster_blob_ref bad = {h, 64, wrong}, good = {h, 64, px}, other = {sy_hash_bytes(px, 63), 63, px};
+    m[1].header.type = SY_CLUSTER_BLOBS;
+    m[1].u.blobs = (__typeof__(m[1].u.blobs)){5, 1, &bad};
+    uint32_t types[3];
+    char why[3][SY_CLUSTER_REASON_MAX];
+    if (raw_steps(&s[3], m, 2, types, why)) return 1;
+    CHECK_MSG(types[0] == SY_CLUSTER_BLOB_REQUEST, "SCENE answered with %s (%s)", sy_cluster_msg_type_name(types[0]),
+              why[0]);
+    CHECK_MSG(types[1] == SY_CLUSTER_ERROR && strstr(why[1], "does not match its hash"), "wrong payload: %s", why[1]);
+    CHECK(log_contains(&s[3], "payload does not match its hash"));
+    /* a blob that was not asked for; then BLOBS with nothing pending */
+    m[1].u.blobs.blobs = &other;
+    m[2] = m[1];
+    if (raw_steps(&s[3], m, 3, types, why)) return 1;
+    CHECK_MSG(types[1] == SY_CLUSTER_ERROR && strstr(why[1], "was not requested"), "%s", why[1]);
+    CHECK_MSG(types[2] == SY_CLUSTER_ERROR && strstr(why[2], "without a SCENE"), "%s", why[2]);
+    /* the right payload: applied; the next session's SCENE needs no BLOBS */
+    m[1].u.blobs.blobs = &good;
+    if (raw_steps(&s[3], m, 2, types, why)) return 1;
+    CHECK_MSG(types[0] == SY_CLUSTER_BLOB_REQUEST && types[1] == SY_CLUSTER_SCENE_ACK, "%s / %s", why[0], why[1]);
+    if (raw_steps(&s[3], m, 1, types, why)) return 1;
+    CHECK_MSG(types[0] == SY_CLUSTER_SCENE_ACK, "cached blob requested again (%s)", why[0]);
+    free(data);
+    return 0;
+}
+
+/* Half tiles: every pixel is the binary16 rounding of the local float render (so within half
+ * precision of it), infinite depth stays infinite, and fewer bytes travel. */
+static int test_half_tiles(fixture *fx, server *s)
+{
+    sy_error e = {0};
+    sy_layer ref = {0}, out = {0};
+    sy_cluster_frame f;
+    sy_cluster_client *c = sort_first_setup(fx, s, 2, "s3cret", &ref, &out, &f);
+    CHECK(c != NULL);
+    sy_cluster_frame_stats sf, sh;
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &sf, &e), e); /* float: snapshot + tiles */
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &sf, &e), e); /* float: tiles only */
+    f.half = true;
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &sh, &e), e);
+    size_t n = (size_t)fx->w * fx->h, infs = 0;
+    double maxrel = 0;
+    for (size_t i = 0; i < n * 4; ++i) {
+        float want = sy_cluster_half_to_float(sy_cluster_half_from_float(ref.rgba[i]));
+        CHECK_MSG(memcmp(&want, &out.rgba[i], 4) == 0, "value %zu: %g, expected %g (from %g)", i, (double)out.rgba[i],
+                  (double)want, (double)ref.rgba[i]);
+        if (fabsf(ref.rgba[i]) >= 0x1p-14f) {
+            double rel = fabs((double)out.rgba[i] - ref.rgba[i]) / fabs((double)ref.rgba[i]);
+            if (rel > maxrel) maxrel = rel;
+        }
+    }
+    for (size_t i = 0; i < n; ++i) {
+        CHECK(out.depth[i] == sy_cluster_half_to_float(sy_cluster_half_from_float(ref.depth[i])));
+        if (isinf(ref.depth[i])) CHECK(isinf(out.depth[i]) && ++infs);
+    }
+    printf("half tiles: max relative error %.2e (bound 2^-11 = %.2e), %zu infinite depths kept, %llu bytes back "
+           "vs %llu for float\n",
+           maxrel, 0x1p-11, infs, (unsigned long long)sh.bytes_received, (unsigned long long)sf.bytes_received);
+    CHECK(maxrel <= 0x1p-11 && sh.bytes_received < sf.bytes_received);
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&ref);
+    sy_layer_destroy(&out);
+    return 0;
+}
+
+/* A change list naming slot index 3M: refused by the replica's limit (logged, nothing allocated),
+ * and the server still renders correct images. */
+static int test_slot_limit(fixture *fx, server *s)
+{
+    sy_error e = {0};
+    sy_scene *sc = NULL;
+    sy_node nd;
+    sy_changes *ch = NULL;
+    void *data = NULL;
+    size_t size = 0;
+    CHECK_OK(sy_scene_create(&sc, &e), e);
+    CHECK_OK(sy_node_create(sc, NULL, &nd, &e), e);
+    CHECK_OK(sy_scene_commit(sc, NULL, &e), e);
+    CHECK_OK(sy_scene_snapshot(sc, &ch, &e), e);
+    CHECK_OK(sy_changes_serialize(ch, NULL, NULL, &data, &size, &e), e);
+    sy_changes_release(ch);
+    sy_scene_destroy(sc);
+    /* header 32 bytes, no blobs, then the entry {u8 type, u8 flags, u16 0, u32 id}: the id at 36 */
+    uint32_t id;
+    memcpy(&id, (uint8_t *)data + 36, 4);
+    CHECK(id == nd.id);
+    id = (1u << SY_HANDLE_INDEX_BITS) | 3000000u;
+    memcpy((uint8_t *)data + 36, &id, 4);
+    sy_cluster_msg m;
+    memset(&m, 0, sizeof m);
+    m.header.type = SY_CLUSTER_SCENE;
+    m.u.scene = (__typeof__(m.u.scene)){1, SY_CLUSTER_SCENE_SNAPSHOT, data, (uint32_t)size};
+    char why[SY_CLUSTER_REASON_MAX];
+    if (raw_session(&s[3], &m, why, sizeof why)) return 1;
+    CHECK_MSG(strstr(why, "slot index 3000000 exceeds this replica's limit of 1048576"), "%s", why);
+    CHECK(log_contains(&s[3], "exceeds this replica's limit"));
+    free(data);
+    sy_layer ref = {0}, out = {0};
+    sy_cluster_frame f;
+    sy_cluster_client *c = sort_first_setup(fx, &s[3], 1, NULL, &ref, &out, &f);
+    CHECK(c != NULL);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, NULL, &e), e);
+    CHECK(same_region(&out, 0, &ref, fx->w, fx->h));
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&ref);
+    sy_layer_destroy(&out);
+    return 0;
+}
+
+typedef struct spewer {
+    const server *s;
+    volatile int stop;
+    int replies, failures;
+} spewer;
+
+/* sends garbage frames on one connection as fast as the server answers them */
+static void *spew(void *p)
+{
+    spewer *sp = p;
+    nng_socket sock;
+    if (nng_req0_open(&sock) != 0) return NULL;
+    nng_socket_set_ms(sock, NNG_OPT_RECVTIMEO, 20000);
+    if (nng_dial(sock, sp->s->url, NULL, 0) != 0) {
+        sp->failures++;
+        nng_close(sock);
+        return NULL;
+    }
+    uint8_t junk[512];
+    for (uint32_t k = 0; !sp->stop && k < 100000; ++k) {
+        for (size_t i = 0; i < sizeof junk; ++i) junk[i] = (uint8_t)(k * 131 + i * 7);
+        void *buf = NULL;
+        size_t n = 0;
+        if (nng_send(sock, junk, sizeof junk, 0) != 0 || nng_recv(sock, &buf, &n, NNG_FLAG_ALLOC) != 0) {
+            sp->failures++;
+            break;
+        }
+        nng_free(buf, n);
+        sp->replies++;
+    }
+    nng_close(sock);
+    return NULL;
+}
+
+/* Two well-behaved clients keep rendering correct frames while another connection spews garbage,
+ * one sent half a frame and stalled, and one sent HELLO and never reads a reply. */
+static int test_several_clients(fixture *fx, server *s)
+{
+    sy_error e = {0};
+    const server *srv = &s[3];
+    /* a stalled TCP peer: half a header, then silence */
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)srv->port)};
+    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    CHECK(fd >= 0 && connect(fd, (struct sockaddr *)&sa, sizeof sa) == 0);
+    CHECK(write(fd, "\0\0\0\0SP", 6) == 6);
+    /* a peer that asks and never reads */
+    nng_socket mute;
+    CHECK(nng_req0_open(&mute) == 0);
+    CHECK(nng_dial(mute, srv->url, NULL, 0) == 0);
+    sy_cluster_msg hello = hello_msg();
+    if (send_frame(mute, &hello)) return 1;
+    spewer sp = {srv, 0, 0, 0};
+    pthread_t th;
+    CHECK(pthread_create(&th, NULL, spew, &sp) == 0);
+    sy_layer ref = {0}, out1 = {0}, out2 = {0};
+    sy_cluster_frame f;
+    sy_cluster_client *c1 = sort_first_setup(fx, (server *)srv, 1, NULL, &ref, &out1, &f);
+    sy_cluster_client *c2 = c1 ? connect_all(fx, (server *)srv, 1, NULL, 30000, &e) : NULL;
+    CHECK_MSG(c1 && c2, "%s", e.message);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &out2, &e), e);
+    int before = sp.replies;
+    for (int i = 0; i < 3; ++i) {
+        sy_layer_clear(&out1);
+        sy_layer_clear(&out2);
+        CHECK_OK(sy_cluster_client_render(c1, &f, &out1, NULL, &e), e);
+        CHECK_OK(sy_cluster_client_render(c2, &f, &out2, NULL, &e), e);
+        CHECK_MSG(same_region(&out1, 0, &ref, fx->w, fx->h) && same_region(&out2, 0, &ref, fx->w, fx->h),
+                  "frame %d differs with a garbage peer and stalled peers connected", i);
+    }
+    int during = sp.replies - before;
+    sp.stop = 1;
+    pthread_join(th, NULL);
+    printf("several clients: 2 clients x 3 correct frames while a peer got %d garbage replies (%d during the frames)\n",
+           sp.replies, during);
+    CHECK_MSG(sp.failures == 0 && sp.replies > 0, "garbage peer: %d replies, %d failures", sp.replies, sp.failures);
+    CHECK(log_contains(srv, "bad magic"));
+    sy_cluster_client_destroy(c1);
+    sy_cluster_client_destroy(c2);
+    nng_close(mute);
+    close(fd);
+    sy_layer_destroy(&ref);
+    sy_layer_destroy(&out1);
+    sy_layer_destroy(&out2);
+    return 0;
+}
+
+/* Failed authentications: two sessions opened before any failure send wrong proofs: the address
+ * is refused for 1000 ms, then 2000 ms (the reasons say so), even with the right secret; after
+ * the window the right secret works again. */
+static int test_auth_backoff(fixture *fx, server *unused)
+{
+    (void)unused;
+    server sv;
+    memset(&sv, 0, sizeof sv);
+    const char *extra[] = {"--auth-backoff-ms", "1000", NULL};
+    if (start_server_args("s3cret", 0, extra, &sv)) return 1;
+    sy_error e = {0};
+    nng_socket sock[2];
+    char why[2][SY_CLUSTER_REASON_MAX];
+    sy_cluster_msg m;
+    for (int i = 0; i < 2; ++i) { /* both past HELLO before the first failure */
+        CHECK(nng_req0_open(&sock[i]) == 0);
+        nng_socket_set_ms(sock[i], NNG_OPT_RECVTIMEO, 10000);
+        CHECK(nng_dial(sock[i], sv.url, NULL, 0) == 0);
+        m = hello_msg();
+        if (raw_call(sock[i], &m, NULL, why[i], sizeof why[i])) return 1;
+        CHECK_MSG(why[i][0] == 0, "HELLO refused: %s", why[i]);
+    }
+    for (int i = 0; i < 2; ++i) {
+        memset(&m, 0, sizeof m);
+        m.header.type = SY_CLUSTER_AUTH;
+        m.header.seq = 2;
+        if (raw_call(sock[i], &m, NULL, why[i], sizeof why[i])) return 1;
+        nng_close(sock[i]);
+    }
+    CHECK_MSG(strstr(why[0], "wrong secret (127.0.0.1 refused for 1000 ms)"), "%s", why[0]);
+    CHECK_MSG(strstr(why[1], "wrong secret (127.0.0.1 refused for 2000 ms)"), "%s", why[1]);
+    sy_cluster_client *c = connect_all(fx, &sv, 1, "s3cret", 5000, &e);
+    CHECK(c == NULL);
+    CHECK_MSG(strstr(e.message, "throttled: too many failed authentications from 127.0.0.1, retry in"), "%s", e.message);
+    CHECK(log_contains(&sv, "throttled"));
+    sleep_ms(2100);
+    c = connect_all(fx, &sv, 1, "s3cret", 5000, &e);
+    CHECK_MSG(c != NULL, "after the back-off: %s", e.message);
+    sy_cluster_client_destroy(c);
+    stop_server(&sv);
     return 0;
 }
 
@@ -654,19 +1096,27 @@ int main(int argc, char **argv)
         start_server(NULL, 0, &s[3])) {
         failed = 1;
     } else {
-        int r;
-        failed += r = test_sort_first_balanced_stereo(&fx, s);
-        printf("sort-first / balanced / stereo: %s\n", r ? "FAILED" : "ok");
-        failed += r = test_cooperative(&fx, s);
-        printf("cooperative merge: %s\n", r ? "FAILED" : "ok");
-        failed += r = test_cooperative_pathtracer(&fx, s);
-        printf("cooperative pathtracer: %s\n", r ? "FAILED" : "ok");
-        failed += r = test_auth(&fx, &s[2]);
-        printf("authentication: %s\n", r ? "FAILED" : "ok");
-        failed += r = test_bad_messages(&fx, &s[3]);
-        printf("bad messages: %s\n", r ? "FAILED" : "ok");
-        failed += r = test_faults(&fx, s);
-        printf("faults: %s\n", r ? "FAILED" : "ok");
+        static const struct {
+            const char *name;
+            int (*run)(fixture *, server *);
+        } tests[] = {{"sort-first / balanced / stereo", test_sort_first_balanced_stereo},
+                     {"cooperative merge", test_cooperative},
+                     {"cooperative pathtracer", test_cooperative_pathtracer},
+                     {"authentication", test_auth},
+                     {"bad messages", test_bad_messages},
+                     {"blob cache", test_blob_cache},
+                     {"blob eviction", test_blob_eviction},
+                     {"blob requests", test_blob_requests},
+                     {"half tiles", test_half_tiles},
+                     {"replica slot limit", test_slot_limit},
+                     {"several clients", test_several_clients},
+                     {"authentication back-off", test_auth_backoff},
+                     {"faults", test_faults}};
+        for (size_t i = 0; i < sizeof tests / sizeof tests[0]; ++i) {
+            int r = tests[i].run(&fx, s);
+            failed += r;
+            printf("%s: %s\n", tests[i].name, r ? "FAILED" : "ok");
+        }
     }
     for (int i = 0; i < 4; ++i) stop_server(&s[i]);
     sy_context_pool_destroy(fx.pool);

@@ -6,6 +6,7 @@
 #include "../core/check.h"
 #include "sy_cluster.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -21,6 +22,7 @@ static uint32_t rnd(void)
 static sy_cluster_rect g_tiles[3] = {{0, 0, 64, 10}, {0, 10, 64, 20}, {10, 30, 5, 2}};
 static uint8_t g_payload[100];
 static sy_cluster_tile g_rtiles[2];
+static sy_cluster_blob_ref g_blobs[2];
 
 /* A valid message of each type. */
 static sy_cluster_msg sample(uint32_t type)
@@ -87,6 +89,14 @@ static sy_cluster_msg sample(uint32_t type)
         m.u.error.code = SY_ERR_PROTOCOL;
         strcpy(m.u.error.reason, "nope");
         break;
+    case SY_CLUSTER_BLOB_REQUEST:
+    case SY_CLUSTER_BLOBS:
+        m.u.blobs.frame = 11;
+        m.u.blobs.count = 2;
+        g_blobs[0] = (sy_cluster_blob_ref){sy_hash_bytes(g_payload, 30), 30, g_payload};
+        g_blobs[1] = (sy_cluster_blob_ref){sy_hash_bytes(g_payload + 30, 0), 0, g_payload + 30};
+        m.u.blobs.blobs = g_blobs;
+        break;
     default: break;
     }
     return m;
@@ -117,6 +127,12 @@ static int test_round_trip(void)
             CHECK(d.u.tiles.tiles[1].data == b.data + (b.size - 5));
         }
         if (t == SY_CLUSTER_ERROR) CHECK(!strcmp(d.u.error.reason, "nope") && d.u.error.code == SY_ERR_PROTOCOL);
+        if (t == SY_CLUSTER_BLOB_REQUEST || t == SY_CLUSTER_BLOBS) {
+            CHECK(d.u.blobs.frame == 11 && d.u.blobs.count == 2 && d.u.blobs.blobs[0].size == 30);
+            CHECK(sy_hash_equal(d.u.blobs.blobs[0].hash, g_blobs[0].hash) && d.u.blobs.blobs[1].size == 0);
+            if (t == SY_CLUSTER_BLOBS) CHECK(memcmp(d.u.blobs.blobs[0].data, g_payload, 30) == 0);
+            else CHECK(d.u.blobs.blobs[0].data == NULL && b.size == SY_CLUSTER_HEADER_SIZE + 12 + 2 * 24);
+        }
         sy_cluster_msg_free(&d);
         /* every truncation is rejected */
         for (size_t n = 0; n < b.size; ++n) {
@@ -147,9 +163,9 @@ static int test_bad_headers(void)
     CHECK(strstr(e.message, "magic"));
     /* wrong version */
     memcpy(c, b.data, b.size);
-    c[4] = 2;
+    c[4] = 1; /* a version-1 peer */
     CHECK_ERR(sy_cluster_decode(c, b.size, NULL, &d, &e), SY_ERR_UNSUPPORTED, e);
-    CHECK(strstr(e.message, "version 2"));
+    CHECK(strstr(e.message, "version 1, this peer speaks 2"));
     /* unknown type, unknown flags */
     memcpy(c, b.data, b.size);
     c[6] = 200;
@@ -190,6 +206,40 @@ static int test_bad_headers(void)
     b.size = 0;
     CHECK_OK(sy_cluster_encode(&tm, 0, &b, &e), e);
     CHECK_ERR(sy_cluster_decode(b.data, b.size, NULL, &d, &e), SY_ERR_PARSE, e);
+    g_rtiles[0].raw_size = 64;
+    /* a half tile's raw size is w * h * channels * 2; an unknown encoding is refused */
+    g_rtiles[0].encoding = SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD;
+    b.size = 0;
+    CHECK_OK(sy_cluster_encode(&tm, 0, &b, &e), e);
+    CHECK_ERR(sy_cluster_decode(b.data, b.size, NULL, &d, &e), SY_ERR_PARSE, e);
+    g_rtiles[0].raw_size = 32;
+    b.size = 0;
+    CHECK_OK(sy_cluster_encode(&tm, 0, &b, &e), e);
+    CHECK_OK(sy_cluster_decode(b.data, b.size, NULL, &d, &e), e);
+    sy_cluster_msg_free(&d);
+    g_rtiles[0].encoding = 3;
+    b.size = 0;
+    CHECK_OK(sy_cluster_encode(&tm, 0, &b, &e), e);
+    CHECK_ERR(sy_cluster_decode(b.data, b.size, NULL, &d, &e), SY_ERR_UNSUPPORTED, e);
+    g_rtiles[0] = (sy_cluster_tile){{0, 0, 2, 2}, SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD, 4, 64, g_payload, 10};
+    /* blob lists: count 0, a count the body cannot hold, a payload that runs past the end */
+    sy_cluster_msg bm = sample(SY_CLUSTER_BLOBS);
+    bm.u.blobs.count = 0;
+    CHECK(sy_cluster_encode(&bm, 0, &b, &e) != SY_OK);
+    bm.u.blobs.count = 2;
+    b.size = 0;
+    CHECK_OK(sy_cluster_encode(&bm, 0, &b, &e), e);
+    memcpy(c, b.data, b.size < 200 ? b.size : 200);
+    put32(c + SY_CLUSTER_HEADER_SIZE + 8, 5000);
+    CHECK_ERR(sy_cluster_decode(c, b.size, NULL, &d, &e), SY_ERR_PARSE, e);
+    CHECK(strstr(e.message, "truncated blob list"));
+    memcpy(c, b.data, b.size);
+    put32(c + SY_CLUSTER_HEADER_SIZE + 12 + 16, 31); /* first blob claims 31 bytes: the rest shifts */
+    CHECK(sy_cluster_decode(c, b.size, NULL, &d, &e) != SY_OK);
+    memcpy(c, b.data, b.size);
+    put32(c + SY_CLUSTER_HEADER_SIZE + 12 + 16, 0xFFFFFF00u);
+    CHECK_ERR(sy_cluster_decode(c, b.size, NULL, &d, &e), SY_ERR_PARSE, e);
+    CHECK(strstr(e.message, "runs past"));
     free(c);
     sy_cluster_buf_free(&b);
     return 0;
@@ -211,8 +261,13 @@ static int check_accepted(const sy_cluster_msg *d, const uint8_t *buf, size_t si
         for (uint32_t i = 0; i < d->u.tiles.tile_count; ++i) {
             const sy_cluster_tile *t = &d->u.tiles.tiles[i];
             CHECK(t->data >= buf && t->data + t->data_size <= buf + size);
-            CHECK(t->raw_size == (uint64_t)t->rect.w * t->rect.h * t->channels * 4);
+            CHECK(t->raw_size == (uint64_t)t->rect.w * t->rect.h * t->channels * sy_cluster_encoding_bytes(t->encoding));
         }
+    if (d->header.type == SY_CLUSTER_BLOBS || d->header.type == SY_CLUSTER_BLOB_REQUEST) {
+        CHECK(d->u.blobs.count >= 1 && d->u.blobs.count <= SY_CLUSTER_MAX_BLOBS);
+        for (uint32_t i = 0; i < d->u.blobs.count && d->header.type == SY_CLUSTER_BLOBS; ++i)
+            CHECK(d->u.blobs.blobs[i].data >= buf && d->u.blobs.blobs[i].data + d->u.blobs.blobs[i].size <= buf + size);
+    }
     if (d->header.type == SY_CLUSTER_SCENE)
         CHECK(d->u.scene.changes >= buf && d->u.scene.changes + d->u.scene.changes_size <= buf + size);
     return 0;
@@ -296,13 +351,223 @@ static int test_tile_codec(void)
     return 0;
 }
 
-int main(void)
+static float f_bits(uint32_t u)
 {
+    float f;
+    memcpy(&f, &u, 4);
+    return f;
+}
+
+/* binary16: every half survives half -> float -> half exactly (NaNs stay NaN with their sign and
+ * payload, quieted); float -> half rounds to nearest even at every boundary; overflow, underflow,
+ * infinities; and (gcc, x86-64) agreement with the compiler's _Float16 conversion on 4M floats. */
+static int test_half(void)
+{
+    uint32_t nans = 0;
+    for (uint32_t h = 0; h < 65536; ++h) {
+        float f = sy_cluster_half_to_float((uint16_t)h);
+        uint16_t back = sy_cluster_half_from_float(f);
+        bool nan = (h & 0x7c00u) == 0x7c00u && (h & 0x3ffu);
+        if (nan) {
+            nans++;
+            CHECK_MSG(isnan(f) && back == (h | 0x200u), "NaN %04x -> %04x", h, back);
+        } else {
+            CHECK_MSG(back == h, "half %04x -> %g -> %04x", h, (double)f, back);
+        }
+        /* the float value is exact: compare with the formula */
+        uint32_t ex = (h >> 10) & 31u, m = h & 0x3ffu;
+        if (ex != 31) {
+            double v = ex ? ldexp(1.0 + m / 1024.0, (int)ex - 15) : ldexp((double)m, -24);
+            if (h & 0x8000u) v = -v;
+            CHECK_MSG((double)f == v && !!signbit(f) == !!(h & 0x8000u), "half %04x = %g, expected %g", h, (double)f, v);
+        }
+    }
+    CHECK(nans == 2 * 1023);
+    /* rounding: ties to even, just above / below the ties, normal and subnormal */
+    CHECK(sy_cluster_half_from_float(1.0f) == 0x3c00);
+    CHECK(sy_cluster_half_from_float(1.0f + 0x1p-11f) == 0x3c00);          /* tie, even stays */
+    CHECK(sy_cluster_half_from_float(1.0f + 3 * 0x1p-11f) == 0x3c02);      /* tie, odd rounds up */
+    CHECK(sy_cluster_half_from_float(nextafterf(1.0f + 0x1p-11f, 2)) == 0x3c01);
+    CHECK(sy_cluster_half_from_float(nextafterf(1.0f + 3 * 0x1p-11f, 0)) == 0x3c01);
+    CHECK(sy_cluster_half_from_float(2047.0f / 1024.0f * 1.0f + 0x1p-11f) == 0x4000); /* carry into the exponent */
+    CHECK(sy_cluster_half_from_float(65504.0f) == 0x7bff);
+    CHECK(sy_cluster_half_from_float(65519.996f) == 0x7bff);
+    CHECK(sy_cluster_half_from_float(65520.0f) == 0x7c00); /* the tie above the largest half is inf */
+    CHECK(sy_cluster_half_from_float(-1e10f) == 0xfc00);
+    CHECK(sy_cluster_half_from_float(INFINITY) == 0x7c00 && sy_cluster_half_from_float(-INFINITY) == 0xfc00);
+    CHECK((sy_cluster_half_from_float(NAN) & 0x7e00) == 0x7e00);
+    CHECK(sy_cluster_half_from_float(-0.0f) == 0x8000 && sy_cluster_half_from_float(0.0f) == 0);
+    CHECK(sy_cluster_half_from_float(0x1p-24f) == 0x0001);               /* smallest subnormal */
+    CHECK(sy_cluster_half_from_float(0x1p-25f) == 0x0000);               /* tie to even: zero */
+    CHECK(sy_cluster_half_from_float(nextafterf(0x1p-25f, 1)) == 0x0001);
+    CHECK(sy_cluster_half_from_float(3 * 0x1p-25f) == 0x0002);           /* tie 1.5 -> 2 */
+    CHECK(sy_cluster_half_from_float(5 * 0x1p-25f) == 0x0002);           /* tie 2.5 -> 2 */
+    CHECK(sy_cluster_half_from_float(-0x1p-26f) == 0x8000);
+    CHECK(sy_cluster_half_from_float(f_bits(1)) == 0);                    /* float subnormal */
+    CHECK(sy_cluster_half_from_float(nextafterf(0x1p-14f, 0)) == 0x0400); /* rounds up to the smallest normal */
+    CHECK(sy_cluster_half_from_float(0x1p-14f - 0x1p-25f) == 0x0400);    /* tie between 0x3ff and 0x400: even */
+    CHECK(sy_cluster_half_from_float(0x1p-14f - 3 * 0x1p-25f) == 0x03fe); /* tie between 0x3fe and 0x3ff: even */
+#if defined(__FLT16_MAX__) && defined(__x86_64__) && !defined(__clang__)
+    uint32_t checked = 0;
+    for (uint64_t u = 0; u < 0x100000000ull; u += 1021) {
+        float f = f_bits((uint32_t)u);
+        _Float16 ref = (_Float16)f;
+        uint16_t rb;
+        memcpy(&rb, &ref, 2);
+        uint16_t ours = sy_cluster_half_from_float(f);
+        if (isnan(f)) CHECK_MSG((ours & 0x7e00) == 0x7e00 && (ours & 0x8000) == (rb & 0x8000), "NaN %08x", (uint32_t)u);
+        else CHECK_MSG(ours == rb, "float %08x: ours %04x, _Float16 %04x", (uint32_t)u, ours, rb);
+        checked++;
+    }
+    printf("half: %u floats agree with _Float16\n", checked);
+#else
+    printf("half: no _Float16 reference in this compiler (checked against the formula and the edge cases)\n");
+#endif
+    return 0;
+}
+
+/* A half tile decodes to the half-rounded values (inf depth stays inf) and is smaller. */
+static int test_half_tile(void)
+{
+    sy_error e = {0};
+    sy_layer a = {0}, b = {0};
+    CHECK_OK(sy_layer_create(31, 9, &a, &e), e);
+    CHECK_OK(sy_layer_create(31, 9, &b, &e), e);
+    for (size_t i = 0; i < 31 * 9; ++i) {
+        for (int c = 0; c < 4; ++c) a.rgba[i * 4 + c] = (float)(rnd() % 100000) / 3000.0f;
+        a.depth[i] = (i % 7) ? 0.5f + (float)i * 0.01f : INFINITY;
+    }
+    sy_cluster_buf f32 = {0}, f16 = {0};
+    CHECK_OK(sy_cluster_tile_encode(&a, true, &f32, &e), e);
+    CHECK_OK(sy_cluster_tile_encode_as(&a, true, SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD, &f16, &e), e);
+    CHECK_MSG(f16.size < f32.size, "half tile %zu bytes, float %zu", f16.size, f32.size);
+    sy_cluster_tile t = {{0, 0, 31, 9}, SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD, 5, 31 * 9 * 5 * 2, f16.data, (uint32_t)f16.size};
+    CHECK_OK(sy_cluster_tile_decode(&t, &b, 0, 0, &e), e);
+    for (size_t i = 0; i < 31 * 9; ++i) {
+        for (int c = 0; c < 4; ++c) {
+            float want = sy_cluster_half_to_float(sy_cluster_half_from_float(a.rgba[i * 4 + c]));
+            CHECK(b.rgba[i * 4 + c] == want && fabsf(want - a.rgba[i * 4 + c]) <= a.rgba[i * 4 + c] * 0x1p-11f);
+        }
+        CHECK(b.depth[i] == sy_cluster_half_to_float(sy_cluster_half_from_float(a.depth[i])));
+        if (isinf(a.depth[i])) CHECK(isinf(b.depth[i]));
+    }
+    /* the float32 raw size under the half encoding is refused */
+    t.raw_size = 31 * 9 * 5 * 4;
+    CHECK(sy_cluster_tile_decode(&t, &b, 0, 0, &e) != SY_OK);
+    sy_cluster_buf_free(&f32);
+    sy_cluster_buf_free(&f16);
+    sy_layer_destroy(&a);
+    sy_layer_destroy(&b);
+    return 0;
+}
+
+/* The fuzz seed corpus (tests/cluster/fuzz_seeds): one valid frame of every message type, as
+ * sample() makes them. `--write-seeds DIR` (re)generates it; given DIR, every seed must still
+ * decode, so the corpus follows the protocol version. */
+static bool no_payloads(void *user, const sy_blob *b)
+{
+    (void)user, (void)b;
+    return false;
+}
+
+/* Seeds 15 and 16: a SCENE carrying a real change list (a texture, its blob by hash) and a TILES
+ * carrying a real binary16 tile, so the fuzzer starts inside the nested decoders. */
+static int real_seed(uint32_t which, sy_cluster_buf *b)
+{
+    sy_error e = {0};
+    sy_cluster_msg m;
+    memset(&m, 0, sizeof m);
+    m.header.seq = 3;
+    if (which == 15) {
+        sy_scene *sc = NULL;
+        sy_texture t;
+        sy_blob *px = NULL;
+        sy_changes *ch = NULL;
+        void *data = NULL;
+        size_t size = 0;
+        CHECK_OK(sy_scene_create(&sc, &e), e);
+        CHECK_OK(sy_texture_create(sc, "seed", &t, &e), e);
+        CHECK_OK(sy_blob_create_copy(g_payload, 16, &px, &e), e);
+        sy_image_info ii = {2, 2, 4, SY_PIXEL_U8_LINEAR};
+        CHECK_OK(sy_texture_set_image(sc, t, &ii, px, &e), e);
+        sy_blob_release(px);
+        CHECK_OK(sy_scene_commit(sc, NULL, &e), e);
+        CHECK_OK(sy_scene_snapshot(sc, &ch, &e), e);
+        CHECK_OK(sy_changes_serialize(ch, no_payloads, NULL, &data, &size, &e), e);
+        m.header.type = SY_CLUSTER_SCENE;
+        m.u.scene.frame = 1;
+        m.u.scene.flags = SY_CLUSTER_SCENE_SNAPSHOT;
+        m.u.scene.changes = data;
+        m.u.scene.changes_size = (uint32_t)size;
+        CHECK_OK(sy_cluster_encode(&m, 0, b, &e), e);
+        free(data);
+        sy_changes_release(ch);
+        sy_scene_destroy(sc);
+        return 0;
+    }
+    sy_layer l = {0};
+    sy_cluster_buf enc = {0};
+    CHECK_OK(sy_layer_create(4, 3, &l, &e), e);
+    for (int i = 0; i < 12; ++i) {
+        for (int c = 0; c < 4; ++c) l.rgba[i * 4 + c] = (float)(i * 4 + c) / 8.0f;
+        l.depth[i] = i % 3 ? (float)i : INFINITY;
+    }
+    CHECK_OK(sy_cluster_tile_encode_as(&l, true, SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD, &enc, &e), e);
+    sy_cluster_tile tl = {{1, 2, 4, 3}, SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD, 5, 4 * 3 * 5 * 2, enc.data, (uint32_t)enc.size};
+    m.header.type = SY_CLUSTER_TILES;
+    m.u.tiles.samples = 1;
+    m.u.tiles.tile_count = 1;
+    m.u.tiles.tiles = &tl;
+    CHECK_OK(sy_cluster_encode(&m, 0, b, &e), e);
+    sy_cluster_buf_free(&enc);
+    sy_layer_destroy(&l);
+    return 0;
+}
+
+static int seeds(const char *dir, bool write)
+{
+    char path[4096];
+    for (uint32_t t = 1; t <= SY_CLUSTER_MSG_TYPE_MAX + 2; ++t) {
+        sy_error e = {0};
+        sy_cluster_msg m = sample(t), d;
+        sy_cluster_buf b = {0};
+        if (t > SY_CLUSTER_MSG_TYPE_MAX) {
+            if (real_seed(t, &b)) return 1;
+        } else {
+            CHECK_OK(sy_cluster_encode(&m, 0, &b, &e), e);
+        }
+        snprintf(path, sizeof path, "%s/%02u_%s.bin", dir, t,
+                 t <= SY_CLUSTER_MSG_TYPE_MAX ? sy_cluster_msg_type_name(t) : t == 15 ? "SCENE_real" : "TILES_half");
+        if (write) {
+            FILE *f = fopen(path, "wb");
+            CHECK_MSG(f && fwrite(b.data, 1, b.size, f) == b.size && fclose(f) == 0, "cannot write %s", path);
+        } else {
+            FILE *f = fopen(path, "rb");
+            CHECK_MSG(f != NULL, "%s is missing (regenerate: test_cluster_proto --write-seeds DIR)", path);
+            uint8_t buf[4096];
+            size_t n = fread(buf, 1, sizeof buf, f);
+            fclose(f);
+            CHECK_MSG(n == b.size && memcmp(buf, b.data, n) == 0, "%s is stale (regenerate: test_cluster_proto "
+                      "--write-seeds DIR)", path);
+            CHECK_OK(sy_cluster_decode(buf, n, NULL, &d, &e), e);
+            sy_cluster_msg_free(&d);
+        }
+        sy_cluster_buf_free(&b);
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc == 3 && !strcmp(argv[1], "--write-seeds")) return seeds(argv[2], true);
     int failed = 0;
+    if (argc == 2) failed += seeds(argv[1], false);
     failed += test_round_trip();
     failed += test_bad_headers();
     failed += test_mutations();
     failed += test_tile_codec();
+    failed += test_half();
+    failed += test_half_tile();
     if (failed) fprintf(stderr, "test_cluster_proto: %d test(s) failed\n", failed);
     else printf("test_cluster_proto: all passed\n");
     return failed ? 1 : 0;

@@ -1,6 +1,7 @@
 /* test_cluster_server.c — a render server process for the cluster tests: the built-in mediators
  * plus the "coop_test" double, served through core/sy_cluster.c exactly as `sy serve` does.
  *   test_cluster_server --port-file F [--listen URL] [--secret S] [--max-lifetime SECONDS] [--present RAW]
+ *                       [--blob-cache-mb N | --blob-cache-bytes N] [--max-objects N] [--auth-backoff-ms MS]
  * Stops on SIGTERM / SIGINT or after --max-lifetime (default 120 s), so nothing outlives a test. */
 #include "coop_double.h"
 #include "sy_cluster.h"
@@ -43,6 +44,10 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--listen")) o.listen_url = argv[i + 1];
         else if (!strcmp(argv[i], "--secret")) secret = argv[i + 1];
         else if (!strcmp(argv[i], "--max-lifetime")) o.max_lifetime_s = atof(argv[i + 1]);
+        else if (!strcmp(argv[i], "--blob-cache-mb")) o.blob_cache_bytes = (size_t)atol(argv[i + 1]) << 20;
+        else if (!strcmp(argv[i], "--blob-cache-bytes")) o.blob_cache_bytes = (size_t)atol(argv[i + 1]);
+        else if (!strcmp(argv[i], "--max-objects")) o.max_objects = (uint32_t)atol(argv[i + 1]);
+        else if (!strcmp(argv[i], "--auth-backoff-ms")) o.auth_backoff_ms = (uint32_t)atol(argv[i + 1]);
         else if (!strcmp(argv[i], "--present")) {
             o.present = present_raw;
             o.present_user = argv[i + 1];

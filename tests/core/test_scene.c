@@ -134,6 +134,17 @@ static int test_dirty_noop(void)
     uint32_t con;
     CHECK_OK(sy_scene_consumer_add(s, &con, &e), e);
     CHECK(!sy_scene_has_pending(s));
+    /* created and destroyed in one frame: nothing is pending, and a commit delivers no change */
+    sy_node tmp;
+    CHECK_OK(sy_node_create(s, "tmp", &tmp, &e), e);
+    CHECK(sy_scene_has_pending(s));
+    CHECK_OK(sy_object_destroy(s, SY_TYPE_NODE, tmp.id, &e), e);
+    CHECK(!sy_scene_has_pending(s));
+    sy_changes *none = NULL;
+    CHECK_OK(sy_scene_commit(s, NULL, &e), e);
+    CHECK_OK(sy_scene_consumer_pull(s, con, &none, &e), e);
+    CHECK(none == NULL || sy_changes_count(none) == 0); /* no change list, or an empty one */
+    sy_changes_release(none);
     sy_node n;
     sy_material m;
     CHECK_OK(sy_node_create(s, "n", &n, &e), e);

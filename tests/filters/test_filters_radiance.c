@@ -2,7 +2,8 @@
  * synthetic stored samples: a textured Lambertian plane under constant incident radiance (the
  * filter re-shades with each pixel's own albedo, so texture stays sharp and the result converges
  * to albedo * L), no leaking across a depth step (world-space prism), the switch to plain path
- * tracing (correction phase) and the unbiased buffer, NaN isolation, parameter rejection. */
+ * tracing (correction phase) and the unbiased buffer, NaN isolation, parameter rejection, and
+ * resuming on an existing estimate (sy_filter_radiance_seed). */
 #include "sy_filter_radiance.h"
 #include "synth.h"
 
@@ -226,12 +227,51 @@ static void test_nan_and_params(void)
     scene_free(&s);
 }
 
+/* Seeded with a converged mean (k = 1000, per-sample variance equal to the frame noise): the next
+ * frame is k + 1 = 1001 with T_k = 2001 T_u, every pixel in the correction phase, and the output is
+ * the running mean (1000 * seed + plain PT) / 1001; bad seeds are rejected. */
+static void test_seed(void)
+{
+    scene s;
+    scene_init(&s, 32, 24, false, 0.0f);
+    size_t n = (size_t)s.w * s.h;
+    sy_filter_radiance *rf = NULL;
+    sy_filter_error err = {0};
+    CHECK(sy_filter_radiance_create(NULL, &rf, &err) == SY_FILTER_OK);
+    float *out = malloc(4 * n * sizeof(float)), *var = malloc(n * sizeof(float));
+    CHECK(out && var);
+    for (size_t i = 0; i < n; ++i) var[i] = 0.05f * sy_filter_luminance(s.truth + 4 * i);
+    CHECK(sy_filter_radiance_seed(rf, s.w, s.h, s.truth, 4, var, 1000, &err) == SY_FILTER_OK);
+    CHECK(sy_filter_radiance_frame_index(rf) == 1000);
+    sy_filter_radiance_input in = input(&s);
+    scene_frame(&s, 1.0f, 1001);
+    sy_filter_stats st;
+    CHECK(sy_filter_radiance_frame(rf, &in, out, &st, &err) == SY_FILTER_OK);
+    double worst = 0;
+    for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c) {
+            double pt = s.sh[i].direct[c] + s.sh[i].pt_indirect[c];
+            double want = (1000.0 * s.truth[4 * i + c] + pt) / 1001.0;
+            worst = fmax(worst, fabs(out[4 * i + c] - want) / (want + 1e-3));
+        }
+    printf("radiance seed: correction share %.3f, worst relative deviation from the resumed mean %.2e\n",
+           st.mean_blend, worst);
+    CHECK(st.mean_blend == 1.0 && worst < 1e-4);
+    CHECK(sy_filter_radiance_seed(rf, s.w, s.h, s.truth, 2, var, 10, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    CHECK(sy_filter_radiance_seed(rf, s.w, s.h, s.truth, 4, var, 0, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    CHECK(sy_filter_radiance_seed(rf, 0, s.h, s.truth, 4, var, 10, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    sy_filter_radiance_destroy(rf);
+    free(out), free(var);
+    scene_free(&s);
+}
+
 int main(void)
 {
     test_texture_and_convergence();
     test_depth_step();
     test_correction_phase();
     test_nan_and_params();
+    test_seed();
     printf("filters radiance: ok\n");
     return 0;
 }

@@ -8,8 +8,8 @@
 #   - sy bench sync / sy bench rays on small sizes: exit 0 and their result lines (no thresholds)
 #   - sy demo -o DIR -w 64 -h 36: demo_whitted.png / .exr written
 #   - -b pathtracer: --spp with --aov (EXR with feature channels), --time; a non-EXR --env fails
-#   - -b pathtracer --filter pixel --threshold T writes an image; --filter bogus / radiance and a
-#     negative threshold fail naming the problem
+#   - -b pathtracer --filter pixel --threshold T and --filter radiance write an image; --filter
+#     bogus, a bad radiance option and a negative threshold fail naming the problem
 #     naming the file
 #   - --stereo sbs / tb / anaglyph / separate: output sizes and per-eye files; bad stereo parameters
 #     and overlays (negative separation, zero parallax 0, unknown mode, missing file, unknown
@@ -248,10 +248,17 @@ run pt_filter "$SY" render demo -b pathtracer --spp 4 -w 32 -h 24 --filter pixel
     fail "pathtracer --filter pixel: status $rc, $(cat "$TMP/pt_filter.out" "$TMP/pt_filter.err")"
 expect_error pt_filter_bad bogus "$TMP/o_ptfilter" "$SY" render demo -b pathtracer --spp 1 -w 8 -h 8 \
     --filter bogus -o "$TMP/o_ptfilter/x.png"
-expect_error pt_filter_radiance "stored-sample hook" "$TMP/o_ptfilter" "$SY" render demo -b pathtracer --spp 1 -w 8 -h 8 \
-    --filter radiance -o "$TMP/o_ptfilter/x.png"
+run pt_radiance "$SY" render demo -b pathtracer --spp 4 -w 32 -h 24 --filter radiance --params rf_unbiased=1 \
+    -o "$TMP/pt/radiance.png"
+[ "$rc" -eq 0 ] && magic "$TMP/pt/radiance.png" 89504e47 &&
+    grep -q '^filter radiance: threshold 0.01, .*last pass at 4 spp.*NaN/Inf: 0 pixels' "$TMP/pt_radiance.out" ||
+    fail "pathtracer --filter radiance: status $rc, $(cat "$TMP/pt_radiance.out" "$TMP/pt_radiance.err")"
+expect_error pt_filter_radiance rf_kernel "$TMP/o_ptfilter" "$SY" render demo -b pathtracer --spp 1 -w 8 -h 8 \
+    --filter radiance --params rf_kernel=box -o "$TMP/o_ptfilter/x.png"
 expect_error pt_filter_threshold threshold "$TMP/o_ptfilter" "$SY" render demo -b pathtracer --spp 1 -w 8 -h 8 \
     --filter pixel --threshold -1 -o "$TMP/o_ptfilter/x.png"
+expect_error pt_filter_sigma "sigma_s = 0: must be a finite value > 0" "$TMP/o_ptfilter" "$SY" render demo \
+    -b pathtracer --spp 1 -w 8 -h 8 --filter pixel --params sigma_s=0 -o "$TMP/o_ptfilter/x.png"
 
 if [ "$fails" -ne 0 ]; then
     echo "integration_cli: $fails failure(s)" >&2

@@ -15,22 +15,34 @@
  *      grows as 1/W: measured (RelWithDebInfo, this seed) unfiltered/filtered relMSE 2.40x at 64,
  *      4.30x at 128, 11.6x at 256, while on interior pixels it is 12.9x, 20.3x and 25.2x; the
  *      split is printed and the interior ratio is checked too (>= 8x).
+ *      Radiance filtering (filter=radiance: the path tracer's stored-sample hook, one filter frame
+ *      per 1-spp pass, the same samples) must reach the same 4x: measured 4.6x at 128x128 and
+ *      12.7x at 256x256 (it filters the indirect part only, so the same edge/direct floor applies;
+ *      a filter that does nothing, or blurs across the box edges, stays well below 4x).
  *   2. Consistency: a tiny view at high spp: the blend operator has switched the filter off where
  *      the unfiltered estimate's perceived variance is under the threshold, so the filtered image
- *      differs from the unfiltered one by less than the unfiltered image's own noise.
+ *      differs from the unfiltered one by less than the unfiltered image's own noise. The same for
+ *      radiance filtering (pixels in the correction phase), and with its unbiased buffer every
+ *      pixel in the correction phase equals the accumulation.
  *   3. Live changes: sy_mediator_rt_set_filter (filter and threshold) never restarts the
- *      accumulation (sy_mediator_stats.samples keeps growing, no restart counted); "none" gives the
+ *      accumulation (sy_mediator_stats.samples keeps growing, no restart counted; a switch to
+ *      radiance resumes on the accumulation instead of starting over); "none" gives the
  *      unfiltered estimate exactly; on error nothing changes. A visible scene change restarts the
  *      accumulation and the pixel filter's state with it.
- *   4. Bad parameters are rejected with a message naming them (unknown filter, radiance without
- *      the integrator's stored-sample hook, negative threshold, zero sigma, bad kernel).
- * Exit 77 when the test data is absent. SY_PT_FILTER_SIZE overrides W (a divisor of 256);
+ *   4. Bad parameters are rejected with a message naming them (unknown filter, negative threshold,
+ *      zero sigma, bad kernel, the radiance filter's options out of range).
+ *   5. The stored-sample hook on the back-end directly (test_hook_records).
+ * Exit 77 when the test data is absent. SY_PT_FILTER_SIZE overrides W (a divisor of 256),
+ * SY_PT_FILTER_CONS_SIZE the consistency view (default 16; 256 with SY_PT_FILTER_SIZE=256 is the
+ * issue's full 256x256 / 1024 spp measurement);
  * SY_PT_FILTER_PARAMS appends back-end params to part 1 (experiments, e.g. "threshold=0,sigma_s=4"). */
 #include "it_util.h"
 #include "sy_exr.h"
 #include "sy_filter_metrics.h"
 #include "sy_gltf.h"
 #include "sy_mediator_rt.h"
+#include "sy_radiance_hook.h"
+#include "sy_rt.h"
 
 #define PT_PARAMS "max_depth=64,specular=0"
 
@@ -92,6 +104,132 @@ static void expect_rejected(fixture *fx, const char *params, const char *needle)
     if (r != SY_OK) printf("rejected %-40s -> %s\n", params, e.message);
 }
 
+/* 5. The stored-sample hook itself, on the Embree back-end directly (a floor, a back wall and an
+ * area light seen from above; 48x48, 1 spp):
+ *   - records change nothing: the accumulation with records is bit-identical to one without;
+ *   - a record's colour is the sample the accumulation received, and where it has P0 it splits as
+ *     colour = prefix + throughput * f_cos(wi) / pdf(wi) * incident (sy_rt_pt_record_bsdf);
+ *   - NaN/Inf records (as a broken back-end could deliver) are counted by the radiance filter,
+ *     the output stays finite, and they are kept out of every neighbourhood: every other pixel is
+ *     bit-identical to a run where those pixels carried no sample at all. */
+static void test_hook_records(void)
+{
+    enum { S = 48 };
+    char e[256];
+    sy_rt_device *dev;
+    if (sy_rt_device_create(NULL, &dev, e, sizeof e) != SY_RT_OK) {
+        fprintf(stderr, "device: %s\n", e);
+        exit(1);
+    }
+    /* floor y = 0 and back wall z = -1 (grey Lambert), light quad at y = 1.2 (double-sided emitter) */
+    const float quads[3][12] = {{-2, 0, 2, 2, 0, 2, 2, 0, -2, -2, 0, -2},
+                                {-2, 0, -1, 2, 0, -1, 2, 3, -1, -2, 3, -1},
+                                {-0.3f, 1.2f, -0.3f, 0.3f, 1.2f, -0.3f, 0.3f, 1.2f, 0.3f, -0.3f, 1.2f, 0.3f}};
+    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    for (int q = 0; q < 3; ++q) {
+        sy_rt_mesh_desc md = {.positions = quads[q], .indices = idx, .vertex_count = 4, .triangle_count = 2};
+        sy_rt_mesh mesh;
+        sy_rt_material mat;
+        sy_rt_instance inst;
+        sy_rt_material_desc mt;
+        sy_rt_material_desc_init(&mt);
+        mt.metallic = 0.0f, mt.specular = 0.0f, mt.double_sided = true;
+        mt.base_color[0] = mt.base_color[1] = mt.base_color[2] = q == 2 ? 0.0f : 0.7f;
+        if (q == 2) mt.emissive[0] = mt.emissive[1] = mt.emissive[2] = 8.0f;
+        sy_rt_instance_desc id = {.transform = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
+        if (sy_rt_mesh_create(dev, &md, &mesh, e, sizeof e) || sy_rt_material_create(dev, &mt, &mat, e, sizeof e))
+            fprintf(stderr, "scene: %s\n", e), exit(1);
+        id.mesh = mesh, id.material = mat;
+        if (sy_rt_instance_create(dev, &id, &inst, e, sizeof e)) fprintf(stderr, "instance: %s\n", e), exit(1);
+    }
+    if (sy_rt_commit(dev, e, sizeof e)) fprintf(stderr, "commit: %s\n", e), exit(1);
+    /* camera at (0, 1, 1.6) looking down 35 degrees */
+    float c = cosf(0.61f), sn = sinf(0.61f);
+    sy_rt_camera cam = {.camera_to_world = {1, 0, 0, 0, 0, c, -sn, 0, 0, sn, c, 0, 0, 1.0f, 1.6f, 1},
+                        .projection = SY_RT_PROJECTION_PERSPECTIVE,
+                        .window = {-0.6f, 0.6f, -0.6f, 0.6f}};
+    sy_rt_accum *acc[2];
+    for (int i = 0; i < 2; ++i)
+        if (sy_rt_accum_create(S, S, &acc[i], e, sizeof e)) fprintf(stderr, "accum: %s\n", e), exit(1);
+    sy_rt_pt_record *rec = calloc(S * S, sizeof *rec);
+    float *rgba = malloc(S * S * 4 * sizeof(float)), *rgba2 = malloc(S * S * 4 * sizeof(float));
+    sy_rt_render_desc d = {.integrator = SY_RT_INTEGRATOR_PATHTRACER, .image_width = S, .image_height = S,
+                           .width = S, .height = S, .max_depth = 16, .seed = 7, .samples = 1, .accum = acc[0]};
+    if (sy_rt_render(dev, &cam, &d, rgba, NULL, e, sizeof e)) fprintf(stderr, "render: %s\n", e), exit(1);
+    d.accum = acc[1], d.records = rec;
+    if (sy_rt_render(dev, &cam, &d, rgba2, NULL, e, sizeof e)) fprintf(stderr, "render: %s\n", e), exit(1);
+    size_t differ = 0, p0 = 0, split_bad = 0, color_bad = 0;
+    double inc_sum = 0;
+    for (size_t i = 0; i < S * S; ++i) {
+        differ += memcmp(rgba + 4 * i, rgba2 + 4 * i, 4 * sizeof(float)) != 0;
+        const sy_rt_pt_record *r = rec + i;
+        for (int k = 0; k < 3; ++k) color_bad += r->color[k] != rgba2[4 * i + k];
+        if (!(r->flags & SY_RT_RECORD_P0)) continue;
+        p0++;
+        float fc[3], pdf;
+        sy_rt_pt_record_bsdf(r, r->wi, fc, &pdf);
+        for (int k = 0; k < 3; ++k) {
+            double want = r->prefix[k] + (pdf > 0 ? r->throughput[k] * fc[k] / pdf * r->incident[k] : 0.0);
+            split_bad += fabs(want - r->color[k]) > 1e-4 * (1.0 + fabs(r->color[k]));
+            inc_sum += r->incident[k];
+        }
+    }
+    printf("hook: %zu/%d pixels with P0, mean incident %.4f; %zu pixels differ from the render without records, "
+           "%zu colour values differ from the accumulation, %zu split mismatches\n",
+           p0, S * S, inc_sum / (3.0 * (double)(p0 ? p0 : 1)), differ, color_bad, split_bad);
+    CHECKF(differ == 0, "records changed %zu pixels of the path-traced image", differ);
+    CHECKF(color_bad == 0 && split_bad == 0, "record colour / split mismatches: %zu / %zu", color_bad, split_bad);
+    CHECKF(p0 > S * S * 9 / 10 && inc_sum > 0, "only %zu P0 records, incident sum %g", p0, inc_sum);
+
+    /* NaN/Inf records: counted, output finite, kept out of every neighbourhood */
+    const size_t bad[3] = {10 * S + 10, 24 * S + 24, 25 * S + 24};
+    sy_filter_radiance_params fp;
+    sy_filter_radiance_params_default(&fp);
+    float *out[2] = {calloc(S * S * 4, sizeof(float)), calloc(S * S * 4, sizeof(float))};
+    sy_filter_stats st[2];
+    for (int run = 0; run < 2; ++run) {
+        sy_radiance_hook *h;
+        sy_rt_pt_record *hr;
+        MUST(sy_radiance_hook_create(&fp, &h, err));
+        MUST(sy_radiance_hook_records(h, S, S, &hr, err));
+        memcpy(hr, rec, S * S * sizeof *rec);
+        for (int b = 0; b < 3; ++b) {
+            sy_rt_pt_record *r = hr + bad[b];
+            if (run == 1) { /* the same pixels without any sample */
+                memset(r, 0, sizeof *r);
+                continue;
+            }
+            CHECK(r->flags & SY_RT_RECORD_P0);
+            if (b == 0) r->incident[1] = NAN;
+            if (b == 1) r->color[0] = INFINITY;
+            if (b == 2) r->position[2] = NAN;
+        }
+        sy_radiance_hook_frame_desc fd = {.pixel_angle = 1.2f / S};
+        MUST(sy_radiance_hook_frame(h, &fd, out[run], &st[run], err));
+        sy_radiance_hook_destroy(h);
+    }
+    size_t nonfinite = 0, other_differ = 0, filtered = 0;
+    for (size_t i = 0; i < S * S; ++i) {
+        bool is_bad = i == bad[0] || i == bad[1] || i == bad[2];
+        for (int k = 0; k < 3; ++k) {
+            nonfinite += !isfinite(out[0][4 * i + k]);
+            if (!is_bad) other_differ += out[0][4 * i + k] != out[1][4 * i + k];
+            filtered += !is_bad && k == 0 && out[0][4 * i] != rec[i].color[0];
+        }
+    }
+    printf("hook NaN/Inf: %llu non-finite records reported, %zu non-finite outputs, %zu values of other pixels differ "
+           "from the run without those samples, %zu pixels filtered\n",
+           (unsigned long long)st[0].nonfinite_samples, nonfinite, other_differ, filtered);
+    CHECKF(st[0].nonfinite_samples == 3 && st[1].nonfinite_samples == 0, "reported %llu / %llu non-finite records",
+           (unsigned long long)st[0].nonfinite_samples, (unsigned long long)st[1].nonfinite_samples);
+    CHECKF(nonfinite == 0 && other_differ == 0, "non-finite outputs %zu, other pixels changed %zu", nonfinite,
+           other_differ);
+    CHECKF(filtered > S * S / 2, "only %zu pixels were filtered (frame 1 uses the warm-up radius)", filtered);
+    free(out[0]), free(out[1]), free(rec), free(rgba), free(rgba2);
+    sy_rt_accum_destroy(acc[0]), sy_rt_accum_destroy(acc[1]);
+    sy_rt_device_destroy(dev);
+}
+
 int main(void)
 {
     it_register();
@@ -137,13 +275,13 @@ int main(void)
     sy_exr_image_free(ref);
 
     /* 1. quality at 4 spp: pixel filter, then the baselines on the same seed */
-    const char *names[] = {"pixel", "atrous", "jbu", "adaptive"};
+    const char *names[] = {"pixel", "radiance", "atrous", "jbu", "adaptive"};
 #ifdef SY_PT_SANITIZE
-    const int methods = 1; /* sanitizer builds: the pixel filter only (the baselines have unit tests) */
+    const int methods = 2; /* sanitizer builds: pixel and radiance filter only (the baselines have unit tests) */
 #else
-    const int methods = 4;
+    const int methods = 5;
 #endif
-    double unfiltered_relmse = 0, pixel_relmse = 0;
+    double unfiltered_relmse = 0, pixel_relmse = 0, radiance_relmse = 0;
     for (int k = 0; k < methods; ++k) {
         char params[256];
         const char *extra = getenv("SY_PT_FILTER_PARAMS"); /* experiments: e.g. "threshold=0,sigma_s=4" */
@@ -172,7 +310,7 @@ int main(void)
                        "filter %.2f ms, NaN/Inf pixels %llu%s\n",
                        W, W, names[k], u, fr, u / fr, fi.seconds * 1e3, (unsigned long long)fi.nonfinite_pixels,
                        k == 0 ? (fi.filter_pass ? ", pass ran" : ", NO PASS") : "");
-                if (k == 0) { /* where the error sits: geometric edges (sub-pixel coverage) vs interiors */
+                if (k <= 1) { /* where the error sits: geometric edges (sub-pixel coverage) vs interiors */
                     double se[2][2] = {{0, 0}, {0, 0}};
                     size_t ne = 0;
                     for (uint32_t y = 0; y < W; ++y)
@@ -195,7 +333,11 @@ int main(void)
                             }
                         }
                     double tot = 3.0 * (double)n;
-                    CHECKF(se[0][0] >= 8.0 * se[0][1], "interior pixels: relMSE only %.2fx lower", se[0][0] / se[0][1]);
+                    /* radiance: 27.9x measured; the same filter without the world-space prism
+                     * (rf_prism_thickness=100, rf_grazing_epsilon=1: samples leak across surfaces) gets 14.3x */
+                    double want = k == 1 ? 20.0 : 8.0;
+                    CHECKF(se[0][0] >= want * se[0][1], "%s, interior pixels: relMSE only %.2fx lower (want %.0fx)",
+                           names[k], se[0][0] / se[0][1], want);
                     printf("  relMSE split: %zu edge pixels (%.1f%%) contribute unfiltered %.5f filtered %.5f; interior "
                            "pixels unfiltered %.5f filtered %.5f (%.2fx lower)\n",
                            ne, 100.0 * (double)ne / (double)n, se[1][0] / tot, se[1][1] / tot, se[0][0] / tot,
@@ -210,6 +352,7 @@ int main(void)
                     unfiltered_relmse = u, pixel_relmse = fr;
                     CHECK(fi.filter_pass && fi.last_pass_samples == 4);
                 }
+                if (k == 1) radiance_relmse = fr;
             }
             sy_mediator_rt_aovs_free(&a);
         }
@@ -218,6 +361,9 @@ int main(void)
     }
     CHECKF(pixel_relmse * 4.0 <= unfiltered_relmse, "pixel filter relMSE %.5f is not 4x below unfiltered %.5f (%.2fx)",
            pixel_relmse, unfiltered_relmse, unfiltered_relmse / pixel_relmse);
+    CHECKF(radiance_relmse * 4.0 <= unfiltered_relmse,
+           "radiance filter relMSE %.5f is not 4x below unfiltered %.5f (%.2fx)", radiance_relmse, unfiltered_relmse,
+           unfiltered_relmse / radiance_relmse);
 
     /* 3. live changes never restart the accumulation */
     {
@@ -229,9 +375,9 @@ int main(void)
         void *st = sy_context_state(ctx);
         sy_mediator_rt_counters c0;
         sy_mediator_rt_counters_get(st, &c0);
-        const char *seq[] = {"atrous", NULL, "jbu", "adaptive", "none", "pixel"};
+        const char *seq[] = {"atrous", NULL, "jbu", "adaptive", "radiance", "none", "pixel"};
         uint64_t last = 4;
-        for (int i = 0; i < 6; ++i) {
+        for (int i = 0; i < 7; ++i) {
             sy_params opts = {0};
             if (!seq[i]) MUST(sy_params_set(&opts, "threshold", "0.04", err)); /* threshold alone */
             MUST(sy_mediator_rt_set_filter(st, seq[i], &opts, err));
@@ -249,6 +395,13 @@ int main(void)
             size_t diff = 0;
             for (size_t j = 0; j < n * 4; ++j) diff += img.rgba[j] != a.planes[0][j];
             if (seq[i] && !strcmp(seq[i], "none")) CHECKF(diff == 0, "filter none: %zu values differ from unfiltered", diff);
+            if (seq[i] && !strcmp(seq[i], "radiance")) { /* resumed on the accumulation, not restarted */
+                double rel = relmse(img.rgba, a.planes[0], W, W);
+                printf("switch to radiance at %llu spp: relMSE against the unfiltered accumulation %.5f\n",
+                       (unsigned long long)ms.samples, rel);
+                CHECKF(diff > 0 && rel < 0.005, "radiance after the switch: %zu values differ, relMSE %.5f to unfiltered",
+                       diff, rel);
+            }
             if (seq[i] && !strcmp(seq[i], "pixel"))
                 CHECKF(diff > n, "pixel filter re-enabled: only %zu values differ (no pass ran?)", diff);
             sy_mediator_rt_aovs_free(&a);
@@ -298,16 +451,28 @@ int main(void)
         sy_window_destroy(win);
     }
 
-    /* 2. consistency at high spp on a tiny view: the blend operator has switched the filter off
-     * where the threshold allows, so the filtered image is within the unfiltered image's own noise
-     * of the reference (and mostly bit-identical to the unfiltered estimate) */
-    {
+    /* 2. consistency at high spp on a tiny view (SY_PT_FILTER_CONS_SIZE overrides T = 16, e.g. 256
+     * for the issue's full measurement): the pixel filter's blend operator has switched the filter
+     * off where the threshold allows; the radiance filter's pixels have entered the correction
+     * phase (plain path tracing: its bias decays as O(1/N)). Either way the filtered image is
+     * within the unfiltered image's own noise of the reference */
+    const char *cs = getenv("SY_PT_FILTER_CONS_SIZE");
+    const uint32_t T = cs && *cs ? (uint32_t)strtoul(cs, NULL, 10) : 16;
+    if (T == 0 || 256 % T != 0 || T > W) {
+        fprintf(stderr, "SY_PT_FILTER_CONS_SIZE must divide 256 and be <= SY_PT_FILTER_SIZE\n");
+        return 1;
+    }
+    for (int fk = 0; fk < 3; ++fk) {
+        /* fk 2: the radiance filter's unbiased buffer: pixels in the correction phase show the plain
+         * path-traced mean (equal to the accumulation up to float rounding) */
+        const char *fname = fk ? "radiance" : "pixel";
 #ifdef SY_PT_SANITIZE
-        const uint32_t T = 16, SPP = 256, ft = 256 / T; /* sanitizer builds: 4x fewer samples */
+        const uint32_t SPP = 256, ft = 256 / T; /* sanitizer builds: 4x fewer samples */
 #else
-        const uint32_t T = 16, SPP = 1024, ft = 256 / T;
+        const uint32_t SPP = 1024, ft = 256 / T;
 #endif
-        const char *params = PT_PARAMS ",filter=pixel";
+        char params[128];
+        snprintf(params, sizeof params, PT_PARAMS ",filter=%s%s", fname, fk == 2 ? ",rf_unbiased=1" : "");
         sy_window *win = make_window(&fx, T, T, params);
         sy_layer img;
         MUST(sy_layer_create(T, T, &img, err));
@@ -319,10 +484,10 @@ int main(void)
         sy_mediator_rt_filter_info fi;
         sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
         double zu = 0, zf = 0, zd = 0, worst = 0;
-        size_t m = (size_t)T * T, exact = 0, cnt = 0;
+        size_t m = (size_t)T * T, exact = 0, cnt = 0, close = 0;
         for (size_t i = 0; i < m; ++i) {
             size_t x = i % T, y = i / T;
-            bool same = true;
+            bool same = true, near = true;
             for (int c = 0; c < 3; ++c) {
                 double r = 0; /* the reference box-averaged to T x T */
                 for (uint32_t j = 0; j < ft; ++j)
@@ -330,6 +495,7 @@ int main(void)
                 r /= (double)(ft * ft);
                 double u = a.planes[0][4 * i + c], fv = img.rgba[4 * i + c], v = a.planes[1][3 * i + c];
                 same = same && u == fv;
+                near = near && fabs(fv - u) <= 1e-4 * (fabs(u) + 1e-3);
                 if (!(v > 0)) continue; /* the light's interior: exact */
                 zu += (u - r) * (u - r) / v;
                 zf += (fv - r) * (fv - r) / v;
@@ -338,12 +504,18 @@ int main(void)
                 cnt++;
             }
             exact += same;
+            close += near;
         }
         zu /= (double)cnt, zf /= (double)cnt, zd /= (double)cnt;
-        printf("consistency %ux%u, %u spp, pixel filter: mean blend s %.4f, last pass at %u spp, %zu/%zu pixels exactly "
-               "unfiltered; mean squared error / Var against the reference: unfiltered %.3f, filtered %.3f; "
-               "(filtered - unfiltered)^2 / Var mean %.3f worst %.3f\n",
-               T, T, SPP, fi.mean_blend, fi.last_pass_samples, exact, m, zu, zf, zd, worst);
+        printf("consistency %ux%u, %u spp, %s filter%s: mean blend s / correction share %.4f, last pass at %u spp, "
+               "%zu/%zu pixels exactly (%zu within 1e-4) unfiltered; mean squared error / Var against the reference: "
+               "unfiltered %.3f, filtered %.3f; (filtered - unfiltered)^2 / Var mean %.3f worst %.3f\n",
+               T, T, SPP, fname, fk == 2 ? " (unbiased buffer)" : "", fi.mean_blend, fi.last_pass_samples, exact, m,
+               close, zu, zf, zd, worst);
+        if (fk == 2)
+            CHECKF((double)close >= fi.mean_blend * (double)m - 0.5,
+                   "unbiased buffer: %zu pixels equal the accumulation, %.0f are in the correction phase", close,
+                   fi.mean_blend * (double)m);
         CHECKF(fi.last_pass_samples == SPP, "last pass at %u spp", fi.last_pass_samples);
         CHECKF(zf < zu + 0.5, "filtered image is %.3f variances from the reference (unfiltered: %.3f)", zf, zu);
         CHECKF(zd < 0.5, "filtered differs from unfiltered by %.3f times its own variance on average", zd);
@@ -354,13 +526,21 @@ int main(void)
 
     /* 4. bad parameters */
     expect_rejected(&fx, PT_PARAMS ",filter=bogus", "bogus");
-    expect_rejected(&fx, PT_PARAMS ",filter=radiance", "stored-sample hook");
+    expect_rejected(&fx, PT_PARAMS ",filter=radiance,threshold=0", "threshold");
+    expect_rejected(&fx, PT_PARAMS ",filter=radiance,rf_max_radius=0.5", "rf_max_radius");
+    expect_rejected(&fx, PT_PARAMS ",filter=radiance,rf_warmup_radius=0", "warmup_radius");
+    expect_rejected(&fx, PT_PARAMS ",filter=radiance,rf_warmup_frames=65", "rf_warmup_frames");
+    expect_rejected(&fx, PT_PARAMS ",filter=radiance,rf_kernel=box", "rf_kernel");
+    expect_rejected(&fx, PT_PARAMS ",filter=radiance,rf_unbiased=2", "rf_unbiased");
+    expect_rejected(&fx, PT_PARAMS ",filter=pixel,rf_prism_thickness=0", "prism_thickness"); /* checked whatever the filter */
     expect_rejected(&fx, PT_PARAMS ",filter=pixel,threshold=-1", "threshold");
     expect_rejected(&fx, PT_PARAMS ",filter=pixel,sigma_s=0", "sigma_s");
     expect_rejected(&fx, PT_PARAMS ",filter=pixel,sigma_c=0", "sigma_c");
     expect_rejected(&fx, PT_PARAMS ",filter=pixel,filter_kernel=box", "filter_kernel");
     expect_rejected(&fx, PT_PARAMS ",filter=pixel,filter_start=3", "schedule_start");
     expect_rejected(&fx, PT_PARAMS ",filter=adaptive,threshold=0", "threshold");
+
+    test_hook_records();
 
     free(refw);
     sy_context_pool_destroy(fx.pool);

@@ -2,8 +2,10 @@
 # view_test.sh SY PNG_COMPARE TMPDIR — the interactive viewer in a real window under Xvfb: `sy view
 # demo` shows frames and its screenshot (read back from the window's framebuffer) matches `sy
 # render` of the same view with the same tone mapping, within 2 of 255 per channel (the screenshot
-# goes through an sRGB decode / encode round trip). Skipped (77) when xvfb-run is not installed or
-# the viewer was built without GLFW.
+# goes through an sRGB decode / encode round trip). The path tracer's display filter keys (F cycles
+# the filter, [ / ] halve / double the threshold) are pressed through the keyboard handler with
+# --keys and checked in the heads-up line after each key. Skipped (77) when xvfb-run is not
+# installed or the viewer was built without GLFW.
 set -u
 SY=$1
 CMP=$2
@@ -38,6 +40,44 @@ if [ $rc -ne 0 ] || [ ! -s "$TMP/view_filter.png" ] || ! grep -q "filter pixel t
     echo "FAIL: sy view -b pathtracer --filter pixel: status $rc: $(cat "$TMP/view_filter.out" "$TMP/view_filter.err")"
     exit 1
 fi
+# live filter keys (issue 7) through the viewer's keyboard handler (--keys presses one key per
+# answered frame and prints the heads-up line once the key took effect): from no filter, F picks
+# the pixel filter at the default t = 0.01, ] doubles t, F moves on to a-trous keeping t, [ [
+# halve it twice
+timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b pathtracer -w 64 -h 48 --keys 'F]F[[' \
+    --frames 2 >"$TMP/view_keys.out" 2>"$TMP/view_keys.err"
+rc=$?
+keys_expect() { # $1 = line number, $2 = key, $3 = expected filter status
+    local line
+    line=$(grep '^sy view: after key' "$TMP/view_keys.out" | sed -n "$1p")
+    case "$line" in
+    "sy view: after key $2: "*"| filter $3 "*) ;;
+    *) echo "FAIL: key $1 ($2): expected 'filter $3' in: '$line'"; cat "$TMP/view_keys.out" "$TMP/view_keys.err"
+       exit 1 ;;
+    esac
+}
+[ $rc -eq 0 ] || { echo "FAIL: sy view --keys: status $rc: $(cat "$TMP/view_keys.err")"; exit 1; }
+grep -q '| filter none' "$TMP/view_keys.out" && { echo "FAIL: a filter key left the filter at none"; exit 1; }
+keys_expect 1 F 'pixel t=0.01'
+keys_expect 2 ']' 'pixel t=0.02'
+keys_expect 3 F 'atrous t=0.02'
+keys_expect 4 '[' 'atrous t=0.01'
+keys_expect 5 '[' 'atrous t=0.005'
+tail -n 1 "$TMP/view_keys.out" | grep -q '| filter atrous t=0.005 ' || {
+    echo "FAIL: the last heads-up line does not show the final filter state"; exit 1; }
+# a scripted key that is not a key is refused before any window opens
+if "$SY" view demo -b pathtracer --keys 'F?' --frames 1 2>"$TMP/badk.err"; then
+    echo "FAIL: sy view accepted --keys with '?'"
+    exit 1
+fi
+grep -q "'?' is not a key" "$TMP/badk.err" || { echo "FAIL: the --keys error does not name the key"; exit 1; }
+# a negative threshold is refused with the reason, not just the usage text
+if "$SY" view demo -b pathtracer --filter pixel --threshold -0.5 --frames 1 2>"$TMP/badt.err"; then
+    echo "FAIL: sy view accepted a negative threshold"
+    exit 1
+fi
+grep -q "threshold -0.5 must be a finite value >= 0" "$TMP/badt.err" || {
+    echo "FAIL: the threshold error does not say why: $(cat "$TMP/badt.err")"; exit 1; }
 # an unknown filter is refused before any window opens, naming it
 if "$SY" view demo -b pathtracer --filter bogus --frames 1 2>"$TMP/badf.err"; then
     echo "FAIL: sy view accepted an unknown filter"
