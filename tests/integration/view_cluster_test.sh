@@ -15,14 +15,7 @@ CMP=$2
 W=$3
 rm -rf "$W"
 mkdir -p "$W"
-if ! command -v xvfb-run >/dev/null 2>&1; then
-    echo "skipped: xvfb-run is not installed (Debian package xvfb)"
-    exit 77
-fi
-if ! "$SY" 2>&1 | grep -q "sy view"; then
-    echo "skipped: sy was built without GLFW/OpenGL (no 'sy view')"
-    exit 77
-fi
+. "$(dirname "$0")/view_skip.sh"
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; }
 trap cleanup EXIT

@@ -12,14 +12,7 @@ CMP=$2
 TMP=$3
 rm -rf "$TMP"
 mkdir -p "$TMP"
-if ! command -v xvfb-run >/dev/null 2>&1; then
-    echo "skipped: xvfb-run is not installed (Debian package xvfb)"
-    exit 77
-fi
-if ! "$SY" 2>&1 | grep -q "sy view"; then
-    echo "skipped: sy was built without GLFW/OpenGL (no 'sy view')"
-    exit 77
-fi
+. "$(dirname "$0")/view_skip.sh"
 timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -w 320 -h 180 --frames 5 \
     --screenshot "$TMP/view.png" >"$TMP/view.out" 2>"$TMP/view.err"
 rc=$?

@@ -1,0 +1,11 @@
+# view_skip.sh — sourced by the viewer tests (view_test.sh, view_cluster_test.sh): exits 77 with
+# the reason when the machine cannot run `sy view` in a virtual X server (no xvfb-run, or sy built
+# without GLFW/OpenGL). Expects SY to name the sy binary.
+if ! command -v xvfb-run >/dev/null 2>&1; then
+    echo "skipped: xvfb-run is not installed (Debian package xvfb)"
+    exit 77
+fi
+if ! "$SY" 2>&1 | grep -q "sy view"; then
+    echo "skipped: sy was built without GLFW/OpenGL (no 'sy view')"
+    exit 77
+fi
