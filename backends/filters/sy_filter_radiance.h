@@ -22,7 +22,14 @@
  * ">>path records"); mediators/rt/sy_radiance_hook.c converts them and passes its BSDF.
  *
  * Ownership: sy_filter_radiance owns its accumulation state; inputs are borrowed per call.
- * Thread-safety: one object per thread at a time; runs multithreaded internally. */
+ * Thread-safety: one object per thread at a time; runs multithreaded internally (a worker pool
+ * owned by the object, created on the first frame with params.threads, reused for every frame).
+ *
+ * Cost (exact; results equal the plain per-neighbour loop bit for bit): the frame first copies the
+ * neighbours' data into compact per-frame arrays (position, wi, radiance, 1/hit distance, variance;
+ * invalid samples get a NaN position so the prism test rejects them without a branch); per owner
+ * pixel the kernel frame is built once, each window row is tested in one vectorisable loop (prism
+ * thickness, tangent-plane ellipse) and only the neighbours inside go to the BSDF, in batches. */
 #ifndef SY_FILTER_RADIANCE_H
 #define SY_FILTER_RADIANCE_H
 
@@ -68,6 +75,16 @@ typedef void (*sy_filter_rf_bsdf_fn)(const sy_filter_rf_shading *s, const float 
                                      void *user);
 void sy_filter_rf_bsdf_default(const sy_filter_rf_shading *s, const float wi[3], float f_cos[3], float *pdf,
                                void *user);
+/* Batched form (the filter's hot path: one call per owner pixel and batch of neighbours instead
+ * of one indirect call per neighbour; owner constants are computed once per call). Structure of
+ * arrays: direction m is (wi[0][m], wi[1][m], wi[2][m]) (unit), its result f_cos[c][m] and pdf[m],
+ * m < count (outputs never alias inputs). Must give exactly what count calls of the single form
+ * would. Called concurrently
+ * from the filter's threads (must be pure). */
+typedef void (*sy_filter_rf_bsdf_batch_fn)(const sy_filter_rf_shading *s, uint32_t count, const float *const wi[3],
+                                           float *const f_cos[3], float *pdf, void *user);
+void sy_filter_rf_bsdf_default_batch(const sy_filter_rf_shading *s, uint32_t count, const float *const wi[3],
+                                     float *const f_cos[3], float *pdf, void *user);
 
 typedef enum sy_filter_rf_kernel {
     SY_FILTER_RF_EPANECHNIKOV = 0, /* 1 - t^2 (default) */
@@ -100,7 +117,9 @@ typedef struct sy_filter_radiance_input {
     const sy_filter_rf_shading *shading; /* width*height */
     const sy_filter_rf_sample *samples;  /* width*height (one sample per pixel) */
     sy_filter_rf_bsdf_fn bsdf;           /* NULL = sy_filter_rf_bsdf_default */
-    void *bsdf_user;
+    sy_filter_rf_bsdf_batch_fn bsdf_batch; /* preferred when set (same BSDF as bsdf, batched); both
+                                              NULL = sy_filter_rf_bsdf_default_batch */
+    void *bsdf_user;                     /* passed to either */
 } sy_filter_radiance_input;
 
 typedef struct sy_filter_radiance sy_filter_radiance;

@@ -443,6 +443,12 @@ typedef struct sy_rt_pt_record {
  * with which the path tracer samples wi there (the same mixture it used for the record's own wi).
  * Zero for a record without SY_RT_RECORD_P0. wi is unit, world space. Thread-safe (pure). */
 void sy_rt_pt_record_bsdf(const sy_rt_pt_record *record, const float wi[3], float f_cos[3], float *pdf);
+/* The same for count directions at once (a filter re-shading many neighbours with one record):
+ * structure of arrays, direction m = (wi[0][m], wi[1][m], wi[2][m]) -> f_cos[c][m], pdf[m]; the
+ * record is unpacked and its wo-only terms computed once. Results equal count single calls bit
+ * for bit. Outputs must not alias inputs. Thread-safe (pure). */
+void sy_rt_pt_record_bsdf_batch(const sy_rt_pt_record *record, uint32_t count, const float *const wi[3],
+                                float *const f_cos[3], float *pdf);
 
 /* >>coverage
  *

@@ -103,20 +103,27 @@ void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
     }
 }
 
-sy_rt_v3 sy_rt_bsdf_eval(const sy_rt_bsdf *b, sy_rt_v3 wo, sy_rt_v3 wi, float *pdf)
+/* The GGX lobes are evaluated (not delta, some glossy weight). */
+static inline bool bsdf_glossy(const sy_rt_bsdf *b) { return !b->delta && (b->q_metal > 0.0f || b->q_spec > 0.0f); }
+
+/* sy_rt_bsdf_eval with the wo-only terms given: nv = n . wo and lv = Lambda(nv) (< 0: computed
+ * here when needed, as a single evaluation does); a batch of directions for one wo computes them
+ * once (sy_rt_pt_record_bsdf_batch). */
+static inline sy_rt_v3 bsdf_eval_wo(const sy_rt_bsdf *b, sy_rt_v3 wo, float nv, float lv, sy_rt_v3 wi, float *pdf)
 {
     *pdf = 0.0f;
-    float nl = v3_dot(b->n, wi), nv = v3_dot(b->n, wo);
+    float nl = v3_dot(b->n, wi);
     if (nl <= 0.0f || nv <= 0.0f || v3_dot(b->ng, wi) <= 0.0f) return v3(0.0f, 0.0f, 0.0f);
     sy_rt_v3 h = v3_normalize(v3_add(wo, wi));
     float vh = fmaxf(v3_dot(wo, h), 0.0f);
     float fd = b->spec * schlick1(b->f0d, vh);
     sy_rt_v3 f = v3_scale(b->base, b->w_diel * (1.0f - fd) * INV_PI);
     float p = b->q_diff * nl * INV_PI;
-    if (!b->delta && (b->q_metal > 0.0f || b->q_spec > 0.0f)) {
+    if (bsdf_glossy(b)) {
         float a2 = b->alpha * b->alpha, nh = fmaxf(v3_dot(b->n, h), 0.0f);
         float D = ggx_d(a2, nh);
-        float lv = ggx_lambda(a2, nv), ll = ggx_lambda(a2, nl);
+        float ll = ggx_lambda(a2, nl);
+        if (lv < 0.0f) lv = ggx_lambda(a2, nv);
         float common = D / (1.0f + lv + ll) / (4.0f * nl * nv);
         f = v3_add(f, v3_scale(schlick3(b->base, vh), b->w_metal * common));
         f = v3_add(f, v3_scale(v3(1.0f, 1.0f, 1.0f), b->w_diel * fd * common));
@@ -124,6 +131,11 @@ sy_rt_v3 sy_rt_bsdf_eval(const sy_rt_bsdf *b, sy_rt_v3 wo, sy_rt_v3 wi, float *p
     }
     *pdf = p;
     return v3_scale(f, nl);
+}
+
+sy_rt_v3 sy_rt_bsdf_eval(const sy_rt_bsdf *b, sy_rt_v3 wo, sy_rt_v3 wi, float *pdf)
+{
+    return bsdf_eval_wo(b, wo, v3_dot(b->n, wo), -1.0f, wi, pdf);
 }
 
 bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], sy_rt_bsdf_sample *out)
@@ -207,11 +219,14 @@ void sy_rt_bsdf_pack(const sy_rt_bsdf *b, float o[SY_RT_RECORD_BSDF_FLOATS])
     memcpy(o, v, sizeof v);
 }
 
-void sy_rt_pt_record_bsdf(const sy_rt_pt_record *r, const float wi[3], float f_cos[3], float *pdf)
+void sy_rt_pt_record_bsdf_batch(const sy_rt_pt_record *r, uint32_t count, const float *const wi[3],
+                                float *const f_cos[3], float *pdf)
 {
-    f_cos[0] = f_cos[1] = f_cos[2] = 0.0f;
-    *pdf = 0.0f;
-    if (!(r->flags & SY_RT_RECORD_P0)) return;
+    if (!(r->flags & SY_RT_RECORD_P0)) {
+        for (uint32_t m = 0; m < count; ++m) f_cos[0][m] = f_cos[1][m] = f_cos[2][m] = pdf[m] = 0.0f;
+        return;
+    }
+    /* unpacked once per batch, with the wo-only terms */
     const float *p = r->bsdf;
     sy_rt_bsdf b;
     memset(&b, 0, sizeof b);
@@ -222,8 +237,19 @@ void sy_rt_pt_record_bsdf(const sy_rt_pt_record *r, const float wi[3], float f_c
     b.delta = p[10] != 0.0f;
     b.f0d = p[11], b.spec = p[12], b.w_metal = p[13], b.w_diel = p[14];
     b.q_metal = p[15], b.q_spec = p[16], b.q_diff = p[17];
-    float q;
-    sy_rt_v3 f = sy_rt_bsdf_eval(&b, v3(r->wo[0], r->wo[1], r->wo[2]), v3(wi[0], wi[1], wi[2]), &q);
-    f_cos[0] = f.x, f_cos[1] = f.y, f_cos[2] = f.z;
-    *pdf = q;
+    sy_rt_v3 wo = v3(r->wo[0], r->wo[1], r->wo[2]);
+    float nv = v3_dot(b.n, wo), lv = bsdf_glossy(&b) && nv > 0.0f ? ggx_lambda(b.alpha * b.alpha, nv) : -1.0f;
+    for (uint32_t m = 0; m < count; ++m) {
+        float q;
+        sy_rt_v3 f = bsdf_eval_wo(&b, wo, nv, lv, v3(wi[0][m], wi[1][m], wi[2][m]), &q);
+        f_cos[0][m] = f.x, f_cos[1][m] = f.y, f_cos[2][m] = f.z;
+        pdf[m] = q;
+    }
+}
+
+void sy_rt_pt_record_bsdf(const sy_rt_pt_record *r, const float wi[3], float f_cos[3], float *pdf)
+{
+    const float *const w[3] = {wi + 0, wi + 1, wi + 2};
+    float *const f[3] = {f_cos + 0, f_cos + 1, f_cos + 2};
+    sy_rt_pt_record_bsdf_batch(r, 1, w, f, pdf);
 }

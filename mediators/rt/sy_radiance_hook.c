@@ -100,11 +100,13 @@ sy_result sy_radiance_hook_records(sy_radiance_hook *h, uint32_t w, uint32_t hgt
 
 uint32_t sy_radiance_hook_frame_index(const sy_radiance_hook *h) { return h ? h->frames : 0u; }
 
-/* The filter's BSDF callback: the owner pixel's record evaluates the path tracer's own BSDF. */
-static void hook_bsdf(const sy_filter_rf_shading *s, const float wi[3], float f_cos[3], float *pdf, void *user)
+/* The filter's (batched) BSDF callback: the owner pixel's record evaluates the path tracer's own
+ * BSDF for a batch of neighbours' directions. */
+static void hook_bsdf_batch(const sy_filter_rf_shading *s, uint32_t count, const float *const wi[3],
+                            float *const f_cos[3], float *pdf, void *user)
 {
     const sy_radiance_hook *h = user;
-    sy_rt_pt_record_bsdf(h->records + (s - h->shading), wi, f_cos, pdf);
+    sy_rt_pt_record_bsdf_batch(h->records + (s - h->shading), count, wi, f_cos, pdf);
 }
 
 /* Seeds the filter and the Welford state from an accumulation of d->prior_samples samples. */
@@ -181,7 +183,7 @@ sy_result sy_radiance_hook_frame(sy_radiance_hook *h, const sy_radiance_hook_fra
                                    .pixel_angle = d->pixel_angle,
                                    .shading = h->shading,
                                    .samples = h->samples,
-                                   .bsdf = hook_bsdf,
+                                   .bsdf_batch = hook_bsdf_batch,
                                    .bsdf_user = h};
     sy_filter_error fe = {0};
     if (sy_filter_radiance_frame(h->rf, &in, h->out, stats, &fe)) {
