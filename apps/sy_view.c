@@ -26,7 +26,9 @@ typedef struct view_cluster view_cluster;
 
 typedef struct viewer {
     const sy_view_args *args;
-    view_cluster *cluster; /* sy view --cluster: used by the render thread only; NULL = local */
+    /* sy view --cluster, NULL = local: set before the threads start, dereferenced by the render
+     * thread only (the window thread tests it for the title) */
+    view_cluster *cluster;
     sy_node cam_node; /* the viewer's own top-level camera node */
     pthread_mutex_t mu;
     pthread_cond_t cv;
@@ -627,8 +629,10 @@ static sy_result view_run(const sy_view_args *args, view_cluster *cluster, sy_er
                 if (img) memcpy(img, v.img, (size_t)v.img_w * v.img_h * 4);
                 iw = img ? v.img_w : 0, ih = img ? v.img_h : 0;
             }
-            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms | %llu spp | sync %.2f ms%s%s", v.status,
-                     v.frame_ms, (unsigned long long)v.spp, v.sync_ms,
+            char sync[32] = ""; /* cluster mode: the servers sync (their time is in the status) */
+            if (!v.cluster) snprintf(sync, sizeof sync, " | sync %.2f ms", v.sync_ms);
+            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms | %llu spp%s%s%s", v.status, v.frame_ms,
+                     (unsigned long long)v.spp, sync,
                      v.stereo == SY_STEREO_SBS ? " | stereo sbs" : v.stereo == SY_STEREO_ANAGLYPH ? " | anaglyph" : "",
                      v.filter_status);
             glfwSetWindowTitle(win, title);

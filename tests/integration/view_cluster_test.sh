@@ -85,7 +85,7 @@ fi
 grep -q "cluster cooperative: pathtracer | 1/2 servers alive" "$W/coop.out" ||
     fail "the title does not report the lost server"
 grep -q "dropped for this frame" "$W/coop.err" || fail "the viewer did not log the lost server"
-spp=$(sed -n 's/.* \([0-9][0-9]*\) spp .*/\1/p' "$W/coop.out")
+spp=$(grep -o '[0-9][0-9]* spp' "$W/coop.out" | tail -n 1 | cut -d' ' -f1)
 [ -n "$spp" ] && [ "$spp" -ge 2 ] || fail "cooperative refinement did not go on after the loss (spp '$spp')"
 "$CMP" "$W/coop.png" "$W/coop.png" 0 20 || fail "the cooperative window is empty"
 
