@@ -270,3 +270,31 @@ float sy_rt_env_sample(const sy_rt_env *env, float u1, float u2, sy_rt_v3 *d, sy
     *radiance = sy_rt_env_eval(env, *d);
     return e->texel_pdf[(size_t)y * e->width + x] * (float)e->width * (float)e->height / (2.0f * PI_F * PI_F * st);
 }
+
+bool sy_rt_punctual_incident(const sy_rt_punctual *l, sy_rt_v3 p, sy_rt_v3 *wi, sy_rt_v3 *e, float *tmax)
+{
+    if (l->type == SY_RT_LIGHT_DIRECTIONAL) {
+        *wi = v3_scale(l->direction, -1.0f);
+        *e = l->radiant;
+        *tmax = INFINITY;
+        return true;
+    }
+    sy_rt_v3 to = v3_sub(l->position, p);
+    float d2 = v3_dot(to, to);
+    if (!(d2 > 0.0f)) return false;
+    float d = sqrtf(d2);
+    *wi = v3_scale(to, 1.0f / d);
+    float att = 1.0f / d2;
+    if (l->range > 0.0f) {
+        float x = d / l->range, w = sy_rt_clampf(1.0f - x * x * x * x, 0.0f, 1.0f);
+        att *= w * w;
+    }
+    if (l->type == SY_RT_LIGHT_SPOT) {
+        float a = sy_rt_clampf(-v3_dot(l->direction, *wi) * l->cone_scale + l->cone_offset, 0.0f, 1.0f);
+        att *= a * a;
+    }
+    if (!(att > 0.0f)) return false;
+    *e = v3_scale(l->radiant, att);
+    *tmax = d - sy_rt_ray_eps(p);
+    return true;
+}

@@ -1,8 +1,9 @@
-/* sy_rt_lights.h — light sampling support of the path tracer: the Vose alias table over the
- * emissive triangles (selection by power in O(1), whatever their number), the environment light
- * (equirectangular texture x intensity, or the constant background colour as a uniform
- * environment) with its importance-sampling distribution, and the area-light pdf of a hit point.
- * Built at sy_rt_commit; read-only while rendering. Internal to backends/rt. */
+/* sy_rt_lights.h — light support of the integrators: punctual-light incidence (Whitted and path
+ * tracer), the Vose alias table over the emissive triangles (selection by power in O(1), whatever
+ * their number), the environment light (equirectangular texture x intensity, or the constant
+ * background colour as a uniform environment) with its importance-sampling distribution, and the
+ * area-light pdf of a hit point. Built at sy_rt_commit; read-only while rendering. Internal to
+ * backends/rt. */
 #ifndef SY_RT_LIGHTS_H
 #define SY_RT_LIGHTS_H
 
@@ -44,6 +45,12 @@ sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d);
 float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d);
 /* Samples a direction from two uniform numbers; returns its pdf (0 = failed) and radiance. */
 float sy_rt_env_sample(const sy_rt_env *env, float u1, float u2, sy_rt_v3 *d, sy_rt_v3 *radiance);
+
+/* Light arriving at point p from punctual light l: the unit direction wi toward the light, the
+ * irradiance-scaled radiance e (KHR_lights_punctual: inverse square, the glTF range window, spot
+ * falloff) and the length of the shadow ray (INFINITY for directional lights). Returns false when
+ * the light contributes nothing at p. */
+bool sy_rt_punctual_incident(const sy_rt_punctual *l, sy_rt_v3 p, sy_rt_v3 *wi, sy_rt_v3 *e, float *tmax);
 
 /* Area-measure pdf with which the alias table + uniform point selection picks a point on an
  * emissive instance (the same value for every point of the instance's non-degenerate triangles). */

@@ -29,6 +29,8 @@ static inline sy_rt_v3 v3_normalize(sy_rt_v3 a)
     return l2 > 0.0f ? v3_scale(a, 1.0f / sqrtf(l2)) : v3(0.0f, 0.0f, 0.0f);
 }
 static inline float v3_max_abs(sy_rt_v3 a) { return fmaxf(fabsf(a.x), fmaxf(fabsf(a.y), fabsf(a.z))); }
+/* Offset for secondary rays leaving point p (scales with its magnitude: float precision). */
+static inline float sy_rt_ray_eps(sy_rt_v3 p) { return 1e-4f * (1.0f + v3_max_abs(p)); }
 static inline bool v3_is_zero(sy_rt_v3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
 static inline float v3_luminance(sy_rt_v3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 static inline float sy_rt_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }

@@ -45,7 +45,6 @@ typedef struct pt_ctx {
     uint64_t rays;
 } pt_ctx;
 
-static float ray_eps(sy_rt_v3 p) { return 1e-4f * (1.0f + v3_max_abs(p)); }
 static float maxc(sy_rt_v3 v) { return fmaxf(v.x, fmaxf(v.y, v.z)); }
 static float power_heuristic(float a, float b)
 {
@@ -77,7 +76,7 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
     if (j->has_area && k++ == cat) kind = 0;
     else if (j->has_env && k++ == cat) kind = 1;
     else if (j->has_punctual) kind = 2;
-    sy_rt_v3 p_off = v3_madd(s->p, b->ng, ray_eps(s->p));
+    sy_rt_v3 p_off = v3_madd(s->p, b->ng, sy_rt_ray_eps(s->p));
     if (kind == 0) {
         const sy_rt_area_tri *t = &dev->area[sy_rt_alias_pick(dev, ur)];
         float su = sqrtf(u[1]), bu = su * (1.0f - u[2]), bv = su * u[2];
@@ -95,7 +94,7 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
         if (v3_is_zero(f)) return zero;
         float pdf_l = sy_rt_area_pdf(dev, t->inst) * d2 / cos_l * p_cat;
         if (!(pdf_l > 0.0f)) return zero;
-        float tmax = d - ray_eps(q) - ray_eps(s->p);
+        float tmax = d - sy_rt_ray_eps(q) - sy_rt_ray_eps(s->p);
         if (tmax > 0.0f && !unoccluded(c, p_off, wi, tmax)) return zero;
         sy_rt_v3 le = sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv);
         return v3_scale(v3_mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l);
@@ -113,32 +112,9 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
     if (kind == 2) {
         uint32_t n = dev->punctual_count, i = (uint32_t)(ur * (float)n);
         if (i >= n) i = n - 1u;
-        const sy_rt_punctual *l = &dev->punctual[i];
         sy_rt_v3 wi, e;
         float tmax;
-        if (l->type == SY_RT_LIGHT_DIRECTIONAL) {
-            wi = v3_scale(l->direction, -1.0f);
-            e = l->radiant;
-            tmax = INFINITY;
-        } else {
-            wi = v3_sub(l->position, s->p);
-            float d2 = v3_dot(wi, wi);
-            if (!(d2 > 0.0f)) return zero;
-            float d = sqrtf(d2);
-            wi = v3_scale(wi, 1.0f / d);
-            float att = 1.0f / d2;
-            if (l->range > 0.0f) {
-                float xr = d / l->range, w = sy_rt_clampf(1.0f - xr * xr * xr * xr, 0.0f, 1.0f);
-                att *= w * w;
-            }
-            if (l->type == SY_RT_LIGHT_SPOT) {
-                float a = sy_rt_clampf(-v3_dot(l->direction, wi) * l->cone_scale + l->cone_offset, 0.0f, 1.0f);
-                att *= a * a;
-            }
-            if (!(att > 0.0f)) return zero;
-            e = v3_scale(l->radiant, att);
-            tmax = d - ray_eps(s->p);
-        }
+        if (!sy_rt_punctual_incident(&dev->punctual[i], s->p, &wi, &e, &tmax)) return zero;
         float pdf_b;
         sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
         if (v3_is_zero(f)) return zero;
@@ -225,7 +201,7 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
             rng = sy_rt_hash32(rng + 0x9e3779b9u);
             if (sy_rt_u01(rng) >= sy_rt_clampf(s.alpha, 0.0f, 1.0f)) { /* pass through */
                 if (++crossings > 64u) break;
-                org = v3_madd(s.p, s.ng_facing, -ray_eps(s.p));
+                org = v3_madd(s.p, s.ng_facing, -sy_rt_ray_eps(s.p));
                 dir = d;
                 tnear = 0.0f;
                 tfar = INFINITY;
@@ -296,7 +272,7 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
             beta_s = v3_scale(beta_s, 1.0f / q);
         }
         if (v3_is_zero(beta)) break;
-        org = v3_madd(s.p, b.ng, bs.transmit ? -ray_eps(s.p) : ray_eps(s.p));
+        org = v3_madd(s.p, b.ng, bs.transmit ? -sy_rt_ray_eps(s.p) : sy_rt_ray_eps(s.p));
         dir = bs.wi;
         tnear = 0.0f;
         tfar = INFINITY;

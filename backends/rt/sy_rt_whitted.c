@@ -30,7 +30,6 @@ typedef struct trace_ctx {
 
 typedef struct rgba_t { sy_rt_v3 rgb; float a; } rgba_t;
 
-static float ray_eps(sy_rt_v3 p) { return 1e-4f * (1.0f + v3_max_abs(p)); }
 
 /* True when nothing blocks the segment org + t*dir, t in (0, tfar). */
 static bool visible(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar)
@@ -110,7 +109,7 @@ static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 p_off
         if (t->double_sided) cos_l = fabsf(cos_l);
         float cos_s = v3_dot(s->ns, wi);
         if (cos_l <= 0.0f || cos_s <= 0.0f || v3_dot(s->ng_facing, wi) <= 0.0f) continue;
-        float tmax = d - ray_eps(q) - ray_eps(s->p);
+        float tmax = d - sy_rt_ray_eps(q) - sy_rt_ray_eps(s->p);
         if (tmax > 0.0f && !visible(c, p_off, wi, tmax)) continue;
         sy_rt_v3 le = sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv);
         float g = cos_s * cos_l / d2 * t->area / p_sel;
@@ -124,33 +123,9 @@ static sy_rt_v3 direct_punctual(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 p
     const sy_rt_device *dev = c->dev;
     sy_rt_v3 sum = v3(0.0f, 0.0f, 0.0f);
     for (uint32_t i = 0; i < dev->punctual_count; ++i) {
-        const sy_rt_punctual *l = &dev->punctual[i];
         sy_rt_v3 wi, e;
         float tmax;
-        if (l->type == SY_RT_LIGHT_DIRECTIONAL) {
-            wi = v3_scale(l->direction, -1.0f);
-            e = l->radiant;
-            tmax = INFINITY;
-        } else {
-            wi = v3_sub(l->position, s->p);
-            float d2 = v3_dot(wi, wi);
-            if (!(d2 > 0.0f)) continue;
-            float d = sqrtf(d2);
-            wi = v3_scale(wi, 1.0f / d);
-            float att = 1.0f / d2;
-            if (l->range > 0.0f) {
-                float x = d / l->range, w = sy_rt_clampf(1.0f - x * x * x * x, 0.0f, 1.0f);
-                att *= w * w;
-            }
-            if (l->type == SY_RT_LIGHT_SPOT) {
-                float cd = -v3_dot(l->direction, wi);
-                float a = sy_rt_clampf(cd * l->cone_scale + l->cone_offset, 0.0f, 1.0f);
-                att *= a * a;
-            }
-            if (!(att > 0.0f)) continue;
-            e = v3_scale(l->radiant, att);
-            tmax = d - ray_eps(s->p);
-        }
+        if (!sy_rt_punctual_incident(&dev->punctual[i], s->p, &wi, &e, &tmax)) continue;
         float cos_s = v3_dot(s->ns, wi);
         if (cos_s <= 0.0f || v3_dot(s->ng_facing, wi) <= 0.0f) continue;
         if (!visible(c, p_off, wi, tmax)) continue;
@@ -183,7 +158,7 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
         out.rgb = s->base;
     } else {
         sy_rt_v3 wo = v3_scale(d, -1.0f);
-        float eps = ray_eps(s->p);
+        float eps = sy_rt_ray_eps(s->p);
         sy_rt_v3 p_out = v3_madd(s->p, s->ng_facing, eps);  /* the side the ray came from */
         sy_rt_v3 p_in = v3_madd(s->p, s->ng_facing, -eps);  /* the other side */
         sy_rt_v3 L = direct_punctual(c, s, p_out, wo);
@@ -226,7 +201,7 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
         float a = sy_rt_clampf(s->alpha, 0.0f, 1.0f);
         rgba_t behind = {v3(0.0f, 0.0f, 0.0f), 0.0f};
         if (depth + 1u < c->f->max_depth)
-            behind = trace(c, v3_madd(s->p, s->ng_facing, -ray_eps(s->p)), d, 0.0f, INFINITY, depth + 1u, &c->ictx, NULL);
+            behind = trace(c, v3_madd(s->p, s->ng_facing, -sy_rt_ray_eps(s->p)), d, 0.0f, INFINITY, depth + 1u, &c->ictx, NULL);
         out.rgb = v3_add(v3_scale(out.rgb, a), v3_scale(behind.rgb, 1.0f - a));
         out.a = a + (1.0f - a) * behind.a;
     }
