@@ -18,10 +18,7 @@ static void raw_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0,
         for (uint32_t px = x0; px < x1; ++px) {
             struct RTCRayHit rh;
             float axial;
-            sy_rt_frame_ray(f, px, py, &rh.ray, &axial);
-            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            rtcIntersect1(f->dev->top, &ctx, &rh);
+            sy_rt_frame_hit(f, &ctx, px, py, &rh, &axial);
             tbuf[(size_t)(py - f->y) * f->width + (px - f->x)] =
                 rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar;
         }

@@ -15,10 +15,7 @@ void sy_rt_coverage_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
         for (uint32_t px = x0; px < x1; ++px) {
             struct RTCRayHit rh;
             float axial;
-            sy_rt_frame_ray(f, px, py, &rh.ray, &axial);
-            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            rtcIntersect1(f->dev->top, &ctx, &rh);
+            sy_rt_frame_hit(f, &ctx, px, py, &rh, &axial);
             size_t o = (size_t)(py - f->y) * f->width + (px - f->x);
             const sy_rt_instance_data *in = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID
                                                 ? NULL

@@ -73,6 +73,17 @@ static inline const sy_rt_instance_data *sy_rt_intersect(const sy_rt_device *dev
                                                      : sy_rt_hit_instance(dev, rh->hit.geomID, rh->hit.instID[0]);
 }
 
+/* Nearest hit of the camera ray through the centre of pixel (px, py) (sy_rt_frame_ray): fills *rh
+ * (geomID RTC_INVALID_GEOMETRY_ID on a miss) and *axial. */
+static inline void sy_rt_frame_hit(const sy_rt_frame *f, struct RTCIntersectContext *ctx, uint32_t px, uint32_t py,
+                                   struct RTCRayHit *rh, float *axial)
+{
+    sy_rt_frame_ray(f, px, py, &rh->ray, axial);
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(f->dev->top, ctx, rh);
+}
+
 /* Renders one tile: pixels [x0, x1) x [y0, y1) in full-image coordinates. */
 typedef void (*sy_rt_tile_fn)(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1);
 
