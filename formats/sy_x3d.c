@@ -178,20 +178,29 @@ static bool parse_numbers(const char *s, double **out, size_t *n)
     return true;
 }
 
+/* Attribute `name` of el as a list of numbers into *v (malloc()ed, NULL when empty). Returns 1 when
+ * present, 0 when absent, -1 (warned as "not a list of <what>; <then>") when malformed. */
+static int attr_numbers(loader *L, xfile *F, const xmlNode *el, const char *name, const char *what, const char *then,
+                        double **v, size_t *n)
+{
+    *v = NULL;
+    *n = 0;
+    char *s = attr(el, name);
+    if (!s) return 0;
+    bool ok = parse_numbers(s, v, n);
+    xmlFree(s);
+    if (ok) return 1;
+    warn(L, "%s:%d: %s.%s: not a list of %s; %s", F->path, line_of(el), ename(el), name, what, then);
+    return -1;
+}
+
 /* Numeric attribute: fills up to max values into out (defaults kept otherwise); returns the
  * number of values in the attribute (0 when absent or bad: warned). */
 static size_t get_floats(loader *L, xfile *F, const xmlNode *el, const char *name, float *out, size_t max)
 {
-    char *s = attr(el, name);
-    if (!s) return 0;
     double *v;
     size_t n;
-    if (!parse_numbers(s, &v, &n)) {
-        warn(L, "%s:%d: %s.%s: not a list of numbers; ignored", F->path, line_of(el), ename(el), name);
-        xmlFree(s);
-        return 0;
-    }
-    xmlFree(s);
+    if (attr_numbers(L, F, el, name, "numbers", "ignored", &v, &n) <= 0) return 0;
     for (size_t k = 0; k < n && k < max; k++) out[k] = (float)v[k];
     free(v);
     return n;
@@ -221,16 +230,10 @@ static bool get_float_array(loader *L, xfile *F, const xmlNode *el, const char *
 {
     *out = NULL;
     *count = 0;
-    char *s = attr(el, name);
-    if (!s) return true;
     double *v;
     size_t n;
-    bool ok = parse_numbers(s, &v, &n);
-    xmlFree(s);
-    if (!ok) {
-        warn(L, "%s:%d: %s.%s: not a list of numbers; geometry skipped", F->path, line_of(el), ename(el), name);
-        return false;
-    }
+    int present = attr_numbers(L, F, el, name, "numbers", "geometry skipped", &v, &n);
+    if (present <= 0) return present == 0;
     if (n % group)
         warn(L, "%s:%d: %s.%s: %zu values are not a multiple of %zu; the rest is ignored", F->path, line_of(el),
              ename(el), name, n, group);
@@ -251,16 +254,10 @@ static bool get_int_array(loader *L, xfile *F, const xmlNode *el, const char *na
 {
     *out = NULL;
     *count = 0;
-    char *s = attr(el, name);
-    if (!s) return true;
     double *v;
     size_t n;
-    bool ok = parse_numbers(s, &v, &n);
-    xmlFree(s);
-    if (!ok) {
-        warn(L, "%s:%d: %s.%s: not a list of integers; geometry skipped", F->path, line_of(el), ename(el), name);
-        return false;
-    }
+    int present = attr_numbers(L, F, el, name, "integers", "geometry skipped", &v, &n);
+    if (present <= 0) return present == 0;
     int32_t *a = malloc((n ? n : 1) * sizeof *a);
     if (!a) {
         free(v);
