@@ -142,16 +142,7 @@ static void *field_ptr(const sy_type_desc *td, uint32_t f, const void *data)
 
 static void prims_free(sy_primitive_list *l)
 {
-    for (uint32_t i = 0; i < l->count; ++i) {
-        sy_primitive *p = &l->items[i];
-        sy_blob_release(p->positions);
-        sy_blob_release(p->normals);
-        sy_blob_release(p->tangents);
-        sy_blob_release(p->texcoords0);
-        sy_blob_release(p->texcoords1);
-        sy_blob_release(p->colors);
-        sy_blob_release(p->indices);
-    }
+    for (uint32_t i = 0; i < l->count; ++i) sy_primitive_release(&l->items[i]);
     free(l->items);
     l->items = NULL;
     l->count = 0;

@@ -1056,6 +1056,13 @@ uint32_t sy_primitive_triangle_count(const sy_primitive *p)
     return p->indices ? (uint32_t)(sy_blob_size(p->indices) / 12) : sy_primitive_vertex_count(p) / 3;
 }
 
+void sy_primitive_release(sy_primitive *p)
+{
+    sy_blob *blobs[7] = {p->positions, p->texcoords0, p->texcoords1, p->normals, p->tangents, p->colors, p->indices};
+    for (int i = 0; i < 7; ++i) sy_blob_release(blobs[i]);
+    memset(p, 0, sizeof *p);
+}
+
 bool sy_texture_ref_matrix(const sy_texture_ref *r, float m[6])
 {
     /* KHR_texture_transform (ratified): uv' = offset + R (uv_scale * uv), R = [cos sin; -sin cos]

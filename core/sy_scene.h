@@ -134,6 +134,8 @@ typedef struct sy_mesh_data {
 
 uint32_t sy_primitive_vertex_count(const sy_primitive *p);
 uint32_t sy_primitive_triangle_count(const sy_primitive *p);
+/* Releases the primitive's blob references (NULL ones are skipped) and zeroes it. */
+void sy_primitive_release(sy_primitive *p);
 
 /* ---------------------------------------------------------------- material (glTF 2.0 metallic-roughness) */
 typedef enum sy_alpha_mode { SY_ALPHA_OPAQUE = 0, SY_ALPHA_MASK = 1, SY_ALPHA_BLEND = 2 } sy_alpha_mode;

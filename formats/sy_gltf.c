@@ -780,18 +780,6 @@ static sy_result create_material(loader *L, size_t i)
 
 /* >>meshes ------------------------------------------------------------------------------------ */
 
-static void release_primitive(sy_primitive *p)
-{
-    sy_blob_release(p->positions);
-    sy_blob_release(p->normals);
-    sy_blob_release(p->tangents);
-    sy_blob_release(p->texcoords0);
-    sy_blob_release(p->texcoords1);
-    sy_blob_release(p->colors);
-    sy_blob_release(p->indices);
-    memset(p, 0, sizeof *p);
-}
-
 /* Takes ownership of data (freed on failure too). */
 static sy_result make_blob(loader *L, void *data, size_t bytes, sy_blob **out)
 {
@@ -962,13 +950,13 @@ static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *
         (r = read_attribute(L, pr->texcoord0, vcount, 2, m, p, "TEXCOORD_0", &out->texcoords0)) ||
         (r = read_attribute(L, pr->texcoord1, vcount, 2, m, p, "TEXCOORD_1", &out->texcoords1)) ||
         (r = read_attribute(L, pr->color0, vcount, 4, m, p, "COLOR_0", &out->colors))) {
-        release_primitive(out);
+        sy_primitive_release(out);
         return r;
     }
     /* glTF 2.0: without NORMAL the client computes flat normals; a normal map without TANGENT
      * needs generated tangents (sy_mesh_util: MikkTSpace-style angle-weighted accumulation). */
     if (!out->normals && (r = sy_prim_make_flat_normals(out, &L->err))) {
-        release_primitive(out);
+        sy_primitive_release(out);
         return fail(L, r, "meshes[%zu].primitives[%zu]: flat normals: %s", m, p, L->err.message);
     }
     if (!out->tangents && pr->material >= 0 && d->materials[pr->material].normal_texture.index >= 0) {
@@ -978,7 +966,7 @@ static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *
         if (!(tc ? out->texcoords1 : out->texcoords0)) {
             warn(L, "meshes[%zu].primitives[%zu]: normal map without TEXCOORD_%d; tangents not generated", m, p, (int)tc);
         } else if ((r = sy_prim_generate_tangents(out, (uint32_t)tc, &L->err))) {
-            release_primitive(out);
+            sy_primitive_release(out);
             return fail(L, r, "meshes[%zu].primitives[%zu]: tangents: %s", m, p, L->err.message);
         }
     }
@@ -1026,8 +1014,8 @@ static sy_result create_mesh(loader *L, size_t m)
     L->meshes[m] = h;
     L->mesh_triangles[m] = triangles;
 done:
-    for (uint32_t k = 0; k < used_count; k++) release_primitive(&prims[k]);
-    if (r) release_primitive(&prims[used_count]); /* a primitive that failed half-way released itself; harmless */
+    for (uint32_t k = 0; k < used_count; k++) sy_primitive_release(&prims[k]);
+    if (r) sy_primitive_release(&prims[used_count]); /* a primitive that failed half-way released itself; harmless */
     free(prims);
     return r;
 }

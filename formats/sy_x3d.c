@@ -1594,9 +1594,7 @@ static sy_result visit_shape(loader *L, xfile *F, const xmlNode *el, const sy_ma
         } else {
             sy_error_prefix(&L->err, "%s:%d: Shape", F->path, line_of(el));
         }
-        sy_blob_release(prim.positions); sy_blob_release(prim.normals); sy_blob_release(prim.tangents);
-        sy_blob_release(prim.texcoords0); sy_blob_release(prim.texcoords1); sy_blob_release(prim.colors);
-        sy_blob_release(prim.indices);
+        sy_primitive_release(&prim);
         if (r) return r;
     }
     if (c->mesh && (r = sy_node_set_mesh(L->scene, h, (sy_mesh){c->mesh}, &L->err))) return r;

@@ -100,13 +100,6 @@ static inline sy_primitive it_quad_prim(float cx, float cy, float h, sy_material
     return p;
 }
 
-static inline void it_prim_release(sy_primitive *p)
-{
-    sy_blob_release(p->positions);
-    sy_blob_release(p->normals);
-    sy_blob_release(p->indices);
-}
-
 /* A mesh of `count` quads (one primitive each) given as (cx, cy, h) triples. */
 static inline sy_mesh it_quad_mesh(sy_scene *s, const char *name, const float (*quads)[3], const sy_material *mats,
                             uint32_t count)
@@ -116,7 +109,7 @@ static inline sy_mesh it_quad_mesh(sy_scene *s, const char *name, const float (*
     MUST(sy_mesh_create(s, name, &m, err));
     for (uint32_t i = 0; i < count; ++i) prims[i] = it_quad_prim(quads[i][0], quads[i][1], quads[i][2], mats[i]);
     MUST(sy_mesh_set_primitives(s, m, prims, count, err));
-    for (uint32_t i = 0; i < count; ++i) it_prim_release(&prims[i]);
+    for (uint32_t i = 0; i < count; ++i) sy_primitive_release(&prims[i]);
     return m;
 }
 
