@@ -68,7 +68,6 @@ typedef struct rt_state {
     float specular; /* "specular" parameter: KHR_materials_specular factor given to every material */
     uint32_t current_bg; /* background id applied to the device */
     bool bg_applied;
-    bool needs_commit;
     sy_mediator_rt_counters counters;
     uint64_t frames_rendered;
     accum_slot slots[ACCUM_SLOTS]; /* path tracer only */
@@ -147,7 +146,6 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     sy_rt_result r = h.id ? sy_rt_material_update(st->dev, h, &d, e, sizeof e)
                           : sy_rt_material_create(st->dev, &d, &h, e, sizeof e);
     *a->handle = h.id;
-    st->needs_commit = true;
     return r == SY_RT_OK ? SY_OK : rt_fail(err, r, "material", e);
 }
 
@@ -254,9 +252,7 @@ static void cb_release(void *user, const sy_mirror_release_args *a)
 static void cb_object_changed(void *user, const sy_mirror_object_args *a)
 {
     rt_state *st = user;
-    if (a->type == SY_TYPE_MATERIAL) {
-        st->needs_commit = true;
-    } else if (a->type == SY_TYPE_BACKGROUND) {
+    if (a->type == SY_TYPE_BACKGROUND) {
         if (st->current_bg == a->id) st->bg_applied = false;
     } else if (a->type == SY_TYPE_TEXTURE) {
         const sy_mirror_background *cb = sy_mirror_background_get(st->mirror, st->current_bg);
@@ -282,15 +278,12 @@ static sy_result rt_sync(void *state, const sy_changes *changes, sy_error *err)
     sy_result r = sy_mirror_sync(st->mirror, changes, &ms, err);
     st->counters.last_sync_placements = ms.placements;
     st->counters.last_sync_entries = ms.entries;
-    if (ms.placements || ms.nodes_destroyed) st->needs_commit = true;
-    /* sy_rt_commit is a no-op on a clean device; a texture or material that no placement uses
-     * (yet) dirties the device too, and an uncommitted device refuses to render */
-    if (r == SY_OK && ms.entries) st->needs_commit = true;
-    if (r == SY_OK && st->needs_commit) {
+    /* The device tracks what is staged (sy_rt_commit is a no-op on a clean device), so every
+     * successful sync ends with a commit: an uncommitted device refuses to render. */
+    if (r == SY_OK) {
         char e[ERRLEN];
         sy_rt_result rr = sy_rt_commit(st->dev, e, sizeof e);
         if (rr != SY_RT_OK) r = rt_fail(err, rr, "commit", e);
-        st->needs_commit = false;
     }
     sy_rt_stats s;
     sy_rt_device_stats(st->dev, &s);
@@ -458,13 +451,10 @@ sy_result sy_mediator_rt_coverage(void *state, const sy_camera_view *view, uint3
     if (!sy_size_mul(width, height, &n) || n == 0) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "coverage: bad size %ux%u", width, height);
     uint32_t *ids = malloc(n * sizeof *ids);
     if (!ids) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "coverage: out of memory for %ux%u", width, height);
-    if (st->needs_commit) {
-        sy_rt_result cr = sy_rt_commit(st->dev, e, sizeof e);
-        if (cr != SY_RT_OK) {
-            free(ids);
-            return rt_fail(err, cr, "commit", e);
-        }
-        st->needs_commit = false;
+    sy_rt_result cr = sy_rt_commit(st->dev, e, sizeof e); /* no-op unless a failed sync left changes */
+    if (cr != SY_RT_OK) {
+        free(ids);
+        return rt_fail(err, cr, "commit", e);
     }
     sy_rt_result r = sy_rt_coverage(st->dev, &cam, &d, ids, NULL, e, sizeof e);
     if (r != SY_RT_OK) {
