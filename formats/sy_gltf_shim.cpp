@@ -127,28 +127,25 @@ bool load_image(tinygltf::Image *image, const int image_idx, std::string *err, s
     int w2 = 0, h2 = 0, c2 = 0;
     bool is16 = stbi_is_16_bit_from_memory(bytes, int(len)) != 0;
     image->image.resize(n);
+    // decode (16-bit sources are rounded to 8 bits); a size that differs from the header is a failure
+    bool ok = false;
     if (is16) {
         stbi_us *p = stbi_load_16_from_memory(bytes, int(len), &w2, &h2, &c2, req);
-        if (p && (w2 != w || h2 != h)) { stbi_image_free(p); p = nullptr; }
-        if (!p) {
-            image->image.clear();
-            const char *why = stbi_failure_reason();
-            ctx->image_problems[image_idx] = "cannot decode image (" + std::string(why ? why : "unknown") + ")";
-            return true;
-        }
-        for (size_t i = 0; i < n; i++) image->image[i] = (unsigned char)((uint32_t(p[i]) * 255u + 32767u) / 65535u);
+        ok = p && w2 == w && h2 == h;
+        if (ok)
+            for (size_t i = 0; i < n; i++) image->image[i] = (unsigned char)((uint32_t(p[i]) * 255u + 32767u) / 65535u);
         stbi_image_free(p);
     } else {
         stbi_uc *p = stbi_load_from_memory(bytes, int(len), &w2, &h2, &c2, req);
-        if (p && (w2 != w || h2 != h)) { stbi_image_free(p); p = nullptr; }
-        if (!p) {
-            image->image.clear();
-            const char *why = stbi_failure_reason();
-            ctx->image_problems[image_idx] = "cannot decode image (" + std::string(why ? why : "unknown") + ")";
-            return true;
-        }
-        memcpy(image->image.data(), p, n);
+        ok = p && w2 == w && h2 == h;
+        if (ok) memcpy(image->image.data(), p, n);
         stbi_image_free(p);
+    }
+    if (!ok) {
+        image->image.clear();
+        const char *why = stbi_failure_reason();
+        ctx->image_problems[image_idx] = "cannot decode image (" + std::string(why ? why : "unknown") + ")";
+        return true;
     }
     image->width = w;
     image->height = h;
