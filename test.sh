@@ -1,20 +1,32 @@
 #!/usr/bin/env bash
-# test.sh — the whole test suite: installs what is missing (Debian), builds two configurations
-# (optimised, and AddressSanitizer + UndefinedBehaviorSanitizer) and runs ctest in both.
-set -euo pipefail
+# test.sh — the whole test suite: installs what is missing (Debian), builds three configurations
+# (optimised; AddressSanitizer + UndefinedBehaviorSanitizer; clang with libFuzzer) and runs ctest in
+# each. Every step runs even when an earlier one failed; the exit status is non-zero when any failed.
+set -uo pipefail
 cd "$(dirname "$0")"
 . .ci/deps.sh
-sy_install_deps
+sy_install_deps || exit 1
 jobs=$(nproc 2>/dev/null || echo 2)
-sy_configure_build build -- -DCMAKE_BUILD_TYPE=RelWithDebInfo
-ctest --test-dir build --output-on-failure -j "$jobs"
-sy_configure_build build-asan -- -DCMAKE_BUILD_TYPE=Debug -DSY_SANITIZE=ON
-# tests/lsan.supp names third-party driver libraries (Mesa, GLX, GLFW) only, never our code.
-ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+failed=()
+step() { # step NAME COMMAND...: runs the command, remembers NAME when it fails
+    local name=$1
+    shift
+    "$@" || failed+=("$name")
+}
+step "build (RelWithDebInfo)" sy_configure_build build -- -DCMAKE_BUILD_TYPE=RelWithDebInfo &&
+  step "ctest (RelWithDebInfo)" ctest --test-dir build --output-on-failure -j "$jobs"
+# Sanitizer build: every executable keeps dlopen()ed GL drivers loaded until exit
+# (tests/support/sy_keep_loaded.c), so LeakSanitizer needs one suppression only (tests/lsan.supp).
+step "build (ASan+UBSan)" sy_configure_build build-asan -- -DCMAKE_BUILD_TYPE=Debug -DSY_SANITIZE=ON &&
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0" \
-  ctest --test-dir build-asan --output-on-failure -j "$jobs"
+  step "ctest (ASan+UBSan)" ctest --test-dir build-asan --output-on-failure -j "$jobs"
 # Fuzzing (tests/fuzz): clang + libFuzzer, only the fuzz targets; each fuzz_run_* test fuzzes
-# SY_FUZZ_SECONDS on seeds from ../shared/testdata (about 2 minutes in all with the build).
-CC=clang CXX=clang++ sy_configure_build build-fuzz sy_fuzzers -- -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSY_FUZZ=ON \
-  -DSY_FUZZ_SECONDS=15
-ctest --test-dir build-fuzz --output-on-failure -L fuzz
+# SY_FUZZ_SECONDS on seeds from ../shared/testdata (tests/fuzz/fuzz.sh runs long campaigns).
+CC=clang CXX=clang++ step "build (libFuzzer)" sy_configure_build build-fuzz sy_fuzzers -- \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSY_FUZZ=ON -DSY_FUZZ_SECONDS=15 &&
+  step "ctest (fuzz)" ctest --test-dir build-fuzz --output-on-failure -L fuzz
+if [ ${#failed[@]} -gt 0 ]; then
+  printf 'test.sh: failed: %s\n' "${failed[@]}"
+  exit 1
+fi

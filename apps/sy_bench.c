@@ -415,7 +415,7 @@ static sy_result bench_one_load(const char *label, const char *path, uint32_t re
     else dir[0] = '\0';
     size_t n = strlen(path);
     bool binary = n > 4 && !strcmp(path + n - 4, ".glb");
-    sy_gltf_shim_limits lim = {(size_t)2 << 30, (uint64_t)1 << 26};
+    sy_gltf_shim_limits lim = {.max_file_bytes = (size_t)2 << 30, .max_image_pixels = (uint64_t)1 << 26};
     uint32_t tris = 0;
     for (uint32_t k = 0; r == SY_OK && k < repeats; k++) {
         /* tinygltf alone: read + parse (buffers, image decoding), nothing else */

@@ -2,15 +2,23 @@
  * (see sy_cluster_cli.h). The protocol and the modes live in core/sy_cluster.c. */
 #define _GNU_SOURCE /* sched_setaffinity for the pinned benchmark servers */
 #include "sy_cluster_cli.h"
+#include "sy_signals.h"
 
 #include "sy_demo.h"
 #include "sy_exr.h"
 #include "sy_file.h"
 #include "sy_png.h"
 
+#include <arpa/inet.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <netinet/in.h>
+#include <pthread.h>
 #include <sched.h>
+#include <stdatomic.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <time.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,14 +27,6 @@
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-static volatile int g_stop; /* set by SIGINT / SIGTERM in `sy serve` (the process's only server) */
-
-static void on_signal(int sig)
-{
-    (void)sig;
-    g_stop = 1;
-}
 
 static bool has_suffix(const char *s, const char *suffix)
 {
@@ -73,11 +73,23 @@ static sy_result write_port_file(const char *path, int port, sy_error *err)
     return sy_atomic_file_commit(&af, err);
 }
 
+/* A whole decimal number in [lo, hi] (the option's value); false for anything else. */
+static bool uint_arg(const char *s, unsigned long long lo, unsigned long long hi, unsigned long long *out)
+{
+    char *end = NULL;
+    errno = 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (errno || !end || end == s || *end || s[0] == '-' || v < lo || v > hi) return false;
+    *out = v;
+    return true;
+}
+
 int sy_cmd_serve(int argc, char **argv)
 {
     sy_cluster_server_opts o = {0};
     const char *secret_file = NULL, *port_file = NULL;
     present_ctx pc = {0};
+    unsigned long long v = 0;
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
@@ -93,12 +105,26 @@ int sy_cmd_serve(int argc, char **argv)
         else if (!strcmp(a, "--blob-cache-mb") && has) o.blob_cache_bytes = (size_t)strtoul(argv[++i], NULL, 10) << 20;
         else if (!strcmp(a, "--max-objects") && has) o.max_objects = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(a, "--auth-backoff-ms") && has) o.auth_backoff_ms = (uint32_t)strtoul(argv[++i], NULL, 10);
+        /* budgets against hostile peers (docs/PROTOCOL.md, "Budgets and limits") */
+        else if (!strcmp(a, "--max-peer-memory-mb") && has && uint_arg(argv[i + 1], 1, 1u << 20, &v))
+            o.max_peer_memory = (size_t)v << 20, ++i;
+        else if (!strcmp(a, "--max-frame-kb") && has && uint_arg(argv[i + 1], 64, 1u << 20, &v))
+            o.max_frame = (size_t)v << 10, ++i;
+        else if (!strcmp(a, "--max-message-mb") && has && uint_arg(argv[i + 1], 1, 1u << 20, &v))
+            o.max_message = (size_t)v << 20, ++i;
+        else if (!strcmp(a, "--max-unauthenticated") && has && uint_arg(argv[i + 1], 1, 65536, &v))
+            o.max_unauthenticated = (uint32_t)v, ++i;
+        else if (!strcmp(a, "--handshake-timeout-ms") && has && uint_arg(argv[i + 1], 100, 600000, &v))
+            o.handshake_timeout_ms = (uint32_t)v, ++i;
         else {
             fprintf(stderr,
                     "usage: sy serve [--listen tcp://HOST:PORT|tls+tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png]\n"
                     "                [--port-file F] [--tls-cert PEM --tls-key PEM] [--name NAME] [--max-sessions N]\n"
                     "                [--blob-cache-mb N (1024)] [--max-objects N per type (1048576)]\n"
                     "                [--auth-backoff-ms MS (250, doubled per failed authentication)]\n"
+                    "                [--max-peer-memory-mb N (1024: all peers' messages in flight)]\n"
+                    "                [--max-frame-kb N (8192, 64..1048576)] [--max-message-mb N (1024)]\n"
+                    "                [--max-unauthenticated N (32)] [--handshake-timeout-ms MS (3000)]\n"
                     "                [--max-lifetime SECONDS]\n"
                     "  the secret comes from --secret-file or $SY_CLUSTER_SECRET; without one only loopback is allowed\n");
             return 1;
@@ -116,9 +142,8 @@ int sy_cmd_serve(int argc, char **argv)
     o.secret_len = secret_len;
     o.present = present_tile;
     o.present_user = &pc;
-    o.stop = &g_stop;
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
+    o.stop = sy_signals_stop_flag(); /* SIGINT / SIGTERM: the first stops the server cleanly */
+    sy_signals_set_graceful("stopping the server");
     signal(SIGPIPE, SIG_IGN);
     sy_cluster_server *s = NULL;
     sy_result r = sy_cluster_server_create(&o, &s, &err);
@@ -612,15 +637,184 @@ static sy_result bench_half_and_blob_cache(sy_scene *scene, const sy_cluster_cli
     return r;
 }
 
+/* >>hostile peers (issue 14): connections that never authenticate. Tricklers announce a 256 MiB
+ * message and send 64 KiB every 100 ms; flooders announce 8 MiB and send it as fast as they can;
+ * both reconnect whenever the server closes them. Plain sockets, 127.0.0.1 only. */
+typedef struct hostile_peer {
+    int port;
+    bool flood;
+    atomic_int *stop;
+    uint64_t bytes;
+    uint32_t conns;
+} hostile_peer;
+
+static int hostile_connect(int port)
+{
+    int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (fd < 0) return -1;
+    struct timeval tv = {2, 0};
+    setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
+    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+static bool hostile_send(int fd, const void *p, size_t n)
+{
+    while (n) {
+        ssize_t k = send(fd, p, n, MSG_NOSIGNAL);
+        if (k <= 0) return false;
+        p = (const uint8_t *)p + k;
+        n -= (size_t)k;
+    }
+    return true;
+}
+
+static void hostile_sleep_ms(int ms)
+{
+    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}
+
+static void *hostile_main(void *arg)
+{
+    hostile_peer *h = arg;
+    static uint8_t chunk[256 << 10]; /* only ever read: shared by every peer */
+    while (!atomic_load(h->stop)) {
+        int fd = hostile_connect(h->port);
+        if (fd < 0) {
+            hostile_sleep_ms(50);
+            continue;
+        }
+        h->conns++;
+        uint8_t hdr[SY_CLUSTER_HEADER_SIZE];
+        sy_cluster_header_write(hdr, SY_CLUSTER_HELLO, 0, h->flood ? 8u << 20 : 256u << 20, 1);
+        if (hostile_send(fd, hdr, sizeof hdr)) {
+            for (uint32_t left = 8u << 20; h->flood && left && !atomic_load(h->stop);) {
+                uint32_t n = left < sizeof chunk ? left : (uint32_t)sizeof chunk;
+                if (!hostile_send(fd, chunk, n)) break;
+                h->bytes += n;
+                left -= n;
+            }
+            while (!h->flood && !atomic_load(h->stop) && hostile_send(fd, chunk, 64 << 10)) {
+                h->bytes += 64 << 10;
+                hostile_sleep_ms(100);
+            }
+        }
+        close(fd);
+        hostile_sleep_ms(h->flood ? 20 : 50);
+    }
+    return NULL;
+}
+
+/* VmRSS (or another "Vm...:" line) of a process in KiB; -1 when unreadable. */
+static long proc_status_kb(pid_t pid, const char *field)
+{
+    char path[64], line[256];
+    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+    FILE *f = fopen(path, "r");
+    if (!f) return -1;
+    long kb = -1;
+    size_t fl = strlen(field);
+    while (fgets(line, sizeof line, f))
+        if (!strncmp(line, field, fl) && line[fl] == ':') {
+            kb = strtol(line + fl + 1, NULL, 10);
+            break;
+        }
+    fclose(f);
+    return kb;
+}
+
+/* Server srv's resident memory before, at the peak of and after 64 tricklers + 8 flooders (5 s),
+ * and the frame time of a client of that server alone (320x180 sort-first) before and during. */
+static sy_result bench_hostile(sy_scene *scene, const sy_demo_info *d, const char *backend, const child_server *srv,
+                               sy_error *err)
+{
+    enum { TRICKLERS = 64, FLOODERS = 8, W = 320, H = 180 };
+    const char *urls[1] = {srv->url};
+    sy_cluster_client_opts co = {.urls = urls, .url_count = 1, .timeout_ms = 60000};
+    sy_cluster_client *c = NULL;
+    sy_layer out = {0};
+    sy_camera_view view = sy_camera_view_frame_bounds(&(sy_bounds){{-3, -1, -3}, {3, 3, 3}}, (float)W / H);
+    sy_cluster_frame f = {.mode = SY_CLUSTER_SORT_FIRST, .backend = backend, .root_id = d->root.id,
+                          .background_id = d->background.id, .camera = view, .width = W, .height = H};
+    sy_result r = sy_cluster_client_create(scene, &co, &c, err);
+    if (r == SY_OK) r = sy_layer_create(W, H, &out, err);
+    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &out, NULL, err); /* snapshot + translation */
+    double quiet = 0;
+    const int quiet_n = 20;
+    for (int i = 0; i < quiet_n && r == SY_OK; ++i) {
+        double t0 = sy_time_now();
+        r = sy_cluster_client_render(c, &f, &out, NULL, err);
+        quiet += sy_time_now() - t0;
+    }
+    const char *colon = strrchr(srv->url, ':');
+    int port = colon ? atoi(colon + 1) : 0;
+    long rss0 = proc_status_kb(srv->pid, "VmRSS"), peak = rss0;
+    atomic_int stop = 0;
+    hostile_peer hp[TRICKLERS + FLOODERS];
+    pthread_t th[TRICKLERS + FLOODERS];
+    int started = 0;
+    for (int i = 0; i < TRICKLERS + FLOODERS && r == SY_OK; ++i) {
+        hp[i] = (hostile_peer){port, i >= TRICKLERS, &stop, 0, 0};
+        pthread_attr_t at;
+        pthread_attr_init(&at);
+        pthread_attr_setstacksize(&at, 256 << 10);
+        if (pthread_create(&th[started], &at, hostile_main, &hp[i]) == 0) started++;
+        pthread_attr_destroy(&at);
+    }
+    double t_start = sy_time_now(), busy = 0, worst = 0;
+    int frames = 0;
+    while (r == SY_OK && sy_time_now() - t_start < 5.0) {
+        double t0 = sy_time_now();
+        r = sy_cluster_client_render(c, &f, &out, NULL, err);
+        double dt = sy_time_now() - t0;
+        busy += dt;
+        worst = dt > worst ? dt : worst;
+        frames++;
+        long kb = proc_status_kb(srv->pid, "VmRSS");
+        if (kb > peak) peak = kb;
+    }
+    atomic_store(&stop, 1);
+    for (int i = 0; i < started; ++i) pthread_join(th[i], NULL);
+    hostile_sleep_ms(300);
+    long rss1 = proc_status_kb(srv->pid, "VmRSS");
+    uint64_t trickled = 0, flooded = 0;
+    uint32_t conns = 0;
+    for (int i = 0; i < started; ++i) {
+        conns += hp[i].conns;
+        if (hp[i].flood) flooded += hp[i].bytes;
+        else trickled += hp[i].bytes;
+    }
+    if (r == SY_OK) {
+        printf("  hostile peers on server 0 (%d announce 256 MiB and trickle 64 KiB / 100 ms, %d flood 8 MiB; none "
+               "authenticates; %u connections, %.0f MiB trickled, %.0f MiB flooded in 5 s):\n",
+               TRICKLERS, FLOODERS, conns, (double)trickled / 1048576.0, (double)flooded / 1048576.0);
+        printf("    server VmRSS %.1f MiB before, %.1f MiB peak, %.1f MiB after (+%.1f MiB at the peak); client frame "
+               "%ux%u %s: %.2f ms before, %.2f ms mean / %.2f ms worst during (%d frames)\n",
+               rss0 / 1024.0, peak / 1024.0, rss1 / 1024.0, (peak - rss0) / 1024.0, W, H, backend,
+               quiet / quiet_n * 1e3, frames ? busy / frames * 1e3 : 0.0, worst * 1e3, frames);
+    }
+    sy_layer_destroy(&out);
+    sy_cluster_client_destroy(c);
+    return r;
+}
+
 int sy_cmd_bench_cluster(int argc, char **argv)
 {
     uint32_t w = 1920, h = 1080, rounds = 3;
+    bool hostile_only = false; /* only the hostile-peer measurement (one server) */
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "-w") && i + 1 < argc) w = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "-h") && i + 1 < argc) h = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--repeats") && i + 1 < argc) rounds = (uint32_t)strtoul(argv[++i], NULL, 10);
+        else if (!strcmp(argv[i], "--hostile-only")) hostile_only = true;
         else {
-            fprintf(stderr, "usage: sy bench cluster [-w W] [-h H] [--repeats ROUNDS]\n");
+            fprintf(stderr, "usage: sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only]\n");
             return 1;
         }
     }
@@ -650,6 +844,13 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     free(buf);
     sy_changes_release(snap);
     if (r == SY_OK) r = spawn_server(ncpu >= 2 ? 0 : -1, &srv[0], &err);
+    if (r == SY_OK && hostile_only) {
+        printf("sy bench cluster --hostile-only: demo scene, one server on loopback\n");
+        r = bench_hostile(scene, &d, sy_mediator_find("raster") ? "raster" : "whitted", &srv[0], &err);
+        stop_server(&srv[0]);
+        sy_scene_destroy(scene);
+        return r == SY_OK ? 0 : cli_fail("bench cluster", &err);
+    }
     if (r == SY_OK) r = spawn_server(ncpu >= 2 ? 1 : -1, &srv[1], &err);
     if (r == SY_OK && ncpu >= 3) { /* the client keeps off the servers' cores where it can */
         cpu_set_t set;
@@ -746,6 +947,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
         sy_cluster_buf_free(&enc);
     }
     if (r == SY_OK) r = bench_half_and_blob_cache(scene, &co, c, &f, &out, &s1, &err);
+    if (r == SY_OK) r = bench_hostile(scene, &d, backend, &srv[0], &err);
     sy_layer_destroy(&out);
     sy_cluster_client_destroy(c);
     c = NULL;

@@ -9,7 +9,8 @@
 
 /* sy serve [--listen URL] [--secret-file F] [--output PATH] [--port-file F] [--tls-cert F --tls-key F]
  *          [--max-sessions N] [--max-lifetime S] [--name NAME] [--blob-cache-mb N] [--max-objects N]
- *          [--auth-backoff-ms MS] */
+ *          [--auth-backoff-ms MS] [--max-peer-memory-mb N] [--max-frame-kb N] [--max-message-mb N]
+ *          [--max-unauthenticated N] [--handshake-timeout-ms MS] */
 int sy_cmd_serve(int argc, char **argv);
 
 /* Options of `sy render` that select cluster rendering. Zero-initialise. */
@@ -51,7 +52,9 @@ sy_result sy_cluster_cli_connect(const sy_cluster_cli_opts *o, sy_scene *scene, 
 sy_result sy_cluster_cli_render(const sy_cluster_cli_opts *o, sy_scene *scene, const sy_viewport_desc *vd,
                                 uint32_t w, uint32_t h, sy_layer *out, double *seconds, sy_error *err);
 
-/* sy bench cluster [-w W] [-h H] [--repeats ROUNDS]: sizes, overhead, latency, codec, cooperative speed-up */
+/* sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only]: sizes, overhead, latency, codec,
+ * a server's memory and a client's frame time under 72 hostile unauthenticated connections,
+ * cooperative speed-up (--hostile-only: the hostile measurement alone) */
 int sy_cmd_bench_cluster(int argc, char **argv);
 
 #endif /* SY_CLUSTER_CLI_H */

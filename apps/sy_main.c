@@ -32,6 +32,7 @@
 #include "sy_mediator_rt.h"
 #include "sy_mediators.h"
 #include "sy_png.h"
+#include "sy_signals.h"
 #include "sy_viewport.h"
 #include "sy_x3d.h"
 
@@ -111,6 +112,31 @@ static sy_result add_defaults(loaded *ld, sy_error *err)
     return sy_scene_commit(s, NULL, err);
 }
 
+/* Loader options every command shares, taken out of the arguments in main: --allow-path DIR
+ * (repeatable: more folders that a model's external files may lie in) and --strict (whatever a
+ * loader skips or repairs is an error). */
+#define SY_MAX_ALLOW_PATHS 16
+static struct {
+    const char *roots[SY_MAX_ALLOW_PATHS];
+    size_t root_count;
+    bool strict;
+} g_load;
+
+/* Prints what the loader skipped or repaired (sy: warning: FILE: item: what); with --strict any of
+ * them fails the load. */
+static sy_result report_warnings(const char *path, char **warnings, uint32_t stored, uint32_t total, sy_error *err)
+{
+    size_t plen = strlen(path);
+    for (uint32_t i = 0; i < stored; ++i) /* X3D's warnings name the file (and line) themselves */
+        if (!strncmp(warnings[i], path, plen)) fprintf(stderr, "sy: warning: %s\n", warnings[i]);
+        else fprintf(stderr, "sy: warning: %s: %s\n", path, warnings[i]);
+    if (total > stored) fprintf(stderr, "sy: warning: %s: %u more warnings not shown\n", path, total - stored);
+    if (g_load.strict && total)
+        return sy_error_set(err, SY_ERR_PARSE, "%s: %u warning%s and --strict given; nothing rendered", path, total,
+                            total == 1 ? "" : "s");
+    return SY_OK;
+}
+
 static sy_result load(const char *path, const char *camera_sel, bool defaults, loaded *out, sy_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -128,7 +154,10 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
         }
     } else if (strlen(path) > 4 && !strcasecmp(path + strlen(path) - 4, ".x3d")) {
         out->is_x3d = true;
-        r = sy_x3d_load(path, out->scene, NULL, &out->x3d, err);
+        sy_x3d_options xo = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count};
+        r = sy_x3d_load(path, out->scene, &xo, &out->x3d, err);
+        if (r == SY_OK)
+            r = report_warnings(path, out->x3d.warnings, out->x3d.stored_warning_count, out->x3d.warning_count, err);
         if (r == SY_OK) {
             out->root = out->x3d.root;
             out->background = out->x3d.background;
@@ -138,7 +167,10 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
         }
     } else {
         out->is_gltf = true;
-        r = sy_gltf_load(path, out->scene, NULL, &out->gltf, err);
+        sy_gltf_options go = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count};
+        r = sy_gltf_load(path, out->scene, &go, &out->gltf, err);
+        if (r == SY_OK)
+            r = report_warnings(path, out->gltf.warnings, out->gltf.stored_warning_count, out->gltf.warning_count, err);
         if (r == SY_OK) {
             out->root = out->gltf.root;
             if (camera_sel) r = sy_gltf_find_camera(out->scene, &out->gltf, camera_sel, &out->camera, err);
@@ -193,13 +225,15 @@ static bool ends_with(const char *s, const char *suffix)
 typedef struct out_opts {
     bool half;
     sy_png_options png;
+    const sy_exr_attribute *attrs; /* extra EXR header attributes (sy:samples, sy:interrupted, ...) */
+    int attr_count;
 } out_opts;
 
 static sy_result write_image(const char *path, const sy_layer *l, const out_opts *o, sy_error *err)
 {
     if (ends_with(path, ".exr"))
-        return sy_exr_write_rgba(path, (int)l->width, (int)l->height, l->rgba, l->depth,
-                                 o->half ? SY_EXR_PIXEL_HALF : SY_EXR_PIXEL_FLOAT, err);
+        return sy_exr_write_rgba_attrs(path, (int)l->width, (int)l->height, l->rgba, l->depth,
+                                       o->half ? SY_EXR_PIXEL_HALF : SY_EXR_PIXEL_FLOAT, o->attrs, o->attr_count, err);
     if (ends_with(path, ".png")) return sy_png_write(path, (int)l->width, (int)l->height, l->rgba, &o->png, err);
     return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", path);
 }
@@ -358,6 +392,7 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
         }
         if (target && pr.done >= target) break;
         if (po->time_budget > 0 && now - t0 + pass > po->time_budget) break;
+        if (sy_signals_interrupted()) break; /* first Ctrl-C: keep what the finished passes gave */
         /* passes of about a quarter of a second: responsive progress, little overhead */
         double want = pass > 0 ? 0.25 / pass : 64;
         chunk = want < 1 ? 1 : want > 1024 ? 1024 : (uint32_t)want;
@@ -381,7 +416,7 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
 
 /* Writes colour + depth and the path tracer's feature buffers as channels of one EXR:
  * R G B A Z, variance.{R,G,B}, albedo.{R,G,B}, normal.{X,Y,Z}, direct.{R,G,B}, indirect.{R,G,B}. */
-static sy_result write_aov_exr(const char *path, sy_context *ctx, bool half, sy_error *err)
+static sy_result write_aov_exr(const char *path, sy_context *ctx, const out_opts *o, sy_error *err)
 {
     if (strcmp(sy_context_class(ctx)->name, "pathtracer") != 0)
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--aov: back-end %s has no feature buffers",
@@ -393,7 +428,7 @@ static sy_result write_aov_exr(const char *path, sy_context *ctx, bool half, sy_
     int n = 0;
     static const char *const rgba[4] = {"R", "G", "B", "A"}, *const rgb[3] = {"R", "G", "B"}, *const xyz[3] = {"X", "Y", "Z"};
     char names[SY_MEDIATOR_RT_AOV_COUNT][3][32];
-    sy_exr_pixel_type ct = half ? SY_EXR_PIXEL_HALF : SY_EXR_PIXEL_FLOAT;
+    sy_exr_pixel_type ct = o->half ? SY_EXR_PIXEL_HALF : SY_EXR_PIXEL_FLOAT;
     for (uint32_t k = 0; k < SY_MEDIATOR_RT_AOV_COUNT; ++k) {
         uint32_t c = sy_mediator_rt_aov_channels(k);
         const char *name = sy_mediator_rt_aov_name(k);
@@ -408,7 +443,8 @@ static sy_result write_aov_exr(const char *path, sy_context *ctx, bool half, sy_
             }
         }
     }
-    sy_exr_write_desc wd = {.width = (int)a.width, .height = (int)a.height, .channels = ch, .channel_count = n};
+    sy_exr_write_desc wd = {.width = (int)a.width, .height = (int)a.height, .channels = ch, .channel_count = n,
+                            .attributes = o->attrs, .attribute_count = o->attr_count};
     r = sy_exr_write(path, &wd, err);
     sy_mediator_rt_aovs_free(&a);
     return r;
@@ -556,7 +592,9 @@ static sy_result add_overlay(loaded *ld, const char *arg, const char *composite,
     if (!backend) backend = sy_mediator_find("raster") ? "raster" : spec->backend;
     if (!sy_mediator_find(backend)) return sy_error_set(err, SY_ERR_NOT_FOUND, "--overlay %s: back-end '%s' is not registered", arg, backend);
     sy_gltf_info info = {0};
-    sy_result r = sy_gltf_load(path, ld->scene, NULL, &info, err);
+    sy_gltf_options go = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count};
+    sy_result r = sy_gltf_load(path, ld->scene, &go, &info, err);
+    if (r == SY_OK) r = report_warnings(path, info.warnings, info.stored_warning_count, info.warning_count, err);
     if (r == SY_OK) r = sy_scene_commit(ld->scene, NULL, err);
     if (r != SY_OK) {
         sy_gltf_info_free(&info);
@@ -716,9 +754,22 @@ static int cmd_render(int argc, char **argv)
     double t0 = sy_time_now();
     uint64_t samples = 0;
     sy_context *pctx = NULL;
+    bool interrupted = false;
+    char samples_str[32], secs_str[32];
+    sy_exr_attribute attrs[4];
     if (r == SY_OK && progressive) {
+        /* the first Ctrl-C ends the render after the pass in progress and keeps its image */
+        sy_signals_set_graceful("finishing the current pass, then writing the image accumulated so far");
         r = render_progressive(&ld, &spec, w, h, &po, pool, &img, &img_right, &secs, &samples, &pctx, &err);
         t0 = sy_time_now() - secs;
+        interrupted = sy_signals_interrupted();
+        snprintf(samples_str, sizeof samples_str, "%llu", (unsigned long long)samples);
+        snprintf(secs_str, sizeof secs_str, "%.3f", secs);
+        attrs[oo.attr_count++] = (sy_exr_attribute){"sy:backend", backend};
+        attrs[oo.attr_count++] = (sy_exr_attribute){"sy:samples", samples_str};
+        attrs[oo.attr_count++] = (sy_exr_attribute){"sy:seconds", secs_str};
+        if (interrupted) attrs[oo.attr_count++] = (sy_exr_attribute){"sy:interrupted", "1"};
+        oo.attrs = attrs;
     } else if (r == SY_OK && clo.cluster) {
         sy_viewport_desc cvd = {.root = ld.root, .camera = ld.camera, .background = ld.background, .backend = backend,
                                 .params = params, .eye_separation = spec.eye_separation, .zero_parallax = spec.zero_parallax};
@@ -737,10 +788,11 @@ static int cmd_render(int argc, char **argv)
             if (r == SY_OK) r = write_image(rp, &img_right, &oo, &err);
             if (r == SY_OK) printf("%s, %s: %ux%u per eye, %s, %.3f s\n", lp, rp, w, h, backend, secs);
         } else {
-            r = po.aov ? write_aov_exr(outp, pctx, oo.half, &err) : write_image(outp, &img, &oo, &err);
+            r = po.aov ? write_aov_exr(outp, pctx, &oo, &err) : write_image(outp, &img, &oo, &err);
             if (r == SY_OK && progressive)
-                printf("%s: %ux%u, %s, %llu samples per pixel, %.3f s (%.2f samples/s)\n", outp, img.width, img.height,
-                       backend, (unsigned long long)samples, secs, secs > 0 ? (double)samples / secs : 0.0);
+                printf("%s: %ux%u, %s, %llu samples per pixel, %.3f s (%.2f samples/s)%s\n", outp, img.width,
+                       img.height, backend, (unsigned long long)samples, secs,
+                       secs > 0 ? (double)samples / secs : 0.0, interrupted ? ", interrupted" : "");
             else if (r == SY_OK) printf("%s: %ux%u, %s, %.3f s\n", outp, img.width, img.height, backend, secs);
             if (r == SY_OK && progressive && filter && pctx) { /* the display filter's report (issue 7) */
                 sy_mediator_rt_filter_info fi;
@@ -756,6 +808,12 @@ static int cmd_render(int argc, char **argv)
     sy_layer_destroy(&img_right);
     sy_context_pool_destroy(pool);
     loaded_free(&ld);
+    interrupted = interrupted || (progressive && sy_signals_interrupted()); /* also while writing */
+    if (r == SY_OK && interrupted) {
+        fprintf(stderr, "sy render: interrupted: wrote the image of %llu samples per pixel (sy:samples in the EXR "
+                        "header); exit status 130\n", (unsigned long long)samples);
+        return 130;
+    }
     return r == SY_OK ? 0 : fail(&err);
 }
 
@@ -1055,7 +1113,31 @@ static int cmd_bench(int argc, char **argv)
 int main(int argc, char **argv)
 {
     sy_error err = {0};
+    /* before any thread: interrupts are taken on a thread of their own, output files in progress
+     * are removed when one ends the process */
+    sy_signals_start();
     if (sy_mediators_register_builtin(&err) != SY_OK) return fail(&err);
+    /* loader options of every command: --allow-path DIR (repeatable) and --strict */
+    int kept = 1;
+    for (int i = 1; i < argc; ++i) {
+        if (!strcmp(argv[i], "--strict")) {
+            g_load.strict = true;
+        } else if (!strcmp(argv[i], "--allow-path")) {
+            struct stat st;
+            if (i + 1 >= argc || stat(argv[i + 1], &st) != 0 || !S_ISDIR(st.st_mode)) {
+                fprintf(stderr, "sy: error: --allow-path %s: expected an existing folder\n", i + 1 < argc ? argv[i + 1] : "");
+                return 2;
+            }
+            if (g_load.root_count == SY_MAX_ALLOW_PATHS) {
+                fprintf(stderr, "sy: error: --allow-path: at most %d folders\n", SY_MAX_ALLOW_PATHS);
+                return 2;
+            }
+            g_load.roots[g_load.root_count++] = argv[++i];
+        } else {
+            argv[kept++] = argv[i];
+        }
+    }
+    argc = kept;
     if (argc < 2) return usage();
     const char *cmd = argv[1];
     if (!strcmp(cmd, "info")) return cmd_info(argc - 2, argv + 2);

@@ -1,9 +1,9 @@
-/* sy_cluster.c — render server and cluster client over nng (see sy_cluster.h, docs/PROTOCOL.md). */
+/* sy_cluster.c — render server and cluster client over nng byte streams (see sy_cluster.h,
+ * docs/PROTOCOL.md). Sections: >>wire (frames on a stream, shared), tile codec, secrets, server
+ * (blob cache, back-off table, peer memory, >>serving, >>connections), client. */
 #include "sy_cluster.h"
 
 #include <nng/nng.h>
-#include <nng/protocol/reqrep0/rep.h>
-#include <nng/protocol/reqrep0/req.h>
 #include <nng/supplemental/tls/tls.h>
 #include <nng/transport/tcp/tcp.h>
 #include <sodium.h>
@@ -21,6 +21,21 @@
 #include <time.h>
 
 #include "sy_viewport.h"
+
+/* Each connection's reader thread: 64 KiB of stack reserved (a few KiB touched); sanitizer frames
+ * are larger. */
+#if defined(__SANITIZE_ADDRESS__)
+#define SY__ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SY__ASAN 1
+#endif
+#endif
+#ifdef SY__ASAN
+#define SY_CLUSTER_READER_STACK ((size_t)512 << 10)
+#else
+#define SY_CLUSTER_READER_STACK ((size_t)64 << 10)
+#endif
 
 /* ---- shared helpers ---- */
 static void log_line(sy_cluster_log_fn fn, void *user, const char *prefix, const char *fmt, ...)
@@ -63,57 +78,306 @@ static void mac3(uint8_t out[32], const uint8_t *key, size_t key_len, const char
     crypto_auth_hmacsha512256_final(&st, out);
 }
 
-static void frame_tag(uint8_t out[32], const uint8_t key[32], const uint8_t *frame, size_t n)
+/* >>wire: frames over an nng byte stream (shared by the server and the client)
+ *
+ * A message travels as one frame or, when its body is larger than the receiver's frame limit, as
+ * several frames of the same type (SY_CLUSTER_FLAG_MORE on all but the last). Every frame carries
+ * its own sequence number and, once the session has a key, its own tag over header + body, so a
+ * forged or replayed frame is refused as soon as it has arrived, before the next one is read.
+ * The receiver reads the fixed 24-byte header first and checks it against its budget
+ * (sy_cluster_frame_check) before it reads or allocates anything for the body. */
+typedef struct wire {
+    nng_stream *st;
+    nng_aio *aio;                /* completes through wire_done (busy, cond) */
+    pthread_mutex_t lock;
+    pthread_cond_t cond;         /* CLOCK_MONOTONIC */
+    bool busy, sync_ok;
+    uint64_t send_seq, recv_seq; /* last sequence number sent / received */
+    uint8_t key[32];
+    bool tagged;                 /* frames carry tags under key (both directions) */
+    int last_rv;                 /* nng result of the last failed operation (0: a protocol error) */
+} wire;
+
+static void wire_done(void *arg)
+{
+    wire *w = arg;
+    pthread_mutex_lock(&w->lock);
+    w->busy = false;
+    pthread_cond_broadcast(&w->cond);
+    pthread_mutex_unlock(&w->lock);
+}
+
+/* The aio and its completion signal (w zeroed before; the stream is set later). nng result. */
+static int wire_init(wire *w)
+{
+    pthread_condattr_t ca;
+    pthread_condattr_init(&ca);
+    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    pthread_mutex_init(&w->lock, NULL);
+    pthread_cond_init(&w->cond, &ca);
+    pthread_condattr_destroy(&ca);
+    w->sync_ok = true;
+    return nng_aio_alloc(&w->aio, wire_done, w);
+}
+
+/* Frees the aio (waiting for a pending operation) and the signal; not the stream. */
+static void wire_fini(wire *w)
+{
+    if (w->aio) nng_aio_free(w->aio);
+    w->aio = NULL;
+    if (w->sync_ok) {
+        pthread_mutex_destroy(&w->lock);
+        pthread_cond_destroy(&w->cond);
+    }
+    w->sync_ok = false;
+}
+
+/* Runs one stream operation (already set up on w->aio) to completion. The aio's own timeout ends
+ * it at the deadline; in case the stream does not honour it (nng 1.5.2's TLS streams leave a
+ * receive pending forever once the TCP connection under them has failed), the stream is closed
+ * SY_CLUSTER_WATCHDOG_MS after the deadline, which completes every pending operation. */
+static int wire_wait(wire *w, double deadline)
+{
+    bool forced = false;
+    pthread_mutex_lock(&w->lock);
+    while (w->busy) {
+        if (deadline <= 0) {
+            pthread_cond_wait(&w->cond, &w->lock);
+            continue;
+        }
+        double until = deadline + SY_CLUSTER_WATCHDOG_MS / 1000.0;
+        struct timespec now;
+        clock_gettime(CLOCK_MONOTONIC, &now);
+        double left = until - sy_time_now();
+        if (left <= 0) {
+            forced = true;
+            break;
+        }
+        long ns = now.tv_nsec + (long)((left - (double)(long)left) * 1e9);
+        struct timespec ts = {now.tv_sec + (time_t)left + ns / 1000000000L, ns % 1000000000L};
+        pthread_cond_timedwait(&w->cond, &w->lock, &ts);
+    }
+    pthread_mutex_unlock(&w->lock);
+    if (forced) nng_stream_close(w->st); /* every pending operation completes (NNG_ECLOSED) */
+    nng_aio_wait(w->aio);
+    int rv = nng_aio_result(w->aio);
+    return forced && rv ? NNG_ETIMEDOUT : rv;
+}
+
+/* Memory for reassembled messages: reserve() may wait (back-pressure) and returns false when the
+ * bytes cannot be had; NULL = plain malloc (the client). */
+typedef struct wire_mem {
+    bool (*reserve)(void *user, size_t bytes, sy_error *err);
+    void (*release)(void *user, size_t bytes);
+    void *user;
+} wire_mem;
+
+/* A received message: the first frame's header (body_size = the reassembled size, clamped to
+ * UINT32_MAX) and the body, in the caller's fixed buffer or malloc()ed (charged bytes in
+ * `charged`; free with rx_release). */
+typedef struct rx_msg {
+    sy_cluster_header h;
+    uint8_t *body;
+    size_t size, cap, charged;
+    bool fixed;
+} rx_msg;
+
+static void rx_release(rx_msg *m, const wire_mem *mem)
+{
+    if (!m->fixed) free(m->body);
+    if (m->charged && mem && mem->release) mem->release(mem->user, m->charged);
+    memset(m, 0, sizeof *m);
+}
+
+/* error prefix: "WHO: " or nothing (the server logs the peer's address itself) */
+#define WHO(who) ((who) ? (who) : ""), ((who) ? ": " : "")
+
+static bool wire_closed(const wire *w)
+{
+    return w->last_rv == NNG_ECLOSED || w->last_rv == NNG_ECONNSHUT || w->last_rv == NNG_ECONNRESET ||
+           w->last_rv == NNG_ECONNABORTED;
+}
+
+static void frame_tag_parts(uint8_t out[32], const uint8_t key[32], const uint8_t *hdr, const uint8_t *body, size_t n)
 {
     crypto_auth_hmacsha512256_state st;
     crypto_auth_hmacsha512256_init(&st, key, 32);
-    crypto_auth_hmacsha512256_update(&st, frame, n);
+    crypto_auth_hmacsha512256_update(&st, hdr, SY_CLUSTER_HEADER_SIZE);
+    if (n) crypto_auth_hmacsha512256_update(&st, body, n);
     crypto_auth_hmacsha512256_final(&st, out);
 }
 
-/* Encodes msg (seq filled by caller), tagging with key when key != NULL. */
-static sy_result encode_frame(sy_cluster_msg *msg, const uint8_t *key, sy_cluster_buf *out, sy_error *err)
+/* Moves all bytes of iov[0..n) in one direction; every operation must finish by deadline
+ * (absolute sy_time_now() seconds; 0 = none). */
+static sy_result wire_io(wire *w, bool sending, nng_iov *iov, unsigned n, double deadline, const char *who,
+                         sy_error *err)
 {
-    out->size = 0;
-    sy_result r = sy_cluster_encode(msg, key ? SY_CLUSTER_FLAG_TAGGED : 0, out, err);
-    if (r || !key) return r;
-    uint8_t tag[32];
-    frame_tag(tag, key, out->data, out->size);
-    if (out->size + 32 > out->cap) {
-        uint8_t *d = realloc(out->data, out->size + 32);
-        if (!d) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
-        out->data = d;
-        out->cap = out->size + 32;
+    unsigned first = 0;
+    while (first < n && iov[first].iov_len == 0) first++;
+    while (first < n) {
+        nng_duration ms = NNG_DURATION_INFINITE;
+        if (deadline > 0) {
+            double left = deadline - sy_time_now();
+            ms = left <= 0.001 ? 1 : (nng_duration)(left * 1000.0 + 0.5);
+        }
+        int rv = nng_aio_set_iov(w->aio, n - first, iov + first);
+        if (rv == 0) {
+            nng_aio_set_timeout(w->aio, ms);
+            pthread_mutex_lock(&w->lock);
+            w->busy = true;
+            pthread_mutex_unlock(&w->lock);
+            if (sending) nng_stream_send(w->st, w->aio);
+            else nng_stream_recv(w->st, w->aio);
+            rv = wire_wait(w, deadline);
+        }
+        size_t got = rv == 0 ? nng_aio_count(w->aio) : 0;
+        if (rv == 0 && got == 0) rv = NNG_ECONNSHUT;
+        if (rv) {
+            w->last_rv = rv;
+            if (rv == NNG_ETIMEDOUT)
+                return sy_error_set(err, SY_ERR_IO, "%s%s%s", WHO(who),
+                                    sending ? "the peer did not take the data before the deadline"
+                                            : "no data before the deadline");
+            return sy_error_set(err, SY_ERR_IO, "%s%s%s: %s", WHO(who), sending ? "send failed" : "receive failed",
+                                nng_strerror(rv));
+        }
+        while (got && first < n) {
+            size_t k = got < iov[first].iov_len ? got : iov[first].iov_len;
+            iov[first].iov_buf = (uint8_t *)iov[first].iov_buf + k;
+            iov[first].iov_len -= k;
+            got -= k;
+            if (!iov[first].iov_len) first++;
+        }
+        while (first < n && iov[first].iov_len == 0) first++;
     }
-    memcpy(out->data + out->size, tag, 32);
-    out->size += 32;
     return SY_OK;
 }
 
-/* Checks the frame's tag (when key) and sequence number, then decodes. */
-static sy_result decode_frame(const uint8_t *data, size_t size, const uint8_t *key, uint64_t expect_seq,
-                              size_t max_message, sy_cluster_msg *out, sy_error *err)
+/* Sends one message. frame: an untagged frame as sy_cluster_encode writes it (header + body; its
+ * sequence number and flags are ignored). The body goes out in frames of at most max_frame bytes;
+ * each operation must finish within progress_s seconds (0 = no limit) and by deadline. */
+static sy_result wire_send(wire *w, const uint8_t *frame, size_t size, size_t max_frame, double deadline,
+                           double progress_s, const char *who, sy_error *err)
 {
-    sy_cluster_limits lim = {max_message};
-    sy_cluster_header h;
-    sy_result r = sy_cluster_decode_header(data, size, &lim, &h, err);
-    if (r) return r;
-    bool tagged = (h.flags & SY_CLUSTER_FLAG_TAGGED) != 0;
-    if (key && !tagged)
-        return sy_error_set(err, SY_ERR_PROTOCOL, "cluster %s: message is not authenticated (no tag)",
-                            sy_cluster_msg_type_name(h.type));
-    if (key) {
-        uint8_t tag[32];
-        frame_tag(tag, key, data, size - 32);
-        if (crypto_verify_32(tag, data + size - 32) != 0)
-            return sy_error_set(err, SY_ERR_PROTOCOL, "cluster %s: authentication tag does not match",
-                                sy_cluster_msg_type_name(h.type));
+    if (size < SY_CLUSTER_HEADER_SIZE) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s%sempty frame", WHO(who));
+    uint32_t type = (uint32_t)frame[6] | ((uint32_t)frame[7] << 8);
+    const uint8_t *body = frame + SY_CLUSTER_HEADER_SIZE;
+    size_t n = size - SY_CLUSTER_HEADER_SIZE, tag = w->tagged ? SY_CLUSTER_TAG_SIZE : 0;
+    if (max_frame <= SY_CLUSTER_HEADER_SIZE + tag)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s%sframe limit %zu too small", WHO(who), max_frame);
+    size_t per = max_frame - SY_CLUSTER_HEADER_SIZE - tag, off = 0;
+    if (per > UINT32_MAX) per = UINT32_MAX;
+    do {
+        size_t c = n - off < per ? n - off : per;
+        bool more = off + c < n;
+        uint8_t hdr[SY_CLUSTER_HEADER_SIZE], t[SY_CLUSTER_TAG_SIZE];
+        sy_cluster_header_write(hdr, type, (w->tagged ? SY_CLUSTER_FLAG_TAGGED : 0u) | (more ? SY_CLUSTER_FLAG_MORE : 0u),
+                                (uint32_t)c, ++w->send_seq);
+        if (w->tagged) frame_tag_parts(t, w->key, hdr, body + off, c);
+        nng_iov iov[3] = {{hdr, sizeof hdr}, {(void *)(body + off), c}, {t, tag}};
+        double d = deadline;
+        if (progress_s > 0 && (d <= 0 || sy_time_now() + progress_s < d)) d = sy_time_now() + progress_s;
+        sy_result r = wire_io(w, true, iov, 3, d, who, err);
+        if (r) return r;
+        off += c;
+    } while (off < n);
+    return SY_OK;
+}
+
+/* Receives one message within budget b. fixed (fixed_cap bytes) receives the body when given
+ * (the handshake: nothing is allocated); otherwise the body grows frame by frame, each growth
+ * reserved from mem first. The first header must arrive by deadline (0 = wait for ever); once it
+ * has, every further operation must finish within progress_s (0 = by deadline). Sequence numbers
+ * and tags are checked frame by frame. On failure w->last_rv tells a closed connection (nng code)
+ * from a refused frame (0). */
+static sy_result wire_recv(wire *w, const sy_cluster_budget *b, uint8_t *fixed, size_t fixed_cap, const wire_mem *mem,
+                           double deadline, double progress_s, rx_msg *out, const char *who, sy_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->fixed = fixed != NULL;
+    out->body = fixed;
+    out->cap = fixed ? fixed_cap : 0;
+    size_t so_far = 0;
+    uint32_t type = 0;
+    sy_result r = SY_OK;
+    w->last_rv = 0;
+    for (;;) {
+        uint8_t hdr[SY_CLUSTER_HEADER_SIZE];
+        double d = deadline;
+        if (type && progress_s > 0 && (d <= 0 || sy_time_now() + progress_s < d)) d = sy_time_now() + progress_s;
+        nng_iov iov[2] = {{hdr, sizeof hdr}, {NULL, 0}};
+        r = wire_io(w, false, iov, 1, d, who, err);
+        if (r) goto fail;
+        if (progress_s > 0 && (deadline <= 0 || sy_time_now() + progress_s < deadline))
+            d = sy_time_now() + progress_s;
+        else d = deadline;
+        sy_cluster_header h;
+        size_t follow = 0;
+        r = sy_cluster_parse_header(hdr, &h, err);
+        if (r == SY_OK) r = sy_cluster_frame_check(&h, b, so_far, type, &follow, err);
+        if (r == SY_OK && h.seq != w->recv_seq + 1)
+            r = sy_error_set(err, SY_ERR_PROTOCOL, "cluster %s: sequence number %llu, expected %llu (replay or loss)",
+                             sy_cluster_msg_type_name(h.type), (unsigned long long)h.seq,
+                             (unsigned long long)(w->recv_seq + 1));
+        if (r) {
+            if (who) sy_error_prefix(err, "%s", who);
+            goto fail;
+        }
+        size_t need = so_far + h.body_size; /* <= b->max_message: checked */
+        if (need > out->cap) {
+            if (out->fixed) { /* cannot happen when the budget fits the buffer */
+                r = sy_error_set(err, SY_ERR_LIMIT, "%s%sframe of %u bytes does not fit the %zu-byte buffer", WHO(who),
+                                 h.body_size, fixed_cap);
+                goto fail;
+            }
+            size_t ncap = need;
+            if (h.flags & SY_CLUSTER_FLAG_MORE) { /* more frames follow: grow geometrically, within the limit */
+                size_t dbl = out->cap > b->max_message / 2 ? b->max_message : out->cap * 2;
+                if (dbl > ncap) ncap = dbl;
+            }
+            size_t extra = ncap - out->cap;
+            if (mem && mem->reserve && !mem->reserve(mem->user, extra, err)) {
+                r = SY_ERR_LIMIT;
+                sy_error_prefix(err, "%s%s%s frame of %u bytes", WHO(who), sy_cluster_msg_type_name(h.type), h.body_size);
+                goto fail;
+            }
+            uint8_t *nb = realloc(out->body, ncap ? ncap : 1);
+            if (!nb) {
+                if (mem && mem->release) mem->release(mem->user, extra);
+                r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s%sout of memory for a %zu-byte message", WHO(who), ncap);
+                goto fail;
+            }
+            out->body = nb;
+            out->cap = ncap;
+            if (mem && mem->reserve) out->charged += extra;
+        }
+        uint8_t tag[SY_CLUSTER_TAG_SIZE];
+        size_t tag_len = follow - h.body_size;
+        nng_iov biov[2] = {{out->body ? out->body + so_far : NULL, h.body_size}, {tag, tag_len}};
+        r = wire_io(w, false, biov, 2, d, who, err);
+        if (r) goto fail;
+        if (tag_len) {
+            uint8_t expect[SY_CLUSTER_TAG_SIZE];
+            frame_tag_parts(expect, w->key, hdr, out->body ? out->body + so_far : NULL, h.body_size);
+            if (crypto_verify_32(expect, tag) != 0) {
+                r = sy_error_set(err, SY_ERR_PROTOCOL, "%s%scluster %s: authentication tag does not match", WHO(who),
+                                 sy_cluster_msg_type_name(h.type));
+                goto fail;
+            }
+        }
+        w->recv_seq = h.seq;
+        if (!type) out->h = h;
+        type = h.type;
+        so_far = need;
+        if (!(h.flags & SY_CLUSTER_FLAG_MORE)) break;
     }
-    if (h.seq != expect_seq)
-        return sy_error_set(err, SY_ERR_PROTOCOL, "cluster %s: sequence number %llu, expected %llu (replay or loss)",
-                            sy_cluster_msg_type_name(h.type), (unsigned long long)h.seq,
-                            (unsigned long long)expect_seq);
-    return sy_cluster_decode(data, size, &lim, out, err);
+    out->size = so_far;
+    out->h.body_size = so_far > UINT32_MAX ? UINT32_MAX : (uint32_t)so_far;
+    out->h.flags &= ~(uint32_t)SY_CLUSTER_FLAG_MORE;
+    return SY_OK;
+fail:
+    rx_release(out, mem);
+    return r;
 }
 
 static bool sockaddr_is_loopback(const nng_sockaddr *sa)
@@ -492,14 +756,9 @@ static void auth_succeeded(auth_fail *t, const char *host)
     if (a) memset(a, 0, sizeof *a);
 }
 
+/* A client's session: the replica and what the serving thread keeps for it. Serving thread only. */
 typedef struct session {
-    bool used;
-    uint32_t pipe_id;
-    int state; /* 0: expects HELLO, 1: expects AUTH, 2: authenticated */
-    uint8_t cnonce[32], snonce[32], key[32];
-    bool tagged;
-    uint64_t recv_seq, send_seq;
-    char peer[80], host[48];
+    char peer[80];
     double last_active;
     sy_scene *scene;
     sy_context_pool *pool;
@@ -512,72 +771,203 @@ typedef struct session {
     uint8_t *pending;
     uint32_t pending_size, pending_flags;
     uint64_t pending_frame;
+    size_t pending_charged;        /* bytes of pending charged to the peer memory ceiling */
     sy_blob_store *pending_blobs;  /* every blob the pending SCENE names, as found or received */
     sy_cluster_blob_ref *missing;  /* requested and not yet received (data unused) */
     uint32_t missing_count;
 } session;
 
-/* A request handed from an I/O worker to the serving thread and its reply handed back. */
-typedef struct io_job {
-    nng_msg *in;
-    sy_cluster_buf out;
-    bool done;
-    struct io_job *next;
-} io_job;
+/* One connection, from accept to close. Its reader thread (peer_main) owns the stream and the
+ * wire state: it runs the handshake itself (HELLO / AUTH touch only this record and the
+ * back-off table, so a busy serving thread never delays a handshake), then reads each message,
+ * hands it to the serving thread (the job fields, under qlock), waits for the reply and sends it.
+ * Before the session is open nothing is allocated for the connection beyond this record (the
+ * handshake frame buffer is inside it), its nng aio and stream, and the thread's stack. The
+ * record is freed by the serving thread (reap_peers) after the thread has ended. */
+typedef struct peer {
+    sy_cluster_server *s;
+    struct peer *next;  /* all connections (s->lock) */
+    struct peer *qnext; /* job queue (s->qlock) */
+    pthread_t thread;
+    wire w;
+    char addr[80], host[48];
+    bool loopback;
+    int state;          /* handshake: 0 expects HELLO, 1 expects AUTH, 2 open (reader thread) */
+    uint8_t cnonce[32], snonce[32];
+    size_t peer_max_frame;    /* what the client accepts (from its HELLO) */
+    double accepted;
+    bool counted_unauth;      /* counted in s->unauth (s->lock) */
+    bool counted_open;        /* counted in s->open_sessions (s->lock) */
+    bool dead;                /* the reader thread has finished (s->lock) */
+    /* the job handed to the serving thread (qlock) */
+    rx_msg in;
+    sy_cluster_buf reply;     /* encoded untagged reply; size 0 = none */
+    size_t reply_charged;
+    bool done, close_after;
+    /* serving thread only */
+    session se;
+    bool registered, evicted;
+    uint8_t hbuf[SY_CLUSTER_HANDSHAKE_MAX_FRAME]; /* handshake frames: no allocation before authentication */
+} peer;
 
 struct sy_cluster_server {
     sy_cluster_server_opts o;
     uint8_t *secret;
-    nng_socket sock;
-    nng_listener listener;
+    nng_stream_listener *listener;
     nng_tls_config *tls;
     int port;
-    size_t max_message;
-    session *sessions;
-    uint32_t max_sessions;
-    pthread_mutex_t lock; /* guards removed[] (filled by nng's pipe callback thread) */
-    uint32_t removed[256];
-    uint32_t removed_count;
+    size_t max_frame, max_message, max_peer_memory;
+    uint32_t max_sessions, max_unauth, handshake_ms;
     char name[SY_CLUSTER_NAME_MAX];
-    blob_cache cache;
+    blob_cache cache;             /* serving thread */
+    uint32_t session_count;       /* registered sessions (serving thread) */
+    pthread_mutex_t auth_lock;    /* guards auth[] (reader threads) */
     auth_fail auth[SY_CLUSTER_AUTH_TABLE];
-    /* I/O workers (one nng rep0 context each) queue requests for the serving thread */
-    pthread_mutex_t qlock;
+    pthread_mutex_t lock;         /* guards peers, unauth, dead flags, the noise log limiter */
+    peer *peers;
+    uint32_t unauth, npeers;
+    uint32_t open_sessions;       /* connections past the handshake (at most 2 x max_sessions) */
+    double noise_window;          /* start of the current second of rate-limited log lines */
+    uint32_t noise_lines, noise_dropped;
+    pthread_mutex_t qlock;        /* the job queue */
     pthread_cond_t qcond, dcond;
-    io_job *qhead, *qtail;
+    peer *qhead, *qtail;
     bool stopping;
+    pthread_mutex_t mem_lock;     /* peer memory ceiling */
+    pthread_cond_t mem_cond;
+    size_t mem_used, mem_peak;
+    bool mem_stopping;
+    pthread_mutex_t log_lock;
+    pthread_t acceptor;
+    bool acceptor_started;
+    bool sync_ok;                 /* mutexes and conditions initialised */
 };
 
-#define SLOG(s, ...) log_line((s)->o.log, (s)->o.log_user, "sy serve", __VA_ARGS__)
+static void slog(sy_cluster_server *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void slog(sy_cluster_server *s, const char *fmt, ...)
+{
+    char line[768];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    if (s->sync_ok) pthread_mutex_lock(&s->log_lock);
+    log_line(s->o.log, s->o.log_user, "sy serve", "%s", line);
+    if (s->sync_ok) pthread_mutex_unlock(&s->log_lock);
+}
+#define SLOG(s, ...) slog((s), __VA_ARGS__)
 
-static void pending_drop(session *se)
+/* Events unauthenticated peers can cause at any rate (refused connections, handshake failures):
+ * at most 20 lines a second, then one line saying how many were left out. */
+static void slog_noise(sy_cluster_server *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void slog_noise(sy_cluster_server *s, const char *fmt, ...)
+{
+    double now = sy_time_now();
+    uint32_t dropped = 0;
+    bool emit;
+    pthread_mutex_lock(&s->lock);
+    if (now - s->noise_window >= 1.0) {
+        dropped = s->noise_dropped;
+        s->noise_window = now;
+        s->noise_lines = s->noise_dropped = 0;
+    }
+    emit = s->noise_lines < 20;
+    if (emit) s->noise_lines++;
+    else s->noise_dropped++;
+    pthread_mutex_unlock(&s->lock);
+    if (dropped) SLOG(s, "(%u more lines about unauthenticated peers left out in the last second)", dropped);
+    if (!emit) return;
+    char line[768];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    SLOG(s, "%s", line);
+}
+
+/* >>peer memory: everything the server holds for peers' messages in flight (reassembly buffers,
+ * encoded replies, SCENEs waiting for blobs) stays under max_peer_memory. */
+static bool mem_try(sy_cluster_server *s, size_t n)
+{
+    pthread_mutex_lock(&s->mem_lock);
+    bool ok = n <= s->max_peer_memory - s->mem_used;
+    if (ok) {
+        s->mem_used += n;
+        if (s->mem_used > s->mem_peak) s->mem_peak = s->mem_used;
+    }
+    pthread_mutex_unlock(&s->mem_lock);
+    return ok;
+}
+
+static void mem_release(void *user, size_t n)
+{
+    sy_cluster_server *s = user;
+    if (!n) return;
+    pthread_mutex_lock(&s->mem_lock);
+    s->mem_used -= n <= s->mem_used ? n : s->mem_used;
+    pthread_cond_broadcast(&s->mem_cond);
+    pthread_mutex_unlock(&s->mem_lock);
+}
+
+/* Receive side: waits up to SY_CLUSTER_MEMORY_WAIT_MS for other peers' messages to finish (the
+ * reader stops reading meanwhile, so TCP pushes back on the sender), then refuses. */
+static bool mem_reserve_wait(void *user, size_t n, sy_error *err)
+{
+    sy_cluster_server *s = user;
+    double until = sy_time_now() + SY_CLUSTER_MEMORY_WAIT_MS / 1000.0;
+    pthread_mutex_lock(&s->mem_lock);
+    bool ok;
+    while (!(ok = n <= s->max_peer_memory - s->mem_used) && !s->mem_stopping && n <= s->max_peer_memory) {
+        double now = sy_time_now();
+        if (now >= until) break;
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        double wait = until - now < 0.1 ? until - now : 0.1;
+        long ns = ts.tv_nsec + (long)(wait * 1e9);
+        ts.tv_sec += ns / 1000000000L;
+        ts.tv_nsec = ns % 1000000000L;
+        pthread_cond_timedwait(&s->mem_cond, &s->mem_lock, &ts);
+    }
+    if (ok) {
+        s->mem_used += n;
+        if (s->mem_used > s->mem_peak) s->mem_peak = s->mem_used;
+    }
+    size_t used = s->mem_used;
+    pthread_mutex_unlock(&s->mem_lock);
+    if (!ok)
+        sy_error_set(err, SY_ERR_LIMIT,
+                     "server busy: peers' messages in flight hold %zu KiB of the %zu KiB this server allows "
+                     "(--max-peer-memory-mb); %zu more bytes were not free within %u ms",
+                     used >> 10, s->max_peer_memory >> 10, n, (unsigned)SY_CLUSTER_MEMORY_WAIT_MS);
+    return ok;
+}
+
+static void pending_drop(sy_cluster_server *s, session *se)
 {
     free(se->pending);
     free(se->missing);
     sy_blob_store_destroy(se->pending_blobs);
+    mem_release(s, se->pending_charged);
     se->pending = NULL;
     se->missing = NULL;
     se->pending_blobs = NULL;
     se->pending_size = se->missing_count = 0;
+    se->pending_charged = 0;
 }
 
-static void session_reset(session *se)
+static void session_reset(sy_cluster_server *s, session *se)
 {
-    pending_drop(se);
+    pending_drop(s, se);
     sy_layer_destroy(&se->present);
     sy_context_pool_destroy(se->pool);
     sy_scene_destroy(se->scene);
+    char peer[80];
+    memcpy(peer, se->peer, sizeof peer);
     memset(se, 0, sizeof *se);
+    memcpy(se->peer, peer, sizeof peer);
 }
 
-static void pipe_removed(nng_pipe p, nng_pipe_ev ev, void *user)
-{
-    (void)ev;
-    sy_cluster_server *s = user;
-    pthread_mutex_lock(&s->lock);
-    if (s->removed_count < 256) s->removed[s->removed_count++] = (uint32_t)nng_pipe_id(p);
-    pthread_mutex_unlock(&s->lock);
-}
+static void *acceptor_main(void *arg);
 
 sy_result sy_cluster_server_create(const sy_cluster_server_opts *opts, sy_cluster_server **out, sy_error *err)
 {
@@ -589,41 +979,46 @@ sy_result sy_cluster_server_create(const sy_cluster_server_opts *opts, sy_cluste
     const char *url = opts->listen_url ? opts->listen_url : SY_CLUSTER_DEFAULT_URL;
     copy_str(s->name, sizeof s->name, opts->name ? opts->name : "sy serve");
     s->max_sessions = opts->max_sessions ? opts->max_sessions : 16;
+    s->max_frame = opts->max_frame ? opts->max_frame : SY_CLUSTER_DEFAULT_MAX_FRAME;
     s->max_message = opts->max_message ? opts->max_message : SY_CLUSTER_DEFAULT_MAX_MESSAGE;
-    pthread_mutex_init(&s->lock, NULL);
-    pthread_mutex_init(&s->qlock, NULL);
-    pthread_cond_init(&s->qcond, NULL);
-    pthread_cond_init(&s->dcond, NULL);
+    s->max_peer_memory = opts->max_peer_memory ? opts->max_peer_memory : SY_CLUSTER_DEFAULT_MAX_PEER_MEMORY;
+    s->max_unauth = opts->max_unauthenticated ? opts->max_unauthenticated : SY_CLUSTER_DEFAULT_MAX_UNAUTHENTICATED;
+    s->handshake_ms = opts->handshake_timeout_ms ? opts->handshake_timeout_ms : SY_CLUSTER_DEFAULT_HANDSHAKE_MS;
+    if (s->max_frame < SY_CLUSTER_MIN_FRAME || s->max_frame > SY_CLUSTER_MAX_FRAME_LIMIT ||
+        s->max_message < SY_CLUSTER_MIN_FRAME || s->max_message > SY_CLUSTER_MAX_MESSAGE_LIMIT ||
+        s->max_peer_memory < SY_CLUSTER_MIN_FRAME) {
+        free(s);
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "sy serve: frame limit %zu (64 KiB..1 GiB), message limit %zu (>= 64 KiB) or peer memory %zu "
+                            "(>= 64 KiB) out of range",
+                            opts->max_frame, opts->max_message, opts->max_peer_memory);
+    }
+    if (s->max_message > s->max_peer_memory) s->max_message = s->max_peer_memory; /* one message must fit */
     s->cache.budget = opts->blob_cache_bytes ? opts->blob_cache_bytes : SY_CLUSTER_DEFAULT_BLOB_CACHE;
     if (!s->o.max_objects) s->o.max_objects = SY_CLUSTER_DEFAULT_MAX_OBJECTS;
     if (!s->o.auth_backoff_ms) s->o.auth_backoff_ms = 250;
-    if (!s->o.io_workers) s->o.io_workers = 8;
-    if (s->o.io_workers > 64) s->o.io_workers = 64;
-    s->sessions = calloc(s->max_sessions, sizeof *s->sessions);
+    pthread_mutex_init(&s->auth_lock, NULL);
+    pthread_mutex_init(&s->lock, NULL);
+    pthread_mutex_init(&s->qlock, NULL);
+    pthread_mutex_init(&s->mem_lock, NULL);
+    pthread_mutex_init(&s->log_lock, NULL);
+    pthread_cond_init(&s->qcond, NULL);
+    pthread_cond_init(&s->dcond, NULL);
+    pthread_cond_init(&s->mem_cond, NULL);
+    s->sync_ok = true;
     if (opts->secret_len) {
         s->secret = malloc(opts->secret_len);
-        if (s->secret) memcpy(s->secret, opts->secret, opts->secret_len);
-    }
-    if (!s->sessions || (opts->secret_len && !s->secret)) {
-        sy_cluster_server_destroy(s);
-        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "sy serve: out of memory");
+        if (!s->secret) {
+            sy_cluster_server_destroy(s);
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "sy serve: out of memory");
+        }
+        memcpy(s->secret, opts->secret, opts->secret_len);
     }
     s->o.secret = s->secret;
     int rv;
     bool tls = strncmp(url, "tls+tcp://", 10) == 0;
-    if ((rv = nng_rep0_open(&s->sock)) != 0) {
-        free(s->sessions);
-        free(s->secret);
-        pthread_mutex_destroy(&s->lock);
-        pthread_mutex_destroy(&s->qlock);
-        pthread_cond_destroy(&s->qcond);
-        pthread_cond_destroy(&s->dcond);
-        free(s);
-        return sy_error_set(err, SY_ERR_IO, "sy serve: cannot open socket: %s", nng_strerror(rv));
-    }
-    nng_socket_set_size(s->sock, NNG_OPT_RECVMAXSZ, s->max_message);
-    nng_pipe_notify(s->sock, NNG_PIPE_EV_REM_POST, pipe_removed, s);
-    if ((rv = nng_listener_create(&s->listener, s->sock, url)) != 0) {
+    if ((rv = nng_stream_listener_alloc(&s->listener, url)) != 0) {
+        s->listener = NULL;
         sy_cluster_server_destroy(s);
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy serve: %s: %s", url, nng_strerror(rv));
     }
@@ -645,20 +1040,21 @@ sy_result sy_cluster_server_create(const sy_cluster_server_opts *opts, sy_cluste
         if (key) sodium_memzero(key, strlen(key));
         free(cert);
         free(key);
-        if (rv != 0 || (rv = nng_listener_set_ptr(s->listener, NNG_OPT_TLS_CONFIG, s->tls)) != 0) {
+        if (rv != 0 || (rv = nng_stream_listener_set_ptr(s->listener, NNG_OPT_TLS_CONFIG, s->tls)) != 0) {
             sy_cluster_server_destroy(s);
             return sy_error_set(err, rv == NNG_ENOTSUP ? SY_ERR_UNSUPPORTED : SY_ERR_INVALID_ARGUMENT,
                                 "sy serve: TLS with %s / %s: %s", opts->tls_cert_file, opts->tls_key_file,
                                 nng_strerror(rv));
         }
     }
-    if ((rv = nng_listener_start(s->listener, 0)) != 0) {
+    nng_stream_listener_set_bool(s->listener, NNG_OPT_TCP_NODELAY, true);
+    if ((rv = nng_stream_listener_listen(s->listener)) != 0) {
         sy_cluster_server_destroy(s);
         return sy_error_set(err, SY_ERR_IO, "sy serve: cannot listen on %s: %s", url, nng_strerror(rv));
     }
     nng_sockaddr la;
     memset(&la, 0, sizeof la);
-    nng_listener_get_addr(s->listener, NNG_OPT_LOCADDR, &la);
+    nng_stream_listener_get_addr(s->listener, NNG_OPT_LOCADDR, &la);
     if (!s->secret && !sockaddr_is_loopback(&la)) {
         sy_cluster_server_destroy(s);
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
@@ -666,7 +1062,7 @@ sy_result sy_cluster_server_create(const sy_cluster_server_opts *opts, sy_cluste
                             "SY_CLUSTER_SECRET) is required to listen there",
                             url);
     }
-    nng_listener_get_int(s->listener, NNG_OPT_TCP_BOUND_PORT, &s->port);
+    nng_stream_listener_get_int(s->listener, NNG_OPT_TCP_BOUND_PORT, &s->port);
     *out = s;
     return SY_OK;
 }
@@ -676,53 +1072,48 @@ int sy_cluster_server_port(const sy_cluster_server *s)
     return s->port;
 }
 
+size_t sy_cluster_server_peer_memory(const sy_cluster_server *s, size_t *peak_out)
+{
+    pthread_mutex_lock((pthread_mutex_t *)&s->mem_lock);
+    size_t used = s->mem_used;
+    if (peak_out) *peak_out = s->mem_peak;
+    pthread_mutex_unlock((pthread_mutex_t *)&s->mem_lock);
+    return used;
+}
+
+static void peer_free(sy_cluster_server *s, peer *p);
+
 void sy_cluster_server_destroy(sy_cluster_server *s)
 {
     if (!s) return;
-    nng_close(s->sock);
+    if (s->listener) {
+        nng_stream_listener_close(s->listener);
+        if (s->acceptor_started) pthread_join(s->acceptor, NULL);
+        nng_stream_listener_free(s->listener);
+    }
+    /* sy_cluster_server_run has ended every connection; a server that never ran has none */
+    while (s->peers) {
+        peer *p = s->peers;
+        s->peers = p->next;
+        peer_free(s, p);
+    }
     if (s->tls) nng_tls_config_free(s->tls);
-    for (uint32_t i = 0; s->sessions && i < s->max_sessions; ++i)
-        if (s->sessions[i].used) session_reset(&s->sessions[i]);
-    free(s->sessions);
     cache_free(&s->cache);
     if (s->secret) sodium_memzero(s->secret, s->o.secret_len);
     free(s->secret);
-    pthread_mutex_destroy(&s->lock);
-    pthread_mutex_destroy(&s->qlock);
-    pthread_cond_destroy(&s->qcond);
-    pthread_cond_destroy(&s->dcond);
+    if (s->sync_ok) {
+        pthread_mutex_destroy(&s->auth_lock);
+        pthread_mutex_destroy(&s->lock);
+        pthread_mutex_destroy(&s->qlock);
+        pthread_mutex_destroy(&s->mem_lock);
+        pthread_mutex_destroy(&s->log_lock);
+        pthread_cond_destroy(&s->qcond);
+        pthread_cond_destroy(&s->dcond);
+        pthread_cond_destroy(&s->mem_cond);
+    }
     free(s);
 }
 
-static session *session_for(sy_cluster_server *s, nng_pipe p)
-{
-    uint32_t id = (uint32_t)nng_pipe_id(p);
-    session *free_slot = NULL, *oldest = NULL;
-    for (uint32_t i = 0; i < s->max_sessions; ++i) {
-        session *se = &s->sessions[i];
-        if (se->used && se->pipe_id == id) return se;
-        if (!se->used && !free_slot) free_slot = se;
-        /* evict unauthenticated sessions before authenticated ones, then the longest idle */
-        if (se->used && (!oldest || (se->state != 2 && oldest->state == 2) ||
-                         ((se->state == 2) == (oldest->state == 2) && se->last_active < oldest->last_active)))
-            oldest = se;
-    }
-    if (!free_slot) {
-        SLOG(s, "%s: session evicted (idle longest; %u sessions max)", oldest->peer, s->max_sessions);
-        session_reset(oldest);
-        free_slot = oldest;
-    }
-    free_slot->used = true;
-    free_slot->pipe_id = id;
-    nng_sockaddr sa;
-    memset(&sa, 0, sizeof sa);
-    nng_pipe_get_addr(p, NNG_OPT_REMADDR, &sa);
-    sockaddr_str(&sa, true, free_slot->peer, sizeof free_slot->peer);
-    sockaddr_str(&sa, false, free_slot->host, sizeof free_slot->host);
-    return free_slot;
-}
-
-/* Builds the reply to one request in *reply (type set); returns non-OK with err for ERROR. */
 static sy_result handle_render(sy_cluster_server *s, session *se, const sy_cluster_msg *m, sy_cluster_msg *reply,
                                sy_cluster_buf *payload, sy_error *err)
 {
@@ -848,9 +1239,13 @@ static sy_result apply_scene(sy_cluster_server *s, session *se, const uint8_t *c
     }
     sy_changes *ch = NULL;
     r = sy_changes_deserialize(changes, size, blobs, NULL, &ch, err);
-    if (r == SY_OK) r = sy_scene_apply(se->scene, ch, err);
+    /* the replica's pools grow by at most SY_CLUSTER_APPLY_SLACK_SLOTS + one slot per
+     * SY_CLUSTER_APPLY_BYTES_PER_SLOT bytes of the list */
+    if (r == SY_OK)
+        r = sy_scene_apply_bounded(se->scene, ch, SY_CLUSTER_APPLY_SLACK_SLOTS + size / SY_CLUSTER_APPLY_BYTES_PER_SLOT,
+                                   err);
+    sy_changes_release(ch); /* before the commit copies the changes for the contexts: one copy at a time */
     if (r == SY_OK) r = sy_scene_commit(se->scene, NULL, err);
-    sy_changes_release(ch);
     if (r) {
         /* the replica may be partly updated: drop it, the client must start from a snapshot */
         sy_context_pool_destroy(se->pool);
@@ -913,16 +1308,24 @@ static sy_result handle_scene(sy_cluster_server *s, session *se, const sy_cluste
                               sy_error *err)
 {
     bool snap = (m->u.scene.flags & SY_CLUSTER_SCENE_SNAPSHOT) != 0;
-    pending_drop(se); /* a new SCENE replaces one still waiting for blobs */
+    pending_drop(s, se); /* a new SCENE replaces one still waiting for blobs */
     if (!snap && !se->scene) return sy_error_set(err, SY_ERR_PROTOCOL, "the first SCENE must be a snapshot");
     sy_result r = sy_blob_store_create(&se->pending_blobs, err);
     ref_scan rs = {&s->cache, se, 0, false};
     if (r == SY_OK) r = sy_changes_blob_refs(m->u.scene.changes, m->u.scene.changes_size, NULL, scan_ref, &rs, err);
     if (r == SY_OK && rs.oom) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory for the blob list");
     if (r == SY_OK && se->missing_count) { /* keep the list until the blobs arrive */
-        se->pending = malloc(m->u.scene.changes_size ? m->u.scene.changes_size : 1);
-        if (!se->pending) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory for a pending scene");
-        else {
+        size_t keep = m->u.scene.changes_size ? m->u.scene.changes_size : 1;
+        if (!mem_try(s, keep))
+            r = sy_error_set(err, SY_ERR_LIMIT,
+                             "server busy: no room to keep a %u-byte scene while its blobs arrive (peers' messages "
+                             "may hold %zu KiB in all)",
+                             m->u.scene.changes_size, s->max_peer_memory >> 10);
+        else if (!(se->pending = malloc(keep))) {
+            mem_release(s, keep);
+            r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory for a pending scene");
+        } else {
+            se->pending_charged = keep;
             memcpy(se->pending, m->u.scene.changes, m->u.scene.changes_size);
             se->pending_size = m->u.scene.changes_size;
             se->pending_flags = m->u.scene.flags;
@@ -940,7 +1343,7 @@ static sy_result handle_scene(sy_cluster_server *s, session *se, const sy_cluste
         r = apply_scene(s, se, m->u.scene.changes, m->u.scene.changes_size, m->u.scene.flags, m->u.scene.frame,
                         se->pending_blobs, reply, err);
     else sy_error_prefix(err, "scene for frame %llu rejected", (unsigned long long)m->u.scene.frame);
-    pending_drop(se);
+    pending_drop(s, se);
     return r;
 }
 
@@ -986,74 +1389,63 @@ static sy_result handle_blobs(sy_cluster_server *s, session *se, const sy_cluste
         r = apply_scene(s, se, se->pending, se->pending_size, se->pending_flags, se->pending_frame, se->pending_blobs,
                         reply, err);
     else sy_error_prefix(err, "scene for frame %llu rejected", (unsigned long long)se->pending_frame);
-    pending_drop(se);
+    pending_drop(s, se);
     return r;
 }
 
 /* Processes one request frame; fills *out with the encoded reply. */
-static void serve_one(sy_cluster_server *s, nng_msg *in, sy_cluster_buf *out)
+
+/* >>serving: one request at a time, on the thread that runs sy_cluster_server_run */
+
+/* The first request of an open session registers it; beyond max_sessions the longest idle session
+ * is ended (its connection closed, its replica dropped). */
+static void session_register(sy_cluster_server *s, peer *p)
 {
-    session *se = session_for(s, nng_msg_get_pipe(in));
+    if (p->registered) return;
+    if (s->session_count >= s->max_sessions) {
+        peer *victim = NULL;
+        pthread_mutex_lock(&s->lock);
+        for (peer *q = s->peers; q; q = q->next)
+            if (q != p && q->registered && !q->evicted && (!victim || q->se.last_active < victim->se.last_active))
+                victim = q;
+        if (victim) nng_stream_close(victim->w.st); /* its reader thread ends; reap_peers frees it */
+        pthread_mutex_unlock(&s->lock);
+        if (victim) {
+            SLOG(s, "%s: session ended to make room for %s (idle longest; %u sessions max)", victim->se.peer, p->addr,
+                 s->max_sessions);
+            session_reset(s, &victim->se);
+            victim->evicted = true;
+            victim->registered = false;
+            s->session_count--;
+        }
+    }
+    p->registered = true;
+    s->session_count++;
+}
+
+/* Serves the message in p->in; leaves the encoded (untagged) reply in p->reply. */
+static void serve_job(sy_cluster_server *s, peer *p)
+{
+    p->reply.size = 0;
+    p->close_after = false;
+    if (p->evicted) {
+        p->close_after = true;
+        return;
+    }
+    session_register(s, p);
+    session *se = &p->se;
     se->last_active = sy_time_now();
-    const uint8_t *data = nng_msg_body(in);
-    size_t size = nng_msg_len(in);
     sy_error err = {0};
     sy_cluster_msg m, reply;
     memset(&reply, 0, sizeof reply);
     sy_cluster_buf payload = {0};
-    bool drop_session = false;
-    sy_result r = decode_frame(data, size, se->tagged ? se->key : NULL, se->recv_seq + 1, s->max_message, &m, &err);
-    if (r) {
-        drop_session = se->state != 2 || r == SY_ERR_PROTOCOL;
-    } else {
-        se->recv_seq = m.header.seq;
+    sy_cluster_limits lim = {s->max_message};
+    sy_result r = sy_cluster_decode_body(&p->in.h, p->in.body, p->in.size, &lim, &m, &err);
+    if (r == SY_OK) {
         uint32_t t = m.header.type;
-        if (t == SY_CLUSTER_HELLO) {
-            if (se->state != 0) {
-                r = sy_error_set(&err, SY_ERR_PROTOCOL, "HELLO in the middle of a session");
-                drop_session = true;
-            } else {
-                nng_sockaddr sa;
-                memset(&sa, 0, sizeof sa);
-                nng_pipe_get_addr(nng_msg_get_pipe(in), NNG_OPT_REMADDR, &sa);
-                double wait = s->secret ? auth_refused_for(s->auth, se->host, sy_time_now()) : 0;
-                if (!s->secret && !sockaddr_is_loopback(&sa)) {
-                    r = sy_error_set(&err, SY_ERR_PROTOCOL, "server has no secret and accepts loopback peers only");
-                    drop_session = true;
-                } else if (wait > 0) {
-                    r = sy_error_set(&err, SY_ERR_PROTOCOL,
-                                     "throttled: too many failed authentications from %s, retry in %.0f ms", se->host,
-                                     ceil(wait * 1000));
-                    drop_session = true;
-                } else {
-                    memcpy(se->cnonce, m.u.hello.nonce, 32);
-                    randombytes_buf(se->snonce, 32);
-                    reply.header.type = SY_CLUSTER_CHALLENGE;
-                    memcpy(reply.u.hello.nonce, se->snonce, 32);
-                    reply.u.hello.flags = s->secret ? 1u : 0u;
-                    copy_str(reply.u.hello.name, sizeof reply.u.hello.name, s->name);
-                    se->state = s->secret ? 1 : 2;
-                    SLOG(s, "%s: hello from '%s'%s", se->peer, m.u.hello.name, s->secret ? "" : " (no secret, loopback)");
-                }
-            }
-        } else if (t == SY_CLUSTER_AUTH && se->state == 1) {
-            uint8_t expect[32];
-            mac3(expect, s->secret, s->o.secret_len, "SYCP-client", se->snonce, se->cnonce);
-            if (crypto_verify_32(expect, m.u.auth.mac) != 0) {
-                double wait = auth_failed(s->auth, se->host, sy_time_now(), s->o.auth_backoff_ms);
-                r = sy_error_set(&err, SY_ERR_PROTOCOL, "authentication failed: wrong secret (%s refused for %.0f ms)",
-                                 se->host, wait * 1000);
-                drop_session = true;
-            } else {
-                auth_succeeded(s->auth, se->host);
-                reply.header.type = SY_CLUSTER_WELCOME;
-                mac3(reply.u.auth.mac, s->secret, s->o.secret_len, "SYCP-server", se->cnonce, se->snonce);
-                se->state = 2;
-                SLOG(s, "%s: authenticated", se->peer);
-            }
-        } else if (se->state != 2) {
-            r = sy_error_set(&err, SY_ERR_PROTOCOL, "%s before authentication", sy_cluster_msg_type_name(t));
-            drop_session = true;
+        if (t == SY_CLUSTER_HELLO || t == SY_CLUSTER_AUTH) {
+            r = sy_error_set(&err, SY_ERR_PROTOCOL, "%s in the middle of a session", sy_cluster_msg_type_name(t));
+            p->close_after = true;
         } else if (t == SY_CLUSTER_SCENE) {
             r = handle_scene(s, se, &m, &reply, &err);
         } else if (t == SY_CLUSTER_BLOBS) {
@@ -1073,6 +1465,7 @@ static void serve_one(sy_cluster_server *s, nng_msg *in, sy_cluster_buf *out)
             }
         } else if (t == SY_CLUSTER_BYE) {
             reply.header.type = SY_CLUSTER_BYE;
+            p->close_after = true;
             SLOG(s, "%s: bye", se->peer);
         } else {
             r = sy_error_set(&err, SY_ERR_PROTOCOL, "unexpected %s from a client", sy_cluster_msg_type_name(t));
@@ -1080,133 +1473,390 @@ static void serve_one(sy_cluster_server *s, nng_msg *in, sy_cluster_buf *out)
         sy_cluster_msg_free(&m);
     }
     if (r) {
-        SLOG(s, "%s: rejected: %s%s", se->peer, err.message, drop_session ? " (session reset)" : "");
+        SLOG(s, "%s: rejected: %s%s", se->peer, err.message, p->close_after ? " (connection closed)" : "");
         memset(&reply, 0, sizeof reply);
         reply.header.type = SY_CLUSTER_ERROR;
         reply.u.error.code = (uint32_t)r;
         copy_str(reply.u.error.reason, sizeof reply.u.error.reason, err.message);
     }
-    /* reply keys: handshake replies are untagged; once authenticated with a secret, tagged */
-    const uint8_t *key = (se->state == 2 && se->tagged) ? se->key : NULL;
-    reply.header.seq = ++se->send_seq;
     sy_error e2 = {0};
-    if (encode_frame(&reply, key, out, &e2) != SY_OK) {
-        SLOG(s, "%s: cannot encode reply: %s", se->peer, e2.message);
-        out->size = 0;
+    if (sy_cluster_encode(&reply, 0, &p->reply, &e2) != SY_OK) {
+        SLOG(s, "%s: cannot encode the reply: %s", se->peer, e2.message);
+        p->reply.size = 0;
+        p->close_after = true;
     }
     if (reply.header.type == SY_CLUSTER_TILES) free(reply.u.tiles.tiles);
     sy_cluster_buf_free(&payload);
-    if (reply.header.type == SY_CLUSTER_WELCOME) {
-        /* from now on both directions carry tags under the session key */
-        uint8_t k[32];
-        mac3(k, s->secret, s->o.secret_len, "SYCP-session", se->cnonce, se->snonce);
-        memcpy(se->key, k, 32);
-        se->tagged = true;
-    }
-    if (drop_session || reply.header.type == SY_CLUSTER_BYE) {
-        char peer[80];
-        memcpy(peer, se->peer, sizeof peer);
-        uint32_t pid = se->pipe_id;
-        session_reset(se);
-        se->used = true; /* keep the slot for this pipe: a new HELLO starts over */
-        se->pipe_id = pid;
-        memcpy(se->peer, peer, sizeof peer);
+    /* the encoded reply counts against the peer memory ceiling until it has been sent */
+    if (p->reply.size && !mem_try(s, p->reply.cap)) {
+        size_t want = p->reply.cap;
+        sy_cluster_buf_free(&p->reply);
+        memset(&reply, 0, sizeof reply);
+        reply.header.type = SY_CLUSTER_ERROR;
+        reply.u.error.code = SY_ERR_LIMIT;
+        snprintf(reply.u.error.reason, sizeof reply.u.error.reason,
+                 "server busy: a reply of %zu KiB does not fit the memory left for peers' messages (%zu KiB ceiling)",
+                 want >> 10, s->max_peer_memory >> 10);
+        SLOG(s, "%s: rejected: %s", se->peer, reply.u.error.reason);
+        if (sy_cluster_encode(&reply, 0, &p->reply, &e2) != SY_OK) p->reply.size = 0;
+        p->reply_charged = 0; /* a few hundred bytes, not charged */
+    } else {
+        p->reply_charged = p->reply.size ? p->reply.cap : 0;
     }
 }
 
-/* One I/O worker: receives on its own rep0 context, hands the request to the serving thread, sends
- * the reply. Receives and sends of different peers overlap, so a peer that is slow to send or to
- * read never holds the others; requests are still served one at a time, in arrival order, on the
- * serving thread (mediators and their GL contexts stay on one thread). */
-static void *io_worker(void *p)
+/* >>connections: reader threads */
+
+/* Sends an ERROR (untagged before the session is open) and ends the connection. An open session's
+ * peer may still be sending the rest of a refused message: what it sends within 500 ms is read and
+ * dropped first, so that it sees the ERROR instead of a reset connection. */
+static void peer_refuse(peer *p, sy_result code, const char *reason)
 {
-    sy_cluster_server *s = p;
-    nng_ctx ctx;
-    nng_aio *aio = NULL;
-    int rv = nng_ctx_open(&ctx, s->sock);
-    if (rv == 0 && (rv = nng_aio_alloc(&aio, NULL, NULL)) != 0) nng_ctx_close(ctx);
-    if (rv) {
-        SLOG(s, "I/O worker not started: %s", nng_strerror(rv));
-        return NULL;
+    sy_cluster_msg m;
+    memset(&m, 0, sizeof m);
+    m.header.type = SY_CLUSTER_ERROR;
+    m.u.error.code = (uint32_t)code;
+    copy_str(m.u.error.reason, sizeof m.u.error.reason, reason);
+    sy_cluster_buf b = {0};
+    sy_error e = {0};
+    size_t max_frame = p->state == 2 ? p->peer_max_frame : SY_CLUSTER_HANDSHAKE_MAX_FRAME;
+    if (sy_cluster_encode(&m, 0, &b, &e) == SY_OK)
+        (void)wire_send(&p->w, b.data, b.size, max_frame, sy_time_now() + 1.0, 0, NULL, &e);
+    sy_cluster_buf_free(&b);
+    if (p->state == 2) {
+        double until = sy_time_now() + 0.5;
+        for (;;) {
+            nng_iov iov = {p->hbuf, sizeof p->hbuf};
+            if (wire_io(&p->w, false, &iov, 1, until, NULL, &e) != SY_OK) break; /* the deadline or the end */
+        }
     }
-    io_job job;
-    memset(&job, 0, sizeof job);
-    for (;;) {
-        nng_aio_set_timeout(aio, 100);
-        nng_ctx_recv(ctx, aio);
-        nng_aio_wait(aio);
-        rv = nng_aio_result(aio);
+}
+
+/* HELLO (and AUTH when the server has a secret) on the reader thread, under the handshake
+ * deadline and budget. Returns true when the session is open. */
+static bool peer_handshake(peer *p)
+{
+    sy_cluster_server *s = p->s;
+    double deadline = p->accepted + s->handshake_ms / 1000.0;
+    const sy_cluster_budget hb = {SY_CLUSTER_HANDSHAKE_MAX_FRAME, SY_CLUSTER_HANDSHAKE_MAX_FRAME, false, false};
+    while (p->state != 2) {
+        sy_error err = {0};
+        rx_msg in;
+        sy_result r = wire_recv(&p->w, &hb, p->hbuf, sizeof p->hbuf, NULL, deadline, 0, &in, NULL, &err);
+        if (r) {
+            if (p->w.last_rv == NNG_ETIMEDOUT)
+                slog_noise(s, "%s: closed: no %s within the %u ms handshake deadline", p->addr,
+                           p->state == 0 ? "HELLO" : "AUTH", s->handshake_ms);
+            else if (wire_closed(&p->w))
+                slog_noise(s, "%s: disconnected during the handshake", p->addr);
+            else if (p->w.last_rv) /* the connection failed (e.g. TLS): nothing can be sent */
+                slog_noise(s, "%s: connection failed during the handshake: %s", p->addr, err.message);
+            else {
+                slog_noise(s, "%s: rejected: %s (before authentication; connection closed)", p->addr, err.message);
+                peer_refuse(p, r, err.message);
+            }
+            return false;
+        }
+        sy_cluster_msg m, reply;
+        memset(&reply, 0, sizeof reply);
+        sy_cluster_limits lim = {SY_CLUSTER_HANDSHAKE_MAX_FRAME};
+        r = sy_cluster_decode_body(&in.h, in.body, in.size, &lim, &m, &err);
+        bool refused = r != SY_OK;
+        uint32_t t = refused ? 0 : m.header.type;
+        if (r == SY_OK) {
+            if (t == SY_CLUSTER_HELLO && p->state == 0) {
+                double wait = 0;
+                if (s->secret) {
+                    pthread_mutex_lock(&s->auth_lock);
+                    wait = auth_refused_for(s->auth, p->host, sy_time_now());
+                    pthread_mutex_unlock(&s->auth_lock);
+                }
+                if (!s->secret && !p->loopback) {
+                    r = sy_error_set(&err, SY_ERR_PROTOCOL, "server has no secret and accepts loopback peers only");
+                } else if (wait > 0) {
+                    r = sy_error_set(&err, SY_ERR_PROTOCOL,
+                                     "throttled: too many failed authentications from %s, retry in %.0f ms", p->host,
+                                     ceil(wait * 1000));
+                } else {
+                    memcpy(p->cnonce, m.u.hello.nonce, 32);
+                    randombytes_buf(p->snonce, 32);
+                    p->peer_max_frame = m.u.hello.max_frame;
+                    reply.header.type = SY_CLUSTER_CHALLENGE;
+                    memcpy(reply.u.hello.nonce, p->snonce, 32);
+                    reply.u.hello.flags = s->secret ? 1u : 0u;
+                    reply.u.hello.max_frame = (uint32_t)s->max_frame;
+                    reply.u.hello.max_message = s->max_message;
+                    copy_str(reply.u.hello.name, sizeof reply.u.hello.name, s->name);
+                    char name[SY_CLUSTER_NAME_MAX]; /* the peer's words in our log: printable only */
+                    copy_str(name, sizeof name, m.u.hello.name);
+                    for (char *c = name; *c; ++c)
+                        if ((unsigned char)*c < 0x20 || (unsigned char)*c == 0x7f) *c = '?';
+                    slog_noise(s, "%s: hello from '%s'%s", p->addr, name, s->secret ? "" : " (no secret, loopback)");
+                }
+            } else if (t == SY_CLUSTER_AUTH && p->state == 1) {
+                uint8_t expect[32];
+                mac3(expect, s->secret, s->o.secret_len, "SYCP-client", p->snonce, p->cnonce);
+                if (crypto_verify_32(expect, m.u.auth.mac) != 0) {
+                    pthread_mutex_lock(&s->auth_lock);
+                    double wait = auth_failed(s->auth, p->host, sy_time_now(), s->o.auth_backoff_ms);
+                    pthread_mutex_unlock(&s->auth_lock);
+                    r = sy_error_set(&err, SY_ERR_PROTOCOL, "authentication failed: wrong secret (%s refused for %.0f ms)",
+                                     p->host, wait * 1000);
+                } else {
+                    pthread_mutex_lock(&s->auth_lock);
+                    auth_succeeded(s->auth, p->host);
+                    pthread_mutex_unlock(&s->auth_lock);
+                    reply.header.type = SY_CLUSTER_WELCOME;
+                    mac3(reply.u.auth.mac, s->secret, s->o.secret_len, "SYCP-server", p->cnonce, p->snonce);
+                }
+            } else {
+                r = sy_error_set(&err, SY_ERR_PROTOCOL, "%s before authentication", sy_cluster_msg_type_name(t));
+            }
+            sy_cluster_msg_free(&m);
+        }
+        if (r) {
+            /* a wrong secret is worth every line (the back-off bounds them per address); garbage,
+             * out-of-order and throttled HELLOs are rate-limited like any unauthenticated noise */
+            if (t == SY_CLUSTER_AUTH) SLOG(s, "%s: rejected: %s (connection closed)", p->addr, err.message);
+            else slog_noise(s, "%s: rejected: %s (connection closed)", p->addr, err.message);
+            peer_refuse(p, r, err.message);
+            return false;
+        }
+        sy_cluster_buf b = {0};
+        r = sy_cluster_encode(&reply, 0, &b, &err);
+        if (r == SY_OK) r = wire_send(&p->w, b.data, b.size, SY_CLUSTER_HANDSHAKE_MAX_FRAME, deadline, 0, NULL, &err);
+        sy_cluster_buf_free(&b);
+        if (r) {
+            slog_noise(s, "%s: handshake reply not sent: %s", p->addr, err.message);
+            return false;
+        }
+        if (reply.header.type == SY_CLUSTER_CHALLENGE) p->state = s->secret ? 1 : 2;
+        if (reply.header.type == SY_CLUSTER_WELCOME) {
+            /* from now on both directions carry tags under the session key */
+            mac3(p->w.key, s->secret, s->o.secret_len, "SYCP-session", p->cnonce, p->snonce);
+            p->w.tagged = true;
+            p->state = 2;
+            SLOG(s, "%s: authenticated", p->addr);
+        }
+    }
+    return true;
+}
+
+static void *peer_main(void *arg)
+{
+    peer *p = arg;
+    sy_cluster_server *s = p->s;
+    bool open = peer_handshake(p);
+    if (open) {
+        /* sessions that never send a request are not registered (and evicted) by the serving
+         * thread: at most twice max_sessions may be open at all */
+        pthread_mutex_lock(&s->lock);
+        if (p->counted_unauth) s->unauth--;
+        p->counted_unauth = false;
+        uint32_t n = s->open_sessions;
+        open = n < 2 * s->max_sessions;
+        if (open) s->open_sessions++, p->counted_open = true;
+        pthread_mutex_unlock(&s->lock);
+        if (!open) {
+            char why[160];
+            snprintf(why, sizeof why, "server busy: %u sessions are open (--max-sessions %u)", n, s->max_sessions);
+            SLOG(s, "%s: rejected: %s (connection closed)", p->addr, why);
+            peer_refuse(p, SY_ERR_LIMIT, why);
+        }
+    }
+    const sy_cluster_budget fb = {s->max_frame, s->max_message, true, p->w.tagged};
+    const wire_mem mem = {mem_reserve_wait, mem_release, s};
+    while (open) {
+        sy_error err = {0};
+        sy_result r = wire_recv(&p->w, &fb, NULL, 0, &mem, 0, SY_CLUSTER_PROGRESS_MS / 1000.0, &p->in, NULL, &err);
+        if (r) {
+            if (wire_closed(&p->w)) SLOG(s, "%s: disconnected", p->addr);
+            else if (p->w.last_rv) SLOG(s, "%s: connection failed: %s (connection closed)", p->addr, err.message);
+            else {
+                SLOG(s, "%s: rejected: %s (connection closed)", p->addr, err.message);
+                peer_refuse(p, r, err.message);
+            }
+            break;
+        }
         pthread_mutex_lock(&s->qlock);
         bool stop = s->stopping;
-        pthread_mutex_unlock(&s->qlock);
-        if (rv == 0 && stop) nng_msg_free(nng_aio_get_msg(aio));
-        if (stop || rv == NNG_ECLOSED) break;
-        if (rv) continue; /* timeout (poll the stop flag) or a failed receive of one peer */
-        job.in = nng_aio_get_msg(aio);
-        job.done = false;
-        job.next = NULL;
-        pthread_mutex_lock(&s->qlock);
-        if (s->qtail) s->qtail->next = &job;
-        else s->qhead = &job;
-        s->qtail = &job;
-        pthread_cond_signal(&s->qcond);
-        while (!job.done) pthread_cond_wait(&s->dcond, &s->qlock);
-        pthread_mutex_unlock(&s->qlock);
-        nng_msg_free(job.in);
-        nng_msg *rep = NULL;
-        if (!job.out.size) continue;
-        if ((rv = nng_msg_alloc(&rep, 0)) == 0 && (rv = nng_msg_append(rep, job.out.data, job.out.size)) == 0) {
-            nng_aio_set_msg(aio, rep);
-            nng_aio_set_timeout(aio, 10000);
-            nng_ctx_send(ctx, aio);
-            nng_aio_wait(aio);
-            if ((rv = nng_aio_result(aio)) == 0) rep = NULL; /* nng owns it now */
+        if (!stop) {
+            p->done = false;
+            p->qnext = NULL;
+            if (s->qtail) s->qtail->qnext = p;
+            else s->qhead = p;
+            s->qtail = p;
+            pthread_cond_signal(&s->qcond);
+            while (!p->done) pthread_cond_wait(&s->dcond, &s->qlock);
+            stop = s->stopping;
         }
-        if (rep) nng_msg_free(rep);
-        if (rv) SLOG(s, "reply not sent: %s", nng_strerror(rv));
+        pthread_mutex_unlock(&s->qlock);
+        rx_release(&p->in, &mem);
+        if (!stop && p->reply.size) {
+            r = wire_send(&p->w, p->reply.data, p->reply.size, p->peer_max_frame, 0, SY_CLUSTER_SEND_MS / 1000.0, NULL,
+                          &err);
+            if (r) SLOG(s, "%s: reply not sent: %s (connection closed)", p->addr, err.message);
+        }
+        mem_release(s, p->reply_charged);
+        p->reply_charged = 0;
+        sy_cluster_buf_free(&p->reply);
+        if (stop || r || p->close_after) break;
     }
-    sy_cluster_buf_free(&job.out);
-    nng_aio_free(aio);
-    nng_ctx_close(ctx);
+    nng_stream_close(p->w.st);
+    pthread_mutex_lock(&s->lock);
+    if (p->counted_unauth) s->unauth--;
+    if (p->counted_open) s->open_sessions--;
+    p->counted_unauth = p->counted_open = false;
+    p->dead = true;
+    pthread_mutex_unlock(&s->lock);
+    pthread_mutex_lock(&s->qlock);
+    pthread_cond_signal(&s->qcond); /* the serving thread reaps */
+    pthread_mutex_unlock(&s->qlock);
     return NULL;
 }
 
-/* Frees the sessions of connections nng reported closed. */
-static void reap_sessions(sy_cluster_server *s)
+/* Frees a connection whose reader thread has ended (or never started). Serving thread. */
+static void peer_free(sy_cluster_server *s, peer *p)
 {
-    pthread_mutex_lock(&s->lock);
-    uint32_t removed[256], nrem = s->removed_count;
-    memcpy(removed, s->removed, nrem * sizeof *removed);
-    s->removed_count = 0;
-    pthread_mutex_unlock(&s->lock);
-    for (uint32_t k = 0; k < nrem; ++k)
-        for (uint32_t i = 0; i < s->max_sessions; ++i)
-            if (s->sessions[i].used && s->sessions[i].pipe_id == removed[k]) {
-                SLOG(s, "%s: disconnected", s->sessions[i].peer);
-                session_reset(&s->sessions[i]);
+    if (p->registered) s->session_count--;
+    session_reset(s, &p->se);
+    rx_release(&p->in, &(wire_mem){mem_reserve_wait, mem_release, s});
+    mem_release(s, p->reply_charged);
+    sy_cluster_buf_free(&p->reply);
+    if (p->w.st) {
+        nng_stream_close(p->w.st);
+        nng_stream_free(p->w.st);
+    }
+    wire_fini(&p->w);
+    sodium_memzero(p->w.key, sizeof p->w.key);
+    free(p);
+}
+
+/* Joins and frees every connection whose reader thread has finished. Serving thread. */
+static void reap_peers(sy_cluster_server *s)
+{
+    for (;;) {
+        peer *dead = NULL;
+        pthread_mutex_lock(&s->lock);
+        for (peer **pp = &s->peers; *pp; pp = &(*pp)->next)
+            if ((*pp)->dead) {
+                dead = *pp;
+                *pp = dead->next;
+                s->npeers--;
+                break;
             }
+        pthread_mutex_unlock(&s->lock);
+        if (!dead) return;
+        pthread_join(dead->thread, NULL);
+        peer_free(s, dead);
+    }
+}
+
+/* A new connection: refused at once beyond max_unauthenticated; else a record and a reader
+ * thread with a small stack. */
+static void peer_start(sy_cluster_server *s, nng_stream *st)
+{
+    nng_sockaddr sa;
+    memset(&sa, 0, sizeof sa);
+    char addr[80];
+    if (nng_stream_get_addr(st, NNG_OPT_REMADDR, &sa) == 0) sockaddr_str(&sa, true, addr, sizeof addr);
+    else copy_str(addr, sizeof addr, "unknown peer");
+    pthread_mutex_lock(&s->lock);
+    uint32_t unauth = s->unauth;
+    bool room = unauth < s->max_unauth;
+    if (room) s->unauth++;
+    pthread_mutex_unlock(&s->lock);
+    if (!room) {
+        slog_noise(s, "%s: connection refused: %u unauthenticated connections are open (limit %u, "
+                      "--max-unauthenticated)", addr, unauth, s->max_unauth);
+        nng_stream_close(st);
+        nng_stream_free(st);
+        return;
+    }
+    peer *p = calloc(1, sizeof *p);
+    int rv = p ? wire_init(&p->w) : NNG_ENOMEM;
+    if (rv == 0) {
+        p->s = s;
+        p->w.st = st;
+        p->accepted = sy_time_now();
+        p->counted_unauth = true;
+        p->loopback = sockaddr_is_loopback(&sa);
+        copy_str(p->addr, sizeof p->addr, addr);
+        copy_str(p->se.peer, sizeof p->se.peer, addr);
+        sockaddr_str(&sa, false, p->host, sizeof p->host);
+        pthread_attr_t at;
+        pthread_attr_init(&at);
+        pthread_attr_setstacksize(&at, SY_CLUSTER_READER_STACK);
+        pthread_mutex_lock(&s->lock); /* listed before it runs: its exit finds itself */
+        rv = pthread_create(&p->thread, &at, peer_main, p);
+        if (rv == 0) {
+            p->next = s->peers;
+            s->peers = p;
+            s->npeers++;
+        }
+        pthread_mutex_unlock(&s->lock);
+        pthread_attr_destroy(&at);
+        if (rv == 0) return;
+        rv = NNG_ENOMEM;
+    }
+    slog_noise(s, "%s: connection dropped: %s", addr, rv == NNG_ENOMEM ? "out of memory" : nng_strerror(rv));
+    pthread_mutex_lock(&s->lock);
+    s->unauth--;
+    pthread_mutex_unlock(&s->lock);
+    if (p) wire_fini(&p->w);
+    free(p);
+    nng_stream_close(st);
+    nng_stream_free(st);
+}
+
+static void *acceptor_main(void *arg)
+{
+    sy_cluster_server *s = arg;
+    nng_aio *aio = NULL;
+    if (nng_aio_alloc(&aio, NULL, NULL) != 0) {
+        SLOG(s, "cannot accept connections: out of memory");
+        return NULL;
+    }
+    for (;;) {
+        nng_stream_listener_accept(s->listener, aio);
+        nng_aio_wait(aio);
+        int rv = nng_aio_result(aio);
+        if (rv == NNG_ECLOSED || rv == NNG_ECANCELED) break;
+        if (rv) {
+            slog_noise(s, "accept failed: %s", nng_strerror(rv));
+            struct timespec ts = {0, 20000000L}; /* e.g. out of descriptors: do not spin */
+            nanosleep(&ts, NULL);
+            continue;
+        }
+        peer_start(s, nng_aio_get_output(aio, 0));
+    }
+    nng_aio_free(aio);
+    return NULL;
 }
 
 sy_result sy_cluster_server_run(sy_cluster_server *s, sy_error *err)
 {
     double start = sy_time_now();
-    SLOG(s, "listening on %s (port %d)%s; blob cache %zu MiB, %u I/O workers",
+    SLOG(s, "listening on %s (port %d)%s; blob cache %zu MiB; frames <= %zu KiB, messages <= %zu MiB, peers' "
+            "messages <= %zu MiB in all; <= %u unauthenticated connections, handshake deadline %u ms",
          s->o.listen_url ? s->o.listen_url : SY_CLUSTER_DEFAULT_URL, s->port,
          s->secret ? ", shared-secret authentication" : ", no secret: loopback peers only", s->cache.budget >> 20,
-         s->o.io_workers);
-    pthread_t th[64];
-    uint32_t nth = 0;
+         s->max_frame >> 10, s->max_message >> 20, s->max_peer_memory >> 20, s->max_unauth, s->handshake_ms);
+    pthread_mutex_lock(&s->qlock);
     s->stopping = false;
-    for (uint32_t i = 0; i < s->o.io_workers; ++i)
-        if (pthread_create(&th[nth], NULL, io_worker, s) == 0) nth++;
-    if (!nth) return sy_error_set(err, SY_ERR_IO, "sy serve: cannot start any I/O thread");
+    pthread_mutex_unlock(&s->qlock);
+    if (!s->acceptor_started) {
+        if (pthread_create(&s->acceptor, NULL, acceptor_main, s) != 0)
+            return sy_error_set(err, SY_ERR_IO, "sy serve: cannot start the accepting thread");
+        s->acceptor_started = true;
+    }
     for (;;) {
         if (s->o.stop && *s->o.stop) break;
         if (s->o.max_lifetime_s > 0 && sy_time_now() - start > s->o.max_lifetime_s) {
             SLOG(s, "maximum lifetime of %.0f s reached, stopping", s->o.max_lifetime_s);
             break;
         }
-        reap_sessions(s);
+        reap_peers(s);
         pthread_mutex_lock(&s->qlock);
         if (!s->qhead) {
             struct timespec ts;
@@ -1215,47 +1865,66 @@ sy_result sy_cluster_server_run(sy_cluster_server *s, sy_error *err)
             if (ts.tv_nsec >= 1000000000L) ts.tv_sec++, ts.tv_nsec -= 1000000000L;
             pthread_cond_timedwait(&s->qcond, &s->qlock, &ts);
         }
-        io_job *job = s->qhead;
+        peer *job = s->qhead;
         if (job) {
-            s->qhead = job->next;
+            s->qhead = job->qnext;
             if (!s->qhead) s->qtail = NULL;
         }
         pthread_mutex_unlock(&s->qlock);
         if (!job) continue;
-        reap_sessions(s); /* a request may come after its connection's close was reported */
-        serve_one(s, job->in, &job->out);
+        serve_job(s, job);
         pthread_mutex_lock(&s->qlock);
         job->done = true;
         pthread_cond_broadcast(&s->dcond);
         pthread_mutex_unlock(&s->qlock);
     }
+    /* stop: no new connections, every connection closed, every reader thread joined */
+    nng_stream_listener_close(s->listener);
+    if (s->acceptor_started) pthread_join(s->acceptor, NULL);
+    s->acceptor_started = false;
     pthread_mutex_lock(&s->qlock);
     s->stopping = true;
-    for (io_job *j = s->qhead; j; j = j->next) {
-        j->out.size = 0;
+    for (peer *j = s->qhead; j; j = j->qnext) {
+        j->reply.size = 0;
         j->done = true;
     }
     s->qhead = s->qtail = NULL;
     pthread_cond_broadcast(&s->dcond);
     pthread_mutex_unlock(&s->qlock);
-    for (uint32_t i = 0; i < nth; ++i) pthread_join(th[i], NULL);
+    pthread_mutex_lock(&s->mem_lock);
+    s->mem_stopping = true;
+    pthread_cond_broadcast(&s->mem_cond);
+    pthread_mutex_unlock(&s->mem_lock);
+    pthread_mutex_lock(&s->lock);
+    for (peer *p = s->peers; p; p = p->next) nng_stream_close(p->w.st);
+    pthread_mutex_unlock(&s->lock);
+    for (;;) {
+        reap_peers(s);
+        pthread_mutex_lock(&s->lock);
+        bool left = s->peers != NULL;
+        pthread_mutex_unlock(&s->lock);
+        if (!left) break;
+        struct timespec ts = {0, 5000000L};
+        nanosleep(&ts, NULL);
+    }
     return SY_OK;
 }
 
 /* ======================================================================== client */
 typedef struct conn {
     char url[256];
-    nng_socket sock;
-    bool open, live, fresh; /* fresh: connected during this frame (needs a snapshot) */
+    nng_stream_dialer *dialer;
+    wire w;                      /* w.st != NULL: connected */
+    bool live, fresh;            /* fresh: connected during this frame (needs a snapshot) */
+    bool session_open;           /* past the handshake: the session's budget applies */
+    size_t srv_max_frame;        /* the server's limits (from CHALLENGE) */
+    uint64_t srv_max_message;
     bool has_consumer;
     uint32_t consumer;
-    uint64_t send_seq, recv_seq;
-    uint8_t key[32];
-    bool tagged;
     char backend[SY_CLUSTER_BACKEND_MAX]; /* "" = the frame's back-end */
     sy_cluster_rect wall;        /* multi-display tile; w == 0: column i of n */
     sy_blob_store *offered;      /* the blobs this frame's SCENE names (by hash), for the server's BLOB_REQUEST */
-    sy_cluster_buf scene_msg;    /* encoded SCENE for this frame (0 size = none) */
+    sy_cluster_buf scene_msg;    /* encoded (untagged) SCENE for this frame (0 size = none) */
     bool offer_failed;           /* out of memory while keeping a blob */
     uint64_t blob_frames_bytes, blob_payload_bytes; /* BLOBS sent (frames / payloads), cumulative */
     double last_seconds;         /* last render time, for balanced mode */
@@ -1272,7 +1941,7 @@ struct sy_cluster_client {
     uint32_t n;
     uint64_t frame;
     uint32_t coop_next; /* cooperative: first sample index of the next frame (ranges never repeat) */
-    size_t max_message;
+    size_t max_frame, max_message;
     uint32_t timeout_ms, connect_timeout_ms;
     char *tls_ca; /* owned copy of the CA file path */
 };
@@ -1281,39 +1950,72 @@ struct sy_cluster_client {
 
 static void conn_close(conn *k)
 {
-    if (k->open) nng_close(k->sock);
-    k->open = k->live = k->tagged = false;
+    if (k->w.st) {
+        nng_stream_close(k->w.st);
+        nng_stream_free(k->w.st);
+    }
+    if (k->dialer) nng_stream_dialer_free(k->dialer);
+    wire_fini(&k->w);
+    sodium_memzero(k->w.key, sizeof k->w.key);
+    memset(&k->w, 0, sizeof k->w);
+    k->dialer = NULL;
+    k->live = k->session_open = false;
 }
 
-/* One request/reply exchange. *reply borrows *raw (free with nng_msg_free + sy_cluster_msg_free). */
+/* Bytes a message body may have on this connection (what the server accepts). */
+static uint64_t conn_body_limit(const conn *k)
+{
+    return k->session_open ? k->srv_max_message : SY_CLUSTER_HANDSHAKE_MAX_FRAME - SY_CLUSTER_HEADER_SIZE;
+}
+
+/* One request/reply exchange within timeout_ms (the handshake's deadline before the session is
+ * open). *reply borrows *raw (free it with free() after sy_cluster_msg_free). */
 static sy_result conn_call(sy_cluster_client *c, conn *k, sy_cluster_msg *req, const sy_cluster_buf *preencoded,
-                           uint32_t expect, sy_cluster_msg *reply, nng_msg **raw, sy_error *err)
+                           uint32_t expect, sy_cluster_msg *reply, uint8_t **raw, sy_error *err)
 {
     *raw = NULL;
+    memset(reply, 0, sizeof *reply);
+    if (!k->w.st) return sy_error_set(err, SY_ERR_IO, "%s: not connected", k->url);
+    double deadline = sy_time_now() + (k->session_open ? c->timeout_ms : c->connect_timeout_ms) / 1000.0;
     sy_cluster_buf buf = {0};
     const sy_cluster_buf *b = preencoded;
     sy_result r = SY_OK;
     if (!b) {
-        req->header.seq = ++k->send_seq;
-        r = encode_frame(req, k->tagged ? k->key : NULL, &buf, err);
+        r = sy_cluster_encode(req, 0, &buf, err);
         b = &buf;
     }
-    int rv = r ? 0 : nng_send(k->sock, b->data, b->size, 0);
-    if (!r && rv) r = sy_error_set(err, SY_ERR_IO, "%s: send failed: %s", k->url, nng_strerror(rv));
-    if (!r) k->bytes_sent += b->size;
+    if (r == SY_OK && b->size - SY_CLUSTER_HEADER_SIZE > conn_body_limit(k))
+        r = sy_error_set(err, SY_ERR_LIMIT, "%s: a %s of %zu bytes exceeds the server's message limit of %llu", k->url,
+                         sy_cluster_msg_type_name((uint32_t)b->data[6] | ((uint32_t)b->data[7] << 8)),
+                         b->size - SY_CLUSTER_HEADER_SIZE, (unsigned long long)conn_body_limit(k));
+    if (r == SY_OK) {
+        uint64_t seq0 = k->w.send_seq;
+        size_t max_frame = k->session_open ? k->srv_max_frame : SY_CLUSTER_HANDSHAKE_MAX_FRAME;
+        r = wire_send(&k->w, b->data, b->size, max_frame, deadline, 0, k->url, err);
+        uint64_t frames = k->w.send_seq - seq0; /* headers and tags of every frame, plus the body */
+        if (frames)
+            k->bytes_sent += b->size + (frames - 1) * SY_CLUSTER_HEADER_SIZE + (k->w.tagged ? frames * SY_CLUSTER_TAG_SIZE : 0);
+    }
     sy_cluster_buf_free(&buf);
     if (r) return r;
-    rv = nng_recvmsg(k->sock, raw, 0);
-    if (rv)
-        return sy_error_set(err, SY_ERR_IO, "%s: %s", k->url,
-                            rv == NNG_ETIMEDOUT ? "no reply before the deadline" : nng_strerror(rv));
-    k->bytes_received += nng_msg_len(*raw);
-    r = decode_frame(nng_msg_body(*raw), nng_msg_len(*raw), k->tagged ? k->key : NULL, k->recv_seq + 1,
-                     c->max_message, reply, err);
+    const sy_cluster_budget budget = k->session_open
+                                         ? (sy_cluster_budget){c->max_frame, c->max_message, true, k->w.tagged}
+                                         : (sy_cluster_budget){SY_CLUSTER_HANDSHAKE_MAX_FRAME,
+                                                               SY_CLUSTER_HANDSHAKE_MAX_FRAME, false, false};
+    rx_msg in;
+    uint64_t rseq0 = k->w.recv_seq;
+    r = wire_recv(&k->w, &budget, NULL, 0, NULL, deadline, 0, &in, k->url, err);
+    if (r) {
+        if (k->w.last_rv == NNG_ETIMEDOUT) sy_error_set(err, SY_ERR_IO, "%s: no reply before the deadline", k->url);
+        return r;
+    }
+    k->bytes_received += in.size + (k->w.recv_seq - rseq0) * SY_CLUSTER_HEADER_SIZE +
+                         (k->w.tagged ? (k->w.recv_seq - rseq0) * SY_CLUSTER_TAG_SIZE : 0);
+    sy_cluster_limits lim = {c->max_message};
+    r = sy_cluster_decode_body(&in.h, in.body, in.size, &lim, reply, err);
     if (r) {
         sy_error_prefix(err, "%s", k->url);
     } else {
-        k->recv_seq = reply->header.seq;
         if (reply->header.type == SY_CLUSTER_ERROR) {
             r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: server rejected the request: %s", k->url, reply->u.error.reason);
         } else if (reply->header.type != expect &&
@@ -1323,28 +2025,21 @@ static sy_result conn_call(sy_cluster_client *c, conn *k, sy_cluster_msg *req, c
         }
         if (r) sy_cluster_msg_free(reply);
     }
-    if (r) {
-        nng_msg_free(*raw);
-        *raw = NULL;
-    }
+    if (r) free(in.body);
+    else *raw = in.body;
     return r;
 }
 
+/* Dials (within the connect timeout), then HELLO / CHALLENGE (/ AUTH / WELCOME). */
 static sy_result conn_connect(sy_cluster_client *c, conn *k, sy_error *err)
 {
     conn_close(k);
-    k->send_seq = k->recv_seq = 0;
-    int rv = nng_req0_open(&k->sock);
-    if (rv) return sy_error_set(err, SY_ERR_IO, "%s: cannot open socket: %s", k->url, nng_strerror(rv));
-    k->open = true;
-    nng_socket_set_ms(k->sock, NNG_OPT_RECVTIMEO, (nng_duration)c->connect_timeout_ms);
-    nng_socket_set_ms(k->sock, NNG_OPT_SENDTIMEO, (nng_duration)c->connect_timeout_ms);
-    nng_socket_set_ms(k->sock, NNG_OPT_REQ_RESENDTIME, NNG_DURATION_INFINITE);
-    nng_socket_set_size(k->sock, NNG_OPT_RECVMAXSZ, c->max_message);
-    nng_dialer d;
-    if ((rv = nng_dialer_create(&d, k->sock, k->url)) != 0) {
+    int rv = wire_init(&k->w);
+    if (rv == 0) rv = nng_stream_dialer_alloc(&k->dialer, k->url);
+    if (rv) {
         conn_close(k);
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: %s", k->url, nng_strerror(rv));
+        return sy_error_set(err, rv == NNG_ENOMEM ? SY_ERR_OUT_OF_MEMORY : SY_ERR_INVALID_ARGUMENT, "%s: %s", k->url,
+                            nng_strerror(rv));
     }
     if (!strncmp(k->url, "tls+tcp://", 10)) {
         if (!c->o.tls_ca_file) {
@@ -1363,7 +2058,8 @@ static sy_result conn_connect(sy_cluster_client *c, conn *k, sy_error *err)
         if ((rv = nng_tls_config_alloc(&cfg, NNG_TLS_MODE_CLIENT)) != 0 ||
             (rv = nng_tls_config_ca_file(cfg, c->o.tls_ca_file)) != 0 ||
             (rv = nng_tls_config_auth_mode(cfg, NNG_TLS_AUTH_MODE_REQUIRED)) != 0 ||
-            (rv = nng_tls_config_server_name(cfg, host)) != 0 || (rv = nng_dialer_set_ptr(d, NNG_OPT_TLS_CONFIG, cfg)) != 0) {
+            (rv = nng_tls_config_server_name(cfg, host)) != 0 ||
+            (rv = nng_stream_dialer_set_ptr(k->dialer, NNG_OPT_TLS_CONFIG, cfg)) != 0) {
             if (cfg) nng_tls_config_free(cfg);
             conn_close(k);
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: TLS with CA %s: %s", k->url, c->o.tls_ca_file,
@@ -1371,25 +2067,38 @@ static sy_result conn_connect(sy_cluster_client *c, conn *k, sy_error *err)
         }
         nng_tls_config_free(cfg); /* the dialer holds its own reference */
     }
-    if ((rv = nng_dialer_start(d, 0)) != 0) {
+    nng_stream_dialer_set_bool(k->dialer, NNG_OPT_TCP_NODELAY, true);
+    nng_aio_set_timeout(k->w.aio, (nng_duration)c->connect_timeout_ms);
+    pthread_mutex_lock(&k->w.lock);
+    k->w.busy = true;
+    pthread_mutex_unlock(&k->w.lock);
+    nng_stream_dialer_dial(k->dialer, k->w.aio);
+    nng_aio_wait(k->w.aio); /* the dialer honours the timeout (no stream yet to close) */
+    if ((rv = nng_aio_result(k->w.aio)) != 0) {
         conn_close(k);
-        return sy_error_set(err, SY_ERR_IO, "%s: cannot connect: %s", k->url, nng_strerror(rv));
+        return sy_error_set(err, SY_ERR_IO, "%s: cannot connect: %s", k->url,
+                            rv == NNG_ETIMEDOUT ? "no answer before the deadline" : nng_strerror(rv));
     }
+    k->w.st = nng_aio_get_output(k->w.aio, 0);
     sy_cluster_msg m, rep;
     memset(&m, 0, sizeof m);
     m.header.type = SY_CLUSTER_HELLO;
     uint8_t cnonce[32];
     randombytes_buf(cnonce, 32);
     memcpy(m.u.hello.nonce, cnonce, 32);
+    m.u.hello.max_frame = (uint32_t)c->max_frame;
+    m.u.hello.max_message = c->max_message;
     snprintf(m.u.hello.name, sizeof m.u.hello.name, "sy client");
-    nng_msg *raw = NULL;
+    uint8_t *raw = NULL;
     sy_result r = conn_call(c, k, &m, NULL, SY_CLUSTER_CHALLENGE, &rep, &raw, err);
     if (r == SY_OK) {
         bool need = rep.u.hello.flags & 1u;
         uint8_t snonce[32];
         memcpy(snonce, rep.u.hello.nonce, 32);
+        k->srv_max_frame = rep.u.hello.max_frame;
+        k->srv_max_message = rep.u.hello.max_message;
         sy_cluster_msg_free(&rep);
-        nng_msg_free(raw);
+        free(raw);
         if (need && !c->secret)
             r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: server requires a shared secret (SY_CLUSTER_SECRET or --secret-file)",
                              k->url);
@@ -1408,9 +2117,9 @@ static sy_result conn_connect(sy_cluster_client *c, conn *k, sy_error *err)
                     r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: the server's proof does not match (wrong secret or impostor)",
                                      k->url);
                 sy_cluster_msg_free(&rep);
-                nng_msg_free(raw);
-                mac3(k->key, c->secret, c->o.secret_len, "SYCP-session", cnonce, snonce);
-                k->tagged = true;
+                free(raw);
+                mac3(k->w.key, c->secret, c->o.secret_len, "SYCP-session", cnonce, snonce);
+                k->w.tagged = true;
             }
         }
     }
@@ -1418,8 +2127,7 @@ static sy_result conn_connect(sy_cluster_client *c, conn *k, sy_error *err)
         conn_close(k);
         return r;
     }
-    nng_socket_set_ms(k->sock, NNG_OPT_RECVTIMEO, (nng_duration)c->timeout_ms);
-    nng_socket_set_ms(k->sock, NNG_OPT_SENDTIMEO, (nng_duration)c->timeout_ms);
+    k->session_open = true;
     k->live = true;
     k->fresh = true;
     return SY_OK;
@@ -1433,6 +2141,13 @@ sy_result sy_cluster_client_create(sy_scene *scene, const sy_cluster_client_opts
     if (!opts->url_count || opts->url_count > SY_CLUSTER_MAX_SERVERS)
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster: between 1 and %u server URLs needed, got %u",
                             SY_CLUSTER_MAX_SERVERS, opts->url_count);
+    size_t max_frame = opts->max_frame ? opts->max_frame : SY_CLUSTER_DEFAULT_MAX_FRAME;
+    size_t max_message = opts->max_message ? opts->max_message : SY_CLUSTER_DEFAULT_MAX_MESSAGE;
+    if (max_frame < SY_CLUSTER_MIN_FRAME || max_frame > SY_CLUSTER_MAX_FRAME_LIMIT || max_message < SY_CLUSTER_MIN_FRAME ||
+        max_message > SY_CLUSTER_MAX_MESSAGE_LIMIT)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "cluster: frame limit %zu (64 KiB..1 GiB) or message limit %zu (>= 64 KiB) out of range",
+                            max_frame, max_message);
     sy_cluster_client *c = calloc(1, sizeof *c);
     if (!c) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
     c->o = *opts;
@@ -1440,7 +2155,8 @@ sy_result sy_cluster_client_create(sy_scene *scene, const sy_cluster_client_opts
     c->n = opts->url_count;
     c->timeout_ms = opts->timeout_ms ? opts->timeout_ms : 60000;
     c->connect_timeout_ms = opts->connect_timeout_ms ? opts->connect_timeout_ms : 5000;
-    c->max_message = opts->max_message ? opts->max_message : SY_CLUSTER_DEFAULT_MAX_MESSAGE;
+    c->max_frame = max_frame;
+    c->max_message = max_message;
     c->conns = calloc(c->n, sizeof *c->conns);
     if (opts->secret_len) {
         c->secret = malloc(opts->secret_len);
@@ -1502,28 +2218,23 @@ uint32_t sy_cluster_client_live(const sy_cluster_client *c)
 void sy_cluster_client_set_timeout(sy_cluster_client *c, uint32_t timeout_ms)
 {
     c->timeout_ms = timeout_ms ? timeout_ms : 60000;
-    for (uint32_t i = 0; i < c->n; ++i)
-        if (c->conns[i].live) {
-            nng_socket_set_ms(c->conns[i].sock, NNG_OPT_RECVTIMEO, (nng_duration)c->timeout_ms);
-            nng_socket_set_ms(c->conns[i].sock, NNG_OPT_SENDTIMEO, (nng_duration)c->timeout_ms);
-        }
 }
 
 void sy_cluster_client_destroy(sy_cluster_client *c)
 {
     if (!c) return;
+    c->timeout_ms = 1000;
     for (uint32_t i = 0; c->conns && i < c->n; ++i) {
         conn *k = &c->conns[i];
         if (k->live) {
-            nng_socket_set_ms(k->sock, NNG_OPT_RECVTIMEO, 1000);
             sy_cluster_msg m, rep;
             memset(&m, 0, sizeof m);
             m.header.type = SY_CLUSTER_BYE;
-            nng_msg *raw = NULL;
+            uint8_t *raw = NULL;
             sy_error e = {0};
             if (conn_call(c, k, &m, NULL, SY_CLUSTER_BYE, &rep, &raw, &e) == SY_OK) {
                 sy_cluster_msg_free(&rep);
-                nng_msg_free(raw);
+                free(raw);
             }
         }
         conn_close(k);
@@ -1606,7 +2317,7 @@ static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, s
     q->camera = fc->views[it->eye];
     q->tile_count = 1;
     q->tiles = &it->rect;
-    nng_msg *raw = NULL;
+    uint8_t *raw = NULL;
     sy_result r = conn_call(c, k, &m, NULL, SY_CLUSTER_TILES, &rep, &raw, err);
     if (r) return r;
     const __typeof__(rep.u.tiles) *t = &rep.u.tiles;
@@ -1632,7 +2343,7 @@ static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, s
         k->last_rows = it->rect.h;
     }
     sy_cluster_msg_free(&rep);
-    nng_msg_free(raw);
+    free(raw);
     return r;
 }
 
@@ -1641,7 +2352,7 @@ static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, s
 static sy_result send_scene(sy_cluster_client *c, conn *k, sy_error *err)
 {
     sy_cluster_msg rep;
-    nng_msg *raw = NULL;
+    uint8_t *raw = NULL;
     sy_result r = conn_call(c, k, NULL, &k->scene_msg, SY_CLUSTER_SCENE_ACK, &rep, &raw, err);
     for (uint32_t rounds = 0; r == SY_OK && rep.header.type == SY_CLUSTER_BLOB_REQUEST; ++rounds) {
         const __typeof__(rep.u.blobs) *q = &rep.u.blobs;
@@ -1651,7 +2362,10 @@ static sy_result send_scene(sy_cluster_client *c, conn *k, sy_error *err)
         m.header.type = SY_CLUSTER_BLOBS;
         m.u.blobs.frame = c->frame;
         m.u.blobs.blobs = refs;
-        uint64_t bytes = 0, budget = c->max_message / 4;
+        /* BLOBS messages of at most SY_CLUSTER_BLOBS_BATCH (or half the server's message limit), at
+         * least one blob; the transport splits each into frames the server accepts */
+        uint64_t bytes = 0, budget = k->srv_max_message / 2 < SY_CLUSTER_BLOBS_BATCH ? k->srv_max_message / 2
+                                                                                    : SY_CLUSTER_BLOBS_BATCH;
         if (!refs) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
         else if (q->frame != c->frame || rounds > SY_CLUSTER_MAX_BLOBS)
             r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: blob request for frame %llu during frame %llu", k->url,
@@ -1668,7 +2382,7 @@ static sy_result send_scene(sy_cluster_client *c, conn *k, sy_error *err)
             bytes += sy_blob_size(b);
         }
         sy_cluster_msg_free(&rep);
-        nng_msg_free(raw);
+        free(raw);
         raw = NULL;
         if (r == SY_OK) {
             uint64_t before = k->bytes_sent;
@@ -1680,7 +2394,7 @@ static sy_result send_scene(sy_cluster_client *c, conn *k, sy_error *err)
     }
     if (r == SY_OK) {
         sy_cluster_msg_free(&rep);
-        nng_msg_free(raw);
+        free(raw);
     }
     return r;
 }
@@ -1899,12 +2613,12 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
                 sy_cluster_msg m;
                 memset(&m, 0, sizeof m);
                 m.header.type = SY_CLUSTER_SCENE;
-                m.header.seq = ++k->send_seq;
                 m.u.scene.frame = c->frame;
                 m.u.scene.flags = snapshot ? SY_CLUSTER_SCENE_SNAPSHOT : 0;
                 m.u.scene.changes = data;
                 m.u.scene.changes_size = (uint32_t)size;
-                r = encode_frame(&m, k->tagged ? k->key : NULL, &k->scene_msg, err);
+                k->scene_msg.size = 0;
+                r = sy_cluster_encode(&m, 0, &k->scene_msg, err); /* tagged frame by frame when sent */
                 st.scene_bytes += k->scene_msg.size;
             }
             free(data);
@@ -2042,11 +2756,11 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
             memset(&m, 0, sizeof m);
             m.header.type = SY_CLUSTER_SWAP;
             m.u.ack.frame = c->frame;
-            nng_msg *raw = NULL;
+            uint8_t *raw = NULL;
             sy_error e = {0};
             if (conn_call(c, k, &m, NULL, SY_CLUSTER_SWAP_ACK, &rep, &raw, &e) == SY_OK) {
                 sy_cluster_msg_free(&rep);
-                nng_msg_free(raw);
+                free(raw);
             } else {
                 CLOG(c, "%s: swap failed: %s", k->url, e.message);
                 conn_close(k);

@@ -1,21 +1,28 @@
 /* sy_cluster.h — cluster rendering over sockets: the render server (`sy serve`) and the client
- * that drives a set of servers from the application's scene. Transport: nng req/rep over TCP
- * (optionally TLS via nng's mbedTLS), authentication: HMAC-SHA512-256 challenge-response with a
- * shared secret (libsodium), then every message tagged with a per-session key; tiles compressed
- * with zstd. The wire format is in sy_cluster_proto.h and docs/PROTOCOL.md.
+ * that drives a set of servers from the application's scene. Transport: nng byte streams over TCP
+ * (optionally TLS via nng's mbedTLS) carrying length-prefixed frames (a large message travels as
+ * several frames); authentication: HMAC-SHA512-256 challenge-response with a shared secret
+ * (libsodium), then every frame tagged with a per-session key; tiles compressed with zstd. The
+ * wire format is in sy_cluster_proto.h and docs/PROTOCOL.md.
  *
  * This module is built as its own library (sy_cluster) so that sy_core stays free of nng,
  * libsodium and zstd; it uses only core headers (scene, change lists, mediator contexts).
  *
  * Server: holds one session per connected client (replica scene fed by change lists, context
  * pool) and a blob cache shared by all sessions (keyed by content hash, LRU under a byte budget,
- * outliving sessions), and renders with the mediators registered in the process. I/O runs on
- * several nng rep0 contexts at once (a slow, stalled or garbage-sending peer holds only its own);
- * requests are served one at a time on the thread that calls sy_cluster_server_run (renders use
- * every core through the back-ends; mediators stay on one thread). A bad message or a failed
- * authentication is answered with ERROR, logged with the peer's address and the reason, and the
- * server keeps serving; failed authentications refuse the address for an exponentially growing
- * time; replicas refuse change lists naming slot indices beyond max_objects.
+ * outliving sessions), and renders with the mediators registered in the process. Every connection
+ * has its own reader thread (small stack) that runs the handshake and reads and sends that peer's
+ * frames, so a slow, stalled or garbage-sending peer holds only its own thread; requests are served
+ * one at a time on the thread that calls sy_cluster_server_run (renders use every core through the
+ * back-ends; mediators stay on one thread). Budgets: before a connection has authenticated it
+ * gets a fixed record (a 1 KiB frame buffer inside), at most max_unauthenticated such
+ * connections exist (more are closed at once), and each must finish HELLO / AUTH within
+ * handshake_timeout_ms; after, frames are at most max_frame bytes, messages max_message, and all
+ * peers' messages in flight together at most max_peer_memory (a reader waits for room, then
+ * refuses). A bad message or a failed authentication is answered with ERROR, logged with the
+ * peer's address, the place and the reason, and the server keeps serving; failed authentications
+ * refuse the address for an exponentially growing time; replicas refuse change lists naming slot
+ * indices beyond max_objects or growing the replica by more than the list's size allows.
  *
  * Client: one connection per server URL; each connection is a scene consumer (its first sync is a
  * snapshot), names blobs by hash and sends only those the server asks for (BLOB_REQUEST), and
@@ -41,6 +48,19 @@ extern "C" {
 #define SY_CLUSTER_DEFAULT_BLOB_CACHE ((size_t)1024 << 20) /* 1 GiB of blob payloads per server */
 #define SY_CLUSTER_DEFAULT_MAX_OBJECTS (1u << 20) /* replica slots per object type */
 #define SY_CLUSTER_AUTH_TABLE 256u /* addresses remembered for authentication back-off */
+#define SY_CLUSTER_DEFAULT_MAX_PEER_MEMORY ((size_t)1024 << 20) /* all peers' messages in flight */
+#define SY_CLUSTER_DEFAULT_MAX_UNAUTHENTICATED 32u /* connections before HELLO / AUTH completed */
+#define SY_CLUSTER_DEFAULT_HANDSHAKE_MS 3000u      /* from accept to an open session */
+#define SY_CLUSTER_MEMORY_WAIT_MS 5000u            /* a reader waits this long for peer memory, then refuses */
+#define SY_CLUSTER_PROGRESS_MS 60000u              /* once a message has begun, each read must finish in this */
+#define SY_CLUSTER_SEND_MS 10000u                  /* each write of a reply must finish in this */
+#define SY_CLUSTER_WATCHDOG_MS 250u                /* a stream operation past its deadline by this: stream closed */
+#define SY_CLUSTER_BLOBS_BATCH ((uint64_t)64 << 20) /* the client's BLOBS messages (at least one blob each) */
+/* A change list of N bytes may add at most SY_CLUSTER_APPLY_SLACK_SLOTS + N / 8 pool slots to a
+ * replica (sy_scene_apply_bounded; a slot costs SY_SCENE_SLOT_BYTES = 104 bytes, so at most 13 bytes
+ * per byte of the list + 416 KiB). docs/PROTOCOL.md, "Budgets and limits". */
+#define SY_CLUSTER_APPLY_SLACK_SLOTS 4096u
+#define SY_CLUSTER_APPLY_BYTES_PER_SLOT 8u
 
 /* Receives one log line (no trailing newline). NULL = lines go to stderr. */
 typedef void (*sy_cluster_log_fn)(void *user, const char *line);
@@ -57,8 +77,15 @@ typedef struct sy_cluster_server_opts {
     size_t secret_len;
     const char *tls_cert_file, *tls_key_file; /* both for tls+tcp:// URLs (PEM) */
     const char *name;         /* reported to clients; NULL = "sy serve" */
-    uint32_t max_sessions;    /* 0 = 16 */
-    size_t max_message;       /* 0 = SY_CLUSTER_DEFAULT_MAX_MESSAGE */
+    uint32_t max_sessions;    /* sessions; a request beyond ends the longest idle one; more than twice this
+                                 many open at once are refused (0 = 16) */
+    size_t max_frame;         /* largest frame accepted after authentication (0 = SY_CLUSTER_DEFAULT_MAX_FRAME, 8 MiB) */
+    size_t max_message;       /* largest message body, frames reassembled (0 = SY_CLUSTER_DEFAULT_MAX_MESSAGE;
+                                 at most max_peer_memory) */
+    size_t max_peer_memory;   /* all peers' messages in flight together: reassembly buffers, replies, SCENEs
+                                 waiting for blobs (0 = SY_CLUSTER_DEFAULT_MAX_PEER_MEMORY) */
+    uint32_t max_unauthenticated; /* connections not yet authenticated; more are closed at once (0 = 32) */
+    uint32_t handshake_timeout_ms; /* HELLO (/ AUTH) must complete this long after accept (0 = 3000) */
     sy_cluster_log_fn log;
     void *log_user;
     sy_cluster_present_fn present; /* NULL: SWAP only acknowledges */
@@ -69,7 +96,6 @@ typedef struct sy_cluster_server_opts {
     uint32_t max_objects;     /* replica policy: slot index limit per object type (0 = SY_CLUSTER_DEFAULT_MAX_OBJECTS) */
     uint32_t auth_backoff_ms; /* refusal window after a failed authentication from an address, doubled per
                                  further failure up to 60 s or this value (0 = 250) */
-    uint32_t io_workers;      /* concurrent receive/send contexts (0 = 8) */
 } sy_cluster_server_opts;
 
 typedef struct sy_cluster_server sy_cluster_server;
@@ -78,6 +104,8 @@ typedef struct sy_cluster_server sy_cluster_server;
 sy_result sy_cluster_server_create(const sy_cluster_server_opts *opts, sy_cluster_server **out, sy_error *err);
 /* The TCP port actually bound (useful with port 0). */
 int sy_cluster_server_port(const sy_cluster_server *s);
+/* Bytes now held for peers' messages in flight (and the most ever, *peak_out); any thread. */
+size_t sy_cluster_server_peer_memory(const sy_cluster_server *s, size_t *peak_out);
 /* Serves until *opts.stop becomes non-zero or max_lifetime_s passes. */
 sy_result sy_cluster_server_run(sy_cluster_server *s, sy_error *err);
 void sy_cluster_server_destroy(sy_cluster_server *s); /* NULL-safe */
@@ -91,7 +119,8 @@ typedef struct sy_cluster_client_opts {
     const char *tls_ca_file; /* CA for tls+tcp:// servers (verified); NULL = no TLS */
     uint32_t timeout_ms;     /* deadline per request (render, scene); 0 = 60000 */
     uint32_t connect_timeout_ms; /* handshake; 0 = 5000 */
-    size_t max_message;      /* 0 = SY_CLUSTER_DEFAULT_MAX_MESSAGE */
+    size_t max_frame;        /* largest frame accepted from a server (0 = SY_CLUSTER_DEFAULT_MAX_FRAME) */
+    size_t max_message;      /* largest reply body (0 = SY_CLUSTER_DEFAULT_MAX_MESSAGE) */
     sy_cluster_log_fn log;
     void *log_user;
     /* Optional, url_count entries each: a back-end per server (NULL entry = the frame's; e.g. a

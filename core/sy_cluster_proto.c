@@ -141,8 +141,13 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
     if (t == SY_CLUSTER_HELLO || t == SY_CLUSTER_CHALLENGE) {
         if (!str_fits(msg->u.hello.name, SY_CLUSTER_NAME_MAX))
             return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode %s: name too long", tn);
+        if (msg->u.hello.max_frame < SY_CLUSTER_MIN_FRAME || msg->u.hello.max_frame > SY_CLUSTER_MAX_FRAME_LIMIT ||
+            msg->u.hello.max_message < SY_CLUSTER_MIN_FRAME || msg->u.hello.max_message > SY_CLUSTER_MAX_MESSAGE_LIMIT)
+            return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode %s: frame or message limit out of range", tn);
         w_bytes(&w, msg->u.hello.nonce, SY_CLUSTER_NONCE_SIZE);
         w_u32(&w, msg->u.hello.flags);
+        w_u32(&w, msg->u.hello.max_frame);
+        w_u64(&w, msg->u.hello.max_message);
         w_str(&w, msg->u.hello.name);
     } else if (t == SY_CLUSTER_AUTH || t == SY_CLUSTER_WELCOME) {
         w_bytes(&w, msg->u.auth.mac, SY_CLUSTER_TAG_SIZE);
@@ -246,6 +251,20 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
     return SY_OK;
 }
 
+void sy_cluster_header_write(uint8_t out[SY_CLUSTER_HEADER_SIZE], uint32_t type, uint32_t flags, uint32_t body_size,
+                             uint64_t seq)
+{
+    put_u32_at(out, SY_CLUSTER_MAGIC);
+    out[4] = (uint8_t)SY_CLUSTER_VERSION;
+    out[5] = (uint8_t)(SY_CLUSTER_VERSION >> 8);
+    out[6] = (uint8_t)type;
+    out[7] = (uint8_t)(type >> 8);
+    put_u32_at(out + 8, flags);
+    put_u32_at(out + 12, body_size);
+    put_u32_at(out + 16, (uint32_t)seq);
+    put_u32_at(out + 20, (uint32_t)(seq >> 32));
+}
+
 /* ---- reader ---- */
 typedef struct reader {
     const uint8_t *p;
@@ -257,7 +276,7 @@ typedef struct reader {
 
 static bool rd_fail(reader *rd, sy_result code, const char *reason)
 {
-    if (rd->r == SY_OK) rd->r = sy_error_set(rd->err, code, "cluster %s: byte %zu: %s", rd->what, rd->pos, reason);
+    if (rd->r == SY_OK) rd->r = sy_error_set(rd->err, code, "cluster %s: body byte %zu: %s", rd->what, rd->pos, reason);
     return false;
 }
 
@@ -316,16 +335,9 @@ static bool rd_str(reader *rd, char *out, size_t cap, const char *field)
     return true;
 }
 
-sy_result sy_cluster_decode_header(const void *data, size_t size, const sy_cluster_limits *limits,
-                                   sy_cluster_header *out, sy_error *err)
+sy_result sy_cluster_parse_header(const uint8_t data[SY_CLUSTER_HEADER_SIZE], sy_cluster_header *out, sy_error *err)
 {
-    size_t max = limits && limits->max_message ? limits->max_message : SY_CLUSTER_DEFAULT_MAX_MESSAGE;
-    if (!data || size < SY_CLUSTER_HEADER_SIZE)
-        return sy_error_set(err, SY_ERR_PARSE, "cluster message: %zu bytes is shorter than the %u-byte header", size,
-                            SY_CLUSTER_HEADER_SIZE);
-    if (size > max)
-        return sy_error_set(err, SY_ERR_LIMIT, "cluster message: %zu bytes exceeds the limit of %zu", size, max);
-    reader rd = {data, size, 0, "header", err, SY_OK};
+    reader rd = {data, SY_CLUSTER_HEADER_SIZE, 0, "header", err, SY_OK};
     sy_cluster_header h;
     h.magic = rd_u32(&rd);
     h.version = rd_u16(&rd);
@@ -341,9 +353,50 @@ sy_result sy_cluster_decode_header(const void *data, size_t size, const sy_clust
                             (unsigned)h.version, SY_CLUSTER_VERSION);
     if (h.type < 1 || h.type > SY_CLUSTER_MSG_TYPE_MAX)
         return sy_error_set(err, SY_ERR_PARSE, "cluster message: unknown type %u", (unsigned)h.type);
-    if (h.flags & ~(uint32_t)SY_CLUSTER_FLAG_TAGGED)
+    if (h.flags & ~(uint32_t)(SY_CLUSTER_FLAG_TAGGED | SY_CLUSTER_FLAG_MORE))
         return sy_error_set(err, SY_ERR_PARSE, "cluster %s: unknown frame flags 0x%x", sy_cluster_msg_type_name(h.type),
                             (unsigned)h.flags);
+    *out = h;
+    return SY_OK;
+}
+
+sy_result sy_cluster_frame_check(const sy_cluster_header *h, const sy_cluster_budget *b, size_t so_far,
+                                 uint32_t msg_type, size_t *follow_out, sy_error *err)
+{
+    const char *tn = sy_cluster_msg_type_name(h->type);
+    bool tagged = (h->flags & SY_CLUSTER_FLAG_TAGGED) != 0, more = (h->flags & SY_CLUSTER_FLAG_MORE) != 0;
+    *follow_out = 0;
+    if (tagged != b->tagged)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "cluster %s: frame %s, the session requires %s", tn,
+                            tagged ? "is tagged" : "is not authenticated (no tag)", b->tagged ? "a tag" : "none yet");
+    if (more && !b->chunks)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "cluster %s: a chunked message before the session is open", tn);
+    if ((so_far || msg_type) && h->type != msg_type)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "cluster %s: frame continues a %s message", tn,
+                            sy_cluster_msg_type_name(msg_type));
+    uint64_t frame = (uint64_t)SY_CLUSTER_HEADER_SIZE + h->body_size + (tagged ? SY_CLUSTER_TAG_SIZE : 0);
+    if (frame > b->max_frame)
+        return sy_error_set(err, SY_ERR_LIMIT, "cluster %s: frame announces %llu bytes, this connection accepts at most %zu",
+                            tn, (unsigned long long)frame, b->max_frame);
+    if (h->body_size > b->max_message || so_far > b->max_message - h->body_size)
+        return sy_error_set(err, SY_ERR_LIMIT, "cluster %s: message of %llu bytes so far exceeds the limit of %zu", tn,
+                            (unsigned long long)so_far + h->body_size, b->max_message);
+    *follow_out = (size_t)(frame - SY_CLUSTER_HEADER_SIZE);
+    return SY_OK;
+}
+
+sy_result sy_cluster_decode_header(const void *data, size_t size, const sy_cluster_limits *limits,
+                                   sy_cluster_header *out, sy_error *err)
+{
+    size_t max = limits && limits->max_message ? limits->max_message : SY_CLUSTER_DEFAULT_MAX_MESSAGE;
+    if (!data || size < SY_CLUSTER_HEADER_SIZE)
+        return sy_error_set(err, SY_ERR_PARSE, "cluster message: %zu bytes is shorter than the %u-byte header", size,
+                            SY_CLUSTER_HEADER_SIZE);
+    if (size > max)
+        return sy_error_set(err, SY_ERR_LIMIT, "cluster message: %zu bytes exceeds the limit of %zu", size, max);
+    sy_cluster_header h;
+    sy_result r = sy_cluster_parse_header(data, &h, err);
+    if (r) return r;
     uint64_t expect = (uint64_t)SY_CLUSTER_HEADER_SIZE + h.body_size + ((h.flags & SY_CLUSTER_FLAG_TAGGED) ? SY_CLUSTER_TAG_SIZE : 0);
     if (expect != size)
         return sy_error_set(err, SY_ERR_PARSE, "cluster %s: header announces %llu bytes, the frame has %zu",
@@ -368,8 +421,28 @@ sy_result sy_cluster_decode(const void *data, size_t size, const sy_cluster_limi
     sy_cluster_header h;
     sy_result r = sy_cluster_decode_header(data, size, limits, &h, err);
     if (r) return r;
-    reader rd = {data, SY_CLUSTER_HEADER_SIZE + (size_t)h.body_size, SY_CLUSTER_HEADER_SIZE,
-                 sy_cluster_msg_type_name(h.type), err, SY_OK};
+    if (h.flags & SY_CLUSTER_FLAG_MORE)
+        return sy_error_set(err, SY_ERR_PARSE, "cluster %s: one frame of a chunked message (reassemble it first)",
+                            sy_cluster_msg_type_name(h.type));
+    return sy_cluster_decode_body(&h, (const uint8_t *)data + SY_CLUSTER_HEADER_SIZE, h.body_size, limits, out, err);
+}
+
+sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, size_t size,
+                                 const sy_cluster_limits *limits, sy_cluster_msg *out, sy_error *err)
+{
+    memset(out, 0, sizeof *out);
+    size_t max = limits && limits->max_message ? limits->max_message : SY_CLUSTER_DEFAULT_MAX_MESSAGE;
+    sy_cluster_header h = *hp;
+    if (h.type < 1 || h.type > SY_CLUSTER_MSG_TYPE_MAX)
+        return sy_error_set(err, SY_ERR_PARSE, "cluster message: unknown type %u", (unsigned)h.type);
+    if (!body && size) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster message: no body");
+    if (size > max)
+        return sy_error_set(err, SY_ERR_LIMIT, "cluster %s: body of %zu bytes exceeds the limit of %zu",
+                            sy_cluster_msg_type_name(h.type), size, max);
+    h.body_size = size > UINT32_MAX ? UINT32_MAX : (uint32_t)size;
+    static const uint8_t empty[1];
+    /* offsets in messages count from the start of the body */
+    reader rd = {body ? body : empty, size, 0, sy_cluster_msg_type_name(h.type), err, SY_OK};
     sy_cluster_msg m;
     memset(&m, 0, sizeof m);
     m.header = h;
@@ -377,6 +450,12 @@ sy_result sy_cluster_decode(const void *data, size_t size, const sy_cluster_limi
     if (t == SY_CLUSTER_HELLO || t == SY_CLUSTER_CHALLENGE) {
         rd_bytes(&rd, m.u.hello.nonce, SY_CLUSTER_NONCE_SIZE);
         m.u.hello.flags = rd_u32(&rd);
+        m.u.hello.max_frame = rd_u32(&rd);
+        m.u.hello.max_message = rd_u64(&rd);
+        if (!rd.r && (m.u.hello.max_frame < SY_CLUSTER_MIN_FRAME || m.u.hello.max_frame > SY_CLUSTER_MAX_FRAME_LIMIT))
+            rd_fail(&rd, SY_ERR_PARSE, "frame limit outside 64 KiB..1 GiB");
+        if (!rd.r && (m.u.hello.max_message < SY_CLUSTER_MIN_FRAME || m.u.hello.max_message > SY_CLUSTER_MAX_MESSAGE_LIMIT))
+            rd_fail(&rd, SY_ERR_PARSE, "message limit outside 64 KiB..1 TiB");
         rd_str(&rd, m.u.hello.name, SY_CLUSTER_NAME_MAX, "name");
     } else if (t == SY_CLUSTER_AUTH || t == SY_CLUSTER_WELCOME) {
         rd_bytes(&rd, m.u.auth.mac, SY_CLUSTER_TAG_SIZE);

@@ -5,9 +5,14 @@
  *
  * Frame: a 24-byte little-endian header {magic "SYCP", version, type, flags, body size, sequence},
  * the body, then (flag SY_CLUSTER_FLAG_TAGGED) a 32-byte authentication tag computed by the
- * transport over header + body. The decoder checks the magic, the version, the type, that the body
- * size matches the frame exactly, and every field of the body (lengths against what remains,
- * counts against limits, rectangles inside the image, floats finite) before anything is used.
+ * transport over header + body. A message is one frame, or several frames of the same type whose
+ * bodies are concatenated (flag SY_CLUSTER_FLAG_MORE on every frame but the last): on a byte
+ * stream the receiver reads the fixed header first and checks the announced size against its
+ * current budget (sy_cluster_frame_check) before it reads or allocates anything for the body. The
+ * decoder checks the magic, the version, the type, that the body size matches the frame exactly,
+ * and every field of the body (lengths against what remains, counts against the bytes that carry
+ * them and against limits, rectangles inside the image, floats finite) before anything is
+ * allocated or used.
  *
  * Ownership: encoders append to a caller-owned sy_cluster_buf (free with sy_cluster_buf_free).
  * A decoded sy_cluster_msg borrows byte ranges of the input buffer (changes payload, tile data),
@@ -23,7 +28,7 @@ extern "C" {
 #endif
 
 #define SY_CLUSTER_MAGIC 0x50435953u /* "SYCP" little endian */
-#define SY_CLUSTER_VERSION 2u
+#define SY_CLUSTER_VERSION 3u
 #define SY_CLUSTER_HEADER_SIZE 24u
 #define SY_CLUSTER_TAG_SIZE 32u
 #define SY_CLUSTER_NONCE_SIZE 32u
@@ -35,7 +40,12 @@ extern "C" {
 #define SY_CLUSTER_MAX_IMAGE 16384u  /* image width / height */
 #define SY_CLUSTER_MAX_SAMPLES (1u << 20)
 #define SY_CLUSTER_MAX_BLOBS (1u << 20)   /* blob references per BLOB_REQUEST / BLOBS */
-#define SY_CLUSTER_DEFAULT_MAX_MESSAGE ((size_t)1 << 30)
+#define SY_CLUSTER_DEFAULT_MAX_MESSAGE ((size_t)1 << 30) /* a reassembled message body */
+#define SY_CLUSTER_HANDSHAKE_MAX_FRAME 1024u               /* any frame before the session is open */
+#define SY_CLUSTER_DEFAULT_MAX_FRAME ((size_t)8 << 20)    /* one frame once the session is open */
+#define SY_CLUSTER_MIN_FRAME ((size_t)64 << 10)           /* the smallest frame limit a peer may announce */
+#define SY_CLUSTER_MAX_FRAME_LIMIT ((size_t)1 << 30)      /* the largest */
+#define SY_CLUSTER_MAX_MESSAGE_LIMIT ((uint64_t)1 << 40)  /* the largest message limit a peer may announce */
 
 typedef enum sy_cluster_msg_type {
     SY_CLUSTER_HELLO = 1,     /* client -> server: nonce, name */
@@ -57,6 +67,7 @@ typedef enum sy_cluster_msg_type {
 
 typedef enum sy_cluster_frame_flags {
     SY_CLUSTER_FLAG_TAGGED = 1u << 0, /* a 32-byte authentication tag follows the body */
+    SY_CLUSTER_FLAG_MORE = 1u << 1,   /* the message goes on in the next frame (same type) */
 } sy_cluster_frame_flags;
 
 typedef enum sy_cluster_scene_flags {
@@ -116,7 +127,9 @@ typedef struct sy_cluster_msg {
     union {
         struct { /* HELLO, CHALLENGE */
             uint8_t nonce[SY_CLUSTER_NONCE_SIZE];
-            uint32_t flags; /* CHALLENGE: bit 0 = authentication required */
+            uint32_t flags;       /* CHALLENGE: bit 0 = authentication required */
+            uint32_t max_frame;   /* largest frame the sender accepts once the session is open */
+            uint64_t max_message; /* largest message body it accepts (frames reassembled) */
             char name[SY_CLUSTER_NAME_MAX];
         } hello;
         struct { /* AUTH, WELCOME */
@@ -182,14 +195,47 @@ typedef struct sy_cluster_limits {
     size_t max_message; /* 0 = SY_CLUSTER_DEFAULT_MAX_MESSAGE */
 } sy_cluster_limits;
 
-/* Parses and checks only the header of an untrusted frame: magic, version, known type, body size
- * consistent with size (including the tag when flagged). */
+/* Writes a frame header (magic and version filled in). */
+void sy_cluster_header_write(uint8_t out[SY_CLUSTER_HEADER_SIZE], uint32_t type, uint32_t flags, uint32_t body_size,
+                             uint64_t seq);
+
+/* Parses and checks the fixed header alone (the first SY_CLUSTER_HEADER_SIZE bytes of a frame):
+ * magic, version, known type, known flags. Nothing about the body is read. */
+sy_result sy_cluster_parse_header(const uint8_t data[SY_CLUSTER_HEADER_SIZE], sy_cluster_header *out, sy_error *err);
+
+/* What a stream receiver accepts next: checked against every header before a byte of its body is
+ * read or allocated. */
+typedef struct sy_cluster_budget {
+    size_t max_frame;   /* largest frame (header + body + tag) */
+    size_t max_message; /* largest message body (its frames' bodies together) */
+    bool chunks;        /* SY_CLUSTER_FLAG_MORE allowed (not before the session is open) */
+    bool tagged;        /* frames must carry a tag (true) or must not (false) */
+} sy_cluster_budget;
+
+/* Checks the header h of the next frame on a stream: the tag flag as the session requires, the
+ * frame within max_frame, MORE only where chunks are allowed, a continuation frame (so_far > 0 or
+ * msg_type != 0: the message's earlier frames held so_far body bytes) of the same type as the
+ * message, and the message within max_message. *follow_out = the bytes that follow the header
+ * (body + tag). Errors name the type, the announced size and the limit. */
+sy_result sy_cluster_frame_check(const sy_cluster_header *h, const sy_cluster_budget *b, size_t so_far,
+                                 uint32_t msg_type, size_t *follow_out, sy_error *err);
+
+/* Parses and checks only the header of an untrusted complete frame: magic, version, known type,
+ * body size consistent with size (including the tag when flagged), size within the limit. */
 sy_result sy_cluster_decode_header(const void *data, size_t size, const sy_cluster_limits *limits,
                                    sy_cluster_header *out, sy_error *err);
 
-/* Decodes an untrusted frame completely (header + body; the tag, if any, is not verified here).
+/* Decodes an untrusted message body of type h->type (size bytes: the body of one frame, or the
+ * reassembled bodies of a chunked message; h->body_size is not used). *out borrows ranges of body.
  * On success the caller releases *out with sy_cluster_msg_free. Errors name the message type, the
- * byte offset and the reason. */
+ * byte offset and the reason. Allocations: at most 2 bytes per body byte (RENDER tiles, TILES
+ * tiles, blob lists), each count checked against the bytes that carry it first. */
+sy_result sy_cluster_decode_body(const sy_cluster_header *h, const void *body, size_t size,
+                                 const sy_cluster_limits *limits, sy_cluster_msg *out, sy_error *err);
+
+/* Decodes an untrusted single frame completely (header + body; the tag, if any, is not verified
+ * here; MORE is refused: chunked messages are reassembled by the transport and decoded with
+ * sy_cluster_decode_body). On success the caller releases *out with sy_cluster_msg_free. */
 sy_result sy_cluster_decode(const void *data, size_t size, const sy_cluster_limits *limits, sy_cluster_msg *out,
                             sy_error *err);
 void sy_cluster_msg_free(sy_cluster_msg *m); /* frees decoder allocations; NULL-safe */

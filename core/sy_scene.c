@@ -150,6 +150,23 @@ static bool pool_grow(pool *p, uint32_t min_count)
     return true;
 }
 
+/* Replica apply: grows the slot array to exactly min_count slots (no doubling), so the memory a
+ * change list makes a replica allocate follows what the list creates (see apply_reserve). */
+_Static_assert(sizeof(slot) + sizeof(uint32_t) <= SY_SCENE_SLOT_BYTES,
+               "SY_SCENE_SLOT_BYTES is a slot + its free-list entry");
+
+static bool pool_reserve_exact(pool *p, uint32_t min_count)
+{
+    if (min_count <= p->capacity) return true;
+    if (min_count > SY_HANDLE_INDEX_MASK + 1) return false;
+    slot *ns = realloc(p->slots, sizeof *ns * min_count);
+    if (!ns) return false;
+    memset(ns + p->capacity, 0, sizeof *ns * (min_count - p->capacity));
+    p->slots = ns;
+    p->capacity = min_count;
+    return true;
+}
+
 static void free_list_push(pool *p, uint32_t idx)
 {
     if (p->slots[idx].in_free_list || p->slots[idx].retired) return;
@@ -1482,9 +1499,56 @@ void sy_scene_set_apply_limit(sy_scene *s, uint32_t max_slots)
     s->apply_max_slots = max_slots;
 }
 
+/* Before anything of a change list is applied: every slot index it creates is checked against the
+ * replica's slot limit, and the pool slots it would add (all types together) against max_new_slots;
+ * then each pool is grown once, to exactly what the list needs. A list that fails either check
+ * leaves the scene untouched. */
+static sy_result apply_reserve(sy_scene *s, const sy_changes *changes, uint64_t max_new_slots, sy_error *err)
+{
+    uint32_t need[SY_TYPE_COUNT] = {0}, which[SY_TYPE_COUNT] = {0};
+    uint32_t n = sy_changes_count(changes);
+    for (uint32_t i = 0; i < n; ++i) {
+        const sy_change *e = sy_changes_get(changes, i);
+        if (!(e->flags & SY_CHANGE_CREATED) || (e->flags & SY_CHANGE_DESTROYED) || e->type == SY_TYPE_NONE ||
+            e->type >= SY_TYPE_COUNT)
+            continue;
+        uint32_t idx = id_index(e->id);
+        if (idx == 0 || id_generation(e->id) == 0) continue; /* refused by object_create_at, naming the id */
+        if (s->apply_max_slots && idx >= s->apply_max_slots)
+            return sy_error_set(err, SY_ERR_LIMIT, "create %s %#x: slot index %u exceeds this replica's limit of %u",
+                                sy__type_desc(e->type)->name, e->id, idx, s->apply_max_slots);
+        if (idx + 1 > need[e->type]) need[e->type] = idx + 1, which[e->type] = e->id;
+    }
+    uint64_t growth = 0;
+    uint32_t worst = 0;
+    uint64_t worst_growth = 0;
+    for (uint32_t t = 1; t < SY_TYPE_COUNT; ++t) {
+        uint64_t g = need[t] > s->pools[t].count ? (uint64_t)need[t] - s->pools[t].count : 0;
+        growth += g;
+        if (g > worst_growth) worst_growth = g, worst = t;
+    }
+    if (max_new_slots && growth > max_new_slots)
+        return sy_error_set(err, SY_ERR_LIMIT,
+                            "create %s %#x: slot index %u would add %llu slots to this replica's pools, more than the "
+                            "%llu this change list may add (replica policy: slots follow the size of the message)",
+                            sy__type_desc(worst)->name, which[worst], id_index(which[worst]),
+                            (unsigned long long)growth, (unsigned long long)max_new_slots);
+    for (uint32_t t = 1; t < SY_TYPE_COUNT; ++t)
+        if (need[t] > s->pools[t].count && !pool_reserve_exact(&s->pools[t], need[t]))
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "create %s: out of memory for %u slots",
+                                sy__type_desc(t)->name, need[t]);
+    return SY_OK;
+}
+
 sy_result sy_scene_apply(sy_scene *s, const sy_changes *changes, sy_error *err)
 {
-    sy_result r = SY_OK;
+    return sy_scene_apply_bounded(s, changes, 0, err);
+}
+
+sy_result sy_scene_apply_bounded(sy_scene *s, const sy_changes *changes, uint64_t max_new_slots, sy_error *err)
+{
+    sy_result r = apply_reserve(s, changes, max_new_slots, err);
+    if (r != SY_OK) return r;
     uint32_t n = sy_changes_count(changes);
     s->applying = true;
     if (sy_changes_is_snapshot(changes)) r = resync_destroy_unlisted(s, changes, err);

@@ -447,6 +447,17 @@ sy_result sy_scene_apply(sy_scene *s, const sy_changes *changes, sy_error *err);
  * message cannot make a pool grow to millions of slots. 0 (the default) = no limit beyond the
  * handle format's SY_HANDLE_INDEX_MASK. Objects created locally are not affected. */
 void sy_scene_set_apply_limit(sy_scene *s, uint32_t max_slots);
+/* sy_scene_apply with a bound on the pool slots this one change list may add, all object types
+ * together (0 = no bound). A slot costs the replica about SY_SCENE_SLOT_BYTES whether or not an
+ * object lives in it, so a list creating slot index I makes a pool of I + 1 slots: the bound keeps
+ * what an untrusted list makes a replica allocate proportional to the list's size (the cluster
+ * server passes SY_CLUSTER_APPLY_SLACK_SLOTS + the list's bytes / SY_CLUSTER_APPLY_BYTES_PER_SLOT).
+ * The bound and the slot limit are checked for every creation before anything is applied
+ * (SY_ERR_LIMIT naming the type, the id, the growth and the bound; the scene is then untouched);
+ * each pool then grows once, to exactly the slots the list needs. */
+sy_result sy_scene_apply_bounded(sy_scene *s, const sy_changes *changes, uint64_t max_new_slots, sy_error *err);
+/* Bytes one pool slot costs (the slot record and its free-list entry), for the bound above. */
+#define SY_SCENE_SLOT_BYTES 104u
 
 /* Deep comparison of every live object, field and attachment (blobs by content hash). Returns
  * true when equal; otherwise false and a description of the first difference in err->message. */

@@ -26,6 +26,7 @@
 /* Per-call I/O state handed to the library as user_data. */
 typedef struct exr_io {
     int fd;
+    const uint8_t *mem; /* reader from memory (sy_exr_read_memory): the bytes, fd unused */
     int64_t size;  /* reader: file size in bytes */
     int os_errno;  /* reader: errno of a failed pread (0: reads only ever came up short) */
     char msg[256]; /* first message the library reported for this context */
@@ -49,6 +50,12 @@ static int64_t exr_io_read(exr_const_context_t ctxt, void *ud, void *buffer, uin
         return -1;
     }
     uint8_t *p = buffer;
+    if (io->mem) { /* from memory: a short count past the end, as pread gives */
+        uint64_t avail = offset < (uint64_t)io->size ? (uint64_t)io->size - offset : 0;
+        uint64_t n = sz < avail ? sz : avail;
+        if (n) memcpy(p, io->mem + offset, (size_t)n);
+        return (int64_t)n;
+    }
     uint64_t done = 0;
     while (done < sz) {
         size_t want = (sz - done) > (uint64_t)(SSIZE_MAX / 2) ? (size_t)(SSIZE_MAX / 2) : (size_t)(sz - done);
@@ -153,6 +160,18 @@ static sy_result validate_write_desc(const char *path, const sy_exr_write_desc *
     (void)map_compression(d->compression, &ok);
     if (!ok)
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: unknown compression %d", path, (int)d->compression);
+    if (d->attribute_count < 0 || d->attribute_count > SY_EXR_MAX_ATTRIBUTES ||
+        (d->attribute_count && !d->attributes))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: need 0..%d attributes, got %d", path,
+                            SY_EXR_MAX_ATTRIBUTES, d->attribute_count);
+    for (int a = 0; a < d->attribute_count; ++a) {
+        const sy_exr_attribute *at = &d->attributes[a];
+        size_t nlen = at->name ? strlen(at->name) : 0;
+        if (!nlen || nlen > SY_EXR_MAX_ATTRIBUTE_NAME || !at->value || strlen(at->value) > SY_EXR_MAX_ATTRIBUTE_VALUE)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "%s: attribute %d needs a name of 1..%d bytes and a value of at most %d bytes", path, a,
+                                SY_EXR_MAX_ATTRIBUTE_NAME, SY_EXR_MAX_ATTRIBUTE_VALUE);
+    }
     for (int c = 0; c < d->channel_count; ++c) {
         const sy_exr_channel_desc *ch = &d->channels[c];
         if (!ch->name || !ch->name[0])
@@ -237,6 +256,15 @@ sy_result sy_exr_write(const char *path, const sy_exr_write_desc *desc, sy_error
             goto fail;
         }
     }
+    for (int a = 0; a < desc->attribute_count; ++a) {
+        const sy_exr_attribute *at = &desc->attributes[a];
+        if ((rv = exr_attr_set_string(ctxt, part, at->name, at->value)) != EXR_ERR_SUCCESS) {
+            char what[320];
+            snprintf(what, sizeof what, "cannot add the attribute \"%.200s\"", at->name);
+            rc = exr_fail(err, SY_ERR_BACKEND, path, what, rv, &io);
+            goto fail;
+        }
+    }
     if ((rv = exr_write_header(ctxt)) != EXR_ERR_SUCCESS) {
         rc = exr_fail(err, SY_ERR_IO, path, "cannot write the header", rv, &io);
         goto fail;
@@ -314,6 +342,13 @@ fail:
 sy_result sy_exr_write_rgba(const char *path, int width, int height, const float *rgba, const float *depth,
                             sy_exr_pixel_type color_type, sy_error *err)
 {
+    return sy_exr_write_rgba_attrs(path, width, height, rgba, depth, color_type, NULL, 0, err);
+}
+
+sy_result sy_exr_write_rgba_attrs(const char *path, int width, int height, const float *rgba, const float *depth,
+                                  sy_exr_pixel_type color_type, const sy_exr_attribute *attributes,
+                                  int attribute_count, sy_error *err)
+{
     if (!rgba) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: no colour data", path ? path : "(null)");
     if (color_type != SY_EXR_PIXEL_HALF && color_type != SY_EXR_PIXEL_FLOAT)
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: colour must be stored HALF or FLOAT",
@@ -331,6 +366,8 @@ sy_result sy_exr_write_rgba(const char *path, int width, int height, const float
         .compression = SY_EXR_COMPRESSION_ZIP,
         .channels = ch,
         .channel_count = depth ? 5 : 4,
+        .attributes = attributes,
+        .attribute_count = attribute_count,
     };
     return sy_exr_write(path, &d, err);
 }
@@ -361,6 +398,8 @@ const float *sy_exr_image_channel(const sy_exr_image *img, const char *name)
 /* State of one read call, so the helpers share one error path. */
 typedef struct exr_reader {
     const char *path;
+    uint64_t max_pixels;
+    size_t max_samples;
     exr_context_t ctxt;
     exr_io io;
     exr_decode_pipeline_t dec;
@@ -461,6 +500,22 @@ static sy_result read_tiles(exr_reader *r, sy_error *err)
     return SY_OK;
 }
 
+/* Upper bound of (raw pixel bytes) / (stored bytes) per compression, with margin: RLE stores at most
+ * 128 bytes in 2, deflate at most ~1032:1 (PXR24: zlib over 24-bit floats), PIZ's Huffman run codes
+ * ~410:1, B44A 32 bytes in 3, DWA a DC value per 8x8 block through zlib. Unknown methods: the DWA bound. */
+static uint64_t max_ratio(exr_compression_t c)
+{
+    switch (c) {
+    case EXR_COMPRESSION_NONE: return 1;
+    case EXR_COMPRESSION_RLE: return 64;
+    case EXR_COMPRESSION_ZIPS: case EXR_COMPRESSION_ZIP: return 1100;
+    case EXR_COMPRESSION_PXR24: return 1500;
+    case EXR_COMPRESSION_PIZ: return 4096;
+    case EXR_COMPRESSION_B44: case EXR_COMPRESSION_B44A: return 16;
+    default: return (uint64_t)1 << 17;
+    }
+}
+
 /* Header checks and allocation of the planes; everything taken from the file is validated here. */
 static sy_result read_header(exr_reader *r, exr_storage_t *storage, exr_attr_box2i_t *dw, sy_error *err)
 {
@@ -478,9 +533,9 @@ static sy_result read_header(exr_reader *r, exr_storage_t *storage, exr_attr_box
     if (w < 1 || h < 1)
         return sy_error_set(err, SY_ERR_PARSE, "%s: empty or inverted data window (%d,%d)-(%d,%d)", path, dw->min.x,
                             dw->min.y, dw->max.x, dw->max.y);
-    if (w > SY_EXR_MAX_SIDE || h > SY_EXR_MAX_SIDE || (uint64_t)w * (uint64_t)h > SY_EXR_MAX_PIXELS)
-        return sy_error_set(err, SY_ERR_LIMIT, "%s: image %" PRId64 "x%" PRId64 " exceeds the limit of %d per side / %u pixels",
-                            path, w, h, SY_EXR_MAX_SIDE, SY_EXR_MAX_PIXELS);
+    if (w > SY_EXR_MAX_SIDE || h > SY_EXR_MAX_SIDE || (uint64_t)w * (uint64_t)h > r->max_pixels)
+        return sy_error_set(err, SY_ERR_LIMIT, "%s: image %" PRId64 "x%" PRId64 " exceeds the limit of %d per side / %" PRIu64 " pixels",
+                            path, w, h, SY_EXR_MAX_SIDE, r->max_pixels);
     const exr_attr_chlist_t *chl = NULL;
     if ((rv = exr_get_channels(r->ctxt, 0, &chl)) != EXR_ERR_SUCCESS || !chl)
         return exr_fail(err, SY_ERR_PARSE, path, "bad channel list", rv, &r->io);
@@ -488,9 +543,24 @@ static sy_result read_header(exr_reader *r, exr_storage_t *storage, exr_attr_box
         return sy_error_set(err, chl->num_channels < 1 ? SY_ERR_PARSE : SY_ERR_LIMIT, "%s: %d channels (need 1..%d)",
                             path, chl->num_channels, SY_EXR_MAX_CHANNELS);
     size_t pixels = (size_t)w * (size_t)h, samples;
-    if (!sy_size_mul(pixels, (size_t)chl->num_channels, &samples) || samples > SY_EXR_MAX_SAMPLES)
+    if (!sy_size_mul(pixels, (size_t)chl->num_channels, &samples) || samples > r->max_samples)
         return sy_error_set(err, SY_ERR_LIMIT, "%s: %" PRId64 "x%" PRId64 " pixels x %d channels exceeds %zu samples",
-                            path, w, h, chl->num_channels, SY_EXR_MAX_SAMPLES);
+                            path, w, h, chl->num_channels, r->max_samples);
+
+    /* The pixels must fit the bytes present: raw size (data window x channel bytes) at most the
+     * file size times the best ratio the compression can reach, so a small hostile header cannot
+     * make us allocate planes its file could never fill. */
+    exr_compression_t comp = EXR_COMPRESSION_NONE;
+    if ((rv = exr_get_compression(r->ctxt, 0, &comp)) != EXR_ERR_SUCCESS)
+        return exr_fail(err, SY_ERR_PARSE, path, "bad compression", rv, &r->io);
+    uint64_t raw = 0, ratio = max_ratio(comp);
+    for (int c = 0; c < chl->num_channels; ++c)
+        raw += (uint64_t)pixels * (chl->entries[c].pixel_type == EXR_PIXEL_HALF ? 2u : 4u);
+    if (raw / ratio > (uint64_t)r->io.size)
+        return sy_error_set(err, SY_ERR_PARSE,
+                            "%s: truncated: a %" PRId64 "x%" PRId64 " data window with %d channels holds %" PRIu64
+                            " bytes of pixels, more than %" PRId64 " bytes can carry (compression %d reaches at most %" PRIu64 ":1)",
+                            path, w, h, chl->num_channels, raw, r->io.size, (int)comp, ratio);
 
     /* Every chunk has an 8-byte entry in the offset table: a file too small for its own table is
      * truncated, and refusing it here avoids allocating a table sized by a hostile header. */
@@ -538,24 +608,48 @@ static sy_result read_header(exr_reader *r, exr_storage_t *storage, exr_attr_box
     return SY_OK;
 }
 
+static sy_result read_image(exr_reader *rp, const sy_exr_read_options *opts, sy_exr_image **out, sy_error *err);
+
 sy_result sy_exr_read(const char *path, sy_exr_image **out, sy_error *err)
 {
     if (out) *out = NULL;
     if (!path || !out) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_exr_read: path and out are required");
 
-    exr_reader r = {.path = path, .io = {.fd = -1, .size = -1}};
-    sy_result rc = SY_OK;
-    r.io.fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (r.io.fd < 0) {
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0) {
         int e = errno;
         return sy_error_set(err, e == ENOENT ? SY_ERR_NOT_FOUND : SY_ERR_IO, "%s: cannot open: %s", path, strerror(e));
     }
     struct stat st;
-    if (fstat(r.io.fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        rc = sy_error_set(err, SY_ERR_IO, "%s: not a regular file", path);
-        goto done;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        return sy_error_set(err, SY_ERR_IO, "%s: not a regular file", path);
     }
-    r.io.size = (int64_t)st.st_size;
+    exr_reader r = {.path = path, .io = {.fd = fd, .size = (int64_t)st.st_size}};
+    sy_result rc = read_image(&r, NULL, out, err);
+    close(fd);
+    return rc;
+}
+
+sy_result sy_exr_read_memory(const void *data, size_t size, const char *name, const sy_exr_read_options *opts,
+                             sy_exr_image **out, sy_error *err)
+{
+    if (out) *out = NULL;
+    if (!data || !name || !out || size > (size_t)INT64_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_exr_read_memory: data, name and out are required");
+    exr_reader r = {.path = name, .io = {.fd = -1, .mem = data, .size = (int64_t)size}};
+    return read_image(&r, opts, out, err);
+}
+
+/* The reader behind sy_exr_read and sy_exr_read_memory: r has path and io set up. */
+static sy_result read_image(exr_reader *rp, const sy_exr_read_options *opts, sy_exr_image **out, sy_error *err)
+{
+    exr_reader r = *rp;
+    const char *path = r.path;
+    sy_result rc = SY_OK;
+    r.max_pixels = opts && opts->max_pixels && opts->max_pixels < SY_EXR_MAX_PIXELS ? opts->max_pixels : SY_EXR_MAX_PIXELS;
+    r.max_samples = opts && opts->max_samples && opts->max_samples < SY_EXR_MAX_SAMPLES ? opts->max_samples
+                                                                                        : SY_EXR_MAX_SAMPLES;
 
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = exr_io_on_error;
@@ -595,7 +689,6 @@ sy_result sy_exr_read(const char *path, sy_exr_image **out, sy_error *err)
 done:
     if (r.dec_inited) exr_decoding_destroy(r.ctxt, &r.dec);
     if (r.ctxt) exr_finish(&r.ctxt);
-    close(r.io.fd);
     if (rc != SY_OK) {
         sy_exr_image_free(r.img);
         return rc;

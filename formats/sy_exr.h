@@ -61,12 +61,25 @@ typedef struct sy_exr_channel_desc {
     sy_exr_pixel_type type; /* FLOAT (default) or HALF */
 } sy_exr_channel_desc;
 
+/* One string attribute of the header (metadata such as "sy:samples" = "128"). Names must not
+ * collide with the required attributes (channels, compression, dataWindow, ...).
+ * Ownership: borrowed for the duration of the write call only. */
+typedef struct sy_exr_attribute {
+    const char *name;  /* 1..SY_EXR_MAX_ATTRIBUTE_NAME bytes */
+    const char *value; /* any length up to SY_EXR_MAX_ATTRIBUTE_VALUE bytes */
+} sy_exr_attribute;
+#define SY_EXR_MAX_ATTRIBUTES 64
+#define SY_EXR_MAX_ATTRIBUTE_NAME 255
+#define SY_EXR_MAX_ATTRIBUTE_VALUE 4096
+
 /* A single-part scanline image to write; zero-initialised fields mean the defaults. */
 typedef struct sy_exr_write_desc {
     int width, height;              /* 1..SY_EXR_MAX_SIDE each */
     sy_exr_compression compression; /* default ZIP */
     const sy_exr_channel_desc *channels;
     int channel_count;              /* 1..SY_EXR_MAX_CHANNELS */
+    const sy_exr_attribute *attributes; /* extra string attributes, may be NULL */
+    int attribute_count;                /* 0..SY_EXR_MAX_ATTRIBUTES */
 } sy_exr_write_desc;
 
 /* Writes desc to path (temp file + rename). Channels may be given in any order (the file stores
@@ -80,6 +93,11 @@ sy_result sy_exr_write(const char *path, const sy_exr_write_desc *desc, sy_error
  * ZIP compression. */
 sy_result sy_exr_write_rgba(const char *path, int width, int height, const float *rgba, const float *depth,
                             sy_exr_pixel_type color_type, sy_error *err);
+
+/* The same with extra string attributes in the header (attribute_count 0..SY_EXR_MAX_ATTRIBUTES). */
+sy_result sy_exr_write_rgba_attrs(const char *path, int width, int height, const float *rgba, const float *depth,
+                                  sy_exr_pixel_type color_type, const sy_exr_attribute *attributes,
+                                  int attribute_count, sy_error *err);
 
 /* One channel of a read image. */
 typedef struct sy_exr_plane {
@@ -103,6 +121,21 @@ typedef struct sy_exr_image {
  * Ownership: on success the caller owns *out and releases it with sy_exr_image_free; on failure
  * *out is NULL. */
 sy_result sy_exr_read(const char *path, sy_exr_image **out, sy_error *err);
+
+/* Limits of a read; zero fields mean the SY_EXR_MAX_* defaults (larger values are capped to them). */
+typedef struct sy_exr_read_options {
+    uint64_t max_pixels; /* width * height of the data window */
+    size_t max_samples;  /* width * height * channels */
+} sy_exr_read_options;
+
+/* Reads an OpenEXR image held in memory (size bytes at data, borrowed for the call) with the given
+ * limits (opts NULL = defaults); `name` names it in messages. Otherwise as sy_exr_read.
+ * Before anything is allocated from the header, the data window is checked against the limits and
+ * against the input size: width * height * channel bytes must fit the bytes present at the best
+ * ratio the compression can reach (1:1 uncompressed, 64:1 RLE, ~1032:1 zlib, ...), and the chunk
+ * offset table must fit; otherwise SY_ERR_PARSE ("truncated"). sy_exr_read applies the same. */
+sy_result sy_exr_read_memory(const void *data, size_t size, const char *name, const sy_exr_read_options *opts,
+                             sy_exr_image **out, sy_error *err);
 
 /* The plane of the channel called name (exact, case-sensitive match), or NULL if there is none.
  * Ownership: the pointer belongs to img and lives until sy_exr_image_free. */

@@ -1,10 +1,14 @@
 /* sy_file.c — whole-file reading with a size limit and atomic temp-then-rename output (see sy_file.h). */
+#define _DEFAULT_SOURCE /* realpath */
 #include "sy_file.h"
 
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -134,6 +138,106 @@ static char *dir_of(const char *path)
     return d;
 }
 
+/* ---- model files stay in their folder ---- */
+
+/* real path of dir ("" = "."), NULL when it does not resolve */
+static char *real_dir(const char *dir)
+{
+    return realpath(dir && dir[0] ? dir : ".", NULL);
+}
+
+/* true when real lies inside root (both real paths): root itself or below root + '/' */
+static bool path_inside(const char *real, const char *root)
+{
+    size_t n = strlen(root);
+    if (n == 1 && root[0] == '/') return true;
+    return strncmp(real, root, n) == 0 && (real[n] == '/' || real[n] == '\0');
+}
+
+sy_result sy_path_confine(const char *model, const char *uri, const char *path, const char *model_dir,
+                          const char *const *roots, size_t root_count, char **real_out, sy_error *err)
+{
+    *real_out = NULL;
+    bool is_file_uri = strncasecmp(uri, "file:", 5) == 0;
+    bool absolute = uri[0] == '/' || is_file_uri;
+    const char *target = uri[0] == '/' ? uri : path;
+    if (is_file_uri) { /* file:///abs/path, file://localhost/abs/path, file:/abs/path */
+        target = uri + 5;
+        if (!strncmp(target, "//", 2)) {
+            target += 2;
+            if (!strncasecmp(target, "localhost/", 10)) target += 9;
+        }
+    }
+    char *real = realpath(target, NULL);
+    if (!real)
+        return sy_error_set(err, errno == ENOENT ? SY_ERR_NOT_FOUND : SY_ERR_IO, "%s: '%s': cannot open %s: %s", model,
+                            uri, target, strerror(errno));
+    bool ok = false;
+    if (!absolute) {
+        char *base = real_dir(model_dir);
+        ok = base && path_inside(real, base);
+        free(base);
+    }
+    for (size_t i = 0; i < root_count && !ok; ++i) {
+        char *base = real_dir(roots[i]);
+        ok = base && path_inside(real, base);
+        free(base);
+    }
+    if (!ok) {
+        sy_result r = sy_error_set(err, SY_ERR_LIMIT,
+                                   "%s: '%s' %s%s, outside the model's folder %s; refused (allow a folder with "
+                                   "--allow-path DIR, or allowed_roots in the loader's options)",
+                                   model, uri, absolute ? "is an absolute path or file: URI resolving to " : "resolves to ",
+                                   real, model_dir && model_dir[0] ? model_dir : ".");
+        free(real);
+        return r;
+    }
+    *real_out = real;
+    return SY_OK;
+}
+
+/* ---- the registry of temporary files in progress (for sy_atomic_file_cancel_all) ----
+ * Every open temporary file's name is listed here from the moment it is created until it is renamed
+ * or removed, both under the lock, so a cancel never misses one and never removes a finished file. */
+static pthread_mutex_t g_tmp_lock = PTHREAD_MUTEX_INITIALIZER;
+static const char **g_tmp;    /* borrowed from the handles' tmp_path */
+static size_t g_tmp_n, g_tmp_cap;
+static bool g_tmp_cancelled;  /* set once by sy_atomic_file_cancel_all; never cleared */
+
+/* lock held: room for one more entry */
+static bool tmp_reserve(void)
+{
+    if (g_tmp_n < g_tmp_cap) return true;
+    size_t cap = g_tmp_cap ? g_tmp_cap * 2 : 8;
+    const char **n = realloc(g_tmp, cap * sizeof *n);
+    if (!n) return false;
+    g_tmp = n;
+    g_tmp_cap = cap;
+    return true;
+}
+
+/* lock held */
+static void tmp_unregister(const char *tmp)
+{
+    for (size_t i = 0; i < g_tmp_n; ++i)
+        if (g_tmp[i] == tmp) {
+            g_tmp[i] = g_tmp[--g_tmp_n];
+            return;
+        }
+}
+
+size_t sy_atomic_file_cancel_all(void)
+{
+    pthread_mutex_lock(&g_tmp_lock);
+    g_tmp_cancelled = true;
+    size_t n = 0;
+    for (size_t i = 0; i < g_tmp_n; ++i)
+        if (unlink(g_tmp[i]) == 0) n++;
+    g_tmp_n = 0;
+    pthread_mutex_unlock(&g_tmp_lock);
+    return n;
+}
+
 sy_result sy_atomic_file_begin(const char *path, sy_atomic_file *af, sy_error *err)
 {
     if (af) memset(af, 0, sizeof *af);
@@ -166,6 +270,15 @@ sy_result sy_atomic_file_begin(const char *path, sy_atomic_file *af, sy_error *e
                      (uint64_t)(uintptr_t)af;
     int fd = -1;
     int e = 0;
+    pthread_mutex_lock(&g_tmp_lock);
+    if (g_tmp_cancelled || !tmp_reserve()) {
+        bool cancelled = g_tmp_cancelled;
+        pthread_mutex_unlock(&g_tmp_lock);
+        free(tmp);
+        free(final_path);
+        return cancelled ? sy_error_set(err, SY_ERR_IO, "%s: not written: output was cancelled (interrupted)", path)
+                         : sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
     for (int attempt = 0; attempt < MAX_TRIES; ++attempt) {
         uint64_t r = splitmix64(&state);
         for (int i = 0; i < RANDOM_CHARS; ++i) {
@@ -177,6 +290,8 @@ sy_result sy_atomic_file_begin(const char *path, sy_atomic_file *af, sy_error *e
         e = errno;
         if (e != EEXIST && e != EINTR) break;
     }
+    if (fd >= 0) g_tmp[g_tmp_n++] = tmp;
+    pthread_mutex_unlock(&g_tmp_lock);
     if (fd < 0) {
         free(tmp);
         free(final_path);
@@ -190,7 +305,10 @@ sy_result sy_atomic_file_begin(const char *path, sy_atomic_file *af, sy_error *e
     if (!fp) {
         e = errno;
         close(fd);
+        pthread_mutex_lock(&g_tmp_lock);
         unlink(tmp);
+        tmp_unregister(tmp);
+        pthread_mutex_unlock(&g_tmp_lock);
         free(tmp);
         free(final_path);
         return sy_error_set(err, SY_ERR_IO, "%s: cannot open a stream on the temporary file: %s", path, strerror(e));
@@ -206,7 +324,12 @@ void sy_atomic_file_abort(sy_atomic_file *af)
 {
     if (!af) return;
     if (af->fp) fclose(af->fp);
-    if (af->tmp_path) unlink(af->tmp_path);
+    if (af->tmp_path) {
+        pthread_mutex_lock(&g_tmp_lock);
+        unlink(af->tmp_path);
+        tmp_unregister(af->tmp_path);
+        pthread_mutex_unlock(&g_tmp_lock);
+    }
     free(af->tmp_path);
     free(af->path);
     memset(af, 0, sizeof *af);
@@ -238,9 +361,19 @@ sy_result sy_atomic_file_commit(sy_atomic_file *af, sy_error *err)
                           strerror(errno));
         goto fail;
     }
-    if (rename(af->tmp_path, path) != 0) {
+    pthread_mutex_lock(&g_tmp_lock);
+    bool cancelled = g_tmp_cancelled;
+    int renamed = cancelled ? -1 : rename(af->tmp_path, path);
+    int rename_errno = errno;
+    if (renamed == 0) tmp_unregister(af->tmp_path);
+    pthread_mutex_unlock(&g_tmp_lock);
+    if (cancelled) {
+        rc = sy_error_set(err, SY_ERR_IO, "%s: not written: output was cancelled (interrupted)", path);
+        goto fail;
+    }
+    if (renamed != 0) {
         rc = sy_error_set(err, SY_ERR_IO, "%s: cannot rename the temporary file %s over it: %s", path, af->tmp_path,
-                          strerror(errno));
+                          strerror(rename_errno));
         goto fail;
     }
     /* The content is durable; make the rename durable too. Best effort: some file systems refuse

@@ -7,8 +7,9 @@
  * stays untouched.
  *
  * Errors name the file and the reason (see core/sy_common.h).
- * Thread-safety: no shared state; distinct handles may be used from distinct threads. One
- * sy_atomic_file must not be used from two threads at once. */
+ * Thread-safety: distinct handles may be used from distinct threads; the only shared state is the
+ * process-wide list of temporary files in progress (behind a lock), which sy_atomic_file_cancel_all
+ * empties. One sy_atomic_file must not be used from two threads at once. */
 #ifndef SY_FILE_H
 #define SY_FILE_H
 
@@ -54,6 +55,28 @@ sy_result sy_atomic_file_commit(sy_atomic_file *af, sy_error *err);
 /* Closes and removes the temporary file; the target is untouched. Safe on a zeroed, committed or
  * already aborted handle (does nothing then). *af is zeroed afterwards. */
 void sy_atomic_file_abort(sy_atomic_file *af);
+
+/* Model files stay in their folder: checks a file that a model names by `uri` (a glTF buffer or
+ * image URI, an X3D url) before it is read. `path` is the uri already joined to the referring
+ * file's folder. The file is allowed when its real path (symbolic links and ".." resolved) lies
+ * inside the model's folder `model_dir` (the folder of the top-level model file; "" = the working
+ * directory) or inside one of the extra `roots`. An absolute uri and a "file:" uri are refused
+ * unless they lie inside one of the extra roots (the model's folder alone never admits them).
+ * On success *real_out is the resolved path to read (malloc()ed, the caller frees it), so the file
+ * read is the file checked. A file that does not exist gives SY_ERR_NOT_FOUND; a refusal
+ * SY_ERR_LIMIT with a message naming `model`, the uri and the option that admits more folders
+ * (--allow-path DIR, the loaders' allowed_roots). Thread-safe (no shared state). */
+sy_result sy_path_confine(const char *model, const char *uri, const char *path, const char *model_dir,
+                          const char *const *roots, size_t root_count, char **real_out, sy_error *err);
+
+/* Removes every temporary file that an unfinished sy_atomic_file of this process holds, and makes
+ * every later sy_atomic_file_begin and sy_atomic_file_commit fail ("output was cancelled"): for a
+ * process that is about to end on SIGINT / SIGTERM (apps/sy_signals.c calls it from its
+ * signal-waiting thread). A commit that already renamed its file is finished and stays. Returns
+ * the number of files removed. Thread-safe (one lock shared with begin / commit / abort); it takes
+ * a lock, so it is not for use inside an asynchronous signal handler. There is no way back: the
+ * cancelled state lasts for the life of the process. */
+size_t sy_atomic_file_cancel_all(void);
 
 #ifdef __cplusplus
 }

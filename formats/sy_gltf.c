@@ -631,6 +631,31 @@ static sy_result read_floats(loader *L, size_t ai, size_t out_comps, float **out
     return SY_OK;
 }
 
+/* Element i of accessor ai (i < count) as out_comps floats, sparse substitution applied; allocates
+ * nothing (for accessors whose count is bounded by no limit, such as animation outputs). */
+static sy_result read_element(loader *L, size_t ai, size_t i, size_t out_comps, float *dst)
+{
+    const sy_gltf_doc *d = L->doc;
+    const sy_gltf_shim_accessor *a = &d->accessors[ai];
+    size_t comps = (size_t)a->components < out_comps ? (size_t)a->components : out_comps;
+    size_t cs = component_size(a->component_type);
+    bool norm = a->normalized != 0;
+    const uint8_t *p = element_ptr(d, a, i);
+    for (size_t c = 0; c < out_comps; c++) dst[c] = c < comps && p ? load_component(p + c * cs, a->component_type, norm) : 0.0f;
+    if (out_comps == 4 && comps < 4) dst[3] = 1.0f;
+    if (a->sparse) {
+        for (size_t k = 0; k < (size_t)a->sparse_count; k++) {
+            size_t t;
+            sy_result r = sparse_index(L, ai, k, &t);
+            if (r) return r;
+            if (t != i) continue;
+            const uint8_t *q = sparse_value_ptr(d, a, k);
+            for (size_t c = 0; c < comps; c++) dst[c] = load_component(q + c * cs, a->component_type, norm);
+        }
+    }
+    return SY_OK;
+}
+
 static sy_result read_uints(loader *L, size_t ai, uint32_t **out)
 {
     const sy_gltf_doc *d = L->doc;
@@ -1170,10 +1195,9 @@ static sy_result first_frame(loader *L, size_t ni, float t[3], float q[4], float
                  c, (int)ch->output, comps);
             continue;
         }
-        float *v;
-        sy_result r = read_floats(L, (size_t)ch->output, comps, &v);
+        float x[4];
+        sy_result r = read_element(L, (size_t)ch->output, at, comps, x); /* not the whole accessor: its count is unbounded */
         if (r) return r;
-        const float *x = v + at * comps;
         bool finite = true;
         for (size_t k = 0; k < comps; k++) finite = finite && isfinite(x[k]);
         if (finite && comps == 4 && !(x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3] > 1e-12f)) finite = false;
@@ -1184,7 +1208,6 @@ static sy_result first_frame(loader *L, size_t ni, float t[3], float q[4], float
             memcpy(dst, x, comps * sizeof(float));
             *animated = true;
         }
-        free(v);
     }
     return SY_OK;
 }
@@ -1415,14 +1438,15 @@ static sy_result load_doc(loader *L)
     return r;
 }
 
-sy_result sy_gltf_load(const char *path, sy_scene *scene, const sy_gltf_options *opts, sy_gltf_info *info_out,
-                       sy_error *err)
+/* Shared by sy_gltf_load (mem NULL: reads path; external files relative to its directory) and
+ * sy_gltf_load_memory (mem borrowed, path only names it in messages, base_dir given). */
+static sy_result load_common(const char *path, const void *mem, size_t mem_size, const char *base_dir, sy_scene *scene,
+                             const sy_gltf_options *opts, sy_gltf_info *info_out, sy_error *err)
 {
     sy_gltf_info local_info;
     sy_gltf_info *info = info_out ? info_out : &local_info;
     memset(info, 0, sizeof *info);
     info->scene_index = -1;
-    if (!path || !scene) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_gltf_load: path and scene are required");
 
     loader L;
     memset(&L, 0, sizeof L);
@@ -1434,10 +1458,18 @@ sy_result sy_gltf_load(const char *path, sy_scene *scene, const sy_gltf_options 
     void *bytes = NULL;
     size_t size = 0;
     sy_gltf_doc *doc = NULL;
-    sy_result r = sy_file_read_all(path, L.opt.max_file_bytes, &bytes, &size, &L.err);
-    if (r) goto out; /* the message names the path already */
+    sy_result r = SY_OK;
+    if (!mem) {
+        r = sy_file_read_all(path, L.opt.max_file_bytes, &bytes, &size, &L.err);
+        if (r) goto out; /* the message names the path already */
+    } else if (mem_size > L.opt.max_file_bytes) {
+        r = fail(&L, SY_ERR_LIMIT, "%zu bytes exceed the file size limit of %zu", mem_size, L.opt.max_file_bytes);
+        goto out;
+    } else {
+        size = mem_size;
+    }
 
-    const uint8_t *b = bytes, *json = b;
+    const uint8_t *b = mem ? (const uint8_t *)mem : (const uint8_t *)bytes, *json = b;
     size_t json_len = size;
     size_t plen = strlen(path);
     bool ext_glb = plen >= 4 && (!strcmp(path + plen - 4, ".glb") || !strcmp(path + plen - 4, ".GLB"));
@@ -1455,15 +1487,16 @@ sy_result sy_gltf_load(const char *path, sy_scene *scene, const sy_gltf_options 
 
     /* external files are relative to the file's directory */
     const char *slash = strrchr(path, '/');
-    size_t dlen = slash ? (size_t)(slash - path) + 1 : 0;
+    size_t dlen = mem ? strlen(base_dir) : slash ? (size_t)(slash - path) + 1 : 0;
     char *base = malloc(dlen + 1);
     if (!base) {
         r = fail(&L, SY_ERR_OUT_OF_MEMORY, "out of memory");
         goto out;
     }
-    memcpy(base, path, dlen);
+    memcpy(base, mem ? base_dir : path, dlen);
     base[dlen] = '\0';
-    sy_gltf_shim_limits lim = {L.opt.max_file_bytes, L.opt.max_image_pixels};
+    sy_gltf_shim_limits lim = {L.opt.max_file_bytes, L.opt.max_image_pixels, L.opt.allowed_roots,
+                               L.opt.allowed_root_count};
     r = sy_gltf_shim_parse(b, size, binary, base, &lim, &doc, &L.err);
     free(base);
     if (r) {
@@ -1499,6 +1532,32 @@ out:
     }
     if (!info_out) sy_gltf_info_free(&local_info);
     return SY_OK;
+}
+
+sy_result sy_gltf_load(const char *path, sy_scene *scene, const sy_gltf_options *opts, sy_gltf_info *info_out,
+                       sy_error *err)
+{
+    if (!path || !scene) {
+        if (info_out) {
+            memset(info_out, 0, sizeof *info_out);
+            info_out->scene_index = -1;
+        }
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_gltf_load: path and scene are required");
+    }
+    return load_common(path, NULL, 0, NULL, scene, opts, info_out, err);
+}
+
+sy_result sy_gltf_load_memory(const void *data, size_t size, const char *name, const char *base_dir, sy_scene *scene,
+                              const sy_gltf_options *opts, sy_gltf_info *info_out, sy_error *err)
+{
+    if (!data || !name || !base_dir || !scene) {
+        if (info_out) {
+            memset(info_out, 0, sizeof *info_out);
+            info_out->scene_index = -1;
+        }
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_gltf_load_memory: data, name, base_dir and scene are required");
+    }
+    return load_common(name, data, size, base_dir, scene, opts, info_out, err);
 }
 
 sy_result sy_gltf_find_camera(const sy_scene *scene, const sy_gltf_info *info, const char *selector, sy_node *out,

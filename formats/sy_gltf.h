@@ -56,6 +56,12 @@ typedef struct sy_gltf_options {
     uint32_t max_json_depth;    /* nesting of JSON arrays / objects; 0 = 64 */
     int32_t scene_index;        /* glTF scene to load; 0 = the file's default (see below) */
     bool use_scene_index;       /* true: load scenes[scene_index] instead of the default */
+    /* Files named by buffer and image URIs must lie in the model file's folder (after symbolic
+     * links and ".."; sy_path_confine in sy_file.h) or in one of these folders; absolute paths and
+     * file: URIs only in these. A refused URI fails the load (SY_ERR_LIMIT) with a message naming
+     * the file and the URI. Borrowed for the call. */
+    const char *const *allowed_roots;
+    size_t allowed_root_count;
 } sy_gltf_options;
 
 #define SY_GLTF_MAX_WARNINGS 32 /* messages kept; warning_count counts them all */
@@ -84,6 +90,13 @@ typedef struct sy_gltf_info {
  * (extensionsRequired names an unsupported extension), SY_ERR_OUT_OF_MEMORY. */
 sy_result sy_gltf_load(const char *path, sy_scene *scene, const sy_gltf_options *opts, sy_gltf_info *info_out,
                        sy_error *err);
+
+/* Same from memory (size bytes at data, borrowed for the call): `name` is used in messages and, by
+ * its ".glb" suffix, like the path above (GLB is also recognised by its magic); external URIs
+ * resolve in base_dir ("" = the working directory, as for a path without a directory). The same
+ * options and limits apply (max_file_bytes to size too). */
+sy_result sy_gltf_load_memory(const void *data, size_t size, const char *name, const char *base_dir, sy_scene *scene,
+                              const sy_gltf_options *opts, sy_gltf_info *info_out, sy_error *err);
 
 /* Frees the arrays in *info and zeroes it. NULL-safe. */
 void sy_gltf_info_free(sy_gltf_info *info);

@@ -22,7 +22,10 @@
 namespace {
 
 struct LoadContext {
-    std::string prefix;            // external files must start with this ("" = anything)
+    std::string prefix;            // the model's folder: external files are joined to it
+    const char *const *roots = nullptr; // further folders external files may lie in
+    size_t root_count = 0;
+    std::string refused;           // the first URI refused by the confinement (fails the load)
     size_t max_file_bytes = 0;
     uint64_t max_image_pixels = 0;
     tinygltf::Model *model = nullptr;
@@ -31,13 +34,34 @@ struct LoadContext {
     std::map<int, std::string> image_problems; // images that failed to decode (local: missing texture)
 };
 
-// >>file-system callbacks: lookups confined to the glTF's directory, reads size-limited.
+// >>file-system callbacks: files confined to the glTF's folder (sy_path_confine: after symbolic
+// links and "..", absolute paths and file: URIs only inside allowed_roots), reads size-limited.
+// A refusal is remembered (fs_result) and fails the whole load with its message.
+// Resolves path (tinygltf joined it to the prefix) to the real file to read; "" when refused or absent.
+std::string confine(LoadContext *ctx, const std::string &path)
+{
+    std::string uri = ctx->prefix.empty() || path.compare(0, ctx->prefix.size(), ctx->prefix) != 0
+                          ? path
+                          : path.substr(ctx->prefix.size());
+    char *real = nullptr;
+    sy_error e = {};
+    sy_result r = sy_path_confine("URI", uri.c_str(), path.c_str(), ctx->prefix.c_str(), ctx->roots, ctx->root_count,
+                                  &real, &e);
+    if (r != SY_OK) {
+        if (r != SY_ERR_NOT_FOUND && ctx->refused.empty()) ctx->refused = e.message;
+        return std::string();
+    }
+    std::string out = real;
+    free(real);
+    return out;
+}
+
 bool fs_file_exists(const std::string &path, void *user)
 {
-    const LoadContext *ctx = static_cast<const LoadContext *>(user);
-    if (!ctx->prefix.empty() && path.compare(0, ctx->prefix.size(), ctx->prefix) != 0) return false;
+    LoadContext *ctx = static_cast<LoadContext *>(user);
+    std::string real = confine(ctx, path);
     struct stat st;
-    return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+    return !real.empty() && stat(real.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
 std::string fs_expand(const std::string &path, void *) { return path; } // no shell expansion
@@ -45,10 +69,15 @@ std::string fs_expand(const std::string &path, void *) { return path; } // no sh
 bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
 {
     LoadContext *ctx = static_cast<LoadContext *>(user);
+    std::string real = confine(ctx, path);
+    if (real.empty()) {
+        if (err) *err = ctx->refused.empty() ? "file not found" : ctx->refused;
+        return false;
+    }
     void *data = nullptr;
     size_t size = 0;
     sy_error e = {};
-    sy_result r = sy_file_read_all(path.c_str(), ctx->max_file_bytes, &data, &size, &e);
+    sy_result r = sy_file_read_all(real.c_str(), ctx->max_file_bytes, &data, &size, &e);
     if (r != SY_OK) {
         if (ctx->fs_result == SY_OK) {
             ctx->fs_result = r;
@@ -501,6 +530,8 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
     ctx->max_file_bytes = limits->max_file_bytes;
     ctx->max_image_pixels = limits->max_image_pixels;
     ctx->model = model;
+    ctx->roots = limits->allowed_roots;
+    ctx->root_count = limits->allowed_root_count;
     std::string base = base_dir;
     if (!base.empty()) ctx->prefix = base.back() == '/' ? base : base + "/";
     tinygltf::TinyGLTF loader;
@@ -516,6 +547,8 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
     bool ok = binary ? loader.LoadBinaryFromMemory(model, &terr, twarn, bytes, unsigned(size), base)
                      : loader.LoadASCIIFromString(model, &terr, twarn, reinterpret_cast<const char *>(bytes),
                                                   unsigned(size), base);
+    // a refused file fails the load, also where tinygltf would go on without it (an image)
+    if (!ctx->refused.empty()) return sy_error_set(err, SY_ERR_LIMIT, "%s", ctx->refused.c_str());
     if (ok) return SY_OK;
     sy_result code = SY_ERR_PARSE;
     if (ctx->fs_result != SY_OK) code = ctx->fs_result;

@@ -29,6 +29,8 @@ extern "C" {
 typedef struct sy_gltf_shim_limits {
     size_t max_file_bytes;     /* external buffer / image files */
     uint64_t max_image_pixels; /* width * height of one decoded image */
+    const char *const *allowed_roots; /* folders besides base_dir that external files may lie in */
+    size_t allowed_root_count;
 } sy_gltf_shim_limits;
 
 typedef struct sy_gltf_shim_buffer {

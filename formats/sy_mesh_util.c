@@ -186,7 +186,8 @@ sy_result sy_corner_normals(const float *positions, size_t position_count, const
                             size_t tri_count, float crease_angle, float **out, sy_error *err)
 {
     *out = NULL;
-    float *fn = malloc((tri_count ? tri_count : 1) * 12);          /* unit face normals (0 if degenerate) */
+    float *fn = malloc((tri_count ? tri_count : 1) * 24);          /* unit face normals (0 if degenerate) */
+    float *ang = fn + 3 * (tri_count ? tri_count : 1);               /* corner angles, computed once */
     float *res = malloc((tri_count ? tri_count : 1) * 36);
     uint32_t *start = calloc(position_count + 1, sizeof(uint32_t)); /* CSR: corners per position */
     uint32_t *list = malloc((tri_count ? tri_count : 1) * 3 * sizeof(uint32_t));
@@ -203,6 +204,8 @@ sy_result sy_corner_normals(const float *positions, size_t position_count, const
         v3_cross(e1, e2, fn + 3 * t);
         if (!v3_normalize(fn + 3 * t)) fn[3 * t] = fn[3 * t + 1] = fn[3 * t + 2] = 0;
         for (int k = 0; k < 3; k++) start[i[k] + 1]++;
+        if (crease_angle > 0.0f)
+            for (int k = 0; k < 3; k++) ang[3 * t + (size_t)k] = corner_angle(positions, i, k);
     }
     for (size_t v = 0; v < position_count; v++) start[v + 1] += start[v];
     memcpy(fill, start, position_count * sizeof(uint32_t));
@@ -210,26 +213,44 @@ sy_result sy_corner_normals(const float *positions, size_t position_count, const
         for (int k = 0; k < 3; k++) list[fill[pos_index[3 * t + k]]++] = (uint32_t)(3 * t + (size_t)k);
     free(fill);
     float cos_crease = crease_angle >= PI_F ? -2.0f : cosf(crease_angle);
-    for (size_t t = 0; t < tri_count; t++) {
-        const float *ft = fn + 3 * t;
-        bool ok = ft[0] != 0 || ft[1] != 0 || ft[2] != 0;
-        for (int k = 0; k < 3; k++) {
-            float *o = res + 9 * t + 3 * k;
-            uint32_t v = pos_index[3 * t + k];
+    /* Per position: angle-weighted average of the faces within the crease angle; vertices shared by
+     * more than SY_CREASE_MAX_VALENCE triangles keep the face normal (bounds the cost, which is
+     * quadratic in the valence; such vertices are fan centres of big planar polygons). Corners at
+     * one position whose faces have the same normal get the same result: it is computed once
+     * (a small cache per position; coplanar fans of hostile input no longer cost valence^2). */
+    enum { CACHE = 8 };
+    for (size_t v = 0; v < position_count; v++) {
+        uint32_t m = start[v + 1] - start[v];
+        const float *cn[CACHE];
+        float cr[CACHE][3];
+        int nc = 0;
+        for (uint32_t c0 = start[v]; c0 < start[v + 1]; c0++) {
+            size_t t = list[c0] / 3;
+            const float *ft = fn + 3 * t;
+            float *o = res + 3 * (size_t)list[c0];
+            bool ok = ft[0] != 0 || ft[1] != 0 || ft[2] != 0;
             o[0] = o[1] = o[2] = 0;
-            /* angle-weighted average of the faces within the crease angle; vertices shared by more
-             * than SY_CREASE_MAX_VALENCE triangles keep the face normal (bounds the cost, which is
-             * quadratic in the valence; such vertices are fan centres of big planar polygons) */
-            if (ok && crease_angle > 0.0f && start[v + 1] - start[v] <= SY_CREASE_MAX_VALENCE) {
+            if (ok && crease_angle > 0.0f && m <= SY_CREASE_MAX_VALENCE) {
+                int hit = -1;
+                for (int j = 0; j < nc && hit < 0; j++)
+                    if (!memcmp(cn[j], ft, 12)) hit = j;
+                if (hit >= 0) {
+                    memcpy(o, cr[hit], 12);
+                    continue;
+                }
                 for (uint32_t q = start[v]; q < start[v + 1]; q++) {
                     size_t g = list[q] / 3;
                     const float *gn = fn + 3 * g;
                     if (g != t && v3_dot(gn, ft) < cos_crease - 1e-6f) continue;
-                    float w = corner_angle(positions, pos_index + 3 * g, (int)(list[q] % 3));
+                    float w = ang[list[q]];
                     o[0] += gn[0] * w; o[1] += gn[1] * w; o[2] += gn[2] * w;
                 }
             }
             if (!v3_normalize(o)) memcpy(o, ok ? ft : (const float[3]){0, 0, 1}, 12);
+            if (ok && crease_angle > 0.0f && m <= SY_CREASE_MAX_VALENCE && nc < CACHE) {
+                cn[nc] = ft;
+                memcpy(cr[nc++], o, 12);
+            }
         }
     }
     free(fn); free(start); free(list);
@@ -265,8 +286,8 @@ size_t sy_triangulate_polygon(const float *positions, const uint32_t *poly, size
         nn[1] += (a[2] - b[2]) * (a[0] + b[0]);
         nn[2] += (a[0] - b[0]) * (a[1] + b[1]);
     }
-    uint32_t *idx = scratch; /* n live positions into poly */
-    float *uv = (float *)(idx + 2 * n);
+    uint32_t *idx = scratch; /* 4 * n: ring links, reflex list, states (below) */
+    float *uv = (float *)(idx + 4 * n);
     int ax = 0;
     if (fabsf(nn[1]) > fabsf(nn[ax])) ax = 1;
     if (fabsf(nn[2]) > fabsf(nn[ax])) ax = 2;
@@ -277,44 +298,75 @@ size_t sy_triangulate_polygon(const float *positions, const uint32_t *poly, size
         const float *p = positions + 3 * (size_t)poly[i];
         uv[2 * i] = p[u];
         uv[2 * i + 1] = flip ? -p[w] : p[w];
-        idx[i] = (uint32_t)i;
     }
     /* convex (every turn the same way): a fan, in linear time */
     bool convex = true;
     for (size_t k = 0; k < n && convex; k++)
         convex = cross2(uv + 2 * k, uv + 2 * ((k + 1) % n), uv + 2 * ((k + 2) % n)) >= 0;
     if (convex) goto fan;
-    size_t m = n, guard = 0;
-    size_t i = 0;
-    /* ear tests cost O(m) each; past this budget the rest is fanned (bounded time on hostile input) */
+    /* Ear clipping on a doubly linked ring. Only reflex (or straight) vertices can lie inside an
+     * ear of a simple polygon, and clipping never turns a convex vertex reflex, so an ear test scans
+     * the list of reflex vertices only (compacted as they turn convex or go). */
+    uint32_t *prv = idx, *nxt = idx + n, *rl = idx + 2 * n, *st = idx + 3 * n; /* st: 1 reflex, 2 clipped */
+    size_t nr = 0, live_r = 0;
+    for (size_t k = 0; k < n; k++) {
+        prv[k] = (uint32_t)((k + n - 1) % n);
+        nxt[k] = (uint32_t)((k + 1) % n);
+        st[k] = cross2(uv + 2 * prv[k], uv + 2 * k, uv + 2 * nxt[k]) <= 0;
+        if (st[k]) rl[nr++] = (uint32_t)k;
+    }
+    live_r = nr;
+    size_t m = n, fails = 0;
+    uint32_t cur = 0;
+    /* ear tests cost O(reflex) each; past this budget the rest is fanned (bounded time on hostile input) */
     uint64_t budget = (uint64_t)1 << 26;
-    while (m > 3 && guard < 2 * m + 2 && budget > m) {
-        budget -= m;
-        size_t ip = (i + m - 1) % m, in = (i + 1) % m;
-        const float *a = uv + 2 * idx[ip], *b = uv + 2 * idx[i], *c = uv + 2 * idx[in];
-        bool ear = cross2(a, b, c) > 0;
-        for (size_t k = 0; ear && k < m; k++) {
-            if (k == ip || k == i || k == in) continue;
-            const float *q = uv + 2 * idx[k];
-            if ((q[0] == a[0] && q[1] == a[1]) || (q[0] == b[0] && q[1] == b[1]) || (q[0] == c[0] && q[1] == c[1]))
-                continue;
-            if (in_triangle(q, a, b, c)) ear = false;
-        }
+    while (m > 3 && fails < m && budget > nr) {
+        budget -= nr + 1;
+        uint32_t ip = prv[cur], in = nxt[cur];
+        const float *a = uv + 2 * ip, *b = uv + 2 * cur, *c = uv + 2 * in;
+        bool ear = !(st[cur] & 1) && cross2(a, b, c) > 0;
         if (ear) {
-            tris[3 * out] = poly[idx[ip]]; tris[3 * out + 1] = poly[idx[i]]; tris[3 * out + 2] = poly[idx[in]];
-            out++;
-            memmove(idx + i, idx + i + 1, (m - i - 1) * sizeof *idx);
-            m--;
-            if (i >= m) i = 0;
-            guard = 0;
-        } else {
-            i = (i + 1) % m;
-            guard++;
+            float x0 = fminf(a[0], fminf(b[0], c[0])), x1 = fmaxf(a[0], fmaxf(b[0], c[0]));
+            float y0 = fminf(a[1], fminf(b[1], c[1])), y1 = fmaxf(a[1], fmaxf(b[1], c[1]));
+            for (size_t k = 0; ear && k < nr; k++) {
+                uint32_t v = rl[k];
+                if (st[v] != 1 || v == ip || v == cur || v == in) continue;
+                const float *q = uv + 2 * v;
+                if (q[0] < x0 || q[0] > x1 || q[1] < y0 || q[1] > y1) continue;
+                if ((q[0] == a[0] && q[1] == a[1]) || (q[0] == b[0] && q[1] == b[1]) || (q[0] == c[0] && q[1] == c[1]))
+                    continue;
+                if (in_triangle(q, a, b, c)) ear = false;
+            }
         }
+        if (!ear) {
+            cur = in;
+            fails++;
+            continue;
+        }
+        tris[3 * out] = poly[ip]; tris[3 * out + 1] = poly[cur]; tris[3 * out + 2] = poly[in];
+        out++;
+        nxt[ip] = in;
+        prv[in] = ip;
+        st[cur] = 2;
+        m--;
+        fails = 0;
+        const uint32_t nb[2] = {ip, in};
+        for (int j = 0; j < 2; j++)
+            if (st[nb[j]] == 1 && cross2(uv + 2 * prv[nb[j]], uv + 2 * nb[j], uv + 2 * nxt[nb[j]]) > 0) {
+                st[nb[j]] = 0;
+                live_r--;
+            }
+        if (nr > 2 * live_r + 16) { /* compact: drop clipped and convex vertices */
+            size_t w = 0;
+            for (size_t k = 0; k < nr; k++)
+                if (st[rl[k]] == 1) rl[w++] = rl[k];
+            nr = w;
+        }
+        cur = in;
     }
     /* remainder (3 vertices, or a self-intersecting rest): fan */
-    for (size_t k = 1; k + 1 < m; k++) {
-        tris[3 * out] = poly[idx[0]]; tris[3 * out + 1] = poly[idx[k]]; tris[3 * out + 2] = poly[idx[k + 1]];
+    for (size_t k = 0, v = nxt[cur]; k + 2 < m; k++, v = nxt[v]) {
+        tris[3 * out] = poly[cur]; tris[3 * out + 1] = poly[v]; tris[3 * out + 2] = poly[nxt[v]];
         out++;
     }
     return out;

@@ -55,10 +55,10 @@ sy_result sy_corner_normals(const float *positions, size_t position_count, const
  * ear is found falls back to a fan for the remainder. Degenerate (zero-area) polygons give a fan.
  * Convex polygons are fanned directly (linear time); ear clipping of concave ones has a work budget
  * (about 2^26 point tests) after which the remainder is fanned, so hostile input cannot hang it.
- * scratch must hold 2 * n uint32 and 2 * n float (see SY_TRIANGULATE_SCRATCH). */
+ * scratch must hold 4 * n uint32 and 2 * n float (see SY_TRIANGULATE_SCRATCH). */
 size_t sy_triangulate_polygon(const float *positions, const uint32_t *poly, size_t n, uint32_t *tris,
                               void *scratch);
-#define SY_TRIANGULATE_SCRATCH(n) ((size_t)(n) * 2 * (sizeof(uint32_t) + sizeof(float)))
+#define SY_TRIANGULATE_SCRATCH(n) ((size_t)(n) * (4 * sizeof(uint32_t) + 2 * sizeof(float)))
 
 /* X3D primitives, tessellated into an indexed triangle primitive with normals and texcoords
  * following the X3D texture mapping of each primitive. The blobs in *out are owned by the caller

@@ -67,6 +67,10 @@ typedef struct loader {
     sy_bounds bounds; /* world bounds of the shapes (first placement), for light intensities */
     bool have_background;
     uint32_t file_serial;
+    size_t max_values;    /* numbers in one attribute: 4 * max_vertices (checked before allocating) */
+    sy_result limit_r;    /* first attribute over max_values (the load fails with it) */
+    sy_error limit_err;
+    const char *model_dir; /* the top-level file's folder: urls must stay inside it (or allowed_roots) */
 } loader;
 
 static void warn(loader *L, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -143,31 +147,102 @@ static char *attr(const xmlNode *el, const char *name)
     return (char *)xmlGetNoNsProp(el, (const xmlChar *)name);
 }
 
-/* Parses whitespace / comma separated numbers. Returns false (with *n = count parsed) on a bad
- * token; arrays are malloc()ed (NULL when empty). */
-static bool parse_numbers(const char *s, double **out, size_t *n)
+static bool is_sep(char c) { return c == ' ' || c == ',' || c == '\t' || c == '\n' || c == '\r'; }
+
+/* strtod for the common case, exactly: at most 15 significant decimal digits and a decimal
+ * exponent within +-22 make both the mantissa and the power of ten exact doubles, so one multiply
+ * or divide rounds correctly (Clinger's fast path), as strtod does. Anything else goes to strtod. */
+static double parse_double(const char *p, char **end)
+{
+    static const double pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                     1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+    const char *s = p;
+    bool neg = *s == '-';
+    if (*s == '-' || *s == '+') s++;
+    uint64_t m = 0;
+    int sig = 0, e10 = 0;
+    bool any = false;
+    for (; *s >= '0' && *s <= '9'; s++) {
+        any = true;
+        if (m || *s != '0') {
+            if (++sig > 15) return strtod(p, end);
+            m = m * 10 + (uint64_t)(*s - '0');
+        }
+    }
+    if (*s == '.')
+        for (s++; *s >= '0' && *s <= '9'; s++) {
+            any = true;
+            if (m || *s != '0') {
+                if (++sig > 15) return strtod(p, end);
+                m = m * 10 + (uint64_t)(*s - '0');
+            }
+            e10--;
+        }
+    if (!any) return strtod(p, end);
+    if (*s == 'e' || *s == 'E') {
+        const char *t = s + 1;
+        bool eneg = *t == '-';
+        if (*t == '-' || *t == '+') t++;
+        if (!(*t >= '0' && *t <= '9')) return strtod(p, end);
+        int x = 0;
+        for (; *t >= '0' && *t <= '9'; t++) {
+            if (x > 1000) return strtod(p, end);
+            x = x * 10 + (*t - '0');
+        }
+        e10 += eneg ? -x : x;
+        s = t;
+    }
+    if (e10 < -22 || e10 > 22) return strtod(p, end);
+    double v = e10 < 0 ? (double)m / pow10[-e10] : (double)m * pow10[e10];
+    *end = (char *)s;
+    return neg ? -v : v;
+}
+
+/* Parses whitespace / comma separated numbers. The tokens are counted first and checked against
+ * max before the array is allocated (once). Returns 1 on success, 0 on a bad token, -1 when there
+ * are more than max numbers (*n = the count) or memory runs out; arrays are malloc()ed (NULL when
+ * empty). */
+static int parse_numbers(const char *s, size_t max, double **out, size_t *n)
 {
     *out = NULL;
     *n = 0;
-    size_t cap = 0;
-    double *a = NULL;
+    size_t tokens = 0;
+    for (const char *p = s; *p;) {
+        while (is_sep(*p)) p++;
+        if (!*p) break;
+        tokens++;
+        while (*p && !is_sep(*p)) p++;
+    }
+    if (tokens > max) {
+        *n = tokens;
+        return -1;
+    }
+    if (!tokens) return 1;
+    size_t cap = tokens;
+    double *a = malloc(cap * sizeof *a);
+    if (!a) return -1;
     const char *p = s;
     for (;;) {
-        while (*p == ' ' || *p == ',' || *p == '\t' || *p == '\n' || *p == '\r') p++;
+        while (is_sep(*p)) p++;
         if (!*p) break;
         char *end;
         errno = 0;
-        double v = strtod(p, &end);
+        double v = parse_double(p, &end);
         if (end == p || !isfinite(v) || fabs(v) > 3.0e38) { /* must fit a float */
             free(a);
-            return false;
+            return 0;
         }
-        if (*n == cap) {
-            cap = cap ? cap * 2 : 16;
+        if (*n == cap) { /* "1-2" is one token and two numbers */
+            if (cap >= max) {
+                free(a);
+                *n = cap + 1;
+                return -1;
+            }
+            cap = cap > max / 2 ? max : cap * 2;
             double *q = realloc(a, cap * sizeof *a);
             if (!q) {
                 free(a);
-                return false;
+                return -1;
             }
             a = q;
         }
@@ -175,11 +250,12 @@ static bool parse_numbers(const char *s, double **out, size_t *n)
         p = end;
     }
     *out = a;
-    return true;
+    return 1;
 }
 
 /* Attribute `name` of el as a list of numbers into *v (malloc()ed, NULL when empty). Returns 1 when
- * present, 0 when absent, -1 (warned as "not a list of <what>; <then>") when malformed. */
+ * present, 0 when absent, -1 (warned as "not a list of <what>; <then>") when malformed. More than
+ * L->max_values numbers also give -1 and make the load fail (SY_ERR_LIMIT, file:line). */
 static int attr_numbers(loader *L, xfile *F, const xmlNode *el, const char *name, const char *what, const char *then,
                         double **v, size_t *n)
 {
@@ -187,9 +263,19 @@ static int attr_numbers(loader *L, xfile *F, const xmlNode *el, const char *name
     *n = 0;
     char *s = attr(el, name);
     if (!s) return 0;
-    bool ok = parse_numbers(s, v, n);
+    int ok = parse_numbers(s, L->max_values, v, n);
     xmlFree(s);
-    if (ok) return 1;
+    if (ok == 1) return 1;
+    if (ok < 0) {
+        size_t count = *n;
+        *n = 0;
+        if (!L->limit_r)
+            L->limit_r = count ? sy_error_set(&L->limit_err, SY_ERR_LIMIT, "%s:%d: %s.%s: %zu values exceed the limit of %zu (4 x max_vertices)",
+                                              F->path, line_of(el), ename(el), name, count, L->max_values)
+                               : sy_error_set(&L->limit_err, SY_ERR_OUT_OF_MEMORY, "%s:%d: %s.%s: out of memory",
+                                              F->path, line_of(el), ename(el), name);
+        return -1;
+    }
     warn(L, "%s:%d: %s.%s: not a list of %s; %s", F->path, line_of(el), ename(el), name, what, then);
     return -1;
 }
@@ -395,6 +481,27 @@ static bool resolve_url(const xfile *F, const char *u, char *out, size_t cap)
     return (size_t)snprintf(out, cap, "%s%s", F->dir, u) < cap;
 }
 
+/* Model files stay in their folder: the file that url u (joined: path) names must lie in the
+ * top-level model's folder or in allowed_roots (sy_path_confine). Returns SY_OK with out = the real
+ * path to read, SY_ERR_NOT_FOUND (the caller tries the next url), or the refusal in L->err (the
+ * load fails: a file outside the tree is never read). */
+static sy_result confine_url(loader *L, const xfile *F, const xmlNode *el, const char *u, const char *path, char *out,
+                             size_t cap)
+{
+    char *real = NULL;
+    sy_error e = {0};
+    sy_result r = sy_path_confine("url", u, path, L->model_dir, L->opt.allowed_roots, L->opt.allowed_root_count,
+                                  &real, &e);
+    if (r == SY_OK && strlen(real) >= cap) r = SY_ERR_NOT_FOUND;
+    if (r == SY_OK) memcpy(out, real, strlen(real) + 1);
+    free(real);
+    if (r != SY_OK && r != SY_ERR_NOT_FOUND) {
+        L->err = e;
+        sy_error_prefix(&L->err, "%s:%d: %s", F->path, line_of(el), ename(el));
+    }
+    return r;
+}
+
 static uint32_t map_filter(const char *s)
 {
     if (!s) return SY_FILTER_LINEAR;
@@ -444,7 +551,18 @@ static sy_result load_texture(loader *L, xfile *F, const xmlNode *el, bool srgb,
             snprintf(why, sizeof why, "data: URLs are not supported");
             continue;
         }
-        if (!resolve_url(F, u, path, sizeof path) || !regular_file(path, why, sizeof why)) continue;
+        char joined[4096];
+        if (!resolve_url(F, u, joined, sizeof joined)) continue;
+        sy_result cr = confine_url(L, F, el, u, joined, path, sizeof path);
+        if (cr == SY_ERR_NOT_FOUND) {
+            snprintf(why, sizeof why, "%.400s: not found", joined);
+            continue;
+        }
+        if (cr != SY_OK) {
+            xmlFree(urls);
+            return cr;
+        }
+        if (!regular_file(path, why, sizeof why)) continue;
         void *bytes;
         size_t size;
         sy_error ferr = {0};
@@ -1358,7 +1476,8 @@ static sy_result build_geometry(loader *L, xfile *F, const xmlNode *el, const xm
         texture_transform(L, F, ttel, g.tt);
         if (!read_sources(L, F, el, &g)) {
             geom_src_free(&g);
-            return SY_OK;
+            if (L->limit_r) L->err = L->limit_err;
+            return L->limit_r;
         }
         if (!strcmp(n, "Extrusion")) {
             geom_src_free(&g); /* an Extrusion has no Coordinate etc.: its fields build the sources */
@@ -1378,6 +1497,10 @@ static sy_result build_geometry(loader *L, xfile *F, const xmlNode *el, const xm
 
         } else {
             r = build_triset(L, F, el, &g, &c, false, &built);
+        }
+        if (!r && L->limit_r) { /* an attribute over the value limit: the load fails */
+            r = L->limit_r;
+            L->err = L->limit_err;
         }
         if (!r && built) {
             r = emit(L, F, el, &g, &c, prim);
@@ -1780,7 +1903,15 @@ static sy_result visit_inline(loader *L, xfile *F, const xmlNode *el, sy_node h)
         if (!u[0] || is_remote(u)) continue;
         char *hash = strchr(u, '#');
         if (hash) *hash = '\0';
-        if (!resolve_url(F, u, path, sizeof path)) continue;
+        char joined[4096];
+        if (!resolve_url(F, u, joined, sizeof joined)) continue;
+        r = confine_url(L, F, el, u, joined, path, sizeof path);
+        if (r == SY_ERR_NOT_FOUND) {
+            r = SY_OK;
+            warn(L, "%s:%d: Inline '%s': not found", F->path, line_of(el), joined);
+            continue;
+        }
+        if (r) break;
         sy_node sub = {0};
         r = load_file(L, path, NULL, 0, NULL, F, &sub, el, F);
         if (r) break;
@@ -2066,6 +2197,7 @@ static sy_result load_common(const char *path, const void *mem, size_t size, con
     if (!L.opt.max_vertices) L.opt.max_vertices = (size_t)1 << 27;
     if (!L.opt.max_image_pixels) L.opt.max_image_pixels = (uint64_t)1 << 26;
     if (!L.opt.max_inline_depth) L.opt.max_inline_depth = 16;
+    L.max_values = L.opt.max_vertices > SIZE_MAX / 4 ? SIZE_MAX : L.opt.max_vertices * 4;
     L.bounds = sy_bounds_empty();
     xmlInitParser();
     L.cache = xmlHashCreate(256);
@@ -2074,7 +2206,26 @@ static sy_result load_common(const char *path, const void *mem, size_t size, con
     sy_result r = SY_OK;
     if (!L.cache || !L.inline_roots || !L.warned) r = sy_error_set(&L.err, SY_ERR_OUT_OF_MEMORY, "out of memory");
     sy_node root = {0};
+    char *model_dir = NULL;
+    if (mem) {
+        model_dir = strdup(base_dir ? base_dir : "");
+    } else {
+        const char *slash = strrchr(path, '/');
+        size_t n = slash ? (size_t)(slash - path) + 1 : 0;
+        if ((model_dir = malloc(n + 1))) {
+            memcpy(model_dir, path, n);
+            model_dir[n] = '\0';
+        }
+    }
+    L.model_dir = model_dir;
+    if (!model_dir && !r) r = sy_error_set(&L.err, SY_ERR_OUT_OF_MEMORY, "out of memory");
     if (!r) r = load_file(&L, path, mem, size, base_dir, NULL, &root, NULL, NULL);
+    free(model_dir);
+    L.model_dir = NULL;
+    if (!r && L.limit_r) {
+        r = L.limit_r;
+        L.err = L.limit_err;
+    }
     if (!r) {
         finish_lights(&L);
         info->root = root;

@@ -71,6 +71,12 @@ typedef struct sy_x3d_options {
     size_t max_vertices;       /* per geometry node, after triangulation; 0 = 1 << 27 */
     uint64_t max_image_pixels; /* width * height; 0 = 1 << 26 */
     uint32_t max_inline_depth; /* nesting of Inline files; 0 = 16 */
+    /* Files named by Inline and ImageTexture urls must lie in the top-level file's folder (after
+     * symbolic links and ".."; sy_path_confine in sy_file.h) or in one of these folders; absolute
+     * paths and file: URLs only in these. A refused url fails the load (SY_ERR_LIMIT) with a
+     * message naming the file, line and url. Borrowed for the call. */
+    const char *const *allowed_roots;
+    size_t allowed_root_count;
 } sy_x3d_options;
 
 #define SY_X3D_MAX_WARNINGS 32

@@ -253,7 +253,12 @@ sy_gl_result sy_gl_context_create(sy_gl_provider provider, uint32_t window_w, ui
 void sy_gl_context_destroy(sy_gl_context *c)
 {
     if (!c) return;
-    if (c->osmesa) c->om.destroy(c->osmesa);
+    if (c->osmesa) {
+        /* release it first: a context destroyed while current keeps its framebuffer referenced
+         * by the thread's binding, and Mesa never frees either */
+        c->om.make_current(NULL, NULL, 0, 0, 0);
+        c->om.destroy(c->osmesa);
+    }
     /* libOSMesa stays loaded: Mesa keeps process-wide state (its glapi, llvmpipe threads) */
     if (c->egl_context != EGL_NO_CONTEXT) {
         eglMakeCurrent(c->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);

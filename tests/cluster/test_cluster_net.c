@@ -7,20 +7,22 @@
  * tiles to the others within the same frame and rejoins with a snapshot. Protocol 2: the blob cache
  * (a returning client sends no payload; LRU eviction under a small budget), BLOB_REQUEST / BLOBS
  * (wrong, unrequested and unexpected payloads), half tiles, the replica slot limit, two clients
- * beside garbage / stalled / never-reading peers, and the authentication back-off.
+ * beside garbage / stalled / never-reading peers, and the authentication back-off. Protocol 3:
+ * raw peers speak plain TCP (raw_peer.h); a truncated HELLO is closed at the handshake deadline,
+ * a header announcing more than the handshake budget is refused from the header alone, and
+ * messages larger than a frame travel in frames both ways (64 KiB frames, an exact image).
  *
  *   test_cluster_net SERVER_EXE WORK_DIR
  * Every server is started with --max-lifetime and stopped with SIGTERM (SIGKILL after 5 s), and
  * every wait is bounded, so nothing outlives the test. */
 #include "../core/check.h"
 #include "coop_double.h"
+#include "raw_peer.h"
+#include "server_proc.h"
 #include "sy_cluster.h"
 #include "sy_demo.h"
 #include "sy_mediators.h"
 #include "sy_viewport.h"
-
-#include <nng/nng.h>
-#include <nng/protocol/reqrep0/req.h>
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -35,109 +37,6 @@
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
-
-static const char *g_exe, *g_dir;
-static int g_serial;
-
-typedef struct server {
-    pid_t pid;
-    int port;
-    int serial;
-    char url[64];
-    char log[512];
-} server;
-
-static void sleep_ms(int ms)
-{
-    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
-    nanosleep(&ts, NULL);
-}
-
-/* port 0 = any free port; extra: NULL or up to 4 more "--option", "value" words, NULL-terminated */
-static int start_server_args(const char *secret, int port, const char *const *extra, server *out)
-{
-    char pf[512], listen[64];
-    snprintf(pf, sizeof pf, "%s/port%d", g_dir, ++g_serial);
-    snprintf(out->log, sizeof out->log, "%s/server%d.log", g_dir, g_serial);
-    snprintf(listen, sizeof listen, "tcp://127.0.0.1:%d", port);
-    unlink(pf);
-    pid_t pid = fork();
-    CHECK(pid >= 0);
-    if (pid == 0) {
-        int fd = open(out->log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fd >= 0) dup2(fd, 2);
-        char present[512];
-        snprintf(present, sizeof present, "%s/present%d.raw", g_dir, g_serial);
-        const char *args[24] = {g_exe, "--port-file", pf, "--listen", listen, "--max-lifetime", "120", "--present", present};
-        int n = 9;
-        if (secret) args[n++] = "--secret", args[n++] = secret;
-        for (int k = 0; extra && extra[k] && k < 8; ++k) args[n++] = extra[k];
-        execv(g_exe, (char *const *)args);
-        _exit(127);
-    }
-    out->pid = pid;
-    out->serial = g_serial;
-    for (int i = 0; i < 400; ++i) { /* at most 20 s (ASan builds start slowly) */
-        FILE *f = fopen(pf, "r");
-        int p = 0;
-        if (f) {
-            if (fscanf(f, "%d", &p) != 1) p = 0;
-            fclose(f);
-        }
-        if (p > 0) {
-            out->port = p;
-            snprintf(out->url, sizeof out->url, "tcp://127.0.0.1:%d", p);
-            return 0;
-        }
-        int st;
-        if (waitpid(pid, &st, WNOHANG) == pid) {
-            fprintf(stderr, "server exited early, see %s\n", out->log);
-            out->pid = 0;
-            return 1;
-        }
-        sleep_ms(50);
-    }
-    fprintf(stderr, "server did not report its port\n");
-    return 1;
-}
-
-static int start_server(const char *secret, int port, server *out)
-{
-    return start_server_args(secret, port, NULL, out);
-}
-
-static void stop_server(server *s)
-{
-    if (s->pid <= 0) return;
-    kill(s->pid, SIGCONT);
-    kill(s->pid, SIGTERM);
-    for (int i = 0; i < 100; ++i) {
-        if (waitpid(s->pid, NULL, WNOHANG) == s->pid) {
-            s->pid = 0;
-            return;
-        }
-        sleep_ms(50);
-    }
-    kill(s->pid, SIGKILL);
-    waitpid(s->pid, NULL, 0);
-    s->pid = 0;
-}
-
-static bool log_contains(const server *s, const char *needle)
-{
-    for (int i = 0; i < 40; ++i) { /* the server may still be writing */
-        FILE *f = fopen(s->log, "r");
-        if (f) {
-            static char buf[1 << 16];
-            size_t n = fread(buf, 1, sizeof buf - 1, f);
-            fclose(f);
-            buf[n] = 0;
-            if (strstr(buf, needle)) return true;
-        }
-        sleep_ms(50);
-    }
-    return false;
-}
 
 /* ---- the scene and local references ---- */
 typedef struct fixture {
@@ -421,64 +320,41 @@ static int test_auth(fixture *fx, server *all)
     return 0;
 }
 
-/* one raw request on a fresh req socket; returns the ERROR reason (or "" for another reply) */
+/* one raw request on a fresh connection; returns the ERROR reason (or "" for another reply) */
 static int raw_exchange(const server *s, const void *data, size_t size, char *reason, size_t cap)
 {
-    nng_socket sock;
-    CHECK(nng_req0_open(&sock) == 0);
-    nng_socket_set_ms(sock, NNG_OPT_RECVTIMEO, 10000);
-    nng_socket_set_ms(sock, NNG_OPT_SENDTIMEO, 10000);
-    CHECK(nng_dial(sock, s->url, NULL, 0) == 0);
-    CHECK(nng_send(sock, (void *)data, size, 0) == 0);
-    void *buf = NULL;
-    size_t n = 0;
-    int rv = nng_recv(sock, &buf, &n, NNG_FLAG_ALLOC);
-    CHECK_MSG(rv == 0, "no reply: %s", nng_strerror(rv));
+    int fd = raw_connect(s->port, 10000);
+    CHECK(fd >= 0);
+    CHECK(raw_write_all(fd, data, size));
     sy_cluster_msg m;
-    sy_error e = {0};
-    CHECK_OK(sy_cluster_decode(buf, n, NULL, &m, &e), e);
+    uint8_t *raw = NULL;
+    int rc = raw_recv_msg(fd, 1 << 20, &m, &raw);
+    CHECK_MSG(rc == 0, "no reply (%d)", rc);
     snprintf(reason, cap, "%s", m.header.type == SY_CLUSTER_ERROR ? m.u.error.reason : "");
     sy_cluster_msg_free(&m);
-    nng_free(buf, n);
-    nng_close(sock);
+    free(raw);
+    close(fd);
     return 0;
 }
 
 /* A HELLO as a raw client sends it first (sequence 1, untagged). */
 static sy_cluster_msg hello_msg(void)
 {
-    sy_cluster_msg m;
-    memset(&m, 0, sizeof m);
-    m.header.type = SY_CLUSTER_HELLO;
-    m.header.seq = 1;
-    strcpy(m.u.hello.name, "raw test");
-    return m;
-}
-
-static int send_frame(nng_socket sock, const sy_cluster_msg *m)
-{
-    sy_error e = {0};
-    sy_cluster_buf b = {0};
-    CHECK_OK(sy_cluster_encode(m, 0, &b, &e), e);
-    CHECK(nng_send(sock, b.data, b.size, 0) == 0);
-    sy_cluster_buf_free(&b);
-    return 0;
+    return raw_hello();
 }
 
 /* Sends one untagged frame; *type / why = the reply's type and ERROR reason ("" for another reply). */
-static int raw_call(nng_socket sock, const sy_cluster_msg *m, uint32_t *type, char *why, size_t cap)
+static int raw_call(int fd, const sy_cluster_msg *m, uint32_t *type, char *why, size_t cap)
 {
-    if (send_frame(sock, m)) return 1;
-    sy_error e = {0};
-    void *buf = NULL;
-    size_t n = 0;
-    CHECK(nng_recv(sock, &buf, &n, NNG_FLAG_ALLOC) == 0);
+    CHECK(raw_send_msg(fd, m) == 0);
     sy_cluster_msg r;
-    CHECK_OK(sy_cluster_decode(buf, n, NULL, &r, &e), e);
+    uint8_t *raw = NULL;
+    int rc = raw_recv_msg(fd, 1 << 26, &r, &raw);
+    CHECK_MSG(rc == 0, "no reply to %s (%d)", sy_cluster_msg_type_name(m->header.type), rc);
     if (type) *type = r.header.type;
     snprintf(why, cap, "%s", r.header.type == SY_CLUSTER_ERROR ? r.u.error.reason : "");
     sy_cluster_msg_free(&r);
-    nng_free(buf, n);
+    free(raw);
     return 0;
 }
 
@@ -487,22 +363,20 @@ static int raw_call(nng_socket sock, const sy_cluster_msg *m, uint32_t *type, ch
  * another reply). */
 static int raw_steps(const server *s, sy_cluster_msg *msgs, int n, uint32_t *types, char (*reasons)[SY_CLUSTER_REASON_MAX])
 {
-    nng_socket sock;
-    CHECK(nng_req0_open(&sock) == 0);
-    nng_socket_set_ms(sock, NNG_OPT_RECVTIMEO, 10000);
-    CHECK(nng_dial(sock, s->url, NULL, 0) == 0);
+    int fd = raw_connect(s->port, 10000);
+    CHECK(fd >= 0);
     sy_cluster_msg hello = hello_msg();
     char why[SY_CLUSTER_REASON_MAX];
-    if (raw_call(sock, &hello, NULL, why, sizeof why)) return 1;
+    if (raw_call(fd, &hello, NULL, why, sizeof why)) return 1;
     for (int i = 0; i < n; ++i) {
         msgs[i].header.seq = (uint64_t)i + 2;
-        if (raw_call(sock, &msgs[i], &types[i], reasons[i], SY_CLUSTER_REASON_MAX)) return 1;
+        if (raw_call(fd, &msgs[i], &types[i], reasons[i], SY_CLUSTER_REASON_MAX)) return 1;
     }
-    nng_close(sock);
+    close(fd);
     return 0;
 }
 
-/* HELLO then one more message on the same socket (no secret: no tags) */
+/* HELLO then one more message on the same connection (no secret: no tags) */
 static int raw_session(const server *s, const sy_cluster_msg *second, char *reason, size_t cap)
 {
     sy_cluster_msg m = *second;
@@ -521,24 +395,25 @@ static int test_bad_messages(fixture *fx, server *all)
     for (int i = 0; i < 100; ++i) garbage[i] = (uint8_t)(i * 37 + 11);
     if (raw_exchange(s, garbage, sizeof garbage, why, sizeof why)) return 1;
     CHECK_MSG(strstr(why, "magic"), "%s", why);
-    /* a valid HELLO, truncated; with a lying size; with version 2 */
+    /* a valid HELLO, truncated (then silence: closed at the handshake deadline, 1 s here); with a
+     * lying size (refused from the header alone); from a version-2 peer */
     sy_error e = {0};
-    sy_cluster_msg hello;
-    memset(&hello, 0, sizeof hello);
-    hello.header.type = SY_CLUSTER_HELLO;
-    hello.header.seq = 1;
+    sy_cluster_msg hello = hello_msg();
     sy_cluster_buf b = {0};
     CHECK_OK(sy_cluster_encode(&hello, 0, &b, &e), e);
-    if (raw_exchange(s, b.data, b.size - 3, why, sizeof why)) return 1;
-    CHECK_MSG(strstr(why, "announces"), "%s", why);
+    int fd = raw_connect(s->port, 10000);
+    CHECK(fd >= 0 && raw_write_all(fd, b.data, b.size - 3));
+    CHECK_MSG(raw_closed_within(fd, 4000), "a truncated HELLO kept its connection past the handshake deadline");
+    close(fd);
+    CHECK(log_contains(s, "no HELLO within the 1000 ms handshake deadline"));
     b.data[12] = 0xFF, b.data[13] = 0xFF, b.data[14] = 0xFF, b.data[15] = 0x7F;
     if (raw_exchange(s, b.data, b.size, why, sizeof why)) return 1;
-    CHECK_MSG(strstr(why, "announces"), "%s", why);
+    CHECK_MSG(strstr(why, "announces 2147483671 bytes, this connection accepts at most 1024"), "%s", why);
     b.size = 0;
     CHECK_OK(sy_cluster_encode(&hello, 0, &b, &e), e);
-    b.data[4] = 1; /* a version-1 peer */
+    b.data[4] = 2; /* a version-2 peer */
     if (raw_exchange(s, b.data, b.size, why, sizeof why)) return 1;
-    CHECK_MSG(strstr(why, "version 1, this peer speaks 2"), "%s", why);
+    CHECK_MSG(strstr(why, "version 2, this peer speaks 3"), "%s", why);
     /* requests out of order: RENDER before HELLO; RENDER before any scene; non-snapshot first scene */
     sy_cluster_msg r;
     memset(&r, 0, sizeof r);
@@ -596,7 +471,7 @@ static int test_bad_messages(fixture *fx, server *all)
     free(data);
     sy_cluster_buf_free(&b);
     CHECK(log_contains(s, "rejected: cluster message: bad magic"));
-    CHECK(log_contains(s, "protocol version 1"));
+    CHECK(log_contains(s, "protocol version 2"));
     /* the server still renders correct images for a well-behaved client */
     sy_layer ref = {0}, out = {0};
     sy_camera_view view;
@@ -886,31 +761,26 @@ typedef struct spewer {
     int replies, failures;
 } spewer;
 
-/* sends garbage frames on one connection as fast as the server answers them */
+/* sends garbage as fast as the server answers it: a connection, 512 bytes, the ERROR, closed */
 static void *spew(void *p)
 {
     spewer *sp = p;
-    nng_socket sock;
-    if (nng_req0_open(&sock) != 0) return NULL;
-    nng_socket_set_ms(sock, NNG_OPT_RECVTIMEO, 20000);
-    if (nng_dial(sock, sp->s->url, NULL, 0) != 0) {
-        sp->failures++;
-        nng_close(sock);
-        return NULL;
-    }
     uint8_t junk[512];
     for (uint32_t k = 0; !sp->stop && k < 100000; ++k) {
         for (size_t i = 0; i < sizeof junk; ++i) junk[i] = (uint8_t)(k * 131 + i * 7);
-        void *buf = NULL;
-        size_t n = 0;
-        if (nng_send(sock, junk, sizeof junk, 0) != 0 || nng_recv(sock, &buf, &n, NNG_FLAG_ALLOC) != 0) {
+        int fd = raw_connect(sp->s->port, 20000);
+        sy_cluster_msg m;
+        uint8_t *raw = NULL;
+        if (fd < 0 || !raw_write_all(fd, junk, sizeof junk) || raw_recv_msg(fd, 1 << 16, &m, &raw) != 0) {
+            if (fd >= 0) close(fd);
             sp->failures++;
             break;
         }
-        nng_free(buf, n);
+        sy_cluster_msg_free(&m);
+        free(raw);
+        close(fd);
         sp->replies++;
     }
-    nng_close(sock);
     return NULL;
 }
 
@@ -921,17 +791,13 @@ static int test_several_clients(fixture *fx, server *s)
     sy_error e = {0};
     const server *srv = &s[3];
     /* a stalled TCP peer: half a header, then silence */
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)srv->port)};
-    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    CHECK(fd >= 0 && connect(fd, (struct sockaddr *)&sa, sizeof sa) == 0);
-    CHECK(write(fd, "\0\0\0\0SP", 6) == 6);
+    int fd = raw_connect(srv->port, 10000);
+    CHECK(fd >= 0 && raw_write_all(fd, "SYCP\3\0", 6));
     /* a peer that asks and never reads */
-    nng_socket mute;
-    CHECK(nng_req0_open(&mute) == 0);
-    CHECK(nng_dial(mute, srv->url, NULL, 0) == 0);
+    int mute = raw_connect(srv->port, 10000);
+    CHECK(mute >= 0);
     sy_cluster_msg hello = hello_msg();
-    if (send_frame(mute, &hello)) return 1;
+    CHECK(raw_send_msg(mute, &hello) == 0);
     spewer sp = {srv, 0, 0, 0};
     pthread_t th;
     CHECK(pthread_create(&th, NULL, spew, &sp) == 0);
@@ -959,7 +825,7 @@ static int test_several_clients(fixture *fx, server *s)
     CHECK(log_contains(srv, "bad magic"));
     sy_cluster_client_destroy(c1);
     sy_cluster_client_destroy(c2);
-    nng_close(mute);
+    close(mute);
     close(fd);
     sy_layer_destroy(&ref);
     sy_layer_destroy(&out1);
@@ -978,13 +844,12 @@ static int test_auth_backoff(fixture *fx, server *unused)
     const char *extra[] = {"--auth-backoff-ms", "1000", NULL};
     if (start_server_args("s3cret", 0, extra, &sv)) return 1;
     sy_error e = {0};
-    nng_socket sock[2];
+    int sock[2];
     char why[2][SY_CLUSTER_REASON_MAX];
     sy_cluster_msg m;
     for (int i = 0; i < 2; ++i) { /* both past HELLO before the first failure */
-        CHECK(nng_req0_open(&sock[i]) == 0);
-        nng_socket_set_ms(sock[i], NNG_OPT_RECVTIMEO, 10000);
-        CHECK(nng_dial(sock[i], sv.url, NULL, 0) == 0);
+        sock[i] = raw_connect(sv.port, 10000);
+        CHECK(sock[i] >= 0);
         m = hello_msg();
         if (raw_call(sock[i], &m, NULL, why[i], sizeof why[i])) return 1;
         CHECK_MSG(why[i][0] == 0, "HELLO refused: %s", why[i]);
@@ -994,7 +859,7 @@ static int test_auth_backoff(fixture *fx, server *unused)
         m.header.type = SY_CLUSTER_AUTH;
         m.header.seq = 2;
         if (raw_call(sock[i], &m, NULL, why[i], sizeof why[i])) return 1;
-        nng_close(sock[i]);
+        close(sock[i]);
     }
     CHECK_MSG(strstr(why[0], "wrong secret (127.0.0.1 refused for 1000 ms)"), "%s", why[0]);
     CHECK_MSG(strstr(why[1], "wrong secret (127.0.0.1 refused for 2000 ms)"), "%s", why[1]);
@@ -1007,6 +872,64 @@ static int test_auth_backoff(fixture *fx, server *unused)
     CHECK_MSG(c != NULL, "after the back-off: %s", e.message);
     sy_cluster_client_destroy(c);
     stop_server(&sv);
+    return 0;
+}
+
+/* Protocol 3: messages larger than a frame travel in frames. A server that takes frames of at
+ * most 64 KiB and a client that takes 64 KiB: the demo snapshot's BLOBS (117 KB of payloads) and
+ * the TILES of a 320x240 float image with depth (far over 64 KiB) are chunked both ways, and the
+ * image is still the local render bit for bit; a change list larger than the server's message
+ * limit is refused by the client, naming both sizes. */
+static int test_chunked(fixture *fx, server *unused)
+{
+    (void)unused;
+    server sv;
+    memset(&sv, 0, sizeof sv);
+    const char *extra[] = {"--max-frame-kb", "64", "--max-message-mb", "1", NULL};
+    if (start_server_args("s3cret", 0, extra, &sv)) return 1;
+    fixture big = *fx;
+    big.w = 320, big.h = 240;
+    sy_error e = {0};
+    sy_layer ref = {0}, out = {0};
+    sy_camera_view view;
+    if (local_render(&big, "whitted", SY_EYE_MONO, &ref, &view)) return 1;
+    const char *urls[1] = {sv.url};
+    sy_cluster_client_opts co = {.urls = urls, .url_count = 1, .secret = (const uint8_t *)"s3cret", .secret_len = 6,
+                                 .timeout_ms = 30000, .connect_timeout_ms = 3000, .max_frame = 64 << 10};
+    sy_cluster_client *c = NULL;
+    CHECK_OK(sy_cluster_client_create(big.scene, &co, &c, &e), e);
+    CHECK_OK(sy_layer_create(big.w, big.h, &out, &e), e);
+    sy_cluster_frame f = make_frame(&big, SY_CLUSTER_SORT_FIRST, "whitted", &view);
+    sy_cluster_frame_stats st;
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    printf("chunked: frames <= 64 KiB: %llu blob payload bytes sent, %llu bytes back, image exact\n",
+           (unsigned long long)st.blob_bytes, (unsigned long long)st.bytes_received);
+    CHECK(st.blob_bytes > 64 * 1024 && st.bytes_received > 64 * 1024);
+    CHECK(same_region(&out, 0, &ref, big.w, big.h));
+    /* a 2 MiB texture: its BLOBS message exceeds the server's 1 MiB message limit */
+    sy_texture tex;
+    static uint8_t px[2 << 20];
+    for (size_t i = 0; i < sizeof px; ++i) px[i] = (uint8_t)(i * 2654435761u >> 13);
+    sy_blob *pb = NULL;
+    CHECK_OK(sy_blob_create_copy(px, sizeof px, &pb, &e), e);
+    CHECK_OK(sy_texture_create(big.scene, "too-big", &tex, &e), e);
+    sy_image_info ii = {1024, 512, 4, SY_PIXEL_U8_LINEAR};
+    CHECK_OK(sy_texture_set_image(big.scene, tex, &ii, pb, &e), e);
+    sy_blob_release(pb);
+    CHECK_OK(sy_scene_commit(big.scene, NULL, &e), e);
+    sy_cluster_client_set_timeout(c, 5000);
+    CHECK(sy_cluster_client_render(c, &f, &out, &st, &e) != SY_OK);
+    CHECK_MSG(strstr(e.message, "exceeds the server's message limit of 1048576"), "%s", e.message);
+    CHECK_OK(sy_object_destroy(big.scene, SY_TYPE_TEXTURE, tex.id, &e), e);
+    CHECK_OK(sy_scene_commit(big.scene, NULL, &e), e);
+    sy_cluster_client_set_timeout(c, 30000);
+    sy_layer_clear(&out);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e); /* reconnected: a snapshot again */
+    CHECK(same_region(&out, 0, &ref, big.w, big.h));
+    sy_cluster_client_destroy(c);
+    stop_server(&sv);
+    sy_layer_destroy(&ref);
+    sy_layer_destroy(&out);
     return 0;
 }
 
@@ -1093,7 +1016,7 @@ int main(int argc, char **argv)
     memset(s, 0, sizeof s);
     int failed = 0;
     if (start_server("s3cret", 0, &s[0]) || start_server("s3cret", 0, &s[1]) || start_server("s3cret", 0, &s[2]) ||
-        start_server(NULL, 0, &s[3])) {
+        start_server_args(NULL, 0, (const char *const[]){"--handshake-timeout-ms", "1000", NULL}, &s[3])) {
         failed = 1;
     } else {
         static const struct {
@@ -1111,6 +1034,7 @@ int main(int argc, char **argv)
                      {"replica slot limit", test_slot_limit},
                      {"several clients", test_several_clients},
                      {"authentication back-off", test_auth_backoff},
+                     {"chunked transfers", test_chunked},
                      {"faults", test_faults}};
         for (size_t i = 0; i < sizeof tests / sizeof tests[0]; ++i) {
             int r = tests[i].run(&fx, s);

@@ -36,6 +36,8 @@ static sy_cluster_msg sample(uint32_t type)
     case SY_CLUSTER_CHALLENGE:
         for (int i = 0; i < 32; ++i) m.u.hello.nonce[i] = (uint8_t)(i * 7);
         m.u.hello.flags = 1;
+        m.u.hello.max_frame = 1u << 20;
+        m.u.hello.max_message = (uint64_t)3 << 30;
         strcpy(m.u.hello.name, "node-1");
         break;
     case SY_CLUSTER_AUTH:
@@ -112,6 +114,7 @@ static int test_round_trip(void)
         CHECK_OK(sy_cluster_decode(b.data, b.size, NULL, &d, &e), e);
         CHECK(d.header.type == t && d.header.seq == 7 && d.header.version == SY_CLUSTER_VERSION);
         if (t == SY_CLUSTER_HELLO) CHECK(!strcmp(d.u.hello.name, "node-1") && d.u.hello.nonce[3] == 21 && d.u.hello.flags == 1);
+        if (t == SY_CLUSTER_CHALLENGE) CHECK(d.u.hello.max_frame == 1u << 20 && d.u.hello.max_message == (uint64_t)3 << 30);
         if (t == SY_CLUSTER_AUTH) CHECK(d.u.auth.mac[0] == 255 && d.u.auth.mac[31] == 224);
         if (t == SY_CLUSTER_SCENE) CHECK(d.u.scene.frame == 42 && d.u.scene.changes_size == 100 && d.u.scene.flags == 1);
         if (t == SY_CLUSTER_SWAP) CHECK(d.u.ack.frame == 99 && d.u.ack.objects == 5);
@@ -163,9 +166,9 @@ static int test_bad_headers(void)
     CHECK(strstr(e.message, "magic"));
     /* wrong version */
     memcpy(c, b.data, b.size);
-    c[4] = 1; /* a version-1 peer */
+    c[4] = 2; /* a version-2 peer */
     CHECK_ERR(sy_cluster_decode(c, b.size, NULL, &d, &e), SY_ERR_UNSUPPORTED, e);
-    CHECK(strstr(e.message, "version 1, this peer speaks 2"));
+    CHECK(strstr(e.message, "version 2, this peer speaks 3"));
     /* unknown type, unknown flags */
     memcpy(c, b.data, b.size);
     c[6] = 200;
@@ -241,6 +244,161 @@ static int test_bad_headers(void)
     CHECK_ERR(sy_cluster_decode(c, b.size, NULL, &d, &e), SY_ERR_PARSE, e);
     CHECK(strstr(e.message, "runs past"));
     free(c);
+    sy_cluster_buf_free(&b);
+    return 0;
+}
+
+/* Reads buf as a stream of frames the way a receiver does (the first message under the
+ * handshake budget, the rest under an open, untagged session's), decoding every complete message
+ * into out[*count] (at most cap; the caller frees them). Returns 0 when the whole stream was
+ * consumed, 1 on the first refused frame (err says why). */
+static int stream_messages(const uint8_t *buf, size_t n, sy_cluster_msg *out, uint32_t cap, uint32_t *count,
+                           uint8_t **bodies, sy_error *err)
+{
+    const sy_cluster_budget hs = {SY_CLUSTER_HANDSHAKE_MAX_FRAME, SY_CLUSTER_HANDSHAKE_MAX_FRAME, false, false};
+    const sy_cluster_budget open = {1u << 16, 1u << 20, true, false};
+    const sy_cluster_budget *b = &hs;
+    size_t pos = 0, so_far = 0;
+    uint32_t type = 0;
+    uint8_t *body = NULL;
+    sy_cluster_header first = {0};
+    *count = 0;
+    while (pos < n) {
+        sy_cluster_header h;
+        size_t follow;
+        if (n - pos < SY_CLUSTER_HEADER_SIZE) return sy_error_set(err, SY_ERR_PARSE, "stream ends inside a header"), 1;
+        if (sy_cluster_parse_header(buf + pos, &h, err) != SY_OK) return 1;
+        if (sy_cluster_frame_check(&h, b, so_far, type, &follow, err) != SY_OK) return 1;
+        pos += SY_CLUSTER_HEADER_SIZE;
+        if (follow > n - pos) return sy_error_set(err, SY_ERR_PARSE, "stream ends inside a frame"), 1;
+        uint8_t *nb = realloc(body, so_far + h.body_size + 1);
+        if (!nb) return 1;
+        body = nb;
+        memcpy(body + so_far, buf + pos, h.body_size);
+        pos += follow;
+        if (!type) first = h;
+        type = h.type;
+        so_far += h.body_size;
+        if (h.flags & SY_CLUSTER_FLAG_MORE) continue;
+        if (*count == cap || sy_cluster_decode_body(&first, body, so_far, NULL, &out[*count], err) != SY_OK) {
+            free(body);
+            return 1;
+        }
+        bodies[(*count)++] = body;
+        body = NULL;
+        so_far = 0;
+        type = 0;
+        b = &open;
+    }
+    free(body);
+    return type ? (sy_error_set(err, SY_ERR_PARSE, "stream ends inside a chunked message"), 1) : 0;
+}
+
+/* Appends msg to out as frames of at most chunk body bytes (untagged, sequence numbers from *seq). */
+static int append_chunked(const sy_cluster_msg *msg, size_t chunk, uint64_t *seq, sy_cluster_buf *out)
+{
+    sy_error e = {0};
+    sy_cluster_buf one = {0};
+    CHECK_OK(sy_cluster_encode(msg, 0, &one, &e), e);
+    const uint8_t *body = one.data + SY_CLUSTER_HEADER_SIZE;
+    size_t n = one.size - SY_CLUSTER_HEADER_SIZE, off = 0;
+    do {
+        size_t c = n - off < chunk ? n - off : chunk;
+        uint8_t hdr[SY_CLUSTER_HEADER_SIZE];
+        sy_cluster_header_write(hdr, msg->header.type, off + c < n ? SY_CLUSTER_FLAG_MORE : 0u, (uint32_t)c, ++*seq);
+        size_t need = out->size + sizeof hdr + c;
+        if (need > out->cap) {
+            uint8_t *d = realloc(out->data, need);
+            CHECK(d != NULL);
+            out->data = d;
+            out->cap = need;
+        }
+        memcpy(out->data + out->size, hdr, sizeof hdr);
+        memcpy(out->data + out->size + sizeof hdr, body + off, c);
+        out->size = need;
+        off += c;
+    } while (off < n);
+    sy_cluster_buf_free(&one);
+    return 0;
+}
+
+/* Stream framing (protocol 3): a header is judged against the receiver's budget before a byte of
+ * its body is read or allocated; a message split into frames reassembles to the same message. */
+static int test_framing(void)
+{
+    sy_error e = {0};
+    sy_cluster_header h;
+    size_t follow = 0;
+    uint8_t hdr[SY_CLUSTER_HEADER_SIZE];
+    const sy_cluster_budget hs = {SY_CLUSTER_HANDSHAKE_MAX_FRAME, SY_CLUSTER_HANDSHAKE_MAX_FRAME, false, false};
+    const sy_cluster_budget open = {1u << 16, 1u << 20, true, true};
+    /* a HELLO announcing 256 MiB: refused from its header alone */
+    sy_cluster_header_write(hdr, SY_CLUSTER_HELLO, 0, 256u << 20, 1);
+    CHECK_OK(sy_cluster_parse_header(hdr, &h, &e), e);
+    CHECK_ERR(sy_cluster_frame_check(&h, &hs, 0, 0, &follow, &e), SY_ERR_LIMIT, e);
+    CHECK_MSG(strstr(e.message, "HELLO: frame announces 268435480 bytes, this connection accepts at most 1024"), "%s",
+              e.message);
+    /* chunks before the session is open; a tag before there is a key; no tag once there is */
+    sy_cluster_header_write(hdr, SY_CLUSTER_HELLO, SY_CLUSTER_FLAG_MORE, 10, 1);
+    CHECK_OK(sy_cluster_parse_header(hdr, &h, &e), e);
+    CHECK_ERR(sy_cluster_frame_check(&h, &hs, 0, 0, &follow, &e), SY_ERR_PROTOCOL, e);
+    sy_cluster_header_write(hdr, SY_CLUSTER_AUTH, SY_CLUSTER_FLAG_TAGGED, 32, 2);
+    CHECK_OK(sy_cluster_parse_header(hdr, &h, &e), e);
+    CHECK_ERR(sy_cluster_frame_check(&h, &hs, 0, 0, &follow, &e), SY_ERR_PROTOCOL, e);
+    sy_cluster_header_write(hdr, SY_CLUSTER_SCENE, 0, 100, 3);
+    CHECK_OK(sy_cluster_parse_header(hdr, &h, &e), e);
+    CHECK_ERR(sy_cluster_frame_check(&h, &open, 0, 0, &follow, &e), SY_ERR_PROTOCOL, e);
+    /* within the budget: the body and the tag follow */
+    sy_cluster_header_write(hdr, SY_CLUSTER_SCENE, SY_CLUSTER_FLAG_TAGGED | SY_CLUSTER_FLAG_MORE, 1000, 3);
+    CHECK_OK(sy_cluster_parse_header(hdr, &h, &e), e);
+    CHECK_OK(sy_cluster_frame_check(&h, &open, 0, 0, &follow, &e), e);
+    CHECK(follow == 1000 + SY_CLUSTER_TAG_SIZE);
+    /* over the frame limit (header + body + tag); a continuation of another type; the message limit */
+    sy_cluster_header_write(hdr, SY_CLUSTER_SCENE, SY_CLUSTER_FLAG_TAGGED, (1u << 16) - 56 + 1, 4);
+    CHECK_OK(sy_cluster_parse_header(hdr, &h, &e), e);
+    CHECK_ERR(sy_cluster_frame_check(&h, &open, 0, 0, &follow, &e), SY_ERR_LIMIT, e);
+    sy_cluster_header_write(hdr, SY_CLUSTER_SCENE, SY_CLUSTER_FLAG_TAGGED, (1u << 16) - 56, 4);
+    CHECK_OK(sy_cluster_parse_header(hdr, &h, &e), e);
+    CHECK_OK(sy_cluster_frame_check(&h, &open, 0, 0, &follow, &e), e);
+    sy_cluster_header_write(hdr, SY_CLUSTER_RENDER, SY_CLUSTER_FLAG_TAGGED, 100, 5);
+    CHECK_OK(sy_cluster_parse_header(hdr, &h, &e), e);
+    CHECK_ERR(sy_cluster_frame_check(&h, &open, 1000, SY_CLUSTER_SCENE, &follow, &e), SY_ERR_PROTOCOL, e);
+    sy_cluster_header_write(hdr, SY_CLUSTER_SCENE, SY_CLUSTER_FLAG_TAGGED, 100, 5);
+    CHECK_OK(sy_cluster_parse_header(hdr, &h, &e), e);
+    CHECK_ERR(sy_cluster_frame_check(&h, &open, (1u << 20) - 99, SY_CLUSTER_SCENE, &follow, &e), SY_ERR_LIMIT, e);
+    CHECK(strstr(e.message, "exceeds the limit of 1048576"));
+    CHECK_OK(sy_cluster_frame_check(&h, &open, (1u << 20) - 100, SY_CLUSTER_SCENE, &follow, &e), e);
+    /* an unknown flag bit */
+    sy_cluster_header_write(hdr, SY_CLUSTER_SCENE, 4, 100, 5);
+    CHECK_ERR(sy_cluster_parse_header(hdr, &h, &e), SY_ERR_PARSE, e);
+    /* one frame of a chunked message is not a message */
+    sy_cluster_msg m = sample(SY_CLUSTER_BLOBS), d[4];
+    sy_cluster_buf b = {0};
+    CHECK_OK(sy_cluster_encode(&m, 0, &b, &e), e);
+    b.data[8] |= SY_CLUSTER_FLAG_MORE;
+    CHECK_ERR(sy_cluster_decode(b.data, b.size, NULL, &d[0], &e), SY_ERR_PARSE, e);
+    /* HELLO, then RENDER and BLOBS in frames of 17 and 40 body bytes: the same messages */
+    b.size = 0;
+    uint64_t seq = 0;
+    sy_cluster_msg hello = sample(SY_CLUSTER_HELLO), render = sample(SY_CLUSTER_RENDER);
+    if (append_chunked(&hello, 1000, &seq, &b) || append_chunked(&render, 17, &seq, &b) ||
+        append_chunked(&m, 40, &seq, &b))
+        return 1;
+    uint32_t count = 0;
+    uint8_t *bodies[4] = {0};
+    CHECK_MSG(stream_messages(b.data, b.size, d, 4, &count, bodies, &e) == 0, "%s", e.message);
+    CHECK(count == 3 && d[1].header.type == SY_CLUSTER_RENDER && d[2].header.type == SY_CLUSTER_BLOBS);
+    CHECK(d[1].u.render.tile_count == 3 && d[1].u.render.tiles[2].x == 10 && !strcmp(d[1].u.render.params, "max_depth=4"));
+    CHECK(d[2].u.blobs.count == 2 && memcmp(d[2].u.blobs.blobs[0].data, g_payload, 30) == 0);
+    for (uint32_t i = 0; i < count; ++i) {
+        sy_cluster_msg_free(&d[i]);
+        free(bodies[i]);
+    }
+    /* a chunked HELLO (before the session is open) is refused */
+    b.size = 0;
+    seq = 0;
+    if (append_chunked(&hello, 20, &seq, &b)) return 1;
+    CHECK(stream_messages(b.data, b.size, d, 4, &count, bodies, &e) == 1 && count == 0);
     sy_cluster_buf_free(&b);
     return 0;
 }
@@ -527,17 +685,24 @@ static int real_seed(uint32_t which, sy_cluster_buf *b)
 static int seeds(const char *dir, bool write)
 {
     char path[4096];
-    for (uint32_t t = 1; t <= SY_CLUSTER_MSG_TYPE_MAX + 2; ++t) {
+    for (uint32_t t = 1; t <= SY_CLUSTER_MSG_TYPE_MAX + 3; ++t) {
         sy_error e = {0};
         sy_cluster_msg m = sample(t), d;
         sy_cluster_buf b = {0};
-        if (t > SY_CLUSTER_MSG_TYPE_MAX) {
+        if (t == SY_CLUSTER_MSG_TYPE_MAX + 3) { /* a stream: HELLO, then a SCENE in frames of 40 body bytes */
+            sy_cluster_msg hello = sample(SY_CLUSTER_HELLO), scene = sample(SY_CLUSTER_SCENE);
+            uint64_t seq = 0;
+            if (append_chunked(&hello, 1000, &seq, &b) || append_chunked(&scene, 40, &seq, &b)) return 1;
+        } else if (t > SY_CLUSTER_MSG_TYPE_MAX) {
             if (real_seed(t, &b)) return 1;
         } else {
             CHECK_OK(sy_cluster_encode(&m, 0, &b, &e), e);
         }
         snprintf(path, sizeof path, "%s/%02u_%s.bin", dir, t,
-                 t <= SY_CLUSTER_MSG_TYPE_MAX ? sy_cluster_msg_type_name(t) : t == 15 ? "SCENE_real" : "TILES_half");
+                 t <= SY_CLUSTER_MSG_TYPE_MAX ? sy_cluster_msg_type_name(t)
+                 : t == 15                    ? "SCENE_real"
+                 : t == 16                    ? "TILES_half"
+                                              : "stream_HELLO_SCENE_chunked");
         if (write) {
             FILE *f = fopen(path, "wb");
             CHECK_MSG(f && fwrite(b.data, 1, b.size, f) == b.size && fclose(f) == 0, "cannot write %s", path);
@@ -549,8 +714,19 @@ static int seeds(const char *dir, bool write)
             fclose(f);
             CHECK_MSG(n == b.size && memcmp(buf, b.data, n) == 0, "%s is stale (regenerate: test_cluster_proto "
                       "--write-seeds DIR)", path);
-            CHECK_OK(sy_cluster_decode(buf, n, NULL, &d, &e), e);
-            sy_cluster_msg_free(&d);
+            if (t == SY_CLUSTER_MSG_TYPE_MAX + 3) {
+                sy_cluster_msg ms[2];
+                uint8_t *bodies[2];
+                uint32_t count = 0;
+                CHECK_MSG(stream_messages(buf, n, ms, 2, &count, bodies, &e) == 0 && count == 2, "%s: %s", path, e.message);
+                for (uint32_t i = 0; i < count; ++i) {
+                    sy_cluster_msg_free(&ms[i]);
+                    free(bodies[i]);
+                }
+            } else {
+                CHECK_OK(sy_cluster_decode(buf, n, NULL, &d, &e), e);
+                sy_cluster_msg_free(&d);
+            }
         }
         sy_cluster_buf_free(&b);
     }
@@ -564,6 +740,7 @@ int main(int argc, char **argv)
     if (argc == 2) failed += seeds(argv[1], false);
     failed += test_round_trip();
     failed += test_bad_headers();
+    failed += test_framing();
     failed += test_mutations();
     failed += test_tile_codec();
     failed += test_half();

@@ -2,6 +2,8 @@
  * plus the "coop_test" double, served through core/sy_cluster.c exactly as `sy serve` does.
  *   test_cluster_server --port-file F [--listen URL] [--secret S] [--max-lifetime SECONDS] [--present RAW]
  *                       [--blob-cache-mb N | --blob-cache-bytes N] [--max-objects N] [--auth-backoff-ms MS]
+ *                       [--max-unauthenticated N] [--handshake-timeout-ms MS] [--max-peer-memory-mb N]
+ *                       [--max-frame-kb N] [--max-message-mb N]
  * Stops on SIGTERM / SIGINT or after --max-lifetime (default 120 s), so nothing outlives a test. */
 #include "coop_double.h"
 #include "sy_cluster.h"
@@ -48,6 +50,11 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--blob-cache-bytes")) o.blob_cache_bytes = (size_t)atol(argv[i + 1]);
         else if (!strcmp(argv[i], "--max-objects")) o.max_objects = (uint32_t)atol(argv[i + 1]);
         else if (!strcmp(argv[i], "--auth-backoff-ms")) o.auth_backoff_ms = (uint32_t)atol(argv[i + 1]);
+        else if (!strcmp(argv[i], "--max-unauthenticated")) o.max_unauthenticated = (uint32_t)atol(argv[i + 1]);
+        else if (!strcmp(argv[i], "--handshake-timeout-ms")) o.handshake_timeout_ms = (uint32_t)atol(argv[i + 1]);
+        else if (!strcmp(argv[i], "--max-peer-memory-mb")) o.max_peer_memory = (size_t)atol(argv[i + 1]) << 20;
+        else if (!strcmp(argv[i], "--max-frame-kb")) o.max_frame = (size_t)atol(argv[i + 1]) << 10;
+        else if (!strcmp(argv[i], "--max-message-mb")) o.max_message = (size_t)atol(argv[i + 1]) << 20;
         else if (!strcmp(argv[i], "--present")) {
             o.present = present_raw;
             o.present_user = argv[i + 1];

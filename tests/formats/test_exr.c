@@ -348,6 +348,31 @@ static void test_damaged(const char *dir)
             CHECK(r == SY_ERR_LIMIT || r == SY_ERR_PARSE, "hostile width %d: got %d (%s)", big[k], (int)r, err.message);
             sy_exr_image_free(img);
         }
+        /* issue 14 (finding 3): a data window within every limit (65536 x 3072 pixels x 5 channels
+         * <= SY_EXR_MAX_SAMPLES, offset table fits) that the file's bytes could never fill, even at
+         * ZIP's best ratio, is refused from the header, before the planes are allocated (before
+         * the fix: 5 x 768 MiB calloc()ed, then a chunk error). From a file and from memory. */
+        memcpy(patched, bytes, n);
+        const int32_t maxxy[2] = {65535, 3071};
+        memcpy(patched + at, maxxy, 8);
+        write_bytes(g, patched, n);
+        sy_exr_image *img = NULL;
+        sy_result r = sy_exr_read(g, &img, &err);
+        CHECK(r == SY_ERR_PARSE && img == NULL, "window vs file size: got %d (%s)", (int)r, err.message);
+        CHECK(strstr(err.message, g) && strstr(err.message, "truncated") && strstr(err.message, "65536x3072"),
+              "window vs file size: message should name the file, the window and the reason: %s", err.message);
+        r = sy_exr_read_memory(patched, n, "patched.exr", NULL, &img, &err);
+        CHECK(r == SY_ERR_PARSE && img == NULL && strstr(err.message, "patched.exr: truncated"),
+              "window vs size from memory: got %d (%s)", (int)r, err.message);
+        /* the same bytes unpatched read from memory, and a pixel limit below the image */
+        r = sy_exr_read_memory(bytes, n, "valid.exr", NULL, &img, &err);
+        CHECK(r == SY_OK && img && img->width == w && img->height == h, "memory read: %s", err.message);
+        sy_exr_image_free(img);
+        img = NULL;
+        sy_exr_read_options lim = {.max_pixels = (uint64_t)w * h - 1};
+        r = sy_exr_read_memory(bytes, n, "valid.exr", &lim, &img, &err);
+        CHECK(r == SY_ERR_LIMIT && img == NULL && strstr(err.message, "valid.exr"), "max_pixels: got %d (%s)", (int)r,
+              err.message);
         free(patched);
     }
 

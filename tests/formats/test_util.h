@@ -61,7 +61,7 @@ static void remove_scratch_dir(const char *dir)
 }
 
 /* Number of entries in dir whose name contains needle. */
-static int count_entries_containing(const char *dir, const char *needle)
+static inline int count_entries_containing(const char *dir, const char *needle)
 {
     int n = 0;
     DIR *d = opendir(dir);
@@ -73,7 +73,7 @@ static int count_entries_containing(const char *dir, const char *needle)
     return n;
 }
 
-static int path_exists(const char *p)
+static inline int path_exists(const char *p)
 {
     struct stat st;
     return stat(p, &st) == 0;
@@ -90,7 +90,7 @@ static int write_bytes(const char *path, const void *data, size_t n)
 }
 
 /* Reads a whole small file; caller frees. NULL on failure. */
-static unsigned char *slurp(const char *path, size_t *n)
+static inline unsigned char *slurp(const char *path, size_t *n)
 {
     FILE *f = fopen(path, "rb");
     if (!f) return NULL;

@@ -1,7 +1,11 @@
 /* fuzz_changes.c — libFuzzer target for the change-list wire decoder (sy_changes_deserialize):
- * untrusted network input in the cluster. Decoded lists are applied to a scratch scene too, so
- * what the decoder accepts is exercised downstream. */
+ * untrusted network input in the cluster. Decoded lists are applied to a scratch scene too, under
+ * the render server's replica policy (slot limit, and pool growth bounded by the list's size:
+ * sy_scene_apply_bounded with SY_CLUSTER_APPLY_SLACK_SLOTS + size / SY_CLUSTER_APPLY_BYTES_PER_SLOT),
+ * so what the decoder accepts is exercised downstream and no input can make the replica allocate
+ * pools for millions of slots (which an unbounded apply would: one entry naming slot 4M). */
 #include "sy_changes.h"
+#include "sy_cluster.h"
 #include "sy_scene.h"
 
 int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size);
@@ -15,7 +19,8 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
     if (sy_changes_deserialize(data, size, store, &lim, &c, NULL) == SY_OK) {
         sy_scene *s;
         if (sy_scene_create(&s, NULL) == SY_OK) {
-            sy_scene_apply(s, c, NULL);
+            sy_scene_set_apply_limit(s, SY_CLUSTER_DEFAULT_MAX_OBJECTS);
+            sy_scene_apply_bounded(s, c, SY_CLUSTER_APPLY_SLACK_SLOTS + size / SY_CLUSTER_APPLY_BYTES_PER_SLOT, NULL);
             sy_scene_commit(s, NULL, NULL);
             sy_scene_destroy(s);
         }

@@ -340,6 +340,26 @@ static void test_bad_glb(void)
     write_file("good.glb", g, n, path);
     outcome o = run(path, NULL, NULL);
     CHECK(o.r == SY_OK, "good.glb: %s", o.err.message);
+    { /* the same bytes from memory (sy_gltf_load_memory, as the fuzz targets load), and a GLB
+       * whose header length is one byte short of the input, named in the message */
+        sy_scene *s = NULL;
+        if (sy_scene_create(&s, NULL) != SY_OK) exit(1);
+        sy_gltf_info info;
+        sy_error e = {0};
+        sy_result r = sy_gltf_load_memory(g, n, "mem.glb", g_dir, s, NULL, &info, &e);
+        CHECK(r == SY_OK && sy_scene_count(s, SY_TYPE_MESH) == 1, "good.glb from memory: %s", e.message);
+        sy_gltf_info_free(&info);
+        sy_scene_destroy(s);
+        if (sy_scene_create(&s, NULL) != SY_OK) exit(1);
+        r = sy_gltf_load_memory(g, n - 1, "short.glb", g_dir, s, NULL, NULL, &e);
+        CHECK(r == SY_ERR_PARSE && strstr(e.message, "short.glb") && strstr(e.message, "total length"),
+              "short GLB from memory: %s", e.message);
+        sy_gltf_options small = {0};
+        small.max_file_bytes = n - 1;
+        r = sy_gltf_load_memory(g, n, "big.glb", g_dir, s, &small, NULL, &e);
+        CHECK(r == SY_ERR_LIMIT && strstr(e.message, "big.glb"), "memory input over max_file_bytes: %s", e.message);
+        sy_scene_destroy(s);
+    }
 
     uint8_t *c = malloc(n + 16);
     struct {
@@ -415,6 +435,41 @@ static void test_valid(void)
             CHECK(nd && nd->transform.translation[0] == 1 && nd->transform.translation[2] == 3,
                   "first frame translation (1, 2, 3), not the static (7, 7, 7)");
             CHECK(nd && nd->transform.scale[0] == 2 && nd->transform.scale[2] == 2, "CUBICSPLINE first value (2, 2, 2)");
+        }
+        sy_scene_destroy(s);
+        s = NULL;
+    }
+
+    /* issue 14 (finding 3): an animation output accessor without bufferView declares 2^40 elements;
+     * only its first value is used (here a sparse substitution), so the count costs nothing. Before
+     * the fix the whole accessor was read: calloc of 12 TiB (out of memory; ASan: abort). */
+    {
+        uint8_t data[24];
+        const float in[2] = {0, 1}, val[3] = {4, 5, 6};
+        const uint32_t sidx = 0;
+        memcpy(data, in, 8);
+        memcpy(data + 8, &sidx, 4);
+        memcpy(data + 12, val, 12);
+        const char *fmt = "{" ASSET ",\"buffers\":[{\"byteLength\":24,\"uri\":\"%s\"}],"
+                          "\"bufferViews\":[{\"buffer\":0,\"byteLength\":8},{\"buffer\":0,\"byteOffset\":8,\"byteLength\":4},"
+                          "{\"buffer\":0,\"byteOffset\":12,\"byteLength\":12}],"
+                          "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},"
+                          "{\"componentType\":5126,\"count\":1099511627776,\"type\":\"VEC3\",\"sparse\":{\"count\":1,"
+                          "\"indices\":{\"bufferView\":1,\"componentType\":5125},\"values\":{\"bufferView\":2}}}],"
+                          "\"nodes\":[{\"name\":\"moved\"}],"
+                          "\"animations\":[{\"samplers\":[{\"input\":0,\"output\":1}],"
+                          "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]}";
+        write_gltf("anim_output_count.gltf", fmt, data, sizeof data, path);
+        outcome o = run(path, NULL, &s);
+        CHECK(o.r == SY_OK, "anim_output_count.gltf: %s", o.err.message);
+        if (o.r == SY_OK) {
+            const sy_node_data *nd = NULL;
+            for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id)) {
+                const sy_node_data *x = sy_node_get(s, (sy_node){id});
+                if (x->name && !strcmp(x->name, "moved")) nd = x;
+            }
+            CHECK(nd && nd->transform.translation[0] == 4 && nd->transform.translation[2] == 6,
+                  "anim_output_count: first frame translation (4, 5, 6) from the sparse value");
         }
         sy_scene_destroy(s);
         s = NULL;

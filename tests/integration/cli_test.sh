@@ -260,6 +260,33 @@ expect_error pt_filter_threshold threshold "$TMP/o_ptfilter" "$SY" render demo -
 expect_error pt_filter_sigma "sigma_s = 0: must be a finite value > 0" "$TMP/o_ptfilter" "$SY" render demo \
     -b pathtracer --spp 1 -w 8 -h 8 --filter pixel --params sigma_s=0 -o "$TMP/o_ptfilter/x.png"
 
+# ---------------------------------------------------------------- loaders: confinement, warnings (issue 14)
+# a buffer URI leaving the model's folder is refused naming the file, the URI and --allow-path;
+# --allow-path admits the folder
+mkdir -p "$TMP/esc/model" "$TMP/o_esc"
+printf '\000\000\000\000\000\000\000\000\000\000\000\000\000\000\200\077\000\000\000\000\000\000\000\000\000\000\000\000\000\000\200\077\000\000\000\000' \
+    >"$TMP/esc/outside.bin"
+cat >"$TMP/esc/model/esc.gltf" <<'GLTF'
+{"asset":{"version":"2.0"},"buffers":[{"uri":"../outside.bin","byteLength":36}],
+ "bufferViews":[{"buffer":0,"byteLength":36}],
+ "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+ "meshes":[{"primitives":[{"attributes":{"POSITION":0}},{"attributes":{"POSITION":0},"mode":0}]}],
+ "nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0}
+GLTF
+expect_error escape "'../outside.bin' resolves to" "$TMP/o_esc" "$SY" render "$TMP/esc/model/esc.gltf" -b whitted \
+    -w 8 -h 8 -o "$TMP/o_esc/x.png"
+grep -q -- "--allow-path" "$TMP/escape.err" || fail "escape: the error does not name --allow-path"
+# allowed: renders, and the POINTS primitive it skips is reported (file and item), exit 0
+run allowed "$SY" render "$TMP/esc/model/esc.gltf" --allow-path "$TMP/esc" -b whitted -w 8 -h 8 -o "$TMP/esc/ok.png"
+[ "$rc" -eq 0 ] && [ -s "$TMP/esc/ok.png" ] || fail "--allow-path: status $rc: $(cat "$TMP/allowed.err")"
+grep -q "warning: $TMP/esc/model/esc.gltf: meshes\[0\].primitives\[1\]: mode POINTS skipped" "$TMP/allowed.err" ||
+    fail "the skipped POINTS primitive is not reported: $(cat "$TMP/allowed.err")"
+# --strict: the same warning is an error, nothing written
+expect_error strict "--strict" "$TMP/o_esc" "$SY" render "$TMP/esc/model/esc.gltf" --allow-path "$TMP/esc" --strict \
+    -b whitted -w 8 -h 8 -o "$TMP/o_esc/x.png"
+expect_error allow_path_missing "--allow-path" "$TMP/o_esc" "$SY" render "$TMP/esc/model/esc.gltf" --allow-path \
+    "$TMP/esc/no_such_dir" -b whitted -w 8 -h 8 -o "$TMP/o_esc/x.png"
+
 if [ "$fails" -ne 0 ]; then
     echo "integration_cli: $fails failure(s)" >&2
     exit 1

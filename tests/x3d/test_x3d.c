@@ -132,6 +132,45 @@ static void test_concave_and_defaults(void)
     }
     CHECK(nt == 8 && fabs(area - 11.0) < 1e-6, "comb: %zu triangles, area %g (expected 8, 11)", nt, area);
 
+    /* random star-shaped (so simple, mostly concave) polygons in both orientations, the ear clipper
+     * of issue 14 (reflex vertices on a linked ring): n - 2 triangles, none clockwise (relative to
+     * the polygon), covering exactly the shoelace area */
+    uint32_t seed = 12345;
+    for (int round = 0; round < 300; round++) {
+        size_t n = 4 + (size_t)(round % 97);
+        float *sp = malloc(n * 12);
+        uint32_t *sidx = malloc(n * 4), *st = malloc(3 * n * 4);
+        void *sscr = malloc(SY_TRIANGULATE_SCRATCH(n));
+        if (!sp || !sidx || !st || !sscr) exit(1);
+        double shoe = 0;
+        bool cw = round % 2;
+        for (size_t k = 0; k < n; k++) {
+            seed = seed * 1664525u + 1013904223u;
+            double rad = 0.2 + (double)(seed >> 8) / 16777216.0;
+            double a = 6.283185307179586 * (double)(cw ? n - k : k) / (double)n;
+            sp[3 * k] = (float)(rad * cos(a));
+            sp[3 * k + 1] = (float)(rad * sin(a));
+            sp[3 * k + 2] = 0.0f;
+            sidx[k] = (uint32_t)k;
+        }
+        for (size_t k = 0; k < n; k++) {
+            const float *a = sp + 3 * k, *b = sp + 3 * ((k + 1) % n);
+            shoe += 0.5 * ((double)a[0] * b[1] - (double)b[0] * a[1]);
+        }
+        size_t snt = sy_triangulate_polygon(sp, sidx, n, st, sscr);
+        double sum = 0;
+        bool ok = snt == n - 2;
+        for (size_t t = 0; t < snt; t++) {
+            const float *a = sp + 3 * st[3 * t], *b = sp + 3 * st[3 * t + 1], *c = sp + 3 * st[3 * t + 2];
+            double z = 0.5 * (((double)b[0] - a[0]) * ((double)c[1] - a[1]) - ((double)b[1] - a[1]) * ((double)c[0] - a[0]));
+            ok = ok && z * (shoe > 0 ? 1 : -1) >= -1e-7;
+            sum += z;
+        }
+        CHECK(ok && fabs(sum - shoe) < 1e-4 * fabs(shoe), "star polygon %d (n %zu): %zu triangles, area %g vs %g", round, n,
+              snt, sum, shoe);
+        free(sp); free(sidx); free(st); free(sscr);
+    }
+
     /* no Material: unlit white; per-face colours; ccw false flips the winding */
     l = load_text("colors.x3d", HDR
         "<Shape><IndexedFaceSet ccw='false' colorPerVertex='false' coordIndex='0 2 1 -1 0 3 2'>"
@@ -187,6 +226,49 @@ static void test_big_polygons(void)
         sy_scene_destroy(s);
         free(x);
     }
+}
+
+/* issue 14 (finding 3): an index or coordinate list is counted before it is allocated and checked
+ * against 4 x max_vertices; more values fail the load (SY_ERR_LIMIT, file:line, attribute). Before
+ * the fix, 200 coordIndex values of degenerate faces loaded (a warning, no triangles) whatever
+ * the limit, and any list was held as doubles before any limit applied. */
+static void test_value_limits(void)
+{
+    char x[8192];
+    size_t len = (size_t)snprintf(x, sizeof x, HDR "<Shape><IndexedFaceSet coordIndex='");
+    for (int k = 0; k < 66; k++) len += (size_t)snprintf(x + len, sizeof x - len, "0 1 -1 ");
+    len += (size_t)snprintf(x + len, sizeof x - len, "0 1'>\n<Coordinate point='0 0 0 1 0 0 0 1 0'/></IndexedFaceSet></Shape>" FTR);
+    sy_x3d_options o = {0};
+    o.max_vertices = 30; /* 120 values per attribute */
+    for (int pass = 0; pass < 2; pass++) {
+        sy_scene *s;
+        if (sy_scene_create(&s, NULL) != SY_OK) exit(1);
+        sy_x3d_info info;
+        sy_error e = {0};
+        sy_result r = sy_x3d_load_memory(x, len, "limits.x3d", "", s, &o, &info, &e);
+        if (pass == 0) {
+            CHECK(r == SY_ERR_LIMIT && strstr(e.message, "limits.x3d:3: IndexedFaceSet.coordIndex: 200 values exceed the limit of 120"),
+                  "coordIndex over the value limit: %s (%s)", sy_result_str(r), e.message);
+            CHECK(sy_scene_count(s, SY_TYPE_NODE) == 0 && sy_scene_count(s, SY_TYPE_MESH) == 0, "objects left behind");
+        } else {
+            CHECK(r == SY_OK, "within the default limits: %s", e.message);
+        }
+        sy_x3d_info_free(&info);
+        sy_scene_destroy(s);
+        o.max_vertices = 0;
+    }
+    /* a Coordinate list over the limit: 41 points = 123 values */
+    len = (size_t)snprintf(x, sizeof x, HDR "<Shape><IndexedFaceSet coordIndex='0 1 2'><Coordinate point='");
+    for (int k = 0; k < 41; k++) len += (size_t)snprintf(x + len, sizeof x - len, "%d 0 0 ", k);
+    len += (size_t)snprintf(x + len, sizeof x - len, "'/></IndexedFaceSet></Shape>" FTR);
+    o.max_vertices = 30;
+    sy_scene *s;
+    if (sy_scene_create(&s, NULL) != SY_OK) exit(1);
+    sy_error e = {0};
+    sy_result r = sy_x3d_load_memory(x, len, "points.x3d", "", s, &o, NULL, &e);
+    CHECK(r == SY_ERR_LIMIT && strstr(e.message, "points.x3d:3: Coordinate.point: 123 values exceed the limit of 120"),
+          "point over the value limit: %s (%s)", sy_result_str(r), e.message);
+    sy_scene_destroy(s);
 }
 
 /* Extrusion with its defaults: the unit square swept from y 0 to 1 = a 2 x 1 x 2 box, outward */
@@ -371,18 +453,22 @@ static void test_inline_css_and_bad_input(void)
                                "<IndexedTriangleSet index='0 1 2'><Coordinate point='0 0 0 1 0 0 0 1 0'/>"
                                "<TextureCoordinate point='0 0 1 0 0 1'/></IndexedTriangleSet></Shape>" FTR);
     write_text("self.x3d", HDR "<Inline url='\"self.x3d\"'/><Shape><Box/></Shape>" FTR);
+    /* a FIFO inside the model's folder (absolute paths such as /dev/zero are refused before) */
+    char fifo[2048];
+    PATHF(fifo, "%s/dev.fifo", g_dir);
+    CHECK(mkfifo(fifo, 0600) == 0, "mkfifo %s", fifo);
     loaded l = load_text("main.x3d", HDR
         "<Inline url='\"missing.x3d\" \"part.x3d\"'/>\n"
         "<Transform translation='5 0 0'><Inline url='\"part.x3d\"'/></Transform>\n"
         "<Inline url='\"self.x3d\"'/>\n"
         "<Shape><Appearance><ImageTexture url='\"bad.png\"'/></Appearance><Box/></Shape>\n"
-        "<Inline url='\"/dev/zero\"'/><Shape><Appearance><ImageTexture url='\"/dev/zero\"'/></Appearance><Sphere/></Shape>\n" FTR);
+        "<Inline url='\"dev.fifo\"'/><Shape><Appearance><ImageTexture url='\"dev.fifo\"'/></Appearance><Sphere/></Shape>\n" FTR);
     CHECK(l.r == SY_OK, "inline: %s", l.err.message);
     dump_warnings(&l);
     CHECK(l.info.counts.inlines == 2, "part.x3d loaded once and shared, self.x3d once: %u", l.info.counts.inlines);
     CHECK(has_warning(&l, "includes itself", "self.x3d:3"), "Inline cycle warned with file:line");
     CHECK(has_warning(&l, "bad.png", "main.x3d:6"), "undecodable texture warned with file:line");
-    CHECK(has_warning(&l, "/dev/zero: not a regular file", "main.x3d:7"), "devices are not read");
+    CHECK(has_warning(&l, "dev.fifo: not a regular file", "main.x3d:7"), "devices are not read");
     CHECK(sy_scene_count(l.scene, SY_TYPE_MESH) == 4, "triangle + self box + main box + sphere: 4 meshes, got %u",
           sy_scene_count(l.scene, SY_TYPE_MESH));
     const sy_material_data *css = NULL;
@@ -543,6 +629,7 @@ int main(int argc, char **argv)
     test_extrusion();
     test_strips_fans_quads();
     test_big_polygons();
+    test_value_limits();
     test_def_use_and_scene_nodes();
     test_inline_css_and_bad_input();
     remove_scratch_dir(g_dir);

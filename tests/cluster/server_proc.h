@@ -1,0 +1,163 @@
+/* server_proc.h — render servers as child processes for the cluster tests (header-only): start
+ * test_cluster_server on a free 127.0.0.1 port (it writes the port to a file), stop it with
+ * SIGTERM (SIGKILL after 5 s), search its log, read its memory from /proc/PID/status.
+ * The caller sets g_exe (the server executable) and g_dir (a work directory). Every wait is
+ * bounded; servers a failed check left running are killed when the test exits. Thread-safety:
+ * main thread only (except server_status_kb, any thread). */
+#ifndef SY_TEST_SERVER_PROC_H
+#define SY_TEST_SERVER_PROC_H
+
+#include "../core/check.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+static const char *g_exe, *g_dir;
+static int g_serial;
+static pid_t g_started[256]; /* every server started, killed at exit if a failed check left it running */
+static int g_nstarted;
+
+static void kill_leftover_servers(void)
+{
+    for (int i = 0; i < g_nstarted; ++i)
+        if (g_started[i] > 0 && kill(g_started[i], SIGKILL) == 0) waitpid(g_started[i], NULL, 0);
+}
+
+typedef struct server {
+    pid_t pid;
+    int port;
+    int serial;
+    char url[64];
+    char log[512];
+} server;
+
+static inline void sleep_ms(int ms)
+{
+    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}
+
+/* port 0 = any free port; extra: NULL or up to 8 more "--option", "value" words, NULL-terminated */
+static inline int start_server_args(const char *secret, int port, const char *const *extra, server *out)
+{
+    char pf[512], listen[64];
+    snprintf(pf, sizeof pf, "%s/port%d", g_dir, ++g_serial);
+    snprintf(out->log, sizeof out->log, "%s/server%d.log", g_dir, g_serial);
+    snprintf(listen, sizeof listen, "tcp://127.0.0.1:%d", port);
+    unlink(pf);
+    pid_t pid = fork();
+    CHECK(pid >= 0);
+    if (pid == 0) {
+        int fd = open(out->log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd >= 0) dup2(fd, 2), dup2(fd, 1); /* never the test's own pipes */
+        char present[512];
+        snprintf(present, sizeof present, "%s/present%d.raw", g_dir, g_serial);
+        const char *args[32] = {g_exe, "--port-file", pf, "--listen", listen, "--max-lifetime", "120", "--present", present};
+        int n = 9;
+        if (secret) args[n++] = "--secret", args[n++] = secret;
+        for (int k = 0; extra && extra[k] && k < 16; ++k) args[n++] = extra[k];
+        execv(g_exe, (char *const *)args);
+        _exit(127);
+    }
+    out->pid = pid;
+    out->serial = g_serial;
+    if (g_nstarted == 0) atexit(kill_leftover_servers);
+    if (g_nstarted < (int)(sizeof g_started / sizeof g_started[0])) g_started[g_nstarted++] = pid;
+    for (int i = 0; i < 400; ++i) { /* at most 20 s (ASan builds start slowly) */
+        FILE *f = fopen(pf, "r");
+        int p = 0;
+        if (f) {
+            if (fscanf(f, "%d", &p) != 1) p = 0;
+            fclose(f);
+        }
+        if (p > 0) {
+            out->port = p;
+            snprintf(out->url, sizeof out->url, "tcp://127.0.0.1:%d", p);
+            return 0;
+        }
+        int st;
+        if (waitpid(pid, &st, WNOHANG) == pid) {
+            fprintf(stderr, "server exited early, see %s\n", out->log);
+            out->pid = 0;
+            return 1;
+        }
+        sleep_ms(50);
+    }
+    fprintf(stderr, "server did not report its port\n");
+    return 1;
+}
+
+static inline int start_server(const char *secret, int port, server *out)
+{
+    return start_server_args(secret, port, NULL, out);
+}
+
+static inline void forget_server(pid_t pid);
+
+static inline void stop_server(server *s)
+{
+    if (s->pid <= 0) return;
+    forget_server(s->pid);
+    kill(s->pid, SIGCONT);
+    kill(s->pid, SIGTERM);
+    for (int i = 0; i < 100; ++i) {
+        if (waitpid(s->pid, NULL, WNOHANG) == s->pid) {
+            s->pid = 0;
+            return;
+        }
+        sleep_ms(50);
+    }
+    kill(s->pid, SIGKILL);
+    waitpid(s->pid, NULL, 0);
+    s->pid = 0;
+}
+
+/* a stopped server's pid is forgotten by the exit handler (a reused pid is never killed) */
+static inline void forget_server(pid_t pid)
+{
+    for (int i = 0; i < g_nstarted; ++i)
+        if (g_started[i] == pid) g_started[i] = 0;
+}
+
+static inline bool log_contains(const server *s, const char *needle)
+{
+    for (int i = 0; i < 40; ++i) { /* the server may still be writing */
+        FILE *f = fopen(s->log, "r");
+        if (f) {
+            static char buf[1 << 18];
+            size_t n = fread(buf, 1, sizeof buf - 1, f);
+            fclose(f);
+            buf[n] = 0;
+            if (strstr(buf, needle)) return true;
+        }
+        sleep_ms(50);
+    }
+    return false;
+}
+
+/* A "VmRSS:" / "VmHWM:" ... line of /proc/PID/status in KiB; -1 when unreadable. */
+static inline long server_status_kb(pid_t pid, const char *field)
+{
+    char path[64], line[256];
+    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+    FILE *f = fopen(path, "r");
+    if (!f) return -1;
+    long kb = -1;
+    size_t fl = strlen(field);
+    while (fgets(line, sizeof line, f))
+        if (!strncmp(line, field, fl) && line[fl] == ':') {
+            kb = strtol(line + fl + 1, NULL, 10);
+            break;
+        }
+    fclose(f);
+    return kb;
+}
+
+#endif /* SY_TEST_SERVER_PROC_H */

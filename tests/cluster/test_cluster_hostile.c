@@ -1,0 +1,762 @@
+/* test_cluster_hostile.c — the render server against hostile peers (issue 14, findings 2 and 3).
+ * Servers are separate processes on 127.0.0.1 (test_cluster_server); their memory is read from
+ * /proc/PID/status. Groups (argv[3...], default all three):
+ *   rss     64 connections each announce a 256 MiB message and trickle 64 KiB every 100 ms, 8 more
+ *           flood 8 MiB as fast as they can, none of them authenticated, for 5 s, reconnecting
+ *           whenever the server closes them; an authenticated client keeps rendering frames equal
+ *           to its first one all the while, and the server's resident memory (VmRSS sampled every
+ *           50 ms, and VmHWM) grows by less than 64 MiB. Prints RSS before / peak / after and the
+ *           client's frame times before and during the attack.
+ *   counts  a 144-byte change list creating one object of each of the 7 types at slot index
+ *           2^20 - 1 (a replica of protocol 2 makes 7 pools of 2^20 slots: ~700 MiB) and messages
+ *           with forged counts (entries, blobs, primitives, attachments, BLOBS, RENDER tiles,
+ *           SCENE size) are refused with their reasons while the server's peak RSS grows by less
+ *           than 32 MiB, and it keeps rendering; then the replica's allocation per message byte for
+ *           a dense snapshot of materials and for the sparsest list the growth bound admits is
+ *           measured against the bound documented in docs/PROTOCOL.md.
+ *   cap     with --max-unauthenticated 8 --handshake-timeout-ms 1500: of 12 idle connections the 4
+ *           beyond the cap are closed at once (and logged), the other 8 at the deadline; a client
+ *           connects afterwards.
+ *   ceiling with --max-peer-memory-mb 1: a chunked message that does not fit waits while another
+ *           peer holds the memory and goes on once it is released (back-pressure); one that still
+ *           does not fit after the wait is refused with "server busy: ..." naming the option.
+ *
+ *   test_cluster_hostile SERVER_EXE WORK_DIR [rss|counts|cap|ceiling]...
+ *
+ * Compiled with -DSY_TEST_LEGACY_WIRE against the protocol-2 tree (nng req/rep), the hostile peers
+ * and raw sessions speak nng's SP framing instead, so that the same groups run against the old
+ * server (that is how their failures there were shown). Every wait is bounded; servers stop with
+ * SIGTERM (SIGKILL after 5 s) and --max-lifetime. */
+#include "../core/check.h"
+#include "raw_peer.h"
+#include "server_proc.h"
+#include "sy_cluster.h"
+#include "sy_demo.h"
+#include "sy_mediators.h"
+#include "sy_viewport.h"
+
+#ifdef SY_TEST_LEGACY_WIRE
+#include <nng/nng.h>
+#include <nng/protocol/reqrep0/req.h>
+#endif
+
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <sys/stat.h>
+
+#define MIB (1024.0 * 1024.0)
+
+#if defined(__SANITIZE_ADDRESS__) /* gcc */
+#define HOSTILE_ASAN 1
+#elif defined(__has_feature) /* clang */
+#if __has_feature(address_sanitizer)
+#define HOSTILE_ASAN 1
+#endif
+#endif
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* ---- wire details that differ between protocol 3 (streams) and the legacy nng SP framing ---- */
+
+/* The start of a message of `size` bytes, as far as the server's transport is concerned. */
+static bool send_announce(int fd, uint64_t size)
+{
+#ifdef SY_TEST_LEGACY_WIRE
+    /* nng's TCP SP header for a req0 peer (protocol 0x30), then the 8-byte big-endian length */
+    uint8_t b[16] = {0, 'S', 'P', 0, 0, 0x30, 0, 0};
+    for (int i = 0; i < 8; ++i) b[8 + i] = (uint8_t)(size >> (56 - 8 * i));
+    return raw_write_all(fd, b, sizeof b);
+#else
+    uint8_t h[SY_CLUSTER_HEADER_SIZE];
+    sy_cluster_header_write(h, SY_CLUSTER_HELLO, 0, (uint32_t)size, 1);
+    return raw_write_all(fd, h, sizeof h);
+#endif
+}
+
+/* A raw frame: the 24-byte header (protocol version of this build, untagged) + body. */
+static size_t frame_bytes(uint8_t *out, uint32_t type, const void *body, uint32_t n, uint64_t seq)
+{
+    const uint32_t magic = SY_CLUSTER_MAGIC;
+    const uint16_t version = SY_CLUSTER_VERSION, t = (uint16_t)type;
+    const uint32_t flags = 0;
+    memcpy(out, &magic, 4);
+    memcpy(out + 4, &version, 2);
+    memcpy(out + 6, &t, 2);
+    memcpy(out + 8, &flags, 4);
+    memcpy(out + 12, &n, 4);
+    memcpy(out + 16, &seq, 8);
+    memcpy(out + 24, body, n);
+    return 24 + (size_t)n;
+}
+
+/* A session on a server without a secret: HELLO, then one raw frame; *type / why = the reply's
+ * type and ERROR reason ("" for another reply). */
+static int raw_session_frame(const server *s, const uint8_t *frame, size_t n, uint32_t *type, char *why, size_t cap)
+{
+    sy_cluster_msg hello, rep;
+    memset(&hello, 0, sizeof hello);
+    hello.header.type = SY_CLUSTER_HELLO;
+    hello.header.seq = 1;
+    strcpy(hello.u.hello.name, "hostile test");
+    *type = 0;
+    why[0] = 0;
+#ifdef SY_TEST_LEGACY_WIRE
+    sy_error e = {0};
+    nng_socket sock;
+    CHECK(nng_req0_open(&sock) == 0);
+    nng_socket_set_ms(sock, NNG_OPT_RECVTIMEO, 60000);
+    nng_socket_set_ms(sock, NNG_OPT_SENDTIMEO, 60000);
+    CHECK(nng_dial(sock, s->url, NULL, 0) == 0);
+    sy_cluster_buf b = {0};
+    CHECK_OK(sy_cluster_encode(&hello, 0, &b, &e), e);
+    void *buf = NULL;
+    size_t len = 0;
+    CHECK(nng_send(sock, b.data, b.size, 0) == 0 && nng_recv(sock, &buf, &len, NNG_FLAG_ALLOC) == 0);
+    nng_free(buf, len);
+    sy_cluster_buf_free(&b);
+    CHECK(nng_send(sock, (void *)frame, n, 0) == 0);
+    int rv = nng_recv(sock, &buf, &len, NNG_FLAG_ALLOC);
+    CHECK_MSG(rv == 0, "no reply: %s", nng_strerror(rv));
+    CHECK_OK(sy_cluster_decode(buf, len, NULL, &rep, &e), e);
+    *type = rep.header.type;
+    if (rep.header.type == SY_CLUSTER_ERROR) snprintf(why, cap, "%s", rep.u.error.reason);
+    sy_cluster_msg_free(&rep);
+    nng_free(buf, len);
+    nng_close(sock);
+#else
+    hello.u.hello.max_frame = (uint32_t)SY_CLUSTER_DEFAULT_MAX_FRAME;
+    hello.u.hello.max_message = SY_CLUSTER_DEFAULT_MAX_MESSAGE;
+    int fd = raw_connect(s->port, 60000);
+    CHECK(fd >= 0);
+    uint8_t *raw = NULL;
+    CHECK(raw_send_msg(fd, &hello) == 0 && raw_recv_msg(fd, 1 << 16, &rep, &raw) == 0);
+    CHECK(rep.header.type == SY_CLUSTER_CHALLENGE);
+    sy_cluster_msg_free(&rep);
+    free(raw);
+    CHECK(raw_write_all(fd, frame, n));
+    int rc = raw_recv_msg(fd, 1 << 16, &rep, &raw);
+    CHECK_MSG(rc == 0, "no reply (%d)", rc);
+    *type = rep.header.type;
+    if (rep.header.type == SY_CLUSTER_ERROR) snprintf(why, cap, "%s", rep.u.error.reason);
+    sy_cluster_msg_free(&rep);
+    free(raw);
+    close(fd);
+#endif
+    return 0;
+}
+
+/* ---- the scene and an honest client ---- */
+typedef struct fixture {
+    sy_scene *scene;
+    sy_demo_info d;
+    uint32_t w, h;
+} fixture;
+
+static sy_cluster_client *honest_client(fixture *fx, const server *s, const char *secret, sy_error *e)
+{
+    const char *urls[1] = {s->url};
+    sy_cluster_client_opts co = {.urls = urls,
+                                 .url_count = 1,
+                                 .secret = (const uint8_t *)secret,
+                                 .secret_len = secret ? strlen(secret) : 0,
+                                 .timeout_ms = 30000,
+                                 .connect_timeout_ms = 5000};
+    sy_cluster_client *c = NULL;
+    if (sy_cluster_client_create(fx->scene, &co, &c, e) != SY_OK) return NULL;
+    return c;
+}
+
+static sy_cluster_frame honest_frame(fixture *fx)
+{
+    sy_camera_view view = sy_camera_view_frame_bounds(&(sy_bounds){{-3, -1, -3}, {3, 3, 3}}, (float)fx->w / (float)fx->h);
+    sy_cluster_frame f = {.mode = SY_CLUSTER_SORT_FIRST, .backend = "whitted", .root_id = fx->d.root.id,
+                          .background_id = fx->d.background.id, .camera = view, .width = fx->w, .height = fx->h};
+    return f;
+}
+
+static bool same_image(const sy_layer *a, const sy_layer *b)
+{
+    return memcmp(a->rgba, b->rgba, sizeof(float) * 4 * a->width * a->height) == 0;
+}
+
+/* ======================================================================== rss */
+typedef struct hostile {
+    int port;
+    int kind; /* 0: announce 256 MiB, trickle; 1: announce 8 MiB, flood */
+    atomic_int *stop;
+    uint64_t bytes;
+    uint32_t conns;
+} hostile;
+
+static void *hostile_main(void *arg)
+{
+    hostile *h = arg;
+    static uint8_t chunk[256 << 10];
+    memset(chunk, 'A', sizeof chunk);
+    while (!atomic_load(h->stop)) {
+        int fd = raw_connect(h->port, 2000);
+        if (fd < 0) {
+            sleep_ms(50);
+            continue;
+        }
+        h->conns++;
+        if (send_announce(fd, h->kind == 0 ? (256u << 20) : (8u << 20))) {
+            if (h->kind == 0) {
+                while (!atomic_load(h->stop) && raw_write_all(fd, chunk, 64 << 10)) {
+                    h->bytes += 64 << 10;
+                    sleep_ms(100);
+                }
+            } else {
+                for (uint32_t left = 8u << 20; left && !atomic_load(h->stop);) {
+                    uint32_t n = left < sizeof chunk ? left : (uint32_t)sizeof chunk;
+                    if (!raw_write_all(fd, chunk, n)) break;
+                    h->bytes += n;
+                    left -= n;
+                }
+            }
+        }
+        close(fd);
+        sleep_ms(h->kind == 0 ? 50 : 20);
+    }
+    return NULL;
+}
+
+typedef struct sampler {
+    pid_t pid;
+    atomic_int *stop;
+    long max_rss_kb;
+} sampler;
+
+static void *sampler_main(void *arg)
+{
+    sampler *sm = arg;
+    while (!atomic_load(sm->stop)) {
+        long kb = server_status_kb(sm->pid, "VmRSS");
+        if (kb > sm->max_rss_kb) sm->max_rss_kb = kb;
+        sleep_ms(50);
+    }
+    return NULL;
+}
+
+static int test_rss(fixture *fx)
+{
+    server sv;
+    memset(&sv, 0, sizeof sv);
+    if (start_server("s3cret", 0, &sv)) return 1;
+    sy_error e = {0};
+    sy_layer first = {0}, out = {0};
+    sy_cluster_client *c = honest_client(fx, &sv, "s3cret", &e);
+    CHECK_MSG(c != NULL, "%s", e.message);
+    sy_cluster_frame f = honest_frame(fx);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &first, &e), e);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
+    CHECK_OK(sy_cluster_client_render(c, &f, &first, NULL, &e), e); /* snapshot + translation */
+    double quiet = 0;
+    const int quiet_n = 8;
+    for (int i = 0; i < quiet_n; ++i) {
+        double t0 = now_s();
+        CHECK_OK(sy_cluster_client_render(c, &f, &out, NULL, &e), e);
+        quiet += now_s() - t0;
+        CHECK(same_image(&out, &first));
+    }
+    long rss0 = server_status_kb(sv.pid, "VmRSS"), hwm0 = server_status_kb(sv.pid, "VmHWM");
+    CHECK(rss0 > 0 && hwm0 > 0);
+    atomic_int stop = 0;
+    enum { TRICKLERS = 64, FLOODERS = 8 };
+    hostile hs[TRICKLERS + FLOODERS];
+    pthread_t th[TRICKLERS + FLOODERS], smt;
+    sampler sm = {sv.pid, &stop, rss0};
+    CHECK(pthread_create(&smt, NULL, sampler_main, &sm) == 0);
+    int started = 0;
+    for (int i = 0; i < TRICKLERS + FLOODERS; ++i) {
+        hs[i] = (hostile){sv.port, i < TRICKLERS ? 0 : 1, &stop, 0, 0};
+        pthread_attr_t at;
+        pthread_attr_init(&at);
+        pthread_attr_setstacksize(&at, 256 << 10);
+        if (pthread_create(&th[i], &at, hostile_main, &hs[i]) == 0) started++;
+        pthread_attr_destroy(&at);
+    }
+    /* the honest client renders all the while */
+    double t_start = now_s(), busy = 0, worst = 0;
+    int frames = 0, failed = 0, differ = 0;
+    char first_error[SY_ERROR_MESSAGE_MAX] = "";
+    while (now_s() - t_start < 5.0) {
+        double t0 = now_s();
+        sy_result r = sy_cluster_client_render(c, &f, &out, NULL, &e);
+        double dt = now_s() - t0;
+        if (r != SY_OK) {
+            if (!failed) snprintf(first_error, sizeof first_error, "%s", e.message);
+            failed++;
+            sleep_ms(50);
+            continue;
+        }
+        frames++;
+        busy += dt;
+        if (dt > worst) worst = dt;
+        differ += !same_image(&out, &first);
+    }
+    atomic_store(&stop, 1);
+    for (int i = 0; i < started; ++i) pthread_join(th[i], NULL);
+    pthread_join(smt, NULL);
+    sleep_ms(300);
+    long rss1 = server_status_kb(sv.pid, "VmRSS"), hwm1 = server_status_kb(sv.pid, "VmHWM");
+    uint64_t trickled = 0, flooded = 0;
+    uint32_t conns = 0;
+    for (int i = 0; i < started; ++i) {
+        conns += hs[i].conns;
+        if (hs[i].kind == 0) trickled += hs[i].bytes;
+        else flooded += hs[i].bytes;
+    }
+    printf("rss: %d hostile peers (%d announce 256 MiB and trickle, %d flood 8 MiB), %u connections, %.1f MiB "
+           "trickled + %.1f MiB flooded in 5 s\n",
+           started, TRICKLERS, FLOODERS, conns, trickled / MIB, flooded / MIB);
+    printf("rss: server VmRSS %.1f MiB before, %.1f MiB peak during, %.1f MiB after (VmHWM %.1f -> %.1f MiB): "
+           "+%.1f MiB at the peak (limit +64 MiB)\n",
+           rss0 / 1024.0, sm.max_rss_kb / 1024.0, rss1 / 1024.0, hwm0 / 1024.0, hwm1 / 1024.0,
+           (sm.max_rss_kb - rss0) / 1024.0);
+    printf("rss: honest client %ux%u whitted frames: %.2f ms mean before; during the attack %d frames, %.2f ms "
+           "mean, %.2f ms worst, %d failed, %d differing\n",
+           fx->w, fx->h, quiet / quiet_n * 1e3, frames, frames ? busy / frames * 1e3 : 0.0, worst * 1e3, failed,
+           differ);
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&first);
+    sy_layer_destroy(&out);
+    stop_server(&sv);
+    CHECK_MSG(failed == 0 && frames >= 3 && differ == 0, "honest frames: %d done, %d failed (%s), %d differ", frames,
+              failed, first_error, differ);
+    CHECK_MSG(sm.max_rss_kb - rss0 < 64 * 1024 && hwm1 - hwm0 < 64 * 1024,
+              "server memory grew by %.1f MiB (VmRSS peak) / %.1f MiB (VmHWM) under unauthenticated peers",
+              (sm.max_rss_kb - rss0) / 1024.0, (hwm1 - hwm0) / 1024.0);
+    return 0;
+}
+
+/* ======================================================================== counts */
+/* A change list header (sy_changes.c): magic, version 1, flags (snapshot), frames, counts. */
+static size_t cl_header(uint8_t *p, uint32_t entries, uint32_t blobs)
+{
+    const uint32_t magic = SY_CHANGES_WIRE_MAGIC;
+    const uint16_t version = SY_CHANGES_WIRE_VERSION, flags = 1;
+    const uint64_t first = 0, last = 1;
+    memcpy(p, &magic, 4);
+    memcpy(p + 4, &version, 2);
+    memcpy(p + 6, &flags, 2);
+    memcpy(p + 8, &first, 8);
+    memcpy(p + 16, &last, 8);
+    memcpy(p + 24, &entries, 4);
+    memcpy(p + 28, &blobs, 4);
+    return 32;
+}
+
+/* An entry header {u8 type, u8 flags, u16 0, u32 id, u64 mask}. */
+static size_t cl_entry(uint8_t *p, uint32_t type, uint32_t flags, uint32_t id, uint64_t mask)
+{
+    p[0] = (uint8_t)type;
+    p[1] = (uint8_t)flags;
+    p[2] = p[3] = 0;
+    memcpy(p + 4, &id, 4);
+    memcpy(p + 8, &mask, 8);
+    return 16;
+}
+
+/* SCENE {u64 frame, u32 flags (snapshot), u32 size, size bytes} as a raw frame with sequence 2. */
+static size_t scene_frame(uint8_t *out, const uint8_t *changes, uint32_t n, uint32_t declared)
+{
+    uint8_t *body = malloc(16 + (size_t)n);
+    if (!body) return 0;
+    const uint64_t frame = 1;
+    const uint32_t flags = SY_CLUSTER_SCENE_SNAPSHOT;
+    memcpy(body, &frame, 8);
+    memcpy(body + 8, &flags, 4);
+    memcpy(body + 12, &declared, 4);
+    memcpy(body + 16, changes, n);
+    size_t r = frame_bytes(out, SY_CLUSTER_SCENE, body, 16 + n, 2);
+    free(body);
+    return r;
+}
+
+#define HANDLE(index) ((1u << SY_HANDLE_INDEX_BITS) | (uint32_t)(index)) /* generation 1 */
+
+static int test_counts(fixture *fx)
+{
+    server sv;
+    memset(&sv, 0, sizeof sv);
+    if (start_server(NULL, 0, &sv)) return 1;
+    sleep_ms(100);
+    long hwm0 = server_status_kb(sv.pid, "VmHWM");
+    CHECK(hwm0 > 0);
+    static uint8_t cl[4096], fr[8192];
+    uint32_t type;
+    char why[SY_CLUSTER_REASON_MAX];
+    int bad = 0;
+    /* 1. the finding: 144 bytes creating every type at slot index 2^20 - 1 */
+    size_t n = cl_header(cl, SY_TYPE_COUNT - 1, 0);
+    for (uint32_t t = 1; t < SY_TYPE_COUNT; ++t) n += cl_entry(cl + n, t, 1, HANDLE((1u << 20) - 1), 0);
+    CHECK(n == 144);
+    size_t fn = scene_frame(fr, cl, (uint32_t)n, (uint32_t)n);
+    if (raw_session_frame(&sv, fr, fn, &type, why, sizeof why)) return 1;
+    long hwm1 = server_status_kb(sv.pid, "VmHWM");
+    printf("counts: 144-byte change list creating 7 objects at slot index 1048575: %s '%s'; server VmHWM %+.1f MiB\n",
+           sy_cluster_msg_type_name(type), why, (hwm1 - hwm0) / 1024.0);
+    if (!(type == SY_CLUSTER_ERROR && strstr(why, "slots to this replica's pools"))) {
+        fprintf(stderr, "counts: the 144-byte list was not refused for its pool growth\n");
+        bad++;
+    }
+    /* 2..5: change lists whose counts their bytes cannot carry */
+    static const struct {
+        const char *what, *reason;
+    } lists[] = {{"2^20 entries in 144 bytes", "counts larger than the message can hold"},
+                 {"2^20 blobs in 144 bytes", "counts larger than the message can hold"},
+                 {"a mesh with 2^20 primitives", "primitive count larger than the message can hold"},
+                 {"a node with 2^20 attachments", "attachment count larger than the message can hold"}};
+    for (int k = 0; k < 4; ++k) {
+        memset(cl, 0, sizeof cl);
+        n = k == 0 ? cl_header(cl, 1u << 20, 0) : k == 1 ? cl_header(cl, 0, 1u << 20) : cl_header(cl, 1, 0);
+        if (k == 2) n += cl_entry(cl + n, SY_TYPE_MESH, 1, HANDLE(1), 1ull << SY_MESH_PRIMITIVES);
+        if (k == 3) n += cl_entry(cl + n, SY_TYPE_NODE, 1, HANDLE(1), 1ull << SY_FIELD_ATTACHMENTS);
+        const uint32_t big = 1u << 20;
+        if (k >= 2) memcpy(cl + n, &big, 4), n += 4;
+        n = n < 144 ? 144 : n;
+        fn = scene_frame(fr, cl, (uint32_t)n, (uint32_t)n);
+        if (raw_session_frame(&sv, fr, fn, &type, why, sizeof why)) return 1;
+        printf("counts: %s: %s '%s'\n", lists[k].what, sy_cluster_msg_type_name(type), why);
+        if (!(type == SY_CLUSTER_ERROR && strstr(why, lists[k].reason))) bad++;
+    }
+    /* 6..8: messages whose counts their bytes cannot carry */
+    uint8_t body[64];
+    memset(body, 0, sizeof body);
+    const uint64_t frame = 1;
+    const uint32_t many = 1u << 20;
+    memcpy(body, &frame, 8);
+    memcpy(body + 8, &many, 4);
+    fn = frame_bytes(fr, SY_CLUSTER_BLOBS, body, 40, 2);
+    if (raw_session_frame(&sv, fr, fn, &type, why, sizeof why)) return 1;
+    printf("counts: BLOBS naming 2^20 blobs in 40 bytes: %s '%s'\n", sy_cluster_msg_type_name(type), why);
+    if (!(type == SY_CLUSTER_ERROR && strstr(why, "truncated blob list"))) bad++;
+    {
+        sy_error e = {0};
+        sy_cluster_rect tile = {0, 0, 4, 4};
+        sy_cluster_msg r;
+        memset(&r, 0, sizeof r);
+        r.header.type = SY_CLUSTER_RENDER;
+        r.header.seq = 2;
+        strcpy(r.u.render.backend, "whitted");
+        r.u.render.full_width = r.u.render.full_height = 8;
+        r.u.render.camera = sy_camera_view_frame_bounds(&(sy_bounds){{-1, -1, -1}, {1, 1, 1}}, 1.0f);
+        r.u.render.tile_count = 1;
+        r.u.render.tiles = &tile;
+        sy_cluster_buf b = {0};
+        CHECK_OK(sy_cluster_encode(&r, 0, &b, &e), e);
+        const uint32_t tiles = 4096, body_size = (uint32_t)(b.size - SY_CLUSTER_HEADER_SIZE - 16);
+        memcpy(b.data + b.size - 20, &tiles, 4); /* tile_count, then drop the one tile */
+        memcpy(b.data + 12, &body_size, 4);
+        if (raw_session_frame(&sv, b.data, b.size - 16, &type, why, sizeof why)) return 1;
+        sy_cluster_buf_free(&b);
+        printf("counts: RENDER naming 4096 tiles and carrying none: %s '%s'\n", sy_cluster_msg_type_name(type), why);
+        if (!(type == SY_CLUSTER_ERROR && strstr(why, "truncated tile list"))) bad++;
+    }
+    n = cl_header(cl, 0, 0);
+    fn = scene_frame(fr, cl, (uint32_t)n, 1u << 31);
+    if (raw_session_frame(&sv, fr, fn, &type, why, sizeof why)) return 1;
+    printf("counts: SCENE announcing a 2 GiB change list and carrying 32 bytes: %s '%s'\n",
+           sy_cluster_msg_type_name(type), why);
+    if (!(type == SY_CLUSTER_ERROR && strstr(why, "truncated"))) bad++;
+    long hwm2 = server_status_kb(sv.pid, "VmHWM");
+    printf("counts: server VmHWM %.1f MiB before, %.1f MiB after every forged message (+%.1f MiB; limit +32 MiB)\n",
+           hwm0 / 1024.0, hwm2 / 1024.0, (hwm2 - hwm0) / 1024.0);
+    /* and it still renders */
+    sy_error e = {0};
+    sy_layer out = {0};
+    sy_cluster_client *c = honest_client(fx, &sv, NULL, &e);
+    CHECK_MSG(c != NULL, "%s", e.message);
+    sy_cluster_frame f = honest_frame(fx);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, NULL, &e), e);
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&out);
+    stop_server(&sv);
+    CHECK_MSG(bad == 0, "%d forged message(s) not refused with the expected reason", bad);
+    CHECK_MSG(hwm2 - hwm0 < 32 * 1024, "forged counts made the server allocate %.1f MiB", (hwm2 - hwm0) / 1024.0);
+    return 0;
+}
+
+#ifndef SY_TEST_LEGACY_WIRE
+/* The replica's allocation per byte of a SCENE, on a fresh server: VmHWM after the SCENE less
+ * VmHWM before it (the reassembly buffer, the decoded list, the replica, its commit). */
+static int replica_cost(const uint8_t *changes, size_t n, const char *what, double *per_byte, long *kb_out)
+{
+    server sv;
+    memset(&sv, 0, sizeof sv);
+    if (start_server(NULL, 0, &sv)) return 1;
+    sleep_ms(100);
+    long hwm0 = server_status_kb(sv.pid, "VmHWM");
+    uint8_t *fr = malloc(n + 64);
+    CHECK(fr != NULL);
+    size_t fn = scene_frame(fr, changes, (uint32_t)n, (uint32_t)n);
+    uint32_t type;
+    char why[SY_CLUSTER_REASON_MAX];
+    int rc = raw_session_frame(&sv, fr, fn, &type, why, sizeof why);
+    free(fr);
+    long hwm1 = server_status_kb(sv.pid, "VmHWM");
+    stop_server(&sv);
+    if (rc) return 1;
+    CHECK_MSG(type == SY_CLUSTER_SCENE_ACK, "%s refused: %s", what, why);
+    *kb_out = hwm1 - hwm0;
+    *per_byte = (double)(hwm1 - hwm0) * 1024.0 / (double)n;
+    printf("counts: replica cost of %s (%zu bytes): VmHWM +%.1f MiB = %.1f bytes per message byte\n", what, n,
+           (hwm1 - hwm0) / 1024.0, *per_byte);
+    return 0;
+}
+
+static int test_replica_multiple(void)
+{
+    sy_error e = {0};
+    /* dense: a snapshot of 20000 materials (the largest data record) with default values */
+    sy_scene *sc = NULL;
+    sy_changes *ch = NULL;
+    void *data = NULL;
+    size_t size = 0;
+    CHECK_OK(sy_scene_create(&sc, &e), e);
+    for (int i = 0; i < 20000; ++i) {
+        sy_material m;
+        CHECK_OK(sy_material_create(sc, NULL, &m, &e), e);
+    }
+    CHECK_OK(sy_scene_commit(sc, NULL, &e), e);
+    CHECK_OK(sy_scene_snapshot(sc, &ch, &e), e);
+    CHECK_OK(sy_changes_serialize(ch, NULL, NULL, &data, &size, &e), e);
+    sy_changes_release(ch);
+    sy_scene_destroy(sc);
+    double dense, sparse;
+    long kb_dense, kb_sparse;
+    size_t dense_size = size;
+    if (replica_cost(data, size, "a dense snapshot of 20000 materials", &dense, &kb_dense)) return 1;
+    free(data);
+    /* sparse: 40000 bare material creations (16 bytes each, the largest data record per wire byte)
+     * spread over the pool slots the bound admits for the list's size (SY_CLUSTER_APPLY_SLACK_SLOTS
+     * + size / SY_CLUSTER_APPLY_BYTES_PER_SLOT): the worst case per byte */
+    const uint32_t k = 40000;
+    size = 32 + (size_t)16 * k;
+    uint32_t allowed = SY_CLUSTER_APPLY_SLACK_SLOTS + (uint32_t)(size / SY_CLUSTER_APPLY_BYTES_PER_SLOT);
+    uint32_t step = (allowed - 1) / k;
+    uint8_t *cl = malloc(size);
+    CHECK(cl != NULL);
+    size_t n = cl_header(cl, k, 0);
+    for (uint32_t i = 1; i <= k; ++i) n += cl_entry(cl + n, SY_TYPE_MATERIAL, 1, HANDLE(i * step), 0);
+    CHECK(n == size);
+    if (replica_cost(cl, size, "40000 materials spread over the slots the bound admits", &sparse, &kb_sparse)) return 1;
+    free(cl);
+    /* docs/PROTOCOL.md: a SCENE of N bytes makes a server allocate at most 64 N + 4 MiB, plus the
+     * blobs it references (the reassembly buffer, the decoded list, the replica and its commit,
+     * allocator slack included); AddressSanitizer's redzones add about half to small blocks */
+#ifdef HOSTILE_ASAN
+    const double slack = 1.5;
+#else
+    const double slack = 1.0;
+#endif
+    CHECK_MSG(kb_dense * 1024.0 <= slack * (64.0 * (double)dense_size + 4 * MIB),
+              "dense snapshot: %.1f bytes per byte exceeds the documented bound", dense);
+    CHECK_MSG(kb_sparse * 1024.0 <= slack * (64.0 * (double)size + 4 * MIB),
+              "sparse list: %.1f bytes per byte exceeds the documented bound", sparse);
+    return 0;
+}
+#endif
+
+#ifndef SY_TEST_LEGACY_WIRE
+/* ======================================================================== ceiling */
+/* A raw session (no secret) that has sent HELLO; -1 on failure. */
+static int open_session(int port)
+{
+    int fd = raw_connect(port, 20000);
+    if (fd < 0) return -1;
+    sy_cluster_msg hello = raw_hello(), rep;
+    uint8_t *raw = NULL;
+    if (raw_send_msg(fd, &hello) != 0 || raw_recv_msg(fd, 1 << 16, &rep, &raw) != 0) {
+        close(fd);
+        return -1;
+    }
+    sy_cluster_msg_free(&rep);
+    free(raw);
+    return fd;
+}
+
+/* One frame of a SCENE message: n body bytes (zeros), MORE unless last. */
+static bool scene_chunk(int fd, uint32_t n, bool last, uint64_t seq)
+{
+    static uint8_t zeros[400 << 10];
+    uint8_t h[SY_CLUSTER_HEADER_SIZE];
+    sy_cluster_header_write(h, SY_CLUSTER_SCENE, last ? 0u : SY_CLUSTER_FLAG_MORE, n, seq);
+    return n <= sizeof zeros && raw_write_all(fd, h, sizeof h) && raw_write_all(fd, zeros, n);
+}
+
+/* The peer memory ceiling (--max-peer-memory-mb 1): a message that does not fit waits while
+ * another peer holds the memory (back-pressure) and goes on when it is released; one that still
+ * does not fit after the wait is refused with a reason naming the ceiling; the server keeps
+ * serving. */
+static int test_ceiling(fixture *fx)
+{
+    server sv;
+    memset(&sv, 0, sizeof sv);
+    const char *extra[] = {"--max-peer-memory-mb", "1", "--max-frame-kb", "512", NULL};
+    if (start_server_args(NULL, 0, extra, &sv)) return 1;
+    const uint32_t k = 400 << 10;
+    /* A holds 400 KiB; B's message needs 800 KiB: it waits until A goes away after 1 s */
+    int a = open_session(sv.port), b = open_session(sv.port);
+    CHECK(a >= 0 && b >= 0);
+    CHECK(scene_chunk(a, k, false, 2) && scene_chunk(b, k, false, 2));
+    sleep_ms(200);
+    double t0 = now_s();
+    CHECK(scene_chunk(b, k, false, 3));
+    sleep_ms(1000);
+    close(a);
+    CHECK(scene_chunk(b, 16, true, 4));
+    sy_cluster_msg rep;
+    uint8_t *raw = NULL;
+    CHECK(raw_recv_msg(b, 1 << 16, &rep, &raw) == 0);
+    double waited = now_s() - t0;
+    printf("ceiling: a message that did not fit waited %.2f s for another peer's 400 KiB, then got %s '%s'\n", waited,
+           sy_cluster_msg_type_name(rep.header.type), rep.header.type == SY_CLUSTER_ERROR ? rep.u.error.reason : "");
+    /* its 800 KiB of zeros is no SCENE: refused by the decoder, not by the ceiling */
+    CHECK(rep.header.type == SY_CLUSTER_ERROR && strstr(rep.u.error.reason, "cluster SCENE") &&
+          !strstr(rep.u.error.reason, "server busy"));
+    CHECK(waited >= 0.9);
+    sy_cluster_msg_free(&rep);
+    free(raw);
+    close(b);
+    /* A holds 400 KiB for good: C's second frame is refused after the wait */
+    a = open_session(sv.port);
+    int c = open_session(sv.port);
+    CHECK(a >= 0 && c >= 0);
+    CHECK(scene_chunk(a, k, false, 2) && scene_chunk(c, k, false, 2));
+    sleep_ms(200);
+    t0 = now_s();
+    (void)scene_chunk(c, k, false, 3); /* the server stops reading: may or may not all be taken */
+    int rc = raw_recv_msg(c, 1 << 16, &rep, &raw);
+    double refused = now_s() - t0;
+    CHECK_MSG(rc == 0, "no reply to the message beyond the ceiling (%d)", rc);
+    printf("ceiling: with the memory held, refused after %.2f s: %s '%s'\n", refused,
+           sy_cluster_msg_type_name(rep.header.type), rep.header.type == SY_CLUSTER_ERROR ? rep.u.error.reason : "");
+    CHECK(rep.header.type == SY_CLUSTER_ERROR && strstr(rep.u.error.reason, "server busy") &&
+          strstr(rep.u.error.reason, "--max-peer-memory-mb"));
+    CHECK(refused >= 4.0 && refused < 15.0);
+    sy_cluster_msg_free(&rep);
+    free(raw);
+    close(c);
+    close(a);
+    CHECK(log_contains(&sv, "server busy: peers' messages in flight hold"));
+    /* and it still renders */
+    sy_error e = {0};
+    sy_layer out = {0};
+    sy_cluster_client *cl = honest_client(fx, &sv, NULL, &e);
+    CHECK_MSG(cl != NULL, "%s", e.message);
+    sy_cluster_frame f = honest_frame(fx);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
+    CHECK_OK(sy_cluster_client_render(cl, &f, &out, NULL, &e), e);
+    sy_cluster_client_destroy(cl);
+    sy_layer_destroy(&out);
+    stop_server(&sv);
+    return 0;
+}
+#endif
+
+/* ======================================================================== cap */
+static int test_cap(fixture *fx)
+{
+    server sv;
+    memset(&sv, 0, sizeof sv);
+    const char *extra[] = {"--max-unauthenticated", "8", "--handshake-timeout-ms", "1500", NULL};
+    if (start_server_args("s3cret", 0, extra, &sv)) return 1;
+    int fd[12];
+    double opened = now_s();
+    for (int i = 0; i < 12; ++i) {
+        fd[i] = raw_connect(sv.port, 5000);
+        CHECK(fd[i] >= 0);
+        sleep_ms(30);
+    }
+    int closed_early = 0, open_early = 0;
+    for (int i = 8; i < 12; ++i) closed_early += raw_closed_within(fd[i], 500);
+    for (int i = 0; i < 8; ++i) open_early += !raw_closed_within(fd[i], 10);
+    double t_check = now_s() - opened;
+    int closed_late = 0;
+    for (int i = 0; i < 8; ++i) closed_late += raw_closed_within(fd[i], 3000);
+    double t_late = now_s() - opened;
+    for (int i = 0; i < 12; ++i) close(fd[i]);
+    printf("cap: 12 idle connections, limit 8: %d of the 4 beyond the limit closed within 500 ms, %d of the first 8 "
+           "still open %.2f s after opening, %d of them closed by %.2f s (handshake deadline 1.5 s)\n",
+           closed_early, open_early, t_check, closed_late, t_late);
+    bool logged_cap = log_contains(&sv, "connection refused: 8 unauthenticated connections are open (limit 8");
+    bool logged_deadline = log_contains(&sv, "no HELLO within the 1500 ms handshake deadline");
+    sy_error e = {0};
+    sy_cluster_client *c = honest_client(fx, &sv, "s3cret", &e);
+    bool client_ok = c != NULL;
+    sy_cluster_client_destroy(c);
+    stop_server(&sv);
+    CHECK_MSG(closed_early == 4, "only %d of the 4 connections beyond the cap were closed at once", closed_early);
+    CHECK_MSG(open_early == 8, "%d of the 8 connections within the cap were open", open_early);
+    CHECK_MSG(closed_late == 8, "only %d of 8 idle connections were closed at the handshake deadline", closed_late);
+    CHECK_MSG(logged_cap && logged_deadline, "server log: cap %s, deadline %s", logged_cap ? "logged" : "missing",
+              logged_deadline ? "logged" : "missing");
+    CHECK_MSG(client_ok, "no client after the idle connections: %s", e.message);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 3) {
+        fprintf(stderr, "usage: test_cluster_hostile SERVER_EXE WORK_DIR [rss|counts|cap|ceiling]...\n");
+        return 2;
+    }
+    g_exe = argv[1];
+    g_dir = argv[2];
+    mkdir(g_dir, 0755);
+    signal(SIGPIPE, SIG_IGN);
+#ifdef HOSTILE_ASAN
+    /* AddressSanitizer keeps freed memory in a quarantine (256 MiB by default) and so counts every
+     * buffer a server ever freed as resident: the servers this test starts run without it (every
+     * access is still checked, leaks still reported), so that their RSS means what it does in a
+     * plain build. */
+    {
+        static char opts[1024];
+        const char *old = getenv("ASAN_OPTIONS");
+        snprintf(opts, sizeof opts, "%s%squarantine_size_mb=0:thread_local_quarantine_size_kb=0", old ? old : "",
+                 old && *old ? ":" : "");
+        setenv("ASAN_OPTIONS", opts, 1);
+    }
+#endif
+    sy_error e = {0};
+    if (sy_mediators_register_builtin(&e)) {
+        fprintf(stderr, "%s\n", e.message);
+        return 1;
+    }
+    fixture fx = {.w = 64, .h = 48};
+    if (sy_scene_create(&fx.scene, &e) || sy_demo_build(fx.scene, &fx.d, &e) || sy_scene_commit(fx.scene, NULL, &e)) {
+        fprintf(stderr, "%s\n", e.message);
+        return 1;
+    }
+    int failed = 0;
+    for (int g = 0; g < 4; ++g) {
+        static const char *names[] = {"rss", "counts", "cap", "ceiling"};
+        bool want = argc == 3;
+        for (int i = 3; i < argc; ++i) want = want || !strcmp(argv[i], names[g]);
+        if (!want) continue;
+        int r = 0;
+        if (g == 0) r = test_rss(&fx);
+        else if (g == 1) r = test_counts(&fx);
+        else if (g == 2) r = test_cap(&fx);
+#ifndef SY_TEST_LEGACY_WIRE
+        if (g == 1 && !r) r = test_replica_multiple();
+        if (g == 3) r = test_ceiling(&fx);
+#else
+        if (g == 3) continue; /* protocol 2 has no peer memory ceiling at all */
+#endif
+        printf("%s: %s\n", names[g], r ? "FAILED" : "ok");
+        failed += r;
+    }
+    sy_scene_destroy(fx.scene);
+    if (failed) fprintf(stderr, "test_cluster_hostile: %d group(s) failed (server logs in %s)\n", failed, g_dir);
+    return failed ? 1 : 0;
+}
