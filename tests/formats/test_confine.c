@@ -168,6 +168,11 @@ int main(void)
           "allowed_roots admits the Inline: %s (inlines %u)", e.message, xi.counts.inlines);
     sy_x3d_info_free(&xi);
 
+    const char *sub[] = {"model/sub", "model", "model2"}; /* remove_scratch_dir takes flat folders */
+    for (size_t i = 0; i < sizeof sub / sizeof sub[0]; ++i) {
+        PATHF(dir, "%s/%s", g_root, sub[i]);
+        remove_scratch_dir(dir);
+    }
     remove_scratch_dir(g_root);
     return finish_tests("formats_confine");
 }
