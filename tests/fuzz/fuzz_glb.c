@@ -3,8 +3,8 @@
  * the size would always fail the header's total-length check, so when the input is at least a
  * header long, a copy with the total length set to the input size is loaded as well (the chunk
  * lengths stay as mutated). External URIs resolve in fuzz_resource_dir(). */
+#define SY_FUZZ_GLTF
 #include "fuzz_util.h"
-#include "sy_gltf.h"
 
 #include <string.h>
 
@@ -12,20 +12,7 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size);
 
 static void load(const unsigned char *data, size_t size)
 {
-    sy_scene *s;
-    if (sy_scene_create(&s, NULL) != SY_OK) return;
-    sy_gltf_options o = {0};
-    o.max_file_bytes = 1u << 20;
-    o.max_vertices = 1u << 18;
-    o.max_indices = 1u << 19;
-    o.max_image_pixels = 1u << 18;
-    o.max_instances = 1u << 12;
-    sy_gltf_info info = {0};
-    sy_error err = {0};
-    if (sy_gltf_load_memory(data, size, "fuzz.glb", fuzz_resource_dir(), s, &o, &info, &err) == SY_OK)
-        sy_scene_commit(s, NULL, NULL);
-    sy_gltf_info_free(&info);
-    sy_scene_destroy(s);
+    fuzz_load_gltf(data, size, "fuzz.glb");
 }
 
 int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)

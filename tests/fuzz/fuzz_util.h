@@ -21,4 +21,28 @@ static const char *fuzz_resource_dir(void)
     return dir;
 }
 
+#ifdef SY_FUZZ_GLTF
+#include "sy_gltf.h"
+
+/* The glTF and GLB targets' load: from memory into a fresh scene, small limits; `name` (".gltf" or
+ * ".glb") picks the container as a file name would. Any result code is fine. */
+static void fuzz_load_gltf(const unsigned char *data, size_t size, const char *name)
+{
+    sy_scene *s;
+    if (sy_scene_create(&s, NULL) != SY_OK) return;
+    sy_gltf_options o = {0};
+    o.max_file_bytes = 1u << 20;
+    o.max_vertices = 1u << 18;
+    o.max_indices = 1u << 19;
+    o.max_image_pixels = 1u << 18;
+    o.max_instances = 1u << 12;
+    sy_gltf_info info = {0};
+    sy_error err = {0};
+    if (sy_gltf_load_memory(data, size, name, fuzz_resource_dir(), s, &o, &info, &err) == SY_OK)
+        sy_scene_commit(s, NULL, NULL);
+    sy_gltf_info_free(&info);
+    sy_scene_destroy(s);
+}
+#endif
+
 #endif /* SY_FUZZ_UTIL_H */
