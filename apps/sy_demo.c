@@ -1,6 +1,8 @@
 /* sy_demo.c — procedural demo and benchmark scenes (see sy_demo.h). */
 #include "sy_demo.h"
 
+#include "sy_look.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -160,6 +162,45 @@ static sy_result place(sy_scene *s, sy_node parent, const char *name, sy_mesh me
     return SY_OK;
 }
 
+/* A clear-sky lat-long environment (row 0 = up, sy_look.h's convention): deep blue at the zenith,
+ * pale haze at the horizon, a soft warm glow towards the sun (no disc: the demo has its own
+ * lights and a disc would only add noise), a dark ground below. Linear radiance. */
+static sy_result sky_texture(sy_scene *s, sy_texture *out, sy_error *err)
+{
+    enum { W = 256, H = 128 };
+    float *px = malloc(sizeof(float) * 3 * W * H);
+    if (!px) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "demo sky: out of memory");
+    static const float zenith[3] = {0.10f, 0.20f, 0.50f}, horizon[3] = {0.55f, 0.62f, 0.72f},
+                       ground[3] = {0.12f, 0.11f, 0.10f}, sun_dir[3] = {0.48f, 0.60f, 0.64f};
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i) {
+            float d[3];
+            sy_look_latlong_dir(((float)i + 0.5f) / W, ((float)j + 0.5f) / H, d);
+            float *p = px + 3 * (j * W + i);
+            float up = d[1];
+            float t = up > 0.0f ? powf(up, 0.5f) : 0.0f;
+            float cs = d[0] * sun_dir[0] + d[1] * sun_dir[1] + d[2] * sun_dir[2];
+            float glow = cs > 0.0f ? 0.8f * powf(cs, 8.0f) : 0.0f;
+            for (int k = 0; k < 3; ++k) {
+                float skyc = horizon[k] + (zenith[k] - horizon[k]) * t + glow * (k == 0 ? 1.0f : k == 1 ? 0.85f : 0.6f);
+                float b = up < -0.02f ? 0.0f : up > 0.02f ? 1.0f : (up + 0.02f) / 0.04f;
+                p[k] = ground[k] + (skyc - ground[k]) * b;
+            }
+        }
+    sy_blob *blob = NULL;
+    sy_result r = sy_blob_create_take(px, sizeof(float) * 3 * W * H, &blob, err);
+    if (r != SY_OK) {
+        free(px);
+        return r;
+    }
+    sy_image_info info = {W, H, 3, SY_PIXEL_F32};
+    sy_sampler smp = {SY_WRAP_REPEAT, SY_WRAP_CLAMP, SY_FILTER_LINEAR, SY_FILTER_LINEAR};
+    if ((r = sy_texture_create(s, "sky", out, err)) == SY_OK && (r = sy_texture_set_image(s, *out, &info, blob, err)) == SY_OK)
+        r = sy_texture_set_sampler(s, *out, &smp, err);
+    sy_blob_release(blob);
+    return r;
+}
+
 sy_result sy_demo_build(sy_scene *s, sy_demo_info *out, sy_error *err)
 {
     sy_result r;
@@ -210,9 +251,13 @@ sy_result sy_demo_build(sy_scene *s, sy_demo_info *out, sy_error *err)
         (r = sy_node_create(s, "camera", &cam_node, err)) || (r = sy_node_set_trs(s, cam_node, t, q, one, err)) ||
         (r = sy_node_set_camera(s, cam_node, cam, err)) || (r = sy_node_add_child(s, root, cam_node, err)))
         return r;
+    /* the world: a clear sky as the environment light, seen behind the scene */
     sy_background bg;
+    sy_texture sky;
     sy_background_data bd = *(const sy_background_data *)sy_object_defaults(SY_TYPE_BACKGROUND);
-    bd.color[0] = 0.18f, bd.color[1] = 0.24f, bd.color[2] = 0.34f, bd.color[3] = 1.0f;
+    if ((r = sky_texture(s, &sky, err))) return r;
+    bd.environment = sky;
+    bd.intensity = 1.0f;
     if ((r = sy_background_create(s, "sky", &bg, err)) || (r = sy_background_set(s, bg, &bd, err))) return r;
     out->root = root;
     out->camera = cam_node;

@@ -3,10 +3,13 @@
  *   sy info SCENE                       JSON summary (counts, bounds) of a glTF file
  *   sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]
  *             [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]
- *             with -b pathtracer: [--spp N | --time SECONDS] [--aov] [--env MAP.exr] [--env-intensity X]
- *             [--background R,G,B] [--filter none|pixel|atrous|jbu|adaptive|radiance [--threshold T]]
+ *             with -b pathtracer: [--spp N | --time SECONDS] [--aov]
+ *             [--filter none|pixel|atrous|jbu|adaptive|radiance [--threshold T]]
+ *   world options of every command: [--env MAP.exr | --env-color R,G,B] [--env-intensity X] [--env-hidden]
+ *             [--background R,G,B[,A]] [--no-default-light]   (see sy_world.h and sy_look.h)
  *             [--gl osmesa|egl|glfw]  (raster back-end's GL context provider)
  *   sy demo [-o DIR] [-w W] [-h H]      render the built-in demo scene with every back-end
+ *   sy compare SCENE [-w W] [-h H] [--spp N] [-o SHEET.png]   every back-end side by side (sy_compare.h)
  *   sy bench sync [--nodes N] [--tris T] [--repeats R]
  *   sy bench rays [SCENE] [-w W] [-h H] [--repeats R]
  *   sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params k=v,...]
@@ -22,12 +25,14 @@
  * the file and the reason; the exit code is non-zero (1 = usage, 2 = failure). */
 #include "sy_bench.h"
 #include "sy_cluster_cli.h"
+#include "sy_compare.h"
 #include "sy_compose.h"
 #ifdef SY_HAVE_GLFW
 #include "sy_view.h"
 #endif
 #include "sy_demo.h"
 #include "sy_exr.h"
+#include "sy_world.h"
 #include "sy_gltf.h"
 #include "sy_mediator_rt.h"
 #include "sy_mediators.h"
@@ -91,24 +96,7 @@ static sy_result add_defaults(loaded *ld, sy_error *err)
     } else if ((r = sy_node_world_matrix(s, ld->camera, &cam_world, err))) {
         return r;
     }
-    bool emissive = false;
-    for (uint32_t id = sy_scene_next(s, SY_TYPE_MATERIAL, 0); id && !emissive; id = sy_scene_next(s, SY_TYPE_MATERIAL, id)) {
-        const sy_material_data *m = sy_object_get(s, SY_TYPE_MATERIAL, id);
-        emissive = m->emissive_strength * (m->emissive[0] + m->emissive[1] + m->emissive[2]) > 0.0f;
-    }
-    if (sy_scene_count(s, SY_TYPE_LIGHT) == 0 && !emissive) {
-        fprintf(stderr, "sy: note: the scene has no lights; adding a directional headlight\n");
-        sy_light l;
-        sy_node n;
-        sy_light_data ld2 = *(const sy_light_data *)sy_object_defaults(SY_TYPE_LIGHT);
-        ld2.type = SY_LIGHT_DIRECTIONAL;
-        ld2.intensity = 3.0f;
-        /* under the root (identity for glTF), so the mediator's root filter sees it */
-        if ((r = sy_light_create(s, "headlight", &l, err)) || (r = sy_light_set(s, l, &ld2, err)) ||
-            (r = sy_node_create(s, "headlight", &n, err)) || (r = sy_node_set_matrix(s, n, &cam_world, err)) ||
-            (r = sy_node_set_light(s, n, l, err)) || (r = sy_node_add_child(s, ld->root, n, err)))
-            return r;
-    }
+    (void)cam_world;
     return sy_scene_commit(s, NULL, err);
 }
 
@@ -120,7 +108,60 @@ static struct {
     const char *roots[SY_MAX_ALLOW_PATHS];
     size_t root_count;
     bool strict;
+    sy_world_options world; /* --env, --env-color, --env-intensity, --env-hidden, --background, --no-default-light */
 } g_load;
+
+/* The world flags every command shares (taken out of the arguments in main): --env MAP.exr,
+ * --env-color R,G,B, --env-intensity X, --env-hidden, --background R,G,B[,A], --no-default-light.
+ * *used = arguments consumed (0: not a world flag). Only maps text onto sy_world_options; the
+ * meaning is the library's (sy_look.h, sy_world.h). */
+static bool parse_floats(const char *text, float *out, int min_n, int max_n, int *n_out)
+{
+    int n = 0;
+    const char *p = text;
+    while (n < max_n) {
+        char *end = NULL;
+        out[n] = strtof(p, &end);
+        if (end == p || !isfinite(out[n])) return false;
+        ++n;
+        if (*end == '\0') break;
+        if (*end != ',') return false;
+        p = end + 1;
+    }
+    *n_out = n;
+    return n >= min_n && *p && p[strlen(p) - 1] != ',';
+}
+
+static sy_result parse_world_flag(int argc, char **argv, sy_world_options *w, int *used, sy_error *err)
+{
+    const char *a = argv[0], *v = argc > 1 ? argv[1] : NULL;
+    int n = 0;
+    *used = 0;
+    if (!strcmp(a, "--env-hidden")) w->env_hidden = true, *used = 1;
+    else if (!strcmp(a, "--no-default-light")) w->no_default_light = true, *used = 1;
+    else if (!strcmp(a, "--env") || !strcmp(a, "--env-color") || !strcmp(a, "--env-intensity") ||
+             !strcmp(a, "--background")) {
+        if (!v) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: missing value", a);
+        *used = 2;
+        if (!strcmp(a, "--env")) {
+            w->env_path = v;
+        } else if (!strcmp(a, "--env-color")) {
+            if (!parse_floats(v, w->env_color, 3, 3, &n))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--env-color %s: expected R,G,B", v);
+            w->has_env_color = true;
+        } else if (!strcmp(a, "--env-intensity")) {
+            if (!parse_floats(v, &w->env_intensity, 1, 1, &n))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--env-intensity %s: expected a number", v);
+            w->env_intensity_set = true;
+        } else {
+            if (!parse_floats(v, w->background, 3, 4, &n))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--background %s: expected R,G,B or R,G,B,A", v);
+            if (n == 3) w->background[3] = 1.0f;
+            w->has_background = true;
+        }
+    }
+    return SY_OK;
+}
 
 /* Prints what the loader skipped or repaired (sy: warning: FILE: item: what); with --strict any of
  * them fails the load. */
@@ -180,6 +221,10 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
     }
     if (r == SY_OK) r = sy_scene_commit(out->scene, NULL, err);
     if (r == SY_OK && (out->is_gltf || out->is_x3d) && defaults) r = add_defaults(out, err);
+    /* the user's world choices: sy_world (formats) maps them onto the world object */
+    if (r == SY_OK && !sy_world_options_empty(&g_load.world) &&
+        (r = sy_world_apply(out->scene, &out->background, &g_load.world, err)) == SY_OK)
+        r = sy_scene_commit(out->scene, NULL, err);
     if (r != SY_OK) loaded_free(out);
     return r;
 }
@@ -265,78 +310,7 @@ typedef struct pt_opts {
     uint32_t spp;         /* 0 = default (64 unless a time budget is given) */
     double time_budget;   /* seconds, 0 = none */
     bool aov;             /* write feature buffers as extra EXR channels */
-    const char *env;      /* equirectangular EXR environment */
-    float env_intensity;
-    bool has_bg;
-    float bg[3];          /* constant background radiance (a uniform environment for the path tracer) */
 } pt_opts;
-
-/* Reads an equirectangular EXR (R, G, B or Y channels) into a float RGB texture and makes it the
- * environment (and/or sets the background colour) of the viewport's background object. */
-static sy_result setup_environment(loaded *ld, const pt_opts *po, sy_error *err)
-{
-    if (!po->env && !po->has_bg) return SY_OK;
-    sy_scene *s = ld->scene;
-    sy_background_data bd = *(const sy_background_data *)sy_object_defaults(SY_TYPE_BACKGROUND);
-    if (ld->background.id) bd = *sy_background_get(s, ld->background);
-    bd.name = NULL;
-    if (po->has_bg) {
-        for (int k = 0; k < 3; ++k) bd.color[k] = po->bg[k];
-        bd.color[3] = 1.0f;
-    }
-    sy_result r = SY_OK;
-    if (po->env) {
-        sy_exr_image *img = NULL;
-        if ((r = sy_exr_read(po->env, &img, err)) != SY_OK) {
-            sy_error_prefix(err, "environment");
-            return r;
-        }
-        const float *ch[3] = {sy_exr_image_channel(img, "R"), sy_exr_image_channel(img, "G"), sy_exr_image_channel(img, "B")};
-        const float *y = sy_exr_image_channel(img, "Y");
-        if (!ch[0] || !ch[1] || !ch[2]) {
-            if (!y) {
-                sy_exr_image_free(img);
-                return sy_error_set(err, SY_ERR_PARSE, "environment %s: no R, G, B (or Y) channels", po->env);
-            }
-            ch[0] = ch[1] = ch[2] = y;
-        }
-        size_t n = (size_t)img->width * (size_t)img->height;
-        float *px = malloc(n * 3 * sizeof *px);
-        if (!px) {
-            sy_exr_image_free(img);
-            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "environment %s: out of memory", po->env);
-        }
-        for (size_t i = 0; i < n && r == SY_OK; ++i)
-            for (int k = 0; k < 3; ++k) {
-                float v = ch[k][i];
-                if (!isfinite(v) || v < 0.0f)
-                    r = sy_error_set(err, SY_ERR_PARSE, "environment %s: pixel (%zu, %zu) has a %s value %g", po->env,
-                                     i % (size_t)img->width, i / (size_t)img->width,
-                                     isfinite(v) ? "negative" : "non-finite", (double)v);
-                px[i * 3 + (size_t)k] = v;
-            }
-        sy_image_info info = {(uint32_t)img->width, (uint32_t)img->height, 3, SY_PIXEL_F32};
-        sy_exr_image_free(img);
-        sy_blob *blob = NULL;
-        if (r == SY_OK) r = sy_blob_create_take(px, n * 3 * sizeof *px, &blob, err);
-        if (r != SY_OK) {
-            free(px);
-            return r;
-        }
-        sy_texture tex;
-        sy_sampler smp = {SY_WRAP_REPEAT, SY_WRAP_CLAMP, SY_FILTER_LINEAR, SY_FILTER_LINEAR};
-        if ((r = sy_texture_create(s, "environment", &tex, err)) == SY_OK &&
-            (r = sy_texture_set_image(s, tex, &info, blob, err)) == SY_OK)
-            r = sy_texture_set_sampler(s, tex, &smp, err);
-        sy_blob_release(blob);
-        if (r != SY_OK) return r;
-        bd.environment = tex;
-        bd.intensity = po->env_intensity;
-    }
-    if (!ld->background.id && (r = sy_background_create(s, "background", &ld->background, err)) != SY_OK) return r;
-    if ((r = sy_background_set(s, ld->background, &bd, err)) != SY_OK) return r;
-    return sy_scene_commit(s, NULL, err);
-}
 
 typedef struct pt_progress {
     double start;
@@ -468,9 +442,11 @@ static int usage(void)
             "            [--stereo sbs|tb|anaglyph|separate] [--eye-sep M] [--zero-parallax M]\n"
             "            [--overlay FILE[:BACKEND]] [--composite depth|over|replace]\n"
             "  sy render SCENE -b pathtracer -o OUT.exr|png [--spp N | --time SECONDS] [--aov]\n"
-            "            [--env MAP.exr] [--env-intensity X] [--background R,G,B] (+ the options above)\n"
+            "            (+ the options above)\n"
             "            [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]   (display filter)\n"
-            "  sy demo [-o DIR] [-w W] [-h H]\n"
+            "  sy demo [-o DIR] [-w W] [-h H] [--filter pixel|none|...]   (the progressive back-end's display filter)\n"
+            "  sy compare SCENE [-w W] [-h H] [--spp N] [-o SHEET.png] [--camera C] [--backends a,b,...]\n"
+            "            (every back-end side by side: contact sheet + mean luminance, ratio and IoU table)\n"
             "  sy view SCENE [-b BACKEND] [-w W] [-h H] [--camera C] [--overlay FILE[:BACKEND]]\n"
             "          [--frames N --screenshot OUT.png] [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]\n"
             "          [--keys KEYS]   (automated runs: press these keys one frame after another, e.g. F]F[)\n"
@@ -490,7 +466,11 @@ static int usage(void)
             "            [--cluster-mode sort-first|balanced|cooperative|multi-display|stereo] [--secret-file F]\n"
             "            [--tls-ca PEM] [--timeout-ms MS] [--frames N] [--spp N] [--cluster-pixels float|half]\n"
             "  sy bench cluster [-w W] [-h H] [--repeats ROUNDS]\n"
-            "SCENE: a .gltf/.glb/.x3d file, or 'demo' for the built-in scene\n");
+            "SCENE: a .gltf/.glb/.x3d file, or 'demo' for the built-in scene\n"
+            "world options (every command): [--env MAP.exr | --env-color R,G,B] [--env-intensity X] [--env-hidden]\n"
+            "  [--background R,G,B[,A]] [--no-default-light]: the environment is a light; the background is what\n"
+            "  the camera sees where nothing is hit; a scene with no light of its own is lit by a neutral studio\n"
+            "  environment unless --no-default-light is given\n");
     return 1;
 }
 
@@ -638,7 +618,7 @@ static int cmd_render(int argc, char **argv)
     sy_error perr = {0};
     sy_cluster_cli_opts clo = {0};
     bool clbad = false;
-    pt_opts po = {.env_intensity = 1.0f};
+    pt_opts po = {0};
     bool progressive_opts = false; /* --spp / --time / --aov given */
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
@@ -653,16 +633,6 @@ static int cmd_render(int argc, char **argv)
             if (*end || !(po.time_budget > 0) || !isfinite(po.time_budget)) return usage();
             progressive_opts = true;
         } else if (!strcmp(a, "--aov")) po.aov = progressive_opts = true;
-        else if (!strcmp(a, "--env") && has) po.env = argv[++i];
-        else if (!strcmp(a, "--env-intensity") && has) {
-            po.env_intensity = strtof(argv[++i], &end);
-            if (*end || !isfinite(po.env_intensity) || po.env_intensity < 0) return usage();
-        } else if (!strcmp(a, "--background") && has) {
-            if (sscanf(argv[++i], "%f,%f,%f", &po.bg[0], &po.bg[1], &po.bg[2]) != 3 || !isfinite(po.bg[0]) ||
-                !isfinite(po.bg[1]) || !isfinite(po.bg[2]) || po.bg[0] < 0 || po.bg[1] < 0 || po.bg[2] < 0)
-                return usage();
-            po.has_bg = true;
-        }
         else if (!strcmp(a, "-o") && has) outp = argv[++i];
         else if (!strcmp(a, "-w") && has) {
             if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
@@ -745,10 +715,6 @@ static int cmd_render(int argc, char **argv)
     spec.background = ld.background;
     sy_result r = overlay ? add_overlay(&ld, overlay, composite, &spec, &err) : SY_OK;
     if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
-    if (r == SY_OK && (po.env || po.has_bg)) {
-        r = setup_environment(&ld, &po, &err);
-        spec.background = ld.background;
-    }
     progress_state ps = {backend, sy_time_now(), 0, sy_is_terminal(2)};
     sy_window_render_opts ro = {.progress = progress_cb, .progress_user = &ps};
     double t0 = sy_time_now();
@@ -817,13 +783,61 @@ static int cmd_render(int argc, char **argv)
     return r == SY_OK ? 0 : fail(&err);
 }
 
+/* sy compare SCENE [-w W] [-h H] [--spp N] [-o SHEET.png] [--camera C] [--backends a,b]:
+ * every picture back-end side by side (sy_compare.h). */
+static int cmd_compare(int argc, char **argv)
+{
+    const char *scene = NULL, *camera = NULL, *sheet = "compare.png", *only = NULL;
+    uint32_t w = 200, h = 150, spp = 256;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        bool has = i + 1 < argc;
+        if (!strcmp(a, "-w") && has) {
+            if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
+        } else if (!strcmp(a, "-h") && has) {
+            if (!parse_u32(argv[++i], 1, 16384, &h)) return usage();
+        } else if (!strcmp(a, "--spp") && has) {
+            if (!parse_u32(argv[++i], 1, 1u << 20, &spp)) return usage();
+        } else if (!strcmp(a, "-o") && has) sheet = argv[++i];
+        else if (!strcmp(a, "--camera") && has) camera = argv[++i];
+        else if (!strcmp(a, "--backends") && has) only = argv[++i];
+        else if (a[0] != '-' && !scene) scene = a;
+        else {
+            fprintf(stderr, "sy compare: unknown or incomplete option '%s'\n", a);
+            return usage();
+        }
+    }
+    if (!scene) return usage();
+    if (!ends_with(sheet, ".png")) {
+        fprintf(stderr, "sy compare: %s: the contact sheet must end in .png\n", sheet);
+        return 2;
+    }
+    sy_error err = {0};
+    loaded ld;
+    if (load(scene, camera, true, &ld, &err) != SY_OK) return fail(&err);
+    if (ld.is_x3d) fit_x3d_cameras(&ld, w, h);
+    sy_context_pool *pool = NULL;
+    sy_result r = sy_context_pool_create(&pool, &err);
+    sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .background = ld.background};
+    sy_compare_opts co = {.width = w, .height = h, .spp = spp, .sheet_path = sheet, .title = scene, .only = only};
+    sy_compare_row rows[16];
+    uint32_t n = 0;
+    printf("%s, %ux%u\n", scene, w, h);
+    if (r == SY_OK) r = sy_compare_run(ld.scene, &vd, &co, pool, stdout, rows, 16, &n, &err);
+    if (r == SY_OK) printf("contact sheet: %s\n", sheet);
+    sy_context_pool_destroy(pool);
+    loaded_free(&ld);
+    return r == SY_OK ? 0 : fail(&err);
+}
+
 static int cmd_demo(int argc, char **argv)
 {
-    const char *dir = "out";
+    const char *dir = "out", *filter = "pixel";
     uint32_t w = 800, h = 450;
     for (int i = 0; i < argc; ++i) {
         bool has = i + 1 < argc;
         if (!strcmp(argv[i], "-o") && has) dir = argv[++i];
+        else if (!strcmp(argv[i], "--filter") && has) filter = argv[++i];
         else if (!strcmp(argv[i], "-w") && has) {
             if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
         } else if (!strcmp(argv[i], "-h") && has) {
@@ -845,16 +859,23 @@ static int cmd_demo(int argc, char **argv)
         const char *name = sy_mediator_at(i)->name;
         sy_layer img = {0};
         double secs = 0;
-        /* a progressive back-end gets 32 samples per pixel: a readable image in a few seconds */
-        uint32_t spp = (sy_mediator_at(i)->caps & SY_CAP_PROGRESSIVE) ? 32 : 0;
-        r = render_scene(&ld, name, NULL, w, h, spp, pool, &img, &secs, &err);
+        /* a progressive back-end gets 32 samples per pixel and its display filter (pixel filtering,
+         * which also withholds fireflies; --filter none shows the raw samples): a clean image in a
+         * few seconds */
+        bool progressive = (sy_mediator_at(i)->caps & SY_CAP_PROGRESSIVE) != 0;
+        if (sy_mediator_at(i)->caps & SY_CAP_ANALYSIS) continue;
+        uint32_t spp = progressive ? 32 : 0;
+        char params[64];
+        snprintf(params, sizeof params, "filter=%s", filter);
+        r = render_scene(&ld, name, progressive ? params : NULL, w, h, spp, pool, &img, &secs, &err);
         char png[1024], exr[1024];
         snprintf(png, sizeof png, "%s/demo_%s.png", dir, name);
         snprintf(exr, sizeof exr, "%s/demo_%s.exr", dir, name);
         out_opts oo = {.png = {.tonemap = SY_TONEMAP_ACES}};
         if (r == SY_OK) r = write_image(png, &img, &oo, &err);
         if (r == SY_OK) r = write_image(exr, &img, &oo, &err);
-        if (r == SY_OK && spp) printf("  %-12s %8.3f s  %s  %s  (%u samples per pixel)\n", name, secs, png, exr, spp);
+        if (r == SY_OK && spp)
+            printf("  %-12s %8.3f s  %s  %s  (%u samples per pixel, filter %s)\n", name, secs, png, exr, spp, filter);
         else if (r == SY_OK) printf("  %-12s %8.3f s  %s  %s\n", name, secs, png, exr);
         sy_layer_destroy(&img);
     }
@@ -1021,8 +1042,10 @@ static int cmd_bench_pathtracer(const char *scene, uint32_t w, uint32_t h, uint3
     for (int i = 0; i < 2 && list[i]; ++i) {
         loaded ld;
         if (load(list[i], NULL, true, &ld, &err) != SY_OK) return fail(&err);
-        pt_opts po = {.has_bg = i == 1, .bg = {0.8f, 0.8f, 0.8f}, .env_intensity = 1.0f};
-        sy_result r = setup_environment(&ld, &po, &err);
+        /* the helmet under a uniform grey environment light (a 1x1 lat-long map) */
+        sy_world_options wo = {.has_env_color = i == 1, .env_color = {0.8f, 0.8f, 0.8f}};
+        sy_result r = sy_world_apply(ld.scene, &ld.background, &wo, &err);
+        if (r == SY_OK) r = sy_scene_commit(ld.scene, NULL, &err);
         sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .background = ld.background};
         if (r == SY_OK) r = sy_bench_pathtracer(ld.scene, &vd, list[i], w, h, passes ? passes : 8, &err);
         loaded_free(&ld);
@@ -1120,7 +1143,15 @@ int main(int argc, char **argv)
     /* loader options of every command: --allow-path DIR (repeatable) and --strict */
     int kept = 1;
     for (int i = 1; i < argc; ++i) {
-        if (!strcmp(argv[i], "--strict")) {
+        int used = 0;
+        sy_result wr = parse_world_flag(argc - i, argv + i, &g_load.world, &used, &err);
+        if (wr != SY_OK) {
+            fprintf(stderr, "sy: error: %s\n", err.message);
+            return 2;
+        }
+        if (used) {
+            i += used - 1;
+        } else if (!strcmp(argv[i], "--strict")) {
             g_load.strict = true;
         } else if (!strcmp(argv[i], "--allow-path")) {
             struct stat st;
@@ -1143,6 +1174,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "info")) return cmd_info(argc - 2, argv + 2);
     if (!strcmp(cmd, "render")) return cmd_render(argc - 2, argv + 2);
     if (!strcmp(cmd, "demo")) return cmd_demo(argc - 2, argv + 2);
+    if (!strcmp(cmd, "compare")) return cmd_compare(argc - 2, argv + 2);
     if (!strcmp(cmd, "bench")) return cmd_bench(argc - 2, argv + 2);
     if (!strcmp(cmd, "backends")) return cmd_backends();
     if (!strcmp(cmd, "coverage")) return cmd_coverage(argc - 2, argv + 2);

@@ -6,13 +6,15 @@
  *   entries  entry_count x { u8 type, u8 flags, u16 reserved(0), u32 id, u64 mask, fields... }
  *   field    POD: its bytes; string: u32 length (0xffffffff = NULL) + bytes; blob: u32 index into
  *            the blob table (0xffffffff = NULL); primitives: u32 count + count x (7 blob indices +
- *            u32 material id); attachments (mask bit 63): u32 count + count x {string key, u8 kind,
+ *            u32 material id + u32 topology (sy_topology, < SY_TOPOLOGY_COUNT) + f32 width (finite,
+ *            >= 0)) (version 2; version 1 had neither); attachments (mask bit 63): u32 count + count x {string key, u8 kind,
  *            value: i64 | f64 | 4 x f32 | string | blob index}
  *
  * The decoder never trusts a length: every read is checked against what remains, counts are
  * checked against limits before allocation, payload hashes are verified. */
 #include "sy_fields.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -256,6 +258,8 @@ sy_result sy_changes_serialize(const sy_changes *c, sy_blob_send_fn send_blob, v
                     w_blobref(&w, &t, pr->colors);
                     w_blobref(&w, &t, pr->indices);
                     w_u32(&w, pr->material.id);
+                    w_u32(&w, pr->topology);
+                    w_bytes(&w, &pr->width, sizeof pr->width);
                 }
                 break;
             }
@@ -512,7 +516,7 @@ sy_result sy_changes_deserialize(const void *data, size_t size, sy_blob_store *s
             case SY_FK_PRIMS: {
                 uint32_t n;
                 if (!r_u32(&r, &n, "primitive count")) goto fail;
-                if (n > (r.size - r.pos) / 32) {
+                if (n > (r.size - r.pos) / 40) { /* 7 blob indices, material, topology, width */
                     r_fail(&r, SY_ERR_PARSE, "primitive count larger than the message can hold");
                     goto fail;
                 }
@@ -532,7 +536,18 @@ sy_result sy_changes_deserialize(const void *data, size_t size, sy_blob_store *s
                         if (!r_blobref(&r, blobs, nblobs, &b)) goto fail;
                         *slots[s] = sy_blob_retain(b);
                     }
-                    if (!r_u32(&r, &pr->material.id, "primitive material")) goto fail;
+                    if (!r_u32(&r, &pr->material.id, "primitive material") ||
+                        !r_u32(&r, &pr->topology, "primitive topology") ||
+                        !r_bytes(&r, &pr->width, sizeof pr->width, "primitive width"))
+                        goto fail;
+                    if (pr->topology >= SY_TOPOLOGY_COUNT) {
+                        r_fail(&r, SY_ERR_PARSE, "unknown primitive topology");
+                        goto fail;
+                    }
+                    if (!isfinite(pr->width) || pr->width < 0.0f) {
+                        r_fail(&r, SY_ERR_PARSE, "primitive width not finite and >= 0");
+                        goto fail;
+                    }
                 }
                 l->count = n;
                 break;

@@ -61,6 +61,9 @@ static const sy_field_desc background_fields[SY_BACKGROUND_FIELD_COUNT] = {
     F(sy_background_data, color, SY_FK_POD),
     F(sy_background_data, environment, SY_FK_POD),
     F(sy_background_data, intensity, SY_FK_POD),
+    F(sy_background_data, environment_visible, SY_FK_POD),
+    F(sy_background_data, gradient, SY_FK_POD),
+    F(sy_background_data, default_lighting, SY_FK_POD),
 };
 #undef F
 
@@ -95,7 +98,8 @@ static const sy_light_data light_defaults = {
     .type = SY_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 1.0f, .outer_cone = 0.78539816f};
 static const sy_camera_data camera_defaults = {
     .projection = SY_PROJECTION_PERSPECTIVE, .yfov = 0.8f, .znear = 0.01f, .xmag = 1.0f, .ymag = 1.0f};
-static const sy_background_data background_defaults = {.color = {0, 0, 0, 1}, .intensity = 1.0f};
+static const sy_background_data background_defaults = {
+    .color = {0, 0, 0, 1}, .intensity = 1.0f, .environment_visible = 1, .default_lighting = 1};
 
 #define T(name, D, fields, defaults) {name, sizeof(D), fields, sizeof fields / sizeof fields[0], &defaults}
 static const sy_type_desc type_descs[SY_TYPE_COUNT] = {
@@ -265,7 +269,8 @@ bool sy__field_equal(uint32_t type, uint32_t f, const void *a, const void *b)
             if (!blob_same(x->positions, y->positions) || !blob_same(x->normals, y->normals) ||
                 !blob_same(x->tangents, y->tangents) || !blob_same(x->texcoords0, y->texcoords0) ||
                 !blob_same(x->texcoords1, y->texcoords1) || !blob_same(x->colors, y->colors) ||
-                !blob_same(x->indices, y->indices) || x->material.id != y->material.id)
+                !blob_same(x->indices, y->indices) || x->material.id != y->material.id ||
+                x->topology != y->topology || memcmp(&x->width, &y->width, sizeof x->width) != 0)
                 return false;
         }
         return true;

@@ -94,6 +94,8 @@ typedef enum sy_mediator_caps {
     SY_CAP_DEPTH = 1u << 0,       /* fills the depth layer */
     SY_CAP_PROGRESSIVE = 1u << 1, /* accumulates samples across render calls */
     SY_CAP_TILES = 1u << 2,       /* renders any sub-rectangle exactly like the full image */
+    SY_CAP_ANALYSIS = 1u << 3,    /* draws an analysis image (e.g. object coverage), not the scene's look:
+                                     comparisons of looks (sy compare) leave it out */
 } sy_mediator_caps;
 
 typedef struct sy_mediator_create_args {

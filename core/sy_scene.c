@@ -428,6 +428,36 @@ static sy_result check_blob_elems(const sy_blob *b, size_t elem, uint32_t count,
     return SY_OK;
 }
 
+/* An X3D gradient: counts within SY_GRADIENT_MAX, finite non-negative colours, angles increasing
+ * within (0, pi] (sky) and (0, pi/2] (ground), one angle fewer than colours. */
+static sy_result check_gradient(const sy_gradient *g, sy_error *err)
+{
+    if (g->sky_count > SY_GRADIENT_MAX || g->ground_count > SY_GRADIENT_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "background: gradient has more than %u colours", SY_GRADIENT_MAX);
+    if (g->ground_count && !g->sky_count)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "background: ground gradient without a sky colour");
+    for (int part = 0; part < 2; ++part) {
+        uint32_t n = part ? g->ground_count : g->sky_count;
+        const float(*c)[3] = part ? g->ground_color : g->sky_color;
+        const float *a = part ? g->ground_angle : g->sky_angle;
+        float lim = part ? 1.5707964f : 3.1415927f, prev = 0.0f;
+        const char *what = part ? "ground" : "sky";
+        for (uint32_t i = 0; i < n; ++i)
+            for (int k = 0; k < 3; ++k)
+                if (!isfinite(c[i][k]) || c[i][k] < 0.0f)
+                    return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "background: %s colour %u is not finite and >= 0",
+                                        what, i);
+        for (uint32_t i = 0; i + 1 < n; ++i) {
+            if (!isfinite(a[i]) || a[i] <= prev || a[i] > lim)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "background: %s angle %u = %g must increase within (0, %g]", what, i, (double)a[i],
+                                    (double)lim);
+            prev = a[i];
+        }
+    }
+    return SY_OK;
+}
+
 static sy_result check_primitive(const sy_scene *s, const sy_primitive *p, uint32_t i, sy_error *err)
 {
     if (!p->positions) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: no positions", i);
@@ -448,19 +478,27 @@ static sy_result check_primitive(const sy_scene *s, const sy_primitive *p, uint3
         (r = check_blob_elems(p->texcoords1, 8, nv, "texcoords1", i, err)) ||
         (r = check_blob_elems(p->colors, 16, nv, "colors", i, err)))
         return r;
+    if (p->topology >= SY_TOPOLOGY_COUNT)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: unknown topology %u", i, p->topology);
+    if (!isfinite(p->width) || p->width < 0.0f)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: stroke width %g is not finite and >= 0", i,
+                            (double)p->width);
+    /* elements: triangles take index triples, lines pairs, points any count */
+    uint32_t per = p->topology == SY_TOPOLOGY_TRIANGLES ? 3u : p->topology == SY_TOPOLOGY_LINES ? 2u : 1u;
+    const char *whole = per == 3 ? "whole triangles" : "whole line segments (index pairs)";
     if (p->indices) {
         size_t isize = sy_blob_size(p->indices);
-        if (isize % 12 != 0)
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "mesh primitive %u: index data %zu bytes is not whole triangles", i, isize);
+        if (isize % (4u * per) != 0)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: index data %zu bytes is not %s", i,
+                                isize, per == 1 ? "whole uint32 indices" : whole);
         const uint32_t *idx = sy_blob_data(p->indices);
         for (size_t k = 0; k < isize / 4; ++k)
             if (idx[k] >= nv)
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
                                     "mesh primitive %u: index %zu = %u is past the vertex count %u", i, k, idx[k], nv);
-    } else if (nv % 3 != 0) {
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                            "mesh primitive %u: %u vertices without indices is not whole triangles", i, nv);
+    } else if (nv % per != 0) {
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: %u vertices without indices is not %s", i,
+                            nv, whole);
     }
     if (!ref_ok(s, SY_TYPE_MATERIAL, p->material.id))
         return sy_error_set(err, SY_ERR_INVALID_HANDLE, "mesh primitive %u: stale material handle", i);
@@ -592,6 +630,11 @@ static sy_result validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_
                 if (!isfinite(fv[i]) || fv[i] < 0.0f)
                     return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "light: %s must be finite and >= 0",
                                         sy__type_desc(type)->fields[f].name);
+            /* KHR_lights_punctual: 0 <= inner < outer <= pi/2 (inner >= outer is read as a hard edge:
+             * every back-end gets the light through the mirror, which orders them) */
+            if ((f == SY_LIGHT_INNER_CONE || f == SY_LIGHT_OUTER_CONE) && fv[0] > 1.5707964f)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "light: %s %g is beyond pi/2",
+                                    sy__type_desc(type)->fields[f].name, (double)fv[0]);
         }
         return SY_OK;
     case SY_TYPE_CAMERA:
@@ -619,6 +662,10 @@ static sy_result validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "background: intensity must be finite and >= 0");
         if (f == SY_BACKGROUND_ENVIRONMENT && !ref_ok(s, SY_TYPE_TEXTURE, ((const sy_texture *)v)->id))
             return sy_error_set(err, SY_ERR_INVALID_HANDLE, "background: stale environment texture");
+        if ((f == SY_BACKGROUND_ENVIRONMENT_VISIBLE || f == SY_BACKGROUND_DEFAULT_LIGHTING) && *(const uint32_t *)v > 1)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "background: %s must be 0 or 1",
+                                sy__type_desc(type)->fields[f].name);
+        if (f == SY_BACKGROUND_GRADIENT) return check_gradient(v, err);
         return SY_OK;
     default: return SY_OK;
     }
@@ -790,10 +837,16 @@ static void mesh_bounds_update(sy_scene *s, slot *sl)
     const sy_mesh_data *d = sl->data;
     sy_bounds b = sy_bounds_empty();
     for (uint32_t i = 0; i < d->primitives.count; ++i) {
-        const sy_blob *pb = d->primitives.items[i].positions;
-        const float *p = sy_blob_data(pb);
-        size_t n = sy_blob_size(pb) / 12;
-        for (size_t v = 0; v < n; ++v) sy_bounds_add_point(&b, p + 3 * v);
+        const sy_primitive *pr = &d->primitives.items[i];
+        sy_bounds pb = sy_primitive_position_bounds(pr);
+        if (pr->topology != SY_TOPOLOGY_TRIANGLES && !sy_bounds_is_empty(&pb)) {
+            float r = 0.5f * sy_primitive_stroke_width(pr, &pb); /* strokes reach half a width out */
+            for (int k = 0; k < 3; ++k) {
+                pb.min[k] -= r;
+                pb.max[k] += r;
+            }
+        }
+        sy_bounds_add_bounds(&b, &pb);
     }
     sl->bounds = b;
     for (uint32_t i = 0; i < sl->user_count; ++i) mark_bounds_dirty(s, sl->users[i]);
@@ -818,7 +871,9 @@ sy_result sy_object_set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32
         !((const sy_primitive_list *)value)->items)
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh: NULL primitives");
     /* Build a source struct holding the value at the field's offset (the generic copy reads it there). */
-    unsigned char src[sizeof(sy_material_data) > sizeof(sy_node_data) ? sizeof(sy_material_data) : sizeof(sy_node_data)];
+#define SY_MAX2_(a, b) ((a) > (b) ? (a) : (b))
+    _Alignas(16) unsigned char src[SY_MAX2_(sizeof(sy_background_data), SY_MAX2_(sizeof(sy_material_data), sizeof(sy_node_data)))];
+#undef SY_MAX2_
     _Static_assert(sizeof(sy_texture_data) <= sizeof src && sizeof(sy_mesh_data) <= sizeof src &&
                        sizeof(sy_light_data) <= sizeof src && sizeof(sy_camera_data) <= sizeof src &&
                        sizeof(sy_background_data) <= sizeof src,
@@ -1070,7 +1125,42 @@ const sy_background_data *sy_background_get(const sy_scene *s, sy_background b)
 uint32_t sy_primitive_vertex_count(const sy_primitive *p) { return (uint32_t)(sy_blob_size(p->positions) / 12); }
 uint32_t sy_primitive_triangle_count(const sy_primitive *p)
 {
-    return p->indices ? (uint32_t)(sy_blob_size(p->indices) / 12) : sy_primitive_vertex_count(p) / 3;
+    return p->topology == SY_TOPOLOGY_TRIANGLES ? sy_primitive_element_count(p) : 0u;
+}
+
+uint32_t sy_primitive_element_count(const sy_primitive *p)
+{
+    uint32_t per = p->topology == SY_TOPOLOGY_TRIANGLES ? 3u : p->topology == SY_TOPOLOGY_LINES ? 2u : 1u;
+    return p->indices ? (uint32_t)(sy_blob_size(p->indices) / (4u * per)) : sy_primitive_vertex_count(p) / per;
+}
+
+sy_bounds sy_primitive_position_bounds(const sy_primitive *p)
+{
+    sy_bounds b = sy_bounds_empty();
+    const float *v = sy_blob_data(p->positions);
+    size_t n = sy_blob_size(p->positions) / 12;
+    for (size_t k = 0; v && k < n; ++k) sy_bounds_add_point(&b, v + 3 * k);
+    return b;
+}
+
+float sy_primitive_stroke_width(const sy_primitive *p, const sy_bounds *primitive_bounds)
+{
+    if (p->topology == SY_TOPOLOGY_TRIANGLES) return 0.0f;
+    if (p->width > 0.0f && isfinite(p->width)) return p->width;
+    sy_bounds own;
+    if (!primitive_bounds) {
+        own = sy_primitive_position_bounds(p);
+        primitive_bounds = &own;
+    }
+    float diag = 0.0f;
+    if (!sy_bounds_is_empty(primitive_bounds)) {
+        float d[3];
+        for (int k = 0; k < 3; ++k) d[k] = primitive_bounds->max[k] - primitive_bounds->min[k];
+        diag = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    }
+    float f = p->topology == SY_TOPOLOGY_POINTS ? SY_STROKE_POINT_FRACTION : SY_STROKE_LINE_FRACTION;
+    float w = f * diag;
+    return isfinite(w) && w > SY_STROKE_MIN_WIDTH ? w : SY_STROKE_MIN_WIDTH;
 }
 
 void sy_primitive_release(sy_primitive *p)

@@ -101,10 +101,36 @@ typedef struct sy_node_data {
 } sy_node_data;
 
 /* ---------------------------------------------------------------- mesh */
-/* One triangle-list primitive. Fixed vertex formats; every present attribute has vertex_count
- * elements: positions float[3] (required), normals float[3], tangents float[4], texcoords float[2],
- * colors float[4] (linear RGBA), indices uint32[3 * triangle_count] (NULL: non-indexed, vertex_count
- * must be a multiple of 3). */
+/* What a primitive's indices (or, without indices, its vertices in order) form. */
+typedef enum sy_topology {
+    SY_TOPOLOGY_TRIANGLES = 0, /* triples: indices uint32[3 * n] (default) */
+    SY_TOPOLOGY_LINES = 1,     /* pairs: each pair is one straight segment, indices uint32[2 * n] */
+    SY_TOPOLOGY_POINTS = 2,    /* each index (or vertex) is one point */
+    SY_TOPOLOGY_COUNT = 3
+} sy_topology;
+
+/* One primitive. Fixed vertex formats; every present attribute has vertex_count elements:
+ * positions float[3] (required), normals float[3], tangents float[4], texcoords float[2], colors
+ * float[4] (linear RGBA), indices uint32 (NULL: non-indexed). Triangles: indices hold whole
+ * triples (without indices vertex_count must be a multiple of 3). Lines: indices hold whole pairs
+ * (without indices an even vertex_count). Points: any count.
+ *
+ * Strokes (lines and points) have a width: the diameter of the tube drawn along each segment and
+ * of the ball drawn at each point and line joint, in the primitive's own coordinate units (the
+ * node transforms scale it with the positions, so it is a world-space width under unscaled
+ * transforms). Every back-end draws strokes as the same triangle geometry (the scene mirror
+ * tessellates them, mediators/sy_strokes.h), so they cover the same pixels in the rasterizer and
+ * the ray tracers. The width rule, sy_primitive_stroke_width:
+ *   - width > 0: that width;
+ *   - width == 0 (default): SY_STROKE_LINE_FRACTION (lines) or SY_STROKE_POINT_FRACTION (points)
+ *     times the diagonal of the primitive's position bounds, at least SY_STROKE_MIN_WIDTH.
+ *     (The Khronos MeshPrimitiveModes sample, 1.73 x 2 units per primitive (diagonal 2.65), gets
+ *     0.159-unit lines and 0.318-unit points: about 2 and 4 pixels in `sy render -w 200 -h 150`.)
+ * Normals, tangents and the material's normal map of a stroke are not used: a stroke is lit as a
+ * tube / ball with the tessellation's own normals; texcoords and colours are carried along. */
+#define SY_STROKE_LINE_FRACTION 0.06f
+#define SY_STROKE_POINT_FRACTION 0.12f
+#define SY_STROKE_MIN_WIDTH 0.001f
 typedef struct sy_primitive {
     sy_blob *positions;
     sy_blob *normals;
@@ -114,6 +140,8 @@ typedef struct sy_primitive {
     sy_blob *colors;
     sy_blob *indices;
     sy_material material; /* {0}: default material */
+    uint32_t topology;    /* sy_topology */
+    float width;          /* strokes: diameter (finite, >= 0; 0 = the default rule above) */
 } sy_primitive;
 
 enum sy_mesh_field {
@@ -133,7 +161,15 @@ typedef struct sy_mesh_data {
 } sy_mesh_data;
 
 uint32_t sy_primitive_vertex_count(const sy_primitive *p);
+/* Triangles of a triangle primitive; 0 for lines and points (their tessellation is the mirror's). */
 uint32_t sy_primitive_triangle_count(const sy_primitive *p);
+/* Elements of any topology: triangles, segments or points. */
+uint32_t sy_primitive_element_count(const sy_primitive *p);
+/* Position bounds of the primitive, without the stroke width (empty when it has no positions). */
+sy_bounds sy_primitive_position_bounds(const sy_primitive *p);
+/* The stroke width of a line or point primitive by the rule above; primitive_bounds are its
+ * position bounds (sy_primitive_position_bounds; NULL = computed here). 0 for triangles. */
+float sy_primitive_stroke_width(const sy_primitive *p, const sy_bounds *primitive_bounds);
 /* Releases the primitive's blob references (NULL ones are skipped) and zeroes it. */
 void sy_primitive_release(sy_primitive *p);
 
@@ -281,13 +317,31 @@ typedef struct sy_camera_data {
     float ymag;
 } sy_camera_data;
 
-/* ---------------------------------------------------------------- background */
+/* ---------------------------------------------------------------- background (the world) */
+/* What the camera sees where nothing is hit, and the environment light (see sy_look.h for the
+ * rules every back-end follows). */
+#define SY_GRADIENT_MAX 8
+/* X3D Background: sky colours by angle from the zenith (sky_color[0] at the zenith, sky_color[i]
+ * at sky_angle[i-1], increasing, in (0, pi]); ground colours by angle from the nadir (ground_color[0]
+ * at the nadir, ground_angle increasing, in (0, pi/2]). sky_count 0 = no gradient; ground_count 0 =
+ * the sky continues below the horizon. Colours are linear RGB. */
+typedef struct sy_gradient {
+    uint32_t sky_count, ground_count;
+    float sky_color[SY_GRADIENT_MAX][3];
+    float sky_angle[SY_GRADIENT_MAX];
+    float ground_color[SY_GRADIENT_MAX][3];
+    float ground_angle[SY_GRADIENT_MAX];
+} sy_gradient;
+
 enum sy_background_field {
     SY_BACKGROUND_NAME = 0,
     SY_BACKGROUND_COLOR = 1,       /* float[4] linear RGBA, premultiplied; alpha 0 = transparent */
-    SY_BACKGROUND_ENVIRONMENT = 2, /* sy_texture (equirectangular), {0} = none */
+    SY_BACKGROUND_ENVIRONMENT = 2, /* sy_texture (equirectangular), {0} = none: a light */
     SY_BACKGROUND_INTENSITY = 3,   /* float multiplier for the environment */
-    SY_BACKGROUND_FIELD_COUNT = 4
+    SY_BACKGROUND_ENVIRONMENT_VISIBLE = 4, /* uint32: 1 (default) = camera rays see the environment */
+    SY_BACKGROUND_GRADIENT = 5,    /* sy_gradient: shown where nothing is hit (unless the environment is) */
+    SY_BACKGROUND_DEFAULT_LIGHTING = 6, /* uint32: 1 (default) = studio light when the scene brings none */
+    SY_BACKGROUND_FIELD_COUNT = 7
 };
 
 typedef struct sy_background_data {
@@ -295,6 +349,9 @@ typedef struct sy_background_data {
     float color[4];
     sy_texture environment;
     float intensity;
+    uint32_t environment_visible;
+    sy_gradient gradient;
+    uint32_t default_lighting;
 } sy_background_data;
 
 /* ---------------------------------------------------------------- attachments */

@@ -18,6 +18,8 @@
 #include <string.h>
 
 #define GLTF_POINTS 0
+#define GLTF_LINES 1
+#define GLTF_LINE_LOOP 2
 #define GLTF_LINE_STRIP 3
 #define GLTF_TRIANGLES 4
 #define GLTF_TRIANGLE_STRIP 5
@@ -857,6 +859,91 @@ static sy_result read_attribute(loader *L, int32_t ai, size_t vcount, size_t com
     return make_blob(L, f, n * sizeof(float), out);
 }
 
+static uint32_t add_sat(uint32_t a, uint32_t b) { return a > UINT32_MAX - b ? UINT32_MAX : a + b; }
+
+static sy_result read_all_attributes(loader *L, const sy_gltf_shim_primitive *pr, size_t vcount, size_t m, size_t p,
+                                     sy_primitive *out)
+{
+    sy_result r;
+    if ((r = read_attribute(L, pr->position, vcount, 3, m, p, "POSITION", &out->positions)) ||
+        (r = read_attribute(L, pr->normal, vcount, 3, m, p, "NORMAL", &out->normals)) ||
+        (r = read_attribute(L, pr->tangent, vcount, 4, m, p, "TANGENT", &out->tangents)) ||
+        (r = read_attribute(L, pr->texcoord0, vcount, 2, m, p, "TEXCOORD_0", &out->texcoords0)) ||
+        (r = read_attribute(L, pr->texcoord1, vcount, 2, m, p, "TEXCOORD_1", &out->texcoords1)) ||
+        (r = read_attribute(L, pr->color0, vcount, 4, m, p, "COLOR_0", &out->colors)))
+        sy_primitive_release(out);
+    return r;
+}
+
+/* POINTS, LINES, LINE_LOOP, LINE_STRIP: point and line primitives (loops and strips expanded to
+ * index pairs). Takes ownership of idx (icount indices, or NULL: the vertices in order). Strokes
+ * are drawn as tubes and balls with their own normals (sy_scene.h), so no flat normals are made. */
+static sy_result convert_stroke(loader *L, size_t m, size_t p, sy_primitive *out, bool *used, uint32_t *idx,
+                                size_t icount, size_t vcount)
+{
+    const sy_gltf_shim_primitive *pr = &L->doc->meshes[m].primitives[p];
+    sy_result r = SY_OK;
+    uint32_t *pairs = NULL;
+    size_t elements = 0;
+    if (pr->mode == GLTF_POINTS) {
+        elements = icount;
+        pairs = idx; /* NULL: non-indexed points */
+        idx = NULL;
+    } else if (pr->mode == GLTF_LINES) {
+        elements = icount / 2;
+        if (icount % 2)
+            warn(L, "meshes[%zu].primitives[%zu]: LINES with %zu %s (odd); the last one ignored", m, p, icount,
+                 idx ? "indices" : "vertices");
+        if (idx) {
+            pairs = idx;
+            idx = NULL;
+        } else if (icount % 2 && elements) {
+            if (!(pairs = xcalloc(L, elements * 2, sizeof(uint32_t), &r))) return r;
+            for (size_t k = 0; k < elements * 2; k++) pairs[k] = (uint32_t)k;
+        }
+    } else { /* LINE_LOOP closes back to the first vertex; LINE_STRIP does not */
+        bool loop = pr->mode == GLTF_LINE_LOOP;
+        elements = icount >= 2 ? icount - 1 + (loop && icount >= 3) : 0;
+        if (elements > L->opt.max_indices / 2) {
+            free(idx);
+            return fail(L, SY_ERR_LIMIT, "meshes[%zu].primitives[%zu]: %zu line segments exceed the index limit of %zu", m,
+                        p, elements, L->opt.max_indices);
+        }
+        if (elements && !(pairs = xcalloc(L, elements * 2, sizeof(uint32_t), &r))) {
+            free(idx);
+            return r;
+        }
+        for (size_t k = 0; k < elements; k++) {
+            size_t a = k, b = (k + 1) % icount;
+            pairs[2 * k] = idx ? idx[a] : (uint32_t)a;
+            pairs[2 * k + 1] = idx ? idx[b] : (uint32_t)b;
+        }
+        free(idx);
+        idx = NULL;
+    }
+    free(idx);
+    if (elements == 0) {
+        free(pairs);
+        warn(L, "meshes[%zu].primitives[%zu]: %s without a complete %s; skipped", m, p, mode_name(pr->mode),
+             pr->mode == GLTF_POINTS ? "point" : "segment");
+        L->info->counts.skipped_primitives++;
+        return SY_OK;
+    }
+    if (elements > UINT32_MAX / 2) {
+        free(pairs);
+        return fail(L, SY_ERR_LIMIT, "meshes[%zu].primitives[%zu]: too many elements", m, p);
+    }
+    size_t per = pr->mode == GLTF_POINTS ? 1 : 2;
+    if (pairs && (r = make_blob(L, pairs, elements * per * sizeof(uint32_t), &out->indices))) return r;
+    if ((r = read_all_attributes(L, pr, vcount, m, p, out))) return r;
+    out->topology = per == 1 ? SY_TOPOLOGY_POINTS : SY_TOPOLOGY_LINES;
+    out->material = pr->material >= 0 ? L->materials[pr->material] : (sy_material){0};
+    if (per == 1) L->info->counts.points = add_sat(L->info->counts.points, (uint32_t)elements);
+    else L->info->counts.line_segments = add_sat(L->info->counts.line_segments, (uint32_t)elements);
+    *used = true;
+    return SY_OK;
+}
+
 static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *out, bool *used, uint32_t *tris)
 {
     const sy_gltf_doc *d = L->doc;
@@ -868,11 +955,6 @@ static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *
     if (pr->has_targets && !L->warned_morph) {
         L->warned_morph = true;
         warn(L, "meshes[%zu].primitives[%zu]: morph targets ignored", m, p);
-    }
-    if (pr->mode < GLTF_TRIANGLES) {
-        warn(L, "meshes[%zu].primitives[%zu]: mode %s skipped (only triangles are supported)", m, p, mode_name(pr->mode));
-        L->info->counts.skipped_primitives++;
-        return SY_OK;
     }
     if (pr->position < 0) {
         warn(L, "meshes[%zu].primitives[%zu]: no POSITION attribute; skipped", m, p);
@@ -907,6 +989,8 @@ static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *
             }
         }
     }
+
+    if (pr->mode < GLTF_TRIANGLES) return convert_stroke(L, m, p, out, used, idx, icount, vcount);
 
     /* triangle list */
     uint32_t *tri = NULL;
@@ -969,15 +1053,7 @@ static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *
     }
     if (tri && (r = make_blob(L, tri, tcount * 3 * sizeof(uint32_t), &out->indices))) return r;
 
-    if ((r = read_attribute(L, pr->position, vcount, 3, m, p, "POSITION", &out->positions)) ||
-        (r = read_attribute(L, pr->normal, vcount, 3, m, p, "NORMAL", &out->normals)) ||
-        (r = read_attribute(L, pr->tangent, vcount, 4, m, p, "TANGENT", &out->tangents)) ||
-        (r = read_attribute(L, pr->texcoord0, vcount, 2, m, p, "TEXCOORD_0", &out->texcoords0)) ||
-        (r = read_attribute(L, pr->texcoord1, vcount, 2, m, p, "TEXCOORD_1", &out->texcoords1)) ||
-        (r = read_attribute(L, pr->color0, vcount, 4, m, p, "COLOR_0", &out->colors))) {
-        sy_primitive_release(out);
-        return r;
-    }
+    if ((r = read_all_attributes(L, pr, vcount, m, p, out))) return r;
     /* glTF 2.0: without NORMAL the client computes flat normals; a normal map without TANGENT
      * needs generated tangents (sy_mesh_util: MikkTSpace-style angle-weighted accumulation). */
     if (!out->normals && (r = sy_prim_make_flat_normals(out, &L->err))) {

@@ -10,8 +10,10 @@
  * scene's root nodes. Every created node has SY_NODE_VISIBLE. EXT_mesh_gpu_instancing expands into
  * one child node per instance, all referencing the same sy_mesh.
  *
- * Supported: node TRS / matrix; triangle lists, strips and fans (strips and fans become lists;
- * POINTS / LINES primitives are skipped with a warning); attributes POSITION, NORMAL, TANGENT,
+ * Supported: node TRS / matrix; triangle lists, strips and fans (strips and fans become lists);
+ * POINTS become SY_TOPOLOGY_POINTS primitives and LINES, LINE_LOOP, LINE_STRIP become
+ * SY_TOPOLOGY_LINES primitives (loops and strips expanded to index pairs; width 0 = core's rule,
+ * drawn as tubes and balls by every back-end, lit with their own normals); attributes POSITION, NORMAL, TANGENT,
  * TEXCOORD_0/1, COLOR_0 of any glTF component type (normalized integers scaled) including sparse
  * accessors; glTF metallic-roughness materials with KHR_materials_emissive_strength,
  * KHR_materials_transmission, KHR_materials_ior, KHR_materials_unlit, KHR_texture_transform;
@@ -69,7 +71,8 @@ typedef struct sy_gltf_options {
 /* What the file contains (the whole file, not only the loaded scene). */
 typedef struct sy_gltf_counts {
     uint32_t nodes, meshes, primitives, triangles, materials, textures, images, lights, cameras;
-    uint32_t skipped_primitives; /* points / lines / without POSITION */
+    uint32_t skipped_primitives; /* without POSITION, or without one complete element */
+    uint32_t points, line_segments; /* elements of POINTS and of LINES / LINE_LOOP / LINE_STRIP primitives */
 } sy_gltf_counts;
 
 typedef struct sy_gltf_info {

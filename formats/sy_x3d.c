@@ -5,6 +5,7 @@
 
 #include "sy_file.h"
 #include "sy_mesh_util.h"
+#include "sy_text.h"
 
 #include <libxml/hash.h>
 #include <libxml/parser.h>
@@ -145,6 +146,11 @@ static created *cache_get(loader *L, const xfile *F, const void *el, const char 
 static char *attr(const xmlNode *el, const char *name)
 {
     return (char *)xmlGetNoNsProp(el, (const xmlChar *)name);
+}
+
+static bool attr_present(const xmlNode *el, const char *name)
+{
+    return xmlHasProp(el, (const xmlChar *)name) != NULL;
 }
 
 static bool is_sep(char c) { return c == ' ' || c == ',' || c == '\t' || c == '\n' || c == '\r'; }
@@ -674,11 +680,11 @@ static void set_tex(sy_texture_ref *ref, uint32_t id)
 
 /* Material for (Appearance, solid, vertex colours). 0 = the default material (never: X3D needs
  * an explicit one); *normal_map tells the geometry to generate tangents. */
-static sy_result get_material(loader *L, xfile *F, const xmlNode *app, bool solid, bool vcolors, uint32_t *out,
-                              bool *normal_map)
+static sy_result get_material(loader *L, xfile *F, const xmlNode *app, bool solid, bool vcolors, bool stroke,
+                              uint32_t *out, bool *normal_map)
 {
     char variant[16];
-    snprintf(variant, sizeof variant, "m%d%d", solid, vcolors);
+    snprintf(variant, sizeof variant, "m%d%d%d", solid, vcolors, stroke);
     created *c = cache_get(L, F, app ? (const void *)app : (const void *)F, variant, true);
     if (!c) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
     if (c->done) {
@@ -813,6 +819,22 @@ static sy_result get_material(loader *L, xfile *F, const xmlNode *app, bool soli
     }
     if (vcolors && !css && !(mat && !strcmp(ename(mat), "PhysicalMaterial")))
         md.base_color[0] = md.base_color[1] = md.base_color[2] = 1.0f; /* X3D: Color replaces diffuseColor */
+    if (stroke && !css) {
+        /* X3D points and lines are unlit: the Material's emissiveColor (UnlitMaterial: its colour;
+         * no Material: white), replaced by the Color node's colours when present */
+        if (mat && strcmp(ename(mat), "UnlitMaterial") != 0) {
+            float e[3] = {0, 0, 0};
+            get_floats(L, F, mat, "emissiveColor", e, 3);
+            clamp01(e, 3);
+            memcpy(md.base_color, e, sizeof e);
+        }
+        if (vcolors) md.base_color[0] = md.base_color[1] = md.base_color[2] = 1.0f;
+        md.unlit = 1;
+        md.emissive[0] = md.emissive[1] = md.emissive[2] = 0.0f;
+        memset(&md.normal_texture, 0, sizeof md.normal_texture);
+        memset(&md.emissive_texture, 0, sizeof md.emissive_texture);
+        md.double_sided = 0;
+    }
     /* alpha mode: Appearance.alphaMode (X3D 4) or AUTO */
     char *am = app ? attr(app, "alphaMode") : NULL;
     if (am && !strcmp(am, "OPAQUE")) md.alpha_mode = SY_ALPHA_OPAQUE;
@@ -1438,6 +1460,257 @@ static void bounds_add_prim(loader *L, const sy_primitive *p, const sy_mat4 *wor
     sy_bounds_add_bounds(&L->bounds, &w);
 }
 
+/* Output of a stroke geometry node: vertices (positions, optional RGBA colours) and, for lines,
+ * index pairs. */
+typedef struct stroke_out {
+    float *pos, *col;
+    uint32_t *pairs;
+    size_t nv, npairs, cap_v;
+} stroke_out;
+
+static void stroke_out_free(stroke_out *o)
+{
+    free(o->pos); free(o->col); free(o->pairs);
+    memset(o, 0, sizeof *o);
+}
+
+/* Colour k of a Color / ColorRGBA source as RGBA. */
+static void src_color(const geom_src *g, size_t k, float *out)
+{
+    const float *c = g->col + (size_t)g->col_comps * k;
+    out[0] = c[0]; out[1] = c[1]; out[2] = c[2];
+    out[3] = g->col_comps == 4 ? c[3] : 1.0f;
+}
+
+/* PointSet, LineSet, IndexedLineSet: SY_TOPOLOGY_POINTS / SY_TOPOLOGY_LINES primitives (width 0:
+ * core's rule; every back-end draws them as tubes and balls). Polylines become index pairs;
+ * IndexedLineSet vertices are repeated per polyline so per-polyline colours stay exact. Colours: per
+ * vertex (PointSet, LineSet; IndexedLineSet with colorPerVertex, through colorIndex or coordIndex)
+ * or per polyline (IndexedLineSet colorPerVertex false, through colorIndex or the polyline number).
+ * Bad indices or counts are warned (file:line) and skip the geometry. */
+static sy_result build_strokes(loader *L, xfile *F, const xmlNode *el, const geom_src *g, stroke_out *o, bool *ok)
+{
+    *ok = false;
+    const char *n = ename(el);
+    sy_result r = SY_OK;
+    int32_t *ci = NULL, *coi = NULL, *vc = NULL;
+    size_t nci = 0, ncoi = 0, nvc = 0;
+    if (!strcmp(n, "PointSet")) {
+        o->nv = g->npts;
+        if (o->nv == 0) {
+            warn(L, "%s:%d: PointSet without points; skipped", F->path, line_of(el));
+            return SY_OK;
+        }
+    } else if (!strcmp(n, "LineSet")) {
+        if (!get_int_array(L, F, el, "vertexCount", &vc, &nvc)) return SY_OK;
+        size_t used = 0;
+        for (size_t k = 0; k < nvc; k++) {
+            if (vc[k] < 2) {
+                warn(L, "%s:%d: LineSet.vertexCount[%zu] = %d is less than 2; geometry skipped", F->path, line_of(el), k,
+                     (int)vc[k]);
+                goto done;
+            }
+            if ((size_t)vc[k] > g->npts - used) {
+                warn(L, "%s:%d: LineSet.vertexCount needs more than the %zu points of its Coordinate; geometry skipped",
+                     F->path, line_of(el), g->npts);
+                goto done;
+            }
+            used += (size_t)vc[k];
+            o->npairs += (size_t)vc[k] - 1;
+        }
+        o->nv = used;
+    } else { /* IndexedLineSet */
+        if (!get_int_array(L, F, el, "coordIndex", &ci, &nci) || !get_int_array(L, F, el, "colorIndex", &coi, &ncoi))
+            goto done;
+        for (size_t k = 0, k0 = 0; k <= nci; k++) {
+            if (k < nci && ci[k] != -1) {
+                if (ci[k] < 0 || (size_t)ci[k] >= g->npts) {
+                    warn(L, "%s:%d: IndexedLineSet: coordIndex[%zu] = %d is outside the %zu points of its Coordinate; "
+                         "geometry skipped", F->path, line_of(el), k, (int)ci[k], g->npts);
+                    goto done;
+                }
+                continue;
+            }
+            if (k - k0 >= 2) {
+                o->nv += k - k0;
+                o->npairs += k - k0 - 1;
+            }
+            k0 = k + 1;
+        }
+    }
+    if (o->nv > L->opt.max_vertices) {
+        r = sy_error_set(&L->err, SY_ERR_LIMIT, "%s:%d: %s: %zu vertices exceed the limit of %zu", F->path, line_of(el),
+                         n, o->nv, L->opt.max_vertices);
+        goto done;
+    }
+    if (o->nv == 0 || (strcmp(n, "PointSet") && o->npairs == 0)) {
+        warn(L, "%s:%d: %s has no polyline with 2 or more vertices; skipped", F->path, line_of(el), n);
+        goto done;
+    }
+    o->pos = malloc(o->nv * 12);
+    o->col = g->col ? malloc(o->nv * 16) : NULL;
+    o->pairs = o->npairs ? malloc(o->npairs * 2 * sizeof(uint32_t)) : NULL;
+    if (!o->pos || (g->col && !o->col) || (o->npairs && !o->pairs)) {
+        r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+        goto done;
+    }
+    size_t v = 0, pr = 0;
+    if (strcmp(n, "IndexedLineSet")) { /* PointSet, LineSet: the first nv points, in order */
+        if (g->col && g->ncol < o->nv) {
+            warn(L, "%s:%d: %s: %zu colours for %zu vertices; geometry skipped", F->path, line_of(el), n, g->ncol, o->nv);
+            goto done;
+        }
+        memcpy(o->pos, g->pts, o->nv * 12);
+        for (size_t k = 0; o->col && k < o->nv; k++) src_color(g, k, o->col + 4 * k);
+        for (size_t k = 0, start = 0; k < nvc; start += (size_t)vc[k], k++)
+            for (size_t j = 0; j + 1 < (size_t)vc[k]; j++, pr++) {
+                o->pairs[2 * pr] = (uint32_t)(start + j);
+                o->pairs[2 * pr + 1] = (uint32_t)(start + j + 1);
+            }
+    } else {
+        bool cpv = get_bool(el, "colorPerVertex", true);
+        size_t line = 0;
+        for (size_t k = 0, k0 = 0; k <= nci; k++) {
+            if (k < nci && ci[k] != -1) continue;
+            size_t cnt = k - k0;
+            if (cnt >= 2) {
+                for (size_t j = 0; j < cnt; j++) {
+                    memcpy(o->pos + 3 * (v + j), g->pts + 3 * (size_t)ci[k0 + j], 12);
+                    if (o->col) {
+                        size_t at = cpv ? k0 + j : line;
+                        int64_t c = ncoi ? (at < ncoi ? coi[at] : -2) : cpv ? ci[at] : (int64_t)at;
+                        if (c < 0 || (size_t)c >= g->ncol) {
+                            warn(L, "%s:%d: IndexedLineSet: colour %lld of %s %zu is outside the %zu colours; geometry "
+                                 "skipped", F->path, line_of(el), (long long)c, cpv ? "vertex" : "polyline",
+                                 cpv ? k0 + j : line, g->ncol);
+                            goto done;
+                        }
+                        src_color(g, (size_t)c, o->col + 4 * (v + j));
+                    }
+                    if (j + 1 < cnt) {
+                        o->pairs[2 * pr] = (uint32_t)(v + j);
+                        o->pairs[2 * pr + 1] = (uint32_t)(v + j + 1);
+                        pr++;
+                    }
+                }
+                v += cnt;
+            }
+            if (k < nci || cnt > 0) line++;
+            k0 = k + 1;
+        }
+    }
+    *ok = true;
+done:
+    free(ci); free(coi); free(vc);
+    return r;
+}
+
+/* Text: the strings as flat geometry (sy_text.h) with the FontStyle's font (family SANS / SERIF
+ * (the default) / TYPEWRITER -> DejaVu Sans / Serif / Sans Mono under SY_X3D_FONT_DIR, style PLAIN /
+ * BOLD / ITALIC / BOLDITALIC), size, spacing and justify (major, minor). A missing font is a
+ * warning and the text is skipped; length, maxExtent and vertical / right-to-left layouts are not
+ * supported (warned). */
+#ifndef SY_X3D_FONT_DIR
+#define SY_X3D_FONT_DIR "/usr/share/fonts/truetype/dejavu/"
+#endif
+static uint32_t justify_of(const char *s, bool major)
+{
+    if (!strcmp(s, "BEGIN")) return SY_TEXT_BEGIN;
+    if (!strcmp(s, "MIDDLE")) return SY_TEXT_MIDDLE;
+    if (!strcmp(s, "END")) return SY_TEXT_END;
+    return major ? SY_TEXT_BEGIN : SY_TEXT_FIRST; /* FIRST (and anything else) */
+}
+
+static sy_result build_text(loader *L, xfile *F, const xmlNode *el, sy_primitive *prim, bool *ok)
+{
+    *ok = false;
+    sy_result r = SY_OK;
+    char *strs = attr(el, "string");
+    if (!strs) return SY_OK; /* no string: nothing to draw */
+    size_t cap = strlen(strs) + 1, nl = 0, lcap = 0;
+    char **lines = NULL, *buf = NULL;
+    for (const char *p = strs;;) {
+        if (!buf && !(buf = malloc(cap))) goto oom;
+        if (!next_mfstring(&p, buf, cap)) break;
+        if (nl == lcap) {
+            lcap = lcap ? lcap * 2 : 4;
+            char **q = realloc(lines, lcap * sizeof *q);
+            if (!q) goto oom;
+            lines = q;
+        }
+        lines[nl++] = buf;
+        buf = NULL;
+    }
+    const xmlNode *fs = field_child(L, F, el, "FontStyle|ScreenFontStyle", "fontStyle");
+    const char *family = "DejaVuSerif", *style_sfx = "";
+    float size = 1.0f, spacing = 1.0f;
+    uint32_t major = SY_TEXT_BEGIN, minor = SY_TEXT_FIRST;
+    if (fs) {
+        char *fam = attr(fs, "family"), tok[64];
+        const char *p = fam;
+        while (p && next_mfstring(&p, tok, sizeof tok)) {
+            if (!strcmp(tok, "SANS")) { family = "DejaVuSans"; break; }
+            if (!strcmp(tok, "SERIF")) { family = "DejaVuSerif"; break; }
+            if (!strcmp(tok, "TYPEWRITER")) { family = "DejaVuSansMono"; break; }
+        }
+        xmlFree(fam);
+        char *st = attr(fs, "style");
+        bool bold = st && strstr(st, "BOLD"), italic = st && strstr(st, "ITALIC");
+        xmlFree(st);
+        bool serif = !strcmp(family, "DejaVuSerif");
+        style_sfx = bold && italic ? (serif ? "-BoldItalic" : "-BoldOblique") : bold ? "-Bold"
+                    : italic ? (serif ? "-Italic" : "-Oblique") : "";
+        size = get_float(L, F, fs, "size", 1.0f);
+        spacing = get_float(L, F, fs, "spacing", 1.0f);
+        char *j = attr(fs, "justify");
+        p = j;
+        if (p && next_mfstring(&p, tok, sizeof tok)) {
+            major = justify_of(tok, true);
+            if (next_mfstring(&p, tok, sizeof tok)) minor = justify_of(tok, false);
+        }
+        xmlFree(j);
+        if (!get_bool(fs, "horizontal", true) || !get_bool(fs, "leftToRight", true) || !get_bool(fs, "topToBottom", true))
+            warn(L, "%s:%d: FontStyle: only horizontal, left-to-right, top-to-bottom text is supported", F->path,
+                 line_of(fs));
+    }
+    if (!(size > 0) || !(spacing >= 0)) {
+        warn(L, "%s:%d: Text: FontStyle size %g / spacing %g out of range; skipped", F->path, line_of(el), (double)size,
+             (double)spacing);
+        goto done;
+    }
+    if (attr_present(el, "length") || attr_present(el, "maxExtent"))
+        warn(L, "%s:%d: Text: length and maxExtent are not supported; ignored", F->path, line_of(el));
+    char font[512];
+    snprintf(font, sizeof font, "%s%s%s.ttf", SY_X3D_FONT_DIR, family, style_sfx);
+    if (!regular_file(font, NULL, 0)) {
+        warn(L, "%s:%d: Text: font '%s' not found (install fonts-dejavu-core); text skipped", F->path, line_of(el), font);
+        goto done;
+    }
+    sy_text_desc td = {.lines = (const char *const *)lines, .line_count = nl, .font_path = font, .size = size,
+                       .spacing = spacing, .major = major, .minor = minor, .max_triangles = L->opt.max_vertices / 3};
+    sy_text_stats ts;
+    r = sy_text_build(&td, prim, &ts, &L->err);
+    if (r == SY_ERR_NOT_FOUND) {
+        warn(L, "%s:%d: Text: %s; text skipped", F->path, line_of(el), L->err.message);
+        r = SY_OK;
+    } else if (r) {
+        sy_error_prefix(&L->err, "%s:%d: Text", F->path, line_of(el));
+    } else if (!prim->positions) {
+        warn(L, "%s:%d: Text has no visible glyph; skipped", F->path, line_of(el));
+    } else {
+        *ok = true;
+    }
+    goto done;
+oom:
+    r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+done:
+    for (size_t k = 0; k < nl; k++) free(lines[k]);
+    free(lines);
+    free(buf);
+    xmlFree(strs);
+    return r;
+}
+
 /* Builds the primitive of a geometry node (cached per geometry element and texture transform). */
 static sy_result build_geometry(loader *L, xfile *F, const xmlNode *el, const xmlNode *ttel, sy_primitive *prim,
                                 bool *ok, bool *has_colors, bool *solid)
@@ -1463,6 +1736,11 @@ static sy_result build_geometry(loader *L, xfile *F, const xmlNode *el, const xm
         bool side = get_bool(el, "side", true), bottom = get_bool(el, "bottom", true);
         if (!side && !bottom) goto empty;
         r = sy_tess_cone(rad, h, side, bottom, NULL, prim, &L->err);
+    } else if (!strcmp(n, "Text")) {
+        *solid = get_bool(el, "solid", false); /* X3D: Text is not solid by default */
+        bool built = false;
+        r = build_text(L, F, el, prim, &built);
+        if (r || !built) return r;
     } else if (!strcmp(n, "Cylinder")) {
         float rad = get_float(L, F, el, "radius", 1.0f), h = get_float(L, F, el, "height", 2.0f);
         if (!(rad > 0 && h > 0)) goto bad_size;
@@ -1488,6 +1766,29 @@ static sy_result build_geometry(loader *L, xfile *F, const xmlNode *el, const xm
             r = build_extrusion(L, F, el, &g, &c, &built);
         } else if (!g.pts) {
             warn(L, "%s:%d: %s without Coordinate points; skipped", F->path, line_of(el), n);
+        } else if (name_in(n, "PointSet|LineSet|IndexedLineSet")) {
+            stroke_out so = {0};
+            r = build_strokes(L, F, el, &g, &so, &built);
+            if (!r && L->limit_r) {
+                r = L->limit_r;
+                L->err = L->limit_err;
+            }
+            if (!r && built) {
+                r = make_blob(L, so.pos, so.nv * 12, &prim->positions);
+                so.pos = NULL;
+                if (!r && so.col) r = make_blob(L, so.col, so.nv * 16, &prim->colors);
+                so.col = NULL;
+                if (!r && so.pairs) r = make_blob(L, so.pairs, so.npairs * 8, &prim->indices);
+                so.pairs = NULL;
+                if (r) sy_primitive_release(prim);
+                else prim->topology = so.npairs ? SY_TOPOLOGY_LINES : SY_TOPOLOGY_POINTS;
+                *ok = !r;
+                *has_colors = !r && prim->colors != NULL;
+                *solid = false;
+            }
+            stroke_out_free(&so);
+            geom_src_free(&g);
+            return r;
         } else if (!strcmp(n, "IndexedFaceSet")) {
             r = build_faceset(L, F, el, &g, &c, &built);
         } else if (!strcmp(n, "IndexedTriangleSet")) {
@@ -1682,7 +1983,8 @@ static sy_result visit_shape(loader *L, xfile *F, const xmlNode *el, const sy_ma
         }
         if (!geo) return SY_OK;
         if (!name_in(ename(geo), "IndexedFaceSet|IndexedTriangleSet|TriangleSet|IndexedTriangleStripSet|IndexedTriangleFanSet|"
-                           "TriangleStripSet|TriangleFanSet|IndexedQuadSet|QuadSet|Extrusion|Box|Sphere|Cone|Cylinder")) {
+                           "TriangleStripSet|TriangleFanSet|IndexedQuadSet|QuadSet|Extrusion|Box|Sphere|Cone|Cylinder|"
+                           "PointSet|LineSet|IndexedLineSet|Text")) {
             L->info->counts.skipped_geometry++;
             if (warn_type_once(L, ename(geo)))
                 warn(L, "%s:%d: geometry %s not supported; skipped (reported once per type)", F->path, line_of(geo),
@@ -1699,7 +2001,7 @@ static sy_result visit_shape(loader *L, xfile *F, const xmlNode *el, const sy_ma
         }
         uint32_t mat = 0;
         bool normal_map = false;
-        r = get_material(L, F, app, solid, colors, &mat, &normal_map);
+        r = get_material(L, F, app, solid, colors, prim.topology != SY_TOPOLOGY_TRIANGLES, &mat, &normal_map);
         if (!r && normal_map && prim.texcoords0 && prim.normals) r = sy_prim_generate_tangents(&prim, 0, &L->err);
         prim.material.id = mat;
         char *def = attr(el, "DEF");
@@ -1712,6 +2014,9 @@ static sy_result visit_shape(loader *L, xfile *F, const xmlNode *el, const sy_ma
             L->info->counts.meshes++;
             L->info->counts.primitives++;
             L->info->counts.triangles += sy_primitive_triangle_count(&prim);
+            if (prim.topology == SY_TOPOLOGY_LINES) L->info->counts.line_segments += sy_primitive_element_count(&prim);
+            if (prim.topology == SY_TOPOLOGY_POINTS) L->info->counts.points += sy_primitive_element_count(&prim);
+            if (!strcmp(ename(geo), "Text")) L->info->counts.texts++;
             c->mesh = mid;
             bounds_add_prim(L, &prim, world);
         } else {
@@ -1854,20 +2159,75 @@ static sy_result visit_viewpoint(loader *L, xfile *F, const xmlNode *el, sy_node
     return SY_OK;
 }
 
+/* One part of an X3D Background gradient (sky or ground) into colours[]/angles[]: at most
+ * SY_GRADIENT_MAX colours (more are cut, warned), one angle fewer than colours (a mismatch is
+ * warned and the shorter list wins), angles increasing within (0, limit] as core's check_gradient
+ * requires (angles up to 1e-3 past the limit are taken as the limit; otherwise warned and only the
+ * first colour is used). Returns the colour count (0: none). */
+static uint32_t gradient_part(loader *L, xfile *F, const xmlNode *el, const char *cname, const char *aname,
+                              float limit, float (*colours)[3], float *angles)
+{
+    float *c = NULL, *a = NULL;
+    size_t nc = 0, na = 0;
+    if (!get_float_array(L, F, el, cname, 3, &c, &nc) || !get_float_array(L, F, el, aname, 1, &a, &na)) {
+        free(c);
+        free(a);
+        return 0;
+    }
+    size_t given = nc;
+    if (nc > SY_GRADIENT_MAX) {
+        warn(L, "%s:%d: %s.%s: %zu colours, only the first %u are used", F->path, line_of(el), ename(el), cname, nc,
+             (unsigned)SY_GRADIENT_MAX);
+        nc = SY_GRADIENT_MAX;
+    }
+    if (nc && na != nc - 1) {
+        size_t keep = na < nc - 1 ? na + 1 : nc;
+        if (na != given - 1)
+            warn(L, "%s:%d: %s: %zu %s for %zu %s (expected one fewer angle than colours); %zu colour(s) used", F->path,
+                 line_of(el), ename(el), na, aname, nc, cname, keep);
+        nc = keep;
+    }
+    float prev = 0.0f;
+    for (size_t k = 0; k + 1 < nc; k++) {
+        if (a[k] > limit && a[k] <= limit + 1e-3f) a[k] = limit; /* "1.5708", "3.1416" */
+        if (!(a[k] > prev && a[k] <= limit)) {
+            warn(L, "%s:%d: %s.%s[%zu] = %g must increase within (0, %g]; only the first %s used", F->path,
+                 line_of(el), ename(el), aname, k, (double)a[k], (double)limit, cname);
+            nc = 1; /* one colour needs no angle */
+            break;
+        }
+        prev = a[k];
+    }
+    for (size_t k = 0; k < nc; k++) {
+        for (int j = 0; j < 3; j++) colours[k][j] = fmaxf(0.0f, fminf(1.0f, c[3 * k + j]));
+        if (k + 1 < nc) angles[k] = a[k];
+    }
+    free(c);
+    free(a);
+    return (uint32_t)nc;
+}
+
+/* Background / TextureBackground: skyColor / skyAngle / groundColor / groundAngle become the
+ * world's gradient (SY_BACKGROUND_GRADIENT), shown where nothing is hit; the world's colour is
+ * transparent (alpha 0) and nothing of it lights the scene. No skyColor: X3D's default black sky.
+ * transparency is not supported with a gradient (warned). Textures of the panorama are ignored. */
 static sy_result visit_background(loader *L, xfile *F, const xmlNode *el)
 {
     if (L->have_background) return SY_OK; /* the first one is bound */
     L->have_background = true;
-    float sky[3] = {0, 0, 0};
-    get_floats(L, F, el, "skyColor", sky, 3);
-    clamp01(sky, 3);
     sy_background_data bd = *(const sy_background_data *)sy_object_defaults(SY_TYPE_BACKGROUND);
-    bd.color[0] = sky[0]; bd.color[1] = sky[1]; bd.color[2] = sky[2]; bd.color[3] = 1.0f;
-    float tr = get_float(L, F, el, "transparency", 0.0f);
-    if (tr > 0) {
-        float a = 1.0f - fminf(1.0f, tr);
-        for (int k = 0; k < 4; k++) bd.color[k] *= a; /* premultiplied */
-    }
+    memset(bd.color, 0, sizeof bd.color);
+    sy_gradient *g = &bd.gradient;
+    memset(g, 0, sizeof *g);
+    char *sky = attr(el, "skyColor");
+    bool has_sky = sky != NULL;
+    xmlFree(sky);
+    if (has_sky) g->sky_count = gradient_part(L, F, el, "skyColor", "skyAngle", 3.1415927f, g->sky_color, g->sky_angle);
+    else g->sky_count = 1; /* X3D default: skyColor 0 0 0 */
+    if (g->sky_count)
+        g->ground_count = gradient_part(L, F, el, "groundColor", "groundAngle", 1.5707964f, g->ground_color, g->ground_angle);
+    if (get_float(L, F, el, "transparency", 0.0f) > 0.0f)
+        warn(L, "%s:%d: %s.transparency is not supported; the background is opaque", F->path, line_of(el), ename(el));
     char *def = attr(el, "DEF");
     uint32_t id;
     sy_result r = new_object(L, SY_TYPE_BACKGROUND, def ? def : "Background", &id);

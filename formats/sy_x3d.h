@@ -85,6 +85,8 @@ typedef struct sy_x3d_options {
 typedef struct sy_x3d_counts {
     uint32_t nodes, meshes, primitives, triangles, materials, textures, lights, cameras, inlines;
     uint32_t skipped_geometry; /* geometry nodes skipped (unsupported type or bad data) */
+    uint32_t points, line_segments; /* elements of PointSet and of (Indexed)LineSet primitives */
+    uint32_t texts;                 /* Text nodes loaded */
 } sy_x3d_counts;
 
 typedef struct sy_x3d_info {

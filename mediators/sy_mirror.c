@@ -3,7 +3,9 @@
  * Sections: >>tables (id-indexed mirrors)  >>textures/materials/meshes  >>nodes and placements
  * >>entries  >>sync  >>lifetime */
 #include "sy_mirror.h"
+#include "sy_strokes.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -87,7 +89,18 @@ struct sy_mirror {
     uint32_t dirty_count, dirty_capacity;
     uint32_t epoch;
     sy_mirror_sync_stats *stats; /* of the running sync */
+    uint32_t light_placements;   /* placements holding a back-end light (visible ones) */
+    uint32_t emissive_materials; /* mirrored materials whose emission lights the scene (radiance > 1) */
+    uint32_t default_material;   /* back-end handle of glTF's default material (0 = not made yet) */
 };
+
+/* An emitter that lights the scene (sy_look.h): emitted radiance above 1 in some channel. */
+static bool material_emits(const sy_material_data *d)
+{
+    float m = d->emissive[0] > d->emissive[1] ? d->emissive[0] : d->emissive[1];
+    m = m > d->emissive[2] ? m : d->emissive[2];
+    return m * d->emissive_strength > 1.0f;
+}
 
 static bool grow(void **arr, uint32_t *cap, size_t elem, uint32_t index)
 {
@@ -206,6 +219,21 @@ static sy_result mesh_upload(sy_mirror *st, mesh_m *m, const sy_primitive_list *
     for (uint32_t i = 0; i < pl->count; ++i) {
         const sy_primitive *p = &pl->items[i];
         m->prims[i].material = p->material.id;
+        if (p->topology != SY_TOPOLOGY_TRIANGLES) {
+            /* strokes: the same tubes and balls for every back-end (sy_strokes.h) */
+            if (sy_primitive_element_count(p) == 0) continue;
+            char what[96];
+            snprintf(what, sizeof what, "%s: mesh %#x primitive %u", st->name, m->id, i);
+            sy_bounds b = sy_primitive_position_bounds(p);
+            sy_primitive tri;
+            sy_result r = sy_strokes_tessellate(p, sy_primitive_stroke_width(p, &b), what, &tri, err);
+            if (r != SY_OK) return r;
+            sy_mirror_primitive_args a = {m->id, i, &tri, &m->prims[i].handle};
+            r = st->cb->primitive_set(st->user, &a, err);
+            sy_primitive_release(&tri); /* back-ends copy what they keep */
+            if (r != SY_OK) return r;
+            continue;
+        }
         if (sy_primitive_triangle_count(p) == 0) continue;
         sy_mirror_primitive_args a = {m->id, i, p, &m->prims[i].handle};
         sy_result r = st->cb->primitive_set(st->user, &a, err);
@@ -227,8 +255,25 @@ static void drop_instances(sy_mirror *st, placement *p)
 static void placement_clear(sy_mirror *st, placement *p)
 {
     drop_instances(st, p);
-    if (p->light) release(st, SY_MIRROR_LIGHT, p->light);
+    if (p->light) {
+        release(st, SY_MIRROR_LIGHT, p->light);
+        st->light_placements--;
+    }
     p->light = 0;
+}
+
+/* The back-end material for primitives without one: glTF 2.0's default material, made once. */
+static sy_result default_material(sy_mirror *st, uint32_t *handle, sy_error *err)
+{
+    if (!st->default_material) {
+        sy_material_data d = *(const sy_material_data *)sy_object_defaults(SY_TYPE_MATERIAL);
+        d.name = NULL;
+        sy_mirror_material_args a = {0, &d, &st->default_material};
+        sy_result r = st->cb->material_set(st->user, &a, err);
+        if (r != SY_OK) return r;
+    }
+    *handle = st->default_material;
+    return SY_OK;
 }
 
 /* Brings a placement's instances and light in line with the node's mesh/light and the world
@@ -249,9 +294,11 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
             for (uint32_t i = 0; i < want; ++i) {
                 if (!m->prims[i].handle) continue;
                 const mat_m *mm = LOOKUP(st, mat, mat_cap, m->prims[i].material);
-                sy_mirror_instance_args a = {n->id, index, m->prims[i].handle, mm ? mm->handle : 0u,
-                                             &p->world, visible, bake, &p->inst[i]};
-                sy_result r = st->cb->instance_set(st->user, &a, err);
+                uint32_t mh = mm ? mm->handle : 0u;
+                sy_result r = mh ? SY_OK : default_material(st, &mh, err);
+                if (r != SY_OK) return r;
+                sy_mirror_instance_args a = {n->id, index, m->prims[i].handle, mh, &p->world, visible, bake, &p->inst[i]};
+                r = st->cb->instance_set(st->user, &a, err);
                 if (r != SY_OK) return r;
             }
         }
@@ -265,15 +312,21 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
     }
     const light_m *l = LOOKUP(st, light, light_cap, n->light);
     if (l && visible) {
-        sy_mirror_light_args a = {.node = n->id, .placement = index, .light = &l->d, .handle = &p->light};
+        /* one reading of a spot cone for every back-end: inner >= outer is a hard edge */
+        sy_light_data ld = l->d;
+        if (ld.type == SY_LIGHT_SPOT && ld.inner_cone >= ld.outer_cone) ld.inner_cone = ld.outer_cone * 0.999f;
+        sy_mirror_light_args a = {.node = n->id, .placement = index, .light = &ld, .handle = &p->light};
         float o[3] = {0, 0, 0}, z[3] = {0, 0, -1};
         sy_mat4_transform_point(&p->world, o, a.position);
         sy_mat4_transform_dir(&p->world, z, a.direction);
+        bool had = p->light != 0;
         sy_result r = st->cb->light_set(st->user, &a, err);
+        if (!had && p->light) st->light_placements++;
         if (r != SY_OK) return r;
     } else if (p->light) {
         release(st, SY_MIRROR_LIGHT, p->light);
         p->light = 0;
+        st->light_placements--;
     }
     return SY_OK;
 }
@@ -418,6 +471,7 @@ static sy_result apply_material(sy_mirror *st, const sy_change *e, bool destroye
     if (destroyed) {
         if (m) {
             if (m->handle) release(st, SY_MIRROR_MATERIAL, m->handle);
+            if (material_emits(&m->d)) st->emissive_materials--;
             memset(m, 0, sizeof *m);
             notify(st, SY_TYPE_MATERIAL, e->id, true);
         }
@@ -446,6 +500,7 @@ static sy_result apply_material(sy_mirror *st, const sy_change *e, bool destroye
         TAKE(SY_MATERIAL_IOR, ior);
         TAKE(SY_MATERIAL_UNLIT, unlit);
 #undef TAKE
+        st->emissive_materials += (uint32_t)material_emits(&merged) - (uint32_t)material_emits(&m->d);
         m->d = merged;
         if (e->mask & ~(SY_BIT(SY_MATERIAL_NAME) | SY_BIT(SY_FIELD_ATTACHMENTS))) return material_upload(st, m, err);
         return SY_OK;
@@ -455,9 +510,12 @@ static sy_result apply_material(sy_mirror *st, const sy_change *e, bool destroye
         m = &st->mat[IDX(e->id)];
         memset(m, 0, sizeof *m);
         m->id = e->id;
+    } else if (material_emits(&m->d)) {
+        st->emissive_materials--;
     }
     /* a creation (or the first sight of a material) carries every field */
     m->d = *(const sy_material_data *)e->data;
+    if (material_emits(&m->d)) st->emissive_materials++;
     m->d.name = NULL; /* not owned by the mirror */
     if (e->mask == SY_BIT(SY_MATERIAL_NAME) || e->mask == SY_BIT(SY_FIELD_ATTACHMENTS)) return SY_OK;
     return material_upload(st, m, err);
@@ -537,16 +595,21 @@ static sy_result apply_background(sy_mirror *st, const sy_change *e, bool destro
         b = &st->bg[IDX(e->id)];
         memset(b, 0, sizeof *b);
         b->id = e->id;
-        const sy_background_data *def = sy_object_defaults(SY_TYPE_BACKGROUND);
-        memcpy(b->color, def->color, sizeof b->color);
-        b->environment = def->environment.id;
-        b->intensity = def->intensity;
+        b->world = *(const sy_background_data *)sy_object_defaults(SY_TYPE_BACKGROUND);
+        b->world.name = NULL;
     }
     const sy_background_data *bd = e->data;
-    if (e->mask & SY_BIT(SY_BACKGROUND_COLOR)) memcpy(b->color, bd->color, sizeof b->color);
-    if (e->mask & SY_BIT(SY_BACKGROUND_ENVIRONMENT)) b->environment = bd->environment.id;
-    if (e->mask & SY_BIT(SY_BACKGROUND_INTENSITY)) b->intensity = bd->intensity;
-    if (e->mask & (SY_BIT(SY_BACKGROUND_COLOR) | SY_BIT(SY_BACKGROUND_ENVIRONMENT) | SY_BIT(SY_BACKGROUND_INTENSITY)))
+    sy_background_data *w = &b->world;
+    if (e->mask & SY_BIT(SY_BACKGROUND_COLOR)) memcpy(w->color, bd->color, sizeof w->color);
+    if (e->mask & SY_BIT(SY_BACKGROUND_ENVIRONMENT)) w->environment = bd->environment;
+    if (e->mask & SY_BIT(SY_BACKGROUND_INTENSITY)) w->intensity = bd->intensity;
+    if (e->mask & SY_BIT(SY_BACKGROUND_ENVIRONMENT_VISIBLE)) w->environment_visible = bd->environment_visible;
+    if (e->mask & SY_BIT(SY_BACKGROUND_GRADIENT)) w->gradient = bd->gradient;
+    if (e->mask & SY_BIT(SY_BACKGROUND_DEFAULT_LIGHTING)) w->default_lighting = bd->default_lighting;
+    memcpy(b->color, w->color, sizeof b->color);
+    b->environment = w->environment.id;
+    b->intensity = w->intensity;
+    if (e->mask & ~(SY_BIT(SY_BACKGROUND_NAME) | SY_BIT(SY_FIELD_ATTACHMENTS)))
         notify(st, SY_TYPE_BACKGROUND, e->id, false); /* not for name or attachments: nothing visible */
     return SY_OK;
 }
@@ -659,6 +722,18 @@ uint32_t sy_mirror_texture_handle(const sy_mirror *st, uint32_t texture_id)
 {
     const tex_m *t = LOOKUP(st, tex, tex_cap, texture_id);
     return t ? t->handle : 0u;
+}
+
+void sy_mirror_look(const sy_mirror *st, uint32_t background_id, sy_look *out)
+{
+    const sy_mirror_background *b = LOOKUP(st, bg, bg_cap, background_id);
+    sy_look_inputs in = {
+        .world = b ? &b->world : NULL,
+        .world_env_ready = b && b->environment && sy_mirror_texture_handle(st, b->environment) != 0,
+        .light_count = st->light_placements,
+        .emitter_count = st->emissive_materials,
+    };
+    sy_look_resolve(&in, out);
 }
 
 const sy_mirror_background *sy_mirror_background_get(const sy_mirror *st, uint32_t background_id)

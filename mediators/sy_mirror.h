@@ -17,6 +17,7 @@
 #ifndef SY_MIRROR_H
 #define SY_MIRROR_H
 
+#include "sy_look.h"
 #include "sy_mediator.h"
 
 #ifdef __cplusplus
@@ -41,7 +42,9 @@ typedef struct sy_mirror_material_args {
     uint32_t *handle; /* in/out */
 } sy_mirror_material_args;
 
-/* One primitive of a mesh that has triangles: create its back-end mesh into *handle. */
+/* One primitive of a mesh as triangles (line and point primitives arrive tessellated into tubes
+ * and small spheres by sy_strokes.h, so every back-end draws the same strokes): create its
+ * back-end mesh into *handle. */
 typedef struct sy_mirror_primitive_args {
     uint32_t mesh_id, index;
     const sy_primitive *primitive;
@@ -122,6 +125,7 @@ typedef struct sy_mirror_background {
     float color[4];
     uint32_t environment; /* core texture id, 0 = none */
     float intensity;
+    sy_background_data world; /* every field (name NULL); color/environment/intensity repeat it */
 } sy_mirror_background;
 
 sy_result sy_mirror_create(const sy_mirror_desc *desc, sy_mirror **out, sy_error *err);
@@ -133,6 +137,12 @@ sy_result sy_mirror_sync(sy_mirror *m, const sy_changes *changes, sy_mirror_sync
 uint32_t sy_mirror_texture_handle(const sy_mirror *m, uint32_t texture_id);
 /* Mirrored background or NULL. Borrowed until the next sync. */
 const sy_mirror_background *sy_mirror_background_get(const sy_mirror *m, uint32_t background_id);
+
+/* The resolved look (sy_look.h) of a view of this scene with the given world (background id, 0 =
+ * none): environment light, background and default lighting, decided by sy_look_resolve from what
+ * the mirror holds. Every mediator asks this and nothing else. Texture ids in it are core ids
+ * (sy_mirror_texture_handle gives the back-end handle). */
+void sy_mirror_look(const sy_mirror *m, uint32_t background_id, sy_look *out);
 
 #ifdef __cplusplus
 }

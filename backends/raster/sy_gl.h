@@ -20,20 +20,38 @@
  *   sy_gl_instance  a mesh placed with a model matrix and a material.
  *   sy_gl_light     point / spot / directional light (KHR_lights_punctual units); directional and
  *                   spot lights cast shadow-mapped shadows.
+ *   area lights     up to SY_GL_MAX_AREA_LIGHTS emissive polygons (triangles or quads, world space),
+ *                   set as one list (sy_gl_set_area_lights): the mediator's emissive meshes.
+ *   environment     a lat-long texture x intensity that lights the scene (sy_gl_set_environment).
+ *   background      what camera rays that hit nothing see (sy_gl_set_background); never a light.
  *
  * Handles are one-field structs holding index + generation; id 0 is never valid; stale handles
  * give SY_GL_ERROR_INVALID_HANDLE. References between objects are resolved at render time: an
  * instance whose material is stale renders with the default material.
  *
- * Shading (the same BSDF as backends/rt's Whitted integrator for direct light): Lambert
- * base*(1-metallic)*(1-transmission)/pi plus GGX with height-correlated Smith visibility and
- * Schlick Fresnel, F0 = mix(((ior-1)/(ior+1))^2 * specular, base, metallic); point/spot intensity
- * in candela (irradiance I/d^2 times the glTF range window), directional in lux, spot cone
- * falloff clamp((cos - cos_outer)/(cos_inner - cos_outer))^2. Emissive materials are pure
- * emitters: a visible front side (both sides when double-sided) shows exactly its emissive
- * radiance. Unlit materials show their base colour. An ambient term lights every surface with
- * the background colour as a uniform environment (base*(1-metallic) + F0) * occlusion; a
- * transparent background gives no ambient light.
+ * Shading (the BSDF of backends/rt's path tracer): metal GGX with Schlick Fresnel on the base
+ * colour (weight metallic), dielectric GGX with spec x Schlick(((ior-1)/(ior+1))^2) (weight
+ * (1-metallic)(1-transmission)), Lambert base (1 - that Fresnel)/pi with the same weight, and
+ * transmission (weight (1-metallic) transmission); height-correlated Smith visibility.
+ *  - punctual lights exactly: point/spot intensity in candela (I/d^2 times the glTF range window),
+ *    directional in lux, spot cone falloff clamp((cos - cos_outer)/(cos_inner - cos_outer))^2;
+ *  - area lights with linearly transformed cosines (Heitz et al. 2016, clipless form with the
+ *    horizon-clipped sphere table; GGX and Lambert); a polygon emits from its front face
+ *    (counter-clockwise) only unless double-sided; it does not light points in its own plane;
+ *  - the environment with the split-sum approximation: a prefiltered GGX cube (one roughness per
+ *    mip) x (F0 A + B) from the BRDF table plus an irradiance cube (E/pi) x diffuse weight, both
+ *    times the occlusion texture; transmissive surfaces add Fresnel-weighted reflection and the
+ *    environment refracted in and out of a sphere tangent at the point (exact for a glass ball,
+ *    base colour tinted); the scene's own geometry is not seen through them (only the environment;
+ *    blend mode shows what is behind by alpha);
+ *  - emission (a visible front side, both when double-sided) adds to the reflected light; unlit
+ *    materials show their base colour (+ emission).
+ * Shadows: directional and spot lights and area lights (from the polygon's centre along its
+ * normal, a 150-degree frustum; a Poisson PCF whose radius grows with the polygon's size and the
+ * receiver's distance, an approximation of the penumbra without a blocker search) share
+ * SY_GL_MAX_SHADOW_MAPS maps, punctual lights first; point lights cast no shadow. Alpha-masked
+ * casters honour the mask; blended and transmissive casters shadow like opaque ones; emitters cast
+ * no shadow (they are the lights, as in the ray tracers).
  *
  * Output: sy_gl_render fills RGBA float (linear, premultiplied, row 0 = top) and depth (linear
  * distance along the viewing axis, +INFINITY where nothing was drawn) for a sub-rectangle of the
@@ -220,16 +238,47 @@ typedef struct sy_gl_light_desc {
     bool no_shadow;
 } sy_gl_light_desc;
 #define SY_GL_MAX_LIGHTS 32
-#define SY_GL_MAX_SHADOW_MAPS 4 /* the first spot/directional lights get shadow maps */
+#define SY_GL_MAX_SHADOW_MAPS 4 /* the first spot/directional lights, then area lights, get shadow maps */
 sy_gl_result sy_gl_light_create(sy_gl_device *dev, const sy_gl_light_desc *desc, sy_gl_light *out, char *err,
                                 size_t err_len);
 sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_gl_light_desc *desc, char *err,
                                 size_t err_len);
 sy_gl_result sy_gl_light_destroy(sy_gl_device *dev, sy_gl_light light);
 
-/* Background: transparent (alpha 0, no ambient) when has_color is false, else constant radiance
- * with alpha 1 that also lights the scene as an ambient environment. */
-void sy_gl_set_background(sy_gl_device *dev, bool has_color, const float color[3]);
+/* Background: what camera rays that hit nothing see; it lights nothing. NONE: RGBA 0 (alpha 0);
+ * COLOR: color (premultiplied linear RGBA); TEXTURE: the lat-long texture x intensity along each
+ * pixel's camera ray (u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, row 0 up), alpha 1;
+ * a stale texture draws as NONE. Non-finite or negative values are replaced by 0 with a warning. */
+typedef enum sy_gl_background_mode {
+    SY_GL_BACKGROUND_NONE = 0,
+    SY_GL_BACKGROUND_COLOR = 1,
+    SY_GL_BACKGROUND_TEXTURE = 2
+} sy_gl_background_mode;
+void sy_gl_set_background(sy_gl_device *dev, sy_gl_background_mode mode, const float color[4], sy_gl_texture texture,
+                          float intensity);
+
+/* Environment light: a lat-long texture (same convention; texels are radiance) x intensity, or none
+ * (texture 0 or intensity 0). When it changes, the next render prefilters it on the GPU (one
+ * specular and one irradiance cube map; see sy_gl_ibl.h). Destroying the texture removes the light. */
+void sy_gl_set_environment(sy_gl_device *dev, sy_gl_texture texture, float intensity);
+
+/* Emissive polygons as area lights (replaces the previous list; an unchanged list costs nothing).
+ * Vertices in world space, convex and planar; the front face is counter-clockwise. */
+typedef struct sy_gl_area_light {
+    float vertices[4][3];
+    uint32_t vertex_count; /* 3 or 4 */
+    float radiance[3];     /* finite, >= 0 */
+    bool double_sided;
+} sy_gl_area_light;
+#define SY_GL_MAX_AREA_LIGHTS 16
+/* The indirect light of the area lights as one radiance (the mediator's estimate): wherever area
+ * lights are set, non-emissive surfaces add (diffuse + specular weight) x ambient x occlusion x
+ * (1 + 0.75 n.d), d = the lights' flux-weighted mean emission direction (surfaces facing the way the
+ * lights shine see the directly lit ones). Non-finite or negative components are replaced by 0
+ * with a warning. */
+void sy_gl_set_ambient(sy_gl_device *dev, const float radiance[3]);
+sy_gl_result sy_gl_set_area_lights(sy_gl_device *dev, const sy_gl_area_light *lights, uint32_t count, char *err,
+                                   size_t err_len);
 
 /* >>render */
 typedef struct sy_gl_camera {

@@ -5,6 +5,7 @@
  * Sections: >>pools  >>math  >>device  >>mesh  >>texture  >>material  >>instance/light  >>render */
 #include "sy_gl.h"
 #include "sy_gl_context.h"
+#include "sy_gl_ibl.h"
 #include "sy_gl_shaders.h"
 
 #include <math.h>
@@ -16,8 +17,9 @@
 #define IDX_BITS 20u
 #define IDX_MASK ((1u << IDX_BITS) - 1u)
 #define SHADOW_SIZE_DEFAULT 2048u
-enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_COUNT };
-enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1 };
+enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_ENV_SPEC, UNIT_ENV_IRR, UNIT_BRDF,
+       UNIT_LTC1, UNIT_LTC2, UNIT_COUNT };
+enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1, BIND_AREAS = 2 };
 
 static sy_gl_result fail(char *err, size_t len, sy_gl_result r, const char *fmt, ...)
 {
@@ -98,6 +100,7 @@ typedef struct mesh_o {
 typedef struct tex_o {
     slot_head h;
     GLuint tex;
+    uint32_t width, height; /* level 0 as uploaded */
 } tex_o;
 
 typedef struct mat_o {
@@ -132,12 +135,15 @@ enum {
     VAR_TEX = 4,      /* the material samples a texture */
     VAR_NMAP = 8,     /* ... a normal map (only with VAR_TEX and lighting) */
     VAR_LIGHTS = 16,  /* punctual lights present */
-    VAR_AMBIENT = 32, /* background ambient */
-    VAR_SHADOW = 64,  /* shadow maps (only with VAR_LIGHTS) */
+    VAR_ENV = 32,     /* environment light (prefiltered cube maps) */
+    VAR_SHADOW = 64,  /* punctual shadow maps (only with VAR_LIGHTS) */
     VAR_NL_SHIFT = 7, /* bits 7-9: the light count when 1..VAR_NL_MAX (a loop the compiler unrolls, with
                        * constant uniform-block offsets), 0 = read from the Lights block */
     VAR_NL_MAX = 7,
-    VAR_COUNT = 1024
+    VAR_AREA = 1024,    /* emissive polygons (LTC) */
+    VAR_ASHADOW = 2048, /* area-light shadow maps (only with VAR_AREA) */
+    VAR_TRANS = 4096,   /* the material transmits (refracts the environment; only with VAR_ENV) */
+    VAR_COUNT = 8192
 };
 
 struct sy_gl_device {
@@ -155,8 +161,7 @@ struct sy_gl_device {
         uint64_t frame; /* the frame whose view uniforms it holds */
     } pm[VAR_COUNT];
     uint64_t frame_no;
-    uint32_t light_count, shadow_count; /* as uploaded by lights_upload: they pick the variants */
-    bool ambient;
+    uint32_t light_count, shadow_count, area_shadow_count; /* as uploaded by lights_upload: they pick the variants */
     struct {
         GLuint prog;
         GLint model, lightvp;
@@ -171,8 +176,23 @@ struct sy_gl_device {
     GLuint shadow_tex, shadow_fbo;
     targets t;
     bool lights_dirty;
-    bool has_bg;
-    float bg[3];
+    /* background (camera rays only) */
+    sy_gl_background_mode bg_mode;
+    float bg_color[4], bg_intensity;
+    sy_gl_texture bg_tex;
+    GLuint prog_sky;
+    GLint sky_inv_vp, sky_size_int;
+    /* environment light */
+    sy_gl_texture env_tex;
+    float env_intensity;
+    bool env_dirty, env_ready;
+    sy_gl_ibl ibl;
+    /* emissive polygons */
+    sy_gl_area_light areas[SY_GL_MAX_AREA_LIGHTS];
+    uint32_t area_count;
+    GLuint areas_ubo;
+    bool areas_dirty;
+    float ambient[3];
     bool warned_lights;
     sy_gl_upload_counts counts, frame, mark;
     uint32_t shadow_maps;
@@ -256,6 +276,8 @@ static void v3_norm(float *v)
     if (l > 0.0f)
         for (int i = 0; i < 3; ++i) v[i] /= l;
 }
+
+static float dot3f(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 static void cross3(const float *a, const float *b, float *o)
 {
@@ -387,7 +409,8 @@ static void material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
 
 static void bind_samplers(const sy_gl_fns *gl, GLuint prog)
 {
-    static const char *names[UNIT_COUNT] = {"t_base", "t_mr", "t_nrm", "t_occ", "t_emis", "t_shadow"};
+    static const char *names[UNIT_COUNT] = {"t_base", "t_mr",       "t_nrm",     "t_occ",  "t_emis", "t_shadow",
+                                            "t_env_spec", "t_env_irr", "t_brdf", "t_ltc1", "t_ltc2"};
     gl->UseProgram(prog);
     for (int i = 0; i < UNIT_COUNT; ++i) {
         GLint loc = gl->GetUniformLocation(prog, names[i]);
@@ -397,13 +420,18 @@ static void bind_samplers(const sy_gl_fns *gl, GLuint prog)
     if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_MATERIAL);
     b = gl->GetUniformBlockIndex(prog, "Lights");
     if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_LIGHTS);
+    b = gl->GetUniformBlockIndex(prog, "Areas");
+    if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_AREAS);
 }
 
 /* Drops variant bits that cannot matter, so that equivalent draws share one program. */
 static int variant_normalize(int v)
 {
-    if (!(v & (VAR_LIGHTS | VAR_AMBIENT)) || !(v & VAR_TEX)) v &= ~VAR_NMAP;
-    if (!(v & VAR_LIGHTS)) v &= ~(VAR_SHADOW | (7 << VAR_NL_SHIFT));
+    if (!(v & (VAR_LIGHTS | VAR_ENV | VAR_AREA)) || !(v & VAR_TEX)) v &= ~VAR_NMAP;
+    if (!(v & VAR_LIGHTS)) v &= ~(7 << VAR_NL_SHIFT);
+    if (!(v & VAR_LIGHTS)) v &= ~VAR_SHADOW;
+    if (!(v & VAR_AREA)) v &= ~VAR_ASHADOW;
+    if (!(v & VAR_ENV)) v &= ~VAR_TRANS;
     return v;
 }
 
@@ -413,13 +441,25 @@ static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 {
     v = variant_normalize(v);
     if (dev->pm[v].prog) return dev->pm[v].prog;
-    static const char *const names[7] = {"LEAN", "MASK", "TEX", "NMAP", "LIGHTS", "AMBIENT", "SHADOW"};
+    static const char *const names[7] = {"LEAN", "MASK", "TEX", "NMAP", "LIGHTS", "ENV", "SHADOW"};
     char defs[256] = "", name[128] = "main";
     size_t dl = 0, nl = strlen(name);
     for (int b = 0; b < 7; ++b) {
         if (!(v & (1 << b))) continue;
         dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_%s 1\n", names[b]);
         nl += (size_t)snprintf(name + nl, sizeof name - nl, " %s", names[b]);
+    }
+    if (v & VAR_AREA) {
+        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_AREA 1\n");
+        nl += (size_t)snprintf(name + nl, sizeof name - nl, " AREA");
+    }
+    if (v & VAR_TRANS) {
+        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_TRANS 1\n");
+        nl += (size_t)snprintf(name + nl, sizeof name - nl, " TRANS");
+    }
+    if (v & VAR_ASHADOW) {
+        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_ASHADOW 1\n");
+        nl += (size_t)snprintf(name + nl, sizeof name - nl, " ASHADOW");
     }
     int nlights = (v >> VAR_NL_SHIFT) & 7;
     if (nlights) {
@@ -445,6 +485,7 @@ static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 }
 
 #define LIGHTS_FLOATS 600 /* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes */
+#define AREAS_FLOATS (8 + SY_GL_MAX_AREA_LIGHTS * 6 * 4) /* std140 Areas block: ivec4 + vec4 + vec4[16 * 6] */
 
 sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **out, char *err, size_t err_len)
 {
@@ -484,13 +525,14 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     static const char *const defs[4] = {NULL, "#define SY_LEAN 1\n", "#define SY_MASK 1\n",
                                         "#define SY_MASK 1\n#define SY_LEAN 1\n"};
     /* the fullest main variant now, so that a shader the driver rejects fails here */
-    if (!main_program(dev, VAR_TEX | VAR_NMAP | VAR_LIGHTS | VAR_AMBIENT | VAR_SHADOW | VAR_MASK, err, err_len))
+    if (!main_program(dev, VAR_TEX | VAR_NMAP | VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_SHADOW | VAR_ASHADOW | VAR_TRANS | VAR_MASK, err, err_len))
         r = SY_GL_ERROR_GL;
     for (int v = 0; v < 2 && r == SY_GL_OK; ++v)
         r = sy_gl_program_build(gl, v ? "shadow (alpha mask)" : "shadow", sy_gl_shadow_vs, sy_gl_shadow_fs, defs[2 * v],
                                 &dev->ps[v].prog, err, err_len);
     if (r == SY_GL_OK) r = sy_gl_program_build(gl, "resolve", sy_gl_resolve_vs, sy_gl_resolve_fs, NULL, &dev->prog_resolve, err, err_len);
     if (r == SY_GL_OK) r = sy_gl_program_build(gl, "floor", sy_gl_floor_vs, sy_gl_floor_fs, NULL, &dev->prog_floor, err, err_len);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "sky", sy_gl_resolve_vs, sy_gl_sky_fs, NULL, &dev->prog_sky, err, err_len);
     if (r != SY_GL_OK) {
         sy_gl_device_destroy(dev);
         return r;
@@ -507,6 +549,10 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     dev->uf.model = gl->GetUniformLocation(dev->prog_floor, "u_model");
     dev->uf.view = gl->GetUniformLocation(dev->prog_floor, "u_view");
     dev->uf.proj = gl->GetUniformLocation(dev->prog_floor, "u_proj");
+    gl->UseProgram(dev->prog_sky);
+    gl->Uniform1i(gl->GetUniformLocation(dev->prog_sky, "t_bg"), 0);
+    dev->sky_inv_vp = gl->GetUniformLocation(dev->prog_sky, "u_inv_vp");
+    dev->sky_size_int = gl->GetUniformLocation(dev->prog_sky, "u_size_int");
 
     static const unsigned char white[4] = {255, 255, 255, 255}, flat[4] = {128, 128, 255, 255};
     dev->white_tex = make_tex1(gl, white);
@@ -521,6 +567,9 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     gl->GenBuffers(1, &dev->lights_ubo);
     gl->BindBuffer(GL_UNIFORM_BUFFER, dev->lights_ubo);
     gl->BufferData(GL_UNIFORM_BUFFER, LIGHTS_FLOATS * sizeof(float), NULL, GL_DYNAMIC_DRAW);
+    gl->GenBuffers(1, &dev->areas_ubo);
+    gl->BindBuffer(GL_UNIFORM_BUFFER, dev->areas_ubo);
+    gl->BufferData(GL_UNIFORM_BUFFER, AREAS_FLOATS * sizeof(float), NULL, GL_DYNAMIC_DRAW);
     gl->GenVertexArrays(1, &dev->empty_vao);
     /* shadow maps: one depth texture array, compared in the shader (hardware PCF) */
     gl->GenTextures(1, &dev->shadow_tex);
@@ -578,11 +627,12 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         targets_free(dev, &dev->t);
         for (int v = 0; v < VAR_COUNT; ++v)
             if (dev->pm[v].prog) gl->DeleteProgram(dev->pm[v].prog);
-        GLuint progs[4] = {dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor};
-        for (int i = 0; i < 4; ++i)
+        GLuint progs[5] = {dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor, dev->prog_sky};
+        for (int i = 0; i < 5; ++i)
             if (progs[i]) gl->DeleteProgram(progs[i]);
-        GLuint bufs[2] = {dev->default_ubo, dev->lights_ubo}, texs[3] = {dev->white_tex, dev->flat_normal_tex, dev->shadow_tex};
-        gl->DeleteBuffers(2, bufs);
+        sy_gl_ibl_free(gl, &dev->ibl);
+        GLuint bufs[3] = {dev->default_ubo, dev->lights_ubo, dev->areas_ubo}, texs[3] = {dev->white_tex, dev->flat_normal_tex, dev->shadow_tex};
+        gl->DeleteBuffers(3, bufs);
         gl->DeleteTextures(3, texs);
         gl->DeleteFramebuffers(1, &dev->shadow_fbo);
         gl->DeleteVertexArrays(1, &dev->empty_vao);
@@ -823,6 +873,8 @@ sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d
         return r;
     }
     const sy_gl_fns *gl = dev->gl;
+    t->width = w;
+    t->height = h;
     gl->GenTextures(1, &t->tex);
     gl->BindTexture(GL_TEXTURE_2D, t->tex);
     gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
@@ -858,6 +910,10 @@ sy_gl_result sy_gl_texture_destroy(sy_gl_device *dev, sy_gl_texture tex)
     if (!t) return SY_GL_ERROR_INVALID_HANDLE;
     if (current(dev, NULL, 0) == SY_GL_OK) dev->gl->DeleteTextures(1, &t->tex);
     pool_free(&dev->textures, t);
+    if (tex.id == dev->env_tex.id) { /* the environment is gone: no environment light */
+        dev->env_tex.id = 0;
+        dev->env_dirty = true;
+    }
     return SY_GL_OK;
 }
 
@@ -1068,13 +1124,88 @@ sy_gl_result sy_gl_light_destroy(sy_gl_device *dev, sy_gl_light light)
     return SY_GL_OK;
 }
 
-void sy_gl_set_background(sy_gl_device *dev, bool has_color, const float color[3])
+void sy_gl_set_background(sy_gl_device *dev, sy_gl_background_mode mode, const float color[4], sy_gl_texture texture,
+                          float intensity)
 {
-    bool same = dev->has_bg == has_color && (!has_color || !memcmp(dev->bg, color, sizeof dev->bg));
-    if (same) return;
-    dev->has_bg = has_color;
-    if (has_color) memcpy(dev->bg, color, sizeof dev->bg);
+    if ((unsigned)mode > (unsigned)SY_GL_BACKGROUND_TEXTURE) {
+        warn(dev, "raster: unknown background mode %d; using a transparent background", (int)mode);
+        mode = SY_GL_BACKGROUND_NONE;
+    }
+    float c[4] = {0, 0, 0, 0};
+    if (mode == SY_GL_BACKGROUND_COLOR && color)
+        for (int i = 0; i < 4; ++i) {
+            c[i] = color[i];
+            if (!isfinite(c[i]) || c[i] < 0.0f) {
+                warn(dev, "raster: background colour component %d (%g) is not a finite non-negative value; using 0", i,
+                     (double)c[i]);
+                c[i] = 0.0f;
+            }
+        }
+    if (!isfinite(intensity) || intensity < 0.0f) {
+        warn(dev, "raster: background intensity %g is not a finite non-negative value; using 0", (double)intensity);
+        intensity = 0.0f;
+    }
+    dev->bg_mode = mode;
+    memcpy(dev->bg_color, c, sizeof c);
+    dev->bg_tex = mode == SY_GL_BACKGROUND_TEXTURE ? texture : (sy_gl_texture){0};
+    dev->bg_intensity = intensity;
+}
+
+void sy_gl_set_environment(sy_gl_device *dev, sy_gl_texture texture, float intensity)
+{
+    if (!isfinite(intensity) || intensity < 0.0f) {
+        warn(dev, "raster: environment intensity %g is not a finite non-negative value; using 0", (double)intensity);
+        intensity = 0.0f;
+    }
+    if (intensity == 0.0f) texture.id = 0;
+    if (texture.id == dev->env_tex.id && intensity == dev->env_intensity && (texture.id != 0) == dev->env_ready) return;
+    dev->env_tex = texture;
+    dev->env_intensity = intensity;
+    dev->env_dirty = true;
+}
+
+void sy_gl_set_ambient(sy_gl_device *dev, const float radiance[3])
+{
+    float a[3];
+    for (int c = 0; c < 3; ++c) {
+        a[c] = radiance[c];
+        if (!isfinite(a[c]) || a[c] < 0.0f) {
+            warn(dev, "raster: ambient radiance[%d] = %g is not a finite non-negative value; using 0", c, (double)a[c]);
+            a[c] = 0.0f;
+        }
+    }
+    if (memcmp(a, dev->ambient, sizeof a)) {
+        memcpy(dev->ambient, a, sizeof a);
+        dev->lights_dirty = true;
+    }
+}
+
+sy_gl_result sy_gl_set_area_lights(sy_gl_device *dev, const sy_gl_area_light *lights, uint32_t count, char *err,
+                                   size_t err_len)
+{
+    if (count > SY_GL_MAX_AREA_LIGHTS)
+        return fail(err, err_len, SY_GL_ERROR_LIMIT, "area lights: %u exceed the limit of %d", count, SY_GL_MAX_AREA_LIGHTS);
+    if (count && !lights) return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "area lights: NULL array");
+    for (uint32_t i = 0; i < count; ++i) {
+        const sy_gl_area_light *a = &lights[i];
+        if (a->vertex_count != 3 && a->vertex_count != 4)
+            return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "area light %u: %u vertices (3 or 4 expected)", i,
+                        a->vertex_count);
+        for (uint32_t k = 0; k < a->vertex_count; ++k)
+            for (int c = 0; c < 3; ++c)
+                if (!isfinite(a->vertices[k][c]))
+                    return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "area light %u: vertex %u is not finite", i, k);
+        for (int c = 0; c < 3; ++c)
+            if (!isfinite(a->radiance[c]) || a->radiance[c] < 0.0f)
+                return fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT,
+                            "area light %u: radiance[%d] = %g is not a finite non-negative value", i, c, (double)a->radiance[c]);
+    }
+    if (count == dev->area_count && (!count || !memcmp(dev->areas, lights, count * sizeof *lights))) return SY_GL_OK;
+    if (count) memcpy(dev->areas, lights, count * sizeof *lights);
+    dev->area_count = count;
+    dev->areas_dirty = true;
     dev->lights_dirty = true;
+    return SY_GL_OK;
 }
 
 bool sy_gl_window_should_close(sy_gl_device *dev) { return sy_gl_context_should_close(dev->ctx); }
@@ -1174,17 +1305,72 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
         n++;
     }
     ib[0] = (int32_t)n;
-    if (dev->has_bg) {
-        memcpy(blk + 4, dev->bg, 3 * sizeof(float));
-        blk[7] = 1.0f;
+    blk[4] = (float)(SY_GL_IBL_SPEC_LEVELS - 1); /* l_env.x: the roughness-1 mip of the specular cube */
+    memcpy(blk + 5, dev->ambient, sizeof dev->ambient); /* l_env.yzw: the area lights' indirect radiance */
+    /* emissive polygons: one shadow map each from its centre along its emitting normal (a 150 degree
+     * frustum) while maps are left; penumbrae widen with the polygon's size (sy_gl.h) */
+    float ab[AREAS_FLOATS];
+    memset(ab, 0, sizeof ab);
+    int32_t *aib = (int32_t *)(void *)ab;
+    uint32_t ns_punctual = ns;
+    aib[0] = (int32_t)dev->area_count;
+    for (uint32_t i = 0; i < dev->area_count; ++i) {
+        const sy_gl_area_light *a = &dev->areas[i];
+        float *o = ab + 8 + 24 * i, cen[3] = {0, 0, 0}, e1[3], e2[3], nrm[3];
+        for (uint32_t k = 0; k < 4; ++k) {
+            const float *v = a->vertices[k < a->vertex_count ? k : a->vertex_count - 1];
+            memcpy(o + 4 * k, v, 3 * sizeof(float));
+            if (k < a->vertex_count)
+                for (int c = 0; c < 3; ++c) cen[c] += v[c] / (float)a->vertex_count;
+        }
+        o[3] = (float)a->vertex_count;
+        memcpy(o + 16, a->radiance, 3 * sizeof(float));
+        o[19] = a->double_sided ? 1.0f : 0.0f;
+        memcpy(o + 20, cen, sizeof cen);
+        o[23] = -1.0f;
+        for (int c = 0; c < 3; ++c) {
+            e1[c] = a->vertices[1][c] - a->vertices[0][c];
+            e2[c] = a->vertices[2][c] - a->vertices[0][c];
+        }
+        cross3(e1, e2, nrm);
+        float area2 = sqrtf(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]) * (a->vertex_count == 4 ? 1.0f : 0.5f);
+        if (!a->double_sided) { /* a_dir: flux-weighted mean emission direction (two-sided: none) */
+            float flux = (0.2126f * a->radiance[0] + 0.7152f * a->radiance[1] + 0.0722f * a->radiance[2]) * area2, l = sqrtf(dot3f(nrm, nrm));
+            for (int c = 0; c < 3 && l > 0.0f; ++c) ab[4 + c] += flux * nrm[c] / l;
+            ab[7] += flux;
+        } else
+            ab[7] += 2.0f * (0.2126f * a->radiance[0] + 0.7152f * a->radiance[1] + 0.0722f * a->radiance[2]) * area2;
+        if (!(area2 > 0.0f) || ns >= SY_GL_MAX_SHADOW_MAPS) continue;
+        v3_norm(nrm);
+        float view[16], proj[16], t = tanf(75.0f * 3.14159265f / 180.0f), S = (float)dev->shadow_size;
+        float dc = sqrtf((cen[0] - c[0]) * (cen[0] - c[0]) + (cen[1] - c[1]) * (cen[1] - c[1]) + (cen[2] - c[2]) * (cen[2] - c[2]));
+        double far = dc + R, nearp = fmax(1e-3 * far, 1e-4);
+        look_along(cen, nrm, view);
+        projection(false, -t, t, -t, t, nearp, far, proj);
+        m4_mul(proj, view, fs->shadow_vp[ns]);
+        memcpy(blk + 8 + 16 * ns, fs->shadow_vp[ns], 16 * sizeof(float));
+        blk[72 + 4 * ns] = 1.5f * 2.0f * t / S;
+        blk[72 + 4 * ns + 1] = 1.0f;
+        blk[72 + 4 * ns + 2] = 0.15f * sqrtf(area2) / t; /* penumbra radius (uv) x distance */
+        blk[72 + 4 * ns + 3] = 2.0f * t;
+        o[23] = (float)ns;
+        ns++;
     }
+    for (int c = 0; c < 3; ++c) ab[4 + c] = ab[7] > 0.0f ? ab[4 + c] / ab[7] : 0.0f;
+    ab[7] = 0.0f;
     fs->shadow_count = ns;
     dev->light_count = n;
-    dev->shadow_count = ns;
-    dev->ambient = dev->has_bg;
+    dev->shadow_count = ns_punctual;
+    dev->area_shadow_count = ns - ns_punctual;
     dev->gl->BindBuffer(GL_UNIFORM_BUFFER, dev->lights_ubo);
     dev->gl->BufferSubData(GL_UNIFORM_BUFFER, 0, sizeof blk, blk);
     count_buffer(dev, true, sizeof blk);
+    if (dev->area_count || dev->areas_dirty) {
+        dev->gl->BindBuffer(GL_UNIFORM_BUFFER, dev->areas_ubo);
+        dev->gl->BufferSubData(GL_UNIFORM_BUFFER, 0, sizeof ab, ab);
+        count_buffer(dev, true, sizeof ab);
+        dev->areas_dirty = false;
+    }
 }
 
 static void draw_mesh(sy_gl_device *dev, const mesh_o *m)
@@ -1364,7 +1550,7 @@ static int cmp_far_first(const void *a, const void *b)
     return x[0] < y[0] ? 1 : x[0] > y[0] ? -1 : 0;
 }
 
-static void begin_target(sy_gl_device *dev)
+static void begin_target(sy_gl_device *dev, const view_setup *v)
 {
     const sy_gl_fns *gl = dev->gl;
     gl->BindFramebuffer(GL_FRAMEBUFFER, dev->t.fbo);
@@ -1374,14 +1560,29 @@ static void begin_target(sy_gl_device *dev)
     gl->ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     gl->DepthMask(GL_TRUE);
     float bg[4] = {0, 0, 0, 0};
-    if (dev->has_bg) {
-        memcpy(bg, dev->bg, 3 * sizeof(float));
-        bg[3] = 1.0f;
-    }
+    if (dev->bg_mode == SY_GL_BACKGROUND_COLOR) memcpy(bg, dev->bg_color, sizeof bg);
     const float inf[4] = {INFINITY, 0, 0, 0}, one = 1.0f;
     gl->ClearBufferfv(GL_COLOR, 0, bg);
     gl->ClearBufferfv(GL_COLOR, 1, inf);
     gl->ClearBufferfv(GL_DEPTH, 0, &one);
+    const tex_o *sky = dev->bg_mode == SY_GL_BACKGROUND_TEXTURE ? pool_get(&dev->textures, dev->bg_tex.id) : NULL;
+    float vp[16], inv[16];
+    if (sky && v) {
+        m4_mul(v->proj, v->view, vp);
+        if (m4_invert(vp, inv)) { /* the sky: camera rays that hit nothing see the texture */
+            gl->Disable(GL_DEPTH_TEST);
+            gl->DepthMask(GL_FALSE);
+            gl->UseProgram(dev->prog_sky);
+            gl->UniformMatrix4fv(dev->sky_inv_vp, 1, GL_FALSE, inv);
+            const float si[4] = {(float)dev->t.w, (float)dev->t.h, dev->bg_intensity, 0.0f};
+            gl->Uniform4fv(dev->sky_size_int, 1, si);
+            gl->ActiveTexture(GL_TEXTURE0);
+            gl->BindTexture(GL_TEXTURE_2D, sky->tex);
+            gl->BindVertexArray(dev->empty_vao);
+            gl->DrawArrays(GL_TRIANGLES, 0, 3);
+            gl->DepthMask(GL_TRUE);
+        }
+    }
     gl->Enable(GL_DEPTH_TEST);
     gl->DepthFunc(GL_LESS);
     gl->Disable(GL_CULL_FACE); /* the ray tracers see both sides of every triangle */
@@ -1444,10 +1645,13 @@ static int draw_variant(const sy_gl_device *dev, const mesh_o *m, const mat_o *m
     int v = mesh_lean(m) ? VAR_LEAN : 0;
     if (dev->light_count) v |= VAR_LIGHTS;
     if (dev->light_count && dev->light_count <= VAR_NL_MAX) v |= (int)dev->light_count << VAR_NL_SHIFT;
-    if (dev->ambient) v |= VAR_AMBIENT;
+    if (dev->env_ready) v |= VAR_ENV;
+    if (dev->area_count) v |= VAR_AREA;
     if (dev->shadow_count) v |= VAR_SHADOW;
+    if (dev->area_shadow_count) v |= VAR_ASHADOW;
     if (!mt) return v;
     if (mt->d.alpha_mode == SY_GL_ALPHA_MASK) v |= VAR_MASK;
+    if (mt->d.transmission > 0.0f && mt->d.metallic < 1.0f) v |= VAR_TRANS;
     const sy_gl_texture_ref *refs[5] = {&mt->d.base_color_texture, &mt->d.metallic_roughness_texture,
                                         &mt->d.normal_texture, &mt->d.occlusion_texture, &mt->d.emissive_texture};
     for (int i = 0; i < 5; ++i)
@@ -1491,7 +1695,7 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, const inst_o 
     float mvp[16];
     m4_mul(dc->viewproj, in->model, mvp);
     gl->UniformMatrix4fv(dev->pm[pv].mvp, 1, GL_FALSE, mvp);
-    if (pv & (VAR_LIGHTS | VAR_AMBIENT)) {
+    if (pv & (VAR_LIGHTS | VAR_ENV | VAR_AREA)) {
         gl->UniformMatrix4fv(dev->pm[pv].model, 1, GL_FALSE, in->model);
         gl->UniformMatrix3fv(dev->pm[pv].normal_mat, 1, GL_FALSE, in->normal_mat);
         gl->Uniform1i(dev->pm[pv].has_normals, m->has_normals);
@@ -1529,18 +1733,41 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     dev->frame_no++;
     static frame_state fs_zero;
     frame_state fs = fs_zero;
+    if (dev->env_dirty) {
+        const tex_o *et = pool_get(&dev->textures, dev->env_tex.id);
+        dev->env_ready = false;
+        if (et) {
+            r = sy_gl_ibl_tables(gl, &dev->ibl, err, err_len);
+            if (r == SY_GL_OK)
+                r = sy_gl_ibl_prefilter(gl, &dev->ibl, et->tex, et->width, et->height, dev->env_intensity, err, err_len);
+            if (r != SY_GL_OK) return r;
+            dev->env_ready = true;
+        }
+        dev->env_dirty = false;
+    }
+    if (dev->area_count && (r = sy_gl_ibl_tables(gl, &dev->ibl, err, err_len)) != SY_GL_OK) return r;
     if (dev->lights_dirty) {
         lights_upload(dev, &fs);
         if (fs.shadow_count) render_shadows(dev, &fs);
         else dev->shadow_maps = 0;
         dev->lights_dirty = false;
     }
-    begin_target(dev);
+    begin_target(dev, &v);
     draw_ctx dc = {.v = &v, .ortho_z = {v.proj[10], v.proj[14], 0.0f}, .bound = -1};
     m4_mul(v.proj, v.view, dc.viewproj);
     gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_LIGHTS, dev->lights_ubo);
+    gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_AREAS, dev->areas_ubo);
     gl->ActiveTexture(GL_TEXTURE0 + UNIT_SHADOW);
     gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->shadow_tex);
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_ENV_SPEC);
+    gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->ibl.spec_cube);
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_ENV_IRR);
+    gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->ibl.irr_cube);
+    GLuint tables[3] = {dev->ibl.brdf_lut, dev->ibl.ltc1, dev->ibl.ltc2};
+    for (int i = 0; i < 3; ++i) {
+        gl->ActiveTexture(GL_TEXTURE0 + UNIT_BRDF + (GLenum)i);
+        gl->BindTexture(GL_TEXTURE_2D, tables[i]);
+    }
     /* opaque near to far (early depth tests reject hidden fragments before shading), then
      * alpha-masked (the discard variant) near to far, then blended far to near with depth writes
      * off. Each list holds (view distance, instance index) pairs. */
@@ -1596,7 +1823,7 @@ sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, cons
     if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
     dev->tris = dev->draws = 0;
-    begin_target(dev);
+    begin_target(dev, NULL);
     gl->UseProgram(dev->prog_floor);
     gl->UniformMatrix4fv(dev->uf.view, 1, GL_FALSE, v.view);
     gl->UniformMatrix4fv(dev->uf.proj, 1, GL_FALSE, v.proj);

@@ -1,7 +1,9 @@
 /* sy_gl_shaders.c — the rasterizer's GLSL programs (see sy_gl_shaders.h). The main fragment
- * shader implements the same BSDF and light falloffs as backends/rt/sy_rt_whitted.c (see sy_gl.h
- * for the model); the shadow pass honours alpha masks; the resolve pass averages colour and takes
- * the nearest linear depth of the MSAA samples. */
+ * shader implements the same BSDF as backends/rt's path tracer (see sy_gl.h for the model): punctual
+ * lights exactly, emissive polygons with linearly transformed cosines, the environment with the
+ * split-sum approximation (prefiltered GGX cube + irradiance cube + BRDF LUT); the shadow pass
+ * honours alpha masks; the sky pass draws the background; the resolve pass averages colour and
+ * takes the nearest linear depth of the MSAA samples; the IBL programs prefilter the environment. */
 #include "sy_gl_shaders.h"
 
 #include <stdio.h>
@@ -11,12 +13,14 @@
 /* Vertex attributes: 0 position, 1 normal, 2 uv0, 3 uv1, 4 colour. Variant defines (see
  * sy_gl_device.c main_program): SY_LEAN (no uv1 / colours), SY_MASK (alpha mask: discard), SY_TEX
  * (the material has a texture: uv varyings), SY_NMAP (normal map), SY_LIGHTS (punctual lights),
- * SY_AMBIENT (background ambient), SY_SHADOW (shadow maps), SY_NLIGHTS (a constant light count:
+ * SY_ENV (environment light), SY_AREA (emissive polygons), SY_SHADOW (punctual shadow maps),
+ * SY_ASHADOW (area-light shadow maps), SY_TRANS (a transmissive material; llvmpipe runs both sides of a branch, so code that no
+ * light of this frame needs is left out of the variant), SY_NLIGHTS (a constant light count:
  * the loop unrolls with constant uniform-block offsets). Every varying costs set-up per
  * triangle and interpolation per fragment in a software rasterizer, so a variant interpolates only
- * what it reads; unlit variants (no lights, no ambient) need no position or normal at all. */
+ * what it reads; unlit variants (no lights, no environment) need no position or normal at all. */
 #define SY_GL_VARIANT_PRELUDE                                 \
-    "#if defined(SY_LIGHTS) || defined(SY_AMBIENT)\n"         \
+    "#if defined(SY_LIGHTS) || defined(SY_ENV) || defined(SY_AREA)\n" \
     "#define SY_LIT 1\n"                                      \
     "#endif\n"                                                \
     "#if defined(SY_TEX) && !defined(SY_LEAN)\n"              \
@@ -67,9 +71,12 @@ const char *const sy_gl_main_vs =
 const char *const sy_gl_main_fs =
     "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_MATERIAL_BLOCK
     "struct Light { vec4 pos_type; vec4 dir_range; vec4 radiant; vec4 cone; };\n"
-    "layout(std140) uniform Lights { ivec4 l_count; vec4 l_ambient; mat4 l_shadow_mat[4]; vec4 l_shadow[4];\n"
+    "layout(std140) uniform Lights { ivec4 l_count; vec4 l_env; mat4 l_shadow_mat[4]; vec4 l_shadow[4];\n"
     "  Light l_lights[32]; };\n"
+    /* area lights: 4 vertices (xyz, w unused), radiance (rgb, w = double-sided), centre (xyz, w = shadow map or -1) */
+    "layout(std140) uniform Areas { ivec4 a_count; vec4 a_dir; vec4 a_data[16 * 6]; };\n"
     "uniform sampler2DArrayShadow t_shadow;\n"
+    "uniform samplerCube t_env_spec, t_env_irr; uniform sampler2D t_brdf, t_ltc1, t_ltc2;\n"
     "uniform vec3 u_cam_pos; uniform vec3 u_cam_fwd; uniform bool u_ortho; uniform bool u_mirror;\n"
     "uniform bool u_has_normals; uniform vec3 u_ortho_z;\n" /* orthographic: proj[10], proj[14] */
     "#ifdef SY_LIT\n"
@@ -94,16 +101,55 @@ const char *const sy_gl_main_fs =
     "const float INV_PI = 0.31830988618;\n"
     "vec3 schlick(vec3 f0, float c) { float m = 1.0 - clamp(c, 0.0, 1.0); float m5 = m*m*m*m*m;\n"
     "  return f0 + (vec3(1.0) - f0) * m5; }\n"
-    "#ifdef SY_SHADOW\n"
-    "float shadow_vis(int si, vec3 p, vec3 ngf) {\n"
-    "  vec4 sp = l_shadow[si]; vec4 c0 = l_shadow_mat[si] * vec4(p, 1.0); if (c0.w <= 0.0) return 1.0;\n"
+    "float schlick1(float f0, float c) { float m = 1.0 - clamp(c, 0.0, 1.0); return f0 + (1.0 - f0) * m*m*m*m*m; }\n"
+    "#if defined(SY_SHADOW) || defined(SY_ASHADOW)\n"
+    /* sp.x: normal offset (x w in perspective when sp.y > 0.5); sp.z: area-light penumbra scale
+     * (radius in shadow-map uv = sp.z / w); sp.w: 2 tan(half fov). Returns the light-space position. */
+    "bool shadow_coord(int si, vec3 p, vec3 ngf, out vec3 q, out float r) {\n"
+    "  vec4 sp = l_shadow[si]; vec4 c0 = l_shadow_mat[si] * vec4(p, 1.0); r = 0.0; q = vec3(0.0); if (c0.w <= 0.0) return false;\n"
     "  float off = sp.x * (sp.y > 0.5 ? c0.w : 1.0);\n"
-    "  vec4 c = l_shadow_mat[si] * vec4(p + ngf * off, 1.0); if (c.w <= 0.0) return 1.0;\n"
-    "  vec3 q = c.xyz / c.w * 0.5 + 0.5; if (q.z >= 1.0) return 1.0;\n"
+    "  r = sp.z / c0.w;\n" /* penumbra kernel (uv); its world size sp.w r w */
+    "  off = max(off, 0.5 * r * sp.w * c0.w);\n" /* offset the receiver by the kernel's footprint: no self-shadowing */
+    "  vec4 c = l_shadow_mat[si] * vec4(p + ngf * off, 1.0); if (c.w <= 0.0) return false;\n"
+    "  q = c.xyz / c.w * 0.5 + 0.5; return q.z < 1.0; }\n"
+    "#endif\n"
+    "#ifdef SY_SHADOW\n" /* punctual lights: 3 x 3 hardware PCF */
+    "float shadow_vis(int si, vec3 p, vec3 ngf) {\n"
+    "  vec3 q; float r; if (!shadow_coord(si, p, ngf, q, r)) return 1.0;\n"
     "  float s = 0.0; vec2 ts = 1.0 / vec2(textureSize(t_shadow, 0).xy);\n"
     "  for (int y = -1; y <= 1; ++y) for (int x = -1; x <= 1; ++x)\n"
     "    s += texture(t_shadow, vec4(q.xy + vec2(x, y) * ts, float(si), q.z));\n"
     "  return s / 9.0; }\n"
+    "#endif\n"
+    "#ifdef SY_ASHADOW\n" /* area lights: 8 Poisson taps (hardware PCF each) over the penumbra */
+    "const vec2 POISSON[8] = vec2[8](vec2(-0.840,-0.074), vec2(0.962,-0.195), vec2(-0.203,0.621), vec2(0.185,-0.893),\n"
+    "  vec2(-0.326,-0.406), vec2(0.473,-0.480), vec2(0.519,0.767), vec2(-0.696,0.457));\n"
+    "float shadow_area(int si, vec3 p, vec3 ngf) {\n"
+    "  vec3 q; float r; if (!shadow_coord(si, p, ngf, q, r)) return 1.0;\n"
+    "  r = max(r, 1.5 / float(textureSize(t_shadow, 0).x)); float s = 0.0;\n"
+    "  for (int k = 0; k < 8; ++k) s += texture(t_shadow, vec4(q.xy + POISSON[k] * r, float(si), q.z));\n"
+    "  return s * 0.125; }\n"
+    "#endif\n"
+    "#ifdef SY_AREA\n"
+    /* Heitz et al. 2016, clipless form: the vector form factor of the (transformed) polygon, its
+     * horizon clipping looked up as a sphere in ltc_2.w */
+    "vec3 edge_vec(vec3 v1, vec3 v2) { float x = dot(v1, v2), y = abs(x);\n"
+    "  float a = 0.8543985 + (0.4965155 + 0.0145206 * y) * y, b = 3.4175940 + (4.1616724 + y) * y, v = a / b;\n"
+    "  float ts = x > 0.0 ? v : 0.5 * inversesqrt(max(1.0 - x * x, 1e-7)) - v; return cross(v1, v2) * ts; }\n"
+    "float ltc_eval(mat3 Minv, vec3 P, int li, int nv) {\n"
+    "  vec3 L[4]; vec3 ctr = vec3(0.0);\n"
+    "  for (int k = 0; k < 4; ++k) { L[k] = Minv * (a_data[li * 6 + k].xyz - P); }\n"
+    "  ctr = Minv * (a_data[li * 6 + 5].xyz - P);\n"
+    "  for (int k = 0; k < 4; ++k) L[k] = normalize(L[k]);\n"
+    "  vec3 f = edge_vec(L[0], L[1]) + edge_vec(L[1], L[2]);\n"
+    "  if (nv == 4) f += edge_vec(L[2], L[3]) + edge_vec(L[3], L[0]); else f += edge_vec(L[2], L[0]);\n"
+    "  if (dot(f, ctr) < 0.0) f = -f;\n"
+    "  float len = length(f); if (!(len > 0.0)) return 0.0;\n"
+    "  float z = f.z / len; vec2 uv = vec2(z * 0.5 + 0.5, len) * (63.0 / 64.0) + 0.5 / 64.0;\n"
+    "  return len * textureLod(t_ltc2, uv, 0.0).w; }\n"
+    "#endif\n"
+    "#ifdef SY_ENV\n"
+    "vec3 env_spec(vec3 d, float rough) { return textureLod(t_env_spec, d, rough * l_env.x).rgb; }\n"
     "#endif\n"
     "void main() {\n"
     "  vec2 uv[2] = vec2[2](v_uv0, v_uv1);\n"
@@ -118,15 +164,17 @@ const char *const sy_gl_main_fs =
     "  if (m_modes.x != 2) alpha = 1.0;\n"
     "  bool front = gl_FrontFacing != u_mirror;\n"
     "  vec3 L = vec3(0.0);\n"
+    /* emission is radiance and adds to the reflected light */
     "  if (m_modes.w != 0 && (front || m_modes.z != 0)) {\n"
     "    L = m_emissive.rgb;\n"
     "#ifdef SY_TEX\n"
     "    if (m_tex2.x >= 0) L *= texture(t_emis, tuv(4, uv[m_tex2.x])).rgb;\n"
     "#endif\n"
-    "  } else if (m_modes.y != 0) {\n"
-    "    L = base.rgb;\n"
     "  }\n"
-    "#ifdef SY_LIT\n" /* without lights and ambient a surface that is neither emissive nor unlit is black */
+    "  if (m_modes.y != 0) {\n"
+    "    L += base.rgb;\n"
+    "  }\n"
+    "#ifdef SY_LIT\n" /* without lights a surface that is neither emissive nor unlit is black */
     "  else {\n"
     "    vec3 dpx = dFdx(v_wpos), dpy = dFdy(v_wpos);\n"
     "    vec3 wo = u_ortho ? -u_cam_fwd : normalize(u_cam_pos - v_wpos);\n"
@@ -153,10 +201,14 @@ const char *const sy_gl_main_fs =
     "#ifdef SY_TEX\n"
     "    if (m_tex.y >= 0) { vec4 t = texture(t_mr, tuv(1, uv[m_tex.y])); rough *= t.g; metallic *= t.b; }\n"
     "#endif\n"
-    "    float ior = m_oist.y, spec = m_oist.z, trans = m_oist.w;\n"
-    "    float r0 = (ior - 1.0) / (ior + 1.0); float f0d = r0 * r0 * spec;\n"
-    "    vec3 f0 = vec3(f0d) * (1.0 - metallic) + base.rgb * metallic;\n"
-    "    vec3 kd = base.rgb * (1.0 - metallic) * (1.0 - trans);\n"
+    "    metallic = clamp(metallic, 0.0, 1.0); rough = clamp(rough, 0.0, 1.0);\n"
+    "    vec3 bc = clamp(base.rgb, 0.0, 1.0);\n"
+    "    float ior = m_oist.y, spec = clamp(m_oist.z, 0.0, 1.0), trans = clamp(m_oist.w, 0.0, 1.0);\n"
+    /* the path tracer's lobes: metal (Schlick on the base colour), dielectric specular
+     * spec x Schlick(f0d), diffuse base (1 - that) / pi, transmission */
+    "    float r0 = (ior - 1.0) / (ior + 1.0); float f0d = r0 * r0;\n"
+    "    float w_metal = metallic, w_diel = (1.0 - metallic) * (1.0 - trans), w_trans = (1.0 - metallic) * trans;\n"
+    "    vec3 kd = bc * w_diel;\n"
     "    float a = max(rough * rough, 1e-4), a2 = a * a;\n"
     "    float nv = max(dot(ns, wo), 1e-4);\n"
     "#ifdef SY_LIGHTS\n"
@@ -180,22 +232,83 @@ const char *const sy_gl_main_fs =
     "#else\n"
     "      float vis = 1.0;\n"
     "#endif\n"
-    "      vec3 f = kd * INV_PI;\n"
-    "      if (rough > 0.0 && any(greaterThan(f0, vec3(0.0)))) {\n"
-    "        vec3 h = normalize(wi + wo); float nl = cs, nh = max(dot(ns, h), 0.0);\n"
+    "      vec3 h = normalize(wi + wo); float vh = max(dot(wo, h), 0.0);\n"
+    "      float fd = spec * schlick1(f0d, vh);\n"
+    "      vec3 f = kd * (1.0 - fd) * INV_PI;\n"
+    "      if (rough > 0.0) {\n"
+    "        float nl = cs, nh = max(dot(ns, h), 0.0);\n"
     "        float dd = nh * nh * (a2 - 1.0) + 1.0; float D = a2 * INV_PI / (dd * dd);\n"
     "        float V = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));\n"
-    "        f += schlick(f0, dot(wi, h)) * (D * V);\n"
+    "        f += (schlick(bc, vh) * w_metal + vec3(w_diel * fd)) * (D * V);\n"
     "      }\n"
     "      L += e * f * cs * vis;\n"
     "    }\n"
     "#endif\n"
-    "#ifdef SY_AMBIENT\n"
-    "    float ao = 1.0;\n"
-    "#ifdef SY_TEX\n"
-    "    if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, tuv(3, uv[m_tex.w])).r - 1.0);\n"
+    "#if defined(SY_AREA) || defined(SY_ENV)\n"
+    /* split-sum terms: A, B of the GGX BRDF for this view and roughness */
+    "    vec2 ab = textureLod(t_brdf, vec2(nv, rough) * (31.0 / 32.0) + 0.5 / 32.0, 0.0).rg;\n"
+    "    float fd_avg = spec * (f0d * ab.x + ab.y);\n"
+    "    vec3 fspec = (bc * ab.x + ab.y) * w_metal + vec3(w_diel * fd_avg);\n"
     "#endif\n"
-    "    L += l_ambient.rgb * (kd + schlick(f0, nv)) * ao;\n"
+    "#ifdef SY_AREA\n"
+    "    {\n"
+    "      vec2 luv = vec2(rough, sqrt(1.0 - nv)) * (63.0 / 64.0) + 0.5 / 64.0;\n"
+    "      vec4 t1 = textureLod(t_ltc1, luv, 0.0), t2 = textureLod(t_ltc2, luv, 0.0);\n"
+    "      vec3 T1 = normalize(wo - ns * dot(wo, ns)); vec3 T2 = cross(ns, T1);\n"
+    "      mat3 frame = transpose(mat3(T1, T2, ns));\n"
+    "      mat3 Minv = mat3(vec3(t1.x, 0.0, t1.y), vec3(0.0, 1.0, 0.0), vec3(t1.z, 0.0, t1.w)) * frame;\n"
+    /* the LTC norm replaces A, B for the polygon's specular (F0 t2.x + (1 - F0) t2.y) */
+    "      vec3 fl = (bc * t2.x + (1.0 - bc) * t2.y) * w_metal + vec3(w_diel * spec * (f0d * t2.x + (1.0 - f0d) * t2.y));\n"
+    "      vec3 kdl = kd * (1.0 - fd_avg);\n"
+    "      for (int i = 0; i < a_count.x; ++i) {\n"
+    "        vec4 v0 = a_data[i * 6], rad = a_data[i * 6 + 4], cen = a_data[i * 6 + 5];\n"
+    "        int nvx = int(v0.w);\n"
+    "        vec3 ln = cross(a_data[i * 6 + 1].xyz - v0.xyz, a_data[i * 6 + 2].xyz - v0.xyz);\n"
+    "        float side = dot(v_wpos - v0.xyz, ln);\n"
+    "        if (!(abs(side) > 1e-5 * dot(ln, ln) + 1e-9) || (side < 0.0 && rad.w < 0.5)) continue;\n"
+    "#ifdef SY_ASHADOW\n"
+    "        int si = int(cen.w); float vis = si >= 0 ? shadow_area(si, v_wpos, ngf) : 1.0;\n"
+    "        if (vis <= 0.0) continue;\n"
+    "#else\n"
+    "        float vis = 1.0;\n"
+    "#endif\n"
+    "        float d = ltc_eval(frame, v_wpos, i, nvx);\n"
+    "        float s = rough > 0.0 ? ltc_eval(Minv, v_wpos, i, nvx) : 0.0;\n"
+    "        L += rad.rgb * (kdl * d + fl * s) * vis;\n"
+    "      }\n"
+    "      float ao = 1.0;\n"
+    "#ifdef SY_TEX\n"
+    "      if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, tuv(3, uv[m_tex.w])).r - 1.0);\n"
+    "#endif\n"
+    /* the area lights' indirect light (sy_gl_set_ambient), stronger on surfaces facing the way the
+     * emitters shine (they see the directly lit surfaces), weaker on those facing the emitters; not
+     * on emitters (the estimate counts them as sources only) */
+    "      if (m_modes.w == 0) L += (kdl + fspec) * l_env.yzw * (ao * (1.0 + 0.75 * dot(ns, a_dir.xyz)));\n"
+    "    }\n"
+    "#endif\n"
+    "#ifdef SY_ENV\n"
+    "    {\n"
+    "      float ao = 1.0;\n"
+    "#ifdef SY_TEX\n"
+    "      if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, tuv(3, uv[m_tex.w])).r - 1.0);\n"
+    "#endif\n"
+    "      vec3 R = reflect(-wo, ns);\n"
+    "      vec3 irr = textureLod(t_env_irr, ns, 0.0).rgb;\n" /* cosine-weighted mean radiance = E / pi */
+    "      vec3 env = kd * (1.0 - fd_avg) * irr + fspec * env_spec(R, rough);\n"
+    "#ifdef SY_TRANS\n"
+    "      {\n" /* glass: Fresnel reflection + refraction of the environment */
+    "        float F = schlick1(f0d, nv);\n"
+    /* through a solid: refract in, cross a sphere tangent to this point, refract out (exact for
+     * a glass ball: the environment appears inverted as in the path tracer) */
+    "        float eta = max(ior, 1.0); vec3 T = refract(-wo, ns, 1.0 / eta);\n"
+    "        if (dot(T, T) == 0.0) T = R; else {\n"
+    "          vec3 n2 = ns - 2.0 * dot(ns, T) * T;\n" /* the exit normal (outward) */
+    "          vec3 T2 = refract(T, -n2, eta); T = dot(T2, T2) > 0.0 ? T2 : reflect(T, -n2);\n"
+    "        }\n"
+    "        env += w_trans * (F * env_spec(R, rough) + (1.0 - F) * bc * env_spec(T, rough));\n"
+    "      }\n"    "#endif\n"
+    "      L += env * ao;\n"
+    "    }\n"
     "#endif\n"
     "  }\n"
     "#endif\n"
@@ -222,6 +335,18 @@ const char *const sy_gl_shadow_fs =
     "  if (a < m_mrna.w) discard;\n"
     "#endif\n"
     "}\n";
+
+/* The background where nothing is drawn: the lat-long texture x intensity along each pixel's
+ * camera ray (u_inv_vp: inverse view-projection of this target), alpha 1, depth +infinity. */
+const char *const sy_gl_sky_fs =
+    "#version 330 core\n"
+    "uniform mat4 u_inv_vp; uniform vec4 u_size_int; uniform sampler2D t_bg;\n" /* target w, h, intensity */
+    "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
+    "void main() { vec2 ndc = gl_FragCoord.xy / u_size_int.xy * 2.0 - 1.0;\n"
+    "  vec4 a = u_inv_vp * vec4(ndc, -1.0, 1.0), b = u_inv_vp * vec4(ndc, 1.0, 1.0);\n"
+    "  vec3 d = normalize(b.xyz * a.w - a.xyz * b.w);\n"
+    "  vec2 uv = vec2(0.5 + atan(d.x, -d.z) * 0.15915494309, acos(clamp(d.y, -1.0, 1.0)) * 0.31830988618);\n"
+    "  o_color = vec4(textureLod(t_bg, uv, 0.0).rgb * u_size_int.z, 1.0); o_depth = uintBitsToFloat(0x7F800000u); }\n";
 
 const char *const sy_gl_resolve_vs =
     "#version 330 core\n"

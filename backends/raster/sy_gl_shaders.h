@@ -1,5 +1,5 @@
 /* sy_gl_shaders.h — internal: GLSL 3.30 core sources of the rasterizer's programs (main PBR
- * pass, shadow pass, MSAA resolve, benchmark floor) and the compile/link helper that returns the
+ * pass, shadow pass, sky, MSAA resolve, benchmark floor) and the compile/link helper that returns the
  * driver's info log on failure. */
 #ifndef SY_GL_SHADERS_H
 #define SY_GL_SHADERS_H
@@ -8,7 +8,8 @@
 
 extern const char *const sy_gl_main_vs, *const sy_gl_main_fs;
 extern const char *const sy_gl_shadow_vs, *const sy_gl_shadow_fs;
-extern const char *const sy_gl_resolve_vs, *const sy_gl_resolve_fs;
+extern const char *const sy_gl_resolve_vs, *const sy_gl_resolve_fs; /* resolve_vs: a full-screen triangle */
+extern const char *const sy_gl_sky_fs; /* with sy_gl_resolve_vs */
 extern const char *const sy_gl_floor_vs, *const sy_gl_floor_fs;
 
 /* Compiles and links; fs_defines (NULL = none, e.g. "#define SY_MASK 1\n") is inserted after the

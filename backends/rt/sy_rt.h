@@ -166,7 +166,7 @@ sy_rt_result sy_rt_texture_destroy(sy_rt_device *dev, sy_rt_texture tex, char *e
 typedef enum sy_rt_alpha_mode {
     SY_RT_ALPHA_OPAQUE = 0,
     SY_RT_ALPHA_MASK = 1,  /* cut out where alpha < alpha_cutoff (also for shadow rays) */
-    SY_RT_ALPHA_BLEND = 2, /* camera/secondary rays blend with what is behind; shadows opaque */
+    SY_RT_ALPHA_BLEND = 2, /* rays blend with what is behind; shadow rays are attenuated by 1 - alpha */
     SY_RT_ALPHA_MODE_MAX_ENUM = 0x7fffffff
 } sy_rt_alpha_mode;
 
@@ -265,31 +265,44 @@ sy_rt_result sy_rt_light_update(sy_rt_device *dev, sy_rt_light light, const sy_r
                                 char *err, size_t err_len);
 sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light, char *err, size_t err_len);
 
-/* >>background */
+/* >>background and environment
+ *
+ * One scene, one look (docs: "One scene, one look"): the BACKGROUND is only what CAMERA rays that
+ * hit nothing see (straight through alpha-blended surfaces included); it never lights anything.
+ * The ENVIRONMENT (sy_rt_set_environment) is a light: every other ray that leaves the scene
+ * (reflection, refraction, diffuse bounce, shadow ray toward it) sees it, and sees black when
+ * there is none. Showing the environment behind the scene is a background in TEXTURE mode on the
+ * same texture and intensity. */
 
 typedef enum sy_rt_background_mode {
-    SY_RT_BACKGROUND_NONE = 0,  /* transparent: colour 0, alpha 0 (secondary rays see black) */
-    SY_RT_BACKGROUND_COLOR = 1, /* constant radiance, alpha 1 */
+    SY_RT_BACKGROUND_NONE = 0,    /* transparent: colour 0, alpha 0 */
+    SY_RT_BACKGROUND_COLOR = 1,   /* constant radiance `color`, alpha 1 */
+    SY_RT_BACKGROUND_TEXTURE = 2, /* lat-long `texture` (convention of sy_rt_set_environment) x
+                                   * `intensity`, alpha 1; a texture destroyed later shows black */
     SY_RT_BACKGROUND_MODE_MAX_ENUM = 0x7fffffff
 } sy_rt_background_mode;
 
 typedef struct sy_rt_background {
     sy_rt_background_mode mode;
-    float color[3];
+    float color[3];        /* COLOR: finite, >= 0 */
+    sy_rt_texture texture; /* TEXTURE: a live texture */
+    float intensity;       /* TEXTURE: finite, >= 0 */
 } sy_rt_background;
 
 /* Default: SY_RT_BACKGROUND_NONE. Takes effect at the next commit. */
 sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg, char *err,
                                   size_t err_len);
 
-/* Environment light: an equirectangular (latitude-longitude) texture times intensity, seen by rays
- * that leave the scene instead of the background colour (alpha 1). Direction d (unit, world) maps
- * to u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, so the image centre is seen looking
+/* Environment light: an equirectangular (latitude-longitude) texture times intensity, seen by every
+ * ray but camera rays when it leaves the scene. Direction d (unit, world) maps to
+ * u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, so the image centre is seen looking
  * down -Z and row 0 is straight up (+Y). The PATHTRACER importance-samples it (piecewise-constant
- * distribution over the texels, luminance x sin(theta)); WHITTED shows it on misses.
- * A zero texture handle removes the environment (the background colour applies again). The
- * texture must stay alive while it is set (a destroyed texture renders as no environment).
- * intensity must be finite and >= 0. Takes effect at the next commit. */
+ * distribution over the texels, luminance x sin(theta)) with MIS; WHITTED importance-samples the
+ * same distribution with shadow rays (desc.env_light_samples) and shows it in mirror reflections
+ * and refractions. A uniform environment is a 1x1 texture. A zero texture handle removes the
+ * environment (escaping rays see black). The texture must stay alive while it is set (a destroyed
+ * texture renders as no environment). intensity must be finite and >= 0. Takes effect at the next
+ * commit. */
 sy_rt_result sy_rt_set_environment(sy_rt_device *dev, sy_rt_texture texture, float intensity, char *err,
                                    size_t err_len);
 
@@ -314,7 +327,8 @@ typedef struct sy_rt_camera {
 
 typedef enum sy_rt_integrator {
     SY_RT_INTEGRATOR_PRIMARY = 1, /* primary rays only, eye-light shading (benchmarks, debugging) */
-    SY_RT_INTEGRATOR_WHITTED = 2, /* direct light + hard shadows + mirror reflection/refraction */
+    SY_RT_INTEGRATOR_WHITTED = 2, /* anti-aliased; direct light from punctual, area and environment
+                                   * lights (stratified, deterministic) + mirror reflection/refraction */
     SY_RT_INTEGRATOR_PATHTRACER = 3, /* progressive path tracer (needs a sy_rt_accum, see below) */
     SY_RT_INTEGRATOR_COVERAGE = 4, /* object ids per pixel, no shading: use sy_rt_coverage() */
     SY_RT_INTEGRATOR_MAX_ENUM = 0x7fffffff
@@ -336,8 +350,16 @@ typedef struct sy_rt_render_desc {
     uint32_t max_depth;                 /* WHITTED: recursion depth for reflection/refraction;
                                          * PATHTRACER: most bounces (scattering events) per path;
                                          * 0 = 8 */
-    uint32_t area_light_samples;        /* fixed light samples per pixel; 0 = 16 */
+    uint32_t area_light_samples;        /* WHITTED: area-light (emissive triangle) samples per pixel,
+                                         * shared among its pixel samples (each shading point takes
+                                         * ceil(n / pixel_samples)); 0 = 16 */
     uint32_t seed;                      /* decorrelates sample patterns; same seed = same image */
+    /* WHITTED only: */
+    uint32_t pixel_samples;             /* anti-aliasing: camera rays per pixel through stratified
+                                         * jittered points (Owen-scrambled Sobol per pixel), box filter
+                                         * over the pixel; 0 or 1 = one ray through the pixel centre */
+    uint32_t env_light_samples;         /* environment-light samples (importance-sampled, with shadow
+                                         * rays) per shading point of each pixel sample; 0 = 4 */
     sy_rt_progress_fn progress;         /* optional */
     void *progress_user_data;
     /* PATHTRACER only: */
@@ -348,9 +370,18 @@ typedef struct sy_rt_render_desc {
 } sy_rt_render_desc;
 
 /* Renders the sub-rectangle. rgba: width*height*4 floats (required); depth: width*height floats
- * or NULL. Row 0 of both buffers is the top row of the sub-rectangle. Deterministic: a pixel's
- * value depends only on the scene, the camera, its full-image coordinates and the render desc's
- * integrator/max_depth/area_light_samples/seed, so tiles and sub-rectangles stitch bit-identically. */
+ * or NULL (WHITTED: the mean camera-axis distance of the pixel samples that hit, +INFINITY when none
+ * did). Row 0 of both buffers is the top row of the sub-rectangle. Deterministic: a pixel's value
+ * depends only on the scene, the camera, its full-image coordinates and the render desc's
+ * integrator/max_depth/area_light_samples/pixel_samples/env_light_samples/seed, so tiles and
+ * sub-rectangles stitch bit-identically.
+ *
+ * WHITTED: per pixel sample, direct light from punctual lights, emissive triangles and the
+ * environment (stratified samples, Owen-scrambled per pixel: no pattern repeats across pixels, no
+ * banding, no frame-to-frame change) with shadow rays that pass alpha-masked holes, alpha-blended
+ * surfaces (transmittance 1 - alpha) and transmissive surfaces (transmittance base colour x
+ * transmission x (1 - F0) per crossing: straight-line, refraction and angular Fresnel ignored);
+ * emission adds to the reflected light; recursive perfect mirror reflection and Fresnel refraction. */
 sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera,
                           const sy_rt_render_desc *desc, float *rgba, float *depth, char *err,
                           size_t err_len);

@@ -218,12 +218,26 @@ void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out)
 sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg, char *err, size_t err_len)
 {
     if (!dev || !bg) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "background: NULL argument");
-    if (bg->mode != SY_RT_BACKGROUND_NONE && bg->mode != SY_RT_BACKGROUND_COLOR)
+    if (bg->mode != SY_RT_BACKGROUND_NONE && bg->mode != SY_RT_BACKGROUND_COLOR && bg->mode != SY_RT_BACKGROUND_TEXTURE)
         return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "background: unknown mode %d", (int)bg->mode);
-    for (int k = 0; k < 3; ++k)
-        if (!isfinite(bg->color[k]) || bg->color[k] < 0.0f)
-            return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "background: colour[%d] = %g is not a finite non-negative radiance", k, (double)bg->color[k]);
-    dev->background_staged = *bg;
+    sy_rt_background b = {.mode = bg->mode};
+    if (bg->mode == SY_RT_BACKGROUND_COLOR) {
+        for (int k = 0; k < 3; ++k)
+            if (!isfinite(bg->color[k]) || bg->color[k] < 0.0f)
+                return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT,
+                                  "background: colour[%d] = %g is not a finite non-negative radiance", k, (double)bg->color[k]);
+        memcpy(b.color, bg->color, sizeof b.color);
+    } else if (bg->mode == SY_RT_BACKGROUND_TEXTURE) {
+        if (!sy_rt_pool_get(&dev->textures, bg->texture.id))
+            return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_HANDLE, "background: texture 0x%08x is not a live texture",
+                              bg->texture.id);
+        if (!isfinite(bg->intensity) || bg->intensity < 0.0f)
+            return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT,
+                              "background: intensity %g is not a finite non-negative number", (double)bg->intensity);
+        b.texture = bg->texture;
+        b.intensity = bg->intensity;
+    }
+    dev->background_staged = b;
     dev->dirty = true;
     return SY_RT_OK;
 }

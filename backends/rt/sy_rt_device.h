@@ -127,6 +127,10 @@ struct sy_rt_device {
     float *area_alias_prob;
     uint32_t *area_alias_idx;
 
+    /* committed: some visible instance's material lets shadow rays through in part (alpha blend;
+     * transmission); without one, shadow rays are plain occlusion queries (sy_rt_shadow.h) */
+    bool shadow_blend, shadow_transmission;
+
     /* environment (sy_rt_set_environment): staged values and the committed importance-sampling
      * distribution (sy_rt_lights.h) */
     sy_rt_texture env_texture_staged, env_texture;

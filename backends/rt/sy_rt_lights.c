@@ -1,5 +1,5 @@
 /* sy_rt_lights.c — alias table over emissive triangles, environment distribution and sampling,
- * sy_rt_set_environment (see sy_rt_lights.h). */
+ * sy_rt_set_environment, the background seen by camera rays (see sy_rt_lights.h). */
 #include "sy_rt_lights.h"
 #include "sy_rt_texture.h"
 
@@ -184,16 +184,11 @@ void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env)
 {
     memset(env, 0, sizeof *env);
     const sy_rt_texture_data *t = dev->env_dist ? sy_rt_pool_get(&dev->textures, dev->env_texture.id) : NULL;
-    if (t) {
+    if (t && dev->env_intensity > 0.0f) {
         env->mode = 2;
         env->tex = t;
         env->intensity = dev->env_intensity;
         env->dist = dev->env_dist;
-        return;
-    }
-    if (dev->background.mode == SY_RT_BACKGROUND_COLOR && !v3_is_zero(v3_load(dev->background.color))) {
-        env->mode = 1;
-        env->color = v3_load(dev->background.color);
     }
 }
 
@@ -204,21 +199,41 @@ static void dir_to_uv(sy_rt_v3 d, float *u, float *v)
     *v = acosf(sy_rt_clampf(d.y, -1.0f, 1.0f)) * (1.0f / PI_F);
 }
 
-sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d)
+/* Lat-long lookup of a texture times intensity; non-finite or negative radiance reads as 0. */
+static sy_rt_v3 latlong_eval(const sy_rt_texture_data *tex, float intensity, sy_rt_v3 d)
 {
-    if (env->mode == 1) return env->color;
-    if (env->mode != 2) return v3(0.0f, 0.0f, 0.0f);
     float u, v, c[4];
     dir_to_uv(d, &u, &v);
-    sy_rt_texture_sample(env->tex, u, v, c);
-    sy_rt_v3 r = v3_scale(v3(c[0], c[1], c[2]), env->intensity);
+    sy_rt_texture_sample(tex, u, v, c);
+    sy_rt_v3 r = v3_scale(v3(c[0], c[1], c[2]), intensity);
     return (isfinite(r.x) && isfinite(r.y) && isfinite(r.z)) ? v3(fmaxf(r.x, 0.0f), fmaxf(r.y, 0.0f), fmaxf(r.z, 0.0f))
                                                              : v3(0.0f, 0.0f, 0.0f);
 }
 
+sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d)
+{
+    if (env->mode != 2) return v3(0.0f, 0.0f, 0.0f);
+    return latlong_eval(env->tex, env->intensity, d);
+}
+
+float sy_rt_background_eval(const sy_rt_device *dev, sy_rt_v3 d, sy_rt_v3 *rgb)
+{
+    const sy_rt_background *bg = &dev->background;
+    *rgb = v3(0.0f, 0.0f, 0.0f);
+    if (bg->mode == SY_RT_BACKGROUND_COLOR) {
+        *rgb = v3_load(bg->color);
+        return 1.0f;
+    }
+    if (bg->mode == SY_RT_BACKGROUND_TEXTURE) {
+        const sy_rt_texture_data *t = sy_rt_pool_get(&dev->textures, bg->texture.id);
+        if (t) *rgb = latlong_eval(t, bg->intensity, v3_normalize(d));
+        return 1.0f;
+    }
+    return 0.0f;
+}
+
 float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d)
 {
-    if (env->mode == 1) return 1.0f / (4.0f * PI_F);
     if (env->mode != 2) return 0.0f;
     const sy_rt_env_dist *e = env->dist;
     float u, v;
@@ -247,12 +262,6 @@ static uint32_t cdf_find(const float *cdf, uint32_t n, float u)
 
 float sy_rt_env_sample(const sy_rt_env *env, float u1, float u2, sy_rt_v3 *d, sy_rt_v3 *radiance)
 {
-    if (env->mode == 1) {
-        float z = 1.0f - 2.0f * u1, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * PI_F * u2;
-        *d = v3(r * cosf(phi), z, r * sinf(phi));
-        *radiance = env->color;
-        return 1.0f / (4.0f * PI_F);
-    }
     if (env->mode != 2) return 0.0f;
     const sy_rt_env_dist *e = env->dist;
     uint32_t y = cdf_find(e->marginal, e->height, u2);

@@ -1,9 +1,9 @@
 /* sy_rt_lights.h — light support of the integrators: punctual-light incidence (Whitted and path
  * tracer), the Vose alias table over the emissive triangles (selection by power in O(1), whatever
- * their number), the environment light (equirectangular texture x intensity, or the constant
- * background colour as a uniform environment) with its importance-sampling distribution, and the
- * area-light pdf of a hit point. Built at sy_rt_commit; read-only while rendering. Internal to
- * backends/rt. */
+ * their number), the environment light (equirectangular texture x intensity; the background never
+ * lights anything) with its importance-sampling distribution, the background seen by camera rays,
+ * and the area-light pdf of a hit point. Built at sy_rt_commit; read-only while rendering.
+ * Internal to backends/rt. */
 #ifndef SY_RT_LIGHTS_H
 #define SY_RT_LIGHTS_H
 
@@ -27,11 +27,10 @@ uint32_t sy_rt_alias_pick(const sy_rt_device *dev, float u);
 sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev, char *err, size_t err_len);
 void sy_rt_env_free(sy_rt_device *dev);
 
-/* Environment as seen by the integrators. mode: 0 none, 1 constant colour (uniform sphere
- * sampling), 2 texture (importance sampled). */
+/* Environment light as seen by the integrators. mode: 0 none (escaping rays see black), 2 texture
+ * (importance sampled). */
 typedef struct sy_rt_env {
     int mode;
-    sy_rt_v3 color;                 /* mode 1 */
     const struct sy_rt_texture_data *tex; /* mode 2 */
     float intensity;
     const sy_rt_env_dist *dist;     /* mode 2 */
@@ -41,6 +40,9 @@ typedef struct sy_rt_env {
 void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env);
 /* Radiance arriving from direction d (unit). */
 sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d);
+/* The committed background along camera-ray direction d (any length): radiance in *rgb, returns
+ * its alpha (0 for NONE, else 1). */
+float sy_rt_background_eval(const sy_rt_device *dev, sy_rt_v3 d, sy_rt_v3 *rgb);
 /* Solid-angle pdf of sampling direction d with sy_rt_env_sample. */
 float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d);
 /* Samples a direction from two uniform numbers; returns its pdf (0 = failed) and radiance. */

@@ -8,7 +8,11 @@
  * area / environment / punctual, an emissive triangle by power through the alias table, a uniform
  * point on it), then the BSDF is sampled. max_depth bounds the number of scattering events;
  * Russian roulette (survival = min(0.95, max throughput)) starts after three. Alpha-blended
- * surfaces are crossed stochastically with probability 1 - alpha.
+ * surfaces are crossed stochastically with probability 1 - alpha, and shadow rays are attenuated
+ * by 1 - alpha through them (sy_rt_shadow.h; shadow rays toward punctual lights also pass
+ * transmissive surfaces, see unoccluded()). A camera ray that leaves the scene (straight through
+ * blended surfaces, before any scattering) sees the background (never a light); every other ray
+ * sees the environment light, black without one.
  *
  * Path records (desc->records, the radiance filter's stored-sample hook, sy_rt.h): the path is
  * split at P0, the first vertex that sampled a non-specular lobe; a second throughput beta_s,
@@ -22,6 +26,7 @@
 #include "sy_rt_bsdf.h"
 #include "sy_rt_lights.h"
 #include "sy_rt_sampler.h"
+#include "sy_rt_shadow.h"
 
 #include <stdatomic.h>
 #include <string.h>
@@ -34,7 +39,6 @@ typedef struct pt_job {
     sy_rt_env env;
     uint32_t categories;     /* light categories present */
     bool has_area, has_env, has_punctual;
-    bool env_opaque;         /* misses are opaque (a background colour or environment is set) */
 } pt_job;
 
 typedef struct pt_ctx {
@@ -52,10 +56,15 @@ static float power_heuristic(float a, float b)
     return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
 }
 
-static bool unoccluded(pt_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar)
+/* What a shadow ray lets through: alpha-masked holes and alpha-blended surfaces (1 - alpha, the
+ * probability with which paths cross them). Transmissive (refracting) surfaces block shadow rays
+ * toward emitters and the environment: light from those arrives along sampled refraction paths,
+ * and a straight-line shadow ray would count it twice. Punctual lights can never be hit by a
+ * path, so their shadow rays (punctual = true) pass transmissive surfaces with the straight-line
+ * transmittance of sy_rt_shadow.h, as Whitted's do (without it a light behind glass is lost). */
+static sy_rt_v3 unoccluded(pt_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar, bool punctual)
 {
-    c->rays++;
-    return sy_rt_segment_clear(c->dev, &c->ictx, org, dir, tfar);
+    return sy_rt_shadow_transmittance(c->dev, &c->ictx, org, dir, tfar, punctual, &c->rays);
 }
 
 /* One light sample from the shading point: returns f * Le * cos * MIS weight / pdf (visibility
@@ -95,8 +104,9 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
         float pdf_l = sy_rt_area_pdf(dev, t->inst) * d2 / cos_l * p_cat;
         if (!(pdf_l > 0.0f)) return zero;
         float tmax = d - sy_rt_ray_eps(q) - sy_rt_ray_eps(s->p);
-        if (tmax > 0.0f && !unoccluded(c, p_off, wi, tmax)) return zero;
-        sy_rt_v3 le = sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv);
+        sy_rt_v3 tr = tmax > 0.0f ? unoccluded(c, p_off, wi, tmax, false) : v3(1.0f, 1.0f, 1.0f);
+        if (v3_is_zero(tr)) return zero;
+        sy_rt_v3 le = v3_mul(tr, sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv));
         return v3_scale(v3_mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l);
     }
     if (kind == 1) {
@@ -106,8 +116,9 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
         float pdf_b;
         sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
         if (v3_is_zero(f)) return zero;
-        if (!unoccluded(c, p_off, wi, INFINITY)) return zero;
-        return v3_scale(v3_mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l);
+        sy_rt_v3 tr = unoccluded(c, p_off, wi, INFINITY, false);
+        if (v3_is_zero(tr)) return zero;
+        return v3_scale(v3_mul(f, v3_mul(tr, le)), power_heuristic(pdf_l, pdf_b) / pdf_l);
     }
     if (kind == 2) {
         uint32_t n = dev->punctual_count, i = (uint32_t)(ur * (float)n);
@@ -118,8 +129,9 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
         float pdf_b;
         sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
         if (v3_is_zero(f)) return zero;
-        if (!unoccluded(c, p_off, wi, tmax)) return zero;
-        return v3_scale(v3_mul(f, e), (float)n / p_cat);
+        sy_rt_v3 tr = unoccluded(c, p_off, wi, tmax, true);
+        if (v3_is_zero(tr)) return zero;
+        return v3_scale(v3_mul(f, v3_mul(tr, e)), (float)n / p_cat);
     }
     return zero;
 }
@@ -184,8 +196,14 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
             if (!after_p0 && in) path_len += rh.ray.tfar * dlen;
         }
         if (!in) {
-            if (first) out->alpha = j->env_opaque ? 1.0f : 0.0f;
-            if (j->env.mode) {
+            if (bounce == 0u) { /* a camera ray (through alpha-blended crossings) sees the background */
+                sy_rt_v3 bg;
+                float a = sy_rt_background_eval(dev, d, &bg);
+                if (first) out->alpha = a;
+                sy_rt_v3 contrib = v3_mul(beta, bg);
+                L = v3_add(L, contrib);
+                direct = v3_add(direct, contrib);
+            } else if (j->env.mode) { /* every other ray sees the environment light */
                 sy_rt_v3 le = sy_rt_env_eval(&j->env, d);
                 float w = specular ? 1.0f : power_heuristic(pdf_prev, sy_rt_env_pdf(&j->env, d) * p_env_sel);
                 sy_rt_v3 contrib = v3_scale(v3_mul(beta, le), w);
@@ -334,7 +352,6 @@ sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_de
     j.has_env = j.env.mode != 0;
     j.has_punctual = f->dev->punctual_count > 0;
     j.categories = (uint32_t)j.has_area + (uint32_t)j.has_env + (uint32_t)j.has_punctual;
-    j.env_opaque = j.env.mode == 2 || f->dev->background.mode == SY_RT_BACKGROUND_COLOR;
     atomic_store(&acc->rays, 0u);
     sy_rt_result r = sy_rt_run_tiles(f, pt_tile, &j, desc->progress, desc->progress_user_data, err, err_len);
     if (r == SY_RT_ERROR_CANCELLED) {

@@ -3,6 +3,7 @@
  * neighbours whatever the tile or sub-rectangle; lanes outside the tile are masked off) and the
  * lean eye-light shading of sy_rt_surface_eyelight. */
 #include "sy_rt_primary.h"
+#include "sy_rt_lights.h"
 #include "sy_rt_surface.h"
 
 #define PKT_W 4u
@@ -16,9 +17,6 @@ void sy_rt_primary_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t 
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    const sy_rt_background *bg = &dev->background;
-    const float bg_alpha = bg->mode == SY_RT_BACKGROUND_COLOR ? 1.0f : 0.0f;
-    const float bg_rgba[4] = {bg_alpha * bg->color[0], bg_alpha * bg->color[1], bg_alpha * bg->color[2], bg_alpha};
     float *const depth = f->depth;
     const uint32_t bx0 = x0 - x0 % PKT_W, by0 = y0 - y0 % PKT_H;
     for (uint32_t by = by0; by < y1; by += PKT_H) {
@@ -54,10 +52,11 @@ void sy_rt_primary_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t 
                 const sy_rt_instance_data *in = rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID
                                                     ? NULL : sy_rt_hit_instance(dev, rh.hit.geomID[k], rh.hit.instID[0][k]);
                 if (!in) {
-                    c[0] = bg_rgba[0];
-                    c[1] = bg_rgba[1];
-                    c[2] = bg_rgba[2];
-                    c[3] = bg_rgba[3];
+                    sy_rt_v3 bg;
+                    c[3] = sy_rt_background_eval(dev, v3(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]), &bg);
+                    c[0] = bg.x;
+                    c[1] = bg.y;
+                    c[2] = bg.z;
                     if (depth) depth[o] = INFINITY;
                     continue;
                 }

@@ -42,6 +42,10 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
     size_t n;
     if (!sy_rt_size_mul(d->width, d->height, &n) || !sy_rt_size_mul(n, 4u * sizeof(float), &n))
         return FAIL(SY_RT_ERROR_LIMIT, "render: %ux%u rectangle overflows size_t", d->width, d->height);
+    if (d->pixel_samples > 65536u || d->env_light_samples > 65536u || d->area_light_samples > 65536u ||
+        (uint64_t)(d->pixel_samples ? d->pixel_samples : 1u) * (d->env_light_samples ? d->env_light_samples : 4u) > 65536u)
+        return FAIL(SY_RT_ERROR_LIMIT, "render: pixel_samples %u, env_light_samples %u, area_light_samples %u: at most 65536 "
+                    "each and 65536 environment samples per pixel", d->pixel_samples, d->env_light_samples, d->area_light_samples);
     if (!rgba && d->integrator != SY_RT_INTEGRATOR_PATHTRACER && d->integrator != SY_RT_INTEGRATOR_COVERAGE) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: rgba is NULL");
 
     const float *m = cam->camera_to_world;
@@ -190,6 +194,6 @@ sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera, const s
     if (desc->integrator == SY_RT_INTEGRATOR_PATHTRACER) return sy_rt_pathtracer_render(&f, desc, err, err_len);
     if (desc->integrator == SY_RT_INTEGRATOR_COVERAGE)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: the coverage integrator writes ids: use sy_rt_coverage");
-    sy_rt_tile_fn fn = desc->integrator == SY_RT_INTEGRATOR_PRIMARY ? sy_rt_primary_tile : sy_rt_whitted_tile;
-    return sy_rt_run_tiles(&f, fn, NULL, desc->progress, desc->progress_user_data, err, err_len);
+    if (desc->integrator == SY_RT_INTEGRATOR_WHITTED) return sy_rt_whitted_render(&f, desc, err, err_len);
+    return sy_rt_run_tiles(&f, sy_rt_primary_tile, NULL, desc->progress, desc->progress_user_data, err, err_len);
 }

@@ -3,6 +3,7 @@
  * staged changes: alpha filters, top-level BVH, area-light list and punctual-light array. */
 #include "sy_rt_scene.h"
 #include "sy_rt_lights.h"
+#include "sy_rt_shadow.h"
 #include "sy_rt_surface.h"
 
 #include <stdlib.h>
@@ -702,6 +703,7 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len)
         dev->punctual_dirty = false;
     }
     dev->background = dev->background_staged;
+    sy_rt_shadow_flags_update(dev);
     if (dev->env_dirty) {
         if ((r = sy_rt_env_rebuild(dev, err, err_len)) != SY_RT_OK) return r;
         dev->env_dirty = false;

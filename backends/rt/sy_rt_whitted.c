@@ -1,42 +1,71 @@
 /* sy_rt_whitted.c — the Whitted integrator.
  *
- * Shading model (glTF metallic-roughness, Whitted-style):
- *   - emitters are pure emitters: a surface whose material emits shows its emission radiance
- *     (front side, or both sides when double-sided) and nothing else;
- *   - unlit materials show their base colour;
- *   - direct light: Lambert base*(1-metallic)*(1-transmission)/pi plus a GGX highlight (Schlick
- *     Fresnel, F0 = mix(0.04-from-IOR * specular, base, metallic)) for roughness > 0;
- *   - roughness == 0: recursive perfect reflection, metal part tinted by the base colour,
- *     dielectric part weighted by Schlick Fresnel * specular;
+ * Per pixel: pixel_samples camera rays (1 = the pixel centre; more = stratified jittered points,
+ * the first points of an Owen-scrambled Sobol sequence per pixel, averaged: a box filter over the
+ * pixel). Per hit, shading model (glTF metallic-roughness, Whitted-style):
+ *   - emission (front side, or both sides when double-sided) is ADDED to the reflected light;
+ *   - unlit materials show their base colour (plus emission);
+ *   - direct light from punctual lights, emissive triangles and the environment with the path
+ *     tracer's BSDF (sy_rt_bsdf.h: GGX metal, GGX specular over Lambert scaled by 1 - F, the
+ *     finite-density lobes), the environment with the path tracer's MIS of an environment sample
+ *     and a BSDF sample, so Whitted's direct light is the path tracer's direct light;
+ *   - roughness below SY_RT_BSDF_DELTA_ROUGHNESS (the path tracer's delta lobes): recursive
+ *     perfect reflection, metal part tinted by the base colour, dielectric part weighted by
+ *     Schlick Fresnel * specular;
  *   - transmission: exact dielectric Fresnel between reflection and refraction (tinted by base
  *     colour), total internal reflection;
  *   - alpha blend: the surface is composited over what the continued ray sees.
- * Area lights use N samples per shading point: stratified light selection by power over the
- * area-light CDF and an R2 point set on the triangle, rotated per pixel (Cranley-Patterson) by a
- * hash of the full-image pixel, the seed and the recursion depth. The pattern never changes between
- * frames, so the image is deterministic. */
+ * Shadow rays pass alpha-masked holes, alpha-blended and transmissive surfaces with their
+ * transmittance (sy_rt_shadow.h). Camera rays that hit nothing see the background; every other
+ * escaping ray sees the environment light (black without one).
+ * Light samples: area lights take n = ceil(area_light_samples / pixel_samples) samples per shading
+ * point (light chosen by power through the area-light CDF, uniform point on the triangle), the
+ * environment env_light_samples (each an environment and a BSDF sample, MIS); the
+ * numbers come from the pixel's Owen-scrambled Sobol sequence (sy_rt_sampler.h), sample k of pixel
+ * sample j being point j*n + k of a set chosen by the recursion depth, so the samples of one pixel
+ * are stratified together and every pixel has its own scramble: no pattern shared between pixels
+ * (no banding), no change between frames (deterministic). */
 #include "sy_rt_whitted.h"
+#include "sy_rt_bsdf.h"
 #include "sy_rt_lights.h"
+#include "sy_rt_sampler.h"
+#include "sy_rt_shadow.h"
 #include "sy_rt_surface.h"
 
+#include <stdlib.h>
+
 #define INV_PI 0.31830988618f
+
+/* Sobol sets of a pixel: 0 = sub-pixel positions; per recursion depth d, area-light samples,
+ * environment samples and BSDF samples for the environment. */
+#define SET_AREA(d) (1u + 3u * (d))
+#define SET_ENV(d) (2u + 3u * (d))
+#define SET_BSDF(d) (3u + 3u * (d))
+
+typedef struct whitted_job {
+    sy_rt_sobol sobol;
+    sy_rt_env env;
+    uint32_t spp;    /* camera rays per pixel */
+    uint32_t n_area; /* area-light samples per shading point */
+    uint32_t n_env;  /* environment samples per shading point (0 without an environment) */
+} whitted_job;
 
 typedef struct trace_ctx {
     const sy_rt_frame *f;
     const sy_rt_device *dev;
+    const whitted_job *job;
     struct RTCIntersectContext ictx;
-    uint32_t px, py;
+    uint32_t pseed;  /* per-pixel scramble seed */
+    uint32_t sample; /* pixel sample index */
 } trace_ctx;
 
 typedef struct rgba_t { sy_rt_v3 rgb; float a; } rgba_t;
 
-
-/* True when nothing blocks the segment org + t*dir, t in (0, tfar). */
-static bool visible(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar)
+/* Light let through between org and org + tfar*dir (alpha, transmission). */
+static sy_rt_v3 shadow(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar)
 {
-    return sy_rt_segment_clear(c->dev, &c->ictx, org, dir, tfar);
+    return sy_rt_shadow_transmittance(c->dev, &c->ictx, org, dir, tfar, true, NULL);
 }
-
 /* Specular reflectance at normal incidence of the dielectric part. */
 static float dielectric_f0(const sy_rt_material_desc *d)
 {
@@ -51,42 +80,23 @@ static sy_rt_v3 schlick(sy_rt_v3 f0, float cos_t)
     return v3_add(f0, v3_scale(v3_sub(v3(1.0f, 1.0f, 1.0f), f0), m5));
 }
 
-/* BRDF value for light direction wi and view direction wo (both unit, away from the surface). */
-static sy_rt_v3 brdf(const sy_rt_surface *s, sy_rt_v3 wi, sy_rt_v3 wo)
+/* Sobol point k of this pixel sample's shading-point samples in set `set`. */
+static void light_u(const trace_ctx *c, uint32_t set, uint32_t n, uint32_t k, float u[4])
 {
-    const sy_rt_material_desc *d = &s->mat->desc;
-    sy_rt_v3 r = v3_scale(s->base, (1.0f - s->metallic) * (1.0f - d->transmission) * INV_PI);
-    if (s->roughness <= 0.0f) return r; /* delta lobe: handled by recursive reflection */
-    float f0d = dielectric_f0(d);
-    sy_rt_v3 f0 = v3_add(v3_scale(v3(f0d, f0d, f0d), 1.0f - s->metallic), v3_scale(s->base, s->metallic));
-    if (v3_is_zero(f0)) return r;
-    sy_rt_v3 h = v3_normalize(v3_add(wi, wo));
-    float nl = v3_dot(s->ns, wi), nv = fmaxf(v3_dot(s->ns, wo), 1e-4f), nh = fmaxf(v3_dot(s->ns, h), 0.0f);
-    float a = fmaxf(s->roughness * s->roughness, 1e-4f), a2 = a * a;
-    float dd = nh * nh * (a2 - 1.0f) + 1.0f;
-    float D = a2 * INV_PI / (dd * dd);
-    float V = 0.5f / (nl * sqrtf(nv * nv * (1.0f - a2) + a2) + nv * sqrtf(nl * nl * (1.0f - a2) + a2));
-    return v3_add(r, v3_scale(schlick(f0, v3_dot(wi, h)), D * V));
+    sy_rt_sobol_sample4(&c->job->sobol, c->pseed, set, c->sample * n + k, u);
 }
 
-/* Per-pixel rotation bits for the sample pattern at a recursion depth. */
-static uint32_t pixel_hash(const trace_ctx *c, uint32_t depth)
-{
-    return sy_rt_hash32(c->px ^ sy_rt_hash32(c->py ^ sy_rt_hash32(c->f->seed ^ sy_rt_hash32(depth + 0x9e3779b9u))));
-}
-
-static float fracf_(float x) { return x - floorf(x); }
-
-static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 p_off, sy_rt_v3 wo, uint32_t depth)
+static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, sy_rt_v3 p_off, sy_rt_v3 wo,
+                            uint32_t depth)
 {
     const sy_rt_device *dev = c->dev;
-    uint32_t n = c->f->light_samples;
-    uint32_t h = pixel_hash(c, depth);
-    float r0 = sy_rt_u01(h), r1 = sy_rt_u01(sy_rt_hash32(h + 1u)), r2 = sy_rt_u01(sy_rt_hash32(h + 2u));
+    uint32_t n = c->job->n_area;
     sy_rt_v3 sum = v3(0.0f, 0.0f, 0.0f);
     for (uint32_t i = 0; i < n; ++i) {
-        /* Stratified light selection by power (upper bound in the CDF). */
-        float xi = ((float)i + r0) / (float)n;
+        float u[4];
+        light_u(c, SET_AREA(depth), n, i, u);
+        /* Light selection by power (upper bound in the CDF). */
+        float xi = u[0];
         uint32_t lo = 0, hi = dev->area_count;
         while (lo + 1u < hi) {
             uint32_t mid = (lo + hi) / 2u;
@@ -95,10 +105,8 @@ static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 p_off
         float p_sel = dev->area_cdf[lo + 1u] - dev->area_cdf[lo];
         if (!(p_sel > 0.0f)) continue;
         const sy_rt_area_tri *t = &dev->area[lo];
-        /* R2 low-discrepancy point set, uniformly warped onto the triangle. */
-        float u1 = fracf_(r1 + 0.7548776662f * (float)i), u2 = fracf_(r2 + 0.5698402910f * (float)i);
-        float su = sqrtf(u1);
-        float bu = su * (1.0f - u2), bv = su * u2;
+        float su = sqrtf(u[1]);
+        float bu = su * (1.0f - u[2]), bv = su * u[2];
         sy_rt_v3 q = v3_add(t->p0, v3_add(v3_scale(t->e1, bu), v3_scale(t->e2, bv)));
         sy_rt_v3 wi = v3_sub(q, s->p);
         float d2 = v3_dot(wi, wi);
@@ -109,16 +117,69 @@ static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 p_off
         if (t->double_sided) cos_l = fabsf(cos_l);
         float cos_s = v3_dot(s->ns, wi);
         if (cos_l <= 0.0f || cos_s <= 0.0f || v3_dot(s->ng_facing, wi) <= 0.0f) continue;
+        float pdf_b;
+        sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b); /* includes cos_s */
+        if (v3_is_zero(f)) continue;
         float tmax = d - sy_rt_ray_eps(q) - sy_rt_ray_eps(s->p);
-        if (tmax > 0.0f && !visible(c, p_off, wi, tmax)) continue;
-        sy_rt_v3 le = sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv);
-        float g = cos_s * cos_l / d2 * t->area / p_sel;
-        sum = v3_add(sum, v3_scale(v3_mul(le, brdf(s, wi, wo)), g));
+        sy_rt_v3 tr = tmax > 0.0f ? shadow(c, p_off, wi, tmax) : v3(1.0f, 1.0f, 1.0f);
+        if (v3_is_zero(tr)) continue;
+        sy_rt_v3 le = v3_mul(tr, sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv));
+        float g = cos_l / d2 * t->area / p_sel;
+        sum = v3_add(sum, v3_scale(v3_mul(le, f), g));
     }
     return v3_scale(sum, 1.0f / (float)n);
 }
 
-static sy_rt_v3 direct_punctual(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 p_off, sy_rt_v3 wo)
+static float power_heuristic(float a, float b)
+{
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+/* Environment light, exactly the path tracer's direct light from the environment: per sample one
+ * direction from the environment's importance distribution and one from the BSDF (the path
+ * tracer's sy_rt_bsdf, so glossy lobes that the environment's distribution rarely hits are found),
+ * combined with the power heuristic, each with a shadow ray. Delta lobes (roughness 0 mirrors,
+ * refraction) see the environment through Whitted's recursive rays instead. */
+static sy_rt_v3 direct_env(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, sy_rt_v3 p_off, sy_rt_v3 wo,
+                           uint32_t depth)
+{
+    const sy_rt_env *env = &c->job->env;
+    sy_rt_v3 sum = v3(0.0f, 0.0f, 0.0f);
+    uint32_t n = c->job->n_env;
+    for (uint32_t i = 0; i < n; ++i) {
+        float ul[4], ub[4];
+        light_u(c, SET_ENV(depth), n, i, ul);
+        light_u(c, SET_BSDF(depth), n, i, ub);
+        /* light strategy */
+        sy_rt_v3 wi, le;
+        float pdf_l = sy_rt_env_sample(env, ul[0], ul[1], &wi, &le);
+        if (pdf_l > 0.0f && !v3_is_zero(le) && v3_dot(s->ng_facing, wi) > 0.0f) {
+            float pdf_b;
+            sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
+            if (!v3_is_zero(f)) {
+                sy_rt_v3 tr = shadow(c, p_off, wi, INFINITY);
+                if (!v3_is_zero(tr))
+                    sum = v3_add(sum, v3_scale(v3_mul(v3_mul(f, le), tr), power_heuristic(pdf_l, pdf_b) / pdf_l));
+            }
+        }
+        /* BSDF strategy */
+        sy_rt_bsdf_sample bs;
+        if (sy_rt_bsdf_sample_dir(b, wo, ub, &bs) && !bs.specular && !bs.transmit && bs.pdf > 0.0f &&
+            v3_dot(s->ng_facing, bs.wi) > 0.0f) {
+            sy_rt_v3 lb = sy_rt_env_eval(env, bs.wi);
+            if (!v3_is_zero(lb)) {
+                sy_rt_v3 tr = shadow(c, p_off, bs.wi, INFINITY);
+                if (!v3_is_zero(tr))
+                    sum = v3_add(sum, v3_scale(v3_mul(v3_mul(bs.weight, lb), tr),
+                                               power_heuristic(bs.pdf, sy_rt_env_pdf(env, bs.wi))));
+            }
+        }
+    }
+    return v3_scale(sum, 1.0f / (float)n);
+}
+
+static sy_rt_v3 direct_punctual(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, sy_rt_v3 p_off, sy_rt_v3 wo)
 {
     const sy_rt_device *dev = c->dev;
     sy_rt_v3 sum = v3(0.0f, 0.0f, 0.0f);
@@ -128,32 +189,35 @@ static sy_rt_v3 direct_punctual(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 p
         if (!sy_rt_punctual_incident(&dev->punctual[i], s->p, &wi, &e, &tmax)) continue;
         float cos_s = v3_dot(s->ns, wi);
         if (cos_s <= 0.0f || v3_dot(s->ng_facing, wi) <= 0.0f) continue;
-        if (!visible(c, p_off, wi, tmax)) continue;
-        sum = v3_add(sum, v3_scale(v3_mul(e, brdf(s, wi, wo)), cos_s));
+        float pdf_b;
+        sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b); /* includes cos_s */
+        if (v3_is_zero(f)) continue;
+        sy_rt_v3 tr = shadow(c, p_off, wi, tmax);
+        if (v3_is_zero(tr)) continue;
+        sum = v3_add(sum, v3_mul(v3_mul(e, tr), f));
     }
     return sum;
 }
 
-static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float tfar, uint32_t depth,
+static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float tfar, uint32_t depth, bool camera,
                     struct RTCIntersectContext *ictx, float *t_hit);
 
-/* Radiance along a secondary ray (background radiance on a miss, never alpha). */
+/* Radiance along a secondary ray (the environment on a miss, never alpha). */
 static sy_rt_v3 trace_secondary(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, uint32_t depth)
 {
-    return trace(c, org, dir, 0.0f, INFINITY, depth, &c->ictx, NULL).rgb;
+    return trace(c, org, dir, 0.0f, INFINITY, depth, false, &c->ictx, NULL).rgb;
 }
 
 static sy_rt_v3 reflect(sy_rt_v3 d, sy_rt_v3 n) { return v3_sub(d, v3_scale(n, 2.0f * v3_dot(d, n))); }
 
-/* Shades a hit; d is the unit ray direction. */
-static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t depth)
+/* Shades a hit; d is the unit ray direction; camera: the ray is a camera ray (for what an
+ * alpha-blended surface shows behind it). */
+static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t depth, bool camera)
 {
     const sy_rt_material_desc *md = &s->mat->desc;
     rgba_t out = {v3(0.0f, 0.0f, 0.0f), 1.0f};
-    if (s->mat->emissive && (s->front || md->double_sided)) {
-        out.rgb = s->emission;
-        return out;
-    }
+    sy_rt_v3 emit = v3(0.0f, 0.0f, 0.0f);
+    if (s->mat->emissive && (s->front || md->double_sided)) emit = s->emission;
     if (md->unlit) {
         out.rgb = s->base;
     } else {
@@ -161,11 +225,17 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
         float eps = sy_rt_ray_eps(s->p);
         sy_rt_v3 p_out = v3_madd(s->p, s->ng_facing, eps);  /* the side the ray came from */
         sy_rt_v3 p_in = v3_madd(s->p, s->ng_facing, -eps);  /* the other side */
-        sy_rt_v3 L = direct_punctual(c, s, p_out, wo);
-        if (c->dev->area_count) L = v3_add(L, direct_area(c, s, p_out, wo, depth));
+        sy_rt_v3 L = v3(0.0f, 0.0f, 0.0f);
+        sy_rt_bsdf b;
+        sy_rt_bsdf_init(&b, s, wo);
+        if (sy_rt_bsdf_evaluable(&b)) {
+            L = direct_punctual(c, s, &b, p_out, wo);
+            if (c->dev->area_count) L = v3_add(L, direct_area(c, s, &b, p_out, wo, depth));
+            if (c->job->n_env) L = v3_add(L, direct_env(c, s, &b, p_out, wo, depth));
+        }
         bool recurse = depth + 1u < c->f->max_depth;
         float cos_o = fmaxf(v3_dot(s->ns, wo), 0.0f);
-        if (recurse && s->roughness <= 0.0f) {
+        if (recurse && b.delta) { /* the path tracer's delta lobes: a perfect mirror */
             sy_rt_v3 w = v3_scale(s->base, s->metallic);
             float fd = (1.0f - s->metallic) * (1.0f - md->transmission);
             if (fd > 0.0f) {
@@ -197,11 +267,13 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
         }
         out.rgb = L;
     }
+    out.rgb = v3_add(emit, out.rgb); /* emission adds to the reflected light */
     if (md->alpha_mode == SY_RT_ALPHA_BLEND && s->alpha < 1.0f) {
         float a = sy_rt_clampf(s->alpha, 0.0f, 1.0f);
         rgba_t behind = {v3(0.0f, 0.0f, 0.0f), 0.0f};
         if (depth + 1u < c->f->max_depth)
-            behind = trace(c, v3_madd(s->p, s->ng_facing, -sy_rt_ray_eps(s->p)), d, 0.0f, INFINITY, depth + 1u, &c->ictx, NULL);
+            behind = trace(c, v3_madd(s->p, s->ng_facing, -sy_rt_ray_eps(s->p)), d, 0.0f, INFINITY, depth + 1u, camera,
+                           &c->ictx, NULL);
         out.rgb = v3_add(v3_scale(out.rgb, a), v3_scale(behind.rgb, 1.0f - a));
         out.a = a + (1.0f - a) * behind.a;
     }
@@ -209,26 +281,15 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
 }
 
 /* Traces a ray; returns premultiplied radiance + coverage. t_hit (optional) gets the hit t. */
-static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float tfar, uint32_t depth,
+static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float tfar, uint32_t depth, bool camera,
                     struct RTCIntersectContext *ictx, float *t_hit)
 {
     struct RTCRayHit rh;
     const sy_rt_instance_data *in = sy_rt_intersect(c->dev, ictx, org, dir, tnear, tfar, &rh);
     if (!in) {
-        const sy_rt_background *bg = &c->dev->background;
         rgba_t r = {v3(0.0f, 0.0f, 0.0f), 0.0f};
-        if (bg->mode == SY_RT_BACKGROUND_COLOR) {
-            r.rgb = v3_load(bg->color);
-            r.a = 1.0f;
-        }
-        if (c->dev->env_dist) { /* an environment map replaces the colour */
-            sy_rt_env env;
-            sy_rt_env_get(c->dev, &env);
-            if (env.mode == 2) {
-                r.rgb = sy_rt_env_eval(&env, v3_normalize(dir));
-                r.a = 1.0f;
-            }
-        }
+        if (camera) r.a = sy_rt_background_eval(c->dev, dir, &r.rgb); /* the background */
+        else r.rgb = sy_rt_env_eval(&c->job->env, v3_normalize(dir)); /* the environment light */
         if (t_hit) *t_hit = INFINITY;
         return r;
     }
@@ -236,35 +297,66 @@ static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float
     sy_rt_v3 d = v3_normalize(dir);
     sy_rt_surface s;
     sy_rt_surface_fetch(c->dev, in, rh.hit.primID, rh.hit.u, rh.hit.v, d, &s);
-    return shade(c, &s, d, depth);
+    return shade(c, &s, d, depth, camera);
 }
 
-void sy_rt_whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
+static void whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
 {
-    (void)user;
+    const whitted_job *j = user;
     trace_ctx c;
     c.f = f;
     c.dev = f->dev;
+    c.job = j;
     rtcInitIntersectContext(&c.ictx);
     struct RTCIntersectContext primary_ctx;
     rtcInitIntersectContext(&primary_ctx);
     primary_ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     for (uint32_t py = y0; py < y1; ++py) {
         for (uint32_t px = x0; px < x1; ++px) {
-            c.px = px;
-            c.py = py;
-            struct RTCRay ray;
-            float axial, t;
-            sy_rt_frame_ray(f, px, py, &ray, &axial);
-            rgba_t r = trace(&c, v3(ray.org_x, ray.org_y, ray.org_z), v3(ray.dir_x, ray.dir_y, ray.dir_z), ray.tnear,
-                             ray.tfar, 0u, &primary_ctx, &t);
+            c.pseed = sy_rt_hash32(px ^ sy_rt_hash32(py ^ sy_rt_hash32(f->seed ^ 0x3c6ef372u)));
+            sy_rt_v3 sum = v3(0.0f, 0.0f, 0.0f);
+            float alpha = 0.0f, dsum = 0.0f;
+            uint32_t hits = 0;
+            for (uint32_t k = 0; k < j->spp; ++k) {
+                float fx = (float)px + 0.5f, fy = (float)py + 0.5f;
+                if (j->spp > 1u) {
+                    float u[4];
+                    sy_rt_sobol_sample4(&j->sobol, c.pseed, 0u, k, u);
+                    fx = (float)px + u[0];
+                    fy = (float)py + u[1];
+                }
+                c.sample = k;
+                struct RTCRay ray;
+                float axial, t;
+                sy_rt_frame_ray_at(f, fx, fy, &ray, &axial);
+                rgba_t r = trace(&c, v3(ray.org_x, ray.org_y, ray.org_z), v3(ray.dir_x, ray.dir_y, ray.dir_z), ray.tnear,
+                                 ray.tfar, 0u, true, &primary_ctx, &t);
+                sum = v3_add(sum, r.rgb);
+                alpha += r.a;
+                if (isfinite(t)) dsum += t * axial, hits++;
+            }
             size_t o = (size_t)(py - f->y) * f->width + (px - f->x);
             float *out = f->rgba + 4u * o;
-            out[0] = r.rgb.x;
-            out[1] = r.rgb.y;
-            out[2] = r.rgb.z;
-            out[3] = r.a;
-            if (f->depth) f->depth[o] = isfinite(t) ? t * axial : INFINITY;
+            float n = (float)j->spp; /* divide (not multiply by 1/n): n equal samples average exactly */
+            out[0] = sum.x / n;
+            out[1] = sum.y / n;
+            out[2] = sum.z / n;
+            out[3] = alpha / n;
+            if (f->depth) f->depth[o] = hits ? dsum / (float)hits : INFINITY;
         }
     }
+}
+
+sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc *desc, char *err, size_t err_len)
+{
+    whitted_job *j = malloc(sizeof *j);
+    if (!j) return sy_rt_fail(err, err_len, SY_RT_ERROR_OUT_OF_MEMORY, "render: out of memory");
+    sy_rt_sobol_init(&j->sobol);
+    sy_rt_env_get(f->dev, &j->env);
+    j->spp = desc->pixel_samples ? desc->pixel_samples : 1u;
+    j->n_area = (f->light_samples + j->spp - 1u) / j->spp;
+    j->n_env = j->env.mode ? (desc->env_light_samples ? desc->env_light_samples : 4u) : 0u;
+    sy_rt_result r = sy_rt_run_tiles(f, whitted_tile, j, desc->progress, desc->progress_user_data, err, err_len);
+    free(j);
+    return r;
 }

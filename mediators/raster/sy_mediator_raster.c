@@ -1,10 +1,25 @@
 /* sy_mediator_raster.c — core scene -> OpenGL rasterizer adapter (see sy_mediator_raster.h).
  *
- * Sections: >>mirror callbacks (the scene mirror is mediators/sy_mirror)  >>sync  >>render
- * >>class */
+ * Besides the mirror callbacks it translates the resolved look (sy_mirror_look) into the device's
+ * background and environment light, and the emissive meshes into area lights:
+ *  - it keeps, per back-end mesh, references to the primitive's position and index blobs (no copy:
+ *    blobs are immutable and shared with the scene), per material its emission, and per instance
+ *    its mesh, material and world matrix; when something emissive changes, the next render
+ *    rebuilds the list of emissive triangles in world space (front face = counter-clockwise after
+ *    the world transform; double-sided emitters emit from both faces), merging two consecutive
+ *    coplanar triangles that share an edge into a convex quad (the Cornell ceiling panel is one
+ *    quad);
+ *  - textured emission uses the factor x the texture's mean (computed once per texture);
+ *  - at most SY_GL_MAX_AREA_LIGHTS polygons are lights: beyond that the most powerful are kept and
+ *    their radiance is scaled so that the total emitted power (radiance x area x sides) is kept
+ *    (a big emissive mesh lights like a few of its polygons, with its total power).
+ *
+ * Sections: >>tables  >>mirror callbacks (the scene mirror is mediators/sy_mirror)  >>sync
+ * >>look  >>area lights  >>render  >>class */
 #include "sy_mediator_raster.h"
 
 #include "sy_gl.h"
+#include "sy_look.h"
 #include "sy_mirror.h"
 
 #include <stdio.h>
@@ -16,12 +31,117 @@
 
 /* The scene mirror (textures, materials, meshes, lights, backgrounds, nodes and placements) is
  * mediators/sy_mirror; this adapter turns its callbacks into OpenGL back-end calls. */
+/* >>tables: open-addressing maps from a 32-bit key (back-end handle or core id, never 0) to a
+ * record; deleted slots keep key 0 and a tombstone flag. */
+typedef struct emesh { /* per back-end mesh: the primitive's blobs (references) */
+    sy_blob *positions, *indices;
+    uint32_t vertex_count, triangle_count;
+} emesh;
+typedef struct emat { /* per back-end material */
+    float emission[3]; /* radiance: factor x strength (x the emissive texture's mean) */
+    bool double_sided;
+} emat;
+typedef struct einst { /* per back-end instance */
+    uint32_t mesh, material;
+    float world[16];
+    bool visible;
+} einst;
+typedef struct ealb { /* per back-end material: diffuse-ish albedo (base x base texture mean) */
+    float albedo[3];
+} ealb;
+typedef struct etex { /* per core texture id: mean linear RGB */
+    float mean[3];
+} etex;
+
+typedef struct map {
+    uint32_t *keys;
+    uint8_t *used; /* 0 empty, 1 live, 2 tombstone */
+    void *vals;
+    uint32_t cap, live, filled;
+    size_t elem;
+} map;
+
+static uint32_t map_hash(uint32_t k) { k ^= k >> 16; k *= 0x7feb352dU; k ^= k >> 15; k *= 0x846ca68bU; return k ^ (k >> 16); }
+
+static void *map_get(const map *m, uint32_t key)
+{
+    if (!m->cap || !key) return NULL;
+    for (uint32_t i = map_hash(key) & (m->cap - 1), n = 0; n < m->cap; ++n, i = (i + 1) & (m->cap - 1)) {
+        if (m->used[i] == 0) return NULL;
+        if (m->used[i] == 1 && m->keys[i] == key) return (char *)m->vals + (size_t)i * m->elem;
+    }
+    return NULL;
+}
+
+static void map_free(map *m)
+{
+    free(m->keys);
+    free(m->used);
+    free(m->vals);
+    m->keys = NULL, m->used = NULL, m->vals = NULL;
+    m->cap = m->live = m->filled = 0;
+}
+
+/* Inserts or finds key; the record is zeroed when new. NULL when out of memory. */
+static void *map_put(map *m, uint32_t key)
+{
+    void *v = map_get(m, key);
+    if (v) return v;
+    if ((m->filled + 1) * 4 >= m->cap * 3) {
+        map old = *m;
+        uint32_t nc = m->cap ? m->cap * 2 : 64;
+        while ((m->live + 1) * 4 >= nc * 3 / 2) nc *= 2;
+        m->keys = calloc(nc, sizeof *m->keys);
+        m->used = calloc(nc, 1);
+        m->vals = calloc(nc, m->elem);
+        if (!m->keys || !m->used || !m->vals) {
+            free(m->keys), free(m->used), free(m->vals);
+            *m = old;
+            return NULL;
+        }
+        m->cap = nc;
+        m->live = m->filled = 0;
+        for (uint32_t i = 0; i < old.cap; ++i)
+            if (old.used[i] == 1) memcpy(map_put(m, old.keys[i]), (char *)old.vals + (size_t)i * old.elem, old.elem);
+        map_free(&old);
+    }
+    uint32_t i = map_hash(key) & (m->cap - 1);
+    while (m->used[i] == 1) i = (i + 1) & (m->cap - 1);
+    if (m->used[i] == 0) m->filled++;
+    m->used[i] = 1;
+    m->keys[i] = key;
+    m->live++;
+    v = (char *)m->vals + (size_t)i * m->elem;
+    memset(v, 0, m->elem);
+    return v;
+}
+
+static void map_del(map *m, uint32_t key)
+{
+    void *v = map_get(m, key);
+    if (!v) return;
+    uint32_t i = (uint32_t)(((char *)v - (char *)m->vals) / m->elem);
+    m->used[i] = 2;
+    m->keys[i] = 0;
+    m->live--;
+}
+
 typedef struct raster_state {
     sy_gl_device *dev;
     sy_mirror *mirror;
     sy_mediator_raster_counters counters;
     uint64_t frames_rendered;
     double last_sync_seconds, last_render_seconds;
+    /* look */
+    bool look_valid;
+    sy_look look;
+    uint32_t env_handle, bg_handle; /* as applied */
+    sy_gl_texture studio, gradient;
+    /* emissive meshes */
+    map meshes, mats, insts, texs, albs;
+    bool areas_dirty;
+    uint32_t area_count;
+    bool warned_area_cap;
 } raster_state;
 
 static sy_result gl_fail(sy_error *err, sy_gl_result r, const char *what, const char *msg)
@@ -65,7 +185,35 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     sy_gl_result r = h.id ? sy_gl_material_update(st->dev, h, &d, e, sizeof e)
                           : sy_gl_material_create(st->dev, &d, &h, e, sizeof e);
     *a->handle = h.id;
-    return r == SY_GL_OK ? SY_OK : gl_fail(err, r, "material", e);
+    if (r != SY_GL_OK) return gl_fail(err, r, "material", e);
+    /* albedo for the indirect estimate (area lights) */
+    ealb *al = map_put(&st->albs, h.id);
+    if (!al) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (material albedo)");
+    const etex *bt = m->base_color_texture.texture.id ? map_get(&st->texs, m->base_color_texture.texture.id) : NULL;
+    for (int i = 0; i < 3; ++i) {
+        float v = d.base_color[i] * (bt ? bt->mean[i] : 1.0f);
+        al->albedo[i] = isfinite(v) ? fminf(fmaxf(v, 0.0f), 1.0f) : 0.0f;
+    }
+    /* emission as area light: factor x strength (x the emissive texture's mean) */
+    emat em = {{0, 0, 0}, d.double_sided};
+    const etex *et = m->emissive_texture.texture.id ? map_get(&st->texs, m->emissive_texture.texture.id) : NULL;
+    for (int i = 0; i < 3; ++i) {
+        float v = d.emissive[i] * (m->emissive_texture.texture.id ? (et ? et->mean[i] : 0.0f) : 1.0f);
+        em.emission[i] = isfinite(v) && v > 0.0f ? v : 0.0f;
+    }
+    emat *old = map_get(&st->mats, h.id);
+    bool was = old && (old->emission[0] > 0 || old->emission[1] > 0 || old->emission[2] > 0);
+    bool is = em.emission[0] > 0 || em.emission[1] > 0 || em.emission[2] > 0;
+    if (is) {
+        emat *slot = map_put(&st->mats, h.id);
+        if (!slot) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (emissive materials)");
+        if (!was || memcmp(slot, &em, sizeof em)) st->areas_dirty = true;
+        *slot = em;
+    } else if (was) {
+        map_del(&st->mats, h.id);
+        st->areas_dirty = true;
+    }
+    return SY_OK;
 }
 
 static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_error *err)
@@ -87,7 +235,25 @@ static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_erro
     sy_gl_texture h = {0};
     sy_gl_result r = sy_gl_texture_create(st->dev, &d, &h, e, sizeof e);
     *a->handle = h.id;
-    return r == SY_GL_OK ? SY_OK : gl_fail(err, r, "texture", e);
+    if (r != SY_GL_OK) return gl_fail(err, r, "texture", e);
+    /* mean linear RGB (for textured emitters as area lights) */
+    etex *t = map_put(&st->texs, a->id);
+    if (!t) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (texture means)");
+    size_t n = (size_t)d.width * d.height, ch = d.channels;
+    double sum[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; ++i)
+        for (size_t c = 0; c < 3; ++c) {
+            size_t k = ch <= 2 ? 0 : c;
+            float v;
+            if (d.format == SY_GL_TEXEL_FLOAT32) v = ((const float *)d.pixels)[i * ch + k];
+            else {
+                v = ((const unsigned char *)d.pixels)[i * ch + k] / 255.0f;
+                if (d.format == SY_GL_TEXEL_UNORM8_SRGB) v = v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
+            }
+            if (isfinite(v)) sum[c] += v;
+        }
+    for (int c = 0; c < 3; ++c) t->mean[c] = n ? (float)(sum[c] / (double)n) : 0.0f;
+    return SY_OK;
 }
 
 static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
@@ -107,7 +273,29 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
     sy_gl_mesh h = {0};
     sy_gl_result r = sy_gl_mesh_create(st->dev, &d, &h, e, sizeof e);
     *a->handle = h.id;
-    return r == SY_GL_OK ? SY_OK : gl_fail(err, r, "mesh primitive", e);
+    if (r != SY_GL_OK) return gl_fail(err, r, "mesh primitive", e);
+    emesh *em = map_put(&st->meshes, h.id);
+    if (!em) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (mesh table)");
+    em->positions = sy_blob_retain(p->positions);
+    em->indices = sy_blob_retain(p->indices);
+    em->vertex_count = d.vertex_count;
+    em->triangle_count = d.triangle_count;
+    return SY_OK;
+}
+
+static bool material_emits(const raster_state *st, uint32_t material) { return map_get(&st->mats, material) != NULL; }
+
+/* Records the instance for the area-light list; marks it dirty when an emitter changed. */
+static sy_result track_instance(raster_state *st, uint32_t handle, const sy_mirror_instance_args *a, sy_error *err)
+{
+    einst *in = map_put(&st->insts, handle);
+    if (!in) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (instance table)");
+    if (material_emits(st, a->material) || (in->material && material_emits(st, in->material))) st->areas_dirty = true;
+    in->mesh = a->mesh;
+    in->material = a->material;
+    memcpy(in->world, a->world->m, sizeof in->world);
+    in->visible = a->visible;
+    return SY_OK;
 }
 
 static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_error *err)
@@ -121,11 +309,13 @@ static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_er
         memcpy(d.transform, a->world->m, sizeof d.transform);
         r = sy_gl_instance_create(st->dev, &d, &h, e, sizeof e);
         *a->handle = h.id;
-        return r == SY_GL_OK ? SY_OK : gl_fail(err, r, "instance", e);
+        if (r != SY_GL_OK) return gl_fail(err, r, "instance", e);
+        return track_instance(st, h.id, a, err);
     }
     r = sy_gl_instance_set_transform(st->dev, h, a->world->m, e, sizeof e);
     if (r == SY_GL_OK) r = sy_gl_instance_set_visible(st->dev, h, a->visible);
-    return r == SY_GL_OK ? SY_OK : gl_fail(err, r, "instance transform", e);
+    if (r != SY_GL_OK) return gl_fail(err, r, "instance transform", e);
+    return track_instance(st, h.id, a, err);
 }
 
 static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *err)
@@ -155,9 +345,29 @@ static void cb_release(void *user, const sy_mirror_release_args *a)
     raster_state *st = user;
     switch (a->kind) {
     case SY_MIRROR_TEXTURE: sy_gl_texture_destroy(st->dev, (sy_gl_texture){a->handle}); break;
-    case SY_MIRROR_MATERIAL: sy_gl_material_destroy(st->dev, (sy_gl_material){a->handle}); break;
-    case SY_MIRROR_PRIMITIVE: sy_gl_mesh_destroy(st->dev, (sy_gl_mesh){a->handle}); break;
-    case SY_MIRROR_INSTANCE: sy_gl_instance_destroy(st->dev, (sy_gl_instance){a->handle}); break;
+    case SY_MIRROR_MATERIAL:
+        if (map_get(&st->mats, a->handle)) st->areas_dirty = true;
+        map_del(&st->mats, a->handle);
+        map_del(&st->albs, a->handle);
+        sy_gl_material_destroy(st->dev, (sy_gl_material){a->handle});
+        break;
+    case SY_MIRROR_PRIMITIVE: {
+        emesh *em = map_get(&st->meshes, a->handle);
+        if (em) {
+            sy_blob_release(em->positions);
+            sy_blob_release(em->indices);
+            map_del(&st->meshes, a->handle);
+        }
+        sy_gl_mesh_destroy(st->dev, (sy_gl_mesh){a->handle});
+        break;
+    }
+    case SY_MIRROR_INSTANCE: {
+        einst *in = map_get(&st->insts, a->handle);
+        if (in && material_emits(st, in->material)) st->areas_dirty = true;
+        map_del(&st->insts, a->handle);
+        sy_gl_instance_destroy(st->dev, (sy_gl_instance){a->handle});
+        break;
+    }
     case SY_MIRROR_LIGHT: sy_gl_light_destroy(st->dev, (sy_gl_light){a->handle}); break;
     }
 }
@@ -201,10 +411,260 @@ static void camera_of(const sy_camera_view *v, sy_gl_camera *cam)
     cam->far_clip = v->zfar;
 }
 
-static void apply_background(raster_state *st, uint32_t background_id)
+/* >>look: the resolved look -> the device's environment light and background. */
+static sy_result float_texture(raster_state *st, uint32_t w, uint32_t h, const float *rgb, sy_gl_texture *out,
+                               const char *what, sy_error *err)
 {
-    const sy_mirror_background *b = sy_mirror_background_get(st->mirror, background_id);
-    sy_gl_set_background(st->dev, b && b->color[3] > 0.0f, b ? b->color : NULL);
+    char e[ERRLEN];
+    sy_gl_texture_desc d = {.width = w, .height = h, .channels = 3, .format = SY_GL_TEXEL_FLOAT32, .pixels = rgb,
+                            .wrap_s = SY_GL_WRAP_REPEAT, .wrap_t = SY_GL_WRAP_CLAMP};
+    sy_gl_result r = sy_gl_texture_create(st->dev, &d, out, e, sizeof e);
+    return r == SY_GL_OK ? SY_OK : gl_fail(err, r, what, e);
+}
+
+static sy_result apply_look(raster_state *st, uint32_t background_id, sy_error *err)
+{
+    sy_look look;
+    sy_mirror_look(st->mirror, background_id, &look);
+    uint32_t tex = look.env_texture ? sy_mirror_texture_handle(st->mirror, look.env_texture) : 0;
+    if (st->look_valid && sy_look_equal(&look, &st->look) && tex == st->env_handle) return SY_OK;
+    sy_result r = SY_OK;
+    /* environment light */
+    uint32_t env = 0;
+    if (look.env == SY_LOOK_ENV_TEXTURE) env = tex;
+    else if (look.env == SY_LOOK_ENV_STUDIO) {
+        if (!st->studio.id) {
+            float *px = malloc(sizeof(float) * 3 * SY_LOOK_STUDIO_WIDTH * SY_LOOK_STUDIO_HEIGHT);
+            if (!px) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (studio environment)");
+            sy_look_studio_pixels(SY_LOOK_STUDIO_WIDTH, SY_LOOK_STUDIO_HEIGHT, px);
+            r = float_texture(st, SY_LOOK_STUDIO_WIDTH, SY_LOOK_STUDIO_HEIGHT, px, &st->studio, "studio environment", err);
+            free(px);
+            if (r != SY_OK) return r;
+        }
+        env = st->studio.id;
+    }
+    sy_gl_set_environment(st->dev, (sy_gl_texture){env}, env ? look.env_intensity : 0.0f);
+    /* background: camera rays only */
+    bool gradient_same = st->look_valid && st->look.background == SY_LOOK_BG_GRADIENT &&
+                         !memcmp(&st->look.gradient, &look.gradient, sizeof look.gradient) && st->gradient.id;
+    if (look.background == SY_LOOK_BG_GRADIENT && !gradient_same) {
+        enum { GW = 4, GH = 256 };
+        float px[GW * GH * 3];
+        sy_look_gradient_pixels(&look.gradient, GW, GH, px);
+        if (st->gradient.id) sy_gl_texture_destroy(st->dev, st->gradient);
+        st->gradient.id = 0;
+        if ((r = float_texture(st, GW, GH, px, &st->gradient, "background gradient", err)) != SY_OK) return r;
+    }
+    switch (look.background) {
+    case SY_LOOK_BG_COLOR: sy_gl_set_background(st->dev, SY_GL_BACKGROUND_COLOR, look.bg_color, (sy_gl_texture){0}, 1.0f); break;
+    case SY_LOOK_BG_ENVIRONMENT:
+        sy_gl_set_background(st->dev, tex ? SY_GL_BACKGROUND_TEXTURE : SY_GL_BACKGROUND_NONE, NULL, (sy_gl_texture){tex},
+                             look.env_intensity);
+        break;
+    case SY_LOOK_BG_GRADIENT: sy_gl_set_background(st->dev, SY_GL_BACKGROUND_TEXTURE, NULL, st->gradient, 1.0f); break;
+    default: sy_gl_set_background(st->dev, SY_GL_BACKGROUND_NONE, NULL, (sy_gl_texture){0}, 1.0f); break;
+    }
+    st->look = look;
+    st->look_valid = true;
+    st->env_handle = tex;
+    return SY_OK;
+}
+
+/* >>area lights */
+typedef struct poly {
+    sy_gl_area_light l;
+    float power; /* luminance x area x sides */
+} poly;
+
+static void xform(const float *m, const float *p, float *o)
+{
+    for (int a = 0; a < 3; ++a) o[a] = m[a] * p[0] + m[4 + a] * p[1] + m[8 + a] * p[2] + m[12 + a];
+}
+static void sub3(const float *a, const float *b, float *o) { o[0] = a[0] - b[0], o[1] = a[1] - b[1], o[2] = a[2] - b[2]; }
+static void cross3(const float *a, const float *b, float *o)
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+static float dot3(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static bool same3(const float *a, const float *b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
+
+/* Tries to merge triangles A and B (world space, front = counter-clockwise) into a convex quad. */
+static bool merge_quad(const float a[3][3], const float b[3][3], float q[4][3])
+{
+    float na[3], nb[3], e1[3], e2[3];
+    sub3(a[1], a[0], e1), sub3(a[2], a[0], e2), cross3(e1, e2, na);
+    sub3(b[1], b[0], e1), sub3(b[2], b[0], e2), cross3(e1, e2, nb);
+    float la = sqrtf(dot3(na, na)), lb = sqrtf(dot3(nb, nb));
+    if (!(la > 0.0f && lb > 0.0f) || dot3(na, nb) < 0.99999f * la * lb) return false;
+    for (int k = 0; k < 3; ++k) { /* shared edge x = a[k] -> y = a[k+1] appears in B as y -> x */
+        const float *x = a[k], *y = a[(k + 1) % 3], *z = a[(k + 2) % 3];
+        for (int j = 0; j < 3; ++j)
+            if (same3(b[j], y) && same3(b[(j + 1) % 3], x)) {
+                const float *d = b[(j + 2) % 3];
+                const float *v[4] = {x, d, y, z};
+                for (int i = 0; i < 4; ++i) { /* convex: every corner turns the same way as the normal */
+                    float u[3], w[3], c[3];
+                    sub3(v[(i + 1) % 4], v[i], u), sub3(v[(i + 2) % 4], v[(i + 1) % 4], w), cross3(u, w, c);
+                    if (dot3(c, na) <= 0.0f) return false;
+                }
+                for (int i = 0; i < 4; ++i) memcpy(q[i], v[i], sizeof q[i]);
+                return true;
+            }
+    }
+    return false;
+}
+
+static int cmp_power_desc(const void *a, const void *b)
+{
+    float x = ((const poly *)a)->power, y = ((const poly *)b)->power;
+    return x < y ? 1 : x > y ? -1 : 0;
+}
+
+static sy_result push_poly(poly **ps, size_t *n, size_t *cap, const float v[4][3], uint32_t nv, const emat *em, sy_error *err)
+{
+    float e1[3], e2[3], c[3];
+    sub3(v[1], v[0], e1), sub3(v[2], v[0], e2), cross3(e1, e2, c);
+    float area = sqrtf(dot3(c, c)) * (nv == 4 ? 1.0f : 0.5f);
+    if (!(area > 0.0f)) return SY_OK;
+    if (*n == *cap) {
+        size_t nc = *cap ? *cap * 2 : 64;
+        poly *np = realloc(*ps, nc * sizeof *np);
+        if (!np) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (area lights)");
+        *ps = np, *cap = nc;
+    }
+    poly *p = &(*ps)[(*n)++];
+    memset(p, 0, sizeof *p);
+    memcpy(p->l.vertices, v, nv * sizeof v[0]);
+    p->l.vertex_count = nv;
+    memcpy(p->l.radiance, em->emission, sizeof p->l.radiance);
+    p->l.double_sided = em->double_sided;
+    p->power = (0.2126f * em->emission[0] + 0.7152f * em->emission[1] + 0.0722f * em->emission[2]) * area *
+               (em->double_sided ? 2.0f : 1.0f);
+    return SY_OK;
+}
+
+static sy_result rebuild_area_lights(raster_state *st, sy_error *err)
+{
+    poly *ps = NULL;
+    size_t n = 0, cap = 0;
+    sy_result r = SY_OK;
+    for (uint32_t s = 0; s < st->insts.cap && r == SY_OK; ++s) {
+        if (st->insts.used[s] != 1) continue;
+        const einst *in = (const einst *)((const char *)st->insts.vals + (size_t)s * st->insts.elem);
+        const emat *em = map_get(&st->mats, in->material);
+        const emesh *me = map_get(&st->meshes, in->mesh);
+        if (!in->visible || !em || !me || !me->positions) continue;
+        const float *pos = sy_blob_data(me->positions);
+        const uint32_t *idx = me->indices ? sy_blob_data(me->indices) : NULL;
+        const float *m = in->world;
+        float det = m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
+        float tri[2][3][3];
+        bool pending = false;
+        for (uint32_t t = 0; t < me->triangle_count && r == SY_OK; ++t) {
+            float w[3][3];
+            for (int k = 0; k < 3; ++k) {
+                uint32_t vi = idx ? idx[3 * t + k] : 3 * t + k;
+                if (vi >= me->vertex_count) vi = 0;
+                xform(m, pos + 3 * (size_t)vi, w[det < 0.0f ? 2 - k : k]); /* mirrored: keep the front face */
+            }
+            if (pending) {
+                float q[4][3];
+                if (merge_quad(tri[0], w, q)) {
+                    r = push_poly(&ps, &n, &cap, q, 4, em, err);
+                    pending = false;
+                    continue;
+                }
+                float v4[4][3];
+                memcpy(v4, tri[0], sizeof tri[0]);
+                r = push_poly(&ps, &n, &cap, v4, 3, em, err);
+            }
+            memcpy(tri[0], w, sizeof w);
+            pending = true;
+        }
+        if (pending && r == SY_OK) {
+            float v4[4][3];
+            memcpy(v4, tri[0], sizeof tri[0]);
+            r = push_poly(&ps, &n, &cap, v4, 3, em, err);
+        }
+    }
+    /* the indirect light of the emitters as one uniform radiance (the "ambient term" of progressive
+     * radiosity, Cohen et al. 1988): emitted flux phi, total surface area A, area-weighted albedo rho,
+     * captured fraction c = min(1, A / area of the scene's bounding box): mean indirect irradiance
+     * c phi / A x (c rho + (c rho)^2) (two bounces: the infinite series c rho / (1 - c rho)
+     * overestimates open scenes such as the Cornell box, whose light escapes through the open
+     * side); the radiance is that / pi. Emitters are not counted as receivers. Computed when
+     * emitters change (not when only other geometry moves). */
+    float ambient[3] = {0, 0, 0};
+    if (r == SY_OK && n) {
+        double phi[3] = {0, 0, 0}, area = 0.0, rho[3] = {0, 0, 0}, lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < n; ++i) {
+            float lumv = 0.2126f * ps[i].l.radiance[0] + 0.7152f * ps[i].l.radiance[1] + 0.0722f * ps[i].l.radiance[2];
+            double a = lumv > 0.0f ? ps[i].power / lumv : 0.0; /* area x sides */
+            for (int c = 0; c < 3; ++c) phi[c] += 3.14159265 * ps[i].l.radiance[c] * a;
+        }
+        for (uint32_t s = 0; s < st->insts.cap; ++s) {
+            if (st->insts.used[s] != 1) continue;
+            const einst *in = (const einst *)((const char *)st->insts.vals + (size_t)s * st->insts.elem);
+            const emesh *me = map_get(&st->meshes, in->mesh);
+            if (!in->visible || !me || !me->positions || map_get(&st->mats, in->material)) continue;
+            const ealb *al = map_get(&st->albs, in->material);
+            const float alb_def[3] = {1, 1, 1}, *alb = al ? al->albedo : alb_def;
+            const float *pos = sy_blob_data(me->positions);
+            const uint32_t *idx = me->indices ? sy_blob_data(me->indices) : NULL;
+            double ia = 0.0;
+            for (uint32_t t = 0; t < me->triangle_count; ++t) {
+                float w[3][3], e1[3], e2[3], c[3];
+                for (int k = 0; k < 3; ++k) {
+                    uint32_t vi = idx ? idx[3 * t + k] : 3 * t + k;
+                    if (vi >= me->vertex_count) vi = 0;
+                    xform(in->world, pos + 3 * (size_t)vi, w[k]);
+                    for (int a = 0; a < 3; ++a) lo[a] = fmin(lo[a], w[k][a]), hi[a] = fmax(hi[a], w[k][a]);
+                }
+                sub3(w[1], w[0], e1), sub3(w[2], w[0], e2), cross3(e1, e2, c);
+                ia += 0.5 * sqrt(dot3(c, c));
+            }
+            area += ia;
+            for (int c = 0; c < 3; ++c) rho[c] += ia * alb[c];
+        }
+        if (area > 0.0) {
+            double ex[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+            double box = 2.0 * (ex[0] * ex[1] + ex[1] * ex[2] + ex[2] * ex[0]);
+            double cap_f = box > 0.0 ? fmin(1.0, area / box) : 0.0;
+            for (int c = 0; c < 3; ++c) {
+                double cr = fmin(cap_f * rho[c] / area, 0.95);
+                ambient[c] = (float)(cap_f * phi[c] / area * (cr + cr * cr) / 3.14159265);
+            }
+        }
+    }
+    if (r == SY_OK) sy_gl_set_ambient(st->dev, ambient);
+    if (r == SY_OK && n > SY_GL_MAX_AREA_LIGHTS) {
+        double total = 0.0, kept = 0.0;
+        for (size_t i = 0; i < n; ++i) total += ps[i].power;
+        qsort(ps, n, sizeof *ps, cmp_power_desc);
+        for (size_t i = 0; i < SY_GL_MAX_AREA_LIGHTS; ++i) kept += ps[i].power;
+        float scale = kept > 0.0 ? (float)(total / kept) : 1.0f;
+        for (size_t i = 0; i < SY_GL_MAX_AREA_LIGHTS; ++i)
+            for (int c = 0; c < 3; ++c) ps[i].l.radiance[c] *= scale;
+        if (!st->warned_area_cap) {
+            fprintf(stderr, "sy: note: raster: %zu emissive polygons; the %d most powerful light the scene (radiance x %.3g keeps the total power)\n",
+                    n, SY_GL_MAX_AREA_LIGHTS, (double)scale);
+            st->warned_area_cap = true;
+        }
+        n = SY_GL_MAX_AREA_LIGHTS;
+    }
+    if (r == SY_OK) {
+        sy_gl_area_light ls[SY_GL_MAX_AREA_LIGHTS];
+        for (size_t i = 0; i < n; ++i) ls[i] = ps[i].l;
+        char e[ERRLEN];
+        sy_gl_result gr = sy_gl_set_area_lights(st->dev, ls, (uint32_t)n, e, sizeof e);
+        if (gr != SY_GL_OK) r = gl_fail(err, gr, "area lights", e);
+        else st->area_count = (uint32_t)n;
+    }
+    free(ps);
+    if (r == SY_OK) st->areas_dirty = false;
+    return r;
 }
 
 static sy_result check_layer(const sy_render_request *req, const sy_layer *layer, sy_error *err)
@@ -222,7 +682,8 @@ static sy_result raster_render(void *state, const sy_render_request *req, sy_lay
     sy_result rr = check_layer(req, layer, err);
     if (rr != SY_OK) return rr;
     double t0 = sy_time_now();
-    apply_background(st, req->background_id);
+    if ((rr = apply_look(st, req->background_id, err)) != SY_OK) return rr;
+    if (st->areas_dirty && (rr = rebuild_area_lights(st, err)) != SY_OK) return rr;
     sy_gl_camera cam;
     camera_of(&req->camera, &cam);
     sy_gl_render_desc d = {req->full_width, req->full_height, req->rect_x, req->rect_y, req->rect_w, req->rect_h};
@@ -243,7 +704,7 @@ sy_result sy_mediator_raster_render_floor(void *state, const sy_render_request *
     char e[ERRLEN];
     sy_result rr = check_layer(req, layer, err);
     if (rr != SY_OK) return rr;
-    apply_background(st, req->background_id);
+    if ((rr = apply_look(st, req->background_id, err)) != SY_OK) return rr;
     sy_gl_camera cam;
     camera_of(&req->camera, &cam);
     sy_gl_render_desc d = {req->full_width, req->full_height, req->rect_x, req->rect_y, req->rect_w, req->rect_h};
@@ -258,6 +719,17 @@ static void raster_destroy(void *state)
     if (!st) return;
     sy_mirror_destroy(st->mirror); /* releases instances, lights and meshes while the device lives */
     sy_gl_device_destroy(st->dev);
+    for (uint32_t i = 0; i < st->meshes.cap; ++i) {
+        if (st->meshes.used[i] != 1) continue;
+        emesh *em = (emesh *)((char *)st->meshes.vals + (size_t)i * st->meshes.elem);
+        sy_blob_release(em->positions);
+        sy_blob_release(em->indices);
+    }
+    map_free(&st->meshes);
+    map_free(&st->mats);
+    map_free(&st->insts);
+    map_free(&st->texs);
+    map_free(&st->albs);
     free(st);
 }
 
@@ -286,6 +758,11 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
         return r;
     raster_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster mediator: out of memory");
+    st->meshes.elem = sizeof(emesh);
+    st->mats.elem = sizeof(emat);
+    st->insts.elem = sizeof(einst);
+    st->texs.elem = sizeof(etex);
+    st->albs.elem = sizeof(ealb);
     char e[ERRLEN];
     sy_gl_device_desc dd = {.provider = provider,
                             .msaa = (uint32_t)msaa,

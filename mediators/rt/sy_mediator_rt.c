@@ -15,10 +15,21 @@
 #include "sy_radiance_hook.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define ERRLEN 256
+
+/* Whitted's default anti-aliasing: 1 camera ray through the pixel centre. spp=4 (4 stratified rays,
+ * one per pixel quadrant) removes the staircases of the demo's edges at 4x the primary-ray cost
+ * (the area-light budget, light_samples per pixel, is shared among them) and is what the CLI should
+ * ask for; the default stays 1 because with jittered rays the depth and coverage of an edge pixel
+ * no longer come from its centre (the pixel convention raster/Whitted alignment, IoU >= 0.99, and
+ * depth compositing rely on: tests/raster/test_raster_align.c fails at spp=4), and
+ * tests/integration/test_viewport.c checks exact colours of edge pixels. Open: depth from the
+ * centre ray with colour averaged over the strata. */
+#define WHITTED_DEFAULT_SPP 1
 
 /* Path tracer: one accumulation per distinct request (camera, sizes, rectangle, background, seed);
  * a few are kept so that viewports sharing this context (stereo eyes, tiles) do not evict each
@@ -65,9 +76,15 @@ typedef struct rt_state {
     sy_mirror *mirror;
     uint32_t integrator;
     uint32_t max_depth, light_samples;
+    uint32_t pixel_samples, env_samples; /* whitted: "spp", "env_samples" */
     float specular; /* "specular" parameter: KHR_materials_specular factor given to every material */
-    uint32_t current_bg; /* background id applied to the device */
-    bool bg_applied;
+    /* the look (sy_look.h) applied to the device, with the back-end textures it resolved to */
+    sy_look look;
+    bool look_applied;
+    uint32_t look_env_tex, look_bg_tex;
+    sy_rt_texture studio;   /* the built-in studio environment, made on first use */
+    sy_rt_texture gradient; /* the baked sky/ground gradient of the current look, 0 = none */
+    sy_gradient gradient_baked;
     sy_mediator_rt_counters counters;
     uint64_t frames_rendered;
     accum_slot slots[ACCUM_SLOTS]; /* path tracer only */
@@ -112,6 +129,24 @@ static sy_result rt_fail(sy_error *err, sy_rt_result r, const char *what, const 
 }
 
 /* >>mirror callbacks */
+/* >>bad input: the core scene refuses non-finite and negative values; what it accepts but the
+ * device does not (factors above 1, cone angles out of order) is clamped into the device's range
+ * with a warning naming the object and the value, so that one odd value never fails a render. */
+static void rt_warn(rt_state *st, const char *kind, uint32_t id, const char *field, double from, double to)
+{
+    st->counters.warnings++;
+    snprintf(st->counters.last_warning, sizeof st->counters.last_warning, "rt mediator: %s %u: %s %g clamped to %g",
+             kind, id, field, from, to);
+    fprintf(stderr, "sy: warning: %s\n", st->counters.last_warning);
+}
+
+static float clamp_warn(rt_state *st, const char *kind, uint32_t id, const char *field, float v, float lo, float hi)
+{
+    float c = !(v >= lo) ? lo : v > hi ? hi : v; /* NaN -> lo */
+    if (c != v) rt_warn(st, kind, id, field, (double)v, (double)c);
+    return c;
+}
+
 static sy_rt_texture_ref texref(const rt_state *st, const sy_texture_ref *r)
 {
     sy_rt_texture_ref o = {{sy_mirror_texture_handle(st->mirror, r->texture.id)}, r->texcoord, false, {0}};
@@ -126,20 +161,24 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     char e[ERRLEN];
     sy_rt_material_desc d;
     sy_rt_material_desc_init(&d);
-    memcpy(d.base_color, m->base_color, sizeof d.base_color);
+    static const char *const bc[4] = {"base_color[0]", "base_color[1]", "base_color[2]", "base_color[3] (alpha)"};
+    for (int i = 0; i < 4; ++i) d.base_color[i] = clamp_warn(st, "material", a->id, bc[i], m->base_color[i], 0.0f, i == 3 ? 1.0f : INFINITY);
     d.base_color_texture = texref(st, &m->base_color_texture);
-    d.metallic = m->metallic;
-    d.roughness = m->roughness;
+    d.metallic = clamp_warn(st, "material", a->id, "metallic", m->metallic, 0.0f, 1.0f);
+    d.roughness = clamp_warn(st, "material", a->id, "roughness", m->roughness, 0.0f, 1.0f);
     d.metallic_roughness_texture = texref(st, &m->metallic_roughness_texture);
-    for (int i = 0; i < 3; ++i) d.emissive[i] = m->emissive[i] * m->emissive_strength;
+    for (int i = 0; i < 3; ++i) {
+        float e = m->emissive[i] * m->emissive_strength;
+        d.emissive[i] = isfinite(e) && e >= 0.0f ? e : clamp_warn(st, "material", a->id, "emission", e, 0.0f, 3.0e38f);
+    }
     d.emissive_texture = texref(st, &m->emissive_texture);
     d.normal_texture = texref(st, &m->normal_texture);
     d.normal_scale = m->normal_texture.scale;
-    d.transmission = m->transmission;
+    d.transmission = clamp_warn(st, "material", a->id, "transmission", m->transmission, 0.0f, 1.0f);
     d.ior = m->ior >= 1.0f ? m->ior : 1.5f;
     d.specular = st->specular;
     d.alpha_mode = (sy_rt_alpha_mode)m->alpha_mode;
-    d.alpha_cutoff = m->alpha_cutoff;
+    d.alpha_cutoff = clamp_warn(st, "material", a->id, "alpha_cutoff", m->alpha_cutoff, 0.0f, 1.0f);
     d.double_sided = m->double_sided != 0;
     d.unlit = m->unlit != 0;
     sy_rt_material h = {*a->handle};
@@ -221,11 +260,14 @@ static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *e
     memset(&d, 0, sizeof d);
     d.type = l->type == SY_LIGHT_SPOT ? SY_RT_LIGHT_SPOT : l->type == SY_LIGHT_DIRECTIONAL ? SY_RT_LIGHT_DIRECTIONAL
                                                                                          : SY_RT_LIGHT_POINT;
-    memcpy(d.color, l->color, sizeof d.color);
-    d.intensity = l->intensity;
-    d.range = l->range;
-    d.inner_cone_angle = l->inner_cone;
-    d.outer_cone_angle = l->outer_cone;
+    static const char *const cn[3] = {"color[0]", "color[1]", "color[2]"};
+    for (int i = 0; i < 3; ++i) d.color[i] = clamp_warn(st, "light of node", a->node, cn[i], l->color[i], 0.0f, 3.0e38f);
+    d.intensity = clamp_warn(st, "light of node", a->node, "intensity", l->intensity, 0.0f, 3.0e38f);
+    d.range = clamp_warn(st, "light of node", a->node, "range", l->range, 0.0f, 3.0e38f);
+    if (d.type == SY_RT_LIGHT_SPOT) {
+        d.outer_cone_angle = clamp_warn(st, "light of node", a->node, "outer_cone", l->outer_cone, 0.0f, 1.5707963f);
+        d.inner_cone_angle = clamp_warn(st, "light of node", a->node, "inner_cone", l->inner_cone, 0.0f, d.outer_cone_angle);
+    }
     memcpy(d.position, a->position, sizeof d.position);
     memcpy(d.direction, a->direction, sizeof d.direction);
     sy_rt_light h = {*a->handle};
@@ -249,17 +291,6 @@ static void cb_release(void *user, const sy_mirror_release_args *a)
     }
 }
 
-static void cb_object_changed(void *user, const sy_mirror_object_args *a)
-{
-    rt_state *st = user;
-    if (a->type == SY_TYPE_BACKGROUND) {
-        if (st->current_bg == a->id) st->bg_applied = false;
-    } else if (a->type == SY_TYPE_TEXTURE) {
-        const sy_mirror_background *cb = sy_mirror_background_get(st->mirror, st->current_bg);
-        if (cb && cb->environment == a->id) st->bg_applied = false; /* new back-end texture for the environment */
-    }
-}
-
 static const sy_mirror_callbacks rt_mirror_callbacks = {
     .texture_set = cb_texture,
     .material_set = cb_material,
@@ -267,7 +298,6 @@ static const sy_mirror_callbacks rt_mirror_callbacks = {
     .instance_set = cb_instance,
     .light_set = cb_light,
     .release = cb_release,
-    .object_changed = cb_object_changed,
 };
 
 /* >>sync */
@@ -818,26 +848,100 @@ static sy_result radiance_render(rt_state *st, const sy_render_request *req, con
     return SY_OK;
 }
 
+/* >>look: the resolved look (sy_look.h) of the request's world, applied to the device when it (or
+ * the back-end texture it resolves to) changed. The device's commit bumps its version, so
+ * progressive accumulations restart. */
+#define GRADIENT_W 4u
+#define GRADIENT_H 256u
+
+static sy_result studio_texture(rt_state *st, uint32_t *handle, sy_error *err)
+{
+    if (!st->studio.id) {
+        const size_t n = (size_t)SY_LOOK_STUDIO_WIDTH * SY_LOOK_STUDIO_HEIGHT * 3u;
+        float *px = malloc(n * sizeof *px);
+        if (!px) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "studio environment: out of memory");
+        sy_look_studio_pixels(SY_LOOK_STUDIO_WIDTH, SY_LOOK_STUDIO_HEIGHT, px);
+        sy_rt_texture_desc d = {.width = SY_LOOK_STUDIO_WIDTH, .height = SY_LOOK_STUDIO_HEIGHT, .channels = 3,
+                                .format = SY_RT_TEXEL_FLOAT32, .pixels = px, .wrap_s = SY_RT_WRAP_REPEAT,
+                                .wrap_t = SY_RT_WRAP_CLAMP, .filter = SY_RT_FILTER_LINEAR};
+        char e[ERRLEN];
+        sy_rt_result r = sy_rt_texture_create(st->dev, &d, &st->studio, e, sizeof e);
+        free(px);
+        if (r != SY_RT_OK) return rt_fail(err, r, "studio environment", e);
+    }
+    *handle = st->studio.id;
+    return SY_OK;
+}
+
+static sy_result gradient_texture(rt_state *st, const sy_gradient *g, uint32_t *handle, sy_error *err)
+{
+    if (!st->gradient.id || memcmp(&st->gradient_baked, g, sizeof *g)) {
+        float *px = malloc((size_t)GRADIENT_W * GRADIENT_H * 3u * sizeof *px);
+        if (!px) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "background gradient: out of memory");
+        sy_look_gradient_pixels(g, GRADIENT_W, GRADIENT_H, px);
+        sy_rt_texture_desc d = {.width = GRADIENT_W, .height = GRADIENT_H, .channels = 3, .format = SY_RT_TEXEL_FLOAT32,
+                                .pixels = px, .wrap_s = SY_RT_WRAP_REPEAT, .wrap_t = SY_RT_WRAP_CLAMP,
+                                .filter = SY_RT_FILTER_LINEAR};
+        char e[ERRLEN];
+        sy_rt_texture t = {0};
+        sy_rt_result r = sy_rt_texture_create(st->dev, &d, &t, e, sizeof e);
+        free(px);
+        if (r != SY_RT_OK) return rt_fail(err, r, "background gradient", e);
+        /* the device's background still names the old one until the look is applied (it stays
+         * valid: a destroyed background texture draws black, and the new look replaces it now) */
+        if (st->gradient.id) sy_rt_texture_destroy(st->dev, st->gradient, NULL, 0);
+        st->gradient = t;
+        st->gradient_baked = *g;
+    }
+    *handle = st->gradient.id;
+    return SY_OK;
+}
+
+static sy_result apply_look(rt_state *st, uint32_t background_id, sy_error *err)
+{
+    sy_look look;
+    sy_mirror_look(st->mirror, background_id, &look);
+    uint32_t env_tex = 0, bg_tex = 0;
+    sy_result r = SY_OK;
+    if (look.env == SY_LOOK_ENV_TEXTURE) env_tex = sy_mirror_texture_handle(st->mirror, look.env_texture);
+    else if (look.env == SY_LOOK_ENV_STUDIO) r = studio_texture(st, &env_tex, err);
+    if (r != SY_OK) return r;
+    if (look.background == SY_LOOK_BG_ENVIRONMENT) bg_tex = env_tex;
+    else if (look.background == SY_LOOK_BG_GRADIENT && (r = gradient_texture(st, &look.gradient, &bg_tex, err)) != SY_OK)
+        return r;
+    if (st->look_applied && sy_look_equal(&st->look, &look) && st->look_env_tex == env_tex && st->look_bg_tex == bg_tex)
+        return SY_OK;
+    sy_rt_background bg = {.mode = SY_RT_BACKGROUND_NONE};
+    if (look.background == SY_LOOK_BG_COLOR) {
+        /* premultiplied; the device's colour background is opaque (alpha 1) */
+        bg.mode = SY_RT_BACKGROUND_COLOR;
+        memcpy(bg.color, look.bg_color, sizeof bg.color);
+    } else if (bg_tex) {
+        bg.mode = SY_RT_BACKGROUND_TEXTURE;
+        bg.texture.id = bg_tex;
+        bg.intensity = look.background == SY_LOOK_BG_ENVIRONMENT ? look.env_intensity : 1.0f;
+    }
+    char e[ERRLEN];
+    sy_rt_result rr = sy_rt_set_background(st->dev, &bg, e, sizeof e);
+    if (rr == SY_RT_OK) rr = sy_rt_set_environment(st->dev, (sy_rt_texture){env_tex}, look.env_intensity, e, sizeof e);
+    if (rr == SY_RT_OK) rr = sy_rt_commit(st->dev, e, sizeof e);
+    if (rr != SY_RT_OK) {
+        st->look_applied = false;
+        return rt_fail(err, rr, "look (background, environment)", e);
+    }
+    st->look = look;
+    st->look_env_tex = env_tex;
+    st->look_bg_tex = bg_tex;
+    st->look_applied = true;
+    return SY_OK;
+}
+
 static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     rt_state *st = state;
     char e[ERRLEN];
-    /* background: the request names it; the device keeps the last one applied */
-    if (!st->bg_applied || st->current_bg != req->background_id) {
-        const sy_mirror_background *b = sy_mirror_background_get(st->mirror, req->background_id);
-        sy_rt_background bg = {.mode = SY_RT_BACKGROUND_NONE};
-        if (b && b->color[3] > 0.0f) {
-            bg.mode = SY_RT_BACKGROUND_COLOR;
-            memcpy(bg.color, b->color, sizeof bg.color);
-        }
-        sy_rt_result r = sy_rt_set_background(st->dev, &bg, e, sizeof e);
-        if (r == SY_RT_OK) r = sy_rt_set_environment(st->dev, (sy_rt_texture){b ? sy_mirror_texture_handle(st->mirror, b->environment) : 0u},
-                                                     b ? b->intensity : 1.0f, e, sizeof e);
-        if (r == SY_RT_OK) r = sy_rt_commit(st->dev, e, sizeof e);
-        if (r != SY_RT_OK) return rt_fail(err, r, "background", e);
-        st->current_bg = req->background_id;
-        st->bg_applied = true;
-    }
+    sy_result lr = apply_look(st, req->background_id, err);
+    if (lr != SY_OK) return lr;
     sy_rt_camera cam;
     camera_of(&req->camera, &cam);
     progress_bridge pb = {req->progress, req->progress_user};
@@ -852,6 +956,8 @@ static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *
         .max_depth = st->max_depth,
         .area_light_samples = st->light_samples,
         .seed = req->seed,
+        .pixel_samples = st->pixel_samples,
+        .env_light_samples = st->env_samples,
         .progress = req->progress ? progress_cb : NULL,
         .progress_user_data = &pb,
     };
@@ -892,9 +998,13 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
                                   sy_error *err)
 {
     *state_out = NULL;
-    long max_depth, light_samples, threads;
+    long max_depth, light_samples, threads, spp = 1, env_samples = 4;
     double specular;
     sy_result r;
+    if (integrator == SY_RT_INTEGRATOR_WHITTED &&
+        ((r = sy_params_get_int(args->params, "spp", WHITTED_DEFAULT_SPP, 1, 256, &spp, err)) ||
+         (r = sy_params_get_int(args->params, "env_samples", 4, 1, 256, &env_samples, err))))
+        return r;
     if ((r = sy_params_get_int(args->params, "max_depth", integrator == SY_RT_INTEGRATOR_PATHTRACER ? 64 : 8, 1,
                                integrator == SY_RT_INTEGRATOR_PATHTRACER ? 1024 : 64, &max_depth, err)) ||
         (r = sy_params_get_int(args->params, "light_samples", 16, 1, 1024, &light_samples, err)) ||
@@ -919,6 +1029,8 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     st->integrator = integrator;
     st->max_depth = (uint32_t)max_depth;
     st->light_samples = (uint32_t)light_samples;
+    st->pixel_samples = (uint32_t)spp;
+    st->env_samples = (uint32_t)env_samples;
     st->specular = (float)specular;
     st->last_slot = -1;
     filter_cfg_default(&st->filter, (uint32_t)threads);
@@ -1016,7 +1128,7 @@ static sy_result coverage_create(const sy_mediator_create_args *args, void **sta
 
 static const sy_mediator_class coverage_class = {
     .name = "coverage",
-    .caps = SY_CAP_DEPTH | SY_CAP_TILES,
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_ANALYSIS,
     .create = coverage_create,
     .destroy = rt_destroy,
     .sync = rt_sync,

@@ -9,9 +9,20 @@
  * change re-places the node's subtree only (rtcSetGeometryTransform, no BLAS rebuild).
  *
  * Parameters (sy_params): max_depth (1..64, default 8; pathtracer 1..1024, default 64),
- * light_samples (1..1024, default 16), threads (0 = all cores), specular (0..1, default 1: the
- * KHR_materials_specular factor of every material; 1 is glTF's dielectric F0 = 0.04 layer, 0 makes
- * dielectrics pure Lambertian, e.g. to match a Lambertian reference render).
+ * light_samples (whitted: area-light samples per pixel, shared among its pixel samples; 1..1024,
+ * default 16), threads (0 = all cores), specular (0..1, default 1: the KHR_materials_specular factor
+ * of every material; 1 is glTF's dielectric F0 = 0.04 layer, 0 makes dielectrics pure Lambertian,
+ * e.g. to match a Lambertian reference render). Whitted only: spp (anti-aliasing camera rays per
+ * pixel, stratified jittered, box filter; 1..256, default 1 = the pixel centre; 4 recommended for
+ * final images) and env_samples
+ * (environment-light samples per shading point of each pixel sample; 1..256, default 4).
+ *
+ * The look (sy_look.h) is resolved by the scene mirror on every render (sy_mirror_look with the
+ * request's background id) and applied to the device when it changed: the background is what
+ * camera rays that hit nothing see (none, colour, the environment texture, or the world's gradient
+ * baked into a small lat-long texture); the environment light (the world's texture, or the built-in
+ * studio when the scene brings no light) is what every other escaping ray sees and is sampled as a
+ * light. A change restarts progressive accumulation.
  *
  * Ownership/thread-safety: as any mediator (see core/sy_mediator.h). */
 #ifndef SY_MEDIATOR_RT_H
@@ -117,6 +128,9 @@ typedef struct sy_mediator_rt_counters {
     uint32_t last_sync_entries;    /* change entries handled by the last sync */
     uint32_t accum_restarts;       /* path tracer: accumulations restarted (not counting the first) */
     uint64_t last_render_rays;     /* path tracer: rays traced by the last render */
+    uint32_t warnings;             /* out-of-range material / light values clamped (each also printed
+                                    * as "sy: warning: rt mediator: material|light ID: ...") */
+    char last_warning[160];
 } sy_mediator_rt_counters;
 /* state is the mediator state of a context whose class is one of this adapter's classes. */
 void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out);

@@ -136,9 +136,9 @@ static int build_rich(sy_scene *s, rich *r)
     sy_blob *bc = blob_of(col, sizeof col), *bi = blob_of(idx, sizeof idx);
     sy_blob *tri = blob_of(pos, 36);
     sy_primitive prims[3] = {
-        {r->pos, bn, bt, buv, buv, bc, bi, r->mat},
-        {r->pos, NULL, NULL, NULL, NULL, NULL, bi, {0}}, /* shares positions and indices */
-        {tri, NULL, NULL, NULL, NULL, NULL, NULL, r->mat},
+        {r->pos, bn, bt, buv, buv, bc, bi, r->mat, SY_TOPOLOGY_TRIANGLES, 0.0f},
+        {r->pos, NULL, NULL, NULL, NULL, NULL, bi, {0}, SY_TOPOLOGY_TRIANGLES, 0.0f}, /* shares positions and indices */
+        {tri, NULL, NULL, NULL, NULL, NULL, NULL, r->mat, SY_TOPOLOGY_TRIANGLES, 0.0f},
     };
     CHECK_OK(sy_mesh_set_primitives(s, r->mesh, prims, 3, &e), e);
     sy_blob_release(bn);
@@ -881,7 +881,7 @@ static int test_decoder_errors(void)
     m[0] ^= 0xff;
     CHECK(expect_decode_error(m, size, SY_ERR_PARSE, "magic", NULL) == 0);
     RESET();
-    m[4] = 2; /* version 2 */
+    m[4] = SY_CHANGES_WIRE_VERSION + 1; /* a version from the future */
     CHECK(expect_decode_error(m, size, SY_ERR_UNSUPPORTED, "version", NULL) == 0);
     RESET();
     m[6] = 2; /* header flags */

@@ -1,7 +1,8 @@
 // test_gltf_counts.cpp — `sy info` counts of EVERY glTF / GLB file under TESTDATA/gltf checked against
 // values computed independently from the file's JSON with nlohmann::json (no tinygltf involved):
 // nodes, meshes, primitives, triangles (per mode: lists count / 3, strips and fans count - 2),
-// skipped primitives (points, lines, no POSITION), materials, textures, images, cameras and
+// skipped primitives (no POSITION or no complete element), points and line segments (LINES
+// pairs, LINE_LOOP n, LINE_STRIP n - 1), materials, textures, images, cameras and
 // KHR_lights_punctual lights; and, in the loaded scene, the triangle total, normals on every
 // primitive (generated flat when the file has none) and tangents wherever a material with a
 // normal map is used with texture coordinates. C++ only because nlohmann::json is; the code under
@@ -37,7 +38,7 @@ static int g_failures = 0, g_checks = 0;
 
 struct expected {
     uint64_t nodes = 0, meshes = 0, primitives = 0, triangles = 0, skipped = 0, materials = 0, textures = 0,
-             images = 0, cameras = 0, lights = 0;
+             images = 0, cameras = 0, lights = 0, points = 0, segments = 0;
 };
 
 static bool read_json(const std::string &file, json &doc)
@@ -79,12 +80,18 @@ static expected compute(const json &d)
             e.primitives++;
             int mode = p.value("mode", 4);
             const json &attrs = p["attributes"];
-            if (!attrs.contains("POSITION") || mode < 4) {
+            if (!attrs.contains("POSITION")) {
                 e.skipped++;
                 continue;
             }
             uint64_t count = acc[attrs["POSITION"].get<size_t>()]["count"].get<uint64_t>();
             if (p.contains("indices")) count = acc[p["indices"].get<size_t>()]["count"].get<uint64_t>();
+            if (mode < 4) { // points; lines: pairs, loops: n (n >= 3), strips: n - 1
+                uint64_t el = mode == 0 ? count : mode == 1 ? count / 2 : count < 2 ? 0 : mode == 2 && count >= 3 ? count : count - 1;
+                if (el == 0) e.skipped++;
+                (mode == 0 ? e.points : e.segments) += el;
+                continue;
+            }
             uint64_t t = mode == 4 ? count / 3 : (count >= 3 ? count - 2 : 0);
             if (t == 0) e.skipped++;
             e.triangles += t;
@@ -127,6 +134,8 @@ static void check_file(const std::string &file, uint32_t *models)
         CHECK_EQ("primitives", c.primitives, e.primitives);
         CHECK_EQ("triangles", c.triangles, e.triangles);
         CHECK_EQ("skipped_primitives", c.skipped_primitives, e.skipped);
+        CHECK_EQ("points", c.points, e.points);
+        CHECK_EQ("line_segments", c.line_segments, e.segments);
         CHECK_EQ("materials", c.materials, e.materials);
         CHECK_EQ("textures", c.textures, e.textures);
         CHECK_EQ("images", c.images, e.images);
@@ -140,7 +149,7 @@ static void check_file(const std::string &file, uint32_t *models)
                 const sy_primitive &p = m->primitives.items[k];
                 prims++;
                 tris += sy_primitive_triangle_count(&p);
-                if (!p.normals) without_normals++;
+                if (!p.normals && p.topology == SY_TOPOLOGY_TRIANGLES) without_normals++; // strokes: own normals
                 const sy_material_data *md = sy_material_get(scene, p.material);
                 if (md && md->normal_texture.texture.id && !p.tangents &&
                     (md->normal_texture.texcoord ? p.texcoords1 : p.texcoords0))

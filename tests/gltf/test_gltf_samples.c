@@ -170,10 +170,24 @@ static void check_specific(const char *model, const char *path, loaded *l)
                   "%s: material %s", path, names[k]);
         }
     } else if (!strcmp(model, "MeshPrimitiveModes")) {
-        /* 3 triangle primitives: 18 indices = 6, strip of 6 = 4, fan of 8 = 6; 4 point/line ones skipped */
-        CHECK(c->primitives == 7 && c->skipped_primitives == 4 && c->triangles == 16, "%s: %u/%u/%u", path,
-              c->primitives, c->skipped_primitives, c->triangles);
-        CHECK(l->info.warning_count >= 4, "%s: warnings %u", path, l->info.warning_count);
+        /* 3 triangle primitives: 18 indices = 6, strip of 6 = 4, fan of 8 = 6; POINTS of 7 indices = 7
+         * points; LINES of 12 indices = 6 segments, LINE_LOOP of 7 = 7, LINE_STRIP of 7 = 6 */
+        CHECK(c->primitives == 7 && c->skipped_primitives == 0 && c->triangles == 16 && c->points == 7 &&
+                  c->line_segments == 6 + 7 + 6,
+              "%s: %u/%u/%u/%u/%u", path, c->primitives, c->skipped_primitives, c->triangles, c->points, c->line_segments);
+        uint32_t kinds[SY_TOPOLOGY_COUNT] = {0}, elements[SY_TOPOLOGY_COUNT] = {0};
+        for (uint32_t id = sy_scene_next(s, SY_TYPE_MESH, 0); id; id = sy_scene_next(s, SY_TYPE_MESH, id)) {
+            const sy_mesh_data *m = sy_object_get(s, SY_TYPE_MESH, id);
+            for (uint32_t k = 0; k < m->primitives.count; k++) {
+                const sy_primitive *p = &m->primitives.items[k];
+                kinds[p->topology]++;
+                elements[p->topology] += sy_primitive_element_count(p);
+            }
+        }
+        CHECK(kinds[SY_TOPOLOGY_TRIANGLES] == 3 && kinds[SY_TOPOLOGY_LINES] == 3 && kinds[SY_TOPOLOGY_POINTS] == 1 &&
+                  elements[SY_TOPOLOGY_LINES] == 19 && elements[SY_TOPOLOGY_POINTS] == 7,
+              "%s: primitives by topology %u/%u/%u, %u segments, %u points", path, kinds[0], kinds[1], kinds[2],
+              elements[1], elements[2]);
     } else if (!strcmp(model, "DamagedHelmet")) {
         CHECK(sy_scene_count(s, SY_TYPE_TEXTURE) == 5, "%s: textures", path);
         const sy_material_data *m = sy_material_get(s, (sy_material){sy_scene_next(s, SY_TYPE_MATERIAL, 0)});

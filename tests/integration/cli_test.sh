@@ -11,6 +11,10 @@
 #   - -b pathtracer --filter pixel --threshold T and --filter radiance write an image; --filter
 #     bogus, a bad radiance option and a negative threshold fail naming the problem
 #     naming the file
+#   - world flags: a NaN --env-color, a negative --env-intensity, a short --background and a non-2:1
+#     --env EXR fail naming the problem; a 2:1 map renders; sy compare prints a row per picture
+#     back-end (not coverage) and writes a PNG sheet; the Box is lit by the default studio
+#     (mean luminance >= 0.05) and black with --no-default-light
 #   - --stereo sbs / tb / anaglyph / separate: output sizes and per-eye files; bad stereo parameters
 #     and overlays (negative separation, zero parallax 0, unknown mode, missing file, unknown
 #     back-end) fail naming the problem and write nothing
@@ -270,22 +274,59 @@ cat >"$TMP/esc/model/esc.gltf" <<'GLTF'
 {"asset":{"version":"2.0"},"buffers":[{"uri":"../outside.bin","byteLength":36}],
  "bufferViews":[{"buffer":0,"byteLength":36}],
  "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
- "meshes":[{"primitives":[{"attributes":{"POSITION":0}},{"attributes":{"POSITION":0},"mode":0}]}],
+ "meshes":[{"primitives":[{"attributes":{"POSITION":0}},{"attributes":{"POSITION":0},"mode":1}]}],
  "nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0}
 GLTF
 expect_error escape "'../outside.bin' resolves to" "$TMP/o_esc" "$SY" render "$TMP/esc/model/esc.gltf" -b whitted \
     -w 8 -h 8 -o "$TMP/o_esc/x.png"
 grep -q -- "--allow-path" "$TMP/escape.err" || fail "escape: the error does not name --allow-path"
-# allowed: renders, and the POINTS primitive it skips is reported (file and item), exit 0
+# allowed: renders, and the LINES primitive's odd vertex it drops is reported (file and item), exit 0
 run allowed "$SY" render "$TMP/esc/model/esc.gltf" --allow-path "$TMP/esc" -b whitted -w 8 -h 8 -o "$TMP/esc/ok.png"
 [ "$rc" -eq 0 ] && [ -s "$TMP/esc/ok.png" ] || fail "--allow-path: status $rc: $(cat "$TMP/allowed.err")"
-grep -q "warning: $TMP/esc/model/esc.gltf: meshes\[0\].primitives\[1\]: mode POINTS skipped" "$TMP/allowed.err" ||
-    fail "the skipped POINTS primitive is not reported: $(cat "$TMP/allowed.err")"
+grep -q "warning: $TMP/esc/model/esc.gltf: meshes\[0\].primitives\[1\]: LINES with 3 vertices (odd)" "$TMP/allowed.err" ||
+    fail "the odd LINES vertex is not reported: $(cat "$TMP/allowed.err")"
 # --strict: the same warning is an error, nothing written
 expect_error strict "--strict" "$TMP/o_esc" "$SY" render "$TMP/esc/model/esc.gltf" --allow-path "$TMP/esc" --strict \
     -b whitted -w 8 -h 8 -o "$TMP/o_esc/x.png"
 expect_error allow_path_missing "--allow-path" "$TMP/o_esc" "$SY" render "$TMP/esc/model/esc.gltf" --allow-path \
     "$TMP/esc/no_such_dir" -b whitted -w 8 -h 8 -o "$TMP/o_esc/x.png"
+
+# --- the world (issue 15): flags only fill sy_world_options; the library decides what they mean
+mkdir -p "$TMP/world" "$TMP/o_world"
+expect_error env_color_nan "--env-color" "$TMP/o_world" "$SY" render demo -b whitted -w 8 -h 8 --env-color 1,nan,0 \
+    -o "$TMP/o_world/x.png"
+expect_error env_intensity_neg "environment intensity" "$TMP/o_world" "$SY" render demo -b whitted -w 8 -h 8 \
+    --env-intensity -1 -o "$TMP/o_world/x.png"
+expect_error background_short "--background" "$TMP/o_world" "$SY" render demo -b whitted -w 8 -h 8 --background 1,2 \
+    -o "$TMP/o_world/x.png"
+# an EXR that is not a 2:1 lat-long map is refused, naming the file and the reason
+run world_exr "$SY" render demo -b whitted -w 30 -h 20 -o "$TMP/world/notlatlong.exr"
+[ "$rc" -eq 0 ] || fail "world: cannot write the test EXR: $(cat "$TMP/world_exr.err")"
+expect_error env_not_latlong "not a lat-long map" "$TMP/o_world" "$SY" render demo -b whitted -w 8 -h 8 \
+    --env "$TMP/world/notlatlong.exr" -o "$TMP/o_world/x.png"
+grep -q "notlatlong.exr" "$TMP/env_not_latlong.err" || fail "env_not_latlong: the file is not named"
+# a 2:1 map is taken (and lights every back-end; sy compare prints the table)
+run world_exr2 "$SY" render demo -b whitted -w 32 -h 16 -o "$TMP/world/latlong.exr"
+run env_ok "$SY" render demo -b raster -w 16 -h 16 --env "$TMP/world/latlong.exr" --env-intensity 2 -o "$TMP/world/e.png"
+[ "$rc" -eq 0 ] && [ -s "$TMP/world/e.png" ] || fail "--env with a 2:1 map: status $rc: $(cat "$TMP/env_ok.err")"
+# sy compare: a table row per picture back-end, a PNG contact sheet; a bad sheet name is refused
+run compare "$SY" compare demo -w 48 -h 32 --spp 4 -o "$TMP/world/sheet.png"
+[ "$rc" -eq 0 ] || fail "sy compare: status $rc: $(cat "$TMP/compare.err")"
+for b in whitted pathtracer raster; do
+    grep -q "^$b " "$TMP/compare.out" || fail "sy compare: no row for $b: $(cat "$TMP/compare.out")"
+done
+grep -q "^coverage " "$TMP/compare.out" && fail "sy compare: the analysis back-end 'coverage' is compared"
+magic "$TMP/world/sheet.png" 89504e47 || fail "sy compare: no PNG contact sheet"
+expect_error compare_jpg "must end in .png" "$TMP/o_world" "$SY" compare demo -w 8 -h 8 -o "$TMP/o_world/x.jpg"
+# default lighting: the Box (no lights of its own) is lit by the studio unless --no-default-light
+if [ -f "$BOX" ]; then
+    lum() { awk -v b="$1" '$1 == b {print $4}' "$2"; }
+    run box_lit "$SY" compare "$BOX" -w 32 -h 24 --spp 4 --backends whitted -o "$TMP/world/box.png"
+    run box_dark "$SY" compare "$BOX" -w 32 -h 24 --spp 4 --backends whitted --no-default-light -o "$TMP/world/box2.png"
+    lit=$(lum whitted "$TMP/box_lit.out"); dark=$(lum whitted "$TMP/box_dark.out")
+    awk -v a="$lit" -v b="$dark" 'BEGIN { exit !(a >= 0.05 && b == 0) }' ||
+        fail "default lighting: Box mean luminance lit $lit (want >= 0.05), --no-default-light $dark (want 0)"
+fi
 
 if [ "$fails" -ne 0 ]; then
     echo "integration_cli: $fails failure(s)" >&2

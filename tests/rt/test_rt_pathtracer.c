@@ -105,19 +105,20 @@ static void furnace_case(const char *name, const sy_rt_material_desc *md, double
 {
     sy_rt_device *dev = rt_device();
     const float L[3] = {0.25f, 0.5f, 1.0f};
-    if (env_texture) {
-        /* constant map of value L / 2 at intensity 2 */
-        float px[8 * 4 * 3];
-        for (int k = 0; k < 8 * 4; ++k) px[3 * k] = L[0] / 2, px[3 * k + 1] = L[1] / 2, px[3 * k + 2] = L[2] / 2;
-        sy_rt_texture_desc td = {.width = 8, .height = 4, .channels = 3, .format = SY_RT_TEXEL_FLOAT32, .pixels = px,
-                                 .wrap_t = SY_RT_WRAP_CLAMP};
-        sy_rt_texture tex;
-        MUST(sy_rt_texture_create(dev, &td, &tex, ERR));
-        MUST(sy_rt_set_environment(dev, tex, 2.0f, ERR));
-    } else {
-        sy_rt_background bg = {.mode = SY_RT_BACKGROUND_COLOR, .color = {L[0], L[1], L[2]}};
-        MUST(sy_rt_set_background(dev, &bg, ERR));
-    }
+    /* env_texture: a constant 8x4 map of value L / 2 at intensity 2; otherwise a uniform
+     * environment, i.e. a 1x1 map of value L. The background shows the same environment, so that
+     * pixels on the silhouette see L where they miss. */
+    float px[8 * 4 * 3];
+    uint32_t tw = env_texture ? 8 : 1, th = env_texture ? 4 : 1;
+    float scale = env_texture ? 0.5f : 1.0f;
+    for (uint32_t k = 0; k < tw * th; ++k) px[3 * k] = L[0] * scale, px[3 * k + 1] = L[1] * scale, px[3 * k + 2] = L[2] * scale;
+    sy_rt_texture_desc td = {.width = tw, .height = th, .channels = 3, .format = SY_RT_TEXEL_FLOAT32, .pixels = px,
+                             .wrap_t = SY_RT_WRAP_CLAMP};
+    sy_rt_texture tex;
+    MUST(sy_rt_texture_create(dev, &td, &tex, ERR));
+    MUST(sy_rt_set_environment(dev, tex, 1.0f / scale, ERR));
+    sy_rt_background bg = {.mode = SY_RT_BACKGROUND_TEXTURE, .texture = tex, .intensity = 1.0f / scale};
+    MUST(sy_rt_set_background(dev, &bg, ERR));
     sy_rt_material mat;
     MUST(sy_rt_material_create(dev, md, &mat, ERR));
     float id[16];

@@ -23,7 +23,14 @@ static void test_emitter_exact(void)
     sy_rt_device *dev = rt_device();
     float xf[16];
     rt_identity(xf);
-    sy_rt_instance inst = rt_place(dev, rt_quad(dev, 1.0f), xf, rt_emitter(dev, 17, 12, 4), 0);
+    /* a black emitter (like the Cornell box's light) reflects nothing: exactly its emission */
+    sy_rt_material_desc ed;
+    sy_rt_material_desc_init(&ed);
+    ed.base_color[0] = ed.base_color[1] = ed.base_color[2] = 0.0f;
+    ed.emissive[0] = 17, ed.emissive[1] = 12, ed.emissive[2] = 4;
+    sy_rt_material em;
+    MUST(sy_rt_material_create(dev, &ed, &em, ERR));
+    sy_rt_instance inst = rt_place(dev, rt_quad(dev, 1.0f), xf, em, 0);
     (void)inst;
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 100, .position = {0, 0, 2}};
     sy_rt_light l;
@@ -45,7 +52,7 @@ static void test_emitter_exact(void)
         free(depth);
     }
     /* A coloured background is radiance with alpha 1. */
-    sy_rt_background bgd = {SY_RT_BACKGROUND_COLOR, {0.25f, 0.5f, 2.0f}};
+    sy_rt_background bgd = {.mode = SY_RT_BACKGROUND_COLOR, .color = {0.25f, 0.5f, 2.0f}};
     MUST(sy_rt_set_background(dev, &bgd, ERR));
     MUST(sy_rt_commit(dev, ERR));
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);

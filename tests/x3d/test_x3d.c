@@ -420,8 +420,10 @@ static void test_def_use_and_scene_nodes(void)
     }
     CHECK(fabsf(sy_x3d_yfov(1.0f, 2.0f) - 1.0f) < 1e-6f, "landscape: yfov = fieldOfView");
     const sy_background_data *bd = sy_background_get(l.scene, l.info.background);
-    CHECK(bd && bd->color[0] == 0.1f && bd->color[1] == 0.2f && bd->color[2] == 0.3f && bd->color[3] == 1.0f,
-          "Background skyColor[0]");
+    /* skyColor is a gradient (background only): two sky colours without skyAngle -> the first alone */
+    CHECK(bd && bd->color[3] == 0.0f && bd->gradient.sky_count == 1 && bd->gradient.sky_color[0][0] == 0.1f &&
+              bd->gradient.sky_color[0][1] == 0.2f && bd->gradient.sky_color[0][2] == 0.3f && bd->gradient.ground_count == 0,
+          "Background skyColor[0] as a one-colour gradient, colour transparent");
     CHECK(sy_scene_count(l.scene, SY_TYPE_LIGHT) == 3, "3 lights, got %u", sy_scene_count(l.scene, SY_TYPE_LIGHT));
     for (uint32_t id = sy_scene_next(l.scene, SY_TYPE_LIGHT, 0); id; id = sy_scene_next(l.scene, SY_TYPE_LIGHT, id)) {
         const sy_light_data *ld = sy_object_get(l.scene, SY_TYPE_LIGHT, id);
@@ -580,18 +582,18 @@ static void test_samples(const char *data)
     /* every sample loads; specific values */
     static const struct { const char *file; uint32_t meshes, lights, cameras; } expect[] = {
         {"web3d/ConformanceNist/Appearance/Material/default_primitives.x3d", 4, 0, 0},
-        {"web3d/ConformanceNist/Lights/PointLight/test_locationsim.x3d", 1, 1, 4}, /* two lights are on='false' */
+        {"web3d/ConformanceNist/Lights/PointLight/test_locationsim.x3d", 2, 1, 4}, /* two lights are on='false'; 1 Text */
         {"web3d/X3dForWebAuthors/Chapter06GeometryPointsLinesPolygons/IndexedFaceSetExample.x3d", 9, 0, 1},
-        {"web3d/X3dForWebAuthors/Chapter05AppearanceMaterialTextures/GeometryPrimitiveNodesImageTexture.x3d", 4, 0, 0},
+        {"web3d/X3dForWebAuthors/Chapter05AppearanceMaterialTextures/GeometryPrimitiveNodesImageTexture.x3d", 5, 0, 0}, /* 4 primitives + 1 Text */
         {"web3d/X3dForWebAuthors/Chapter05AppearanceMaterialTextures/SpecularColor.x3d", 1, 0, 1},
         {"web3d/X3dForWebAuthors/Chapter03Grouping/TransformExample.x3d", 4, 0, 1},
-        {"web3d/X3dForWebAuthors/Chapter02GeometryPrimitives/GeometryPrimitiveNodes.x3d", 4, 0, 0},
+        {"web3d/X3dForWebAuthors/Chapter02GeometryPrimitives/GeometryPrimitiveNodes.x3d", 5, 0, 0}, /* 4 primitives + 1 Text */
         {"web3d/X3dForWebAuthors/Chapter13GeometryTrianglesQuadrilaterals/IndexedTriangleSetExample.x3d", 1, 0, 1},
         {"web3d/X3dForWebAuthors/Chapter11LightingEnvironmentalEffects/SpotLightExample.x3d", 1, 1, 1},
         {"web3d/X3dForWebAuthors/Chapter11LightingEnvironmentalEffects/PointLightExample.x3d", 2, 2, 3},
         {"web3d/X3dForWebAuthors/Chapter11LightingEnvironmentalEffects/DirectionalLightExample.x3d", 6, 1, 1},
-        {"web3d/X3dForWebAuthors/Chapter11LightingEnvironmentalEffects/BackgroundColorsOnly.x3d", 0, 0, 1},
-        {"assimp_debian_testmodels/HelloX3dTrademark.x3d", 1, 0, 1},
+        {"web3d/X3dForWebAuthors/Chapter11LightingEnvironmentalEffects/BackgroundColorsOnly.x3d", 1, 0, 1}, /* 1 Text */
+        {"assimp_debian_testmodels/HelloX3dTrademark.x3d", 2, 0, 1}, /* 1 Text */
         {"assimp_debian_testmodels/ComputerKeyboard.x3d", 3, 0, 1}, /* Extrusion keys, shared by USE */
     };
     for (size_t i = 0; i < sizeof expect / sizeof expect[0]; i++) {
@@ -607,7 +609,13 @@ static void test_samples(const char *data)
               l.info.camera_node_count, expect[i].cameras);
         if (strstr(expect[i].file, "BackgroundColorsOnly")) {
             const sy_background_data *bd = sy_background_get(l.scene, l.info.background);
-            CHECK(bd && bd->color[0] == 0.8f && bd->color[2] == 0.2f, "BackgroundColorsOnly: skyColor[0] 0.8 0.8 0.2");
+            /* 6 sky colours / 5 angles, 5 ground colours / 4 angles (file values) */
+            CHECK(bd && bd->color[3] == 0.0f && bd->gradient.sky_count == 6 && bd->gradient.ground_count == 5 &&
+                      bd->gradient.sky_color[0][0] == 0.8f && bd->gradient.sky_color[0][2] == 0.2f &&
+                      bd->gradient.sky_angle[4] == 1.570f && bd->gradient.ground_angle[3] == 1.5707f &&
+                      bd->gradient.ground_color[4][2] == 0.4f,
+                  "BackgroundColorsOnly: gradient sky %u ground %u", bd ? bd->gradient.sky_count : 0,
+                  bd ? bd->gradient.ground_count : 0);
         }
         if (strstr(expect[i].file, "default_primitives")) {
             uint32_t tris;

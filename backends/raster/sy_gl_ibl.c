@@ -1,0 +1,220 @@
+/* sy_gl_ibl.c — image-based lighting on the GPU: prefiltered GGX cube, irradiance cube, split-sum
+ * BRDF table and the LTC tables (see sy_gl_ibl.h). */
+#include "sy_gl_ibl.h"
+
+#include "sy_gl_ltc.h"
+#include "sy_gl_shaders.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#define IBL_COMMON                                                                                           \
+    "const float PI = 3.14159265359;\n"                                                                      \
+    "float radinv(uint b) { b = (b << 16u) | (b >> 16u);\n"                                                  \
+    "  b = ((b & 0x55555555u) << 1u) | ((b & 0xAAAAAAAAu) >> 1u); b = ((b & 0x33333333u) << 2u) | ((b & 0xCCCCCCCCu) >> 2u);\n" \
+    "  b = ((b & 0x0F0F0F0Fu) << 4u) | ((b & 0xF0F0F0F0u) >> 4u); b = ((b & 0x00FF00FFu) << 8u) | ((b & 0xFF00FF00u) >> 8u);\n" \
+    "  return float(b) * 2.3283064365386963e-10; }\n"                                                        \
+    "mat3 basis(vec3 n) { vec3 up = abs(n.y) < 0.999 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);\n"         \
+    "  vec3 t = normalize(cross(up, n)); return mat3(t, cross(n, t), n); }\n"                                \
+    "vec3 ggx_h(vec2 xi, float a2) { float phi = 2.0 * PI * xi.x;\n"                                         \
+    "  float c = sqrt((1.0 - xi.y) / (1.0 + (a2 - 1.0) * xi.y)), s = sqrt(max(0.0, 1.0 - c * c));\n"       \
+    "  return vec3(s * cos(phi), s * sin(phi), c); }\n"
+
+/* cube faces in GL order; s, t in [-1, 1] from the face texel (row 0 = t -1) */
+#define IBL_CUBE                                                                                             \
+    "uniform sampler2D t_src; uniform int u_face; uniform vec4 u_size;\n" /* face size, src texel sa, intensity, samples */ \
+    "vec3 face_dir(vec2 st) { float s = st.x, t = st.y;\n"                                                   \
+    "  if (u_face == 0) return vec3(1.0, -t, -s); if (u_face == 1) return vec3(-1.0, -t, s);\n"            \
+    "  if (u_face == 2) return vec3(s, 1.0, t); if (u_face == 3) return vec3(s, -1.0, -t);\n"              \
+    "  if (u_face == 4) return vec3(s, -t, 1.0); return vec3(-s, -t, -1.0); }\n"                            \
+    "vec2 latlong(vec3 d) { return vec2(0.5 + atan(d.x, -d.z) * (0.5 / PI), acos(clamp(d.y, -1.0, 1.0)) / PI); }\n" \
+    "vec3 src_lod(vec3 d, float sa) {\n" /* filtered importance sampling: the source mip for solid angle sa */ \
+    "  float texel = u_size.y * max(sqrt(max(0.0, 1.0 - d.y * d.y)), 1e-3);\n"                             \
+    "  return textureLod(t_src, latlong(d), max(0.5 * log2(sa / texel) + 1.0, 0.0)).rgb; }\n"
+
+static const char *const spec_fs =
+    "#version 330 core\n" IBL_COMMON IBL_CUBE
+    "uniform float u_rough; out vec4 o;\n"
+    "void main() { vec3 N = normalize(face_dir(gl_FragCoord.xy / u_size.x * 2.0 - 1.0));\n"
+    "  if (u_rough <= 0.0) {\n"
+    "    float texel = u_size.y * max(sqrt(max(0.0, 1.0 - N.y * N.y)), 1e-3);\n"
+    "    float lod = max(0.5 * log2(4.0 / (u_size.x * u_size.x) / texel), 0.0);\n"
+    "    o = vec4(textureLod(t_src, latlong(N), lod).rgb * u_size.z, 1.0); return; }\n"
+    "  float a = u_rough * u_rough, a2 = a * a; mat3 B = basis(N); vec3 sum = vec3(0.0); float w = 0.0;\n"
+    "  uint n = uint(u_size.w);\n"
+    "  for (uint i = 0u; i < n; ++i) {\n"
+    "    vec3 h = ggx_h(vec2((float(i) + 0.5) / float(n), radinv(i)), a2); vec3 H = B * h;\n"
+    "    vec3 L = 2.0 * h.z * H - N; float nl = dot(N, L); if (nl <= 0.0) continue;\n"
+    "    float dd = h.z * h.z * (a2 - 1.0) + 1.0; float pdf = a2 / (PI * dd * dd) * 0.25;\n"
+    "    sum += src_lod(L, 1.0 / (float(n) * pdf)) * nl; w += nl; }\n"
+    "  o = vec4(sum / max(w, 1e-6) * u_size.z, 1.0); }\n";
+
+static const char *const irr_fs =
+    "#version 330 core\n" IBL_COMMON IBL_CUBE
+    "out vec4 o;\n"
+    "void main() { vec3 N = normalize(face_dir(gl_FragCoord.xy / u_size.x * 2.0 - 1.0));\n"
+    "  mat3 B = basis(N); vec3 sum = vec3(0.0); uint n = uint(u_size.w);\n"
+    "  for (uint i = 0u; i < n; ++i) {\n"
+    "    float u = (float(i) + 0.5) / float(n), v = radinv(i), r = sqrt(v), phi = 2.0 * PI * u;\n"
+    "    vec3 l = vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - v)));\n"
+    "    sum += src_lod(B * l, PI / (float(n) * max(l.z, 1e-3))); }\n"
+    "  o = vec4(sum / float(n) * u_size.z, 1.0); }\n";
+
+static const char *const brdf_fs =
+    "#version 330 core\n" IBL_COMMON
+    "out vec4 o;\n"
+    "void main() { vec2 c = floor(gl_FragCoord.xy) / 31.0; float nv = max(c.x, 1e-3), r = c.y;\n"
+    "  float a = max(r * r, 1e-4), a2 = a * a; vec3 V = vec3(sqrt(1.0 - nv * nv), 0.0, nv);\n"
+    "  float A = 0.0, Bv = 0.0; const uint n = 512u;\n"
+    "  for (uint i = 0u; i < n; ++i) {\n"
+    "    vec3 H = ggx_h(vec2((float(i) + 0.5) / float(n), radinv(i)), a2);\n"
+    "    float vh = dot(V, H); vec3 L = 2.0 * vh * H - V; float nl = L.z; if (nl <= 0.0 || vh <= 0.0) continue;\n"
+    "    float vis = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));\n"
+    "    float gv = vis * 4.0 * nl * vh / max(H.z, 1e-6); float m = 1.0 - vh, fc = m * m * m * m * m;\n"
+    "    A += (1.0 - fc) * gv; Bv += fc * gv; }\n"
+    "  o = vec4(A / float(n), Bv / float(n), 0.0, 1.0); }\n";
+
+static sy_gl_result build(const sy_gl_fns *gl, sy_gl_ibl *ibl, char *err, size_t err_len)
+{
+    if (ibl->prog_spec) return SY_GL_OK;
+    sy_gl_result r = sy_gl_program_build(gl, "IBL specular prefilter", sy_gl_resolve_vs, spec_fs, NULL, &ibl->prog_spec, err, err_len);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL irradiance", sy_gl_resolve_vs, irr_fs, NULL, &ibl->prog_irr, err, err_len);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL BRDF table", sy_gl_resolve_vs, brdf_fs, NULL, &ibl->prog_brdf, err, err_len);
+    if (r != SY_GL_OK) return r;
+    ibl->spec_face = gl->GetUniformLocation(ibl->prog_spec, "u_face");
+    ibl->spec_rough = gl->GetUniformLocation(ibl->prog_spec, "u_rough");
+    ibl->spec_size = gl->GetUniformLocation(ibl->prog_spec, "u_size");
+    ibl->spec_src = gl->GetUniformLocation(ibl->prog_spec, "t_src");
+    ibl->irr_face = gl->GetUniformLocation(ibl->prog_irr, "u_face");
+    ibl->irr_size = gl->GetUniformLocation(ibl->prog_irr, "u_size");
+    ibl->irr_src = gl->GetUniformLocation(ibl->prog_irr, "t_src");
+    gl->GenFramebuffers(1, &ibl->fbo);
+    gl->GenVertexArrays(1, &ibl->vao);
+    return SY_GL_OK;
+}
+
+static GLuint table_tex(const sy_gl_fns *gl, GLint internal, GLsizei size, GLenum format, const float *data)
+{
+    GLuint t;
+    gl->GenTextures(1, &t);
+    gl->BindTexture(GL_TEXTURE_2D, t);
+    gl->PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl->TexImage2D(GL_TEXTURE_2D, 0, internal, size, size, 0, format, GL_FLOAT, data);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+static sy_gl_result fb_check(const sy_gl_fns *gl, const char *what, char *err, size_t err_len)
+{
+    GLenum st = gl->CheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (st == GL_FRAMEBUFFER_COMPLETE) return SY_GL_OK;
+    if (err && err_len) snprintf(err, err_len, "%s: framebuffer incomplete (0x%04x)", what, (unsigned)st);
+    return SY_GL_ERROR_GL;
+}
+
+sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, char *err, size_t err_len)
+{
+    if (ibl->brdf_lut) return SY_GL_OK;
+    sy_gl_result r = build(gl, ibl, err, err_len);
+    if (r != SY_GL_OK) return r;
+    ibl->ltc1 = table_tex(gl, GL_RGBA32F, SY_GL_LTC_SIZE, GL_RGBA, sy_gl_ltc_1);
+    ibl->ltc2 = table_tex(gl, GL_RGBA32F, SY_GL_LTC_SIZE, GL_RGBA, sy_gl_ltc_2);
+    GLuint lut = table_tex(gl, GL_RG32F, SY_GL_IBL_BRDF_SIZE, GL_RG, NULL);
+    gl->BindFramebuffer(GL_FRAMEBUFFER, ibl->fbo);
+    gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, lut, 0);
+    gl->DrawBuffer(GL_COLOR_ATTACHMENT0);
+    if ((r = fb_check(gl, "BRDF table", err, err_len)) != SY_GL_OK) {
+        gl->BindFramebuffer(GL_FRAMEBUFFER, 0);
+        gl->DeleteTextures(1, &lut);
+        return r;
+    }
+    gl->Viewport(0, 0, SY_GL_IBL_BRDF_SIZE, SY_GL_IBL_BRDF_SIZE);
+    gl->Disable(GL_DEPTH_TEST);
+    gl->Disable(GL_BLEND);
+    gl->UseProgram(ibl->prog_brdf);
+    gl->BindVertexArray(ibl->vao);
+    gl->DrawArrays(GL_TRIANGLES, 0, 3);
+    gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, 0, 0);
+    gl->BindFramebuffer(GL_FRAMEBUFFER, 0);
+    ibl->brdf_lut = lut;
+    return SY_GL_OK;
+}
+
+static GLuint cube_tex(const sy_gl_fns *gl, uint32_t size, uint32_t levels)
+{
+    GLuint t;
+    gl->GenTextures(1, &t);
+    gl->BindTexture(GL_TEXTURE_CUBE_MAP, t);
+    for (uint32_t l = 0; l < levels; ++l)
+        for (int f = 0; f < 6; ++f)
+            gl->TexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, (GLint)l, GL_RGBA16F, (GLsizei)(size >> l),
+                           (GLsizei)(size >> l), 0, GL_RGBA, GL_FLOAT, NULL);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_BASE_LEVEL, 0);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAX_LEVEL, (GLint)levels - 1);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, levels > 1 ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+sy_gl_result sy_gl_ibl_prefilter(const sy_gl_fns *gl, sy_gl_ibl *ibl, GLuint src, uint32_t src_w, uint32_t src_h,
+                                 float intensity, char *err, size_t err_len)
+{
+    sy_gl_result r = build(gl, ibl, err, err_len);
+    if (r != SY_GL_OK) return r;
+    if (!ibl->spec_cube) ibl->spec_cube = cube_tex(gl, SY_GL_IBL_SPEC_SIZE, SY_GL_IBL_SPEC_LEVELS);
+    if (!ibl->irr_cube) ibl->irr_cube = cube_tex(gl, SY_GL_IBL_IRR_SIZE, 1);
+    gl->Enable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+    gl->Disable(GL_DEPTH_TEST);
+    gl->Disable(GL_BLEND);
+    gl->Disable(GL_MULTISAMPLE);
+    gl->BindFramebuffer(GL_FRAMEBUFFER, ibl->fbo);
+    gl->DrawBuffer(GL_COLOR_ATTACHMENT0);
+    gl->BindVertexArray(ibl->vao);
+    gl->ActiveTexture(GL_TEXTURE0);
+    gl->BindTexture(GL_TEXTURE_2D, src);
+    const float texel_sa = 2.0f * 3.14159265f * 3.14159265f / ((float)src_w * (float)src_h);
+    for (int pass = 0; pass < 2 && r == SY_GL_OK; ++pass) {
+        GLuint prog = pass ? ibl->prog_irr : ibl->prog_spec, cube = pass ? ibl->irr_cube : ibl->spec_cube;
+        uint32_t levels = pass ? 1u : SY_GL_IBL_SPEC_LEVELS, size0 = pass ? SY_GL_IBL_IRR_SIZE : SY_GL_IBL_SPEC_SIZE;
+        gl->UseProgram(prog);
+        gl->Uniform1i(pass ? ibl->irr_src : ibl->spec_src, 0);
+        for (uint32_t l = 0; l < levels && r == SY_GL_OK; ++l) {
+            uint32_t size = size0 >> l;
+            float rough = pass ? 0.0f : (float)l / (float)(SY_GL_IBL_SPEC_LEVELS - 1);
+            float samples = pass ? 256.0f : l == 1 ? 64.0f : 128.0f;
+            const float u_size[4] = {(float)size, texel_sa, intensity, samples};
+            gl->Uniform4fv(pass ? ibl->irr_size : ibl->spec_size, 1, u_size);
+            if (!pass) gl->Uniform1f(ibl->spec_rough, rough);
+            gl->Viewport(0, 0, (GLsizei)size, (GLsizei)size);
+            for (int f = 0; f < 6 && r == SY_GL_OK; ++f) {
+                gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f,
+                                         cube, (GLint)l);
+                if (f == 0 && l == 0) r = fb_check(gl, pass ? "irradiance cube" : "specular cube", err, err_len);
+                if (r != SY_GL_OK) break;
+                gl->Uniform1i(pass ? ibl->irr_face : ibl->spec_face, f);
+                gl->DrawArrays(GL_TRIANGLES, 0, 3);
+            }
+        }
+    }
+    gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, 0, 0);
+    gl->BindFramebuffer(GL_FRAMEBUFFER, 0);
+    return r;
+}
+
+void sy_gl_ibl_free(const sy_gl_fns *gl, sy_gl_ibl *ibl)
+{
+    GLuint progs[3] = {ibl->prog_spec, ibl->prog_irr, ibl->prog_brdf};
+    for (int i = 0; i < 3; ++i)
+        if (progs[i]) gl->DeleteProgram(progs[i]);
+    GLuint texs[5] = {ibl->brdf_lut, ibl->ltc1, ibl->ltc2, ibl->spec_cube, ibl->irr_cube};
+    gl->DeleteTextures(5, texs);
+    if (ibl->fbo) gl->DeleteFramebuffers(1, &ibl->fbo);
+    if (ibl->vao) gl->DeleteVertexArrays(1, &ibl->vao);
+    memset(ibl, 0, sizeof *ibl);
+}

@@ -1,0 +1,41 @@
+/* sy_gl_ibl.h — internal: image-based lighting for the rasterizer, computed on the GPU.
+ *
+ * From a lat-long environment texture (the convention of the shared look: direction d maps to
+ * u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, row 0 up; texels are radiance) it builds
+ *  - a prefiltered specular cube map: SY_GL_IBL_SPEC_SIZE texels per side at mip 0 and one GGX
+ *    roughness per mip (roughness = mip / (levels - 1)), importance-sampled with filtered
+ *    importance sampling (source mip chosen from the sample's pdf), N = V = R as in the split sum;
+ *  - an irradiance cube map (SY_GL_IBL_IRR_SIZE per side) holding the cosine-weighted mean radiance
+ *    E(n) / pi, so that Lambert is base x texel;
+ * and once per device the split-sum BRDF table (32 x 32, x = n.v, y = roughness; RG = A, B of the
+ * height-correlated Smith GGX with Schlick: specular = F0 A + B) and the LTC tables (sy_gl_ltc.h).
+ *
+ * Ownership: the GL objects belong to the sy_gl_ibl struct (sy_gl_ibl_free). Thread-safety: the
+ * caller's GL context must be current. */
+#ifndef SY_GL_IBL_H
+#define SY_GL_IBL_H
+
+#include "sy_gl_context.h"
+
+#define SY_GL_IBL_SPEC_SIZE 256u
+#define SY_GL_IBL_SPEC_LEVELS 6u /* 256 .. 8: roughness 0, 0.2, ..., 1 */
+#define SY_GL_IBL_IRR_SIZE 16u
+#define SY_GL_IBL_BRDF_SIZE 32u
+
+typedef struct sy_gl_ibl {
+    GLuint prog_spec, prog_irr, prog_brdf;
+    GLint spec_face, spec_rough, spec_size, spec_src, irr_face, irr_size, irr_src;
+    GLuint fbo, vao;
+    GLuint brdf_lut, ltc1, ltc2; /* once per device */
+    GLuint spec_cube, irr_cube;  /* per environment */
+} sy_gl_ibl;
+
+/* Builds the BRDF table and uploads the LTC tables (no-op when done). */
+sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, char *err, size_t err_len);
+/* (Re)computes both cube maps from a lat-long RGBA float texture with mipmaps (src_w x src_h at
+ * level 0) scaled by intensity. Leaves the framebuffer binding at 0 and the viewport changed. */
+sy_gl_result sy_gl_ibl_prefilter(const sy_gl_fns *gl, sy_gl_ibl *ibl, GLuint src, uint32_t src_w, uint32_t src_h,
+                                 float intensity, char *err, size_t err_len);
+void sy_gl_ibl_free(const sy_gl_fns *gl, sy_gl_ibl *ibl);
+
+#endif /* SY_GL_IBL_H */

@@ -1,0 +1,226 @@
+/* test_raster_light.c — the rasterizer's environment light, background and area lights through
+ * the back-end API (sy_gl.h), against analytic values:
+ *  1. a constant white environment of radiance E lights a Lambert quad (no specular) to exactly
+ *     base x E (irradiance pi E); the background stays transparent (the environment is no
+ *     background) and a TEXTURE background shows the texel x intensity with alpha 1;
+ *  2. a mirror (metallic 1, roughness 0) under a lat-long environment whose upper half is 2 and lower
+ *     half 0.5 reflects one half or the other, not their mean (the prefiltered mip 0 is sharp);
+ *  3. a square emitter above a Lambert floor: the irradiance under its centre matches the form
+ *     factor of a square (LTC, diffuse), the emitter does not light points behind it (one-sided),
+ *     a double-sided emitter lights both sides, an occluder casts a shadow;
+ *  4. invalid area lights are refused with a message naming the item.
+ * argv[1] = provider (osmesa default). */
+#include "sy_gl.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int failures;
+#define CHECK(c, ...)                                                                                  \
+    do {                                                                                               \
+        if (!(c)) {                                                                                    \
+            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #c);                      \
+            fprintf(stderr, __VA_ARGS__);                                                              \
+            fputc('\n', stderr);                                                                       \
+            failures++;                                                                                \
+        }                                                                                              \
+    } while (0)
+#define MUST(call)                                                                                     \
+    do {                                                                                               \
+        sy_gl_result r_ = (call);                                                                      \
+        if (r_ != SY_GL_OK) {                                                                          \
+            fprintf(stderr, "%s:%d: %s failed (%d): %s\n", __FILE__, __LINE__, #call, (int)r_, e);     \
+            exit(1);                                                                                   \
+        }                                                                                              \
+    } while (0)
+
+#define N 32
+#define PI_F 3.14159265358979f
+static char e[1024];
+static float rgba[N * N * 4], depth[N * N];
+static const sy_gl_render_desc full = {N, N, 0, 0, N, N};
+static const float *px(int x, int y) { return rgba + 4 * (y * N + x); }
+static bool near_(float a, float b, float tol) { return fabsf(a - b) <= tol * fmaxf(1e-3f, fabsf(b)); }
+
+static sy_gl_mesh quad(sy_gl_device *d, const float *p4, const float n[3])
+{
+    float nrm[12];
+    for (int i = 0; i < 4; ++i) memcpy(nrm + 3 * i, n, 3 * sizeof(float));
+    static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    sy_gl_mesh_desc md = {.positions = p4, .normals = nrm, .indices = idx, .vertex_count = 4, .triangle_count = 2};
+    sy_gl_mesh m;
+    MUST(sy_gl_mesh_create(d, &md, &m, e, sizeof e));
+    return m;
+}
+
+static sy_gl_instance place(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat)
+{
+    sy_gl_instance_desc id = {.mesh = m, .material = mat, .transform = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
+    sy_gl_instance in;
+    MUST(sy_gl_instance_create(d, &id, &in, e, sizeof e));
+    return in;
+}
+
+static sy_gl_material lambert(sy_gl_device *d, float albedo)
+{
+    sy_gl_material_desc md;
+    sy_gl_material_desc_init(&md);
+    md.base_color[0] = md.base_color[1] = md.base_color[2] = albedo;
+    md.metallic = 0.0f;
+    md.specular = 0.0f;
+    sy_gl_material h;
+    MUST(sy_gl_material_create(d, &md, &h, e, sizeof e));
+    return h;
+}
+
+static sy_gl_texture env_texture(sy_gl_device *d, float upper, float lower)
+{
+    enum { W = 64, H = 32 };
+    static float t[W * H * 3];
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W * 3; ++x) t[y * W * 3 + x] = y < H / 2 ? upper : lower;
+    sy_gl_texture_desc td = {.width = W, .height = H, .channels = 3, .format = SY_GL_TEXEL_FLOAT32, .pixels = t,
+                             .wrap_t = SY_GL_WRAP_CLAMP};
+    sy_gl_texture h;
+    MUST(sy_gl_texture_create(d, &td, &h, e, sizeof e));
+    return h;
+}
+
+/* Form factor from a point to a parallel square of half-size a centred at height h above it. */
+static float square_form_factor(float a, float h)
+{
+    /* four rectangles a x a with a corner above the point: F = 1/(2 pi) (x/sqrt(1+x^2) atan(y/sqrt(1+x^2)) + (x<->y)) */
+    float x = a / h, y = a / h;
+    float f = (x / sqrtf(1 + x * x) * atanf(y / sqrtf(1 + x * x)) + y / sqrtf(1 + y * y) * atanf(x / sqrtf(1 + y * y))) / (2 * PI_F);
+    return 4.0f * f;
+}
+
+int main(int argc, char **argv)
+{
+    sy_gl_provider prov = SY_GL_PROVIDER_OSMESA;
+    if (argc > 1 && !sy_gl_provider_parse(argv[1], &prov)) return 2;
+    sy_gl_device *d;
+    sy_gl_device_desc dd = {.provider = prov, .msaa = 1, .shadow_map_size = 512};
+    sy_gl_result cr = sy_gl_device_create(&dd, &d, e, sizeof e);
+    if (cr == SY_GL_ERROR_NO_CONTEXT && prov != SY_GL_PROVIDER_OSMESA) {
+        printf("SKIP: no %s context: %s\n", sy_gl_provider_name(prov), e);
+        return 77;
+    }
+    MUST(cr);
+    sy_gl_camera cam = {.camera_to_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, .window = {-0.5f, 0.5f, -0.5f, 0.5f},
+                        .near_clip = 0.1f};
+    const float nz[3] = {0, 0, 1};
+    const float facing[12] = {-1, -1, -3, 1, -1, -3, 1, 1, -3, -1, 1, -3};
+
+    /* 1. constant environment: Lambert = base x E; no background from it */
+    sy_gl_texture env = env_texture(d, 1.5f, 1.5f);
+    sy_gl_mesh mq = quad(d, facing, nz);
+    sy_gl_instance q = place(d, mq, lambert(d, 0.5f));
+    sy_gl_set_environment(d, env, 2.0f);
+    MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+    printf("Lambert under a constant environment of 3: %g (want 1.5)\n", px(16, 16)[0]);
+    CHECK(near_(px(16, 16)[0], 0.5f * 3.0f, 0.02f), "Lambert under a constant environment: %g (want %g)", px(16, 16)[0], 1.5);
+    MUST(sy_gl_instance_destroy(d, q));
+    MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+    CHECK(px(16, 16)[3] == 0.0f && px(16, 16)[0] == 0.0f, "the environment is not a background: %g %g", px(16, 16)[0], px(16, 16)[3]);
+    sy_gl_texture bg = env_texture(d, 3.0f, 0.25f);
+    sy_gl_set_background(d, SY_GL_BACKGROUND_TEXTURE, NULL, bg, 2.0f);
+    MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+    CHECK(near_(px(16, 2)[0], 6.0f, 1e-3f) && px(16, 2)[3] == 1.0f && isinf(depth[2 * N + 16]),
+          "sky above the horizon %g alpha %g (want 6, 1)", px(16, 2)[0], px(16, 2)[3]);
+    CHECK(near_(px(16, 29)[0], 0.5f, 1e-3f), "sky below the horizon %g (want 0.5)", px(16, 29)[0]);
+    const float red[4] = {0.25f, 0, 0, 0.5f};
+    sy_gl_set_background(d, SY_GL_BACKGROUND_COLOR, red, (sy_gl_texture){0}, 1.0f);
+    MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+    CHECK(px(3, 3)[0] == 0.25f && px(3, 3)[3] == 0.5f, "colour background %g %g", px(3, 3)[0], px(3, 3)[3]);
+    sy_gl_set_background(d, SY_GL_BACKGROUND_NONE, NULL, (sy_gl_texture){0}, 1.0f);
+
+    /* 2. a mirror reflects the environment sharply: tilted down it sees the lower half (0.5 x 2) */
+    {
+        sy_gl_set_environment(d, env_texture(d, 2.0f, 0.5f), 1.0f);
+        sy_gl_material_desc md;
+        sy_gl_material_desc_init(&md);
+        md.metallic = 1.0f;
+        md.roughness = 0.0f;
+        sy_gl_material mm;
+        MUST(sy_gl_material_create(d, &md, &mm, e, sizeof e));
+        /* a mirror tilted 30 degrees about x, facing up-forward: view rays reflect upwards */
+        const float tilt[12] = {-1, -1.2f, -2.5f, 1, -1.2f, -2.5f, 1, 0.6f, -3.5f, -1, 0.6f, -3.5f};
+        const float tn[3] = {0, 0.866f, 0.5f};
+        sy_gl_instance mi = place(d, quad(d, tilt, tn), mm);
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        printf("mirror up %g (want 2)\n", px(16, 16)[0]);
+        CHECK(near_(px(16, 16)[0], 2.0f, 0.03f), "mirror reflects the upper half: %g (want 2)", px(16, 16)[0]);
+        const float flip[12] = {-1, 0.6f, -2.5f, 1, 0.6f, -2.5f, 1, -1.2f, -3.5f, -1, -1.2f, -3.5f};
+        const float fn[3] = {0, -0.866f, 0.5f};
+        MUST(sy_gl_instance_destroy(d, mi));
+        mi = place(d, quad(d, flip, fn), mm);
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        CHECK(near_(px(16, 16)[0], 0.5f, 0.03f), "mirror reflects the lower half: %g (want 0.5)", px(16, 16)[0]);
+        MUST(sy_gl_instance_destroy(d, mi));
+        sy_gl_set_environment(d, (sy_gl_texture){0}, 0.0f);
+    }
+
+    /* 3. a square emitter (half-size 0.5) 1 above a Lambert floor; camera looking down */
+    {
+        sy_gl_camera top = {.camera_to_world = {1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 5, 0, 1}, .window = {-0.2f, 0.2f, -0.2f, 0.2f},
+                            .near_clip = 0.1f};
+        const float floor_q[12] = {-5, 0, 5, 5, 0, 5, 5, 0, -5, -5, 0, -5};
+        const float ny[3] = {0, 1, 0};
+        sy_gl_instance fl = place(d, quad(d, floor_q, ny), lambert(d, 0.5f));
+        /* counter-clockwise seen from below: the front faces down */
+        sy_gl_area_light al = {.vertices = {{-0.5f, 1, -0.5f}, {0.5f, 1, -0.5f}, {0.5f, 1, 0.5f}, {-0.5f, 1, 0.5f}},
+                               .vertex_count = 4, .radiance = {10, 10, 10}};
+        MUST(sy_gl_set_area_lights(d, &al, 1, e, sizeof e));
+        MUST(sy_gl_render(d, &top, &full, rgba, depth, e, sizeof e));
+        float want = 0.5f * 10.0f * square_form_factor(0.5f, 1.0f);
+        printf("floor under a square light %g (want %g)\n", px(16, 16)[0], want);
+        CHECK(near_(px(16, 16)[0], want, 0.04f), "floor under a square light: %g (want %g)", px(16, 16)[0], want);
+        sy_gl_stats st;
+        sy_gl_device_stats(d, &st);
+        CHECK(st.shadow_maps == 1, "area light shadow maps %u", st.shadow_maps);
+        /* reversed winding: the front faces up, the floor is behind it and stays dark */
+        sy_gl_area_light up = al;
+        memcpy(up.vertices[1], al.vertices[3], sizeof up.vertices[1]);
+        memcpy(up.vertices[3], al.vertices[1], sizeof up.vertices[3]);
+        MUST(sy_gl_set_area_lights(d, &up, 1, e, sizeof e));
+        MUST(sy_gl_render(d, &top, &full, rgba, depth, e, sizeof e));
+        CHECK(px(16, 16)[0] == 0.0f, "one-sided emitter lights its back side: %g", px(16, 16)[0]);
+        up.double_sided = true;
+        MUST(sy_gl_set_area_lights(d, &up, 1, e, sizeof e));
+        MUST(sy_gl_render(d, &top, &full, rgba, depth, e, sizeof e));
+        CHECK(near_(px(16, 16)[0], want, 0.04f), "double-sided emitter: %g (want %g)", px(16, 16)[0], want);
+        /* an occluder between light and floor: the centre is in (soft) shadow */
+        const float occ_q[12] = {-0.3f, 0.5f, 0.3f, 0.3f, 0.5f, 0.3f, 0.3f, 0.5f, -0.3f, -0.3f, 0.5f, -0.3f};
+        sy_gl_instance oc = place(d, quad(d, occ_q, ny), lambert(d, 0.5f));
+        MUST(sy_gl_set_area_lights(d, &al, 1, e, sizeof e));
+        sy_gl_camera under = top;
+        under.camera_to_world[13] = 0.4f;
+        under.window[0] = under.window[2] = -2.0f, under.window[1] = under.window[3] = 2.0f;
+        MUST(sy_gl_render(d, &under, &full, rgba, depth, e, sizeof e));
+        printf("floor under an occluder %g (unshadowed %g)\n", px(16, 16)[0], want);
+        CHECK(px(16, 16)[0] < 0.5f * want, "floor under an occluder: %g (unshadowed %g)", px(16, 16)[0], want);
+        MUST(sy_gl_instance_destroy(d, oc));
+        MUST(sy_gl_instance_destroy(d, fl));
+        /* 4. refused input */
+        sy_gl_area_light bad = al;
+        bad.radiance[1] = -1.0f;
+        CHECK(sy_gl_set_area_lights(d, &bad, 1, e, sizeof e) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "area light 0") &&
+                  strstr(e, "radiance[1]"),
+              "negative radiance: %s", e);
+        bad = al;
+        bad.vertices[2][0] = NAN;
+        CHECK(sy_gl_set_area_lights(d, &bad, 1, e, sizeof e) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "vertex 2"),
+              "NaN vertex: %s", e);
+        CHECK(sy_gl_set_area_lights(d, &al, SY_GL_MAX_AREA_LIGHTS + 1, e, sizeof e) == SY_GL_ERROR_LIMIT, "cap: %s", e);
+    }
+    sy_gl_device_destroy(d);
+    if (failures) {
+        fprintf(stderr, "test_raster_light: %d check(s) failed\n", failures);
+        return 1;
+    }
+    printf("test_raster_light: all checks passed\n");
+    return 0;
+}
