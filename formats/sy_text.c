@@ -341,7 +341,7 @@ size_t sy_text_triangulate(const double *xy, size_t n, const size_t *ring_start,
             } while (p != list);
             holes[nh++] = left;
         }
-        qsort(holes, nh, sizeof *holes, cmp_leftmost);
+        if (nh) qsort(holes, nh, sizeof *holes, cmp_leftmost);
         for (size_t k = 0; k < nh; k++) {
             enode *bridge = e_bridge(holes[k], outer);
             if (!bridge) continue;
