@@ -2,6 +2,7 @@
 #include "sy_demo.h"
 
 #include "sy_look.h"
+#include "sy_world.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -187,18 +188,7 @@ static sy_result sky_texture(sy_scene *s, sy_texture *out, sy_error *err)
                 p[k] = ground[k] + (skyc - ground[k]) * b;
             }
         }
-    sy_blob *blob = NULL;
-    sy_result r = sy_blob_create_take(px, sizeof(float) * 3 * W * H, &blob, err);
-    if (r != SY_OK) {
-        free(px);
-        return r;
-    }
-    sy_image_info info = {W, H, 3, SY_PIXEL_F32};
-    sy_sampler smp = {SY_WRAP_REPEAT, SY_WRAP_CLAMP, SY_FILTER_LINEAR, SY_FILTER_LINEAR};
-    if ((r = sy_texture_create(s, "sky", out, err)) == SY_OK && (r = sy_texture_set_image(s, *out, &info, blob, err)) == SY_OK)
-        r = sy_texture_set_sampler(s, *out, &smp, err);
-    sy_blob_release(blob);
-    return r;
+    return sy_world_texture_take(s, "sky", px, W, H, out, err);
 }
 
 sy_result sy_demo_build(sy_scene *s, sy_demo_info *out, sy_error *err)

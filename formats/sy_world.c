@@ -13,8 +13,8 @@ bool sy_world_options_empty(const sy_world_options *o)
            !o->no_default_light;
 }
 
-static sy_result texture_from_rgb(sy_scene *s, const char *name, float *px, uint32_t w, uint32_t h, sy_texture *out,
-                                  sy_error *err)
+sy_result sy_world_texture_take(sy_scene *s, const char *name, float *px, uint32_t w, uint32_t h, sy_texture *out,
+                                sy_error *err)
 {
     sy_blob *blob = NULL;
     sy_result r = sy_blob_create_take(px, (size_t)w * h * 3 * sizeof *px, &blob, err);
@@ -72,7 +72,7 @@ sy_result sy_world_load_environment(sy_scene *s, const char *path, sy_texture *o
         free(px);
         return r;
     }
-    return texture_from_rgb(s, "environment", px, w, h, out, err);
+    return sy_world_texture_take(s, "environment", px, w, h, out, err);
 }
 
 static sy_result check_colour(const float *c, int n, const char *what, sy_error *err)
@@ -110,7 +110,7 @@ sy_result sy_world_apply(sy_scene *s, sy_background *world, const sy_world_optio
         float *px = malloc(3 * sizeof *px);
         if (!px) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "environment colour: out of memory");
         memcpy(px, o->env_color, 3 * sizeof *px);
-        if ((r = texture_from_rgb(s, "environment colour", px, 1, 1, &bd.environment, err))) return r;
+        if ((r = sy_world_texture_take(s, "environment colour", px, 1, 1, &bd.environment, err))) return r;
     }
     if (o->env_intensity_set) bd.intensity = o->env_intensity;
     if (o->env_hidden) bd.environment_visible = 0;

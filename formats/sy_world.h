@@ -34,6 +34,11 @@ bool sy_world_options_empty(const sy_world_options *o);
  * Errors name the file and the reason (unreadable, not lat-long, non-finite or negative texels). */
 sy_result sy_world_apply(sy_scene *s, sy_background *world, const sy_world_options *o, sy_error *err);
 
+/* Makes a new lat-long float RGB texture of s from px (w x h x 3 floats, row 0 = up), taking
+ * ownership of px (freed on failure too): the environment texture an application generates. */
+sy_result sy_world_texture_take(sy_scene *s, const char *name, float *px, uint32_t w, uint32_t h, sy_texture *out,
+                                sy_error *err);
+
 /* Reads a lat-long EXR environment map into a new float RGB texture of s. */
 sy_result sy_world_load_environment(sy_scene *s, const char *path, sy_texture *out, sy_error *err);
 
