@@ -109,7 +109,7 @@ const char *const sy_gl_main_fs =
     "  vec4 sp = l_shadow[si]; vec4 c0 = l_shadow_mat[si] * vec4(p, 1.0); r = 0.0; q = vec3(0.0); if (c0.w <= 0.0) return false;\n"
     "  float off = sp.x * (sp.y > 0.5 ? c0.w : 1.0);\n"
     "  r = sp.z / c0.w;\n" /* penumbra kernel (uv); its world size sp.w r w */
-    "  off = max(off, 0.5 * r * sp.w * c0.w);\n" /* offset the receiver by the kernel's footprint: no self-shadowing */
+    "  off = max(off, r * sp.w * c0.w);\n" /* offset the receiver by the kernel's world radius (r of uv = 2 t r w): no self-shadowing at any slope */
     "  vec4 c = l_shadow_mat[si] * vec4(p + ngf * off, 1.0); if (c.w <= 0.0) return false;\n"
     "  q = c.xyz / c.w * 0.5 + 0.5; return q.z < 1.0; }\n"
     "#endif\n"
@@ -294,7 +294,11 @@ const char *const sy_gl_main_fs =
     "#endif\n"
     "      vec3 R = reflect(-wo, ns);\n"
     "      vec3 irr = textureLod(t_env_irr, ns, 0.0).rgb;\n" /* cosine-weighted mean radiance = E / pi */
-    "      vec3 env = kd * (1.0 - fd_avg) * irr + fspec * env_spec(R, rough);\n"
+    /* the GGX lobe's dominant direction leans from R towards N as roughness grows (Lagarde and
+     * de Rousiers 2014, "Moving Frostbite to PBR", eq. 55); looking up R alone lights rough
+     * surfaces from below the horizon */
+    "      float ga = rough * rough; vec3 Rd = normalize(mix(ns, R, (1.0 - ga) * (sqrt(1.0 - ga) + ga)));\n"
+    "      vec3 env = kd * (1.0 - fd_avg) * irr + fspec * env_spec(Rd, rough);\n"
     "#ifdef SY_TRANS\n"
     "      {\n" /* glass: Fresnel reflection + refraction of the environment */
     "        float F = schlick1(f0d, nv);\n"

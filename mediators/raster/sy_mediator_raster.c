@@ -142,6 +142,7 @@ typedef struct raster_state {
     bool areas_dirty;
     uint32_t area_count;
     bool warned_area_cap;
+    bool indirect; /* "indirect" parameter: the emitters' indirect light estimate (below); 0 = direct light only */
 } raster_state;
 
 static sy_result gl_fail(sy_error *err, sy_gl_result r, const char *what, const char *msg)
@@ -597,7 +598,7 @@ static sy_result rebuild_area_lights(raster_state *st, sy_error *err)
      * side); the radiance is that / pi. Emitters are not counted as receivers. Computed when
      * emitters change (not when only other geometry moves). */
     float ambient[3] = {0, 0, 0};
-    if (r == SY_OK && n) {
+    if (r == SY_OK && n && st->indirect) {
         double phi[3] = {0, 0, 0}, area = 0.0, rho[3] = {0, 0, 0}, lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (size_t i = 0; i < n; ++i) {
             float lumv = 0.2126f * ps[i].l.radiance[0] + 0.7152f * ps[i].l.radiance[1] + 0.0722f * ps[i].l.radiance[2];
@@ -744,7 +745,7 @@ static void log_warning(void *user, const char *msg)
 static sy_result raster_create(const sy_mediator_create_args *args, void **state_out, sy_error *err)
 {
     *state_out = NULL;
-    long msaa, shadow, max_tex, ww, wh;
+    long msaa, shadow, max_tex, ww, wh, indirect;
     sy_result r;
     sy_gl_provider provider = SY_GL_PROVIDER_OSMESA;
     const char *gl = sy_params_get(args->params, "gl");
@@ -754,7 +755,8 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
         (r = sy_params_get_int(args->params, "shadow_map_size", 2048, 16, 16384, &shadow, err)) ||
         (r = sy_params_get_int(args->params, "max_texture_size", 0, 0, 1 << 20, &max_tex, err)) ||
         (r = sy_params_get_int(args->params, "window_width", 640, 1, 16384, &ww, err)) ||
-        (r = sy_params_get_int(args->params, "window_height", 480, 1, 16384, &wh, err)))
+        (r = sy_params_get_int(args->params, "window_height", 480, 1, 16384, &wh, err)) ||
+        (r = sy_params_get_int(args->params, "indirect", 1, 0, 1, &indirect, err)))
         return r;
     raster_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster mediator: out of memory");
@@ -763,6 +765,7 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
     st->insts.elem = sizeof(einst);
     st->texs.elem = sizeof(etex);
     st->albs.elem = sizeof(ealb);
+    st->indirect = indirect != 0;
     char e[ERRLEN];
     sy_gl_device_desc dd = {.provider = provider,
                             .msaa = (uint32_t)msaa,

@@ -21,15 +21,12 @@
 
 #define ERRLEN 256
 
-/* Whitted's default anti-aliasing: 1 camera ray through the pixel centre. spp=4 (4 stratified rays,
- * one per pixel quadrant) removes the staircases of the demo's edges at 4x the primary-ray cost
- * (the area-light budget, light_samples per pixel, is shared among them) and is what the CLI should
- * ask for; the default stays 1 because with jittered rays the depth and coverage of an edge pixel
- * no longer come from its centre (the pixel convention raster/Whitted alignment, IoU >= 0.99, and
- * depth compositing rely on: tests/raster/test_raster_align.c fails at spp=4), and
- * tests/integration/test_viewport.c checks exact colours of edge pixels. Open: depth from the
- * centre ray with colour averaged over the strata. */
-#define WHITTED_DEFAULT_SPP 1
+/* Whitted's default anti-aliasing: 4 stratified camera rays per pixel (one per quadrant, Sobol
+ * jittered), sharing the pixel's area-light budget (light_samples); colour and alpha average them,
+ * depth and coverage come from the pixel centre (backends/rt/sy_rt_whitted.c), so edges are smooth
+ * while raster / Whitted alignment and depth compositing keep their pixel convention. spp=1 traces
+ * the centre ray alone. */
+#define WHITTED_DEFAULT_SPP 4
 
 /* Path tracer: one accumulation per distinct request (camera, sizes, rectangle, background, seed);
  * a few are kept so that viewports sharing this context (stereo eyes, tiles) do not evict each

@@ -180,8 +180,10 @@ static void test_layered(void)
     sy_window *win;
     sy_viewport *va, *vb;
     MUST(sy_window_create(LW, LH, &win, err));
-    sy_viewport_desc da = {.root = a, .camera = cam, .backend = "whitted", .composite = SY_COMPOSITE_REPLACE};
-    sy_viewport_desc db = {.root = b, .camera = cam, .backend = "whitted", .composite = SY_COMPOSITE_ALPHA_OVER};
+    /* spp=1: one centre ray per pixel, so edge pixels are exactly one quad's colour and the checks
+     * below see compositing alone (the default 4 strata blend colours at edges) */
+    sy_viewport_desc da = {.root = a, .camera = cam, .backend = "whitted", .params = "spp=1", .composite = SY_COMPOSITE_REPLACE};
+    sy_viewport_desc db = {.root = b, .camera = cam, .backend = "whitted", .params = "spp=1", .composite = SY_COMPOSITE_ALPHA_OVER};
     MUST(sy_window_add_viewport(win, &da, &va, err));
     MUST(sy_window_add_viewport(win, &db, &vb, err));
     CHECK(sy_window_viewport_count(win) == 2 && sy_window_viewport(win, 1) == vb);
@@ -255,11 +257,11 @@ static void test_layered(void)
     MUST(sy_window_render(win, s, pool, NULL, &again, err)); /* still renders with the old back-end */
     CHECK(it_layers_identical(&img, &again));
     /* switching to other parameters makes one new context; switching back reuses the cached one */
-    MUST(sy_viewport_set_backend(vb, "whitted", "max_depth=2", err));
+    MUST(sy_viewport_set_backend(vb, "whitted", "spp=1,max_depth=2", err));
     MUST(sy_window_render(win, s, pool, NULL, &again, err));
     CHECK(sy_context_pool_size(pool) == 3);
     CHECK(it_layers_identical(&img, &again));
-    MUST(sy_viewport_set_backend(vb, "whitted", NULL, err));
+    MUST(sy_viewport_set_backend(vb, "whitted", "spp=1", err));
     MUST(sy_window_render(win, s, pool, NULL, &again, err));
     CHECK(sy_context_pool_size(pool) == 3);
     CHECK(it_layers_identical(&img, &again));
@@ -359,8 +361,9 @@ static void test_stereo_render(void)
     sy_window *win;
     sy_viewport *vl, *vr;
     MUST(sy_window_create(2 * half, h, &win, err));
+    /* spp=1: hard edges, so the centroids below measure the frusta alone */
     sy_viewport_desc d = {.width = half, .height = h, .root = root, .camera = cam, .backend = "whitted",
-                          .eye = SY_EYE_LEFT, .eye_separation = sep, .zero_parallax = zp};
+                          .params = "spp=1", .eye = SY_EYE_LEFT, .eye_separation = sep, .zero_parallax = zp};
     MUST(sy_window_add_viewport(win, &d, &vl, err));
     d.x = half;
     d.eye = SY_EYE_RIGHT;
