@@ -49,9 +49,12 @@
  * Shadows: directional and spot lights and area lights (from the polygon's centre along its
  * normal, a 150-degree frustum; a Poisson PCF whose radius grows with the polygon's size and the
  * receiver's distance, an approximation of the penumbra without a blocker search) share
- * SY_GL_MAX_SHADOW_MAPS maps, punctual lights first; point lights cast no shadow. Alpha-masked
- * casters honour the mask; blended and transmissive casters shadow like opaque ones; emitters cast
- * no shadow (they are the lights, as in the ray tracers).
+ * SY_GL_MAX_SHADOW_MAPS maps, punctual lights first; the first SY_GL_MAX_CUBE_SHADOWS point lights
+ * get cube shadows (six 90-degree faces of half the map size, 3 x 3 PCF). Alpha-masked
+ * casters honour the mask; alpha-blended casters block where their opacity reaches the cutoff (the
+ * ray tracers let 1 - alpha through; a depth map can only threshold it); transmissive casters
+ * (transmission x (1 - metallic) >= 0.5) and emitters cast none, as in the ray tracers, whose
+ * shadow rays pass glass with its transmittance and treat emitters as the lights.
  *
  * Output: sy_gl_render fills RGBA float (linear, premultiplied, row 0 = top) and depth (linear
  * distance along the viewing axis, +INFINITY where nothing was drawn) for a sub-rectangle of the
@@ -239,6 +242,7 @@ typedef struct sy_gl_light_desc {
 } sy_gl_light_desc;
 #define SY_GL_MAX_LIGHTS 32
 #define SY_GL_MAX_SHADOW_MAPS 4 /* the first spot/directional lights, then area lights, get shadow maps */
+#define SY_GL_MAX_CUBE_SHADOWS 2 /* the first point lights get cube shadow maps (6 faces, half the map size) */
 sy_gl_result sy_gl_light_create(sy_gl_device *dev, const sy_gl_light_desc *desc, sy_gl_light *out, char *err,
                                 size_t err_len);
 sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_gl_light_desc *desc, char *err,

@@ -18,7 +18,7 @@
 #define IDX_MASK ((1u << IDX_BITS) - 1u)
 #define SHADOW_SIZE_DEFAULT 2048u
 enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_ENV_SPEC, UNIT_ENV_IRR, UNIT_BRDF,
-       UNIT_LTC1, UNIT_LTC2, UNIT_COUNT };
+       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW, UNIT_COUNT };
 enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1, BIND_AREAS = 2 };
 
 static sy_gl_result fail(char *err, size_t len, sy_gl_result r, const char *fmt, ...)
@@ -174,6 +174,8 @@ struct sy_gl_device {
     } uf;
     GLuint default_ubo, lights_ubo, white_tex, flat_normal_tex, empty_vao;
     GLuint shadow_tex, shadow_fbo;
+    GLuint cube_tex; /* point-light cube shadows: 6 layers per light (+X -X +Y -Y +Z -Z), made on first use */
+    uint32_t cube_size;
     targets t;
     bool lights_dirty;
     /* background (camera rays only) */
@@ -287,6 +289,35 @@ static void cross3(const float *a, const float *b, float *o)
 }
 
 /* World-to-light view looking from eye along dir. */
+enum { CASTER_NONE, CASTER_OPAQUE, CASTER_MASKED };
+
+/* How a material casts shadows in the shadow maps (render_shadow_layer). */
+static int caster_kind(const sy_gl_material_desc *d)
+{
+    if (d->emissive[0] > 0.0f || d->emissive[1] > 0.0f || d->emissive[2] > 0.0f) return CASTER_NONE;
+    if (d->transmission * (1.0f - d->metallic) >= 0.5f) return CASTER_NONE;
+    return d->alpha_mode == SY_GL_ALPHA_OPAQUE ? CASTER_OPAQUE : CASTER_MASKED;
+}
+
+/* A depth texture array compared in the shader (hardware PCF); outside it reads as lit. */
+static GLuint shadow_array(const sy_gl_fns *gl, uint32_t size, uint32_t layers)
+{
+    GLuint t = 0;
+    gl->GenTextures(1, &t);
+    gl->BindTexture(GL_TEXTURE_2D_ARRAY, t);
+    gl->TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT32F, (GLsizei)size, (GLsizei)size, (GLsizei)layers, 0,
+                   GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    static const float border[4] = {1, 1, 1, 1};
+    gl->TexParameterfv(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_BORDER_COLOR, border);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    return t;
+}
+
 static void look_along(const float *eye, const float *dir, float *view)
 {
     float z[3] = {-dir[0], -dir[1], -dir[2]}, up[3] = {0, 1, 0}, x[3], y[3];
@@ -410,7 +441,7 @@ static void material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
 static void bind_samplers(const sy_gl_fns *gl, GLuint prog)
 {
     static const char *names[UNIT_COUNT] = {"t_base", "t_mr",       "t_nrm",     "t_occ",  "t_emis", "t_shadow",
-                                            "t_env_spec", "t_env_irr", "t_brdf", "t_ltc1", "t_ltc2"};
+                                            "t_env_spec", "t_env_irr", "t_brdf", "t_ltc1", "t_ltc2", "t_cshadow"};
     gl->UseProgram(prog);
     for (int i = 0; i < UNIT_COUNT; ++i) {
         GLint loc = gl->GetUniformLocation(prog, names[i]);
@@ -484,7 +515,11 @@ static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
     return p;
 }
 
-#define LIGHTS_FLOATS 600 /* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes */
+/* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes, then the cube faces' matrices and
+ * their parameters (SY_GL_MAX_CUBE_SHADOWS x (6 x 64 + 16) bytes) */
+#define LIGHTS_CUBE_MAT 600
+#define LIGHTS_CUBE_PAR (LIGHTS_CUBE_MAT + 6 * 16 * SY_GL_MAX_CUBE_SHADOWS)
+#define LIGHTS_FLOATS (LIGHTS_CUBE_PAR + 4 * SY_GL_MAX_CUBE_SHADOWS)
 #define AREAS_FLOATS (8 + SY_GL_MAX_AREA_LIGHTS * 6 * 4) /* std140 Areas block: ivec4 + vec4 + vec4[16 * 6] */
 
 sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **out, char *err, size_t err_len)
@@ -572,18 +607,8 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     gl->BufferData(GL_UNIFORM_BUFFER, AREAS_FLOATS * sizeof(float), NULL, GL_DYNAMIC_DRAW);
     gl->GenVertexArrays(1, &dev->empty_vao);
     /* shadow maps: one depth texture array, compared in the shader (hardware PCF) */
-    gl->GenTextures(1, &dev->shadow_tex);
-    gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->shadow_tex);
-    gl->TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT32F, (GLsizei)dev->shadow_size, (GLsizei)dev->shadow_size,
-                   SY_GL_MAX_SHADOW_MAPS, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
-    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-    static const float border[4] = {1, 1, 1, 1};
-    gl->TexParameterfv(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_BORDER_COLOR, border);
-    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-    gl->TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    dev->shadow_tex = shadow_array(gl, dev->shadow_size, SY_GL_MAX_SHADOW_MAPS);
+    dev->cube_size = dev->shadow_size / 2u > 16u ? dev->shadow_size / 2u : 16u;
     gl->GenFramebuffers(1, &dev->shadow_fbo);
     dev->lights_dirty = true;
     if ((r = gl_check(dev, "GL device setup", err, err_len)) != SY_GL_OK) {
@@ -631,9 +656,10 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         for (int i = 0; i < 5; ++i)
             if (progs[i]) gl->DeleteProgram(progs[i]);
         sy_gl_ibl_free(gl, &dev->ibl);
-        GLuint bufs[3] = {dev->default_ubo, dev->lights_ubo, dev->areas_ubo}, texs[3] = {dev->white_tex, dev->flat_normal_tex, dev->shadow_tex};
+        GLuint bufs[3] = {dev->default_ubo, dev->lights_ubo, dev->areas_ubo};
+        GLuint texs[4] = {dev->white_tex, dev->flat_normal_tex, dev->shadow_tex, dev->cube_tex};
         gl->DeleteBuffers(3, bufs);
-        gl->DeleteTextures(3, texs);
+        gl->DeleteTextures(dev->cube_tex ? 4 : 3, texs);
         gl->DeleteFramebuffers(1, &dev->shadow_fbo);
         gl->DeleteVertexArrays(1, &dev->empty_vao);
     }
@@ -983,7 +1009,7 @@ sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const 
     sy_gl_result r = material_check(d, err, err_len);
     if (r == SY_GL_OK) r = current(dev, err, err_len);
     if (r != SY_GL_OK) return r;
-    bool shadows = m->d.alpha_mode == SY_GL_ALPHA_MASK || d->alpha_mode == SY_GL_ALPHA_MASK ||
+    bool shadows = caster_kind(&m->d) != caster_kind(d) || m->d.alpha_mode != SY_GL_ALPHA_OPAQUE ||
                    memcmp(m->d.emissive, d->emissive, sizeof d->emissive) != 0;
     m->d = *d;
     material_upload(dev, m, false);
@@ -1244,6 +1270,8 @@ static void scene_bounds(const sy_gl_device *dev, float *c, float *radius)
 typedef struct frame_state {
     float shadow_vp[SY_GL_MAX_SHADOW_MAPS][16];
     uint32_t shadow_count;
+    float cube_vp[6 * SY_GL_MAX_CUBE_SHADOWS][16];
+    uint32_t cube_count; /* point lights with a cube shadow */
 } frame_state;
 
 /* Lights UBO (+ shadow matrices from the scene bounds). One upload. */
@@ -1277,6 +1305,31 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
         o[12] = 1.0f / fmaxf(0.001f, ci - co);
         o[13] = -co * o[12];
         o[14] = -1.0f;
+        o[15] = -1.0f;
+        if (d->type == SY_GL_LIGHT_POINT && !d->no_shadow && fs->cube_count < SY_GL_MAX_CUBE_SHADOWS) {
+            /* six 90-degree faces along the axes (look_along keeps them axis-aligned), widened by a
+             * few texels so that PCF taps at a face's edge stay inside it; the shader picks the
+             * face by the major axis of (point - light) */
+            uint32_t slot = fs->cube_count++;
+            float S = (float)dev->cube_size, t = 1.0f + 4.0f / S;
+            float dc = sqrtf((d->position[0] - c[0]) * (d->position[0] - c[0]) +
+                             (d->position[1] - c[1]) * (d->position[1] - c[1]) +
+                             (d->position[2] - c[2]) * (d->position[2] - c[2]));
+            double far = dc + R, nearp = fmax(1e-3 * far, 1e-4);
+            float proj[16];
+            projection(false, -t, t, -t, t, nearp, far, proj);
+            for (int f = 0; f < 6; ++f) {
+                float axis[3] = {0, 0, 0}, view[16];
+                axis[f / 2] = (f & 1) ? -1.0f : 1.0f;
+                look_along(d->position, axis, view);
+                m4_mul(proj, view, fs->cube_vp[6 * slot + (uint32_t)f]);
+                memcpy(blk + LIGHTS_CUBE_MAT + 16 * (6 * slot + (uint32_t)f), fs->cube_vp[6 * slot + (uint32_t)f],
+                       16 * sizeof(float));
+            }
+            blk[LIGHTS_CUBE_PAR + 4 * slot] = 1.5f * 2.0f * t / S; /* normal offset per unit distance */
+            blk[LIGHTS_CUBE_PAR + 4 * slot + 1] = 1.0f;
+            o[15] = (float)slot;
+        }
         if (d->type != SY_GL_LIGHT_POINT && !d->no_shadow && ns < SY_GL_MAX_SHADOW_MAPS) {
             float view[16], proj[16];
             float S = (float)dev->shadow_size;
@@ -1360,7 +1413,7 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
     ab[7] = 0.0f;
     fs->shadow_count = ns;
     dev->light_count = n;
-    dev->shadow_count = ns_punctual;
+    dev->shadow_count = ns_punctual + fs->cube_count;
     dev->area_shadow_count = ns - ns_punctual;
     dev->gl->BindBuffer(GL_UNIFORM_BUFFER, dev->lights_ubo);
     dev->gl->BufferSubData(GL_UNIFORM_BUFFER, 0, sizeof blk, blk);
@@ -1402,41 +1455,55 @@ static const mat_o *bind_material(sy_gl_device *dev, sy_gl_material id, bool all
     return m;
 }
 
+/* Depth of every shadow caster into one layer of a depth texture array, seen through vp. Casters
+ * as the ray tracers' shadow rays see them (backends/rt/sy_rt_shadow.c): opaque ones block;
+ * alpha-masked ones block where the mask keeps them; alpha-blended ones let 1 - alpha through,
+ * which a depth map can only threshold (opacity >= the cutoff, 0.5 unless set, blocks);
+ * transmissive ones (transmission x (1 - metallic) >= 0.5) let their tinted transmittance through
+ * and cast none; emitters are the lights and cast none either. */
+static void render_shadow_layer(sy_gl_device *dev, GLuint tex, uint32_t layer, const float *vp)
+{
+    const sy_gl_fns *gl = dev->gl;
+    gl->FramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, tex, 0, (GLint)layer);
+    gl->Clear(GL_DEPTH_BUFFER_BIT);
+    for (int v = 0; v < 2; ++v) {
+        gl->UseProgram(dev->ps[v].prog);
+        gl->UniformMatrix4fv(dev->ps[v].lightvp, 1, GL_FALSE, vp);
+        for (uint32_t i = 0; i < dev->instances.count; ++i) {
+            const inst_o *in = pool_at(&dev->instances, i);
+            if (!in->h.id || !in->visible) continue;
+            const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
+            const mat_o *mt = pool_get(&dev->materials, in->material.id);
+            int kind = mt ? caster_kind(&mt->d) : CASTER_OPAQUE;
+            if (!m || kind == CASTER_NONE || (kind == CASTER_MASKED) != (v == 1)) continue;
+            bind_material(dev, in->material, false);
+            gl->UniformMatrix4fv(dev->ps[v].model, 1, GL_FALSE, in->model);
+            draw_mesh(dev, m);
+        }
+    }
+}
+
 static void render_shadows(sy_gl_device *dev, const frame_state *fs)
 {
     const sy_gl_fns *gl = dev->gl;
     gl->BindFramebuffer(GL_FRAMEBUFFER, dev->shadow_fbo);
     gl->DrawBuffer(GL_NONE);
     gl->ReadBuffer(GL_NONE);
-    gl->Viewport(0, 0, (GLsizei)dev->shadow_size, (GLsizei)dev->shadow_size);
     gl->Enable(GL_DEPTH_TEST);
     gl->DepthFunc(GL_LESS);
     gl->DepthMask(GL_TRUE);
     gl->Disable(GL_BLEND);
     gl->Enable(GL_POLYGON_OFFSET_FILL);
     gl->PolygonOffset(1.5f, 4.0f);
-    for (uint32_t s = 0; s < fs->shadow_count; ++s) {
-        gl->FramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, dev->shadow_tex, 0, (GLint)s);
-        gl->Clear(GL_DEPTH_BUFFER_BIT);
-        for (int v = 0; v < 2; ++v) {
-            gl->UseProgram(dev->ps[v].prog);
-            gl->UniformMatrix4fv(dev->ps[v].lightvp, 1, GL_FALSE, fs->shadow_vp[s]);
-            for (uint32_t i = 0; i < dev->instances.count; ++i) {
-                const inst_o *in = pool_at(&dev->instances, i);
-                if (!in->h.id || !in->visible) continue;
-                const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
-                const mat_o *mt = pool_get(&dev->materials, in->material.id);
-                if (!m || (mt && mt->d.alpha_mode == SY_GL_ALPHA_MASK) != (v == 1)) continue;
-                if (mt && (mt->d.emissive[0] > 0.0f || mt->d.emissive[1] > 0.0f || mt->d.emissive[2] > 0.0f))
-                    continue; /* emitters are lights in the ray tracers: they cast no shadow there either */
-                bind_material(dev, in->material, false);
-                gl->UniformMatrix4fv(dev->ps[v].model, 1, GL_FALSE, in->model);
-                draw_mesh(dev, m);
-            }
-        }
+    gl->Viewport(0, 0, (GLsizei)dev->shadow_size, (GLsizei)dev->shadow_size);
+    for (uint32_t s = 0; s < fs->shadow_count; ++s) render_shadow_layer(dev, dev->shadow_tex, s, fs->shadow_vp[s]);
+    if (fs->cube_count) {
+        if (!dev->cube_tex) dev->cube_tex = shadow_array(gl, dev->cube_size, 6u * SY_GL_MAX_CUBE_SHADOWS);
+        gl->Viewport(0, 0, (GLsizei)dev->cube_size, (GLsizei)dev->cube_size);
+        for (uint32_t f = 0; f < 6u * fs->cube_count; ++f) render_shadow_layer(dev, dev->cube_tex, f, fs->cube_vp[f]);
     }
     gl->Disable(GL_POLYGON_OFFSET_FILL);
-    dev->shadow_maps = fs->shadow_count;
+    dev->shadow_maps = fs->shadow_count + 6u * fs->cube_count;
 }
 
 static void frame_end(sy_gl_device *dev)
@@ -1748,7 +1815,7 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     if (dev->area_count && (r = sy_gl_ibl_tables(gl, &dev->ibl, err, err_len)) != SY_GL_OK) return r;
     if (dev->lights_dirty) {
         lights_upload(dev, &fs);
-        if (fs.shadow_count) render_shadows(dev, &fs);
+        if (fs.shadow_count || fs.cube_count) render_shadows(dev, &fs);
         else dev->shadow_maps = 0;
         dev->lights_dirty = false;
     }
@@ -1759,6 +1826,8 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_AREAS, dev->areas_ubo);
     gl->ActiveTexture(GL_TEXTURE0 + UNIT_SHADOW);
     gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->shadow_tex);
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_CUBE_SHADOW);
+    gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->cube_tex ? dev->cube_tex : dev->shadow_tex);
     gl->ActiveTexture(GL_TEXTURE0 + UNIT_ENV_SPEC);
     gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->ibl.spec_cube);
     gl->ActiveTexture(GL_TEXTURE0 + UNIT_ENV_IRR);

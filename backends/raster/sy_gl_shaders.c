@@ -72,10 +72,10 @@ const char *const sy_gl_main_fs =
     "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_MATERIAL_BLOCK
     "struct Light { vec4 pos_type; vec4 dir_range; vec4 radiant; vec4 cone; };\n"
     "layout(std140) uniform Lights { ivec4 l_count; vec4 l_env; mat4 l_shadow_mat[4]; vec4 l_shadow[4];\n"
-    "  Light l_lights[32]; };\n"
+    "  Light l_lights[32]; mat4 l_cube_mat[12]; vec4 l_cube[2]; };\n" /* cube faces (+X -X +Y -Y +Z -Z) of SY_GL_MAX_CUBE_SHADOWS point lights */
     /* area lights: 4 vertices (xyz, w unused), radiance (rgb, w = double-sided), centre (xyz, w = shadow map or -1) */
     "layout(std140) uniform Areas { ivec4 a_count; vec4 a_dir; vec4 a_data[16 * 6]; };\n"
-    "uniform sampler2DArrayShadow t_shadow;\n"
+    "uniform sampler2DArrayShadow t_shadow, t_cshadow;\n"
     "uniform samplerCube t_env_spec, t_env_irr; uniform sampler2D t_brdf, t_ltc1, t_ltc2;\n"
     "uniform vec3 u_cam_pos; uniform vec3 u_cam_fwd; uniform bool u_ortho; uniform bool u_mirror;\n"
     "uniform bool u_has_normals; uniform vec3 u_ortho_z;\n" /* orthographic: proj[10], proj[14] */
@@ -105,13 +105,15 @@ const char *const sy_gl_main_fs =
     "#if defined(SY_SHADOW) || defined(SY_ASHADOW)\n"
     /* sp.x: normal offset (x w in perspective when sp.y > 0.5); sp.z: area-light penumbra scale
      * (radius in shadow-map uv = sp.z / w); sp.w: 2 tan(half fov). Returns the light-space position. */
-    "bool shadow_coord(int si, vec3 p, vec3 ngf, out vec3 q, out float r) {\n"
-    "  vec4 sp = l_shadow[si]; vec4 c0 = l_shadow_mat[si] * vec4(p, 1.0); r = 0.0; q = vec3(0.0); if (c0.w <= 0.0) return false;\n"
+    "bool proj_coord(mat4 M, vec4 sp, vec3 p, vec3 ngf, out vec3 q, out float r) {\n"
+    "  vec4 c0 = M * vec4(p, 1.0); r = 0.0; q = vec3(0.0); if (c0.w <= 0.0) return false;\n"
     "  float off = sp.x * (sp.y > 0.5 ? c0.w : 1.0);\n"
     "  r = sp.z / c0.w;\n" /* penumbra kernel (uv); its world size sp.w r w */
     "  off = max(off, r * sp.w * c0.w);\n" /* offset the receiver by the kernel's world radius (r of uv = 2 t r w): no self-shadowing at any slope */
-    "  vec4 c = l_shadow_mat[si] * vec4(p + ngf * off, 1.0); if (c.w <= 0.0) return false;\n"
+    "  vec4 c = M * vec4(p + ngf * off, 1.0); if (c.w <= 0.0) return false;\n"
     "  q = c.xyz / c.w * 0.5 + 0.5; return q.z < 1.0; }\n"
+    "bool shadow_coord(int si, vec3 p, vec3 ngf, out vec3 q, out float r) {\n"
+    "  return proj_coord(l_shadow_mat[si], l_shadow[si], p, ngf, q, r); }\n"
     "#endif\n"
     "#ifdef SY_SHADOW\n" /* punctual lights: 3 x 3 hardware PCF */
     "float shadow_vis(int si, vec3 p, vec3 ngf) {\n"
@@ -119,6 +121,16 @@ const char *const sy_gl_main_fs =
     "  float s = 0.0; vec2 ts = 1.0 / vec2(textureSize(t_shadow, 0).xy);\n"
     "  for (int y = -1; y <= 1; ++y) for (int x = -1; x <= 1; ++x)\n"
     "    s += texture(t_shadow, vec4(q.xy + vec2(x, y) * ts, float(si), q.z));\n"
+    "  return s / 9.0; }\n"
+    /* point lights: the cube face of the major axis of (p - light), 3 x 3 hardware PCF */
+    "float cube_vis(int slot, vec3 lp, vec3 p, vec3 ngf) {\n"
+    "  vec3 d = p - lp, ad = abs(d); int f = ad.x >= ad.y && ad.x >= ad.z ? (d.x > 0.0 ? 0 : 1)\n"
+    "    : ad.y >= ad.z ? (d.y > 0.0 ? 2 : 3) : (d.z > 0.0 ? 4 : 5);\n"
+    "  int layer = slot * 6 + f; vec3 q; float r;\n"
+    "  if (!proj_coord(l_cube_mat[layer], l_cube[slot], p, ngf, q, r)) return 1.0;\n"
+    "  float s = 0.0; vec2 ts = 1.0 / vec2(textureSize(t_cshadow, 0).xy);\n"
+    "  for (int y = -1; y <= 1; ++y) for (int x = -1; x <= 1; ++x)\n"
+    "    s += texture(t_cshadow, vec4(q.xy + vec2(x, y) * ts, float(layer), q.z));\n"
     "  return s / 9.0; }\n"
     "#endif\n"
     "#ifdef SY_ASHADOW\n" /* area lights: 8 Poisson taps (hardware PCF each) over the penumbra */
@@ -227,7 +239,8 @@ const char *const sy_gl_main_fs =
     "      }\n"
     "      float cs = dot(ns, wi); if (cs <= 0.0 || dot(ngf, wi) <= 0.0) continue;\n"
     "#ifdef SY_SHADOW\n"
-    "      int si = int(l.cone.z); float vis = si >= 0 ? shadow_vis(si, v_wpos, ngf) : 1.0;\n"
+    "      int si = int(l.cone.z), ci = int(l.cone.w);\n"
+    "      float vis = si >= 0 ? shadow_vis(si, v_wpos, ngf) : ci >= 0 ? cube_vis(ci, l.pos_type.xyz, v_wpos, ngf) : 1.0;\n"
     "      if (vis <= 0.0) continue;\n"
     "#else\n"
     "      float vis = 1.0;\n"
