@@ -18,7 +18,16 @@
 #define IDX_MASK ((1u << IDX_BITS) - 1u)
 #define SHADOW_SIZE_DEFAULT 2048u
 enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_ENV_SPEC, UNIT_ENV_IRR, UNIT_BRDF,
-       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW, UNIT_COUNT };
+       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW, UNIT_PROBE, UNIT_COUNT };
+/* Scene probes: mirror-like and glass instances see the scene, not only the environment. Each of
+ * the first SY_GL_MAX_PROBES such instances gets a cube map of PROBE_SIZE texels per side rendered
+ * from its bounding-box centre (the instance itself left out, other probed instances showing the
+ * environment), with a mip chain for roughness; re-rendered only when geometry, materials, lights
+ * or the environment change, never for a camera move. */
+#define SY_GL_MAX_PROBES 4u
+#define PROBE_SIZE 256u
+#define PROBE_LEVELS 9u /* 256 .. 1 */
+#define PROBE_MAX_ROUGHNESS 0.4f
 enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1, BIND_AREAS = 2 };
 
 static sy_gl_result fail(char *err, size_t len, sy_gl_result r, const char *fmt, ...)
@@ -142,8 +151,9 @@ enum {
     VAR_NL_MAX = 7,
     VAR_AREA = 1024,    /* emissive polygons (LTC) */
     VAR_ASHADOW = 2048, /* area-light shadow maps (only with VAR_AREA) */
-    VAR_TRANS = 4096,   /* the material transmits (refracts the environment; only with VAR_ENV) */
-    VAR_COUNT = 8192
+    VAR_TRANS = 4096,   /* the material transmits (refracts the environment; only with VAR_ENV or VAR_PROBE) */
+    VAR_PROBE = 8192,   /* the instance reflects and refracts its own scene probe instead of the environment */
+    VAR_COUNT = 16384
 };
 
 struct sy_gl_device {
@@ -157,7 +167,7 @@ struct sy_gl_device {
     GLuint prog_resolve, prog_floor;
     struct { /* main-pass variants, built on first use, indexed by VAR_* bits (main_program) */
         GLuint prog;
-        GLint model, normal_mat, mvp, cam_pos, cam_fwd, ortho, ortho_z, mirror, has_normals;
+        GLint model, normal_mat, mvp, cam_pos, cam_fwd, ortho, ortho_z, mirror, has_normals, probe_lod;
         uint64_t frame; /* the frame whose view uniforms it holds */
     } pm[VAR_COUNT];
     uint64_t frame_no;
@@ -176,6 +186,13 @@ struct sy_gl_device {
     GLuint shadow_tex, shadow_fbo;
     GLuint cube_tex; /* point-light cube shadows: 6 layers per light (+X -X +Y -Y +Z -Z), made on first use */
     uint32_t cube_size;
+    struct {
+        GLuint cube;
+        uint32_t inst; /* instance pool index */
+    } probes[SY_GL_MAX_PROBES];
+    uint32_t probe_count;
+    GLuint probe_fbo, probe_depth;
+    bool probes_dirty, in_probe_pass;
     targets t;
     bool lights_dirty;
     /* background (camera rays only) */
@@ -441,7 +458,8 @@ static void material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
 static void bind_samplers(const sy_gl_fns *gl, GLuint prog)
 {
     static const char *names[UNIT_COUNT] = {"t_base", "t_mr",       "t_nrm",     "t_occ",  "t_emis", "t_shadow",
-                                            "t_env_spec", "t_env_irr", "t_brdf", "t_ltc1", "t_ltc2", "t_cshadow"};
+                                            "t_env_spec", "t_env_irr", "t_brdf", "t_ltc1", "t_ltc2", "t_cshadow",
+                                            "t_probe"};
     gl->UseProgram(prog);
     for (int i = 0; i < UNIT_COUNT; ++i) {
         GLint loc = gl->GetUniformLocation(prog, names[i]);
@@ -458,11 +476,11 @@ static void bind_samplers(const sy_gl_fns *gl, GLuint prog)
 /* Drops variant bits that cannot matter, so that equivalent draws share one program. */
 static int variant_normalize(int v)
 {
-    if (!(v & (VAR_LIGHTS | VAR_ENV | VAR_AREA)) || !(v & VAR_TEX)) v &= ~VAR_NMAP;
+    if (!(v & (VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_PROBE)) || !(v & VAR_TEX)) v &= ~VAR_NMAP;
     if (!(v & VAR_LIGHTS)) v &= ~(7 << VAR_NL_SHIFT);
     if (!(v & VAR_LIGHTS)) v &= ~VAR_SHADOW;
     if (!(v & VAR_AREA)) v &= ~VAR_ASHADOW;
-    if (!(v & VAR_ENV)) v &= ~VAR_TRANS;
+    if (!(v & (VAR_ENV | VAR_PROBE))) v &= ~VAR_TRANS;
     return v;
 }
 
@@ -492,6 +510,10 @@ static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
         dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_ASHADOW 1\n");
         nl += (size_t)snprintf(name + nl, sizeof name - nl, " ASHADOW");
     }
+    if (v & VAR_PROBE) {
+        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_PROBE 1\n");
+        nl += (size_t)snprintf(name + nl, sizeof name - nl, " PROBE");
+    }
     int nlights = (v >> VAR_NL_SHIFT) & 7;
     if (nlights) {
         dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_NLIGHTS %d\n", nlights);
@@ -510,6 +532,7 @@ static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
     dev->pm[v].ortho_z = gl->GetUniformLocation(p, "u_ortho_z");
     dev->pm[v].mirror = gl->GetUniformLocation(p, "u_mirror");
     dev->pm[v].has_normals = gl->GetUniformLocation(p, "u_has_normals");
+    dev->pm[v].probe_lod = gl->GetUniformLocation(p, "u_probe_lod");
     dev->pm[v].frame = 0;
     bind_samplers(gl, p);
     return p;
@@ -560,7 +583,7 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     static const char *const defs[4] = {NULL, "#define SY_LEAN 1\n", "#define SY_MASK 1\n",
                                         "#define SY_MASK 1\n#define SY_LEAN 1\n"};
     /* the fullest main variant now, so that a shader the driver rejects fails here */
-    if (!main_program(dev, VAR_TEX | VAR_NMAP | VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_SHADOW | VAR_ASHADOW | VAR_TRANS | VAR_MASK, err, err_len))
+    if (!main_program(dev, VAR_TEX | VAR_NMAP | VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_SHADOW | VAR_ASHADOW | VAR_TRANS | VAR_MASK | VAR_PROBE, err, err_len))
         r = SY_GL_ERROR_GL;
     for (int v = 0; v < 2 && r == SY_GL_OK; ++v)
         r = sy_gl_program_build(gl, v ? "shadow (alpha mask)" : "shadow", sy_gl_shadow_vs, sy_gl_shadow_fs, defs[2 * v],
@@ -660,6 +683,10 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         GLuint texs[4] = {dev->white_tex, dev->flat_normal_tex, dev->shadow_tex, dev->cube_tex};
         gl->DeleteBuffers(3, bufs);
         gl->DeleteTextures(dev->cube_tex ? 4 : 3, texs);
+        for (uint32_t p = 0; p < SY_GL_MAX_PROBES; ++p)
+            if (dev->probes[p].cube) gl->DeleteTextures(1, &dev->probes[p].cube);
+        if (dev->probe_fbo) gl->DeleteFramebuffers(1, &dev->probe_fbo);
+        if (dev->probe_depth) gl->DeleteRenderbuffers(1, &dev->probe_depth);
         gl->DeleteFramebuffers(1, &dev->shadow_fbo);
         gl->DeleteVertexArrays(1, &dev->empty_vao);
     }
@@ -697,6 +724,7 @@ void sy_gl_device_stats(const sy_gl_device *dev, sy_gl_stats *out)
 static void geometry_changed(sy_gl_device *dev)
 {
     if (dev->shadow_maps > 0) dev->lights_dirty = true;
+    dev->probes_dirty = true;
 }
 
 /* >>mesh */
@@ -1014,6 +1042,7 @@ sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const 
     m->d = *d;
     material_upload(dev, m, false);
     if (shadows) geometry_changed(dev); /* shadow casters changed */
+    dev->probes_dirty = true;              /* what the probes see changed */
     return SY_GL_OK;
 }
 
@@ -1079,6 +1108,7 @@ sy_gl_result sy_gl_instance_set_material(sy_gl_device *dev, sy_gl_instance inst,
 {
     inst_o *in = pool_get(&dev->instances, inst.id);
     if (!in) return SY_GL_ERROR_INVALID_HANDLE;
+    if (in->material.id != mat.id) geometry_changed(dev); /* shadow casters and probes */
     in->material = mat;
     return SY_GL_OK;
 }
@@ -1751,18 +1781,33 @@ static sy_gl_result use_variant(sy_gl_device *dev, draw_ctx *dc, int pv, char *e
     return SY_GL_OK;
 }
 
-static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const mesh_o *m, const mat_o *mt,
-                                  char *err, size_t err_len)
+/* The probe of instance pool index i, or -1 (none, or while the probes themselves are drawn). */
+static int probe_of(const sy_gl_device *dev, uint32_t i)
+{
+    if (dev->in_probe_pass) return -1;
+    for (uint32_t p = 0; p < dev->probe_count; ++p)
+        if (dev->probes[p].inst == i) return (int)p;
+    return -1;
+}
+
+static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t index, const inst_o *in, const mesh_o *m,
+                                  const mat_o *mt, char *err, size_t err_len)
 {
     const sy_gl_fns *gl = dev->gl;
-    int pv = draw_variant(dev, m, mt);
+    int probe = probe_of(dev, index);
+    int pv = variant_normalize(draw_variant(dev, m, mt) | (probe >= 0 ? VAR_PROBE : 0));
     sy_gl_result r = use_variant(dev, dc, pv, err, err_len);
     if (r != SY_GL_OK) return r;
+    if (probe >= 0) {
+        gl->ActiveTexture(GL_TEXTURE0 + UNIT_PROBE);
+        gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->probes[probe].cube);
+        gl->Uniform1f(dev->pm[pv].probe_lod, (float)(PROBE_LEVELS - 1u));
+    }
     bind_material(dev, in->material, (pv & VAR_TEX) != 0);
     float mvp[16];
     m4_mul(dc->viewproj, in->model, mvp);
     gl->UniformMatrix4fv(dev->pm[pv].mvp, 1, GL_FALSE, mvp);
-    if (pv & (VAR_LIGHTS | VAR_ENV | VAR_AREA)) {
+    if (pv & (VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_PROBE)) {
         gl->UniformMatrix4fv(dev->pm[pv].model, 1, GL_FALSE, in->model);
         gl->UniformMatrix3fv(dev->pm[pv].normal_mat, 1, GL_FALSE, in->normal_mat);
         gl->Uniform1i(dev->pm[pv].has_normals, m->has_normals);
@@ -1786,6 +1831,188 @@ static float view_distance(const inst_o *in, const mesh_o *m, const view_setup *
 }
 
 static int cmp_near_first(const void *a, const void *b) { return -cmp_far_first(a, b); }
+
+/* The textures and uniform blocks every main-pass variant reads. */
+static void bind_frame_resources(sy_gl_device *dev)
+{
+    const sy_gl_fns *gl = dev->gl;
+    gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_LIGHTS, dev->lights_ubo);
+    gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_AREAS, dev->areas_ubo);
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_SHADOW);
+    gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->shadow_tex);
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_CUBE_SHADOW);
+    gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->cube_tex ? dev->cube_tex : dev->shadow_tex);
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_ENV_SPEC);
+    gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->ibl.spec_cube);
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_ENV_IRR);
+    gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->ibl.irr_cube);
+    GLuint tables[3] = {dev->ibl.brdf_lut, dev->ibl.ltc1, dev->ibl.ltc2};
+    for (int i = 0; i < 3; ++i) {
+        gl->ActiveTexture(GL_TEXTURE0 + UNIT_BRDF + (GLenum)i);
+        gl->BindTexture(GL_TEXTURE_2D, tables[i]);
+    }
+}
+
+/* Draws every visible instance but `skip` (a pool index, UINT32_MAX for none) into the bound
+ * target: opaque near to far (early depth tests reject hidden fragments before shading), then
+ * alpha-masked (the discard variant) near to far, then blended far to near with depth writes off.
+ * Each list holds (view distance, instance index) pairs. */
+static sy_gl_result draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t skip, char *err, size_t err_len)
+{
+    const sy_gl_fns *gl = dev->gl;
+    sy_gl_result r = SY_GL_OK;
+    draw_ctx dc = {.v = v, .ortho_z = {v->proj[10], v->proj[14], 0.0f}, .bound = -1};
+    m4_mul(v->proj, v->view, dc.viewproj);
+    uint32_t cap = dev->instances.count ? dev->instances.count : 1, nl[3] = {0, 0, 0};
+    float *lists = malloc(sizeof(float) * 2 * 3 * cap);
+    if (!lists) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory");
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        const inst_o *in = pool_at(&dev->instances, i);
+        if (!in->h.id || !in->visible || i == skip) continue;
+        const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
+        if (!m) continue;
+        const mat_o *mt = pool_get(&dev->materials, in->material.id);
+        sy_gl_alpha_mode mode = mt ? mt->d.alpha_mode : SY_GL_ALPHA_OPAQUE;
+        int li = mode == SY_GL_ALPHA_BLEND ? 2 : mode == SY_GL_ALPHA_MASK ? 1 : 0;
+        float *e = lists + 2 * ((size_t)li * cap + nl[li]++);
+        e[0] = view_distance(in, m, v);
+        memcpy(&e[1], &i, sizeof i);
+    }
+    for (int li = 0; li < 3 && r == SY_GL_OK; ++li) {
+        float *list = lists + 2 * (size_t)li * cap;
+        qsort(list, nl[li], 2 * sizeof(float), li == 2 ? cmp_far_first : cmp_near_first);
+        if (li == 2 && nl[li]) {
+            gl->Enable(GL_BLEND);
+            gl->Disablei(GL_BLEND, 1); /* linear depth: the last (nearest) blended surface wins */
+            gl->BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA); /* premultiplied over */
+            gl->DepthMask(GL_FALSE);
+        }
+        for (uint32_t k = 0; k < nl[li] && r == SY_GL_OK; ++k) {
+            uint32_t i;
+            memcpy(&i, &list[2 * k + 1], sizeof i);
+            const inst_o *in = pool_at(&dev->instances, i);
+            r = draw_instance(dev, &dc, i, in, pool_get(&dev->meshes, in->mesh.id),
+                              pool_get(&dev->materials, in->material.id), err, err_len);
+        }
+        if (li == 2 && nl[li]) {
+            gl->DepthMask(GL_TRUE);
+            gl->Disable(GL_BLEND);
+        }
+    }
+    free(lists);
+    return r;
+}
+
+/* Whether an instance's material is mirror-like or glass enough to need the scene around it. */
+static bool wants_probe(const mat_o *mt)
+{
+    if (!mt || mt->d.roughness > PROBE_MAX_ROUGHNESS) return false;
+    return mt->d.metallic >= 0.5f || mt->d.transmission * (1.0f - mt->d.metallic) >= 0.5f;
+}
+
+/* (Re)renders the scene probes (see SY_GL_MAX_PROBES). */
+static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
+{
+    const sy_gl_fns *gl = dev->gl;
+    dev->probe_count = 0;
+    float centres[SY_GL_MAX_PROBES][3];
+    for (uint32_t i = 0; i < dev->instances.count && dev->probe_count < SY_GL_MAX_PROBES; ++i) {
+        const inst_o *in = pool_at(&dev->instances, i);
+        if (!in->h.id || !in->visible) continue;
+        const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
+        if (!m || !wants_probe(pool_get(&dev->materials, in->material.id))) continue;
+        float *c = centres[dev->probe_count];
+        for (int a = 0; a < 3; ++a) {
+            c[a] = in->model[12 + a];
+            for (int k = 0; k < 3; ++k) c[a] += in->model[4 * k + a] * 0.5f * (m->bmin[k] + m->bmax[k]);
+        }
+        dev->probes[dev->probe_count++].inst = i;
+    }
+    if (!dev->probe_count) return SY_GL_OK;
+    if (!dev->probe_fbo) {
+        gl->GenFramebuffers(1, &dev->probe_fbo);
+        gl->GenRenderbuffers(1, &dev->probe_depth);
+        gl->BindRenderbuffer(GL_RENDERBUFFER, dev->probe_depth);
+        gl->RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_DEPTH_COMPONENT32F, PROBE_SIZE, PROBE_SIZE);
+    }
+    float sc[3], R;
+    scene_bounds(dev, sc, &R);
+    /* the cube faces in GL order, as (right, up, forward): window x and y grow along right and up */
+    static const float faces[6][3][3] = {
+        {{0, 0, -1}, {0, -1, 0}, {1, 0, 0}},  {{0, 0, 1}, {0, -1, 0}, {-1, 0, 0}}, {{1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
+        {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}}, {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}},  {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}}};
+    const tex_o *env = dev->env_ready ? pool_get(&dev->textures, dev->env_tex.id) : NULL;
+    bind_frame_resources(dev);
+    dev->in_probe_pass = true;
+    sy_gl_result r = SY_GL_OK;
+    for (uint32_t p = 0; p < dev->probe_count && r == SY_GL_OK; ++p) {
+        if (!dev->probes[p].cube) {
+            gl->GenTextures(1, &dev->probes[p].cube);
+            gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->probes[p].cube);
+            for (int f = 0; f < 6; ++f)
+                gl->TexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, 0, GL_RGBA16F, PROBE_SIZE, PROBE_SIZE, 0, GL_RGBA,
+                               GL_FLOAT, NULL);
+            gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+            gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+            gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+        }
+        const float *c = centres[p];
+        float dc = sqrtf((c[0] - sc[0]) * (c[0] - sc[0]) + (c[1] - sc[1]) * (c[1] - sc[1]) + (c[2] - sc[2]) * (c[2] - sc[2]));
+        double far = dc + R, nearp = fmax(1e-4 * far, 1e-5);
+        for (int f = 0; f < 6 && r == SY_GL_OK; ++f) {
+            view_setup v;
+            memset(&v, 0, sizeof v);
+            const float(*b)[3] = faces[f];
+            float m[16] = {b[0][0], b[1][0], -b[2][0], 0, b[0][1], b[1][1], -b[2][1], 0, b[0][2], b[1][2], -b[2][2], 0, 0, 0, 0, 1};
+            for (int i = 0; i < 3; ++i) m[12 + i] = -(m[i] * c[0] + m[4 + i] * c[1] + m[8 + i] * c[2]);
+            memcpy(v.view, m, sizeof m);
+            projection(false, -1.0, 1.0, -1.0, 1.0, nearp, far, v.proj);
+            memcpy(v.cam_pos, c, sizeof v.cam_pos);
+            memcpy(v.cam_fwd, b[2], sizeof v.cam_fwd);
+            gl->BindFramebuffer(GL_FRAMEBUFFER, dev->probe_fbo);
+            gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f,
+                                     dev->probes[p].cube, 0);
+            gl->FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, dev->probe_depth);
+            static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+            gl->DrawBuffers(2, bufs);
+            gl->Viewport(0, 0, PROBE_SIZE, PROBE_SIZE);
+            gl->ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+            gl->DepthMask(GL_TRUE);
+            const float black[4] = {0, 0, 0, 1}, one = 1.0f;
+            gl->ClearBufferfv(GL_COLOR, 0, black);
+            gl->ClearBufferfv(GL_DEPTH, 0, &one);
+            gl->Disable(GL_CULL_FACE);
+            gl->Disable(GL_BLEND);
+            float vp[16], inv[16];
+            m4_mul(v.proj, v.view, vp);
+            if (env && m4_invert(vp, inv)) { /* rays that leave the scene see the environment (a light) */
+                gl->Disable(GL_DEPTH_TEST);
+                gl->DepthMask(GL_FALSE);
+                gl->UseProgram(dev->prog_sky);
+                gl->UniformMatrix4fv(dev->sky_inv_vp, 1, GL_FALSE, inv);
+                const float si[4] = {(float)PROBE_SIZE, (float)PROBE_SIZE, dev->env_intensity, 0.0f};
+                gl->Uniform4fv(dev->sky_size_int, 1, si);
+                gl->ActiveTexture(GL_TEXTURE0);
+                gl->BindTexture(GL_TEXTURE_2D, env->tex);
+                gl->BindVertexArray(dev->empty_vao);
+                gl->DrawArrays(GL_TRIANGLES, 0, 3);
+                gl->DepthMask(GL_TRUE);
+            }
+            gl->Enable(GL_DEPTH_TEST);
+            gl->DepthFunc(GL_LESS);
+            dev->frame_no++; /* the variants take this face's camera */
+            r = draw_scene(dev, &v, dev->probes[p].inst, err, err_len);
+        }
+        gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->probes[p].cube);
+        gl->GenerateMipmap(GL_TEXTURE_CUBE_MAP);
+    }
+    dev->in_probe_pass = false;
+    dev->frame_no++;
+    if (r == SY_GL_OK) r = gl_check(dev, "scene probes", err, err_len);
+    return r;
+}
 
 sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, float *rgba,
                           float *depth, char *err, size_t err_len)
@@ -1811,6 +2038,7 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
             dev->env_ready = true;
         }
         dev->env_dirty = false;
+        dev->probes_dirty = true;
     }
     if (dev->area_count && (r = sy_gl_ibl_tables(gl, &dev->ibl, err, err_len)) != SY_GL_OK) return r;
     if (dev->lights_dirty) {
@@ -1818,65 +2046,15 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         if (fs.shadow_count || fs.cube_count) render_shadows(dev, &fs);
         else dev->shadow_maps = 0;
         dev->lights_dirty = false;
+        dev->probes_dirty = true;
+    }
+    if (dev->probes_dirty) {
+        if ((r = render_probes(dev, err, err_len)) != SY_GL_OK) return r;
+        dev->probes_dirty = false;
     }
     begin_target(dev, &v);
-    draw_ctx dc = {.v = &v, .ortho_z = {v.proj[10], v.proj[14], 0.0f}, .bound = -1};
-    m4_mul(v.proj, v.view, dc.viewproj);
-    gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_LIGHTS, dev->lights_ubo);
-    gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_AREAS, dev->areas_ubo);
-    gl->ActiveTexture(GL_TEXTURE0 + UNIT_SHADOW);
-    gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->shadow_tex);
-    gl->ActiveTexture(GL_TEXTURE0 + UNIT_CUBE_SHADOW);
-    gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->cube_tex ? dev->cube_tex : dev->shadow_tex);
-    gl->ActiveTexture(GL_TEXTURE0 + UNIT_ENV_SPEC);
-    gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->ibl.spec_cube);
-    gl->ActiveTexture(GL_TEXTURE0 + UNIT_ENV_IRR);
-    gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->ibl.irr_cube);
-    GLuint tables[3] = {dev->ibl.brdf_lut, dev->ibl.ltc1, dev->ibl.ltc2};
-    for (int i = 0; i < 3; ++i) {
-        gl->ActiveTexture(GL_TEXTURE0 + UNIT_BRDF + (GLenum)i);
-        gl->BindTexture(GL_TEXTURE_2D, tables[i]);
-    }
-    /* opaque near to far (early depth tests reject hidden fragments before shading), then
-     * alpha-masked (the discard variant) near to far, then blended far to near with depth writes
-     * off. Each list holds (view distance, instance index) pairs. */
-    uint32_t cap = dev->instances.count ? dev->instances.count : 1, nl[3] = {0, 0, 0};
-    float *lists = malloc(sizeof(float) * 2 * 3 * cap);
-    if (!lists) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory");
-    for (uint32_t i = 0; i < dev->instances.count; ++i) {
-        const inst_o *in = pool_at(&dev->instances, i);
-        if (!in->h.id || !in->visible) continue;
-        const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
-        if (!m) continue;
-        const mat_o *mt = pool_get(&dev->materials, in->material.id);
-        sy_gl_alpha_mode mode = mt ? mt->d.alpha_mode : SY_GL_ALPHA_OPAQUE;
-        int li = mode == SY_GL_ALPHA_BLEND ? 2 : mode == SY_GL_ALPHA_MASK ? 1 : 0;
-        float *e = lists + 2 * ((size_t)li * cap + nl[li]++);
-        e[0] = view_distance(in, m, &v);
-        memcpy(&e[1], &i, sizeof i);
-    }
-    for (int li = 0; li < 3 && r == SY_GL_OK; ++li) {
-        float *list = lists + 2 * (size_t)li * cap;
-        qsort(list, nl[li], 2 * sizeof(float), li == 2 ? cmp_far_first : cmp_near_first);
-        if (li == 2 && nl[li]) {
-            gl->Enable(GL_BLEND);
-            gl->Disablei(GL_BLEND, 1); /* linear depth: the last (nearest) blended surface wins */
-            gl->BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA); /* premultiplied over */
-            gl->DepthMask(GL_FALSE);
-        }
-        for (uint32_t k = 0; k < nl[li] && r == SY_GL_OK; ++k) {
-            uint32_t i;
-            memcpy(&i, &list[2 * k + 1], sizeof i);
-            const inst_o *in = pool_at(&dev->instances, i);
-            r = draw_instance(dev, &dc, in, pool_get(&dev->meshes, in->mesh.id), pool_get(&dev->materials, in->material.id),
-                              err, err_len);
-        }
-        if (li == 2 && nl[li]) {
-            gl->DepthMask(GL_TRUE);
-            gl->Disable(GL_BLEND);
-        }
-    }
-    free(lists);
+    bind_frame_resources(dev);
+    r = draw_scene(dev, &v, UINT32_MAX, err, err_len);
     if (r == SY_GL_OK) r = finish_target(dev, rgba, depth, err, err_len);
     frame_end(dev);
     return r;

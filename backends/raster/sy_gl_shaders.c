@@ -14,13 +14,14 @@
  * sy_gl_device.c main_program): SY_LEAN (no uv1 / colours), SY_MASK (alpha mask: discard), SY_TEX
  * (the material has a texture: uv varyings), SY_NMAP (normal map), SY_LIGHTS (punctual lights),
  * SY_ENV (environment light), SY_AREA (emissive polygons), SY_SHADOW (punctual shadow maps),
- * SY_ASHADOW (area-light shadow maps), SY_TRANS (a transmissive material; llvmpipe runs both sides of a branch, so code that no
+ * SY_ASHADOW (area-light shadow maps), SY_PROBE (reflections and refraction see the object's scene
+ * probe instead of the environment), SY_TRANS (a transmissive material; llvmpipe runs both sides of a branch, so code that no
  * light of this frame needs is left out of the variant), SY_NLIGHTS (a constant light count:
  * the loop unrolls with constant uniform-block offsets). Every varying costs set-up per
  * triangle and interpolation per fragment in a software rasterizer, so a variant interpolates only
  * what it reads; unlit variants (no lights, no environment) need no position or normal at all. */
 #define SY_GL_VARIANT_PRELUDE                                 \
-    "#if defined(SY_LIGHTS) || defined(SY_ENV) || defined(SY_AREA)\n" \
+    "#if defined(SY_LIGHTS) || defined(SY_ENV) || defined(SY_AREA) || defined(SY_PROBE)\n" \
     "#define SY_LIT 1\n"                                      \
     "#endif\n"                                                \
     "#if defined(SY_TEX) && !defined(SY_LEAN)\n"              \
@@ -76,7 +77,8 @@ const char *const sy_gl_main_fs =
     /* area lights: 4 vertices (xyz, w unused), radiance (rgb, w = double-sided), centre (xyz, w = shadow map or -1) */
     "layout(std140) uniform Areas { ivec4 a_count; vec4 a_dir; vec4 a_data[16 * 6]; };\n"
     "uniform sampler2DArrayShadow t_shadow, t_cshadow;\n"
-    "uniform samplerCube t_env_spec, t_env_irr; uniform sampler2D t_brdf, t_ltc1, t_ltc2;\n"
+    "uniform samplerCube t_env_spec, t_env_irr, t_probe; uniform sampler2D t_brdf, t_ltc1, t_ltc2;\n"
+    "uniform float u_probe_lod;\n" /* the probe's last mip */
     "uniform vec3 u_cam_pos; uniform vec3 u_cam_fwd; uniform bool u_ortho; uniform bool u_mirror;\n"
     "uniform bool u_has_normals; uniform vec3 u_ortho_z;\n" /* orthographic: proj[10], proj[14] */
     "#ifdef SY_LIT\n"
@@ -160,8 +162,16 @@ const char *const sy_gl_main_fs =
     "  float z = f.z / len; vec2 uv = vec2(z * 0.5 + 0.5, len) * (63.0 / 64.0) + 0.5 / 64.0;\n"
     "  return len * textureLod(t_ltc2, uv, 0.0).w; }\n"
     "#endif\n"
-    "#ifdef SY_ENV\n"
-    "vec3 env_spec(vec3 d, float rough) { return textureLod(t_env_spec, d, rough * l_env.x).rgb; }\n"
+    "#if defined(SY_ENV) || defined(SY_PROBE)\n"
+    /* what a reflected or refracted ray sees: the scene probe around this object (the scene and,
+     * beyond it, the environment; its mips blur for roughness) or the prefiltered environment */
+    "vec3 env_spec(vec3 d, float rough) {\n"
+    "#ifdef SY_PROBE\n"
+    "  return textureLod(t_probe, d, rough * u_probe_lod).rgb;\n"
+    "#else\n"
+    "  return textureLod(t_env_spec, d, rough * l_env.x).rgb;\n"
+    "#endif\n"
+    "}\n"
     "#endif\n"
     "void main() {\n"
     "  vec2 uv[2] = vec2[2](v_uv0, v_uv1);\n"
@@ -257,7 +267,7 @@ const char *const sy_gl_main_fs =
     "      L += e * f * cs * vis;\n"
     "    }\n"
     "#endif\n"
-    "#if defined(SY_AREA) || defined(SY_ENV)\n"
+    "#if defined(SY_AREA) || defined(SY_ENV) || defined(SY_PROBE)\n"
     /* split-sum terms: A, B of the GGX BRDF for this view and roughness */
     "    vec2 ab = textureLod(t_brdf, vec2(nv, rough) * (31.0 / 32.0) + 0.5 / 32.0, 0.0).rg;\n"
     "    float fd_avg = spec * (f0d * ab.x + ab.y);\n"
@@ -299,14 +309,18 @@ const char *const sy_gl_main_fs =
     "      if (m_modes.w == 0) L += (kdl + fspec) * l_env.yzw * (ao * (1.0 + 0.75 * dot(ns, a_dir.xyz)));\n"
     "    }\n"
     "#endif\n"
-    "#ifdef SY_ENV\n"
+    "#if defined(SY_ENV) || defined(SY_PROBE)\n"
     "    {\n"
     "      float ao = 1.0;\n"
     "#ifdef SY_TEX\n"
     "      if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, tuv(3, uv[m_tex.w])).r - 1.0);\n"
     "#endif\n"
     "      vec3 R = reflect(-wo, ns);\n"
+    "#ifdef SY_ENV\n"
     "      vec3 irr = textureLod(t_env_irr, ns, 0.0).rgb;\n" /* cosine-weighted mean radiance = E / pi */
+    "#else\n"
+    "      vec3 irr = vec3(0.0);\n"
+    "#endif\n"
     /* the GGX lobe's dominant direction leans from R towards N as roughness grows (Lagarde and
      * de Rousiers 2014, "Moving Frostbite to PBR", eq. 55); looking up R alone lights rough
      * surfaces from below the horizon */

@@ -5,6 +5,8 @@
  *     background) and a TEXTURE background shows the texel x intensity with alpha 1;
  *  2. a mirror (metallic 1, roughness 0) under a lat-long environment whose upper half is 2 and lower
  *     half 0.5 reflects one half or the other, not their mean (the prefiltered mip 0 is sharp);
+ *     without an environment it reflects the scene around it (an emissive ceiling; its scene
+ *     probe), and hiding the ceiling updates the reflection;
  *  3. a square emitter above a Lambert floor: the irradiance under its centre matches the form
  *     factor of a square (LTC, diffuse), the emitter does not light points behind it (one-sided),
  *     a double-sided emitter lights both sides, an occluder casts a shadow;
@@ -161,6 +163,30 @@ int main(int argc, char **argv)
         CHECK(near_(px(16, 16)[0], 0.5f, 0.03f), "mirror reflects the lower half: %g (want 0.5)", px(16, 16)[0]);
         MUST(sy_gl_instance_destroy(d, mi));
         sy_gl_set_environment(d, (sy_gl_texture){0}, 0.0f);
+
+        /* 2b. the mirror sees the scene (its probe), not only the environment: with no environment,
+         * an emissive green ceiling above it is what the upward reflections see; hiding the ceiling
+         * re-renders the probe and the mirror goes black */
+        mi = place(d, quad(d, tilt, tn), mm);
+        sy_gl_material_desc gd;
+        sy_gl_material_desc_init(&gd);
+        gd.base_color[0] = gd.base_color[1] = gd.base_color[2] = 0.0f;
+        gd.emissive[1] = 4.0f;
+        gd.double_sided = true;
+        sy_gl_material gm;
+        MUST(sy_gl_material_create(d, &gd, &gm, e, sizeof e));
+        const float ceiling[12] = {-4, 3, 1, 4, 3, 1, 4, 3, -8, -4, 3, -8};
+        const float down[3] = {0, -1, 0};
+        sy_gl_instance ci = place(d, quad(d, ceiling, down), gm);
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        printf("mirror under a green ceiling %g %g (want 0 4)\n", px(16, 16)[0], px(16, 16)[1]);
+        CHECK(near_(px(16, 16)[1], 4.0f, 0.03f) && px(16, 16)[0] < 0.01f, "mirror reflects the ceiling: %g %g (want 0 4)",
+              px(16, 16)[0], px(16, 16)[1]);
+        MUST(sy_gl_instance_set_visible(d, ci, false));
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        CHECK(px(16, 16)[1] < 0.01f, "hidden ceiling still reflected: %g", px(16, 16)[1]);
+        MUST(sy_gl_instance_destroy(d, ci));
+        MUST(sy_gl_instance_destroy(d, mi));
     }
 
     /* 3. a square emitter (half-size 0.5) 1 above a Lambert floor; camera looking down */
