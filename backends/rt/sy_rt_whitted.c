@@ -342,19 +342,10 @@ static void whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
             out[1] = sum.y / n;
             out[2] = sum.z / n;
             out[3] = alpha / n;
-            if (f->depth && j->spp > 1u) {
-                /* colour and alpha average the strata (anti-aliased edges); depth and so coverage
-                 * come from the pixel centre, as in every back-end (the pixel convention that
-                 * depth compositing and raster / ray tracer alignment rely on) */
-                struct RTCRay ray;
-                struct RTCRayHit rh;
-                float axial;
-                sy_rt_frame_ray_at(f, (float)px + 0.5f, (float)py + 0.5f, &ray, &axial);
-                const sy_rt_instance_data *in = sy_rt_intersect(c.dev, &primary_ctx, v3(ray.org_x, ray.org_y, ray.org_z),
-                                                                v3(ray.dir_x, ray.dir_y, ray.dir_z), ray.tnear, ray.tfar, &rh);
-                f->depth[o] = in ? rh.ray.tfar * axial : INFINITY;
-            } else if (f->depth)
-                f->depth[o] = hits ? dsum / (float)hits : INFINITY;
+            /* coverage = any stratum hit, depth = the mean of those that hit: with fractional alpha
+             * at anti-aliased edges, as the path tracer's accumulation and the raster's MSAA
+             * resolve (nearest sample) give it, so depth compositing keeps the edges */
+            if (f->depth) f->depth[o] = hits ? dsum / (float)hits : INFINITY;
         }
     }
 }

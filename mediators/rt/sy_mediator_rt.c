@@ -23,9 +23,8 @@
 
 /* Whitted's default anti-aliasing: 4 stratified camera rays per pixel (one per quadrant, Sobol
  * jittered), sharing the pixel's area-light budget (light_samples); colour and alpha average them,
- * depth and coverage come from the pixel centre (backends/rt/sy_rt_whitted.c), so edges are smooth
- * while raster / Whitted alignment and depth compositing keep their pixel convention. spp=1 traces
- * the centre ray alone. */
+ * a pixel is covered where any of them hits and its depth is the mean of those hits, as in the
+ * path tracer and the raster's MSAA. spp=1 traces the pixel centre alone. */
 #define WHITTED_DEFAULT_SPP 4
 
 /* Path tracer: one accumulation per distinct request (camera, sizes, rectangle, background, seed);
