@@ -518,9 +518,16 @@ static sy_result validate_doc(loader *L)
         const sy_gltf_shim_light *l = &d->lights[i];
         if (strcmp(l->type, "point") && strcmp(l->type, "spot") && strcmp(l->type, "directional"))
             return fail(L, SY_ERR_PARSE, "KHR_lights_punctual.lights[%zu]: type '%s' is not point, spot or directional", i, l->type);
-        if ((l->color_count != 0 && l->color_count != 3) || !all_finite(l->color, 3) || !isfinite(l->intensity) ||
-            l->intensity < 0 || !isfinite(l->range) || l->range < 0 || !isfinite(l->inner_cone) || !isfinite(l->outer_cone))
-            return fail(L, SY_ERR_PARSE, "KHR_lights_punctual.lights[%zu]: invalid colour, intensity, range or cone angle", i);
+        if ((l->color_count != 0 && l->color_count != 3) || !all_finite(l->color, 3) || l->color[0] < 0 ||
+            l->color[1] < 0 || l->color[2] < 0)
+            return fail(L, SY_ERR_PARSE, "KHR_lights_punctual.lights[%zu]: color must be 3 finite values >= 0", i);
+        if (!isfinite(l->intensity) || l->intensity < 0)
+            return fail(L, SY_ERR_PARSE, "KHR_lights_punctual.lights[%zu]: intensity %g must be finite and >= 0", i,
+                        l->intensity);
+        if (!isfinite(l->range) || l->range < 0)
+            return fail(L, SY_ERR_PARSE, "KHR_lights_punctual.lights[%zu]: range %g must be finite and >= 0", i, l->range);
+        if (!isfinite(l->inner_cone) || !isfinite(l->outer_cone))
+            return fail(L, SY_ERR_PARSE, "KHR_lights_punctual.lights[%zu]: spot cone angles must be finite", i);
     }
     if ((r = validate_nodes(L))) return r;
     for (size_t s = 0; s < d->scene_count; s++) {

@@ -305,6 +305,20 @@ run world_exr "$SY" render demo -b whitted -w 30 -h 20 -o "$TMP/world/notlatlong
 expect_error env_not_latlong "not a lat-long map" "$TMP/o_world" "$SY" render demo -b whitted -w 8 -h 8 \
     --env "$TMP/world/notlatlong.exr" -o "$TMP/o_world/x.png"
 grep -q "notlatlong.exr" "$TMP/env_not_latlong.err" || fail "env_not_latlong: the file is not named"
+# a light out of range (negative intensity, cone beyond pi/2) is refused the same way for every
+# back-end (core validates it once), naming the light and the value
+bad_light() { # bad_light FILE LIGHT_JSON
+    printf '{"asset":{"version":"2.0"},"extensionsUsed":["KHR_lights_punctual"],"extensions":{"KHR_lights_punctual":{"lights":[%s]}},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"extensions":{"KHR_lights_punctual":{"light":0}}}]}\n' "$2" >"$1"
+}
+bad_light "$TMP/world/neg_light.gltf" '{"type":"point","intensity":-2}'
+bad_light "$TMP/world/wide_spot.gltf" '{"type":"spot","intensity":5,"spot":{"innerConeAngle":0.1,"outerConeAngle":2.0}}'
+for b in whitted raster pathtracer; do
+    expect_error "neg_light_$b" "KHR_lights_punctual.lights[0]" "$TMP/o_world" "$SY" render "$TMP/world/neg_light.gltf" \
+        -b "$b" -w 8 -h 8 -o "$TMP/o_world/x.png"
+    grep -q "intensity -2 must be" "$TMP/neg_light_$b.err" || fail "neg_light_$b: the value is not named: $(cat "$TMP/neg_light_$b.err")"
+    expect_error "wide_spot_$b" "beyond pi/2" "$TMP/o_world" "$SY" render "$TMP/world/wide_spot.gltf" \
+        -b "$b" -w 8 -h 8 -o "$TMP/o_world/x.png"
+done
 # a 2:1 map is taken (and lights every back-end; sy compare prints the table)
 run world_exr2 "$SY" render demo -b whitted -w 32 -h 16 -o "$TMP/world/latlong.exr"
 run env_ok "$SY" render demo -b raster -w 16 -h 16 --env "$TMP/world/latlong.exr" --env-intensity 2 -o "$TMP/world/e.png"
