@@ -18,7 +18,7 @@
 #define IDX_MASK ((1u << IDX_BITS) - 1u)
 #define SHADOW_SIZE_DEFAULT 2048u
 enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_ENV_SPEC, UNIT_ENV_IRR, UNIT_BRDF,
-       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW, UNIT_PROBE, UNIT_COUNT };
+       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW0, UNIT_CUBE_SHADOW1, UNIT_PROBE, UNIT_COUNT };
 /* Scene probes: mirror-like and glass instances see the scene, not only the environment. Each of
  * the first SY_GL_MAX_PROBES such instances gets a cube map of PROBE_SIZE texels per side rendered
  * from its bounding-box centre (the instance itself left out, other probed instances showing the
@@ -184,7 +184,7 @@ struct sy_gl_device {
     } uf;
     GLuint default_ubo, lights_ubo, white_tex, flat_normal_tex, empty_vao;
     GLuint shadow_tex, shadow_fbo;
-    GLuint cube_tex; /* point-light cube shadows: 6 layers per light (+X -X +Y -Y +Z -Z), made on first use */
+    GLuint cube_tex[SY_GL_MAX_CUBE_SHADOWS]; /* point-light depth cube maps, made on first use */
     uint32_t cube_size;
     struct {
         GLuint cube;
@@ -335,6 +335,39 @@ static GLuint shadow_array(const sy_gl_fns *gl, uint32_t size, uint32_t layers)
     return t;
 }
 
+/* The cube-map faces in GL order as (right, up, forward): rendering a face with this camera and a
+ * 90-degree frustum fills it as GL's cube sampling reads it (window x and y along right and up). */
+static const float cube_faces[6][3][3] = {
+    {{0, 0, -1}, {0, -1, 0}, {1, 0, 0}},  {{0, 0, 1}, {0, -1, 0}, {-1, 0, 0}}, {{1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
+    {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}}, {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}},  {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}}};
+
+static void cube_face_view(const float *eye, int f, float *view)
+{
+    const float(*b)[3] = cube_faces[f];
+    float m[16] = {b[0][0], b[1][0], -b[2][0], 0, b[0][1], b[1][1], -b[2][1], 0, b[0][2], b[1][2], -b[2][2], 0, 0, 0, 0, 1};
+    for (int i = 0; i < 3; ++i) m[12 + i] = -(m[i] * eye[0] + m[4 + i] * eye[1] + m[8 + i] * eye[2]);
+    memcpy(view, m, sizeof m);
+}
+
+/* A depth cube map compared in the shader (hardware PCF, seamless across faces). */
+static GLuint shadow_cube(const sy_gl_fns *gl, uint32_t size)
+{
+    GLuint t = 0;
+    gl->GenTextures(1, &t);
+    gl->BindTexture(GL_TEXTURE_CUBE_MAP, t);
+    for (int f = 0; f < 6; ++f)
+        gl->TexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, 0, GL_DEPTH_COMPONENT32F, (GLsizei)size, (GLsizei)size, 0,
+                       GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    return t;
+}
+
 static void look_along(const float *eye, const float *dir, float *view)
 {
     float z[3] = {-dir[0], -dir[1], -dir[2]}, up[3] = {0, 1, 0}, x[3], y[3];
@@ -458,8 +491,8 @@ static void material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
 static void bind_samplers(const sy_gl_fns *gl, GLuint prog)
 {
     static const char *names[UNIT_COUNT] = {"t_base", "t_mr",       "t_nrm",     "t_occ",  "t_emis", "t_shadow",
-                                            "t_env_spec", "t_env_irr", "t_brdf", "t_ltc1", "t_ltc2", "t_cshadow",
-                                            "t_probe"};
+                                            "t_env_spec", "t_env_irr", "t_brdf", "t_ltc1", "t_ltc2", "t_cshadow0",
+                                            "t_cshadow1", "t_probe"};
     gl->UseProgram(prog);
     for (int i = 0; i < UNIT_COUNT; ++i) {
         GLint loc = gl->GetUniformLocation(prog, names[i]);
@@ -538,10 +571,9 @@ static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
     return p;
 }
 
-/* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes, then the cube faces' matrices and
- * their parameters (SY_GL_MAX_CUBE_SHADOWS x (6 x 64 + 16) bytes) */
-#define LIGHTS_CUBE_MAT 600
-#define LIGHTS_CUBE_PAR (LIGHTS_CUBE_MAT + 6 * 16 * SY_GL_MAX_CUBE_SHADOWS)
+/* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes, then the cube shadows' parameters
+ * (SY_GL_MAX_CUBE_SHADOWS x 16 bytes) */
+#define LIGHTS_CUBE_PAR 600
 #define LIGHTS_FLOATS (LIGHTS_CUBE_PAR + 4 * SY_GL_MAX_CUBE_SHADOWS)
 #define AREAS_FLOATS (8 + SY_GL_MAX_AREA_LIGHTS * 6 * 4) /* std140 Areas block: ivec4 + vec4 + vec4[16 * 6] */
 
@@ -631,6 +663,7 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     gl->GenVertexArrays(1, &dev->empty_vao);
     /* shadow maps: one depth texture array, compared in the shader (hardware PCF) */
     dev->shadow_tex = shadow_array(gl, dev->shadow_size, SY_GL_MAX_SHADOW_MAPS);
+    gl->Enable(GL_TEXTURE_CUBE_MAP_SEAMLESS); /* cube shadows and probes filter across faces */
     dev->cube_size = dev->shadow_size / 2u > 16u ? dev->shadow_size / 2u : 16u;
     gl->GenFramebuffers(1, &dev->shadow_fbo);
     dev->lights_dirty = true;
@@ -680,9 +713,11 @@ void sy_gl_device_destroy(sy_gl_device *dev)
             if (progs[i]) gl->DeleteProgram(progs[i]);
         sy_gl_ibl_free(gl, &dev->ibl);
         GLuint bufs[3] = {dev->default_ubo, dev->lights_ubo, dev->areas_ubo};
-        GLuint texs[4] = {dev->white_tex, dev->flat_normal_tex, dev->shadow_tex, dev->cube_tex};
+        GLuint texs[3] = {dev->white_tex, dev->flat_normal_tex, dev->shadow_tex};
         gl->DeleteBuffers(3, bufs);
-        gl->DeleteTextures(dev->cube_tex ? 4 : 3, texs);
+        gl->DeleteTextures(3, texs);
+        for (uint32_t c = 0; c < SY_GL_MAX_CUBE_SHADOWS; ++c)
+            if (dev->cube_tex[c]) gl->DeleteTextures(1, &dev->cube_tex[c]);
         for (uint32_t p = 0; p < SY_GL_MAX_PROBES; ++p)
             if (dev->probes[p].cube) gl->DeleteTextures(1, &dev->probes[p].cube);
         if (dev->probe_fbo) gl->DeleteFramebuffers(1, &dev->probe_fbo);
@@ -1300,7 +1335,7 @@ static void scene_bounds(const sy_gl_device *dev, float *c, float *radius)
 typedef struct frame_state {
     float shadow_vp[SY_GL_MAX_SHADOW_MAPS][16];
     uint32_t shadow_count;
-    float cube_vp[6 * SY_GL_MAX_CUBE_SHADOWS][16];
+    float cube_pos[SY_GL_MAX_CUBE_SHADOWS][3], cube_near[SY_GL_MAX_CUBE_SHADOWS], cube_far[SY_GL_MAX_CUBE_SHADOWS];
     uint32_t cube_count; /* point lights with a cube shadow */
 } frame_state;
 
@@ -1337,27 +1372,19 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
         o[14] = -1.0f;
         o[15] = -1.0f;
         if (d->type == SY_GL_LIGHT_POINT && !d->no_shadow && fs->cube_count < SY_GL_MAX_CUBE_SHADOWS) {
-            /* six 90-degree faces along the axes (look_along keeps them axis-aligned), widened by a
-             * few texels so that PCF taps at a face's edge stay inside it; the shader picks the
-             * face by the major axis of (point - light) */
+            /* a depth cube map around the light (GL's face order and orientation, seamless
+             * filtering); the shader compares the window depth of the major axis */
             uint32_t slot = fs->cube_count++;
-            float S = (float)dev->cube_size, t = 1.0f + 4.0f / S;
             float dc = sqrtf((d->position[0] - c[0]) * (d->position[0] - c[0]) +
                              (d->position[1] - c[1]) * (d->position[1] - c[1]) +
                              (d->position[2] - c[2]) * (d->position[2] - c[2]));
-            double far = dc + R, nearp = fmax(1e-3 * far, 1e-4);
-            float proj[16];
-            projection(false, -t, t, -t, t, nearp, far, proj);
-            for (int f = 0; f < 6; ++f) {
-                float axis[3] = {0, 0, 0}, view[16];
-                axis[f / 2] = (f & 1) ? -1.0f : 1.0f;
-                look_along(d->position, axis, view);
-                m4_mul(proj, view, fs->cube_vp[6 * slot + (uint32_t)f]);
-                memcpy(blk + LIGHTS_CUBE_MAT + 16 * (6 * slot + (uint32_t)f), fs->cube_vp[6 * slot + (uint32_t)f],
-                       16 * sizeof(float));
-            }
-            blk[LIGHTS_CUBE_PAR + 4 * slot] = 1.5f * 2.0f * t / S; /* normal offset per unit distance */
-            blk[LIGHTS_CUBE_PAR + 4 * slot + 1] = 1.0f;
+            float far = dc + R, nearp = fmaxf(1e-3f * far, 1e-4f);
+            memcpy(fs->cube_pos[slot], d->position, sizeof fs->cube_pos[slot]);
+            fs->cube_near[slot] = nearp;
+            fs->cube_far[slot] = far;
+            blk[LIGHTS_CUBE_PAR + 4 * slot] = nearp;
+            blk[LIGHTS_CUBE_PAR + 4 * slot + 1] = far;
+            blk[LIGHTS_CUBE_PAR + 4 * slot + 2] = 1.5f * 2.0f / (float)dev->cube_size; /* normal offset per unit distance */
             o[15] = (float)slot;
         }
         if (d->type != SY_GL_LIGHT_POINT && !d->no_shadow && ns < SY_GL_MAX_SHADOW_MAPS) {
@@ -1485,16 +1512,15 @@ static const mat_o *bind_material(sy_gl_device *dev, sy_gl_material id, bool all
     return m;
 }
 
-/* Depth of every shadow caster into one layer of a depth texture array, seen through vp. Casters
+/* Depth of every shadow caster into the attached depth target, seen through vp. Casters
  * as the ray tracers' shadow rays see them (backends/rt/sy_rt_shadow.c): opaque ones block;
  * alpha-masked ones block where the mask keeps them; alpha-blended ones let 1 - alpha through,
  * which a depth map can only threshold (opacity >= the cutoff, 0.5 unless set, blocks);
  * transmissive ones (transmission x (1 - metallic) >= 0.5) let their tinted transmittance through
  * and cast none; emitters are the lights and cast none either. */
-static void render_shadow_layer(sy_gl_device *dev, GLuint tex, uint32_t layer, const float *vp)
+static void draw_casters(sy_gl_device *dev, const float *vp)
 {
     const sy_gl_fns *gl = dev->gl;
-    gl->FramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, tex, 0, (GLint)layer);
     gl->Clear(GL_DEPTH_BUFFER_BIT);
     for (int v = 0; v < 2; ++v) {
         gl->UseProgram(dev->ps[v].prog);
@@ -1526,11 +1552,22 @@ static void render_shadows(sy_gl_device *dev, const frame_state *fs)
     gl->Enable(GL_POLYGON_OFFSET_FILL);
     gl->PolygonOffset(1.5f, 4.0f);
     gl->Viewport(0, 0, (GLsizei)dev->shadow_size, (GLsizei)dev->shadow_size);
-    for (uint32_t s = 0; s < fs->shadow_count; ++s) render_shadow_layer(dev, dev->shadow_tex, s, fs->shadow_vp[s]);
-    if (fs->cube_count) {
-        if (!dev->cube_tex) dev->cube_tex = shadow_array(gl, dev->cube_size, 6u * SY_GL_MAX_CUBE_SHADOWS);
-        gl->Viewport(0, 0, (GLsizei)dev->cube_size, (GLsizei)dev->cube_size);
-        for (uint32_t f = 0; f < 6u * fs->cube_count; ++f) render_shadow_layer(dev, dev->cube_tex, f, fs->cube_vp[f]);
+    for (uint32_t s = 0; s < fs->shadow_count; ++s) {
+        gl->FramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, dev->shadow_tex, 0, (GLint)s);
+        draw_casters(dev, fs->shadow_vp[s]);
+    }
+    if (fs->cube_count) gl->Viewport(0, 0, (GLsizei)dev->cube_size, (GLsizei)dev->cube_size);
+    for (uint32_t c = 0; c < fs->cube_count; ++c) {
+        if (!dev->cube_tex[c]) dev->cube_tex[c] = shadow_cube(gl, dev->cube_size);
+        float proj[16], view[16], vp[16];
+        projection(false, -1.0, 1.0, -1.0, 1.0, fs->cube_near[c], fs->cube_far[c], proj);
+        for (int f = 0; f < 6; ++f) {
+            cube_face_view(fs->cube_pos[c], f, view);
+            m4_mul(proj, view, vp);
+            gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f,
+                                     dev->cube_tex[c], 0);
+            draw_casters(dev, vp);
+        }
     }
     gl->Disable(GL_POLYGON_OFFSET_FILL);
     dev->shadow_maps = fs->shadow_count + 6u * fs->cube_count;
@@ -1840,8 +1877,10 @@ static void bind_frame_resources(sy_gl_device *dev)
     gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_AREAS, dev->areas_ubo);
     gl->ActiveTexture(GL_TEXTURE0 + UNIT_SHADOW);
     gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->shadow_tex);
-    gl->ActiveTexture(GL_TEXTURE0 + UNIT_CUBE_SHADOW);
-    gl->BindTexture(GL_TEXTURE_2D_ARRAY, dev->cube_tex ? dev->cube_tex : dev->shadow_tex);
+    for (uint32_t c = 0; c < SY_GL_MAX_CUBE_SHADOWS; ++c) {
+        gl->ActiveTexture(GL_TEXTURE0 + UNIT_CUBE_SHADOW0 + (GLenum)c);
+        gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->cube_tex[c]);
+    }
     gl->ActiveTexture(GL_TEXTURE0 + UNIT_ENV_SPEC);
     gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->ibl.spec_cube);
     gl->ActiveTexture(GL_TEXTURE0 + UNIT_ENV_IRR);
@@ -1937,10 +1976,6 @@ static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
     }
     float sc[3], R;
     scene_bounds(dev, sc, &R);
-    /* the cube faces in GL order, as (right, up, forward): window x and y grow along right and up */
-    static const float faces[6][3][3] = {
-        {{0, 0, -1}, {0, -1, 0}, {1, 0, 0}},  {{0, 0, 1}, {0, -1, 0}, {-1, 0, 0}}, {{1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
-        {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}}, {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}},  {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}}};
     const tex_o *env = dev->env_ready ? pool_get(&dev->textures, dev->env_tex.id) : NULL;
     bind_frame_resources(dev);
     dev->in_probe_pass = true;
@@ -1964,13 +1999,10 @@ static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
         for (int f = 0; f < 6 && r == SY_GL_OK; ++f) {
             view_setup v;
             memset(&v, 0, sizeof v);
-            const float(*b)[3] = faces[f];
-            float m[16] = {b[0][0], b[1][0], -b[2][0], 0, b[0][1], b[1][1], -b[2][1], 0, b[0][2], b[1][2], -b[2][2], 0, 0, 0, 0, 1};
-            for (int i = 0; i < 3; ++i) m[12 + i] = -(m[i] * c[0] + m[4 + i] * c[1] + m[8 + i] * c[2]);
-            memcpy(v.view, m, sizeof m);
+            cube_face_view(c, f, v.view);
             projection(false, -1.0, 1.0, -1.0, 1.0, nearp, far, v.proj);
             memcpy(v.cam_pos, c, sizeof v.cam_pos);
-            memcpy(v.cam_fwd, b[2], sizeof v.cam_fwd);
+            memcpy(v.cam_fwd, cube_faces[f][2], sizeof v.cam_fwd);
             gl->BindFramebuffer(GL_FRAMEBUFFER, dev->probe_fbo);
             gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f,
                                      dev->probes[p].cube, 0);

@@ -73,10 +73,10 @@ const char *const sy_gl_main_fs =
     "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_MATERIAL_BLOCK
     "struct Light { vec4 pos_type; vec4 dir_range; vec4 radiant; vec4 cone; };\n"
     "layout(std140) uniform Lights { ivec4 l_count; vec4 l_env; mat4 l_shadow_mat[4]; vec4 l_shadow[4];\n"
-    "  Light l_lights[32]; mat4 l_cube_mat[12]; vec4 l_cube[2]; };\n" /* cube faces (+X -X +Y -Y +Z -Z) of SY_GL_MAX_CUBE_SHADOWS point lights */
+    "  Light l_lights[32]; vec4 l_cube[2]; };\n" /* SY_GL_MAX_CUBE_SHADOWS point lights: near, far, normal offset */
     /* area lights: 4 vertices (xyz, w unused), radiance (rgb, w = double-sided), centre (xyz, w = shadow map or -1) */
     "layout(std140) uniform Areas { ivec4 a_count; vec4 a_dir; vec4 a_data[16 * 6]; };\n"
-    "uniform sampler2DArrayShadow t_shadow, t_cshadow;\n"
+    "uniform sampler2DArrayShadow t_shadow; uniform samplerCubeShadow t_cshadow0, t_cshadow1;\n"
     "uniform samplerCube t_env_spec, t_env_irr, t_probe; uniform sampler2D t_brdf, t_ltc1, t_ltc2;\n"
     "uniform float u_probe_lod;\n" /* the probe's last mip */
     "uniform vec3 u_cam_pos; uniform vec3 u_cam_fwd; uniform bool u_ortho; uniform bool u_mirror;\n"
@@ -117,23 +117,21 @@ const char *const sy_gl_main_fs =
     "bool shadow_coord(int si, vec3 p, vec3 ngf, out vec3 q, out float r) {\n"
     "  return proj_coord(l_shadow_mat[si], l_shadow[si], p, ngf, q, r); }\n"
     "#endif\n"
-    "#ifdef SY_SHADOW\n" /* punctual lights: 3 x 3 hardware PCF */
+    /* punctual lights cast hard shadows (as in the ray tracers): one hardware-bilinear PCF tap, an
+     * edge one texel wide */
+    "#ifdef SY_SHADOW\n"
     "float shadow_vis(int si, vec3 p, vec3 ngf) {\n"
     "  vec3 q; float r; if (!shadow_coord(si, p, ngf, q, r)) return 1.0;\n"
-    "  float s = 0.0; vec2 ts = 1.0 / vec2(textureSize(t_shadow, 0).xy);\n"
-    "  for (int y = -1; y <= 1; ++y) for (int x = -1; x <= 1; ++x)\n"
-    "    s += texture(t_shadow, vec4(q.xy + vec2(x, y) * ts, float(si), q.z));\n"
-    "  return s / 9.0; }\n"
-    /* point lights: the cube face of the major axis of (p - light), 3 x 3 hardware PCF */
+    "  return texture(t_shadow, vec4(q.xy, float(si), q.z)); }\n"
+    /* point lights: a depth cube map, compared at the window depth of the major axis of (p - light)
+     * after the normal offset */
     "float cube_vis(int slot, vec3 lp, vec3 p, vec3 ngf) {\n"
-    "  vec3 d = p - lp, ad = abs(d); int f = ad.x >= ad.y && ad.x >= ad.z ? (d.x > 0.0 ? 0 : 1)\n"
-    "    : ad.y >= ad.z ? (d.y > 0.0 ? 2 : 3) : (d.z > 0.0 ? 4 : 5);\n"
-    "  int layer = slot * 6 + f; vec3 q; float r;\n"
-    "  if (!proj_coord(l_cube_mat[layer], l_cube[slot], p, ngf, q, r)) return 1.0;\n"
-    "  float s = 0.0; vec2 ts = 1.0 / vec2(textureSize(t_cshadow, 0).xy);\n"
-    "  for (int y = -1; y <= 1; ++y) for (int x = -1; x <= 1; ++x)\n"
-    "    s += texture(t_cshadow, vec4(q.xy + vec2(x, y) * ts, float(layer), q.z));\n"
-    "  return s / 9.0; }\n"
+    "  vec4 cp = l_cube[slot]; vec3 d0 = p - lp; float m0 = max(abs(d0.x), max(abs(d0.y), abs(d0.z)));\n"
+    "  vec3 d = d0 + ngf * (cp.z * m0); vec3 ad = abs(d); float ma = max(ad.x, max(ad.y, ad.z));\n"
+    "  if (!(ma > cp.x)) return 1.0;\n"
+    "  float z = 0.5 * ((cp.y + cp.x) / (cp.y - cp.x) - 2.0 * cp.y * cp.x / ((cp.y - cp.x) * ma)) + 0.5;\n"
+    "  if (z >= 1.0) return 1.0;\n"
+    "  return slot == 0 ? texture(t_cshadow0, vec4(d, z)) : texture(t_cshadow1, vec4(d, z)); }\n"
     "#endif\n"
     "#ifdef SY_ASHADOW\n" /* area lights: 8 Poisson taps (hardware PCF each) over the penumbra */
     "const vec2 POISSON[8] = vec2[8](vec2(-0.840,-0.074), vec2(0.962,-0.195), vec2(-0.203,0.621), vec2(0.185,-0.893),\n"

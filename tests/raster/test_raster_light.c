@@ -9,7 +9,8 @@
  *     probe), and hiding the ceiling updates the reflection;
  *  3. a square emitter above a Lambert floor: the irradiance under its centre matches the form
  *     factor of a square (LTC, diffuse), the emitter does not light points behind it (one-sided),
- *     a double-sided emitter lights both sides, an occluder casts a shadow;
+ *     a double-sided emitter lights both sides, an occluder casts a shadow; a point light's cube
+ *     shadow map shadows the floor under the same occluder and leaves I cos / d^2 beside it;
  *  4. invalid area lights are refused with a message naming the item.
  * argv[1] = provider (osmesa default). */
 #include "sy_gl.h"
@@ -228,6 +229,22 @@ int main(int argc, char **argv)
         MUST(sy_gl_render(d, &under, &full, rgba, depth, e, sizeof e));
         printf("floor under an occluder %g (unshadowed %g)\n", px(16, 16)[0], want);
         CHECK(px(16, 16)[0] < 0.5f * want, "floor under an occluder: %g (unshadowed %g)", px(16, 16)[0], want);
+        /* 3b. a point light (intensity 10 at 1 above the floor) instead: its cube shadow map darkens
+         * the floor under the occluder; beside the shadow the floor has I cos / d^2 x albedo / pi */
+        MUST(sy_gl_set_area_lights(d, NULL, 0, e, sizeof e));
+        sy_gl_light_desc pd = {.type = SY_GL_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10.0f, .position = {0, 1, 0}};
+        sy_gl_light pl;
+        MUST(sy_gl_light_create(d, &pd, &pl, e, sizeof e));
+        MUST(sy_gl_render(d, &under, &full, rgba, depth, e, sizeof e));
+        float xs = 0.4f * (-2.0f + 4.0f * 0.5f / N), d2 = xs * xs + 1.0f; /* pixel (0, 16) on the floor */
+        float lit = 0.5f / PI_F * 10.0f / d2 / sqrtf(d2);
+        sy_gl_device_stats(d, &st);
+        printf("point light: floor under the occluder %g, beside it %g (want %g), %u shadow maps\n", px(16, 16)[0],
+               px(0, 16)[0], lit, st.shadow_maps);
+        CHECK(px(16, 16)[0] < 0.02f * 0.5f / PI_F * 10.0f, "point light shines through the occluder: %g", px(16, 16)[0]);
+        CHECK(near_(px(0, 16)[0], lit, 0.03f), "point light beside the shadow: %g (want %g)", px(0, 16)[0], lit);
+        CHECK(st.shadow_maps == 6, "a point light's cube shadow: %u shadow maps (want 6 faces)", st.shadow_maps);
+        MUST(sy_gl_light_destroy(d, pl));
         MUST(sy_gl_instance_destroy(d, oc));
         MUST(sy_gl_instance_destroy(d, fl));
         /* 4. refused input */
