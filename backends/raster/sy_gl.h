@@ -42,8 +42,11 @@
  *    mip) x (F0 A + B) from the BRDF table plus an irradiance cube (E/pi) x diffuse weight, both
  *    times the occlusion texture; transmissive surfaces add Fresnel-weighted reflection and the
  *    environment refracted in and out of a sphere tangent at the point (exact for a glass ball,
- *    base colour tinted); the scene's own geometry is not seen through them (only the environment;
- *    blend mode shows what is behind by alpha);
+ *    base colour tinted);
+ *  - scene probes: the first 4 mirror-like or glass instances (roughness <= 0.4; metallic >= 0.5
+ *    or transmission >= 0.5) reflect and refract a cube map of the scene rendered from their
+ *    bounding-box centre (themselves left out, the environment beyond) instead of the
+ *    environment alone; re-rendered when geometry, materials, lights or the environment change;
  *  - emission (a visible front side, both when double-sided) adds to the reflected light; unlit
  *    materials show their base colour (+ emission).
  * Shadows: directional and spot lights and area lights (from the polygon's centre along its
