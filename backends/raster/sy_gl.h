@@ -53,7 +53,8 @@
  * normal, a 150-degree frustum; a Poisson PCF whose radius grows with the polygon's size and the
  * receiver's distance, an approximation of the penumbra without a blocker search) share
  * SY_GL_MAX_SHADOW_MAPS maps, punctual lights first; the first SY_GL_MAX_CUBE_SHADOWS point lights
- * get cube shadows (six 90-degree faces of half the map size, 3 x 3 PCF). Alpha-masked
+ * get depth cube maps (half the map size per face); punctual shadows are hard (one bilinear PCF
+ * tap), as in the ray tracers. Alpha-masked
  * casters honour the mask; alpha-blended casters block where their opacity reaches the cutoff (the
  * ray tracers let 1 - alpha through; a depth map can only threshold it); transmissive casters
  * (transmission x (1 - metallic) >= 0.5) and emitters cast none, as in the ray tracers, whose

@@ -1773,17 +1773,19 @@ static sy_gl_result finish_target(sy_gl_device *dev, float *rgba, float *depth, 
 
 static int mesh_lean(const mesh_o *m) { return !m->has_attr[3] && !m->has_attr[4]; }
 
-/* The variant bits for one draw: mesh attributes, material textures and mode, frame lighting. */
-static int draw_variant(const sy_gl_device *dev, const mesh_o *m, const mat_o *mt)
+/* The variant bits for one draw: mesh attributes, material textures and mode, frame lighting,
+ * whether the instance has a scene probe. */
+static int draw_variant(const sy_gl_device *dev, const mesh_o *m, const mat_o *mt, bool probe)
 {
     int v = mesh_lean(m) ? VAR_LEAN : 0;
+    if (probe) v |= VAR_PROBE;
     if (dev->light_count) v |= VAR_LIGHTS;
     if (dev->light_count && dev->light_count <= VAR_NL_MAX) v |= (int)dev->light_count << VAR_NL_SHIFT;
     if (dev->env_ready) v |= VAR_ENV;
     if (dev->area_count) v |= VAR_AREA;
     if (dev->shadow_count) v |= VAR_SHADOW;
     if (dev->area_shadow_count) v |= VAR_ASHADOW;
-    if (!mt) return v;
+    if (!mt) return variant_normalize(v);
     if (mt->d.alpha_mode == SY_GL_ALPHA_MASK) v |= VAR_MASK;
     if (mt->d.transmission > 0.0f && mt->d.metallic < 1.0f) v |= VAR_TRANS;
     const sy_gl_texture_ref *refs[5] = {&mt->d.base_color_texture, &mt->d.metallic_roughness_texture,
@@ -1832,7 +1834,7 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
 {
     const sy_gl_fns *gl = dev->gl;
     int probe = probe_of(dev, index);
-    int pv = variant_normalize(draw_variant(dev, m, mt) | (probe >= 0 ? VAR_PROBE : 0));
+    int pv = draw_variant(dev, m, mt, probe >= 0);
     sy_gl_result r = use_variant(dev, dc, pv, err, err_len);
     if (r != SY_GL_OK) return r;
     if (probe >= 0) {

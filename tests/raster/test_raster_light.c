@@ -183,6 +183,21 @@ int main(int argc, char **argv)
         printf("mirror under a green ceiling %g %g (want 0 4)\n", px(16, 16)[0], px(16, 16)[1]);
         CHECK(near_(px(16, 16)[1], 4.0f, 0.03f) && px(16, 16)[0] < 0.01f, "mirror reflects the ceiling: %g %g (want 0 4)",
               px(16, 16)[0], px(16, 16)[1]);
+        /* the same quad as clear glass (no environment either): its Fresnel reflection and
+         * refraction see the ceiling through the probe too */
+        sy_gl_material_desc glass;
+        sy_gl_material_desc_init(&glass);
+        glass.metallic = 0.0f;
+        glass.roughness = 0.0f;
+        glass.transmission = 1.0f;
+        sy_gl_material gl_m;
+        MUST(sy_gl_material_create(d, &glass, &gl_m, e, sizeof e));
+        MUST(sy_gl_instance_set_material(d, mi, gl_m));
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        printf("glass under a green ceiling %g %g\n", px(16, 16)[0], px(16, 16)[1]);
+        CHECK(px(16, 16)[1] > 0.1f && px(16, 16)[0] < 0.01f, "glass without an environment sees nothing: %g %g",
+              px(16, 16)[0], px(16, 16)[1]);
+        MUST(sy_gl_instance_set_material(d, mi, mm));
         MUST(sy_gl_instance_set_visible(d, ci, false));
         MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
         CHECK(px(16, 16)[1] < 0.01f, "hidden ceiling still reflected: %g", px(16, 16)[1]);
