@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# compare_all.sh — `sy compare` over every glTF sample model and X3D example in ../shared/testdata
-# and the demo: one contact sheet per scene (OUT_DIR/NAME.png) and one table of every back-end's
+# compare_all.sh — `sy compare` over the Cornell box, every glTF sample model and X3D example in
+# ../shared/testdata and the demo: one contact sheet per scene (OUT_DIR/NAME.png) and one table of every back-end's
 # mean luminance over covered pixels, its ratio to the path tracer and its coverage IoU against it.
 # A measurement, not a test (issue 15's targets: no back-end dark, mean >= 0.05; Whitted and raster
 # within 0.67-1.5x of the path tracer); rows outside the targets are marked with '!'.
@@ -16,7 +16,7 @@ data=$root/../shared/testdata
 [ -d "$data" ] || { echo "compare_all.sh: skipped: $data is absent"; exit 0; }
 mkdir -p "$out"
 scenes=(demo)
-while IFS= read -r f; do scenes+=("$f"); done < <(cd "$data" && { find gltf -path '*/glTF/*.gltf'; find x3d -name '*.x3d'; } | sort)
+while IFS= read -r f; do scenes+=("$f"); done < <(cd "$data" && { find cornell gltf -path '*/glTF/*.gltf' -o -name 'cornell_box.gltf'; find x3d -name '*.x3d'; } | sort)
 printf '%-58s %-10s %8s %8s %6s %7s\n' scene backend covered mean ratio iou
 for s in "${scenes[@]}"; do
     path=$s
