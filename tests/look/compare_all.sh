@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # compare_all.sh — `sy compare` over the Cornell box, every glTF sample model and X3D example in
-# ../shared/testdata and the demo: one contact sheet per scene (OUT_DIR/NAME.png) and one table of every back-end's
-# mean luminance over covered pixels, its ratio to the path tracer and its coverage IoU against it.
+# ../shared/testdata and the demo: one contact sheet per scene (OUT_DIR/NAME.png) and one table of
+# every back-end's mean luminance over covered pixels, its ratio to the path tracer and its
+# coverage IoU against it.
 # A measurement, not a test (issue 15's targets: no back-end dark, mean >= 0.05; Whitted and raster
 # within 0.67-1.5x of the path tracer); rows outside the targets are marked with '!'.
 # Usage: tests/look/compare_all.sh [BUILD_DIR (build)] [OUT_DIR (compare-all)] [W H SPP (200 150 64)]
