@@ -74,7 +74,9 @@ if [ $rc -ne 0 ] && ! sanitizer_exit_noise "$W/coop.err"; then
 fi
 grep -q "cluster cooperative: pathtracer | 1/2 servers alive" "$W/coop.out" ||
     fail "the title does not report the lost server"
-grep -q "dropped for this frame" "$W/coop.err" || fail "the viewer did not log the lost server"
+# the loss is logged as a frame that dropped the server or, when it died between two frames, as
+# the failed reconnection at the next one (which of the two depends on timing under load)
+grep -Eq "dropped for this frame|cannot connect" "$W/coop.err" || fail "the viewer did not log the lost server"
 spp=$(grep -o '[0-9][0-9]* spp' "$W/coop.out" | tail -n 1 | cut -d' ' -f1)
 [ -n "$spp" ] && [ "$spp" -ge 2 ] || fail "cooperative refinement did not go on after the loss (spp '$spp')"
 "$CMP" "$W/coop.png" "$W/coop.png" 0 20 || fail "the cooperative window is empty"
