@@ -50,8 +50,8 @@
  *  - emission (a visible front side, both when double-sided) adds to the reflected light; unlit
  *    materials show their base colour (+ emission).
  * Shadows: directional and spot lights and area lights (from the polygon's centre along its
- * normal, a 150-degree frustum; a Poisson PCF whose radius grows with the polygon's size and the
- * receiver's distance, an approximation of the penumbra without a blocker search) share
+ * normal, a 150-degree frustum; a Poisson PCF over a penumbra of fixed world radius, 0.3 x the
+ * square root of the polygon's area, an approximation without a blocker search) share
  * SY_GL_MAX_SHADOW_MAPS maps, punctual lights first; the first SY_GL_MAX_CUBE_SHADOWS point lights
  * get depth cube maps (half the map size per face); punctual shadows are hard (one bilinear PCF
  * tap), as in the ray tracers. Alpha-masked
