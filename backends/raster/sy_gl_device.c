@@ -1684,6 +1684,28 @@ static int cmp_far_first(const void *a, const void *b)
     return x[0] < y[0] ? 1 : x[0] > y[0] ? -1 : 0;
 }
 
+/* Fills the bound w x h target with a lat-long texture x intensity along each pixel's ray through
+ * view v (depth test and writes off while it draws, depth writes on after). */
+static void draw_latlong(sy_gl_device *dev, const view_setup *v, const tex_o *tex, float intensity, uint32_t w,
+                         uint32_t h)
+{
+    const sy_gl_fns *gl = dev->gl;
+    float vp[16], inv[16];
+    m4_mul(v->proj, v->view, vp);
+    if (!m4_invert(vp, inv)) return;
+    gl->Disable(GL_DEPTH_TEST);
+    gl->DepthMask(GL_FALSE);
+    gl->UseProgram(dev->prog_sky);
+    gl->UniformMatrix4fv(dev->sky_inv_vp, 1, GL_FALSE, inv);
+    const float si[4] = {(float)w, (float)h, intensity, 0.0f};
+    gl->Uniform4fv(dev->sky_size_int, 1, si);
+    gl->ActiveTexture(GL_TEXTURE0);
+    gl->BindTexture(GL_TEXTURE_2D, tex->tex);
+    gl->BindVertexArray(dev->empty_vao);
+    gl->DrawArrays(GL_TRIANGLES, 0, 3);
+    gl->DepthMask(GL_TRUE);
+}
+
 static void begin_target(sy_gl_device *dev, const view_setup *v)
 {
     const sy_gl_fns *gl = dev->gl;
@@ -1700,23 +1722,8 @@ static void begin_target(sy_gl_device *dev, const view_setup *v)
     gl->ClearBufferfv(GL_COLOR, 1, inf);
     gl->ClearBufferfv(GL_DEPTH, 0, &one);
     const tex_o *sky = dev->bg_mode == SY_GL_BACKGROUND_TEXTURE ? pool_get(&dev->textures, dev->bg_tex.id) : NULL;
-    float vp[16], inv[16];
-    if (sky && v) {
-        m4_mul(v->proj, v->view, vp);
-        if (m4_invert(vp, inv)) { /* the sky: camera rays that hit nothing see the texture */
-            gl->Disable(GL_DEPTH_TEST);
-            gl->DepthMask(GL_FALSE);
-            gl->UseProgram(dev->prog_sky);
-            gl->UniformMatrix4fv(dev->sky_inv_vp, 1, GL_FALSE, inv);
-            const float si[4] = {(float)dev->t.w, (float)dev->t.h, dev->bg_intensity, 0.0f};
-            gl->Uniform4fv(dev->sky_size_int, 1, si);
-            gl->ActiveTexture(GL_TEXTURE0);
-            gl->BindTexture(GL_TEXTURE_2D, sky->tex);
-            gl->BindVertexArray(dev->empty_vao);
-            gl->DrawArrays(GL_TRIANGLES, 0, 3);
-            gl->DepthMask(GL_TRUE);
-        }
-    }
+    if (sky && v) /* the sky: camera rays that hit nothing see the texture */
+        draw_latlong(dev, v, sky, dev->bg_intensity, dev->t.w, dev->t.h);
     gl->Enable(GL_DEPTH_TEST);
     gl->DepthFunc(GL_LESS);
     gl->Disable(GL_CULL_FACE); /* the ray tracers see both sides of every triangle */
@@ -2019,21 +2026,8 @@ static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
             gl->ClearBufferfv(GL_DEPTH, 0, &one);
             gl->Disable(GL_CULL_FACE);
             gl->Disable(GL_BLEND);
-            float vp[16], inv[16];
-            m4_mul(v.proj, v.view, vp);
-            if (env && m4_invert(vp, inv)) { /* rays that leave the scene see the environment (a light) */
-                gl->Disable(GL_DEPTH_TEST);
-                gl->DepthMask(GL_FALSE);
-                gl->UseProgram(dev->prog_sky);
-                gl->UniformMatrix4fv(dev->sky_inv_vp, 1, GL_FALSE, inv);
-                const float si[4] = {(float)PROBE_SIZE, (float)PROBE_SIZE, dev->env_intensity, 0.0f};
-                gl->Uniform4fv(dev->sky_size_int, 1, si);
-                gl->ActiveTexture(GL_TEXTURE0);
-                gl->BindTexture(GL_TEXTURE_2D, env->tex);
-                gl->BindVertexArray(dev->empty_vao);
-                gl->DrawArrays(GL_TRIANGLES, 0, 3);
-                gl->DepthMask(GL_TRUE);
-            }
+            if (env) /* rays that leave the scene see the environment (a light) */
+                draw_latlong(dev, &v, env, dev->env_intensity, PROBE_SIZE, PROBE_SIZE);
             gl->Enable(GL_DEPTH_TEST);
             gl->DepthFunc(GL_LESS);
             dev->frame_no++; /* the variants take this face's camera */
@@ -2048,16 +2042,24 @@ static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
     return r;
 }
 
+/* What every frame starts with: the context current, the view, the targets, zeroed counters. */
+static sy_gl_result frame_setup(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, view_setup *v,
+                                char *err, size_t err_len)
+{
+    sy_gl_result r = current(dev, err, err_len);
+    if (r == SY_GL_OK) r = view_make(dev, cam, d, v, err, err_len);
+    if (r == SY_GL_OK) r = targets_ensure(dev, d->width, d->height, err, err_len);
+    dev->tris = dev->draws = 0;
+    return r;
+}
+
 sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, float *rgba,
                           float *depth, char *err, size_t err_len)
 {
     view_setup v;
-    sy_gl_result r = current(dev, err, err_len);
-    if (r == SY_GL_OK) r = view_make(dev, cam, d, &v, err, err_len);
-    if (r == SY_GL_OK) r = targets_ensure(dev, d->width, d->height, err, err_len);
+    sy_gl_result r = frame_setup(dev, cam, d, &v, err, err_len);
     if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
-    dev->tris = dev->draws = 0;
     dev->frame_no++;
     static frame_state fs_zero;
     frame_state fs = fs_zero;
@@ -2098,12 +2100,9 @@ sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, cons
                                 char *err, size_t err_len)
 {
     view_setup v;
-    sy_gl_result r = current(dev, err, err_len);
-    if (r == SY_GL_OK) r = view_make(dev, cam, d, &v, err, err_len);
-    if (r == SY_GL_OK) r = targets_ensure(dev, d->width, d->height, err, err_len);
+    sy_gl_result r = frame_setup(dev, cam, d, &v, err, err_len);
     if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
-    dev->tris = dev->draws = 0;
     begin_target(dev, NULL);
     gl->UseProgram(dev->prog_floor);
     gl->UniformMatrix4fv(dev->uf.view, 1, GL_FALSE, v.view);
