@@ -1,7 +1,8 @@
 /* sy_cluster_cli.c — `sy serve`, the `--cluster` options of `sy render` and `sy bench cluster`
- * (see sy_cluster_cli.h). The protocol and the modes live in core/sy_cluster.c. */
+ * (see sy_cluster_cli.h). The protocol, the modes and the cluster mediator live in mediators/cluster/. */
 #define _GNU_SOURCE /* sched_setaffinity for the pinned benchmark servers */
 #include "sy_cluster_cli.h"
+#include "sy_mediator_cluster.h"
 #include "sy_signals.h"
 
 #include "sy_demo.h"
@@ -294,107 +295,93 @@ static sy_result parse_conf(const char *path, char **text, const char **urls, co
     return SY_OK;
 }
 
+/* The client options the command line describes: URL list or configuration file, mode (option,
+ * else the file's, else sort-first), secret, CA, per-server back-ends and wall tiles. The strings
+ * live in *list (the caller frees it) and in the arrays of the caller. */
+typedef struct cli_client_opts {
+    const char *urls[SY_CLUSTER_MAX_SERVERS], *backends[SY_CLUSTER_MAX_SERVERS];
+    sy_cluster_rect tiles[SY_CLUSTER_MAX_SERVERS];
+    uint32_t n, mode;
+    sy_cluster_rect viewer_tile;
+    char *list;
+    uint8_t *secret;
+    size_t secret_len;
+    sy_cluster_client_opts co;
+} cli_client_opts;
+
+static void cli_client_opts_free(cli_client_opts *c)
+{
+    free(c->list);
+    free(c->secret);
+}
+
+static sy_result cli_client_opts_make(const sy_cluster_cli_opts *o, cli_client_opts *out, sy_error *err)
+{
+    memset(out, 0, sizeof *out);
+    const char *conf_mode = NULL;
+    if (!strstr(o->cluster, "://")) { /* a configuration file */
+        sy_result cr = parse_conf(o->cluster, &out->list, out->urls, out->backends, out->tiles, &out->n, &conf_mode,
+                                  &out->viewer_tile, err);
+        if (cr) return cr;
+    } else { /* a comma-separated URL list */
+        out->list = strdup(o->cluster);
+        if (!out->list) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+        for (char *save = NULL, *t = strtok_r(out->list, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+            if (out->n == SY_CLUSTER_MAX_SERVERS)
+                return sy_error_set(err, SY_ERR_LIMIT, "--cluster: more than %u servers", SY_CLUSTER_MAX_SERVERS);
+            out->urls[out->n++] = t;
+        }
+    }
+    out->mode = SY_CLUSTER_SORT_FIRST;
+    const char *mode_name = o->mode ? o->mode : conf_mode;
+    if (mode_name && !sy_cluster_mode_parse(mode_name, &out->mode))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "unknown --cluster-mode '%s'", mode_name);
+    sy_result r = sy_cluster_secret_load(o->secret_file, &out->secret, &out->secret_len, err);
+    out->co = (sy_cluster_client_opts){.urls = out->urls,
+                                       .url_count = out->n,
+                                       .secret = out->secret,
+                                       .secret_len = out->secret_len,
+                                       .tls_ca_file = o->tls_ca,
+                                       .timeout_ms = o->timeout_ms,
+                                       .connect_timeout_ms = o->connect_timeout_ms,
+                                       .log = o->log,
+                                       .log_user = o->log_user,
+                                       .backends = out->backends,
+                                       .wall_tiles = out->tiles};
+    return r;
+}
+
 sy_result sy_cluster_cli_connect(const sy_cluster_cli_opts *o, sy_scene *scene, sy_cluster_cli_client *out,
                                  sy_error *err)
 {
     memset(out, 0, sizeof *out);
-    const char *urls[SY_CLUSTER_MAX_SERVERS], *backends[SY_CLUSTER_MAX_SERVERS] = {0}, *conf_mode = NULL;
-    sy_cluster_rect tiles[SY_CLUSTER_MAX_SERVERS];
-    memset(tiles, 0, sizeof tiles);
-    uint32_t n = 0;
-    char *list = NULL;
-    if (!strstr(o->cluster, "://")) { /* a configuration file */
-        sy_result cr = parse_conf(o->cluster, &list, urls, backends, tiles, &n, &conf_mode, &out->viewer_tile, err);
-        if (cr) {
-            free(list);
-            return cr;
-        }
-    } else { /* a comma-separated URL list */
-        list = strdup(o->cluster);
-        if (!list) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory");
-        for (char *save = NULL, *t = strtok_r(list, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
-            if (n == SY_CLUSTER_MAX_SERVERS) {
-                free(list);
-                return sy_error_set(err, SY_ERR_LIMIT, "--cluster: more than %u servers", SY_CLUSTER_MAX_SERVERS);
-            }
-            urls[n++] = t;
-        }
-    }
-    uint32_t mode = SY_CLUSTER_SORT_FIRST;
-    const char *mode_name = o->mode ? o->mode : conf_mode;
-    if (mode_name && !sy_cluster_mode_parse(mode_name, &mode)) {
-        free(list);
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "unknown --cluster-mode '%s'", mode_name);
-    }
-    uint8_t *secret = NULL;
-    size_t secret_len = 0;
-    sy_result r = sy_cluster_secret_load(o->secret_file, &secret, &secret_len, err);
-    sy_cluster_client_opts co = {.urls = urls,
-                                 .url_count = n,
-                                 .secret = secret,
-                                 .secret_len = secret_len,
-                                 .tls_ca_file = o->tls_ca,
-                                 .timeout_ms = o->timeout_ms,
-                                 .connect_timeout_ms = o->connect_timeout_ms,
-                                 .log = o->log,
-                                 .log_user = o->log_user,
-                                 .backends = backends,
-                                 .wall_tiles = tiles};
+    cli_client_opts c;
+    sy_result r = cli_client_opts_make(o, &c, err);
     /* the client copies the URLs, back-end names, wall tiles and the secret */
-    if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &out->client, err);
-    out->mode = mode;
-    out->servers = n;
-    free(secret);
-    free(list);
+    if (r == SY_OK) r = sy_cluster_client_create(scene, &c.co, &out->client, err);
+    out->mode = c.mode;
+    out->servers = c.n;
+    out->viewer_tile = c.viewer_tile;
+    cli_client_opts_free(&c);
     return r;
 }
 
-sy_result sy_cluster_cli_render(const sy_cluster_cli_opts *o, sy_scene *scene, const sy_viewport_desc *vd, uint32_t w,
-                                uint32_t h, sy_layer *out, double *seconds, sy_error *err)
+sy_result sy_cluster_cli_setup(const sy_cluster_cli_opts *o, const char *backend, const char *params, char *params_out,
+                               size_t len, uint32_t *mode_out, uint32_t *servers_out, sy_error *err)
 {
-    sy_cluster_cli_client cc;
-    sy_window *win = NULL;
-    sy_viewport *vp = NULL;
-    sy_camera_view view;
-    sy_result r = sy_cluster_cli_connect(o, scene, &cc, err);
-    sy_cluster_client *c = cc.client;
-    uint32_t mode = cc.mode, n = cc.servers;
-    if (r == SY_OK) r = sy_window_create(w, h, &win, err);
-    if (r == SY_OK) r = sy_window_add_viewport(win, vd, &vp, err);
-    if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, err);
-    if (r == SY_OK && mode != SY_CLUSTER_MULTI_DISPLAY)
-        r = sy_layer_create(mode == SY_CLUSTER_STEREO ? 2 * w : w, h, out, err);
-    sy_cluster_frame f = {.mode = mode,
-                          .backend = vd->backend,
-                          .params = vd->params,
-                          .root_id = vd->root.id,
-                          .background_id = vd->background.id,
-                          .camera = view,
-                          .width = w,
-                          .height = h,
-                          .samples = o->samples,
-                          .depth = true,
-                          .half = o->half_pixels,
-                          .eye_separation = vd->eye_separation,
-                          .zero_parallax = vd->zero_parallax};
-    double t0 = sy_time_now();
-    uint32_t frames = o->frames ? o->frames : 1;
-    for (uint32_t i = 0; i < frames && r == SY_OK; ++i) {
-        sy_cluster_frame_stats st;
-        r = sy_cluster_client_render(c, &f, out, &st, err);
-        if (r == SY_OK)
-            fprintf(stderr,
-                    "sy render: cluster frame %u (%s): %u/%u servers, %u failed, %u reassigned, %.3f s, "
-                    "%llu bytes sent (%llu scene), %llu received\n",
-                    i + 1, sy_cluster_mode_name(mode), st.servers_live, n, st.servers_failed, st.reassigned, st.seconds,
-                    (unsigned long long)st.bytes_sent, (unsigned long long)st.scene_bytes,
-                    (unsigned long long)st.bytes_received);
-        if (r == SY_OK && mode == SY_CLUSTER_COOPERATIVE)
-            fprintf(stderr, "sy render: merged %llu samples per pixel\n", (unsigned long long)st.samples);
+    cli_client_opts c;
+    sy_result r = cli_client_opts_make(o, &c, err);
+    if (r == SY_OK) r = sy_mediator_cluster_register(SY_MEDIATOR_CLUSTER_NAME, &c.co, err); /* copies */
+    uint32_t mode = c.mode == SY_CLUSTER_STEREO ? SY_CLUSTER_SORT_FIRST : c.mode;
+    if (r == SY_OK) {
+        int n = snprintf(params_out, len, "backend=%s,mode=%s%s", backend, sy_cluster_mode_name(mode),
+                         o->half_pixels ? ",pixels=half" : "");
+        if (n > 0 && (size_t)n < len && params && *params) n += snprintf(params_out + n, len - (size_t)n, ",%s", params);
+        if (n < 0 || (size_t)n >= len) r = sy_error_set(err, SY_ERR_LIMIT, "--cluster: back-end parameters too long");
     }
-    *seconds = sy_time_now() - t0;
-    sy_cluster_client_destroy(c);
-    sy_window_destroy(win);
+    *mode_out = c.mode;
+    *servers_out = c.n;
+    cli_client_opts_free(&c);
     return r;
 }
 

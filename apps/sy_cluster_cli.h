@@ -1,5 +1,6 @@
 /* sy_cluster_cli.h — the cluster parts of the `sy` tool: `sy serve` (a render server),
- * the `--cluster ...` options of `sy render` and `sy view`, and `sy bench cluster`. Built on core/sy_cluster.h.
+ * the `--cluster ...` options of `sy render` and `sy view`, and `sy bench cluster`. Built on
+ * mediators/cluster/ (sy_cluster.h, sy_mediator_cluster.h).
  * Thread-safety: command-line entry points, single-threaded callers. */
 #ifndef SY_CLUSTER_CLI_H
 #define SY_CLUSTER_CLI_H
@@ -47,10 +48,13 @@ typedef struct sy_cluster_cli_client {
 sy_result sy_cluster_cli_connect(const sy_cluster_cli_opts *o, sy_scene *scene, sy_cluster_cli_client *out,
                                  sy_error *err);
 
-/* Renders the viewport (scene, root, camera, background, back-end) on the cluster; creates *out
- * (w x h, or 2w x h side by side in stereo; untouched / empty in multi-display). */
-sy_result sy_cluster_cli_render(const sy_cluster_cli_opts *o, sy_scene *scene, const sy_viewport_desc *vd,
-                                uint32_t w, uint32_t h, sy_layer *out, double *seconds, sy_error *err);
+/* `sy render --cluster`: registers the cluster mediator class (SY_MEDIATOR_CLUSTER_NAME) from the
+ * options and writes the viewport parameters that select it into params_out:
+ * "backend=BACKEND,mode=MODE[,pixels=half][,PARAMS]". The render then goes through the window like
+ * any local one. *mode_out: the configured mode (stereo is the window's business: the parameters
+ * say sort-first); *servers_out: the servers configured. */
+sy_result sy_cluster_cli_setup(const sy_cluster_cli_opts *o, const char *backend, const char *params, char *params_out,
+                               size_t len, uint32_t *mode_out, uint32_t *servers_out, sy_error *err);
 
 /* sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only]: sizes, overhead, latency, codec,
  * a server's memory and a client's frame time under 72 hostile unauthenticated connections,

@@ -25,6 +25,7 @@
  * the file and the reason; the exit code is non-zero (1 = usage, 2 = failure). */
 #include "sy_bench.h"
 #include "sy_cluster_cli.h"
+#include "sy_mediator_cluster.h"
 #include "sy_compare.h"
 #include "sy_compose.h"
 #ifdef SY_HAVE_GLFW
@@ -388,39 +389,37 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
     return r;
 }
 
-/* Writes colour + depth and the path tracer's feature buffers as channels of one EXR:
- * R G B A Z, variance.{R,G,B}, albedo.{R,G,B}, normal.{X,Y,Z}, direct.{R,G,B}, indirect.{R,G,B}. */
+/* Writes the back-end's feature buffers (SY_CAP_AOVS) as channels of one EXR: colour and depth
+ * as R G B A Z, every other plane as NAME.{R,G,B} (normal: NAME.{X,Y,Z}), e.g. variance.R. */
 static sy_result write_aov_exr(const char *path, sy_context *ctx, const out_opts *o, sy_error *err)
 {
-    if (strcmp(sy_context_class(ctx)->name, "pathtracer") != 0)
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--aov: back-end %s has no feature buffers",
-                            sy_context_class(ctx)->name);
-    sy_mediator_rt_aovs a;
-    sy_result r = sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err);
+    sy_aovs a;
+    sy_result r = sy_context_aovs(ctx, &a, err);
     if (r != SY_OK) return r;
-    sy_exr_channel_desc ch[32];
+    sy_exr_channel_desc ch[4 * SY_AOVS_MAX];
     int n = 0;
-    static const char *const rgba[4] = {"R", "G", "B", "A"}, *const rgb[3] = {"R", "G", "B"}, *const xyz[3] = {"X", "Y", "Z"};
-    char names[SY_MEDIATOR_RT_AOV_COUNT][3][32];
+    static const char *const rgba[4] = {"R", "G", "B", "A"}, *const rgb[4] = {"R", "G", "B", "A"},
+                             *const xyz[3] = {"X", "Y", "Z"};
+    char names[SY_AOVS_MAX][4][48];
     sy_exr_pixel_type ct = o->half ? SY_EXR_PIXEL_HALF : SY_EXR_PIXEL_FLOAT;
-    for (uint32_t k = 0; k < SY_MEDIATOR_RT_AOV_COUNT; ++k) {
-        uint32_t c = sy_mediator_rt_aov_channels(k);
-        const char *name = sy_mediator_rt_aov_name(k);
-        if (!strcmp(name, "color")) {
-            for (uint32_t i = 0; i < 4; ++i) ch[n++] = (sy_exr_channel_desc){rgba[i], a.planes[k], 4, i, ct};
-        } else if (!strcmp(name, "depth")) {
-            ch[n++] = (sy_exr_channel_desc){"Z", a.planes[k], 1, 0, SY_EXR_PIXEL_FLOAT};
+    for (uint32_t k = 0; k < a.count; ++k) {
+        const sy_aov_plane *p = &a.planes[k];
+        if (!strcmp(p->name, "color")) {
+            for (uint32_t i = 0; i < 4 && i < p->channels; ++i) ch[n++] = (sy_exr_channel_desc){rgba[i], p->data, p->channels, i, ct};
+        } else if (!strcmp(p->name, "depth")) {
+            ch[n++] = (sy_exr_channel_desc){"Z", p->data, p->channels, 0, SY_EXR_PIXEL_FLOAT};
         } else {
-            for (uint32_t i = 0; i < c && i < 3; ++i) {
-                snprintf(names[k][i], sizeof names[k][i], "%s.%s", name, !strcmp(name, "normal") ? xyz[i] : rgb[i]);
-                ch[n++] = (sy_exr_channel_desc){names[k][i], a.planes[k], c, i, ct};
+            bool normal = !strcmp(p->name, "normal");
+            for (uint32_t i = 0; i < p->channels && i < (normal ? 3u : 4u); ++i) {
+                snprintf(names[k][i], sizeof names[k][i], "%s.%s", p->name, normal ? xyz[i] : rgb[i]);
+                ch[n++] = (sy_exr_channel_desc){names[k][i], p->data, p->channels, i, ct};
             }
         }
     }
     sy_exr_write_desc wd = {.width = (int)a.width, .height = (int)a.height, .channels = ch, .channel_count = n,
                             .attributes = o->attrs, .attribute_count = o->attr_count};
     r = sy_exr_write(path, &wd, err);
-    sy_mediator_rt_aovs_free(&a);
+    sy_aovs_free(&a);
     return r;
 }
 
@@ -606,6 +605,31 @@ static const char *render_filter_params(const char *params, const char *filter, 
     return buf;
 }
 
+/* One line per cluster frame on stderr: servers, failures, bytes (the cluster mediator's statistics). */
+static void cluster_report(sy_scene *scene, sy_context_pool *pool, const sy_compose_spec *spec, uint32_t frame,
+                           uint32_t servers)
+{
+    sy_params pp;
+    sy_context *ctx = NULL;
+    sy_error e = {0};
+    if (sy_params_parse(spec->params, &pp, &e) != SY_OK ||
+        sy_context_pool_get(pool, scene, spec->backend, &pp, spec->root.id, &ctx, &e) != SY_OK ||
+        !(sy_context_caps(ctx) & SY_CAP_REMOTE))
+        return;
+    sy_cluster_frame_stats st;
+    uint32_t mode = 0;
+    sy_mediator_cluster_last_frame(sy_context_state(ctx), &st);
+    sy_mediator_cluster_describe(sy_context_state(ctx), &mode, NULL);
+    fprintf(stderr,
+            "sy render: cluster frame %u (%s): %u/%u servers, %u failed, %u reassigned, %.3f s, "
+            "%llu bytes sent (%llu scene), %llu received\n",
+            frame + 1, sy_cluster_mode_name(mode), st.servers_live, servers, st.servers_failed, st.reassigned,
+            st.seconds, (unsigned long long)st.bytes_sent, (unsigned long long)st.scene_bytes,
+            (unsigned long long)st.bytes_received);
+    if (mode == SY_CLUSTER_COOPERATIVE)
+        fprintf(stderr, "sy render: merged %llu samples per pixel\n", (unsigned long long)st.samples);
+}
+
 static int cmd_render(int argc, char **argv)
 {
     const char *scene = NULL, *backend = NULL, *outp = NULL, *camera = NULL, *params = NULL;
@@ -663,30 +687,65 @@ static int cmd_render(int argc, char **argv)
             return usage();
         }
     }
-    if (po.spp) clo.samples = po.spp; /* --spp also sets the cluster's cooperative sample count */
     if (!scene || !backend || !outp) return usage();
     char gl_params[256];
     if (gl_provider) params = render_gl_params(params, gl_provider, gl_params, sizeof gl_params);
     char filter_params[512];
     if (filter || threshold) params = render_filter_params(params, filter, threshold, filter_params, sizeof filter_params);
     sy_error err = {0};
-    if ((filter || threshold) && (strcmp(backend, "pathtracer") != 0 || clo.cluster)) {
-        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--filter and --threshold need a local -b pathtracer render (got -b %s%s)",
-                     backend, clo.cluster ? " with --cluster: tiles would be filtered separately" : "");
-        return fail(&err);
-    }
     if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) { /* before any loading or rendering */
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);
         return fail(&err);
     }
+    /* --cluster: the main viewport's back-end becomes the cluster mediator (the servers render with
+     * -b BACKEND); everything below is the same render path as a local one */
+    const char *remote = backend;
+    char cluster_params[1400];
+    uint32_t cluster_mode = 0, cluster_servers = 0;
+    if (clo.cluster) {
+        if (sy_cluster_cli_setup(&clo, backend, params, cluster_params, sizeof cluster_params, &cluster_mode,
+                                 &cluster_servers, &err) != SY_OK)
+            return fail(&err);
+        if (cluster_mode == SY_CLUSTER_STEREO && spec.stereo == SY_STEREO_NONE) spec.stereo = SY_STEREO_SBS;
+        backend = SY_MEDIATOR_CLUSTER_NAME;
+        params = cluster_params;
+    }
+    char shown[96]; /* the back-end as reported: "whitted", or "whitted on 2 servers (sort-first)" */
+    if (clo.cluster)
+        snprintf(shown, sizeof shown, "%s on %u server%s (%s)", remote, cluster_servers, cluster_servers == 1 ? "" : "s",
+                 sy_cluster_mode_name(cluster_mode));
+    else snprintf(shown, sizeof shown, "%s", remote);
     const sy_mediator_class *bcls = sy_mediator_find(backend);
-    bool progressive = bcls && (bcls->caps & SY_CAP_PROGRESSIVE) && !clo.cluster;
-    if (progressive_opts && bcls && !(bcls->caps & SY_CAP_PROGRESSIVE) && !clo.cluster) {
-        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--spp, --time and --aov need a progressive back-end; '%s' is not",
-                     backend);
+    sy_params bparams = {0};
+    if (!bcls) {
+        sy_context *none = NULL;
+        sy_context_create(NULL, backend, NULL, 0, &none, &err); /* the error that lists the back-ends */
         return fail(&err);
     }
-    if (po.aov && (!ends_with(outp, ".exr") || spec.stereo != SY_STEREO_NONE || overlay || clo.cluster)) {
+    if (sy_params_parse(params, &bparams, &err) != SY_OK) return fail(&err);
+    uint32_t caps = sy_mediator_class_caps(bcls, &bparams);
+    const sy_mediator_class *rcls = sy_mediator_find(remote);
+    if ((filter || threshold) && !(caps & SY_CAP_FILTERS)) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--filter and --threshold need a back-end with display filters, "
+                     "such as a local -b pathtracer (got -b %s%s)",
+                     remote, clo.cluster ? " with --cluster: its strips would be filtered apart" : "");
+        return fail(&err);
+    }
+    bool progressive = (caps & SY_CAP_PROGRESSIVE) != 0;
+    /* a cluster in sort-first / balanced mode over a progressive back-end: --spp is the samples of each request */
+    bool remote_spp = clo.cluster && !progressive && rcls && (rcls->caps & SY_CAP_PROGRESSIVE) && po.spp && !po.aov &&
+                      !(po.time_budget > 0);
+    if (progressive_opts && !progressive && !remote_spp) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--spp, --time and --aov need a progressive back-end; '%s'%s is not",
+                     remote, clo.cluster ? " on the cluster in this mode (cooperative is)" : "");
+        return fail(&err);
+    }
+    if (po.aov && !(caps & SY_CAP_AOVS)) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--aov: back-end %s%s keeps no feature buffers", remote,
+                     clo.cluster ? " on the cluster" : "");
+        return fail(&err);
+    }
+    if (po.aov && (!ends_with(outp, ".exr") || spec.stereo != SY_STEREO_NONE || overlay)) {
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: --aov needs an .exr output of a local mono render without overlay",
                      outp);
         return fail(&err);
@@ -715,7 +774,7 @@ static int cmd_render(int argc, char **argv)
     spec.background = ld.background;
     sy_result r = overlay ? add_overlay(&ld, overlay, composite, &spec, &err) : SY_OK;
     if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
-    progress_state ps = {backend, sy_time_now(), 0, sy_is_terminal(2)};
+    progress_state ps = {shown, sy_time_now(), 0, sy_is_terminal(2)};
     sy_window_render_opts ro = {.progress = progress_cb, .progress_user = &ps};
     double t0 = sy_time_now();
     uint64_t samples = 0;
@@ -731,19 +790,25 @@ static int cmd_render(int argc, char **argv)
         interrupted = sy_signals_interrupted();
         snprintf(samples_str, sizeof samples_str, "%llu", (unsigned long long)samples);
         snprintf(secs_str, sizeof secs_str, "%.3f", secs);
-        attrs[oo.attr_count++] = (sy_exr_attribute){"sy:backend", backend};
+        attrs[oo.attr_count++] = (sy_exr_attribute){"sy:backend", shown};
         attrs[oo.attr_count++] = (sy_exr_attribute){"sy:samples", samples_str};
         attrs[oo.attr_count++] = (sy_exr_attribute){"sy:seconds", secs_str};
         if (interrupted) attrs[oo.attr_count++] = (sy_exr_attribute){"sy:interrupted", "1"};
         oo.attrs = attrs;
     } else if (r == SY_OK && clo.cluster) {
-        sy_viewport_desc cvd = {.root = ld.root, .camera = ld.camera, .background = ld.background, .backend = backend,
-                                .params = params, .eye_separation = spec.eye_separation, .zero_parallax = spec.zero_parallax};
-        r = sy_cluster_cli_render(&clo, ld.scene, &cvd, w, h, &img, &secs, &err);
+        /* --frames N: N frames through the same window (balanced strips adapt from frame to frame) */
+        if (remote_spp) ro.sample_count = po.spp;
+        uint32_t frames = clo.frames ? clo.frames : 1;
+        for (uint32_t i = 0; i < frames && r == SY_OK; ++i) {
+            sy_layer_destroy(&img);
+            sy_layer_destroy(&img_right);
+            r = sy_compose_render(ld.scene, pool, &spec, w, h, &ro, &img, &img_right, &err);
+            if (r == SY_OK) cluster_report(ld.scene, pool, &spec, i, cluster_servers);
+        }
     } else if (r == SY_OK) r = sy_compose_render(ld.scene, pool, &spec, w, h, &ro, &img, &img_right, &err);
     secs = sy_time_now() - t0;
-    if (r == SY_OK && clo.cluster && !img.rgba) {
-        printf("multi-display: %ux%u wall presented by the servers, %s, %.3f s\n", w, h, backend, secs);
+    if (r == SY_OK && clo.cluster && cluster_mode == SY_CLUSTER_MULTI_DISPLAY) {
+        printf("multi-display: %ux%u wall presented by the servers, %s, %.3f s\n", w, h, remote, secs);
     } else if (r == SY_OK) {
         size_t bad = sy_layer_count_nonfinite(&img) + (img_right.rgba ? sy_layer_count_nonfinite(&img_right) : 0);
         if (bad) fprintf(stderr, "sy render: warning: %zu pixels are not finite\n", bad);
@@ -752,17 +817,17 @@ static int cmd_render(int argc, char **argv)
             r = eye_paths(outp, lp, rp, sizeof lp, &err);
             if (r == SY_OK) r = write_image(lp, &img, &oo, &err);
             if (r == SY_OK) r = write_image(rp, &img_right, &oo, &err);
-            if (r == SY_OK) printf("%s, %s: %ux%u per eye, %s, %.3f s\n", lp, rp, w, h, backend, secs);
+            if (r == SY_OK) printf("%s, %s: %ux%u per eye, %s, %.3f s\n", lp, rp, w, h, shown, secs);
         } else {
             r = po.aov ? write_aov_exr(outp, pctx, &oo, &err) : write_image(outp, &img, &oo, &err);
             if (r == SY_OK && progressive)
                 printf("%s: %ux%u, %s, %llu samples per pixel, %.3f s (%.2f samples/s)%s\n", outp, img.width,
-                       img.height, backend, (unsigned long long)samples, secs,
+                       img.height, shown, (unsigned long long)samples, secs,
                        secs > 0 ? (double)samples / secs : 0.0, interrupted ? ", interrupted" : "");
-            else if (r == SY_OK) printf("%s: %ux%u, %s, %.3f s\n", outp, img.width, img.height, backend, secs);
+            else if (r == SY_OK) printf("%s: %ux%u, %s, %.3f s\n", outp, img.width, img.height, shown, secs);
             if (r == SY_OK && progressive && filter && pctx) { /* the display filter's report (issue 7) */
-                sy_mediator_rt_filter_info fi;
-                sy_mediator_rt_filter_info_get(sy_context_state(pctx), &fi);
+                sy_filter_info fi;
+                sy_context_filter_info(pctx, &fi);
                 printf("filter %s: threshold %g, last filter %.1f ms, last pass at %u spp, mean blend %.3f, "
                        "NaN/Inf: %llu pixels, %llu samples\n",
                        fi.name, (double)fi.threshold, fi.seconds * 1e3, fi.last_pass_samples, fi.mean_blend,
@@ -1010,8 +1075,14 @@ static int cmd_backends(void)
 {
     for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
         const sy_mediator_class *c = sy_mediator_at(i);
-        printf("%s%s%s%s\n", c->name, (c->caps & SY_CAP_DEPTH) ? " depth" : "",
-               (c->caps & SY_CAP_PROGRESSIVE) ? " progressive" : "", (c->caps & SY_CAP_TILES) ? " tiles" : "");
+        static const struct { uint32_t bit; const char *word; } caps[] = {
+            {SY_CAP_DEPTH, "depth"}, {SY_CAP_PROGRESSIVE, "progressive"}, {SY_CAP_TILES, "tiles"},
+            {SY_CAP_SAMPLE_RANGES, "sample-ranges"}, {SY_CAP_AOVS, "aovs"}, {SY_CAP_FILTERS, "filters"},
+            {SY_CAP_ANALYSIS, "analysis"}, {SY_CAP_REMOTE, "remote"}};
+        printf("%s", c->name);
+        for (size_t k = 0; k < sizeof caps / sizeof caps[0]; ++k)
+            if (c->caps & caps[k].bit) printf(" %s", caps[k].word);
+        printf("\n");
     }
     return 0;
 }

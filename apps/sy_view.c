@@ -87,7 +87,7 @@ static void orbit_from_matrix(const sy_mat4 *m, const sy_bounds *b, orbit *o)
     o->yaw = atan2f(back[0], back[2]);
 }
 
-/* Display filters of the path tracer the F key cycles through (sy_mediator_rt_set_filter). */
+/* Display filters the F key cycles through, on a back-end with SY_CAP_FILTERS (sy_context_set_filter). */
 static const char *const view_filters[] = {"none", "pixel", "atrous", "jbu", "adaptive", "radiance"};
 #define VIEW_FILTER_COUNT (sizeof view_filters / sizeof view_filters[0])
 
@@ -98,7 +98,7 @@ static void view_apply_filter(sy_context_pool *pool, const sy_view_args *a, cons
                               uint64_t *applied_version, char *status, size_t len)
 {
     status[0] = 0;
-    if (strcmp(cls->name, "pathtracer") != 0) return;
+    if (!(cls->caps & SY_CAP_FILTERS)) return;
     sy_context *ctx = NULL;
     sy_error err = {0};
     if (sy_context_pool_get(pool, a->scene, cls->name, NULL, a->spec.root.id, &ctx, &err) != SY_OK) {
@@ -111,15 +111,15 @@ static void view_apply_filter(sy_context_pool *pool, const sy_view_args *a, cons
         char t[32];
         snprintf(t, sizeof t, "%g", (double)threshold);
         if (sy_params_set(&opts, "threshold", t, &err) != SY_OK ||
-            sy_mediator_rt_set_filter(state, view_filters[filter % VIEW_FILTER_COUNT], &opts, &err) != SY_OK) {
+            sy_context_set_filter(ctx, view_filters[filter % VIEW_FILTER_COUNT], &opts, &err) != SY_OK) {
             snprintf(status, len, " | filter: %.80s", err.message);
             return;
         }
         *applied_state = state;
         *applied_version = version;
     }
-    sy_mediator_rt_filter_info fi;
-    sy_mediator_rt_filter_info_get(state, &fi);
+    sy_filter_info fi;
+    sy_context_filter_info(ctx, &fi);
     if (strcmp(fi.name, "none") != 0)
         snprintf(status, len, " | filter %s t=%g %.1f ms%s", fi.name, (double)fi.threshold, fi.seconds * 1e3,
                  fi.nonfinite_pixels ? " | NaN/Inf pixels!" : "");

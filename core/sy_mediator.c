@@ -291,7 +291,7 @@ sy_result sy_context_create(sy_scene *scene, const char *backend, const sy_param
     c->scene = scene;
     c->root = root_node_id;
     if (params) c->params = *params;
-    sy_mediator_create_args args = {root_node_id, &c->params};
+    sy_mediator_create_args args = {root_node_id, &c->params, cls->user};
     sy_result r = cls->create(&args, &c->state, err);
     if (r == SY_OK) r = sy_scene_consumer_add(scene, &c->consumer, err);
     if (r != SY_OK) {
@@ -404,3 +404,40 @@ sy_result sy_context_pool_get(sy_context_pool *p, sy_scene *scene, const char *b
 }
 
 uint32_t sy_context_pool_size(const sy_context_pool *p) { return p->count; }
+
+uint32_t sy_mediator_class_caps(const sy_mediator_class *cls, const sy_params *params)
+{
+    sy_params none = {0};
+    return cls->caps_of ? cls->caps_of(params ? params : &none, cls->user) : cls->caps;
+}
+
+uint32_t sy_context_caps(const sy_context *c) { return sy_mediator_class_caps(c->cls, &c->params); }
+
+void sy_aovs_free(sy_aovs *a)
+{
+    if (!a) return;
+    for (uint32_t i = 0; i < a->count && i < SY_AOVS_MAX; ++i) free(a->planes[i].data);
+    memset(a, 0, sizeof *a);
+}
+
+sy_result sy_context_aovs(sy_context *c, sy_aovs *out, sy_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!(sy_context_caps(c) & SY_CAP_AOVS) || !c->cls->aovs)
+        return sy_error_set(err, SY_ERR_UNSUPPORTED, "back-end %s keeps no feature buffers (AOVs)", c->cls->name);
+    return c->cls->aovs(c->state, out, err);
+}
+
+sy_result sy_context_set_filter(sy_context *c, const char *name, const sy_params *opts, sy_error *err)
+{
+    if (!(sy_context_caps(c) & SY_CAP_FILTERS) || !c->cls->set_filter)
+        return sy_error_set(err, SY_ERR_UNSUPPORTED, "back-end %s has no display filters", c->cls->name);
+    return c->cls->set_filter(c->state, name, opts, err);
+}
+
+void sy_context_filter_info(const sy_context *c, sy_filter_info *out)
+{
+    memset(out, 0, sizeof *out);
+    snprintf(out->name, sizeof out->name, "none");
+    if ((sy_context_caps(c) & SY_CAP_FILTERS) && c->cls->filter_info) c->cls->filter_info(c->state, out);
+}

@@ -90,17 +90,54 @@ sy_result sy_params_get_float(const sy_params *p, const char *key, double def, d
 bool sy_params_equal(const sy_params *a, const sy_params *b);
 
 /* ---- mediator classes ---- */
+/* Typed capabilities: the rest of the library and the applications ask these (sy_context_caps,
+ * sy_mediator_class.caps), never a back-end's name. */
 typedef enum sy_mediator_caps {
     SY_CAP_DEPTH = 1u << 0,       /* fills the depth layer */
     SY_CAP_PROGRESSIVE = 1u << 1, /* accumulates samples across render calls */
     SY_CAP_TILES = 1u << 2,       /* renders any sub-rectangle exactly like the full image */
     SY_CAP_ANALYSIS = 1u << 3,    /* draws an analysis image (e.g. object coverage), not the scene's look:
                                      comparisons of looks (sy compare) leave it out */
+    SY_CAP_SAMPLE_RANGES = 1u << 4, /* its samples split across renderers: renders with distinct seeds (or
+                                       sample_first ranges) draw independent samples, and their images
+                                       merged by sample count estimate the same pixel (cooperative) */
+    SY_CAP_AOVS = 1u << 5,        /* keeps feature buffers (variance, albedo, normal, ...): sy_context_aovs */
+    SY_CAP_FILTERS = 1u << 6,     /* display noise filters: sy_context_set_filter / sy_context_filter_info */
+    SY_CAP_REMOTE = 1u << 7,      /* renders on other machines (the cluster mediator) */
 } sy_mediator_caps;
+
+/* ---- feature buffers (SY_CAP_AOVS) ---- */
+#define SY_AOVS_MAX 16
+typedef struct sy_aov_plane {
+    const char *name;  /* "color", "depth", "variance", "albedo", "normal", ... (static storage) */
+    uint32_t channels; /* values per pixel */
+    float *data;       /* width*height*channels floats, row 0 = top; malloc()ed, owned by the sy_aovs */
+} sy_aov_plane;
+typedef struct sy_aovs {
+    uint32_t width, height;
+    uint64_t samples;           /* samples per pixel accumulated */
+    uint64_t nonfinite_samples; /* samples replaced by zero because they were NaN/Inf */
+    uint32_t count;
+    sy_aov_plane planes[SY_AOVS_MAX];
+} sy_aovs;
+void sy_aovs_free(sy_aovs *a); /* frees every plane, zeroes the struct; NULL-safe */
+
+/* ---- display filters (SY_CAP_FILTERS) ---- */
+typedef struct sy_filter_info {
+    char name[32];              /* current filter, "none" when unfiltered */
+    float threshold;            /* current threshold */
+    uint64_t frames;            /* filtered frames so far */
+    uint64_t nonfinite_pixels;  /* last filtered frame: NaN/Inf input pixels kept out of neighbourhoods */
+    uint64_t nonfinite_samples; /* last filtered accumulation: NaN/Inf samples the back-end replaced by 0 */
+    double seconds;             /* last filter call's wall time */
+    uint32_t last_pass_samples; /* samples of the last filter pass (0 = none yet, or the filter runs every frame) */
+    double mean_blend;          /* mean share of the unfiltered image in the output (1 = unfiltered everywhere) */
+} sy_filter_info;
 
 typedef struct sy_mediator_create_args {
     uint32_t root_node_id; /* 0 = every root of the scene */
     const sy_params *params;
+    const void *class_user; /* the class's user pointer (sy_mediator_class.user) */
 } sy_mediator_create_args;
 
 typedef struct sy_mediator_stats {
@@ -110,7 +147,7 @@ typedef struct sy_mediator_stats {
 
 typedef struct sy_mediator_class {
     const char *name; /* "whitted", "pathtracer", "raster", ... */
-    uint32_t caps;    /* sy_mediator_caps */
+    uint32_t caps;    /* sy_mediator_caps every instance has */
     sy_result (*create)(const sy_mediator_create_args *args, void **state_out, sy_error *err);
     void (*destroy)(void *state);
     /* Applies a change list (the first one is a snapshot). */
@@ -118,6 +155,16 @@ typedef struct sy_mediator_class {
     /* Fills layer (rect_w x rect_h) for the request. */
     sy_result (*render)(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err);
     void (*stats)(void *state, sy_mediator_stats *out); /* optional */
+    /* Optional: the capabilities of an instance made with these parameters, when they depend on them
+     * (the cluster: those of the servers' back-end in that mode); NULL = caps. */
+    uint32_t (*caps_of)(const sy_params *params, const void *class_user);
+    /* SY_CAP_AOVS: copies the feature buffers of the last render into out (caller frees). */
+    sy_result (*aovs)(void *state, sy_aovs *out, sy_error *err);
+    /* SY_CAP_FILTERS: sets the display filter ("none" turns it off) and its options; the info of the
+     * filter now set. */
+    sy_result (*set_filter)(void *state, const char *name, const sy_params *opts, sy_error *err);
+    void (*filter_info)(void *state, sy_filter_info *out);
+    const void *user; /* handed to create as class_user (a class registered at run time: its configuration) */
 } sy_mediator_class;
 
 /* Registry (process-wide; the one piece of global state). The class must outlive the process's
@@ -126,6 +173,8 @@ sy_result sy_mediator_register(const sy_mediator_class *cls, sy_error *err);
 const sy_mediator_class *sy_mediator_find(const char *name);
 uint32_t sy_mediator_count(void);
 const sy_mediator_class *sy_mediator_at(uint32_t i);
+/* Capabilities of an instance of cls made with params (NULL = none): cls->caps, or cls->caps_of for the parameters. */
+uint32_t sy_mediator_class_caps(const sy_mediator_class *cls, const sy_params *params);
 
 /* ---- contexts ---- */
 typedef struct sy_context sy_context;
@@ -143,6 +192,15 @@ const sy_mediator_class *sy_context_class(const sy_context *c);
 /* The mediator's own state (for the mediator module's diagnostics functions). Borrowed. */
 void *sy_context_state(const sy_context *c);
 void sy_context_stats(const sy_context *c, sy_mediator_stats *out);
+/* The instance's capabilities (sy_mediator_caps): the class's, or what caps_of says for its parameters. */
+uint32_t sy_context_caps(const sy_context *c);
+/* Feature buffers of the last render; SY_ERR_UNSUPPORTED naming the back-end without SY_CAP_AOVS.
+ * out is the caller's: sy_aovs_free. */
+sy_result sy_context_aovs(sy_context *c, sy_aovs *out, sy_error *err);
+/* Display filter (SY_CAP_FILTERS; others: SY_ERR_UNSUPPORTED naming the back-end). */
+sy_result sy_context_set_filter(sy_context *c, const char *name, const sy_params *opts, sy_error *err);
+/* Fills out (name "none" for a back-end without filters). */
+void sy_context_filter_info(const sy_context *c, sy_filter_info *out);
 
 /* A cache of contexts keyed by (scene, back-end, parameters, root): viewports showing the same
  * scene with the same back-end share one context, so the scene is converted once and switching

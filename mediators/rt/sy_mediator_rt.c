@@ -1056,17 +1056,6 @@ static sy_result pathtracer_create(const sy_mediator_create_args *args, void **s
     return rt_create_common(args, SY_RT_INTEGRATOR_PATHTRACER, state_out, err);
 }
 
-static const sy_mediator_class pathtracer_class = {
-    .name = "pathtracer",
-    .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES,
-    .create = pathtracer_create,
-    .destroy = rt_destroy,
-    .sync = rt_sync,
-    .render = rt_render,
-    .stats = rt_stats,
-};
-
-const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtracer_class; }
 
 sy_result sy_mediator_rt_aovs_get(void *state, sy_mediator_rt_aovs *out, sy_error *err)
 {
@@ -1104,6 +1093,52 @@ void sy_mediator_rt_aovs_free(sy_mediator_rt_aovs *a)
 
 const char *sy_mediator_rt_aov_name(uint32_t index) { return sy_rt_aov_name((sy_rt_aov)index); }
 uint32_t sy_mediator_rt_aov_channels(uint32_t index) { return sy_rt_aov_channels((sy_rt_aov)index); }
+
+/* The generic feature-buffer and filter hooks of the path tracer's class (sy_context_aovs, ...). */
+static sy_result pathtracer_aovs(void *state, sy_aovs *out, sy_error *err)
+{
+    sy_mediator_rt_aovs a;
+    memset(out, 0, sizeof *out);
+    sy_result r = sy_mediator_rt_aovs_get(state, &a, err);
+    if (r != SY_OK) return r;
+    out->width = a.width, out->height = a.height;
+    out->samples = a.samples, out->nonfinite_samples = a.nonfinite_samples;
+    for (uint32_t k = 0; k < SY_MEDIATOR_RT_AOV_COUNT && k < SY_AOVS_MAX; ++k) {
+        out->planes[k] = (sy_aov_plane){sy_mediator_rt_aov_name(k), sy_mediator_rt_aov_channels(k), a.planes[k]};
+        a.planes[k] = NULL; /* moved */
+        out->count = k + 1;
+    }
+    return SY_OK;
+}
+
+static void pathtracer_filter_info(void *state, sy_filter_info *out)
+{
+    sy_mediator_rt_filter_info fi;
+    sy_mediator_rt_filter_info_get(state, &fi);
+    snprintf(out->name, sizeof out->name, "%s", fi.name ? fi.name : "none");
+    out->threshold = fi.threshold;
+    out->frames = fi.frames;
+    out->nonfinite_pixels = fi.nonfinite_pixels;
+    out->nonfinite_samples = fi.nonfinite_samples;
+    out->seconds = fi.seconds;
+    out->last_pass_samples = fi.last_pass_samples;
+    out->mean_blend = fi.mean_blend;
+}
+
+static const sy_mediator_class pathtracer_class = {
+    .name = "pathtracer",
+    .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_SAMPLE_RANGES | SY_CAP_AOVS | SY_CAP_FILTERS,
+    .create = pathtracer_create,
+    .destroy = rt_destroy,
+    .sync = rt_sync,
+    .render = rt_render,
+    .stats = rt_stats,
+    .aovs = pathtracer_aovs,
+    .set_filter = sy_mediator_rt_set_filter,
+    .filter_info = pathtracer_filter_info,
+};
+
+const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtracer_class; }
 
 static const sy_mediator_class whitted_class = {
     .name = "whitted",

@@ -81,7 +81,7 @@ static void coop_stats(void *state, sy_mediator_stats *out)
 
 static const sy_mediator_class coop_class = {
     .name = "coop_test",
-    .caps = SY_CAP_PROGRESSIVE | SY_CAP_TILES | SY_CAP_DEPTH,
+    .caps = SY_CAP_PROGRESSIVE | SY_CAP_TILES | SY_CAP_DEPTH | SY_CAP_SAMPLE_RANGES,
     .create = coop_create,
     .destroy = coop_destroy,
     .sync = coop_sync,

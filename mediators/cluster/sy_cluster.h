@@ -152,6 +152,7 @@ typedef struct sy_cluster_frame {
     sy_camera_view camera;   /* mono view; stereo derives both eyes from it */
     uint32_t width, height;  /* per eye */
     uint32_t samples;        /* cooperative: samples per server per frame (0 = 16); others: per request */
+    uint32_t samples_total;  /* cooperative, when > 0: this frame's samples, split across the live servers */
     uint32_t seed;
     bool depth;              /* fetch depth too */
     bool half;               /* tiles as binary16 (display walls, previews); false = float32, bit-exact */

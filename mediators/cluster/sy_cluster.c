@@ -1212,7 +1212,7 @@ static sy_result handle_render(sy_cluster_server *s, session *se, const sy_clust
     reply->u.tiles.job = q->job;
     reply->u.tiles.sync_seconds = t1 - t0;
     reply->u.tiles.render_seconds = t2 - t1;
-    reply->u.tiles.samples = (sy_context_class(ctx)->caps & SY_CAP_PROGRESSIVE) && st.samples ? st.samples
+    reply->u.tiles.samples = (sy_context_caps(ctx) & SY_CAP_PROGRESSIVE) && st.samples ? st.samples
                                                                                            : (q->sample_count ? q->sample_count : 1);
     reply->u.tiles.tile_count = n;
     reply->u.tiles.tiles = tiles; /* freed by the caller */
@@ -2652,14 +2652,19 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
     uint32_t spp = f->samples ? f->samples : (f->mode == SY_CLUSTER_COOPERATIVE ? 16 : 0);
     if (r == SY_OK) {
         if (f->mode == SY_CLUSTER_COOPERATIVE) {
+            /* samples_total: split across the live servers (the first ones take one more); else spp each */
+            uint64_t total = f->samples_total ? f->samples_total : (uint64_t)nl * spp, first = c->coop_next;
             for (uint32_t s = 0; s < nl && r == SY_OK; ++s) {
+                uint32_t mine = f->samples_total ? (uint32_t)(total / nl + (s < total % nl)) : spp;
+                if (!mine) continue; /* fewer samples than servers */
                 r = sy_layer_create(f->width, f->height, &fc.accum[live[s]], err);
                 fc.items[fc.item_count++] =
-                    (work_item){0, {0, 0, f->width, f->height}, c->coop_next + s * spp, spp, (int)live[s], false};
+                    (work_item){0, {0, 0, f->width, f->height}, (uint32_t)first, mine, (int)live[s], false};
+                first += mine;
             }
-            if ((uint64_t)c->coop_next + (uint64_t)nl * spp > UINT32_MAX - SY_CLUSTER_MAX_SAMPLES)
+            if (first > UINT32_MAX - SY_CLUSTER_MAX_SAMPLES)
                 r = sy_error_set(err, SY_ERR_LIMIT, "cluster: the cooperative sample index would overflow");
-            c->coop_next += nl * spp;
+            c->coop_next = (uint32_t)first;
         } else if (f->mode == SY_CLUSTER_STEREO) {
             uint32_t groups = nl >= 2 ? 2 : 1;
             for (uint32_t eye = 0; eye < 2; ++eye) {
@@ -2734,16 +2739,21 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
         if (!total) r = sy_error_set(err, SY_ERR_IO, "cluster: no server returned samples");
         size_t px = (size_t)f->width * f->height;
         for (size_t p = 0; r == SY_OK && p < px; ++p) {
-            double acc[4] = {0, 0, 0, 0};
-            float depth = INFINITY;
+            /* depth as a local render keeps it: the mean over the samples that hit (each server's
+             * mean weighted by its samples times its coverage, alpha), +INFINITY where none hit */
+            double acc[4] = {0, 0, 0, 0}, dsum = 0, dwgt = 0;
             for (uint32_t i = 0; i < c->n; ++i) {
                 if (!fc.accum[i].rgba || !fc.accum_samples[i]) continue;
                 double wgt = (double)fc.accum_samples[i];
                 for (int ch = 0; ch < 4; ++ch) acc[ch] += wgt * fc.accum[i].rgba[p * 4 + ch];
-                if (fc.accum[i].depth[p] < depth) depth = fc.accum[i].depth[p];
+                float d = fc.accum[i].depth[p];
+                if (isfinite(d)) {
+                    double a = fc.accum[i].rgba[p * 4 + 3], dw = wgt * (a > 1e-6 ? a : 1e-6);
+                    dsum += dw * d, dwgt += dw;
+                }
             }
             for (int ch = 0; ch < 4; ++ch) out->rgba[p * 4 + ch] = (float)(acc[ch] / (double)total);
-            if (out->depth) out->depth[p] = depth;
+            if (out->depth) out->depth[p] = dwgt > 0 ? (float)(dsum / dwgt) : INFINITY;
         }
         st.samples = total;
     }

@@ -1,0 +1,278 @@
+/* sy_mediator_cluster.c — the cluster mediator class (see sy_mediator_cluster.h): a replica scene
+ * fed by the context's change lists, a cluster client on it, and the translation of a render
+ * request into a cluster frame. */
+#include "sy_mediator_cluster.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A registered configuration: deep copies of what sy_cluster_client_opts points to. */
+typedef struct cluster_config {
+    sy_mediator_class cls;
+    char name[32];
+    sy_cluster_client_opts opts;
+    char *urls[SY_CLUSTER_MAX_SERVERS];
+    char *backends[SY_CLUSTER_MAX_SERVERS];
+    sy_cluster_rect tiles[SY_CLUSTER_MAX_SERVERS];
+    uint8_t *secret;
+    char *tls_ca;
+} cluster_config;
+
+typedef struct cluster_state {
+    const cluster_config *cfg;
+    sy_scene *replica;
+    sy_cluster_client *client;
+    uint32_t root_id;
+    uint32_t mode;
+    bool half;
+    uint32_t samples;   /* cooperative default per render (0 = 16 per server) */
+    uint32_t caps;
+    char backend[SY_CLUSTER_BACKEND_MAX];
+    char params[SY_CLUSTER_PARAMS_MAX]; /* forwarded to the servers' back-end */
+    sy_cluster_frame_stats last;
+    uint64_t merged_samples;
+    sy_layer full; /* a request for a sub-rectangle renders the whole image here */
+} cluster_state;
+
+/* Caps the servers' back-end `name` has, as registered in this process (same binary); unknown
+ * here: depth only (the servers may know it). */
+static uint32_t remote_caps(const char *name)
+{
+    const sy_mediator_class *c = sy_mediator_find(name);
+    return c ? c->caps : SY_CAP_DEPTH;
+}
+
+/* What an instance with these parameters can do: what every node's back-end has, as the mode
+ * delivers it (cooperative accumulates: progressive). */
+static uint32_t cluster_caps_of(const sy_params *p, const void *class_user)
+{
+    const cluster_config *cfg = class_user;
+    const char *backend = sy_params_get(p, "backend"), *m = sy_params_get(p, "mode");
+    uint32_t mode = SY_CLUSTER_SORT_FIRST;
+    if (m && !sy_cluster_mode_parse(m, &mode)) mode = SY_CLUSTER_SORT_FIRST;
+    uint32_t common = SY_CAP_DEPTH | SY_CAP_ANALYSIS | SY_CAP_SAMPLE_RANGES;
+    for (uint32_t i = 0; i < cfg->opts.url_count; ++i) {
+        const char *b = cfg->backends[i] ? cfg->backends[i] : backend;
+        common &= b ? remote_caps(b) : 0;
+    }
+    uint32_t caps = SY_CAP_REMOTE | SY_CAP_TILES | (common & (SY_CAP_DEPTH | SY_CAP_ANALYSIS));
+    if (mode == SY_CLUSTER_COOPERATIVE && (common & SY_CAP_SAMPLE_RANGES)) caps |= SY_CAP_PROGRESSIVE;
+    return caps;
+}
+
+static sy_result check_node(const cluster_config *cfg, uint32_t i, const char *backend, uint32_t mode, sy_error *err)
+{
+    uint32_t caps = remote_caps(backend);
+    if (mode == SY_CLUSTER_COOPERATIVE && !(caps & SY_CAP_SAMPLE_RANGES))
+        return sy_error_set(err, SY_ERR_UNSUPPORTED,
+                            "cluster: server %u (%s) renders with %s, whose samples cannot be split across servers: "
+                            "mode cooperative needs a back-end with sample ranges (e.g. pathtracer)",
+                            i + 1, cfg->urls[i], backend);
+    if (caps & SY_CAP_ANALYSIS && mode == SY_CLUSTER_COOPERATIVE)
+        return sy_error_set(err, SY_ERR_UNSUPPORTED, "cluster: server %u (%s): %s is an analysis back-end", i + 1,
+                            cfg->urls[i], backend);
+    return SY_OK;
+}
+
+static void cluster_destroy(void *state)
+{
+    cluster_state *st = state;
+    if (!st) return;
+    sy_cluster_client_destroy(st->client);
+    sy_scene_destroy(st->replica);
+    sy_layer_destroy(&st->full);
+    free(st);
+}
+
+static sy_result cluster_create(const sy_mediator_create_args *args, void **state_out, sy_error *err)
+{
+    *state_out = NULL;
+    const cluster_config *cfg = args->class_user;
+    const sy_params *p = args->params;
+    const char *backend = sy_params_get(p, "backend");
+    if (!backend || !backend[0])
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "%s: parameter backend=NAME (the servers' back-end) is required", cfg->name);
+    if (strlen(backend) >= SY_CLUSTER_BACKEND_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: back-end name '%s' is too long", cfg->name, backend);
+    const sy_mediator_class *own = sy_mediator_find(backend);
+    if (own && (own->caps & SY_CAP_REMOTE))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: backend=%s is itself a cluster", cfg->name, backend);
+    uint32_t mode = SY_CLUSTER_SORT_FIRST;
+    const char *m = sy_params_get(p, "mode");
+    if (m && !sy_cluster_mode_parse(m, &mode))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "%s: mode=%s is not one of sort-first, balanced, cooperative, multi-display", cfg->name, m);
+    if (mode == SY_CLUSTER_STEREO)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "%s: mode=stereo: a cluster viewport renders the eye it is asked for; give the window "
+                            "stereo viewports (sy render --stereo sbs) instead",
+                            cfg->name);
+    const char *px = sy_params_get(p, "pixels");
+    if (px && strcmp(px, "float") && strcmp(px, "half"))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: pixels=%s is not float or half", cfg->name, px);
+    long samples = 0;
+    sy_result r = sy_params_get_int(p, "samples", 0, 0, SY_CLUSTER_MAX_SAMPLES, &samples, err);
+    if (r) return r;
+    /* set-up checks: every node can do what the mode asks */
+    for (uint32_t i = 0; i < cfg->opts.url_count; ++i) {
+        r = check_node(cfg, i, cfg->backends[i] ? cfg->backends[i] : backend, mode, err);
+        if (r) return r;
+    }
+    cluster_state *st = calloc(1, sizeof *st);
+    if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", cfg->name);
+    st->cfg = cfg;
+    st->root_id = args->root_node_id;
+    st->mode = mode;
+    st->half = px && !strcmp(px, "half");
+    st->samples = (uint32_t)samples;
+    snprintf(st->backend, sizeof st->backend, "%s", backend);
+    /* the rest goes to the servers' back-end */
+    size_t len = 0;
+    for (uint32_t i = 0; i < p->count && r == SY_OK; ++i) {
+        const char *k = p->items[i].key;
+        if (!strcmp(k, "backend") || !strcmp(k, "mode") || !strcmp(k, "samples") || !strcmp(k, "pixels")) continue;
+        int n = snprintf(st->params + len, sizeof st->params - len, "%s%s=%s", len ? "," : "", k, p->items[i].value);
+        if (n < 0 || (size_t)n >= sizeof st->params - len)
+            r = sy_error_set(err, SY_ERR_LIMIT, "%s: back-end parameters longer than %u bytes", cfg->name,
+                             SY_CLUSTER_PARAMS_MAX - 1);
+        else len += (size_t)n;
+    }
+    st->caps = cluster_caps_of(p, cfg);
+    if (r == SY_OK) r = sy_scene_create(&st->replica, err);
+    if (r == SY_OK) r = sy_cluster_client_create(st->replica, &cfg->opts, &st->client, err);
+    if (r) {
+        cluster_destroy(st);
+        return r;
+    }
+    *state_out = st;
+    return SY_OK;
+}
+
+static sy_result cluster_sync(void *state, const sy_changes *changes, sy_error *err)
+{
+    cluster_state *st = state;
+    sy_result r = sy_scene_apply(st->replica, changes, err);
+    if (r == SY_OK) r = sy_scene_commit(st->replica, NULL, err);
+    return r;
+}
+
+static sy_result cluster_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
+{
+    cluster_state *st = state;
+    sy_cluster_frame f = {.mode = st->mode,
+                          .backend = st->backend,
+                          .params = st->params[0] ? st->params : NULL,
+                          .root_id = st->root_id,
+                          .background_id = req->background_id,
+                          .camera = req->camera,
+                          .width = req->full_width,
+                          .height = req->full_height,
+                          .samples = st->mode == SY_CLUSTER_COOPERATIVE ? st->samples : req->sample_count,
+                          /* cooperative: the request's samples, split across the live servers */
+                          .samples_total = st->mode == SY_CLUSTER_COOPERATIVE ? req->sample_count : 0,
+                          .seed = req->seed,
+                          .depth = true,
+                          .half = st->half};
+    bool whole = req->rect_x == 0 && req->rect_y == 0 && req->rect_w == req->full_width && req->rect_h == req->full_height;
+    sy_layer *out = layer;
+    sy_result r = SY_OK;
+    if (!whole) {
+        if (st->full.width != req->full_width || st->full.height != req->full_height) {
+            sy_layer_destroy(&st->full);
+            r = sy_layer_create(req->full_width, req->full_height, &st->full, err);
+        }
+        out = &st->full;
+    }
+    if (r == SY_OK) sy_layer_clear(out);
+    if (r == SY_OK) r = sy_cluster_client_render(st->client, &f, out, &st->last, err);
+    if (r == SY_OK && st->mode == SY_CLUSTER_COOPERATIVE) st->merged_samples = st->last.samples;
+    if (r == SY_OK && !whole)
+        for (uint32_t y = 0; y < req->rect_h; ++y) {
+            size_t src = (size_t)(req->rect_y + y) * req->full_width + req->rect_x, dst = (size_t)y * req->rect_w;
+            memcpy(layer->rgba + dst * 4, out->rgba + src * 4, (size_t)req->rect_w * 4 * sizeof(float));
+            memcpy(layer->depth + dst, out->depth + src, (size_t)req->rect_w * sizeof(float));
+        }
+    if (req->progress && r == SY_OK) {
+        sy_progress pr = {1, 1};
+        req->progress(req->progress_user, &pr);
+    }
+    return r;
+}
+
+static void cluster_stats(void *state, sy_mediator_stats *out)
+{
+    cluster_state *st = state;
+    out->samples = st->mode == SY_CLUSTER_COOPERATIVE ? st->merged_samples : (st->last.seconds > 0 ? 1 : 0);
+}
+
+
+void sy_mediator_cluster_last_frame(void *state, sy_cluster_frame_stats *out)
+{
+    memset(out, 0, sizeof *out);
+    if (state) *out = ((cluster_state *)state)->last;
+}
+
+void sy_mediator_cluster_describe(void *state, uint32_t *mode, uint32_t *servers)
+{
+    const cluster_state *st = state;
+    if (mode) *mode = st ? st->mode : 0;
+    if (servers) *servers = st ? st->cfg->opts.url_count : 0;
+}
+
+static void config_free(cluster_config *c)
+{
+    if (!c) return;
+    for (uint32_t i = 0; i < SY_CLUSTER_MAX_SERVERS; ++i) free(c->urls[i]), free(c->backends[i]);
+    free(c->secret);
+    free(c->tls_ca);
+    free(c);
+}
+
+sy_result sy_mediator_cluster_register(const char *name, const sy_cluster_client_opts *opts, sy_error *err)
+{
+    if (!name || !name[0] || strlen(name) >= 32)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster register: a name of 1..31 characters is needed");
+    if (!opts || !opts->url_count || opts->url_count > SY_CLUSTER_MAX_SERVERS)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster register: between 1 and %u server URLs needed",
+                            SY_CLUSTER_MAX_SERVERS);
+    cluster_config *c = calloc(1, sizeof *c);
+    if (!c) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster register: out of memory");
+    bool oom = false;
+    snprintf(c->name, sizeof c->name, "%s", name);
+    c->opts = *opts;
+    for (uint32_t i = 0; i < opts->url_count; ++i) {
+        c->urls[i] = strdup(opts->urls[i] ? opts->urls[i] : "");
+        oom = oom || !c->urls[i];
+        if (opts->backends && opts->backends[i]) oom = oom || !(c->backends[i] = strdup(opts->backends[i]));
+        if (opts->wall_tiles) c->tiles[i] = opts->wall_tiles[i];
+    }
+    if (opts->secret_len) {
+        c->secret = malloc(opts->secret_len);
+        if (c->secret) memcpy(c->secret, opts->secret, opts->secret_len);
+        else oom = true;
+    }
+    if (opts->tls_ca_file) oom = oom || !(c->tls_ca = strdup(opts->tls_ca_file));
+    if (oom) {
+        config_free(c);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster register: out of memory");
+    }
+    c->opts.urls = (const char *const *)c->urls;
+    c->opts.backends = (const char *const *)c->backends;
+    c->opts.wall_tiles = c->tiles;
+    c->opts.secret = c->secret;
+    c->opts.tls_ca_file = c->tls_ca;
+    c->cls = (sy_mediator_class){.name = c->name,
+                                 .caps = SY_CAP_REMOTE | SY_CAP_TILES,
+                                 .create = cluster_create,
+                                 .destroy = cluster_destroy,
+                                 .sync = cluster_sync,
+                                 .render = cluster_render,
+                                 .stats = cluster_stats,
+                                 .caps_of = cluster_caps_of,
+                                 .user = c};
+    sy_result r = sy_mediator_register(&c->cls, err);
+    if (r) config_free(c); /* the registry keeps a registered class (and so its configuration) for good */
+    return r;
+}

@@ -1,0 +1,54 @@
+/* sy_mediator_cluster.h — the cluster as a mediator: a viewport whose back-end is a cluster class
+ * renders on render servers (`sy serve`) exactly as it would render locally. The application,
+ * the window, compositing, stereo, layers and the progress loop never know.
+ *
+ * A cluster class is registered at run time under a name (e.g. "cluster") with a connection
+ * configuration: server URLs, secret, TLS CA, timeouts, a back-end per server (a raster preview
+ * node beside path tracers) and wall tiles. A viewport then names it as its back-end and gives its
+ * parameters:
+ *   backend=NAME     the back-end the servers render with (required; a server configured with its
+ *                    own back-end uses that one)
+ *   mode=MODE        sort-first (default), balanced, cooperative, multi-display
+ *   samples=N        cooperative: samples per render when the request gives none (default 16 per
+ *                    server); a request's sample count is split across the live servers
+ *   pixels=float|half  tiles as float32 (bit-exact, default) or binary16
+ * Every other key=value is handed to the servers' back-end unchanged.
+ *
+ * An instance: a replica of the scene fed by the change lists its context receives (so a
+ * reconnecting server gets a snapshot of exactly what this context has seen) and a cluster client
+ * on that replica. render() asks the servers for the request's image (strips, balanced strips,
+ * sample ranges or wall tiles) and returns it as the layer; a request for a sub-rectangle renders
+ * the whole image and returns the rectangle. Capabilities of an instance are those of the
+ * servers' back-end as registered in this process (the same binary), filtered by the mode:
+ * cooperative adds progressive accumulation and needs a back-end whose samples merge
+ * (SY_CAP_SAMPLE_RANGES); set-up refuses what a node cannot do, naming the node and the reason.
+ *
+ * Ownership: registration copies the configuration; the class lives until the process ends (the
+ * registry holds it). Thread-safety: registration is safe from any thread; an instance is used like
+ * every context (one thread at a time). */
+#ifndef SY_MEDIATOR_CLUSTER_H
+#define SY_MEDIATOR_CLUSTER_H
+
+#include "sy_cluster.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SY_MEDIATOR_CLUSTER_NAME "cluster"
+
+/* Registers a cluster class named `name` (SY_MEDIATOR_CLUSTER_NAME for the usual one) connecting
+ * with opts (copied: URLs, secret, CA path, per-server back-ends and wall tiles; the log callback
+ * and its user pointer are kept as given and must stay valid). Fails when the name is taken. */
+sy_result sy_mediator_cluster_register(const char *name, const sy_cluster_client_opts *opts, sy_error *err);
+
+/* The last frame's statistics of a cluster instance (sy_context_state of a context whose caps have
+ * SY_CAP_REMOTE); zeroes for anything else. */
+void sy_mediator_cluster_last_frame(void *state, sy_cluster_frame_stats *out);
+/* The instance's mode (sy_cluster_mode) and configured server count. */
+void sy_mediator_cluster_describe(void *state, uint32_t *mode, uint32_t *servers);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_MEDIATOR_CLUSTER_H */

@@ -1,0 +1,287 @@
+/* test_cluster_mediator.c — the cluster as a mediator (issue 16): a window whose viewports name the
+ * "cluster" class renders through the same sy_window_render as a local one, with two render
+ * servers as separate processes on 127.0.0.1.
+ *   1. Side-by-side stereo with a raster overlay (depth composite), whitted on the cluster in
+ *      sort-first and balanced modes: equal to the same window rendered locally (rmse <= 1e-6).
+ *   2. The same layout with a cooperative path trace: coverage IoU >= 0.99 against the local
+ *      composite, and its per-pixel difference from the local render no larger than the difference
+ *      between two local renders with other seeds (1.25x, both at the same sample count); the
+ *      merged sample count is exactly the requested one.
+ *   3. A sub-rectangle request (SY_CAP_TILES) equals that rectangle of the whole image.
+ *   4. Capabilities: the instance's caps follow the servers' back-end and the mode (cooperative
+ *      path tracing is progressive, sort-first whitted is not; both are remote).
+ *   5. Set-up refusals name the node and the reason: cooperative whitted, mode=stereo, no
+ *      backend=, an unknown mode.
+ *   test_cluster_mediator SERVER_EXE WORK_DIR */
+#include "../core/check.h"
+#include "server_proc.h"
+#include "sy_demo.h"
+#include "sy_mediator_cluster.h"
+#include "sy_mediators.h"
+#include "sy_viewport.h"
+
+#include <math.h>
+#include <sys/stat.h>
+
+#define W 96
+#define H 64
+
+typedef struct fixture {
+    sy_scene *scene;
+    sy_demo_info d;
+    sy_node overlay; /* a second root: a sphere above the demo's centre, drawn by the raster overlay */
+} fixture;
+
+static sy_result add_overlay_root(fixture *fx, sy_error *e)
+{
+    sy_bounds b;
+    sy_material m;
+    sy_mesh mesh;
+    sy_result r = sy_node_world_bounds(fx->scene, fx->d.root, &b, e);
+    if (!r) r = sy_material_create(fx->scene, "overlay", &m, e);
+    float ext = b.max[0] - b.min[0];
+    if (!r) r = sy_demo_sphere(fx->scene, 0.12f * ext, 24, 12, m, &mesh, e);
+    const float t[3] = {(b.min[0] + b.max[0]) / 2, b.max[1] + 0.05f * ext, (b.min[2] + b.max[2]) / 2},
+                q[4] = {0, 0, 0, 1}, one[3] = {1, 1, 1};
+    if (!r) r = sy_node_create(fx->scene, "overlay", &fx->overlay, e);
+    if (!r) r = sy_node_set_trs(fx->scene, fx->overlay, t, q, one, e);
+    if (!r) r = sy_node_set_mesh(fx->scene, fx->overlay, mesh, e);
+    if (!r) r = sy_node_set_flags(fx->scene, fx->overlay, SY_NODE_VISIBLE, e);
+    return r;
+}
+
+/* Side-by-side stereo: per eye the main viewport (backend/params) and a raster overlay composited
+ * by depth; renders into out (2W x H) with a fresh context pool (a fresh accumulation). */
+static int render_sbs(fixture *fx, const char *backend, const char *params, uint32_t spp, uint32_t seed, sy_layer *out,
+                      uint64_t *samples_out)
+{
+    sy_error e = {0};
+    sy_window *win = NULL;
+    CHECK_OK(sy_window_create(2 * W, H, &win, &e), e);
+    for (uint32_t eye = SY_EYE_LEFT; eye <= SY_EYE_RIGHT; ++eye) {
+        uint32_t x = eye == SY_EYE_LEFT ? 0 : W;
+        sy_viewport_desc main = {.x = x, .y = 0, .width = W, .height = H, .root = fx->d.root, .camera = fx->d.camera,
+                                 .background = fx->d.background, .backend = backend, .params = params, .eye = eye,
+                                 .composite = SY_COMPOSITE_REPLACE};
+        sy_viewport_desc overlay = main;
+        overlay.backend = "raster";
+        overlay.root = fx->overlay;
+        overlay.params = NULL;
+        overlay.background = (sy_background){0};
+        overlay.composite = SY_COMPOSITE_DEPTH;
+        sy_viewport *v = NULL;
+        CHECK_OK(sy_window_add_viewport(win, &main, &v, &e), e);
+        CHECK_OK(sy_window_add_viewport(win, &overlay, &v, &e), e);
+    }
+    sy_context_pool *pool = NULL;
+    CHECK_OK(sy_context_pool_create(&pool, &e), e);
+    CHECK_OK(sy_layer_create(2 * W, H, out, &e), e);
+    sy_window_render_opts ro = {.sample_count = spp, .seed = seed};
+    CHECK_OK(sy_window_render(win, fx->scene, pool, &ro, out, &e), e);
+    if (samples_out) {
+        sy_params pp;
+        sy_context *ctx = NULL;
+        CHECK_OK(sy_params_parse(params, &pp, &e), e);
+        CHECK_OK(sy_context_pool_get(pool, fx->scene, backend, &pp, fx->d.root.id, &ctx, &e), e);
+        sy_mediator_stats st;
+        sy_context_stats(ctx, &st);
+        *samples_out = st.samples;
+    }
+    sy_context_pool_destroy(pool);
+    sy_window_destroy(win);
+    return 0;
+}
+
+static double rmse(const sy_layer *a, const sy_layer *b)
+{
+    double s = 0;
+    size_t n = (size_t)a->width * a->height * 4;
+    for (size_t i = 0; i < n; ++i) s += (double)(a->rgba[i] - b->rgba[i]) * (a->rgba[i] - b->rgba[i]);
+    return sqrt(s / (double)n);
+}
+
+static double coverage_iou(const sy_layer *a, const sy_layer *b)
+{
+    size_t both = 0, any = 0, n = (size_t)a->width * a->height;
+    for (size_t i = 0; i < n; ++i) {
+        bool ca = a->rgba[i * 4 + 3] > 0.5f, cb = b->rgba[i * 4 + 3] > 0.5f;
+        both += ca && cb;
+        any += ca || cb;
+    }
+    return any ? (double)both / (double)any : 1.0;
+}
+
+static double mean_abs_diff(const sy_layer *a, const sy_layer *b)
+{
+    double s = 0;
+    size_t n = (size_t)a->width * a->height * 4;
+    for (size_t i = 0; i < n; ++i) s += fabs((double)a->rgba[i] - b->rgba[i]);
+    return s / (double)n;
+}
+
+static double mean_rgb(const sy_layer *a)
+{
+    double s = 0;
+    size_t n = (size_t)a->width * a->height;
+    for (size_t i = 0; i < n; ++i) s += a->rgba[i * 4] + a->rgba[i * 4 + 1] + a->rgba[i * 4 + 2];
+    return s / (3.0 * (double)n);
+}
+
+static int test_sort_first_and_balanced(fixture *fx)
+{
+    sy_layer local = {0}, sf = {0}, bal = {0};
+    CHECK(render_sbs(fx, "whitted", NULL, 0, 0, &local, NULL) == 0);
+    CHECK(render_sbs(fx, "cluster", "backend=whitted,mode=sort-first", 0, 0, &sf, NULL) == 0);
+    CHECK(render_sbs(fx, "cluster", "backend=whitted,mode=balanced", 0, 0, &bal, NULL) == 0);
+    double e1 = rmse(&local, &sf), e2 = rmse(&local, &bal);
+    printf("stereo sbs + raster overlay, whitted: sort-first rmse %.3g, balanced rmse %.3g; mean %.4f\n", e1, e2,
+           mean_rgb(&local));
+    CHECK_MSG(e1 <= 1e-6 && e2 <= 1e-6, "cluster composite differs from the local one");
+    CHECK_MSG(mean_rgb(&local) > 0.01, "the reference image is black: the comparison would see nothing");
+    sy_layer_destroy(&local), sy_layer_destroy(&sf), sy_layer_destroy(&bal);
+    return 0;
+}
+
+static int test_cooperative(fixture *fx)
+{
+    enum { SPP = 16 };
+    sy_layer l1 = {0}, l2 = {0}, c = {0};
+    uint64_t samples = 0;
+    CHECK(render_sbs(fx, "pathtracer", NULL, SPP, 1, &l1, NULL) == 0);
+    CHECK(render_sbs(fx, "pathtracer", NULL, SPP, 977, &l2, NULL) == 0);
+    CHECK(render_sbs(fx, "cluster", "backend=pathtracer,mode=cooperative", SPP, 5, &c, &samples) == 0);
+    double iou = coverage_iou(&l1, &c), noise = mean_abs_diff(&l1, &l2), diff = mean_abs_diff(&l1, &c);
+    double ratio = mean_rgb(&c) / mean_rgb(&l1);
+    printf("stereo sbs + raster overlay, cooperative pathtracer %d spp: IoU %.4f, |cluster - local| %.5f vs local "
+           "noise %.5f, mean ratio %.4f, merged %llu samples\n",
+           SPP, iou, diff, noise, ratio, (unsigned long long)samples);
+    CHECK_MSG(samples == SPP, "merged %llu samples, asked for %d", (unsigned long long)samples, SPP);
+    CHECK(iou >= 0.99);
+    CHECK_MSG(noise > 0, "two local renders with other seeds are equal: the noise reference would see nothing");
+    CHECK(diff <= 1.25 * noise);
+    CHECK(fabs(ratio - 1) < 0.03);
+    sy_layer_destroy(&l1), sy_layer_destroy(&l2), sy_layer_destroy(&c);
+    return 0;
+}
+
+static int test_tiles_and_caps(fixture *fx)
+{
+    sy_error e = {0};
+    sy_params pp;
+    sy_context *ctx = NULL, *coop = NULL;
+    CHECK_OK(sy_params_parse("backend=whitted", &pp, &e), e);
+    CHECK_OK(sy_context_create(fx->scene, "cluster", &pp, fx->d.root.id, &ctx, &e), e);
+    uint32_t caps = sy_context_caps(ctx);
+    CHECK((caps & SY_CAP_REMOTE) && (caps & SY_CAP_DEPTH) && (caps & SY_CAP_TILES) && !(caps & SY_CAP_PROGRESSIVE));
+    sy_params pc;
+    CHECK_OK(sy_params_parse("backend=pathtracer,mode=cooperative", &pc, &e), e);
+    CHECK_OK(sy_context_create(fx->scene, "cluster", &pc, fx->d.root.id, &coop, &e), e);
+    CHECK((sy_context_caps(coop) & (SY_CAP_REMOTE | SY_CAP_PROGRESSIVE)) == (SY_CAP_REMOTE | SY_CAP_PROGRESSIVE));
+    CHECK(!(sy_context_caps(coop) & SY_CAP_AOVS)); /* the feature buffers stay on the servers */
+    sy_aovs a;
+    CHECK_ERR(sy_context_aovs(coop, &a, &e), SY_ERR_UNSUPPORTED, e);
+    sy_context_release(coop);
+
+    CHECK_OK(sy_context_sync(ctx, &e), e);
+    sy_camera_view view;
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_viewport_desc vd = {.root = fx->d.root, .camera = fx->d.camera, .backend = "whitted"};
+    CHECK_OK(sy_window_create(W, H, &win, &e), e);
+    CHECK_OK(sy_window_add_viewport(win, &vd, &vp, &e), e);
+    CHECK_OK(sy_viewport_camera_view(vp, fx->scene, W, H, &view, &e), e);
+    sy_window_destroy(win);
+    sy_render_request full = {.camera = view, .full_width = W, .full_height = H, .rect_w = W, .rect_h = H,
+                              .background_id = fx->d.background.id};
+    sy_render_request part = full;
+    part.rect_x = 17, part.rect_y = 9, part.rect_w = 40, part.rect_h = 30;
+    sy_layer lf = {0}, lp = {0};
+    CHECK_OK(sy_layer_create(W, H, &lf, &e), e);
+    CHECK_OK(sy_layer_create(40, 30, &lp, &e), e);
+    CHECK_OK(sy_context_render(ctx, &full, &lf, &e), e);
+    CHECK_OK(sy_context_render(ctx, &part, &lp, &e), e);
+    for (uint32_t y = 0; y < 30; ++y)
+        for (uint32_t x = 0; x < 40; ++x)
+            for (int k = 0; k < 4; ++k)
+                CHECK(lp.rgba[((size_t)y * 40 + x) * 4 + k] == lf.rgba[((size_t)(y + 9) * W + x + 17) * 4 + k]);
+    printf("sub-rectangle 40x30+17+9 equals the whole image's pixels\n");
+    sy_layer_destroy(&lf), sy_layer_destroy(&lp);
+    sy_context_release(ctx);
+    return 0;
+}
+
+static int refused(fixture *fx, const char *params, const char *needle)
+{
+    sy_error e = {0};
+    sy_params pp;
+    sy_context *ctx = NULL;
+    CHECK_OK(sy_params_parse(params, &pp, &e), e);
+    sy_result r = sy_context_create(fx->scene, "cluster", &pp, 0, &ctx, &e);
+    if (r == SY_OK) sy_context_release(ctx);
+    CHECK_MSG(r != SY_OK, "'%s' was accepted", params);
+    CHECK_MSG(strstr(e.message, needle) != NULL, "'%s': error '%s' does not say '%s'", params, e.message, needle);
+    printf("refused '%s': %s\n", params, e.message);
+    return 0;
+}
+
+static int test_refusals(fixture *fx, const server *s)
+{
+    char node[96];
+    snprintf(node, sizeof node, "server 1 (%s)", s[0].url);
+    CHECK(refused(fx, "backend=whitted,mode=cooperative", node) == 0);
+    CHECK(refused(fx, "backend=whitted,mode=cooperative", "sample ranges") == 0);
+    CHECK(refused(fx, "backend=whitted,mode=stereo", "stereo viewports") == 0);
+    CHECK(refused(fx, "mode=sort-first", "backend=NAME") == 0);
+    CHECK(refused(fx, "backend=whitted,mode=sideways", "sideways") == 0);
+    CHECK(refused(fx, "backend=whitted,pixels=double", "pixels=double") == 0);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 3) {
+        fprintf(stderr, "usage: test_cluster_mediator SERVER_EXE WORK_DIR\n");
+        return 2;
+    }
+    g_exe = argv[1];
+    g_dir = argv[2];
+    mkdir(g_dir, 0755);
+    signal(SIGPIPE, SIG_IGN);
+    atexit(kill_leftover_servers);
+    sy_error e = {0};
+    fixture fx = {0};
+    if (sy_mediators_register_builtin(&e) || sy_scene_create(&fx.scene, &e) || sy_demo_build(fx.scene, &fx.d, &e) ||
+        sy_scene_commit(fx.scene, NULL, &e) || add_overlay_root(&fx, &e) || sy_scene_commit(fx.scene, NULL, &e)) {
+        fprintf(stderr, "%s\n", e.message);
+        return 1;
+    }
+    server s[2];
+    memset(s, 0, sizeof s);
+    int failed = 0;
+    if (start_server("s3cret", 0, &s[0]) || start_server("s3cret", 0, &s[1])) {
+        failed = 1;
+    } else {
+        const char *urls[2] = {s[0].url, s[1].url};
+        sy_cluster_client_opts co = {.urls = urls, .url_count = 2, .secret = (const uint8_t *)"s3cret", .secret_len = 6,
+                                     .timeout_ms = 60000, .connect_timeout_ms = 3000};
+        if (sy_mediator_cluster_register("cluster", &co, &e) != SY_OK) {
+            fprintf(stderr, "register: %s\n", e.message);
+            failed = 1;
+        } else {
+            CHECK(sy_mediator_cluster_register("cluster", &co, &e) != SY_OK); /* the name is taken */
+            int r;
+            failed += r = test_sort_first_and_balanced(&fx);
+            printf("sort-first / balanced composite: %s\n", r ? "FAILED" : "ok");
+            failed += r = test_cooperative(&fx);
+            printf("cooperative composite: %s\n", r ? "FAILED" : "ok");
+            failed += r = test_tiles_and_caps(&fx);
+            printf("tiles and capabilities: %s\n", r ? "FAILED" : "ok");
+            failed += r = test_refusals(&fx, s);
+            printf("set-up refusals: %s\n", r ? "FAILED" : "ok");
+        }
+    }
+    for (int i = 0; i < 2; ++i) stop_server(&s[i]);
+    sy_scene_destroy(fx.scene);
+    if (failed) fprintf(stderr, "test_cluster_mediator: %d group(s) failed (server logs in %s)\n", failed, g_dir);
+    return failed ? 1 : 0;
+}
