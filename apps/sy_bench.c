@@ -189,6 +189,13 @@ static double median_of(double *t, uint32_t n)
     return t[n / 2];
 }
 
+sy_bench_spread sy_bench_spread_of(double *v, uint32_t n)
+{
+    qsort(v, n, sizeof *v, cmp_double);
+    double med = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    return (sy_bench_spread){v[0], med, v[n - 1]};
+}
+
 static sy_result bench_raster_scene(const char *label, sy_scene *scene, const sy_viewport_desc *vd, sy_node moved,
                                     uint32_t width, uint32_t height, uint32_t repeats, sy_error *err)
 {

@@ -59,4 +59,11 @@ sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, co
 sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
                                  uint32_t height, const char *reference_exr, const char *png_path, sy_error *err);
 
+/* Minimum, median and maximum of n > 0 values (sorts v in place): benchmarks report the median of
+ * their rounds with the spread. */
+typedef struct sy_bench_spread {
+    double min, median, max;
+} sy_bench_spread;
+sy_bench_spread sy_bench_spread_of(double *v, uint32_t n);
+
 #endif /* SY_BENCH_H */

@@ -2,6 +2,7 @@
  * (see sy_cluster_cli.h). The protocol, the modes and the cluster mediator live in mediators/cluster/. */
 #define _GNU_SOURCE /* sched_setaffinity for the pinned benchmark servers */
 #include "sy_cluster_cli.h"
+#include "sy_bench.h"
 #include "sy_mediator_cluster.h"
 #include "sy_signals.h"
 
@@ -351,38 +352,30 @@ static sy_result cli_client_opts_make(const sy_cluster_cli_opts *o, cli_client_o
     return r;
 }
 
-sy_result sy_cluster_cli_connect(const sy_cluster_cli_opts *o, sy_scene *scene, sy_cluster_cli_client *out,
-                                 sy_error *err)
-{
-    memset(out, 0, sizeof *out);
-    cli_client_opts c;
-    sy_result r = cli_client_opts_make(o, &c, err);
-    /* the client copies the URLs, back-end names, wall tiles and the secret */
-    if (r == SY_OK) r = sy_cluster_client_create(scene, &c.co, &out->client, err);
-    out->mode = c.mode;
-    out->servers = c.n;
-    out->viewer_tile = c.viewer_tile;
-    cli_client_opts_free(&c);
-    return r;
-}
-
 sy_result sy_cluster_cli_setup(const sy_cluster_cli_opts *o, const char *backend, const char *params, char *params_out,
-                               size_t len, uint32_t *mode_out, uint32_t *servers_out, sy_error *err)
+                               size_t len, uint32_t *mode_out, uint32_t *servers_out, sy_cluster_rect *viewer_tile,
+                               sy_error *err)
 {
     cli_client_opts c;
     sy_result r = cli_client_opts_make(o, &c, err);
     if (r == SY_OK) r = sy_mediator_cluster_register(SY_MEDIATOR_CLUSTER_NAME, &c.co, err); /* copies */
-    uint32_t mode = c.mode == SY_CLUSTER_STEREO ? SY_CLUSTER_SORT_FIRST : c.mode;
-    if (r == SY_OK) {
-        int n = snprintf(params_out, len, "backend=%s,mode=%s%s", backend, sy_cluster_mode_name(mode),
-                         o->half_pixels ? ",pixels=half" : "");
-        if (n > 0 && (size_t)n < len && params && *params) n += snprintf(params_out + n, len - (size_t)n, ",%s", params);
-        if (n < 0 || (size_t)n >= len) r = sy_error_set(err, SY_ERR_LIMIT, "--cluster: back-end parameters too long");
-    }
+    if (r == SY_OK) r = sy_cluster_cli_params(o, backend, c.mode, params, params_out, len, err);
     *mode_out = c.mode;
     *servers_out = c.n;
+    if (viewer_tile) *viewer_tile = c.viewer_tile;
     cli_client_opts_free(&c);
     return r;
+}
+
+sy_result sy_cluster_cli_params(const sy_cluster_cli_opts *o, const char *backend, uint32_t mode, const char *params,
+                                char *out, size_t len, sy_error *err)
+{
+    if (mode == SY_CLUSTER_STEREO) mode = SY_CLUSTER_SORT_FIRST; /* stereo is the window's business */
+    int n = snprintf(out, len, "backend=%s,mode=%s%s", backend, sy_cluster_mode_name(mode),
+                     o->half_pixels ? ",pixels=half" : "");
+    if (n > 0 && (size_t)n < len && params && *params) n += snprintf(out + n, len - (size_t)n, ",%s", params);
+    if (n < 0 || (size_t)n >= len) return sy_error_set(err, SY_ERR_LIMIT, "--cluster: back-end parameters too long");
+    return SY_OK;
 }
 
 /* ---- sy bench cluster ---- */
@@ -548,7 +541,10 @@ static sy_result bench_coop(sy_scene *scene, const sy_viewport_desc *vd, const c
     const uint32_t w = 320, h = 180;
     const double min_seconds = 1.5;
     uint32_t spf = 0;
-    double best[2] = {0, 0}, eff[2] = {0, 0}; /* samples per pixel per second; per server CPU-second */
+    enum { MAX_ROUNDS = 64 };
+    double ratio[MAX_ROUNDS], rate[2][MAX_ROUNDS], eff[2][MAX_ROUNDS]; /* per round: speed-up, spp/s, spp per CPU-s */
+    uint32_t nr = 0, ne = 0;
+    if (rounds > MAX_ROUNDS) rounds = MAX_ROUNDS;
     sy_result r = SY_OK;
     printf("  cooperative pathtracer %ux%u, servers %s, %u interleaved rounds of >= %.1f s per side:\n", w, h,
            pinned ? "pinned to cores 0 and 1" : "not pinned (1 core)", rounds, min_seconds);
@@ -557,25 +553,33 @@ static sy_result bench_coop(sy_scene *scene, const sy_viewport_desc *vd, const c
         for (uint32_t k = 0; k < 2 && r == SY_OK; ++k) {
             uint32_t n = (round & 1) ? 2 - k : 1 + k; /* 1,2 / 2,1 / 1,2 ... */
             r = coop_measure(scene, vd, srv, n, w, h, &spf, min_seconds, &run[n - 1], err);
-            if (r == SY_OK && run[n - 1].rate > best[n - 1]) best[n - 1] = run[n - 1].rate;
-            double cpu = run[n - 1].cpu[0] + (n > 1 ? run[n - 1].cpu[1] : 0.0);
-            if (r == SY_OK && run[n - 1].cpu[0] >= 0 && (n < 2 || run[n - 1].cpu[1] >= 0) && cpu > 0 &&
-                (double)run[n - 1].samples / cpu > eff[n - 1])
-                eff[n - 1] = (double)run[n - 1].samples / cpu;
         }
-        if (r == SY_OK)
-            printf("    round %u (%u spp per server and frame): 1 server %.1f spp/s (busy %.2f s CPU of %.2f s); "
-                   "2 servers %.1f spp/s (busy %.2f + %.2f s CPU of %.2f s): %.2fx\n",
-                   round + 1, spf, run[0].rate, run[0].cpu[0], run[0].seconds, run[1].rate, run[1].cpu[0], run[1].cpu[1],
-                   run[1].seconds, run[0].rate > 0 ? run[1].rate / run[0].rate : 0.0);
+        if (r != SY_OK) break;
+        rate[0][nr] = run[0].rate, rate[1][nr] = run[1].rate;
+        ratio[nr++] = run[0].rate > 0 ? run[1].rate / run[0].rate : 0.0;
+        double cpu1 = run[0].cpu[0], cpu2 = run[1].cpu[0] + run[1].cpu[1];
+        if (run[0].cpu[0] >= 0 && run[1].cpu[0] >= 0 && run[1].cpu[1] >= 0 && cpu1 > 0 && cpu2 > 0) {
+            eff[0][ne] = (double)run[0].samples / cpu1, eff[1][ne] = (double)run[1].samples / cpu2;
+            ne++;
+        }
+        printf("    round %u (%u spp per server and frame): 1 server %.1f spp/s (busy %.2f s CPU of %.2f s); "
+               "2 servers %.1f spp/s (busy %.2f + %.2f s CPU of %.2f s): %.2fx\n",
+               round + 1, spf, run[0].rate, run[0].cpu[0], run[0].seconds, run[1].rate, run[1].cpu[0], run[1].cpu[1],
+               run[1].seconds, ratio[nr - 1]);
     }
-    if (r == SY_OK)
-        printf("  cooperative speed-up (best of %u): 1 server %.1f spp/s, 2 servers %.1f spp/s: %.2fx (target >= 1.8x)\n",
-               rounds, best[0], best[1], best[0] > 0 ? best[1] / best[0] : 0.0);
-    if (r == SY_OK && eff[0] > 0 && eff[1] > 0)
-        printf("  per server CPU-second (best of %u): 1 server %.1f spp, 2 servers %.1f spp (%.0f%% efficiency): "
+    if (r == SY_OK && nr) {
+        sy_bench_spread sr = sy_bench_spread_of(ratio, nr), s1 = sy_bench_spread_of(rate[0], nr),
+                        s2 = sy_bench_spread_of(rate[1], nr);
+        printf("  cooperative speed-up (median of %u rounds, min..max): %.2fx (%.2f..%.2f; target >= 1.95x); "
+               "1 server %.1f spp/s, 2 servers %.1f spp/s (medians)\n",
+               nr, sr.median, sr.min, sr.max, s1.median, s2.median);
+    }
+    if (r == SY_OK && ne) {
+        sy_bench_spread e1 = sy_bench_spread_of(eff[0], ne), e2 = sy_bench_spread_of(eff[1], ne);
+        printf("  per server CPU-second (median of %u): 1 server %.1f spp, 2 servers %.1f spp (%.0f%% efficiency): "
                "2 x %.2f = %.2fx with each server's core to itself\n",
-               rounds, eff[0], eff[1], 100.0 * eff[1] / eff[0], eff[1] / eff[0], 2.0 * eff[1] / eff[0]);
+               ne, e1.median, e2.median, 100.0 * e2.median / e1.median, e2.median / e1.median, 2.0 * e2.median / e1.median);
+    }
     return r;
 }
 

@@ -34,27 +34,18 @@ bool sy_cluster_cli_requested(int argc, char **argv);
  * Returns false for other options; sets *bad when the value is missing or invalid. */
 bool sy_cluster_cli_option(int argc, char **argv, int *i, sy_cluster_cli_opts *o, bool *bad);
 
-/* A cluster client made from the options: the URL list or configuration file, the mode (option,
- * else the file's, else sort-first), the secret, per-server back-ends and wall tiles. */
-typedef struct sy_cluster_cli_client {
-    sy_cluster_client *client; /* owned: sy_cluster_client_destroy */
-    uint32_t mode;             /* sy_cluster_mode */
-    uint32_t servers;          /* servers configured */
-    sy_cluster_rect viewer_tile; /* configuration 'viewer tile X Y W H'; w == 0: 'viewer full' (default) */
-} sy_cluster_cli_client;
-
-/* Parses the options and connects (sy_cluster_client_create). Ownership: out->client is the
- * caller's; it borrows the scene. Used by `sy render --cluster` and `sy view --cluster`. */
-sy_result sy_cluster_cli_connect(const sy_cluster_cli_opts *o, sy_scene *scene, sy_cluster_cli_client *out,
-                                 sy_error *err);
-
-/* `sy render --cluster`: registers the cluster mediator class (SY_MEDIATOR_CLUSTER_NAME) from the
+/* `sy render --cluster` and `sy view --cluster`: registers the cluster mediator class (SY_MEDIATOR_CLUSTER_NAME) from the
  * options and writes the viewport parameters that select it into params_out:
  * "backend=BACKEND,mode=MODE[,pixels=half][,PARAMS]". The render then goes through the window like
- * any local one. *mode_out: the configured mode (stereo is the window's business: the parameters
+ * any local one. *viewer_tile (may be NULL): the configuration's 'viewer tile' (w 0: none). *mode_out: the configured mode (stereo is the window's business: the parameters
  * say sort-first); *servers_out: the servers configured. */
 sy_result sy_cluster_cli_setup(const sy_cluster_cli_opts *o, const char *backend, const char *params, char *params_out,
-                               size_t len, uint32_t *mode_out, uint32_t *servers_out, sy_error *err);
+                               size_t len, uint32_t *mode_out, uint32_t *servers_out, sy_cluster_rect *viewer_tile,
+                               sy_error *err);
+/* The cluster viewport's parameters for back-end `backend` in `mode` (stereo: sort-first) with the
+ * options' pixel format and the back-end's own params (may be NULL). */
+sy_result sy_cluster_cli_params(const sy_cluster_cli_opts *o, const char *backend, uint32_t mode, const char *params,
+                                char *out, size_t len, sy_error *err);
 
 /* sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only]: sizes, overhead, latency, codec,
  * a server's memory and a client's frame time under 72 hostile unauthenticated connections,

@@ -704,7 +704,7 @@ static int cmd_render(int argc, char **argv)
     uint32_t cluster_mode = 0, cluster_servers = 0;
     if (clo.cluster) {
         if (sy_cluster_cli_setup(&clo, backend, params, cluster_params, sizeof cluster_params, &cluster_mode,
-                                 &cluster_servers, &err) != SY_OK)
+                                 &cluster_servers, NULL, &err) != SY_OK)
             return fail(&err);
         if (cluster_mode == SY_CLUSTER_STEREO && spec.stereo == SY_STEREO_NONE) spec.stereo = SY_STEREO_SBS;
         backend = SY_MEDIATOR_CLUSTER_NAME;

@@ -2,7 +2,7 @@
  * scene (see sy_view.h). */
 #include "sy_view.h"
 
-#include "sy_mediator_rt.h"
+#include "sy_mediator_cluster.h"
 #include "sy_png.h"
 
 #define GLFW_INCLUDE_NONE
@@ -29,6 +29,7 @@ typedef struct viewer {
     /* sy view --cluster, NULL = local: set before the threads start, dereferenced by the render
      * thread only (the window thread tests it for the title) */
     view_cluster *cluster;
+    sy_context_pool *pool; /* created before the threads start; used by the render thread only */
     sy_node cam_node; /* the viewer's own top-level camera node */
     pthread_mutex_t mu;
     pthread_cond_t cv;
@@ -127,54 +128,63 @@ static void view_apply_filter(sy_context_pool *pool, const sy_view_args *a, cons
         snprintf(status, len, " | filter none");
 }
 
-/* >>cluster (`sy view --cluster`): the render thread drives render servers through the cluster
- * client (core/sy_cluster.h) instead of local contexts. Camera moves are committed scene changes
- * that the client sends as change lists; the deadline of each request adapts to the frame time. */
+/* >>cluster (`sy view --cluster`): the viewport's back-end is the cluster mediator (registered
+ * from the options before the window opens); the render thread renders through the same window
+ * path as locally, with the servers' back-end named in the viewport parameters. Deadlines adapt in
+ * the mediator (sy_mediator_cluster.h). */
 struct view_cluster {
-    sy_cluster_cli_client cc;
-    uint32_t wall_w, wall_h; /* multi-display: the wall (-w x -h); the window may show only a tile */
-    sy_window *win; /* one viewport: the viewer's camera node, for sy_viewport_camera_view */
-    sy_viewport *vp;
-    bool fixed_timeout;    /* --timeout-ms given */
-    uint32_t timeout_ms;   /* current per-request deadline */
-    sy_camera_view last_view;
-    const char *last_backend;
-    uint32_t last_w, last_h;
-    uint32_t passes;       /* frames since the last restart (camera, back-end or size changed) */
-    uint64_t samples;      /* samples per pixel requested since the last restart (not cooperative) */
-    char log[128];         /* the client's last log line (a server dropped, a reconnect) */
+    sy_cluster_cli_opts opts;
+    uint32_t mode, servers;
+    sy_cluster_rect viewer_tile; /* multi-display: what the window shows ('viewer tile'; w 0 = the wall) */
+    uint32_t wall_w, wall_h;     /* multi-display: the wall (-w x -h) */
+    uint32_t passes;             /* frames since the last restart (camera, back-end, size changed) */
+    pthread_mutex_t log_mu;
+    char log[128];               /* the client's last log line (a server dropped, a reconnect) */
 };
 
-/* Client log lines (called on the thread that calls the client: the render thread). */
+/* Client log lines (the render thread, and the main thread while connecting). */
 static void view_cluster_log(void *user, const char *line)
 {
     view_cluster *vc = user;
     fprintf(stderr, "%s\n", line);
     const char *prefix = "sy cluster: "; /* the title has little room */
+    pthread_mutex_lock(&vc->log_mu);
     snprintf(vc->log, sizeof vc->log, "%s", strncmp(line, prefix, strlen(prefix)) ? line : line + strlen(prefix));
+    pthread_mutex_unlock(&vc->log_mu);
 }
 
-/* Connects before any window opens, so a bad option, secret or address fails right away. */
-static sy_result view_cluster_open(const sy_view_args *a, view_cluster **out, sy_error *err)
+/* The cluster viewport's parameters for the servers' back-end `backend`. */
+static sy_result view_cluster_params(const view_cluster *vc, const char *backend, char *out, size_t len, sy_error *err)
+{
+    return sy_cluster_cli_params(&vc->opts, backend, vc->mode, NULL, out, len, err);
+}
+
+/* Registers the cluster class and connects (a context in the pool) before any window opens, so a bad
+ * option, secret or address fails right away. */
+static sy_result view_cluster_open(const sy_view_args *a, sy_context_pool *pool, view_cluster **out, sy_error *err)
 {
     view_cluster *vc = calloc(1, sizeof *vc);
     if (!vc) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "view: out of memory");
-    sy_cluster_cli_opts o = *a->cluster;
-    o.log = view_cluster_log;
-    o.log_user = vc;
-    if (!o.connect_timeout_ms) o.connect_timeout_ms = 2000; /* a stalled server costs at most this per frame */
-    vc->fixed_timeout = o.timeout_ms != 0;
-    vc->timeout_ms = o.timeout_ms ? o.timeout_ms : 60000; /* the first frame: snapshot + translation */
-    o.timeout_ms = vc->timeout_ms;
-    sy_result r = sy_cluster_cli_connect(&o, a->scene, &vc->cc, err);
-    if (r == SY_OK && vc->cc.mode == SY_CLUSTER_MULTI_DISPLAY && vc->cc.viewer_tile.w) {
-        const sy_cluster_rect *t = &vc->cc.viewer_tile;
+    pthread_mutex_init(&vc->log_mu, NULL);
+    vc->opts = *a->cluster;
+    vc->opts.log = view_cluster_log;
+    vc->opts.log_user = vc;
+    if (!vc->opts.connect_timeout_ms) vc->opts.connect_timeout_ms = 2000; /* a stalled server costs at most this */
+    char params[1400];
+    sy_result r = sy_cluster_cli_setup(&vc->opts, a->backend, NULL, params, sizeof params, &vc->mode, &vc->servers,
+                                       &vc->viewer_tile, err);
+    if (r == SY_OK && vc->mode == SY_CLUSTER_MULTI_DISPLAY && vc->viewer_tile.w) {
+        const sy_cluster_rect *t = &vc->viewer_tile;
         if (t->x >= a->width || t->y >= a->height || t->w > a->width - t->x || t->h > a->height - t->y)
             r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: viewer tile %ux%u at %u,%u lies outside the %ux%u wall (-w, -h)",
                              t->w, t->h, t->x, t->y, a->width, a->height);
     }
+    sy_params pp;
+    sy_context *ctx = NULL;
+    if (r == SY_OK) r = sy_params_parse(params, &pp, err);
+    if (r == SY_OK) r = sy_context_pool_get(pool, a->scene, SY_MEDIATOR_CLUSTER_NAME, &pp, a->spec.root.id, &ctx, err);
     if (r) {
-        sy_cluster_client_destroy(vc->cc.client);
+        pthread_mutex_destroy(&vc->log_mu);
         free(vc);
         return r;
     }
@@ -186,85 +196,80 @@ static sy_result view_cluster_open(const sy_view_args *a, view_cluster **out, sy
 static void view_cluster_close(view_cluster *vc)
 {
     if (!vc) return;
-    sy_cluster_client_destroy(vc->cc.client);
-    sy_window_destroy(vc->win);
+    pthread_mutex_destroy(&vc->log_mu);
     free(vc);
 }
 
 /* Multi-display: the window's own picture of the wall, rendered locally with the same back-end
  * (the whole wall, or the configured viewer tile: an exact crop, as the servers' tiles are). */
 static sy_result view_cluster_local(view_cluster *vc, const sy_view_args *a, sy_context_pool *pool, const char *backend,
-                                    const sy_camera_view *view, uint32_t fw, uint32_t fh, sy_layer *img, sy_error *err)
+                                    sy_node cam, uint32_t fw, uint32_t fh, sy_layer *img, sy_error *err)
 {
-    sy_cluster_rect t = vc->cc.viewer_tile.w ? vc->cc.viewer_tile : (sy_cluster_rect){0, 0, fw, fh};
+    sy_cluster_rect t = vc->viewer_tile.w ? vc->viewer_tile : (sy_cluster_rect){0, 0, fw, fh};
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_camera_view view;
+    sy_viewport_desc vd = {.root = a->spec.root, .camera = cam, .backend = backend};
     sy_context *ctx = NULL;
-    sy_result r = sy_context_pool_get(pool, a->scene, backend, NULL, a->spec.root.id, &ctx, err);
+    sy_result r = sy_window_create(fw, fh, &win, err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
+    if (r == SY_OK) r = sy_viewport_camera_view(vp, a->scene, fw, fh, &view, err);
+    sy_window_destroy(win);
+    if (r == SY_OK) r = sy_context_pool_get(pool, a->scene, backend, NULL, a->spec.root.id, &ctx, err);
     if (r == SY_OK) r = sy_context_sync(ctx, err);
     if (r == SY_OK) r = sy_layer_create(t.w, t.h, img, err);
-    sy_render_request req = {.camera = *view, .full_width = fw, .full_height = fh, .rect_x = t.x, .rect_y = t.y,
+    sy_render_request req = {.camera = view, .full_width = fw, .full_height = fh, .rect_x = t.x, .rect_y = t.y,
                              .rect_w = t.w, .rect_h = t.h, .sample_count = 1, .background_id = a->spec.background.id};
     if (r == SY_OK) r = sy_context_render(ctx, &req, img, err);
     return r;
 }
 
-/* One cluster frame of w x h (the window; multi-display: the -w x -h wall) into *img. Fills the
+/* One cluster frame through the window path: spec names the cluster viewport; w x h is the window
+ * (multi-display: the -w x -h wall, and *img is the window's local picture of it). Fills the
  * heads-up status, the merged samples per pixel and whether to keep refining. */
-static sy_result view_cluster_frame(view_cluster *vc, const sy_view_args *a, sy_context_pool *pool, sy_node cam,
-                                    const sy_mediator_class *cls, uint32_t w, uint32_t h, sy_layer *img, uint64_t *spp,
-                                    bool *refine, char *status, size_t len, sy_error *err)
+static sy_result view_cluster_frame(view_cluster *vc, const sy_view_args *a, sy_context_pool *pool, sy_compose_spec *spec,
+                                    const char *backend, bool restart, uint32_t w, uint32_t h, sy_layer *img,
+                                    sy_layer *right, uint64_t *spp, bool *refine, char *status, size_t len, sy_error *err)
 {
-    uint32_t mode = vc->cc.mode;
-    bool progressive = (cls->caps & SY_CAP_PROGRESSIVE) != 0;
-    uint32_t fw = mode == SY_CLUSTER_MULTI_DISPLAY ? vc->wall_w : mode == SY_CLUSTER_STEREO ? (w / 2 ? w / 2 : 1) : w;
-    uint32_t fh = mode == SY_CLUSTER_MULTI_DISPLAY ? vc->wall_h : h;
-    sy_result r = SY_OK;
-    if (!vc->win) {
-        sy_viewport_desc vd = {.root = a->spec.root, .camera = cam, .background = a->spec.background, .backend = cls->name};
-        r = sy_window_create(fw, fh, &vc->win, err);
-        if (r == SY_OK) r = sy_window_add_viewport(vc->win, &vd, &vc->vp, err);
-    }
-    sy_camera_view view;
-    if (r == SY_OK) r = sy_window_resize(vc->win, fw, fh, err);
-    if (r == SY_OK) r = sy_viewport_camera_view(vc->vp, a->scene, fw, fh, &view, err);
+    char params[1400];
+    sy_result r = view_cluster_params(vc, backend, params, sizeof params, err);
     if (r) return r;
-    if (memcmp(&view, &vc->last_view, sizeof view) != 0 || vc->last_backend != cls->name || vc->last_w != fw ||
-        vc->last_h != fh) { /* the servers restart their accumulations too */
-        vc->last_view = view, vc->last_backend = cls->name, vc->last_w = fw, vc->last_h = fh;
-        vc->passes = 0;
-        vc->samples = 0;
-    }
+    spec->backend = SY_MEDIATOR_CLUSTER_NAME;
+    spec->params = params;
+    vc->passes = restart ? 0 : vc->passes + 1;
+    sy_params pp;
+    sy_context *ctx = NULL;
+    if (r == SY_OK) r = sy_params_parse(params, &pp, err);
+    if (r == SY_OK) r = sy_context_pool_get(pool, a->scene, SY_MEDIATOR_CLUSTER_NAME, &pp, a->spec.root.id, &ctx, err);
+    bool progressive = r == SY_OK && (sy_context_caps(ctx) & SY_CAP_PROGRESSIVE);
     /* progressive: 1, 2, 4, 8, then 16 samples per server and frame after a restart (--spp: fixed) */
     uint32_t per = a->cluster->samples ? a->cluster->samples : 1u << (vc->passes < 4 ? vc->passes : 4);
-    sy_cluster_frame f = {.mode = mode, .backend = cls->name, .root_id = a->spec.root.id,
-                          .background_id = a->spec.background.id, .camera = view, .width = fw, .height = fh,
-                          .samples = per, .eye_separation = a->spec.eye_separation, .zero_parallax = a->spec.zero_parallax,
-                          .half = a->cluster->half_pixels};
-    if (mode == SY_CLUSTER_MULTI_DISPLAY) r = view_cluster_local(vc, a, pool, cls->name, &view, fw, fh, img, err);
-    else r = sy_layer_create(mode == SY_CLUSTER_STEREO ? 2 * fw : fw, fh, img, err);
-    if (!vc->fixed_timeout) sy_cluster_client_set_timeout(vc->cc.client, vc->timeout_ms);
-    sy_cluster_frame_stats st = {0};
-    if (r == SY_OK) r = sy_cluster_client_render(vc->cc.client, &f, mode == SY_CLUSTER_MULTI_DISPLAY ? NULL : img, &st, err);
-    uint32_t live = sy_cluster_client_live(vc->cc.client);
-    if (r) {
+    sy_window_render_opts ro = {.sample_count = progressive ? per * vc->servers : 0};
+    bool wall = vc->mode == SY_CLUSTER_MULTI_DISPLAY;
+    if (r == SY_OK) r = sy_compose_render(a->scene, pool, spec, wall ? vc->wall_w : w, wall ? vc->wall_h : h, &ro, img, right, err);
+    if (r == SY_OK && wall) { /* the servers presented the wall; the window shows its own picture of it */
         sy_layer_destroy(img);
-        snprintf(status, len, "cluster %s: %u/%u servers alive", sy_cluster_mode_name(mode), live, vc->cc.servers);
-        vc->timeout_ms = vc->timeout_ms < 30000 ? 2 * vc->timeout_ms : 60000;
+        r = view_cluster_local(vc, a, pool, backend, spec->camera, vc->wall_w, vc->wall_h, img, err);
+    }
+    sy_cluster_frame_stats st = {0};
+    if (ctx) sy_mediator_cluster_last_frame(sy_context_state(ctx), &st);
+    sy_mediator_stats ms = {0};
+    if (ctx) sy_context_stats(ctx, &ms);
+    const char *mode = sy_cluster_mode_name(vc->mode);
+    if (r) {
+        snprintf(status, len, "cluster %s: %u/%u servers alive", mode, st.servers_live, vc->servers);
         struct timespec pause = {0, 250000000}; /* every server down: retry a few times a second */
         nanosleep(&pause, NULL);
         return r;
     }
-    /* deadline for the next frame: generous next to this frame's time, doubled after a failure
-     * (a server that rejoins needs a snapshot and a first translation) */
-    double next = st.servers_failed ? 2.0 * vc->timeout_ms : 1000.0 + 4000.0 * st.seconds;
-    vc->timeout_ms = next > 60000.0 ? 60000u : next < 1000.0 ? 1000u : (uint32_t)next;
-    vc->passes++;
-    vc->samples += per;
-    *spp = mode == SY_CLUSTER_COOPERATIVE ? st.samples : progressive ? vc->samples : 1;
+    *spp = progressive ? ms.samples : 1;
     *refine = progressive && *spp < 65536;
-    int n = snprintf(status, len, "cluster %s: %s | %u/%u servers alive | slowest server %.1f ms",
-                     sy_cluster_mode_name(mode), cls->name, live, vc->cc.servers, st.max_server_seconds * 1e3);
-    if (n > 0 && (size_t)n < len && live < vc->cc.servers && vc->log[0])
+    int n = snprintf(status, len, "cluster %s: %s | %u/%u servers alive | slowest server %.1f ms", mode, backend,
+                     st.servers_live, vc->servers, st.max_server_seconds * 1e3);
+    pthread_mutex_lock(&vc->log_mu);
+    if (n > 0 && (size_t)n < len && st.servers_live < vc->servers && vc->log[0])
         snprintf(status + n, len - (size_t)n, " | %s", vc->log);
+    pthread_mutex_unlock(&vc->log_mu);
     return SY_OK;
 }
 
@@ -273,10 +278,9 @@ static void *render_main(void *p)
 {
     viewer *v = p;
     const sy_view_args *a = v->args;
-    sy_context_pool *pool = NULL;
+    sy_context_pool *pool = v->pool;
     sy_error err = {0};
-    if (sy_context_pool_create(&pool, &err) != SY_OK) goto fail_unlocked;
-    uint64_t seen = 0;
+    uint64_t seen = 0, cl_seen = 0;
     sy_mat4 cam_applied;
     memset(&cam_applied, 0, sizeof cam_applied);
     bool refine = false;
@@ -301,6 +305,8 @@ static void *render_main(void *p)
 
         const sy_mediator_class *cls = sy_mediator_at(bi);
         if (!cls) cls = sy_mediator_at(0);
+        if (cls->caps & SY_CAP_REMOTE) cls = sy_mediator_find(a->backend); /* the cluster is not a choice of its own */
+        if (!cls) cls = sy_mediator_at(0);
         if (!sy_mat4_equal(&cam, &cam_applied)) {
             if (sy_node_set_matrix(a->scene, v->cam_node, &cam, &err) != SY_OK ||
                 sy_scene_commit(a->scene, NULL, &err) != SY_OK)
@@ -321,8 +327,11 @@ static void *render_main(void *p)
         char cl_status[sizeof v->status] = "";
         sy_result r;
         if (v->cluster) {
-            r = view_cluster_frame(v->cluster, a, pool, v->cam_node, cls, w, h, &img, &cl_spp, &cl_refine, cl_status,
-                                   sizeof cl_status, &err);
+            /* a restart: anything asked since the last frame (camera, back-end, size, stereo) */
+            bool restart = seen != cl_seen;
+            cl_seen = seen;
+            r = view_cluster_frame(v->cluster, a, pool, &spec, cls->name, restart, ew, h, &img, &right, &cl_spp,
+                                   &cl_refine, cl_status, sizeof cl_status, &err);
         } else {
             view_apply_filter(pool, a, cls, filter, threshold, filter_version, &filter_state, &filter_applied, fstatus,
                               sizeof fstatus);
@@ -373,7 +382,6 @@ static void *render_main(void *p)
         /* progressive back-ends keep refining a resting mono view */
         refine = v->cluster ? cl_refine : (cls->caps & SY_CAP_PROGRESSIVE) && stereo == SY_STEREO_NONE && st.samples < 65536;
     }
-    sy_context_pool_destroy(pool);
     return NULL;
 fail_unlocked:
     pthread_mutex_lock(&v->mu);
@@ -381,7 +389,6 @@ fail_unlocked:
     v->failed = true;
     v->img_version++;
     pthread_mutex_unlock(&v->mu);
-    sy_context_pool_destroy(pool);
     return NULL;
 }
 
@@ -519,7 +526,7 @@ static sy_result write_screenshot(const char *path, int w, int h, sy_error *err)
     return r;
 }
 
-static sy_result view_run(const sy_view_args *args, view_cluster *cluster, sy_error *err)
+static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_cluster *cluster, sy_error *err)
 {
     uint32_t filter0 = 0;
     if (args->filter) { /* the initial display filter, checked before any window opens */
@@ -556,11 +563,13 @@ static sy_result view_run(const sy_view_args *args, view_cluster *cluster, sy_er
     memset(&v, 0, sizeof v);
     v.args = args;
     v.cluster = cluster;
+    v.pool = pool;
     pthread_mutex_init(&v.mu, NULL);
     pthread_cond_init(&v.cv, NULL);
     for (uint32_t i = 0; i < sy_mediator_count(); ++i)
         if (!strcmp(sy_mediator_at(i)->name, args->backend)) v.backend = i;
     v.overlay = true;
+    if (cluster && cluster->mode == SY_CLUSTER_STEREO) v.stereo = SY_STEREO_SBS; /* --cluster-mode stereo */
 
     /* the viewer's own camera node: same camera object, top level, world = local */
     sy_result r = SY_OK;
@@ -693,12 +702,15 @@ static sy_result view_run(const sy_view_args *args, view_cluster *cluster, sy_er
 
 sy_result sy_view_run(const sy_view_args *args, sy_error *err)
 {
+    sy_context_pool *pool = NULL;
     view_cluster *vc = NULL; /* sy view --cluster: connected before the window opens */
-    sy_result r = args->cluster ? view_cluster_open(args, &vc, err) : SY_OK;
+    sy_result r = sy_context_pool_create(&pool, err);
+    if (r == SY_OK && args->cluster) r = view_cluster_open(args, pool, &vc, err);
     sy_view_args a = *args;
-    if (vc && vc->cc.mode == SY_CLUSTER_MULTI_DISPLAY && vc->cc.viewer_tile.w) /* a window of the tile's size */
-        a.width = vc->cc.viewer_tile.w, a.height = vc->cc.viewer_tile.h;
-    if (r == SY_OK) r = view_run(&a, vc, err);
+    if (vc && vc->mode == SY_CLUSTER_MULTI_DISPLAY && vc->viewer_tile.w) /* a window of the tile's size */
+        a.width = vc->viewer_tile.w, a.height = vc->viewer_tile.h;
+    if (r == SY_OK) r = view_run(&a, pool, vc, err);
+    sy_context_pool_destroy(pool); /* the cluster contexts say BYE to their servers */
     view_cluster_close(vc);
     return r;
 }

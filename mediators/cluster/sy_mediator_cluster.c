@@ -33,6 +33,7 @@ typedef struct cluster_state {
     sy_cluster_frame_stats last;
     uint64_t merged_samples;
     sy_layer full; /* a request for a sub-rectangle renders the whole image here */
+    uint32_t timeout_ms; /* adaptive deadline (the configuration gave none) */
 } cluster_state;
 
 /* Caps the servers' back-end `name` has, as registered in this process (same binary); unknown
@@ -127,6 +128,7 @@ static sy_result cluster_create(const sy_mediator_create_args *args, void **stat
     st->mode = mode;
     st->half = px && !strcmp(px, "half");
     st->samples = (uint32_t)samples;
+    st->timeout_ms = 60000; /* adaptive (no timeout configured): the first frame sends a snapshot */
     snprintf(st->backend, sizeof st->backend, "%s", backend);
     /* the rest goes to the servers' back-end */
     size_t len = 0;
@@ -186,7 +188,15 @@ static sy_result cluster_render(void *state, const sy_render_request *req, sy_la
         out = &st->full;
     }
     if (r == SY_OK) sy_layer_clear(out);
+    bool adaptive = st->cfg->opts.timeout_ms == 0;
+    if (adaptive) sy_cluster_client_set_timeout(st->client, st->timeout_ms);
     if (r == SY_OK) r = sy_cluster_client_render(st->client, &f, out, &st->last, err);
+    if (adaptive) {
+        /* the next deadline: generous next to this frame's time (1 s + 4x), doubled after a failure (a
+         * server that rejoins needs a snapshot and a first translation), within 1..60 s */
+        double next = r != SY_OK || st->last.servers_failed ? 2.0 * st->timeout_ms : 1000.0 + 4000.0 * st->last.seconds;
+        st->timeout_ms = next > 60000.0 ? 60000u : next < 1000.0 ? 1000u : (uint32_t)next;
+    }
     if (r == SY_OK && st->mode == SY_CLUSTER_COOPERATIVE) st->merged_samples = st->last.samples;
     if (r == SY_OK && !whole)
         for (uint32_t y = 0; y < req->rect_h; ++y) {

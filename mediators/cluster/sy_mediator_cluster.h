@@ -23,6 +23,11 @@
  * cooperative adds progressive accumulation and needs a back-end whose samples merge
  * (SY_CAP_SAMPLE_RANGES); set-up refuses what a node cannot do, naming the node and the reason.
  *
+ * Deadlines: the configuration's timeout_ms for every request, or, when it is 0, an adaptive one:
+ * 60 s for the first frame (snapshot, first translation), then 1 s + 4x the last frame's time,
+ * doubled after a failure, within 1..60 s: a dead or stalled server is dropped within about a
+ * second of an interactive frame, and its work goes to the others in the same frame.
+ *
  * Ownership: registration copies the configuration; the class lives until the process ends (the
  * registry holds it). Thread-safety: registration is safe from any thread; an instance is used like
  * every context (one thread at a time). */

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# cluster_cli_test.sh SY WORKDIR — `sy serve` and `sy render --cluster` through the command line:
+# cluster_cli_test.sh SY WORKDIR [TESTDATA] — `sy serve` and `sy render --cluster` through the command line:
 # two authenticated servers on free loopback ports, sort-first output equal to a local render
 # (EXR bytes), a wrong secret refused with a logged reason, a non-loopback listen refused without
 # a secret, multi-display tiles written by the servers at the swap barrier. Servers stop by
-# themselves (--max-lifetime) and are killed on exit; every wait is bounded.
+# themselves (--max-lifetime) and are killed on exit; every wait is bounded. With TESTDATA (the
+# shared test data): side-by-side stereo with a raster overlay on the cluster equals the local
+# composite (one render path: nothing the local window does is dropped).
 set -u
-SY=$1; W=$2
+SY=$1; W=$2; DATA=${3:-}
 rm -rf "$W"; mkdir -p "$W"
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; }
@@ -32,6 +34,23 @@ cmp -s "$W/local.exr" "$W/cluster.exr" || fail "sort-first EXR differs from the 
 SY_CLUSTER_SECRET=cli-test-secret "$SY" render demo -b whitted -w 120 -h 80 -o "$W/balanced.exr" --cluster "$URLS" \
   --cluster-mode balanced --frames 3 2> "$W/client2.log" > /dev/null || fail "balanced render (secret from env)"
 cmp -s "$W/local.exr" "$W/balanced.exr" || fail "balanced EXR differs from the local render"
+
+# stereo + a raster overlay: the same window as locally, the main viewport on the cluster
+DUCK="$DATA/gltf/Duck/glTF-Binary/Duck.glb"
+if [ -n "$DATA" ] && [ -f "$DUCK" ]; then
+  "$SY" render demo -b whitted -w 320 -h 240 --stereo sbs --overlay "$DUCK:raster" -o "$W/sbs_local.exr" > /dev/null ||
+    fail "local stereo render with overlay"
+  "$SY" render demo -b whitted -w 320 -h 240 --stereo sbs --overlay "$DUCK:raster" -o "$W/sbs_cluster.exr" \
+    --cluster "$URLS" --secret-file "$W/secret" > "$W/sbs.out" 2> "$W/sbs.err" || fail "cluster stereo render with overlay"
+  grep -q "640x240, whitted on 2 servers (sort-first)" "$W/sbs.out" || fail "the cluster stereo image is not 640x240"
+  cmp -s "$W/sbs_local.exr" "$W/sbs_cluster.exr" || fail "cluster stereo + overlay differs from the local composite"
+  # a request the cluster cannot serve is refused at set-up, naming the node and the reason
+  if "$SY" render demo -b whitted -w 32 -h 24 -o "$W/coopw.exr" --cluster "$URLS" --secret-file "$W/secret" \
+    --cluster-mode cooperative 2> "$W/coopw.err"; then fail "cooperative whitted was accepted"; fi
+  grep -q "server 1 (tcp://127.0.0.1:[0-9]*) renders with whitted" "$W/coopw.err" || fail "the refusal does not name the node"
+else
+  echo "note: stereo + overlay part skipped: no test data at '$DATA' (Duck.glb)"
+fi
 
 # wrong secret: refused, reason logged on the server, exit code 2
 if SY_CLUSTER_SECRET=nope "$SY" render demo -b whitted -w 16 -h 16 -o "$W/x.exr" --cluster "$URLS" 2> "$W/bad.err"; then
