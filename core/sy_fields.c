@@ -1,5 +1,6 @@
 /* sy_fields.c — field tables of every object type and the generic deep copy / free / compare
- * operations they drive; change list building blocks (push, sort, merge). See sy_fields.h. */
+ * operations they drive (see sy_fields.h). The lowest module of core's scene: it calls neither the
+ * change lists (sy_changes.c) nor the scene (sy_scene.c); both build on it. */
 #include "sy_fields.h"
 
 #include <stdlib.h>
@@ -139,6 +140,13 @@ const void *sy_object_defaults(sy_object_type t)
 }
 
 /* >>generic field operations */
+void sy__primitive_release(sy_primitive *p)
+{
+    sy_blob *blobs[7] = {p->positions, p->texcoords0, p->texcoords1, p->normals, p->tangents, p->colors, p->indices};
+    for (int i = 0; i < 7; ++i) sy_blob_release(blobs[i]);
+    memset(p, 0, sizeof *p);
+}
+
 static void *field_ptr(const sy_type_desc *td, uint32_t f, const void *data)
 {
     return (char *)data + td->fields[f].offset;
@@ -146,7 +154,7 @@ static void *field_ptr(const sy_type_desc *td, uint32_t f, const void *data)
 
 static void prims_free(sy_primitive_list *l)
 {
-    for (uint32_t i = 0; i < l->count; ++i) sy_primitive_release(&l->items[i]);
+    for (uint32_t i = 0; i < l->count; ++i) sy__primitive_release(&l->items[i]);
     free(l->items);
     l->items = NULL;
     l->count = 0;
@@ -356,188 +364,4 @@ bool sy__attachments_equal(const sy_attachment *a, uint32_t na, const sy_attachm
         }
     }
     return true;
-}
-
-/* >>change lists */
-sy_changes *sy__changes_new(uint64_t first_frame, uint64_t last_frame, bool snapshot)
-{
-    sy_changes *c = calloc(1, sizeof *c);
-    if (!c) return NULL;
-    atomic_init(&c->refs, 1);
-    c->first_frame = first_frame;
-    c->last_frame = last_frame;
-    c->snapshot = snapshot;
-    c->bytes = sizeof *c;
-    return c;
-}
-
-sy_result sy__changes_push(sy_changes *c, uint32_t type, uint32_t id, uint32_t flags, uint64_t mask,
-                           const void *src_data, const sy_attachment *att, uint32_t natt, sy_error *err)
-{
-    const sy_type_desc *td = sy__type_desc(type);
-    if (!td) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "change list: unknown object type %u", type);
-    if (c->count == c->capacity) {
-        uint32_t ncap = c->capacity ? c->capacity * 2 : 16;
-        if (ncap <= c->capacity) return sy_error_set(err, SY_ERR_LIMIT, "change list: too many entries");
-        sy_change *ne = realloc(c->entries, sizeof(sy_change) * ncap);
-        if (!ne) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list: out of memory");
-        c->entries = ne;
-        c->capacity = ncap;
-    }
-    sy_change *e = &c->entries[c->count];
-    memset(e, 0, sizeof *e);
-    e->type = type;
-    e->id = id;
-    e->flags = flags;
-    e->mask = mask & sy__type_full_mask(type);
-    if (!(flags & SY_CHANGE_DESTROYED)) {
-        void *d = sy__data_new(type);
-        if (!d) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list: out of memory");
-        for (uint32_t f = 0; f < td->field_count; ++f) {
-            if (!(e->mask & SY_BIT(f))) continue;
-            if (!sy__field_copy(type, f, d, src_data)) {
-                sy__data_free(type, d);
-                return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list: out of memory");
-            }
-            c->bytes += sy__field_heap_bytes(type, f, d);
-        }
-        if (e->mask & SY_BIT(SY_FIELD_ATTACHMENTS)) {
-            sy_attachment *a;
-            if (!sy__attachments_copy(att, natt, &a)) {
-                sy__data_free(type, d);
-                return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list: out of memory");
-            }
-            e->attachments = a;
-            e->attachment_count = natt;
-            c->bytes += natt * sizeof(sy_attachment);
-        }
-        e->data = d;
-        c->bytes += td->data_size;
-    } else {
-        e->mask = 0;
-    }
-    c->bytes += sizeof *e;
-    c->count++;
-    return SY_OK;
-}
-
-static int change_order(const void *pa, const void *pb)
-{
-    const sy_change *a = pa, *b = pb;
-    int da = (a->flags & SY_CHANGE_DESTROYED) ? 0 : 1, db = (b->flags & SY_CHANGE_DESTROYED) ? 0 : 1;
-    if (da != db) return da - db;
-    if (a->type != b->type) return a->type < b->type ? -1 : 1;
-    if (a->id != b->id) return a->id < b->id ? -1 : 1;
-    return 0;
-}
-
-void sy__changes_sort(sy_changes *c)
-{
-    if (c->count > 1) qsort(c->entries, c->count, sizeof(sy_change), change_order);
-}
-
-/* Merge: an open-addressing map from (type, id) to the output entry index. */
-typedef struct merge_map {
-    uint64_t *keys; /* 0 = empty (type is never 0) */
-    uint32_t *vals;
-    size_t capacity;
-} merge_map;
-
-static uint64_t mix64(uint64_t x)
-{
-    x ^= x >> 33;
-    x *= 0xff51afd7ed558ccdull;
-    x ^= x >> 33;
-    return x;
-}
-
-sy_result sy__changes_merge(sy_changes *const *lists, uint32_t n, sy_changes **out, sy_error *err)
-{
-    *out = NULL;
-    size_t total = 0;
-    for (uint32_t i = 0; i < n; ++i) total += lists[i]->count;
-    uint64_t first = n ? lists[0]->first_frame : 0, last = n ? lists[n - 1]->last_frame : 0;
-    sy_changes *c = sy__changes_new(first, last, n && lists[0]->snapshot);
-    merge_map m = {0};
-    m.capacity = 16;
-    while (m.capacity < total * 2) m.capacity *= 2;
-    m.keys = calloc(m.capacity, sizeof *m.keys);
-    m.vals = calloc(m.capacity, sizeof *m.vals);
-    sy_result r = SY_OK;
-    if (!c || !m.keys || !m.vals) {
-        r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list merge: out of memory");
-        goto fail;
-    }
-    for (uint32_t li = 0; li < n; ++li) {
-        const sy_changes *src = lists[li];
-        for (uint32_t ei = 0; ei < src->count; ++ei) {
-            const sy_change *s = &src->entries[ei];
-            uint64_t key = ((uint64_t)s->type << 32) | s->id;
-            size_t h = (size_t)mix64(key) & (m.capacity - 1);
-            while (m.keys[h] && m.keys[h] != key) h = (h + 1) & (m.capacity - 1);
-            if (!m.keys[h]) {
-                r = sy__changes_push(c, s->type, s->id, s->flags, s->mask, s->data, s->attachments,
-                                     s->attachment_count, err);
-                if (r != SY_OK) goto fail;
-                m.keys[h] = key;
-                m.vals[h] = c->count - 1;
-                continue;
-            }
-            sy_change *d = &c->entries[m.vals[h]];
-            if (s->flags & SY_CHANGE_DESTROYED) {
-                /* created and destroyed within the range: the consumer never needs to know */
-                bool was_created = (d->flags & SY_CHANGE_CREATED) != 0;
-                sy__data_free(d->type, (void *)d->data);
-                sy__attachments_free((sy_attachment *)d->attachments, d->attachment_count);
-                d->data = NULL;
-                d->attachments = NULL;
-                d->attachment_count = 0;
-                d->mask = 0;
-                d->flags = was_created ? 0xffffffffu /* dropped below */ : SY_CHANGE_DESTROYED;
-                continue;
-            }
-            d->flags |= s->flags;
-            if (!d->data) {
-                d->data = sy__data_new(d->type);
-                if (!d->data) {
-                    r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list merge: out of memory");
-                    goto fail;
-                }
-            }
-            const sy_type_desc *td = sy__type_desc(s->type);
-            for (uint32_t f = 0; f < td->field_count; ++f)
-                if ((s->mask & SY_BIT(f)) && !sy__field_copy(s->type, f, (void *)d->data, s->data)) {
-                    r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list merge: out of memory");
-                    goto fail;
-                }
-            if (s->mask & SY_BIT(SY_FIELD_ATTACHMENTS)) {
-                sy_attachment *a;
-                if (!sy__attachments_copy(s->attachments, s->attachment_count, &a)) {
-                    r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "change list merge: out of memory");
-                    goto fail;
-                }
-                sy__attachments_free((sy_attachment *)d->attachments, d->attachment_count);
-                d->attachments = a;
-                d->attachment_count = s->attachment_count;
-            }
-            d->mask |= s->mask;
-        }
-    }
-    /* drop entries of objects created and destroyed within the range */
-    uint32_t w = 0;
-    for (uint32_t i = 0; i < c->count; ++i) {
-        if (c->entries[i].flags == 0xffffffffu) continue;
-        c->entries[w++] = c->entries[i];
-    }
-    c->count = w;
-    sy__changes_sort(c);
-    free(m.keys);
-    free(m.vals);
-    *out = c;
-    return SY_OK;
-fail:
-    free(m.keys);
-    free(m.vals);
-    sy_changes_release(c);
-    return r;
 }

@@ -36,6 +36,8 @@ const sy_type_desc *sy__type_desc(uint32_t type);
 /* Mask of every defined field of a type, attachments included. */
 uint64_t sy__type_full_mask(uint32_t type);
 
+/* Releases a primitive's blobs and zeroes it (sy_primitive_release, scene API, is this). */
+void sy__primitive_release(sy_primitive *p);
 /* Allocates a data struct holding the type's defaults (strings NULL, no blobs). */
 void *sy__data_new(uint32_t type);
 /* Frees everything a data struct owns, then the struct itself. NULL-safe. */
@@ -62,6 +64,8 @@ struct sy_changes {
     size_t bytes; /* approximate heap bytes held (entries + copied values) */
 };
 
+/* Change lists (defined in sy_changes.c, which builds on the field operations above; this file's
+ * functions never call back into change lists or the scene). */
 sy_changes *sy__changes_new(uint64_t first_frame, uint64_t last_frame, bool snapshot);
 /* Appends an entry copying the fields in mask from src_data (and the attachments when mask has
  * SY_FIELD_ATTACHMENTS). src_data may be NULL when mask is 0. */

@@ -1163,12 +1163,7 @@ float sy_primitive_stroke_width(const sy_primitive *p, const sy_bounds *primitiv
     return isfinite(w) && w > SY_STROKE_MIN_WIDTH ? w : SY_STROKE_MIN_WIDTH;
 }
 
-void sy_primitive_release(sy_primitive *p)
-{
-    sy_blob *blobs[7] = {p->positions, p->texcoords0, p->texcoords1, p->normals, p->tangents, p->colors, p->indices};
-    for (int i = 0; i < 7; ++i) sy_blob_release(blobs[i]);
-    memset(p, 0, sizeof *p);
-}
+void sy_primitive_release(sy_primitive *p) { sy__primitive_release(p); }
 
 bool sy_texture_ref_matrix(const sy_texture_ref *r, float m[6])
 {

@@ -304,3 +304,24 @@ bool sy_gl_context_should_close(sy_gl_context *c)
 {
     return c->provider == SY_GL_PROVIDER_GLFW && glfwWindowShouldClose(c->window);
 }
+
+/* >>provider names (the device and the CLI name providers through these) */
+const char *sy_gl_provider_name(sy_gl_provider p)
+{
+    switch (p) {
+    case SY_GL_PROVIDER_OSMESA: return "osmesa";
+    case SY_GL_PROVIDER_EGL: return "egl";
+    case SY_GL_PROVIDER_GLFW: return "glfw";
+    default: return "unknown";
+    }
+}
+
+bool sy_gl_provider_parse(const char *name, sy_gl_provider *out)
+{
+    for (int i = 0; i < 3; ++i)
+        if (name && !strcmp(name, sy_gl_provider_name((sy_gl_provider)i))) {
+            *out = (sy_gl_provider)i;
+            return true;
+        }
+    return false;
+}

@@ -231,26 +231,6 @@ static void warn(sy_gl_device *dev, const char *fmt, ...)
     dev->log(dev->log_user, msg);
 }
 
-const char *sy_gl_provider_name(sy_gl_provider p)
-{
-    switch (p) {
-    case SY_GL_PROVIDER_OSMESA: return "osmesa";
-    case SY_GL_PROVIDER_EGL: return "egl";
-    case SY_GL_PROVIDER_GLFW: return "glfw";
-    default: return "unknown";
-    }
-}
-
-bool sy_gl_provider_parse(const char *name, sy_gl_provider *out)
-{
-    for (int i = 0; i < 3; ++i)
-        if (name && !strcmp(name, sy_gl_provider_name((sy_gl_provider)i))) {
-            *out = (sy_gl_provider)i;
-            return true;
-        }
-    return false;
-}
-
 /* >>math (column-major 4x4) */
 static void m4_mul(const float *a, const float *b, float *o)
 {

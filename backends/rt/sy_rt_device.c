@@ -1,5 +1,6 @@
-/* sy_rt_device.c — device lifetime (Embree device + top-level scene), handle pools, error
- * helpers, Embree error capture, background and statistics. */
+/* sy_rt_device.c — device lifetime (Embree device + top-level scene), background and statistics.
+ * Above the scene and texture modules (it releases their objects with the device); the handle pools
+ * and error helpers they all use are sy_rt_base.c. */
 #include "sy_rt_device.h"
 #include "sy_rt_scene.h"
 #include "sy_rt_texture.h"
@@ -26,114 +27,6 @@ const char *sy_rt_result_str(sy_rt_result r)
     case SY_RT_ERROR_SYSTEM: return "system error";
     default: return "unknown result";
     }
-}
-
-sy_rt_result sy_rt_fail(char *err, size_t err_len, sy_rt_result r, const char *fmt, ...)
-{
-    if (err && err_len > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, err_len, fmt, ap);
-        va_end(ap);
-    }
-    return r;
-}
-
-static const char *rtc_error_name(enum RTCError e)
-{
-    switch (e) {
-    case RTC_ERROR_NONE: return "none";
-    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
-    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
-    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
-    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
-    case RTC_ERROR_CANCELLED: return "cancelled";
-    default: return "unknown error";
-    }
-}
-
-/* Embree calls this synchronously on the thread that caused the error (or a build thread). */
-static void rtc_error_callback(void *user, enum RTCError code, const char *msg)
-{
-    sy_rt_device *dev = user;
-    pthread_mutex_lock(&dev->rtc_err_lock);
-    snprintf(dev->rtc_msg, sizeof dev->rtc_msg, "%s (%s)", msg ? msg : "", rtc_error_name(code));
-    pthread_mutex_unlock(&dev->rtc_err_lock);
-}
-
-sy_rt_result sy_rt_check_embree(sy_rt_device *dev, char *err, size_t err_len, const char *what)
-{
-    enum RTCError code = rtcGetDeviceError(dev->rtc);
-    if (code == RTC_ERROR_NONE) return SY_RT_OK;
-    pthread_mutex_lock(&dev->rtc_err_lock);
-    sy_rt_result r = sy_rt_fail(err, err_len, SY_RT_ERROR_EMBREE, "%s: embree: %s", what,
-                                dev->rtc_msg[0] ? dev->rtc_msg : rtc_error_name(code));
-    dev->rtc_msg[0] = '\0';
-    pthread_mutex_unlock(&dev->rtc_err_lock);
-    return r;
-}
-
-/* >>pool */
-
-bool sy_rt_pool_insert(sy_rt_pool *p, void *item, uint32_t *id_out)
-{
-    uint32_t idx;
-    if (p->free_count > 0) {
-        idx = p->free_idx[--p->free_count];
-    } else {
-        if (p->count >= SY_RT_POOL_MAX) return false;
-        if (p->count == p->cap) {
-            uint32_t ncap = p->cap ? p->cap * 2u : 64u;
-            if (ncap > SY_RT_POOL_MAX) ncap = SY_RT_POOL_MAX;
-            void **items = realloc(p->items, (size_t)ncap * sizeof *items);
-            if (!items) return false;
-            p->items = items;
-            uint32_t *gens = realloc(p->gens, (size_t)ncap * sizeof *gens);
-            if (!gens) return false;
-            p->gens = gens;
-            uint32_t *fr = realloc(p->free_idx, (size_t)ncap * sizeof *fr);
-            if (!fr) return false;
-            p->free_idx = fr;
-            p->cap = ncap;
-        }
-        idx = p->count++;
-        p->gens[idx] = 1;
-    }
-    p->items[idx] = item;
-    p->live++;
-    *id_out = (p->gens[idx] << SY_RT_INDEX_BITS) | (idx + 1u);
-    return true;
-}
-
-void *sy_rt_pool_get(const sy_rt_pool *p, uint32_t id)
-{
-    uint32_t slot = id & SY_RT_INDEX_MASK;
-    if (slot == 0 || slot > p->count) return NULL;
-    uint32_t idx = slot - 1u;
-    if (p->gens[idx] != (id >> SY_RT_INDEX_BITS)) return NULL;
-    return p->items[idx];
-}
-
-void *sy_rt_pool_remove(sy_rt_pool *p, uint32_t id)
-{
-    void *item = sy_rt_pool_get(p, id);
-    if (!item) return NULL;
-    uint32_t idx = (id & SY_RT_INDEX_MASK) - 1u;
-    p->items[idx] = NULL;
-    /* Generation wraps within 1..SY_RT_GEN_MASK; a handle is only confused with a new object
-     * after SY_RT_GEN_MASK reuses of the same slot. */
-    p->gens[idx] = p->gens[idx] % SY_RT_GEN_MASK + 1u;
-    p->free_idx[p->free_count++] = idx;
-    p->live--;
-    return item;
-}
-
-void sy_rt_pool_free(sy_rt_pool *p)
-{
-    free(p->items);
-    free(p->gens);
-    free(p->free_idx);
-    memset(p, 0, sizeof *p);
 }
 
 /* >>device */
@@ -164,9 +57,9 @@ sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **o
         pthread_mutex_destroy(&dev->rtc_err_lock);
         free(dev);
         return sy_rt_fail(err, err_len, SY_RT_ERROR_EMBREE, "device create: rtcNewDevice(\"%s\") failed: %s",
-                          config, rtc_error_name(e));
+                          config, sy_rt_embree_error_name(e));
     }
-    rtcSetDeviceErrorFunction(dev->rtc, rtc_error_callback, dev);
+    rtcSetDeviceErrorFunction(dev->rtc, sy_rt_embree_error_callback, dev);
     dev->top = rtcNewScene(dev->rtc);
     sy_rt_result r = sy_rt_check_embree(dev, err, err_len, "device create: top-level scene");
     if (r != SY_RT_OK) {

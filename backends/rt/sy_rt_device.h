@@ -11,29 +11,7 @@
 #include <pthread.h>
 #include <stdarg.h>
 
-/* >>pool: index + generation handles. id = generation << SY_RT_INDEX_BITS | (index + 1). */
-#define SY_RT_INDEX_BITS 22u
-#define SY_RT_INDEX_MASK ((1u << SY_RT_INDEX_BITS) - 1u)
-#define SY_RT_POOL_MAX (SY_RT_INDEX_MASK - 1u) /* most live objects per type */
-#define SY_RT_GEN_MASK ((1u << (32u - SY_RT_INDEX_BITS)) - 1u)
-
-typedef struct sy_rt_pool {
-    void **items;       /* slot -> object or NULL */
-    uint32_t *gens;     /* slot -> current generation (1..SY_RT_GEN_MASK) */
-    uint32_t *free_idx; /* stack of free slots */
-    uint32_t count;     /* slots in use or on the free stack */
-    uint32_t cap;
-    uint32_t free_count;
-    uint32_t live;
-} sy_rt_pool;
-
-/* Stores item in a slot; *id_out gets its handle. Returns false when out of memory or full. */
-bool sy_rt_pool_insert(sy_rt_pool *p, void *item, uint32_t *id_out);
-/* Object for id, or NULL for a zero, stale or foreign id. */
-void *sy_rt_pool_get(const sy_rt_pool *p, uint32_t id);
-/* Frees the slot of a valid id (bumps its generation) and returns its object (NULL if invalid). */
-void *sy_rt_pool_remove(sy_rt_pool *p, uint32_t id);
-void sy_rt_pool_free(sy_rt_pool *p);
+#include "sy_rt_base.h"
 
 /* >>objects */
 
@@ -141,18 +119,6 @@ struct sy_rt_device {
     sy_rt_material_data default_material;
     float srgb_lut[256]; /* sRGB 8-bit -> linear */
 };
-
-/* >>errors */
-
-/* Writes a printf-style message to err (if non-NULL, err_len > 0) and returns r. */
-sy_rt_result sy_rt_fail(char *err, size_t err_len, sy_rt_result r, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 4, 5)))
-#endif
-    ;
-/* Returns SY_RT_OK, or SY_RT_ERROR_EMBREE with "what: <embree message>" when Embree recorded an
- * error since the last check. */
-sy_rt_result sy_rt_check_embree(sy_rt_device *dev, char *err, size_t err_len, const char *what);
 
 /* Checked size arithmetic: false on overflow. */
 static inline bool sy_rt_size_mul(size_t a, size_t b, size_t *out)

@@ -5,7 +5,7 @@
 #ifndef SY_RT_PATHTRACER_H
 #define SY_RT_PATHTRACER_H
 
-#include "sy_rt_render.h"
+#include "sy_rt_frame.h"
 
 /* Adds desc->samples (0 = 1) samples per pixel of the frame's rectangle to desc->accum, then
  * resolves colour into f->rgba and depth into f->depth when they are non-NULL. */

@@ -9,7 +9,7 @@
 #ifndef SY_RT_SHADOW_H
 #define SY_RT_SHADOW_H
 
-#include "sy_rt_render.h"
+#include "sy_rt_frame.h"
 
 /* Transmittance (RGB in [0, 1]) of org + t*dir for t in (0, tfar). *rays (may be NULL) is
  * incremented by the rays traced. */

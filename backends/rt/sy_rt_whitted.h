@@ -7,7 +7,7 @@
 #ifndef SY_RT_WHITTED_H
 #define SY_RT_WHITTED_H
 
-#include "sy_rt_render.h"
+#include "sy_rt_frame.h"
 
 /* Renders the frame's rectangle with the Whitted integrator (desc: pixel_samples,
  * env_light_samples, progress). */

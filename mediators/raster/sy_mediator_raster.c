@@ -830,3 +830,5 @@ void sy_mediator_raster_counters_get(void *state, sy_mediator_raster_counters *o
 }
 
 const char *sy_mediator_raster_info(void *state) { return sy_gl_device_info(((raster_state *)state)->dev); }
+
+sy_result sy_mediator_raster_register(sy_error *err) { return sy_mediator_register(&raster_class, err); }

@@ -25,6 +25,8 @@ extern "C" {
 #endif
 
 /* The rasterizer class ("raster"). Static storage. */
+/* Registers raster (the build's registration list calls it). */
+sy_result sy_mediator_raster_register(sy_error *err);
 const sy_mediator_class *sy_mediator_raster_class(void);
 
 /* Counters for tests and benchmarks. Upload counts are those of the last rendered frame: every

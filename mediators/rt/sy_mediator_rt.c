@@ -1173,3 +1173,11 @@ void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out)
 {
     *out = ((rt_state *)state)->counters;
 }
+
+sy_result sy_mediator_rt_register(sy_error *err)
+{
+    sy_result r = sy_mediator_register(&whitted_class, err);
+    if (r == SY_OK) r = sy_mediator_register(&pathtracer_class, err);
+    if (r == SY_OK) r = sy_mediator_register(&coverage_class, err);
+    return r;
+}

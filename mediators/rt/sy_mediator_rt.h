@@ -35,6 +35,8 @@ extern "C" {
 #endif
 
 /* The Whitted ray tracer class ("whitted"). Static storage. */
+/* Registers whitted, pathtracer and coverage (the build's registration list calls it). */
+sy_result sy_mediator_rt_register(sy_error *err);
 const sy_mediator_class *sy_mediator_rt_whitted_class(void);
 /* The coverage class ("coverage"): no shading; the layer shows every visible object in a stable
  * colour derived from its node id (alpha 1 where covered) with depth. A culling service: which

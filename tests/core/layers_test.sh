@@ -3,11 +3,15 @@
 #   1. core/ includes only core headers (and system headers); backends/ includes no core/,
 #      mediators/ or formats/ header; formats/ no mediators/ or backends/ header.
 #   2. The built core library references no transport or codec symbol (nng, libsodium, zstd, MPI).
+#   4. Within each library, modules do not call each other in a loop (the calls between the object
+#      files of each archive, from nm, sort topologically with tsort), so each layer reads bottom-up.
 #   3. apps/ never decides behaviour by a back-end's name: no string comparison against a
 #      registered back-end name (capabilities are asked instead, sy_mediator.h).
-# Usage: layers_test.sh SOURCE_DIR LIBSY_CORE_A
+# Usage: layers_test.sh SOURCE_DIR LIBSY_CORE_A [MORE_LIBRARIES.a ...]
 set -u
 SRC=$1 CORE_LIB=$2
+shift 2
+MORE_LIBS=("$@")
 fail=0
 bad() { echo "FAIL: $*"; fail=1; }
 
@@ -46,4 +50,20 @@ for n in $names; do
     [ -z "$hits" ] || { bad "apps/ compares against the back-end name $n:"; echo "$hits"; }
 done
 [ $fail = 0 ] && echo "ok: apps/ compares no back-end name ($(echo $names | tr '\n' ' '))"
+# 4. module call graph per archive: member -> member that defines a symbol it uses
+for lib in "$CORE_LIB" "${MORE_LIBS[@]}"; do
+    [ -f "$lib" ] || { bad "library $lib not found"; continue; }
+    edges=$(awk 'NR == FNR { if ($2 ~ /^[TDBR]$/) def[$3] = $1; next }
+                 $2 == "U" && ($3 in def) && def[$3] != $1 { print $1, def[$3] }' \
+            <(nm -A --defined-only "$lib" 2>/dev/null | sed -E 's/^[^:]*:([^:]*): *[0-9a-f]* /\1 /') \
+            <(nm -A -u "$lib" 2>/dev/null | sed -E 's/^[^:]*:([^:]*): *U /\1 U /') | sort -u)
+    n=$(echo "$edges" | grep -c .)
+    if ! loop=$(echo "$edges" | tsort 2>&1 >/dev/null) || [ -n "$loop" ]; then
+        bad "$(basename "$lib"): modules call each other in a loop: $(echo "$loop" | tr '\n' ' ')"
+    elif [ "$n" -lt 1 ]; then
+        bad "$(basename "$lib"): no calls between modules found (the check would see nothing)"
+    else
+        echo "ok: $(basename "$lib"): $n calls between modules, no loop"
+    fi
+done
 exit $fail

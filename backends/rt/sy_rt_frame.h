@@ -1,8 +1,8 @@
-/* sy_rt_render.h — per-frame render state shared by the integrators and the benchmark: the
+/* sy_rt_frame.h — per-frame render state shared by the integrators and the benchmark: the
  * validated camera with its primary-ray generator, the output rectangle, and the tile scheduler
  * (pthreads + atomic tile counter, progress and cancellation). Internal to backends/rt. */
-#ifndef SY_RT_RENDER_H
-#define SY_RT_RENDER_H
+#ifndef SY_RT_FRAME_H
+#define SY_RT_FRAME_H
 
 #include "sy_rt_device.h"
 
@@ -91,4 +91,4 @@ typedef void (*sy_rt_tile_fn)(const sy_rt_frame *f, void *user, uint32_t x0, uin
 sy_rt_result sy_rt_run_tiles(const sy_rt_frame *f, sy_rt_tile_fn fn, void *user, sy_rt_progress_fn progress,
                              void *progress_user, char *err, size_t err_len);
 
-#endif /* SY_RT_RENDER_H */
+#endif /* SY_RT_FRAME_H */

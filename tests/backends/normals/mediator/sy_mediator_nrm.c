@@ -1,0 +1,139 @@
+/* sy_mediator_nrm.c — the normals mediator (see sy_mediator_nrm.h). */
+#include "sy_mediator_nrm.h"
+
+#include "sy_mirror.h"
+#include "sy_nrm.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct nrm_state {
+    sy_nrm_device *dev;
+    sy_mirror *mirror;
+} nrm_state;
+
+static sy_result nrm_fail(sy_error *err, const char *e) { return sy_error_set(err, SY_ERR_BACKEND, "%s", e); }
+
+static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_error *err)
+{
+    (void)user, (void)err;
+    *a->handle = 0; /* normals use no texture */
+    return SY_OK;
+}
+
+static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_error *err)
+{
+    (void)user, (void)err;
+    *a->handle = 1; /* one stand-in: normals ignore materials */
+    return SY_OK;
+}
+
+static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
+{
+    nrm_state *st = user;
+    const sy_primitive *p = a->primitive;
+    uint32_t nv = sy_primitive_vertex_count(p), nt = sy_primitive_triangle_count(p);
+    const uint32_t *idx = sy_blob_data(p->indices);
+    uint32_t *seq = NULL;
+    if (!idx && nt) { /* non-indexed: vertices in order */
+        seq = malloc((size_t)nt * 3 * sizeof *seq);
+        if (!seq) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "normals: out of memory");
+        for (uint32_t i = 0; i < nt * 3; ++i) seq[i] = i;
+        idx = seq;
+    }
+    char e[256];
+    *a->handle = sy_nrm_mesh_create(st->dev, sy_blob_data(p->positions), nv, idx, nt, e, sizeof e);
+    free(seq);
+    return *a->handle ? SY_OK : nrm_fail(err, e);
+}
+
+static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_error *err)
+{
+    nrm_state *st = user;
+    char e[256];
+    uint32_t h = sy_nrm_instance_set(st->dev, *a->handle, a->mesh, a->world->m, a->visible, e, sizeof e);
+    if (!h) return nrm_fail(err, e);
+    *a->handle = h;
+    return SY_OK;
+}
+
+static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *err)
+{
+    (void)user, (void)err;
+    *a->handle = 1; /* normals are unlit */
+    return SY_OK;
+}
+
+static void cb_release(void *user, const sy_mirror_release_args *a)
+{
+    nrm_state *st = user;
+    if (a->kind == SY_MIRROR_PRIMITIVE) sy_nrm_mesh_release(st->dev, a->handle);
+    else if (a->kind == SY_MIRROR_INSTANCE) sy_nrm_instance_release(st->dev, a->handle);
+}
+
+static const sy_mirror_callbacks nrm_callbacks = {
+    .texture_set = cb_texture,
+    .material_set = cb_material,
+    .primitive_set = cb_primitive,
+    .instance_set = cb_instance,
+    .light_set = cb_light,
+    .release = cb_release,
+};
+
+static void nrm_destroy(void *state)
+{
+    nrm_state *st = state;
+    if (!st) return;
+    sy_mirror_destroy(st->mirror); /* releases instances and meshes through the device */
+    sy_nrm_device_destroy(st->dev);
+    free(st);
+}
+
+static sy_result nrm_create(const sy_mediator_create_args *args, void **state_out, sy_error *err)
+{
+    *state_out = NULL;
+    if (args->params && args->params->count)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "normals: unknown parameter '%s' (it takes none)",
+                            args->params->items[0].key);
+    nrm_state *st = calloc(1, sizeof *st);
+    if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "normals: out of memory");
+    char e[256];
+    sy_result r = sy_nrm_device_create(&st->dev, e, sizeof e) ? nrm_fail(err, e) : SY_OK;
+    sy_mirror_desc md = {.name = "normals mediator", .root_node_id = args->root_node_id, .callbacks = &nrm_callbacks,
+                         .user = st};
+    if (r == SY_OK) r = sy_mirror_create(&md, &st->mirror, err);
+    if (r) {
+        nrm_destroy(st);
+        return r;
+    }
+    *state_out = st;
+    return SY_OK;
+}
+
+static sy_result nrm_sync(void *state, const sy_changes *changes, sy_error *err)
+{
+    return sy_mirror_sync(((nrm_state *)state)->mirror, changes, NULL, err);
+}
+
+static sy_result nrm_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
+{
+    nrm_state *st = state;
+    sy_nrm_view v = {.orthographic = req->camera.projection == SY_PROJECTION_ORTHOGRAPHIC,
+                     .full_width = req->full_width, .full_height = req->full_height,
+                     .rect_x = req->rect_x, .rect_y = req->rect_y, .rect_w = req->rect_w, .rect_h = req->rect_h};
+    memcpy(v.camera_to_world, req->camera.camera_to_world.m, sizeof v.camera_to_world);
+    memcpy(v.window, req->camera.window, sizeof v.window);
+    char e[256];
+    return sy_nrm_render(st->dev, &v, layer->rgba, layer->depth, e, sizeof e) ? nrm_fail(err, e) : SY_OK;
+}
+
+static const sy_mediator_class nrm_class = {
+    .name = "normals",
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_ANALYSIS,
+    .create = nrm_create,
+    .destroy = nrm_destroy,
+    .sync = nrm_sync,
+    .render = nrm_render,
+};
+
+sy_result sy_mediator_nrm_register(sy_error *err) { return sy_mediator_register(&nrm_class, err); }
