@@ -1,11 +1,10 @@
-/* sy_cluster.c — render server and cluster client over nng byte streams (see sy_cluster.h,
- * docs/PROTOCOL.md). Sections: >>wire (frames on a stream, shared), tile codec, secrets, server
+/* sy_cluster.c — render server and cluster client over the transports' byte streams (nng TCP/TLS,
+ * MPI: sy_cluster_transport.h; this file never sees which) (see sy_cluster.h, docs/PROTOCOL.md). Sections: >>wire (frames on a stream, shared), tile codec, secrets, server
  * (blob cache, back-off table, peer memory, >>serving, >>connections), client. */
 #include "sy_cluster.h"
 
-#include <nng/nng.h>
-#include <nng/supplemental/tls/tls.h>
-#include <nng/transport/tcp/tcp.h>
+#include "sy_cluster_transport.h"
+
 #include <sodium.h>
 #include <zstd.h>
 
@@ -78,7 +77,7 @@ static void mac3(uint8_t out[32], const uint8_t *key, size_t key_len, const char
     crypto_auth_hmacsha512256_final(&st, out);
 }
 
-/* >>wire: frames over an nng byte stream (shared by the server and the client)
+/* >>wire: frames over a transport's byte stream (shared by the server and the client)
  *
  * A message travels as one frame or, when its body is larger than the receiver's frame limit, as
  * several frames of the same type (SY_CLUSTER_FLAG_MORE on all but the last). Every frame carries
@@ -87,82 +86,12 @@ static void mac3(uint8_t out[32], const uint8_t *key, size_t key_len, const char
  * The receiver reads the fixed 24-byte header first and checks it against its budget
  * (sy_cluster_frame_check) before it reads or allocates anything for the body. */
 typedef struct wire {
-    nng_stream *st;
-    nng_aio *aio;                /* completes through wire_done (busy, cond) */
-    pthread_mutex_t lock;
-    pthread_cond_t cond;         /* CLOCK_MONOTONIC */
-    bool busy, sync_ok;
+    sy_cluster_stream *st;       /* the transport's byte stream (sy_cluster_transport.h); NULL = none */
     uint64_t send_seq, recv_seq; /* last sequence number sent / received */
     uint8_t key[32];
     bool tagged;                 /* frames carry tags under key (both directions) */
-    int last_rv;                 /* nng result of the last failed operation (0: a protocol error) */
+    int last_rv;                 /* sy_stream_status of the last failed operation (0: a protocol error) */
 } wire;
-
-static void wire_done(void *arg)
-{
-    wire *w = arg;
-    pthread_mutex_lock(&w->lock);
-    w->busy = false;
-    pthread_cond_broadcast(&w->cond);
-    pthread_mutex_unlock(&w->lock);
-}
-
-/* The aio and its completion signal (w zeroed before; the stream is set later). nng result. */
-static int wire_init(wire *w)
-{
-    pthread_condattr_t ca;
-    pthread_condattr_init(&ca);
-    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
-    pthread_mutex_init(&w->lock, NULL);
-    pthread_cond_init(&w->cond, &ca);
-    pthread_condattr_destroy(&ca);
-    w->sync_ok = true;
-    return nng_aio_alloc(&w->aio, wire_done, w);
-}
-
-/* Frees the aio (waiting for a pending operation) and the signal; not the stream. */
-static void wire_fini(wire *w)
-{
-    if (w->aio) nng_aio_free(w->aio);
-    w->aio = NULL;
-    if (w->sync_ok) {
-        pthread_mutex_destroy(&w->lock);
-        pthread_cond_destroy(&w->cond);
-    }
-    w->sync_ok = false;
-}
-
-/* Runs one stream operation (already set up on w->aio) to completion. The aio's own timeout ends
- * it at the deadline; in case the stream does not honour it (nng 1.5.2's TLS streams leave a
- * receive pending forever once the TCP connection under them has failed), the stream is closed
- * SY_CLUSTER_WATCHDOG_MS after the deadline, which completes every pending operation. */
-static int wire_wait(wire *w, double deadline)
-{
-    bool forced = false;
-    pthread_mutex_lock(&w->lock);
-    while (w->busy) {
-        if (deadline <= 0) {
-            pthread_cond_wait(&w->cond, &w->lock);
-            continue;
-        }
-        double until = deadline + SY_CLUSTER_WATCHDOG_MS / 1000.0;
-        struct timespec now;
-        clock_gettime(CLOCK_MONOTONIC, &now);
-        double left = until - sy_time_now();
-        if (left <= 0) {
-            forced = true;
-            break;
-        }
-        long ns = now.tv_nsec + (long)((left - (double)(long)left) * 1e9);
-        struct timespec ts = {now.tv_sec + (time_t)left + ns / 1000000000L, ns % 1000000000L};
-        pthread_cond_timedwait(&w->cond, &w->lock, &ts);
-    }
-    pthread_mutex_unlock(&w->lock);
-    if (forced) nng_stream_close(w->st); /* every pending operation completes (NNG_ECLOSED) */
-    nng_aio_wait(w->aio);
-    int rv = nng_aio_result(w->aio);
-    return forced && rv ? NNG_ETIMEDOUT : rv;
-}
 
 /* Memory for reassembled messages: reserve() may wait (back-pressure) and returns false when the
  * bytes cannot be had; NULL = plain malloc (the client). */
@@ -192,11 +121,7 @@ static void rx_release(rx_msg *m, const wire_mem *mem)
 /* error prefix: "WHO: " or nothing (the server logs the peer's address itself) */
 #define WHO(who) ((who) ? (who) : ""), ((who) ? ": " : "")
 
-static bool wire_closed(const wire *w)
-{
-    return w->last_rv == NNG_ECLOSED || w->last_rv == NNG_ECONNSHUT || w->last_rv == NNG_ECONNRESET ||
-           w->last_rv == NNG_ECONNABORTED;
-}
+static bool wire_closed(const wire *w) { return w->last_rv == SY_STREAM_CLOSED; }
 
 static void frame_tag_parts(uint8_t out[32], const uint8_t key[32], const uint8_t *hdr, const uint8_t *body, size_t n)
 {
@@ -209,46 +134,32 @@ static void frame_tag_parts(uint8_t out[32], const uint8_t key[32], const uint8_
 
 /* Moves all bytes of iov[0..n) in one direction; every operation must finish by deadline
  * (absolute sy_time_now() seconds; 0 = none). */
-static sy_result wire_io(wire *w, bool sending, nng_iov *iov, unsigned n, double deadline, const char *who,
+static sy_result wire_io(wire *w, bool sending, sy_cluster_iov *iov, unsigned n, double deadline, const char *who,
                          sy_error *err)
 {
     unsigned first = 0;
-    while (first < n && iov[first].iov_len == 0) first++;
+    while (first < n && iov[first].len == 0) first++;
     while (first < n) {
-        nng_duration ms = NNG_DURATION_INFINITE;
-        if (deadline > 0) {
-            double left = deadline - sy_time_now();
-            ms = left <= 0.001 ? 1 : (nng_duration)(left * 1000.0 + 0.5);
-        }
-        int rv = nng_aio_set_iov(w->aio, n - first, iov + first);
-        if (rv == 0) {
-            nng_aio_set_timeout(w->aio, ms);
-            pthread_mutex_lock(&w->lock);
-            w->busy = true;
-            pthread_mutex_unlock(&w->lock);
-            if (sending) nng_stream_send(w->st, w->aio);
-            else nng_stream_recv(w->st, w->aio);
-            rv = wire_wait(w, deadline);
-        }
-        size_t got = rv == 0 ? nng_aio_count(w->aio) : 0;
-        if (rv == 0 && got == 0) rv = NNG_ECONNSHUT;
-        if (rv) {
-            w->last_rv = rv;
-            if (rv == NNG_ETIMEDOUT)
+        size_t got = 0;
+        char msg[160] = "";
+        sy_stream_status st = w->st->ops->io(w->st, sending, iov + first, n - first, deadline, &got, msg, sizeof msg);
+        if (st == SY_STREAM_OK && got == 0) st = SY_STREAM_CLOSED, snprintf(msg, sizeof msg, "connection shut");
+        if (st != SY_STREAM_OK) {
+            w->last_rv = (int)st;
+            if (st == SY_STREAM_TIMEDOUT)
                 return sy_error_set(err, SY_ERR_IO, "%s%s%s", WHO(who),
                                     sending ? "the peer did not take the data before the deadline"
                                             : "no data before the deadline");
-            return sy_error_set(err, SY_ERR_IO, "%s%s%s: %s", WHO(who), sending ? "send failed" : "receive failed",
-                                nng_strerror(rv));
+            return sy_error_set(err, SY_ERR_IO, "%s%s%s: %s", WHO(who), sending ? "send failed" : "receive failed", msg);
         }
         while (got && first < n) {
-            size_t k = got < iov[first].iov_len ? got : iov[first].iov_len;
-            iov[first].iov_buf = (uint8_t *)iov[first].iov_buf + k;
-            iov[first].iov_len -= k;
+            size_t k = got < iov[first].len ? got : iov[first].len;
+            iov[first].buf = (uint8_t *)iov[first].buf + k;
+            iov[first].len -= k;
             got -= k;
-            if (!iov[first].iov_len) first++;
+            if (!iov[first].len) first++;
         }
-        while (first < n && iov[first].iov_len == 0) first++;
+        while (first < n && iov[first].len == 0) first++;
     }
     return SY_OK;
 }
@@ -274,7 +185,7 @@ static sy_result wire_send(wire *w, const uint8_t *frame, size_t size, size_t ma
         sy_cluster_header_write(hdr, type, (w->tagged ? SY_CLUSTER_FLAG_TAGGED : 0u) | (more ? SY_CLUSTER_FLAG_MORE : 0u),
                                 (uint32_t)c, ++w->send_seq);
         if (w->tagged) frame_tag_parts(t, w->key, hdr, body + off, c);
-        nng_iov iov[3] = {{hdr, sizeof hdr}, {(void *)(body + off), c}, {t, tag}};
+        sy_cluster_iov iov[3] = {{hdr, sizeof hdr}, {(void *)(body + off), c}, {t, tag}};
         double d = deadline;
         if (progress_s > 0 && (d <= 0 || sy_time_now() + progress_s < d)) d = sy_time_now() + progress_s;
         sy_result r = wire_io(w, true, iov, 3, d, who, err);
@@ -305,7 +216,7 @@ static sy_result wire_recv(wire *w, const sy_cluster_budget *b, uint8_t *fixed, 
         uint8_t hdr[SY_CLUSTER_HEADER_SIZE];
         double d = deadline;
         if (type && progress_s > 0 && (d <= 0 || sy_time_now() + progress_s < d)) d = sy_time_now() + progress_s;
-        nng_iov iov[2] = {{hdr, sizeof hdr}, {NULL, 0}};
+        sy_cluster_iov iov[2] = {{hdr, sizeof hdr}, {NULL, 0}};
         r = wire_io(w, false, iov, 1, d, who, err);
         if (r) goto fail;
         if (progress_s > 0 && (deadline <= 0 || sy_time_now() + progress_s < deadline))
@@ -353,7 +264,7 @@ static sy_result wire_recv(wire *w, const sy_cluster_budget *b, uint8_t *fixed, 
         }
         uint8_t tag[SY_CLUSTER_TAG_SIZE];
         size_t tag_len = follow - h.body_size;
-        nng_iov biov[2] = {{out->body ? out->body + so_far : NULL, h.body_size}, {tag, tag_len}};
+        sy_cluster_iov biov[2] = {{out->body ? out->body + so_far : NULL, h.body_size}, {tag, tag_len}};
         r = wire_io(w, false, biov, 2, d, who, err);
         if (r) goto fail;
         if (tag_len) {
@@ -378,33 +289,6 @@ static sy_result wire_recv(wire *w, const sy_cluster_budget *b, uint8_t *fixed, 
 fail:
     rx_release(out, mem);
     return r;
-}
-
-static bool sockaddr_is_loopback(const nng_sockaddr *sa)
-{
-    if (sa->s_family == NNG_AF_INET) return (ntohl(sa->s_in.sa_addr) >> 24) == 127;
-    if (sa->s_family == NNG_AF_INET6) {
-        static const uint8_t lo6[16] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1};
-        return memcmp(sa->s_in6.sa_addr, lo6, 16) == 0;
-    }
-    return sa->s_family == NNG_AF_INPROC || sa->s_family == NNG_AF_IPC;
-}
-
-/* "1.2.3.4:port" / "[::1]:port"; with_port false: the host alone (the key of the back-off table) */
-static void sockaddr_str(const nng_sockaddr *sa, bool with_port, char *buf, size_t n)
-{
-    if (sa->s_family == NNG_AF_INET) {
-        char a[INET_ADDRSTRLEN];
-        struct in_addr ia = {sa->s_in.sa_addr};
-        inet_ntop(AF_INET, &ia, a, sizeof a);
-        if (with_port) snprintf(buf, n, "%s:%u", a, (unsigned)ntohs(sa->s_in.sa_port));
-        else snprintf(buf, n, "%s", a);
-    } else if (sa->s_family == NNG_AF_INET6) {
-        char a[INET6_ADDRSTRLEN];
-        inet_ntop(AF_INET6, sa->s_in6.sa_addr, a, sizeof a);
-        if (with_port) snprintf(buf, n, "[%s]:%u", a, (unsigned)ntohs(sa->s_in6.sa_port));
-        else snprintf(buf, n, "%s", a);
-    } else snprintf(buf, n, "local peer");
 }
 
 /* ---- tile codec ---- */
@@ -782,7 +666,7 @@ typedef struct session {
  * back-off table, so a busy serving thread never delays a handshake), then reads each message,
  * hands it to the serving thread (the job fields, under qlock), waits for the reply and sends it.
  * Before the session is open nothing is allocated for the connection beyond this record (the
- * handshake frame buffer is inside it), its nng aio and stream, and the thread's stack. The
+ * handshake frame buffer is inside it), its transport stream, and the thread's stack. The
  * record is freed by the serving thread (reap_peers) after the thread has ended. */
 typedef struct peer {
     sy_cluster_server *s;
@@ -813,8 +697,7 @@ typedef struct peer {
 struct sy_cluster_server {
     sy_cluster_server_opts o;
     uint8_t *secret;
-    nng_stream_listener *listener;
-    nng_tls_config *tls;
+    sy_cluster_listener *listener;
     int port;
     size_t max_frame, max_message, max_peer_memory;
     uint32_t max_sessions, max_unauth, handshake_ms;
@@ -1015,54 +898,29 @@ sy_result sy_cluster_server_create(const sy_cluster_server_opts *opts, sy_cluste
         memcpy(s->secret, opts->secret, opts->secret_len);
     }
     s->o.secret = s->secret;
-    int rv;
-    bool tls = strncmp(url, "tls+tcp://", 10) == 0;
-    if ((rv = nng_stream_listener_alloc(&s->listener, url)) != 0) {
-        s->listener = NULL;
+    char *cert = NULL, *key = NULL;
+    sy_result lr = SY_OK;
+    if (!strncmp(url, "tls+tcp://", 10) && opts->tls_cert_file && opts->tls_key_file) {
+        lr = read_pem(opts->tls_cert_file, &cert, err);
+        if (lr == SY_OK) lr = read_pem(opts->tls_key_file, &key, err);
+    }
+    sy_cluster_listen_opts lo = {cert, key};
+    if (lr == SY_OK) lr = sy_cluster_listen(url, &lo, &s->listener, err);
+    if (key) sodium_memzero(key, strlen(key));
+    free(cert);
+    free(key);
+    if (lr != SY_OK) {
         sy_cluster_server_destroy(s);
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy serve: %s: %s", url, nng_strerror(rv));
+        return lr;
     }
-    if (tls) {
-        if (!opts->tls_cert_file || !opts->tls_key_file) {
-            sy_cluster_server_destroy(s);
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy serve: %s: TLS needs --tls-cert and --tls-key", url);
-        }
-        char *cert = NULL, *key = NULL;
-        sy_result fr = read_pem(opts->tls_cert_file, &cert, err);
-        if (fr == SY_OK) fr = read_pem(opts->tls_key_file, &key, err);
-        if (fr != SY_OK) {
-            free(cert);
-            sy_cluster_server_destroy(s);
-            return fr;
-        }
-        rv = nng_tls_config_alloc(&s->tls, NNG_TLS_MODE_SERVER);
-        if (rv == 0) rv = nng_tls_config_own_cert(s->tls, cert, key, NULL);
-        if (key) sodium_memzero(key, strlen(key));
-        free(cert);
-        free(key);
-        if (rv != 0 || (rv = nng_stream_listener_set_ptr(s->listener, NNG_OPT_TLS_CONFIG, s->tls)) != 0) {
-            sy_cluster_server_destroy(s);
-            return sy_error_set(err, rv == NNG_ENOTSUP ? SY_ERR_UNSUPPORTED : SY_ERR_INVALID_ARGUMENT,
-                                "sy serve: TLS with %s / %s: %s", opts->tls_cert_file, opts->tls_key_file,
-                                nng_strerror(rv));
-        }
-    }
-    nng_stream_listener_set_bool(s->listener, NNG_OPT_TCP_NODELAY, true);
-    if ((rv = nng_stream_listener_listen(s->listener)) != 0) {
-        sy_cluster_server_destroy(s);
-        return sy_error_set(err, SY_ERR_IO, "sy serve: cannot listen on %s: %s", url, nng_strerror(rv));
-    }
-    nng_sockaddr la;
-    memset(&la, 0, sizeof la);
-    nng_stream_listener_get_addr(s->listener, NNG_OPT_LOCADDR, &la);
-    if (!s->secret && !sockaddr_is_loopback(&la)) {
+    if (!s->secret && !s->listener->loopback && !s->listener->trusted) {
         sy_cluster_server_destroy(s);
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
                             "sy serve: %s is not a loopback address; a shared secret (--secret-file or "
                             "SY_CLUSTER_SECRET) is required to listen there",
                             url);
     }
-    nng_stream_listener_get_int(s->listener, NNG_OPT_TCP_BOUND_PORT, &s->port);
+    s->port = s->listener->port;
     *out = s;
     return SY_OK;
 }
@@ -1087,9 +945,9 @@ void sy_cluster_server_destroy(sy_cluster_server *s)
 {
     if (!s) return;
     if (s->listener) {
-        nng_stream_listener_close(s->listener);
+        s->listener->ops->close(s->listener);
         if (s->acceptor_started) pthread_join(s->acceptor, NULL);
-        nng_stream_listener_free(s->listener);
+        s->listener->ops->free(s->listener);
     }
     /* sy_cluster_server_run has ended every connection; a server that never ran has none */
     while (s->peers) {
@@ -1097,7 +955,6 @@ void sy_cluster_server_destroy(sy_cluster_server *s)
         s->peers = p->next;
         peer_free(s, p);
     }
-    if (s->tls) nng_tls_config_free(s->tls);
     cache_free(&s->cache);
     if (s->secret) sodium_memzero(s->secret, s->o.secret_len);
     free(s->secret);
@@ -1408,7 +1265,7 @@ static void session_register(sy_cluster_server *s, peer *p)
         for (peer *q = s->peers; q; q = q->next)
             if (q != p && q->registered && !q->evicted && (!victim || q->se.last_active < victim->se.last_active))
                 victim = q;
-        if (victim) nng_stream_close(victim->w.st); /* its reader thread ends; reap_peers frees it */
+        if (victim) victim->w.st->ops->close(victim->w.st); /* its reader thread ends; reap_peers frees it */
         pthread_mutex_unlock(&s->lock);
         if (victim) {
             SLOG(s, "%s: session ended to make room for %s (idle longest; %u sessions max)", victim->se.peer, p->addr,
@@ -1526,7 +1383,7 @@ static void peer_refuse(peer *p, sy_result code, const char *reason)
     if (p->state == 2) {
         double until = sy_time_now() + 0.5;
         for (;;) {
-            nng_iov iov = {p->hbuf, sizeof p->hbuf};
+            sy_cluster_iov iov = {p->hbuf, sizeof p->hbuf};
             if (wire_io(&p->w, false, &iov, 1, until, NULL, &e) != SY_OK) break; /* the deadline or the end */
         }
     }
@@ -1544,7 +1401,7 @@ static bool peer_handshake(peer *p)
         rx_msg in;
         sy_result r = wire_recv(&p->w, &hb, p->hbuf, sizeof p->hbuf, NULL, deadline, 0, &in, NULL, &err);
         if (r) {
-            if (p->w.last_rv == NNG_ETIMEDOUT)
+            if (p->w.last_rv == SY_STREAM_TIMEDOUT)
                 slog_noise(s, "%s: closed: no %s within the %u ms handshake deadline", p->addr,
                            p->state == 0 ? "HELLO" : "AUTH", s->handshake_ms);
             else if (wire_closed(&p->w))
@@ -1702,7 +1559,7 @@ static void *peer_main(void *arg)
         sy_cluster_buf_free(&p->reply);
         if (stop || r || p->close_after) break;
     }
-    nng_stream_close(p->w.st);
+    p->w.st->ops->close(p->w.st);
     pthread_mutex_lock(&s->lock);
     if (p->counted_unauth) s->unauth--;
     if (p->counted_open) s->open_sessions--;
@@ -1723,11 +1580,7 @@ static void peer_free(sy_cluster_server *s, peer *p)
     rx_release(&p->in, &(wire_mem){mem_reserve_wait, mem_release, s});
     mem_release(s, p->reply_charged);
     sy_cluster_buf_free(&p->reply);
-    if (p->w.st) {
-        nng_stream_close(p->w.st);
-        nng_stream_free(p->w.st);
-    }
-    wire_fini(&p->w);
+    if (p->w.st) p->w.st->ops->free(p->w.st);
     sodium_memzero(p->w.key, sizeof p->w.key);
     free(p);
 }
@@ -1754,13 +1607,8 @@ static void reap_peers(sy_cluster_server *s)
 
 /* A new connection: refused at once beyond max_unauthenticated; else a record and a reader
  * thread with a small stack. */
-static void peer_start(sy_cluster_server *s, nng_stream *st)
+static void peer_start(sy_cluster_server *s, sy_cluster_stream *st)
 {
-    nng_sockaddr sa;
-    memset(&sa, 0, sizeof sa);
-    char addr[80];
-    if (nng_stream_get_addr(st, NNG_OPT_REMADDR, &sa) == 0) sockaddr_str(&sa, true, addr, sizeof addr);
-    else copy_str(addr, sizeof addr, "unknown peer");
     pthread_mutex_lock(&s->lock);
     uint32_t unauth = s->unauth;
     bool room = unauth < s->max_unauth;
@@ -1768,22 +1616,21 @@ static void peer_start(sy_cluster_server *s, nng_stream *st)
     pthread_mutex_unlock(&s->lock);
     if (!room) {
         slog_noise(s, "%s: connection refused: %u unauthenticated connections are open (limit %u, "
-                      "--max-unauthenticated)", addr, unauth, s->max_unauth);
-        nng_stream_close(st);
-        nng_stream_free(st);
+                      "--max-unauthenticated)", st->peer, unauth, s->max_unauth);
+        st->ops->free(st);
         return;
     }
     peer *p = calloc(1, sizeof *p);
-    int rv = p ? wire_init(&p->w) : NNG_ENOMEM;
+    int rv = p ? 0 : ENOMEM;
     if (rv == 0) {
         p->s = s;
         p->w.st = st;
         p->accepted = sy_time_now();
         p->counted_unauth = true;
-        p->loopback = sockaddr_is_loopback(&sa);
-        copy_str(p->addr, sizeof p->addr, addr);
-        copy_str(p->se.peer, sizeof p->se.peer, addr);
-        sockaddr_str(&sa, false, p->host, sizeof p->host);
+        p->loopback = st->loopback;
+        copy_str(p->addr, sizeof p->addr, st->peer);
+        copy_str(p->se.peer, sizeof p->se.peer, st->peer);
+        copy_str(p->host, sizeof p->host, st->host);
         pthread_attr_t at;
         pthread_attr_init(&at);
         pthread_attr_setstacksize(&at, SY_CLUSTER_READER_STACK);
@@ -1797,40 +1644,31 @@ static void peer_start(sy_cluster_server *s, nng_stream *st)
         pthread_mutex_unlock(&s->lock);
         pthread_attr_destroy(&at);
         if (rv == 0) return;
-        rv = NNG_ENOMEM;
     }
-    slog_noise(s, "%s: connection dropped: %s", addr, rv == NNG_ENOMEM ? "out of memory" : nng_strerror(rv));
+    slog_noise(s, "%s: connection dropped: %s", st->peer, rv == ENOMEM ? "out of memory" : strerror(rv));
     pthread_mutex_lock(&s->lock);
     s->unauth--;
     pthread_mutex_unlock(&s->lock);
-    if (p) wire_fini(&p->w);
     free(p);
-    nng_stream_close(st);
-    nng_stream_free(st);
+    st->ops->free(st);
 }
 
 static void *acceptor_main(void *arg)
 {
     sy_cluster_server *s = arg;
-    nng_aio *aio = NULL;
-    if (nng_aio_alloc(&aio, NULL, NULL) != 0) {
-        SLOG(s, "cannot accept connections: out of memory");
-        return NULL;
-    }
     for (;;) {
-        nng_stream_listener_accept(s->listener, aio);
-        nng_aio_wait(aio);
-        int rv = nng_aio_result(aio);
-        if (rv == NNG_ECLOSED || rv == NNG_ECANCELED) break;
-        if (rv) {
-            slog_noise(s, "accept failed: %s", nng_strerror(rv));
+        sy_cluster_stream *st = NULL;
+        char msg[160] = "";
+        sy_stream_status rv = s->listener->ops->accept(s->listener, &st, msg, sizeof msg);
+        if (rv == SY_STREAM_CLOSED) break;
+        if (rv != SY_STREAM_OK) {
+            slog_noise(s, "%s", msg);
             struct timespec ts = {0, 20000000L}; /* e.g. out of descriptors: do not spin */
             nanosleep(&ts, NULL);
             continue;
         }
-        peer_start(s, nng_aio_get_output(aio, 0));
+        peer_start(s, st);
     }
-    nng_aio_free(aio);
     return NULL;
 }
 
@@ -1879,7 +1717,7 @@ sy_result sy_cluster_server_run(sy_cluster_server *s, sy_error *err)
         pthread_mutex_unlock(&s->qlock);
     }
     /* stop: no new connections, every connection closed, every reader thread joined */
-    nng_stream_listener_close(s->listener);
+    s->listener->ops->close(s->listener);
     if (s->acceptor_started) pthread_join(s->acceptor, NULL);
     s->acceptor_started = false;
     pthread_mutex_lock(&s->qlock);
@@ -1896,7 +1734,7 @@ sy_result sy_cluster_server_run(sy_cluster_server *s, sy_error *err)
     pthread_cond_broadcast(&s->mem_cond);
     pthread_mutex_unlock(&s->mem_lock);
     pthread_mutex_lock(&s->lock);
-    for (peer *p = s->peers; p; p = p->next) nng_stream_close(p->w.st);
+    for (peer *p = s->peers; p; p = p->next) p->w.st->ops->close(p->w.st);
     pthread_mutex_unlock(&s->lock);
     for (;;) {
         reap_peers(s);
@@ -1913,7 +1751,6 @@ sy_result sy_cluster_server_run(sy_cluster_server *s, sy_error *err)
 /* ======================================================================== client */
 typedef struct conn {
     char url[256];
-    nng_stream_dialer *dialer;
     wire w;                      /* w.st != NULL: connected */
     bool live, fresh;            /* fresh: connected during this frame (needs a snapshot) */
     bool session_open;           /* past the handshake: the session's budget applies */
@@ -1950,15 +1787,9 @@ struct sy_cluster_client {
 
 static void conn_close(conn *k)
 {
-    if (k->w.st) {
-        nng_stream_close(k->w.st);
-        nng_stream_free(k->w.st);
-    }
-    if (k->dialer) nng_stream_dialer_free(k->dialer);
-    wire_fini(&k->w);
+    if (k->w.st) k->w.st->ops->free(k->w.st);
     sodium_memzero(k->w.key, sizeof k->w.key);
     memset(&k->w, 0, sizeof k->w);
-    k->dialer = NULL;
     k->live = k->session_open = false;
 }
 
@@ -2006,7 +1837,7 @@ static sy_result conn_call(sy_cluster_client *c, conn *k, sy_cluster_msg *req, c
     uint64_t rseq0 = k->w.recv_seq;
     r = wire_recv(&k->w, &budget, NULL, 0, NULL, deadline, 0, &in, k->url, err);
     if (r) {
-        if (k->w.last_rv == NNG_ETIMEDOUT) sy_error_set(err, SY_ERR_IO, "%s: no reply before the deadline", k->url);
+        if (k->w.last_rv == SY_STREAM_TIMEDOUT) sy_error_set(err, SY_ERR_IO, "%s: no reply before the deadline", k->url);
         return r;
     }
     k->bytes_received += in.size + (k->w.recv_seq - rseq0) * SY_CLUSTER_HEADER_SIZE +
@@ -2034,52 +1865,12 @@ static sy_result conn_call(sy_cluster_client *c, conn *k, sy_cluster_msg *req, c
 static sy_result conn_connect(sy_cluster_client *c, conn *k, sy_error *err)
 {
     conn_close(k);
-    int rv = wire_init(&k->w);
-    if (rv == 0) rv = nng_stream_dialer_alloc(&k->dialer, k->url);
-    if (rv) {
+    sy_cluster_dial_opts dopts = {c->o.tls_ca_file, c->connect_timeout_ms};
+    sy_result dr = sy_cluster_dial(k->url, &dopts, &k->w.st, err);
+    if (dr != SY_OK) {
         conn_close(k);
-        return sy_error_set(err, rv == NNG_ENOMEM ? SY_ERR_OUT_OF_MEMORY : SY_ERR_INVALID_ARGUMENT, "%s: %s", k->url,
-                            nng_strerror(rv));
+        return dr;
     }
-    if (!strncmp(k->url, "tls+tcp://", 10)) {
-        if (!c->o.tls_ca_file) {
-            conn_close(k);
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: a TLS server needs --tls-ca", k->url);
-        }
-        /* the certificate must be valid for the host named in the URL */
-        char host[256];
-        const char *h = k->url + 10, *end = strrchr(h, ':');
-        size_t hn = end ? (size_t)(end - h) : strlen(h);
-        if (hn && h[0] == '[' && h[hn - 1] == ']') h++, hn -= 2;
-        if (hn >= sizeof host) hn = sizeof host - 1;
-        memcpy(host, h, hn);
-        host[hn] = 0;
-        nng_tls_config *cfg = NULL;
-        if ((rv = nng_tls_config_alloc(&cfg, NNG_TLS_MODE_CLIENT)) != 0 ||
-            (rv = nng_tls_config_ca_file(cfg, c->o.tls_ca_file)) != 0 ||
-            (rv = nng_tls_config_auth_mode(cfg, NNG_TLS_AUTH_MODE_REQUIRED)) != 0 ||
-            (rv = nng_tls_config_server_name(cfg, host)) != 0 ||
-            (rv = nng_stream_dialer_set_ptr(k->dialer, NNG_OPT_TLS_CONFIG, cfg)) != 0) {
-            if (cfg) nng_tls_config_free(cfg);
-            conn_close(k);
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: TLS with CA %s: %s", k->url, c->o.tls_ca_file,
-                                nng_strerror(rv));
-        }
-        nng_tls_config_free(cfg); /* the dialer holds its own reference */
-    }
-    nng_stream_dialer_set_bool(k->dialer, NNG_OPT_TCP_NODELAY, true);
-    nng_aio_set_timeout(k->w.aio, (nng_duration)c->connect_timeout_ms);
-    pthread_mutex_lock(&k->w.lock);
-    k->w.busy = true;
-    pthread_mutex_unlock(&k->w.lock);
-    nng_stream_dialer_dial(k->dialer, k->w.aio);
-    nng_aio_wait(k->w.aio); /* the dialer honours the timeout (no stream yet to close) */
-    if ((rv = nng_aio_result(k->w.aio)) != 0) {
-        conn_close(k);
-        return sy_error_set(err, SY_ERR_IO, "%s: cannot connect: %s", k->url,
-                            rv == NNG_ETIMEDOUT ? "no answer before the deadline" : nng_strerror(rv));
-    }
-    k->w.st = nng_aio_get_output(k->w.aio, 0);
     sy_cluster_msg m, rep;
     memset(&m, 0, sizeof m);
     m.header.type = SY_CLUSTER_HELLO;
