@@ -25,7 +25,18 @@ typedef struct sy_cluster_cli_opts {
     bool half_pixels;            /* --cluster-pixels half: binary16 tiles (default float: bit-exact) */
     sy_cluster_log_fn log;       /* client log lines; NULL = stderr */
     void *log_user;
+    const uint8_t *secret;       /* non-NULL: this secret (the MPI job's), not secret_file */
+    size_t secret_len;
 } sy_cluster_cli_opts;
+
+/* `--cluster mpi` (sy render under mpirun / srun): initialises MPI and shares the job secret.
+ * Rank 0 returns SY_OK with o->cluster set to the other ranks' URLs and o->secret to the job
+ * secret: it is the client. Every other rank serves rank 0 until it is done, then *served is set
+ * (the command ends there). Errors name the reason (no MPI in this build, a single rank). */
+sy_result sy_cluster_cli_mpi_start(sy_cluster_cli_opts *o, bool *served, sy_error *err);
+/* After the command on rank 0 (its cluster contexts gone): releases the server ranks and ends MPI;
+ * nothing when MPI was not started. */
+void sy_cluster_cli_mpi_end(void);
 
 /* true when argv holds --cluster (the render goes to the cluster whatever the back-end). */
 bool sy_cluster_cli_requested(int argc, char **argv);

@@ -687,6 +687,13 @@ static int cmd_render(int argc, char **argv)
             return usage();
         }
     }
+    if (clo.cluster && !strcmp(clo.cluster, "mpi")) { /* mpirun -np N sy render ... --cluster mpi */
+        bool served = false;
+        sy_error merr = {0};
+        sy_result mr = sy_cluster_cli_mpi_start(&clo, &served, &merr);
+        if (served) return mr == SY_OK ? 0 : fail(&merr); /* a server rank: rank 0 is done */
+        if (mr != SY_OK) return fail(&merr);
+    }
     if (!scene || !backend || !outp) return usage();
     char gl_params[256];
     if (gl_provider) params = render_gl_params(params, gl_provider, gl_params, sizeof gl_params);
@@ -1243,7 +1250,11 @@ int main(int argc, char **argv)
     if (argc < 2) return usage();
     const char *cmd = argv[1];
     if (!strcmp(cmd, "info")) return cmd_info(argc - 2, argv + 2);
-    if (!strcmp(cmd, "render")) return cmd_render(argc - 2, argv + 2);
+    if (!strcmp(cmd, "render")) {
+        int rc = cmd_render(argc - 2, argv + 2);
+        sy_cluster_cli_mpi_end(); /* --cluster mpi on rank 0: release the server ranks */
+        return rc;
+    }
     if (!strcmp(cmd, "demo")) return cmd_demo(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare")) return cmd_compare(argc - 2, argv + 2);
     if (!strcmp(cmd, "bench")) return cmd_bench(argc - 2, argv + 2);
