@@ -34,6 +34,7 @@ typedef struct cluster_state {
     uint64_t merged_samples;
     sy_layer full; /* a request for a sub-rectangle renders the whole image here */
     uint32_t timeout_ms; /* adaptive deadline (the configuration gave none) */
+    uint32_t servers;    /* the servers this viewport uses (servers=) */
 } cluster_state;
 
 /* Caps the servers' back-end `name` has, as registered in this process (same binary); unknown
@@ -42,6 +43,38 @@ static uint32_t remote_caps(const char *name)
 {
     const sy_mediator_class *c = sy_mediator_find(name);
     return c ? c->caps : SY_CAP_DEPTH;
+}
+
+/* servers=LIST: 1-based server numbers and ranges joined by '+' ("1", "2-4", "1+3"); absent = all.
+ * *mask gets bit i for server i + 1. */
+static sy_result parse_servers(const cluster_config *cfg, const char *list, uint64_t *mask, sy_error *err)
+{
+    uint32_t n = cfg->opts.url_count;
+    *mask = n >= 64 ? ~0ull : ((1ull << n) - 1);
+    if (!list) return SY_OK;
+    *mask = 0;
+    const char *p = list;
+    while (*p) {
+        char *end = NULL;
+        unsigned long a = strtoul(p, &end, 10), b = a;
+        if (end == p) break;
+        if (*end == '-') {
+            const char *q = end + 1;
+            b = strtoul(q, &end, 10);
+            if (end == q) break;
+        }
+        if (a < 1 || b < a || b > n)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: servers=%s: server numbers are 1..%u", cfg->name, list, n);
+        for (unsigned long i = a; i <= b; ++i) *mask |= 1ull << (i - 1);
+        p = end;
+        if (*p == '+') p++;
+        else if (*p) break;
+    }
+    if (*p || !*mask)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "%s: servers=%s: expected server numbers and ranges joined by '+' (e.g. 1+3, 2-4)", cfg->name,
+                            list);
+    return SY_OK;
 }
 
 /* What an instance with these parameters can do: what every node's back-end has, as the mode
@@ -53,7 +86,10 @@ static uint32_t cluster_caps_of(const sy_params *p, const void *class_user)
     uint32_t mode = SY_CLUSTER_SORT_FIRST;
     if (m && !sy_cluster_mode_parse(m, &mode)) mode = SY_CLUSTER_SORT_FIRST;
     uint32_t common = SY_CAP_DEPTH | SY_CAP_ANALYSIS | SY_CAP_SAMPLE_RANGES;
+    uint64_t mask = 0;
+    if (parse_servers(cfg, sy_params_get(p, "servers"), &mask, NULL) != SY_OK) mask = 0;
     for (uint32_t i = 0; i < cfg->opts.url_count; ++i) {
+        if (!(mask >> i & 1)) continue;
         const char *b = cfg->backends[i] ? cfg->backends[i] : backend;
         common &= b ? remote_caps(b) : 0;
     }
@@ -116,8 +152,12 @@ static sy_result cluster_create(const sy_mediator_create_args *args, void **stat
     long samples = 0;
     sy_result r = sy_params_get_int(p, "samples", 0, 0, SY_CLUSTER_MAX_SAMPLES, &samples, err);
     if (r) return r;
-    /* set-up checks: every node can do what the mode asks */
+    uint64_t mask = 0;
+    r = parse_servers(cfg, sy_params_get(p, "servers"), &mask, err);
+    if (r) return r;
+    /* set-up checks: every node this viewport uses can do what the mode asks */
     for (uint32_t i = 0; i < cfg->opts.url_count; ++i) {
+        if (!(mask >> i & 1)) continue;
         r = check_node(cfg, i, cfg->backends[i] ? cfg->backends[i] : backend, mode, err);
         if (r) return r;
     }
@@ -134,7 +174,9 @@ static sy_result cluster_create(const sy_mediator_create_args *args, void **stat
     size_t len = 0;
     for (uint32_t i = 0; i < p->count && r == SY_OK; ++i) {
         const char *k = p->items[i].key;
-        if (!strcmp(k, "backend") || !strcmp(k, "mode") || !strcmp(k, "samples") || !strcmp(k, "pixels")) continue;
+        if (!strcmp(k, "backend") || !strcmp(k, "mode") || !strcmp(k, "samples") || !strcmp(k, "pixels") ||
+            !strcmp(k, "servers"))
+            continue;
         int n = snprintf(st->params + len, sizeof st->params - len, "%s%s=%s", len ? "," : "", k, p->items[i].value);
         if (n < 0 || (size_t)n >= sizeof st->params - len)
             r = sy_error_set(err, SY_ERR_LIMIT, "%s: back-end parameters longer than %u bytes", cfg->name,
@@ -143,7 +185,19 @@ static sy_result cluster_create(const sy_mediator_create_args *args, void **stat
     }
     st->caps = cluster_caps_of(p, cfg);
     if (r == SY_OK) r = sy_scene_create(&st->replica, err);
-    if (r == SY_OK) r = sy_cluster_client_create(st->replica, &cfg->opts, &st->client, err);
+    /* the client of this viewport: the servers it uses, in their configured order */
+    const char *urls[SY_CLUSTER_MAX_SERVERS], *backends[SY_CLUSTER_MAX_SERVERS];
+    sy_cluster_rect tiles[SY_CLUSTER_MAX_SERVERS];
+    sy_cluster_client_opts co = cfg->opts;
+    co.url_count = 0;
+    for (uint32_t i = 0; i < cfg->opts.url_count; ++i)
+        if (mask >> i & 1) {
+            urls[co.url_count] = cfg->urls[i], backends[co.url_count] = cfg->backends[i], tiles[co.url_count] = cfg->tiles[i];
+            co.url_count++;
+        }
+    co.urls = urls, co.backends = backends, co.wall_tiles = tiles;
+    st->servers = co.url_count;
+    if (r == SY_OK) r = sy_cluster_client_create(st->replica, &co, &st->client, err);
     if (r) {
         cluster_destroy(st);
         return r;
@@ -228,7 +282,7 @@ void sy_mediator_cluster_describe(void *state, uint32_t *mode, uint32_t *servers
 {
     const cluster_state *st = state;
     if (mode) *mode = st ? st->mode : 0;
-    if (servers) *servers = st ? st->cfg->opts.url_count : 0;
+    if (servers) *servers = st ? st->servers : 0;
 }
 
 static void config_free(cluster_config *c)

@@ -12,6 +12,10 @@
  *   samples=N        cooperative: samples per render when the request gives none (default 16 per
  *                    server); a request's sample count is split across the live servers
  *   pixels=float|half  tiles as float32 (bit-exact, default) or binary16
+ *   servers=LIST     the configured servers this viewport uses: 1-based numbers and ranges joined by
+ *                    '+' ("2-4", "1+3"); default all. Mixed back-ends per node: one window with a
+ *                    raster preview viewport on server 1 (servers=1,backend=raster) beside a
+ *                    cooperative path trace on servers 2-4, or a wall with a back-end per display.
  * Every other key=value is handed to the servers' back-end unchanged.
  *
  * An instance: a replica of the scene fed by the change lists its context receives (so a
@@ -50,7 +54,7 @@ sy_result sy_mediator_cluster_register(const char *name, const sy_cluster_client
 /* The last frame's statistics of a cluster instance (sy_context_state of a context whose caps have
  * SY_CAP_REMOTE); zeroes for anything else. */
 void sy_mediator_cluster_last_frame(void *state, sy_cluster_frame_stats *out);
-/* The instance's mode (sy_cluster_mode) and configured server count. */
+/* The instance's mode (sy_cluster_mode) and the number of servers it uses. */
 void sy_mediator_cluster_describe(void *state, uint32_t *mode, uint32_t *servers);
 
 #ifdef __cplusplus

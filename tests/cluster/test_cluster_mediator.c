@@ -7,6 +7,8 @@
  *      composite, and its per-pixel difference from the local render no larger than the difference
  *      between two local renders with other seeds (1.25x, both at the same sample count); the
  *      merged sample count is exactly the requested one.
+ *   2b. Mixed back-ends per node: the raster overlay on server 1, the cooperative path trace on
+ *      server 2 (servers=), the same checks.
  *   3. A sub-rectangle request (SY_CAP_TILES) equals that rectangle of the whole image.
  *   4. Capabilities: the instance's caps follow the servers' back-end and the mode (cooperative
  *      path tracing is progressive, sort-first whitted is not; both are remote).
@@ -51,9 +53,10 @@ static sy_result add_overlay_root(fixture *fx, sy_error *e)
 }
 
 /* Side-by-side stereo: per eye the main viewport (backend/params) and a raster overlay composited
- * by depth; renders into out (2W x H) with a fresh context pool (a fresh accumulation). */
-static int render_sbs(fixture *fx, const char *backend, const char *params, uint32_t spp, uint32_t seed, sy_layer *out,
-                      uint64_t *samples_out)
+ * by depth (overlay_backend/overlay_params; NULL = local raster); renders into out (2W x H) with a
+ * fresh context pool (a fresh accumulation). */
+static int render_sbs_with(fixture *fx, const char *backend, const char *params, const char *overlay_backend,
+                           const char *overlay_params, uint32_t spp, uint32_t seed, sy_layer *out, uint64_t *samples_out)
 {
     sy_error e = {0};
     sy_window *win = NULL;
@@ -64,9 +67,9 @@ static int render_sbs(fixture *fx, const char *backend, const char *params, uint
                                  .background = fx->d.background, .backend = backend, .params = params, .eye = eye,
                                  .composite = SY_COMPOSITE_REPLACE};
         sy_viewport_desc overlay = main;
-        overlay.backend = "raster";
+        overlay.backend = overlay_backend ? overlay_backend : "raster";
         overlay.root = fx->overlay;
-        overlay.params = NULL;
+        overlay.params = overlay_params;
         overlay.background = (sy_background){0};
         overlay.composite = SY_COMPOSITE_DEPTH;
         sy_viewport *v = NULL;
@@ -90,6 +93,12 @@ static int render_sbs(fixture *fx, const char *backend, const char *params, uint
     sy_context_pool_destroy(pool);
     sy_window_destroy(win);
     return 0;
+}
+
+static int render_sbs(fixture *fx, const char *backend, const char *params, uint32_t spp, uint32_t seed, sy_layer *out,
+                      uint64_t *samples_out)
+{
+    return render_sbs_with(fx, backend, params, NULL, NULL, spp, seed, out, samples_out);
 }
 
 static double rmse(const sy_layer *a, const sy_layer *b)
@@ -164,6 +173,28 @@ static int test_cooperative(fixture *fx)
     return 0;
 }
 
+/* Mixed back-ends per node: the raster overlay renders on server 1, the cooperative path trace on
+ * server 2 (servers=), in one window; it matches the local composite like test_cooperative. */
+static int test_mixed_nodes(fixture *fx)
+{
+    enum { SPP = 16 };
+    sy_layer l1 = {0}, l2 = {0}, c = {0};
+    CHECK(render_sbs(fx, "pathtracer", NULL, SPP, 1, &l1, NULL) == 0);
+    CHECK(render_sbs(fx, "pathtracer", NULL, SPP, 977, &l2, NULL) == 0);
+    uint64_t samples = 0;
+    CHECK(render_sbs_with(fx, "cluster", "backend=pathtracer,mode=cooperative,servers=2", "cluster",
+                          "backend=raster,servers=1", SPP, 5, &c, &samples) == 0);
+    double iou = coverage_iou(&l1, &c), noise = mean_abs_diff(&l1, &l2), diff = mean_abs_diff(&l1, &c);
+    printf("raster overlay on server 1 + cooperative pathtracer on server 2: IoU %.4f, |cluster - local| %.5f vs "
+           "noise %.5f, %llu samples\n",
+           iou, diff, noise, (unsigned long long)samples);
+    CHECK(samples == SPP);
+    CHECK(iou >= 0.99);
+    CHECK(diff <= 1.25 * noise);
+    sy_layer_destroy(&l1), sy_layer_destroy(&l2), sy_layer_destroy(&c);
+    return 0;
+}
+
 static int test_tiles_and_caps(fixture *fx)
 {
     sy_error e = {0};
@@ -234,6 +265,8 @@ static int test_refusals(fixture *fx, const server *s)
     CHECK(refused(fx, "mode=sort-first", "backend=NAME") == 0);
     CHECK(refused(fx, "backend=whitted,mode=sideways", "sideways") == 0);
     CHECK(refused(fx, "backend=whitted,pixels=double", "pixels=double") == 0);
+    CHECK(refused(fx, "backend=whitted,servers=3", "server numbers are 1..2") == 0);
+    CHECK(refused(fx, "backend=whitted,servers=1+x", "joined by '+'") == 0);
     return 0;
 }
 
@@ -274,6 +307,8 @@ int main(int argc, char **argv)
             printf("sort-first / balanced composite: %s\n", r ? "FAILED" : "ok");
             failed += r = test_cooperative(&fx);
             printf("cooperative composite: %s\n", r ? "FAILED" : "ok");
+            failed += r = test_mixed_nodes(&fx);
+            printf("mixed back-ends per node: %s\n", r ? "FAILED" : "ok");
             failed += r = test_tiles_and_caps(&fx);
             printf("tiles and capabilities: %s\n", r ? "FAILED" : "ok");
             failed += r = test_refusals(&fx, s);
