@@ -17,6 +17,7 @@
 
 #include <arpa/inet.h>
 #include <errno.h>
+#include <math.h>
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <pthread.h>
@@ -452,7 +453,9 @@ typedef struct child_server {
 } child_server;
 
 /* Starts `sy serve` on a free loopback port, pinned to cpu (or unpinned when cpu < 0). */
-static sy_result spawn_server(int cpu, child_server *out, sy_error *err)
+/* Starts `sy serve` on a free loopback port, pinned to cpu (or unpinned when cpu < 0), for at most
+ * lifetime_s seconds; one_core: llvmpipe draws on one thread (LP_NUM_THREADS=1). */
+static sy_result spawn_server_ex(int cpu, int lifetime_s, bool one_core, child_server *out, sy_error *err)
 {
     char port_file[] = "/tmp/sy_bench_portXXXXXX";
     int fd = mkstemp(port_file);
@@ -470,8 +473,11 @@ static sy_result spawn_server(int cpu, child_server *out, sy_error *err)
         }
         int devnull = open("/dev/null", 1);
         if (devnull >= 0) dup2(devnull, 2);
+        if (one_core) setenv("LP_NUM_THREADS", "1", 1);
+        char life[32];
+        snprintf(life, sizeof life, "%d", lifetime_s);
         execl("/proc/self/exe", "sy", "serve", "--listen", "tcp://127.0.0.1:0", "--port-file", port_file,
-              "--max-lifetime", "600", (char *)NULL);
+              "--max-lifetime", life, (char *)NULL);
         _exit(127);
     }
     for (int tries = 0; tries < 200; ++tries) { /* bounded: 10 s */
@@ -492,6 +498,11 @@ static sy_result spawn_server(int cpu, child_server *out, sy_error *err)
     kill(pid, SIGTERM);
     waitpid(pid, NULL, 0);
     return sy_error_set(err, SY_ERR_IO, "bench: the server did not start within 10 s");
+}
+
+static sy_result spawn_server(int cpu, child_server *out, sy_error *err)
+{
+    return spawn_server_ex(cpu, 600, false, out, err);
 }
 
 static void stop_server(child_server *s)
@@ -547,7 +558,8 @@ typedef struct coop_run {
  * that a frame takes about 0.4 s (the client's per-frame transfer and merge stay small next to
  * the rendering), and returned for the other runs. */
 static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const child_server *srv, uint32_t n,
-                              uint32_t w, uint32_t h, uint32_t *spf, double min_seconds, coop_run *out, sy_error *err)
+                              uint32_t w, uint32_t h, uint32_t *spf, double frame_s, double min_seconds, coop_run *out,
+                              sy_error *err)
 {
     memset(out, 0, sizeof *out);
     const char *urls[2] = {srv[0].url, n > 1 ? srv[1].url : NULL};
@@ -570,7 +582,7 @@ static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const
         double t = sy_time_now();
         r = sy_cluster_client_render(c, &f, &out_img, &st, err);
         t = sy_time_now() - t;
-        double k = t > 0 ? 0.4 / t : 256.0;
+        double k = t > 0 ? frame_s / t : 256.0;
         *spf = k >= 256.0 ? 1024u : k <= 1.0 ? 4u : (uint32_t)(4.0 * k + 0.5);
     }
     f.samples = *spf;
@@ -603,23 +615,24 @@ static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const
  * the wall-clock ratio drops, while samples per server CPU-second (the cost of cooperating: the
  * sample split, transfers, merging, waiting for the other server) stay comparable. */
 static sy_result bench_coop(sy_scene *scene, const sy_viewport_desc *vd, const child_server *srv, uint32_t rounds,
-                            bool pinned, sy_error *err)
+                            bool pinned, double frame_s, sy_error *err)
 {
     const uint32_t w = 320, h = 180;
-    const double min_seconds = 1.5;
+    const double min_seconds = frame_s * 3.75 > 1.5 ? frame_s * 3.75 : 1.5;
     uint32_t spf = 0;
     enum { MAX_ROUNDS = 64 };
     double ratio[MAX_ROUNDS], rate[2][MAX_ROUNDS], eff[2][MAX_ROUNDS]; /* per round: speed-up, spp/s, spp per CPU-s */
     uint32_t nr = 0, ne = 0;
     if (rounds > MAX_ROUNDS) rounds = MAX_ROUNDS;
     sy_result r = SY_OK;
-    printf("  cooperative pathtracer %ux%u, servers %s, %u interleaved rounds of >= %.1f s per side:\n", w, h,
-           pinned ? "pinned to cores 0 and 1" : "not pinned (1 core)", rounds, min_seconds);
+    printf("  cooperative pathtracer %ux%u, servers %s, %u interleaved rounds of >= %.1f s per side, frames of about "
+           "%.2f s on one server:\n",
+           w, h, pinned ? "pinned to cores 0 and 1" : "not pinned (1 core)", rounds, min_seconds, frame_s);
     for (uint32_t round = 0; round < rounds && r == SY_OK; ++round) {
         coop_run run[2];
         for (uint32_t k = 0; k < 2 && r == SY_OK; ++k) {
             uint32_t n = (round & 1) ? 2 - k : 1 + k; /* 1,2 / 2,1 / 1,2 ... */
-            r = coop_measure(scene, vd, srv, n, w, h, &spf, min_seconds, &run[n - 1], err);
+            r = coop_measure(scene, vd, srv, n, w, h, &spf, frame_s, min_seconds, &run[n - 1], err);
         }
         if (r != SY_OK) break;
         rate[0][nr] = run[0].rate, rate[1][nr] = run[1].rate;
@@ -862,21 +875,172 @@ static sy_result bench_hostile(sy_scene *scene, const sy_demo_info *d, const cha
     return r;
 }
 
+
+/* >>scale: per-frame protocol cost and bytes on the wire, 1-3 servers, sort-first / balanced /
+ * cooperative at 1080p and 4K, against the scaling model of docs/ARCHITECTURE.md ("Scaling model").
+ * Every server renders on one core (raster: LP_NUM_THREADS=1; path tracer: threads=1), so 2
+ * servers use this machine's 2 cores and 3 are oversubscribed (stated in the output). The protocol
+ * cost of a frame is the client's time beyond the slowest server's sync + render:
+ *   sort-first, balanced:  overhead(N) = L + ceil(N/C) * (P/N) * r / D,  bytes back = P * c
+ *     (the strips decode on their own threads while the slowest one still renders: the last
+ *     strip's decode is what remains)
+ *   cooperative:           overhead(N) = L + ceil(N/C) * P * r / D + N * P * m,  bytes back = N * P * c
+ *     (every server returns the whole image; the merge costs m per pixel and server)
+ * L from tiny frames, c and D from the 1-server frame of each mode and size (its image encoded and
+ * decoded here), m calibrated on the 1-server cooperative frame; N = 2 and 3 check the model. The
+ * loopback's bandwidth is taken as infinite (P * c / B adds on a real network). */
+typedef struct scale_point {
+    double frame, overhead, server; /* medians, seconds */
+    double bytes_back, bytes_out;   /* per frame */
+} scale_point;
+
+static sy_result scale_measure(sy_scene *scene, const sy_demo_info *d, const child_server *srv, uint32_t n, uint32_t mode,
+                               uint32_t w, uint32_t h, uint32_t frames, scale_point *out, sy_layer *img_out, sy_error *err)
+{
+    const char *urls[3] = {srv[0].url, srv[1].url, srv[2].url};
+    sy_cluster_client_opts co = {.urls = urls, .url_count = n, .timeout_ms = 600000};
+    sy_cluster_client *c = NULL;
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_camera_view view;
+    sy_layer img = {0};
+    bool coop = mode == SY_CLUSTER_COOPERATIVE;
+    const char *backend = coop ? "pathtracer" : sy_mediator_find("raster") ? "raster" : "whitted";
+    sy_viewport_desc vd = {.root = d->root, .camera = d->camera, .background = d->background, .backend = backend};
+    sy_result r = sy_window_create(w, h, &win, err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
+    if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, err);
+    if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &c, err);
+    if (r == SY_OK) r = sy_layer_create(w, h, &img, err);
+    sy_cluster_frame f = {.mode = mode, .backend = backend, .params = coop ? "threads=1" : strcmp(backend, "raster") ? "spp=1,threads=1" : NULL,
+                          .root_id = d->root.id, .background_id = d->background.id, .camera = view, .width = w,
+                          .height = h, .samples = 1, .samples_total = coop ? n : 0, .depth = true};
+    sy_cluster_frame_stats st;
+    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &img, &st, err); /* warm-up: snapshot + translation */
+    double fr[16], ov[16], sv[16], back[16], sent[16];
+    if (frames > 16) frames = 16;
+    for (uint32_t i = 0; i < frames && r == SY_OK; ++i) {
+        r = sy_cluster_client_render(c, &f, &img, &st, err);
+        fr[i] = st.seconds, sv[i] = st.max_server_seconds, ov[i] = st.seconds - st.max_server_seconds;
+        back[i] = (double)st.bytes_received, sent[i] = (double)st.bytes_sent;
+        if (r == SY_OK && st.servers_live != n) r = sy_error_set(err, SY_ERR_IO, "bench: a server dropped out");
+    }
+    if (r == SY_OK) {
+        out->frame = sy_bench_spread_of(fr, frames).median;
+        out->overhead = sy_bench_spread_of(ov, frames).median;
+        out->server = sy_bench_spread_of(sv, frames).median;
+        out->bytes_back = sy_bench_spread_of(back, frames).median;
+        out->bytes_out = sy_bench_spread_of(sent, frames).median;
+    }
+    if (r == SY_OK && img_out) {
+        *img_out = img;
+        img = (sy_layer){0};
+    }
+    sy_layer_destroy(&img);
+    sy_cluster_client_destroy(c);
+    sy_window_destroy(win);
+    return r;
+}
+
+/* Decode rate (raw bytes per second, one core) and wire bytes per pixel of an image's tile. */
+static sy_result codec_of(const sy_layer *img, double *D, double *c, sy_error *err)
+{
+    sy_cluster_buf enc = {0};
+    sy_layer back = {0};
+    sy_result r = sy_cluster_tile_encode(img, true, &enc, err);
+    if (r == SY_OK) r = sy_layer_create(img->width, img->height, &back, err);
+    double P = (double)img->width * img->height, best = 1e30;
+    for (int k = 0; k < 3 && r == SY_OK; ++k) {
+        sy_cluster_tile t = {{0, 0, img->width, img->height}, SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD, 5, (uint64_t)P * 20,
+                             enc.data, (uint32_t)enc.size};
+        double t0 = sy_time_now();
+        r = sy_cluster_tile_decode(&t, &back, 0, 0, err);
+        double dt = sy_time_now() - t0;
+        if (dt < best) best = dt;
+    }
+    *D = P * 20.0 / best;
+    *c = (double)enc.size / P;
+    sy_cluster_buf_free(&enc);
+    sy_layer_destroy(&back);
+    return r;
+}
+
+static sy_result bench_scale(sy_scene *scene, const sy_demo_info *d, uint32_t frames, sy_error *err)
+{
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    double C = ncpu > 0 ? (double)ncpu : 1.0;
+    child_server srv[3] = {{0}};
+    sy_result r = SY_OK;
+    for (int i = 0; i < 3 && r == SY_OK; ++i) r = spawn_server_ex(-1, 7200, true, &srv[i], err);
+    printf("sy bench cluster --scale: demo scene, 1-3 servers on loopback, each rendering on one core (%ld cores here: "
+           "3 servers are oversubscribed); raster (sort-first, balanced) and pathtracer 1 spp per frame in all "
+           "(cooperative); medians of %u frames after a warm-up\n", ncpu, frames);
+    double L = 0;
+    if (r == SY_OK) {
+        scale_point tiny;
+        r = scale_measure(scene, d, srv, 1, SY_CLUSTER_SORT_FIRST, 64, 36, 15, &tiny, NULL, err);
+        L = tiny.overhead;
+        if (r == SY_OK) printf("  L = %.2f ms (request latency: 64x36 frames, time beyond the server)\n", L * 1e3);
+    }
+    static const uint32_t sizes[2][2] = {{1920, 1080}, {3840, 2160}};
+    static const uint32_t modes[3] = {SY_CLUSTER_SORT_FIRST, SY_CLUSTER_BALANCED, SY_CLUSTER_COOPERATIVE};
+    for (int si = 0; si < 2 && r == SY_OK; ++si) {
+        uint32_t w = sizes[si][0], h = sizes[si][1];
+        double P = (double)w * h, rb = 20.0; /* RGBA + depth float32 */
+        printf("  %ux%u (P = %.2f Mpx, r = 20 bytes per pixel raw):\n", w, h, P / 1e6);
+        double D = 0, c = 0, m = 0;
+        for (int mi = 0; mi < 3 && r == SY_OK; ++mi)
+            for (uint32_t n = 1; n <= 3 && r == SY_OK; ++n) {
+                scale_point pt;
+                sy_layer img = {0};
+                bool coop = modes[mi] == SY_CLUSTER_COOPERATIVE;
+                r = scale_measure(scene, d, srv, n, modes[mi], w, h, frames, &pt, n == 1 ? &img : NULL, err);
+                if (r == SY_OK && n == 1 && mi != 1) { /* constants of this mode's images */
+                    r = codec_of(&img, &D, &c, err);
+                    if (r == SY_OK)
+                        printf("    %s images: c = %.2f bytes per pixel on the wire, D = %.0f MB/s decode (one core)\n",
+                               sy_cluster_mode_name(modes[mi]), c, D / 1e6);
+                    if (r == SY_OK && coop) m = fmax(0.0, (pt.overhead - L - P * rb / D) / P);
+                }
+                sy_layer_destroy(&img);
+                if (r != SY_OK) break;
+                double per_core = ceil((double)n / C);
+                double model = coop ? L + per_core * P * rb / D + n * P * m : L + per_core * (P / n) * rb / D;
+                double bytes_model = (coop ? n : 1) * P * c;
+                printf("    %-11s N=%u%s: frame %7.3f s, slowest server %7.3f s, protocol %6.1f ms (model %6.1f ms%s), "
+                       "back %6.2f MB (model %6.2f MB), out %4.1f KB\n",
+                       sy_cluster_mode_name(modes[mi]), n, n > C ? " (oversubscribed)" : "", pt.frame, pt.server,
+                       pt.overhead * 1e3, model * 1e3, coop && n == 1 ? ": calibrates m" : "", pt.bytes_back / 1e6,
+                       bytes_model / 1e6, pt.bytes_out / 1e3);
+            }
+        if (r == SY_OK && m > 0) printf("    m = %.1f ns per pixel and server (merge, calibrated at N=1)\n", m * 1e9);
+    }
+    for (int i = 0; i < 3; ++i)
+        if (srv[i].pid) stop_server(&srv[i]);
+    return r;
+}
+
 int sy_cmd_bench_cluster(int argc, char **argv)
 {
     uint32_t w = 1920, h = 1080, rounds = 3;
-    bool hostile_only = false; /* only the hostile-peer measurement (one server) */
+    bool hostile_only = false, coop_only = false, scale = false; /* one measurement alone */
+    double coop_frame = 1.6; /* cooperative: seconds per frame on one server (each frame costs ~15 ms of sync + merge) */
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "-w") && i + 1 < argc) w = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "-h") && i + 1 < argc) h = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--repeats") && i + 1 < argc) rounds = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--hostile-only")) hostile_only = true;
+        else if (!strcmp(argv[i], "--coop-only")) coop_only = true;
+        else if (!strcmp(argv[i], "--scale")) scale = true;
+        else if (!strcmp(argv[i], "--coop-frame") && i + 1 < argc) coop_frame = strtod(argv[++i], NULL);
         else {
-            fprintf(stderr, "usage: sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only]\n");
+            fprintf(stderr, "usage: sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only | --coop-only] "
+                            "[--coop-frame SECONDS] | --scale\n");
             return 1;
         }
     }
-    if (w < 1 || h < 1 || w > 16384 || h > 16384 || rounds < 1 || rounds > 100) return 1;
+    if (w < 1 || h < 1 || w > 16384 || h > 16384 || rounds < 1 || rounds > 100 || !(coop_frame >= 0.05 && coop_frame <= 60))
+        return 1;
     signal(SIGPIPE, SIG_IGN);
     sy_error err = {0};
     sy_scene *scene = NULL;
@@ -901,6 +1065,11 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     if (r == SY_OK) r = sy_changes_serialize(snap, count_none, NULL, &buf, &without, &err);
     free(buf);
     sy_changes_release(snap);
+    if (r == SY_OK && scale) {
+        r = bench_scale(scene, &d, rounds < 3 ? 3 : rounds, &err);
+        sy_scene_destroy(scene);
+        return r == SY_OK ? 0 : cli_fail("bench cluster", &err);
+    }
     if (r == SY_OK) r = spawn_server(ncpu >= 2 ? 0 : -1, &srv[0], &err);
     if (r == SY_OK && hostile_only) {
         printf("sy bench cluster --hostile-only: demo scene, one server on loopback\n");
@@ -920,6 +1089,14 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     sy_cluster_client_opts co = {.urls = urls, .url_count = 2, .timeout_ms = 120000};
     const char *backend = sy_mediator_find("raster") ? "raster" : "whitted";
     sy_viewport_desc vd = {.root = d.root, .camera = d.camera, .background = d.background, .backend = backend};
+    if (r == SY_OK && coop_only) {
+        printf("sy bench cluster --coop-only: demo scene, 2 servers on loopback\n");
+        r = bench_coop(scene, &vd, srv, rounds, ncpu >= 2, coop_frame, &err);
+        stop_server(&srv[0]);
+        stop_server(&srv[1]);
+        sy_scene_destroy(scene);
+        return r == SY_OK ? 0 : cli_fail("bench cluster", &err);
+    }
     sy_camera_view view;
     if (r == SY_OK) r = sy_window_create(w, h, &win, &err);
     if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, &err);
@@ -1011,7 +1188,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     c = NULL;
     /* cooperative path tracing: 2 pinned servers vs 1 */
     if (r == SY_OK && sy_mediator_find("pathtracer")) {
-        r = bench_coop(scene, &vd, srv, rounds, ncpu >= 2, &err);
+        r = bench_coop(scene, &vd, srv, rounds, ncpu >= 2, coop_frame, &err);
     } else if (r == SY_OK) {
         printf("  cooperative: skipped (no 'pathtracer' back-end registered in this build)\n");
     }

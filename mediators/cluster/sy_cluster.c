@@ -199,7 +199,7 @@ static sy_result wire_send(wire *w, const uint8_t *frame, size_t size, size_t ma
  * (the handshake: nothing is allocated); otherwise the body grows frame by frame, each growth
  * reserved from mem first. The first header must arrive by deadline (0 = wait for ever); once it
  * has, every further operation must finish within progress_s (0 = by deadline). Sequence numbers
- * and tags are checked frame by frame. On failure w->last_rv tells a closed connection (nng code)
+ * and tags are checked frame by frame. On failure w->last_rv tells a closed connection (sy_stream_status)
  * from a refused frame (0). */
 static sy_result wire_recv(wire *w, const sy_cluster_budget *b, uint8_t *fixed, size_t fixed_cap, const wire_mem *mem,
                            double deadline, double progress_s, rx_msg *out, const char *who, sy_error *err)

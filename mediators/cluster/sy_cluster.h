@@ -1,12 +1,15 @@
-/* sy_cluster.h — cluster rendering over sockets: the render server (`sy serve`) and the client
- * that drives a set of servers from the application's scene. Transport: nng byte streams over TCP
- * (optionally TLS via nng's mbedTLS) carrying length-prefixed frames (a large message travels as
- * several frames); authentication: HMAC-SHA512-256 challenge-response with a shared secret
- * (libsodium), then every frame tagged with a per-session key; tiles compressed with zstd. The
- * wire format is in sy_cluster_proto.h and docs/PROTOCOL.md.
+/* sy_cluster.h — cluster rendering: the render server (`sy serve`) and the client that drives a
+ * set of servers from a scene. Transports (sy_cluster_transport.h): nng byte streams over TCP
+ * (optionally TLS via nng's mbedTLS) and MPI (sy_cluster_mpi.h), carrying length-prefixed frames (a
+ * large message travels as several frames); authentication: HMAC-SHA512-256 challenge-response
+ * with a shared secret (libsodium), then every frame tagged with a per-session key; tiles
+ * compressed with zstd. The wire format is in sy_cluster_proto.h and docs/PROTOCOL.md.
+ * Applications usually render through the cluster mediator (sy_mediator_cluster.h), a viewport
+ * back-end like any other; this API is the layer under it.
  *
- * This module is built as its own library (sy_cluster) so that sy_core stays free of nng,
- * libsodium and zstd; it uses only core headers (scene, change lists, mediator contexts).
+ * Built, with the mediator and the transports, as the library sy_cluster (mediators/cluster/), so
+ * that sy_core stays free of nng, libsodium and zstd; it uses only core headers (scene, change
+ * lists, mediator contexts).
  *
  * Server: holds one session per connected client (replica scene fed by change lists, context
  * pool) and a blob cache shared by all sessions (keyed by content hash, LRU under a byte budget,
