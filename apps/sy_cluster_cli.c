@@ -905,14 +905,16 @@ static sy_result scale_measure(sy_scene *scene, const sy_demo_info *d, const chi
     sy_camera_view view;
     sy_layer img = {0};
     bool coop = mode == SY_CLUSTER_COOPERATIVE;
-    const char *backend = coop ? "pathtracer" : sy_mediator_find("raster") ? "raster" : "whitted";
+    bool raster = sy_mediator_find("raster") != NULL; /* the picture back-ends measured: raster, else whitted */
+    const char *backend = coop ? "pathtracer" : raster ? "raster" : "whitted";
+    const char *params = coop ? "threads=1" : raster ? NULL : "spp=1,threads=1"; /* one core per server */
     sy_viewport_desc vd = {.root = d->root, .camera = d->camera, .background = d->background, .backend = backend};
     sy_result r = sy_window_create(w, h, &win, err);
     if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
     if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, err);
     if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &c, err);
     if (r == SY_OK) r = sy_layer_create(w, h, &img, err);
-    sy_cluster_frame f = {.mode = mode, .backend = backend, .params = coop ? "threads=1" : strcmp(backend, "raster") ? "spp=1,threads=1" : NULL,
+    sy_cluster_frame f = {.mode = mode, .backend = backend, .params = params,
                           .root_id = d->root.id, .background_id = d->background.id, .camera = view, .width = w,
                           .height = h, .samples = 1, .samples_total = coop ? n : 0, .depth = true};
     sy_cluster_frame_stats st;

@@ -360,6 +360,14 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
         r = sy_compose_render(ld->scene, pool, spec, w, h, &ro, out, out_right, err);
         if (r != SY_OK) break;
         pr.done += n;
+        /* the samples the back-end actually holds (a cooperative cluster adds them in multiples of its
+         * server count) */
+        sy_context *mc = NULL;
+        sy_mediator_stats ms = {0};
+        if (sy_context_pool_get(pool, ld->scene, spec->backend, &pp, ld->root.id, &mc, err) == SY_OK) {
+            sy_context_stats(mc, &ms);
+            if (ms.samples > pr.done) pr.done = ms.samples;
+        }
         double now = sy_time_now(), pass = (now - p0) / n;
         if (tty && now - last_print > 0.1) {
             pt_progress_print(&pr, false);

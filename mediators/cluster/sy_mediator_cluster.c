@@ -214,9 +214,18 @@ static sy_result cluster_sync(void *state, const sy_changes *changes, sy_error *
     return r;
 }
 
+/* n samples in multiples of the live servers (0: the servers' default) */
+static uint32_t coop_total(uint32_t n, uint32_t live)
+{
+    if (!n || !live) return n;
+    uint64_t t = ((uint64_t)n + live - 1) / live * live;
+    return t > SY_CLUSTER_MAX_SAMPLES ? n : (uint32_t)t;
+}
+
 static sy_result cluster_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     cluster_state *st = state;
+    uint32_t live = sy_cluster_client_live(st->client);
     sy_cluster_frame f = {.mode = st->mode,
                           .backend = st->backend,
                           .params = st->params[0] ? st->params : NULL,
@@ -226,8 +235,10 @@ static sy_result cluster_render(void *state, const sy_render_request *req, sy_la
                           .width = req->full_width,
                           .height = req->full_height,
                           .samples = st->mode == SY_CLUSTER_COOPERATIVE ? st->samples : req->sample_count,
-                          /* cooperative: the request's samples, split across the live servers */
-                          .samples_total = st->mode == SY_CLUSTER_COOPERATIVE ? req->sample_count : 0,
+                          /* cooperative: the request's samples, split across the live servers, rounded up to
+                           * a multiple of their number: a server left without samples in a frame would
+                           * leave its accumulation out of the merged image */
+                          .samples_total = st->mode == SY_CLUSTER_COOPERATIVE ? coop_total(req->sample_count, live) : 0,
                           .seed = req->seed,
                           .depth = true,
                           .half = st->half};

@@ -10,7 +10,9 @@
  *                    own back-end uses that one)
  *   mode=MODE        sort-first (default), balanced, cooperative, multi-display
  *   samples=N        cooperative: samples per render when the request gives none (default 16 per
- *                    server); a request's sample count is split across the live servers
+ *                    server); a request's sample count is split across the live servers, rounded up
+ *                    to a multiple of their number (every server adds to every frame, so none of
+ *                    their accumulations is left out of a merged image)
  *   pixels=float|half  tiles as float32 (bit-exact, default) or binary16
  *   servers=LIST     the configured servers this viewport uses: 1-based numbers and ranges joined by
  *                    '+' ("2-4", "1+3"); default all. Mixed back-ends per node: one window with a
