@@ -103,12 +103,9 @@ static sy_result check_node(const cluster_config *cfg, uint32_t i, const char *b
     uint32_t caps = remote_caps(backend);
     if (mode == SY_CLUSTER_COOPERATIVE && !(caps & SY_CAP_SAMPLE_RANGES))
         return sy_error_set(err, SY_ERR_UNSUPPORTED,
-                            "cluster: server %u (%s) renders with %s, whose samples cannot be split across servers: "
+                            "%s: server %u (%s) renders with %s, whose samples cannot be split across servers: "
                             "mode cooperative needs a back-end with sample ranges (e.g. pathtracer)",
-                            i + 1, cfg->urls[i], backend);
-    if (caps & SY_CAP_ANALYSIS && mode == SY_CLUSTER_COOPERATIVE)
-        return sy_error_set(err, SY_ERR_UNSUPPORTED, "cluster: server %u (%s): %s is an analysis back-end", i + 1,
-                            cfg->urls[i], backend);
+                            cfg->name, i + 1, cfg->urls[i], backend);
     return SY_OK;
 }
 
