@@ -44,7 +44,7 @@ static bool has_suffix(const char *s, const char *suffix)
 static int cli_fail(const char *cmd, const sy_error *e)
 {
     fprintf(stderr, "sy %s: error: %s\n", cmd, e->message);
-    return 2;
+    return 1; /* a failure; usage errors exit 2 */
 }
 
 /* ---- sy serve ---- */
@@ -124,7 +124,8 @@ int sy_cmd_serve(int argc, char **argv)
         else if (!strcmp(a, "--handshake-timeout-ms") && has && uint_arg(argv[i + 1], 100, 600000, &v))
             o.handshake_timeout_ms = (uint32_t)v, ++i;
         else {
-            fprintf(stderr,
+            bool help = !strcmp(argv[i], "--help");
+            fprintf(help ? stdout : stderr,
                     "usage: sy serve [--listen tcp://HOST:PORT|tls+tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png]\n"
                     "                [--port-file F] [--tls-cert PEM --tls-key PEM] [--name NAME] [--max-sessions N]\n"
                     "                [--blob-cache-mb N (1024)] [--max-objects N per type (1048576)]\n"
@@ -134,12 +135,13 @@ int sy_cmd_serve(int argc, char **argv)
                     "                [--max-unauthenticated N (32)] [--handshake-timeout-ms MS (3000)]\n"
                     "                [--max-lifetime SECONDS]\n"
                     "  the secret comes from --secret-file or $SY_CLUSTER_SECRET; without one only loopback is allowed\n");
-            return 1;
+            if (!help) fprintf(stderr, "sy serve: error: unknown or incomplete option '%s'\n", argv[i]);
+            return help ? 0 : 2;
         }
     }
     if (pc.output && !has_suffix(pc.output, ".exr") && !has_suffix(pc.output, ".png")) {
         fprintf(stderr, "sy serve: error: %s: --output must end in .exr or .png\n", pc.output);
-        return 1;
+        return 2;
     }
     sy_error err = {0};
     uint8_t *secret = NULL;
@@ -1038,11 +1040,13 @@ int sy_cmd_bench_cluster(int argc, char **argv)
         else {
             fprintf(stderr, "usage: sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only | --coop-only] "
                             "[--coop-frame SECONDS] | --scale\n");
-            return 1;
+            return 2;
         }
     }
-    if (w < 1 || h < 1 || w > 16384 || h > 16384 || rounds < 1 || rounds > 100 || !(coop_frame >= 0.05 && coop_frame <= 60))
-        return 1;
+    if (w < 1 || h < 1 || w > 16384 || h > 16384 || rounds < 1 || rounds > 100 || !(coop_frame >= 0.05 && coop_frame <= 60)) {
+        fprintf(stderr, "sy bench cluster: error: sizes 1..16384, --repeats 1..100, --coop-frame 0.05..60\n");
+        return 2;
+    }
     signal(SIGPIPE, SIG_IGN);
     sy_error err = {0};
     sy_scene *scene = NULL;

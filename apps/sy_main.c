@@ -435,13 +435,16 @@ static sy_result write_aov_exr(const char *path, sy_context *ctx, const out_opts
 static int fail(const sy_error *e)
 {
     fprintf(stderr, "sy: error: %s\n", e->message);
-    return 2;
+    return 1;
 }
 
-static int usage(void)
+/* The command summary, to stdout for --help (exit 0) or stderr after a usage error (exit 2). */
+static void usage_to(FILE *f)
 {
-    fprintf(stderr,
+    fprintf(f,
             "usage:\n"
+            "  sy --version | sy version            the Switchyard version\n"
+            "  sy --help | sy help [COMMAND]        this summary (on stdout)\n"
             "  sy info SCENE\n"
             "  sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]\n"
             "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]\n"
@@ -477,8 +480,22 @@ static int usage(void)
             "world options (every command): [--env MAP.exr | --env-color R,G,B] [--env-intensity X] [--env-hidden]\n"
             "  [--background R,G,B[,A]] [--no-default-light]: the environment is a light; the background is what\n"
             "  the camera sees where nothing is hit; a scene with no light of its own is lit by a neutral studio\n"
-            "  environment unless --no-default-light is given\n");
-    return 1;
+            "  environment unless --no-default-light is given\n"
+            "exit status: 0 success, 1 failure (the error names the file, peer or value), 2 usage error,\n"
+            "  130 interrupted\n");
+}
+
+static int usage(void)
+{
+    usage_to(stderr);
+    return 2;
+}
+
+/* A usage error naming the option and the value it did not accept. */
+static int bad_value(const char *opt, const char *value)
+{
+    fprintf(stderr, "sy: error: %s: '%s' is not an accepted value\n", opt, value);
+    return 2;
 }
 
 static bool parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
@@ -658,7 +675,7 @@ static int cmd_render(int argc, char **argv)
         char *end = NULL;
         if (!strcmp(a, "-b") && has) backend = argv[++i];
         else if (!strcmp(a, "--spp") && has) {
-            if (!parse_u32(argv[++i], 1, 1u << 24, &po.spp)) return usage();
+            if (!parse_u32(argv[++i], 1, 1u << 24, &po.spp)) return bad_value(argv[i - 1], argv[i]);
             progressive_opts = true;
         } else if (!strcmp(a, "--time") && has) {
             po.time_budget = strtod(argv[++i], &end);
@@ -667,9 +684,9 @@ static int cmd_render(int argc, char **argv)
         } else if (!strcmp(a, "--aov")) po.aov = progressive_opts = true;
         else if (!strcmp(a, "-o") && has) outp = argv[++i];
         else if (!strcmp(a, "-w") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
+            if (!parse_u32(argv[++i], 1, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(a, "-h") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &h)) return usage();
+            if (!parse_u32(argv[++i], 1, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
         else if (!strcmp(a, "--params") && has) params = argv[++i];
         else if (!strcmp(a, "--gl") && has) gl_provider = argv[++i]; /* raster: gl=... parameter */
@@ -873,11 +890,11 @@ static int cmd_compare(int argc, char **argv)
         const char *a = argv[i];
         bool has = i + 1 < argc;
         if (!strcmp(a, "-w") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
+            if (!parse_u32(argv[++i], 1, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(a, "-h") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &h)) return usage();
+            if (!parse_u32(argv[++i], 1, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(a, "--spp") && has) {
-            if (!parse_u32(argv[++i], 1, 1u << 20, &spp)) return usage();
+            if (!parse_u32(argv[++i], 1, 1u << 20, &spp)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(a, "-o") && has) sheet = argv[++i];
         else if (!strcmp(a, "--camera") && has) camera = argv[++i];
         else if (!strcmp(a, "--backends") && has) only = argv[++i];
@@ -919,9 +936,9 @@ static int cmd_demo(int argc, char **argv)
         if (!strcmp(argv[i], "-o") && has) dir = argv[++i];
         else if (!strcmp(argv[i], "--filter") && has) filter = argv[++i];
         else if (!strcmp(argv[i], "-w") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
+            if (!parse_u32(argv[++i], 1, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(argv[i], "-h") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &h)) return usage();
+            if (!parse_u32(argv[++i], 1, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
         } else return usage();
     }
     if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
@@ -980,14 +997,14 @@ static int cmd_view(int argc, char **argv)
         bool has = i + 1 < argc;
         if (!strcmp(a, "-b") && has) backend = argv[++i];
         else if (!strcmp(a, "-w") && has) {
-            if (!parse_u32(argv[++i], 16, 16384, &w)) return usage();
+            if (!parse_u32(argv[++i], 16, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(a, "-h") && has) {
-            if (!parse_u32(argv[++i], 16, 16384, &h)) return usage();
+            if (!parse_u32(argv[++i], 16, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
         else if (!strcmp(a, "--overlay") && has) overlay = argv[++i];
         else if (!strcmp(a, "--composite") && has) composite = argv[++i];
         else if (!strcmp(a, "--frames") && has) {
-            if (!parse_u32(argv[++i], 1, 1000000, &frames)) return usage();
+            if (!parse_u32(argv[++i], 1, 1000000, &frames)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(a, "--screenshot") && has) shot = argv[++i];
         else if (!strcmp(a, "--filter") && has) view_filter = argv[++i];
         else if (!strcmp(a, "--threshold") && has) {
@@ -1036,12 +1053,12 @@ static int cmd_coverage(int argc, char **argv)
         const char *a = argv[i];
         bool has = i + 1 < argc;
         if (!strcmp(a, "-w") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
+            if (!parse_u32(argv[++i], 1, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(a, "-h") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &h)) return usage();
+            if (!parse_u32(argv[++i], 1, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
         else if (!strcmp(a, "--top") && has) {
-            if (!parse_u32(argv[++i], 1, 1u << 30, &top)) return usage();
+            if (!parse_u32(argv[++i], 1, 1u << 30, &top)) return bad_value(argv[i - 1], argv[i]);
         } else if (a[0] != '-' && !scene) scene = a;
         else return usage();
     }
@@ -1150,11 +1167,11 @@ static int cmd_bench_filters(int argc, char **argv)
     for (int i = 0; i < argc; ++i) {
         bool has = i + 1 < argc;
         if (!strcmp(argv[i], "-w") && has) {
-            if (!parse_u32(argv[++i], 8, 16384, &w)) return usage();
+            if (!parse_u32(argv[++i], 8, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(argv[i], "-h") && has) {
-            if (!parse_u32(argv[++i], 8, 16384, &h)) return usage();
+            if (!parse_u32(argv[++i], 8, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(argv[i], "--repeats") && has) {
-            if (!parse_u32(argv[++i], 1, 1000, &repeats)) return usage();
+            if (!parse_u32(argv[++i], 1, 1000, &repeats)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(argv[i], "--reference") && has) reference = argv[++i];
         else if (argv[i][0] != '-' && ends_with(argv[i], ".png") && !sheet) sheet = argv[i];
         else if (argv[i][0] != '-' && !scene) scene = argv[i];
@@ -1185,15 +1202,15 @@ static int cmd_bench(int argc, char **argv)
         bool has = i + 1 < argc;
         if (!strcmp(argv[i], "--params") && has) params = argv[++i]; /* bench raster */
         else if (!strcmp(argv[i], "--nodes") && has) {
-            if (!parse_u32(argv[++i], 1, 1u << 22, &nodes)) return usage();
+            if (!parse_u32(argv[++i], 1, 1u << 22, &nodes)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(argv[i], "--tris") && has) {
-            if (!parse_u32(argv[++i], 12, 1u << 20, &tris)) return usage();
+            if (!parse_u32(argv[++i], 12, 1u << 20, &tris)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(argv[i], "--repeats") && has) {
-            if (!parse_u32(argv[++i], 1, 100000, &repeats)) return usage();
+            if (!parse_u32(argv[++i], 1, 100000, &repeats)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(argv[i], "-w") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &w)) return usage();
+            if (!parse_u32(argv[++i], 1, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
         } else if (!strcmp(argv[i], "-h") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &h)) return usage();
+            if (!parse_u32(argv[++i], 1, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
         } else if (argv[i][0] != '-' && !scene) scene = argv[i];
         else return usage();
     }
@@ -1257,6 +1274,16 @@ int main(int argc, char **argv)
     argc = kept;
     if (argc < 2) return usage();
     const char *cmd = argv[1];
+    if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
+        printf("sy (Switchyard) %s\n", sy_version());
+        return 0;
+    }
+    bool help = !strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help");
+    for (int i = 2; i < argc && strcmp(cmd, "serve"); ++i) help = help || !strcmp(argv[i], "--help"); /* sy CMD --help */
+    if (help) {
+        usage_to(stdout);
+        return 0;
+    }
     if (!strcmp(cmd, "info")) return cmd_info(argc - 2, argv + 2);
     if (!strcmp(cmd, "render")) {
         int rc = cmd_render(argc - 2, argv + 2);
@@ -1272,10 +1299,6 @@ int main(int argc, char **argv)
 #ifdef SY_HAVE_GLFW
     if (!strcmp(cmd, "view")) return cmd_view(argc - 2, argv + 2);
 #endif
-    if (!strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
-        usage();
-        return 0;
-    }
-    fprintf(stderr, "sy: unknown command '%s'\n", cmd);
-    return usage();
+    fprintf(stderr, "sy: error: unknown command '%s' (sy --help lists them)\n", cmd);
+    return 2;
 }

@@ -68,3 +68,8 @@ double sy_time_now(void)
 }
 
 bool sy_is_terminal(int fd) { return isatty(fd) == 1; }
+
+#ifndef SY_VERSION_STRING
+#error "SY_VERSION_STRING comes from the project version (core/CMakeLists.txt)"
+#endif
+const char *sy_version(void) { return SY_VERSION_STRING; }

@@ -86,6 +86,9 @@ double sy_time_now(void);
 /* true when fd refers to a terminal: long jobs print progress only then. */
 bool sy_is_terminal(int fd);
 
+/* The library's version, "MAJOR.MINOR.PATCH" (static storage). */
+const char *sy_version(void);
+
 #ifdef __cplusplus
 }
 #endif

@@ -78,6 +78,28 @@ CORNELL="$DATA/cornell/cornell_box.gltf"
 run backends "$SY" backends
 [ "$rc" -eq 0 ] && grep -q '^whitted' "$TMP/backends.out" || fail "sy backends does not list whitted"
 
+# conventions: --version and --help on stdout with status 0; a usage error names the option or value
+# on stderr with status 2; a failure has status 1
+run version "$SY" --version
+[ "$rc" -eq 0 ] && grep -Eq '^sy \(Switchyard\) [0-9]+\.[0-9]+\.[0-9]+$' "$TMP/version.out" && [ ! -s "$TMP/version.err" ] ||
+    fail "sy --version: status $rc, '$(cat "$TMP/version.out" "$TMP/version.err")'"
+for h in "--help" "help" "render --help"; do
+    run help "$SY" $h
+    [ "$rc" -eq 0 ] && grep -q '^usage:' "$TMP/help.out" && grep -q 'sy render SCENE' "$TMP/help.out" && [ ! -s "$TMP/help.err" ] ||
+        fail "sy $h: status $rc, the summary is not on stdout"
+done
+run serve_help "$SY" serve --help
+[ "$rc" -eq 0 ] && grep -q 'usage: sy serve' "$TMP/serve_help.out" || fail "sy serve --help: status $rc"
+run badopt "$SY" render demo -b whitted -o "$TMP/x.png" --frobnicate
+[ "$rc" -eq 2 ] && grep -q -- "'--frobnicate'" "$TMP/badopt.err" || fail "a bad option: status $rc (want 2), $(cat "$TMP/badopt.err")"
+run badval "$SY" render demo -b whitted -o "$TMP/x.png" -w 0
+[ "$rc" -eq 2 ] && grep -q -- "-w: '0'" "$TMP/badval.err" || fail "a bad value: status $rc (want 2), $(cat "$TMP/badval.err")"
+run badcmd "$SY" renderr demo
+[ "$rc" -eq 2 ] && grep -q "unknown command 'renderr'" "$TMP/badcmd.err" || fail "an unknown command: status $rc (want 2)"
+run failure "$SY" render "$TMP/does_not_exist.gltf" -b whitted -o "$TMP/x.png"
+[ "$rc" -eq 1 ] && grep -q "does_not_exist.gltf" "$TMP/failure.err" || fail "a failure: status $rc (want 1), $(cat "$TMP/failure.err")"
+[ ! -e "$TMP/x.png" ] || fail "an image was written by a failed or refused command"
+
 # garbage bytes named bad.gltf
 mkdir -p "$TMP/in" "$TMP/o_garbage"
 printf 'this is not glTF \000\377\376 {{{' >"$TMP/in/bad.gltf"
