@@ -520,9 +520,35 @@ static void json_string(FILE *f, const char *s)
     fputc('"', f);
 }
 
+/* sy info IMAGE.exr: size, channels and the header's string attributes (what sy render records) as JSON. */
+static int info_exr(const char *path)
+{
+    sy_error err = {0};
+    sy_exr_image *img = NULL;
+    if (sy_exr_read(path, &img, &err) != SY_OK) return fail(&err);
+    printf("{\n  \"file\": ");
+    json_string(stdout, path);
+    printf(",\n  \"width\": %d, \"height\": %d,\n  \"channels\": [", img->width, img->height);
+    for (int i = 0; i < img->channel_count; ++i) {
+        printf(i ? ", " : "");
+        json_string(stdout, img->channels[i].name);
+    }
+    printf("],\n  \"attributes\": {");
+    for (int i = 0; i < img->attribute_count; ++i) {
+        printf(i ? ",\n    " : "\n    ");
+        json_string(stdout, img->attributes[i].name);
+        printf(": ");
+        json_string(stdout, img->attributes[i].value);
+    }
+    printf("%s}\n}\n", img->attribute_count ? "\n  " : "");
+    sy_exr_image_free(img);
+    return 0;
+}
+
 static int cmd_info(int argc, char **argv)
 {
     if (argc != 1) return usage();
+    if (ends_with(argv[0], ".exr")) return info_exr(argv[0]);
     sy_error err = {0};
     loaded ld;
     if (load(argv[0], NULL, false, &ld, &err) != SY_OK) return fail(&err);
@@ -813,20 +839,12 @@ static int cmd_render(int argc, char **argv)
     sy_context *pctx = NULL;
     bool interrupted = false;
     char samples_str[32], secs_str[32];
-    sy_exr_attribute attrs[4];
     if (r == SY_OK && progressive) {
         /* the first Ctrl-C ends the render after the pass in progress and keeps its image */
         sy_signals_set_graceful("finishing the current pass, then writing the image accumulated so far");
         r = render_progressive(&ld, &spec, w, h, &po, pool, &img, &img_right, &secs, &samples, &pctx, &err);
         t0 = sy_time_now() - secs;
         interrupted = sy_signals_interrupted();
-        snprintf(samples_str, sizeof samples_str, "%llu", (unsigned long long)samples);
-        snprintf(secs_str, sizeof secs_str, "%.3f", secs);
-        attrs[oo.attr_count++] = (sy_exr_attribute){"sy:backend", shown};
-        attrs[oo.attr_count++] = (sy_exr_attribute){"sy:samples", samples_str};
-        attrs[oo.attr_count++] = (sy_exr_attribute){"sy:seconds", secs_str};
-        if (interrupted) attrs[oo.attr_count++] = (sy_exr_attribute){"sy:interrupted", "1"};
-        oo.attrs = attrs;
     } else if (r == SY_OK && clo.cluster) {
         /* --frames N: N frames through the same window (balanced strips adapt from frame to frame) */
         if (remote_spp) ro.sample_count = po.spp;
@@ -839,6 +857,47 @@ static int cmd_render(int argc, char **argv)
         }
     } else if (r == SY_OK) r = sy_compose_render(ld.scene, pool, &spec, w, h, &ro, &img, &img_right, &err);
     secs = sy_time_now() - t0;
+    /* the image's metadata (EXR header attributes, PNG text chunks): what made it and how */
+    sy_exr_attribute attrs[12];
+    sy_png_text texts[12];
+    char renderer[64], size_str[48], camera_str[256];
+    if (r == SY_OK) {
+        if (!progressive) { /* what the main back-end accumulated (a single pass: 1) */
+            sy_params mp;
+            sy_context *mc = NULL;
+            sy_mediator_stats ms = {0};
+            sy_error ignore = {0};
+            if (sy_params_parse(spec.params, &mp, &ignore) == SY_OK &&
+                sy_context_pool_get(pool, ld.scene, spec.backend, &mp, ld.root.id, &mc, &ignore) == SY_OK)
+                sy_context_stats(mc, &ms);
+            samples = ms.samples;
+        }
+        snprintf(renderer, sizeof renderer, "Switchyard %s", sy_version());
+        snprintf(samples_str, sizeof samples_str, "%llu", (unsigned long long)samples);
+        snprintf(secs_str, sizeof secs_str, "%.3f", secs);
+        snprintf(size_str, sizeof size_str, "%ux%u%s", w, h,
+                 spec.stereo == SY_STEREO_NONE ? "" : spec.stereo == SY_STEREO_SEPARATE ? " per eye" : " per eye, stereo");
+        sy_mat4 cm = sy_mat4_identity();
+        bool has_cam = ld.camera.id && sy_node_world_matrix(ld.scene, ld.camera, &cm, NULL) == SY_OK;
+        if (has_cam)
+            snprintf(camera_str, sizeof camera_str, "%s at (%g, %g, %g) looking along (%g, %g, %g)",
+                     camera ? camera : "the scene's first camera", (double)cm.m[12], (double)cm.m[13], (double)cm.m[14],
+                     (double)-cm.m[8], (double)-cm.m[9], (double)-cm.m[10]);
+        else snprintf(camera_str, sizeof camera_str, "a view framing the scene's bounds");
+        const char *kv[][2] = {{"sy:renderer", renderer}, {"sy:backend", shown}, {"sy:params", params},
+                               {"sy:camera", camera_str}, {"sy:size", size_str}, {"sy:samples", samples_str},
+                               {"sy:seconds", secs_str}, {"sy:source", scene},
+                               {"sy:interrupted", interrupted ? "1" : NULL}};
+        for (size_t k = 0; k < sizeof kv / sizeof kv[0]; ++k) {
+            if (!kv[k][1] || !kv[k][1][0]) continue;
+            attrs[oo.attr_count] = (sy_exr_attribute){kv[k][0], kv[k][1]};
+            texts[oo.attr_count] = (sy_png_text){kv[k][0], kv[k][1]};
+            oo.attr_count++;
+        }
+        oo.attrs = attrs;
+        oo.png.text = texts;
+        oo.png.text_count = oo.attr_count;
+    }
     if (r == SY_OK && clo.cluster && cluster_mode == SY_CLUSTER_MULTI_DISPLAY) {
         printf("multi-display: %ux%u wall presented by the servers, %s, %.3f s\n", w, h, remote, secs);
     } else if (r == SY_OK) {

@@ -384,7 +384,38 @@ void sy_exr_image_free(sy_exr_image *img)
         }
         free(img->channels);
     }
+    for (int i = 0; i < img->attribute_count; ++i) free(img->attributes[i].name), free(img->attributes[i].value);
+    free(img->attributes);
     free(img);
+}
+
+/* Copies part 0's string attributes (the metadata sy writes, and any other tool's) into img. */
+static sy_result read_text_attributes(exr_const_context_t ctxt, sy_exr_image *img, const char *path, sy_error *err)
+{
+    int32_t n = 0;
+    if (exr_get_attribute_count(ctxt, 0, &n) != EXR_ERR_SUCCESS || n <= 0) return SY_OK;
+    img->attributes = calloc((size_t)(n < SY_EXR_MAX_ATTRIBUTES ? n : SY_EXR_MAX_ATTRIBUTES), sizeof *img->attributes);
+    if (!img->attributes) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory for the header", path);
+    for (int32_t i = 0; i < n && img->attribute_count < SY_EXR_MAX_ATTRIBUTES; ++i) {
+        const exr_attribute_t *a = NULL;
+        if (exr_get_attribute_by_index(ctxt, 0, EXR_ATTR_LIST_FILE_ORDER, i, &a) != EXR_ERR_SUCCESS || !a ||
+            a->type != EXR_ATTR_STRING || !a->string || !a->name)
+            continue;
+        int32_t len = a->string->length < 0 ? 0 : a->string->length;
+        if (len > SY_EXR_MAX_ATTRIBUTE_VALUE) len = SY_EXR_MAX_ATTRIBUTE_VALUE;
+        sy_exr_text *t = &img->attributes[img->attribute_count];
+        t->name = strdup(a->name);
+        t->value = malloc((size_t)len + 1);
+        if (!t->name || !t->value) {
+            free(t->name), free(t->value);
+            t->name = t->value = NULL;
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory for the header", path);
+        }
+        if (len) memcpy(t->value, a->string->str, (size_t)len);
+        t->value[len] = 0;
+        img->attribute_count++;
+    }
+    return SY_OK;
 }
 
 const float *sy_exr_image_channel(const sy_exr_image *img, const char *name)
@@ -672,6 +703,7 @@ static sy_result read_image(exr_reader *rp, const sy_exr_read_options *opts, sy_
     exr_attr_box2i_t dw;
     rc = read_header(&r, &storage, &dw, err);
     if (rc == SY_OK) rc = storage == EXR_STORAGE_TILED ? read_tiles(&r, err) : read_scanlines(&r, &dw, err);
+    if (rc == SY_OK) rc = read_text_attributes(r.ctxt, r.img, path, err);
     if (rc != SY_OK) goto done;
 
     /* UINT planes hold raw integers so far (the decoder wrote 4-byte integers): convert in place. */

@@ -107,11 +107,19 @@ typedef struct sy_exr_plane {
 } sy_exr_plane;
 
 /* A decoded image: the data window of the first part, level 0 of a tiled part. */
+/* A string attribute of a read header (owned copies). */
+typedef struct sy_exr_text {
+    char *name, *value;
+} sy_exr_text;
+
 typedef struct sy_exr_image {
     int width, height;          /* data window size */
     int origin_x, origin_y;     /* data window minimum (usually 0, 0) */
     int channel_count;
     sy_exr_plane *channels;     /* sorted by name, as the file lists them */
+    int attribute_count;        /* the header's string attributes, in file order (at most SY_EXR_MAX_ATTRIBUTES
+                                   are kept; longer values are cut at SY_EXR_MAX_ATTRIBUTE_VALUE bytes) */
+    sy_exr_text *attributes;
 } sy_exr_image;
 
 /* Reads the first part of the OpenEXR file at path (scanline or tiled; HALF, FLOAT and UINT

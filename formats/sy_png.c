@@ -47,6 +47,8 @@ typedef struct png_write_job {
     float scale;
     sy_tonemap op;
     uint8_t *row; /* width * 4 bytes */
+    const sy_png_text *text;
+    int text_count;
     char msg[256];
 } png_write_job;
 
@@ -70,6 +72,17 @@ static void write_png_body(png_structp png, png_infop info, png_write_job *job)
     png_set_IHDR(png, info, (png_uint_32)job->width, (png_uint_32)job->height, 8, PNG_COLOR_TYPE_RGB_ALPHA,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    if (job->text_count > 0) {
+        png_text t[SY_PNG_MAX_TEXT];
+        memset(t, 0, sizeof t);
+        for (int i = 0; i < job->text_count; ++i) {
+            t[i].compression = PNG_TEXT_COMPRESSION_NONE;
+            t[i].key = (png_charp)job->text[i].key;
+            t[i].text = (png_charp)job->text[i].value;
+            t[i].text_length = strlen(job->text[i].value);
+        }
+        png_set_text(png, info, t, job->text_count);
+    }
     png_write_info(png, info);
     for (int y = 0; y < job->height; ++y) {
         const float *src = job->rgba + (size_t)y * (size_t)job->width * 4u;
@@ -117,6 +130,14 @@ sy_result sy_png_write(const char *path, int width, int height, const float *rgb
                             path, (double)o.exposure_stops);
     if (o.tonemap != SY_TONEMAP_CLAMP && o.tonemap != SY_TONEMAP_REINHARD && o.tonemap != SY_TONEMAP_ACES)
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: unknown tone-mapping operator %d", path, (int)o.tonemap);
+    if (o.text_count < 0 || o.text_count > SY_PNG_MAX_TEXT || (o.text_count && !o.text))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: %d text chunks (0..%d)", path, o.text_count, SY_PNG_MAX_TEXT);
+    for (int i = 0; i < o.text_count; ++i) {
+        size_t kl = o.text[i].key ? strlen(o.text[i].key) : 0;
+        if (kl < 1 || kl > 79 || !o.text[i].value)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: text chunk %d: a key of 1..79 bytes and a value are needed",
+                                path, i);
+    }
 
     png_write_job job = {
         .width = width,
@@ -124,6 +145,8 @@ sy_result sy_png_write(const char *path, int width, int height, const float *rgb
         .rgba = rgba,
         .scale = exp2f(o.exposure_stops),
         .op = o.tonemap,
+        .text = o.text,
+        .text_count = o.text_count,
     };
     job.row = malloc((size_t)width * 4u);
     if (!job.row) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: cannot allocate a %d-pixel row", path, width);

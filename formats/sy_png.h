@@ -26,9 +26,17 @@ extern "C" {
 /* sy_tonemap, sy_srgb_encode/decode and sy_tonemap_apply live in core/sy_post.h. */
 
 /* Zero-initialised ({0}) means: exposure 0 stops, SY_TONEMAP_CLAMP. */
+/* A text chunk (tEXt: Latin-1 key of 1..79 bytes; the value is written as given). */
+typedef struct sy_png_text {
+    const char *key, *value;
+} sy_png_text;
+#define SY_PNG_MAX_TEXT 32
+
 typedef struct sy_png_options {
     float exposure_stops; /* colour is multiplied by 2^exposure_stops before tone mapping */
     sy_tonemap tonemap;
+    const sy_png_text *text; /* metadata chunks (e.g. the renderer, back-end, samples), borrowed */
+    int text_count;          /* 0..SY_PNG_MAX_TEXT */
 } sy_png_options;
 
 /* Converts one premultiplied linear RGBA pixel to 8-bit straight-alpha sRGB exactly as

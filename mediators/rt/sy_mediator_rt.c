@@ -1046,7 +1046,8 @@ static sy_result whitted_create(const sy_mediator_create_args *args, void **stat
 static void rt_stats(void *state, sy_mediator_stats *out)
 {
     rt_state *st = state;
-    out->samples = st->frames_rendered ? 1 : 0;
+    /* Whitted: its camera rays per pixel (spp); the path tracer: its accumulation */
+    out->samples = st->frames_rendered ? (st->integrator == SY_RT_INTEGRATOR_WHITTED ? st->pixel_samples : 1) : 0;
     if (st->integrator == SY_RT_INTEGRATOR_PATHTRACER)
         out->samples = st->last_slot >= 0 ? sy_rt_accum_samples(st->slots[st->last_slot].acc) : 0;
 }

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# cluster_cli_test.sh SY WORKDIR [TESTDATA] — `sy serve` and `sy render --cluster` through the command line:
+# cluster_cli_test.sh SY WORKDIR [TESTDATA] EXR_EQUAL — `sy serve` and `sy render --cluster` through the command line:
 # two authenticated servers on free loopback ports, sort-first output equal to a local render
 # (EXR bytes), a wrong secret refused with a logged reason, a non-loopback listen refused without
 # a secret, multi-display tiles written by the servers at the swap barrier. Servers stop by
@@ -7,7 +7,7 @@
 # shared test data): side-by-side stereo with a raster overlay on the cluster equals the local
 # composite (one render path: nothing the local window does is dropped).
 set -u
-SY=$1; W=$2; DATA=${3:-}
+SY=$1; W=$2; DATA=${3:-}; EXR_EQUAL=${4:?exr_equal}
 rm -rf "$W"; mkdir -p "$W"
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; }
@@ -30,10 +30,10 @@ URLS="tcp://127.0.0.1:$(cat "$W/a.port"),tcp://127.0.0.1:$(cat "$W/b.port")"
 "$SY" render demo -b whitted -w 120 -h 80 -o "$W/local.exr" > /dev/null || fail "local render"
 "$SY" render demo -b whitted -w 120 -h 80 -o "$W/cluster.exr" --cluster "$URLS" --secret-file "$W/secret" \
   --cluster-mode sort-first 2> "$W/client.log" > /dev/null || fail "cluster render"
-cmp -s "$W/local.exr" "$W/cluster.exr" || fail "sort-first EXR differs from the local render"
+"$EXR_EQUAL" "$W/local.exr" "$W/cluster.exr" || fail "sort-first EXR differs from the local render"
 SY_CLUSTER_SECRET=cli-test-secret "$SY" render demo -b whitted -w 120 -h 80 -o "$W/balanced.exr" --cluster "$URLS" \
   --cluster-mode balanced --frames 3 2> "$W/client2.log" > /dev/null || fail "balanced render (secret from env)"
-cmp -s "$W/local.exr" "$W/balanced.exr" || fail "balanced EXR differs from the local render"
+"$EXR_EQUAL" "$W/local.exr" "$W/balanced.exr" || fail "balanced EXR differs from the local render"
 
 # stereo + a raster overlay: the same window as locally, the main viewport on the cluster
 DUCK="$DATA/gltf/Duck/glTF-Binary/Duck.glb"
@@ -43,7 +43,7 @@ if [ -n "$DATA" ] && [ -f "$DUCK" ]; then
   "$SY" render demo -b whitted -w 320 -h 240 --stereo sbs --overlay "$DUCK:raster" -o "$W/sbs_cluster.exr" \
     --cluster "$URLS" --secret-file "$W/secret" > "$W/sbs.out" 2> "$W/sbs.err" || fail "cluster stereo render with overlay"
   grep -q "640x240, whitted on 2 servers (sort-first)" "$W/sbs.out" || fail "the cluster stereo image is not 640x240"
-  cmp -s "$W/sbs_local.exr" "$W/sbs_cluster.exr" || fail "cluster stereo + overlay differs from the local composite"
+  "$EXR_EQUAL" "$W/sbs_local.exr" "$W/sbs_cluster.exr" || fail "cluster stereo + overlay differs from the local composite"
   # a request the cluster cannot serve is refused at set-up, naming the node and the reason
   if "$SY" render demo -b whitted -w 32 -h 24 -o "$W/coopw.exr" --cluster "$URLS" --secret-file "$W/secret" \
     --cluster-mode cooperative 2> "$W/coopw.err"; then fail "cooperative whitted was accepted"; fi
@@ -108,7 +108,7 @@ if command -v openssl > /dev/null; then
   TLS="tls+tcp://localhost:$(cat "$W/tls.port")"
   "$SY" render demo -b whitted -w 120 -h 80 -o "$W/tls.exr" --cluster "$TLS" --tls-ca "$W/srv.crt" \
     --secret-file "$W/secret" > /dev/null 2> "$W/tlsclient.log" || fail "TLS render"
-  cmp -s "$W/local.exr" "$W/tls.exr" || fail "TLS image differs from the local render"
+  "$EXR_EQUAL" "$W/local.exr" "$W/tls.exr" || fail "TLS image differs from the local render"
   if "$SY" render demo -b whitted -w 16 -h 16 -o "$W/tlsbad.exr" --cluster "$TLS" --tls-ca "$W/other.crt" \
     --secret-file "$W/secret" --timeout-ms 3000 > /dev/null 2> "$W/tlsbad.err"; then
     fail "a server certificate from an unknown CA was accepted"

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# cluster_netns_test.sh SY WORKDIR — a render server in its own network namespace (a separate
+# cluster_netns_test.sh SY WORKDIR EXR_EQUAL — a render server in its own network namespace (a separate
 # host as far as TCP is concerned, joined by a veth pair), rendered from the root namespace with a
 # shared secret; the image must equal a local render. Skipped (77, with the reason) unless running
 # as root with `ip netns` working.
 set -u
-SY=$1; W=$2
+SY=$1; W=$2; EXR_EQUAL=${3:?exr_equal}
 [ "$(id -u)" = 0 ] || { echo "SKIP: needs root for ip netns"; exit 77; }
 command -v ip > /dev/null || { echo "SKIP: the ip tool (iproute2) is not installed"; exit 77; }
 NS=sytest$$
@@ -26,5 +26,5 @@ sleep 1
 "$SY" render demo -b whitted -w 64 -h 48 -o "$W/local.exr" > /dev/null || { echo "FAIL: local render"; exit 1; }
 "$SY" render demo -b whitted -w 64 -h 48 -o "$W/remote.exr" --cluster tcp://10.213.0.2:5791 --secret-file "$W/secret" \
   --timeout-ms 20000 > /dev/null 2> "$W/client.log" || { echo "FAIL: remote render"; cat "$W"/*.log; exit 1; }
-cmp -s "$W/local.exr" "$W/remote.exr" || { echo "FAIL: image across namespaces differs"; exit 1; }
+"$EXR_EQUAL" "$W/local.exr" "$W/remote.exr" || { echo "FAIL: image across namespaces differs"; exit 1; }
 echo "cluster_netns: ok"

@@ -254,6 +254,29 @@ static void test_tiled_uint(const char *dir)
 }
 
 /* Every prefix of a valid file must fail cleanly: SY_ERR_PARSE naming the file, no crash. */
+/* String attributes written into the header come back from sy_exr_read, in file order. */
+static void test_attributes(const char *dir)
+{
+    const int w = 4, h = 3;
+    float rgba[4 * 4 * 3] = {0};
+    char p[4096];
+    PATHF(p, "%s/attrs.exr", dir);
+    const sy_exr_attribute at[3] = {{"sy:renderer", "Switchyard test"}, {"sy:backend", "whitted on 2 servers"},
+                                    {"sy:source", "a/b c.gltf"}};
+    sy_error err = {0};
+    CHECK(sy_exr_write_rgba_attrs(p, w, h, rgba, NULL, SY_EXR_PIXEL_HALF, at, 3, &err) == SY_OK, "%s", err.message);
+    sy_exr_image *img = NULL;
+    CHECK(sy_exr_read(p, &img, &err) == SY_OK, "%s", err.message);
+    if (!img) return;
+    int found = 0;
+    for (int i = 0; i < img->attribute_count; ++i)
+        for (int k = 0; k < 3; ++k)
+            if (!strcmp(img->attributes[i].name, at[k].name))
+                found += !strcmp(img->attributes[i].value, at[k].value);
+    CHECK(found == 3, "%d of 3 string attributes read back (%d attributes in all)", found, img->attribute_count);
+    sy_exr_image_free(img);
+}
+
 static void check_truncations(const char *dir, const unsigned char *bytes, size_t n, const char *label)
 {
     char p[4096];
@@ -455,6 +478,7 @@ int main(int argc, char **argv)
         test_rgba_roundtrip(dir, SY_EXR_PIXEL_HALF);
         test_multichannel(dir);
         test_tiled_uint(dir);
+        test_attributes(dir);
         test_damaged(dir);
     }
     remove_scratch_dir(dir);

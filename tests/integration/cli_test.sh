@@ -100,6 +100,20 @@ run failure "$SY" render "$TMP/does_not_exist.gltf" -b whitted -o "$TMP/x.png"
 [ "$rc" -eq 1 ] && grep -q "does_not_exist.gltf" "$TMP/failure.err" || fail "a failure: status $rc (want 1), $(cat "$TMP/failure.err")"
 [ ! -e "$TMP/x.png" ] || fail "an image was written by a failed or refused command"
 
+# metadata: every image records the renderer, back-end, camera, size, samples, time and source
+# (EXR string attributes, PNG text chunks); sy info IMAGE.exr prints them
+mkdir -p "$TMP/meta"
+run meta_exr "$SY" render demo -b whitted -w 40 -h 30 -o "$TMP/meta/m.exr" --params spp=2
+run meta_info "$SY" info "$TMP/meta/m.exr"
+for kv in '"sy:renderer": "Switchyard ' '"sy:backend": "whitted"' '"sy:params": "spp=2"' '"sy:size": "40x30"' \
+          '"sy:samples": "2"' '"sy:source": "demo"' '"sy:camera": "the scene' '"sy:seconds": "' '"width": 40, "height": 30'; do
+    grep -qF -- "$kv" "$TMP/meta_info.out" || fail "sy info m.exr lacks $kv: $(cat "$TMP/meta_info.out" "$TMP/meta_info.err")"
+done
+run meta_png "$SY" render demo -b pathtracer --spp 3 -w 40 -h 30 -o "$TMP/meta/m.png"
+for kv in 'sy:renderer' 'sy:backend.pathtracer' 'sy:samples.3' 'sy:source.demo'; do
+    tr '\0' '.' < "$TMP/meta/m.png" | grep -qa -- "$kv" || fail "the PNG's text chunks lack $kv"
+done
+
 # garbage bytes named bad.gltf
 mkdir -p "$TMP/in" "$TMP/o_garbage"
 printf 'this is not glTF \000\377\376 {{{' >"$TMP/in/bad.gltf"
