@@ -11,16 +11,15 @@
  * responsive while a slow back-end renders and always shows the last complete image; a
  * progressive back-end keeps refining while the camera rests and restarts when it moves.
  *
- * Cluster (--cluster URL[,URL...]|FILE.conf, --cluster-mode ...): the render thread sends the
- * camera moves as scene changes and render requests to `sy serve` processes and shows the merged
- * image (sort-first / balanced: bit-identical to a local render; cooperative: the servers' sample
- * ranges merged, refined while the camera rests; stereo: both eyes side by side). Each request has
- * a deadline (--timeout-ms, else adaptive: 1 s + 4x the last frame, doubled after a failure), so
- * a dead or stalled server is dropped and its work given to the others; the title shows the mode,
- * the servers alive, the frame time, spp and the last server failure. Multi-display: the servers
- * present the wall (-w x -h) at the swap barrier, and the window shows the whole wall rendered
- * locally with the same back-end, or the configuration's 'viewer tile X Y W H'. The overlay and
- * the path tracer display filter are local-only (not used with --cluster).
+ * Cluster (--cluster URL[,URL...]|FILE.conf, --cluster-mode ...): the viewport's back-end is the
+ * cluster mediator (sy_mediator_cluster.h), so the viewer renders through the same window path as
+ * locally (overlay and stereo included); camera moves reach the servers as change lists. Sort-first
+ * / balanced are bit-identical to a local render; cooperative merges the servers' sample ranges and
+ * refines while the camera rests. Deadlines (--timeout-ms, else adaptive in the mediator) drop a
+ * dead or stalled server and give its work to the others; the title shows the mode, the servers
+ * alive, the frame time, spp and the last server failure. Multi-display: the servers present the
+ * wall (-w x -h) at the swap barrier, and the window shows the whole wall rendered locally with the
+ * same back-end, or the configuration's 'viewer tile X Y W H'. The display filter is local only.
  *
  * Thread-safety: runs the whole viewer; call from the main thread (GLFW requires it). */
 #ifndef SY_VIEW_H

@@ -1,6 +1,7 @@
 /* sy_cluster_proto.h — the cluster wire protocol: message encoder and decoder, pure (no sockets,
  * no crypto, no compression), so that it can be fuzzed and tested alone. The transport
- * (core/sy_cluster.c, nng + libsodium + zstd) frames, authenticates and compresses around it.
+ * (sy_cluster.c on a transport of sy_cluster_transport.h, libsodium, zstd) frames, authenticates and
+ * compresses around it.
  * Every message is documented in docs/PROTOCOL.md.
  *
  * Frame: a 24-byte little-endian header {magic "SYCP", version, type, flags, body size, sequence},
