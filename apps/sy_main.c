@@ -38,6 +38,7 @@
 #include "sy_mediator_rt.h"
 #include "sy_mediators.h"
 #include "sy_png.h"
+#include "sy_sniff.h"
 #include "sy_signals.h"
 #include "sy_viewport.h"
 #include "sy_x3d.h"
@@ -179,9 +180,25 @@ static sy_result report_warnings(const char *path, char **warnings, uint32_t sto
     return SY_OK;
 }
 
+/* The scene format of path, from its content (sy_sniff.h): a file of another kind is refused,
+ * named for what it is; one that is not recognised goes to the loader its name suggests (which
+ * then says what is wrong with it). */
+static sy_result recognise(const char *path, sy_file_format *fmt, sy_error *err)
+{
+    *fmt = SY_FORMAT_UNKNOWN;
+    sy_error ignore = {0};
+    if (sy_sniff_file(path, fmt, &ignore) != SY_OK) return SY_OK; /* the loader reports a missing file */
+    if (*fmt == SY_FORMAT_UNKNOWN || sy_file_format_is_scene(*fmt)) return SY_OK;
+    return sy_error_set(err, SY_ERR_UNSUPPORTED,
+                        "%s: %s content, which sy does not read as a scene (it reads glTF 2.0 .gltf / .glb and X3D in XML "
+                        "encoding)",
+                        path, sy_file_format_name(*fmt));
+}
+
 static sy_result load(const char *path, const char *camera_sel, bool defaults, loaded *out, sy_error *err)
 {
     memset(out, 0, sizeof *out);
+    sy_file_format fmt = SY_FORMAT_UNKNOWN;
     sy_result r = sy_scene_create(&out->scene, err);
     if (r != SY_OK) return r;
     if (strcmp(path, "demo") == 0) {
@@ -194,7 +211,10 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
             if (camera_sel && strcmp(camera_sel, "0") != 0 && strcmp(camera_sel, "camera") != 0)
                 r = sy_error_set(err, SY_ERR_NOT_FOUND, "demo: no camera '%s' (available: 0 \"camera\")", camera_sel);
         }
-    } else if (strlen(path) > 4 && !strcasecmp(path + strlen(path) - 4, ".x3d")) {
+    } else if ((r = recognise(path, &fmt, err)) != SY_OK) {
+        /* named for what it is: not a scene format the loaders read */
+    } else if (fmt == SY_FORMAT_X3D || (fmt == SY_FORMAT_UNKNOWN && strlen(path) > 4 &&
+                                        !strcasecmp(path + strlen(path) - 4, ".x3d"))) {
         out->is_x3d = true;
         sy_x3d_options xo = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count};
         r = sy_x3d_load(path, out->scene, &xo, &out->x3d, err);
@@ -476,7 +496,7 @@ static void usage_to(FILE *f)
             "            [--cluster-mode sort-first|balanced|cooperative|multi-display|stereo] [--secret-file F]\n"
             "            [--tls-ca PEM] [--timeout-ms MS] [--frames N] [--spp N] [--cluster-pixels float|half]\n"
             "  sy bench cluster [-w W] [-h H] [--repeats ROUNDS]\n"
-            "SCENE: a .gltf/.glb/.x3d file, or 'demo' for the built-in scene\n"
+            "SCENE: a glTF (.gltf, .glb) or X3D (XML) file, recognised by its content, or 'demo' (the built-in scene)\n"
             "world options (every command): [--env MAP.exr | --env-color R,G,B] [--env-intensity X] [--env-hidden]\n"
             "  [--background R,G,B[,A]] [--no-default-light]: the environment is a light; the background is what\n"
             "  the camera sees where nothing is hit; a scene with no light of its own is lit by a neutral studio\n"

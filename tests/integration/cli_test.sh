@@ -100,6 +100,17 @@ run failure "$SY" render "$TMP/does_not_exist.gltf" -b whitted -o "$TMP/x.png"
 [ "$rc" -eq 1 ] && grep -q "does_not_exist.gltf" "$TMP/failure.err" || fail "a failure: status $rc (want 1), $(cat "$TMP/failure.err")"
 [ ! -e "$TMP/x.png" ] || fail "an image was written by a failed or refused command"
 
+# files are recognised by content: an OBJ (under its own name or a glTF one) is named as such, with
+# status 1 and no image
+mkdir -p "$TMP/in"
+printf '# a triangle\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$TMP/in/tri.obj"
+cp "$TMP/in/tri.obj" "$TMP/in/tri_obj.gltf"
+for f in tri.obj tri_obj.gltf; do
+    run obj "$SY" render "$TMP/in/$f" -b whitted -o "$TMP/x.png"
+    [ "$rc" -eq 1 ] && grep -q "$f: Wavefront OBJ content, which sy does not read as a scene" "$TMP/obj.err" && [ ! -e "$TMP/x.png" ] ||
+        fail "an OBJ file ($f): status $rc, $(cat "$TMP/obj.err")"
+done
+
 # metadata: every image records the renderer, back-end, camera, size, samples, time and source
 # (EXR string attributes, PNG text chunks); sy info IMAGE.exr prints them
 mkdir -p "$TMP/meta"

@@ -1,0 +1,112 @@
+/* sy_sniff.c — file formats from their first bytes (see sy_sniff.h). */
+#include "sy_sniff.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#define SNIFF_BYTES 1024
+
+static bool starts(const unsigned char *p, size_t n, const char *sig)
+{
+    size_t k = strlen(sig);
+    return n >= k && memcmp(p, sig, k) == 0;
+}
+
+/* Whether the text contains needle within its first n bytes (case-sensitive). */
+static bool contains(const unsigned char *p, size_t n, const char *needle)
+{
+    size_t k = strlen(needle);
+    for (size_t i = 0; i + k <= n; ++i)
+        if (memcmp(p + i, needle, k) == 0) return true;
+    return false;
+}
+
+/* A Wavefront OBJ: its first statement (after comments and blank lines) is one of OBJ's keywords. */
+static bool looks_obj(const unsigned char *p, size_t n)
+{
+    static const char *const kw[] = {"v", "vt", "vn", "vp", "f", "o", "g", "s", "l", "p", "mtllib", "usemtl"};
+    size_t i = 0;
+    while (i < n) {
+        while (i < n && (p[i] == ' ' || p[i] == '\t' || p[i] == '\r' || p[i] == '\n')) i++;
+        if (i < n && p[i] == '#') { /* a comment line */
+            while (i < n && p[i] != '\n') i++;
+            continue;
+        }
+        size_t s = i;
+        while (i < n && p[i] > ' ') i++;
+        if (i >= n || (p[i] != ' ' && p[i] != '\t')) return false; /* a keyword is followed by its arguments */
+        for (size_t k = 0; k < sizeof kw / sizeof kw[0]; ++k)
+            if (strlen(kw[k]) == i - s && memcmp(p + s, kw[k], i - s) == 0) return true;
+        return false;
+    }
+    return false;
+}
+
+sy_file_format sy_sniff_bytes(const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    if (starts(p, n, "glTF")) return SY_FORMAT_GLB;
+    if (n >= 4 && p[0] == 0x76 && p[1] == 0x2f && p[2] == 0x31 && p[3] == 0x01) return SY_FORMAT_EXR;
+    if (starts(p, n, "\x89PNG\r\n\x1a\n")) return SY_FORMAT_PNG;
+    if (n >= 3 && p[0] == 0xff && p[1] == 0xd8 && p[2] == 0xff) return SY_FORMAT_JPEG;
+    if (starts(p, n, "Kaydara FBX Binary")) return SY_FORMAT_FBX;
+    if (starts(p, n, "ply\n") || starts(p, n, "ply\r")) return SY_FORMAT_PLY;
+    size_t i = 0;
+    if (starts(p, n, "\xef\xbb\xbf")) i = 3; /* UTF-8 byte order mark */
+    while (i < n && (p[i] == ' ' || p[i] == '\t' || p[i] == '\r' || p[i] == '\n')) i++;
+    const unsigned char *t = p + i;
+    size_t m = n - i;
+    if (m && t[0] == '{') return SY_FORMAT_GLTF;
+    if (starts(t, m, "#VRML") || starts(t, m, "#X3D")) return SY_FORMAT_VRML;
+    if (m && t[0] == '<') {
+        if (contains(t, m, "<X3D") || contains(t, m, "X3D PUBLIC") || contains(t, m, "x3d-3.") || contains(t, m, "x3d-4."))
+            return SY_FORMAT_X3D;
+        if (contains(t, m, "<COLLADA")) return SY_FORMAT_COLLADA;
+        return SY_FORMAT_UNKNOWN;
+    }
+    if (starts(t, m, "solid") && (contains(t, m, "facet normal") || contains(t, m, "endsolid"))) return SY_FORMAT_STL;
+    if (looks_obj(t, m)) return SY_FORMAT_OBJ;
+    return SY_FORMAT_UNKNOWN;
+}
+
+sy_result sy_sniff_file(const char *path, sy_file_format *out, sy_error *err)
+{
+    *out = SY_FORMAT_UNKNOWN;
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return sy_error_set(err, errno == ENOENT ? SY_ERR_NOT_FOUND : SY_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    if (S_ISDIR(st.st_mode)) return sy_error_set(err, SY_ERR_IO, "%s: is a folder, not a scene file", path);
+    FILE *f = fopen(path, "rb");
+    if (!f) return sy_error_set(err, SY_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    unsigned char buf[SNIFF_BYTES];
+    size_t n = fread(buf, 1, sizeof buf, f);
+    fclose(f);
+    *out = sy_sniff_bytes(buf, n);
+    return SY_OK;
+}
+
+const char *sy_file_format_name(sy_file_format f)
+{
+    switch (f) {
+    case SY_FORMAT_GLTF: return "glTF";
+    case SY_FORMAT_GLB: return "binary glTF (GLB)";
+    case SY_FORMAT_X3D: return "X3D";
+    case SY_FORMAT_OBJ: return "Wavefront OBJ";
+    case SY_FORMAT_PLY: return "PLY";
+    case SY_FORMAT_STL: return "STL";
+    case SY_FORMAT_FBX: return "FBX";
+    case SY_FORMAT_COLLADA: return "COLLADA";
+    case SY_FORMAT_VRML: return "VRML / X3D classic encoding";
+    case SY_FORMAT_EXR: return "OpenEXR image";
+    case SY_FORMAT_PNG: return "PNG image";
+    case SY_FORMAT_JPEG: return "JPEG image";
+    default: return "unknown";
+    }
+}
+
+bool sy_file_format_is_scene(sy_file_format f)
+{
+    return f == SY_FORMAT_GLTF || f == SY_FORMAT_GLB || f == SY_FORMAT_X3D;
+}

@@ -1,0 +1,64 @@
+/* test_sniff.c — sy_sniff: every format recognised from its first bytes (signatures, leading
+ * whitespace and byte order marks, OBJ after comments), look-alikes left unknown (plain text, an
+ * XML file that is not X3D, a word starting with "v"), and files: a missing one and a folder are
+ * errors naming them. */
+#include "sy_sniff.h"
+
+#include "test_util.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static sy_file_format of(const char *s) { return sy_sniff_bytes(s, strlen(s)); }
+
+int main(void)
+{
+    static const struct {
+        const char *bytes;
+        sy_file_format want;
+    } cases[] = {
+        {"{\"asset\": {\"version\": \"2.0\"}}", SY_FORMAT_GLTF},
+        {"\xef\xbb\xbf  \n{\"asset\":{}}", SY_FORMAT_GLTF},
+        {"glTF\x02\x00\x00\x00", SY_FORMAT_GLB},
+        {"<?xml version=\"1.0\"?>\n<!DOCTYPE X3D PUBLIC \"ISO//Web3D//DTD X3D 3.3//EN\" \"x\">\n<X3D>", SY_FORMAT_X3D},
+        {"<X3D profile='Interchange' version='4.0'><Scene/></X3D>", SY_FORMAT_X3D},
+        {"<?xml version=\"1.0\"?><COLLADA xmlns=\"x\">", SY_FORMAT_COLLADA},
+        {"#VRML V2.0 utf8\nShape {}", SY_FORMAT_VRML},
+        {"#X3D V3.3 utf8\nPROFILE Interchange", SY_FORMAT_VRML},
+        {"# Blender OBJ\n# comment\n\nmtllib a.mtl\no Cube\nv 1 1 1\n", SY_FORMAT_OBJ},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", SY_FORMAT_OBJ},
+        {"ply\nformat ascii 1.0\n", SY_FORMAT_PLY},
+        {"solid cube\n  facet normal 0 0 1\n", SY_FORMAT_STL},
+        {"Kaydara FBX Binary  \x00", SY_FORMAT_FBX},
+        {"\x89PNG\r\n\x1a\n\x00\x00", SY_FORMAT_PNG},
+        {"\x76\x2f\x31\x01\x02", SY_FORMAT_EXR},
+        {"\xff\xd8\xff\xe0", SY_FORMAT_JPEG},
+        /* look-alikes */
+        {"hello world\n", SY_FORMAT_UNKNOWN},
+        {"<?xml version=\"1.0\"?><svg/>", SY_FORMAT_UNKNOWN},
+        {"very nice\n", SY_FORMAT_UNKNOWN},
+        {"v\n", SY_FORMAT_UNKNOWN},
+        {"solid but no facets", SY_FORMAT_UNKNOWN},
+        {"", SY_FORMAT_UNKNOWN},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        sy_file_format got = of(cases[i].bytes);
+        CHECK(got == cases[i].want, "case %zu: %s, expected %s", i, sy_file_format_name(got), sy_file_format_name(cases[i].want));
+    }
+    CHECK(!strcmp(sy_file_format_name(SY_FORMAT_OBJ), "Wavefront OBJ"), "OBJ's name");
+    CHECK(sy_file_format_is_scene(SY_FORMAT_GLB) && !sy_file_format_is_scene(SY_FORMAT_OBJ), "scene formats");
+
+    char dir[4096], p[4200];
+    make_scratch_dir(dir, sizeof dir, "sniff");
+    snprintf(p, sizeof p, "%s/model.gltf", dir); /* an OBJ under a glTF name */
+    const char obj[] = "v 0 0 0\nf 1 1 1\n";
+    CHECK(write_bytes(p, obj, sizeof obj - 1) == 0, "cannot write %s", p);
+    sy_file_format got = SY_FORMAT_UNKNOWN;
+    sy_error e = {0};
+    CHECK(sy_sniff_file(p, &got, &e) == SY_OK && got == SY_FORMAT_OBJ, "model.gltf holding OBJ: %s", sy_file_format_name(got));
+    snprintf(p, sizeof p, "%s/missing.glb", dir);
+    CHECK(sy_sniff_file(p, &got, &e) == SY_ERR_NOT_FOUND && strstr(e.message, "missing.glb"), "missing: %s", e.message);
+    CHECK(sy_sniff_file(dir, &got, &e) != SY_OK && strstr(e.message, "folder"), "a folder: %s", e.message);
+    remove_scratch_dir(dir);
+    return finish_tests("test_sniff");
+}
