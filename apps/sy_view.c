@@ -138,6 +138,8 @@ struct view_cluster {
     sy_cluster_rect viewer_tile; /* multi-display: what the window shows ('viewer tile'; w 0 = the wall) */
     uint32_t wall_w, wall_h;     /* multi-display: the wall (-w x -h) */
     uint32_t passes;             /* frames since the last restart (camera, back-end, size changed) */
+    sy_window *wall_win;         /* multi-display: one viewport on the viewer's camera, for its view */
+    sy_viewport *wall_vp;
     pthread_mutex_t log_mu;
     char log[128];               /* the client's last log line (a server dropped, a reconnect) */
 };
@@ -196,6 +198,7 @@ static sy_result view_cluster_open(const sy_view_args *a, sy_context_pool *pool,
 static void view_cluster_close(view_cluster *vc)
 {
     if (!vc) return;
+    sy_window_destroy(vc->wall_win);
     pthread_mutex_destroy(&vc->log_mu);
     free(vc);
 }
@@ -206,15 +209,20 @@ static sy_result view_cluster_local(view_cluster *vc, const sy_view_args *a, sy_
                                     sy_node cam, uint32_t fw, uint32_t fh, sy_layer *img, sy_error *err)
 {
     sy_cluster_rect t = vc->viewer_tile.w ? vc->viewer_tile : (sy_cluster_rect){0, 0, fw, fh};
-    sy_window *win = NULL;
-    sy_viewport *vp = NULL;
     sy_camera_view view;
-    sy_viewport_desc vd = {.root = a->spec.root, .camera = cam, .backend = backend};
     sy_context *ctx = NULL;
-    sy_result r = sy_window_create(fw, fh, &win, err);
-    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
-    if (r == SY_OK) r = sy_viewport_camera_view(vp, a->scene, fw, fh, &view, err);
-    sy_window_destroy(win);
+    sy_result r = SY_OK;
+    if (!vc->wall_vp) { /* made once: the camera node and the wall size do not change */
+        sy_viewport_desc vd = {.root = a->spec.root, .camera = cam, .backend = backend};
+        r = sy_window_create(fw, fh, &vc->wall_win, err);
+        if (r == SY_OK) r = sy_window_add_viewport(vc->wall_win, &vd, &vc->wall_vp, err);
+        if (r != SY_OK) {
+            sy_window_destroy(vc->wall_win);
+            vc->wall_win = NULL, vc->wall_vp = NULL;
+            return r;
+        }
+    }
+    if (r == SY_OK) r = sy_viewport_camera_view(vc->wall_vp, a->scene, fw, fh, &view, err);
     if (r == SY_OK) r = sy_context_pool_get(pool, a->scene, backend, NULL, a->spec.root.id, &ctx, err);
     if (r == SY_OK) r = sy_context_sync(ctx, err);
     if (r == SY_OK) r = sy_layer_create(t.w, t.h, img, err);

@@ -126,7 +126,24 @@ static void sockaddr_str(const nng_sockaddr *sa, bool with_port, char *buf, size
 
 static const sy_cluster_stream_ops nng_stream_ops;
 
-/* A stream record for st (NULL when out of memory; st is then left to the caller). */
+/* Gives the record its connected stream and the peer's address (for the log and the back-off). */
+static void strm_attach(nng_strm *s, nng_stream *st)
+{
+    s->st = st;
+    nng_sockaddr sa;
+    memset(&sa, 0, sizeof sa);
+    if (nng_stream_get_addr(st, NNG_OPT_REMADDR, &sa) == 0) {
+        sockaddr_str(&sa, true, s->base.peer, sizeof s->base.peer);
+        sockaddr_str(&sa, false, s->base.host, sizeof s->base.host);
+        s->base.loopback = sockaddr_is_loopback(&sa);
+    } else {
+        snprintf(s->base.peer, sizeof s->base.peer, "unknown peer");
+        snprintf(s->base.host, sizeof s->base.host, "unknown peer");
+    }
+}
+
+/* A stream record for st (NULL: connected later, strm_attach). NULL when out of memory; st is then
+ * left to the caller. */
 static nng_strm *strm_new(nng_stream *st)
 {
     nng_strm *s = calloc(1, sizeof *s);
@@ -144,19 +161,7 @@ static nng_strm *strm_new(nng_stream *st)
         return NULL;
     }
     s->base.ops = &nng_stream_ops;
-    s->st = st;
-    if (st) {
-        nng_sockaddr sa;
-        memset(&sa, 0, sizeof sa);
-        if (nng_stream_get_addr(st, NNG_OPT_REMADDR, &sa) == 0) {
-            sockaddr_str(&sa, true, s->base.peer, sizeof s->base.peer);
-            sockaddr_str(&sa, false, s->base.host, sizeof s->base.host);
-            s->base.loopback = sockaddr_is_loopback(&sa);
-        } else {
-            snprintf(s->base.peer, sizeof s->base.peer, "unknown peer");
-            snprintf(s->base.host, sizeof s->base.host, "unknown peer");
-        }
-    }
+    if (st) strm_attach(s, st);
     return s;
 }
 
@@ -381,20 +386,9 @@ static sy_result tr_nng_dial(const char *url, const sy_cluster_dial_opts *o, sy_
     nng_aio_wait(s->aio); /* the dialer honours the timeout (no stream yet to close) */
     rv = nng_aio_result(s->aio);
     if (rv == 0) {
-        nng_stream *st = nng_aio_get_output(s->aio, 0);
-        nng_strm *full = strm_new(st); /* with the peer's address */
-        if (!full) {
-            nng_stream_close(st);
-            nng_stream_free(st);
-            rv = NNG_ENOMEM;
-        } else {
-            strm_free(&s->base);
-            s = full;
-            s->dialer = d;
-            d = NULL;
-        }
-    }
-    if (d) nng_stream_dialer_free(d);
+        strm_attach(s, nng_aio_get_output(s->aio, 0));
+        s->dialer = d; /* kept with its stream */
+    } else nng_stream_dialer_free(d);
     if (rv) {
         strm_free(&s->base);
         return sy_error_set(err, SY_ERR_IO, "%s: cannot connect: %s", url,
