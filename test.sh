@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# test.sh — the whole test suite: installs what is missing (Debian), builds three configurations
-# (optimised; AddressSanitizer + UndefinedBehaviorSanitizer; clang with libFuzzer) and runs ctest in
-# each. Every step runs even when an earlier one failed; the exit status is non-zero when any failed.
+# test.sh — the whole test suite: installs what is missing (Debian), builds four configurations
+# (optimised; AddressSanitizer + UndefinedBehaviorSanitizer; minimal: Embree only, shared
+# libraries; clang with libFuzzer) and runs ctest in each. Every step runs even when an earlier one
+# failed; the exit status is non-zero when any failed.
 set -uo pipefail
 cd "$(dirname "$0")"
 . .ci/deps.sh
@@ -21,6 +22,12 @@ step "build (ASan+UBSan)" sy_configure_build build-asan -- -DCMAKE_BUILD_TYPE=De
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0" \
   step "ctest (ASan+UBSan)" ctest --test-dir build-asan --output-on-failure -j "$jobs"
+# Minimal configuration (the modular build): only the Embree back-ends, as shared libraries; GL,
+# GLFW, nng, libsodium, zstd and MPI are not even looked for (package_parts checks that), and the
+# suite runs what this build has, the installed-package test included.
+step "build (minimal: Embree only, shared)" sy_configure_build build-min -- -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DSY_WITH_RASTER=OFF -DSY_WITH_CLUSTER=OFF -DBUILD_SHARED_LIBS=ON &&
+  step "ctest (minimal)" ctest --test-dir build-min --output-on-failure -j "$jobs"
 # Fuzzing (tests/fuzz): clang + libFuzzer, only the fuzz targets; each fuzz_run_* test fuzzes
 # SY_FUZZ_SECONDS on seeds from ../shared/testdata (tests/fuzz/fuzz.sh runs long campaigns).
 CC=clang CXX=clang++ step "build (libFuzzer)" sy_configure_build build-fuzz sy_fuzzers -- \

@@ -3,8 +3,17 @@
 
 #include "sy_compose.h"
 #include "sy_demo.h"
+#ifdef SY_HAVE_RASTER
 #include "sy_mediator_raster.h"
+#endif
+#ifdef SY_HAVE_EMBREE
 #include "sy_mediator_rt.h"
+#endif
+
+/* A benchmark of a back-end this build lacks (SY_WITH_EMBREE / SY_WITH_RASTER off) says so. */
+#define SY_BENCH_WITHOUT(err, what, option)                                                                            \
+    return sy_error_set(err, SY_ERR_UNSUPPORTED, "sy bench: %s needs a back-end this sy was built without (%s=OFF)",   \
+                        what, option)
 
 #include <math.h>
 #include <stdio.h>
@@ -18,6 +27,10 @@ static int cmp_double(const void *a, const void *b)
 
 sy_result sy_bench_sync(uint32_t nodes, uint32_t tris, uint32_t repeats, sy_error *err)
 {
+#ifndef SY_HAVE_EMBREE
+    (void)nodes, (void)tris, (void)repeats;
+    SY_BENCH_WITHOUT(err, "sync (whitted)", "SY_WITH_EMBREE");
+#else
     uint32_t per_group = nodes < 100 ? nodes : 100, groups = (nodes + per_group - 1) / per_group;
     sy_scene *s = NULL;
     sy_context *ctx = NULL;
@@ -72,11 +85,16 @@ sy_result sy_bench_sync(uint32_t nodes, uint32_t tris, uint32_t repeats, sy_erro
     sy_scene_destroy(s);
     free(times);
     return r;
+#endif
 }
 
 sy_result sy_bench_rays(sy_scene *scene, const sy_viewport_desc *vd, uint32_t width, uint32_t height, uint32_t repeats,
                         sy_error *err)
 {
+#ifndef SY_HAVE_EMBREE
+    (void)scene, (void)vd, (void)width, (void)height, (void)repeats;
+    SY_BENCH_WITHOUT(err, "rays (whitted)", "SY_WITH_EMBREE");
+#else
     sy_window *win = NULL;
     sy_viewport *vp = NULL;
     sy_context *ctx = NULL;
@@ -97,6 +115,7 @@ sy_result sy_bench_rays(sy_scene *scene, const sy_viewport_desc *vd, uint32_t wi
     sy_context_release(ctx);
     sy_window_destroy(win);
     return r;
+#endif
 }
 
 static double best_of(double a, double b) { return a < b ? a : b; }
@@ -183,7 +202,7 @@ sy_result sy_bench_viewports(uint32_t width, uint32_t height, uint32_t repeats, 
 
 /* >>bench raster: our frame against the floor (the same buffers, trivial shader), transform
  * latency and uploads per frame, for one scene. */
-static double median_of(double *t, uint32_t n)
+static inline double median_of(double *t, uint32_t n) /* inline: used only with the rasterizer */
 {
     qsort(t, n, sizeof *t, cmp_double);
     return t[n / 2];
@@ -196,6 +215,7 @@ sy_bench_spread sy_bench_spread_of(double *v, uint32_t n)
     return (sy_bench_spread){v[0], med, v[n - 1]};
 }
 
+#ifdef SY_HAVE_RASTER
 static sy_result bench_raster_scene(const char *label, sy_scene *scene, const sy_viewport_desc *vd, sy_node moved,
                                     uint32_t width, uint32_t height, uint32_t repeats, sy_error *err)
 {
@@ -278,8 +298,10 @@ static sy_result bench_raster_scene(const char *label, sy_scene *scene, const sy
     free(t);
     return r;
 }
+#endif
 
 /* Adds a point light above the generated scene and a sky background (ambient light). */
+#ifdef SY_HAVE_RASTER
 static sy_result bench_raster_light_scene(sy_scene *s, sy_node root, sy_background *bg_out, sy_error *err)
 {
     static const float q[4] = {0, 0, 0, 1}, one[3] = {1, 1, 1}, at[3] = {1.2f, 3.0f, 3.0f};
@@ -297,10 +319,15 @@ static sy_result bench_raster_light_scene(sy_scene *s, sy_node root, sy_backgrou
         return r;
     return sy_scene_commit(s, NULL, err);
 }
+#endif
 
 sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
                           uint32_t height, uint32_t repeats, sy_error *err)
 {
+#ifndef SY_HAVE_RASTER
+    (void)scene, (void)vd, (void)label, (void)width, (void)height, (void)repeats;
+    SY_BENCH_WITHOUT(err, "raster", "SY_WITH_RASTER");
+#else
     sy_viewport_desc d = *vd;
     if (!d.params) d.params = "gl=osmesa";
     sy_params p;
@@ -323,6 +350,7 @@ sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const cha
     if (r == SY_OK) r = bench_raster_scene("generated 1M triangles, lit", s, &g, leaf, width, height, repeats, err);
     sy_scene_destroy(s);
     return r;
+#endif
 }
 
 /* >>bench load (formats, issue 6) ------------------------------------------------------------ */
@@ -578,6 +606,7 @@ sy_result sy_bench_load(const char *data_dir, uint32_t tris, uint32_t repeats, s
 
 /* >>pathtracer (issue 3): samples/s and Mrays/s of the path tracer next to the Whitted back-end on
  * the same scene, and the restart latency after a transform change. */
+#ifdef SY_HAVE_EMBREE
 static sy_result pt_bench_frame(sy_window *win, sy_scene *scene, sy_context_pool *pool, uint32_t samples, sy_layer *out,
                                 double *secs, sy_error *err)
 {
@@ -587,10 +616,15 @@ static sy_result pt_bench_frame(sy_window *win, sy_scene *scene, sy_context_pool
     *secs = sy_time_now() - t0;
     return r;
 }
+#endif
 
 sy_result sy_bench_pathtracer(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
                               uint32_t height, uint32_t passes, sy_error *err)
 {
+#ifndef SY_HAVE_EMBREE
+    (void)scene, (void)vd, (void)label, (void)width, (void)height, (void)passes;
+    SY_BENCH_WITHOUT(err, "pathtracer", "SY_WITH_EMBREE");
+#else
     sy_window *win_w = NULL, *win_p = NULL;
     sy_viewport *vp;
     sy_context_pool *pool = NULL;
@@ -661,6 +695,7 @@ sy_result sy_bench_pathtracer(sy_scene *scene, const sy_viewport_desc *vd, const
     sy_window_destroy(win_w);
     sy_window_destroy(win_p);
     return r;
+#endif
 }
 
 /* ---- sy bench filters (issue 7): noise-reduction filters of backends/filters ---------------- */
@@ -738,6 +773,10 @@ static double fb_median(double *v, uint32_t n)
  * a warm-up pass that includes the translation): the yardstick the pixel filter's cost is given in. */
 static sy_result fb_pt_pass(uint32_t width, uint32_t height, uint32_t repeats, double *secs, sy_error *err)
 {
+#ifndef SY_HAVE_EMBREE
+    (void)width, (void)height, (void)repeats, (void)secs;
+    SY_BENCH_WITHOUT(err, "filters (a path-traced pass)", "SY_WITH_EMBREE");
+#else
     sy_scene *s = NULL;
     sy_demo_info demo;
     sy_window *win = NULL;
@@ -766,6 +805,7 @@ static sy_result fb_pt_pass(uint32_t width, uint32_t height, uint32_t repeats, d
     sy_scene_destroy(s);
     free(t);
     return r;
+#endif
 }
 
 sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, const char *png_path, sy_error *err)
@@ -928,6 +968,10 @@ sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, co
 sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
                                  uint32_t height, const char *reference_exr, const char *png_path, sy_error *err)
 {
+#ifndef SY_HAVE_EMBREE
+    (void)scene, (void)vd, (void)label, (void)width, (void)height, (void)reference_exr, (void)png_path;
+    SY_BENCH_WITHOUT(err, "filters on a scene (pathtracer)", "SY_WITH_EMBREE");
+#else
     sy_filter_error fe = {0};
     sy_exr_image *refimg = NULL;
     sy_window *win = NULL;
@@ -1091,4 +1135,5 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
     sy_window_destroy(win);
     sy_window_destroy(win_rf);
     return r;
+#endif
 }

@@ -13,6 +13,7 @@
 #include "sy_demo.h"
 #include "sy_exr.h"
 #include "sy_file.h"
+#include "sy_log.h"
 #include "sy_png.h"
 
 #include <arpa/inet.h>
@@ -43,7 +44,8 @@ static bool has_suffix(const char *s, const char *suffix)
 
 static int cli_fail(const char *cmd, const sy_error *e)
 {
-    fprintf(stderr, "sy %s: error: %s\n", cmd, e->message);
+    (void)cmd;
+    sy_log(SY_LOG_ERROR, "sy", NULL, "%s", e->message);
     return 1; /* a failure; usage errors exit 2 */
 }
 
@@ -91,53 +93,99 @@ static bool uint_arg(const char *s, unsigned long long lo, unsigned long long hi
     return true;
 }
 
+/* "-w" or "--name" of option code c in a getopt_long table (for messages). */
+static const char *opt_label(const struct option *lo, int c, char name[48])
+{
+    if (c < 0x100) {
+        snprintf(name, 48, "-%c", c);
+        return name;
+    }
+    while (lo->name && lo->val != c) ++lo;
+    snprintf(name, 48, "--%s", lo->name ? lo->name : "?");
+    return name;
+}
+
 int sy_cmd_serve(int argc, char **argv)
 {
     sy_cluster_server_opts o = {0};
     const char *secret_file = NULL, *port_file = NULL;
     present_ctx pc = {0};
     unsigned long long v = 0;
-    for (int i = 0; i < argc; ++i) {
-        const char *a = argv[i];
-        bool has = i + 1 < argc;
-        if (!strcmp(a, "--listen") && has) o.listen_url = argv[++i];
-        else if (!strcmp(a, "--secret-file") && has) secret_file = argv[++i];
-        else if (!strcmp(a, "--output") && has) pc.output = argv[++i];
-        else if (!strcmp(a, "--port-file") && has) port_file = argv[++i];
-        else if (!strcmp(a, "--tls-cert") && has) o.tls_cert_file = argv[++i];
-        else if (!strcmp(a, "--tls-key") && has) o.tls_key_file = argv[++i];
-        else if (!strcmp(a, "--name") && has) o.name = argv[++i];
-        else if (!strcmp(a, "--max-sessions") && has) o.max_sessions = (uint32_t)strtoul(argv[++i], NULL, 10);
-        else if (!strcmp(a, "--max-lifetime") && has) o.max_lifetime_s = strtod(argv[++i], NULL);
-        else if (!strcmp(a, "--blob-cache-mb") && has) o.blob_cache_bytes = (size_t)strtoul(argv[++i], NULL, 10) << 20;
-        else if (!strcmp(a, "--max-objects") && has) o.max_objects = (uint32_t)strtoul(argv[++i], NULL, 10);
-        else if (!strcmp(a, "--auth-backoff-ms") && has) o.auth_backoff_ms = (uint32_t)strtoul(argv[++i], NULL, 10);
+    enum { O_LISTEN = 0x100, O_SECRET_FILE, O_OUTPUT, O_PORT_FILE, O_TLS_CERT, O_TLS_KEY, O_NAME, O_MAX_SESSIONS,
+           O_MAX_LIFETIME, O_BLOB_CACHE, O_MAX_OBJECTS, O_AUTH_BACKOFF, O_PEER_MEMORY, O_FRAME_KB, O_MESSAGE_MB,
+           O_UNAUTH, O_HANDSHAKE, O_HELP };
+    static const struct option lo[] = {
+        {"listen", required_argument, NULL, O_LISTEN}, {"secret-file", required_argument, NULL, O_SECRET_FILE},
+        {"output", required_argument, NULL, O_OUTPUT}, {"port-file", required_argument, NULL, O_PORT_FILE},
+        {"tls-cert", required_argument, NULL, O_TLS_CERT}, {"tls-key", required_argument, NULL, O_TLS_KEY},
+        {"name", required_argument, NULL, O_NAME}, {"max-sessions", required_argument, NULL, O_MAX_SESSIONS},
+        {"max-lifetime", required_argument, NULL, O_MAX_LIFETIME},
+        {"blob-cache-mb", required_argument, NULL, O_BLOB_CACHE}, {"max-objects", required_argument, NULL, O_MAX_OBJECTS},
+        {"auth-backoff-ms", required_argument, NULL, O_AUTH_BACKOFF},
         /* budgets against hostile peers (docs/PROTOCOL.md, "Budgets and limits") */
-        else if (!strcmp(a, "--max-peer-memory-mb") && has && uint_arg(argv[i + 1], 1, 1u << 20, &v))
-            o.max_peer_memory = (size_t)v << 20, ++i;
-        else if (!strcmp(a, "--max-frame-kb") && has && uint_arg(argv[i + 1], 64, 1u << 20, &v))
-            o.max_frame = (size_t)v << 10, ++i;
-        else if (!strcmp(a, "--max-message-mb") && has && uint_arg(argv[i + 1], 1, 1u << 20, &v))
-            o.max_message = (size_t)v << 20, ++i;
-        else if (!strcmp(a, "--max-unauthenticated") && has && uint_arg(argv[i + 1], 1, 65536, &v))
-            o.max_unauthenticated = (uint32_t)v, ++i;
-        else if (!strcmp(a, "--handshake-timeout-ms") && has && uint_arg(argv[i + 1], 100, 600000, &v))
-            o.handshake_timeout_ms = (uint32_t)v, ++i;
-        else {
-            bool help = !strcmp(argv[i], "--help");
-            fprintf(help ? stdout : stderr,
-                    "usage: sy serve [--listen tcp://HOST:PORT|tls+tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png]\n"
-                    "                [--port-file F] [--tls-cert PEM --tls-key PEM] [--name NAME] [--max-sessions N]\n"
-                    "                [--blob-cache-mb N (1024)] [--max-objects N per type (1048576)]\n"
-                    "                [--auth-backoff-ms MS (250, doubled per failed authentication)]\n"
-                    "                [--max-peer-memory-mb N (1024: all peers' messages in flight)]\n"
-                    "                [--max-frame-kb N (8192, 64..1048576)] [--max-message-mb N (1024)]\n"
-                    "                [--max-unauthenticated N (32)] [--handshake-timeout-ms MS (3000)]\n"
-                    "                [--max-lifetime SECONDS]\n"
-                    "  the secret comes from --secret-file or $SY_CLUSTER_SECRET; without one only loopback is allowed\n");
-            if (!help) fprintf(stderr, "sy serve: error: unknown or incomplete option '%s'\n", argv[i]);
-            return help ? 0 : 2;
+        {"max-peer-memory-mb", required_argument, NULL, O_PEER_MEMORY},
+        {"max-frame-kb", required_argument, NULL, O_FRAME_KB}, {"max-message-mb", required_argument, NULL, O_MESSAGE_MB},
+        {"max-unauthenticated", required_argument, NULL, O_UNAUTH},
+        {"handshake-timeout-ms", required_argument, NULL, O_HANDSHAKE}, {"help", no_argument, NULL, O_HELP},
+        {"quiet", no_argument, NULL, 'q'}, {"verbose", no_argument, NULL, 'v'}, {NULL, 0, NULL, 0}};
+    static const char usage_text[] =
+        "usage: sy serve [--listen tcp://HOST:PORT|tls+tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png]\n"
+        "                [--port-file F] [--tls-cert PEM --tls-key PEM] [--name NAME] [--max-sessions N]\n"
+        "                [--blob-cache-mb N (1024)] [--max-objects N per type (1048576)]\n"
+        "                [--auth-backoff-ms MS (250, doubled per failed authentication)]\n"
+        "                [--max-peer-memory-mb N (1024: all peers' messages in flight)]\n"
+        "                [--max-frame-kb N (8192, 64..1048576)] [--max-message-mb N (1024)]\n"
+        "                [--max-unauthenticated N (32)] [--handshake-timeout-ms MS (3000)]\n"
+        "                [--max-lifetime SECONDS] [-q | -v]\n"
+        "  the secret comes from --secret-file or $SY_CLUSTER_SECRET; without one only loopback is allowed\n";
+    int c;
+    optind = 0; /* glibc: start over (new arguments, GNU ordering) */
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":qv", lo, NULL)) != -1) {
+        const char *opt = argv[optind - 1];
+        bool ok = true;
+        switch (c) {
+        case O_LISTEN: o.listen_url = optarg; break;
+        case O_SECRET_FILE: secret_file = optarg; break;
+        case O_OUTPUT: pc.output = optarg; break;
+        case O_PORT_FILE: port_file = optarg; break;
+        case O_TLS_CERT: o.tls_cert_file = optarg; break;
+        case O_TLS_KEY: o.tls_key_file = optarg; break;
+        case O_NAME: o.name = optarg; break;
+        case O_MAX_SESSIONS: ok = uint_arg(optarg, 1, 65536, &v), o.max_sessions = (uint32_t)v; break;
+        case O_MAX_LIFETIME: {
+            char *end = NULL;
+            o.max_lifetime_s = strtod(optarg, &end);
+            ok = end != optarg && !*end && o.max_lifetime_s > 0 && isfinite(o.max_lifetime_s);
+            break;
         }
+        case O_BLOB_CACHE: ok = uint_arg(optarg, 1, 1u << 24, &v), o.blob_cache_bytes = (size_t)v << 20; break;
+        case O_MAX_OBJECTS: ok = uint_arg(optarg, 1, 1u << 30, &v), o.max_objects = (uint32_t)v; break;
+        case O_AUTH_BACKOFF: ok = uint_arg(optarg, 0, 3600000, &v), o.auth_backoff_ms = (uint32_t)v; break;
+        case O_PEER_MEMORY: ok = uint_arg(optarg, 1, 1u << 20, &v), o.max_peer_memory = (size_t)v << 20; break;
+        case O_FRAME_KB: ok = uint_arg(optarg, 64, 1u << 20, &v), o.max_frame = (size_t)v << 10; break;
+        case O_MESSAGE_MB: ok = uint_arg(optarg, 1, 1u << 20, &v), o.max_message = (size_t)v << 20; break;
+        case O_UNAUTH: ok = uint_arg(optarg, 1, 65536, &v), o.max_unauthenticated = (uint32_t)v; break;
+        case O_HANDSHAKE: ok = uint_arg(optarg, 100, 600000, &v), o.handshake_timeout_ms = (uint32_t)v; break;
+        case 'q': sy_log_set_level(SY_LOG_ERROR); break;
+        case 'v': sy_log_set_level(SY_LOG_DEBUG); break;
+        case O_HELP: fputs(usage_text, stdout); return 0;
+        case ':': fprintf(stderr, "sy serve: error: option '%s' needs a value\n%s", opt, usage_text); return 2;
+        default:
+            if (optopt >= 0x100) fprintf(stderr, "sy serve: error: option '%s' takes no value\n%s", opt, usage_text);
+            else if (optopt) fprintf(stderr, "sy serve: error: unknown option '-%c'\n%s", optopt, usage_text);
+            else fprintf(stderr, "sy serve: error: unknown option '%s'\n%s", opt, usage_text);
+            return 2;
+        }
+        if (!ok) {
+            char name[48];
+            fprintf(stderr, "sy serve: error: %s: '%s' is not an accepted value\n", opt_label(lo, c, name), optarg);
+            return 2;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "sy serve: error: unexpected argument '%s' (sy serve takes options only)\n%s", argv[optind], usage_text);
+        return 2;
     }
     if (pc.output && !has_suffix(pc.output, ".exr") && !has_suffix(pc.output, ".png")) {
         fprintf(stderr, "sy serve: error: %s: --output must end in .exr or .png\n", pc.output);
@@ -164,55 +212,25 @@ int sy_cmd_serve(int argc, char **argv)
 }
 
 /* ---- sy render --cluster ---- */
-bool sy_cluster_cli_requested(int argc, char **argv)
+bool sy_cluster_cli_getopt(int c, const char *v, sy_cluster_cli_opts *o)
 {
-    for (int i = 0; i + 1 < argc; ++i)
-        if (!strcmp(argv[i], "--cluster")) return true;
-    return false;
-}
-
-bool sy_cluster_cli_option(int argc, char **argv, int *i, sy_cluster_cli_opts *o, bool *bad)
-{
-    const char *a = argv[*i];
-    bool has = *i + 1 < argc;
-    if (!strcmp(a, "--cluster-pixels")) { /* float (bit-exact) | half (binary16 tiles) */
-        if (!has || (strcmp(argv[*i + 1], "float") && strcmp(argv[*i + 1], "half"))) *bad = true;
-        else o->half_pixels = !strcmp(argv[*i + 1], "half");
-        *i += has;
+    unsigned long long n = 0;
+    uint32_t m;
+    switch (c) {
+    case SY_CLUSTER_OPT_CLUSTER: o->cluster = v; return true;
+    case SY_CLUSTER_OPT_MODE: o->mode = v; return sy_cluster_mode_parse(v, &m);
+    case SY_CLUSTER_OPT_SECRET_FILE: o->secret_file = v; return true;
+    case SY_CLUSTER_OPT_TLS_CA: o->tls_ca = v; return true;
+    case SY_CLUSTER_OPT_TIMEOUT_MS:
+        if (!uint_arg(v, 1, 100000000ull, &n)) return false;
+        o->timeout_ms = (uint32_t)n;
         return true;
-    }
-    const char *names[] = {"--cluster", "--cluster-mode", "--secret-file", "--tls-ca", "--timeout-ms", "--frames", "--spp"};
-    int which = -1;
-    for (int k = 0; k < 7; ++k)
-        if (!strcmp(a, names[k])) which = k;
-    if (which < 0) return false;
-    if (!has) {
-        *bad = true;
+    case SY_CLUSTER_OPT_PIXELS: /* float (bit-exact) | half (binary16 tiles) */
+        if (strcmp(v, "float") && strcmp(v, "half")) return false;
+        o->half_pixels = !strcmp(v, "half");
         return true;
+    default: return false;
     }
-    const char *v = argv[++*i];
-    char *end = NULL;
-    unsigned long n = 0;
-    if (which >= 4) {
-        errno = 0;
-        n = strtoul(v, &end, 10);
-        if (errno || end == v || *end || n < 1 || n > 100000000ul) *bad = true;
-    }
-    switch (which) {
-    case 0: o->cluster = v; break;
-    case 1: {
-        uint32_t m;
-        if (!sy_cluster_mode_parse(v, &m)) *bad = true;
-        o->mode = v;
-        break;
-    }
-    case 2: o->secret_file = v; break;
-    case 3: o->tls_ca = v; break;
-    case 4: o->timeout_ms = (uint32_t)n; break;
-    case 5: o->frames = (uint32_t)n; break;
-    default: o->samples = (uint32_t)n; break;
-    }
-    return true;
 }
 
 /* Parses the four values of a configuration line's `tile X Y W H` (tok[0..3]). */
@@ -379,6 +397,14 @@ sy_result sy_cluster_cli_setup(const sy_cluster_cli_opts *o, const char *backend
     cli_client_opts_free(&c);
     return r;
 }
+
+void sy_cluster_cli_last_frame(const sy_context *ctx, sy_cluster_frame_stats *stats, uint32_t *mode)
+{
+    sy_mediator_cluster_last_frame(sy_context_state(ctx), stats);
+    if (mode) sy_mediator_cluster_describe(sy_context_state(ctx), mode, NULL);
+}
+
+const char *sy_cluster_cli_mode_name(uint32_t mode) { return sy_cluster_mode_name(mode); }
 
 sy_result sy_cluster_cli_params(const sy_cluster_cli_opts *o, const char *backend, uint32_t mode, const char *params,
                                 char *out, size_t len, sy_error *err)
@@ -879,7 +905,7 @@ static sy_result bench_hostile(sy_scene *scene, const sy_demo_info *d, const cha
 
 
 /* >>scale: per-frame protocol cost and bytes on the wire, 1-3 servers, sort-first / balanced /
- * cooperative at 1080p and 4K, against the scaling model of docs/ARCHITECTURE.md ("Scaling model").
+ * cooperative at 1080p and 4K, against the scaling model of docs/CLUSTER.md ("Scaling model").
  * Every server renders on one core (raster: LP_NUM_THREADS=1; path tracer: threads=1), so 2
  * servers use this machine's 2 cores and 3 are oversubscribed (stated in the output). The protocol
  * cost of a frame is the client's time beyond the slowest server's sync + render:
@@ -1029,19 +1055,46 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     uint32_t w = 1920, h = 1080, rounds = 3;
     bool hostile_only = false, coop_only = false, scale = false; /* one measurement alone */
     double coop_frame = 1.6; /* cooperative: seconds per frame on one server (each frame costs ~15 ms of sync + merge) */
-    for (int i = 0; i < argc; ++i) {
-        if (!strcmp(argv[i], "-w") && i + 1 < argc) w = (uint32_t)strtoul(argv[++i], NULL, 10);
-        else if (!strcmp(argv[i], "-h") && i + 1 < argc) h = (uint32_t)strtoul(argv[++i], NULL, 10);
-        else if (!strcmp(argv[i], "--repeats") && i + 1 < argc) rounds = (uint32_t)strtoul(argv[++i], NULL, 10);
-        else if (!strcmp(argv[i], "--hostile-only")) hostile_only = true;
-        else if (!strcmp(argv[i], "--coop-only")) coop_only = true;
-        else if (!strcmp(argv[i], "--scale")) scale = true;
-        else if (!strcmp(argv[i], "--coop-frame") && i + 1 < argc) coop_frame = strtod(argv[++i], NULL);
-        else {
-            fprintf(stderr, "usage: sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only | --coop-only] "
-                            "[--coop-frame SECONDS] | --scale\n");
+    static const char usage_text[] = "usage: sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only | --coop-only] "
+                                     "[--coop-frame SECONDS] | --scale\n";
+    enum { O_REPEATS = 0x100, O_HOSTILE, O_COOP, O_SCALE, O_COOP_FRAME, O_HELP };
+    static const struct option lo[] = {
+        {"repeats", required_argument, NULL, O_REPEATS}, {"hostile-only", no_argument, NULL, O_HOSTILE},
+        {"coop-only", no_argument, NULL, O_COOP}, {"scale", no_argument, NULL, O_SCALE},
+        {"coop-frame", required_argument, NULL, O_COOP_FRAME}, {"help", no_argument, NULL, O_HELP},
+        {"quiet", no_argument, NULL, 'q'}, {"verbose", no_argument, NULL, 'v'}, {NULL, 0, NULL, 0}};
+    int opt;
+    unsigned long long v = 0;
+    optind = 0; /* glibc: start over (new arguments, GNU ordering) */
+    opterr = 0;
+    while ((opt = getopt_long(argc, argv, ":w:h:qv", lo, NULL)) != -1) {
+        bool ok = true;
+        char *end = NULL;
+        switch (opt) {
+        case 'w': ok = uint_arg(optarg, 1, 16384, &v), w = (uint32_t)v; break;
+        case 'h': ok = uint_arg(optarg, 1, 16384, &v), h = (uint32_t)v; break;
+        case O_REPEATS: ok = uint_arg(optarg, 1, 100, &v), rounds = (uint32_t)v; break;
+        case O_HOSTILE: hostile_only = true; break;
+        case O_COOP: coop_only = true; break;
+        case O_SCALE: scale = true; break;
+        case O_COOP_FRAME: coop_frame = strtod(optarg, &end), ok = end != optarg && !*end; break;
+        case 'q': sy_log_set_level(SY_LOG_ERROR); break;
+        case 'v': sy_log_set_level(SY_LOG_DEBUG); break;
+        case O_HELP: fputs(usage_text, stdout); return 0;
+        case ':': fprintf(stderr, "sy bench cluster: error: option '%s' needs a value\n%s", argv[optind - 1], usage_text); return 2;
+        default:
+            fprintf(stderr, "sy bench cluster: error: unknown option '%s'\n%s", argv[optind - 1], usage_text);
             return 2;
         }
+        if (!ok) {
+            char name[48];
+            fprintf(stderr, "sy bench cluster: error: %s: '%s' is not an accepted value\n", opt_label(lo, opt, name), optarg);
+            return 2;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "sy bench cluster: error: unexpected argument '%s'\n%s", argv[optind], usage_text);
+        return 2;
     }
     if (w < 1 || h < 1 || w > 16384 || h > 16384 || rounds < 1 || rounds > 100 || !(coop_frame >= 0.05 && coop_frame <= 60)) {
         fprintf(stderr, "sy bench cluster: error: sizes 1..16384, --repeats 1..100, --coop-frame 0.05..60\n");
@@ -1168,7 +1221,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
                    lat_n, lat_min * 1e3, lat_sum / lat_n * 1e3, frame_sum / lat_n * 1e3);
         sy_layer_destroy(&tiny);
     }
-    /* codec constants for the scaling model (docs/ARCHITECTURE.md): compression and decompression
+    /* codec constants for the scaling model (docs/CLUSTER.md): compression and decompression
      * throughput of the final frame's pixels (RGBA + depth float32) on this core */
     if (r == SY_OK) {
         sy_cluster_buf enc = {0};

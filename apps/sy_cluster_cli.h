@@ -1,6 +1,7 @@
 /* sy_cluster_cli.h — the cluster parts of the `sy` tool: `sy serve` (a render server),
  * the `--cluster ...` options of `sy render` and `sy view`, and `sy bench cluster`. Built on
- * mediators/cluster/ (sy_cluster.h, sy_mediator_cluster.h).
+ * mediators/cluster/ (sy_cluster.h, sy_mediator_cluster.h) by sy_cluster_cli.c; a build without
+ * the cluster compiles sy_cluster_cli_off.c instead, whose entry points say so.
  * Thread-safety: command-line entry points, single-threaded callers. */
 #ifndef SY_CLUSTER_CLI_H
 #define SY_CLUSTER_CLI_H
@@ -8,10 +9,14 @@
 #include "sy_cluster.h"
 #include "sy_viewport.h"
 
+#include <getopt.h>
+
 /* sy serve [--listen URL] [--secret-file F] [--output PATH] [--port-file F] [--tls-cert F --tls-key F]
  *          [--max-sessions N] [--max-lifetime S] [--name NAME] [--blob-cache-mb N] [--max-objects N]
  *          [--auth-backoff-ms MS] [--max-peer-memory-mb N] [--max-frame-kb N] [--max-message-mb N]
- *          [--max-unauthenticated N] [--handshake-timeout-ms MS] */
+ *          [--max-unauthenticated N] [--handshake-timeout-ms MS] [-q | -v] [--help]
+ * argv[0] is the command's name ("serve"); the options are parsed with getopt_long (a bad option or
+ * value: named on stderr, 2). */
 int sy_cmd_serve(int argc, char **argv);
 
 /* Options of `sy render` that select cluster rendering. Zero-initialise. */
@@ -23,7 +28,7 @@ typedef struct sy_cluster_cli_opts {
     uint32_t timeout_ms, frames, samples;
     uint32_t connect_timeout_ms; /* handshake deadline; 0 = the client's default */
     bool half_pixels;            /* --cluster-pixels half: binary16 tiles (default float: bit-exact) */
-    sy_cluster_log_fn log;       /* client log lines; NULL = stderr */
+    sy_cluster_log_fn log;       /* client log lines; NULL = sy_log (sy_log.h) */
     void *log_user;
     const uint8_t *secret;       /* non-NULL: this secret (the MPI job's), not secret_file */
     size_t secret_len;
@@ -38,12 +43,24 @@ sy_result sy_cluster_cli_mpi_start(sy_cluster_cli_opts *o, bool *served, sy_erro
  * nothing when MPI was not started. */
 void sy_cluster_cli_mpi_end(void);
 
-/* true when argv holds --cluster (the render goes to the cluster whatever the back-end). */
-bool sy_cluster_cli_requested(int argc, char **argv);
+/* The cluster options of sy render and sy view as getopt_long entries (their codes are
+ * SY_CLUSTER_OPT_*; --frames and --spp are each command's own): --cluster, --cluster-mode,
+ * --secret-file, --tls-ca, --timeout-ms, --cluster-pixels. */
+enum {
+    SY_CLUSTER_OPT_CLUSTER = 0x200, SY_CLUSTER_OPT_MODE, SY_CLUSTER_OPT_SECRET_FILE, SY_CLUSTER_OPT_TLS_CA,
+    SY_CLUSTER_OPT_TIMEOUT_MS, SY_CLUSTER_OPT_PIXELS
+};
+#define SY_CLUSTER_CLI_OPTIONS                                                                                         \
+    {"cluster", required_argument, NULL, SY_CLUSTER_OPT_CLUSTER},                                                      \
+    {"cluster-mode", required_argument, NULL, SY_CLUSTER_OPT_MODE},                                                    \
+    {"secret-file", required_argument, NULL, SY_CLUSTER_OPT_SECRET_FILE},                                              \
+    {"tls-ca", required_argument, NULL, SY_CLUSTER_OPT_TLS_CA},                                                        \
+    {"timeout-ms", required_argument, NULL, SY_CLUSTER_OPT_TIMEOUT_MS},                                                \
+    {"cluster-pixels", required_argument, NULL, SY_CLUSTER_OPT_PIXELS}
 
-/* If argv[*i] is a cluster option, consumes it (and its value: *i advances) and returns true.
- * Returns false for other options; sets *bad when the value is missing or invalid. */
-bool sy_cluster_cli_option(int argc, char **argv, int *i, sy_cluster_cli_opts *o, bool *bad);
+/* Applies the cluster option with code c (SY_CLUSTER_OPT_*) and its value to *o; false when the value
+ * is not accepted (the caller names it) or c is not a cluster option. */
+bool sy_cluster_cli_getopt(int c, const char *value, sy_cluster_cli_opts *o);
 
 /* `sy render --cluster` and `sy view --cluster`: registers the cluster mediator class (SY_MEDIATOR_CLUSTER_NAME) from the
  * options and writes the viewport parameters that select it into params_out:
@@ -58,9 +75,15 @@ sy_result sy_cluster_cli_setup(const sy_cluster_cli_opts *o, const char *backend
 sy_result sy_cluster_cli_params(const sy_cluster_cli_opts *o, const char *backend, uint32_t mode, const char *params,
                                 char *out, size_t len, sy_error *err);
 
+/* The cluster mediator's statistics of its last frame and its configured mode (mode may be NULL);
+ * ctx is a context of the cluster class (caps SY_CAP_REMOTE). */
+void sy_cluster_cli_last_frame(const sy_context *ctx, sy_cluster_frame_stats *stats, uint32_t *mode);
+/* The name of a cluster mode (sy_cluster_mode_name). */
+const char *sy_cluster_cli_mode_name(uint32_t mode);
+
 /* sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only]: sizes, overhead, latency, codec,
  * a server's memory and a client's frame time under 72 hostile unauthenticated connections,
- * cooperative speed-up (--hostile-only: the hostile measurement alone) */
+ * cooperative speed-up (--hostile-only: the hostile measurement alone). argv[0] is "cluster". */
 int sy_cmd_bench_cluster(int argc, char **argv);
 
 #endif /* SY_CLUSTER_CLI_H */

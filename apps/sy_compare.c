@@ -1,6 +1,7 @@
 /* sy_compare.c — renders every picture back-end side by side (see sy_compare.h). */
 #include "sy_compare.h"
 
+#include "sy_log.h"
 #include "sy_png.h"
 #include "sy_stats.h"
 
@@ -125,7 +126,7 @@ sy_result sy_compare_run(sy_scene *scene, const sy_viewport_desc *vd, const sy_c
         FT_Library ft = NULL;
         FT_Face face = NULL;
         if (img && (FT_Init_FreeType(&ft) || FT_New_Face(ft, SY_COMPARE_FONT, 0, &face) || FT_Set_Pixel_Sizes(face, 0, 13))) {
-            fprintf(stderr, "sy: warning: contact sheet without labels: cannot load the font %s\n", SY_COMPARE_FONT);
+            sy_log(SY_LOG_WARNING, "sy", SY_COMPARE_FONT, "contact sheet without labels: cannot load the font");
             face = NULL;
         }
         if (img && face) {

@@ -1,6 +1,8 @@
-/* sy_main.c — the `sy` command line tool: info, render, demo, bench, backends.
+/* sy_main.c — the `sy` command line tool: info, render, demo, compare, coverage, view, bench, backends, serve.
  *
- *   sy info SCENE                       JSON summary (counts, bounds) of a glTF file
+ *   sy [-q | -v] [--version | --help] COMMAND ...   -q: errors only, -v: debug messages (sy_log.h)
+ *   sy help [COMMAND], sy COMMAND --help            usage on stdout, exit status 0
+ *   sy info SCENE | IMAGE.exr           JSON summary (counts, bounds, warnings; an EXR's header)
  *   sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]
  *             [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]
  *             with -b pathtracer: [--spp N | --time SECONDS] [--aov]
@@ -15,14 +17,18 @@
  *   sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params k=v,...]
  *   sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]
  *   sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]
- *   sy backends                         list registered back-ends
+ *   sy backends [--params] [--json]     list registered back-ends (--params: their parameters)
  *   sy serve [--listen URL] [--secret-file F] [--output OUT]   render server (apps/sy_cluster_cli.c)
  *   sy render ... --cluster URL[,URL...]|FILE.conf [--cluster-mode MODE]   render on servers
  *   sy view ... --cluster URL[,URL...]|FILE.conf [--cluster-mode MODE]     the viewer on servers
  *   sy bench cluster [-w W] [-h H] [--repeats ROUNDS]
  *
- * SCENE is a .gltf / .glb / .x3d file or the word "demo" (the built-in scene). Errors go to stderr with
- * the file and the reason; the exit code is non-zero (1 = usage, 2 = failure). */
+ * SCENE is a .gltf / .glb / .x3d file or the word "demo" (the built-in scene). Options are parsed with
+ * getopt_long (GNU ordering: options and operands in any order; --name=value; "--" ends the options);
+ * -q / -v and the world and loader flags are accepted before and after the command. JSON output is
+ * written with cJSON. Warnings, notes and errors go to stderr through the library's log (sy_log.h) with
+ * the file and the reason. Exit status: 0 success, 1 failure, 2 usage error (the bad option or value
+ * is named), 130 interrupted. Bash completion: apps/sy-completion.bash. */
 #include "sy_bench.h"
 #include "sy_cluster_cli.h"
 #include "sy_mediator_cluster.h"
@@ -35,7 +41,10 @@
 #include "sy_exr.h"
 #include "sy_world.h"
 #include "sy_gltf.h"
-#include "sy_mediator_rt.h"
+#include "sy_log.h"
+#ifdef SY_HAVE_EMBREE
+#include "sy_mediator_rt.h" /* sy coverage */
+#endif
 #include "sy_mediators.h"
 #include "sy_png.h"
 #include "sy_sniff.h"
@@ -43,7 +52,9 @@
 #include "sy_viewport.h"
 #include "sy_x3d.h"
 
+#include <cJSON.h>
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -134,46 +145,128 @@ static bool parse_floats(const char *text, float *out, int min_n, int max_n, int
     return n >= min_n && *p && p[strlen(p) - 1] != ',';
 }
 
-static sy_result parse_world_flag(int argc, char **argv, sy_world_options *w, int *used, sy_error *err)
+/* >>options: every command parses its options with getopt_long (GNU ordering: options and operands
+ * in any order, "--" ends the options, --name=value and unambiguous abbreviations accepted). The
+ * options every command takes (the world and loader flags, -q / -v, --help) are applied by
+ * next_option; a command's own ones come back to it. */
+enum {
+    OPT_STOP = -2, /* next_option: the command ends with *status (after --help or a usage error) */
+    OPT_HELP = 0x100, OPT_VERSION, OPT_ENV, OPT_ENV_COLOR, OPT_ENV_INTENSITY, OPT_ENV_HIDDEN, OPT_BACKGROUND,
+    OPT_NO_DEFAULT_LIGHT, OPT_ALLOW_PATH, OPT_STRICT,
+    /* the commands' own long options (cluster ones: SY_CLUSTER_OPT_*, sy_cluster_cli.h) */
+    OPT_SPP, OPT_TIME, OPT_AOV, OPT_CAMERA, OPT_PARAMS, OPT_GL, OPT_FILTER, OPT_THRESHOLD, OPT_HALF, OPT_EXPOSURE,
+    OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
+    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON
+};
+/* getopt_long entries of the options of every command, with the table's terminator: the end of
+ * every command's table */
+#define COMMON_OPTIONS                                                                                     \
+    {"help", no_argument, NULL, OPT_HELP}, {"quiet", no_argument, NULL, 'q'},                              \
+    {"verbose", no_argument, NULL, 'v'}, {"env", required_argument, NULL, OPT_ENV},                        \
+    {"env-color", required_argument, NULL, OPT_ENV_COLOR},                                                 \
+    {"env-intensity", required_argument, NULL, OPT_ENV_INTENSITY},                                         \
+    {"env-hidden", no_argument, NULL, OPT_ENV_HIDDEN}, {"background", required_argument, NULL, OPT_BACKGROUND}, \
+    {"no-default-light", no_argument, NULL, OPT_NO_DEFAULT_LIGHT},                                         \
+    {"allow-path", required_argument, NULL, OPT_ALLOW_PATH}, {"strict", no_argument, NULL, OPT_STRICT},    \
+    {NULL, 0, NULL, 0}
+/* short options: ':' first (a missing value is told apart from an unknown option), then -q and -v */
+#define SHORT_OPTIONS(own) ":" own "qv"
+
+static void usage_to(FILE *f, const char *cmd);
+
+/* The world flags (only maps text onto sy_world_options; the meaning is the library's: sy_look.h,
+ * sy_world.h). */
+static sy_result apply_world_option(int c, const char *v, sy_world_options *w, sy_error *err)
 {
-    const char *a = argv[0], *v = argc > 1 ? argv[1] : NULL;
     int n = 0;
-    *used = 0;
-    if (!strcmp(a, "--env-hidden")) w->env_hidden = true, *used = 1;
-    else if (!strcmp(a, "--no-default-light")) w->no_default_light = true, *used = 1;
-    else if (!strcmp(a, "--env") || !strcmp(a, "--env-color") || !strcmp(a, "--env-intensity") ||
-             !strcmp(a, "--background")) {
-        if (!v) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: missing value", a);
-        *used = 2;
-        if (!strcmp(a, "--env")) {
-            w->env_path = v;
-        } else if (!strcmp(a, "--env-color")) {
-            if (!parse_floats(v, w->env_color, 3, 3, &n))
-                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--env-color %s: expected R,G,B", v);
-            w->has_env_color = true;
-        } else if (!strcmp(a, "--env-intensity")) {
-            if (!parse_floats(v, &w->env_intensity, 1, 1, &n))
-                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--env-intensity %s: expected a number", v);
-            w->env_intensity_set = true;
-        } else {
-            if (!parse_floats(v, w->background, 3, 4, &n))
-                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--background %s: expected R,G,B or R,G,B,A", v);
-            if (n == 3) w->background[3] = 1.0f;
-            w->has_background = true;
-        }
+    switch (c) {
+    case OPT_ENV_HIDDEN: w->env_hidden = true; break;
+    case OPT_NO_DEFAULT_LIGHT: w->no_default_light = true; break;
+    case OPT_ENV: w->env_path = v; break;
+    case OPT_ENV_COLOR:
+        if (!parse_floats(v, w->env_color, 3, 3, &n))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--env-color %s: expected R,G,B", v);
+        w->has_env_color = true;
+        break;
+    case OPT_ENV_INTENSITY:
+        if (!parse_floats(v, &w->env_intensity, 1, 1, &n))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--env-intensity %s: expected a number", v);
+        w->env_intensity_set = true;
+        break;
+    default: /* OPT_BACKGROUND */
+        if (!parse_floats(v, w->background, 3, 4, &n))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--background %s: expected R,G,B or R,G,B,A", v);
+        if (n == 3) w->background[3] = 1.0f;
+        w->has_background = true;
     }
     return SY_OK;
 }
 
-/* Prints what the loader skipped or repaired (sy: warning: FILE: item: what); with --strict any of
- * them fails the load. */
-static sy_result report_warnings(const char *path, char **warnings, uint32_t stored, uint32_t total, sy_error *err)
+/* The next option of a command's arguments (argv[0]: the command's name, for messages; cmd: the
+ * command as `sy help` names it, NULL for sy's own options). Call with optind = 0 first (glibc's way
+ * to start over with new arguments and a new ordering). Returns the option's code, -1 after the last
+ * option (the operands are argv[optind..argc-1]), or OPT_STOP with *status: 0 after --help (the
+ * command's usage on stdout), 2 after a usage error (named on stderr). */
+static int next_option(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *longopts,
+                       int *status)
 {
-    size_t plen = strlen(path);
-    for (uint32_t i = 0; i < stored; ++i) /* X3D's warnings name the file (and line) themselves */
-        if (!strncmp(warnings[i], path, plen)) fprintf(stderr, "sy: warning: %s\n", warnings[i]);
-        else fprintf(stderr, "sy: warning: %s: %s\n", path, warnings[i]);
-    if (total > stored) fprintf(stderr, "sy: warning: %s: %u more warnings not shown\n", path, total - stored);
+    opterr = 0; /* the messages are ours */
+    const char *who = cmd ? cmd : "sy";
+    for (;;) {
+        int c = getopt_long(argc, argv, shortopts, longopts, NULL);
+        const char *bad = optind > 0 && optind <= argc ? argv[optind - 1] : "";
+        sy_error e = {0};
+        switch (c) {
+        case '?':
+            if (optopt >= 0x100) fprintf(stderr, "sy %s: error: option '%s' takes no value", who, bad);
+            else if (optopt) fprintf(stderr, "sy %s: error: unknown option '-%c'", who, optopt);
+            else fprintf(stderr, "sy %s: error: unknown option '%s'", who, bad);
+            fprintf(stderr, " (sy %s%s--help lists the options)\n", cmd ? cmd : "", cmd ? " " : "");
+            *status = 2;
+            return OPT_STOP;
+        case ':':
+            fprintf(stderr, "sy %s: error: option '%s' needs a value\n", who, bad);
+            *status = 2;
+            return OPT_STOP;
+        case OPT_HELP:
+            usage_to(stdout, cmd);
+            *status = 0;
+            return OPT_STOP;
+        case 'q': sy_log_set_level(SY_LOG_ERROR); break;
+        case 'v': sy_log_set_level(SY_LOG_DEBUG); break;
+        case OPT_STRICT: g_load.strict = true; break;
+        case OPT_ALLOW_PATH: { /* repeatable: more folders that a model's external files may lie in */
+            struct stat st;
+            if (stat(optarg, &st) != 0 || !S_ISDIR(st.st_mode)) {
+                fprintf(stderr, "sy: error: --allow-path %s: expected an existing folder\n", optarg);
+                *status = 2;
+                return OPT_STOP;
+            }
+            if (g_load.root_count == SY_MAX_ALLOW_PATHS) {
+                fprintf(stderr, "sy: error: --allow-path: at most %d folders\n", SY_MAX_ALLOW_PATHS);
+                *status = 2;
+                return OPT_STOP;
+            }
+            g_load.roots[g_load.root_count++] = optarg;
+            break;
+        }
+        case OPT_ENV: case OPT_ENV_COLOR: case OPT_ENV_INTENSITY: case OPT_ENV_HIDDEN: case OPT_BACKGROUND:
+        case OPT_NO_DEFAULT_LIGHT:
+            if (apply_world_option(c, optarg, &g_load.world, &e) != SY_OK) {
+                fprintf(stderr, "sy: error: %s\n", e.message);
+                *status = 2;
+                return OPT_STOP;
+            }
+            break;
+        default: return c;
+        }
+    }
+}
+
+/* What the loader skipped or repaired is on the log already (the loaders report it through sy_log:
+ * sy: warning: FILE: item: what); with --strict any of it fails the load. */
+static sy_result report_warnings(const char *path, uint32_t total, sy_error *err)
+{
     if (g_load.strict && total)
         return sy_error_set(err, SY_ERR_PARSE, "%s: %u warning%s and --strict given; nothing rendered", path, total,
                             total == 1 ? "" : "s");
@@ -199,6 +292,7 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
 {
     memset(out, 0, sizeof *out);
     sy_file_format fmt = SY_FORMAT_UNKNOWN;
+    double t0 = sy_time_now();
     sy_result r = sy_scene_create(&out->scene, err);
     if (r != SY_OK) return r;
     if (strcmp(path, "demo") == 0) {
@@ -219,7 +313,7 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
         sy_x3d_options xo = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count};
         r = sy_x3d_load(path, out->scene, &xo, &out->x3d, err);
         if (r == SY_OK)
-            r = report_warnings(path, out->x3d.warnings, out->x3d.stored_warning_count, out->x3d.warning_count, err);
+            r = report_warnings(path, out->x3d.warning_count, err);
         if (r == SY_OK) {
             out->root = out->x3d.root;
             out->background = out->x3d.background;
@@ -232,7 +326,7 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
         sy_gltf_options go = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count};
         r = sy_gltf_load(path, out->scene, &go, &out->gltf, err);
         if (r == SY_OK)
-            r = report_warnings(path, out->gltf.warnings, out->gltf.stored_warning_count, out->gltf.warning_count, err);
+            r = report_warnings(path, out->gltf.warning_count, err);
         if (r == SY_OK) {
             out->root = out->gltf.root;
             if (camera_sel) r = sy_gltf_find_camera(out->scene, &out->gltf, camera_sel, &out->camera, err);
@@ -247,6 +341,11 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
         (r = sy_world_apply(out->scene, &out->background, &g_load.world, err)) == SY_OK)
         r = sy_scene_commit(out->scene, NULL, err);
     if (r != SY_OK) loaded_free(out);
+    else
+        sy_log(SY_LOG_DEBUG, "sy", path, "loaded in %.3f s: %u nodes, %u meshes, %u materials, %u lights, %u cameras",
+               sy_time_now() - t0, sy_scene_count(out->scene, SY_TYPE_NODE), sy_scene_count(out->scene, SY_TYPE_MESH),
+               sy_scene_count(out->scene, SY_TYPE_MATERIAL), sy_scene_count(out->scene, SY_TYPE_LIGHT),
+               sy_scene_count(out->scene, SY_TYPE_CAMERA));
     return r;
 }
 
@@ -256,7 +355,7 @@ static void fit_x3d_cameras(loaded *ld, uint32_t w, uint32_t h)
     sy_error e = {0};
     if (sy_x3d_fit_cameras(ld->scene, &ld->x3d, (float)w / (float)h, &e) != SY_OK ||
         sy_scene_commit(ld->scene, NULL, &e) != SY_OK)
-        fprintf(stderr, "sy: warning: viewpoint field of view not adapted: %s\n", e.message);
+        sy_log(SY_LOG_WARNING, "sy", NULL, "viewpoint field of view not adapted: %s", e.message);
 }
 
 /* >>progress (terminal only) */
@@ -454,18 +553,21 @@ static sy_result write_aov_exr(const char *path, sy_context *ctx, const out_opts
 /* >>commands */
 static int fail(const sy_error *e)
 {
-    fprintf(stderr, "sy: error: %s\n", e->message);
+    sy_log(SY_LOG_ERROR, "sy", NULL, "%s", e->message);
     return 1;
 }
 
-/* The command summary, to stdout for --help (exit 0) or stderr after a usage error (exit 2). */
-static void usage_to(FILE *f)
-{
-    fprintf(f,
+/* The command summary, to stdout for --help (exit 0) or stderr after a usage error (exit 2). An entry
+ * is a line "  sy COMMAND ..." and the deeper-indented lines after it; the lines from "SCENE:" on
+ * are for every command. */
+static const char usage_text[] =
             "usage:\n"
+            "  sy [-q | -v] COMMAND [ARGS]          -q (--quiet): errors only; -v (--verbose): debug messages too\n"
+            "                                       (also accepted after COMMAND)\n"
             "  sy --version | sy version            the Switchyard version\n"
-            "  sy --help | sy help [COMMAND]        this summary (on stdout)\n"
-            "  sy info SCENE\n"
+            "  sy --help | sy help [COMMAND]        this summary (on stdout); sy COMMAND --help: the command's\n"
+            "  sy info SCENE | IMAGE.exr            JSON summary: counts, bounds, warnings; an EXR's size, channels\n"
+            "                                       and header attributes\n"
             "  sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]\n"
             "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]\n"
             "            [--gl osmesa|egl|glfw]   (-b raster: the GL context provider)\n"
@@ -490,7 +592,7 @@ static void usage_to(FILE *f)
             "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
             "  sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]\n"
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
-            "  sy backends\n"
+            "  sy backends [--params] [--json]\n"
             "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
             "  sy render SCENE -b BACKEND -o OUT --cluster URL[,URL...]|FILE.conf\n"
             "            [--cluster-mode sort-first|balanced|cooperative|multi-display|stereo] [--secret-file F]\n"
@@ -502,13 +604,49 @@ static void usage_to(FILE *f)
             "  the camera sees where nothing is hit; a scene with no light of its own is lit by a neutral studio\n"
             "  environment unless --no-default-light is given\n"
             "exit status: 0 success, 1 failure (the error names the file, peer or value), 2 usage error,\n"
-            "  130 interrupted\n");
+            "  130 interrupted\n"
+            "bash completion: source apps/sy-completion.bash\n";
+
+/* The summary (cmd NULL) or the entries of one command ("render", "bench", "bench sync") and the
+ * common part. */
+static void usage_to(FILE *f, const char *cmd)
+{
+    if (!cmd) {
+        fputs(usage_text, f);
+        return;
+    }
+    char want[64];
+    snprintf(want, sizeof want, "  sy %s ", cmd);
+    bool in = false, footer = false;
+    for (const char *l = usage_text; *l;) {
+        const char *nl = strchr(l, '\n');
+        size_t n = nl ? (size_t)(nl - l) + 1 : strlen(l);
+        if (!strncmp(l, "usage:", 6)) in = true;                          /* the heading */
+        else if (!strncmp(l, "  sy ", 5)) in = !strncmp(l, want, strlen(want)); /* an entry */
+        else if (strncmp(l, "   ", 3) != 0 && strncmp(l, "  ", 2) != 0) footer = true; /* SCENE:, world options... */
+        if (in || footer) fwrite(l, 1, n, f);
+        l += n;
+    }
 }
 
-static int usage(void)
+/* A usage error without a named option (an operand missing): the command's usage on stderr, 2. */
+static int usage_of(const char *cmd, const char *what)
 {
-    usage_to(stderr);
+    if (what) fprintf(stderr, "sy %s: error: %s\n", cmd, what);
+    usage_to(stderr, cmd);
     return 2;
+}
+
+/* "--name" of a long option's code in a getopt_long table (for messages). */
+static const char *option_name(const struct option *lo, int c)
+{
+    static char buf[64];
+    for (; lo->name; ++lo)
+        if (lo->val == c && !lo->flag) {
+            snprintf(buf, sizeof buf, "--%s", lo->name);
+            return buf;
+        }
+    return "an option";
 }
 
 /* A usage error naming the option and the value it did not accept. */
@@ -528,16 +666,95 @@ static bool parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
     return true;
 }
 
-static void json_string(FILE *f, const char *s)
+/* >>json: the JSON that commands print is built and written by cJSON. jadd adds an item to an object
+ * (key) or an array (key NULL); a failed allocation is remembered and reported by print_json. */
+static bool g_json_failed;
+
+static cJSON *jadd(cJSON *parent, const char *key, cJSON *item)
 {
-    fputc('"', f);
-    for (; s && *s; ++s) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
-        else if (c < 0x20) fprintf(f, "\\u%04x", c);
-        else fputc(c, f);
+    if (item && parent && (key ? cJSON_AddItemToObject(parent, key, item) : cJSON_AddItemToArray(parent, item)))
+        return item;
+    cJSON_Delete(item);
+    g_json_failed = true;
+    return NULL;
+}
+
+/* a float as its shortest decimal that reads back as the same float (not the double's 17 digits) */
+static cJSON *jfloat(double v)
+{
+    char t[32];
+    snprintf(t, sizeof t, "%.9g", v);
+    return cJSON_CreateNumber(strtod(t, NULL));
+}
+
+static cJSON *jstr(const char *s) { return cJSON_CreateString(s ? s : ""); }
+
+/* The layout of sy's JSON (for people and grep; cJSON writes every key and value): the top level's
+ * members one per line, a nested value on one line ("key": value, ", " between items) unless it
+ * holds objects or is longer than JSON_LINE characters; then its members one per line. */
+#define JSON_LINE 160
+
+static bool json_write(FILE *f, const cJSON *v, int depth);
+
+static bool json_leaf(FILE *f, const cJSON *v) /* a string, number, bool or null: cJSON's text */
+{
+    char *t = cJSON_PrintUnformatted(v);
+    if (!t) return false;
+    fputs(t, f);
+    cJSON_free(t);
+    return true;
+}
+
+static bool json_members(FILE *f, const cJSON *v, int depth, bool broken)
+{
+    bool obj = cJSON_IsObject(v), ok = true;
+    fputc(obj ? '{' : '[', f);
+    for (const cJSON *c = v->child; c && ok; c = c->next) {
+        if (broken) fprintf(f, "%s\n%*s", c == v->child ? "" : ",", 2 * (depth + 1), "");
+        else if (c != v->child) fputs(", ", f);
+        if (obj) {
+            cJSON *key = cJSON_CreateString(c->string);
+            ok = key && json_leaf(f, key);
+            cJSON_Delete(key);
+            fputs(": ", f);
+        }
+        ok = ok && json_write(f, c, depth + 1);
     }
-    fputc('"', f);
+    if (broken && v->child) fprintf(f, "\n%*s", 2 * depth, "");
+    fputc(obj ? '}' : ']', f);
+    return ok;
+}
+
+static bool json_write(FILE *f, const cJSON *v, int depth)
+{
+    if (!cJSON_IsObject(v) && !cJSON_IsArray(v)) return json_leaf(f, v);
+    bool broken = depth == 0;
+    for (const cJSON *c = v->child; c && !broken; c = c->next) broken = cJSON_IsObject(c);
+    if (!broken) { /* one line if it is short */
+        char *line = NULL;
+        size_t len = 0;
+        FILE *m = open_memstream(&line, &len);
+        bool ok = m && json_members(m, v, depth, false);
+        if (m) fclose(m);
+        if (ok && len <= JSON_LINE) fputs(line, f);
+        free(line);
+        if (!ok) return false;
+        if (len <= JSON_LINE) return true;
+    }
+    return json_members(f, v, depth, true);
+}
+
+/* Writes doc to stdout and frees it; 1 when something failed (out of memory). */
+static int print_json(cJSON *doc)
+{
+    bool ok = doc && !g_json_failed && json_write(stdout, doc, 0);
+    cJSON_Delete(doc);
+    if (!ok) {
+        sy_log(SY_LOG_ERROR, "sy", NULL, "out of memory while writing JSON");
+        return 1;
+    }
+    fputc('\n', stdout);
+    return 0;
 }
 
 /* sy info IMAGE.exr: size, channels and the header's string attributes (what sy render records) as JSON. */
@@ -546,32 +763,37 @@ static int info_exr(const char *path)
     sy_error err = {0};
     sy_exr_image *img = NULL;
     if (sy_exr_read(path, &img, &err) != SY_OK) return fail(&err);
-    printf("{\n  \"file\": ");
-    json_string(stdout, path);
-    printf(",\n  \"width\": %d, \"height\": %d,\n  \"channels\": [", img->width, img->height);
-    for (int i = 0; i < img->channel_count; ++i) {
-        printf(i ? ", " : "");
-        json_string(stdout, img->channels[i].name);
-    }
-    printf("],\n  \"attributes\": {");
-    for (int i = 0; i < img->attribute_count; ++i) {
-        printf(i ? ",\n    " : "\n    ");
-        json_string(stdout, img->attributes[i].name);
-        printf(": ");
-        json_string(stdout, img->attributes[i].value);
-    }
-    printf("%s}\n}\n", img->attribute_count ? "\n  " : "");
+    cJSON *doc = cJSON_CreateObject();
+    jadd(doc, "file", jstr(path));
+    jadd(doc, "width", cJSON_CreateNumber(img->width));
+    jadd(doc, "height", cJSON_CreateNumber(img->height));
+    cJSON *ch = jadd(doc, "channels", cJSON_CreateArray());
+    for (int i = 0; i < img->channel_count; ++i) jadd(ch, NULL, jstr(img->channels[i].name));
+    cJSON *at = jadd(doc, "attributes", cJSON_CreateObject());
+    for (int i = 0; i < img->attribute_count; ++i) jadd(at, img->attributes[i].name, jstr(img->attributes[i].value));
     sy_exr_image_free(img);
-    return 0;
+    return print_json(doc);
+}
+
+/* counts of one kind of object in an info object */
+static void jcounts(cJSON *o, const char *const *names, const uint32_t *values, size_t n)
+{
+    for (size_t i = 0; i < n; ++i) jadd(o, names[i], cJSON_CreateNumber(values[i]));
 }
 
 static int cmd_info(int argc, char **argv)
 {
-    if (argc != 1) return usage();
-    if (ends_with(argv[0], ".exr")) return info_exr(argv[0]);
+    static const struct option lo[] = {{"json", no_argument, NULL, OPT_JSON}, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = next_option("info", argc, argv, SHORT_OPTIONS(""), lo, &status)) != -1)
+        if (c == OPT_STOP) return status; /* --json: the output is JSON anyway */
+    if (argc - optind != 1) return usage_of("info", argc == optind ? "a SCENE or IMAGE.exr is required" : "one file at a time");
+    const char *path = argv[optind];
+    if (ends_with(path, ".exr")) return info_exr(path);
     sy_error err = {0};
     loaded ld;
-    if (load(argv[0], NULL, false, &ld, &err) != SY_OK) return fail(&err);
+    if (load(path, NULL, false, &ld, &err) != SY_OK) return fail(&err);
     sy_bounds b;
     sy_node_world_bounds(ld.scene, ld.root, &b, NULL);
     /* counts of what was loaded into the scene (less the synthetic root node) */
@@ -581,36 +803,37 @@ static int cmd_info(int argc, char **argv)
         prims += m->primitives.count;
         for (uint32_t i = 0; i < m->primitives.count; ++i) tris += sy_primitive_triangle_count(&m->primitives.items[i]);
     }
-    printf("{\n  \"file\": ");
-    json_string(stdout, argv[0]);
+    cJSON *doc = cJSON_CreateObject();
+    jadd(doc, "file", jstr(path));
     if (ld.is_gltf) {
-        const sy_gltf_counts *c = &ld.gltf.counts;
-        printf(",\n  \"nodes\": %u,\n  \"meshes\": %u,\n  \"primitives\": %u,\n  \"triangles\": %u,\n"
-               "  \"materials\": %u,\n  \"textures\": %u,\n  \"images\": %u,\n  \"lights\": %u,\n  \"cameras\": %u",
-               c->nodes, c->meshes, c->primitives, c->triangles, c->materials, c->textures, c->images, c->lights,
-               c->cameras);
+        const sy_gltf_counts *gc = &ld.gltf.counts;
+        static const char *const names[] = {"nodes", "meshes", "primitives", "triangles", "materials",
+                                            "textures", "images", "lights", "cameras"};
+        const uint32_t v[] = {gc->nodes, gc->meshes, gc->primitives, gc->triangles, gc->materials,
+                              gc->textures, gc->images, gc->lights, gc->cameras};
+        jcounts(doc, names, v, 9);
     }
-    printf(",\n  \"loaded\": {\"nodes\": %u, \"meshes\": %u, \"primitives\": %u, \"triangles\": %u, \"materials\": %u, "
-           "\"textures\": %u, \"lights\": %u, \"cameras\": %u}",
-           sy_scene_count(ld.scene, SY_TYPE_NODE) - 1, sy_scene_count(ld.scene, SY_TYPE_MESH), prims, tris,
-           sy_scene_count(ld.scene, SY_TYPE_MATERIAL), sy_scene_count(ld.scene, SY_TYPE_TEXTURE),
-           sy_scene_count(ld.scene, SY_TYPE_LIGHT), sy_scene_count(ld.scene, SY_TYPE_CAMERA));
-    if (sy_bounds_is_empty(&b)) printf(",\n  \"bounds\": null");
-    else
-        printf(",\n  \"bounds\": {\"min\": [%.9g, %.9g, %.9g], \"max\": [%.9g, %.9g, %.9g]}", (double)b.min[0],
-               (double)b.min[1], (double)b.min[2], (double)b.max[0], (double)b.max[1], (double)b.max[2]);
-    printf(",\n  \"warnings\": [");
-    for (uint32_t i = 0; i < ld.gltf.stored_warning_count; ++i) {
-        printf(i ? ", " : "");
-        json_string(stdout, ld.gltf.warnings[i]);
+    static const char *const lnames[] = {"nodes", "meshes", "primitives", "triangles", "materials",
+                                         "textures", "lights", "cameras"};
+    const uint32_t lv[] = {sy_scene_count(ld.scene, SY_TYPE_NODE) - 1, sy_scene_count(ld.scene, SY_TYPE_MESH), prims,
+                           tris, sy_scene_count(ld.scene, SY_TYPE_MATERIAL), sy_scene_count(ld.scene, SY_TYPE_TEXTURE),
+                           sy_scene_count(ld.scene, SY_TYPE_LIGHT), sy_scene_count(ld.scene, SY_TYPE_CAMERA)};
+    jcounts(jadd(doc, "loaded", cJSON_CreateObject()), lnames, lv, 8);
+    if (sy_bounds_is_empty(&b)) {
+        jadd(doc, "bounds", cJSON_CreateNull());
+    } else {
+        cJSON *bo = jadd(doc, "bounds", cJSON_CreateObject());
+        cJSON *mn = jadd(bo, "min", cJSON_CreateArray()), *mx = jadd(bo, "max", cJSON_CreateArray());
+        for (int k = 0; k < 3; ++k) {
+            jadd(mn, NULL, jfloat((double)b.min[k]));
+            jadd(mx, NULL, jfloat((double)b.max[k]));
+        }
     }
-    for (uint32_t i = 0; i < ld.x3d.stored_warning_count; ++i) {
-        printf(i ? ", " : "");
-        json_string(stdout, ld.x3d.warnings[i]);
-    }
-    printf("]\n}\n");
+    cJSON *wa = jadd(doc, "warnings", cJSON_CreateArray());
+    for (uint32_t i = 0; i < ld.gltf.stored_warning_count; ++i) jadd(wa, NULL, jstr(ld.gltf.warnings[i]));
+    for (uint32_t i = 0; i < ld.x3d.stored_warning_count; ++i) jadd(wa, NULL, jstr(ld.x3d.warnings[i]));
     loaded_free(&ld);
-    return 0;
+    return print_json(doc);
 }
 
 /* NAME.EXT -> NAME_left.EXT and NAME_right.EXT */
@@ -644,7 +867,7 @@ static sy_result add_overlay(loaded *ld, const char *arg, const char *composite,
     sy_gltf_info info = {0};
     sy_gltf_options go = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count};
     sy_result r = sy_gltf_load(path, ld->scene, &go, &info, err);
-    if (r == SY_OK) r = report_warnings(path, info.warnings, info.stored_warning_count, info.warning_count, err);
+    if (r == SY_OK) r = report_warnings(path, info.warning_count, err);
     if (r == SY_OK) r = sy_scene_commit(ld->scene, NULL, err);
     if (r != SY_OK) {
         sy_gltf_info_free(&info);
@@ -689,16 +912,15 @@ static void cluster_report(sy_scene *scene, sy_context_pool *pool, const sy_comp
         return;
     sy_cluster_frame_stats st;
     uint32_t mode = 0;
-    sy_mediator_cluster_last_frame(sy_context_state(ctx), &st);
-    sy_mediator_cluster_describe(sy_context_state(ctx), &mode, NULL);
-    fprintf(stderr,
-            "sy render: cluster frame %u (%s): %u/%u servers, %u failed, %u reassigned, %.3f s, "
-            "%llu bytes sent (%llu scene), %llu received\n",
-            frame + 1, sy_cluster_mode_name(mode), st.servers_live, servers, st.servers_failed, st.reassigned,
-            st.seconds, (unsigned long long)st.bytes_sent, (unsigned long long)st.scene_bytes,
-            (unsigned long long)st.bytes_received);
+    sy_cluster_cli_last_frame(ctx, &st, &mode);
+    sy_log(SY_LOG_NOTE, "sy", NULL,
+           "cluster frame %u (%s): %u/%u servers, %u failed, %u reassigned, %.3f s, "
+           "%llu bytes sent (%llu scene), %llu received",
+           frame + 1, sy_cluster_cli_mode_name(mode), st.servers_live, servers, st.servers_failed, st.reassigned,
+           st.seconds, (unsigned long long)st.bytes_sent, (unsigned long long)st.scene_bytes,
+           (unsigned long long)st.bytes_received);
     if (mode == SY_CLUSTER_COOPERATIVE)
-        fprintf(stderr, "sy render: merged %llu samples per pixel\n", (unsigned long long)st.samples);
+        sy_log(SY_LOG_NOTE, "sy", NULL, "cluster: merged %llu samples per pixel", (unsigned long long)st.samples);
 }
 
 static int cmd_render(int argc, char **argv)
@@ -712,51 +934,82 @@ static int cmd_render(int argc, char **argv)
     sy_compose_spec spec = {.eye_separation = 0.065f, .zero_parallax = 2.0f};
     sy_error perr = {0};
     sy_cluster_cli_opts clo = {0};
-    bool clbad = false;
     pt_opts po = {0};
     bool progressive_opts = false; /* --spp / --time / --aov given */
-    for (int i = 0; i < argc; ++i) {
-        const char *a = argv[i];
-        bool has = i + 1 < argc;
+    static const struct option lo[] = {
+        {"spp", required_argument, NULL, OPT_SPP}, {"time", required_argument, NULL, OPT_TIME},
+        {"aov", no_argument, NULL, OPT_AOV}, {"camera", required_argument, NULL, OPT_CAMERA},
+        {"params", required_argument, NULL, OPT_PARAMS}, {"gl", required_argument, NULL, OPT_GL},
+        {"filter", required_argument, NULL, OPT_FILTER}, {"threshold", required_argument, NULL, OPT_THRESHOLD},
+        {"half", no_argument, NULL, OPT_HALF}, {"exposure", required_argument, NULL, OPT_EXPOSURE},
+        {"tonemap", required_argument, NULL, OPT_TONEMAP}, {"stereo", required_argument, NULL, OPT_STEREO},
+        {"eye-sep", required_argument, NULL, OPT_EYE_SEP}, {"zero-parallax", required_argument, NULL, OPT_ZERO_PARALLAX},
+        {"overlay", required_argument, NULL, OPT_OVERLAY}, {"composite", required_argument, NULL, OPT_COMPOSITE},
+        {"frames", required_argument, NULL, OPT_FRAMES}, /* cluster: frames through the same window */
+        SY_CLUSTER_CLI_OPTIONS, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = next_option("render", argc, argv, SHORT_OPTIONS("b:o:w:h:"), lo, &status)) != -1) {
         char *end = NULL;
-        if (!strcmp(a, "-b") && has) backend = argv[++i];
-        else if (!strcmp(a, "--spp") && has) {
-            if (!parse_u32(argv[++i], 1, 1u << 24, &po.spp)) return bad_value(argv[i - 1], argv[i]);
+        switch (c) {
+        case OPT_STOP: return status;
+        case 'b': backend = optarg; break;
+        case OPT_SPP:
+            if (!parse_u32(optarg, 1, 1u << 24, &po.spp)) return bad_value("--spp", optarg);
             progressive_opts = true;
-        } else if (!strcmp(a, "--time") && has) {
-            po.time_budget = strtod(argv[++i], &end);
-            if (*end || !(po.time_budget > 0) || !isfinite(po.time_budget)) return usage();
+            break;
+        case OPT_TIME:
+            po.time_budget = strtod(optarg, &end);
+            if (end == optarg || *end || !(po.time_budget > 0) || !isfinite(po.time_budget)) return bad_value("--time", optarg);
             progressive_opts = true;
-        } else if (!strcmp(a, "--aov")) po.aov = progressive_opts = true;
-        else if (!strcmp(a, "-o") && has) outp = argv[++i];
-        else if (!strcmp(a, "-w") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(a, "-h") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
-        else if (!strcmp(a, "--params") && has) params = argv[++i];
-        else if (!strcmp(a, "--gl") && has) gl_provider = argv[++i]; /* raster: gl=... parameter */
-        else if (!strcmp(a, "--filter") && has) filter = argv[++i];       /* pathtracer: filter=... */
-        else if (!strcmp(a, "--threshold") && has) threshold = argv[++i]; /* pathtracer: threshold=... */
-        else if (!strcmp(a, "--half")) oo.half = true;
-        else if (!strcmp(a, "--exposure") && has) oo.png.exposure_stops = strtof(argv[++i], NULL);
-        else if (!strcmp(a, "--tonemap") && has) {
-            const char *t = argv[++i];
-            oo.png.tonemap = !strcmp(t, "aces") ? SY_TONEMAP_ACES : !strcmp(t, "reinhard") ? SY_TONEMAP_REINHARD
-                                                                                           : SY_TONEMAP_CLAMP;
-        } else if (!strcmp(a, "--stereo") && has) {
-            if (sy_stereo_mode_parse(argv[++i], &spec.stereo, &perr) != SY_OK) return fail(&perr);
-        } else if (!strcmp(a, "--eye-sep") && has) spec.eye_separation = strtof(argv[++i], NULL);
-        else if (!strcmp(a, "--zero-parallax") && has) spec.zero_parallax = strtof(argv[++i], NULL);
-        else if (!strcmp(a, "--overlay") && has) overlay = argv[++i];
-        else if (!strcmp(a, "--composite") && has) composite = argv[++i];
-        else if (sy_cluster_cli_option(argc, argv, &i, &clo, &clbad)) { /* --cluster ... (sy_cluster_cli.c) */
-            if (clbad) return usage();
-        } else if (a[0] != '-' && !scene) scene = a;
-        else {
-            fprintf(stderr, "sy render: unknown or incomplete option '%s'\n", a);
-            return usage();
+            break;
+        case OPT_AOV: po.aov = progressive_opts = true; break;
+        case 'o': outp = optarg; break;
+        case 'w':
+            if (!parse_u32(optarg, 1, 16384, &w)) return bad_value("-w", optarg);
+            break;
+        case 'h':
+            if (!parse_u32(optarg, 1, 16384, &h)) return bad_value("-h", optarg);
+            break;
+        case OPT_CAMERA: camera = optarg; break;
+        case OPT_PARAMS: params = optarg; break;
+        case OPT_GL: gl_provider = optarg; break;          /* raster: gl=... parameter */
+        case OPT_FILTER: filter = optarg; break;           /* pathtracer: filter=... */
+        case OPT_THRESHOLD: threshold = optarg; break;     /* pathtracer: threshold=... */
+        case OPT_HALF: oo.half = true; break;
+        case OPT_EXPOSURE:
+            oo.png.exposure_stops = strtof(optarg, &end);
+            if (end == optarg || *end || !isfinite(oo.png.exposure_stops)) return bad_value("--exposure", optarg);
+            break;
+        case OPT_TONEMAP:
+            if (!strcmp(optarg, "aces")) oo.png.tonemap = SY_TONEMAP_ACES;
+            else if (!strcmp(optarg, "reinhard")) oo.png.tonemap = SY_TONEMAP_REINHARD;
+            else if (!strcmp(optarg, "clamp")) oo.png.tonemap = SY_TONEMAP_CLAMP;
+            else return bad_value("--tonemap", optarg);
+            break;
+        case OPT_STEREO:
+            if (sy_stereo_mode_parse(optarg, &spec.stereo, &perr) != SY_OK) return fail(&perr);
+            break;
+        case OPT_EYE_SEP: /* the range: sy_compose says why */
+            spec.eye_separation = strtof(optarg, &end);
+            if (end == optarg || *end) return bad_value("--eye-sep", optarg);
+            break;
+        case OPT_ZERO_PARALLAX:
+            spec.zero_parallax = strtof(optarg, &end);
+            if (end == optarg || *end) return bad_value("--zero-parallax", optarg);
+            break;
+        case OPT_OVERLAY: overlay = optarg; break;
+        case OPT_COMPOSITE: composite = optarg; break;
+        case OPT_FRAMES:
+            if (!parse_u32(optarg, 1, 100000000u, &clo.frames)) return bad_value("--frames", optarg);
+            break;
+        default: /* --cluster ... (sy_cluster_cli.c) */
+            if (!sy_cluster_cli_getopt(c, optarg, &clo)) return bad_value(option_name(lo, c), optarg);
         }
+    }
+    for (; optind < argc; ++optind) {
+        if (scene) return usage_of("render", "one SCENE at a time");
+        scene = argv[optind];
     }
     if (clo.cluster && !strcmp(clo.cluster, "mpi")) { /* mpirun -np N sy render ... --cluster mpi */
         bool served = false;
@@ -765,7 +1018,8 @@ static int cmd_render(int argc, char **argv)
         if (served) return mr == SY_OK ? 0 : fail(&merr); /* a server rank: rank 0 is done */
         if (mr != SY_OK) return fail(&merr);
     }
-    if (!scene || !backend || !outp) return usage();
+    if (!scene || !backend || !outp)
+        return usage_of("render", !scene ? "a SCENE is required" : !backend ? "-b BACKEND is required" : "-o OUT is required");
     char gl_params[256];
     if (gl_provider) params = render_gl_params(params, gl_provider, gl_params, sizeof gl_params);
     char filter_params[512];
@@ -791,7 +1045,7 @@ static int cmd_render(int argc, char **argv)
     char shown[96]; /* the back-end as reported: "whitted", or "whitted on 2 servers (sort-first)" */
     if (clo.cluster)
         snprintf(shown, sizeof shown, "%s on %u server%s (%s)", remote, cluster_servers, cluster_servers == 1 ? "" : "s",
-                 sy_cluster_mode_name(cluster_mode));
+                 sy_cluster_cli_mode_name(cluster_mode));
     else snprintf(shown, sizeof shown, "%s", remote);
     const sy_mediator_class *bcls = sy_mediator_find(backend);
     sy_params bparams = {0};
@@ -801,6 +1055,10 @@ static int cmd_render(int argc, char **argv)
         return fail(&err);
     }
     if (sy_params_parse(params, &bparams, &err) != SY_OK) return fail(&err);
+    if (sy_mediator_class_check_params(bcls, &bparams, &err) != SY_OK) { /* unknown key, bad value: usage */
+        sy_log(SY_LOG_ERROR, "sy", NULL, "%s", err.message); /* --params, --filter, --threshold, --gl */
+        return 2;
+    }
     uint32_t caps = sy_mediator_class_caps(bcls, &bparams);
     const sy_mediator_class *rcls = sy_mediator_find(remote);
     if ((filter || threshold) && !(caps & SY_CAP_FILTERS)) {
@@ -922,7 +1180,7 @@ static int cmd_render(int argc, char **argv)
         printf("multi-display: %ux%u wall presented by the servers, %s, %.3f s\n", w, h, remote, secs);
     } else if (r == SY_OK) {
         size_t bad = sy_layer_count_nonfinite(&img) + (img_right.rgba ? sy_layer_count_nonfinite(&img_right) : 0);
-        if (bad) fprintf(stderr, "sy render: warning: %zu pixels are not finite\n", bad);
+        if (bad) sy_log(SY_LOG_WARNING, "sy", outp, "%zu pixels are not finite", bad);
         if (spec.stereo == SY_STEREO_SEPARATE) {
             char lp[4096], rp[4096];
             r = eye_paths(outp, lp, rp, sizeof lp, &err);
@@ -965,25 +1223,30 @@ static int cmd_compare(int argc, char **argv)
 {
     const char *scene = NULL, *camera = NULL, *sheet = "compare.png", *only = NULL;
     uint32_t w = 200, h = 150, spp = 256;
-    for (int i = 0; i < argc; ++i) {
-        const char *a = argv[i];
-        bool has = i + 1 < argc;
-        if (!strcmp(a, "-w") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(a, "-h") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(a, "--spp") && has) {
-            if (!parse_u32(argv[++i], 1, 1u << 20, &spp)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(a, "-o") && has) sheet = argv[++i];
-        else if (!strcmp(a, "--camera") && has) camera = argv[++i];
-        else if (!strcmp(a, "--backends") && has) only = argv[++i];
-        else if (a[0] != '-' && !scene) scene = a;
-        else {
-            fprintf(stderr, "sy compare: unknown or incomplete option '%s'\n", a);
-            return usage();
+    static const struct option lo[] = {{"spp", required_argument, NULL, OPT_SPP},
+                                       {"camera", required_argument, NULL, OPT_CAMERA},
+                                       {"backends", required_argument, NULL, OPT_BACKENDS}, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = next_option("compare", argc, argv, SHORT_OPTIONS("w:h:o:"), lo, &status)) != -1) {
+        switch (c) {
+        case OPT_STOP: return status;
+        case 'w':
+            if (!parse_u32(optarg, 1, 16384, &w)) return bad_value("-w", optarg);
+            break;
+        case 'h':
+            if (!parse_u32(optarg, 1, 16384, &h)) return bad_value("-h", optarg);
+            break;
+        case OPT_SPP:
+            if (!parse_u32(optarg, 1, 1u << 20, &spp)) return bad_value("--spp", optarg);
+            break;
+        case 'o': sheet = optarg; break;
+        case OPT_CAMERA: camera = optarg; break;
+        case OPT_BACKENDS: only = optarg; break;
         }
     }
-    if (!scene) return usage();
+    if (argc - optind != 1) return usage_of("compare", argc == optind ? "a SCENE is required" : "one SCENE at a time");
+    scene = argv[optind];
     if (!ends_with(sheet, ".png")) {
         fprintf(stderr, "sy compare: %s: the contact sheet must end in .png\n", sheet);
         return 2;
@@ -1010,16 +1273,23 @@ static int cmd_demo(int argc, char **argv)
 {
     const char *dir = "out", *filter = "pixel";
     uint32_t w = 800, h = 450;
-    for (int i = 0; i < argc; ++i) {
-        bool has = i + 1 < argc;
-        if (!strcmp(argv[i], "-o") && has) dir = argv[++i];
-        else if (!strcmp(argv[i], "--filter") && has) filter = argv[++i];
-        else if (!strcmp(argv[i], "-w") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(argv[i], "-h") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
-        } else return usage();
+    static const struct option lo[] = {{"filter", required_argument, NULL, OPT_FILTER}, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = next_option("demo", argc, argv, SHORT_OPTIONS("o:w:h:"), lo, &status)) != -1) {
+        switch (c) {
+        case OPT_STOP: return status;
+        case 'o': dir = optarg; break;
+        case OPT_FILTER: filter = optarg; break;
+        case 'w':
+            if (!parse_u32(optarg, 1, 16384, &w)) return bad_value("-w", optarg);
+            break;
+        case 'h':
+            if (!parse_u32(optarg, 1, 16384, &h)) return bad_value("-h", optarg);
+            break;
+        }
     }
+    if (optind < argc) return usage_of("demo", "sy demo takes no operand (-o DIR names the folder)");
     if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "sy: error: %s: cannot create directory: %s\n", dir, strerror(errno));
         return 2;
@@ -1070,33 +1340,48 @@ static int cmd_view(int argc, char **argv)
     const char *view_keys = NULL;   /* --keys: scripted key presses (tests) */
     uint32_t w = 960, h = 540, frames = 0;
     sy_cluster_cli_opts clo = {0}; /* --cluster ... (sy_cluster_cli.c; --frames is the viewer's own) */
-    bool clbad = false;
-    for (int i = 0; i < argc; ++i) {
-        const char *a = argv[i];
-        bool has = i + 1 < argc;
-        if (!strcmp(a, "-b") && has) backend = argv[++i];
-        else if (!strcmp(a, "-w") && has) {
-            if (!parse_u32(argv[++i], 16, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(a, "-h") && has) {
-            if (!parse_u32(argv[++i], 16, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
-        else if (!strcmp(a, "--overlay") && has) overlay = argv[++i];
-        else if (!strcmp(a, "--composite") && has) composite = argv[++i];
-        else if (!strcmp(a, "--frames") && has) {
-            if (!parse_u32(argv[++i], 1, 1000000, &frames)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(a, "--screenshot") && has) shot = argv[++i];
-        else if (!strcmp(a, "--filter") && has) view_filter = argv[++i];
-        else if (!strcmp(a, "--threshold") && has) {
-            char *end = NULL;
-            view_threshold = strtof(argv[++i], &end);
-            if (*end || end == argv[i]) return usage(); /* range: sy_view_run says why */
-        } else if (!strcmp(a, "--keys") && has) view_keys = argv[++i];
-        else if (sy_cluster_cli_option(argc, argv, &i, &clo, &clbad)) {
-            if (clbad) return usage();
-        } else if (a[0] != '-' && !scene) scene = a;
-        else return usage();
+    static const struct option lo[] = {
+        {"camera", required_argument, NULL, OPT_CAMERA}, {"overlay", required_argument, NULL, OPT_OVERLAY},
+        {"composite", required_argument, NULL, OPT_COMPOSITE}, {"frames", required_argument, NULL, OPT_FRAMES},
+        {"screenshot", required_argument, NULL, OPT_SCREENSHOT}, {"filter", required_argument, NULL, OPT_FILTER},
+        {"threshold", required_argument, NULL, OPT_THRESHOLD}, {"keys", required_argument, NULL, OPT_KEYS},
+        {"spp", required_argument, NULL, OPT_SPP}, /* cluster: samples per server and frame */
+        SY_CLUSTER_CLI_OPTIONS, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = next_option("view", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, &status)) != -1) {
+        char *end = NULL;
+        switch (c) {
+        case OPT_STOP: return status;
+        case 'b': backend = optarg; break;
+        case 'w':
+            if (!parse_u32(optarg, 16, 16384, &w)) return bad_value("-w", optarg);
+            break;
+        case 'h':
+            if (!parse_u32(optarg, 16, 16384, &h)) return bad_value("-h", optarg);
+            break;
+        case OPT_CAMERA: camera = optarg; break;
+        case OPT_OVERLAY: overlay = optarg; break;
+        case OPT_COMPOSITE: composite = optarg; break;
+        case OPT_FRAMES:
+            if (!parse_u32(optarg, 1, 1000000, &frames)) return bad_value("--frames", optarg);
+            break;
+        case OPT_SCREENSHOT: shot = optarg; break;
+        case OPT_FILTER: view_filter = optarg; break;
+        case OPT_THRESHOLD: /* the range: sy_view_run says why */
+            view_threshold = strtof(optarg, &end);
+            if (end == optarg || *end) return bad_value("--threshold", optarg);
+            break;
+        case OPT_KEYS: view_keys = optarg; break;
+        case OPT_SPP:
+            if (!parse_u32(optarg, 1, 100000000u, &clo.samples)) return bad_value("--spp", optarg);
+            break;
+        default:
+            if (!sy_cluster_cli_getopt(c, optarg, &clo)) return bad_value(option_name(lo, c), optarg);
+        }
     }
-    if (!scene) return usage();
+    if (argc - optind != 1) return usage_of("view", argc == optind ? "a SCENE is required" : "one SCENE at a time");
+    scene = argv[optind];
     sy_error err = {0};
     if (!sy_mediator_find(backend)) {
         sy_error_set(&err, SY_ERR_NOT_FOUND, "back-end '%s' is not registered (see sy backends)", backend);
@@ -1128,21 +1413,35 @@ static int cmd_coverage(int argc, char **argv)
 {
     const char *scene = NULL, *camera = NULL;
     uint32_t w = 512, h = 512, top = 0;
-    for (int i = 0; i < argc; ++i) {
-        const char *a = argv[i];
-        bool has = i + 1 < argc;
-        if (!strcmp(a, "-w") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(a, "-h") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(a, "--camera") && has) camera = argv[++i];
-        else if (!strcmp(a, "--top") && has) {
-            if (!parse_u32(argv[++i], 1, 1u << 30, &top)) return bad_value(argv[i - 1], argv[i]);
-        } else if (a[0] != '-' && !scene) scene = a;
-        else return usage();
+    static const struct option lo[] = {{"camera", required_argument, NULL, OPT_CAMERA},
+                                       {"top", required_argument, NULL, OPT_TOP},
+                                       {"json", no_argument, NULL, OPT_JSON}, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = next_option("coverage", argc, argv, SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
+        switch (c) {
+        case OPT_STOP: return status;
+        case 'w':
+            if (!parse_u32(optarg, 1, 16384, &w)) return bad_value("-w", optarg);
+            break;
+        case 'h':
+            if (!parse_u32(optarg, 1, 16384, &h)) return bad_value("-h", optarg);
+            break;
+        case OPT_CAMERA: camera = optarg; break;
+        case OPT_TOP:
+            if (!parse_u32(optarg, 1, 1u << 30, &top)) return bad_value("--top", optarg);
+            break;
+        case OPT_JSON: break; /* the output is JSON anyway */
+        }
     }
-    if (!scene) return usage();
+    if (argc - optind != 1) return usage_of("coverage", argc == optind ? "a SCENE is required" : "one SCENE at a time");
+    scene = argv[optind];
     sy_error err = {0};
+#ifndef SY_HAVE_EMBREE /* the coverage back-end is one of the Embree ones */
+    (void)scene, (void)camera, (void)w, (void)h, (void)top;
+    sy_error_set(&err, SY_ERR_UNSUPPORTED, "sy coverage: this sy was built without the Embree back-ends (SY_WITH_EMBREE=OFF)");
+    return fail(&err);
+#else
     loaded ld;
     if (load(scene, camera, true, &ld, &err) != SY_OK) return fail(&err);
     if (ld.is_x3d) fit_x3d_cameras(&ld, w, h);
@@ -1159,43 +1458,93 @@ static int cmd_coverage(int argc, char **argv)
     if (r == SY_OK) r = sy_context_create(ld.scene, "coverage", NULL, ld.root.id, &ctx, &err);
     if (r == SY_OK) r = sy_context_sync(ctx, &err);
     if (r == SY_OK) r = sy_mediator_rt_coverage(sy_context_state(ctx), &view, w, h, &e, &n, &err);
+    cJSON *doc = NULL;
     if (r == SY_OK) {
         uint64_t covered = 0;
         for (uint32_t i = 0; i < n; ++i) covered += e[i].pixels;
-        printf("{\n  \"file\": ");
-        json_string(stdout, scene);
-        printf(",\n  \"width\": %u,\n  \"height\": %u,\n  \"covered_pixels\": %llu,\n  \"objects\": [", w, h,
-               (unsigned long long)covered);
+        doc = cJSON_CreateObject();
+        jadd(doc, "file", jstr(scene));
+        jadd(doc, "width", cJSON_CreateNumber(w));
+        jadd(doc, "height", cJSON_CreateNumber(h));
+        jadd(doc, "covered_pixels", cJSON_CreateNumber((double)covered));
+        cJSON *objs = jadd(doc, "objects", cJSON_CreateArray());
         uint32_t shown = top && top < n ? top : n;
         for (uint32_t i = 0; i < shown; ++i) {
             const sy_node_data *nd = sy_object_get(ld.scene, SY_TYPE_NODE, e[i].node_id);
-            printf("%s\n    {\"node\": %u, \"name\": ", i ? "," : "", e[i].node_id);
-            json_string(stdout, nd && nd->name ? nd->name : "");
-            printf(", \"pixels\": %u, \"fraction\": %.6f}", e[i].pixels, (double)e[i].pixels / ((double)w * h));
+            cJSON *o = jadd(objs, NULL, cJSON_CreateObject());
+            jadd(o, "node", cJSON_CreateNumber(e[i].node_id));
+            jadd(o, "name", jstr(nd ? nd->name : NULL));
+            jadd(o, "pixels", cJSON_CreateNumber(e[i].pixels));
+            jadd(o, "fraction", cJSON_CreateNumber(round((double)e[i].pixels / ((double)w * h) * 1e6) / 1e6));
         }
-        printf("\n  ]\n}\n");
     }
     free(e);
     sy_context_release(ctx);
     sy_window_destroy(win);
     loaded_free(&ld);
-    return r == SY_OK ? 0 : fail(&err);
+    return r == SY_OK ? print_json(doc) : fail(&err);
+#endif
 }
 
-static int cmd_backends(void)
+/* --params --json: a class's declared parameters (sy_params.h) */
+static void jparams(cJSON *o, const sy_mediator_class *m)
 {
-    for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
-        const sy_mediator_class *c = sy_mediator_at(i);
-        static const struct { uint32_t bit; const char *word; } caps[] = {
-            {SY_CAP_DEPTH, "depth"}, {SY_CAP_PROGRESSIVE, "progressive"}, {SY_CAP_TILES, "tiles"},
-            {SY_CAP_SAMPLE_RANGES, "sample-ranges"}, {SY_CAP_AOVS, "aovs"}, {SY_CAP_FILTERS, "filters"},
-            {SY_CAP_ANALYSIS, "analysis"}, {SY_CAP_REMOTE, "remote"}};
-        printf("%s", c->name);
-        for (size_t k = 0; k < sizeof caps / sizeof caps[0]; ++k)
-            if (c->caps & caps[k].bit) printf(" %s", caps[k].word);
-        printf("\n");
+    cJSON *a = jadd(o, "params", cJSON_CreateArray());
+    for (uint32_t i = 0; a && i < m->param_table.count; ++i) {
+        const sy_param_decl *d = &m->param_table.decls[i];
+        cJSON *p = jadd(a, NULL, cJSON_CreateObject());
+        if (!p) return;
+        jadd(p, "name", jstr(d->name));
+        jadd(p, "type", jstr(sy_param_type_name(d->type)));
+        if (d->min != 0.0 || d->max != 0.0) jadd(p, "min", cJSON_CreateNumber(d->min)), jadd(p, "max", cJSON_CreateNumber(d->max));
+        if (d->enum_values) jadd(p, "values", jstr(d->enum_values));
+        jadd(p, "default", d->default_value ? jstr(d->default_value) : cJSON_CreateNull());
+        jadd(p, "help", jstr(d->help));
     }
-    return 0;
+}
+
+/* sy backends [--params] [--json]: one line per registered back-end, its name and capability words;
+ * --params: then its parameter table (sy_mediator_class_format_params) (--json: an array of
+ * {"name", "caps"[, "params"]}). */
+static int cmd_backends(int argc, char **argv)
+{
+    bool json = false, params = false;
+    static const struct option lo[] = {{"json", no_argument, NULL, OPT_JSON}, {"params", no_argument, NULL, OPT_PARAMS},
+                                       COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = next_option("backends", argc, argv, SHORT_OPTIONS(""), lo, &status)) != -1) {
+        if (c == OPT_STOP) return status;
+        if (c == OPT_JSON) json = true;
+        if (c == OPT_PARAMS) params = true;
+    }
+    if (optind < argc) return usage_of("backends", "sy backends takes no operand");
+    static const struct { uint32_t bit; const char *word; } caps[] = {
+        {SY_CAP_DEPTH, "depth"}, {SY_CAP_PROGRESSIVE, "progressive"}, {SY_CAP_TILES, "tiles"},
+        {SY_CAP_SAMPLE_RANGES, "sample-ranges"}, {SY_CAP_AOVS, "aovs"}, {SY_CAP_FILTERS, "filters"},
+        {SY_CAP_ANALYSIS, "analysis"}, {SY_CAP_REMOTE, "remote"}};
+    cJSON *doc = json ? cJSON_CreateArray() : NULL;
+    for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
+        const sy_mediator_class *m = sy_mediator_at(i);
+        cJSON *o = json ? jadd(doc, NULL, cJSON_CreateObject()) : NULL, *cj = NULL;
+        if (json) {
+            jadd(o, "name", jstr(m->name));
+            cj = jadd(o, "caps", cJSON_CreateArray());
+        } else {
+            printf("%s", m->name);
+        }
+        for (size_t k = 0; k < sizeof caps / sizeof caps[0]; ++k) {
+            if (!(m->caps & caps[k].bit)) continue;
+            if (json) jadd(cj, NULL, jstr(caps[k].word));
+            else printf(" %s", caps[k].word);
+        }
+        if (!json) printf("\n");
+        size_t n = params && !json ? sy_mediator_class_format_params(m, "  ", NULL, 0) : 0;
+        char *t = n ? malloc(n + 1) : NULL; /* --params: the class's table, from the library */
+        if (t) sy_mediator_class_format_params(m, "  ", t, n + 1), fputs(t, stdout), free(t);
+        if (params && json) jparams(o, m);
+    }
+    return json ? print_json(doc) : 0;
 }
 
 /* sy bench raster [SCENE] [-w W -h H] [--repeats R] [--params k=v]: default 1280x720 on OSMesa. */
@@ -1243,18 +1592,30 @@ static int cmd_bench_filters(int argc, char **argv)
 {
     const char *scene = NULL, *sheet = NULL, *reference = NULL;
     uint32_t w = 0, h = 0, repeats = 5;
-    for (int i = 0; i < argc; ++i) {
-        bool has = i + 1 < argc;
-        if (!strcmp(argv[i], "-w") && has) {
-            if (!parse_u32(argv[++i], 8, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(argv[i], "-h") && has) {
-            if (!parse_u32(argv[++i], 8, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(argv[i], "--repeats") && has) {
-            if (!parse_u32(argv[++i], 1, 1000, &repeats)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(argv[i], "--reference") && has) reference = argv[++i];
-        else if (argv[i][0] != '-' && ends_with(argv[i], ".png") && !sheet) sheet = argv[i];
-        else if (argv[i][0] != '-' && !scene) scene = argv[i];
-        else return usage();
+    static const struct option lo[] = {{"repeats", required_argument, NULL, OPT_REPEATS},
+                                       {"reference", required_argument, NULL, OPT_REFERENCE}, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = next_option("bench filters", argc, argv, SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
+        switch (c) {
+        case OPT_STOP: return status;
+        case 'w':
+            if (!parse_u32(optarg, 8, 16384, &w)) return bad_value("-w", optarg);
+            break;
+        case 'h':
+            if (!parse_u32(optarg, 8, 16384, &h)) return bad_value("-h", optarg);
+            break;
+        case OPT_REPEATS:
+            if (!parse_u32(optarg, 1, 1000, &repeats)) return bad_value("--repeats", optarg);
+            break;
+        case OPT_REFERENCE: reference = optarg; break;
+        }
+    }
+    for (; optind < argc; ++optind) { /* [SCENE] [SHEET.png] */
+        const char *a = argv[optind];
+        if (ends_with(a, ".png") && !sheet) sheet = a;
+        else if (!scene) scene = a;
+        else return usage_of("bench filters", "at most one SCENE and one SHEET.png");
     }
     sy_error err = {0};
     if (!scene) return sy_bench_filters(w ? w : 640, h ? h : 480, repeats, sheet, &err) == SY_OK ? 0 : fail(&err);
@@ -1270,41 +1631,69 @@ static int cmd_bench_filters(int argc, char **argv)
     return r == SY_OK ? 0 : fail(&err);
 }
 
+/* sy bench KIND ...: argv[0] is "bench", argv[1] the kind. */
 static int cmd_bench(int argc, char **argv)
 {
-    if (argc < 1) return usage();
-    if (!strcmp(argv[0], "filters")) return cmd_bench_filters(argc - 1, argv + 1);
-    if (!strcmp(argv[0], "cluster")) return sy_cmd_bench_cluster(argc - 1, argv + 1);
+    static const char *const kinds[] = {"sync", "rays", "pathtracer", "filters", "raster", "viewports", "load", "cluster"};
+    bool known = false;
+    for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
+    if (argc >= 2 && !strcmp(argv[1], "--help")) {
+        usage_to(stdout, "bench");
+        return 0;
+    }
+    if (!known) {
+        if (argc >= 2) fprintf(stderr, "sy bench: error: unknown benchmark '%s'\n", argv[1]);
+        return usage_of("bench", argc < 2 ? "which benchmark?" : NULL);
+    }
+    const char *cmd = argv[1]; /* the benchmark */
+    argc -= 1, argv += 1; /* argv[0]: the kind */
+    if (!strcmp(cmd, "filters")) return cmd_bench_filters(argc, argv);
+    if (!strcmp(cmd, "cluster")) return sy_cmd_bench_cluster(argc, argv);
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
     const char *scene = NULL, *params = NULL;
-    for (int i = 1; i < argc; ++i) {
-        bool has = i + 1 < argc;
-        if (!strcmp(argv[i], "--params") && has) params = argv[++i]; /* bench raster */
-        else if (!strcmp(argv[i], "--nodes") && has) {
-            if (!parse_u32(argv[++i], 1, 1u << 22, &nodes)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(argv[i], "--tris") && has) {
-            if (!parse_u32(argv[++i], 12, 1u << 20, &tris)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(argv[i], "--repeats") && has) {
-            if (!parse_u32(argv[++i], 1, 100000, &repeats)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(argv[i], "-w") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &w)) return bad_value(argv[i - 1], argv[i]);
-        } else if (!strcmp(argv[i], "-h") && has) {
-            if (!parse_u32(argv[++i], 1, 16384, &h)) return bad_value(argv[i - 1], argv[i]);
-        } else if (argv[i][0] != '-' && !scene) scene = argv[i];
-        else return usage();
+    static const struct option lo[] = {{"params", required_argument, NULL, OPT_PARAMS},
+                                       {"nodes", required_argument, NULL, OPT_NODES},
+                                       {"tris", required_argument, NULL, OPT_TRIS},
+                                       {"repeats", required_argument, NULL, OPT_REPEATS}, COMMON_OPTIONS};
+    char who[32];
+    snprintf(who, sizeof who, "bench %s", cmd);
+    int c, status = 0;
+    optind = 0;
+    while ((c = next_option(who, argc, argv, SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
+        switch (c) {
+        case OPT_STOP: return status;
+        case OPT_PARAMS: params = optarg; break; /* bench raster */
+        case OPT_NODES:
+            if (!parse_u32(optarg, 1, 1u << 22, &nodes)) return bad_value("--nodes", optarg);
+            break;
+        case OPT_TRIS:
+            if (!parse_u32(optarg, 12, 1u << 20, &tris)) return bad_value("--tris", optarg);
+            break;
+        case OPT_REPEATS:
+            if (!parse_u32(optarg, 1, 100000, &repeats)) return bad_value("--repeats", optarg);
+            break;
+        case 'w':
+            if (!parse_u32(optarg, 1, 16384, &w)) return bad_value("-w", optarg);
+            break;
+        case 'h':
+            if (!parse_u32(optarg, 1, 16384, &h)) return bad_value("-h", optarg);
+            break;
+        }
     }
+    if (argc - optind > 1) return usage_of(who, "at most one SCENE");
+    if (optind < argc) scene = argv[optind];
     sy_error err = {0};
-    if (!strcmp(argv[0], "sync")) return sy_bench_sync(nodes, tris, repeats ? repeats : 50, &err) == SY_OK ? 0 : fail(&err);
-    if (!strcmp(argv[0], "viewports"))
+    if (!strcmp(cmd, "sync")) return sy_bench_sync(nodes, tris, repeats ? repeats : 50, &err) == SY_OK ? 0 : fail(&err);
+    if (!strcmp(cmd, "viewports"))
         return sy_bench_viewports(w == 512 ? 480 : w, h == 512 ? 270 : h, repeats ? repeats : 5, &err) == SY_OK
                    ? 0
                    : fail(&err);
-    if (!strcmp(argv[0], "raster")) return cmd_bench_raster(scene, w, h, repeats, params);
-    if (!strcmp(argv[0], "pathtracer")) return cmd_bench_pathtracer(scene, w, h, repeats);
-    if (!strcmp(argv[0], "load")) /* SCENE = the glTF sample directory; --tris: generated model (default 1M) */
+    if (!strcmp(cmd, "raster")) return cmd_bench_raster(scene, w, h, repeats, params);
+    if (!strcmp(cmd, "pathtracer")) return cmd_bench_pathtracer(scene, w, h, repeats);
+    if (!strcmp(cmd, "load")) /* SCENE = the glTF sample directory; --tris: generated model (default 1M) */
         return sy_bench_load(scene ? scene : "../shared/testdata/gltf", tris == 100 ? 1000000 : tris,
                              repeats ? repeats : 3, &err) == SY_OK ? 0 : fail(&err);
-    if (!strcmp(argv[0], "rays")) {
+    if (!strcmp(cmd, "rays")) {
         loaded ld;
         if (load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return fail(&err);
         sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .backend = "whitted"};
@@ -1312,7 +1701,7 @@ static int cmd_bench(int argc, char **argv)
         loaded_free(&ld);
         return r == SY_OK ? 0 : fail(&err);
     }
-    return usage();
+    return usage_of("bench", NULL);
 }
 
 int main(int argc, char **argv)
@@ -1322,61 +1711,59 @@ int main(int argc, char **argv)
      * are removed when one ends the process */
     sy_signals_start();
     if (sy_mediators_register_builtin(&err) != SY_OK) return fail(&err);
-    /* loader options of every command: --allow-path DIR (repeatable) and --strict */
-    int kept = 1;
-    for (int i = 1; i < argc; ++i) {
-        int used = 0;
-        sy_result wr = parse_world_flag(argc - i, argv + i, &g_load.world, &used, &err);
-        if (wr != SY_OK) {
-            fprintf(stderr, "sy: error: %s\n", err.message);
-            return 2;
+    /* sy's own options before the command (stops at the first operand, the command): --version,
+     * --help / -h, -q / -v and the options of every command (world and loader flags) */
+    static const struct option lo[] = {{"version", no_argument, NULL, OPT_VERSION}, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = next_option(NULL, argc, argv, "+" SHORT_OPTIONS("h"), lo, &status)) != -1) {
+        if (c == OPT_STOP) return status;
+        if (c == OPT_VERSION) {
+            printf("sy (Switchyard) %s\n", sy_version());
+            return 0;
         }
-        if (used) {
-            i += used - 1;
-        } else if (!strcmp(argv[i], "--strict")) {
-            g_load.strict = true;
-        } else if (!strcmp(argv[i], "--allow-path")) {
-            struct stat st;
-            if (i + 1 >= argc || stat(argv[i + 1], &st) != 0 || !S_ISDIR(st.st_mode)) {
-                fprintf(stderr, "sy: error: --allow-path %s: expected an existing folder\n", i + 1 < argc ? argv[i + 1] : "");
-                return 2;
-            }
-            if (g_load.root_count == SY_MAX_ALLOW_PATHS) {
-                fprintf(stderr, "sy: error: --allow-path: at most %d folders\n", SY_MAX_ALLOW_PATHS);
-                return 2;
-            }
-            g_load.roots[g_load.root_count++] = argv[++i];
-        } else {
-            argv[kept++] = argv[i];
+        if (c == 'h') {
+            usage_to(stdout, NULL);
+            return 0;
         }
     }
-    argc = kept;
-    if (argc < 2) return usage();
-    const char *cmd = argv[1];
-    if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
+    if (optind >= argc) {
+        fprintf(stderr, "sy: error: no command given\n");
+        usage_to(stderr, NULL);
+        return 2;
+    }
+    argc -= optind, argv += optind; /* argv[0]: the command; each command parses the rest itself */
+    const char *cmd = argv[0];
+    if (!strcmp(cmd, "version")) {
         printf("sy (Switchyard) %s\n", sy_version());
         return 0;
     }
-    bool help = !strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help");
-    for (int i = 2; i < argc && strcmp(cmd, "serve"); ++i) help = help || !strcmp(argv[i], "--help"); /* sy CMD --help */
-    if (help) {
-        usage_to(stdout);
+    static const char *const commands[] = {"info", "render", "demo", "compare", "bench", "backends", "coverage",
+                                           "serve", "view", "version", "help"};
+    if (!strcmp(cmd, "help")) { /* sy help [COMMAND] */
+        bool known = argc < 2;
+        for (size_t k = 0; !known && k < sizeof commands / sizeof commands[0]; ++k) known = !strcmp(argv[1], commands[k]);
+        if (!known) {
+            fprintf(stderr, "sy help: error: unknown command '%s' (sy --help lists them)\n", argv[1]);
+            return 2;
+        }
+        usage_to(stdout, argc < 2 || !strcmp(argv[1], "help") || !strcmp(argv[1], "version") ? NULL : argv[1]);
         return 0;
     }
-    if (!strcmp(cmd, "info")) return cmd_info(argc - 2, argv + 2);
+    if (!strcmp(cmd, "info")) return cmd_info(argc, argv);
     if (!strcmp(cmd, "render")) {
-        int rc = cmd_render(argc - 2, argv + 2);
+        int rc = cmd_render(argc, argv);
         sy_cluster_cli_mpi_end(); /* --cluster mpi on rank 0: release the server ranks */
         return rc;
     }
-    if (!strcmp(cmd, "demo")) return cmd_demo(argc - 2, argv + 2);
-    if (!strcmp(cmd, "compare")) return cmd_compare(argc - 2, argv + 2);
-    if (!strcmp(cmd, "bench")) return cmd_bench(argc - 2, argv + 2);
-    if (!strcmp(cmd, "backends")) return cmd_backends();
-    if (!strcmp(cmd, "coverage")) return cmd_coverage(argc - 2, argv + 2);
-    if (!strcmp(cmd, "serve")) return sy_cmd_serve(argc - 2, argv + 2);
+    if (!strcmp(cmd, "demo")) return cmd_demo(argc, argv);
+    if (!strcmp(cmd, "compare")) return cmd_compare(argc, argv);
+    if (!strcmp(cmd, "bench")) return cmd_bench(argc, argv);
+    if (!strcmp(cmd, "backends")) return cmd_backends(argc, argv);
+    if (!strcmp(cmd, "coverage")) return cmd_coverage(argc, argv);
+    if (!strcmp(cmd, "serve")) return sy_cmd_serve(argc, argv);
 #ifdef SY_HAVE_GLFW
-    if (!strcmp(cmd, "view")) return cmd_view(argc - 2, argv + 2);
+    if (!strcmp(cmd, "view")) return cmd_view(argc, argv);
 #endif
     fprintf(stderr, "sy: error: unknown command '%s' (sy --help lists them)\n", cmd);
     return 2;

@@ -2,6 +2,7 @@
  * scene (see sy_view.h). */
 #include "sy_view.h"
 
+#include "sy_log.h"
 #include "sy_mediator_cluster.h"
 #include "sy_png.h"
 
@@ -148,10 +149,11 @@ struct view_cluster {
 static void view_cluster_log(void *user, const char *line)
 {
     view_cluster *vc = user;
-    fprintf(stderr, "%s\n", line);
     const char *prefix = "sy cluster: "; /* the title has little room */
+    const char *text = strncmp(line, prefix, strlen(prefix)) ? line : line + strlen(prefix);
+    sy_log(SY_LOG_NOTE, "cluster.client", NULL, "%s", text);
     pthread_mutex_lock(&vc->log_mu);
-    snprintf(vc->log, sizeof vc->log, "%s", strncmp(line, prefix, strlen(prefix)) ? line : line + strlen(prefix));
+    snprintf(vc->log, sizeof vc->log, "%s", text);
     pthread_mutex_unlock(&vc->log_mu);
 }
 
@@ -260,10 +262,10 @@ static sy_result view_cluster_frame(view_cluster *vc, const sy_view_args *a, sy_
         r = view_cluster_local(vc, a, pool, backend, spec->camera, vc->wall_w, vc->wall_h, img, err);
     }
     sy_cluster_frame_stats st = {0};
-    if (ctx) sy_mediator_cluster_last_frame(sy_context_state(ctx), &st);
+    if (ctx) sy_cluster_cli_last_frame(ctx, &st, NULL);
     sy_mediator_stats ms = {0};
     if (ctx) sy_context_stats(ctx, &ms);
-    const char *mode = sy_cluster_mode_name(vc->mode);
+    const char *mode = sy_cluster_cli_mode_name(vc->mode);
     if (r) {
         snprintf(status, len, "cluster %s: %u/%u servers alive", mode, st.servers_live, vc->servers);
         struct timespec pause = {0, 250000000}; /* every server down: retry a few times a second */

@@ -1,4 +1,5 @@
-/* sy_common.h — result codes, error messages and checked arithmetic shared by every Switchyard
+/** @file
+ * sy_common.h — result codes, error messages and checked arithmetic shared by every Switchyard
  * layer above the back-ends (core, mediators, formats, apps).
  *
  * Error convention: every fallible call returns a sy_result (SY_OK == 0) and, when the caller passed
@@ -17,33 +18,34 @@
 extern "C" {
 #endif
 
+/** Result codes of every fallible call (SY_OK == 0). */
 typedef enum sy_result {
     SY_OK = 0,
-    SY_ERR_INVALID_ARGUMENT = 1, /* a caller passed something the API does not accept */
-    SY_ERR_INVALID_HANDLE = 2,   /* stale or foreign handle */
+    SY_ERR_INVALID_ARGUMENT = 1, /**< a caller passed something the API does not accept */
+    SY_ERR_INVALID_HANDLE = 2,   /**< stale or foreign handle */
     SY_ERR_OUT_OF_MEMORY = 3,
-    SY_ERR_IO = 4,               /* file or socket could not be read or written */
-    SY_ERR_PARSE = 5,            /* input data is malformed (file, message) */
-    SY_ERR_UNSUPPORTED = 6,      /* well-formed but uses something we do not implement */
-    SY_ERR_LIMIT = 7,            /* a size or count exceeds a configured limit / would overflow */
-    SY_ERR_NOT_FOUND = 8,        /* named thing (file, camera, back-end) does not exist */
-    SY_ERR_BACKEND = 9,          /* a back-end library reported a failure */
-    SY_ERR_PROTOCOL = 10,        /* network peer violated the protocol */
+    SY_ERR_IO = 4,               /**< file or socket could not be read or written */
+    SY_ERR_PARSE = 5,            /**< input data is malformed (file, message) */
+    SY_ERR_UNSUPPORTED = 6,      /**< well-formed but uses something we do not implement */
+    SY_ERR_LIMIT = 7,            /**< a size or count exceeds a configured limit / would overflow */
+    SY_ERR_NOT_FOUND = 8,        /**< named thing (file, camera, back-end) does not exist */
+    SY_ERR_BACKEND = 9,          /**< a back-end library reported a failure */
+    SY_ERR_PROTOCOL = 10,        /**< network peer violated the protocol */
     SY_RESULT_MAX_ENUM = 0x7fffffff
 } sy_result;
 
-#define SY_ERROR_MESSAGE_MAX 512
+#define SY_ERROR_MESSAGE_MAX 512 /**< bytes of a message, NUL included */
 
-/* A result plus its message. Zero-initialise before first use ({0}). */
+/** A result plus its message. Zero-initialise before first use ({0}). */
 typedef struct sy_error {
-    sy_result code;
-    char message[SY_ERROR_MESSAGE_MAX];
+    sy_result code; /**< the result */
+    char message[SY_ERROR_MESSAGE_MAX]; /**< what failed and why (NUL-terminated) */
 } sy_error;
 
-/* Human-readable name of a result code ("invalid argument", ...). Static storage. */
+/** Human-readable name of a result code ("invalid argument", ...). Static storage. */
 const char *sy_result_str(sy_result r);
 
-/* Records code + printf-style message in *err (if err is not NULL) and returns code, so that
+/** Records code + printf-style message in *err (if err is not NULL) and returns code, so that
  * call sites read `return sy_error_set(err, SY_ERR_PARSE, "%s: ...", path);`. */
 sy_result sy_error_set(sy_error *err, sy_result code, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -51,7 +53,7 @@ sy_result sy_error_set(sy_error *err, sy_result code, const char *fmt, ...)
 #endif
     ;
 
-/* Prepends "prefix: " to an existing message (adds context while an error travels up). */
+/** Prepends "prefix: " to an existing message (adds context while an error travels up). */
 void sy_error_prefix(sy_error *err, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
@@ -73,20 +75,20 @@ static inline bool sy_size_mul(size_t a, size_t b, size_t *out)
     return true;
 }
 
-/* a*b+c, all checked. */
+/** a*b+c, all checked. */
 static inline bool sy_size_mad(size_t a, size_t b, size_t c, size_t *out)
 {
     size_t t;
     return sy_size_mul(a, b, &t) && sy_size_add(t, c, out);
 }
 
-/* Monotonic wall clock in seconds (for timings and progress only). */
+/** Monotonic wall clock in seconds (for timings and progress only). */
 double sy_time_now(void);
 
-/* true when fd refers to a terminal: long jobs print progress only then. */
+/** true when fd refers to a terminal: long jobs print progress only then. */
 bool sy_is_terminal(int fd);
 
-/* The library's version, "MAJOR.MINOR.PATCH" (static storage). */
+/** The library's version, "MAJOR.MINOR.PATCH" (static storage). */
 const char *sy_version(void);
 
 #ifdef __cplusplus

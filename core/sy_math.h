@@ -1,4 +1,5 @@
-/* sy_math.h — small vector / matrix / bounds helpers shared by core, formats and mediators.
+/** @file
+ * sy_math.h — small vector / matrix / bounds helpers shared by core, formats and mediators.
  *
  * Matrices are 4x4 float, column-major (glTF convention: m[12], m[13], m[14] are the translation).
  * Quaternions are (x, y, z, w) as in glTF. All functions are pure; thread-safe. */
@@ -11,31 +12,42 @@
 extern "C" {
 #endif
 
+/** 4x4 matrix, column-major (glTF): m[12..14] = translation. */
 typedef struct sy_mat4 {
-    float m[16];
+    float m[16]; /**< the 16 elements, column by column */
 } sy_mat4;
 
+/** Axis-aligned bounds. */
 typedef struct sy_bounds {
-    float min[3];
-    float max[3]; /* empty bounds have min > max (see sy_bounds_empty) */
+    float min[3]; /**< smallest corner */
+    float max[3]; /**< empty bounds have min > max (see sy_bounds_empty) */
 } sy_bounds;
 
+/** The identity matrix. */
 sy_mat4 sy_mat4_identity(void);
-sy_mat4 sy_mat4_mul(const sy_mat4 *a, const sy_mat4 *b); /* a * b */
-/* T * R * S from translation, unit quaternion (x,y,z,w) and scale. */
+sy_mat4 sy_mat4_mul(const sy_mat4 *a, const sy_mat4 *b); /**< a * b */
+/** T * R * S from translation, unit quaternion (x,y,z,w) and scale. */
 sy_mat4 sy_mat4_from_trs(const float t[3], const float q[4], const float s[3]);
-/* General inverse; returns false (and identity) for a singular matrix. */
+/** General inverse; returns false (and identity) for a singular matrix. */
 bool sy_mat4_invert(const sy_mat4 *a, sy_mat4 *out);
+/** a applied to a point (w = 1). */
 void sy_mat4_transform_point(const sy_mat4 *a, const float p[3], float out[3]);
+/** a applied to a direction (w = 0). */
 void sy_mat4_transform_dir(const sy_mat4 *a, const float d[3], float out[3]);
+/** true when every element is finite. */
 bool sy_mat4_is_finite(const sy_mat4 *a);
+/** true when every element is equal. */
 bool sy_mat4_equal(const sy_mat4 *a, const sy_mat4 *b);
 
+/** Empty bounds (min > max). */
 sy_bounds sy_bounds_empty(void);
+/** true for empty bounds. */
 bool sy_bounds_is_empty(const sy_bounds *b);
+/** Grows b to contain p. */
 void sy_bounds_add_point(sy_bounds *b, const float p[3]);
+/** Grows b to contain o. */
 void sy_bounds_add_bounds(sy_bounds *b, const sy_bounds *o);
-/* Bounds of the 8 transformed corners of b (empty stays empty). */
+/** Bounds of the 8 transformed corners of b (empty stays empty). */
 sy_bounds sy_bounds_transform(const sy_bounds *b, const sy_mat4 *m);
 
 #ifdef __cplusplus

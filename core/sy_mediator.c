@@ -1,8 +1,7 @@
-/* sy_mediator.c — layers, camera views, back-end parameters, the mediator registry, contexts and
- * the context pool (see sy_mediator.h). */
+/* sy_mediator.c — layers, camera views, the mediator registry, the checking of a class's
+ * parameters, contexts and the context pool (see sy_mediator.h). */
 #include "sy_mediator.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <pthread.h>
@@ -113,99 +112,6 @@ sy_camera_view sy_camera_view_frame_bounds(const sy_bounds *b, float image_aspec
     return sy_camera_view_make(&cam, &m, image_aspect);
 }
 
-/* >>params */
-sy_result sy_params_set(sy_params *p, const char *key, const char *value, sy_error *err)
-{
-    if (!key[0] || strlen(key) >= sizeof p->items[0].key)
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameter '%s': bad key", key);
-    if (strlen(value) >= sizeof p->items[0].value)
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameter '%s': value too long", key);
-    uint32_t i = 0;
-    while (i < p->count && strcmp(p->items[i].key, key) != 0) i++;
-    if (i == p->count) {
-        if (p->count == SY_PARAMS_MAX)
-            return sy_error_set(err, SY_ERR_LIMIT, "parameter '%s': more than %d parameters", key, SY_PARAMS_MAX);
-        p->count++;
-        strcpy(p->items[i].key, key);
-    }
-    strcpy(p->items[i].value, value);
-    return SY_OK;
-}
-
-sy_result sy_params_parse(const char *text, sy_params *out, sy_error *err)
-{
-    memset(out, 0, sizeof *out);
-    if (!text) return SY_OK;
-    const char *p = text;
-    while (*p) {
-        const char *end = strchr(p, ',');
-        size_t len = end ? (size_t)(end - p) : strlen(p);
-        char item[160];
-        if (len >= sizeof item) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameters: item too long in '%s'", text);
-        memcpy(item, p, len);
-        item[len] = '\0';
-        if (len) {
-            char *eq = strchr(item, '=');
-            if (!eq || eq == item)
-                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameters: '%s' is not key=value", item);
-            *eq = '\0';
-            sy_result r = sy_params_set(out, item, eq + 1, err);
-            if (r != SY_OK) return r;
-        }
-        p += len;
-        if (*p == ',') p++;
-    }
-    return SY_OK;
-}
-
-const char *sy_params_get(const sy_params *p, const char *key)
-{
-    if (!p) return NULL;
-    for (uint32_t i = 0; i < p->count; ++i)
-        if (strcmp(p->items[i].key, key) == 0) return p->items[i].value;
-    return NULL;
-}
-
-sy_result sy_params_get_int(const sy_params *p, const char *key, long def, long min, long max, long *out, sy_error *err)
-{
-    const char *v = sy_params_get(p, key);
-    *out = def;
-    if (!v) return SY_OK;
-    char *end;
-    errno = 0;
-    long x = strtol(v, &end, 10);
-    if (errno || end == v || *end || x < min || x > max)
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameter %s=%s: expected an integer in [%ld, %ld]", key, v,
-                            min, max);
-    *out = x;
-    return SY_OK;
-}
-
-sy_result sy_params_get_float(const sy_params *p, const char *key, double def, double min, double max, double *out,
-                              sy_error *err)
-{
-    const char *v = sy_params_get(p, key);
-    *out = def;
-    if (!v) return SY_OK;
-    char *end;
-    double x = strtod(v, &end);
-    if (end == v || *end || !isfinite(x) || x < min || x > max)
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameter %s=%s: expected a number in [%g, %g]", key, v, min,
-                            max);
-    *out = x;
-    return SY_OK;
-}
-
-bool sy_params_equal(const sy_params *a, const sy_params *b)
-{
-    if (a->count != b->count) return false;
-    for (uint32_t i = 0; i < a->count; ++i) {
-        const char *v = sy_params_get(b, a->items[i].key);
-        if (!v || strcmp(v, a->items[i].value) != 0) return false;
-    }
-    return true;
-}
-
 /* >>registry (the one process-wide table) */
 #define REGISTRY_MAX 32
 static pthread_mutex_t g_registry_lock = PTHREAD_MUTEX_INITIALIZER;
@@ -258,6 +164,23 @@ const sy_mediator_class *sy_mediator_at(uint32_t i)
     return c;
 }
 
+/* >>parameters: the one place a back-end's parameters are validated */
+sy_result sy_mediator_class_check_params(const sy_mediator_class *cls, const sy_params *params, sy_error *err)
+{
+    char owner[64];
+    snprintf(owner, sizeof owner, "back-end '%s'", cls->name);
+    if (!cls->check_params) return sy_params_check(&cls->param_table, params, 0, owner, NULL, err);
+    sy_params rest;
+    sy_result r = sy_params_check(&cls->param_table, params, 0, owner, &rest, err);
+    if (r == SY_OK && rest.count) r = cls->check_params(params, &rest, cls->user, err);
+    return r;
+}
+
+size_t sy_mediator_class_format_params(const sy_mediator_class *cls, const char *indent, char *buf, size_t len)
+{
+    return sy_param_table_format(&cls->param_table, indent, buf, len);
+}
+
 /* >>contexts */
 struct sy_context {
     int refs;
@@ -284,6 +207,8 @@ sy_result sy_context_create(sy_scene *scene, const char *backend, const sy_param
         return sy_error_set(err, SY_ERR_NOT_FOUND, "back-end '%s' is not registered (available: %s)", backend,
                             names[0] ? names : "none");
     }
+    sy_result r = sy_mediator_class_check_params(cls, params, err);
+    if (r != SY_OK) return r;
     sy_context *c = calloc(1, sizeof *c);
     if (!c) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "context: out of memory");
     c->refs = 1;
@@ -292,7 +217,7 @@ sy_result sy_context_create(sy_scene *scene, const char *backend, const sy_param
     c->root = root_node_id;
     if (params) c->params = *params;
     sy_mediator_create_args args = {root_node_id, &c->params, cls->user};
-    sy_result r = cls->create(&args, &c->state, err);
+    r = cls->create(&args, &c->state, err);
     if (r == SY_OK) r = sy_scene_consumer_add(scene, &c->consumer, err);
     if (r != SY_OK) {
         if (c->state) cls->destroy(c->state);
@@ -432,7 +357,10 @@ sy_result sy_context_set_filter(sy_context *c, const char *name, const sy_params
 {
     if (!(sy_context_caps(c) & SY_CAP_FILTERS) || !c->cls->set_filter)
         return sy_error_set(err, SY_ERR_UNSUPPORTED, "back-end %s has no display filters", c->cls->name);
-    return c->cls->set_filter(c->state, name, opts, err);
+    char owner[64];
+    snprintf(owner, sizeof owner, "back-end '%s'", c->cls->name);
+    sy_result r = sy_params_check(&c->cls->param_table, opts, SY_PARAM_LIVE, owner, NULL, err);
+    return r != SY_OK ? r : c->cls->set_filter(c->state, name, opts, err);
 }
 
 void sy_context_filter_info(const sy_context *c, sy_filter_info *out)

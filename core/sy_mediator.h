@@ -1,4 +1,5 @@
-/* sy_mediator.h — the one small interface between core and every back-end: mediator classes
+/** @file
+ * sy_mediator.h — the one small interface between core and every back-end: mediator classes
  * (a vtable registered by name), render requests, RGBA float + depth layers, and reference-counted
  * contexts (back-end instance + its adapted scene) shared by every viewport that shows the same
  * scene with the same back-end.
@@ -15,202 +16,234 @@
 #define SY_MEDIATOR_H
 
 #include "sy_changes.h"
+#include "sy_params.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
 /* ---- layers ---- */
+/** A rendered rectangle: RGBA and depth planes (sy_layer_create). */
 typedef struct sy_layer {
-    uint32_t width, height;
-    float *rgba;  /* width*height*4, linear premultiplied, row 0 = top */
-    float *depth; /* width*height, linear distance along the view axis, +INFINITY = nothing */
+    /** @{ size in pixels */
+    uint32_t width, height; /** @} */
+    float *rgba;  /**< width*height*4, linear premultiplied, row 0 = top */
+    float *depth; /**< width*height, linear distance along the view axis, +INFINITY = nothing */
 } sy_layer;
 
-/* Allocates a layer cleared to transparent black and +INFINITY depth. */
+/** Allocates a layer cleared to transparent black and +INFINITY depth. */
 sy_result sy_layer_create(uint32_t width, uint32_t height, sy_layer *out, sy_error *err);
-void sy_layer_destroy(sy_layer *l); /* frees the buffers, zeroes the struct */
+void sy_layer_destroy(sy_layer *l); /**< frees the buffers, zeroes the struct */
+/** Clears to transparent black and +INFINITY depth. */
 void sy_layer_clear(sy_layer *l);
-/* Counts pixels with a non-finite colour component (tests: must be zero). */
+/** Counts pixels with a non-finite colour component (tests: must be zero). */
 size_t sy_layer_count_nonfinite(const sy_layer *l);
 
 /* ---- camera and render requests ---- */
+/** What a back-end renders: camera placement, projection and image-plane window. */
 typedef struct sy_camera_view {
-    sy_mat4 camera_to_world; /* the camera looks down its local -Z, +Y up */
-    uint32_t projection;     /* sy_projection */
-    /* Image-plane window {left, right, bottom, top}: for perspective in tangent space at distance 1
+    sy_mat4 camera_to_world; /**< the camera looks down its local -Z, +Y up */
+    uint32_t projection;     /**< sy_projection */
+    /** Image-plane window {left, right, bottom, top}: for perspective in tangent space at distance 1
      * (symmetric and off-axis frusta alike), for orthographic in camera units. The full image maps
      * onto this window; pixel (x, y) has its centre at (x + 0.5, y + 0.5), row 0 at the top. */
     float window[4];
-    float znear, zfar; /* zfar 0 = infinite */
+    /** @{ zfar 0 = infinite */
+    float znear, zfar; /** @} */
 } sy_camera_view;
 
-/* Camera view for a camera object at a world matrix, for an image of the given aspect
+/** Camera view for a camera object at a world matrix, for an image of the given aspect
  * (width / height). The image aspect wins over the camera's own aspect, keeping yfov / ymag. */
 sy_camera_view sy_camera_view_make(const sy_camera_data *cam, const sy_mat4 *world, float image_aspect);
-/* A perspective view (yfov 45 degrees) looking at the bounds from +Z/+Y, framing all of it. */
+/** A perspective view (yfov 45 degrees) looking at the bounds from +Z/+Y, framing all of it. */
 sy_camera_view sy_camera_view_frame_bounds(const sy_bounds *b, float image_aspect);
 
+/** Progress of a long render. */
 typedef struct sy_progress {
-    uint64_t done, total; /* units of work (tiles, samples) */
+    /** @{ units of work (tiles, samples) */
+    uint64_t done, total; /** @} */
 } sy_progress;
+/** Receives progress reports. */
 typedef void (*sy_progress_fn)(void *user, const sy_progress *p);
 
+/** What to render: the camera view, the full image, the rectangle to fill, samples, background. */
 typedef struct sy_render_request {
-    sy_camera_view camera;
-    uint32_t full_width, full_height; /* the whole image */
-    uint32_t rect_x, rect_y, rect_w, rect_h; /* sub-rectangle to fill; the layer is rect_w x rect_h */
-    uint32_t sample_first, sample_count; /* progressive back-ends: samples to add; 0 count = default */
-    uint32_t background_id; /* sy_background handle id, 0 = the back-end's default (black) */
-    uint32_t seed;
-    sy_progress_fn progress; /* optional, called from the rendering thread(s) serially */
-    void *progress_user;
+    sy_camera_view camera; /**< the camera */
+    /** @{ the whole image */
+    uint32_t full_width, full_height; /** @} */
+    /** @{ sub-rectangle to fill; the layer is rect_w x rect_h */
+    uint32_t rect_x, rect_y, rect_w, rect_h; /** @} */
+    /** @{ progressive back-ends: samples to add; 0 count = default */
+    uint32_t sample_first, sample_count; /** @} */
+    uint32_t background_id; /**< sy_background handle id, 0 = the back-end's default (black) */
+    uint32_t seed; /**< seed for the back-end's sampling (same seed = same image) */
+    sy_progress_fn progress; /**< optional, called from the rendering thread(s) serially */
+    void *progress_user; /**< passed to progress */
 } sy_render_request;
 
-/* ---- parameters: "key=value" pairs given to a back-end ---- */
-#define SY_PARAMS_MAX 16
-typedef struct sy_params {
-    uint32_t count;
-    struct {
-        char key[32];
-        char value[96];
-    } items[SY_PARAMS_MAX];
-} sy_params;
-
-/* Parses "k=v,k=v" (NULL or "" = empty). Errors name the offending item. */
-sy_result sy_params_parse(const char *text, sy_params *out, sy_error *err);
-sy_result sy_params_set(sy_params *p, const char *key, const char *value, sy_error *err);
-const char *sy_params_get(const sy_params *p, const char *key); /* NULL when absent */
-/* Typed getters: default when absent; SY_ERR_INVALID_ARGUMENT naming the key when malformed or
- * outside [min, max]. */
-sy_result sy_params_get_int(const sy_params *p, const char *key, long def, long min, long max, long *out,
-                            sy_error *err);
-sy_result sy_params_get_float(const sy_params *p, const char *key, double def, double min, double max,
-                              double *out, sy_error *err);
-bool sy_params_equal(const sy_params *a, const sy_params *b);
+/* ---- parameters: "key=value" pairs given to a back-end (sy_params) and each class's declared
+ * table of them (sy_param_table): sy_params.h ---- */
 
 /* ---- mediator classes ---- */
-/* Typed capabilities: the rest of the library and the applications ask these (sy_context_caps,
+/** Typed capabilities: the rest of the library and the applications ask these (sy_context_caps,
  * sy_mediator_class.caps), never a back-end's name. */
 typedef enum sy_mediator_caps {
-    SY_CAP_DEPTH = 1u << 0,       /* fills the depth layer */
-    SY_CAP_PROGRESSIVE = 1u << 1, /* accumulates samples across render calls */
-    SY_CAP_TILES = 1u << 2,       /* renders any sub-rectangle exactly like the full image */
-    SY_CAP_ANALYSIS = 1u << 3,    /* draws an analysis image (e.g. object coverage), not the scene's look:
+    SY_CAP_DEPTH = 1u << 0,       /**< fills the depth layer */
+    SY_CAP_PROGRESSIVE = 1u << 1, /**< accumulates samples across render calls */
+    SY_CAP_TILES = 1u << 2,       /**< renders any sub-rectangle exactly like the full image */
+    SY_CAP_ANALYSIS = 1u << 3,    /**< draws an analysis image (e.g. object coverage), not the scene's look:
                                      comparisons of looks (sy compare) leave it out */
-    SY_CAP_SAMPLE_RANGES = 1u << 4, /* its samples split across renderers: renders with distinct seeds (or
+    SY_CAP_SAMPLE_RANGES = 1u << 4, /**< its samples split across renderers: renders with distinct seeds (or
                                        sample_first ranges) draw independent samples, and their images
                                        merged by sample count estimate the same pixel (cooperative) */
-    SY_CAP_AOVS = 1u << 5,        /* keeps feature buffers (variance, albedo, normal, ...): sy_context_aovs */
-    SY_CAP_FILTERS = 1u << 6,     /* display noise filters: sy_context_set_filter / sy_context_filter_info */
-    SY_CAP_REMOTE = 1u << 7,      /* renders on other machines (the cluster mediator) */
+    SY_CAP_AOVS = 1u << 5,        /**< keeps feature buffers (variance, albedo, normal, ...): sy_context_aovs */
+    SY_CAP_FILTERS = 1u << 6,     /**< display noise filters: sy_context_set_filter / sy_context_filter_info */
+    SY_CAP_REMOTE = 1u << 7,      /**< renders on other machines (the cluster mediator) */
 } sy_mediator_caps;
 
 /* ---- feature buffers (SY_CAP_AOVS) ---- */
-#define SY_AOVS_MAX 16
+#define SY_AOVS_MAX 16 /**< most planes in a sy_aovs */
+/** One feature buffer plane. */
 typedef struct sy_aov_plane {
-    const char *name;  /* "color", "depth", "variance", "albedo", "normal", ... (static storage) */
-    uint32_t channels; /* values per pixel */
-    float *data;       /* width*height*channels floats, row 0 = top; malloc()ed, owned by the sy_aovs */
+    const char *name;  /**< "color", "depth", "variance", "albedo", "normal", ... (static storage) */
+    uint32_t channels; /**< values per pixel */
+    float *data;       /**< width*height*channels floats, row 0 = top; malloc()ed, owned by the sy_aovs */
 } sy_aov_plane;
+/** Feature buffers of a render (SY_CAP_AOVS). */
 typedef struct sy_aovs {
-    uint32_t width, height;
-    uint64_t samples;           /* samples per pixel accumulated */
-    uint64_t nonfinite_samples; /* samples replaced by zero because they were NaN/Inf */
-    uint32_t count;
-    sy_aov_plane planes[SY_AOVS_MAX];
+    /** @{ size in pixels */
+    uint32_t width, height; /** @} */
+    uint64_t samples;           /**< samples per pixel accumulated */
+    uint64_t nonfinite_samples; /**< samples replaced by zero because they were NaN/Inf */
+    uint32_t count; /**< planes used */
+    sy_aov_plane planes[SY_AOVS_MAX]; /**< the planes */
 } sy_aovs;
-void sy_aovs_free(sy_aovs *a); /* frees every plane, zeroes the struct; NULL-safe */
+void sy_aovs_free(sy_aovs *a); /**< frees every plane, zeroes the struct; NULL-safe */
 
 /* ---- display filters (SY_CAP_FILTERS) ---- */
+/** A display filter's state and its last run (SY_CAP_FILTERS). */
 typedef struct sy_filter_info {
-    char name[32];              /* current filter, "none" when unfiltered */
-    float threshold;            /* current threshold */
-    uint64_t frames;            /* filtered frames so far */
-    uint64_t nonfinite_pixels;  /* last filtered frame: NaN/Inf input pixels kept out of neighbourhoods */
-    uint64_t nonfinite_samples; /* last filtered accumulation: NaN/Inf samples the back-end replaced by 0 */
-    double seconds;             /* last filter call's wall time */
-    uint32_t last_pass_samples; /* samples of the last filter pass (0 = none yet, or the filter runs every frame) */
-    double mean_blend;          /* mean share of the unfiltered image in the output (1 = unfiltered everywhere) */
+    char name[32];              /**< current filter, "none" when unfiltered */
+    float threshold;            /**< current threshold */
+    uint64_t frames;            /**< filtered frames so far */
+    uint64_t nonfinite_pixels;  /**< last filtered frame: NaN/Inf input pixels kept out of neighbourhoods */
+    uint64_t nonfinite_samples; /**< last filtered accumulation: NaN/Inf samples the back-end replaced by 0 */
+    double seconds;             /**< last filter call's wall time */
+    uint32_t last_pass_samples; /**< samples of the last filter pass (0 = none yet, or the filter runs every frame) */
+    double mean_blend;          /**< mean share of the unfiltered image in the output (1 = unfiltered everywhere) */
 } sy_filter_info;
 
+/** What a class's create receives. */
 typedef struct sy_mediator_create_args {
-    uint32_t root_node_id; /* 0 = every root of the scene */
-    const sy_params *params;
-    const void *class_user; /* the class's user pointer (sy_mediator_class.user) */
+    uint32_t root_node_id; /**< 0 = every root of the scene */
+    const sy_params *params; /**< the context's parameters, checked against the class's param_table */
+    const void *class_user; /**< the class's user pointer (sy_mediator_class.user) */
 } sy_mediator_create_args;
 
+/** Statistics of a mediator instance. */
 typedef struct sy_mediator_stats {
-    uint64_t samples;        /* progressive: samples accumulated per pixel so far */
-    double last_sync_seconds, last_render_seconds;
+    uint64_t samples;        /**< progressive: samples accumulated per pixel so far */
+    /** @{ seconds of the last sync and the last render */
+    double last_sync_seconds, last_render_seconds; /** @} */
 } sy_mediator_stats;
 
+/** A mediator class: the vtable and capabilities of one back-end kind (see docs/BACKENDS.md). */
 typedef struct sy_mediator_class {
-    const char *name; /* "whitted", "pathtracer", "raster", ... */
-    uint32_t caps;    /* sy_mediator_caps every instance has */
-    sy_result (*create)(const sy_mediator_create_args *args, void **state_out, sy_error *err);
-    void (*destroy)(void *state);
-    /* Applies a change list (the first one is a snapshot). */
+    const char *name; /**< "whitted", "pathtracer", "raster", ... */
+    uint32_t caps;    /**< sy_mediator_caps every instance has */
+    sy_result (*create)(const sy_mediator_create_args *args, void **state_out, sy_error *err); /**< creates an instance (its state) for args */
+    void (*destroy)(void *state); /**< destroys an instance */
+    /** Applies a change list (the first one is a snapshot). */
     sy_result (*sync)(void *state, const sy_changes *changes, sy_error *err);
-    /* Fills layer (rect_w x rect_h) for the request. */
+    /** Fills layer (rect_w x rect_h) for the request. */
     sy_result (*render)(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err);
-    void (*stats)(void *state, sy_mediator_stats *out); /* optional */
-    /* Optional: the capabilities of an instance made with these parameters, when they depend on them
+    void (*stats)(void *state, sy_mediator_stats *out); /**< optional */
+    /** Optional: the capabilities of an instance made with these parameters, when they depend on them
      * (the cluster: those of the servers' back-end in that mode); NULL = caps. */
     uint32_t (*caps_of)(const sy_params *params, const void *class_user);
-    /* SY_CAP_AOVS: copies the feature buffers of the last render into out (caller frees). */
+    /** SY_CAP_AOVS: copies the feature buffers of the last render into out (caller frees). */
     sy_result (*aovs)(void *state, sy_aovs *out, sy_error *err);
-    /* SY_CAP_FILTERS: sets the display filter ("none" turns it off) and its options; the info of the
+    /** SY_CAP_FILTERS: sets the display filter ("none" turns it off) and its options; the info of the
      * filter now set. */
     sy_result (*set_filter)(void *state, const char *name, const sy_params *opts, sy_error *err);
-    void (*filter_info)(void *state, sy_filter_info *out);
-    const void *user; /* handed to create as class_user (a class registered at run time: its configuration) */
+    void (*filter_info)(void *state, sy_filter_info *out); /**< SY_CAP_FILTERS: the filter now set */
+    const void *user; /**< handed to create as class_user (a class registered at run time: its configuration) */
+    /** The parameters an instance accepts: name, type, range or values, default, help (sy_params.h;
+     * SY_PARAM_TABLE(array)). Core checks every context's parameters against it before create and
+     * wherever they change later (sy_mediator_class_check_params), so create reads them through the
+     * typed getters (sy_param_int, ...: declared defaults) and sees only declared, valid keys. An
+     * empty table: the class accepts no parameter. */
+    sy_param_table param_table;
+    /** Optional: checks the given keys param_table does not declare (undeclared) instead of refusing
+     * them; all holds every given key. The cluster checks the keys it forwards against the servers'
+     * back-end. NULL: an undeclared key is an error listing the valid names. */
+    sy_result (*check_params)(const sy_params *all, const sy_params *undeclared, const void *class_user,
+                              sy_error *err);
 } sy_mediator_class;
 
-/* Registry (process-wide; the one piece of global state). The class must outlive the process's
+/** Registry (process-wide; the one piece of global state). The class must outlive the process's
  * use of it (a static const struct). Registering a name twice replaces nothing and fails. */
 sy_result sy_mediator_register(const sy_mediator_class *cls, sy_error *err);
+/** The class registered under name, or NULL. */
 const sy_mediator_class *sy_mediator_find(const char *name);
+/** Number of registered classes. */
 uint32_t sy_mediator_count(void);
+/** The i-th registered class (i < sy_mediator_count), or NULL. */
 const sy_mediator_class *sy_mediator_at(uint32_t i);
-/* Capabilities of an instance of cls made with params (NULL = none): cls->caps, or cls->caps_of for the parameters. */
+/** Capabilities of an instance of cls made with params (NULL = none): cls->caps, or cls->caps_of for the parameters. */
 uint32_t sy_mediator_class_caps(const sy_mediator_class *cls, const sy_params *params);
+/** Checks params (NULL = none) against cls->param_table (and cls->check_params): an unknown key is
+ * SY_ERR_INVALID_ARGUMENT naming it and the valid keys, a malformed value, one out of range or not
+ * in the enum names the key, the value and what is allowed; every message names the back-end. The
+ * one validation of back-end parameters: contexts, viewports and filters call it; an application
+ * may too, to refuse bad input up front (sy render: a usage error). */
+sy_result sy_mediator_class_check_params(const sy_mediator_class *cls, const sy_params *params, sy_error *err);
+/** The class's parameters as a listing (sy_param_table_format; the same return convention). */
+size_t sy_mediator_class_format_params(const sy_mediator_class *cls, const char *indent, char *buf, size_t len);
 
 /* ---- contexts ---- */
+/** A back-end instance with its adapted scene, shared by reference count (opaque). */
 typedef struct sy_context sy_context;
 
-/* Creates a context: a consumer on the scene plus the mediator's state. Caller owns one ref. */
+/** Creates a context: a consumer on the scene plus the mediator's state. Caller owns one ref. */
 sy_result sy_context_create(sy_scene *scene, const char *backend, const sy_params *params, uint32_t root_node_id,
                             sy_context **out, sy_error *err);
+/** Adds a reference; returns c. */
 sy_context *sy_context_retain(sy_context *c);
-void sy_context_release(sy_context *c); /* the last release destroys the mediator state */
-/* Pulls everything committed since the last sync and hands it to the mediator. Cost is
+void sy_context_release(sy_context *c); /**< the last release destroys the mediator state */
+/** Pulls everything committed since the last sync and hands it to the mediator. Cost is
  * proportional to the changes. */
 sy_result sy_context_sync(sy_context *c, sy_error *err);
+/** Renders the request into layer (rect_w x rect_h) with the context's mediator. */
 sy_result sy_context_render(sy_context *c, const sy_render_request *req, sy_layer *layer, sy_error *err);
+/** The context's mediator class. */
 const sy_mediator_class *sy_context_class(const sy_context *c);
-/* The mediator's own state (for the mediator module's diagnostics functions). Borrowed. */
+/** The mediator's own state (for the mediator module's diagnostics functions). Borrowed. */
 void *sy_context_state(const sy_context *c);
+/** Fills out with the mediator's statistics. */
 void sy_context_stats(const sy_context *c, sy_mediator_stats *out);
-/* The instance's capabilities (sy_mediator_caps): the class's, or what caps_of says for its parameters. */
+/** The instance's capabilities (sy_mediator_caps): the class's, or what caps_of says for its parameters. */
 uint32_t sy_context_caps(const sy_context *c);
-/* Feature buffers of the last render; SY_ERR_UNSUPPORTED naming the back-end without SY_CAP_AOVS.
+/** Feature buffers of the last render; SY_ERR_UNSUPPORTED naming the back-end without SY_CAP_AOVS.
  * out is the caller's: sy_aovs_free. */
 sy_result sy_context_aovs(sy_context *c, sy_aovs *out, sy_error *err);
-/* Display filter (SY_CAP_FILTERS; others: SY_ERR_UNSUPPORTED naming the back-end). */
+/** Display filter (SY_CAP_FILTERS; others: SY_ERR_UNSUPPORTED naming the back-end). opts are checked
+ * against the class's table first: only keys declared SY_PARAM_LIVE may change here. */
 sy_result sy_context_set_filter(sy_context *c, const char *name, const sy_params *opts, sy_error *err);
-/* Fills out (name "none" for a back-end without filters). */
+/** Fills out (name "none" for a back-end without filters). */
 void sy_context_filter_info(const sy_context *c, sy_filter_info *out);
 
-/* A cache of contexts keyed by (scene, back-end, parameters, root): viewports showing the same
+/** A cache of contexts keyed by (scene, back-end, parameters, root): viewports showing the same
  * scene with the same back-end share one context, so the scene is converted once and switching
  * back to a back-end is instant. */
 typedef struct sy_context_pool sy_context_pool;
+/** Creates an empty pool. */
 sy_result sy_context_pool_create(sy_context_pool **out, sy_error *err);
-void sy_context_pool_destroy(sy_context_pool *p); /* releases the pool's references */
-/* Returns a borrowed context (valid while the pool lives), creating it on first use. */
+void sy_context_pool_destroy(sy_context_pool *p); /**< releases the pool's references */
+/** Returns a borrowed context (valid while the pool lives), creating it on first use. */
 sy_result sy_context_pool_get(sy_context_pool *p, sy_scene *scene, const char *backend, const sy_params *params,
                               uint32_t root_node_id, sy_context **out, sy_error *err);
+/** Number of contexts in the pool. */
 uint32_t sy_context_pool_size(const sy_context_pool *p);
 
 #ifdef __cplusplus

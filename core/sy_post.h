@@ -1,4 +1,5 @@
-/* sy_post.h — the display post-process chain: exposure, tone mapping (Reinhard, ACES filmic fit),
+/** @file
+ * sy_post.h — the display post-process chain: exposure, tone mapping (Reinhard, ACES filmic fit),
  * exact sRGB encoding, and red-cyan anaglyph of a stereo pair. It runs on finished layers
  * (per viewport before compositing, or per window after it), never inside a back-end, so
  * display-only parameters never restart a progressive back-end's accumulation.
@@ -12,34 +13,35 @@
 extern "C" {
 #endif
 
+/** Tone-mapping operators. */
 typedef enum sy_tonemap {
-    SY_TONEMAP_CLAMP = 0,    /* plain clamp to [0, 1] (the default) */
-    SY_TONEMAP_REINHARD = 1, /* x / (1 + x) */
-    SY_TONEMAP_ACES = 2,     /* Narkowicz 2015 ACES filmic fit, then clamp */
+    SY_TONEMAP_CLAMP = 0,    /**< plain clamp to [0, 1] (the default) */
+    SY_TONEMAP_REINHARD = 1, /**< x / (1 + x) */
+    SY_TONEMAP_ACES = 2,     /**< Narkowicz 2015 ACES filmic fit, then clamp */
     SY_TONEMAP_MAX_ENUM = 0x7fffffff
 } sy_tonemap;
 
-/* Exact piecewise sRGB OETF: linear [0, 1] -> encoded [0, 1]; input is clamped, NaN gives 0. */
+/** Exact piecewise sRGB OETF: linear [0, 1] -> encoded [0, 1]; input is clamped, NaN gives 0. */
 float sy_srgb_encode(float linear);
-/* Exact inverse (EOTF): encoded [0, 1] -> linear [0, 1]; input is clamped, NaN gives 0. */
+/** Exact inverse (EOTF): encoded [0, 1] -> linear [0, 1]; input is clamped, NaN gives 0. */
 float sy_srgb_decode(float encoded);
-/* Applies the operator to one linear channel value; returns [0, 1]. Negative and NaN give 0,
+/** Applies the operator to one linear channel value; returns [0, 1]. Negative and NaN give 0,
  * +INFINITY gives 1. An unknown operator behaves as CLAMP. */
 float sy_tonemap_apply(sy_tonemap op, float linear);
 
-/* A post-process chain. Zero-initialised = disabled (identity). */
+/** A post-process chain. Zero-initialised = disabled (identity). */
 typedef struct sy_post_desc {
-    bool enabled;
-    float exposure_stops; /* colour x 2^stops */
-    uint32_t tonemap;     /* sy_tonemap */
-    bool srgb;            /* encode to sRGB (display-referred output in [0, 1]) */
+    bool enabled; /**< false = identity (the rest is ignored) */
+    float exposure_stops; /**< colour x 2^stops */
+    uint32_t tonemap;     /**< sy_tonemap */
+    bool srgb;            /**< encode to sRGB (display-referred output in [0, 1]) */
 } sy_post_desc;
 
-/* Applies the chain in place to un-premultiplied colour (alpha and depth untouched; colour is
+/** Applies the chain in place to un-premultiplied colour (alpha and depth untouched; colour is
  * re-premultiplied afterwards). No-op when !post->enabled. */
 void sy_layer_post_apply(sy_layer *l, const sy_post_desc *post);
 
-/* Red-cyan colour anaglyph of two equally sized layers: red from the left eye, green and blue
+/** Red-cyan colour anaglyph of two equally sized layers: red from the left eye, green and blue
  * from the right; alpha and depth are the per-pixel maximum / minimum. out may alias neither. */
 sy_result sy_layer_anaglyph(const sy_layer *left, const sy_layer *right, sy_layer *out, sy_error *err);
 

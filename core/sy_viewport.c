@@ -78,6 +78,7 @@ sy_result sy_viewport_set_backend(sy_viewport *v, const char *backend, const cha
     }
     sy_params parsed;
     sy_result r = sy_params_parse(params, &parsed, err);
+    if (r == SY_OK) r = sy_mediator_class_check_params(sy_mediator_find(backend), &parsed, err); /* now, too */
     if (r != SY_OK) return r;
     char *b = strdup(backend), *p = params ? strdup(params) : NULL;
     if (!b || (params && !p)) {
@@ -97,7 +98,7 @@ sy_result sy_viewport_set_backend(sy_viewport *v, const char *backend, const cha
 
 sy_result sy_window_add_viewport(sy_window *w, const sy_viewport_desc *desc, sy_viewport **out, sy_error *err)
 {
-    *out = NULL;
+    if (out) *out = NULL;
     if (desc->eye > SY_EYE_RIGHT || desc->composite > SY_COMPOSITE_ALPHA_OVER)
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "viewport: bad eye %u or composite mode %u", desc->eye,
                             desc->composite);
@@ -123,7 +124,7 @@ sy_result sy_window_add_viewport(sy_window *w, const sy_viewport_desc *desc, sy_
         w->capacity = nc;
     }
     w->viewports[w->count++] = v;
-    *out = v;
+    if (out) *out = v;
     return SY_OK;
 }
 

@@ -1,4 +1,5 @@
-/* sy_viewport.h — windows, viewports and compositing.
+/** @file
+ * sy_viewport.h — windows, viewports and compositing.
  *
  * A window has a size and an ordered list of viewports (back to front). A viewport has a
  * rectangle in the window, a root node, a camera node, an optional background, a back-end name
@@ -20,70 +21,90 @@
 extern "C" {
 #endif
 
+/** Which eye a viewport renders. */
 typedef enum sy_eye { SY_EYE_MONO = 0, SY_EYE_LEFT = 1, SY_EYE_RIGHT = 2 } sy_eye;
 
+/** How a viewport's layer is composited over the ones below it. */
 typedef enum sy_composite {
-    SY_COMPOSITE_REPLACE = 0,    /* the viewport's pixels replace what is below */
-    SY_COMPOSITE_DEPTH = 1,      /* per pixel, the nearer depth wins */
-    SY_COMPOSITE_ALPHA_OVER = 2, /* premultiplied "over" the pixels below */
+    SY_COMPOSITE_REPLACE = 0,    /**< the viewport's pixels replace what is below */
+    SY_COMPOSITE_DEPTH = 1,      /**< per pixel, the nearer depth wins */
+    SY_COMPOSITE_ALPHA_OVER = 2, /**< premultiplied "over" the pixels below */
 } sy_composite;
 
+/** A viewport: rectangle, scene root, camera, back-end and its parameters, eye, composite mode. */
 typedef struct sy_viewport_desc {
-    uint32_t x, y, width, height; /* rectangle in the window, row 0 = top; 0 size = whole window */
-    sy_node root;                 /* {0}: every root of the scene */
-    sy_node camera;               /* a node carrying a camera; {0}: frame the root's bounds */
-    sy_background background;     /* {0}: black */
-    const char *backend;          /* registered mediator name (copied) */
-    const char *params;           /* "k=v,k=v" for the back-end (copied), may be NULL */
-    uint32_t eye;                 /* sy_eye */
-    float eye_separation;         /* metres, for stereo (default 0.065 when 0) */
-    float zero_parallax;          /* metres, distance of the screen plane (default 2 when 0) */
-    uint32_t composite;           /* sy_composite */
-    bool inactive;                /* created inactive */
-    sy_post_desc post;            /* applied to this viewport's layer before compositing */
+    /** @{ rectangle in the window, row 0 = top; 0 size = whole window */
+    uint32_t x, y, width, height; /** @} */
+    sy_node root;                 /**< {0}: every root of the scene */
+    sy_node camera;               /**< a node carrying a camera; {0}: frame the root's bounds */
+    sy_background background;     /**< {0}: black */
+    const char *backend;          /**< registered mediator name (copied) */
+    const char *params;           /**< "k=v,k=v" for the back-end (copied), may be NULL */
+    uint32_t eye;                 /**< sy_eye */
+    float eye_separation;         /**< metres, for stereo (default 0.065 when 0) */
+    float zero_parallax;          /**< metres, distance of the screen plane (default 2 when 0) */
+    uint32_t composite;           /**< sy_composite */
+    bool inactive;                /**< created inactive */
+    sy_post_desc post;            /**< applied to this viewport's layer before compositing */
 } sy_viewport_desc;
 
+/** A window: a size and an ordered list of viewports, back to front (opaque). */
 typedef struct sy_window sy_window;
+/** A viewport of a window (opaque, owned by the window). */
 typedef struct sy_viewport sy_viewport;
 
+/** Creates a window of width x height pixels without viewports. */
 sy_result sy_window_create(uint32_t width, uint32_t height, sy_window **out, sy_error *err);
+/** Destroys the window and its viewports (NULL-safe). */
 void sy_window_destroy(sy_window *w);
+/** Changes the window's size. */
 sy_result sy_window_resize(sy_window *w, uint32_t width, uint32_t height, sy_error *err);
+/** The window's size. */
 void sy_window_size(const sy_window *w, uint32_t *width, uint32_t *height);
 
-/* Appends a viewport on top of the existing ones. The pointer is owned by the window. */
+/** Appends a viewport on top of the existing ones. The pointer (out may be NULL) is owned by the
+ * window. */
 sy_result sy_window_add_viewport(sy_window *w, const sy_viewport_desc *desc, sy_viewport **out, sy_error *err);
+/** Number of viewports. */
 uint32_t sy_window_viewport_count(const sy_window *w);
+/** The i-th viewport, back to front (NULL when i is out of range). */
 sy_viewport *sy_window_viewport(const sy_window *w, uint32_t i);
 
+/** Makes the viewport take part in rendering, or not. */
 void sy_viewport_set_active(sy_viewport *v, bool active);
+/** true when the viewport is active. */
 bool sy_viewport_active(const sy_viewport *v);
-/* Switches the back-end (cached contexts make switching back instant). */
+/** Switches the back-end (cached contexts make switching back instant). An unregistered back-end or
+ * parameters its class does not accept (sy_mediator_class_check_params) fail here, keeping the
+ * current back-end. */
 sy_result sy_viewport_set_backend(sy_viewport *v, const char *backend, const char *params, sy_error *err);
+/** Sets the viewport's camera node ({0}: frame the root's bounds). */
 void sy_viewport_set_camera(sy_viewport *v, sy_node camera);
+/** The viewport's back-end name (borrowed). */
 const char *sy_viewport_backend(const sy_viewport *v);
 
-/* The camera view a viewport renders with (its camera node's world matrix as of the last commit,
+/** The camera view a viewport renders with (its camera node's world matrix as of the last commit,
  * or a view framing the root's bounds), with the eye's off-axis frustum applied. */
 sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, uint32_t window_width,
                                   uint32_t window_height, sy_camera_view *out, sy_error *err);
 
-/* Off-axis stereo: shifts the camera along its local X by -/+ separation/2 and skews the window
+/** Off-axis stereo: shifts the camera along its local X by -/+ separation/2 and skews the window
  * so that the plane at zero_parallax coincides for both eyes. MONO returns the view unchanged. */
 sy_camera_view sy_camera_view_eye(const sy_camera_view *mono, uint32_t eye, float separation, float zero_parallax);
 
-/* Composites src (a viewport's layer) into dst at (x, y) with the given mode. */
+/** Composites src (a viewport's layer) into dst at (x, y) with the given mode. */
 void sy_layer_composite(sy_layer *dst, const sy_layer *src, uint32_t x, uint32_t y, uint32_t mode);
 
+/** Options of sy_window_render. */
 typedef struct sy_window_render_opts {
-    uint32_t seed;
-    uint32_t sample_count; /* progressive back-ends: samples to add this call; 0 = default */
-    sy_progress_fn progress;
-    void *progress_user;
-    sy_post_desc post; /* applied to the composited window image */
+    uint32_t seed; /**< seed for the back-ends' sampling */
+    uint32_t sample_count; /**< progressive back-ends: samples to add this call; 0 = default */
+    sy_progress_fn progress; /**< optional progress callback */
+    void *progress_user; /**< passed to progress */
+    sy_post_desc post; /**< applied to the composited window image */
 } sy_window_render_opts;
 
-/* Syncs and renders every active viewport and composites into out (window-sized; created by the
+/** Syncs and renders every active viewport and composites into out (window-sized; created by the
  * caller with sy_layer_create). */
 sy_result sy_window_render(sy_window *w, sy_scene *scene, sy_context_pool *pool, const sy_window_render_opts *opts,
                            sy_layer *out, sy_error *err);

@@ -13,4 +13,4 @@ else()
 endif()
 # stb_image: the shim decodes images itself (dimension limit before allocation).
 pkg_check_modules(SY_STB REQUIRED IMPORTED_TARGET stb)
-target_link_libraries(sy_formats PRIVATE ${SY_TINYGLTF_TARGET} PkgConfig::SY_STB)
+target_link_libraries(sy_formats PRIVATE ${SY_TINYGLTF_TARGET} PkgConfig::SY_STB) # Debian builds stb as libstb

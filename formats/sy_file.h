@@ -1,4 +1,5 @@
-/* sy_file.h — whole-file reading with a size limit, and atomic (temp-then-rename) file output.
+/** @file
+ * sy_file.h — whole-file reading with a size limit, and atomic (temp-then-rename) file output.
  *
  * Every file reader in formats/ goes through sy_file_read_all so that a size limit is always applied
  * to untrusted input, and every writer goes through sy_atomic_file so that a failed write never
@@ -21,7 +22,7 @@
 extern "C" {
 #endif
 
-/* Reads the whole file at `path` into a fresh buffer.
+/** Reads the whole file at `path` into a fresh buffer.
  * Refuses (SY_ERR_LIMIT) files larger than max_bytes, without reading them. A missing file gives
  * SY_ERR_NOT_FOUND, anything else that cannot be read (a directory, an I/O error) SY_ERR_IO.
  * The buffer holds *size_out bytes followed by one extra '\0' byte (handy for text formats); it is
@@ -31,32 +32,32 @@ extern "C" {
 sy_result sy_file_read_all(const char *path, size_t max_bytes, void **data_out, size_t *size_out,
                            sy_error *err);
 
-/* An output file in progress. Zero-initialise ({0}) before sy_atomic_file_begin; the fields are
+/** An output file in progress. Zero-initialise ({0}) before sy_atomic_file_begin; the fields are
  * readable by the caller, never to be changed by it. */
 typedef struct sy_atomic_file {
-    FILE *fp;       /* write the content here (or through fd, not both at once) */
-    int fd;         /* the descriptor behind fp, for positional writers (pwrite) */
-    char *path;     /* the final target path (owned copy) */
-    char *tmp_path; /* the temporary file in the same directory (owned) */
+    FILE *fp;       /**< write the content here (or through fd, not both at once) */
+    int fd;         /**< the descriptor behind fp, for positional writers (pwrite) */
+    char *path;     /**< the final target path (owned copy) */
+    char *tmp_path; /**< the temporary file in the same directory (owned) */
 } sy_atomic_file;
 
-/* Creates the temporary file "<path>.tmp-XXXXXX" (mode 0666 minus the umask) and opens it for
+/** Creates the temporary file "<path>.tmp-XXXXXX" (mode 0666 minus the umask) and opens it for
  * binary writing. Fails with a message naming the path when the directory does not exist or is not
  * writable; nothing is created then.
  * Ownership: on success *af holds resources that exactly one of sy_atomic_file_commit or
  * sy_atomic_file_abort releases. On failure *af is left zeroed and needs no cleanup. */
 sy_result sy_atomic_file_begin(const char *path, sy_atomic_file *af, sy_error *err);
 
-/* Flushes, fsyncs and closes the temporary file, then renames it over the target (and fsyncs the
+/** Flushes, fsyncs and closes the temporary file, then renames it over the target (and fsyncs the
  * directory, best effort). On any failure the temporary file is removed and an existing target is
  * left as it was. Always releases the handle (*af is zeroed afterwards, success or not). */
 sy_result sy_atomic_file_commit(sy_atomic_file *af, sy_error *err);
 
-/* Closes and removes the temporary file; the target is untouched. Safe on a zeroed, committed or
+/** Closes and removes the temporary file; the target is untouched. Safe on a zeroed, committed or
  * already aborted handle (does nothing then). *af is zeroed afterwards. */
 void sy_atomic_file_abort(sy_atomic_file *af);
 
-/* Model files stay in their folder: checks a file that a model names by `uri` (a glTF buffer or
+/** Model files stay in their folder: checks a file that a model names by `uri` (a glTF buffer or
  * image URI, an X3D url) before it is read. `path` is the uri already joined to the referring
  * file's folder. The file is allowed when its real path (symbolic links and ".." resolved) lies
  * inside the model's folder `model_dir` (the folder of the top-level model file; "" = the working
@@ -69,7 +70,7 @@ void sy_atomic_file_abort(sy_atomic_file *af);
 sy_result sy_path_confine(const char *model, const char *uri, const char *path, const char *model_dir,
                           const char *const *roots, size_t root_count, char **real_out, sy_error *err);
 
-/* Removes every temporary file that an unfinished sy_atomic_file of this process holds, and makes
+/** Removes every temporary file that an unfinished sy_atomic_file of this process holds, and makes
  * every later sy_atomic_file_begin and sy_atomic_file_commit fail ("output was cancelled"): for a
  * process that is about to end on SIGINT / SIGTERM (apps/sy_signals.c calls it from its
  * signal-waiting thread). A commit that already renamed its file is finished and stays. Returns

@@ -1,4 +1,5 @@
-/* sy_gltf.h — glTF 2.0 loader: reads .gltf (embedded data: URIs or external files) and .glb and
+/** @file
+ * sy_gltf.h — glTF 2.0 loader: reads .gltf (embedded data: URIs or external files) and .glb and
  * adds its default scene to a sy_scene through the public scene API.
  *
  * What is created: one texture per (glTF texture, role) actually used by a material — colour roles
@@ -48,45 +49,49 @@
 extern "C" {
 #endif
 
-/* Limits for untrusted files. Zero-initialise ({0}) for the defaults given per field. */
+/** Limits for untrusted files. Zero-initialise ({0}) for the defaults given per field. */
 typedef struct sy_gltf_options {
-    size_t max_file_bytes;      /* .gltf / .glb and every external file; 0 = 2 GiB (max 4 GiB - 1) */
-    size_t max_vertices;        /* per primitive; 0 = 1 << 28 */
-    size_t max_indices;         /* per primitive, after strip / fan conversion; 0 = 1 << 28 */
-    uint64_t max_image_pixels;  /* width * height per image (larger ones: missing, warned); 0 = 1 << 26 */
-    size_t max_instances;       /* EXT_mesh_gpu_instancing instances per node; 0 = 1 << 20 */
-    uint32_t max_json_depth;    /* nesting of JSON arrays / objects; 0 = 64 */
-    int32_t scene_index;        /* glTF scene to load; 0 = the file's default (see below) */
-    bool use_scene_index;       /* true: load scenes[scene_index] instead of the default */
-    /* Files named by buffer and image URIs must lie in the model file's folder (after symbolic
+    size_t max_file_bytes;      /**< .gltf / .glb and every external file; 0 = 2 GiB (max 4 GiB - 1) */
+    size_t max_vertices;        /**< per primitive; 0 = 1 << 28 */
+    size_t max_indices;         /**< per primitive, after strip / fan conversion; 0 = 1 << 28 */
+    uint64_t max_image_pixels;  /**< width * height per image (larger ones: missing, warned); 0 = 1 << 26 */
+    size_t max_instances;       /**< EXT_mesh_gpu_instancing instances per node; 0 = 1 << 20 */
+    uint32_t max_json_depth;    /**< nesting of JSON arrays / objects; 0 = 64 */
+    int32_t scene_index;        /**< glTF scene to load; 0 = the file's default (see below) */
+    bool use_scene_index;       /**< true: load scenes[scene_index] instead of the default */
+    /** Files named by buffer and image URIs must lie in the model file's folder (after symbolic
      * links and ".."; sy_path_confine in sy_file.h) or in one of these folders; absolute paths and
      * file: URIs only in these. A refused URI fails the load (SY_ERR_LIMIT) with a message naming
      * the file and the URI. Borrowed for the call. */
     const char *const *allowed_roots;
-    size_t allowed_root_count;
+    size_t allowed_root_count; /**< entries of allowed_roots */
 } sy_gltf_options;
 
-#define SY_GLTF_MAX_WARNINGS 32 /* messages kept; warning_count counts them all */
+#define SY_GLTF_MAX_WARNINGS 32 /**< messages kept; warning_count counts them all */
 
-/* What the file contains (the whole file, not only the loaded scene). */
+/** What the file contains (the whole file, not only the loaded scene). */
 typedef struct sy_gltf_counts {
-    uint32_t nodes, meshes, primitives, triangles, materials, textures, images, lights, cameras;
-    uint32_t skipped_primitives; /* without POSITION, or without one complete element */
-    uint32_t points, line_segments; /* elements of POINTS and of LINES / LINE_LOOP / LINE_STRIP primitives */
+    /** @{ objects of each kind in the file, and triangles */
+    uint32_t nodes, meshes, primitives, triangles, materials, textures, images, lights, cameras; /** @} */
+    uint32_t skipped_primitives; /**< without POSITION, or without one complete element */
+    /** @{ elements of POINTS and of LINES / LINE_LOOP / LINE_STRIP primitives */
+    uint32_t points, line_segments; /** @} */
 } sy_gltf_counts;
 
+/** What a load produced: the root, camera nodes, warnings and counts (sy_gltf_info_free). */
 typedef struct sy_gltf_info {
-    sy_node root;              /* the new node whose children are the glTF scene's root nodes */
-    int32_t scene_index;       /* glTF scene loaded; -1: none given, all parentless nodes used */
-    sy_node *camera_nodes;     /* nodes with a camera, in glTF node order (malloc()ed) */
-    uint32_t camera_node_count;
-    char **warnings;           /* up to SY_GLTF_MAX_WARNINGS messages (malloc()ed) */
-    uint32_t warning_count;    /* total number of warnings (may exceed the stored ones) */
-    uint32_t stored_warning_count;
-    sy_gltf_counts counts;
+    sy_node root;              /**< the new node whose children are the glTF scene's root nodes */
+    int32_t scene_index;       /**< glTF scene loaded; -1: none given, all parentless nodes used */
+    sy_node *camera_nodes;     /**< nodes with a camera, in glTF node order (malloc()ed) */
+    uint32_t camera_node_count; /**< entries of camera_nodes */
+    char **warnings;           /**< up to SY_GLTF_MAX_WARNINGS messages (malloc()ed); a successful load
+                                  also logs them (sy_log.h, module "gltf") */
+    uint32_t warning_count;    /**< total number of warnings (may exceed the stored ones) */
+    uint32_t stored_warning_count; /**< entries of warnings */
+    sy_gltf_counts counts; /**< what the file contains */
 } sy_gltf_info;
 
-/* Loads the glTF file at `path` into `scene`. The default glTF scene is `scene` of the file, else
+/** Loads the glTF file at `path` into `scene`. The default glTF scene is `scene` of the file, else
  * scenes[0], else (no scenes) all parentless nodes. opts NULL = defaults; info_out and err may be
  * NULL. Result codes: SY_ERR_NOT_FOUND (file or external file missing), SY_ERR_IO, SY_ERR_PARSE
  * (malformed), SY_ERR_LIMIT (an option's limit or arithmetic overflow), SY_ERR_UNSUPPORTED
@@ -94,23 +99,23 @@ typedef struct sy_gltf_info {
 sy_result sy_gltf_load(const char *path, sy_scene *scene, const sy_gltf_options *opts, sy_gltf_info *info_out,
                        sy_error *err);
 
-/* Same from memory (size bytes at data, borrowed for the call): `name` is used in messages and, by
+/** Same from memory (size bytes at data, borrowed for the call): `name` is used in messages and, by
  * its ".glb" suffix, like the path above (GLB is also recognised by its magic); external URIs
  * resolve in base_dir ("" = the working directory, as for a path without a directory). The same
  * options and limits apply (max_file_bytes to size too). */
 sy_result sy_gltf_load_memory(const void *data, size_t size, const char *name, const char *base_dir, sy_scene *scene,
                               const sy_gltf_options *opts, sy_gltf_info *info_out, sy_error *err);
 
-/* Frees the arrays in *info and zeroes it. NULL-safe. */
+/** Frees the arrays in *info and zeroes it. NULL-safe. */
 void sy_gltf_info_free(sy_gltf_info *info);
 
-/* Picks a camera node for a command-line style selector: a decimal index into info->camera_nodes,
+/** Picks a camera node for a command-line style selector: a decimal index into info->camera_nodes,
  * else the first camera node whose node name or camera name equals `selector`. SY_ERR_NOT_FOUND
  * (message lists the available cameras) when nothing matches. */
 sy_result sy_gltf_find_camera(const sy_scene *scene, const sy_gltf_info *info, const char *selector, sy_node *out,
                               sy_error *err);
 
-/* Names of the extensions this loader supports (for "extensionsRequired"), NULL-terminated. */
+/** Names of the extensions this loader supports (for "extensionsRequired"), NULL-terminated. */
 const char *const *sy_gltf_supported_extensions(void);
 
 #ifdef __cplusplus

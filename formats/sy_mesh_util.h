@@ -1,4 +1,5 @@
-/* sy_mesh_util.h — geometry helpers shared by the file loaders (glTF, X3D): flat and crease-angle
+/** @file
+ * sy_mesh_util.h — geometry helpers shared by the file loaders (glTF, X3D): flat and crease-angle
  * normal generation, tangent generation for normal mapping, triangulation of convex and concave
  * planar polygons (ear clipping), and tessellation of the X3D primitives (Box, Sphere, Cone,
  * Cylinder) into triangle lists.
@@ -22,14 +23,14 @@
 extern "C" {
 #endif
 
-/* Replaces an indexed or non-indexed triangle primitive by a non-indexed one (every triangle gets
+/** Replaces an indexed or non-indexed triangle primitive by a non-indexed one (every triangle gets
  * its own three vertices; all present attributes are copied) and sets flat normals (the
  * normalised geometric normal of each triangle, counter-clockwise front; degenerate triangles get
  * (0, 0, 1)). Existing normals and tangents are discarded. This is what glTF 2.0 requires when a
  * primitive has no NORMAL attribute. */
 sy_result sy_prim_make_flat_normals(sy_primitive *p, sy_error *err);
 
-/* Generates tangents (float[4]: xyz unit tangent orthogonal to the normal, w = +1 or -1 the
+/** Generates tangents (float[4]: xyz unit tangent orthogonal to the normal, w = +1 or -1 the
  * handedness of the bitangent, glTF convention B = cross(N, T) * w) from positions, normals and the
  * texcoord set `texcoord` (0 or 1). Method: per-triangle tangent/bitangent from the UV gradient,
  * accumulated per vertex weighted by the corner angle (as MikkTSpace does), Gram-Schmidt
@@ -38,7 +39,7 @@ sy_result sy_prim_make_flat_normals(sy_primitive *p, sy_error *err);
  * Requires normals and the texcoord set; SY_ERR_INVALID_ARGUMENT otherwise. Replaces p->tangents. */
 sy_result sy_prim_generate_tangents(sy_primitive *p, uint32_t texcoord, sy_error *err);
 
-/* Normals of triangle corners with a crease angle (X3D IndexedFaceSet semantics): corner k of
+/** Normals of triangle corners with a crease angle (X3D IndexedFaceSet semantics): corner k of
  * triangle t gets the average of the face normals of all triangles that share its position index
  * (pos_index[3t+k]) and whose face normal lies within crease_angle (radians) of triangle t's; 0
  * gives flat normals, >= pi fully smooth. Face normals are weighted by the corner angle (so the
@@ -48,7 +49,7 @@ sy_result sy_prim_generate_tangents(sy_primitive *p, uint32_t texcoord, sy_error
 sy_result sy_corner_normals(const float *positions, size_t position_count, const uint32_t *pos_index,
                             size_t tri_count, float crease_angle, float **out, sy_error *err);
 
-/* Triangulates one simple planar polygon given as n indices into positions (n >= 3). Convex and
+/** Triangulates one simple planar polygon given as n indices into positions (n >= 3). Convex and
  * concave polygons (either orientation) are handled by ear clipping in the polygon's best-fit
  * plane (Newell normal); the output keeps the polygon's winding. Writes (n - 2) triangles (3 * (n-2)
  * indices into positions) to tris and returns their count; a self-intersecting polygon where no
@@ -58,20 +59,23 @@ sy_result sy_corner_normals(const float *positions, size_t position_count, const
  * scratch must hold 4 * n uint32 and 2 * n float (see SY_TRIANGULATE_SCRATCH). */
 size_t sy_triangulate_polygon(const float *positions, const uint32_t *poly, size_t n, uint32_t *tris,
                               void *scratch);
-#define SY_TRIANGULATE_SCRATCH(n) ((size_t)(n) * (4 * sizeof(uint32_t) + 2 * sizeof(float)))
+#define SY_TRIANGULATE_SCRATCH(n) ((size_t)(n) * (4 * sizeof(uint32_t) + 2 * sizeof(float))) /**< bytes of scratch sy_triangulate_polygon needs for n points */
 
-/* X3D primitives, tessellated into an indexed triangle primitive with normals and texcoords
+/** X3D primitives, tessellated into an indexed triangle primitive with normals and texcoords
  * following the X3D texture mapping of each primitive. The blobs in *out are owned by the caller
  * (release with sy_blob_release). Sizes must be > 0 (the X3D loader checks). */
 typedef struct sy_prim_tess {
-    uint32_t segments; /* around the axis; 0 = 32 */
-    uint32_t rings;    /* sphere latitude bands; 0 = 16 */
+    uint32_t segments; /**< around the axis; 0 = 32 */
+    uint32_t rings;    /**< sphere latitude bands; 0 = 16 */
 } sy_prim_tess;
+/** Box of size x, y, z centred at the origin (X3D Box). */
 sy_result sy_tess_box(const float size[3], sy_primitive *out, sy_error *err);
+/** Sphere of radius centred at the origin (X3D Sphere). */
 sy_result sy_tess_sphere(float radius, const sy_prim_tess *t, sy_primitive *out, sy_error *err);
-/* Cone and cylinder along +Y centred at the origin (X3D). Parts may be switched off. */
+/** Cone and cylinder along +Y centred at the origin (X3D). Parts may be switched off. */
 sy_result sy_tess_cone(float bottom_radius, float height, bool side, bool bottom, const sy_prim_tess *t,
                        sy_primitive *out, sy_error *err);
+/** Cylinder along +Y centred at the origin (as sy_tess_cone). */
 sy_result sy_tess_cylinder(float radius, float height, bool side, bool top, bool bottom, const sy_prim_tess *t,
                            sy_primitive *out, sy_error *err);
 

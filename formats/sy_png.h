@@ -1,4 +1,5 @@
-/* sy_png.h — display-referred 8-bit PNG output of a linear render layer (exposure, tone mapping,
+/** @file
+ * sy_png.h — display-referred 8-bit PNG output of a linear render layer (exposure, tone mapping,
  * sRGB encoding), an 8-bit RGBA PNG reader for tests and tools, and the small colour helpers
  * (sRGB OETF / EOTF, tone-mapping operators) other modules reuse.
  *
@@ -20,36 +21,37 @@
 extern "C" {
 #endif
 
-#define SY_PNG_MAX_SIDE 65536            /* pixels per side, both directions */
-#define SY_PNG_MAX_PIXELS (1u << 28)     /* width * height */
+#define SY_PNG_MAX_SIDE 65536            /**< pixels per side, both directions */
+#define SY_PNG_MAX_PIXELS (1u << 28)     /**< width * height */
 
 /* sy_tonemap, sy_srgb_encode/decode and sy_tonemap_apply live in core/sy_post.h. */
 
-/* Zero-initialised ({0}) means: exposure 0 stops, SY_TONEMAP_CLAMP. */
-/* A text chunk (tEXt: Latin-1 key of 1..79 bytes; the value is written as given). */
+/** A text chunk (tEXt: Latin-1 key of 1..79 bytes; the value is written as given). */
 typedef struct sy_png_text {
-    const char *key, *value;
+    /** @{ key and value (see above) */
+    const char *key, *value; /** @} */
 } sy_png_text;
-#define SY_PNG_MAX_TEXT 32
+#define SY_PNG_MAX_TEXT 32 /**< text chunks per file */
 
+/** PNG output options; zero-initialised ({0}): exposure 0 stops, SY_TONEMAP_CLAMP. */
 typedef struct sy_png_options {
-    float exposure_stops; /* colour is multiplied by 2^exposure_stops before tone mapping */
-    sy_tonemap tonemap;
-    const sy_png_text *text; /* metadata chunks (e.g. the renderer, back-end, samples), borrowed */
-    int text_count;          /* 0..SY_PNG_MAX_TEXT */
+    float exposure_stops; /**< colour is multiplied by 2^exposure_stops before tone mapping */
+    sy_tonemap tonemap; /**< tone-mapping operator (core/sy_post.h) */
+    const sy_png_text *text; /**< metadata chunks (e.g. the renderer, back-end, samples), borrowed */
+    int text_count;          /**< 0..SY_PNG_MAX_TEXT */
 } sy_png_options;
 
-/* Converts one premultiplied linear RGBA pixel to 8-bit straight-alpha sRGB exactly as
+/** Converts one premultiplied linear RGBA pixel to 8-bit straight-alpha sRGB exactly as
  * sy_png_write does (opts may be NULL for the defaults). */
 void sy_png_encode_pixel(const float rgba_premultiplied[4], const sy_png_options *opts, uint8_t out[4]);
 
-/* Writes w x h pixels (rgba: w*h*4 floats, premultiplied linear, row 0 on top) as an 8-bit RGBA
+/** Writes w x h pixels (rgba: w*h*4 floats, premultiplied linear, row 0 on top) as an 8-bit RGBA
  * sRGB PNG at path. opts may be NULL (defaults). Errors name the file and the reason.
  * Ownership: borrows rgba and opts for the duration of the call. */
 sy_result sy_png_write(const char *path, int width, int height, const float *rgba, const sy_png_options *opts,
                        sy_error *err);
 
-/* Reads any PNG as 8-bit straight-alpha RGBA (sRGB-encoded bytes as stored, row 0 on top) through
+/** Reads any PNG as 8-bit straight-alpha RGBA (sRGB-encoded bytes as stored, row 0 on top) through
  * libpng's simplified API. Sizes beyond SY_PNG_MAX_* give SY_ERR_LIMIT; malformed files SY_ERR_PARSE.
  * Ownership: on success the caller owns *pixels_out (w*h*4 bytes) and frees it with free(); on
  * failure *pixels_out is NULL and the sizes are 0. */

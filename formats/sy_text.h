@@ -1,4 +1,5 @@
-/* sy_text.h — flat text geometry from a TrueType / OpenType font (FreeType), for X3D Text.
+/** @file
+ * sy_text.h — flat text geometry from a TrueType / OpenType font (FreeType), for X3D Text.
  *
  * Each string is one line; glyph outlines (font units, unscaled) are flattened (quadratic
  * segments split in SY_TEXT_CONIC_STEPS, cubic in SY_TEXT_CUBIC_STEPS straight pieces) and
@@ -28,42 +29,47 @@
 extern "C" {
 #endif
 
-#define SY_TEXT_CONIC_STEPS 4
-#define SY_TEXT_CUBIC_STEPS 6
+#define SY_TEXT_CONIC_STEPS 4 /**< line segments per quadratic (conic) outline curve */
+#define SY_TEXT_CUBIC_STEPS 6 /**< line segments per cubic outline curve */
 
+/** Justification of text lines (X3D FontStyle justify). */
 typedef enum sy_text_justify {
-    SY_TEXT_FIRST = 0, /* minor only */
+    SY_TEXT_FIRST = 0, /**< minor only */
     SY_TEXT_BEGIN = 1,
     SY_TEXT_MIDDLE = 2,
     SY_TEXT_END = 3,
 } sy_text_justify;
 
+/** A text to build (X3D Text + FontStyle). */
 typedef struct sy_text_desc {
-    const char *const *lines; /* UTF-8 strings, one per line */
-    size_t line_count;
-    const char *font_path;    /* a font file FreeType reads */
-    float size;               /* em height (> 0) */
-    float spacing;            /* line distance in sizes (>= 0) */
-    uint32_t major, minor;    /* sy_text_justify (major: BEGIN, MIDDLE or END) */
-    size_t max_triangles;     /* 0 = 1 << 24 */
+    const char *const *lines; /**< UTF-8 strings, one per line */
+    size_t line_count; /**< entries of lines */
+    const char *font_path;    /**< a font file FreeType reads */
+    float size;               /**< em height (> 0) */
+    float spacing;            /**< line distance in sizes (>= 0) */
+    /** @{ sy_text_justify (major: BEGIN, MIDDLE or END) */
+    uint32_t major, minor; /** @} */
+    size_t max_triangles;     /**< 0 = 1 << 24 */
 } sy_text_desc;
 
+/** What sy_text_build laid out. */
 typedef struct sy_text_stats {
-    uint32_t glyphs;    /* characters laid out */
-    uint32_t triangles; /* in the primitive */
+    uint32_t glyphs;    /**< characters laid out */
+    uint32_t triangles; /**< in the primitive */
 } sy_text_stats;
 
-/* Builds an indexed triangle primitive (positions, normals, indices; material {0}) into *out.
+/** Builds an indexed triangle primitive (positions, normals, indices; material {0}) into *out.
  * A text with no visible glyph (empty strings, spaces only) gives SY_OK and an empty *out (no
  * positions). Errors: SY_ERR_NOT_FOUND (font missing or unreadable: the message names it),
  * SY_ERR_INVALID_ARGUMENT, SY_ERR_LIMIT, SY_ERR_OUT_OF_MEMORY. stats may be NULL. */
 sy_result sy_text_build(const sy_text_desc *d, sy_primitive *out, sy_text_stats *stats, sy_error *err);
 
-/* Triangulates one polygon with holes in 2D (the earcut method). xy: n points; ring_start: ring
+/** Triangulates one polygon with holes in 2D (the earcut method). xy: n points; ring_start: ring
  * k is [ring_start[k], ring_start[k+1]) (ring_start[rings] = n), ring 0 the outer contour, the
  * others holes; any orientation. tris must hold 3 * SY_TEXT_TRIANGULATE_CAPACITY(n, rings) indices;
  * returns the triangle count (zero-area ones dropped), every triangle counter-clockwise. */
 #define SY_TEXT_TRIANGULATE_CAPACITY(n, rings) (3 * (size_t)(n) + 4 * (size_t)(rings) + 8)
+/** Triangulates one polygon with holes (see above). */
 size_t sy_text_triangulate(const double *xy, size_t n, const size_t *ring_start, size_t rings, uint32_t *tris);
 
 #ifdef __cplusplus

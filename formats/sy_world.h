@@ -1,4 +1,5 @@
-/* sy_world.h — sets up a view's world (the background object: background, environment light,
+/** @file
+ * sy_world.h — sets up a view's world (the background object: background, environment light,
  * default lighting) from user choices, so that every program (sy's flags, an embedding
  * application) says the same thing the same way. The meaning of each field is core's (sy_look.h);
  * this module only creates and fills the objects, reading environment maps from EXR files.
@@ -14,32 +15,33 @@
 extern "C" {
 #endif
 
+/** What the user asks of the world (the CLI's world flags); sy_world_apply maps it onto the scene. */
 typedef struct sy_world_options {
-    const char *env_path;    /* lat-long (2:1) EXR with R, G, B or Y channels: the environment light */
-    bool has_env_color;      /* a uniform environment light of this radiance (a 1x1 lat-long map) */
-    float env_color[3];
-    float env_intensity;     /* multiplier for the environment; 0 is taken as 1 unless env_intensity_set */
-    bool env_intensity_set;
-    bool env_hidden;         /* camera rays do not see the environment (they see the background) */
-    bool has_background;     /* what camera rays see where nothing is hit (never a light) */
-    float background[4];     /* linear RGBA, premultiplied */
-    bool no_default_light;   /* no studio lighting even when the scene brings no light */
+    const char *env_path;    /**< lat-long (2:1) EXR with R, G, B or Y channels: the environment light */
+    bool has_env_color;      /**< a uniform environment light of this radiance (a 1x1 lat-long map) */
+    float env_color[3]; /**< radiance of the uniform environment (with has_env_color) */
+    float env_intensity;     /**< multiplier for the environment; 0 is taken as 1 unless env_intensity_set */
+    bool env_intensity_set; /**< env_intensity was given (so 0 means 0) */
+    bool env_hidden;         /**< camera rays do not see the environment (they see the background) */
+    bool has_background;     /**< what camera rays see where nothing is hit (never a light) */
+    float background[4];     /**< linear RGBA, premultiplied */
+    bool no_default_light;   /**< no studio lighting even when the scene brings no light */
 } sy_world_options;
 
-/* True when the options ask for nothing (the world can stay as it is). */
+/** True when the options ask for nothing (the world can stay as it is). */
 bool sy_world_options_empty(const sy_world_options *o);
 
-/* Applies the options to *world (a background object; {0}: one is created when the options ask for
+/** Applies the options to *world (a background object; {0}: one is created when the options ask for
  * anything), keeping the fields the options do not mention (e.g. an X3D gradient). Commits nothing.
  * Errors name the file and the reason (unreadable, not lat-long, non-finite or negative texels). */
 sy_result sy_world_apply(sy_scene *s, sy_background *world, const sy_world_options *o, sy_error *err);
 
-/* Makes a new lat-long float RGB texture of s from px (w x h x 3 floats, row 0 = up), taking
+/** Makes a new lat-long float RGB texture of s from px (w x h x 3 floats, row 0 = up), taking
  * ownership of px (freed on failure too): the environment texture an application generates. */
 sy_result sy_world_texture_take(sy_scene *s, const char *name, float *px, uint32_t w, uint32_t h, sy_texture *out,
                                 sy_error *err);
 
-/* Reads a lat-long EXR environment map into a new float RGB texture of s. */
+/** Reads a lat-long EXR environment map into a new float RGB texture of s. */
 sy_result sy_world_load_environment(sy_scene *s, const char *path, sy_texture *out, sy_error *err);
 
 #ifdef __cplusplus

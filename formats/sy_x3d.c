@@ -4,6 +4,7 @@
 #include "sy_x3d.h"
 
 #include "sy_file.h"
+#include "sy_log.h"
 #include "sy_mesh_util.h"
 #include "sy_text.h"
 
@@ -2542,6 +2543,16 @@ static void finish_lights(loader *L)
     }
 }
 
+/* What a successful load skipped or repaired, on the log (sy_log.h; module "x3d"): the stored
+ * warnings (each names its file and line, so the item is NULL), then how many more there were. They
+ * stay in info->warnings as well. */
+static void log_warnings(const char *path, const sy_x3d_info *info)
+{
+    for (uint32_t i = 0; i < info->stored_warning_count; i++) sy_log(SY_LOG_WARNING, "x3d", NULL, "%s", info->warnings[i]);
+    if (info->warning_count > info->stored_warning_count)
+        sy_log(SY_LOG_WARNING, "x3d", path, "%u more warnings not shown", info->warning_count - info->stored_warning_count);
+}
+
 static sy_result load_common(const char *path, const void *mem, size_t size, const char *base_dir, sy_scene *scene,
                              const sy_x3d_options *opts, sy_x3d_info *info_out, sy_error *err)
 {
@@ -2602,6 +2613,7 @@ static sy_result load_common(const char *path, const void *mem, size_t size, con
         return r;
     }
     free(L.objs);
+    log_warnings(path, info);
     if (info == &local_info) sy_x3d_info_free(info);
     return SY_OK;
 }

@@ -1,4 +1,5 @@
-/* sy_x3d.h — X3D loader (XML encoding, .x3d) on libxml2: adds the file's Scene to a sy_scene through
+/** @file
+ * sy_x3d.h — X3D loader (XML encoding, .x3d) on libxml2: adds the file's Scene to a sy_scene through
  * the public scene API, as the glTF loader does.
  *
  * Nodes: Scene, Transform (full center / scaleOrientation form), Group, StaticGroup, Collision,
@@ -66,62 +67,67 @@
 extern "C" {
 #endif
 
+/** Limits for untrusted files. Zero-initialise ({0}) for the defaults given per field. */
 typedef struct sy_x3d_options {
-    size_t max_file_bytes;     /* each .x3d / image file; 0 = 1 GiB */
-    size_t max_vertices;       /* per geometry node, after triangulation; 0 = 1 << 27 */
-    uint64_t max_image_pixels; /* width * height; 0 = 1 << 26 */
-    uint32_t max_inline_depth; /* nesting of Inline files; 0 = 16 */
-    /* Files named by Inline and ImageTexture urls must lie in the top-level file's folder (after
+    size_t max_file_bytes;     /**< each .x3d / image file; 0 = 1 GiB */
+    size_t max_vertices;       /**< per geometry node, after triangulation; 0 = 1 << 27 */
+    uint64_t max_image_pixels; /**< width * height; 0 = 1 << 26 */
+    uint32_t max_inline_depth; /**< nesting of Inline files; 0 = 16 */
+    /** Files named by Inline and ImageTexture urls must lie in the top-level file's folder (after
      * symbolic links and ".."; sy_path_confine in sy_file.h) or in one of these folders; absolute
      * paths and file: URLs only in these. A refused url fails the load (SY_ERR_LIMIT) with a
      * message naming the file, line and url. Borrowed for the call. */
     const char *const *allowed_roots;
-    size_t allowed_root_count;
+    size_t allowed_root_count; /**< entries of allowed_roots */
 } sy_x3d_options;
 
-#define SY_X3D_MAX_WARNINGS 32
+#define SY_X3D_MAX_WARNINGS 32 /**< messages kept in sy_x3d_info; warning_count counts them all */
 
-/* What was loaded (Inline files included, shared objects counted once). */
+/** What was loaded (Inline files included, shared objects counted once). */
 typedef struct sy_x3d_counts {
-    uint32_t nodes, meshes, primitives, triangles, materials, textures, lights, cameras, inlines;
-    uint32_t skipped_geometry; /* geometry nodes skipped (unsupported type or bad data) */
-    uint32_t points, line_segments; /* elements of PointSet and of (Indexed)LineSet primitives */
-    uint32_t texts;                 /* Text nodes loaded */
+    /** @{ objects created, by kind, and triangles; Inline files loaded */
+    uint32_t nodes, meshes, primitives, triangles, materials, textures, lights, cameras, inlines; /** @} */
+    uint32_t skipped_geometry; /**< geometry nodes skipped (unsupported type or bad data) */
+    /** @{ elements of PointSet and of (Indexed)LineSet primitives */
+    uint32_t points, line_segments; /** @} */
+    uint32_t texts;                 /**< Text nodes loaded */
 } sy_x3d_counts;
 
+/** What a load produced: the root, cameras, background, warnings and counts (sy_x3d_info_free). */
 typedef struct sy_x3d_info {
-    sy_node root;              /* new node for the Scene element */
-    sy_node *camera_nodes;     /* Viewpoint nodes in document order (malloc()ed); [0] is the bound one */
-    float *camera_fovs;        /* their fieldOfView (radians) */
-    uint32_t camera_node_count;
-    sy_background background;  /* first Background, {0} when none */
-    char **warnings;           /* up to SY_X3D_MAX_WARNINGS messages (malloc()ed) */
-    uint32_t warning_count;    /* total, may exceed the stored ones */
-    uint32_t stored_warning_count;
-    sy_x3d_counts counts;
+    sy_node root;              /**< new node for the Scene element */
+    sy_node *camera_nodes;     /**< Viewpoint nodes in document order (malloc()ed); [0] is the bound one */
+    float *camera_fovs;        /**< their fieldOfView (radians) */
+    uint32_t camera_node_count; /**< entries of camera_nodes and camera_fovs */
+    sy_background background;  /**< first Background, {0} when none */
+    char **warnings;           /**< up to SY_X3D_MAX_WARNINGS messages (malloc()ed); a successful load
+                                  also logs them (sy_log.h, module "x3d") */
+    uint32_t warning_count;    /**< total, may exceed the stored ones */
+    uint32_t stored_warning_count; /**< entries of warnings */
+    sy_x3d_counts counts; /**< what was loaded */
 } sy_x3d_info;
 
-/* Loads the .x3d file at path. opts NULL = defaults; info_out and err may be NULL. Results:
+/** Loads the .x3d file at path. opts NULL = defaults; info_out and err may be NULL. Results:
  * SY_ERR_NOT_FOUND, SY_ERR_IO, SY_ERR_PARSE (not XML, or no X3D / Scene element), SY_ERR_LIMIT,
  * SY_ERR_OUT_OF_MEMORY. */
 sy_result sy_x3d_load(const char *path, sy_scene *scene, const sy_x3d_options *opts, sy_x3d_info *info_out,
                       sy_error *err);
 
-/* Same from memory: `name` is used in messages, base_dir ("" = none: Inline and textures are then
+/** Same from memory: `name` is used in messages, base_dir ("" = none: Inline and textures are then
  * looked up relative to the current directory) resolves relative URLs. */
 sy_result sy_x3d_load_memory(const void *data, size_t size, const char *name, const char *base_dir,
                              sy_scene *scene, const sy_x3d_options *opts, sy_x3d_info *info_out, sy_error *err);
 
-void sy_x3d_info_free(sy_x3d_info *info); /* NULL-safe; zeroes *info */
+void sy_x3d_info_free(sy_x3d_info *info); /**< NULL-safe; zeroes *info */
 
-/* The vertical field of view that shows fov across the smaller image side for an image of
+/** The vertical field of view that shows fov across the smaller image side for an image of
  * aspect = width / height. */
 float sy_x3d_yfov(float fov, float aspect);
 
-/* Sets the yfov of every Viewpoint camera in info for an image of the given aspect. */
+/** Sets the yfov of every Viewpoint camera in info for an image of the given aspect. */
 sy_result sy_x3d_fit_cameras(sy_scene *scene, const sy_x3d_info *info, float aspect, sy_error *err);
 
-/* Picks a Viewpoint: decimal index into camera_nodes or a node name (the DEF or description). */
+/** Picks a Viewpoint: decimal index into camera_nodes or a node name (the DEF or description). */
 sy_result sy_x3d_find_camera(const sy_scene *scene, const sy_x3d_info *info, const char *selector, sy_node *out,
                              sy_error *err);
 

@@ -1,4 +1,5 @@
-/* sy_mirror.h — the back-end-independent scene mirror shared by the mediators.
+/** @file
+ * sy_mirror.h — the back-end-independent scene mirror shared by the mediators.
  *
  * A mediator never reads the live scene: it keeps a mirror built from change lists. This module
  * is that mirror: id-indexed tables of textures, materials, meshes, lights, backgrounds and nodes
@@ -24,52 +25,59 @@
 extern "C" {
 #endif
 
+/** The shared scene mirror of a mediator (opaque). */
 typedef struct sy_mirror sy_mirror;
 
-/* Complete texture (pixels match the info): create one back-end texture into *handle. */
+/** Complete texture (pixels match the info): create one back-end texture into *handle. */
 typedef struct sy_mirror_texture_args {
-    uint32_t id;
-    const sy_image_info *info;
-    const sy_sampler *sampler;
-    const void *pixels;
-    uint32_t *handle; /* out */
+    uint32_t id; /**< core texture id */
+    const sy_image_info *info; /**< size and layout of the pixels */
+    const sy_sampler *sampler; /**< wrap and filter */
+    const void *pixels; /**< the pixels (borrowed for the call) */
+    uint32_t *handle; /**< out */
 } sy_mirror_texture_args;
 
-/* Material data (merged, name NULL): create (*handle == 0) or update the back-end material. */
+/** Material data (merged, name NULL): create (*handle == 0) or update the back-end material. */
 typedef struct sy_mirror_material_args {
-    uint32_t id;
-    const sy_material_data *data;
-    uint32_t *handle; /* in/out */
+    uint32_t id; /**< core material id */
+    const sy_material_data *data; /**< the material's fields */
+    uint32_t *handle; /**< in/out */
 } sy_mirror_material_args;
 
-/* One primitive of a mesh as triangles (line and point primitives arrive tessellated into tubes
+/** One primitive of a mesh as triangles (line and point primitives arrive tessellated into tubes
  * and small spheres by sy_strokes.h, so every back-end draws the same strokes): create its
  * back-end mesh into *handle. */
 typedef struct sy_mirror_primitive_args {
-    uint32_t mesh_id, index;
-    const sy_primitive *primitive;
-    uint32_t *handle; /* out */
+    /** @{ core mesh id and the primitive's index in it */
+    uint32_t mesh_id, index; /** @} */
+    const sy_primitive *primitive; /**< the primitive (borrowed for the call) */
+    uint32_t *handle; /**< out */
 } sy_mirror_primitive_args;
 
-/* One instance of one placement: *handle == 0: create it from mesh/material/world/flags;
+/** One instance of one placement: *handle == 0: create it from mesh/material/world/flags;
  * otherwise update its world matrix and visibility. */
 typedef struct sy_mirror_instance_args {
-    uint32_t node, placement;
-    uint32_t mesh, material; /* back-end handles (material 0 = none) */
-    const sy_mat4 *world;
-    bool visible;
-    bool baked; /* SY_NODE_STATIC node, mesh used once, one placement: may be baked into the scene */
-    uint32_t *handle; /* in/out */
+    /** @{ core node id and which of its placements (DAG paths) */
+    uint32_t node, placement; /** @} */
+    /** @{ back-end handles (material 0 = none) */
+    uint32_t mesh, material; /** @} */
+    const sy_mat4 *world; /**< world matrix of the placement */
+    bool visible; /**< visible along this path */
+    bool baked; /**< SY_NODE_STATIC node, mesh used once, one placement: may be baked into the scene */
+    uint32_t *handle; /**< in/out */
 } sy_mirror_instance_args;
 
-/* The light of one visible placement: create (*handle == 0) or update. */
+/** The light of one visible placement: create (*handle == 0) or update. */
 typedef struct sy_mirror_light_args {
-    uint32_t node, placement;
-    const sy_light_data *light;
-    float position[3], direction[3]; /* world space; direction = the node's -Z */
-    uint32_t *handle; /* in/out */
+    /** @{ core node id and which of its placements */
+    uint32_t node, placement; /** @} */
+    const sy_light_data *light; /**< the light's fields */
+    /** @{ world space; direction = the node's -Z */
+    float position[3], direction[3]; /** @} */
+    uint32_t *handle; /**< in/out */
 } sy_mirror_light_args;
 
+/** Kinds of back-end objects the mirror creates. */
 typedef enum sy_mirror_kind {
     SY_MIRROR_TEXTURE,
     SY_MIRROR_MATERIAL,
@@ -78,67 +86,70 @@ typedef enum sy_mirror_kind {
     SY_MIRROR_LIGHT,
 } sy_mirror_kind;
 
-/* A back-end object the mirror no longer uses (handle != 0). */
+/** A back-end object the mirror no longer uses (handle != 0). */
 typedef struct sy_mirror_release_args {
-    sy_mirror_kind kind;
-    uint32_t handle;
+    sy_mirror_kind kind; /**< what kind of object */
+    uint32_t handle; /**< its back-end handle */
 } sy_mirror_release_args;
 
-/* Notification: type SY_TYPE_TEXTURE: a new back-end texture was made for id; SY_TYPE_MATERIAL
+/** Notification: type SY_TYPE_TEXTURE: a new back-end texture was made for id; SY_TYPE_MATERIAL
  * (destroyed): a mirrored material is gone; SY_TYPE_BACKGROUND: a background's colour,
  * environment or intensity changed, or it was destroyed (also when it was never mirrored). */
 typedef struct sy_mirror_object_args {
-    sy_object_type type;
-    uint32_t id;
-    bool destroyed;
+    sy_object_type type; /**< type of the object */
+    uint32_t id; /**< its core id */
+    bool destroyed; /**< the object was destroyed */
 } sy_mirror_object_args;
 
-/* The back-end side. Every entry but object_changed is required. Failing callbacks set err and
+/** The back-end side. Every entry but object_changed is required. Failing callbacks set err and
  * stop the sync (the mirror stays consistent: a later sync may retry). */
 typedef struct sy_mirror_callbacks {
-    sy_result (*texture_set)(void *user, const sy_mirror_texture_args *a, sy_error *err);
-    sy_result (*material_set)(void *user, const sy_mirror_material_args *a, sy_error *err);
-    sy_result (*primitive_set)(void *user, const sy_mirror_primitive_args *a, sy_error *err);
-    sy_result (*instance_set)(void *user, const sy_mirror_instance_args *a, sy_error *err);
-    sy_result (*light_set)(void *user, const sy_mirror_light_args *a, sy_error *err);
-    void (*release)(void *user, const sy_mirror_release_args *a);
-    void (*object_changed)(void *user, const sy_mirror_object_args *a); /* optional */
+    sy_result (*texture_set)(void *user, const sy_mirror_texture_args *a, sy_error *err); /**< creates a back-end texture */
+    sy_result (*material_set)(void *user, const sy_mirror_material_args *a, sy_error *err); /**< creates or updates a back-end material */
+    sy_result (*primitive_set)(void *user, const sy_mirror_primitive_args *a, sy_error *err); /**< creates a back-end mesh for one primitive */
+    sy_result (*instance_set)(void *user, const sy_mirror_instance_args *a, sy_error *err); /**< creates or updates an instance */
+    sy_result (*light_set)(void *user, const sy_mirror_light_args *a, sy_error *err); /**< creates or updates a light */
+    void (*release)(void *user, const sy_mirror_release_args *a); /**< releases a back-end object */
+    void (*object_changed)(void *user, const sy_mirror_object_args *a); /**< optional */
 } sy_mirror_callbacks;
 
+/** How a mediator sets up its mirror. */
 typedef struct sy_mirror_desc {
-    const char *name;       /* error prefix, e.g. "raster mediator" */
-    uint32_t root_node_id;  /* 0 = every parentless node is a root */
-    const sy_mirror_callbacks *callbacks; /* static storage */
-    void *user;
+    const char *name;       /**< error prefix, e.g. "raster mediator" */
+    uint32_t root_node_id;  /**< 0 = every parentless node is a root */
+    const sy_mirror_callbacks *callbacks; /**< static storage */
+    void *user; /**< passed to every callback */
 } sy_mirror_desc;
 
-/* What one sync did. */
+/** What one sync did. */
 typedef struct sy_mirror_sync_stats {
-    uint32_t entries;         /* change entries handled */
-    uint32_t placements;      /* node placements recomputed */
-    uint32_t nodes_destroyed; /* mirrored nodes removed */
+    uint32_t entries;         /**< change entries handled */
+    uint32_t placements;      /**< node placements recomputed */
+    uint32_t nodes_destroyed; /**< mirrored nodes removed */
 } sy_mirror_sync_stats;
 
-/* A mirrored background (defaults for fields never set). */
+/** A mirrored background (defaults for fields never set). */
 typedef struct sy_mirror_background {
-    uint32_t id;
-    float color[4];
-    uint32_t environment; /* core texture id, 0 = none */
-    float intensity;
-    sy_background_data world; /* every field (name NULL); color/environment/intensity repeat it */
+    uint32_t id; /**< core background id */
+    float color[4]; /**< background colour, linear RGBA premultiplied */
+    uint32_t environment; /**< core texture id, 0 = none */
+    float intensity; /**< environment multiplier */
+    sy_background_data world; /**< every field (name NULL); color/environment/intensity repeat it */
 } sy_mirror_background;
 
+/** Creates a mirror that drives the back-end through desc->callbacks. */
 sy_result sy_mirror_create(const sy_mirror_desc *desc, sy_mirror **out, sy_error *err);
+/** Destroys the mirror (NULL-safe) without calling release: back-end objects are the mediator's to free. */
 void sy_mirror_destroy(sy_mirror *m);
-/* Applies a change list (ordered as sy_changes delivers it), then re-places dirty subtrees.
+/** Applies a change list (ordered as sy_changes delivers it), then re-places dirty subtrees.
  * stats may be NULL; it is filled also when the sync fails. */
 sy_result sy_mirror_sync(sy_mirror *m, const sy_changes *changes, sy_mirror_sync_stats *stats, sy_error *err);
-/* Back-end handle of a mirrored texture (0 = unknown or incomplete). */
+/** Back-end handle of a mirrored texture (0 = unknown or incomplete). */
 uint32_t sy_mirror_texture_handle(const sy_mirror *m, uint32_t texture_id);
-/* Mirrored background or NULL. Borrowed until the next sync. */
+/** Mirrored background or NULL. Borrowed until the next sync. */
 const sy_mirror_background *sy_mirror_background_get(const sy_mirror *m, uint32_t background_id);
 
-/* The resolved look (sy_look.h) of a view of this scene with the given world (background id, 0 =
+/** The resolved look (sy_look.h) of a view of this scene with the given world (background id, 0 =
  * none): environment light, background and default lighting, decided by sy_look_resolve from what
  * the mirror holds. Every mediator asks this and nothing else. Texture ids in it are core ids
  * (sy_mirror_texture_handle gives the back-end handle). */

@@ -1,4 +1,5 @@
-/* sy_strokes.h — line and point primitives as triangle geometry, for every back-end alike.
+/** @file
+ * sy_strokes.h — line and point primitives as triangle geometry, for every back-end alike.
  *
  * Why: a stroke must cover the same pixels whichever back-end draws it. GL lines and points have a
  * width in pixels (and a driver-dependent maximum); Embree's curve and point primitives have a
@@ -33,17 +34,17 @@
 extern "C" {
 #endif
 
-#define SY_STROKES_TUBE_SIDES 6u
-#define SY_STROKES_TUBE_TRIANGLES (2u * SY_STROKES_TUBE_SIDES)
-#define SY_STROKES_BALL_VERTICES 12u
-#define SY_STROKES_BALL_TRIANGLES 20u
-#define SY_STROKES_MAX_TRIANGLES (1u << 28)
+#define SY_STROKES_TUBE_SIDES 6u /**< sides of a tube around a segment */
+#define SY_STROKES_TUBE_TRIANGLES (2u * SY_STROKES_TUBE_SIDES) /**< triangles of a tube segment */
+#define SY_STROKES_BALL_VERTICES 12u /**< vertices of a ball (icosahedron) */
+#define SY_STROKES_BALL_TRIANGLES 20u /**< triangles of a ball */
+#define SY_STROKES_MAX_TRIANGLES (1u << 28) /**< most output triangles of one primitive */
 
-/* Number of triangles the tessellation of p will have (0 for triangles; UINT64_MAX when p is
+/** Number of triangles the tessellation of p will have (0 for triangles; UINT64_MAX when p is
  * malformed, e.g. an index past the vertices). */
 uint64_t sy_strokes_triangle_count(const sy_primitive *p);
 
-/* Tessellates a line or point primitive (validated as sy_mesh_set_primitives does) into *out, a
+/** Tessellates a line or point primitive (validated as sy_mesh_set_primitives does) into *out, a
  * triangle primitive. width: the diameter (> 0; sy_primitive_stroke_width). what: prefix for
  * messages (e.g. "mesh 0x401 primitive 2"). */
 sy_result sy_strokes_tessellate(const sy_primitive *p, float width, const char *what, sy_primitive *out,

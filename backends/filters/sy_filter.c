@@ -1,14 +1,11 @@
 /* sy_filter.c — shared parts of the filter back-end: errors, parameter validation, frame checks,
- * NaN/Inf scan and the row-parallel pthread helper (see sy_filter.h). */
+ * NaN/Inf scan and the row-parallel helper on OpenMP's thread team (see sy_filter.h). */
 #include "sy_filter.h"
 
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
+#include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
-#include <stdlib.h>
-#include <unistd.h>
 
 const char *sy_filter_status_name(sy_filter_status s)
 {
@@ -167,164 +164,21 @@ sy_filter_status sy_filter_position_from_depth(uint32_t w, uint32_t h, const flo
     return SY_FILTER_OK;
 }
 
-uint32_t sy_filter_default_threads(void)
-{
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    if (n < 1) n = 1;
-    if (n > (long)SY_FILTER_MAX_THREADS) n = SY_FILTER_MAX_THREADS;
-    return (uint32_t)n;
-}
-
-typedef struct band {
-    sy_filter_rows_fn fn;
-    void *ctx;
-    uint32_t y0, y1;
-} band;
-
-static void *band_main(void *arg)
-{
-    band *b = arg;
-    b->fn(b->ctx, b->y0, b->y1);
-    return NULL;
-}
-
-sy_filter_status sy_filter_parallel_rows(uint32_t threads, uint32_t rows, sy_filter_rows_fn fn, void *ctx,
-                                         sy_filter_error *err)
-{
-    if (threads == 0) threads = sy_filter_default_threads();
-    if (threads > SY_FILTER_MAX_THREADS) threads = SY_FILTER_MAX_THREADS;
-    if (threads > rows) threads = rows ? rows : 1;
-    if (threads <= 1) {
-        if (rows) fn(ctx, 0, rows);
-        return SY_FILTER_OK;
-    }
-    band bands[SY_FILTER_MAX_THREADS];
-    pthread_t tids[SY_FILTER_MAX_THREADS];
-    bool started[SY_FILTER_MAX_THREADS] = {0};
-    for (uint32_t t = 0; t < threads; ++t)
-        bands[t] = (band){fn, ctx, (uint32_t)((uint64_t)rows * t / threads), (uint32_t)((uint64_t)rows * (t + 1) / threads)};
-    bool failed = false;
-    for (uint32_t t = 1; t < threads; ++t) {
-        if (pthread_create(&tids[t], NULL, band_main, &bands[t]) == 0)
-            started[t] = true;
-        else
-            band_main(&bands[t]), failed = true; /* run it here: the result is still complete */
-    }
-    band_main(&bands[0]);
-    for (uint32_t t = 1; t < threads; ++t)
-        if (started[t]) pthread_join(tids[t], NULL);
-    (void)failed; /* degraded to fewer threads, never an incomplete image */
-    (void)err;
-    return SY_FILTER_OK;
-}
-
-/* ---- persistent worker pool ---------------------------------------------------------------- */
-
-struct sy_filter_pool {
-    pthread_mutex_t mu;
-    pthread_cond_t go, done;
-    uint32_t threads;  /* asked for (including the caller) */
-    uint32_t started;  /* workers actually running */
-    uint64_t gen;      /* bumped per job */
-    uint32_t busy;     /* workers still in the current job */
-    bool quit;
-    sy_filter_rows_fn fn;
-    void *ctx;
-    uint32_t rows, chunk;
-    atomic_uint next; /* next unclaimed row */
-    pthread_t tids[SY_FILTER_MAX_THREADS];
-};
-
-static void pool_work(sy_filter_pool *p)
-{
-    for (;;) {
-        uint32_t y0 = atomic_fetch_add(&p->next, p->chunk);
-        if (y0 >= p->rows) return;
-        uint32_t y1 = p->rows - y0 < p->chunk ? p->rows : y0 + p->chunk;
-        p->fn(p->ctx, y0, y1);
-    }
-}
-
-static void *pool_main(void *arg)
-{
-    sy_filter_pool *p = arg;
-    uint64_t seen = 0;
-    pthread_mutex_lock(&p->mu);
-    for (;;) {
-        while (!p->quit && p->gen == seen) pthread_cond_wait(&p->go, &p->mu);
-        if (p->quit) break;
-        seen = p->gen;
-        pthread_mutex_unlock(&p->mu);
-        pool_work(p);
-        pthread_mutex_lock(&p->mu);
-        if (--p->busy == 0) pthread_cond_signal(&p->done);
-    }
-    pthread_mutex_unlock(&p->mu);
-    return NULL;
-}
-
-sy_filter_status sy_filter_pool_create(uint32_t threads, sy_filter_pool **out, sy_filter_error *err)
-{
-    if (!out) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "worker pool: out is NULL");
-    *out = NULL;
-    if (threads == 0) threads = sy_filter_default_threads();
-    if (threads > SY_FILTER_MAX_THREADS)
-        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "worker pool: threads = %u: at most %u", threads,
-                              SY_FILTER_MAX_THREADS);
-    sy_filter_pool *p = calloc(1, sizeof *p);
-    if (!p) return sy_filter_fail(err, SY_FILTER_ERROR_OUT_OF_MEMORY, "worker pool: out of memory");
-    if (pthread_mutex_init(&p->mu, NULL)) return free(p), sy_filter_fail(err, SY_FILTER_ERROR_THREADS, "worker pool: mutex");
-    if (pthread_cond_init(&p->go, NULL)) {
-        pthread_mutex_destroy(&p->mu), free(p);
-        return sy_filter_fail(err, SY_FILTER_ERROR_THREADS, "worker pool: condition variable");
-    }
-    if (pthread_cond_init(&p->done, NULL)) {
-        pthread_cond_destroy(&p->go), pthread_mutex_destroy(&p->mu), free(p);
-        return sy_filter_fail(err, SY_FILTER_ERROR_THREADS, "worker pool: condition variable");
-    }
-    p->threads = threads;
-    atomic_init(&p->next, 0);
-    for (uint32_t t = 1; t < threads; ++t) {
-        if (pthread_create(&p->tids[p->started], NULL, pool_main, p) != 0) break; /* fewer threads, same result */
-        ++p->started;
-    }
-    *out = p;
-    return SY_FILTER_OK;
-}
-
-void sy_filter_pool_destroy(sy_filter_pool *p)
-{
-    if (!p) return;
-    pthread_mutex_lock(&p->mu);
-    p->quit = true;
-    pthread_cond_broadcast(&p->go);
-    pthread_mutex_unlock(&p->mu);
-    for (uint32_t t = 0; t < p->started; ++t) pthread_join(p->tids[t], NULL);
-    pthread_cond_destroy(&p->done), pthread_cond_destroy(&p->go), pthread_mutex_destroy(&p->mu);
-    free(p);
-}
-
-uint32_t sy_filter_pool_threads(const sy_filter_pool *p) { return p ? p->threads : 0; }
-
-void sy_filter_pool_rows(sy_filter_pool *p, uint32_t rows, sy_filter_rows_fn fn, void *ctx)
+void sy_filter_parallel_rows(uint32_t threads, uint32_t rows, sy_filter_rows_fn fn, void *ctx)
 {
     if (!rows) return;
-    if (!p || p->started == 0 || rows < 2) {
-        fn(ctx, 0, rows);
-        return;
+    int team = threads ? (int)(threads < SY_FILTER_MAX_THREADS ? threads : SY_FILTER_MAX_THREADS)
+                       : omp_get_max_threads();
+    if ((uint32_t)team > rows) team = (int)rows;
+    /* about 16 chunks per thread, handed out dynamically: the phases end together even when
+     * another process takes a core for a while */
+    uint32_t chunk = rows / (16u * (uint32_t)team);
+    if (!chunk) chunk = 1;
+    const int chunks = (int)((rows + chunk - 1) / chunk);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(team) if (team > 1) default(none) \
+    firstprivate(fn, ctx, rows, chunk, chunks)
+    for (int k = 0; k < chunks; ++k) {
+        uint32_t y0 = (uint32_t)k * chunk;
+        fn(ctx, y0, rows - y0 < chunk ? rows : y0 + chunk);
     }
-    /* about 16 chunks per thread: the phases end together even when another process takes a core
-     * for a while (claiming a chunk is one atomic add) */
-    uint32_t chunk = rows / (16 * (p->started + 1));
-    pthread_mutex_lock(&p->mu);
-    p->fn = fn, p->ctx = ctx, p->rows = rows, p->chunk = chunk ? chunk : 1;
-    atomic_store(&p->next, 0);
-    p->busy = p->started;
-    ++p->gen;
-    pthread_cond_broadcast(&p->go);
-    pthread_mutex_unlock(&p->mu);
-    pool_work(p);
-    pthread_mutex_lock(&p->mu);
-    while (p->busy) pthread_cond_wait(&p->done, &p->mu);
-    pthread_mutex_unlock(&p->mu);
 }

@@ -1,7 +1,8 @@
-/* sy_filter.h — common API of the noise-reduction filter back-end (backends/filters): the input
+/** @file
+ * sy_filter.h — common API of the noise-reduction filter back-end (backends/filters): the input
  * frame description (plain float buffers of a progressive path tracer), errors, parameter
  * validation helpers, the NaN/Inf scan that keeps bad samples out of every neighbourhood, and the
- * row-parallel pthread helper shared by all filters.
+ * row-parallel helper (OpenMP) shared by all filters.
  *
  * The library is standalone: it never includes core/, mediators/, formats/, apps/ or another
  * back-end's headers. Filters: pixel filtering (sy_filter_pixel.h, Schwenk 2013 ch. 3), radiance
@@ -15,7 +16,8 @@
  *
  * Errors: fallible calls return sy_filter_status and, when err != NULL, fill err->message with the
  * filter, parameter and reason. No global state. Thread-safety: a filter object is used by one
- * thread at a time; distinct objects are independent; the filters themselves run multithreaded. */
+ * thread at a time; distinct objects are independent; the filters themselves run multithreaded on
+ * the process's OpenMP thread team (sy_filter_parallel_rows). */
 #ifndef SY_FILTER_H
 #define SY_FILTER_H
 
@@ -23,23 +25,26 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/** Result of every fallible filter call. */
 typedef enum sy_filter_status {
     SY_FILTER_OK = 0,
-    SY_FILTER_ERROR_INVALID_ARGUMENT = 1, /* parameter out of range, missing buffer, bad size */
+    SY_FILTER_ERROR_INVALID_ARGUMENT = 1, /**< parameter out of range, missing buffer, bad size */
     SY_FILTER_ERROR_OUT_OF_MEMORY = 2,
-    SY_FILTER_ERROR_THREADS = 3 /* pthread_create failed */
+    SY_FILTER_ERROR_THREADS = 3 /**< not returned any more (filters run on OpenMP's team); kept so
+                                 * the values stay stable */
 } sy_filter_status;
 
+/** A status plus its message (the filter, parameter and reason). */
 typedef struct sy_filter_error {
-    sy_filter_status status;
-    char message[256];
+    sy_filter_status status; /**< the status */
+    char message[256]; /**< the message */
 } sy_filter_error;
 
-/* Largest accepted image side and thread count. */
+/** Largest accepted image side and thread count. */
 #define SY_FILTER_MAX_SIDE 32768u
-#define SY_FILTER_MAX_THREADS 256u
+#define SY_FILTER_MAX_THREADS 256u /**< largest accepted thread count */
 
-/* One frame of a progressive renderer's buffers. Every pointer is borrowed for the duration of
+/** One frame of a progressive renderer's buffers. Every pointer is borrowed for the duration of
  * the call; width*height pixels, row-major, no padding. Which buffers a filter needs is stated in
  * its header; unused ones may be NULL.
  *   color      RGB or premultiplied RGBA (color_channels = 3 or 4): mean radiance of all paths.
@@ -56,38 +61,44 @@ typedef struct sy_filter_error {
  *   range      RGBA range buffer ("virtual flash" RGB + depth in A), see sy_filter_range_compose;
  *              NULL: pixel filtering composes it from albedo/normal/depth(/position). */
 typedef struct sy_filter_frame {
-    uint32_t width, height;
-    uint32_t color_channels, variance_channels;
-    const float *color, *variance, *albedo, *normal, *depth, *position, *direct, *indirect, *spp, *range;
-    float spp_uniform;
-    bool has_camera;           /* camera_position valid: headlight term of the composed range buffer */
-    float camera_position[3];  /* world-space eye position */
+    /** @{ image size in pixels */
+    uint32_t width, height; /** @} */
+    /** @{ channels of color (3 or 4) and of variance (1 or 3) */
+    uint32_t color_channels, variance_channels; /** @} */
+    /** @{ the buffers described above (NULL when unused) */
+    const float *color, *variance, *albedo, *normal, *depth, *position, *direct, *indirect, *spp, *range; /** @} */
+    float spp_uniform; /**< samples per pixel when spp is NULL */
+    bool has_camera;           /**< camera_position valid: headlight term of the composed range buffer */
+    float camera_position[3];  /**< world-space eye position */
 } sy_filter_frame;
 
-/* Per-call statistics every filter fills (any pointer may be NULL). */
+/** Per-call statistics every filter fills (any pointer may be NULL). */
 typedef struct sy_filter_stats {
-    uint64_t nonfinite_samples; /* NaN/Inf pixels found in the inputs, excluded from neighbourhoods */
-    uint64_t filtered_pixels;   /* pixels whose output used a neighbourhood this call */
-    double seconds;             /* wall time of the call */
-    bool filter_pass;           /* pixel filter: a filter pass ran this frame (2^i schedule) */
-    double mean_blend;          /* pixel filter: mean blend factor s; radiance: share in correction phase */
+    uint64_t nonfinite_samples; /**< NaN/Inf pixels found in the inputs, excluded from neighbourhoods */
+    uint64_t filtered_pixels;   /**< pixels whose output used a neighbourhood this call */
+    double seconds;             /**< wall time of the call */
+    bool filter_pass;           /**< pixel filter: a filter pass ran this frame (2^i schedule) */
+    double mean_blend;          /**< pixel filter: mean blend factor s; radiance: share in correction phase */
 } sy_filter_stats;
 
+/** Short name of a status. Static storage. */
 const char *sy_filter_status_name(sy_filter_status s);
 
-/* Fill err (if non-NULL) and return status; printf-style message. */
+/** Fill err (if non-NULL) and return status; printf-style message. */
 sy_filter_status sy_filter_fail(sy_filter_error *err, sy_filter_status status, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
 
-/* Parameter validation, the one place every filter uses: positive finite (sigma-like), non-negative
+/** Parameter validation, the one place every filter uses: positive finite (sigma-like), non-negative
  * finite (threshold-like), inclusive range. `what` names "filter.parameter" in the message. */
 sy_filter_status sy_filter_check_positive(float v, const char *what, sy_filter_error *err);
+/** Fails unless v is finite and >= 0. */
 sy_filter_status sy_filter_check_nonnegative(float v, const char *what, sy_filter_error *err);
+/** Fails unless v is finite and within [lo, hi]. */
 sy_filter_status sy_filter_check_range(float v, float lo, float hi, const char *what, sy_filter_error *err);
-/* Image size and the buffers flagged in `need` (SY_FILTER_NEED_*) present; channel counts valid. */
+/** Image size and the buffers flagged in `need` (SY_FILTER_NEED_*) present; channel counts valid. */
 enum {
     SY_FILTER_NEED_COLOR = 1u << 0,
     SY_FILTER_NEED_VARIANCE = 1u << 1,
@@ -95,16 +106,17 @@ enum {
     SY_FILTER_NEED_NORMAL = 1u << 3,
     SY_FILTER_NEED_DEPTH = 1u << 4,
     SY_FILTER_NEED_POSITION = 1u << 5,
-    SY_FILTER_NEED_SPLIT = 1u << 6 /* direct and indirect */
+    SY_FILTER_NEED_SPLIT = 1u << 6 /**< direct and indirect */
 };
+/** Fails unless the frame's size and channel counts are valid and every buffer in need is present. */
 sy_filter_status sy_filter_check_frame(const sy_filter_frame *f, uint32_t need, const char *filter,
                                        sy_filter_error *err);
 
-/* Mark pixels whose used buffers hold a NaN/Inf (mask[i] = 0, else 1; +INFINITY depth is a valid
+/** Mark pixels whose used buffers hold a NaN/Inf (mask[i] = 0, else 1; +INFINITY depth is a valid
  * miss). Returns the number of bad pixels. `need` as above selects the buffers inspected. */
 uint64_t sy_filter_scan_finite(const sy_filter_frame *f, uint32_t need, uint8_t *mask);
 
-/* World positions of the first hits from a camera-axis depth buffer (as SY_RT_AOV_DEPTH) for a
+/** World positions of the first hits from a camera-axis depth buffer (as SY_RT_AOV_DEPTH) for a
  * pinhole camera: camera_to_world is a 4x4 column-major matrix (camera looks down local -Z, +Y up),
  * yfov the vertical field of view in radians, aspect = width / height of the view. Misses (+INF or
  * NaN depth) get the point 1e18 along the pixel's ray, so guides treat them as far away. out:
@@ -112,17 +124,18 @@ uint64_t sy_filter_scan_finite(const sy_filter_frame *f, uint32_t need, uint8_t 
 sy_filter_status sy_filter_position_from_depth(uint32_t width, uint32_t height, const float camera_to_world[16],
                                                float yfov, const float *depth, float *out, sy_filter_error *err);
 
-/* Rec.709 luminance. */
+/** Rec.709 luminance. */
 static inline float sy_filter_luminance(const float *rgb)
 {
     return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2];
 }
-/* Scalar variance of the colour mean of pixel i (luminance; 3-channel variances assume fully
+/** Scalar variance of the colour mean of pixel i (luminance; 3-channel variances assume fully
  * correlated channels, as path-traced RGB is: sd_Y = sum_c w_c sd_c — spec 1.2 [GAP] colour->scalar). */
 float sy_filter_pixel_variance(const sy_filter_frame *f, size_t i);
+/** Samples of pixel i (spp buffer, else spp_uniform). */
 float sy_filter_pixel_spp(const sy_filter_frame *f, size_t i);
 
-/* exp(-x) for x >= 0, relative error < 2e-4, 0 beyond x = 40: the range-kernel hot path. */
+/** exp(-x) for x >= 0, relative error < 2e-4, 0 beyond x = 40: the range-kernel hot path. */
 static inline float sy_filter_expneg(float x)
 {
     if (!(x < 40.0f)) return 0.0f;
@@ -138,27 +151,21 @@ static inline float sy_filter_expneg(float x)
     return p * s.fl;
 }
 
-/* Run fn(ctx, y0, y1) over rows [0, rows) split into contiguous bands on `threads` threads
- * (0 = online CPU count); the calling thread runs one band. Blocks until all are done. */
+/** Row function of sy_filter_parallel_rows: processes rows [y0, y1). */
 typedef void (*sy_filter_rows_fn)(void *ctx, uint32_t y0, uint32_t y1);
-sy_filter_status sy_filter_parallel_rows(uint32_t threads, uint32_t rows, sy_filter_rows_fn fn, void *ctx,
-                                         sy_filter_error *err);
-uint32_t sy_filter_default_threads(void);
+/** Runs fn(ctx, y0, y1) over rows [0, rows) on the process's OpenMP thread team (libgomp), which
+ * every filter and the ray tracers share: no filter object owns threads, and a team's threads stay
+ * alive between calls, so the many short phases of an interactive frame start at no thread-creation
+ * cost. threads = team size (0 = the OpenMP default: OMP_NUM_THREADS, else the cores this process
+ * may run on; at most SY_FILTER_MAX_THREADS); the calling thread is one of them. Chunks of rows
+ * are handed out dynamically (a busy core takes fewer); results never depend on the split (fn must
+ * treat rows independently). Blocks until every row is done; cannot fail. Called from inside an
+ * active OpenMP parallel region it runs on the calling thread only (unless nesting is enabled).
+ * Where other busy processes share the cores, set OMP_WAIT_POLICY=passive: libgomp's default
+ * spin-waiting between the many short phases of a filter then costs several times the work. */
+void sy_filter_parallel_rows(uint32_t threads, uint32_t rows, sy_filter_rows_fn fn, void *ctx);
 
-/* Persistent worker pool: threads are created once (by the filter object that owns the pool) and
- * reused for every row-parallel phase of every frame; no global state. run_rows hands out chunks
- * of rows dynamically (a busy core takes fewer), the calling thread works too, and it returns
- * when every row is done. Results never depend on the split (rows are independent).
- * Ownership: the creator owns the pool. Thread-safety: one run_rows at a time per pool. A thread
- * that cannot be started leaves a smaller pool (never an incomplete result). */
-typedef struct sy_filter_pool sy_filter_pool;
-/* threads = total threads including the caller (0 = online CPU count). */
-sy_filter_status sy_filter_pool_create(uint32_t threads, sy_filter_pool **out, sy_filter_error *err);
-void sy_filter_pool_destroy(sy_filter_pool *pool);
-uint32_t sy_filter_pool_threads(const sy_filter_pool *pool); /* the count asked for at creation */
-void sy_filter_pool_rows(sy_filter_pool *pool, uint32_t rows, sy_filter_rows_fn fn, void *ctx);
-
-/* sy_filter_scan_finite for rows [y0, y1) only (the mask is indexed by pixel as there). */
+/** sy_filter_scan_finite for rows [y0, y1) only (the mask is indexed by pixel as there). */
 uint64_t sy_filter_scan_finite_rows(const sy_filter_frame *f, uint32_t need, uint8_t *mask, uint32_t y0, uint32_t y1);
 
 #endif /* SY_FILTER_H */

@@ -197,7 +197,7 @@ sy_filter_status sy_filter_adaptive(const sy_filter_adaptive_params *p, const sy
                     }
             }
     actx c = {.p = p, .in = in, .ok = ok, .lv = lv, .nlev = nlev, .out = out, .lvl_out = level_out};
-    s = sy_filter_parallel_rows(p->threads, in->height, out_rows, &c, err);
+    sy_filter_parallel_rows(p->threads, in->height, out_rows, &c);
     free(ok);
     for (uint32_t l = 0; l < nlev; ++l) free(lv[l].t);
     if (stats && s == SY_FILTER_OK) {

@@ -142,7 +142,7 @@ sy_filter_status sy_filter_atrous(const sy_filter_atrous_params *p, const sy_fil
     float sc = p->sigma_color;
     for (uint32_t it = 0; it < p->iterations && s == SY_FILTER_OK; ++it) {
         c.src = a, c.dst = b, c.step = 1 << it, c.inv_c = 1.0f / (sc * sc);
-        s = sy_filter_parallel_rows(p->threads, in->height, atrous_rows, &c, err);
+        sy_filter_parallel_rows(p->threads, in->height, atrous_rows, &c);
         float *t = a;
         a = b, b = t;
         if (p->halve_color_sigma) sc *= 0.5f;

@@ -115,7 +115,8 @@ sy_filter_status sy_filter_jbu_upsample(const sy_filter_jbu_params *p, const flo
     uctx c = {.p = p, .low = low, .ld = ld, .ln = ln, .lw = lw, .lh = lh, .g = g, .out = out3,
               .inv_s = 1.0f / (p->sigma_spatial * p->sigma_spatial),
               .inv_d = 1.0f / (p->sigma_depth * p->sigma_depth), .inv_n = 1.0f / (p->sigma_normal * p->sigma_normal)};
-    return sy_filter_parallel_rows(p->threads, g->height, up_rows, &c, err);
+    sy_filter_parallel_rows(p->threads, g->height, up_rows, &c);
+    return SY_FILTER_OK;
 }
 
 sy_filter_status sy_filter_jbu(const sy_filter_jbu_params *p, const sy_filter_frame *in, float *out,

@@ -1,4 +1,5 @@
-/* sy_filter_metrics.h — image-quality metrics for the filter harness: RMSE, relative MSE and SSIM
+/** @file
+ * sy_filter_metrics.h — image-quality metrics for the filter harness: RMSE, relative MSE and SSIM
  * (Wang, Bovik, Sheikh, Simoncelli 2004) of an image against a reference.
  *
  * Images are float RGB or RGBA (channels 3 or 4; alpha ignored), width*height pixels.
@@ -15,16 +16,19 @@
 
 #include "sy_filter.h"
 
+/** Error metrics of an image against a reference. */
 typedef struct sy_filter_metrics {
-    double rmse, relmse, ssim;
-    uint64_t nonfinite; /* pixels skipped */
+    /** @{ root mean squared error; relative MSE; SSIM */
+    double rmse, relmse, ssim; /** @} */
+    uint64_t nonfinite; /**< pixels skipped */
 } sy_filter_metrics;
 
+/** RMSE, relMSE and SSIM of image against reference (width x height x channels floats). */
 sy_filter_status sy_filter_metrics_compute(const float *image, const float *reference, uint32_t width,
                                            uint32_t height, uint32_t channels, sy_filter_metrics *out,
                                            sy_filter_error *err);
 
-/* SSIM alone on two single-channel images already in [0, 1] (dynamic range L = 1). */
+/** SSIM alone on two single-channel images already in [0, 1] (dynamic range L = 1). */
 double sy_filter_ssim_gray(const float *a, const float *b, uint32_t width, uint32_t height);
 
 #endif /* SY_FILTER_METRICS_H */

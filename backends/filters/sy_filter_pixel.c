@@ -24,7 +24,6 @@ struct sy_filter_pixel {
     sy_filter_pixel_params p;
     uint32_t w, h;
     bool have_pass;
-    sy_filter_pool *pool; /* created on the first run, kept across frames (params.threads) */
     float *guide;   /* 4/px: range RGB + depth (copy used by the pass) */
     uint8_t *ok;    /* 1 = value and guide finite */
     uint8_t *gok;   /* 1 = guide finite (the range term applies with this pixel as centre) */
@@ -590,12 +589,12 @@ static void box_v_rows(void *vctx, uint32_t y0, uint32_t y1)
 }
 
 /* separable (2R+1)^2 box mean over valid pixels, row-parallel */
-static void box_masked(sy_filter_pool *pool, const float *src, const uint8_t *ok, float *dst, float *tmp, int w, int h,
+static void box_masked(uint32_t threads, const float *src, const uint8_t *ok, float *dst, float *tmp, int w, int h,
                        int R)
 {
     box_ctx b = {src, ok, dst, tmp, w, h, R};
-    sy_filter_pool_rows(pool, (uint32_t)h, box_h_rows, &b);
-    sy_filter_pool_rows(pool, (uint32_t)h, box_v_rows, &b);
+    sy_filter_parallel_rows(threads, (uint32_t)h, box_h_rows, &b);
+    sy_filter_parallel_rows(threads, (uint32_t)h, box_v_rows, &b);
 }
 
 static void free_buffers(sy_filter_pixel *pf)
@@ -610,7 +609,6 @@ void sy_filter_pixel_destroy(sy_filter_pixel *pf)
 {
     if (!pf) return;
     free_buffers(pf);
-    sy_filter_pool_destroy(pf->pool);
     free(pf);
 }
 
@@ -812,38 +810,38 @@ static void filter_pass(sy_filter_pixel *pf, const sy_filter_frame *in)
     prep_ctx pc = {.pf = pf, .in = in};
     atomic_init(&pc.any_single, false);
     atomic_init(&pc.bad, 0);
-    sy_filter_pool_rows(pf->pool, pf->h, prep_rows, &pc);
+    sy_filter_parallel_rows(pf->p.threads, pf->h, prep_rows, &pc);
     /* [GAP spec 1.2, variance before two samples]: Welford gives no variance at 1 spp. There the
      * per-sample variance is taken as the squared deviation of the pixel's HV luminance from its
      * 5x5 neighbourhood mean; the bilateral pass smooths it like any variance estimate. */
     if (atomic_load(&pc.any_single)) {
-        sy_filter_pool_rows(pf->pool, pf->h, lum_rows, &pc);
-        box_masked(pf->pool, pf->tmp[0], pf->ok, pf->tmp[1], pf->tmp[2], w, h, 2);
-        sy_filter_pool_rows(pf->pool, pf->h, single_var_rows, &pc);
+        sy_filter_parallel_rows(pf->p.threads, pf->h, lum_rows, &pc);
+        box_masked(pf->p.threads, pf->tmp[0], pf->ok, pf->tmp[1], pf->tmp[2], w, h, 2);
+        sy_filter_parallel_rows(pf->p.threads, pf->h, single_var_rows, &pc);
     }
     /* spatial sigma per pixel: fixed (set in prep_rows), or adaptive (Sec. 3.6.3, Eqs. 3.15-3.17) */
     if (p->adaptive_width) {
         /* u from 5x5 box-smoothed variance of the mean and background luminance (raw early
          * estimates differ too much between neighbours to size kernels from) */
-        sy_filter_pool_rows(pf->pool, pf->h, adapt_in_rows, &pc);
-        box_masked(pf->pool, pf->tmp[0], pf->ok, pf->oth[0], pf->oth[2], w, h, 2);
-        box_masked(pf->pool, pf->tmp[1], pf->ok, pf->oth[1], pf->oth[2], w, h, 2);
+        sy_filter_parallel_rows(pf->p.threads, pf->h, adapt_in_rows, &pc);
+        box_masked(pf->p.threads, pf->tmp[0], pf->ok, pf->oth[0], pf->oth[2], w, h, 2);
+        box_masked(pf->p.threads, pf->tmp[1], pf->ok, pf->oth[1], pf->oth[2], w, h, 2);
         float s0 = p->adaptive_sigma0 > 0.0f ? p->adaptive_sigma0 : 2.0f * p->sigma_s; /* [GAP spec 1.10(b)]:
                                            sigma_bar(0) = 2 sigma_s, so the guide equals sigma_s at frame 4 */
         pc.bv = pf->oth[0], pc.bl = pf->oth[1], pc.s0 = s0;
-        sy_filter_pool_rows(pf->pool, pf->h, sigma_rows, &pc);
+        sy_filter_parallel_rows(pf->p.threads, pf->h, sigma_rows, &pc);
     }
     pass_ctx c = {.pf = pf, .inv2c = 0.5f / (p->sigma_c * p->sigma_c), .inv2d = 0.5f / (p->sigma_d * p->sigma_d)};
     if (p->kernel == SY_FILTER_PIXEL_BRUTE) {
         for (int k = 0; k < 4; ++k) c.src[k] = pf->val[k];
         c.dst[0] = pf->lf, c.rdst = pf->r, c.a0 = pf->a0;
-        sy_filter_pool_rows(pf->pool, pf->h, brute_rows, &c);
+        sy_filter_parallel_rows(pf->p.threads, pf->h, brute_rows, &c);
     } else {
         /* Eq. 3.14: sigma_k = sigma sqrt(3) 2^(N-k) / sqrt(4^N - 1); sum of squares = sigma^2 */
         uint32_t N = p->iterations;
         float norm = sqrtf(3.0f) / sqrtf(powf(4.0f, (float)N) - 1.0f);
         float **cur = pf->val, **other = pf->oth;
-        if (p->aa_recovery) sy_filter_pool_rows(pf->pool, pf->h, edge_rows, pf);
+        if (p->aa_recovery) sy_filter_parallel_rows(pf->p.threads, pf->h, edge_rows, pf);
         sy_filter_rows_fn sep = sep_rows_best();
         /* [GAP spec 1.10(a)]: r of the iterated filter. One separable iteration propagates r
          * exactly (r_k); iterations compose like convolved Gaussians, whose 1/r add up:
@@ -857,10 +855,10 @@ static void filter_pass(sy_filter_pixel *pf, const sy_filter_frame *in)
             c.a0 = k == N ? pf->a0 : NULL;
             for (int q = 0; q < 4; ++q) c.src[q] = cur[q], c.dst[q] = pf->tmp[q];
             c.rsrc = NULL, c.rdst = pf->rtmp, c.dir = 0, c.last = false;
-            sy_filter_pool_rows(pf->pool, pf->h, sep, &c);
+            sy_filter_parallel_rows(pf->p.threads, pf->h, sep, &c);
             for (int q = 0; q < 4; ++q) c.src[q] = pf->tmp[q], c.dst[q] = other[q];
             c.rsrc = pf->rtmp, c.rdst = pf->racc, c.dir = 1, c.last = k == N;
-            sy_filter_pool_rows(pf->pool, pf->h, sep, &c);
+            sy_filter_parallel_rows(pf->p.threads, pf->h, sep, &c);
             float **t = cur;
             cur = other, other = t;
         }
@@ -938,19 +936,15 @@ sy_filter_status sy_filter_pixel_run(sy_filter_pixel *pf, const sy_filter_frame 
         if ((s = ensure_size(pf, in->width, in->height, err))) return s;
     }
     if (!pf->p.all_high_variance && in->direct && in->indirect) need |= SY_FILTER_NEED_SPLIT;
-    /* the worker pool lives as long as the object (recreated only when params.threads changes) */
-    uint32_t want = pf->p.threads ? pf->p.threads : sy_filter_default_threads();
-    if (pf->pool && sy_filter_pool_threads(pf->pool) != want) sy_filter_pool_destroy(pf->pool), pf->pool = NULL;
-    if (!pf->pool && (s = sy_filter_pool_create(want, &pf->pool, err))) return s;
     prep_ctx sc = {.pf = pf, .in = in, .need = need};
     atomic_init(&sc.any_single, false);
     atomic_init(&sc.bad, 0);
-    sy_filter_pool_rows(pf->pool, pf->h, scan_rows, &sc);
+    sy_filter_parallel_rows(pf->p.threads, pf->h, scan_rows, &sc);
     uint64_t bad = atomic_load(&sc.bad);
     bool pass = force_pass || sy_filter_pixel_scheduled(&pf->p, frame);
     if (pass) filter_pass(pf, in);
     blend_ctx b = {.pf = pf, .in = in, .out = out};
-    sy_filter_pool_rows(pf->pool, pf->h, blend_rows, &b);
+    sy_filter_parallel_rows(pf->p.threads, pf->h, blend_rows, &b);
     if (stats) {
         size_t n = (size_t)pf->w * pf->h;
         double ssum = 0;

@@ -21,7 +21,6 @@ struct sy_filter_radiance {
     float *alpha2;
     float *radius; /* 1/px kernel radius (px) of the last frame, 0 = correction phase */
     uint8_t *phase; /* 1 = correction */
-    sy_filter_pool *pool; /* created on the first frame (params.threads), kept across frames */
     /* per-frame neighbour data, compact (SoA), filled from the inputs before the gather: */
     float *px, *py, *pz; /* sample position; NaN where the sample is invalid (prism test rejects) */
     float *wi[3], *rad[3]; /* sample direction and incident radiance, one array per component */
@@ -406,7 +405,6 @@ void sy_filter_radiance_destroy(sy_filter_radiance *rf)
 {
     if (!rf) return;
     rf_free_buffers(rf);
-    sy_filter_pool_destroy(rf->pool);
     free(rf);
 }
 
@@ -506,7 +504,6 @@ sy_filter_status sy_filter_radiance_frame(sy_filter_radiance *rf, const sy_filte
         memset(rf->ptacc, 0, 3 * n * sizeof(float));
         for (size_t i = 0; i < n; ++i) rf->svar[i] = 0.0f, rf->alpha[i] = 1.0f;
     }
-    if (!rf->pool && (s = sy_filter_pool_create(rf->p.threads, &rf->pool, err))) return s;
     uint8_t *ok = rf->ok;
     uint64_t bad = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -521,8 +518,8 @@ sy_filter_status sy_filter_radiance_frame(sy_filter_radiance *rf, const sy_filte
     rf->k++;
     rctx c = {.rf = rf, .in = in, .sok = ok, .hok = ok + n, .bsdf = in->bsdf, .bsdf_batch = in->bsdf_batch};
     if (!c.bsdf_batch && !c.bsdf) c.bsdf_batch = sy_filter_rf_bsdf_default_batch;
-    sy_filter_pool_rows(rf->pool, rf->h, rf_prep_rows, &c);
-    sy_filter_pool_rows(rf->pool, rf->h, rf_rows, &c);
+    sy_filter_parallel_rows(rf->p.threads, rf->h, rf_prep_rows, &c);
+    sy_filter_parallel_rows(rf->p.threads, rf->h, rf_rows, &c);
     float *t = rf->svar;
     rf->svar = rf->svar2, rf->svar2 = t;
     t = rf->alpha, rf->alpha = rf->alpha2, rf->alpha2 = t;

@@ -1,4 +1,5 @@
-/* sy_gl.h — public API of the OpenGL 3.3 core rasterizer back-end (backends/raster).
+/** @file
+ * sy_gl.h — public API of the OpenGL 3.3 core rasterizer back-end (backends/raster).
  *
  * A standalone renderer library with its own small scene API (meshes, textures, materials,
  * instances, punctual lights, background), like a third-party renderer: it knows nothing about
@@ -83,17 +84,19 @@
 extern "C" {
 #endif
 
+/** Result codes of every fallible sy_gl call. */
 typedef enum sy_gl_result {
     SY_GL_OK = 0,
     SY_GL_ERROR_INVALID_ARGUMENT = 1,
     SY_GL_ERROR_INVALID_HANDLE = 2,
     SY_GL_ERROR_OUT_OF_MEMORY = 3,
     SY_GL_ERROR_LIMIT = 4,
-    SY_GL_ERROR_NO_CONTEXT = 5, /* the provider could not give a GL 3.3 core context */
-    SY_GL_ERROR_GL = 6,         /* a GL call or shader compile failed (log included) */
+    SY_GL_ERROR_NO_CONTEXT = 5, /**< the provider could not give a GL 3.3 core context */
+    SY_GL_ERROR_GL = 6,         /**< a GL call or shader compile failed (log included) */
     SY_GL_RESULT_MAX_ENUM = 0x7fffffff
 } sy_gl_result;
 
+/** OpenGL context providers. */
 typedef enum sy_gl_provider {
     SY_GL_PROVIDER_OSMESA = 0,
     SY_GL_PROVIDER_EGL = 1,
@@ -101,159 +104,207 @@ typedef enum sy_gl_provider {
     SY_GL_PROVIDER_MAX_ENUM = 0x7fffffff
 } sy_gl_provider;
 
-/* "osmesa", "egl", "glfw". Static storage. */
+/** "osmesa", "egl", "glfw". Static storage. */
 const char *sy_gl_provider_name(sy_gl_provider p);
-/* Parses a provider name; false when unknown. */
+/** Parses a provider name; false when unknown. */
 bool sy_gl_provider_parse(const char *name, sy_gl_provider *out);
 
+/** An OpenGL renderer with its context (opaque). */
 typedef struct sy_gl_device sy_gl_device;
-typedef struct sy_gl_mesh { uint32_t id; } sy_gl_mesh;
-typedef struct sy_gl_texture { uint32_t id; } sy_gl_texture;
-typedef struct sy_gl_material { uint32_t id; } sy_gl_material;
-typedef struct sy_gl_instance { uint32_t id; } sy_gl_instance;
-typedef struct sy_gl_light { uint32_t id; } sy_gl_light;
+/** Handle of a mesh. */
+typedef struct sy_gl_mesh { uint32_t id; /**< index + generation; 0 = none */ } sy_gl_mesh;
+/** Handle of a texture. */
+typedef struct sy_gl_texture { uint32_t id; /**< index + generation; 0 = none */ } sy_gl_texture;
+/** Handle of a material. */
+typedef struct sy_gl_material { uint32_t id; /**< index + generation; 0 = none */ } sy_gl_material;
+/** Handle of an instance. */
+typedef struct sy_gl_instance { uint32_t id; /**< index + generation; 0 = none */ } sy_gl_instance;
+/** Handle of a punctual light. */
+typedef struct sy_gl_light { uint32_t id; /**< index + generation; 0 = none */ } sy_gl_light;
 
+/** Receives one warning message. */
 typedef void (*sy_gl_log_fn)(void *user, const char *message);
 
+/** Device options (sy_gl_device_create). */
 typedef struct sy_gl_device_desc {
-    sy_gl_provider provider;
-    uint32_t msaa;             /* samples per pixel: 0/1 = none, else clamped to GL_MAX_SAMPLES (warning) */
-    uint32_t shadow_map_size;  /* texels per side; 0 = 2048 */
-    uint32_t max_texture_size; /* 0 = GL_MAX_TEXTURE_SIZE; smaller values force downscaling */
-    uint32_t window_width, window_height; /* GLFW window size; 0 = 640 x 480 */
-    sy_gl_log_fn log;          /* warnings; NULL = silent */
-    void *log_user;
+    sy_gl_provider provider; /**< OSMesa, EGL or GLFW */
+    uint32_t msaa;             /**< samples per pixel: 0/1 = none, else clamped to GL_MAX_SAMPLES (warning) */
+    uint32_t shadow_map_size;  /**< texels per side; 0 = 2048 */
+    uint32_t max_texture_size; /**< 0 = GL_MAX_TEXTURE_SIZE; smaller values force downscaling */
+    /** @{ GLFW window size; 0 = 640 x 480 */
+    uint32_t window_width, window_height; /** @} */
+    sy_gl_log_fn log;          /**< warnings; NULL = silent */
+    void *log_user; /**< passed to log */
 } sy_gl_device_desc;
 
-/* Creates the context and the renderer. On a missing provider (no EGL device/display, no X
+/** Creates the context and the renderer. On a missing provider (no EGL device/display, no X
  * display for GLFW) fails with SY_GL_ERROR_NO_CONTEXT and a message naming the provider and
  * suggesting the OSMesa fallback. *out is owned by the caller (sy_gl_device_destroy). */
 sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **out, char *err, size_t err_len);
-void sy_gl_device_destroy(sy_gl_device *dev); /* destroys every object; NULL is a no-op */
-/* "OpenGL 4.5 (Core Profile) Mesa 22.3.6 on llvmpipe (...)". Borrowed, valid while dev lives. */
+void sy_gl_device_destroy(sy_gl_device *dev); /**< destroys every object; NULL is a no-op */
+/** "OpenGL 4.5 (Core Profile) Mesa 22.3.6 on llvmpipe (...)". Borrowed, valid while dev lives. */
 const char *sy_gl_device_info(const sy_gl_device *dev);
 
-/* Upload counters. Every call that sends data to GL counts: buffer uploads (glBufferData /
+/** Upload counters. Every call that sends data to GL counts: buffer uploads (glBufferData /
  * glBufferSubData of vertex, index and uniform buffers) and texture uploads (glTexImage2D per
  * level). `frame` holds what happened between the end of the previous sy_gl_render and the end of
  * the last one (object updates + the frame itself); `total` everything since creation. */
 typedef struct sy_gl_upload_counts {
-    uint64_t vertex_buffer_uploads, vertex_bytes; /* VBO + IBO */
-    uint64_t uniform_buffer_uploads, uniform_bytes; /* material and light UBOs */
-    uint64_t texture_uploads, texture_bytes;
-    uint64_t model_matrix_updates; /* instance transforms set (no GL upload until drawn) */
+    /** @{ VBO + IBO */
+    uint64_t vertex_buffer_uploads, vertex_bytes; /** @} */
+    /** @{ material and light UBOs */
+    uint64_t uniform_buffer_uploads, uniform_bytes; /** @} */
+    /** @{ texture uploads (per level) and their bytes */
+    uint64_t texture_uploads, texture_bytes; /** @} */
+    uint64_t model_matrix_updates; /**< instance transforms set (no GL upload until drawn) */
 } sy_gl_upload_counts;
+/** Live objects and per-frame counters of a device. */
 typedef struct sy_gl_stats {
-    uint32_t meshes, textures, materials, instances, lights;
-    uint32_t msaa_samples;       /* effective */
-    uint32_t shadow_maps;        /* rendered in the last frame */
-    uint64_t triangles_drawn;    /* last frame, main pass */
-    uint64_t draw_calls;         /* last frame, all passes */
-    sy_gl_upload_counts frame, total;
+    /** @{ live objects of each kind */
+    uint32_t meshes, textures, materials, instances, lights; /** @} */
+    uint32_t msaa_samples;       /**< effective */
+    uint32_t shadow_maps;        /**< rendered in the last frame */
+    uint64_t triangles_drawn;    /**< last frame, main pass */
+    uint64_t draw_calls;         /**< last frame, all passes */
+    /** @{ uploads of the last frame and since creation */
+    sy_gl_upload_counts frame, total; /** @} */
 } sy_gl_stats;
+/** Fills *out with the device's counters. */
 void sy_gl_device_stats(const sy_gl_device *dev, sy_gl_stats *out);
 
 /* >>mesh: arrays are uploaded to GL at creation (one VBO per attribute + one IBO) and not kept. */
+/** Triangle mesh (arrays uploaded, not kept). */
 typedef struct sy_gl_mesh_desc {
-    const float *positions;  /* float3 x vertex_count (required, finite) */
-    const float *normals;    /* float3 or NULL (flat normals) */
-    const float *uv[2];      /* float2 or NULL */
-    const float *colors;     /* float4 linear RGBA or NULL (white) */
-    const uint32_t *indices; /* 3 x triangle_count or NULL (then vertex_count == 3 x triangle_count) */
-    uint32_t vertex_count, triangle_count;
+    const float *positions;  /**< float3 x vertex_count (required, finite) */
+    const float *normals;    /**< float3 or NULL (flat normals) */
+    const float *uv[2];      /**< float2 or NULL */
+    const float *colors;     /**< float4 linear RGBA or NULL (white) */
+    const uint32_t *indices; /**< 3 x triangle_count or NULL (then vertex_count == 3 x triangle_count) */
+    /** @{ vertex and triangle counts */
+    uint32_t vertex_count, triangle_count; /** @} */
 } sy_gl_mesh_desc;
+/** Creates a mesh from desc (uploaded at once). */
 sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *desc, sy_gl_mesh *out, char *err,
                                size_t err_len);
+/** Destroys a mesh. */
 sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh);
 
 /* >>texture: row 0 = top (glTF uv (0,0)); 1 = grey, 2 = grey+alpha, 3 = RGB, 4 = RGBA. Copied
  * to GL (with mipmaps); sizes beyond the GL limit are box-downscaled with a warning. */
+/** Texel formats of a texture. */
 typedef enum sy_gl_texel_format {
     SY_GL_TEXEL_UNORM8 = 1,
-    SY_GL_TEXEL_UNORM8_SRGB = 2, /* RGB sRGB-encoded, alpha linear (GL_SRGB8_ALPHA8) */
+    SY_GL_TEXEL_UNORM8_SRGB = 2, /**< RGB sRGB-encoded, alpha linear (GL_SRGB8_ALPHA8) */
     SY_GL_TEXEL_FLOAT32 = 3,
     SY_GL_TEXEL_FORMAT_MAX_ENUM = 0x7fffffff
 } sy_gl_texel_format;
+/** Texture wrap modes. */
 typedef enum sy_gl_wrap { SY_GL_WRAP_REPEAT = 0, SY_GL_WRAP_CLAMP = 1, SY_GL_WRAP_MIRROR = 2 } sy_gl_wrap;
+/** Texture: row 0 = top; 1 = grey, 2 = grey+alpha, 3 = RGB, 4 = RGBA; copied to GL with mipmaps. */
 typedef struct sy_gl_texture_desc {
-    uint32_t width, height, channels;
-    sy_gl_texel_format format;
-    const void *pixels;
-    sy_gl_wrap wrap_s, wrap_t;
-    bool nearest; /* nearest magnification (else linear); minification is always mipmapped */
+    /** @{ size in pixels and channels (1..4) */
+    uint32_t width, height, channels; /** @} */
+    sy_gl_texel_format format; /**< 8-bit linear, 8-bit sRGB or float */
+    const void *pixels; /**< width * height * channels elements of the format (copied) */
+    /** @{ wrap mode in u and v */
+    sy_gl_wrap wrap_s, wrap_t; /** @} */
+    bool nearest; /**< nearest magnification (else linear); minification is always mipmapped */
 } sy_gl_texture_desc;
+/** Creates a texture from desc. */
 sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *desc, sy_gl_texture *out, char *err,
                                   size_t err_len);
+/** Destroys a texture. */
 sy_gl_result sy_gl_texture_destroy(sy_gl_device *dev, sy_gl_texture tex);
 
 /* >>material */
+/** Alpha modes (glTF). */
 typedef enum sy_gl_alpha_mode { SY_GL_ALPHA_OPAQUE = 0, SY_GL_ALPHA_MASK = 1, SY_GL_ALPHA_BLEND = 2 } sy_gl_alpha_mode;
+/** A material's reference to a texture. */
 typedef struct sy_gl_texture_ref {
-    sy_gl_texture texture; /* zero = none */
-    uint32_t texcoord;     /* 0 or 1 */
-    bool transformed;      /* false: identity; true: uv' = transform (row-major 2x3 affine) x (uv, 1) */
-    float transform[6];    /* KHR_texture_transform; finite */
+    sy_gl_texture texture; /**< zero = none */
+    uint32_t texcoord;     /**< 0 or 1 */
+    bool transformed;      /**< false: identity; true: uv' = transform (row-major 2x3 affine) x (uv, 1) */
+    float transform[6];    /**< KHR_texture_transform; finite */
 } sy_gl_texture_ref;
+/** glTF 2.0 metallic-roughness material (fill with sy_gl_material_desc_init). */
 typedef struct sy_gl_material_desc {
-    float base_color[4];
-    sy_gl_texture_ref base_color_texture;
-    float metallic, roughness;
-    sy_gl_texture_ref metallic_roughness_texture; /* G = roughness, B = metallic */
-    float emissive[3]; /* radiance: emissiveFactor * emissiveStrength */
-    sy_gl_texture_ref emissive_texture;
-    sy_gl_texture_ref normal_texture;
-    float normal_scale;
-    sy_gl_texture_ref occlusion_texture; /* R channel, ambient term only */
-    float occlusion_strength;
-    float specular, transmission, ior;
-    sy_gl_alpha_mode alpha_mode;
-    float alpha_cutoff;
-    bool double_sided, unlit;
+    float base_color[4]; /**< linear RGBA factor */
+    sy_gl_texture_ref base_color_texture; /**< base colour texture (sRGB) */
+    /** @{ metallic and roughness factors */
+    float metallic, roughness; /** @} */
+    sy_gl_texture_ref metallic_roughness_texture; /**< G = roughness, B = metallic */
+    float emissive[3]; /**< radiance: emissiveFactor * emissiveStrength */
+    sy_gl_texture_ref emissive_texture; /**< emissive texture (sRGB) */
+    sy_gl_texture_ref normal_texture; /**< tangent-space normal map */
+    float normal_scale; /**< normal map scale */
+    sy_gl_texture_ref occlusion_texture; /**< R channel, ambient term only */
+    float occlusion_strength; /**< occlusion strength */
+    /** @{ specular factor, transmission factor, index of refraction */
+    float specular, transmission, ior; /** @} */
+    sy_gl_alpha_mode alpha_mode; /**< opaque, mask or blend */
+    float alpha_cutoff; /**< alpha cutoff of SY_GL_ALPHA_MASK */
+    /** @{ both faces are front faces; unlit (pixel = base colour) */
+    bool double_sided, unlit; /** @} */
 } sy_gl_material_desc;
-void sy_gl_material_desc_init(sy_gl_material_desc *desc); /* glTF defaults */
+void sy_gl_material_desc_init(sy_gl_material_desc *desc); /**< glTF defaults */
+/** Creates a material from desc (one UBO). */
 sy_gl_result sy_gl_material_create(sy_gl_device *dev, const sy_gl_material_desc *desc, sy_gl_material *out,
                                    char *err, size_t err_len);
-/* One UBO update. */
+/** One UBO update. */
 sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const sy_gl_material_desc *desc,
                                    char *err, size_t err_len);
+/** Destroys a material. */
 sy_gl_result sy_gl_material_destroy(sy_gl_device *dev, sy_gl_material mat);
 
 /* >>instance */
+/** An instance: a mesh placed with a material and a transform. */
 typedef struct sy_gl_instance_desc {
-    sy_gl_mesh mesh;
-    sy_gl_material material;
-    float transform[16]; /* object-to-world, finite and invertible */
-    bool hidden;
+    sy_gl_mesh mesh; /**< the mesh it draws */
+    sy_gl_material material; /**< its material */
+    float transform[16]; /**< object-to-world, finite and invertible */
+    bool hidden; /**< not drawn, casts no shadow */
 } sy_gl_instance_desc;
+/** Creates an instance from desc. */
 sy_gl_result sy_gl_instance_create(sy_gl_device *dev, const sy_gl_instance_desc *desc, sy_gl_instance *out,
                                    char *err, size_t err_len);
-/* Updates the model matrix only (no GL upload). */
+/** Updates the model matrix only (no GL upload). */
 sy_gl_result sy_gl_instance_set_transform(sy_gl_device *dev, sy_gl_instance inst, const float transform[16],
                                           char *err, size_t err_len);
+/** Changes an instance's material. */
 sy_gl_result sy_gl_instance_set_material(sy_gl_device *dev, sy_gl_instance inst, sy_gl_material mat);
+/** Shows or hides an instance. */
 sy_gl_result sy_gl_instance_set_visible(sy_gl_device *dev, sy_gl_instance inst, bool visible);
+/** Destroys an instance. */
 sy_gl_result sy_gl_instance_destroy(sy_gl_device *dev, sy_gl_instance inst);
 
 /* >>light (world space; direction = where the light travels, need not be normalised) */
+/** Punctual light types (KHR_lights_punctual). */
 typedef enum sy_gl_light_type { SY_GL_LIGHT_POINT = 1, SY_GL_LIGHT_SPOT = 2, SY_GL_LIGHT_DIRECTIONAL = 3 } sy_gl_light_type;
+/** A punctual light (KHR_lights_punctual units, world space). */
 typedef struct sy_gl_light_desc {
-    sy_gl_light_type type;
-    float color[3], intensity;
-    float position[3], direction[3];
-    float range; /* 0 = infinite */
-    float inner_cone_angle, outer_cone_angle;
-    bool no_shadow;
+    sy_gl_light_type type; /**< point, spot or directional */
+    /** @{ linear RGB colour; candela (point, spot) or lux (directional) */
+    float color[3], intensity; /** @} */
+    /** @{ position (point, spot); direction the light travels (spot, directional) */
+    float position[3], direction[3]; /** @} */
+    float range; /**< 0 = infinite */
+    /** @{ spot cone angles, radians */
+    float inner_cone_angle, outer_cone_angle; /** @} */
+    bool no_shadow; /**< casts no shadow */
 } sy_gl_light_desc;
-#define SY_GL_MAX_LIGHTS 32
-#define SY_GL_MAX_SHADOW_MAPS 4 /* the first spot/directional lights, then area lights, get shadow maps */
-#define SY_GL_MAX_CUBE_SHADOWS 2 /* the first point lights get cube shadow maps (6 faces, half the map size) */
+#define SY_GL_MAX_LIGHTS 32 /**< most punctual lights drawn */
+#define SY_GL_MAX_SHADOW_MAPS 4 /**< the first spot/directional lights, then area lights, get shadow maps */
+#define SY_GL_MAX_CUBE_SHADOWS 2 /**< the first point lights get cube shadow maps (6 faces, half the map size) */
+/** Creates a light from desc. */
 sy_gl_result sy_gl_light_create(sy_gl_device *dev, const sy_gl_light_desc *desc, sy_gl_light *out, char *err,
                                 size_t err_len);
+/** Replaces every field of a light with desc. */
 sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_gl_light_desc *desc, char *err,
                                 size_t err_len);
+/** Destroys a light. */
 sy_gl_result sy_gl_light_destroy(sy_gl_device *dev, sy_gl_light light);
 
-/* Background: what camera rays that hit nothing see; it lights nothing. NONE: RGBA 0 (alpha 0);
+/** Background: what camera rays that hit nothing see; it lights nothing. NONE: RGBA 0 (alpha 0);
  * COLOR: color (premultiplied linear RGBA); TEXTURE: the lat-long texture x intensity along each
  * pixel's camera ray (u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, row 0 up), alpha 1;
  * a stale texture draws as NONE. Non-finite or negative values are replaced by 0 with a warning. */
@@ -262,52 +313,60 @@ typedef enum sy_gl_background_mode {
     SY_GL_BACKGROUND_COLOR = 1,
     SY_GL_BACKGROUND_TEXTURE = 2
 } sy_gl_background_mode;
+/** Sets the background (see sy_gl_background_mode). */
 void sy_gl_set_background(sy_gl_device *dev, sy_gl_background_mode mode, const float color[4], sy_gl_texture texture,
                           float intensity);
 
-/* Environment light: a lat-long texture (same convention; texels are radiance) x intensity, or none
+/** Environment light: a lat-long texture (same convention; texels are radiance) x intensity, or none
  * (texture 0 or intensity 0). When it changes, the next render prefilters it on the GPU (one
  * specular and one irradiance cube map; see sy_gl_ibl.h). Destroying the texture removes the light. */
 void sy_gl_set_environment(sy_gl_device *dev, sy_gl_texture texture, float intensity);
 
-/* Emissive polygons as area lights (replaces the previous list; an unchanged list costs nothing).
+/** Emissive polygons as area lights (replaces the previous list; an unchanged list costs nothing).
  * Vertices in world space, convex and planar; the front face is counter-clockwise. */
 typedef struct sy_gl_area_light {
-    float vertices[4][3];
-    uint32_t vertex_count; /* 3 or 4 */
-    float radiance[3];     /* finite, >= 0 */
-    bool double_sided;
+    float vertices[4][3]; /**< corners, world space (vertex_count used) */
+    uint32_t vertex_count; /**< 3 or 4 */
+    float radiance[3];     /**< finite, >= 0 */
+    bool double_sided; /**< emits from both faces */
 } sy_gl_area_light;
-#define SY_GL_MAX_AREA_LIGHTS 16
-/* The indirect light of the area lights as one radiance (the mediator's estimate): wherever area
+#define SY_GL_MAX_AREA_LIGHTS 16 /**< most area lights drawn */
+/** The indirect light of the area lights as one radiance (the mediator's estimate): wherever area
  * lights are set, non-emissive surfaces add (diffuse + specular weight) x ambient x occlusion x
  * (1 + 0.75 n.d), d = the lights' flux-weighted mean emission direction (surfaces facing the way the
  * lights shine see the directly lit ones). Non-finite or negative components are replaced by 0
  * with a warning. */
 void sy_gl_set_ambient(sy_gl_device *dev, const float radiance[3]);
+/** Sets the area lights (at most SY_GL_MAX_AREA_LIGHTS). */
 sy_gl_result sy_gl_set_area_lights(sy_gl_device *dev, const sy_gl_area_light *lights, uint32_t count, char *err,
                                    size_t err_len);
 
 /* >>render */
+/** Camera (same convention as the ray tracers). */
 typedef struct sy_gl_camera {
-    float camera_to_world[16];
-    bool orthographic;
-    float window[4]; /* {left, right, bottom, top}: tangent space at distance 1 (perspective) or camera units */
-    float near_clip, far_clip; /* far 0 = infinite */
+    float camera_to_world[16]; /**< column-major; the camera looks down local -Z, +Y up */
+    bool orthographic; /**< orthographic projection (else perspective) */
+    float window[4]; /**< {left, right, bottom, top}: tangent space at distance 1 (perspective) or camera units */
+    /** @{ far 0 = infinite */
+    float near_clip, far_clip; /** @} */
 } sy_gl_camera;
+/** What to render: the full image and the rectangle to fill. */
 typedef struct sy_gl_render_desc {
-    uint32_t image_width, image_height;
-    uint32_t x, y, width, height; /* sub-rectangle, row 0 = top */
+    /** @{ the full image the camera window maps onto */
+    uint32_t image_width, image_height; /** @} */
+    /** @{ sub-rectangle, row 0 = top */
+    uint32_t x, y, width, height; /** @} */
 } sy_gl_render_desc;
-/* Renders and reads back: rgba (width*height*4 floats) and depth (width*height, may be NULL). */
+/** Renders and reads back: rgba (width*height*4 floats) and depth (width*height, may be NULL). */
 sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *desc, float *rgba,
                           float *depth, char *err, size_t err_len);
-/* GLFW provider: true once the user asked to close the window (false for other providers). */
+/** GLFW provider: true once the user asked to close the window (false for other providers). */
 bool sy_gl_window_should_close(sy_gl_device *dev);
 
 /* >>bench: the floor — draws every visible instance's buffers with a trivial shader (one
  * colour, no lighting, no shadows, no MSAA) into the same targets, then reads back like
  * sy_gl_render. */
+/** Benchmark floor: every visible instance drawn with a trivial shader into the same targets, read back into rgba. */
 sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *desc,
                                 float *rgba, char *err, size_t err_len);
 

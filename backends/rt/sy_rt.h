@@ -1,11 +1,12 @@
-/* sy_rt.h — public API of the Embree ray-tracing back-end (backends/rt).
+/** @file
+ * sy_rt.h — public API of the Embree ray-tracing back-end (backends/rt).
  *
  * A standalone renderer library with its own small scene API, exactly like a third-party renderer:
  * it knows nothing about the Switchyard scene graph. A mediator (mediators/rt) translates the core
  * scene into these objects and keeps them in sync incrementally.
  *
  * Object model
- *   sy_rt_device   owns everything: Embree device, top-level scene, object pools, worker threads.
+ *   sy_rt_device   owns everything: Embree device, top-level scene, object pools.
  *   sy_rt_mesh     a prototype triangle mesh (its own Embree scene / BLAS). Data is copied.
  *   sy_rt_instance a mesh placed in the world with a transform and a material; either an Embree
  *                  instance of the mesh's BLAS, or (SY_RT_INSTANCE_BAKED) world-space triangles
@@ -31,7 +32,13 @@
  * that caused them.
  *
  * Thread-safety: one device may be used by one thread at a time (the API does not lock). Several
- * devices are independent. sy_rt_render() itself runs multithreaded over tiles.
+ * devices are independent. sy_rt_render() itself runs multithreaded over tiles on the process's
+ * OpenMP thread team (libgomp), which every Switchyard back-end and filter shares: no device owns
+ * threads of its own (Embree keeps its own BVH build threads). OMP_NUM_THREADS sets the default
+ * team size and OMP_WAIT_POLICY how idle team threads wait: libgomp's default spins for a while
+ * first, best on cores of one's own; where other busy processes share the cores, passive is
+ * faster (spinning threads take CPU time from the ones with work). Called from inside an active
+ * OpenMP parallel region, a render runs on the calling thread only (unless nesting is enabled).
  *
  * Conventions (shared by every Switchyard back-end): right-handed world, Y up, metres. Cameras look
  * down local -Z with +Y up. Matrices are 4x4 column-major float[16] (glTF): m[12..14] = translation.
@@ -52,88 +59,102 @@ extern "C" {
 
 /* >>results */
 
+/** Result codes of every fallible sy_rt call. */
 typedef enum sy_rt_result {
     SY_RT_OK = 0,
-    SY_RT_ERROR_INVALID_ARGUMENT = 1,  /* a desc or parameter the API does not accept */
-    SY_RT_ERROR_INVALID_HANDLE = 2,    /* stale, foreign or zero handle */
+    SY_RT_ERROR_INVALID_ARGUMENT = 1,  /**< a desc or parameter the API does not accept */
+    SY_RT_ERROR_INVALID_HANDLE = 2,    /**< stale, foreign or zero handle */
     SY_RT_ERROR_OUT_OF_MEMORY = 3,
-    SY_RT_ERROR_LIMIT = 4,             /* a count or size would overflow or exceeds a pool limit */
-    SY_RT_ERROR_EMBREE = 5,            /* Embree reported an error (message included) */
-    SY_RT_ERROR_UNSUPPORTED = 6,       /* well-formed request this back-end does not implement */
-    SY_RT_ERROR_INVALID_OPERATION = 7, /* e.g. rendering with uncommitted changes */
-    SY_RT_ERROR_CANCELLED = 8,         /* the progress callback asked to stop */
-    SY_RT_ERROR_SYSTEM = 9,            /* an OS call (thread creation) failed */
+    SY_RT_ERROR_LIMIT = 4,             /**< a count or size would overflow or exceeds a pool limit */
+    SY_RT_ERROR_EMBREE = 5,            /**< Embree reported an error (message included) */
+    SY_RT_ERROR_UNSUPPORTED = 6,       /**< well-formed request this back-end does not implement */
+    SY_RT_ERROR_INVALID_OPERATION = 7, /**< e.g. rendering with uncommitted changes */
+    SY_RT_ERROR_CANCELLED = 8,         /**< the progress callback asked to stop */
+    SY_RT_ERROR_SYSTEM = 9,            /**< an OS call (creating a mutex) failed */
     SY_RT_RESULT_MAX_ENUM = 0x7fffffff
 } sy_rt_result;
 
-/* Short name of a result code ("invalid argument", ...). Static storage. */
+/** Short name of a result code ("invalid argument", ...). Static storage. */
 const char *sy_rt_result_str(sy_rt_result r);
 
 /* >>handles */
 
+/** A ray-tracing device (opaque): owns every object and the Embree device. */
 typedef struct sy_rt_device sy_rt_device;
-typedef struct sy_rt_mesh { uint32_t id; } sy_rt_mesh;
-typedef struct sy_rt_instance { uint32_t id; } sy_rt_instance;
-typedef struct sy_rt_material { uint32_t id; } sy_rt_material;
-typedef struct sy_rt_texture { uint32_t id; } sy_rt_texture;
-typedef struct sy_rt_light { uint32_t id; } sy_rt_light;
+/** Handle of a triangle mesh. */
+typedef struct sy_rt_mesh { uint32_t id; /**< index + generation; 0 = none */ } sy_rt_mesh;
+/** Handle of an instance (a mesh placed in the world). */
+typedef struct sy_rt_instance { uint32_t id; /**< index + generation; 0 = none */ } sy_rt_instance;
+/** Handle of a material. */
+typedef struct sy_rt_material { uint32_t id; /**< index + generation; 0 = none */ } sy_rt_material;
+/** Handle of a texture. */
+typedef struct sy_rt_texture { uint32_t id; /**< index + generation; 0 = none */ } sy_rt_texture;
+/** Handle of a punctual light. */
+typedef struct sy_rt_light { uint32_t id; /**< index + generation; 0 = none */ } sy_rt_light;
 
 /* >>device */
 
+/** Device options (sy_rt_device_create). */
 typedef struct sy_rt_device_desc {
-    uint32_t thread_count; /* render and Embree build threads; 0 = all online cores */
+    uint32_t thread_count; /**< render and Embree build threads; 0 = the OpenMP default
+                            * (OMP_NUM_THREADS, else the cores this process may run on) */
 } sy_rt_device_desc;
 
-/* Creates a device. desc may be NULL (defaults). Ownership: *out belongs to the caller, who
+/** Creates a device. desc may be NULL (defaults). Ownership: *out belongs to the caller, who
  * releases it with sy_rt_device_destroy (which destroys every object it still holds). */
 sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **out,
                                  char *err, size_t err_len);
-/* Destroys the device and all its objects. NULL is a no-op. */
+/** Destroys the device and all its objects. NULL is a no-op. */
 void sy_rt_device_destroy(sy_rt_device *dev);
 
-/* Publishes all staged changes (BLAS/TLAS commits, area-light list when instances or materials
+/** Publishes all staged changes (BLAS/TLAS commits, area-light list when instances or materials
  * changed). Must be called before sy_rt_render after any change. */
 sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len);
 
-/* Live object counts, for leak diagnostics and tests. */
+/** Live object counts, for leak diagnostics and tests. */
 typedef struct sy_rt_stats {
-    uint32_t meshes, instances, materials, textures, lights;
-    uint32_t area_light_triangles; /* emissive triangles in the committed area-light list */
-    uint64_t version; /* bumped by every commit that published a change (accumulation restarts) */
+    /** @{ live objects of each kind */
+    uint32_t meshes, instances, materials, textures, lights; /** @} */
+    uint32_t area_light_triangles; /**< emissive triangles in the committed area-light list */
+    uint64_t version; /**< bumped by every commit that published a change (accumulation restarts) */
 } sy_rt_stats;
+/** Fills *out with the device's live object counts and version. */
 void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out);
 
 /* >>mesh */
 
-/* Triangle mesh. Ownership: every array is COPIED; the caller may free its arrays after the call.
+/** Triangle mesh. Ownership: every array is COPIED; the caller may free its arrays after the call.
  * Positions are required and must be finite. Optional arrays are NULL when absent; when present
  * they hold vertex_count elements. Without indices the mesh is a non-indexed triangle list and
  * vertex_count must equal 3 * triangle_count. With indices there are 3 * triangle_count indices
  * and every index must be < vertex_count. */
 typedef struct sy_rt_mesh_desc {
-    const float *positions;  /* float3 x vertex_count (required) */
-    const float *normals;    /* float3 x vertex_count or NULL (then geometric normals) */
-    const float *uv[2];      /* float2 x vertex_count per texture-coordinate set, or NULL */
-    const float *colors;     /* float4 RGBA x vertex_count (linear) or NULL (then white) */
-    const uint32_t *indices; /* 3 x triangle_count or NULL */
-    uint32_t vertex_count;
-    uint32_t triangle_count;
+    const float *positions;  /**< float3 x vertex_count (required) */
+    const float *normals;    /**< float3 x vertex_count or NULL (then geometric normals) */
+    const float *uv[2];      /**< float2 x vertex_count per texture-coordinate set, or NULL */
+    const float *colors;     /**< float4 RGBA x vertex_count (linear) or NULL (then white) */
+    const uint32_t *indices; /**< 3 x triangle_count or NULL */
+    uint32_t vertex_count; /**< number of vertices in every per-vertex array */
+    uint32_t triangle_count; /**< number of triangles */
 } sy_rt_mesh_desc;
 
+/** Creates a mesh from desc (arrays copied). */
 sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *desc, sy_rt_mesh *out,
                                char *err, size_t err_len);
-/* Invalidates the handle; the data is freed once no instance uses it any more. */
+/** Invalidates the handle; the data is freed once no instance uses it any more. */
 sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh, char *err, size_t err_len);
 
 /* >>texture */
 
+/** Texel formats of a texture. */
 typedef enum sy_rt_texel_format {
-    SY_RT_TEXEL_UNORM8 = 1,      /* 8-bit linear */
-    SY_RT_TEXEL_UNORM8_SRGB = 2, /* 8-bit; RGB channels sRGB-encoded, alpha linear */
-    SY_RT_TEXEL_FLOAT32 = 3,     /* 32-bit float, linear */
+    SY_RT_TEXEL_UNORM8 = 1,      /**< 8-bit linear */
+    SY_RT_TEXEL_UNORM8_SRGB = 2, /**< 8-bit; RGB channels sRGB-encoded, alpha linear */
+    SY_RT_TEXEL_FLOAT32 = 3,     /**< 32-bit float, linear */
     SY_RT_TEXEL_FORMAT_MAX_ENUM = 0x7fffffff
 } sy_rt_texel_format;
 
+/** Texture wrap modes. */
 typedef enum sy_rt_wrap {
     SY_RT_WRAP_REPEAT = 0,
     SY_RT_WRAP_CLAMP = 1,
@@ -141,103 +162,120 @@ typedef enum sy_rt_wrap {
     SY_RT_WRAP_MAX_ENUM = 0x7fffffff
 } sy_rt_wrap;
 
+/** Texture filters. */
 typedef enum sy_rt_filter {
     SY_RT_FILTER_LINEAR = 0,
     SY_RT_FILTER_NEAREST = 1,
     SY_RT_FILTER_MAX_ENUM = 0x7fffffff
 } sy_rt_filter;
 
-/* Texture. Pixels are row-major, row 0 = top row (glTF uv (0,0) is the top-left corner), channels
+/** Texture. Pixels are row-major, row 0 = top row (glTF uv (0,0) is the top-left corner), channels
  * interleaved: 1 = grey, 2 = grey+alpha, 3 = RGB, 4 = RGBA. Ownership: pixels are COPIED. */
 typedef struct sy_rt_texture_desc {
-    uint32_t width, height, channels; /* channels 1..4 */
-    sy_rt_texel_format format;
-    const void *pixels; /* uint8_t or float, width*height*channels elements */
-    sy_rt_wrap wrap_s, wrap_t;
-    sy_rt_filter filter;
+    /** @{ channels 1..4 */
+    uint32_t width, height, channels; /** @} */
+    sy_rt_texel_format format; /**< 8-bit sRGB, 8-bit linear or float texels */
+    const void *pixels; /**< uint8_t or float, width*height*channels elements */
+    /** @{ wrap mode in u and v */
+    sy_rt_wrap wrap_s, wrap_t; /** @} */
+    sy_rt_filter filter; /**< texture filter */
 } sy_rt_texture_desc;
 
+/** Creates a texture from desc (pixels copied). */
 sy_rt_result sy_rt_texture_create(sy_rt_device *dev, const sy_rt_texture_desc *desc,
                                   sy_rt_texture *out, char *err, size_t err_len);
+/** Destroys a texture; references to it become stale (ignored at render time). */
 sy_rt_result sy_rt_texture_destroy(sy_rt_device *dev, sy_rt_texture tex, char *err, size_t err_len);
 
 /* >>material */
 
+/** Alpha modes (glTF). */
 typedef enum sy_rt_alpha_mode {
     SY_RT_ALPHA_OPAQUE = 0,
-    SY_RT_ALPHA_MASK = 1,  /* cut out where alpha < alpha_cutoff (also for shadow rays) */
-    SY_RT_ALPHA_BLEND = 2, /* rays blend with what is behind; shadow rays are attenuated by 1 - alpha */
+    SY_RT_ALPHA_MASK = 1,  /**< cut out where alpha < alpha_cutoff (also for shadow rays) */
+    SY_RT_ALPHA_BLEND = 2, /**< rays blend with what is behind; shadow rays are attenuated by 1 - alpha */
     SY_RT_ALPHA_MODE_MAX_ENUM = 0x7fffffff
 } sy_rt_alpha_mode;
 
-/* A texture reference: a zero handle means "no texture". With `transformed` set, the
+/** A texture reference: a zero handle means "no texture". With `transformed` set, the
  * texture-coordinate set is mapped through the 2x3 affine `transform` (row-major:
  * u' = t[0] u + t[1] v + t[2], v' = t[3] u + t[4] v + t[5]; glTF KHR_texture_transform) before the
  * lookup; all entries must be finite. */
 typedef struct sy_rt_texture_ref {
-    sy_rt_texture texture;
-    uint32_t texcoord; /* texture-coordinate set, 0 or 1 */
-    bool transformed;  /* default false: identity */
-    float transform[6];
+    sy_rt_texture texture; /**< {0}: no texture */
+    uint32_t texcoord; /**< texture-coordinate set, 0 or 1 */
+    bool transformed;  /**< default false: identity */
+    float transform[6]; /**< row-major 2x3 affine uv transform (with `transformed`) */
 } sy_rt_texture_ref;
 
-/* glTF 2.0 metallic-roughness material. Fill it with sy_rt_material_desc_init (glTF defaults),
+/** glTF 2.0 metallic-roughness material. Fill it with sy_rt_material_desc_init (glTF defaults),
  * then set what differs. */
 typedef struct sy_rt_material_desc {
-    float base_color[4];            /* linear RGBA factor (default 1,1,1,1) */
-    sy_rt_texture_ref base_color_texture;
-    float metallic, roughness;      /* factors (default 1, 1) */
-    sy_rt_texture_ref metallic_roughness_texture; /* G = roughness, B = metallic */
-    float emissive[3];              /* radiance: emissiveFactor * emissiveStrength (default 0) */
-    sy_rt_texture_ref emissive_texture;
-    sy_rt_texture_ref normal_texture;
-    float normal_scale;             /* default 1 */
-    float specular;                 /* KHR_materials_specular factor (default 1; 0 = pure Lambert) */
-    float transmission;             /* KHR_materials_transmission factor (default 0) */
-    float ior;                      /* default 1.5 */
-    sy_rt_alpha_mode alpha_mode;    /* default opaque */
-    float alpha_cutoff;             /* default 0.5 */
-    bool double_sided;              /* default false: emitters emit from the front side only */
-    bool unlit;                     /* KHR_materials_unlit: pixel = base colour */
+    float base_color[4];            /**< linear RGBA factor (default 1,1,1,1) */
+    sy_rt_texture_ref base_color_texture; /**< base colour texture (sRGB) */
+    /** @{ factors (default 1, 1) */
+    float metallic, roughness; /** @} */
+    sy_rt_texture_ref metallic_roughness_texture; /**< G = roughness, B = metallic */
+    float emissive[3];              /**< radiance: emissiveFactor * emissiveStrength (default 0) */
+    sy_rt_texture_ref emissive_texture; /**< emissive texture (sRGB) */
+    sy_rt_texture_ref normal_texture; /**< tangent-space normal map */
+    float normal_scale;             /**< default 1 */
+    float specular;                 /**< KHR_materials_specular factor (default 1; 0 = pure Lambert) */
+    float transmission;             /**< KHR_materials_transmission factor (default 0) */
+    float ior;                      /**< default 1.5 */
+    sy_rt_alpha_mode alpha_mode;    /**< default opaque */
+    float alpha_cutoff;             /**< default 0.5 */
+    bool double_sided;              /**< default false: emitters emit from the front side only */
+    bool unlit;                     /**< KHR_materials_unlit: pixel = base colour */
 } sy_rt_material_desc;
 
+/** Fills desc with the glTF 2.0 defaults. */
 void sy_rt_material_desc_init(sy_rt_material_desc *desc);
+/** Creates a material from desc. */
 sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc *desc,
                                    sy_rt_material *out, char *err, size_t err_len);
+/** Replaces every field of a material with desc. */
 sy_rt_result sy_rt_material_update(sy_rt_device *dev, sy_rt_material mat,
                                    const sy_rt_material_desc *desc, char *err, size_t err_len);
+/** Destroys a material; instances using it render with the default material. */
 sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat, char *err, size_t err_len);
 
 /* >>instance */
 
 enum {
-    /* Static geometry: transformed to world space and merged into the top-level BVH. Moving it
+    /** Static geometry: transformed to world space and merged into the top-level BVH. Moving it
      * re-transforms just its triangles (and rebuilds the top-level BVH at commit). */
     SY_RT_INSTANCE_BAKED = 1u << 0,
-    /* Not rendered and casts no shadows (also no area light); toggle with set_visible. */
+    /** Not rendered and casts no shadows (also no area light); toggle with set_visible. */
     SY_RT_INSTANCE_HIDDEN = 1u << 1,
 };
 
+/** An instance: a mesh, its object-to-world transform, material and flags. */
 typedef struct sy_rt_instance_desc {
-    sy_rt_mesh mesh;
-    float transform[16]; /* object-to-world, column-major; must be finite and invertible */
-    sy_rt_material material; /* zero/stale = default grey material */
-    uint32_t flags;          /* SY_RT_INSTANCE_* */
+    sy_rt_mesh mesh; /**< the mesh it places */
+    float transform[16]; /**< object-to-world, column-major; must be finite and invertible */
+    sy_rt_material material; /**< zero/stale = default grey material */
+    uint32_t flags;          /**< SY_RT_INSTANCE_* */
 } sy_rt_instance_desc;
 
+/** Creates an instance from desc. */
 sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc *desc,
                                    sy_rt_instance *out, char *err, size_t err_len);
-/* Cheap for non-baked instances (rtcSetGeometryTransform + top-level recommit, no BLAS rebuild). */
+/** Cheap for non-baked instances (rtcSetGeometryTransform + top-level recommit, no BLAS rebuild). */
 sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst,
                                           const float transform[16], char *err, size_t err_len);
+/** Changes an instance's material (zero/stale = default). */
 sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst,
                                          sy_rt_material material, char *err, size_t err_len);
+/** Shows or hides an instance (hidden: not rendered, casts no shadows, no area light). */
 sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, bool visible,
                                         char *err, size_t err_len);
+/** Destroys an instance. */
 sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst, char *err, size_t err_len);
 
 /* >>light */
 
+/** Punctual light types (KHR_lights_punctual). */
 typedef enum sy_rt_light_type {
     SY_RT_LIGHT_POINT = 1,
     SY_RT_LIGHT_SPOT = 2,
@@ -245,24 +283,28 @@ typedef enum sy_rt_light_type {
     SY_RT_LIGHT_TYPE_MAX_ENUM = 0x7fffffff
 } sy_rt_light_type;
 
-/* Punctual light in world space (KHR_lights_punctual units). Point/spot: intensity in candela,
+/** Punctual light in world space (KHR_lights_punctual units). Point/spot: intensity in candela,
  * irradiance at distance d is color * intensity / d^2 (times the range window when range > 0).
  * Directional: intensity in lux. direction is the direction the light travels (the light node's
  * -Z axis in world space); it need not be normalised. */
 typedef struct sy_rt_light_desc {
-    sy_rt_light_type type;
-    float color[3];
-    float intensity;
-    float position[3];  /* point, spot */
-    float direction[3]; /* spot, directional */
-    float range;        /* point, spot; 0 = infinite */
-    float inner_cone_angle, outer_cone_angle; /* spot, radians, 0 <= inner < outer <= pi/2 */
+    sy_rt_light_type type; /**< point, spot or directional */
+    float color[3]; /**< linear RGB */
+    float intensity; /**< candela (point, spot) or lux (directional) */
+    float position[3];  /**< point, spot */
+    float direction[3]; /**< spot, directional */
+    float range;        /**< point, spot; 0 = infinite */
+    /** @{ spot, radians, 0 <= inner < outer <= pi/2 */
+    float inner_cone_angle, outer_cone_angle; /** @} */
 } sy_rt_light_desc;
 
+/** Creates a punctual light from desc. */
 sy_rt_result sy_rt_light_create(sy_rt_device *dev, const sy_rt_light_desc *desc, sy_rt_light *out,
                                 char *err, size_t err_len);
+/** Replaces every field of a light with desc. */
 sy_rt_result sy_rt_light_update(sy_rt_device *dev, sy_rt_light light, const sy_rt_light_desc *desc,
                                 char *err, size_t err_len);
+/** Destroys a light. */
 sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light, char *err, size_t err_len);
 
 /* >>background and environment
@@ -274,26 +316,28 @@ sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light, char *err
  * there is none. Showing the environment behind the scene is a background in TEXTURE mode on the
  * same texture and intensity. */
 
+/** What camera rays see where they hit nothing. */
 typedef enum sy_rt_background_mode {
-    SY_RT_BACKGROUND_NONE = 0,    /* transparent: colour 0, alpha 0 */
-    SY_RT_BACKGROUND_COLOR = 1,   /* constant radiance `color`, alpha 1 */
-    SY_RT_BACKGROUND_TEXTURE = 2, /* lat-long `texture` (convention of sy_rt_set_environment) x
+    SY_RT_BACKGROUND_NONE = 0,    /**< transparent: colour 0, alpha 0 */
+    SY_RT_BACKGROUND_COLOR = 1,   /**< constant radiance `color`, alpha 1 */
+    SY_RT_BACKGROUND_TEXTURE = 2, /**< lat-long `texture` (convention of sy_rt_set_environment) x
                                    * `intensity`, alpha 1; a texture destroyed later shows black */
     SY_RT_BACKGROUND_MODE_MAX_ENUM = 0x7fffffff
 } sy_rt_background_mode;
 
+/** The background (sy_rt_set_background). */
 typedef struct sy_rt_background {
-    sy_rt_background_mode mode;
-    float color[3];        /* COLOR: finite, >= 0 */
-    sy_rt_texture texture; /* TEXTURE: a live texture */
-    float intensity;       /* TEXTURE: finite, >= 0 */
+    sy_rt_background_mode mode; /**< none, colour or texture */
+    float color[3];        /**< COLOR: finite, >= 0 */
+    sy_rt_texture texture; /**< TEXTURE: a live texture */
+    float intensity;       /**< TEXTURE: finite, >= 0 */
 } sy_rt_background;
 
-/* Default: SY_RT_BACKGROUND_NONE. Takes effect at the next commit. */
+/** Default: SY_RT_BACKGROUND_NONE. Takes effect at the next commit. */
 sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg, char *err,
                                   size_t err_len);
 
-/* Environment light: an equirectangular (latitude-longitude) texture times intensity, seen by every
+/** Environment light: an equirectangular (latitude-longitude) texture times intensity, seen by every
  * ray but camera rays when it leaves the scene. Direction d (unit, world) maps to
  * u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, so the image centre is seen looking
  * down -Z and row 0 is straight up (+Y). The PATHTRACER importance-samples it (piecewise-constant
@@ -308,68 +352,79 @@ sy_rt_result sy_rt_set_environment(sy_rt_device *dev, sy_rt_texture texture, flo
 
 /* >>render */
 
+/** Camera projections. */
 typedef enum sy_rt_projection {
     SY_RT_PROJECTION_PERSPECTIVE = 0,
     SY_RT_PROJECTION_ORTHOGRAPHIC = 1,
     SY_RT_PROJECTION_MAX_ENUM = 0x7fffffff
 } sy_rt_projection;
 
-/* Camera. window = {left, right, bottom, top}: for perspective the image-plane window at distance
+/** Camera. window = {left, right, bottom, top}: for perspective the image-plane window at distance
  * 1 in front of the camera (tangents of the half-angles, so symmetric and off-axis/stereo frusta are
  * the same code), for orthographic the window in camera units. Geometry nearer than near_clip or
  * farther than far_clip (0 = infinite) along the viewing axis is not seen by camera rays. */
 typedef struct sy_rt_camera {
-    float camera_to_world[16]; /* column-major; camera looks down local -Z, +Y up */
-    sy_rt_projection projection;
-    float window[4];
-    float near_clip, far_clip;
+    float camera_to_world[16]; /**< column-major; camera looks down local -Z, +Y up */
+    sy_rt_projection projection; /**< perspective or orthographic */
+    float window[4]; /**< image-plane window {left, right, bottom, top} (see above) */
+    /** @{ near and far clip distances along the viewing axis (far 0 = infinite) */
+    float near_clip, far_clip; /** @} */
 } sy_rt_camera;
 
+/** Integrators sy_rt_render can run. */
 typedef enum sy_rt_integrator {
-    SY_RT_INTEGRATOR_PRIMARY = 1, /* primary rays only, eye-light shading (benchmarks, debugging) */
-    SY_RT_INTEGRATOR_WHITTED = 2, /* anti-aliased; direct light from punctual, area and environment
+    SY_RT_INTEGRATOR_PRIMARY = 1, /**< primary rays only, eye-light shading (benchmarks, debugging) */
+    SY_RT_INTEGRATOR_WHITTED = 2, /**< anti-aliased; direct light from punctual, area and environment
                                    * lights (stratified, deterministic) + mirror reflection/refraction */
-    SY_RT_INTEGRATOR_PATHTRACER = 3, /* progressive path tracer (needs a sy_rt_accum, see below) */
-    SY_RT_INTEGRATOR_COVERAGE = 4, /* object ids per pixel, no shading: use sy_rt_coverage() */
+    SY_RT_INTEGRATOR_PATHTRACER = 3, /**< progressive path tracer (needs a sy_rt_accum, see below) */
+    SY_RT_INTEGRATOR_COVERAGE = 4, /**< object ids per pixel, no shading: use sy_rt_coverage() */
     SY_RT_INTEGRATOR_MAX_ENUM = 0x7fffffff
 } sy_rt_integrator;
 
-/* Progress report; return false from the callback to cancel the render. Called from worker
- * threads, serialised (never two calls at once). */
+/** Progress report; return false from the callback to cancel the render (tiles not yet started
+ * are skipped, those running finish). Called after each finished tile from the render's worker
+ * threads (the OpenMP team, the thread that called sy_rt_render among them), serialised (never
+ * two calls at once; tiles_done counts up by one per call). */
 typedef struct sy_rt_progress {
-    uint32_t tiles_done, tiles_total;
+    /** @{ tiles finished and in all */
+    uint32_t tiles_done, tiles_total; /** @} */
 } sy_rt_progress;
+/** Progress callback: return false to cancel the render (SY_RT_ERROR_CANCELLED). */
 typedef bool (*sy_rt_progress_fn)(const sy_rt_progress *progress, void *user_data);
 
+/** Accumulation of a progressive render (opaque; see sy_rt_accum_create). */
 typedef struct sy_rt_accum sy_rt_accum;
 
+/** What to render: integrator, image and rectangle, sampling settings. */
 typedef struct sy_rt_render_desc {
-    sy_rt_integrator integrator;
-    uint32_t image_width, image_height; /* the full image the camera window maps onto */
-    uint32_t x, y, width, height;       /* sub-rectangle to fill (row 0 = top) */
-    uint32_t max_depth;                 /* WHITTED: recursion depth for reflection/refraction;
+    sy_rt_integrator integrator; /**< which integrator runs */
+    /** @{ the full image the camera window maps onto */
+    uint32_t image_width, image_height; /** @} */
+    /** @{ sub-rectangle to fill (row 0 = top) */
+    uint32_t x, y, width, height; /** @} */
+    uint32_t max_depth;                 /**< WHITTED: recursion depth for reflection/refraction;
                                          * PATHTRACER: most bounces (scattering events) per path;
                                          * 0 = 8 */
-    uint32_t area_light_samples;        /* WHITTED: area-light (emissive triangle) samples per pixel,
+    uint32_t area_light_samples;        /**< WHITTED: area-light (emissive triangle) samples per pixel,
                                          * shared among its pixel samples (each shading point takes
                                          * ceil(n / pixel_samples)); 0 = 16 */
-    uint32_t seed;                      /* decorrelates sample patterns; same seed = same image */
-    /* WHITTED only: */
-    uint32_t pixel_samples;             /* anti-aliasing: camera rays per pixel through stratified
+    uint32_t seed;                      /**< decorrelates sample patterns; same seed = same image */
+    /** WHITTED only: */
+    uint32_t pixel_samples;             /**< anti-aliasing: camera rays per pixel through stratified
                                          * jittered points (Owen-scrambled Sobol per pixel), box filter
                                          * over the pixel; 0 or 1 = one ray through the pixel centre */
-    uint32_t env_light_samples;         /* environment-light samples (importance-sampled, with shadow
+    uint32_t env_light_samples;         /**< environment-light samples (importance-sampled, with shadow
                                          * rays) per shading point of each pixel sample; 0 = 4 */
-    sy_rt_progress_fn progress;         /* optional */
-    void *progress_user_data;
-    /* PATHTRACER only: */
-    sy_rt_accum *accum;                 /* required: accumulation of this rectangle (width x height) */
-    uint32_t samples;                   /* samples per pixel to add in this call; 0 = 1 */
-    struct sy_rt_pt_record *records;    /* optional: width * height path records (see >>path records);
+    sy_rt_progress_fn progress;         /**< optional */
+    void *progress_user_data; /**< passed to progress */
+    /** PATHTRACER only: */
+    sy_rt_accum *accum;                 /**< required: accumulation of this rectangle (width x height) */
+    uint32_t samples;                   /**< samples per pixel to add in this call; 0 = 1 */
+    struct sy_rt_pt_record *records;    /**< optional: width * height path records (see >>path records);
                                          * NULL = none (no cost) */
 } sy_rt_render_desc;
 
-/* Renders the sub-rectangle. rgba: width*height*4 floats (required); depth: width*height floats
+/** Renders the sub-rectangle. rgba: width*height*4 floats (required); depth: width*height floats
  * or NULL (WHITTED: the mean camera-axis distance of the pixel samples that hit, +INFINITY when none
  * did). Row 0 of both buffers is the top row of the sub-rectangle. Deterministic: a pixel's value
  * depends only on the scene, the camera, its full-image coordinates and the render desc's
@@ -404,32 +459,35 @@ sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera,
  *
  * Ownership: the caller owns the accum; it is not tied to a device. Thread-safety: an accum is used
  * by one render call at a time. */
+/** Creates an accumulation for a width x height rectangle (0 samples). */
 sy_rt_result sy_rt_accum_create(uint32_t width, uint32_t height, sy_rt_accum **out, char *err, size_t err_len);
-void sy_rt_accum_destroy(sy_rt_accum *accum); /* NULL is a no-op */
-void sy_rt_accum_reset(sy_rt_accum *accum);   /* back to 0 samples */
+void sy_rt_accum_destroy(sy_rt_accum *accum); /**< NULL is a no-op */
+void sy_rt_accum_reset(sy_rt_accum *accum);   /**< back to 0 samples */
+/** Samples per pixel accumulated since the last reset. */
 uint32_t sy_rt_accum_samples(const sy_rt_accum *accum);
+/** Size of the accumulation's rectangle. */
 void sy_rt_accum_size(const sy_rt_accum *accum, uint32_t *width, uint32_t *height);
-/* Samples dropped since the last reset because their radiance was NaN or infinite. */
+/** Samples dropped since the last reset because their radiance was NaN or infinite. */
 uint64_t sy_rt_accum_nonfinite(const sy_rt_accum *accum);
-/* Rays (closest-hit and shadow) traced by the last render call into this accum (benchmarks). */
+/** Rays (closest-hit and shadow) traced by the last render call into this accum (benchmarks). */
 uint64_t sy_rt_accum_last_rays(const sy_rt_accum *accum);
 
-/* Feature buffers. Row 0 is the top row of the rectangle; all values are finite except DEPTH
+/** Feature buffers. Row 0 is the top row of the rectangle; all values are finite except DEPTH
  * (+INFINITY where no sample hit anything). */
 typedef enum sy_rt_aov {
-    SY_RT_AOV_COLOR = 0,    /* 4 ch: mean RGBA radiance, premultiplied (alpha = coverage) */
-    SY_RT_AOV_VARIANCE = 1, /* 3 ch: variance of the colour mean per channel, s^2 / n (Welford) */
-    SY_RT_AOV_ALBEDO = 2,   /* 3 ch: base colour at the first non-specular hit (0 on a miss) */
-    SY_RT_AOV_NORMAL = 3,   /* 3 ch: world shading normal there, facing the camera (mean) */
-    SY_RT_AOV_DEPTH = 4,    /* 1 ch: mean camera-axis distance of the first hit */
-    SY_RT_AOV_DIRECT = 5,   /* 3 ch: emission seen directly + light reaching the first hit directly */
-    SY_RT_AOV_INDIRECT = 6, /* 3 ch: the rest; DIRECT + INDIRECT = COLOR (RGB) */
+    SY_RT_AOV_COLOR = 0,    /**< 4 ch: mean RGBA radiance, premultiplied (alpha = coverage) */
+    SY_RT_AOV_VARIANCE = 1, /**< 3 ch: variance of the colour mean per channel, s^2 / n (Welford) */
+    SY_RT_AOV_ALBEDO = 2,   /**< 3 ch: base colour at the first non-specular hit (0 on a miss) */
+    SY_RT_AOV_NORMAL = 3,   /**< 3 ch: world shading normal there, facing the camera (mean) */
+    SY_RT_AOV_DEPTH = 4,    /**< 1 ch: mean camera-axis distance of the first hit */
+    SY_RT_AOV_DIRECT = 5,   /**< 3 ch: emission seen directly + light reaching the first hit directly */
+    SY_RT_AOV_INDIRECT = 6, /**< 3 ch: the rest; DIRECT + INDIRECT = COLOR (RGB) */
     SY_RT_AOV_COUNT = 7,
     SY_RT_AOV_MAX_ENUM = 0x7fffffff
 } sy_rt_aov;
-uint32_t sy_rt_aov_channels(sy_rt_aov aov); /* 0 for an unknown value */
-const char *sy_rt_aov_name(sy_rt_aov aov);  /* "color", "variance", ... ; NULL if unknown */
-/* Copies one feature buffer into out (width * height * channels floats, interleaved). */
+uint32_t sy_rt_aov_channels(sy_rt_aov aov); /**< 0 for an unknown value */
+const char *sy_rt_aov_name(sy_rt_aov aov);  /**< "color", "variance", ... ; NULL if unknown */
+/** Copies one feature buffer into out (width * height * channels floats, interleaved). */
 sy_rt_result sy_rt_accum_read(const sy_rt_accum *accum, sy_rt_aov aov, float *out, char *err, size_t err_len);
 
 /* >>path records (PATHTRACER): the stored-sample hook of radiance filtering
@@ -452,29 +510,31 @@ sy_rt_result sy_rt_accum_read(const sy_rt_accum *accum, sy_rt_aov aov, float *ou
  * P0's BSDF for any direction, so a filter can re-shade a neighbour's incident sample with this
  * pixel's own material, normal and wo. Ownership: caller-owned array; plain data. */
 enum { SY_RT_RECORD_P0 = 1u << 0 };
-#define SY_RT_RECORD_BSDF_FLOATS 18
+#define SY_RT_RECORD_BSDF_FLOATS 18 /**< floats of the packed BSDF in a record */
+/** One path record of the path tracer (see above). */
 typedef struct sy_rt_pt_record {
-    float color[3], prefix[3];
-    float position[3];   /* P0, world */
-    float normal[3];     /* unit shading normal at P0, on the side wo comes from */
-    float wo[3];         /* unit, from P0 toward the previous vertex */
-    float ray_dir[3];    /* unit direction of the ray segment that reached P0 */
-    float path_length;   /* camera -> P0 along the (specular) chain, world units */
-    float throughput[3]; /* camera -> P0 along the chain (1 without specular bounces) */
-    float wi[3];         /* unit direction sampled at P0 (toward the incoming light) */
-    float incident[3];   /* radiance estimate arriving at P0 along wi (see above) */
-    float hit_distance;  /* length of the ray along wi; +INFINITY when it escaped or was not traced */
-    float glossy_exponent; /* Blinn-Phong exponent equivalent to P0's GGX lobes (2 / alpha^2 - 2) when
+    /** @{ color = the sample's radiance; prefix = what the path gathered before wi (see above) */
+    float color[3], prefix[3]; /** @} */
+    float position[3];   /**< P0, world */
+    float normal[3];     /**< unit shading normal at P0, on the side wo comes from */
+    float wo[3];         /**< unit, from P0 toward the previous vertex */
+    float ray_dir[3];    /**< unit direction of the ray segment that reached P0 */
+    float path_length;   /**< camera -> P0 along the (specular) chain, world units */
+    float throughput[3]; /**< camera -> P0 along the chain (1 without specular bounces) */
+    float wi[3];         /**< unit direction sampled at P0 (toward the incoming light) */
+    float incident[3];   /**< radiance estimate arriving at P0 along wi (see above) */
+    float hit_distance;  /**< length of the ray along wi; +INFINITY when it escaped or was not traced */
+    float glossy_exponent; /**< Blinn-Phong exponent equivalent to P0's GGX lobes (2 / alpha^2 - 2) when
                               they are sampled with probability >= 1/4, else 0 (diffuse-dominated) */
-    uint32_t flags;      /* SY_RT_RECORD_P0 */
-    float bsdf[SY_RT_RECORD_BSDF_FLOATS]; /* opaque: P0's BSDF for sy_rt_pt_record_bsdf */
+    uint32_t flags;      /**< SY_RT_RECORD_P0 */
+    float bsdf[SY_RT_RECORD_BSDF_FLOATS]; /**< opaque: P0's BSDF for sy_rt_pt_record_bsdf */
 } sy_rt_pt_record;
 
-/* f(wo, wi) * |n . wi| of P0's BSDF (RGB, the lobes with a finite density) and the solid-angle pdf
+/** f(wo, wi) * |n . wi| of P0's BSDF (RGB, the lobes with a finite density) and the solid-angle pdf
  * with which the path tracer samples wi there (the same mixture it used for the record's own wi).
  * Zero for a record without SY_RT_RECORD_P0. wi is unit, world space. Thread-safe (pure). */
 void sy_rt_pt_record_bsdf(const sy_rt_pt_record *record, const float wi[3], float f_cos[3], float *pdf);
-/* The same for count directions at once (a filter re-shading many neighbours with one record):
+/** The same for count directions at once (a filter re-shading many neighbours with one record):
  * structure of arrays, direction m = (wi[0][m], wi[1][m], wi[2][m]) -> f_cos[c][m], pdf[m]; the
  * record is unpacked and its wo-only terms computed once. Results equal count single calls bit
  * for bit. Outputs must not alias inputs. Thread-safe (pure). */
@@ -488,6 +548,7 @@ void sy_rt_pt_record_bsdf_batch(const sy_rt_pt_record *record, uint32_t count, c
  * (not hidden) instance hit, or 0 where nothing is hit; alpha-masked holes are seen through like
  * in the other integrators. depth may be NULL. The desc's integrator field is ignored (coverage),
  * as are max_depth, area_light_samples and seed. Deterministic and tile-stitchable. */
+/** Fills ids (and depth, if not NULL) with the nearest visible instance per pixel centre. */
 sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
                             uint32_t *ids, float *depth, char *err, size_t err_len);
 

@@ -70,7 +70,7 @@ sy_rt_result sy_rt_bench_rays(sy_rt_device *dev, const sy_rt_camera *camera, uin
     out->width = width;
     out->height = height;
     out->repeats = repeats;
-    out->threads = dev->thread_count;
+    out->threads = (uint32_t)sy_rt_render_threads(dev);
     out->primary_seconds = best_primary;
     out->raw_seconds = best_raw;
     out->primary_mrays = (double)pixels / best_primary * 1e-6;

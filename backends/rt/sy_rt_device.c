@@ -5,10 +5,10 @@
 #include "sy_rt_scene.h"
 #include "sy_rt_texture.h"
 
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 /* >>errors */
 
@@ -42,15 +42,11 @@ sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **o
         return sy_rt_fail(err, err_len, SY_RT_ERROR_SYSTEM, "device create: pthread_mutex_init failed");
     }
     uint32_t threads = desc ? desc->thread_count : 0;
-    if (threads == 0) {
-        long n = sysconf(_SC_NPROCESSORS_ONLN);
-        threads = n > 0 ? (uint32_t)n : 1u;
-    }
     if (threads > 1024) threads = 1024;
-    dev->thread_count = threads;
+    dev->thread_count = threads; /* 0: the OpenMP default team size, looked up per render */
 
     char config[64];
-    snprintf(config, sizeof config, "threads=%u", threads);
+    snprintf(config, sizeof config, "threads=%d", sy_rt_render_threads(dev));
     dev->rtc = rtcNewDevice(config);
     if (!dev->rtc) {
         enum RTCError e = rtcGetDeviceError(NULL);
@@ -81,6 +77,11 @@ sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **o
     dev->dirty = dev->top_dirty = true;
     *out = dev;
     return SY_RT_OK;
+}
+
+int sy_rt_render_threads(const sy_rt_device *dev)
+{
+    return dev->thread_count ? (int)dev->thread_count : omp_get_max_threads();
 }
 
 void sy_rt_device_destroy(sy_rt_device *dev)

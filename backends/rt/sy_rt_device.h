@@ -73,7 +73,7 @@ typedef struct sy_rt_area_tri {
 struct sy_rt_device {
     RTCDevice rtc;
     RTCScene top;
-    uint32_t thread_count;
+    uint32_t thread_count; /* render threads asked for (sy_rt_device_desc); 0 = OpenMP default */
 
     /* Embree error callback output; read back by the call that triggered it. */
     pthread_mutex_t rtc_err_lock;
@@ -127,6 +127,10 @@ static inline bool sy_rt_size_mul(size_t a, size_t b, size_t *out)
     *out = a * b;
     return true;
 }
+
+/* Threads a render runs on: thread_count, or where that is 0 the OpenMP default team size of the
+ * calling thread (OMP_NUM_THREADS, else the cores this process may run on). Also Embree's. */
+int sy_rt_render_threads(const sy_rt_device *dev);
 
 /* Lookups used at render time; NULL for invalid handles. */
 static inline const sy_rt_material_data *sy_rt_material_lookup(const sy_rt_device *dev, sy_rt_material m)

@@ -1,11 +1,11 @@
 /* sy_rt_frame.c — one frame's render state: validation, camera rays (perspective and orthographic
  * with an arbitrary image-plane window, so off-axis stereo frusta are the same code), and the tile
- * scheduler that runs an integrator over the requested rectangle on all threads (see
+ * scheduler that runs an integrator over the requested rectangle on the OpenMP thread team (see
  * sy_rt_frame.h). Below the integrators: it calls none of them (sy_rt_render.c dispatches). */
 #include "sy_rt_frame.h"
 
+#include <omp.h>
 #include <stdatomic.h>
-#include <stdlib.h>
 #include <string.h>
 
 #define FAIL(r, ...) sy_rt_fail(err, err_len, (r), __VA_ARGS__)
@@ -105,75 +105,47 @@ void sy_rt_frame_ray_at(const sy_rt_frame *f, float fx, float fy, struct RTCRay 
 
 /* >>scheduler */
 
-typedef struct tile_job {
-    const sy_rt_frame *f;
-    sy_rt_tile_fn fn;
-    void *user;
-    uint32_t tiles_x, tiles_total;
-    atomic_uint next;
-    atomic_bool cancelled;
-    pthread_mutex_t progress_lock;
-    uint32_t done;
-    sy_rt_progress_fn progress;
-    void *progress_user;
-} tile_job;
-
-static void *tile_worker(void *arg)
-{
-    tile_job *job = arg;
-    const sy_rt_frame *f = job->f;
-    for (;;) {
-        if (atomic_load_explicit(&job->cancelled, memory_order_relaxed)) break;
-        uint32_t t = atomic_fetch_add_explicit(&job->next, 1u, memory_order_relaxed);
-        if (t >= job->tiles_total) break;
-        uint32_t x0 = f->x + (t % job->tiles_x) * SY_RT_TILE_SIZE, y0 = f->y + (t / job->tiles_x) * SY_RT_TILE_SIZE;
-        uint32_t x1 = x0 + SY_RT_TILE_SIZE, y1 = y0 + SY_RT_TILE_SIZE;
-        if (x1 > f->x + f->width) x1 = f->x + f->width;
-        if (y1 > f->y + f->height) y1 = f->y + f->height;
-        job->fn(f, job->user, x0, y0, x1, y1);
-        if (job->progress) {
-            pthread_mutex_lock(&job->progress_lock);
-            sy_rt_progress p = {++job->done, job->tiles_total};
-            if (!job->progress(&p, job->progress_user)) atomic_store(&job->cancelled, true);
-            pthread_mutex_unlock(&job->progress_lock);
-        }
-    }
-    return NULL;
-}
-
+/* One tile job on the process's OpenMP thread team: tiles are handed out one at a time in any
+ * order (schedule(dynamic)); each tile's pixels depend only on the tile, never on the thread or the
+ * order, so the result is the same for every thread count. Cancellation: a flag every worker reads
+ * before a tile; once set the remaining tiles are skipped (the loop still runs out, at the cost of
+ * one counter increment per skipped tile). Progress: reported after each finished tile under a
+ * per-job lock, so calls are serialised, from whichever team thread finished the tile. */
 sy_rt_result sy_rt_run_tiles(const sy_rt_frame *f, sy_rt_tile_fn fn, void *user, sy_rt_progress_fn progress,
                              void *progress_user, char *err, size_t err_len)
 {
-    tile_job job;
-    memset(&job, 0, sizeof job);
-    job.f = f;
-    job.fn = fn;
-    job.user = user;
-    uint64_t tiles_x = ((uint64_t)f->width + SY_RT_TILE_SIZE - 1u) / SY_RT_TILE_SIZE;
-    uint64_t tiles_y = ((uint64_t)f->height + SY_RT_TILE_SIZE - 1u) / SY_RT_TILE_SIZE;
-    if (tiles_x * tiles_y > UINT32_MAX - 1024u)
+    uint64_t tiles_x64 = ((uint64_t)f->width + SY_RT_TILE_SIZE - 1u) / SY_RT_TILE_SIZE;
+    uint64_t tiles_y64 = ((uint64_t)f->height + SY_RT_TILE_SIZE - 1u) / SY_RT_TILE_SIZE;
+    if (tiles_x64 * tiles_y64 > INT32_MAX)
         return FAIL(SY_RT_ERROR_LIMIT, "render: %ux%u rectangle has too many tiles", f->width, f->height);
-    job.tiles_x = (uint32_t)tiles_x;
-    job.tiles_total = (uint32_t)(tiles_x * tiles_y);
-    atomic_init(&job.next, 0u);
-    atomic_init(&job.cancelled, false);
-    job.progress = progress;
-    job.progress_user = progress_user;
-    if (pthread_mutex_init(&job.progress_lock, NULL) != 0)
-        return FAIL(SY_RT_ERROR_SYSTEM, "render: pthread_mutex_init failed");
+    const uint32_t tiles_x = (uint32_t)tiles_x64;
+    const int tiles_total = (int)(tiles_x64 * tiles_y64);
+    int threads = sy_rt_render_threads(f->dev);
+    if (threads > tiles_total) threads = tiles_total;
+    atomic_bool cancelled;
+    atomic_init(&cancelled, false);
+    uint32_t done = 0;
+    omp_lock_t progress_lock;
+    if (progress) omp_init_lock(&progress_lock);
 
-    uint32_t extra = f->dev->thread_count > 1u ? f->dev->thread_count - 1u : 0u;
-    if (extra > job.tiles_total - 1u) extra = job.tiles_total - 1u;
-    pthread_t *threads = extra ? malloc(extra * sizeof *threads) : NULL;
-    uint32_t started = 0;
-    if (threads)
-        for (; started < extra; ++started)
-            if (pthread_create(&threads[started], NULL, tile_worker, &job) != 0) break;
-    /* The calling thread works too; if some threads failed to start, fewer threads finish the job. */
-    tile_worker(&job);
-    for (uint32_t i = 0; i < started; ++i) pthread_join(threads[i], NULL);
-    free(threads);
-    pthread_mutex_destroy(&job.progress_lock);
-    if (atomic_load(&job.cancelled)) return FAIL(SY_RT_ERROR_CANCELLED, "render: cancelled by the progress callback");
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (threads > 1) default(none) \
+    shared(f, fn, user, progress, progress_user, cancelled, done, progress_lock) firstprivate(tiles_x, tiles_total)
+    for (int t = 0; t < tiles_total; ++t) {
+        if (atomic_load_explicit(&cancelled, memory_order_relaxed)) continue;
+        uint32_t x0 = f->x + ((uint32_t)t % tiles_x) * SY_RT_TILE_SIZE, y0 = f->y + ((uint32_t)t / tiles_x) * SY_RT_TILE_SIZE;
+        uint32_t x1 = x0 + SY_RT_TILE_SIZE, y1 = y0 + SY_RT_TILE_SIZE;
+        if (x1 > f->x + f->width) x1 = f->x + f->width;
+        if (y1 > f->y + f->height) y1 = f->y + f->height;
+        fn(f, user, x0, y0, x1, y1);
+        if (progress) {
+            omp_set_lock(&progress_lock);
+            sy_rt_progress p = {++done, (uint32_t)tiles_total};
+            if (!progress(&p, progress_user)) atomic_store(&cancelled, true);
+            omp_unset_lock(&progress_lock);
+        }
+    }
+
+    if (progress) omp_destroy_lock(&progress_lock);
+    if (atomic_load(&cancelled)) return FAIL(SY_RT_ERROR_CANCELLED, "render: cancelled by the progress callback");
     return SY_RT_OK;
 }

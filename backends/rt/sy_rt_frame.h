@@ -1,6 +1,7 @@
 /* sy_rt_frame.h — per-frame render state shared by the integrators and the benchmark: the
  * validated camera with its primary-ray generator, the output rectangle, and the tile scheduler
- * (pthreads + atomic tile counter, progress and cancellation). Internal to backends/rt. */
+ * (OpenMP: the process's thread team, dynamic tiles, progress and cancellation). Internal to
+ * backends/rt. */
 #ifndef SY_RT_FRAME_H
 #define SY_RT_FRAME_H
 
@@ -87,7 +88,12 @@ static inline void sy_rt_frame_hit(const sy_rt_frame *f, struct RTCIntersectCont
 /* Renders one tile: pixels [x0, x1) x [y0, y1) in full-image coordinates. */
 typedef void (*sy_rt_tile_fn)(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1);
 
-/* Runs fn over all tiles of the frame's rectangle on dev->thread_count threads. */
+/* Runs fn over all tiles of the frame's rectangle on the OpenMP thread team (sy_rt_render_threads
+ * threads, the calling thread among them; one thread when called from inside an active parallel
+ * region), handing tiles out dynamically. fn runs concurrently on distinct tiles and must write
+ * only its tile's pixels. progress (may be NULL) is called after each tile, serialised, from the
+ * thread that finished it; returning false skips the tiles not yet started and gives
+ * SY_RT_ERROR_CANCELLED once the running ones are done. */
 sy_rt_result sy_rt_run_tiles(const sy_rt_frame *f, sy_rt_tile_fn fn, void *user, sy_rt_progress_fn progress,
                              void *progress_user, char *err, size_t err_len);
 

@@ -19,6 +19,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "sy_log.h"
 #include "sy_viewport.h"
 
 /* Each connection's reader thread: 64 KiB of stack reserved (a few KiB touched); sanitizer frames
@@ -37,10 +38,14 @@
 #endif
 
 /* ---- shared helpers ---- */
-static void log_line(sy_cluster_log_fn fn, void *user, const char *prefix, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-static void log_line(sy_cluster_log_fn fn, void *user, const char *prefix, const char *fmt, ...)
+/* One log line: to the options' callback as "PREFIX: text" when there is one, else to sy_log
+ * (module "cluster.server" / "cluster.client", sy_log.h) with its level. */
+static void log_line(sy_cluster_log_fn fn, void *user, sy_log_level level, const char *module, const char *prefix,
+                     const char *fmt, ...) __attribute__((format(printf, 6, 7)));
+static void log_line(sy_cluster_log_fn fn, void *user, sy_log_level level, const char *module, const char *prefix,
+                     const char *fmt, ...)
 {
+    if (!fn && !sy_log_enabled(level)) return;
     char line[768];
     int n = snprintf(line, sizeof line, "%s: ", prefix);
     va_list ap;
@@ -48,7 +53,7 @@ static void log_line(sy_cluster_log_fn fn, void *user, const char *prefix, const
     vsnprintf(line + n, sizeof line - (size_t)n, fmt, ap);
     va_end(ap);
     if (fn) fn(user, line);
-    else fprintf(stderr, "%s\n", line);
+    else sy_log(level, module, NULL, "%s", line + n);
 }
 
 /* strlcpy: copies what fits, always terminates */
@@ -726,8 +731,8 @@ struct sy_cluster_server {
     bool sync_ok;                 /* mutexes and conditions initialised */
 };
 
-static void slog(sy_cluster_server *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void slog(sy_cluster_server *s, const char *fmt, ...)
+static void slog(sy_cluster_server *s, sy_log_level level, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void slog(sy_cluster_server *s, sy_log_level level, const char *fmt, ...)
 {
     char line[768];
     va_list ap;
@@ -735,15 +740,17 @@ static void slog(sy_cluster_server *s, const char *fmt, ...)
     vsnprintf(line, sizeof line, fmt, ap);
     va_end(ap);
     if (s->sync_ok) pthread_mutex_lock(&s->log_lock);
-    log_line(s->o.log, s->o.log_user, "sy serve", "%s", line);
+    log_line(s->o.log, s->o.log_user, level, "cluster.server", "sy serve", "%s", line);
     if (s->sync_ok) pthread_mutex_unlock(&s->log_lock);
 }
-#define SLOG(s, ...) slog((s), __VA_ARGS__)
+#define SLOG(s, ...) slog((s), SY_LOG_NOTE, __VA_ARGS__)
+#define SWARN(s, ...) slog((s), SY_LOG_WARNING, __VA_ARGS__)
 
 /* Events unauthenticated peers can cause at any rate (refused connections, handshake failures):
  * at most 20 lines a second, then one line saying how many were left out. */
-static void slog_noise(sy_cluster_server *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void slog_noise(sy_cluster_server *s, const char *fmt, ...)
+static void slog_noise(sy_cluster_server *s, sy_log_level level, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static void slog_noise(sy_cluster_server *s, sy_log_level level, const char *fmt, ...)
 {
     double now = sy_time_now();
     uint32_t dropped = 0;
@@ -758,14 +765,14 @@ static void slog_noise(sy_cluster_server *s, const char *fmt, ...)
     if (emit) s->noise_lines++;
     else s->noise_dropped++;
     pthread_mutex_unlock(&s->lock);
-    if (dropped) SLOG(s, "(%u more lines about unauthenticated peers left out in the last second)", dropped);
+    if (dropped) SWARN(s, "(%u more lines about unauthenticated peers left out in the last second)", dropped);
     if (!emit) return;
     char line[768];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(line, sizeof line, fmt, ap);
     va_end(ap);
-    SLOG(s, "%s", line);
+    slog(s, level, "%s", line);
 }
 
 /* >>peer memory: everything the server holds for peers' messages in flight (reassembly buffers,
@@ -1330,7 +1337,7 @@ static void serve_job(sy_cluster_server *s, peer *p)
         sy_cluster_msg_free(&m);
     }
     if (r) {
-        SLOG(s, "%s: rejected: %s%s", se->peer, err.message, p->close_after ? " (connection closed)" : "");
+        SWARN(s, "%s: rejected: %s%s", se->peer, err.message, p->close_after ? " (connection closed)" : "");
         memset(&reply, 0, sizeof reply);
         reply.header.type = SY_CLUSTER_ERROR;
         reply.u.error.code = (uint32_t)r;
@@ -1338,7 +1345,7 @@ static void serve_job(sy_cluster_server *s, peer *p)
     }
     sy_error e2 = {0};
     if (sy_cluster_encode(&reply, 0, &p->reply, &e2) != SY_OK) {
-        SLOG(s, "%s: cannot encode the reply: %s", se->peer, e2.message);
+        SWARN(s, "%s: cannot encode the reply: %s", se->peer, e2.message);
         p->reply.size = 0;
         p->close_after = true;
     }
@@ -1354,7 +1361,7 @@ static void serve_job(sy_cluster_server *s, peer *p)
         snprintf(reply.u.error.reason, sizeof reply.u.error.reason,
                  "server busy: a reply of %zu KiB does not fit the memory left for peers' messages (%zu KiB ceiling)",
                  want >> 10, s->max_peer_memory >> 10);
-        SLOG(s, "%s: rejected: %s", se->peer, reply.u.error.reason);
+        SWARN(s, "%s: rejected: %s", se->peer, reply.u.error.reason);
         if (sy_cluster_encode(&reply, 0, &p->reply, &e2) != SY_OK) p->reply.size = 0;
         p->reply_charged = 0; /* a few hundred bytes, not charged */
     } else {
@@ -1402,14 +1409,14 @@ static bool peer_handshake(peer *p)
         sy_result r = wire_recv(&p->w, &hb, p->hbuf, sizeof p->hbuf, NULL, deadline, 0, &in, NULL, &err);
         if (r) {
             if (p->w.last_rv == SY_STREAM_TIMEDOUT)
-                slog_noise(s, "%s: closed: no %s within the %u ms handshake deadline", p->addr,
+                slog_noise(s, SY_LOG_WARNING, "%s: closed: no %s within the %u ms handshake deadline", p->addr,
                            p->state == 0 ? "HELLO" : "AUTH", s->handshake_ms);
             else if (wire_closed(&p->w))
-                slog_noise(s, "%s: disconnected during the handshake", p->addr);
+                slog_noise(s, SY_LOG_WARNING, "%s: disconnected during the handshake", p->addr);
             else if (p->w.last_rv) /* the connection failed (e.g. TLS): nothing can be sent */
-                slog_noise(s, "%s: connection failed during the handshake: %s", p->addr, err.message);
+                slog_noise(s, SY_LOG_WARNING, "%s: connection failed during the handshake: %s", p->addr, err.message);
             else {
-                slog_noise(s, "%s: rejected: %s (before authentication; connection closed)", p->addr, err.message);
+                slog_noise(s, SY_LOG_WARNING, "%s: rejected: %s (before authentication; connection closed)", p->addr, err.message);
                 peer_refuse(p, r, err.message);
             }
             return false;
@@ -1448,7 +1455,7 @@ static bool peer_handshake(peer *p)
                     copy_str(name, sizeof name, m.u.hello.name);
                     for (char *c = name; *c; ++c)
                         if ((unsigned char)*c < 0x20 || (unsigned char)*c == 0x7f) *c = '?';
-                    slog_noise(s, "%s: hello from '%s'%s", p->addr, name, s->secret ? "" : " (no secret, loopback)");
+                    slog_noise(s, SY_LOG_NOTE, "%s: hello from '%s'%s", p->addr, name, s->secret ? "" : " (no secret, loopback)");
                 }
             } else if (t == SY_CLUSTER_AUTH && p->state == 1) {
                 uint8_t expect[32];
@@ -1474,8 +1481,8 @@ static bool peer_handshake(peer *p)
         if (r) {
             /* a wrong secret is worth every line (the back-off bounds them per address); garbage,
              * out-of-order and throttled HELLOs are rate-limited like any unauthenticated noise */
-            if (t == SY_CLUSTER_AUTH) SLOG(s, "%s: rejected: %s (connection closed)", p->addr, err.message);
-            else slog_noise(s, "%s: rejected: %s (connection closed)", p->addr, err.message);
+            if (t == SY_CLUSTER_AUTH) SWARN(s, "%s: rejected: %s (connection closed)", p->addr, err.message);
+            else slog_noise(s, SY_LOG_WARNING, "%s: rejected: %s (connection closed)", p->addr, err.message);
             peer_refuse(p, r, err.message);
             return false;
         }
@@ -1484,7 +1491,7 @@ static bool peer_handshake(peer *p)
         if (r == SY_OK) r = wire_send(&p->w, b.data, b.size, SY_CLUSTER_HANDSHAKE_MAX_FRAME, deadline, 0, NULL, &err);
         sy_cluster_buf_free(&b);
         if (r) {
-            slog_noise(s, "%s: handshake reply not sent: %s", p->addr, err.message);
+            slog_noise(s, SY_LOG_WARNING, "%s: handshake reply not sent: %s", p->addr, err.message);
             return false;
         }
         if (reply.header.type == SY_CLUSTER_CHALLENGE) p->state = s->secret ? 1 : 2;
@@ -1517,7 +1524,7 @@ static void *peer_main(void *arg)
         if (!open) {
             char why[160];
             snprintf(why, sizeof why, "server busy: %u sessions are open (--max-sessions %u)", n, s->max_sessions);
-            SLOG(s, "%s: rejected: %s (connection closed)", p->addr, why);
+            SWARN(s, "%s: rejected: %s (connection closed)", p->addr, why);
             peer_refuse(p, SY_ERR_LIMIT, why);
         }
     }
@@ -1528,9 +1535,9 @@ static void *peer_main(void *arg)
         sy_result r = wire_recv(&p->w, &fb, NULL, 0, &mem, 0, SY_CLUSTER_PROGRESS_MS / 1000.0, &p->in, NULL, &err);
         if (r) {
             if (wire_closed(&p->w)) SLOG(s, "%s: disconnected", p->addr);
-            else if (p->w.last_rv) SLOG(s, "%s: connection failed: %s (connection closed)", p->addr, err.message);
+            else if (p->w.last_rv) SWARN(s, "%s: connection failed: %s (connection closed)", p->addr, err.message);
             else {
-                SLOG(s, "%s: rejected: %s (connection closed)", p->addr, err.message);
+                SWARN(s, "%s: rejected: %s (connection closed)", p->addr, err.message);
                 peer_refuse(p, r, err.message);
             }
             break;
@@ -1552,7 +1559,7 @@ static void *peer_main(void *arg)
         if (!stop && p->reply.size) {
             r = wire_send(&p->w, p->reply.data, p->reply.size, p->peer_max_frame, 0, SY_CLUSTER_SEND_MS / 1000.0, NULL,
                           &err);
-            if (r) SLOG(s, "%s: reply not sent: %s (connection closed)", p->addr, err.message);
+            if (r) SWARN(s, "%s: reply not sent: %s (connection closed)", p->addr, err.message);
         }
         mem_release(s, p->reply_charged);
         p->reply_charged = 0;
@@ -1615,7 +1622,7 @@ static void peer_start(sy_cluster_server *s, sy_cluster_stream *st)
     if (room) s->unauth++;
     pthread_mutex_unlock(&s->lock);
     if (!room) {
-        slog_noise(s, "%s: connection refused: %u unauthenticated connections are open (limit %u, "
+        slog_noise(s, SY_LOG_WARNING, "%s: connection refused: %u unauthenticated connections are open (limit %u, "
                       "--max-unauthenticated)", st->peer, unauth, s->max_unauth);
         st->ops->free(st);
         return;
@@ -1645,7 +1652,7 @@ static void peer_start(sy_cluster_server *s, sy_cluster_stream *st)
         pthread_attr_destroy(&at);
         if (rv == 0) return;
     }
-    slog_noise(s, "%s: connection dropped: %s", st->peer, rv == ENOMEM ? "out of memory" : strerror(rv));
+    slog_noise(s, SY_LOG_WARNING, "%s: connection dropped: %s", st->peer, rv == ENOMEM ? "out of memory" : strerror(rv));
     pthread_mutex_lock(&s->lock);
     s->unauth--;
     pthread_mutex_unlock(&s->lock);
@@ -1662,7 +1669,7 @@ static void *acceptor_main(void *arg)
         sy_stream_status rv = s->listener->ops->accept(s->listener, &st, msg, sizeof msg);
         if (rv == SY_STREAM_CLOSED) break;
         if (rv != SY_STREAM_OK) {
-            slog_noise(s, "%s", msg);
+            slog_noise(s, SY_LOG_WARNING, "%s", msg);
             struct timespec ts = {0, 20000000L}; /* e.g. out of descriptors: do not spin */
             nanosleep(&ts, NULL);
             continue;
@@ -1783,7 +1790,8 @@ struct sy_cluster_client {
     char *tls_ca; /* owned copy of the CA file path */
 };
 
-#define CLOG(c, ...) log_line((c)->o.log, (c)->o.log_user, "sy cluster", __VA_ARGS__)
+#define CLOG(c, ...) log_line((c)->o.log, (c)->o.log_user, SY_LOG_NOTE, "cluster.client", "sy cluster", __VA_ARGS__)
+#define CWARN(c, ...) log_line((c)->o.log, (c)->o.log_user, SY_LOG_WARNING, "cluster.client", "sy cluster", __VA_ARGS__)
 
 static void conn_close(conn *k)
 {
@@ -1986,7 +1994,7 @@ sy_result sy_cluster_client_create(sy_scene *scene, const sy_cluster_client_opts
         sy_error e = {0};
         if (conn_connect(c, k, &e) == SY_OK) live++;
         else {
-            CLOG(c, "%s", e.message);
+            CWARN(c, "%s", e.message);
             copy_str(k->error, sizeof k->error, e.message);
             if (!first.code) first = e;
         }
@@ -2234,7 +2242,7 @@ static uint32_t run_round(frame_ctx *fc, bool send_scene)
         if (started[i]) pthread_join(th[i], NULL);
         if (args[i].failed) {
             conn *k = &c->conns[i];
-            CLOG(c, "%s: dropped for this frame: %s", k->url, k->error);
+            CWARN(c, "%s: dropped for this frame: %s", k->url, k->error);
             conn_close(k);
             if (k->has_consumer) sy_scene_consumer_remove(c->scene, k->consumer);
             k->has_consumer = false;
@@ -2563,7 +2571,7 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
                 sy_cluster_msg_free(&rep);
                 free(raw);
             } else {
-                CLOG(c, "%s: swap failed: %s", k->url, e.message);
+                CWARN(c, "%s: swap failed: %s", k->url, e.message);
                 conn_close(k);
                 if (k->has_consumer) sy_scene_consumer_remove(c->scene, k->consumer);
                 k->has_consumer = false;

@@ -3,6 +3,8 @@
  * wire, no embedded NUL accepted); floats are IEEE-754 binary32 / binary64 bit patterns. */
 #include "sy_cluster_proto.h"
 
+#define IMATH_HALF_NO_LOOKUP_TABLE
+#include <half.h> /* Imath (libimath-dev): binary16 conversions */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -611,45 +613,8 @@ uint32_t sy_cluster_encoding_bytes(uint32_t encoding)
     return encoding == SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD ? 4u : encoding == SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD ? 2u : 0u;
 }
 
-/* q = integer part of mant / 2^shift (1 <= shift <= 31), rounded to nearest, ties to even */
-static uint32_t shift_rne(uint32_t mant, uint32_t shift)
-{
-    uint32_t q = mant >> shift, rem = mant & ((1u << shift) - 1u), halfway = 1u << (shift - 1u);
-    if (rem > halfway || (rem == halfway && (q & 1u))) q++;
-    return q;
-}
+/* binary16 conversions: Imath's C API (half.h, inline code; IMATH_HALF_NO_LOOKUP_TABLE keeps it from
+ * needing libImath's table): round to nearest even, overflow to infinity, NaNs keep sign and payload. */
+uint16_t sy_cluster_half_from_float(float f) { return imath_float_to_half(f); }
 
-uint16_t sy_cluster_half_from_float(float f)
-{
-    uint32_t x;
-    memcpy(&x, &f, 4);
-    uint32_t sign = (x >> 16) & 0x8000u, ax = x & 0x7fffffffu;
-    if (ax >= 0x7f800000u) { /* inf, NaN: keep the top 10 payload bits, force the quiet bit */
-        if (ax == 0x7f800000u) return (uint16_t)(sign | 0x7c00u);
-        return (uint16_t)(sign | 0x7c00u | 0x200u | ((ax >> 13) & 0x3ffu));
-    }
-    if (ax >= 0x477ff000u) return (uint16_t)(sign | 0x7c00u); /* >= 65520: the tie above 65504 goes to inf */
-    uint32_t exp = ax >> 23, mant = (ax & 0x7fffffu) | 0x800000u;
-    if (exp < 113) { /* below 2^-14: a subnormal half, in units of 2^-24: mant * 2^(exp - 126) */
-        if (exp < 102) return (uint16_t)sign; /* below 2^-25: rounds to zero */
-        return (uint16_t)(sign | shift_rne(mant, 126u - exp)); /* 0x400 = the smallest normal, encoded right */
-    }
-    /* normal: the rounding carry runs into the exponent, which is the correct next value */
-    return (uint16_t)(sign | shift_rne(((exp - 112u) << 23) | (ax & 0x7fffffu), 13u));
-}
-
-float sy_cluster_half_to_float(uint16_t h)
-{
-    uint32_t sign = (uint32_t)(h & 0x8000u) << 16, exp = (h >> 10) & 0x1fu, mant = h & 0x3ffu, bits;
-    if (exp == 0x1fu) bits = sign | 0x7f800000u | (mant << 13);
-    else if (exp) bits = sign | ((exp + 112u) << 23) | (mant << 13);
-    else if (!mant) bits = sign;
-    else { /* subnormal: normalise */
-        uint32_t e = 113;
-        while (!(mant & 0x400u)) mant <<= 1, e--;
-        bits = sign | (e << 23) | ((mant & 0x3ffu) << 13);
-    }
-    float f;
-    memcpy(&f, &bits, 4);
-    return f;
-}
+float sy_cluster_half_to_float(uint16_t h) { return imath_half_to_float(h); }

@@ -98,6 +98,50 @@ static uint32_t cluster_caps_of(const sy_params *p, const void *class_user)
     return caps;
 }
 
+/* >>parameters: the cluster's own keys (sy_params.h); every other key is forwarded to the servers'
+ * back-end. Core checks the own keys against this table; cluster_check_params checks the forwarded
+ * ones against the table of each used server's back-end when that class is registered in this
+ * process (the same binary as the servers, usually); a back-end unknown here is left to the
+ * servers, which check the keys when they create their context. */
+static const sy_param_decl cluster_params[] = {
+    {"backend", SY_PARAM_STRING, 0, 0, NULL, NULL,
+     "the servers' back-end (required; a server configured with its own uses that); keys not listed here go to it", 0},
+    {"mode", SY_PARAM_ENUM, 0, 0, "sort-first", "sort-first|balanced|cooperative|multi-display",
+     "how the servers share a frame (for stereo give the window stereo viewports: sy render --stereo sbs)", 0},
+    {"samples", SY_PARAM_INT, 0, SY_CLUSTER_MAX_SAMPLES, "0", NULL,
+     "cooperative: samples per render when the request gives none (0 = 16 per server)", 0},
+    {"pixels", SY_PARAM_ENUM, 0, 0, "float", "float|half", "tiles on the wire: float32 (bit-exact) or binary16", 0},
+    {"servers", SY_PARAM_STRING, 0, 0, NULL, NULL,
+     "the configured servers this viewport uses: 1-based numbers and ranges joined by '+' (2-4, 1+3); absent = all", 0},
+};
+static const sy_param_table cluster_table = SY_PARAM_TABLE(cluster_params);
+
+static sy_result cluster_check_params(const sy_params *all, const sy_params *forwarded, const void *class_user,
+                                      sy_error *err)
+{
+    const cluster_config *cfg = class_user;
+    const char *backend = sy_params_get(all, "backend");
+    uint64_t mask = 0;
+    if (parse_servers(cfg, sy_params_get(all, "servers"), &mask, NULL) != SY_OK) return SY_OK; /* create says why */
+    const sy_mediator_class *checked[SY_CLUSTER_MAX_SERVERS];
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < cfg->opts.url_count; ++i) {
+        const char *b = cfg->backends[i] ? cfg->backends[i] : backend;
+        const sy_mediator_class *c = (mask >> i & 1) && b ? sy_mediator_find(b) : NULL;
+        if (!c || (c->caps & SY_CAP_REMOTE)) continue; /* unknown here: the servers check */
+        bool seen = false;
+        for (uint32_t k = 0; k < n; ++k) seen = seen || checked[k] == c;
+        if (seen) continue;
+        checked[n++] = c;
+        sy_result r = sy_mediator_class_check_params(c, forwarded, err);
+        if (r != SY_OK) {
+            sy_error_prefix(err, "%s, forwarded to server %u", cfg->name, i + 1);
+            return r;
+        }
+    }
+    return SY_OK;
+}
+
 static sy_result check_node(const cluster_config *cfg, uint32_t i, const char *backend, uint32_t mode, sy_error *err)
 {
     uint32_t caps = remote_caps(backend);
@@ -124,7 +168,14 @@ static sy_result cluster_create(const sy_mediator_create_args *args, void **stat
     *state_out = NULL;
     const cluster_config *cfg = args->class_user;
     const sy_params *p = args->params;
-    const char *backend = sy_params_get(p, "backend");
+    const char *backend = NULL, *m = NULL, *px = NULL; /* mode, pixels: declared defaults */
+    long samples = 0;
+    sy_result r;
+    if ((r = sy_param_string(&cluster_table, p, "backend", &backend, err)) ||
+        (r = sy_param_string(&cluster_table, p, "mode", &m, err)) ||
+        (r = sy_param_string(&cluster_table, p, "pixels", &px, err)) ||
+        (r = sy_param_int(&cluster_table, p, "samples", &samples, err)))
+        return r;
     if (!backend || !backend[0])
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
                             "%s: parameter backend=NAME (the servers' back-end) is required", cfg->name);
@@ -134,21 +185,8 @@ static sy_result cluster_create(const sy_mediator_create_args *args, void **stat
     if (own && (own->caps & SY_CAP_REMOTE))
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: backend=%s is itself a cluster", cfg->name, backend);
     uint32_t mode = SY_CLUSTER_SORT_FIRST;
-    const char *m = sy_params_get(p, "mode");
-    if (m && !sy_cluster_mode_parse(m, &mode))
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                            "%s: mode=%s is not one of sort-first, balanced, cooperative, multi-display", cfg->name, m);
-    if (mode == SY_CLUSTER_STEREO)
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                            "%s: mode=stereo: a cluster viewport renders the eye it is asked for; give the window "
-                            "stereo viewports (sy render --stereo sbs) instead",
-                            cfg->name);
-    const char *px = sy_params_get(p, "pixels");
-    if (px && strcmp(px, "float") && strcmp(px, "half"))
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: pixels=%s is not float or half", cfg->name, px);
-    long samples = 0;
-    sy_result r = sy_params_get_int(p, "samples", 0, 0, SY_CLUSTER_MAX_SAMPLES, &samples, err);
-    if (r) return r;
+    if (!sy_cluster_mode_parse(m, &mode) || mode == SY_CLUSTER_STEREO) /* the table's enum has the others */
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: mode=%s is not a mode of a cluster viewport", cfg->name, m);
     uint64_t mask = 0;
     r = parse_servers(cfg, sy_params_get(p, "servers"), &mask, err);
     if (r) return r;
@@ -163,7 +201,7 @@ static sy_result cluster_create(const sy_mediator_create_args *args, void **stat
     st->cfg = cfg;
     st->root_id = args->root_node_id;
     st->mode = mode;
-    st->half = px && !strcmp(px, "half");
+    st->half = !strcmp(px, "half");
     st->samples = (uint32_t)samples;
     st->timeout_ms = 60000; /* adaptive (no timeout configured): the first frame sends a snapshot */
     snprintf(st->backend, sizeof st->backend, "%s", backend);
@@ -171,9 +209,7 @@ static sy_result cluster_create(const sy_mediator_create_args *args, void **stat
     size_t len = 0;
     for (uint32_t i = 0; i < p->count && r == SY_OK; ++i) {
         const char *k = p->items[i].key;
-        if (!strcmp(k, "backend") || !strcmp(k, "mode") || !strcmp(k, "samples") || !strcmp(k, "pixels") ||
-            !strcmp(k, "servers"))
-            continue;
+        if (sy_param_find(&cluster_table, k)) continue; /* the cluster's own */
         int n = snprintf(st->params + len, sizeof st->params - len, "%s%s=%s", len ? "," : "", k, p->items[i].value);
         if (n < 0 || (size_t)n >= sizeof st->params - len)
             r = sy_error_set(err, SY_ERR_LIMIT, "%s: back-end parameters longer than %u bytes", cfg->name,
@@ -343,7 +379,9 @@ sy_result sy_mediator_cluster_register(const char *name, const sy_cluster_client
                                  .render = cluster_render,
                                  .stats = cluster_stats,
                                  .caps_of = cluster_caps_of,
-                                 .user = c};
+                                 .user = c,
+                                 .param_table = cluster_table,
+                                 .check_params = cluster_check_params};
     sy_result r = sy_mediator_register(&c->cls, err);
     if (r) config_free(c); /* the registry keeps a registered class (and so its configuration) for good */
     return r;

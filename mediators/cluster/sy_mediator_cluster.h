@@ -1,4 +1,5 @@
-/* sy_mediator_cluster.h — the cluster as a mediator: a viewport whose back-end is a cluster class
+/** @file
+ * sy_mediator_cluster.h — the cluster as a mediator: a viewport whose back-end is a cluster class
  * renders on render servers (`sy serve`) exactly as it would render locally. The application,
  * the window, compositing, stereo, layers and the progress loop never know.
  *
@@ -18,7 +19,9 @@
  *                    '+' ("2-4", "1+3"); default all. Mixed back-ends per node: one window with a
  *                    raster preview viewport on server 1 (servers=1,backend=raster) beside a
  *                    cooperative path trace on servers 2-4, or a wall with a back-end per display.
- * Every other key=value is handed to the servers' back-end unchanged.
+ * Every other key=value is handed to the servers' back-end unchanged; core checks the keys above
+ * against the class's param_table, and the others against the table of each used server's back-end
+ * when that class is registered in this process too (a back-end unknown here: the servers check).
  *
  * An instance: a replica of the scene fed by the change lists its context receives (so a
  * reconnecting server gets a snapshot of exactly what this context has seen) and a cluster client
@@ -46,17 +49,17 @@
 extern "C" {
 #endif
 
-#define SY_MEDIATOR_CLUSTER_NAME "cluster"
+#define SY_MEDIATOR_CLUSTER_NAME "cluster" /**< the usual class name */
 
-/* Registers a cluster class named `name` (SY_MEDIATOR_CLUSTER_NAME for the usual one) connecting
+/** Registers a cluster class named `name` (SY_MEDIATOR_CLUSTER_NAME for the usual one) connecting
  * with opts (copied: URLs, secret, CA path, per-server back-ends and wall tiles; the log callback
  * and its user pointer are kept as given and must stay valid). Fails when the name is taken. */
 sy_result sy_mediator_cluster_register(const char *name, const sy_cluster_client_opts *opts, sy_error *err);
 
-/* The last frame's statistics of a cluster instance (sy_context_state of a context whose caps have
+/** The last frame's statistics of a cluster instance (sy_context_state of a context whose caps have
  * SY_CAP_REMOTE); zeroes for anything else. */
 void sy_mediator_cluster_last_frame(void *state, sy_cluster_frame_stats *out);
-/* The instance's mode (sy_cluster_mode) and the number of servers it uses. */
+/** The instance's mode (sy_cluster_mode) and the number of servers it uses. */
 void sy_mediator_cluster_describe(void *state, uint32_t *mode, uint32_t *servers);
 
 #ifdef __cplusplus

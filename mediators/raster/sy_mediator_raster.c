@@ -19,6 +19,7 @@
 #include "sy_mediator_raster.h"
 
 #include "sy_gl.h"
+#include "sy_log.h"
 #include "sy_look.h"
 #include "sy_mirror.h"
 
@@ -649,8 +650,9 @@ static sy_result rebuild_area_lights(raster_state *st, sy_error *err)
         for (size_t i = 0; i < SY_GL_MAX_AREA_LIGHTS; ++i)
             for (int c = 0; c < 3; ++c) ps[i].l.radiance[c] *= scale;
         if (!st->warned_area_cap) {
-            fprintf(stderr, "sy: note: raster: %zu emissive polygons; the %d most powerful light the scene (radiance x %.3g keeps the total power)\n",
-                    n, SY_GL_MAX_AREA_LIGHTS, (double)scale);
+            sy_log(SY_LOG_NOTE, "raster", NULL,
+                   "raster: %zu emissive polygons; the %d most powerful light the scene (radiance x %.3g keeps the total power)",
+                   n, SY_GL_MAX_AREA_LIGHTS, (double)scale);
             st->warned_area_cap = true;
         }
         n = SY_GL_MAX_AREA_LIGHTS;
@@ -739,25 +741,40 @@ static void log_warning(void *user, const char *msg)
     raster_state *st = user;
     st->counters.warnings++;
     snprintf(st->counters.last_warning, sizeof st->counters.last_warning, "%s", msg);
-    fprintf(stderr, "sy: warning: %s\n", msg);
+    sy_log(SY_LOG_WARNING, "raster", NULL, "%s", msg); /* the GL back-end's own callback, forwarded */
 }
+
+/* The raster's parameters: the one source of their names, ranges, defaults and help (sy_params.h). */
+static const sy_param_decl raster_params[] = {
+    {"gl", SY_PARAM_ENUM, 0, 0, "osmesa", "osmesa|egl|glfw", "OpenGL context provider (glfw: a window)", 0},
+    {"msaa", SY_PARAM_INT, 1, 32, "4", NULL, "multisample anti-aliasing samples (clamped to the context's limit)", 0},
+    {"shadow_map_size", SY_PARAM_INT, 16, 16384, "2048", NULL, "shadow map resolution (texels per side)", 0},
+    {"max_texture_size", SY_PARAM_INT, 0, 1 << 20, "0", NULL, "largest texture side; larger are downscaled (0 = the GL limit)",
+     0},
+    {"window_width", SY_PARAM_INT, 1, 16384, "640", NULL, "gl=glfw: window width", 0},
+    {"window_height", SY_PARAM_INT, 1, 16384, "480", NULL, "gl=glfw: window height", 0},
+    {"indirect", SY_PARAM_BOOL, 0, 0, "1", NULL, "emitters' indirect light as an ambient estimate (0: direct light only)", 0},
+};
+static const sy_param_table raster_table = SY_PARAM_TABLE(raster_params);
 
 static sy_result raster_create(const sy_mediator_create_args *args, void **state_out, sy_error *err)
 {
     *state_out = NULL;
-    long msaa, shadow, max_tex, ww, wh, indirect;
+    long msaa = 4, shadow = 2048, max_tex = 0, ww = 640, wh = 480;
+    bool indirect = true;
     sy_result r;
+    const sy_param_table *t = &raster_table;
+    const char *gl = "osmesa";
     sy_gl_provider provider = SY_GL_PROVIDER_OSMESA;
-    const char *gl = sy_params_get(args->params, "gl");
-    if (gl && !sy_gl_provider_parse(gl, &provider))
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "raster: parameter gl=%s: expected osmesa, egl or glfw", gl);
-    if ((r = sy_params_get_int(args->params, "msaa", 4, 1, 32, &msaa, err)) ||
-        (r = sy_params_get_int(args->params, "shadow_map_size", 2048, 16, 16384, &shadow, err)) ||
-        (r = sy_params_get_int(args->params, "max_texture_size", 0, 0, 1 << 20, &max_tex, err)) ||
-        (r = sy_params_get_int(args->params, "window_width", 640, 1, 16384, &ww, err)) ||
-        (r = sy_params_get_int(args->params, "window_height", 480, 1, 16384, &wh, err)) ||
-        (r = sy_params_get_int(args->params, "indirect", 1, 0, 1, &indirect, err)))
+    if ((r = sy_param_string(t, args->params, "gl", &gl, err)) || (r = sy_param_int(t, args->params, "msaa", &msaa, err)) ||
+        (r = sy_param_int(t, args->params, "shadow_map_size", &shadow, err)) ||
+        (r = sy_param_int(t, args->params, "max_texture_size", &max_tex, err)) ||
+        (r = sy_param_int(t, args->params, "window_width", &ww, err)) ||
+        (r = sy_param_int(t, args->params, "window_height", &wh, err)) ||
+        (r = sy_param_bool(t, args->params, "indirect", &indirect, err)))
         return r;
+    if (!sy_gl_provider_parse(gl, &provider)) /* the table's enum lists the same names */
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "raster: parameter gl=%s: expected osmesa, egl or glfw", gl);
     raster_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster mediator: out of memory");
     st->meshes.elem = sizeof(emesh);
@@ -765,7 +782,7 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
     st->insts.elem = sizeof(einst);
     st->texs.elem = sizeof(etex);
     st->albs.elem = sizeof(ealb);
-    st->indirect = indirect != 0;
+    st->indirect = indirect;
     char e[ERRLEN];
     sy_gl_device_desc dd = {.provider = provider,
                             .msaa = (uint32_t)msaa,
@@ -800,6 +817,7 @@ static void raster_stats(void *state, sy_mediator_stats *out)
 
 static const sy_mediator_class raster_class = {
     .name = "raster",
+    .param_table = SY_PARAM_TABLE(raster_params),
     .caps = SY_CAP_DEPTH | SY_CAP_TILES,
     .create = raster_create,
     .destroy = raster_destroy,

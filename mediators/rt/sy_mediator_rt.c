@@ -6,6 +6,7 @@
 
 #include "sy_rt.h"
 #include "sy_rt_bench.h"
+#include "sy_log.h"
 #include "sy_mirror.h"
 
 #include "sy_filter_adaptive.h"
@@ -21,11 +22,11 @@
 
 #define ERRLEN 256
 
-/* Whitted's default anti-aliasing: 4 stratified camera rays per pixel (one per quadrant, Sobol
- * jittered), sharing the pixel's area-light budget (light_samples); colour and alpha average them,
- * a pixel is covered where any of them hits and its depth is the mean of those hits, as in the
- * path tracer and the raster's MSAA. spp=1 traces the pixel centre alone. */
-#define WHITTED_DEFAULT_SPP 4
+/* Whitted's default anti-aliasing (spp, default 4 in whitted_params): 4 stratified camera rays per
+ * pixel (one per quadrant, Sobol jittered), sharing the pixel's area-light budget (light_samples);
+ * colour and alpha average them, a pixel is covered where any of them hits and its depth is the
+ * mean of those hits, as in the path tracer and the raster's MSAA. spp=1 traces the pixel centre
+ * alone. */
 
 /* Path tracer: one accumulation per distinct request (camera, sizes, rectangle, background, seed);
  * a few are kept so that viewports sharing this context (stereo eyes, tiles) do not evict each
@@ -55,6 +56,59 @@ typedef enum pt_filter_kind {
 } pt_filter_kind;
 static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel", "atrous", "jbu", "adaptive",
                                                                    "radiance"};
+
+/* >>parameters: the classes' declared tables (sy_params.h), the one source of their names, ranges,
+ * defaults and help; core checks given parameters against them before create. The path tracer's
+ * display-filter options are SY_PARAM_LIVE (sy_context_set_filter). Enum orders: "filter" is
+ * pt_filter_kind, "rf_kernel" sy_filter_rf_kernel, "filter_kernel" separable, brute. */
+#define RT_COMMON_PARAMS(depth_default, depth_max, depth_help)                                                      \
+    {"max_depth", SY_PARAM_INT, 1, depth_max, depth_default, NULL, depth_help, 0},                                  \
+    {"light_samples", SY_PARAM_INT, 1, 1024, "16", NULL, "area-light samples per pixel, shared by its pixel samples", \
+     0},                                                                                                             \
+    {"threads", SY_PARAM_INT, 0, 1024, "0", NULL, "worker threads (0 = OpenMP's default: OMP_NUM_THREADS, else all cores)", 0},                             \
+    {"specular", SY_PARAM_FLOAT, 0, 1, "1", NULL,                                                                   \
+     "KHR_materials_specular factor of every material (0: dielectrics purely Lambertian)", 0}
+static const sy_param_decl whitted_params[] = {
+    {"spp", SY_PARAM_INT, 1, 256, "4", NULL, "camera rays per pixel (stratified, jittered; 1 = the pixel centre)", 0},
+    {"env_samples", SY_PARAM_INT, 1, 256, "4", NULL, "environment-light samples per shading point and pixel sample", 0},
+    RT_COMMON_PARAMS("8", 64, "longest ray path: depth of mirror and glass recursion"),
+};
+static const sy_param_decl coverage_params[] = {
+    RT_COMMON_PARAMS("8", 64, "longest ray path: depth of mirror and glass recursion"),
+};
+#define LIVE SY_PARAM_LIVE
+static const sy_param_decl pathtracer_params[] = {
+    RT_COMMON_PARAMS("64", 1024, "bounces per path"),
+    {"filter", SY_PARAM_ENUM, 0, 0, "none", "none|pixel|atrous|jbu|adaptive|radiance", "display noise filter", LIVE},
+    {"threshold", SY_PARAM_FLOAT, 0, 1e6, "0.01", NULL,
+     "perceived-variance threshold of the pixel filter's blend, the adaptive preview and radiance's T_u", LIVE},
+    {"sigma_s", SY_PARAM_FLOAT, 0, 1000, "8", NULL, "pixel filter: spatial sigma (pixels, > 0)", LIVE},
+    {"sigma_c", SY_PARAM_FLOAT, 0, 1e6, "0.02", NULL, "pixel filter: virtual-flash colour sigma (> 0)", LIVE},
+    {"sigma_d", SY_PARAM_FLOAT, 0, 1e9, "2", NULL, "pixel filter: depth sigma (scene units, > 0)", LIVE},
+    {"filter_kernel", SY_PARAM_ENUM, 0, 0, "separable", "separable|brute", "pixel filter: kernel evaluation", LIVE},
+    {"filter_iterations", SY_PARAM_INT, 1, 8, "3", NULL, "pixel filter: iterations", LIVE},
+    {"filter_start", SY_PARAM_INT, 1, 1 << 30, "4", NULL,
+     "pixel filter: first pass at this sample count (a power of two), then at every power of two", LIVE},
+    {"atrous_iterations", SY_PARAM_INT, 1, 10, "5", NULL, "a-trous filter: iterations", LIVE},
+    {"jbu_factor", SY_PARAM_INT, 1, 64, "4", NULL, "joint bilateral upsampling: downsampling factor", LIVE},
+    {"rf_warmup_frames", SY_PARAM_INT, 0, 64, "4", NULL, "radiance filter: warm-up frames", LIVE},
+    {"rf_warmup_radius", SY_PARAM_FLOAT, 0, 128, "8", NULL, "radiance filter: warm-up radius (pixels, > 0)", LIVE},
+    {"rf_max_radius", SY_PARAM_FLOAT, 1, 128, "24", NULL, "radiance filter: largest radius (pixels)", LIVE},
+    {"rf_kernel", SY_PARAM_ENUM, 0, 0, "epanechnikov", "epanechnikov|silverman|uniform|gaussian",
+     "radiance filter: kernel", LIVE},
+    {"rf_ao", SY_PARAM_BOOL, 0, 0, "1", NULL, "radiance filter: ambient-occlusion term", LIVE},
+    {"rf_prism_thickness", SY_PARAM_FLOAT, 0, 100, "0.25", NULL,
+     "radiance filter: prism half thickness / tangent extent (> 0)", LIVE},
+    {"rf_grazing_epsilon", SY_PARAM_FLOAT, 0, 1, "0.1", NULL, "radiance filter: grazing-angle epsilon (> 0)", LIVE},
+    {"rf_glossy_limit", SY_PARAM_FLOAT, 0, 1e9, "128", NULL, "radiance filter: glossy limit", LIVE},
+    {"rf_specular_limit", SY_PARAM_FLOAT, 0, 1e9, "4096", NULL, "radiance filter: specular limit", LIVE},
+    {"rf_unbiased", SY_PARAM_BOOL, 0, 0, "0", NULL,
+     "radiance filter: show the plain path-traced mean in the correction phase", LIVE},
+};
+#undef LIVE
+static const sy_param_table whitted_table = SY_PARAM_TABLE(whitted_params);
+static const sy_param_table coverage_table = SY_PARAM_TABLE(coverage_params);
+static const sy_param_table pt_table = SY_PARAM_TABLE(pathtracer_params);
 
 typedef struct pt_filter_cfg {
     pt_filter_kind kind;
@@ -133,7 +187,9 @@ static void rt_warn(rt_state *st, const char *kind, uint32_t id, const char *fie
     st->counters.warnings++;
     snprintf(st->counters.last_warning, sizeof st->counters.last_warning, "rt mediator: %s %u: %s %g clamped to %g",
              kind, id, field, from, to);
-    fprintf(stderr, "sy: warning: %s\n", st->counters.last_warning);
+    char item[64];
+    snprintf(item, sizeof item, "%s %u", kind, id);
+    sy_log(SY_LOG_WARNING, "rt", item, "%s %g clamped to %g (rt mediator)", field, from, to);
 }
 
 static float clamp_warn(rt_state *st, const char *kind, uint32_t id, const char *field, float v, float lo, float hi)
@@ -551,87 +607,86 @@ static void filter_cfg_default(pt_filter_cfg *c, uint32_t threads)
     c->pixel.threads = c->atrous.threads = c->jbu.threads = c->adaptive.threads = c->radiance.threads = threads;
 }
 
-/* The radiance filter's own keys (rf_*), present ones only; ranges as sy_filter_radiance_params. */
-static sy_result radiance_cfg_apply(sy_filter_radiance_params *rp, const sy_params *p, sy_error *err)
+/* One path-tracer key into *v through its table: the given value, else (all: at creation) the
+ * declared default; otherwise an absent key keeps *v. */
+static sy_result pt_float(const sy_params *p, bool all, const char *key, float *v, sy_error *err)
 {
-    static const char *const kernels[] = {"epanechnikov", "silverman", "uniform", "gaussian"};
-    double v;
-    long l;
+    if (!all && !sy_params_get(p, key)) return SY_OK;
+    double x = *v;
+    sy_result r = sy_param_float(&pt_table, p, key, &x, err);
+    if (r == SY_OK) *v = (float)x;
+    return r;
+}
+
+static sy_result pt_u32(const sy_params *p, bool all, const char *key, uint32_t *v, sy_error *err)
+{
+    if (!all && !sy_params_get(p, key)) return SY_OK;
+    long x = (long)*v;
+    sy_result r = sy_param_int(&pt_table, p, key, &x, err);
+    if (r == SY_OK) *v = (uint32_t)x;
+    return r;
+}
+
+static sy_result pt_bool(const sy_params *p, bool all, const char *key, bool *v, sy_error *err)
+{
+    return !all && !sy_params_get(p, key) ? SY_OK : sy_param_bool(&pt_table, p, key, v, err);
+}
+
+static sy_result pt_enum(const sy_params *p, bool all, const char *key, uint32_t *v, sy_error *err)
+{
+    return !all && !sy_params_get(p, key) ? SY_OK : sy_param_enum(&pt_table, p, key, v, err);
+}
+
+/* The radiance filter's own keys (rf_*); ranges as sy_filter_radiance_params. */
+static sy_result radiance_cfg_apply(sy_filter_radiance_params *rp, const sy_params *p, bool all, sy_error *err)
+{
     sy_result r;
-    if ((r = sy_params_get_int(p, "rf_warmup_frames", rp->warmup_frames, 0, 64, &l, err))) return r;
-    rp->warmup_frames = (uint32_t)l;
-    const struct { const char *key; float *v; double lo, hi; } fl[] = {
-        {"rf_warmup_radius", &rp->warmup_radius, 0.0, 128.0},     {"rf_max_radius", &rp->max_radius, 1.0, 128.0},
-        {"rf_prism_thickness", &rp->prism_thickness, 0.0, 100.0}, {"rf_grazing_epsilon", &rp->grazing_epsilon, 0.0, 1.0},
-        {"rf_glossy_limit", &rp->glossy_limit, 0.0, 1e9},         {"rf_specular_limit", &rp->specular_limit, 0.0, 1e9}};
-    for (size_t i = 0; i < sizeof fl / sizeof fl[0]; ++i) {
-        if ((r = sy_params_get_float(p, fl[i].key, *fl[i].v, fl[i].lo, fl[i].hi, &v, err))) return r;
-        *fl[i].v = (float)v;
-    }
-    const struct { const char *key; bool *v; } bl[] = {{"rf_ao", &rp->ambient_occlusion}, {"rf_unbiased", &rp->unbiased_switch}};
-    for (size_t i = 0; i < sizeof bl / sizeof bl[0]; ++i) {
-        if ((r = sy_params_get_int(p, bl[i].key, *bl[i].v, 0, 1, &l, err))) return r;
-        *bl[i].v = l != 0;
-    }
-    const char *kern = sy_params_get(p, "rf_kernel");
-    if (kern) {
-        int k = -1;
-        for (int i = 0; i < 4; ++i)
-            if (!strcmp(kern, kernels[i])) k = i;
-        if (k < 0)
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "parameter rf_kernel=%s: expected epanechnikov, silverman, uniform or gaussian", kern);
-        rp->kernel = (sy_filter_rf_kernel)k;
-    }
+    uint32_t kernel = (uint32_t)rp->kernel;
+    if ((r = pt_u32(p, all, "rf_warmup_frames", &rp->warmup_frames, err)) ||
+        (r = pt_float(p, all, "rf_warmup_radius", &rp->warmup_radius, err)) ||
+        (r = pt_float(p, all, "rf_max_radius", &rp->max_radius, err)) ||
+        (r = pt_float(p, all, "rf_prism_thickness", &rp->prism_thickness, err)) ||
+        (r = pt_float(p, all, "rf_grazing_epsilon", &rp->grazing_epsilon, err)) ||
+        (r = pt_float(p, all, "rf_glossy_limit", &rp->glossy_limit, err)) ||
+        (r = pt_float(p, all, "rf_specular_limit", &rp->specular_limit, err)) ||
+        (r = pt_bool(p, all, "rf_ao", &rp->ambient_occlusion, err)) ||
+        (r = pt_bool(p, all, "rf_unbiased", &rp->unbiased_switch, err)) ||
+        (r = pt_enum(p, all, "rf_kernel", &kernel, err)))
+        return r;
+    rp->kernel = (sy_filter_rf_kernel)kernel;
     return SY_OK;
 }
 
 /* New configuration = *base with the filter `name` (NULL: p's "filter", absent: unchanged) and the
- * keys present in p (absent keys keep base's values). Validated as a whole; *base unchanged on error. */
-static sy_result filter_cfg_apply(pt_filter_cfg *base, const char *name, const sy_params *p_in, sy_error *err)
+ * keys present in p (all, at creation: absent keys take their declared defaults; otherwise they
+ * keep base's values). Validated as a whole; *base unchanged on error. */
+static sy_result filter_cfg_apply(pt_filter_cfg *base, const char *name, const sy_params *p_in, bool all, sy_error *err)
 {
     static const sy_params empty;
     const sy_params *p = p_in ? p_in : &empty;
     pt_filter_cfg c = *base;
-    const char *nm = name ? name : sy_params_get(p, "filter");
-    if (nm) {
-        int k = -1;
-        for (int i = 0; i < PT_FILTER_KIND_COUNT; ++i)
-            if (!strcmp(nm, pt_filter_names[i])) k = i;
-        if (k < 0)
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "pathtracer: unknown filter '%s' (expected none, pixel, atrous, jbu, adaptive or radiance)",
-                                nm);
-        c.kind = (pt_filter_kind)k;
-    }
-    double v;
-    long l;
     sy_result r;
-    if ((r = sy_params_get_float(p, "threshold", c.pixel.threshold, 0.0, 1e6, &v, err))) return r;
-    c.pixel.threshold = c.adaptive.threshold = c.radiance.threshold = (float)v;
-    if ((r = sy_params_get_float(p, "sigma_s", c.pixel.sigma_s, 0.0, 1000.0, &v, err))) return r;
-    c.pixel.sigma_s = (float)v;
-    if ((r = sy_params_get_float(p, "sigma_c", c.pixel.sigma_c, 0.0, 1e6, &v, err))) return r;
-    c.pixel.sigma_c = (float)v;
-    if ((r = sy_params_get_float(p, "sigma_d", c.pixel.sigma_d, 0.0, 1e9, &v, err))) return r;
-    c.pixel.sigma_d = (float)v;
-    const char *kern = sy_params_get(p, "filter_kernel");
-    if (kern) {
-        if (!strcmp(kern, "separable")) c.pixel.kernel = SY_FILTER_PIXEL_SEPARABLE;
-        else if (!strcmp(kern, "brute")) c.pixel.kernel = SY_FILTER_PIXEL_BRUTE;
-        else
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "parameter filter_kernel=%s: expected separable or brute", kern);
-    }
-    if ((r = sy_params_get_int(p, "filter_iterations", c.pixel.iterations, 1, 8, &l, err))) return r;
-    c.pixel.iterations = (uint32_t)l;
-    if ((r = sy_params_get_int(p, "filter_start", c.pixel.schedule_start, 1, 1L << 30, &l, err))) return r;
-    c.pixel.schedule_start = (uint32_t)l;
-    if ((r = sy_params_get_int(p, "atrous_iterations", c.atrous.iterations, 1, 10, &l, err))) return r;
-    c.atrous.iterations = (uint32_t)l;
-    if ((r = sy_params_get_int(p, "jbu_factor", c.jbu.factor, 1, 64, &l, err))) return r;
-    c.jbu.factor = (uint32_t)l;
-    if ((r = radiance_cfg_apply(&c.radiance, p, err))) return r;
+    uint32_t kind = (uint32_t)c.kind;
+    if (name) {
+        const sy_param_decl *d = sy_param_find(&pt_table, "filter");
+        int k = sy_param_enum_index(d, name);
+        if (k < 0) return sy_param_check_value(d, name, "back-end 'pathtracer'", err); /* names the filters */
+        kind = (uint32_t)k;
+    } else if ((r = pt_enum(p, all, "filter", &kind, err)))
+        return r;
+    c.kind = (pt_filter_kind)kind;
+    float threshold = c.pixel.threshold;
+    uint32_t fkernel = c.pixel.kernel == SY_FILTER_PIXEL_BRUTE ? 1u : 0u;
+    if ((r = pt_float(p, all, "threshold", &threshold, err)) || (r = pt_float(p, all, "sigma_s", &c.pixel.sigma_s, err)) ||
+        (r = pt_float(p, all, "sigma_c", &c.pixel.sigma_c, err)) || (r = pt_float(p, all, "sigma_d", &c.pixel.sigma_d, err)) ||
+        (r = pt_enum(p, all, "filter_kernel", &fkernel, err)) ||
+        (r = pt_u32(p, all, "filter_iterations", &c.pixel.iterations, err)) ||
+        (r = pt_u32(p, all, "filter_start", &c.pixel.schedule_start, err)) ||
+        (r = pt_u32(p, all, "atrous_iterations", &c.atrous.iterations, err)) ||
+        (r = pt_u32(p, all, "jbu_factor", &c.jbu.factor, err)) || (r = radiance_cfg_apply(&c.radiance, p, all, err)))
+        return r;
+    c.pixel.threshold = c.adaptive.threshold = c.radiance.threshold = threshold;
+    c.pixel.kernel = fkernel ? SY_FILTER_PIXEL_BRUTE : SY_FILTER_PIXEL_SEPARABLE;
     /* the rf_* options are checked whatever the filter; T_u = threshold only matters for radiance */
     sy_filter_radiance_params rq = c.radiance;
     if (c.kind != PT_FILTER_RADIANCE && !(rq.threshold > 0.0f)) rq.threshold = 0.01f;
@@ -650,8 +705,11 @@ sy_result sy_mediator_rt_set_filter(void *state, const char *name, const sy_para
     rt_state *st = state;
     if (st->integrator != SY_RT_INTEGRATOR_PATHTRACER)
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "set filter: only the pathtracer class has display filters");
+    /* the same check core makes (sy_context_set_filter), for callers of this function */
+    sy_result r = sy_params_check(&pt_table, opts, SY_PARAM_LIVE, "back-end 'pathtracer'", NULL, err);
+    if (r != SY_OK) return r;
     pt_filter_cfg c = st->filter;
-    sy_result r = filter_cfg_apply(&c, name, opts, err);
+    r = filter_cfg_apply(&c, name, opts, false, err);
     if (r != SY_OK) return r;
     /* Only the threshold acts on the blend alone; anything else invalidates the filtered buffers,
      * which are recomputed at the next frame (the accumulation itself is never touched). */
@@ -994,18 +1052,19 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
                                   sy_error *err)
 {
     *state_out = NULL;
-    long max_depth, light_samples, threads, spp = 1, env_samples = 4;
-    double specular;
+    const sy_param_table *t = integrator == SY_RT_INTEGRATOR_WHITTED      ? &whitted_table
+                              : integrator == SY_RT_INTEGRATOR_PATHTRACER ? &pt_table
+                                                                          : &coverage_table;
+    long max_depth = 8, light_samples = 16, threads = 0, spp = 1, env_samples = 4; /* spp, env: Whitted's */
+    double specular = 1.0;
     sy_result r;
-    if (integrator == SY_RT_INTEGRATOR_WHITTED &&
-        ((r = sy_params_get_int(args->params, "spp", WHITTED_DEFAULT_SPP, 1, 256, &spp, err)) ||
-         (r = sy_params_get_int(args->params, "env_samples", 4, 1, 256, &env_samples, err))))
+    if (integrator == SY_RT_INTEGRATOR_WHITTED && ((r = sy_param_int(t, args->params, "spp", &spp, err)) ||
+                                                   (r = sy_param_int(t, args->params, "env_samples", &env_samples, err))))
         return r;
-    if ((r = sy_params_get_int(args->params, "max_depth", integrator == SY_RT_INTEGRATOR_PATHTRACER ? 64 : 8, 1,
-                               integrator == SY_RT_INTEGRATOR_PATHTRACER ? 1024 : 64, &max_depth, err)) ||
-        (r = sy_params_get_int(args->params, "light_samples", 16, 1, 1024, &light_samples, err)) ||
-        (r = sy_params_get_int(args->params, "threads", 0, 0, 1024, &threads, err)) ||
-        (r = sy_params_get_float(args->params, "specular", 1.0, 0.0, 1.0, &specular, err)))
+    if ((r = sy_param_int(t, args->params, "max_depth", &max_depth, err)) ||
+        (r = sy_param_int(t, args->params, "light_samples", &light_samples, err)) ||
+        (r = sy_param_int(t, args->params, "threads", &threads, err)) ||
+        (r = sy_param_float(t, args->params, "specular", &specular, err)))
         return r;
     rt_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt mediator: out of memory");
@@ -1030,7 +1089,7 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     st->specular = (float)specular;
     st->last_slot = -1;
     filter_cfg_default(&st->filter, (uint32_t)threads);
-    if (integrator == SY_RT_INTEGRATOR_PATHTRACER && (r = filter_cfg_apply(&st->filter, NULL, args->params, err)) != SY_OK) {
+    if (integrator == SY_RT_INTEGRATOR_PATHTRACER && (r = filter_cfg_apply(&st->filter, NULL, args->params, true, err)) != SY_OK) {
         rt_destroy(st);
         return r;
     }
@@ -1128,6 +1187,7 @@ static void pathtracer_filter_info(void *state, sy_filter_info *out)
 
 static const sy_mediator_class pathtracer_class = {
     .name = "pathtracer",
+    .param_table = SY_PARAM_TABLE(pathtracer_params),
     .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_SAMPLE_RANGES | SY_CAP_AOVS | SY_CAP_FILTERS,
     .create = pathtracer_create,
     .destroy = rt_destroy,
@@ -1143,6 +1203,7 @@ const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtra
 
 static const sy_mediator_class whitted_class = {
     .name = "whitted",
+    .param_table = SY_PARAM_TABLE(whitted_params),
     .caps = SY_CAP_DEPTH | SY_CAP_TILES,
     .create = whitted_create,
     .destroy = rt_destroy,
@@ -1160,6 +1221,7 @@ static sy_result coverage_create(const sy_mediator_create_args *args, void **sta
 
 static const sy_mediator_class coverage_class = {
     .name = "coverage",
+    .param_table = SY_PARAM_TABLE(coverage_params),
     .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_ANALYSIS,
     .create = coverage_create,
     .destroy = rt_destroy,

@@ -1,4 +1,5 @@
-/* sy_mediator_rt.h — the mediator between the core scene and the Embree back-end (backends/rt).
+/** @file
+ * sy_mediator_rt.h — the mediator between the core scene and the Embree back-end (backends/rt).
  *
  * One Embree scene adapter serving several integrators: the "whitted" and "pathtracer" classes
  * registered here and "coverage" share this adapter; only the integrator chosen at render
@@ -8,13 +9,14 @@
  * instances everything else (shared meshes are one BLAS), and syncs incrementally: a transform
  * change re-places the node's subtree only (rtcSetGeometryTransform, no BLAS rebuild).
  *
- * Parameters (sy_params): max_depth (1..64, default 8; pathtracer 1..1024, default 64),
+ * Parameters (sy_params; declared in each class's param_table, which core checks and `sy backends
+ * --params` prints: the authority for names, ranges and defaults): max_depth (1..64, default 8;
+ * pathtracer 1..1024, default 64),
  * light_samples (whitted: area-light samples per pixel, shared among its pixel samples; 1..1024,
  * default 16), threads (0 = all cores), specular (0..1, default 1: the KHR_materials_specular factor
  * of every material; 1 is glTF's dielectric F0 = 0.04 layer, 0 makes dielectrics pure Lambertian,
  * e.g. to match a Lambertian reference render). Whitted only: spp (anti-aliasing camera rays per
- * pixel, stratified jittered, box filter; 1..256, default 1 = the pixel centre; 4 recommended for
- * final images) and env_samples
+ * pixel, stratified jittered, box filter; 1..256, default 4; 1 = the pixel centre) and env_samples
  * (environment-light samples per shading point of each pixel sample; 1..256, default 4).
  *
  * The look (sy_look.h) is resolved by the scene mirror on every render (sy_mirror_look with the
@@ -34,25 +36,26 @@
 extern "C" {
 #endif
 
-/* The Whitted ray tracer class ("whitted"). Static storage. */
-/* Registers whitted, pathtracer and coverage (the build's registration list calls it). */
+/** Registers whitted, pathtracer and coverage (the build's registration list calls it). */
 sy_result sy_mediator_rt_register(sy_error *err);
+/** The Whitted ray tracer class ("whitted"). Static storage. */
 const sy_mediator_class *sy_mediator_rt_whitted_class(void);
-/* The coverage class ("coverage"): no shading; the layer shows every visible object in a stable
+/** The coverage class ("coverage"): no shading; the layer shows every visible object in a stable
  * colour derived from its node id (alpha 1 where covered) with depth. A culling service: which
  * objects a camera sees and how many pixels each covers, with occlusion. */
 const sy_mediator_class *sy_mediator_rt_coverage_class(void);
 
+/** Pixels one node covers (sy_mediator_rt_coverage). */
 typedef struct sy_mediator_rt_coverage_entry {
-    uint32_t node_id; /* the core node whose placement covers the pixels */
-    uint32_t pixels;
+    uint32_t node_id; /**< the core node whose placement covers the pixels */
+    uint32_t pixels; /**< pixels it covers */
 } sy_mediator_rt_coverage_entry;
-/* Per-node pixel coverage (ray through every pixel centre, nearest visible object) for the view
+/** Per-node pixel coverage (ray through every pixel centre, nearest visible object) for the view
  * at width x height, sorted by pixels, most first. Works on any context of this adapter (whitted,
  * pathtracer, coverage). Ownership: *entries_out is malloc()ed, the caller frees it. */
 sy_result sy_mediator_rt_coverage(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
                                   sy_mediator_rt_coverage_entry **entries_out, uint32_t *count_out, sy_error *err);
-/* The progressive path tracer class ("pathtracer"; caps PROGRESSIVE | DEPTH | TILES) on the same
+/** The progressive path tracer class ("pathtracer"; caps PROGRESSIVE | DEPTH | TILES) on the same
  * adapter. Each render adds req->sample_count samples per pixel (0 = 1) to an accumulation kept per
  * distinct request (camera view, image size, rectangle, background, seed; up to 4 at once, least
  * recently used recycled). The accumulation restarts when the request's camera differs from the
@@ -64,22 +67,26 @@ sy_result sy_mediator_rt_coverage(void *state, const sy_camera_view *view, uint3
  * Parameters: max_depth (bounces, 1..1024, default 64), specular, threads. */
 const sy_mediator_class *sy_mediator_rt_pathtracer_class(void);
 
-/* Feature buffers of the last path-traced render of a context (its rectangle), as separate planes
+/** Feature buffers of the last path-traced render of a context (its rectangle), as separate planes
  * indexed like the back-end's sy_rt_aov: 0 colour RGBA (4 channels), 1 variance of the colour mean
  * RGB (Welford), 2 albedo and 3 normal of the first non-specular hit, 4 depth (1), 5 direct and
  * 6 indirect radiance (3 each). Ownership: the caller frees with sy_mediator_rt_aovs_free. */
 #define SY_MEDIATOR_RT_AOV_COUNT 7
+/** Feature buffers (see above). */
 typedef struct sy_mediator_rt_aovs {
-    uint32_t width, height, samples;
-    uint64_t nonfinite_samples; /* samples replaced by zero because they were NaN/Inf */
-    float *planes[SY_MEDIATOR_RT_AOV_COUNT]; /* width*height*channels floats each, row 0 = top */
+    /** @{ rectangle size and samples per pixel */
+    uint32_t width, height, samples; /** @} */
+    uint64_t nonfinite_samples; /**< samples replaced by zero because they were NaN/Inf */
+    float *planes[SY_MEDIATOR_RT_AOV_COUNT]; /**< width*height*channels floats each, row 0 = top */
 } sy_mediator_rt_aovs;
+/** Copies the feature buffers of the context's last path-traced render into *out. */
 sy_result sy_mediator_rt_aovs_get(void *state, sy_mediator_rt_aovs *out, sy_error *err);
+/** Frees the planes of *aovs (NULL-safe). */
 void sy_mediator_rt_aovs_free(sy_mediator_rt_aovs *aovs);
-const char *sy_mediator_rt_aov_name(uint32_t index);   /* "color", "variance", "albedo", ... */
-uint32_t sy_mediator_rt_aov_channels(uint32_t index);  /* 4, 3, 3, 3, 1, 3, 3 */
+const char *sy_mediator_rt_aov_name(uint32_t index);   /**< "color", "variance", "albedo", ... */
+uint32_t sy_mediator_rt_aov_channels(uint32_t index);  /**< 4, 3, 3, 3, 1, 3, 3 */
 
-/* Display filter of the path tracer (backends/filters), applied per viewport to the layer the path
+/** Display filter of the path tracer (backends/filters), applied per viewport to the layer the path
  * tracer returns, computed from the accumulation's feature buffers; per accumulation slot (the
  * pixel filter's state restarts with the slot's accumulation). Display-only: changing the filter
  * or its options never restarts the accumulation. Parameters (at creation, the initial value):
@@ -108,41 +115,46 @@ uint32_t sy_mediator_rt_aov_channels(uint32_t index);  /* 4, 3, 3, 3, 1, 3, 3 */
  * changes. Thread-safety: like render (the thread that renders the context). */
 sy_result sy_mediator_rt_set_filter(void *state, const char *name, const sy_params *opts, sy_error *err);
 
+/** The path tracer's current display filter and its last run. */
 typedef struct sy_mediator_rt_filter_info {
-    const char *name;           /* current filter ("none", "pixel", ...), static storage */
-    float threshold;            /* current threshold */
-    uint64_t frames;            /* filtered frames so far */
-    uint64_t nonfinite_pixels;  /* last filtered frame: NaN/Inf input pixels kept out of neighbourhoods
+    const char *name;           /**< current filter ("none", "pixel", ...), static storage */
+    float threshold;            /**< current threshold */
+    uint64_t frames;            /**< filtered frames so far */
+    uint64_t nonfinite_pixels;  /**< last filtered frame: NaN/Inf input pixels kept out of neighbourhoods
                                    (radiance: NaN/Inf path records over the last render's passes) */
-    uint64_t nonfinite_samples; /* last filtered accumulation: NaN/Inf samples the back-end replaced by 0 */
-    double seconds;             /* last filter call's wall time (radiance: its frames in the last render) */
-    bool filter_pass;           /* pixel: a filter pass ran in the last frame */
-    double mean_blend;          /* pixel: mean blend factor s (1 = unfiltered everywhere); radiance:
+    uint64_t nonfinite_samples; /**< last filtered accumulation: NaN/Inf samples the back-end replaced by 0 */
+    double seconds;             /**< last filter call's wall time (radiance: its frames in the last render) */
+    bool filter_pass;           /**< pixel: a filter pass ran in the last frame */
+    double mean_blend;          /**< pixel: mean blend factor s (1 = unfiltered everywhere); radiance:
                                    share of pixels in the correction phase (plain path tracing) */
-    uint32_t last_pass_samples; /* pixel: sample count of the last filter pass (0 = none yet) */
+    uint32_t last_pass_samples; /**< pixel: sample count of the last filter pass (0 = none yet) */
 } sy_mediator_rt_filter_info;
+/** Fills *out with the context's filter state. */
 void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out);
 
-/* Counters of the adapter, for tests and benchmarks. */
+/** Counters of the adapter, for tests and benchmarks. */
 typedef struct sy_mediator_rt_counters {
-    uint32_t instances, baked_instances, meshes, materials, textures, lights;
-    uint32_t last_sync_placements; /* node placements recomputed by the last sync */
-    uint32_t last_sync_entries;    /* change entries handled by the last sync */
-    uint32_t accum_restarts;       /* path tracer: accumulations restarted (not counting the first) */
-    uint64_t last_render_rays;     /* path tracer: rays traced by the last render */
-    uint32_t warnings;             /* out-of-range material / light values clamped (each also printed
-                                    * as "sy: warning: rt mediator: material|light ID: ...") */
-    char last_warning[160];
+    /** @{ live back-end objects (baked instances are merged into the top-level BVH) */
+    uint32_t instances, baked_instances, meshes, materials, textures, lights; /** @} */
+    uint32_t last_sync_placements; /**< node placements recomputed by the last sync */
+    uint32_t last_sync_entries;    /**< change entries handled by the last sync */
+    uint32_t accum_restarts;       /**< path tracer: accumulations restarted (not counting the first) */
+    uint64_t last_render_rays;     /**< path tracer: rays traced by the last render */
+    uint32_t warnings;             /**< out-of-range material / light values clamped (each also logged:
+                                    * sy_log, module "rt", item "material|light ID") */
+    char last_warning[160]; /**< the last warning */
 } sy_mediator_rt_counters;
-/* state is the mediator state of a context whose class is one of this adapter's classes. */
+/** state is the mediator state of a context whose class is one of this adapter's classes. */
 void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out);
 
-/* Ray throughput of this adapter's device on the given view (see backends/rt/sy_rt_bench.h):
+/** Ray throughput of this adapter's device on the given view (see backends/rt/sy_rt_bench.h):
  * our PRIMARY integrator against raw rtcIntersect1 on the same rays, in one run. */
 typedef struct sy_mediator_rt_bench {
-    double ours_mrays, raw_mrays, overhead_percent;
-    uint32_t threads;
+    /** @{ primary rays per second (ours, raw Embree, in millions) and our overhead */
+    double ours_mrays, raw_mrays, overhead_percent; /** @} */
+    uint32_t threads; /**< render threads */
 } sy_mediator_rt_bench;
+/** Measures ray throughput (see sy_mediator_rt_bench) for view at width x height, best of repeats. */
 sy_result sy_mediator_rt_bench_rays(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
                                     uint32_t repeats, sy_mediator_rt_bench *out, sy_error *err);
 

@@ -267,6 +267,11 @@ static int test_refusals(fixture *fx, const server *s)
     CHECK(refused(fx, "backend=whitted,pixels=double", "pixels=double") == 0);
     CHECK(refused(fx, "backend=whitted,servers=3", "server numbers are 1..2") == 0);
     CHECK(refused(fx, "backend=whitted,servers=1+x", "joined by '+'") == 0);
+    /* typed parameters: the cluster's own keys by its table, the forwarded ones by the servers' back-end's */
+    CHECK(refused(fx, "backend=whitted,samples=-1", "samples=-1 for back-end 'cluster'") == 0);
+    CHECK(refused(fx, "backend=whitted,max_detph=8", "unknown parameter 'max_detph' for back-end 'whitted'") == 0);
+    CHECK(refused(fx, "backend=whitted,max_detph=8", "valid: spp, env_samples, max_depth") == 0);
+    CHECK(refused(fx, "backend=pathtracer,max_depth=2000", "max_depth=2000 for back-end 'pathtracer'") == 0);
     return 0;
 }
 

@@ -516,8 +516,8 @@ static float f_bits(uint32_t u)
     return f;
 }
 
-/* binary16: every half survives half -> float -> half exactly (NaNs stay NaN with their sign and
- * payload, quieted); float -> half rounds to nearest even at every boundary; overflow, underflow,
+/* binary16 (Imath's conversions): every half survives half -> float -> half exactly, NaNs with
+ * their sign and payload; float -> half rounds to nearest even at every boundary; overflow, underflow,
  * infinities; and (gcc, x86-64) agreement with the compiler's _Float16 conversion on 4M floats. */
 static int test_half(void)
 {
@@ -528,7 +528,7 @@ static int test_half(void)
         bool nan = (h & 0x7c00u) == 0x7c00u && (h & 0x3ffu);
         if (nan) {
             nans++;
-            CHECK_MSG(isnan(f) && back == (h | 0x200u), "NaN %04x -> %04x", h, back);
+            CHECK_MSG(isnan(f) && back == h, "NaN %04x -> %04x", h, back);
         } else {
             CHECK_MSG(back == h, "half %04x -> %g -> %04x", h, (double)f, back);
         }
@@ -573,7 +573,8 @@ static int test_half(void)
         uint16_t rb;
         memcpy(&rb, &ref, 2);
         uint16_t ours = sy_cluster_half_from_float(f);
-        if (isnan(f)) CHECK_MSG((ours & 0x7e00) == 0x7e00 && (ours & 0x8000) == (rb & 0x8000), "NaN %08x", (uint32_t)u);
+        if (isnan(f)) /* NaN stays NaN with its sign (_Float16 also quiets it; Imath keeps the payload) */
+            CHECK_MSG((ours & 0x7c00) == 0x7c00 && (ours & 0x3ff) && (ours & 0x8000) == (rb & 0x8000), "NaN %08x", (uint32_t)u);
         else CHECK_MSG(ours == rb, "float %08x: ours %04x, _Float16 %04x", (uint32_t)u, ours, rb);
         checked++;
     }

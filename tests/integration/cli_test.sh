@@ -1,10 +1,14 @@
 #!/usr/bin/env bash
 # cli_test.sh SY TESTDATA TMPDIR — tests of the `sy` command line tool (integration_cli).
 #   - sy info Box.gltf: JSON counts meshes/primitives/triangles/materials = 1/1/12/1, bounds +-0.5
+#   - conventions: --version, --help / help / CMD --help / help bench on stdout; a bad option, a
+#     missing or bad value named with status 2; a failure status 1; backends --json; -q / -v
 #   - sy render (cornell, whitted) to PNG and EXR: exit 0, files with the right signature and size
 #   - bad inputs (missing file, truncated GLB, garbage .gltf, unknown back-end, output in a missing
 #     directory, unknown output extension): non-zero exit, the offending name in stderr, and no
 #     output file nor temporary file left behind
+#   - typed parameters: sy backends --params (text and --json) lists each back-end's table; an unknown
+#     --params key, a value out of range or not in the enum: status 2 naming it (and the valid keys)
 #   - sy bench sync / sy bench rays on small sizes: exit 0 and their result lines (no thresholds)
 #   - sy demo -o DIR -w 64 -h 36: demo_whitted.png / .exr written
 #   - -b pathtracer: --spp with --aov (EXR with feature channels), --time; a non-EXR --env fails
@@ -18,6 +22,8 @@
 #   - --stereo sbs / tb / anaglyph / separate: output sizes and per-eye files; bad stereo parameters
 #     and overlays (negative separation, zero parallax 0, unknown mode, missing file, unknown
 #     back-end) fail naming the problem and write nothing
+# SY_TEST_PARTS (tests/CMakeLists.txt) names the parts this build has ("embree raster cluster
+# ..."); the checks of a part that was not built are skipped, saying so.
 # The parts that need ../shared/testdata run only when it is present; when it is absent the rest
 # still runs and the test then exits 77 (skipped) naming what was missing.
 set -u
@@ -34,6 +40,13 @@ fail() {
     echo "FAIL: $*" >&2
     fails=$((fails + 1))
 }
+
+# has PART: this build has the part (SY_TEST_PARTS; unset = the full build)
+has() { [ -z "${SY_TEST_PARTS+x}" ] || [[ " $SY_TEST_PARTS " == *" $1 "* ]]; }
+# picture back-ends of this build
+PICTURE=(whitted pathtracer)
+has raster && PICTURE+=(raster)
+for p in raster cluster; do has $p || echo "skip: the checks of '$p' (not in this build: SY_TEST_PARTS='$SY_TEST_PARTS')"; done
 
 # run NAME CMD...: runs a command with stdout/stderr captured in $TMP/NAME.{out,err}; sets $rc.
 run() {
@@ -78,6 +91,29 @@ CORNELL="$DATA/cornell/cornell_box.gltf"
 run backends "$SY" backends
 [ "$rc" -eq 0 ] && grep -q '^whitted' "$TMP/backends.out" || fail "sy backends does not list whitted"
 
+# typed back-end parameters (core/sy_params.h): sy backends --params prints every class's table; an
+# unknown --params key or a bad value is a usage error (2) naming it and listing the valid keys, and
+# nothing is written
+run backends_params "$SY" backends --params
+[ "$rc" -eq 0 ] && grep -Eq '^  max_depth +int +1\.\.64 +8 +longest' "$TMP/backends_params.out" &&
+    grep -Eq '^  filter +enum +none\|pixel\|atrous\|jbu\|adaptive\|radiance +none ' "$TMP/backends_params.out" ||
+    fail "sy backends --params: status $rc, $(head -c 600 "$TMP/backends_params.out" "$TMP/backends_params.err")"
+run backends_params_json "$SY" backends --params --json
+[ "$rc" -eq 0 ] && grep -Eq '"name":[[:space:]]*"max_depth"' "$TMP/backends_params_json.out" ||
+    fail "sy backends --params --json: status $rc"
+mkdir -p "$TMP/o_params"
+run params_unknown "$SY" render demo -b whitted --params max_detph=8 -o "$TMP/o_params/x.exr"
+[ "$rc" -eq 2 ] && grep -q "unknown parameter 'max_detph' for back-end 'whitted'" "$TMP/params_unknown.err" &&
+    grep -q "valid: spp, env_samples, max_depth, light_samples, threads, specular" "$TMP/params_unknown.err" ||
+    fail "an unknown --params key: status $rc (want 2), $(cat "$TMP/params_unknown.err")"
+run params_range "$SY" render demo -b whitted --params max_depth=99 -o "$TMP/o_params/x.exr"
+[ "$rc" -eq 2 ] && grep -q "max_depth=99 for back-end 'whitted': expected an integer in \[1, 64\]" "$TMP/params_range.err" ||
+    fail "--params max_depth=99: status $rc (want 2), $(cat "$TMP/params_range.err")"
+run params_enum "$SY" render demo -b pathtracer --params filter_kernel=fast -o "$TMP/o_params/x.exr"
+[ "$rc" -eq 2 ] && grep -q "filter_kernel=fast for back-end 'pathtracer': expected one of separable, brute" "$TMP/params_enum.err" ||
+    fail "--params filter_kernel=fast: status $rc (want 2), $(cat "$TMP/params_enum.err")"
+[ -z "$(ls -A "$TMP/o_params")" ] || fail "refused --params left files behind: $(ls -A "$TMP/o_params")"
+
 # conventions: --version and --help on stdout with status 0; a usage error names the option or value
 # on stderr with status 2; a failure has status 1
 run version "$SY" --version
@@ -88,12 +124,24 @@ for h in "--help" "help" "render --help"; do
     [ "$rc" -eq 0 ] && grep -q '^usage:' "$TMP/help.out" && grep -q 'sy render SCENE' "$TMP/help.out" && [ ! -s "$TMP/help.err" ] ||
         fail "sy $h: status $rc, the summary is not on stdout"
 done
-run serve_help "$SY" serve --help
-[ "$rc" -eq 0 ] && grep -q 'usage: sy serve' "$TMP/serve_help.out" || fail "sy serve --help: status $rc"
+if has cluster; then
+    run serve_help "$SY" serve --help
+    [ "$rc" -eq 0 ] && grep -q 'usage: sy serve' "$TMP/serve_help.out" || fail "sy serve --help: status $rc"
+fi
 run badopt "$SY" render demo -b whitted -o "$TMP/x.png" --frobnicate
 [ "$rc" -eq 2 ] && grep -q -- "'--frobnicate'" "$TMP/badopt.err" || fail "a bad option: status $rc (want 2), $(cat "$TMP/badopt.err")"
 run badval "$SY" render demo -b whitted -o "$TMP/x.png" -w 0
 [ "$rc" -eq 2 ] && grep -q -- "-w: '0'" "$TMP/badval.err" || fail "a bad value: status $rc (want 2), $(cat "$TMP/badval.err")"
+run badmissing "$SY" render demo -b whitted -o "$TMP/x.png" -w
+[ "$rc" -eq 2 ] && grep -q -- "option '-w' needs a value" "$TMP/badmissing.err" || fail "a missing value: status $rc, $(cat "$TMP/badmissing.err")"
+run badword "$SY" render demo -b whitted -o "$TMP/x.png" --tonemap=bogus
+[ "$rc" -eq 2 ] && grep -q -- "--tonemap: 'bogus'" "$TMP/badword.err" || fail "a bad --tonemap: status $rc, $(cat "$TMP/badword.err")"
+run help_bench "$SY" help bench
+[ "$rc" -eq 0 ] && grep -q '^  sy bench sync' "$TMP/help_bench.out" && ! grep -q '^  sy render' "$TMP/help_bench.out" ||
+    fail "sy help bench: status $rc, not the bench entries alone"
+run backends_json "$SY" backends --json
+[ "$rc" -eq 0 ] && head -n 1 "$TMP/backends_json.out" | grep -qx '\[' && grep -q '{"name": "whitted", "caps": \["depth"' "$TMP/backends_json.out" ||
+    fail "sy backends --json: status $rc, $(cat "$TMP/backends_json.out" "$TMP/backends_json.err")"
 run badcmd "$SY" renderr demo
 [ "$rc" -eq 2 ] && grep -q "unknown command 'renderr'" "$TMP/badcmd.err" || fail "an unknown command: status $rc (want 2)"
 run failure "$SY" render "$TMP/does_not_exist.gltf" -b whitted -o "$TMP/x.png"
@@ -117,7 +165,7 @@ mkdir -p "$TMP/meta"
 run meta_exr "$SY" render demo -b whitted -w 40 -h 30 -o "$TMP/meta/m.exr" --params spp=2
 run meta_info "$SY" info "$TMP/meta/m.exr"
 for kv in '"sy:renderer": "Switchyard ' '"sy:backend": "whitted"' '"sy:params": "spp=2"' '"sy:size": "40x30"' \
-          '"sy:samples": "2"' '"sy:source": "demo"' '"sy:camera": "the scene' '"sy:seconds": "' '"width": 40, "height": 30'; do
+          '"sy:samples": "2"' '"sy:source": "demo"' '"sy:camera": "the scene' '"sy:seconds": "' '"width": 40,' '"height": 30,'; do
     grep -qF -- "$kv" "$TMP/meta_info.out" || fail "sy info m.exr lacks $kv: $(cat "$TMP/meta_info.out" "$TMP/meta_info.err")"
 done
 run meta_png "$SY" render demo -b pathtracer --spp 3 -w 40 -h 30 -o "$TMP/meta/m.png"
@@ -231,7 +279,7 @@ fi
 
 if [ -f "$CORNELL" ]; then
     # layered hybrid rendering: path-traced Cornell box under a rasterised overlay, depth-composited
-    if [ -f "$BOX" ]; then
+    if [ -f "$BOX" ] && has raster; then
         mkdir -p "$TMP/hybrid"
         run hybrid "$SY" render "$CORNELL" -b pathtracer --spp 2 -w 32 -h 32 --overlay "$BOX:raster" \
             --composite depth -o "$TMP/hybrid/h.exr"
@@ -332,6 +380,15 @@ run allowed "$SY" render "$TMP/esc/model/esc.gltf" --allow-path "$TMP/esc" -b wh
 [ "$rc" -eq 0 ] && [ -s "$TMP/esc/ok.png" ] || fail "--allow-path: status $rc: $(cat "$TMP/allowed.err")"
 grep -q "warning: $TMP/esc/model/esc.gltf: meshes\[0\].primitives\[1\]: LINES with 3 vertices (odd)" "$TMP/allowed.err" ||
     fail "the odd LINES vertex is not reported: $(cat "$TMP/allowed.err")"
+# the log level (sy_log): -q keeps errors only, -v adds debug lines; before or after the command
+run allowed_q "$SY" -q render "$TMP/esc/model/esc.gltf" --allow-path "$TMP/esc" -b whitted -w 8 -h 8 -o "$TMP/esc/ok.png"
+[ "$rc" -eq 0 ] && [ ! -s "$TMP/allowed_q.err" ] || fail "sy -q: status $rc, stderr: $(cat "$TMP/allowed_q.err")"
+run allowed_v "$SY" render "$TMP/esc/model/esc.gltf" --allow-path "$TMP/esc" -b whitted -w 8 -h 8 -o "$TMP/esc/ok.png" -v
+[ "$rc" -eq 0 ] && grep -q "^sy: debug: $TMP/esc/model/esc.gltf: loaded in" "$TMP/allowed_v.err" &&
+    grep -q "LINES with 3 vertices (odd)" "$TMP/allowed_v.err" || fail "sy ... -v: status $rc, stderr: $(cat "$TMP/allowed_v.err")"
+grep -q "^sy: debug: " "$TMP/allowed.err" && fail "debug lines without -v: $(cat "$TMP/allowed.err")"
+run quiet_error "$SY" --quiet render "$TMP/in/no_such_scene.gltf" -b whitted -o "$TMP/x.png"
+[ "$rc" -eq 1 ] && grep -q "no_such_scene.gltf" "$TMP/quiet_error.err" || fail "sy --quiet hides an error: $(cat "$TMP/quiet_error.err")"
 # --strict: the same warning is an error, nothing written
 expect_error strict "--strict" "$TMP/o_esc" "$SY" render "$TMP/esc/model/esc.gltf" --allow-path "$TMP/esc" --strict \
     -b whitted -w 8 -h 8 -o "$TMP/o_esc/x.png"
@@ -359,7 +416,7 @@ bad_light() { # bad_light FILE LIGHT_JSON
 }
 bad_light "$TMP/world/neg_light.gltf" '{"type":"point","intensity":-2}'
 bad_light "$TMP/world/wide_spot.gltf" '{"type":"spot","intensity":5,"spot":{"innerConeAngle":0.1,"outerConeAngle":2.0}}'
-for b in whitted raster pathtracer; do
+for b in "${PICTURE[@]}"; do
     expect_error "neg_light_$b" "KHR_lights_punctual.lights[0]" "$TMP/o_world" "$SY" render "$TMP/world/neg_light.gltf" \
         -b "$b" -w 8 -h 8 -o "$TMP/o_world/x.png"
     grep -q "intensity -2 must be" "$TMP/neg_light_$b.err" || fail "neg_light_$b: the value is not named: $(cat "$TMP/neg_light_$b.err")"
@@ -368,12 +425,12 @@ for b in whitted raster pathtracer; do
 done
 # a 2:1 map is taken (and lights every back-end; sy compare prints the table)
 run world_exr2 "$SY" render demo -b whitted -w 32 -h 16 -o "$TMP/world/latlong.exr"
-run env_ok "$SY" render demo -b raster -w 16 -h 16 --env "$TMP/world/latlong.exr" --env-intensity 2 -o "$TMP/world/e.png"
+run env_ok "$SY" render demo -b "${PICTURE[-1]}" -w 16 -h 16 --env "$TMP/world/latlong.exr" --env-intensity 2 -o "$TMP/world/e.png"
 [ "$rc" -eq 0 ] && [ -s "$TMP/world/e.png" ] || fail "--env with a 2:1 map: status $rc: $(cat "$TMP/env_ok.err")"
 # sy compare: a table row per picture back-end, a PNG contact sheet; a bad sheet name is refused
 run compare "$SY" compare demo -w 48 -h 32 --spp 4 -o "$TMP/world/sheet.png"
 [ "$rc" -eq 0 ] || fail "sy compare: status $rc: $(cat "$TMP/compare.err")"
-for b in whitted pathtracer raster; do
+for b in "${PICTURE[@]}"; do
     grep -q "^$b " "$TMP/compare.out" || fail "sy compare: no row for $b: $(cat "$TMP/compare.out")"
 done
 grep -q "^coverage " "$TMP/compare.out" && fail "sy compare: the analysis back-end 'coverage' is compared"

@@ -91,10 +91,7 @@ static void nrm_destroy(void *state)
 
 static sy_result nrm_create(const sy_mediator_create_args *args, void **state_out, sy_error *err)
 {
-    *state_out = NULL;
-    if (args->params && args->params->count)
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "normals: unknown parameter '%s' (it takes none)",
-                            args->params->items[0].key);
+    *state_out = NULL; /* args->params: always empty (the class declares none, core refuses any) */
     nrm_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "normals: out of memory");
     char e[256];
@@ -134,6 +131,11 @@ static const sy_mediator_class nrm_class = {
     .destroy = nrm_destroy,
     .sync = nrm_sync,
     .render = nrm_render,
+    /* its parameters: none. A back-end with some declares them here, e.g.
+     *   static const sy_param_decl nrm_params[] = {{"flip", SY_PARAM_BOOL, 0, 0, "0", NULL, "negate normals", 0}};
+     *   .param_table = SY_PARAM_TABLE(nrm_params),
+     * and reads them in create with sy_param_bool(&table, args->params, "flip", &flip, err). */
+    .param_table = {NULL, 0},
 };
 
 sy_result sy_mediator_nrm_register(sy_error *err) { return sy_mediator_register(&nrm_class, err); }

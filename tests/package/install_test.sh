@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# install_test.sh BUILD_DIR SOURCE_DIR TMP EXR_EQUAL [C_FLAGS] — install_consumer: the library as a
+# program outside the tree sees it (issue 17).
+#   1. cmake --install BUILD_DIR into TMP/prefix: headers in include/switchyard, the CMake package,
+#      pkg-config files, sy (which runs from there: sy --version).
+#   2. apps/examples configured as a project of its own with find_package(Switchyard COMPONENTS
+#      ...) against that prefix, built, and run on a two-triangle glTF written here; render_gltf's
+#      image equals the in-tree render_gltf's pixel for pixel (exr_equal).
+#   3. render_gltf built with only `cc ... $(pkg-config [--static] --cflags --libs switchyard-rt
+#      switchyard-formats)`, run, the same pixels again.
+#   4. Both render_gltf binaries (Whitted only) link no GL library (ldd: no libGL, libEGL,
+#      libOpenGL, libGLX, libOSMesa, libglfw).
+#   5. find_package of a component this installation lacks fails with a message naming it.
+# Works for static and shared builds (BUILD_SHARED_LIBS) alike.
+set -u
+BUILD=$1 SRC=$2 TMP=$3 EXR_EQUAL=$4 CFLAGS_EXTRA=${5:-}
+fails=0
+fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
+rm -rf "$TMP"
+mkdir -p "$TMP"
+P=$TMP/prefix
+cmake --install "$BUILD" --prefix "$P" >"$TMP/install.log" 2>&1 || { cat "$TMP/install.log"; echo "FAIL: cmake --install"; exit 1; }
+for f in include/switchyard/sy_scene.h include/switchyard/sy_viewport.h include/switchyard/sy_gltf.h \
+         lib/cmake/Switchyard/SwitchyardConfig.cmake lib/pkgconfig/switchyard.pc lib/pkgconfig/switchyard-core.pc \
+         lib/pkgconfig/switchyard-rt.pc bin/sy; do
+    [ -e "$P/$f" ] || fail "not installed: $f"
+done
+[ -e "$P/include/switchyard/sy_gltf_shim.h" ] && fail "an internal header (sy_gltf_shim.h) was installed"
+"$P/bin/sy" --version >"$TMP/version.out" 2>&1 || fail "installed sy --version: $(cat "$TMP/version.out")"
+grep -q '^sy ' "$TMP/version.out" || fail "installed sy --version printed: $(cat "$TMP/version.out")"
+
+# two triangles, one in front of the other (no test data needed)
+cat >"$TMP/tri.gltf" <<'GLTF'
+{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+ "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+ "accessors":[{"bufferView":0,"componentType":5126,"count":6,"type":"VEC3","min":[-1,-1,-1],"max":[1,1,0]}],
+ "bufferViews":[{"buffer":0,"byteLength":72}],
+ "buffers":[{"byteLength":72,"uri":"data:application/octet-stream;base64,AACAvwAAgL8AAAAAAACAPwAAgL8AAAAAAAAAAAAAgD8AAAAAAACAvwAAgL8AAIC/AACAPwAAgL8AAIC/AACAPwAAgD8AAIC/"}]}
+GLTF
+"$BUILD/apps/examples/render_gltf" "$TMP/tri.gltf" "$TMP/in_tree.exr" >"$TMP/in_tree.log" 2>&1 ||
+    fail "in-tree render_gltf: $(cat "$TMP/in_tree.log")"
+
+# 2. find_package
+gen=()
+command -v ninja >/dev/null 2>&1 && gen=(-G Ninja)
+if cmake -S "$SRC/apps/examples" -B "$TMP/cmake" "${gen[@]}" -DCMAKE_PREFIX_PATH="$P" \
+        -DCMAKE_C_FLAGS="$CFLAGS_EXTRA" -DCMAKE_EXE_LINKER_FLAGS="$CFLAGS_EXTRA" >"$TMP/cmake.log" 2>&1 &&
+    cmake --build "$TMP/cmake" >>"$TMP/cmake.log" 2>&1; then
+    "$TMP/cmake/render_gltf" "$TMP/tri.gltf" "$TMP/cmake.exr" >"$TMP/run1.log" 2>&1 ||
+        fail "find_package render_gltf: $(cat "$TMP/run1.log")"
+    "$EXR_EQUAL" "$TMP/in_tree.exr" "$TMP/cmake.exr" || fail "find_package render_gltf: pixels differ from the in-tree build"
+    "$TMP/cmake/switch_backends" "$TMP/tri.gltf" "$TMP/sw" >"$TMP/run2.log" 2>&1 ||
+        fail "find_package switch_backends: $(cat "$TMP/run2.log")"
+    grep -q "^whitted .*after one transform change" "$TMP/run2.log" || fail "switch_backends printed: $(cat "$TMP/run2.log")"
+    "$TMP/cmake/layered_stereo" "$TMP/tri.gltf" "$TMP/tri.gltf" "$TMP/st.exr" >"$TMP/run3.log" 2>&1 ||
+        fail "find_package layered_stereo: $(cat "$TMP/run3.log")"
+    echo "ok: find_package(Switchyard): the three examples built and ran ($(grep -c . "$TMP/run2.log") back-ends switched)"
+else
+    tail -30 "$TMP/cmake.log"
+    fail "the examples do not configure or build against the installed package"
+fi
+
+# 3. pkg-config
+static=()
+[ -e "$P/lib/libsy_core.a" ] && static=(--static)
+export PKG_CONFIG_PATH=$P/lib/pkgconfig
+if flags=$(pkg-config "${static[@]}" --cflags --libs switchyard-rt switchyard-formats 2>"$TMP/pc.err"); then
+    # shellcheck disable=SC2086
+    if cc -std=c11 $CFLAGS_EXTRA "$SRC/apps/examples/render_gltf.c" -o "$TMP/pc_render" $flags -Wl,-rpath,"$P/lib" \
+        >"$TMP/cc.log" 2>&1; then
+        "$TMP/pc_render" "$TMP/tri.gltf" "$TMP/pc.exr" >"$TMP/run4.log" 2>&1 || fail "pkg-config render_gltf: $(cat "$TMP/run4.log")"
+        "$EXR_EQUAL" "$TMP/in_tree.exr" "$TMP/pc.exr" || fail "pkg-config render_gltf: pixels differ from the in-tree build"
+        echo "ok: pkg-config ${static[*]} switchyard-rt switchyard-formats: $flags"
+    else
+        cat "$TMP/cc.log"
+        fail "render_gltf does not build with pkg-config's flags"
+    fi
+else
+    fail "pkg-config switchyard-rt switchyard-formats: $(cat "$TMP/pc.err")"
+fi
+pkg-config --exists switchyard || fail "pkg-config switchyard (every component) is not usable"
+
+# 4. no GL in a Whitted-only program
+for exe in "$TMP/cmake/render_gltf" "$TMP/pc_render"; do
+    [ -x "$exe" ] || continue
+    gl=$(ldd "$exe" | grep -Ei 'lib(GL|EGL|OpenGL|GLX|OSMesa|glfw)[.-]')
+    if [ -n "$gl" ]; then fail "$(basename "$(dirname "$exe")")/$(basename "$exe") links GL: $gl"; else
+        echo "ok: $exe links no GL library ($(ldd "$exe" | wc -l) libraries)"; fi
+done
+
+# 5. a missing component is named
+mkdir -p "$TMP/missing"
+printf 'cmake_minimum_required(VERSION 3.20)\nproject(m C)\nfind_package(Switchyard REQUIRED COMPONENTS warp_drive)\n' \
+    >"$TMP/missing/CMakeLists.txt"
+if cmake -S "$TMP/missing" -B "$TMP/missing/b" -DCMAKE_PREFIX_PATH="$P" >"$TMP/missing.log" 2>&1; then
+    fail "find_package accepted a component that does not exist"
+else
+    grep -q "warp_drive" "$TMP/missing.log" || fail "find_package's error does not name the missing component: $(tail -5 "$TMP/missing.log")"
+fi
+[ $fails -eq 0 ] && echo "install_consumer: ok"
+exit $((fails > 0))
