@@ -117,6 +117,9 @@ typedef struct sy_rt_stats {
     uint32_t meshes, instances, materials, textures, lights; /** @} */
     uint32_t area_light_triangles; /**< emissive triangles in the committed area-light list */
     uint64_t version; /**< bumped by every commit that published a change (accumulation restarts) */
+    /** Seconds Embree's rtcCommitScene of the top-level scene took in the last sy_rt_commit (0 when
+     * that commit did not rebuild it): the part of a commit that is Embree's, not ours. */
+    double last_top_commit_seconds;
 } sy_rt_stats;
 /** Fills *out with the device's live object counts and version. */
 void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out);

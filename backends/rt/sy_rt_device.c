@@ -74,7 +74,7 @@ sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **o
     dev->default_material.desc.metallic = 0.0f;
     dev->background_staged.mode = SY_RT_BACKGROUND_NONE;
     dev->background = dev->background_staged;
-    dev->dirty = dev->top_dirty = true;
+    dev->dirty = dev->top_dirty = dev->shadow_dirty = true;
     *out = dev;
     return SY_RT_OK;
 }
@@ -107,6 +107,7 @@ void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out)
     out->lights = dev->lights.live;
     out->area_light_triangles = dev->area_count;
     out->version = dev->version;
+    out->last_top_commit_seconds = dev->last_top_commit_seconds;
 }
 
 sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg, char *err, size_t err_len)

@@ -93,6 +93,9 @@ struct sy_rt_device {
     bool area_dirty;     /* area-light list needs a rebuild */
     bool filters_dirty;  /* alpha filters may need (un)installing */
     bool punctual_dirty; /* punctual light array needs a rebuild */
+    bool shadow_dirty;   /* shadow_blend / shadow_transmission need a recount (an instance's material,
+                          * visibility or existence, or a material changed; never a transform) */
+    double last_top_commit_seconds; /* rtcCommitScene of the top-level scene in the last commit */
 
     /* committed light data used while rendering */
     sy_rt_punctual *punctual;

@@ -8,6 +8,7 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #define FAIL(r, ...) sy_rt_fail(err, err_len, (r), __VA_ARGS__)
 
@@ -206,7 +207,7 @@ sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc 
         free(m);
         return FAIL(SY_RT_ERROR_LIMIT, "material: pool full or out of memory");
     }
-    dev->dirty = true;
+    dev->dirty = dev->shadow_dirty = true;
     return SY_RT_OK;
 }
 
@@ -223,7 +224,7 @@ sy_rt_result sy_rt_material_update(sy_rt_device *dev, sy_rt_material mat, const 
     material_set(m, d);
     if (was_emissive != m->emissive || (m->emissive && emission_changed)) dev->area_dirty = true;
     if (was_masked != m->masked) dev->filters_dirty = true;
-    dev->dirty = true;
+    dev->dirty = dev->shadow_dirty = true;
     return SY_RT_OK;
 }
 
@@ -236,7 +237,7 @@ sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat, char 
     if (m->emissive) dev->area_dirty = true;
     if (m->masked) dev->filters_dirty = true;
     free(m);
-    dev->dirty = true;
+    dev->dirty = dev->shadow_dirty = true;
     return SY_RT_OK;
 }
 
@@ -377,11 +378,11 @@ sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc 
     in->handle = out->id;
     if (instance_emissive(dev, in)) dev->area_dirty = true;
     if (instance_masked(dev, in)) dev->filters_dirty = true;
-    dev->dirty = dev->top_dirty = true;
+    dev->dirty = dev->top_dirty = dev->shadow_dirty = true;
     return SY_RT_OK;
 fail:
     instance_free(dev, in);
-    dev->dirty = dev->top_dirty = true;
+    dev->dirty = dev->top_dirty = dev->shadow_dirty = true;
     return r;
 }
 
@@ -418,7 +419,7 @@ sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst,
     in->material = material;
     if (was_emissive || instance_emissive(dev, in)) dev->area_dirty = true;
     if (was_masked != instance_masked(dev, in)) dev->filters_dirty = true;
-    dev->dirty = true;
+    dev->dirty = dev->shadow_dirty = true;
     return SY_RT_OK;
 }
 
@@ -438,7 +439,7 @@ sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, 
     }
     if (sy_rt_material_lookup(dev, in->material)->emissive) dev->area_dirty = true;
     if (instance_masked(dev, in)) dev->filters_dirty = true;
-    dev->dirty = dev->top_dirty = true;
+    dev->dirty = dev->top_dirty = dev->shadow_dirty = true;
     return sy_rt_check_embree(dev, err, err_len, "instance set_visible");
 }
 
@@ -450,7 +451,7 @@ sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst, char
     if (instance_emissive(dev, in)) dev->area_dirty = true;
     if (instance_masked(dev, in)) dev->filters_dirty = true;
     instance_free(dev, in);
-    dev->dirty = dev->top_dirty = true;
+    dev->dirty = dev->top_dirty = dev->shadow_dirty = true;
     return sy_rt_check_embree(dev, err, err_len, "instance destroy");
 }
 
@@ -521,6 +522,13 @@ sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light, char *err
 }
 
 /* >>commit */
+
+static double sy_rt_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 static void set_filter(RTCGeometry g, bool on)
 {
@@ -689,8 +697,11 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len)
         if ((r = sy_rt_check_embree(dev, err, err_len, "commit: alpha filters")) != SY_RT_OK) return r;
         dev->filters_dirty = false;
     }
+    dev->last_top_commit_seconds = 0.0;
     if (dev->top_dirty) {
+        double t0 = sy_rt_seconds();
         rtcCommitScene(dev->top);
+        dev->last_top_commit_seconds = sy_rt_seconds() - t0;
         if ((r = sy_rt_check_embree(dev, err, err_len, "commit: top-level scene")) != SY_RT_OK) return r;
         dev->top_dirty = false;
     }
@@ -703,7 +714,10 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len)
         dev->punctual_dirty = false;
     }
     dev->background = dev->background_staged;
-    sy_rt_shadow_flags_update(dev);
+    if (dev->shadow_dirty) { /* O(instances): only when a material, visibility or instance set changed */
+        sy_rt_shadow_flags_update(dev);
+        dev->shadow_dirty = false;
+    }
     if (dev->env_dirty) {
         if ((r = sy_rt_env_rebuild(dev, err, err_len)) != SY_RT_OK) return r;
         dev->env_dirty = false;

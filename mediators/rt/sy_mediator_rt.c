@@ -374,6 +374,7 @@ static sy_result rt_sync(void *state, const sy_changes *changes, sy_error *err)
     st->counters.materials = s.materials;
     st->counters.textures = s.textures;
     st->counters.lights = s.lights;
+    st->counters.last_sync_top_commit_seconds = s.last_top_commit_seconds;
     return r;
 }
 

@@ -138,6 +138,8 @@ typedef struct sy_mediator_rt_counters {
     uint32_t instances, baked_instances, meshes, materials, textures, lights; /** @} */
     uint32_t last_sync_placements; /**< node placements recomputed by the last sync */
     uint32_t last_sync_entries;    /**< change entries handled by the last sync */
+    double last_sync_top_commit_seconds; /**< of the last sync: Embree's rebuild of the top-level BVH
+                                          * (rtcCommitScene over every instance; 0 when not needed) */
     uint32_t accum_restarts;       /**< path tracer: accumulations restarted (not counting the first) */
     uint64_t last_render_rays;     /**< path tracer: rays traced by the last render */
     uint32_t warnings;             /**< out-of-range material / light values clamped (each also logged:
