@@ -16,6 +16,7 @@
  *   sy bench rays [SCENE] [-w W] [-h H] [--repeats R]
  *   sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params k=v,...]
  *   sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]
+ *   sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   peak RSS per triangle (sy_bench.h)
  *   sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]
  *   sy backends [--params] [--json]     list registered back-ends (--params: their parameters)
  *   sy serve [--listen URL] [--secret-file F] [--output OUT]   render server (apps/sy_cluster_cli.c)
@@ -156,7 +157,7 @@ enum {
     /* the commands' own long options (cluster ones: SY_CLUSTER_OPT_*, sy_cluster_cli.h) */
     OPT_SPP, OPT_TIME, OPT_AOV, OPT_CAMERA, OPT_PARAMS, OPT_GL, OPT_FILTER, OPT_THRESHOLD, OPT_HALF, OPT_EXPOSURE,
     OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
-    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON
+    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB
 };
 /* getopt_long entries of the options of every command, with the table's terminator: the end of
  * every command's table */
@@ -591,6 +592,7 @@ static const char usage_text[] =
             "  sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params gl=egl,msaa=4]\n"
             "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
             "  sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]\n"
+            "  sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   (peak RSS per triangle)\n"
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy backends [--params] [--json]\n"
             "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
@@ -1634,7 +1636,8 @@ static int cmd_bench_filters(int argc, char **argv)
 /* sy bench KIND ...: argv[0] is "bench", argv[1] the kind. */
 static int cmd_bench(int argc, char **argv)
 {
-    static const char *const kinds[] = {"sync", "rays", "pathtracer", "filters", "raster", "viewports", "load", "cluster"};
+    static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
+                                        "viewports", "load", "cluster",    "memory"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -1650,24 +1653,32 @@ static int cmd_bench(int argc, char **argv)
     if (!strcmp(cmd, "filters")) return cmd_bench_filters(argc, argv);
     if (!strcmp(cmd, "cluster")) return sy_cmd_bench_cluster(argc, argv);
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
-    const char *scene = NULL, *params = NULL;
+    const char *scene = NULL, *params = NULL, *backend = NULL;
+    bool memory = !strcmp(cmd, "memory");
     static const struct option lo[] = {{"params", required_argument, NULL, OPT_PARAMS},
                                        {"nodes", required_argument, NULL, OPT_NODES},
                                        {"tris", required_argument, NULL, OPT_TRIS},
+                                       {"glb", no_argument, NULL, OPT_GLB},
                                        {"repeats", required_argument, NULL, OPT_REPEATS}, COMMON_OPTIONS};
     char who[32];
     snprintf(who, sizeof who, "bench %s", cmd);
+    bool glb = false;
     int c, status = 0;
     optind = 0;
-    while ((c = next_option(who, argc, argv, SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
+    while ((c = next_option(who, argc, argv, memory ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
         switch (c) {
         case OPT_STOP: return status;
         case OPT_PARAMS: params = optarg; break; /* bench raster */
+        case 'b': backend = optarg; break; /* bench memory */
+        case OPT_GLB:
+            if (!memory) return usage_of(who, "--glb is an option of sy bench memory");
+            glb = true;
+            break;
         case OPT_NODES:
             if (!parse_u32(optarg, 1, 1u << 22, &nodes)) return bad_value("--nodes", optarg);
             break;
         case OPT_TRIS:
-            if (!parse_u32(optarg, 12, 1u << 20, &tris)) return bad_value("--tris", optarg);
+            if (!parse_u32(optarg, 12, memory ? 1u << 30 : 1u << 20, &tris)) return bad_value("--tris", optarg);
             break;
         case OPT_REPEATS:
             if (!parse_u32(optarg, 1, 100000, &repeats)) return bad_value("--repeats", optarg);
@@ -1690,6 +1701,12 @@ static int cmd_bench(int argc, char **argv)
                    : fail(&err);
     if (!strcmp(cmd, "raster")) return cmd_bench_raster(scene, w, h, repeats, params);
     if (!strcmp(cmd, "pathtracer")) return cmd_bench_pathtracer(scene, w, h, repeats);
+    if (memory) {
+        if (optind < argc) return usage_of(who, "no SCENE: the height field is generated");
+        return sy_bench_memory(tris == 100 ? 1000000 : tris, backend, glb, w == 512 ? 256 : w, h == 512 ? 256 : h, &err) == SY_OK
+                   ? 0
+                   : fail(&err);
+    }
     if (!strcmp(cmd, "load")) /* SCENE = the glTF sample directory; --tris: generated model (default 1M) */
         return sy_bench_load(scene ? scene : "../shared/testdata/gltf", tris == 100 ? 1000000 : tris,
                              repeats ? repeats : 3, &err) == SY_OK ? 0 : fail(&err);

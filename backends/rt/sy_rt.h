@@ -117,6 +117,11 @@ typedef struct sy_rt_stats {
     uint32_t meshes, instances, materials, textures, lights; /** @} */
     uint32_t area_light_triangles; /**< emissive triangles in the committed area-light list */
     uint64_t version; /**< bumped by every commit that published a change (accumulation restarts) */
+    /** @{ memory: bytes of mesh arrays the back-end allocated itself (copies: shading normals,
+     * texture coordinates, colours; not Embree's), bytes of mesh arrays shared with the caller
+     * (sy_rt_mesh_desc.release), and Embree's own allocations now and at their peak (geometry
+     * buffers, BVHs, build scratch; counted by rtcSetDeviceMemoryMonitorFunction) */
+    uint64_t mesh_bytes, shared_bytes, embree_bytes, embree_peak_bytes; /** @} */
 } sy_rt_stats;
 /** Fills *out with the device's live object counts and version. */
 void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out);

@@ -13,34 +13,36 @@
 
 /* >>mesh */
 
-static void mesh_free(sy_rt_mesh_data *m)
+static void mesh_free(sy_rt_device *dev, sy_rt_mesh_data *m)
 {
     if (!m) return;
     if (m->geom) rtcReleaseGeometry(m->geom);
     if (m->scene) rtcReleaseScene(m->scene);
-    free(m->normals);
-    free(m->uv[0]);
-    free(m->uv[1]);
-    free(m->colors);
+    free((void *)m->normals);
+    free((void *)m->uv[0]);
+    free((void *)m->uv[1]);
+    free((void *)m->colors);
+    dev->mesh_bytes -= m->own_bytes;
     free(m);
 }
 
-static void mesh_unref(sy_rt_mesh_data *m)
+static void mesh_unref(sy_rt_device *dev, sy_rt_mesh_data *m)
 {
-    if (m && --m->refs == 0) mesh_free(m);
+    if (m && --m->refs == 0) mesh_free(dev, m);
 }
 
 /* Copies n floats, rejecting non-finite values. */
-static sy_rt_result copy_finite(const float *src, size_t n, float **dst, const char *what, char *err, size_t err_len)
+static sy_rt_result copy_finite(const float *src, size_t n, const float **dst, const char *what, char *err, size_t err_len)
 {
     for (size_t i = 0; i < n; ++i)
         if (!isfinite(src[i]))
             return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: %s[%zu] = %g is not finite", what, i, (double)src[i]);
     size_t bytes;
     if (!sy_rt_size_mul(n, sizeof(float), &bytes)) return FAIL(SY_RT_ERROR_LIMIT, "mesh: %s too large", what);
-    *dst = malloc(bytes ? bytes : 1);
-    if (!*dst) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: cannot allocate %s (%zu bytes)", what, bytes);
-    memcpy(*dst, src, bytes);
+    float *copy = malloc(bytes ? bytes : 1);
+    if (!copy) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: cannot allocate %s (%zu bytes)", what, bytes);
+    memcpy(copy, src, bytes);
+    *dst = copy;
     return SY_RT_OK;
 }
 
@@ -118,10 +120,14 @@ sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *d, sy_r
     if ((r = sy_rt_check_embree(dev, err, err_len, "mesh: building BLAS")) != SY_RT_OK) goto fail;
     if (!m->scene) { r = FAIL(SY_RT_ERROR_EMBREE, "mesh: rtcNewScene failed"); goto fail; }
     if (!sy_rt_pool_insert(&dev->meshes, m, &out->id)) { r = FAIL(SY_RT_ERROR_LIMIT, "mesh: pool full or out of memory"); goto fail; }
+    m->own_bytes = (d->normals ? vc * 3u : 0u) + (d->uv[0] ? vc * 2u : 0u) + (d->uv[1] ? vc * 2u : 0u) +
+                   (d->colors ? vc * 4u : 0u);
+    m->own_bytes *= sizeof(float);
+    dev->mesh_bytes += m->own_bytes;
     dev->dirty = true;
     return SY_RT_OK;
 fail:
-    mesh_free(m);
+    mesh_free(dev, m);
     return r;
 }
 
@@ -130,7 +136,7 @@ sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh, char *err, s
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh destroy: NULL device");
     sy_rt_mesh_data *m = sy_rt_pool_remove(&dev->meshes, mesh.id);
     if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "mesh destroy: stale handle 0x%08x", mesh.id);
-    mesh_unref(m); /* instances keep it alive until they go */
+    mesh_unref(dev, m); /* instances keep it alive until they go */
     dev->dirty = true;
     return SY_RT_OK;
 }
@@ -316,7 +322,7 @@ static void instance_free(sy_rt_device *dev, sy_rt_instance_data *in)
         }
         rtcReleaseGeometry(in->geom);
     }
-    mesh_unref(in->mesh);
+    mesh_unref(dev, in->mesh);
     free(in);
 }
 
@@ -718,7 +724,7 @@ void sy_rt_scene_release_all(sy_rt_device *dev)
     for (uint32_t i = 0; i < dev->instances.count; ++i)
         if (dev->instances.items[i]) instance_free(dev, dev->instances.items[i]);
     for (uint32_t i = 0; i < dev->meshes.count; ++i)
-        if (dev->meshes.items[i]) mesh_unref(dev->meshes.items[i]);
+        if (dev->meshes.items[i]) mesh_unref(dev, dev->meshes.items[i]);
     for (uint32_t i = 0; i < dev->materials.count; ++i) free(dev->materials.items[i]);
     for (uint32_t i = 0; i < dev->lights.count; ++i) free(dev->lights.items[i]);
     sy_rt_pool_free(&dev->instances);

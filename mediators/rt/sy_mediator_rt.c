@@ -1234,7 +1234,14 @@ const sy_mediator_class *sy_mediator_rt_coverage_class(void) { return &coverage_
 
 void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out)
 {
-    *out = ((rt_state *)state)->counters;
+    rt_state *st = state;
+    *out = st->counters;
+    sy_rt_stats rs;
+    sy_rt_device_stats(st->dev, &rs);
+    out->mesh_bytes = rs.mesh_bytes;
+    out->shared_bytes = rs.shared_bytes;
+    out->embree_bytes = rs.embree_bytes;
+    out->embree_peak_bytes = rs.embree_peak_bytes;
 }
 
 sy_result sy_mediator_rt_register(sy_error *err)

@@ -209,6 +209,18 @@ grep -Eq 'raw Embree rtcIntersect1 +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fa
 grep -Eq 'whitted back-end \(primary\) +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fail "bench rays: no ours line"
 grep -Eq 'overhead +-?[0-9.]+ %' "$TMP/bench_rays.out" || fail "bench rays: no overhead (ratio) line"
 cat "$TMP/bench_rays.out"
+run bench_memory "$SY" bench memory --tris 2000 -w 16 -h 16
+if [ "$rc" -ne 0 ]; then fail "bench memory: status $rc: $(cat "$TMP/bench_memory.err")"; fi
+[ "$(grep -Ec '^  peak RSS +[0-9.]+ MB +[0-9.]+ bytes/triangle' "$TMP/bench_memory.out")" -eq 2 ] ||
+    fail "bench memory: not one peak line per ray tracer"
+grep -Eq '^  Embree peak .* [0-9.]+ bytes/triangle' "$TMP/bench_memory.out" || fail "bench memory: no Embree line"
+run bench_memory_glb "$SY" bench memory --tris 2000 -b whitted --glb -w 16 -h 16
+if [ "$rc" -ne 0 ]; then fail "bench memory --glb: status $rc: $(cat "$TMP/bench_memory_glb.err")"; fi
+grep -Eq '^whitted: 2048 triangles' "$TMP/bench_memory_glb.out" || fail "bench memory --glb: wrong triangle count"
+run bench_memory_bad "$SY" bench memory -b raster --tris 2000
+[ "$rc" -eq 1 ] && grep -q 'expected one of the ray tracers' "$TMP/bench_memory_bad.err" ||
+    fail "bench memory -b raster: status $rc, $(cat "$TMP/bench_memory_bad.err")"
+cat "$TMP/bench_memory.out"
 
 # demo
 run demo "$SY" demo -o "$TMP/demo" -w 64 -h 36
