@@ -7,7 +7,8 @@
  *
  * Object model
  *   sy_rt_device   owns everything: Embree device, top-level scene, object pools.
- *   sy_rt_mesh     a prototype triangle mesh (its own Embree scene / BLAS). Data is copied.
+ *   sy_rt_mesh     a prototype triangle mesh (its own Embree scene / BLAS). Data is copied, or
+ *                  shared in place when the caller passes a release callback (sy_rt_mesh_desc).
  *   sy_rt_instance a mesh placed in the world with a transform and a material; either an Embree
  *                  instance of the mesh's BLAS, or (SY_RT_INSTANCE_BAKED) world-space triangles
  *                  merged into the top-level BVH.
@@ -128,7 +129,12 @@ void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out);
 
 /* >>mesh */
 
-/** Triangle mesh. Ownership: every array is COPIED; the caller may free its arrays after the call.
+/** Triangle mesh. Ownership: without `release`, every array is COPIED and the caller may free its
+ * arrays after the call. With `release`, nothing is copied: the back-end (and Embree, through
+ * rtcSetSharedGeometryBuffer) reads the arrays in place until it calls release(release_user) exactly
+ * once, when the mesh handle and its last instance are gone; the arrays must not change meanwhile,
+ * and positions must stay readable for 16 bytes past its last element (Embree's SIMD loads). When
+ * sy_rt_mesh_create fails, release is not called (the caller still owns the arrays).
  * Positions are required and must be finite. Optional arrays are NULL when absent; when present
  * they hold vertex_count elements. Without indices the mesh is a non-indexed triangle list and
  * vertex_count must equal 3 * triangle_count. With indices there are 3 * triangle_count indices
@@ -141,9 +147,12 @@ typedef struct sy_rt_mesh_desc {
     const uint32_t *indices; /**< 3 x triangle_count or NULL */
     uint32_t vertex_count; /**< number of vertices in every per-vertex array */
     uint32_t triangle_count; /**< number of triangles */
+    void (*release)(void *release_user); /**< NULL: arrays copied; else shared until this is called */
+    void *release_user; /**< argument of release */
 } sy_rt_mesh_desc;
 
-/** Creates a mesh from desc (arrays copied). */
+/** Creates a mesh from desc (arrays copied or shared, see sy_rt_mesh_desc). Its BLAS is built when
+ * its first instance that is not SY_RT_INSTANCE_BAKED is created. */
 sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *desc, sy_rt_mesh *out,
                                char *err, size_t err_len);
 /** Invalidates the handle; the data is freed once no instance uses it any more. */

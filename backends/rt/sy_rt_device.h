@@ -16,6 +16,9 @@
 
 /* >>objects */
 
+/* Meshes of at least this many triangles get a compact, medium-quality BLAS (sy_rt_scene.c). */
+#define SY_RT_LARGE_MESH_TRIANGLES (1u << 20)
+
 typedef struct sy_rt_mesh_data {
     RTCScene scene;       /* BLAS holding geom as geometry 0; NULL until a non-baked instance needs it */
     RTCGeometry geom;

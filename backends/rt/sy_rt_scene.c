@@ -18,11 +18,16 @@ static void mesh_free(sy_rt_device *dev, sy_rt_mesh_data *m)
     if (!m) return;
     if (m->geom) rtcReleaseGeometry(m->geom);
     if (m->scene) rtcReleaseScene(m->scene);
-    free((void *)m->normals);
-    free((void *)m->uv[0]);
-    free((void *)m->uv[1]);
-    free((void *)m->colors);
+    if (m->shared) {
+        if (m->release) m->release(m->release_user);
+    } else {
+        free((void *)m->normals);
+        free((void *)m->uv[0]);
+        free((void *)m->uv[1]);
+        free((void *)m->colors);
+    }
     dev->mesh_bytes -= m->own_bytes;
+    dev->shared_bytes -= m->shared_bytes;
     free(m);
 }
 
@@ -31,18 +36,26 @@ static void mesh_unref(sy_rt_device *dev, sy_rt_mesh_data *m)
     if (m && --m->refs == 0) mesh_free(dev, m);
 }
 
-/* Copies n floats, rejecting non-finite values. */
-static sy_rt_result copy_finite(const float *src, size_t n, const float **dst, const char *what, char *err, size_t err_len)
+/* Checks n floats for non-finite values, then copies them (m->own_bytes) or, for a shared mesh,
+ * points at them (m->shared_bytes). */
+static sy_rt_result take_finite(sy_rt_mesh_data *m, const float *src, size_t n, const float **dst, const char *what,
+                                char *err, size_t err_len)
 {
     for (size_t i = 0; i < n; ++i)
         if (!isfinite(src[i]))
             return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: %s[%zu] = %g is not finite", what, i, (double)src[i]);
     size_t bytes;
     if (!sy_rt_size_mul(n, sizeof(float), &bytes)) return FAIL(SY_RT_ERROR_LIMIT, "mesh: %s too large", what);
+    if (m->shared) {
+        *dst = src;
+        m->shared_bytes += bytes;
+        return SY_RT_OK;
+    }
     float *copy = malloc(bytes ? bytes : 1);
     if (!copy) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: cannot allocate %s (%zu bytes)", what, bytes);
     memcpy(copy, src, bytes);
     *dst = copy;
+    m->own_bytes += bytes;
     return SY_RT_OK;
 }
 
@@ -83,51 +96,90 @@ sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *d, sy_r
     sy_rt_mesh_data *m = calloc(1, sizeof *m);
     if (!m) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
     m->refs = 1;
+    m->shared = d->release != NULL;
     m->vertex_count = d->vertex_count;
     m->triangle_count = d->triangle_count;
-    size_t vc = d->vertex_count;
-    if (d->normals && (r = copy_finite(d->normals, vc * 3u, &m->normals, "normals", err, err_len)) != SY_RT_OK) goto fail;
-    if (d->uv[0] && (r = copy_finite(d->uv[0], vc * 2u, &m->uv[0], "uv[0]", err, err_len)) != SY_RT_OK) goto fail;
-    if (d->uv[1] && (r = copy_finite(d->uv[1], vc * 2u, &m->uv[1], "uv[1]", err, err_len)) != SY_RT_OK) goto fail;
-    if (d->colors && (r = copy_finite(d->colors, vc * 4u, &m->colors, "colors", err, err_len)) != SY_RT_OK) goto fail;
+    size_t vc = d->vertex_count, corners = (size_t)d->triangle_count * 3u;
+    if (d->normals && (r = take_finite(m, d->normals, vc * 3u, &m->normals, "normals", err, err_len)) != SY_RT_OK) goto fail;
+    if (d->uv[0] && (r = take_finite(m, d->uv[0], vc * 2u, &m->uv[0], "uv[0]", err, err_len)) != SY_RT_OK) goto fail;
+    if (d->uv[1] && (r = take_finite(m, d->uv[1], vc * 2u, &m->uv[1], "uv[1]", err, err_len)) != SY_RT_OK) goto fail;
+    if (d->colors && (r = take_finite(m, d->colors, vc * 4u, &m->colors, "colors", err, err_len)) != SY_RT_OK) goto fail;
 
     m->geom = rtcNewGeometry(dev->rtc, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (!m->geom) { r = sy_rt_check_embree(dev, err, err_len, "mesh: rtcNewGeometry"); goto fail; }
-    /* rtcSetNewGeometryBuffer pads vertex buffers as Embree's SIMD loads require. */
-    float *pos = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                         3 * sizeof(float), d->vertex_count);
-    uint32_t *idx = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                            3 * sizeof(uint32_t), d->triangle_count);
+    const float *pos = NULL;
+    const uint32_t *idx = NULL;
+    if (m->shared) {
+        /* Embree reads the caller's arrays in place (the caller guarantees the padding). */
+        rtcSetSharedGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, d->positions, 0,
+                                   3 * sizeof(float), d->vertex_count);
+        pos = d->positions;
+        m->shared_bytes += vc * 3u * sizeof(float);
+        if (d->indices) {
+            rtcSetSharedGeometryBuffer(m->geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, d->indices, 0,
+                                       3 * sizeof(uint32_t), d->triangle_count);
+            idx = d->indices;
+            m->shared_bytes += corners * sizeof(uint32_t);
+        }
+    } else {
+        /* rtcSetNewGeometryBuffer pads vertex buffers as Embree's SIMD loads require. */
+        float *p = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                           d->vertex_count);
+        if (p) memcpy(p, d->positions, vc * 3u * sizeof(float));
+        pos = p;
+    }
+    if (!idx) {
+        uint32_t *ix = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                               3 * sizeof(uint32_t), d->triangle_count);
+        if (ix) {
+            if (d->indices) memcpy(ix, d->indices, corners * sizeof(uint32_t));
+            else for (size_t i = 0; i < corners; ++i) ix[i] = (uint32_t)i;
+        }
+        idx = ix;
+    }
     if (!pos || !idx) {
         r = sy_rt_check_embree(dev, err, err_len, "mesh: allocating Embree buffers");
         if (r == SY_RT_OK) r = FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: allocating Embree buffers failed");
         goto fail;
     }
-    memcpy(pos, d->positions, vc * 3u * sizeof(float));
-    size_t corners = (size_t)d->triangle_count * 3u;
-    if (d->indices) memcpy(idx, d->indices, corners * sizeof(uint32_t));
-    else for (size_t i = 0; i < corners; ++i) idx[i] = (uint32_t)i;
     m->positions = pos;
     m->indices = idx;
     rtcSetGeometryUserData(m->geom, dev);
     rtcCommitGeometry(m->geom);
-    m->scene = rtcNewScene(dev->rtc);
-    if (m->scene) {
-        rtcSetSceneBuildQuality(m->scene, RTC_BUILD_QUALITY_HIGH);
-        rtcAttachGeometryByID(m->scene, m->geom, 0);
-        rtcCommitScene(m->scene);
-    }
-    if ((r = sy_rt_check_embree(dev, err, err_len, "mesh: building BLAS")) != SY_RT_OK) goto fail;
-    if (!m->scene) { r = FAIL(SY_RT_ERROR_EMBREE, "mesh: rtcNewScene failed"); goto fail; }
+    if ((r = sy_rt_check_embree(dev, err, err_len, "mesh: creating geometry")) != SY_RT_OK) goto fail;
     if (!sy_rt_pool_insert(&dev->meshes, m, &out->id)) { r = FAIL(SY_RT_ERROR_LIMIT, "mesh: pool full or out of memory"); goto fail; }
-    m->own_bytes = (d->normals ? vc * 3u : 0u) + (d->uv[0] ? vc * 2u : 0u) + (d->uv[1] ? vc * 2u : 0u) +
-                   (d->colors ? vc * 4u : 0u);
-    m->own_bytes *= sizeof(float);
+    m->release = d->release;
+    m->release_user = d->release_user;
     dev->mesh_bytes += m->own_bytes;
+    dev->shared_bytes += m->shared_bytes;
     dev->dirty = true;
     return SY_RT_OK;
 fail:
-    mesh_free(dev, m);
+    m->own_bytes = m->shared_bytes = 0; /* not yet counted in dev */
+    mesh_free(dev, m); /* m->release is still NULL: the caller keeps its arrays */
+    return r;
+}
+
+/* The mesh's BLAS, built on first use by an Embree instance (a mesh used only by baked instances
+ * never needs one). Large meshes build with a compact layout and medium quality: a high-quality
+ * build (spatial splits) of 10^7 triangles needs several times the memory of the finished BVH. */
+static sy_rt_result mesh_blas(sy_rt_device *dev, sy_rt_mesh_data *m, char *err, size_t err_len)
+{
+    if (m->scene) return SY_RT_OK;
+    bool large = m->triangle_count >= SY_RT_LARGE_MESH_TRIANGLES;
+    m->scene = rtcNewScene(dev->rtc);
+    if (m->scene) {
+        if (large) rtcSetSceneFlags(m->scene, RTC_SCENE_FLAG_COMPACT);
+        rtcSetSceneBuildQuality(m->scene, large ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH);
+        rtcAttachGeometryByID(m->scene, m->geom, 0);
+        rtcCommitScene(m->scene);
+    }
+    sy_rt_result r = sy_rt_check_embree(dev, err, err_len, "mesh: building BLAS");
+    if (r == SY_RT_OK && !m->scene) r = FAIL(SY_RT_ERROR_EMBREE, "mesh: rtcNewScene failed");
+    if (r != SY_RT_OK && m->scene) {
+        rtcReleaseScene(m->scene);
+        m->scene = NULL;
+    }
     return r;
 }
 
@@ -339,6 +391,7 @@ sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc 
     float nrm[9];
     sy_rt_result r = normal_matrix(d->transform, nrm, err, err_len);
     if (r != SY_RT_OK) return r;
+    if (!(d->flags & SY_RT_INSTANCE_BAKED) && (r = mesh_blas(dev, mesh, err, err_len)) != SY_RT_OK) return r;
 
     sy_rt_instance_data *in = calloc(1, sizeof *in);
     if (!in) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance: out of memory");
@@ -568,7 +621,7 @@ static void update_filters(sy_rt_device *dev)
             sy_rt_mesh_data *m = pass == 0 ? pool->items[i] : ((sy_rt_instance_data *)pool->items[i])->mesh;
             if (m->want_filter == m->filter_on) continue;
             set_filter(m->geom, m->want_filter);
-            rtcCommitScene(m->scene);
+            if (m->scene) rtcCommitScene(m->scene);
             m->filter_on = m->want_filter;
             dev->top_dirty = true;
         }

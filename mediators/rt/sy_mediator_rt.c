@@ -262,11 +262,27 @@ static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_erro
     return r == SY_RT_OK ? SY_OK : rt_fail(err, r, "texture", e);
 }
 
+/* The blobs a shared back-end mesh reads in place (sy_rt_mesh_desc.release): one reference each,
+ * given back when the back-end lets the mesh go. Blobs are immutable and padded (SY_BLOB_PADDING),
+ * so Embree may use them as its vertex and index buffers: no copy in the back-end. */
+typedef struct rt_mesh_blobs {
+    sy_blob *b[6];
+} rt_mesh_blobs;
+
+static void rt_mesh_blobs_release(void *user)
+{
+    rt_mesh_blobs *h = user;
+    for (int k = 0; k < 6; ++k) sy_blob_release(h->b[k]);
+    free(h);
+}
+
 static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
 {
     rt_state *st = user;
     char e[ERRLEN];
     const sy_primitive *p = a->primitive;
+    rt_mesh_blobs *held = malloc(sizeof *held);
+    if (!held) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt: mesh primitive: out of memory");
     sy_rt_mesh_desc d = {
         .positions = sy_blob_data(p->positions),
         .normals = sy_blob_data(p->normals),
@@ -275,9 +291,14 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
         .indices = sy_blob_data(p->indices),
         .vertex_count = sy_primitive_vertex_count(p),
         .triangle_count = sy_primitive_triangle_count(p),
+        .release = rt_mesh_blobs_release,
+        .release_user = held,
     };
+    sy_blob *const used[6] = {p->positions, p->normals, p->texcoords0, p->texcoords1, p->colors, p->indices};
+    for (int k = 0; k < 6; ++k) held->b[k] = sy_blob_retain(used[k]);
     sy_rt_mesh h = {0};
     sy_rt_result r = sy_rt_mesh_create(st->dev, &d, &h, e, sizeof e);
+    if (r != SY_RT_OK) rt_mesh_blobs_release(held); /* a failed create keeps nothing */
     *a->handle = h.id;
     return r == SY_RT_OK ? SY_OK : rt_fail(err, r, "mesh primitive", e);
 }
