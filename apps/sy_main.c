@@ -5,6 +5,7 @@
  *   sy info SCENE | IMAGE.exr           JSON summary (counts, bounds, warnings; an EXR's header)
  *   sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]
  *             [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]
+ *             [--max-memory MB]   (ray tracers: max_memory_mb, a scene whose BVHs need more is refused)
  *             with -b pathtracer: [--spp N | --time SECONDS] [--aov]
  *             [--filter none|pixel|atrous|jbu|adaptive|radiance [--threshold T]]
  *   world options of every command: [--env MAP.exr | --env-color R,G,B] [--env-intensity X] [--env-hidden]
@@ -157,7 +158,7 @@ enum {
     /* the commands' own long options (cluster ones: SY_CLUSTER_OPT_*, sy_cluster_cli.h) */
     OPT_SPP, OPT_TIME, OPT_AOV, OPT_CAMERA, OPT_PARAMS, OPT_GL, OPT_FILTER, OPT_THRESHOLD, OPT_HALF, OPT_EXPOSURE,
     OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
-    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB
+    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB, OPT_MAX_MEMORY
 };
 /* getopt_long entries of the options of every command, with the table's terminator: the end of
  * every command's table */
@@ -571,6 +572,7 @@ static const char usage_text[] =
             "                                       and header attributes\n"
             "  sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]\n"
             "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]\n"
+            "            [--max-memory MB]   (ray tracers: refuse a scene whose BVHs need more)\n"
             "            [--gl osmesa|egl|glfw]   (-b raster: the GL context provider)\n"
             "            [--stereo sbs|tb|anaglyph|separate] [--eye-sep M] [--zero-parallax M]\n"
             "            [--overlay FILE[:BACKEND]] [--composite depth|over|replace]\n"
@@ -948,7 +950,9 @@ static int cmd_render(int argc, char **argv)
         {"eye-sep", required_argument, NULL, OPT_EYE_SEP}, {"zero-parallax", required_argument, NULL, OPT_ZERO_PARALLAX},
         {"overlay", required_argument, NULL, OPT_OVERLAY}, {"composite", required_argument, NULL, OPT_COMPOSITE},
         {"frames", required_argument, NULL, OPT_FRAMES}, /* cluster: frames through the same window */
+        {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
         SY_CLUSTER_CLI_OPTIONS, COMMON_OPTIONS};
+    uint32_t max_memory_mb = 0;
     int c, status = 0;
     optind = 0;
     while ((c = next_option("render", argc, argv, SHORT_OPTIONS("b:o:w:h:"), lo, &status)) != -1) {
@@ -1005,6 +1009,9 @@ static int cmd_render(int argc, char **argv)
         case OPT_FRAMES:
             if (!parse_u32(optarg, 1, 100000000u, &clo.frames)) return bad_value("--frames", optarg);
             break;
+        case OPT_MAX_MEMORY:
+            if (!parse_u32(optarg, 1, 1u << 30, &max_memory_mb)) return bad_value("--max-memory", optarg);
+            break;
         default: /* --cluster ... (sy_cluster_cli.c) */
             if (!sy_cluster_cli_getopt(c, optarg, &clo)) return bad_value(option_name(lo, c), optarg);
         }
@@ -1027,6 +1034,18 @@ static int cmd_render(int argc, char **argv)
     char filter_params[512];
     if (filter || threshold) params = render_filter_params(params, filter, threshold, filter_params, sizeof filter_params);
     sy_error err = {0};
+    char memory_params[600];
+    if (max_memory_mb) { /* --max-memory MB: the back-end's declared memory limit (max_memory_mb) */
+        const sy_mediator_class *mc = sy_mediator_find(backend);
+        if (mc && !sy_param_find(&mc->param_table, "max_memory_mb")) {
+            sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--max-memory: back-end '%s' has no memory limit (no max_memory_mb "
+                         "parameter)", backend);
+            return fail(&err);
+        }
+        snprintf(memory_params, sizeof memory_params, "%s%smax_memory_mb=%u", params ? params : "",
+                 params && *params ? "," : "", max_memory_mb);
+        params = memory_params;
+    }
     if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) { /* before any loading or rendering */
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);
         return fail(&err);

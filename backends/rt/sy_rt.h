@@ -99,6 +99,11 @@ typedef struct sy_rt_light { uint32_t id; /**< index + generation; 0 = none */ }
 typedef struct sy_rt_device_desc {
     uint32_t thread_count; /**< render and Embree build threads; 0 = the OpenMP default
                             * (OMP_NUM_THREADS, else the cores this process may run on) */
+    uint64_t max_memory_bytes; /**< 0: no limit of its own. Else Embree may hold at most this many
+                                * bytes (further allocations fail with SY_RT_ERROR_OUT_OF_MEMORY).
+                                * Either way a mesh whose BVH would not fit in what is left (or in
+                                * the machine's available memory) is refused before it is built,
+                                * with the size needed and the size available. */
 } sy_rt_device_desc;
 
 /** Creates a device. desc may be NULL (defaults). Ownership: *out belongs to the caller, who

@@ -37,6 +37,9 @@ static bool embree_memory_monitor(void *user, ssize_t bytes, bool post)
 {
     (void)post;
     sy_rt_device *dev = user;
+    if (bytes > 0 && dev->max_memory > 0 &&
+        atomic_load_explicit(&dev->embree_bytes, memory_order_relaxed) + (int64_t)bytes > dev->max_memory)
+        return false; /* Embree reports RTC_ERROR_OUT_OF_MEMORY */
     int64_t now = atomic_fetch_add_explicit(&dev->embree_bytes, (int64_t)bytes, memory_order_relaxed) + (int64_t)bytes;
     int64_t peak = atomic_load_explicit(&dev->embree_peak, memory_order_relaxed);
     while (now > peak && !atomic_compare_exchange_weak_explicit(&dev->embree_peak, &peak, now, memory_order_relaxed,
@@ -58,6 +61,8 @@ sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **o
     uint32_t threads = desc ? desc->thread_count : 0;
     if (threads > 1024) threads = 1024;
     dev->thread_count = threads; /* 0: the OpenMP default team size, looked up per render */
+    uint64_t limit = desc ? desc->max_memory_bytes : 0;
+    dev->max_memory = limit > (uint64_t)INT64_MAX ? INT64_MAX : (int64_t)limit;
 
     char config[64];
     snprintf(config, sizeof config, "threads=%d", sy_rt_render_threads(dev));

@@ -130,6 +130,7 @@ struct sy_rt_device {
     /* memory accounting: mesh arrays (own copies, shared), Embree's allocations (memory monitor) */
     uint64_t mesh_bytes, shared_bytes;
     _Atomic int64_t embree_bytes, embree_peak;
+    int64_t max_memory; /* sy_rt_device_desc.max_memory_bytes (0 = none) */
 };
 
 /* Checked size arithmetic: false on overflow. */

@@ -67,7 +67,10 @@ static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel
      0},                                                                                                             \
     {"threads", SY_PARAM_INT, 0, 1024, "0", NULL, "worker threads (0 = OpenMP's default: OMP_NUM_THREADS, else all cores)", 0},                             \
     {"specular", SY_PARAM_FLOAT, 0, 1, "1", NULL,                                                                   \
-     "KHR_materials_specular factor of every material (0: dielectrics purely Lambertian)", 0}
+     "KHR_materials_specular factor of every material (0: dielectrics purely Lambertian)", 0},                       \
+    {"max_memory_mb", SY_PARAM_INT, 0, 1 << 30, "0", NULL,                                                          \
+     "MB Embree may hold (0: no limit of its own); a mesh whose BVH needs more than is left, or than the machine "  \
+     "has available, is refused with both sizes", 0}
 static const sy_param_decl whitted_params[] = {
     {"spp", SY_PARAM_INT, 1, 256, "4", NULL, "camera rays per pixel (stratified, jittered; 1 = the pixel centre)", 0},
     {"env_samples", SY_PARAM_INT, 1, 256, "4", NULL, "environment-light samples per shading point and pixel sample", 0},
@@ -1076,7 +1079,7 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     const sy_param_table *t = integrator == SY_RT_INTEGRATOR_WHITTED      ? &whitted_table
                               : integrator == SY_RT_INTEGRATOR_PATHTRACER ? &pt_table
                                                                           : &coverage_table;
-    long max_depth = 8, light_samples = 16, threads = 0, spp = 1, env_samples = 4; /* spp, env: Whitted's */
+    long max_depth = 8, light_samples = 16, threads = 0, spp = 1, env_samples = 4, max_memory_mb = 0; /* spp, env: Whitted's */
     double specular = 1.0;
     sy_result r;
     if (integrator == SY_RT_INTEGRATOR_WHITTED && ((r = sy_param_int(t, args->params, "spp", &spp, err)) ||
@@ -1085,12 +1088,13 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     if ((r = sy_param_int(t, args->params, "max_depth", &max_depth, err)) ||
         (r = sy_param_int(t, args->params, "light_samples", &light_samples, err)) ||
         (r = sy_param_int(t, args->params, "threads", &threads, err)) ||
-        (r = sy_param_float(t, args->params, "specular", &specular, err)))
+        (r = sy_param_float(t, args->params, "specular", &specular, err)) ||
+        (r = sy_param_int(t, args->params, "max_memory_mb", &max_memory_mb, err)))
         return r;
     rt_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt mediator: out of memory");
     char e[ERRLEN];
-    sy_rt_device_desc dd = {(uint32_t)threads};
+    sy_rt_device_desc dd = {(uint32_t)threads, (uint64_t)max_memory_mb << 20};
     sy_rt_result rr = sy_rt_device_create(&dd, &st->dev, e, sizeof e);
     if (rr != SY_RT_OK) {
         free(st);

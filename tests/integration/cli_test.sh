@@ -221,6 +221,17 @@ run bench_memory_bad "$SY" bench memory -b raster --tris 2000
 [ "$rc" -eq 1 ] && grep -q 'expected one of the ray tracers' "$TMP/bench_memory_bad.err" ||
     fail "bench memory -b raster: status $rc, $(cat "$TMP/bench_memory_bad.err")"
 cat "$TMP/bench_memory.out"
+# --max-memory: a scene over the ray tracer's memory limit is refused with the sizes, not killed
+run max_memory "$SY" render demo -b whitted --max-memory 1 -w 16 -h 16 -o "$TMP/max_memory.png"
+[ "$rc" -eq 1 ] && grep -Eq 'memory limit of 1\.0 MB' "$TMP/max_memory.err" && [ ! -e "$TMP/max_memory.png" ] ||
+    fail "--max-memory 1: status $rc, $(cat "$TMP/max_memory.err")"
+run max_memory_ok "$SY" render demo -b whitted --max-memory 256 -w 16 -h 16 -o "$TMP/max_memory.png"
+[ "$rc" -eq 0 ] || fail "--max-memory 256: status $rc, $(cat "$TMP/max_memory_ok.err")"
+if has raster; then
+    run max_memory_raster "$SY" render demo -b raster --max-memory 256 -w 16 -h 16 -o "$TMP/max_memory.png"
+    [ "$rc" -eq 1 ] && grep -q 'has no memory limit' "$TMP/max_memory_raster.err" ||
+        fail "--max-memory with -b raster: status $rc, $(cat "$TMP/max_memory_raster.err")"
+fi
 
 # demo
 run demo "$SY" demo -o "$TMP/demo" -w 64 -h 36

@@ -205,6 +205,49 @@ static void test_shared_mesh(void)
     free(img[1]);
 }
 
+/* Scenes too big for the device's memory limit are refused with the size needed and the size
+ * available, before Embree builds anything. */
+static void test_memory_limit(void)
+{
+    char err[256];
+    sy_rt_device_desc dd = {.max_memory_bytes = 1u << 20};
+    sy_rt_device *dev = NULL;
+    MUST(sy_rt_device_create(&dd, &dev, ERR));
+    enum { G = 100 }; /* 2 G^2 = 20000 triangles: about 2.4 MB of BVH */
+    float *pos = malloc((G + 1) * (G + 1) * 3 * sizeof(float));
+    uint32_t *idx = malloc(G * G * 6 * sizeof(uint32_t));
+    for (uint32_t z = 0, v = 0; z <= G; ++z)
+        for (uint32_t x = 0; x <= G; ++x, ++v) pos[3 * v] = (float)x, pos[3 * v + 1] = 0, pos[3 * v + 2] = (float)z;
+    for (uint32_t z = 0, k = 0; z < G; ++z)
+        for (uint32_t x = 0; x < G; ++x) {
+            uint32_t a = z * (G + 1) + x, b = a + G + 1;
+            idx[k++] = a, idx[k++] = b, idx[k++] = a + 1, idx[k++] = a + 1, idx[k++] = b, idx[k++] = b + 1;
+        }
+    sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = (G + 1) * (G + 1), .triangle_count = 2 * G * G};
+    sy_rt_mesh m;
+    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    float xf[16];
+    rt_identity(xf);
+    sy_rt_instance_desc id = {.mesh = m};
+    memcpy(id.transform, xf, sizeof xf);
+    sy_rt_instance inst;
+    err[0] = 0;
+    CHECK(sy_rt_instance_create(dev, &id, &inst, err, sizeof err) == SY_RT_ERROR_OUT_OF_MEMORY,
+          "a BVH over the device's memory limit was built");
+    CHECK(strstr(err, "20000 triangles needs about 2.4 MB") && strstr(err, "MB left under the device's memory limit"),
+          "message was '%s'", err);
+    sy_rt_device_destroy(dev);
+    /* without a limit of its own the device builds it */
+    MUST(sy_rt_device_create(NULL, &dev, ERR));
+    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    id.mesh = m;
+    MUST(sy_rt_instance_create(dev, &id, &inst, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_device_destroy(dev);
+    free(pos);
+    free(idx);
+}
+
 int main(void)
 {
     sy_rt_device *dev = rt_device();
@@ -214,5 +257,6 @@ int main(void)
     test_progress(dev);
     sy_rt_device_destroy(dev);
     test_shared_mesh();
+    test_memory_limit();
     return rt_finish("test_rt_api");
 }
