@@ -426,6 +426,7 @@ sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const cha
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <signal.h>
 #include <unistd.h>
 
 static int cmp_cstr(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
@@ -665,6 +666,253 @@ sy_result sy_bench_load(const char *data_dir, uint32_t tris, uint32_t repeats, s
     unlink(path);
     rmdir(dir);
     return r;
+}
+
+/* >>memory (issue 19): peak RSS per triangle of a generated height field, rendered by a ray
+ * tracer in a forked child (each measurement starts from a clean process). */
+
+/* Resident high-water mark of this process in KiB (/proc/self/status VmHWM, else ru_maxrss). */
+static long rss_peak_kib(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    long kib = -1;
+    char line[256];
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "VmHWM: %ld kB", &kib) == 1) break;
+    if (f) fclose(f);
+    if (kib < 0) {
+        struct rusage ru;
+        getrusage(RUSAGE_SELF, &ru);
+        kib = ru.ru_maxrss;
+    }
+    return kib;
+}
+
+/* Adds a height field of about `tris` unique triangles (a (g+1)^2-vertex grid of 2 g^2 triangles,
+ * 1 x 1 m in XZ, heights from a few sines; positions, normals, one UV set, uint32 indices, one
+ * blob each) to s as one mesh under *node_out. */
+sy_result sy_bench_height_field(sy_scene *s, uint32_t tris, sy_node *node_out, uint32_t *tris_out, sy_error *err)
+{
+    uint32_t g = (uint32_t)ceil(sqrt((double)tris / 2.0));
+    if (g < 1) g = 1;
+    if ((uint64_t)(g + 1) * (g + 1) > UINT32_MAX / 3u || (uint64_t)g * g * 6u > UINT32_MAX)
+        return sy_error_set(err, SY_ERR_LIMIT, "height field: %u triangles exceed the index range", tris);
+    size_t nv = (size_t)(g + 1) * (g + 1), nt = (size_t)g * g * 2;
+    float *pos = malloc(nv * 3 * sizeof(float)), *nrm = malloc(nv * 3 * sizeof(float)), *uv = malloc(nv * 2 * sizeof(float));
+    uint32_t *idx = malloc(nt * 3 * sizeof(uint32_t));
+    sy_blob *bp = NULL, *bn = NULL, *bu = NULL, *bi = NULL;
+    sy_result r = SY_OK;
+    if (!pos || !nrm || !uv || !idx) {
+        r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "height field: out of memory for %u triangles", 2 * g * g);
+        goto done;
+    }
+    const float a = 0.04f, kx = 23.0f, kz = 17.0f;
+    for (uint32_t z = 0; z <= g; ++z)
+        for (uint32_t x = 0; x <= g; ++x) {
+            size_t v = (size_t)z * (g + 1) + x;
+            float fx = (float)x / (float)g, fz = (float)z / (float)g;
+            float sx = sinf(kx * fx), cx = cosf(kx * fx), sz = sinf(kz * fz), cz = cosf(kz * fz);
+            float h = a * sx * cz + 0.5f * a * sinf(3.1f * kx * fx + 2.3f * kz * fz);
+            float dx = a * kx * cx * cz + 0.5f * a * 3.1f * kx * cosf(3.1f * kx * fx + 2.3f * kz * fz);
+            float dz = -a * kz * sx * sz + 0.5f * a * 2.3f * kz * cosf(3.1f * kx * fx + 2.3f * kz * fz);
+            float il = 1.0f / sqrtf(dx * dx + 1.0f + dz * dz);
+            pos[3 * v] = fx - 0.5f, pos[3 * v + 1] = h, pos[3 * v + 2] = fz - 0.5f;
+            nrm[3 * v] = -dx * il, nrm[3 * v + 1] = il, nrm[3 * v + 2] = -dz * il;
+            uv[2 * v] = fx, uv[2 * v + 1] = fz;
+        }
+    size_t k = 0;
+    for (uint32_t z = 0; z < g; ++z)
+        for (uint32_t x = 0; x < g; ++x) {
+            uint32_t v0 = z * (g + 1) + x, v1 = v0 + g + 1;
+            idx[k++] = v0, idx[k++] = v1, idx[k++] = v0 + 1;
+            idx[k++] = v0 + 1, idx[k++] = v1, idx[k++] = v1 + 1;
+        }
+    if ((r = sy_blob_create_take(pos, nv * 3 * sizeof(float), &bp, err)) != SY_OK) goto done;
+    pos = NULL;
+    if ((r = sy_blob_create_take(nrm, nv * 3 * sizeof(float), &bn, err)) != SY_OK) goto done;
+    nrm = NULL;
+    if ((r = sy_blob_create_take(uv, nv * 2 * sizeof(float), &bu, err)) != SY_OK) goto done;
+    uv = NULL;
+    if ((r = sy_blob_create_take(idx, nt * 3 * sizeof(uint32_t), &bi, err)) != SY_OK) goto done;
+    idx = NULL;
+    sy_material_data md = *(const sy_material_data *)sy_object_defaults(SY_TYPE_MATERIAL);
+    md.base_color[0] = 0.7f, md.base_color[1] = 0.6f, md.base_color[2] = 0.5f;
+    md.roughness = 0.8f, md.metallic = 0.0f;
+    sy_material mat;
+    sy_mesh mesh;
+    if ((r = sy_material_create(s, "ground", &mat, err)) || (r = sy_material_set(s, mat, &md, err))) goto done;
+    sy_primitive p = {.positions = bp, .normals = bn, .texcoords0 = bu, .indices = bi, .material = mat};
+    if ((r = sy_mesh_create(s, "height field", &mesh, err)) || (r = sy_mesh_set_primitives(s, mesh, &p, 1, err)) ||
+        (r = sy_node_create(s, "height field", node_out, err)) || (r = sy_node_set_mesh(s, *node_out, mesh, err)))
+        goto done;
+    *tris_out = (uint32_t)nt;
+done:
+    free(pos), free(nrm), free(uv), free(idx);
+    sy_blob_release(bp), sy_blob_release(bn), sy_blob_release(bu), sy_blob_release(bi);
+    return r;
+}
+
+#ifdef SY_HAVE_EMBREE
+typedef struct mem_report {
+    int ok;
+    char message[sizeof(((sy_error *)0)->message)];
+    uint32_t tris;
+    long base_kib, scene_kib, peak_kib;    /* RSS at the start, after the scene, high-water mark */
+    double blob_bytes, build_s, frame_s;  /* scene blob payload; translation; one frame */
+    sy_mediator_rt_counters c;
+} mem_report;
+
+/* The child: scene -> commit -> context (translation) -> one frame; fills *o. */
+static void mem_measure(uint32_t tris, const char *glb, const char *backend, uint32_t width, uint32_t height, mem_report *o)
+{
+    sy_error err = {0};
+    sy_scene *s = NULL;
+    sy_window *win = NULL;
+    sy_context_pool *pool = NULL;
+    sy_context *ctx = NULL;
+    sy_layer img = {0};
+    sy_node node = {0};
+    o->base_kib = rss_now_kib();
+    sy_result r = sy_scene_create(&s, &err);
+    if (r == SY_OK && glb) {
+        sy_gltf_info info = {0};
+        r = sy_gltf_load(glb, s, NULL, &info, &err);
+        o->tris = info.counts.triangles;
+        sy_gltf_info_free(&info);
+    } else if (r == SY_OK) {
+        r = sy_bench_height_field(s, tris, &node, &o->tris, &err);
+    }
+    if (r == SY_OK) r = sy_scene_commit(s, NULL, &err);
+    o->scene_kib = rss_now_kib();
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_MESH, 0); r == SY_OK && id; id = sy_scene_next(s, SY_TYPE_MESH, id)) {
+        const sy_mesh_data *m = sy_object_get(s, SY_TYPE_MESH, id);
+        for (uint32_t i = 0; i < m->primitives.count; ++i) {
+            const sy_primitive *p = &m->primitives.items[i];
+            o->blob_bytes += (double)(sy_blob_size(p->positions) + sy_blob_size(p->normals) + sy_blob_size(p->tangents) +
+                                      sy_blob_size(p->texcoords0) + sy_blob_size(p->texcoords1) +
+                                      sy_blob_size(p->colors) + sy_blob_size(p->indices));
+        }
+    }
+    sy_viewport_desc vd = {.root = node, .backend = backend}; /* .glb: node {0} = every root */
+    const sy_mediator_class *cls = sy_mediator_find(backend);
+    sy_window_render_opts ro = {.sample_count = cls && (sy_mediator_class_caps(cls, NULL) & SY_CAP_PROGRESSIVE) ? 1u : 0u};
+    sy_params pp = {0};
+    double t0 = sy_time_now();
+    if (r == SY_OK) r = sy_window_create(width, height, &win, &err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, NULL, &err);
+    if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
+    if (r == SY_OK) r = sy_layer_create(width, height, &img, &err);
+    if (r == SY_OK) r = sy_context_pool_get(pool, s, backend, &pp, node.id, &ctx, &err);
+    if (r == SY_OK) r = sy_context_sync(ctx, &err);
+    double t1 = sy_time_now();
+    if (r == SY_OK) r = sy_window_render(win, s, pool, &ro, &img, &err);
+    double t2 = sy_time_now();
+    o->build_s = t1 - t0;
+    o->frame_s = t2 - t1;
+    o->peak_kib = rss_peak_kib();
+    if (r == SY_OK) sy_mediator_rt_counters_get(sy_context_state(ctx), &o->c);
+    o->ok = r == SY_OK;
+    if (r != SY_OK) snprintf(o->message, sizeof o->message, "%s", err.message);
+    /* the process ends here: nothing is freed (the parent reads the report) */
+    (void)img;
+}
+
+/* Runs mem_measure in a forked child and returns its report through a pipe. */
+static sy_result mem_run(uint32_t tris, const char *glb, const char *backend, uint32_t width, uint32_t height, mem_report *o,
+                         sy_error *err)
+{
+    memset(o, 0, sizeof *o);
+    int fds[2];
+    if (pipe(fds) != 0) return sy_error_set(err, SY_ERR_IO, "bench memory: pipe failed");
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid < 0) {
+        close(fds[0]), close(fds[1]);
+        return sy_error_set(err, SY_ERR_IO, "bench memory: fork failed");
+    }
+    if (pid == 0) {
+        close(fds[0]);
+        mem_report rep;
+        memset(&rep, 0, sizeof rep);
+        mem_measure(tris, glb, backend, width, height, &rep);
+        ssize_t w = write(fds[1], &rep, sizeof rep);
+        _exit(w == (ssize_t)sizeof rep ? 0 : 1);
+    }
+    close(fds[1]);
+    size_t got = 0;
+    while (got < sizeof *o) {
+        ssize_t n = read(fds[0], (char *)o + got, sizeof *o - got);
+        if (n <= 0) break;
+        got += (size_t)n;
+    }
+    close(fds[0]);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (got != sizeof *o) {
+        if (WIFSIGNALED(status))
+            return sy_error_set(err, SY_ERR_IO, "bench memory: %s: the measuring process was killed by signal %d%s", backend,
+                                WTERMSIG(status), WTERMSIG(status) == SIGKILL ? " (out of memory?)" : "");
+        return sy_error_set(err, SY_ERR_IO, "bench memory: %s: the measuring process gave no report", backend);
+    }
+    if (!o->ok) return sy_error_set(err, SY_ERR_IO, "bench memory: %s: %s", backend, o->message);
+    return SY_OK;
+}
+#endif
+
+sy_result sy_bench_memory(uint32_t tris, const char *backend, bool glb, uint32_t width, uint32_t height, sy_error *err)
+{
+#ifndef SY_HAVE_EMBREE
+    (void)tris, (void)backend, (void)glb, (void)width, (void)height;
+    SY_BENCH_WITHOUT(err, "memory (whitted, pathtracer)", "SY_WITH_EMBREE");
+#else
+    static const char *const both[] = {"whitted", "pathtracer"};
+    const char *const *list = backend ? &backend : both;
+    const sy_mediator_class *cls = backend ? sy_mediator_find(backend) : NULL;
+    if (backend && (!cls || (cls != sy_mediator_rt_whitted_class() && cls != sy_mediator_rt_pathtracer_class())))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "bench memory: -b %s: expected one of the ray tracers (whitted, pathtracer)",
+                            backend);
+    uint32_t n = backend ? 1u : 2u;
+    printf("sy bench memory: a height field of ~%u unique triangles (positions, normals, UVs, uint32 indices)\n"
+           "%s, the mediator and the back-end, one %ux%u frame, in a forked child each;\n"
+           "peak = the child's RSS high-water mark (VmHWM) less its RSS at the start\n\n",
+           tris, glb ? "loaded from a .glb (sy_gltf_load), through the scene's blobs" : "through the scene's blobs", width,
+           height);
+    char dir[] = "/tmp/sy_bench_memory_XXXXXX", path[128] = "";
+    sy_result r = SY_OK;
+    if (glb) {
+        if (!mkdtemp(dir)) return sy_error_set(err, SY_ERR_IO, "bench memory: cannot create a temporary directory");
+        snprintf(path, sizeof path, "%s/height_field.glb", dir);
+        uint32_t grid = (uint32_t)ceil(sqrt((double)tris / 2.0));
+        r = write_grid_glb(path, grid, err);
+    }
+    for (uint32_t i = 0; i < n && r == SY_OK; ++i) {
+        mem_report o;
+        if ((r = mem_run(tris, glb ? path : NULL, list[i], width, height, &o, err)) != SY_OK) break;
+        double t = (double)o.tris, peak = (double)(o.peak_kib - o.base_kib) * 1024.0;
+        double scene = (double)(o.scene_kib - o.base_kib) * 1024.0;
+        const sy_mediator_rt_counters *c = &o.c;
+        printf("%s: %u triangles, translation %.2f s, first frame %.2f s\n", list[i], o.tris, o.build_s, o.frame_s);
+        printf("  peak RSS                      %9.1f MB  %7.1f bytes/triangle\n", peak / 1e6, peak / t);
+        printf("  scene (RSS after commit)      %9.1f MB  %7.1f bytes/triangle\n", scene / 1e6, scene / t);
+        printf("    of which mesh blobs         %9.1f MB  %7.1f bytes/triangle\n", o.blob_bytes / 1e6, o.blob_bytes / t);
+        printf("  back-end copies (normals, UV) %9.1f MB  %7.1f bytes/triangle\n", (double)c->mesh_bytes / 1e6,
+               (double)c->mesh_bytes / t);
+        printf("  shared with the blobs         %9.1f MB  %7.1f bytes/triangle  (not counted again)\n",
+               (double)c->shared_bytes / 1e6, (double)c->shared_bytes / t);
+        printf("  Embree now (buffers, BVH)     %9.1f MB  %7.1f bytes/triangle\n", (double)c->embree_bytes / 1e6,
+               (double)c->embree_bytes / t);
+        printf("  Embree peak (+ build scratch) %9.1f MB  %7.1f bytes/triangle\n", (double)c->embree_peak_bytes / 1e6,
+               (double)c->embree_peak_bytes / t);
+        double rest = peak - scene - (double)c->mesh_bytes - (double)c->embree_peak_bytes;
+        printf("  rest (frame buffers, threads) %9.1f MB  %7.1f bytes/triangle\n", rest / 1e6, rest / t);
+        fflush(stdout);
+    }
+    if (glb) {
+        unlink(path);
+        rmdir(dir);
+    }
+    return r;
+#endif
 }
 
 /* >>pathtracer (issue 3): samples/s and Mrays/s of the path tracer next to the Whitted back-end on

@@ -5,6 +5,7 @@
  *   sy info SCENE | IMAGE.exr           JSON summary (counts, bounds, warnings; an EXR's header)
  *   sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]
  *             [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]
+ *             [--max-memory MB]   (ray tracers: max_memory_mb, a scene whose BVHs need more is refused)
  *             with -b pathtracer: [--spp N | --time SECONDS] [--aov]
  *             [--filter none|pixel|atrous|jbu|adaptive|radiance [--threshold T]]
  *   world options of every command: [--env MAP.exr | --env-color R,G,B] [--env-intensity X] [--env-hidden]
@@ -16,6 +17,7 @@
  *   sy bench rays [SCENE] [-w W] [-h H] [--repeats R]
  *   sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params k=v,...]
  *   sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]
+ *   sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   peak RSS per triangle (sy_bench.h)
  *   sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]
  *   sy backends [--params] [--json]     list registered back-ends (--params: their parameters)
  *   sy serve [--listen URL] [--secret-file F] [--output OUT]   render server (apps/sy_cluster_cli.c)
@@ -156,7 +158,7 @@ enum {
     /* the commands' own long options (cluster ones: SY_CLUSTER_OPT_*, sy_cluster_cli.h) */
     OPT_SPP, OPT_TIME, OPT_AOV, OPT_CAMERA, OPT_PARAMS, OPT_GL, OPT_FILTER, OPT_THRESHOLD, OPT_HALF, OPT_EXPOSURE,
     OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
-    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON
+    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB, OPT_MAX_MEMORY
 };
 /* getopt_long entries of the options of every command, with the table's terminator: the end of
  * every command's table */
@@ -570,6 +572,7 @@ static const char usage_text[] =
             "                                       and header attributes\n"
             "  sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]\n"
             "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]\n"
+            "            [--max-memory MB]   (ray tracers: refuse a scene whose BVHs need more)\n"
             "            [--gl osmesa|egl|glfw]   (-b raster: the GL context provider)\n"
             "            [--stereo sbs|tb|anaglyph|separate] [--eye-sep M] [--zero-parallax M]\n"
             "            [--overlay FILE[:BACKEND]] [--composite depth|over|replace]\n"
@@ -591,6 +594,7 @@ static const char usage_text[] =
             "  sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params gl=egl,msaa=4]\n"
             "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
             "  sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]\n"
+            "  sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   (peak RSS per triangle)\n"
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy backends [--params] [--json]\n"
             "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
@@ -946,7 +950,9 @@ static int cmd_render(int argc, char **argv)
         {"eye-sep", required_argument, NULL, OPT_EYE_SEP}, {"zero-parallax", required_argument, NULL, OPT_ZERO_PARALLAX},
         {"overlay", required_argument, NULL, OPT_OVERLAY}, {"composite", required_argument, NULL, OPT_COMPOSITE},
         {"frames", required_argument, NULL, OPT_FRAMES}, /* cluster: frames through the same window */
+        {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
         SY_CLUSTER_CLI_OPTIONS, COMMON_OPTIONS};
+    uint32_t max_memory_mb = 0;
     int c, status = 0;
     optind = 0;
     while ((c = next_option("render", argc, argv, SHORT_OPTIONS("b:o:w:h:"), lo, &status)) != -1) {
@@ -1003,6 +1009,9 @@ static int cmd_render(int argc, char **argv)
         case OPT_FRAMES:
             if (!parse_u32(optarg, 1, 100000000u, &clo.frames)) return bad_value("--frames", optarg);
             break;
+        case OPT_MAX_MEMORY:
+            if (!parse_u32(optarg, 1, 1u << 30, &max_memory_mb)) return bad_value("--max-memory", optarg);
+            break;
         default: /* --cluster ... (sy_cluster_cli.c) */
             if (!sy_cluster_cli_getopt(c, optarg, &clo)) return bad_value(option_name(lo, c), optarg);
         }
@@ -1025,6 +1034,18 @@ static int cmd_render(int argc, char **argv)
     char filter_params[512];
     if (filter || threshold) params = render_filter_params(params, filter, threshold, filter_params, sizeof filter_params);
     sy_error err = {0};
+    char memory_params[600];
+    if (max_memory_mb) { /* --max-memory MB: the back-end's declared memory limit (max_memory_mb) */
+        const sy_mediator_class *mc = sy_mediator_find(backend);
+        if (mc && !sy_param_find(&mc->param_table, "max_memory_mb")) {
+            sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--max-memory: back-end '%s' has no memory limit (no max_memory_mb "
+                         "parameter)", backend);
+            return fail(&err);
+        }
+        snprintf(memory_params, sizeof memory_params, "%s%smax_memory_mb=%u", params ? params : "",
+                 params && *params ? "," : "", max_memory_mb);
+        params = memory_params;
+    }
     if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) { /* before any loading or rendering */
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);
         return fail(&err);
@@ -1634,7 +1655,8 @@ static int cmd_bench_filters(int argc, char **argv)
 /* sy bench KIND ...: argv[0] is "bench", argv[1] the kind. */
 static int cmd_bench(int argc, char **argv)
 {
-    static const char *const kinds[] = {"sync", "rays", "pathtracer", "filters", "raster", "viewports", "load", "cluster"};
+    static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
+                                        "viewports", "load", "cluster",    "memory"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -1650,24 +1672,32 @@ static int cmd_bench(int argc, char **argv)
     if (!strcmp(cmd, "filters")) return cmd_bench_filters(argc, argv);
     if (!strcmp(cmd, "cluster")) return sy_cmd_bench_cluster(argc, argv);
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
-    const char *scene = NULL, *params = NULL;
+    const char *scene = NULL, *params = NULL, *backend = NULL;
+    bool memory = !strcmp(cmd, "memory");
     static const struct option lo[] = {{"params", required_argument, NULL, OPT_PARAMS},
                                        {"nodes", required_argument, NULL, OPT_NODES},
                                        {"tris", required_argument, NULL, OPT_TRIS},
+                                       {"glb", no_argument, NULL, OPT_GLB},
                                        {"repeats", required_argument, NULL, OPT_REPEATS}, COMMON_OPTIONS};
     char who[32];
     snprintf(who, sizeof who, "bench %s", cmd);
+    bool glb = false;
     int c, status = 0;
     optind = 0;
-    while ((c = next_option(who, argc, argv, SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
+    while ((c = next_option(who, argc, argv, memory ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
         switch (c) {
         case OPT_STOP: return status;
         case OPT_PARAMS: params = optarg; break; /* bench raster */
+        case 'b': backend = optarg; break; /* bench memory */
+        case OPT_GLB:
+            if (!memory) return usage_of(who, "--glb is an option of sy bench memory");
+            glb = true;
+            break;
         case OPT_NODES:
             if (!parse_u32(optarg, 1, 1u << 22, &nodes)) return bad_value("--nodes", optarg);
             break;
         case OPT_TRIS:
-            if (!parse_u32(optarg, 12, 1u << 20, &tris)) return bad_value("--tris", optarg);
+            if (!parse_u32(optarg, 12, memory ? 1u << 30 : 1u << 20, &tris)) return bad_value("--tris", optarg);
             break;
         case OPT_REPEATS:
             if (!parse_u32(optarg, 1, 100000, &repeats)) return bad_value("--repeats", optarg);
@@ -1690,6 +1720,12 @@ static int cmd_bench(int argc, char **argv)
                    : fail(&err);
     if (!strcmp(cmd, "raster")) return cmd_bench_raster(scene, w, h, repeats, params);
     if (!strcmp(cmd, "pathtracer")) return cmd_bench_pathtracer(scene, w, h, repeats);
+    if (memory) {
+        if (optind < argc) return usage_of(who, "no SCENE: the height field is generated");
+        return sy_bench_memory(tris == 100 ? 1000000 : tris, backend, glb, w == 512 ? 256 : w, h == 512 ? 256 : h, &err) == SY_OK
+                   ? 0
+                   : fail(&err);
+    }
     if (!strcmp(cmd, "load")) /* SCENE = the glTF sample directory; --tris: generated model (default 1M) */
         return sy_bench_load(scene ? scene : "../shared/testdata/gltf", tris == 100 ? 1000000 : tris,
                              repeats ? repeats : 3, &err) == SY_OK ? 0 : fail(&err);

@@ -29,8 +29,17 @@ sy_result sy_blob_create_take(void *data, size_t size, sy_blob **out, sy_error *
 {
     *out = NULL;
     if (!data && size) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "blob: NULL data with size %zu", size);
+    if (size > SIZE_MAX - SY_BLOB_PADDING) return sy_error_set(err, SY_ERR_LIMIT, "blob: %zu bytes is too large", size);
     sy_blob *b = malloc(sizeof *b);
     if (!b) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "blob: out of memory");
+    /* SY_BLOB_PADDING readable bytes after the data: realloc keeps a large (mmapped) block where it
+     * is or remaps it, so this costs no copy of bulk data */
+    void *padded = realloc(data, size + SY_BLOB_PADDING);
+    if (!padded) {
+        free(b);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "blob: out of memory for %zu bytes", size + SY_BLOB_PADDING);
+    }
+    data = padded;
     atomic_init(&b->refs, 1);
     b->size = size;
     b->data = data;
@@ -44,9 +53,11 @@ sy_result sy_blob_create_copy(const void *data, size_t size, sy_blob **out, sy_e
 {
     *out = NULL;
     if (!data && size) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "blob: NULL data with size %zu", size);
-    void *copy = malloc(size ? size : 1);
+    if (size > SIZE_MAX - SY_BLOB_PADDING) return sy_error_set(err, SY_ERR_LIMIT, "blob: %zu bytes is too large", size);
+    char *copy = malloc(size + SY_BLOB_PADDING);
     if (!copy) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "blob: out of memory for %zu bytes", size);
     if (size) memcpy(copy, data, size);
+    memset(copy + size, 0, SY_BLOB_PADDING);
     sy_result r = sy_blob_create_take(copy, size, out, err);
     if (r != SY_OK) free(copy);
     return r;

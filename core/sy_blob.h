@@ -20,6 +20,11 @@
 extern "C" {
 #endif
 
+/** Every blob's data is followed by at least this many readable bytes (zero for a copied blob), so
+ * a consumer may hand the data to a library that reads past the last element in place, as
+ * Embree's SIMD loads do on vertex buffers (mediators/rt shares blobs with Embree). */
+#define SY_BLOB_PADDING 16u
+
 /** An immutable, reference-counted, content-hashed byte array (opaque). */
 typedef struct sy_blob sy_blob;
 
@@ -31,7 +36,8 @@ typedef struct sy_hash128 {
 
 /** Copies size bytes from data. size may be 0 (data may then be NULL). */
 sy_result sy_blob_create_copy(const void *data, size_t size, sy_blob **out, sy_error *err);
-/** Takes ownership of malloc()ed data on success only (on failure the caller still owns it). */
+/** Takes ownership of malloc()ed data on success only (on failure the caller still owns it). The
+ * allocation is grown by SY_BLOB_PADDING bytes (realloc: the pointer may change). */
 sy_result sy_blob_create_take(void *data, size_t size, sy_blob **out, sy_error *err);
 
 sy_blob *sy_blob_retain(sy_blob *b); /**< returns b; NULL-safe */

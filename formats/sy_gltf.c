@@ -1592,6 +1592,10 @@ static sy_result load_common(const char *path, const void *mem, size_t mem_size,
                                L.opt.allowed_root_count};
     r = sy_gltf_shim_parse(b, size, binary, base, &lim, &doc, &L.err);
     free(base);
+    /* the document holds its own copy of every buffer: the file's bytes go before the scene's blobs
+     * are made (a 10^7-triangle .glb peaks at one copy of it less) */
+    free(bytes);
+    bytes = NULL;
     if (r) {
         sy_error_prefix(&L.err, "%s: %s", path, r == SY_ERR_PARSE ? "invalid glTF" : "cannot load");
         goto out;

@@ -7,7 +7,8 @@
  *
  * Object model
  *   sy_rt_device   owns everything: Embree device, top-level scene, object pools.
- *   sy_rt_mesh     a prototype triangle mesh (its own Embree scene / BLAS). Data is copied.
+ *   sy_rt_mesh     a prototype triangle mesh (its own Embree scene / BLAS). Data is copied, or
+ *                  shared in place when the caller passes a release callback (sy_rt_mesh_desc).
  *   sy_rt_instance a mesh placed in the world with a transform and a material; either an Embree
  *                  instance of the mesh's BLAS, or (SY_RT_INSTANCE_BAKED) world-space triangles
  *                  merged into the top-level BVH.
@@ -98,6 +99,11 @@ typedef struct sy_rt_light { uint32_t id; /**< index + generation; 0 = none */ }
 typedef struct sy_rt_device_desc {
     uint32_t thread_count; /**< render and Embree build threads; 0 = the OpenMP default
                             * (OMP_NUM_THREADS, else the cores this process may run on) */
+    uint64_t max_memory_bytes; /**< 0: no limit of its own. Else Embree may hold at most this many
+                                * bytes (further allocations fail with SY_RT_ERROR_OUT_OF_MEMORY).
+                                * Either way a mesh whose BVH would not fit in what is left (or in
+                                * the machine's available memory) is refused before it is built,
+                                * with the size needed and the size available. */
 } sy_rt_device_desc;
 
 /** Creates a device. desc may be NULL (defaults). Ownership: *out belongs to the caller, who
@@ -120,13 +126,23 @@ typedef struct sy_rt_stats {
     /** Seconds Embree's rtcCommitScene of the top-level scene took in the last sy_rt_commit (0 when
      * that commit did not rebuild it): the part of a commit that is Embree's, not ours. */
     double last_top_commit_seconds;
+    /** @{ memory: bytes of mesh arrays the back-end allocated itself (copies: shading normals,
+     * texture coordinates, colours; not Embree's), bytes of mesh arrays shared with the caller
+     * (sy_rt_mesh_desc.release), and Embree's own allocations now and at their peak (geometry
+     * buffers, BVHs, build scratch; counted by rtcSetDeviceMemoryMonitorFunction) */
+    uint64_t mesh_bytes, shared_bytes, embree_bytes, embree_peak_bytes; /** @} */
 } sy_rt_stats;
 /** Fills *out with the device's live object counts and version. */
 void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out);
 
 /* >>mesh */
 
-/** Triangle mesh. Ownership: every array is COPIED; the caller may free its arrays after the call.
+/** Triangle mesh. Ownership: without `release`, every array is COPIED and the caller may free its
+ * arrays after the call. With `release`, nothing is copied: the back-end (and Embree, through
+ * rtcSetSharedGeometryBuffer) reads the arrays in place until it calls release(release_user) exactly
+ * once, when the mesh handle and its last instance are gone; the arrays must not change meanwhile,
+ * and positions must stay readable for 16 bytes past its last element (Embree's SIMD loads). When
+ * sy_rt_mesh_create fails, release is not called (the caller still owns the arrays).
  * Positions are required and must be finite. Optional arrays are NULL when absent; when present
  * they hold vertex_count elements. Without indices the mesh is a non-indexed triangle list and
  * vertex_count must equal 3 * triangle_count. With indices there are 3 * triangle_count indices
@@ -139,9 +155,12 @@ typedef struct sy_rt_mesh_desc {
     const uint32_t *indices; /**< 3 x triangle_count or NULL */
     uint32_t vertex_count; /**< number of vertices in every per-vertex array */
     uint32_t triangle_count; /**< number of triangles */
+    void (*release)(void *release_user); /**< NULL: arrays copied; else shared until this is called */
+    void *release_user; /**< argument of release */
 } sy_rt_mesh_desc;
 
-/** Creates a mesh from desc (arrays copied). */
+/** Creates a mesh from desc (arrays copied or shared, see sy_rt_mesh_desc). Its BLAS is built when
+ * its first instance that is not SY_RT_INSTANCE_BAKED is created. */
 sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *desc, sy_rt_mesh *out,
                                char *err, size_t err_len);
 /** Invalidates the handle; the data is freed once no instance uses it any more. */

@@ -31,6 +31,23 @@ const char *sy_rt_result_str(sy_rt_result r)
 
 /* >>device */
 
+/* Embree's memory monitor: counts every allocation and release of the device (geometry buffers,
+ * BVHs, build scratch) from any build thread, and keeps the high-water mark. */
+static bool embree_memory_monitor(void *user, ssize_t bytes, bool post)
+{
+    (void)post;
+    sy_rt_device *dev = user;
+    if (bytes > 0 && dev->max_memory > 0 &&
+        atomic_load_explicit(&dev->embree_bytes, memory_order_relaxed) + (int64_t)bytes > dev->max_memory)
+        return false; /* Embree reports RTC_ERROR_OUT_OF_MEMORY */
+    int64_t now = atomic_fetch_add_explicit(&dev->embree_bytes, (int64_t)bytes, memory_order_relaxed) + (int64_t)bytes;
+    int64_t peak = atomic_load_explicit(&dev->embree_peak, memory_order_relaxed);
+    while (now > peak && !atomic_compare_exchange_weak_explicit(&dev->embree_peak, &peak, now, memory_order_relaxed,
+                                                                memory_order_relaxed)) {
+    }
+    return true;
+}
+
 sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **out, char *err, size_t err_len)
 {
     if (!out) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "device create: out is NULL");
@@ -44,6 +61,8 @@ sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **o
     uint32_t threads = desc ? desc->thread_count : 0;
     if (threads > 1024) threads = 1024;
     dev->thread_count = threads; /* 0: the OpenMP default team size, looked up per render */
+    uint64_t limit = desc ? desc->max_memory_bytes : 0;
+    dev->max_memory = limit > (uint64_t)INT64_MAX ? INT64_MAX : (int64_t)limit;
 
     char config[64];
     snprintf(config, sizeof config, "threads=%d", sy_rt_render_threads(dev));
@@ -56,6 +75,7 @@ sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **o
                           config, sy_rt_embree_error_name(e));
     }
     rtcSetDeviceErrorFunction(dev->rtc, sy_rt_embree_error_callback, dev);
+    rtcSetDeviceMemoryMonitorFunction(dev->rtc, embree_memory_monitor, dev);
     dev->top = rtcNewScene(dev->rtc);
     sy_rt_result r = sy_rt_check_embree(dev, err, err_len, "device create: top-level scene");
     if (r != SY_RT_OK) {
@@ -108,6 +128,11 @@ void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out)
     out->area_light_triangles = dev->area_count;
     out->version = dev->version;
     out->last_top_commit_seconds = dev->last_top_commit_seconds;
+    out->mesh_bytes = dev->mesh_bytes;
+    out->shared_bytes = dev->shared_bytes;
+    int64_t now = atomic_load(&((sy_rt_device *)dev)->embree_bytes), peak = atomic_load(&((sy_rt_device *)dev)->embree_peak);
+    out->embree_bytes = now > 0 ? (uint64_t)now : 0u;
+    out->embree_peak_bytes = peak > 0 ? (uint64_t)peak : 0u;
 }
 
 sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg, char *err, size_t err_len)

@@ -9,18 +9,26 @@
 
 #include <embree3/rtcore.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdarg.h>
 
 #include "sy_rt_base.h"
 
 /* >>objects */
 
+/* Meshes of at least this many triangles get a compact, medium-quality BLAS (sy_rt_scene.c). */
+#define SY_RT_LARGE_MESH_TRIANGLES (1u << 20)
+
 typedef struct sy_rt_mesh_data {
-    RTCScene scene;       /* BLAS holding geom as geometry 0 */
+    RTCScene scene;       /* BLAS holding geom as geometry 0; NULL until a non-baked instance needs it */
     RTCGeometry geom;
-    const float *positions;  /* Embree-owned vertex buffer, float3 */
-    const uint32_t *indices; /* Embree-owned index buffer, 3 per triangle */
-    float *normals, *uv[2], *colors; /* own copies or NULL */
+    const float *positions;  /* vertex buffer, float3: Embree's own, or the caller's (shared) */
+    const uint32_t *indices; /* index buffer, 3 per triangle: Embree's own, or the caller's (shared) */
+    const float *normals, *uv[2], *colors; /* own copies, the caller's arrays (shared), or NULL */
+    void (*release)(void *);  /* shared: gives the caller's arrays back (mesh_free) */
+    void *release_user;
+    bool shared;              /* the arrays are the caller's (not freed here) */
+    uint64_t own_bytes, shared_bytes; /* accounting (sy_rt_device_stats) */
     uint32_t vertex_count, triangle_count;
     uint32_t refs;        /* 1 for the live handle + 1 per instance */
     bool filter_on;       /* alpha filter installed on geom */
@@ -121,6 +129,11 @@ struct sy_rt_device {
 
     sy_rt_material_data default_material;
     float srgb_lut[256]; /* sRGB 8-bit -> linear */
+
+    /* memory accounting: mesh arrays (own copies, shared), Embree's allocations (memory monitor) */
+    uint64_t mesh_bytes, shared_bytes;
+    _Atomic int64_t embree_bytes, embree_peak;
+    int64_t max_memory; /* sy_rt_device_desc.max_memory_bytes (0 = none) */
 };
 
 /* Checked size arithmetic: false on overflow. */

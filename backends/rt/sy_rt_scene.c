@@ -6,42 +6,82 @@
 #include "sy_rt_shadow.h"
 #include "sy_rt_surface.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #define FAIL(r, ...) sy_rt_fail(err, err_len, (r), __VA_ARGS__)
 
 /* >>mesh */
 
-static void mesh_free(sy_rt_mesh_data *m)
+/* Bytes this process could still allocate without swapping (MemAvailable of /proc/meminfo, else
+ * the free physical pages); -1 when unknown. */
+static double sy_rt_memory_available(void)
+{
+    FILE *f = fopen("/proc/meminfo", "r");
+    char line[128];
+    double kib = -1;
+    while (f && fgets(line, sizeof line, f)) {
+        unsigned long long v;
+        if (sscanf(line, "MemAvailable: %llu kB", &v) == 1) {
+            kib = (double)v;
+            break;
+        }
+    }
+    if (f) fclose(f);
+    if (kib >= 0) return kib * 1024.0;
+#ifdef _SC_AVPHYS_PAGES
+    long pages = sysconf(_SC_AVPHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && size > 0) return (double)pages * (double)size;
+#endif
+    return -1.0;
+}
+
+static void mesh_free(sy_rt_device *dev, sy_rt_mesh_data *m)
 {
     if (!m) return;
     if (m->geom) rtcReleaseGeometry(m->geom);
     if (m->scene) rtcReleaseScene(m->scene);
-    free(m->normals);
-    free(m->uv[0]);
-    free(m->uv[1]);
-    free(m->colors);
+    if (m->shared) {
+        if (m->release) m->release(m->release_user);
+    } else {
+        free((void *)m->normals);
+        free((void *)m->uv[0]);
+        free((void *)m->uv[1]);
+        free((void *)m->colors);
+    }
+    dev->mesh_bytes -= m->own_bytes;
+    dev->shared_bytes -= m->shared_bytes;
     free(m);
 }
 
-static void mesh_unref(sy_rt_mesh_data *m)
+static void mesh_unref(sy_rt_device *dev, sy_rt_mesh_data *m)
 {
-    if (m && --m->refs == 0) mesh_free(m);
+    if (m && --m->refs == 0) mesh_free(dev, m);
 }
 
-/* Copies n floats, rejecting non-finite values. */
-static sy_rt_result copy_finite(const float *src, size_t n, float **dst, const char *what, char *err, size_t err_len)
+/* Checks n floats for non-finite values, then copies them (m->own_bytes) or, for a shared mesh,
+ * points at them (m->shared_bytes). */
+static sy_rt_result take_finite(sy_rt_mesh_data *m, const float *src, size_t n, const float **dst, const char *what,
+                                char *err, size_t err_len)
 {
     for (size_t i = 0; i < n; ++i)
         if (!isfinite(src[i]))
             return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: %s[%zu] = %g is not finite", what, i, (double)src[i]);
     size_t bytes;
     if (!sy_rt_size_mul(n, sizeof(float), &bytes)) return FAIL(SY_RT_ERROR_LIMIT, "mesh: %s too large", what);
-    *dst = malloc(bytes ? bytes : 1);
-    if (!*dst) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: cannot allocate %s (%zu bytes)", what, bytes);
-    memcpy(*dst, src, bytes);
+    if (m->shared) {
+        *dst = src;
+        m->shared_bytes += bytes;
+        return SY_RT_OK;
+    }
+    float *copy = malloc(bytes ? bytes : 1);
+    if (!copy) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: cannot allocate %s (%zu bytes)", what, bytes);
+    memcpy(copy, src, bytes);
+    *dst = copy;
+    m->own_bytes += bytes;
     return SY_RT_OK;
 }
 
@@ -82,47 +122,108 @@ sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *d, sy_r
     sy_rt_mesh_data *m = calloc(1, sizeof *m);
     if (!m) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
     m->refs = 1;
+    m->shared = d->release != NULL;
     m->vertex_count = d->vertex_count;
     m->triangle_count = d->triangle_count;
-    size_t vc = d->vertex_count;
-    if (d->normals && (r = copy_finite(d->normals, vc * 3u, &m->normals, "normals", err, err_len)) != SY_RT_OK) goto fail;
-    if (d->uv[0] && (r = copy_finite(d->uv[0], vc * 2u, &m->uv[0], "uv[0]", err, err_len)) != SY_RT_OK) goto fail;
-    if (d->uv[1] && (r = copy_finite(d->uv[1], vc * 2u, &m->uv[1], "uv[1]", err, err_len)) != SY_RT_OK) goto fail;
-    if (d->colors && (r = copy_finite(d->colors, vc * 4u, &m->colors, "colors", err, err_len)) != SY_RT_OK) goto fail;
+    size_t vc = d->vertex_count, corners = (size_t)d->triangle_count * 3u;
+    if (d->normals && (r = take_finite(m, d->normals, vc * 3u, &m->normals, "normals", err, err_len)) != SY_RT_OK) goto fail;
+    if (d->uv[0] && (r = take_finite(m, d->uv[0], vc * 2u, &m->uv[0], "uv[0]", err, err_len)) != SY_RT_OK) goto fail;
+    if (d->uv[1] && (r = take_finite(m, d->uv[1], vc * 2u, &m->uv[1], "uv[1]", err, err_len)) != SY_RT_OK) goto fail;
+    if (d->colors && (r = take_finite(m, d->colors, vc * 4u, &m->colors, "colors", err, err_len)) != SY_RT_OK) goto fail;
 
     m->geom = rtcNewGeometry(dev->rtc, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (!m->geom) { r = sy_rt_check_embree(dev, err, err_len, "mesh: rtcNewGeometry"); goto fail; }
-    /* rtcSetNewGeometryBuffer pads vertex buffers as Embree's SIMD loads require. */
-    float *pos = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                         3 * sizeof(float), d->vertex_count);
-    uint32_t *idx = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                            3 * sizeof(uint32_t), d->triangle_count);
+    const float *pos = NULL;
+    const uint32_t *idx = NULL;
+    if (m->shared) {
+        /* Embree reads the caller's arrays in place (the caller guarantees the padding). */
+        rtcSetSharedGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, d->positions, 0,
+                                   3 * sizeof(float), d->vertex_count);
+        pos = d->positions;
+        m->shared_bytes += vc * 3u * sizeof(float);
+        if (d->indices) {
+            rtcSetSharedGeometryBuffer(m->geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, d->indices, 0,
+                                       3 * sizeof(uint32_t), d->triangle_count);
+            idx = d->indices;
+            m->shared_bytes += corners * sizeof(uint32_t);
+        }
+    } else {
+        /* rtcSetNewGeometryBuffer pads vertex buffers as Embree's SIMD loads require. */
+        float *p = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                           d->vertex_count);
+        if (p) memcpy(p, d->positions, vc * 3u * sizeof(float));
+        pos = p;
+    }
+    if (!idx) {
+        uint32_t *ix = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                               3 * sizeof(uint32_t), d->triangle_count);
+        if (ix) {
+            if (d->indices) memcpy(ix, d->indices, corners * sizeof(uint32_t));
+            else for (size_t i = 0; i < corners; ++i) ix[i] = (uint32_t)i;
+        }
+        idx = ix;
+    }
     if (!pos || !idx) {
         r = sy_rt_check_embree(dev, err, err_len, "mesh: allocating Embree buffers");
         if (r == SY_RT_OK) r = FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: allocating Embree buffers failed");
         goto fail;
     }
-    memcpy(pos, d->positions, vc * 3u * sizeof(float));
-    size_t corners = (size_t)d->triangle_count * 3u;
-    if (d->indices) memcpy(idx, d->indices, corners * sizeof(uint32_t));
-    else for (size_t i = 0; i < corners; ++i) idx[i] = (uint32_t)i;
     m->positions = pos;
     m->indices = idx;
     rtcSetGeometryUserData(m->geom, dev);
     rtcCommitGeometry(m->geom);
-    m->scene = rtcNewScene(dev->rtc);
-    if (m->scene) {
-        rtcSetSceneBuildQuality(m->scene, RTC_BUILD_QUALITY_HIGH);
-        rtcAttachGeometryByID(m->scene, m->geom, 0);
-        rtcCommitScene(m->scene);
-    }
-    if ((r = sy_rt_check_embree(dev, err, err_len, "mesh: building BLAS")) != SY_RT_OK) goto fail;
-    if (!m->scene) { r = FAIL(SY_RT_ERROR_EMBREE, "mesh: rtcNewScene failed"); goto fail; }
+    if ((r = sy_rt_check_embree(dev, err, err_len, "mesh: creating geometry")) != SY_RT_OK) goto fail;
     if (!sy_rt_pool_insert(&dev->meshes, m, &out->id)) { r = FAIL(SY_RT_ERROR_LIMIT, "mesh: pool full or out of memory"); goto fail; }
+    m->release = d->release;
+    m->release_user = d->release_user;
+    dev->mesh_bytes += m->own_bytes;
+    dev->shared_bytes += m->shared_bytes;
     dev->dirty = true;
     return SY_RT_OK;
 fail:
-    mesh_free(m);
+    m->own_bytes = m->shared_bytes = 0; /* not yet counted in dev */
+    mesh_free(dev, m); /* m->release is still NULL: the caller keeps its arrays */
+    return r;
+}
+
+/* The mesh's BLAS, built on first use by an Embree instance (a mesh used only by baked instances
+ * never needs one). Large meshes build with a compact layout and medium quality: a high-quality
+ * build (spatial splits) of 10^7 triangles needs several times the memory of the finished BVH. */
+static sy_rt_result mesh_blas(sy_rt_device *dev, sy_rt_mesh_data *m, char *err, size_t err_len)
+{
+    if (m->scene) return SY_RT_OK;
+    bool large = m->triangle_count >= SY_RT_LARGE_MESH_TRIANGLES;
+    /* Too big for the machine (or the device's limit): refused with the sizes, before Embree
+     * allocates anything (an out-of-memory kill would come without a word). Peak bytes per
+     * triangle of a build, measured (sy bench memory): about 56 compact / medium, 120 high. */
+    double need = (double)m->triangle_count * (large ? 64.0 : 128.0);
+    double avail = sy_rt_memory_available();
+    const char *what = "available memory";
+    if (dev->max_memory > 0) {
+        double left = (double)(dev->max_memory - atomic_load(&dev->embree_bytes));
+        if (avail < 0 || left < avail) avail = left < 0 ? 0 : left, what = "left under the device's memory limit";
+    }
+    if (avail >= 0 && need > avail)
+        return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: the BVH of %u triangles needs about %.1f MB; %.1f MB %s",
+                    m->triangle_count, need / 1048576.0, avail / 1048576.0, what);
+    m->scene = rtcNewScene(dev->rtc);
+    if (m->scene) {
+        if (large) rtcSetSceneFlags(m->scene, RTC_SCENE_FLAG_COMPACT);
+        rtcSetSceneBuildQuality(m->scene, large ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH);
+        rtcAttachGeometryByID(m->scene, m->geom, 0);
+        rtcCommitScene(m->scene);
+    }
+    sy_rt_result r = sy_rt_check_embree(dev, err, err_len, "mesh: building BLAS");
+    if (r == SY_RT_OK && !m->scene) r = FAIL(SY_RT_ERROR_EMBREE, "mesh: rtcNewScene failed");
+    if (r != SY_RT_OK && dev->max_memory > 0 &&
+        (double)atomic_load(&dev->embree_peak) + need > (double)dev->max_memory) /* the monitor refused it */
+        r = FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: building the BVH of %u triangles went past the device's memory limit "
+                 "of %.1f MB (Embree held %.1f MB at its peak)", m->triangle_count, (double)dev->max_memory / 1048576.0,
+                 (double)atomic_load(&dev->embree_peak) / 1048576.0);
+    if (r != SY_RT_OK && m->scene) {
+        rtcReleaseScene(m->scene);
+        m->scene = NULL;
+    }
     return r;
 }
 
@@ -131,7 +232,7 @@ sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh, char *err, s
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh destroy: NULL device");
     sy_rt_mesh_data *m = sy_rt_pool_remove(&dev->meshes, mesh.id);
     if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "mesh destroy: stale handle 0x%08x", mesh.id);
-    mesh_unref(m); /* instances keep it alive until they go */
+    mesh_unref(dev, m); /* instances keep it alive until they go */
     dev->dirty = true;
     return SY_RT_OK;
 }
@@ -317,7 +418,7 @@ static void instance_free(sy_rt_device *dev, sy_rt_instance_data *in)
         }
         rtcReleaseGeometry(in->geom);
     }
-    mesh_unref(in->mesh);
+    mesh_unref(dev, in->mesh);
     free(in);
 }
 
@@ -334,6 +435,7 @@ sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc 
     float nrm[9];
     sy_rt_result r = normal_matrix(d->transform, nrm, err, err_len);
     if (r != SY_RT_OK) return r;
+    if (!(d->flags & SY_RT_INSTANCE_BAKED) && (r = mesh_blas(dev, mesh, err, err_len)) != SY_RT_OK) return r;
 
     sy_rt_instance_data *in = calloc(1, sizeof *in);
     if (!in) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance: out of memory");
@@ -570,7 +672,7 @@ static void update_filters(sy_rt_device *dev)
             sy_rt_mesh_data *m = pass == 0 ? pool->items[i] : ((sy_rt_instance_data *)pool->items[i])->mesh;
             if (m->want_filter == m->filter_on) continue;
             set_filter(m->geom, m->want_filter);
-            rtcCommitScene(m->scene);
+            if (m->scene) rtcCommitScene(m->scene);
             m->filter_on = m->want_filter;
             dev->top_dirty = true;
         }
@@ -702,7 +804,13 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len)
         double t0 = sy_rt_seconds();
         rtcCommitScene(dev->top);
         dev->last_top_commit_seconds = sy_rt_seconds() - t0;
-        if ((r = sy_rt_check_embree(dev, err, err_len, "commit: top-level scene")) != SY_RT_OK) return r;
+        if ((r = sy_rt_check_embree(dev, err, err_len, "commit: top-level scene")) != SY_RT_OK) {
+            if (dev->max_memory > 0 && (double)atomic_load(&dev->embree_peak) * 1.25 > (double)dev->max_memory)
+                r = FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "commit: the top-level BVH went past the device's memory limit of "
+                         "%.1f MB (Embree held %.1f MB at its peak)", (double)dev->max_memory / 1048576.0,
+                         (double)atomic_load(&dev->embree_peak) / 1048576.0);
+            return r;
+        }
         dev->top_dirty = false;
     }
     if (dev->area_dirty) {
@@ -732,7 +840,7 @@ void sy_rt_scene_release_all(sy_rt_device *dev)
     for (uint32_t i = 0; i < dev->instances.count; ++i)
         if (dev->instances.items[i]) instance_free(dev, dev->instances.items[i]);
     for (uint32_t i = 0; i < dev->meshes.count; ++i)
-        if (dev->meshes.items[i]) mesh_unref(dev->meshes.items[i]);
+        if (dev->meshes.items[i]) mesh_unref(dev, dev->meshes.items[i]);
     for (uint32_t i = 0; i < dev->materials.count; ++i) free(dev->materials.items[i]);
     for (uint32_t i = 0; i < dev->lights.count; ++i) free(dev->lights.items[i]);
     sy_rt_pool_free(&dev->instances);

@@ -67,7 +67,10 @@ static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel
      0},                                                                                                             \
     {"threads", SY_PARAM_INT, 0, 1024, "0", NULL, "worker threads (0 = OpenMP's default: OMP_NUM_THREADS, else all cores)", 0},                             \
     {"specular", SY_PARAM_FLOAT, 0, 1, "1", NULL,                                                                   \
-     "KHR_materials_specular factor of every material (0: dielectrics purely Lambertian)", 0}
+     "KHR_materials_specular factor of every material (0: dielectrics purely Lambertian)", 0},                       \
+    {"max_memory_mb", SY_PARAM_INT, 0, 1 << 30, "0", NULL,                                                          \
+     "MB Embree may hold (0: no limit of its own); a mesh whose BVH needs more than is left, or than the machine "  \
+     "has available, is refused with both sizes", 0}
 static const sy_param_decl whitted_params[] = {
     {"spp", SY_PARAM_INT, 1, 256, "4", NULL, "camera rays per pixel (stratified, jittered; 1 = the pixel centre)", 0},
     {"env_samples", SY_PARAM_INT, 1, 256, "4", NULL, "environment-light samples per shading point and pixel sample", 0},
@@ -262,11 +265,27 @@ static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_erro
     return r == SY_RT_OK ? SY_OK : rt_fail(err, r, "texture", e);
 }
 
+/* The blobs a shared back-end mesh reads in place (sy_rt_mesh_desc.release): one reference each,
+ * given back when the back-end lets the mesh go. Blobs are immutable and padded (SY_BLOB_PADDING),
+ * so Embree may use them as its vertex and index buffers: no copy in the back-end. */
+typedef struct rt_mesh_blobs {
+    sy_blob *b[6];
+} rt_mesh_blobs;
+
+static void rt_mesh_blobs_release(void *user)
+{
+    rt_mesh_blobs *h = user;
+    for (int k = 0; k < 6; ++k) sy_blob_release(h->b[k]);
+    free(h);
+}
+
 static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
 {
     rt_state *st = user;
     char e[ERRLEN];
     const sy_primitive *p = a->primitive;
+    rt_mesh_blobs *held = malloc(sizeof *held);
+    if (!held) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt: mesh primitive: out of memory");
     sy_rt_mesh_desc d = {
         .positions = sy_blob_data(p->positions),
         .normals = sy_blob_data(p->normals),
@@ -275,9 +294,14 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
         .indices = sy_blob_data(p->indices),
         .vertex_count = sy_primitive_vertex_count(p),
         .triangle_count = sy_primitive_triangle_count(p),
+        .release = rt_mesh_blobs_release,
+        .release_user = held,
     };
+    sy_blob *const used[6] = {p->positions, p->normals, p->texcoords0, p->texcoords1, p->colors, p->indices};
+    for (int k = 0; k < 6; ++k) held->b[k] = sy_blob_retain(used[k]);
     sy_rt_mesh h = {0};
     sy_rt_result r = sy_rt_mesh_create(st->dev, &d, &h, e, sizeof e);
+    if (r != SY_RT_OK) rt_mesh_blobs_release(held); /* a failed create keeps nothing */
     *a->handle = h.id;
     return r == SY_RT_OK ? SY_OK : rt_fail(err, r, "mesh primitive", e);
 }
@@ -1056,7 +1080,7 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     const sy_param_table *t = integrator == SY_RT_INTEGRATOR_WHITTED      ? &whitted_table
                               : integrator == SY_RT_INTEGRATOR_PATHTRACER ? &pt_table
                                                                           : &coverage_table;
-    long max_depth = 8, light_samples = 16, threads = 0, spp = 1, env_samples = 4; /* spp, env: Whitted's */
+    long max_depth = 8, light_samples = 16, threads = 0, spp = 1, env_samples = 4, max_memory_mb = 0; /* spp, env: Whitted's */
     double specular = 1.0;
     sy_result r;
     if (integrator == SY_RT_INTEGRATOR_WHITTED && ((r = sy_param_int(t, args->params, "spp", &spp, err)) ||
@@ -1065,12 +1089,13 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     if ((r = sy_param_int(t, args->params, "max_depth", &max_depth, err)) ||
         (r = sy_param_int(t, args->params, "light_samples", &light_samples, err)) ||
         (r = sy_param_int(t, args->params, "threads", &threads, err)) ||
-        (r = sy_param_float(t, args->params, "specular", &specular, err)))
+        (r = sy_param_float(t, args->params, "specular", &specular, err)) ||
+        (r = sy_param_int(t, args->params, "max_memory_mb", &max_memory_mb, err)))
         return r;
     rt_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt mediator: out of memory");
     char e[ERRLEN];
-    sy_rt_device_desc dd = {(uint32_t)threads};
+    sy_rt_device_desc dd = {(uint32_t)threads, (uint64_t)max_memory_mb << 20};
     sy_rt_result rr = sy_rt_device_create(&dd, &st->dev, e, sizeof e);
     if (rr != SY_RT_OK) {
         free(st);
@@ -1235,7 +1260,14 @@ const sy_mediator_class *sy_mediator_rt_coverage_class(void) { return &coverage_
 
 void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out)
 {
-    *out = ((rt_state *)state)->counters;
+    rt_state *st = state;
+    *out = st->counters;
+    sy_rt_stats rs;
+    sy_rt_device_stats(st->dev, &rs);
+    out->mesh_bytes = rs.mesh_bytes;
+    out->shared_bytes = rs.shared_bytes;
+    out->embree_bytes = rs.embree_bytes;
+    out->embree_peak_bytes = rs.embree_peak_bytes;
 }
 
 sy_result sy_mediator_rt_register(sy_error *err)

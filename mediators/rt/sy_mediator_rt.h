@@ -145,6 +145,9 @@ typedef struct sy_mediator_rt_counters {
     uint32_t warnings;             /**< out-of-range material / light values clamped (each also logged:
                                     * sy_log, module "rt", item "material|light ID") */
     char last_warning[160]; /**< the last warning */
+    /** @{ memory of the back-end (sy_rt_stats): mesh arrays it copied, mesh arrays it shares with
+     * the scene's blobs, Embree's allocations now and at their peak */
+    uint64_t mesh_bytes, shared_bytes, embree_bytes, embree_peak_bytes; /** @} */
 } sy_mediator_rt_counters;
 /** state is the mediator state of a context whose class is one of this adapter's classes. */
 void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out);

@@ -209,6 +209,29 @@ grep -Eq 'raw Embree rtcIntersect1 +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fa
 grep -Eq 'whitted back-end \(primary\) +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fail "bench rays: no ours line"
 grep -Eq 'overhead +-?[0-9.]+ %' "$TMP/bench_rays.out" || fail "bench rays: no overhead (ratio) line"
 cat "$TMP/bench_rays.out"
+run bench_memory "$SY" bench memory --tris 2000 -w 16 -h 16
+if [ "$rc" -ne 0 ]; then fail "bench memory: status $rc: $(cat "$TMP/bench_memory.err")"; fi
+[ "$(grep -Ec '^  peak RSS +[0-9.]+ MB +[0-9.]+ bytes/triangle' "$TMP/bench_memory.out")" -eq 2 ] ||
+    fail "bench memory: not one peak line per ray tracer"
+grep -Eq '^  Embree peak .* [0-9.]+ bytes/triangle' "$TMP/bench_memory.out" || fail "bench memory: no Embree line"
+run bench_memory_glb "$SY" bench memory --tris 2000 -b whitted --glb -w 16 -h 16
+if [ "$rc" -ne 0 ]; then fail "bench memory --glb: status $rc: $(cat "$TMP/bench_memory_glb.err")"; fi
+grep -Eq '^whitted: 2048 triangles' "$TMP/bench_memory_glb.out" || fail "bench memory --glb: wrong triangle count"
+run bench_memory_bad "$SY" bench memory -b raster --tris 2000
+[ "$rc" -eq 1 ] && grep -q 'expected one of the ray tracers' "$TMP/bench_memory_bad.err" ||
+    fail "bench memory -b raster: status $rc, $(cat "$TMP/bench_memory_bad.err")"
+cat "$TMP/bench_memory.out"
+# --max-memory: a scene over the ray tracer's memory limit is refused with the sizes, not killed
+run max_memory "$SY" render demo -b whitted --max-memory 1 -w 16 -h 16 -o "$TMP/max_memory.png"
+[ "$rc" -eq 1 ] && grep -Eq 'memory limit of 1\.0 MB' "$TMP/max_memory.err" && [ ! -e "$TMP/max_memory.png" ] ||
+    fail "--max-memory 1: status $rc, $(cat "$TMP/max_memory.err")"
+run max_memory_ok "$SY" render demo -b whitted --max-memory 256 -w 16 -h 16 -o "$TMP/max_memory.png"
+[ "$rc" -eq 0 ] || fail "--max-memory 256: status $rc, $(cat "$TMP/max_memory_ok.err")"
+if has raster; then
+    run max_memory_raster "$SY" render demo -b raster --max-memory 256 -w 16 -h 16 -o "$TMP/max_memory.png"
+    [ "$rc" -eq 1 ] && grep -q 'has no memory limit' "$TMP/max_memory_raster.err" ||
+        fail "--max-memory with -b raster: status $rc, $(cat "$TMP/max_memory_raster.err")"
+fi
 
 # demo
 run demo "$SY" demo -o "$TMP/demo" -w 64 -h 36

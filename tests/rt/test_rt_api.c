@@ -1,6 +1,7 @@
 /* test_rt_api.c — validation and lifetime rules of the backends/rt API: rejected mesh, material,
  * light and camera descs come back with a result and a message; stale handles are detected;
- * rendering needs a commit; meshes outlive their handle while instances use them. */
+ * rendering needs a commit; meshes outlive their handle while instances use them; shared meshes
+ * (a release callback) are not copied and are given back once. */
 #include "rt_test.h"
 
 static void test_mesh_validation(sy_rt_device *dev)
@@ -146,6 +147,107 @@ static void test_progress(sy_rt_device *dev)
     free(rgba);
 }
 
+static void count_release(void *user) { ++*(int *)user; }
+
+/* Shared meshes (sy_rt_mesh_desc.release): nothing is copied, the pixels equal a copied mesh's,
+ * release comes exactly once after the handle and the last instance are gone, and never for a
+ * create that failed. */
+static void test_shared_mesh(void)
+{
+    char err[256];
+    /* positions padded by one float (Embree reads 16 bytes at the last vertex) */
+    const float pos[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0, 0};
+    const float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    const float uv[] = {0, 1, 1, 1, 1, 0, 0, 0};
+    const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+    float *img[2] = {NULL, NULL};
+    for (int shared = 0; shared < 2; ++shared) {
+        sy_rt_device *dev = rt_device();
+        int released = 0;
+        sy_rt_mesh_desc d = {.positions = pos, .normals = nrm, .uv = {uv, NULL}, .indices = idx, .vertex_count = 4,
+                             .triangle_count = 2, .release = shared ? count_release : NULL, .release_user = &released};
+        sy_rt_mesh m;
+        MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+        sy_rt_stats st;
+        sy_rt_device_stats(dev, &st);
+        if (shared)
+            CHECK(st.mesh_bytes == 0 && st.shared_bytes == sizeof pos - 4 + sizeof nrm + sizeof uv + sizeof idx,
+                  "shared mesh: %llu bytes copied, %llu shared", (unsigned long long)st.mesh_bytes,
+                  (unsigned long long)st.shared_bytes);
+        else
+            CHECK(st.mesh_bytes == sizeof nrm + sizeof uv && st.shared_bytes == 0, "copied mesh: %llu bytes copied",
+                  (unsigned long long)st.mesh_bytes);
+        sy_rt_material mat = rt_emitter(dev, 0.25f, 0.5f, 1.0f);
+        float xf[16];
+        rt_identity(xf);
+        sy_rt_instance inst = rt_place(dev, m, xf, mat, 0);
+        MUST(sy_rt_mesh_destroy(dev, m, ERR));
+        CHECK(released == 0, "released while an instance uses the mesh");
+        MUST(sy_rt_commit(dev, ERR));
+        sy_rt_camera cam = rt_camera(5.0f, 0.5f);
+        sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, 16, 16);
+        float *depth = NULL;
+        rt_render(dev, &cam, &rd, &img[shared], &depth);
+        free(depth);
+        MUST(sy_rt_instance_destroy(dev, inst, ERR));
+        CHECK(released == shared, "release called %d times after the last instance went (expected %d)", released, shared);
+        /* a failed create leaves the arrays with the caller */
+        const uint32_t bad[] = {0, 1, 7};
+        sy_rt_mesh_desc db = d;
+        db.indices = bad;
+        db.triangle_count = 1;
+        CHECK(sy_rt_mesh_create(dev, &db, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "bad index accepted");
+        sy_rt_device_destroy(dev);
+        CHECK(released == shared, "release called %d times in all (expected %d)", released, shared);
+    }
+    CHECK(memcmp(img[0], img[1], 16 * 16 * 4 * sizeof(float)) == 0, "shared and copied meshes render differently");
+    free(img[0]);
+    free(img[1]);
+}
+
+/* Scenes too big for the device's memory limit are refused with the size needed and the size
+ * available, before Embree builds anything. */
+static void test_memory_limit(void)
+{
+    char err[256];
+    sy_rt_device_desc dd = {.max_memory_bytes = 1u << 20};
+    sy_rt_device *dev = NULL;
+    MUST(sy_rt_device_create(&dd, &dev, ERR));
+    enum { G = 100 }; /* 2 G^2 = 20000 triangles: about 2.4 MB of BVH */
+    float *pos = malloc((G + 1) * (G + 1) * 3 * sizeof(float));
+    uint32_t *idx = malloc(G * G * 6 * sizeof(uint32_t));
+    for (uint32_t z = 0, v = 0; z <= G; ++z)
+        for (uint32_t x = 0; x <= G; ++x, ++v) pos[3 * v] = (float)x, pos[3 * v + 1] = 0, pos[3 * v + 2] = (float)z;
+    for (uint32_t z = 0, k = 0; z < G; ++z)
+        for (uint32_t x = 0; x < G; ++x) {
+            uint32_t a = z * (G + 1) + x, b = a + G + 1;
+            idx[k++] = a, idx[k++] = b, idx[k++] = a + 1, idx[k++] = a + 1, idx[k++] = b, idx[k++] = b + 1;
+        }
+    sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = (G + 1) * (G + 1), .triangle_count = 2 * G * G};
+    sy_rt_mesh m;
+    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    float xf[16];
+    rt_identity(xf);
+    sy_rt_instance_desc id = {.mesh = m};
+    memcpy(id.transform, xf, sizeof xf);
+    sy_rt_instance inst;
+    err[0] = 0;
+    CHECK(sy_rt_instance_create(dev, &id, &inst, err, sizeof err) == SY_RT_ERROR_OUT_OF_MEMORY,
+          "a BVH over the device's memory limit was built");
+    CHECK(strstr(err, "20000 triangles needs about 2.4 MB") && strstr(err, "MB left under the device's memory limit"),
+          "message was '%s'", err);
+    sy_rt_device_destroy(dev);
+    /* without a limit of its own the device builds it */
+    MUST(sy_rt_device_create(NULL, &dev, ERR));
+    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    id.mesh = m;
+    MUST(sy_rt_instance_create(dev, &id, &inst, ERR));
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_device_destroy(dev);
+    free(pos);
+    free(idx);
+}
+
 int main(void)
 {
     sy_rt_device *dev = rt_device();
@@ -154,5 +256,7 @@ int main(void)
     test_lifetime_and_commit(dev);
     test_progress(dev);
     sy_rt_device_destroy(dev);
+    test_shared_mesh();
+    test_memory_limit();
     return rt_finish("test_rt_api");
 }
