@@ -670,6 +670,12 @@ static bool parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
     return true;
 }
 
+/* -w W / -h H of every command that renders: 1..16384 pixels; false names nothing (the caller does). */
+static bool size_option(int c, const char *value, uint32_t *w, uint32_t *h)
+{
+    return parse_u32(value, 1, 16384, c == 'w' ? w : h);
+}
+
 /* >>json: the JSON that commands print is built and written by cJSON. jadd adds an item to an object
  * (key) or an array (key NULL); a failed allocation is remembered and reported by print_json. */
 static bool g_json_failed;
@@ -972,10 +978,8 @@ static int cmd_render(int argc, char **argv)
         case OPT_AOV: po.aov = progressive_opts = true; break;
         case 'o': outp = optarg; break;
         case 'w':
-            if (!parse_u32(optarg, 1, 16384, &w)) return bad_value("-w", optarg);
-            break;
         case 'h':
-            if (!parse_u32(optarg, 1, 16384, &h)) return bad_value("-h", optarg);
+            if (!size_option(c, optarg, &w, &h)) return bad_value(c == 'w' ? "-w" : "-h", optarg);
             break;
         case OPT_CAMERA: camera = optarg; break;
         case OPT_PARAMS: params = optarg; break;
@@ -1253,10 +1257,8 @@ static int cmd_compare(int argc, char **argv)
         switch (c) {
         case OPT_STOP: return status;
         case 'w':
-            if (!parse_u32(optarg, 1, 16384, &w)) return bad_value("-w", optarg);
-            break;
         case 'h':
-            if (!parse_u32(optarg, 1, 16384, &h)) return bad_value("-h", optarg);
+            if (!size_option(c, optarg, &w, &h)) return bad_value(c == 'w' ? "-w" : "-h", optarg);
             break;
         case OPT_SPP:
             if (!parse_u32(optarg, 1, 1u << 20, &spp)) return bad_value("--spp", optarg);
@@ -1303,10 +1305,8 @@ static int cmd_demo(int argc, char **argv)
         case 'o': dir = optarg; break;
         case OPT_FILTER: filter = optarg; break;
         case 'w':
-            if (!parse_u32(optarg, 1, 16384, &w)) return bad_value("-w", optarg);
-            break;
         case 'h':
-            if (!parse_u32(optarg, 1, 16384, &h)) return bad_value("-h", optarg);
+            if (!size_option(c, optarg, &w, &h)) return bad_value(c == 'w' ? "-w" : "-h", optarg);
             break;
         }
     }
@@ -1443,10 +1443,8 @@ static int cmd_coverage(int argc, char **argv)
         switch (c) {
         case OPT_STOP: return status;
         case 'w':
-            if (!parse_u32(optarg, 1, 16384, &w)) return bad_value("-w", optarg);
-            break;
         case 'h':
-            if (!parse_u32(optarg, 1, 16384, &h)) return bad_value("-h", optarg);
+            if (!size_option(c, optarg, &w, &h)) return bad_value(c == 'w' ? "-w" : "-h", optarg);
             break;
         case OPT_CAMERA: camera = optarg; break;
         case OPT_TOP:
@@ -1703,10 +1701,8 @@ static int cmd_bench(int argc, char **argv)
             if (!parse_u32(optarg, 1, 100000, &repeats)) return bad_value("--repeats", optarg);
             break;
         case 'w':
-            if (!parse_u32(optarg, 1, 16384, &w)) return bad_value("-w", optarg);
-            break;
         case 'h':
-            if (!parse_u32(optarg, 1, 16384, &h)) return bad_value("-h", optarg);
+            if (!size_option(c, optarg, &w, &h)) return bad_value(c == 'w' ? "-w" : "-h", optarg);
             break;
         }
     }
