@@ -72,9 +72,10 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
 /* sy bench instances (sy_bench_instances.c, built with the Embree back-ends): `instances` nodes
  * instancing one height field of about `tris` triangles, rendered with every picture back-end:
  * first frame (translation included), median and worst frame of an orbit of `frames` frames, the
- * rasterizer's triangles drawn and instances culled, coverage IoU against Whitted, peak RSS. */
+ * rasterizer's triangles drawn and instances culled, coverage IoU against Whitted, peak RSS. `only`
+ * (NULL = all): that back-end alone (Whitted still renders its first frame for the IoU). */
 sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, uint32_t height, uint32_t frames,
-                             sy_error *err);
+                             const char *only, sy_error *err);
 
 /* Minimum, median and maximum of n > 0 values (sorts v in place): benchmarks report the median of
  * their rounds with the spread. */

@@ -96,8 +96,10 @@ static sy_result place_camera(sy_scene *s, sy_node cam, float extent, uint32_t k
 }
 
 sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, uint32_t height, uint32_t frames,
-                             sy_error *err)
+                             const char *only, sy_error *err)
 {
+    const sy_mediator_class *only_cls = only ? sy_mediator_find(only) : NULL;
+    if (only && !only_cls) return sy_error_set(err, SY_ERR_NOT_FOUND, "sy bench instances: no back-end '%s'", only);
     sy_scene *s = NULL;
     sy_context_pool *pool = NULL;
     sy_node root = {0}, cam = {0};
@@ -128,6 +130,9 @@ sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, 
             const sy_mediator_class *cls = sy_mediator_at(b);
             if (cls->caps & (SY_CAP_ANALYSIS | SY_CAP_REMOTE)) continue; /* picture back-ends only */
             if ((pass == 0) != (cls == ref_cls)) continue;
+            if (only_cls && cls != only_cls && cls != ref_cls) continue;
+            /* -b: the reference still gives its first frame (for the IoU), without the orbit */
+            uint32_t orbit = only_cls && cls != only_cls ? 0 : frames;
             sy_context_pool_destroy(pool); /* each back-end's translation is part of its first frame, */
             pool = NULL;                   /* and only one back-end's scene is held at a time */
             if ((r = sy_context_pool_create(&pool, err)) != SY_OK) break;
@@ -150,8 +155,8 @@ sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, 
             } else if (r == SY_OK && ref_name) {
                 r = sy_layer_coverage_iou(&img, &ref, &iou, err);
             }
-            double *ft = frames ? calloc(frames, sizeof *ft) : NULL;
-            for (uint32_t k = 1; k <= frames && r == SY_OK && ft; ++k) {
+            double *ft = orbit ? calloc(orbit, sizeof *ft) : NULL;
+            for (uint32_t k = 1; k <= orbit && r == SY_OK && ft; ++k) {
                 a = sy_time_now();
                 r = place_camera(s, cam, extent, k, frames, err);
                 if (r == SY_OK) r = sy_window_render(win, s, pool, &ro, &img, err);
@@ -170,10 +175,10 @@ sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, 
 #endif
             if (r == SY_OK) {
                 double p50 = 0, mx = 0;
-                if (frames && ft) {
-                    qsort(ft, frames, sizeof *ft, cmp_d);
-                    p50 = ft[frames / 2];
-                    mx = ft[frames - 1];
+                if (orbit && ft) {
+                    qsort(ft, orbit, sizeof *ft, cmp_d);
+                    p50 = ft[orbit / 2];
+                    mx = ft[orbit - 1];
                 }
                 char iou_s[32] = "reference", drawn_s[32] = "-", culled_s[32] = "-";
                 if (iou >= 0.0) snprintf(iou_s, sizeof iou_s, "%.4f", iou);

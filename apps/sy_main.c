@@ -595,7 +595,7 @@ static const char usage_text[] =
             "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
             "  sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]\n"
             "  sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   (peak RSS per triangle)\n"
-            "  sy bench instances [--nodes INSTANCES] [--tris PER_MESH] [-w W] [-h H] [--repeats FRAMES]\n"
+            "  sy bench instances [--nodes INSTANCES] [--tris PER_MESH] [-w W] [-h H] [--repeats FRAMES] [-b BACKEND]\n"
             "            (one mesh instanced: 10^3 x 10^6 triangles by default, every picture back-end)\n"
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy backends [--params] [--json]\n"
@@ -1684,11 +1684,12 @@ static int cmd_bench(int argc, char **argv)
     bool glb = false;
     int c, status = 0;
     optind = 0;
-    while ((c = next_option(who, argc, argv, memory ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
+    while ((c = next_option(who, argc, argv, memory || instanced ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"), lo,
+                            &status)) != -1) {
         switch (c) {
         case OPT_STOP: return status;
         case OPT_PARAMS: params = optarg; break; /* bench raster */
-        case 'b': backend = optarg; break; /* bench memory */
+        case 'b': backend = optarg; break; /* bench memory, bench instances */
         case OPT_GLB:
             if (!memory) return usage_of(who, "--glb is an option of sy bench memory");
             glb = true;
@@ -1728,7 +1729,7 @@ static int cmd_bench(int argc, char **argv)
         if (optind < argc) return usage_of(who, "no SCENE: the instanced height field is generated");
 #ifdef SY_HAVE_EMBREE
         return sy_bench_instances(nodes == 10000 ? 1000 : nodes, tris == 100 ? 1000000 : tris, w == 512 ? 320 : w,
-                                  h == 512 ? 240 : h, repeats ? repeats : 10, &err) == SY_OK ? 0 : fail(&err);
+                                  h == 512 ? 240 : h, repeats ? repeats : 10, backend, &err) == SY_OK ? 0 : fail(&err);
 #else
         sy_error_set(&err, SY_ERR_UNSUPPORTED, "sy bench instances: this sy was built without the Embree back-ends");
         return fail(&err);
