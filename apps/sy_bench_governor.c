@@ -186,7 +186,7 @@ static sy_result gov_backend(gov_scene *gs, const sy_mediator_class *cls, const 
         sy_governor_desc d;
         sy_governor_settings(gov, &d);
         if (model) printf("%.1f ms + %.1f ms/Mpixel%s\n", fixed, per * 1e6,
-                          scale_sum / o->frames <= d.min_scale + 1e-3 ? " (at the smallest scale: no split)" : "");
+                          scale_sum / o->frames <= 1.05 * d.min_scale ? " (at the smallest scale)" : "");
         else printf("-\n");
         fflush(stdout); /* a row at a time, also into a file */
     }
@@ -221,7 +221,8 @@ int sy_cmd_bench_governor(int argc, char **argv)
         "usage: sy bench governor [SCENE] [--budget MS] [--frames N] [-w W] [-h H] [--tris T] [--trace]\n"
         "  every picture back-end on an orbiting camera (one step per frame) through the frame-time governor:\n"
         "  p50 / p95 frame interval against the budget (default 33 ms), mean resolution scale. Without SCENE:\n"
-        "  the glTF Duck (" GOV_DUCK ") and a generated height field of T triangles (default 1000000).\n"
+        "  the glTF Duck (" GOV_DUCK ")\n"
+        "  and a generated height field of T triangles (default 1000000).\n"
         "  --trace: one line per governed frame (size, samples, time)\n";
     enum { O_BUDGET = 0x100, O_FRAMES, O_TRIS, O_TRACE, O_HELP };
     static const struct option lo[] = {{"budget", required_argument, NULL, O_BUDGET},
