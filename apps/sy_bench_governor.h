@@ -5,7 +5,8 @@
  * Per back-end it prints the first frame (the scene's translation, left out), the full-size frame
  * time without the governor (median of 5 frames on the same path), then over N governed frames the
  * p50 / p95 / max frame interval against the budget, p95 / budget, the share of frames over the
- * budget, the mean resolution scale and the fitted cost model. Default scenes: the glTF Duck of
+ * budget, the mean resolution scale, the share of the cores the process had (a loaded machine
+ * shows) and the fitted cost model. Default scenes: the glTF Duck of
  * ../shared/testdata (skipped with a note when absent) and a generated height field of --tris
  * triangles (default 1M). Timings only (never pass/fail); progress on a terminal only.
  * Thread-safety: call from the main thread. */
