@@ -32,6 +32,7 @@
  * the file and the reason. Exit status: 0 success, 1 failure, 2 usage error (the bad option or value
  * is named), 130 interrupted. Bash completion: apps/sy-completion.bash. */
 #include "sy_bench.h"
+#include "sy_bench_governor.h"
 #include "sy_cluster_cli.h"
 #include "sy_mediator_cluster.h"
 #include "sy_compare.h"
@@ -158,7 +159,8 @@ enum {
     /* the commands' own long options (cluster ones: SY_CLUSTER_OPT_*, sy_cluster_cli.h) */
     OPT_SPP, OPT_TIME, OPT_AOV, OPT_CAMERA, OPT_PARAMS, OPT_GL, OPT_FILTER, OPT_THRESHOLD, OPT_HALF, OPT_EXPOSURE,
     OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
-    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB, OPT_MAX_MEMORY
+    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB, OPT_MAX_MEMORY,
+    OPT_BUDGET
 };
 /* getopt_long entries of the options of every command, with the table's terminator: the end of
  * every command's table */
@@ -585,6 +587,7 @@ static const char usage_text[] =
             "  sy view SCENE [-b BACKEND] [-w W] [-h H] [--camera C] [--overlay FILE[:BACKEND]]\n"
             "          [--frames N --screenshot OUT.png] [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]\n"
             "          [--keys KEYS]   (automated runs: press these keys one frame after another, e.g. F]F[)\n"
+            "          [--budget MS]   (frame time while the view moves: the resolution follows it; default 33)\n"
             "          [--cluster URL[,URL...]|FILE.conf [--cluster-mode MODE] [--secret-file F] [--timeout-ms MS]\n"
             "           [--spp SAMPLES_PER_SERVER_AND_FRAME]]   (the same cluster options as sy render)\n"
             "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"
@@ -597,6 +600,7 @@ static const char usage_text[] =
             "  sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   (peak RSS per triangle)\n"
             "  sy bench instances [--nodes INSTANCES] [--tris PER_MESH] [-w W] [-h H] [--repeats FRAMES] [-b BACKEND]\n"
             "            (one mesh instanced: 10^3 x 10^6 triangles by default, every picture back-end)\n"
+            "  sy bench governor [SCENE] [--budget MS] [--frames N] [-w W] [-h H]   (frame-time governor, orbiting camera)\n"
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy backends [--params] [--json]\n"
             "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
@@ -1369,7 +1373,9 @@ static int cmd_view(int argc, char **argv)
         {"screenshot", required_argument, NULL, OPT_SCREENSHOT}, {"filter", required_argument, NULL, OPT_FILTER},
         {"threshold", required_argument, NULL, OPT_THRESHOLD}, {"keys", required_argument, NULL, OPT_KEYS},
         {"spp", required_argument, NULL, OPT_SPP}, /* cluster: samples per server and frame */
+        {"budget", required_argument, NULL, OPT_BUDGET}, /* the frame-time governor's budget (ms) */
         SY_CLUSTER_CLI_OPTIONS, COMMON_OPTIONS};
+    double budget = 0.0;
     int c, status = 0;
     optind = 0;
     while ((c = next_option("view", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, &status)) != -1) {
@@ -1396,6 +1402,10 @@ static int cmd_view(int argc, char **argv)
             if (end == optarg || *end) return bad_value("--threshold", optarg);
             break;
         case OPT_KEYS: view_keys = optarg; break;
+        case OPT_BUDGET:
+            budget = strtod(optarg, &end);
+            if (end == optarg || *end || !(budget >= 1.0 && budget <= 10000.0)) return bad_value("--budget", optarg);
+            break;
         case OPT_SPP:
             if (!parse_u32(optarg, 1, 100000000u, &clo.samples)) return bad_value("--spp", optarg);
             break;
@@ -1416,6 +1426,7 @@ static int cmd_view(int argc, char **argv)
     va.filter = view_filter;
     va.threshold = view_threshold;
     va.keys = view_keys;
+    va.budget_ms = budget;
     va.cluster = clo.cluster ? &clo : NULL;
     va.spec.root = ld.root;
     va.spec.camera = ld.camera;
@@ -1656,7 +1667,7 @@ static int cmd_bench_filters(int argc, char **argv)
 static int cmd_bench(int argc, char **argv)
 {
     static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
-                                        "viewports", "load", "cluster",    "memory", "instances"};
+                                        "viewports", "load", "cluster",    "memory", "instances", "governor"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -1671,6 +1682,7 @@ static int cmd_bench(int argc, char **argv)
     argc -= 1, argv += 1; /* argv[0]: the kind */
     if (!strcmp(cmd, "filters")) return cmd_bench_filters(argc, argv);
     if (!strcmp(cmd, "cluster")) return sy_cmd_bench_cluster(argc, argv);
+    if (!strcmp(cmd, "governor")) return sy_cmd_bench_governor(argc, argv); /* sy_bench_governor.c */
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
     const char *scene = NULL, *params = NULL, *backend = NULL;
     bool memory = !strcmp(cmd, "memory"), instanced = !strcmp(cmd, "instances");
