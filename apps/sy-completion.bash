@@ -10,7 +10,7 @@
 # apps/sy_cluster_cli.c; tests/integration/completion_test.sh checks a few.
 
 _sy_commands="info render demo compare coverage view bench backends serve help version"
-_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor"
+_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit"
 _sy_common="--help -q --quiet -v --verbose --env --env-color --env-intensity --env-hidden --background
             --no-default-light --allow-path --strict"
 _sy_cluster="--cluster --cluster-mode --secret-file --tls-ca --timeout-ms --cluster-pixels"

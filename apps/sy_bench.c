@@ -301,28 +301,39 @@ static sy_result bench_raster_scene(const char *label, sy_scene *scene, const sy
     sy_render_request rq = {.camera = view, .full_width = width, .full_height = height, .rect_w = width, .rect_h = height,
                             .background_id = vd->background.id};
     void *st = ctx ? sy_context_state(ctx) : NULL;
-    double ours = 0, floor_t = 0, latency = 0;
+    double latency = 0;
+    sy_bench_spread ours = {0}, floor_t = {0}, floor_lit = {0}, ratio = {0}, ratio_lit = {0};
     sy_mediator_raster_counters first = {0}, steady = {0}, moved_c = {0};
     if (r == SY_OK) r = sy_context_render(ctx, &rq, &layer, err); /* warm-up: first frame, shadow maps, shaders */
     if (r == SY_OK) sy_mediator_raster_counters_get(st, &first);
-    if (r == SY_OK) r = sy_mediator_raster_render_floor(st, &rq, &layer, err); /* its warm-up */
+    if (r == SY_OK) r = sy_mediator_raster_render_floor(st, &rq, false, &layer, err); /* their warm-ups */
+    if (r == SY_OK) r = sy_mediator_raster_render_floor(st, &rq, true, &layer, err);
     if (r == SY_OK) r = sy_context_render(ctx, &rq, &layer, err);
     if (r == SY_OK) sy_mediator_raster_counters_get(st, &steady);
-    /* ours and the floor alternate frame by frame, so that other load on the machine weighs on
-     * both medians alike */
-    double *tf = r == SY_OK ? calloc(repeats, sizeof *tf) : NULL;
+    /* ours and the floors alternate frame by frame, so that other load on the machine weighs on
+     * all alike; the ratios are taken per repeat */
+    double *tf = r == SY_OK ? calloc(4u * (size_t)repeats, sizeof *tf) : NULL;
     if (r == SY_OK && !tf) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench: out of memory");
+    double *tl = tf + repeats, *q0 = tl + repeats, *q1 = q0 + repeats;
     for (uint32_t i = 0; i < repeats && r == SY_OK; ++i) {
         double a = sy_time_now();
         r = sy_context_render(ctx, &rq, &layer, err);
         t[i] = sy_time_now() - a;
         a = sy_time_now();
-        if (r == SY_OK) r = sy_mediator_raster_render_floor(st, &rq, &layer, err);
+        if (r == SY_OK) r = sy_mediator_raster_render_floor(st, &rq, false, &layer, err);
         tf[i] = sy_time_now() - a;
+        a = sy_time_now();
+        if (r == SY_OK) r = sy_mediator_raster_render_floor(st, &rq, true, &layer, err);
+        tl[i] = sy_time_now() - a;
+        q0[i] = t[i] / tf[i];
+        q1[i] = t[i] / tl[i];
     }
     if (r == SY_OK) {
-        ours = median_of(t, repeats);
-        floor_t = median_of(tf, repeats);
+        ours = sy_bench_spread_of(t, repeats);
+        floor_t = sy_bench_spread_of(tf, repeats);
+        floor_lit = sy_bench_spread_of(tl, repeats);
+        ratio = sy_bench_spread_of(q0, repeats);
+        ratio_lit = sy_bench_spread_of(q1, repeats);
     }
     free(tf);
     for (uint32_t i = 0; i < repeats && r == SY_OK; ++i) {
@@ -343,10 +354,17 @@ static sy_result bench_raster_scene(const char *label, sy_scene *scene, const sy
                moved_c.msaa_samples, moved_c.shadow_maps);
         printf("    first sync (upload)            %10.2f ms  (%llu vertex/index buffers, %llu textures)\n", t_sync * 1e3,
                (unsigned long long)first.total_vertex_buffer_uploads, (unsigned long long)first.total_texture_uploads);
-        printf("    frame (median of %u)           %10.2f ms\n", repeats, ours * 1e3);
-        printf("    floor: same buffers, trivial   %10.2f ms\n", floor_t * 1e3);
-        printf("    ratio frame / floor            %10.2f x   (goal <= 1.5 for the geometry-bound scene)\n",
-               ours / floor_t);
+        printf("    frame (median of %u)           %10.2f ms  (%.2f .. %.2f)\n", repeats, ours.median * 1e3, ours.min * 1e3,
+               ours.max * 1e3);
+        printf("    floor: same buffers, trivial   %10.2f ms  (%.2f .. %.2f)  one colour\n", floor_t.median * 1e3,
+               floor_t.min * 1e3, floor_t.max * 1e3);
+        printf("    floor lit: trivial lit         %10.2f ms  (%.2f .. %.2f)  one directional light, Lambert on the "
+               "vertex normals\n",
+               floor_lit.median * 1e3, floor_lit.min * 1e3, floor_lit.max * 1e3);
+        printf("    ratio frame / floor            %10.2f x   (%.2f .. %.2f, per repeat)\n", ratio.median, ratio.min,
+               ratio.max);
+        printf("    ratio frame / trivial lit      %10.2f x   (%.2f .. %.2f, per repeat; goal <= 1.1 lit)\n",
+               ratio_lit.median, ratio_lit.min, ratio_lit.max);
         printf("    transform change -> frame done %10.2f ms  (commit + sync + render, median)\n", latency * 1e3);
         printf("    uploads per steady frame       %10llu buffers, %llu textures, %llu uniform blocks\n",
                (unsigned long long)steady.vertex_buffer_uploads, (unsigned long long)steady.texture_uploads,

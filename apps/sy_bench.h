@@ -76,6 +76,17 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
  * (NULL = all): that back-end alone (Whitted still renders its first frame for the IoU). */
 sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, uint32_t height, uint32_t frames,
                              const char *only, sy_error *err);
+/* Distance to the limit (issue 19, part 6; apps/sy_bench_limit.c): one path-traced frame of the
+ * view in vd (spp samples per pixel, width x height) is recorded ray by ray, then the frame and raw
+ * Embree on exactly those rays (rtcIntersect1/rtcOccluded1, the 4/8/16-wide packets, the 1M
+ * streams; the back-end's threads) are timed `repeats` times, interleaved; prints the path
+ * tracer's rays/s as a share of each form's (median, min .. max) and any replayed answer that
+ * differs from the frame's. */
+sy_result sy_bench_limit(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
+                         uint32_t height, uint32_t spp, uint32_t repeats, sy_error *err);
+/* sy bench limit [SCENE] [-w W -h H] [--spp N] [--repeats N]: argv[0] is "limit". Without SCENE the
+ * Cornell box (../shared/testdata/cornell) and the demo. Returns the exit status. */
+int sy_cmd_bench_limit(int argc, char **argv);
 
 /* Minimum, median and maximum of n > 0 values (sorts v in place): benchmarks report the median of
  * their rounds with the spread. */

@@ -17,6 +17,7 @@
  *   sy bench rays [SCENE] [-w W] [-h H] [--repeats R]
  *   sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params k=v,...]
  *   sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]
+ *   sy bench limit [SCENE] [-w W] [-h H] [--spp N] [--repeats N]   (sy_bench_limit.c)
  *   sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   peak RSS per triangle (sy_bench.h)
  *   sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]
  *   sy backends [--params] [--json]     list registered back-ends (--params: their parameters)
@@ -593,6 +594,7 @@ static const char usage_text[] =
             "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"
             "  sy bench rays [SCENE] [-w W] [-h H] [--repeats R]\n"
             "  sy bench pathtracer [SCENE] [-w W] [-h H] [--repeats PASSES]\n"
+            "  sy bench limit [SCENE] [-w W] [-h H] [--spp N] [--repeats N]   (path tracer vs raw Embree, same rays)\n"
             "  sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]\n"
             "  sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params gl=egl,msaa=4]\n"
             "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
@@ -1667,7 +1669,8 @@ static int cmd_bench_filters(int argc, char **argv)
 static int cmd_bench(int argc, char **argv)
 {
     static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
-                                        "viewports", "load", "cluster",    "memory", "instances", "governor"};
+                                        "viewports", "load", "cluster",    "memory", "instances", "governor",
+                                        "limit"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -1683,6 +1686,7 @@ static int cmd_bench(int argc, char **argv)
     if (!strcmp(cmd, "filters")) return cmd_bench_filters(argc, argv);
     if (!strcmp(cmd, "cluster")) return sy_cmd_bench_cluster(argc, argv);
     if (!strcmp(cmd, "governor")) return sy_cmd_bench_governor(argc, argv); /* sy_bench_governor.c */
+    if (!strcmp(cmd, "limit")) return sy_cmd_bench_limit(argc, argv); /* apps/sy_bench_limit.c */
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
     const char *scene = NULL, *params = NULL, *backend = NULL;
     bool memory = !strcmp(cmd, "memory"), instanced = !strcmp(cmd, "instances");

@@ -175,7 +175,7 @@ struct sy_gl_device {
     void *log_user;
     uint32_t msaa, max_tex, shadow_size;
     pool meshes, textures, materials, instances, lights;
-    GLuint prog_resolve, prog_floor;
+    GLuint prog_resolve, prog_floor, prog_floor_lit;
     struct { /* main-pass variants, built on first use, indexed by VAR_* bits (main_program) */
         GLuint prog;
         GLint model, normal_mat, mvp, cam_pos, cam_fwd, ortho, ortho_z, mirror, has_normals, probe_lod;
@@ -192,7 +192,7 @@ struct sy_gl_device {
     } ur;
     struct {
         GLint model, view, proj;
-    } uf;
+    } uf[2]; /* the floors: unlit, trivial lit */
     GLuint default_ubo, lights_ubo, white_tex, flat_normal_tex, empty_vao;
     GLuint shadow_tex, shadow_fbo;
     GLuint cube_tex[SY_GL_MAX_CUBE_SHADOWS]; /* point-light depth cube maps, made on first use */
@@ -616,6 +616,9 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
                                 &dev->ps[v].prog, err, err_len);
     if (r == SY_GL_OK) r = sy_gl_program_build(gl, "resolve", sy_gl_resolve_vs, sy_gl_resolve_fs, NULL, &dev->prog_resolve, err, err_len);
     if (r == SY_GL_OK) r = sy_gl_program_build(gl, "floor", sy_gl_floor_vs, sy_gl_floor_fs, NULL, &dev->prog_floor, err, err_len);
+    if (r == SY_GL_OK)
+        r = sy_gl_program_build(gl, "floor (trivial lit)", sy_gl_floor_vs, sy_gl_floor_fs, "#define SY_FLOOR_LIT 1\n",
+                                &dev->prog_floor_lit, err, err_len);
     if (r == SY_GL_OK) r = sy_gl_program_build(gl, "sky", sy_gl_resolve_vs, sy_gl_sky_fs, NULL, &dev->prog_sky, err, err_len);
     if (r != SY_GL_OK) {
         sy_gl_device_destroy(dev);
@@ -630,9 +633,12 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     gl->Uniform1i(gl->GetUniformLocation(dev->prog_resolve, "t_color"), 0);
     gl->Uniform1i(gl->GetUniformLocation(dev->prog_resolve, "t_depth"), 1);
     dev->ur.samples = gl->GetUniformLocation(dev->prog_resolve, "u_samples");
-    dev->uf.model = gl->GetUniformLocation(dev->prog_floor, "u_model");
-    dev->uf.view = gl->GetUniformLocation(dev->prog_floor, "u_view");
-    dev->uf.proj = gl->GetUniformLocation(dev->prog_floor, "u_proj");
+    for (int k = 0; k < 2; ++k) {
+        GLuint fp = k ? dev->prog_floor_lit : dev->prog_floor;
+        dev->uf[k].model = gl->GetUniformLocation(fp, "u_model");
+        dev->uf[k].view = gl->GetUniformLocation(fp, "u_view");
+        dev->uf[k].proj = gl->GetUniformLocation(fp, "u_proj");
+    }
     gl->UseProgram(dev->prog_sky);
     gl->Uniform1i(gl->GetUniformLocation(dev->prog_sky, "t_bg"), 0);
     dev->sky_inv_vp = gl->GetUniformLocation(dev->prog_sky, "u_inv_vp");
@@ -702,7 +708,8 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         targets_free(dev, &dev->t);
         for (int v = 0; v < VAR_COUNT; ++v)
             if (dev->pm[v].prog) gl->DeleteProgram(dev->pm[v].prog);
-        GLuint progs[5] = {dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor, dev->prog_sky};
+        GLuint progs[6] = {dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor, dev->prog_sky,
+                           dev->prog_floor_lit};
         for (int i = 0; i < 5; ++i)
             if (progs[i]) gl->DeleteProgram(progs[i]);
         sy_gl_ibl_free(gl, &dev->ibl);
@@ -2264,17 +2271,18 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     return r;
 }
 
-sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, float *rgba,
-                                char *err, size_t err_len)
+sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, bool lit,
+                                float *rgba, char *err, size_t err_len)
 {
     view_setup v;
     sy_gl_result r = frame_setup(dev, cam, d, &v, err, err_len);
     if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
     begin_target(dev, NULL);
-    gl->UseProgram(dev->prog_floor);
-    gl->UniformMatrix4fv(dev->uf.view, 1, GL_FALSE, v.view);
-    gl->UniformMatrix4fv(dev->uf.proj, 1, GL_FALSE, v.proj);
+    const int k = lit ? 1 : 0;
+    gl->UseProgram(lit ? dev->prog_floor_lit : dev->prog_floor);
+    gl->UniformMatrix4fv(dev->uf[k].view, 1, GL_FALSE, v.view);
+    gl->UniformMatrix4fv(dev->uf[k].proj, 1, GL_FALSE, v.proj);
     float vp[16], planes[6][4];
     m4_mul(v.proj, v.view, vp);
     frustum_planes(vp, planes);
@@ -2286,7 +2294,7 @@ sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, cons
         float c[3], scale, r = world_sphere(in, m, c, &scale);
         if (sphere_outside(planes, c, r)) continue;
         in->lod = choose_lod(dev, m, &v, c, r, scale);
-        gl->UniformMatrix4fv(dev->uf.model, 1, GL_FALSE, in->model);
+        gl->UniformMatrix4fv(dev->uf[k].model, 1, GL_FALSE, in->model);
         dev->tris += draw_mesh_lod(dev, m, in->lod);
     }
     r = finish_target(dev, rgba, NULL, err, err_len);

@@ -390,16 +390,32 @@ const char *const sy_gl_resolve_fs =
     "  for (int i = 0; i < u_samples; ++i) { c += texelFetch(t_color, p, i); d = min(d, texelFetch(t_depth, p, i).r); }\n"
     "  o_color = c / float(u_samples); o_depth = d; }\n";
 
+/* The benchmark floors (sy_gl_render_floor): the same buffers, trivially shaded. Unlit: one
+ * constant colour. SY_FLOOR_LIT ("trivial lit"): one directional light, Lambert, on the vertex
+ * normal (the model matrix's upper 3x3, renormalised per fragment) plus a constant ambient term. */
 const char *const sy_gl_floor_vs =
     "#version 330 core\n"
     "layout(location=0) in vec3 a_pos; uniform mat4 u_model; uniform mat4 u_view; uniform mat4 u_proj;\n"
+    "#ifdef SY_FLOOR_LIT\n"
+    "layout(location=1) in vec3 a_nrm; out vec3 v_nrm;\n"
+    "#endif\n"
     "out float v_vz;\n"
-    "void main() { vec4 e = u_view * u_model * vec4(a_pos, 1.0); v_vz = -e.z; gl_Position = u_proj * e; }\n";
+    "void main() { vec4 e = u_view * u_model * vec4(a_pos, 1.0); v_vz = -e.z; gl_Position = u_proj * e;\n"
+    "#ifdef SY_FLOOR_LIT\n"
+    "  v_nrm = mat3(u_model) * a_nrm;\n"
+    "#endif\n"
+    "}\n";
 
 const char *const sy_gl_floor_fs =
     "#version 330 core\n"
     "in float v_vz; layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
-    "void main() { o_color = vec4(0.8, 0.8, 0.8, 1.0); o_depth = v_vz; }\n";
+    "#ifdef SY_FLOOR_LIT\n"
+    "in vec3 v_nrm;\n"
+    "void main() { float l = max(dot(normalize(v_nrm), vec3(0.48, 0.8, 0.36)), 0.0);\n"
+    "  o_color = vec4(vec3(0.8) * (0.2 + 0.8 * l), 1.0); o_depth = v_vz; }\n"
+    "#else\n"
+    "void main() { o_color = vec4(0.8, 0.8, 0.8, 1.0); o_depth = v_vz; }\n"
+    "#endif\n";
 
 static sy_gl_result compile(const sy_gl_fns *gl, const char *name, GLenum stage, const char *src, const char *defines,
                             GLuint *out, char *err, size_t err_len)

@@ -450,6 +450,10 @@ typedef struct sy_rt_render_desc {
     uint32_t samples;                   /**< samples per pixel to add in this call; 0 = 1 */
     struct sy_rt_pt_record *records;    /**< optional: width * height path records (see >>path records);
                                          * NULL = none (no cost) */
+    struct sy_rt_ray_log *ray_log;      /**< optional: every ray the frame casts (extension and shadow
+                                         * rays, with Embree's answers) is appended to this log, for
+                                         * the "distance to the limit" benchmark (backends/rt/
+                                         * sy_rt_raylog.h); NULL = off (no cost) */
 } sy_rt_render_desc;
 
 /** Renders the sub-rectangle. rgba: width*height*4 floats (required); depth: width*height floats

@@ -25,6 +25,7 @@
 #include "sy_rt_accum.h"
 #include "sy_rt_bsdf.h"
 #include "sy_rt_lights.h"
+#include "sy_rt_raylog.h"
 #include "sy_rt_sampler.h"
 #include "sy_rt_shadow.h"
 
@@ -34,6 +35,7 @@
 typedef struct pt_job {
     sy_rt_accum *acc;
     sy_rt_pt_record *records; /* optional path records of the rectangle (sy_rt.h >>path records) */
+    sy_rt_ray_log *log;       /* optional ray log (sy_rt_raylog.h) */
     uint32_t first, count;
     sy_rt_sobol sobol;
     sy_rt_env env;
@@ -47,6 +49,7 @@ typedef struct pt_ctx {
     const pt_job *job;
     sy_rt_ictx ictx;
     uint64_t rays;
+    sy_rt_ray_buf *log; /* the tile's rays when the job logs them, else NULL */
 } pt_ctx;
 
 static float maxc(sy_rt_v3 v) { return fmaxf(v.x, fmaxf(v.y, v.z)); }
@@ -64,7 +67,7 @@ static float power_heuristic(float a, float b)
  * transmittance of sy_rt_shadow.h, as Whitted's do (without it a light behind glass is lost). */
 static sy_rt_v3 unoccluded(pt_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar, bool punctual)
 {
-    return sy_rt_shadow_transmittance(c->dev, &c->ictx.rtc, org, dir, tfar, punctual, &c->rays);
+    return sy_rt_shadow_transmittance(c->dev, &c->ictx.rtc, org, dir, tfar, punctual, &c->rays, c->log);
 }
 
 /* One light sample from the shading point: returns f * Le * cos * MIS weight / pdf (visibility
@@ -189,6 +192,7 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
         struct RTCRayHit rh;
         const sy_rt_instance_data *in = sy_rt_intersect(dev, &c->ictx.rtc, org, dir, tnear, tfar, &rh);
         c->rays++;
+        if (c->log) sy_rt_ray_buf_add_hit(c->log, SY_RT_RAY_EXTENSION, org, dir, tnear, tfar, &rh);
         float dlen = v3_length(dir);
         sy_rt_v3 d = v3_scale(dir, 1.0f / dlen);
         if (rec) {
@@ -314,6 +318,8 @@ static void pt_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, 
     c.job = j;
     sy_rt_context_init(f->dev, &c.ictx, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
     c.rays = 0;
+    sy_rt_ray_buf tile_log = {0};
+    c.log = j->log ? &tile_log : NULL;
     uint64_t bad = 0;
     for (uint32_t py = y0; py < y1; ++py)
         for (uint32_t px = x0; px < x1; ++px) {
@@ -328,6 +334,10 @@ static void pt_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, 
         }
     if (bad) atomic_fetch_add(&j->acc->nonfinite, bad);
     atomic_fetch_add(&j->acc->rays, c.rays);
+    if (c.log) {
+        sy_rt_ray_log_append(j->log, c.log);
+        sy_rt_ray_buf_free(c.log);
+    }
 }
 
 sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_desc *desc, char *err, size_t err_len)
@@ -344,6 +354,7 @@ sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_de
     memset(&j, 0, sizeof j);
     j.acc = acc;
     j.records = desc->records;
+    j.log = desc->ray_log;
     j.first = acc->samples;
     j.count = count;
     sy_rt_sobol_init(&j.sobol);

@@ -19,6 +19,8 @@ sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera, const s
     if (r != SY_RT_OK) return r;
     if (desc->records && desc->integrator != SY_RT_INTEGRATOR_PATHTRACER)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: path records need the PATHTRACER integrator");
+    if (desc->ray_log && desc->integrator != SY_RT_INTEGRATOR_PATHTRACER)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: a ray log needs the PATHTRACER integrator");
     if (desc->integrator == SY_RT_INTEGRATOR_PATHTRACER) return sy_rt_pathtracer_render(&f, desc, err, err_len);
     if (desc->integrator == SY_RT_INTEGRATOR_COVERAGE)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: the coverage integrator writes ids: use sy_rt_coverage");

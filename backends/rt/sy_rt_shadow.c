@@ -2,6 +2,7 @@
  * (see sy_rt_shadow.h): an occlusion query when nothing in the scene is see-through, otherwise
  * closest-hit steps along the segment, multiplying what every crossed surface lets through. */
 #include "sy_rt_shadow.h"
+#include "sy_rt_raylog.h"
 #include "sy_rt_surface.h"
 
 /* Most surfaces one shadow ray crosses before it counts as blocked. */
@@ -28,12 +29,15 @@ void sy_rt_shadow_flags_update(sy_rt_device *dev)
 }
 
 sy_rt_v3 sy_rt_shadow_transmittance(const sy_rt_device *dev, struct RTCIntersectContext *ctx, sy_rt_v3 org,
-                                    sy_rt_v3 dir, float tfar, bool transmission, uint64_t *rays)
+                                    sy_rt_v3 dir, float tfar, bool transmission, uint64_t *rays,
+                                    sy_rt_ray_buf *log)
 {
     const sy_rt_v3 one = v3(1.0f, 1.0f, 1.0f), zero = v3(0.0f, 0.0f, 0.0f);
     if (!dev->shadow_blend && !(transmission && dev->shadow_transmission)) {
         if (rays) ++*rays;
-        return sy_rt_segment_clear(dev, ctx, org, dir, tfar) ? one : zero;
+        bool clear = sy_rt_segment_clear(dev, ctx, org, dir, tfar);
+        if (log) sy_rt_ray_buf_add_occluded(log, org, dir, 0.0f, tfar, !clear);
+        return clear ? one : zero;
     }
     sy_rt_v3 T = one;
     float tnear = 0.0f, inv_len = 1.0f / fmaxf(v3_length(dir), 1e-30f);
@@ -42,6 +46,7 @@ sy_rt_v3 sy_rt_shadow_transmittance(const sy_rt_device *dev, struct RTCIntersect
         struct RTCRayHit rh;
         if (rays) ++*rays;
         const sy_rt_instance_data *in = sy_rt_intersect(dev, ctx, org, dir, tnear, tfar, &rh);
+        if (log) sy_rt_ray_buf_add_hit(log, SY_RT_RAY_SHADOW, org, dir, tnear, tfar, &rh);
         if (!in) return T;
         if (k == MAX_CROSSINGS) break;
         const sy_rt_material_data *m = sy_rt_material_lookup(dev, in->material);

@@ -11,10 +11,13 @@
 
 #include "sy_rt_frame.h"
 
+struct sy_rt_ray_buf;
+
 /* Transmittance (RGB in [0, 1]) of org + t*dir for t in (0, tfar). *rays (may be NULL) is
- * incremented by the rays traced. */
+ * incremented by the rays traced; log (may be NULL, sy_rt_raylog.h) receives them. */
 sy_rt_v3 sy_rt_shadow_transmittance(const sy_rt_device *dev, struct RTCIntersectContext *ctx, sy_rt_v3 org,
-                                    sy_rt_v3 dir, float tfar, bool transmission, uint64_t *rays);
+                                    sy_rt_v3 dir, float tfar, bool transmission, uint64_t *rays,
+                                    struct sy_rt_ray_buf *log);
 
 /* Recomputes dev->shadow_blend / shadow_transmission from the visible instances (at commit). */
 void sy_rt_shadow_flags_update(sy_rt_device *dev);

@@ -64,7 +64,7 @@ typedef struct rgba_t { sy_rt_v3 rgb; float a; } rgba_t;
 /* Light let through between org and org + tfar*dir (alpha, transmission). */
 static sy_rt_v3 shadow(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar)
 {
-    return sy_rt_shadow_transmittance(c->dev, &c->ictx.rtc, org, dir, tfar, true, NULL);
+    return sy_rt_shadow_transmittance(c->dev, &c->ictx.rtc, org, dir, tfar, true, NULL, NULL);
 }
 /* Specular reflectance at normal incidence of the dielectric part. */
 static float dielectric_f0(const sy_rt_material_desc *d)

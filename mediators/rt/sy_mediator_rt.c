@@ -6,6 +6,7 @@
 
 #include "sy_rt.h"
 #include "sy_rt_bench.h"
+#include "sy_rt_limit.h"
 #include "sy_log.h"
 #include "sy_mirror.h"
 
@@ -1053,6 +1054,44 @@ static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *
     if (d.accum) st->counters.last_render_rays = sy_rt_accum_last_rays(d.accum);
     st->frames_rendered++;
     if (d.accum && st->filter.kind != PT_FILTER_NONE) return filter_layer(st, req, layer, err);
+    return SY_OK;
+}
+
+sy_result sy_mediator_rt_bench_limit(void *state, const sy_camera_view *view, uint32_t background_id, uint32_t width,
+                                     uint32_t height, uint32_t samples, uint32_t repeats, sy_mediator_rt_limit *out,
+                                     sy_error *err)
+{
+    rt_state *st = state;
+    if (st->integrator != SY_RT_INTEGRATOR_PATHTRACER)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "rt bench limit: the context must be a pathtracer context");
+    sy_result lr = apply_look(st, background_id, err);
+    if (lr != SY_OK) return lr;
+    char e[ERRLEN];
+    sy_rt_camera cam;
+    camera_of(view, &cam);
+    sy_rt_accum *acc = NULL;
+    sy_rt_result r = sy_rt_accum_create(width, height, &acc, e, sizeof e);
+    sy_rt_render_desc d = {.integrator = SY_RT_INTEGRATOR_PATHTRACER, .image_width = width, .image_height = height,
+                           .width = width, .height = height, .max_depth = st->max_depth, .seed = 1u, .accum = acc,
+                           .samples = samples};
+    sy_rt_limit_result lim;
+    if (r == SY_RT_OK) r = sy_rt_bench_limit(st->dev, &cam, &d, repeats, &lim, e, sizeof e);
+    sy_rt_accum_destroy(acc);
+    if (r != SY_RT_OK) return rt_fail(err, r, "limit benchmark", e);
+    _Static_assert(SY_MEDIATOR_RT_LIMIT_FORMS == SY_RT_FORM_COUNT, "one entry per replay form");
+    memset(out, 0, sizeof *out);
+    out->width = lim.width, out->height = lim.height, out->samples = lim.samples, out->repeats = lim.repeats;
+    out->threads = lim.threads;
+    out->rays = lim.rays, out->extension_rays = lim.extension_rays, out->shadow_rays = lim.shadow_rays;
+    out->intersect_queries = lim.intersect_queries, out->occluded_queries = lim.occluded_queries;
+    memcpy(out->frame_seconds, lim.frame_seconds, sizeof out->frame_seconds);
+    memcpy(out->form_seconds, lim.form_seconds, sizeof out->form_seconds);
+    memcpy(out->share, lim.share, sizeof out->share);
+    for (int f = 0; f < SY_RT_FORM_COUNT; ++f) {
+        out->mismatches[f] = lim.mismatches[f];
+        out->native[f] = lim.native[f];
+        out->form_names[f] = sy_rt_ray_form_name((sy_rt_ray_form)f);
+    }
     return SY_OK;
 }
 

@@ -163,6 +163,32 @@ typedef struct sy_mediator_rt_bench {
 sy_result sy_mediator_rt_bench_rays(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
                                     uint32_t repeats, sy_mediator_rt_bench *out, sy_error *err);
 
+/** Distance to the limit (issue 19; backends/rt/sy_rt_raylog.h, sy_rt_limit.h): one path-traced frame is logged
+ * (every extension and shadow ray with Embree's answer), then the frame and raw Embree on exactly
+ * those rays in each form are timed, interleaved, `repeats` times. Forms, in order:
+ * rtcIntersect1/rtcOccluded1, rtcIntersect4/rtcOccluded4, ...8, ...16, rtcIntersect1M/rtcOccluded1M. */
+#define SY_MEDIATOR_RT_LIMIT_FORMS 5
+/** Result of sy_mediator_rt_bench_limit (times in seconds). */
+typedef struct sy_mediator_rt_limit {
+    /** @{ frame size, samples per pixel, repeats, render threads (the replay's too) */
+    uint32_t width, height, samples, repeats, threads; /** @} */
+    /** @{ rays of one frame: all, by purpose (extension, shadow), by query (closest hit, occlusion) */
+    uint64_t rays, extension_rays, shadow_rays, intersect_queries, occluded_queries; /** @} */
+    double frame_seconds[3];                                  /**< path-traced frame: min, median, max */
+    double form_seconds[SY_MEDIATOR_RT_LIMIT_FORMS][3];       /**< raw Embree per form: min, median, max */
+    double share[SY_MEDIATOR_RT_LIMIT_FORMS][3]; /**< per repeat, raw time / frame time = the path tracer's
+                                                  * rays/s as a share of the form's: min, median, max */
+    uint64_t mismatches[SY_MEDIATOR_RT_LIMIT_FORMS];          /**< replayed answers that differ from the frame's */
+    bool native[SY_MEDIATOR_RT_LIMIT_FORMS];                  /**< Embree runs the form natively (not emulated) */
+    const char *form_names[SY_MEDIATOR_RT_LIMIT_FORMS];       /**< static storage */
+} sy_mediator_rt_limit;
+/** Runs the distance-to-the-limit benchmark on a pathtracer context's device for the view at width
+ * x height (the look of background_id applied as a render would), `samples` samples per pixel per
+ * frame (>= 1), max_depth of the context. Memory: about 200 bytes per ray of the frame. */
+sy_result sy_mediator_rt_bench_limit(void *state, const sy_camera_view *view, uint32_t background_id, uint32_t width,
+                                     uint32_t height, uint32_t samples, uint32_t repeats, sy_mediator_rt_limit *out,
+                                     sy_error *err);
+
 #ifdef __cplusplus
 }
 #endif

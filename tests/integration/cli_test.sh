@@ -9,8 +9,8 @@
 #     output file nor temporary file left behind
 #   - typed parameters: sy backends --params (text and --json) lists each back-end's table; an unknown
 #     --params key, a value out of range or not in the enum: status 2 naming it (and the valid keys)
-#   - sy bench sync / sy bench rays / sy bench governor on small sizes: exit 0 and their result lines
-#     (no thresholds)
+#   - sy bench sync / sy bench rays / sy bench governor / sy bench limit on small sizes: exit 0 and
+#     their result lines (no thresholds; bench limit: no replayed answer differs from the frame's), a bad --spp named
 #   - sy demo -o DIR -w 64 -h 36: demo_whitted.png / .exr written
 #   - -b pathtracer: --spp with --aov (EXR with feature channels), --time; a non-EXR --env fails
 #   - -b pathtracer --filter pixel --threshold T and --filter radiance write an image; --filter
@@ -210,6 +210,14 @@ grep -Eq 'raw Embree rtcIntersect1 +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fa
 grep -Eq 'whitted back-end \(primary\) +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fail "bench rays: no ours line"
 grep -Eq 'overhead +-?[0-9.]+ %' "$TMP/bench_rays.out" || fail "bench rays: no overhead (ratio) line"
 cat "$TMP/bench_rays.out"
+run bench_limit "$SY" bench limit demo -w 24 -h 16 --repeats 1
+if [ "$rc" -ne 0 ]; then fail "bench limit: status $rc: $(cat "$TMP/bench_limit.err")"; fi
+[ "$(grep -Ec '^  rtcIntersect(1|4|8|16|1M) / rtcOccluded(1|4|8|16|1M) +[0-9.]+ Mrays/s .* path tracer = +[0-9.]+ %' \
+    "$TMP/bench_limit.out")" -eq 5 ] || fail "bench limit: not one share line per raw Embree form"
+grep -q 'answers differ' "$TMP/bench_limit.out" && fail "bench limit: the replay does not reproduce the frame's answers"
+cat "$TMP/bench_limit.out"
+mkdir -p "$TMP/o_limit"
+expect_error bench_limit_spp "--spp: '0' is not in 1..1024" "$TMP/o_limit" "$SY" bench limit demo --spp 0
 run bench_memory "$SY" bench memory --tris 2000 -w 16 -h 16
 if [ "$rc" -ne 0 ]; then fail "bench memory: status $rc: $(cat "$TMP/bench_memory.err")"; fi
 [ "$(grep -Ec '^  peak RSS +[0-9.]+ MB +[0-9.]+ bytes/triangle' "$TMP/bench_memory.out")" -eq 2 ] ||

@@ -1,0 +1,157 @@
+/* sy_bench_limit.c — `sy bench limit` (issue 19, part 6, "distance to the limit"): the path
+ * tracer's rays per second as a share of raw Embree's on exactly the rays of its frame (see
+ * sy_bench.h, sy_mediator_rt_bench_limit and backends/rt/sy_rt_limit.h). Parses its own options. */
+#include "sy_bench.h"
+
+#include "sy_demo.h"
+#include "sy_gltf.h"
+#ifdef SY_HAVE_EMBREE
+#include "sy_mediator_rt.h"
+#endif
+
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define DEFAULT_CORNELL "../shared/testdata/cornell/cornell_box.gltf"
+
+#ifdef SY_HAVE_EMBREE
+/* rays/s from the median time (min .. max); the share: per repeat (the frame and the form timed
+ * side by side), median (min .. max) */
+static void print_row(const char *name, double rays, const double s[3], const double share[3], const char *note)
+{
+    printf("  %-32s %8.2f Mrays/s (%.2f .. %.2f)   path tracer = %5.1f %% (%.1f .. %.1f)%s%s\n", name,
+           rays / s[1] * 1e-6, rays / s[2] * 1e-6, rays / s[0] * 1e-6, 100.0 * share[1], 100.0 * share[0],
+           100.0 * share[2], note ? "  " : "", note ? note : "");
+}
+#endif
+
+sy_result sy_bench_limit(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
+                         uint32_t height, uint32_t spp, uint32_t repeats, sy_error *err)
+{
+#ifndef SY_HAVE_EMBREE
+    (void)scene, (void)vd, (void)label, (void)width, (void)height, (void)spp, (void)repeats;
+    return sy_error_set(err, SY_ERR_UNSUPPORTED,
+                        "sy bench: limit (pathtracer) needs a back-end this sy was built without (SY_WITH_EMBREE=OFF)");
+#else
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_context *ctx = NULL;
+    sy_camera_view view;
+    sy_viewport_desc d = *vd;
+    d.backend = "pathtracer";
+    sy_result r = sy_window_create(width, height, &win, err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, &d, &vp, err);
+    if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, width, height, &view, err);
+    if (r == SY_OK) r = sy_context_create(scene, "pathtracer", NULL, vd->root.id, &ctx, err);
+    if (r == SY_OK) r = sy_context_sync(ctx, err);
+    sy_mediator_rt_limit b;
+    if (r == SY_OK)
+        r = sy_mediator_rt_bench_limit(sy_context_state(ctx), &view, vd->background.id, width, height, spp, repeats, &b, err);
+    if (r == SY_OK) {
+        double rays = (double)b.rays, f_mrays = rays / b.frame_seconds[1] * 1e-6;
+        printf("%s, %ux%u, %u spp, %u threads, median of %u (min .. max), one run:\n", label, width, height, b.samples,
+               b.threads, b.repeats);
+        printf("  rays of the frame: %llu = %llu extension + %llu shadow (%llu closest-hit + %llu occlusion queries), "
+               "%.2f per sample\n",
+               (unsigned long long)b.rays, (unsigned long long)b.extension_rays, (unsigned long long)b.shadow_rays,
+               (unsigned long long)b.intersect_queries, (unsigned long long)b.occluded_queries,
+               rays / ((double)width * height * b.samples));
+        printf("  %-32s %8.2f Mrays/s (%.2f .. %.2f)   frame %.1f ms (%.1f .. %.1f)\n", "path tracer (whole frame)", f_mrays,
+               rays / b.frame_seconds[2] * 1e-6, rays / b.frame_seconds[0] * 1e-6, b.frame_seconds[1] * 1e3,
+               b.frame_seconds[0] * 1e3, b.frame_seconds[2] * 1e3);
+        for (int f = 0; f < SY_MEDIATOR_RT_LIMIT_FORMS; ++f) {
+            char note[96] = "";
+            if (!b.native[f]) snprintf(note, sizeof note, "(emulated by Embree: not native on this CPU/build)");
+            if (b.mismatches[f])
+                snprintf(note + strlen(note), sizeof note - strlen(note), "%s%llu answers differ from the frame's",
+                         note[0] ? "; " : "", (unsigned long long)b.mismatches[f]);
+            print_row(b.form_names[f], rays, b.form_seconds[f], b.share[f], note[0] ? note : NULL);
+        }
+    }
+    sy_context_release(ctx);
+    sy_window_destroy(win);
+    return r;
+#endif
+}
+
+/* The demo (built in code) or a glTF file (its first camera, else a view framing its bounds). */
+static sy_result load_scene(const char *path, sy_scene **scene, sy_viewport_desc *vd, sy_gltf_info *info, sy_error *err)
+{
+    memset(vd, 0, sizeof *vd);
+    sy_result r = sy_scene_create(scene, err);
+    if (r != SY_OK) return r;
+    if (!strcmp(path, "demo")) {
+        sy_demo_info d;
+        r = sy_demo_build(*scene, &d, err);
+        if (r == SY_OK) vd->root = d.root, vd->camera = d.camera, vd->background = d.background;
+    } else {
+        sy_gltf_options go = {0};
+        r = sy_gltf_load(path, *scene, &go, info, err);
+        if (r == SY_OK) {
+            vd->root = info->root;
+            if (info->camera_node_count) vd->camera = info->camera_nodes[0];
+        }
+    }
+    if (r == SY_OK) r = sy_scene_commit(*scene, NULL, err);
+    return r;
+}
+
+int sy_cmd_bench_limit(int argc, char **argv)
+{
+    static const char usage_text[] =
+        "usage: sy bench limit [SCENE] [-w W] [-h H] [--spp N] [--repeats N]\n"
+        "  the path tracer's rays/s as a share of raw Embree's on the same rays (single, packets, streams);\n"
+        "  default: the Cornell box (" DEFAULT_CORNELL ") and the demo, 256x256, 1 spp, 5 repeats\n";
+    enum { O_SPP = 0x100, O_REPEATS, O_HELP };
+    static const struct option lo[] = {{"spp", required_argument, NULL, O_SPP},
+                                       {"repeats", required_argument, NULL, O_REPEATS},
+                                       {"help", no_argument, NULL, O_HELP},
+                                       {NULL, 0, NULL, 0}};
+    uint32_t w = 256, h = 256, spp = 1, repeats = 5;
+    int opt;
+    optind = 0;
+    opterr = 0;
+    while ((opt = getopt_long(argc, argv, ":w:h:", lo, NULL)) != -1) {
+        uint32_t *dst = opt == 'w' ? &w : opt == 'h' ? &h : opt == O_SPP ? &spp : opt == O_REPEATS ? &repeats : NULL;
+        unsigned long hi = opt == 'w' || opt == 'h' ? 16384 : opt == O_SPP ? 1024 : 1000;
+        if (opt == O_HELP) {
+            fputs(usage_text, stdout);
+            return 0;
+        }
+        if (!dst) {
+            fprintf(stderr, "sy bench limit: error: %s '%s'\n%s", opt == ':' ? "missing value of" : "unknown option",
+                    argv[optind - 1], usage_text);
+            return 2;
+        }
+        char *end = NULL;
+        unsigned long v = strtoul(optarg, &end, 10);
+        if (!optarg[0] || *end || optarg[0] == '-' || v < 1 || v > hi) {
+            const char *name = opt == 'w' ? "-w" : opt == 'h' ? "-h" : opt == O_SPP ? "--spp" : "--repeats";
+            fprintf(stderr, "sy bench limit: error: %s: '%s' is not in 1..%lu\n", name, optarg, hi);
+            return 2;
+        }
+        *dst = (uint32_t)v;
+    }
+    if (argc - optind > 1) {
+        fprintf(stderr, "sy bench limit: error: at most one SCENE\n%s", usage_text);
+        return 2;
+    }
+    const char *list[2] = {optind < argc ? argv[optind] : DEFAULT_CORNELL, optind < argc ? NULL : "demo"};
+    for (int i = 0; i < 2 && list[i]; ++i) {
+        sy_error err = {0};
+        sy_scene *scene = NULL;
+        sy_viewport_desc vd;
+        sy_gltf_info info = {0};
+        sy_result r = load_scene(list[i], &scene, &vd, &info, &err);
+        if (r == SY_OK) r = sy_bench_limit(scene, &vd, list[i], w, h, spp, repeats, &err);
+        sy_gltf_info_free(&info);
+        sy_scene_destroy(scene);
+        if (r != SY_OK) {
+            fprintf(stderr, "sy bench limit: error: %s\n", err.message);
+            return 1;
+        }
+    }
+    return 0;
+}

@@ -1,0 +1,361 @@
+/* sy_rt_limit.c — the rays of a path-traced frame replayed with raw Embree in single, packet and
+ * stream form, and the benchmark that times them against the frame (see sy_rt_limit.h). */
+#include "sy_rt_limit.h"
+#include "sy_rt_accum.h"
+
+#include <omp.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define FAIL(r, ...) sy_rt_fail(err, err_len, (r), __VA_ARGS__)
+
+/* Rays per unit of work handed to a thread (and per rtcIntersect1M call): a multiple of 16. */
+#define RUN 64u
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* >>replay */
+const char *sy_rt_ray_form_name(sy_rt_ray_form form)
+{
+    static const char *const names[SY_RT_FORM_COUNT] = {"rtcIntersect1 / rtcOccluded1", "rtcIntersect4 / rtcOccluded4",
+                                                         "rtcIntersect8 / rtcOccluded8", "rtcIntersect16 / rtcOccluded16",
+                                                         "rtcIntersect1M / rtcOccluded1M"};
+    return (unsigned)form < SY_RT_FORM_COUNT ? names[form] : "?";
+}
+
+bool sy_rt_ray_form_native(const sy_rt_device *dev, sy_rt_ray_form form)
+{
+    switch (form) {
+    case SY_RT_FORM_4: return rtcGetDeviceProperty(dev->rtc, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED) != 0;
+    case SY_RT_FORM_8: return rtcGetDeviceProperty(dev->rtc, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0;
+    case SY_RT_FORM_16: return rtcGetDeviceProperty(dev->rtc, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0;
+    default: return true;
+    }
+}
+
+static const uint32_t form_width[SY_RT_FORM_COUNT] = {1u, 4u, 8u, 16u, 1u};
+
+/* The SoA packets are filled by offset (soa_ray, soa_hit_reset): 12 ray fields then the hit. */
+_Static_assert(offsetof(struct RTCRayHit4, hit) == 12u * 4u * sizeof(float), "RTCRayHit4 layout");
+_Static_assert(offsetof(struct RTCRayHit8, hit) == 12u * 8u * sizeof(float), "RTCRayHit8 layout");
+_Static_assert(offsetof(struct RTCRayHit16, hit) == 12u * 16u * sizeof(float), "RTCRayHit16 layout");
+_Static_assert(offsetof(struct RTCRay16, tfar) == 8u * 16u * sizeof(float), "RTCRay16 layout");
+_Static_assert(offsetof(struct RTCHit16, geomID) == 6u * 16u * sizeof(float), "RTCHit16 layout");
+
+/* Bytes of one prepared closest-hit / occlusion element of a form (a ray or a packet). */
+static size_t hit_size(sy_rt_ray_form f)
+{
+    switch (f) {
+    case SY_RT_FORM_4: return sizeof(struct RTCRayHit4);
+    case SY_RT_FORM_8: return sizeof(struct RTCRayHit8);
+    case SY_RT_FORM_16: return sizeof(struct RTCRayHit16);
+    default: return sizeof(struct RTCRayHit);
+    }
+}
+static size_t ray_size(sy_rt_ray_form f)
+{
+    switch (f) {
+    case SY_RT_FORM_4: return sizeof(struct RTCRay4);
+    case SY_RT_FORM_8: return sizeof(struct RTCRay8);
+    case SY_RT_FORM_16: return sizeof(struct RTCRay16);
+    default: return sizeof(struct RTCRay);
+    }
+}
+
+struct sy_rt_ray_replay {
+    const sy_rt_device *dev;
+    const sy_rt_ray_log *log;
+    sy_rt_ray_form form;
+    void *hits, *rays; /* prepared elements, 64-byte aligned */
+    size_t hit_elems, ray_elems;
+};
+
+/* Writes ray r into lane k of an SoA packet of width N (the RTCRayN layout: each field an array
+ * of N floats/uints, in the order of struct RTCRay). */
+static void soa_ray(float *base, uint32_t N, uint32_t k, const sy_rt_logged_ray *r)
+{
+    const float v[9] = {r->org[0], r->org[1], r->org[2], r->tnear, r->dir[0], r->dir[1], r->dir[2], 0.0f, r->tfar};
+    for (int i = 0; i < 9; ++i) base[i * N + k] = v[i];
+    uint32_t *u = (uint32_t *)(base + 9 * N);
+    u[0 * N + k] = r->mask, u[1 * N + k] = 0, u[2 * N + k] = r->flags;
+}
+/* The hit part of an SoA packet (struct RTCHitN: Ng_x, Ng_y, Ng_z, u, v, primID, geomID, instID[0]). */
+static void soa_hit_reset(float *base, uint32_t N, uint32_t k)
+{
+    uint32_t *u = (uint32_t *)base;
+    u[6 * N + k] = RTC_INVALID_GEOMETRY_ID, u[7 * N + k] = RTC_INVALID_GEOMETRY_ID;
+}
+
+static void aos_ray(struct RTCRay *o, const sy_rt_logged_ray *r)
+{
+    o->org_x = r->org[0], o->org_y = r->org[1], o->org_z = r->org[2], o->tnear = r->tnear;
+    o->dir_x = r->dir[0], o->dir_y = r->dir[1], o->dir_z = r->dir[2], o->time = 0.0f;
+    o->tfar = r->tfar, o->mask = r->mask, o->id = 0, o->flags = r->flags;
+}
+
+static void *prepare(const sy_rt_ray_buf *b, sy_rt_ray_form form, bool hits, size_t *elems)
+{
+    uint32_t N = form_width[form];
+    size_t n = (b->n + N - 1u) / N, sz = hits ? hit_size(form) : ray_size(form);
+    *elems = n;
+    if (n > SIZE_MAX / sz - 1u) return NULL;
+    size_t bytes = (n * sz + 63u) & ~(size_t)63u;
+    void *mem = aligned_alloc(64, bytes ? bytes : 64u);
+    if (!mem) return NULL;
+    memset(mem, 0, bytes);
+    for (size_t i = 0; i < b->n; ++i) {
+        const sy_rt_logged_ray *r = &b->v[i];
+        if (N == 1u) {
+            if (hits) {
+                struct RTCRayHit *h = (struct RTCRayHit *)mem + i;
+                aos_ray(&h->ray, r);
+                h->hit.geomID = h->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            } else {
+                aos_ray((struct RTCRay *)mem + i, r);
+            }
+        } else {
+            float *p = (float *)((char *)mem + (i / N) * sz);
+            uint32_t k = (uint32_t)(i % N);
+            soa_ray(p, N, k, r);
+            if (hits) soa_hit_reset(p + 12u * N, N, k);
+        }
+    }
+    return mem;
+}
+
+sy_rt_result sy_rt_ray_replay_create(const sy_rt_device *dev, const sy_rt_ray_log *log, sy_rt_ray_form form,
+                                     sy_rt_ray_replay **out, char *err, size_t err_len)
+{
+    if (!dev || !log || !out || (unsigned)form >= SY_RT_FORM_COUNT)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "ray replay: NULL argument or unknown form");
+    sy_rt_ray_replay *rp = calloc(1, sizeof *rp);
+    if (!rp) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "ray replay: out of memory");
+    rp->dev = dev;
+    rp->log = log;
+    rp->form = form;
+    rp->hits = prepare(&log->intersect, form, true, &rp->hit_elems);
+    rp->rays = rp->hits ? prepare(&log->occluded, form, false, &rp->ray_elems) : NULL;
+    if (!rp->rays) {
+        sy_rt_ray_replay_destroy(rp);
+        return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "ray replay: cannot prepare %zu + %zu rays as %s", log->intersect.n,
+                    log->occluded.n, sy_rt_ray_form_name(form));
+    }
+    *out = rp;
+    return SY_RT_OK;
+}
+
+void sy_rt_ray_replay_destroy(sy_rt_ray_replay *rp)
+{
+    if (!rp) return;
+    free(rp->hits);
+    free(rp->rays);
+    free(rp);
+}
+
+/* Lanes [0, count) valid. */
+static void valid_mask(int *valid, uint32_t N, uint32_t count)
+{
+    for (uint32_t k = 0; k < N; ++k) valid[k] = k < count ? -1 : 0;
+}
+
+/* One run (RUN rays from index first) of closest-hit queries; returns mismatches when check. */
+static uint64_t run_hits(const sy_rt_ray_replay *rp, size_t first, bool check)
+{
+    const sy_rt_ray_buf *b = &rp->log->intersect;
+    size_t end = first + RUN < b->n ? first + RUN : b->n;
+    /* the back-end's own context (its alpha filters read it); the scene as it renders when no
+     * instance moved since the last full build (the bench builds its scene once) */
+    sy_rt_ictx ictx;
+    sy_rt_context_init(rp->dev, &ictx, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+    struct RTCIntersectContext *ctx = &ictx.rtc;
+    RTCScene scene = rp->dev->top;
+    uint64_t bad = 0;
+    const uint32_t N = form_width[rp->form];
+    if (rp->form == SY_RT_FORM_1 || rp->form == SY_RT_FORM_STREAM) {
+        const struct RTCRayHit *src = (const struct RTCRayHit *)rp->hits + first;
+        struct RTCRayHit local[RUN];
+        uint32_t n = (uint32_t)(end - first);
+        memcpy(local, src, n * sizeof *local);
+        if (rp->form == SY_RT_FORM_1)
+            for (uint32_t i = 0; i < n; ++i) rtcIntersect1(scene, ctx, &local[i]);
+        else
+            rtcIntersect1M(scene, ctx, local, n, sizeof *local);
+        for (uint32_t i = 0; check && i < n; ++i) {
+            const sy_rt_logged_ray *r = &b->v[first + i];
+            const struct RTCHit *h = &local[i].hit;
+            bool miss = h->geomID == RTC_INVALID_GEOMETRY_ID;
+            if (h->geomID != r->geom || (!miss && (h->primID != r->prim || h->instID[0] != r->inst))) ++bad;
+        }
+        return bad;
+    }
+    size_t sz = hit_size(rp->form);
+    _Alignas(64) unsigned char local[sizeof(struct RTCRayHit16)];
+    for (size_t p = first / N; p * N < end; ++p) {
+        uint32_t count = (uint32_t)(end - p * N < N ? end - p * N : N);
+        _Alignas(64) int valid[16]; /* Embree loads the mask with aligned SIMD loads */
+        valid_mask(valid, N, count);
+        memcpy(local, (const char *)rp->hits + p * sz, sz);
+        if (N == 4u) rtcIntersect4(valid, scene, ctx, (struct RTCRayHit4 *)local);
+        else if (N == 8u) rtcIntersect8(valid, scene, ctx, (struct RTCRayHit8 *)local);
+        else rtcIntersect16(valid, scene, ctx, (struct RTCRayHit16 *)local);
+        const uint32_t *hit = (const uint32_t *)(local + 12u * N * sizeof(float));
+        for (uint32_t k = 0; check && k < count; ++k) {
+            const sy_rt_logged_ray *r = &b->v[p * N + k];
+            uint32_t prim = hit[5 * N + k], geom = hit[6 * N + k], inst = hit[7 * N + k];
+            bool miss = geom == RTC_INVALID_GEOMETRY_ID;
+            if (geom != r->geom || (!miss && (prim != r->prim || inst != r->inst))) ++bad;
+        }
+    }
+    return bad;
+}
+
+/* One run of occlusion queries; returns mismatches when check. */
+static uint64_t run_occluded(const sy_rt_ray_replay *rp, size_t first, bool check)
+{
+    const sy_rt_ray_buf *b = &rp->log->occluded;
+    size_t end = first + RUN < b->n ? first + RUN : b->n;
+    /* the back-end's own context (its alpha filters read it); the scene as it renders when no
+     * instance moved since the last full build (the bench builds its scene once) */
+    sy_rt_ictx ictx;
+    sy_rt_context_init(rp->dev, &ictx, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+    struct RTCIntersectContext *ctx = &ictx.rtc;
+    RTCScene scene = rp->dev->top;
+    uint64_t bad = 0;
+    const uint32_t N = form_width[rp->form];
+    if (rp->form == SY_RT_FORM_1 || rp->form == SY_RT_FORM_STREAM) {
+        const struct RTCRay *src = (const struct RTCRay *)rp->rays + first;
+        struct RTCRay local[RUN];
+        uint32_t n = (uint32_t)(end - first);
+        memcpy(local, src, n * sizeof *local);
+        if (rp->form == SY_RT_FORM_1)
+            for (uint32_t i = 0; i < n; ++i) rtcOccluded1(scene, ctx, &local[i]);
+        else
+            rtcOccluded1M(scene, ctx, local, n, sizeof *local);
+        for (uint32_t i = 0; check && i < n; ++i) bad += (local[i].tfar < 0.0f) != (b->v[first + i].geom != 0);
+        return bad;
+    }
+    size_t sz = ray_size(rp->form);
+    _Alignas(64) unsigned char local[sizeof(struct RTCRay16)];
+    for (size_t p = first / N; p * N < end; ++p) {
+        uint32_t count = (uint32_t)(end - p * N < N ? end - p * N : N);
+        _Alignas(64) int valid[16]; /* Embree loads the mask with aligned SIMD loads */
+        valid_mask(valid, N, count);
+        memcpy(local, (const char *)rp->rays + p * sz, sz);
+        if (N == 4u) rtcOccluded4(valid, scene, ctx, (struct RTCRay4 *)local);
+        else if (N == 8u) rtcOccluded8(valid, scene, ctx, (struct RTCRay8 *)local);
+        else rtcOccluded16(valid, scene, ctx, (struct RTCRay16 *)local);
+        const float *tfar = (const float *)local + 8u * N;
+        for (uint32_t k = 0; check && k < count; ++k) bad += (tfar[k] < 0.0f) != (b->v[p * N + k].geom != 0);
+    }
+    return bad;
+}
+
+double sy_rt_ray_replay_run(sy_rt_ray_replay *rp, uint64_t *mismatches)
+{
+    const bool check = mismatches != NULL;
+    const long hit_runs = (long)((rp->log->intersect.n + RUN - 1u) / RUN);
+    const long occ_runs = (long)((rp->log->occluded.n + RUN - 1u) / RUN);
+    int threads = sy_rt_render_threads(rp->dev);
+    uint64_t bad = 0;
+    double t0 = now_s();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (threads > 1) reduction(+ : bad)
+    for (long i = 0; i < hit_runs + occ_runs; ++i)
+        bad += i < hit_runs ? run_hits(rp, (size_t)i * RUN, check) : run_occluded(rp, (size_t)(i - hit_runs) * RUN, check);
+    double t = now_s() - t0;
+    if (mismatches) *mismatches = bad;
+    return t;
+}
+
+/* >>benchmark */
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static void spread(double *v, uint32_t n, double out[3])
+{
+    qsort(v, n, sizeof *v, cmp_double);
+    out[0] = v[0];
+    out[1] = n % 2u ? v[n / 2u] : 0.5 * (v[n / 2u - 1u] + v[n / 2u]);
+    out[2] = v[n - 1u];
+}
+
+sy_rt_result sy_rt_bench_limit(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
+                               uint32_t repeats, sy_rt_limit_result *out, char *err, size_t err_len)
+{
+    if (!dev || !camera || !desc || !out || !desc->accum)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "bench limit: NULL argument (a PATHTRACER desc with an accum is needed)");
+    if (desc->integrator != SY_RT_INTEGRATOR_PATHTRACER)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "bench limit: the desc's integrator must be PATHTRACER");
+    if (repeats == 0) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "bench limit: repeats must be >= 1");
+    memset(out, 0, sizeof *out);
+    sy_rt_render_desc d = *desc;
+    d.progress = NULL;
+    d.progress_user_data = NULL;
+    d.records = NULL;
+    sy_rt_ray_log *log = NULL;
+    sy_rt_ray_replay *rp[SY_RT_FORM_COUNT] = {0};
+    double *t = calloc((size_t)repeats * (2u * SY_RT_FORM_COUNT + 1u), sizeof *t);
+    sy_rt_result r = t ? sy_rt_ray_log_create(&log, err, err_len) : FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "bench limit: out of memory");
+    /* the logged frame (also the warm-up) */
+    if (r == SY_RT_OK) {
+        d.ray_log = log;
+        sy_rt_accum_reset(d.accum);
+        r = sy_rt_render(dev, camera, &d, NULL, NULL, err, err_len);
+        d.ray_log = NULL;
+    }
+    if (r == SY_RT_OK && (log->intersect.failed || log->occluded.failed))
+        r = FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "bench limit: out of memory logging the frame's rays (fewer samples?)");
+    if (r == SY_RT_OK) {
+        out->rays = log->intersect.n + log->occluded.n;
+        if (out->rays != sy_rt_accum_last_rays(d.accum))
+            r = FAIL(SY_RT_ERROR_INVALID_OPERATION, "bench limit: %llu rays logged but the frame counted %llu",
+                     (unsigned long long)out->rays, (unsigned long long)sy_rt_accum_last_rays(d.accum));
+    }
+    for (int f = 0; r == SY_RT_OK && f < SY_RT_FORM_COUNT; ++f) {
+        r = sy_rt_ray_replay_create(dev, log, (sy_rt_ray_form)f, &rp[f], err, err_len);
+        if (r == SY_RT_OK) sy_rt_ray_replay_run(rp[f], &out->mismatches[f]); /* checked, also the warm-up */
+        out->native[f] = sy_rt_ray_form_native(dev, (sy_rt_ray_form)f);
+    }
+    /* interleaved: frame, then every form, per repeat */
+    for (uint32_t i = 0; r == SY_RT_OK && i < repeats; ++i) {
+        sy_rt_accum_reset(d.accum);
+        double t0 = now_s();
+        r = sy_rt_render(dev, camera, &d, NULL, NULL, err, err_len);
+        t[i] = now_s() - t0;
+        for (int f = 0; r == SY_RT_OK && f < SY_RT_FORM_COUNT; ++f)
+            t[(size_t)(f + 1) * repeats + i] = sy_rt_ray_replay_run(rp[f], NULL);
+    }
+    if (r == SY_RT_OK) {
+        out->width = d.width;
+        out->height = d.height;
+        out->samples = d.samples ? d.samples : 1u;
+        out->repeats = repeats;
+        out->threads = (uint32_t)sy_rt_render_threads(dev);
+        out->extension_rays = log->kind_count[SY_RT_RAY_EXTENSION];
+        out->shadow_rays = log->kind_count[SY_RT_RAY_SHADOW];
+        out->intersect_queries = log->intersect.n;
+        out->occluded_queries = log->occluded.n;
+        double *share = t + (size_t)(SY_RT_FORM_COUNT + 1u) * repeats;
+        for (int f = 0; f < SY_RT_FORM_COUNT; ++f)
+            for (uint32_t i = 0; i < repeats; ++i)
+                share[(size_t)f * repeats + i] = t[(size_t)(f + 1) * repeats + i] / t[i];
+        for (int f = 0; f < SY_RT_FORM_COUNT; ++f) {
+            spread(t + (size_t)(f + 1) * repeats, repeats, out->form_seconds[f]);
+            spread(share + (size_t)f * repeats, repeats, out->share[f]);
+        }
+        spread(t, repeats, out->frame_seconds);
+    }
+    for (int f = 0; f < SY_RT_FORM_COUNT; ++f) sy_rt_ray_replay_destroy(rp[f]);
+    sy_rt_ray_log_destroy(log);
+    free(t);
+    return r;
+}
