@@ -32,6 +32,12 @@
  * the file and the reason. Exit status: 0 success, 1 failure, 2 usage error (the bad option or value
  * is named), 130 interrupted. Bash completion: apps/sy-completion.bash. */
 #include "sy_bench.h"
+#ifdef SY_HAVE_EMBREE
+#include "sy_bench_cull.h" /* sy bench cull: the culling service needs the coverage back-end */
+#define SY_BENCH_CULL sy_cmd_bench_cull
+#else
+#define SY_BENCH_CULL(argc, argv) ((void)(argc), (void)(argv), fprintf(stderr, "sy bench cull: error: this sy was built without the Embree back-ends (SY_WITH_EMBREE=OFF)\n"), 1)
+#endif
 #include "sy_cluster_cli.h"
 #include "sy_mediator_cluster.h"
 #include "sy_compare.h"
@@ -595,6 +601,7 @@ static const char usage_text[] =
             "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
             "  sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]\n"
             "  sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   (peak RSS per triangle)\n"
+            "  sy bench cull [--tris N] [--objects N] [--budget T] [-w W] [-h H] [--frames N] [--write PLANT.glb]\n"
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy backends [--params] [--json]\n"
             "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
@@ -1654,7 +1661,7 @@ static int cmd_bench_filters(int argc, char **argv)
 static int cmd_bench(int argc, char **argv)
 {
     static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
-                                        "viewports", "load", "cluster",    "memory"};
+                                        "viewports", "load", "cluster",    "memory", "cull"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -1669,6 +1676,7 @@ static int cmd_bench(int argc, char **argv)
     argc -= 1, argv += 1; /* argv[0]: the kind */
     if (!strcmp(cmd, "filters")) return cmd_bench_filters(argc, argv);
     if (!strcmp(cmd, "cluster")) return sy_cmd_bench_cluster(argc, argv);
+    if (!strcmp(cmd, "cull")) return SY_BENCH_CULL(argc, argv); /* apps/sy_bench_cull.c */
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
     const char *scene = NULL, *params = NULL, *backend = NULL;
     bool memory = !strcmp(cmd, "memory");

@@ -31,6 +31,7 @@ struct sy_culler {
     cull_obj *objs; /* sorted by id */
     uint32_t obj_count;
     uint64_t total_triangles;
+    sy_bounds bounds; /* of every placement */
 };
 
 static uint64_t mesh_triangles(const sy_scene *s, sy_mesh m)
@@ -74,8 +75,15 @@ static sy_result index_build(sy_culler *c, sy_error *err)
     qsort(ord, n, sizeof *ord, order_cmp);
     uint32_t m = 0;
     uint64_t total = 0;
+    sy_bounds all = sy_bounds_empty();
     for (uint32_t i = 0; i < n; ++i) {
         sorted[i] = p[ord[i].pos];
+        sy_bounds mb, wb;
+        sy_error ignored = {0};
+        if (sy_mesh_bounds(c->scene, sorted[i].mesh, &mb, &ignored) == SY_OK) {
+            wb = sy_bounds_transform(&mb, &sorted[i].world);
+            sy_bounds_add_bounds(&all, &wb);
+        }
         uint64_t t = mesh_triangles(c->scene, sorted[i].mesh);
         if (m == 0 || objs[m - 1].id != sorted[i].node_id) objs[m++] = (cull_obj){sorted[i].node_id, i, 0, 0};
         objs[m - 1].count++;
@@ -85,6 +93,7 @@ static sy_result index_build(sy_culler *c, sy_error *err)
     free(p), free(ord);
     free(c->placements), free(c->objs);
     c->placements = sorted, c->placement_count = n, c->objs = objs, c->obj_count = m, c->total_triangles = total;
+    c->bounds = all;
     c->index_frame = frame, c->indexed = true;
     return SY_OK;
 }
@@ -221,6 +230,7 @@ sy_result sy_culler_query(sy_culler *c, const sy_cull_view *v, uint64_t budget, 
     free(e);
     out->total_objects = c->obj_count, out->total_triangles = c->total_triangles;
     out->coverage_width = cw, out->coverage_height = ch;
+    out->bounds = c->bounds;
     return SY_OK;
 }
 
@@ -343,6 +353,16 @@ sy_result sy_culler_query_json(sy_culler *c, const char *body, size_t len, char 
          jadd(doc, "visible_triangles", cJSON_CreateNumber((double)res.visible_triangles)) &&
          jadd(doc, "total_objects", cJSON_CreateNumber(res.total_objects)) &&
          jadd(doc, "total_triangles", cJSON_CreateNumber((double)res.total_triangles));
+    if (ok && !sy_bounds_is_empty(&res.bounds)) {
+        cJSON *bo = jadd(doc, "bounds", cJSON_CreateObject());
+        const float *mm[2] = {res.bounds.min, res.bounds.max};
+        static const char *const names[2] = {"min", "max"};
+        for (int k = 0; ok && k < 2; ++k) {
+            cJSON *a = bo ? jadd(bo, names[k], cJSON_CreateArray()) : NULL;
+            for (int i = 0; a && i < 3; ++i) ok = jadd(a, NULL, cJSON_CreateNumber(mm[k][i])) != NULL;
+            ok = ok && a;
+        }
+    }
     char *text = ok ? cJSON_PrintUnformatted(doc) : NULL;
     cJSON_Delete(doc);
     sy_cull_result_free(&res);

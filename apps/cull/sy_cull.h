@@ -20,12 +20,13 @@
  * Answer:
  *   {"objects":[{"id":N,"pixels":P,"triangles":T},...], "triangles":sum, "budget":T,
  *    "visible_objects":V, "visible_triangles":VT, "total_objects":N, "total_triangles":NT,
- *    "coverage":[cw,ch]}
+ *    "coverage":[cw,ch], "bounds":{"min":[x,y,z],"max":[x,y,z]}}
  * Visible objects (pixels > 0) in the order of their pixels, most first (ties: smaller id first);
  * walking that order, an object is kept when its triangles fit in what remains of the budget and
  * left out otherwise (a big object does not stop smaller ones behind it), so "triangles" <= budget.
  * Coverage is counted at a reduced resolution when W x H exceeds max_coverage_pixels (the same
- * aspect; "coverage" gives the size used and "pixels" are pixels of that grid).
+ * aspect; "coverage" gives the size used and "pixels" are pixels of that grid). "bounds" (absent
+ * when there is no object) are the bounds of all objects, so a client can frame the scene.
  *
  * Errors: SY_ERR_LIMIT (body too long), SY_ERR_PARSE (not JSON, not an object),
  * SY_ERR_INVALID_ARGUMENT (a field missing, of the wrong type, not finite or out of range, or
@@ -83,6 +84,7 @@ typedef struct sy_cull_result {
     uint32_t total_objects;   /**< objects under the root */
     uint64_t total_triangles; /**< their triangles */
     uint32_t coverage_width, coverage_height; /**< the grid coverage was counted on */
+    sy_bounds bounds;         /**< bounds of every object (empty when there is none) */
 } sy_cull_result;
 
 /** Creates a culler over the objects under root (a valid node) of scene, with its "coverage" context

@@ -377,7 +377,7 @@ static sy_result make_materials(sy_scene *s, sy_material mats[M_COUNT], sy_error
         {"pipe blue", {0.12f, 0.3f, 0.75f}, 0.0f, 0.6f, {0, 0, 0}},
         {"concrete", {0.55f, 0.54f, 0.5f}, 0.0f, 0.9f, {0, 0, 0}},
         {"steel", {0.36f, 0.37f, 0.4f}, 0.9f, 0.35f, {0, 0, 0}},
-        {"valve", {0.75f, 0.1f, 0.08f}, 0.2f, 0.5f, {0.3f, 0.02f, 0.0f}},
+        {"valve", {0.75f, 0.1f, 0.08f}, 0.2f, 0.5f, {0, 0, 0}},
     };
     sy_material_data md = *(const sy_material_data *)sy_object_defaults(SY_TYPE_MATERIAL);
     for (int m = 0; m < M_COUNT; ++m) {
@@ -474,7 +474,10 @@ sy_result sy_plant_generate(sy_scene *s, const sy_plant_desc *desc, sy_plant_inf
         }
     }
     if (r == SY_OK) r = sy_node_set_children(s, out->root, nodes, n, err);
-    if (r == SY_OK) out->objects = n, out->grid = grid, out->cell = PLANT_CELL;
+    if (r == SY_OK) {
+        out->objects = n, out->grid = grid, out->cell = PLANT_CELL;
+        out->corridor_x = PLANT_CELL * (float)(grid / 2) - half - 11.1f;
+    }
     free(cache);
     free(nodes);
     return r;

@@ -41,6 +41,9 @@ typedef struct sy_plant_info {
     uint32_t grid;       /**< units per side of the grid */
     float cell;          /**< unit size in metres (24) */
     sy_bounds bounds;    /**< world bounds of the objects */
+    float corridor_x;    /**< x of a free corridor along z nearest the centre (a camera path): every
+                          * cell column has one at x = its centre - 11.1 m, 1.8 m wide, where only
+                          * pipe racks (up to 7.8 m high) cross it at the cells' edges */
 } sy_plant_info;
 
 /** Generates the plant into scene s (see the file comment). On failure the objects created so far

@@ -144,6 +144,8 @@ static void test_boxes(void)
         CHECK(cJSON_GetObjectItem(doc, "triangles")->valuedouble == 36, "triangles 36");
         cJSON *cov = cJSON_GetObjectItem(doc, "coverage");
         CHECK(cJSON_GetArraySize(cov) == 2 && cov->child->valuedouble == 160, "coverage at the full size");
+        cJSON *bmin = cJSON_GetObjectItem(cJSON_GetObjectItem(doc, "bounds"), "min");
+        CHECK(cJSON_GetArraySize(bmin) == 3 && fabs(bmin->child->valuedouble - -2.8) < 1e-6, "bounds.min x = far box's -2.8");
         cJSON_Delete(doc);
     }
     free(json);
