@@ -641,7 +641,7 @@ int add_view(tinygltf::Model &m, const void *data, size_t n, int target)
 int add_accessor(tinygltf::Model &m, const void *data, size_t count, int type, int components, int ctype, int target,
                  bool minmax)
 {
-    size_t elem = ctype == TINYGLTF_COMPONENT_TYPE_FLOAT || ctype == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT ? 4 : 0;
+    size_t elem = ctype == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2 : 4; // float, uint32 or uint16
     tinygltf::Accessor a;
     a.bufferView = add_view(m, data, count * elem * size_t(components), target);
     a.byteOffset = 0;
@@ -717,9 +717,14 @@ void build_model(const sy_gltf_shim_wdoc *d, tinygltf::Model &m)
             if (p.colors)
                 pr.attributes["COLOR_0"] = add_accessor(m, p.colors, p.vertex_count, TINYGLTF_TYPE_VEC4, 4,
                                                         TINYGLTF_COMPONENT_TYPE_FLOAT, vt, false);
-            if (p.indices)
+            if (p.indices && p.vertex_count <= 65536) { // 16-bit indices where they reach every vertex
+                std::vector<uint16_t> small(p.indices, p.indices + p.index_count);
+                pr.indices = add_accessor(m, small.data(), small.size(), TINYGLTF_TYPE_SCALAR, 1,
+                                          TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, false);
+            } else if (p.indices) {
                 pr.indices = add_accessor(m, p.indices, p.index_count, TINYGLTF_TYPE_SCALAR, 1,
                                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, false);
+            }
             mesh.primitives.push_back(pr);
         }
         m.meshes.push_back(mesh);

@@ -257,8 +257,12 @@ typedef struct sy_gltf_shim_wdoc {
 
 /* Writes doc as GLB into a malloc()ed buffer (*glb_out, *len_out; the caller frees it). Buffers:
  * one binary chunk, one bufferView per attribute / index array, accessors with min / max of
- * positions. SY_ERR_LIMIT when the GLB would exceed 4 GiB - 1 (its 32-bit length), SY_ERR_OUT_OF_MEMORY,
- * SY_ERR_IO when tinygltf reports a failure. */
+ * positions; indices as uint16 where the primitive has at most 65536 vertices (every index value
+ * is below its vertex_count: sy_gltf_write.c checks), uint32 otherwise. SY_ERR_LIMIT when the
+ * GLB would exceed 4 GiB - 1 (its 32-bit length), SY_ERR_OUT_OF_MEMORY, SY_ERR_IO when tinygltf
+ * reports a failure. EXT_meshopt_compression is not written: tinygltf 2.8's writer serialises
+ * every buffer after the first as a data: URI of its bytes and no buffer extensions, so the
+ * extension's fallback buffer (a byteLength without data) cannot be expressed. */
 sy_result sy_gltf_shim_write_glb(const sy_gltf_shim_wdoc *doc, uint8_t **glb_out, size_t *len_out, sy_error *err);
 
 #ifdef __cplusplus

@@ -182,6 +182,11 @@ static sy_result mesh_index(writer *w, sy_mesh m, int32_t *out)
         if (nv > UINT32_MAX || ni > UINT32_MAX)
             return sy_error_set(w->err, SY_ERR_LIMIT, "write GLB: mesh %u primitive %u: %zu vertices / %zu indices exceed 2^32",
                                 m.id, i, nv, ni);
+        const uint32_t *idx = p->indices ? sy_blob_data(p->indices) : NULL;
+        for (size_t j = 0; j < ni; ++j) /* the writer narrows indices to 16 bits: each must name a vertex */
+            if (idx[j] >= nv)
+                return sy_error_set(w->err, SY_ERR_INVALID_ARGUMENT, "write GLB: mesh %u primitive %u: index %zu is %u, past its %zu vertices",
+                                    m.id, i, j, idx[j], nv);
         sy_gltf_shim_wprimitive *o = &ps[k++];
         o->mode = modes[p->topology];
         o->vertex_count = (uint32_t)nv;

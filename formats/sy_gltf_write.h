@@ -5,7 +5,7 @@
  * What is written: placements — a mesh at a world matrix — as one glTF node each (a root of scene
  * 0, its matrix unless the identity, its name, and the caller's id as extras {"id": N}); each
  * distinct sy_mesh once (placements of one mesh share it), with every primitive's POSITION (with
- * min / max), NORMAL, TEXCOORD_0 and COLOR_0 when present, uint32 indices, the mode (triangles,
+ * min / max), NORMAL, TEXCOORD_0 and COLOR_0 when present, uint16 or uint32 indices, the mode (triangles,
  * lines, points); each material used once as a glTF metallic-roughness material: base colour,
  * metallic, roughness, emissive (+ KHR_materials_emissive_strength), alpha mode / cutoff, double
  * sided, KHR_materials_unlit. Not written: textures (and texture coordinate set 1, tangents),

@@ -52,6 +52,7 @@ extern "C" {
 #define SY_CULL_MAX_SIZE 16384u          /**< width and height */
 #define SY_CULL_MAX_BUDGET (1ull << 40)  /**< triangles */
 
+/** A culling service over one scene and root (opaque; sy_culler_create). */
 typedef struct sy_culler sy_culler;
 
 /** Options of a culler. Zero-initialise ({0}) for the defaults. */
