@@ -65,7 +65,8 @@ typedef struct sy_cull_view {
     double position[3];    /**< camera position */
     double orientation[4]; /**< quaternion x, y, z, w (normalised by the culler) */
     double fov_degrees;    /**< vertical field of view */
-    uint32_t width, height; /**< viewport in pixels */
+    /** @{ viewport in pixels */
+    uint32_t width, height; /** @} */
 } sy_cull_view;
 
 /** One kept object of an answer. */
@@ -84,7 +85,8 @@ typedef struct sy_cull_result {
     uint64_t visible_triangles; /**< their triangles */
     uint32_t total_objects;   /**< objects under the root */
     uint64_t total_triangles; /**< their triangles */
-    uint32_t coverage_width, coverage_height; /**< the grid coverage was counted on */
+    /** @{ the grid coverage was counted on */
+    uint32_t coverage_width, coverage_height; /** @} */
     sy_bounds bounds;         /**< bounds of every object (empty when there is none) */
 } sy_cull_result;
 
