@@ -29,8 +29,11 @@ static double now_s(void)
 
 static int bench_usage(const char *why)
 {
-    if (why) fprintf(stderr, "sy bench cull: error: %s\n", why);
-    fprintf(why ? stderr : stdout,
+    if (why) {
+        fprintf(stderr, "sy bench cull: error: %s (sy bench cull --help)\n", why);
+        return 2;
+    }
+    fprintf(stdout,
             "usage: sy bench cull [--tris N] [--objects N] [--budget T] [-w W] [-h H] [--frames N] [--seed S]\n"
             "                     [--write FILE.glb]\n"
             "  the culling service on a generated plant (default 10000000 triangles in 10000 objects) along a\n"
@@ -38,7 +41,7 @@ static int bench_usage(const char *why)
             "  (default 2000000): IoU of the culled raster render against the full one, triangles drawn, and\n"
             "  GLB bytes fetched against JPEG video of the same path. --write: write the plant as GLB and stop\n"
             "  (serve it with sy web FILE.glb --client-render).\n");
-    return why ? 2 : 0;
+    return 0;
 }
 
 static bool parse_u64(const char *s, uint64_t lo, uint64_t hi, uint64_t *out)
@@ -354,8 +357,11 @@ int sy_cmd_bench_cull(int argc, char **argv)
         default: return bench_usage("unknown option");
         }
         if (!ok) {
+            const char *name = c == 'w' ? "-w" : c == 'h' ? "-h" : "?";
+            for (const struct option *o = lo; o->name; ++o)
+                if (o->val == c) name = o->name;
             char why[160];
-            snprintf(why, sizeof why, "bad value '%s' for %s", optarg, argv[optind - 1]);
+            snprintf(why, sizeof why, "bad value '%.60s' for %s%s", optarg, c == 'w' || c == 'h' ? "" : "--", name);
             return bench_usage(why);
         }
     }

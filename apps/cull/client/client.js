@@ -18,7 +18,8 @@ import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 
 const params = new URLSearchParams(window.location.search);
 const token = params.get('token');
-const budget = Math.max(0, Math.floor(Number(params.get('budget') || 2000000))) || 0;
+const budgetParam = Number(params.get('budget') ?? 2000000);
+const budget = Number.isFinite(budgetParam) && budgetParam >= 0 ? Math.min(Math.floor(budgetParam), 2 ** 40) : 2000000;
 const DEBOUNCE_MS = 250;
 const MAX_PARALLEL_FETCHES = 6;
 
