@@ -204,7 +204,10 @@ static int run_bench(uint64_t tris, uint32_t objects, uint64_t budget, uint32_t 
     if (r == SY_OK) r = sy_node_set_flags(s, cam_node, SY_NODE_VISIBLE, &err);
     if (r == SY_OK) r = sy_scene_commit(s, NULL, &err);
     if (r == SY_OK) r = sy_window_create(w, h, &win, &err);
-    if (r == SY_OK) r = sy_window_add_viewport(win, &(sy_viewport_desc){.root = pi.root, .camera = cam_node, .backend = "raster"}, NULL, &err);
+    if (r == SY_OK) {
+        r = sy_window_add_viewport(win, &(sy_viewport_desc){.root = pi.root, .camera = cam_node, .backend = "raster"}, NULL, &err);
+        if (r != SY_OK) sy_error_prefix(&err, "bench cull: the renders to compare need the raster back-end (SY_WITH_RASTER)");
+    }
     if (r == SY_OK) r = sy_layer_create(w, h, &full, &err);
     if (r == SY_OK) r = sy_layer_create(w, h, &part, &err);
     uint32_t nobj = 0;
