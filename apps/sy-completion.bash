@@ -10,7 +10,7 @@
 # apps/sy_cluster_cli.c; tests/integration/completion_test.sh checks a few.
 
 _sy_commands="info render demo compare coverage view bench backends serve help version"
-_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit"
+_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit cull"
 _sy_common="--help -q --quiet -v --verbose --env --env-color --env-intensity --env-hidden --background
             --no-default-light --allow-path --strict"
 _sy_cluster="--cluster --cluster-mode --secret-file --tls-ca --timeout-ms --cluster-pixels"
@@ -43,6 +43,7 @@ _sy_options() {
         filters) echo "-w -h --repeats --reference $_sy_common" ;;
         memory) echo "-w -h -b --tris --glb $_sy_common" ;;
         governor) echo "-w -h --budget --frames --tris --trace --help -q -v" ;;
+        cull) echo "-w -h --tris --objects --budget --frames --seed --write --help" ;;
         *) echo "-w -h --repeats --nodes --tris --params $_sy_common" ;;
         esac ;;
     "") echo "--version --help -h -q --quiet -v --verbose" ;;

@@ -34,6 +34,12 @@
  * is named), 130 interrupted. Bash completion: apps/sy-completion.bash. */
 #include "sy_bench.h"
 #include "sy_bench_governor.h"
+#ifdef SY_HAVE_EMBREE
+#include "sy_bench_cull.h" /* sy bench cull: the culling service needs the coverage back-end */
+#define SY_BENCH_CULL sy_cmd_bench_cull
+#else
+#define SY_BENCH_CULL(argc, argv) ((void)(argc), (void)(argv), fprintf(stderr, "sy bench cull: error: this sy was built without the Embree back-ends (SY_WITH_EMBREE=OFF)\n"), 1)
+#endif
 #include "sy_cluster_cli.h"
 #include "sy_mediator_cluster.h"
 #include "sy_compare.h"
@@ -603,6 +609,7 @@ static const char usage_text[] =
             "  sy bench instances [--nodes INSTANCES] [--tris PER_MESH] [-w W] [-h H] [--repeats FRAMES] [-b BACKEND]\n"
             "            (one mesh instanced: 10^3 x 10^6 triangles by default, every picture back-end)\n"
             "  sy bench governor [SCENE] [--budget MS] [--frames N] [-w W] [-h H]   (frame-time governor, orbiting camera)\n"
+            "  sy bench cull [--tris N] [--objects N] [--budget T] [-w W] [-h H] [--frames N] [--write PLANT.glb]\n"
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy backends [--params] [--json]\n"
             "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
@@ -1670,7 +1677,7 @@ static int cmd_bench(int argc, char **argv)
 {
     static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
                                         "viewports", "load", "cluster",    "memory", "instances", "governor",
-                                        "limit"};
+                                        "limit",     "cull"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -1687,6 +1694,7 @@ static int cmd_bench(int argc, char **argv)
     if (!strcmp(cmd, "cluster")) return sy_cmd_bench_cluster(argc, argv);
     if (!strcmp(cmd, "governor")) return sy_cmd_bench_governor(argc, argv); /* sy_bench_governor.c */
     if (!strcmp(cmd, "limit")) return sy_cmd_bench_limit(argc, argv); /* apps/sy_bench_limit.c */
+    if (!strcmp(cmd, "cull")) return SY_BENCH_CULL(argc, argv); /* apps/sy_bench_cull.c */
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
     const char *scene = NULL, *params = NULL, *backend = NULL;
     bool memory = !strcmp(cmd, "memory"), instanced = !strcmp(cmd, "instances");

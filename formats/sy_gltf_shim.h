@@ -212,6 +212,59 @@ void sy_gltf_shim_free(sy_gltf_doc *doc);
 sy_result sy_gltf_shim_parse_only(const uint8_t *bytes, size_t size, bool binary, const char *base_dir,
                                   const sy_gltf_shim_limits *limits, sy_error *err);
 
+/* >>writing (GLB). A plain description of what to write: the shim builds a tinygltf model from it
+ * and serialises it with tinygltf's GLB writer. Everything here is trusted (the caller's own
+ * scene data, checked by formats/sy_gltf_write.c): counts match the arrays. */
+typedef struct sy_gltf_shim_wprimitive {
+    int32_t mode;                /* glTF mode: 0 points, 1 lines, 4 triangles */
+    int32_t material;            /* index into materials, -1: none (glTF's default material) */
+    uint32_t vertex_count;
+    const float *positions;      /* float[3] per vertex (required) */
+    const float *normals;        /* float[3] per vertex or NULL */
+    const float *texcoords0;     /* float[2] per vertex or NULL */
+    const float *colors;         /* float[4] per vertex or NULL */
+    const uint32_t *indices;     /* NULL: non-indexed */
+    uint32_t index_count;
+} sy_gltf_shim_wprimitive;
+
+typedef struct sy_gltf_shim_wmesh {
+    const char *name; /* may be NULL */
+    const sy_gltf_shim_wprimitive *primitives;
+    uint32_t primitive_count;
+} sy_gltf_shim_wmesh;
+
+typedef struct sy_gltf_shim_wmaterial {
+    const char *name; /* may be NULL */
+    double base_color[4], metallic, roughness, emissive[3], emissive_strength; /* strength 1: no extension */
+    const char *alpha_mode; /* "OPAQUE", "MASK", "BLEND" */
+    double alpha_cutoff;
+    int32_t double_sided, unlit;
+} sy_gltf_shim_wmaterial;
+
+typedef struct sy_gltf_shim_wnode {
+    const char *name; /* may be NULL */
+    int32_t mesh;     /* index into meshes, -1: none */
+    double matrix[16]; /* column-major; the identity is not written */
+    int64_t id;        /* >= 0: written as the node's extras {"id": id} */
+} sy_gltf_shim_wnode;
+
+typedef struct sy_gltf_shim_wdoc {
+    const char *generator;
+    const sy_gltf_shim_wmaterial *materials; uint32_t material_count;
+    const sy_gltf_shim_wmesh *meshes;        uint32_t mesh_count;
+    const sy_gltf_shim_wnode *nodes;         uint32_t node_count; /* every node is a root of scene 0 */
+} sy_gltf_shim_wdoc;
+
+/* Writes doc as GLB into a malloc()ed buffer (*glb_out, *len_out; the caller frees it). Buffers:
+ * one binary chunk, one bufferView per attribute / index array, accessors with min / max of
+ * positions; indices as uint16 where the primitive has at most 65536 vertices (every index value
+ * is below its vertex_count: sy_gltf_write.c checks), uint32 otherwise. SY_ERR_LIMIT when the
+ * GLB would exceed 4 GiB - 1 (its 32-bit length), SY_ERR_OUT_OF_MEMORY, SY_ERR_IO when tinygltf
+ * reports a failure. EXT_meshopt_compression is not written: tinygltf 2.8's writer serialises
+ * every buffer after the first as a data: URI of its bytes and no buffer extensions, so the
+ * extension's fallback buffer (a byteLength without data) cannot be expressed. */
+sy_result sy_gltf_shim_write_glb(const sy_gltf_shim_wdoc *doc, uint8_t **glb_out, size_t *len_out, sy_error *err);
+
 #ifdef __cplusplus
 }
 #endif

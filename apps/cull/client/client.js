@@ -1,0 +1,231 @@
+// client.js — the culled WebGL client (docs/CULLING.md). It asks POST /api/cull which objects
+// cover the most pixels of its current view within a triangle budget, draws only those, fetches
+// each object once (GET /api/object/ID, GLB) and keeps it cached, and re-asks (debounced) whenever
+// the view changes. The page URL's ?token= is passed on to every request; ?budget=T sets the
+// budget (default 2000000 triangles).
+//
+// For tests (a browser driven over the DevTools protocol) the state is window.syClient:
+//   requested: ids of the last answer (what should be drawn), loaded: ids fetched so far,
+//   visible: ids drawn now, triangles: triangles drawn now, fetched_triangles, bytes (GLB bytes),
+//   total_objects, total_triangles, queries (answers received), fetches, errors (messages),
+//   idle (true when no query or fetch is outstanding and the drawing matches the last answer),
+//   lastAnswer (the parsed JSON), cameraJSON() (the view as sent), setView(position, target)
+//   (moves the camera and re-asks), cull() (re-asks now).
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
+
+const params = new URLSearchParams(window.location.search);
+const token = params.get('token');
+const budgetParam = Number(params.get('budget') ?? 2000000);
+const budget = Number.isFinite(budgetParam) && budgetParam >= 0 ? Math.min(Math.floor(budgetParam), 2 ** 40) : 2000000;
+const DEBOUNCE_MS = 250;
+const MAX_PARALLEL_FETCHES = 6;
+
+function withToken(url) {
+  return token ? `${url}${url.includes('?') ? '&' : '?'}token=${encodeURIComponent(token)}` : url;
+}
+
+const canvas = document.getElementById('view');
+const overlay = document.getElementById('overlay');
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: true });
+renderer.setPixelRatio(window.devicePixelRatio || 1);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0x20242a);
+scene.add(new THREE.HemisphereLight(0xffffff, 0x444444, 2.0));
+const sun = new THREE.DirectionalLight(0xffffff, 2.0);
+sun.position.set(0.5, 1, 0.3);
+scene.add(sun);
+const camera = new THREE.PerspectiveCamera(60, 1, 0.05, 1e6);
+camera.position.set(0, 0, 10);
+const controls = new OrbitControls(camera, canvas);
+const loader = new GLTFLoader();
+loader.setMeshoptDecoder(MeshoptDecoder);
+
+const objects = new Map(); // id -> THREE.Object3D (loaded)
+const pending = new Map(); // id -> Promise (being fetched)
+const state = {
+  requested: [], loaded: [], visible: [], triangles: 0, fetched_triangles: 0, bytes: 0,
+  total_objects: 0, total_triangles: 0, queries: 0, fetches: 0, errors: [], idle: false, lastAnswer: null,
+};
+const triangleCount = new Map(); // id -> triangles (from the answers)
+let framed = false;
+let inFlight = false;
+let again = false;
+let timer = null;
+
+function cameraJSON() {
+  const size = renderer.getSize(new THREE.Vector2());
+  camera.updateMatrixWorld();
+  const p = camera.position, q = camera.quaternion;
+  return {
+    position: [p.x, p.y, p.z], orientation: [q.x, q.y, q.z, q.w], fov: camera.fov,
+    width: Math.max(1, Math.min(16384, Math.round(size.x))), height: Math.max(1, Math.min(16384, Math.round(size.y))),
+    budget,
+  };
+}
+
+function showError(message) {
+  state.errors.push(message);
+  if (state.errors.length > 20) state.errors.shift();
+  updateOverlay();
+}
+
+function updateOverlay() {
+  const lines = [
+    `objects  ${state.visible.length} drawn, ${state.loaded.length} loaded of ${state.total_objects}`,
+    `triangles ${state.triangles.toLocaleString()} drawn of ${state.total_triangles.toLocaleString()}` +
+      ` (budget ${budget.toLocaleString()})`,
+    `fetched  ${state.fetched_triangles.toLocaleString()} triangles, ${(state.bytes / 1e6).toFixed(2)} MB`,
+  ];
+  overlay.textContent = lines.join('\n');
+  if (state.errors.length) {
+    const e = document.createElement('div');
+    e.className = 'error';
+    e.textContent = state.errors[state.errors.length - 1];
+    overlay.appendChild(e);
+  }
+}
+
+// Shows exactly the requested objects that are loaded.
+function applyVisibility() {
+  const want = new Set(state.requested);
+  let tris = 0;
+  const vis = [];
+  for (const [id, obj] of objects) {
+    obj.visible = want.has(id);
+    if (obj.visible) {
+      vis.push(id);
+      tris += triangleCount.get(id) || 0;
+    }
+  }
+  state.visible = vis;
+  state.triangles = tris;
+  state.idle = !inFlight && !again && timer === null && pending.size === 0 && vis.length === want.size;
+  updateOverlay();
+}
+
+async function fetchObject(id) {
+  const response = await fetch(withToken(`/api/object/${id}`));
+  if (!response.ok) throw new Error(`object ${id}: ${response.status} ${await response.text()}`);
+  const data = await response.arrayBuffer();
+  state.bytes += data.byteLength;
+  state.fetches++;
+  const gltf = await loader.parseAsync(data, '');
+  gltf.scene.traverse((o) => { o.matrixAutoUpdate = false; o.updateMatrix(); });
+  gltf.scene.updateMatrixWorld(true);
+  return gltf.scene;
+}
+
+// Fetches the requested objects not loaded yet, a few at a time.
+async function fetchMissing() {
+  const queue = state.requested.filter((id) => !objects.has(id) && !pending.has(id));
+  const worker = async () => {
+    while (queue.length) {
+      const id = queue.shift();
+      const p = fetchObject(id);
+      pending.set(id, p);
+      try {
+        const obj = await p;
+        obj.name = `object ${id}`;
+        objects.set(id, obj);
+        scene.add(obj);
+        state.loaded.push(id);
+        state.fetched_triangles += triangleCount.get(id) || 0;
+      } catch (e) {
+        showError(String(e.message || e));
+      } finally {
+        pending.delete(id);
+        applyVisibility();
+      }
+    }
+  };
+  await Promise.all(Array.from({ length: MAX_PARALLEL_FETCHES }, worker));
+}
+
+function frameBounds(b) {
+  const min = new THREE.Vector3(...b.min), max = new THREE.Vector3(...b.max);
+  const centre = min.clone().add(max).multiplyScalar(0.5);
+  const radius = Math.max(1e-3, max.clone().sub(min).length() * 0.5);
+  const dist = radius / Math.tan(THREE.MathUtils.degToRad(camera.fov * 0.5));
+  camera.position.copy(centre).add(new THREE.Vector3(0, 0.5, 1).normalize().multiplyScalar(dist));
+  camera.near = Math.max(0.01, dist * 1e-4);
+  camera.far = dist * 10 + radius * 10;
+  camera.updateProjectionMatrix();
+  controls.target.copy(centre);
+  controls.update();
+}
+
+async function cull() {
+  if (inFlight) {
+    again = true;
+    return;
+  }
+  inFlight = true;
+  state.idle = false;
+  try {
+    const response = await fetch(withToken('/api/cull'), {
+      method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(cameraJSON()),
+    });
+    const text = await response.text();
+    if (!response.ok) throw new Error(`cull: ${response.status} ${text}`);
+    const answer = JSON.parse(text);
+    state.lastAnswer = answer;
+    state.queries++;
+    state.total_objects = answer.total_objects;
+    state.total_triangles = answer.total_triangles;
+    if (!framed && answer.bounds) { // the first answer tells where the scene is: frame it, ask again
+      framed = true;
+      frameBounds(answer.bounds);
+      again = true;
+    } else {
+      for (const o of answer.objects) triangleCount.set(o.id, o.triangles);
+      state.requested = answer.objects.map((o) => o.id);
+    }
+  } catch (e) {
+    showError(String(e.message || e));
+  } finally {
+    inFlight = false;
+  }
+  if (again) {
+    again = false;
+    cull();
+    return;
+  }
+  applyVisibility();
+  await fetchMissing();
+  applyVisibility();
+}
+
+function scheduleCull() {
+  state.idle = false;
+  if (timer !== null) clearTimeout(timer);
+  timer = setTimeout(() => { timer = null; cull(); }, DEBOUNCE_MS);
+}
+
+function resize() {
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  renderer.setSize(w, h, false);
+  camera.aspect = w / Math.max(1, h);
+  camera.updateProjectionMatrix();
+  scheduleCull();
+}
+
+controls.addEventListener('change', scheduleCull);
+window.addEventListener('resize', resize);
+
+window.syClient = Object.assign(state, {
+  cameraJSON,
+  cull,
+  setView(position, target) {
+    camera.position.set(...position);
+    controls.target.set(...target);
+    controls.update();
+    framed = true;
+    scheduleCull();
+  },
+});
+
+renderer.setAnimationLoop(() => renderer.render(scene, camera));
+resize();
