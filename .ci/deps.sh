@@ -4,7 +4,8 @@ SY_PACKAGES="cmake ninja-build gcc g++ pkg-config libembree-dev libtinygltf-dev 
  libopenexr-dev libpng-dev libxxhash-dev libxml2-dev clang libclang-rt-14-dev
  libglfw3-dev libgl-dev xvfb xauth libosmesa6-dev libegl-dev
  libnng-dev libsodium-dev libzstd-dev iproute2 libfreetype-dev fonts-dejavu-core
- libopenmpi-dev openmpi-bin libimath-dev libcjson-dev doxygen"
+ libopenmpi-dev openmpi-bin libimath-dev libcjson-dev doxygen
+ libwebsockets-dev libturbojpeg0-dev"
 
 sy_install_deps() {
   local missing=()
