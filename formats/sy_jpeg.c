@@ -52,7 +52,9 @@ sy_result sy_jpeg_decode_rgba8(const uint8_t *jpeg, size_t len, size_t max_pixel
     uint8_t *px = NULL;
     if (tjDecompressHeader3(tj, jpeg, (unsigned long)len, &iw, &ih, &sub, &cs) != 0)
         r = sy_error_set(err, SY_ERR_PARSE, "jpeg: decode: bad header: %s", tjGetErrorStr2(tj));
-    else if (iw <= 0 || ih <= 0 || (uint32_t)iw > SY_JPEG_MAX_SIDE || (uint32_t)ih > SY_JPEG_MAX_SIDE ||
+    else if (iw <= 0 || ih <= 0)
+        r = sy_error_set(err, SY_ERR_PARSE, "jpeg: decode: the header gives the size %dx%d", iw, ih);
+    else if ((uint32_t)iw > SY_JPEG_MAX_SIDE || (uint32_t)ih > SY_JPEG_MAX_SIDE ||
              (size_t)iw * (size_t)ih > max_pixels)
         r = sy_error_set(err, SY_ERR_LIMIT, "jpeg: decode: %dx%d exceeds the limit (%zu pixels, side %u)", iw, ih,
                          max_pixels, SY_JPEG_MAX_SIDE);

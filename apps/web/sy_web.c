@@ -355,10 +355,12 @@ static int http_request(sy_web *w, struct lws *wsi, http_pss *p, const char *uri
 {
     memset(p, 0, sizeof *p);
     lws_get_peer_simple(wsi, p->peer, sizeof p->peer);
-    snprintf(p->path, sizeof p->path, "%s", uri ? uri : "/");
+    (void)uri; /* relative to the mount; the request line's path is taken instead */
     copy_query(wsi, p->query, sizeof p->query);
     bool post = lws_hdr_total_length(wsi, WSI_TOKEN_POST_URI) > 0;
     bool get = lws_hdr_total_length(wsi, WSI_TOKEN_GET_URI) > 0;
+    if (lws_hdr_copy(wsi, p->path, (int)sizeof p->path, post ? WSI_TOKEN_POST_URI : WSI_TOKEN_GET_URI) <= 0)
+        snprintf(p->path, sizeof p->path, "/");
     if (!host_ok(w, wsi)) {
         sy_log(SY_LOG_WARNING, "web", p->peer, "refused a request for a foreign Host (%s)", p->path);
         return respond_text(wsi, p, 403, "this server answers requests for a loopback host only");

@@ -19,7 +19,7 @@ typedef struct sy_web_client_opts {
     const char *host;   /**< e.g. "127.0.0.1" */
     uint16_t port;      /**< the server's port */
     const char *path;   /**< "/ws" or "/ws?token=..." (NULL: "/ws") */
-    const char *origin; /**< the Origin header to send (NULL: none) */
+    const char *origin; /**< the Origin header's host[:port] (libwebsockets writes http:// before it; NULL: none) */
 } sy_web_client_opts;
 
 /** A frame's header (docs/WEB.md). */
