@@ -24,7 +24,10 @@ typedef struct sy_web_client_opts {
 
 /** A frame's header (docs/WEB.md). */
 typedef struct sy_web_frame_info {
-    uint32_t width, height, backend, samples; /**< size, back-end index, samples per pixel */
+    uint32_t width;     /**< frame width */
+    uint32_t height;    /**< frame height */
+    uint32_t backend;   /**< back-end index (registry order, the hello message) */
+    uint32_t samples;   /**< samples per pixel accumulated (progressive back-ends) */
     float render_ms;    /**< the server's render time */
     uint64_t seq;       /**< the frame's number */
     uint64_t input_id;  /**< the newest input of this client it answers */

@@ -12,6 +12,7 @@
  *                 differs from the one before; malformed messages are ignored and serving goes on;
  *                 a message over the limit closes that connection only; foreign Origin and missing
  *                 subprotocol upgrades are refused
+ *   web_progressive  the path tracer refines while the view rests and restarts when it moves
  *   web_token     listening on 0.0.0.0: without the token 401 with the page saying it is missing,
  *                 a wrong one 403, the right one 200 plus a cookie that works alone; WebSocket
  *                 upgrades need it too */
@@ -158,14 +159,14 @@ static sy_result route_echo(void *user, sy_scene *scene, const sy_web_request *r
     return SY_OK;
 }
 
-static int start(server *s, const char *listen, sy_error *e)
+static int start(server *s, const char *listen, const char *backend, sy_error *e)
 {
     memset(s, 0, sizeof *s);
     sy_demo_info demo;
     if (sy_scene_create(&s->scene, e) || sy_demo_build(s->scene, &demo, e) || sy_scene_commit(s->scene, NULL, e)) return 1;
     static const sy_web_route routes[] = {{"GET", "/api/object/", route_info, NULL}, {"POST", "/api/echo", route_echo, NULL}};
     sy_web_desc d = {.scene = s->scene, .root = demo.root, .camera = demo.camera, .background = demo.background,
-                     .backend = "whitted", .listen = listen, .max_body = 1000, .max_message = 256,
+                     .backend = backend, .listen = listen, .max_body = 1000, .max_message = 256,
                      .routes = routes, .route_count = 2};
     if (sy_web_create(&d, &s->web, e)) return 1;
     return pthread_create(&s->th, NULL, server_main, s) != 0;
@@ -350,11 +351,46 @@ static int test_stream(uint16_t port)
     return 0;
 }
 
+/* the path tracer refines while the view rests (samples grow frame after frame) and restarts
+ * when it moves (the frame answering a drag has fewer samples than the one before) */
+static int test_progressive(void)
+{
+    sy_error err = {0};
+    server s;
+    if (start(&s, "127.0.0.1:0", "pathtracer", &err)) {
+        fprintf(stderr, "start: %s\n", err.message);
+        return 1;
+    }
+    sy_web_client *c = NULL;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err));
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":48,\"h\":32}", &err));
+    sy_web_frame_info fi = {0};
+    do {
+        if (next_frame(c, &fi, NULL, NULL)) return 1;
+    } while (fi.width != 48);
+    uint32_t prev = fi.samples, rising = 0;
+    while (rising < 4) { /* four frames in a row, each with more samples */
+        if (next_frame(c, &fi, NULL, NULL)) return 1;
+        CHECK(fi.width == 48 && fi.samples > prev);
+        prev = fi.samples, rising++;
+    }
+    CHECK(prev >= 5);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"drag\",\"dx\":30,\"dy\":0,\"id\":1}", &err));
+    do {
+        if (next_frame(c, &fi, NULL, NULL)) return 1;
+    } while (fi.input_id < 1);
+    if (fi.samples >= prev) fprintf(stderr, "after the drag: %u samples, before %u\n", fi.samples, prev);
+    CHECK(fi.samples < prev);
+    sy_web_client_close(c);
+    return stop(&s);
+}
+
 static int test_token(void)
 {
     sy_error err = {0};
     server s;
-    if (start(&s, "0.0.0.0:0", &err)) {
+    if (start(&s, "0.0.0.0:0", "whitted", &err)) {
         fprintf(stderr, "start: %s\n", err.message);
         return 1;
     }
@@ -400,9 +436,13 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s\n", err.message);
         return 1;
     }
-    if (!strcmp(which, "token")) return test_token();
+    if (!strcmp(which, "token") || !strcmp(which, "progressive")) {
+        int f = !strcmp(which, "token") ? test_token() : test_progressive();
+        if (!f) printf("web %s: ok\n", which);
+        return f;
+    }
     server s;
-    if (start(&s, "127.0.0.1:0", &err)) {
+    if (start(&s, "127.0.0.1:0", "whitted", &err)) {
         fprintf(stderr, "start: %s\n", err.message);
         return 1;
     }
