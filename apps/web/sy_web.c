@@ -1097,7 +1097,8 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         pthread_mutex_lock(&w->mu);
         for (;;) {
             if (w->quit || (stop && *stop) || w->pending) break;
-            if (w->clients && (w->view_version != seen || refine)) break;
+            /* frames once a page said its size (the page does as it connects) */
+            if (w->clients && w->display_w && (w->view_version != seen || refine)) break;
             struct timespec ts;
             clock_gettime(CLOCK_REALTIME, &ts);
             ts.tv_nsec += 100000000;
@@ -1117,7 +1118,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         uint32_t bi = w->backend, dw = w->display_w, dh = w->display_h, filter = w->filter;
         float threshold = w->threshold;
         uint64_t fv = w->filter_version, gen = w->input_gen;
-        bool clients = w->clients > 0;
+        bool clients = w->clients > 0 && w->display_w > 0;
         pthread_mutex_unlock(&w->mu);
         while (jobs) { /* stills and routes first: they wait on an HTTP connection */
             web_job *j = jobs;
