@@ -11,7 +11,7 @@
  *   web_stream    a viewer receives JPEG frames; a drag message gives a frame tagged with its id that
  *                 differs from the one before; malformed messages are ignored and serving goes on;
  *                 a message over the limit closes that connection only; foreign Origin and missing
- *                 subprotocol upgrades are refused
+ *                 subprotocol upgrades are refused; a viewer beyond max_clients is refused
  *   web_progressive  the path tracer refines while the view rests and restarts when it moves
  *   web_token     listening on 0.0.0.0: without the token 401 with the page saying it is missing,
  *                 a wrong one 403, the right one 200 plus a cookie that works alone; WebSocket
@@ -166,7 +166,7 @@ static int start(server *s, const char *listen, const char *backend, sy_error *e
     if (sy_scene_create(&s->scene, e) || sy_demo_build(s->scene, &demo, e) || sy_scene_commit(s->scene, NULL, e)) return 1;
     static const sy_web_route routes[] = {{"GET", "/api/object/", route_info, NULL}, {"POST", "/api/echo", route_echo, NULL}};
     sy_web_desc d = {.scene = s->scene, .root = demo.root, .camera = demo.camera, .background = demo.background,
-                     .backend = backend, .listen = listen, .max_body = 1000, .max_message = 256,
+                     .backend = backend, .listen = listen, .max_body = 1000, .max_message = 256, .max_clients = 3,
                      .routes = routes, .route_count = 2};
     if (sy_web_create(&d, &s->web, e)) return 1;
     return pthread_create(&s->th, NULL, server_main, s) != 0;
@@ -348,6 +348,15 @@ static int test_stream(uint16_t port)
     int rc = http(port, req, NULL, 0, &a);
     CHECK(rc != 0 || a.status != 101);
     if (rc == 0) free(a.body);
+    /* at most 3 viewers (max_clients): a fourth is refused (the server may still be closing the
+     * connections above: each of the three is retried a while) */
+    sy_web_client *v[3] = {NULL, NULL, NULL};
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 50 && !v[i]; ++k)
+            if (sy_web_client_connect(&o, 10000, &v[i], &err) != SY_OK) usleep(100000);
+    CHECK(v[0] && v[1] && v[2]);
+    CHECK(sy_web_client_connect(&o, 10000, &c, &err) == SY_ERR_PROTOCOL);
+    for (int i = 0; i < 3; ++i) sy_web_client_close(v[i]);
     return 0;
 }
 
