@@ -585,14 +585,19 @@ struct web_conn {
     uint64_t sent_seq, sent_status;
     uint64_t last_id, last_gen, answered_id; /* the newest input id and the generation it got */
     bool hello_sent;
-    web_frame *sending; /* held while lws_write runs */
+    uint32_t warned;    /* malformed messages logged */
     char *msg;          /* a text message being assembled (max_message bytes) */
     size_t msg_len;
 };
 
+/* A malformed message: logged with the client's address, the first 10 per connection (a flood
+ * does not flood the log). */
 static void ws_warn(web_conn *c, const char *what, const char *detail)
 {
-    sy_log(SY_LOG_WARNING, "web", c->peer, "ignored a message: %s%s%.80s", what, detail ? ": " : "", detail ? detail : "");
+    if (c->warned >= 10) return;
+    c->warned++;
+    sy_log(SY_LOG_WARNING, "web", c->peer, "ignored a message: %s%s%.80s%s", what, detail ? ": " : "", detail ? detail : "",
+           c->warned == 10 ? " (further ones from this client are not logged)" : "");
 }
 
 static bool json_num(const cJSON *o, const char *key, double lo, double hi, double *out)
