@@ -7,7 +7,8 @@
  *   web_still     /api/frame.jpg?w=&h= is a JPEG of that size that is not uniform; bad sizes get 400
  *                 with the reason
  *   web_routes    a GET route and a POST route run on the render thread (the body arrives whole);
- *                 a body over the limit gets 413
+ *                 a body over the limit gets 413; garbage, huge headers and cut-off requests
+ *                 leave the server serving
  *   web_stream    a viewer receives JPEG frames; a drag message gives a frame tagged with its id that
  *                 differs from the one before; malformed messages are ignored and serving goes on;
  *                 a message over the limit closes that connection only; foreign Origin and missing
@@ -269,6 +270,25 @@ static int test_routes(uint16_t port)
              port);
     CHECK(http(port, req, "{}", 2, &a) == 0 && a.status == 404);
     free(a.body);
+    /* hostile requests: garbage, a header far over lws's limit, a path of 4000 bytes, a request cut
+     * off; each may be answered with an error or closed, and the server keeps serving */
+    static char huge[20000];
+    memset(huge, 'A', sizeof huge - 1);
+    const char *junk[] = {"\x01\x02garbage\r\n\r\n", "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Big: ", "GET /", huge};
+    for (size_t i = 0; i < sizeof junk / sizeof junk[0]; ++i) {
+        char r2[24000];
+        snprintf(r2, sizeof r2, "%s%s", junk[i], i == 1 ? huge : "");
+        if (http(port, r2, NULL, 0, &a) == 0) {
+            CHECK(a.status >= 400 || a.status == 0);
+            free(a.body);
+        }
+    }
+    char longpath[4200] = "/";
+    memset(longpath + 1, 'p', 4000);
+    if (get(port, longpath, NULL, &a) == 0) {
+        CHECK(a.status >= 400);
+        free(a.body);
+    }
     /* the server still serves */
     CHECK(get(port, "/", NULL, &a) == 0 && a.status == 200);
     free(a.body);
