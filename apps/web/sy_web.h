@@ -71,7 +71,7 @@ typedef struct sy_web_desc {
     sy_scene *scene;          /**< borrowed; touched only by the thread in sy_web_run */
     sy_node root;             /**< {0}: every root */
     sy_node camera;           /**< a node carrying a camera: the view starts there (required) */
-    sy_background background; /**< {0}: the scene's */
+    sy_background background; /**< what the camera sees where nothing is hit ({0}: black, as sy_viewport_desc) */
     const char *backend;      /**< the initial back-end (a registered name) */
     const char *listen;       /**< "HOST:PORT" (NULL: "127.0.0.1:8080"); port 0 = a free one */
     const char *token;        /**< access token (hex, >= 16 characters); NULL: generated when HOST is
