@@ -1483,7 +1483,9 @@ static int cmd_web(int argc, char **argv)
     sy_web *web = NULL;
     sy_result r = sy_web_create(&d, &web, &err);
     if (r == SY_OK) {
-        printf("sy web: serving %s with %s; open %s\n", argv[optind], backend, sy_web_url(web));
+        const char *url = sy_web_url(web);
+        printf("sy web: serving %s with %s; open %s%s\n", argv[optind], backend, url,
+               strstr(url, "//0.0.0.0:") || strstr(url, "//[::]:") ? " (with this machine's name or address for the host)" : "");
         fflush(stdout);
         sy_signals_set_graceful("closing the server");
         r = sy_web_run(web, sy_signals_stop_flag(), &err);
