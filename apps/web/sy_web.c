@@ -985,7 +985,7 @@ static void run_job(sy_web *w, render_state *rs, web_job *j, const sy_orbit *o)
         const sy_mediator_class *cls = sy_mediator_at(rs->backend_applied);
         uint32_t spp = cls && (cls->caps & SY_CAP_PROGRESSIVE) ? w->d.still_samples : 1;
         r = apply_camera(w, rs, o, &err);
-        if (r == SY_OK) r = sy_viewport_set_backend(rs->still_vp, cls ? cls->name : w->d.backend, NULL, &err);
+        if (r == SY_OK) r = sy_viewport_set_backend(rs->still_vp, (cls ? cls : sy_mediator_at(w->initial_backend))->name, NULL, &err);
         if (r == SY_OK) r = render_rgba8(w, rs, rs->still_win, j->w, j->h, spp, &px, &err);
         if (r == SY_OK) r = sy_jpeg_encode_rgba8(px, j->w, j->h, 95, &j->resp.body, &j->resp.body_len, &err);
         free(px);

@@ -66,7 +66,8 @@ typedef struct sy_web_route {
     void *user;         /**< passed to fn */
 } sy_web_route;
 
-/** What the server serves. Zero fields take the defaults named. */
+/** What the server serves. Zero fields take the defaults named. Its strings are read during
+ * sy_web_create only; the routes array is copied. */
 typedef struct sy_web_desc {
     sy_scene *scene;          /**< borrowed; touched only by the thread in sy_web_run */
     sy_node root;             /**< {0}: every root */
