@@ -67,7 +67,7 @@ typedef struct sy_web_route {
 } sy_web_route;
 
 /** What the server serves. Zero fields take the defaults named. Its strings are read during
- * sy_web_create only; the routes array is copied. */
+ * sy_web_create only (the routes' strings excepted). */
 typedef struct sy_web_desc {
     sy_scene *scene;          /**< borrowed; touched only by the thread in sy_web_run */
     sy_node root;             /**< {0}: every root */
@@ -87,7 +87,7 @@ typedef struct sy_web_desc {
     uint32_t idle_timeout_s;  /**< a silent WebSocket is pinged, then closed after twice this (default 30) */
     const char *filter;       /**< initial display filter of a back-end with SY_CAP_FILTERS (NULL: none) */
     float threshold;          /**< its threshold (0: 0.01) */
-    const sy_web_route *routes; /**< extra routes (copied; their user pointers are borrowed) */
+    const sy_web_route *routes; /**< extra routes (the array is copied; its strings and user pointers must outlive the server) */
     uint32_t route_count;     /**< how many */
 } sy_web_desc;
 
