@@ -10,7 +10,7 @@
 # apps/sy_cluster_cli.c; tests/integration/completion_test.sh checks a few.
 
 _sy_commands="info render demo compare coverage view web bench backends serve help version"
-_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory web"
+_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor web"
 _sy_common="--help -q --quiet -v --verbose --env --env-color --env-intensity --env-hidden --background
             --no-default-light --allow-path --strict"
 _sy_cluster="--cluster --cluster-mode --secret-file --tls-ca --timeout-ms --cluster-pixels"
@@ -20,16 +20,16 @@ _sy_with_value=" -b -o -w -h --camera --params --max-memory --gl --filter --thre
   --timeout-ms --cluster-pixels --screenshot --keys --top --backends --repeats --nodes --tris --reference --env
   --env-color --env-intensity --background --allow-path --listen --output --port-file --tls-cert --tls-key --name
   --max-sessions --max-lifetime --blob-cache-mb --max-objects --auth-backoff-ms --max-peer-memory-mb
-  --max-frame-kb --max-message-mb --max-unauthenticated --handshake-timeout-ms --coop-frame --quality "
+  --max-frame-kb --max-message-mb --max-unauthenticated --handshake-timeout-ms --coop-frame --budget --quality "
 
 # _sy_options COMMAND [BENCH_KIND]: the options of a command
 _sy_options() {
     case "${1:-}" in
     render) echo "-b -o -w -h --camera --params --max-memory --gl --filter --threshold --half --exposure --tonemap --stereo
                   --eye-sep --zero-parallax --overlay --composite --frames --spp --time --aov $_sy_cluster $_sy_common" ;;
-    view) echo "-b -w -h --camera --overlay --composite --frames --screenshot --filter --threshold --keys --spp
+    view) echo "-b -w -h --camera --overlay --composite --frames --screenshot --filter --threshold --keys --spp --budget
                 $_sy_cluster $_sy_common" ;;
-    web) echo "-b -w -h --camera --listen --quality --filter --threshold --client-render $_sy_common" ;;
+    web) echo "-b -w -h --camera --listen --quality --filter --threshold --budget --client-render $_sy_common" ;;
     info) echo "--json $_sy_common" ;;
     compare) echo "-w -h -o --spp --camera --backends $_sy_common" ;;
     coverage) echo "-w -h --camera --top --json $_sy_common" ;;
@@ -44,6 +44,7 @@ _sy_options() {
         filters) echo "-w -h --repeats --reference $_sy_common" ;;
         memory) echo "-w -h -b --tris --glb $_sy_common" ;;
         web) echo "-w -h -b --repeats $_sy_common" ;;
+        governor) echo "-w -h --budget --frames --tris --trace --help -q -v" ;;
         *) echo "-w -h --repeats --nodes --tris --params $_sy_common" ;;
         esac ;;
     "") echo "--version --help -h -q --quiet -v --verbose" ;;

@@ -94,8 +94,8 @@ static void print_sync(const char *title, sync_result *sr, uint32_t repeats, uin
     print_spread("  core: set + commit", sr->core, repeats, NULL);
     if (sr->has_embree) {
         char note[96];
-        snprintf(note, sizeof note, "rtcCommitScene over %u instances", instances);
-        print_spread("  Embree top-level rebuild", sr->embree, repeats, note);
+        snprintf(note, sizeof note, "rtcCommitScene: the moved instances' scene (%u instances in all)", instances);
+        print_spread("  Embree commits", sr->embree, repeats, note);
         print_spread("  ours (all but Embree's)", sr->ours, repeats, "core + pull + mirror + mediator + back-end");
     }
     printf("    ratio full / incremental       %9.1f x   (goal >= 10000)\n", sr->full / med_total);

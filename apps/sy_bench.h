@@ -69,6 +69,14 @@ sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, co
 sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
                                  uint32_t height, const char *reference_exr, const char *png_path, sy_error *err);
 
+/* sy bench instances (sy_bench_instances.c, built with the Embree back-ends): `instances` nodes
+ * instancing one height field of about `tris` triangles, rendered with every picture back-end:
+ * first frame (translation included), median and worst frame of an orbit of `frames` frames, the
+ * rasterizer's triangles drawn and instances culled, coverage IoU against Whitted, peak RSS. `only`
+ * (NULL = all): that back-end alone (Whitted still renders its first frame for the IoU). */
+sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, uint32_t height, uint32_t frames,
+                             const char *only, sy_error *err);
+
 /* Minimum, median and maximum of n > 0 values (sorts v in place): benchmarks report the median of
  * their rounds with the spread. */
 typedef struct sy_bench_spread {

@@ -32,6 +32,7 @@
  * the file and the reason. Exit status: 0 success, 1 failure, 2 usage error (the bad option or value
  * is named), 130 interrupted. Bash completion: apps/sy-completion.bash. */
 #include "sy_bench.h"
+#include "sy_bench_governor.h"
 #include "sy_cluster_cli.h"
 #include "sy_mediator_cluster.h"
 #include "sy_compare.h"
@@ -162,7 +163,8 @@ enum {
     /* the commands' own long options (cluster ones: SY_CLUSTER_OPT_*, sy_cluster_cli.h) */
     OPT_SPP, OPT_TIME, OPT_AOV, OPT_CAMERA, OPT_PARAMS, OPT_GL, OPT_FILTER, OPT_THRESHOLD, OPT_HALF, OPT_EXPOSURE,
     OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
-    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB, OPT_MAX_MEMORY
+    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB, OPT_MAX_MEMORY,
+    OPT_BUDGET
 };
 /* getopt_long entries of the options of every command, with the table's terminator: the end of
  * every command's table */
@@ -589,10 +591,11 @@ static const char usage_text[] =
             "  sy view SCENE [-b BACKEND] [-w W] [-h H] [--camera C] [--overlay FILE[:BACKEND]]\n"
             "          [--frames N --screenshot OUT.png] [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]\n"
             "          [--keys KEYS]   (automated runs: press these keys one frame after another, e.g. F]F[)\n"
+            "          [--budget MS]   (frame time while the view moves: the resolution follows it; default 33)\n"
             "          [--cluster URL[,URL...]|FILE.conf [--cluster-mode MODE] [--secret-file F] [--timeout-ms MS]\n"
             "           [--spp SAMPLES_PER_SERVER_AND_FRAME]]   (the same cluster options as sy render)\n"
             "  sy web SCENE [-b BACKEND] [--listen HOST:PORT] [--camera C] [-w MAX_W] [-h MAX_H] [--quality Q]\n"
-            "          [--filter none|pixel|...] [--threshold T] [--client-render]   (the view in a web browser:\n"
+            "          [--filter none|pixel|...] [--threshold T] [--budget MS] [--client-render]   (the view in a browser:\n"
             "           open the URL it prints; another address than loopback needs the printed token)\n"
             "  sy bench web [SCENE] [-b BACKEND] [-w W] [-h H] [--repeats N]   (input-to-frame latency, loopback)\n"
             "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"
@@ -603,6 +606,9 @@ static const char usage_text[] =
             "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
             "  sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]\n"
             "  sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   (peak RSS per triangle)\n"
+            "  sy bench instances [--nodes INSTANCES] [--tris PER_MESH] [-w W] [-h H] [--repeats FRAMES] [-b BACKEND]\n"
+            "            (one mesh instanced: 10^3 x 10^6 triangles by default, every picture back-end)\n"
+            "  sy bench governor [SCENE] [--budget MS] [--frames N] [-w W] [-h H]   (frame-time governor, orbiting camera)\n"
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy backends [--params] [--json]\n"
             "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
@@ -1375,7 +1381,9 @@ static int cmd_view(int argc, char **argv)
         {"screenshot", required_argument, NULL, OPT_SCREENSHOT}, {"filter", required_argument, NULL, OPT_FILTER},
         {"threshold", required_argument, NULL, OPT_THRESHOLD}, {"keys", required_argument, NULL, OPT_KEYS},
         {"spp", required_argument, NULL, OPT_SPP}, /* cluster: samples per server and frame */
+        {"budget", required_argument, NULL, OPT_BUDGET}, /* the frame-time governor's budget (ms) */
         SY_CLUSTER_CLI_OPTIONS, COMMON_OPTIONS};
+    double budget = 0.0;
     int c, status = 0;
     optind = 0;
     while ((c = next_option("view", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, &status)) != -1) {
@@ -1402,6 +1410,10 @@ static int cmd_view(int argc, char **argv)
             if (end == optarg || *end) return bad_value("--threshold", optarg);
             break;
         case OPT_KEYS: view_keys = optarg; break;
+        case OPT_BUDGET:
+            budget = strtod(optarg, &end);
+            if (end == optarg || *end || !(budget >= 1.0 && budget <= 10000.0)) return bad_value("--budget", optarg);
+            break;
         case OPT_SPP:
             if (!parse_u32(optarg, 1, 100000000u, &clo.samples)) return bad_value("--spp", optarg);
             break;
@@ -1422,6 +1434,7 @@ static int cmd_view(int argc, char **argv)
     va.filter = view_filter;
     va.threshold = view_threshold;
     va.keys = view_keys;
+    va.budget_ms = budget;
     va.cluster = clo.cluster ? &clo : NULL;
     va.spec.root = ld.root;
     va.spec.camera = ld.camera;
@@ -1444,10 +1457,11 @@ static int cmd_web(int argc, char **argv)
     const char *backend = "whitted", *camera = NULL, *listen = NULL, *filter = NULL;
     uint32_t w = 1920, h = 1200, quality = 80;
     float threshold = 0.0f;
+    double budget = 0; /* 0: the governor's default (33 ms) */
     static const struct option lo[] = {
         {"camera", required_argument, NULL, OPT_CAMERA}, {"listen", required_argument, NULL, OPT_WEB_LISTEN},
         {"quality", required_argument, NULL, OPT_WEB_QUALITY}, {"filter", required_argument, NULL, OPT_FILTER},
-        {"threshold", required_argument, NULL, OPT_THRESHOLD},
+        {"threshold", required_argument, NULL, OPT_THRESHOLD}, {"budget", required_argument, NULL, OPT_BUDGET},
         {"client-render", no_argument, NULL, OPT_WEB_CLIENT_RENDER}, COMMON_OPTIONS};
     int c, status = 0;
     optind = 0;
@@ -1470,6 +1484,10 @@ static int cmd_web(int argc, char **argv)
             threshold = strtof(optarg, &end);
             if (end == optarg || *end || !(threshold >= 0.0f) || !isfinite(threshold)) return bad_value("--threshold", optarg);
             break;
+        case OPT_BUDGET: /* the frame-time governor's budget (ms) */
+            budget = strtod(optarg, &end);
+            if (end == optarg || *end || !(budget >= 1.0 && budget <= 10000.0)) return bad_value("--budget", optarg);
+            break;
         case OPT_WEB_CLIENT_RENDER: break; /* the client-render page comes with remote culling (issue 18, part 4) */
         }
     }
@@ -1479,7 +1497,7 @@ static int cmd_web(int argc, char **argv)
     if (load(argv[optind], camera, true, &ld, &err) != SY_OK) return fail(&err);
     sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,
                      .backend = backend, .listen = listen, .max_width = w, .max_height = h, .quality = (int)quality,
-                     .filter = filter, .threshold = threshold};
+                     .filter = filter, .threshold = threshold, .budget_ms = budget};
     sy_web *web = NULL;
     sy_result r = sy_web_create(&d, &web, &err);
     if (r == SY_OK) {
@@ -1723,7 +1741,7 @@ static int cmd_bench_filters(int argc, char **argv)
 static int cmd_bench(int argc, char **argv)
 {
     static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
-                                        "viewports", "load", "cluster",    "memory", "web"};
+                                        "viewports", "load", "cluster",    "memory", "instances", "governor", "web"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -1738,9 +1756,10 @@ static int cmd_bench(int argc, char **argv)
     argc -= 1, argv += 1; /* argv[0]: the kind */
     if (!strcmp(cmd, "filters")) return cmd_bench_filters(argc, argv);
     if (!strcmp(cmd, "cluster")) return sy_cmd_bench_cluster(argc, argv);
+    if (!strcmp(cmd, "governor")) return sy_cmd_bench_governor(argc, argv); /* sy_bench_governor.c */
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
     const char *scene = NULL, *params = NULL, *backend = NULL;
-    bool memory = !strcmp(cmd, "memory"), web = !strcmp(cmd, "web");
+    bool memory = !strcmp(cmd, "memory"), instanced = !strcmp(cmd, "instances"), web = !strcmp(cmd, "web");
     static const struct option lo[] = {{"params", required_argument, NULL, OPT_PARAMS},
                                        {"nodes", required_argument, NULL, OPT_NODES},
                                        {"tris", required_argument, NULL, OPT_TRIS},
@@ -1751,20 +1770,21 @@ static int cmd_bench(int argc, char **argv)
     bool glb = false;
     int c, status = 0;
     optind = 0;
-    while ((c = next_option(who, argc, argv, memory || web ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
+    while ((c = next_option(who, argc, argv, memory || instanced || web ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"), lo,
+                            &status)) != -1) {
         switch (c) {
         case OPT_STOP: return status;
         case OPT_PARAMS: params = optarg; break; /* bench raster */
-        case 'b': backend = optarg; break; /* bench memory, bench web */
+        case 'b': backend = optarg; break; /* bench memory, bench instances, bench web */
         case OPT_GLB:
             if (!memory) return usage_of(who, "--glb is an option of sy bench memory");
             glb = true;
             break;
-        case OPT_NODES:
+        case OPT_NODES: /* bench sync: nodes; bench instances: instances */
             if (!parse_u32(optarg, 1, 1u << 22, &nodes)) return bad_value("--nodes", optarg);
             break;
         case OPT_TRIS:
-            if (!parse_u32(optarg, 12, memory ? 1u << 30 : 1u << 20, &tris)) return bad_value("--tris", optarg);
+            if (!parse_u32(optarg, 12, memory || instanced ? 1u << 30 : 1u << 20, &tris)) return bad_value("--tris", optarg);
             break;
         case OPT_REPEATS:
             if (!parse_u32(optarg, 1, 100000, &repeats)) return bad_value("--repeats", optarg);
@@ -1790,6 +1810,16 @@ static int cmd_bench(int argc, char **argv)
         return sy_bench_memory(tris == 100 ? 1000000 : tris, backend, glb, w == 512 ? 256 : w, h == 512 ? 256 : h, &err) == SY_OK
                    ? 0
                    : fail(&err);
+    }
+    if (instanced) {
+        if (optind < argc) return usage_of(who, "no SCENE: the instanced height field is generated");
+#ifdef SY_HAVE_EMBREE
+        return sy_bench_instances(nodes == 10000 ? 1000 : nodes, tris == 100 ? 1000000 : tris, w == 512 ? 320 : w,
+                                  h == 512 ? 240 : h, repeats ? repeats : 10, backend, &err) == SY_OK ? 0 : fail(&err);
+#else
+        sy_error_set(&err, SY_ERR_UNSUPPORTED, "sy bench instances: this sy was built without the Embree back-ends");
+        return fail(&err);
+#endif
     }
     if (!strcmp(cmd, "load")) /* SCENE = the glTF sample directory; --tris: generated model (default 1M) */
         return sy_bench_load(scene ? scene : "../shared/testdata/gltf", tris == 100 ? 1000000 : tris,

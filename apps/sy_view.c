@@ -2,6 +2,7 @@
  * scene (see sy_view.h). */
 #include "sy_view.h"
 
+#include "sy_governor.h"
 #include "sy_log.h"
 #include "sy_orbit.h"
 #include "sy_mediator_cluster.h"
@@ -48,6 +49,9 @@ typedef struct viewer {
     uint64_t img_req;       /* the req_version the image answers (scripted --keys wait for it) */
     double frame_ms, sync_ms;
     uint64_t spp;
+    float img_scale;  /* the governor's resolution scale of the image (1 = full size) */
+    bool img_moving;  /* a moving frame (reduced size): --frames counts only settled ones */
+    bool governed;    /* local rendering (the governor's scale is in the title) */
     char status[256];
     char filter_status[96];
     sy_error error;
@@ -61,11 +65,12 @@ static const char *const view_filters[] = {"none", "pixel", "atrous", "jbu", "ad
 /* Render thread: applies the requested filter to the path tracer's context when it changed (or the
  * context is new); fills status (empty for other back-ends). Errors go to status, not fatal. */
 static void view_apply_filter(sy_context_pool *pool, const sy_view_args *a, const sy_mediator_class *cls,
-                              uint32_t filter, float threshold, uint64_t version, void **applied_state,
-                              uint64_t *applied_version, char *status, size_t len)
+                              uint32_t filter, float threshold, uint64_t version, bool enabled, void **applied_state,
+                              uint64_t *applied_version, bool *applied_enabled, char *status, size_t len)
 {
     status[0] = 0;
     if (!(cls->caps & SY_CAP_FILTERS)) return;
+    const char *chosen = view_filters[filter % VIEW_FILTER_COUNT];
     sy_context *ctx = NULL;
     sy_error err = {0};
     if (sy_context_pool_get(pool, a->scene, cls->name, NULL, a->spec.root.id, &ctx, &err) != SY_OK) {
@@ -73,17 +78,22 @@ static void view_apply_filter(sy_context_pool *pool, const sy_view_args *a, cons
         return;
     }
     void *state = sy_context_state(ctx);
-    if (state != *applied_state || version != *applied_version) {
+    if (state != *applied_state || version != *applied_version || enabled != *applied_enabled) {
         sy_params opts = {0};
         char t[32];
         snprintf(t, sizeof t, "%g", (double)threshold);
         if (sy_params_set(&opts, "threshold", t, &err) != SY_OK ||
-            sy_context_set_filter(ctx, view_filters[filter % VIEW_FILTER_COUNT], &opts, &err) != SY_OK) {
+            sy_context_set_filter(ctx, enabled ? chosen : "none", &opts, &err) != SY_OK) {
             snprintf(status, len, " | filter: %.80s", err.message);
             return;
         }
         *applied_state = state;
         *applied_version = version;
+        *applied_enabled = enabled;
+    }
+    if (!enabled && strcmp(chosen, "none") != 0) { /* the governor keeps it off while the view moves */
+        snprintf(status, len, " | filter %s t=%g off while moving", chosen, (double)threshold);
+        return;
     }
     sy_filter_info fi;
     sy_context_filter_info(ctx, &fi);
@@ -249,6 +259,22 @@ static sy_result view_cluster_frame(view_cluster *vc, const sy_view_args *a, sy_
 }
 
 /* >>render thread */
+/* Waits on the viewer's condition variable until ms_left ms passed (monotonic clock: view_run sets
+ * the condition's clock). */
+static void view_wait_ms(viewer *v, double ms_left)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    double ns = (double)ts.tv_nsec + ms_left * 1e6;
+    ts.tv_sec += (time_t)(ns / 1e9);
+    ts.tv_nsec = (long)fmod(ns, 1e9);
+    pthread_cond_timedwait(&v->cv, &v->mu, &ts);
+}
+
+/* Local rendering goes through the frame-time governor (core/sy_governor.h): while the view moves
+ * each frame renders at the size that fits the budget (the display scales the image up), then the
+ * view refines (full size, progressive samples per frame within the budget) and the thread sleeps
+ * until input. The cluster renders at full size and refines on its own schedule. */
 static void *render_main(void *p)
 {
     viewer *v = p;
@@ -258,17 +284,35 @@ static void *render_main(void *p)
     uint64_t seen = 0, cl_seen = 0;
     sy_mat4 cam_applied;
     memset(&cam_applied, 0, sizeof cam_applied);
-    bool refine = false;
+    bool again = false;     /* plan (or, cluster: render) again without waiting for input */
+    double wait_until = 0;  /* ms (sy_time_now): the governor's settle wait, 0 = none */
     void *filter_state = NULL;
     uint64_t filter_applied = 0;
+    bool filter_enabled = false;
     char fstatus[96] = "";
+    sy_governor *gov = NULL;
+    if (sy_governor_create(&(sy_governor_desc){.budget_ms = a->budget_ms}, &gov, &err) != SY_OK) goto fail_unlocked;
+    /* what the last planned frame showed: a difference is a view change for the governor */
+    uint32_t prev_bi = UINT32_MAX, prev_stereo = 0, prev_w = 0, prev_h = 0;
+    bool prev_overlay = false;
+    uint64_t prev_filter_version = 0;
     for (;;) {
         pthread_mutex_lock(&v->mu);
-        while (!v->quit && seen == v->req_version && !refine) pthread_cond_wait(&v->cv, &v->mu);
+        while (!v->quit && seen == v->req_version && !again) {
+            if (wait_until <= 0) {
+                pthread_cond_wait(&v->cv, &v->mu);
+                continue;
+            }
+            double left = wait_until - sy_time_now() * 1e3;
+            if (left <= 0) break;
+            view_wait_ms(v, left);
+        }
         if (v->quit) {
             pthread_mutex_unlock(&v->mu);
             break;
         }
+        again = false;
+        wait_until = 0;
         seen = v->req_version;
         sy_mat4 cam = v->cam;
         uint32_t bi = v->backend, stereo = v->stereo, w = v->w, h = v->h;
@@ -282,12 +326,18 @@ static void *render_main(void *p)
         if (!cls) cls = sy_mediator_at(0);
         if (cls->caps & SY_CAP_REMOTE) cls = sy_mediator_find(a->backend); /* the cluster is not a choice of its own */
         if (!cls) cls = sy_mediator_at(0);
+        bool changed = !sy_mat4_equal(&cam, &cam_applied) || bi != prev_bi || stereo != prev_stereo || w != prev_w ||
+                       h != prev_h || overlay != prev_overlay;
         if (!sy_mat4_equal(&cam, &cam_applied)) {
             if (sy_node_set_matrix(a->scene, v->cam_node, &cam, &err) != SY_OK ||
                 sy_scene_commit(a->scene, NULL, &err) != SY_OK)
                 goto fail_unlocked;
             cam_applied = cam;
         }
+        if (bi != prev_bi) sy_governor_reset(gov); /* another back-end: another cost */
+        if (filter_version != prev_filter_version) sy_governor_redraw(gov); /* shown again, same samples */
+        prev_bi = bi, prev_stereo = stereo, prev_w = w, prev_h = h, prev_overlay = overlay;
+        prev_filter_version = filter_version;
         sy_compose_spec spec = a->spec;
         spec.backend = cls->name;
         spec.params = NULL;
@@ -295,10 +345,23 @@ static void *render_main(void *p)
         spec.has_overlay = a->spec.has_overlay && overlay;
         spec.stereo = stereo;
         uint32_t ew = stereo == SY_STEREO_SBS ? (w / 2 ? w / 2 : 1) : w;
+        sy_governor_frame gf = {.width = ew, .height = h, .scale = 1.0f, .samples = 1};
+        if (!v->cluster) {
+            /* a progressive back-end refines a resting mono view; stereo renders once at full size */
+            uint32_t caps = sy_mediator_class_caps(cls, NULL);
+            if (stereo != SY_STEREO_NONE) caps &= ~(uint32_t)SY_CAP_PROGRESSIVE;
+            sy_governor_plan(gov, ew, h, caps, changed, sy_time_now() * 1e3, &gf);
+            if (gf.wait_ms > 0) { /* settling after a moving frame: the refining frame comes next */
+                wait_until = sy_time_now() * 1e3 + gf.wait_ms;
+                continue;
+            }
+            if (gf.idle) continue; /* refined: sleep until input */
+        }
         sy_layer img = {0}, right = {0};
         double t0 = sy_time_now();
         uint64_t cl_spp = 0; /* sy view --cluster: view_cluster_frame's results */
         bool cl_refine = false;
+        uint32_t contexts = sy_context_pool_size(pool);
         char cl_status[sizeof v->status] = "";
         sy_result r;
         if (v->cluster) {
@@ -308,10 +371,10 @@ static void *render_main(void *p)
             r = view_cluster_frame(v->cluster, a, pool, &spec, cls->name, restart, ew, h, &img, &right, &cl_spp,
                                    &cl_refine, cl_status, sizeof cl_status, &err);
         } else {
-            view_apply_filter(pool, a, cls, filter, threshold, filter_version, &filter_state, &filter_applied, fstatus,
-                              sizeof fstatus);
-            sy_window_render_opts ro = {.sample_count = 1};
-            r = sy_compose_render(a->scene, pool, &spec, ew, h, &ro, &img, &right, &err);
+            view_apply_filter(pool, a, cls, filter, threshold, filter_version, gf.filter, &filter_state, &filter_applied,
+                              &filter_enabled, fstatus, sizeof fstatus);
+            sy_window_render_opts ro = {.sample_count = gf.samples};
+            r = sy_compose_render(a->scene, pool, &spec, gf.width, gf.height, &ro, &img, &right, &err);
         }
         double ms = (sy_time_now() - t0) * 1e3;
         sy_layer_destroy(&right);
@@ -322,7 +385,7 @@ static void *render_main(void *p)
                      cls->name, err.message);
             v->img_version++;
             pthread_mutex_unlock(&v->mu);
-            refine = v->cluster != NULL; /* cluster: retry, the servers may come back */
+            again = v->cluster != NULL; /* cluster: retry, the servers may come back */
             continue;
         }
         sy_post_desc post = {.enabled = true, .tonemap = SY_TONEMAP_ACES, .srgb = true};
@@ -335,6 +398,10 @@ static void *render_main(void *p)
                 if ((i & 3) != 3 && img.rgba[(i | 3)] > 0.0f) x /= img.rgba[(i | 3)]; /* straight for display */
                 bytes[i] = (uint8_t)(x <= 0.0f ? 0 : x >= 1.0f ? 255 : (int)(x * 255.0f + 0.5f));
             }
+        /* the frame's whole time (render, tone mapping, conversion); a frame that translated the
+         * scene for a new context says nothing about the next ones */
+        ms = (sy_time_now() - t0) * 1e3;
+        if (!v->cluster && sy_context_pool_size(pool) == contexts) sy_governor_report(gov, &gf, ms);
         sy_context *ctx = NULL;
         sy_mediator_stats st = {0};
         if (v->cluster) st.samples = cl_spp; /* no local context in cluster mode */
@@ -348,17 +415,22 @@ static void *render_main(void *p)
         v->frame_ms = ms;
         v->sync_ms = st.last_sync_seconds * 1e3;
         v->spp = st.samples;
+        v->img_scale = gf.scale;
+        v->img_moving = gf.moving;
+        v->governed = !v->cluster;
         snprintf(v->status, sizeof v->status, "%s", v->cluster ? cl_status : cls->name);
         snprintf(v->filter_status, sizeof v->filter_status, "%s", fstatus);
         v->img_version++;
         v->img_req = seen;
         pthread_mutex_unlock(&v->mu);
         sy_layer_destroy(&img);
-        /* progressive back-ends keep refining a resting mono view */
-        refine = v->cluster ? cl_refine : (cls->caps & SY_CAP_PROGRESSIVE) && stereo == SY_STEREO_NONE && st.samples < 65536;
+        /* local: plan again (the governor says what comes next); cluster: keep refining */
+        again = v->cluster ? cl_refine : true;
     }
+    sy_governor_destroy(gov);
     return NULL;
 fail_unlocked:
+    sy_governor_destroy(gov);
     pthread_mutex_lock(&v->mu);
     v->error = err;
     v->failed = true;
@@ -530,7 +602,11 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
     v.cluster = cluster;
     v.pool = pool;
     pthread_mutex_init(&v.mu, NULL);
-    pthread_cond_init(&v.cv, NULL);
+    pthread_condattr_t ca; /* the render thread's timed waits use the monotonic clock */
+    pthread_condattr_init(&ca);
+    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    pthread_cond_init(&v.cv, &ca);
+    pthread_condattr_destroy(&ca);
     for (uint32_t i = 0; i < sy_mediator_count(); ++i)
         if (!strcmp(sy_mediator_at(i)->name, args->backend)) v.backend = i;
     v.overlay = true;
@@ -603,15 +679,17 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
                 if (img) memcpy(img, v.img, (size_t)v.img_w * v.img_h * 4);
                 iw = img ? v.img_w : 0, ih = img ? v.img_h : 0;
             }
-            char sync[32] = ""; /* cluster mode: the servers sync (their time is in the status) */
+            char sync[32] = "", scale[40] = ""; /* cluster mode: the servers sync (their time is in the status) */
             if (!v.cluster) snprintf(sync, sizeof sync, " | sync %.2f ms", v.sync_ms);
-            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms | %llu spp%s%s%s", v.status, v.frame_ms,
+            if (v.governed) /* the governor's resolution scale: reduced while the view moves */
+                snprintf(scale, sizeof scale, " | scale %.2f%s", (double)v.img_scale, v.img_moving ? " moving" : "");
+            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms%s | %llu spp%s%s%s", v.status, v.frame_ms, scale,
                      (unsigned long long)v.spp, sync,
                      v.stereo == SY_STEREO_SBS ? " | stereo sbs" : v.stereo == SY_STEREO_ANAGLYPH ? " | anaglyph" : "",
                      v.filter_status);
             glfwSetWindowTitle(win, title);
         }
-        bool failed = v.failed, answered = fresh && v.img_req >= key_req;
+        bool failed = v.failed, answered = fresh && v.img_req >= key_req, settled = !v.img_moving;
         pthread_mutex_unlock(&v.mu);
         if (failed) break;
         if (answered && key_last) { /* scripted --keys: the heads-up line once the key took effect */
@@ -638,7 +716,7 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
             glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
             glDrawPixels((GLsizei)iw, (GLsizei)ih, GL_RGBA, GL_UNSIGNED_BYTE, img);
         }
-        if (img && !key_last && !(keys && *keys)) displayed++; /* frames shown (after scripted keys) */
+        if (img && settled && !key_last && !(keys && *keys)) displayed++; /* settled frames shown (after scripted keys) */
         if (args->frames && displayed >= args->frames) {
             if (args->screenshot) r = write_screenshot(args->screenshot, fbw, fbh, err);
             if (!glfwWindowShouldClose(win)) printf("%s\n", title); /* automated runs: the last heads-up line */

@@ -5,11 +5,16 @@
  * side-by-side, anaglyph), R resets the camera, Esc quits. With the path tracer, F cycles the display
  * filter (none, pixel, atrous, jbu, adaptive) and [ / ] halve / double its threshold (default 0.01),
  * live and without restarting the accumulation; the title shows the filter, threshold and its time.
- * With --frames the last title line is printed to stdout at exit (automated runs). The window title is the heads-up line:
- * back-end, frame time, samples per pixel, sync time. Rendering runs on its own thread, which owns
- * the scene (the input thread only posts camera poses and switches), so the window stays
- * responsive while a slow back-end renders and always shows the last complete image; a
- * progressive back-end keeps refining while the camera rests and restarts when it moves.
+ * With --frames the last title line is printed to stdout at exit (automated runs); only frames
+ * shown after the view settled (full size) count. The window title is the heads-up line: back-end,
+ * frame time, the governor's resolution scale ("moving" while reduced), samples per pixel, sync
+ * time. Rendering runs on its own thread, which owns the scene (the input thread only posts camera
+ * poses and switches), so the window stays responsive while a slow back-end renders and always
+ * shows the last complete image. Local rendering goes through the frame-time governor
+ * (core/sy_governor.h, --budget MS): while the view moves each frame renders at the largest size
+ * that fits the budget and the display scales it up, without the display filter; once the view
+ * rests for 150 ms it renders at full size, a progressive back-end then adds samples per frame
+ * within the budget (restarting when the view moves), and the thread sleeps until input.
  *
  * Cluster (--cluster URL[,URL...]|FILE.conf, --cluster-mode ...): the viewport's back-end is the
  * cluster mediator (sy_mediator_cluster.h), so the viewer renders through the same window path as
@@ -42,6 +47,7 @@ typedef struct sy_view_args {
                                each once the frame answering the previous one is shown (letters, digits,
                                [ ]); the heads-up line after each is printed; --frames counts after them */
     const sy_cluster_cli_opts *cluster; /* non-NULL: render on these servers (sy view --cluster) */
+    double budget_ms;       /* the frame-time governor's budget while the view moves (0 = 33 ms; --budget) */
 } sy_view_args;
 
 sy_result sy_view_run(const sy_view_args *args, sy_error *err);

@@ -8,6 +8,7 @@
  * >>lifecycle  create / destroy */
 #include "sy_web.h"
 
+#include "sy_governor.h"
 #include "sy_jpeg.h"
 #include "sy_log.h"
 #include "sy_mediator.h"
@@ -33,7 +34,6 @@
 #define WEB_FRAME_HEADER 40u
 #define WEB_TOKEN_BYTES 16u
 #define WEB_COOKIE "sy_token"
-#define WEB_MAX_SPP 65536u /* a resting progressive view stops refining here */
 
 /* Display filters the F key cycles through (as sy view), on a back-end with SY_CAP_FILTERS. */
 static const char *const web_filters[] = {"none", "pixel", "atrous", "jbu", "adaptive", "radiance"};
@@ -867,26 +867,26 @@ typedef struct render_state {
     uint32_t backend_applied;
     void *filter_state;
     uint64_t filter_applied;
+    bool filter_enabled;
     uint64_t seq;
+    sy_governor *gov;
+    uint32_t prev_bi, prev_w, prev_h; /* what the last planned frame showed: a difference is a change */
+    uint64_t prev_filter_version;
 } render_state;
 
-/* The planned frame: the governor (core/sy_governor.h) takes this place once it lands. */
-typedef struct web_plan {
-    uint32_t width, height, samples;
-} web_plan;
-
-static web_plan web_plan_frame(const sy_web *w, uint32_t dw, uint32_t dh)
+/* The display size the governor plans for: what the page asked, capped at max_width x max_height
+ * keeping the aspect. */
+static void display_size(const sy_web *w, uint32_t dw, uint32_t dh, uint32_t *ow, uint32_t *oh)
 {
-    web_plan p = {dw ? dw : 640, dh ? dh : 480, 1};
     double s = 1.0;
-    if (p.width > w->d.max_width) s = (double)w->d.max_width / p.width;
-    if (p.height * s > w->d.max_height) s = (double)w->d.max_height / p.height;
+    if (dw > w->d.max_width) s = (double)w->d.max_width / dw;
+    if (dh * s > w->d.max_height) s = (double)w->d.max_height / dh;
+    *ow = dw, *oh = dh;
     if (s < 1.0) {
-        p.width = (uint32_t)(p.width * s + 0.5), p.height = (uint32_t)(p.height * s + 0.5);
-        if (!p.width) p.width = 1;
-        if (!p.height) p.height = 1;
+        *ow = (uint32_t)(dw * s + 0.5), *oh = (uint32_t)(dh * s + 0.5);
+        if (!*ow) *ow = 1;
+        if (!*oh) *oh = 1;
     }
-    return p;
 }
 
 /* Premultiplied linear RGBA after the display chain -> 8-bit (composited over black). */
@@ -933,7 +933,7 @@ static sy_result render_rgba8(sy_web *w, render_state *rs, sy_window *win, uint3
 
 /* The path tracer's display filter (as sy view): applied when it changed or the context is new. */
 static void apply_filter(sy_web *w, render_state *rs, const sy_mediator_class *cls, uint32_t filter, float threshold,
-                         uint64_t version, char *status, size_t len)
+                         uint64_t version, bool enabled, char *status, size_t len)
 {
     status[0] = 0;
     if (!(cls->caps & SY_CAP_FILTERS)) return;
@@ -944,17 +944,18 @@ static void apply_filter(sy_web *w, render_state *rs, const sy_mediator_class *c
         return;
     }
     void *state = sy_context_state(ctx);
-    if (state == rs->filter_state && version == rs->filter_applied) return;
+    if (state == rs->filter_state && version == rs->filter_applied && enabled == rs->filter_enabled) return;
     sy_params opts = {0};
     char t[32];
     snprintf(t, sizeof t, "%g", (double)threshold);
     if (sy_params_set(&opts, "threshold", t, &err) != SY_OK ||
-        sy_context_set_filter(ctx, web_filters[filter % WEB_FILTER_COUNT], &opts, &err) != SY_OK) {
+        sy_context_set_filter(ctx, enabled ? web_filters[filter % WEB_FILTER_COUNT] : "none", &opts, &err) != SY_OK) {
         snprintf(status, len, "filter: %.200s", err.message);
         return;
     }
     rs->filter_state = state;
     rs->filter_applied = version;
+    rs->filter_enabled = enabled; /* the governor keeps the filter off while the view moves */
 }
 
 static void finish_job(sy_web *w, web_job *j)
@@ -1031,30 +1032,51 @@ static void set_status(sy_web *w, const char *s)
     wake_network(w);
 }
 
+/* One frame through the frame-time governor (core/sy_governor.h): plans it for the display size,
+ * renders what the plan says, reports its time. *again: plan again without waiting for input;
+ * *wait_ms > 0: plan again after that long (the view is settling). */
 static sy_result render_frame(sy_web *w, render_state *rs, const sy_orbit *o, uint32_t bi, uint32_t dw, uint32_t dh,
-                              uint64_t gen, uint32_t filter, float threshold, uint64_t filter_version, bool *refine,
-                              sy_error *err)
+                              uint64_t gen, uint32_t filter, float threshold, uint64_t filter_version, bool *again,
+                              double *wait_ms, sy_error *err)
 {
-    *refine = false;
+    *again = false, *wait_ms = 0;
     const sy_mediator_class *cls = sy_mediator_at(bi);
     if (!cls) return sy_error_set(err, SY_ERR_NOT_FOUND, "web: back-end %u is not registered", bi);
+    uint32_t pw = 0, ph = 0;
+    display_size(w, dw, dh, &pw, &ph);
+    sy_mat4 m;
+    sy_orbit_matrix(o, &m);
+    bool changed = !rs->cam_valid || memcmp(&m, &rs->cam_applied, sizeof m) != 0 || bi != rs->prev_bi ||
+                   pw != rs->prev_w || ph != rs->prev_h;
     sy_result r = apply_camera(w, rs, o, err);
     if (r == SY_OK && bi != rs->backend_applied) {
         r = sy_viewport_set_backend(rs->vp, cls->name, NULL, err);
         if (r == SY_OK) rs->backend_applied = bi;
     }
     if (r != SY_OK) return r;
+    if (bi != rs->prev_bi) sy_governor_reset(rs->gov); /* another back-end: another cost */
+    if (filter_version != rs->prev_filter_version) sy_governor_redraw(rs->gov); /* shown again, same samples */
+    rs->prev_bi = bi, rs->prev_w = pw, rs->prev_h = ph, rs->prev_filter_version = filter_version;
+    sy_governor_frame gf;
+    sy_governor_plan(rs->gov, pw, ph, sy_mediator_class_caps(cls, NULL), changed, sy_time_now() * 1e3, &gf);
+    if (gf.wait_ms > 0) { /* settling after a moving frame: the refining frame comes next */
+        *wait_ms = gf.wait_ms;
+        return SY_OK;
+    }
+    if (gf.idle || !gf.width || !gf.height) return SY_OK; /* refined: sleep until input */
     char fstatus[240];
-    apply_filter(w, rs, cls, filter, threshold, filter_version, fstatus, sizeof fstatus);
-    web_plan plan = web_plan_frame(w, dw, dh);
+    apply_filter(w, rs, cls, filter, threshold, filter_version, gf.filter, fstatus, sizeof fstatus);
     uint8_t *px = NULL, *jpeg = NULL;
     size_t jlen = 0;
+    uint32_t contexts = sy_context_pool_size(rs->pool);
     double t0 = sy_time_now();
-    r = render_rgba8(w, rs, rs->win, plan.width, plan.height, plan.samples, &px, err);
-    double ms = (sy_time_now() - t0) * 1e3;
-    if (r == SY_OK) r = sy_jpeg_encode_rgba8(px, plan.width, plan.height, w->d.quality, &jpeg, &jlen, err);
+    r = render_rgba8(w, rs, rs->win, gf.width, gf.height, gf.samples, &px, err);
+    if (r == SY_OK) r = sy_jpeg_encode_rgba8(px, gf.width, gf.height, w->d.quality, &jpeg, &jlen, err);
+    double ms = (sy_time_now() - t0) * 1e3; /* render, display chain, JPEG: the frame's whole cost */
     free(px);
     if (r != SY_OK) return r;
+    /* a frame that translated the scene for a new context says nothing about the next ones */
+    if (sy_context_pool_size(rs->pool) == contexts) sy_governor_report(rs->gov, &gf, ms);
     sy_mediator_stats st = {0};
     sy_context *ctx = NULL;
     if (sy_context_pool_get(rs->pool, w->d.scene, cls->name, NULL, w->d.root.id, &ctx, NULL) == SY_OK)
@@ -1068,7 +1090,7 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_orbit *o, ui
         return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %zu bytes", len);
     }
     uint8_t *h = f->buf + LWS_PRE;
-    uint32_t u[5] = {WEB_FRAME_MAGIC, plan.width, plan.height, bi,
+    uint32_t u[5] = {WEB_FRAME_MAGIC, gf.width, gf.height, bi,
                      (uint32_t)(st.samples > UINT32_MAX ? UINT32_MAX : st.samples)};
     float fms = (float)ms;
     uint64_t seq = ++rs->seq, zero = 0;
@@ -1081,7 +1103,7 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_orbit *o, ui
     f->refs = 1, f->seq = seq, f->gen = gen, f->len = len;
     publish_frame(w, f);
     set_status(w, fstatus);
-    *refine = (cls->caps & SY_CAP_PROGRESSIVE) && st.samples < WEB_MAX_SPP;
+    *again = true; /* the governor says what comes next */
     return SY_OK;
 }
 
@@ -1095,18 +1117,25 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
     if (r == SY_OK) r = sy_window_add_viewport(rs.win, &vd, &rs.vp, err);
     if (r == SY_OK) r = sy_window_create(64, 64, &rs.still_win, err);
     if (r == SY_OK) r = sy_window_add_viewport(rs.still_win, &vd, &rs.still_vp, err);
+    if (r == SY_OK) r = sy_governor_create(&(sy_governor_desc){.budget_ms = w->d.budget_ms}, &rs.gov, err);
     rs.backend_applied = w->initial_backend;
+    rs.prev_bi = UINT32_MAX;
     uint64_t seen = 0;
-    bool refine = false;
+    bool again = false;    /* plan again without waiting for input */
+    double wait_until = 0; /* ms (sy_time_now): the governor's settle wait, 0 = none */
     while (r == SY_OK) {
         pthread_mutex_lock(&w->mu);
         for (;;) {
             if (w->quit || (stop && *stop) || w->pending) break;
             /* frames once a page said its size (the page does as it connects) */
-            if (w->clients && w->display_w && (w->view_version != seen || refine)) break;
+            bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
+            if (w->clients && w->display_w && (w->view_version != seen || due)) break;
+            double nap_ms = 100; /* polls *stop ten times a second */
+            if (wait_until > 0 && wait_until - sy_time_now() * 1e3 < nap_ms) nap_ms = wait_until - sy_time_now() * 1e3;
+            if (nap_ms < 0.1) nap_ms = 0.1;
             struct timespec ts;
             clock_gettime(CLOCK_REALTIME, &ts);
-            ts.tv_nsec += 100000000;
+            ts.tv_nsec += (long)(nap_ms * 1e6);
             if (ts.tv_nsec >= 1000000000) ts.tv_sec++, ts.tv_nsec -= 1000000000;
             pthread_cond_timedwait(&w->cv, &w->mu, &ts);
         }
@@ -1134,16 +1163,21 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
             if (gone) job_free(j);
             else run_job(w, &rs, j, &o);
         }
-        if (!clients || !(moved || refine)) continue;
+        bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
+        if (!clients || !(moved || due)) continue;
+        again = false, wait_until = 0;
         sy_error ferr = {0};
-        if (render_frame(w, &rs, &o, bi, dw, dh, gen, filter, threshold, fv, &refine, &ferr) != SY_OK) {
+        double wait_ms = 0;
+        if (render_frame(w, &rs, &o, bi, dw, dh, gen, filter, threshold, fv, &again, &wait_ms, &ferr) == SY_OK) {
+            if (wait_ms > 0) wait_until = sy_time_now() * 1e3 + wait_ms;
+        } else {
             /* a back-end that fails is reported to the pages; the others keep serving */
             char s[300];
             snprintf(s, sizeof s, "%s failed: %.240s", sy_mediator_at(bi) ? sy_mediator_at(bi)->name : "back-end",
                      ferr.message);
             sy_log(SY_LOG_WARNING, "web", NULL, "%s", s);
             set_status(w, s);
-            refine = false;
+            again = false;
         }
     }
     /* jobs still queued are answered 503 */
@@ -1158,6 +1192,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         snprintf(j->resp.content_type, sizeof j->resp.content_type, "text/plain; charset=utf-8");
         finish_job(w, j);
     }
+    sy_governor_destroy(rs.gov);
     sy_window_destroy(rs.win);
     sy_window_destroy(rs.still_win);
     sy_context_pool_destroy(rs.pool);
@@ -1232,10 +1267,11 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     w->pending_tail = &w->pending;
     sy_result r = SY_OK;
     if (w->d.max_width > 16384 || w->d.max_height > 16384 || w->d.max_clients > 1000 || w->d.max_message < 64 ||
-        w->d.max_message > (1u << 24) || w->d.quality < 1 || w->d.quality > 100 || w->d.idle_timeout_s > 3600)
+        w->d.max_message > (1u << 24) || w->d.quality < 1 || w->d.quality > 100 || w->d.idle_timeout_s > 3600 ||
+        !(w->d.budget_ms >= 0 && w->d.budget_ms <= 1e5))
         r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
                          "web: a limit is out of range (frame <= 16384, clients <= 1000, message 64..16 MiB, quality "
-                         "1..100, idle timeout <= 3600 s)");
+                         "1..100, idle timeout <= 3600 s, budget 0..1e5 ms)");
     if (r == SY_OK && desc->filter) {
         while (w->filter < WEB_FILTER_COUNT && strcmp(web_filters[w->filter], desc->filter) != 0) w->filter++;
         if (w->filter == WEB_FILTER_COUNT)

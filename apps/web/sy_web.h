@@ -83,6 +83,7 @@ typedef struct sy_web_desc {
     size_t max_body;          /**< largest request body (default 1 MiB): 413 beyond */
     size_t max_message;       /**< largest WebSocket message (default 4096): the connection is closed */
     int quality;              /**< JPEG quality of streamed frames (default 80; stills: 95) */
+    double budget_ms;         /**< frame-time budget of the governor while the view moves (default 33) */
     uint32_t still_samples;   /**< samples per pixel of a progressive back-end's still (default 16) */
     uint32_t idle_timeout_s;  /**< a silent WebSocket is pinged, then closed after twice this (default 30) */
     const char *filter;       /**< initial display filter of a back-end with SY_CAP_FILTERS (NULL: none) */

@@ -166,6 +166,7 @@ typedef struct sy_gl_stats {
     uint32_t shadow_maps;        /**< rendered in the last frame */
     uint64_t triangles_drawn;    /**< last frame, main pass */
     uint64_t draw_calls;         /**< last frame, all passes */
+    uint64_t instances_culled;   /**< last frame, main pass: instances outside the view, not drawn */
     /** @{ uploads of the last frame and since creation */
     sy_gl_upload_counts frame, total; /** @} */
 } sy_gl_stats;
@@ -188,6 +189,18 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *desc, s
                                size_t err_len);
 /** Destroys a mesh. */
 sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh);
+
+/** Levels of detail: an indexed mesh of at least this many triangles gets, at creation, a chain of
+ * simplified levels (meshoptimizer's meshopt_simplify, each about a quarter of the one before, all
+ * in its index buffer, each with a bound on its deviation from the mesh). */
+#define SY_GL_LOD_MIN_TRIANGLES 65536u
+/** Default of sy_gl_set_lod: half a pixel. */
+#define SY_GL_LOD_PIXELS_DEFAULT 0.5f
+/** Each frame, every instance is drawn with the coarsest level whose deviation, projected at the
+ * instance's nearest distance from the camera, stays within `pixels` pixels (0 = always the mesh
+ * itself); instances whose bounding sphere is outside the view are not drawn. Shadow maps draw the
+ * levels the camera view picked. */
+void sy_gl_set_lod(sy_gl_device *dev, float pixels);
 
 /* >>texture: row 0 = top (glTF uv (0,0)); 1 = grey, 2 = grey+alpha, 3 = RGB, 4 = RGBA. Copied
  * to GL (with mipmaps); sizes beyond the GL limit are box-downscaled with a warning. */

@@ -8,6 +8,8 @@
 #include "sy_gl_ibl.h"
 #include "sy_gl_shaders.h"
 
+#include <meshoptimizer.h>
+
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -98,12 +100,20 @@ static void pool_free(pool *p, void *item)
     p->live--;
 }
 
+/* Levels of detail (meshoptimizer): level 0 is the mesh; each further level is simplified from the
+ * one before to about a quarter of its triangles, all levels in one index buffer. */
+#define LOD_MAX 12
+
 typedef struct mesh_o {
     slot_head h;
     GLuint vao, vbo[1], ibo;
     uint32_t vertex_count, triangle_count;
     bool has_normals, indexed, has_attr[5];
     float bmin[3], bmax[3];
+    float centre[3], radius;     /* bounding sphere of the box (object space) */
+    uint32_t lod_count;          /* levels, 1 = the mesh only */
+    uint32_t lod_first[LOD_MAX], lod_tris[LOD_MAX]; /* first index, triangles */
+    float lod_error[LOD_MAX];    /* object-space deviation from level 0 (bound, metres) */
 } mesh_o;
 
 typedef struct tex_o {
@@ -124,6 +134,7 @@ typedef struct inst_o {
     sy_gl_material material;
     float model[16], normal_mat[9];
     bool mirror, visible;
+    uint32_t lod;  /* level chosen for the last view drawn (choose_lod); shadow maps reuse it */
 } inst_o;
 
 typedef struct light_o {
@@ -216,6 +227,8 @@ struct sy_gl_device {
     sy_gl_upload_counts counts, frame, mark;
     uint32_t shadow_maps;
     uint64_t tris, draws;
+    float lod_pixels;    /* sy_gl_set_lod */
+    uint64_t culled;     /* instances outside the view in the last main pass */
     float *scratch;
     size_t scratch_len;
 };
@@ -591,6 +604,7 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     dev->max_tex = (uint32_t)max_tex;
     if (dd.max_texture_size && dd.max_texture_size < dev->max_tex) dev->max_tex = dd.max_texture_size;
     dev->shadow_size = dd.shadow_map_size ? dd.shadow_map_size : SHADOW_SIZE_DEFAULT;
+    dev->lod_pixels = SY_GL_LOD_PIXELS_DEFAULT;
     if (dev->shadow_size > (uint32_t)max_tex) dev->shadow_size = (uint32_t)max_tex;
     static const char *const defs[4] = {NULL, "#define SY_LEAN 1\n", "#define SY_MASK 1\n",
                                         "#define SY_MASK 1\n#define SY_LEAN 1\n"};
@@ -729,6 +743,7 @@ void sy_gl_device_stats(const sy_gl_device *dev, sy_gl_stats *out)
     out->shadow_maps = dev->shadow_maps;
     out->triangles_drawn = dev->tris;
     out->draw_calls = dev->draws;
+    out->instances_culled = dev->culled;
     out->frame = dev->frame;
     out->total = dev->counts;
 }
@@ -743,6 +758,60 @@ static void geometry_changed(sy_gl_device *dev)
 }
 
 /* >>mesh */
+
+/* The levels of detail of an indexed mesh of at least SY_GL_LOD_MIN_TRIANGLES: into *out (malloc'd,
+ * level 0 first) the mesh's indices followed by each simplified level; m->lod_* describe them.
+ * Without memory, or when a level would not shrink the one before by a fifth, the chain stops
+ * there (level 0 alone is a valid chain). */
+static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size_t *count_out)
+{
+    size_t n0 = 3u * (size_t)d->triangle_count;
+    m->lod_count = 1;
+    m->lod_first[0] = 0;
+    m->lod_tris[0] = d->triangle_count;
+    m->lod_error[0] = 0.0f;
+    *out = NULL;
+    *count_out = n0;
+    if (!d->indices || d->triangle_count < SY_GL_LOD_MIN_TRIANGLES) return;
+    /* the chain: at most n0 * (1 + 4/5 + (4/5)^2 + ...) = 5 n0 indices, 4/3 n0 in practice; each
+     * level first into scratch (meshopt_simplify may need index_count entries) */
+    size_t cap = n0 + n0 / 2u;
+    uint32_t *all = malloc(cap * sizeof *all), *scratch = malloc(n0 * sizeof *scratch);
+    if (!all || !scratch) {
+        free(all), free(scratch);
+        return;
+    }
+    memcpy(all, d->indices, n0 * sizeof *all);
+    size_t used = n0;
+    float scale = meshopt_simplifyScale(d->positions, d->vertex_count, 3 * sizeof(float)), err_sum = 0.0f;
+    while (m->lod_count < LOD_MAX) {
+        uint32_t k = m->lod_count;
+        size_t prev_n = 3u * (size_t)m->lod_tris[k - 1], target = prev_n / 4u / 3u * 3u;
+        if (target < 3u * 32u) break;
+        float rel = 0.0f;
+        size_t n = meshopt_simplify(scratch, all + m->lod_first[k - 1], prev_n, d->positions, d->vertex_count,
+                                    3 * sizeof(float), target, 1.0f, 0, &rel);
+        if (n == 0 || n * 5u > prev_n * 4u) break;
+        if (used + n > cap) {
+            size_t ncap = used + n + n0 / 4u;
+            uint32_t *grown = realloc(all, ncap * sizeof *all);
+            if (!grown) break;
+            all = grown;
+            cap = ncap;
+        }
+        memcpy(all + used, scratch, n * sizeof *all);
+        err_sum += rel * scale; /* deviation from the level before, relative to the mesh extent */
+        m->lod_first[k] = (uint32_t)used;
+        m->lod_tris[k] = (uint32_t)(n / 3u);
+        m->lod_error[k] = err_sum;
+        m->lod_count++;
+        used += n;
+    }
+    free(scratch);
+    *out = all;
+    *count_out = used;
+}
+
 sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_gl_mesh *out, char *err,
                                size_t err_len)
 {
@@ -777,6 +846,15 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     m->triangle_count = d->triangle_count;
     memcpy(m->bmin, bmin, sizeof bmin);
     memcpy(m->bmax, bmax, sizeof bmax);
+    float r2 = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+        m->centre[k] = 0.5f * (bmin[k] + bmax[k]);
+        r2 += 0.25f * (bmax[k] - bmin[k]) * (bmax[k] - bmin[k]);
+    }
+    m->radius = sqrtf(r2);
+    uint32_t *lods = NULL;
+    size_t index_count = 0;
+    build_lods(d, m, &lods, &index_count);
     gl->GenVertexArrays(1, &m->vao);
     gl->BindVertexArray(m->vao);
     /* one interleaved vertex buffer (present attributes only) + one index buffer */
@@ -810,10 +888,11 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     }
     m->has_normals = d->normals != NULL;
     if (d->indices) {
-        size_t bytes = (size_t)d->triangle_count * 3u * sizeof(uint32_t);
+        size_t bytes = index_count * sizeof(uint32_t);
         gl->GenBuffers(1, &m->ibo);
         gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, m->ibo);
-        gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)bytes, d->indices, GL_STATIC_DRAW);
+        gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)bytes, lods ? lods : d->indices, GL_STATIC_DRAW);
+        free(lods);
         count_buffer(dev, false, bytes);
         m->indexed = true;
     }
@@ -1463,6 +1542,27 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
     }
 }
 
+static void draw_mesh(sy_gl_device *dev, const mesh_o *m);
+
+/* Draws level `lod` of the mesh (0 = the mesh itself); returns the triangles drawn. */
+static uint32_t draw_mesh_lod(sy_gl_device *dev, const mesh_o *m, uint32_t lod)
+{
+    const sy_gl_fns *gl = dev->gl;
+    if (lod == 0 || lod >= m->lod_count || !m->indexed) {
+        draw_mesh(dev, m);
+        return m->triangle_count;
+    }
+    gl->BindVertexArray(m->vao);
+    if (!m->has_attr[1]) gl->VertexAttrib4f(1, 0, 0, 1, 0);
+    if (!m->has_attr[2]) gl->VertexAttrib4f(2, 0, 0, 0, 0);
+    if (!m->has_attr[3]) gl->VertexAttrib4f(3, 0, 0, 0, 0);
+    if (!m->has_attr[4]) gl->VertexAttrib4f(4, 1, 1, 1, 1);
+    gl->DrawElements(GL_TRIANGLES, (GLsizei)(3u * m->lod_tris[lod]), GL_UNSIGNED_INT,
+                     (const void *)((uintptr_t)m->lod_first[lod] * sizeof(uint32_t)));
+    dev->draws++;
+    return m->lod_tris[lod];
+}
+
 static void draw_mesh(sy_gl_device *dev, const mesh_o *m)
 {
     const sy_gl_fns *gl = dev->gl;
@@ -1514,7 +1614,7 @@ static void draw_casters(sy_gl_device *dev, const float *vp)
             if (!m || kind == CASTER_NONE || (kind == CASTER_MASKED) != (v == 1)) continue;
             bind_material(dev, in->material, false);
             gl->UniformMatrix4fv(dev->ps[v].model, 1, GL_FALSE, in->model);
-            draw_mesh(dev, m);
+            draw_mesh_lod(dev, m, in->lod); /* the level of the last camera view */
         }
     }
 }
@@ -1618,6 +1718,8 @@ static sy_gl_result targets_ensure(sy_gl_device *dev, uint32_t w, uint32_t h, ch
 typedef struct view_setup {
     float view[16], proj[16], cam_pos[3], cam_fwd[3];
     bool ortho;
+    float ppu; /* pixels per unit of the image plane at distance 1 (perspective) or per metre (ortho); 0 =
+                * unknown (levels of detail off) */
 } view_setup;
 
 static sy_gl_result view_make(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, view_setup *v,
@@ -1655,7 +1757,84 @@ static sy_gl_result view_make(sy_gl_device *dev, const sy_gl_camera *cam, const 
     if (!v->ortho && n <= 0.0) n = fmax(1e-5 * (fabs(dist) + R), 1e-6);
     if (v->ortho && f <= 0.0) f = fmax(dist + 2.0 * R, n + 1.0);
     projection(v->ortho, l2, r2, b2, t2, n, f, v->proj);
+    v->ppu = (float)((double)d->height / (t2 - b2));
     return SY_GL_OK;
+}
+
+/* >>culling and levels of detail */
+
+/* The six planes (inside: dot(p.xyz, x) + p.w >= 0) of a column-major view-projection matrix. */
+static void frustum_planes(const float *m, float planes[6][4])
+{
+    for (int i = 0; i < 3; ++i)
+        for (int s = 0; s < 2; ++s) {
+            float *p = planes[2 * i + s];
+            for (int c = 0; c < 4; ++c) p[c] = m[4 * c + 3] + (s ? -m[4 * c + i] : m[4 * c + i]);
+        }
+}
+
+/* World-space bounding sphere of an instance: centre into c, radius returned; *scale = the largest
+ * axis scale of its model matrix. */
+static float world_sphere(const inst_o *in, const mesh_o *m, float c[3], float *scale)
+{
+    float s2 = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        c[a] = in->model[12 + a];
+        for (int k = 0; k < 3; ++k) c[a] += in->model[4 * k + a] * m->centre[k];
+        float l2 = in->model[4 * a] * in->model[4 * a] + in->model[4 * a + 1] * in->model[4 * a + 1] +
+                   in->model[4 * a + 2] * in->model[4 * a + 2];
+        s2 = fmaxf(s2, l2);
+    }
+    *scale = sqrtf(s2);
+    return m->radius * *scale;
+}
+
+static bool sphere_outside(const float planes[6][4], const float c[3], float r)
+{
+    for (int i = 0; i < 6; ++i) {
+        const float *p = planes[i];
+        float len = sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        if (p[0] * c[0] + p[1] * c[1] + p[2] * c[2] + p[3] < -r * len) return true;
+    }
+    return false;
+}
+
+static uint32_t choose_lod(const sy_gl_device *dev, const mesh_o *m, const view_setup *v, const float c[3], float r,
+                           float scale);
+
+/* Every visible instance's level for view v (before the shadow maps, which reuse them). */
+static void choose_lods(sy_gl_device *dev, const view_setup *v)
+{
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        inst_o *in = pool_at(&dev->instances, i);
+        const mesh_o *m = in->h.id ? pool_get(&dev->meshes, in->mesh.id) : NULL;
+        if (!m) continue;
+        float c[3], scale, r = world_sphere(in, m, c, &scale);
+        in->lod = choose_lod(dev, m, v, c, r, scale);
+    }
+}
+
+void sy_gl_set_lod(sy_gl_device *dev, float pixels)
+{
+    if (dev) dev->lod_pixels = isfinite(pixels) && pixels > 0.0f ? pixels : 0.0f;
+}
+
+/* The coarsest level whose deviation, projected at the sphere's nearest distance, stays within
+ * dev->lod_pixels pixels (0 when the view's scale is unknown or the view is inside the sphere). */
+static uint32_t choose_lod(const sy_gl_device *dev, const mesh_o *m, const view_setup *v, const float c[3], float r,
+                           float scale)
+{
+    if (m->lod_count < 2 || dev->lod_pixels <= 0.0f || v->ppu <= 0.0f) return 0;
+    float px_per_m = v->ppu;
+    if (!v->ortho) {
+        float d = (c[0] - v->cam_pos[0]) * v->cam_fwd[0] + (c[1] - v->cam_pos[1]) * v->cam_fwd[1] +
+                  (c[2] - v->cam_pos[2]) * v->cam_fwd[2] - r;
+        if (!(d > 1e-6f)) return 0;
+        px_per_m /= d;
+    }
+    uint32_t lod = 0;
+    while (lod + 1 < m->lod_count && m->lod_error[lod + 1] * scale * px_per_m <= dev->lod_pixels) ++lod;
+    return lod;
 }
 
 static int cmp_far_first(const void *a, const void *b)
@@ -1839,8 +2018,7 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
         gl->Uniform1i(dev->pm[pv].has_normals, m->has_normals);
     }
     gl->Uniform1i(dev->pm[pv].mirror, in->mirror);
-    draw_mesh(dev, m);
-    dev->tris += m->triangle_count;
+    dev->tris += draw_mesh_lod(dev, m, in->lod);
     return SY_GL_OK;
 }
 
@@ -1894,11 +2072,20 @@ static sy_gl_result draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
     uint32_t cap = dev->instances.count ? dev->instances.count : 1, nl[3] = {0, 0, 0};
     float *lists = malloc(sizeof(float) * 2 * 3 * cap);
     if (!lists) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory");
+    float planes[6][4];
+    frustum_planes(dc.viewproj, planes);
+    if (skip == UINT32_MAX) dev->culled = 0;
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
-        const inst_o *in = pool_at(&dev->instances, i);
+        inst_o *in = pool_at(&dev->instances, i);
         if (!in->h.id || !in->visible || i == skip) continue;
         const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
         if (!m) continue;
+        float c[3], scale, r = world_sphere(in, m, c, &scale);
+        if (sphere_outside(planes, c, r)) { /* outside the view: not drawn */
+            if (skip == UINT32_MAX) dev->culled++;
+            continue;
+        }
+        in->lod = choose_lod(dev, m, v, c, r, scale);
         const mat_o *mt = pool_get(&dev->materials, in->material.id);
         sy_gl_alpha_mode mode = mt ? mt->d.alpha_mode : SY_GL_ALPHA_OPAQUE;
         int li = mode == SY_GL_ALPHA_BLEND ? 2 : mode == SY_GL_ALPHA_MASK ? 1 : 0;
@@ -2058,6 +2245,7 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     }
     if (dev->area_count && (r = sy_gl_ibl_tables(gl, &dev->ibl, err, err_len)) != SY_GL_OK) return r;
     if (dev->lights_dirty) {
+        choose_lods(dev, &v); /* shadow maps draw the levels this view picks */
         lights_upload(dev, &fs);
         if (fs.shadow_count || fs.cube_count) render_shadows(dev, &fs);
         else dev->shadow_maps = 0;
@@ -2087,14 +2275,19 @@ sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, cons
     gl->UseProgram(dev->prog_floor);
     gl->UniformMatrix4fv(dev->uf.view, 1, GL_FALSE, v.view);
     gl->UniformMatrix4fv(dev->uf.proj, 1, GL_FALSE, v.proj);
-    for (uint32_t i = 0; i < dev->instances.count; ++i) {
-        const inst_o *in = pool_at(&dev->instances, i);
+    float vp[16], planes[6][4];
+    m4_mul(v.proj, v.view, vp);
+    frustum_planes(vp, planes);
+    for (uint32_t i = 0; i < dev->instances.count; ++i) { /* the same culling and levels as sy_gl_render */
+        inst_o *in = pool_at(&dev->instances, i);
         if (!in->h.id || !in->visible) continue;
         const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
         if (!m) continue;
+        float c[3], scale, r = world_sphere(in, m, c, &scale);
+        if (sphere_outside(planes, c, r)) continue;
+        in->lod = choose_lod(dev, m, &v, c, r, scale);
         gl->UniformMatrix4fv(dev->uf.model, 1, GL_FALSE, in->model);
-        draw_mesh(dev, m);
-        dev->tris += m->triangle_count;
+        dev->tris += draw_mesh_lod(dev, m, in->lod);
     }
     r = finish_target(dev, rgba, NULL, err, err_len);
     frame_end(dev);

@@ -126,6 +126,12 @@ typedef struct sy_rt_stats {
     /** Seconds Embree's rtcCommitScene of the top-level scene took in the last sy_rt_commit (0 when
      * that commit did not rebuild it): the part of a commit that is Embree's, not ours. */
     double last_top_commit_seconds;
+    /** Full builds of the top-level BVH so far. Moving instances does not rebuild it: a moved
+     * instance is shown by a twin in a small second top-level scene until the next full build
+     * (anything structural: instances created, destroyed, shown or hidden; or more than about
+     * 64 + instances / 64 instances moved since) folds it back. */
+    uint64_t top_builds;
+    uint32_t moved_instances; /**< instances shown by twins now (0 after a full build) */
     /** @{ memory: bytes of mesh arrays the back-end allocated itself (copies: shading normals,
      * texture coordinates, colours; not Embree's), bytes of mesh arrays shared with the caller
      * (sy_rt_mesh_desc.release), and Embree's own allocations now and at their peak (geometry

@@ -11,14 +11,13 @@
 static void raw_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
 {
     float *tbuf = user;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    sy_rt_ictx ctx;
+    sy_rt_context_init(f->dev, &ctx, RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
     for (uint32_t py = y0; py < y1; ++py)
         for (uint32_t px = x0; px < x1; ++px) {
             struct RTCRayHit rh;
             float axial;
-            sy_rt_frame_hit(f, &ctx, px, py, &rh, &axial);
+            sy_rt_frame_hit(f, &ctx.rtc, px, py, &rh, &axial);
             tbuf[(size_t)(py - f->y) * f->width + (px - f->x)] =
                 rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar;
         }

@@ -77,12 +77,21 @@ sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **o
     rtcSetDeviceErrorFunction(dev->rtc, sy_rt_embree_error_callback, dev);
     rtcSetDeviceMemoryMonitorFunction(dev->rtc, embree_memory_monitor, dev);
     dev->top = rtcNewScene(dev->rtc);
-    sy_rt_result r = sy_rt_check_embree(dev, err, err_len, "device create: top-level scene");
+    dev->dyn = rtcNewScene(dev->rtc);
+    sy_rt_result r = sy_rt_check_embree(dev, err, err_len, "device create: top-level scenes");
+    if (r == SY_RT_OK && (!dev->top || !dev->dyn))
+        r = sy_rt_fail(err, err_len, SY_RT_ERROR_EMBREE, "device create: rtcNewScene failed");
     if (r != SY_RT_OK) {
         sy_rt_device_destroy(dev);
         return r;
     }
+    /* The stale filter of moved instances (sy_rt_device.h) runs from the intersection context, so
+     * every scene whose geometry it must see carries the flag: the top scene (baked geometry) and
+     * each BLAS (sy_rt_scene.c mesh_blas). The moved instances' scene is small and rebuilt often. */
+    rtcSetSceneFlags(dev->top, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(dev->top, RTC_BUILD_QUALITY_MEDIUM);
+    rtcSetSceneBuildQuality(dev->dyn, RTC_BUILD_QUALITY_LOW);
+    rtcCommitScene(dev->dyn);
 
     for (int i = 0; i < 256; ++i) {
         double c = i / 255.0;
@@ -111,6 +120,7 @@ void sy_rt_device_destroy(sy_rt_device *dev)
     for (uint32_t i = 0; i < dev->textures.count; ++i) sy_rt_texture_free(dev->textures.items[i]);
     sy_rt_pool_free(&dev->textures);
     if (dev->top) rtcReleaseScene(dev->top);
+    if (dev->dyn) rtcReleaseScene(dev->dyn);
     if (dev->rtc) rtcReleaseDevice(dev->rtc);
     pthread_mutex_destroy(&dev->rtc_err_lock);
     free(dev);
@@ -128,6 +138,8 @@ void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out)
     out->area_light_triangles = dev->area_count;
     out->version = dev->version;
     out->last_top_commit_seconds = dev->last_top_commit_seconds;
+    out->top_builds = dev->top_builds;
+    out->moved_instances = dev->stale_count;
     out->mesh_bytes = dev->mesh_bytes;
     out->shared_bytes = dev->shared_bytes;
     int64_t now = atomic_load(&((sy_rt_device *)dev)->embree_bytes), peak = atomic_load(&((sy_rt_device *)dev)->embree_peak);

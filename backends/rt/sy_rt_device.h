@@ -52,6 +52,11 @@ typedef struct sy_rt_instance_data {
     float *baked_positions;    /* baked: Embree vertex buffer (world space) */
     bool filter_on;            /* baked: alpha filter installed */
     uint32_t handle;           /* this instance's own handle id (coverage output) */
+    /* Moves without rebuilding the top-level BVH (sy_rt_scene.c, "moved instances"): */
+    bool xf_pending;           /* geom in the top scene still holds an older transform (in dev->pending) */
+    bool stale;                /* the top scene's copy is filtered out; `twin` in dev->dyn shows the instance */
+    RTCGeometry twin;          /* instance of the mesh's BLAS in dev->dyn, or NULL */
+    unsigned twin_id;          /* its geometry id in dev->dyn */
 } sy_rt_instance_data;
 
 typedef struct sy_rt_light_data {
@@ -81,6 +86,22 @@ typedef struct sy_rt_area_tri {
 struct sy_rt_device {
     RTCDevice rtc;
     RTCScene top;
+    /* Instances moved since the top-level BVH was last built: rebuilding the top scene costs
+     * O(instances) (about 5 ms at 10^4), so a moved instance's copy in `top` is filtered out (the
+     * context filter sy_rt_stale_filter, installed only while stale_count > 0) and a twin instance
+     * in the small scene `dyn`, attached under the same geometry id, shows it where it is now. Every
+     * ray cast traces `top`, then `dyn` when dyn_count > 0 (sy_rt_frame.h). The next full rebuild
+     * (anything structural, or more than sy_rt_stale_limit stale instances) folds them back. */
+    RTCScene dyn;
+    uint32_t dyn_count;    /* twins attached to dyn */
+    sy_rt_instance_data **dyn_map; /* dyn geometry id -> instance (ids are dense: Embree's commit
+                                    * walks every id up to the largest) */
+    uint32_t dyn_map_cap;
+    uint32_t stale_count;  /* instances with stale set */
+    sy_rt_instance_data **pending; /* instances with xf_pending */
+    uint32_t pending_count, pending_cap;
+    bool dyn_dirty;        /* dyn needs rtcCommitScene */
+    uint64_t top_builds;   /* rtcCommitScene(top) calls (sy_rt_stats) */
     uint32_t thread_count; /* render threads asked for (sy_rt_device_desc); 0 = OpenMP default */
 
     /* Embree error callback output; read back by the call that triggered it. */
@@ -156,11 +177,65 @@ static inline const sy_rt_material_data *sy_rt_material_lookup(const sy_rt_devic
 }
 
 /* The instance a hit belongs to (instance id for Embree instances, geometry id for baked). */
+/* The context filter that hides the top scene's stale copies of moved instances (sy_rt_scene.c). */
+void sy_rt_stale_filter(const struct RTCFilterFunctionNArguments *args);
+
+/* Every intersection context of the back-end: Embree's, then which scene is being traced. Filter
+ * functions receive &rtc and read the rest (every context comes from sy_rt_context_init). */
+typedef struct sy_rt_ictx {
+    struct RTCIntersectContext rtc; /* first member */
+    int in_dyn;                     /* tracing dev->dyn: instance ids are dyn ids (dev->dyn_map) */
+    RTCFilterFunctionN saved;       /* the filter while tracing dev->dyn */
+} sy_rt_ictx;
+
+/* Every intersection context starts here: the stale filter is on exactly while some instance's
+ * top-level copy is stale. */
+static inline void sy_rt_context_init(const sy_rt_device *dev, sy_rt_ictx *ctx, enum RTCIntersectContextFlags flags)
+{
+    rtcInitIntersectContext(&ctx->rtc);
+    ctx->rtc.flags = flags;
+    ctx->in_dyn = 0;
+    ctx->saved = NULL;
+    if (dev->stale_count) ctx->rtc.filter = sy_rt_stale_filter;
+}
+
+/* Around a trace of dev->dyn: no stale filter, ids read through dev->dyn_map. */
+static inline void sy_rt_ictx_enter_dyn(sy_rt_ictx *ctx)
+{
+    ctx->saved = ctx->rtc.filter;
+    ctx->rtc.filter = NULL;
+    ctx->in_dyn = 1;
+}
+static inline void sy_rt_ictx_leave_dyn(sy_rt_ictx *ctx)
+{
+    ctx->in_dyn = 0;
+    ctx->rtc.filter = ctx->saved;
+}
+
+/* The instance of a hit seen by a filter function (geometry ids as Embree reports them). */
+static inline const sy_rt_instance_data *sy_rt_filter_instance(const sy_rt_device *dev,
+                                                               const struct RTCIntersectContext *ctx, unsigned geom_id,
+                                                               unsigned inst_id);
+
+/* The top-scene id of the instance whose twin has dyn geometry id `id`. */
+static inline unsigned sy_rt_dyn_to_top(const sy_rt_device *dev, unsigned id)
+{
+    return id < dev->dyn_map_cap && dev->dyn_map[id] ? dev->dyn_map[id]->top_id : RTC_INVALID_GEOMETRY_ID;
+}
+
 static inline const sy_rt_instance_data *sy_rt_hit_instance(const sy_rt_device *dev, unsigned geom_id,
                                                             unsigned inst_id)
 {
     unsigned top = inst_id != RTC_INVALID_GEOMETRY_ID ? inst_id : geom_id;
     return top < dev->top_map_cap ? dev->top_map[top] : NULL;
+}
+
+static inline const sy_rt_instance_data *sy_rt_filter_instance(const sy_rt_device *dev,
+                                                               const struct RTCIntersectContext *ctx, unsigned geom_id,
+                                                               unsigned inst_id)
+{
+    if (((const sy_rt_ictx *)ctx)->in_dyn) inst_id = sy_rt_dyn_to_top(dev, inst_id);
+    return sy_rt_hit_instance(dev, geom_id, inst_id);
 }
 
 #endif /* SY_RT_DEVICE_H */

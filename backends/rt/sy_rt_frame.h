@@ -35,6 +35,22 @@ void sy_rt_frame_ray(const sy_rt_frame *f, uint32_t px, uint32_t py, struct RTCR
  * sy_rt_frame_ray(px, py) is sy_rt_frame_ray_at(px + 0.5, py + 0.5). */
 void sy_rt_frame_ray_at(const sy_rt_frame *f, float fx, float fy, struct RTCRay *ray, float *axial);
 
+/* rtcIntersect1 on the top scene, then on the moved instances' scene (sy_rt_device.h); a hit on a
+ * twin is reported under its instance's top-level id, so callers never see the difference. */
+static inline void sy_rt_intersect_scenes(const sy_rt_device *dev, struct RTCIntersectContext *ctx,
+                                          struct RTCRayHit *rh)
+{
+    rtcIntersect1(dev->top, ctx, rh);
+    if (dev->dyn_count) {
+        sy_rt_ictx *x = (sy_rt_ictx *)ctx; /* every context is one (sy_rt_context_init) */
+        float t = rh->ray.tfar;
+        sy_rt_ictx_enter_dyn(x);
+        rtcIntersect1(dev->dyn, ctx, rh);
+        sy_rt_ictx_leave_dyn(x);
+        if (rh->ray.tfar < t) rh->hit.instID[0] = sy_rt_dyn_to_top(dev, rh->hit.instID[0]);
+    }
+}
+
 /* Shadow / visibility ray shared by the integrators: true when nothing in the top scene blocks
  * org + t*dir for t in (0, tfar). Alpha-mask filters installed on geometry apply. */
 static inline bool sy_rt_segment_clear(const sy_rt_device *dev, struct RTCIntersectContext *ctx, sy_rt_v3 org,
@@ -50,6 +66,12 @@ static inline bool sy_rt_segment_clear(const sy_rt_device *dev, struct RTCInters
     r.id = 0;
     r.flags = 0;
     rtcOccluded1(dev->top, ctx, &r);
+    if (r.tfar >= 0.0f && dev->dyn_count) { /* moved instances (sy_rt_device.h) */
+        sy_rt_ictx *x = (sy_rt_ictx *)ctx;   /* every context is one (sy_rt_context_init) */
+        sy_rt_ictx_enter_dyn(x);
+        rtcOccluded1(dev->dyn, ctx, &r);
+        sy_rt_ictx_leave_dyn(x);
+    }
     return r.tfar >= 0.0f;
 }
 
@@ -69,7 +91,7 @@ static inline const sy_rt_instance_data *sy_rt_intersect(const sy_rt_device *dev
     rh->ray.flags = 0;
     rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(dev->top, ctx, rh);
+    sy_rt_intersect_scenes(dev, ctx, rh);
     return rh->hit.geomID == RTC_INVALID_GEOMETRY_ID ? NULL
                                                      : sy_rt_hit_instance(dev, rh->hit.geomID, rh->hit.instID[0]);
 }
@@ -82,7 +104,7 @@ static inline void sy_rt_frame_hit(const sy_rt_frame *f, struct RTCIntersectCont
     sy_rt_frame_ray(f, px, py, &rh->ray, axial);
     rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(f->dev->top, ctx, rh);
+    sy_rt_intersect_scenes(f->dev, ctx, rh);
 }
 
 /* Renders one tile: pixels [x0, x1) x [y0, y1) in full-image coordinates. */

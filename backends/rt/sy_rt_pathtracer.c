@@ -45,7 +45,7 @@ typedef struct pt_ctx {
     const sy_rt_frame *f;
     const sy_rt_device *dev;
     const pt_job *job;
-    struct RTCIntersectContext ictx;
+    sy_rt_ictx ictx;
     uint64_t rays;
 } pt_ctx;
 
@@ -64,7 +64,7 @@ static float power_heuristic(float a, float b)
  * transmittance of sy_rt_shadow.h, as Whitted's do (without it a light behind glass is lost). */
 static sy_rt_v3 unoccluded(pt_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar, bool punctual)
 {
-    return sy_rt_shadow_transmittance(c->dev, &c->ictx, org, dir, tfar, punctual, &c->rays);
+    return sy_rt_shadow_transmittance(c->dev, &c->ictx.rtc, org, dir, tfar, punctual, &c->rays);
 }
 
 /* One light sample from the shading point: returns f * Le * cos * MIS weight / pdf (visibility
@@ -187,7 +187,7 @@ static void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy
 
     for (;;) {
         struct RTCRayHit rh;
-        const sy_rt_instance_data *in = sy_rt_intersect(dev, &c->ictx, org, dir, tnear, tfar, &rh);
+        const sy_rt_instance_data *in = sy_rt_intersect(dev, &c->ictx.rtc, org, dir, tnear, tfar, &rh);
         c->rays++;
         float dlen = v3_length(dir);
         sy_rt_v3 d = v3_scale(dir, 1.0f / dlen);
@@ -312,7 +312,7 @@ static void pt_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, 
     c.f = f;
     c.dev = f->dev;
     c.job = j;
-    rtcInitIntersectContext(&c.ictx);
+    sy_rt_context_init(f->dev, &c.ictx, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
     c.rays = 0;
     uint64_t bad = 0;
     for (uint32_t py = y0; py < y1; ++py)

@@ -6,6 +6,8 @@
 #include "sy_rt_lights.h"
 #include "sy_rt_surface.h"
 
+#include <string.h>
+
 #define PKT_W 4u
 #define PKT_H 4u
 #define PKT_N (PKT_W * PKT_H)
@@ -14,9 +16,8 @@ void sy_rt_primary_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t 
 {
     (void)user;
     const sy_rt_device *dev = f->dev;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    sy_rt_ictx ctx;
+    sy_rt_context_init(dev, &ctx, RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
     float *const depth = f->depth;
     const uint32_t bx0 = x0 - x0 % PKT_W, by0 = y0 - y0 % PKT_H;
     for (uint32_t by = by0; by < y1; by += PKT_H) {
@@ -43,7 +44,16 @@ void sy_rt_primary_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t 
                 rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
                 rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
             }
-            rtcIntersect16(valid, dev->top, &ctx, &rh);
+            rtcIntersect16(valid, dev->top, &ctx.rtc, &rh);
+            if (dev->dyn_count) { /* moved instances (sy_rt_device.h) */
+                float t[PKT_N];
+                memcpy(t, rh.ray.tfar, sizeof t);
+                sy_rt_ictx_enter_dyn(&ctx);
+                rtcIntersect16(valid, dev->dyn, &ctx.rtc, &rh);
+                sy_rt_ictx_leave_dyn(&ctx);
+                for (uint32_t k = 0; k < PKT_N; ++k)
+                    if (valid[k] && rh.ray.tfar[k] < t[k]) rh.hit.instID[0][k] = sy_rt_dyn_to_top(dev, rh.hit.instID[0][k]);
+            }
             for (uint32_t k = 0; k < PKT_N; ++k) {
                 if (!valid[k]) continue;
                 uint32_t px = bx + k % PKT_W, py = by + k / PKT_W;

@@ -208,7 +208,8 @@ static sy_rt_result mesh_blas(sy_rt_device *dev, sy_rt_mesh_data *m, char *err, 
                     m->triangle_count, need / 1048576.0, avail / 1048576.0, what);
     m->scene = rtcNewScene(dev->rtc);
     if (m->scene) {
-        if (large) rtcSetSceneFlags(m->scene, RTC_SCENE_FLAG_COMPACT);
+        /* the context flag: moved instances' stale copies are filtered (sy_rt_device.h) */
+        rtcSetSceneFlags(m->scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION | (large ? RTC_SCENE_FLAG_COMPACT : 0));
         rtcSetSceneBuildQuality(m->scene, large ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH);
         rtcAttachGeometryByID(m->scene, m->geom, 0);
         rtcCommitScene(m->scene);
@@ -391,26 +392,154 @@ static void bake_positions(sy_rt_instance_data *in)
     }
 }
 
-static bool top_map_set(sy_rt_device *dev, unsigned id, sy_rt_instance_data *in)
+/* Geometry id -> instance maps (dev->top_map, dev->dyn_map): grows *map to hold id. */
+static bool id_map_set(sy_rt_instance_data ***map_io, uint32_t *cap_io, unsigned id, sy_rt_instance_data *in)
 {
-    if (id >= dev->top_map_cap) {
-        uint32_t ncap = dev->top_map_cap ? dev->top_map_cap : 64u;
+    if (id >= *cap_io) {
+        uint32_t ncap = *cap_io ? *cap_io : 64u;
         while (ncap <= id) {
             if (ncap > UINT32_MAX / 2u) return false;
             ncap *= 2u;
         }
-        sy_rt_instance_data **map = realloc(dev->top_map, (size_t)ncap * sizeof *map);
+        sy_rt_instance_data **map = realloc(*map_io, (size_t)ncap * sizeof *map);
         if (!map) return false;
-        memset(map + dev->top_map_cap, 0, (size_t)(ncap - dev->top_map_cap) * sizeof *map);
-        dev->top_map = map;
-        dev->top_map_cap = ncap;
+        memset(map + *cap_io, 0, (size_t)(ncap - *cap_io) * sizeof *map);
+        *map_io = map;
+        *cap_io = ncap;
     }
-    dev->top_map[id] = in;
+    (*map_io)[id] = in;
     return true;
+}
+
+static bool top_map_set(sy_rt_device *dev, unsigned id, sy_rt_instance_data *in)
+{
+    return id_map_set(&dev->top_map, &dev->top_map_cap, id, in);
+}
+
+/* >>moved instances (sy_rt_device.h): a moved instance's top-level copy keeps its old transform
+ * until the next full rebuild of the top scene; until then it is filtered out and a twin in the
+ * small scene dev->dyn shows it. */
+
+/* Stale instances the fast path accepts before it rebuilds the top scene instead: each one costs
+ * every ray a little (a filtered leaf in the top scene, a twin in dyn). */
+static uint32_t stale_limit(const sy_rt_device *dev) { return 64u + dev->instances.live / 64u; }
+
+void sy_rt_stale_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    const sy_rt_device *dev = args->geometryUserPtr;
+    const unsigned N = args->N;
+    const unsigned *hu = (const unsigned *)args->hit;
+    for (unsigned i = 0; i < N; ++i) {
+        if (args->valid[i] != -1) continue;
+        /* installed only while tracing the top scene: ids are top-level ids */
+        const sy_rt_instance_data *in = sy_rt_hit_instance(dev, hu[6 * N + i], hu[7 * N + i]);
+        if (in && in->stale) args->valid[i] = 0;
+    }
+}
+
+static void twin_drop(sy_rt_device *dev, sy_rt_instance_data *in)
+{
+    if (!in->twin) return;
+    rtcDetachGeometry(dev->dyn, in->twin_id);
+    if (in->twin_id < dev->dyn_map_cap) dev->dyn_map[in->twin_id] = NULL;
+    rtcReleaseGeometry(in->twin);
+    in->twin = NULL;
+    dev->dyn_count--;
+    dev->dyn_dirty = true;
+}
+
+static void pending_remove(sy_rt_device *dev, sy_rt_instance_data *in)
+{
+    if (in->stale) dev->stale_count--;
+    in->stale = false;
+    twin_drop(dev, in);
+    if (!in->xf_pending) return;
+    in->xf_pending = false;
+    for (uint32_t i = 0; i < dev->pending_count; ++i)
+        if (dev->pending[i] == in) {
+            dev->pending[i] = dev->pending[--dev->pending_count];
+            break;
+        }
+}
+
+/* Writes the instance's current transform into its top-level geometry (a full rebuild follows). */
+static void apply_top_transform(sy_rt_instance_data *in)
+{
+    if (in->flags & SY_RT_INSTANCE_BAKED) {
+        bake_positions(in);
+        rtcUpdateGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    } else {
+        rtcSetGeometryTransform(in->geom, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, in->xf);
+    }
+    rtcCommitGeometry(in->geom);
+}
+
+/* Shows a moved instance through its twin in dyn (created on its first move). */
+static sy_rt_result twin_place(sy_rt_device *dev, sy_rt_instance_data *in, char *err, size_t err_len)
+{
+    if (!in->twin) {
+        sy_rt_result r = mesh_blas(dev, in->mesh, err, err_len); /* baked meshes have none yet */
+        if (r != SY_RT_OK) return r;
+        in->twin = rtcNewGeometry(dev->rtc, RTC_GEOMETRY_TYPE_INSTANCE);
+        if (!in->twin) return sy_rt_check_embree(dev, err, err_len, "commit: twin of a moved instance");
+        rtcSetGeometryInstancedScene(in->twin, in->mesh->scene);
+        in->twin_id = rtcAttachGeometry(dev->dyn, in->twin);
+        dev->dyn_count++;
+        if (in->twin_id == RTC_INVALID_GEOMETRY_ID) {
+            rtcReleaseGeometry(in->twin);
+            in->twin = NULL;
+            dev->dyn_count--;
+            return sy_rt_check_embree(dev, err, err_len, "commit: attaching the twin of a moved instance");
+        }
+        if (!id_map_set(&dev->dyn_map, &dev->dyn_map_cap, in->twin_id, in)) {
+            twin_drop(dev, in);
+            return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "commit: twin of a moved instance: out of memory");
+        }
+    }
+    rtcSetGeometryTransform(in->twin, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, in->xf);
+    rtcCommitGeometry(in->twin);
+    if (!in->stale) {
+        in->stale = true;
+        dev->stale_count++;
+    }
+    dev->dyn_dirty = true;
+    return sy_rt_check_embree(dev, err, err_len, "commit: twin of a moved instance");
+}
+
+/* Commit, moved instances: the fast path (twins) when nothing structural changed and few are
+ * stale; otherwise every pending transform goes into the top scene, which is rebuilt. */
+static sy_rt_result commit_moved(sy_rt_device *dev, char *err, size_t err_len)
+{
+    if (!dev->top_dirty && dev->pending_count) {
+        uint32_t stale = dev->stale_count;
+        for (uint32_t i = 0; i < dev->pending_count && !dev->top_dirty; ++i) {
+            const sy_rt_instance_data *in = dev->pending[i];
+            if (in->flags & SY_RT_INSTANCE_HIDDEN) continue; /* applied when it is shown again */
+            if (!in->stale) stale++;
+            /* a baked masked instance's BLAS has no alpha filter (update_filters) */
+            if ((in->flags & SY_RT_INSTANCE_BAKED) && instance_masked(dev, in)) dev->top_dirty = true;
+        }
+        if (stale > stale_limit(dev)) dev->top_dirty = true;
+        for (uint32_t i = 0; i < dev->pending_count && !dev->top_dirty; ++i) {
+            sy_rt_instance_data *in = dev->pending[i];
+            if (in->flags & SY_RT_INSTANCE_HIDDEN) continue;
+            sy_rt_result r = twin_place(dev, in, err, err_len);
+            if (r != SY_RT_OK) dev->top_dirty = true; /* the full path still shows it right */
+        }
+    }
+    if (dev->top_dirty) {
+        while (dev->pending_count) {
+            sy_rt_instance_data *in = dev->pending[dev->pending_count - 1];
+            apply_top_transform(in);
+            pending_remove(dev, in);
+        }
+    }
+    return sy_rt_check_embree(dev, err, err_len, "commit: moved instances");
 }
 
 static void instance_free(sy_rt_device *dev, sy_rt_instance_data *in)
 {
+    pending_remove(dev, in);
     if (in->geom) {
         if (in->top_id != RTC_INVALID_GEOMETRY_ID) {
             rtcDetachGeometry(dev->top, in->top_id);
@@ -496,18 +625,22 @@ sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst
     float nrm[9];
     sy_rt_result r = normal_matrix(transform, nrm, err, err_len);
     if (r != SY_RT_OK) return r;
+    if (!in->xf_pending) { /* Embree sees the move at sy_rt_commit (commit_moved) */
+        if (dev->pending_count == dev->pending_cap) {
+            uint32_t ncap = dev->pending_cap ? dev->pending_cap * 2u : 64u;
+            sy_rt_instance_data **p = ncap > dev->pending_cap ? realloc(dev->pending, (size_t)ncap * sizeof *p) : NULL;
+            if (!p) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance set_transform: out of memory");
+            dev->pending = p;
+            dev->pending_cap = ncap;
+        }
+        dev->pending[dev->pending_count++] = in;
+        in->xf_pending = true;
+    }
     memcpy(in->xf, transform, sizeof in->xf);
     memcpy(in->nrm, nrm, sizeof in->nrm);
-    if (in->flags & SY_RT_INSTANCE_BAKED) {
-        bake_positions(in);
-        rtcUpdateGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, 0);
-    } else {
-        rtcSetGeometryTransform(in->geom, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, in->xf);
-    }
-    rtcCommitGeometry(in->geom);
     if (instance_emissive(dev, in)) dev->area_dirty = true;
-    dev->dirty = dev->top_dirty = true;
-    return sy_rt_check_embree(dev, err, err_len, "instance set_transform");
+    dev->dirty = true;
+    return SY_RT_OK;
 }
 
 sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst, sy_rt_material material, char *err, size_t err_len)
@@ -799,10 +932,17 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len)
         if ((r = sy_rt_check_embree(dev, err, err_len, "commit: alpha filters")) != SY_RT_OK) return r;
         dev->filters_dirty = false;
     }
-    dev->last_top_commit_seconds = 0.0;
+    double t0 = sy_rt_seconds();
+    if ((r = commit_moved(dev, err, err_len)) != SY_RT_OK) return r;
+    if (dev->dyn_dirty) {
+        rtcCommitScene(dev->dyn);
+        if ((r = sy_rt_check_embree(dev, err, err_len, "commit: moved instances' scene")) != SY_RT_OK) return r;
+        dev->dyn_dirty = false;
+    }
+    dev->last_top_commit_seconds = sy_rt_seconds() - t0;
     if (dev->top_dirty) {
-        double t0 = sy_rt_seconds();
         rtcCommitScene(dev->top);
+        dev->top_builds++;
         dev->last_top_commit_seconds = sy_rt_seconds() - t0;
         if ((r = sy_rt_check_embree(dev, err, err_len, "commit: top-level scene")) != SY_RT_OK) {
             if (dev->max_memory > 0 && (double)atomic_load(&dev->embree_peak) * 1.25 > (double)dev->max_memory)
@@ -848,6 +988,12 @@ void sy_rt_scene_release_all(sy_rt_device *dev)
     sy_rt_pool_free(&dev->materials);
     sy_rt_pool_free(&dev->lights);
     free(dev->top_map);
+    free(dev->dyn_map);
+    dev->dyn_map = NULL;
+    dev->dyn_map_cap = 0;
+    free(dev->pending);
+    dev->pending = NULL;
+    dev->pending_count = dev->pending_cap = 0;
     free(dev->punctual);
     free(dev->area);
     free(dev->area_cdf);

@@ -153,7 +153,7 @@ void sy_rt_alpha_filter(const struct RTCFilterFunctionNArguments *args)
         if (args->valid[i] != -1) continue;
         float u = hf[3 * N + i], v = hf[4 * N + i];
         unsigned prim = hu[5 * N + i], geom = hu[6 * N + i], inst_id = hu[7 * N + i];
-        const sy_rt_instance_data *in = sy_rt_hit_instance(dev, geom, inst_id);
+        const sy_rt_instance_data *in = sy_rt_filter_instance(dev, args->context, geom, inst_id);
         if (!in) continue;
         const sy_rt_material_data *mat = sy_rt_material_lookup(dev, in->material);
         if (!mat->masked) continue;

@@ -54,7 +54,7 @@ typedef struct trace_ctx {
     const sy_rt_frame *f;
     const sy_rt_device *dev;
     const whitted_job *job;
-    struct RTCIntersectContext ictx;
+    sy_rt_ictx ictx;
     uint32_t pseed;  /* per-pixel scramble seed */
     uint32_t sample; /* pixel sample index */
 } trace_ctx;
@@ -64,7 +64,7 @@ typedef struct rgba_t { sy_rt_v3 rgb; float a; } rgba_t;
 /* Light let through between org and org + tfar*dir (alpha, transmission). */
 static sy_rt_v3 shadow(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar)
 {
-    return sy_rt_shadow_transmittance(c->dev, &c->ictx, org, dir, tfar, true, NULL);
+    return sy_rt_shadow_transmittance(c->dev, &c->ictx.rtc, org, dir, tfar, true, NULL);
 }
 /* Specular reflectance at normal incidence of the dielectric part. */
 static float dielectric_f0(const sy_rt_material_desc *d)
@@ -205,7 +205,7 @@ static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float
 /* Radiance along a secondary ray (the environment on a miss, never alpha). */
 static sy_rt_v3 trace_secondary(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, uint32_t depth)
 {
-    return trace(c, org, dir, 0.0f, INFINITY, depth, false, &c->ictx, NULL).rgb;
+    return trace(c, org, dir, 0.0f, INFINITY, depth, false, &c->ictx.rtc, NULL).rgb;
 }
 
 static sy_rt_v3 reflect(sy_rt_v3 d, sy_rt_v3 n) { return v3_sub(d, v3_scale(n, 2.0f * v3_dot(d, n))); }
@@ -273,7 +273,7 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
         rgba_t behind = {v3(0.0f, 0.0f, 0.0f), 0.0f};
         if (depth + 1u < c->f->max_depth)
             behind = trace(c, v3_madd(s->p, s->ng_facing, -sy_rt_ray_eps(s->p)), d, 0.0f, INFINITY, depth + 1u, camera,
-                           &c->ictx, NULL);
+                           &c->ictx.rtc, NULL);
         out.rgb = v3_add(v3_scale(out.rgb, a), v3_scale(behind.rgb, 1.0f - a));
         out.a = a + (1.0f - a) * behind.a;
     }
@@ -307,10 +307,9 @@ static void whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
     c.f = f;
     c.dev = f->dev;
     c.job = j;
-    rtcInitIntersectContext(&c.ictx);
-    struct RTCIntersectContext primary_ctx;
-    rtcInitIntersectContext(&primary_ctx);
-    primary_ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    sy_rt_context_init(f->dev, &c.ictx, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+    sy_rt_ictx primary_ctx;
+    sy_rt_context_init(f->dev, &primary_ctx, RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
     for (uint32_t py = y0; py < y1; ++py) {
         for (uint32_t px = x0; px < x1; ++px) {
             c.pseed = sy_rt_hash32(px ^ sy_rt_hash32(py ^ sy_rt_hash32(f->seed ^ 0x3c6ef372u)));
@@ -330,7 +329,7 @@ static void whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
                 float axial, t;
                 sy_rt_frame_ray_at(f, fx, fy, &ray, &axial);
                 rgba_t r = trace(&c, v3(ray.org_x, ray.org_y, ray.org_z), v3(ray.dir_x, ray.dir_y, ray.dir_z), ray.tnear,
-                                 ray.tfar, 0u, true, &primary_ctx, &t);
+                                 ray.tfar, 0u, true, &primary_ctx.rtc, &t);
                 sum = v3_add(sum, r.rgb);
                 alpha += r.a;
                 if (isfinite(t)) dsum += t * axial, hits++;

@@ -845,6 +845,7 @@ void sy_mediator_raster_counters_get(void *state, sy_mediator_raster_counters *o
     out->shadow_maps = gs.shadow_maps;
     out->draw_calls = gs.draw_calls;
     out->triangles_drawn = gs.triangles_drawn;
+    out->instances_culled = gs.instances_culled;
 }
 
 const char *sy_mediator_raster_info(void *state) { return sy_gl_device_info(((raster_state *)state)->dev); }

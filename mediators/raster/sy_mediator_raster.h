@@ -47,6 +47,7 @@ typedef struct sy_mediator_raster_counters {
     uint32_t msaa_samples, shadow_maps; /** @} */
     /** @{ draw calls and main-pass triangles of the last frame */
     uint64_t draw_calls, triangles_drawn; /** @} */
+    uint64_t instances_culled; /**< instances outside the view in the last frame (not drawn) */
     uint32_t warnings; /**< warnings so far */
     char last_warning[256]; /**< the last warning */
 } sy_mediator_raster_counters;

@@ -9,7 +9,8 @@
 #     output file nor temporary file left behind
 #   - typed parameters: sy backends --params (text and --json) lists each back-end's table; an unknown
 #     --params key, a value out of range or not in the enum: status 2 naming it (and the valid keys)
-#   - sy bench sync / sy bench rays on small sizes: exit 0 and their result lines (no thresholds)
+#   - sy bench sync / sy bench rays / sy bench governor on small sizes: exit 0 and their result lines
+#     (no thresholds)
 #   - sy demo -o DIR -w 64 -h 36: demo_whitted.png / .exr written
 #   - -b pathtracer: --spp with --aov (EXR with feature channels), --time; a non-EXR --env fails
 #   - -b pathtracer --filter pixel --threshold T and --filter radiance write an image; --filter
@@ -221,6 +222,19 @@ run bench_memory_bad "$SY" bench memory -b raster --tris 2000
 [ "$rc" -eq 1 ] && grep -q 'expected one of the ray tracers' "$TMP/bench_memory_bad.err" ||
     fail "bench memory -b raster: status $rc, $(cat "$TMP/bench_memory_bad.err")"
 cat "$TMP/bench_memory.out"
+# bench governor: one row per picture back-end of the registry (no analysis or remote class), each
+# with its numbers; a bad budget is a usage error
+run bench_governor "$SY" bench governor demo --frames 4 -w 32 -h 24
+if [ "$rc" -ne 0 ]; then fail "bench governor: status $rc: $(cat "$TMP/bench_governor.err")"; fi
+for b in $("$SY" backends | grep -Ev ' (analysis|remote)( |$)' | cut -d' ' -f1); do
+    grep -Eq "^  $b +[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+[ !] +[0-9]+% +[0-9.]+ +[0-9]+% " \
+        "$TMP/bench_governor.out" || fail "bench governor: no row for back-end $b"
+done
+! grep -Eq '^  coverage ' "$TMP/bench_governor.out" || fail "bench governor: an analysis back-end was timed"
+cat "$TMP/bench_governor.out"
+run bench_governor_bad "$SY" bench governor demo --budget 0
+[ "$rc" -eq 2 ] && grep -q "bad value '0'" "$TMP/bench_governor_bad.err" ||
+    fail "bench governor --budget 0: status $rc, $(cat "$TMP/bench_governor_bad.err")"
 # --max-memory: a scene over the ray tracer's memory limit is refused with the sizes, not killed
 run max_memory "$SY" render demo -b whitted --max-memory 1 -w 16 -h 16 -o "$TMP/max_memory.png"
 [ "$rc" -eq 1 ] && grep -Eq 'memory limit of 1\.0 MB' "$TMP/max_memory.err" && [ ! -e "$TMP/max_memory.png" ] ||

@@ -72,6 +72,10 @@ expect "render demo --stereo s" sbs separate
 expect "render demo --q" --quiet
 expect "serve --max-l" --max-lifetime
 expect "bench cluster --ho" --hostile-only
+expect "bench gov" governor
+expect "bench governor --bu" --budget
+expect "bench governor --budget 20 --tr" --trace
+expect "view demo --bu" --budget
 expect "help ren" render
 # back-end names come from `sy backends`
 first=$("$SY" backends | head -n 1 | cut -d' ' -f1)

@@ -4,7 +4,8 @@
 # render` of the same view with the same tone mapping, within 2 of 255 per channel (the screenshot
 # goes through an sRGB decode / encode round trip). The path tracer's display filter keys (F cycles
 # the filter, [ / ] halve / double the threshold) are pressed through the keyboard handler with
-# --keys and checked in the heads-up line after each key. Skipped (77) when xvfb-run is not
+# --keys and checked in the heads-up line after each key; the frame-time governor answers a back-end
+# switch with a moving frame and settles at full size. Skipped (77) when xvfb-run is not
 # installed or the viewer was built without GLFW.
 set -u
 SY=$1
@@ -58,6 +59,23 @@ keys_expect 4 '[' 'atrous t=0.01'
 keys_expect 5 '[' 'atrous t=0.005'
 tail -n 1 "$TMP/view_keys.out" | grep -q '| filter atrous t=0.005 ' || {
     echo "FAIL: the last heads-up line does not show the final filter state"; exit 1; }
+# the frame-time governor (core/sy_governor.h): a back-end switch (key 2) is a view change, answered
+# by a moving frame (reduced size, "moving" in the heads-up line); --frames counts only frames shown
+# once the view settled, so the last line is at full size
+timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w 160 -h 90 --keys 2 --frames 1 \
+    >"$TMP/view_gov.out" 2>"$TMP/view_gov.err"
+rc=$?
+[ $rc -eq 0 ] || { echo "FAIL: sy view --keys 2: status $rc: $(cat "$TMP/view_gov.err")"; exit 1; }
+grep '^sy view: after key 2' "$TMP/view_gov.out" | grep -q '| scale [0-9.]* moving |' || {
+    echo "FAIL: the frame after a back-end switch is not a moving frame:"; cat "$TMP/view_gov.out"; exit 1; }
+tail -n 1 "$TMP/view_gov.out" | grep -q '| scale 1.00 |' || {
+    echo "FAIL: the settled frame is not at full size:"; cat "$TMP/view_gov.out"; exit 1; }
+# a budget out of range is a usage error naming the option
+if "$SY" view demo --budget 0 --frames 1 2>"$TMP/badb.err"; then
+    echo "FAIL: sy view accepted --budget 0"
+    exit 1
+fi
+grep -q -- "--budget" "$TMP/badb.err" || { echo "FAIL: the --budget error does not name it"; exit 1; }
 # a scripted key that is not a key is refused before any window opens
 if "$SY" view demo -b pathtracer --keys 'F?' --frames 1 2>"$TMP/badk.err"; then
     echo "FAIL: sy view accepted --keys with '?'"

@@ -1,7 +1,8 @@
 /* test_rt_instances.c — incremental scene updates: set_transform moves an instance in the image
  * (Embree instance and baked), set_visible hides it, destroying it removes it, a shared mesh is
  * instanced twice, material changes are picked up, and the area-light list follows emissive
- * instances (moving an emitter changes what it lights). */
+ * instances (moving an emitter changes what it lights). Moves without a top-level rebuild (twins in
+ * the moved instances' scene) render exactly what a device built from scratch renders. */
 #include "rt_test.h"
 
 #define W 40
@@ -145,10 +146,131 @@ static void test_area_light_follows(void)
     sy_rt_device_destroy(dev);
 }
 
+/* >>moves without a top-level rebuild */
+#define GRID 18 /* GRID x GRID instances: 324, so the fast path takes 64 + 324 / 64 = 69 moved ones */
+#define MW 64
+
+typedef struct grid_scene {
+    sy_rt_device *dev;
+    sy_rt_instance inst[GRID * GRID];
+} grid_scene;
+
+/* Instance i's transform after `moves` (a deterministic shuffle: rotated about Y, shifted). */
+static void grid_xf(int i, int moved, float xf[16])
+{
+    float x = -2.0f + 4.0f * (float)(i % GRID) / (GRID - 1), y = -2.0f + 4.0f * (float)(i / GRID) / (GRID - 1);
+    if (moved) rt_rot_y(xf, 0.3f * (float)(i % 5), y * 0.5f, x * 0.7f, -0.5f - 0.05f * (float)(i % 7));
+    else rt_translation(xf, x, y, 0.0f);
+}
+
+/* Every other instance baked; a mix of emitters and lit Lambert quads under one point light. */
+static void grid_build(grid_scene *g, const unsigned char *moved)
+{
+    g->dev = rt_device();
+    sy_rt_mesh q = rt_quad(g->dev, 0.1f);
+    sy_rt_material mats[3] = {rt_emitter(g->dev, 0.0f, 1.0f, 0.0f), rt_lambert(g->dev, 0.8f, 0.2f, 0.2f),
+                              rt_lambert(g->dev, 0.2f, 0.2f, 0.8f)};
+    sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 40.0f, .position = {0, 1, 4}};
+    sy_rt_light l;
+    MUST(sy_rt_light_create(g->dev, &ld, &l, ERR));
+    for (int i = 0; i < GRID * GRID; ++i) {
+        float xf[16];
+        grid_xf(i, moved && moved[i], xf);
+        g->inst[i] = rt_place(g->dev, q, xf, mats[i % 3], i % 2 ? SY_RT_INSTANCE_BAKED : 0u);
+    }
+    MUST(sy_rt_commit(g->dev, ERR));
+}
+
+/* Whitted (shadows) and primary (ray packets) renders must match the from-scratch device bit for bit. */
+static void grid_compare(grid_scene *g, const unsigned char *moved, const char *what)
+{
+    grid_scene ref;
+    grid_build(&ref, moved);
+    sy_rt_camera cam = rt_camera(5.0f, 0.6f);
+    for (int k = 0; k < 2; ++k) {
+        sy_rt_render_desc rd = rt_desc(k ? SY_RT_INTEGRATOR_PRIMARY : SY_RT_INTEGRATOR_WHITTED, MW, MW);
+        float *a, *ad, *b, *bd;
+        rt_render(g->dev, &cam, &rd, &a, &ad);
+        rt_render(ref.dev, &cam, &rd, &b, &bd);
+        size_t diff = 0;
+        for (size_t i = 0; i < (size_t)MW * MW * 4; ++i) diff += a[i] != b[i];
+        for (size_t i = 0; i < (size_t)MW * MW; ++i) diff += ad[i] != bd[i];
+        CHECK(diff == 0, "%s: %s render differs from a device built with the same transforms in %zu values", what,
+              k ? "primary (packets)" : "whitted", diff);
+        free(a), free(ad), free(b), free(bd);
+    }
+    sy_rt_device_destroy(ref.dev);
+}
+
+static void test_moves_match_rebuild(void)
+{
+    unsigned char moved[GRID * GRID] = {0};
+    grid_scene g;
+    grid_build(&g, NULL);
+    sy_rt_stats st;
+    sy_rt_device_stats(g.dev, &st);
+    uint64_t builds = st.top_builds;
+
+    /* A few moves over several commits (instance 7 twice): no top-level rebuild. */
+    const int first[] = {7, 8, 100, 7, 250};
+    for (int k = 0; k < 5; ++k) {
+        float xf[16];
+        moved[first[k]] = 1;
+        grid_xf(first[k], 1, xf);
+        if (k == 0) rt_translation(xf, 9.0f, 9.0f, 0.0f); /* an intermediate pose, moved again below */
+        MUST(sy_rt_instance_set_transform(g.dev, g.inst[first[k]], xf, ERR));
+        MUST(sy_rt_commit(g.dev, ERR));
+    }
+    sy_rt_device_stats(g.dev, &st);
+    CHECK(st.top_builds == builds && st.moved_instances == 4, "4 moved instances: %llu full builds (expected %llu), %u "
+          "shown by twins (expected 4)", (unsigned long long)st.top_builds, (unsigned long long)builds, st.moved_instances);
+    grid_compare(&g, moved, "4 moved instances");
+
+    /* Hiding and showing a moved instance is structural: a full build folds the twins back. */
+    MUST(sy_rt_instance_set_visible(g.dev, g.inst[100], false, ERR));
+    MUST(sy_rt_commit(g.dev, ERR));
+    MUST(sy_rt_instance_set_visible(g.dev, g.inst[100], true, ERR));
+    MUST(sy_rt_commit(g.dev, ERR));
+    sy_rt_device_stats(g.dev, &st);
+    CHECK(st.top_builds == builds + 2 && st.moved_instances == 0, "hide + show: %llu builds, %u twins",
+          (unsigned long long)(st.top_builds - builds), st.moved_instances);
+    grid_compare(&g, moved, "after hide + show");
+
+    /* More moves than the fast path takes at once: one full build. */
+    builds = st.top_builds;
+    for (int i = 0; i < GRID * GRID; i += 3) {
+        float xf[16];
+        moved[i] = 1;
+        grid_xf(i, 1, xf);
+        MUST(sy_rt_instance_set_transform(g.dev, g.inst[i], xf, ERR));
+    }
+    MUST(sy_rt_commit(g.dev, ERR));
+    sy_rt_device_stats(g.dev, &st);
+    CHECK(st.top_builds == builds + 1 && st.moved_instances == 0, "108 moves in one commit: %llu builds, %u twins",
+          (unsigned long long)(st.top_builds - builds), st.moved_instances);
+    grid_compare(&g, moved, "108 moved instances");
+
+    /* Destroying a moved instance. */
+    float xf[16];
+    grid_xf(1, 1, xf);
+    moved[1] = 1;
+    MUST(sy_rt_instance_set_transform(g.dev, g.inst[1], xf, ERR));
+    MUST(sy_rt_commit(g.dev, ERR));
+    sy_rt_device_stats(g.dev, &st);
+    CHECK(st.moved_instances == 1, "one moved: %u twins", st.moved_instances);
+    MUST(sy_rt_instance_destroy(g.dev, g.inst[1], ERR));
+    MUST(sy_rt_commit(g.dev, ERR));
+    sy_rt_device_stats(g.dev, &st);
+    CHECK(st.moved_instances == 0 && st.instances == GRID * GRID - 1, "destroyed the moved one: %u twins, %u instances",
+          st.moved_instances, st.instances);
+    sy_rt_device_destroy(g.dev);
+}
+
 int main(void)
 {
     test_move_hide_destroy(0);
     test_move_hide_destroy(SY_RT_INSTANCE_BAKED);
     test_area_light_follows();
+    test_moves_match_rebuild();
     return rt_finish("test_rt_instances");
 }

@@ -329,9 +329,10 @@ static int test_stream(uint16_t port)
         free(j1);
         if (next_frame(c, &fi, &j1, &n1)) return 1;
     } while (fi.input_id < 7);
-    CHECK(fi.input_id == 7 && fi.width == 80);
+    /* a moving frame: the governor may render it smaller (the page scales it up) */
+    CHECK(fi.input_id == 7 && fi.width >= 1 && fi.width <= 80 && fi.height <= 60);
     CHECK(n1 != n0 || memcmp(j0, j1, n0) != 0); /* the view turned */
-    if (check_jpeg(j1, n1, 80, 60)) return 1;
+    if (check_jpeg(j1, n1, fi.width, fi.height)) return 1;
     free(j0);
     free(j1);
     /* a message over the limit (256 bytes) closes that connection; the other viewer stays */

@@ -1,0 +1,87 @@
+#!/bin/bash
+# browser_test.sh — sy web in a real browser: Debian's chromium, headless, driven over the DevTools
+# protocol by browser.mjs (playwright-core, installed from npm into the build tree at build time).
+#
+#   browser_test.sh stream SY PNG_IOU MODULES_DIR SCENE
+#     sy web SCENE -b raster: the canvas shows the same coverage as `sy render -b raster` at the
+#     canvas size (IoU >= 0.95), and a drag across the canvas changes the view.
+#   browser_test.sh client SY PNG_IOU MODULES_DIR SCENE
+#     sy web SCENE --client-render: the three.js page fetches exactly the objects the culling
+#     service answered (each once, no other), and what it draws covers what `sy render -b raster`
+#     covers for the same (initial) view (IoU >= 0.95).
+#
+# MODULES_DIR holds browser.mjs and node_modules/playwright-core. Skipped (77, with the reason)
+# without chromium, node, playwright-core (npm ci failed: no network at build time) or the scene.
+set -u
+mode=$1 SY=$2 PNG_IOU=$3 MODULES=$4 SCENE=$5
+W=480 H=360
+skip() { echo "SKIP: $*"; exit 77; }
+[ -f "$SCENE" ] || skip "$SCENE is absent (the test data in ../shared/testdata)"
+CHROMIUM=${SY_CHROMIUM:-/usr/bin/chromium}
+[ -x "$CHROMIUM" ] || skip "chromium is not installed ($CHROMIUM; apt-get install chromium)"
+command -v node >/dev/null || skip "node is not installed (apt-get install nodejs)"
+[ -d "$MODULES/node_modules/playwright-core" ] ||
+    skip "playwright-core is not in $MODULES/node_modules (npm ci failed at build time: no network?)"
+out=$(mktemp -d)
+pid=
+cleanup() {
+    [ -n "$pid" ] && kill -TERM "$pid" 2>/dev/null && wait "$pid" 2>/dev/null
+    rm -rf "$out"
+}
+trap cleanup EXIT
+fail=0
+bad() { echo "FAIL: $*"; fail=1; }
+
+args=(web "$SCENE" -b raster --listen 127.0.0.1:0)
+[ "$mode" = client ] && args+=(--client-render)
+"$SY" "${args[@]}" >"$out/log" 2>"$out/err" &
+pid=$!
+url=
+for _ in $(seq 1 300); do
+    url=$(grep -o 'http://[^ ]*' "$out/log" 2>/dev/null | head -1)
+    [ -n "$url" ] && break
+    kill -0 $pid 2>/dev/null || break
+    sleep 0.1
+done
+[ -n "$url" ] || { echo "FAIL: sy web printed no URL: $(cat "$out/log" "$out/err")"; exit 1; }
+echo "sy web: $url"
+
+SY_CHROMIUM=$CHROMIUM node "$MODULES/browser.mjs" "$mode" "$url" "$out" $W $H >"$out/browser.json"
+rc=$?
+cat "$out/browser.json"
+[ $rc = 77 ] && skip "$(cat "$out/browser.json")"
+[ $rc = 0 ] || { echo "FAIL: the browser run failed (exit $rc); sy web said: $(tail -5 "$out/err")"; exit 1; }
+
+# The reference: sy render with the rasterizer at the canvas size, the scene's default view (the
+# view sy web starts with, and the client page asks the server for).
+"$SY" render "$SCENE" -b raster -w $W -h $H -o "$out/ref.png" >/dev/null 2>"$out/render.err" ||
+    { echo "FAIL: sy render: $(cat "$out/render.err")"; exit 1; }
+res=$("$PNG_IOU" "$out/canvas.png" "$out/ref.png" --min 0.95)
+rc=$?
+echo "canvas against sy render -b raster: $res"
+[ $rc = 0 ] || bad "the canvas' coverage differs from sy render -b raster (IoU below 0.95)"
+
+if [ "$mode" = stream ]; then
+    res=$("$PNG_IOU" "$out/canvas.png" "$out/dragged.png")
+    echo "before against after the drag: $res"
+    iou=$(echo "$res" | awk '{print $2}')
+    awk -v v="$iou" 'BEGIN { exit !(v < 0.98) }' || bad "a drag did not change the view (IoU $iou against before)"
+else
+    # what the page fetched: each object of the answer once, nothing else
+    node -e '
+      const s = JSON.parse(require("fs").readFileSync(process.argv[1], "utf8"));
+      const req = [...new Set(s.requested)].sort((a, b) => a - b), got = [...s.fetched].sort((a, b) => a - b);
+      const dup = got.filter((v, i) => i > 0 && got[i - 1] === v);
+      const extra = got.filter((v) => !req.includes(v)), missing = req.filter((v) => !got.includes(v));
+      console.log(`answer: ${req.length} of ${s.total_objects} objects; fetched ${got.length}; drawn ${s.visible.length} ` +
+                  `objects, ${s.triangles} of ${s.total_triangles} triangles; ${s.bytes} GLB bytes`);
+      const errs = [];
+      if (dup.length) errs.push(`fetched twice: ${dup.slice(0, 10)}`);
+      if (extra.length) errs.push(`fetched but not in the answer: ${extra.slice(0, 10)}`);
+      if (missing.length) errs.push(`in the answer but not fetched: ${missing.slice(0, 10)}`);
+      if (s.errors && s.errors.length) errs.push(`page errors: ${s.errors}`);
+      if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
+    ' "$out/client.json" || fail=1
+fi
+[ $fail = 0 ] && echo "ok: sy web $mode in chromium"
+exit $fail

@@ -1,0 +1,160 @@
+/* test_raster_lod.c — levels of detail and view culling in the rasterizer (sy_gl_set_lod): a sphere
+ * of 130k triangles drawn far away uses a simplified level (a small fraction of its triangles)
+ * while its silhouette and depth stay those of the full mesh; near the camera it draws more; an
+ * instance behind the camera is culled and draws nothing; with levels off every triangle is
+ * drawn; a mesh under SY_GL_LOD_MIN_TRIANGLES has no levels. OSMesa. */
+#include "sy_gl.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int failures;
+#define CHECK(c, ...)                                                                                  \
+    do {                                                                                               \
+        if (!(c)) {                                                                                    \
+            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #c);                      \
+            fprintf(stderr, __VA_ARGS__);                                                              \
+            fputc('\n', stderr);                                                                       \
+            failures++;                                                                                \
+        }                                                                                              \
+    } while (0)
+#define MUST(call)                                                                                     \
+    do {                                                                                               \
+        sy_gl_result r_ = (call);                                                                      \
+        if (r_ != SY_GL_OK) {                                                                          \
+            fprintf(stderr, "%s:%d: %s failed (%d): %s\n", __FILE__, __LINE__, #call, (int)r_, e);     \
+            exit(1);                                                                                   \
+        }                                                                                              \
+    } while (0)
+
+#define N 96
+static char e[4096];
+static float rgba[2][N * N * 4], depth[2][N * N];
+
+/* A unit UV sphere of 2 * seg * (seg - 1) triangles with a wavy radius (not trivially flat). */
+static sy_gl_mesh sphere(sy_gl_device *d, uint32_t seg, uint32_t *tris)
+{
+    uint32_t nv = (seg + 1) * (seg + 1), nt = 0;
+    float *p = malloc(nv * 3 * sizeof *p), *n = malloc(nv * 3 * sizeof *n);
+    uint32_t *ix = malloc((size_t)seg * seg * 6 * sizeof *ix);
+    if (!p || !n || !ix) exit(1);
+    for (uint32_t i = 0; i <= seg; ++i)
+        for (uint32_t j = 0; j <= seg; ++j) {
+            float th = 3.14159265f * (float)i / (float)seg, ph = 6.2831853f * (float)j / (float)seg;
+            float r = 1.0f + 0.03f * sinf(7.0f * th) * cosf(5.0f * ph);
+            float *v = p + 3 * (i * (seg + 1) + j), *nn = n + 3 * (i * (seg + 1) + j);
+            nn[0] = sinf(th) * cosf(ph), nn[1] = cosf(th), nn[2] = sinf(th) * sinf(ph);
+            v[0] = r * nn[0], v[1] = r * nn[1], v[2] = r * nn[2];
+        }
+    for (uint32_t i = 0; i < seg; ++i)
+        for (uint32_t j = 0; j < seg; ++j) {
+            uint32_t a = i * (seg + 1) + j, b = a + seg + 1;
+            if (i > 0) ix[3 * nt] = a, ix[3 * nt + 1] = a + 1, ix[3 * nt + 2] = b, nt++;
+            if (i + 1 < seg) ix[3 * nt] = a + 1, ix[3 * nt + 1] = b + 1, ix[3 * nt + 2] = b, nt++;
+        }
+    sy_gl_mesh_desc md = {.positions = p, .normals = n, .indices = ix, .vertex_count = nv, .triangle_count = nt};
+    sy_gl_mesh m;
+    MUST(sy_gl_mesh_create(d, &md, &m, e, sizeof e));
+    free(p), free(n), free(ix);
+    *tris = nt;
+    return m;
+}
+
+static void translate(float *m, float x, float y, float z)
+{
+    memset(m, 0, 16 * sizeof *m);
+    m[0] = m[5] = m[10] = m[15] = 1.0f;
+    m[12] = x, m[13] = y, m[14] = z;
+}
+
+/* Renders into slot k; returns the triangles drawn (stats). */
+static uint64_t draw(sy_gl_device *d, float dist, int k, uint64_t *culled)
+{
+    sy_gl_camera cam = {.window = {-0.5f, 0.5f, -0.5f, 0.5f}, .near_clip = 0.05f};
+    translate(cam.camera_to_world, 0, 0, dist);
+    sy_gl_render_desc rd = {N, N, 0, 0, N, N};
+    MUST(sy_gl_render(d, &cam, &rd, rgba[k], depth[k], e, sizeof e));
+    sy_gl_stats st;
+    sy_gl_device_stats(d, &st);
+    if (culled) *culled = st.instances_culled;
+    return st.triangles_drawn;
+}
+
+/* Coverage IoU of slots 0 and 1, and the share of pixels covered in both whose depths differ by
+ * more than 1 % (silhouette pixels may see another part of the surface). */
+static double iou(double *depth_off)
+{
+    size_t in = 0, un = 0, off = 0;
+    for (size_t i = 0; i < (size_t)N * N; ++i) {
+        bool a = isfinite(depth[0][i]), b = isfinite(depth[1][i]);
+        in += a && b;
+        un += a || b;
+        if (a && b) off += fabs(depth[0][i] - depth[1][i]) > 0.01 * depth[1][i];
+    }
+    *depth_off = in ? (double)off / (double)in : 1.0;
+    return un ? (double)in / (double)un : 0.0;
+}
+
+int main(void)
+{
+    sy_gl_device *d;
+    sy_gl_device_desc dd = {.provider = SY_GL_PROVIDER_OSMESA, .msaa = 1};
+    MUST(sy_gl_device_create(&dd, &d, e, sizeof e));
+    uint32_t tris = 0;
+    sy_gl_mesh big = sphere(d, 256, &tris);
+    CHECK(tris >= SY_GL_LOD_MIN_TRIANGLES, "the sphere has %u triangles", tris);
+    sy_gl_material_desc mdsc;
+    sy_gl_material_desc_init(&mdsc);
+    sy_gl_material mat;
+    MUST(sy_gl_material_create(d, &mdsc, &mat, e, sizeof e));
+    sy_gl_instance_desc id = {.mesh = big, .material = mat};
+    translate(id.transform, 0, 0, 0);
+    sy_gl_instance inst;
+    MUST(sy_gl_instance_create(d, &id, &inst, e, sizeof e));
+
+    /* Far: the sphere covers ~16 px across (dist 12, window 1 wide at 1 m). */
+    const float dists[2] = {12.0f, 3.0f};
+    uint64_t drawn_at[2];
+    for (int k = 0; k < 2; ++k) {
+        sy_gl_set_lod(d, SY_GL_LOD_PIXELS_DEFAULT);
+        uint64_t lod = draw(d, dists[k], 0, NULL);
+        sy_gl_set_lod(d, 0.0f);
+        uint64_t full = draw(d, dists[k], 1, NULL);
+        double drel, io = iou(&drel);
+        printf("distance %4.1f m: %llu of %llu triangles drawn, coverage IoU %.4f, depth off by > 1 %% in %.2f %% of pixels\n",
+               (double)dists[k], (unsigned long long)lod, (unsigned long long)full, io, 100.0 * drel);
+        CHECK(full == tris, "levels off: %llu triangles drawn, want %u", (unsigned long long)full, tris);
+        CHECK(io >= 0.98, "distance %g: coverage IoU %.4f against the full mesh", (double)dists[k], io);
+        CHECK(drel <= 0.02, "distance %g: depth off by > 1 %% in %.2f %% of the pixels", (double)dists[k], 100.0 * drel);
+        drawn_at[k] = lod;
+    }
+    CHECK(drawn_at[0] * 20 <= tris, "far: %llu of %u triangles drawn (want a simplified level, <= 5 %%)",
+          (unsigned long long)drawn_at[0], tris);
+    CHECK(drawn_at[1] > drawn_at[0], "near (%llu triangles) must draw more than far (%llu)",
+          (unsigned long long)drawn_at[1], (unsigned long long)drawn_at[0]);
+
+    /* Behind the camera: culled, nothing drawn. */
+    sy_gl_set_lod(d, SY_GL_LOD_PIXELS_DEFAULT);
+    translate(id.transform, 0, 0, 20);
+    MUST(sy_gl_instance_set_transform(d, inst, id.transform, e, sizeof e));
+    uint64_t culled = 0, behind = draw(d, 3.0f, 0, &culled);
+    CHECK(behind == 0 && culled == 1, "behind the camera: %llu triangles drawn, %llu culled", (unsigned long long)behind,
+          (unsigned long long)culled);
+
+    /* A small mesh has no levels: all its triangles at any distance. */
+    MUST(sy_gl_instance_destroy(d, inst));
+    uint32_t small_tris = 0;
+    sy_gl_mesh small = sphere(d, 64, &small_tris);
+    CHECK(small_tris < SY_GL_LOD_MIN_TRIANGLES, "small sphere: %u triangles", small_tris);
+    id.mesh = small;
+    translate(id.transform, 0, 0, 0);
+    MUST(sy_gl_instance_create(d, &id, &inst, e, sizeof e));
+    uint64_t s = draw(d, 12.0f, 0, NULL);
+    CHECK(s == small_tris, "small mesh far away: %llu of %u triangles drawn", (unsigned long long)s, small_tris);
+    sy_gl_device_destroy(d);
+    if (failures) fprintf(stderr, "test_raster_lod: %d check(s) failed\n", failures);
+    else printf("test_raster_lod: ok\n");
+    return failures ? 1 : 0;
+}
