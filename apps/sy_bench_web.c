@@ -50,8 +50,8 @@ sy_result sy_bench_web(const sy_web_desc *desc, uint32_t width, uint32_t height,
     sy_web_client *c = NULL;
     sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
     double *lat = calloc(repeats, sizeof *lat), *render = calloc(repeats, sizeof *render),
-           *over = calloc(repeats, sizeof *over);
-    if (!lat || !render || !over) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench web: out of memory");
+           *over = calloc(repeats, sizeof *over), *wid = calloc(repeats, sizeof *wid);
+    if (!lat || !render || !over || !wid) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench web: out of memory");
     if (r == SY_OK) r = sy_web_client_connect(&o, 5000, &c, err);
     char m[128];
     snprintf(m, sizeof m, "{\"t\":\"size\",\"w\":%u,\"h\":%u}", width, height);
@@ -74,6 +74,7 @@ sy_result sy_bench_web(const sy_web_desc *desc, uint32_t width, uint32_t height,
         if (r != SY_OK) break;
         lat[done] = (sy_time_now() - t0) * 1e3;
         render[done] = fi.render_ms;
+        wid[done] = fi.width;
         over[done] = lat[done] - fi.render_ms; /* what the stream adds: input, JPEG, socket, wake-ups */
         done++;
         if (sy_is_terminal(1)) fprintf(stdout, "\r%u/%u", done, repeats), fflush(stdout);
@@ -87,11 +88,14 @@ sy_result sy_bench_web(const sy_web_desc *desc, uint32_t width, uint32_t height,
         qsort(lat, done, sizeof *lat, cmp_double);
         qsort(render, done, sizeof *render, cmp_double);
         qsort(over, done, sizeof *over, cmp_double);
+        qsort(wid, done, sizeof *wid, cmp_double);
         printf("sy bench web: %s, %ux%u frames, %u drags on loopback (input sent -> first frame answering it "
                "received)\n",
                d.backend, width, height, done);
         printf("  latency  p50 %.2f ms  p95 %.2f ms  (min %.2f, max %.2f)\n", pct(lat, done, 0.5), pct(lat, done, 0.95),
                lat[0], lat[done - 1]);
+        printf("  answering frames (the governor's moving frames): median width %.0f of %u (min %.0f, max %.0f)\n",
+               pct(wid, done, 0.5), width, wid[0], wid[done - 1]);
         printf("  server render per frame: median %.2f ms; latency / render = %.2fx\n", pct(render, done, 0.5),
                pct(render, done, 0.5) > 0 ? pct(lat, done, 0.5) / pct(render, done, 0.5) : 0.0);
         printf("  stream overhead (latency - that frame's render)  p50 %.2f ms  p95 %.2f ms  (min %.2f, max %.2f)\n",
@@ -100,6 +104,7 @@ sy_result sy_bench_web(const sy_web_desc *desc, uint32_t width, uint32_t height,
     free(lat);
     free(render);
     free(over);
+    free(wid);
     sy_web_destroy(s.web);
     return r;
 }
