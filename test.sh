@@ -22,11 +22,11 @@ step "build (ASan+UBSan)" sy_configure_build build-asan -- -DCMAKE_BUILD_TYPE=De
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0" \
   step "ctest (ASan+UBSan)" ctest --test-dir build-asan --output-on-failure -j "$jobs"
-# Minimal configuration (the modular build): only the Embree back-ends, as shared libraries; GL,
+# Minimal configuration (the modular build): only the Embree back-ends, as shared libraries (no sy web); GL,
 # GLFW, nng, libsodium, zstd and MPI are not even looked for (package_parts checks that), and the
 # suite runs what this build has, the installed-package test included.
 step "build (minimal: Embree only, shared)" sy_configure_build build-min -- -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DSY_WITH_RASTER=OFF -DSY_WITH_CLUSTER=OFF -DBUILD_SHARED_LIBS=ON &&
+  -DSY_WITH_RASTER=OFF -DSY_WITH_CLUSTER=OFF -DSY_WITH_WEB=OFF -DBUILD_SHARED_LIBS=ON &&
   step "ctest (minimal)" ctest --test-dir build-min --output-on-failure -j "$jobs"
 # Fuzzing (tests/fuzz): clang + libFuzzer, only the fuzz targets; each fuzz_run_* test fuzzes
 # SY_FUZZ_SECONDS on seeds from ../shared/testdata (tests/fuzz/fuzz.sh runs long campaigns).

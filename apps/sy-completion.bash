@@ -9,8 +9,8 @@
 # the bash-completion package. Keep the lists in step with apps/sy_main.c (usage_text) and
 # apps/sy_cluster_cli.c; tests/integration/completion_test.sh checks a few.
 
-_sy_commands="info render demo compare coverage view bench backends serve help version"
-_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit cull"
+_sy_commands="info render demo compare coverage view web bench backends serve help version"
+_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit cull web"
 _sy_common="--help -q --quiet -v --verbose --env --env-color --env-intensity --env-hidden --background
             --no-default-light --allow-path --strict"
 _sy_cluster="--cluster --cluster-mode --secret-file --tls-ca --timeout-ms --cluster-pixels"
@@ -20,7 +20,7 @@ _sy_with_value=" -b -o -w -h --camera --params --max-memory --gl --filter --thre
   --timeout-ms --cluster-pixels --screenshot --keys --top --backends --repeats --nodes --tris --reference --env
   --env-color --env-intensity --background --allow-path --listen --output --port-file --tls-cert --tls-key --name
   --max-sessions --max-lifetime --blob-cache-mb --max-objects --auth-backoff-ms --max-peer-memory-mb
-  --max-frame-kb --max-message-mb --max-unauthenticated --handshake-timeout-ms --coop-frame --budget "
+  --max-frame-kb --max-message-mb --max-unauthenticated --handshake-timeout-ms --coop-frame --budget --quality "
 
 # _sy_options COMMAND [BENCH_KIND]: the options of a command
 _sy_options() {
@@ -29,6 +29,7 @@ _sy_options() {
                   --eye-sep --zero-parallax --overlay --composite --frames --spp --time --aov $_sy_cluster $_sy_common" ;;
     view) echo "-b -w -h --camera --overlay --composite --frames --screenshot --filter --threshold --keys --spp --budget
                 $_sy_cluster $_sy_common" ;;
+    web) echo "-b -w -h --camera --listen --quality --filter --threshold --budget --client-render $_sy_common" ;;
     info) echo "--json $_sy_common" ;;
     compare) echo "-w -h -o --spp --camera --backends $_sy_common" ;;
     coverage) echo "-w -h --camera --top --json $_sy_common" ;;
@@ -42,6 +43,7 @@ _sy_options() {
         cluster) echo "-w -h --repeats --hostile-only --coop-only --scale --coop-frame --help -q -v" ;;
         filters) echo "-w -h --repeats --reference $_sy_common" ;;
         memory) echo "-w -h -b --tris --glb $_sy_common" ;;
+        web) echo "-w -h -b --repeats $_sy_common" ;;
         governor) echo "-w -h --budget --frames --tris --trace --help -q -v" ;;
         cull) echo "-w -h --tris --objects --budget --frames --seed --write --help" ;;
         *) echo "-w -h --repeats --nodes --tris --params $_sy_common" ;;
@@ -114,7 +116,7 @@ _sy_complete() {
         if [ -z "$kind" ]; then COMPREPLY=($(compgen -W "$_sy_bench_kinds" -- "$cur"))
         else _sy_files; fi ;;
     info) _sy_files ;; # a scene or an EXR image
-    render | view | compare | coverage) [ $operands = 0 ] && _sy_files scenes ;;
+    render | view | web | compare | coverage) [ $operands = 0 ] && _sy_files scenes ;;
     esac
     return 0
 }

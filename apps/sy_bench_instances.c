@@ -121,9 +121,8 @@ sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, 
     /* The reference: Whitted (one ray through each pixel centre for the depth layer); every other
      * picture back-end is compared against its first frame. */
     const sy_mediator_class *ref_cls = sy_mediator_rt_whitted_class();
-    const sy_mediator_class *raster_cls = NULL;
 #ifdef SY_HAVE_RASTER
-    raster_cls = sy_mediator_raster_class();
+    const sy_mediator_class *raster_cls = sy_mediator_raster_class(); /* its counters: triangles, culled */
 #endif
     for (int pass = 0; pass < 2 && r == SY_OK; ++pass) /* the reference first */
         for (uint32_t b = 0; b < sy_mediator_count() && r == SY_OK; ++b) {

@@ -46,6 +46,10 @@
 #include "sy_compose.h"
 #ifdef SY_HAVE_GLFW
 #include "sy_view.h"
+#ifdef SY_HAVE_WEB
+#include "sy_bench_web.h"
+#include "sy_web.h"
+#endif
 #endif
 #include "sy_demo.h"
 #include "sy_exr.h"
@@ -597,6 +601,10 @@ static const char usage_text[] =
             "          [--budget MS]   (frame time while the view moves: the resolution follows it; default 33)\n"
             "          [--cluster URL[,URL...]|FILE.conf [--cluster-mode MODE] [--secret-file F] [--timeout-ms MS]\n"
             "           [--spp SAMPLES_PER_SERVER_AND_FRAME]]   (the same cluster options as sy render)\n"
+            "  sy web SCENE [-b BACKEND] [--listen HOST:PORT] [--camera C] [-w MAX_W] [-h MAX_H] [--quality Q]\n"
+            "          [--filter none|pixel|...] [--threshold T] [--budget MS] [--client-render]   (the view in a browser:\n"
+            "           open the URL it prints; another address than loopback needs the printed token)\n"
+            "  sy bench web [SCENE] [-b BACKEND] [-w W] [-h H] [--repeats N]   (input-to-frame latency, loopback)\n"
             "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"
             "  sy bench rays [SCENE] [-w W] [-h H] [--repeats R]\n"
             "  sy bench pathtracer [SCENE] [-w W] [-h H] [--repeats PASSES]\n"
@@ -1450,6 +1458,72 @@ static int cmd_view(int argc, char **argv)
 }
 #endif
 
+#ifdef SY_HAVE_WEB
+/* `sy web SCENE`: the view in a web browser (apps/web/sy_web.h, docs/WEB.md). */
+enum { OPT_WEB_LISTEN = 0x300, OPT_WEB_QUALITY, OPT_WEB_CLIENT_RENDER };
+static int cmd_web(int argc, char **argv)
+{
+    const char *backend = "whitted", *camera = NULL, *listen = NULL, *filter = NULL;
+    uint32_t w = 1920, h = 1200, quality = 80;
+    float threshold = 0.0f;
+    double budget = 0; /* 0: the governor's default (33 ms) */
+    static const struct option lo[] = {
+        {"camera", required_argument, NULL, OPT_CAMERA}, {"listen", required_argument, NULL, OPT_WEB_LISTEN},
+        {"quality", required_argument, NULL, OPT_WEB_QUALITY}, {"filter", required_argument, NULL, OPT_FILTER},
+        {"threshold", required_argument, NULL, OPT_THRESHOLD}, {"budget", required_argument, NULL, OPT_BUDGET},
+        {"client-render", no_argument, NULL, OPT_WEB_CLIENT_RENDER}, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = next_option("web", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, &status)) != -1) {
+        char *end = NULL;
+        switch (c) {
+        case OPT_STOP: return status;
+        case 'b': backend = optarg; break;
+        case 'w':
+        case 'h':
+            if (!size_option(c, optarg, &w, &h)) return bad_value(c == 'w' ? "-w" : "-h", optarg);
+            break;
+        case OPT_CAMERA: camera = optarg; break;
+        case OPT_WEB_LISTEN: listen = optarg; break;
+        case OPT_WEB_QUALITY:
+            if (!parse_u32(optarg, 1, 100, &quality)) return bad_value("--quality", optarg);
+            break;
+        case OPT_FILTER: filter = optarg; break;
+        case OPT_THRESHOLD:
+            threshold = strtof(optarg, &end);
+            if (end == optarg || *end || !(threshold >= 0.0f) || !isfinite(threshold)) return bad_value("--threshold", optarg);
+            break;
+        case OPT_BUDGET: /* the frame-time governor's budget (ms) */
+            budget = strtod(optarg, &end);
+            if (end == optarg || *end || !(budget >= 1.0 && budget <= 10000.0)) return bad_value("--budget", optarg);
+            break;
+        case OPT_WEB_CLIENT_RENDER: break; /* the client-render page comes with remote culling (issue 18, part 4) */
+        }
+    }
+    if (argc - optind != 1) return usage_of("web", argc == optind ? "a SCENE is required" : "one SCENE at a time");
+    sy_error err = {0};
+    loaded ld;
+    if (load(argv[optind], camera, true, &ld, &err) != SY_OK) return fail(&err);
+    sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,
+                     .backend = backend, .listen = listen, .max_width = w, .max_height = h, .quality = (int)quality,
+                     .filter = filter, .threshold = threshold, .budget_ms = budget};
+    sy_web *web = NULL;
+    sy_result r = sy_web_create(&d, &web, &err);
+    if (r == SY_OK) {
+        const char *url = sy_web_url(web);
+        printf("sy web: serving %s with %s; open %s%s\n", argv[optind], backend, url,
+               strstr(url, "//0.0.0.0:") || strstr(url, "//[::]:") ? " (with this machine's name or address for the host)" : "");
+        fflush(stdout);
+        sy_signals_set_graceful("closing the server");
+        r = sy_web_run(web, sy_signals_stop_flag(), &err);
+        sy_signals_set_graceful(NULL);
+    }
+    sy_web_destroy(web);
+    loaded_free(&ld);
+    return r == SY_OK ? 0 : fail(&err);
+}
+#endif
+
 /* `sy coverage SCENE`: which objects the camera sees and how many pixels each covers (occlusion
  * included), most first, as JSON: a culling service for clients that load only what is visible. */
 static int cmd_coverage(int argc, char **argv)
@@ -1677,7 +1751,7 @@ static int cmd_bench(int argc, char **argv)
 {
     static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
                                         "viewports", "load", "cluster",    "memory", "instances", "governor",
-                                        "limit",     "cull"};
+                                        "limit",     "cull", "web"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -1697,7 +1771,7 @@ static int cmd_bench(int argc, char **argv)
     if (!strcmp(cmd, "cull")) return SY_BENCH_CULL(argc, argv); /* apps/sy_bench_cull.c */
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
     const char *scene = NULL, *params = NULL, *backend = NULL;
-    bool memory = !strcmp(cmd, "memory"), instanced = !strcmp(cmd, "instances");
+    bool memory = !strcmp(cmd, "memory"), instanced = !strcmp(cmd, "instances"), web = !strcmp(cmd, "web");
     static const struct option lo[] = {{"params", required_argument, NULL, OPT_PARAMS},
                                        {"nodes", required_argument, NULL, OPT_NODES},
                                        {"tris", required_argument, NULL, OPT_TRIS},
@@ -1708,12 +1782,12 @@ static int cmd_bench(int argc, char **argv)
     bool glb = false;
     int c, status = 0;
     optind = 0;
-    while ((c = next_option(who, argc, argv, memory || instanced ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"), lo,
+    while ((c = next_option(who, argc, argv, memory || instanced || web ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"), lo,
                             &status)) != -1) {
         switch (c) {
         case OPT_STOP: return status;
         case OPT_PARAMS: params = optarg; break; /* bench raster */
-        case 'b': backend = optarg; break; /* bench memory, bench instances */
+        case 'b': backend = optarg; break; /* bench memory, bench instances, bench web */
         case OPT_GLB:
             if (!memory) return usage_of(who, "--glb is an option of sy bench memory");
             glb = true;
@@ -1762,6 +1836,17 @@ static int cmd_bench(int argc, char **argv)
     if (!strcmp(cmd, "load")) /* SCENE = the glTF sample directory; --tris: generated model (default 1M) */
         return sy_bench_load(scene ? scene : "../shared/testdata/gltf", tris == 100 ? 1000000 : tris,
                              repeats ? repeats : 3, &err) == SY_OK ? 0 : fail(&err);
+#ifdef SY_HAVE_WEB
+    if (web) { /* input-to-frame latency of sy web on loopback (apps/sy_bench_web.c) */
+        loaded ld;
+        if (load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return fail(&err);
+        sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,
+                         .backend = backend ? backend : "whitted"};
+        sy_result r = sy_bench_web(&d, w == 512 ? 640 : w, h == 512 ? 360 : h, repeats ? repeats : 50, &err);
+        loaded_free(&ld);
+        return r == SY_OK ? 0 : fail(&err);
+    }
+#endif
     if (!strcmp(cmd, "rays")) {
         loaded ld;
         if (load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return fail(&err);
@@ -1808,7 +1893,7 @@ int main(int argc, char **argv)
         return 0;
     }
     static const char *const commands[] = {"info", "render", "demo", "compare", "bench", "backends", "coverage",
-                                           "serve", "view", "version", "help"};
+                                           "serve", "view", "web", "version", "help"};
     if (!strcmp(cmd, "help")) { /* sy help [COMMAND] */
         bool known = argc < 2;
         for (size_t k = 0; !known && k < sizeof commands / sizeof commands[0]; ++k) known = !strcmp(argv[1], commands[k]);
@@ -1833,6 +1918,9 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "serve")) return sy_cmd_serve(argc, argv);
 #ifdef SY_HAVE_GLFW
     if (!strcmp(cmd, "view")) return cmd_view(argc, argv);
+#endif
+#ifdef SY_HAVE_WEB
+    if (!strcmp(cmd, "web")) return cmd_web(argc, argv);
 #endif
     fprintf(stderr, "sy: error: unknown command '%s' (sy --help lists them)\n", cmd);
     return 2;

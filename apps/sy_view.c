@@ -4,6 +4,7 @@
 
 #include "sy_governor.h"
 #include "sy_log.h"
+#include "sy_orbit.h"
 #include "sy_mediator_cluster.h"
 #include "sy_png.h"
 
@@ -18,11 +19,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-
-typedef struct orbit {
-    float target[3];
-    float yaw, pitch, dist;
-} orbit;
 
 typedef struct view_cluster view_cluster;
 
@@ -61,37 +57,6 @@ typedef struct viewer {
     sy_error error;
     bool failed;
 } viewer;
-
-/* >>camera maths */
-static void orbit_matrix(const orbit *o, sy_mat4 *m)
-{
-    float cp = cosf(o->pitch), back[3] = {cp * sinf(o->yaw), sinf(o->pitch), cp * cosf(o->yaw)};
-    float pos[3] = {o->target[0] + back[0] * o->dist, o->target[1] + back[1] * o->dist, o->target[2] + back[2] * o->dist};
-    float x[3] = {back[2], 0.0f, -back[0]}; /* up x z */
-    float xl = sqrtf(x[0] * x[0] + x[2] * x[2]);
-    if (xl < 1e-6f) x[0] = 1.0f, x[2] = 0.0f, xl = 1.0f;
-    x[0] /= xl, x[2] /= xl;
-    float y[3] = {back[1] * x[2] - back[2] * x[1], back[2] * x[0] - back[0] * x[2], back[0] * x[1] - back[1] * x[0]};
-    sy_mat4 r = {{x[0], x[1], x[2], 0, y[0], y[1], y[2], 0, back[0], back[1], back[2], 0, pos[0], pos[1], pos[2], 1}};
-    *m = r;
-}
-
-static void orbit_from_matrix(const sy_mat4 *m, const sy_bounds *b, orbit *o)
-{
-    float pos[3] = {m->m[12], m->m[13], m->m[14]}, back[3] = {m->m[8], m->m[9], m->m[10]};
-    float bl = sqrtf(back[0] * back[0] + back[1] * back[1] + back[2] * back[2]);
-    for (int i = 0; i < 3; ++i) back[i] = bl > 0 ? back[i] / bl : (i == 2);
-    float d = 1.0f;
-    if (!sy_bounds_is_empty(b)) {
-        float c[3], along = 0;
-        for (int i = 0; i < 3; ++i) c[i] = 0.5f * (b->min[i] + b->max[i]), along -= (c[i] - pos[i]) * back[i];
-        if (along > 1e-3f) d = along;
-    }
-    o->dist = d;
-    for (int i = 0; i < 3; ++i) o->target[i] = pos[i] - back[i] * d;
-    o->pitch = asinf(back[1] < -1 ? -1 : back[1] > 1 ? 1 : back[1]);
-    o->yaw = atan2f(back[0], back[2]);
-}
 
 /* Display filters the F key cycles through, on a back-end with SY_CAP_FILTERS (sy_context_set_filter). */
 static const char *const view_filters[] = {"none", "pixel", "atrous", "jbu", "adaptive", "radiance"};
@@ -477,7 +442,7 @@ fail_unlocked:
 /* >>input */
 typedef struct input {
     viewer *v;
-    orbit o, home;
+    sy_orbit o, home;
     double mx, my;
     int drag; /* 0 none, 1 orbit, 2 pan */
     bool changed;
@@ -486,7 +451,7 @@ typedef struct input {
 static void post_request(viewer *v, const input *in)
 {
     pthread_mutex_lock(&v->mu);
-    orbit_matrix(&in->o, &v->cam);
+    sy_orbit_matrix(&in->o, &v->cam);
     v->req_version++;
     pthread_cond_signal(&v->cv);
     pthread_mutex_unlock(&v->mu);
@@ -545,17 +510,8 @@ static void on_cursor(GLFWwindow *w, double x, double y)
     double dx = x - in->mx, dy = y - in->my;
     in->mx = x, in->my = y;
     if (!in->drag) return;
-    if (in->drag == 1) {
-        in->o.yaw -= (float)dx * 0.008f;
-        in->o.pitch += (float)dy * 0.008f;
-        if (in->o.pitch > 1.55f) in->o.pitch = 1.55f;
-        if (in->o.pitch < -1.55f) in->o.pitch = -1.55f;
-    } else {
-        sy_mat4 m;
-        orbit_matrix(&in->o, &m);
-        float k = in->o.dist * 0.0015f;
-        for (int i = 0; i < 3; ++i) in->o.target[i] += (-(float)dx * m.m[i] + (float)dy * m.m[4 + i]) * k;
-    }
+    if (in->drag == 1) sy_orbit_rotate(&in->o, (float)dx, (float)dy);
+    else sy_orbit_pan(&in->o, (float)dx, (float)dy);
     in->changed = true;
 }
 
@@ -563,15 +519,14 @@ static void on_scroll(GLFWwindow *w, double dx, double dy)
 {
     (void)dx;
     input *in = glfwGetWindowUserPointer(w);
-    in->o.dist *= powf(0.9f, (float)dy);
-    if (in->o.dist < 1e-3f) in->o.dist = 1e-3f;
+    sy_orbit_zoom(&in->o, (float)dy);
     in->changed = true;
 }
 
 static void fly(GLFWwindow *w, input *in, float dt)
 {
     sy_mat4 m;
-    orbit_matrix(&in->o, &m);
+    sy_orbit_matrix(&in->o, &m);
     float speed = in->o.dist * 0.8f * dt, mv[3] = {0, 0, 0};
     if (glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) mv[2] -= 1;
     if (glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS) mv[2] += 1;
@@ -673,12 +628,12 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
         glfwTerminate();
         return r;
     }
-    orbit_from_matrix(&world, &b, &in.o);
+    sy_orbit_from_matrix(&world, &b, &in.o);
     in.home = in.o;
     int fbw, fbh;
     glfwGetFramebufferSize(win, &fbw, &fbh);
     v.w = (uint32_t)fbw, v.h = (uint32_t)fbh;
-    orbit_matrix(&in.o, &v.cam);
+    sy_orbit_matrix(&in.o, &v.cam);
     v.req_version = 1;
     v.threshold = args->threshold > 0.0f ? args->threshold : 0.01f; /* the pixel filter's default t */
     v.filter = filter0;

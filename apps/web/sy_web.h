@@ -1,0 +1,123 @@
+/** @file
+ * sy_web.h — the viewport in a web browser: an HTTP + WebSocket server (libwebsockets) that serves
+ * one page whose canvas shows a back-end's view of a scene, streamed as JPEG frames; the page's
+ * drags, wheel and keys steer the view. Stills (GET /api/frame.jpg?w=W&h=H) and routes added by the
+ * embedding program (e.g. remote culling) are answered on the thread that owns the scene.
+ * docs/WEB.md describes the protocol, the routes, the security model and the threads.
+ *
+ * One view for every client: all connected pages share one camera, back-end and display filter
+ * (a desktop viewport mirrored on a tablet); the render size is the size the most recent page asked
+ * for (capped at max_width x max_height), each page scales the frame to its canvas.
+ *
+ * Threads: sy_web_create starts the network thread (the libwebsockets service loop); the thread
+ * that calls sy_web_run renders, and is the only one that touches the scene while it runs. The two
+ * talk through a mutex-protected mailbox; the render thread wakes the service loop with
+ * lws_cancel_service. A slow client never holds up the others: each connection is sent only the
+ * newest frame when its socket can take one, older frames are dropped.
+ *
+ * Security: a loopback address (the default 127.0.0.1) is served to anyone on this machine whose
+ * Host header names a loopback host; any other address needs a random access token (generated,
+ * printed in the URL) on every request (?token=... or the cookie set by the first good request);
+ * WebSocket upgrades from a foreign Origin are refused; bodies, messages, connections and idle
+ * time are limited.
+ *
+ * Ownership: the server borrows the scene (it must outlive the server). Responses of route
+ * handlers are malloc()ed by the handler and freed by the server.
+ * Thread-safety: sy_web_stop, sy_web_port and sy_web_url may be called from any thread; sy_web_run
+ * from one thread at a time; sy_web_destroy after sy_web_run returned. */
+#ifndef SY_WEB_H
+#define SY_WEB_H
+
+#include "sy_scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** A request given to a route handler (valid during the call). */
+typedef struct sy_web_request {
+    const char *method;   /**< "GET" or "POST" */
+    const char *path;     /**< the URL path, e.g. "/api/object/12" (no query) */
+    const char *query;    /**< the decoded query arguments, '&'-separated ("" if none) */
+    const uint8_t *body;  /**< POST: the whole body (at most sy_web_desc.max_body bytes), else NULL */
+    size_t body_len;      /**< its length */
+    const char *peer;     /**< the client's address (for log messages) */
+} sy_web_request;
+
+/** A route handler's answer. The handler fills it; body is malloc()ed and taken by the server. */
+typedef struct sy_web_response {
+    int status;              /**< HTTP status (0 = 200) */
+    char content_type[64];   /**< e.g. "application/json" ("" = application/octet-stream) */
+    uint8_t *body;           /**< malloc()ed bytes (may be NULL when body_len is 0) */
+    size_t body_len;         /**< their count */
+} sy_web_response;
+
+/** A route handler, called on the render thread (the scene's owner) between frames. A failure
+ * (non-SY_OK) is answered with 400 (invalid argument, parse), 404 (not found), 413 (limit) or 500
+ * and err's message as text; the response's body is freed then. */
+typedef sy_result (*sy_web_handler)(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp,
+                                    sy_error *err);
+
+/** A route: requests whose method and path match go to fn on the render thread. */
+typedef struct sy_web_route {
+    const char *method; /**< "GET" or "POST" */
+    const char *path;   /**< the exact path, or a prefix when it ends with '/' ("/api/object/") */
+    sy_web_handler fn;  /**< the handler */
+    void *user;         /**< passed to fn */
+} sy_web_route;
+
+/** What the server serves. Zero fields take the defaults named. Its strings are read during
+ * sy_web_create only (the routes' strings excepted). */
+typedef struct sy_web_desc {
+    sy_scene *scene;          /**< borrowed; touched only by the thread in sy_web_run */
+    sy_node root;             /**< {0}: every root */
+    sy_node camera;           /**< a node carrying a camera: the view starts there (required) */
+    sy_background background; /**< what the camera sees where nothing is hit ({0}: black, as sy_viewport_desc) */
+    const char *backend;      /**< the initial back-end (a registered name) */
+    const char *listen;       /**< "HOST:PORT" (NULL: "127.0.0.1:8080"); port 0 = a free one */
+    const char *token;        /**< access token (hex, >= 16 characters); NULL: generated when HOST is
+                                   not a loopback address, none otherwise */
+    uint32_t max_width;       /**< largest frame (default 1920) */
+    uint32_t max_height;      /**< (default 1200) */
+    uint32_t max_clients;     /**< WebSocket viewers at once (default 8) */
+    size_t max_body;          /**< largest request body (default 1 MiB): 413 beyond */
+    size_t max_message;       /**< largest WebSocket message (default 4096): the connection is closed */
+    int quality;              /**< JPEG quality of streamed frames (default 80; stills: 95) */
+    double budget_ms;         /**< frame-time budget of the governor while the view moves (default 33) */
+    uint32_t still_samples;   /**< samples per pixel of a progressive back-end's still (default 16) */
+    uint32_t idle_timeout_s;  /**< a silent WebSocket is pinged, then closed after twice this (default 30) */
+    const char *filter;       /**< initial display filter of a back-end with SY_CAP_FILTERS (NULL: none) */
+    float threshold;          /**< its threshold (0: 0.01) */
+    const sy_web_route *routes; /**< extra routes (the array is copied; its strings and user pointers must outlive the server) */
+    uint32_t route_count;     /**< how many */
+} sy_web_desc;
+
+/** The server (opaque). */
+typedef struct sy_web sy_web;
+
+/** Binds the address, makes the server's camera node in the scene and starts the network thread.
+ * Fails with a message naming the address when it cannot be bound, the back-end when it is not
+ * registered, the option when a limit is out of range. */
+sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err);
+
+/** The port the server listens on (useful with port 0). */
+uint16_t sy_web_port(const sy_web *w);
+
+/** The URL to open: "http://HOST:PORT/" plus "?token=..." when a token is required. Static in w. */
+const char *sy_web_url(const sy_web *w);
+
+/** Renders for the connected pages and answers stills and routes until sy_web_stop is called or
+ * *stop (may be NULL) becomes non-zero (polled ten times a second). Returns the first error that
+ * ends serving (a back-end that fails is reported to the pages and serving goes on). */
+sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err);
+
+/** Makes sy_web_run return (any thread). */
+void sy_web_stop(sy_web *w);
+
+/** Stops the network thread, closes every connection, removes the camera node, frees w (NULL-safe). */
+void sy_web_destroy(sy_web *w);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_WEB_H */

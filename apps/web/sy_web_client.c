@@ -1,0 +1,182 @@
+/* sy_web_client.c — blocking WebSocket client of sy web's stream (see sy_web_client.h). */
+#include "sy_web_client.h"
+
+#include <libwebsockets.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CLIENT_MAX_MESSAGE (64u << 20)
+
+typedef struct msg {
+    struct msg *next;
+    uint8_t *data;
+    size_t len;
+} msg;
+
+struct sy_web_client {
+    struct lws_context *ctx;
+    struct lws *wsi;
+    bool established, failed, closed;
+    char fail_reason[200];
+    uint8_t *cur; /* the binary message being assembled */
+    size_t cur_len;
+    bool cur_binary;
+    msg *head, **tail; /* complete binary messages */
+    char *out;         /* a text message waiting for the socket */
+    size_t out_len;
+};
+
+static int client_cb(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
+{
+    (void)user;
+    sy_web_client *c = lws_context_user(lws_get_context(wsi));
+    switch (reason) {
+    case LWS_CALLBACK_CLIENT_CONNECTION_ERROR:
+        c->failed = true;
+        snprintf(c->fail_reason, sizeof c->fail_reason, "%s", in ? (const char *)in : "connection error");
+        c->wsi = NULL;
+        return 0;
+    case LWS_CALLBACK_CLIENT_ESTABLISHED: c->established = true; return 0;
+    case LWS_CALLBACK_CLIENT_RECEIVE: {
+        if (lws_is_first_fragment(wsi)) c->cur_len = 0, c->cur_binary = lws_frame_is_binary(wsi);
+        if (len > CLIENT_MAX_MESSAGE - c->cur_len) return -1;
+        uint8_t *b = realloc(c->cur, c->cur_len + len + 1);
+        if (!b) return -1;
+        c->cur = b;
+        memcpy(c->cur + c->cur_len, in, len);
+        c->cur_len += len;
+        if (lws_is_final_fragment(wsi) && !lws_remaining_packet_payload(wsi) && c->cur_binary) {
+            msg *m = malloc(sizeof *m);
+            if (!m) return -1;
+            m->next = NULL, m->data = c->cur, m->len = c->cur_len;
+            c->cur = NULL, c->cur_len = 0;
+            *c->tail = m;
+            c->tail = &m->next;
+        }
+        return 0;
+    }
+    case LWS_CALLBACK_CLIENT_WRITEABLE:
+        if (c->out) {
+            int n = lws_write(wsi, (unsigned char *)c->out + LWS_PRE, c->out_len, LWS_WRITE_TEXT);
+            free(c->out);
+            c->out = NULL;
+            if (n < (int)c->out_len) return -1;
+        }
+        return 0;
+    case LWS_CALLBACK_CLIENT_CLOSED:
+    case LWS_CALLBACK_CLOSED: c->closed = true, c->wsi = NULL; return 0;
+    default: return 0;
+    }
+}
+
+static const struct lws_protocols client_protocols[] = {{"sy-view", client_cb, 0, 65536, 0, NULL, 0},
+                                                        {NULL, NULL, 0, 0, 0, NULL, 0}};
+
+sy_result sy_web_client_connect(const sy_web_client_opts *o, uint32_t timeout_ms, sy_web_client **out, sy_error *err)
+{
+    *out = NULL;
+    sy_web_client *c = calloc(1, sizeof *c);
+    if (!c) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web client: out of memory");
+    c->tail = &c->head;
+    struct lws_context_creation_info ci;
+    memset(&ci, 0, sizeof ci);
+    ci.port = CONTEXT_PORT_NO_LISTEN;
+    ci.protocols = client_protocols;
+    ci.user = c;
+    c->ctx = lws_create_context(&ci);
+    if (!c->ctx) {
+        free(c);
+        return sy_error_set(err, SY_ERR_IO, "web client: libwebsockets could not start");
+    }
+    struct lws_client_connect_info cc;
+    memset(&cc, 0, sizeof cc);
+    cc.context = c->ctx;
+    cc.address = o->host;
+    cc.port = o->port;
+    cc.path = o->path ? o->path : "/ws";
+    char host[160];
+    snprintf(host, sizeof host, "%s:%u", o->host, o->port);
+    cc.host = host;
+    cc.origin = o->origin;
+    cc.protocol = "sy-view";
+    cc.local_protocol_name = "sy-view";
+    cc.pwsi = &c->wsi;
+    if (!lws_client_connect_via_info(&cc)) c->failed = true;
+    double end = sy_time_now() + timeout_ms / 1000.0;
+    while (!c->established && !c->failed && !c->closed && sy_time_now() < end) lws_service(c->ctx, 0);
+    if (!c->established) {
+        sy_result r = c->failed || c->closed
+                          ? sy_error_set(err, SY_ERR_PROTOCOL, "web client: %s:%u%s: upgrade refused (%s)", o->host, o->port,
+                                         cc.path, c->fail_reason[0] ? c->fail_reason : "closed")
+                          : sy_error_set(err, SY_ERR_IO, "web client: %s:%u: no answer within %u ms", o->host, o->port,
+                                         timeout_ms);
+        sy_web_client_close(c);
+        return r;
+    }
+    *out = c;
+    return SY_OK;
+}
+
+sy_result sy_web_client_send(sy_web_client *c, const char *text, sy_error *err)
+{
+    if (!c->wsi) return sy_error_set(err, SY_ERR_IO, "web client: the connection is closed");
+    size_t n = strlen(text);
+    free(c->out);
+    c->out = malloc(LWS_PRE + n);
+    if (!c->out) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web client: out of memory");
+    memcpy(c->out + LWS_PRE, text, n);
+    c->out_len = n;
+    lws_callback_on_writable(c->wsi);
+    double end = sy_time_now() + 5.0;
+    while (c->out && c->wsi && sy_time_now() < end) lws_service(c->ctx, 0);
+    if (c->out) return sy_error_set(err, SY_ERR_IO, "web client: could not send (connection closed or stalled)");
+    return SY_OK;
+}
+
+sy_result sy_web_client_next_frame(sy_web_client *c, uint32_t timeout_ms, sy_web_frame_info *info, uint8_t **jpeg,
+                                   size_t *jpeg_len, sy_error *err)
+{
+    if (jpeg) *jpeg = NULL;
+    if (jpeg_len) *jpeg_len = 0;
+    double end = sy_time_now() + timeout_ms / 1000.0;
+    while (!c->head && c->wsi && sy_time_now() < end) lws_service(c->ctx, 0);
+    if (!c->head)
+        return sy_error_set(err, SY_ERR_IO, "web client: no frame within %u ms%s", timeout_ms,
+                            c->wsi ? "" : " (connection closed)");
+    msg *m = c->head;
+    c->head = m->next;
+    if (!c->head) c->tail = &c->head;
+    sy_result r = SY_OK;
+    uint32_t u[5];
+    if (m->len < 40 || (memcpy(u, m->data, sizeof u), u[0] != 0x31465953u))
+        r = sy_error_set(err, SY_ERR_PROTOCOL, "web client: a binary message of %zu bytes is no frame", m->len);
+    if (r == SY_OK) {
+        info->width = u[1], info->height = u[2], info->backend = u[3], info->samples = u[4];
+        memcpy(&info->render_ms, m->data + 20, 4);
+        memcpy(&info->seq, m->data + 24, 8);
+        memcpy(&info->input_id, m->data + 32, 8);
+        if (jpeg) {
+            *jpeg = malloc(m->len - 40 + 1);
+            if (!*jpeg) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web client: out of memory");
+            else memcpy(*jpeg, m->data + 40, m->len - 40), *jpeg_len = m->len - 40;
+        }
+    }
+    free(m->data);
+    free(m);
+    return r;
+}
+
+void sy_web_client_close(sy_web_client *c)
+{
+    if (!c) return;
+    if (c->ctx) lws_context_destroy(c->ctx);
+    while (c->head) {
+        msg *m = c->head;
+        c->head = m->next;
+        free(m->data);
+        free(m);
+    }
+    free(c->cur);
+    free(c->out);
+    free(c);
+}

@@ -1,0 +1,95 @@
+/* test_orbit.c — the orbit camera (core/sy_orbit.h): matrix for hand-checked poses, the round trip
+ * matrix -> orbit -> matrix, drag / pan / zoom rules and their limits. */
+#include "check.h"
+#include "sy_orbit.h"
+
+#include <math.h>
+
+static int mat_near(const sy_mat4 *a, const sy_mat4 *b, float eps)
+{
+    for (int i = 0; i < 16; ++i)
+        if (fabsf(a->m[i] - b->m[i]) > eps) return 0;
+    return 1;
+}
+
+static int test_matrix(void)
+{
+    /* yaw 0, pitch 0: from +Z, 5 away from (1,2,3): the identity rotation at (1,2,8) */
+    sy_orbit o = {{1, 2, 3}, 0, 0, 5};
+    sy_mat4 m;
+    sy_orbit_matrix(&o, &m);
+    sy_mat4 want = sy_mat4_identity();
+    want.m[12] = 1, want.m[13] = 2, want.m[14] = 8;
+    CHECK(mat_near(&m, &want, 1e-6f));
+    /* yaw 90 degrees: from +X, looking down -X; the camera's +X is world -Z */
+    o.yaw = (float)(TEST_PI / 2);
+    sy_orbit_matrix(&o, &m);
+    CHECK_NEAR(m.m[12], 6, 1e-5);
+    CHECK_NEAR(m.m[14], 3, 1e-5);
+    CHECK_NEAR(m.m[8], 1, 1e-6); /* back = +X */
+    CHECK_NEAR(m.m[2], -1, 1e-6); /* right = -Z */
+    CHECK_NEAR(m.m[5], 1, 1e-6); /* up = +Y */
+    /* straight down (pitch 90 degrees): still orthonormal, no NaN */
+    o.pitch = (float)(TEST_PI / 2);
+    sy_orbit_matrix(&o, &m);
+    CHECK(sy_mat4_is_finite(&m));
+    CHECK_NEAR(m.m[9], 1, 1e-6);
+    return 0;
+}
+
+static int test_round_trip(void)
+{
+    sy_bounds b = {{-1, -1, -1}, {1, 1, 1}};
+    sy_orbit o = {{0.5f, -0.25f, 0.1f}, 0.7f, -0.4f, 3.0f}, back;
+    sy_mat4 m, m2;
+    sy_orbit_matrix(&o, &m);
+    sy_orbit_from_matrix(&m, &b, &back);
+    sy_orbit_matrix(&back, &m2);
+    CHECK(mat_near(&m, &m2, 1e-5f)); /* same position and axes */
+    CHECK_NEAR(back.yaw, 0.7, 1e-5);
+    CHECK_NEAR(back.pitch, -0.4, 1e-5);
+    /* the target lies where the box centre projects onto the viewing axis */
+    float c[3] = {0, 0, 0}, d = 0;
+    for (int i = 0; i < 3; ++i) d += (back.target[i] - c[i]) * m.m[8 + i];
+    CHECK_NEAR(d, 0, 1e-4);
+    /* an empty box or one behind the camera: distance 1 */
+    sy_bounds empty = {{1, 1, 1}, {-1, -1, -1}};
+    sy_orbit_from_matrix(&m, &empty, &back);
+    CHECK_NEAR(back.dist, 1, 1e-6);
+    sy_orbit_from_matrix(&m, NULL, &back);
+    CHECK_NEAR(back.dist, 1, 1e-6);
+    return 0;
+}
+
+static int test_input(void)
+{
+    sy_orbit o = {{0, 0, 0}, 0, 0, 2};
+    sy_orbit_rotate(&o, 100, 0); /* drag right: yaw decreases */
+    CHECK_NEAR(o.yaw, -0.8, 1e-5);
+    sy_orbit_rotate(&o, 0, 1000); /* pitch clamped */
+    CHECK_NEAR(o.pitch, 1.55, 1e-6);
+    sy_orbit_rotate(&o, 0, -100000);
+    CHECK_NEAR(o.pitch, -1.55, 1e-6);
+    sy_orbit_rotate(&o, NAN, 1); /* ignored */
+    CHECK(isfinite(o.yaw) && o.pitch == -1.55f);
+    sy_orbit_zoom(&o, 1);
+    CHECK_NEAR(o.dist, 1.8, 1e-5);
+    sy_orbit_zoom(&o, INFINITY);
+    CHECK_NEAR(o.dist, 1.8, 1e-5);
+    for (int i = 0; i < 100; ++i) sy_orbit_zoom(&o, 50);
+    CHECK_NEAR(o.dist, 1e-3, 1e-9);
+    sy_orbit p = {{0, 0, 0}, 0, 0, 1000};
+    sy_orbit_pan(&p, 10, 0); /* drag right: the target moves to the camera's left (-X) */
+    CHECK_NEAR(p.target[0], -15, 1e-3);
+    CHECK_NEAR(p.target[1], 0, 1e-6);
+    return 0;
+}
+
+int main(void)
+{
+    int failures = 0;
+    RUN(test_matrix);
+    RUN(test_round_trip);
+    RUN(test_input);
+    return failures ? 1 : 0;
+}

@@ -1,0 +1,488 @@
+/* test_web.c — the sy_web server (apps/web/sy_web.h) in this process on a free loopback port, with
+ * the demo scene and the Whitted back-end; HTTP requests through plain sockets (so malformed and
+ * hostile ones can be sent as they are), WebSockets through apps/web/sy_web_client.h.
+ *
+ *   web_page      the page is served (the canvas id and the test hook are in it); unknown paths 404;
+ *                 a foreign Host is refused (DNS rebinding)
+ *   web_still     /api/frame.jpg?w=&h= is a JPEG of that size that is not uniform; bad sizes get 400
+ *                 with the reason
+ *   web_routes    a GET route and a POST route run on the render thread (the body arrives whole);
+ *                 a body over the limit gets 413; garbage, huge headers and cut-off requests
+ *                 leave the server serving
+ *   web_stream    a viewer receives JPEG frames; a drag message gives a frame tagged with its id that
+ *                 differs from the one before; malformed messages are ignored and serving goes on;
+ *                 a message over the limit closes that connection only; foreign Origin and missing
+ *                 subprotocol upgrades are refused; a viewer beyond max_clients is refused
+ *   web_progressive  the path tracer refines while the view rests and restarts when it moves
+ *   web_token     listening on 0.0.0.0: without the token 401 with the page saying it is missing,
+ *                 a wrong one 403, the right one 200 plus a cookie that works alone; WebSocket
+ *                 upgrades need it too */
+#define _GNU_SOURCE /* strcasestr */
+#include "sy_demo.h"
+#include "sy_jpeg.h"
+#include "sy_mediators.h"
+#include "sy_web.h"
+#include "sy_web_client.h"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+#define CHECK(expr)                                                                 \
+    do {                                                                            \
+        if (!(expr)) {                                                              \
+            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #expr); \
+            return 1;                                                               \
+        }                                                                           \
+    } while (0)
+#define CHECK_OK(call)                                                                                      \
+    do {                                                                                                    \
+        sy_result r_ = (call);                                                                              \
+        if (r_ != SY_OK) {                                                                                  \
+            fprintf(stderr, "%s:%d: %s failed: %s\n", __FILE__, __LINE__, #call, err.message);              \
+            return 1;                                                                                       \
+        }                                                                                                   \
+    } while (0)
+
+/* >>http over a plain socket: one request, Connection: close, the whole answer read */
+typedef struct http_answer {
+    int status;
+    char head[4096];
+    uint8_t *body;
+    size_t body_len;
+} http_answer;
+
+static int http(uint16_t port, const char *request, const void *body, size_t body_len, http_answer *a)
+{
+    memset(a, 0, sizeof *a);
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons(port)};
+    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    struct timeval tv = {30, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    if (fd < 0 || connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
+        if (fd >= 0) close(fd);
+        return -1;
+    }
+    size_t n = strlen(request);
+    if (send(fd, request, n, MSG_NOSIGNAL) != (ssize_t)n) {
+        close(fd);
+        return -1;
+    }
+    if (body_len) send(fd, body, body_len, MSG_NOSIGNAL); /* the server may refuse early: ignore */
+    size_t cap = 1 << 16, len = 0;
+    uint8_t *buf = malloc(cap);
+    for (;;) {
+        if (len + 4096 > cap) buf = realloc(buf, cap *= 2);
+        ssize_t got = recv(fd, buf + len, cap - len - 1, 0);
+        if (got <= 0) break;
+        len += (size_t)got;
+        buf[len] = 0;
+        /* complete once the headers and Content-Length bytes are in */
+        char *eoh = strstr((char *)buf, "\r\n\r\n");
+        if (eoh) {
+            char *cl = strcasestr((char *)buf, "content-length:");
+            size_t hl = (size_t)(eoh + 4 - (char *)buf);
+            if (cl && cl < eoh && len >= hl + strtoul(cl + 15, NULL, 10)) break;
+        }
+    }
+    close(fd);
+    buf[len] = 0;
+    char *eoh = strstr((char *)buf, "\r\n\r\n");
+    if (len < 12 || !eoh) {
+        free(buf);
+        return -1;
+    }
+    a->status = atoi((char *)buf + 9);
+    size_t hl = (size_t)(eoh + 4 - (char *)buf);
+    snprintf(a->head, sizeof a->head, "%.*s", (int)(hl < sizeof a->head ? hl : sizeof a->head - 1), (char *)buf);
+    a->body_len = len - hl;
+    a->body = malloc(a->body_len + 1);
+    memcpy(a->body, buf + hl, a->body_len);
+    a->body[a->body_len] = 0;
+    free(buf);
+    return 0;
+}
+
+static int get(uint16_t port, const char *path, const char *extra, http_answer *a)
+{
+    char req[2048];
+    snprintf(req, sizeof req, "GET %s HTTP/1.1\r\nHost: 127.0.0.1:%u\r\n%sConnection: close\r\n\r\n", path, port,
+             extra ? extra : "");
+    return http(port, req, NULL, 0, a);
+}
+
+/* >>server on a thread of its own (the only one touching the scene while it runs) */
+typedef struct server {
+    sy_scene *scene;
+    sy_web *web;
+    pthread_t th;
+    sy_result r;
+    sy_error err;
+} server;
+
+static void *server_main(void *p)
+{
+    server *s = p;
+    s->r = sy_web_run(s->web, NULL, &s->err);
+    return NULL;
+}
+
+/* a GET route: answers the path, the query and how many nodes the scene has */
+static sy_result route_info(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+{
+    (void)user, (void)scene;
+    if (!strcmp(req->path, "/api/object/404")) return sy_error_set(err, SY_ERR_NOT_FOUND, "object 404 does not exist");
+    char *t = malloc(600);
+    resp->body_len = (size_t)snprintf(t, 600, "%s %s ?%s", req->method, req->path, req->query);
+    resp->body = (uint8_t *)t;
+    snprintf(resp->content_type, sizeof resp->content_type, "text/plain");
+    return SY_OK;
+}
+
+/* a POST route: answers the body's length and its byte sum */
+static sy_result route_echo(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+{
+    (void)user, (void)scene, (void)err;
+    unsigned long sum = 0;
+    for (size_t i = 0; i < req->body_len; ++i) sum += req->body[i];
+    char *t = malloc(100);
+    resp->body_len = (size_t)snprintf(t, 100, "%zu %lu", req->body_len, sum);
+    resp->body = (uint8_t *)t;
+    resp->status = 201;
+    snprintf(resp->content_type, sizeof resp->content_type, "text/plain");
+    return SY_OK;
+}
+
+static int start(server *s, const char *listen, const char *backend, sy_error *e)
+{
+    memset(s, 0, sizeof *s);
+    sy_demo_info demo;
+    if (sy_scene_create(&s->scene, e) || sy_demo_build(s->scene, &demo, e) || sy_scene_commit(s->scene, NULL, e)) return 1;
+    static const sy_web_route routes[] = {{"GET", "/api/object/", route_info, NULL}, {"POST", "/api/echo", route_echo, NULL}};
+    sy_web_desc d = {.scene = s->scene, .root = demo.root, .camera = demo.camera, .background = demo.background,
+                     .backend = backend, .listen = listen, .max_body = 1000, .max_message = 256, .max_clients = 3,
+                     .routes = routes, .route_count = 2};
+    if (sy_web_create(&d, &s->web, e)) return 1;
+    return pthread_create(&s->th, NULL, server_main, s) != 0;
+}
+
+static int stop(server *s)
+{
+    sy_web_stop(s->web);
+    pthread_join(s->th, NULL);
+    sy_web_destroy(s->web);
+    sy_scene_destroy(s->scene);
+    if (s->r != SY_OK) fprintf(stderr, "server: %s\n", s->err.message);
+    return s->r != SY_OK;
+}
+
+static int test_page(uint16_t port)
+{
+    http_answer a;
+    CHECK(get(port, "/", NULL, &a) == 0);
+    CHECK(a.status == 200 && strcasestr(a.head, "content-type: text/html"));
+    CHECK(strstr((char *)a.body, "id=\"sy-canvas\"") && strstr((char *)a.body, "window.syStats"));
+    free(a.body);
+    CHECK(get(port, "/nothing/here", NULL, &a) == 0 && a.status == 404);
+    free(a.body);
+    /* DNS rebinding: a page of evil.example resolving to 127.0.0.1 names its own host */
+    char req[256];
+    snprintf(req, sizeof req, "GET / HTTP/1.1\r\nHost: evil.example:%u\r\nConnection: close\r\n\r\n", port);
+    CHECK(http(port, req, NULL, 0, &a) == 0 && a.status == 403);
+    free(a.body);
+    return 0;
+}
+
+/* decodes and checks the size; not uniform: the channels' range is wide */
+static int check_jpeg(const uint8_t *j, size_t n, uint32_t w, uint32_t h)
+{
+    sy_error err = {0};
+    uint8_t *px = NULL;
+    uint32_t jw = 0, jh = 0;
+    CHECK_OK(sy_jpeg_decode_rgba8(j, n, 0, &px, &jw, &jh, &err));
+    int lo = 255, hi = 0;
+    for (size_t i = 0; i < (size_t)jw * jh * 4; ++i)
+        if ((i & 3) != 3) lo = px[i] < lo ? px[i] : lo, hi = px[i] > hi ? px[i] : hi;
+    free(px);
+    if (jw != w || jh != h || hi - lo < 40) fprintf(stderr, "jpeg %ux%u (want %ux%u), values %d..%d\n", jw, jh, w, h, lo, hi);
+    CHECK(jw == w && jh == h);
+    CHECK(hi - lo >= 40);
+    return 0;
+}
+
+static int test_still(uint16_t port)
+{
+    http_answer a;
+    CHECK(get(port, "/api/frame.jpg?w=96&h=40", NULL, &a) == 0);
+    CHECK(a.status == 200 && strcasestr(a.head, "content-type: image/jpeg"));
+    if (check_jpeg(a.body, a.body_len, 96, 40)) return 1;
+    free(a.body);
+    const char *bad[] = {"/api/frame.jpg", "/api/frame.jpg?w=0&h=10", "/api/frame.jpg?w=10&h=-3",
+                         "/api/frame.jpg?w=10&h=99999999", "/api/frame.jpg?w=1e3&h=10", "/api/frame.jpg?w=10"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        CHECK(get(port, bad[i], NULL, &a) == 0);
+        if (a.status != 400) fprintf(stderr, "%s: %d\n", bad[i], a.status);
+        CHECK(a.status == 400 && (strstr((char *)a.body, "size") || strstr((char *)a.body, "missing")));
+        free(a.body);
+    }
+    return 0;
+}
+
+static int test_routes(uint16_t port)
+{
+    http_answer a;
+    CHECK(get(port, "/api/object/12?lod=2", NULL, &a) == 0);
+    CHECK(a.status == 200 && !strcmp((char *)a.body, "GET /api/object/12 ?lod=2"));
+    free(a.body);
+    CHECK(get(port, "/api/object/404", NULL, &a) == 0);
+    CHECK(a.status == 404 && strstr((char *)a.body, "object 404 does not exist"));
+    free(a.body);
+    char body[900], req[512];
+    unsigned long sum = 0;
+    for (size_t i = 0; i < sizeof body; ++i) body[i] = (char)('a' + i % 26), sum += (unsigned char)body[i];
+    snprintf(req, sizeof req,
+             "POST /api/echo HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nContent-Type: application/json\r\nContent-Length: %zu\r\n"
+             "Connection: close\r\n\r\n",
+             port, sizeof body);
+    CHECK(http(port, req, body, sizeof body, &a) == 0);
+    char want[64];
+    snprintf(want, sizeof want, "%zu %lu", sizeof body, sum);
+    CHECK(a.status == 201 && !strcmp((char *)a.body, want));
+    free(a.body);
+    /* over the limit of 1000 bytes: 413 with the reason, from the Content-Length alone */
+    static char big[5000];
+    memset(big, 'x', sizeof big);
+    snprintf(req, sizeof req,
+             "POST /api/echo HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nContent-Length: %zu\r\nConnection: close\r\n\r\n", port,
+             sizeof big);
+    CHECK(http(port, req, big, sizeof big, &a) == 0);
+    CHECK(a.status == 413 && strstr((char *)a.body, "exceeds the limit"));
+    free(a.body);
+    /* a POST nobody serves */
+    snprintf(req, sizeof req, "POST /api/nope HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nContent-Length: 2\r\nConnection: close\r\n\r\n",
+             port);
+    CHECK(http(port, req, "{}", 2, &a) == 0 && a.status == 404);
+    free(a.body);
+    /* hostile requests: garbage, a header far over lws's limit, a path of 4000 bytes, a request cut
+     * off; each may be answered with an error or closed, and the server keeps serving */
+    static char huge[20000];
+    memset(huge, 'A', sizeof huge - 1);
+    const char *junk[] = {"\x01\x02garbage\r\n\r\n", "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Big: ", "GET /", huge};
+    for (size_t i = 0; i < sizeof junk / sizeof junk[0]; ++i) {
+        char r2[24000];
+        snprintf(r2, sizeof r2, "%s%s", junk[i], i == 1 ? huge : "");
+        if (http(port, r2, NULL, 0, &a) == 0) {
+            CHECK(a.status >= 400 || a.status == 0);
+            free(a.body);
+        }
+    }
+    char longpath[4200] = "/";
+    memset(longpath + 1, 'p', 4000);
+    if (get(port, longpath, NULL, &a) == 0) {
+        CHECK(a.status >= 400);
+        free(a.body);
+    }
+    /* the server still serves */
+    CHECK(get(port, "/", NULL, &a) == 0 && a.status == 200);
+    free(a.body);
+    return 0;
+}
+
+static int next_frame(sy_web_client *c, sy_web_frame_info *fi, uint8_t **j, size_t *n)
+{
+    sy_error err = {0};
+    CHECK_OK(sy_web_client_next_frame(c, 60000, fi, j, n, &err));
+    return 0;
+}
+
+static int test_stream(uint16_t port)
+{
+    sy_error err = {0};
+    sy_web_client *c = NULL, *other = NULL;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = port, .path = "/ws"};
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err));
+    CHECK_OK(sy_web_client_connect(&o, 10000, &other, &err)); /* a second viewer that never reads */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":80,\"h\":60}", &err));
+    sy_web_frame_info fi;
+    uint8_t *j0 = NULL, *j1 = NULL;
+    size_t n0 = 0, n1 = 0;
+    /* the frame at the asked size */
+    do {
+        free(j0);
+        if (next_frame(c, &fi, &j0, &n0)) return 1;
+    } while (fi.width != 80 || fi.height != 60);
+    if (check_jpeg(j0, n0, 80, 60)) return 1;
+    /* malformed input: ignored (logged), the connection keeps working */
+    const char *junk[] = {"not json", "[1,2]", "{\"t\":5}", "{\"t\":\"drag\",\"dx\":\"x\",\"dy\":1}",
+                          "{\"t\":\"size\",\"w\":0,\"h\":10}", "{\"t\":\"warp\"}", "{\"t\":\"drag\",\"dx\":1e400,\"dy\":0}",
+                          "{\"t\":\"key\",\"k\":\"ZZ\"}", "{\"t\":\"drag\",\"dx\":1,\"dy\":1,\"id\":-4}"};
+    for (size_t i = 0; i < sizeof junk / sizeof junk[0]; ++i) CHECK_OK(sy_web_client_send(c, junk[i], &err));
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"drag\",\"dx\":60,\"dy\":-20,\"id\":7}", &err));
+    do {
+        free(j1);
+        if (next_frame(c, &fi, &j1, &n1)) return 1;
+    } while (fi.input_id < 7);
+    /* a moving frame: the governor may render it smaller (the page scales it up) */
+    CHECK(fi.input_id == 7 && fi.width >= 1 && fi.width <= 80 && fi.height <= 60);
+    CHECK(n1 != n0 || memcmp(j0, j1, n0) != 0); /* the view turned */
+    if (check_jpeg(j1, n1, fi.width, fi.height)) return 1;
+    free(j0);
+    free(j1);
+    /* a message over the limit (256 bytes) closes that connection; the other viewer stays */
+    char big[400];
+    memset(big, ' ', sizeof big);
+    memcpy(big, "{\"t\":\"size\"", 11);
+    big[sizeof big - 2] = '}', big[sizeof big - 1] = 0;
+    CHECK_OK(sy_web_client_send(other, big, &err));
+    int closed = 0;
+    for (int i = 0; i < 50 && !closed; ++i)
+        closed = sy_web_client_next_frame(other, 200, &fi, NULL, NULL, &err) == SY_ERR_IO && strstr(err.message, "closed");
+    CHECK(closed);
+    sy_web_client_close(other);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"wheel\",\"steps\":1,\"id\":8}", &err));
+    do {
+        if (next_frame(c, &fi, NULL, NULL)) return 1;
+    } while (fi.input_id < 8);
+    sy_web_client_close(c);
+    /* a foreign Origin and a missing subprotocol are refused */
+    sy_web_client_opts evil = o;
+    evil.origin = "evil.example"; /* lws writes http:// before it */
+    CHECK(sy_web_client_connect(&evil, 10000, &c, &err) == SY_ERR_PROTOCOL);
+    char own[64];
+    snprintf(own, sizeof own, "127.0.0.1:%u", port);
+    evil.origin = own; /* the page's own origin is welcome */
+    CHECK_OK(sy_web_client_connect(&evil, 10000, &c, &err));
+    sy_web_client_close(c);
+    char req[512];
+    http_answer a;
+    snprintf(req, sizeof req,
+             "GET /ws HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+             "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n",
+             port);
+    int rc = http(port, req, NULL, 0, &a);
+    CHECK(rc != 0 || a.status != 101);
+    if (rc == 0) free(a.body);
+    /* at most 3 viewers (max_clients): a fourth is refused (the server may still be closing the
+     * connections above: each of the three is retried a while) */
+    sy_web_client *v[3] = {NULL, NULL, NULL};
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 50 && !v[i]; ++k)
+            if (sy_web_client_connect(&o, 10000, &v[i], &err) != SY_OK) usleep(100000);
+    CHECK(v[0] && v[1] && v[2]);
+    CHECK(sy_web_client_connect(&o, 10000, &c, &err) == SY_ERR_PROTOCOL);
+    for (int i = 0; i < 3; ++i) sy_web_client_close(v[i]);
+    return 0;
+}
+
+/* the path tracer refines while the view rests (samples grow frame after frame) and restarts
+ * when it moves (the frame answering a drag has fewer samples than the one before) */
+static int test_progressive(void)
+{
+    sy_error err = {0};
+    server s;
+    if (start(&s, "127.0.0.1:0", "pathtracer", &err)) {
+        fprintf(stderr, "start: %s\n", err.message);
+        return 1;
+    }
+    sy_web_client *c = NULL;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err));
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":48,\"h\":32}", &err));
+    sy_web_frame_info fi = {0};
+    do {
+        if (next_frame(c, &fi, NULL, NULL)) return 1;
+    } while (fi.width != 48);
+    uint32_t prev = fi.samples, rising = 0;
+    while (rising < 4) { /* four frames in a row, each with more samples */
+        if (next_frame(c, &fi, NULL, NULL)) return 1;
+        CHECK(fi.width == 48 && fi.samples > prev);
+        prev = fi.samples, rising++;
+    }
+    CHECK(prev >= 5);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"drag\",\"dx\":30,\"dy\":0,\"id\":1}", &err));
+    do {
+        if (next_frame(c, &fi, NULL, NULL)) return 1;
+    } while (fi.input_id < 1);
+    if (fi.samples >= prev) fprintf(stderr, "after the drag: %u samples, before %u\n", fi.samples, prev);
+    CHECK(fi.samples < prev);
+    sy_web_client_close(c);
+    return stop(&s);
+}
+
+static int test_token(void)
+{
+    sy_error err = {0};
+    server s;
+    if (start(&s, "0.0.0.0:0", "whitted", &err)) {
+        fprintf(stderr, "start: %s\n", err.message);
+        return 1;
+    }
+    uint16_t port = sy_web_port(s.web);
+    const char *url = sy_web_url(s.web), *t = strstr(url, "?token=");
+    CHECK(t && strlen(t + 7) == 32);
+    char token[64], path[128], cookie[128];
+    snprintf(token, sizeof token, "%s", t + 7);
+    http_answer a;
+    CHECK(get(port, "/", NULL, &a) == 0);
+    CHECK(a.status == 401 && strstr((char *)a.body, "token missing"));
+    free(a.body);
+    CHECK(get(port, "/api/frame.jpg?w=8&h=8&token=0123456789abcdef0123456789abcdef", NULL, &a) == 0);
+    CHECK(a.status == 403 && strstr((char *)a.body, "token wrong"));
+    free(a.body);
+    CHECK(get(port, "/?token=short", NULL, &a) == 0 && a.status == 403);
+    free(a.body);
+    snprintf(path, sizeof path, "/?token=%s", token);
+    CHECK(get(port, path, NULL, &a) == 0);
+    CHECK(a.status == 200 && strstr((char *)a.body, "sy-canvas"));
+    CHECK(strcasestr(a.head, "set-cookie: sy_token=") && strstr(a.head, "HttpOnly"));
+    free(a.body);
+    snprintf(cookie, sizeof cookie, "Cookie: other=1; sy_token=%s\r\n", token);
+    CHECK(get(port, "/api/frame.jpg?w=16&h=16", cookie, &a) == 0);
+    CHECK(a.status == 200);
+    free(a.body);
+    /* WebSocket: without the token refused, with it accepted */
+    sy_web_client *c = NULL;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = port, .path = "/ws"};
+    CHECK(sy_web_client_connect(&o, 10000, &c, &err) == SY_ERR_PROTOCOL);
+    snprintf(path, sizeof path, "/ws?token=%s", token);
+    o.path = path;
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err));
+    sy_web_client_close(c);
+    return stop(&s);
+}
+
+int main(int argc, char **argv)
+{
+    const char *which = argc > 1 ? argv[1] : "all";
+    sy_error err = {0};
+    if (sy_mediators_register_builtin(&err) != SY_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return 1;
+    }
+    if (!strcmp(which, "token") || !strcmp(which, "progressive")) {
+        int f = !strcmp(which, "token") ? test_token() : test_progressive();
+        if (!f) printf("web %s: ok\n", which);
+        return f;
+    }
+    server s;
+    if (start(&s, "127.0.0.1:0", "whitted", &err)) {
+        fprintf(stderr, "start: %s\n", err.message);
+        return 1;
+    }
+    uint16_t port = sy_web_port(s.web);
+    int failed = 0;
+    if (!strcmp(which, "page") || !strcmp(which, "all")) failed |= test_page(port);
+    if (!strcmp(which, "still") || !strcmp(which, "all")) failed |= test_still(port);
+    if (!strcmp(which, "routes") || !strcmp(which, "all")) failed |= test_routes(port);
+    if (!strcmp(which, "stream") || !strcmp(which, "all")) failed |= test_stream(port);
+    failed |= stop(&s);
+    if (!failed) printf("web %s: ok\n", which);
+    return failed;
+}

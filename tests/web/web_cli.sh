@@ -1,0 +1,45 @@
+#!/bin/bash
+# web_cli: `sy web` as a user starts it: the URL it prints (loopback: no token), the page and a
+# still through curl, a clean exit on the first SIGTERM; bad options are refused with the reason.
+# Usage: web_cli.sh SY
+set -u
+SY=$1
+fail=0
+bad() { echo "FAIL: $*"; fail=1; }
+command -v curl >/dev/null || { echo "skip: curl is not installed"; exit 77; }
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+
+"$SY" web demo --listen 127.0.0.1:99999 >/dev/null 2>"$out/err"; rc=$?
+[ $rc = 1 ] && grep -q "port must be 0..65535" "$out/err" || bad "a bad port: exit $rc, $(cat "$out/err")"
+"$SY" web demo -b no_such_backend --listen 127.0.0.1:0 >/dev/null 2>"$out/err"; rc=$?
+[ $rc = 1 ] && grep -q "no_such_backend" "$out/err" || bad "an unknown back-end: exit $rc, $(cat "$out/err")"
+"$SY" web demo --quality 0 >/dev/null 2>&1; [ $? = 2 ] || bad "--quality 0 is not a usage error"
+
+"$SY" web demo --listen 127.0.0.1:0 -b whitted >"$out/log" 2>"$out/err" &
+pid=$!
+url=
+for _ in $(seq 1 100); do
+    url=$(grep -o 'http://[^ ]*' "$out/log" 2>/dev/null | head -1)
+    [ -n "$url" ] && break
+    sleep 0.1
+done
+if [ -z "$url" ]; then
+    bad "no URL printed: $(cat "$out/log" "$out/err")"
+else
+    case $url in *token=*) bad "a loopback server asks for a token: $url" ;; esac
+    code=$(curl -s -o "$out/page.html" -w '%{http_code}' "$url")
+    [ "$code" = 200 ] && grep -q 'id="sy-canvas"' "$out/page.html" || bad "the page: HTTP $code"
+    code=$(curl -s -o "$out/still.jpg" -w '%{http_code} %{content_type}' "${url}api/frame.jpg?w=64&h=48")
+    [ "$code" = "200 image/jpeg" ] || bad "the still: $code"
+    head -c 2 "$out/still.jpg" | od -An -tx1 | grep -q "ff d8" || bad "the still is no JPEG"
+    code=$(curl -s -o "$out/e" -w '%{http_code}' "${url}api/frame.jpg?w=64")
+    [ "$code" = 400 ] && grep -q "missing h=" "$out/e" || bad "a still without h: $code $(cat "$out/e")"
+fi
+kill -TERM $pid # (a background job ignores SIGINT)
+for _ in $(seq 1 100); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done
+if kill -0 $pid 2>/dev/null; then bad "sy web did not stop on SIGTERM"; kill -9 $pid; fi
+wait $pid; rc=$?
+[ $rc = 0 ] || bad "sy web exited $rc after SIGTERM: $(cat "$out/err")"
+[ $fail = 0 ] && echo "ok: sy web serves the page and stills, stops on SIGTERM, refuses bad options"
+exit $fail
