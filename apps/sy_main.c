@@ -49,6 +49,9 @@
 #ifdef SY_HAVE_WEB
 #include "sy_bench_web.h"
 #include "sy_web.h"
+#ifdef SY_WEB_HAVE_CULL
+#include "sy_web_cull.h"
+#endif
 #endif
 #endif
 #include "sy_demo.h"
@@ -1467,6 +1470,7 @@ static int cmd_web(int argc, char **argv)
     uint32_t w = 1920, h = 1200, quality = 80;
     float threshold = 0.0f;
     double budget = 0; /* 0: the governor's default (33 ms) */
+    bool client_render = false;
     static const struct option lo[] = {
         {"camera", required_argument, NULL, OPT_CAMERA}, {"listen", required_argument, NULL, OPT_WEB_LISTEN},
         {"quality", required_argument, NULL, OPT_WEB_QUALITY}, {"filter", required_argument, NULL, OPT_FILTER},
@@ -1497,7 +1501,7 @@ static int cmd_web(int argc, char **argv)
             budget = strtod(optarg, &end);
             if (end == optarg || *end || !(budget >= 1.0 && budget <= 10000.0)) return bad_value("--budget", optarg);
             break;
-        case OPT_WEB_CLIENT_RENDER: break; /* the client-render page comes with remote culling (issue 18, part 4) */
+        case OPT_WEB_CLIENT_RENDER: client_render = true; break;
         }
     }
     if (argc - optind != 1) return usage_of("web", argc == optind ? "a SCENE is required" : "one SCENE at a time");
@@ -1508,10 +1512,28 @@ static int cmd_web(int argc, char **argv)
                      .backend = backend, .listen = listen, .max_width = w, .max_height = h, .quality = (int)quality,
                      .filter = filter, .threshold = threshold, .budget_ms = budget};
     sy_web *web = NULL;
-    sy_result r = sy_web_create(&d, &web, &err);
+    sy_result r = SY_OK;
+#ifdef SY_WEB_HAVE_CULL
+    /* remote culling: /api/cull, /api/object/ID, /api/view; --client-render: the three.js page */
+    sy_web_cull *cull = NULL;
+    sy_web_route routes[SY_WEB_CULL_MAX_ROUTES];
+    r = sy_web_cull_create(ld.scene, ld.root, client_render ? sy_web_cull_client_dir_default() : NULL, &cull, routes,
+                           &d.route_count, &err);
+    d.routes = routes;
+#else
+    if (client_render)
+        r = sy_error_set(&err, SY_ERR_UNSUPPORTED, "sy web --client-render: this sy was built without the culling "
+                         "service (it needs the Embree back-ends)");
+#endif
+    if (r == SY_OK) r = sy_web_create(&d, &web, &err);
+#ifdef SY_WEB_HAVE_CULL
+    if (r == SY_OK) sy_web_cull_attach(cull, web);
+#endif
     if (r == SY_OK) {
-        const char *url = sy_web_url(web);
-        printf("sy web: serving %s with %s; open %s%s\n", argv[optind], backend, url,
+        const char *url = sy_web_url(web), *q = strchr(url, '?');
+        int host_len = q ? (int)(q - url) : (int)strlen(url);
+        printf("sy web: serving %s with %s; open %.*s%s%s%s\n", argv[optind], backend, host_len, url,
+               client_render ? "client/client.html" : "", q ? q : "",
                strstr(url, "//0.0.0.0:") || strstr(url, "//[::]:") ? " (with this machine's name or address for the host)" : "");
         fflush(stdout);
         sy_signals_set_graceful("closing the server");
@@ -1519,6 +1541,9 @@ static int cmd_web(int argc, char **argv)
         sy_signals_set_graceful(NULL);
     }
     sy_web_destroy(web);
+#ifdef SY_WEB_HAVE_CULL
+    sy_web_cull_destroy(cull);
+#endif
     loaded_free(&ld);
     return r == SY_OK ? 0 : fail(&err);
 }

@@ -174,8 +174,10 @@ sy_camera_view sy_cull_view_camera(const sy_cull_view *v)
     float q[4] = {(float)(v->orientation[0] / l), (float)(v->orientation[1] / l), (float)(v->orientation[2] / l),
                   (float)(v->orientation[3] / l)};
     float s[3] = {1, 1, 1};
+    /* no near clip: the view carries none, and a fixed one would cut small scenes (a model in
+     * millimetres seen from a centimetre); the rasterizer picks its near plane from the scene */
     sy_camera_view cv = {.camera_to_world = sy_mat4_from_trs(t, q, s), .projection = SY_PROJECTION_PERSPECTIVE,
-                         .znear = 0.05f, .zfar = 0};
+                         .znear = 0.0f, .zfar = 0};
     double th = tan(0.5 * v->fov_degrees * 3.14159265358979323846 / 180.0), aspect = (double)v->width / v->height;
     cv.window[0] = (float)(-th * aspect), cv.window[1] = (float)(th * aspect);
     cv.window[2] = (float)-th, cv.window[3] = (float)th;

@@ -1378,6 +1378,8 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     return SY_OK;
 }
 
+sy_node sy_web_camera(const sy_web *w) { return w ? w->cam_node : (sy_node){0}; }
+
 uint16_t sy_web_port(const sy_web *w) { return (uint16_t)w->port; }
 
 const char *sy_web_url(const sy_web *w) { return w->url; }

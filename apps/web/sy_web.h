@@ -111,6 +111,9 @@ const char *sy_web_url(const sy_web *w);
  * ends serving (a back-end that fails is reported to the pages and serving goes on). */
 sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err);
 
+/** The server's camera node (made by sy_web_create; the view every page shares). Any thread; read
+ * its matrix on the scene's thread. */
+sy_node sy_web_camera(const sy_web *w);
 /** Makes sy_web_run return (any thread). */
 void sy_web_stop(sy_web *w);
 

@@ -31,9 +31,14 @@ function fail(msg) {
   process.exit(1);
 }
 
+// The canvas as shown (a screenshot of its element: a WebGL canvas' drawing buffer is gone once
+// composited), with every other element of the page hidden (the overlays) meanwhile.
 async function canvasPng(page, selector, path) {
-  const data = await page.evaluate((sel) => document.querySelector(sel).toDataURL('image/png'), selector);
-  writeFileSync(path, Buffer.from(data.slice(data.indexOf(',') + 1), 'base64'));
+  await page.evaluate((sel) => {
+    for (const e of document.body.querySelectorAll('*')) if (!e.matches(sel) && !e.contains(document.querySelector(sel))) e.style.visibility = 'hidden';
+  }, selector);
+  await page.locator(selector).screenshot({ path });
+  await page.evaluate(() => { for (const e of document.body.querySelectorAll('*')) e.style.visibility = ''; });
 }
 
 let browser;

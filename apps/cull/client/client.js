@@ -15,6 +15,7 @@ import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
+import { RoomEnvironment } from 'three/addons/environments/RoomEnvironment.js';
 
 const params = new URLSearchParams(window.location.search);
 const token = params.get('token');
@@ -31,12 +32,15 @@ const canvas = document.getElementById('view');
 const overlay = document.getElementById('overlay');
 const renderer = new THREE.WebGLRenderer({ canvas, antialias: true });
 renderer.setPixelRatio(window.devicePixelRatio || 1);
+// The look of every back-end (docs/BACKENDS.md, one scene, one look): the objects come without
+// lights, so they are lit as sy lights a scene that brings none, by a neutral studio environment
+// (three's RoomEnvironment, prefiltered), over the default black background, ACES tone mapping as
+// the streamed view.
+renderer.toneMapping = THREE.ACESFilmicToneMapping;
 const scene = new THREE.Scene();
-scene.background = new THREE.Color(0x20242a);
-scene.add(new THREE.HemisphereLight(0xffffff, 0x444444, 2.0));
-const sun = new THREE.DirectionalLight(0xffffff, 2.0);
-sun.position.set(0.5, 1, 0.3);
-scene.add(sun);
+scene.background = new THREE.Color(0x000000);
+scene.environment = new THREE.PMREMGenerator(renderer).fromScene(new RoomEnvironment(), 0.04).texture;
+scene.environmentIntensity = 0.55; // the studio environment's level: mean luminance within 1 % of sy render -b raster (MetalRoughSpheresNoTextures, ACES)
 const camera = new THREE.PerspectiveCamera(60, 1, 0.05, 1e6);
 camera.position.set(0, 0, 10);
 const controls = new OrbitControls(camera, canvas);
@@ -124,6 +128,7 @@ async function fetchMissing() {
   const worker = async () => {
     while (queue.length) {
       const id = queue.shift();
+      if (objects.has(id) || pending.has(id)) continue; // another fetchMissing took it meanwhile
       const p = fetchObject(id);
       pending.set(id, p);
       try {
@@ -144,7 +149,30 @@ async function fetchMissing() {
   await Promise.all(Array.from({ length: MAX_PARALLEL_FETCHES }, worker));
 }
 
+// The server's view (GET /api/view): the page starts where every other back-end starts (the scene's
+// camera, or the same framing of its bounds), so the first picture matches `sy render`. Without it
+// (an older server) the page frames the bounds of the first answer itself.
+let serverView = null;
+
+function applyView(v, b) {
+  camera.position.set(...v.position);
+  camera.quaternion.set(...v.orientation);
+  camera.fov = v.fov;
+  const min = new THREE.Vector3(...b.min), max = new THREE.Vector3(...b.max);
+  const radius = Math.max(1e-3, max.clone().sub(min).length() * 0.5);
+  const dist = camera.position.distanceTo(min.clone().add(max).multiplyScalar(0.5)) + radius;
+  camera.near = Math.max(1e-3, Math.min(0.05, dist * 1e-4));
+  camera.far = dist * 10;
+  camera.updateProjectionMatrix();
+  controls.target.set(...v.target);
+  controls.update();
+}
+
 function frameBounds(b) {
+  if (serverView) {
+    applyView(serverView, b);
+    return;
+  }
   const min = new THREE.Vector3(...b.min), max = new THREE.Vector3(...b.max);
   const centre = min.clone().add(max).multiplyScalar(0.5);
   const radius = Math.max(1e-3, max.clone().sub(min).length() * 0.5);
@@ -228,4 +256,10 @@ window.syClient = Object.assign(state, {
 });
 
 renderer.setAnimationLoop(() => renderer.render(scene, camera));
+try {
+  const response = await fetch(withToken('/api/view'));
+  if (response.ok) serverView = await response.json();
+} catch (e) {
+  serverView = null;
+}
 resize();

@@ -14,7 +14,8 @@ execute_process(COMMAND ${NPM} ci --no-audit --no-fund --ignore-scripts --loglev
 set(three ${OUT}/npm/node_modules/three)
 set(files build/three.module.js build/three.core.js examples/jsm/loaders/GLTFLoader.js
           examples/jsm/utils/BufferGeometryUtils.js examples/jsm/utils/SkeletonUtils.js
-          examples/jsm/controls/OrbitControls.js examples/jsm/libs/meshopt_decoder.module.js LICENSE)
+          examples/jsm/controls/OrbitControls.js examples/jsm/libs/meshopt_decoder.module.js
+          examples/jsm/environments/RoomEnvironment.js LICENSE)
 set(missing)
 if(rc EQUAL 0)
   foreach(f ${files})

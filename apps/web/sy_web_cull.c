@@ -1,0 +1,233 @@
+/* sy_web_cull.c — remote culling over sy_web: the route handlers of POST /api/cull, GET
+ * /api/object/ID, GET /api/view and GET /client/... (see sy_web_cull.h). */
+#define _XOPEN_SOURCE 700 /* realpath */
+#include "sy_web_cull.h"
+
+#include "sy_cull.h"
+
+#include <cjson/cJSON.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#ifndef SY_WEB_CLIENT_DIR
+#define SY_WEB_CLIENT_DIR ""
+#endif
+
+/* The client page's files are small (three.js is the largest, about 1.3 MB). */
+#define CLIENT_FILE_MAX (32u << 20)
+
+struct sy_web_cull {
+    sy_scene *scene;
+    sy_node root;
+    sy_context_pool *pool;
+    sy_culler *culler;
+    const sy_web *server;
+    char client_dir[PATH_MAX]; /* realpath, "" = no /client/ route */
+};
+
+const char *sy_web_cull_client_dir_default(void) { return SY_WEB_CLIENT_DIR; }
+
+static sy_result take_text(char *text, const char *type, sy_web_response *resp, sy_error *err)
+{
+    if (!text) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+    resp->status = 200;
+    snprintf(resp->content_type, sizeof resp->content_type, "%s", type);
+    resp->body = (uint8_t *)text;
+    resp->body_len = strlen(text);
+    return SY_OK;
+}
+
+/* POST /api/cull */
+static sy_result on_cull(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+{
+    (void)scene;
+    sy_web_cull *c = user;
+    char *json = NULL;
+    sy_result r = sy_culler_query_json(c->culler, (const char *)req->body, req->body_len, &json, err);
+    return r == SY_OK ? take_text(json, "application/json", resp, err) : r;
+}
+
+/* GET /api/object/ID */
+static sy_result on_object(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+{
+    (void)scene;
+    sy_web_cull *c = user;
+    const char *id_text = req->path + strlen("/api/object/");
+    uint32_t id = 0;
+    uint8_t *glb = NULL;
+    size_t len = 0;
+    sy_result r = sy_cull_parse_id(id_text, strlen(id_text), &id, err);
+    if (r == SY_OK) r = sy_culler_object_glb(c->culler, id, &glb, &len, err);
+    if (r != SY_OK) return r;
+    resp->status = 200;
+    snprintf(resp->content_type, sizeof resp->content_type, "model/gltf-binary");
+    resp->body = glb;
+    resp->body_len = len;
+    return SY_OK;
+}
+
+/* GET /api/view: the server's camera as /api/cull takes it, plus the orbit target (the root's
+ * bounds centre projected on the viewing axis) for a client's orbit controls. */
+static sy_result on_view(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+{
+    (void)req;
+    sy_web_cull *c = user;
+    if (!c->server) return sy_error_set(err, SY_ERR_NOT_FOUND, "/api/view: no server attached");
+    sy_node cam = sy_web_camera(c->server);
+    sy_mat4 m;
+    sy_result r = sy_node_world_matrix(scene, cam, &m, err);
+    if (r != SY_OK) return r;
+    const sy_node_data *nd = sy_node_get(scene, cam);
+    const sy_camera_data *cd = nd ? sy_camera_get(scene, nd->camera) : NULL;
+    double fov = cd && cd->yfov > 0.0f ? (double)cd->yfov * (180.0 / 3.14159265358979323846) : 45.0;
+    /* rotation: the matrix's columns without their scale, to a quaternion (Shepperd) */
+    double R[3][3];
+    for (int col = 0; col < 3; ++col) {
+        double l = sqrt((double)m.m[4 * col] * m.m[4 * col] + (double)m.m[4 * col + 1] * m.m[4 * col + 1] +
+                        (double)m.m[4 * col + 2] * m.m[4 * col + 2]);
+        if (!(l > 0.0)) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "/api/view: the camera matrix is singular");
+        for (int row = 0; row < 3; ++row) R[row][col] = m.m[4 * col + row] / l;
+    }
+    double q[4], tr = R[0][0] + R[1][1] + R[2][2];
+    if (tr > 0.0) {
+        double s = 2.0 * sqrt(tr + 1.0);
+        q[3] = 0.25 * s, q[0] = (R[2][1] - R[1][2]) / s, q[1] = (R[0][2] - R[2][0]) / s, q[2] = (R[1][0] - R[0][1]) / s;
+    } else if (R[0][0] > R[1][1] && R[0][0] > R[2][2]) {
+        double s = 2.0 * sqrt(1.0 + R[0][0] - R[1][1] - R[2][2]);
+        q[3] = (R[2][1] - R[1][2]) / s, q[0] = 0.25 * s, q[1] = (R[0][1] + R[1][0]) / s, q[2] = (R[0][2] + R[2][0]) / s;
+    } else if (R[1][1] > R[2][2]) {
+        double s = 2.0 * sqrt(1.0 + R[1][1] - R[0][0] - R[2][2]);
+        q[3] = (R[0][2] - R[2][0]) / s, q[0] = (R[0][1] + R[1][0]) / s, q[1] = 0.25 * s, q[2] = (R[1][2] + R[2][1]) / s;
+    } else {
+        double s = 2.0 * sqrt(1.0 + R[2][2] - R[0][0] - R[1][1]);
+        q[3] = (R[1][0] - R[0][1]) / s, q[0] = (R[0][2] + R[2][0]) / s, q[1] = (R[1][2] + R[2][1]) / s, q[2] = 0.25 * s;
+    }
+    double pos[3] = {m.m[12], m.m[13], m.m[14]}, fwd[3] = {-R[0][2], -R[1][2], -R[2][2]};
+    sy_bounds b;
+    if (c->root.id == 0 || sy_node_world_bounds(scene, c->root, &b, NULL) != SY_OK) b = sy_scene_world_bounds(scene);
+    double d = 1.0;
+    if (b.min[0] <= b.max[0]) {
+        d = 0.0;
+        for (int k = 0; k < 3; ++k) d += (0.5 * ((double)b.min[k] + b.max[k]) - pos[k]) * fwd[k];
+        if (!(d > 1e-6)) d = 1.0;
+    }
+    cJSON *o = cJSON_CreateObject();
+    double target[3] = {pos[0] + d * fwd[0], pos[1] + d * fwd[1], pos[2] + d * fwd[2]};
+    if (o && cJSON_AddItemToObject(o, "position", cJSON_CreateDoubleArray(pos, 3)) &&
+        cJSON_AddItemToObject(o, "orientation", cJSON_CreateDoubleArray(q, 4)) && cJSON_AddNumberToObject(o, "fov", fov) &&
+        cJSON_AddItemToObject(o, "target", cJSON_CreateDoubleArray(target, 3))) {
+        char *text = cJSON_PrintUnformatted(o);
+        cJSON_Delete(o);
+        return take_text(text, "application/json", resp, err);
+    }
+    cJSON_Delete(o);
+    return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "/api/view: out of memory");
+}
+
+static const char *content_type_of(const char *name)
+{
+    const char *dot = strrchr(name, '.');
+    if (!dot) return "text/plain; charset=utf-8";
+    if (!strcmp(dot, ".html")) return "text/html; charset=utf-8";
+    if (!strcmp(dot, ".js") || !strcmp(dot, ".mjs")) return "text/javascript; charset=utf-8";
+    if (!strcmp(dot, ".json")) return "application/json";
+    if (!strcmp(dot, ".css")) return "text/css; charset=utf-8";
+    if (!strcmp(dot, ".wasm")) return "application/wasm";
+    return "application/octet-stream";
+}
+
+/* GET /client/PATH: a file of the client folder. PATH is plain names (letters, digits, '.', '_',
+ * '-') separated by '/', no name starting with '.'; the file must resolve inside the folder
+ * (symbolic links out of it are refused) and be a regular file under CLIENT_FILE_MAX. */
+static sy_result on_client(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+{
+    (void)scene;
+    sy_web_cull *c = user;
+    const char *rel = req->path + strlen("/client/");
+    if (!*rel) rel = "client.html";
+    size_t n = strlen(rel);
+    bool ok = n < 256;
+    for (size_t i = 0; ok && i < n; ++i) {
+        char ch = rel[i];
+        bool start = i == 0 || rel[i - 1] == '/';
+        ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' || ch == '-' ||
+             (ch == '.' && !start) || (ch == '/' && !start);
+    }
+    if (!ok || rel[n - 1] == '/') return sy_error_set(err, SY_ERR_NOT_FOUND, "/client/%.64s: no such file", rel);
+    char path[PATH_MAX], real[PATH_MAX];
+    if (snprintf(path, sizeof path, "%s/%s", c->client_dir, rel) >= (int)sizeof path || !realpath(path, real) ||
+        strncmp(real, c->client_dir, strlen(c->client_dir)) != 0 || real[strlen(c->client_dir)] != '/')
+        return sy_error_set(err, SY_ERR_NOT_FOUND, "/client/%s: no such file", rel);
+    struct stat st;
+    if (stat(real, &st) != 0 || !S_ISREG(st.st_mode)) return sy_error_set(err, SY_ERR_NOT_FOUND, "/client/%s: no such file", rel);
+    if (st.st_size > (off_t)CLIENT_FILE_MAX) return sy_error_set(err, SY_ERR_LIMIT, "/client/%s: too large", rel);
+    FILE *f = fopen(real, "rb");
+    if (!f) return sy_error_set(err, SY_ERR_NOT_FOUND, "/client/%s: cannot be read", rel);
+    uint8_t *buf = malloc((size_t)st.st_size + 1u);
+    size_t got = buf ? fread(buf, 1, (size_t)st.st_size, f) : 0;
+    fclose(f);
+    if (!buf || got != (size_t)st.st_size) {
+        free(buf);
+        return sy_error_set(err, buf ? SY_ERR_IO : SY_ERR_OUT_OF_MEMORY, "/client/%s: read failed", rel);
+    }
+    resp->status = 200;
+    snprintf(resp->content_type, sizeof resp->content_type, "%s", content_type_of(rel));
+    resp->body = buf;
+    resp->body_len = got;
+    return SY_OK;
+}
+
+sy_result sy_web_cull_create(sy_scene *scene, sy_node root, const char *client_dir, sy_web_cull **out,
+                             sy_web_route routes[SY_WEB_CULL_MAX_ROUTES], uint32_t *count, sy_error *err)
+{
+    *out = NULL;
+    *count = 0;
+    sy_web_cull *c = calloc(1, sizeof *c);
+    if (!c) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web cull: out of memory");
+    c->scene = scene;
+    c->root = root;
+    sy_result r = SY_OK;
+    if (client_dir) {
+        char page[PATH_MAX];
+        struct stat st;
+        if (!*client_dir)
+            r = sy_error_set(err, SY_ERR_NOT_FOUND, "the client-render page was not built (npm was not found at "
+                             "configure time; apps/cull/client needs npm to vendor three.js)");
+        else if (!realpath(client_dir, c->client_dir) ||
+                 snprintf(page, sizeof page, "%s/client.html", c->client_dir) >= (int)sizeof page ||
+                 stat(page, &st) != 0)
+            r = sy_error_set(err, SY_ERR_NOT_FOUND, "the client-render page is not in %s (npm ci failed at build time? "
+                             "delete cull_client/.stamp in the build folder and build again)", client_dir);
+    }
+    if (r == SY_OK) r = sy_context_pool_create(&c->pool, err);
+    if (r == SY_OK) r = sy_culler_create(scene, c->pool, root, NULL, &c->culler, err);
+    if (r != SY_OK) {
+        sy_web_cull_destroy(c);
+        return r;
+    }
+    uint32_t n = 0;
+    routes[n++] = (sy_web_route){"POST", "/api/cull", on_cull, c};
+    routes[n++] = (sy_web_route){"GET", "/api/object/", on_object, c};
+    routes[n++] = (sy_web_route){"GET", "/api/view", on_view, c};
+    if (client_dir) routes[n++] = (sy_web_route){"GET", "/client/", on_client, c};
+    *count = n;
+    *out = c;
+    return SY_OK;
+}
+
+void sy_web_cull_attach(sy_web_cull *c, const sy_web *server)
+{
+    if (c) c->server = server;
+}
+
+void sy_web_cull_destroy(sy_web_cull *c)
+{
+    if (!c) return;
+    sy_culler_destroy(c->culler);
+    sy_context_pool_destroy(c->pool);
+    free(c);
+}
