@@ -35,6 +35,27 @@ else
     head -c 2 "$out/still.jpg" | od -An -tx1 | grep -q "ff d8" || bad "the still is no JPEG"
     code=$(curl -s -o "$out/e" -w '%{http_code}' "${url}api/frame.jpg?w=64")
     [ "$code" = 400 ] && grep -q "missing h=" "$out/e" || bad "a still without h: $code $(cat "$out/e")"
+    # remote culling (where sy has the culling service): the view, a query, an object, bad input
+    code=$(curl -s -o "$out/view.json" -w '%{http_code}' "${url}api/view")
+    if [ "$code" = 200 ]; then
+        view=$(sed 's/,"target".*/}/' "$out/view.json")
+        q=${view%\}},\"width\":64,\"height\":48,\"budget\":100000000\}
+        code=$(curl -s -o "$out/cull.json" -w '%{http_code}' -H 'Content-Type: application/json' --data "$q" "${url}api/cull")
+        id=$(grep -o '"objects":\[{"id":[0-9]*' "$out/cull.json" | grep -o '[0-9]*$')
+        [ "$code" = 200 ] && [ -n "$id" ] || bad "POST /api/cull of the server's view: $code $(head -c 300 "$out/cull.json")"
+        code=$(curl -s -o "$out/obj.glb" -w '%{http_code} %{content_type}' "${url}api/object/$id")
+        [ "$code" = "200 model/gltf-binary" ] && head -c 4 "$out/obj.glb" | grep -q glTF || bad "GET /api/object/$id: $code"
+        code=$(curl -s -o "$out/e" -w '%{http_code}' "${url}api/object/4000000000")
+        [ "$code" = 404 ] || bad "an unknown object: $code $(cat "$out/e")"
+        code=$(curl -s -o "$out/e" -w '%{http_code}' --data '{"position":[0,0,' "${url}api/cull")
+        [ "$code" = 400 ] || bad "malformed JSON: $code $(cat "$out/e")"
+        code=$(curl -s -o "$out/e" -w '%{http_code}' --data "${q/\"fov\":/\"fov\":-}" "${url}api/cull")
+        [ "$code" = 400 ] && grep -q fov "$out/e" || bad "a negative fov: $code $(cat "$out/e")"
+        code=$(curl -s -o "$out/e" -w '%{http_code}' "${url}client/client.html")
+        [ "$code" = 404 ] || bad "the client page without --client-render: $code"
+    elif [ "$code" != 404 ]; then
+        bad "GET /api/view: $code"
+    fi
 fi
 kill -TERM $pid # (a background job ignores SIGINT)
 for _ in $(seq 1 100); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done
