@@ -114,11 +114,11 @@ static sy_result gov_orbit(gov_scene *gs, uint32_t i, sy_error *err)
 /* One frame of back-end `backend` at w x h (samples for a progressive one) at orbit step i; the
  * seconds of the whole frame (camera, commit, sync, render, composite). */
 static sy_result gov_frame(gov_scene *gs, sy_context_pool *pool, const char *backend, uint32_t i, uint32_t w, uint32_t h,
-                           uint32_t samples, double *secs, sy_error *err)
+                           uint32_t samples, float preview, double *secs, sy_error *err)
 {
     double t0 = sy_time_now();
     sy_compose_spec spec = {.backend = backend, .root = gs->root, .camera = gs->cam};
-    sy_window_render_opts ro = {.sample_count = samples};
+    sy_window_render_opts ro = {.sample_count = samples, .preview = preview};
     sy_layer img = {0};
     sy_result r = gov_orbit(gs, i, err);
     if (r == SY_OK) r = sy_compose_render(gs->scene, pool, &spec, w, h, &ro, &img, NULL, err);
@@ -157,16 +157,16 @@ static sy_result gov_backend(gov_scene *gs, const sy_mediator_class *cls, const 
     if (r == SY_OK) r = sy_governor_create(&(sy_governor_desc){.budget_ms = o->budget_ms}, &gov, err);
     uint32_t caps = sy_mediator_class_caps(cls, NULL), step = 0;
     /* the translation (a new context's snapshot): left out of everything below */
-    if (r == SY_OK) r = gov_frame(gs, pool, cls->name, step++, o->width, o->height, 1, &first, err);
+    if (r == SY_OK) r = gov_frame(gs, pool, cls->name, step++, o->width, o->height, 1, 1.0f, &first, err);
     for (uint32_t k = 0; r == SY_OK && k < GOV_FULL_FRAMES; ++k)
-        r = gov_frame(gs, pool, cls->name, step++, o->width, o->height, 1, &full[k], err);
+        r = gov_frame(gs, pool, cls->name, step++, o->width, o->height, 1, 1.0f, &full[k], err);
     uint32_t over = 0;
     double t_prev = sy_time_now(), t_start = t_prev, cpu_start = cpu_now();
     for (uint32_t i = 0; r == SY_OK && i < o->frames; ++i) {
         sy_governor_frame f;
         double secs;
         sy_governor_plan(gov, o->width, o->height, caps, true, sy_time_now() * 1e3, &f); /* moves every frame */
-        r = gov_frame(gs, pool, cls->name, step++, f.width, f.height, f.samples, &secs, err);
+        r = gov_frame(gs, pool, cls->name, step++, f.width, f.height, f.samples, f.preview, &secs, err);
         sy_governor_report(gov, &f, secs * 1e3);
         double now = sy_time_now();
         iv[i] = (now - t_prev) * 1e3; /* frame interval: planning, camera, commit, sync, render */

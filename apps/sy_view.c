@@ -373,7 +373,7 @@ static void *render_main(void *p)
         } else {
             view_apply_filter(pool, a, cls, filter, threshold, filter_version, gf.filter, &filter_state, &filter_applied,
                               &filter_enabled, fstatus, sizeof fstatus);
-            sy_window_render_opts ro = {.sample_count = gf.samples};
+            sy_window_render_opts ro = {.sample_count = gf.samples, .preview = gf.preview};
             r = sy_compose_render(a->scene, pool, &spec, gf.width, gf.height, &ro, &img, &right, &err);
         }
         double ms = (sy_time_now() - t0) * 1e3;

@@ -253,6 +253,7 @@ void sy_governor_plan(sy_governor *g, uint32_t dw, uint32_t dh, uint32_t caps, b
         size_of(dw, dh, s, out);
         out->samples = 1;
         out->moving = true;
+        out->preview = (caps & SY_CAP_PREVIEW) ? SY_GOVERNOR_PREVIEW : 1.0f;
         g->scale = s;
         g->need_moving = false;
         g->moving = *out;
@@ -267,6 +268,7 @@ void sy_governor_plan(sy_governor *g, uint32_t dw, uint32_t dh, uint32_t caps, b
         return;
     }
     out->width = dw, out->height = dh, out->scale = 1.0f;
+    out->preview = 1.0f;
     out->filter = (caps & SY_CAP_FILTERS) != 0;
     out->samples = done ? 1u : progressive ? refine_samples(g, pixels) : 1u;
     g->redraw = false;

@@ -53,6 +53,10 @@ typedef struct sy_governor_desc {
 } sy_governor_desc;
 
 /** What to render this frame (sy_governor_plan). */
+/** The preview level of moving frames (back-ends with SY_CAP_PREVIEW): a quarter of the full
+ * per-pixel work, e.g. Whitted's 4 camera rays and 16 light samples per pixel become 1 and 4. */
+#define SY_GOVERNOR_PREVIEW 0.25f
+
 typedef struct sy_governor_frame {
     /** @{ render size (<= the display size; the display scales it up); 0 when the display is empty */
     uint32_t width, height; /** @} */
@@ -61,6 +65,9 @@ typedef struct sy_governor_frame {
     bool filter;      /**< the display filter may run this frame (refining frames of a back-end with SY_CAP_FILTERS) */
     bool moving;      /**< a moving frame (budgeted) rather than a refining one */
     bool idle;        /**< nothing left to refine: render nothing, sleep until input */
+    /** sy_window_render_opts.preview for this frame: SY_GOVERNOR_PREVIEW on moving frames of a
+     * back-end with SY_CAP_PREVIEW (fewer samples per pixel, same context), 1 otherwise. */
+    float preview;
     /** > 0: nothing to render before this many ms from now (the view is still settling after a
      * moving frame was shown): wait for input at most this long, then plan again. The other fields
      * then describe the last moving frame, so a caller that renders anyway does no harm. */

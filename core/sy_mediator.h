@@ -77,6 +77,10 @@ typedef struct sy_render_request {
     uint32_t sample_first, sample_count; /** @} */
     uint32_t background_id; /**< sy_background handle id, 0 = the back-end's default (black) */
     uint32_t seed; /**< seed for the back-end's sampling (same seed = same image) */
+    /** Interactive preview (back-ends with SY_CAP_PREVIEW): in (0, 1), the share of its full per-pixel
+     * work the back-end may spend on this frame (a frame-time governor's choice while the view
+     * moves); 0 or 1 (or anything else) = full quality. */
+    float preview;
     sy_progress_fn progress; /**< optional, called from the rendering thread(s) serially */
     void *progress_user; /**< passed to progress */
 } sy_render_request;
@@ -99,6 +103,8 @@ typedef enum sy_mediator_caps {
     SY_CAP_AOVS = 1u << 5,        /**< keeps feature buffers (variance, albedo, normal, ...): sy_context_aovs */
     SY_CAP_FILTERS = 1u << 6,     /**< display noise filters: sy_context_set_filter / sy_context_filter_info */
     SY_CAP_REMOTE = 1u << 7,      /**< renders on other machines (the cluster mediator) */
+    SY_CAP_PREVIEW = 1u << 8,     /**< honours sy_render_request.preview: cheaper frames of lower fidelity
+                                     while a view moves (fewer samples per pixel), on the same context */
 } sy_mediator_caps;
 
 /* ---- feature buffers (SY_CAP_AOVS) ---- */

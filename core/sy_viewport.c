@@ -259,6 +259,7 @@ sy_result sy_window_render(sy_window *w, sy_scene *scene, sy_context_pool *pool,
         req.rect_w = rect[2];
         req.rect_h = rect[3];
         req.sample_count = opts->sample_count;
+        req.preview = opts->preview;
         req.background_id = v->desc.background.id;
         req.seed = opts->seed;
         req.progress = opts->progress;

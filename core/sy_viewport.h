@@ -99,6 +99,7 @@ void sy_layer_composite(sy_layer *dst, const sy_layer *src, uint32_t x, uint32_t
 typedef struct sy_window_render_opts {
     uint32_t seed; /**< seed for the back-ends' sampling */
     uint32_t sample_count; /**< progressive back-ends: samples to add this call; 0 = default */
+    float preview; /**< sy_render_request.preview for every viewport (0 = full quality) */
     sy_progress_fn progress; /**< optional progress callback */
     void *progress_user; /**< passed to progress */
     sy_post_desc post; /**< applied to the composited window image */

@@ -915,7 +915,7 @@ static sy_result apply_camera(sy_web *w, render_state *rs, const sy_orbit *o, sy
 
 /* Renders w x h with the current back-end into an 8-bit image (display chain: ACES + sRGB). */
 static sy_result render_rgba8(sy_web *w, render_state *rs, sy_window *win, uint32_t width, uint32_t height,
-                              uint32_t samples, uint8_t **out, sy_error *err)
+                              uint32_t samples, float preview, uint8_t **out, sy_error *err)
 {
     *out = NULL;
     uint32_t cw = 0, ch = 0;
@@ -923,7 +923,7 @@ static sy_result render_rgba8(sy_web *w, render_state *rs, sy_window *win, uint3
     sy_result r = (cw != width || ch != height) ? sy_window_resize(win, width, height, err) : SY_OK;
     sy_layer img = {0};
     if (r == SY_OK) r = sy_layer_create(width, height, &img, err);
-    sy_window_render_opts ro = {.sample_count = samples,
+    sy_window_render_opts ro = {.sample_count = samples, .preview = preview,
                                 .post = {.enabled = true, .tonemap = SY_TONEMAP_ACES, .srgb = true}};
     if (r == SY_OK) r = sy_window_render(win, w->d.scene, rs->pool, &ro, &img, err);
     if (r == SY_OK && !(*out = layer_to_rgba8(&img))) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
@@ -987,7 +987,7 @@ static void run_job(sy_web *w, render_state *rs, web_job *j, const sy_orbit *o)
         uint32_t spp = cls && (cls->caps & SY_CAP_PROGRESSIVE) ? w->d.still_samples : 1;
         r = apply_camera(w, rs, o, &err);
         if (r == SY_OK) r = sy_viewport_set_backend(rs->still_vp, (cls ? cls : sy_mediator_at(w->initial_backend))->name, NULL, &err);
-        if (r == SY_OK) r = render_rgba8(w, rs, rs->still_win, j->w, j->h, spp, &px, &err);
+        if (r == SY_OK) r = render_rgba8(w, rs, rs->still_win, j->w, j->h, spp, 1.0f, &px, &err);
         if (r == SY_OK) r = sy_jpeg_encode_rgba8(px, j->w, j->h, 95, &j->resp.body, &j->resp.body_len, &err);
         free(px);
         if (r == SY_OK) j->resp.status = 200, snprintf(j->resp.content_type, sizeof j->resp.content_type, "image/jpeg");
@@ -1070,7 +1070,7 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_orbit *o, ui
     size_t jlen = 0;
     uint32_t contexts = sy_context_pool_size(rs->pool);
     double t0 = sy_time_now();
-    r = render_rgba8(w, rs, rs->win, gf.width, gf.height, gf.samples, &px, err);
+    r = render_rgba8(w, rs, rs->win, gf.width, gf.height, gf.samples, gf.preview, &px, err);
     if (r == SY_OK) r = sy_jpeg_encode_rgba8(px, gf.width, gf.height, w->d.quality, &jpeg, &jlen, err);
     double ms = (sy_time_now() - t0) * 1e3; /* render, display chain, JPEG: the frame's whole cost */
     free(px);

@@ -1041,6 +1041,13 @@ static sy_result rt_render(void *state, const sy_render_request *req, sy_layer *
         .progress = req->progress ? progress_cb : NULL,
         .progress_user_data = &pb,
     };
+    if (st->integrator == SY_RT_INTEGRATOR_WHITTED && req->preview > 0.0f && req->preview < 1.0f) {
+        /* an interactive preview (SY_CAP_PREVIEW): the share `preview` of the camera rays and of the
+         * area- and environment-light samples per pixel, at least one each (spp=1 is the pixel centre) */
+        d.pixel_samples = (uint32_t)fmaxf(1.0f, floorf((float)st->pixel_samples * req->preview + 0.5f));
+        d.area_light_samples = (uint32_t)fmaxf(1.0f, floorf((float)st->light_samples * req->preview + 0.5f));
+        d.env_light_samples = (uint32_t)fmaxf(1.0f, floorf((float)st->env_samples * req->preview + 0.5f));
+    }
     if (st->integrator == SY_RT_INTEGRATOR_COVERAGE) return coverage_render(st, &cam, &d, layer, err);
     if (st->integrator == SY_RT_INTEGRATOR_PATHTRACER) {
         sy_result pr = pt_slot(st, req, err);
@@ -1269,7 +1276,7 @@ const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtra
 static const sy_mediator_class whitted_class = {
     .name = "whitted",
     .param_table = SY_PARAM_TABLE(whitted_params),
-    .caps = SY_CAP_DEPTH | SY_CAP_TILES,
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PREVIEW,
     .create = whitted_create,
     .destroy = rt_destroy,
     .sync = rt_sync,

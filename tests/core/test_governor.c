@@ -352,6 +352,40 @@ static int test_stall(void)
     return 0;
 }
 
+/* SY_CAP_PREVIEW: moving frames ask for a preview (a quarter of the work), refining frames for full
+ * quality; a back-end without the cap always gets full quality. */
+static int test_preview(void)
+{
+    int failures = 0;
+    sy_error e = {0};
+    for (int with = 0; with < 2; ++with) {
+        sy_governor *g = NULL;
+        CHECK_OK(sy_governor_create(NULL, &g, &e), e);
+        cost_model m = {.fixed = 2.0, .per = 1e-4, .rng = 7};
+        uint32_t caps = with ? SY_CAP_PREVIEW : 0u;
+        double now = 0.0;
+        sy_governor_frame f;
+        bool saw_moving = false, saw_still = false;
+        for (int i = 0; i < 40; ++i) { /* moving */
+            step(g, &m, 640, 480, caps, true, &now, &f);
+            if (f.moving && f.wait_ms == 0.0) {
+                saw_moving = true;
+                CHECK(f.preview == (with ? SY_GOVERNOR_PREVIEW : 1.0f));
+            }
+        }
+        for (int i = 0; i < 20 && !f.idle; ++i) { /* still: refine */
+            step(g, &m, 640, 480, caps, false, &now, &f);
+            if (!f.moving && !f.idle && f.wait_ms == 0.0) {
+                saw_still = true;
+                CHECK(f.preview == 1.0f && f.scale == 1.0f);
+            }
+        }
+        CHECK(saw_moving && saw_still);
+        sy_governor_destroy(g);
+    }
+    return failures;
+}
+
 int main(void)
 {
     int failures = 0;
@@ -363,5 +397,6 @@ int main(void)
     RUN(test_noisy);
     RUN(test_switch);
     RUN(test_stall);
+    RUN(test_preview);
     return failures ? 1 : 0;
 }
