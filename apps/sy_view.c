@@ -186,7 +186,7 @@ static sy_result view_cluster_local(view_cluster *vc, const sy_view_args *a, sy_
                                     sy_node cam, uint32_t fw, uint32_t fh, sy_layer *img, sy_error *err)
 {
     sy_cluster_rect t = vc->viewer_tile.w ? vc->viewer_tile : (sy_cluster_rect){0, 0, fw, fh};
-    sy_camera_view view;
+    sy_camera_view view = {0};
     sy_context *ctx = NULL;
     sy_result r = SY_OK;
     if (!vc->wall_vp) { /* made once: the camera node and the wall size do not change */
