@@ -147,7 +147,7 @@ sy_result sy_compare_run(sy_scene *scene, const sy_viewport_desc *vd, const sy_c
         if (face) FT_Done_Face(face);
         if (ft) FT_Done_FreeType(ft);
         if (img) {
-            sy_png_options po = {.tonemap = SY_TONEMAP_ACES};
+            sy_png_options po = {.tonemap = SY_TONEMAP_DISPLAY};
             r = sy_png_write(o->sheet_path, (int)W, (int)H, img, &po, err);
             free(img);
         }

@@ -587,7 +587,7 @@ static const char usage_text[] =
             "  sy info SCENE | IMAGE.exr            JSON summary: counts, bounds, warnings; an EXR's size, channels\n"
             "                                       and header attributes\n"
             "  sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]\n"
-            "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]\n"
+            "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]  (PNG; default aces)\n"
             "            [--max-memory MB]   (ray tracers: refuse a scene whose BVHs need more)\n"
             "            [--gl osmesa|egl|glfw]   (-b raster: the GL context provider)\n"
             "            [--stereo sbs|tb|anaglyph|separate] [--eye-sep M] [--zero-parallax M]\n"
@@ -966,7 +966,7 @@ static int cmd_render(int argc, char **argv)
     const char *filter = NULL, *threshold = NULL; /* --filter / --threshold (path tracer) */
     const char *overlay = NULL, *composite = "depth";
     uint32_t w = 0, h = 0;
-    out_opts oo = {0};
+    out_opts oo = {.png = {.tonemap = SY_TONEMAP_DISPLAY}}; /* the library's display tone map */
     sy_compose_spec spec = {.eye_separation = 0.065f, .zero_parallax = 2.0f};
     sy_error perr = {0};
     sy_cluster_cli_opts clo = {0};
@@ -1364,7 +1364,7 @@ static int cmd_demo(int argc, char **argv)
         char png[1024], exr[1024];
         snprintf(png, sizeof png, "%s/demo_%s.png", dir, name);
         snprintf(exr, sizeof exr, "%s/demo_%s.exr", dir, name);
-        out_opts oo = {.png = {.tonemap = SY_TONEMAP_ACES}};
+        out_opts oo = {.png = {.tonemap = SY_TONEMAP_DISPLAY}};
         if (r == SY_OK) r = write_image(png, &img, &oo, &err);
         if (r == SY_OK) r = write_image(exr, &img, &oo, &err);
         if (r == SY_OK && spp)

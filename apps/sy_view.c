@@ -388,7 +388,7 @@ static void *render_main(void *p)
             again = v->cluster != NULL; /* cluster: retry, the servers may come back */
             continue;
         }
-        sy_post_desc post = {.enabled = true, .tonemap = SY_TONEMAP_ACES, .srgb = true};
+        sy_post_desc post = sy_post_display();
         sy_layer_post_apply(&img, &post);
         size_t n = (size_t)img.width * img.height;
         uint8_t *bytes = malloc(n * 4);

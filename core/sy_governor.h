@@ -52,11 +52,11 @@ typedef struct sy_governor_desc {
     double settle_ms;     /**< the view counts as moving until this long after its last change (ms); 0 = 150 */
 } sy_governor_desc;
 
-/** What to render this frame (sy_governor_plan). */
 /** The preview level of moving frames (back-ends with SY_CAP_PREVIEW): a quarter of the full
  * per-pixel work, e.g. Whitted's 4 camera rays and 16 light samples per pixel become 1 and 4. */
 #define SY_GOVERNOR_PREVIEW 0.25f
 
+/** What to render this frame (sy_governor_plan). */
 typedef struct sy_governor_frame {
     /** @{ render size (<= the display size; the display scales it up); 0 when the display is empty */
     uint32_t width, height; /** @} */

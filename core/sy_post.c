@@ -34,6 +34,12 @@ float sy_tonemap_apply(sy_tonemap op, float x)
     return y < 1.0f ? y : 1.0f;
 }
 
+sy_post_desc sy_post_display(void)
+{
+    sy_post_desc d = {.enabled = true, .tonemap = SY_TONEMAP_DISPLAY, .srgb = true};
+    return d;
+}
+
 void sy_layer_post_apply(sy_layer *l, const sy_post_desc *post)
 {
     if (!post || !post->enabled) return;

@@ -15,7 +15,7 @@ extern "C" {
 
 /** Tone-mapping operators. */
 typedef enum sy_tonemap {
-    SY_TONEMAP_CLAMP = 0,    /**< plain clamp to [0, 1] (the default) */
+    SY_TONEMAP_CLAMP = 0,    /**< plain clamp to [0, 1] (a zero-initialised chain's) */
     SY_TONEMAP_REINHARD = 1, /**< x / (1 + x) */
     SY_TONEMAP_ACES = 2,     /**< Narkowicz 2015 ACES filmic fit, then clamp */
     SY_TONEMAP_MAX_ENUM = 0x7fffffff
@@ -36,6 +36,12 @@ typedef struct sy_post_desc {
     uint32_t tonemap;     /**< sy_tonemap */
     bool srgb;            /**< encode to sRGB (display-referred output in [0, 1]) */
 } sy_post_desc;
+
+/** The tone map of every image meant to be looked at (a window, a browser's canvas, a PNG, a
+ * contact sheet), unless the user asks for another: one policy for every program. */
+#define SY_TONEMAP_DISPLAY SY_TONEMAP_ACES
+/** The display chain: SY_TONEMAP_DISPLAY, then sRGB encoding, no exposure change. */
+sy_post_desc sy_post_display(void);
 
 /** Applies the chain in place to un-premultiplied colour (alpha and depth untouched; colour is
  * re-premultiplied afterwards). No-op when !post->enabled. */

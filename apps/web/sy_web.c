@@ -924,7 +924,7 @@ static sy_result render_rgba8(sy_web *w, render_state *rs, sy_window *win, uint3
     sy_layer img = {0};
     if (r == SY_OK) r = sy_layer_create(width, height, &img, err);
     sy_window_render_opts ro = {.sample_count = samples, .preview = preview,
-                                .post = {.enabled = true, .tonemap = SY_TONEMAP_ACES, .srgb = true}};
+                                .post = sy_post_display()};
     if (r == SY_OK) r = sy_window_render(win, w->d.scene, rs->pool, &ro, &img, err);
     if (r == SY_OK && !(*out = layer_to_rgba8(&img))) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
     sy_layer_destroy(&img);
