@@ -1025,7 +1025,7 @@ static void set_status(sy_web *w, const char *s)
 {
     pthread_mutex_lock(&w->mu);
     if (strcmp(w->status, s) != 0) {
-        snprintf(w->status, sizeof w->status, "%s", s);
+        snprintf(w->status, sizeof w->status, "%.*s", (int)sizeof w->status - 1, s);
         w->status_version++;
     }
     pthread_mutex_unlock(&w->mu);
