@@ -8,7 +8,7 @@ file(REMOVE ${OUT}/client.html ${OUT}/client.js)
 file(REMOVE_RECURSE ${OUT}/vendor)
 configure_file(${SRC}/package.json ${OUT}/npm/package.json COPYONLY)
 configure_file(${SRC}/package-lock.json ${OUT}/npm/package-lock.json COPYONLY)
-execute_process(COMMAND ${NPM} ci --no-audit --no-fund --ignore-scripts --loglevel=error
+execute_process(COMMAND ${NPM} ci --prefer-offline --no-audit --no-fund --ignore-scripts --loglevel=error
                 WORKING_DIRECTORY ${OUT}/npm RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out
                 TIMEOUT 300)
 set(three ${OUT}/npm/node_modules/three)
