@@ -6,6 +6,7 @@
 #include "sy_compose.h"
 #include "sy_demo.h"
 #include "sy_governor.h"
+#include "sy_orbit.h"
 #include "sy_gltf.h"
 #include "sy_sniff.h"
 #include "sy_x3d.h"
@@ -100,13 +101,10 @@ static sy_result gov_orbit(gov_scene *gs, uint32_t i, sy_error *err)
     float c[3], d2 = 0.0f;
     for (int k = 0; k < 3; ++k) c[k] = 0.5f * (b->min[k] + b->max[k]), d2 += (b->max[k] - b->min[k]) * (b->max[k] - b->min[k]);
     float radius = 0.5f * sqrtf(d2), dist = 1.15f * radius / sinf((float)(22.5 * GOV_PI / 180.0));
-    float yaw = (float)(i * GOV_STEP_DEG * GOV_PI / 180.0), pitch = (float)(25.0 * GOV_PI / 180.0);
-    float back[3] = {cosf(pitch) * sinf(yaw), sinf(pitch), cosf(pitch) * cosf(yaw)}; /* camera +Z */
-    float x[3] = {back[2], 0.0f, -back[0]}, xl = sqrtf(x[0] * x[0] + x[2] * x[2]);
-    x[0] /= xl, x[2] /= xl;
-    float y[3] = {back[1] * x[2] - back[2] * x[1], back[2] * x[0] - back[0] * x[2], back[0] * x[1] - back[1] * x[0]};
-    sy_mat4 m = {{x[0], x[1], x[2], 0, y[0], y[1], y[2], 0, back[0], back[1], back[2], 0, c[0] + back[0] * dist,
-                  c[1] + back[1] * dist, c[2] + back[2] * dist, 1}};
+    sy_orbit o = {.target = {c[0], c[1], c[2]}, .yaw = (float)(i * GOV_STEP_DEG * GOV_PI / 180.0),
+                  .pitch = (float)(25.0 * GOV_PI / 180.0), .dist = dist};
+    sy_mat4 m;
+    sy_orbit_matrix(&o, &m);
     sy_result r = sy_node_set_matrix(gs->scene, gs->cam, &m, err);
     return r == SY_OK ? sy_scene_commit(gs->scene, NULL, err) : r;
 }

@@ -5,6 +5,7 @@
 #include "sy_bench.h"
 
 #include "sy_log.h"
+#include "sy_orbit.h"
 #include "sy_stats.h"
 #include "sy_mediator_rt.h"
 #ifdef SY_HAVE_RASTER
@@ -16,26 +17,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
-
-/* Camera-to-world matrix of a camera at eye looking at target (+Y up). */
-static sy_mat4 look_at(const float eye[3], const float target[3])
-{
-    float z[3] = {eye[0] - target[0], eye[1] - target[1], eye[2] - target[2]};
-    float zl = sqrtf(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]);
-    for (int i = 0; i < 3; ++i) z[i] /= zl;
-    float x[3] = {z[2], 0.0f, -z[0]}; /* up x z */
-    float xl = sqrtf(x[0] * x[0] + x[2] * x[2]);
-    x[0] /= xl, x[2] /= xl;
-    float y[3] = {z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]};
-    sy_mat4 m = sy_mat4_identity();
-    for (int i = 0; i < 3; ++i) {
-        m.m[i] = x[i];
-        m.m[4 + i] = y[i];
-        m.m[8 + i] = z[i];
-        m.m[12 + i] = eye[i];
-    }
-    return m;
-}
 
 static long peak_rss_kib(void)
 {
@@ -88,9 +69,11 @@ static sy_result build(sy_scene *s, uint32_t instances, uint32_t tris, sy_node *
 /* Frame k of the orbit: once around the grid, looking down at about 35 degrees. */
 static sy_result place_camera(sy_scene *s, sy_node cam, float extent, uint32_t k, uint32_t frames, sy_error *err)
 {
+    /* the eye at (d sin a, 0.7 d, d cos a), looking at the origin */
     float a = 6.2831853f * (float)k / (float)(frames ? frames : 1), d = 0.8f * extent;
-    float eye[3] = {d * sinf(a), 0.7f * d, d * cosf(a)}, target[3] = {0, 0, 0};
-    sy_mat4 m = look_at(eye, target);
+    sy_orbit o = {.yaw = a, .pitch = atanf(0.7f), .dist = d * sqrtf(1.49f)};
+    sy_mat4 m;
+    sy_orbit_matrix(&o, &m);
     sy_result r = sy_node_set_matrix(s, cam, &m, err);
     return r == SY_OK ? sy_scene_commit(s, NULL, err) : r;
 }

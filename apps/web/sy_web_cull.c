@@ -4,6 +4,7 @@
 #include "sy_web_cull.h"
 
 #include "sy_cull.h"
+#include "sy_orbit.h"
 
 #include <cjson/cJSON.h>
 #include <limits.h>
@@ -70,8 +71,8 @@ static sy_result on_object(void *user, sy_scene *scene, const sy_web_request *re
     return SY_OK;
 }
 
-/* GET /api/view: the server's camera as /api/cull takes it, plus the orbit target (the root's
- * bounds centre projected on the viewing axis) for a client's orbit controls. */
+/* GET /api/view: the server's camera as /api/cull takes it, plus the orbit target (sy_orbit's:
+ * the root's bounds centre projected on the viewing axis) for a client's orbit controls. */
 static sy_result on_view(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
 {
     (void)req;
@@ -106,17 +107,13 @@ static sy_result on_view(void *user, sy_scene *scene, const sy_web_request *req,
         double s = 2.0 * sqrt(1.0 + R[2][2] - R[0][0] - R[1][1]);
         q[3] = (R[1][0] - R[0][1]) / s, q[0] = (R[0][2] + R[2][0]) / s, q[1] = (R[1][2] + R[2][1]) / s, q[2] = 0.25 * s;
     }
-    double pos[3] = {m.m[12], m.m[13], m.m[14]}, fwd[3] = {-R[0][2], -R[1][2], -R[2][2]};
+    double pos[3] = {m.m[12], m.m[13], m.m[14]};
     sy_bounds b;
     if (c->root.id == 0 || sy_node_world_bounds(scene, c->root, &b, NULL) != SY_OK) b = sy_scene_world_bounds(scene);
-    double d = 1.0;
-    if (b.min[0] <= b.max[0]) {
-        d = 0.0;
-        for (int k = 0; k < 3; ++k) d += (0.5 * ((double)b.min[k] + b.max[k]) - pos[k]) * fwd[k];
-        if (!(d > 1e-6)) d = 1.0;
-    }
+    sy_orbit orbit; /* the target on the viewing axis, as sy web's own orbit places it */
+    sy_orbit_from_matrix(&m, &b, &orbit);
     cJSON *o = cJSON_CreateObject();
-    double target[3] = {pos[0] + d * fwd[0], pos[1] + d * fwd[1], pos[2] + d * fwd[2]};
+    double target[3] = {orbit.target[0], orbit.target[1], orbit.target[2]};
     if (o && cJSON_AddItemToObject(o, "position", cJSON_CreateDoubleArray(pos, 3)) &&
         cJSON_AddItemToObject(o, "orientation", cJSON_CreateDoubleArray(q, 4)) && cJSON_AddNumberToObject(o, "fov", fov) &&
         cJSON_AddItemToObject(o, "target", cJSON_CreateDoubleArray(target, 3))) {

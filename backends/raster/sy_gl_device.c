@@ -1549,38 +1549,23 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
     }
 }
 
-static void draw_mesh(sy_gl_device *dev, const mesh_o *m);
-
-/* Draws level `lod` of the mesh (0 = the mesh itself); returns the triangles drawn. */
+/* Draws level `lod` of the mesh (0 or out of range = the mesh itself); returns the triangles drawn. */
 static uint32_t draw_mesh_lod(sy_gl_device *dev, const mesh_o *m, uint32_t lod)
 {
     const sy_gl_fns *gl = dev->gl;
-    if (lod == 0 || lod >= m->lod_count || !m->indexed) {
-        draw_mesh(dev, m);
-        return m->triangle_count;
-    }
     gl->BindVertexArray(m->vao);
     if (!m->has_attr[1]) gl->VertexAttrib4f(1, 0, 0, 1, 0);
     if (!m->has_attr[2]) gl->VertexAttrib4f(2, 0, 0, 0, 0);
     if (!m->has_attr[3]) gl->VertexAttrib4f(3, 0, 0, 0, 0);
     if (!m->has_attr[4]) gl->VertexAttrib4f(4, 1, 1, 1, 1);
-    gl->DrawElements(GL_TRIANGLES, (GLsizei)(3u * m->lod_tris[lod]), GL_UNSIGNED_INT,
-                     (const void *)((uintptr_t)m->lod_first[lod] * sizeof(uint32_t)));
+    if (lod >= m->lod_count) lod = 0;
+    uint32_t tris = m->lod_tris[lod];
+    if (m->indexed)
+        gl->DrawElements(GL_TRIANGLES, (GLsizei)(3u * tris), GL_UNSIGNED_INT,
+                         (const void *)((uintptr_t)m->lod_first[lod] * sizeof(uint32_t)));
+    else gl->DrawArrays(GL_TRIANGLES, 0, (GLsizei)(3u * tris));
     dev->draws++;
-    return m->lod_tris[lod];
-}
-
-static void draw_mesh(sy_gl_device *dev, const mesh_o *m)
-{
-    const sy_gl_fns *gl = dev->gl;
-    gl->BindVertexArray(m->vao);
-    if (!m->has_attr[1]) gl->VertexAttrib4f(1, 0, 0, 1, 0);
-    if (!m->has_attr[2]) gl->VertexAttrib4f(2, 0, 0, 0, 0);
-    if (!m->has_attr[3]) gl->VertexAttrib4f(3, 0, 0, 0, 0);
-    if (!m->has_attr[4]) gl->VertexAttrib4f(4, 1, 1, 1, 1);
-    if (m->indexed) gl->DrawElements(GL_TRIANGLES, (GLsizei)(3u * m->triangle_count), GL_UNSIGNED_INT, NULL);
-    else gl->DrawArrays(GL_TRIANGLES, 0, (GLsizei)(3u * m->triangle_count));
-    dev->draws++;
+    return tris;
 }
 
 static const mat_o *bind_material(sy_gl_device *dev, sy_gl_material id, bool all_textures)
@@ -1777,6 +1762,9 @@ static void frustum_planes(const float *m, float planes[6][4])
         for (int s = 0; s < 2; ++s) {
             float *p = planes[2 * i + s];
             for (int c = 0; c < 4; ++c) p[c] = m[4 * c + 3] + (s ? -m[4 * c + i] : m[4 * c + i]);
+            float len = sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]); /* unit normals: distances in metres */
+            if (len > 0.0f)
+                for (int c = 0; c < 4; ++c) p[c] /= len;
         }
 }
 
@@ -1799,9 +1787,8 @@ static float world_sphere(const inst_o *in, const mesh_o *m, float c[3], float *
 static bool sphere_outside(const float planes[6][4], const float c[3], float r)
 {
     for (int i = 0; i < 6; ++i) {
-        const float *p = planes[i];
-        float len = sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-        if (p[0] * c[0] + p[1] * c[1] + p[2] * c[2] + p[3] < -r * len) return true;
+        const float *p = planes[i]; /* unit normal (frustum_planes) */
+        if (p[0] * c[0] + p[1] * c[1] + p[2] * c[2] + p[3] < -r) return true;
     }
     return false;
 }
