@@ -738,10 +738,11 @@ static int ws_writeable(sy_web *w, web_conn *c)
     if (c->last_gen && c->last_gen <= f->gen) c->answered_id = c->last_id;
     uint64_t id = c->answered_id;
     memcpy(f->buf + LWS_PRE + 32, &id, 8); /* the buffer is shared: patched right before each write */
-    int n = lws_write(c->wsi, f->buf + LWS_PRE, f->len, LWS_WRITE_BINARY);
+    size_t len = f->len;
+    int n = lws_write(c->wsi, f->buf + LWS_PRE, len, LWS_WRITE_BINARY);
     c->sent_seq = f->seq;
-    frame_release(w, f);
-    return n < (int)f->len ? -1 : 0;
+    frame_release(w, f); /* f may be gone from here: the render thread may have replaced it */
+    return n < (int)len ? -1 : 0;
 }
 
 static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)

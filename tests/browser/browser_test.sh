@@ -47,12 +47,21 @@ done
 [ -n "$url" ] || { echo "FAIL: sy web printed no URL: $(cat "$out/log" "$out/err")"; exit 1; }
 echo "sy web: $url"
 
+# server_said: what sy web wrote to stderr that explains a failure: a sanitizer's report from its
+# first line (the error and the stack), else the last lines
+server_said() {
+    if grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err"; then
+        sed -n -E '/ERROR: (Address|Leak)Sanitizer|runtime error:/,$p' "$out/err" | head -60
+    else
+        tail -5 "$out/err"
+    fi
+}
 browse() { # browse URL: the browser run into $out; exit on failure
     SY_CHROMIUM=$CHROMIUM node "$MODULES/browser.mjs" "$mode" "$1" "$out" $W $H >"$out/browser.json"
     local rc=$?
     cat "$out/browser.json"
     [ $rc = 77 ] && skip "$(cat "$out/browser.json")"
-    [ $rc = 0 ] || { echo "FAIL: the browser run failed (exit $rc); sy web said: $(tail -5 "$out/err")"; exit 1; }
+    [ $rc = 0 ] || { echo "FAIL: the browser run failed (exit $rc); sy web said: $(server_said)"; exit 1; }
 }
 # fetched_check [BUDGET]: what the page fetched is each object of the answer once, nothing else;
 # with BUDGET, the answer is cut at it and leaves objects out
@@ -103,5 +112,8 @@ else
     browse "$burl"
     fetched_check $budget
 fi
+# the server must have lived through it all, without a sanitizer's report
+kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
+grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
 [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
 exit $fail
