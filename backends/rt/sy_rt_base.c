@@ -84,15 +84,6 @@ bool sy_rt_pool_insert(sy_rt_pool *p, void *item, uint32_t *id_out)
     return true;
 }
 
-void *sy_rt_pool_get(const sy_rt_pool *p, uint32_t id)
-{
-    uint32_t slot = id & SY_RT_INDEX_MASK;
-    if (slot == 0 || slot > p->count) return NULL;
-    uint32_t idx = slot - 1u;
-    if (p->gens[idx] != (id >> SY_RT_INDEX_BITS)) return NULL;
-    return p->items[idx];
-}
-
 void *sy_rt_pool_remove(sy_rt_pool *p, uint32_t id)
 {
     void *item = sy_rt_pool_get(p, id);

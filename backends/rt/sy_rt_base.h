@@ -30,8 +30,15 @@ typedef struct sy_rt_pool {
 
 /* Stores item in a slot; *id_out gets its handle. Returns false when out of memory or full. */
 bool sy_rt_pool_insert(sy_rt_pool *p, void *item, uint32_t *id_out);
-/* Object for id, or NULL for a zero, stale or foreign id. */
-void *sy_rt_pool_get(const sy_rt_pool *p, uint32_t id);
+/* Object for id, or NULL for a zero, stale or foreign id (inline: every hit looks up its material). */
+static inline void *sy_rt_pool_get(const sy_rt_pool *p, uint32_t id)
+{
+    uint32_t slot = id & SY_RT_INDEX_MASK;
+    if (slot == 0 || slot > p->count) return NULL;
+    uint32_t idx = slot - 1u;
+    if (p->gens[idx] != (id >> SY_RT_INDEX_BITS)) return NULL;
+    return p->items[idx];
+}
 /* Frees the slot of a valid id (bumps its generation) and returns its object (NULL if invalid). */
 void *sy_rt_pool_remove(sy_rt_pool *p, uint32_t id);
 void sy_rt_pool_free(sy_rt_pool *p);

@@ -6,7 +6,7 @@
 #define PI_F 3.14159265358979f
 #define INV_PI 0.31830988618f
 
-static float maxc(sy_rt_v3 v) { return fmaxf(v.x, fmaxf(v.y, v.z)); }
+static float maxc(sy_rt_v3 v) { return sy_rt_maxf(v.x, sy_rt_maxf(v.y, v.z)); }
 static float schlick1(float f0, float c)
 {
     float m = 1.0f - sy_rt_clampf(c, 0.0f, 1.0f), m2 = m * m;
@@ -41,7 +41,7 @@ static float ggx_lambda(float a2, float c)
 {
     c = fabsf(c);
     if (c >= 1.0f) return 0.0f;
-    float t2 = (1.0f - c * c) / fmaxf(c * c, 1e-12f);
+    float t2 = (1.0f - c * c) / sy_rt_maxf(c * c, 1e-12f);
     return 0.5f * (-1.0f + sqrtf(1.0f + a2 * t2));
 }
 
@@ -61,9 +61,9 @@ static sy_rt_v3 sample_vndf(float a, sy_rt_v3 wo, float u1, float u2)
     float r = sqrtf(u1), phi = 2.0f * PI_F * u2;
     float p1 = r * cosf(phi), p2 = r * sinf(phi);
     float s = 0.5f * (1.0f + vh.z);
-    p2 = (1.0f - s) * sqrtf(fmaxf(0.0f, 1.0f - p1 * p1)) + s * p2;
-    sy_rt_v3 nh = v3_add(v3_add(v3_scale(t1, p1), v3_scale(t2, p2)), v3_scale(vh, sqrtf(fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
-    return v3_normalize(v3(a * nh.x, a * nh.y, fmaxf(1e-7f, nh.z)));
+    p2 = (1.0f - s) * sqrtf(sy_rt_maxf(1.0f - p1 * p1, 0.0f)) + s * p2;
+    sy_rt_v3 nh = v3_add(v3_add(v3_scale(t1, p1), v3_scale(t2, p2)), v3_scale(vh, sqrtf(sy_rt_maxf(1.0f - p1 * p1 - p2 * p2, 0.0f))));
+    return v3_normalize(v3(a * nh.x, a * nh.y, sy_rt_maxf(nh.z, 1e-7f)));
 }
 
 void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
@@ -82,7 +82,7 @@ void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
     float metallic = sy_rt_clampf(s->metallic, 0.0f, 1.0f), trans = sy_rt_clampf(d->transmission, 0.0f, 1.0f);
     float rough = sy_rt_clampf(s->roughness, 0.0f, 1.0f);
     b->delta = rough < SY_RT_BSDF_DELTA_ROUGHNESS;
-    b->alpha = fmaxf(rough * rough, 1e-4f);
+    b->alpha = sy_rt_maxf(rough * rough, 1e-4f);
     b->ior = d->ior >= 1.0f ? d->ior : 1.5f;
     float r = (b->ior - 1.0f) / (b->ior + 1.0f);
     b->f0d = r * r;
@@ -115,12 +115,12 @@ static inline sy_rt_v3 bsdf_eval_wo(const sy_rt_bsdf *b, sy_rt_v3 wo, float nv, 
     float nl = v3_dot(b->n, wi);
     if (nl <= 0.0f || nv <= 0.0f || v3_dot(b->ng, wi) <= 0.0f) return v3(0.0f, 0.0f, 0.0f);
     sy_rt_v3 h = v3_normalize(v3_add(wo, wi));
-    float vh = fmaxf(v3_dot(wo, h), 0.0f);
+    float vh = sy_rt_maxf(v3_dot(wo, h), 0.0f);
     float fd = b->spec * schlick1(b->f0d, vh);
     sy_rt_v3 f = v3_scale(b->base, b->w_diel * (1.0f - fd) * INV_PI);
     float p = b->q_diff * nl * INV_PI;
     if (bsdf_glossy(b)) {
-        float a2 = b->alpha * b->alpha, nh = fmaxf(v3_dot(b->n, h), 0.0f);
+        float a2 = b->alpha * b->alpha, nh = sy_rt_maxf(v3_dot(b->n, h), 0.0f);
         float D = ggx_d(a2, nh);
         float ll = ggx_lambda(a2, nl);
         if (lv < 0.0f) lv = ggx_lambda(a2, nv);
@@ -195,7 +195,7 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
     sy_rt_v3 wi;
     if (lobe == 2) {
         float r = sqrtf(u[1]), phi = 2.0f * PI_F * u[2];
-        wi = to_world(b, v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[1]))));
+        wi = to_world(b, v3(r * cosf(phi), r * sinf(phi), sqrtf(sy_rt_maxf(1.0f - u[1], 0.0f))));
     } else {
         sy_rt_v3 h = to_world(b, sample_vndf(b->alpha, wol, u[1], u[2]));
         wi = v3_sub(v3_scale(h, 2.0f * v3_dot(wo, h)), wo);

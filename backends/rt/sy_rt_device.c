@@ -61,6 +61,7 @@ sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **o
     uint32_t threads = desc ? desc->thread_count : 0;
     if (threads > 1024) threads = 1024;
     dev->thread_count = threads; /* 0: the OpenMP default team size, looked up per render */
+    sy_rt_sobol_init(&dev->sobol);
     uint64_t limit = desc ? desc->max_memory_bytes : 0;
     dev->max_memory = limit > (uint64_t)INT64_MAX ? INT64_MAX : (int64_t)limit;
 

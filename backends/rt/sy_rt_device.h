@@ -6,6 +6,7 @@
 
 #include "sy_rt.h"
 #include "sy_rt_math.h"
+#include "sy_rt_sampler.h"
 
 #include <embree3/rtcore.h>
 #include <pthread.h>
@@ -39,6 +40,7 @@ typedef struct sy_rt_material_data {
     sy_rt_material_desc desc;
     bool emissive;  /* emissive factor non-zero */
     bool masked;    /* alpha mode MASK: needs the Embree alpha filter */
+    bool textured;  /* some texture slot is set: hits need texture coordinates */
 } sy_rt_material_data;
 
 typedef struct sy_rt_instance_data {
@@ -78,12 +80,16 @@ typedef struct sy_rt_area_tri {
     sy_rt_v3 p0, e1, e2;        /* world position of vertex 0 and edges to vertices 1, 2 */
     sy_rt_v3 normal;            /* unit geometric normal, front side (glTF winding) */
     float area;
+    float pdf_select;           /* sy_rt_area_pdf of its instance: selection pdf per unit area */
+    sy_rt_v3 emission;          /* the material's emissive factor (x strength) */
     const sy_rt_instance_data *inst; /* for the emissive texture lookup */
     uint32_t prim;
     bool double_sided;
+    bool textured;              /* the emission is textured: sy_rt_surface_emission at the point */
 } sy_rt_area_tri;
 
 struct sy_rt_device {
+    sy_rt_sobol sobol; /* the integrators' sampler tables: built once, read-only after create */
     RTCDevice rtc;
     RTCScene top;
     /* Instances moved since the top-level BVH was last built: rebuilding the top scene costs

@@ -28,12 +28,16 @@ static inline sy_rt_v3 v3_normalize(sy_rt_v3 a)
     float l2 = v3_dot(a, a);
     return l2 > 0.0f ? v3_scale(a, 1.0f / sqrtf(l2)) : v3(0.0f, 0.0f, 0.0f);
 }
-static inline float v3_max_abs(sy_rt_v3 a) { return fmaxf(fabsf(a.x), fmaxf(fabsf(a.y), fabsf(a.z))); }
 /* Offset for secondary rays leaving point p (scales with its magnitude: float precision). */
-static inline float sy_rt_ray_eps(sy_rt_v3 p) { return 1e-4f * (1.0f + v3_max_abs(p)); }
 static inline bool v3_is_zero(sy_rt_v3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
 static inline float v3_luminance(sy_rt_v3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 static inline float sy_rt_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+/* max / min as one SSE instruction (fmaxf is a libm call without -ffinite-math-only): a NaN in a
+ * gives b, so pass the fallback (a constant) as b. */
+static inline float sy_rt_maxf(float a, float b) { return a > b ? a : b; }
+static inline float sy_rt_minf(float a, float b) { return a < b ? a : b; }
+static inline float v3_max_abs(sy_rt_v3 a) { return sy_rt_maxf(fabsf(a.x), sy_rt_maxf(fabsf(a.y), fabsf(a.z))); }
+static inline float sy_rt_ray_eps(sy_rt_v3 p) { return 1e-4f * (1.0f + v3_max_abs(p)); }
 
 /* Column-major 4x4 (glTF): point and direction transforms. */
 static inline sy_rt_v3 m4_point(const float *m, sy_rt_v3 p)

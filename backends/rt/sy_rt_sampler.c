@@ -2,6 +2,8 @@
 #include "sy_rt_sampler.h"
 #include "sy_rt_math.h"
 
+static void build_tables(sy_rt_sobol *s);
+
 void sy_rt_sobol_init(sy_rt_sobol *s)
 {
     /* Joe-Kuo new-joe-kuo-6.21201, dimensions 2..4 (s, a, m); dimension 1 is van der Corput. */
@@ -21,14 +23,7 @@ void sy_rt_sobol_init(sy_rt_sobol *s)
             s->v[d][k] = x;
         }
     }
-    for (uint32_t d = 0; d < 4; ++d)
-        for (uint32_t b = 0; b < 4; ++b)
-            for (uint32_t x = 0; x < 256; ++x) {
-                uint32_t r = 0;
-                for (uint32_t k = 0; k < 8; ++k)
-                    if (x & (1u << k)) r ^= s->v[d][8u * b + k];
-                s->t[d][b][x] = r;
-            }
+    build_tables(s);
 }
 
 uint32_t sy_rt_sobol_raw(const sy_rt_sobol *s, uint32_t index, uint32_t dim)
@@ -52,26 +47,73 @@ static inline uint32_t reverse_bits(uint32_t x)
 #endif
 }
 
-/* Burley's improved Laine-Karras permutation on bit-reversed values: a nested uniform scramble. */
-static inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed)
+/* Burley's improved Laine-Karras permutation; applied to a bit-reversed value and reversed back it
+ * is the nested uniform (Owen) scramble. */
+static inline uint32_t laine_karras(uint32_t x, uint32_t seed)
 {
-    x = reverse_bits(x);
     x ^= x * 0x3d20adeau;
     x += seed;
     x *= (seed >> 16) | 1u;
     x ^= x * 0x05526c56u;
     x ^= x * 0x53a22864u;
-    return reverse_bits(x);
+    return x;
+}
+
+/* The tables hold everything bit-reversed, so that a point costs one reversal per dimension (and
+ * one for the index) instead of two: with j = LK(R(index)) the scrambled index is R(j), and byte b
+ * of j selects the reversed direction numbers of index bits 31 - 8b - m. */
+static void build_tables(sy_rt_sobol *s)
+{
+    for (uint32_t d = 0; d < 4; ++d)
+        for (uint32_t b = 0; b < 4; ++b)
+            for (uint32_t x = 0; x < 256; ++x) {
+                uint32_t r = 0;
+                for (uint32_t m = 0; m < 8; ++m)
+                    if (x & (1u << m)) r ^= reverse_bits(s->v[d][31u - 8u * b - m]);
+                s->t[b][x][d] = r;
+            }
+}
+
+#if defined(__GNUC__)
+/* The four dimensions' scrambles side by side (GCC / Clang vector extensions: SSE2 on x86-64). */
+typedef uint32_t sy_u32x4 __attribute__((vector_size(16)));
+
+static inline sy_u32x4 reverse_bits4(sy_u32x4 x)
+{
+    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+    x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+    return (x >> 16) | (x << 16);
 }
 
 void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, uint32_t index, float out[4])
 {
     uint32_t seed = sy_rt_hash32(pixel_seed ^ sy_rt_hash32(set * 0x9e3779b9u + 0x632be5abu));
-    uint32_t i = nested_uniform_scramble(index, seed);
+    uint32_t j = laine_karras(reverse_bits(index), seed);
+    uint32_t j0 = j & 0xffu, j1 = (j >> 8) & 0xffu, j2 = (j >> 16) & 0xffu, j3 = j >> 24;
+    sy_u32x4 h = {seed, seed + 0x68e31da4u, seed + 2u * 0x68e31da4u, seed + 3u * 0x68e31da4u};
+    sy_u32x4 x = *(const sy_u32x4 *)s->t[0][j0] ^ *(const sy_u32x4 *)s->t[1][j1] ^ *(const sy_u32x4 *)s->t[2][j2] ^
+                 *(const sy_u32x4 *)s->t[3][j3];
+    /* sy_rt_hash32 of each lane's seed */
+    h ^= h >> 16, h *= 0x7feb352du, h ^= h >> 15, h *= 0x846ca68bu, h ^= h >> 16;
+    x ^= x * 0x3d20adeau;
+    x += h;
+    x *= (h >> 16) | 1u;
+    x ^= x * 0x05526c56u;
+    x ^= x * 0x53a22864u;
+    x = reverse_bits4(x) >> 8;
+    for (uint32_t d = 0; d < 4; ++d) out[d] = (float)x[d] * (1.0f / 16777216.0f);
+}
+#else
+void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, uint32_t index, float out[4])
+{
+    uint32_t seed = sy_rt_hash32(pixel_seed ^ sy_rt_hash32(set * 0x9e3779b9u + 0x632be5abu));
+    uint32_t j = laine_karras(reverse_bits(index), seed);
     for (uint32_t d = 0; d < 4; ++d) {
-        const uint32_t(*t)[256] = s->t[d];
-        uint32_t raw = t[0][i & 0xffu] ^ t[1][(i >> 8) & 0xffu] ^ t[2][(i >> 16) & 0xffu] ^ t[3][i >> 24];
-        uint32_t x = nested_uniform_scramble(raw, sy_rt_hash32(seed + d * 0x68e31da4u));
+        uint32_t rr = s->t[0][j & 0xffu][d] ^ s->t[1][(j >> 8) & 0xffu][d] ^ s->t[2][(j >> 16) & 0xffu][d] ^ s->t[3][j >> 24][d];
+        uint32_t x = reverse_bits(laine_karras(rr, sy_rt_hash32(seed + d * 0x68e31da4u)));
         out[d] = (float)(x >> 8) * (1.0f / 16777216.0f);
     }
 }
+#endif

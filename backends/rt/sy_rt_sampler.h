@@ -11,7 +11,9 @@
 
 typedef struct sy_rt_sobol {
     uint32_t v[4][32];       /* direction numbers of dimensions 0..3 */
-    uint32_t t[4][4][256];   /* per dimension and index byte: XOR of the byte's direction numbers */
+    /* per byte b of the scrambled, bit-reversed index and its value x: the XOR of the byte's direction
+     * numbers, bit-reversed, of the four dimensions side by side (one 16-byte load per byte) */
+    _Alignas(16) uint32_t t[4][256][4];
 } sy_rt_sobol;
 
 void sy_rt_sobol_init(sy_rt_sobol *s);

@@ -294,6 +294,8 @@ static void material_set(sy_rt_material_data *m, const sy_rt_material_desc *d)
     m->desc = *d;
     m->emissive = d->emissive[0] > 0.0f || d->emissive[1] > 0.0f || d->emissive[2] > 0.0f;
     m->masked = d->alpha_mode == SY_RT_ALPHA_MASK;
+    m->textured = d->base_color_texture.texture.id || d->normal_texture.texture.id ||
+                  d->metallic_roughness_texture.texture.id || d->emissive_texture.texture.id;
 }
 
 sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc *d, sy_rt_material *out, char *err, size_t err_len)
@@ -864,6 +866,8 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev, char *err, size_t err
             a->inst = in;
             a->prim = t;
             a->double_sided = mat->desc.double_sided;
+            a->emission = v3_load(mat->desc.emissive);
+            a->textured = mat->desc.emissive_texture.texture.id != 0;
             cdf[count + 1] = cdf[count] + (double)lum * a->area * (a->double_sided ? 2.0 : 1.0);
             count++;
         }
@@ -892,6 +896,7 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev, char *err, size_t err
     }
     dev->area_count = count;
     dev->area_power = (float)total;
+    for (uint32_t i = 0; i < count; ++i) dev->area[i].pdf_select = sy_rt_area_pdf(dev, dev->area[i].inst);
     return SY_RT_OK;
 }
 

@@ -43,7 +43,7 @@
 #define SET_BSDF(d) (3u + 3u * (d))
 
 typedef struct whitted_job {
-    sy_rt_sobol sobol;
+    const sy_rt_sobol *sobol; /* the device's */
     sy_rt_env env;
     uint32_t spp;    /* camera rays per pixel */
     uint32_t n_area; /* area-light samples per shading point */
@@ -83,7 +83,7 @@ static sy_rt_v3 schlick(sy_rt_v3 f0, float cos_t)
 /* Sobol point k of this pixel sample's shading-point samples in set `set`. */
 static void light_u(const trace_ctx *c, uint32_t set, uint32_t n, uint32_t k, float u[4])
 {
-    sy_rt_sobol_sample4(&c->job->sobol, c->pseed, set, c->sample * n + k, u);
+    sy_rt_sobol_sample4(c->job->sobol, c->pseed, set, c->sample * n + k, u);
 }
 
 static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, sy_rt_v3 p_off, sy_rt_v3 wo,
@@ -123,7 +123,7 @@ static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bs
         float tmax = d - sy_rt_ray_eps(q) - sy_rt_ray_eps(s->p);
         sy_rt_v3 tr = tmax > 0.0f ? shadow(c, p_off, wi, tmax) : v3(1.0f, 1.0f, 1.0f);
         if (v3_is_zero(tr)) continue;
-        sy_rt_v3 le = v3_mul(tr, sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv));
+        sy_rt_v3 le = v3_mul(tr, t->textured ? sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv) : t->emission);
         float g = cos_l / d2 * t->area / p_sel;
         sum = v3_add(sum, v3_scale(v3_mul(le, f), g));
     }
@@ -320,7 +320,7 @@ static void whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
                 float fx = (float)px + 0.5f, fy = (float)py + 0.5f;
                 if (j->spp > 1u) {
                     float u[4];
-                    sy_rt_sobol_sample4(&j->sobol, c.pseed, 0u, k, u);
+                    sy_rt_sobol_sample4(j->sobol, c.pseed, 0u, k, u);
                     fx = (float)px + u[0];
                     fy = (float)py + u[1];
                 }
@@ -353,7 +353,7 @@ sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc 
 {
     whitted_job *j = malloc(sizeof *j);
     if (!j) return sy_rt_fail(err, err_len, SY_RT_ERROR_OUT_OF_MEMORY, "render: out of memory");
-    sy_rt_sobol_init(&j->sobol);
+    j->sobol = &f->dev->sobol;
     sy_rt_env_get(f->dev, &j->env);
     j->spp = desc->pixel_samples ? desc->pixel_samples : 1u;
     j->n_area = (f->light_samples + j->spp - 1u) / j->spp;

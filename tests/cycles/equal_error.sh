@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# equal_error.sh — the path tracer against Blender Cycles at equal error, side by side in one run
+# (issue 19, part 1). Renders the Cornell box (../shared/testdata/cornell/cornell_box.gltf,
+# 256x256) with Cycles (tests/cycles/cornell_cycles.py: Lambertian materials, 64 bounces, box
+# filter, no denoising, no adaptive sampling) and with `sy render -b pathtracer --filter none
+# --params specular=0` (the reference's materials are Lambertian), both at the same samples per
+# pixel, alternately RUNS times, and measures each image's relMSE against the independent 4096-spp
+# Cycles reference (cornell_box_cycles_256_4096.exr; tests/exr_error: mean of (x - y)^2 / (y^2 +
+# 0.01)). Times are each renderer's own: Cycles' "Time:" line (scene sync, BVH and sampling; not
+# Blender's start-up or the file save) and sy render's render time (scene translation and sampling).
+#
+# An unbiased estimator's relMSE falls as 1 / time, so time x relMSE is a renderer's cost of one
+# unit of quality; their quotient (Cycles' over ours) is how many times faster the path tracer
+# reaches the same error. Each run prints both and the quotient; the last line the median, min and
+# max over the runs.
+#
+# A measurement, not a test: it needs Blender (Debian's `blender` package) and skips without it.
+# Usage: tests/cycles/equal_error.sh [BUILD_DIR (build)] [OUT_DIR (equal-error)] [SPP (128)] [RUNS (3)]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+build=${1:-$root/build}
+out=${2:-equal-error}
+spp=${3:-128}
+runs=${4:-3}
+data=$root/../shared/testdata/cornell
+gltf=$data/cornell_box.gltf
+ref=$data/cornell_box_cycles_256_4096.exr
+if ! command -v blender >/dev/null 2>&1; then
+    echo "equal_error.sh: skipped: Blender is not installed (apt-get install blender)"
+    exit 0
+fi
+[ -f "$gltf" ] && [ -f "$ref" ] || { echo "equal_error.sh: skipped: $data is absent"; exit 0; }
+sy=$build/apps/sy
+err=$build/tests/exr_error
+for tool in "$sy" "$err"; do
+    [ -x "$tool" ] || { echo "equal_error.sh: error: $tool is missing (build first: cmake --build $build)" >&2; exit 1; }
+done
+mkdir -p "$out"
+
+cycles() { # cycles RUN: prints the render's seconds
+    local log=$out/cycles_$1.log
+    # seeds 1.. : the reference was rendered with seed 0, whose first samples it shares
+    blender -b -noaudio --factory-startup -P "$root/tests/cycles/cornell_cycles.py" -- --gltf "$gltf" \
+        --size 256 --spp "$spp" --bounces 64 --seed "$1" --out "$out/cycles_$1.exr" >"$log" 2>&1 ||
+        { echo "equal_error.sh: error: Blender failed, see $log" >&2; exit 1; }
+    # " Time: 00:06.12 (Saving: 00:00.01)": minutes and seconds
+    sed -n 's/^ *Time: \([0-9]*\):\([0-9.]*\).*/\1 \2/p' "$log" | tail -1 | awk '{ printf "%.3f", $1 * 60 + $2 }'
+}
+ours() { # ours RUN: prints the render's seconds
+    local log=$out/sy_$1.log
+    "$sy" render "$gltf" -b pathtracer -w 256 -h 256 --spp "$spp" --filter none --params specular=0 \
+        -o "$out/sy_$1.exr" >"$log" 2>&1 || { echo "equal_error.sh: error: sy render failed, see $log" >&2; exit 1; }
+    # "OUT.exr: 256x256, pathtracer, 128 samples per pixel, 4.647 s (27.55 samples/s)"
+    sed -n 's/.* samples per pixel, \([0-9.]*\) s .*/\1/p' "$log" | head -1
+}
+relmse() { "$err" "$1" "$ref" | awk '{ print $2 }'; }
+
+echo "Cornell box 256x256, $spp spp, $(nproc) threads, relMSE against $(basename "$ref")"
+printf '%4s  %9s %10s %10s  %9s %10s %10s  %8s  %s\n' run "Cycles s" relMSE "s x relMSE" "sy s" relMSE \
+    "s x relMSE" "speed-up" "sy time to Cycles' error"
+ratios=()
+for run in $(seq 1 "$runs"); do
+    tc=$(cycles "$run")
+    ts=$(ours "$run")
+    ec=$(relmse "$out/cycles_$run.exr")
+    es=$(relmse "$out/sy_$run.exr")
+    line=$(awk -v r="$run" -v tc="$tc" -v ec="$ec" -v ts="$ts" -v es="$es" 'BEGIN {
+        printf "%4d  %9.2f %10.6f %10.6f  %9.2f %10.6f %10.6f  %7.2fx  %.2f s\n", r, tc, ec, tc * ec, ts, es, ts * es,
+               (tc * ec) / (ts * es), ts * es / ec }')
+    echo "$line"
+    ratios+=("$(echo "$line" | awk '{ sub("x", "", $8); print $8 }')")
+done
+printf '%s\n' "${ratios[@]}" | sort -g | awk '{ v[NR] = $1 } END {
+    m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
+    printf "equal-error speed-up over Cycles: median %.2fx (min %.2fx, max %.2fx) over %d runs\n", m, v[1], v[NR], NR }'
