@@ -3,7 +3,6 @@
 
 #include <string.h>
 
-#define PI_F 3.14159265358979f
 #define INV_PI 0.31830988618f
 
 static float maxc(sy_rt_v3 v) { return sy_rt_maxf(v.x, sy_rt_maxf(v.y, v.z)); }
@@ -58,8 +57,9 @@ static sy_rt_v3 sample_vndf(float a, sy_rt_v3 wo, float u1, float u2)
     float l2 = vh.x * vh.x + vh.y * vh.y;
     sy_rt_v3 t1 = l2 > 0.0f ? v3_scale(v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(l2)) : v3(1.0f, 0.0f, 0.0f);
     sy_rt_v3 t2 = v3_cross(vh, t1);
-    float r = sqrtf(u1), phi = 2.0f * PI_F * u2;
-    float p1 = r * cosf(phi), p2 = r * sinf(phi);
+    float r = sqrtf(u1), sp, cp;
+    sy_rt_sincos_2pi(u2, &sp, &cp);
+    float p1 = r * cp, p2 = r * sp;
     float s = 0.5f * (1.0f + vh.z);
     p2 = (1.0f - s) * sqrtf(sy_rt_maxf(1.0f - p1 * p1, 0.0f)) + s * p2;
     sy_rt_v3 nh = v3_add(v3_add(v3_scale(t1, p1), v3_scale(t2, p2)), v3_scale(vh, sqrtf(sy_rt_maxf(1.0f - p1 * p1 - p2 * p2, 0.0f))));
@@ -194,8 +194,9 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
     }
     sy_rt_v3 wi;
     if (lobe == 2) {
-        float r = sqrtf(u[1]), phi = 2.0f * PI_F * u[2];
-        wi = to_world(b, v3(r * cosf(phi), r * sinf(phi), sqrtf(sy_rt_maxf(1.0f - u[1], 0.0f))));
+        float r = sqrtf(u[1]), sp, cp;
+        sy_rt_sincos_2pi(u[2], &sp, &cp);
+        wi = to_world(b, v3(r * cp, r * sp, sqrtf(sy_rt_maxf(1.0f - u[1], 0.0f))));
     } else {
         sy_rt_v3 h = to_world(b, sample_vndf(b->alpha, wol, u[1], u[2]));
         wi = v3_sub(v3_scale(h, 2.0f * v3_dot(wo, h)), wo);

