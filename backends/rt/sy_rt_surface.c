@@ -26,7 +26,7 @@ static void fetch_uv(const sy_rt_mesh_data *m, const uint32_t *ix, float w0, flo
     }
 }
 
-static float base_alpha(const sy_rt_device *dev, const sy_rt_material_data *mat, const sy_rt_mesh_data *m,
+static inline float base_alpha(const sy_rt_device *dev, const sy_rt_material_data *mat, const sy_rt_mesh_data *m,
                         const uint32_t *ix, float w0, float w1, float w2, float uv[2][2], sy_rt_v3 *rgb)
 {
     const sy_rt_material_desc *d = &mat->desc;
