@@ -7,7 +7,9 @@
  * against the light-selection pdf), one light sample is taken (light category uniformly among
  * area / environment / punctual, an emissive triangle by power through the alias table, a uniform
  * point on it), then the BSDF is sampled. max_depth bounds the number of scattering events;
- * Russian roulette (survival = min(0.95, max throughput)) starts after three. Alpha-blended
+ * Russian roulette (survival = min(1, sqrt(max throughput)), as Cycles does) starts at the fifth
+ * bounce: on the Cornell box it cost 41 % more error per sample from the third with survival
+ * min(0.95, max throughput), for 8 % less time (tests/cycles/equal_error.sh). Alpha-blended
  * surfaces are crossed stochastically with probability 1 - alpha, and shadow rays are attenuated
  * by 1 - alpha through them (sy_rt_shadow.h; shadow rays toward punctual lights also pass
  * transmissive surfaces, see unoccluded()). A camera ray that leaves the scene (straight through

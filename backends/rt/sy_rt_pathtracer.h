@@ -1,6 +1,6 @@
 /* sy_rt_pathtracer.h — the PATHTRACER integrator: unidirectional path tracing with next-event
  * estimation and multiple importance sampling (power heuristic) for emissive triangles (alias
- * table by power), punctual lights and the environment; Russian roulette from the third bounce;
+ * table by power), punctual lights and the environment; Russian roulette from the fifth bounce;
  * progressive accumulation into a sy_rt_accum with feature buffers. Internal to backends/rt. */
 #ifndef SY_RT_PATHTRACER_H
 #define SY_RT_PATHTRACER_H
