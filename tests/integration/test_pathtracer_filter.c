@@ -16,10 +16,10 @@
  *      4.30x at 128, 11.6x at 256, while on interior pixels it is 12.9x, 20.3x and 25.2x; the
  *      split is printed and the interior ratio is checked too (>= 8x).
  *      The test ran at W = 128 until the path tracer's own noise fell (issue 19: later Russian
- *      roulette, the first direction stratified with the pixel): unfiltered relMSE 0.0531 -> 0.0389
- *      at 128 while the edge floor stayed (filtered 0.0123 -> 0.0121), so at 128 the whole-image
- *      ratio measured the edges (3.2x); at 256 it is 8.0x (pixel) and 9.8x (radiance), interior
- *      16.6x and 28.0x.
+ *      roulette, stratification of the first directions): unfiltered relMSE 0.0531 -> 0.0389 at
+ *      128 while the edge floor stayed (filtered 0.0123 -> 0.0121), so at 128 the whole-image ratio
+ *      measured the edges (3.2x); at 256 it is 9.4x (pixel) and 11.7x (radiance), interior 17.0x
+ *      and 26.8x.
  *      Radiance filtering (filter=radiance: the path tracer's stored-sample hook, one filter frame
  *      per 1-spp pass, the same samples) must reach the same 4x: measured 4.6x at 128x128 and
  *      12.7x at 256x256 (it filters the indirect part only, so the same edge/direct floor applies;
