@@ -193,7 +193,7 @@ sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh);
 /** Levels of detail: an indexed mesh of at least this many triangles gets, at creation, a chain of
  * simplified levels (meshoptimizer's meshopt_simplify, each about a quarter of the one before, all
  * in its index buffer, each with a bound on its deviation from the mesh). */
-#define SY_GL_LOD_MIN_TRIANGLES 65536u
+#define SY_GL_LOD_MIN_TRIANGLES 8192u
 /** Default of sy_gl_set_lod: half a pixel. */
 #define SY_GL_LOD_PIXELS_DEFAULT 0.5f
 /** Each frame, every instance is drawn with the coarsest level whose deviation, projected at the

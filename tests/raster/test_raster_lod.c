@@ -146,7 +146,7 @@ int main(void)
     /* A small mesh has no levels: all its triangles at any distance. */
     MUST(sy_gl_instance_destroy(d, inst));
     uint32_t small_tris = 0;
-    sy_gl_mesh small = sphere(d, 64, &small_tris);
+    sy_gl_mesh small = sphere(d, 32, &small_tris);
     CHECK(small_tris < SY_GL_LOD_MIN_TRIANGLES, "small sphere: %u triangles", small_tris);
     id.mesh = small;
     translate(id.transform, 0, 0, 0);
