@@ -78,7 +78,7 @@ int main(int argc, char **argv)
                         if (!isfinite(d)) continue;
                         rel += d * d / ((double)y[i] * (double)y[i] + 0.01), cnt++;
                     }
-            printf("%s%.3g", bx ? " " : "", cnt ? rel / (double)cnt : 0.0);
+            printf("%s%.6g", bx ? " " : "", cnt ? rel / (double)cnt : 0.0);
         }
         printf("\n");
     }
