@@ -1,6 +1,7 @@
 /* test_cull.c — the remote culling service (apps/cull/sy_cull.h): ranking by covered pixels,
  * occlusion, the budget cut, the JSON answer, bad queries naming their field, unknown ids; the GLB
  * writer (formats/sy_gltf_write.h) round trip through sy_gltf_load; the generated plant's counts. */
+#include "../support/check_count.h"
 #include "sy_cull.h"
 #include "sy_gltf.h"
 #include "sy_gltf_write.h"
@@ -14,15 +15,7 @@
 #include <string.h>
 
 static int failures;
-#define CHECK(cond, ...)                                                               \
-    do {                                                                               \
-        if (!(cond)) {                                                                 \
-            fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond); \
-            fprintf(stderr, __VA_ARGS__);                                              \
-            fputc('\n', stderr);                                                       \
-            failures++;                                                                \
-        }                                                                              \
-    } while (0)
+#define CHECK(cond, ...) SY_CHECK_COUNT(failures, cond, __VA_ARGS__)
 #define MUST(call)                                                                           \
     do {                                                                                     \
         sy_result must_r_ = (call);                                                          \

@@ -3,6 +3,7 @@
 #ifndef SY_TEST_UTIL_H
 #define SY_TEST_UTIL_H
 
+#include "../support/check_count.h"
 #include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
@@ -22,15 +23,7 @@ static int g_failures;
         }                                                                                \
     } while (0)
 
-#define CHECK(cond, ...)                                                                 \
-    do {                                                                                 \
-        if (!(cond)) {                                                                   \
-            ++g_failures;                                                                \
-            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #cond);     \
-            fprintf(stderr, __VA_ARGS__);                                                \
-            fputc('\n', stderr);                                                         \
-        }                                                                                \
-    } while (0)
+#define CHECK(cond, ...) SY_CHECK_COUNT(g_failures, cond, __VA_ARGS__)
 
 /* Creates a fresh scratch directory under $TMPDIR (or /tmp); path written to buf. */
 static void make_scratch_dir(char *buf, size_t n, const char *tag)

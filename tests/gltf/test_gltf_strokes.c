@@ -4,6 +4,7 @@
  * number of triangles (12 per non-degenerate segment + 20 per distinct vertex or point) whose bounds
  * lie within the positions grown by half the core width and reach at least 0.85 of it (the
  * icosahedron's extent). Usage: test_gltf_strokes TESTDATA_DIR (exit 77 when the sample is absent). */
+#include "../support/check_count.h"
 #include "sy_gltf.h"
 #include "sy_strokes.h"
 
@@ -14,15 +15,7 @@
 #include <unistd.h>
 
 static int g_fail;
-#define CHECK(c, ...)                                                                                 \
-    do {                                                                                              \
-        if (!(c)) {                                                                                   \
-            g_fail++;                                                                                 \
-            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #c);                     \
-            fprintf(stderr, __VA_ARGS__);                                                             \
-            fputc('\n', stderr);                                                                      \
-        }                                                                                             \
-    } while (0)
+#define CHECK(c, ...) SY_CHECK_COUNT(g_fail, c, __VA_ARGS__)
 
 int main(int argc, char **argv)
 {

@@ -10,24 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int failures;
-#define CHECK(c, ...)                                                                                  \
-    do {                                                                                               \
-        if (!(c)) {                                                                                    \
-            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #c);                      \
-            fprintf(stderr, __VA_ARGS__);                                                              \
-            fputc('\n', stderr);                                                                       \
-            failures++;                                                                                \
-        }                                                                                              \
-    } while (0)
-#define MUST(call)                                                                                     \
-    do {                                                                                               \
-        sy_gl_result r_ = (call);                                                                      \
-        if (r_ != SY_GL_OK) {                                                                          \
-            fprintf(stderr, "%s:%d: %s failed (%d): %s\n", __FILE__, __LINE__, #call, (int)r_, e);     \
-            exit(1);                                                                                   \
-        }                                                                                              \
-    } while (0)
+#include "gl_test.h"
 
 #define N 96
 static char e[4096];

@@ -4,6 +4,7 @@
 #ifndef RT_TEST_H
 #define RT_TEST_H
 
+#include "../support/check_count.h"
 #include "sy_rt.h"
 
 #include <math.h>
@@ -19,15 +20,7 @@
 static int rt_failures;
 
 /* Records a failure with its location; the test continues so one run reports every problem. */
-#define CHECK(cond, ...)                                                               \
-    do {                                                                               \
-        if (!(cond)) {                                                                 \
-            fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond); \
-            fprintf(stderr, __VA_ARGS__);                                              \
-            fputc('\n', stderr);                                                       \
-            rt_failures++;                                                             \
-        }                                                                              \
-    } while (0)
+#define CHECK(cond, ...) SY_CHECK_COUNT(rt_failures, cond, __VA_ARGS__)
 
 /* A call that must succeed; aborts the test (returns 1 from main's helper chain) otherwise. */
 #define MUST(call)                                                                                 \
