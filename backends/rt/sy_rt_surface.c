@@ -4,12 +4,6 @@
 #include "sy_rt_surface.h"
 #include "sy_rt_texture.h"
 
-/* sy_rt_texture_sample_ref without the call for the common untextured slot. */
-static inline bool tex_sample(const sy_rt_device *dev, const sy_rt_texture_ref *ref, const float uv[2][2], float out[4])
-{
-    return ref->texture.id != 0 && sy_rt_texture_sample_ref(dev, ref, uv, out);
-}
-
 /* Barycentric interpolation of an attribute with `n` floats per vertex. */
 static void interp(const float *a, uint32_t n, const uint32_t *ix, float w0, float w1, float w2, float *out)
 {
@@ -32,7 +26,7 @@ static inline float base_alpha(const sy_rt_device *dev, const sy_rt_material_dat
     const sy_rt_material_desc *d = &mat->desc;
     float c[4] = {d->base_color[0], d->base_color[1], d->base_color[2], d->base_color[3]};
     float t[4];
-    if (tex_sample(dev, &d->base_color_texture, (const float(*)[2])uv, t))
+    if (sy_rt_texture_sample_ref(dev, &d->base_color_texture, (const float(*)[2])uv, t))
         for (int k = 0; k < 4; ++k) c[k] *= t[k];
     if (m->colors) {
         float vc[4];
@@ -61,7 +55,7 @@ sy_rt_v3 sy_rt_surface_emission(const sy_rt_device *dev, const sy_rt_instance_da
     const uint32_t *ix = m->indices + 3u * prim;
     float uv[2][2], t[4];
     fetch_uv(m, ix, 1.0f - u - v, u, v, uv);
-    if (tex_sample(dev, &d->emissive_texture, (const float(*)[2])uv, t)) e = v3_mul(e, v3(t[0], t[1], t[2]));
+    if (sy_rt_texture_sample_ref(dev, &d->emissive_texture, (const float(*)[2])uv, t)) e = v3_mul(e, v3(t[0], t[1], t[2]));
     return e;
 }
 
@@ -139,13 +133,13 @@ void sy_rt_surface_fetch(const sy_rt_device *dev, const sy_rt_instance_data *ins
     s->roughness = d->roughness;
     float t[4];
     const sy_rt_texture_ref *mr = &d->metallic_roughness_texture;
-    if (tex_sample(dev, mr, (const float(*)[2])uv, t)) {
+    if (sy_rt_texture_sample_ref(dev, mr, (const float(*)[2])uv, t)) {
         s->roughness *= t[1];
         s->metallic *= t[2];
     }
     s->emission = v3_load(d->emissive);
     const sy_rt_texture_ref *em = &d->emissive_texture;
-    if (mat->emissive && tex_sample(dev, em, (const float(*)[2])uv, t))
+    if (mat->emissive && sy_rt_texture_sample_ref(dev, em, (const float(*)[2])uv, t))
         s->emission = v3_mul(s->emission, v3(t[0], t[1], t[2]));
 }
 
@@ -182,7 +176,7 @@ sy_rt_v3 sy_rt_surface_eyelight(const sy_rt_device *dev, const sy_rt_instance_da
         if (em->texture.id != 0) {
             float t[4];
             fetch_uv(m, ix, w0, w1, w2, uv);
-            if (tex_sample(dev, em, (const float(*)[2])uv, t))
+            if (sy_rt_texture_sample_ref(dev, em, (const float(*)[2])uv, t))
                 e = v3_mul(e, v3(t[0], t[1], t[2]));
         }
         return e;

@@ -152,10 +152,9 @@ void sy_rt_texture_ref_uv(const sy_rt_texture_ref *ref, const float uv[2][2], fl
     out[1] = m[3] * c[0] + m[4] * c[1] + m[5];
 }
 
-bool sy_rt_texture_sample_ref(const sy_rt_device *dev, const sy_rt_texture_ref *ref, const float uv[2][2],
-                              float out[4])
+bool sy_rt_texture_sample_set_ref(const sy_rt_device *dev, const sy_rt_texture_ref *ref, const float uv[2][2],
+                                  float out[4])
 {
-    if (ref->texture.id == 0) return false;
     const sy_rt_texture_data *t = sy_rt_pool_get(&dev->textures, ref->texture.id);
     if (!t) return false;
     float c[2];

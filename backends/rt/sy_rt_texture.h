@@ -19,10 +19,17 @@ typedef struct sy_rt_texture_data {
  * (grey is replicated to RGB, missing alpha is 1). */
 void sy_rt_texture_sample(const sy_rt_texture_data *tex, float u, float v, float out[4]);
 
+/* sy_rt_texture_sample_ref for a set handle (out of line). */
+bool sy_rt_texture_sample_set_ref(const sy_rt_device *dev, const sy_rt_texture_ref *ref, const float uv[2][2],
+                                  float out[4]);
 /* Looks up ref's texture in dev and samples it at ref's texture-coordinate set of uv (both sets of
- * the hit point), through ref's transform; returns false (out untouched) for a zero/stale handle. */
-bool sy_rt_texture_sample_ref(const sy_rt_device *dev, const sy_rt_texture_ref *ref, const float uv[2][2],
-                              float out[4]);
+ * the hit point), through ref's transform; returns false (out untouched) for a zero/stale handle.
+ * The common untextured slot costs a test, not a call. */
+static inline bool sy_rt_texture_sample_ref(const sy_rt_device *dev, const sy_rt_texture_ref *ref,
+                                            const float uv[2][2], float out[4])
+{
+    return ref->texture.id != 0 && sy_rt_texture_sample_set_ref(dev, ref, uv, out);
+}
 
 /* The texture coordinates ref reads at a hit point with coordinate sets uv (transform applied). */
 void sy_rt_texture_ref_uv(const sy_rt_texture_ref *ref, const float uv[2][2], float out[2]);
