@@ -36,6 +36,7 @@
     X(PFNGLUSEPROGRAMPROC, UseProgram) X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)                         \
     X(PFNGLGETUNIFORMBLOCKINDEXPROC, GetUniformBlockIndex) X(PFNGLUNIFORMBLOCKBINDINGPROC, UniformBlockBinding)  \
     X(PFNGLUNIFORM1IPROC, Uniform1i) X(PFNGLUNIFORM1FPROC, Uniform1f) X(PFNGLUNIFORM3FVPROC, Uniform3fv)         \
+    X(PFNGLUNIFORM2FVPROC, Uniform2fv) X(PFNGLTEXSUBIMAGE2DPROC, TexSubImage2D)                                   \
     X(PFNGLUNIFORM4FVPROC, Uniform4fv) X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                            \
     X(PFNGLUNIFORMMATRIX3FVPROC, UniformMatrix3fv) X(PFNGLGENTEXTURESPROC, GenTextures)                          \
     X(PFNGLDELETETEXTURESPROC, DeleteTextures) X(PFNGLBINDTEXTUREPROC, BindTexture)                               \

@@ -31,6 +31,17 @@ enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_
 #define PROBE_LEVELS 9u /* 256 .. 1 */
 #define PROBE_MAX_ROUGHNESS 0.4f
 enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1, BIND_AREAS = 2 };
+/* Deferred shading (see sy_gl_shaders.c, sy_gl_gbuf_fs): the shading pass samples no material
+ * texture, so the G-buffer and the material table use the material units. */
+enum { UNIT_GCOL = UNIT_BASE, UNIT_GDEPTH = UNIT_MR, UNIT_MTAB = UNIT_NRM };
+#define MTAB_TEXELS 5u      /* RGBA32F texels per material row: base, emissive, mrna, oist, modes */
+#define MTAB_MAX_ROWS 256u /* the G-buffer's key holds 8 bits of material row (sy_gl_shaders.c) */
+#define DEFERRED_PROGS 16u  /* shading-pass programs kept (one per frame lighting variant) */
+/* Instances whose forward shading would run on more pixels per triangle than this stay forward:
+ * on big triangles the forward pass already shades about once per pixel, and the G-buffer pass
+ * is extra (measured with sy bench raster: the demo's spheres at 24-37 pixels per triangle are
+ * faster forward, the 1M-triangle scene's meshes at 2-8 deferred). */
+#define DEFERRED_MAX_PX_PER_TRI 16.0f
 
 static sy_gl_result fail(char *err, size_t len, sy_gl_result r, const char *fmt, ...)
 {
@@ -135,6 +146,7 @@ typedef struct inst_o {
     float model[16], normal_mat[9];
     bool mirror, visible;
     uint32_t lod;  /* level chosen for the last view drawn (choose_lod); shadow maps reuse it */
+    float px_per_tri; /* the last main view: its projected bounding-sphere area over its level's triangles */
 } inst_o;
 
 typedef struct light_o {
@@ -206,6 +218,23 @@ struct sy_gl_device {
     bool probes_dirty, in_probe_pass;
     targets t;
     bool lights_dirty;
+    /* deferred shading */
+    bool forward; /* sy_gl_device_desc.forward */
+    struct { /* the G-buffer pass: perspective, orthographic */
+        GLuint prog;
+        GLint normal_mat, mvp, xa, xb, ppu, to_world, ortho_z, mirror, has_normals, key;
+    } ug[2];
+    struct {
+        int var; /* the lighting variant bits */
+        GLuint prog;
+        GLint unproj, inv_view, px, cam_pos, cam_fwd, ortho;
+    } dp[DEFERRED_PROGS];
+    uint32_t dp_count;
+    float *mtab_cpu;                 /* material table: row i = the material of pool index i, row 0 = default */
+    uint32_t mtab_cpu_rows, mtab_limit; /* rows held; rows a texture may have (GL_MAX_TEXTURE_SIZE) */
+    GLuint mtab;                     /* its texture, MTAB_TEXELS x mtab_rows */
+    uint32_t mtab_rows, mtab_dirty_lo, mtab_dirty_hi; /* rows [lo, hi) changed since the last upload */
+    uint64_t deferred_draws;         /* instances drawn into the G-buffer in the last main pass */
     /* background (camera rays only) */
     sy_gl_background_mode bg_mode;
     float bg_color[4], bg_intensity;
@@ -510,41 +539,40 @@ static int variant_normalize(int v)
     return v;
 }
 
+/* The #defines of variant bits v (sy_gl_shaders.c) into defs and their names after name's text. */
+static void variant_defines(int v, char *defs, size_t defs_len, char *name, size_t name_len)
+{
+    static const char *const names[7] = {"LEAN", "MASK", "TEX", "NMAP", "LIGHTS", "ENV", "SHADOW"};
+    static const struct {
+        int bit;
+        const char *name;
+    } more[4] = {{VAR_AREA, "AREA"}, {VAR_TRANS, "TRANS"}, {VAR_ASHADOW, "ASHADOW"}, {VAR_PROBE, "PROBE"}};
+    size_t dl = strlen(defs), nl = strlen(name);
+    for (int b = 0; b < 7; ++b) {
+        if (!(v & (1 << b))) continue;
+        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_%s 1\n", names[b]);
+        nl += (size_t)snprintf(name + nl, name_len - nl, " %s", names[b]);
+    }
+    for (int k = 0; k < 4; ++k) {
+        if (!(v & more[k].bit)) continue;
+        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_%s 1\n", more[k].name);
+        nl += (size_t)snprintf(name + nl, name_len - nl, " %s", more[k].name);
+    }
+    int nlights = (v >> VAR_NL_SHIFT) & 7;
+    if (nlights) {
+        snprintf(defs + dl, defs_len - dl, "#define SY_NLIGHTS %d\n", nlights);
+        snprintf(name + nl, name_len - nl, " (%d lights)", nlights);
+    }
+}
+
 /* The main program for variant bits v, built and cached on first use; 0 with err set when the
  * driver rejects it. */
 static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 {
     v = variant_normalize(v);
     if (dev->pm[v].prog) return dev->pm[v].prog;
-    static const char *const names[7] = {"LEAN", "MASK", "TEX", "NMAP", "LIGHTS", "ENV", "SHADOW"};
     char defs[256] = "", name[128] = "main";
-    size_t dl = 0, nl = strlen(name);
-    for (int b = 0; b < 7; ++b) {
-        if (!(v & (1 << b))) continue;
-        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_%s 1\n", names[b]);
-        nl += (size_t)snprintf(name + nl, sizeof name - nl, " %s", names[b]);
-    }
-    if (v & VAR_AREA) {
-        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_AREA 1\n");
-        nl += (size_t)snprintf(name + nl, sizeof name - nl, " AREA");
-    }
-    if (v & VAR_TRANS) {
-        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_TRANS 1\n");
-        nl += (size_t)snprintf(name + nl, sizeof name - nl, " TRANS");
-    }
-    if (v & VAR_ASHADOW) {
-        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_ASHADOW 1\n");
-        nl += (size_t)snprintf(name + nl, sizeof name - nl, " ASHADOW");
-    }
-    if (v & VAR_PROBE) {
-        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_PROBE 1\n");
-        nl += (size_t)snprintf(name + nl, sizeof name - nl, " PROBE");
-    }
-    int nlights = (v >> VAR_NL_SHIFT) & 7;
-    if (nlights) {
-        dl += (size_t)snprintf(defs + dl, sizeof defs - dl, "#define SY_NLIGHTS %d\n", nlights);
-        nl += (size_t)snprintf(name + nl, sizeof name - nl, " (%d lights)", nlights);
-    }
+    variant_defines(v, defs, sizeof defs, name, sizeof name);
     const sy_gl_fns *gl = dev->gl;
     GLuint p = 0;
     if (sy_gl_program_build(gl, name, sy_gl_main_vs, sy_gl_main_fs, defs, &p, err, err_len) != SY_GL_OK) return 0;
@@ -562,6 +590,102 @@ static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
     dev->pm[v].frame = 0;
     bind_samplers(gl, p);
     return p;
+}
+
+/* The deferred shading pass for the frame's lighting variant bits v (only the lighting bits
+ * count), built and kept on first use; 0 with err set when the driver rejects it or the cache is
+ * full. */
+static int deferred_program(sy_gl_device *dev, int v, char *err, size_t err_len)
+{
+    v = variant_normalize(v & (VAR_LIGHTS | VAR_ENV | VAR_SHADOW | VAR_AREA | VAR_ASHADOW | (7 << VAR_NL_SHIFT)));
+    for (uint32_t i = 0; i < dev->dp_count; ++i)
+        if (dev->dp[i].var == v) return (int)i;
+    if (dev->dp_count == DEFERRED_PROGS) {
+        fail(err, err_len, SY_GL_ERROR_LIMIT, "deferred shading: more than %u lighting variants", DEFERRED_PROGS);
+        return -1;
+    }
+    char defs[320] = "", name[128] = "deferred";
+    snprintf(defs, sizeof defs, "#define SY_SAMPLES %u\n", dev->msaa);
+    variant_defines(v, defs, sizeof defs, name, sizeof name);
+    const sy_gl_fns *gl = dev->gl;
+    GLuint p = 0;
+    if (sy_gl_program_build(gl, name, sy_gl_resolve_vs, sy_gl_deferred_fs, defs, &p, err, err_len) != SY_GL_OK) return -1;
+    uint32_t i = dev->dp_count++;
+    dev->dp[i].var = v;
+    dev->dp[i].prog = p;
+    dev->dp[i].unproj = gl->GetUniformLocation(p, "u_unproj");
+    dev->dp[i].inv_view = gl->GetUniformLocation(p, "u_inv_view");
+    dev->dp[i].px = gl->GetUniformLocation(p, "u_px");
+    dev->dp[i].cam_pos = gl->GetUniformLocation(p, "u_cam_pos");
+    dev->dp[i].cam_fwd = gl->GetUniformLocation(p, "u_cam_fwd");
+    dev->dp[i].ortho = gl->GetUniformLocation(p, "u_ortho");
+    bind_samplers(gl, p); /* the light and environment units and blocks; then its own three */
+    gl->Uniform1i(gl->GetUniformLocation(p, "t_gcol"), UNIT_GCOL);
+    gl->Uniform1i(gl->GetUniformLocation(p, "t_gdepth"), UNIT_GDEPTH);
+    gl->Uniform1i(gl->GetUniformLocation(p, "t_mtab"), UNIT_MTAB);
+    return (int)i;
+}
+
+/* >>material table: what the deferred pass knows of a material, one row per material pool index
+ * (row 0: the default material), kept on the CPU and uploaded before a deferred pass when rows
+ * changed. */
+static void mtab_row(const sy_gl_device *dev, const sy_gl_material_desc *d, float *row)
+{
+    mat_block b;
+    material_block(dev, d, &b);
+    memcpy(row, b.base, sizeof b.base);
+    memcpy(row + 4, b.emissive, sizeof b.emissive);
+    memcpy(row + 8, b.mrna, sizeof b.mrna);
+    memcpy(row + 12, b.oist, sizeof b.oist);
+    for (int k = 0; k < 4; ++k) row[16 + k] = (float)b.modes[k];
+}
+
+/* Writes material d into row `row`; false (the material is then shaded forward) when the table
+ * cannot hold it. */
+static bool mtab_set(sy_gl_device *dev, uint32_t row, const sy_gl_material_desc *d)
+{
+    if (row >= dev->mtab_limit) return false;
+    if (row >= dev->mtab_cpu_rows) {
+        uint32_t n = dev->mtab_cpu_rows ? dev->mtab_cpu_rows : 64u;
+        while (n <= row) n *= 2u;
+        if (n > dev->mtab_limit) n = dev->mtab_limit;
+        float *t = realloc(dev->mtab_cpu, (size_t)n * MTAB_TEXELS * 4u * sizeof *t);
+        if (!t) return false;
+        memset(t + (size_t)dev->mtab_cpu_rows * MTAB_TEXELS * 4u, 0,
+               (size_t)(n - dev->mtab_cpu_rows) * MTAB_TEXELS * 4u * sizeof *t);
+        dev->mtab_cpu = t;
+        dev->mtab_cpu_rows = n;
+    }
+    mtab_row(dev, d, dev->mtab_cpu + (size_t)row * MTAB_TEXELS * 4u);
+    if (dev->mtab_dirty_lo >= dev->mtab_dirty_hi) dev->mtab_dirty_lo = row, dev->mtab_dirty_hi = row + 1u;
+    if (row < dev->mtab_dirty_lo) dev->mtab_dirty_lo = row;
+    if (row + 1u > dev->mtab_dirty_hi) dev->mtab_dirty_hi = row + 1u;
+    return true;
+}
+
+/* Brings the table's texture up to date (bound on UNIT_MTAB); counted as one texture upload. */
+static void mtab_upload(sy_gl_device *dev)
+{
+    const sy_gl_fns *gl = dev->gl;
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_MTAB);
+    if (!dev->mtab) {
+        gl->GenTextures(1, &dev->mtab);
+        gl->BindTexture(GL_TEXTURE_2D, dev->mtab);
+        gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    } else gl->BindTexture(GL_TEXTURE_2D, dev->mtab);
+    if (dev->mtab_rows != dev->mtab_cpu_rows) {
+        gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, (GLsizei)MTAB_TEXELS, (GLsizei)dev->mtab_cpu_rows, 0, GL_RGBA, GL_FLOAT,
+                       dev->mtab_cpu);
+        dev->mtab_rows = dev->mtab_cpu_rows;
+    } else if (dev->mtab_dirty_lo < dev->mtab_dirty_hi) {
+        gl->TexSubImage2D(GL_TEXTURE_2D, 0, 0, (GLint)dev->mtab_dirty_lo, (GLsizei)MTAB_TEXELS,
+                          (GLsizei)(dev->mtab_dirty_hi - dev->mtab_dirty_lo), GL_RGBA, GL_FLOAT,
+                          dev->mtab_cpu + (size_t)dev->mtab_dirty_lo * MTAB_TEXELS * 4u);
+    } else return;
+    dev->mtab_dirty_lo = dev->mtab_dirty_hi = 0;
+    dev->counts.texture_uploads++;
 }
 
 /* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes, then the cube shadows' parameters
@@ -620,6 +744,14 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
         r = sy_gl_program_build(gl, "floor (trivial lit)", sy_gl_floor_vs, sy_gl_floor_fs, "#define SY_FLOOR_LIT 1\n",
                                 &dev->prog_floor_lit, err, err_len);
     if (r == SY_GL_OK) r = sy_gl_program_build(gl, "sky", sy_gl_resolve_vs, sy_gl_sky_fs, NULL, &dev->prog_sky, err, err_len);
+    dev->forward = dd.forward || dev->msaa < 2; /* the deferred pass is the MSAA resolve */
+    for (int k = 0; k < 2 && r == SY_GL_OK && !dev->forward; ++k)
+        r = sy_gl_program_build(gl, k ? "G-buffer (orthographic)" : "G-buffer", sy_gl_gbuf_vs, sy_gl_gbuf_fs,
+                                k ? "#define SY_ORTHO 1\n" : NULL, &dev->ug[k].prog, err, err_len);
+    if (r == SY_GL_OK && !dev->forward) { /* the fullest shading pass now, so that a driver's rejection fails here */
+        if (deferred_program(dev, VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_SHADOW | VAR_ASHADOW, err, err_len) < 0)
+            r = SY_GL_ERROR_GL;
+    }
     if (r != SY_GL_OK) {
         sy_gl_device_destroy(dev);
         return r;
@@ -639,6 +771,20 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
         dev->uf[k].view = gl->GetUniformLocation(fp, "u_view");
         dev->uf[k].proj = gl->GetUniformLocation(fp, "u_proj");
     }
+    for (int k = 0; k < 2; ++k) {
+        GLuint g = dev->ug[k].prog;
+        if (!g) continue;
+        dev->ug[k].normal_mat = gl->GetUniformLocation(g, "u_normal_mat");
+        dev->ug[k].mvp = gl->GetUniformLocation(g, "u_mvp");
+        dev->ug[k].xa = gl->GetUniformLocation(g, "u_xa");
+        dev->ug[k].xb = gl->GetUniformLocation(g, "u_xb");
+        dev->ug[k].ppu = gl->GetUniformLocation(g, "u_ppu");
+        dev->ug[k].to_world = gl->GetUniformLocation(g, "u_to_world");
+        dev->ug[k].ortho_z = gl->GetUniformLocation(g, "u_ortho_z");
+        dev->ug[k].mirror = gl->GetUniformLocation(g, "u_mirror");
+        dev->ug[k].has_normals = gl->GetUniformLocation(g, "u_has_normals");
+        dev->ug[k].key = gl->GetUniformLocation(g, "u_key");
+    }
     gl->UseProgram(dev->prog_sky);
     gl->Uniform1i(gl->GetUniformLocation(dev->prog_sky, "t_bg"), 0);
     dev->sky_inv_vp = gl->GetUniformLocation(dev->prog_sky, "u_inv_vp");
@@ -651,6 +797,11 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     sy_gl_material_desc_init(&md);
     mat_block mb;
     material_block(dev, &md, &mb);
+    dev->mtab_limit = (uint32_t)max_tex < MTAB_MAX_ROWS ? (uint32_t)max_tex : MTAB_MAX_ROWS;
+    if (!dev->forward && !mtab_set(dev, 0, &md)) {
+        sy_gl_device_destroy(dev);
+        return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "GL device: out of memory");
+    }
     gl->GenBuffers(1, &dev->default_ubo);
     gl->BindBuffer(GL_UNIFORM_BUFFER, dev->default_ubo);
     gl->BufferData(GL_UNIFORM_BUFFER, sizeof mb, &mb, GL_STATIC_DRAW);
@@ -708,10 +859,13 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         targets_free(dev, &dev->t);
         for (int v = 0; v < VAR_COUNT; ++v)
             if (dev->pm[v].prog) gl->DeleteProgram(dev->pm[v].prog);
-        GLuint progs[6] = {dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor, dev->prog_sky,
-                           dev->prog_floor_lit};
-        for (int i = 0; i < 5; ++i)
+        GLuint progs[7] = {dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor, dev->prog_sky,
+                           dev->prog_floor_lit, dev->ug[0].prog};
+        for (int i = 0; i < 7; ++i)
             if (progs[i]) gl->DeleteProgram(progs[i]);
+        for (uint32_t i = 0; i < dev->dp_count; ++i) gl->DeleteProgram(dev->dp[i].prog);
+        if (dev->ug[1].prog) gl->DeleteProgram(dev->ug[1].prog);
+        if (dev->mtab) gl->DeleteTextures(1, &dev->mtab);
         sy_gl_ibl_free(gl, &dev->ibl);
         GLuint bufs[3] = {dev->default_ubo, dev->lights_ubo, dev->areas_ubo};
         GLuint texs[3] = {dev->white_tex, dev->flat_normal_tex, dev->shadow_tex};
@@ -733,6 +887,7 @@ void sy_gl_device_destroy(sy_gl_device *dev)
     free(dev->instances.items);
     free(dev->lights.items);
     free(dev->scratch);
+    free(dev->mtab_cpu);
     free(dev);
 }
 
@@ -751,6 +906,7 @@ void sy_gl_device_stats(const sy_gl_device *dev, sy_gl_stats *out)
     out->triangles_drawn = dev->tris;
     out->draw_calls = dev->draws;
     out->instances_culled = dev->culled;
+    out->deferred_draws = dev->deferred_draws;
     out->frame = dev->frame;
     out->total = dev->counts;
 }
@@ -1112,6 +1268,7 @@ static void material_upload(sy_gl_device *dev, mat_o *m, bool create)
     if (create) gl->BufferData(GL_UNIFORM_BUFFER, sizeof b, &b, GL_DYNAMIC_DRAW);
     else gl->BufferSubData(GL_UNIFORM_BUFFER, 0, sizeof b, &b);
     count_buffer(dev, true, sizeof b);
+    if (!dev->forward) mtab_set(dev, m->h.id & IDX_MASK, &m->d); /* beyond the table: shaded forward */
 }
 
 sy_gl_result sy_gl_material_create(sy_gl_device *dev, const sy_gl_material_desc *d, sy_gl_material *out, char *err,
@@ -1831,6 +1988,26 @@ static uint32_t choose_lod(const sy_gl_device *dev, const mesh_o *m, const view_
     return lod;
 }
 
+/* An instance's projected bounding-sphere area (at most the target's) over the triangles of level
+ * lod: how many pixels its forward shading would run on per triangle. Deferred shading pays off on
+ * small triangles (DEFERRED_MAX_PX_PER_TRI). */
+static float pixels_per_triangle(const sy_gl_device *dev, const mesh_o *m, uint32_t lod, const view_setup *v,
+                                 const float c[3], float r)
+{
+    float screen = (float)dev->t.w * (float)dev->t.h, px_per_m = v->ppu;
+    if (!(px_per_m > 0.0f)) return screen;
+    if (!v->ortho) {
+        float d = (c[0] - v->cam_pos[0]) * v->cam_fwd[0] + (c[1] - v->cam_pos[1]) * v->cam_fwd[1] +
+                  (c[2] - v->cam_pos[2]) * v->cam_fwd[2] - r;
+        if (!(d > 1e-6f)) return screen;
+        px_per_m /= d;
+    }
+    float rp = r * px_per_m, area = 3.14159265f * rp * rp;
+    if (!(area < screen)) area = screen;
+    uint32_t tris = m->lod_tris[lod < m->lod_count ? lod : 0];
+    return tris ? area / (float)tris : screen;
+}
+
 static int cmp_far_first(const void *a, const void *b)
 {
     const float *x = a, *y = b;
@@ -1884,13 +2061,66 @@ static void begin_target(sy_gl_device *dev, const view_setup *v)
     if (dev->t.samples > 1) gl->Enable(GL_MULTISAMPLE);
 }
 
-/* Resolves (MSAA) and reads the target back into the caller's arrays, flipping rows. */
-static sy_gl_result finish_target(sy_gl_device *dev, float *rgba, float *depth, char *err, size_t len)
+/* What takes a w x h target's window position and view depth back to view space (sy_gl_gbuf_fs):
+ * proj[0], proj[5] and the offsets that undo the projection's x and y; 2 / size. */
+static void view_unproject(const view_setup *v, uint32_t w, uint32_t h, float unproj[4], float px[2])
+{
+    const float *p = v->proj;
+    unproj[0] = p[0], unproj[1] = p[5];
+    unproj[2] = v->ortho ? -p[12] : p[8], unproj[3] = v->ortho ? -p[13] : p[9];
+    px[0] = 2.0f / (float)w, px[1] = 2.0f / (float)h;
+}
+
+static int frame_lighting(const sy_gl_device *dev);
+static void bind_frame_resources(sy_gl_device *dev);
+
+/* The deferred shading pass (sy_gl_deferred_fs) into the bound resolve target. */
+static sy_gl_result deferred_pass(sy_gl_device *dev, const view_setup *v, char *err, size_t len)
+{
+    const sy_gl_fns *gl = dev->gl;
+    const targets *t = &dev->t;
+    int k = deferred_program(dev, frame_lighting(dev), err, len);
+    if (k < 0) return SY_GL_ERROR_GL;
+    float inv_view[16];
+    if (!m4_invert(v->view, inv_view)) return fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: view not invertible");
+    float unproj[4], px[2];
+    view_unproject(v, t->w, t->h, unproj, px);
+    gl->UseProgram(dev->dp[k].prog);
+    gl->Uniform4fv(dev->dp[k].unproj, 1, unproj);
+    gl->UniformMatrix4fv(dev->dp[k].inv_view, 1, GL_FALSE, inv_view);
+    gl->Uniform2fv(dev->dp[k].px, 1, px);
+    gl->Uniform3fv(dev->dp[k].cam_pos, 1, v->cam_pos);
+    gl->Uniform3fv(dev->dp[k].cam_fwd, 1, v->cam_fwd);
+    gl->Uniform1i(dev->dp[k].ortho, v->ortho);
+    bind_frame_resources(dev);
+    mtab_upload(dev);
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_GCOL);
+    gl->BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t->color);
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_GDEPTH);
+    gl->BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t->depthlin);
+    gl->BindVertexArray(dev->empty_vao);
+    gl->DrawArrays(GL_TRIANGLES, 0, 3);
+    return SY_GL_OK;
+}
+
+/* Resolves (MSAA; shading the G-buffer when the main pass of view v drew into it) and reads the
+ * target back into the caller's arrays, flipping rows. */
+static sy_gl_result finish_target(sy_gl_device *dev, const view_setup *v, float *rgba, float *depth, char *err,
+                                  size_t len)
 {
     const sy_gl_fns *gl = dev->gl;
     targets *t = &dev->t;
     GLuint read_fbo = t->fbo;
-    if (t->samples > 1) {
+    if (t->samples > 1 && v && dev->deferred_draws) {
+        gl->BindFramebuffer(GL_FRAMEBUFFER, t->rfbo);
+        static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+        gl->DrawBuffers(2, bufs);
+        gl->Disable(GL_DEPTH_TEST);
+        gl->Disable(GL_BLEND);
+        sy_gl_result r = deferred_pass(dev, v, err, len);
+        if (r != SY_GL_OK) return r;
+        read_fbo = t->rfbo;
+    } else if (t->samples > 1) {
         gl->BindFramebuffer(GL_FRAMEBUFFER, t->rfbo);
         static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
         gl->DrawBuffers(2, bufs);
@@ -1933,18 +2163,25 @@ static sy_gl_result finish_target(sy_gl_device *dev, float *rgba, float *depth, 
 
 static int mesh_lean(const mesh_o *m) { return !m->has_attr[3] && !m->has_attr[4]; }
 
-/* The variant bits for one draw: mesh attributes, material textures and mode, frame lighting,
- * whether the instance has a scene probe. */
-static int draw_variant(const sy_gl_device *dev, const mesh_o *m, const mat_o *mt, bool probe)
+/* The variant bits of this frame's lighting. */
+static int frame_lighting(const sy_gl_device *dev)
 {
-    int v = mesh_lean(m) ? VAR_LEAN : 0;
-    if (probe) v |= VAR_PROBE;
+    int v = 0;
     if (dev->light_count) v |= VAR_LIGHTS;
     if (dev->light_count && dev->light_count <= VAR_NL_MAX) v |= (int)dev->light_count << VAR_NL_SHIFT;
     if (dev->env_ready) v |= VAR_ENV;
     if (dev->area_count) v |= VAR_AREA;
     if (dev->shadow_count) v |= VAR_SHADOW;
     if (dev->area_shadow_count) v |= VAR_ASHADOW;
+    return v;
+}
+
+/* The variant bits for one draw: mesh attributes, material textures and mode, frame lighting,
+ * whether the instance has a scene probe. */
+static int draw_variant(const sy_gl_device *dev, const mesh_o *m, const mat_o *mt, bool probe)
+{
+    int v = frame_lighting(dev) | (mesh_lean(m) ? VAR_LEAN : 0);
+    if (probe) v |= VAR_PROBE;
     if (!mt) return variant_normalize(v);
     if (mt->d.alpha_mode == SY_GL_ALPHA_MASK) v |= VAR_MASK;
     if (mt->d.transmission > 0.0f && mt->d.metallic < 1.0f) v |= VAR_TRANS;
@@ -1958,8 +2195,10 @@ static int draw_variant(const sy_gl_device *dev, const mesh_o *m, const mat_o *m
 typedef struct draw_ctx {
     const view_setup *v;
     float viewproj[16], ortho_z[3]; /* orthographic proj[10], proj[14] (and 0) */
-    int bound;
+    int bound;                      /* the variant whose program is bound, BOUND_GBUF, or -1 */
+    bool deferred, gbuf_view_set;   /* opaque draws may go to the G-buffer; its view uniforms are set */
 } draw_ctx;
+#define BOUND_GBUF (-2)
 
 /* Binds the variant's program (building it on first use) and, once per frame, its view uniforms. */
 static sy_gl_result use_variant(sy_gl_device *dev, draw_ctx *dc, int pv, char *err, size_t err_len)
@@ -1989,12 +2228,63 @@ static int probe_of(const sy_gl_device *dev, uint32_t i)
     return -1;
 }
 
+/* Whether a draw of variant pv with material mt (NULL: the default) can be shaded deferred: an
+ * opaque, untextured, non-transmissive material in the table, on a mesh without colours or a
+ * second uv set, without a scene probe. */
+static bool deferrable(const sy_gl_device *dev, const inst_o *in, int pv, const mat_o *mt)
+{
+    if (!(in->px_per_tri <= DEFERRED_MAX_PX_PER_TRI)) return false;
+    if ((pv & (VAR_TEX | VAR_MASK | VAR_TRANS | VAR_PROBE)) || !(pv & VAR_LEAN)) return false;
+    if (mt && mt->d.alpha_mode != SY_GL_ALPHA_OPAQUE) return false;
+    return (mt ? mt->h.id & IDX_MASK : 0u) < dev->mtab_cpu_rows;
+}
+
+/* One instance into the G-buffer (sy_gl_gbuf_fs). */
+static void draw_gbuf(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const mesh_o *m, const mat_o *mt)
+{
+    const sy_gl_fns *gl = dev->gl;
+    const int k = dc->v->ortho ? 1 : 0;
+    if (dc->bound != BOUND_GBUF) {
+        gl->UseProgram(dev->ug[k].prog);
+        dc->bound = BOUND_GBUF;
+        if (!dc->gbuf_view_set) {
+            float unproj[4], px[2];
+            view_unproject(dc->v, dev->t.w, dev->t.h, unproj, px);
+            /* X = (gl_FragCoord.xy px - 1 + unproj.zw) / unproj.xy */
+            const float xa[2] = {px[0] / unproj[0], px[1] / unproj[1]};
+            const float xb[2] = {(unproj[2] - 1.0f) / unproj[0], (unproj[3] - 1.0f) / unproj[1]};
+            const float ppu[2] = {1.0f / xa[0], 1.0f / xa[1]};
+            const float *w = dc->v->view; /* its rotation's transpose takes view directions to the world */
+            const float to_world[9] = {w[0], w[4], w[8], w[1], w[5], w[9], w[2], w[6], w[10]};
+            gl->Uniform2fv(dev->ug[k].xa, 1, xa);
+            gl->Uniform2fv(dev->ug[k].xb, 1, xb);
+            gl->Uniform2fv(dev->ug[k].ppu, 1, ppu);
+            gl->UniformMatrix3fv(dev->ug[k].to_world, 1, GL_FALSE, to_world);
+            gl->Uniform3fv(dev->ug[k].ortho_z, 1, dc->ortho_z);
+            dc->gbuf_view_set = true;
+        }
+    }
+    float mvp[16];
+    m4_mul(dc->viewproj, in->model, mvp);
+    gl->UniformMatrix4fv(dev->ug[k].mvp, 1, GL_FALSE, mvp);
+    gl->UniformMatrix3fv(dev->ug[k].normal_mat, 1, GL_FALSE, in->normal_mat);
+    gl->Uniform1i(dev->ug[k].has_normals, m->has_normals);
+    gl->Uniform1i(dev->ug[k].mirror, in->mirror);
+    gl->Uniform1f(dev->ug[k].key, (float)(4u * (mt ? mt->h.id & IDX_MASK : 0u)));
+    dev->tris += draw_mesh_lod(dev, m, in->lod);
+    dev->deferred_draws++;
+}
+
 static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t index, const inst_o *in, const mesh_o *m,
                                   const mat_o *mt, char *err, size_t err_len)
 {
     const sy_gl_fns *gl = dev->gl;
     int probe = probe_of(dev, index);
     int pv = draw_variant(dev, m, mt, probe >= 0);
+    if (dc->deferred && deferrable(dev, in, pv, mt)) {
+        draw_gbuf(dev, dc, in, m, mt);
+        return SY_GL_OK;
+    }
     sy_gl_result r = use_variant(dev, dc, pv, err, err_len);
     if (r != SY_GL_OK) return r;
     if (probe >= 0) {
@@ -2068,7 +2358,7 @@ static sy_gl_result draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
     if (!lists) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory");
     float planes[6][4];
     frustum_planes(dc.viewproj, planes);
-    if (skip == UINT32_MAX) dev->culled = 0;
+    if (skip == UINT32_MAX) dev->culled = dev->deferred_draws = 0;
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
         inst_o *in = pool_at(&dev->instances, i);
         if (!in->h.id || !in->visible || i == skip) continue;
@@ -2080,6 +2370,7 @@ static sy_gl_result draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
             continue;
         }
         in->lod = choose_lod(dev, m, v, c, r, scale);
+        in->px_per_tri = pixels_per_triangle(dev, m, in->lod, v, c, r);
         const mat_o *mt = pool_get(&dev->materials, in->material.id);
         sy_gl_alpha_mode mode = mt ? mt->d.alpha_mode : SY_GL_ALPHA_OPAQUE;
         int li = mode == SY_GL_ALPHA_BLEND ? 2 : mode == SY_GL_ALPHA_MASK ? 1 : 0;
@@ -2087,6 +2378,9 @@ static sy_gl_result draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
         e[0] = view_distance(in, m, v);
         memcpy(&e[1], &i, sizeof i);
     }
+    /* deferred shading in the main pass of a frame without blended instances (they would blend
+     * over G-buffer samples) */
+    dc.deferred = !dev->forward && !dev->in_probe_pass && skip == UINT32_MAX && nl[2] == 0;
     for (int li = 0; li < 3 && r == SY_GL_OK; ++li) {
         float *list = lists + 2 * (size_t)li * cap;
         qsort(list, nl[li], 2 * sizeof(float), li == 2 ? cmp_far_first : cmp_near_first);
@@ -2253,7 +2547,7 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     begin_target(dev, &v);
     bind_frame_resources(dev);
     r = draw_scene(dev, &v, UINT32_MAX, err, err_len);
-    if (r == SY_GL_OK) r = finish_target(dev, rgba, depth, err, err_len);
+    if (r == SY_GL_OK) r = finish_target(dev, &v, rgba, depth, err, err_len);
     frame_end(dev);
     return r;
 }
@@ -2284,7 +2578,7 @@ sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, cons
         gl->UniformMatrix4fv(dev->uf[k].model, 1, GL_FALSE, in->model);
         dev->tris += draw_mesh_lod(dev, m, in->lod);
     }
-    r = finish_target(dev, rgba, NULL, err, err_len);
+    r = finish_target(dev, NULL, rgba, NULL, err, err_len);
     frame_end(dev);
     return r;
 }

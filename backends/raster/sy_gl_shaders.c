@@ -69,18 +69,213 @@ const char *const sy_gl_main_vs =
     "uniform sampler2D t_base, t_mr, t_nrm, t_occ, t_emis;\n"                                                \
     "vec2 tuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_xf[2*k].xyz, h), dot(m_xf[2*k+1].xyz, h)); }\n"
 
+/* What the forward and the deferred shading share: the light, area-light and environment blocks,
+ * the view uniforms, the BSDF helpers, shadow look-ups, LTC and environment look-ups. */
+#define SY_GL_SHADING_DECLS \
+    "struct Light { vec4 pos_type; vec4 dir_range; vec4 radiant; vec4 cone; };\n" \
+    "layout(std140) uniform Lights { ivec4 l_count; vec4 l_env; mat4 l_shadow_mat[4]; vec4 l_shadow[4];\n" \
+    "  Light l_lights[32]; vec4 l_cube[2]; };\n" /* SY_GL_MAX_CUBE_SHADOWS point lights: near, far, normal offset */ \
+    /* area lights: 4 vertices (xyz, w unused), radiance (rgb, w = double-sided), centre (xyz, w = shadow map or -1) */ \
+    "layout(std140) uniform Areas { ivec4 a_count; vec4 a_dir; vec4 a_data[16 * 6]; };\n" \
+    "uniform sampler2DArrayShadow t_shadow; uniform samplerCubeShadow t_cshadow0, t_cshadow1;\n" \
+    "uniform samplerCube t_env_spec, t_env_irr, t_probe; uniform sampler2D t_brdf, t_ltc1, t_ltc2;\n" \
+    "uniform float u_probe_lod;\n" /* the probe's last mip */ \
+    "uniform vec3 u_cam_pos; uniform vec3 u_cam_fwd; uniform bool u_ortho; uniform bool u_mirror;\n" \
+    "uniform bool u_has_normals; uniform vec3 u_ortho_z;\n" /* orthographic: proj[10], proj[14] */ \
+    "const float INV_PI = 0.31830988618;\n" \
+    "vec3 schlick(vec3 f0, float c) { float m = 1.0 - clamp(c, 0.0, 1.0); float m5 = m*m*m*m*m;\n" \
+    "  return f0 + (vec3(1.0) - f0) * m5; }\n" \
+    "float schlick1(float f0, float c) { float m = 1.0 - clamp(c, 0.0, 1.0); return f0 + (1.0 - f0) * m*m*m*m*m; }\n" \
+    "#if defined(SY_SHADOW) || defined(SY_ASHADOW)\n" \
+    /* sp.x: normal offset (x w in perspective when sp.y > 0.5); sp.z: area-light penumbra scale \
+     * (radius in shadow-map uv = sp.z / w); sp.w: 2 tan(half fov). Returns the light-space position. */ \
+    "bool proj_coord(mat4 M, vec4 sp, vec3 p, vec3 ngf, out vec3 q, out float r) {\n" \
+    "  vec4 c0 = M * vec4(p, 1.0); r = 0.0; q = vec3(0.0); if (c0.w <= 0.0) return false;\n" \
+    "  float off = sp.x * (sp.y > 0.5 ? c0.w : 1.0);\n" \
+    "  r = sp.z / c0.w;\n" /* penumbra kernel (uv); its world size sp.w r w */ \
+    "  off = max(off, r * sp.w * c0.w);\n" /* offset the receiver by the kernel's world radius (r of uv = 2 t r w): no self-shadowing at any slope */ \
+    "  vec4 c = M * vec4(p + ngf * off, 1.0); if (c.w <= 0.0) return false;\n" \
+    "  q = c.xyz / c.w * 0.5 + 0.5; return q.z < 1.0; }\n" \
+    "bool shadow_coord(int si, vec3 p, vec3 ngf, out vec3 q, out float r) {\n" \
+    "  return proj_coord(l_shadow_mat[si], l_shadow[si], p, ngf, q, r); }\n" \
+    "#endif\n" \
+    /* punctual lights cast hard shadows (as in the ray tracers): one hardware-bilinear PCF tap, an \
+     * edge one texel wide */ \
+    "#ifdef SY_SHADOW\n" \
+    "float shadow_vis(int si, vec3 p, vec3 ngf) {\n" \
+    "  vec3 q; float r; if (!shadow_coord(si, p, ngf, q, r)) return 1.0;\n" \
+    "  return texture(t_shadow, vec4(q.xy, float(si), q.z)); }\n" \
+    /* point lights: a depth cube map, compared at the window depth of the major axis of (p - light) \
+     * after the normal offset */ \
+    "float cube_vis(int slot, vec3 lp, vec3 p, vec3 ngf) {\n" \
+    "  vec4 cp = l_cube[slot]; vec3 d0 = p - lp; float m0 = max(abs(d0.x), max(abs(d0.y), abs(d0.z)));\n" \
+    "  vec3 d = d0 + ngf * (cp.z * m0); vec3 ad = abs(d); float ma = max(ad.x, max(ad.y, ad.z));\n" \
+    "  if (!(ma > cp.x)) return 1.0;\n" \
+    "  float z = 0.5 * ((cp.y + cp.x) / (cp.y - cp.x) - 2.0 * cp.y * cp.x / ((cp.y - cp.x) * ma)) + 0.5;\n" \
+    "  if (z >= 1.0) return 1.0;\n" \
+    "  return slot == 0 ? texture(t_cshadow0, vec4(d, z)) : texture(t_cshadow1, vec4(d, z)); }\n" \
+    "#endif\n" \
+    "#ifdef SY_ASHADOW\n" /* area lights: 8 Poisson taps (hardware PCF each) over the penumbra */ \
+    "const vec2 POISSON[8] = vec2[8](vec2(-0.840,-0.074), vec2(0.962,-0.195), vec2(-0.203,0.621), vec2(0.185,-0.893),\n" \
+    "  vec2(-0.326,-0.406), vec2(0.473,-0.480), vec2(0.519,0.767), vec2(-0.696,0.457));\n" \
+    "float shadow_area(int si, vec3 p, vec3 ngf) {\n" \
+    "  vec3 q; float r; if (!shadow_coord(si, p, ngf, q, r)) return 1.0;\n" \
+    "  r = max(r, 1.5 / float(textureSize(t_shadow, 0).x)); float s = 0.0;\n" \
+    "  for (int k = 0; k < 8; ++k) s += texture(t_shadow, vec4(q.xy + POISSON[k] * r, float(si), q.z));\n" \
+    "  return s * 0.125; }\n" \
+    "#endif\n" \
+    "#ifdef SY_AREA\n" \
+    /* Heitz et al. 2016, clipless form: the vector form factor of the (transformed) polygon, its \
+     * horizon clipping looked up as a sphere in ltc_2.w */ \
+    "vec3 edge_vec(vec3 v1, vec3 v2) { float x = dot(v1, v2), y = abs(x);\n" \
+    "  float a = 0.8543985 + (0.4965155 + 0.0145206 * y) * y, b = 3.4175940 + (4.1616724 + y) * y, v = a / b;\n" \
+    "  float ts = x > 0.0 ? v : 0.5 * inversesqrt(max(1.0 - x * x, 1e-7)) - v; return cross(v1, v2) * ts; }\n" \
+    "float ltc_eval(mat3 Minv, vec3 P, int li, int nv) {\n" \
+    "  vec3 L[4]; vec3 ctr = vec3(0.0);\n" \
+    "  for (int k = 0; k < 4; ++k) { L[k] = Minv * (a_data[li * 6 + k].xyz - P); }\n" \
+    "  ctr = Minv * (a_data[li * 6 + 5].xyz - P);\n" \
+    "  for (int k = 0; k < 4; ++k) L[k] = normalize(L[k]);\n" \
+    "  vec3 f = edge_vec(L[0], L[1]) + edge_vec(L[1], L[2]);\n" \
+    "  if (nv == 4) f += edge_vec(L[2], L[3]) + edge_vec(L[3], L[0]); else f += edge_vec(L[2], L[0]);\n" \
+    "  if (dot(f, ctr) < 0.0) f = -f;\n" \
+    "  float len = length(f); if (!(len > 0.0)) return 0.0;\n" \
+    "  float z = f.z / len; vec2 uv = vec2(z * 0.5 + 0.5, len) * (63.0 / 64.0) + 0.5 / 64.0;\n" \
+    "  return len * textureLod(t_ltc2, uv, 0.0).w; }\n" \
+    "#endif\n" \
+    "#if defined(SY_ENV) || defined(SY_PROBE)\n" \
+    /* what a reflected or refracted ray sees: the scene probe around this object (the scene and, \
+     * beyond it, the environment; its mips blur for roughness) or the prefiltered environment */ \
+    "vec3 env_spec(vec3 d, float rough) {\n" \
+    "#ifdef SY_PROBE\n" \
+    "  return textureLod(t_probe, d, rough * u_probe_lod).rgb;\n" \
+    "#else\n" \
+    "  return textureLod(t_env_spec, d, rough * l_env.x).rgb;\n" \
+    "#endif\n" \
+    "}\n" \
+    "#endif\n" \
+
+/* The lighting of one surface point: P (world), ngf (geometric normal facing the viewer), ns
+ * (shading normal, flipped to the side seen), wo (towards the eye), the material's clamped base
+ * colour, metallic, roughness, ior, specular and transmission, ao (occlusion of the ambient
+ * terms), emitter (an emissive surface gets no indirect estimate). Only in lit variants. */
+#define SY_GL_SHADE_LIT \
+    "#ifdef SY_LIT\n" \
+    "vec3 shade_lit(vec3 P, vec3 ngf, vec3 ns, vec3 wo, vec3 bc, float metallic, float rough, float ior, float spec,\n" \
+    "               float trans, float ao, bool emitter) {\n" \
+    "    vec3 L = vec3(0.0);\n" \
+    /* the path tracer's lobes: metal (Schlick on the base colour), dielectric specular \
+     * spec x Schlick(f0d), diffuse base (1 - that) / pi, transmission */ \
+    "    float r0 = (ior - 1.0) / (ior + 1.0); float f0d = r0 * r0;\n" \
+    "    float w_metal = metallic, w_diel = (1.0 - metallic) * (1.0 - trans), w_trans = (1.0 - metallic) * trans;\n" \
+    "    vec3 kd = bc * w_diel;\n" \
+    "    float a = max(rough * rough, 1e-4), a2 = a * a;\n" \
+    "    float nv = max(dot(ns, wo), 1e-4);\n" \
+    "#ifdef SY_LIGHTS\n" \
+    "#ifndef SY_NLIGHTS\n" \
+    "#define SY_NLIGHTS l_count.x\n" \
+    "#endif\n" \
+    "    for (int i = 0; i < SY_NLIGHTS; ++i) {\n" \
+    "      Light l = l_lights[i]; int type = int(l.pos_type.w); vec3 wi, e;\n" \
+    "      if (type == 3) { wi = -l.dir_range.xyz; e = l.radiant.rgb; }\n" \
+    "      else {\n" \
+    "        wi = l.pos_type.xyz - P; float d2 = dot(wi, wi); if (!(d2 > 0.0)) continue;\n" \
+    "        float d = sqrt(d2); wi /= d; float att = 1.0 / d2;\n" \
+    "        if (l.dir_range.w > 0.0) { float x = d / l.dir_range.w; float w = clamp(1.0 - x*x*x*x, 0.0, 1.0); att *= w * w; }\n" \
+    "        if (type == 2) { float cd = -dot(l.dir_range.xyz, wi); float s = clamp(cd * l.cone.x + l.cone.y, 0.0, 1.0); att *= s * s; }\n" \
+    "        if (!(att > 0.0)) continue; e = l.radiant.rgb * att;\n" \
+    "      }\n" \
+    "      float cs = dot(ns, wi); if (cs <= 0.0 || dot(ngf, wi) <= 0.0) continue;\n" \
+    "#ifdef SY_SHADOW\n" \
+    "      int si = int(l.cone.z), ci = int(l.cone.w);\n" \
+    "      float vis = si >= 0 ? shadow_vis(si, P, ngf) : ci >= 0 ? cube_vis(ci, l.pos_type.xyz, P, ngf) : 1.0;\n" \
+    "      if (vis <= 0.0) continue;\n" \
+    "#else\n" \
+    "      float vis = 1.0;\n" \
+    "#endif\n" \
+    "      vec3 h = normalize(wi + wo); float vh = max(dot(wo, h), 0.0);\n" \
+    "      float fd = spec * schlick1(f0d, vh);\n" \
+    "      vec3 f = kd * (1.0 - fd) * INV_PI;\n" \
+    "      if (rough > 0.0) {\n" \
+    "        float nl = cs, nh = max(dot(ns, h), 0.0);\n" \
+    "        float dd = nh * nh * (a2 - 1.0) + 1.0; float D = a2 * INV_PI / (dd * dd);\n" \
+    "        float V = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));\n" \
+    "        f += (schlick(bc, vh) * w_metal + vec3(w_diel * fd)) * (D * V);\n" \
+    "      }\n" \
+    "      L += e * f * cs * vis;\n" \
+    "    }\n" \
+    "#endif\n" \
+    "#if defined(SY_AREA) || defined(SY_ENV) || defined(SY_PROBE)\n" \
+    /* split-sum terms: A, B of the GGX BRDF for this view and roughness */ \
+    "    vec2 ab = textureLod(t_brdf, vec2(nv, rough) * (31.0 / 32.0) + 0.5 / 32.0, 0.0).rg;\n" \
+    "    float fd_avg = spec * (f0d * ab.x + ab.y);\n" \
+    "    vec3 fspec = (bc * ab.x + ab.y) * w_metal + vec3(w_diel * fd_avg);\n" \
+    "#endif\n" \
+    "#ifdef SY_AREA\n" \
+    "    {\n" \
+    "      vec2 luv = vec2(rough, sqrt(1.0 - nv)) * (63.0 / 64.0) + 0.5 / 64.0;\n" \
+    "      vec4 t1 = textureLod(t_ltc1, luv, 0.0), t2 = textureLod(t_ltc2, luv, 0.0);\n" \
+    "      vec3 T1 = normalize(wo - ns * dot(wo, ns)); vec3 T2 = cross(ns, T1);\n" \
+    "      mat3 frame = transpose(mat3(T1, T2, ns));\n" \
+    "      mat3 Minv = mat3(vec3(t1.x, 0.0, t1.y), vec3(0.0, 1.0, 0.0), vec3(t1.z, 0.0, t1.w)) * frame;\n" \
+    /* the LTC norm replaces A, B for the polygon's specular (F0 t2.x + (1 - F0) t2.y) */ \
+    "      vec3 fl = (bc * t2.x + (1.0 - bc) * t2.y) * w_metal + vec3(w_diel * spec * (f0d * t2.x + (1.0 - f0d) * t2.y));\n" \
+    "      vec3 kdl = kd * (1.0 - fd_avg);\n" \
+    "      for (int i = 0; i < a_count.x; ++i) {\n" \
+    "        vec4 v0 = a_data[i * 6], rad = a_data[i * 6 + 4], cen = a_data[i * 6 + 5];\n" \
+    "        int nvx = int(v0.w);\n" \
+    "        vec3 ln = cross(a_data[i * 6 + 1].xyz - v0.xyz, a_data[i * 6 + 2].xyz - v0.xyz);\n" \
+    "        float side = dot(P - v0.xyz, ln);\n" \
+    "        if (!(abs(side) > 1e-5 * dot(ln, ln) + 1e-9) || (side < 0.0 && rad.w < 0.5)) continue;\n" \
+    "#ifdef SY_ASHADOW\n" \
+    "        int si = int(cen.w); float vis = si >= 0 ? shadow_area(si, P, ngf) : 1.0;\n" \
+    "        if (vis <= 0.0) continue;\n" \
+    "#else\n" \
+    "        float vis = 1.0;\n" \
+    "#endif\n" \
+    "        float d = ltc_eval(frame, P, i, nvx);\n" \
+    "        float s = rough > 0.0 ? ltc_eval(Minv, P, i, nvx) : 0.0;\n" \
+    "        L += rad.rgb * (kdl * d + fl * s) * vis;\n" \
+    "      }\n" \
+    /* the area lights' indirect light (sy_gl_set_ambient), stronger on surfaces facing the way the \
+     * emitters shine (they see the directly lit surfaces), weaker on those facing the emitters; not \
+     * on emitters (the estimate counts them as sources only) */ \
+    "      if (!emitter) L += (kdl + fspec) * l_env.yzw * (ao * (1.0 + 0.75 * dot(ns, a_dir.xyz)));\n" \
+    "    }\n" \
+    "#endif\n" \
+    "#if defined(SY_ENV) || defined(SY_PROBE)\n" \
+    "    {\n" \
+    "      vec3 R = reflect(-wo, ns);\n" \
+    "#ifdef SY_ENV\n" \
+    "      vec3 irr = textureLod(t_env_irr, ns, 0.0).rgb;\n" /* cosine-weighted mean radiance = E / pi */ \
+    "#else\n" \
+    "      vec3 irr = vec3(0.0);\n" \
+    "#endif\n" \
+    /* the GGX lobe's dominant direction leans from R towards N as roughness grows (Lagarde and \
+     * de Rousiers 2014, "Moving Frostbite to PBR", eq. 55); looking up R alone lights rough \
+     * surfaces from below the horizon */ \
+    "      float ga = rough * rough; vec3 Rd = normalize(mix(ns, R, (1.0 - ga) * (sqrt(1.0 - ga) + ga)));\n" \
+    "      vec3 env = kd * (1.0 - fd_avg) * irr + fspec * env_spec(Rd, rough);\n" \
+    "#ifdef SY_TRANS\n" \
+    "      {\n" /* glass: Fresnel reflection + refraction of the environment */ \
+    "        float F = schlick1(f0d, nv);\n" \
+    /* through a solid: refract in, cross a sphere tangent to this point, refract out (exact for \
+     * a glass ball: the environment appears inverted as in the path tracer) */ \
+    "        float eta = max(ior, 1.0); vec3 T = refract(-wo, ns, 1.0 / eta);\n" \
+    "        if (dot(T, T) == 0.0) T = R; else {\n" \
+    "          vec3 n2 = ns - 2.0 * dot(ns, T) * T;\n" /* the exit normal (outward) */ \
+    "          vec3 T2 = refract(T, -n2, eta); T = dot(T2, T2) > 0.0 ? T2 : reflect(T, -n2);\n" \
+    "        }\n" \
+    "        env += w_trans * (F * env_spec(R, rough) + (1.0 - F) * bc * env_spec(T, rough));\n" \
+    "      }\n"    "#endif\n" \
+    "      L += env * ao;\n" \
+    "    }\n" \
+    "#endif\n" \
+    "    return L;\n" \
+    "}\n" \
+    "#endif\n" \
+
 const char *const sy_gl_main_fs =
-    "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_MATERIAL_BLOCK
-    "struct Light { vec4 pos_type; vec4 dir_range; vec4 radiant; vec4 cone; };\n"
-    "layout(std140) uniform Lights { ivec4 l_count; vec4 l_env; mat4 l_shadow_mat[4]; vec4 l_shadow[4];\n"
-    "  Light l_lights[32]; vec4 l_cube[2]; };\n" /* SY_GL_MAX_CUBE_SHADOWS point lights: near, far, normal offset */
-    /* area lights: 4 vertices (xyz, w unused), radiance (rgb, w = double-sided), centre (xyz, w = shadow map or -1) */
-    "layout(std140) uniform Areas { ivec4 a_count; vec4 a_dir; vec4 a_data[16 * 6]; };\n"
-    "uniform sampler2DArrayShadow t_shadow; uniform samplerCubeShadow t_cshadow0, t_cshadow1;\n"
-    "uniform samplerCube t_env_spec, t_env_irr, t_probe; uniform sampler2D t_brdf, t_ltc1, t_ltc2;\n"
-    "uniform float u_probe_lod;\n" /* the probe's last mip */
-    "uniform vec3 u_cam_pos; uniform vec3 u_cam_fwd; uniform bool u_ortho; uniform bool u_mirror;\n"
-    "uniform bool u_has_normals; uniform vec3 u_ortho_z;\n" /* orthographic: proj[10], proj[14] */
+    "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_MATERIAL_BLOCK SY_GL_SHADING_DECLS
     "#ifdef SY_LIT\n"
     "in vec3 v_wpos; in vec3 v_nrm;\n"
     "#endif\n"
@@ -100,77 +295,7 @@ const char *const sy_gl_main_fs =
     "in vec4 v_col;\n"
     "#endif\n"
     "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
-    "const float INV_PI = 0.31830988618;\n"
-    "vec3 schlick(vec3 f0, float c) { float m = 1.0 - clamp(c, 0.0, 1.0); float m5 = m*m*m*m*m;\n"
-    "  return f0 + (vec3(1.0) - f0) * m5; }\n"
-    "float schlick1(float f0, float c) { float m = 1.0 - clamp(c, 0.0, 1.0); return f0 + (1.0 - f0) * m*m*m*m*m; }\n"
-    "#if defined(SY_SHADOW) || defined(SY_ASHADOW)\n"
-    /* sp.x: normal offset (x w in perspective when sp.y > 0.5); sp.z: area-light penumbra scale
-     * (radius in shadow-map uv = sp.z / w); sp.w: 2 tan(half fov). Returns the light-space position. */
-    "bool proj_coord(mat4 M, vec4 sp, vec3 p, vec3 ngf, out vec3 q, out float r) {\n"
-    "  vec4 c0 = M * vec4(p, 1.0); r = 0.0; q = vec3(0.0); if (c0.w <= 0.0) return false;\n"
-    "  float off = sp.x * (sp.y > 0.5 ? c0.w : 1.0);\n"
-    "  r = sp.z / c0.w;\n" /* penumbra kernel (uv); its world size sp.w r w */
-    "  off = max(off, r * sp.w * c0.w);\n" /* offset the receiver by the kernel's world radius (r of uv = 2 t r w): no self-shadowing at any slope */
-    "  vec4 c = M * vec4(p + ngf * off, 1.0); if (c.w <= 0.0) return false;\n"
-    "  q = c.xyz / c.w * 0.5 + 0.5; return q.z < 1.0; }\n"
-    "bool shadow_coord(int si, vec3 p, vec3 ngf, out vec3 q, out float r) {\n"
-    "  return proj_coord(l_shadow_mat[si], l_shadow[si], p, ngf, q, r); }\n"
-    "#endif\n"
-    /* punctual lights cast hard shadows (as in the ray tracers): one hardware-bilinear PCF tap, an
-     * edge one texel wide */
-    "#ifdef SY_SHADOW\n"
-    "float shadow_vis(int si, vec3 p, vec3 ngf) {\n"
-    "  vec3 q; float r; if (!shadow_coord(si, p, ngf, q, r)) return 1.0;\n"
-    "  return texture(t_shadow, vec4(q.xy, float(si), q.z)); }\n"
-    /* point lights: a depth cube map, compared at the window depth of the major axis of (p - light)
-     * after the normal offset */
-    "float cube_vis(int slot, vec3 lp, vec3 p, vec3 ngf) {\n"
-    "  vec4 cp = l_cube[slot]; vec3 d0 = p - lp; float m0 = max(abs(d0.x), max(abs(d0.y), abs(d0.z)));\n"
-    "  vec3 d = d0 + ngf * (cp.z * m0); vec3 ad = abs(d); float ma = max(ad.x, max(ad.y, ad.z));\n"
-    "  if (!(ma > cp.x)) return 1.0;\n"
-    "  float z = 0.5 * ((cp.y + cp.x) / (cp.y - cp.x) - 2.0 * cp.y * cp.x / ((cp.y - cp.x) * ma)) + 0.5;\n"
-    "  if (z >= 1.0) return 1.0;\n"
-    "  return slot == 0 ? texture(t_cshadow0, vec4(d, z)) : texture(t_cshadow1, vec4(d, z)); }\n"
-    "#endif\n"
-    "#ifdef SY_ASHADOW\n" /* area lights: 8 Poisson taps (hardware PCF each) over the penumbra */
-    "const vec2 POISSON[8] = vec2[8](vec2(-0.840,-0.074), vec2(0.962,-0.195), vec2(-0.203,0.621), vec2(0.185,-0.893),\n"
-    "  vec2(-0.326,-0.406), vec2(0.473,-0.480), vec2(0.519,0.767), vec2(-0.696,0.457));\n"
-    "float shadow_area(int si, vec3 p, vec3 ngf) {\n"
-    "  vec3 q; float r; if (!shadow_coord(si, p, ngf, q, r)) return 1.0;\n"
-    "  r = max(r, 1.5 / float(textureSize(t_shadow, 0).x)); float s = 0.0;\n"
-    "  for (int k = 0; k < 8; ++k) s += texture(t_shadow, vec4(q.xy + POISSON[k] * r, float(si), q.z));\n"
-    "  return s * 0.125; }\n"
-    "#endif\n"
-    "#ifdef SY_AREA\n"
-    /* Heitz et al. 2016, clipless form: the vector form factor of the (transformed) polygon, its
-     * horizon clipping looked up as a sphere in ltc_2.w */
-    "vec3 edge_vec(vec3 v1, vec3 v2) { float x = dot(v1, v2), y = abs(x);\n"
-    "  float a = 0.8543985 + (0.4965155 + 0.0145206 * y) * y, b = 3.4175940 + (4.1616724 + y) * y, v = a / b;\n"
-    "  float ts = x > 0.0 ? v : 0.5 * inversesqrt(max(1.0 - x * x, 1e-7)) - v; return cross(v1, v2) * ts; }\n"
-    "float ltc_eval(mat3 Minv, vec3 P, int li, int nv) {\n"
-    "  vec3 L[4]; vec3 ctr = vec3(0.0);\n"
-    "  for (int k = 0; k < 4; ++k) { L[k] = Minv * (a_data[li * 6 + k].xyz - P); }\n"
-    "  ctr = Minv * (a_data[li * 6 + 5].xyz - P);\n"
-    "  for (int k = 0; k < 4; ++k) L[k] = normalize(L[k]);\n"
-    "  vec3 f = edge_vec(L[0], L[1]) + edge_vec(L[1], L[2]);\n"
-    "  if (nv == 4) f += edge_vec(L[2], L[3]) + edge_vec(L[3], L[0]); else f += edge_vec(L[2], L[0]);\n"
-    "  if (dot(f, ctr) < 0.0) f = -f;\n"
-    "  float len = length(f); if (!(len > 0.0)) return 0.0;\n"
-    "  float z = f.z / len; vec2 uv = vec2(z * 0.5 + 0.5, len) * (63.0 / 64.0) + 0.5 / 64.0;\n"
-    "  return len * textureLod(t_ltc2, uv, 0.0).w; }\n"
-    "#endif\n"
-    "#if defined(SY_ENV) || defined(SY_PROBE)\n"
-    /* what a reflected or refracted ray sees: the scene probe around this object (the scene and,
-     * beyond it, the environment; its mips blur for roughness) or the prefiltered environment */
-    "vec3 env_spec(vec3 d, float rough) {\n"
-    "#ifdef SY_PROBE\n"
-    "  return textureLod(t_probe, d, rough * u_probe_lod).rgb;\n"
-    "#else\n"
-    "  return textureLod(t_env_spec, d, rough * l_env.x).rgb;\n"
-    "#endif\n"
-    "}\n"
-    "#endif\n"
+    SY_GL_SHADE_LIT
     "void main() {\n"
     "  vec2 uv[2] = vec2[2](v_uv0, v_uv1);\n"
     "  vec4 base = m_base * v_col;\n"
@@ -224,127 +349,140 @@ const char *const sy_gl_main_fs =
     "    metallic = clamp(metallic, 0.0, 1.0); rough = clamp(rough, 0.0, 1.0);\n"
     "    vec3 bc = clamp(base.rgb, 0.0, 1.0);\n"
     "    float ior = m_oist.y, spec = clamp(m_oist.z, 0.0, 1.0), trans = clamp(m_oist.w, 0.0, 1.0);\n"
-    /* the path tracer's lobes: metal (Schlick on the base colour), dielectric specular
-     * spec x Schlick(f0d), diffuse base (1 - that) / pi, transmission */
-    "    float r0 = (ior - 1.0) / (ior + 1.0); float f0d = r0 * r0;\n"
-    "    float w_metal = metallic, w_diel = (1.0 - metallic) * (1.0 - trans), w_trans = (1.0 - metallic) * trans;\n"
-    "    vec3 kd = bc * w_diel;\n"
-    "    float a = max(rough * rough, 1e-4), a2 = a * a;\n"
-    "    float nv = max(dot(ns, wo), 1e-4);\n"
-    "#ifdef SY_LIGHTS\n"
-    "#ifndef SY_NLIGHTS\n"
-    "#define SY_NLIGHTS l_count.x\n"
+    "    float ao = 1.0;\n"
+    "#if defined(SY_TEX) && (defined(SY_AREA) || defined(SY_ENV) || defined(SY_PROBE))\n"
+    "    if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, tuv(3, uv[m_tex.w])).r - 1.0);\n"
     "#endif\n"
-    "    for (int i = 0; i < SY_NLIGHTS; ++i) {\n"
-    "      Light l = l_lights[i]; int type = int(l.pos_type.w); vec3 wi, e;\n"
-    "      if (type == 3) { wi = -l.dir_range.xyz; e = l.radiant.rgb; }\n"
-    "      else {\n"
-    "        wi = l.pos_type.xyz - v_wpos; float d2 = dot(wi, wi); if (!(d2 > 0.0)) continue;\n"
-    "        float d = sqrt(d2); wi /= d; float att = 1.0 / d2;\n"
-    "        if (l.dir_range.w > 0.0) { float x = d / l.dir_range.w; float w = clamp(1.0 - x*x*x*x, 0.0, 1.0); att *= w * w; }\n"
-    "        if (type == 2) { float cd = -dot(l.dir_range.xyz, wi); float s = clamp(cd * l.cone.x + l.cone.y, 0.0, 1.0); att *= s * s; }\n"
-    "        if (!(att > 0.0)) continue; e = l.radiant.rgb * att;\n"
-    "      }\n"
-    "      float cs = dot(ns, wi); if (cs <= 0.0 || dot(ngf, wi) <= 0.0) continue;\n"
-    "#ifdef SY_SHADOW\n"
-    "      int si = int(l.cone.z), ci = int(l.cone.w);\n"
-    "      float vis = si >= 0 ? shadow_vis(si, v_wpos, ngf) : ci >= 0 ? cube_vis(ci, l.pos_type.xyz, v_wpos, ngf) : 1.0;\n"
-    "      if (vis <= 0.0) continue;\n"
-    "#else\n"
-    "      float vis = 1.0;\n"
-    "#endif\n"
-    "      vec3 h = normalize(wi + wo); float vh = max(dot(wo, h), 0.0);\n"
-    "      float fd = spec * schlick1(f0d, vh);\n"
-    "      vec3 f = kd * (1.0 - fd) * INV_PI;\n"
-    "      if (rough > 0.0) {\n"
-    "        float nl = cs, nh = max(dot(ns, h), 0.0);\n"
-    "        float dd = nh * nh * (a2 - 1.0) + 1.0; float D = a2 * INV_PI / (dd * dd);\n"
-    "        float V = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));\n"
-    "        f += (schlick(bc, vh) * w_metal + vec3(w_diel * fd)) * (D * V);\n"
-    "      }\n"
-    "      L += e * f * cs * vis;\n"
-    "    }\n"
-    "#endif\n"
-    "#if defined(SY_AREA) || defined(SY_ENV) || defined(SY_PROBE)\n"
-    /* split-sum terms: A, B of the GGX BRDF for this view and roughness */
-    "    vec2 ab = textureLod(t_brdf, vec2(nv, rough) * (31.0 / 32.0) + 0.5 / 32.0, 0.0).rg;\n"
-    "    float fd_avg = spec * (f0d * ab.x + ab.y);\n"
-    "    vec3 fspec = (bc * ab.x + ab.y) * w_metal + vec3(w_diel * fd_avg);\n"
-    "#endif\n"
-    "#ifdef SY_AREA\n"
-    "    {\n"
-    "      vec2 luv = vec2(rough, sqrt(1.0 - nv)) * (63.0 / 64.0) + 0.5 / 64.0;\n"
-    "      vec4 t1 = textureLod(t_ltc1, luv, 0.0), t2 = textureLod(t_ltc2, luv, 0.0);\n"
-    "      vec3 T1 = normalize(wo - ns * dot(wo, ns)); vec3 T2 = cross(ns, T1);\n"
-    "      mat3 frame = transpose(mat3(T1, T2, ns));\n"
-    "      mat3 Minv = mat3(vec3(t1.x, 0.0, t1.y), vec3(0.0, 1.0, 0.0), vec3(t1.z, 0.0, t1.w)) * frame;\n"
-    /* the LTC norm replaces A, B for the polygon's specular (F0 t2.x + (1 - F0) t2.y) */
-    "      vec3 fl = (bc * t2.x + (1.0 - bc) * t2.y) * w_metal + vec3(w_diel * spec * (f0d * t2.x + (1.0 - f0d) * t2.y));\n"
-    "      vec3 kdl = kd * (1.0 - fd_avg);\n"
-    "      for (int i = 0; i < a_count.x; ++i) {\n"
-    "        vec4 v0 = a_data[i * 6], rad = a_data[i * 6 + 4], cen = a_data[i * 6 + 5];\n"
-    "        int nvx = int(v0.w);\n"
-    "        vec3 ln = cross(a_data[i * 6 + 1].xyz - v0.xyz, a_data[i * 6 + 2].xyz - v0.xyz);\n"
-    "        float side = dot(v_wpos - v0.xyz, ln);\n"
-    "        if (!(abs(side) > 1e-5 * dot(ln, ln) + 1e-9) || (side < 0.0 && rad.w < 0.5)) continue;\n"
-    "#ifdef SY_ASHADOW\n"
-    "        int si = int(cen.w); float vis = si >= 0 ? shadow_area(si, v_wpos, ngf) : 1.0;\n"
-    "        if (vis <= 0.0) continue;\n"
-    "#else\n"
-    "        float vis = 1.0;\n"
-    "#endif\n"
-    "        float d = ltc_eval(frame, v_wpos, i, nvx);\n"
-    "        float s = rough > 0.0 ? ltc_eval(Minv, v_wpos, i, nvx) : 0.0;\n"
-    "        L += rad.rgb * (kdl * d + fl * s) * vis;\n"
-    "      }\n"
-    "      float ao = 1.0;\n"
-    "#ifdef SY_TEX\n"
-    "      if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, tuv(3, uv[m_tex.w])).r - 1.0);\n"
-    "#endif\n"
-    /* the area lights' indirect light (sy_gl_set_ambient), stronger on surfaces facing the way the
-     * emitters shine (they see the directly lit surfaces), weaker on those facing the emitters; not
-     * on emitters (the estimate counts them as sources only) */
-    "      if (m_modes.w == 0) L += (kdl + fspec) * l_env.yzw * (ao * (1.0 + 0.75 * dot(ns, a_dir.xyz)));\n"
-    "    }\n"
-    "#endif\n"
-    "#if defined(SY_ENV) || defined(SY_PROBE)\n"
-    "    {\n"
-    "      float ao = 1.0;\n"
-    "#ifdef SY_TEX\n"
-    "      if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, tuv(3, uv[m_tex.w])).r - 1.0);\n"
-    "#endif\n"
-    "      vec3 R = reflect(-wo, ns);\n"
-    "#ifdef SY_ENV\n"
-    "      vec3 irr = textureLod(t_env_irr, ns, 0.0).rgb;\n" /* cosine-weighted mean radiance = E / pi */
-    "#else\n"
-    "      vec3 irr = vec3(0.0);\n"
-    "#endif\n"
-    /* the GGX lobe's dominant direction leans from R towards N as roughness grows (Lagarde and
-     * de Rousiers 2014, "Moving Frostbite to PBR", eq. 55); looking up R alone lights rough
-     * surfaces from below the horizon */
-    "      float ga = rough * rough; vec3 Rd = normalize(mix(ns, R, (1.0 - ga) * (sqrt(1.0 - ga) + ga)));\n"
-    "      vec3 env = kd * (1.0 - fd_avg) * irr + fspec * env_spec(Rd, rough);\n"
-    "#ifdef SY_TRANS\n"
-    "      {\n" /* glass: Fresnel reflection + refraction of the environment */
-    "        float F = schlick1(f0d, nv);\n"
-    /* through a solid: refract in, cross a sphere tangent to this point, refract out (exact for
-     * a glass ball: the environment appears inverted as in the path tracer) */
-    "        float eta = max(ior, 1.0); vec3 T = refract(-wo, ns, 1.0 / eta);\n"
-    "        if (dot(T, T) == 0.0) T = R; else {\n"
-    "          vec3 n2 = ns - 2.0 * dot(ns, T) * T;\n" /* the exit normal (outward) */
-    "          vec3 T2 = refract(T, -n2, eta); T = dot(T2, T2) > 0.0 ? T2 : reflect(T, -n2);\n"
-    "        }\n"
-    "        env += w_trans * (F * env_spec(R, rough) + (1.0 - F) * bc * env_spec(T, rough));\n"
-    "      }\n"    "#endif\n"
-    "      L += env * ao;\n"
-    "    }\n"
-    "#endif\n"
+    "    L += shade_lit(v_wpos, ngf, ns, wo, bc, metallic, rough, ior, spec, trans, ao, m_modes.w != 0);\n"
     "  }\n"
     "#endif\n"
     "  o_color = vec4(L * alpha, alpha);\n"
     /* linear view depth from the window coordinates: 1/w_clip = 1/z_view in perspective, the
      * inverse depth mapping in orthographic views; one varying less */
     "  o_depth = u_ortho ? -((gl_FragCoord.z * 2.0 - 1.0) - u_ortho_z.y) / u_ortho_z.x : 1.0 / gl_FragCoord.w;\n"
+    "}\n";
+
+/* Deferred shading (sy_gl_device.c, "deferred shading"). Under MSAA a software rasterizer runs a
+ * fragment shader once per pixel for every triangle that touches any of the pixel's samples, in
+ * blocks of pixels: on meshes of a few pixels per triangle the forward shader runs many times per
+ * pixel, and every instruction of it counts. Opaque, untextured surfaces of meshes without colours
+ * therefore write only what their shading needs into the multisampled colour target, with as few
+ * instructions as possible (the geometry pass below), and one full-screen pass
+ * (sy_gl_deferred_fs) shades each distinct surface of a pixel once and resolves.
+ *
+ * G-buffer sample (RGBA32F, where forward-shaded samples hold their colour, alpha >= 0):
+ *   x, y, z  the interpolated vertex normal (world space, as interpolated: neither normalised nor
+ *            flipped), or for a mesh without normals the geometric normal (world space, facing
+ *            the viewer)
+ *   w        -(1 + key + 1024 q), an exact integer: key = front + 2 x (xyz is the geometric
+ *            normal) + 4 x material row (< 256), q the geometric normal facing the viewer, world
+ *            space, octahedral, 7 + 7 bits on a grid with a level at 0 (axis-aligned planes
+ *            exact; it only picks the side a light must be on and the direction of the shadow
+ *            offset); negative marks a G-buffer sample
+ * and the linear depth target holds the view depth at the pixel centre, as in the forward pass.
+ * The geometric normal comes from the screen-space derivatives of the one quantity that is affine
+ * over a triangle, 1/depth (perspective) or depth (orthographic), instead of from an interpolated
+ * position (three varyings fewer). */
+#define SY_GL_OCT                                                                                           \
+    "vec2 sgn2(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }\n"               \
+    "vec2 oct_enc(vec3 n) { n /= abs(n.x) + abs(n.y) + abs(n.z); return n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * sgn2(n.xy); }\n" \
+    "vec3 oct_dec(vec2 e) { vec3 v = vec3(e, 1.0 - abs(e.x) - abs(e.y));\n"                                  \
+    "  if (v.z < 0.0) v.xy = (1.0 - abs(v.yx)) * sgn2(v.xy); return normalize(v); }\n"
+
+const char *const sy_gl_gbuf_vs =
+    "#version 330 core\n"
+    "layout(location=0) in vec3 a_pos; layout(location=1) in vec3 a_nrm;\n"
+    "uniform mat3 u_normal_mat; uniform mat4 u_mvp; out vec3 v_nrm;\n"
+    "void main() { v_nrm = u_normal_mat * a_nrm; gl_Position = u_mvp * vec4(a_pos, 1.0); }\n";
+
+/* u_xa, u_xb: a window position -> the view plane at distance 1 (perspective) or in metres
+ * (SY_ORTHO), X = gl_FragCoord.xy u_xa + u_xb; u_ppu: pixels per such unit; u_ortho_z (SY_ORTHO):
+ * proj[10], proj[14]; u_key: 4 x material row. Uniform choices are variants (SY_ORTHO), not
+ * branches: a software rasterizer pays for both sides. */
+const char *const sy_gl_gbuf_fs =
+    "#version 330 core\n" SY_GL_OCT
+    "uniform vec2 u_xa; uniform vec2 u_xb; uniform vec2 u_ppu; uniform bool u_mirror; uniform bool u_has_normals;\n"
+    "uniform vec3 u_ortho_z; uniform float u_key; uniform mat3 u_to_world;\n"
+    "in vec3 v_nrm;\n"
+    "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
+    "void main() {\n"
+    "  bool front = gl_FrontFacing != u_mirror;\n"
+    /* perspective: 1/d = A X + B Y + C over the triangle, whose plane's normal facing the eye is
+     * (-A, -B, C); orthographic: d = A X + B Y + C, normal (A, B, 1) */
+    "#ifdef SY_ORTHO\n"
+    "  float d = -((gl_FragCoord.z * 2.0 - 1.0) - u_ortho_z.y) / u_ortho_z.x;\n"
+    "  vec3 ngf = vec3(vec2(dFdx(d), dFdy(d)) * u_ppu, 1.0);\n"
+    "#else\n"
+    "  float W = gl_FragCoord.w, d = 1.0 / W; vec2 g = vec2(dFdx(W), dFdy(W)) * u_ppu;\n"
+    "  vec3 ngf = vec3(-g, W - dot(g, gl_FragCoord.xy * u_xa + u_xb));\n"
+    "#endif\n"
+    "  ngf = u_to_world * ngf;\n"
+    "  if (!(dot(ngf, ngf) > 0.0)) ngf = u_to_world[2];\n"
+    "  vec2 q = floor((oct_enc(ngf) * 0.5 + 0.5) * 126.0 + 0.5);\n"
+    "  bool raw = u_has_normals && dot(v_nrm, v_nrm) > 0.0;\n"
+    "  o_color = vec4(raw ? v_nrm : ngf,\n"
+    "                 -(1.0 + u_key + (front ? 1.0 : 0.0) + (raw ? 0.0 : 2.0) + 1024.0 * (q.x * 128.0 + q.y)));\n"
+    "  o_depth = d;\n"
+    "}\n";
+
+/* The deferred pass: a full-screen triangle (sy_gl_resolve_vs) over the multisampled targets. Per
+ * pixel it groups the G-buffer samples into surfaces (same material, side and kind of normal,
+ * depths within 0.1 %, normals within 1.8 degrees: the triangles of one smooth mesh are one
+ * surface, the facets of a faceted one are not), shades each surface once at the pixel centre (where the forward pass shades it too),
+ * passes forward-shaded samples through, and averages colour and takes the nearest depth as the
+ * resolve does. SY_SAMPLES is the target's sample count; the lighting defines are the frame's, as
+ * for the forward variants. The material table (t_mtab, RGBA32F) holds per row: base colour,
+ * emission, (metallic, roughness, -, -), (-, ior, specular, transmission), (alpha mode, unlit,
+ * double-sided, emissive). */
+const char *const sy_gl_deferred_fs =
+    "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_SHADING_DECLS SY_GL_OCT
+    "uniform sampler2DMS t_gcol; uniform sampler2DMS t_gdepth; uniform sampler2D t_mtab;\n"
+    "uniform vec4 u_unproj; uniform mat4 u_inv_view; uniform vec2 u_px;\n" /* u_px: 2 / target size */
+    "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
+    SY_GL_SHADE_LIT
+    /* g: the sample, key its key, d its depth, nu its normalised xyz */
+    "vec3 shade_sample(vec4 g, float key, float d, vec3 nu, vec2 ndc) {\n"
+    "  float row = floor(key * 0.25), bits = key - 4.0 * row; bool front = mod(bits, 2.0) > 0.5, geo = bits > 1.5;\n"
+    "  int r = int(row);\n"
+    "  vec4 base = texelFetch(t_mtab, ivec2(0, r), 0), modes = texelFetch(t_mtab, ivec2(4, r), 0);\n"
+    "  vec3 L = vec3(0.0);\n"
+    "  if (modes.w != 0.0 && (front || modes.z != 0.0)) L = texelFetch(t_mtab, ivec2(1, r), 0).rgb;\n"
+    "  if (modes.y != 0.0) return L + base.rgb;\n"
+    "#ifdef SY_LIT\n"
+    "  vec4 mrna = texelFetch(t_mtab, ivec2(2, r), 0), oist = texelFetch(t_mtab, ivec2(3, r), 0);\n"
+    "  vec3 pv = vec3((ndc + u_unproj.zw) * (u_ortho ? 1.0 : d) / u_unproj.xy, -d);\n"
+    "  vec3 P = (u_inv_view * vec4(pv, 1.0)).xyz;\n"
+    "  vec3 wo = u_ortho ? -u_cam_fwd : normalize(u_cam_pos - P);\n"
+    "  float c = -g.w - 1.0, qq = (c - key) * (1.0 / 1024.0), qy = mod(qq, 128.0), qx = (qq - qy) * (1.0 / 128.0);\n"
+    "  vec3 ngf = oct_dec(vec2(qx, qy) * (2.0 / 126.0) - 1.0);\n"
+    "  vec3 ns = geo ? nu : (front ? nu : -nu);\n"
+    "  L += shade_lit(P, ngf, ns, wo, clamp(base.rgb, 0.0, 1.0), clamp(mrna.x, 0.0, 1.0), clamp(mrna.y, 0.0, 1.0),\n"
+    "                 oist.y, clamp(oist.z, 0.0, 1.0), clamp(oist.w, 0.0, 1.0), 1.0, modes.w != 0.0);\n"
+    "#endif\n"
+    "  return L;\n"
+    "}\n"
+    "void main() {\n"
+    "  ivec2 p = ivec2(gl_FragCoord.xy); vec2 ndc = gl_FragCoord.xy * u_px - 1.0;\n"
+    "  vec4 g[SY_SAMPLES]; float z[SY_SAMPLES], key[SY_SAMPLES]; vec3 nu[SY_SAMPLES];\n"
+    "  float dmin = uintBitsToFloat(0x7F800000u); vec4 c = vec4(0.0); int todo = 0;\n"
+    "  for (int i = 0; i < SY_SAMPLES; ++i) {\n"
+    "    g[i] = texelFetch(t_gcol, p, i); z[i] = texelFetch(t_gdepth, p, i).r; dmin = min(dmin, z[i]);\n"
+    "    key[i] = mod(-g[i].w - 1.0, 1024.0); nu[i] = normalize(g[i].xyz);\n"
+    "    if (g[i].w >= 0.0) c += g[i]; else todo |= 1 << i;\n"
+    "  }\n"
+    /* a loop, not an if per sample: a software rasterizer runs both sides of a branch for the whole
+     * SIMD vector of pixels, but leaves a loop when no pixel needs another turn */
+    "  while (todo != 0) {\n"
+    "    vec4 gi = vec4(0.0); float zi = 0.0, ki = 0.0; vec3 ni = vec3(0.0); bool found = false;\n"
+    "    for (int k = 0; k < SY_SAMPLES; ++k)\n"
+    "      if (!found && (todo & (1 << k)) != 0) { gi = g[k]; zi = z[k]; ki = key[k]; ni = nu[k]; found = true; }\n"
+    "    float n = 0.0;\n"
+    "    for (int k = 0; k < SY_SAMPLES; ++k)\n"
+    "      if ((todo & (1 << k)) != 0 && key[k] == ki && abs(z[k] - zi) <= 1e-3 * zi && dot(nu[k], ni) > 0.9995) {\n"
+    "        todo &= ~(1 << k); n += 1.0; }\n"
+    "    c += vec4(shade_sample(gi, ki, zi, ni, ndc) * n, n);\n"
+    "  }\n"
+    "  o_color = c / float(SY_SAMPLES); o_depth = dmin;\n"
     "}\n";
 
 const char *const sy_gl_shadow_vs =

@@ -11,6 +11,8 @@ extern const char *const sy_gl_shadow_vs, *const sy_gl_shadow_fs;
 extern const char *const sy_gl_resolve_vs, *const sy_gl_resolve_fs; /* resolve_vs: a full-screen triangle */
 extern const char *const sy_gl_sky_fs; /* with sy_gl_resolve_vs */
 extern const char *const sy_gl_floor_vs, *const sy_gl_floor_fs;
+extern const char *const sy_gl_gbuf_vs, *const sy_gl_gbuf_fs; /* deferred shading: the geometry pass */
+extern const char *const sy_gl_deferred_fs; /* ... its shading and resolve pass, with sy_gl_resolve_vs */
 
 /* Compiles and links; fs_defines (NULL = none, e.g. "#define SY_MASK 1\n") is inserted after the
  * #version line of both stages. On failure returns SY_GL_ERROR_GL with "<name> shader: <stage> compile

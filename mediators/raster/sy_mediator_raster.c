@@ -755,6 +755,8 @@ static const sy_param_decl raster_params[] = {
     {"window_width", SY_PARAM_INT, 1, 16384, "640", NULL, "gl=glfw: window width", 0},
     {"window_height", SY_PARAM_INT, 1, 16384, "480", NULL, "gl=glfw: window height", 0},
     {"indirect", SY_PARAM_BOOL, 0, 0, "1", NULL, "emitters' indirect light as an ambient estimate (0: direct light only)", 0},
+    {"deferred", SY_PARAM_BOOL, 0, 0, "1", NULL,
+     "with MSAA, shade opaque untextured surfaces once per pixel after the geometry pass (0: all forward)", 0},
 };
 static const sy_param_table raster_table = SY_PARAM_TABLE(raster_params);
 
@@ -762,7 +764,7 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
 {
     *state_out = NULL;
     long msaa = 4, shadow = 2048, max_tex = 0, ww = 640, wh = 480;
-    bool indirect = true;
+    bool indirect = true, deferred = true;
     sy_result r;
     const sy_param_table *t = &raster_table;
     const char *gl = "osmesa";
@@ -772,7 +774,8 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
         (r = sy_param_int(t, args->params, "max_texture_size", &max_tex, err)) ||
         (r = sy_param_int(t, args->params, "window_width", &ww, err)) ||
         (r = sy_param_int(t, args->params, "window_height", &wh, err)) ||
-        (r = sy_param_bool(t, args->params, "indirect", &indirect, err)))
+        (r = sy_param_bool(t, args->params, "indirect", &indirect, err)) ||
+        (r = sy_param_bool(t, args->params, "deferred", &deferred, err)))
         return r;
     if (!sy_gl_provider_parse(gl, &provider)) /* the table's enum lists the same names */
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "raster: parameter gl=%s: expected osmesa, egl or glfw", gl);
@@ -792,7 +795,8 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
                             .window_width = (uint32_t)ww,
                             .window_height = (uint32_t)wh,
                             .log = log_warning,
-                            .log_user = st};
+                            .log_user = st,
+                            .forward = !deferred};
     sy_gl_result gr = sy_gl_device_create(&dd, &st->dev, e, sizeof e);
     if (gr != SY_GL_OK) {
         free(st);
@@ -847,6 +851,7 @@ void sy_mediator_raster_counters_get(void *state, sy_mediator_raster_counters *o
     out->draw_calls = gs.draw_calls;
     out->triangles_drawn = gs.triangles_drawn;
     out->instances_culled = gs.instances_culled;
+    out->deferred_draws = gs.deferred_draws;
 }
 
 const char *sy_mediator_raster_info(void *state) { return sy_gl_device_info(((raster_state *)state)->dev); }
