@@ -17,7 +17,8 @@
  *   sy_gl_device    owns the GL context and every object; one per thread at a time.
  *   sy_gl_mesh      vertex + index buffers (VBO/IBO), uploaded once at creation.
  *   sy_gl_texture   RGBA8 / sRGB8_ALPHA8 / RGBA32F texture with mipmaps and its sampler state.
- *   sy_gl_material  glTF metallic-roughness material; one uniform buffer (UBO) per material.
+ *   sy_gl_material  glTF metallic-roughness material; one uniform buffer (UBO) per material (and a
+ *                   row of the deferred shading pass's material table, see sy_gl_device_desc.forward).
  *   sy_gl_instance  a mesh placed with a model matrix and a material.
  *   sy_gl_light     point / spot / directional light (KHR_lights_punctual units); directional and
  *                   spot lights cast shadow-mapped shadows.
