@@ -20,35 +20,8 @@
 #define W 192
 #define H 144
 static char e[4096];
+#include "gl_sphere.h" /* after e, which it uses */
 static float img[2][W * H * 4], dep[2][W * H];
-
-/* A sphere of radius 1 with 2 seg (seg - 1) triangles; normals (smooth) or none (faceted). */
-static sy_gl_mesh sphere(sy_gl_device *d, uint32_t seg, bool normals)
-{
-    uint32_t nv = (seg + 1) * (seg + 1), nt = 0;
-    float *p = malloc(nv * 3 * sizeof *p), *n = malloc(nv * 3 * sizeof *n);
-    uint32_t *ix = malloc((size_t)seg * seg * 6 * sizeof *ix);
-    if (!p || !n || !ix) exit(1);
-    for (uint32_t i = 0; i <= seg; ++i)
-        for (uint32_t j = 0; j <= seg; ++j) {
-            float th = 3.14159265f * (float)i / (float)seg, ph = 6.2831853f * (float)j / (float)seg;
-            float *v = p + 3 * (i * (seg + 1) + j), *nn = n + 3 * (i * (seg + 1) + j);
-            nn[0] = sinf(th) * cosf(ph), nn[1] = cosf(th), nn[2] = sinf(th) * sinf(ph);
-            memcpy(v, nn, 3 * sizeof *v);
-        }
-    for (uint32_t i = 0; i < seg; ++i)
-        for (uint32_t j = 0; j < seg; ++j) {
-            uint32_t a = i * (seg + 1) + j, b = a + seg + 1;
-            if (i > 0) ix[3 * nt] = a, ix[3 * nt + 1] = b, ix[3 * nt + 2] = a + 1, nt++;
-            if (i + 1 < seg) ix[3 * nt] = a + 1, ix[3 * nt + 1] = b, ix[3 * nt + 2] = b + 1, nt++;
-        }
-    sy_gl_mesh_desc md = {.positions = p, .normals = normals ? n : NULL, .indices = ix, .vertex_count = nv,
-                          .triangle_count = nt};
-    sy_gl_mesh m;
-    MUST(sy_gl_mesh_create(d, &md, &m, e, sizeof e));
-    free(p), free(n), free(ix);
-    return m;
-}
 
 static sy_gl_mesh floor_quad(sy_gl_device *d)
 {
@@ -93,8 +66,8 @@ static scene build(bool forward)
     sy_gl_device_desc dd = {.provider = SY_GL_PROVIDER_OSMESA, .msaa = 4, .shadow_map_size = 512, .forward = forward};
     MUST(sy_gl_device_create(&dd, &s.d, e, sizeof e));
     sy_gl_device *d = s.d;
-    s.smooth = sphere(d, 96, true);
-    sy_gl_mesh faceted = sphere(d, 64, false);
+    s.smooth = gl_test_sphere(d, 96, 0.0f, true, NULL);
+    sy_gl_mesh faceted = gl_test_sphere(d, 64, 0.0f, false, NULL);
     s.red = material(d, 0.8f, 0.1f, 0.1f, 0.0f, 0.35f);
     sy_gl_material metal = material(d, 0.9f, 0.7f, 0.3f, 1.0f, 0.55f); /* rough enough to get no scene probe */
     sy_gl_material_desc ud;

@@ -14,36 +14,8 @@
 
 #define N 96
 static char e[4096];
+#include "gl_sphere.h" /* after e, which it uses */
 static float rgba[2][N * N * 4], depth[2][N * N];
-
-/* A unit UV sphere of 2 * seg * (seg - 1) triangles with a wavy radius (not trivially flat). */
-static sy_gl_mesh sphere(sy_gl_device *d, uint32_t seg, uint32_t *tris)
-{
-    uint32_t nv = (seg + 1) * (seg + 1), nt = 0;
-    float *p = malloc(nv * 3 * sizeof *p), *n = malloc(nv * 3 * sizeof *n);
-    uint32_t *ix = malloc((size_t)seg * seg * 6 * sizeof *ix);
-    if (!p || !n || !ix) exit(1);
-    for (uint32_t i = 0; i <= seg; ++i)
-        for (uint32_t j = 0; j <= seg; ++j) {
-            float th = 3.14159265f * (float)i / (float)seg, ph = 6.2831853f * (float)j / (float)seg;
-            float r = 1.0f + 0.03f * sinf(7.0f * th) * cosf(5.0f * ph);
-            float *v = p + 3 * (i * (seg + 1) + j), *nn = n + 3 * (i * (seg + 1) + j);
-            nn[0] = sinf(th) * cosf(ph), nn[1] = cosf(th), nn[2] = sinf(th) * sinf(ph);
-            v[0] = r * nn[0], v[1] = r * nn[1], v[2] = r * nn[2];
-        }
-    for (uint32_t i = 0; i < seg; ++i)
-        for (uint32_t j = 0; j < seg; ++j) {
-            uint32_t a = i * (seg + 1) + j, b = a + seg + 1;
-            if (i > 0) ix[3 * nt] = a, ix[3 * nt + 1] = a + 1, ix[3 * nt + 2] = b, nt++;
-            if (i + 1 < seg) ix[3 * nt] = a + 1, ix[3 * nt + 1] = b + 1, ix[3 * nt + 2] = b, nt++;
-        }
-    sy_gl_mesh_desc md = {.positions = p, .normals = n, .indices = ix, .vertex_count = nv, .triangle_count = nt};
-    sy_gl_mesh m;
-    MUST(sy_gl_mesh_create(d, &md, &m, e, sizeof e));
-    free(p), free(n), free(ix);
-    *tris = nt;
-    return m;
-}
 
 static void translate(float *m, float x, float y, float z)
 {
@@ -86,7 +58,7 @@ int main(void)
     sy_gl_device_desc dd = {.provider = SY_GL_PROVIDER_OSMESA, .msaa = 1};
     MUST(sy_gl_device_create(&dd, &d, e, sizeof e));
     uint32_t tris = 0;
-    sy_gl_mesh big = sphere(d, 256, &tris);
+    sy_gl_mesh big = gl_test_sphere(d, 256, 0.03f, true, &tris);
     CHECK(tris >= SY_GL_LOD_MIN_TRIANGLES, "the sphere has %u triangles", tris);
     sy_gl_material_desc mdsc;
     sy_gl_material_desc_init(&mdsc);
@@ -129,7 +101,7 @@ int main(void)
     /* A small mesh has no levels: all its triangles at any distance. */
     MUST(sy_gl_instance_destroy(d, inst));
     uint32_t small_tris = 0;
-    sy_gl_mesh small = sphere(d, 32, &small_tris);
+    sy_gl_mesh small = gl_test_sphere(d, 32, 0.03f, true, &small_tris);
     CHECK(small_tris < SY_GL_LOD_MIN_TRIANGLES, "small sphere: %u triangles", small_tris);
     id.mesh = small;
     translate(id.transform, 0, 0, 0);
