@@ -222,7 +222,7 @@ struct sy_gl_device {
     bool forward; /* sy_gl_device_desc.forward */
     struct { /* the G-buffer pass: perspective, orthographic */
         GLuint prog;
-        GLint normal_mat, mvp, xa, xb, ppu, to_world, ortho_z, mirror, has_normals, key;
+        GLint normal_mat, mvp, ppu, ortho_z, mirror, has_normals, key;
     } ug[2];
     struct {
         int var; /* the lighting variant bits */
@@ -776,10 +776,7 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
         if (!g) continue;
         dev->ug[k].normal_mat = gl->GetUniformLocation(g, "u_normal_mat");
         dev->ug[k].mvp = gl->GetUniformLocation(g, "u_mvp");
-        dev->ug[k].xa = gl->GetUniformLocation(g, "u_xa");
-        dev->ug[k].xb = gl->GetUniformLocation(g, "u_xb");
         dev->ug[k].ppu = gl->GetUniformLocation(g, "u_ppu");
-        dev->ug[k].to_world = gl->GetUniformLocation(g, "u_to_world");
         dev->ug[k].ortho_z = gl->GetUniformLocation(g, "u_ortho_z");
         dev->ug[k].mirror = gl->GetUniformLocation(g, "u_mirror");
         dev->ug[k].has_normals = gl->GetUniformLocation(g, "u_has_normals");
@@ -2250,16 +2247,9 @@ static void draw_gbuf(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const m
         if (!dc->gbuf_view_set) {
             float unproj[4], px[2];
             view_unproject(dc->v, dev->t.w, dev->t.h, unproj, px);
-            /* X = (gl_FragCoord.xy px - 1 + unproj.zw) / unproj.xy */
-            const float xa[2] = {px[0] / unproj[0], px[1] / unproj[1]};
-            const float xb[2] = {(unproj[2] - 1.0f) / unproj[0], (unproj[3] - 1.0f) / unproj[1]};
-            const float ppu[2] = {1.0f / xa[0], 1.0f / xa[1]};
-            const float *w = dc->v->view; /* its rotation's transpose takes view directions to the world */
-            const float to_world[9] = {w[0], w[4], w[8], w[1], w[5], w[9], w[2], w[6], w[10]};
-            gl->Uniform2fv(dev->ug[k].xa, 1, xa);
-            gl->Uniform2fv(dev->ug[k].xb, 1, xb);
+            /* the view plane's X = (gl_FragCoord.xy px - 1 + unproj.zw) / unproj.xy: pixels per unit */
+            const float ppu[2] = {unproj[0] / px[0], unproj[1] / px[1]};
             gl->Uniform2fv(dev->ug[k].ppu, 1, ppu);
-            gl->UniformMatrix3fv(dev->ug[k].to_world, 1, GL_FALSE, to_world);
             gl->Uniform3fv(dev->ug[k].ortho_z, 1, dc->ortho_z);
             dc->gbuf_view_set = true;
         }

@@ -370,58 +370,58 @@ const char *const sy_gl_main_fs =
  * instructions as possible (the geometry pass below), and one full-screen pass
  * (sy_gl_deferred_fs) shades each distinct surface of a pixel once and resolves.
  *
- * G-buffer sample (RGBA32F, where forward-shaded samples hold their colour, alpha >= 0):
- *   x, y, z  the interpolated vertex normal (world space, as interpolated: neither normalised nor
- *            flipped), or for a mesh without normals the geometric normal (world space, facing
- *            the viewer)
- *   w        -(1 + key + 1024 q), an exact integer: key = front + 2 x (xyz is the geometric
- *            normal) + 4 x material row (< 256), q the geometric normal facing the viewer, world
- *            space, octahedral, 7 + 7 bits on a grid with a level at 0 (axis-aligned planes
- *            exact; it only picks the side a light must be on and the direction of the shadow
- *            offset); negative marks a G-buffer sample
- * and the linear depth target holds the view depth at the pixel centre, as in the forward pass.
- * The geometric normal comes from the screen-space derivatives of the one quantity that is affine
- * over a triangle, 1/depth (perspective) or depth (orthographic), instead of from an interpolated
- * position (three varyings fewer). */
-#define SY_GL_OCT                                                                                           \
-    "vec2 sgn2(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }\n"               \
-    "vec2 oct_enc(vec3 n) { n /= abs(n.x) + abs(n.y) + abs(n.z); return n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * sgn2(n.xy); }\n" \
+ * G-buffer sample, where forward-shaded samples hold their colour (alpha >= 0) and depth:
+ *   colour (RGBA32F):
+ *     x, y  the interpolated vertex normal (world space), octahedral (the encoding normalises it;
+ *           not flipped); for a mesh without normals or where they interpolate to zero ("geo"),
+ *           the slope h itself (below), the geometric normal being the shading normal there
+ *     z     the slope h of the triangle's plane as an exact integer 4096 qx + qy, q = 2047 (1 + h /
+ *           (1 + |h|)) rounded (0 .. 4094; h = 0 exact; the step is at most 0.06 degrees of normal
+ *           at any angle). From h the shading pass rebuilds the geometric normal at the pixel centre
+ *           X (view plane at distance 1, or metres when orthographic): view-space normal
+ *           (-h, 1 - h.X) (perspective) or (h, 1) (orthographic), facing the viewer
+ *     w     -(1 + key), an exact integer: key = front + 2 geo + 4 x material row (< 256); negative
+ *           marks a G-buffer sample
+ *   depth (R32F): the view depth at the pixel centre, as in the forward pass.
+ * The slope comes from the screen-space derivatives of the one quantity that is affine over a
+ * triangle, 1/depth (perspective; divided by 1/depth, so that it is a ratio of the normal's
+ * components) or depth (orthographic), instead of from an interpolated position (three varyings
+ * fewer). The geometry pass writes what the floor writes (one colour, one depth), and does as
+ * little arithmetic as it can: on triangles of a few pixels a software rasterizer runs it on whole
+ * blocks of mostly empty pixels, so each instruction costs many times what it costs in the shading
+ * pass, which turns the slope into a world-space normal. (Measured: a third target for the slope,
+ * or the slope in a wider depth target, costs as much as the arithmetic it saves.) */
+#define SY_GL_OCT_DEC                                                                                       \
     "vec3 oct_dec(vec2 e) { vec3 v = vec3(e, 1.0 - abs(e.x) - abs(e.y));\n"                                  \
-    "  if (v.z < 0.0) v.xy = (1.0 - abs(v.yx)) * sgn2(v.xy); return normalize(v); }\n"
+    "  if (v.z < 0.0) v.xy = (1.0 - abs(v.yx)) * vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);\n" \
+    "  return normalize(v); }\n"
 
 const char *const sy_gl_gbuf_vs =
     "#version 330 core\n"
     "layout(location=0) in vec3 a_pos; layout(location=1) in vec3 a_nrm;\n"
-    "uniform mat3 u_normal_mat; uniform mat4 u_mvp; out vec3 v_nrm;\n"
-    "void main() { v_nrm = u_normal_mat * a_nrm; gl_Position = u_mvp * vec4(a_pos, 1.0); }\n";
+    "uniform mat3 u_normal_mat; uniform mat4 u_mvp; uniform bool u_has_normals; out vec3 v_nrm;\n"
+    "void main() { v_nrm = u_has_normals ? u_normal_mat * a_nrm : vec3(0.0); gl_Position = u_mvp * vec4(a_pos, 1.0); }\n";
 
-/* u_xa, u_xb: a window position -> the view plane at distance 1 (perspective) or in metres
- * (SY_ORTHO), X = gl_FragCoord.xy u_xa + u_xb; u_ppu: pixels per such unit; u_ortho_z (SY_ORTHO):
- * proj[10], proj[14]; u_key: 4 x material row. Uniform choices are variants (SY_ORTHO), not
- * branches: a software rasterizer pays for both sides. */
+/* u_ppu: pixels per unit of the view plane at distance 1 (perspective) or per metre (SY_ORTHO);
+ * u_ortho_z (SY_ORTHO): proj[10], proj[14]; u_key: 4 x material row. Uniform choices are variants
+ * (SY_ORTHO), not branches: a software rasterizer pays for both sides. */
 const char *const sy_gl_gbuf_fs =
-    "#version 330 core\n" SY_GL_OCT
-    "uniform vec2 u_xa; uniform vec2 u_xb; uniform vec2 u_ppu; uniform bool u_mirror; uniform bool u_has_normals;\n"
-    "uniform vec3 u_ortho_z; uniform float u_key; uniform mat3 u_to_world;\n"
+    "#version 330 core\n"
+    "uniform vec2 u_ppu; uniform bool u_mirror; uniform vec3 u_ortho_z; uniform float u_key;\n"
     "in vec3 v_nrm;\n"
     "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
     "void main() {\n"
-    "  bool front = gl_FrontFacing != u_mirror;\n"
-    /* perspective: 1/d = A X + B Y + C over the triangle, whose plane's normal facing the eye is
-     * (-A, -B, C); orthographic: d = A X + B Y + C, normal (A, B, 1) */
     "#ifdef SY_ORTHO\n"
     "  float d = -((gl_FragCoord.z * 2.0 - 1.0) - u_ortho_z.y) / u_ortho_z.x;\n"
-    "  vec3 ngf = vec3(vec2(dFdx(d), dFdy(d)) * u_ppu, 1.0);\n"
+    "  vec2 h = vec2(dFdx(d), dFdy(d)) * u_ppu;\n"
     "#else\n"
-    "  float W = gl_FragCoord.w, d = 1.0 / W; vec2 g = vec2(dFdx(W), dFdy(W)) * u_ppu;\n"
-    "  vec3 ngf = vec3(-g, W - dot(g, gl_FragCoord.xy * u_xa + u_xb));\n"
+    "  float W = gl_FragCoord.w, d = 1.0 / W; vec2 h = vec2(dFdx(W), dFdy(W)) * (u_ppu * d);\n"
     "#endif\n"
-    "  ngf = u_to_world * ngf;\n"
-    "  if (!(dot(ngf, ngf) > 0.0)) ngf = u_to_world[2];\n"
-    "  vec2 q = floor((oct_enc(ngf) * 0.5 + 0.5) * 126.0 + 0.5);\n"
-    "  bool raw = u_has_normals && dot(v_nrm, v_nrm) > 0.0;\n"
-    "  o_color = vec4(raw ? v_nrm : ngf,\n"
-    "                 -(1.0 + u_key + (front ? 1.0 : 0.0) + (raw ? 0.0 : 2.0) + 1024.0 * (q.x * 128.0 + q.y)));\n"
+    "  vec3 n = v_nrm; float s = abs(n.x) + abs(n.y) + abs(n.z); bool geo = !(s > 0.0);\n"
+    "  vec2 e = n.xy / s; if (n.z < 0.0) e = (1.0 - abs(e.yx)) * vec2(e.x >= 0.0 ? 1.0 : -1.0, e.y >= 0.0 ? 1.0 : -1.0);\n"
+    "  vec2 q = floor(h / (1.0 + abs(h)) * 2047.0 + 2047.5);\n"
+    "  o_color = vec4(geo ? h : e, q.x * 4096.0 + q.y,\n"
+    "                 -(1.0 + u_key + (gl_FrontFacing != u_mirror ? 1.0 : 0.0) + (geo ? 2.0 : 0.0)));\n"
     "  o_depth = d;\n"
     "}\n";
 
@@ -435,13 +435,23 @@ const char *const sy_gl_gbuf_fs =
  * emission, (metallic, roughness, -, -), (-, ior, specular, transmission), (alpha mode, unlit,
  * double-sided, emissive). */
 const char *const sy_gl_deferred_fs =
-    "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_SHADING_DECLS SY_GL_OCT
+    "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_SHADING_DECLS SY_GL_OCT_DEC
     "uniform sampler2DMS t_gcol; uniform sampler2DMS t_gdepth; uniform sampler2D t_mtab;\n"
     "uniform vec4 u_unproj; uniform mat4 u_inv_view; uniform vec2 u_px;\n" /* u_px: 2 / target size */
     "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
     SY_GL_SHADE_LIT
-    /* g: the sample, key its key, d its depth, nu its normalised xyz */
-    "vec3 shade_sample(vec4 g, float key, float d, vec3 nu, vec2 ndc) {\n"
+    /* the geometric normal (view space, facing the viewer, not normalised) from a slope h at the
+     * view-plane position X of the pixel centre; never zero */
+    "vec3 geo_normal(vec2 h, vec2 X) {\n"
+    "  vec3 n = u_ortho ? vec3(h, 1.0) : vec3(-h, 1.0 - dot(h, X));\n"
+    "  return dot(n, n) > 0.0 ? n : vec3(0.0, 0.0, 1.0); }\n"
+    /* the slope stored as 4096 qx + qy */
+    "vec2 slope_dec(float qq) {\n"
+    "  float qy = mod(qq, 4096.0); vec2 t = vec2((qq - qy) * (1.0 / 4096.0), qy) * (1.0 / 2047.0) - 1.0;\n"
+    "  return t / max(1.0 - abs(t), 1e-6); }\n"
+    /* g: the sample, key its key, d its depth, nu its normalised shading normal (world) or, where
+     * the key says geo, its geometric normal (view) */
+    "vec3 shade_sample(vec4 g, float key, float d, vec3 nu, vec2 X) {\n"
     "  float row = floor(key * 0.25), bits = key - 4.0 * row; bool front = mod(bits, 2.0) > 0.5, geo = bits > 1.5;\n"
     "  int r = int(row);\n"
     "  vec4 base = texelFetch(t_mtab, ivec2(0, r), 0), modes = texelFetch(t_mtab, ivec2(4, r), 0);\n"
@@ -450,37 +460,40 @@ const char *const sy_gl_deferred_fs =
     "  if (modes.y != 0.0) return L + base.rgb;\n"
     "#ifdef SY_LIT\n"
     "  vec4 mrna = texelFetch(t_mtab, ivec2(2, r), 0), oist = texelFetch(t_mtab, ivec2(3, r), 0);\n"
-    "  vec3 pv = vec3((ndc + u_unproj.zw) * (u_ortho ? 1.0 : d) / u_unproj.xy, -d);\n"
+    "  vec3 pv = vec3(X * (u_ortho ? 1.0 : d), -d);\n"
     "  vec3 P = (u_inv_view * vec4(pv, 1.0)).xyz;\n"
     "  vec3 wo = u_ortho ? -u_cam_fwd : normalize(u_cam_pos - P);\n"
-    "  float c = -g.w - 1.0, qq = (c - key) * (1.0 / 1024.0), qy = mod(qq, 128.0), qx = (qq - qy) * (1.0 / 128.0);\n"
-    "  vec3 ngf = oct_dec(vec2(qx, qy) * (2.0 / 126.0) - 1.0);\n"
-    "  vec3 ns = geo ? nu : (front ? nu : -nu);\n"
+    "  vec3 ngf = normalize(mat3(u_inv_view) * (geo ? nu : geo_normal(slope_dec(g.z), X)));\n"
+    "  vec3 ns = geo ? ngf : (front ? nu : -nu);\n"
     "  L += shade_lit(P, ngf, ns, wo, clamp(base.rgb, 0.0, 1.0), clamp(mrna.x, 0.0, 1.0), clamp(mrna.y, 0.0, 1.0),\n"
     "                 oist.y, clamp(oist.z, 0.0, 1.0), clamp(oist.w, 0.0, 1.0), 1.0, modes.w != 0.0);\n"
     "#endif\n"
     "  return L;\n"
     "}\n"
     "void main() {\n"
-    "  ivec2 p = ivec2(gl_FragCoord.xy); vec2 ndc = gl_FragCoord.xy * u_px - 1.0;\n"
+    "  ivec2 p = ivec2(gl_FragCoord.xy); vec2 X = (gl_FragCoord.xy * u_px - 1.0 + u_unproj.zw) / u_unproj.xy;\n"
     "  vec4 g[SY_SAMPLES]; float z[SY_SAMPLES], key[SY_SAMPLES]; vec3 nu[SY_SAMPLES];\n"
     "  float dmin = uintBitsToFloat(0x7F800000u); vec4 c = vec4(0.0); int todo = 0;\n"
     "  for (int i = 0; i < SY_SAMPLES; ++i) {\n"
     "    g[i] = texelFetch(t_gcol, p, i); z[i] = texelFetch(t_gdepth, p, i).r; dmin = min(dmin, z[i]);\n"
-    "    key[i] = mod(-g[i].w - 1.0, 1024.0); nu[i] = normalize(g[i].xyz);\n"
+    "    key[i] = -g[i].w - 1.0; bool geo = mod(key[i], 4.0) > 1.5;\n"
+    "    nu[i] = geo ? normalize(geo_normal(g[i].xy, X)) : oct_dec(g[i].xy);\n"
     "    if (g[i].w >= 0.0) c += g[i]; else todo |= 1 << i;\n"
     "  }\n"
     /* a loop, not an if per sample: a software rasterizer runs both sides of a branch for the whole
-     * SIMD vector of pixels, but leaves a loop when no pixel needs another turn */
+     * SIMD vector of pixels, but leaves a loop when no pixel needs another turn. Each turn takes the
+     * first sample left and every sample of the same surface (the first one always: no turn can
+     * leave todo as it was, whatever a corrupt sample holds) */
     "  while (todo != 0) {\n"
-    "    vec4 gi = vec4(0.0); float zi = 0.0, ki = 0.0; vec3 ni = vec3(0.0); bool found = false;\n"
+    "    vec4 gi = vec4(0.0); float zi = 0.0, ki = 0.0; vec3 ni = vec3(0.0); int kf = -1;\n"
     "    for (int k = 0; k < SY_SAMPLES; ++k)\n"
-    "      if (!found && (todo & (1 << k)) != 0) { gi = g[k]; zi = z[k]; ki = key[k]; ni = nu[k]; found = true; }\n"
+    "      if (kf < 0 && (todo & (1 << k)) != 0) { gi = g[k]; zi = z[k]; ki = key[k]; ni = nu[k]; kf = k; }\n"
     "    float n = 0.0;\n"
     "    for (int k = 0; k < SY_SAMPLES; ++k)\n"
-    "      if ((todo & (1 << k)) != 0 && key[k] == ki && abs(z[k] - zi) <= 1e-3 * zi && dot(nu[k], ni) > 0.9995) {\n"
+    "      if ((todo & (1 << k)) != 0 &&\n"
+    "          (k == kf || (key[k] == ki && abs(z[k] - zi) <= 1e-3 * zi && dot(nu[k], ni) > 0.9995))) {\n"
     "        todo &= ~(1 << k); n += 1.0; }\n"
-    "    c += vec4(shade_sample(gi, ki, zi, ni, ndc) * n, n);\n"
+    "    c += vec4(shade_sample(gi, ki, zi, ni, X) * n, n);\n"
     "  }\n"
     "  o_color = c / float(SY_SAMPLES); o_depth = dmin;\n"
     "}\n";
