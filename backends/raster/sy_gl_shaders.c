@@ -375,13 +375,13 @@ const char *const sy_gl_main_fs =
  *     x, y  the interpolated vertex normal (world space), octahedral (the encoding normalises it;
  *           not flipped); for a mesh without normals or where they interpolate to zero ("geo"),
  *           the slope h itself (below), the geometric normal being the shading normal there
- *     z     the slope h of the triangle's plane as an exact integer 4096 qx + qy, q = 2047 (1 + h /
- *           (1 + |h|)) rounded (0 .. 4094; h = 0 exact; the step is at most 0.06 degrees of normal
- *           at any angle). From h the shading pass rebuilds the geometric normal at the pixel centre
- *           X (view plane at distance 1, or metres when orthographic): view-space normal
- *           (-h, 1 - h.X) (perspective) or (h, 1) (orthographic), facing the viewer
- *     w     -(1 + key), an exact integer: key = front + 2 geo + 4 x material row (< 256); negative
- *           marks a G-buffer sample
+ *     z     the slope h of the triangle's plane, its x component (exact); from h the shading pass
+ *           rebuilds the geometric normal at the pixel centre X (view plane at distance 1, or
+ *           metres when orthographic): view-space normal (-h, 1 - h.X) (perspective) or (h, 1)
+ *           (orthographic), facing the viewer
+ *     w     -(1 + key + 1024 qy), an exact integer: key = front + 2 geo + 4 x material row (< 256);
+ *           qy the slope's y component, 8191 (1 + h.y / (1 + |h.y|)) rounded (0 .. 16382; h.y = 0
+ *           exact; a step is at most 2.5e-4 radians of normal); negative marks a G-buffer sample
  *   depth (R32F): the view depth at the pixel centre, as in the forward pass.
  * The slope comes from the screen-space derivatives of the one quantity that is affine over a
  * triangle, 1/depth (perspective; divided by 1/depth, so that it is a ratio of the normal's
@@ -419,9 +419,9 @@ const char *const sy_gl_gbuf_fs =
     "#endif\n"
     "  vec3 n = v_nrm; float s = abs(n.x) + abs(n.y) + abs(n.z); bool geo = !(s > 0.0);\n"
     "  vec2 e = n.xy / s; if (n.z < 0.0) e = (1.0 - abs(e.yx)) * vec2(e.x >= 0.0 ? 1.0 : -1.0, e.y >= 0.0 ? 1.0 : -1.0);\n"
-    "  vec2 q = floor(h / (1.0 + abs(h)) * 2047.0 + 2047.5);\n"
-    "  o_color = vec4(geo ? h : e, q.x * 4096.0 + q.y,\n"
-    "                 -(1.0 + u_key + (gl_FrontFacing != u_mirror ? 1.0 : 0.0) + (geo ? 2.0 : 0.0)));\n"
+    "  float qy = floor(h.y / (1.0 + abs(h.y)) * 8191.0 + 8191.5);\n"
+    "  o_color = vec4(geo ? h : e, h.x,\n"
+    "                 -(1.0 + u_key + (gl_FrontFacing != u_mirror ? 1.0 : 0.0) + (geo ? 2.0 : 0.0) + 1024.0 * qy));\n"
     "  o_depth = d;\n"
     "}\n";
 
@@ -445,10 +445,10 @@ const char *const sy_gl_deferred_fs =
     "vec3 geo_normal(vec2 h, vec2 X) {\n"
     "  vec3 n = u_ortho ? vec3(h, 1.0) : vec3(-h, 1.0 - dot(h, X));\n"
     "  return dot(n, n) > 0.0 ? n : vec3(0.0, 0.0, 1.0); }\n"
-    /* the slope stored as 4096 qx + qy */
-    "vec2 slope_dec(float qq) {\n"
-    "  float qy = mod(qq, 4096.0); vec2 t = vec2((qq - qy) * (1.0 / 4096.0), qy) * (1.0 / 2047.0) - 1.0;\n"
-    "  return t / max(1.0 - abs(t), 1e-6); }\n"
+    /* the slope of a sample: x as stored, y from its 14 bits beside the key */
+    "vec2 slope_dec(vec4 g, float key) {\n"
+    "  float t = (-g.w - 1.0 - key) * (1.0 / (1024.0 * 8191.0)) - 1.0;\n"
+    "  return vec2(g.z, t / max(1.0 - abs(t), 1e-6)); }\n"
     /* g: the sample, key its key, d its depth, nu its normalised shading normal (world) or, where
      * the key says geo, its geometric normal (view) */
     "vec3 shade_sample(vec4 g, float key, float d, vec3 nu, vec2 X) {\n"
@@ -463,7 +463,7 @@ const char *const sy_gl_deferred_fs =
     "  vec3 pv = vec3(X * (u_ortho ? 1.0 : d), -d);\n"
     "  vec3 P = (u_inv_view * vec4(pv, 1.0)).xyz;\n"
     "  vec3 wo = u_ortho ? -u_cam_fwd : normalize(u_cam_pos - P);\n"
-    "  vec3 ngf = normalize(mat3(u_inv_view) * (geo ? nu : geo_normal(slope_dec(g.z), X)));\n"
+    "  vec3 ngf = normalize(mat3(u_inv_view) * (geo ? nu : geo_normal(slope_dec(g, key), X)));\n"
     "  vec3 ns = geo ? ngf : (front ? nu : -nu);\n"
     "  L += shade_lit(P, ngf, ns, wo, clamp(base.rgb, 0.0, 1.0), clamp(mrna.x, 0.0, 1.0), clamp(mrna.y, 0.0, 1.0),\n"
     "                 oist.y, clamp(oist.z, 0.0, 1.0), clamp(oist.w, 0.0, 1.0), 1.0, modes.w != 0.0);\n"
@@ -476,7 +476,7 @@ const char *const sy_gl_deferred_fs =
     "  float dmin = uintBitsToFloat(0x7F800000u); vec4 c = vec4(0.0); int todo = 0;\n"
     "  for (int i = 0; i < SY_SAMPLES; ++i) {\n"
     "    g[i] = texelFetch(t_gcol, p, i); z[i] = texelFetch(t_gdepth, p, i).r; dmin = min(dmin, z[i]);\n"
-    "    key[i] = -g[i].w - 1.0; bool geo = mod(key[i], 4.0) > 1.5;\n"
+    "    key[i] = mod(-g[i].w - 1.0, 1024.0); bool geo = mod(key[i], 4.0) > 1.5;\n"
     "    nu[i] = geo ? normalize(geo_normal(g[i].xy, X)) : oct_dec(g[i].xy);\n"
     "    if (g[i].w >= 0.0) c += g[i]; else todo |= 1 << i;\n"
     "  }\n"
