@@ -445,9 +445,10 @@ const char *const sy_gl_deferred_fs =
     "vec3 geo_normal(vec2 h, vec2 X) {\n"
     "  vec3 n = u_ortho ? vec3(h, 1.0) : vec3(-h, 1.0 - dot(h, X));\n"
     "  return dot(n, n) > 0.0 ? n : vec3(0.0, 0.0, 1.0); }\n"
-    /* the slope of a sample: x as stored, y from its 14 bits beside the key */
+    /* the slope of a sample: x as stored, y from its 14 bits beside the key (the level of 0 exact:
+     * the subtraction is of exact integers) */
     "vec2 slope_dec(vec4 g, float key) {\n"
-    "  float t = (-g.w - 1.0 - key) * (1.0 / (1024.0 * 8191.0)) - 1.0;\n"
+    "  float t = ((-g.w - 1.0 - key) * (1.0 / 1024.0) - 8191.0) * (1.0 / 8191.0);\n"
     "  return vec2(g.z, t / max(1.0 - abs(t), 1e-6)); }\n"
     /* g: the sample, key its key, d its depth, nu its normalised shading normal (world) or, where
      * the key says geo, its geometric normal (view) */
