@@ -391,9 +391,12 @@ const char *const sy_gl_main_fs =
  * blocks of mostly empty pixels, so each instruction costs many times what it costs in the shading
  * pass, which turns the slope into a world-space normal. (Measured: a third target for the slope,
  * or the slope in a wider depth target, costs as much as the arithmetic it saves.) */
+/* the octahedral map's fold of the lower hemisphere: the same in the encoder and the decoder */
+#define SY_GL_OCT_FOLD "vec2 oct_fold(vec2 e) { return (1.0 - abs(e.yx)) * vec2(e.x >= 0.0 ? 1.0 : -1.0, e.y >= 0.0 ? 1.0 : -1.0); }\n"
 #define SY_GL_OCT_DEC                                                                                       \
+    SY_GL_OCT_FOLD                                                                                          \
     "vec3 oct_dec(vec2 e) { vec3 v = vec3(e, 1.0 - abs(e.x) - abs(e.y));\n"                                  \
-    "  if (v.z < 0.0) v.xy = (1.0 - abs(v.yx)) * vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);\n" \
+    "  if (v.z < 0.0) v.xy = oct_fold(v.xy);\n"                                                             \
     "  return normalize(v); }\n"
 
 const char *const sy_gl_gbuf_vs =
@@ -406,7 +409,7 @@ const char *const sy_gl_gbuf_vs =
  * u_ortho_z (SY_ORTHO): proj[10], proj[14]; u_key: 4 x material row. Uniform choices are variants
  * (SY_ORTHO), not branches: a software rasterizer pays for both sides. */
 const char *const sy_gl_gbuf_fs =
-    "#version 330 core\n"
+    "#version 330 core\n" SY_GL_OCT_FOLD
     "uniform vec2 u_ppu; uniform bool u_mirror; uniform vec3 u_ortho_z; uniform float u_key;\n"
     "in vec3 v_nrm;\n"
     "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
@@ -418,7 +421,7 @@ const char *const sy_gl_gbuf_fs =
     "  float W = gl_FragCoord.w, d = 1.0 / W; vec2 h = vec2(dFdx(W), dFdy(W)) * (u_ppu * d);\n"
     "#endif\n"
     "  vec3 n = v_nrm; float s = abs(n.x) + abs(n.y) + abs(n.z); bool geo = !(s > 0.0);\n"
-    "  vec2 e = n.xy / s; if (n.z < 0.0) e = (1.0 - abs(e.yx)) * vec2(e.x >= 0.0 ? 1.0 : -1.0, e.y >= 0.0 ? 1.0 : -1.0);\n"
+    "  vec2 e = n.xy / s; if (n.z < 0.0) e = oct_fold(e);\n"
     "  float qy = floor(h.y / (1.0 + abs(h.y)) * 8191.0 + 8191.5);\n"
     "  o_color = vec4(geo ? h : e, h.x,\n"
     "                 -(1.0 + u_key + (gl_FrontFacing != u_mirror ? 1.0 : 0.0) + (geo ? 2.0 : 0.0) + 1024.0 * qy));\n"
