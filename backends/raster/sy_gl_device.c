@@ -192,9 +192,11 @@ struct sy_gl_device {
         GLuint prog;
         GLint model, normal_mat, mvp, cam_pos, cam_fwd, ortho, ortho_z, mirror, has_normals, probe_lod;
         uint64_t frame; /* the frame whose view uniforms it holds */
+        uint32_t kinds; /* the light shadow kinds it was built for (variant_kinds) */
     } pm[VAR_COUNT];
     uint64_t frame_no;
     uint32_t light_count, shadow_count, area_shadow_count; /* as uploaded by lights_upload: they pick the variants */
+    uint32_t light_kinds; /* lights_upload: light i's kind of shadow (shade_light: 0 none, 1 map, 2 + s cube s) in bits 2i, 2i + 1 */
     struct {
         GLuint prog;
         GLint model, lightvp;
@@ -225,11 +227,12 @@ struct sy_gl_device {
         GLint normal_mat, mvp, ppu, ortho_z, mirror, has_normals, key;
     } ug[2];
     struct {
-        int var; /* the lighting variant bits */
+        int var;        /* the lighting variant bits */
+        uint32_t kinds; /* and light shadow kinds (variant_kinds) */
         GLuint prog;
         GLint unproj, inv_view, px, cam_pos, cam_fwd, ortho;
     } dp[DEFERRED_PROGS];
-    uint32_t dp_count;
+    uint32_t dp_count, dp_next; /* dp_next: the slot a new program takes once all are used */
     float *mtab_cpu;                 /* material table: row i = the material of pool index i, row 0 = default */
     uint32_t mtab_cpu_rows, mtab_limit; /* rows held; rows a texture may have (GL_MAX_TEXTURE_SIZE) */
     GLuint mtab;                     /* its texture, MTAB_TEXELS x mtab_rows */
@@ -539,8 +542,17 @@ static int variant_normalize(int v)
     return v;
 }
 
-/* The #defines of variant bits v (sy_gl_shaders.c) into defs and their names after name's text. */
-static void variant_defines(int v, char *defs, size_t defs_len, char *name, size_t name_len)
+/* The light shadow kinds a program of variant bits v depends on: with punctual shadows and a
+ * constant light count the shader calls each light with its kind of shadow (sy_gl_shaders.c,
+ * shade_light), so that only that look-up runs; 0 otherwise. */
+static uint32_t variant_kinds(const sy_gl_device *dev, int v)
+{
+    return (v & VAR_SHADOW) && ((v >> VAR_NL_SHIFT) & 7) ? dev->light_kinds : 0u;
+}
+
+/* The #defines of variant bits v and light shadow kinds (variant_kinds) (sy_gl_shaders.c) into
+ * defs and their names after name's text. */
+static void variant_defines(int v, uint32_t kinds, char *defs, size_t defs_len, char *name, size_t name_len)
 {
     static const char *const names[7] = {"LEAN", "MASK", "TEX", "NMAP", "LIGHTS", "ENV", "SHADOW"};
     static const struct {
@@ -560,8 +572,15 @@ static void variant_defines(int v, char *defs, size_t defs_len, char *name, size
     }
     int nlights = (v >> VAR_NL_SHIFT) & 7;
     if (nlights) {
-        snprintf(defs + dl, defs_len - dl, "#define SY_NLIGHTS %d\n", nlights);
-        snprintf(name + nl, name_len - nl, " (%d lights)", nlights);
+        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_NLIGHTS %d\n", nlights);
+        nl += (size_t)snprintf(name + nl, name_len - nl, " (%d lights", nlights);
+        for (int i = 0; i < nlights; ++i) {
+            int kind = (int)((kinds >> (2 * i)) & 3u); /* 0 none, 1 2D map, 2 + s cube slot s */
+            dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_LK%d %d\n", i, kind);
+            nl += (size_t)snprintf(name + nl, name_len - nl, "%s", i ? "," : ", shadows ");
+            nl += (size_t)snprintf(name + nl, name_len - nl, "%s", (const char *[]){"-", "map", "cube0", "cube1"}[kind]);
+        }
+        snprintf(name + nl, name_len - nl, ")");
     }
 }
 
@@ -570,13 +589,19 @@ static void variant_defines(int v, char *defs, size_t defs_len, char *name, size
 static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 {
     v = variant_normalize(v);
-    if (dev->pm[v].prog) return dev->pm[v].prog;
-    char defs[256] = "", name[128] = "main";
-    variant_defines(v, defs, sizeof defs, name, sizeof name);
+    uint32_t kinds = variant_kinds(dev, v);
     const sy_gl_fns *gl = dev->gl;
+    if (dev->pm[v].prog) {
+        if (dev->pm[v].kinds == kinds) return dev->pm[v].prog;
+        gl->DeleteProgram(dev->pm[v].prog); /* the lights' shadows changed: rebuilt for the new kinds */
+        dev->pm[v].prog = 0;
+    }
+    char defs[512] = "", name[192] = "main";
+    variant_defines(v, kinds, defs, sizeof defs, name, sizeof name);
     GLuint p = 0;
     if (sy_gl_program_build(gl, name, sy_gl_main_vs, sy_gl_main_fs, defs, &p, err, err_len) != SY_GL_OK) return 0;
     dev->pm[v].prog = p;
+    dev->pm[v].kinds = kinds;
     dev->pm[v].model = gl->GetUniformLocation(p, "u_model");
     dev->pm[v].normal_mat = gl->GetUniformLocation(p, "u_normal_mat");
     dev->pm[v].mvp = gl->GetUniformLocation(p, "u_mvp");
@@ -598,20 +623,23 @@ static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 static int deferred_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 {
     v = variant_normalize(v & (VAR_LIGHTS | VAR_ENV | VAR_SHADOW | VAR_AREA | VAR_ASHADOW | (7 << VAR_NL_SHIFT)));
+    uint32_t kinds = variant_kinds(dev, v);
     for (uint32_t i = 0; i < dev->dp_count; ++i)
-        if (dev->dp[i].var == v) return (int)i;
-    if (dev->dp_count == DEFERRED_PROGS) {
-        fail(err, err_len, SY_GL_ERROR_LIMIT, "deferred shading: more than %u lighting variants", DEFERRED_PROGS);
-        return -1;
-    }
-    char defs[320] = "", name[128] = "deferred";
+        if (dev->dp[i].var == v && dev->dp[i].kinds == kinds) return (int)i;
+    char defs[576] = "", name[192] = "deferred";
     snprintf(defs, sizeof defs, "#define SY_SAMPLES %u\n", dev->msaa);
-    variant_defines(v, defs, sizeof defs, name, sizeof name);
+    variant_defines(v, kinds, defs, sizeof defs, name, sizeof name);
     const sy_gl_fns *gl = dev->gl;
     GLuint p = 0;
     if (sy_gl_program_build(gl, name, sy_gl_resolve_vs, sy_gl_deferred_fs, defs, &p, err, err_len) != SY_GL_OK) return -1;
-    uint32_t i = dev->dp_count++;
+    uint32_t i = dev->dp_count;
+    if (i == DEFERRED_PROGS) { /* all kept: the new one takes the slots in turn (one is used per frame) */
+        i = dev->dp_next++ % DEFERRED_PROGS;
+        gl->DeleteProgram(dev->dp[i].prog);
+    } else
+        dev->dp_count++;
     dev->dp[i].var = v;
+    dev->dp[i].kinds = kinds;
     dev->dp[i].prog = p;
     dev->dp[i].unproj = gl->GetUniformLocation(p, "u_unproj");
     dev->dp[i].inv_view = gl->GetUniformLocation(p, "u_inv_view");
@@ -1690,6 +1718,12 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
     ab[7] = 0.0f;
     fs->shadow_count = ns;
     dev->light_count = n;
+    dev->light_kinds = 0;
+    for (uint32_t i = 0; i < n && i < VAR_NL_MAX; ++i) { /* 0 none, 1 a 2D map, 2 + s cube slot s */
+        const float *o = blk + 88 + 16 * i;
+        uint32_t kind = o[14] >= 0.0f ? 1u : o[15] >= 0.0f ? 2u + (uint32_t)o[15] : 0u;
+        dev->light_kinds |= kind << (2 * i);
+    }
     dev->shadow_count = ns_punctual + fs->cube_count;
     dev->area_shadow_count = ns - ns_punctual;
     dev->gl->BindBuffer(GL_UNIFORM_BUFFER, dev->lights_ubo);

@@ -16,8 +16,9 @@
  * SY_ENV (environment light), SY_AREA (emissive polygons), SY_SHADOW (punctual shadow maps),
  * SY_ASHADOW (area-light shadow maps), SY_PROBE (reflections and refraction see the object's scene
  * probe instead of the environment), SY_TRANS (a transmissive material; llvmpipe runs both sides of a branch, so code that no
- * light of this frame needs is left out of the variant), SY_NLIGHTS (a constant light count:
- * the loop unrolls with constant uniform-block offsets). Every varying costs set-up per
+ * light of this frame needs is left out of the variant), SY_NLIGHTS (a constant light count, 1 ..
+ * 7: one call per light with constant uniform-block offsets) with SY_LK0 .. SY_LK<n-1> (each
+ * light's kind of shadow, see shade_light). Every varying costs set-up per
  * triangle and interpolation per fragment in a software rasterizer, so a variant interpolates only
  * what it reads; unlit variants (no lights, no environment) need no position or normal at all. */
 #define SY_GL_VARIANT_PRELUDE                                 \
@@ -160,6 +161,50 @@ const char *const sy_gl_main_vs =
  * terms), emitter (an emissive surface gets no indirect estimate). Only in lit variants. */
 #define SY_GL_SHADE_LIT \
     "#ifdef SY_LIT\n" \
+    "#ifdef SY_LIGHTS\n" \
+    /* one punctual light i; kind: its shadow (0 none, 1 its 2D map, 2 + s cube slot s, -1 read \
+     * from the Lights block); kd: the diffuse albedo, f0d, w_metal, w_diel: the lobes' weights (see \
+     * shade_lit), a2: GGX alpha squared, nv = ns . wo. A software rasterizer runs every branch and \
+     * at least one turn of every loop for the whole SIMD vector of pixels, whatever the condition \
+     * says: code is left out only where the compiler sees that it cannot run. So a variant with a \
+     * constant light count calls this once per light with i and kind constants (straight-line code, \
+     * one shadow look-up of the light's kind) instead of looping over the lights with every kind of \
+     * shadow look-up in the loop's body (measured, issue 19: that loop, even of zero turns, cost \
+     * as much as the lighting in it; it made three shadow look-ups per light where one is used) */ \
+    "vec3 shade_light(int i, int kind, vec3 P, vec3 ngf, vec3 ns, vec3 wo, vec3 bc, vec3 kd, float spec, float f0d,\n" \
+    "                 float w_metal, float w_diel, float rough, float a2, float nv) {\n" \
+    "  Light l = l_lights[i]; int type = int(l.pos_type.w); vec3 wi, e;\n" \
+    "  if (type == 3) { wi = -l.dir_range.xyz; e = l.radiant.rgb; }\n" \
+    "  else {\n" \
+    "    wi = l.pos_type.xyz - P; float d2 = dot(wi, wi); if (!(d2 > 0.0)) return vec3(0.0);\n" \
+    "    float d = sqrt(d2); wi /= d; float att = 1.0 / d2;\n" \
+    "    if (l.dir_range.w > 0.0) { float x = d / l.dir_range.w; float w = clamp(1.0 - x*x*x*x, 0.0, 1.0); att *= w * w; }\n" \
+    "    if (type == 2) { float cd = -dot(l.dir_range.xyz, wi); float s = clamp(cd * l.cone.x + l.cone.y, 0.0, 1.0); att *= s * s; }\n" \
+    "    if (!(att > 0.0)) return vec3(0.0); e = l.radiant.rgb * att;\n" \
+    "  }\n" \
+    "  float cs = dot(ns, wi); if (cs <= 0.0 || dot(ngf, wi) <= 0.0) return vec3(0.0);\n" \
+    "#ifdef SY_SHADOW\n" \
+    "  float vis = 1.0;\n" \
+    "  if (kind == 1) vis = shadow_vis(int(l.cone.z), P, ngf);\n" \
+    "  else if (kind >= 2) vis = cube_vis(kind - 2, l.pos_type.xyz, P, ngf);\n" \
+    "  else if (kind < 0) { int si = int(l.cone.z), ci = int(l.cone.w);\n" \
+    "    vis = si >= 0 ? shadow_vis(si, P, ngf) : ci >= 0 ? cube_vis(ci, l.pos_type.xyz, P, ngf) : 1.0; }\n" \
+    "  if (vis <= 0.0) return vec3(0.0);\n" \
+    "#else\n" \
+    "  float vis = 1.0;\n" \
+    "#endif\n" \
+    "  vec3 h = normalize(wi + wo); float vh = max(dot(wo, h), 0.0);\n" \
+    "  float fd = spec * schlick1(f0d, vh);\n" \
+    "  vec3 f = kd * (1.0 - fd) * INV_PI;\n" \
+    "  if (rough > 0.0) {\n" \
+    "    float nl = cs, nh = max(dot(ns, h), 0.0);\n" \
+    "    float dd = nh * nh * (a2 - 1.0) + 1.0; float D = a2 * INV_PI / (dd * dd);\n" \
+    "    float V = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));\n" \
+    "    f += (schlick(bc, vh) * w_metal + vec3(w_diel * fd)) * (D * V);\n" \
+    "  }\n" \
+    "  return e * f * cs * vis;\n" \
+    "}\n" \
+    "#endif\n" \
     "vec3 shade_lit(vec3 P, vec3 ngf, vec3 ns, vec3 wo, vec3 bc, float metallic, float rough, float ior, float spec,\n" \
     "               float trans, float ao, bool emitter) {\n" \
     "    vec3 L = vec3(0.0);\n" \
@@ -171,38 +216,30 @@ const char *const sy_gl_main_vs =
     "    float a = max(rough * rough, 1e-4), a2 = a * a;\n" \
     "    float nv = max(dot(ns, wo), 1e-4);\n" \
     "#ifdef SY_LIGHTS\n" \
-    "#ifndef SY_NLIGHTS\n" \
-    "#define SY_NLIGHTS l_count.x\n" \
+    "#define SY_LIGHT(i, kind) shade_light(i, kind, P, ngf, ns, wo, bc, kd, spec, f0d, w_metal, w_diel, rough, a2, nv)\n" \
+    "#ifdef SY_NLIGHTS\n" /* the variant's light count (1 .. 7) and shadow kinds SY_LK0 ..: straight-line code */ \
+    "    L += SY_LIGHT(0, SY_LK0);\n" \
+    "#if SY_NLIGHTS > 1\n" \
+    "    L += SY_LIGHT(1, SY_LK1);\n" \
     "#endif\n" \
-    "    for (int i = 0; i < SY_NLIGHTS; ++i) {\n" \
-    "      Light l = l_lights[i]; int type = int(l.pos_type.w); vec3 wi, e;\n" \
-    "      if (type == 3) { wi = -l.dir_range.xyz; e = l.radiant.rgb; }\n" \
-    "      else {\n" \
-    "        wi = l.pos_type.xyz - P; float d2 = dot(wi, wi); if (!(d2 > 0.0)) continue;\n" \
-    "        float d = sqrt(d2); wi /= d; float att = 1.0 / d2;\n" \
-    "        if (l.dir_range.w > 0.0) { float x = d / l.dir_range.w; float w = clamp(1.0 - x*x*x*x, 0.0, 1.0); att *= w * w; }\n" \
-    "        if (type == 2) { float cd = -dot(l.dir_range.xyz, wi); float s = clamp(cd * l.cone.x + l.cone.y, 0.0, 1.0); att *= s * s; }\n" \
-    "        if (!(att > 0.0)) continue; e = l.radiant.rgb * att;\n" \
-    "      }\n" \
-    "      float cs = dot(ns, wi); if (cs <= 0.0 || dot(ngf, wi) <= 0.0) continue;\n" \
-    "#ifdef SY_SHADOW\n" \
-    "      int si = int(l.cone.z), ci = int(l.cone.w);\n" \
-    "      float vis = si >= 0 ? shadow_vis(si, P, ngf) : ci >= 0 ? cube_vis(ci, l.pos_type.xyz, P, ngf) : 1.0;\n" \
-    "      if (vis <= 0.0) continue;\n" \
-    "#else\n" \
-    "      float vis = 1.0;\n" \
+    "#if SY_NLIGHTS > 2\n" \
+    "    L += SY_LIGHT(2, SY_LK2);\n" \
     "#endif\n" \
-    "      vec3 h = normalize(wi + wo); float vh = max(dot(wo, h), 0.0);\n" \
-    "      float fd = spec * schlick1(f0d, vh);\n" \
-    "      vec3 f = kd * (1.0 - fd) * INV_PI;\n" \
-    "      if (rough > 0.0) {\n" \
-    "        float nl = cs, nh = max(dot(ns, h), 0.0);\n" \
-    "        float dd = nh * nh * (a2 - 1.0) + 1.0; float D = a2 * INV_PI / (dd * dd);\n" \
-    "        float V = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));\n" \
-    "        f += (schlick(bc, vh) * w_metal + vec3(w_diel * fd)) * (D * V);\n" \
-    "      }\n" \
-    "      L += e * f * cs * vis;\n" \
-    "    }\n" \
+    "#if SY_NLIGHTS > 3\n" \
+    "    L += SY_LIGHT(3, SY_LK3);\n" \
+    "#endif\n" \
+    "#if SY_NLIGHTS > 4\n" \
+    "    L += SY_LIGHT(4, SY_LK4);\n" \
+    "#endif\n" \
+    "#if SY_NLIGHTS > 5\n" \
+    "    L += SY_LIGHT(5, SY_LK5);\n" \
+    "#endif\n" \
+    "#if SY_NLIGHTS > 6\n" \
+    "    L += SY_LIGHT(6, SY_LK6);\n" \
+    "#endif\n" \
+    "#else\n" /* more lights than variants count: the Lights block's count */ \
+    "    for (int i = 0; i < l_count.x; ++i) L += SY_LIGHT(i, -1);\n" \
+    "#endif\n" \
     "#endif\n" \
     "#if defined(SY_AREA) || defined(SY_ENV) || defined(SY_PROBE)\n" \
     /* split-sum terms: A, B of the GGX BRDF for this view and roughness */ \
