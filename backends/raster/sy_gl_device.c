@@ -169,8 +169,9 @@ enum {
     VAR_LIGHTS = 16,  /* punctual lights present */
     VAR_ENV = 32,     /* environment light (prefiltered cube maps) */
     VAR_SHADOW = 64,  /* punctual shadow maps (only with VAR_LIGHTS) */
-    VAR_NL_SHIFT = 7, /* bits 7-9: the light count when 1..VAR_NL_MAX (a loop the compiler unrolls, with
-                       * constant uniform-block offsets), 0 = read from the Lights block */
+    VAR_NL_SHIFT = 7, /* bits 7-9: the light count when 1..VAR_NL_MAX (one call per light with constant
+                       * uniform-block offsets and shadow kinds: variant_kinds), 0 = a loop over the
+                       * Lights block */
     VAR_NL_MAX = 7,
     VAR_AREA = 1024,    /* emissive polygons (LTC) */
     VAR_ASHADOW = 2048, /* area-light shadow maps (only with VAR_AREA) */

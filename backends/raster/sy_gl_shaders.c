@@ -164,9 +164,10 @@ const char *const sy_gl_main_vs =
     "#ifdef SY_LIGHTS\n" \
     /* one punctual light i; kind: its shadow (0 none, 1 its 2D map, 2 + s cube slot s, -1 read \
      * from the Lights block); kd: the diffuse albedo, f0d, w_metal, w_diel: the lobes' weights (see \
-     * shade_lit), a2: GGX alpha squared, nv = ns . wo. A software rasterizer runs every branch and \
-     * at least one turn of every loop for the whole SIMD vector of pixels, whatever the condition \
-     * says: code is left out only where the compiler sees that it cannot run. So a variant with a \
+     * shade_lit), a2: GGX alpha squared, nv = ns . wo. llvmpipe runs both sides of every branch \
+     * for the whole SIMD vector of pixels, and a loop the compiler keeps costs as much as a turn of \
+     * its body even where no pixel takes one: code is skipped only where the compiler sees that it \
+     * cannot run. So a variant with a \
      * constant light count calls this once per light with i and kind constants (straight-line code, \
      * one shadow look-up of the light's kind) instead of looping over the lights with every kind of \
      * shadow look-up in the loop's body (measured, issue 19: that loop, even of zero turns, cost \
