@@ -165,13 +165,12 @@ const char *const sy_gl_main_vs =
     /* one punctual light i; kind: its shadow (0 none, 1 its 2D map, 2 + s cube slot s, -1 read \
      * from the Lights block); kd: the diffuse albedo, f0d, w_metal, w_diel: the lobes' weights (see \
      * shade_lit), a2: GGX alpha squared, nv = ns . wo. llvmpipe runs both sides of every branch \
-     * for the whole SIMD vector of pixels, and a loop the compiler keeps costs as much as a turn of \
-     * its body even where no pixel takes one: code is skipped only where the compiler sees that it \
-     * cannot run. So a variant with a \
-     * constant light count calls this once per light with i and kind constants (straight-line code, \
-     * one shadow look-up of the light's kind) instead of looping over the lights with every kind of \
-     * shadow look-up in the loop's body (measured, issue 19: that loop, even of zero turns, cost \
-     * as much as the lighting in it; it made three shadow look-ups per light where one is used) */ \
+     * for the whole SIMD vector of pixels, so a loop over the lights whose body chose the shadow \
+     * look-up at run time made all three (2D map, cube 0, cube 1) for every light; and that loop \
+     * (kept by the compiler: it has continues) cost as much with its trip count forced to zero as \
+     * with the light (measured, issue 19). So a variant with a constant light count calls this \
+     * once per light with i and kind constants: straight-line code with the one look-up the light \
+     * needs */ \
     "vec3 shade_light(int i, int kind, vec3 P, vec3 ngf, vec3 ns, vec3 wo, vec3 bc, vec3 kd, float spec, float f0d,\n" \
     "                 float w_metal, float w_diel, float rough, float a2, float nv) {\n" \
     "  Light l = l_lights[i]; int type = int(l.pos_type.w); vec3 wi, e;\n" \
