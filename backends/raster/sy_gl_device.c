@@ -170,7 +170,7 @@ enum {
     VAR_ENV = 32,     /* environment light (prefiltered cube maps) */
     VAR_SHADOW = 64,  /* punctual shadow maps (only with VAR_LIGHTS) */
     VAR_NL_SHIFT = 7, /* bits 7-9: the light count when 1..VAR_NL_MAX (one call per light with constant
-                       * uniform-block offsets and shadow kinds: variant_kinds), 0 = a loop over the
+                       * uniform-block offsets and shadow kinds: variant_sig), 0 = a loop over the
                        * Lights block */
     VAR_NL_MAX = 7,
     VAR_AREA = 1024,    /* emissive polygons (LTC) */
@@ -193,11 +193,14 @@ struct sy_gl_device {
         GLuint prog;
         GLint model, normal_mat, mvp, cam_pos, cam_fwd, ortho, ortho_z, mirror, has_normals, probe_lod;
         uint64_t frame; /* the frame whose view uniforms it holds */
-        uint32_t kinds; /* the light shadow kinds it was built for (variant_kinds) */
+        uint64_t sig; /* the lights' signature it was built for (variant_sig) */
     } pm[VAR_COUNT];
     uint64_t frame_no;
     uint32_t light_count, shadow_count, area_shadow_count; /* as uploaded by lights_upload: they pick the variants */
-    uint32_t light_kinds; /* lights_upload: light i's kind of shadow (shade_light: 0 none, 1 map, 2 + s cube s) in bits 2i, 2i + 1 */
+    /* lights_upload: what the shaders' straight-line light code is built for. Bits 2i, 2i + 1:
+     * punctual light i's kind of shadow (i < VAR_NL_MAX; shade_light: 0 none, 1 map, 2 + s cube s);
+     * bits 16-20: the emissive polygon count; bit 32 + i: polygon i has a shadow map (shade_area) */
+    uint64_t light_sig;
     struct {
         GLuint prog;
         GLint model, lightvp;
@@ -229,7 +232,7 @@ struct sy_gl_device {
     } ug[2];
     struct {
         int var;        /* the lighting variant bits */
-        uint32_t kinds; /* and light shadow kinds (variant_kinds) */
+        uint64_t sig;   /* and the lights' signature (variant_sig) */
         GLuint prog;
         GLint unproj, inv_view, px, cam_pos, cam_fwd, ortho;
     } dp[DEFERRED_PROGS];
@@ -543,17 +546,22 @@ static int variant_normalize(int v)
     return v;
 }
 
-/* The light shadow kinds a program of variant bits v depends on: with punctual shadows and a
- * constant light count the shader calls each light with its kind of shadow (sy_gl_shaders.c,
- * shade_light), so that only that look-up runs; 0 otherwise. */
-static uint32_t variant_kinds(const sy_gl_device *dev, int v)
+/* The part of the lights' signature (light_sig) a program of variant bits v depends on. The
+ * shaders call each punctual light (constant light count) and each emissive polygon with its
+ * shadow fixed (sy_gl_shaders.c, shade_light, shade_area): straight-line code that makes only the
+ * look-ups the frame needs (llvmpipe runs every branch for every pixel). */
+static uint64_t variant_sig(const sy_gl_device *dev, int v)
 {
-    return (v & VAR_SHADOW) && ((v >> VAR_NL_SHIFT) & 7) ? dev->light_kinds : 0u;
+    uint64_t s = 0;
+    if ((v & VAR_SHADOW) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & 0x3FFFu;
+    if (v & VAR_AREA) s |= dev->light_sig & (0x1Fu << 16);
+    if ((v & VAR_AREA) && (v & VAR_ASHADOW)) s |= dev->light_sig & (0xFFFFull << 32);
+    return s;
 }
 
-/* The #defines of variant bits v and light shadow kinds (variant_kinds) (sy_gl_shaders.c) into
- * defs and their names after name's text. */
-static void variant_defines(int v, uint32_t kinds, char *defs, size_t defs_len, char *name, size_t name_len)
+/* The #defines of variant bits v and the lights' signature sig (variant_sig) (sy_gl_shaders.c)
+ * into defs and their names after name's text. */
+static void variant_defines(int v, uint64_t sig, char *defs, size_t defs_len, char *name, size_t name_len)
 {
     static const char *const names[7] = {"LEAN", "MASK", "TEX", "NMAP", "LIGHTS", "ENV", "SHADOW"};
     static const struct {
@@ -576,10 +584,21 @@ static void variant_defines(int v, uint32_t kinds, char *defs, size_t defs_len, 
         dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_NLIGHTS %d\n", nlights);
         nl += (size_t)snprintf(name + nl, name_len - nl, " (%d lights", nlights);
         for (int i = 0; i < nlights; ++i) {
-            int kind = (int)((kinds >> (2 * i)) & 3u); /* 0 none, 1 2D map, 2 + s cube slot s */
+            int kind = (int)((sig >> (2 * i)) & 3u); /* 0 none, 1 2D map, 2 + s cube slot s */
             dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_LK%d %d\n", i, kind);
             nl += (size_t)snprintf(name + nl, name_len - nl, "%s", i ? "," : ", shadows ");
             nl += (size_t)snprintf(name + nl, name_len - nl, "%s", (const char *[]){"-", "map", "cube0", "cube1"}[kind]);
+        }
+        nl += (size_t)snprintf(name + nl, name_len - nl, ")");
+    }
+    int nareas = (int)((sig >> 16) & 0x1Fu);
+    if (nareas) {
+        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_NAREAS %d\n", nareas);
+        nl += (size_t)snprintf(name + nl, name_len - nl, " (%d polygons, shadows ", nareas);
+        for (int i = 0; i < nareas; ++i) {
+            int sh = (int)((sig >> (32 + i)) & 1u);
+            dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_AS%d %d\n", i, sh);
+            nl += (size_t)snprintf(name + nl, name_len - nl, "%c", sh ? '1' : '0');
         }
         snprintf(name + nl, name_len - nl, ")");
     }
@@ -590,19 +609,19 @@ static void variant_defines(int v, uint32_t kinds, char *defs, size_t defs_len, 
 static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 {
     v = variant_normalize(v);
-    uint32_t kinds = variant_kinds(dev, v);
+    uint64_t sig = variant_sig(dev, v);
     const sy_gl_fns *gl = dev->gl;
     if (dev->pm[v].prog) {
-        if (dev->pm[v].kinds == kinds) return dev->pm[v].prog;
-        gl->DeleteProgram(dev->pm[v].prog); /* the lights' shadows changed: rebuilt for the new kinds */
+        if (dev->pm[v].sig == sig) return dev->pm[v].prog;
+        gl->DeleteProgram(dev->pm[v].prog); /* the lights' shadows or count changed: rebuilt for them */
         dev->pm[v].prog = 0;
     }
-    char defs[512] = "", name[192] = "main";
-    variant_defines(v, kinds, defs, sizeof defs, name, sizeof name);
+    char defs[1024] = "", name[256] = "main";
+    variant_defines(v, sig, defs, sizeof defs, name, sizeof name);
     GLuint p = 0;
     if (sy_gl_program_build(gl, name, sy_gl_main_vs, sy_gl_main_fs, defs, &p, err, err_len) != SY_GL_OK) return 0;
     dev->pm[v].prog = p;
-    dev->pm[v].kinds = kinds;
+    dev->pm[v].sig = sig;
     dev->pm[v].model = gl->GetUniformLocation(p, "u_model");
     dev->pm[v].normal_mat = gl->GetUniformLocation(p, "u_normal_mat");
     dev->pm[v].mvp = gl->GetUniformLocation(p, "u_mvp");
@@ -624,12 +643,12 @@ static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 static int deferred_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 {
     v = variant_normalize(v & (VAR_LIGHTS | VAR_ENV | VAR_SHADOW | VAR_AREA | VAR_ASHADOW | (7 << VAR_NL_SHIFT)));
-    uint32_t kinds = variant_kinds(dev, v);
+    uint64_t sig = variant_sig(dev, v);
     for (uint32_t i = 0; i < dev->dp_count; ++i)
-        if (dev->dp[i].var == v && dev->dp[i].kinds == kinds) return (int)i;
-    char defs[576] = "", name[192] = "deferred";
+        if (dev->dp[i].var == v && dev->dp[i].sig == sig) return (int)i;
+    char defs[1024] = "", name[256] = "deferred";
     snprintf(defs, sizeof defs, "#define SY_SAMPLES %u\n", dev->msaa);
-    variant_defines(v, kinds, defs, sizeof defs, name, sizeof name);
+    variant_defines(v, sig, defs, sizeof defs, name, sizeof name);
     const sy_gl_fns *gl = dev->gl;
     GLuint p = 0;
     if (sy_gl_program_build(gl, name, sy_gl_resolve_vs, sy_gl_deferred_fs, defs, &p, err, err_len) != SY_GL_OK) return -1;
@@ -640,7 +659,7 @@ static int deferred_program(sy_gl_device *dev, int v, char *err, size_t err_len)
     } else
         dev->dp_count++;
     dev->dp[i].var = v;
-    dev->dp[i].kinds = kinds;
+    dev->dp[i].sig = sig;
     dev->dp[i].prog = p;
     dev->dp[i].unproj = gl->GetUniformLocation(p, "u_unproj");
     dev->dp[i].inv_view = gl->GetUniformLocation(p, "u_inv_view");
@@ -1719,12 +1738,14 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
     ab[7] = 0.0f;
     fs->shadow_count = ns;
     dev->light_count = n;
-    dev->light_kinds = 0;
+    dev->light_sig = (uint64_t)dev->area_count << 16;
     for (uint32_t i = 0; i < n && i < VAR_NL_MAX; ++i) { /* 0 none, 1 a 2D map, 2 + s cube slot s */
         const float *o = blk + 88 + 16 * i;
-        uint32_t kind = o[14] >= 0.0f ? 1u : o[15] >= 0.0f ? 2u + (uint32_t)o[15] : 0u;
-        dev->light_kinds |= kind << (2 * i);
+        uint64_t kind = o[14] >= 0.0f ? 1u : o[15] >= 0.0f ? 2u + (uint64_t)o[15] : 0u;
+        dev->light_sig |= kind << (2 * i);
     }
+    for (uint32_t i = 0; i < dev->area_count; ++i)
+        if (ab[8 + 24 * i + 23] >= 0.0f) dev->light_sig |= 1ull << (32 + i);
     dev->shadow_count = ns_punctual + fs->cube_count;
     dev->area_shadow_count = ns - ns_punctual;
     dev->gl->BindBuffer(GL_UNIFORM_BUFFER, dev->lights_ubo);

@@ -18,7 +18,8 @@
  * probe instead of the environment), SY_TRANS (a transmissive material; llvmpipe runs both sides of a branch, so code that no
  * light of this frame needs is left out of the variant), SY_NLIGHTS (a constant light count, 1 ..
  * 7: one call per light with constant uniform-block offsets) with SY_LK0 .. SY_LK<n-1> (each
- * light's kind of shadow, see shade_light). Every varying costs set-up per
+ * light's kind of shadow, see shade_light), SY_NAREAS (the emissive polygons' count, 1 .. 16, one
+ * call each) with SY_AS0 .. SY_AS<n-1> (whether each has a shadow map, see shade_area). Every varying costs set-up per
  * triangle and interpolation per fragment in a software rasterizer, so a variant interpolates only
  * what it reads; unlit variants (no lights, no environment) need no position or normal at all. */
 #define SY_GL_VARIANT_PRELUDE                                 \
@@ -155,6 +156,9 @@ const char *const sy_gl_main_vs =
     "}\n" \
     "#endif\n" \
 
+/* One polygon's call in a variant with a constant polygon count SY_NAREAS (shade_area). */
+#define SY_GL_AREA_CALL(i) "#if SY_NAREAS > " #i "\n    L += SY_AREA_L(" #i ", SY_AS" #i ");\n#endif\n"
+
 /* The lighting of one surface point: P (world), ngf (geometric normal facing the viewer), ns
  * (shading normal, flipped to the side seen), wo (towards the eye), the material's clamped base
  * colour, metallic, roughness, ior, specular and transmission, ao (occlusion of the ambient
@@ -203,6 +207,27 @@ const char *const sy_gl_main_vs =
     "    f += (schlick(bc, vh) * w_metal + vec3(w_diel * fd)) * (D * V);\n" \
     "  }\n" \
     "  return e * f * cs * vis;\n" \
+    "}\n" \
+    "#endif\n" \
+    "#ifdef SY_AREA\n" \
+    /* one emissive polygon i (linearly transformed cosines: frame for the diffuse lobe, Minv for \
+     * the specular one; kdl, fl their weights); shadow: whether it has a shadow map (1, 0; -1 \
+     * read from the Areas block). Called once per polygon with constants, as shade_light. */ \
+    "vec3 shade_area(int i, int shadow, vec3 P, vec3 ngf, mat3 frame, mat3 Minv, vec3 kdl, vec3 fl, float rough) {\n" \
+    "  vec4 v0 = a_data[i * 6], rad = a_data[i * 6 + 4], cen = a_data[i * 6 + 5];\n" \
+    "  int nvx = int(v0.w);\n" \
+    "  vec3 ln = cross(a_data[i * 6 + 1].xyz - v0.xyz, a_data[i * 6 + 2].xyz - v0.xyz);\n" \
+    "  float side = dot(P - v0.xyz, ln);\n" \
+    "  if (!(abs(side) > 1e-5 * dot(ln, ln) + 1e-9) || (side < 0.0 && rad.w < 0.5)) return vec3(0.0);\n" \
+    "  float vis = 1.0;\n" \
+    "#ifdef SY_ASHADOW\n" \
+    "  if (shadow > 0) vis = shadow_area(int(cen.w), P, ngf);\n" \
+    "  else if (shadow < 0) { int si = int(cen.w); vis = si >= 0 ? shadow_area(si, P, ngf) : 1.0; }\n" \
+    "  if (vis <= 0.0) return vec3(0.0);\n" \
+    "#endif\n" \
+    "  float d = ltc_eval(frame, P, i, nvx);\n" \
+    "  float s = rough > 0.0 ? ltc_eval(Minv, P, i, nvx) : 0.0;\n" \
+    "  return rad.rgb * (kdl * d + fl * s) * vis;\n" \
     "}\n" \
     "#endif\n" \
     "vec3 shade_lit(vec3 P, vec3 ngf, vec3 ns, vec3 wo, vec3 bc, float metallic, float rough, float ior, float spec,\n" \
@@ -257,22 +282,15 @@ const char *const sy_gl_main_vs =
     /* the LTC norm replaces A, B for the polygon's specular (F0 t2.x + (1 - F0) t2.y) */ \
     "      vec3 fl = (bc * t2.x + (1.0 - bc) * t2.y) * w_metal + vec3(w_diel * spec * (f0d * t2.x + (1.0 - f0d) * t2.y));\n" \
     "      vec3 kdl = kd * (1.0 - fd_avg);\n" \
-    "      for (int i = 0; i < a_count.x; ++i) {\n" \
-    "        vec4 v0 = a_data[i * 6], rad = a_data[i * 6 + 4], cen = a_data[i * 6 + 5];\n" \
-    "        int nvx = int(v0.w);\n" \
-    "        vec3 ln = cross(a_data[i * 6 + 1].xyz - v0.xyz, a_data[i * 6 + 2].xyz - v0.xyz);\n" \
-    "        float side = dot(P - v0.xyz, ln);\n" \
-    "        if (!(abs(side) > 1e-5 * dot(ln, ln) + 1e-9) || (side < 0.0 && rad.w < 0.5)) continue;\n" \
-    "#ifdef SY_ASHADOW\n" \
-    "        int si = int(cen.w); float vis = si >= 0 ? shadow_area(si, P, ngf) : 1.0;\n" \
-    "        if (vis <= 0.0) continue;\n" \
+    "#define SY_AREA_L(i, sh) shade_area(i, sh, P, ngf, frame, Minv, kdl, fl, rough)\n" \
+    "#ifdef SY_NAREAS\n" /* the frame's polygon count (1 .. 16) and shadows SY_AS0 ..: straight-line code */ \
+    SY_GL_AREA_CALL(0) SY_GL_AREA_CALL(1) SY_GL_AREA_CALL(2) SY_GL_AREA_CALL(3) SY_GL_AREA_CALL(4) \
+    SY_GL_AREA_CALL(5) SY_GL_AREA_CALL(6) SY_GL_AREA_CALL(7) SY_GL_AREA_CALL(8) SY_GL_AREA_CALL(9) \
+    SY_GL_AREA_CALL(10) SY_GL_AREA_CALL(11) SY_GL_AREA_CALL(12) SY_GL_AREA_CALL(13) SY_GL_AREA_CALL(14) \
+    SY_GL_AREA_CALL(15) \
     "#else\n" \
-    "        float vis = 1.0;\n" \
+    "      for (int i = 0; i < a_count.x; ++i) L += SY_AREA_L(i, -1);\n" \
     "#endif\n" \
-    "        float d = ltc_eval(frame, P, i, nvx);\n" \
-    "        float s = rough > 0.0 ? ltc_eval(Minv, P, i, nvx) : 0.0;\n" \
-    "        L += rad.rgb * (kdl * d + fl * s) * vis;\n" \
-    "      }\n" \
     /* the area lights' indirect light (sy_gl_set_ambient), stronger on surfaces facing the way the \
      * emitters shine (they see the directly lit surfaces), weaker on those facing the emitters; not \
      * on emitters (the estimate counts them as sources only) */ \

@@ -9,8 +9,11 @@
  *     changes whole regions;
  *  2. turning the first point light's shadow off rebuilds the program for the new kinds: the image
  *     brightens where the occluder shadowed it and nowhere darkens; turning it on again gives the
- *     first image back bit for bit.
- * No environment and no area lights: the image is the punctual lights' light only. */
+ *     first image back bit for bit;
+ *  3. emissive polygons (area lights, each called with its shadow fixed: shade_area) add up the
+ *     same way: three at once (each with its shadow map; a triangle, a quad, a double-sided quad)
+ *     equal the three alone.
+ * No environment and no ambient term: the image is the lights' light only. */
 #include "sy_gl.h"
 
 #include <math.h>
@@ -86,6 +89,39 @@ static void remove_all(sy_gl_device *d, sy_gl_light *h)
         if (h[i].id) sy_gl_light_destroy(d, h[i]), h[i].id = 0;
 }
 
+/* Three emissive polygons at once against each alone (slots 0 .. 3 of img hold three, and each). */
+static void areas_sum(sy_gl_device *d, const char *how)
+{
+    static const sy_gl_area_light al[3] = {
+        {.vertices = {{-2, 2.5f, -5}, {-1, 2.5f, -5}, {-1, 2.5f, -4}, {-2, 2.5f, -4}}, .vertex_count = 4, .radiance = {40, 30, 20}},
+        {.vertices = {{0.5f, 3, -3.5f}, {1.5f, 3, -3.5f}, {1, 3, -2.5f}}, .vertex_count = 3, .radiance = {20, 30, 50}},
+        {.vertices = {{2, 2, -6}, {3, 2, -6}, {3, 2, -5}, {2, 2, -5}}, .vertex_count = 4, .radiance = {30, 30, 30},
+         .double_sided = true},
+    };
+    MUST(sy_gl_set_area_lights(d, al, 3, e, sizeof e));
+    render(d, 0);
+    static float acc[W * H * 4];
+    memset(acc, 0, sizeof acc);
+    for (int k = 0; k < 3; ++k) {
+        MUST(sy_gl_set_area_lights(d, &al[k], 1, e, sizeof e));
+        render(d, 1 + k);
+        for (size_t i = 0; i < (size_t)W * H * 4; ++i) acc[i] += img[1 + k][i];
+    }
+    double sum = 0.0, diff = 0.0, worst = 0.0;
+    for (size_t i = 0; i < (size_t)W * H; ++i)
+        for (int c = 0; c < 3; ++c) {
+            double all = img[0][4 * i + c], dd = fabs(all - acc[4 * i + c]);
+            sum += all, diff += dd;
+            if (dd / (fabs(all) + 1e-3) > worst) worst = dd / (fabs(all) + 1e-3);
+        }
+    printf("%s: three emissive polygons against each alone: mean %.3f, mean difference %.2e of it, worst pixel %.2e\n",
+           how, sum / (3.0 * W * H), sum > 0.0 ? diff / sum : 1.0, worst);
+    CHECK(sum > 0.01 * 3.0 * W * H, "%s: polygons: the image is (nearly) black", how);
+    CHECK(diff <= 1e-5 * sum, "%s: three polygons differ from the sum of each alone by %.2e of the mean", how, diff / sum);
+    CHECK(worst <= 1e-3, "%s: polygons: a pixel differs by %.2e (relative)", how, worst);
+    MUST(sy_gl_set_area_lights(d, NULL, 0, e, sizeof e));
+}
+
 static void run(bool forward)
 {
     const char *how = forward ? "forward" : "deferred";
@@ -140,6 +176,9 @@ static void run(bool forward)
     MUST(sy_gl_light_update(d, h[0], &lights[0], e, sizeof e));
     render(d, 3);
     CHECK(memcmp(img[1], img[3], sizeof img[1]) == 0, "%s: the shadow back on does not give the first image back", how);
+    /* 3. emissive polygons, the punctual lights gone */
+    remove_all(d, h);
+    areas_sum(d, how);
     sy_gl_device_destroy(d);
 }
 
