@@ -206,9 +206,6 @@ struct sy_gl_device {
         GLint model, lightvp;
     } ps[2];
     struct {
-        GLint samples;
-    } ur;
-    struct {
         GLint model, view, proj;
     } uf[2]; /* the floors: unlit, trivial lit */
     GLuint default_ubo, lights_ubo, white_tex, flat_normal_tex, empty_vao;
@@ -786,7 +783,9 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     for (int v = 0; v < 2 && r == SY_GL_OK; ++v)
         r = sy_gl_program_build(gl, v ? "shadow (alpha mask)" : "shadow", sy_gl_shadow_vs, sy_gl_shadow_fs, defs[2 * v],
                                 &dev->ps[v].prog, err, err_len);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "resolve", sy_gl_resolve_vs, sy_gl_resolve_fs, NULL, &dev->prog_resolve, err, err_len);
+    char rdefs[40];
+    snprintf(rdefs, sizeof rdefs, "#define SY_SAMPLES %u\n", dev->msaa);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "resolve", sy_gl_resolve_vs, sy_gl_resolve_fs, rdefs, &dev->prog_resolve, err, err_len);
     if (r == SY_GL_OK) r = sy_gl_program_build(gl, "floor", sy_gl_floor_vs, sy_gl_floor_fs, NULL, &dev->prog_floor, err, err_len);
     if (r == SY_GL_OK)
         r = sy_gl_program_build(gl, "floor (trivial lit)", sy_gl_floor_vs, sy_gl_floor_fs, "#define SY_FLOOR_LIT 1\n",
@@ -812,7 +811,6 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     gl->UseProgram(dev->prog_resolve);
     gl->Uniform1i(gl->GetUniformLocation(dev->prog_resolve, "t_color"), 0);
     gl->Uniform1i(gl->GetUniformLocation(dev->prog_resolve, "t_depth"), 1);
-    dev->ur.samples = gl->GetUniformLocation(dev->prog_resolve, "u_samples");
     for (int k = 0; k < 2; ++k) {
         GLuint fp = k ? dev->prog_floor_lit : dev->prog_floor;
         dev->uf[k].model = gl->GetUniformLocation(fp, "u_model");
@@ -2180,7 +2178,6 @@ static sy_gl_result finish_target(sy_gl_device *dev, const view_setup *v, float 
         gl->Disable(GL_DEPTH_TEST);
         gl->Disable(GL_BLEND);
         gl->UseProgram(dev->prog_resolve);
-        gl->Uniform1i(dev->ur.samples, (GLint)t->samples);
         gl->ActiveTexture(GL_TEXTURE0);
         gl->BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t->color);
         gl->ActiveTexture(GL_TEXTURE1);

@@ -592,13 +592,14 @@ const char *const sy_gl_resolve_vs =
     "void main() { vec2 p = vec2(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID & 2) * 2 - 1));\n"
     "  gl_Position = vec4(p, 0.0, 1.0); }\n";
 
+/* SY_SAMPLES: the targets' sample count, a constant (a loop over a uniform count stays a loop). */
 const char *const sy_gl_resolve_fs =
     "#version 330 core\n"
-    "uniform sampler2DMS t_color; uniform sampler2DMS t_depth; uniform int u_samples;\n"
+    "uniform sampler2DMS t_color; uniform sampler2DMS t_depth;\n"
     "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
     "void main() { ivec2 p = ivec2(gl_FragCoord.xy); vec4 c = vec4(0.0); float d = uintBitsToFloat(0x7F800000u);\n"
-    "  for (int i = 0; i < u_samples; ++i) { c += texelFetch(t_color, p, i); d = min(d, texelFetch(t_depth, p, i).r); }\n"
-    "  o_color = c / float(u_samples); o_depth = d; }\n";
+    "  for (int i = 0; i < SY_SAMPLES; ++i) { c += texelFetch(t_color, p, i); d = min(d, texelFetch(t_depth, p, i).r); }\n"
+    "  o_color = c / float(SY_SAMPLES); o_depth = d; }\n";
 
 /* The benchmark floors (sy_gl_render_floor): the same buffers, trivially shaded. Unlit: one
  * constant colour. SY_FLOOR_LIT ("trivial lit"): one directional light, Lambert, on the vertex
