@@ -37,6 +37,7 @@ enum { UNIT_GCOL = UNIT_BASE, UNIT_GDEPTH = UNIT_MR, UNIT_MTAB = UNIT_NRM };
 #define MTAB_TEXELS 5u      /* RGBA32F texels per material row: base, emissive, mrna, oist, modes */
 #define MTAB_MAX_ROWS 256u /* the G-buffer's key holds 8 bits of material row (sy_gl_shaders.c) */
 #define DEFERRED_PROGS 16u  /* shading-pass programs kept (one per frame lighting variant) */
+#define PM_SPARE 32u        /* main programs kept for other light signatures than the current one */
 /* Instances whose forward shading would run on more pixels per triangle than this stay forward:
  * on big triangles the forward pass already shades about once per pixel, and the G-buffer pass
  * is extra (measured with sy bench raster: the demo's spheres at 24-37 pixels per triangle are
@@ -189,12 +190,18 @@ struct sy_gl_device {
     uint32_t msaa, max_tex, shadow_size;
     pool meshes, textures, materials, instances, lights;
     GLuint prog_resolve, prog_floor, prog_floor_lit;
-    struct { /* main-pass variants, built on first use, indexed by VAR_* bits (main_program) */
+    struct main_prog { /* main-pass variants, built on first use, indexed by VAR_* bits (main_program) */
         GLuint prog;
         GLint model, normal_mat, mvp, cam_pos, cam_fwd, ortho, ortho_z, mirror, has_normals, probe_lod;
         uint64_t frame; /* the frame whose view uniforms it holds */
-        uint64_t sig; /* the lights' signature it was built for (variant_sig) */
+        uint64_t sig;   /* the lights' signature it was built for (variant_sig) */
+        int var;        /* its variant bits (in pm_spare) */
     } pm[VAR_COUNT];
+    /* programs of earlier light signatures, kept so that lights toggled back and forth (a shadow
+     * turned off and on, an emissive object hidden and shown) do not recompile each time; reused
+     * in turn when full */
+    struct main_prog pm_spare[PM_SPARE];
+    uint32_t pm_spare_next;
     uint64_t frame_no;
     uint32_t light_count, shadow_count, area_shadow_count; /* as uploaded by lights_upload: they pick the variants */
     /* lights_upload: what the shaders' straight-line light code is built for. Bits 2i, 2i + 1:
@@ -610,8 +617,21 @@ static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
     const sy_gl_fns *gl = dev->gl;
     if (dev->pm[v].prog) {
         if (dev->pm[v].sig == sig) return dev->pm[v].prog;
-        gl->DeleteProgram(dev->pm[v].prog); /* the lights' shadows or count changed: rebuilt for them */
+        /* the lights' shadows or polygon count changed: one built for them earlier, or a new one;
+         * this one is kept aside */
+        struct main_prog cur = dev->pm[v];
+        cur.var = v;
         dev->pm[v].prog = 0;
+        for (uint32_t i = 0; i < PM_SPARE; ++i)
+            if (dev->pm_spare[i].prog && dev->pm_spare[i].var == v && dev->pm_spare[i].sig == sig) {
+                dev->pm[v] = dev->pm_spare[i];
+                dev->pm[v].frame = 0; /* its view uniforms are an older frame's */
+                dev->pm_spare[i] = cur;
+                return dev->pm[v].prog;
+            }
+        uint32_t slot = dev->pm_spare_next++ % PM_SPARE;
+        if (dev->pm_spare[slot].prog) gl->DeleteProgram(dev->pm_spare[slot].prog);
+        dev->pm_spare[slot] = cur;
     }
     char defs[1024] = "", name[256] = "main";
     variant_defines(v, sig, defs, sizeof defs, name, sizeof name);
@@ -902,6 +922,8 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         targets_free(dev, &dev->t);
         for (int v = 0; v < VAR_COUNT; ++v)
             if (dev->pm[v].prog) gl->DeleteProgram(dev->pm[v].prog);
+        for (uint32_t i = 0; i < PM_SPARE; ++i)
+            if (dev->pm_spare[i].prog) gl->DeleteProgram(dev->pm_spare[i].prog);
         GLuint progs[7] = {dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor, dev->prog_sky,
                            dev->prog_floor_lit, dev->ug[0].prog};
         for (int i = 0; i < 7; ++i)

@@ -7,9 +7,9 @@
  *     of them each (the constant-count programs, each light's shadow of the same kind as in the
  *     eight), to float rounding: a light drawn with the wrong shadow, or twice, or not at all,
  *     changes whole regions;
- *  2. turning the first point light's shadow off rebuilds the program for the new kinds: the image
- *     brightens where the occluder shadowed it and nowhere darkens; turning it on again gives the
- *     first image back bit for bit;
+ *  2. turning the first point light's shadow off builds programs for the new kinds: the image
+ *     brightens where the occluder shadowed it and nowhere darkens; turning it on again takes the
+ *     programs kept aside for the first kinds and gives the first image back bit for bit;
  *  3. emissive polygons (area lights, each called with its shadow fixed: shade_area) add up the
  *     same way: three at once (each with its shadow map; a triangle, a quad, a double-sided quad)
  *     equal the three alone.
@@ -35,8 +35,8 @@ static const sy_gl_light_desc lights[8] = {
     {.type = SY_GL_LIGHT_SPOT, .color = {1, 0.5f, 0.3f}, .intensity = 40.0f, .position = {-2, 3, -2},
      .direction = {0.5f, -1, -0.5f}, .inner_cone_angle = 0.3f, .outer_cone_angle = 0.6f},
     {.type = SY_GL_LIGHT_POINT, .color = {0.3f, 1, 0.4f}, .intensity = 6.0f, .position = {0, 1.5f, -1}, .no_shadow = true},
-    {.type = SY_GL_LIGHT_POINT, .color = {0.5f, 0.6f, 1}, .intensity = 15.0f, .position = {-2.5f, 2, -3}},
     {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {1, 1, 0.8f}, .intensity = 0.7f, .direction = {-0.5f, -1, 0.2f}},
+    {.type = SY_GL_LIGHT_POINT, .color = {0.5f, 0.6f, 1}, .intensity = 15.0f, .position = {-2.5f, 2, -3}},
     {.type = SY_GL_LIGHT_SPOT, .color = {0.8f, 0.8f, 1}, .intensity = 30.0f, .position = {1, 4, -4},
      .direction = {-0.2f, -1, 0.1f}, .inner_cone_angle = 0.4f, .outer_cone_angle = 0.7f},
     {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {0.2f, 0.2f, 0.3f}, .intensity = 0.5f, .direction = {0, -1, 1},
@@ -129,7 +129,9 @@ static void run(bool forward)
     sy_gl_light h[8];
     memset(h, 0, sizeof h);
     /* the eight in the order that gives each the same shadow as in the halves: point lights take
-     * the cube slots, directional and spot lights the 2D maps, in creation order */
+     * the cube slots, directional and spot lights the 2D maps, in creation order. The halves'
+     * kinds differ (cube, map, map, none against map, cube, map, none): each half's programs are
+     * built for its own, and part 2 finds the first half's kept aside */
     add(d, h, 0, 8);
     render(d, 0);
     remove_all(d, h);
