@@ -655,8 +655,8 @@ static GLuint main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 }
 
 /* The deferred shading pass for the frame's lighting variant bits v (only the lighting bits
- * count), built and kept on first use: its index in dev->dp, or -1 with err set when the driver
- * rejects it or the cache is full. */
+ * count) and light signature, built and kept on first use: its index in dev->dp, or -1 with err
+ * set when the driver rejects it. */
 static int deferred_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 {
     v = variant_normalize(v & (VAR_LIGHTS | VAR_ENV | VAR_SHADOW | VAR_AREA | VAR_ASHADOW | (7 << VAR_NL_SHIFT)));
