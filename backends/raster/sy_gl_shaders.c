@@ -156,8 +156,11 @@ const char *const sy_gl_main_vs =
     "}\n" \
     "#endif\n" \
 
-/* One polygon's call in a variant with a constant polygon count SY_NAREAS (shade_area). */
-#define SY_GL_AREA_CALL(i) "#if SY_NAREAS > " #i "\n    L += SY_AREA_L(" #i ", SY_AS" #i ");\n#endif\n"
+/* Call i of a variant's straight-line light code: when the count n (SY_NLIGHTS, SY_NAREAS) is
+ * above i, L += f(i, k<i>), k<i> the item's shadow define (SY_LK<i>, SY_AS<i>); see shade_light. */
+#define SY_GL_CALL(n, f, k, i) "#if " n " > " #i "\n    L += " f "(" #i ", " k #i ");\n#endif\n"
+#define SY_GL_LIGHT_CALL(i) SY_GL_CALL("SY_NLIGHTS", "SY_LIGHT", "SY_LK", i)
+#define SY_GL_AREA_CALL(i) SY_GL_CALL("SY_NAREAS", "SY_AREA_L", "SY_AS", i)
 
 /* The lighting of one surface point: P (world), ngf (geometric normal facing the viewer), ns
  * (shading normal, flipped to the side seen), wo (towards the eye), the material's clamped base
@@ -243,25 +246,8 @@ const char *const sy_gl_main_vs =
     "#ifdef SY_LIGHTS\n" \
     "#define SY_LIGHT(i, kind) shade_light(i, kind, P, ngf, ns, wo, bc, kd, spec, f0d, w_metal, w_diel, rough, a2, nv)\n" \
     "#ifdef SY_NLIGHTS\n" /* the variant's light count (1 .. 7) and shadow kinds SY_LK0 ..: straight-line code */ \
-    "    L += SY_LIGHT(0, SY_LK0);\n" \
-    "#if SY_NLIGHTS > 1\n" \
-    "    L += SY_LIGHT(1, SY_LK1);\n" \
-    "#endif\n" \
-    "#if SY_NLIGHTS > 2\n" \
-    "    L += SY_LIGHT(2, SY_LK2);\n" \
-    "#endif\n" \
-    "#if SY_NLIGHTS > 3\n" \
-    "    L += SY_LIGHT(3, SY_LK3);\n" \
-    "#endif\n" \
-    "#if SY_NLIGHTS > 4\n" \
-    "    L += SY_LIGHT(4, SY_LK4);\n" \
-    "#endif\n" \
-    "#if SY_NLIGHTS > 5\n" \
-    "    L += SY_LIGHT(5, SY_LK5);\n" \
-    "#endif\n" \
-    "#if SY_NLIGHTS > 6\n" \
-    "    L += SY_LIGHT(6, SY_LK6);\n" \
-    "#endif\n" \
+    SY_GL_LIGHT_CALL(0) SY_GL_LIGHT_CALL(1) SY_GL_LIGHT_CALL(2) SY_GL_LIGHT_CALL(3) SY_GL_LIGHT_CALL(4) \
+    SY_GL_LIGHT_CALL(5) SY_GL_LIGHT_CALL(6) \
     "#else\n" /* more lights than variants count: the Lights block's count */ \
     "    for (int i = 0; i < l_count.x; ++i) L += SY_LIGHT(i, -1);\n" \
     "#endif\n" \
