@@ -349,10 +349,11 @@ static sy_result bench_raster_scene(const char *label, sy_scene *scene, const sy
     if (r == SY_OK) {
         latency = median_of(t, repeats);
         sy_mediator_raster_counters_get(st, &moved_c);
-        printf("  %s: %llu triangles, %u meshes, %u instances (%llu shaded deferred), %ux%u, %u MSAA samples, %u shadow "
-               "maps\n",
+        printf("  %s: %llu triangles, %u meshes, %u instances (%llu shaded deferred, on %.1f %% of the pixels), %ux%u, %u "
+               "MSAA samples, %u shadow maps\n",
                label, (unsigned long long)moved_c.triangles_drawn, moved_c.meshes, moved_c.instances,
-               (unsigned long long)moved_c.deferred_draws, width, height, moved_c.msaa_samples, moved_c.shadow_maps);
+               (unsigned long long)moved_c.deferred_draws, 100.0 * (double)moved_c.deferred_pixels / ((double)width * height),
+               width, height, moved_c.msaa_samples, moved_c.shadow_maps);
         printf("    first sync (upload)            %10.2f ms  (%llu vertex/index buffers, %llu textures)\n", t_sync * 1e3,
                (unsigned long long)first.total_vertex_buffer_uploads, (unsigned long long)first.total_texture_uploads);
         printf("    frame (median of %u)           %10.2f ms  (%.2f .. %.2f)\n", repeats, ours.median * 1e3, ours.min * 1e3,

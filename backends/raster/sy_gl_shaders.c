@@ -469,7 +469,19 @@ const char *const sy_gl_gbuf_fs =
     "  o_depth = d;\n"
     "}\n";
 
-/* The deferred pass: a full-screen triangle (sy_gl_resolve_vs) over the multisampled targets. Per
+/* The deferred pass's rectangles (sy_gl_deferred_fs): u_rects[i] = (x0, y0, x1, y1) in normalised
+ * device coordinates, drawn as two triangles each (6 vertices per rectangle) at window depth 0.25,
+ * in front of the resolve's full-screen triangle (0.5; see deferred_pass). */
+#define SY_GL_STR_(x) #x
+#define SY_GL_STR(x) SY_GL_STR_(x)
+const char *const sy_gl_rect_vs =
+    "#version 330 core\n"
+    "uniform vec4 u_rects[" SY_GL_STR(SY_GL_MAX_RECTS) "];\n"
+    "void main() { vec4 r = u_rects[gl_VertexID / 6]; int c = gl_VertexID % 6;\n"
+    "  bool right = c == 1 || c == 2 || c == 4, top = c == 2 || c == 4 || c == 5;\n"
+    "  gl_Position = vec4(right ? r.z : r.x, top ? r.w : r.y, -0.5, 1.0); }\n";
+
+/* The deferred pass: rectangles (sy_gl_rect_vs) over the multisampled targets. Per
  * pixel it groups the G-buffer samples into surfaces (same material, side and kind of normal,
  * depths within 0.1 %, normals within 1.8 degrees: the triangles of one smooth mesh are one
  * surface, the facets of a faceted one are not), shades each surface once at the pixel centre (where the forward pass shades it too),

@@ -12,7 +12,10 @@ extern const char *const sy_gl_resolve_vs, *const sy_gl_resolve_fs; /* resolve_v
 extern const char *const sy_gl_sky_fs; /* with sy_gl_resolve_vs */
 extern const char *const sy_gl_floor_vs, *const sy_gl_floor_fs;
 extern const char *const sy_gl_gbuf_vs, *const sy_gl_gbuf_fs; /* deferred shading: the geometry pass */
-extern const char *const sy_gl_deferred_fs; /* ... its shading and resolve pass, with sy_gl_resolve_vs */
+extern const char *const sy_gl_deferred_fs; /* ... its shading and resolve pass, with sy_gl_rect_vs */
+/* the deferred pass's rectangles: uniform vec4 u_rects[SY_GL_MAX_RECTS] (NDC x0, y0, x1, y1) */
+extern const char *const sy_gl_rect_vs;
+#define SY_GL_MAX_RECTS 16
 
 /* Compiles and links; fs_defines (NULL = none, e.g. "#define SY_MASK 1\n") is inserted after the
  * #version line of both stages. On failure returns SY_GL_ERROR_GL with "<name> shader: <stage> compile

@@ -852,6 +852,7 @@ void sy_mediator_raster_counters_get(void *state, sy_mediator_raster_counters *o
     out->triangles_drawn = gs.triangles_drawn;
     out->instances_culled = gs.instances_culled;
     out->deferred_draws = gs.deferred_draws;
+    out->deferred_pixels = gs.deferred_pixels;
 }
 
 const char *sy_mediator_raster_info(void *state) { return sy_gl_device_info(((raster_state *)state)->dev); }

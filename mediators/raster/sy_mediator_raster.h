@@ -49,6 +49,7 @@ typedef struct sy_mediator_raster_counters {
     uint64_t draw_calls, triangles_drawn; /** @} */
     uint64_t instances_culled; /**< instances outside the view in the last frame (not drawn) */
     uint64_t deferred_draws;   /**< instances the last frame shaded deferred (sy_gl_device_desc.forward) */
+    uint64_t deferred_pixels;  /**< pixels its deferred pass shaded (tiles those instances touch) */
     uint32_t warnings; /**< warnings so far */
     char last_warning[256]; /**< the last warning */
 } sy_mediator_raster_counters;

@@ -5,9 +5,12 @@
  * directional light with a shadow map, an environment, an area light), smooth and faceted meshes,
  * a mirrored instance, metal, unlit and emissive materials, a large quad that stays forward; in
  * perspective and orthographic views, after a material change (the material table's update), and
- * with a blended instance (the whole frame falls back to forward: bit-identical). The images must
- * agree to what grouping a pixel's samples into one surface can change; the counters must show
- * which instances went which way. */
+ * with a blended instance (the whole frame falls back to forward: bit-identical). The deferred pass
+ * runs only on the 8-pixel tiles that the G-buffer instances' projected bounds touch (the target,
+ * 196 x 146, is no multiple of 8), also with 80 small spheres across the image and past its
+ * edges. The images must agree to what grouping a pixel's samples into one surface can change
+ * (a pixel the deferred pass misses shows the raw G-buffer); the counters must show which
+ * instances went which way and where the deferred pass ran. */
 #include "sy_gl.h"
 
 #include <math.h>
@@ -17,8 +20,8 @@
 
 #include "gl_test.h"
 
-#define W 192
-#define H 144
+#define W 196
+#define H 146
 static char e[4096];
 #include "gl_sphere.h" /* after e, which it uses */
 static float img[2][W * H * 4], dep[2][W * H];
@@ -51,6 +54,13 @@ static sy_gl_instance place(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat, f
     sy_gl_instance h;
     MUST(sy_gl_instance_create(d, &id, &h, e, sizeof e));
     return h;
+}
+
+static void place_small(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat, float s, float x, float y, float z)
+{
+    sy_gl_instance_desc id = {.mesh = m, .material = mat, .transform = {s, 0, 0, 0, 0, s, 0, 0, 0, 0, s, 0, x, y, z, 1}};
+    sy_gl_instance h;
+    MUST(sy_gl_instance_create(d, &id, &h, e, sizeof e));
 }
 
 typedef struct scene {
@@ -103,18 +113,31 @@ static scene build(bool forward)
     return s;
 }
 
-static uint64_t render(scene *s, int k, bool ortho)
+static sy_gl_camera camera(bool ortho)
 {
     sy_gl_camera cam = {.camera_to_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0.3f, 0, 1},
                         .window = {-0.8f, 0.8f, -0.6f, 0.6f}, .near_clip = 0.1f, .orthographic = ortho};
     if (ortho) { /* the same framing at the spheres' distance */
         for (int i = 0; i < 4; ++i) cam.window[i] *= 4.0f;
     }
+    return cam;
+}
+
+/* Renders into slot k; returns the deferred draws, and in *px the pixels the deferred pass shaded. */
+static uint64_t render_cam(scene *s, int k, const sy_gl_camera *cam, uint64_t *px)
+{
     sy_gl_render_desc rd = {W, H, 0, 0, W, H};
-    MUST(sy_gl_render(s->d, &cam, &rd, img[k], dep[k], e, sizeof e));
+    MUST(sy_gl_render(s->d, cam, &rd, img[k], dep[k], e, sizeof e));
     sy_gl_stats st;
     sy_gl_device_stats(s->d, &st);
+    if (px) *px = st.deferred_pixels;
     return st.deferred_draws;
+}
+
+static uint64_t render(scene *s, int k, bool ortho)
+{
+    sy_gl_camera cam = camera(ortho);
+    return render_cam(s, k, &cam, NULL);
 }
 
 /* Forward (slot 0) against deferred (slot 1): relative mean difference of the colour, share of
@@ -152,10 +175,14 @@ static void compare(const char *what, double max_mean, double max_share)
 int main(void)
 {
     scene fw = build(true), df = build(false);
-    /* 1. perspective: the four spheres deferred, the floor (two large triangles) forward */
-    uint64_t n0 = render(&fw, 0, false), n1 = render(&df, 1, false);
-    printf("deferred draws: forward device %llu, deferred device %llu\n", (unsigned long long)n0, (unsigned long long)n1);
+    /* 1. perspective: the four spheres deferred, the floor (two large triangles) forward; the
+     * deferred pass on their tiles only */
+    const sy_gl_camera persp = camera(false);
+    uint64_t px = 0, n0 = render(&fw, 0, false), n1 = render_cam(&df, 1, &persp, &px);
+    printf("deferred draws: forward device %llu, deferred device %llu, on %llu of %d pixels\n", (unsigned long long)n0,
+           (unsigned long long)n1, (unsigned long long)px, W * H);
     CHECK(n0 == 0 && n1 == 4, "deferred draws %llu / %llu (want 0 / 4)", (unsigned long long)n0, (unsigned long long)n1);
+    CHECK(px > 0 && px < (uint64_t)W * H, "the deferred pass shaded %llu of %d pixels", (unsigned long long)px, W * H);
     compare("perspective", 2.5e-3, 0.006);
     /* 2. orthographic (the G-buffer pass's orthographic variant) */
     render(&fw, 0, true);
@@ -171,7 +198,19 @@ int main(void)
     render(&fw, 0, false);
     render(&df, 1, false);
     compare("after a material change", 2.5e-3, 0.006);
-    /* 4. a blended instance: the frame is forward on both devices, so the images are the same */
+    /* 4. 80 small spheres (about 3 pixels across) over the image and past its edges: the deferred
+     * pass on the tiles they touch, in many rectangles */
+    for (int k = 0; k < 2; ++k)
+        for (int i = 0; i < 80; ++i)
+            place_small(k ? df.d : fw.d, k ? df.smooth : fw.smooth, k ? df.red : fw.red, 0.045f,
+                        -2.55f + 0.5f * (float)(i % 11) + 0.031f * (float)(i / 11), -1.75f + 0.49f * (float)(i / 11), -3.0f);
+    render(&fw, 0, false);
+    n1 = render_cam(&df, 1, &persp, &px);
+    printf("small spheres: %llu deferred draws on %llu pixels\n", (unsigned long long)n1, (unsigned long long)px);
+    CHECK(n1 > 60 && px < (uint64_t)W * H * 3 / 4, "small spheres: %llu deferred draws on %llu of %d pixels",
+          (unsigned long long)n1, (unsigned long long)px, W * H);
+    compare("small spheres", 2.5e-3, 0.006);
+    /* 5. a blended instance: the frame is forward on both devices, so the images are the same */
     for (int k = 0; k < 2; ++k) {
         scene *s = k ? &df : &fw;
         sy_gl_material_desc bd;
