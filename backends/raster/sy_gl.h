@@ -389,13 +389,14 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
 bool sy_gl_window_should_close(sy_gl_device *dev);
 
 /* >>bench: the floor — draws every visible instance's buffers with a trivial shader into the same
- * targets (MSAA included), then resolves and reads back colour like sy_gl_render (no depth).
+ * targets (MSAA included), then resolves and reads back colour and depth like sy_gl_render.
  * Unlit: one constant colour, position only. lit ("trivial lit"): one directional light, Lambert
  * on the interpolated vertex normal, plus a constant ambient; no shadows, no environment. */
 /** Benchmark floor: every visible instance drawn with a trivial shader (lit: one directional
- * Lambert light) into the same targets, read back into rgba. */
+ * Lambert light) into the same targets, read back into rgba and depth (NULL: not read) as
+ * sy_gl_render does. */
 sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *desc, bool lit,
-                                float *rgba, char *err, size_t err_len);
+                                float *rgba, float *depth, char *err, size_t err_len);
 
 #ifdef __cplusplus
 }

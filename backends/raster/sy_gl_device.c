@@ -2794,7 +2794,7 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
 }
 
 sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, bool lit,
-                                float *rgba, char *err, size_t err_len)
+                                float *rgba, float *depth, char *err, size_t err_len)
 {
     view_setup v;
     sy_gl_result r = frame_setup(dev, cam, d, &v, err, err_len);
@@ -2819,7 +2819,7 @@ sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, cons
         gl->UniformMatrix4fv(dev->uf[k].model, 1, GL_FALSE, in->model);
         dev->tris += draw_mesh_lod(dev, m, in->lod);
     }
-    r = finish_target(dev, NULL, rgba, NULL, err, err_len);
+    r = finish_target(dev, NULL, rgba, depth, err, err_len);
     frame_end(dev);
     return r;
 }

@@ -712,7 +712,7 @@ sy_result sy_mediator_raster_render_floor(void *state, const sy_render_request *
     sy_gl_camera cam;
     camera_of(&req->camera, &cam);
     sy_gl_render_desc d = {req->full_width, req->full_height, req->rect_x, req->rect_y, req->rect_w, req->rect_h};
-    sy_gl_result r = sy_gl_render_floor(st->dev, &cam, &d, lit, layer->rgba, e, sizeof e);
+    sy_gl_result r = sy_gl_render_floor(st->dev, &cam, &d, lit, layer->rgba, layer->depth, e, sizeof e);
     return r == SY_GL_OK ? SY_OK : gl_fail(err, r, "floor render", e);
 }
 

@@ -58,7 +58,8 @@ void sy_mediator_raster_counters_get(void *state, sy_mediator_raster_counters *o
 /** "OpenGL 4.5 (Core Profile) Mesa ... on llvmpipe (...) (osmesa)". Borrowed. */
 const char *sy_mediator_raster_info(void *state);
 /** Benchmark floor: the same visible buffers drawn with a trivial shader into the same targets
- * (lit = "trivial lit": one directional light, Lambert on the vertex normals, constant ambient). */
+ * (lit = "trivial lit": one directional light, Lambert on the vertex normals, constant ambient),
+ * read back into the layer's colour and depth as a frame is. */
 sy_result sy_mediator_raster_render_floor(void *state, const sy_render_request *req, bool lit, sy_layer *layer,
                                           sy_error *err);
 
