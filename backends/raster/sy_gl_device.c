@@ -34,7 +34,7 @@ enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1, BIND_AREAS = 2 };
 /* Deferred shading (see sy_gl_shaders.c, sy_gl_gbuf_fs): the shading pass samples no material
  * texture, so the G-buffer and the material table use the material units. */
 enum { UNIT_GCOL = UNIT_BASE, UNIT_GDEPTH = UNIT_MR, UNIT_MTAB = UNIT_NRM };
-#define MTAB_TEXELS 5u      /* RGBA32F texels per material row: base, emissive, mrna, oist, modes */
+#define MTAB_TEXELS 3u      /* RGBA32F texels per material row (sy_gl_deferred_fs) */
 #define MTAB_MAX_ROWS 256u /* the G-buffer's key holds 8 bits of material row (sy_gl_shaders.c) */
 #define DEFERRED_PROGS 16u  /* shading-pass programs kept (one per frame lighting variant) */
 #define RECT_TILE 8u        /* the deferred pass shades the RECT_TILE-pixel tiles G-buffer instances touch */
@@ -712,11 +712,13 @@ static void mtab_row(const sy_gl_device *dev, const sy_gl_material_desc *d, floa
 {
     mat_block b;
     material_block(dev, d, &b);
-    memcpy(row, b.base, sizeof b.base);
-    memcpy(row + 4, b.emissive, sizeof b.emissive);
-    memcpy(row + 8, b.mrna, sizeof b.mrna);
-    memcpy(row + 12, b.oist, sizeof b.oist);
-    for (int k = 0; k < 4; ++k) row[16 + k] = (float)b.modes[k];
+    /* (base colour, metallic), (emission, roughness), (ior, specular, transmission, flags) */
+    memcpy(row, b.base, 3 * sizeof *b.base);
+    row[3] = b.mrna[0];
+    memcpy(row + 4, b.emissive, 3 * sizeof *b.emissive);
+    row[7] = b.mrna[1];
+    memcpy(row + 8, b.oist + 1, 3 * sizeof *b.oist);
+    row[11] = (float)((b.modes[1] ? 1 : 0) + (b.modes[2] ? 2 : 0) + (b.modes[3] ? 4 : 0)); /* unlit, two-sided, emissive */
 }
 
 /* Writes material d into row `row`; false (the material is then shaded forward) when the table

@@ -487,9 +487,9 @@ const char *const sy_gl_rect_vs =
  * surface, the facets of a faceted one are not), shades each surface once at the pixel centre (where the forward pass shades it too),
  * passes forward-shaded samples through, and averages colour and takes the nearest depth as the
  * resolve does. SY_SAMPLES is the target's sample count; the lighting defines are the frame's, as
- * for the forward variants. The material table (t_mtab, RGBA32F) holds per row: base colour,
- * emission, (metallic, roughness, -, -), (-, ior, specular, transmission), (alpha mode, unlit,
- * double-sided, emissive). */
+ * for the forward variants. The material table (t_mtab, RGBA32F) holds per row three texels:
+ * (base colour, metallic), (emission, roughness), (ior, specular, transmission, flags), flags =
+ * unlit + 2 double-sided + 4 emissive: the fields the pass reads, in three look-ups. */
 const char *const sy_gl_deferred_fs =
     "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_SHADING_DECLS SY_GL_OCT_DEC
     "uniform sampler2DMS t_gcol; uniform sampler2DMS t_gdepth; uniform sampler2D t_mtab;\n"
@@ -511,19 +511,19 @@ const char *const sy_gl_deferred_fs =
     "vec3 shade_sample(vec4 g, float key, float d, vec3 nu, vec2 X) {\n"
     "  float row = floor(key * 0.25), bits = key - 4.0 * row; bool front = mod(bits, 2.0) > 0.5, geo = bits > 1.5;\n"
     "  int r = int(row);\n"
-    "  vec4 base = texelFetch(t_mtab, ivec2(0, r), 0), modes = texelFetch(t_mtab, ivec2(4, r), 0);\n"
-    "  vec3 L = vec3(0.0);\n"
-    "  if (modes.w != 0.0 && (front || modes.z != 0.0)) L = texelFetch(t_mtab, ivec2(1, r), 0).rgb;\n"
-    "  if (modes.y != 0.0) return L + base.rgb;\n"
+    "  vec4 base = texelFetch(t_mtab, ivec2(0, r), 0), emis = texelFetch(t_mtab, ivec2(1, r), 0);\n"
+    "  vec4 oist = texelFetch(t_mtab, ivec2(2, r), 0);\n"
+    "  bool unlit = mod(oist.w, 2.0) > 0.5, two_sided = mod(oist.w, 4.0) > 1.5, emitter = oist.w > 3.5;\n"
+    "  vec3 L = emitter && (front || two_sided) ? emis.rgb : vec3(0.0);\n"
+    "  if (unlit) return L + base.rgb;\n"
     "#ifdef SY_LIT\n"
-    "  vec4 mrna = texelFetch(t_mtab, ivec2(2, r), 0), oist = texelFetch(t_mtab, ivec2(3, r), 0);\n"
     "  vec3 pv = vec3(X * (u_ortho ? 1.0 : d), -d);\n"
     "  vec3 P = (u_inv_view * vec4(pv, 1.0)).xyz;\n"
     "  vec3 wo = u_ortho ? -u_cam_fwd : normalize(u_cam_pos - P);\n"
     "  vec3 ngf = normalize(mat3(u_inv_view) * (geo ? nu : geo_normal(slope_dec(g, key), X)));\n"
     "  vec3 ns = geo ? ngf : (front ? nu : -nu);\n"
-    "  L += shade_lit(P, ngf, ns, wo, clamp(base.rgb, 0.0, 1.0), clamp(mrna.x, 0.0, 1.0), clamp(mrna.y, 0.0, 1.0),\n"
-    "                 oist.y, clamp(oist.z, 0.0, 1.0), clamp(oist.w, 0.0, 1.0), 1.0, modes.w != 0.0);\n"
+    "  L += shade_lit(P, ngf, ns, wo, clamp(base.rgb, 0.0, 1.0), clamp(base.a, 0.0, 1.0), clamp(emis.a, 0.0, 1.0),\n"
+    "                 oist.x, clamp(oist.y, 0.0, 1.0), clamp(oist.z, 0.0, 1.0), 1.0, emitter);\n"
     "#endif\n"
     "  return L;\n"
     "}\n"
