@@ -209,7 +209,9 @@ struct sy_gl_device {
     uint32_t light_count, shadow_count, area_shadow_count; /* as uploaded by lights_upload: they pick the variants */
     /* lights_upload: what the shaders' straight-line light code is built for. Bits 2i, 2i + 1:
      * punctual light i's kind of shadow (i < VAR_NL_MAX; shade_light: 0 none, 1 map, 2 + s cube s);
-     * bits 16-20: the emissive polygon count; bit 32 + i: polygon i has a shadow map (shade_area) */
+     * bits 16-20: the emissive polygon count; bit 32 + i: polygon i has a shadow map (shade_area);
+     * bits 48 + 2i, 49 + 2i: punctual light i's type (shade_light's lt: 0 point, 1 point with a
+     * range, 2 spot, 3 directional) */
     uint64_t light_sig;
     struct {
         GLuint prog;
@@ -571,6 +573,7 @@ static uint64_t variant_sig(const sy_gl_device *dev, int v)
 {
     uint64_t s = 0;
     if ((v & VAR_SHADOW) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & 0x3FFFu;
+    if ((v & VAR_LIGHTS) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & (0x3FFFull << 48);
     if (v & VAR_AREA) s |= dev->light_sig & (0x1Fu << 16);
     if ((v & VAR_AREA) && (v & VAR_ASHADOW)) s |= dev->light_sig & (0xFFFFull << 32);
     return s;
@@ -602,9 +605,11 @@ static void variant_defines(int v, uint64_t sig, char *defs, size_t defs_len, ch
         nl += (size_t)snprintf(name + nl, name_len - nl, " (%d lights", nlights);
         for (int i = 0; i < nlights; ++i) {
             int kind = (int)((sig >> (2 * i)) & 3u); /* 0 none, 1 2D map, 2 + s cube slot s */
-            dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_LK%d %d\n", i, kind);
-            nl += (size_t)snprintf(name + nl, name_len - nl, "%s", i ? "," : ", shadows ");
-            nl += (size_t)snprintf(name + nl, name_len - nl, "%s", (const char *[]){"-", "map", "cube0", "cube1"}[kind]);
+            int type = (int)((sig >> (48 + 2 * i)) & 3u); /* 0 point, 1 point with range, 2 spot, 3 directional */
+            dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_LK%d %d\n#define SY_LT%d %d\n", i, kind, i, type);
+            nl += (size_t)snprintf(name + nl, name_len - nl, "%s", i ? ", " : ": ");
+            nl += (size_t)snprintf(name + nl, name_len - nl, "%s %s", (const char *[]){"point", "point+range", "spot", "sun"}[type],
+                                   (const char *[]){"-", "map", "cube0", "cube1"}[kind]);
         }
         nl += (size_t)snprintf(name + nl, name_len - nl, ")");
     }
@@ -1790,7 +1795,9 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
     for (uint32_t i = 0; i < n && i < VAR_NL_MAX; ++i) { /* 0 none, 1 a 2D map, 2 + s cube slot s */
         const float *o = blk + 88 + 16 * i;
         uint64_t kind = o[14] >= 0.0f ? 1u : o[15] >= 0.0f ? 2u + (uint64_t)o[15] : 0u;
-        dev->light_sig |= kind << (2 * i);
+        /* 0 point, 1 point with a range, 2 spot, 3 directional (shade_light's lt) */
+        uint64_t type = o[3] == (float)SY_GL_LIGHT_DIRECTIONAL ? 3u : o[3] == (float)SY_GL_LIGHT_SPOT ? 2u : o[7] > 0.0f ? 1u : 0u;
+        dev->light_sig |= kind << (2 * i) | type << (48 + 2 * i);
     }
     for (uint32_t i = 0; i < dev->area_count; ++i)
         if (ab[8 + 24 * i + 23] >= 0.0f) dev->light_sig |= 1ull << (32 + i);

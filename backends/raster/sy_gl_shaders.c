@@ -157,10 +157,11 @@ const char *const sy_gl_main_vs =
     "#endif\n" \
 
 /* Call i of a variant's straight-line light code: when the count n (SY_NLIGHTS, SY_NAREAS) is
- * above i, L += f(i, k<i>), k<i> the item's shadow define (SY_LK<i>, SY_AS<i>); see shade_light. */
-#define SY_GL_CALL(n, f, k, i) "#if " n " > " #i "\n    L += " f "(" #i ", " k #i ");\n#endif\n"
-#define SY_GL_LIGHT_CALL(i) SY_GL_CALL("SY_NLIGHTS", "SY_LIGHT", "SY_LK", i)
-#define SY_GL_AREA_CALL(i) SY_GL_CALL("SY_NAREAS", "SY_AREA_L", "SY_AS", i)
+ * above i, L += f(i, k<i>, ...), k<i> the item's defines (punctual lights: shadow SY_LK<i> and
+ * type SY_LT<i>; polygons: shadow SY_AS<i>); see shade_light, shade_area. */
+#define SY_GL_CALL(n, f, k, i) "#if " n " > " #i "\n    L += " f "(" #i ", " k ");\n#endif\n"
+#define SY_GL_LIGHT_CALL(i) SY_GL_CALL("SY_NLIGHTS", "SY_LIGHT", "SY_LK" #i ", SY_LT" #i, i)
+#define SY_GL_AREA_CALL(i) SY_GL_CALL("SY_NAREAS", "SY_AREA_L", "SY_AS" #i, i)
 
 /* The lighting of one surface point: P (world), ngf (geometric normal facing the viewer), ns
  * (shading normal, flipped to the side seen), wo (towards the eye), the material's clamped base
@@ -177,15 +178,16 @@ const char *const sy_gl_main_vs =
      * (kept by the compiler: it has continues) cost as much with its trip count forced to zero as \
      * with the light (measured, issue 19). So a variant with a constant light count calls this \
      * once per light with i and kind constants: straight-line code with the one look-up the light \
-     * needs */ \
-    "vec3 shade_light(int i, int kind, vec3 P, vec3 ngf, vec3 ns, vec3 wo, vec3 bc, vec3 kd, float spec, float f0d,\n" \
-    "                 float w_metal, float w_diel, float rough, float a2, float nv) {\n" \
-    "  Light l = l_lights[i]; int type = int(l.pos_type.w); vec3 wi, e;\n" \
+     * needs. lt, its type, likewise (0 point, 1 point with a range, 2 spot, 3 directional; -1 \
+     * read from the block): a point light runs no spot-cone or range code */ \
+    "vec3 shade_light(int i, int kind, int lt, vec3 P, vec3 ngf, vec3 ns, vec3 wo, vec3 bc, vec3 kd, float spec,\n" \
+    "                 float f0d, float w_metal, float w_diel, float rough, float a2, float nv) {\n" \
+    "  Light l = l_lights[i]; int type = lt < 0 ? int(l.pos_type.w) : lt == 3 ? 3 : lt == 2 ? 2 : 1; vec3 wi, e;\n" \
     "  if (type == 3) { wi = -l.dir_range.xyz; e = l.radiant.rgb; }\n" \
     "  else {\n" \
     "    wi = l.pos_type.xyz - P; float d2 = dot(wi, wi); if (!(d2 > 0.0)) return vec3(0.0);\n" \
     "    float d = sqrt(d2); wi /= d; float att = 1.0 / d2;\n" \
-    "    if (l.dir_range.w > 0.0) { float x = d / l.dir_range.w; float w = clamp(1.0 - x*x*x*x, 0.0, 1.0); att *= w * w; }\n" \
+    "    if (lt != 0 && l.dir_range.w > 0.0) { float x = d / l.dir_range.w; float w = clamp(1.0 - x*x*x*x, 0.0, 1.0); att *= w * w; }\n" \
     "    if (type == 2) { float cd = -dot(l.dir_range.xyz, wi); float s = clamp(cd * l.cone.x + l.cone.y, 0.0, 1.0); att *= s * s; }\n" \
     "    if (!(att > 0.0)) return vec3(0.0); e = l.radiant.rgb * att;\n" \
     "  }\n" \
@@ -244,12 +246,12 @@ const char *const sy_gl_main_vs =
     "    float a = max(rough * rough, 1e-4), a2 = a * a;\n" \
     "    float nv = max(dot(ns, wo), 1e-4);\n" \
     "#ifdef SY_LIGHTS\n" \
-    "#define SY_LIGHT(i, kind) shade_light(i, kind, P, ngf, ns, wo, bc, kd, spec, f0d, w_metal, w_diel, rough, a2, nv)\n" \
+    "#define SY_LIGHT(i, kind, lt) shade_light(i, kind, lt, P, ngf, ns, wo, bc, kd, spec, f0d, w_metal, w_diel, rough, a2, nv)\n" \
     "#ifdef SY_NLIGHTS\n" /* the variant's light count (1 .. 7) and shadow kinds SY_LK0 ..: straight-line code */ \
     SY_GL_LIGHT_CALL(0) SY_GL_LIGHT_CALL(1) SY_GL_LIGHT_CALL(2) SY_GL_LIGHT_CALL(3) SY_GL_LIGHT_CALL(4) \
     SY_GL_LIGHT_CALL(5) SY_GL_LIGHT_CALL(6) \
     "#else\n" /* more lights than variants count: the Lights block's count */ \
-    "    for (int i = 0; i < l_count.x; ++i) L += SY_LIGHT(i, -1);\n" \
+    "    for (int i = 0; i < l_count.x; ++i) L += SY_LIGHT(i, -1, -1);\n" \
     "#endif\n" \
     "#endif\n" \
     "#if defined(SY_AREA) || defined(SY_ENV) || defined(SY_PROBE)\n" \

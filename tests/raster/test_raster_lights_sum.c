@@ -1,12 +1,13 @@
 /* test_raster_lights_sum.c — punctual lights add up, whichever way the shader gets them. A shading
  * program with at most 7 lights calls each light with its kind of shadow fixed when the program is
- * built (sy_gl_shaders.c, shade_light); with more lights it loops over the Lights block and reads
- * each kind there. On an OSMesa device with 4x MSAA, forward and deferred:
+ * built (sy_gl_shaders.c, shade_light), and its type too (point, point with a range, spot,
+ * directional); with more lights it loops over the Lights block and reads each kind and type there.
+ * On an OSMesa device with 4x MSAA, forward and deferred:
  *  1. eight lights at once (two point lights with cube shadows, two directional and two spot lights
- *     with shadow maps, two lights without shadows: the loop) equal the sum of two renders of four
- *     of them each (the constant-count programs, each light's shadow of the same kind as in the
- *     eight), to float rounding: a light drawn with the wrong shadow, or twice, or not at all,
- *     changes whole regions;
+ *     with shadow maps, two lights without shadows; a point and a spot light with ranges: the
+ *     loop) equal the sum of two renders of four of them each (the constant-count programs, each
+ *     light's shadow of the same kind as in the eight), to float rounding: a light drawn with the
+ *     wrong shadow or type, or twice, or not at all, changes whole regions;
  *  2. turning the first point light's shadow off builds programs for the new kinds: the image
  *     brightens where the occluder shadowed it and nowhere darkens; turning it on again takes the
  *     programs kept aside for the first kinds and gives the first image back bit for bit;
@@ -33,8 +34,9 @@ static const sy_gl_light_desc lights[8] = {
     {.type = SY_GL_LIGHT_POINT, .color = {1, 0.9f, 0.8f}, .intensity = 20.0f, .position = {2.0f, 3, -2}},
     {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {0.6f, 0.7f, 1}, .intensity = 1.0f, .direction = {0.3f, -1, -0.4f}},
     {.type = SY_GL_LIGHT_SPOT, .color = {1, 0.5f, 0.3f}, .intensity = 40.0f, .position = {-2, 3, -2},
-     .direction = {0.5f, -1, -0.5f}, .inner_cone_angle = 0.3f, .outer_cone_angle = 0.6f},
-    {.type = SY_GL_LIGHT_POINT, .color = {0.3f, 1, 0.4f}, .intensity = 6.0f, .position = {0, 1.5f, -1}, .no_shadow = true},
+     .direction = {0.5f, -1, -0.5f}, .inner_cone_angle = 0.3f, .outer_cone_angle = 0.6f, .range = 7.0f},
+    {.type = SY_GL_LIGHT_POINT, .color = {0.3f, 1, 0.4f}, .intensity = 6.0f, .position = {0, 1.5f, -1}, .no_shadow = true,
+     .range = 3.5f},
     {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {1, 1, 0.8f}, .intensity = 0.7f, .direction = {-0.5f, -1, 0.2f}},
     {.type = SY_GL_LIGHT_POINT, .color = {0.5f, 0.6f, 1}, .intensity = 15.0f, .position = {-2.5f, 2, -3}},
     {.type = SY_GL_LIGHT_SPOT, .color = {0.8f, 0.8f, 1}, .intensity = 30.0f, .position = {1, 4, -4},
