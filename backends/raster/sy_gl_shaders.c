@@ -471,9 +471,8 @@ const char *const sy_gl_gbuf_fs =
     "  o_depth = d;\n"
     "}\n";
 
-/* The deferred pass's rectangles (sy_gl_deferred_fs): u_rects[i] = (x0, y0, x1, y1) in normalised
- * device coordinates, drawn as two triangles each (6 vertices per rectangle) at window depth 0.25,
- * in front of the resolve's full-screen triangle (0.5; see deferred_pass). */
+/* Rectangles for the deferred pass and the resolve beside it (deferred_pass): u_rects[i] = (x0,
+ * y0, x1, y1) in normalised device coordinates, two triangles each (6 vertices per rectangle). */
 #define SY_GL_STR_(x) #x
 #define SY_GL_STR(x) SY_GL_STR_(x)
 const char *const sy_gl_rect_vs =
@@ -481,7 +480,7 @@ const char *const sy_gl_rect_vs =
     "uniform vec4 u_rects[" SY_GL_STR(SY_GL_MAX_RECTS) "];\n"
     "void main() { vec4 r = u_rects[gl_VertexID / 6]; int c = gl_VertexID % 6;\n"
     "  bool right = c == 1 || c == 2 || c == 4, top = c == 2 || c == 4 || c == 5;\n"
-    "  gl_Position = vec4(right ? r.z : r.x, top ? r.w : r.y, -0.5, 1.0); }\n";
+    "  gl_Position = vec4(right ? r.z : r.x, top ? r.w : r.y, 0.0, 1.0); }\n";
 
 /* The deferred pass: rectangles (sy_gl_rect_vs) over the multisampled targets. Per
  * pixel it groups the G-buffer samples into surfaces (same material, side and kind of normal,
@@ -514,8 +513,8 @@ const char *const sy_gl_deferred_fs =
     "  float row = floor(key * 0.25), bits = key - 4.0 * row; bool front = mod(bits, 2.0) > 0.5, geo = bits > 1.5;\n"
     "  int r = int(row);\n"
     "  vec4 base = texelFetch(t_mtab, ivec2(0, r), 0), emis = texelFetch(t_mtab, ivec2(1, r), 0);\n"
-    "  vec4 oist = texelFetch(t_mtab, ivec2(2, r), 0);\n"
-    "  bool unlit = mod(oist.w, 2.0) > 0.5, two_sided = mod(oist.w, 4.0) > 1.5, emitter = oist.w > 3.5;\n"
+    "  vec4 istf = texelFetch(t_mtab, ivec2(2, r), 0);\n" /* ior, specular, transmission, flags */
+    "  bool unlit = mod(istf.w, 2.0) > 0.5, two_sided = mod(istf.w, 4.0) > 1.5, emitter = istf.w > 3.5;\n"
     "  vec3 L = emitter && (front || two_sided) ? emis.rgb : vec3(0.0);\n"
     "  if (unlit) return L + base.rgb;\n"
     "#ifdef SY_LIT\n"
@@ -525,7 +524,7 @@ const char *const sy_gl_deferred_fs =
     "  vec3 ngf = normalize(mat3(u_inv_view) * (geo ? nu : geo_normal(slope_dec(g, key), X)));\n"
     "  vec3 ns = geo ? ngf : (front ? nu : -nu);\n"
     "  L += shade_lit(P, ngf, ns, wo, clamp(base.rgb, 0.0, 1.0), clamp(base.a, 0.0, 1.0), clamp(emis.a, 0.0, 1.0),\n"
-    "                 oist.x, clamp(oist.y, 0.0, 1.0), clamp(oist.z, 0.0, 1.0), 1.0, emitter);\n"
+    "                 istf.x, clamp(istf.y, 0.0, 1.0), clamp(istf.z, 0.0, 1.0), 1.0, emitter);\n"
     "#endif\n"
     "  return L;\n"
     "}\n"

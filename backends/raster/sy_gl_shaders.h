@@ -13,7 +13,8 @@ extern const char *const sy_gl_sky_fs; /* with sy_gl_resolve_vs */
 extern const char *const sy_gl_floor_vs, *const sy_gl_floor_fs;
 extern const char *const sy_gl_gbuf_vs, *const sy_gl_gbuf_fs; /* deferred shading: the geometry pass */
 extern const char *const sy_gl_deferred_fs; /* ... its shading and resolve pass, with sy_gl_rect_vs */
-/* the deferred pass's rectangles: uniform vec4 u_rects[SY_GL_MAX_RECTS] (NDC x0, y0, x1, y1) */
+/* rectangles (the deferred pass and the resolve beside it): uniform vec4 u_rects[SY_GL_MAX_RECTS]
+ * (NDC x0, y0, x1, y1), 6 vertices each */
 extern const char *const sy_gl_rect_vs;
 #define SY_GL_MAX_RECTS 16
 
