@@ -191,8 +191,7 @@ struct sy_gl_device {
     uint32_t msaa, max_tex, shadow_size;
     pool meshes, textures, materials, instances, lights;
     GLuint prog_resolve, prog_floor, prog_floor_lit;
-    GLuint prog_resolve_rects; /* the resolve over rectangles (sy_gl_rect_vs), beside the deferred pass */
-    GLint resolve_rects;       /* its u_rects */
+    GLint resolve_rects; /* prog_resolve's u_rects (sy_gl_rect_vs: the whole target or the tiles the deferred pass leaves) */
     struct main_prog { /* main-pass variants, built on first use, indexed by VAR_* bits (main_program) */
         GLuint prog;
         GLint model, normal_mat, mvp, cam_pos, cam_fwd, ortho, ortho_z, mirror, has_normals, probe_lod;
@@ -826,10 +825,7 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
                                 &dev->ps[v].prog, err, err_len);
     char rdefs[40];
     snprintf(rdefs, sizeof rdefs, "#define SY_SAMPLES %u\n", dev->msaa);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "resolve", sy_gl_resolve_vs, sy_gl_resolve_fs, rdefs, &dev->prog_resolve, err, err_len);
-    if (r == SY_GL_OK)
-        r = sy_gl_program_build(gl, "resolve (rectangles)", sy_gl_rect_vs, sy_gl_resolve_fs, rdefs, &dev->prog_resolve_rects,
-                                err, err_len);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "resolve", sy_gl_rect_vs, sy_gl_resolve_fs, rdefs, &dev->prog_resolve, err, err_len);
     if (r == SY_GL_OK) r = sy_gl_program_build(gl, "floor", sy_gl_floor_vs, sy_gl_floor_fs, NULL, &dev->prog_floor, err, err_len);
     if (r == SY_GL_OK)
         r = sy_gl_program_build(gl, "floor (trivial lit)", sy_gl_floor_vs, sy_gl_floor_fs, "#define SY_FLOOR_LIT 1\n",
@@ -852,13 +848,10 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
         dev->ps[v].lightvp = gl->GetUniformLocation(dev->ps[v].prog, "u_lightvp");
         bind_samplers(gl, dev->ps[v].prog);
     }
-    for (int i = 0; i < 2; ++i) {
-        GLuint p = i ? dev->prog_resolve_rects : dev->prog_resolve;
-        gl->UseProgram(p);
-        gl->Uniform1i(gl->GetUniformLocation(p, "t_color"), 0);
-        gl->Uniform1i(gl->GetUniformLocation(p, "t_depth"), 1);
-    }
-    dev->resolve_rects = gl->GetUniformLocation(dev->prog_resolve_rects, "u_rects");
+    gl->UseProgram(dev->prog_resolve);
+    gl->Uniform1i(gl->GetUniformLocation(dev->prog_resolve, "t_color"), 0);
+    gl->Uniform1i(gl->GetUniformLocation(dev->prog_resolve, "t_depth"), 1);
+    dev->resolve_rects = gl->GetUniformLocation(dev->prog_resolve, "u_rects");
     for (int k = 0; k < 2; ++k) {
         GLuint fp = k ? dev->prog_floor_lit : dev->prog_floor;
         dev->uf[k].model = gl->GetUniformLocation(fp, "u_model");
@@ -952,9 +945,9 @@ void sy_gl_device_destroy(sy_gl_device *dev)
             if (dev->pm[v].prog) gl->DeleteProgram(dev->pm[v].prog);
         for (uint32_t i = 0; i < PM_SPARE; ++i)
             if (dev->pm_spare[i].prog) gl->DeleteProgram(dev->pm_spare[i].prog);
-        GLuint progs[8] = {dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor, dev->prog_sky,
-                           dev->prog_floor_lit, dev->ug[0].prog, dev->prog_resolve_rects};
-        for (int i = 0; i < 8; ++i)
+        GLuint progs[7] = {dev->ps[0].prog, dev->ps[1].prog, dev->prog_resolve, dev->prog_floor, dev->prog_sky,
+                           dev->prog_floor_lit, dev->ug[0].prog};
+        for (int i = 0; i < 7; ++i)
             if (progs[i]) gl->DeleteProgram(progs[i]);
         for (uint32_t i = 0; i < dev->dp_count; ++i) gl->DeleteProgram(dev->dp[i].prog);
         if (dev->ug[1].prog) gl->DeleteProgram(dev->ug[1].prog);
@@ -2182,8 +2175,24 @@ static void view_unproject(const view_setup *v, uint32_t w, uint32_t h, float un
 static int frame_lighting(const sy_gl_device *dev);
 static void bind_frame_resources(sy_gl_device *dev);
 
-/* The plain MSAA resolve (sy_gl_resolve_fs) of the target's samples into the bound resolve target. */
-static void resolve_pass(sy_gl_device *dev)
+/* Draws rectangles (NDC) with the bound program (sy_gl_rect_vs; loc: its u_rects), in batches. */
+static void draw_rects(sy_gl_device *dev, GLint loc, const float (*r)[4], uint32_t n)
+{
+    const sy_gl_fns *gl = dev->gl;
+    gl->BindVertexArray(dev->empty_vao);
+    for (uint32_t i = 0; i < n; i += SY_GL_MAX_RECTS) {
+        const uint32_t b = n - i < SY_GL_MAX_RECTS ? n - i : SY_GL_MAX_RECTS;
+        gl->Uniform4fv(loc, (GLsizei)b, r[i]);
+        gl->DrawArrays(GL_TRIANGLES, 0, (GLsizei)(6 * b));
+    }
+}
+
+/* The whole target as one rectangle (sy_gl_rect_vs). */
+static const float FULL_TARGET[1][4] = {{-1.0f, -1.0f, 1.0f, 1.0f}};
+
+/* The plain MSAA resolve (sy_gl_resolve_fs) of the target's samples in rectangles r[0, n) into the
+ * bound resolve target. */
+static void resolve_pass(sy_gl_device *dev, const float (*r)[4], uint32_t n)
 {
     const sy_gl_fns *gl = dev->gl;
     gl->UseProgram(dev->prog_resolve);
@@ -2191,15 +2200,14 @@ static void resolve_pass(sy_gl_device *dev)
     gl->BindTexture(GL_TEXTURE_2D_MULTISAMPLE, dev->t.color);
     gl->ActiveTexture(GL_TEXTURE1);
     gl->BindTexture(GL_TEXTURE_2D_MULTISAMPLE, dev->t.depthlin);
-    gl->BindVertexArray(dev->empty_vao);
-    gl->DrawArrays(GL_TRIANGLES, 0, 3);
+    draw_rects(dev, dev->resolve_rects, r, n);
 }
 
 /* Splits the target into the tiles (RECT_TILE pixels square) that the rectangles of rect_add touch
  * and the rest, each as rectangles in NDC (runs of tiles along a row, each extending an equal run
  * of the row below): dev->spans[0, *n_shade) and [*n_shade, *n_shade + *n_rest). Together they
- * cover every pixel once. False without memory. */
-static bool rect_tiles(sy_gl_device *dev, uint32_t *n_shade, uint32_t *n_rest)
+ * cover every pixel once; *shade_px: the pixels of the first list. False without memory. */
+static bool rect_tiles(sy_gl_device *dev, uint32_t *n_shade, uint32_t *n_rest, uint64_t *shade_px)
 {
     const uint32_t tw = (dev->t.w + RECT_TILE - 1) / RECT_TILE, th = (dev->t.h + RECT_TILE - 1) / RECT_TILE;
     const size_t n = (size_t)tw * th;
@@ -2222,22 +2230,25 @@ static bool rect_tiles(sy_gl_device *dev, uint32_t *n_shade, uint32_t *n_rest)
     const float sx = 2.0f / (float)dev->t.w, sy = 2.0f / (float)dev->t.h;
     /* runs[x]: 1 + the rectangle whose run starts at tile column x, runs[tw + x] its end column */
     uint32_t *start = dev->runs, *end = dev->runs + tw, count = 0;
+    *shade_px = 0;
     for (int want = 1; want >= 0; --want) {
         const uint32_t first = count;
         memset(start, 0, sizeof *start * tw);
         for (uint32_t y = 0; y < th; ++y) {
             const uint8_t *row = dev->tiles + (size_t)y * tw;
-            const float y0 = (float)(y * RECT_TILE) * sy - 1.0f;
-            const float y1 = (float)((y + 1) * RECT_TILE < dev->t.h ? (y + 1) * RECT_TILE : dev->t.h) * sy - 1.0f;
+            const uint32_t py1 = (y + 1) * RECT_TILE < dev->t.h ? (y + 1) * RECT_TILE : dev->t.h;
+            const float y0 = (float)(y * RECT_TILE) * sy - 1.0f, y1 = (float)py1 * sy - 1.0f;
             for (uint32_t x = 0, e; x < tw; x = e) {
                 for (e = x + 1; e < tw && row[e] == row[x]; ++e) {}
                 if (row[x] != want) continue;
+                const uint32_t px1 = e * RECT_TILE < dev->t.w ? e * RECT_TILE : dev->t.w;
+                if (want) *shade_px += (uint64_t)(px1 - x * RECT_TILE) * (py1 - y * RECT_TILE);
                 float *o = start[x] ? dev->spans[start[x] - 1] : NULL;
                 if (o && end[x] == e && o[3] == y0) o[3] = y1; /* the same run on the row below: taller */
                 else {
                     o = dev->spans[count++];
                     o[0] = (float)(x * RECT_TILE) * sx - 1.0f, o[1] = y0;
-                    o[2] = (float)(e * RECT_TILE < dev->t.w ? e * RECT_TILE : dev->t.w) * sx - 1.0f, o[3] = y1;
+                    o[2] = (float)px1 * sx - 1.0f, o[3] = y1;
                     start[x] = count, end[x] = e;
                 }
             }
@@ -2246,18 +2257,6 @@ static bool rect_tiles(sy_gl_device *dev, uint32_t *n_shade, uint32_t *n_rest)
         else *n_rest = count - first;
     }
     return true;
-}
-
-/* Draws rectangles (NDC) with the bound program (sy_gl_rect_vs; loc: its u_rects), in batches. */
-static void draw_rects(sy_gl_device *dev, GLint loc, const float (*r)[4], uint32_t n)
-{
-    const sy_gl_fns *gl = dev->gl;
-    gl->BindVertexArray(dev->empty_vao);
-    for (uint32_t i = 0; i < n; i += SY_GL_MAX_RECTS) {
-        const uint32_t b = n - i < SY_GL_MAX_RECTS ? n - i : SY_GL_MAX_RECTS;
-        gl->Uniform4fv(loc, (GLsizei)b, r[i]);
-        gl->DrawArrays(GL_TRIANGLES, 0, (GLsizei)(6 * b));
-    }
 }
 
 /* The deferred shading pass (sy_gl_deferred_fs) into the bound resolve target. It runs only on the
@@ -2277,14 +2276,9 @@ static sy_gl_result deferred_pass(sy_gl_device *dev, const view_setup *v, char *
     float unproj[4], px[2];
     view_unproject(v, t->w, t->h, unproj, px);
     uint32_t n_shade = 1, n_rest = 0;
-    static const float all[1][4] = {{-1.0f, -1.0f, 1.0f, 1.0f}};
-    const float(*shade)[4] = all;
-    if (!dev->rect_all && rect_tiles(dev, &n_shade, &n_rest)) shade = dev->spans;
-    else n_shade = 1, n_rest = 0;
-    dev->deferred_pixels = 0;
-    for (uint32_t i = 0; i < n_shade; ++i) /* exact: the corners are whole pixels */
-        dev->deferred_pixels += (uint64_t)llround((double)(shade[i][2] - shade[i][0]) / px[0]) *
-                                (uint64_t)llround((double)(shade[i][3] - shade[i][1]) / px[1]);
+    const float(*shade)[4] = FULL_TARGET;
+    if (!dev->rect_all && rect_tiles(dev, &n_shade, &n_rest, &dev->deferred_pixels)) shade = dev->spans;
+    else n_shade = 1, n_rest = 0, dev->deferred_pixels = (uint64_t)t->w * t->h;
     if (n_shade) {
         gl->UseProgram(dev->dp[k].prog);
         gl->Uniform4fv(dev->dp[k].unproj, 1, unproj);
@@ -2301,14 +2295,7 @@ static sy_gl_result deferred_pass(sy_gl_device *dev, const view_setup *v, char *
         gl->BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t->depthlin);
         draw_rects(dev, dev->dp[k].rects, shade, n_shade);
     }
-    if (n_rest) {
-        gl->UseProgram(dev->prog_resolve_rects);
-        gl->ActiveTexture(GL_TEXTURE0);
-        gl->BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t->color);
-        gl->ActiveTexture(GL_TEXTURE1);
-        gl->BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t->depthlin);
-        draw_rects(dev, dev->resolve_rects, dev->spans + n_shade, n_rest);
-    }
+    if (n_rest) resolve_pass(dev, dev->spans + n_shade, n_rest);
     return SY_GL_OK;
 }
 
@@ -2335,7 +2322,7 @@ static sy_gl_result finish_target(sy_gl_device *dev, const view_setup *v, float 
         gl->DrawBuffers(2, bufs);
         gl->Disable(GL_DEPTH_TEST);
         gl->Disable(GL_BLEND);
-        resolve_pass(dev);
+        resolve_pass(dev, FULL_TARGET, 1);
         read_fbo = t->rfbo;
     }
     size_t n = (size_t)t->w * t->h;

@@ -8,7 +8,7 @@
 
 extern const char *const sy_gl_main_vs, *const sy_gl_main_fs;
 extern const char *const sy_gl_shadow_vs, *const sy_gl_shadow_fs;
-extern const char *const sy_gl_resolve_vs, *const sy_gl_resolve_fs; /* resolve_vs: a full-screen triangle */
+extern const char *const sy_gl_resolve_vs, *const sy_gl_resolve_fs; /* resolve_vs: a full-screen triangle (sky, IBL); resolve_fs: with sy_gl_rect_vs */
 extern const char *const sy_gl_sky_fs; /* with sy_gl_resolve_vs */
 extern const char *const sy_gl_floor_vs, *const sy_gl_floor_fs;
 extern const char *const sy_gl_gbuf_vs, *const sy_gl_gbuf_fs; /* deferred shading: the geometry pass */
