@@ -236,7 +236,7 @@ struct sy_gl_device {
     bool forward; /* sy_gl_device_desc.forward */
     struct { /* the G-buffer pass: perspective, orthographic */
         GLuint prog;
-        GLint normal_mat, mvp, ppu, ortho_z, mirror, has_normals, key;
+        GLint normal_mat, mvp, ppu, ortho_z, has_normals, keys;
     } ug[2];
     struct {
         int var;        /* the lighting variant bits */
@@ -865,9 +865,8 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
         dev->ug[k].mvp = gl->GetUniformLocation(g, "u_mvp");
         dev->ug[k].ppu = gl->GetUniformLocation(g, "u_ppu");
         dev->ug[k].ortho_z = gl->GetUniformLocation(g, "u_ortho_z");
-        dev->ug[k].mirror = gl->GetUniformLocation(g, "u_mirror");
         dev->ug[k].has_normals = gl->GetUniformLocation(g, "u_has_normals");
-        dev->ug[k].key = gl->GetUniformLocation(g, "u_key");
+        dev->ug[k].keys = gl->GetUniformLocation(g, "u_keys");
     }
     gl->UseProgram(dev->prog_sky);
     gl->Uniform1i(gl->GetUniformLocation(dev->prog_sky, "t_bg"), 0);
@@ -2501,8 +2500,9 @@ static void draw_gbuf(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const m
     gl->UniformMatrix4fv(dev->ug[k].mvp, 1, GL_FALSE, mvp);
     gl->UniformMatrix3fv(dev->ug[k].normal_mat, 1, GL_FALSE, in->normal_mat);
     gl->Uniform1i(dev->ug[k].has_normals, m->has_normals);
-    gl->Uniform1i(dev->ug[k].mirror, in->mirror);
-    gl->Uniform1f(dev->ug[k].key, (float)(4u * (mt ? mt->h.id & IDX_MASK : 0u)));
+    /* the key without geo (sy_gl_gbuf_fs): 4 x material row + front, plus 1 */
+    const float key = (float)(1u + 4u * (mt ? mt->h.id & IDX_MASK : 0u)), keys[2] = {key + !in->mirror, key + in->mirror};
+    gl->Uniform2fv(dev->ug[k].keys, 1, keys);
     dev->tris += draw_mesh_lod(dev, m, in->lod);
     dev->deferred_draws++;
     rect_add(dev, mvp, m);

@@ -415,9 +415,11 @@ const char *const sy_gl_main_fs =
  *
  * G-buffer sample, where forward-shaded samples hold their colour (alpha >= 0) and depth:
  *   colour (RGBA32F):
- *     x, y  the interpolated vertex normal (world space), octahedral (the encoding normalises it;
- *           not flipped); for a mesh without normals or where they interpolate to zero ("geo"),
- *           the slope h itself (below), the geometric normal being the shading normal there
+ *     x, y  the interpolated vertex normal n (world space, not flipped) as n.xy / |n.z| (the
+ *           gnomonic projection: a division, no normalisation or fold; the sign of n.z travels in
+ *           the depth's sign bit, |n.z| = 0 is taken as 1e-30); for a mesh without normals or
+ *           where they interpolate to zero ("geo"), the slope h itself (below), the geometric
+ *           normal being the shading normal there
  *     z     the slope h of the triangle's plane, its x component (exact); from h the shading pass
  *           rebuilds the geometric normal at the pixel centre X (view plane at distance 1, or
  *           metres when orthographic): view-space normal (-h, 1 - h.X) (perspective) or (h, 1)
@@ -425,7 +427,8 @@ const char *const sy_gl_main_fs =
  *     w     -(1 + key + 1024 qy), an exact integer: key = front + 2 geo + 4 x material row (< 256);
  *           qy the slope's y component, 8191 (1 + h.y / (1 + |h.y|)) rounded (0 .. 16382; h.y = 0
  *           exact; a step is at most 2.5e-4 radians of normal); negative marks a G-buffer sample
- *   depth (R32F): the view depth at the pixel centre, as in the forward pass.
+ *   depth (R32F): the view depth at the pixel centre as in the forward pass (never below 1e-30),
+ *           negated where n.z < 0.
  * The slope comes from the screen-space derivatives of the one quantity that is affine over a
  * triangle, 1/depth (perspective; divided by 1/depth, so that it is a ratio of the normal's
  * components) or depth (orthographic), instead of from an interpolated position (three varyings
@@ -434,14 +437,6 @@ const char *const sy_gl_main_fs =
  * blocks of mostly empty pixels, so each instruction costs many times what it costs in the shading
  * pass, which turns the slope into a world-space normal. (Measured: a third target for the slope,
  * or the slope in a wider depth target, costs as much as the arithmetic it saves.) */
-/* the octahedral map's fold of the lower hemisphere: the same in the encoder and the decoder */
-#define SY_GL_OCT_FOLD "vec2 oct_fold(vec2 e) { return (1.0 - abs(e.yx)) * vec2(e.x >= 0.0 ? 1.0 : -1.0, e.y >= 0.0 ? 1.0 : -1.0); }\n"
-#define SY_GL_OCT_DEC                                                                                       \
-    SY_GL_OCT_FOLD                                                                                          \
-    "vec3 oct_dec(vec2 e) { vec3 v = vec3(e, 1.0 - abs(e.x) - abs(e.y));\n"                                  \
-    "  if (v.z < 0.0) v.xy = oct_fold(v.xy);\n"                                                             \
-    "  return normalize(v); }\n"
-
 const char *const sy_gl_gbuf_vs =
     "#version 330 core\n"
     "layout(location=0) in vec3 a_pos; layout(location=1) in vec3 a_nrm;\n"
@@ -449,26 +444,28 @@ const char *const sy_gl_gbuf_vs =
     "void main() { v_nrm = u_has_normals ? u_normal_mat * a_nrm : vec3(0.0); gl_Position = u_mvp * vec4(a_pos, 1.0); }\n";
 
 /* u_ppu: pixels per unit of the view plane at distance 1 (perspective) or per metre (SY_ORTHO);
- * u_ortho_z (SY_ORTHO): proj[10], proj[14]; u_key: 4 x material row. Uniform choices are variants
- * (SY_ORTHO), not branches: a software rasterizer pays for both sides. */
+ * u_ortho_z (SY_ORTHO): proj[10], proj[14]; u_keys: 1 + the key without geo for front-facing
+ * triangles (x) and back-facing ones (y), the instance's mirroring folded in. Uniform choices are
+ * variants (SY_ORTHO) or folded into uniforms, not branches: a software rasterizer pays for both
+ * sides. */
 const char *const sy_gl_gbuf_fs =
-    "#version 330 core\n" SY_GL_OCT_FOLD
-    "uniform vec2 u_ppu; uniform bool u_mirror; uniform vec3 u_ortho_z; uniform float u_key;\n"
+    "#version 330 core\n"
+    "uniform vec2 u_ppu; uniform vec3 u_ortho_z; uniform vec2 u_keys;\n"
     "in vec3 v_nrm;\n"
     "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
     "void main() {\n"
     "#ifdef SY_ORTHO\n"
-    "  float d = -((gl_FragCoord.z * 2.0 - 1.0) - u_ortho_z.y) / u_ortho_z.x;\n"
+    "  float d = max(-((gl_FragCoord.z * 2.0 - 1.0) - u_ortho_z.y) / u_ortho_z.x, 1e-30);\n"
     "  vec2 h = vec2(dFdx(d), dFdy(d)) * u_ppu;\n"
     "#else\n"
     "  float W = gl_FragCoord.w, d = 1.0 / W; vec2 h = vec2(dFdx(W), dFdy(W)) * (u_ppu * d);\n"
     "#endif\n"
-    "  vec3 n = v_nrm; float s = abs(n.x) + abs(n.y) + abs(n.z); bool geo = !(s > 0.0);\n"
-    "  vec2 e = n.xy / s; if (n.z < 0.0) e = oct_fold(e);\n"
+    "  vec3 n = v_nrm; bool geo = !(dot(n, n) > 0.0);\n"
+    "  vec2 e = n.xy / max(abs(n.z), 1e-30);\n"
     "  float qy = floor(h.y / (1.0 + abs(h.y)) * 8191.0 + 8191.5);\n"
     "  o_color = vec4(geo ? h : e, h.x,\n"
-    "                 -(1.0 + u_key + (gl_FrontFacing != u_mirror ? 1.0 : 0.0) + (geo ? 2.0 : 0.0) + 1024.0 * qy));\n"
-    "  o_depth = d;\n"
+    "                 -((gl_FrontFacing ? u_keys.x : u_keys.y) + (geo ? 2.0 : 0.0) + 1024.0 * qy));\n"
+    "  o_depth = n.z < 0.0 ? -d : d;\n"
     "}\n";
 
 /* Rectangles for the deferred pass and the resolve beside it (deferred_pass): u_rects[i] = (x0,
@@ -492,7 +489,7 @@ const char *const sy_gl_rect_vs =
  * (base colour, metallic), (emission, roughness), (ior, specular, transmission, flags), flags =
  * unlit + 2 double-sided + 4 emissive: the fields the pass reads, in three look-ups. */
 const char *const sy_gl_deferred_fs =
-    "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_SHADING_DECLS SY_GL_OCT_DEC
+    "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_SHADING_DECLS
     "uniform sampler2DMS t_gcol; uniform sampler2DMS t_gdepth; uniform sampler2D t_mtab;\n"
     "uniform vec4 u_unproj; uniform mat4 u_inv_view; uniform vec2 u_px;\n" /* u_px: 2 / target size */
     "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
@@ -502,6 +499,10 @@ const char *const sy_gl_deferred_fs =
     "vec3 geo_normal(vec2 h, vec2 X) {\n"
     "  vec3 n = u_ortho ? vec3(h, 1.0) : vec3(-h, 1.0 - dot(h, X));\n"
     "  return dot(n, n) > 0.0 ? n : vec3(0.0, 0.0, 1.0); }\n"
+    /* the shading normal from its projection e and the sign of its z: scaled so that nothing
+     * overflows before it is normalised */
+    "vec3 normal_dec(vec2 e, bool zneg) { e = clamp(e, -1e30, 1e30); float m = max(max(abs(e.x), abs(e.y)), 1.0);\n"
+    "  return normalize(vec3(e, zneg ? -1.0 : 1.0) / m); }\n"
     /* the slope of a sample: x as stored, y from its 14 bits beside the key (the level of 0 exact:
      * the subtraction is of exact integers) */
     "vec2 slope_dec(vec4 g, float key) {\n"
@@ -533,9 +534,9 @@ const char *const sy_gl_deferred_fs =
     "  vec4 g[SY_SAMPLES]; float z[SY_SAMPLES], key[SY_SAMPLES]; vec3 nu[SY_SAMPLES];\n"
     "  float dmin = uintBitsToFloat(0x7F800000u); vec4 c = vec4(0.0); int todo = 0;\n"
     "  for (int i = 0; i < SY_SAMPLES; ++i) {\n"
-    "    g[i] = texelFetch(t_gcol, p, i); z[i] = texelFetch(t_gdepth, p, i).r; dmin = min(dmin, z[i]);\n"
+    "    g[i] = texelFetch(t_gcol, p, i); float zr = texelFetch(t_gdepth, p, i).r; z[i] = abs(zr); dmin = min(dmin, z[i]);\n"
     "    key[i] = mod(-g[i].w - 1.0, 1024.0); bool geo = mod(key[i], 4.0) > 1.5;\n"
-    "    nu[i] = geo ? normalize(geo_normal(g[i].xy, X)) : oct_dec(g[i].xy);\n"
+    "    nu[i] = geo ? normalize(geo_normal(g[i].xy, X)) : normal_dec(g[i].xy, (floatBitsToUint(zr) & 0x80000000u) != 0u);\n"
     "    if (g[i].w >= 0.0) c += g[i]; else todo |= 1 << i;\n"
     "  }\n"
     /* a loop, not an if per sample: a software rasterizer runs both sides of a branch for the whole

@@ -4,7 +4,7 @@
  * after the geometry pass. Every kind of light at once (a point light with a cube shadow, a
  * directional light with a shadow map, an environment, an area light), smooth and faceted meshes,
  * a mirrored instance, metal, unlit and emissive materials, a large quad that stays forward; in
- * perspective and orthographic views, after a material change (the material table's update), and
+ * perspective and orthographic views, from behind (normals with z < 0), after a material change (the material table's update), and
  * with a blended instance (the whole frame falls back to forward: bit-identical). The deferred pass
  * runs only on the 8-pixel tiles that the G-buffer instances' projected bounds touch (the target,
  * 196 x 146, is no multiple of 8), also with 80 small spheres across the image and past its
@@ -189,6 +189,14 @@ int main(void)
     n1 = render(&df, 1, true);
     CHECK(n1 == 4, "orthographic: %llu deferred draws", (unsigned long long)n1);
     compare("orthographic", 2.5e-3, 0.006);
+    /* 2b. from behind the spheres, looking along +z: the visible normals have z < 0 (world), which
+     * the G-buffer keeps in the depth's sign */
+    const sy_gl_camera back = {.camera_to_world = {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0.3f, -9.5f, 1},
+                               .window = {-0.8f, 0.8f, -0.6f, 0.6f}, .near_clip = 0.1f};
+    render_cam(&fw, 0, &back, NULL);
+    n1 = render_cam(&df, 1, &back, NULL);
+    CHECK(n1 == 4, "from behind: %llu deferred draws", (unsigned long long)n1);
+    compare("from behind", 2.5e-3, 0.006);
     /* 3. a material change reaches the deferred pass (its table row) */
     sy_gl_material_desc md;
     sy_gl_material_desc_init(&md);
