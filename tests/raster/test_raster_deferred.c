@@ -4,13 +4,14 @@
  * after the geometry pass. Every kind of light at once (a point light with a cube shadow, a
  * directional light with a shadow map, an environment, an area light), smooth and faceted meshes,
  * a mirrored instance, metal, unlit and emissive materials, a large quad that stays forward; in
- * perspective and orthographic views, from behind (normals with z < 0), after a material change (the material table's update), and
- * with a blended instance (the whole frame falls back to forward: bit-identical). The deferred pass
- * runs only on the 8-pixel tiles that the G-buffer instances' projected bounds touch (the target,
- * 196 x 146, is no multiple of 8), also with 80 small spheres across the image and past its
- * edges. The images must agree to what grouping a pixel's samples into one surface can change
- * (a pixel the deferred pass misses shows the raw G-buffer); the counters must show which
- * instances went which way and where the deferred pass ran. */
+ * perspective and orthographic views, from behind (normals with z < 0), after a material change
+ * (the material table's update), and with a blended instance (the whole frame falls back to
+ * forward: bit-identical). The deferred pass runs only on the 8-pixel tiles that the G-buffer
+ * instances' projected bounds touch (the target, 196 x 146, is no multiple of 8), also with 80
+ * small spheres across the image and past its edges. The images must agree to what grouping a
+ * pixel's samples into one surface can change (a pixel the deferred pass misses shows the raw
+ * G-buffer); the counters must show which instances went which way and where the deferred pass
+ * ran. */
 #include "sy_gl.h"
 
 #include <math.h>
