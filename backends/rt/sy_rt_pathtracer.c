@@ -113,8 +113,9 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
         if (v3_is_zero(f)) return zero;
         float pdf_l = t->pdf_select * d2 / cos_l * p_cat;
         if (!(pdf_l > 0.0f)) return zero;
-        float tmax = d - sy_rt_ray_eps(q) - sy_rt_ray_eps(s->p);
-        sy_rt_v3 tr = tmax > 0.0f ? unoccluded(c, p_off, wi, tmax, false) : v3(1.0f, 1.0f, 1.0f);
+        sy_rt_v3 sdir;
+        float tmax;
+        sy_rt_v3 tr = sy_rt_segment_to(p_off, q, &sdir, &tmax) ? unoccluded(c, p_off, sdir, tmax, false) : v3(1.0f, 1.0f, 1.0f);
         if (v3_is_zero(tr)) return zero;
         sy_rt_v3 le = v3_mul(tr, t->textured ? sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv) : t->emission);
         return v3_scale(v3_mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l);

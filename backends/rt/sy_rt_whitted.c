@@ -120,8 +120,9 @@ static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bs
         float pdf_b;
         sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b); /* includes cos_s */
         if (v3_is_zero(f)) continue;
-        float tmax = d - sy_rt_ray_eps(q) - sy_rt_ray_eps(s->p);
-        sy_rt_v3 tr = tmax > 0.0f ? shadow(c, p_off, wi, tmax) : v3(1.0f, 1.0f, 1.0f);
+        sy_rt_v3 sdir;
+        float tmax;
+        sy_rt_v3 tr = sy_rt_segment_to(p_off, q, &sdir, &tmax) ? shadow(c, p_off, sdir, tmax) : v3(1.0f, 1.0f, 1.0f);
         if (v3_is_zero(tr)) continue;
         sy_rt_v3 le = v3_mul(tr, t->textured ? sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv) : t->emission);
         float g = cos_l / d2 * t->area / p_sel;
