@@ -156,6 +156,22 @@ static inline void rt_render(sy_rt_device *dev, const sy_rt_camera *cam, const s
     MUST(sy_rt_render(dev, cam, d, *rgba, *depth, ERR));
 }
 
+/* Irradiance at a floor point (normal +Z) from a Lambertian square of radiance le, half-size s,
+ * parallel to the floor at height h and facing it, its centre d away along X: the integral of
+ * le cos cos / r^2 = le h^2 / r^4 over the square, midpoint rule on 200 x 200 cells. */
+static inline double rt_square_irradiance_at(double le, double s, double h, double d)
+{
+    const int n = 200;
+    const double cell = 2.0 * s / n;
+    double e = 0.0;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            double x = -s + (i + 0.5) * cell, y = -s + (j + 0.5) * cell, r2 = (d - x) * (d - x) + y * y + h * h;
+            e += le * h * h / (r2 * r2) * cell * cell;
+        }
+    return e;
+}
+
 static inline sy_rt_device *rt_device(void)
 {
     sy_rt_device *dev = NULL;

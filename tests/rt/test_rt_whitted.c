@@ -1,6 +1,6 @@
 /* test_rt_whitted.c — radiometry of the Whitted integrator against analytic values: visible
  * emitters, Lambert under point / spot / directional lights, an area light (rectangle form
- * factor), hard shadows where the geometry says, mirror reflection, glass transmission with
+ * factor; and one seen at a grazing angle), hard shadows where the geometry says, mirror reflection, glass transmission with
  * Fresnel, alpha-mask cut-outs and textured unlit materials. */
 #include "rt_test.h"
 
@@ -167,6 +167,36 @@ static void test_area_light(void)
     rt_render(dev, &cam, &rd, &rgba, &depth);
     c = px_at(rgba, 16, 16);
     CHECK(rt_near(c[0], expect, 0.05), "area light (16 samples): centre %.6g, expected %.6g", c[0], expect);
+    free(rgba);
+    free(depth);
+    sy_rt_device_destroy(dev);
+}
+
+/* An emitter seen at a grazing angle by a surface whose normal faces away from the emitter's: a
+ * small square (half-size 0.1, radiance 100) at height 1 facing down, the floor point 8 away
+ * (cos 0.12 at the emitter). Its shadow rays once ended behind the emitter's plane and the emitter
+ * shadowed itself: this pixel was black (9e-6 against 2.4e-4). Expected: albedo / pi x the
+ * square's irradiance (rt_square_irradiance_at). */
+static void test_area_light_grazing(void)
+{
+    sy_rt_device *dev = rt_device();
+    float xf[16];
+    rt_identity(xf);
+    const float albedo = 0.8f, le = 100.0f, s = 0.1f, d = 8.0f;
+    rt_place(dev, rt_quad(dev, 20.0f), xf, rt_lambert(dev, albedo, albedo, albedo), 0);
+    float em[16];
+    rt_rot_y(em, (float)M_PI, 0.0f, 0.0f, 1.0f);
+    rt_place(dev, rt_quad(dev, s), em, rt_emitter(dev, le, le, le), 0);
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_camera cam = rt_camera(0.5f, 0.02f);
+    cam.camera_to_world[12] = d; /* looking down at (d, 0, 0) */
+    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
+    rd.area_light_samples = 256;
+    float *rgba, *depth;
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    double expect = albedo / M_PI * rt_square_irradiance_at(le, s, 1.0, d);
+    const float *c = px_at(rgba, W / 2, W / 2);
+    CHECK(rt_near(c[0], expect, 0.01), "area light at a grazing angle: %.6g, expected %.6g", c[0], expect);
     free(rgba);
     free(depth);
     sy_rt_device_destroy(dev);
@@ -360,6 +390,7 @@ int main(void)
     test_emitter_exact();
     test_point_and_directional();
     test_area_light();
+    test_area_light_grazing();
     test_hard_shadow();
     test_mirror();
     test_glass();
