@@ -187,4 +187,24 @@ static inline int rt_finish(const char *name)
     return rt_failures ? 1 : 0;
 }
 
+/* The grazing-emitter scene of rt_whitted and rt_pathtracer: a Lambertian floor (albedo 0.8, z = 0,
+ * half-size 20) and a small emitter (half-size 0.1, radiance 100) at height 1 facing down, seen
+ * from the floor point (8, 0, 0) at cos 0.12, where the floor's normal faces away from the
+ * emitter's. Commits; returns a camera at height 0.5 looking down at that point (half-tangent
+ * 0.02) and in *expect the radiance there: albedo / pi x rt_square_irradiance_at. */
+static inline sy_rt_camera rt_grazing_emitter_scene(sy_rt_device *dev, double *expect)
+{
+    const float albedo = 0.8f, le = 100.0f, s = 0.1f, d = 8.0f;
+    float xf[16], em[16];
+    rt_identity(xf);
+    rt_place(dev, rt_quad(dev, 20.0f), xf, rt_lambert(dev, albedo, albedo, albedo), 0);
+    rt_rot_y(em, (float)M_PI, 0.0f, 0.0f, 1.0f);
+    rt_place(dev, rt_quad(dev, s), em, rt_emitter(dev, le, le, le), 0);
+    MUST(sy_rt_commit(dev, ERR));
+    sy_rt_camera cam = rt_camera(0.5f, 0.02f);
+    cam.camera_to_world[12] = d;
+    *expect = albedo / M_PI * rt_square_irradiance_at(le, s, 1.0, d);
+    return cam;
+}
+
 #endif /* RT_TEST_H */
