@@ -830,7 +830,7 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     if (r == SY_GL_OK)
         r = sy_gl_program_build(gl, "floor (trivial lit)", sy_gl_floor_vs, sy_gl_floor_fs, "#define SY_FLOOR_LIT 1\n",
                                 &dev->prog_floor_lit, err, err_len);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "sky", sy_gl_resolve_vs, sy_gl_sky_fs, NULL, &dev->prog_sky, err, err_len);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "sky", sy_gl_fullscreen_vs, sy_gl_sky_fs, NULL, &dev->prog_sky, err, err_len);
     dev->forward = dd.forward || dev->msaa < 2; /* the deferred pass is the MSAA resolve */
     for (int k = 0; k < 2 && r == SY_GL_OK && !dev->forward; ++k)
         r = sy_gl_program_build(gl, k ? "G-buffer (orthographic)" : "G-buffer", sy_gl_gbuf_vs, sy_gl_gbuf_fs,

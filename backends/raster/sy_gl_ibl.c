@@ -77,9 +77,9 @@ static const char *const brdf_fs =
 static sy_gl_result build(const sy_gl_fns *gl, sy_gl_ibl *ibl, char *err, size_t err_len)
 {
     if (ibl->prog_spec) return SY_GL_OK;
-    sy_gl_result r = sy_gl_program_build(gl, "IBL specular prefilter", sy_gl_resolve_vs, spec_fs, NULL, &ibl->prog_spec, err, err_len);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL irradiance", sy_gl_resolve_vs, irr_fs, NULL, &ibl->prog_irr, err, err_len);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL BRDF table", sy_gl_resolve_vs, brdf_fs, NULL, &ibl->prog_brdf, err, err_len);
+    sy_gl_result r = sy_gl_program_build(gl, "IBL specular prefilter", sy_gl_fullscreen_vs, spec_fs, NULL, &ibl->prog_spec, err, err_len);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL irradiance", sy_gl_fullscreen_vs, irr_fs, NULL, &ibl->prog_irr, err, err_len);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL BRDF table", sy_gl_fullscreen_vs, brdf_fs, NULL, &ibl->prog_brdf, err, err_len);
     if (r != SY_GL_OK) return r;
     ibl->spec_face = gl->GetUniformLocation(ibl->prog_spec, "u_face");
     ibl->spec_rough = gl->GetUniformLocation(ibl->prog_spec, "u_rough");

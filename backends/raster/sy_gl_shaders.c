@@ -587,7 +587,8 @@ const char *const sy_gl_sky_fs =
     "  vec2 uv = vec2(0.5 + atan(d.x, -d.z) * 0.15915494309, acos(clamp(d.y, -1.0, 1.0)) * 0.31830988618);\n"
     "  o_color = vec4(textureLod(t_bg, uv, 0.0).rgb * u_size_int.z, 1.0); o_depth = uintBitsToFloat(0x7F800000u); }\n";
 
-const char *const sy_gl_resolve_vs =
+/* A triangle covering the whole target (3 vertices, no attributes). */
+const char *const sy_gl_fullscreen_vs =
     "#version 330 core\n"
     "void main() { vec2 p = vec2(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID & 2) * 2 - 1));\n"
     "  gl_Position = vec4(p, 0.0, 1.0); }\n";

@@ -8,8 +8,9 @@
 
 extern const char *const sy_gl_main_vs, *const sy_gl_main_fs;
 extern const char *const sy_gl_shadow_vs, *const sy_gl_shadow_fs;
-extern const char *const sy_gl_resolve_vs, *const sy_gl_resolve_fs; /* resolve_vs: a full-screen triangle (sky, IBL); resolve_fs: with sy_gl_rect_vs */
-extern const char *const sy_gl_sky_fs; /* with sy_gl_resolve_vs */
+extern const char *const sy_gl_fullscreen_vs; /* a full-screen triangle (the sky, the IBL tables) */
+extern const char *const sy_gl_resolve_fs;    /* the MSAA resolve, with sy_gl_rect_vs */
+extern const char *const sy_gl_sky_fs; /* with sy_gl_fullscreen_vs */
 extern const char *const sy_gl_floor_vs, *const sy_gl_floor_fs;
 extern const char *const sy_gl_gbuf_vs, *const sy_gl_gbuf_fs; /* deferred shading: the geometry pass */
 extern const char *const sy_gl_deferred_fs; /* ... its shading and resolve pass, with sy_gl_rect_vs */
