@@ -110,6 +110,13 @@ void sy_mat4_transform_dir(const sy_mat4 *a, const float d[3], float out[3])
     out[0] = x, out[1] = y, out[2] = z;
 }
 
+bool sy_coords_in_range(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!(fabsf(v[i]) <= SY_COORD_MAX)) return false; /* NaN fails too */
+    return true;
+}
+
 bool sy_mat4_is_finite(const sy_mat4 *a)
 {
     for (int i = 0; i < 16; ++i)

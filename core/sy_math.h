@@ -7,10 +7,24 @@
 #define SY_MATH_H
 
 #include <stdbool.h>
+#include <stddef.h>
 
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/** The largest magnitude of any coordinate a back-end is given, in scene units (metres): vertex
+ * positions, translations, camera, light and orbit positions, bounds, and the world placements
+ * they compose to. One rule for every layer: setters, loaders and the replica refuse larger
+ * values (naming the item), interactive cameras are clamped to it, and the scene commit leaves a
+ * placement whose world transform exceeds it undrawn (logged). 1e12 m is beyond Saturn's orbit,
+ * where float spacing is already 6e4 m; it leaves Embree, which asserts on ray coordinates beyond
+ * 1.844e18, a margin of 10^6 for the instance transforms of a ray tracer (docs/FORMATS.md,
+ * "Numbers in range"). */
+#define SY_COORD_MAX 1.0e12f
+
+/** true when each of the n values is finite and at most SY_COORD_MAX in magnitude. */
+bool sy_coords_in_range(const float *v, size_t n);
 
 /** 4x4 matrix, column-major (glTF): m[12..14] = translation. */
 typedef struct sy_mat4 {
