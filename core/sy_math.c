@@ -117,6 +117,18 @@ bool sy_coords_in_range(const float *v, size_t n)
     return true;
 }
 
+bool sy_mat4_is_degenerate(const sy_mat4 *a)
+{
+    const float *m = a->m; /* column-major: m[c * 4 + r] */
+    double s = 0.0;
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) s = fmax(s, fabs((double)m[c * 4 + r]));
+    double det = (double)m[0] * ((double)m[5] * m[10] - (double)m[9] * m[6]) -
+                 (double)m[4] * ((double)m[1] * m[10] - (double)m[9] * m[2]) +
+                 (double)m[8] * ((double)m[1] * m[6] - (double)m[5] * m[2]);
+    return !(s > 0.0) || !(fabs(det) > 1e-30 * s * s * s);
+}
+
 bool sy_mat4_is_finite(const sy_mat4 *a)
 {
     for (int i = 0; i < 16; ++i)

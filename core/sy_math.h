@@ -48,6 +48,10 @@ bool sy_mat4_invert(const sy_mat4 *a, sy_mat4 *out);
 void sy_mat4_transform_point(const sy_mat4 *a, const float p[3], float out[3]);
 /** a applied to a direction (w = 0). */
 void sy_mat4_transform_dir(const sy_mat4 *a, const float d[3], float out[3]);
+/** true when the upper 3x3 collapses space: it is singular or so near it that its inverse is
+ * meaningless in float (|det| <= 1e-30 s^3, s its largest element; a zero scale on any axis). A
+ * placement with such a world matrix is not drawn (glTF hides parts with a zero scale). */
+bool sy_mat4_is_degenerate(const sy_mat4 *a);
 /** true when every element is finite. */
 bool sy_mat4_is_finite(const sy_mat4 *a);
 /** true when every element is equal. */

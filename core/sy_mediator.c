@@ -256,8 +256,30 @@ sy_result sy_context_sync(sy_context *c, sy_error *err)
     return r;
 }
 
+sy_result sy_camera_view_check(const sy_camera_view *v, sy_error *err)
+{
+    const float *m = v->camera_to_world.m;
+    if (!sy_coords_in_range(m, 16))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "camera at (%g %g %g) is beyond the coordinate range (at most %g in size)", (double)m[12],
+                            (double)m[13], (double)m[14], (double)SY_COORD_MAX);
+    for (int i = 0; i < 4; ++i)
+        if (!isfinite(v->window[i]) || (v->projection == SY_PROJECTION_ORTHOGRAPHIC && !sy_coords_in_range(&v->window[i], 1)))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera window[%d] = %g is not finite or beyond %g", i,
+                                (double)v->window[i], (double)SY_COORD_MAX);
+    if (!isfinite(v->znear) || !isfinite(v->zfar))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera clip range %g..%g is not finite", (double)v->znear,
+                            (double)v->zfar);
+    return SY_OK;
+}
+
 sy_result sy_context_render(sy_context *c, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
+    sy_result rc = sy_camera_view_check(&req->camera, err);
+    if (rc != SY_OK) {
+        sy_error_prefix(err, "%s render", c->cls->name);
+        return rc;
+    }
     if (req->rect_w != layer->width || req->rect_h != layer->height || req->rect_w == 0 || req->rect_h == 0 ||
         req->rect_x > req->full_width || req->rect_w > req->full_width - req->rect_x ||
         req->rect_y > req->full_height || req->rect_h > req->full_height - req->rect_y)

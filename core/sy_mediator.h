@@ -52,6 +52,12 @@ typedef struct sy_camera_view {
     float znear, zfar; /** @} */
 } sy_camera_view;
 
+/** SY_OK when the view is one every back-end can render: finite, the camera's position and every
+ * element of its matrix within SY_COORD_MAX (sy_math.h), an orthographic window within it too;
+ * otherwise SY_ERR_INVALID_ARGUMENT saying which value is out of range. sy_context_render checks
+ * every request with it, so no back-end is given a camera beyond the range. */
+sy_result sy_camera_view_check(const sy_camera_view *v, sy_error *err);
+
 /** Camera view for a camera object at a world matrix, for an image of the given aspect
  * (width / height). The image aspect wins over the camera's own aspect, keeping yfov / ymag. */
 sy_camera_view sy_camera_view_make(const sy_camera_data *cam, const sy_mat4 *world, float image_aspect);

@@ -3,6 +3,18 @@
 
 #include <math.h>
 
+/* SY_COORD_MAX: the target and the distance each within half of it, so the camera is within it;
+ * a non-finite value (never made here, but a caller may write the struct) goes back to the origin. */
+static void orbit_clamp(sy_orbit *o)
+{
+    const float half = 0.5f * SY_COORD_MAX;
+    for (int i = 0; i < 3; ++i)
+        o->target[i] = isfinite(o->target[i]) ? fminf(fmaxf(o->target[i], -half), half) : 0.0f;
+    o->dist = isfinite(o->dist) ? fminf(fmaxf(o->dist, 1e-3f), half) : 1.0f;
+    if (!isfinite(o->yaw)) o->yaw = 0.0f;
+    if (!isfinite(o->pitch)) o->pitch = 0.0f;
+}
+
 void sy_orbit_matrix(const sy_orbit *o, sy_mat4 *m)
 {
     float cp = cosf(o->pitch), back[3] = {cp * sinf(o->yaw), sinf(o->pitch), cp * cosf(o->yaw)};
@@ -31,6 +43,7 @@ void sy_orbit_from_matrix(const sy_mat4 *m, const sy_bounds *b, sy_orbit *o)
     for (int i = 0; i < 3; ++i) o->target[i] = pos[i] - back[i] * d;
     o->pitch = asinf(back[1] < -1 ? -1 : back[1] > 1 ? 1 : back[1]);
     o->yaw = atan2f(back[0], back[2]);
+    orbit_clamp(o);
 }
 
 void sy_orbit_rotate(sy_orbit *o, float dx, float dy)
@@ -40,6 +53,7 @@ void sy_orbit_rotate(sy_orbit *o, float dx, float dy)
     o->pitch += dy * 0.008f;
     if (o->pitch > 1.55f) o->pitch = 1.55f;
     if (o->pitch < -1.55f) o->pitch = -1.55f;
+    orbit_clamp(o);
 }
 
 void sy_orbit_pan(sy_orbit *o, float dx, float dy)
@@ -49,6 +63,7 @@ void sy_orbit_pan(sy_orbit *o, float dx, float dy)
     sy_orbit_matrix(o, &m);
     float k = o->dist * 0.0015f;
     for (int i = 0; i < 3; ++i) o->target[i] += (-dx * m.m[i] + dy * m.m[4 + i]) * k;
+    orbit_clamp(o);
 }
 
 void sy_orbit_zoom(sy_orbit *o, float steps)
@@ -57,6 +72,5 @@ void sy_orbit_zoom(sy_orbit *o, float steps)
     if (steps > 50.0f) steps = 50.0f;
     if (steps < -50.0f) steps = -50.0f;
     o->dist *= powf(0.9f, steps);
-    if (o->dist < 1e-3f) o->dist = 1e-3f;
-    if (o->dist > 1e12f) o->dist = 1e12f;
+    orbit_clamp(o);
 }

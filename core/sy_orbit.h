@@ -35,10 +35,14 @@ void sy_orbit_from_matrix(const sy_mat4 *m, const sy_bounds *b, sy_orbit *o);
  * the pitch clamped to +-1.55. Non-finite input is ignored. */
 void sy_orbit_rotate(sy_orbit *o, float dx, float dy);
 
-/** A pan of dx, dy pixels: moves the target in the image plane, 0.0015 x dist per pixel. */
+/** A pan of dx, dy pixels: moves the target in the image plane, 0.0015 x dist per pixel.
+ * Every call here keeps the orbit within the coordinate range: the target's coordinates and the
+ * distance within SY_COORD_MAX / 2 (so the camera is within SY_COORD_MAX, sy_math.h), the
+ * distance >= 1e-3; however many pans and zooms an input sends. */
 void sy_orbit_pan(sy_orbit *o, float dx, float dy);
 
-/** steps wheel notches (positive = closer): the distance is scaled by 0.9^steps, kept >= 1e-3.
+/** steps wheel notches (positive = closer): the distance is scaled by 0.9^steps, kept within
+ * [1e-3, SY_COORD_MAX / 2].
  * Non-finite input is ignored. */
 void sy_orbit_zoom(sy_orbit *o, float steps);
 

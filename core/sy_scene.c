@@ -367,13 +367,15 @@ static void update_bounds(sy_scene *s)
     s->bounds_dirty.count = 0;
 }
 
-/* true if `target` is reachable downwards from `from` (used to refuse cycles). */
-static bool reaches(sy_scene *s, uint32_t from, uint32_t target)
+/* true if `target` is reachable downwards from any of the n nodes `from` (used to refuse cycles):
+ * one walk that visits each node once, however many of them share subtrees. An allocation failure
+ * answers true (the change is refused rather than risking a cycle). */
+static bool reaches(sy_scene *s, const uint32_t *from, uint32_t n, uint32_t target)
 {
     id_list st = {0};
     s->epoch++;
     bool found = false;
-    list_push(&st, from);
+    for (uint32_t i = 0; i < n && !found; ++i) found = !list_push(&st, from[i]);
     while (st.count && !found) {
         uint32_t id = st.items[--st.count];
         if (id == target) {
@@ -385,10 +387,80 @@ static bool reaches(sy_scene *s, uint32_t from, uint32_t target)
         sl->nx->mark = s->epoch;
         uint32_t nc;
         const uint32_t *ch = sy_node_children(sl->data, &nc);
-        for (uint32_t k = 0; k < nc; ++k) list_push(&st, ch[k]);
+        for (uint32_t k = 0; k < nc && !found; ++k) found = !list_push(&st, ch[k]);
     }
     free(st.items);
     return found;
+}
+
+/* A cycle through a node whose children a change list set: one depth-first walk from all of them
+ * (grey = on the walk's path, black = done; each node visited once, so a snapshot of a large
+ * graph costs its size, not its size per changed node). *at names a node on the cycle. An
+ * allocation failure answers true. */
+static bool find_cycle(sy_scene *s, const sy_changes *changes, uint32_t *at)
+{
+    typedef struct frame {
+        uint32_t id, next;
+    } frame;
+    frame *st = NULL;
+    uint32_t depth = 0, cap = 0;
+    uint32_t grey = s->epoch + 1u, black = s->epoch + 2u;
+    s->epoch += 2u;
+    bool found = false;
+    uint32_t n = sy_changes_count(changes);
+    for (uint32_t i = 0; i < n && !found; ++i) {
+        const sy_change *e = sy_changes_get(changes, i);
+        if (e->type != SY_TYPE_NODE || !(e->mask & SY_BIT(SY_NODE_CHILDREN))) continue;
+        slot *root = lookup(s, SY_TYPE_NODE, e->id);
+        if (!root || root->nx->mark == black) continue;
+        depth = 0;
+        uint32_t id = e->id;
+        for (;;) {
+            slot *sl = lookup(s, SY_TYPE_NODE, id);
+            if (sl && sl->nx->mark == grey) {
+                found = true;
+                *at = id;
+                break;
+            }
+            if (sl && sl->nx->mark != black) { /* enter */
+                if (depth == cap) {
+                    uint32_t nc = cap ? cap * 2u : 64u;
+                    frame *ns = nc > cap ? realloc(st, sizeof *ns * nc) : NULL;
+                    if (!ns) {
+                        found = true;
+                        *at = id;
+                        break;
+                    }
+                    st = ns;
+                    cap = nc;
+                }
+                sl->nx->mark = grey;
+                st[depth++] = (frame){id, 0};
+            }
+            /* next child of the deepest frame, popping finished frames */
+            id = 0;
+            while (depth) {
+                frame *f = &st[depth - 1];
+                uint32_t nc;
+                const uint32_t *ch = sy_node_children(sy_object_get(s, SY_TYPE_NODE, f->id), &nc);
+                if (f->next < nc) {
+                    id = ch[f->next++];
+                    break;
+                }
+                lookup(s, SY_TYPE_NODE, f->id)->nx->mark = black;
+                depth--;
+            }
+            if (!id) break;
+        }
+    }
+    free(st);
+    return found;
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
 }
 
 /* >>validation (one place for every field of every type) */
@@ -468,9 +540,11 @@ static sy_result check_primitive(const sy_scene *s, const sy_primitive *p, uint3
     uint32_t nv = (uint32_t)(psize / 12);
     const float *pos = sy_blob_data(p->positions);
     for (uint32_t v = 0; v < nv * 3; ++v)
-        if (!isfinite(pos[v]))
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: vertex %u has a non-finite position",
-                                i, v / 3);
+        if (!(fabsf(pos[v]) <= SY_COORD_MAX))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "mesh primitive %u: vertex %u has a position %s (%g; at most %g in size)", i, v / 3,
+                                isfinite(pos[v]) ? "beyond the coordinate range" : "that is not finite",
+                                (double)pos[v], (double)SY_COORD_MAX);
     sy_result r;
     if ((r = check_blob_elems(p->normals, 12, nv, "normals", i, err)) ||
         (r = check_blob_elems(p->tangents, 16, nv, "tangents", i, err)) ||
@@ -517,6 +591,15 @@ static sy_result validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_
             if (!finite_n(t->translation, 3) || !finite_n(t->rotation, 4) || !finite_n(t->scale, 3) ||
                 !sy_mat4_is_finite(&t->matrix))
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: non-finite transform");
+            /* SY_COORD_MAX (sy_math.h): translations, scales and every matrix element */
+            if (!sy_coords_in_range(t->translation, 3) || !sy_coords_in_range(t->scale, 3) ||
+                !sy_coords_in_range(t->matrix.m, 16))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "node: transform beyond the coordinate range (translation (%g %g %g), scale "
+                                    "(%g %g %g); at most %g in size)",
+                                    (double)t->matrix.m[12], (double)t->matrix.m[13], (double)t->matrix.m[14],
+                                    (double)t->scale[0], (double)t->scale[1], (double)t->scale[2],
+                                    (double)SY_COORD_MAX);
             return SY_OK;
         }
         case SY_NODE_CHILDREN: {
@@ -531,13 +614,22 @@ static sy_result validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_
                     return sy_error_set(err, SY_ERR_INVALID_HANDLE, "node: child %u is a stale handle %#x", i, ch[i]);
                 if (ch[i] == id)
                     return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: child %u is the node itself", i);
-                for (uint32_t j = 0; j < i; ++j)
-                    if (ch[j] == ch[i])
-                        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: child %#x listed twice", ch[i]);
-                if (!s->applying && reaches(s, ch[i], id))
-                    return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                        "node: child %#x is an ancestor (the graph would have a cycle)", ch[i]);
             }
+            /* duplicates by sorting a copy (n log n: child lists of a million instances stay cheap) */
+            if (n > 1) {
+                uint32_t *sorted = malloc(sizeof *sorted * n);
+                if (!sorted) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "node: %u children: out of memory", n);
+                memcpy(sorted, ch, sizeof *sorted * n);
+                qsort(sorted, n, sizeof *sorted, cmp_u32);
+                uint32_t dup = 0;
+                for (uint32_t i = 1; i < n && !dup; ++i)
+                    if (sorted[i] == sorted[i - 1]) dup = sorted[i];
+                free(sorted);
+                if (dup) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: child %#x listed twice", dup);
+            }
+            if (!s->applying && reaches(s, ch, n, id))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "node: a child is the node's ancestor (the graph would have a cycle)");
             return SY_OK;
         }
         case SY_NODE_MESH:
@@ -630,6 +722,9 @@ static sy_result validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_
                 if (!isfinite(fv[i]) || fv[i] < 0.0f)
                     return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "light: %s must be finite and >= 0",
                                         sy__type_desc(type)->fields[f].name);
+            if (f == SY_LIGHT_RANGE && !sy_coords_in_range(fv, 1))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "light: range %g is beyond the coordinate range (%g)",
+                                    (double)fv[0], (double)SY_COORD_MAX);
             /* KHR_lights_punctual: 0 <= inner < outer <= pi/2 (inner >= outer is read as a hard edge:
              * every back-end gets the light through the mirror, which orders them) */
             if ((f == SY_LIGHT_INNER_CONE || f == SY_LIGHT_OUTER_CONE) && fv[0] > 1.5707964f)
@@ -653,6 +748,10 @@ static sy_result validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera: yfov %g outside (0, pi)", (double)x);
             if (f == SY_CAMERA_ZNEAR && x <= 0.0f)
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera: znear must be > 0");
+            if ((f == SY_CAMERA_ZNEAR || f == SY_CAMERA_ZFAR || f == SY_CAMERA_XMAG || f == SY_CAMERA_YMAG) &&
+                x > SY_COORD_MAX)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera: %s %g is beyond the coordinate range (%g)",
+                                    fn, (double)x, (double)SY_COORD_MAX);
         }
         return SY_OK;
     case SY_TYPE_BACKGROUND:
@@ -1672,14 +1771,10 @@ sy_result sy_scene_apply_bounded(sy_scene *s, const sy_changes *changes, uint64_
     }
     s->applying = false;
     /* the origin never has cycles; a change list that creates one is corrupt */
-    for (uint32_t i = 0; i < n && r == SY_OK; ++i) {
-        const sy_change *e = sy_changes_get(changes, i);
-        if (e->type != SY_TYPE_NODE || !(e->mask & SY_BIT(SY_NODE_CHILDREN))) continue;
-        uint32_t nc;
-        const uint32_t *ch = sy_node_children(sy_object_get(s, SY_TYPE_NODE, e->id), &nc);
-        for (uint32_t k = 0; k < nc && r == SY_OK; ++k)
-            if (reaches(s, ch[k], e->id))
-                r = sy_error_set(err, SY_ERR_PARSE, "apply: node %#x would be its own ancestor (cycle)", e->id);
+    if (r == SY_OK) {
+        uint32_t at = 0;
+        if (find_cycle(s, changes, &at))
+            r = sy_error_set(err, SY_ERR_PARSE, "apply: node %#x would be its own ancestor (cycle)", at);
     }
     return r;
 }

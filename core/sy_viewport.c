@@ -189,7 +189,12 @@ sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, u
         mono = sy_camera_view_frame_bounds(&b, aspect);
     }
     *out = sy_camera_view_eye(&mono, v->desc.eye, v->desc.eye_separation, v->desc.zero_parallax);
-    return SY_OK;
+    sy_result res = sy_camera_view_check(out, err);
+    if (res != SY_OK) {
+        if (v->desc.camera.id) sy_error_prefix(err, "viewport: camera node %#x", v->desc.camera.id);
+        else sy_error_prefix(err, "viewport: the view framing the scene");
+    }
+    return res;
 }
 
 /* One row per mode, the mode switch outside the pixel loops. */

@@ -5,6 +5,7 @@
 
 #include "sy_file.h"
 
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include <stb_image.h>
@@ -521,6 +522,35 @@ static void fill_doc(sy_gltf_shim_impl *d)
     c.internal = d;
 }
 
+// The first entry of the document's extensionsRequired that is not in supported (NULL-terminated),
+// or "" (also when the JSON does not parse or supported is NULL). For GLB the JSON chunk is read
+// within the container the caller validated (header 12 bytes, chunk length and type 8).
+static std::string unsupported_required(const uint8_t *bytes, size_t size, bool binary, const char *const *supported)
+{
+    if (!supported) return "";
+    const uint8_t *json_begin = bytes;
+    size_t json_size = size;
+    if (binary) {
+        if (size < 20) return "";
+        uint32_t len = uint32_t(bytes[12]) | uint32_t(bytes[13]) << 8 | uint32_t(bytes[14]) << 16 | uint32_t(bytes[15]) << 24;
+        if (len > size - 20) return "";
+        json_begin = bytes + 20;
+        json_size = len;
+    }
+    nlohmann::json doc = nlohmann::json::parse(json_begin, json_begin + json_size, nullptr, false);
+    if (!doc.is_object()) return "";
+    auto it = doc.find("extensionsRequired");
+    if (it == doc.end() || !it->is_array()) return "";
+    for (const auto &e : *it) {
+        if (!e.is_string()) continue;
+        const std::string &name = e.get_ref<const std::string &>();
+        bool known = false;
+        for (size_t k = 0; supported[k] && !known; k++) known = name == supported[k];
+        if (!known) return name;
+    }
+    return "";
+}
+
 // Runs tinygltf on the bytes with our file-system and image callbacks (confined, size-limited).
 // On success *model is filled and twarn holds tinygltf's warnings. C++ exceptions propagate to the
 // caller's catch blocks; tinygltf failures are classified into a sy_result with its message.
@@ -551,6 +581,10 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
     // a refused file fails the load, also where tinygltf would go on without it (an image)
     if (!ctx->refused.empty()) return sy_error_set(err, SY_ERR_LIMIT, "%s", ctx->refused.c_str());
     if (ok) return SY_OK;
+    std::string ext = unsupported_required(bytes, size, binary, limits->supported_extensions);
+    if (!ext.empty())
+        return sy_error_set(err, SY_ERR_UNSUPPORTED, "extensionsRequired: '%s' is not supported (tinygltf: %s)",
+                            ext.c_str(), one_line(terr).c_str());
     sy_result code = SY_ERR_PARSE;
     if (ctx->fs_result != SY_OK) code = ctx->fs_result;
     else if (terr.find("File not found") != std::string::npos) code = SY_ERR_NOT_FOUND;

@@ -31,6 +31,11 @@ typedef struct sy_gltf_shim_limits {
     uint64_t max_image_pixels; /* width * height of one decoded image */
     const char *const *allowed_roots; /* folders besides base_dir that external files may lie in */
     size_t allowed_root_count;
+    /* NULL-terminated extensions the caller reads (NULL = not checked here). When tinygltf refuses
+     * a file whose extensionsRequired names one not in this list (a Draco-compressed mesh has no
+     * bufferView, say), the failure is SY_ERR_UNSUPPORTED naming that extension, not tinygltf's
+     * complaint about what the extension changed. */
+    const char *const *supported_extensions;
 } sy_gltf_shim_limits;
 
 typedef struct sy_gltf_shim_buffer {

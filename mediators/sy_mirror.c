@@ -3,8 +3,10 @@
  * Sections: >>tables (id-indexed mirrors)  >>textures/materials/meshes  >>nodes and placements
  * >>entries  >>sync  >>lifetime */
 #include "sy_mirror.h"
+#include "sy_log.h"
 #include "sy_strokes.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,6 +38,7 @@ typedef struct mesh_m {
     uint32_t id;
     prim_m *prims;
     uint32_t prim_count;
+    sy_bounds bounds; /* of the drawn triangles, strokes' tubes included (placements are checked with it) */
     uint32_t *users; /* node ids */
     uint32_t user_count, user_capacity;
 } mesh_m;
@@ -65,7 +68,8 @@ typedef struct node_m {
     uint32_t parent_count, parent_capacity;
     placement *pl;
     uint32_t pl_count;
-    uint32_t visit; /* sync epoch */
+    uint32_t visit;   /* sync epoch: re-placed in this sync */
+    uint32_t pending; /* parents in the set being re-placed that are not done yet */
 } node_m;
 
 struct sy_mirror {
@@ -92,6 +96,8 @@ struct sy_mirror {
     uint32_t light_placements;   /* placements holding a back-end light (visible ones) */
     uint32_t emissive_materials; /* mirrored materials whose emission lights the scene (radiance > 1) */
     uint32_t default_material;   /* back-end handle of glTF's default material (0 = not made yet) */
+    uint32_t placements;         /* placements of every node */
+    uint32_t placements_max;     /* SY_MIRROR_PLACEMENTS_MAX */
 };
 
 /* An emitter that lights the scene (sy_look.h): emitted radiance above 1 in some channel. */
@@ -212,6 +218,7 @@ static void mesh_free_prims(sy_mirror *st, mesh_m *m)
 static sy_result mesh_upload(sy_mirror *st, mesh_m *m, const sy_primitive_list *pl, sy_error *err)
 {
     mesh_free_prims(st, m);
+    m->bounds = sy_bounds_empty();
     if (pl->count == 0) return SY_OK;
     m->prims = calloc(pl->count, sizeof *m->prims);
     if (!m->prims) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: mesh: out of memory", st->name);
@@ -225,8 +232,12 @@ static sy_result mesh_upload(sy_mirror *st, mesh_m *m, const sy_primitive_list *
             char what[96];
             snprintf(what, sizeof what, "%s: mesh %#x primitive %u", st->name, m->id, i);
             sy_bounds b = sy_primitive_position_bounds(p);
+            float width = sy_primitive_stroke_width(p, &b);
+            if (!sy_bounds_is_empty(&b))
+                for (int k = 0; k < 3; ++k) b.min[k] -= width, b.max[k] += width;
+            sy_bounds_add_bounds(&m->bounds, &b);
             sy_primitive tri;
-            sy_result r = sy_strokes_tessellate(p, sy_primitive_stroke_width(p, &b), what, &tri, err);
+            sy_result r = sy_strokes_tessellate(p, width, what, &tri, err);
             if (r != SY_OK) return r;
             sy_mirror_primitive_args a = {m->id, i, &tri, &m->prims[i].handle};
             r = st->cb->primitive_set(st->user, &a, err);
@@ -235,6 +246,8 @@ static sy_result mesh_upload(sy_mirror *st, mesh_m *m, const sy_primitive_list *
             continue;
         }
         if (sy_primitive_triangle_count(p) == 0) continue;
+        sy_bounds b = sy_primitive_position_bounds(p);
+        sy_bounds_add_bounds(&m->bounds, &b);
         sy_mirror_primitive_args a = {m->id, i, p, &m->prims[i].handle};
         sy_result r = st->cb->primitive_set(st->user, &a, err);
         if (r != SY_OK) return r;
@@ -276,12 +289,39 @@ static sy_result default_material(sy_mirror *st, uint32_t *handle, sy_error *err
     return SY_OK;
 }
 
+/* Whether a placement can be drawn (docs/FORMATS.md, "Numbers in range"): its world transform
+ * must keep the node's origin and its mesh within SY_COORD_MAX, and must not collapse space (a
+ * zero or vanishing scale: glTF's way of hiding a part; no back-end can invert it). An undrawn
+ * placement keeps its place in the graph and comes back when the transform does. */
+static bool placement_drawable(sy_mirror *st, const node_m *n, const placement *p, const mesh_m *m)
+{
+    if (sy_mat4_is_degenerate(&p->world)) return false; /* hidden, as the file meant */
+    bool in_range = sy_coords_in_range(&p->world.m[12], 3);
+    if (in_range && m && !sy_bounds_is_empty(&m->bounds)) {
+        sy_bounds wb = sy_bounds_transform(&m->bounds, &p->world);
+        in_range = sy_coords_in_range(wb.min, 3) && sy_coords_in_range(wb.max, 3);
+    }
+    if (!in_range) {
+        char item[32];
+        snprintf(item, sizeof item, "node %#x", n->id);
+        sy_log(SY_LOG_WARNING, st->name, item,
+               "placed beyond the coordinate range (origin at %g %g %g; at most %g): not drawn", (double)p->world.m[12],
+               (double)p->world.m[13], (double)p->world.m[14], (double)SY_COORD_MAX);
+    }
+    return in_range;
+}
+
 /* Brings a placement's instances and light in line with the node's mesh/light and the world
  * matrix; only what changed is touched. */
 static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool mesh_changed, sy_error *err)
 {
     placement *p = &n->pl[index];
     const mesh_m *m = LOOKUP(st, mesh, mesh_cap, n->mesh);
+    const light_m *l = LOOKUP(st, light, light_cap, n->light);
+    if ((m || l) && !placement_drawable(st, n, p, m)) {
+        placement_clear(st, p); /* its instances and light go; they come back with a drawable transform */
+        return SY_OK;
+    }
     uint32_t want = m ? m->prim_count : 0;
     bool visible = p->visible && (n->flags & SY_NODE_VISIBLE);
     if (mesh_changed || want != p->inst_count) {
@@ -310,7 +350,6 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
             if (r != SY_OK) return r;
         }
     }
-    const light_m *l = LOOKUP(st, light, light_cap, n->light);
     if (l && visible) {
         /* one reading of a spot cone for every back-end: inner >= outer is a hard edge */
         sy_light_data ld = l->d;
@@ -331,37 +370,74 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
     return SY_OK;
 }
 
-/* Recomputes the placements of node id and of its whole subtree (children first use their
- * parents' new placements). mesh_changed forces new instances for the first node. */
-static sy_result replace_subtree(sy_mirror *st, uint32_t id, bool mesh_changed, sy_error *err)
+/* Recomputes the placements of every dirty node and of their subtrees, each node once: the nodes
+ * reachable from the dirty ones are collected, then placed in topological order (a node after all
+ * of its parents in the set), so a DAG of k paths costs its nodes plus its k placements, not one
+ * walk per path. A node's placements are its parents' placements times its local matrix; their
+ * total is capped (SY_MIRROR_PLACEMENTS_MAX) before anything is allocated. */
+static sy_result replace_dirty(sy_mirror *st, sy_error *err)
 {
-    uint32_t *stack = NULL, count = 0, cap = 0;
+    uint32_t *set = NULL, count = 0, cap = 0;
     sy_result r = SY_OK;
-    push_u32(&stack, &count, &cap, id);
-    bool first = true;
-    while (count && r == SY_OK) {
-        uint32_t nid = stack[--count];
+    /* collect: visit = epoch marks membership */
+    for (uint32_t i = 0; i < st->dirty_count && r == SY_OK; ++i) {
+        node_m *n = LOOKUP(st, node, node_cap, st->dirty[i]);
+        if (!n || n->visit == st->epoch) continue;
+        n->visit = st->epoch;
+        if (!push_u32(&set, &count, &cap, n->id)) r = oom(st, err);
+    }
+    for (uint32_t i = 0; i < count && r == SY_OK; ++i) {
+        node_m *n = LOOKUP(st, node, node_cap, set[i]);
+        for (uint32_t c = 0; c < n->child_count && r == SY_OK; ++c) {
+            node_m *cn = LOOKUP(st, node, node_cap, n->children[c]);
+            if (!cn || cn->visit == st->epoch) continue;
+            cn->visit = st->epoch;
+            if (!push_u32(&set, &count, &cap, cn->id)) r = oom(st, err);
+        }
+    }
+    /* parents in the set each node waits for */
+    uint32_t *ready = NULL, nready = 0, ready_cap = 0;
+    for (uint32_t i = 0; i < count && r == SY_OK; ++i) {
+        node_m *n = LOOKUP(st, node, node_cap, set[i]);
+        n->pending = 0;
+        for (uint32_t k = 0; k < n->parent_count; ++k) {
+            node_m *pn = LOOKUP(st, node, node_cap, n->parents[k]);
+            if (pn && pn->visit == st->epoch) n->pending++;
+        }
+    }
+    for (uint32_t i = 0; i < count && r == SY_OK; ++i) {
+        node_m *n = LOOKUP(st, node, node_cap, set[i]);
+        if (!n->pending && !push_u32(&ready, &nready, &ready_cap, n->id)) r = oom(st, err);
+    }
+    while (nready && r == SY_OK) {
+        uint32_t nid = ready[--nready];
         node_m *n = LOOKUP(st, node, node_cap, nid);
-        if (!n) continue;
-        /* placements from the parents' placements (a DAG node gets one per path) */
-        uint32_t want = 0;
-        bool is_root = st->root ? nid == st->root : n->parent_count == 0;
-        if (is_root) want = 1;
-        else
+        bool is_root = st->root ? n->id == st->root : n->parent_count == 0;
+        uint64_t want = is_root ? 1u : 0u;
+        if (!is_root)
             for (uint32_t i = 0; i < n->parent_count; ++i) {
                 node_m *pn = LOOKUP(st, node, node_cap, n->parents[i]);
                 if (pn) want += pn->pl_count;
             }
+        if (want > st->placements_max - (st->placements - n->pl_count)) {
+            r = sy_error_set(err, SY_ERR_LIMIT,
+                             "%s: node %#x is reached along %llu paths, past the %u placements a scene may have "
+                             "(SY_MIRROR_PLACEMENTS_MAX)",
+                             st->name, n->id, (unsigned long long)want, st->placements_max);
+            break;
+        }
         if (want != n->pl_count) {
-            for (uint32_t i = want; i < n->pl_count; ++i) placement_clear(st, &n->pl[i]);
+            for (uint32_t i = (uint32_t)want; i < n->pl_count; ++i) placement_clear(st, &n->pl[i]);
             placement *np = realloc(n->pl, sizeof *np * (want ? want : 1));
             if (!np) {
-                r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: placements: out of memory", st->name);
+                r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: node %#x: %llu placements: out of memory", st->name,
+                                 n->id, (unsigned long long)want);
                 break;
             }
             for (uint32_t i = n->pl_count; i < want; ++i) memset(&np[i], 0, sizeof np[i]);
+            st->placements = st->placements - n->pl_count + (uint32_t)want;
             n->pl = np;
-            n->pl_count = want;
+            n->pl_count = (uint32_t)want;
         }
         uint32_t k = 0;
         if (is_root) {
@@ -377,19 +453,24 @@ static sy_result replace_subtree(sy_mirror *st, uint32_t id, bool mesh_changed, 
                 }
             }
         }
-        for (uint32_t i = 0; i < n->pl_count && r == SY_OK; ++i) r = placement_sync(st, n, i, first && mesh_changed, err);
+        for (uint32_t i = 0; i < n->pl_count && r == SY_OK; ++i) r = placement_sync(st, n, i, false, err);
         st->stats->placements += n->pl_count;
-        n->visit = st->epoch;
-        first = false;
-        for (uint32_t c = 0; c < n->child_count; ++c) push_u32(&stack, &count, &cap, n->children[c]);
+        for (uint32_t c = 0; c < n->child_count && r == SY_OK; ++c) {
+            node_m *cn = LOOKUP(st, node, node_cap, n->children[c]);
+            if (cn && cn->visit == st->epoch && cn->pending && --cn->pending == 0 &&
+                !push_u32(&ready, &nready, &ready_cap, cn->id))
+                r = oom(st, err);
+        }
     }
-    free(stack);
+    free(ready);
+    free(set);
     return r;
 }
 
 static void node_free(sy_mirror *st, node_m *n)
 {
     for (uint32_t i = 0; i < n->pl_count; ++i) placement_clear(st, &n->pl[i]);
+    st->placements -= n->pl_count;
     free(n->pl);
     free(n->children);
     free(n->parents);
@@ -708,11 +789,7 @@ sy_result sy_mirror_sync(sy_mirror *st, const sy_changes *changes, sy_mirror_syn
     }
     for (uint32_t i = 0; i < sy_changes_count(changes) && r == SY_OK; ++i) r = apply_entry(st, sy_changes_get(changes, i), err);
     st->epoch++;
-    for (uint32_t i = 0; i < st->dirty_count && r == SY_OK; ++i) {
-        node_m *n = LOOKUP(st, node, node_cap, st->dirty[i]);
-        if (!n || n->visit == st->epoch) continue; /* already re-placed through an ancestor */
-        r = replace_subtree(st, n->id, false, err);
-    }
+    if (r == SY_OK) r = replace_dirty(st, err);
     st->dirty_count = 0;
     st->stats = NULL;
     return r;
@@ -751,6 +828,7 @@ sy_result sy_mirror_create(const sy_mirror_desc *desc, sy_mirror **out, sy_error
     st->root = desc->root_node_id;
     st->cb = desc->callbacks;
     st->user = desc->user;
+    st->placements_max = SY_MIRROR_PLACEMENTS_MAX;
     *out = st;
     return SY_OK;
 }

@@ -25,6 +25,11 @@
 extern "C" {
 #endif
 
+/** The most placements (node x DAG path) one mirror holds: a sync that would need more fails with
+ * SY_ERR_LIMIT naming the node, before allocating them (loaders refuse such files earlier, with
+ * their own placement budget). */
+#define SY_MIRROR_PLACEMENTS_MAX (1u << 22)
+
 /** The shared scene mirror of a mediator (opaque). */
 typedef struct sy_mirror sy_mirror;
 

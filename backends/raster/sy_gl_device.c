@@ -1404,12 +1404,45 @@ sy_gl_result sy_gl_material_destroy(sy_gl_device *dev, sy_gl_material mat)
 }
 
 /* >>instance/light */
+/* The normal matrix of an upper 3x3 whose float inverse under- or overflows (a scale of 1e-30):
+ * the transposed inverse up to a positive factor, i.e. the cofactor matrix times the sign of the
+ * determinant, divided by its largest element (normals are normalised after it). false when the
+ * 3x3 is singular relative to its size (|det| <= 1e-30 s^3), as sy_mat4_is_degenerate in core. */
+static bool normal_mat_scaled(const float *t, float *nm)
+{
+    double a[3][3], s = 0.0; /* a[r][c] */
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) a[r][c] = t[c * 4 + r], s = fmax(s, fabs(a[r][c]));
+    double C[3][3], big = 0.0; /* C[r][c]: cofactor of a[r][c] */
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+            int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+            C[r][c] = a[r1][c1] * a[r2][c2] - a[r1][c2] * a[r2][c1];
+            big = fmax(big, fabs(C[r][c]));
+        }
+    double det = a[0][0] * C[0][0] + a[0][1] * C[0][1] + a[0][2] * C[0][2];
+    if (!(s > 0.0) || !(fabs(det) > 1e-30 * s * s * s) || !(big > 0.0)) return false;
+    double k = (det < 0.0 ? -1.0 : 1.0) / big;
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) nm[c * 3 + r] = (float)(C[r][c] * k); /* inverse transpose = C / det */
+    return true;
+}
+
 static bool set_model(inst_o *in, const float *t)
 {
     float inv[16];
     for (int i = 0; i < 16; ++i)
         if (!isfinite(t[i])) return false;
-    if (!m4_invert(t, inv)) return false;
+    if (!m4_invert(t, inv)) {
+        float nm[9];
+        if (!normal_mat_scaled(t, nm)) return false;
+        memcpy(in->model, t, sizeof in->model);
+        memcpy(in->normal_mat, nm, sizeof nm);
+        /* det(nm) has the sign of det(t): the adjugate's determinant is det(t)^2 */
+        in->mirror = nm[0] * (nm[4] * nm[8] - nm[7] * nm[5]) - nm[3] * (nm[1] * nm[8] - nm[7] * nm[2]) +
+                         nm[6] * (nm[1] * nm[5] - nm[4] * nm[2]) < 0.0f;
+        return true;
+    }
     memcpy(in->model, t, sizeof in->model);
     /* normal matrix = inverse transpose of the upper 3x3 */
     for (int c = 0; c < 3; ++c)

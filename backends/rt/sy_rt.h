@@ -270,6 +270,19 @@ sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat, char 
 
 /* >>instance */
 
+/** The largest coordinate the device accepts, in world units: mesh positions, instance
+ * translations, the world bounds of every instance (estimated as |linear| x the mesh's largest
+ * coordinate + |translation|), light positions, the camera's position and its orthographic window.
+ * Larger ones are refused with SY_RT_ERROR_INVALID_ARGUMENT. With SY_RT_INSTANCE_GAIN_MAX it keeps
+ * every ray Embree is given, in world and in instance space, below 3e17, where Embree 3 asserts
+ * (aborting the process) beyond 1.844e18. */
+#define SY_RT_COORD_MAX 1.0e13f
+/** The largest magnification of an instance's inverse transform (the row-sum norm of the inverse of
+ * its upper 3x3; 1/s for a uniform scale s) that is instanced: an instance scaled down further is
+ * created as if SY_RT_INSTANCE_BAKED (world-space triangles; Embree never transforms a ray into its
+ * space). sy_rt_instance_set_transform refuses such a transform for an instance created unbaked. */
+#define SY_RT_INSTANCE_GAIN_MAX 1.0e4f
+
 enum {
     /** Static geometry: transformed to world space and merged into the top-level BVH. Moving it
      * re-transforms just its triangles (and rebuilds the top-level BVH at commit). */
@@ -281,7 +294,8 @@ enum {
 /** An instance: a mesh, its object-to-world transform, material and flags. */
 typedef struct sy_rt_instance_desc {
     sy_rt_mesh mesh; /**< the mesh it places */
-    float transform[16]; /**< object-to-world, column-major; must be finite and invertible */
+    float transform[16]; /**< object-to-world, column-major; must be finite and invertible, within
+                          * SY_RT_COORD_MAX (see there; strong shrinking bakes the instance) */
     sy_rt_material material; /**< zero/stale = default grey material */
     uint32_t flags;          /**< SY_RT_INSTANCE_* */
 } sy_rt_instance_desc;

@@ -31,6 +31,7 @@ typedef struct sy_rt_mesh_data {
     bool shared;              /* the arrays are the caller's (not freed here) */
     uint64_t own_bytes, shared_bytes; /* accounting (sy_rt_device_stats) */
     uint32_t vertex_count, triangle_count;
+    float extent;         /* largest |coordinate| of its positions */
     uint32_t refs;        /* 1 for the live handle + 1 per instance */
     bool filter_on;       /* alpha filter installed on geom */
     bool want_filter;     /* scratch for sy_rt_commit: some instance needs the filter */

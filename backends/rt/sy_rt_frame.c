@@ -24,6 +24,21 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
     if (!(cam->window[0] < cam->window[1]) || !(cam->window[2] < cam->window[3]))
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: camera window {%g, %g, %g, %g} needs left < right and bottom < top",
                     (double)cam->window[0], (double)cam->window[1], (double)cam->window[2], (double)cam->window[3]);
+    /* SY_RT_COORD_MAX: the farthest a camera ray starts (its position, plus the window for an
+     * orthographic camera) */
+    {
+        const float *m = cam->camera_to_world;
+        double reach = fmax(fabs(m[12]), fmax(fabs(m[13]), fabs(m[14])));
+        if (cam->projection == SY_RT_PROJECTION_ORTHOGRAPHIC) {
+            double w = fmax(fmax(fabs(cam->window[0]), fabs(cam->window[1])), fmax(fabs(cam->window[2]), fabs(cam->window[3])));
+            double ax = fmax(fabs(m[0]) + fabs(m[4]), fmax(fabs(m[1]) + fabs(m[5]), fabs(m[2]) + fabs(m[6])));
+            reach += w * ax;
+        }
+        if (!(reach <= SY_RT_COORD_MAX))
+            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: camera rays would start up to %g away (camera at %g %g %g), "
+                        "beyond SY_RT_COORD_MAX (%g)", reach, (double)m[12], (double)m[13], (double)m[14],
+                        (double)SY_RT_COORD_MAX);
+    }
     if (!isfinite(cam->near_clip) || cam->near_clip < 0.0f || !isfinite(cam->far_clip) || cam->far_clip < 0.0f ||
         (cam->far_clip > 0.0f && cam->far_clip <= cam->near_clip))
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: clip range near %g far %g is invalid (0 <= near < far, far 0 = infinite)",

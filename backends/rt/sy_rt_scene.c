@@ -106,9 +106,10 @@ static sy_rt_result validate_mesh_desc(const sy_rt_mesh_desc *d, char *err, size
                             i, d->indices[i], d->vertex_count);
     size_t n3 = (size_t)d->vertex_count * 3u;
     for (size_t i = 0; i < n3; ++i)
-        if (!isfinite(d->positions[i]))
-            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: positions[%zu] (vertex %zu) = %g is not finite",
-                        i, i / 3u, (double)d->positions[i]);
+        if (!(fabsf(d->positions[i]) <= SY_RT_COORD_MAX))
+            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: positions[%zu] (vertex %zu) = %g is %s",
+                        i, i / 3u, (double)d->positions[i],
+                        isfinite(d->positions[i]) ? "beyond SY_RT_COORD_MAX (1e13)" : "not finite");
     return SY_RT_OK;
 }
 
@@ -124,6 +125,7 @@ sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *d, sy_r
     m->refs = 1;
     m->shared = d->release != NULL;
     m->vertex_count = d->vertex_count;
+    for (size_t i = 0; i < (size_t)d->vertex_count * 3u; ++i) m->extent = fmaxf(m->extent, fabsf(d->positions[i]));
     m->triangle_count = d->triangle_count;
     size_t vc = d->vertex_count, corners = (size_t)d->triangle_count * 3u;
     if (d->normals && (r = take_finite(m, d->normals, vc * 3u, &m->normals, "normals", err, err_len)) != SY_RT_OK) goto fail;
@@ -348,8 +350,9 @@ sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat, char 
 /* >>instance */
 
 /* Checks that xf is finite and invertible and computes the normal matrix (inverse transpose of
- * the upper 3x3, row-major). */
-static sy_rt_result normal_matrix(const float *xf, float nrm[9], char *err, size_t err_len)
+ * the upper 3x3, row-major) and *gain, the row-sum norm of the inverse (how much the inverse
+ * magnifies a ray's coordinates). */
+static sy_rt_result normal_matrix(const float *xf, float nrm[9], double *gain, char *err, size_t err_len)
 {
     for (int i = 0; i < 16; ++i)
         if (!isfinite(xf[i])) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance: transform[%d] = %g is not finite", i, (double)xf[i]);
@@ -369,6 +372,22 @@ static sy_rt_result normal_matrix(const float *xf, float nrm[9], char *err, size
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance: transform is singular (det %g)", det);
     for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) nrm[r * 3 + c] = (float)(C[r][c] / det);
+    *gain = 0.0; /* the inverse is C^T / det: its rows are C's columns */
+    for (int c = 0; c < 3; ++c) *gain = fmax(*gain, (fabs(C[0][c]) + fabs(C[1][c]) + fabs(C[2][c])) / fabs(det));
+    return SY_RT_OK;
+}
+
+/* SY_RT_COORD_MAX for an instance of mesh m placed by xf: its translation and its world extent. */
+static sy_rt_result instance_in_range(const sy_rt_mesh_data *m, const float *xf, char *err, size_t err_len)
+{
+    double lin = 0.0, t = fmax(fabs(xf[12]), fmax(fabs(xf[13]), fabs(xf[14])));
+    for (int r = 0; r < 3; ++r)
+        lin = fmax(lin, fabs(xf[r]) + fabs(xf[4 + r]) + fabs(xf[8 + r]));
+    double reach = lin * m->extent + t;
+    if (!(reach <= SY_RT_COORD_MAX))
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT,
+                    "instance: placed beyond SY_RT_COORD_MAX (translation (%g %g %g), world extent up to %g; at most %g)",
+                    (double)xf[12], (double)xf[13], (double)xf[14], reach, (double)SY_RT_COORD_MAX);
     return SY_RT_OK;
 }
 
@@ -564,21 +583,24 @@ sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc 
     if (d->flags & ~(uint32_t)(SY_RT_INSTANCE_BAKED | SY_RT_INSTANCE_HIDDEN))
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance: unknown flags 0x%x", d->flags);
     float nrm[9];
-    sy_rt_result r = normal_matrix(d->transform, nrm, err, err_len);
-    if (r != SY_RT_OK) return r;
-    if (!(d->flags & SY_RT_INSTANCE_BAKED) && (r = mesh_blas(dev, mesh, err, err_len)) != SY_RT_OK) return r;
+    double gain;
+    sy_rt_result r = normal_matrix(d->transform, nrm, &gain, err, err_len);
+    if (r != SY_RT_OK || (r = instance_in_range(mesh, d->transform, err, err_len)) != SY_RT_OK) return r;
+    uint32_t flags = d->flags;
+    if (gain > SY_RT_INSTANCE_GAIN_MAX) flags |= SY_RT_INSTANCE_BAKED; /* Embree never sees its inverse */
+    if (!(flags & SY_RT_INSTANCE_BAKED) && (r = mesh_blas(dev, mesh, err, err_len)) != SY_RT_OK) return r;
 
     sy_rt_instance_data *in = calloc(1, sizeof *in);
     if (!in) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance: out of memory");
     in->mesh = mesh;
     mesh->refs++;
     in->material = d->material;
-    in->flags = d->flags;
+    in->flags = flags;
     in->top_id = RTC_INVALID_GEOMETRY_ID;
     memcpy(in->xf, d->transform, sizeof in->xf);
     memcpy(in->nrm, nrm, sizeof in->nrm);
 
-    if (d->flags & SY_RT_INSTANCE_BAKED) {
+    if (flags & SY_RT_INSTANCE_BAKED) {
         in->geom = rtcNewGeometry(dev->rtc, RTC_GEOMETRY_TYPE_TRIANGLE);
         if (in->geom) {
             in->baked_positions = rtcSetNewGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -597,12 +619,12 @@ sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc 
         }
     }
     if (in->geom) {
-        if (d->flags & SY_RT_INSTANCE_HIDDEN) rtcDisableGeometry(in->geom);
+        if (flags & SY_RT_INSTANCE_HIDDEN) rtcDisableGeometry(in->geom);
         rtcCommitGeometry(in->geom);
         in->top_id = rtcAttachGeometry(dev->top, in->geom);
     }
     if ((r = sy_rt_check_embree(dev, err, err_len, "instance: creating geometry")) != SY_RT_OK) goto fail;
-    if (!in->geom || ((d->flags & SY_RT_INSTANCE_BAKED) && !in->baked_positions) || in->top_id == RTC_INVALID_GEOMETRY_ID) {
+    if (!in->geom || ((flags & SY_RT_INSTANCE_BAKED) && !in->baked_positions) || in->top_id == RTC_INVALID_GEOMETRY_ID) {
         r = FAIL(SY_RT_ERROR_EMBREE, "instance: Embree geometry creation failed");
         goto fail;
     }
@@ -625,8 +647,14 @@ sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst
     sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
     if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_transform: stale handle 0x%08x", inst.id);
     float nrm[9];
-    sy_rt_result r = normal_matrix(transform, nrm, err, err_len);
-    if (r != SY_RT_OK) return r;
+    double gain;
+    sy_rt_result r = normal_matrix(transform, nrm, &gain, err, err_len);
+    if (r != SY_RT_OK || (r = instance_in_range(in->mesh, transform, err, err_len)) != SY_RT_OK) return r;
+    if (gain > SY_RT_INSTANCE_GAIN_MAX && !(in->flags & SY_RT_INSTANCE_BAKED))
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT,
+                    "instance set_transform: the transform shrinks by %g (more than SY_RT_INSTANCE_GAIN_MAX %g allows "
+                    "for an instance created unbaked); create it again",
+                    1.0 / gain, (double)SY_RT_INSTANCE_GAIN_MAX);
     if (!in->xf_pending) { /* Embree sees the move at sy_rt_commit (commit_moved) */
         if (dev->pending_count == dev->pending_cap) {
             uint32_t ncap = dev->pending_cap ? dev->pending_cap * 2u : 64u;
@@ -706,6 +734,10 @@ static sy_rt_result validate_light(const sy_rt_light_desc *d, char *err, size_t 
                 return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: %s[%d] is not finite", names[a], k);
     for (int k = 0; k < 3; ++k)
         if (d->color[k] < 0.0f) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: color[%d] is negative", k);
+    for (int k = 0; k < 3; ++k)
+        if (fabsf(d->position[k]) > SY_RT_COORD_MAX)
+            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: position[%d] = %g is beyond SY_RT_COORD_MAX (%g)", k,
+                        (double)d->position[k], (double)SY_RT_COORD_MAX);
     if (!isfinite(d->intensity) || d->intensity < 0.0f)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: intensity %g is not a finite non-negative value", (double)d->intensity);
     if (!isfinite(d->range) || d->range < 0.0f)

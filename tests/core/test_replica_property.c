@@ -341,7 +341,7 @@ static sy_blob *sized_blob(blob_pool *p, size_t size, bool floats)
             for (size_t i = 0; fits && floats && i + 4 <= size; i += 4) {
                 float f;
                 memcpy(&f, (const unsigned char *)sy_blob_data(b) + i, 4);
-                fits = isfinite(f); /* random bytes would make NaN positions */
+                fits = fabsf(f) <= SY_COORD_MAX; /* random bytes would make NaN or out-of-range positions */
             }
             if (fits) {
                 if (chance(20)) return pool_keep(p, new_blob(sy_blob_data(b), size)); /* equal content, new blob */

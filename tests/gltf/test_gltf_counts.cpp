@@ -24,7 +24,7 @@
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-static int g_failures = 0, g_checks = 0;
+static int g_failures = 0, g_checks = 0, g_refused = 0;
 
 #define CHECK_EQ(what, got, want)                                                                                      \
     do {                                                                                                               \
@@ -123,7 +123,26 @@ static void check_file(const std::string &file, uint32_t *models)
     opts.max_image_pixels = 1;
     sy_result r = sy_gltf_load(file.c_str(), scene, &opts, &info, &err);
     g_checks++;
-    if (r != SY_OK) {
+    // A file that requires an extension sy does not read must be refused with SY_ERR_UNSUPPORTED
+    // naming it (read independently here from the JSON), and only such a file may be refused.
+    std::string unsupported;
+    if (doc.contains("extensionsRequired") && doc["extensionsRequired"].is_array())
+        for (const auto &x : doc["extensionsRequired"]) {
+            if (!x.is_string() || !unsupported.empty()) continue;
+            bool known = false;
+            for (const char *const *k = sy_gltf_supported_extensions(); *k && !known; ++k) known = x.get<std::string>() == *k;
+            if (!known) unsupported = x.get<std::string>();
+        }
+    if (!unsupported.empty()) {
+        g_refused++;
+        if (r != SY_ERR_UNSUPPORTED || !std::strstr(err.message, ("'" + unsupported + "'").c_str())) {
+            g_failures++;
+            std::fprintf(stderr, "FAIL %s: requires %s: want SY_ERR_UNSUPPORTED naming it, got %s: %s\n",
+                         file.c_str(), unsupported.c_str(), sy_result_str(r), r ? err.message : "loaded");
+        } else {
+            std::printf("refused as it should be (requires %s, not read by sy): %s\n", unsupported.c_str(), file.c_str());
+        }
+    } else if (r != SY_OK) {
         g_failures++;
         std::fprintf(stderr, "FAIL %s: load failed: %s\n", file.c_str(), err.message);
     } else {
@@ -185,7 +204,8 @@ int main(int argc, char **argv)
     std::sort(files.begin(), files.end());
     uint32_t models = 0;
     for (const auto &f : files) check_file(f, &models);
-    std::printf("%zu files, %u loaded, %d checks, %d failures\n", files.size(), models, g_checks, g_failures);
+    std::printf("%zu files, %u loaded, %d refused for an unsupported required extension, %d checks, %d failures\n",
+                files.size(), models, g_refused, g_checks, g_failures);
     if (files.size() < 30) {
         std::fprintf(stderr, "FAIL: only %zu glTF files found under %s\n", files.size(), root.c_str());
         return 1;

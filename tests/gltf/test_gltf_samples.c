@@ -314,7 +314,11 @@ int main(int argc, char **argv)
             if (!find_file(dir, variants[v][1], path, sizeof path)) continue;
             files++;
             loaded l = load(path);
-            CHECK(l.r == SY_OK, "%s: %s", path, l.err.message);
+            /* files requiring an extension sy does not read are refused naming it (gltf_counts checks
+             * each refusal against the file's own extensionsRequired) */
+            bool refused = l.r == SY_ERR_UNSUPPORTED && strstr(l.err.message, "extensionsRequired: '");
+            if (refused) printf("refused (unsupported required extension) %s: %s\n", path + strlen(gdir) + 1, l.err.message);
+            CHECK(l.r == SY_OK || refused, "%s: %s", path, l.err.message);
             if (l.r != SY_OK) {
                 unload(&l);
                 continue;
