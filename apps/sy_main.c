@@ -131,13 +131,14 @@ static sy_result add_defaults(loaded *ld, sy_error *err)
 }
 
 /* Loader options every command shares, taken out of the arguments in main: --allow-path DIR
- * (repeatable: more folders that a model's external files may lie in) and --strict (whatever a
- * loader skips or repairs is an error). */
+ * (repeatable: more folders that a model's external files may lie in), --strict (whatever a
+ * loader skips or repairs is an error) and --max-scene-mb N (the budget per file, sy_budget.h). */
 #define SY_MAX_ALLOW_PATHS 16
 static struct {
     const char *roots[SY_MAX_ALLOW_PATHS];
     size_t root_count;
     bool strict;
+    uint64_t max_scene_bytes; /* --max-scene-mb: the loaders' budget per file (sy_budget.h); 0 = default */
     sy_world_options world; /* --env, --env-color, --env-intensity, --env-hidden, --background, --no-default-light */
 } g_load;
 
@@ -169,7 +170,7 @@ static bool parse_floats(const char *text, float *out, int min_n, int max_n, int
 enum {
     OPT_STOP = -2, /* next_option: the command ends with *status (after --help or a usage error) */
     OPT_HELP = 0x100, OPT_VERSION, OPT_ENV, OPT_ENV_COLOR, OPT_ENV_INTENSITY, OPT_ENV_HIDDEN, OPT_BACKGROUND,
-    OPT_NO_DEFAULT_LIGHT, OPT_ALLOW_PATH, OPT_STRICT,
+    OPT_NO_DEFAULT_LIGHT, OPT_ALLOW_PATH, OPT_STRICT, OPT_MAX_SCENE_MB,
     /* the commands' own long options (cluster ones: SY_CLUSTER_OPT_*, sy_cluster_cli.h) */
     OPT_SPP, OPT_TIME, OPT_AOV, OPT_CAMERA, OPT_PARAMS, OPT_GL, OPT_FILTER, OPT_THRESHOLD, OPT_HALF, OPT_EXPOSURE,
     OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
@@ -186,6 +187,7 @@ enum {
     {"env-hidden", no_argument, NULL, OPT_ENV_HIDDEN}, {"background", required_argument, NULL, OPT_BACKGROUND}, \
     {"no-default-light", no_argument, NULL, OPT_NO_DEFAULT_LIGHT},                                         \
     {"allow-path", required_argument, NULL, OPT_ALLOW_PATH}, {"strict", no_argument, NULL, OPT_STRICT},    \
+    {"max-scene-mb", required_argument, NULL, OPT_MAX_SCENE_MB},                                           \
     {NULL, 0, NULL, 0}
 /* short options: ':' first (a missing value is told apart from an unknown option), then -q and -v */
 #define SHORT_OPTIONS(own) ":" own "qv"
@@ -253,6 +255,18 @@ static int next_option(const char *cmd, int argc, char **argv, const char *short
         case 'q': sy_log_set_level(SY_LOG_ERROR); break;
         case 'v': sy_log_set_level(SY_LOG_DEBUG); break;
         case OPT_STRICT: g_load.strict = true; break;
+        case OPT_MAX_SCENE_MB: { /* the loaders' budget per file, in MiB (sy_budget.h) */
+            char *end = NULL;
+            errno = 0;
+            unsigned long long mb = strtoull(optarg, &end, 10);
+            if (!*optarg || *end || errno || mb < 1 || mb > (1ull << 30)) {
+                fprintf(stderr, "sy: error: --max-scene-mb %s: expected a whole number of MiB from 1 to 2^30\n", optarg);
+                *status = 2;
+                return OPT_STOP;
+            }
+            g_load.max_scene_bytes = (uint64_t)mb << 20;
+            break;
+        }
         case OPT_ALLOW_PATH: { /* repeatable: more folders that a model's external files may lie in */
             struct stat st;
             if (stat(optarg, &st) != 0 || !S_ISDIR(st.st_mode)) {
@@ -328,7 +342,8 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
     } else if (fmt == SY_FORMAT_X3D || (fmt == SY_FORMAT_UNKNOWN && strlen(path) > 4 &&
                                         !strcasecmp(path + strlen(path) - 4, ".x3d"))) {
         out->is_x3d = true;
-        sy_x3d_options xo = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count};
+        sy_x3d_options xo = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count,
+                             .max_scene_bytes = g_load.max_scene_bytes};
         r = sy_x3d_load(path, out->scene, &xo, &out->x3d, err);
         if (r == SY_OK)
             r = report_warnings(path, out->x3d.warning_count, err);
@@ -341,7 +356,8 @@ static sy_result load(const char *path, const char *camera_sel, bool defaults, l
         }
     } else {
         out->is_gltf = true;
-        sy_gltf_options go = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count};
+        sy_gltf_options go = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count,
+                          .max_scene_bytes = g_load.max_scene_bytes};
         r = sy_gltf_load(path, out->scene, &go, &out->gltf, err);
         if (r == SY_OK)
             r = report_warnings(path, out->gltf.warning_count, err);
@@ -633,6 +649,9 @@ static const char usage_text[] =
             "  [--background R,G,B[,A]] [--no-default-light]: the environment is a light; the background is what\n"
             "  the camera sees where nothing is hit; a scene with no light of its own is lit by a neutral studio\n"
             "  environment unless --no-default-light is given\n"
+            "loading (every command): [--allow-path DIR] (more folders a model's files may lie in) [--strict]\n"
+            "  (a skipped or repaired item fails the load) [--max-scene-mb N] (budget per file: vertices, indices,\n"
+            "  images and placements together; default an eighth of the physical memory)\n"
             "exit status: 0 success, 1 failure (the error names the file, peer or value), 2 usage error,\n"
             "  130 interrupted\n"
             "bash completion: source apps/sy-completion.bash\n";
@@ -901,7 +920,8 @@ static sy_result add_overlay(loaded *ld, const char *arg, const char *composite,
     if (!backend) backend = sy_mediator_find("raster") ? "raster" : spec->backend;
     if (!sy_mediator_find(backend)) return sy_error_set(err, SY_ERR_NOT_FOUND, "--overlay %s: back-end '%s' is not registered", arg, backend);
     sy_gltf_info info = {0};
-    sy_gltf_options go = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count};
+    sy_gltf_options go = {.allowed_roots = g_load.roots, .allowed_root_count = g_load.root_count,
+                          .max_scene_bytes = g_load.max_scene_bytes};
     sy_result r = sy_gltf_load(path, ld->scene, &go, &info, err);
     if (r == SY_OK) r = report_warnings(path, info.warning_count, err);
     if (r == SY_OK) r = sy_scene_commit(ld->scene, NULL, err);

@@ -6,6 +6,7 @@
  * >>cameras+lights, >>nodes, >>public. */
 #include "sy_gltf.h"
 
+#include "sy_budget.h"
 #include "sy_file.h"
 #include "sy_gltf_shim.h"
 #include "sy_log.h"
@@ -70,6 +71,7 @@ typedef struct loader {
     int32_t *parent;      /* per glTF node: parent index, -1 none */
     uint8_t *reached;     /* per glTF node: part of the loaded scene */
     uint32_t *mesh_triangles;
+    sy_budget budget; /* the file's (sy_budget.h) */
     bool warned_skin, warned_morph, warned_anim;
 } loader;
 
@@ -952,6 +954,29 @@ static sy_result convert_stroke(loader *L, size_t m, size_t p, sy_primitive *out
     return SY_OK;
 }
 
+/* The file's budget for every primitive of every mesh, before any is decoded: the vertex attributes
+ * as the scene stores them and the indices (one per vertex without an index accessor), for each
+ * primitive even where primitives share accessors (the back-ends copy per primitive). Accessor
+ * indices were validated (validate_doc). */
+static sy_result charge_meshes(loader *L)
+{
+    const sy_gltf_doc *d = L->doc;
+    sy_result r = SY_OK;
+    for (size_t m = 0; m < d->mesh_count && r == SY_OK; m++)
+        for (size_t p = 0; p < d->meshes[m].primitive_count && r == SY_OK; p++) {
+            const sy_gltf_shim_primitive *pr = &d->meshes[m].primitives[p];
+            if (pr->position < 0) continue;
+            size_t vcount = d->accessors[pr->position].count;
+            size_t ic = pr->indices >= 0 ? d->accessors[pr->indices].count : vcount;
+            uint64_t per_vertex = 12u + (pr->normal >= 0 ? 12u : 0u) + (pr->tangent >= 0 ? 16u : 0u) +
+                                  (pr->texcoord0 >= 0 ? 8u : 0u) + (pr->texcoord1 >= 0 ? 8u : 0u) +
+                                  (pr->color0 >= 0 ? 16u : 0u);
+            if ((r = sy_budget_charge(&L->budget, vcount, per_vertex, &L->err, "meshes[%zu].primitives[%zu]: %zu vertices", m, p, vcount)) == SY_OK)
+                r = sy_budget_charge(&L->budget, ic, 4u, &L->err, "meshes[%zu].primitives[%zu]: %zu indices", m, p, ic);
+        }
+    return r;
+}
+
 static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *out, bool *used, uint32_t *tris)
 {
     const sy_gltf_doc *d = L->doc;
@@ -1318,6 +1343,23 @@ static sy_result create_nodes(loader *L, const int32_t *roots, size_t root_count
         }
     }
     free(stack);
+    /* the budget's placements (a glTF graph is a forest: one per node, plus the instances) */
+    size_t reached = 0, instances = 0;
+    for (size_t i = 0; i < d->node_count; i++)
+        if (L->reached[i]) {
+            reached++;
+            if (d->nodes[i].instancing) {
+                const int32_t acc[3] = {d->nodes[i].inst_translation, d->nodes[i].inst_rotation, d->nodes[i].inst_scale};
+                for (int k = 0; k < 3; k++)
+                    if (acc[k] >= 0) {
+                        instances += d->accessors[acc[k]].count;
+                        break;
+                    }
+            }
+        }
+    if ((r = sy_budget_charge(&L->budget, (uint64_t)reached + instances, SY_BUDGET_PLACEMENT_BYTES, &L->err,
+                              "%zu nodes and %zu EXT_mesh_gpu_instancing instances", reached, instances)))
+        return r;
 
     sy_node **inst = xcalloc(L, d->node_count + 1, sizeof(sy_node *), &r);
     size_t *inst_count = inst ? xcalloc(L, d->node_count + 1, sizeof(size_t), &r) : NULL;
@@ -1446,6 +1488,7 @@ static sy_gltf_options resolve_options(const sy_gltf_options *o)
     if (!r.max_image_pixels) r.max_image_pixels = (uint64_t)1 << 26;
     if (!r.max_instances) r.max_instances = (size_t)1 << 20;
     if (!r.max_json_depth) r.max_json_depth = 64;
+    if (!r.max_scene_bytes) r.max_scene_bytes = sy_budget_default_bytes();
     return r;
 }
 
@@ -1481,6 +1524,7 @@ static sy_result load_doc(loader *L)
         warn(L, "%zu animation(s): nodes are placed at the first frame of animations[0], the rest is ignored",
              d->animation_count);
 
+    if ((r = charge_meshes(L))) return r;
     /* dependency order: textures (on demand) + materials, meshes, lights, cameras, nodes */
     for (size_t i = 0; i < d->material_count; i++)
         if ((r = create_material(L, i))) return r;
@@ -1547,6 +1591,7 @@ static sy_result load_common(const char *path, const void *mem, size_t mem_size,
     L.scene = scene;
     L.opt = resolve_options(opts);
     L.info = info;
+    L.budget = sy_budget_make(path, L.opt.max_scene_bytes);
 
     void *bytes = NULL;
     size_t size = 0;
@@ -1589,7 +1634,7 @@ static sy_result load_common(const char *path, const void *mem, size_t mem_size,
     memcpy(base, mem ? base_dir : path, dlen);
     base[dlen] = '\0';
     sy_gltf_shim_limits lim = {L.opt.max_file_bytes, L.opt.max_image_pixels, L.opt.allowed_roots,
-                               L.opt.allowed_root_count, k_supported};
+                               L.opt.allowed_root_count, k_supported, L.budget.limit};
     r = sy_gltf_shim_parse(b, size, binary, base, &lim, &doc, &L.err);
     free(base);
     /* the document holds its own copy of every buffer: the file's bytes go before the scene's blobs
@@ -1602,6 +1647,11 @@ static sy_result load_common(const char *path, const void *mem, size_t mem_size,
     }
     if (doc->warnings[0]) warn(&L, "tinygltf: %s", doc->warnings);
     L.doc = doc;
+    for (size_t i = 0; i < doc->image_count && r == SY_OK; i++) /* within the budget: the shim checked it */
+        if (doc->images[i].pixels)
+            r = sy_budget_charge(&L.budget, (uint64_t)doc->images[i].width * doc->images[i].height,
+                                 doc->images[i].channels, &L.err, "images[%zu]", i);
+    if (r) goto out;
     r = load_doc(&L);
     if (r) rollback(&L);
 

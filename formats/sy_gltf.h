@@ -56,6 +56,10 @@ typedef struct sy_gltf_options {
     size_t max_indices;         /**< per primitive, after strip / fan conversion; 0 = 1 << 28 */
     uint64_t max_image_pixels;  /**< width * height per image (larger ones: missing, warned); 0 = 1 << 26 */
     size_t max_instances;       /**< EXT_mesh_gpu_instancing instances per node; 0 = 1 << 20 */
+    /** The file's budget (sy_budget.h): bytes of vertex data, indices, decoded images and
+     * placements together; 0 = sy_budget_default_bytes(). An image past it goes missing with a
+     * warning; geometry or placements past it fail the load with SY_ERR_LIMIT naming the item. */
+    uint64_t max_scene_bytes;
     uint32_t max_json_depth;    /**< nesting of JSON arrays / objects; 0 = 64 */
     int32_t scene_index;        /**< glTF scene to load; 0 = the file's default (see below) */
     bool use_scene_index;       /**< true: load scenes[scene_index] instead of the default */

@@ -12,6 +12,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <climits>
 #include <cstdlib>
 #include <cstring>
@@ -30,6 +31,8 @@ struct LoadContext {
     std::string refused;           // the first URI refused by the confinement (fails the load)
     size_t max_file_bytes = 0;
     uint64_t max_image_pixels = 0;
+    uint64_t max_image_bytes = 0;  // all decoded images together (0 = no limit)
+    uint64_t image_bytes = 0;      // decoded so far
     tinygltf::Model *model = nullptr;
     sy_result fs_result = SY_OK;   // first file-system failure category
     std::string fs_message;
@@ -155,6 +158,14 @@ bool load_image(tinygltf::Image *image, const int image_idx, std::string *err, s
     }
     const int req = comp <= 2 ? 4 : comp; // grey / grey+alpha become RGBA
     const size_t n = size_t(w) * size_t(h) * size_t(req);
+    if (ctx->max_image_bytes && n > ctx->max_image_bytes - std::min(ctx->image_bytes, ctx->max_image_bytes)) {
+        ctx->image_problems[image_idx] = "image " + std::to_string(w) + "x" + std::to_string(h) + " (" +
+                                         std::to_string(n >> 20) + " MiB decoded) exceeds what is left of the scene budget (" +
+                                         std::to_string((ctx->max_image_bytes - ctx->image_bytes) >> 20) + " MiB)";
+        image->image.clear();
+        return true;
+    }
+    ctx->image_bytes += n;
     int w2 = 0, h2 = 0, c2 = 0;
     bool is16 = stbi_is_16_bit_from_memory(bytes, int(len)) != 0;
     image->image.resize(n);
@@ -560,6 +571,7 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
 {
     ctx->max_file_bytes = limits->max_file_bytes;
     ctx->max_image_pixels = limits->max_image_pixels;
+    ctx->max_image_bytes = limits->max_image_bytes;
     ctx->model = model;
     ctx->roots = limits->allowed_roots;
     ctx->root_count = limits->allowed_root_count;

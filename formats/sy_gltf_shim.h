@@ -36,6 +36,9 @@ typedef struct sy_gltf_shim_limits {
      * bufferView, say), the failure is SY_ERR_UNSUPPORTED naming that extension, not tinygltf's
      * complaint about what the extension changed. */
     const char *const *supported_extensions;
+    /* decoded bytes of all images together (the load's budget, sy_budget.h); an image that would
+     * pass it is refused before decoding, like one over max_image_pixels; 0 = no limit */
+    uint64_t max_image_bytes;
 } sy_gltf_shim_limits;
 
 typedef struct sy_gltf_shim_buffer {

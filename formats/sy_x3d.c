@@ -2,6 +2,7 @@
  * (see sy_x3d.h for the supported nodes and the documented mappings). */
 #define _DEFAULT_SOURCE /* realpath */
 #include "sy_x3d.h"
+#include "sy_budget.h"
 
 #include "sy_file.h"
 #include "sy_log.h"
@@ -57,6 +58,7 @@ typedef struct pending_light {
 typedef struct loader {
     sy_scene *scene;
     sy_x3d_options opt;
+    sy_budget budget; /* the load's, Inline files included (sy_budget.h) */
     sy_x3d_info *info;
     sy_error err;
     xmlHashTablePtr cache;      /* "%p:variant" -> created* */
@@ -74,6 +76,14 @@ typedef struct loader {
     sy_error limit_err;
     const char *model_dir; /* the top-level file's folder: urls must stay inside it (or allowed_roots) */
 } loader;
+
+/* What emit makes per vertex at most (position, normal, texcoord, colour): the budget's unit. */
+#define X3D_VERTEX_BYTES 48u
+
+/* The budget for n vertices of geometry node el: charge = false checks where a generator sizes its
+ * arrays (before it allocates them), charge = true charges once, in emit. */
+static sy_result budget_vertices(loader *L, const char *file, const xmlNode *el, uint64_t n, bool charge);
+
 
 static void warn(loader *L, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void warn(loader *L, const char *fmt, ...)
@@ -582,6 +592,9 @@ static sy_result load_texture(loader *L, xfile *F, const xmlNode *el, bool srgb,
             snprintf(why, sizeof why, "%.400s: cannot decode (%s)", path, size > INT_MAX ? "too large" : stbi_failure_reason());
         } else if ((uint64_t)w * (uint64_t)h > L->opt.max_image_pixels) {
             snprintf(why, sizeof why, "%.400s: %dx%d pixels exceed the limit", path, w, h);
+        } else if (!sy_budget_fits(&L->budget, (uint64_t)w * (uint64_t)h, (uint64_t)comp)) {
+            snprintf(why, sizeof why, "%.400s: %dx%d pixels exceed what is left of the scene budget (%.0f MiB)", path, w,
+                     h, (double)(L->budget.limit - L->budget.used) / (1024.0 * 1024.0));
         } else {
             int w2, h2, c2;
             pixels = stbi_load_from_memory(bytes, (int)size, &w2, &h2, &c2, comp);
@@ -598,6 +611,7 @@ static sy_result load_texture(loader *L, xfile *F, const xmlNode *el, bool srgb,
         warn(L, "%s:%d: ImageTexture: %s; no texture", F->path, line_of(el), why);
         return SY_OK;
     }
+    (void)sy_budget_charge(&L->budget, (uint64_t)w * (uint64_t)h, (uint64_t)comp, &L->err, "ImageTexture"); /* fits */
     sy_result r;
     sy_blob *blob = NULL;
     size_t bytes = (size_t)w * (size_t)h * (size_t)comp;
@@ -912,6 +926,13 @@ static sy_result make_blob(loader *L, void *data, size_t bytes, sy_blob **out)
 }
 
 /* Emits the primitive. Takes ownership of nothing; *prim gets new blobs. */
+static sy_result budget_vertices(loader *L, const char *file, const xmlNode *el, uint64_t n, bool charge)
+{
+    if (!charge && sy_budget_fits(&L->budget, n, X3D_VERTEX_BYTES)) return SY_OK;
+    return sy_budget_charge(&L->budget, n, X3D_VERTEX_BYTES, &L->err, "%s:%d: %s: %llu vertices", file, line_of(el),
+                            ename(el), (unsigned long long)n);
+}
+
 static sy_result emit(loader *L, xfile *F, const xmlNode *el, const geom_src *g, corners *c, sy_primitive *prim)
 {
     size_t nv = c->tris * 3;
@@ -919,6 +940,8 @@ static sy_result emit(loader *L, xfile *F, const xmlNode *el, const geom_src *g,
     if (nv > L->opt.max_vertices)
         return sy_error_set(&L->err, SY_ERR_LIMIT, "%s:%d: %s: %zu vertices exceed the limit of %zu", F->path,
                             line_of(el), ename(el), nv, L->opt.max_vertices);
+    sy_result br = budget_vertices(L, F->path, el, nv, true);
+    if (br) return br;
     if (!g->ccw)
         for (size_t t = 0; t < c->tris; t++) {
             uint32_t a = c->coord[3 * t + 1];
@@ -1095,6 +1118,7 @@ static sy_result build_faces(loader *L, xfile *F, const xmlNode *el, geom_src *g
                          line_of(el), ename(el), total_tris, L->opt.max_vertices);
         goto done;
     }
+    if ((r = budget_vertices(L, F->path, el, (uint64_t)total_tris * 3u, false))) goto done;
     c->tris = total_tris;
     c->coord = malloc(total_tris * 3 * sizeof(uint32_t));
     size_t *src = malloc(total_tris * 3 * sizeof(size_t)); /* position in coordIndex */
@@ -1285,6 +1309,8 @@ static sy_result build_extrusion(loader *L, xfile *F, const xmlNode *el, geom_sr
                          line_of(el), ncs, nsp);
         goto done;
     }
+    /* two triangles per quad of the swept surface (caps come on top, charged in emit) */
+    if ((r = budget_vertices(L, F->path, el, 6u * (uint64_t)(ncs - 1) * (nsp - 1), false))) goto done;
     bool closed_spine = SP[0] == SP[3 * (nsp - 1)] && SP[1] == SP[3 * (nsp - 1) + 1] && SP[2] == SP[3 * (nsp - 1) + 2];
     bool closed_cs = CS[0] == CS[2 * (ncs - 1)] && CS[1] == CS[2 * (ncs - 1) + 1];
     g->npts = ncs * nsp;
@@ -1406,6 +1432,11 @@ static sy_result build_triset(loader *L, xfile *F, const xmlNode *el, geom_src *
         free(ix);
         return sy_error_set(&L->err, SY_ERR_LIMIT, "%s:%d: %s: %zu vertices exceed the limit of %zu", F->path,
                             line_of(el), ename(el), n, L->opt.max_vertices);
+    }
+    sy_result br = budget_vertices(L, F->path, el, n, false);
+    if (br) {
+        free(ix);
+        return br;
     }
     bool npv = get_bool(el, "normalPerVertex", true), cpv = get_bool(el, "colorPerVertex", true);
     c->tris = n / 3;
@@ -1544,6 +1575,7 @@ static sy_result build_strokes(loader *L, xfile *F, const xmlNode *el, const geo
                          n, o->nv, L->opt.max_vertices);
         goto done;
     }
+    if ((r = budget_vertices(L, F->path, el, o->nv, true))) goto done; /* strokes do not go through emit */
     if (o->nv == 0 || (strcmp(n, "PointSet") && o->npairs == 0)) {
         warn(L, "%s:%d: %s has no polyline with 2 or more vertices; skipped", F->path, line_of(el), n);
         goto done;
@@ -2568,6 +2600,7 @@ static sy_result load_common(const char *path, const void *mem, size_t size, con
     if (!L.opt.max_vertices) L.opt.max_vertices = (size_t)1 << 27;
     if (!L.opt.max_image_pixels) L.opt.max_image_pixels = (uint64_t)1 << 26;
     if (!L.opt.max_inline_depth) L.opt.max_inline_depth = 16;
+    L.budget = sy_budget_make(path, L.opt.max_scene_bytes);
     L.max_values = L.opt.max_vertices > SIZE_MAX / 4 ? SIZE_MAX : L.opt.max_vertices * 4;
     L.bounds = sy_bounds_empty();
     xmlInitParser();
@@ -2597,6 +2630,10 @@ static sy_result load_common(const char *path, const void *mem, size_t size, con
         r = L.limit_r;
         L.err = L.limit_err;
     }
+    /* USE and Inline fan-out: what the mirror and the back-ends will hold, once per path */
+    if (!r) r = sy_budget_charge_placements(&L.budget, scene, root, &L.err);
+    /* a message without a place (out of memory) names the file at least */
+    if (r && strncmp(L.err.message, path, strlen(path)) != 0) sy_error_prefix(&L.err, "%s", path);
     if (!r) {
         finish_lights(&L);
         info->root = root;

@@ -73,6 +73,11 @@ typedef struct sy_x3d_options {
     size_t max_vertices;       /**< per geometry node, after triangulation; 0 = 1 << 27 */
     uint64_t max_image_pixels; /**< width * height; 0 = 1 << 26 */
     uint32_t max_inline_depth; /**< nesting of Inline files; 0 = 16 */
+    /** The load's budget (sy_budget.h), Inline files included: vertices of every geometry node as
+     * made, decoded images, and placements (USE and Inline fan-out counted per path); 0 =
+     * sy_budget_default_bytes(). An image past it goes missing with a warning; geometry or
+     * placements past it fail the load with SY_ERR_LIMIT naming the file, line and node. */
+    uint64_t max_scene_bytes;
     /** Files named by Inline and ImageTexture urls must lie in the top-level file's folder (after
      * symbolic links and ".."; sy_path_confine in sy_file.h) or in one of these folders; absolute
      * paths and file: URLs only in these. A refused url fails the load (SY_ERR_LIMIT) with a

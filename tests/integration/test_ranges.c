@@ -15,7 +15,10 @@
  *   - a DAG of 2^14 paths (an X3D USE chain of 7 KB): the mirror walked it once per path and hung;
  *     2^40 paths: now refused with SY_ERR_LIMIT naming the node, before allocating;
  *   - a node with 10^6 children (a 641-byte EXT_mesh_gpu_instancing file): a quadratic duplicate
- *     check hung the load.
+ *     check hung the load;
+ *   - 64 glTF primitives sharing a 2^24-vertex accessor (3.2 GB from 3.3 KB), an X3D Extrusion of
+ *     4000 x 4000 (2.9 GB from 51 KB), a USE graph of 2^30 paths: now each file's budget
+ *     (sy_budget.h) refuses them before allocating, naming the file and the item.
  * Back-ends: whitted, pathtracer, and raster where built (SY_HAVE_RASTER). */
 #include "it_util.h"
 
@@ -293,6 +296,62 @@ static void test_many_children(void)
     sy_scene_destroy(s);
 }
 
+/* One budget per file (sy_budget.h): small files that asked for gigabytes are refused before the
+ * allocation, naming the file and the item (each allocated 2.9-3.2 GB, or hung, before). */
+static void test_budgets(void)
+{
+    const uint64_t budget = (uint64_t)512 << 20;
+    sy_scene *s;
+    MUST(sy_scene_create(&s, err));
+    /* 64 primitives sharing one 2^24-vertex accessor without a buffer view (zeros): 3.3 KB */
+    char *doc = malloc(16384);
+    size_t n = (size_t)snprintf(doc, 16384,
+                                "{\"asset\":{\"version\":\"2.0\"},\"accessors\":[{\"componentType\":5126,\"count\":16777216,"
+                                "\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[0,0,0]}],\"meshes\":[{\"primitives\":[");
+    for (int k = 0; k < 64; ++k) n += (size_t)snprintf(doc + n, 16384 - n, "%s{\"attributes\":{\"POSITION\":0}}", k ? "," : "");
+    n += (size_t)snprintf(doc + n, 16384 - n, "]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0}");
+    sy_gltf_options go = {.max_scene_bytes = budget};
+    sy_gltf_info gi = {0};
+    sy_error e = {0};
+    sy_result r = sy_gltf_load_memory(doc, n, "shared.gltf", ".", s, &go, &gi, &e);
+    sy_gltf_info_free(&gi);
+    CHECKF(r == SY_ERR_LIMIT && strstr(e.message, "shared.gltf") && strstr(e.message, "meshes[0].primitives[") &&
+               strstr(e.message, "scene budget"),
+           "64 x 2^24 vertices: %s (%s)", e.message, sy_result_str(r));
+    free(doc);
+    /* an Extrusion of 4000 x 4000 points (51 KB) */
+    size_t cap = 200000;
+    char *x = malloc(cap);
+    n = (size_t)snprintf(x, cap, "<?xml version=\"1.0\"?><X3D><Scene><Shape><Extrusion crossSection=\"");
+    for (int k = 0; k < 4000; ++k) n += (size_t)snprintf(x + n, cap - n, "%d 0 ", k);
+    n += (size_t)snprintf(x + n, cap - n, "\" spine=\"");
+    for (int k = 0; k < 4000; ++k) n += (size_t)snprintf(x + n, cap - n, "0 %d 0 ", k);
+    n += (size_t)snprintf(x + n, cap - n, "\"/></Shape></Scene></X3D>");
+    sy_x3d_options xo = {.max_scene_bytes = budget};
+    sy_x3d_info xi = {0};
+    r = sy_x3d_load_memory(x, n, "extrusion.x3d", ".", s, &xo, &xi, &e);
+    sy_x3d_info_free(&xi);
+    CHECKF(r == SY_ERR_LIMIT && strstr(e.message, "extrusion.x3d") && strstr(e.message, "Extrusion") &&
+               strstr(e.message, "scene budget"),
+           "Extrusion 4000 x 4000: %s (%s)", e.message, sy_result_str(r));
+    /* a USE graph of 2^30 paths in 30 levels (a few KB) */
+    n = (size_t)snprintf(x, cap, "<?xml version=\"1.0\"?><X3D><Scene><Transform DEF=\"a0\"><Shape><Box/></Shape></Transform>");
+    for (int k = 1; k <= 30; ++k)
+        n += (size_t)snprintf(x + n, cap - n,
+                              "<Transform DEF=\"a%d\"><Transform><Transform USE=\"a%d\"/></Transform>"
+                              "<Transform translation=\"1 0 0\"><Transform USE=\"a%d\"/></Transform></Transform>",
+                              k, k - 1, k - 1);
+    n += (size_t)snprintf(x + n, cap - n, "</Scene></X3D>");
+    xi = (sy_x3d_info){0};
+    r = sy_x3d_load_memory(x, n, "fanout.x3d", ".", s, NULL, &xi, &e); /* the default budget */
+    sy_x3d_info_free(&xi);
+    CHECKF(r == SY_ERR_LIMIT && strstr(e.message, "fanout.x3d") && strstr(e.message, "placements"),
+           "2^30 USE paths: %s (%s)", e.message, sy_result_str(r));
+    free(x);
+    CHECKF(sy_scene_count(s, SY_TYPE_NODE) == 0, "refused loads leave %u nodes", sy_scene_count(s, SY_TYPE_NODE));
+    sy_scene_destroy(s);
+}
+
 static void scales(void)
 {
     test_scale("[1e-30,1e-30,1e-30]", false);
@@ -313,7 +372,7 @@ int main(int argc, char **argv)
         void (*fn)(void);
     } cases[] = {{"gltf_camera_far", test_gltf_camera_far}, {"x3d_viewpoint_far", test_x3d_viewpoint_far},
                  {"scales", scales}, {"orbit", test_orbit}, {"composed", test_composed}, {"dag", test_dag},
-                 {"many_children", test_many_children}};
+                 {"many_children", test_many_children}, {"budgets", test_budgets}};
     it_register();
     sy_log_set_level(SY_LOG_ERROR); /* the undrawn placements warn; the checks read results */
     bool ran = false;
