@@ -533,22 +533,65 @@ static void fill_doc(sy_gltf_shim_impl *d)
     c.internal = d;
 }
 
-// The first entry of the document's extensionsRequired that is not in supported (NULL-terminated),
-// or "" (also when the JSON does not parse or supported is NULL). For GLB the JSON chunk is read
-// within the container the caller validated (header 12 bytes, chunk length and type 8).
-static std::string unsupported_required(const uint8_t *bytes, size_t size, bool binary, const char *const *supported)
+// The document's JSON (a discarded value when it does not parse: tinygltf then says why). For GLB
+// the JSON chunk is read within the container the caller validated (header 12 bytes, chunk length
+// and type 8).
+static nlohmann::json json_of(const uint8_t *bytes, size_t size, bool binary)
 {
-    if (!supported) return "";
     const uint8_t *json_begin = bytes;
     size_t json_size = size;
     if (binary) {
-        if (size < 20) return "";
+        if (size < 20) return nlohmann::json::value_t::discarded;
         uint32_t len = uint32_t(bytes[12]) | uint32_t(bytes[13]) << 8 | uint32_t(bytes[14]) << 16 | uint32_t(bytes[15]) << 24;
-        if (len > size - 20) return "";
+        if (len > size - 20) return nlohmann::json::value_t::discarded;
         json_begin = bytes + 20;
         json_size = len;
     }
-    nlohmann::json doc = nlohmann::json::parse(json_begin, json_begin + json_size, nullptr, false);
+    return nlohmann::json::parse(json_begin, json_begin + json_size, nullptr, false);
+}
+
+// tinygltf reads every index into an int: a larger number wraps ("mesh": 2^40 became mesh 0). The
+// first index property (glTF 2.0's names) that is not an integer in [0, 2^31 - 1], with its JSON
+// path in *where; false when there is none.
+static bool bad_index(const nlohmann::json &j, std::string *where, const std::string &path = "")
+{
+    static const char *const keys[] = {"mesh", "camera", "skin", "scene", "node", "source", "sampler", "index",
+                                       "bufferView", "buffer", "material", "indices", "light", "texCoord",
+                                       "input", "output", "inverseBindMatrices", "skeleton", nullptr};
+    static const char *const lists[] = {"children", "nodes", "joints", nullptr}; // arrays of indices
+    auto is_index = [](const nlohmann::json &v) {
+        if (v.is_number_unsigned()) return v.get<uint64_t>() <= uint64_t(INT32_MAX);
+        if (v.is_number_integer()) return v.get<int64_t>() >= 0 && v.get<int64_t>() <= INT32_MAX;
+        return !v.is_number(); // a float or another type: tinygltf's own checks refuse it
+    };
+    if (j.is_object()) {
+        for (auto it = j.begin(); it != j.end(); ++it) {
+            const std::string &k = it.key();
+            std::string here = path.empty() ? k : path + "." + k;
+            bool key = false, list = false;
+            for (size_t i = 0; keys[i] && !key; i++) key = k == keys[i];
+            for (size_t i = 0; lists[i] && !list; i++) list = k == lists[i];
+            if (key && !is_index(*it)) return *where = here, true;
+            if (list && it->is_array())
+                for (size_t i = 0; i < it->size(); i++)
+                    if ((*it)[i].is_number() && !is_index((*it)[i])) return *where = here + "[" + std::to_string(i) + "]", true;
+            if (k == "attributes" && it->is_object()) // accessor indices by attribute name
+                for (auto a = it->begin(); a != it->end(); ++a)
+                    if (!is_index(*a)) return *where = here + "." + a.key(), true;
+            if (it->is_structured() && bad_index(*it, where, here)) return true;
+        }
+    } else if (j.is_array()) {
+        for (size_t i = 0; i < j.size(); i++)
+            if (j[i].is_structured() && bad_index(j[i], where, path + "[" + std::to_string(i) + "]")) return true;
+    }
+    return false;
+}
+
+// The first entry of the document's extensionsRequired that is not in supported (NULL-terminated),
+// or "" (also when the JSON does not parse or supported is NULL).
+static std::string unsupported_required(const nlohmann::json &doc, const char *const *supported)
+{
+    if (!supported) return "";
     if (!doc.is_object()) return "";
     auto it = doc.find("extensionsRequired");
     if (it == doc.end() || !it->is_array()) return "";
@@ -586,6 +629,11 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
     fs.user_data = ctx;
     loader.SetFsCallbacks(fs);
     loader.SetImageLoader(load_image, ctx);
+    {
+        std::string where;
+        if (bad_index(json_of(bytes, size, binary), &where))
+            return sy_error_set(err, SY_ERR_PARSE, "%s is not an index (an integer from 0 to 2^31 - 1)", where.c_str());
+    }
     std::string terr;
     bool ok = binary ? loader.LoadBinaryFromMemory(model, &terr, twarn, bytes, unsigned(size), base)
                      : loader.LoadASCIIFromString(model, &terr, twarn, reinterpret_cast<const char *>(bytes),
@@ -593,7 +641,7 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
     // a refused file fails the load, also where tinygltf would go on without it (an image)
     if (!ctx->refused.empty()) return sy_error_set(err, SY_ERR_LIMIT, "%s", ctx->refused.c_str());
     if (ok) return SY_OK;
-    std::string ext = unsupported_required(bytes, size, binary, limits->supported_extensions);
+    std::string ext = unsupported_required(json_of(bytes, size, binary), limits->supported_extensions);
     if (!ext.empty())
         return sy_error_set(err, SY_ERR_UNSUPPORTED, "extensionsRequired: '%s' is not supported (tinygltf: %s)",
                             ext.c_str(), one_line(terr).c_str());

@@ -230,6 +230,13 @@ static void test_bad_json(void)
                   SY_ERR_PARSE, "textures[0]: source 2 out of range");
     bad_json_case("camera_index", DOC(BUF, VIEWS, ACCS, MESHES, MATS, "\"nodes\":[{\"mesh\":0,\"camera\":1}]", SCENES, ""),
                   SY_ERR_PARSE, "nodes[0]: camera 1 out of range");
+    /* tinygltf reads indices into an int: 2^40 wrapped to mesh 0, a silent wrong scene (issue 32) */
+    bad_json_case("index_2_40", DOC(BUF, VIEWS, ACCS, MESHES, MATS, "\"nodes\":[{\"mesh\":1099511627776}]", SCENES, ""),
+                  SY_ERR_PARSE, "nodes[0].mesh is not an index");
+    bad_json_case("index_negative", DOC(BUF, VIEWS, ACCS, "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":-4294967296}}]}]", MATS, NODES, SCENES, ""),
+                  SY_ERR_PARSE, "meshes[0].primitives[0].attributes.POSITION is not an index");
+    bad_json_case("child_2_32", DOC(BUF, VIEWS, ACCS, MESHES, MATS, "\"nodes\":[{\"mesh\":0,\"children\":[4294967296]}]", SCENES, ""),
+                  SY_ERR_PARSE, "nodes[0].children[0] is not an index");
     bad_json_case("child_index", DOC(BUF, VIEWS, ACCS, MESHES, MATS, "\"nodes\":[{\"mesh\":0,\"children\":[9]}]", SCENES, ""),
                   SY_ERR_PARSE, "nodes[0].children[0]: node 9 out of range");
     bad_json_case("scene_node_index", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, "\"scenes\":[{\"nodes\":[3]}]", ""),
