@@ -36,6 +36,7 @@ static void fuzz_load_gltf(const unsigned char *data, size_t size, const char *n
     o.max_indices = 1u << 19;
     o.max_image_pixels = 1u << 18;
     o.max_instances = 1u << 12;
+    o.max_scene_bytes = (uint64_t)64 << 20; /* the file budget, small like the other limits */
     sy_gltf_info info = {0};
     sy_error err = {0};
     if (sy_gltf_load_memory(data, size, name, fuzz_resource_dir(), s, &o, &info, &err) == SY_OK)

@@ -16,6 +16,7 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
     o.max_vertices = 1u << 18;
     o.max_image_pixels = 1u << 18;
     o.max_inline_depth = 4;
+    o.max_scene_bytes = (uint64_t)64 << 20; /* the file budget, small like the other limits */
     sy_x3d_info info = {0};
     sy_error err = {0};
     if (sy_x3d_load_memory(data, size, "fuzz.x3d", fuzz_resource_dir(), s, &o, &info, &err) == SY_OK)
