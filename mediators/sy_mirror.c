@@ -70,6 +70,8 @@ typedef struct node_m {
     uint32_t pl_count;
     uint32_t visit;   /* sync epoch: re-placed in this sync */
     uint32_t pending; /* parents in the set being re-placed that are not done yet */
+    uint32_t dry_pending; /* the same, for the counting pass */
+    uint64_t paths;       /* the counting pass: placements it will have (saturating) */
 } node_m;
 
 struct sy_mirror {
@@ -405,6 +407,43 @@ static sy_result replace_dirty(sy_mirror *st, sy_error *err)
             if (pn && pn->visit == st->epoch) n->pending++;
         }
     }
+    /* counting pass, nothing allocated: the placements the set will have, against the cap */
+    uint64_t others = st->placements, total = 0, limit = st->placements_max;
+    for (uint32_t i = 0; i < count && r == SY_OK; ++i) {
+        node_m *n = LOOKUP(st, node, node_cap, set[i]);
+        others -= n->pl_count;
+        n->dry_pending = n->pending;
+        if (!n->pending && !push_u32(&ready, &nready, &ready_cap, n->id)) r = oom(st, err);
+    }
+    while (nready && r == SY_OK) {
+        uint32_t nid = ready[--nready];
+        node_m *n = LOOKUP(st, node, node_cap, nid);
+        bool is_root = st->root ? n->id == st->root : n->parent_count == 0;
+        uint64_t want = is_root ? 1u : 0u;
+        if (!is_root)
+            for (uint32_t i = 0; i < n->parent_count; ++i) {
+                node_m *pn = LOOKUP(st, node, node_cap, n->parents[i]);
+                if (pn) want += pn->visit == st->epoch ? pn->paths : pn->pl_count;
+                if (want > limit) want = limit + 1u; /* saturates: the sum of two stays far below 2^64 */
+            }
+        n->paths = want;
+        total += want;
+        if (others + total > limit) {
+            r = sy_error_set(err, SY_ERR_LIMIT,
+                             "%s: node %#x is reached along %s%llu paths, past the %u placements a scene may have "
+                             "(SY_MIRROR_PLACEMENTS_MAX)",
+                             st->name, n->id, want > limit ? "more than " : "", (unsigned long long)(want > limit ? limit : want),
+                             st->placements_max);
+            break;
+        }
+        for (uint32_t c = 0; c < n->child_count && r == SY_OK; ++c) {
+            node_m *cn = LOOKUP(st, node, node_cap, n->children[c]);
+            if (cn && cn->visit == st->epoch && cn->dry_pending && --cn->dry_pending == 0 &&
+                !push_u32(&ready, &nready, &ready_cap, cn->id))
+                r = oom(st, err);
+        }
+    }
+    nready = 0;
     for (uint32_t i = 0; i < count && r == SY_OK; ++i) {
         node_m *n = LOOKUP(st, node, node_cap, set[i]);
         if (!n->pending && !push_u32(&ready, &nready, &ready_cap, n->id)) r = oom(st, err);

@@ -258,13 +258,12 @@ static void test_dag(void)
                "2^14 placements, %s: %s, %u pixels", k_backends[b], e.message, covered);
     }
     sy_scene_destroy(s);
-    s = diamond(39, &root); /* 2^40 */
-    for (size_t b = 0; b < BACKEND_COUNT; ++b) {
+    s = diamond(39, &root); /* 2^40: the mirror (shared by every back-end) refuses it; one back-end is enough */
+    {
         uint32_t covered = 0;
         sy_error e = {0};
-        sy_result r = render(s, (sy_node){0}, k_backends[b], &covered, &e);
-        CHECKF(r == SY_ERR_LIMIT && strstr(e.message, "paths"), "2^40 placements, %s: %s (%s)", k_backends[b],
-               e.message, sy_result_str(r));
+        sy_result r = render(s, (sy_node){0}, "whitted", &covered, &e);
+        CHECKF(r == SY_ERR_LIMIT && strstr(e.message, "paths"), "2^40 placements: %s (%s)", e.message, sy_result_str(r));
     }
     sy_scene_destroy(s);
 }
