@@ -686,6 +686,7 @@ typedef struct peer {
     size_t peer_max_frame;    /* what the client accepts (from its HELLO) */
     double accepted;
     bool counted_unauth;      /* counted in s->unauth (s->lock) */
+    bool displaced;           /* closed to make room for a newer connection; counted in s->displacing (s->lock) */
     bool counted_open;        /* counted in s->open_sessions (s->lock) */
     bool dead;                /* the reader thread has finished (s->lock) */
     /* the job handed to the serving thread (qlock) */
@@ -714,6 +715,8 @@ struct sy_cluster_server {
     pthread_mutex_t lock;         /* guards peers, unauth, dead flags, the noise log limiter */
     peer *peers;
     uint32_t unauth, npeers;
+    uint32_t displacing;          /* displaced connections whose reader thread has not ended yet */
+    peer **unauth_scratch;        /* max_unauth entries: the victim search (s->lock) */
     uint32_t open_sessions;       /* connections past the handshake (at most 2 x max_sessions) */
     double noise_window;          /* start of the current second of rate-limited log lines */
     uint32_t noise_lines, noise_dropped;
@@ -887,6 +890,11 @@ sy_result sy_cluster_server_create(const sy_cluster_server_opts *opts, sy_cluste
     s->cache.budget = opts->blob_cache_bytes ? opts->blob_cache_bytes : SY_CLUSTER_DEFAULT_BLOB_CACHE;
     if (!s->o.max_objects) s->o.max_objects = SY_CLUSTER_DEFAULT_MAX_OBJECTS;
     if (!s->o.auth_backoff_ms) s->o.auth_backoff_ms = 250;
+    s->unauth_scratch = calloc(s->max_unauth, sizeof *s->unauth_scratch);
+    if (!s->unauth_scratch) {
+        free(s);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "sy serve: out of memory");
+    }
     pthread_mutex_init(&s->auth_lock, NULL);
     pthread_mutex_init(&s->lock, NULL);
     pthread_mutex_init(&s->qlock, NULL);
@@ -963,6 +971,7 @@ void sy_cluster_server_destroy(sy_cluster_server *s)
         peer_free(s, p);
     }
     cache_free(&s->cache);
+    free(s->unauth_scratch);
     if (s->secret) sodium_memzero(s->secret, s->o.secret_len);
     free(s->secret);
     if (s->sync_ok) {
@@ -1570,7 +1579,8 @@ static void *peer_main(void *arg)
     pthread_mutex_lock(&s->lock);
     if (p->counted_unauth) s->unauth--;
     if (p->counted_open) s->open_sessions--;
-    p->counted_unauth = p->counted_open = false;
+    if (p->displaced) s->displacing--;
+    p->counted_unauth = p->counted_open = p->displaced = false;
     p->dead = true;
     pthread_mutex_unlock(&s->lock);
     pthread_mutex_lock(&s->qlock);
@@ -1612,18 +1622,72 @@ static void reap_peers(sy_cluster_server *s)
     }
 }
 
-/* A new connection: refused at once beyond max_unauthenticated; else a record and a reader
- * thread with a small stack. */
+/* Orders unauthenticated connections by host, then by age (oldest first). */
+static int unauth_order(const void *a, const void *b)
+{
+    const peer *p = *(peer *const *)a, *q = *(peer *const *)b;
+    int c = strcmp(p->host, q->host);
+    if (c) return c;
+    return (p->accepted > q->accepted) - (p->accepted < q->accepted);
+}
+
+/* The table of unauthenticated connections is full: picks the connection to close for a newer
+ * one: the oldest connection of the address that holds the most (ties: the address whose oldest
+ * is oldest). So a flood from one address displaces only its own connections while another
+ * address holds fewer, and a client that completes its handshake promptly is never the oldest
+ * for long. NULL when none (the displaced ones have not ended yet). Caller holds s->lock. */
+static peer *unauth_victim(sy_cluster_server *s, uint32_t *same_host)
+{
+    uint32_t n = 0;
+    for (peer *p = s->peers; p && n < s->max_unauth; p = p->next)
+        if (p->counted_unauth && !p->displaced) s->unauth_scratch[n++] = p;
+    if (!n) return NULL;
+    qsort(s->unauth_scratch, n, sizeof *s->unauth_scratch, unauth_order);
+    peer *best = NULL;
+    uint32_t best_run = 0;
+    for (uint32_t i = 0; i < n;) {
+        uint32_t j = i + 1;
+        while (j < n && !strcmp(s->unauth_scratch[j]->host, s->unauth_scratch[i]->host)) ++j;
+        peer *oldest = s->unauth_scratch[i];
+        if (j - i > best_run || (j - i == best_run && oldest->accepted < best->accepted)) best = oldest, best_run = j - i;
+        i = j;
+    }
+    *same_host = best_run;
+    return best;
+}
+
+/* A new connection: when max_unauthenticated connections are waiting for their handshake, the
+ * oldest of the address holding the most is closed to make room (unauth_victim), so idle
+ * connections reopened by one peer cannot lock honest clients out; refused at once only while
+ * max_unauthenticated displaced connections are still closing. Then a record and a reader thread
+ * with a small stack. */
 static void peer_start(sy_cluster_server *s, sy_cluster_stream *st)
 {
     pthread_mutex_lock(&s->lock);
-    uint32_t unauth = s->unauth;
+    uint32_t unauth = s->unauth, same_host = 0, closing = s->displacing;
+    char victim_addr[80] = "";
     bool room = unauth < s->max_unauth;
+    if (!room && closing < s->max_unauth) {
+        peer *v = unauth_victim(s, &same_host);
+        if (v) {
+            copy_str(victim_addr, sizeof victim_addr, v->addr);
+            v->counted_unauth = false;
+            v->displaced = true;
+            s->unauth--;
+            s->displacing++;
+            v->w.st->ops->close(v->w.st); /* its reader thread ends (the record stays listed until then) */
+            room = true;
+        }
+    }
     if (room) s->unauth++;
     pthread_mutex_unlock(&s->lock);
+    if (victim_addr[0])
+        slog_noise(s, SY_LOG_WARNING, "%s: closed before authentication to make room for %s: the oldest of the %u "
+                      "unauthenticated connections from its address (%u open, limit %u, --max-unauthenticated)",
+                   victim_addr, st->peer, same_host, unauth, s->max_unauth);
     if (!room) {
         slog_noise(s, SY_LOG_WARNING, "%s: connection refused: %u unauthenticated connections are open (limit %u, "
-                      "--max-unauthenticated)", st->peer, unauth, s->max_unauth);
+                      "--max-unauthenticated) and %u more are closing", st->peer, unauth, s->max_unauth, closing);
         st->ops->free(st);
         return;
     }

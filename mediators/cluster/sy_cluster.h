@@ -20,8 +20,8 @@
  * one at a time on the thread that calls sy_cluster_server_run (renders use every core through the
  * back-ends; mediators stay on one thread). Budgets: before a connection has authenticated it
  * gets a fixed record (a 1 KiB frame buffer inside), at most max_unauthenticated such
- * connections exist (more are closed at once), and each must finish HELLO / AUTH within
- * handshake_timeout_ms; after, frames are at most max_frame bytes, messages max_message, and all
+ * connections exist (a newer one closes the oldest of the address holding the most), and each must
+ * finish HELLO / AUTH within handshake_timeout_ms; after, frames are at most max_frame bytes, messages max_message, and all
  * peers' messages in flight together at most max_peer_memory (a reader waits for room, then
  * refuses). A bad message or a failed authentication is answered with ERROR, logged with the
  * peer's address, the place and the reason, and the server keeps serving; failed authentications
@@ -91,7 +91,8 @@ typedef struct sy_cluster_server_opts {
                                  at most max_peer_memory) */
     size_t max_peer_memory;   /**< all peers' messages in flight together: reassembly buffers, replies, SCENEs
                                  waiting for blobs (0 = SY_CLUSTER_DEFAULT_MAX_PEER_MEMORY) */
-    uint32_t max_unauthenticated; /**< connections not yet authenticated; more are closed at once (0 = 32) */
+    uint32_t max_unauthenticated; /**< connections not yet authenticated; a newer one closes the oldest of the
+                                     address holding the most (0 = 32) */
     uint32_t handshake_timeout_ms; /**< HELLO (/ AUTH) must complete this long after accept (0 = 3000) */
     sy_cluster_log_fn log; /**< log lines; NULL = sy_log */
     void *log_user; /**< passed to log */

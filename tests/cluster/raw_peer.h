@@ -20,8 +20,10 @@
 #include <time.h>
 #include <unistd.h>
 
-/* A TCP connection to 127.0.0.1:port with send / receive timeouts; -1 on failure. */
-static inline int raw_connect(int port, int timeout_ms)
+/* A TCP connection from the loopback address `from` (NULL: the kernel's choice, 127.0.0.1) to
+ * 127.0.0.1:port with send / receive timeouts; -1 on failure. Linux routes all of 127/8 to the
+ * loopback interface, so "127.0.0.2" is a second peer address on one machine. */
+static inline int raw_connect_from(const char *from, int port, int timeout_ms)
 {
     int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
     if (fd < 0) return -1;
@@ -30,6 +32,13 @@ static inline int raw_connect(int port, int timeout_ms)
     setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
     int one = 1;
     setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    if (from) {
+        struct sockaddr_in la = {.sin_family = AF_INET, .sin_port = 0};
+        if (inet_pton(AF_INET, from, &la.sin_addr) != 1 || bind(fd, (struct sockaddr *)&la, sizeof la) != 0) {
+            close(fd);
+            return -1;
+        }
+    }
     struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
     sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
     if (connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
@@ -37,6 +46,12 @@ static inline int raw_connect(int port, int timeout_ms)
         return -1;
     }
     return fd;
+}
+
+/* A TCP connection to 127.0.0.1:port with send / receive timeouts; -1 on failure. */
+static inline int raw_connect(int port, int timeout_ms)
+{
+    return raw_connect_from(NULL, port, timeout_ms);
 }
 
 static inline bool raw_write_all(int fd, const void *data, size_t n)

@@ -663,51 +663,242 @@ static int test_ceiling(fixture *fx)
 }
 #endif
 
+#ifndef SY_TEST_LEGACY_WIRE
 /* ======================================================================== cap */
+/* An unauthenticated connection from `from` (NULL: 127.0.0.1) that has sent HELLO and read the
+ * CHALLENGE of a server with a secret: the server holds it, waiting for AUTH, and accepted it
+ * before any connection opened after this returns. -1 on failure. */
+static int hello_only(const char *from, int port)
+{
+    int fd = raw_connect_from(from, port, 20000);
+    if (fd < 0) return -1;
+    sy_cluster_msg hello = raw_hello(), rep;
+    uint8_t *raw = NULL;
+    int rc = raw_send_msg(fd, &hello) == 0 ? raw_recv_msg(fd, 1 << 16, &rep, &raw) : -1;
+    bool ok = rc == 0 && rep.header.type == SY_CLUSTER_CHALLENGE;
+    if (rc == 0) sy_cluster_msg_free(&rep);
+    free(raw);
+    if (!ok) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+/* true when the server has closed fd already (nothing waits: 1 ms) */
+static bool closed_now(int fd)
+{
+    return raw_closed_within(fd, 1);
+}
+
+/* The table of unauthenticated connections (--max-unauthenticated 8, a handshake deadline of
+ * 600 s so that nothing expires during the test): 12 connections, each held by the server before
+ * the next opens; each of the 4 beyond the limit closes the oldest, in order, and the newest 8
+ * stay open; a client gets in. Then the deadline (1000 ms on a second server): 8 idle connections
+ * are closed by it, and logged. Every wait is for a state (a connection closed), bounded. */
 static int test_cap(fixture *fx)
 {
     server sv;
     memset(&sv, 0, sizeof sv);
-    const char *extra[] = {"--max-unauthenticated", "8", "--handshake-timeout-ms", "1500", NULL};
+    const char *extra[] = {"--max-unauthenticated", "8", "--handshake-timeout-ms", "600000", NULL};
     if (start_server_args("s3cret", 0, extra, &sv)) return 1;
     int fd[12];
-    double opened = now_s();
+    int displaced_in_order = 0;
     for (int i = 0; i < 12; ++i) {
-        fd[i] = raw_connect(sv.port, 5000);
-        CHECK(fd[i] >= 0);
-        sleep_ms(30);
+        fd[i] = hello_only(NULL, sv.port);
+        CHECK_MSG(fd[i] >= 0, "connection %d got no CHALLENGE", i);
+        if (i >= 8) displaced_in_order += raw_closed_within(fd[i - 8], 20000);
     }
-    int closed_early = 0, open_early = 0;
-    for (int i = 8; i < 12; ++i) closed_early += raw_closed_within(fd[i], 500);
-    for (int i = 0; i < 8; ++i) open_early += !raw_closed_within(fd[i], 10);
-    double t_check = now_s() - opened;
-    int closed_late = 0;
-    for (int i = 0; i < 8; ++i) closed_late += raw_closed_within(fd[i], 3000);
-    double t_late = now_s() - opened;
-    for (int i = 0; i < 12; ++i) close(fd[i]);
-    printf("cap: 12 idle connections, limit 8: %d of the 4 beyond the limit closed within 500 ms, %d of the first 8 "
-           "still open %.2f s after opening, %d of them closed by %.2f s (handshake deadline 1.5 s)\n",
-           closed_early, open_early, t_check, closed_late, t_late);
-    bool logged_cap = log_contains(&sv, "connection refused: 8 unauthenticated connections are open (limit 8");
-    bool logged_deadline = log_contains(&sv, "no HELLO within the 1500 ms handshake deadline");
+    int newest_open = 0;
+    for (int i = 4; i < 12; ++i) newest_open += !closed_now(fd[i]);
+    printf("cap: 12 unauthenticated connections, limit 8: %d of the 4 oldest closed as the 4 newest arrived, %d of "
+           "the newest 8 open\n", displaced_in_order, newest_open);
+    bool logged = log_contains(&sv, "closed before authentication to make room for 127.0.0.1:");
     sy_error e = {0};
     sy_cluster_client *c = honest_client(fx, &sv, "s3cret", &e);
     bool client_ok = c != NULL;
+    char why[SY_ERROR_MESSAGE_MAX];
+    snprintf(why, sizeof why, "%s", e.message);
+    sy_cluster_client_destroy(c);
+    for (int i = 0; i < 12; ++i) close(fd[i]);
+    stop_server(&sv);
+    CHECK_MSG(displaced_in_order == 4, "only %d of the 4 oldest connections were closed for newer ones", displaced_in_order);
+    CHECK_MSG(newest_open == 8, "%d of the newest 8 connections were open", newest_open);
+    CHECK_MSG(logged, "the server did not log the displaced connections");
+    CHECK_MSG(client_ok, "no client beside 8 unauthenticated connections: %s", why);
+
+    /* the handshake deadline */
+    const char *extra2[] = {"--max-unauthenticated", "8", "--handshake-timeout-ms", "1000", NULL};
+    if (start_server_args("s3cret", 0, extra2, &sv)) return 1;
+    int closed = 0;
+    for (int i = 0; i < 8; ++i) {
+        fd[i] = raw_connect(sv.port, 5000);
+        CHECK(fd[i] >= 0);
+    }
+    for (int i = 0; i < 8; ++i) closed += raw_closed_within(fd[i], 30000);
+    for (int i = 0; i < 8; ++i) close(fd[i]);
+    bool logged_deadline = log_contains(&sv, "no HELLO within the 1000 ms handshake deadline");
+    c = honest_client(fx, &sv, "s3cret", &e);
+    client_ok = c != NULL;
     sy_cluster_client_destroy(c);
     stop_server(&sv);
-    CHECK_MSG(closed_early == 4, "only %d of the 4 connections beyond the cap were closed at once", closed_early);
-    CHECK_MSG(open_early == 8, "%d of the 8 connections within the cap were open", open_early);
-    CHECK_MSG(closed_late == 8, "only %d of 8 idle connections were closed at the handshake deadline", closed_late);
-    CHECK_MSG(logged_cap && logged_deadline, "server log: cap %s, deadline %s", logged_cap ? "logged" : "missing",
-              logged_deadline ? "logged" : "missing");
+    printf("cap: %d of 8 idle connections closed at the 1000 ms handshake deadline\n", closed);
+    CHECK_MSG(closed == 8, "only %d of 8 idle connections were closed at the handshake deadline", closed);
+    CHECK_MSG(logged_deadline, "the deadline was not logged");
     CHECK_MSG(client_ok, "no client after the idle connections: %s", e.message);
     return 0;
 }
 
+/* ======================================================================== lockout */
+/* Issue 32, item 3: idle connections reopened whenever the server closes them (at its 3 s
+ * handshake deadline, or to make room) from 127.0.0.2 while clients connect from 127.0.0.1.
+ * held = connections that have had their CHALLENGE and are open. */
+typedef struct reopener {
+    int port;
+    atomic_int *stop;
+    atomic_int held;
+    atomic_uint reopened;
+} reopener;
+
+#define REOPENERS 32
+
+static void *reopener_main(void *arg)
+{
+    reopener *r = arg;
+    struct pollfd pf[REOPENERS];
+    for (int i = 0; i < REOPENERS; ++i) {
+        pf[i].fd = hello_only("127.0.0.2", r->port);
+        pf[i].events = POLLIN;
+        if (pf[i].fd >= 0) atomic_fetch_add(&r->held, 1);
+    }
+    while (!atomic_load(r->stop)) {
+        /* the timeout only lets the loop see the stop flag */
+        int n = poll(pf, REOPENERS, 100);
+        if (n < 0 && errno != EINTR) break;
+        for (int i = 0; i < REOPENERS && !atomic_load(r->stop); ++i) {
+            if (pf[i].fd >= 0 && !(pf[i].revents & (POLLIN | POLLHUP | POLLERR))) continue;
+            if (pf[i].fd >= 0) {
+                uint8_t b[256];
+                ssize_t k = recv(pf[i].fd, b, sizeof b, MSG_DONTWAIT);
+                if (k > 0 || (k < 0 && (errno == EAGAIN || errno == EINTR))) continue; /* still open */
+                close(pf[i].fd);
+                atomic_fetch_sub(&r->held, 1);
+            }
+            pf[i].fd = hello_only("127.0.0.2", r->port); /* reopened at once */
+            pf[i].revents = 0;
+            if (pf[i].fd >= 0) {
+                atomic_fetch_add(&r->held, 1);
+                atomic_fetch_add(&r->reopened, 1);
+            }
+        }
+    }
+    for (int i = 0; i < REOPENERS; ++i)
+        if (pf[i].fd >= 0) close(pf[i].fd);
+    return NULL;
+}
+
+/* One honest client: connects (secret), renders a frame equal to ref. 0 when it did. */
+static int honest_round(fixture *fx, const server *sv, const sy_layer *ref, char *why, size_t cap)
+{
+    sy_error e = {0};
+    sy_layer out = {0};
+    sy_cluster_client *c = honest_client(fx, sv, "s3cret", &e);
+    sy_cluster_frame f = honest_frame(fx);
+    sy_result r = c ? sy_layer_create(fx->w, fx->h, &out, &e) : SY_ERR_IO;
+    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &out, NULL, &e);
+    bool same = r == SY_OK && (!ref || same_image(&out, ref));
+    if (r != SY_OK) snprintf(why, cap, "%s", e.message);
+    else if (!same) snprintf(why, cap, "the frame differs from the reference");
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&out);
+    return same ? 0 : 1;
+}
+
+static int test_lockout(fixture *fx)
+{
+    /* 1. The lock-out itself, without timing: a handshake deadline of 600 s, so the 32 connections
+     * holding the default table (--max-unauthenticated 32) stay until displaced; they come from
+     * the clients' own address, as in the report (everything on loopback). Before the fix every
+     * client was refused at once ("connection refused: 32 unauthenticated connections are
+     * open"). Now each client closes the oldest and gets in; the others stay; the flood reopens
+     * the closed one (the newest then) before the next client tries. */
+    server sv;
+    memset(&sv, 0, sizeof sv);
+    const char *extra[] = {"--handshake-timeout-ms", "600000", NULL};
+    if (start_server_args("s3cret", 0, extra, &sv)) return 1;
+    int fd[32];
+    for (int i = 0; i < 32; ++i) {
+        fd[i] = hello_only(NULL, sv.port);
+        CHECK_MSG(fd[i] >= 0, "connection %d got no CHALLENGE", i);
+    }
+    sy_layer ref = {0};
+    sy_error e = {0};
+    char why[SY_ERROR_MESSAGE_MAX] = "";
+    int got_in = 0, oldest_closed = 0, others_open = 0;
+    for (int k = 0; k < 3; ++k) {
+        if (honest_round(fx, &sv, NULL, why, sizeof why) == 0) got_in++;
+        else fprintf(stderr, "lockout: client %d beside 32 unauthenticated connections: %s\n", k, why);
+        oldest_closed += raw_closed_within(fd[k], 20000);
+        /* and the flood reopens it: the table is full again, this one the newest */
+        close(fd[k]);
+        fd[k] = hello_only(NULL, sv.port);
+        CHECK_MSG(fd[k] >= 0, "reopened connection %d got no CHALLENGE", k);
+    }
+    for (int i = 0; i < 32; ++i) others_open += !closed_now(fd[i]);
+    for (int i = 0; i < 32; ++i) close(fd[i]);
+    printf("lockout: beside 32 held unauthenticated connections from its own address, %d of 3 clients got in; "
+           "%d of the 3 oldest connections closed for them, %d of the 32 held now open\n",
+           got_in, oldest_closed, others_open);
+    stop_server(&sv);
+    CHECK_MSG(got_in == 3, "%d of 3 clients got in beside 32 unauthenticated connections", got_in);
+    CHECK_MSG(oldest_closed == 3 && others_open == 32, "closed for the clients: %d of the 3 oldest; open: %d of 32",
+              oldest_closed, others_open);
+
+    /* 2. The report's attack as it was: the server's defaults (32, 3 s), 32 idle connections from
+     * 127.0.0.2 reopened whenever the server closes them (every 3 s at the deadline, at once when
+     * displaced); 5 clients from 127.0.0.1 in turn each connect, authenticate and render a frame
+     * equal to the reference. A connection from the address holding the most is displaced, never
+     * a client's while the flood holds more. */
+    if (start_server("s3cret", 0, &sv)) return 1;
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &ref, &e), e);
+    {
+        sy_cluster_client *c = honest_client(fx, &sv, "s3cret", &e);
+        CHECK_MSG(c != NULL, "%s", e.message);
+        sy_cluster_frame f = honest_frame(fx);
+        CHECK_OK(sy_cluster_client_render(c, &f, &ref, NULL, &e), e);
+        sy_cluster_client_destroy(c);
+    }
+    atomic_int stop = 0;
+    reopener rp = {.port = sv.port, .stop = &stop};
+    pthread_t th;
+    CHECK(pthread_create(&th, NULL, reopener_main, &rp) == 0);
+    /* the flood holds the whole table before the first client tries (a state, polled) */
+    double t0 = now_s();
+    while (atomic_load(&rp.held) < REOPENERS && now_s() - t0 < 60) sleep_ms(10);
+    int held = atomic_load(&rp.held);
+    got_in = 0;
+    for (int k = 0; k < 5; ++k) {
+        if (honest_round(fx, &sv, &ref, why, sizeof why) == 0) got_in++;
+        else fprintf(stderr, "lockout: client %d under the reopened connections: %s\n", k, why);
+    }
+    atomic_store(&stop, 1);
+    pthread_join(th, NULL);
+    printf("lockout: 32 idle connections from 127.0.0.2 reopened whenever closed (%u reopenings; %d held before the "
+           "first client): %d of 5 clients from 127.0.0.1 got in and rendered the reference frame\n",
+           atomic_load(&rp.reopened), held, got_in);
+    stop_server(&sv);
+    sy_layer_destroy(&ref);
+    CHECK_MSG(held == REOPENERS, "the flood held only %d connections", held);
+    CHECK_MSG(got_in == 5, "%d of 5 clients got in under 32 reopened idle connections", got_in);
+    return 0;
+}
+
+#endif
+
 int main(int argc, char **argv)
 {
     if (argc < 3) {
-        fprintf(stderr, "usage: test_cluster_hostile SERVER_EXE WORK_DIR [rss|counts|cap|ceiling]...\n");
+        fprintf(stderr, "usage: test_cluster_hostile SERVER_EXE WORK_DIR [rss|counts|cap|ceiling|lockout]...\n");
         return 2;
     }
     g_exe = argv[1];
@@ -738,20 +929,21 @@ int main(int argc, char **argv)
         return 1;
     }
     int failed = 0;
-    for (int g = 0; g < 4; ++g) {
-        static const char *names[] = {"rss", "counts", "cap", "ceiling"};
+    for (int g = 0; g < 5; ++g) {
+        static const char *names[] = {"rss", "counts", "cap", "ceiling", "lockout"};
         bool want = argc == 3;
         for (int i = 3; i < argc; ++i) want = want || !strcmp(argv[i], names[g]);
         if (!want) continue;
         int r = 0;
         if (g == 0) r = test_rss(&fx);
         else if (g == 1) r = test_counts(&fx);
-        else if (g == 2) r = test_cap(&fx);
 #ifndef SY_TEST_LEGACY_WIRE
+        else if (g == 2) r = test_cap(&fx);
         if (g == 1 && !r) r = test_replica_multiple();
         if (g == 3) r = test_ceiling(&fx);
+        if (g == 4) r = test_lockout(&fx);
 #else
-        if (g == 3) continue; /* protocol 2 has no peer memory ceiling at all */
+        if (g >= 2) continue; /* protocol 2: no peer memory ceiling, no HELLO-only raw peers */
 #endif
         printf("%s: %s\n", names[g], r ? "FAILED" : "ok");
         failed += r;
