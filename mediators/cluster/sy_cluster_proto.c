@@ -2,6 +2,7 @@
  * docs/PROTOCOL.md). All integers little endian; strings are u16 length + bytes (no NUL on the
  * wire, no embedded NUL accepted); floats are IEEE-754 binary32 / binary64 bit patterns. */
 #include "sy_cluster_proto.h"
+#include "sy_math.h"
 
 #define IMATH_HALF_NO_LOOKUP_TABLE
 #include <half.h> /* Imath (libimath-dev): binary16 conversions */
@@ -112,15 +113,26 @@ static bool rect_ok(const sy_cluster_rect *r, uint32_t fw, uint32_t fh)
     return r->w > 0 && r->h > 0 && r->x < fw && r->y < fh && r->w <= fw - r->x && r->h <= fh - r->y;
 }
 
-static bool camera_ok(const sy_camera_view *c)
+/* NULL when the camera view can reach a back-end, else why not. Every matrix entry and window
+ * value must be finite and within SY_COORD_MAX (core/sy_math.h: the one bound on coordinates,
+ * 1e12): a camera position or an orthographic window beyond it puts ray origins where a ray
+ * tracer's library asserts (Embree aborts beyond 1.844e18) and the rasterizer's depth means
+ * nothing. */
+static const char *camera_problem(const sy_camera_view *c)
 {
     const float *m = &c->camera_to_world.m[0];
     for (int i = 0; i < 16; ++i)
-        if (!isfinite(m[i])) return false;
+        if (!isfinite(m[i])) return "camera matrix has non-finite values";
     for (int i = 0; i < 4; ++i)
-        if (!isfinite(c->window[i])) return false;
-    return c->projection <= 1 && isfinite(c->znear) && isfinite(c->zfar) && c->znear >= 0 && c->zfar >= 0 &&
-           c->window[0] < c->window[1] && c->window[2] < c->window[3];
+        if (!isfinite(c->window[i]) || !isfinite(c->znear) || !isfinite(c->zfar))
+            return "camera window or depth range has non-finite values";
+    if (!sy_coords_in_range(m + 12, 3)) return "camera position beyond 1e12 (SY_COORD_MAX) in magnitude";
+    if (!sy_coords_in_range(m, 12)) return "camera matrix entry beyond 1e12 (SY_COORD_MAX) in magnitude";
+    if (!sy_coords_in_range(c->window, 4)) return "camera window beyond 1e12 (SY_COORD_MAX) in magnitude";
+    if (c->projection > 1) return "camera has an unknown projection";
+    if (c->znear < 0 || c->zfar < 0) return "camera has a negative depth range";
+    if (!(c->window[0] < c->window[1] && c->window[2] < c->window[3])) return "camera window is empty";
+    return NULL;
 }
 
 sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluster_buf *out, sy_error *err)
@@ -166,8 +178,10 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
         if (!str_fits(r->backend, SY_CLUSTER_BACKEND_MAX) || !str_fits(r->params, SY_CLUSTER_PARAMS_MAX))
             return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: back-end or params too long");
         if (r->full_width < 1 || r->full_width > SY_CLUSTER_MAX_IMAGE || r->full_height < 1 ||
-            r->full_height > SY_CLUSTER_MAX_IMAGE || r->tile_count > SY_CLUSTER_MAX_TILES || !camera_ok(&r->camera))
-            return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: image size, tiles or camera out of range");
+            r->full_height > SY_CLUSTER_MAX_IMAGE || r->tile_count > SY_CLUSTER_MAX_TILES)
+            return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: image size or tiles out of range");
+        if (camera_problem(&r->camera))
+            return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: %s", camera_problem(&r->camera));
         for (uint32_t i = 0; i < r->tile_count; ++i)
             if (!rect_ok(&r->tiles[i], r->full_width, r->full_height))
                 return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: tile %u outside the image", i);
@@ -501,8 +515,8 @@ sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, 
                 rd_fail(&rd, SY_ERR_LIMIT, "image size outside 1..16384");
             else if (q->sample_count > SY_CLUSTER_MAX_SAMPLES || q->sample_first > UINT32_MAX - q->sample_count)
                 rd_fail(&rd, SY_ERR_LIMIT, "sample range out of bounds");
-            else if (!camera_ok(&q->camera))
-                rd_fail(&rd, SY_ERR_PARSE, "camera has non-finite values, an unknown projection or an empty window");
+            else if (camera_problem(&q->camera))
+                rd_fail(&rd, SY_ERR_PARSE, camera_problem(&q->camera));
             else if (q->tile_count < 1 || q->tile_count > SY_CLUSTER_MAX_TILES)
                 rd_fail(&rd, SY_ERR_LIMIT, "tile count outside 1..4096");
             else if ((size_t)q->tile_count * 16 > rd.size - rd.pos)

@@ -893,12 +893,148 @@ static int test_lockout(fixture *fx)
     return 0;
 }
 
+/* ======================================================================== camera */
+/* Issue 32, item 1 (cluster path): a RENDER whose camera is at 1e19 (or whose orthographic window
+ * reaches 1e19) used to reach the server's back-end, where Embree asserts on the ray origin and
+ * aborts the server. Now the decoder refuses it, naming the reason; the server logs it with the
+ * peer's address and keeps serving the same session; a client with a secret refuses to send
+ * such a camera at all, and the server renders its next frame. */
+static int raw_expect(int fd, const sy_cluster_msg *m, uint32_t want, char *why, size_t cap)
+{
+    sy_cluster_msg rep;
+    uint8_t *raw = NULL;
+    CHECK(raw_send_msg(fd, m) == 0);
+    int rc = raw_recv_msg(fd, 1 << 26, &rep, &raw);
+    CHECK_MSG(rc == 0, "no reply to %s (%d): has the server died?", sy_cluster_msg_type_name(m->header.type), rc);
+    snprintf(why, cap, "%s", rep.header.type == SY_CLUSTER_ERROR ? rep.u.error.reason : "");
+    uint32_t got = rep.header.type;
+    sy_cluster_msg_free(&rep);
+    free(raw);
+    CHECK_MSG(got == want, "%s answered with %s ('%s'), want %s", sy_cluster_msg_type_name(m->header.type),
+              sy_cluster_msg_type_name(got), why, sy_cluster_msg_type_name(want));
+    return 0;
+}
+
+static int test_camera(fixture *fx)
+{
+    server sv;
+    memset(&sv, 0, sizeof sv);
+    if (start_server(NULL, 0, &sv)) return 1;
+    sy_error e = {0};
+    int fd = raw_connect(sv.port, 60000);
+    CHECK(fd >= 0);
+    char why[SY_CLUSTER_REASON_MAX];
+    sy_cluster_msg hello = raw_hello();
+    CHECK(raw_expect(fd, &hello, SY_CLUSTER_CHALLENGE, why, sizeof why) == 0);
+    sy_changes *ch = NULL;
+    void *data = NULL;
+    size_t size = 0;
+    CHECK_OK(sy_scene_snapshot(fx->scene, &ch, &e), e);
+    CHECK_OK(sy_changes_serialize(ch, NULL, NULL, &data, &size, &e), e);
+    sy_changes_release(ch);
+    sy_cluster_msg m;
+    memset(&m, 0, sizeof m);
+    m.header.type = SY_CLUSTER_SCENE;
+    m.header.seq = 2;
+    m.u.scene.frame = 1;
+    m.u.scene.flags = SY_CLUSTER_SCENE_SNAPSHOT;
+    m.u.scene.changes = data;
+    m.u.scene.changes_size = (uint32_t)size;
+    CHECK(raw_expect(fd, &m, SY_CLUSTER_SCENE_ACK, why, sizeof why) == 0);
+    free(data);
+    /* RENDERs: valid; camera at (1e19, 0, 0); an orthographic window of 1e19; valid again */
+    sy_cluster_frame f = honest_frame(fx);
+    sy_cluster_rect tile = {0, 0, fx->w, fx->h};
+    sy_cluster_msg r;
+    memset(&r, 0, sizeof r);
+    r.header.type = SY_CLUSTER_RENDER;
+    r.u.render.frame = 1;
+    strcpy(r.u.render.backend, "whitted");
+    r.u.render.root_id = f.root_id;
+    r.u.render.background_id = f.background_id;
+    r.u.render.full_width = fx->w;
+    r.u.render.full_height = fx->h;
+    r.u.render.camera = f.camera;
+    r.u.render.tile_count = 1;
+    r.u.render.tiles = &tile;
+    uint8_t body[1 << 12];
+    sy_cluster_buf b = {0};
+    r.header.seq = 3;
+    CHECK(raw_expect(fd, &r, SY_CLUSTER_TILES, why, sizeof why) == 0);
+    /* the encoder refuses such cameras (below): the frames are patched after encoding */
+    const float far_away = 1e19f, marker_x = 12345.5f, marker_w = 0.123456f;
+    struct {
+        const char *what, *reason;
+        bool ortho;
+    } bad[] = {{"camera at (1e19, 0, 0)", "camera position beyond 1e12 (SY_COORD_MAX)", false},
+               {"orthographic window of 1e19", "camera window beyond 1e12 (SY_COORD_MAX)", true}};
+    for (int k = 0; k < 2; ++k) {
+        sy_cluster_msg q = r;
+        q.header.seq = 4 + (uint64_t)k;
+        const float marker = bad[k].ortho ? marker_w : marker_x;
+        if (bad[k].ortho) {
+            q.u.render.camera.projection = SY_PROJECTION_ORTHOGRAPHIC;
+            q.u.render.camera.window[1] = marker;
+        } else {
+            q.u.render.camera.camera_to_world.m[12] = marker;
+        }
+        b.size = 0;
+        CHECK_OK(sy_cluster_encode(&q, 0, &b, &e), e);
+        CHECK(b.size <= sizeof body);
+        memcpy(body, b.data, b.size);
+        int patched = 0;
+        for (size_t i = 0; i + 4 <= b.size; ++i)
+            if (!memcmp(body + i, &marker, 4)) memcpy(body + i, &far_away, 4), patched++;
+        CHECK(patched == 1);
+        CHECK(raw_write_all(fd, body, b.size));
+        sy_cluster_msg rep;
+        uint8_t *raw = NULL;
+        int rc = raw_recv_msg(fd, 1 << 26, &rep, &raw);
+        CHECK_MSG(rc == 0, "no reply to a RENDER with a %s (%d): the server died", bad[k].what, rc);
+        snprintf(why, sizeof why, "%s", rep.header.type == SY_CLUSTER_ERROR ? rep.u.error.reason : "");
+        uint32_t got = rep.header.type;
+        sy_cluster_msg_free(&rep);
+        free(raw);
+        printf("camera: RENDER with a %s: %s '%s'\n", bad[k].what, sy_cluster_msg_type_name(got), why);
+        CHECK_MSG(got == SY_CLUSTER_ERROR && strstr(why, bad[k].reason), "a %s: %s '%s'", bad[k].what,
+                  sy_cluster_msg_type_name(got), why);
+    }
+    sy_cluster_buf_free(&b);
+    r.header.seq = 6;
+    CHECK(raw_expect(fd, &r, SY_CLUSTER_TILES, why, sizeof why) == 0);
+    close(fd);
+    CHECK(log_contains(&sv, "127.0.0.1:"));
+    CHECK_MSG(log_contains(&sv, "rejected: cluster RENDER: body byte") &&
+                  log_contains(&sv, "camera position beyond 1e12 (SY_COORD_MAX)"),
+              "the refusal was not logged with the peer");
+    stop_server(&sv);
+
+    /* with a secret, through the client library: refused before sending, naming the reason; the
+     * server renders the next frame */
+    if (start_server("s3cret", 0, &sv)) return 1;
+    sy_cluster_client *c = honest_client(fx, &sv, "s3cret", &e);
+    CHECK_MSG(c != NULL, "%s", e.message);
+    sy_layer out = {0};
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
+    sy_cluster_frame far = f;
+    far.camera.camera_to_world.m[12] = far_away;
+    sy_result rr = sy_cluster_client_render(c, &far, &out, NULL, &e);
+    printf("camera: client with a secret, camera at 1e19: %s\n", rr ? e.message : "rendered");
+    CHECK_MSG(rr != SY_OK && strstr(e.message, "camera position beyond 1e12"), "camera at 1e19: %s",
+              rr ? e.message : "rendered");
+    e = (sy_error){0};
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, NULL, &e), e);
+    sy_cluster_client_destroy(c);
+    sy_layer_destroy(&out);
+    stop_server(&sv);
+    return 0;
+}
 #endif
 
 int main(int argc, char **argv)
 {
     if (argc < 3) {
-        fprintf(stderr, "usage: test_cluster_hostile SERVER_EXE WORK_DIR [rss|counts|cap|ceiling|lockout]...\n");
+        fprintf(stderr, "usage: test_cluster_hostile SERVER_EXE WORK_DIR [rss|counts|cap|ceiling|lockout|camera]...\n");
         return 2;
     }
     g_exe = argv[1];
@@ -929,8 +1065,8 @@ int main(int argc, char **argv)
         return 1;
     }
     int failed = 0;
-    for (int g = 0; g < 5; ++g) {
-        static const char *names[] = {"rss", "counts", "cap", "ceiling", "lockout"};
+    for (int g = 0; g < 6; ++g) {
+        static const char *names[] = {"rss", "counts", "cap", "ceiling", "lockout", "camera"};
         bool want = argc == 3;
         for (int i = 3; i < argc; ++i) want = want || !strcmp(argv[i], names[g]);
         if (!want) continue;
@@ -942,6 +1078,7 @@ int main(int argc, char **argv)
         if (g == 1 && !r) r = test_replica_multiple();
         if (g == 3) r = test_ceiling(&fx);
         if (g == 4) r = test_lockout(&fx);
+        if (g == 5) r = test_camera(&fx);
 #else
         if (g >= 2) continue; /* protocol 2: no peer memory ceiling, no HELLO-only raw peers */
 #endif

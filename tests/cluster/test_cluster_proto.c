@@ -200,6 +200,46 @@ static int test_bad_headers(void)
     c[SY_CLUSTER_HEADER_SIZE + 16] = 0xFF;
     c[SY_CLUSTER_HEADER_SIZE + 17] = 0x7F;
     CHECK(sy_cluster_decode(c, b.size, NULL, &d, &e) != SY_OK);
+    /* cameras beyond SY_COORD_MAX (issue 32: Embree aborts the server on ray origins beyond
+     * 1.844e18): refused by the encoder, and by the decoder when forged on the wire (the value is
+     * put in place of a marker after encoding) */
+    {
+        static const struct {
+            int index; /* 0..15 matrix, 16..19 window */
+            float value;
+            const char *reason;
+        } far[] = {{12, 1e19f, "camera position beyond 1e12"}, {14, -2e12f, "camera position beyond 1e12"},
+                   {0, 1e13f, "camera matrix entry beyond 1e12"}, {17, 1e19f, "camera window beyond 1e12"},
+                   {16, -INFINITY, "non-finite"}};
+        for (size_t k = 0; k < sizeof far / sizeof far[0]; ++k) {
+            const float marker = far[k].value < 0 ? -4242.25f : 4242.25f; /* keeps the window ordered */
+            sy_cluster_msg q = m;
+            float *slot = far[k].index < 16 ? &q.u.render.camera.camera_to_world.m[far[k].index]
+                                            : &q.u.render.camera.window[far[k].index - 16];
+            *slot = far[k].value;
+            b.size = 0;
+            CHECK_ERR(sy_cluster_encode(&q, 0, &b, &e), SY_ERR_INVALID_ARGUMENT, e);
+            CHECK_MSG(strstr(e.message, far[k].reason), "%s", e.message);
+            *slot = marker;
+            b.size = 0;
+            CHECK_OK(sy_cluster_encode(&q, 0, &b, &e), e);
+            memcpy(c, b.data, b.size);
+            int patched = 0;
+            for (size_t i = 0; i + 4 <= b.size; ++i)
+                if (!memcmp(c + i, &marker, 4)) memcpy(c + i, &far[k].value, 4), patched++;
+            CHECK(patched == 1);
+            CHECK_ERR(sy_cluster_decode(c, b.size, NULL, &d, &e), SY_ERR_PARSE, e);
+            CHECK_MSG(strstr(e.message, "cluster RENDER") && strstr(e.message, far[k].reason), "%s", e.message);
+        }
+        /* at the bound itself: accepted */
+        sy_cluster_msg q = m;
+        q.u.render.camera.camera_to_world.m[12] = SY_COORD_MAX;
+        q.u.render.camera.window[0] = -SY_COORD_MAX;
+        b.size = 0;
+        CHECK_OK(sy_cluster_encode(&q, 0, &b, &e), e);
+        CHECK_OK(sy_cluster_decode(b.data, b.size, NULL, &d, &e), e);
+        sy_cluster_msg_free(&d);
+    }
     /* NaN in the camera */
     m.u.render.camera.znear = NAN;
     CHECK(sy_cluster_encode(&m, 0, &b, &e) != SY_OK);
@@ -683,10 +723,26 @@ static int real_seed(uint32_t which, sy_cluster_buf *b)
     return 0;
 }
 
+/* Seed 18: the RENDER of issue 32 (a camera at 1e19, which aborted the server in Embree), as
+ * forged on the wire: the decoder refuses it, so the fuzzer starts at that check. */
+static int far_camera_seed(sy_cluster_buf *b)
+{
+    sy_error e = {0};
+    sy_cluster_msg m = sample(SY_CLUSTER_RENDER);
+    const float marker = 4242.25f, far = 1e19f;
+    m.u.render.camera.camera_to_world.m[12] = marker;
+    CHECK_OK(sy_cluster_encode(&m, 0, b, &e), e);
+    int patched = 0;
+    for (size_t i = 0; i + 4 <= b->size; ++i)
+        if (!memcmp(b->data + i, &marker, 4)) memcpy(b->data + i, &far, 4), patched++;
+    CHECK(patched == 1);
+    return 0;
+}
+
 static int seeds(const char *dir, bool write)
 {
     char path[4096];
-    for (uint32_t t = 1; t <= SY_CLUSTER_MSG_TYPE_MAX + 3; ++t) {
+    for (uint32_t t = 1; t <= SY_CLUSTER_MSG_TYPE_MAX + 4; ++t) {
         sy_error e = {0};
         sy_cluster_msg m = sample(t), d;
         sy_cluster_buf b = {0};
@@ -694,6 +750,8 @@ static int seeds(const char *dir, bool write)
             sy_cluster_msg hello = sample(SY_CLUSTER_HELLO), scene = sample(SY_CLUSTER_SCENE);
             uint64_t seq = 0;
             if (append_chunked(&hello, 1000, &seq, &b) || append_chunked(&scene, 40, &seq, &b)) return 1;
+        } else if (t == SY_CLUSTER_MSG_TYPE_MAX + 4) {
+            if (far_camera_seed(&b)) return 1;
         } else if (t > SY_CLUSTER_MSG_TYPE_MAX) {
             if (real_seed(t, &b)) return 1;
         } else {
@@ -703,7 +761,8 @@ static int seeds(const char *dir, bool write)
                  t <= SY_CLUSTER_MSG_TYPE_MAX ? sy_cluster_msg_type_name(t)
                  : t == 15                    ? "SCENE_real"
                  : t == 16                    ? "TILES_half"
-                                              : "stream_HELLO_SCENE_chunked");
+                 : t == 17                    ? "stream_HELLO_SCENE_chunked"
+                                              : "RENDER_camera_1e19");
         if (write) {
             FILE *f = fopen(path, "wb");
             CHECK_MSG(f && fwrite(b.data, 1, b.size, f) == b.size && fclose(f) == 0, "cannot write %s", path);
@@ -724,6 +783,9 @@ static int seeds(const char *dir, bool write)
                     sy_cluster_msg_free(&ms[i]);
                     free(bodies[i]);
                 }
+            } else if (t == SY_CLUSTER_MSG_TYPE_MAX + 4) { /* refused, for its reason */
+                CHECK_ERR(sy_cluster_decode(buf, n, NULL, &d, &e), SY_ERR_PARSE, e);
+                CHECK_MSG(strstr(e.message, "camera position beyond 1e12"), "%s: %s", path, e.message);
             } else {
                 CHECK_OK(sy_cluster_decode(buf, n, NULL, &d, &e), e);
                 sy_cluster_msg_free(&d);
