@@ -25,6 +25,7 @@
  *   sy render ... --cluster URL[,URL...]|FILE.conf [--cluster-mode MODE]   render on servers
  *   sy view ... --cluster URL[,URL...]|FILE.conf [--cluster-mode MODE]     the viewer on servers
  *   sy bench cluster [-w W] [-h H] [--repeats ROUNDS]
+ *   sy bench cluster --soak SECONDS [--warmup S] [-b BACKEND]                  the sy serve soak
  *
  * SCENE is a .gltf / .glb / .x3d file or the word "demo" (the built-in scene). Options are parsed with
  * getopt_long (GNU ordering: options and operands in any order; --name=value; "--" ends the options);
@@ -644,6 +645,7 @@ static const char usage_text[] =
             "            [--cluster-mode sort-first|balanced|cooperative|multi-display|stereo] [--secret-file F]\n"
             "            [--tls-ca PEM] [--timeout-ms MS] [--frames N] [--spp N] [--cluster-pixels float|half]\n"
             "  sy bench cluster [-w W] [-h H] [--repeats ROUNDS]\n"
+            "  sy bench cluster --soak SECONDS [--warmup S] [-b BACKEND] [-w W] [-h H]   (sy serve soak: RSS, fds, threads)\n"
             "SCENE: a glTF (.gltf, .glb) or X3D (XML) file, recognised by its content, or 'demo' (the built-in scene)\n"
             "world options (every command): [--env MAP.exr | --env-color R,G,B] [--env-intensity X] [--env-hidden]\n"
             "  [--background R,G,B[,A]] [--no-default-light]: the environment is a light; the background is what\n"
