@@ -113,12 +113,11 @@ static bool rect_ok(const sy_cluster_rect *r, uint32_t fw, uint32_t fh)
     return r->w > 0 && r->h > 0 && r->x < fw && r->y < fh && r->w <= fw - r->x && r->h <= fh - r->y;
 }
 
-/* NULL when the camera view can reach a back-end, else why not. Every matrix entry and window
- * value must be finite and within SY_COORD_MAX (core/sy_math.h: the one bound on coordinates,
- * 1e12): a camera position or an orthographic window beyond it puts ray origins where a ray
- * tracer's library asserts (Embree aborts beyond 1.844e18) and the rasterizer's depth means
- * nothing. */
-static const char *camera_problem(const sy_camera_view *c)
+/* Every matrix entry and window value must be finite and within SY_COORD_MAX (core/sy_math.h:
+ * the one bound on coordinates, 1e12): a camera position or an orthographic window beyond it puts
+ * ray origins where a ray tracer's library asserts (Embree aborts beyond 1.844e18) and the
+ * rasterizer's depth means nothing. */
+const char *sy_cluster_camera_problem(const sy_camera_view *c)
 {
     const float *m = &c->camera_to_world.m[0];
     for (int i = 0; i < 16; ++i)
@@ -180,8 +179,8 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
         if (r->full_width < 1 || r->full_width > SY_CLUSTER_MAX_IMAGE || r->full_height < 1 ||
             r->full_height > SY_CLUSTER_MAX_IMAGE || r->tile_count > SY_CLUSTER_MAX_TILES)
             return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: image size or tiles out of range");
-        if (camera_problem(&r->camera))
-            return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: %s", camera_problem(&r->camera));
+        const char *why = sy_cluster_camera_problem(&r->camera);
+        if (why) return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: %s", why);
         for (uint32_t i = 0; i < r->tile_count; ++i)
             if (!rect_ok(&r->tiles[i], r->full_width, r->full_height))
                 return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: tile %u outside the image", i);
@@ -515,8 +514,8 @@ sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, 
                 rd_fail(&rd, SY_ERR_LIMIT, "image size outside 1..16384");
             else if (q->sample_count > SY_CLUSTER_MAX_SAMPLES || q->sample_first > UINT32_MAX - q->sample_count)
                 rd_fail(&rd, SY_ERR_LIMIT, "sample range out of bounds");
-            else if (camera_problem(&q->camera))
-                rd_fail(&rd, SY_ERR_PARSE, camera_problem(&q->camera));
+            else if (sy_cluster_camera_problem(&q->camera))
+                rd_fail(&rd, SY_ERR_PARSE, sy_cluster_camera_problem(&q->camera)); /* a static string */
             else if (q->tile_count < 1 || q->tile_count > SY_CLUSTER_MAX_TILES)
                 rd_fail(&rd, SY_ERR_LIMIT, "tile count outside 1..4096");
             else if ((size_t)q->tile_count * 16 > rd.size - rd.pos)

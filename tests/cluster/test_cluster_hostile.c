@@ -966,8 +966,8 @@ static int test_camera(fixture *fx)
     struct {
         const char *what, *reason;
         bool ortho;
-    } bad[] = {{"camera at (1e19, 0, 0)", "camera position beyond 1e12 (SY_COORD_MAX)", false},
-               {"orthographic window of 1e19", "camera window beyond 1e12 (SY_COORD_MAX)", true}};
+    } bad[] = {{"a camera at (1e19, 0, 0)", "camera position beyond 1e12 (SY_COORD_MAX)", false},
+               {"an orthographic window of 1e19", "camera window beyond 1e12 (SY_COORD_MAX)", true}};
     for (int k = 0; k < 2; ++k) {
         sy_cluster_msg q = r;
         q.header.seq = 4 + (uint64_t)k;
@@ -990,13 +990,13 @@ static int test_camera(fixture *fx)
         sy_cluster_msg rep;
         uint8_t *raw = NULL;
         int rc = raw_recv_msg(fd, 1 << 26, &rep, &raw);
-        CHECK_MSG(rc == 0, "no reply to a RENDER with a %s (%d): the server died", bad[k].what, rc);
+        CHECK_MSG(rc == 0, "no reply to a RENDER with %s (%d): the server died", bad[k].what, rc);
         snprintf(why, sizeof why, "%s", rep.header.type == SY_CLUSTER_ERROR ? rep.u.error.reason : "");
         uint32_t got = rep.header.type;
         sy_cluster_msg_free(&rep);
         free(raw);
-        printf("camera: RENDER with a %s: %s '%s'\n", bad[k].what, sy_cluster_msg_type_name(got), why);
-        CHECK_MSG(got == SY_CLUSTER_ERROR && strstr(why, bad[k].reason), "a %s: %s '%s'", bad[k].what,
+        printf("camera: RENDER with %s: %s '%s'\n", bad[k].what, sy_cluster_msg_type_name(got), why);
+        CHECK_MSG(got == SY_CLUSTER_ERROR && strstr(why, bad[k].reason), "%s: %s '%s'", bad[k].what,
                   sy_cluster_msg_type_name(got), why);
     }
     sy_cluster_buf_free(&b);
@@ -1018,10 +1018,12 @@ static int test_camera(fixture *fx)
     CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
     sy_cluster_frame far = f;
     far.camera.camera_to_world.m[12] = far_away;
-    sy_result rr = sy_cluster_client_render(c, &far, &out, NULL, &e);
+    sy_cluster_frame_stats st = {0};
+    sy_result rr = sy_cluster_client_render(c, &far, &out, &st, &e);
     printf("camera: client with a secret, camera at 1e19: %s\n", rr ? e.message : "rendered");
-    CHECK_MSG(rr != SY_OK && strstr(e.message, "camera position beyond 1e12"), "camera at 1e19: %s",
+    CHECK_MSG(rr != SY_OK && strstr(e.message, "cluster render: camera position beyond 1e12"), "camera at 1e19: %s",
               rr ? e.message : "rendered");
+    CHECK_MSG(st.servers_failed == 0 && st.bytes_sent == 0, "the refused camera reached a server");
     e = (sy_error){0};
     CHECK_OK(sy_cluster_client_render(c, &f, &out, NULL, &e), e);
     sy_cluster_client_destroy(c);
