@@ -1,6 +1,6 @@
-/* test_cluster_hostile.c — the render server against hostile peers (issue 14, findings 2 and 3).
- * Servers are separate processes on 127.0.0.1 (test_cluster_server); their memory is read from
- * /proc/PID/status. Groups (argv[3...], default all three):
+/* test_cluster_hostile.c — the render server against hostile peers (issue 14, findings 2 and 3;
+ * issue 32, items 1 and 3). Servers are separate processes on 127.0.0.1 (test_cluster_server);
+ * their memory is read from /proc/PID/status. Groups (argv[3...], default all):
  *   rss     64 connections each announce a 256 MiB message and trickle 64 KiB every 100 ms, 8 more
  *           flood 8 MiB as fast as they can, none of them authenticated, for 5 s, reconnecting
  *           whenever the server closes them; an authenticated client keeps rendering frames equal
@@ -14,19 +14,26 @@
  *           than 32 MiB, and it keeps rendering; then the replica's allocation per message byte for
  *           a dense snapshot of materials and for the sparsest list the growth bound admits is
  *           measured against the bound documented in docs/PROTOCOL.md.
- *   cap     with --max-unauthenticated 8 --handshake-timeout-ms 1500: of 12 idle connections the 4
- *           beyond the cap are closed at once (and logged), the other 8 at the deadline; a client
- *           connects afterwards.
+ *   cap     with --max-unauthenticated 8 (and a 600 s handshake deadline): each of the 4
+ *           connections beyond the limit closes the oldest, in order (logged), the newest 8 stay
+ *           open, a client gets in; with a 1000 ms deadline 8 idle connections are closed by it.
  *   ceiling with --max-peer-memory-mb 1: a chunked message that does not fit waits while another
  *           peer holds the memory and goes on once it is released (back-pressure); one that still
  *           does not fit after the wait is refused with "server busy: ..." naming the option.
+ *   lockout issue 32, item 3: clients beside 32 unauthenticated connections from their own address
+ *           get in (the oldest is closed for each); with the server's defaults, 32 idle connections
+ *           from 127.0.0.2 reopened whenever closed do not keep 5 clients from 127.0.0.1 out.
+ *   camera  issue 32, item 1: RENDERs whose camera is at 1e19 or whose orthographic window is 1e19
+ *           are refused with the reason, the server keeps serving the session (it used to abort in
+ *           Embree); the client library refuses such a camera before sending.
  *
- *   test_cluster_hostile SERVER_EXE WORK_DIR [rss|counts|cap|ceiling]...
+ *   test_cluster_hostile SERVER_EXE WORK_DIR [rss|counts|cap|ceiling|lockout|camera]...
  *
  * Compiled with -DSY_TEST_LEGACY_WIRE against the protocol-2 tree (nng req/rep), the hostile peers
  * and raw sessions speak nng's SP framing instead, so that the same groups run against the old
- * server (that is how their failures there were shown). Every wait is bounded; servers stop with
- * SIGTERM (SIGKILL after 5 s) and --max-lifetime. */
+ * server (that is how their failures there were shown; cap, ceiling, lockout and camera need
+ * protocol 3). Every wait is bounded; servers stop with SIGTERM (SIGKILL after 5 s) and
+ * --max-lifetime. */
 #include "../core/check.h"
 #include "raw_peer.h"
 #include "server_proc.h"
