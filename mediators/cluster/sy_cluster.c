@@ -2427,8 +2427,11 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
     uint32_t out_w = f->mode == SY_CLUSTER_STEREO ? 2 * f->width : f->width;
     if (f->mode != SY_CLUSTER_MULTI_DISPLAY && (!out || out->width != out_w || out->height != f->height))
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster render: output layer must be %ux%u", out_w, f->height);
-    const char *why = sy_cluster_camera_problem(&f->camera); /* refused here, before any server is involved */
-    if (why) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster render: %s", why);
+    sy_result cr = sy_cluster_camera_check(&f->camera, err); /* refused here, before any server is involved */
+    if (cr != SY_OK) {
+        sy_error_prefix(err, "cluster render");
+        return cr;
+    }
     c->frame++;
     uint64_t sent0 = 0, recv0 = 0;
     uint64_t blobf0 = 0, blobp0 = 0;

@@ -2,7 +2,6 @@
  * docs/PROTOCOL.md). All integers little endian; strings are u16 length + bytes (no NUL on the
  * wire, no embedded NUL accepted); floats are IEEE-754 binary32 / binary64 bit patterns. */
 #include "sy_cluster_proto.h"
-#include "sy_math.h"
 
 #define IMATH_HALF_NO_LOOKUP_TABLE
 #include <half.h> /* Imath (libimath-dev): binary16 conversions */
@@ -113,25 +112,19 @@ static bool rect_ok(const sy_cluster_rect *r, uint32_t fw, uint32_t fh)
     return r->w > 0 && r->h > 0 && r->x < fw && r->y < fh && r->w <= fw - r->x && r->h <= fh - r->y;
 }
 
-/* Every matrix entry and window value must be finite and within SY_COORD_MAX (core/sy_math.h:
- * the one bound on coordinates, 1e12): a camera position or an orthographic window beyond it puts
- * ray origins where a ray tracer's library asserts (Embree aborts beyond 1.844e18) and the
- * rasterizer's depth means nothing. */
-const char *sy_cluster_camera_problem(const sy_camera_view *c)
+sy_result sy_cluster_camera_check(const sy_camera_view *c, sy_error *err)
 {
-    const float *m = &c->camera_to_world.m[0];
-    for (int i = 0; i < 16; ++i)
-        if (!isfinite(m[i])) return "camera matrix has non-finite values";
-    for (int i = 0; i < 4; ++i)
-        if (!isfinite(c->window[i]) || !isfinite(c->znear) || !isfinite(c->zfar))
-            return "camera window or depth range has non-finite values";
-    if (!sy_coords_in_range(m + 12, 3)) return "camera position beyond 1e12 (SY_COORD_MAX) in magnitude";
-    if (!sy_coords_in_range(m, 12)) return "camera matrix entry beyond 1e12 (SY_COORD_MAX) in magnitude";
-    if (!sy_coords_in_range(c->window, 4)) return "camera window beyond 1e12 (SY_COORD_MAX) in magnitude";
-    if (c->projection > 1) return "camera has an unknown projection";
-    if (c->znear < 0 || c->zfar < 0) return "camera has a negative depth range";
-    if (!(c->window[0] < c->window[1] && c->window[2] < c->window[3])) return "camera window is empty";
-    return NULL;
+    sy_result r = sy_camera_view_check(c, err); /* the core rule: finite, within SY_COORD_MAX */
+    if (r != SY_OK) return r;
+    if (c->projection > 1)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera projection %u is unknown", (unsigned)c->projection);
+    if (c->znear < 0 || c->zfar < 0)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera clip range %g..%g is negative", (double)c->znear,
+                            (double)c->zfar);
+    if (!(c->window[0] < c->window[1] && c->window[2] < c->window[3]))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera window [%g %g %g %g] is empty", (double)c->window[0],
+                            (double)c->window[1], (double)c->window[2], (double)c->window[3]);
+    return SY_OK;
 }
 
 sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluster_buf *out, sy_error *err)
@@ -179,8 +172,9 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
         if (r->full_width < 1 || r->full_width > SY_CLUSTER_MAX_IMAGE || r->full_height < 1 ||
             r->full_height > SY_CLUSTER_MAX_IMAGE || r->tile_count > SY_CLUSTER_MAX_TILES)
             return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: image size or tiles out of range");
-        const char *why = sy_cluster_camera_problem(&r->camera);
-        if (why) return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: %s", why);
+        sy_error ce = {0};
+        if (sy_cluster_camera_check(&r->camera, &ce) != SY_OK)
+            return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: %s", ce.message);
         for (uint32_t i = 0; i < r->tile_count; ++i)
             if (!rect_ok(&r->tiles[i], r->full_width, r->full_height))
                 return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: tile %u outside the image", i);
@@ -486,6 +480,7 @@ sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, 
         m.u.ack.objects = rd_u32(&rd);
     } else if (t == SY_CLUSTER_RENDER) {
         __typeof__(m.u.render) *q = &m.u.render;
+        sy_error ce = {0};
         q->frame = rd_u64(&rd);
         q->job = rd_u32(&rd);
         q->flags = rd_u32(&rd);
@@ -514,8 +509,8 @@ sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, 
                 rd_fail(&rd, SY_ERR_LIMIT, "image size outside 1..16384");
             else if (q->sample_count > SY_CLUSTER_MAX_SAMPLES || q->sample_first > UINT32_MAX - q->sample_count)
                 rd_fail(&rd, SY_ERR_LIMIT, "sample range out of bounds");
-            else if (sy_cluster_camera_problem(&q->camera))
-                rd_fail(&rd, SY_ERR_PARSE, sy_cluster_camera_problem(&q->camera)); /* a static string */
+            else if (sy_cluster_camera_check(&q->camera, &ce) != SY_OK)
+                rd_fail(&rd, SY_ERR_PARSE, ce.message);
             else if (q->tile_count < 1 || q->tile_count > SY_CLUSTER_MAX_TILES)
                 rd_fail(&rd, SY_ERR_LIMIT, "tile count outside 1..4096");
             else if ((size_t)q->tile_count * 16 > rd.size - rd.pos)

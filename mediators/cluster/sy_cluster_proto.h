@@ -260,11 +260,12 @@ void sy_cluster_msg_free(sy_cluster_msg *m); /**< frees decoder allocations; NUL
 
 const char *sy_cluster_msg_type_name(uint32_t type); /**< "HELLO", ..., "?" */
 
-/** NULL when a RENDER may carry this camera view, else why not (a static string): every matrix
- * entry and window value finite and within SY_COORD_MAX (core/sy_math.h), a known projection, a
- * non-empty window, a depth range >= 0. The encoder and the decoder apply it; the client checks a
- * frame's camera with it before talking to any server. */
-const char *sy_cluster_camera_problem(const sy_camera_view *c);
+/** SY_OK when a RENDER may carry this camera view: the core rule first (sy_camera_view_check:
+ * finite, the position and every matrix element within SY_COORD_MAX, an orthographic window too),
+ * then a known projection, a non-empty window and a clip range >= 0; else SY_ERR_INVALID_ARGUMENT
+ * saying which value. The encoder and the decoder apply it (a peer's camera beyond the range never
+ * reaches a back-end); the client checks each frame's camera with it before talking to any server. */
+sy_result sy_cluster_camera_check(const sy_camera_view *c, sy_error *err);
 
 #ifdef __cplusplus
 }

@@ -208,14 +208,18 @@ static int test_bad_headers(void)
             int index; /* 0..15 matrix, 16..19 window */
             float value;
             const char *reason;
-        } far[] = {{12, 1e19f, "camera position beyond 1e12"}, {14, -2e12f, "camera position beyond 1e12"},
-                   {0, 1e13f, "camera matrix entry beyond 1e12"}, {17, 1e19f, "camera window beyond 1e12"},
-                   {16, -INFINITY, "non-finite"}};
+            bool ortho;
+        } far[] = {{12, 1e19f, "camera at (1e+19 0 0) is beyond the coordinate range", false},
+                   {14, -2e12f, "is beyond the coordinate range", false},
+                   {0, 1e13f, "is beyond the coordinate range", false},
+                   {17, 1e19f, "camera window[1] = 1e+19 is not finite or beyond", true},
+                   {16, -INFINITY, "camera window[0] = -inf is not finite", false}};
         for (size_t k = 0; k < sizeof far / sizeof far[0]; ++k) {
             const float marker = far[k].value < 0 ? -4242.25f : 4242.25f; /* keeps the window ordered */
             sy_cluster_msg q = m;
             float *slot = far[k].index < 16 ? &q.u.render.camera.camera_to_world.m[far[k].index]
                                             : &q.u.render.camera.window[far[k].index - 16];
+            if (far[k].ortho) q.u.render.camera.projection = SY_PROJECTION_ORTHOGRAPHIC;
             *slot = far[k].value;
             b.size = 0;
             CHECK_ERR(sy_cluster_encode(&q, 0, &b, &e), SY_ERR_INVALID_ARGUMENT, e);
@@ -785,7 +789,8 @@ static int seeds(const char *dir, bool write)
                 }
             } else if (t == SY_CLUSTER_MSG_TYPE_MAX + 4) { /* refused, for its reason */
                 CHECK_ERR(sy_cluster_decode(buf, n, NULL, &d, &e), SY_ERR_PARSE, e);
-                CHECK_MSG(strstr(e.message, "camera position beyond 1e12"), "%s: %s", path, e.message);
+                CHECK_MSG(strstr(e.message, "camera at (1e+19 0 0) is beyond the coordinate range"), "%s: %s", path,
+                          e.message);
             } else {
                 CHECK_OK(sy_cluster_decode(buf, n, NULL, &d, &e), e);
                 sy_cluster_msg_free(&d);
