@@ -1,5 +1,6 @@
 /* server_proc.h — render servers as child processes for the cluster tests (header-only): start
- * test_cluster_server on a free 127.0.0.1 port (it writes the port to a file), stop it with
+ * test_cluster_server on a free 127.0.0.1 port (it writes the port to a file; --max-lifetime 600 s
+ * only for servers a killed test leaves behind), stop it with
  * SIGTERM (SIGKILL after 5 s), search its log, read its memory from /proc/PID/status.
  * The caller sets g_exe (the server executable) and g_dir (a work directory). Every wait is
  * bounded; servers a failed check left running are killed when the test exits. Thread-safety:
@@ -59,7 +60,10 @@ static inline int start_server_args(const char *secret, int port, const char *co
         if (fd >= 0) dup2(fd, 2), dup2(fd, 1); /* never the test's own pipes */
         char present[512];
         snprintf(present, sizeof present, "%s/present%d.raw", g_dir, g_serial);
-        const char *args[32] = {g_exe, "--port-file", pf, "--listen", listen, "--max-lifetime", "120", "--present", present};
+        /* the lifetime only ends servers a killed test left behind: longer than any cluster test's
+         * ctest TIMEOUT (240-300 s), never a deadline a slow run can reach (at 120 s, cluster_net's
+         * servers under ASan on a loaded machine stopped before its last group) */
+        const char *args[32] = {g_exe, "--port-file", pf, "--listen", listen, "--max-lifetime", "600", "--present", present};
         int n = 9;
         if (secret) args[n++] = "--secret", args[n++] = secret;
         for (int k = 0; extra && extra[k] && k < 16; ++k) args[n++] = extra[k];
