@@ -565,16 +565,22 @@ static int variant_normalize(int v)
 }
 
 /* The part of the lights' signature (light_sig) a program of variant bits v depends on. The
- * shaders call each punctual light (constant light count) and each emissive polygon with its
- * shadow fixed (sy_gl_shaders.c, shade_light, shade_area): straight-line code that makes only the
- * look-ups the frame needs (llvmpipe runs every branch for every pixel). */
+ * shaders call each punctual light (constant light count) with its shadow fixed (sy_gl_shaders.c,
+ * shade_light): straight-line code that makes only the look-ups the frame needs (llvmpipe runs
+ * every branch for every pixel). Emissive polygons run in two loops of constant bounds, those that
+ * may have a shadow map (up to the last that has one) and the rest (shade_lit): sixteen inlined
+ * copies took LLVM many seconds to compile (issue 32). */
 static uint64_t variant_sig(const sy_gl_device *dev, int v)
 {
     uint64_t s = 0;
     if ((v & VAR_SHADOW) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & 0x3FFFu;
     if ((v & VAR_LIGHTS) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & (0x3FFFull << 48);
     if (v & VAR_AREA) s |= dev->light_sig & (0x1Fu << 16);
-    if ((v & VAR_AREA) && (v & VAR_ASHADOW)) s |= dev->light_sig & (0xFFFFull << 32);
+    if ((v & VAR_AREA) && (v & VAR_ASHADOW)) { /* the polygons up to the last with a map: a loop in the shader */
+        uint64_t m = (dev->light_sig >> 32) & 0xFFFFu;
+        while (m & (m + 1)) m |= m >> 1; /* 0b0100101 -> 0b0111111 */
+        s |= m << 32;
+    }
     return s;
 }
 
@@ -614,13 +620,10 @@ static void variant_defines(int v, uint64_t sig, char *defs, size_t defs_len, ch
     }
     int nareas = (int)((sig >> 16) & 0x1Fu);
     if (nareas) {
-        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_NAREAS %d\n", nareas);
-        nl += (size_t)snprintf(name + nl, name_len - nl, " (%d polygons, shadows ", nareas);
-        for (int i = 0; i < nareas; ++i) {
-            int sh = (int)((sig >> (32 + i)) & 1u);
-            dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_AS%d %d\n", i, sh);
-            nl += (size_t)snprintf(name + nl, name_len - nl, "%c", sh ? '1' : '0');
-        }
+        int nash = 0; /* polygons [0, nash) may have a shadow map (variant_sig), the rest have none */
+        while (nash < 16 && (sig >> (32 + nash)) & 1u) nash++;
+        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_NAREAS %d\n#define SY_NASH %d\n", nareas, nash);
+        nl += (size_t)snprintf(name + nl, name_len - nl, " (%d polygons, %d with shadows", nareas, nash);
         snprintf(name + nl, name_len - nl, ")");
     }
 }
