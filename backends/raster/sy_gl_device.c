@@ -817,7 +817,10 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     if (dd.max_texture_size && dd.max_texture_size < dev->max_tex) dev->max_tex = dd.max_texture_size;
     dev->shadow_size = dd.shadow_map_size ? dd.shadow_map_size : SHADOW_SIZE_DEFAULT;
     dev->lod_pixels = SY_GL_LOD_PIXELS_DEFAULT;
-    if (dev->shadow_size > (uint32_t)max_tex) dev->shadow_size = (uint32_t)max_tex;
+    if (dev->shadow_size > (uint32_t)max_tex) {
+        warn(dev, "raster: shadow_map_size %u is above the GL context's texture limit; using %d", dev->shadow_size, max_tex);
+        dev->shadow_size = (uint32_t)max_tex;
+    }
     static const char *const defs[4] = {NULL, "#define SY_LEAN 1\n", "#define SY_MASK 1\n",
                                         "#define SY_MASK 1\n#define SY_LEAN 1\n"};
     /* the fullest main variant now, so that a shader the driver rejects fails here */
@@ -899,9 +902,39 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     gl->BufferData(GL_UNIFORM_BUFFER, AREAS_FLOATS * sizeof(float), NULL, GL_DYNAMIC_DRAW);
     gl->GenVertexArrays(1, &dev->empty_vao);
     /* shadow maps: one depth texture array, compared in the shader (hardware PCF) */
-    dev->shadow_tex = shadow_array(gl, dev->shadow_size, SY_GL_MAX_SHADOW_MAPS);
+    if ((r = gl_check(dev, "GL device setup", err, err_len)) != SY_GL_OK) {
+        sy_gl_device_destroy(dev);
+        return r;
+    }
+    /* the maps' size, halved while the GL cannot hold them (the array of SY_GL_MAX_SHADOW_MAPS and
+     * a point light's cube, made later, tried here): at 16384 texels the array alone is 4 GiB, and
+     * llvmpipe refuses textures of 1 GiB and more with GL_OUT_OF_MEMORY */
+    uint32_t asked = dev->shadow_size;
+    for (;;) {
+        dev->cube_size = dev->shadow_size / 2u > 16u ? dev->shadow_size / 2u : 16u;
+        dev->shadow_tex = shadow_array(gl, dev->shadow_size, SY_GL_MAX_SHADOW_MAPS);
+        GLenum e = gl->GetError();
+        if (e == GL_NO_ERROR) {
+            GLuint cube = shadow_cube(gl, dev->cube_size);
+            e = gl->GetError();
+            gl->DeleteTextures(1, &cube);
+        }
+        if (e != GL_OUT_OF_MEMORY || dev->shadow_size <= 16u) {
+            if (e != GL_NO_ERROR) {
+                sy_gl_device_destroy(dev);
+                return fail(err, err_len, e == GL_OUT_OF_MEMORY ? SY_GL_ERROR_OUT_OF_MEMORY : SY_GL_ERROR_GL,
+                            "GL device setup: shadow maps of %u texels: OpenGL error 0x%04x", asked, (unsigned)e);
+            }
+            break;
+        }
+        gl->DeleteTextures(1, &dev->shadow_tex);
+        dev->shadow_tex = 0;
+        dev->shadow_size /= 2u;
+    }
+    if (dev->shadow_size != asked)
+        warn(dev, "raster: shadow_map_size %u: the GL context cannot hold %d maps of that size; using %u", asked,
+             SY_GL_MAX_SHADOW_MAPS, dev->shadow_size);
     gl->Enable(GL_TEXTURE_CUBE_MAP_SEAMLESS); /* cube shadows and probes filter across faces */
-    dev->cube_size = dev->shadow_size / 2u > 16u ? dev->shadow_size / 2u : 16u;
     gl->GenFramebuffers(1, &dev->shadow_fbo);
     dev->lights_dirty = true;
     if ((r = gl_check(dev, "GL device setup", err, err_len)) != SY_GL_OK) {
