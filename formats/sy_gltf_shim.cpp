@@ -651,6 +651,13 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
     else if (terr.find("exceeds the limit") != std::string::npos) code = SY_ERR_LIMIT;
     std::string msg = one_line(terr);
     if (msg.empty()) msg = "tinygltf failed without a message";
+    // an extension the file requires explains most failures of valid files (a Draco mesh's
+    // accessors have no buffer view): name it (sy_gltf.c refuses the unsupported ones by name
+    // when the parse gets that far)
+    for (const std::string &e : model->extensionsRequired)
+        if (e == "KHR_draco_mesh_compression" || e.rfind("EXT_meshopt", 0) == 0)
+            return sy_error_set(err, SY_ERR_UNSUPPORTED, "extensionsRequired: '%s' is not supported (%s)", e.c_str(),
+                                msg.c_str());
     return sy_error_set(err, code, "%s", msg.c_str());
 }
 

@@ -565,16 +565,22 @@ static int variant_normalize(int v)
 }
 
 /* The part of the lights' signature (light_sig) a program of variant bits v depends on. The
- * shaders call each punctual light (constant light count) and each emissive polygon with its
- * shadow fixed (sy_gl_shaders.c, shade_light, shade_area): straight-line code that makes only the
- * look-ups the frame needs (llvmpipe runs every branch for every pixel). */
+ * shaders call each punctual light (constant light count) with its shadow fixed (sy_gl_shaders.c,
+ * shade_light): straight-line code that makes only the look-ups the frame needs (llvmpipe runs
+ * every branch for every pixel). Emissive polygons run in two loops of constant bounds, those that
+ * may have a shadow map (up to the last that has one) and the rest (shade_lit): sixteen inlined
+ * copies took LLVM many seconds to compile (issue 32). */
 static uint64_t variant_sig(const sy_gl_device *dev, int v)
 {
     uint64_t s = 0;
     if ((v & VAR_SHADOW) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & 0x3FFFu;
     if ((v & VAR_LIGHTS) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & (0x3FFFull << 48);
     if (v & VAR_AREA) s |= dev->light_sig & (0x1Fu << 16);
-    if ((v & VAR_AREA) && (v & VAR_ASHADOW)) s |= dev->light_sig & (0xFFFFull << 32);
+    if ((v & VAR_AREA) && (v & VAR_ASHADOW)) { /* the polygons up to the last with a map: a loop in the shader */
+        uint64_t m = (dev->light_sig >> 32) & 0xFFFFu;
+        while (m & (m + 1)) m |= m >> 1; /* 0b0100101 -> 0b0111111 */
+        s |= m << 32;
+    }
     return s;
 }
 
@@ -614,13 +620,10 @@ static void variant_defines(int v, uint64_t sig, char *defs, size_t defs_len, ch
     }
     int nareas = (int)((sig >> 16) & 0x1Fu);
     if (nareas) {
-        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_NAREAS %d\n", nareas);
-        nl += (size_t)snprintf(name + nl, name_len - nl, " (%d polygons, shadows ", nareas);
-        for (int i = 0; i < nareas; ++i) {
-            int sh = (int)((sig >> (32 + i)) & 1u);
-            dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_AS%d %d\n", i, sh);
-            nl += (size_t)snprintf(name + nl, name_len - nl, "%c", sh ? '1' : '0');
-        }
+        int nash = 0; /* polygons [0, nash) may have a shadow map (variant_sig), the rest have none */
+        while (nash < 16 && (sig >> (32 + nash)) & 1u) nash++;
+        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_NAREAS %d\n#define SY_NASH %d\n", nareas, nash);
+        nl += (size_t)snprintf(name + nl, name_len - nl, " (%d polygons, %d with shadows", nareas, nash);
         snprintf(name + nl, name_len - nl, ")");
     }
 }
@@ -814,7 +817,10 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     if (dd.max_texture_size && dd.max_texture_size < dev->max_tex) dev->max_tex = dd.max_texture_size;
     dev->shadow_size = dd.shadow_map_size ? dd.shadow_map_size : SHADOW_SIZE_DEFAULT;
     dev->lod_pixels = SY_GL_LOD_PIXELS_DEFAULT;
-    if (dev->shadow_size > (uint32_t)max_tex) dev->shadow_size = (uint32_t)max_tex;
+    if (dev->shadow_size > (uint32_t)max_tex) {
+        warn(dev, "raster: shadow_map_size %u is above the GL context's texture limit; using %d", dev->shadow_size, max_tex);
+        dev->shadow_size = (uint32_t)max_tex;
+    }
     static const char *const defs[4] = {NULL, "#define SY_LEAN 1\n", "#define SY_MASK 1\n",
                                         "#define SY_MASK 1\n#define SY_LEAN 1\n"};
     /* the fullest main variant now, so that a shader the driver rejects fails here */
@@ -896,9 +902,39 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     gl->BufferData(GL_UNIFORM_BUFFER, AREAS_FLOATS * sizeof(float), NULL, GL_DYNAMIC_DRAW);
     gl->GenVertexArrays(1, &dev->empty_vao);
     /* shadow maps: one depth texture array, compared in the shader (hardware PCF) */
-    dev->shadow_tex = shadow_array(gl, dev->shadow_size, SY_GL_MAX_SHADOW_MAPS);
+    if ((r = gl_check(dev, "GL device setup", err, err_len)) != SY_GL_OK) {
+        sy_gl_device_destroy(dev);
+        return r;
+    }
+    /* the maps' size, halved while the GL cannot hold them (the array of SY_GL_MAX_SHADOW_MAPS and
+     * a point light's cube, made later, tried here): at 16384 texels the array alone is 4 GiB, and
+     * llvmpipe refuses textures of 1 GiB and more with GL_OUT_OF_MEMORY */
+    uint32_t asked = dev->shadow_size;
+    for (;;) {
+        dev->cube_size = dev->shadow_size / 2u > 16u ? dev->shadow_size / 2u : 16u;
+        dev->shadow_tex = shadow_array(gl, dev->shadow_size, SY_GL_MAX_SHADOW_MAPS);
+        GLenum e = gl->GetError();
+        if (e == GL_NO_ERROR) {
+            GLuint cube = shadow_cube(gl, dev->cube_size);
+            e = gl->GetError();
+            gl->DeleteTextures(1, &cube);
+        }
+        if (e != GL_OUT_OF_MEMORY || dev->shadow_size <= 16u) {
+            if (e != GL_NO_ERROR) {
+                sy_gl_device_destroy(dev);
+                return fail(err, err_len, e == GL_OUT_OF_MEMORY ? SY_GL_ERROR_OUT_OF_MEMORY : SY_GL_ERROR_GL,
+                            "GL device setup: shadow maps of %u texels: OpenGL error 0x%04x", asked, (unsigned)e);
+            }
+            break;
+        }
+        gl->DeleteTextures(1, &dev->shadow_tex);
+        dev->shadow_tex = 0;
+        dev->shadow_size /= 2u;
+    }
+    if (dev->shadow_size != asked)
+        warn(dev, "raster: shadow_map_size %u: the GL context cannot hold %d maps of that size; using %u", asked,
+             SY_GL_MAX_SHADOW_MAPS, dev->shadow_size);
     gl->Enable(GL_TEXTURE_CUBE_MAP_SEAMLESS); /* cube shadows and probes filter across faces */
-    dev->cube_size = dev->shadow_size / 2u > 16u ? dev->shadow_size / 2u : 16u;
     gl->GenFramebuffers(1, &dev->shadow_fbo);
     dev->lights_dirty = true;
     if ((r = gl_check(dev, "GL device setup", err, err_len)) != SY_GL_OK) {

@@ -18,8 +18,9 @@
  * probe instead of the environment), SY_TRANS (a transmissive material; llvmpipe runs both sides of a branch, so code that no
  * light of this frame needs is left out of the variant), SY_NLIGHTS (a constant light count, 1 ..
  * 7: one call per light with constant uniform-block offsets) with SY_LK0 .. SY_LK<n-1> (each
- * light's kind of shadow, see shade_light), SY_NAREAS (the emissive polygons' count, 1 .. 16, one
- * call each) with SY_AS0 .. SY_AS<n-1> (whether each has a shadow map, see shade_area). Every varying costs set-up per
+ * light's kind of shadow, see shade_light), SY_NAREAS (the emissive polygons' count, 1 .. 16) with
+ * SY_NASH (polygons 0 .. SY_NASH-1 may have a shadow map, the rest have none; a loop over each
+ * part, see shade_lit). Every varying costs set-up per
  * triangle and interpolation per fragment in a software rasterizer, so a variant interpolates only
  * what it reads; unlit variants (no lights, no environment) need no position or normal at all. */
 #define SY_GL_VARIANT_PRELUDE                                 \
@@ -69,7 +70,10 @@ const char *const sy_gl_main_vs =
     "  vec4 m_xf[10];\n" /* uv transform rows per slot: base, mr, nrm, occ, emis */                          \
     "};\n"                                                                                                   \
     "uniform sampler2D t_base, t_mr, t_nrm, t_occ, t_emis;\n"                                                \
-    "vec2 tuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_xf[2*k].xyz, h), dot(m_xf[2*k+1].xyz, h)); }\n"
+    "vec2 tuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_xf[2*k].xyz, h), dot(m_xf[2*k+1].xyz, h)); }\n" \
+    /* the texture coordinate set s (0, 1): a select, not an array indexed at run time (a local \
+     * array read with a dynamic index made llvmpipe's LLVM spend seconds per texture look-up) */ \
+    "#define UVSET(s) ((s) == 1 ? v_uv1 : v_uv0)\n"
 
 /* What the forward and the deferred shading share: the light, area-light and environment blocks,
  * the view uniforms, the BSDF helpers, shadow look-ups, LTC and environment look-ups. */
@@ -156,12 +160,11 @@ const char *const sy_gl_main_vs =
     "}\n" \
     "#endif\n" \
 
-/* Call i of a variant's straight-line light code: when the count n (SY_NLIGHTS, SY_NAREAS) is
- * above i, L += f(i, k<i>, ...), k<i> the item's defines (punctual lights: shadow SY_LK<i> and
- * type SY_LT<i>; polygons: shadow SY_AS<i>); see shade_light, shade_area. */
+/* Call i of a variant's straight-line light code: when the count n (SY_NLIGHTS) is above i, L +=
+ * f(i, k<i>, ...), k<i> the item's defines (punctual lights: shadow SY_LK<i> and type SY_LT<i>);
+ * see shade_light. */
 #define SY_GL_CALL(n, f, k, i) "#if " n " > " #i "\n    L += " f "(" #i ", " k ");\n#endif\n"
 #define SY_GL_LIGHT_CALL(i) SY_GL_CALL("SY_NLIGHTS", "SY_LIGHT", "SY_LK" #i ", SY_LT" #i, i)
-#define SY_GL_AREA_CALL(i) SY_GL_CALL("SY_NAREAS", "SY_AREA_L", "SY_AS" #i, i)
 
 /* The lighting of one surface point: P (world), ngf (geometric normal facing the viewer), ns
  * (shading normal, flipped to the side seen), wo (towards the eye), the material's clamped base
@@ -216,8 +219,8 @@ const char *const sy_gl_main_vs =
     "#endif\n" \
     "#ifdef SY_AREA\n" \
     /* one emissive polygon i (linearly transformed cosines: frame for the diffuse lobe, Minv for \
-     * the specular one; kdl, fl their weights); shadow: whether it has a shadow map (1, 0; -1 \
-     * read from the Areas block). Called once per polygon with constants, as shade_light. */ \
+     * the specular one; kdl, fl their weights); shadow: 0 it has no shadow map, else its map's \
+     * index is read from the Areas block (none when negative) */ \
     "vec3 shade_area(int i, int shadow, vec3 P, vec3 ngf, mat3 frame, mat3 Minv, vec3 kdl, vec3 fl, float rough) {\n" \
     "  vec4 v0 = a_data[i * 6], rad = a_data[i * 6 + 4], cen = a_data[i * 6 + 5];\n" \
     "  int nvx = int(v0.w);\n" \
@@ -226,8 +229,7 @@ const char *const sy_gl_main_vs =
     "  if (!(abs(side) > 1e-5 * dot(ln, ln) + 1e-9) || (side < 0.0 && rad.w < 0.5)) return vec3(0.0);\n" \
     "  float vis = 1.0;\n" \
     "#ifdef SY_ASHADOW\n" \
-    "  if (shadow > 0) vis = shadow_area(int(cen.w), P, ngf);\n" \
-    "  else if (shadow < 0) { int si = int(cen.w); vis = si >= 0 ? shadow_area(si, P, ngf) : 1.0; }\n" \
+    "  if (shadow != 0) { int si = int(cen.w); vis = si >= 0 ? shadow_area(max(si, 0), P, ngf) : 1.0; }\n" \
     "  if (vis <= 0.0) return vec3(0.0);\n" \
     "#endif\n" \
     "  float d = ltc_eval(frame, P, i, nvx);\n" \
@@ -271,11 +273,12 @@ const char *const sy_gl_main_vs =
     "      vec3 fl = (bc * t2.x + (1.0 - bc) * t2.y) * w_metal + vec3(w_diel * spec * (f0d * t2.x + (1.0 - f0d) * t2.y));\n" \
     "      vec3 kdl = kd * (1.0 - fd_avg);\n" \
     "#define SY_AREA_L(i, sh) shade_area(i, sh, P, ngf, frame, Minv, kdl, fl, rough)\n" \
-    "#ifdef SY_NAREAS\n" /* the frame's polygon count (1 .. 16) and shadows SY_AS0 ..: straight-line code */ \
-    SY_GL_AREA_CALL(0) SY_GL_AREA_CALL(1) SY_GL_AREA_CALL(2) SY_GL_AREA_CALL(3) SY_GL_AREA_CALL(4) \
-    SY_GL_AREA_CALL(5) SY_GL_AREA_CALL(6) SY_GL_AREA_CALL(7) SY_GL_AREA_CALL(8) SY_GL_AREA_CALL(9) \
-    SY_GL_AREA_CALL(10) SY_GL_AREA_CALL(11) SY_GL_AREA_CALL(12) SY_GL_AREA_CALL(13) SY_GL_AREA_CALL(14) \
-    SY_GL_AREA_CALL(15) \
+    "#ifdef SY_NAREAS\n" /* the frame's polygon count (1 .. 16); those before SY_NASH may have a shadow map */ \
+    /* two loops, not one call per polygon: sixteen inlined copies of shade_area (two LTC \
+     * evaluations and eight shadow taps each) took llvmpipe's LLVM many seconds to compile, the \
+     * loops compile once; constant bounds, so neither is entered in vain */ \
+    "      for (int i = 0; i < SY_NASH; ++i) L += SY_AREA_L(i, 1);\n" \
+    "      for (int i = SY_NASH; i < SY_NAREAS; ++i) L += SY_AREA_L(i, 0);\n" \
     "#else\n" \
     "      for (int i = 0; i < a_count.x; ++i) L += SY_AREA_L(i, -1);\n" \
     "#endif\n" \
@@ -340,10 +343,9 @@ const char *const sy_gl_main_fs =
     "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
     SY_GL_SHADE_LIT
     "void main() {\n"
-    "  vec2 uv[2] = vec2[2](v_uv0, v_uv1);\n"
     "  vec4 base = m_base * v_col;\n"
     "#ifdef SY_TEX\n"
-    "  if (m_tex.x >= 0) base *= texture(t_base, tuv(0, uv[m_tex.x]));\n"
+    "  if (m_tex.x >= 0) base *= texture(t_base, tuv(0, UVSET(m_tex.x)));\n"
     "#endif\n"
     "  float alpha = base.a;\n"
     "#ifdef SY_MASK\n"
@@ -356,7 +358,7 @@ const char *const sy_gl_main_fs =
     "  if (m_modes.w != 0 && (front || m_modes.z != 0)) {\n"
     "    L = m_emissive.rgb;\n"
     "#ifdef SY_TEX\n"
-    "    if (m_tex2.x >= 0) L *= texture(t_emis, tuv(4, uv[m_tex2.x])).rgb;\n"
+    "    if (m_tex2.x >= 0) L *= texture(t_emis, tuv(4, UVSET(m_tex2.x))).rgb;\n"
     "#endif\n"
     "  }\n"
     "  if (m_modes.y != 0) {\n"
@@ -372,7 +374,7 @@ const char *const sy_gl_main_fs =
     "    if (u_has_normals) { vec3 sn = normalize(v_nrm); if (!any(isnan(sn))) n = sn; }\n"
     "#ifdef SY_NMAP\n"
     "    if (m_tex.z >= 0) {\n"
-    "      vec2 t = tuv(2, uv[m_tex.z]); vec2 dtx = dFdx(t), dty = dFdy(t);\n"
+    "      vec2 t = tuv(2, UVSET(m_tex.z)); vec2 dtx = dFdx(t), dty = dFdy(t);\n"
     "      vec3 pp2 = cross(dpy, n), pp1 = cross(n, dpx);\n"
     "      vec3 dpdu = pp2 * dtx.x + pp1 * dty.x, dpdv = pp2 * dtx.y + pp1 * dty.y;\n"
     "      vec3 tg = dpdu - n * dot(n, dpdu);\n"
@@ -387,14 +389,14 @@ const char *const sy_gl_main_fs =
     "    vec3 ns = front ? n : -n;\n"
     "    float metallic = m_mrna.x, rough = m_mrna.y;\n"
     "#ifdef SY_TEX\n"
-    "    if (m_tex.y >= 0) { vec4 t = texture(t_mr, tuv(1, uv[m_tex.y])); rough *= t.g; metallic *= t.b; }\n"
+    "    if (m_tex.y >= 0) { vec4 t = texture(t_mr, tuv(1, UVSET(m_tex.y))); rough *= t.g; metallic *= t.b; }\n"
     "#endif\n"
     "    metallic = clamp(metallic, 0.0, 1.0); rough = clamp(rough, 0.0, 1.0);\n"
     "    vec3 bc = clamp(base.rgb, 0.0, 1.0);\n"
     "    float ior = m_oist.y, spec = clamp(m_oist.z, 0.0, 1.0), trans = clamp(m_oist.w, 0.0, 1.0);\n"
     "    float ao = 1.0;\n"
     "#if defined(SY_TEX) && (defined(SY_AREA) || defined(SY_ENV) || defined(SY_PROBE))\n"
-    "    if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, tuv(3, uv[m_tex.w])).r - 1.0);\n"
+    "    if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, tuv(3, UVSET(m_tex.w))).r - 1.0);\n"
     "#endif\n"
     "    L += shade_lit(v_wpos, ngf, ns, wo, bc, metallic, rough, ior, spec, trans, ao, m_modes.w != 0);\n"
     "  }\n"
@@ -569,8 +571,8 @@ const char *const sy_gl_shadow_fs =
     "in vec2 v_uv0; in vec2 v_uv1; in float v_a;\n"
     "void main() {\n"
     "#ifdef SY_MASK\n"
-    "  float a = m_base.a * v_a; vec2 uv[2] = vec2[2](v_uv0, v_uv1);\n"
-    "  if (m_tex.x >= 0) a *= texture(t_base, tuv(0, uv[m_tex.x])).a;\n"
+    "  float a = m_base.a * v_a;\n"
+    "  if (m_tex.x >= 0) a *= texture(t_base, tuv(0, UVSET(m_tex.x))).a;\n"
     "  if (a < m_mrna.w) discard;\n"
     "#endif\n"
     "}\n";

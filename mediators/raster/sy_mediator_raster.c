@@ -757,6 +757,8 @@ static const sy_param_decl raster_params[] = {
     {"indirect", SY_PARAM_BOOL, 0, 0, "1", NULL, "emitters' indirect light as an ambient estimate (0: direct light only)", 0},
     {"deferred", SY_PARAM_BOOL, 0, 0, "1", NULL,
      "with MSAA, shade opaque untextured surfaces once per pixel after the geometry pass (0: all forward)", 0},
+    {"lod", SY_PARAM_FLOAT, 0, 64, "0.5", NULL,
+     "levels of detail of large meshes: the largest silhouette deviation allowed, in pixels (0: always the full mesh)", 0},
 };
 static const sy_param_table raster_table = SY_PARAM_TABLE(raster_params);
 
@@ -764,6 +766,7 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
 {
     *state_out = NULL;
     long msaa = 4, shadow = 2048, max_tex = 0, ww = 640, wh = 480;
+    double lod = SY_GL_LOD_PIXELS_DEFAULT;
     bool indirect = true, deferred = true;
     sy_result r;
     const sy_param_table *t = &raster_table;
@@ -775,7 +778,8 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
         (r = sy_param_int(t, args->params, "window_width", &ww, err)) ||
         (r = sy_param_int(t, args->params, "window_height", &wh, err)) ||
         (r = sy_param_bool(t, args->params, "indirect", &indirect, err)) ||
-        (r = sy_param_bool(t, args->params, "deferred", &deferred, err)))
+        (r = sy_param_bool(t, args->params, "deferred", &deferred, err)) ||
+        (r = sy_param_float(t, args->params, "lod", &lod, err)))
         return r;
     if (!sy_gl_provider_parse(gl, &provider)) /* the table's enum lists the same names */
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "raster: parameter gl=%s: expected osmesa, egl or glfw", gl);
@@ -802,6 +806,7 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
         free(st);
         return sy_error_set(err, gr == SY_GL_ERROR_NO_CONTEXT ? SY_ERR_UNSUPPORTED : SY_ERR_BACKEND, "raster: %s", e);
     }
+    sy_gl_set_lod(st->dev, (float)lod);
     sy_mirror_desc md = {"raster mediator", args->root_node_id, &raster_mirror_callbacks, st};
     if ((r = sy_mirror_create(&md, &st->mirror, err)) != SY_OK) {
         sy_gl_device_destroy(st->dev);

@@ -261,7 +261,17 @@ int main(int argc, char **argv)
         CHECK(r == SY_GL_ERROR_GL && strstr(e, "broken shader: fragment compile failed") && strstr(e, "undefined_name"),
               "compile failure message: %s", e);
         sy_gl_context_destroy(ctx);
-        /* 9. no display: GLFW names itself and the fallback */
+        /* 9. the largest shadow_map_size the parameter allows (16384: four maps are 4 GiB, more
+         * than llvmpipe gives one texture) makes a device with smaller maps and says so; it
+         * failed with GL_OUT_OF_MEMORY before (issue 32) */
+        warnings = 0;
+        sy_gl_device_desc bd = {.provider = SY_GL_PROVIDER_OSMESA, .msaa = 1, .shadow_map_size = 16384, .log = on_log};
+        r = sy_gl_device_create(&bd, &d, e, sizeof e);
+        CHECK(r == SY_GL_OK, "shadow_map_size 16384: %s", e);
+        CHECK(warnings == 1 && strstr(last_warning, "shadow_map_size 16384"), "shadow map warning (%d): %s", warnings,
+              last_warning);
+        if (r == SY_GL_OK) sy_gl_device_destroy(d);
+        /* 10. no display: GLFW names itself and the fallback */
         unsetenv("DISPLAY");
         unsetenv("WAYLAND_DISPLAY");
         sy_gl_device_desc gd = {.provider = SY_GL_PROVIDER_GLFW};

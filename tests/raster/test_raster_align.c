@@ -1,9 +1,10 @@
 /* test_raster_align.c — the pixel alignment contract between the rasterizer and the ray tracers:
  * the same scene and camera give the same silhouettes. For sample models (Box, Duck, the Cornell
- * box, DamagedHelmet) at 256x256 the object masks (alpha > 0) of raster (single sample per pixel,
+ * box, DamagedHelmet, SimpleInstancing) at 256x256 the object masks (alpha > 0) of raster (single sample per pixel,
  * at the pixel centre) and whitted (spp=1: the centre ray alone) renders overlap with IoU >= 0.99, and where
  * both see a surface their linear depths agree; with each back-end's default anti-aliasing the
- * coverage (finite depth, core/sy_stats.h) still overlaps with IoU >= 0.99. */
+ * coverage (finite depth, core/sy_stats.h) still overlaps with IoU >= 0.99; levels of detail at
+ * their default leave the raster silhouette as the full meshes draw it (IoU >= 0.99). */
 #include "it_util.h"
 #include "sy_gltf.h"
 #include "sy_stats.h"
@@ -60,6 +61,15 @@ static void check_model(const model *m)
     CHECKF(iou >= 0.99, "%s: silhouette IoU %.5f < 0.99", m->path, iou);
     CHECKF(depth_bad <= inter / 100, "%s: %u of %u shared pixels differ in depth by more than 0.2%%", m->path, depth_bad, inter);
     CHECK(sy_layer_count_nonfinite(&a) == 0);
+    /* levels of detail at their default (half a pixel) against the full meshes (lod=0): the same
+     * silhouette (issue 32) */
+    sy_layer full;
+    render(scene, &info, cam, "raster", "msaa=1,shadow_map_size=256,lod=0", &full);
+    double iou_lod = 0.0;
+    MUST(sy_layer_coverage_iou(&a, &full, &iou_lod, err));
+    printf("%-40s IoU %.5f levels of detail against full meshes\n", m->path, iou_lod);
+    CHECKF(iou_lod >= 0.99, "%s: levels of detail change the silhouette: IoU %.5f < 0.99", m->path, iou_lod);
+    sy_layer_destroy(&full);
     sy_layer_destroy(&a);
     sy_layer_destroy(&b);
     /* default anti-aliasing on both sides (raster MSAA 4, Whitted 4 strata): a pixel is covered
@@ -84,6 +94,7 @@ int main(void)
         {"gltf/Duck/glTF/Duck.gltf", NULL},
         {"cornell/cornell_box.gltf", "camera"},
         {"gltf/DamagedHelmet/glTF/DamagedHelmet.gltf", NULL},
+        {"gltf/SimpleInstancing/glTF/SimpleInstancing.gltf", NULL}, /* 125 instances, many edges */
     };
     for (size_t i = 0; i < sizeof models / sizeof models[0]; ++i) check_model(&models[i]);
     return it_finish("raster_align");
