@@ -67,6 +67,7 @@
 #include "sy_png.h"
 #include "sy_sniff.h"
 #include "sy_signals.h"
+#include "sy_testpoint.h"
 #include "sy_viewport.h"
 #include "sy_x3d.h"
 
@@ -398,11 +399,16 @@ typedef struct progress_state {
     const char *label;
     double start, last_print;
     bool tty;
+    bool announced; /* the "tiles" phase (sy_testpoint.h) was announced for this render */
 } progress_state;
 
 static void progress_cb(void *user, const sy_progress *p)
 {
     progress_state *ps = user;
+    if (!ps->announced && p->done < p->total) { /* a render is in progress (tests wait for it) */
+        ps->announced = true;
+        sy_testpoint("tiles");
+    }
     if (!ps->tty || p->total == 0) return;
     double now = sy_time_now();
     if (p->done != p->total && now - ps->last_print < 0.1) return;
@@ -451,7 +457,7 @@ static sy_result render_scene(loaded *ld, const char *backend, const char *param
         .root = ld->root, .camera = ld->camera, .background = ld->background, .backend = backend, .params = params};
     if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
     if (r == SY_OK) r = sy_layer_create(w, h, out, err);
-    progress_state ps = {backend, sy_time_now(), 0, sy_is_terminal(2)};
+    progress_state ps = {backend, sy_time_now(), 0, sy_is_terminal(2), false};
     sy_window_render_opts ro = {.progress = progress_cb, .progress_user = &ps, .sample_count = samples};
     double t0 = sy_time_now();
     if (r == SY_OK) r = sy_window_render(win, ld->scene, pool, &ro, out, err);
@@ -529,6 +535,7 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
         }
         if (target && pr.done >= target) break;
         if (po->time_budget > 0 && now - t0 + pass > po->time_budget) break;
+        sy_testpoint("pass"); /* a pass is done and the graceful interrupt armed (tests wait for it) */
         if (sy_signals_interrupted()) break; /* first Ctrl-C: keep what the finished passes gave */
         /* passes of about a quarter of a second: responsive progress, little overhead */
         double want = pass > 0 ? 0.25 / pass : 64;
@@ -1183,7 +1190,7 @@ static int cmd_render(int argc, char **argv)
     spec.background = ld.background;
     sy_result r = overlay ? add_overlay(&ld, overlay, composite, &spec, &err) : SY_OK;
     if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
-    progress_state ps = {shown, sy_time_now(), 0, sy_is_terminal(2)};
+    progress_state ps = {shown, sy_time_now(), 0, sy_is_terminal(2), false};
     sy_window_render_opts ro = {.progress = progress_cb, .progress_user = &ps};
     double t0 = sy_time_now();
     uint64_t samples = 0;
@@ -1911,6 +1918,7 @@ int main(int argc, char **argv)
     /* before any thread: interrupts are taken on a thread of their own, output files in progress
      * are removed when one ends the process */
     sy_signals_start();
+    sy_testpoint_start(); /* SY_TEST_PHASES / SY_TEST_PAUSE: tests wait for phases (sy_testpoint.h) */
     if (sy_mediators_register_builtin(&err) != SY_OK) return fail(&err);
     /* sy's own options before the command (stops at the first operand, the command): --version,
      * --help / -h, -q / -v and the options of every command (world and loader flags) */
