@@ -12,11 +12,17 @@
 #     scene's triangles: again exactly the answer's objects, fewer than all, drawn within it.
 #
 # MODULES_DIR holds browser.mjs and node_modules/playwright-core. Skipped (77, with the reason)
-# without chromium, node, playwright-core (npm ci failed: no network at build time) or the scene.
+# without chromium, node, playwright-core (npm ci failed: no network at build time) or the scene;
+# with SY_REQUIRE_BROWSER=1 in the environment (CI: .ci/run sets it) each of those is a failure
+# instead, so that the browser coverage is never lost silently.
 set -u
 mode=$1 SY=$2 PNG_IOU=$3 MODULES=$4 SCENE=$5
 W=480 H=360
-skip() { echo "SKIP: $*"; exit 77; }
+skip() {
+    if [ "${SY_REQUIRE_BROWSER:-0}" = 1 ]; then echo "FAIL: SY_REQUIRE_BROWSER=1 but the test cannot run: $*"; exit 1; fi
+    echo "SKIP: $*"
+    exit 77
+}
 [ -f "$SCENE" ] || skip "$SCENE is absent (the test data in ../shared/testdata)"
 CHROMIUM=${SY_CHROMIUM:-/usr/bin/chromium}
 [ -x "$CHROMIUM" ] || skip "chromium is not installed ($CHROMIUM; apt-get install chromium)"
