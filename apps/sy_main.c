@@ -68,6 +68,7 @@
 #include "sy_sniff.h"
 #include "sy_signals.h"
 #include "sy_testpoint.h"
+#include "sy_options.h"
 #include "sy_viewport.h"
 #include "sy_x3d.h"
 
@@ -166,7 +167,8 @@ static bool parse_floats(const char *text, float *out, int min_n, int max_n, int
 }
 
 /* >>options: every command parses its options with getopt_long (GNU ordering: options and operands
- * in any order, "--" ends the options, --name=value and unambiguous abbreviations accepted). The
+ * in any order, "--" ends the options, --name=value) through sy_getopt, which refuses abbreviated
+ * long options (sy_options.h: "--frame" is no "--frames"). The
  * options every command takes (the world and loader flags, -q / -v, --help) are applied by
  * next_option; a command's own ones come back to it. */
 enum {
@@ -234,11 +236,16 @@ static int next_option(const char *cmd, int argc, char **argv, const char *short
 {
     opterr = 0; /* the messages are ours */
     const char *who = cmd ? cmd : "sy";
+    char prefix[64];
+    snprintf(prefix, sizeof prefix, "sy%s%s", cmd ? " " : "", cmd ? cmd : "");
     for (;;) {
-        int c = getopt_long(argc, argv, shortopts, longopts, NULL);
+        int c = sy_getopt(argc, argv, shortopts, longopts, prefix);
         const char *bad = optind > 0 && optind <= argc ? argv[optind - 1] : "";
         sy_error e = {0};
         switch (c) {
+        case SY_GETOPT_ERROR: /* an abbreviated long option (named on stderr) */
+            *status = 2;
+            return OPT_STOP;
         case '?':
             if (optopt >= 0x100) fprintf(stderr, "sy %s: error: option '%s' takes no value", who, bad);
             else if (optopt) fprintf(stderr, "sy %s: error: unknown option '-%c'", who, optopt);

@@ -2,7 +2,9 @@
 # cli_test.sh SY TESTDATA TMPDIR — tests of the `sy` command line tool (integration_cli).
 #   - sy info Box.gltf: JSON counts meshes/primitives/triangles/materials = 1/1/12/1, bounds +-0.5
 #   - conventions: --version, --help / help / CMD --help / help bench on stdout; a bad option, a
-#     missing or bad value named with status 2; a failure status 1; backends --json; -q / -v
+#     missing or bad value named with status 2; a failure status 1; backends --json; -q / -v;
+#     an abbreviated long option (--frame for --frames) is a usage error naming the options it
+#     begins, in every command
 #   - sy render (cornell, whitted) to PNG and EXR: exit 0, files with the right signature and size
 #   - bad inputs (missing file, truncated GLB, garbage .gltf, unknown back-end, output in a missing
 #     directory, unknown output extension): non-zero exit, the offending name in stderr, and no
@@ -137,6 +139,35 @@ run badmissing "$SY" render demo -b whitted -o "$TMP/x.png" -w
 [ "$rc" -eq 2 ] && grep -q -- "option '-w' needs a value" "$TMP/badmissing.err" || fail "a missing value: status $rc, $(cat "$TMP/badmissing.err")"
 run badword "$SY" render demo -b whitted -o "$TMP/x.png" --tonemap=bogus
 [ "$rc" -eq 2 ] && grep -q -- "--tonemap: 'bogus'" "$TMP/badword.err" || fail "a bad --tonemap: status $rc, $(cat "$TMP/badword.err")"
+# long options are matched exactly (issue 32): an abbreviation is a usage error naming the options it
+# begins, in every command (sy_getopt, apps/sy_options.c); getopt_long took "--frame 10" for --frames
+mkdir -p "$TMP/o_abbrev"
+run abbrev "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_abbrev/x.png" --frame 10
+[ "$rc" -eq 2 ] && grep -q -- "unknown option '--frame': long options are not abbreviated; the option that begins so is: --frames" \
+    "$TMP/abbrev.err" || fail "sy render --frame 10: status $rc (want 2), $(cat "$TMP/abbrev.err")"
+run abbrev_eq "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_abbrev/x.png" --param=spp=1
+[ "$rc" -eq 2 ] && grep -q -- "'--param'.*: --params" "$TMP/abbrev_eq.err" ||
+    fail "sy render --param=spp=1: status $rc (want 2), $(cat "$TMP/abbrev_eq.err")"
+run abbrev_many "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_abbrev/x.png" --env-i 2
+[ "$rc" -eq 2 ] && grep -q -- "'--env-i'.*: --env-intensity" "$TMP/abbrev_many.err" ||
+    fail "sy render --env-i 2: status $rc (want 2), $(cat "$TMP/abbrev_many.err")"
+run abbrev_amb "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_abbrev/x.png" --env 2
+[ "$rc" -ne 2 ] || ! grep -q "not abbreviated" "$TMP/abbrev_amb.err" ||
+    fail "sy render --env (an option that begins others) was taken for an abbreviation: $(cat "$TMP/abbrev_amb.err")"
+run abbrev_ambiguous "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_abbrev/x.png" --e 2
+[ "$rc" -eq 2 ] && grep -q -- "'--e'.*the options that begin so are: .*--env, .*--env-color" "$TMP/abbrev_ambiguous.err" ||
+    fail "sy render --e 2 (ambiguous): status $rc (want 2), $(cat "$TMP/abbrev_ambiguous.err")"
+for cmd in "info demo --js" "backends --par" "bench limit --rep 1" "bench governor --fram 2" "compare demo --spp 1 --backend whitted"; do
+    run abbrev_cmd "$SY" $cmd
+    [ "$rc" -eq 2 ] && grep -q "not abbreviated" "$TMP/abbrev_cmd.err" ||
+        fail "sy $cmd: status $rc (want 2), $(head -c 400 "$TMP/abbrev_cmd.err")"
+done
+if has cluster; then
+    run abbrev_serve "$SY" serve --list tcp://127.0.0.1:0
+    [ "$rc" -eq 2 ] && grep -q -- "'--list'.*: --listen" "$TMP/abbrev_serve.err" ||
+        fail "sy serve --list: status $rc (want 2), $(cat "$TMP/abbrev_serve.err")"
+fi
+[ -z "$(ls -A "$TMP/o_abbrev")" ] || fail "an abbreviated option left files behind: $(ls -A "$TMP/o_abbrev")"
 run help_bench "$SY" help bench
 [ "$rc" -eq 0 ] && grep -q '^  sy bench sync' "$TMP/help_bench.out" && ! grep -q '^  sy render' "$TMP/help_bench.out" ||
     fail "sy help bench: status $rc, not the bench entries alone"
