@@ -57,6 +57,7 @@
 #endif
 #include "sy_demo.h"
 #include "sy_exr.h"
+#include "sy_file.h"
 #include "sy_world.h"
 #include "sy_gltf.h"
 #include "sy_log.h"
@@ -1111,6 +1112,16 @@ static int cmd_render(int argc, char **argv)
         snprintf(memory_params, sizeof memory_params, "%s%smax_memory_mb=%u", params ? params : "",
                  params && *params ? "," : "", max_memory_mb);
         params = memory_params;
+    }
+    /* the output's folder must take a file before anything is loaded or rendered (an unwritable
+     * one was found only after the render): a temporary file is created there and removed */
+    sy_atomic_file probe = {0};
+    if (sy_atomic_file_begin(outp, &probe, &err) != SY_OK) return fail(&err);
+    sy_atomic_file_abort(&probe);
+    sy_params given = {0};
+    if (sy_params_parse(params, &given, &err) != SY_OK) { /* a key twice ("spp=1,spp=2"): a usage error */
+        sy_log(SY_LOG_ERROR, "sy", NULL, "%s", err.message);
+        return 2;
     }
     if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) { /* before any loading or rendering */
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);

@@ -7,8 +7,9 @@
 #     begins, in every command
 #   - sy render (cornell, whitted) to PNG and EXR: exit 0, files with the right signature and size
 #   - bad inputs (missing file, truncated GLB, garbage .gltf, unknown back-end, output in a missing
-#     directory, unknown output extension): non-zero exit, the offending name in stderr, and no
-#     output file nor temporary file left behind
+#     or unwritable directory, unknown output extension): non-zero exit, the offending name in
+#     stderr, and no output file nor temporary file left behind; a missing or unwritable output
+#     directory is found before anything is rendered; --params with a key twice is a usage error
 #   - typed parameters: sy backends --params (text and --json) lists each back-end's table; an unknown
 #     --params key, a value out of range or not in the enum: status 2 naming it (and the valid keys)
 #   - sy bench sync / sy bench rays / sy bench governor / sy bench limit on small sizes: exit 0 and
@@ -115,6 +116,9 @@ run params_range "$SY" render demo -b whitted --params max_depth=99 -o "$TMP/o_p
 run params_enum "$SY" render demo -b pathtracer --params filter_kernel=fast -o "$TMP/o_params/x.exr"
 [ "$rc" -eq 2 ] && grep -q "filter_kernel=fast for back-end 'pathtracer': expected one of separable, brute" "$TMP/params_enum.err" ||
     fail "--params filter_kernel=fast: status $rc (want 2), $(cat "$TMP/params_enum.err")"
+run params_twice "$SY" render demo -b whitted -w 16 -h 16 --params spp=1,spp=2 -o "$TMP/o_params/x.png"
+[ "$rc" -eq 2 ] && grep -q "'spp' is given twice" "$TMP/params_twice.err" ||
+    fail "--params spp=1,spp=2: status $rc (want 2), $(cat "$TMP/params_twice.err")"
 [ -z "$(ls -A "$TMP/o_params")" ] || fail "refused --params left files behind: $(ls -A "$TMP/o_params")"
 
 # conventions: --version and --help on stdout with status 0; a usage error names the option or value
@@ -223,8 +227,28 @@ expect_error backend no-such-backend "$TMP/o_backend" "$SY" render demo -b no-su
     -o "$TMP/o_backend/x.png"
 grep -q whitted "$TMP/backend.err" || fail "unknown back-end: the message does not list the available ones"
 mkdir -p "$TMP/o_nodir"
-expect_error nodir "$TMP/o_nodir/missing_dir/x.png" "$TMP/o_nodir" "$SY" render demo -b whitted -w 16 -h 16 \
-    -o "$TMP/o_nodir/missing_dir/x.png"
+expect_error nodir "$TMP/o_nodir/missing_dir/x.png" "$TMP/o_nodir" env SY_TEST_PHASES="$TMP/o_nodir.phases" "$SY" render \
+    demo -b whitted -w 64 -h 64 -o "$TMP/o_nodir/missing_dir/x.png"
+grep -q "missing_dir/x.png" "$TMP/nodir.err" && ! grep -qx tiles "$TMP/o_nodir.phases" 2>/dev/null ||
+    fail "output in a missing directory: found only after rendering (phases: $(cat "$TMP/o_nodir.phases" 2>/dev/null))"
+# an output folder sy may not write to is refused before anything is rendered (it was found only
+# after the render); the phases sy announces (SY_TEST_PHASES, apps/sy_testpoint.h) show no tile
+# rendered. As root every folder is writable, so sy runs as nobody there (setpriv).
+mkdir -p "$TMP/o_ro" "$TMP/ro_phases"
+chmod 555 "$TMP/o_ro"
+chmod 777 "$TMP/ro_phases" # the phases file, written by sy as whichever user runs it
+as_user=()
+[ "$(id -u)" -eq 0 ] && command -v setpriv >/dev/null && as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
+if [ "$(id -u)" -ne 0 ] || [ ${#as_user[@]} -gt 0 ]; then
+    rm -f "$TMP/ro_phases/p"
+    expect_error readonly "$TMP/o_ro/x.png" "$TMP/o_ro" env SY_TEST_PHASES="$TMP/ro_phases/p" "${as_user[@]}" "$SY" render \
+        demo -b whitted -w 64 -h 64 -o "$TMP/o_ro/x.png"
+    grep -q "Permission denied" "$TMP/readonly.err" || fail "an unwritable folder: the reason is not given: $(cat "$TMP/readonly.err")"
+    ! grep -qx tiles "$TMP/ro_phases/p" 2>/dev/null || fail "an unwritable output folder was found only after rendering"
+else
+    echo "note: the unwritable-folder check needs a non-root user or setpriv (skipped)"
+fi
+chmod 755 "$TMP/o_ro"
 mkdir -p "$TMP/o_ext"
 expect_error extension x.jpg "$TMP/o_ext" "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_ext/x.jpg"
 
