@@ -2,7 +2,7 @@
  *
  *   sy [-q | -v] [--version | --help] COMMAND ...   -q: errors only, -v: debug messages (sy_log.h)
  *   sy help [COMMAND], sy COMMAND --help            usage on stdout, exit status 0
- *   sy info SCENE | IMAGE.exr           JSON summary (counts, bounds, warnings; an EXR's header)
+ *   sy info SCENE | IMAGE.exr | .png    JSON summary (counts, bounds, warnings; an image's metadata)
  *   sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]
  *             [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]
  *             [--max-memory MB]   (ray tracers: max_memory_mb, a scene whose BVHs need more is refused)
@@ -616,8 +616,8 @@ static const char usage_text[] =
             "                                       (also accepted after COMMAND)\n"
             "  sy --version | sy version            the Switchyard version\n"
             "  sy --help | sy help [COMMAND]        this summary (on stdout); sy COMMAND --help: the command's\n"
-            "  sy info SCENE | IMAGE.exr            JSON summary: counts, bounds, warnings; an EXR's size, channels\n"
-            "                                       and header attributes\n"
+            "  sy info SCENE | IMAGE.exr | IMAGE.png  JSON summary: counts, bounds, warnings; an image's size and\n"
+            "                                       metadata (EXR channels and header attributes, PNG text chunks)\n"
             "  sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]\n"
             "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]  (PNG; default aces)\n"
             "            [--max-memory MB]   (ray tracers: refuse a scene whose BVHs need more)\n"
@@ -847,6 +847,23 @@ static int info_exr(const char *path)
     return print_json(doc);
 }
 
+/* sy info IMAGE.png: the size and the text chunks (sy render writes its metadata there: sy:renderer,
+ * sy:backend, ...), in the same shape as an EXR's (attributes) */
+static int info_png(const char *path)
+{
+    sy_error err = {0};
+    sy_png_info pi;
+    if (sy_png_read_info(path, &pi, &err) != SY_OK) return fail(&err);
+    cJSON *doc = cJSON_CreateObject();
+    jadd(doc, "file", jstr(path));
+    jadd(doc, "width", cJSON_CreateNumber(pi.width));
+    jadd(doc, "height", cJSON_CreateNumber(pi.height));
+    cJSON *at = jadd(doc, "attributes", cJSON_CreateObject());
+    for (int i = 0; i < pi.text_count; ++i) jadd(at, pi.keys[i], jstr(pi.values[i]));
+    sy_png_info_free(&pi);
+    return print_json(doc);
+}
+
 /* counts of one kind of object in an info object */
 static void jcounts(cJSON *o, const char *const *names, const uint32_t *values, size_t n)
 {
@@ -860,10 +877,13 @@ static int cmd_info(int argc, char **argv)
     optind = 0;
     while ((c = next_option("info", argc, argv, SHORT_OPTIONS(""), lo, &status)) != -1)
         if (c == OPT_STOP) return status; /* --json: the output is JSON anyway */
-    if (argc - optind != 1) return usage_of("info", argc == optind ? "a SCENE or IMAGE.exr is required" : "one file at a time");
+    if (argc - optind != 1) return usage_of("info", argc == optind ? "a SCENE, IMAGE.exr or IMAGE.png is required" : "one file at a time");
     const char *path = argv[optind];
+    sy_file_format fmt = SY_FORMAT_UNKNOWN;
+    sy_error err = {0}, ignore = {0};
+    if (sy_sniff_file(path, &fmt, &ignore) != SY_OK) fmt = SY_FORMAT_UNKNOWN; /* the loader names a missing file */
+    if (fmt == SY_FORMAT_PNG) return info_png(path); /* by content, as scenes are recognised */
     if (ends_with(path, ".exr")) return info_exr(path);
-    sy_error err = {0};
     loaded ld;
     if (load(path, NULL, false, &ld, &err) != SY_OK) return fail(&err);
     sy_bounds b;

@@ -208,6 +208,20 @@ run meta_png "$SY" render demo -b pathtracer --spp 3 -w 40 -h 30 -o "$TMP/meta/m
 for kv in 'sy:renderer' 'sy:backend.pathtracer' 'sy:samples.3' 'sy:source.demo'; do
     tr '\0' '.' < "$TMP/meta/m.png" | grep -qa -- "$kv" || fail "the PNG's text chunks lack $kv"
 done
+# sy info reads them back from the PNG (it refused the PNG sy render wrote, though README promised it)
+run meta_info_png "$SY" info "$TMP/meta/m.png"
+for kv in '"sy:renderer": "Switchyard ' '"sy:backend": "pathtracer"' '"sy:samples": "3"' '"sy:source": "demo"' \
+          '"sy:size": "40x30"' '"width": 40,' '"height": 30,'; do
+    [ "$rc" -eq 0 ] && grep -qF -- "$kv" "$TMP/meta_info_png.out" ||
+        fail "sy info m.png: status $rc, lacks $kv: $(cat "$TMP/meta_info_png.out" "$TMP/meta_info_png.err")"
+done
+cp "$TMP/meta/m.png" "$TMP/meta/png_named.exr" # by content, whatever the name
+run meta_info_png2 "$SY" info "$TMP/meta/png_named.exr"
+grep -qF '"sy:backend": "pathtracer"' "$TMP/meta_info_png2.out" || fail "sy info of a PNG named .exr: $(cat "$TMP/meta_info_png2.err")"
+head -c 60 "$TMP/meta/m.png" > "$TMP/meta/cut.png" # a truncated PNG: an error naming it, never a crash
+run meta_info_cut "$SY" info "$TMP/meta/cut.png"
+[ "$rc" -eq 1 ] && grep -q "cut.png: not a readable PNG" "$TMP/meta_info_cut.err" ||
+    fail "sy info of a truncated PNG: status $rc, $(cat "$TMP/meta_info_cut.err")"
 
 # garbage bytes named bad.gltf
 mkdir -p "$TMP/in" "$TMP/o_garbage"
