@@ -14,6 +14,7 @@
  *            armed; announced after every pass);
  *   tiles    sy render: the back-end reported its first finished tile of a frame (a render is in
  *            progress; no output file exists yet);
+ *   frame    sy view: a settled frame was shown (announced after every one);
  *   commit   any output file: the temporary file is written and about to be renamed over the
  *            target (sy_atomic_file_set_commit_hook, formats/sy_file.h).
  * Thread-safety: sy_testpoint may be called from any thread; the state is set once at start. */

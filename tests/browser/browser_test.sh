@@ -43,13 +43,9 @@ args=(web "$SCENE" -b raster --listen 127.0.0.1:0)
 [ "$mode" = client ] && args+=(--client-render)
 "$SY" "${args[@]}" >"$out/log" 2>"$out/err" &
 pid=$!
-url=
-for _ in $(seq 1 300); do
-    url=$(grep -o 'http://[^ ]*' "$out/log" 2>/dev/null | head -1)
-    [ -n "$url" ] && break
-    kill -0 $pid 2>/dev/null || break
-    sleep 0.1
-done
+. "$(dirname "$0")/../support/wait.sh" # wait_until: states, never sleeps (hang guard only)
+wait_until $pid grep -q 'http://' "$out/log"
+url=$(grep -o 'http://[^ ]*' "$out/log" 2>/dev/null | head -1)
 [ -n "$url" ] || { echo "FAIL: sy web printed no URL: $(cat "$out/log" "$out/err")"; exit 1; }
 echo "sy web: $url"
 
