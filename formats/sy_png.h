@@ -61,9 +61,11 @@ sy_result sy_png_read_rgba8(const char *path, int *width_out, int *height_out, u
 /** A PNG's header and the text chunks that come before its image data (where sy_png_write puts
  * its metadata: sy:renderer, sy:backend, ...). */
 typedef struct sy_png_info {
-    int width, height; /**< from the header */
-    int text_count;    /**< keys / values used (at most SY_PNG_MAX_TEXT; later ones are dropped) */
-    char *keys[SY_PNG_MAX_TEXT], *values[SY_PNG_MAX_TEXT]; /**< owned copies (sy_png_info_free) */
+    int width;                      /**< pixels, from the header */
+    int height;                     /**< pixels, from the header */
+    int text_count;                 /**< keys / values used (at most SY_PNG_MAX_TEXT; later ones are dropped) */
+    char *keys[SY_PNG_MAX_TEXT];    /**< the chunks' keys (owned copies, sy_png_info_free) */
+    char *values[SY_PNG_MAX_TEXT];  /**< the chunks' values (owned copies, sy_png_info_free) */
 } sy_png_info;
 
 /** Reads the header and the text chunks (tEXt, zTXt, iTXt) before the image data of the PNG at
