@@ -16,6 +16,14 @@ step() { # step NAME COMMAND...: runs the command, remembers NAME when it fails
 }
 step "build (RelWithDebInfo)" sy_configure_build build -- -DCMAKE_BUILD_TYPE=RelWithDebInfo &&
   step "ctest (RelWithDebInfo)" ctest --test-dir build --output-on-failure -j "$jobs"
+# SY_REQUIRE_BROWSER=1 (.ci/run): the browser tests must run; a skipped one fails by itself
+# (browser_test.sh), and a main configuration without them (no sy web) fails here.
+browser_tests_present() {
+  local n
+  n=$(ctest --test-dir build -N -L browser | sed -n 's/^Total Tests: //p')
+  [ "${n:-0}" -gt 0 ] || { echo "test.sh: SY_REQUIRE_BROWSER=1 but the build has no browser tests (sy web not built?)"; return 1; }
+}
+[ "${SY_REQUIRE_BROWSER:-0}" = 1 ] && step "browser tests present" browser_tests_present
 # Sanitizer build: every executable keeps dlopen()ed GL drivers loaded until exit
 # (tests/support/sy_keep_loaded.c), so LeakSanitizer needs one suppression only (tests/lsan.supp).
 step "build (ASan+UBSan)" sy_configure_build build-asan -- -DCMAKE_BUILD_TYPE=Debug -DSY_SANITIZE=ON &&

@@ -8,6 +8,8 @@
 #include "sy_plant.h"
 #include "sy_viewport.h"
 
+#include "sy_options.h"
+
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
@@ -344,9 +346,10 @@ int sy_cmd_bench_cull(int argc, char **argv)
     int c;
     optind = 0;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, ":w:h:", lo, NULL)) != -1) {
+    while ((c = sy_getopt(argc, argv, ":w:h:", lo, "sy bench cull")) != -1) {
         bool ok = true;
         switch (c) {
+        case SY_GETOPT_ERROR: return 2; /* an abbreviated long option (named on stderr) */
         case O_HELP: return bench_usage(NULL);
         case O_TRIS: ok = parse_u64(optarg, 1, 1ull << 32, &tris); break;
         case O_OBJECTS: ok = parse_u64(optarg, 1, 1u << 22, &objects); break;

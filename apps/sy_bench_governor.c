@@ -11,6 +11,8 @@
 #include "sy_sniff.h"
 #include "sy_x3d.h"
 
+#include "sy_options.h"
+
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
@@ -246,7 +248,8 @@ int sy_cmd_bench_governor(int argc, char **argv)
     int opt;
     optind = 0; /* glibc: start over */
     opterr = 0;
-    while ((opt = getopt_long(argc, argv, ":w:h:qv", lo, NULL)) != -1) {
+    while ((opt = sy_getopt(argc, argv, ":w:h:qv", lo, "sy bench governor")) != -1) {
+        if (opt == SY_GETOPT_ERROR) return 2; /* an abbreviated long option (named on stderr) */
         char *end = NULL;
         double v = 0;
         if (opt == 'w' || opt == 'h' || opt == O_BUDGET || opt == O_FRAMES || opt == O_TRIS) v = strtod(optarg, &end);

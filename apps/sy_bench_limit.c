@@ -9,6 +9,8 @@
 #include "sy_mediator_rt.h"
 #endif
 
+#include "sy_options.h"
+
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -113,7 +115,8 @@ int sy_cmd_bench_limit(int argc, char **argv)
     int opt;
     optind = 0;
     opterr = 0;
-    while ((opt = getopt_long(argc, argv, ":w:h:", lo, NULL)) != -1) {
+    while ((opt = sy_getopt(argc, argv, ":w:h:", lo, "sy bench limit")) != -1) {
+        if (opt == SY_GETOPT_ERROR) return 2; /* an abbreviated long option (named on stderr) */
         uint32_t *dst = opt == 'w' ? &w : opt == 'h' ? &h : opt == O_SPP ? &spp : opt == O_REPEATS ? &repeats : NULL;
         unsigned long hi = opt == 'w' || opt == 'h' ? 16384 : opt == O_SPP ? 1024 : 1000;
         if (opt == O_HELP) {

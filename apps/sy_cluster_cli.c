@@ -8,6 +8,7 @@
 #include "sy_cluster_mpi.h"
 #include <sodium.h>
 #endif
+#include "sy_options.h"
 #include "sy_signals.h"
 
 #include "sy_demo.h"
@@ -142,10 +143,11 @@ int sy_cmd_serve(int argc, char **argv)
     int c;
     optind = 0; /* glibc: start over (new arguments, GNU ordering) */
     opterr = 0;
-    while ((c = getopt_long(argc, argv, ":qv", lo, NULL)) != -1) {
+    while ((c = sy_getopt(argc, argv, ":qv", lo, "sy serve")) != -1) {
         const char *opt = argv[optind - 1];
         bool ok = true;
         switch (c) {
+        case SY_GETOPT_ERROR: return 2; /* an abbreviated long option (named on stderr) */
         case O_LISTEN: o.listen_url = optarg; break;
         case O_SECRET_FILE: secret_file = optarg; break;
         case O_OUTPUT: pc.output = optarg; break;
@@ -1230,10 +1232,11 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     unsigned long long v = 0;
     optind = 0; /* glibc: start over (new arguments, GNU ordering) */
     opterr = 0;
-    while ((opt = getopt_long(argc, argv, ":w:h:b:qv", lo, NULL)) != -1) {
+    while ((opt = sy_getopt(argc, argv, ":w:h:b:qv", lo, "sy bench cluster")) != -1) {
         bool ok = true;
         char *end = NULL;
         switch (opt) {
+        case SY_GETOPT_ERROR: return 2; /* an abbreviated long option (named on stderr) */
         case 'w': ok = uint_arg(optarg, 1, 16384, &v), w = (uint32_t)v, size_given = true; break;
         case 'h': ok = uint_arg(optarg, 1, 16384, &v), h = (uint32_t)v, size_given = true; break;
         case 'b': soak_backend = optarg; break;

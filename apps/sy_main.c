@@ -2,7 +2,7 @@
  *
  *   sy [-q | -v] [--version | --help] COMMAND ...   -q: errors only, -v: debug messages (sy_log.h)
  *   sy help [COMMAND], sy COMMAND --help            usage on stdout, exit status 0
- *   sy info SCENE | IMAGE.exr           JSON summary (counts, bounds, warnings; an EXR's header)
+ *   sy info SCENE | IMAGE.exr | .png    JSON summary (counts, bounds, warnings; an image's metadata)
  *   sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]
  *             [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]
  *             [--max-memory MB]   (ray tracers: max_memory_mb, a scene whose BVHs need more is refused)
@@ -57,6 +57,7 @@
 #endif
 #include "sy_demo.h"
 #include "sy_exr.h"
+#include "sy_file.h"
 #include "sy_world.h"
 #include "sy_gltf.h"
 #include "sy_log.h"
@@ -67,6 +68,8 @@
 #include "sy_png.h"
 #include "sy_sniff.h"
 #include "sy_signals.h"
+#include "sy_testpoint.h"
+#include "sy_options.h"
 #include "sy_viewport.h"
 #include "sy_x3d.h"
 
@@ -165,7 +168,8 @@ static bool parse_floats(const char *text, float *out, int min_n, int max_n, int
 }
 
 /* >>options: every command parses its options with getopt_long (GNU ordering: options and operands
- * in any order, "--" ends the options, --name=value and unambiguous abbreviations accepted). The
+ * in any order, "--" ends the options, --name=value) through sy_getopt, which refuses abbreviated
+ * long options (sy_options.h: "--frame" is no "--frames"). The
  * options every command takes (the world and loader flags, -q / -v, --help) are applied by
  * next_option; a command's own ones come back to it. */
 enum {
@@ -233,11 +237,16 @@ static int next_option(const char *cmd, int argc, char **argv, const char *short
 {
     opterr = 0; /* the messages are ours */
     const char *who = cmd ? cmd : "sy";
+    char prefix[64];
+    snprintf(prefix, sizeof prefix, "sy%s%s", cmd ? " " : "", cmd ? cmd : "");
     for (;;) {
-        int c = getopt_long(argc, argv, shortopts, longopts, NULL);
+        int c = sy_getopt(argc, argv, shortopts, longopts, prefix);
         const char *bad = optind > 0 && optind <= argc ? argv[optind - 1] : "";
         sy_error e = {0};
         switch (c) {
+        case SY_GETOPT_ERROR: /* an abbreviated long option (named on stderr) */
+            *status = 2;
+            return OPT_STOP;
         case '?':
             if (optopt >= 0x100) fprintf(stderr, "sy %s: error: option '%s' takes no value", who, bad);
             else if (optopt) fprintf(stderr, "sy %s: error: unknown option '-%c'", who, optopt);
@@ -398,11 +407,16 @@ typedef struct progress_state {
     const char *label;
     double start, last_print;
     bool tty;
+    bool announced; /* the "tiles" phase (sy_testpoint.h) was announced for this render */
 } progress_state;
 
 static void progress_cb(void *user, const sy_progress *p)
 {
     progress_state *ps = user;
+    if (!ps->announced && p->done < p->total) { /* a render is in progress (tests wait for it) */
+        ps->announced = true;
+        sy_testpoint("tiles");
+    }
     if (!ps->tty || p->total == 0) return;
     double now = sy_time_now();
     if (p->done != p->total && now - ps->last_print < 0.1) return;
@@ -451,7 +465,7 @@ static sy_result render_scene(loaded *ld, const char *backend, const char *param
         .root = ld->root, .camera = ld->camera, .background = ld->background, .backend = backend, .params = params};
     if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
     if (r == SY_OK) r = sy_layer_create(w, h, out, err);
-    progress_state ps = {backend, sy_time_now(), 0, sy_is_terminal(2)};
+    progress_state ps = {backend, sy_time_now(), 0, sy_is_terminal(2), false};
     sy_window_render_opts ro = {.progress = progress_cb, .progress_user = &ps, .sample_count = samples};
     double t0 = sy_time_now();
     if (r == SY_OK) r = sy_window_render(win, ld->scene, pool, &ro, out, err);
@@ -529,6 +543,7 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
         }
         if (target && pr.done >= target) break;
         if (po->time_budget > 0 && now - t0 + pass > po->time_budget) break;
+        sy_testpoint("pass"); /* a pass is done and the graceful interrupt armed (tests wait for it) */
         if (sy_signals_interrupted()) break; /* first Ctrl-C: keep what the finished passes gave */
         /* passes of about a quarter of a second: responsive progress, little overhead */
         double want = pass > 0 ? 0.25 / pass : 64;
@@ -601,8 +616,8 @@ static const char usage_text[] =
             "                                       (also accepted after COMMAND)\n"
             "  sy --version | sy version            the Switchyard version\n"
             "  sy --help | sy help [COMMAND]        this summary (on stdout); sy COMMAND --help: the command's\n"
-            "  sy info SCENE | IMAGE.exr            JSON summary: counts, bounds, warnings; an EXR's size, channels\n"
-            "                                       and header attributes\n"
+            "  sy info SCENE | IMAGE.exr | IMAGE.png  JSON summary: counts, bounds, warnings; an image's size and\n"
+            "                                       metadata (EXR channels and header attributes, PNG text chunks)\n"
             "  sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]\n"
             "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]  (PNG; default aces)\n"
             "            [--max-memory MB]   (ray tracers: refuse a scene whose BVHs need more)\n"
@@ -832,6 +847,23 @@ static int info_exr(const char *path)
     return print_json(doc);
 }
 
+/* sy info IMAGE.png: the size and the text chunks (sy render writes its metadata there: sy:renderer,
+ * sy:backend, ...), in the same shape as an EXR's (attributes) */
+static int info_png(const char *path)
+{
+    sy_error err = {0};
+    sy_png_info pi;
+    if (sy_png_read_info(path, &pi, &err) != SY_OK) return fail(&err);
+    cJSON *doc = cJSON_CreateObject();
+    jadd(doc, "file", jstr(path));
+    jadd(doc, "width", cJSON_CreateNumber(pi.width));
+    jadd(doc, "height", cJSON_CreateNumber(pi.height));
+    cJSON *at = jadd(doc, "attributes", cJSON_CreateObject());
+    for (int i = 0; i < pi.text_count; ++i) jadd(at, pi.keys[i], jstr(pi.values[i]));
+    sy_png_info_free(&pi);
+    return print_json(doc);
+}
+
 /* counts of one kind of object in an info object */
 static void jcounts(cJSON *o, const char *const *names, const uint32_t *values, size_t n)
 {
@@ -845,10 +877,13 @@ static int cmd_info(int argc, char **argv)
     optind = 0;
     while ((c = next_option("info", argc, argv, SHORT_OPTIONS(""), lo, &status)) != -1)
         if (c == OPT_STOP) return status; /* --json: the output is JSON anyway */
-    if (argc - optind != 1) return usage_of("info", argc == optind ? "a SCENE or IMAGE.exr is required" : "one file at a time");
+    if (argc - optind != 1) return usage_of("info", argc == optind ? "a SCENE, IMAGE.exr or IMAGE.png is required" : "one file at a time");
     const char *path = argv[optind];
+    sy_file_format fmt = SY_FORMAT_UNKNOWN;
+    sy_error err = {0}, ignore = {0};
+    if (sy_sniff_file(path, &fmt, &ignore) != SY_OK) fmt = SY_FORMAT_UNKNOWN; /* the loader names a missing file */
+    if (fmt == SY_FORMAT_PNG) return info_png(path); /* by content, as scenes are recognised */
     if (ends_with(path, ".exr")) return info_exr(path);
-    sy_error err = {0};
     loaded ld;
     if (load(path, NULL, false, &ld, &err) != SY_OK) return fail(&err);
     sy_bounds b;
@@ -1098,6 +1133,16 @@ static int cmd_render(int argc, char **argv)
                  params && *params ? "," : "", max_memory_mb);
         params = memory_params;
     }
+    /* the output's folder must take a file before anything is loaded or rendered (an unwritable
+     * one was found only after the render): a temporary file is created there and removed */
+    sy_atomic_file probe = {0};
+    if (sy_atomic_file_begin(outp, &probe, &err) != SY_OK) return fail(&err);
+    sy_atomic_file_abort(&probe);
+    sy_params given = {0};
+    if (sy_params_parse(params, &given, &err) != SY_OK) { /* a key twice ("spp=1,spp=2"): a usage error */
+        sy_log(SY_LOG_ERROR, "sy", NULL, "%s", err.message);
+        return 2;
+    }
     if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) { /* before any loading or rendering */
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);
         return fail(&err);
@@ -1183,7 +1228,7 @@ static int cmd_render(int argc, char **argv)
     spec.background = ld.background;
     sy_result r = overlay ? add_overlay(&ld, overlay, composite, &spec, &err) : SY_OK;
     if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
-    progress_state ps = {shown, sy_time_now(), 0, sy_is_terminal(2)};
+    progress_state ps = {shown, sy_time_now(), 0, sy_is_terminal(2), false};
     sy_window_render_opts ro = {.progress = progress_cb, .progress_user = &ps};
     double t0 = sy_time_now();
     uint64_t samples = 0;
@@ -1911,6 +1956,7 @@ int main(int argc, char **argv)
     /* before any thread: interrupts are taken on a thread of their own, output files in progress
      * are removed when one ends the process */
     sy_signals_start();
+    sy_testpoint_start(); /* SY_TEST_PHASES / SY_TEST_PAUSE: tests wait for phases (sy_testpoint.h) */
     if (sy_mediators_register_builtin(&err) != SY_OK) return fail(&err);
     /* sy's own options before the command (stops at the first operand, the command): --version,
      * --help / -h, -q / -v and the options of every command (world and loader flags) */

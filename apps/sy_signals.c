@@ -2,6 +2,7 @@
 #include "sy_signals.h"
 
 #include "sy_file.h"
+#include "sy_testpoint.h"
 
 #include <pthread.h>
 #include <signal.h>
@@ -38,6 +39,7 @@ static void *waiter(void *arg)
         if (atomic_fetch_add(&g_count, 1) == 0 && what) {
             g_stop = 1;
             fprintf(stderr, "\nsy: %s: %s (interrupt again to abort)\n", strsignal(sig), what);
+            sy_testpoint("interrupted"); /* tests wait for it before a second interrupt */
             continue;
         }
         size_t removed = sy_atomic_file_cancel_all();

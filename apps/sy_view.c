@@ -7,6 +7,7 @@
 #include "sy_orbit.h"
 #include "sy_mediator_cluster.h"
 #include "sy_png.h"
+#include "sy_testpoint.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GL/gl.h>
@@ -716,7 +717,10 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
             glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
             glDrawPixels((GLsizei)iw, (GLsizei)ih, GL_RGBA, GL_UNSIGNED_BYTE, img);
         }
-        if (img && settled && !key_last && !(keys && *keys)) displayed++; /* settled frames shown (after scripted keys) */
+        if (img && settled && !key_last && !(keys && *keys)) { /* settled frames shown (after scripted keys) */
+            displayed++;
+            sy_testpoint("frame"); /* tests wait for a shown frame (sy_testpoint.h) */
+        }
         if (args->frames && displayed >= args->frames) {
             if (args->screenshot) r = write_screenshot(args->screenshot, fbw, fbh, err);
             if (!glfwWindowShouldClose(win)) printf("%s\n", title); /* automated runs: the last heads-up line */

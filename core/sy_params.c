@@ -45,6 +45,8 @@ sy_result sy_params_parse(const char *text, sy_params *out, sy_error *err)
             if (!eq || eq == item)
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameters: '%s' is not key=value", item);
             *eq = '\0';
+            if (sy_params_get(out, item)) /* "spp=1,spp=2": which one was meant is not ours to guess */
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "parameters: '%s' is given twice in '%s'", item, text);
             sy_result r = sy_params_set(out, item, eq + 1, err);
             if (r != SY_OK) return r;
         }

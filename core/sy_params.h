@@ -35,7 +35,8 @@ typedef struct sy_params {
     } items[SY_PARAMS_MAX]; /**< the pairs */
 } sy_params;
 
-/** Parses "k=v,k=v" (NULL or "" = empty). Errors name the offending item. */
+/** Parses "k=v,k=v" (NULL or "" = empty). Errors name the offending item; a key given twice
+ * ("spp=1,spp=2") is an error naming the key (SY_ERR_INVALID_ARGUMENT). */
 sy_result sy_params_parse(const char *text, sy_params *out, sy_error *err);
 /** Sets key to value (replacing an existing value); fails on a bad key, a value too long or a full list. */
 sy_result sy_params_set(sy_params *p, const char *key, const char *value, sy_error *err);

@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
@@ -335,6 +336,13 @@ void sy_atomic_file_abort(sy_atomic_file *af)
     memset(af, 0, sizeof *af);
 }
 
+static _Atomic(sy_atomic_file_hook) g_commit_hook; /* test support: sy_atomic_file_set_commit_hook */
+
+void sy_atomic_file_set_commit_hook(sy_atomic_file_hook hook)
+{
+    atomic_store(&g_commit_hook, hook);
+}
+
 sy_result sy_atomic_file_commit(sy_atomic_file *af, sy_error *err)
 {
     if (!af || !af->fp || !af->tmp_path || !af->path) {
@@ -343,6 +351,8 @@ sy_result sy_atomic_file_commit(sy_atomic_file *af, sy_error *err)
     }
     sy_result rc = SY_OK;
     const char *path = af->path;
+    sy_atomic_file_hook hook = atomic_load(&g_commit_hook);
+    if (hook) hook(path, af->tmp_path);
 
     if (fflush(af->fp) != 0 || ferror(af->fp)) {
         rc = sy_error_set(err, SY_ERR_IO, "%s: writing the temporary file %s failed: %s", path, af->tmp_path,

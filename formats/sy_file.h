@@ -79,6 +79,16 @@ sy_result sy_path_confine(const char *model, const char *uri, const char *path, 
  * cancelled state lasts for the life of the process. */
 size_t sy_atomic_file_cancel_all(void);
 
+/** A function sy_atomic_file_commit calls first, with the target and the temporary path, before it
+ * flushes and renames: the temporary file exists and the target is untouched while it runs. */
+typedef void (*sy_atomic_file_hook)(const char *path, const char *tmp_path);
+
+/** Test support: sets the commit hook (NULL: none, the default). The sy tool sets one only when a
+ * test asks it to stop at that point (SY_TEST_PAUSE=commit, apps/sy_testpoint.h), so that a test can
+ * interrupt a write in progress without racing it. Process-wide; thread-safe (an atomic pointer),
+ * but meant to be set once before any output begins. */
+void sy_atomic_file_set_commit_hook(sy_atomic_file_hook hook);
+
 #ifdef __cplusplus
 }
 #endif

@@ -221,3 +221,105 @@ sy_result sy_png_read_rgba8(const char *path, int *width_out, int *height_out, u
     *pixels_out = pixels;
     return SY_OK;
 }
+
+/* ---- >>metadata reader ---- */
+
+typedef struct png_info_job {
+    FILE *fp;
+    sy_png_info *out;
+    char msg[256];
+} png_info_job;
+
+static void on_png_read_error(png_structp png, png_const_charp msg)
+{
+    png_info_job *job = png_get_error_ptr(png);
+    if (job && job->msg[0] == '\0') snprintf(job->msg, sizeof job->msg, "%s", msg ? msg : "libpng error");
+    png_longjmp(png, 1);
+}
+
+/* Everything that may longjmp; called from read_info_stream. False with job->msg on failure. */
+static bool read_info_body(png_structp png, png_infop info, png_info_job *job)
+{
+    png_init_io(png, job->fp);
+    png_set_chunk_malloc_max(png, 1u << 20); /* one chunk, zTXt decompressed included */
+    png_set_chunk_cache_max(png, 64);        /* ancillary chunks kept */
+    png_read_info(png, info);
+    job->out->width = (int)png_get_image_width(png, info);
+    job->out->height = (int)png_get_image_height(png, info);
+    png_textp t = NULL;
+    int n = 0;
+    png_get_text(png, info, &t, &n);
+    for (int i = 0; i < n && job->out->text_count < SY_PNG_MAX_TEXT; ++i) {
+        char *k = strdup(t[i].key ? t[i].key : "");
+        char *v = malloc(t[i].text_length + 1);
+        if (!k || !v) {
+            free(k);
+            free(v);
+            snprintf(job->msg, sizeof job->msg, "out of memory for text chunk '%s'", t[i].key ? t[i].key : "");
+            return false;
+        }
+        if (t[i].text_length) memcpy(v, t[i].text, t[i].text_length);
+        v[t[i].text_length] = '\0';
+        job->out->keys[job->out->text_count] = k;
+        job->out->values[job->out->text_count++] = v;
+    }
+    return true;
+}
+
+static bool read_info_stream(png_info_job *job)
+{
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, job, on_png_read_error, on_png_warning);
+    if (!png) {
+        snprintf(job->msg, sizeof job->msg, "cannot create the libpng reader");
+        return false;
+    }
+    png_infop info = png_create_info_struct(png);
+    if (!info) {
+        png_destroy_read_struct(&png, NULL, NULL);
+        snprintf(job->msg, sizeof job->msg, "cannot create the libpng info struct");
+        return false;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_read_struct(&png, &info, NULL);
+        return false;
+    }
+    bool ok = read_info_body(png, info, job);
+    png_destroy_read_struct(&png, &info, NULL);
+    return ok;
+}
+
+sy_result sy_png_read_info(const char *path, sy_png_info *out, sy_error *err)
+{
+    if (!out) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_png_read_info: out is required");
+    memset(out, 0, sizeof *out);
+    if (!path) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_png_read_info: path is required");
+    FILE *fp = fopen(path, "rb");
+    if (!fp) {
+        int e = errno;
+        return sy_error_set(err, e == ENOENT ? SY_ERR_NOT_FOUND : SY_ERR_IO, "%s: cannot open: %s", path, strerror(e));
+    }
+    uint8_t sig[8];
+    if (fread(sig, 1, sizeof sig, fp) != sizeof sig || png_sig_cmp(sig, 0, sizeof sig) != 0) {
+        fclose(fp);
+        return sy_error_set(err, SY_ERR_PARSE, "%s: not a PNG (no PNG signature)", path);
+    }
+    rewind(fp);
+    png_info_job job = {.fp = fp, .out = out};
+    bool ok = read_info_stream(&job);
+    fclose(fp);
+    if (!ok) {
+        sy_png_info_free(out);
+        return sy_error_set(err, SY_ERR_PARSE, "%s: not a readable PNG: %s", path, job.msg);
+    }
+    return SY_OK;
+}
+
+void sy_png_info_free(sy_png_info *info)
+{
+    if (!info) return;
+    for (int i = 0; i < info->text_count; ++i) {
+        free(info->keys[i]);
+        free(info->values[i]);
+    }
+    memset(info, 0, sizeof *info);
+}

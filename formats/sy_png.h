@@ -58,6 +58,25 @@ sy_result sy_png_write(const char *path, int width, int height, const float *rgb
 sy_result sy_png_read_rgba8(const char *path, int *width_out, int *height_out, uint8_t **pixels_out,
                             sy_error *err);
 
+/** A PNG's header and the text chunks that come before its image data (where sy_png_write puts
+ * its metadata: sy:renderer, sy:backend, ...). */
+typedef struct sy_png_info {
+    int width;                      /**< pixels, from the header */
+    int height;                     /**< pixels, from the header */
+    int text_count;                 /**< keys / values used (at most SY_PNG_MAX_TEXT; later ones are dropped) */
+    char *keys[SY_PNG_MAX_TEXT];    /**< the chunks' keys (owned copies, sy_png_info_free) */
+    char *values[SY_PNG_MAX_TEXT];  /**< the chunks' values (owned copies, sy_png_info_free) */
+} sy_png_info;
+
+/** Reads the header and the text chunks (tEXt, zTXt, iTXt) before the image data of the PNG at
+ * path, without decoding pixels. Untrusted input: a chunk over 1 MiB (zTXt decompressed
+ * included), more than 64 ancillary chunks or a malformed file is an error naming the file.
+ * Ownership: on success the caller frees *out with sy_png_info_free; on failure *out is zeroed. */
+sy_result sy_png_read_info(const char *path, sy_png_info *out, sy_error *err);
+
+/** Frees what sy_png_read_info allocated; safe on a zeroed or freed info. */
+void sy_png_info_free(sy_png_info *info);
+
 #ifdef __cplusplus
 }
 #endif

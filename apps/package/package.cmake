@@ -143,6 +143,15 @@ function(sy_write_package)
       list(GET parts 1 module)
       list(APPEND requires_private ${module})
     endforeach()
+    # Static archives carry none of their dependencies: a program needs them whether or not it
+    # asks pkg-config for --static, so a static installation lists them as public (Requires, Libs);
+    # a shared one keeps them private (the .so files record their own).
+    if(NOT BUILD_SHARED_LIBS)
+      list(APPEND requires ${requires_private})
+      set(requires_private)
+      list(APPEND libs ${priv})
+      set(priv)
+    endif()
     string(REPLACE ";" " " requires "${requires}")
     string(REPLACE ";" ", " requires_private "${requires_private}")
     string(REPLACE ";" " " libs "${libs}")

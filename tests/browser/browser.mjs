@@ -24,7 +24,9 @@ if (!['stream', 'client'].includes(mode) || !url || !outDir) {
   process.exit(2);
 }
 const executablePath = process.env.SY_CHROMIUM || '/usr/bin/chromium';
-const TIMEOUT = Number(process.env.SY_BROWSER_TIMEOUT_MS || 60000);
+// Every wait is for a state of the page; the bound is only a hang guard (60 s was too short for
+// SwiftShader on two loaded cores: 'the client did not settle' with the page still loading).
+const TIMEOUT = Number(process.env.SY_BROWSER_TIMEOUT_MS || 300000);
 
 function fail(msg) {
   console.error(`browser.mjs ${mode}: ${msg}`);

@@ -12,11 +12,17 @@
 #     scene's triangles: again exactly the answer's objects, fewer than all, drawn within it.
 #
 # MODULES_DIR holds browser.mjs and node_modules/playwright-core. Skipped (77, with the reason)
-# without chromium, node, playwright-core (npm ci failed: no network at build time) or the scene.
+# without chromium, node, playwright-core (npm ci failed: no network at build time) or the scene;
+# with SY_REQUIRE_BROWSER=1 in the environment (CI: .ci/run sets it) each of those is a failure
+# instead, so that the browser coverage is never lost silently.
 set -u
 mode=$1 SY=$2 PNG_IOU=$3 MODULES=$4 SCENE=$5
 W=480 H=360
-skip() { echo "SKIP: $*"; exit 77; }
+skip() {
+    if [ "${SY_REQUIRE_BROWSER:-0}" = 1 ]; then echo "FAIL: SY_REQUIRE_BROWSER=1 but the test cannot run: $*"; exit 1; fi
+    echo "SKIP: $*"
+    exit 77
+}
 [ -f "$SCENE" ] || skip "$SCENE is absent (the test data in ../shared/testdata)"
 CHROMIUM=${SY_CHROMIUM:-/usr/bin/chromium}
 [ -x "$CHROMIUM" ] || skip "chromium is not installed ($CHROMIUM; apt-get install chromium)"
@@ -37,13 +43,9 @@ args=(web "$SCENE" -b raster --listen 127.0.0.1:0)
 [ "$mode" = client ] && args+=(--client-render)
 "$SY" "${args[@]}" >"$out/log" 2>"$out/err" &
 pid=$!
-url=
-for _ in $(seq 1 300); do
-    url=$(grep -o 'http://[^ ]*' "$out/log" 2>/dev/null | head -1)
-    [ -n "$url" ] && break
-    kill -0 $pid 2>/dev/null || break
-    sleep 0.1
-done
+. "$(dirname "$0")/../support/wait.sh" # wait_until: states, never sleeps (hang guard only)
+wait_until $pid grep -q 'http://' "$out/log"
+url=$(grep -o 'http://[^ ]*' "$out/log" 2>/dev/null | head -1)
 [ -n "$url" ] || { echo "FAIL: sy web printed no URL: $(cat "$out/log" "$out/err")"; exit 1; }
 echo "sy web: $url"
 

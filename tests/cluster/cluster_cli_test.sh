@@ -14,14 +14,14 @@ cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/n
 trap cleanup EXIT
 fail() { echo "FAIL: $*" >&2; for f in "$W"/*.log; do echo "--- $f"; cat "$f"; done >&2; exit 1; }
 
+. "$(dirname "$0")/../support/wait.sh" # wait_until: states, never sleeps (hang guard only)
 printf 'cli-test-secret\n' > "$W/secret"; chmod 600 "$W/secret"
 start() { # name [extra args]
   local n=$1; shift
-  "$SY" serve --listen tcp://127.0.0.1:0 --port-file "$W/$n.port" --secret-file "$W/secret" --max-lifetime 200 "$@" \
+  "$SY" serve --listen tcp://127.0.0.1:0 --port-file "$W/$n.port" --secret-file "$W/secret" --max-lifetime 900 "$@" \
     2> "$W/$n.log" &
   pids+=($!)
-  for _ in $(seq 1 400); do [ -s "$W/$n.port" ] && return 0; sleep 0.05; done
-  fail "server $n did not start"
+  wait_until $! test -s "$W/$n.port" || fail "server $n did not start"
 }
 start a --output "$W/wall_a.exr"
 start b --output "$W/wall_b.exr"
@@ -57,8 +57,7 @@ if SY_CLUSTER_SECRET=nope "$SY" render demo -b whitted -w 16 -h 16 -o "$W/x.exr"
   fail "a wrong secret was accepted"
 fi
 grep -q "wrong secret" "$W/bad.err" || fail "client error does not name the reason"
-for _ in $(seq 1 40); do grep -q "authentication failed: wrong secret" "$W/a.log" && break; sleep 0.05; done
-grep -q "authentication failed: wrong secret" "$W/a.log" || fail "server did not log the rejection"
+wait_until "${pids[0]}" grep -q "authentication failed: wrong secret" "$W/a.log" || fail "server did not log the rejection"
 [ ! -e "$W/x.exr" ] || fail "an output file was written after a refused connection"
 sleep 0.3 # the servers refuse this address for 250 ms after a failed authentication (--auth-backoff-ms)
 
@@ -101,10 +100,9 @@ if command -v openssl > /dev/null; then
       -addext "subjectAltName=DNS:localhost" 2> /dev/null || fail "openssl could not make a certificate"
   done
   "$SY" serve --listen tls+tcp://127.0.0.1:0 --port-file "$W/tls.port" --tls-cert "$W/srv.crt" --tls-key "$W/srv.key" \
-    --secret-file "$W/secret" --max-lifetime 200 2> "$W/tls.log" &
+    --secret-file "$W/secret" --max-lifetime 900 2> "$W/tls.log" &
   pids+=($!)
-  for _ in $(seq 1 400); do [ -s "$W/tls.port" ] && break; sleep 0.05; done
-  [ -s "$W/tls.port" ] || fail "TLS server did not start"
+  wait_until $! test -s "$W/tls.port" || fail "TLS server did not start"
   TLS="tls+tcp://localhost:$(cat "$W/tls.port")"
   "$SY" render demo -b whitted -w 120 -h 80 -o "$W/tls.exr" --cluster "$TLS" --tls-ca "$W/srv.crt" \
     --secret-file "$W/secret" > /dev/null 2> "$W/tlsclient.log" || fail "TLS render"

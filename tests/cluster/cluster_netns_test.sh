@@ -19,10 +19,11 @@ ip addr add 10.213.0.1/24 dev "v$NS" && ip link set "v$NS" up &&
   ip netns exec "$NS" ip addr add 10.213.0.2/24 dev "p$NS" && ip netns exec "$NS" ip link set "p$NS" up &&
   ip netns exec "$NS" ip link set lo up || { echo "SKIP: cannot configure the veth pair"; exit 77; }
 printf 'netns-secret' > "$W/secret"; chmod 600 "$W/secret"
-ip netns exec "$NS" "$SY" serve --listen tcp://10.213.0.2:5791 --secret-file "$W/secret" --max-lifetime 100 \
-  2> "$W/server.log" &
+ip netns exec "$NS" "$SY" serve --listen tcp://10.213.0.2:5791 --port-file "$W/port" --secret-file "$W/secret" \
+  --max-lifetime 900 2> "$W/server.log" &
 SPID=$!
-sleep 1
+. "$(dirname "$0")/../support/wait.sh" # the server listens once it has written its port (no sleep)
+wait_until $SPID test -s "$W/port" || { echo "FAIL: the server in the namespace did not start"; cat "$W/server.log"; exit 1; }
 "$SY" render demo -b whitted -w 64 -h 48 -o "$W/local.exr" > /dev/null || { echo "FAIL: local render"; exit 1; }
 "$SY" render demo -b whitted -w 64 -h 48 -o "$W/remote.exr" --cluster tcp://10.213.0.2:5791 --secret-file "$W/secret" \
   --timeout-ms 20000 > /dev/null 2> "$W/client.log" || { echo "FAIL: remote render"; cat "$W"/*.log; exit 1; }

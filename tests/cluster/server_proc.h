@@ -61,9 +61,9 @@ static inline int start_server_args(const char *secret, int port, const char *co
         char present[512];
         snprintf(present, sizeof present, "%s/present%d.raw", g_dir, g_serial);
         /* the lifetime only ends servers a killed test left behind: longer than any cluster test's
-         * ctest TIMEOUT (240-300 s), never a deadline a slow run can reach (at 120 s, cluster_net's
+         * ctest TIMEOUT (600 s), never a deadline a slow run can reach (at 120 s, cluster_net's
          * servers under ASan on a loaded machine stopped before its last group) */
-        const char *args[32] = {g_exe, "--port-file", pf, "--listen", listen, "--max-lifetime", "600", "--present", present};
+        const char *args[32] = {g_exe, "--port-file", pf, "--listen", listen, "--max-lifetime", "900", "--present", present};
         int n = 9;
         if (secret) args[n++] = "--secret", args[n++] = secret;
         for (int k = 0; extra && extra[k] && k < 16; ++k) args[n++] = extra[k];
@@ -74,7 +74,7 @@ static inline int start_server_args(const char *secret, int port, const char *co
     out->serial = g_serial;
     if (g_nstarted == 0) atexit(kill_leftover_servers);
     if (g_nstarted < (int)(sizeof g_started / sizeof g_started[0])) g_started[g_nstarted++] = pid;
-    for (int i = 0; i < 400; ++i) { /* at most 20 s (ASan builds start slowly) */
+    for (int i = 0; i < 6000; ++i) { /* until the port is written or the server exits; 300 s: a hang guard */
         FILE *f = fopen(pf, "r");
         int p = 0;
         if (f) {
@@ -132,7 +132,8 @@ static inline void forget_server(pid_t pid)
 
 static inline bool log_contains(const server *s, const char *needle)
 {
-    for (int i = 0; i < 40; ++i) { /* the server may still be writing */
+    for (int i = 0; i < 6000; ++i) { /* the server may still be writing (300 s: a hang guard; 2 s was too
+                                        * short on a loaded machine) */
         FILE *f = fopen(s->log, "r");
         if (f) {
             static char buf[1 << 18];

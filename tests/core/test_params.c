@@ -76,6 +76,10 @@ static int test_validation(void)
     /* declared keys are still checked then */
     CHECK_OK(sy_params_parse("spp=0,foo=1", &p, &e), e);
     CHECK(sy_params_check(&table, &p, 0, NULL, &rest, &e) == SY_ERR_INVALID_ARGUMENT);
+    /* a key given twice is refused, named (issue 32: "spp=1,spp=2" was taken as spp=2) */
+    CHECK(sy_params_parse("spp=1,filter=pixel,spp=2", &p, &e) == SY_ERR_INVALID_ARGUMENT);
+    CHECK_SAYS(e, "parameters: 'spp' is given twice in 'spp=1,filter=pixel,spp=2'");
+    CHECK(sy_params_parse("spp=1,spp=1", &p, &e) == SY_ERR_INVALID_ARGUMENT);
     /* an empty table accepts nothing */
     sy_param_table none = {NULL, 0};
     CHECK_OK(sy_params_parse("spp=4", &p, &e), e);

@@ -207,6 +207,45 @@ static void test_file_properties(const char *dir)
     free(px);
 }
 
+/* sy_png_read_info: the text chunks sy_png_write wrote come back with the size, pixels not decoded;
+ * a cut or garbage file is an error naming it (sy info IMAGE.png, issue 32) */
+static void test_metadata(const char *dir)
+{
+    const int w = 5, h = 3;
+    float img[5 * 3 * 4] = {0};
+    const sy_png_text texts[] = {{"sy:backend", "whitted"}, {"sy:samples", "7"}, {"sy:source", ""}};
+    sy_png_options o = {.text = texts, .text_count = 3};
+    char p[4096], q[4096];
+    PATHF(p, "%s/meta.png", dir);
+    sy_error err = {0};
+    CHECK(sy_png_write(p, w, h, img, &o, &err) == SY_OK, "%s", err.message);
+    sy_png_info pi;
+    CHECK(sy_png_read_info(p, &pi, &err) == SY_OK, "%s", err.message);
+    CHECK(pi.width == w && pi.height == h && pi.text_count == 3, "%dx%d, %d texts", pi.width, pi.height, pi.text_count);
+    for (int i = 0; i < pi.text_count && i < 3; ++i)
+        CHECK(!strcmp(pi.keys[i], texts[i].key) && !strcmp(pi.values[i], texts[i].value), "text %d: %s=%s", i,
+              pi.keys[i], pi.values[i]);
+    sy_png_info_free(&pi);
+    sy_png_info_free(&pi); /* twice: safe */
+    size_t n = 0;
+    unsigned char *bytes = slurp(p, &n);
+    PATHF(q, "%s/meta_cut.png", dir);
+    for (size_t len = 0; bytes && len < 40; ++len) { /* inside the signature, IHDR or a text chunk */
+        write_bytes(q, bytes, len);
+        if (sy_png_read_info(q, &pi, &err) == SY_OK) {
+            CHECK(0, "PNG cut at %zu accepted", len);
+            sy_png_info_free(&pi);
+            break;
+        }
+        CHECK(strstr(err.message, q) != NULL && pi.text_count == 0, "cut at %zu: %s", len, err.message);
+    }
+    free(bytes);
+    CHECK(sy_png_read_info(p + 0, &pi, &err) == SY_OK, "%s", err.message);
+    sy_png_info_free(&pi);
+    PATHF(q, "%s/missing.png", dir);
+    CHECK(sy_png_read_info(q, &pi, &err) == SY_ERR_NOT_FOUND, "missing file: %s", err.message);
+}
+
 int main(void)
 {
     char dir[4096];
@@ -214,6 +253,7 @@ int main(void)
     test_helpers();
     test_values(dir);
     test_file_properties(dir);
+    test_metadata(dir);
     remove_scratch_dir(dir);
     return finish_tests("test_png");
 }

@@ -2,11 +2,14 @@
 # cli_test.sh SY TESTDATA TMPDIR — tests of the `sy` command line tool (integration_cli).
 #   - sy info Box.gltf: JSON counts meshes/primitives/triangles/materials = 1/1/12/1, bounds +-0.5
 #   - conventions: --version, --help / help / CMD --help / help bench on stdout; a bad option, a
-#     missing or bad value named with status 2; a failure status 1; backends --json; -q / -v
+#     missing or bad value named with status 2; a failure status 1; backends --json; -q / -v;
+#     an abbreviated long option (--frame for --frames) is a usage error naming the options it
+#     begins, in every command
 #   - sy render (cornell, whitted) to PNG and EXR: exit 0, files with the right signature and size
 #   - bad inputs (missing file, truncated GLB, garbage .gltf, unknown back-end, output in a missing
-#     directory, unknown output extension): non-zero exit, the offending name in stderr, and no
-#     output file nor temporary file left behind
+#     or unwritable directory, unknown output extension): non-zero exit, the offending name in
+#     stderr, and no output file nor temporary file left behind; a missing or unwritable output
+#     directory is found before anything is rendered; --params with a key twice is a usage error
 #   - typed parameters: sy backends --params (text and --json) lists each back-end's table; an unknown
 #     --params key, a value out of range or not in the enum: status 2 naming it (and the valid keys)
 #   - sy bench sync / sy bench rays / sy bench governor / sy bench limit on small sizes: exit 0 and
@@ -113,6 +116,9 @@ run params_range "$SY" render demo -b whitted --params max_depth=99 -o "$TMP/o_p
 run params_enum "$SY" render demo -b pathtracer --params filter_kernel=fast -o "$TMP/o_params/x.exr"
 [ "$rc" -eq 2 ] && grep -q "filter_kernel=fast for back-end 'pathtracer': expected one of separable, brute" "$TMP/params_enum.err" ||
     fail "--params filter_kernel=fast: status $rc (want 2), $(cat "$TMP/params_enum.err")"
+run params_twice "$SY" render demo -b whitted -w 16 -h 16 --params spp=1,spp=2 -o "$TMP/o_params/x.png"
+[ "$rc" -eq 2 ] && grep -q "'spp' is given twice" "$TMP/params_twice.err" ||
+    fail "--params spp=1,spp=2: status $rc (want 2), $(cat "$TMP/params_twice.err")"
 [ -z "$(ls -A "$TMP/o_params")" ] || fail "refused --params left files behind: $(ls -A "$TMP/o_params")"
 
 # conventions: --version and --help on stdout with status 0; a usage error names the option or value
@@ -137,6 +143,35 @@ run badmissing "$SY" render demo -b whitted -o "$TMP/x.png" -w
 [ "$rc" -eq 2 ] && grep -q -- "option '-w' needs a value" "$TMP/badmissing.err" || fail "a missing value: status $rc, $(cat "$TMP/badmissing.err")"
 run badword "$SY" render demo -b whitted -o "$TMP/x.png" --tonemap=bogus
 [ "$rc" -eq 2 ] && grep -q -- "--tonemap: 'bogus'" "$TMP/badword.err" || fail "a bad --tonemap: status $rc, $(cat "$TMP/badword.err")"
+# long options are matched exactly (issue 32): an abbreviation is a usage error naming the options it
+# begins, in every command (sy_getopt, apps/sy_options.c); getopt_long took "--frame 10" for --frames
+mkdir -p "$TMP/o_abbrev"
+run abbrev "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_abbrev/x.png" --frame 10
+[ "$rc" -eq 2 ] && grep -q -- "unknown option '--frame': long options are not abbreviated; the option that begins so is: --frames" \
+    "$TMP/abbrev.err" || fail "sy render --frame 10: status $rc (want 2), $(cat "$TMP/abbrev.err")"
+run abbrev_eq "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_abbrev/x.png" --param=spp=1
+[ "$rc" -eq 2 ] && grep -q -- "'--param'.*: --params" "$TMP/abbrev_eq.err" ||
+    fail "sy render --param=spp=1: status $rc (want 2), $(cat "$TMP/abbrev_eq.err")"
+run abbrev_many "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_abbrev/x.png" --env-i 2
+[ "$rc" -eq 2 ] && grep -q -- "'--env-i'.*: --env-intensity" "$TMP/abbrev_many.err" ||
+    fail "sy render --env-i 2: status $rc (want 2), $(cat "$TMP/abbrev_many.err")"
+run abbrev_amb "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_abbrev/x.png" --env 2
+[ "$rc" -ne 2 ] || ! grep -q "not abbreviated" "$TMP/abbrev_amb.err" ||
+    fail "sy render --env (an option that begins others) was taken for an abbreviation: $(cat "$TMP/abbrev_amb.err")"
+run abbrev_ambiguous "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_abbrev/x.png" --e 2
+[ "$rc" -eq 2 ] && grep -q -- "'--e'.*the options that begin so are: .*--env, .*--env-color" "$TMP/abbrev_ambiguous.err" ||
+    fail "sy render --e 2 (ambiguous): status $rc (want 2), $(cat "$TMP/abbrev_ambiguous.err")"
+for cmd in "info demo --js" "backends --par" "bench limit --rep 1" "bench governor --fram 2" "compare demo --spp 1 --backend whitted"; do
+    run abbrev_cmd "$SY" $cmd
+    [ "$rc" -eq 2 ] && grep -q "not abbreviated" "$TMP/abbrev_cmd.err" ||
+        fail "sy $cmd: status $rc (want 2), $(head -c 400 "$TMP/abbrev_cmd.err")"
+done
+if has cluster; then
+    run abbrev_serve "$SY" serve --list tcp://127.0.0.1:0
+    [ "$rc" -eq 2 ] && grep -q -- "'--list'.*: --listen" "$TMP/abbrev_serve.err" ||
+        fail "sy serve --list: status $rc (want 2), $(cat "$TMP/abbrev_serve.err")"
+fi
+[ -z "$(ls -A "$TMP/o_abbrev")" ] || fail "an abbreviated option left files behind: $(ls -A "$TMP/o_abbrev")"
 run help_bench "$SY" help bench
 [ "$rc" -eq 0 ] && grep -q '^  sy bench sync' "$TMP/help_bench.out" && ! grep -q '^  sy render' "$TMP/help_bench.out" ||
     fail "sy help bench: status $rc, not the bench entries alone"
@@ -173,6 +208,20 @@ run meta_png "$SY" render demo -b pathtracer --spp 3 -w 40 -h 30 -o "$TMP/meta/m
 for kv in 'sy:renderer' 'sy:backend.pathtracer' 'sy:samples.3' 'sy:source.demo'; do
     tr '\0' '.' < "$TMP/meta/m.png" | grep -qa -- "$kv" || fail "the PNG's text chunks lack $kv"
 done
+# sy info reads them back from the PNG (it refused the PNG sy render wrote, though README promised it)
+run meta_info_png "$SY" info "$TMP/meta/m.png"
+for kv in '"sy:renderer": "Switchyard ' '"sy:backend": "pathtracer"' '"sy:samples": "3"' '"sy:source": "demo"' \
+          '"sy:size": "40x30"' '"width": 40,' '"height": 30,'; do
+    [ "$rc" -eq 0 ] && grep -qF -- "$kv" "$TMP/meta_info_png.out" ||
+        fail "sy info m.png: status $rc, lacks $kv: $(cat "$TMP/meta_info_png.out" "$TMP/meta_info_png.err")"
+done
+cp "$TMP/meta/m.png" "$TMP/meta/png_named.exr" # by content, whatever the name
+run meta_info_png2 "$SY" info "$TMP/meta/png_named.exr"
+grep -qF '"sy:backend": "pathtracer"' "$TMP/meta_info_png2.out" || fail "sy info of a PNG named .exr: $(cat "$TMP/meta_info_png2.err")"
+head -c 60 "$TMP/meta/m.png" > "$TMP/meta/cut.png" # a truncated PNG: an error naming it, never a crash
+run meta_info_cut "$SY" info "$TMP/meta/cut.png"
+[ "$rc" -eq 1 ] && grep -q "cut.png: not a readable PNG" "$TMP/meta_info_cut.err" ||
+    fail "sy info of a truncated PNG: status $rc, $(cat "$TMP/meta_info_cut.err")"
 
 # garbage bytes named bad.gltf
 mkdir -p "$TMP/in" "$TMP/o_garbage"
@@ -192,8 +241,28 @@ expect_error backend no-such-backend "$TMP/o_backend" "$SY" render demo -b no-su
     -o "$TMP/o_backend/x.png"
 grep -q whitted "$TMP/backend.err" || fail "unknown back-end: the message does not list the available ones"
 mkdir -p "$TMP/o_nodir"
-expect_error nodir "$TMP/o_nodir/missing_dir/x.png" "$TMP/o_nodir" "$SY" render demo -b whitted -w 16 -h 16 \
-    -o "$TMP/o_nodir/missing_dir/x.png"
+expect_error nodir "$TMP/o_nodir/missing_dir/x.png" "$TMP/o_nodir" env SY_TEST_PHASES="$TMP/o_nodir.phases" "$SY" render \
+    demo -b whitted -w 64 -h 64 -o "$TMP/o_nodir/missing_dir/x.png"
+grep -q "missing_dir/x.png" "$TMP/nodir.err" && ! grep -qx tiles "$TMP/o_nodir.phases" 2>/dev/null ||
+    fail "output in a missing directory: found only after rendering (phases: $(cat "$TMP/o_nodir.phases" 2>/dev/null))"
+# an output folder sy may not write to is refused before anything is rendered (it was found only
+# after the render); the phases sy announces (SY_TEST_PHASES, apps/sy_testpoint.h) show no tile
+# rendered. As root every folder is writable, so sy runs as nobody there (setpriv).
+mkdir -p "$TMP/o_ro" "$TMP/ro_phases"
+chmod 555 "$TMP/o_ro"
+chmod 777 "$TMP/ro_phases" # the phases file, written by sy as whichever user runs it
+as_user=()
+[ "$(id -u)" -eq 0 ] && command -v setpriv >/dev/null && as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
+if [ "$(id -u)" -ne 0 ] || [ ${#as_user[@]} -gt 0 ]; then
+    rm -f "$TMP/ro_phases/p"
+    expect_error readonly "$TMP/o_ro/x.png" "$TMP/o_ro" env SY_TEST_PHASES="$TMP/ro_phases/p" "${as_user[@]}" "$SY" render \
+        demo -b whitted -w 64 -h 64 -o "$TMP/o_ro/x.png"
+    grep -q "Permission denied" "$TMP/readonly.err" || fail "an unwritable folder: the reason is not given: $(cat "$TMP/readonly.err")"
+    ! grep -qx tiles "$TMP/ro_phases/p" 2>/dev/null || fail "an unwritable output folder was found only after rendering"
+else
+    echo "note: the unwritable-folder check needs a non-root user or setpriv (skipped)"
+fi
+chmod 755 "$TMP/o_ro"
 mkdir -p "$TMP/o_ext"
 expect_error extension x.jpg "$TMP/o_ext" "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_ext/x.jpg"
 

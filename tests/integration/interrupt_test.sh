@@ -6,6 +6,9 @@
 #  2. two interrupts while the image is being written: no image, no "*.tmp-*", killed by SIGTERM;
 #  3. one interrupt while a single-pass back-end writes: the same;
 #  4. an interrupt during a single-pass render: no file at all.
+# No step sleeps or depends on how fast sy runs (issue 32): sy announces the phase it is in
+# (SY_TEST_PHASES, apps/sy_testpoint.h) and the test polls for it; where the interrupt must land in
+# a phase, sy stops there until the signal comes (SY_TEST_PAUSE).
 set -u
 set -m # job control: background jobs keep SIGINT (a script's background jobs otherwise ignore it)
 SY=$1
@@ -14,15 +17,25 @@ rm -rf "$W"
 mkdir -p "$W"
 fails=0
 fail() { echo "FAIL: $*"; for f in "$W"/*.err; do [ -e "$f" ] && { echo "--- $f"; cat "$f"; }; done; fails=$((fails + 1)); }
-# wait_for GLOB: until a file matching GLOB exists (at most 60 s)
-wait_for() { for _ in $(seq 1 6000); do compgen -G "$1" >/dev/null && return 0; sleep 0.01; done; return 1; }
+# phases NAME: a FIFO for sy's announced phases, open on descriptor 3 (read-write, so sy's open and
+# writes never block); pass SY_TEST_PHASES="$W/NAME.fifo" to sy
+phases() { rm -f "$W/$1.fifo"; mkfifo "$W/$1.fifo" && exec 3<>"$W/$1.fifo"; }
+# wait_phase PHASE: blocks until sy announces PHASE; the 120 s bound is only a hang guard (sy ended
+# or stuck without reaching it), and it fails loudly
+wait_phase() {
+    local line
+    while read -r -t 120 -u 3 line; do [ "$line" = "$1" ] && return 0; done
+    echo "FAIL: sy did not announce the phase '$1' within 120 s"
+    return 1
+}
 leftovers() { compgen -G "$W/*.tmp-*" >/dev/null; }
 
 # 1. graceful: the first SIGINT ends the progressive render after its current pass
-"$SY" render demo -b pathtracer --spp 1000000 -w 64 -h 48 -o "$W/pt.exr" >"$W/pt.out" 2>"$W/pt.err" &
+phases pt
+SY_TEST_PHASES="$W/pt.fifo" "$SY" render demo -b pathtracer --spp 1000000 -w 64 -h 48 -o "$W/pt.exr" \
+    >"$W/pt.out" 2>"$W/pt.err" &
 pid=$!
-sleep 2
-kill -INT $pid
+wait_phase pass && kill -INT $pid # after a finished pass: the interrupt is graceful
 wait $pid
 rc=$?
 if [ $rc -ne 130 ] || [ ! -s "$W/pt.exr" ]; then
@@ -36,13 +49,16 @@ else
 fi
 leftovers && fail "graceful interrupt left a temporary file: $(ls "$W")"
 
-# 2. two interrupts while the (large, multi-channel) image is being written: abort, nothing left
-"$SY" render demo -b pathtracer --spp 1 --aov -w 1200 -h 1200 -o "$W/aov.exr" >"$W/aov.out" 2>"$W/aov.err" &
+# 2. two interrupts while the (multi-channel) image is being written: abort, nothing left
+phases aov
+SY_TEST_PHASES="$W/aov.fifo" SY_TEST_PAUSE=commit \
+    "$SY" render demo -b pathtracer --spp 1 --aov -w 120 -h 120 -o "$W/aov.exr" >"$W/aov.out" 2>"$W/aov.err" &
 pid=$!
-if wait_for "$W/aov.exr.tmp-*"; then
+if wait_phase commit; then # written, held before the rename
+    compgen -G "$W/aov.exr.tmp-*" >/dev/null || fail "second interrupt while writing: no temporary file while writing"
     kill -TERM $pid
-    sleep 0.05
-    kill -TERM $pid 2>/dev/null
+    # the first interrupt is graceful: the second, once sy has taken the first, aborts
+    wait_phase interrupted && kill -TERM $pid
 fi
 wait $pid
 rc=$?
@@ -53,9 +69,11 @@ fi
 leftovers && fail "interrupt while writing left a temporary file: $(ls "$W")"
 
 # 3. a single-pass back-end: the first interrupt while writing aborts
-"$SY" render demo -b whitted -w 1000 -h 1000 -o "$W/w.png" >"$W/w.out" 2>"$W/w.err" &
+phases w
+SY_TEST_PHASES="$W/w.fifo" SY_TEST_PAUSE=commit "$SY" render demo -b whitted -w 100 -h 100 -o "$W/w.png" \
+    >"$W/w.out" 2>"$W/w.err" &
 pid=$!
-wait_for "$W/w.png.tmp-*" && kill -INT $pid
+wait_phase commit && kill -INT $pid
 wait $pid
 rc=$?
 if [ $rc -ne 130 ] || [ -e "$W/w.png" ]; then fail "interrupt while writing a PNG: status $rc (want 130), image: $(ls "$W")"
@@ -64,10 +82,11 @@ fi
 leftovers && fail "interrupt while writing a PNG left a temporary file: $(ls "$W")"
 
 # 4. an interrupt during a single-pass render: nothing written
-"$SY" render demo -b whitted -w 1000 -h 1000 --params light_samples=64 -o "$W/r.exr" >"$W/r.out" 2>"$W/r.err" &
+phases r
+SY_TEST_PHASES="$W/r.fifo" SY_TEST_PAUSE=tiles "$SY" render demo -b whitted -w 100 -h 100 -o "$W/r.exr" \
+    >"$W/r.out" 2>"$W/r.err" &
 pid=$!
-sleep 0.5
-kill -TERM $pid
+wait_phase tiles && kill -TERM $pid # a tile is done, the render held in progress
 wait $pid
 rc=$?
 if [ $rc -ne 143 ] || compgen -G "$W/r.exr*" >/dev/null; then fail "interrupt while rendering: status $rc, files: $(ls "$W")"

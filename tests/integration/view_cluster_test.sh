@@ -20,7 +20,7 @@ pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; }
 trap cleanup EXIT
 fail() { echo "FAIL: $*"; for f in "$W"/*.log "$W"/*.err "$W"/*.out; do [ -e "$f" ] && { echo "--- $f"; cat "$f"; }; done; exit 1; }
-XVFB=(timeout 120 xvfb-run -a -s "-screen 0 1024x768x24")
+XVFB=(timeout 500 xvfb-run -a -s "-screen 0 1024x768x24")
 # sanitizer_exit_noise ERRFILE: true when a viewer's only failure is LeakSanitizer's own tracer
 # failing at exit ("Tracer caught signal 11 ... LeakSanitizer has encountered a fatal error": LSan
 # stops the world to scan for leaks and its tracer crashed; no leak check ran, so nothing was
@@ -39,18 +39,18 @@ view() {
     [ $rc -eq 0 ] || fail "sy view $* exited with status $rc"
 }
 
+. "$(dirname "$0")/../support/wait.sh" # wait_until: states, never sleeps (hang guard only)
 printf 'view-cluster-secret\n' >"$W/secret"
 chmod 600 "$W/secret"
 start() { # name [extra args]: a server on a free port; its pid goes to $W/NAME.pid
     local n=$1
     shift
-    "$SY" serve --listen tcp://127.0.0.1:0 --port-file "$W/$n.port" --secret-file "$W/secret" --max-lifetime 200 "$@" \
+    "$SY" serve --listen tcp://127.0.0.1:0 --port-file "$W/$n.port" --secret-file "$W/secret" --max-lifetime 900 "$@" \
         2>"$W/$n.log" &
     local p=$!
     pids+=("$p")
     echo "$p" >"$W/$n.pid"
-    for _ in $(seq 1 400); do [ -s "$W/$n.port" ] && return 0; sleep 0.05; done
-    fail "server $n did not start"
+    wait_until "$p" test -s "$W/$n.port" || fail "server $n did not start"
 }
 start a
 start b
@@ -67,13 +67,19 @@ grep -q "sy view | whitted" "$W/local.out" || fail "the local viewer did not fin
 "$CMP" "$W/cluster.png" "$W/render.png" 2 50 || fail "the cluster window does not show the rendered image"
 
 # 2. cooperative path tracing; server b is killed once the viewer has rendered with both
-"${XVFB[@]}" "$SY" view demo -b pathtracer -w 64 -h 48 --frames 120 --cluster "$URLS" --cluster-mode cooperative \
+rm -f "$W/coop.fifo"
+mkfifo "$W/coop.fifo" && exec 3<>"$W/coop.fifo" # the viewer's announced phases (apps/sy_testpoint.h)
+SY_TEST_PHASES="$W/coop.fifo" "${XVFB[@]}" "$SY" view demo -b pathtracer -w 64 -h 48 --frames 120 --cluster "$URLS" --cluster-mode cooperative \
     --secret-file "$W/secret" --screenshot "$W/coop.png" >"$W/coop.out" 2>"$W/coop.err" &
 viewer=$!
 pids+=("$viewer")
-for _ in $(seq 1 400); do [ "$(grep -c authenticated "$W/b.log")" -ge 2 ] && break; sleep 0.05; done
-[ "$(grep -c authenticated "$W/b.log")" -ge 2 ] || fail "the cooperative viewer did not connect to server b"
-sleep 0.5
+# once the viewer, connected to both servers, has shown a frame, b dies (the event, no sleep; the
+# 300 s bound of read is a hang guard)
+wait_until "$viewer" eval '[ "$(grep -c authenticated "$W/b.log")" -ge 2 ]' ||
+    fail "the cooperative viewer did not connect to server b"
+shown=
+while read -r -t 300 -u 3 line; do [ "$line" = frame ] && { shown=1; break; }; done
+[ -n "$shown" ] || fail "the cooperative viewer showed no frame"
 { kill -9 "$(cat "$W/b.pid")"; wait "$(cat "$W/b.pid")"; } 2>/dev/null
 wait "$viewer"
 rc=$?

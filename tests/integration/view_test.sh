@@ -14,7 +14,7 @@ TMP=$3
 rm -rf "$TMP"
 mkdir -p "$TMP"
 . "$(dirname "$0")/view_skip.sh"
-timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -w 320 -h 180 --frames 5 \
+timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -w 320 -h 180 --frames 5 \
     --screenshot "$TMP/view.png" >"$TMP/view.out" 2>"$TMP/view.err"
 rc=$?
 if [ $rc -ne 0 ]; then
@@ -27,7 +27,7 @@ fi
     exit 1
 }
 # the path tracer with its pixel display filter (issue 7): applied on the render thread's context
-timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b pathtracer --filter pixel --threshold 0.02 \
+timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b pathtracer --filter pixel --threshold 0.02 \
     -w 64 -h 48 --frames 6 --screenshot "$TMP/view_filter.png" >"$TMP/view_filter.out" 2>"$TMP/view_filter.err"
 rc=$?
 if [ $rc -ne 0 ] || [ ! -s "$TMP/view_filter.png" ] || ! grep -q "filter pixel t=0.02" "$TMP/view_filter.out"; then
@@ -38,7 +38,7 @@ fi
 # answered frame and prints the heads-up line once the key took effect): from no filter, F picks
 # the pixel filter at the default t = 0.01, ] doubles t, F moves on to a-trous keeping t, [ [
 # halve it twice
-timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b pathtracer -w 64 -h 48 --keys 'F]F[[' \
+timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b pathtracer -w 64 -h 48 --keys 'F]F[[' \
     --frames 2 >"$TMP/view_keys.out" 2>"$TMP/view_keys.err"
 rc=$?
 keys_expect() { # $1 = line number, $2 = key, $3 = expected filter status
@@ -62,7 +62,7 @@ tail -n 1 "$TMP/view_keys.out" | grep -q '| filter atrous t=0.005 ' || {
 # the frame-time governor (core/sy_governor.h): a back-end switch (key 2) is a view change, answered
 # by a moving frame (reduced size, "moving" in the heads-up line); --frames counts only frames shown
 # once the view settled, so the last line is at full size
-timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w 160 -h 90 --keys 2 --frames 1 \
+timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w 160 -h 90 --keys 2 --frames 1 \
     >"$TMP/view_gov.out" 2>"$TMP/view_gov.err"
 rc=$?
 [ $rc -eq 0 ] || { echo "FAIL: sy view --keys 2: status $rc: $(cat "$TMP/view_gov.err")"; exit 1; }

@@ -7,6 +7,7 @@ SY=$1
 fail=0
 bad() { echo "FAIL: $*"; fail=1; }
 command -v curl >/dev/null || { echo "skip: curl is not installed"; exit 77; }
+. "$(dirname "$0")/../support/wait.sh" # wait_until: states, never sleeps (hang guard only)
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
@@ -18,12 +19,8 @@ trap 'rm -rf "$out"' EXIT
 
 "$SY" web demo --listen 127.0.0.1:0 -b whitted >"$out/log" 2>"$out/err" &
 pid=$!
-url=
-for _ in $(seq 1 100); do
-    url=$(grep -o 'http://[^ ]*' "$out/log" 2>/dev/null | head -1)
-    [ -n "$url" ] && break
-    sleep 0.1
-done
+wait_until $pid grep -q 'http://' "$out/log"
+url=$(grep -o 'http://[^ ]*' "$out/log" 2>/dev/null | head -1)
 if [ -z "$url" ]; then
     bad "no URL printed: $(cat "$out/log" "$out/err")"
 else
@@ -58,8 +55,7 @@ else
     fi
 fi
 kill -TERM $pid # (a background job ignores SIGINT)
-for _ in $(seq 1 100); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done
-if kill -0 $pid 2>/dev/null; then bad "sy web did not stop on SIGTERM"; kill -9 $pid; fi
+if ! wait_gone $pid; then bad "sy web did not stop on SIGTERM"; kill -9 $pid; fi
 wait $pid; rc=$?
 [ $rc = 0 ] || bad "sy web exited $rc after SIGTERM: $(cat "$out/err")"
 [ $fail = 0 ] && echo "ok: sy web serves the page and stills, stops on SIGTERM, refuses bad options"
