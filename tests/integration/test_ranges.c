@@ -351,12 +351,17 @@ static void test_budgets(void)
     sy_scene_destroy(s);
 }
 
+/* Sanitizer builds (SY_RANGES_REDUCED) render the scales that failed differently before the fix
+ * (an abort, a failed render) and skip the three that repeat a kind: each scene costs every
+ * back-end a new context, which is slow under ASan. */
 static void scales(void)
 {
+#ifndef SY_RANGES_REDUCED
     test_scale("[1e-30,1e-30,1e-30]", false);
-    test_scale("[0,0,0]", false);
     test_scale("[1,0,1]", false);
     test_scale("[1e-3,1e-3,1e-3]", false);
+#endif
+    test_scale("[0,0,0]", false);
     test_scale("[1,1,1]", true);
     /* flat in its own z = 0 plane: drawn at full size, while the inverse magnifies z by 1e20 (an
      * instanced ray from the camera at z = 3 went to 3e20 in its space: Embree's assertion) */
