@@ -15,11 +15,16 @@
  * lws_cancel_service. A slow client never holds up the others: each connection is sent only the
  * newest frame when its socket can take one, older frames are dropped.
  *
- * Security: a loopback address (the default 127.0.0.1) is served to anyone on this machine whose
- * Host header names a loopback host; any other address needs a random access token (generated,
- * printed in the URL) on every request (?token=... or the cookie set by the first good request);
- * WebSocket upgrades from a foreign Origin are refused; bodies, messages, connections and idle
- * time are limited.
+ * Security (docs/WEB.md; the checks are the pure functions of sy_web_check.h): a gate thread
+ * (sy_web_gate.h) holds each connection until its request head is whole (a budget per address, a
+ * head deadline, malformed heads answered at once); a loopback address (the default 127.0.0.1) is
+ * served to anyone on this machine whose Host header is a loopback host (127.0.0.0/8, [::1],
+ * localhost); any other address needs a random access token (generated, printed in the URL) on
+ * every request (?token=... or the cookie set by the first good request); POSTs, stills and
+ * WebSocket upgrades need a same-origin Origin (or the token), POSTs a JSON Content-Type; stills
+ * have a pixel budget per request and per client, wait behind the live view with a deadline and
+ * are cancelled when the requester leaves; bodies, messages, connections and idle time are
+ * limited.
  *
  * Ownership: the server borrows the scene (it must outlive the server). Responses of route
  * handlers are malloc()ed by the handler and freed by the server.
