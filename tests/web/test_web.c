@@ -15,14 +15,27 @@
  *                 subprotocol upgrades are refused; a viewer beyond max_clients is refused
  *   web_progressive  the path tracer refines while the view rests and restarts when it moves
  *   web_token     listening on 0.0.0.0: without the token 401 with the page saying it is missing,
- *                 a wrong one 403, the right one 200 plus a cookie that works alone; WebSocket
- *                 upgrades need it too */
+ *                 a wrong one 403 (one of 200 characters too), the right one 200 plus a cookie
+ *                 that works alone; WebSocket upgrades need it too
+ *   web_hostile   issue 32's findings: Hosts that only look like loopback (DNS rebinding), for
+ *                 pages and upgrades; upgrades off /ws; cross-site POSTs (text/plain, foreign or
+ *                 no Origin); stills without Origin, past the side cap, past the pixel budget; a
+ *                 one-character header name (400 at once); two pipelined GETs (the first answered,
+ *                 then a clean close); paths of 256+ bytes (414); a binary message announcing
+ *                 50 MB (close 1009 before its payload)
+ *   web_slowloris 100 reconnecting slowloris connections; an honest client's 20 GETs all answered
+ *   web_stillbudget  stills queue behind a held render thread: the per-client pixel budget (429),
+ *                 another client's own budget, a still whose requester left is not rendered
+ *   web_clientfiles  /client/ serves client.html, client.js and vendor/ only, not npm/ */
 #define _GNU_SOURCE /* strcasestr */
 #include "sy_demo.h"
 #include "sy_jpeg.h"
 #include "sy_mediators.h"
 #include "sy_web.h"
 #include "sy_web_client.h"
+#ifdef SY_WEB_HAVE_CULL
+#include "sy_web_cull.h"
+#endif
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -32,6 +45,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/time.h>
 #include <unistd.h>
 
@@ -800,6 +814,77 @@ static int test_still_budget(server *s, uint16_t port)
     return 0;
 }
 
+/* /client/ serves the page's own files only: client.html, client.js, vendor/...; not the npm
+ * folder the build installs beside them (issue 32: it was served whole). */
+static int test_client_files(void)
+{
+#ifdef SY_WEB_HAVE_CULL
+    sy_error err = {0};
+    char dir[] = "/tmp/sy_web_client_XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    const char *files[] = {"client.html", "client.js", "vendor/three/three.module.js", "npm/package.json",
+                           "npm/node_modules/three/package.json", "other.txt"};
+    char path[512];
+    snprintf(path, sizeof path, "%s/vendor", dir), mkdir(path, 0700);
+    snprintf(path, sizeof path, "%s/vendor/three", dir), mkdir(path, 0700);
+    snprintf(path, sizeof path, "%s/npm", dir), mkdir(path, 0700);
+    snprintf(path, sizeof path, "%s/npm/node_modules", dir), mkdir(path, 0700);
+    snprintf(path, sizeof path, "%s/npm/node_modules/three", dir), mkdir(path, 0700);
+    for (size_t i = 0; i < sizeof files / sizeof *files; ++i) {
+        snprintf(path, sizeof path, "%s/%s", dir, files[i]);
+        FILE *f = fopen(path, "w");
+        CHECK(f != NULL);
+        fputs(files[i], f);
+        fclose(f);
+    }
+    server s = {0};
+    sy_demo_info demo;
+    CHECK_OK(sy_scene_create(&s.scene, &err));
+    CHECK_OK(sy_demo_build(s.scene, &demo, &err));
+    CHECK_OK(sy_scene_commit(s.scene, NULL, &err));
+    sy_web_cull *cull = NULL;
+    sy_web_route routes[SY_WEB_CULL_MAX_ROUTES];
+    uint32_t n = 0;
+    CHECK_OK(sy_web_cull_create(s.scene, demo.root, dir, &cull, routes, &n, &err));
+    sy_web_desc d = {.scene = s.scene, .root = demo.root, .camera = demo.camera, .backend = "whitted",
+                     .listen = "127.0.0.1:0", .routes = routes, .route_count = n};
+    CHECK_OK(sy_web_create(&d, &s.web, &err));
+    sy_web_cull_attach(cull, s.web);
+    CHECK(pthread_create(&s.th, NULL, server_main, &s) == 0);
+    uint16_t port = sy_web_port(s.web);
+    const int want[] = {200, 200, 200, 404, 404, 404};
+    for (size_t i = 0; i < sizeof files / sizeof *files; ++i) {
+        http_answer a;
+        snprintf(path, sizeof path, "/client/%s", files[i]);
+        CHECK(get(port, path, NULL, &a) == 0);
+        if (a.status != want[i]) fprintf(stderr, "%s: %d\n", path, a.status);
+        CHECK(a.status == want[i]);
+        if (want[i] == 200) CHECK(!strcmp((char *)a.body, files[i]));
+        free(a.body);
+    }
+    /* the culler after the server, before the scene */
+    sy_web_stop(s.web);
+    pthread_join(s.th, NULL);
+    sy_web_destroy(s.web);
+    sy_web_cull_destroy(cull);
+    sy_scene_destroy(s.scene);
+    int r = s.r != SY_OK;
+    for (size_t i = sizeof files / sizeof *files; i-- > 0;) {
+        snprintf(path, sizeof path, "%s/%s", dir, files[i]);
+        remove(path);
+    }
+    const char *dirs[] = {"npm/node_modules/three", "npm/node_modules", "npm", "vendor/three", "vendor", ""};
+    for (size_t i = 0; i < sizeof dirs / sizeof *dirs; ++i) {
+        snprintf(path, sizeof path, "%s/%s", dir, dirs[i]);
+        rmdir(path);
+    }
+    return r;
+#else
+    printf("skip: this sy_web has no culling service (the Embree back-ends)\n");
+    return 77;
+#endif
+}
+
 int main(int argc, char **argv)
 {
     const char *which = argc > 1 ? argv[1] : "all";
@@ -807,6 +892,11 @@ int main(int argc, char **argv)
     if (sy_mediators_register_builtin(&err) != SY_OK) {
         fprintf(stderr, "%s\n", err.message);
         return 1;
+    }
+    if (!strcmp(which, "clientfiles")) {
+        int f = test_client_files();
+        if (!f) printf("web %s: ok\n", which);
+        return f;
     }
     if (!strcmp(which, "token") || !strcmp(which, "progressive")) {
         int f = !strcmp(which, "token") ? test_token() : test_progressive();
