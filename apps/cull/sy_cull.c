@@ -147,9 +147,11 @@ void sy_culler_destroy(sy_culler *c)
 sy_result sy_cull_view_check(const sy_cull_view *v, sy_error *err)
 {
     static const char *const axes[] = {"x", "y", "z", "w"};
+    /* the core's one bound on coordinates (core/sy_math.h): the back-ends' rays stay valid */
     for (int i = 0; i < 3; ++i)
-        if (!isfinite(v->position[i]) || fabs(v->position[i]) > 1e30)
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cull: position.%s must be a finite number (at most 1e30 in size)", axes[i]);
+        if (!(fabs(v->position[i]) <= (double)SY_COORD_MAX))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cull: position.%s must be a finite number at most %g in size (SY_COORD_MAX)",
+                                axes[i], (double)SY_COORD_MAX);
     double q2 = 0;
     for (int i = 0; i < 4; ++i) {
         if (!isfinite(v->orientation[i]) || fabs(v->orientation[i]) > 1e6)

@@ -16,6 +16,8 @@
 #include "sy_post.h"
 #include "sy_viewport.h"
 #include "sy_web_assets.h"
+#include "sy_web_check.h"
+#include "sy_web_gate.h"
 
 #include <cjson/cJSON.h>
 #include <libwebsockets.h>
@@ -29,6 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #define WEB_FRAME_MAGIC 0x31465953u /* "SYF1" little-endian */
 #define WEB_FRAME_HEADER 40u
@@ -52,6 +55,8 @@ typedef struct web_job {
     struct lws *wsi;
     const sy_web_route *route; /* NULL: a still */
     uint32_t w, h;             /* still size */
+    uint64_t pixels;           /* w x h */
+    double queued_ms;          /* when the still was queued (sy_time_now, ms) */
     char method[8], path[256], query[512], peer[64];
     uint8_t *body;
     size_t body_len;
@@ -69,6 +74,15 @@ typedef struct web_frame {
 
 typedef struct web_conn web_conn;
 
+/* A connection the gate (sy_web_gate.h) hands over with its request: adopted by libwebsockets on
+ * the network thread. */
+typedef struct web_handoff {
+    struct web_handoff *next;
+    int fd;
+    uint8_t *buf;
+    size_t len;
+} web_handoff;
+
 struct sy_web {
     sy_web_desc d;
     sy_web_route *routes;
@@ -82,6 +96,8 @@ struct sy_web {
     uint32_t initial_backend;
     struct lws_context *ctx;
     struct lws_vhost *vhost;
+    sy_web_gate *gate;
+    sy_web_policy policy; /* what sy_web_check_request allows */
     lws_retry_bo_t idle; /* the vhost's ping / hang-up policy (lws keeps a pointer) */
     uint32_t retry_ms;
     pthread_t net_thread;
@@ -102,7 +118,11 @@ struct sy_web {
     uint64_t filter_version;
     uint32_t display_w, display_h;
     uint32_t clients;
-    web_job *pending, **pending_tail;
+    web_job *pending, **pending_tail; /* routes */
+    web_job *stills, **stills_tail;   /* stills: one after each live frame */
+    web_job *still_running;
+    web_handoff *handoffs;            /* gate -> network thread */
+    sy_web_stats st;                  /* the still counters */
     /* --- under mu: render thread -> network thread --- */
     web_frame *latest;
     web_job *finished;
@@ -148,6 +168,25 @@ static void post_job(sy_web *w, web_job *j)
     pthread_mutex_unlock(&w->mu);
 }
 
+static void post_still(sy_web *w, web_job *j)
+{
+    pthread_mutex_lock(&w->mu);
+    j->state = JOB_PENDING;
+    j->next = NULL;
+    *w->stills_tail = j;
+    w->stills_tail = &j->next;
+    pthread_cond_signal(&w->cv);
+    pthread_mutex_unlock(&w->mu);
+}
+
+static bool job_abandoned(sy_web *w, const web_job *j)
+{
+    pthread_mutex_lock(&w->mu);
+    bool gone = j->abandoned;
+    pthread_mutex_unlock(&w->mu);
+    return gone;
+}
+
 /* >>http */
 typedef struct http_pss {
     web_job *job;         /* a request answered on the render thread */
@@ -158,73 +197,13 @@ typedef struct http_pss {
     const uint8_t *body;  /* what is being sent (resp, a job's body or a static asset) */
     size_t body_len, sent;
     bool headers_done, set_cookie, responding;
+    bool close_after;     /* the request said Connection: close (the gate says so for every GET) */
     const sy_web_route *route; /* POST: the route the body is for */
     uint8_t *post;        /* POST: the body so far */
     size_t post_len;
     bool post_too_big;
     char path[256], query[512], peer[64];
 } http_pss;
-
-static bool is_loopback_host(const char *h)
-{
-    return !strcmp(h, "127.0.0.1") || !strcmp(h, "localhost") || !strcmp(h, "::1") || !strncmp(h, "127.", 4);
-}
-
-/* A query argument's decoded value ("name=" as lws wants it); false when absent or too long. */
-static bool urlarg(struct lws *wsi, const char *name, char *out, size_t len)
-{
-    char buf[600];
-    const char *v = lws_get_urlarg_by_name(wsi, name, buf, (int)sizeof buf);
-    if (!v || strlen(v) >= len) return false;
-    memmove(out, v, strlen(v) + 1);
-    return true;
-}
-
-/* The token of the request (?token= or the cookie): 0 none given, 1 right, -1 wrong. */
-static int check_token(sy_web *w, struct lws *wsi)
-{
-    if (!w->token[0]) return 1;
-    char got[128] = "";
-    int n = urlarg(wsi, "token=", got, sizeof got) ? (int)strlen(got) : 0;
-    if (n <= 0) { /* the cookie */
-        char cookie[1024];
-        if (lws_hdr_copy(wsi, cookie, (int)sizeof cookie, WSI_TOKEN_HTTP_COOKIE) > 0) {
-            for (char *p = cookie; (p = strstr(p, WEB_COOKIE "=")) != NULL; p += strlen(WEB_COOKIE "=")) {
-                if (p != cookie && p[-1] != ' ' && p[-1] != ';') continue;
-                const char *v = p + strlen(WEB_COOKIE "=");
-                size_t l = strcspn(v, "; ");
-                if (l < sizeof got) {
-                    memcpy(got, v, l);
-                    got[l] = 0;
-                    n = (int)l;
-                }
-                break;
-            }
-        }
-    }
-    if (n <= 0) return 0;
-    size_t tl = strlen(w->token);
-    if ((size_t)n != tl) return -1;
-    return sodium_memcmp(got, w->token, tl) == 0 ? 1 : -1;
-}
-
-/* The Host header names this server: a loopback name (against DNS rebinding) when serving
- * loopback without a token; anything when a token guards the server. */
-static bool host_ok(sy_web *w, struct lws *wsi)
-{
-    if (w->token[0]) return true;
-    char host[256];
-    if (lws_hdr_copy(wsi, host, (int)sizeof host, WSI_TOKEN_HOST) <= 0) return false;
-    char *colon = host[0] == '[' ? strstr(host, "]:") : strrchr(host, ':');
-    if (colon) *(host[0] == '[' ? colon + 1 : colon) = 0;
-    const char *name = host;
-    if (host[0] == '[') {
-        name = host + 1;
-        char *e = strchr(host, ']');
-        if (e) *e = 0;
-    }
-    return is_loopback_host(name) || !strcmp(name, w->host);
-}
 
 /* Queues an immediate response (copied) and asks for a writeable callback. */
 static int respond(struct lws *wsi, http_pss *p, int status, const char *ctype, const void *body, size_t len)
@@ -286,41 +265,6 @@ static int http_status_of(sy_result r)
     }
 }
 
-/* The still's size from the query: 1..max each; false with the reason. */
-static bool parse_still_size(struct lws *wsi, const sy_web *w, uint32_t *ow, uint32_t *oh, char *why, size_t len)
-{
-    const char *names[2] = {"w=", "h="};
-    uint32_t lim[2] = {w->d.max_width * 2 > 8192 ? w->d.max_width * 2 : 8192, w->d.max_height * 2 > 8192 ? w->d.max_height * 2 : 8192};
-    uint32_t *out[2] = {ow, oh};
-    for (int i = 0; i < 2; ++i) {
-        char v[32];
-        if (!urlarg(wsi, names[i], v, sizeof v)) {
-            snprintf(why, len, "missing %s (the still's size: /api/frame.jpg?w=W&h=H)", names[i]);
-            return false;
-        }
-        char *end;
-        errno = 0;
-        unsigned long x = strtoul(v, &end, 10);
-        if (errno || end == v || *end || v[0] == '-' || x < 1 || x > lim[i]) {
-            snprintf(why, len, "%s'%.20s' is not a size in 1..%u", names[i], v, lim[i]);
-            return false;
-        }
-        *out[i] = (uint32_t)x;
-    }
-    return true;
-}
-
-static const sy_web_route *find_route(const sy_web *w, const char *method, const char *path)
-{
-    for (uint32_t i = 0; i < w->d.route_count; ++i) {
-        const sy_web_route *r = &w->routes[i];
-        size_t n = strlen(r->path);
-        if (strcmp(r->method, method) != 0) continue;
-        if (n && r->path[n - 1] == '/' ? !strncmp(path, r->path, n) : !strcmp(path, r->path)) return r;
-    }
-    return NULL;
-}
-
 static web_job *new_job(struct lws *wsi, http_pss *p, const sy_web_route *route, const char *method)
 {
     web_job *j = calloc(1, sizeof *j);
@@ -351,70 +295,115 @@ static void copy_query(struct lws *wsi, char *out, size_t len)
     }
 }
 
+/* A header's value: NULL when absent; "" (matching nothing) when longer than the buffer. */
+static const char *hdr(struct lws *wsi, enum lws_token_indexes t, char *buf, int len)
+{
+    int n = lws_hdr_total_length(wsi, t);
+    if (n <= 0) return NULL;
+    if (n >= len || lws_hdr_copy(wsi, buf, len, t) < 0) buf[0] = 0;
+    return buf;
+}
+
+/* The request's head as sy_web_check_request takes it (h points into b). */
+typedef struct head_bufs {
+    char path[SY_WEB_MAX_PATH], query[512], host[256], origin[256], ctype[128], cookie[1024], cl[32];
+} head_bufs;
+
+static void read_head(struct lws *wsi, head_bufs *b, sy_web_head *h)
+{
+    memset(h, 0, sizeof *h);
+    bool post = lws_hdr_total_length(wsi, WSI_TOKEN_POST_URI) > 0;
+    bool get = lws_hdr_total_length(wsi, WSI_TOKEN_GET_URI) > 0;
+    enum lws_token_indexes ut = post ? WSI_TOKEN_POST_URI : WSI_TOKEN_GET_URI;
+    int n = lws_hdr_total_length(wsi, ut);
+    h->method = post ? "POST" : get ? "GET" : "OTHER";
+    h->path_len = n > 0 ? (size_t)n : 0;
+    b->path[0] = 0;
+    if (h->path_len < sizeof b->path && lws_hdr_copy(wsi, b->path, (int)sizeof b->path, ut) < 0) b->path[0] = 0;
+    h->path = b->path;
+    copy_query(wsi, b->query, sizeof b->query);
+    h->query = b->query;
+    h->host = hdr(wsi, WSI_TOKEN_HOST, b->host, (int)sizeof b->host);
+    h->origin = hdr(wsi, WSI_TOKEN_ORIGIN, b->origin, (int)sizeof b->origin);
+    h->content_type = hdr(wsi, WSI_TOKEN_HTTP_CONTENT_TYPE, b->ctype, (int)sizeof b->ctype);
+    h->cookie = hdr(wsi, WSI_TOKEN_HTTP_COOKIE, b->cookie, (int)sizeof b->cookie);
+    h->upgrade = lws_hdr_total_length(wsi, WSI_TOKEN_UPGRADE) > 0;
+    if (hdr(wsi, WSI_TOKEN_HTTP_CONTENT_LENGTH, b->cl, (int)sizeof b->cl))
+        h->has_length = true, h->content_length = strtoull(b->cl, NULL, 10);
+}
+
+/* A still: within the per-client budget (its queued and rendering stills together) and the
+ * queue's length, queued behind the live view. */
+static int still_request(sy_web *w, struct lws *wsi, http_pss *p, uint32_t sw, uint32_t sh)
+{
+    uint64_t px = (uint64_t)sw * sh, mine = 0;
+    uint32_t queued = 0;
+    pthread_mutex_lock(&w->mu);
+    for (const web_job *j = w->stills; j; j = j->next, ++queued)
+        if (!strcmp(j->peer, p->peer)) mine += j->pixels;
+    if (w->still_running && !strcmp(w->still_running->peer, p->peer)) mine += w->still_running->pixels;
+    bool over = mine + px > w->policy.still_max_pixels, full = !over && queued >= 2 * w->d.max_clients;
+    if (over || full) w->st.stills_refused++;
+    pthread_mutex_unlock(&w->mu);
+    if (over) {
+        sy_log(SY_LOG_WARNING, "web", p->peer, "refused a still of %ux%u: this client's stills exceed the budget", sw, sh);
+        return respond_text(wsi, p, 429, "this client's stills in progress (%llu pixels) and this one (%llu) exceed the "
+                            "budget of %llu pixels per client: wait for the first",
+                            (unsigned long long)mine, (unsigned long long)px, (unsigned long long)w->policy.still_max_pixels);
+    }
+    if (full) return respond_text(wsi, p, 503, "%u stills are queued: try again later", queued);
+    web_job *j = new_job(wsi, p, NULL, "GET");
+    if (!j) return -1;
+    j->w = sw, j->h = sh, j->pixels = px, j->queued_ms = sy_time_now() * 1e3;
+    post_still(w, j);
+    return 0;
+}
+
 static int http_request(sy_web *w, struct lws *wsi, http_pss *p, const char *uri)
 {
     memset(p, 0, sizeof *p);
     lws_get_peer_simple(wsi, p->peer, sizeof p->peer);
     (void)uri; /* relative to the mount; the request line's path is taken instead */
-    copy_query(wsi, p->query, sizeof p->query);
-    bool post = lws_hdr_total_length(wsi, WSI_TOKEN_POST_URI) > 0;
-    bool get = lws_hdr_total_length(wsi, WSI_TOKEN_GET_URI) > 0;
-    if (lws_hdr_copy(wsi, p->path, (int)sizeof p->path, post ? WSI_TOKEN_POST_URI : WSI_TOKEN_GET_URI) <= 0)
-        snprintf(p->path, sizeof p->path, "/");
-    if (!host_ok(w, wsi)) {
-        sy_log(SY_LOG_WARNING, "web", p->peer, "refused a request for a foreign Host (%s)", p->path);
-        return respond_text(wsi, p, 403, "this server answers requests for a loopback host only");
+    head_bufs b;
+    sy_web_head h;
+    sy_web_verdict v;
+    read_head(wsi, &b, &h);
+    sy_web_check_request(&w->policy, &h, &v);
+    snprintf(p->path, sizeof p->path, "%s", b.path);
+    snprintf(p->query, sizeof p->query, "%s", b.query);
+    bool post = !strcmp(h.method, "POST");
+    char conn[64];
+    if (hdr(wsi, WSI_TOKEN_CONNECTION, conn, (int)sizeof conn)) {
+        for (char *c = conn; *c; ++c) *c = (char)tolower((unsigned char)*c);
+        p->close_after = strstr(conn, "close") != NULL;
     }
-    int tok = check_token(w, wsi);
-    if (tok != 1) {
-        sy_log(SY_LOG_WARNING, "web", p->peer, "refused %s: access token %s", p->path, tok ? "wrong" : "missing");
-        return respond_token_page(wsi, p, tok);
+    if (v.target == SY_WEB_TARGET_REFUSED) {
+        sy_log(SY_LOG_WARNING, "web", p->peer, "refused %s %.100s: %s (%d)", h.method, b.path, v.reason, v.status);
+        p->post_too_big = post; /* a body may follow: close after the answer */
+        if (v.token_page) return respond_token_page(wsi, p, v.token);
+        return respond_text(wsi, p, v.status, "%s", v.reason);
     }
-    char tq[128];
-    p->set_cookie = w->token[0] && urlarg(wsi, "token=", tq, sizeof tq);
-    const char *method = post ? "POST" : "GET";
-    if (!post && !get) return respond_text(wsi, p, 405, "only GET and POST are served");
-    const sy_web_route *route = find_route(w, method, p->path);
-    if (post) {
-        if (!route) return respond_text(wsi, p, 404, "no POST route %s", p->path);
-        char cl[32];
-        if (lws_hdr_copy(wsi, cl, (int)sizeof cl, WSI_TOKEN_HTTP_CONTENT_LENGTH) > 0) {
-            unsigned long long n = strtoull(cl, NULL, 10);
-            if (n > w->d.max_body) {
-                sy_log(SY_LOG_WARNING, "web", p->peer, "refused a body of %llu bytes for %s (limit %zu)", n, p->path,
-                       w->d.max_body);
-                p->post_too_big = true;
-                return respond_text(wsi, p, 413, "request body of %llu bytes exceeds the limit of %zu bytes", n,
-                                    w->d.max_body);
-            }
-        }
-        p->route = route; /* the body follows: HTTP_BODY, then HTTP_BODY_COMPLETION */
-        return 0;
-    }
-    if (!strcmp(p->path, "/") || !strcmp(p->path, "/index.html")) {
+    p->set_cookie = w->token[0] && v.token_in_query;
+    switch (v.target) {
+    case SY_WEB_TARGET_PAGE:
         p->status = 200, p->ctype = "text/html; charset=utf-8";
         p->body = (const uint8_t *)sy_web_asset_index_html, p->body_len = sy_web_asset_index_html_len;
         p->responding = true;
         lws_callback_on_writable(wsi);
         return 0;
+    case SY_WEB_TARGET_STILL: return still_request(w, wsi, p, v.still_w, v.still_h);
+    case SY_WEB_TARGET_ROUTE:
+        if (post) {
+            p->route = v.route; /* the body follows: HTTP_BODY, then HTTP_BODY_COMPLETION */
+            return 0;
+        } else {
+            web_job *j = new_job(wsi, p, v.route, "GET");
+            if (!j) return -1;
+            post_job(w, j);
+            return 0;
+        }
+    default: return respond_text(wsi, p, 400, "a WebSocket upgrade needs the sy-view subprotocol");
     }
-    if (!strcmp(p->path, "/api/frame.jpg")) {
-        uint32_t sw = 0, sh = 0;
-        char why[160];
-        if (!parse_still_size(wsi, w, &sw, &sh, why, sizeof why)) return respond_text(wsi, p, 400, "%s", why);
-        web_job *j = new_job(wsi, p, NULL, "GET");
-        if (!j) return -1;
-        j->w = sw, j->h = sh;
-        post_job(w, j);
-        return 0;
-    }
-    if (route) {
-        web_job *j = new_job(wsi, p, route, "GET");
-        if (!j) return -1;
-        post_job(w, j);
-        return 0;
-    }
-    return respond_text(wsi, p, 404, "not found: %s", p->path);
 }
 
 static int http_body(sy_web *w, struct lws *wsi, http_pss *p, const void *in, size_t len)
@@ -459,6 +448,9 @@ static int http_writeable(sy_web *w, struct lws *wsi, http_pss *p)
                                         &q, end) ||
             lws_add_http_header_by_name(wsi, (const unsigned char *)"x-content-type-options:",
                                         (const unsigned char *)"nosniff", 7, &q, end))
+            return -1;
+        if ((p->close_after || p->post_too_big) &&
+            lws_add_http_header_by_name(wsi, (const unsigned char *)"connection:", (const unsigned char *)"close", 5, &q, end))
             return -1;
         if (p->set_cookie) {
             char c[160];
@@ -524,7 +516,7 @@ static void http_closed(sy_web *w, http_pss *p)
     if (!j) return;
     pthread_mutex_lock(&w->mu);
     bool mine = j->state == JOB_DELIVERING;
-    if (!mine) j->abandoned = true, j->wsi = NULL;
+    if (!mine) j->abandoned = true, j->wsi = NULL, w->st.requests_abandoned++;
     pthread_mutex_unlock(&w->mu);
     if (mine) job_free(j);
 }
@@ -550,6 +542,42 @@ static void http_collect_finished(sy_web *w)
     }
 }
 
+/* The gate's connections: libwebsockets takes each with the request bytes the gate read. */
+static void http_adopt(sy_web *w)
+{
+    pthread_mutex_lock(&w->mu);
+    web_handoff *list = w->handoffs;
+    w->handoffs = NULL;
+    pthread_mutex_unlock(&w->mu);
+    while (list) {
+        web_handoff *h = list;
+        list = h->next;
+        /* closes the socket itself when it fails; without bytes: lws reads the request itself */
+        if (h->len) lws_adopt_socket_vhost_readbuf(w->vhost, h->fd, (const char *)h->buf, h->len);
+        else lws_adopt_socket_vhost(w->vhost, h->fd);
+        free(h->buf);
+        free(h);
+    }
+}
+
+/* The gate's thread: a connection whose request arrived whole. */
+static void gate_deliver(void *user, int fd, uint8_t *bytes, size_t len)
+{
+    sy_web *w = user;
+    web_handoff *h = malloc(sizeof *h);
+    if (!h) {
+        close(fd);
+        free(bytes);
+        return;
+    }
+    h->fd = fd, h->buf = bytes, h->len = len;
+    pthread_mutex_lock(&w->mu);
+    h->next = w->handoffs;
+    w->handoffs = h;
+    pthread_mutex_unlock(&w->mu);
+    lws_cancel_service(w->ctx);
+}
+
 static int http_callback(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
 {
     struct lws_context *ctx = lws_get_context(wsi);
@@ -564,7 +592,10 @@ static int http_callback(struct lws *wsi, enum lws_callback_reasons reason, void
         if (p) http_closed(w, p);
         return 0;
     case LWS_CALLBACK_EVENT_WAIT_CANCELLED:
-        if (w) http_collect_finished(w);
+        if (w) {
+            http_adopt(w);
+            http_collect_finished(w);
+        }
         return 0;
     case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION: { /* an upgrade without the "sy-view" subprotocol */
         char peer[64] = "";
@@ -587,7 +618,8 @@ struct web_conn {
     bool hello_sent;
     uint32_t warned;    /* malformed messages logged */
     char *msg;          /* a text message being assembled (max_message bytes) */
-    size_t msg_len;
+    size_t msg_len;     /* its bytes so far (a binary message's are counted, not kept) */
+    bool msg_binary;
 };
 
 /* A malformed message: logged with the client's address, the first 10 per connection (a flood
@@ -600,81 +632,54 @@ static void ws_warn(web_conn *c, const char *what, const char *detail)
            c->warned == 10 ? " (further ones from this client are not logged)" : "");
 }
 
-static bool json_num(const cJSON *o, const char *key, double lo, double hi, double *out)
-{
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
-    if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) || v->valuedouble < lo || v->valuedouble > hi) return false;
-    *out = v->valuedouble;
-    return true;
-}
-
-/* One input message (JSON text; docs/WEB.md). Malformed ones are logged with the client's address
- * and ignored. */
+/* One input message (JSON text; docs/WEB.md; parsed by sy_web_parse_input). Malformed ones are
+ * logged with the client's address and ignored. */
 static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
 {
-    cJSON *m = cJSON_ParseWithLength(text, len);
-    const cJSON *t = m ? cJSON_GetObjectItemCaseSensitive(m, "t") : NULL;
-    if (!cJSON_IsObject(m) || !cJSON_IsString(t)) {
-        ws_warn(c, "not a JSON object with a string \"t\"", NULL);
-        cJSON_Delete(m);
+    sy_web_input in;
+    sy_error err = {0};
+    if (sy_web_parse_input(text, len, &in, &err) != SY_OK) {
+        ws_warn(c, err.message, NULL);
         return;
     }
-    double id = 0, a = 0, b = 0, btn = 0;
-    bool has_id = cJSON_GetObjectItemCaseSensitive(m, "id") != NULL;
-    if (has_id && !json_num(m, "id", 0, 9007199254740991.0, &id)) {
-        ws_warn(c, "\"id\" must be a whole number >= 0", NULL);
-        cJSON_Delete(m);
-        return;
-    }
-    const char *type = t->valuestring;
     pthread_mutex_lock(&w->mu);
-    bool ok = true, input = true;
-    if (!strcmp(type, "size")) {
+    bool input = true;
+    switch (in.type) {
+    case SY_WEB_INPUT_SIZE:
         input = false;
-        if ((ok = json_num(m, "w", 1, 16384, &a) && json_num(m, "h", 1, 16384, &b))) {
-            w->display_w = (uint32_t)a, w->display_h = (uint32_t)b;
-            w->view_version++;
-        }
-    } else if (!strcmp(type, "drag")) {
-        if ((ok = json_num(m, "dx", -1e5, 1e5, &a) && json_num(m, "dy", -1e5, 1e5, &b))) {
-            if (cJSON_GetObjectItemCaseSensitive(m, "b") && !json_num(m, "b", 0, 2, &btn)) ok = false;
-            else if (btn >= 1) sy_orbit_pan(&w->orbit, (float)a, (float)b);
-            else sy_orbit_rotate(&w->orbit, (float)a, (float)b);
-        }
-    } else if (!strcmp(type, "wheel")) {
-        if ((ok = json_num(m, "steps", -50, 50, &a))) sy_orbit_zoom(&w->orbit, (float)a);
-    } else if (!strcmp(type, "key")) {
-        const cJSON *k = cJSON_GetObjectItemCaseSensitive(m, "k");
-        char key = cJSON_IsString(k) && k->valuestring[0] && !k->valuestring[1] ? k->valuestring[0] : 0;
-        if (key >= '1' && key <= '9') {
-            uint32_t i = (uint32_t)(key - '1');
+        w->display_w = (uint32_t)in.a, w->display_h = (uint32_t)in.b;
+        w->view_version++;
+        break;
+    case SY_WEB_INPUT_DRAG:
+        if (in.button >= 1) sy_orbit_pan(&w->orbit, (float)in.a, (float)in.b);
+        else sy_orbit_rotate(&w->orbit, (float)in.a, (float)in.b);
+        break;
+    case SY_WEB_INPUT_WHEEL: sy_orbit_zoom(&w->orbit, (float)in.a); break;
+    case SY_WEB_INPUT_KEY:
+        if (in.key >= '1' && in.key <= '9') {
+            uint32_t i = (uint32_t)(in.key - '1');
             if (i < sy_mediator_count()) /* the cluster is no choice of its own: the initial back-end */
                 w->backend = (sy_mediator_at(i)->caps & SY_CAP_REMOTE) ? w->initial_backend : i;
-        } else if (key == 'f' || key == 'F') {
+        } else if (in.key == 'f') {
             w->filter = (w->filter + 1) % (uint32_t)WEB_FILTER_COUNT, w->filter_version++;
-        } else if (key == '[') {
+        } else if (in.key == '[') {
             if (w->threshold > 1e-6f) w->threshold *= 0.5f;
             w->filter_version++;
-        } else if (key == ']') {
+        } else if (in.key == ']') {
             if (w->threshold < 1e3f) w->threshold *= 2.0f;
             w->filter_version++;
-        } else if (key == 'r' || key == 'R') {
+        } else if (in.key == 'r') {
             w->orbit = w->home;
-        } else {
-            ok = false;
         }
-    } else {
-        ok = false;
+        break;
     }
-    if (ok && input) {
+    if (input) {
         w->view_version++;
         w->input_gen++;
-        if (has_id) c->last_id = (uint64_t)id, c->last_gen = w->input_gen;
+        if (in.has_id) c->last_id = in.id, c->last_gen = w->input_gen;
     }
-    if (ok) pthread_cond_signal(&w->cv);
+    pthread_cond_signal(&w->cv);
     pthread_mutex_unlock(&w->mu);
-    if (!ok) ws_warn(c, "unknown type or a field missing or out of range", type);
-    cJSON_Delete(m);
 }
 
 /* The hello: the back-ends of the registry in key order (docs/WEB.md). */
@@ -752,25 +757,17 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
     web_conn *c = user;
     switch (reason) {
     case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION: {
-        char peer[64] = "", origin[256] = "", host[256] = "";
+        char peer[64] = "";
         lws_get_peer_simple(wsi, peer, sizeof peer);
-        if (!host_ok(w, wsi)) {
-            sy_log(SY_LOG_WARNING, "web", peer, "refused a WebSocket for a foreign Host");
+        head_bufs b;
+        sy_web_head h;
+        sy_web_verdict v;
+        read_head(wsi, &b, &h);
+        h.upgrade = true;
+        sy_web_check_request(&w->policy, &h, &v);
+        if (v.target != SY_WEB_TARGET_STREAM) {
+            sy_log(SY_LOG_WARNING, "web", peer, "refused a WebSocket: %s", v.target == SY_WEB_TARGET_REFUSED ? v.reason : "not /ws");
             return 1;
-        }
-        int tok = check_token(w, wsi);
-        if (tok != 1) {
-            sy_log(SY_LOG_WARNING, "web", peer, "refused a WebSocket: access token %s", tok ? "wrong" : "missing");
-            return 1;
-        }
-        /* a browser names the page's origin: it must be this server (scheme://host:port = Host) */
-        if (lws_hdr_copy(wsi, origin, (int)sizeof origin, WSI_TOKEN_ORIGIN) > 0) {
-            lws_hdr_copy(wsi, host, (int)sizeof host, WSI_TOKEN_HOST);
-            const char *o = !strncmp(origin, "http://", 7) ? origin + 7 : !strncmp(origin, "https://", 8) ? origin + 8 : NULL;
-            if (!o || !host[0] || strcmp(o, host) != 0) {
-                sy_log(SY_LOG_WARNING, "web", peer, "refused a WebSocket from the foreign origin %.100s", origin);
-                return 1;
-            }
         }
         pthread_mutex_lock(&w->mu);
         bool full = w->clients >= w->d.max_clients;
@@ -810,24 +807,25 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
         free(c->msg);
         c->msg = NULL;
         return 0;
-    case LWS_CALLBACK_RECEIVE:
-        if (lws_frame_is_binary(wsi)) {
-            ws_warn(c, "binary messages are not part of the protocol", NULL);
-            c->msg_len = 0;
-            return 0;
-        }
-        if (len > w->d.max_message - c->msg_len) {
+    case LWS_CALLBACK_RECEIVE: {
+        /* the message's size so far plus what its frame still announces: over the limit closes at
+         * once (1009), before the rest is read */
+        if (lws_is_first_fragment(wsi)) c->msg_len = 0, c->msg_binary = lws_frame_is_binary(wsi);
+        size_t rest = lws_remaining_packet_payload(wsi);
+        if (len > w->d.max_message - c->msg_len || rest > w->d.max_message - c->msg_len - len) {
             sy_log(SY_LOG_WARNING, "web", c->peer, "closed: a message over %zu bytes", w->d.max_message);
             lws_close_reason(wsi, LWS_CLOSE_STATUS_MESSAGE_TOO_LARGE, (unsigned char *)"message too large", 17);
             return -1;
         }
-        memcpy(c->msg + c->msg_len, in, len);
+        if (!c->msg_binary) memcpy(c->msg + c->msg_len, in, len);
         c->msg_len += len;
-        if (lws_is_final_fragment(wsi) && !lws_remaining_packet_payload(wsi)) {
-            ws_message(w, c, c->msg, c->msg_len);
+        if (lws_is_final_fragment(wsi) && !rest) {
+            if (c->msg_binary) ws_warn(c, "binary messages are not part of the protocol", NULL);
+            else ws_message(w, c, c->msg, c->msg_len);
             c->msg_len = 0;
         }
         return 0;
+    }
     case LWS_CALLBACK_SERVER_WRITEABLE: return ws_writeable(w, c);
     case LWS_CALLBACK_EVENT_WAIT_CANCELLED: /* a new frame or status: every viewer that can take it */
         if (w) lws_callback_on_writable_all_protocol(ctx, &web_protocols[1]);
@@ -973,38 +971,81 @@ static void finish_job(sy_web *w, web_job *j)
     else wake_network(w);
 }
 
-static void run_job(sy_web *w, render_state *rs, web_job *j, const sy_orbit *o)
+/* A failed job's answer: the status of its error and the message as text. */
+static void job_error(web_job *j, sy_result r, const sy_error *err)
+{
+    free(j->resp.body);
+    memset(&j->resp, 0, sizeof j->resp);
+    j->resp.status = http_status_of(r);
+    snprintf(j->resp.content_type, sizeof j->resp.content_type, "text/plain; charset=utf-8");
+    char *m = malloc(strlen(err->message) + 2);
+    if (m) {
+        j->resp.body_len = (size_t)sprintf(m, "%s\n", err->message);
+        j->resp.body = (uint8_t *)m;
+    }
+    sy_log(SY_LOG_WARNING, "web", j->peer, "%s %s: %s", j->method, j->path, err->message);
+}
+
+static void run_job(sy_web *w, web_job *j)
+{
+    sy_error err = {0};
+    memset(&j->resp, 0, sizeof j->resp);
+    sy_web_request req = {.method = j->method, .path = j->path, .query = j->query, .body = j->body,
+                          .body_len = j->body_len, .peer = j->peer};
+    sy_result r = j->route->fn(j->route->user, w->d.scene, &req, &j->resp, &err);
+    if (r != SY_OK) job_error(j, r, &err);
+    finish_job(w, j);
+}
+
+/* A still of the current view, after the live frame: answered 503 past its deadline; rendered in
+ * passes of a few samples (progressive back-ends), each pass only while the requester is still
+ * connected; the still's window is shrunk afterwards so its memory goes back. */
+static void run_still(sy_web *w, render_state *rs, web_job *j, const sy_orbit *o)
 {
     sy_error err = {0};
     sy_result r = SY_OK;
     memset(&j->resp, 0, sizeof j->resp);
-    if (j->route) {
-        sy_web_request req = {.method = j->method, .path = j->path, .query = j->query, .body = j->body,
-                              .body_len = j->body_len, .peer = j->peer};
-        r = j->route->fn(j->route->user, w->d.scene, &req, &j->resp, &err);
-    } else { /* a still of the current view */
-        uint8_t *px = NULL;
+    double waited = sy_time_now() * 1e3 - j->queued_ms;
+    bool cancelled = job_abandoned(w, j), expired = !cancelled && waited > w->d.still_deadline_ms;
+    if (expired) {
+        r = sy_error_set(&err, SY_ERR_LIMIT, "the still waited %.0f ms behind the live view (deadline %u ms): try again",
+                         waited, w->d.still_deadline_ms);
+    } else if (!cancelled) {
         const sy_mediator_class *cls = sy_mediator_at(rs->backend_applied);
         uint32_t spp = cls && (cls->caps & SY_CAP_PROGRESSIVE) ? w->d.still_samples : 1;
+        sy_layer img = {0};
         r = apply_camera(w, rs, o, &err);
         if (r == SY_OK) r = sy_viewport_set_backend(rs->still_vp, (cls ? cls : sy_mediator_at(w->initial_backend))->name, NULL, &err);
-        if (r == SY_OK) r = render_rgba8(w, rs, rs->still_win, j->w, j->h, spp, 1.0f, &px, &err);
-        if (r == SY_OK) r = sy_jpeg_encode_rgba8(px, j->w, j->h, 95, &j->resp.body, &j->resp.body_len, &err);
-        free(px);
-        if (r == SY_OK) j->resp.status = 200, snprintf(j->resp.content_type, sizeof j->resp.content_type, "image/jpeg");
-    }
-    if (r != SY_OK) {
-        free(j->resp.body);
-        memset(&j->resp, 0, sizeof j->resp);
-        j->resp.status = http_status_of(r);
-        snprintf(j->resp.content_type, sizeof j->resp.content_type, "text/plain; charset=utf-8");
-        char *m = malloc(strlen(err.message) + 2);
-        if (m) {
-            j->resp.body_len = (size_t)sprintf(m, "%s\n", err.message);
-            j->resp.body = (uint8_t *)m;
+        if (r == SY_OK) r = sy_window_resize(rs->still_win, j->w, j->h, &err);
+        if (r == SY_OK) r = sy_layer_create(j->w, j->h, &img, &err);
+        for (uint32_t done = 0; r == SY_OK && done < spp && !cancelled; ) {
+            uint32_t n = spp - done > 4 ? 4 : spp - done;
+            sy_window_render_opts ro = {.sample_count = n, .preview = 1.0f, .post = sy_post_display()};
+            r = sy_window_render(rs->still_win, w->d.scene, rs->pool, &ro, &img, &err);
+            done += n;
+            cancelled = job_abandoned(w, j);
         }
-        sy_log(SY_LOG_WARNING, "web", j->peer, "%s %s: %s", j->method, j->path, err.message);
+        uint8_t *px = NULL;
+        if (r == SY_OK && !cancelled && !(px = layer_to_rgba8(&img))) r = sy_error_set(&err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
+        sy_layer_destroy(&img);
+        if (px) r = sy_jpeg_encode_rgba8(px, j->w, j->h, 95, &j->resp.body, &j->resp.body_len, &err);
+        free(px);
+        sy_window_resize(rs->still_win, 64, 64, NULL);
+        if (r == SY_OK && !cancelled) j->resp.status = 200, snprintf(j->resp.content_type, sizeof j->resp.content_type, "image/jpeg");
     }
+    pthread_mutex_lock(&w->mu);
+    w->still_running = NULL;
+    if (cancelled) w->st.stills_cancelled++;
+    else if (expired) w->st.stills_expired++;
+    else if (r == SY_OK) w->st.stills_done++;
+    pthread_mutex_unlock(&w->mu);
+    if (cancelled) {
+        sy_log(SY_LOG_NOTE, "web", j->peer, "a still of %ux%u cancelled: the requester left", j->w, j->h);
+        finish_job(w, j); /* abandoned: freed there */
+        return;
+    }
+    if (r != SY_OK) job_error(j, r, &err);
+    if (expired) j->resp.status = 503;
     finish_job(w, j);
 }
 
@@ -1108,6 +1149,26 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_orbit *o, ui
     return SY_OK;
 }
 
+/* The live frame (the governor says its size) and what a failed back-end tells the pages. */
+static void render_live(sy_web *w, render_state *rs, const sy_orbit *o, uint32_t bi, uint32_t dw, uint32_t dh, uint64_t gen,
+                        uint32_t filter, float threshold, uint64_t fv, bool *again, double *wait_until)
+{
+    *again = false, *wait_until = 0;
+    sy_error ferr = {0};
+    double wait_ms = 0;
+    if (render_frame(w, rs, o, bi, dw, dh, gen, filter, threshold, fv, again, &wait_ms, &ferr) == SY_OK) {
+        if (wait_ms > 0) *wait_until = sy_time_now() * 1e3 + wait_ms;
+    } else {
+        /* a back-end that fails is reported to the pages; the others keep serving */
+        char s[300];
+        snprintf(s, sizeof s, "%s failed: %.240s", sy_mediator_at(bi) ? sy_mediator_at(bi)->name : "back-end",
+                 ferr.message);
+        sy_log(SY_LOG_WARNING, "web", NULL, "%s", s);
+        set_status(w, s);
+        *again = false;
+    }
+}
+
 sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
 {
     render_state rs = {0};
@@ -1127,7 +1188,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
     while (r == SY_OK) {
         pthread_mutex_lock(&w->mu);
         for (;;) {
-            if (w->quit || (stop && *stop) || w->pending) break;
+            if (w->quit || (stop && *stop) || w->pending || w->stills) break;
             /* frames once a page said its size (the page does as it connects) */
             bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
             if (w->clients && w->display_w && (w->view_version != seen || due)) break;
@@ -1162,29 +1223,34 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
             bool gone = j->abandoned;
             pthread_mutex_unlock(&w->mu);
             if (gone) job_free(j);
-            else run_job(w, &rs, j, &o);
+            else run_job(w, j);
         }
         bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
-        if (!clients || !(moved || due)) continue;
-        again = false, wait_until = 0;
-        sy_error ferr = {0};
-        double wait_ms = 0;
-        if (render_frame(w, &rs, &o, bi, dw, dh, gen, filter, threshold, fv, &again, &wait_ms, &ferr) == SY_OK) {
-            if (wait_ms > 0) wait_until = sy_time_now() * 1e3 + wait_ms;
-        } else {
-            /* a back-end that fails is reported to the pages; the others keep serving */
-            char s[300];
-            snprintf(s, sizeof s, "%s failed: %.240s", sy_mediator_at(bi) ? sy_mediator_at(bi)->name : "back-end",
-                     ferr.message);
-            sy_log(SY_LOG_WARNING, "web", NULL, "%s", s);
-            set_status(w, s);
-            again = false;
+        if (clients && (moved || due)) render_live(w, &rs, &o, bi, dw, dh, gen, filter, threshold, fv, &again, &wait_until);
+        /* then one still: stills wait behind the live view */
+        pthread_mutex_lock(&w->mu);
+        web_job *still = w->stills;
+        if (still) {
+            w->stills = still->next;
+            if (!w->stills) w->stills_tail = &w->stills;
+            still->state = JOB_RUNNING;
+            w->still_running = still;
         }
+        pthread_mutex_unlock(&w->mu);
+        if (still) run_still(w, &rs, still, &o);
     }
     /* jobs still queued are answered 503 */
     pthread_mutex_lock(&w->mu);
     web_job *left = w->pending;
     w->pending = NULL, w->pending_tail = &w->pending;
+    if (left) {
+        web_job **t = &left;
+        while (*t) t = &(*t)->next;
+        *t = w->stills;
+    } else {
+        left = w->stills;
+    }
+    w->stills = NULL, w->stills_tail = &w->stills;
     pthread_mutex_unlock(&w->mu);
     while (left) {
         web_job *j = left;
@@ -1211,6 +1277,8 @@ void sy_web_stop(sy_web *w)
 /* >>lifecycle */
 static void lws_log_to_sy(int level, const char *line)
 {
+    /* lws 4.1 logs every adoption of a socket with its read buffer as an error: not one */
+    if (strstr(line, "adopt_socket_readbuf")) return;
     size_t n = strlen(line);
     while (n && (line[n - 1] == '\n' || line[n - 1] == '\r')) n--;
     sy_log(level & LLL_ERR ? SY_LOG_ERROR : SY_LOG_WARNING, "web.lws", NULL, "%.*s", (int)n, line);
@@ -1261,18 +1329,25 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     if (!w->d.quality) w->d.quality = 80;
     if (!w->d.still_samples) w->d.still_samples = 16;
     if (!w->d.idle_timeout_s) w->d.idle_timeout_s = 30;
+    if (!w->d.still_max_pixels) w->d.still_max_pixels = 2048u * 2048u;
+    if (!w->d.still_deadline_ms) w->d.still_deadline_ms = 10000;
+    if (!w->d.head_timeout_ms) w->d.head_timeout_ms = 5000;
+    if (!w->d.max_pending) w->d.max_pending = 128;
     w->initial_backend = w->backend = (uint32_t)bi;
     w->threshold = desc->threshold > 0 ? desc->threshold : 0.01f;
     pthread_mutex_init(&w->mu, NULL);
     pthread_cond_init(&w->cv, NULL);
     w->pending_tail = &w->pending;
+    w->stills_tail = &w->stills;
     sy_result r = SY_OK;
     if (w->d.max_width > 16384 || w->d.max_height > 16384 || w->d.max_clients > 1000 || w->d.max_message < 64 ||
         w->d.max_message > (1u << 24) || w->d.quality < 1 || w->d.quality > 100 || w->d.idle_timeout_s > 3600 ||
-        !(w->d.budget_ms >= 0 && w->d.budget_ms <= 1e5))
+        !(w->d.budget_ms >= 0 && w->d.budget_ms <= 1e5) || w->d.still_max_pixels > (uint64_t)SY_JPEG_MAX_SIDE * SY_JPEG_MAX_SIDE ||
+        w->d.max_pending > 1024 || w->d.head_timeout_ms > 600000 || w->d.still_deadline_ms > 600000)
         r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
                          "web: a limit is out of range (frame <= 16384, clients <= 1000, message 64..16 MiB, quality "
-                         "1..100, idle timeout <= 3600 s, budget 0..1e5 ms)");
+                         "1..100, idle timeout <= 3600 s, budget 0..1e5 ms, still pixels <= 16384^2, pending "
+                         "connections <= 1024, head timeout and still deadline <= 600 s)");
     if (r == SY_OK && desc->filter) {
         while (w->filter < WEB_FILTER_COUNT && strcmp(web_filters[w->filter], desc->filter) != 0) w->filter++;
         if (w->filter == WEB_FILTER_COUNT)
@@ -1293,7 +1368,7 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
         w->d.routes = w->routes;
     }
     /* the access token: required off loopback */
-    w->loopback = is_loopback_host(w->host);
+    w->loopback = sy_web_name_is_loopback(w->host);
     if (r == SY_OK && desc->token) {
         size_t n = strlen(desc->token);
         bool hex = n >= 16 && n < sizeof w->token;
@@ -1329,12 +1404,15 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
         return r;
     }
     /* libwebsockets: one context, one vhost on the address, the page and /ws */
-    lws_set_log_level(LLL_ERR | LLL_WARN, lws_log_to_sy);
+    lws_set_log_level(getenv("SY_LWS_DEBUG") ? 0xff : LLL_ERR | LLL_WARN, lws_log_to_sy);
     struct lws_context_creation_info ci;
     memset(&ci, 0, sizeof ci);
     ci.options = LWS_SERVER_OPTION_EXPLICIT_VHOSTS | LWS_SERVER_OPTION_VALIDATE_UTF8;
     ci.user = w;
-    ci.fd_limit_per_thread = 64 + 2 * w->d.max_clients; /* connections beyond are not accepted */
+    /* the gate holds connections until their request is whole: lws sees only requests being
+     * answered and viewers */
+    ci.fd_limit_per_thread = 256 + 2 * w->d.max_clients;
+    ci.max_http_header_data = SY_WEB_MAX_HEAD + 1024;
     ci.port = CONTEXT_PORT_NO_LISTEN;
     w->ctx = lws_create_context(&ci);
     if (!w->ctx) {
@@ -1343,8 +1421,7 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     }
     struct lws_context_creation_info vi;
     memset(&vi, 0, sizeof vi);
-    vi.port = w->port;
-    vi.iface = w->host;
+    vi.port = CONTEXT_PORT_NO_LISTEN_SERVER; /* the gate listens (sy_web_gate.h) */
     vi.protocols = web_protocols;
     vi.mounts = &web_mount;
     vi.vhost_name = "sy-web";
@@ -1361,20 +1438,33 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     vi.retry_and_idle_policy = &w->idle;
     w->vhost = lws_create_vhost(w->ctx, &vi);
     if (!w->vhost) {
-        sy_error_set(err, SY_ERR_IO, "web: cannot listen on %s:%d (in use, or not an address of this machine)", w->host,
-                     w->port);
         sy_web_destroy(w);
-        return err ? err->code : SY_ERR_IO;
+        return sy_error_set(err, SY_ERR_IO, "web: libwebsockets could not make its vhost");
     }
-    w->port = lws_get_vhost_listen_port(w->vhost);
-    const char *shown = strchr(w->host, ':') ? "[" : "";
-    snprintf(w->url, sizeof w->url, "http://%s%s%s:%d/%s%s", shown, w->host, shown[0] ? "]" : "", w->port,
-             w->token[0] ? "?token=" : "", w->token);
+    /* what sy_web_check_request allows: stills at most 2 x the frame cap per side (within JPEG's) */
+    uint32_t sw = 2 * w->d.max_width, sh = 2 * w->d.max_height;
+    w->policy = (sy_web_policy){.token = w->token, .routes = w->routes, .route_count = w->d.route_count,
+                                .max_body = w->d.max_body,
+                                .still_max_w = sw < SY_JPEG_MAX_SIDE ? sw : SY_JPEG_MAX_SIDE,
+                                .still_max_h = sh < SY_JPEG_MAX_SIDE ? sh : SY_JPEG_MAX_SIDE,
+                                .still_max_pixels = w->d.still_max_pixels};
     if (pthread_create(&w->net_thread, NULL, net_main, w) != 0) {
         sy_web_destroy(w);
         return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: cannot start the network thread");
     }
     w->net_started = true;
+    sy_web_gate_desc gd = {.host = w->host, .port = w->port, .max_pending = w->d.max_pending,
+                           .head_timeout_ms = w->d.head_timeout_ms, .max_body = w->d.max_body,
+                           .deliver = gate_deliver, .user = w};
+    r = sy_web_gate_create(&gd, &w->gate, err);
+    if (r != SY_OK) {
+        sy_web_destroy(w);
+        return r;
+    }
+    w->port = sy_web_gate_port(w->gate);
+    const char *shown = strchr(w->host, ':') ? "[" : "";
+    snprintf(w->url, sizeof w->url, "http://%s%s%s:%d/%s%s", shown, w->host, shown[0] ? "]" : "", w->port,
+             w->token[0] ? "?token=" : "", w->token);
     *out = w;
     return SY_OK;
 }
@@ -1385,9 +1475,23 @@ uint16_t sy_web_port(const sy_web *w) { return (uint16_t)w->port; }
 
 const char *sy_web_url(const sy_web *w) { return w->url; }
 
+void sy_web_stats_get(sy_web *w, sy_web_stats *out)
+{
+    memset(out, 0, sizeof *out);
+    sy_web_gate_stats g = {0};
+    if (w->gate) sy_web_gate_stats_get(w->gate, &g);
+    pthread_mutex_lock(&w->mu);
+    *out = w->st;
+    for (const web_job *j = w->stills; j; j = j->next) out->stills_queued++;
+    pthread_mutex_unlock(&w->mu);
+    out->accepted = g.accepted, out->delivered = g.delivered, out->refused = g.refused;
+    out->evicted = g.evicted, out->expired = g.expired, out->pending = g.pending;
+}
+
 void sy_web_destroy(sy_web *w)
 {
     if (!w) return;
+    sy_web_gate_destroy(w->gate); /* no more connections handed over */
     if (w->net_started) {
         w->net_quit = 1;
         lws_cancel_service(w->ctx);
@@ -1403,6 +1507,18 @@ void sy_web_destroy(sy_web *w)
         web_job *j = w->pending;
         w->pending = j->next;
         job_free(j);
+    }
+    while (w->stills) {
+        web_job *j = w->stills;
+        w->stills = j->next;
+        job_free(j);
+    }
+    while (w->handoffs) {
+        web_handoff *h = w->handoffs;
+        w->handoffs = h->next;
+        close(h->fd);
+        free(h->buf);
+        free(h);
     }
     if (w->latest) {
         free(w->latest->buf);

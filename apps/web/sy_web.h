@@ -15,11 +15,16 @@
  * lws_cancel_service. A slow client never holds up the others: each connection is sent only the
  * newest frame when its socket can take one, older frames are dropped.
  *
- * Security: a loopback address (the default 127.0.0.1) is served to anyone on this machine whose
- * Host header names a loopback host; any other address needs a random access token (generated,
- * printed in the URL) on every request (?token=... or the cookie set by the first good request);
- * WebSocket upgrades from a foreign Origin are refused; bodies, messages, connections and idle
- * time are limited.
+ * Security (docs/WEB.md; the checks are the pure functions of sy_web_check.h): a gate thread
+ * (sy_web_gate.h) holds each connection until its request head is whole (a budget per address, a
+ * head deadline, malformed heads answered at once); a loopback address (the default 127.0.0.1) is
+ * served to anyone on this machine whose Host header is a loopback host (127.0.0.0/8, [::1],
+ * localhost); any other address needs a random access token (generated, printed in the URL) on
+ * every request (?token=... or the cookie set by the first good request); POSTs, stills and
+ * WebSocket upgrades need a same-origin Origin (or the token), POSTs a JSON Content-Type; stills
+ * have a pixel budget per request and per client, wait behind the live view with a deadline and
+ * are cancelled when the requester leaves; bodies, messages, connections and idle time are
+ * limited.
  *
  * Ownership: the server borrows the scene (it must outlive the server). Responses of route
  * handlers are malloc()ed by the handler and freed by the server.
@@ -88,6 +93,12 @@ typedef struct sy_web_desc {
     uint32_t idle_timeout_s;  /**< a silent WebSocket is pinged, then closed after twice this (default 30) */
     const char *filter;       /**< initial display filter of a back-end with SY_CAP_FILTERS (NULL: none) */
     float threshold;          /**< its threshold (0: 0.01) */
+    uint64_t still_max_pixels; /**< a still's W x H at most (default 4194304, 2048 x 2048), per request
+                                    and per client address (its queued and rendering stills together) */
+    uint32_t still_deadline_ms; /**< a still not started within this (it waits behind the live view) is
+                                    answered 503 (default 10000) */
+    uint32_t head_timeout_ms;   /**< a connection's request head must arrive within (default 5000) */
+    uint32_t max_pending;       /**< connections waiting for their head (default 128; 32 per address) */
     const sy_web_route *routes; /**< extra routes (the array is copied; its strings and user pointers must outlive the server) */
     uint32_t route_count;     /**< how many */
 } sy_web_desc;
@@ -95,7 +106,7 @@ typedef struct sy_web_desc {
 /** The server (opaque). */
 typedef struct sy_web sy_web;
 
-/** Binds the address, makes the server's camera node in the scene and starts the network thread.
+/** Binds the address (apps/web/sy_web_gate.h takes the connections until their request is whole), makes the server's camera node in the scene and starts the network thread.
  * Fails with a message naming the address when it cannot be bound, the back-end when it is not
  * registered, the option when a limit is out of range. */
 sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err);
@@ -114,6 +125,19 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err);
 /** The server's camera node (made by sy_web_create; the view every page shares). Any thread; read
  * its matrix on the scene's thread. */
 sy_node sy_web_camera(const sy_web *w);
+/** The server's counters (any thread): connections (sy_web_gate.h) and stills. */
+typedef struct sy_web_stats {
+    uint64_t accepted, delivered, refused, evicted, expired; /**< connections: see sy_web_gate_stats */
+    uint32_t pending;          /**< connections waiting for their head now */
+    uint64_t stills_done;      /**< stills answered with a JPEG */
+    uint64_t stills_refused;   /**< over the per-client budget or the queue (429 / 503) */
+    uint64_t stills_expired;   /**< not started within still_deadline_ms (503) */
+    uint64_t stills_cancelled; /**< the requester left before or while it rendered */
+    uint64_t requests_abandoned; /**< connections closed while their still or route was queued or running */
+    uint32_t stills_queued;    /**< stills waiting now (the one rendering not counted) */
+} sy_web_stats;
+void sy_web_stats_get(sy_web *w, sy_web_stats *out);
+
 /** Makes sy_web_run return (any thread). */
 void sy_web_stop(sy_web *w);
 

@@ -97,7 +97,7 @@ sy_result sy_web_client_connect(const sy_web_client_opts *o, uint32_t timeout_ms
     char host[160];
     snprintf(host, sizeof host, "%s:%u", o->host, o->port);
     cc.host = host;
-    cc.origin = o->origin;
+    cc.origin = o->origin ? o->origin : host; /* a page of the server itself, as a browser names it */
     cc.protocol = "sy-view";
     cc.local_protocol_name = "sy-view";
     cc.pwsi = &c->wsi;

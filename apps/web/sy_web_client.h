@@ -19,7 +19,8 @@ typedef struct sy_web_client_opts {
     const char *host;   /**< e.g. "127.0.0.1" */
     uint16_t port;      /**< the server's port */
     const char *path;   /**< "/ws" or "/ws?token=..." (NULL: "/ws") */
-    const char *origin; /**< the Origin header's host[:port] (libwebsockets writes http:// before it; NULL: none) */
+    const char *origin; /**< the Origin header's host[:port] (libwebsockets writes http:// before it; NULL: the
+                             server's own, host:port, as a page the server served sends it) */
 } sy_web_client_opts;
 
 /** A frame's header (docs/WEB.md). */

@@ -137,7 +137,7 @@ static const char *content_type_of(const char *name)
     return "application/octet-stream";
 }
 
-/* GET /client/PATH: a file of the client folder. PATH is plain names (letters, digits, '.', '_',
+/* GET /client/PATH: a file of the page: client.html, client.js or vendor/...; PATH is plain names (letters, digits, '.', '_',
  * '-') separated by '/', no name starting with '.'; the file must resolve inside the folder
  * (symbolic links out of it are refused) and be a regular file under CLIENT_FILE_MAX. */
 static sy_result on_client(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
@@ -154,6 +154,9 @@ static sy_result on_client(void *user, sy_scene *scene, const sy_web_request *re
         ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' || ch == '-' ||
              (ch == '.' && !start) || (ch == '/' && !start);
     }
+    /* only the page's own files: client.html, client.js and what the build vendored under vendor/
+     * (the npm folder the build installs beside them is not served) */
+    ok = ok && (!strcmp(rel, "client.html") || !strcmp(rel, "client.js") || !strncmp(rel, "vendor/", 7));
     if (!ok || rel[n - 1] == '/') return sy_error_set(err, SY_ERR_NOT_FOUND, "/client/%.64s: no such file", rel);
     char path[PATH_MAX], real[PATH_MAX];
     if (snprintf(path, sizeof path, "%s/%s", c->client_dir, rel) >= (int)sizeof path || !realpath(path, real) ||

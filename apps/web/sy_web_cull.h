@@ -8,8 +8,9 @@
  *   GET  /api/view        the server's current view as JSON, in the form /api/cull takes
  *                         ({"position", "orientation", "fov", "target"}): the client page starts
  *                         from the view every other back-end starts from
- *   GET  /client/...      the three.js client page (client.html, client.js, vendored three.js) from
- *                         the folder the build made (apps/cull/client), when one is given
+ *   GET  /client/...      the three.js client page (client.html, client.js, vendor/: the vendored
+ *                         three.js; nothing else) from the folder the build made (apps/cull/client),
+ *                         when one is given
  *
  * Built into sy_web where the culling service is (the Embree back-ends). Every handler runs on the
  * server's render thread (the scene's owner), behind the server's token check like every route.

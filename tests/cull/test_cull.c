@@ -198,6 +198,9 @@ static void test_boxes(void)
         {"{\"position\":[0,0],\"orientation\":[0,0,0,1],\"fov\":40,\"width\":10,\"height\":10,\"budget\":5}", SY_ERR_INVALID_ARGUMENT, "position must be an array of 3"},
         {"{\"position\":[0,0,\"a\"],\"orientation\":[0,0,0,1],\"fov\":40,\"width\":10,\"height\":10,\"budget\":5}", SY_ERR_INVALID_ARGUMENT, "position[2]"},
         {"{\"position\":[0,0,1e999],\"orientation\":[0,0,0,1],\"fov\":40,\"width\":10,\"height\":10,\"budget\":5}", SY_ERR_INVALID_ARGUMENT, "position[2] must be finite"},
+        /* issue 32: 1e19 passed (the bound was 1e30) and Embree aborted on the ray origin */
+        {"{\"position\":[1e19,0,0],\"orientation\":[0,0,0,1],\"fov\":40,\"width\":10,\"height\":10,\"budget\":5}", SY_ERR_INVALID_ARGUMENT, "position.x must be a finite number at most 1e+12"},
+        {"{\"position\":[0,-1.1e12,0],\"orientation\":[0,0,0,1],\"fov\":40,\"width\":10,\"height\":10,\"budget\":5}", SY_ERR_INVALID_ARGUMENT, "position.y"},
         {"{\"position\":[0,0,NaN],\"orientation\":[0,0,0,1],\"fov\":40,\"width\":10,\"height\":10,\"budget\":5}", SY_ERR_PARSE, "JSON"},
         {"{\"position\":[0,0,1],\"orientation\":[0,0,0,0],\"fov\":40,\"width\":10,\"height\":10,\"budget\":5}", SY_ERR_INVALID_ARGUMENT, "orientation must be a nonzero"},
         {"{\"position\":[0,0,1],\"orientation\":[0,0,0,1],\"fov\":180,\"width\":10,\"height\":10,\"budget\":5}", SY_ERR_INVALID_ARGUMENT, "fov"},

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # fuzz.sh TARGET SECONDS [options] — fuzzes one libFuzzer target for a bounded time and prints the
-# totals (executions, exec/s, corpus size) at the end. Targets: gltf glb x3d exr changes.
+# totals (executions, exec/s, corpus size) at the end. Targets: gltf glb x3d exr changes web_request
+# web_message cull_query.
 #
 #   tests/fuzz/fuzz.sh x3d 600                 # 10 minutes, one process
 #   tests/fuzz/fuzz.sh gltf 3600 -j 2          # two libFuzzer jobs in parallel
@@ -55,7 +56,10 @@ case $target in
   x3d) len=16384; seed_dirs=(x3d); seed_pat=('*.x3d'); res_pat=('*.png' '*.jpg' '*.jpeg' '*.x3d'); dicts=(x3d.dict) ;;
   exr) len=65536; seed_dirs=(.); seed_pat=('*.exr'); res_pat=(); dicts=(exr.dict) ;;
   changes) len=65536; seed_dirs=(); seed_pat=(); res_pat=(); dicts=(wire.dict) ;;
-  *) echo "fuzz.sh: unknown target '$target' (gltf glb x3d exr changes)" >&2; exit 2 ;;
+  web_request) len=12288; seed_dirs=(); seed_pat=(); res_pat=(); dicts=(web.dict) ;;
+  web_message) len=4096; seed_dirs=(); seed_pat=(); res_pat=(); dicts=(web.dict) ;;
+  cull_query) len=65536; seed_dirs=(); seed_pat=(); res_pat=(); dicts=(web.dict) ;;
+  *) echo "fuzz.sh: unknown target '$target' (gltf glb x3d exr changes web_request web_message cull_query)" >&2; exit 2 ;;
 esac
 [ -n "$max_len" ] && len=$max_len
 

@@ -15,22 +15,37 @@
  *                 subprotocol upgrades are refused; a viewer beyond max_clients is refused
  *   web_progressive  the path tracer refines while the view rests and restarts when it moves
  *   web_token     listening on 0.0.0.0: without the token 401 with the page saying it is missing,
- *                 a wrong one 403, the right one 200 plus a cookie that works alone; WebSocket
- *                 upgrades need it too */
+ *                 a wrong one 403 (one of 200 characters too), the right one 200 plus a cookie
+ *                 that works alone; WebSocket upgrades need it too
+ *   web_hostile   issue 32's findings: Hosts that only look like loopback (DNS rebinding), for
+ *                 pages and upgrades; upgrades off /ws; cross-site POSTs (text/plain, foreign or
+ *                 no Origin); stills without Origin, past the side cap, past the pixel budget; a
+ *                 one-character header name (400 at once); two pipelined GETs (the first answered,
+ *                 then a clean close); paths of 256+ bytes (414); a binary message announcing
+ *                 50 MB (close 1009 before its payload)
+ *   web_slowloris 100 reconnecting slowloris connections; an honest client's 20 GETs all answered
+ *   web_stillbudget  stills queue behind a held render thread: the per-client pixel budget (429),
+ *                 another client's own budget, a still whose requester left is not rendered
+ *   web_clientfiles  /client/ serves client.html, client.js and vendor/ only, not npm/ */
 #define _GNU_SOURCE /* strcasestr */
 #include "sy_demo.h"
 #include "sy_jpeg.h"
 #include "sy_mediators.h"
 #include "sy_web.h"
 #include "sy_web_client.h"
+#ifdef SY_WEB_HAVE_CULL
+#include "sy_web_cull.h"
+#endif
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/time.h>
 #include <unistd.h>
 
@@ -58,15 +73,37 @@ typedef struct http_answer {
     size_t body_len;
 } http_answer;
 
+/* A connection to the server from source (NULL: 127.0.0.1; 127.0.0.2 is another client). */
+static int connect_from(uint16_t port, const char *source)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    if (fd < 0) return -1;
+    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons(port)};
+    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    struct timeval tv = {30, 0}; /* a guard against a hang, not a measurement */
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    if (source) {
+        struct sockaddr_in src = {.sin_family = AF_INET};
+        inet_pton(AF_INET, source, &src.sin_addr);
+        if (bind(fd, (struct sockaddr *)&src, sizeof src) != 0) {
+            close(fd);
+            return -1;
+        }
+    }
+    if (connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+static const char *http_source; /* the source address of http() (NULL: 127.0.0.1) */
+
 static int http(uint16_t port, const char *request, const void *body, size_t body_len, http_answer *a)
 {
     memset(a, 0, sizeof *a);
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons(port)};
-    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    struct timeval tv = {30, 0};
-    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    if (fd < 0 || connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
+    int fd = connect_from(port, http_source);
+    if (fd < 0) {
         if (fd >= 0) close(fd);
         return -1;
     }
@@ -113,8 +150,9 @@ static int http(uint16_t port, const char *request, const void *body, size_t bod
 static int get(uint16_t port, const char *path, const char *extra, http_answer *a)
 {
     char req[2048];
-    snprintf(req, sizeof req, "GET %s HTTP/1.1\r\nHost: 127.0.0.1:%u\r\n%sConnection: close\r\n\r\n", path, port,
-             extra ? extra : "");
+    /* as the page asks: its own Origin (stills need it) */
+    snprintf(req, sizeof req, "GET %s HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nOrigin: http://127.0.0.1:%u\r\n%sConnection: close\r\n\r\n",
+             path, port, port, extra ? extra : "");
     return http(port, req, NULL, 0, a);
 }
 
@@ -160,15 +198,20 @@ static sy_result route_echo(void *user, sy_scene *scene, const sy_web_request *r
     return SY_OK;
 }
 
+static sy_result route_block(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err);
+
 static int start(server *s, const char *listen, const char *backend, sy_error *e)
 {
     memset(s, 0, sizeof *s);
     sy_demo_info demo;
     if (sy_scene_create(&s->scene, e) || sy_demo_build(s->scene, &demo, e) || sy_scene_commit(s->scene, NULL, e)) return 1;
-    static const sy_web_route routes[] = {{"GET", "/api/object/", route_info, NULL}, {"POST", "/api/echo", route_echo, NULL}};
+    static const sy_web_route routes[] = {{"GET", "/api/object/", route_info, NULL},
+                                          {"POST", "/api/echo", route_echo, NULL},
+                                          {"GET", "/api/block", route_block, NULL}};
     sy_web_desc d = {.scene = s->scene, .root = demo.root, .camera = demo.camera, .background = demo.background,
                      .backend = backend, .listen = listen, .max_body = 1000, .max_message = 256, .max_clients = 3,
-                     .routes = routes, .route_count = 2};
+                     .routes = routes, .route_count = 3,
+                     .still_max_pixels = 20000}; /* small stills: fast on a loaded machine */
     if (sy_web_create(&d, &s->web, e)) return 1;
     return pthread_create(&s->th, NULL, server_main, s) != 0;
 }
@@ -249,8 +292,8 @@ static int test_routes(uint16_t port)
     for (size_t i = 0; i < sizeof body; ++i) body[i] = (char)('a' + i % 26), sum += (unsigned char)body[i];
     snprintf(req, sizeof req,
              "POST /api/echo HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nContent-Type: application/json\r\nContent-Length: %zu\r\n"
-             "Connection: close\r\n\r\n",
-             port, sizeof body);
+             "Origin: http://127.0.0.1:%u\r\nConnection: close\r\n\r\n",
+             port, sizeof body, port);
     CHECK(http(port, req, body, sizeof body, &a) == 0);
     char want[64];
     snprintf(want, sizeof want, "%zu %lu", sizeof body, sum);
@@ -439,6 +482,12 @@ static int test_token(void)
     free(a.body);
     CHECK(get(port, "/?token=short", NULL, &a) == 0 && a.status == 403);
     free(a.body);
+    /* a token of 128 characters or more is wrong, not missing (issue 32) */
+    char longtok[300] = "/?token=";
+    memset(longtok + 8, 'a', 200);
+    CHECK(get(port, longtok, NULL, &a) == 0);
+    CHECK(a.status == 403 && strstr((char *)a.body, "token wrong"));
+    free(a.body);
     snprintf(path, sizeof path, "/?token=%s", token);
     CHECK(get(port, path, NULL, &a) == 0);
     CHECK(a.status == 200 && strstr((char *)a.body, "sy-canvas"));
@@ -459,6 +508,384 @@ static int test_token(void)
     return stop(&s);
 }
 
+/* >>the render thread held in a route (GET /api/block) until the test releases it: stills queue
+ * behind it deterministically */
+static pthread_mutex_t block_mu = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t block_cv = PTHREAD_COND_INITIALIZER;
+static int block_state; /* 0 free, 1 a handler is held, 2 released */
+
+static sy_result route_block(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+{
+    (void)user, (void)scene, (void)req, (void)err;
+    pthread_mutex_lock(&block_mu);
+    block_state = 1;
+    pthread_cond_broadcast(&block_cv);
+    while (block_state != 2) pthread_cond_wait(&block_cv, &block_mu);
+    block_state = 0;
+    pthread_mutex_unlock(&block_mu);
+    resp->body = (uint8_t *)strdup("released");
+    resp->body_len = 8;
+    snprintf(resp->content_type, sizeof resp->content_type, "text/plain");
+    return SY_OK;
+}
+
+/* Sends GET /api/block and waits until the render thread is in it; returns the connection. */
+static int hold_render_thread(uint16_t port)
+{
+    int fd = connect_from(port, NULL);
+    char req[200];
+    int n = snprintf(req, sizeof req, "GET /api/block HTTP/1.1\r\nHost: 127.0.0.1:%u\r\n\r\n", port);
+    if (fd < 0 || send(fd, req, (size_t)n, MSG_NOSIGNAL) != n) return -1;
+    pthread_mutex_lock(&block_mu);
+    while (block_state != 1) pthread_cond_wait(&block_cv, &block_mu);
+    pthread_mutex_unlock(&block_mu);
+    return fd;
+}
+
+static void release_render_thread(int fd)
+{
+    pthread_mutex_lock(&block_mu);
+    block_state = 2;
+    pthread_cond_broadcast(&block_cv);
+    pthread_mutex_unlock(&block_mu);
+    char buf[512];
+    while (recv(fd, buf, sizeof buf, 0) > 0) {} /* the answer, then the close */
+    close(fd);
+}
+
+/* A request sent on a connection of its own, answered later (read_answer). */
+static int send_request(uint16_t port, const char *source, const char *req)
+{
+    int fd = connect_from(port, source);
+    size_t n = strlen(req);
+    if (fd >= 0 && send(fd, req, n, MSG_NOSIGNAL) != (ssize_t)n) close(fd), fd = -1;
+    return fd;
+}
+
+/* Everything up to the peer's close: its HTTP status lines counted, the first status returned. */
+static int read_all(int fd, int *answers, char *first, size_t first_len)
+{
+    char buf[1 << 16];
+    size_t len = 0;
+    ssize_t got;
+    while ((got = recv(fd, buf + len, sizeof buf - 1 - len, 0)) > 0 && len + (size_t)got < sizeof buf - 1) len += (size_t)got;
+    if (got > 0) len += (size_t)got;
+    buf[len] = 0;
+    close(fd);
+    int n = 0;
+    for (const char *p = buf; (p = strstr(p, "HTTP/1.1 ")) != NULL; p += 9) n++;
+    if (answers) *answers = n;
+    if (first) snprintf(first, first_len, "%.*s", (int)(len < first_len - 1 ? len : first_len - 1), buf);
+    return len >= 12 ? atoi(buf + 9) : -1;
+}
+
+static int raw_status(uint16_t port, const char *req)
+{
+    int fd = send_request(port, NULL, req);
+    return fd < 0 ? -1 : read_all(fd, NULL, NULL, 0);
+}
+
+/* issue 32's findings, each failed before its fix (see the commit) */
+static int test_hostile(uint16_t port)
+{
+    char req[2048];
+    http_answer a;
+    /* DNS rebinding: the Host is parsed; a name that starts with 127. is no loopback address */
+    const char *hosts_bad[] = {"127.attacker.example", "127.0.0.1.attacker.example", "localhost.attacker.example",
+                               "127.0.0.1:80:80", "[::1]x", "127.1", "evil.example"};
+    for (size_t i = 0; i < sizeof hosts_bad / sizeof *hosts_bad; ++i) {
+        snprintf(req, sizeof req, "GET / HTTP/1.1\r\nHost: %s\r\nConnection: close\r\n\r\n", hosts_bad[i]);
+        int st = raw_status(port, req);
+        if (st != 403) fprintf(stderr, "Host: %s: %d\n", hosts_bad[i], st);
+        CHECK(st == 403);
+    }
+    const char *hosts_good[] = {"localhost", "LocalHost:1", "127.0.0.1", "127.9.8.7:65535", "[::1]:8080"};
+    for (size_t i = 0; i < sizeof hosts_good / sizeof *hosts_good; ++i) {
+        snprintf(req, sizeof req, "GET / HTTP/1.1\r\nHost: %s\r\nConnection: close\r\n\r\n", hosts_good[i]);
+        CHECK(raw_status(port, req) == 200);
+    }
+    /* ... also for the WebSocket upgrade (the Origin matching that Host) */
+    snprintf(req, sizeof req,
+             "GET /ws HTTP/1.1\r\nHost: 127.attacker.example:%u\r\nOrigin: http://127.attacker.example:%u\r\n"
+             "Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+             "Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: sy-view\r\n\r\n", port, port);
+    CHECK(raw_status(port, req) != 101);
+    /* the upgrade only at /ws (this one is fine but for its path) */
+    snprintf(req, sizeof req,
+             "GET /elsewhere HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nOrigin: http://127.0.0.1:%u\r\n"
+             "Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+             "Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: sy-view\r\n\r\n", port, port);
+    CHECK(raw_status(port, req) != 101);
+    /* a cross-site "simple" POST: text/plain, or another Origin, or none, never reaches the route */
+    const char *posts[] = {"Origin: http://127.0.0.1:%u\r\nContent-Type: text/plain\r\n",
+                           "Origin: http://evil.example:%u\r\nContent-Type: application/json\r\n",
+                           "Content-Type: application/json\r\nX-Port: %u\r\n"};
+    const int want[] = {415, 403, 403};
+    for (int i = 0; i < 3; ++i) {
+        char extra[200];
+        snprintf(extra, sizeof extra, posts[i], port);
+        snprintf(req, sizeof req, "POST /api/echo HTTP/1.1\r\nHost: 127.0.0.1:%u\r\n%sContent-Length: 2\r\n\r\n{}", port, extra);
+        int st = raw_status(port, req);
+        if (st != want[i]) fprintf(stderr, "POST %d: %d\n", i, st);
+        CHECK(st == want[i]);
+    }
+    /* stills: only for the page's origin; sides past the cap refused up front; the pixel budget */
+    snprintf(req, sizeof req, "GET /api/frame.jpg?w=8&h=8 HTTP/1.1\r\nHost: 127.0.0.1:%u\r\n\r\n", port);
+    CHECK(raw_status(port, req) == 403);
+    CHECK(get(port, "/api/frame.jpg?w=8192&h=8192", NULL, &a) == 0 && a.status == 400 && strstr((char *)a.body, "1..3840"));
+    free(a.body);
+    CHECK(get(port, "/api/frame.jpg?w=200&h=101", NULL, &a) == 0 && a.status == 413 && strstr((char *)a.body, "budget"));
+    free(a.body);
+    /* a one-character header name: 400 at once (libwebsockets waited 10 s for the end of the head) */
+    snprintf(req, sizeof req, "GET / HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nConnection: close\r\nX: y\r\n\r\n", port);
+    CHECK(raw_status(port, req) == 400);
+    /* two pipelined GETs: the first answered with Connection: close, then a clean close */
+    snprintf(req, sizeof req, "GET /api/object/1 HTTP/1.1\r\nHost: 127.0.0.1:%u\r\n\r\n"
+             "GET /api/object/2 HTTP/1.1\r\nHost: 127.0.0.1:%u\r\n\r\n", port, port);
+    int answers = 0;
+    char head[400];
+    int fd = send_request(port, NULL, req);
+    CHECK(fd >= 0 && read_all(fd, &answers, head, sizeof head) == 200);
+    if (answers != 1 || !strcasestr(head, "connection: close")) fprintf(stderr, "pipelined: %d answers\n%s\n", answers, head);
+    CHECK(answers == 1 && strcasestr(head, "connection: close") && strstr(head, "/api/object/1"));
+    /* a path of 256 bytes or more: 414, never the page */
+    char path[400] = "/";
+    memset(path + 1, 'a', 300);
+    CHECK(get(port, path, NULL, &a) == 0 && a.status == 414);
+    free(a.body);
+    path[256] = 0; /* 256 bytes */
+    CHECK(get(port, path, NULL, &a) == 0 && a.status == 414);
+    free(a.body);
+    /* a binary message announcing 50 MB: closed at once with 1009, before its payload is sent */
+    snprintf(req, sizeof req,
+             "GET /ws HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nOrigin: http://127.0.0.1:%u\r\n"
+             "Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+             "Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: sy-view\r\n\r\n", port, port);
+    fd = send_request(port, NULL, req);
+    CHECK(fd >= 0);
+    uint8_t frame[14 + 1000] = {0x82, 0x80 | 127, 0, 0, 0, 0, 0x02, 0xfa, 0xf0, 0x80, 1, 2, 3, 4}; /* 50,000,000 */
+    CHECK(send(fd, frame, sizeof frame, MSG_NOSIGNAL) == (ssize_t)sizeof frame);
+    uint8_t buf[1 << 16];
+    size_t len = 0;
+    ssize_t got;
+    while ((got = recv(fd, buf + len, sizeof buf - len, 0)) > 0) len += (size_t)got;
+    close(fd);
+    /* after the 101 and the hello: a close frame (0x88) whose code is 1009 */
+    bool closed_1009 = false;
+    for (size_t i = 0; i + 3 < len; ++i)
+        if (buf[i] == 0x88 && (buf[i + 1] & 0x7f) >= 2 && buf[i + 2] == 0x03 && buf[i + 3] == 0xf1) closed_1009 = true;
+    CHECK(strstr((char *)buf, " 101 ") && closed_1009);
+    return 0;
+}
+
+/* 100 reconnecting slowloris connections from 127.0.0.1 (each sends its head a byte at a time and
+ * reconnects when the server closes it) while an honest client at 127.0.0.2 asks for the page 20
+ * times: every GET is answered. */
+typedef struct slowloris {
+    uint16_t port;
+    volatile int stop;
+    uint64_t reconnects;
+} slowloris;
+
+static void *slowloris_main(void *p)
+{
+    slowloris *sl = p;
+    enum { N = 100 };
+    int fd[N];
+    char head[128];
+    int hn = snprintf(head, sizeof head, "GET / HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nX-Slow: ", sl->port);
+    for (int i = 0; i < N; ++i) fd[i] = -1;
+    while (!sl->stop) {
+        struct pollfd pf[N];
+        for (int i = 0; i < N; ++i) {
+            if (fd[i] < 0) {
+                fd[i] = connect_from(sl->port, NULL);
+                if (fd[i] >= 0) send(fd[i], head, (size_t)hn, MSG_NOSIGNAL | MSG_DONTWAIT);
+                sl->reconnects++;
+            }
+            pf[i] = (struct pollfd){.fd = fd[i], .events = POLLIN};
+        }
+        poll(pf, N, 20); /* the attacker's pace: a byte per connection every 20 ms */
+        for (int i = 0; i < N; ++i) {
+            if (fd[i] < 0) continue;
+            char b[256];
+            if ((pf[i].revents && recv(fd[i], b, sizeof b, MSG_DONTWAIT) <= 0) || pf[i].revents & (POLLHUP | POLLERR) ||
+                send(fd[i], "a", 1, MSG_NOSIGNAL | MSG_DONTWAIT) < 0) {
+                close(fd[i]);
+                fd[i] = -1;
+            }
+        }
+    }
+    for (int i = 0; i < N; ++i)
+        if (fd[i] >= 0) close(fd[i]);
+    return NULL;
+}
+
+static int test_slowloris(server *s, uint16_t port)
+{
+    slowloris sl = {.port = port};
+    pthread_t th;
+    CHECK(pthread_create(&th, NULL, slowloris_main, &sl) == 0);
+    /* the attack is on once the server holds a full budget for that address and evicts */
+    sy_web_stats st;
+    do {
+        usleep(1000); /* polls the server's state */
+        sy_web_stats_get(s->web, &st);
+    } while (st.evicted < 100);
+    int answered = 0;
+    http_source = "127.0.0.2";
+    for (int i = 0; i < 20; ++i) {
+        http_answer a;
+        if (get(port, "/", NULL, &a) == 0) {
+            answered += a.status == 200;
+            free(a.body);
+        }
+    }
+    http_source = NULL;
+    sy_web_stats_get(s->web, &st);
+    sl.stop = 1;
+    pthread_join(th, NULL);
+    printf("slowloris: honest GETs answered %d/20 (attacker reconnects %llu; server: accepted %llu, evicted %llu, "
+           "expired %llu, waiting %u)\n",
+           answered, (unsigned long long)sl.reconnects, (unsigned long long)st.accepted, (unsigned long long)st.evicted,
+           (unsigned long long)st.expired, st.pending);
+    CHECK(answered == 20);
+    return 0;
+}
+
+/* The still budget: a client's queued and rendering stills together; another client is served;
+ * a still whose requester left is not rendered. The render thread is held in /api/block so the
+ * stills wait in the queue, whatever the machine's speed. */
+static void wait_queued(server *s, uint32_t n)
+{
+    sy_web_stats st;
+    for (;;) {
+        sy_web_stats_get(s->web, &st);
+        if (st.stills_queued == n) return;
+        usleep(1000); /* polls the server's state */
+    }
+}
+
+static int test_still_budget(server *s, uint16_t port)
+{
+    char req[300];
+    const char *fmt = "GET /api/frame.jpg?w=%u&h=%u HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nOrigin: http://127.0.0.1:%u\r\n\r\n";
+    sy_web_stats st;
+    sy_web_stats_get(s->web, &st);
+    uint64_t abandoned = st.requests_abandoned, cancelled = st.stills_cancelled, done = st.stills_done;
+    int hold = hold_render_thread(port);
+    CHECK(hold >= 0);
+    snprintf(req, sizeof req, fmt, 100, 100, port, port);
+    int first = send_request(port, NULL, req); /* 10000 pixels of this client's 20000 */
+    CHECK(first >= 0);
+    wait_queued(s, 1);
+    /* 12000 more from the same client: over its budget while the first waits */
+    http_answer a;
+    CHECK(get(port, "/api/frame.jpg?w=120&h=100", NULL, &a) == 0);
+    CHECK(a.status == 429 && strstr((char *)a.body, "budget"));
+    free(a.body);
+    /* another client has a budget of its own */
+    snprintf(req, sizeof req, fmt, 141, 141, port, port);
+    int second = send_request(port, "127.0.0.2", req);
+    CHECK(second >= 0);
+    wait_queued(s, 2);
+    /* a third client leaves before its still is rendered: it is not rendered */
+    snprintf(req, sizeof req, fmt, 64, 48, port, port);
+    int gone = send_request(port, "127.0.0.3", req);
+    CHECK(gone >= 0);
+    wait_queued(s, 3);
+    close(gone);
+    do {
+        usleep(1000); /* polls the server's state */
+        sy_web_stats_get(s->web, &st);
+    } while (st.requests_abandoned == abandoned);
+    release_render_thread(hold);
+    char head[300];
+    int st1 = read_all(first, NULL, head, sizeof head);
+    if (st1 != 200) fprintf(stderr, "first still: %s\n", head);
+    CHECK(st1 == 200);
+    int st2 = read_all(second, NULL, head, sizeof head);
+    if (st2 != 200) fprintf(stderr, "second still: %s\n", head);
+    CHECK(st2 == 200);
+    do {
+        usleep(1000);
+        sy_web_stats_get(s->web, &st);
+    } while (st.stills_cancelled + st.stills_done < cancelled + done + 3);
+    CHECK(st.stills_cancelled == cancelled + 1 && st.stills_done == done + 2);
+    return 0;
+}
+
+/* /client/ serves the page's own files only: client.html, client.js, vendor/...; not the npm
+ * folder the build installs beside them (issue 32: it was served whole). */
+static int test_client_files(void)
+{
+#ifdef SY_WEB_HAVE_CULL
+    sy_error err = {0};
+    char dir[] = "/tmp/sy_web_client_XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    const char *files[] = {"client.html", "client.js", "vendor/three/three.module.js", "npm/package.json",
+                           "npm/node_modules/three/package.json", "other.txt"};
+    char path[512];
+    snprintf(path, sizeof path, "%s/vendor", dir), mkdir(path, 0700);
+    snprintf(path, sizeof path, "%s/vendor/three", dir), mkdir(path, 0700);
+    snprintf(path, sizeof path, "%s/npm", dir), mkdir(path, 0700);
+    snprintf(path, sizeof path, "%s/npm/node_modules", dir), mkdir(path, 0700);
+    snprintf(path, sizeof path, "%s/npm/node_modules/three", dir), mkdir(path, 0700);
+    for (size_t i = 0; i < sizeof files / sizeof *files; ++i) {
+        snprintf(path, sizeof path, "%s/%s", dir, files[i]);
+        FILE *f = fopen(path, "w");
+        CHECK(f != NULL);
+        fputs(files[i], f);
+        fclose(f);
+    }
+    server s = {0};
+    sy_demo_info demo;
+    CHECK_OK(sy_scene_create(&s.scene, &err));
+    CHECK_OK(sy_demo_build(s.scene, &demo, &err));
+    CHECK_OK(sy_scene_commit(s.scene, NULL, &err));
+    sy_web_cull *cull = NULL;
+    sy_web_route routes[SY_WEB_CULL_MAX_ROUTES];
+    uint32_t n = 0;
+    CHECK_OK(sy_web_cull_create(s.scene, demo.root, dir, &cull, routes, &n, &err));
+    sy_web_desc d = {.scene = s.scene, .root = demo.root, .camera = demo.camera, .backend = "whitted",
+                     .listen = "127.0.0.1:0", .routes = routes, .route_count = n};
+    CHECK_OK(sy_web_create(&d, &s.web, &err));
+    sy_web_cull_attach(cull, s.web);
+    CHECK(pthread_create(&s.th, NULL, server_main, &s) == 0);
+    uint16_t port = sy_web_port(s.web);
+    const int want[] = {200, 200, 200, 404, 404, 404};
+    for (size_t i = 0; i < sizeof files / sizeof *files; ++i) {
+        http_answer a;
+        snprintf(path, sizeof path, "/client/%s", files[i]);
+        CHECK(get(port, path, NULL, &a) == 0);
+        if (a.status != want[i]) fprintf(stderr, "%s: %d\n", path, a.status);
+        CHECK(a.status == want[i]);
+        if (want[i] == 200) CHECK(!strcmp((char *)a.body, files[i]));
+        free(a.body);
+    }
+    /* the culler after the server, before the scene */
+    sy_web_stop(s.web);
+    pthread_join(s.th, NULL);
+    sy_web_destroy(s.web);
+    sy_web_cull_destroy(cull);
+    sy_scene_destroy(s.scene);
+    int r = s.r != SY_OK;
+    for (size_t i = sizeof files / sizeof *files; i-- > 0;) {
+        snprintf(path, sizeof path, "%s/%s", dir, files[i]);
+        remove(path);
+    }
+    const char *dirs[] = {"npm/node_modules/three", "npm/node_modules", "npm", "vendor/three", "vendor", ""};
+    for (size_t i = 0; i < sizeof dirs / sizeof *dirs; ++i) {
+        snprintf(path, sizeof path, "%s/%s", dir, dirs[i]);
+        rmdir(path);
+    }
+    return r;
+#else
+    printf("skip: this sy_web has no culling service (the Embree back-ends)\n");
+    return 77;
+#endif
+}
+
 int main(int argc, char **argv)
 {
     const char *which = argc > 1 ? argv[1] : "all";
@@ -466,6 +893,11 @@ int main(int argc, char **argv)
     if (sy_mediators_register_builtin(&err) != SY_OK) {
         fprintf(stderr, "%s\n", err.message);
         return 1;
+    }
+    if (!strcmp(which, "clientfiles")) {
+        int f = test_client_files();
+        if (!f) printf("web %s: ok\n", which);
+        return f;
     }
     if (!strcmp(which, "token") || !strcmp(which, "progressive")) {
         int f = !strcmp(which, "token") ? test_token() : test_progressive();
@@ -483,6 +915,9 @@ int main(int argc, char **argv)
     if (!strcmp(which, "still") || !strcmp(which, "all")) failed |= test_still(port);
     if (!strcmp(which, "routes") || !strcmp(which, "all")) failed |= test_routes(port);
     if (!strcmp(which, "stream") || !strcmp(which, "all")) failed |= test_stream(port);
+    if (!strcmp(which, "hostile") || !strcmp(which, "all")) failed |= test_hostile(port);
+    if (!strcmp(which, "slowloris") || !strcmp(which, "all")) failed |= test_slowloris(&s, port);
+    if (!strcmp(which, "stillbudget") || !strcmp(which, "all")) failed |= test_still_budget(&s, port);
     failed |= stop(&s);
     if (!failed) printf("web %s: ok\n", which);
     return failed;

@@ -25,29 +25,42 @@ if [ -z "$url" ]; then
     bad "no URL printed: $(cat "$out/log" "$out/err")"
 else
     case $url in *token=*) bad "a loopback server asks for a token: $url" ;; esac
+    origin=${url%/}  # stills and POSTs need the page's own Origin (docs/WEB.md, Security)
     code=$(curl -s -o "$out/page.html" -w '%{http_code}' "$url")
     [ "$code" = 200 ] && grep -q 'id="sy-canvas"' "$out/page.html" || bad "the page: HTTP $code"
-    code=$(curl -s -o "$out/still.jpg" -w '%{http_code} %{content_type}' "${url}api/frame.jpg?w=64&h=48")
+    code=$(curl -s -o "$out/still.jpg" -w '%{http_code} %{content_type}' -H "Origin: $origin" "${url}api/frame.jpg?w=64&h=48")
     [ "$code" = "200 image/jpeg" ] || bad "the still: $code"
     head -c 2 "$out/still.jpg" | od -An -tx1 | grep -q "ff d8" || bad "the still is no JPEG"
-    code=$(curl -s -o "$out/e" -w '%{http_code}' "${url}api/frame.jpg?w=64")
+    code=$(curl -s -o "$out/e" -w '%{http_code}' -H "Origin: $origin" "${url}api/frame.jpg?w=64")
     [ "$code" = 400 ] && grep -q "missing h=" "$out/e" || bad "a still without h: $code $(cat "$out/e")"
     # remote culling (where sy has the culling service): the view, a query, an object, bad input
     code=$(curl -s -o "$out/view.json" -w '%{http_code}' "${url}api/view")
     if [ "$code" = 200 ]; then
         view=$(sed 's/,"target".*/}/' "$out/view.json")
         q=${view%\}},\"width\":64,\"height\":48,\"budget\":100000000\}
-        code=$(curl -s -o "$out/cull.json" -w '%{http_code}' -H 'Content-Type: application/json' --data "$q" "${url}api/cull")
+        code=$(curl -s -o "$out/cull.json" -w '%{http_code}' -H 'Content-Type: application/json' -H "Origin: $origin" --data "$q" "${url}api/cull")
         id=$(grep -o '"objects":\[{"id":[0-9]*' "$out/cull.json" | grep -o '[0-9]*$')
         [ "$code" = 200 ] && [ -n "$id" ] || bad "POST /api/cull of the server's view: $code $(head -c 300 "$out/cull.json")"
         code=$(curl -s -o "$out/obj.glb" -w '%{http_code} %{content_type}' "${url}api/object/$id")
         [ "$code" = "200 model/gltf-binary" ] && head -c 4 "$out/obj.glb" | grep -q glTF || bad "GET /api/object/$id: $code"
         code=$(curl -s -o "$out/e" -w '%{http_code}' "${url}api/object/4000000000")
         [ "$code" = 404 ] || bad "an unknown object: $code $(cat "$out/e")"
-        code=$(curl -s -o "$out/e" -w '%{http_code}' --data '{"position":[0,0,' "${url}api/cull")
+        code=$(curl -s -o "$out/e" -w '%{http_code}' -H 'Content-Type: application/json' -H "Origin: $origin" --data '{"position":[0,0,' "${url}api/cull")
         [ "$code" = 400 ] || bad "malformed JSON: $code $(cat "$out/e")"
-        code=$(curl -s -o "$out/e" -w '%{http_code}' --data "${q/\"fov\":/\"fov\":-}" "${url}api/cull")
+        code=$(curl -s -o "$out/e" -w '%{http_code}' -H 'Content-Type: application/json' -H "Origin: $origin" --data "${q/\"fov\":/\"fov\":-}" "${url}api/cull")
         [ "$code" = 400 ] && grep -q fov "$out/e" || bad "a negative fov: $code $(cat "$out/e")"
+        # issue 32: a position past SY_COORD_MAX aborted the process in Embree (ray.valid())
+        code=$(curl -s -o "$out/e" -w '%{http_code}' -H 'Content-Type: application/json' -H "Origin: $origin" \
+            --data "$(echo "$q" | sed 's/"position":\[[^]]*\]/"position":[1e19,0,0]/')" "${url}api/cull")
+        [ "$code" = 400 ] && grep -q "position.x" "$out/e" || bad "a position of 1e19: $code $(cat "$out/e")"
+        kill -0 $pid 2>/dev/null || bad "sy web died on a position of 1e19"
+        # a cross-site "simple" POST (text/plain, another Origin, or none) is refused
+        code=$(curl -s -o "$out/e" -w '%{http_code}' -H 'Content-Type: text/plain' -H "Origin: $origin" --data "$q" "${url}api/cull")
+        [ "$code" = 415 ] || bad "a text/plain POST: $code $(cat "$out/e")"
+        code=$(curl -s -o "$out/e" -w '%{http_code}' -H 'Content-Type: application/json' -H "Origin: http://evil.example" --data "$q" "${url}api/cull")
+        [ "$code" = 403 ] || bad "a POST from another origin: $code $(cat "$out/e")"
+        code=$(curl -s -o "$out/e" -w '%{http_code}' -H 'Content-Type: application/json' --data "$q" "${url}api/cull")
+        [ "$code" = 403 ] || bad "a POST without Origin: $code $(cat "$out/e")"
         code=$(curl -s -o "$out/e" -w '%{http_code}' "${url}client/client.html")
         [ "$code" = 404 ] || bad "the client page without --client-render: $code"
     elif [ "$code" != 404 ]; then
