@@ -127,7 +127,9 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err);
 sy_node sy_web_camera(const sy_web *w);
 /** The server's counters (any thread): connections (sy_web_gate.h) and stills. */
 typedef struct sy_web_stats {
-    uint64_t accepted, delivered, refused, evicted, expired; /**< connections: see sy_web_gate_stats */
+    /** @{ connections accepted, handed to the HTTP server, refused, evicted and expired while
+     * waiting for their head (sy_web_gate_stats) */
+    uint64_t accepted, delivered, refused, evicted, expired; /** @} */
     uint32_t pending;          /**< connections waiting for their head now */
     uint64_t stills_done;      /**< stills answered with a JPEG */
     uint64_t stills_refused;   /**< over the per-client budget or the queue (429 / 503) */
@@ -136,6 +138,7 @@ typedef struct sy_web_stats {
     uint64_t requests_abandoned; /**< connections closed while their still or route was queued or running */
     uint32_t stills_queued;    /**< stills waiting now (the one rendering not counted) */
 } sy_web_stats;
+/** Fills *out with the server's counters now (any thread). */
 void sy_web_stats_get(sy_web *w, sy_web_stats *out);
 
 /** Makes sy_web_run return (any thread). */
