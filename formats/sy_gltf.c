@@ -1149,7 +1149,9 @@ static sy_result create_mesh(loader *L, size_t m)
     L->mesh_triangles[m] = triangles;
 done:
     for (uint32_t k = 0; k < used_count; k++) sy_primitive_release(&prims[k]);
-    if (r) sy_primitive_release(&prims[used_count]); /* a primitive that failed half-way released itself; harmless */
+    /* a primitive that failed half-way (released itself; harmless) - none when every one was made
+     * and sy_mesh_set_primitives refused them (a position beyond SY_COORD_MAX, say) */
+    if (r && used_count < mesh->primitive_count) sy_primitive_release(&prims[used_count]);
     free(prims);
     return r;
 }
