@@ -88,8 +88,15 @@ static inline sy_u32x4 reverse_bits4(sy_u32x4 x)
 }
 
 /* One clone per instruction set (the loader picks at start-up): SSE4.1's pmulld multiplies four
- * lanes in one instruction where SSE2 needs six (5-8 % of a path-traced frame on the Cornell box). */
-__attribute__((target_clones("avx2", "sse4.1", "default")))
+ * lanes in one instruction where SSE2 needs six (5-8 % of a path-traced frame on the Cornell box).
+ * GCC only: clang 14 leaves the function's symbol undefined when a program links the static archive
+ * (the clang fuzz build's web and culling targets link this back-end). */
+#if defined(__clang__)
+#define SY_RT_SAMPLE4_CLONES
+#else
+#define SY_RT_SAMPLE4_CLONES __attribute__((target_clones("avx2", "sse4.1", "default")))
+#endif
+SY_RT_SAMPLE4_CLONES
 void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, uint32_t index, float out[4])
 {
     uint32_t seed = sy_rt_hash32(pixel_seed ^ sy_rt_hash32(set * 0x9e3779b9u + 0x632be5abu));
