@@ -452,19 +452,7 @@ static sy_result replace_dirty(sy_mirror *st, sy_error *err)
         uint32_t nid = ready[--nready];
         node_m *n = LOOKUP(st, node, node_cap, nid);
         bool is_root = st->root ? n->id == st->root : n->parent_count == 0;
-        uint64_t want = is_root ? 1u : 0u;
-        if (!is_root)
-            for (uint32_t i = 0; i < n->parent_count; ++i) {
-                node_m *pn = LOOKUP(st, node, node_cap, n->parents[i]);
-                if (pn) want += pn->pl_count;
-            }
-        if (want > st->placements_max - (st->placements - n->pl_count)) {
-            r = sy_error_set(err, SY_ERR_LIMIT,
-                             "%s: node %#x is reached along %llu paths, past the %u placements a scene may have "
-                             "(SY_MIRROR_PLACEMENTS_MAX)",
-                             st->name, n->id, (unsigned long long)want, st->placements_max);
-            break;
-        }
+        uint64_t want = n->paths; /* the counting pass's, within the cap */
         if (want != n->pl_count) {
             for (uint32_t i = (uint32_t)want; i < n->pl_count; ++i) placement_clear(st, &n->pl[i]);
             placement *np = realloc(n->pl, sizeof *np * (want ? want : 1));
