@@ -22,13 +22,17 @@
 enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_ENV_SPEC, UNIT_ENV_IRR, UNIT_BRDF,
        UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW0, UNIT_CUBE_SHADOW1, UNIT_PROBE, UNIT_COUNT };
 /* Scene probes: mirror-like and glass instances see the scene, not only the environment. Each of
- * the first SY_GL_MAX_PROBES such instances gets a cube map of PROBE_SIZE texels per side rendered
- * from its bounding-box centre (the instance itself left out, other probed instances showing the
- * environment), with a mip chain for roughness; re-rendered only when geometry, materials, lights
- * or the environment change, never for a camera move. */
+ * the first SY_GL_MAX_PROBES such instances gets a cube map rendered from its bounding-box centre
+ * (the instance itself left out, other probed instances showing the environment), with a mip
+ * chain for roughness; re-rendered only when geometry, materials, lights or the environment
+ * change, never for a camera move. Its side (probe_size_for) follows the largest frame rendered so
+ * far, from PROBE_SIZE_MIN to PROBE_SIZE_MAX texels: a 90 degree face needs no more texels than
+ * about half the frame's width has (a small first frame renders four times fewer probe pixels,
+ * issue 32), and it never shrinks, so a view whose resolution drops while it moves (sy view, sy
+ * web) does not re-render its probes. */
 #define SY_GL_MAX_PROBES 4u
-#define PROBE_SIZE 256u
-#define PROBE_LEVELS 9u /* 256 .. 1 */
+#define PROBE_SIZE_MIN 32u
+#define PROBE_SIZE_MAX 256u
 #define PROBE_MAX_ROUGHNESS 0.4f
 enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1, BIND_AREAS = 2 };
 /* Deferred shading (see sy_gl_shaders.c, sy_gl_gbuf_fs): the shading pass samples no material
@@ -208,7 +212,6 @@ struct sy_gl_device {
     uint32_t light_count, shadow_count, area_shadow_count; /* as uploaded by lights_upload: they pick the variants */
     /* lights_upload: what the shaders' straight-line light code is built for. Bits 2i, 2i + 1:
      * punctual light i's kind of shadow (i < VAR_NL_MAX; shade_light: 0 none, 1 map, 2 + s cube s);
-     * bits 16-20: the emissive polygon count; bit 32 + i: polygon i has a shadow map (shade_area);
      * bits 48 + 2i, 49 + 2i: punctual light i's type (shade_light's lt: 0 point, 1 point with a
      * range, 2 spot, 3 directional) */
     uint64_t light_sig;
@@ -229,6 +232,7 @@ struct sy_gl_device {
     } probes[SY_GL_MAX_PROBES];
     uint32_t probe_count;
     GLuint probe_fbo, probe_depth;
+    uint32_t probe_size; /* the probes' side in texels (0: none made yet; see probe_size_for) */
     bool probes_dirty, in_probe_pass;
     targets t;
     bool lights_dirty;
@@ -553,6 +557,8 @@ static void bind_samplers(const sy_gl_fns *gl, GLuint prog)
     if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_AREAS);
 }
 
+static void probes_free(sy_gl_device *dev);
+
 /* Drops variant bits that cannot matter, so that equivalent draws share one program. */
 static int variant_normalize(int v)
 {
@@ -567,20 +573,14 @@ static int variant_normalize(int v)
 /* The part of the lights' signature (light_sig) a program of variant bits v depends on. The
  * shaders call each punctual light (constant light count) with its shadow fixed (sy_gl_shaders.c,
  * shade_light): straight-line code that makes only the look-ups the frame needs (llvmpipe runs
- * every branch for every pixel). Emissive polygons run in two loops of constant bounds, those that
- * may have a shadow map (up to the last that has one) and the rest (shade_lit): sixteen inlined
- * copies took LLVM many seconds to compile (issue 32). */
+ * every branch for every pixel). Emissive polygons run in two loops whose bounds are uniforms (the
+ * Areas block, lights_upload), so no program depends on them: loops of constant bounds were
+ * unrolled, sixteen inlined copies took LLVM many seconds to compile (issue 32). */
 static uint64_t variant_sig(const sy_gl_device *dev, int v)
 {
     uint64_t s = 0;
     if ((v & VAR_SHADOW) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & 0x3FFFu;
     if ((v & VAR_LIGHTS) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & (0x3FFFull << 48);
-    if (v & VAR_AREA) s |= dev->light_sig & (0x1Fu << 16);
-    if ((v & VAR_AREA) && (v & VAR_ASHADOW)) { /* the polygons up to the last with a map: a loop in the shader */
-        uint64_t m = (dev->light_sig >> 32) & 0xFFFFu;
-        while (m & (m + 1)) m |= m >> 1; /* 0b0100101 -> 0b0111111 */
-        s |= m << 32;
-    }
     return s;
 }
 
@@ -617,14 +617,6 @@ static void variant_defines(int v, uint64_t sig, char *defs, size_t defs_len, ch
                                    (const char *[]){"-", "map", "cube0", "cube1"}[kind]);
         }
         nl += (size_t)snprintf(name + nl, name_len - nl, ")");
-    }
-    int nareas = (int)((sig >> 16) & 0x1Fu);
-    if (nareas) {
-        int nash = 0; /* polygons [0, nash) may have a shadow map (variant_sig), the rest have none */
-        while (nash < 16 && (sig >> (32 + nash)) & 1u) nash++;
-        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_NAREAS %d\n#define SY_NASH %d\n", nareas, nash);
-        nl += (size_t)snprintf(name + nl, name_len - nl, " (%d polygons, %d with shadows", nareas, nash);
-        snprintf(name + nl, name_len - nl, ")");
     }
 }
 
@@ -994,10 +986,7 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         gl->DeleteTextures(3, texs);
         for (uint32_t c = 0; c < SY_GL_MAX_CUBE_SHADOWS; ++c)
             if (dev->cube_tex[c]) gl->DeleteTextures(1, &dev->cube_tex[c]);
-        for (uint32_t p = 0; p < SY_GL_MAX_PROBES; ++p)
-            if (dev->probes[p].cube) gl->DeleteTextures(1, &dev->probes[p].cube);
-        if (dev->probe_fbo) gl->DeleteFramebuffers(1, &dev->probe_fbo);
-        if (dev->probe_depth) gl->DeleteRenderbuffers(1, &dev->probe_depth);
+        probes_free(dev);
         gl->DeleteFramebuffers(1, &dev->shadow_fbo);
         gl->DeleteVertexArrays(1, &dev->empty_vao);
     }
@@ -1852,7 +1841,7 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
     ab[7] = 0.0f;
     fs->shadow_count = ns;
     dev->light_count = n;
-    dev->light_sig = (uint64_t)dev->area_count << 16;
+    dev->light_sig = 0;
     for (uint32_t i = 0; i < n && i < VAR_NL_MAX; ++i) { /* 0 none, 1 a 2D map, 2 + s cube slot s */
         const float *o = blk + 88 + 16 * i;
         uint64_t kind = o[14] >= 0.0f ? 1u : o[15] >= 0.0f ? 2u + (uint64_t)o[15] : 0u;
@@ -1860,8 +1849,12 @@ static void lights_upload(sy_gl_device *dev, frame_state *fs)
         uint64_t type = o[3] == (float)SY_GL_LIGHT_DIRECTIONAL ? 3u : o[3] == (float)SY_GL_LIGHT_SPOT ? 2u : o[7] > 0.0f ? 1u : 0u;
         dev->light_sig |= kind << (2 * i) | type << (48 + 2 * i);
     }
+    /* a_count.y: the polygons up to the last with a shadow map (the shaders' first loop); z: the
+     * shadow taps per polygon (shadow_area's loop bound, a uniform so that it is not unrolled) */
+    aib[1] = 0;
     for (uint32_t i = 0; i < dev->area_count; ++i)
-        if (ab[8 + 24 * i + 23] >= 0.0f) dev->light_sig |= 1ull << (32 + i);
+        if (ab[8 + 24 * i + 23] >= 0.0f) aib[1] = (int32_t)i + 1;
+    aib[2] = 8;
     dev->shadow_count = ns_punctual + fs->cube_count;
     dev->area_shadow_count = ns - ns_punctual;
     dev->gl->BindBuffer(GL_UNIFORM_BUFFER, dev->lights_ubo);
@@ -2592,7 +2585,7 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
     if (probe >= 0) {
         gl->ActiveTexture(GL_TEXTURE0 + UNIT_PROBE);
         gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->probes[probe].cube);
-        gl->Uniform1f(dev->pm[pv].probe_lod, (float)(PROBE_LEVELS - 1u));
+        gl->Uniform1f(dev->pm[pv].probe_lod, log2f((float)dev->probe_size)); /* the 1-texel mip */
     }
     bind_material(dev, in->material, (pv & VAR_TEX) != 0);
     float mvp[16];
@@ -2719,6 +2712,29 @@ static bool wants_probe(const mat_o *mt)
     return mt->d.metallic >= 0.5f || mt->d.transmission * (1.0f - mt->d.metallic) >= 0.5f;
 }
 
+/* The probes' side for a frame of w x h: the power of two at or above half the larger side, within
+ * [PROBE_SIZE_MIN, PROBE_SIZE_MAX], and never below the side they have (see SY_GL_MAX_PROBES). */
+static uint32_t probe_size_for(const sy_gl_device *dev, uint32_t w, uint32_t h)
+{
+    uint32_t half = (w > h ? w : h) / 2u, s = PROBE_SIZE_MIN;
+    while (s < half && s < PROBE_SIZE_MAX) s *= 2u;
+    return s > dev->probe_size ? s : dev->probe_size;
+}
+
+/* Frees the probes' cube maps and depth buffer (made again at the next render_probes). */
+static void probes_free(sy_gl_device *dev)
+{
+    const sy_gl_fns *gl = dev->gl;
+    for (uint32_t p = 0; p < SY_GL_MAX_PROBES; ++p)
+        if (dev->probes[p].cube) {
+            gl->DeleteTextures(1, &dev->probes[p].cube);
+            dev->probes[p].cube = 0;
+        }
+    if (dev->probe_fbo) gl->DeleteFramebuffers(1, &dev->probe_fbo);
+    if (dev->probe_depth) gl->DeleteRenderbuffers(1, &dev->probe_depth);
+    dev->probe_fbo = dev->probe_depth = 0;
+}
+
 /* (Re)renders the scene probes (see SY_GL_MAX_PROBES). */
 static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
 {
@@ -2738,11 +2754,12 @@ static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
         dev->probes[dev->probe_count++].inst = i;
     }
     if (!dev->probe_count) return SY_GL_OK;
+    const GLsizei ps = (GLsizei)dev->probe_size;
     if (!dev->probe_fbo) {
         gl->GenFramebuffers(1, &dev->probe_fbo);
         gl->GenRenderbuffers(1, &dev->probe_depth);
         gl->BindRenderbuffer(GL_RENDERBUFFER, dev->probe_depth);
-        gl->RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_DEPTH_COMPONENT32F, PROBE_SIZE, PROBE_SIZE);
+        gl->RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_DEPTH_COMPONENT32F, ps, ps);
     }
     float sc[3], R;
     scene_bounds(dev, sc, &R);
@@ -2755,7 +2772,7 @@ static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
             gl->GenTextures(1, &dev->probes[p].cube);
             gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->probes[p].cube);
             for (int f = 0; f < 6; ++f)
-                gl->TexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, 0, GL_RGBA16F, PROBE_SIZE, PROBE_SIZE, 0, GL_RGBA,
+                gl->TexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, 0, GL_RGBA16F, ps, ps, 0, GL_RGBA,
                                GL_FLOAT, NULL);
             gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
             gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -2779,7 +2796,7 @@ static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
             gl->FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, dev->probe_depth);
             static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_NONE};
             gl->DrawBuffers(2, bufs);
-            gl->Viewport(0, 0, PROBE_SIZE, PROBE_SIZE);
+            gl->Viewport(0, 0, ps, ps);
             gl->ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
             gl->DepthMask(GL_TRUE);
             const float black[4] = {0, 0, 0, 1}, one = 1.0f;
@@ -2788,7 +2805,7 @@ static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
             gl->Disable(GL_CULL_FACE);
             gl->Disable(GL_BLEND);
             if (env) /* rays that leave the scene see the environment (a light) */
-                draw_latlong(dev, &v, env, dev->env_intensity, PROBE_SIZE, PROBE_SIZE);
+                draw_latlong(dev, &v, env, dev->env_intensity, (uint32_t)ps, (uint32_t)ps);
             gl->Enable(GL_DEPTH_TEST);
             gl->DepthFunc(GL_LESS);
             dev->frame_no++; /* the variants take this face's camera */
@@ -2844,6 +2861,12 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         if (fs.shadow_count || fs.cube_count) render_shadows(dev, &fs);
         else dev->shadow_maps = 0;
         dev->lights_dirty = false;
+        dev->probes_dirty = true;
+    }
+    uint32_t psize = probe_size_for(dev, d->width, d->height);
+    if (psize != dev->probe_size) { /* a larger frame than any before: sharper probes */
+        probes_free(dev);
+        dev->probe_size = psize;
         dev->probes_dirty = true;
     }
     if (dev->probes_dirty) {

@@ -18,9 +18,8 @@
  * probe instead of the environment), SY_TRANS (a transmissive material; llvmpipe runs both sides of a branch, so code that no
  * light of this frame needs is left out of the variant), SY_NLIGHTS (a constant light count, 1 ..
  * 7: one call per light with constant uniform-block offsets) with SY_LK0 .. SY_LK<n-1> (each
- * light's kind of shadow, see shade_light), SY_NAREAS (the emissive polygons' count, 1 .. 16) with
- * SY_NASH (polygons 0 .. SY_NASH-1 may have a shadow map, the rest have none; a loop over each
- * part, see shade_lit). Every varying costs set-up per
+ * light's kind of shadow, see shade_light); the emissive polygons run in two loops of uniform
+ * bounds (see shade_lit). Every varying costs set-up per
  * triangle and interpolation per fragment in a software rasterizer, so a variant interpolates only
  * what it reads; unlit variants (no lights, no environment) need no position or normal at all. */
 #define SY_GL_VARIANT_PRELUDE                                 \
@@ -81,7 +80,8 @@ const char *const sy_gl_main_vs =
     "struct Light { vec4 pos_type; vec4 dir_range; vec4 radiant; vec4 cone; };\n" \
     "layout(std140) uniform Lights { ivec4 l_count; vec4 l_env; mat4 l_shadow_mat[4]; vec4 l_shadow[4];\n" \
     "  Light l_lights[32]; vec4 l_cube[2]; };\n" /* SY_GL_MAX_CUBE_SHADOWS point lights: near, far, normal offset */ \
-    /* area lights: 4 vertices (xyz, w unused), radiance (rgb, w = double-sided), centre (xyz, w = shadow map or -1) */ \
+    /* area lights: a_count: x polygons, y those up to the last with a shadow map, z shadow taps (8); \
+     * per polygon 4 vertices (xyz, w vertex count), radiance (rgb, w = double-sided), centre (xyz, w = shadow map or -1) */ \
     "layout(std140) uniform Areas { ivec4 a_count; vec4 a_dir; vec4 a_data[16 * 6]; };\n" \
     "uniform sampler2DArrayShadow t_shadow; uniform samplerCubeShadow t_cshadow0, t_cshadow1;\n" \
     "uniform samplerCube t_env_spec, t_env_irr, t_probe; uniform sampler2D t_brdf, t_ltc1, t_ltc2;\n" \
@@ -127,7 +127,9 @@ const char *const sy_gl_main_vs =
     "float shadow_area(int si, vec3 p, vec3 ngf) {\n" \
     "  vec3 q; float r; if (!shadow_coord(si, p, ngf, q, r)) return 1.0;\n" \
     "  r = max(r, 1.5 / float(textureSize(t_shadow, 0).x)); float s = 0.0;\n" \
-    "  for (int k = 0; k < 8; ++k) s += texture(t_shadow, vec4(q.xy + POISSON[k] * r, float(si), q.z));\n" \
+    /* a_count.z taps (8, the Areas block): a uniform bound keeps the loop a loop (eight unrolled \
+     * PCF look-ups per shadowed polygon made LLVM's code generation about 15 % slower) */ \
+    "  for (int k = 0; k < a_count.z; ++k) s += texture(t_shadow, vec4(q.xy + POISSON[k & 7] * r, float(si), q.z));\n" \
     "  return s * 0.125; }\n" \
     "#endif\n" \
     "#ifdef SY_AREA\n" \
@@ -273,15 +275,14 @@ const char *const sy_gl_main_vs =
     "      vec3 fl = (bc * t2.x + (1.0 - bc) * t2.y) * w_metal + vec3(w_diel * spec * (f0d * t2.x + (1.0 - f0d) * t2.y));\n" \
     "      vec3 kdl = kd * (1.0 - fd_avg);\n" \
     "#define SY_AREA_L(i, sh) shade_area(i, sh, P, ngf, frame, Minv, kdl, fl, rough)\n" \
-    "#ifdef SY_NAREAS\n" /* the frame's polygon count (1 .. 16); those before SY_NASH may have a shadow map */ \
     /* two loops, not one call per polygon: sixteen inlined copies of shade_area (two LTC \
-     * evaluations and eight shadow taps each) took llvmpipe's LLVM many seconds to compile, the \
-     * loops compile once; constant bounds, so neither is entered in vain */ \
-    "      for (int i = 0; i < SY_NASH; ++i) L += SY_AREA_L(i, 1);\n" \
-    "      for (int i = SY_NASH; i < SY_NAREAS; ++i) L += SY_AREA_L(i, 0);\n" \
-    "#else\n" \
-    "      for (int i = 0; i < a_count.x; ++i) L += SY_AREA_L(i, -1);\n" \
-    "#endif\n" \
+     * evaluations and eight shadow taps each) took llvmpipe's LLVM many seconds to compile. The \
+     * polygons up to the last with a shadow map (a_count.y; maps go to the first polygons) run \
+     * with the look-up, the rest without (llvmpipe runs both sides of a branch). The bounds are \
+     * uniforms, not constants: the compiler cannot unroll the loops, so each body is compiled \
+     * once, and a program does not depend on the polygon count (issue 32) */ \
+    "      for (int i = 0; i < a_count.y; ++i) L += SY_AREA_L(i, 1);\n" \
+    "      for (int i = a_count.y; i < a_count.x; ++i) L += SY_AREA_L(i, 0);\n" \
     /* the area lights' indirect light (sy_gl_set_ambient), stronger on surfaces facing the way the \
      * emitters shine (they see the directly lit surfaces), weaker on those facing the emitters; not \
      * on emitters (the estimate counts them as sources only) */ \

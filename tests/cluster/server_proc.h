@@ -1,7 +1,8 @@
 /* server_proc.h — render servers as child processes for the cluster tests (header-only): start
  * test_cluster_server on a free 127.0.0.1 port (it writes the port to a file; --max-lifetime 600 s
  * only for servers a killed test leaves behind), stop it with
- * SIGTERM (SIGKILL after 5 s), search its log, read its memory from /proc/PID/status.
+ * SIGTERM (SIGKILL after 5 s), search its log, read its memory from /proc/PID/status, wait for
+ * the bytes it holds for peers' messages in flight (its --memory-file).
  * The caller sets g_exe (the server executable) and g_dir (a work directory). Every wait is
  * bounded; servers a failed check left running are killed when the test exits. Thread-safety:
  * main thread only (except server_status_kb, any thread). */
@@ -37,6 +38,7 @@ typedef struct server {
     int serial;
     char url[64];
     char log[512];
+    char memory[512]; /* its --memory-file: "USED PEAK" bytes of peer memory (wait_peer_memory) */
 } server;
 
 static inline void sleep_ms(int ms)
@@ -51,6 +53,8 @@ static inline int start_server_args(const char *secret, int port, const char *co
     char pf[512], listen[64];
     snprintf(pf, sizeof pf, "%s/port%d", g_dir, ++g_serial);
     snprintf(out->log, sizeof out->log, "%s/server%d.log", g_dir, g_serial);
+    snprintf(out->memory, sizeof out->memory, "%s/memory%d", g_dir, g_serial);
+    unlink(out->memory);
     snprintf(listen, sizeof listen, "tcp://127.0.0.1:%d", port);
     unlink(pf);
     pid_t pid = fork();
@@ -63,8 +67,9 @@ static inline int start_server_args(const char *secret, int port, const char *co
         /* the lifetime only ends servers a killed test left behind: longer than any cluster test's
          * ctest TIMEOUT (600 s), never a deadline a slow run can reach (at 120 s, cluster_net's
          * servers under ASan on a loaded machine stopped before its last group) */
-        const char *args[32] = {g_exe, "--port-file", pf, "--listen", listen, "--max-lifetime", "900", "--present", present};
-        int n = 9;
+        const char *args[32] = {g_exe,     "--port-file", pf,      "--listen",      listen,     "--max-lifetime",
+                                "900",     "--present",   present, "--memory-file", out->memory};
+        int n = 11;
         if (secret) args[n++] = "--secret", args[n++] = secret;
         for (int k = 0; extra && extra[k] && k < 16; ++k) args[n++] = extra[k];
         execv(g_exe, (char *const *)args);
@@ -128,6 +133,33 @@ static inline void forget_server(pid_t pid)
 {
     for (int i = 0; i < g_nstarted; ++i)
         if (g_started[i] == pid) g_started[i] = 0;
+}
+
+/* The server's peer memory from its --memory-file: bytes held now and the most ever; false while
+ * the file is not written yet. */
+static inline bool read_peer_memory(const server *s, size_t *used, size_t *peak)
+{
+    FILE *f = fopen(s->memory, "r");
+    if (!f) return false;
+    size_t u = 0, p = 0;
+    bool ok = fscanf(f, "%zu %zu", &u, &p) == 2;
+    fclose(f);
+    if (ok) *used = u, *peak = p;
+    return ok;
+}
+
+/* Waits until the server holds at least `bytes` for peers' messages in flight (its --memory-file);
+ * false after 300 s (a hang guard) or when the server is gone. *used_out: the last value read. */
+static inline bool wait_peer_memory(const server *s, size_t bytes, size_t *used_out)
+{
+    size_t used = 0, peak = 0;
+    for (int i = 0; i < 60000; ++i) {
+        if (read_peer_memory(s, &used, &peak) && used >= bytes) break;
+        if (s->pid <= 0 || waitpid(s->pid, NULL, WNOHANG) == s->pid) break;
+        sleep_ms(5);
+    }
+    if (used_out) *used_out = used;
+    return used >= bytes;
 }
 
 static inline bool log_contains(const server *s, const char *needle)

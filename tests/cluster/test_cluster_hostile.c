@@ -2,9 +2,9 @@
  * issue 32, items 1 and 3). Servers are separate processes on 127.0.0.1 (test_cluster_server);
  * their memory is read from /proc/PID/status. Groups (argv[3...], default all):
  *   rss     64 connections each announce a 256 MiB message and trickle 64 KiB every 100 ms, 8 more
- *           flood 8 MiB as fast as they can, none of them authenticated, for 5 s, reconnecting
- *           whenever the server closes them; an authenticated client keeps rendering frames equal
- *           to its first one all the while, and the server's resident memory (VmRSS sampled every
+ *           flood 8 MiB as fast as they can, none of them authenticated, for 5 s (and at least 3
+ *           honest frames), reconnecting whenever the server closes them; an authenticated client
+ *           keeps rendering frames equal to its first one all the while, and the server's resident memory (VmRSS sampled every
  *           50 ms, and VmHWM) grows by less than 64 MiB. Prints RSS before / peak / after and the
  *           client's frame times before and during the attack.
  *   counts  a 144-byte change list creating one object of each of the 7 types at slot index
@@ -18,8 +18,10 @@
  *           connections beyond the limit closes the oldest, in order (logged), the newest 8 stay
  *           open, a client gets in; with a 1000 ms deadline 8 idle connections are closed by it.
  *   ceiling with --max-peer-memory-mb 1: a chunked message that does not fit waits while another
- *           peer holds the memory and goes on once it is released (back-pressure); one that still
- *           does not fit after the wait is refused with "server busy: ..." naming the option.
+ *           peer holds the memory (the server's held bytes, read from its --memory-file, never
+ *           pass the ceiling) and goes on once it is released (back-pressure); one that still
+ *           does not fit after the wait is refused with "server busy: ..." naming the option, no
+ *           sooner than the server's wait (a lower bound only: nothing here races a clock).
  *   lockout issue 32, item 3: clients beside 32 unauthenticated connections from their own address
  *           get in (the oldest is closed for each); with the server's defaults, 32 idle connections
  *           from 127.0.0.2 reopened whenever closed do not keep 5 clients from 127.0.0.1 out.
@@ -293,7 +295,9 @@ static int test_rss(fixture *fx)
     double t_start = now_s(), busy = 0, worst = 0;
     int frames = 0, failed = 0, differ = 0;
     char first_error[SY_ERROR_MESSAGE_MAX] = "";
-    while (now_s() - t_start < 5.0) {
+    /* at least 5 s of attack and at least 3 honest frames, however slow the machine (a frame that
+     * takes longer only lengthens the attack; 300 s is a hang guard) */
+    while ((now_s() - t_start < 5.0 || frames < 3) && now_s() - t_start < 300.0) {
         double t0 = now_s();
         sy_result r = sy_cluster_client_render(c, &f, &out, NULL, &e);
         double dt = now_s() - t0;
@@ -308,6 +312,7 @@ static int test_rss(fixture *fx)
         if (dt > worst) worst = dt;
         differ += !same_image(&out, &first);
     }
+    double attack_s = now_s() - t_start;
     atomic_store(&stop, 1);
     for (int i = 0; i < started; ++i) pthread_join(th[i], NULL);
     pthread_join(smt, NULL);
@@ -321,8 +326,8 @@ static int test_rss(fixture *fx)
         else flooded += hs[i].bytes;
     }
     printf("rss: %d hostile peers (%d announce 256 MiB and trickle, %d flood 8 MiB), %u connections, %.1f MiB "
-           "trickled + %.1f MiB flooded in 5 s\n",
-           started, TRICKLERS, FLOODERS, conns, trickled / MIB, flooded / MIB);
+           "trickled + %.1f MiB flooded in %.1f s\n",
+           started, TRICKLERS, FLOODERS, conns, trickled / MIB, flooded / MIB, attack_s);
     printf("rss: server VmRSS %.1f MiB before, %.1f MiB peak during, %.1f MiB after (VmHWM %.1f -> %.1f MiB): "
            "+%.1f MiB at the peak (limit +64 MiB)\n",
            rss0 / 1024.0, sm.max_rss_kb / 1024.0, rss1 / 1024.0, hwm0 / 1024.0, hwm1 / 1024.0,
@@ -611,26 +616,35 @@ static int test_ceiling(fixture *fx)
     const char *extra[] = {"--max-peer-memory-mb", "1", "--max-frame-kb", "512", NULL};
     if (start_server_args(NULL, 0, extra, &sv)) return 1;
     const uint32_t k = 400 << 10;
-    /* A holds 400 KiB; B's message needs 800 KiB: it waits until A goes away after 1 s */
+    /* A holds 400 KiB; B's message needs 800 KiB: it waits until A goes away. The server's state
+     * is read from its --memory-file (server_proc.h), never guessed from a sleep. */
     int a = open_session(sv.port), b = open_session(sv.port);
     CHECK(a >= 0 && b >= 0);
     CHECK(scene_chunk(a, k, false, 2) && scene_chunk(b, k, false, 2));
-    sleep_ms(200);
-    double t0 = now_s();
+    size_t held = 0;
+    CHECK_MSG(wait_peer_memory(&sv, 2 * (size_t)k, &held), "the server took %zu bytes of the two first frames", held);
     CHECK(scene_chunk(b, k, false, 3));
+    /* B's second frame does not fit beside A's: for the next second (a window, not a deadline: a
+     * slow machine only makes it longer) the server holds no more than it did */
     sleep_ms(1000);
+    size_t during = 0, peak = 0;
+    CHECK(read_peer_memory(&sv, &during, &peak));
     close(a);
     CHECK(scene_chunk(b, 16, true, 4));
     sy_cluster_msg rep;
     uint8_t *raw = NULL;
     CHECK(raw_recv_msg(b, 1 << 16, &rep, &raw) == 0);
-    double waited = now_s() - t0;
-    printf("ceiling: a message that did not fit waited %.2f s for another peer's 400 KiB, then got %s '%s'\n", waited,
-           sy_cluster_msg_type_name(rep.header.type), rep.header.type == SY_CLUSTER_ERROR ? rep.u.error.reason : "");
+    size_t wait_peak = peak;
+    CHECK(read_peer_memory(&sv, &held, &peak)); /* the peak over the whole exchange */
+    printf("ceiling: a message that did not fit waited (the server held %zu KiB, at most %zu KiB, while another "
+           "peer held 400 KiB), then got %s '%s'\n",
+           during >> 10, wait_peak >> 10, sy_cluster_msg_type_name(rep.header.type),
+           rep.header.type == SY_CLUSTER_ERROR ? rep.u.error.reason : "");
+    CHECK_MSG(during < 3 * (size_t)k && peak < 3 * (size_t)k,
+              "the server took a frame beyond its 1 MiB ceiling (%zu bytes held while waiting, peak %zu)", during, peak);
     /* its 800 KiB of zeros is no SCENE: refused by the decoder, not by the ceiling */
     CHECK(rep.header.type == SY_CLUSTER_ERROR && strstr(rep.u.error.reason, "cluster SCENE") &&
           !strstr(rep.u.error.reason, "server busy"));
-    CHECK(waited >= 0.9);
     sy_cluster_msg_free(&rep);
     free(raw);
     close(b);
@@ -639,8 +653,8 @@ static int test_ceiling(fixture *fx)
     int c = open_session(sv.port);
     CHECK(a >= 0 && c >= 0);
     CHECK(scene_chunk(a, k, false, 2) && scene_chunk(c, k, false, 2));
-    sleep_ms(200);
-    t0 = now_s();
+    CHECK_MSG(wait_peer_memory(&sv, 2 * (size_t)k, &held), "the server took %zu bytes of the two first frames", held);
+    double t0 = now_s();
     (void)scene_chunk(c, k, false, 3); /* the server stops reading: may or may not all be taken */
     int rc = raw_recv_msg(c, 1 << 16, &rep, &raw);
     double refused = now_s() - t0;
@@ -649,7 +663,9 @@ static int test_ceiling(fixture *fx)
            sy_cluster_msg_type_name(rep.header.type), rep.header.type == SY_CLUSTER_ERROR ? rep.u.error.reason : "");
     CHECK(rep.header.type == SY_CLUSTER_ERROR && strstr(rep.u.error.reason, "server busy") &&
           strstr(rep.u.error.reason, "--max-peer-memory-mb"));
-    CHECK(refused >= 4.0 && refused < 15.0);
+    /* after the server's wait (SY_CLUSTER_MEMORY_WAIT_MS), never at once; a lower bound only, which
+     * a loaded machine cannot break */
+    CHECK_MSG(refused >= SY_CLUSTER_MEMORY_WAIT_MS / 1000.0 - 0.5, "refused after %.2f s", refused);
     sy_cluster_msg_free(&rep);
     free(raw);
     close(c);
@@ -881,7 +897,7 @@ static int test_lockout(fixture *fx)
     CHECK(pthread_create(&th, NULL, reopener_main, &rp) == 0);
     /* the flood holds the whole table before the first client tries (a state, polled) */
     double t0 = now_s();
-    while (atomic_load(&rp.held) < REOPENERS && now_s() - t0 < 60) sleep_ms(10);
+    while (atomic_load(&rp.held) < REOPENERS && now_s() - t0 < 300) sleep_ms(10); /* 300 s: a hang guard */
     int held = atomic_load(&rp.held);
     got_in = 0;
     for (int k = 0; k < 5; ++k) {
