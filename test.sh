@@ -37,10 +37,11 @@ step "build (minimal: Embree only, shared)" sy_configure_build build-min -- -DCM
   -DSY_WITH_RASTER=OFF -DSY_WITH_CLUSTER=OFF -DSY_WITH_WEB=OFF -DBUILD_SHARED_LIBS=ON &&
   step "ctest (minimal)" ctest --test-dir build-min --output-on-failure -j "$jobs"
 # Fuzzing (tests/fuzz): clang + libFuzzer, only the fuzz targets; each fuzz_run_* test fuzzes
-# SY_FUZZ_SECONDS on seeds from ../shared/testdata (tests/fuzz/fuzz.sh runs long campaigns).
+# SY_FUZZ_SECONDS on seeds from ../shared/testdata, one target per core (tests/fuzz/fuzz.sh runs
+# long campaigns).
 CC=clang CXX=clang++ step "build (libFuzzer)" sy_configure_build build-fuzz sy_fuzzers -- \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSY_FUZZ=ON -DSY_FUZZ_SECONDS=15 &&
-  step "ctest (fuzz)" ctest --test-dir build-fuzz --output-on-failure -L fuzz
+  step "ctest (fuzz)" ctest --test-dir build-fuzz --output-on-failure -L fuzz -j "$jobs"
 if [ ${#failed[@]} -gt 0 ]; then
   printf 'test.sh: failed: %s\n' "${failed[@]}"
   exit 1
