@@ -40,7 +40,7 @@ step "build (minimal: Embree only, shared)" sy_configure_build build-min -- -DCM
 # SY_FUZZ_SECONDS on seeds from ../shared/testdata, one target per core (tests/fuzz/fuzz.sh runs
 # long campaigns).
 CC=clang CXX=clang++ step "build (libFuzzer)" sy_configure_build build-fuzz sy_fuzzers -- \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSY_FUZZ=ON -DSY_FUZZ_SECONDS=15 &&
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSY_FUZZ=ON -DSY_FUZZ_SECONDS=10 &&
   step "ctest (fuzz)" ctest --test-dir build-fuzz --output-on-failure -L fuzz -j "$jobs"
 if [ ${#failed[@]} -gt 0 ]; then
   printf 'test.sh: failed: %s\n' "${failed[@]}"

@@ -9,7 +9,7 @@
 # PARTS: the parts that were built ("embree raster ..."). full: each model's main file (its glTF/
 # form, the Cornell box, every X3D file) in every back-end, and its other forms (embedded, binary,
 # Draco, quantized: the same scene once loaded) in Whitted only, which keeps the test within about
-# two minutes on two cores; reduced (sanitizer builds): every third main file, every back-end.
+# two minutes on two cores; reduced (sanitizer and minimal builds): every third main file, every back-end.
 # Environment: SY_SMOKE_ALL=1 renders every file in every back-end; SY_SMOKE_LIMIT (seconds per
 # render, default 90: a hang guard, not a speed test; the first frame of a sample costs 1 to 19
 # seconds of CPU (TransmissionTest: 7 main variants to compile), and ctest runs other tests beside
