@@ -893,39 +893,8 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     gl->BindBuffer(GL_UNIFORM_BUFFER, dev->areas_ubo);
     gl->BufferData(GL_UNIFORM_BUFFER, AREAS_FLOATS * sizeof(float), NULL, GL_DYNAMIC_DRAW);
     gl->GenVertexArrays(1, &dev->empty_vao);
-    /* shadow maps: one depth texture array, compared in the shader (hardware PCF) */
-    if ((r = gl_check(dev, "GL device setup", err, err_len)) != SY_GL_OK) {
-        sy_gl_device_destroy(dev);
-        return r;
-    }
-    /* the maps' size, halved while the GL cannot hold them (the array of SY_GL_MAX_SHADOW_MAPS and
-     * a point light's cube, made later, tried here): at 16384 texels the array alone is 4 GiB, and
-     * llvmpipe refuses textures of 1 GiB and more with GL_OUT_OF_MEMORY */
-    uint32_t asked = dev->shadow_size;
-    for (;;) {
-        dev->cube_size = dev->shadow_size / 2u > 16u ? dev->shadow_size / 2u : 16u;
-        dev->shadow_tex = shadow_array(gl, dev->shadow_size, SY_GL_MAX_SHADOW_MAPS);
-        GLenum e = gl->GetError();
-        if (e == GL_NO_ERROR) {
-            GLuint cube = shadow_cube(gl, dev->cube_size);
-            e = gl->GetError();
-            gl->DeleteTextures(1, &cube);
-        }
-        if (e != GL_OUT_OF_MEMORY || dev->shadow_size <= 16u) {
-            if (e != GL_NO_ERROR) {
-                sy_gl_device_destroy(dev);
-                return fail(err, err_len, e == GL_OUT_OF_MEMORY ? SY_GL_ERROR_OUT_OF_MEMORY : SY_GL_ERROR_GL,
-                            "GL device setup: shadow maps of %u texels: OpenGL error 0x%04x", asked, (unsigned)e);
-            }
-            break;
-        }
-        gl->DeleteTextures(1, &dev->shadow_tex);
-        dev->shadow_tex = 0;
-        dev->shadow_size /= 2u;
-    }
-    if (dev->shadow_size != asked)
-        warn(dev, "raster: shadow_map_size %u: the GL context cannot hold %d maps of that size; using %u", asked,
-             SY_GL_MAX_SHADOW_MAPS, dev->shadow_size);
+    /* the shadow maps are made on the first frame with a shadowed light (shadow_maps_make) */
+    dev->cube_size = dev->shadow_size / 2u > 16u ? dev->shadow_size / 2u : 16u;
     gl->Enable(GL_TEXTURE_CUBE_MAP_SEAMLESS); /* cube shadows and probes filter across faces */
     gl->GenFramebuffers(1, &dev->shadow_fbo);
     dev->lights_dirty = true;
@@ -1930,6 +1899,46 @@ static void draw_casters(sy_gl_device *dev, const float *vp)
     }
 }
 
+/* The shadow maps' depth array, made on the first frame with a shadowed light: a scene without one
+ * never allocates it (64 MiB zeroed by llvmpipe at the default 2048 texels, 0.2 s of a small first
+ * frame). Its side is halved while the GL cannot hold it (the array of SY_GL_MAX_SHADOW_MAPS and a
+ * point light's cube, made later, tried here): at 16384 texels the array alone is 4 GiB, and
+ * llvmpipe refuses textures of 1 GiB and more with GL_OUT_OF_MEMORY. */
+static sy_gl_result shadow_maps_make(sy_gl_device *dev, char *err, size_t err_len)
+{
+    const sy_gl_fns *gl = dev->gl;
+    sy_gl_result r = gl_check(dev, "before the shadow maps", err, err_len);
+    if (r != SY_GL_OK || dev->shadow_tex) return r;
+    uint32_t asked = dev->shadow_size;
+    for (;;) {
+        dev->cube_size = dev->shadow_size / 2u > 16u ? dev->shadow_size / 2u : 16u;
+        dev->shadow_tex = shadow_array(gl, dev->shadow_size, SY_GL_MAX_SHADOW_MAPS);
+        GLenum e = gl->GetError();
+        if (e == GL_NO_ERROR) {
+            GLuint cube = shadow_cube(gl, dev->cube_size);
+            e = gl->GetError();
+            gl->DeleteTextures(1, &cube);
+        }
+        if (e != GL_OUT_OF_MEMORY || dev->shadow_size <= 16u) {
+            if (e != GL_NO_ERROR) {
+                gl->DeleteTextures(1, &dev->shadow_tex);
+                dev->shadow_tex = 0;
+                dev->shadow_size = asked;
+                return fail(err, err_len, e == GL_OUT_OF_MEMORY ? SY_GL_ERROR_OUT_OF_MEMORY : SY_GL_ERROR_GL,
+                            "shadow maps of %u texels: OpenGL error 0x%04x", asked, (unsigned)e);
+            }
+            break;
+        }
+        gl->DeleteTextures(1, &dev->shadow_tex);
+        dev->shadow_tex = 0;
+        dev->shadow_size /= 2u;
+    }
+    if (dev->shadow_size != asked)
+        warn(dev, "raster: shadow_map_size %u: the GL context cannot hold %d maps of that size; using %u", asked,
+             SY_GL_MAX_SHADOW_MAPS, dev->shadow_size);
+    return SY_GL_OK;
+}
+
 static void render_shadows(sy_gl_device *dev, const frame_state *fs)
 {
     const sy_gl_fns *gl = dev->gl;
@@ -2858,6 +2867,11 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     if (dev->lights_dirty) {
         choose_lods(dev, &v); /* shadow maps draw the levels this view picks */
         lights_upload(dev, &fs);
+        if ((fs.shadow_count || fs.cube_count) && !dev->shadow_tex) { /* the maps' size is known now */
+            if ((r = shadow_maps_make(dev, err, err_len)) != SY_GL_OK) return r;
+            fs = fs_zero;
+            lights_upload(dev, &fs);
+        }
         if (fs.shadow_count || fs.cube_count) render_shadows(dev, &fs);
         else dev->shadow_maps = 0;
         dev->lights_dirty = false;

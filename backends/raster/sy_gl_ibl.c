@@ -6,6 +6,7 @@
 #include "sy_gl_shaders.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define IBL_COMMON                                                                                           \
@@ -118,10 +119,20 @@ static sy_gl_result fb_check(const sy_gl_fns *gl, const char *what, char *err, s
 sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, char *err, size_t err_len)
 {
     if (ibl->brdf_lut) return SY_GL_OK;
+    float *ltc = malloc(2 * SY_GL_LTC_FLOATS * sizeof *ltc);
+    if (!ltc) {
+        if (err && err_len) snprintf(err, err_len, "LTC tables: out of memory");
+        return SY_GL_ERROR_OUT_OF_MEMORY;
+    }
     sy_gl_result r = build(gl, ibl, err, err_len);
-    if (r != SY_GL_OK) return r;
-    ibl->ltc1 = table_tex(gl, GL_RGBA32F, SY_GL_LTC_SIZE, GL_RGBA, sy_gl_ltc_1);
-    ibl->ltc2 = table_tex(gl, GL_RGBA32F, SY_GL_LTC_SIZE, GL_RGBA, sy_gl_ltc_2);
+    if (r != SY_GL_OK) {
+        free(ltc);
+        return r;
+    }
+    sy_gl_ltc_tables(ltc, ltc + SY_GL_LTC_FLOATS);
+    ibl->ltc1 = table_tex(gl, GL_RGBA32F, SY_GL_LTC_SIZE, GL_RGBA, ltc);
+    ibl->ltc2 = table_tex(gl, GL_RGBA32F, SY_GL_LTC_SIZE, GL_RGBA, ltc + SY_GL_LTC_FLOATS);
+    free(ltc);
     GLuint lut = table_tex(gl, GL_RG32F, SY_GL_IBL_BRDF_SIZE, GL_RG, NULL);
     gl->BindFramebuffer(GL_FRAMEBUFFER, ibl->fbo);
     gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, lut, 0);

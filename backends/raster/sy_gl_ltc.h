@@ -1,19 +1,21 @@
-/* sy_gl_ltc.h — internal: the linearly-transformed-cosine tables for GGX (Heitz et al. 2016, see
- * sy_gl_ltc.c for the source and licence), uploaded as two 64 x 64 RGBA float textures.
+/* sy_gl_ltc.h — internal: the linearly-transformed-cosine tables for GGX (Heitz et al. 2016; the
+ * data, its source and licence: data/README.md), uploaded as two 64 x 64 RGBA float textures.
  *
  * Layout (row-major, texel (x, y) at [(y * 64 + x) * 4]): x = roughness (perceptual, glTF's),
  * y = sqrt(1 - cos theta_v); sampled at uv * (63/64) + 0.5/64.
- *  sy_gl_ltc_1: the inverse transform M^-1 = mat3((a, 0, b), (0, 1, 0), (c, 0, d)) as (a, b, c, d)
- *               in the (T1, T2, N) frame with T1 in the plane of N and the view direction.
- *  sy_gl_ltc_2: x = BRDF norm with F0 = 1, y = the Fresnel (1 - F0) part (specular = F0 x + (1-F0) y),
- *               w = the horizon-clipped sphere form factor indexed by (x = 0.5 + 0.5 z, y = |F|)
- *               for the clipless polygon integral. */
+ *  ltc1: the inverse transform M^-1 = mat3((a, 0, b), (0, 1, 0), (c, 0, d)) as (a, b, c, d)
+ *        in the (T1, T2, N) frame with T1 in the plane of N and the view direction.
+ *  ltc2: x = BRDF norm with F0 = 1, y = the Fresnel (1 - F0) part (specular = F0 x + (1-F0) y),
+ *        w = the horizon-clipped sphere form factor indexed by (x = 0.5 + 0.5 z, y = |F|)
+ *        for the clipless polygon integral. */
 #ifndef SY_GL_LTC_H
 #define SY_GL_LTC_H
 
 #define SY_GL_LTC_SIZE 64
+#define SY_GL_LTC_FLOATS (SY_GL_LTC_SIZE * SY_GL_LTC_SIZE * 4) /**< floats in one table */
 
-extern const float sy_gl_ltc_1[SY_GL_LTC_SIZE * SY_GL_LTC_SIZE * 4];
-extern const float sy_gl_ltc_2[SY_GL_LTC_SIZE * SY_GL_LTC_SIZE * 4];
+/* Decodes the two tables (data/ltc_ggx.bin, embedded at build time) into ltc1 and ltc2, each of
+ * SY_GL_LTC_FLOATS floats owned by the caller. Reads constant data only: thread-safe. */
+void sy_gl_ltc_tables(float *ltc1, float *ltc2);
 
 #endif /* SY_GL_LTC_H */

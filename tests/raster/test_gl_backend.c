@@ -262,15 +262,34 @@ int main(int argc, char **argv)
               "compile failure message: %s", e);
         sy_gl_context_destroy(ctx);
         /* 9. the largest shadow_map_size the parameter allows (16384: four maps are 4 GiB, more
-         * than llvmpipe gives one texture) makes a device with smaller maps and says so; it
-         * failed with GL_OUT_OF_MEMORY before (issue 32) */
+         * than llvmpipe gives one texture) renders with smaller maps and says so; it failed with
+         * GL_OUT_OF_MEMORY before (issue 32). The maps are made by the first frame with a
+         * shadowed light: creating the device, and a frame without lights, allocate none. */
         warnings = 0;
         sy_gl_device_desc bd = {.provider = SY_GL_PROVIDER_OSMESA, .msaa = 1, .shadow_map_size = 16384, .log = on_log};
         r = sy_gl_device_create(&bd, &d, e, sizeof e);
         CHECK(r == SY_GL_OK, "shadow_map_size 16384: %s", e);
-        CHECK(warnings == 1 && strstr(last_warning, "shadow_map_size 16384"), "shadow map warning (%d): %s", warnings,
-              last_warning);
-        if (r == SY_GL_OK) sy_gl_device_destroy(d);
+        if (r == SY_GL_OK) {
+            sy_gl_camera top = {.camera_to_world = {1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 5, 0, 1}, .window = {-0.6f, 0.6f, -0.6f, 0.6f}, .near_clip = 0.1f};
+            const float floor_q[12] = {-5, 0, 5, 5, 0, 5, 5, 0, -5, -5, 0, -5};
+            const float occ_q[12] = {-0.5f, 1, 0.5f, 0.5f, 1, 0.5f, 0.5f, 1, -0.5f, -0.5f, 1, -0.5f};
+            const float ny[3] = {0, 1, 0};
+            sy_gl_material grey = material(d, 0.5f, 0.5f, 0.5f, 1, false, SY_GL_ALPHA_OPAQUE);
+            place(d, quad(d, floor_q, ny), grey);
+            place(d, quad(d, occ_q, ny), grey);
+            render(d, &top);
+            CHECK(warnings == 0, "a frame without lights made shadow maps: %s", last_warning);
+            sy_gl_light_desc ld = {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3, .direction = {1, -1, 0}};
+            sy_gl_light l;
+            MUST(sy_gl_light_create(d, &ld, &l, e, sizeof e));
+            render(d, &top);
+            CHECK(warnings == 1 && strstr(last_warning, "shadow_map_size 16384"), "shadow map warning (%d): %s", warnings,
+                  last_warning);
+            float lit = 3.0f * sqrtf(0.5f) * 0.5f / PI_F;
+            CHECK(near_(px(10, 31)[0], lit, 0.01f), "lit floor %g (want %g), smaller maps", px(10, 31)[0], lit);
+            CHECK(px(42, 31)[0] < 0.05f * lit, "shadowed floor %g (lit %g), smaller maps", px(42, 31)[0], lit);
+            sy_gl_device_destroy(d);
+        }
         /* 10. no display: GLFW names itself and the fallback */
         unsetenv("DISPLAY");
         unsetenv("WAYLAND_DISPLAY");
