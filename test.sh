@@ -26,10 +26,12 @@ browser_tests_present() {
 [ "${SY_REQUIRE_BROWSER:-0}" = 1 ] && step "browser tests present" browser_tests_present
 # Sanitizer build: every executable keeps dlopen()ed GL drivers loaded until exit
 # (tests/support/sy_keep_loaded.c), so LeakSanitizer needs one suppression only (tests/lsan.supp).
+# Every test but the browser ones (-LE browser: a minute and a half of chromium driving sy web,
+# whose server code the web_* tests already run here).
 step "build (ASan+UBSan)" sy_configure_build build-asan -- -DCMAKE_BUILD_TYPE=Debug -DSY_SANITIZE=ON &&
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0" \
-  step "ctest (ASan+UBSan)" ctest --test-dir build-asan --output-on-failure -j "$jobs"
+  step "ctest (ASan+UBSan)" ctest --test-dir build-asan --output-on-failure -j "$jobs" -LE browser
 # Minimal configuration (the modular build): only the Embree back-ends, as shared libraries (no sy web); GL,
 # GLFW, nng, libsodium, zstd and MPI are not even looked for (package_parts checks that), and the
 # suite runs what this build has, the installed-package test included.
