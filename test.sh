@@ -14,8 +14,10 @@ step() { # step NAME COMMAND...: runs the command, remembers NAME when it fails
     shift
     "$@" || failed+=("$name")
 }
+# Two tests per core: many wait on sockets, servers, chromium or a throttle (22 of 270 s idle on
+# 2 cores); the suite runs green that way under two busy loops as well (docs/TESTING.md).
 step "build (RelWithDebInfo)" sy_configure_build build -- -DCMAKE_BUILD_TYPE=RelWithDebInfo &&
-  step "ctest (RelWithDebInfo)" ctest --test-dir build --output-on-failure -j "$jobs"
+  step "ctest (RelWithDebInfo)" ctest --test-dir build --output-on-failure -j "$((2 * jobs))"
 # SY_REQUIRE_BROWSER=1 (.ci/run): the browser tests must run; a skipped one fails by itself
 # (browser_test.sh), and a main configuration without them (no sy web) fails here.
 browser_tests_present() {
@@ -33,16 +35,17 @@ step "build (ASan+UBSan)" sy_configure_build build-asan -- -DCMAKE_BUILD_TYPE=De
   LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0" \
   step "ctest (ASan+UBSan)" ctest --test-dir build-asan --output-on-failure -j "$jobs" -LE browser
 # Minimal configuration (the modular build): only the Embree back-ends, as shared libraries (no sy web); GL,
-# GLFW, nng, libsodium, zstd and MPI are not even looked for (package_parts checks that), and the
-# suite runs what this build has, the installed-package test included.
+# GLFW, nng, libsodium, zstd and MPI are not even looked for (package_parts checks that). Its code
+# is the main configuration's: it runs the tests of what its shape changes (label linkage: the
+# installed package, the parts linked, the CLI, every sample, a back-end added from outside).
 step "build (minimal: Embree only, shared)" sy_configure_build build-min -- -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DSY_WITH_RASTER=OFF -DSY_WITH_CLUSTER=OFF -DSY_WITH_WEB=OFF -DBUILD_SHARED_LIBS=ON &&
-  step "ctest (minimal)" ctest --test-dir build-min --output-on-failure -j "$jobs"
+  step "ctest (minimal)" ctest --test-dir build-min --output-on-failure -j "$jobs" -L linkage
 # Fuzzing (tests/fuzz): clang + libFuzzer, only the fuzz targets; each fuzz_run_* test fuzzes
 # SY_FUZZ_SECONDS on seeds from ../shared/testdata, one target per core (tests/fuzz/fuzz.sh runs
 # long campaigns).
 CC=clang CXX=clang++ step "build (libFuzzer)" sy_configure_build build-fuzz sy_fuzzers -- \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSY_FUZZ=ON -DSY_FUZZ_SECONDS=10 &&
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSY_FUZZ=ON -DSY_FUZZ_SECONDS=5 &&
   step "ctest (fuzz)" ctest --test-dir build-fuzz --output-on-failure -L fuzz -j "$jobs"
 if [ ${#failed[@]} -gt 0 ]; then
   printf 'test.sh: failed: %s\n' "${failed[@]}"

@@ -3,6 +3,7 @@
  * process, its render loop on a thread of its own (the only one touching the scene meanwhile). */
 #include "sy_bench_web.h"
 
+#include "sy_mediator.h"
 #include "sy_web_client.h"
 
 #include <pthread.h>
@@ -39,6 +40,11 @@ sy_result sy_bench_web(const sy_web_desc *desc, uint32_t width, uint32_t height,
 {
     sy_web_desc d = *desc;
     d.listen = "127.0.0.1:0";
+    if (!d.backend) { /* the default back-end, named in the report */
+        const sy_mediator_class *c = sy_mediator_default();
+        if (!c) return sy_error_set(err, SY_ERR_NOT_FOUND, "bench web: no default back-end; name one with -b");
+        d.backend = c->name;
+    }
     bench_server s = {0};
     sy_result r = sy_web_create(&d, &s.web, err);
     if (r) return r;

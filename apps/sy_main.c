@@ -60,6 +60,7 @@
 #include "sy_file.h"
 #include "sy_world.h"
 #include "sy_gltf.h"
+#include "sy_jpeg.h"
 #include "sy_log.h"
 #ifdef SY_HAVE_EMBREE
 #include "sy_mediator_rt.h" /* sy coverage */
@@ -74,6 +75,7 @@
 #include "sy_x3d.h"
 
 #include <cJSON.h>
+#include <dirent.h>
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
@@ -443,13 +445,111 @@ typedef struct out_opts {
     int attr_count;
 } out_opts;
 
+#define OUTPUT_KINDS ".exr, .png, .jpg or .jpeg"
+#define JPEG_QUALITY 92
+
+static bool is_output_path(const char *path)
+{
+    return ends_with(path, ".exr") || ends_with(path, ".png") || ends_with(path, ".jpg") || ends_with(path, ".jpeg");
+}
+
 static sy_result write_image(const char *path, const sy_layer *l, const out_opts *o, sy_error *err)
 {
     if (ends_with(path, ".exr"))
         return sy_exr_write_rgba_attrs(path, (int)l->width, (int)l->height, l->rgba, l->depth,
                                        o->half ? SY_EXR_PIXEL_HALF : SY_EXR_PIXEL_FLOAT, o->attrs, o->attr_count, err);
     if (ends_with(path, ".png")) return sy_png_write(path, (int)l->width, (int)l->height, l->rgba, &o->png, err);
-    return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", path);
+    if (ends_with(path, ".jpg") || ends_with(path, ".jpeg"))
+        return sy_jpeg_write(path, (int)l->width, (int)l->height, l->rgba, &o->png, JPEG_QUALITY, err);
+    return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in " OUTPUT_KINDS, path);
+}
+
+/* The back-end a command uses without -b: the registry's default (sy_mediator_default). */
+static const char *default_backend(sy_error *err)
+{
+    const sy_mediator_class *c = sy_mediator_default();
+    if (!c) sy_error_set(err, SY_ERR_NOT_FOUND, "no back-end offers itself as the default; name one with -b (sy backends)");
+    return c ? c->name : NULL;
+}
+
+/* A scene file's extension, as the loaders' names suggest (the content decides later). */
+static bool is_scene_name(const char *name)
+{
+    return ends_with(name, ".gltf") || ends_with(name, ".glb") || ends_with(name, ".x3d");
+}
+
+static int cmp_names(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
+
+/* `sy render DIR`: the one scene file in dir (into out), looked for directly in it and, when there
+ * is none, one folder down (a Khronos sample's glTF/, glTF-Binary/ ...); several: an error that
+ * lists them. */
+static sy_result scene_in_folder(const char *dir, char *out, size_t out_len, sy_error *err)
+{
+    enum { MAX_LISTED = 12 };
+    char *found[64];
+    uint32_t n = 0, total = 0;
+    for (int depth = 0; depth < 2 && total == 0; ++depth) {
+        DIR *d = opendir(dir);
+        if (!d) return sy_error_set(err, SY_ERR_IO, "%s: cannot read the folder: %s", dir, strerror(errno));
+        struct dirent *de;
+        while ((de = readdir(d))) {
+            if (de->d_name[0] == '.') continue;
+            char path[4096];
+            snprintf(path, sizeof path, "%s%s%s", dir, ends_with(dir, "/") ? "" : "/", de->d_name);
+            struct stat st;
+            if (stat(path, &st) != 0) continue;
+            if (depth == 0 && S_ISREG(st.st_mode) && is_scene_name(de->d_name)) {
+                if (n < 64) found[n++] = strdup(path);
+                total++;
+            } else if (depth == 1 && S_ISDIR(st.st_mode)) {
+                DIR *sd = opendir(path);
+                struct dirent *se;
+                while (sd && (se = readdir(sd))) {
+                    char sub[4096 + 256];
+                    snprintf(sub, sizeof sub, "%s/%s", path, se->d_name);
+                    if (se->d_name[0] == '.' || !is_scene_name(se->d_name) || stat(sub, &st) != 0 || !S_ISREG(st.st_mode))
+                        continue;
+                    if (n < 64) found[n++] = strdup(sub);
+                    total++;
+                }
+                if (sd) closedir(sd);
+            }
+        }
+        closedir(d);
+    }
+    for (uint32_t i = 0; i < n; ++i)
+        if (!found[i]) { /* strdup failed */
+            for (uint32_t k = 0; k < n; ++k) free(found[k]);
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", dir);
+        }
+    qsort(found, n, sizeof *found, cmp_names);
+    sy_result r = SY_OK;
+    if (total == 1) {
+        if (snprintf(out, out_len, "%s", found[0]) >= (int)out_len)
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: path too long", found[0]);
+    } else if (total == 0) {
+        r = sy_error_set(err, SY_ERR_NOT_FOUND, "%s: no scene file (.gltf, .glb, .x3d) in the folder or one folder down", dir);
+    } else {
+        char list[2048] = "";
+        size_t used = 0;
+        for (uint32_t i = 0; i < n && i < MAX_LISTED && used < sizeof list; ++i)
+            used += (size_t)snprintf(list + used, sizeof list - used, "\n  %s", found[i]);
+        r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: %u scene files; name one:%s%s", dir, total, list,
+                         total > MAX_LISTED ? "\n  ..." : "");
+    }
+    for (uint32_t i = 0; i < n; ++i) free(found[i]);
+    return r;
+}
+
+/* `sy render SCENE` without -o: STEM.png in the current folder (STEM: the file's name without its
+ * extension; "demo" for the built-in scene). */
+static void default_output(const char *scene, char *out, size_t out_len)
+{
+    const char *base = strrchr(scene, '/');
+    base = base ? base + 1 : scene;
+    const char *dot = strrchr(base, '.');
+    int n = dot && dot != base ? (int)(dot - base) : (int)strlen(base);
+    snprintf(out, out_len, "%.*s.png", n, base);
 }
 
 /* Renders one mono viewport of the whole window with the given back-end. */
@@ -618,13 +718,15 @@ static const char usage_text[] =
             "  sy --help | sy help [COMMAND]        this summary (on stdout); sy COMMAND --help: the command's\n"
             "  sy info SCENE | IMAGE.exr | IMAGE.png  JSON summary: counts, bounds, warnings; an image's size and\n"
             "                                       metadata (EXR channels and header attributes, PNG text chunks)\n"
-            "  sy render SCENE -b BACKEND -o OUT.exr|png [-w W] [-h H] [--camera NAME|INDEX]\n"
+            "  sy render SCENE|DIR [-b BACKEND] [-o OUT.exr|png|jpg] [-w W] [-h H] [--camera NAME|INDEX]\n"
+            "            (-b: the default back-end, sy backends marks it; -o: STEM.png in the current folder;\n"
+            "             DIR: the one scene file in the folder, or one folder down)\n"
             "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]  (PNG; default aces)\n"
             "            [--max-memory MB]   (ray tracers: refuse a scene whose BVHs need more)\n"
             "            [--gl osmesa|egl|glfw]   (-b raster: the GL context provider)\n"
             "            [--stereo sbs|tb|anaglyph|separate] [--eye-sep M] [--zero-parallax M]\n"
             "            [--overlay FILE[:BACKEND]] [--composite depth|over|replace]\n"
-            "  sy render SCENE -b pathtracer -o OUT.exr|png [--spp N | --time SECONDS] [--aov]\n"
+            "  sy render SCENE -b pathtracer [-o OUT.exr|png|jpg] [--spp N | --time SECONDS] [--aov]\n"
             "            (+ the options above)\n"
             "            [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]   (display filter)\n"
             "  sy demo [-o DIR] [-w W] [-h H] [--filter pixel|none|...]   (the progressive back-end's display filter)\n"
@@ -1114,13 +1216,23 @@ static int cmd_render(int argc, char **argv)
         if (served) return mr == SY_OK ? 0 : fail(&merr); /* a server rank: rank 0 is done */
         if (mr != SY_OK) return fail(&merr);
     }
-    if (!scene || !backend || !outp)
-        return usage_of("render", !scene ? "a SCENE is required" : !backend ? "-b BACKEND is required" : "-o OUT is required");
+    if (!scene) return usage_of("render", "a SCENE is required");
+    sy_error err = {0};
+    char in_folder[4096], auto_out[1024];
+    struct stat sst;
+    if (stat(scene, &sst) == 0 && S_ISDIR(sst.st_mode)) { /* sy render DIR: its one scene file */
+        if (scene_in_folder(scene, in_folder, sizeof in_folder, &err) != SY_OK) return fail(&err);
+        scene = in_folder;
+    }
+    if (!backend && !(backend = default_backend(&err))) return fail(&err);
+    if (!outp) { /* STEM.png here; the line that reports the render names it */
+        default_output(scene, auto_out, sizeof auto_out);
+        outp = auto_out;
+    }
     char gl_params[256];
     if (gl_provider) params = render_gl_params(params, gl_provider, gl_params, sizeof gl_params);
     char filter_params[512];
     if (filter || threshold) params = render_filter_params(params, filter, threshold, filter_params, sizeof filter_params);
-    sy_error err = {0};
     char memory_params[600];
     if (max_memory_mb) { /* --max-memory MB: the back-end's declared memory limit (max_memory_mb) */
         const sy_mediator_class *mc = sy_mediator_find(backend);
@@ -1143,8 +1255,8 @@ static int cmd_render(int argc, char **argv)
         sy_log(SY_LOG_ERROR, "sy", NULL, "%s", err.message);
         return 2;
     }
-    if (!ends_with(outp, ".exr") && !ends_with(outp, ".png")) { /* before any loading or rendering */
-        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in .exr or .png", outp);
+    if (!is_output_path(outp)) { /* before any loading or rendering */
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in " OUTPUT_KINDS, outp);
         return fail(&err);
     }
     /* --cluster: the main viewport's back-end becomes the cluster mediator (the servers render with
@@ -1447,7 +1559,7 @@ static int cmd_demo(int argc, char **argv)
 #ifdef SY_HAVE_GLFW
 static int cmd_view(int argc, char **argv)
 {
-    const char *scene = NULL, *backend = "whitted", *camera = NULL, *overlay = NULL, *composite = "depth",
+    const char *scene = NULL, *backend = NULL, *camera = NULL, *overlay = NULL, *composite = "depth",
                *shot = NULL;
     const char *view_filter = NULL; /* --filter: initial path tracer display filter */
     float view_threshold = 0.0f;    /* --threshold (0 = default) */
@@ -1503,6 +1615,7 @@ static int cmd_view(int argc, char **argv)
     if (argc - optind != 1) return usage_of("view", argc == optind ? "a SCENE is required" : "one SCENE at a time");
     scene = argv[optind];
     sy_error err = {0};
+    if (!backend && !(backend = default_backend(&err))) return fail(&err);
     if (!sy_mediator_find(backend)) {
         sy_error_set(&err, SY_ERR_NOT_FOUND, "back-end '%s' is not registered (see sy backends)", backend);
         return fail(&err);
@@ -1533,7 +1646,7 @@ static int cmd_view(int argc, char **argv)
 enum { OPT_WEB_LISTEN = 0x300, OPT_WEB_QUALITY, OPT_WEB_CLIENT_RENDER };
 static int cmd_web(int argc, char **argv)
 {
-    const char *backend = "whitted", *camera = NULL, *listen = NULL, *filter = NULL;
+    const char *backend = NULL, *camera = NULL, *listen = NULL, *filter = NULL;
     uint32_t w = 1920, h = 1200, quality = 80;
     float threshold = 0.0f;
     double budget = 0; /* 0: the governor's default (33 ms) */
@@ -1573,6 +1686,7 @@ static int cmd_web(int argc, char **argv)
     }
     if (argc - optind != 1) return usage_of("web", argc == optind ? "a SCENE is required" : "one SCENE at a time");
     sy_error err = {0};
+    if (!backend && !(backend = default_backend(&err))) return fail(&err);
     loaded ld;
     if (load(argv[optind], camera, true, &ld, &err) != SY_OK) return fail(&err);
     sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,
@@ -1745,7 +1859,9 @@ static int cmd_backends(int argc, char **argv)
             if (json) jadd(cj, NULL, jstr(caps[k].word));
             else printf(" %s", caps[k].word);
         }
-        if (!json) printf("\n");
+        bool is_default = m == sy_mediator_default(); /* what sy render, view and web use without -b */
+        if (json) jadd(o, "default", cJSON_CreateBool(is_default));
+        else printf(is_default ? "  (default)\n" : "\n");
         size_t n = params && !json ? sy_mediator_class_format_params(m, "  ", NULL, 0) : 0;
         char *t = n ? malloc(n + 1) : NULL; /* --params: the class's table, from the library */
         if (t) sy_mediator_class_format_params(m, "  ", t, n + 1), fputs(t, stdout), free(t);
@@ -1933,7 +2049,7 @@ static int cmd_bench(int argc, char **argv)
         loaded ld;
         if (load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return fail(&err);
         sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,
-                         .backend = backend ? backend : "whitted"};
+                         .backend = backend}; /* NULL: the default back-end */
         sy_result r = sy_bench_web(&d, w == 512 ? 640 : w, h == 512 ? 360 : h, repeats ? repeats : 50, &err);
         loaded_free(&ld);
         return r == SY_OK ? 0 : fail(&err);

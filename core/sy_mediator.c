@@ -148,6 +148,17 @@ const sy_mediator_class *sy_mediator_find(const char *name)
     return found;
 }
 
+const sy_mediator_class *sy_mediator_default(void)
+{
+    const sy_mediator_class *best = NULL;
+    pthread_mutex_lock(&g_registry_lock);
+    for (uint32_t i = 0; i < g_registry_count; ++i)
+        if (g_registry[i]->default_rank > 0 && (!best || g_registry[i]->default_rank > best->default_rank))
+            best = g_registry[i];
+    pthread_mutex_unlock(&g_registry_lock);
+    return best;
+}
+
 uint32_t sy_mediator_count(void)
 {
     pthread_mutex_lock(&g_registry_lock);

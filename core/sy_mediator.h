@@ -191,6 +191,10 @@ typedef struct sy_mediator_class {
      * back-end. NULL: an undeclared key is an error listing the valid names. */
     sy_result (*check_params)(const sy_params *all, const sy_params *undeclared, const void *class_user,
                               sy_error *err);
+    /** How strongly the class offers itself as the default back-end (sy_mediator_default): the
+     * registered class of the highest rank above 0 is it; 0 (the default): never. The built-in
+     * ones: raster 20 (the complete look, fastest), whitted 10. */
+    int default_rank;
 } sy_mediator_class;
 
 /** Registry (process-wide; the one piece of global state). The class must outlive the process's
@@ -198,6 +202,10 @@ typedef struct sy_mediator_class {
 sy_result sy_mediator_register(const sy_mediator_class *cls, sy_error *err);
 /** The class registered under name, or NULL. */
 const sy_mediator_class *sy_mediator_find(const char *name);
+/** The default back-end: the registered class of the highest default_rank above 0 (the first
+ * registered of equal ranks), or NULL when none offers itself. Every program's default (sy render,
+ * sy view, sy web, sy compare) is this class. */
+const sy_mediator_class *sy_mediator_default(void);
 /** Number of registered classes. */
 uint32_t sy_mediator_count(void);
 /** The i-th registered class (i < sy_mediator_count), or NULL. */

@@ -1,5 +1,8 @@
-/* sy_jpeg.c — RGBA8 <-> JPEG through libjpeg-turbo's TurboJPEG API (see sy_jpeg.h). */
+/* sy_jpeg.c — RGBA8 <-> JPEG through libjpeg-turbo's TurboJPEG API, and JPEG files of rendered
+ * images (see sy_jpeg.h). */
 #include "sy_jpeg.h"
+
+#include "sy_file.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -70,4 +73,39 @@ sy_result sy_jpeg_decode_rgba8(const uint8_t *jpeg, size_t len, size_t max_pixel
     }
     *out = px, *w = (uint32_t)iw, *h = (uint32_t)ih;
     return SY_OK;
+}
+
+sy_result sy_jpeg_write(const char *path, int width, int height, const float *rgba, const sy_png_options *opts,
+                        int quality, sy_error *err)
+{
+    if (!path || !rgba)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_jpeg_write: path and pixel data are required");
+    if (width < 1 || height < 1 || (uint32_t)width > SY_JPEG_MAX_SIDE || (uint32_t)height > SY_JPEG_MAX_SIDE)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: image size %dx%d outside 1..%u per side", path, width,
+                            height, SY_JPEG_MAX_SIDE);
+    size_t n = (size_t)width * (size_t)height;
+    uint8_t *px = malloc(n * 4);
+    if (!px) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory (%dx%d)", path, width, height);
+    for (size_t i = 0; i < n; ++i) { /* composited over black: the premultiplied colour, opaque */
+        const float c[4] = {rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2], 1.0f};
+        sy_png_encode_pixel(c, opts, px + 4 * i);
+    }
+    uint8_t *jpeg = NULL;
+    size_t len = 0;
+    sy_result r = sy_jpeg_encode_rgba8(px, (uint32_t)width, (uint32_t)height, quality, &jpeg, &len, err);
+    free(px);
+    if (r != SY_OK) {
+        sy_error_prefix(err, "%s", path);
+        return r;
+    }
+    sy_atomic_file af = {0};
+    r = sy_atomic_file_begin(path, &af, err);
+    if (r == SY_OK && fwrite(jpeg, 1, len, af.fp) != len) {
+        sy_atomic_file_abort(&af);
+        r = sy_error_set(err, SY_ERR_IO, "%s: write failed", path);
+    } else if (r == SY_OK) {
+        r = sy_atomic_file_commit(&af, err);
+    }
+    free(jpeg);
+    return r;
 }

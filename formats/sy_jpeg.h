@@ -1,8 +1,8 @@
 /** @file
  * sy_jpeg.h — JPEG encoding and decoding of 8-bit RGBA pixels (libjpeg-turbo's TurboJPEG API):
- * the frames and stills that sy web streams to a browser. Alpha is dropped when encoding (the
- * colour is written as it is: premultiplied pixels come out composited over black) and set to 255
- * when decoding. Built with the web part (SY_WITH_WEB).
+ * the frames and stills that sy web streams to a browser, and JPEG files of rendered images
+ * (sy_jpeg_write: `sy render -o X.jpg`). Alpha is dropped when encoding (the colour is written as
+ * it is: premultiplied pixels come out composited over black) and set to 255 when decoding.
  *
  * Ownership: *out buffers are malloc()ed and owned by the caller (free()).
  * Thread-safety: every call uses its own TurboJPEG handle; calls may run on any thread. */
@@ -10,6 +10,7 @@
 #define SY_JPEG_H
 
 #include "sy_common.h"
+#include "sy_png.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -22,6 +23,13 @@ extern "C" {
  * below 90, 4:4:4 from 90). *out receives the JPEG bytes, *out_len their count. */
 sy_result sy_jpeg_encode_rgba8(const uint8_t *rgba, uint32_t w, uint32_t h, int quality, uint8_t **out,
                                size_t *out_len, sy_error *err);
+
+/** Writes width x height premultiplied linear RGBA floats (rows top first) as a JPEG file at
+ * quality 1..100, each pixel encoded for display exactly as sy_png_write encodes it
+ * (sy_png_encode_pixel: exposure, tone map, sRGB; opts NULL = the defaults; text chunks are not
+ * written). Through sy_atomic_file: a failure leaves no partial file. */
+sy_result sy_jpeg_write(const char *path, int width, int height, const float *rgba, const sy_png_options *opts,
+                        int quality, sy_error *err);
 
 /** Decodes a JPEG (untrusted bytes) into RGBA8: *out holds w x h x 4 bytes; images larger than
  * max_pixels (0 = SY_JPEG_MAX_SIDE squared) or with a side above SY_JPEG_MAX_SIDE are refused

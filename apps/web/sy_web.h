@@ -78,7 +78,7 @@ typedef struct sy_web_desc {
     sy_node root;             /**< {0}: every root */
     sy_node camera;           /**< a node carrying a camera: the view starts there (required) */
     sy_background background; /**< what the camera sees where nothing is hit ({0}: black, as sy_viewport_desc) */
-    const char *backend;      /**< the initial back-end (a registered name) */
+    const char *backend;      /**< the initial back-end (a registered name; NULL: sy_mediator_default) */
     const char *listen;       /**< "HOST:PORT" (NULL: "127.0.0.1:8080"); port 0 = a free one */
     const char *token;        /**< access token (hex, >= 16 characters); NULL: generated when HOST is
                                    not a loopback address, none otherwise */

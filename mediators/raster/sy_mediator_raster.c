@@ -834,6 +834,7 @@ static const sy_mediator_class raster_class = {
     .sync = raster_sync,
     .render = raster_render,
     .stats = raster_stats,
+    .default_rank = 20, /* the default back-end where it is built: the complete look, fastest */
 };
 
 const sy_mediator_class *sy_mediator_raster_class(void) { return &raster_class; }

@@ -1282,6 +1282,7 @@ static const sy_mediator_class whitted_class = {
     .sync = rt_sync,
     .render = rt_render,
     .stats = rt_stats,
+    .default_rank = 10, /* the default back-end without the rasterizer */
 };
 
 const sy_mediator_class *sy_mediator_rt_whitted_class(void) { return &whitted_class; }

@@ -1,11 +1,17 @@
 /* test_jpeg.c — formats/sy_jpeg.h: an encoded gradient decodes back to the same size and close to
  * the same pixels (quality 95 and 50: the lower quality is smaller and less exact), bad arguments
- * and malformed or truncated bytes get errors, and the decode limit is enforced. */
+ * and malformed or truncated bytes get errors, and the decode limit is enforced; sy_jpeg_write
+ * (sy render -o X.jpg) writes what sy_png_write would show, composited over black, and leaves no
+ * file behind when it fails. */
 #include "../core/check.h"
 #include "sy_jpeg.h"
 
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static uint8_t *gradient(uint32_t w, uint32_t h)
 {
@@ -85,10 +91,65 @@ static int test_bad_arguments(void)
     return 0;
 }
 
+/* sy_jpeg_write: linear premultiplied floats (a ramp over 0..4, alpha 1, 0.5 and 0) come back as
+ * sy_png_encode_pixel shows each colour over black (ACES tone map, +1 stop), within JPEG's error */
+static int test_write(void)
+{
+    sy_error e = {0};
+    enum { W = 64, H = 40 };
+    static float rgba[W * H * 4];
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            float *p = rgba + 4 * (y * W + x), a = y < H / 2 ? 1.0f : x < W / 2 ? 0.5f : 0.0f;
+            p[0] = 4.0f * (float)x / (W - 1) * a, p[1] = (float)y / (H - 1) * a, p[2] = 0.25f * a, p[3] = a;
+        }
+    char dir[] = "/tmp/sy-test-jpeg.XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char path[256];
+    snprintf(path, sizeof path, "%s/out.jpg", dir);
+    sy_png_options o = {.tonemap = SY_TONEMAP_ACES, .exposure_stops = 1.0f};
+    CHECK_OK(sy_jpeg_write(path, W, H, rgba, &o, 92, &e), e);
+    FILE *f = fopen(path, "rb");
+    CHECK(f != NULL);
+    static uint8_t bytes[1 << 16];
+    size_t n = f ? fread(bytes, 1, sizeof bytes, f) : 0;
+    if (f) fclose(f);
+    uint8_t *back = NULL;
+    uint32_t bw = 0, bh = 0;
+    CHECK_OK(sy_jpeg_decode_rgba8(bytes, n, 0, &back, &bw, &bh, &e), e);
+    CHECK(bw == W && bh == H);
+    static uint8_t want[W * H * 4];
+    for (int i = 0; i < W * H; ++i) {
+        const float c[4] = {rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2], 1.0f};
+        sy_png_encode_pixel(c, &o, want + 4 * i);
+    }
+    double d = back ? mad(want, back, (size_t)W * H) : 1e9;
+    CHECK_MSG(d < 2.0, "mean abs difference against the PNG encoding over black: %.3f", d);
+    /* the transparent corner is black, the half-transparent one darker than the opaque row above */
+    CHECK_MSG(back && back[4 * ((H - 1) * W + W - 1)] < 4, "transparent pixel %d", back ? back[4 * ((H - 1) * W + W - 1)] : -1);
+    free(back);
+    /* a failure (a folder that is not there; an image too large) leaves no file, no temporary */
+    char bad[300];
+    snprintf(bad, sizeof bad, "%s/missing/out.jpg", dir);
+    CHECK(sy_jpeg_write(bad, W, H, rgba, &o, 92, &e) != SY_OK);
+    CHECK_ERR(sy_jpeg_write(path, (int)SY_JPEG_MAX_SIDE + 1, 1, rgba, &o, 92, &e), SY_ERR_INVALID_ARGUMENT, e);
+    CHECK_ERR(sy_jpeg_write(path, W, H, rgba, &o, 0, &e), SY_ERR_INVALID_ARGUMENT, e);
+    DIR *dd = opendir(dir);
+    int entries = 0;
+    for (struct dirent *de; dd && (de = readdir(dd));)
+        if (de->d_name[0] != '.') entries++;
+    if (dd) closedir(dd);
+    CHECK_MSG(entries == 1, "%d files in the folder (want out.jpg only)", entries);
+    unlink(path);
+    rmdir(dir);
+    return 0;
+}
+
 int main(void)
 {
     int failures = 0;
     RUN(test_round_trip);
     RUN(test_bad_arguments);
+    RUN(test_write);
     return failures ? 1 : 0;
 }

@@ -9,7 +9,7 @@
  * Usage: test_gltf_counts TESTDATA_DIR (exit 77 when the data is absent). */
 #include "sy_gltf.h"
 
-#include <cjson/cJSON.h>
+#include <cJSON.h>
 #include <dirent.h>
 #include <stdbool.h>
 #include <stdint.h>

@@ -178,6 +178,32 @@ run help_bench "$SY" help bench
 run backends_json "$SY" backends --json
 [ "$rc" -eq 0 ] && head -n 1 "$TMP/backends_json.out" | grep -qx '\[' && grep -q '{"name": "whitted", "caps": \["depth"' "$TMP/backends_json.out" ||
     fail "sy backends --json: status $rc, $(cat "$TMP/backends_json.out" "$TMP/backends_json.err")"
+# the front door (issue 33): sy backends marks the default; sy render SCENE without -b and -o
+# renders with it into STEM.png in the current folder; -o X.jpg writes a JPEG; sy render DIR takes
+# the one scene file of the folder and lists the candidates when there are several
+default_b=$("$SY" backends | grep '  (default)$' | cut -d' ' -f1)
+want_default=whitted
+has raster && want_default=raster
+[ "$default_b" = "$want_default" ] || fail "sy backends: default '$default_b' (want $want_default)"
+grep -q "\"name\": \"$want_default\".*\"default\": true" <("$SY" backends --json | tr -d '\n') ||
+    fail "sy backends --json: $want_default is not marked the default"
+mkdir -p "$TMP/front/one" "$TMP/front/two" "$TMP/front/here"
+printf '{"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{}]}' > "$TMP/front/one/empty.gltf"
+cp "$TMP/front/one/empty.gltf" "$TMP/front/two/a.gltf"
+cp "$TMP/front/one/empty.gltf" "$TMP/front/two/b.glb.x3d"
+(cd "$TMP/front/here" && "$SY" render demo -w 32 -h 24 >../plain.out 2>../plain.err)
+rc=$?
+[ "$rc" -eq 0 ] && magic "$TMP/front/here/demo.png" 89504e47 && grep -q "demo.png: 32x24, $want_default, " "$TMP/front/plain.out" ||
+    fail "sy render demo (no -b, no -o): status $rc, $(cat "$TMP/front/plain.out" "$TMP/front/plain.err"; ls "$TMP/front/here")"
+run jpeg "$SY" render demo -b whitted -w 32 -h 24 -o "$TMP/front/demo.jpg"
+[ "$rc" -eq 0 ] && magic "$TMP/front/demo.jpg" ffd8ff || fail "sy render -o X.jpg: status $rc, $(cat "$TMP/jpeg.err")"
+(cd "$TMP/front/here" && "$SY" render ../one -b whitted -w 32 -h 24 >../dir.out 2>../dir.err)
+rc=$?
+[ "$rc" -eq 0 ] && [ -f "$TMP/front/here/empty.png" ] || fail "sy render DIR (one scene file): status $rc, $(cat "$TMP/front/dir.err")"
+run dir_two "$SY" render "$TMP/front/two" -b whitted -w 32 -h 24
+[ "$rc" -eq 1 ] && grep -q "2 scene files; name one" "$TMP/dir_two.err" && grep -q "/two/a.gltf" "$TMP/dir_two.err" &&
+    grep -q "/two/b.glb.x3d" "$TMP/dir_two.err" || fail "sy render DIR (two scene files): status $rc, $(cat "$TMP/dir_two.err")"
+[ ! -e "$TMP/front/two.png" ] && [ ! -e two.png ] || fail "sy render DIR (two scene files) wrote an image"
 run badcmd "$SY" renderr demo
 [ "$rc" -eq 2 ] && grep -q "unknown command 'renderr'" "$TMP/badcmd.err" || fail "an unknown command: status $rc (want 2)"
 run failure "$SY" render "$TMP/does_not_exist.gltf" -b whitted -o "$TMP/x.png"
@@ -264,7 +290,7 @@ else
 fi
 chmod 755 "$TMP/o_ro"
 mkdir -p "$TMP/o_ext"
-expect_error extension x.jpg "$TMP/o_ext" "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_ext/x.jpg"
+expect_error extension x.bmp "$TMP/o_ext" "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_ext/x.bmp"
 
 # benchmarks on small sizes: exit status and result lines only (speed is not tested here)
 run bench_sync "$SY" bench sync --nodes 200 --tris 48 --repeats 5

@@ -49,10 +49,10 @@ start b
 URLS="tcp://127.0.0.1:$(cat "$W/a.port"),tcp://127.0.0.1:$(cat "$W/b.port")"
 
 # 1. sort-first: bit-identical to the local viewer
-view cluster demo -w 320 -h 180 --frames 5 --cluster "$URLS" --cluster-mode sort-first --secret-file "$W/secret" \
+view cluster demo -b whitted -w 320 -h 180 --frames 5 --cluster "$URLS" --cluster-mode sort-first --secret-file "$W/secret" \
     --screenshot "$W/cluster.png"
 grep -q "cluster sort-first: whitted | 2/2 servers alive" "$W/cluster.out" || fail "the title does not show the mode and servers"
-view local demo -w 320 -h 180 --frames 5 --screenshot "$W/local.png"
+view local demo -b whitted -w 320 -h 180 --frames 5 --screenshot "$W/local.png"
 grep -q "sy view | whitted" "$W/local.out" || fail "the local viewer did not finish"
 "$CMP" "$W/cluster.png" "$W/local.png" 0 50 || fail "the sort-first cluster window differs from the local viewer"
 "$SY" render demo -b whitted -w 320 -h 180 --tonemap aces -o "$W/render.png" >/dev/null || fail "sy render"
@@ -96,7 +96,7 @@ server tcp://127.0.0.1:$(cat "$W/c.port") tile 0 0 160 180
 server tcp://127.0.0.1:$(cat "$W/d.port") tile 160 0 160 180
 viewer tile 160 0 160 180
 CONF
-view wall demo -w 320 -h 180 --frames 3 --cluster "$W/wall.conf" --secret-file "$W/secret" \
+view wall demo -b whitted -w 320 -h 180 --frames 3 --cluster "$W/wall.conf" --secret-file "$W/secret" \
     --screenshot "$W/wall_view.png"
 [ -s "$W/wall_c.png" ] && [ -s "$W/wall_d.png" ] || fail "the servers did not present their wall tiles"
 grep -q "cluster multi-display: whitted | 2/2 servers alive" "$W/wall.out" || fail "no multi-display title"

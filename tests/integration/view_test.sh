@@ -14,7 +14,7 @@ TMP=$3
 rm -rf "$TMP"
 mkdir -p "$TMP"
 . "$(dirname "$0")/view_skip.sh"
-timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -w 320 -h 180 --frames 5 \
+timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w 320 -h 180 --frames 5 \
     --screenshot "$TMP/view.png" >"$TMP/view.out" 2>"$TMP/view.err"
 rc=$?
 if [ $rc -ne 0 ]; then
