@@ -14,10 +14,8 @@ step() { # step NAME COMMAND...: runs the command, remembers NAME when it fails
     shift
     "$@" || failed+=("$name")
 }
-# Two tests per core: many wait on sockets, servers, chromium or a throttle (22 of 270 s idle on
-# 2 cores); the suite runs green that way under two busy loops as well (docs/TESTING.md).
 step "build (RelWithDebInfo)" sy_configure_build build -- -DCMAKE_BUILD_TYPE=RelWithDebInfo &&
-  step "ctest (RelWithDebInfo)" ctest --test-dir build --output-on-failure -j "$((2 * jobs))"
+  step "ctest (RelWithDebInfo)" ctest --test-dir build --output-on-failure -j "$jobs"
 # SY_REQUIRE_BROWSER=1 (.ci/run): the browser tests must run; a skipped one fails by itself
 # (browser_test.sh), and a main configuration without them (no sy web) fails here.
 browser_tests_present() {

@@ -85,11 +85,12 @@ try {
     const after = await page.evaluate(() => ({ ...syStats }));
     console.log(JSON.stringify({ before, after, consoleErrors }));
   } else {
+    // idle (the last answer's objects all shown) and that state drawn (the page renders on demand)
     await page.waitForFunction(() => window.syClient && syClient.queries > 0 && syClient.idle &&
-                                     syClient.requested.length > 0, null, { timeout: TIMEOUT })
+                                     syClient.requested.length > 0 && !syClient.renderPending, null,
+                               { timeout: TIMEOUT })
       .catch(async () => fail(`the client did not settle: ${JSON.stringify(await page.evaluate(() => window.syClient &&
         { queries: syClient.queries, idle: syClient.idle, errors: syClient.errors }))}`));
-    await page.waitForTimeout(500); // a few animation frames with everything drawn
     await canvasPng(page, 'canvas', join(outDir, 'canvas.png'));
     const s = await page.evaluate(() => ({
       requested: syClient.requested, loaded: syClient.loaded, visible: syClient.visible,

@@ -52,12 +52,26 @@ const pending = new Map(); // id -> Promise (being fetched)
 const state = {
   requested: [], loaded: [], visible: [], triangles: 0, fetched_triangles: 0, bytes: 0,
   total_objects: 0, total_triangles: 0, queries: 0, fetches: 0, errors: [], idle: false, lastAnswer: null,
+  frames: 0, renderPending: false,
 };
 const triangleCount = new Map(); // id -> triangles (from the answers)
 let framed = false;
 let inFlight = false;
 let again = false;
 let timer = null;
+
+// Rendering on demand (three.js's own advice for static scenes): one frame after anything drawn
+// changed (the camera, objects loaded or shown, the canvas size) and none while the view rests, so
+// a resting page costs no CPU or GPU. syClient.renderPending: a frame is queued, not drawn yet.
+function requestRender() {
+  if (state.renderPending) return;
+  state.renderPending = true;
+  requestAnimationFrame(() => {
+    renderer.render(scene, camera);
+    state.frames++;
+    state.renderPending = false;
+  });
+}
 
 function cameraJSON() {
   const size = renderer.getSize(new THREE.Vector2());
@@ -108,6 +122,7 @@ function applyVisibility() {
   state.triangles = tris;
   state.idle = !inFlight && !again && timer === null && pending.size === 0 && vis.length === want.size;
   updateOverlay();
+  requestRender();
 }
 
 async function fetchObject(id) {
@@ -166,6 +181,7 @@ function applyView(v, b) {
   camera.updateProjectionMatrix();
   controls.target.set(...v.target);
   controls.update();
+  requestRender();
 }
 
 function frameBounds(b) {
@@ -183,6 +199,7 @@ function frameBounds(b) {
   camera.updateProjectionMatrix();
   controls.target.copy(centre);
   controls.update();
+  requestRender();
 }
 
 async function cull() {
@@ -237,10 +254,14 @@ function resize() {
   renderer.setSize(w, h, false);
   camera.aspect = w / Math.max(1, h);
   camera.updateProjectionMatrix();
+  requestRender();
   scheduleCull();
 }
 
-controls.addEventListener('change', scheduleCull);
+controls.addEventListener('change', () => {
+  requestRender();
+  scheduleCull();
+});
 window.addEventListener('resize', resize);
 
 window.syClient = Object.assign(state, {
@@ -251,11 +272,12 @@ window.syClient = Object.assign(state, {
     controls.target.set(...target);
     controls.update();
     framed = true;
+    requestRender();
     scheduleCull();
   },
 });
 
-renderer.setAnimationLoop(() => renderer.render(scene, camera));
+requestRender();
 try {
   const response = await fetch(withToken('/api/view'));
   if (response.ok) serverView = await response.json();
