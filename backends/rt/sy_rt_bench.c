@@ -1,10 +1,13 @@
 /* sy_rt_bench.c — sy_rt_bench_rays: times the PRIMARY integrator and a raw-Embree kernel that
  * generates the same camera rays through the same tile scheduler and only stores the hit
  * distance, so the difference is exactly what the renderer adds (hit lookup, surface evaluation,
- * shading, output). */
+ * shading, output). It also compares the two depth images: the comparison is only fair when both
+ * traced the same rays to the same hits. */
 #include "sy_rt_bench.h"
 #include "sy_rt_primary.h"
 
+#include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <time.h>
 
@@ -19,7 +22,7 @@ static void raw_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0,
             float axial;
             sy_rt_frame_hit(f, &ctx.rtc, px, py, &rh, &axial);
             tbuf[(size_t)(py - f->y) * f->width + (px - f->x)] =
-                rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar;
+                rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar * axial;
         }
 }
 
@@ -41,10 +44,11 @@ sy_rt_result sy_rt_bench_rays(sy_rt_device *dev, const sy_rt_camera *camera, uin
     if (!sy_rt_size_mul(width, height, &pixels) || !sy_rt_size_mul(pixels, 4u * sizeof(float), &bytes))
         return sy_rt_fail(err, err_len, SY_RT_ERROR_LIMIT, "bench: %ux%u overflows size_t", width, height);
     float *rgba = malloc(bytes ? bytes : 1);
-    float *depth = malloc(pixels * sizeof(float) + 1);
-    if (!rgba || !depth) {
+    float *depth = malloc(pixels * sizeof(float) + 1), *raw = malloc(pixels * sizeof(float) + 1);
+    if (!rgba || !depth || !raw) {
         free(rgba);
         free(depth);
+        free(raw);
         return sy_rt_fail(err, err_len, SY_RT_ERROR_OUT_OF_MEMORY, "bench: cannot allocate %ux%u buffers", width, height);
     }
     sy_rt_render_desc rd = {.integrator = SY_RT_INTEGRATOR_PRIMARY, .image_width = width, .image_height = height,
@@ -56,16 +60,25 @@ sy_rt_result sy_rt_bench_rays(sy_rt_device *dev, const sy_rt_camera *camera, uin
         double t0 = now_s();
         r = sy_rt_run_tiles(&f, sy_rt_primary_tile, NULL, NULL, NULL, err, err_len);
         double t1 = now_s();
-        if (r == SY_RT_OK) r = sy_rt_run_tiles(&f, raw_tile, depth, NULL, NULL, err, err_len);
+        if (r == SY_RT_OK) r = sy_rt_run_tiles(&f, raw_tile, raw, NULL, NULL, err, err_len);
         double t2 = now_s();
         if (i > 0) {
             best_primary = fmin(best_primary, t1 - t0);
             best_raw = fmin(best_raw, t2 - t1);
         }
     }
+    uint64_t hits = 0, differ = 0; /* the last frame of each: same rays, same hits, same depths */
+    for (size_t i = 0; r == SY_RT_OK && i < pixels; ++i) {
+        bool hp = isfinite(depth[i]), hr = isfinite(raw[i]);
+        hits += hp;
+        if (hp != hr || (hp && fabsf(depth[i] - raw[i]) > 1e-4f * fmaxf(1.0f, fabsf(raw[i])))) differ++;
+    }
     free(rgba);
     free(depth);
+    free(raw);
     if (r != SY_RT_OK) return r;
+    out->hits = hits;
+    out->differing_pixels = differ;
     out->width = width;
     out->height = height;
     out->repeats = repeats;

@@ -13,6 +13,9 @@ typedef struct sy_rt_bench_result {
     double primary_mrays;    /* width*height / primary_seconds / 1e6 */
     double raw_mrays;
     double overhead_percent; /* (primary_seconds / raw_seconds - 1) * 100 */
+    uint64_t hits;             /* pixels whose camera ray hit something (the PRIMARY integrator's depth) */
+    uint64_t differing_pixels; /* pixels where the two methods disagree: hit against miss, or depths
+                                * more than 1e-4 apart (relative): 0 when they traced the same rays */
 } sy_rt_bench_result;
 
 /* Renders a width x height frame `repeats` times (>= 1) with each method, alternating, after one

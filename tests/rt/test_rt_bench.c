@@ -1,7 +1,8 @@
-/* test_rt_bench.c — runs sy_rt_bench_rays on a scene of many instanced and baked meshes and
- * checks that it reports consistent numbers; prints the measured throughput and overhead. The
- * < 25 % overhead target is checked only when SY_RT_BENCH_STRICT is set in the environment
- * (timings on shared CI machines and under sanitizers are not reliable). */
+/* test_rt_bench.c — sy_rt_bench_rays on a scene of many instanced and baked meshes: what makes its
+ * comparison fair, not how fast it is (speed lives in `sy bench rays`, docs/BACKENDS.md): the
+ * PRIMARY integrator and the raw-Embree kernel traced the same rays to the same hits (their depth
+ * images agree at every pixel), and the hits are those of the scene (a 20 x 20 quad filling the
+ * view behind 64 spheres: every ray hits). It prints the measured throughput and overhead. */
 #include "rt_test.h"
 #include "sy_rt_bench.h"
 
@@ -58,9 +59,10 @@ int main(void)
            r.primary_mrays, r.raw_mrays, r.overhead_percent);
     CHECK(r.primary_mrays > 0 && r.raw_mrays > 0 && isfinite(r.overhead_percent), "bench numbers %g %g %g", r.primary_mrays,
           r.raw_mrays, r.overhead_percent);
-    CHECK(rt_near(r.primary_mrays, 512.0 * 512.0 / r.primary_seconds * 1e-6, 1e-9), "Mrays/s inconsistent with time");
-    const char *strict = getenv("SY_RT_BENCH_STRICT");
-    if (strict && strict[0] == '1') CHECK(r.overhead_percent < 25.0, "overhead %.1f %% >= 25 %%", r.overhead_percent);
+    CHECK(r.differing_pixels == 0, "%llu of %d pixels differ between the integrator and raw Embree",
+          (unsigned long long)r.differing_pixels, 512 * 512);
+    CHECK(r.hits == 512u * 512u, "%llu of %d camera rays hit (the quad fills the view)", (unsigned long long)r.hits,
+          512 * 512);
     sy_rt_device_destroy(dev);
     return rt_finish("test_rt_bench");
 }
