@@ -972,6 +972,12 @@ static void jcounts(cJSON *o, const char *const *names, const uint32_t *values, 
     for (size_t i = 0; i < n; ++i) jadd(o, names[i], cJSON_CreateNumber(values[i]));
 }
 
+/* sy info's log while it loads: warnings are part of its JSON output, everything else goes to stderr. */
+static void info_log(void *user, sy_log_level level, const char *module, const char *item, const char *message)
+{
+    if (level != SY_LOG_WARNING) sy_log_stderr(user, level, module, item, message);
+}
+
 static int cmd_info(int argc, char **argv)
 {
     static const struct option lo[] = {{"json", no_argument, NULL, OPT_JSON}, COMMON_OPTIONS};
@@ -987,7 +993,10 @@ static int cmd_info(int argc, char **argv)
     if (fmt == SY_FORMAT_PNG) return info_png(path); /* by content, as scenes are recognised */
     if (ends_with(path, ".exr")) return info_exr(path);
     loaded ld;
-    if (load(path, NULL, false, &ld, &err) != SY_OK) return fail(&err);
+    sy_log_set_callback(info_log, NULL); /* the load's warnings go into the JSON, not also to stderr */
+    sy_result lr = load(path, NULL, false, &ld, &err);
+    sy_log_set_callback(NULL, NULL);
+    if (lr != SY_OK) return fail(&err);
     sy_bounds b;
     sy_node_world_bounds(ld.scene, ld.root, &b, NULL);
     /* counts of what was loaded into the scene (less the synthetic root node) */
@@ -997,16 +1006,29 @@ static int cmd_info(int argc, char **argv)
         prims += m->primitives.count;
         for (uint32_t i = 0; i < m->primitives.count; ++i) tris += sy_primitive_triangle_count(&m->primitives.items[i]);
     }
+    /* One layout for every format: format, the file's own counts (file_counts: what it declares,
+     * skipped items included), what was loaded into the scene (loaded), bounds, warnings. */
     cJSON *doc = cJSON_CreateObject();
     jadd(doc, "file", jstr(path));
+    jadd(doc, "format", jstr(ld.is_gltf ? "gltf" : ld.is_x3d ? "x3d" : "demo"));
+    static const char *const names[] = {"nodes",  "meshes", "primitives", "triangles", "materials",     "textures",
+                                        "images", "lights", "cameras",    "points",    "line_segments", "skipped"};
+    uint32_t v[12] = {0};
     if (ld.is_gltf) {
         const sy_gltf_counts *gc = &ld.gltf.counts;
-        static const char *const names[] = {"nodes", "meshes", "primitives", "triangles", "materials",
-                                            "textures", "images", "lights", "cameras"};
-        const uint32_t v[] = {gc->nodes, gc->meshes, gc->primitives, gc->triangles, gc->materials,
-                              gc->textures, gc->images, gc->lights, gc->cameras};
-        jcounts(doc, names, v, 9);
+        const uint32_t g[12] = {gc->nodes,   gc->meshes,  gc->primitives, gc->triangles,     gc->materials,
+                                gc->textures, gc->images, gc->lights,     gc->cameras,       gc->points,
+                                gc->line_segments, gc->skipped_primitives};
+        memcpy(v, g, sizeof v);
+    } else if (ld.is_x3d) { /* X3D declares no totals: what its nodes made (an ImageTexture is one image) */
+        const sy_x3d_counts *xc = &ld.x3d.counts;
+        const uint32_t x[12] = {xc->nodes,    xc->meshes,   xc->primitives, xc->triangles, xc->materials,
+                                xc->textures, xc->textures, xc->lights,     xc->cameras,   xc->points,
+                                xc->line_segments, xc->skipped_geometry};
+        memcpy(v, x, sizeof v);
     }
+    if (ld.is_gltf || ld.is_x3d) jcounts(jadd(doc, "file_counts", cJSON_CreateObject()), names, v, 12);
+    else jadd(doc, "file_counts", cJSON_CreateNull()); /* the built-in scene: no file */
     static const char *const lnames[] = {"nodes", "meshes", "primitives", "triangles", "materials",
                                          "textures", "lights", "cameras"};
     const uint32_t lv[] = {sy_scene_count(ld.scene, SY_TYPE_NODE) - 1, sy_scene_count(ld.scene, SY_TYPE_MESH), prims,
@@ -1023,6 +1045,7 @@ static int cmd_info(int argc, char **argv)
             jadd(mx, NULL, jfloat((double)b.max[k]));
         }
     }
+    jadd(doc, "warning_count", cJSON_CreateNumber(ld.gltf.warning_count + ld.x3d.warning_count)); /* all, stored or not */
     cJSON *wa = jadd(doc, "warnings", cJSON_CreateArray());
     for (uint32_t i = 0; i < ld.gltf.stored_warning_count; ++i) jadd(wa, NULL, jstr(ld.gltf.warnings[i]));
     for (uint32_t i = 0; i < ld.x3d.stored_warning_count; ++i) jadd(wa, NULL, jstr(ld.x3d.warnings[i]));

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # cli_test.sh SY TESTDATA TMPDIR — tests of the `sy` command line tool (integration_cli).
-#   - sy info Box.gltf: JSON counts meshes/primitives/triangles/materials = 1/1/12/1, bounds +-0.5
+#   - sy info Box.gltf: JSON in the one layout of every format (format, file_counts, loaded, bounds,
+#     warning_count, warnings): meshes/primitives/triangles/materials = 1/1/12/1, bounds +-0.5;
+#     a file's warnings only in the JSON
 #   - conventions: --version, --help / help / CMD --help / help bench on stdout; a bad option, a
 #     missing or bad value named with status 2; a failure status 1; backends --json; -q / -v;
 #     an abbreviated long option (--frame for --frames) is a usage error naming the options it
@@ -178,6 +180,12 @@ run help_bench "$SY" help bench
 run backends_json "$SY" backends --json
 [ "$rc" -eq 0 ] && head -n 1 "$TMP/backends_json.out" | grep -qx '\[' && grep -q '{"name": "whitted", "caps": \["depth"' "$TMP/backends_json.out" ||
     fail "sy backends --json: status $rc, $(cat "$TMP/backends_json.out" "$TMP/backends_json.err")"
+# sy info says a file's warnings once, in its JSON (warning_count, warnings), not also on stderr
+printf '{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]}' \
+    > "$TMP/info_warn.gltf"
+run info_warn "$SY" info "$TMP/info_warn.gltf"
+[ "$rc" -eq 0 ] && grep -qxF '  "warning_count": 1,' "$TMP/info_warn.out" && grep -q 'no POSITION attribute; skipped' "$TMP/info_warn.out" &&
+    [ ! -s "$TMP/info_warn.err" ] || fail "sy info with a warning: status $rc, $(cat "$TMP/info_warn.out" "$TMP/info_warn.err")"
 # the front door (issue 33): sy backends marks the default; sy render SCENE without -b and -o
 # renders with it into STEM.png in the current folder; -o X.jpg writes a JPEG; sy render DIR takes
 # the one scene file of the folder and lists the candidates when there are several
@@ -395,10 +403,14 @@ expect_error overlay_backend nosuchbackend "$TMP/o_stereo" "$SY" render demo -b 
 if [ -f "$BOX" ] && [ -f "$GLB" ]; then
     run info "$SY" info "$BOX"
     if [ "$rc" -ne 0 ]; then fail "info Box.gltf: status $rc: $(cat "$TMP/info.err")"; fi
-    # the top-level counts are indented by two spaces (the "loaded" object is on one line)
+    # one layout for every format: format, file_counts (the file's own, indented by four spaces),
+    # loaded (on one line), bounds, warning_count, warnings
+    grep -qxF '  "format": "gltf",' "$TMP/info.out" || fail "info Box.gltf: no format line"
     for kv in '"meshes": 1,' '"primitives": 1,' '"triangles": 12,' '"materials": 1,'; do
-        grep -qxF "  $kv" "$TMP/info.out" || fail "info Box.gltf: no line '$kv'"
+        grep -qxF "    $kv" "$TMP/info.out" || fail "info Box.gltf: no file_counts line '$kv'"
     done
+    grep -qF '"loaded": {"nodes": 2, "meshes": 1, "primitives": 1, "triangles": 12, "materials": 1,' "$TMP/info.out" ||
+        fail "info Box.gltf: loaded counts: $(grep loaded "$TMP/info.out")"
     grep -qF '"bounds": {"min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]}' "$TMP/info.out" ||
         fail "info Box.gltf: bounds are not +-0.5: $(grep bounds "$TMP/info.out")"
     head -c 1 "$TMP/info.out" | grep -q '{' && tail -n 1 "$TMP/info.out" | grep -qx '}' ||
