@@ -2,7 +2,7 @@
  * sy_exr.h — OpenEXR output of render layers (colour, depth, feature AOVs) and input of any
  * scanline or tiled OpenEXR image (reference renders, environment maps), on the OpenEXR C core API.
  *
- * Conventions (see ../shared/DESIGN.md): pixel (x, y) with row 0 at the TOP, which is also the EXR
+ * Conventions (those of sy_layer, sy_mediator.h): pixel (x, y) with row 0 at the TOP, which is also the EXR
  * orientation (y grows downwards in the data window). Colour stays linear scene-referred; depth is
  * linear distance with +INFINITY for "nothing hit", stored as FLOAT so it survives exactly.
  *

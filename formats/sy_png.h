@@ -3,7 +3,7 @@
  * sRGB encoding), an 8-bit RGBA PNG reader for tests and tools, and the small colour helpers
  * (sRGB OETF / EOTF, tone-mapping operators) other modules reuse.
  *
- * Input layers follow ../shared/DESIGN.md: w*h interleaved RGBA floats, linear scene-referred,
+ * Input layers are sy_layer's (sy_mediator.h): w*h interleaved RGBA floats, linear scene-referred,
  * alpha PREMULTIPLIED, row 0 at the TOP. The writer un-premultiplies, applies exposure and the
  * tone-mapping operator per channel, clamps to [0, 1], encodes with the exact piecewise sRGB OETF
  * and rounds to 8 bits; alpha is stored linearly (straight, not premultiplied, as PNG requires).

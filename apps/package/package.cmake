@@ -57,13 +57,15 @@ function(sy_component name)
   set_property(GLOBAL PROPERTY SY_COMPONENT_${name}_PC_REQUIRES_PRIVATE "${C_PC_REQUIRES_PRIVATE}")
 endfunction()
 
-# The public include directory of a library: the source folder in the tree, include/switchyard
-# once installed.
+# The public include directory of a library: the source folder in the tree; once installed,
+# include/ so that programs write #include <switchyard/sy_scene.h> (as <embree3/rtcore.h>), and
+# include/switchyard as well, so that #include <sy_scene.h> keeps working for this release.
 function(sy_public_includes target)
   foreach(d ${ARGN})
     target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${d}>)
   endforeach()
-  target_include_directories(${target} INTERFACE $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/switchyard>)
+  target_include_directories(${target} INTERFACE $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
+                                                 $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/switchyard>)
 endfunction()
 
 function(sy_write_package)
@@ -162,7 +164,7 @@ function(sy_write_package)
     if(libs)
       string(APPEND pc "Libs: -L\${libdir} ${libs}\n")
     endif()
-    string(APPEND pc "Libs.private: ${priv}\nCflags: -I\${includedir}/switchyard\n")
+    string(APPEND pc "Libs.private: ${priv}\nCflags: -I\${includedir} -I\${includedir}/switchyard\n")
     file(WRITE ${dir}/switchyard-${c}.pc "${pc}")
     install(FILES ${dir}/switchyard-${c}.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
     list(APPEND all_pc switchyard-${c})

@@ -86,6 +86,13 @@ for mode in plain --static; do
     fi
 done
 pkg-config --exists switchyard || fail "pkg-config switchyard (every component) is not usable"
+# the headers as a C programmer includes them (<switchyard/...>, as <embree3/rtcore.h>), and the
+# flat form of earlier releases
+printf '#include <switchyard/sy_scene.h>\n#include <switchyard/sy_gltf.h>\n#include <sy_viewport.h>\nint main(void) { return 0; }\n' \
+    >"$TMP/include_forms.c"
+# shellcheck disable=SC2046
+cc -std=c11 -fsyntax-only $(pkg-config --cflags switchyard-rt switchyard-formats) "$TMP/include_forms.c" 2>"$TMP/inc.err" ||
+    fail "#include <switchyard/sy_scene.h> with pkg-config's flags: $(cat "$TMP/inc.err")"
 
 # 4. no GL in a Whitted-only program
 for exe in "$TMP/cmake/render_gltf" "$TMP/pc_render_plain" "$TMP/pc_render_--static"; do
