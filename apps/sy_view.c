@@ -52,6 +52,8 @@ typedef struct viewer {
     uint64_t spp;
     float img_scale;  /* the governor's resolution scale of the image (1 = full size) */
     bool img_moving;  /* a moving frame (reduced size): --frames counts only settled ones */
+    float first_scale; /* the first frame answering img_req: its scale and whether it moved (the main */
+    bool first_moving; /* thread may see only a later frame of the same request on a busy machine) */
     bool governed;    /* local rendering (the governor's scale is in the title) */
     char status[256];
     char filter_status[96];
@@ -422,6 +424,7 @@ static void *render_main(void *p)
         snprintf(v->status, sizeof v->status, "%s", v->cluster ? cl_status : cls->name);
         snprintf(v->filter_status, sizeof v->filter_status, "%s", fstatus);
         v->img_version++;
+        if (v->img_req != seen) v->first_scale = gf.scale, v->first_moving = gf.moving;
         v->img_req = seen;
         pthread_mutex_unlock(&v->mu);
         sy_layer_destroy(&img);
@@ -691,9 +694,14 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
             glfwSetWindowTitle(win, title);
         }
         bool failed = v.failed, answered = fresh && v.img_req >= key_req, settled = !v.img_moving;
+        float first_scale = v.first_scale;
+        bool first_moving = v.first_moving, governed = v.governed;
         pthread_mutex_unlock(&v.mu);
         if (failed) break;
         if (answered && key_last) { /* scripted --keys: the heads-up line once the key took effect */
+            if (governed) /* the frame that first answered the key (this one, or an earlier one not shown) */
+                printf("sy view: key %c first answered by: scale %.2f%s\n", key_last, (double)first_scale,
+                       first_moving ? " moving" : "");
             printf("sy view: after key %c: %s\n", key_last, title);
             key_last = 0;
         }

@@ -66,7 +66,8 @@ timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w
     >"$TMP/view_gov.out" 2>"$TMP/view_gov.err"
 rc=$?
 [ $rc -eq 0 ] || { echo "FAIL: sy view --keys 2: status $rc: $(cat "$TMP/view_gov.err")"; exit 1; }
-grep '^sy view: after key 2' "$TMP/view_gov.out" | grep -q '| scale [0-9.]* moving |' || {
+# (the first frame answering the key: on a busy machine the window may show only a later one)
+grep -q '^sy view: key 2 first answered by: scale [0-9.]* moving$' "$TMP/view_gov.out" || {
     echo "FAIL: the frame after a back-end switch is not a moving frame:"; cat "$TMP/view_gov.out"; exit 1; }
 tail -n 1 "$TMP/view_gov.out" | grep -q '| scale 1.00 |' || {
     echo "FAIL: the settled frame is not at full size:"; cat "$TMP/view_gov.out"; exit 1; }
