@@ -5,6 +5,8 @@
 #include "sy_bench.h"
 #include "sy_cull.h"
 #include "sy_gltf_write.h"
+#include "sy_jpeg.h"
+#include "sy_png.h"
 #include "sy_plant.h"
 #include "sy_viewport.h"
 
@@ -18,9 +20,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#ifdef SY_HAVE_TURBOJPEG
-#include <turbojpeg.h>
-#endif
 
 static double now_s(void)
 {
@@ -98,34 +97,22 @@ static double iou(const uint8_t *a, const uint8_t *b, size_t n)
     return un ? (double)in / (double)un : 1.0;
 }
 
-#ifdef SY_HAVE_TURBOJPEG
-static float to_srgb(float c)
+/* JPEG bytes of the layer (sRGB over black, clamped, quality 80: what sy web streams), 0 on failure. */
+static size_t jpeg_bytes(const sy_layer *l, uint8_t *rgba8, double *seconds)
 {
-    c = c < 0 ? 0 : c > 1 ? 1 : c;
-    return c <= 0.0031308f ? 12.92f * c : 1.055f * powf(c, 1 / 2.4f) - 0.055f;
-}
-#endif
-
-/* JPEG bytes of the layer (sRGB over black, quality 80, 4:2:0), 0 without libturbojpeg. */
-static size_t jpeg_bytes(const sy_layer *l, uint8_t *rgb, double *seconds)
-{
-    *seconds = 0;
-#ifdef SY_HAVE_TURBOJPEG
     double t0 = now_s();
-    for (size_t i = 0; i < (size_t)l->width * l->height; ++i)
-        for (int c = 0; c < 3; ++c) rgb[3 * i + c] = (uint8_t)lroundf(255.0f * to_srgb(l->rgba[4 * i + c]));
-    tjhandle tj = tjInitCompress();
-    unsigned char *jpg = NULL;
-    unsigned long size = 0;
-    int rc = tj ? tjCompress2(tj, rgb, (int)l->width, 0, (int)l->height, TJPF_RGB, &jpg, &size, TJSAMP_420, 80, 0) : -1;
-    tjFree(jpg);
-    if (tj) tjDestroy(tj);
+    const sy_png_options clamp = {.tonemap = SY_TONEMAP_CLAMP};
+    for (size_t i = 0; i < (size_t)l->width * l->height; ++i) {
+        const float c[4] = {l->rgba[4 * i], l->rgba[4 * i + 1], l->rgba[4 * i + 2], 1.0f}; /* over black */
+        sy_png_encode_pixel(c, &clamp, rgba8 + 4 * i);
+    }
+    uint8_t *jpg = NULL;
+    size_t size = 0;
+    sy_error err = {0};
+    sy_result r = sy_jpeg_encode_rgba8(rgba8, l->width, l->height, 80, &jpg, &size, &err);
+    free(jpg);
     *seconds = now_s() - t0;
-    return rc == 0 ? size : 0;
-#else
-    (void)l, (void)rgb;
-    return 0;
-#endif
+    return r == SY_OK ? size : 0;
 }
 
 static int cmp_u32(const void *a, const void *b)
@@ -215,7 +202,7 @@ static int run_bench(uint64_t tris, uint32_t objects, uint64_t budget, uint32_t 
     uint32_t nobj = 0;
     const uint32_t *objs = sy_node_children(sy_node_get(s, pi.root), &nobj);
     size_t npx = (size_t)w * h;
-    ma = malloc(npx), mb = malloc(npx), rgb = malloc(npx * 3), state = malloc(nobj ? nobj : 1);
+    ma = malloc(npx), mb = malloc(npx), rgb = malloc(npx * 4), state = malloc(nobj ? nobj : 1);
     fetched.ids = calloc(nobj ? nobj : 1, sizeof *fetched.ids);
     keep = malloc(sizeof *keep * (nobj ? nobj : 1));
     ious = calloc(frames, sizeof *ious), qtimes = calloc(frames, sizeof *qtimes);

@@ -721,7 +721,7 @@ static const char usage_text[] =
             "  sy render SCENE|DIR [-b BACKEND] [-o OUT.exr|png|jpg] [-w W] [-h H] [--camera NAME|INDEX]\n"
             "            (-b: the default back-end, sy backends marks it; -o: STEM.png in the current folder;\n"
             "             DIR: the one scene file in the folder, or one folder down)\n"
-            "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]  (PNG; default aces)\n"
+            "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]  (PNG, JPEG; default aces)\n"
             "            [--max-memory MB]   (ray tracers: refuse a scene whose BVHs need more)\n"
             "            [--gl osmesa|egl|glfw]   (-b raster: the GL context provider)\n"
             "            [--stereo sbs|tb|anaglyph|separate] [--eye-sep M] [--zero-parallax M]\n"
