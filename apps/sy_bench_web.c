@@ -40,11 +40,7 @@ sy_result sy_bench_web(const sy_web_desc *desc, uint32_t width, uint32_t height,
 {
     sy_web_desc d = *desc;
     d.listen = "127.0.0.1:0";
-    if (!d.backend) { /* the default back-end, named in the report */
-        const sy_mediator_class *c = sy_mediator_default();
-        if (!c) return sy_error_set(err, SY_ERR_NOT_FOUND, "bench web: no default back-end; name one with -b");
-        d.backend = c->name;
-    }
+    if (!d.backend) d.backend = sy_mediator_default_name(); /* named in the report; "": sy_web_create says so */
     bench_server s = {0};
     sy_result r = sy_web_create(&d, &s.web, err);
     if (r) return r;

@@ -38,13 +38,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-/* The registry's default back-end (sy_mediator_default); "" names none (the server then says so). */
-static const char *default_backend_name(void)
-{
-    const sy_mediator_class *c = sy_mediator_default();
-    return c ? c->name : "";
-}
-
 static bool has_suffix(const char *s, const char *suffix)
 {
     size_t n = strlen(s), m = strlen(suffix);
@@ -1301,7 +1294,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     free(buf);
     sy_changes_release(snap);
     if (r == SY_OK && soak > 0) {
-        const char *backend = soak_backend ? soak_backend : default_backend_name();
+        const char *backend = soak_backend ? soak_backend : sy_mediator_default_name();
         bool passed = false;
         if (warmup < 0) warmup = soak / 10 < 60 ? soak / 10 : 60;
         if (warmup >= soak) {
@@ -1331,7 +1324,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     if (r == SY_OK) r = spawn_server(ncpu >= 2 ? 0 : -1, &srv[0], &err);
     if (r == SY_OK && hostile_only) {
         printf("sy bench cluster --hostile-only: demo scene, one server on loopback\n");
-        r = bench_hostile(scene, &d, default_backend_name(), &srv[0], &err);
+        r = bench_hostile(scene, &d, sy_mediator_default_name(), &srv[0], &err);
         stop_server(&srv[0]);
         sy_scene_destroy(scene);
         return r == SY_OK ? 0 : cli_fail("bench cluster", &err);
@@ -1345,7 +1338,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     }
     const char *urls[2] = {srv[0].url, srv[1].url};
     sy_cluster_client_opts co = {.urls = urls, .url_count = 2, .timeout_ms = 120000};
-    const char *backend = default_backend_name();
+    const char *backend = sy_mediator_default_name();
     sy_viewport_desc vd = {.root = d.root, .camera = d.camera, .background = d.background, .backend = backend};
     if (r == SY_OK && coop_only) {
         printf("sy bench cluster --coop-only: demo scene, 2 servers on loopback\n");

@@ -467,9 +467,9 @@ static sy_result write_image(const char *path, const sy_layer *l, const out_opts
 /* The back-end a command uses without -b: the registry's default (sy_mediator_default). */
 static const char *default_backend(sy_error *err)
 {
-    const sy_mediator_class *c = sy_mediator_default();
-    if (!c) sy_error_set(err, SY_ERR_NOT_FOUND, "no back-end offers itself as the default; name one with -b (sy backends)");
-    return c ? c->name : NULL;
+    const char *name = sy_mediator_default_name();
+    if (!*name) sy_error_set(err, SY_ERR_NOT_FOUND, "no back-end offers itself as the default; name one with -b (sy backends)");
+    return *name ? name : NULL;
 }
 
 /* A scene file's extension, as the loaders' names suggest (the content decides later). */

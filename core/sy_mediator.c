@@ -159,6 +159,12 @@ const sy_mediator_class *sy_mediator_default(void)
     return best;
 }
 
+const char *sy_mediator_default_name(void)
+{
+    const sy_mediator_class *c = sy_mediator_default();
+    return c ? c->name : "";
+}
+
 uint32_t sy_mediator_count(void)
 {
     pthread_mutex_lock(&g_registry_lock);

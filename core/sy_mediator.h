@@ -206,6 +206,9 @@ const sy_mediator_class *sy_mediator_find(const char *name);
  * registered of equal ranks), or NULL when none offers itself. Every program's default (sy render,
  * sy view, sy web, sy compare) is this class. */
 const sy_mediator_class *sy_mediator_default(void);
+/** The name of sy_mediator_default's class, or "" when no class offers itself (a name no back-end
+ * has, so that a lookup of it fails naming it). */
+const char *sy_mediator_default_name(void);
 /** Number of registered classes. */
 uint32_t sy_mediator_count(void);
 /** The i-th registered class (i < sy_mediator_count), or NULL. */

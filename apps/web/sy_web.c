@@ -1311,8 +1311,7 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     if (!desc || !desc->scene) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "web: no scene");
     const sy_node_data *cn = desc->camera.id ? sy_node_get(desc->scene, desc->camera) : NULL;
     if (!cn || !cn->camera.id) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "web: the scene has no camera");
-    const sy_mediator_class *dflt = sy_mediator_default();
-    const char *backend = desc->backend ? desc->backend : dflt ? dflt->name : "";
+    const char *backend = desc->backend ? desc->backend : sy_mediator_default_name();
     int bi = -1;
     for (uint32_t i = 0; i < sy_mediator_count(); ++i)
         if (!strcmp(sy_mediator_at(i)->name, backend)) bi = (int)i;
