@@ -222,7 +222,8 @@ struct sy_gl_device {
     struct {
         GLint model, view, proj;
     } uf[2]; /* the floors: unlit, trivial lit */
-    GLuint default_ubo, lights_ubo, white_tex, flat_normal_tex, empty_vao;
+    GLuint default_ubo, lights_ubo, empty_vao;
+    GLuint standin[5]; /* per material texture unit, bound where the material has no texture (make_standin) */
     GLuint shadow_tex, shadow_fbo;
     GLuint cube_tex[SY_GL_MAX_CUBE_SHADOWS]; /* point-light depth cube maps, made on first use */
     uint32_t cube_size;
@@ -493,14 +494,23 @@ static sy_gl_result current(sy_gl_device *dev, char *err, size_t len)
 }
 
 /* >>device */
-static GLuint make_tex1(const sy_gl_fns *gl, const unsigned char rgba[4])
+/* A material's stand-in for a texture it does not have in one unit (bind_material): a constant 2x2
+ * texture with a mipmap, in the unit's format (sRGB for colours) and the sampling of an uploaded
+ * texture by default (repeat, trilinear). llvmpipe compiles a fragment shader per state of what it
+ * samples (format, filters, wraps, whether there are mip levels), so a stand-in that samples like the
+ * real textures lets materials with and without a texture in that unit share one compiled shader
+ * (issue 32: the first frame's compile time). A constant texture filters to its value exactly. */
+static GLuint make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], bool srgb)
 {
+    unsigned char px[16];
+    for (int i = 0; i < 16; ++i) px[i] = rgba[i & 3];
     GLuint t;
     gl->GenTextures(1, &t);
     gl->BindTexture(GL_TEXTURE_2D, t);
-    gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba);
-    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl->TexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, 2, 2, 0, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    gl->TexImage2D(GL_TEXTURE_2D, 1, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     return t;
 }
 
@@ -872,8 +882,8 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     dev->sky_size_int = gl->GetUniformLocation(dev->prog_sky, "u_size_int");
 
     static const unsigned char white[4] = {255, 255, 255, 255}, flat[4] = {128, 128, 255, 255};
-    dev->white_tex = make_tex1(gl, white);
-    dev->flat_normal_tex = make_tex1(gl, flat);
+    for (int i = 0; i < 5; ++i)
+        dev->standin[i] = make_standin(gl, i == UNIT_NRM ? flat : white, i == UNIT_BASE || i == UNIT_EMIS);
     sy_gl_material_desc md;
     sy_gl_material_desc_init(&md);
     mat_block mb;
@@ -950,9 +960,9 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         if (dev->mtab) gl->DeleteTextures(1, &dev->mtab);
         sy_gl_ibl_free(gl, &dev->ibl);
         GLuint bufs[3] = {dev->default_ubo, dev->lights_ubo, dev->areas_ubo};
-        GLuint texs[3] = {dev->white_tex, dev->flat_normal_tex, dev->shadow_tex};
         gl->DeleteBuffers(3, bufs);
-        gl->DeleteTextures(3, texs);
+        gl->DeleteTextures(5, dev->standin);
+        gl->DeleteTextures(1, &dev->shadow_tex);
         for (uint32_t c = 0; c < SY_GL_MAX_CUBE_SHADOWS; ++c)
             if (dev->cube_tex[c]) gl->DeleteTextures(1, &dev->cube_tex[c]);
         probes_free(dev);
@@ -1867,7 +1877,7 @@ static const mat_o *bind_material(sy_gl_device *dev, sy_gl_material id, bool all
     for (int i = 0; i < (all_textures ? 5 : 1); ++i) {
         const tex_o *t = pool_get(&dev->textures, refs[i]->texture.id);
         gl->ActiveTexture(GL_TEXTURE0 + (GLenum)i);
-        gl->BindTexture(GL_TEXTURE_2D, t ? t->tex : i == UNIT_NRM ? dev->flat_normal_tex : dev->white_tex);
+        gl->BindTexture(GL_TEXTURE_2D, t ? t->tex : dev->standin[i]);
     }
     return m;
 }
@@ -2435,6 +2445,22 @@ static int frame_lighting(const sy_gl_device *dev)
     return v;
 }
 
+/* The material's variant bits that the shaders turn on and off per draw by the material's own
+ * uniforms (m_tex, m_tex2, the transmission factor): textures, normal map, transmission. */
+static int material_features(const sy_gl_device *dev, const mat_o *mt)
+{
+    int v = 0;
+    const sy_gl_texture_ref *refs[5] = {&mt->d.base_color_texture, &mt->d.metallic_roughness_texture,
+                                        &mt->d.normal_texture, &mt->d.occlusion_texture, &mt->d.emissive_texture};
+    for (int i = 0; i < 5; ++i)
+        if (pool_get(&dev->textures, refs[i]->texture.id)) v |= i == UNIT_NRM ? VAR_TEX | VAR_NMAP : VAR_TEX;
+    /* a metallic-roughness texture scales metallic per texel: a metal factor of 1 still transmits
+     * where the texture says dielectric (TransmissionTest's striped "Metal" spheres) */
+    bool mr_tex = pool_get(&dev->textures, mt->d.metallic_roughness_texture.texture.id) != NULL;
+    if (mt->d.transmission > 0.0f && (mt->d.metallic < 1.0f || mr_tex)) v |= VAR_TRANS;
+    return v;
+}
+
 /* The variant bits for one draw: mesh attributes, material textures and mode, frame lighting,
  * whether the instance has a scene probe. */
 static int draw_variant(const sy_gl_device *dev, const mesh_o *m, const mat_o *mt, bool probe)
@@ -2443,18 +2469,16 @@ static int draw_variant(const sy_gl_device *dev, const mesh_o *m, const mat_o *m
     if (probe) v |= VAR_PROBE;
     if (!mt) return variant_normalize(v);
     if (mt->d.alpha_mode == SY_GL_ALPHA_MASK) v |= VAR_MASK;
-    if (mt->d.transmission > 0.0f && mt->d.metallic < 1.0f) v |= VAR_TRANS;
-    const sy_gl_texture_ref *refs[5] = {&mt->d.base_color_texture, &mt->d.metallic_roughness_texture,
-                                        &mt->d.normal_texture, &mt->d.occlusion_texture, &mt->d.emissive_texture};
-    for (int i = 0; i < 5; ++i)
-        if (pool_get(&dev->textures, refs[i]->texture.id)) v |= i == UNIT_NRM ? VAR_TEX | VAR_NMAP : VAR_TEX;
-    return variant_normalize(v);
+    return variant_normalize(v | material_features(dev, mt));
 }
+
 
 typedef struct draw_ctx {
     const view_setup *v;
     float viewproj[16], ortho_z[3]; /* orthographic proj[10], proj[14] (and 0) */
     int bound;                      /* the variant whose program is bound, BOUND_GBUF, or -1 */
+    int shared;                     /* material_features of every visible instance: forward draws use
+                                     * them all (draw_instance) */
     bool deferred, gbuf_view_set;   /* opaque draws may go to the G-buffer; its view uniforms are set */
 } draw_ctx;
 #define BOUND_GBUF (-2)
@@ -2589,6 +2613,12 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
         draw_gbuf(dev, dc, in, m, mt);
         return SY_GL_OK;
     }
+    /* Every forward draw of the frame takes the features any visible material has: llvmpipe
+     * compiles each program on its first draw in each pipeline state (about 0.2-0.5 s of LLVM for a
+     * lit one), and a program that samples textures, maps normals or transmits only where the
+     * material's uniforms say so draws the others as they were. TransmissionTest's first frame
+     * compiled 11 main-pass shaders before, 6 now (issue 32). */
+    pv = variant_normalize(pv | dc->shared);
     sy_gl_result r = use_variant(dev, dc, pv, err, err_len);
     if (r != SY_GL_OK) return r;
     if (probe >= 0) {
@@ -2667,11 +2697,15 @@ static sy_gl_result draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
         dev->rect_count = 0;
         dev->rect_all = false;
     }
+    const mat_o *last = NULL;
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
         inst_o *in = pool_at(&dev->instances, i);
-        if (!in->h.id || !in->visible || i == skip) continue;
+        if (!in->h.id || !in->visible) continue;
         const mesh_o *m = pool_get(&dev->meshes, in->mesh.id);
         if (!m) continue;
+        const mat_o *mt = pool_get(&dev->materials, in->material.id);
+        if (mt && mt != last) dc.shared |= material_features(dev, last = mt); /* the same in every pass */
+        if (i == skip) continue;
         float c[3], scale, r = world_sphere(in, m, c, &scale);
         if (sphere_outside(planes, c, r)) { /* outside the view: not drawn */
             if (skip == UINT32_MAX) dev->culled++;
@@ -2679,7 +2713,6 @@ static sy_gl_result draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
         }
         in->lod = choose_lod(dev, m, v, c, r, scale);
         in->px_per_tri = pixels_per_triangle(dev, m, in->lod, v, c, r);
-        const mat_o *mt = pool_get(&dev->materials, in->material.id);
         sy_gl_alpha_mode mode = mt ? mt->d.alpha_mode : SY_GL_ALPHA_OPAQUE;
         int li = mode == SY_GL_ALPHA_BLEND ? 2 : mode == SY_GL_ALPHA_MASK ? 1 : 0;
         float *e = lists + 2 * ((size_t)li * cap + nl[li]++);

@@ -180,6 +180,25 @@ int main(int argc, char **argv)
         printf("glass under a green ceiling %g %g\n", px(16, 16)[0], px(16, 16)[1]);
         CHECK(px(16, 16)[1] > 0.1f && px(16, 16)[0] < 0.01f, "glass without an environment sees nothing: %g %g",
               px(16, 16)[0], px(16, 16)[1]);
+        /* glass by its metallic-roughness texture: a metal factor of 1 that the texture's blue channel
+         * scales to 0 transmits as the glass above (such materials were drawn without transmission,
+         * black where the texture says dielectric: TransmissionTest's "Metallic" row) */
+        const float glass_px[2] = {px(16, 16)[0], px(16, 16)[1]};
+        static const unsigned char mr_px[2 * 2 * 3] = {0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0};
+        sy_gl_texture_desc mtd = {.width = 2, .height = 2, .channels = 3, .format = SY_GL_TEXEL_UNORM8, .pixels = mr_px};
+        sy_gl_texture mr_tex;
+        MUST(sy_gl_texture_create(d, &mtd, &mr_tex, e, sizeof e));
+        sy_gl_material_desc tglass = glass;
+        tglass.metallic = 1.0f;
+        tglass.metallic_roughness_texture.texture = mr_tex;
+        sy_gl_material tgl_m;
+        MUST(sy_gl_material_create(d, &tglass, &tgl_m, e, sizeof e));
+        MUST(sy_gl_instance_set_material(d, mi, tgl_m));
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        printf("glass by its texture %g %g (glass %g %g)\n", px(16, 16)[0], px(16, 16)[1], glass_px[0], glass_px[1]);
+        CHECK(near_(px(16, 16)[1], glass_px[1], 1e-3f) && near_(px(16, 16)[0], glass_px[0], 1e-3f),
+              "metal factor 1, texture metallic 0, transmission 1: %g %g (want the glass's %g %g)", px(16, 16)[0],
+              px(16, 16)[1], glass_px[0], glass_px[1]);
         MUST(sy_gl_instance_set_material(d, mi, mm));
         MUST(sy_gl_instance_set_visible(d, ci, false));
         MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
