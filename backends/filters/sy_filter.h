@@ -25,6 +25,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /** Result of every fallible filter call. */
 typedef enum sy_filter_status {
     SY_FILTER_OK = 0,
@@ -167,5 +171,9 @@ void sy_filter_parallel_rows(uint32_t threads, uint32_t rows, sy_filter_rows_fn 
 
 /** sy_filter_scan_finite for rows [y0, y1) only (the mask is indexed by pixel as there). */
 uint64_t sy_filter_scan_finite_rows(const sy_filter_frame *f, uint32_t need, uint8_t *mask, uint32_t y0, uint32_t y1);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* SY_FILTER_H */

@@ -17,6 +17,10 @@
 
 #include "sy_filter.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /** Adaptive-resolution preview options (sy_filter_adaptive_params_default gives the defaults). */
 typedef struct sy_filter_adaptive_params {
     float target_spp;      /**< samples a displayed texel should hold; default 4 (>= 1) */
@@ -34,5 +38,9 @@ sy_filter_status sy_filter_adaptive_params_check(const sy_filter_adaptive_params
 /** out_rgba: width*height*4; level_out (optional, width*height): the fractional level used. */
 sy_filter_status sy_filter_adaptive(const sy_filter_adaptive_params *p, const sy_filter_frame *in, float *out_rgba,
                                     float *level_out, sy_filter_stats *stats, sy_filter_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* SY_FILTER_ADAPTIVE_H */

@@ -14,6 +14,10 @@
 
 #include "sy_filter.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /** Edge-avoiding a-trous options (sy_filter_atrous_params_default gives the defaults). */
 typedef struct sy_filter_atrous_params {
     uint32_t iterations;  /**< default 5 (Dammertz); the thesis' progressive variant uses 3 (1..10) */
@@ -34,5 +38,9 @@ sy_filter_status sy_filter_atrous_params_check(const sy_filter_atrous_params *p,
 /** out_rgba: width*height*4 floats; stats may be NULL. */
 sy_filter_status sy_filter_atrous(const sy_filter_atrous_params *p, const sy_filter_frame *in, float *out_rgba,
                                   sy_filter_stats *stats, sy_filter_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* SY_FILTER_ATROUS_H */

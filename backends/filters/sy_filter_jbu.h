@@ -19,6 +19,10 @@
 
 #include "sy_filter.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /** Joint bilateral upsampling options (sy_filter_jbu_params_default gives the defaults). */
 typedef struct sy_filter_jbu_params {
     uint32_t factor;     /**< downsampling factor k; default 4 (1..64) */
@@ -45,5 +49,9 @@ sy_filter_status sy_filter_jbu_upsample(const sy_filter_jbu_params *p, const flo
 /** Filters in (see above) into out_rgba (width*height*4 floats); stats may be NULL. */
 sy_filter_status sy_filter_jbu(const sy_filter_jbu_params *p, const sy_filter_frame *in, float *out_rgba,
                                sy_filter_stats *stats, sy_filter_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* SY_FILTER_JBU_H */

@@ -16,6 +16,10 @@
 
 #include "sy_filter.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /** Error metrics of an image against a reference. */
 typedef struct sy_filter_metrics {
     /** @{ root mean squared error; relative MSE; SSIM */
@@ -30,5 +34,9 @@ sy_filter_status sy_filter_metrics_compute(const float *image, const float *refe
 
 /** SSIM alone on two single-channel images already in [0, 1] (dynamic range L = 1). */
 double sy_filter_ssim_gray(const float *a, const float *b, uint32_t width, uint32_t height);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* SY_FILTER_METRICS_H */

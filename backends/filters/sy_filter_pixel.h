@@ -22,6 +22,10 @@
 
 #include "sy_filter.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /** Kernels of the pixel filter. */
 typedef enum sy_filter_pixel_kernel {
     SY_FILTER_PIXEL_BRUTE = 0,    /**< brute-force 2D cross bilateral, window 3 sigma_s (Eq. 3.6) */
@@ -96,5 +100,9 @@ const float *sy_filter_pixel_blend(const sy_filter_pixel *pf);
 const float *sy_filter_pixel_reduction(const sy_filter_pixel *pf);
 /** Filtered HV RGB of the last pass (3 ch; owned by pf; NULL before the first pass). */
 const float *sy_filter_pixel_filtered(const sy_filter_pixel *pf);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* SY_FILTER_PIXEL_H */

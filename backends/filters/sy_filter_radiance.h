@@ -36,6 +36,10 @@
 
 #include "sy_filter.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 enum {
     SY_FILTER_RF_VALID = 1u << 0,     /**< sample/shading present and finite */
     SY_FILTER_RF_NO_FILTER = 1u << 1  /**< shading: never filter this pixel (e.g. too glossy, mixed
@@ -161,5 +165,9 @@ sy_filter_status sy_filter_radiance_seed(sy_filter_radiance *rf, uint32_t width,
 const float *sy_filter_radiance_radius(const sy_filter_radiance *rf);
 /** Frames filtered since the last reset or seed (k). */
 uint32_t sy_filter_radiance_frame_index(const sy_filter_radiance *rf);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* SY_FILTER_RADIANCE_H */

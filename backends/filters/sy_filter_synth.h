@@ -17,6 +17,10 @@
 #include "sy_filter.h"
 #include "sy_filter_radiance.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /** The analytic progressive-render surrogate (opaque). */
 typedef struct sy_filter_synth sy_filter_synth;
 
@@ -37,5 +41,9 @@ sy_filter_frame sy_filter_synth_frame(const sy_filter_synth *s);
 sy_filter_radiance_input sy_filter_synth_rf_input(const sy_filter_synth *s);
 /** The converged image, RGBA. */
 const float *sy_filter_synth_reference(const sy_filter_synth *s);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* SY_FILTER_SYNTH_H */

@@ -24,6 +24,10 @@
 #include "sy_filter_radiance.h"
 #include "sy_rt.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct sy_radiance_hook sy_radiance_hook;
 
 sy_result sy_radiance_hook_create(const sy_filter_radiance_params *p, sy_radiance_hook **out, sy_error *err);
@@ -57,5 +61,9 @@ typedef struct sy_radiance_hook_frame_desc {
 sy_result sy_radiance_hook_frame(sy_radiance_hook *h, const sy_radiance_hook_frame_desc *d, float *rgba,
                                  sy_filter_stats *stats, sy_error *err);
 uint32_t sy_radiance_hook_frame_index(const sy_radiance_hook *h); /* frames since the last reset */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* SY_RADIANCE_HOOK_H */

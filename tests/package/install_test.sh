@@ -97,6 +97,21 @@ printf '#include <switchyard/sy_scene.h>\n#include <switchyard/sy_gltf.h>\n#incl
 # shellcheck disable=SC2046
 cc -std=c11 -fsyntax-only $(pkg-config --cflags switchyard-rt switchyard-formats) "$TMP/include_forms.c" 2>"$TMP/inc.err" ||
     fail "#include <switchyard/sy_scene.h> with pkg-config's flags: $(cat "$TMP/inc.err")"
+# the umbrella header: every public header of the installation at once, warning-free in C11, and
+# in C++ (extern "C" declarations, nothing C-only in the headers)
+printf '#include <switchyard/switchyard.h>\nint main(void) { sy_scene *s = NULL; (void)s; return 0; }\n' >"$TMP/umbrella.c"
+cp "$TMP/umbrella.c" "$TMP/umbrella.cpp"
+# shellcheck disable=SC2046
+cc -std=c11 -Wall -Wextra -Werror -fsyntax-only $(pkg-config --cflags switchyard) "$TMP/umbrella.c" 2>"$TMP/umb.err" ||
+    fail "#include <switchyard/switchyard.h> (C11): $(head -5 "$TMP/umb.err")"
+# shellcheck disable=SC2046
+c++ -std=c++17 -Wall -Wextra -Werror -fsyntax-only $(pkg-config --cflags switchyard) "$TMP/umbrella.cpp" 2>"$TMP/umbxx.err" ||
+    fail "#include <switchyard/switchyard.h> (C++17): $(head -5 "$TMP/umbxx.err")"
+for h in "$P"/include/switchyard/sy_*.h; do # C++ programs link the C functions: extern "C" in every header
+    grep -q '__cplusplus' "$h" || fail "$(basename "$h") declares its functions without extern \"C\" for C++"
+done
+grep -q '#include "sy_fields.h"' "$P/include/switchyard/switchyard.h" && fail "the umbrella names core's internal sy_fields.h"
+[ -e "$P/include/switchyard/sy_fields.h" ] && fail "an internal header (sy_fields.h) was installed"
 
 # 4. no GL in a Whitted-only program
 for exe in "$TMP/cmake/render_gltf" "$TMP/pc_render_plain" "$TMP/pc_render_--static"; do
