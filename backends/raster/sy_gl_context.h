@@ -1,6 +1,6 @@
 /* sy_gl_context.h — internal: GL context providers (OSMesa, EGL, GLFW) and the table of GL 3.3
  * entry points loaded through the provider's GetProcAddress. No GL library is linked directly, so
- * the renderer code (sy_gl_device.c) is identical on every provider.
+ * the renderer code (sy_gl_device.c and the modules of sy_gl_internal.h) is identical on every provider.
  *
  * Ownership: sy_gl_context_destroy releases everything sy_gl_context_create made. Thread-safety:
  * a context is current on one thread at a time (sy_gl_context_make_current). */

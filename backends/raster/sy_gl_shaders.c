@@ -11,7 +11,7 @@
 #include <string.h>
 
 /* Vertex attributes: 0 position, 1 normal, 2 uv0, 3 uv1, 4 colour. Variant defines (see
- * sy_gl_device.c main_program): SY_LEAN (no uv1 / colours), SY_MASK (alpha mask: discard), SY_TEX
+ * sy_gl_programs.c main_program): SY_LEAN (no uv1 / colours), SY_MASK (alpha mask: discard), SY_TEX
  * (the material has a texture: uv varyings), SY_NMAP (normal map), SY_LIGHTS (punctual lights),
  * SY_ENV (environment light), SY_AREA (emissive polygons), SY_SHADOW (punctual shadow maps),
  * SY_ASHADOW (area-light shadow maps), SY_PROBE (reflections and refraction see the object's scene
@@ -408,7 +408,7 @@ const char *const sy_gl_main_fs =
     "  o_depth = u_ortho ? -((gl_FragCoord.z * 2.0 - 1.0) - u_ortho_z.y) / u_ortho_z.x : 1.0 / gl_FragCoord.w;\n"
     "}\n";
 
-/* Deferred shading (sy_gl_device.c, "deferred shading"). Under MSAA a software rasterizer runs a
+/* Deferred shading (sy_gl_draw.c, deferred_pass). Under MSAA a software rasterizer runs a
  * fragment shader once per pixel for every triangle that touches any of the pixel's samples, in
  * blocks of pixels: on meshes of a few pixels per triangle the forward shader runs many times per
  * pixel, and every instruction of it counts. Opaque, untextured surfaces of meshes without colours

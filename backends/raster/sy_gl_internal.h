@@ -1,0 +1,374 @@
+/* sy_gl_internal.h — INTERNAL to backends/raster (not installed): what the rasterizer's modules
+ * share: limits and texture units, the object pools and object structs, the device struct, the
+ * per-frame structs, and the functions one module calls in another (prefix sy_gli_). The modules,
+ * bottom-up (each calls only those before it; tests/core/layers_test.sh checks it):
+ *   sy_gl_base.c     pools, errors, math, frustum tests, GL checks
+ *   sy_gl_programs.c stand-in textures, material blocks, shader variants, the material table
+ *   sy_gl_objects.c  meshes (levels of detail), textures, materials, instances, lights, environment
+ *   sy_gl_lod.c      levels of detail chosen per view, drawing one level
+ *   sy_gl_shadows.c  the lights' uniform blocks and shadow maps
+ *   sy_gl_draw.c     targets, views, the forward and deferred passes, culling, MSAA resolve
+ *   sy_gl_render.c   scene probes and the frame (sy_gl_render, sy_gl_render_floor)
+ *   sy_gl_device.c   the device: create, destroy, statistics
+ * Not thread-safe: one device is used by one thread at a time (sy_gl.h). */
+#ifndef SY_GL_INTERNAL_H
+#define SY_GL_INTERNAL_H
+
+#include "sy_gl.h"
+#include "sy_gl_context.h"
+#include "sy_gl_ibl.h"
+#include "sy_gl_shaders.h"
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define IDX_BITS 20u
+#define IDX_MASK ((1u << IDX_BITS) - 1u)
+#define SHADOW_SIZE_DEFAULT 2048u
+enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_ENV_SPEC, UNIT_ENV_IRR, UNIT_BRDF,
+       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW0, UNIT_CUBE_SHADOW1, UNIT_PROBE, UNIT_COUNT };
+/* Scene probes: mirror-like and glass instances see the scene, not only the environment. Each of
+ * the first SY_GL_MAX_PROBES such instances gets a cube map rendered from its bounding-box centre
+ * (the instance itself left out, other probed instances showing the environment), with a mip
+ * chain for roughness; re-rendered only when geometry, materials, lights or the environment
+ * change, never for a camera move. Its side (probe_size_for) follows the largest frame rendered so
+ * far, from PROBE_SIZE_MIN to PROBE_SIZE_MAX texels: a 90 degree face needs no more texels than
+ * about half the frame's width has (a small first frame renders four times fewer probe pixels,
+ * issue 32), and it never shrinks, so a view whose resolution drops while it moves (sy view, sy
+ * web) does not re-render its probes. */
+#define SY_GL_MAX_PROBES 4u
+#define PROBE_SIZE_MIN 32u
+#define PROBE_SIZE_MAX 256u
+#define PROBE_MAX_ROUGHNESS 0.4f
+enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1, BIND_AREAS = 2 };
+/* Deferred shading (see sy_gl_shaders.c, sy_gl_gbuf_fs): the shading pass samples no material
+ * texture, so the G-buffer and the material table use the material units. */
+enum { UNIT_GCOL = UNIT_BASE, UNIT_GDEPTH = UNIT_MR, UNIT_MTAB = UNIT_NRM };
+#define MTAB_TEXELS 3u      /* RGBA32F texels per material row (sy_gl_deferred_fs) */
+#define MTAB_MAX_ROWS 256u /* the G-buffer's key holds 8 bits of material row (sy_gl_shaders.c) */
+#define DEFERRED_PROGS 16u  /* shading-pass programs kept (one per frame lighting variant) */
+#define RECT_TILE 8u        /* the deferred pass shades the RECT_TILE-pixel tiles G-buffer instances touch */
+#define PM_SPARE 32u        /* main programs kept for other light signatures than the sy_gli_current one */
+/* Instances whose forward shading would run on more pixels per triangle than this stay forward:
+ * on big triangles the forward pass already shades about once per pixel, and the G-buffer pass
+ * is extra (measured with sy bench raster: the demo's spheres at 24-37 pixels per triangle are
+ * faster forward, the 1M-triangle scene's meshes at 2-8 deferred). */
+#define DEFERRED_MAX_PX_PER_TRI 16.0f
+
+
+
+/* Object pools: every object struct starts with {id, gen}; id 0 = free slot. */
+typedef struct slot_head {
+    uint32_t id, gen;
+} slot_head;
+
+typedef struct pool {
+    void *items;
+    uint32_t count, cap, live;
+    size_t elem;
+} pool;
+
+static inline void *sy_gli_pool_at(const pool *p, uint32_t i) { return (char *)p->items + (size_t)i * p->elem; }
+
+
+/* Levels of detail (meshoptimizer): level 0 is the mesh; each further level is simplified from the
+ * one before to about a quarter of its triangles, all levels in one index buffer. */
+#define LOD_MAX 12
+
+typedef struct mesh_o {
+    slot_head h;
+    GLuint vao, vbo[1], ibo;
+    uint32_t vertex_count, triangle_count;
+    bool has_normals, indexed, has_attr[5];
+    float bmin[3], bmax[3];
+    float centre[3], radius;     /* bounding sphere of the box (object space) */
+    uint32_t lod_count;          /* levels, 1 = the mesh only */
+    uint32_t lod_first[LOD_MAX], lod_tris[LOD_MAX]; /* first index, triangles */
+    float lod_error[LOD_MAX];    /* object-space deviation from level 0 (bound, metres) */
+} mesh_o;
+
+typedef struct tex_o {
+    slot_head h;
+    GLuint tex;
+    uint32_t width, height; /* level 0 as uploaded */
+} tex_o;
+
+typedef struct mat_o {
+    slot_head h;
+    GLuint ubo;
+    sy_gl_material_desc d;
+} mat_o;
+
+typedef struct inst_o {
+    slot_head h;
+    sy_gl_mesh mesh;
+    sy_gl_material material;
+    float model[16], normal_mat[9];
+    bool mirror, visible;
+    uint32_t lod;  /* level chosen for the last view drawn (sy_gli_choose_lod); shadow maps reuse it */
+    float px_per_tri; /* the last main view: its projected bounding-sphere area over its level's triangles */
+} inst_o;
+
+typedef struct light_o {
+    slot_head h;
+    sy_gl_light_desc d;
+} light_o;
+
+typedef struct targets {
+    uint32_t w, h, samples;
+    GLuint fbo, color, depthlin, depth_rb;
+    GLuint rfbo, rcolor, rdepthlin; /* resolve targets when samples > 1 */
+} targets;
+
+/* Main-pass shader variant bits (the SY_* defines of sy_gl_shaders.c). */
+enum {
+    VAR_LEAN = 1,     /* mesh without uv1 and colours */
+    VAR_MASK = 2,     /* alpha mask: the only variants with discard */
+    VAR_TEX = 4,      /* the material samples a texture */
+    VAR_NMAP = 8,     /* ... a normal map (only with VAR_TEX and lighting) */
+    VAR_LIGHTS = 16,  /* punctual lights present */
+    VAR_ENV = 32,     /* environment light (prefiltered cube maps) */
+    VAR_SHADOW = 64,  /* punctual shadow maps (only with VAR_LIGHTS) */
+    VAR_NL_SHIFT = 7, /* bits 7-9: the light count when 1..VAR_NL_MAX (one call per light with constant
+                       * uniform-block offsets and shadow kinds: variant_sig), 0 = a loop over the
+                       * Lights block */
+    VAR_NL_MAX = 7,
+    VAR_AREA = 1024,    /* emissive polygons (LTC) */
+    VAR_ASHADOW = 2048, /* area-light shadow maps (only with VAR_AREA) */
+    VAR_TRANS = 4096,   /* the material transmits (refracts the environment; only with VAR_ENV or VAR_PROBE) */
+    VAR_PROBE = 8192,   /* the instance reflects and refracts its own scene probe instead of the environment */
+    VAR_COUNT = 16384
+};
+
+struct sy_gl_device {
+    sy_gl_context *ctx;
+    const sy_gl_fns *gl;
+    char info[256];
+    sy_gl_log_fn log;
+    void *log_user;
+    uint32_t msaa, max_tex, shadow_size;
+    pool meshes, textures, materials, instances, lights;
+    GLuint prog_resolve, prog_floor, prog_floor_lit;
+    GLint resolve_rects; /* prog_resolve's u_rects (sy_gl_rect_vs: the whole target or the tiles the deferred pass leaves) */
+    struct main_prog { /* main-pass variants, built on first use, indexed by VAR_* bits (sy_gli_main_program) */
+        GLuint prog;
+        GLint model, normal_mat, mvp, cam_pos, cam_fwd, ortho, ortho_z, mirror, has_normals, probe_lod;
+        uint64_t frame; /* the frame whose view uniforms it holds */
+        uint64_t sig;   /* the lights' signature it was built for (variant_sig) */
+        int var;        /* its variant bits (in pm_spare) */
+    } pm[VAR_COUNT];
+    /* programs of earlier light signatures, kept so that lights toggled back and forth (a shadow
+     * turned off and on, an emissive object hidden and shown) do not recompile each time; reused
+     * in turn when full */
+    struct main_prog pm_spare[PM_SPARE];
+    uint32_t pm_spare_next;
+    uint64_t frame_no;
+    uint32_t light_count, shadow_count, area_shadow_count; /* as uploaded by sy_gli_lights_upload: they pick the variants */
+    /* sy_gli_lights_upload: what the shaders' straight-line light code is built for. Bits 2i, 2i + 1:
+     * punctual light i's kind of shadow (i < VAR_NL_MAX; shade_light: 0 none, 1 map, 2 + s cube s);
+     * bits 48 + 2i, 49 + 2i: punctual light i's type (shade_light's lt: 0 point, 1 point with a
+     * range, 2 spot, 3 directional) */
+    uint64_t light_sig;
+    struct {
+        GLuint prog;
+        GLint model, lightvp;
+    } ps[2];
+    struct {
+        GLint model, view, proj;
+    } uf[2]; /* the floors: unlit, trivial lit */
+    GLuint default_ubo, lights_ubo, empty_vao;
+    GLuint standin[5]; /* per material texture unit, bound where the material has no texture (sy_gli_make_standin) */
+    GLuint shadow_tex, shadow_fbo;
+    GLuint cube_tex[SY_GL_MAX_CUBE_SHADOWS]; /* point-light depth cube maps, made on first use */
+    uint32_t cube_size;
+    struct {
+        GLuint cube;
+        uint32_t inst; /* instance pool index */
+    } probes[SY_GL_MAX_PROBES];
+    uint32_t probe_count;
+    GLuint probe_fbo, probe_depth;
+    uint32_t probe_size; /* the probes' side in texels (0: none made yet; see probe_size_for) */
+    bool probes_dirty, in_probe_pass;
+    targets t;
+    bool lights_dirty;
+    /* deferred shading */
+    bool forward; /* sy_gl_device_desc.forward */
+    struct { /* the G-buffer pass: perspective, orthographic */
+        GLuint prog;
+        GLint normal_mat, mvp, ppu, ortho_z, has_normals, keys;
+    } ug[2];
+    struct {
+        int var;        /* the lighting variant bits */
+        uint64_t sig;   /* and the lights' signature (variant_sig) */
+        GLuint prog;
+        GLint unproj, inv_view, px, cam_pos, cam_fwd, ortho, rects;
+    } dp[DEFERRED_PROGS];
+    uint32_t dp_count, dp_next; /* dp_next: the slot a new program takes once all are used */
+    float *mtab_cpu;                 /* material table: row i = the material of pool index i, row 0 = default */
+    uint32_t mtab_cpu_rows, mtab_limit; /* rows held; rows a texture may have (GL_MAX_TEXTURE_SIZE) */
+    GLuint mtab;                     /* its texture, MTAB_TEXELS x mtab_rows */
+    uint32_t mtab_rows, mtab_dirty_lo, mtab_dirty_hi; /* rows [lo, hi) changed since the last upload */
+    uint64_t deferred_draws;         /* instances drawn into the G-buffer in the last main pass */
+    /* where the deferred pass shades (rect_add): pixel rectangles (x0, y0, x1, y1) bounding the
+     * G-buffer instances of the last main pass, or everywhere (rect_all) */
+    uint32_t (*rects)[4];
+    uint32_t rect_count, rect_cap;
+    bool rect_all;
+    uint64_t deferred_pixels; /* the pixels the last deferred pass shaded */
+    uint8_t *tiles;       /* rect_tiles: RECT_TILE-pixel tiles the rectangles touch, then both lists of */
+    float (*spans)[4];    /* tile runs in NDC (sy_gl_rect_vs) */
+    uint32_t *runs;       /* rect_tiles' scratch: two per tile column */
+    size_t tiles_cap;     /* tiles and spans hold (in tiles) */
+    /* background (camera rays only) */
+    sy_gl_background_mode bg_mode;
+    float bg_color[4], bg_intensity;
+    sy_gl_texture bg_tex;
+    GLuint prog_sky;
+    GLint sky_inv_vp, sky_size_int;
+    /* environment light */
+    sy_gl_texture env_tex;
+    float env_intensity;
+    bool env_dirty, env_ready;
+    sy_gl_ibl ibl;
+    /* emissive polygons */
+    sy_gl_area_light areas[SY_GL_MAX_AREA_LIGHTS];
+    uint32_t area_count;
+    GLuint areas_ubo;
+    bool areas_dirty;
+    float ambient[3];
+    bool warned_lights;
+    sy_gl_upload_counts counts, frame, mark;
+    uint32_t shadow_maps;
+    uint64_t tris, draws;
+    float lod_pixels;    /* sy_gl_set_lod */
+    uint64_t culled;     /* instances outside the view in the last main pass */
+    float *scratch;
+    size_t scratch_len;
+};
+
+
+
+static inline float sy_gli_dot3f(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+enum { CASTER_NONE, CASTER_OPAQUE, CASTER_MASKED }; /* caster_kind */
+extern const float sy_gli_cube_faces[6][3][3]; /* (right, up, forward) per GL cube face (sy_gl_base.c) */
+
+
+typedef struct mat_block {
+    float base[4], emissive[4], mrna[4], oist[4];
+    int32_t modes[4], tex[4], tex2[4];
+    float xf[10][4]; /* per texture slot (base, mr, nrm, occ, emis) two rows of its uv transform */
+} mat_block;
+
+
+
+/* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes, then the cube shadows' parameters
+ * (SY_GL_MAX_CUBE_SHADOWS x 16 bytes) */
+#define LIGHTS_CUBE_PAR 600
+#define LIGHTS_FLOATS (LIGHTS_CUBE_PAR + 4 * SY_GL_MAX_CUBE_SHADOWS)
+#define AREAS_FLOATS (8 + SY_GL_MAX_AREA_LIGHTS * 6 * 4) /* std140 Areas block: ivec4 + vec4 + vec4[16 * 6] */
+
+
+
+typedef struct frame_state {
+    float shadow_vp[SY_GL_MAX_SHADOW_MAPS][16];
+    uint32_t shadow_count;
+    float cube_pos[SY_GL_MAX_CUBE_SHADOWS][3], cube_near[SY_GL_MAX_CUBE_SHADOWS], cube_far[SY_GL_MAX_CUBE_SHADOWS];
+    uint32_t cube_count; /* point lights with a cube shadow */
+} frame_state;
+
+
+
+typedef struct view_setup {
+    float view[16], proj[16], cam_pos[3], cam_fwd[3];
+    bool ortho;
+    float ppu; /* pixels per unit of the image plane at distance 1 (perspective) or per metre (ortho); 0 =
+                * unknown (levels of detail off) */
+} view_setup;
+
+
+
+
+typedef struct draw_ctx {
+    const view_setup *v;
+    float viewproj[16], ortho_z[3]; /* orthographic proj[10], proj[14] (and 0) */
+    int bound;                      /* the variant whose program is bound, BOUND_GBUF, or -1 */
+    int shared;                     /* material_features of every visible instance: forward draws use
+                                     * them all (draw_instance) */
+    bool deferred, gbuf_view_set;   /* opaque draws may go to the G-buffer; its view uniforms are set */
+} draw_ctx;
+#define BOUND_GBUF (-2)
+
+
+
+static inline int sy_gli_mesh_lean(const mesh_o *m) { return !m->has_attr[3] && !m->has_attr[4]; }
+
+
+/* sy_gl_base.c */
+sy_gl_result sy_gli_fail(char *err, size_t len, sy_gl_result r, const char *fmt, ...);
+void *sy_gli_pool_get(const pool *p, uint32_t id);
+void *sy_gli_pool_alloc(pool *p);
+void sy_gli_pool_free(pool *p, void *item);
+void sy_gli_warn(sy_gl_device *dev, const char *fmt, ...);
+void sy_gli_m4_mul(const float *a, const float *b, float *o);
+bool sy_gli_m4_invert(const float *m, float *out);
+void sy_gli_v3_norm(float *v);
+void sy_gli_cross3(const float *a, const float *b, float *o);
+int sy_gli_caster_kind(const sy_gl_material_desc *d);
+GLuint sy_gli_shadow_array(const sy_gl_fns *gl, uint32_t size, uint32_t layers);
+void sy_gli_cube_face_view(const float *eye, int f, float *view);
+GLuint sy_gli_shadow_cube(const sy_gl_fns *gl, uint32_t size);
+void sy_gli_look_along(const float *eye, const float *dir, float *view);
+void sy_gli_projection(bool ortho, double l, double r, double b, double t, double n, double f, float *p);
+void sy_gli_count_buffer(sy_gl_device *dev, bool uniform, size_t bytes);
+sy_gl_result sy_gli_gl_check(sy_gl_device *dev, const char *where, char *err, size_t len);
+sy_gl_result sy_gli_current(sy_gl_device *dev, char *err, size_t len);
+void sy_gli_geometry_changed(sy_gl_device *dev);
+void sy_gli_frustum_planes(const float *m, float planes[6][4]);
+float sy_gli_world_sphere(const inst_o *in, const mesh_o *m, float c[3], float *scale);
+bool sy_gli_sphere_outside(const float planes[6][4], const float c[3], float r);
+
+/* sy_gl_programs.c */
+GLuint sy_gli_make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], bool srgb);
+void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b);
+void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog);
+int sy_gli_variant_normalize(int v);
+GLuint sy_gli_main_program(sy_gl_device *dev, int v, char *err, size_t err_len);
+int sy_gli_deferred_program(sy_gl_device *dev, int v, char *err, size_t err_len);
+bool sy_gli_mtab_set(sy_gl_device *dev, uint32_t row, const sy_gl_material_desc *d);
+void sy_gli_mtab_upload(sy_gl_device *dev);
+
+/* sy_gl_lod.c */
+uint32_t sy_gli_draw_mesh_lod(sy_gl_device *dev, const mesh_o *m, uint32_t lod);
+const mat_o *sy_gli_bind_material(sy_gl_device *dev, sy_gl_material id, bool all_textures);
+void sy_gli_choose_lods(sy_gl_device *dev, const view_setup *v);
+uint32_t sy_gli_choose_lod(const sy_gl_device *dev, const mesh_o *m, const view_setup *v, const float c[3], float r,
+                           float scale);
+float sy_gli_pixels_per_triangle(const sy_gl_device *dev, const mesh_o *m, uint32_t lod, const view_setup *v,
+                                 const float c[3], float r);
+
+/* sy_gl_shadows.c */
+void sy_gli_scene_bounds(const sy_gl_device *dev, float *c, float *radius);
+void sy_gli_lights_upload(sy_gl_device *dev, frame_state *fs);
+sy_gl_result sy_gli_shadow_maps_make(sy_gl_device *dev, char *err, size_t err_len);
+void sy_gli_render_shadows(sy_gl_device *dev, const frame_state *fs);
+
+/* sy_gl_draw.c */
+void sy_gli_targets_free(sy_gl_device *dev, targets *t);
+void sy_gli_frame_end(sy_gl_device *dev);
+sy_gl_result sy_gli_targets_ensure(sy_gl_device *dev, uint32_t w, uint32_t h, char *err, size_t len);
+sy_gl_result sy_gli_view_make(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, view_setup *v,
+                              char *err, size_t len);
+void sy_gli_draw_latlong(sy_gl_device *dev, const view_setup *v, const tex_o *tex, float intensity, uint32_t w,
+                         uint32_t h);
+void sy_gli_begin_target(sy_gl_device *dev, const view_setup *v);
+sy_gl_result sy_gli_finish_target(sy_gl_device *dev, const view_setup *v, float *rgba, float *depth, char *err,
+                                  size_t len);
+void sy_gli_bind_frame_resources(sy_gl_device *dev);
+sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t skip, char *err, size_t err_len);
+
+/* sy_gl_render.c */
+void sy_gli_probes_free(sy_gl_device *dev);
+
+#endif /* SY_GL_INTERNAL_H */

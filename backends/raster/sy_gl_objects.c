@@ -1,0 +1,644 @@
+/* sy_gl_objects.c — the scene objects of the rasterizer's API (sy_gl.h): meshes with their levels
+ * of detail, textures, materials, instances, punctual and area lights, environment and background. */
+#include "sy_gl_internal.h"
+
+#include <meshoptimizer.h>
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+
+static float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
+static float linear_to_srgb(float c) { return c <= 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f; }
+
+
+/* The levels of detail of an indexed mesh of at least SY_GL_LOD_MIN_TRIANGLES: into *out (malloc'd,
+ * level 0 first) the mesh's indices followed by each simplified level; m->lod_* describe them.
+ * Without memory, or when a level would not shrink the one before by a fifth, the chain stops
+ * there (level 0 alone is a valid chain). */
+static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size_t *count_out)
+{
+    size_t n0 = 3u * (size_t)d->triangle_count;
+    m->lod_count = 1;
+    m->lod_first[0] = 0;
+    m->lod_tris[0] = d->triangle_count;
+    m->lod_error[0] = 0.0f;
+    *out = NULL;
+    *count_out = n0;
+    if (!d->indices || d->triangle_count < SY_GL_LOD_MIN_TRIANGLES) return;
+    /* the chain: at most n0 * (1 + 4/5 + (4/5)^2 + ...) = 5 n0 indices, 4/3 n0 in practice; each
+     * level first into scratch (meshopt_simplify may need index_count entries) */
+    size_t cap = n0 + n0 / 2u;
+    uint32_t *all = malloc(cap * sizeof *all), *scratch = malloc(n0 * sizeof *scratch);
+    if (!all || !scratch) {
+        free(all), free(scratch);
+        return;
+    }
+    memcpy(all, d->indices, n0 * sizeof *all);
+    size_t used = n0;
+    float scale = meshopt_simplifyScale(d->positions, d->vertex_count, 3 * sizeof(float)), err_sum = 0.0f;
+    while (m->lod_count < LOD_MAX) {
+        uint32_t k = m->lod_count;
+        size_t prev_n = 3u * (size_t)m->lod_tris[k - 1], target = prev_n / 4u / 3u * 3u;
+        if (target < 3u * 32u) break;
+        float rel = 0.0f;
+        size_t n = meshopt_simplify(scratch, all + m->lod_first[k - 1], prev_n, d->positions, d->vertex_count,
+                                    3 * sizeof(float), target, 1.0f, 0, &rel);
+        if (n == 0 || n * 5u > prev_n * 4u) break;
+        if (used + n > cap) {
+            size_t ncap = used + n + n0 / 4u;
+            uint32_t *grown = realloc(all, ncap * sizeof *all);
+            if (!grown) break;
+            all = grown;
+            cap = ncap;
+        }
+        memcpy(all + used, scratch, n * sizeof *all);
+        err_sum += rel * scale; /* deviation from the level before, relative to the mesh extent */
+        m->lod_first[k] = (uint32_t)used;
+        m->lod_tris[k] = (uint32_t)(n / 3u);
+        m->lod_error[k] = err_sum;
+        m->lod_count++;
+        used += n;
+    }
+    free(scratch);
+    *out = all;
+    *count_out = used;
+}
+
+sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_gl_mesh *out, char *err,
+                               size_t err_len)
+{
+    out->id = 0;
+    if (!d || !d->positions || d->vertex_count == 0 || d->triangle_count == 0)
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: positions and a non-zero vertex and triangle count are required");
+    if (d->triangle_count > UINT32_MAX / 3u)
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_LIMIT, "mesh: %u triangles exceed the index range", d->triangle_count);
+    if (!d->indices && d->vertex_count != 3u * d->triangle_count)
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT,
+                    "mesh: without indices vertex_count (%u) must be 3 x triangle_count (%u)", d->vertex_count,
+                    d->triangle_count);
+    float bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < d->vertex_count; ++i)
+        for (int k = 0; k < 3; ++k) {
+            float v = d->positions[3u * i + k];
+            if (!isfinite(v)) return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: position %u is not finite", i);
+            bmin[k] = fminf(bmin[k], v);
+            bmax[k] = fmaxf(bmax[k], v);
+        }
+    if (d->indices)
+        for (uint32_t i = 0; i < 3u * d->triangle_count; ++i)
+            if (d->indices[i] >= d->vertex_count)
+                return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: index %u = %u is out of range (%u vertices)",
+                            i, d->indices[i], d->vertex_count);
+    sy_gl_result r = sy_gli_current(dev, err, err_len);
+    if (r != SY_GL_OK) return r;
+    mesh_o *m = sy_gli_pool_alloc(&dev->meshes);
+    if (!m) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
+    const sy_gl_fns *gl = dev->gl;
+    m->vertex_count = d->vertex_count;
+    m->triangle_count = d->triangle_count;
+    memcpy(m->bmin, bmin, sizeof bmin);
+    memcpy(m->bmax, bmax, sizeof bmax);
+    float r2 = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+        m->centre[k] = 0.5f * (bmin[k] + bmax[k]);
+        r2 += 0.25f * (bmax[k] - bmin[k]) * (bmax[k] - bmin[k]);
+    }
+    m->radius = sqrtf(r2);
+    uint32_t *lods = NULL;
+    size_t index_count = 0;
+    build_lods(d, m, &lods, &index_count);
+    gl->GenVertexArrays(1, &m->vao);
+    gl->BindVertexArray(m->vao);
+    /* one interleaved vertex buffer (present attributes only) + one index buffer */
+    const float *arrays[5] = {d->positions, d->normals, d->uv[0], d->uv[1], d->colors};
+    static const int comps[5] = {3, 3, 2, 2, 4};
+    int stride = 0, offs[5];
+    for (int a = 0; a < 5; ++a) {
+        offs[a] = stride;
+        if (arrays[a]) stride += comps[a];
+    }
+    size_t bytes = (size_t)d->vertex_count * (size_t)stride * sizeof(float);
+    float *vb = malloc(bytes);
+    if (!vb) {
+        sy_gli_pool_free(&dev->meshes, m);
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory (%u vertices)", d->vertex_count);
+    }
+    for (uint32_t i = 0; i < d->vertex_count; ++i)
+        for (int a = 0; a < 5; ++a)
+            if (arrays[a]) memcpy(vb + (size_t)i * stride + offs[a], arrays[a] + (size_t)i * comps[a], comps[a] * sizeof(float));
+    gl->GenBuffers(1, &m->vbo[0]);
+    gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
+    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, vb, GL_STATIC_DRAW);
+    sy_gli_count_buffer(dev, false, bytes);
+    free(vb);
+    for (int a = 0; a < 5; ++a) {
+        m->has_attr[a] = arrays[a] != NULL;
+        if (!arrays[a]) continue;
+        gl->EnableVertexAttribArray((GLuint)a);
+        gl->VertexAttribPointer((GLuint)a, comps[a], GL_FLOAT, GL_FALSE, stride * (GLsizei)sizeof(float),
+                                (const void *)(uintptr_t)(offs[a] * sizeof(float)));
+    }
+    m->has_normals = d->normals != NULL;
+    if (d->indices) {
+        size_t bytes = index_count * sizeof(uint32_t);
+        gl->GenBuffers(1, &m->ibo);
+        gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, m->ibo);
+        gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)bytes, lods ? lods : d->indices, GL_STATIC_DRAW);
+        free(lods);
+        sy_gli_count_buffer(dev, false, bytes);
+        m->indexed = true;
+    }
+    gl->BindVertexArray(0);
+    r = sy_gli_gl_check(dev, "mesh upload", err, err_len);
+    if (r != SY_GL_OK) {
+        sy_gl_mesh h = {m->h.id};
+        sy_gl_mesh_destroy(dev, h);
+        return r;
+    }
+    out->id = m->h.id;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh)
+{
+    mesh_o *m = sy_gli_pool_get(&dev->meshes, mesh.id);
+    if (!m) return SY_GL_ERROR_INVALID_HANDLE;
+    if (sy_gli_current(dev, NULL, 0) == SY_GL_OK) {
+        dev->gl->DeleteBuffers(1, m->vbo);
+        dev->gl->DeleteBuffers(1, &m->ibo);
+        dev->gl->DeleteVertexArrays(1, &m->vao);
+    }
+    sy_gli_pool_free(&dev->meshes, m);
+    sy_gli_geometry_changed(dev);
+    return SY_GL_OK;
+}
+
+/* Halves an RGBA float image (box filter; odd edges clamp). */
+static void halve(const float *src, uint32_t w, uint32_t h, float *dst, uint32_t *ow, uint32_t *oh)
+{
+    uint32_t nw = w > 1 ? w / 2 : 1, nh = h > 1 ? h / 2 : 1;
+    for (uint32_t y = 0; y < nh; ++y)
+        for (uint32_t x = 0; x < nw; ++x)
+            for (int c = 0; c < 4; ++c) {
+                uint32_t x0 = x * 2 < w ? x * 2 : w - 1, x1 = x * 2 + 1 < w ? x * 2 + 1 : w - 1;
+                uint32_t y0 = y * 2 < h ? y * 2 : h - 1, y1 = y * 2 + 1 < h ? y * 2 + 1 : h - 1;
+                dst[((size_t)y * nw + x) * 4 + c] =
+                    0.25f * (src[((size_t)y0 * w + x0) * 4 + c] + src[((size_t)y0 * w + x1) * 4 + c] +
+                             src[((size_t)y1 * w + x0) * 4 + c] + src[((size_t)y1 * w + x1) * 4 + c]);
+            }
+    *ow = nw;
+    *oh = nh;
+}
+
+sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d, sy_gl_texture *out, char *err,
+                                  size_t err_len)
+{
+    out->id = 0;
+    if (!d || !d->pixels || d->width == 0 || d->height == 0 || d->channels < 1 || d->channels > 4)
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "texture: needs pixels, a non-zero size and 1..4 channels");
+    if (d->format != SY_GL_TEXEL_UNORM8 && d->format != SY_GL_TEXEL_UNORM8_SRGB && d->format != SY_GL_TEXEL_FLOAT32)
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "texture: unknown texel format %d", (int)d->format);
+    size_t n = (size_t)d->width * d->height;
+    if (n / d->width != d->height || n > ((size_t)1 << 32))
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_LIMIT, "texture: %ux%u is too large", d->width, d->height);
+    bool is_float = d->format == SY_GL_TEXEL_FLOAT32, srgb = d->format == SY_GL_TEXEL_UNORM8_SRGB;
+    bool downscale = d->width > dev->max_tex || d->height > dev->max_tex;
+    const unsigned char *u8 = d->pixels;
+    const float *f32 = d->pixels;
+    uint32_t ch = d->channels, w = d->width, h = d->height;
+    float *img = NULL;          /* RGBA float: float textures, and 8-bit ones that need downscaling */
+    unsigned char *img8 = NULL; /* RGBA8: 8-bit textures within the limit (no conversion) */
+    if (!is_float && !downscale) {
+        img8 = malloc(n * 4);
+        if (!img8) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (%ux%u)", d->width, d->height);
+        for (size_t i = 0; i < n; ++i) {
+            const unsigned char *s = u8 + i * ch;
+            unsigned char *o = img8 + i * 4;
+            if (ch <= 2) o[0] = o[1] = o[2] = s[0], o[3] = ch == 2 ? s[1] : 255;
+            else o[0] = s[0], o[1] = s[1], o[2] = s[2], o[3] = ch == 4 ? s[3] : 255;
+        }
+    } else {
+        /* expand to RGBA (grey -> rgb, grey+alpha -> rgb+a) in float, filter in linear space */
+        img = malloc(n * 4 * sizeof *img);
+        if (!img) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (%ux%u)", d->width, d->height);
+        for (size_t i = 0; i < n; ++i) {
+            float v[4] = {0, 0, 0, 1};
+            for (uint32_t c = 0; c < ch; ++c) v[c] = is_float ? f32[i * ch + c] : (float)u8[i * ch + c] / 255.0f;
+            if (ch <= 2) {
+                if (ch == 2) v[3] = v[1];
+                v[1] = v[2] = v[0];
+            }
+            if (srgb)
+                for (int c = 0; c < 3; ++c) v[c] = srgb_to_linear(v[c]);
+            memcpy(img + i * 4, v, sizeof v);
+        }
+    }
+    if (downscale) {
+        uint32_t ow = w, oh = h;
+        while (w > dev->max_tex || h > dev->max_tex) {
+            float *nimg = malloc((size_t)(w > 1 ? w / 2 : 1) * (h > 1 ? h / 2 : 1) * 4 * sizeof *nimg);
+            if (!nimg) {
+                free(img);
+                return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory while downscaling");
+            }
+            halve(img, w, h, nimg, &w, &h);
+            free(img);
+            img = nimg;
+        }
+        sy_gli_warn(dev, "raster: texture %ux%u exceeds the GL limit of %u texels per side; downscaled to %ux%u", ow, oh,
+             dev->max_tex, w, h);
+    }
+    sy_gl_result r = sy_gli_current(dev, err, err_len);
+    tex_o *t = r == SY_GL_OK ? sy_gli_pool_alloc(&dev->textures) : NULL;
+    if (r == SY_GL_OK && !t) r = sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory");
+    size_t count = (size_t)w * h;
+    if (r == SY_GL_OK && !is_float && !img8) { /* downscaled 8-bit: back to bytes */
+        img8 = malloc(count * 4);
+        if (!img8) r = sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory");
+        for (size_t i = 0; img8 && i < count * 4; ++i) {
+            float v = img[i];
+            if (srgb && (i & 3u) != 3u) v = linear_to_srgb(v);
+            v = v < 0.0f ? 0.0f : v > 1.0f ? 1.0f : v;
+            img8[i] = (unsigned char)lrintf(v * 255.0f);
+        }
+    }
+    if (r != SY_GL_OK) {
+        if (t) sy_gli_pool_free(&dev->textures, t);
+        free(img);
+        free(img8);
+        return r;
+    }
+    const sy_gl_fns *gl = dev->gl;
+    t->width = w;
+    t->height = h;
+    gl->GenTextures(1, &t->tex);
+    gl->BindTexture(GL_TEXTURE_2D, t->tex);
+    gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    if (is_float) {
+        gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, (GLsizei)w, (GLsizei)h, 0, GL_RGBA, GL_FLOAT, img);
+        dev->counts.texture_bytes += count * 16;
+    } else {
+        gl->TexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, (GLsizei)w, (GLsizei)h, 0, GL_RGBA,
+                       GL_UNSIGNED_BYTE, img8);
+        dev->counts.texture_bytes += count * 4;
+    }
+    free(img);
+    free(img8);
+    dev->counts.texture_uploads++;
+    gl->GenerateMipmap(GL_TEXTURE_2D);
+    static const GLint wraps[3] = {GL_REPEAT, GL_CLAMP_TO_EDGE, GL_MIRRORED_REPEAT};
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wraps[(unsigned)d->wrap_s < 3u ? d->wrap_s : 0]);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wraps[(unsigned)d->wrap_t < 3u ? d->wrap_t : 0]);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, d->nearest ? GL_NEAREST : GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, d->nearest ? GL_NEAREST_MIPMAP_LINEAR : GL_LINEAR_MIPMAP_LINEAR);
+    r = sy_gli_gl_check(dev, "texture upload", err, err_len);
+    if (r != SY_GL_OK) {
+        sy_gl_texture_destroy(dev, (sy_gl_texture){t->h.id});
+        return r;
+    }
+    out->id = t->h.id;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_texture_destroy(sy_gl_device *dev, sy_gl_texture tex)
+{
+    tex_o *t = sy_gli_pool_get(&dev->textures, tex.id);
+    if (!t) return SY_GL_ERROR_INVALID_HANDLE;
+    if (sy_gli_current(dev, NULL, 0) == SY_GL_OK) dev->gl->DeleteTextures(1, &t->tex);
+    sy_gli_pool_free(&dev->textures, t);
+    if (tex.id == dev->env_tex.id) { /* the environment is gone: no environment light */
+        dev->env_tex.id = 0;
+        dev->env_dirty = true;
+    }
+    return SY_GL_OK;
+}
+
+/* >>material */
+void sy_gl_material_desc_init(sy_gl_material_desc *d)
+{
+    memset(d, 0, sizeof *d);
+    for (int i = 0; i < 4; ++i) d->base_color[i] = 1.0f;
+    d->metallic = d->roughness = 1.0f;
+    d->normal_scale = 1.0f;
+    d->occlusion_strength = 1.0f;
+    d->specular = 1.0f;
+    d->ior = 1.5f;
+    d->alpha_cutoff = 0.5f;
+}
+
+static sy_gl_result material_check(const sy_gl_material_desc *d, char *err, size_t len)
+{
+    const float *v[] = {d->base_color, d->base_color + 1, d->base_color + 2, d->base_color + 3, &d->metallic,
+                        &d->roughness, d->emissive, d->emissive + 1, d->emissive + 2, &d->normal_scale,
+                        &d->occlusion_strength, &d->specular, &d->transmission, &d->ior, &d->alpha_cutoff};
+    for (size_t i = 0; i < sizeof v / sizeof v[0]; ++i)
+        if (!isfinite(*v[i])) return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "material: parameter %zu is not finite", i);
+    if ((unsigned)d->alpha_mode > 2u)
+        return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "material: unknown alpha mode %d", (int)d->alpha_mode);
+    const sy_gl_texture_ref *refs[5] = {&d->base_color_texture, &d->metallic_roughness_texture, &d->normal_texture,
+                                        &d->occlusion_texture, &d->emissive_texture};
+    for (int i = 0; i < 5; ++i)
+        for (int k = 0; refs[i]->transformed && k < 6; ++k)
+            if (!isfinite(refs[i]->transform[k]))
+                return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "material: texture %d transform[%d] is not finite", i, k);
+    return SY_GL_OK;
+}
+
+static void material_upload(sy_gl_device *dev, mat_o *m, bool create)
+{
+    mat_block b;
+    sy_gli_material_block(dev, &m->d, &b);
+    const sy_gl_fns *gl = dev->gl;
+    gl->BindBuffer(GL_UNIFORM_BUFFER, m->ubo);
+    if (create) gl->BufferData(GL_UNIFORM_BUFFER, sizeof b, &b, GL_DYNAMIC_DRAW);
+    else gl->BufferSubData(GL_UNIFORM_BUFFER, 0, sizeof b, &b);
+    sy_gli_count_buffer(dev, true, sizeof b);
+    if (!dev->forward) sy_gli_mtab_set(dev, m->h.id & IDX_MASK, &m->d); /* beyond the table: shaded forward */
+}
+
+sy_gl_result sy_gl_material_create(sy_gl_device *dev, const sy_gl_material_desc *d, sy_gl_material *out, char *err,
+                                   size_t err_len)
+{
+    out->id = 0;
+    sy_gl_result r = material_check(d, err, err_len);
+    if (r == SY_GL_OK) r = sy_gli_current(dev, err, err_len);
+    if (r != SY_GL_OK) return r;
+    mat_o *m = sy_gli_pool_alloc(&dev->materials);
+    if (!m) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "material: out of memory");
+    m->d = *d;
+    dev->gl->GenBuffers(1, &m->ubo);
+    material_upload(dev, m, true);
+    out->id = m->h.id;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const sy_gl_material_desc *d, char *err,
+                                   size_t err_len)
+{
+    mat_o *m = sy_gli_pool_get(&dev->materials, mat.id);
+    if (!m) return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "material update: stale handle %u", mat.id);
+    sy_gl_result r = material_check(d, err, err_len);
+    if (r == SY_GL_OK) r = sy_gli_current(dev, err, err_len);
+    if (r != SY_GL_OK) return r;
+    bool shadows = sy_gli_caster_kind(&m->d) != sy_gli_caster_kind(d) || m->d.alpha_mode != SY_GL_ALPHA_OPAQUE ||
+                   memcmp(m->d.emissive, d->emissive, sizeof d->emissive) != 0;
+    m->d = *d;
+    material_upload(dev, m, false);
+    if (shadows) sy_gli_geometry_changed(dev); /* shadow casters changed */
+    dev->probes_dirty = true;              /* what the probes see changed */
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_material_destroy(sy_gl_device *dev, sy_gl_material mat)
+{
+    mat_o *m = sy_gli_pool_get(&dev->materials, mat.id);
+    if (!m) return SY_GL_ERROR_INVALID_HANDLE;
+    if (sy_gli_current(dev, NULL, 0) == SY_GL_OK) dev->gl->DeleteBuffers(1, &m->ubo);
+    sy_gli_pool_free(&dev->materials, m);
+    return SY_GL_OK;
+}
+
+/* The normal matrix of an upper 3x3 whose float inverse under- or overflows (a scale of 1e-30):
+ * the transposed inverse up to a positive factor, i.e. the cofactor matrix times the sign of the
+ * determinant, divided by its largest element (normals are normalised after it). false when the
+ * 3x3 is singular relative to its size (|det| <= 1e-30 s^3), as sy_mat4_is_degenerate in core. */
+static bool normal_mat_scaled(const float *t, float *nm)
+{
+    double a[3][3], s = 0.0; /* a[r][c] */
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) a[r][c] = t[c * 4 + r], s = fmax(s, fabs(a[r][c]));
+    double C[3][3], big = 0.0; /* C[r][c]: cofactor of a[r][c] */
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+            int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+            C[r][c] = a[r1][c1] * a[r2][c2] - a[r1][c2] * a[r2][c1];
+            big = fmax(big, fabs(C[r][c]));
+        }
+    double det = a[0][0] * C[0][0] + a[0][1] * C[0][1] + a[0][2] * C[0][2];
+    if (!(s > 0.0) || !(fabs(det) > 1e-30 * s * s * s) || !(big > 0.0)) return false;
+    double k = (det < 0.0 ? -1.0 : 1.0) / big;
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) nm[c * 3 + r] = (float)(C[r][c] * k); /* inverse transpose = C / det */
+    return true;
+}
+
+static bool set_model(inst_o *in, const float *t)
+{
+    float inv[16];
+    for (int i = 0; i < 16; ++i)
+        if (!isfinite(t[i])) return false;
+    if (!sy_gli_m4_invert(t, inv)) {
+        float nm[9];
+        if (!normal_mat_scaled(t, nm)) return false;
+        memcpy(in->model, t, sizeof in->model);
+        memcpy(in->normal_mat, nm, sizeof nm);
+        /* det(nm) has the sign of det(t): the adjugate's determinant is det(t)^2 */
+        in->mirror = nm[0] * (nm[4] * nm[8] - nm[7] * nm[5]) - nm[3] * (nm[1] * nm[8] - nm[7] * nm[2]) +
+                         nm[6] * (nm[1] * nm[5] - nm[4] * nm[2]) < 0.0f;
+        return true;
+    }
+    memcpy(in->model, t, sizeof in->model);
+    /* normal matrix = inverse transpose of the upper 3x3 */
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) in->normal_mat[c * 3 + r] = inv[r * 4 + c];
+    float det = t[0] * (t[5] * t[10] - t[9] * t[6]) - t[4] * (t[1] * t[10] - t[9] * t[2]) + t[8] * (t[1] * t[6] - t[5] * t[2]);
+    in->mirror = det < 0.0f;
+    return true;
+}
+
+sy_gl_result sy_gl_instance_create(sy_gl_device *dev, const sy_gl_instance_desc *d, sy_gl_instance *out, char *err,
+                                   size_t err_len)
+{
+    out->id = 0;
+    if (!sy_gli_pool_get(&dev->meshes, d->mesh.id))
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "instance: mesh handle %u is stale", d->mesh.id);
+    inst_o tmp;
+    if (!set_model(&tmp, d->transform))
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "instance: transform is not finite and invertible");
+    inst_o *in = sy_gli_pool_alloc(&dev->instances);
+    if (!in) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "instance: out of memory");
+    set_model(in, d->transform);
+    in->mesh = d->mesh;
+    in->material = d->material;
+    in->visible = !d->hidden;
+    dev->counts.model_matrix_updates++;
+    sy_gli_geometry_changed(dev);
+    out->id = in->h.id;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_instance_set_transform(sy_gl_device *dev, sy_gl_instance inst, const float t[16], char *err,
+                                          size_t err_len)
+{
+    inst_o *in = sy_gli_pool_get(&dev->instances, inst.id);
+    if (!in) return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "instance transform: stale handle %u", inst.id);
+    if (!set_model(in, t))
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "instance transform: not finite and invertible");
+    dev->counts.model_matrix_updates++;
+    sy_gli_geometry_changed(dev);
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_instance_set_material(sy_gl_device *dev, sy_gl_instance inst, sy_gl_material mat)
+{
+    inst_o *in = sy_gli_pool_get(&dev->instances, inst.id);
+    if (!in) return SY_GL_ERROR_INVALID_HANDLE;
+    if (in->material.id != mat.id) sy_gli_geometry_changed(dev); /* shadow casters and probes */
+    in->material = mat;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_instance_set_visible(sy_gl_device *dev, sy_gl_instance inst, bool visible)
+{
+    inst_o *in = sy_gli_pool_get(&dev->instances, inst.id);
+    if (!in) return SY_GL_ERROR_INVALID_HANDLE;
+    if (in->visible != visible) sy_gli_geometry_changed(dev);
+    in->visible = visible;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_instance_destroy(sy_gl_device *dev, sy_gl_instance inst)
+{
+    inst_o *in = sy_gli_pool_get(&dev->instances, inst.id);
+    if (!in) return SY_GL_ERROR_INVALID_HANDLE;
+    sy_gli_pool_free(&dev->instances, in);
+    sy_gli_geometry_changed(dev);
+    return SY_GL_OK;
+}
+
+static sy_gl_result light_check(const sy_gl_light_desc *d, char *err, size_t len)
+{
+    if (d->type != SY_GL_LIGHT_POINT && d->type != SY_GL_LIGHT_SPOT && d->type != SY_GL_LIGHT_DIRECTIONAL)
+        return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "light: unknown type %d", (int)d->type);
+    const float *v[] = {d->color, d->color + 1, d->color + 2, &d->intensity, d->position, d->position + 1,
+                        d->position + 2, d->direction, d->direction + 1, d->direction + 2, &d->range,
+                        &d->inner_cone_angle, &d->outer_cone_angle};
+    for (size_t i = 0; i < sizeof v / sizeof v[0]; ++i)
+        if (!isfinite(*v[i])) return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "light: parameter %zu is not finite", i);
+    if (d->type != SY_GL_LIGHT_POINT && !(fabsf(d->direction[0]) + fabsf(d->direction[1]) + fabsf(d->direction[2]) > 0.0f))
+        return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "light: zero direction");
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_light_create(sy_gl_device *dev, const sy_gl_light_desc *d, sy_gl_light *out, char *err,
+                                size_t err_len)
+{
+    out->id = 0;
+    sy_gl_result r = light_check(d, err, err_len);
+    if (r != SY_GL_OK) return r;
+    light_o *l = sy_gli_pool_alloc(&dev->lights);
+    if (!l) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "light: out of memory");
+    l->d = *d;
+    dev->lights_dirty = true;
+    out->id = l->h.id;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_gl_light_desc *d, char *err,
+                                size_t err_len)
+{
+    light_o *l = sy_gli_pool_get(&dev->lights, light.id);
+    if (!l) return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "light update: stale handle %u", light.id);
+    sy_gl_result r = light_check(d, err, err_len);
+    if (r != SY_GL_OK) return r;
+    l->d = *d;
+    dev->lights_dirty = true;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_light_destroy(sy_gl_device *dev, sy_gl_light light)
+{
+    light_o *l = sy_gli_pool_get(&dev->lights, light.id);
+    if (!l) return SY_GL_ERROR_INVALID_HANDLE;
+    sy_gli_pool_free(&dev->lights, l);
+    dev->lights_dirty = true;
+    return SY_GL_OK;
+}
+
+void sy_gl_set_background(sy_gl_device *dev, sy_gl_background_mode mode, const float color[4], sy_gl_texture texture,
+                          float intensity)
+{
+    if ((unsigned)mode > (unsigned)SY_GL_BACKGROUND_TEXTURE) {
+        sy_gli_warn(dev, "raster: unknown background mode %d; using a transparent background", (int)mode);
+        mode = SY_GL_BACKGROUND_NONE;
+    }
+    float c[4] = {0, 0, 0, 0};
+    if (mode == SY_GL_BACKGROUND_COLOR && color)
+        for (int i = 0; i < 4; ++i) {
+            c[i] = color[i];
+            if (!isfinite(c[i]) || c[i] < 0.0f) {
+                sy_gli_warn(dev, "raster: background colour component %d (%g) is not a finite non-negative value; using 0", i,
+                     (double)c[i]);
+                c[i] = 0.0f;
+            }
+        }
+    if (!isfinite(intensity) || intensity < 0.0f) {
+        sy_gli_warn(dev, "raster: background intensity %g is not a finite non-negative value; using 0", (double)intensity);
+        intensity = 0.0f;
+    }
+    dev->bg_mode = mode;
+    memcpy(dev->bg_color, c, sizeof c);
+    dev->bg_tex = mode == SY_GL_BACKGROUND_TEXTURE ? texture : (sy_gl_texture){0};
+    dev->bg_intensity = intensity;
+}
+
+void sy_gl_set_environment(sy_gl_device *dev, sy_gl_texture texture, float intensity)
+{
+    if (!isfinite(intensity) || intensity < 0.0f) {
+        sy_gli_warn(dev, "raster: environment intensity %g is not a finite non-negative value; using 0", (double)intensity);
+        intensity = 0.0f;
+    }
+    if (intensity == 0.0f) texture.id = 0;
+    if (texture.id == dev->env_tex.id && intensity == dev->env_intensity && (texture.id != 0) == dev->env_ready) return;
+    dev->env_tex = texture;
+    dev->env_intensity = intensity;
+    dev->env_dirty = true;
+}
+
+void sy_gl_set_ambient(sy_gl_device *dev, const float radiance[3])
+{
+    float a[3];
+    for (int c = 0; c < 3; ++c) {
+        a[c] = radiance[c];
+        if (!isfinite(a[c]) || a[c] < 0.0f) {
+            sy_gli_warn(dev, "raster: ambient radiance[%d] = %g is not a finite non-negative value; using 0", c, (double)a[c]);
+            a[c] = 0.0f;
+        }
+    }
+    if (memcmp(a, dev->ambient, sizeof a)) {
+        memcpy(dev->ambient, a, sizeof a);
+        dev->lights_dirty = true;
+    }
+}
+
+sy_gl_result sy_gl_set_area_lights(sy_gl_device *dev, const sy_gl_area_light *lights, uint32_t count, char *err,
+                                   size_t err_len)
+{
+    if (count > SY_GL_MAX_AREA_LIGHTS)
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_LIMIT, "area lights: %u exceed the limit of %d", count, SY_GL_MAX_AREA_LIGHTS);
+    if (count && !lights) return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "area lights: NULL array");
+    for (uint32_t i = 0; i < count; ++i) {
+        const sy_gl_area_light *a = &lights[i];
+        if (a->vertex_count != 3 && a->vertex_count != 4)
+            return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "area light %u: %u vertices (3 or 4 expected)", i,
+                        a->vertex_count);
+        for (uint32_t k = 0; k < a->vertex_count; ++k)
+            for (int c = 0; c < 3; ++c)
+                if (!isfinite(a->vertices[k][c]))
+                    return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "area light %u: vertex %u is not finite", i, k);
+        for (int c = 0; c < 3; ++c)
+            if (!isfinite(a->radiance[c]) || a->radiance[c] < 0.0f)
+                return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT,
+                            "area light %u: radiance[%d] = %g is not a finite non-negative value", i, c, (double)a->radiance[c]);
+    }
+    if (count == dev->area_count && (!count || !memcmp(dev->areas, lights, count * sizeof *lights))) return SY_GL_OK;
+    if (count) memcpy(dev->areas, lights, count * sizeof *lights);
+    dev->area_count = count;
+    dev->areas_dirty = true;
+    dev->lights_dirty = true;
+    return SY_GL_OK;
+}

@@ -1,0 +1,286 @@
+/* sy_gl_programs.c — the main pass's shader programs: stand-in textures, material uniform blocks,
+ * the variants (built on first use, one per feature set and light signature), the deferred
+ * shading programs and the material table the deferred pass reads. */
+#include "sy_gl_internal.h"
+
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A material's stand-in for a texture it does not have in one unit (sy_gli_bind_material): a constant 2x2
+ * texture with a mipmap, in the unit's format (sRGB for colours) and the sampling of an uploaded
+ * texture by default (repeat, trilinear). llvmpipe compiles a fragment shader per state of what it
+ * samples (format, filters, wraps, whether there are mip levels), so a stand-in that samples like the
+ * real textures lets materials with and without a texture in that unit share one compiled shader
+ * (issue 32: the first frame's compile time). A constant texture filters to its value exactly. */
+GLuint sy_gli_make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], bool srgb)
+{
+    unsigned char px[16];
+    for (int i = 0; i < 16; ++i) px[i] = rgba[i & 3];
+    GLuint t;
+    gl->GenTextures(1, &t);
+    gl->BindTexture(GL_TEXTURE_2D, t);
+    gl->TexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, 2, 2, 0, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    gl->TexImage2D(GL_TEXTURE_2D, 1, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    return t;
+}
+
+void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b)
+{
+    memset(b, 0, sizeof *b);
+    memcpy(b->base, d->base_color, sizeof b->base);
+    memcpy(b->emissive, d->emissive, sizeof d->emissive);
+    b->mrna[0] = d->metallic;
+    b->mrna[1] = d->roughness;
+    b->mrna[2] = d->normal_scale;
+    b->mrna[3] = d->alpha_cutoff;
+    b->oist[0] = d->occlusion_strength;
+    b->oist[1] = d->ior >= 1.0f ? d->ior : 1.5f;
+    b->oist[2] = d->specular;
+    b->oist[3] = d->transmission;
+    b->modes[0] = (int32_t)d->alpha_mode;
+    b->modes[1] = d->unlit;
+    b->modes[2] = d->double_sided;
+    b->modes[3] = d->emissive[0] > 0.0f || d->emissive[1] > 0.0f || d->emissive[2] > 0.0f;
+    const sy_gl_texture_ref *refs[5] = {&d->base_color_texture, &d->metallic_roughness_texture, &d->normal_texture,
+                                        &d->occlusion_texture, &d->emissive_texture};
+    for (int i = 0; i < 5; ++i) {
+        int32_t v = sy_gli_pool_get(&dev->textures, refs[i]->texture.id) ? (int32_t)(refs[i]->texcoord & 1u) : -1;
+        if (i < 4) b->tex[i] = v;
+        else b->tex2[0] = v;
+        const float id[6] = {1, 0, 0, 0, 1, 0}, *m = refs[i]->transformed ? refs[i]->transform : id;
+        memcpy(b->xf[2 * i], m, 3 * sizeof(float));
+        memcpy(b->xf[2 * i + 1], m + 3, 3 * sizeof(float));
+    }
+}
+
+void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog)
+{
+    static const char *names[UNIT_COUNT] = {"t_base", "t_mr",       "t_nrm",     "t_occ",  "t_emis", "t_shadow",
+                                            "t_env_spec", "t_env_irr", "t_brdf", "t_ltc1", "t_ltc2", "t_cshadow0",
+                                            "t_cshadow1", "t_probe"};
+    gl->UseProgram(prog);
+    for (int i = 0; i < UNIT_COUNT; ++i) {
+        GLint loc = gl->GetUniformLocation(prog, names[i]);
+        if (loc >= 0) gl->Uniform1i(loc, i);
+    }
+    GLuint b = gl->GetUniformBlockIndex(prog, "Material");
+    if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_MATERIAL);
+    b = gl->GetUniformBlockIndex(prog, "Lights");
+    if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_LIGHTS);
+    b = gl->GetUniformBlockIndex(prog, "Areas");
+    if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_AREAS);
+}
+
+/* Drops variant bits that cannot matter, so that equivalent draws share one program. */
+int sy_gli_variant_normalize(int v)
+{
+    if (!(v & (VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_PROBE)) || !(v & VAR_TEX)) v &= ~VAR_NMAP;
+    if (!(v & VAR_LIGHTS)) v &= ~(7 << VAR_NL_SHIFT);
+    if (!(v & VAR_LIGHTS)) v &= ~VAR_SHADOW;
+    if (!(v & VAR_AREA)) v &= ~VAR_ASHADOW;
+    if (!(v & (VAR_ENV | VAR_PROBE))) v &= ~VAR_TRANS;
+    return v;
+}
+
+/* The part of the lights' signature (light_sig) a program of variant bits v depends on. The
+ * shaders call each punctual light (constant light count) with its shadow fixed (sy_gl_shaders.c,
+ * shade_light): straight-line code that makes only the look-ups the frame needs (llvmpipe runs
+ * every branch for every pixel). Emissive polygons run in two loops whose bounds are uniforms (the
+ * Areas block, sy_gli_lights_upload), so no program depends on them: loops of constant bounds were
+ * unrolled, sixteen inlined copies took LLVM many seconds to compile (issue 32). */
+static uint64_t variant_sig(const sy_gl_device *dev, int v)
+{
+    uint64_t s = 0;
+    if ((v & VAR_SHADOW) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & 0x3FFFu;
+    if ((v & VAR_LIGHTS) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & (0x3FFFull << 48);
+    return s;
+}
+
+/* The #defines of variant bits v and the lights' signature sig (variant_sig) (sy_gl_shaders.c)
+ * into defs and their names after name's text. */
+static void variant_defines(int v, uint64_t sig, char *defs, size_t defs_len, char *name, size_t name_len)
+{
+    static const char *const names[7] = {"LEAN", "MASK", "TEX", "NMAP", "LIGHTS", "ENV", "SHADOW"};
+    static const struct {
+        int bit;
+        const char *name;
+    } more[4] = {{VAR_AREA, "AREA"}, {VAR_TRANS, "TRANS"}, {VAR_ASHADOW, "ASHADOW"}, {VAR_PROBE, "PROBE"}};
+    size_t dl = strlen(defs), nl = strlen(name);
+    for (int b = 0; b < 7; ++b) {
+        if (!(v & (1 << b))) continue;
+        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_%s 1\n", names[b]);
+        nl += (size_t)snprintf(name + nl, name_len - nl, " %s", names[b]);
+    }
+    for (int k = 0; k < 4; ++k) {
+        if (!(v & more[k].bit)) continue;
+        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_%s 1\n", more[k].name);
+        nl += (size_t)snprintf(name + nl, name_len - nl, " %s", more[k].name);
+    }
+    int nlights = (v >> VAR_NL_SHIFT) & 7;
+    if (nlights) {
+        dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_NLIGHTS %d\n", nlights);
+        nl += (size_t)snprintf(name + nl, name_len - nl, " (%d lights", nlights);
+        for (int i = 0; i < nlights; ++i) {
+            int kind = (int)((sig >> (2 * i)) & 3u); /* 0 none, 1 2D map, 2 + s cube slot s */
+            int type = (int)((sig >> (48 + 2 * i)) & 3u); /* 0 point, 1 point with range, 2 spot, 3 directional */
+            dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_LK%d %d\n#define SY_LT%d %d\n", i, kind, i, type);
+            nl += (size_t)snprintf(name + nl, name_len - nl, "%s", i ? ", " : ": ");
+            nl += (size_t)snprintf(name + nl, name_len - nl, "%s %s", (const char *[]){"point", "point+range", "spot", "sun"}[type],
+                                   (const char *[]){"-", "map", "cube0", "cube1"}[kind]);
+        }
+        nl += (size_t)snprintf(name + nl, name_len - nl, ")");
+    }
+}
+
+/* The main program for variant bits v, built and cached on first use; 0 with err set when the
+ * driver rejects it. */
+GLuint sy_gli_main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
+{
+    v = sy_gli_variant_normalize(v);
+    uint64_t sig = variant_sig(dev, v);
+    const sy_gl_fns *gl = dev->gl;
+    if (dev->pm[v].prog) {
+        if (dev->pm[v].sig == sig) return dev->pm[v].prog;
+        /* the lights' shadows or polygon count changed: one built for them earlier, or a new one;
+         * this one is kept aside */
+        struct main_prog cur = dev->pm[v];
+        cur.var = v;
+        dev->pm[v].prog = 0;
+        for (uint32_t i = 0; i < PM_SPARE; ++i)
+            if (dev->pm_spare[i].prog && dev->pm_spare[i].var == v && dev->pm_spare[i].sig == sig) {
+                dev->pm[v] = dev->pm_spare[i];
+                dev->pm[v].frame = 0; /* its view uniforms are an older frame's */
+                dev->pm_spare[i] = cur;
+                return dev->pm[v].prog;
+            }
+        uint32_t slot = dev->pm_spare_next++ % PM_SPARE;
+        if (dev->pm_spare[slot].prog) gl->DeleteProgram(dev->pm_spare[slot].prog);
+        dev->pm_spare[slot] = cur;
+    }
+    char defs[1024] = "", name[256] = "main";
+    variant_defines(v, sig, defs, sizeof defs, name, sizeof name);
+    GLuint p = 0;
+    if (sy_gl_program_build(gl, name, sy_gl_main_vs, sy_gl_main_fs, defs, &p, err, err_len) != SY_GL_OK) return 0;
+    dev->pm[v].prog = p;
+    dev->pm[v].sig = sig;
+    dev->pm[v].model = gl->GetUniformLocation(p, "u_model");
+    dev->pm[v].normal_mat = gl->GetUniformLocation(p, "u_normal_mat");
+    dev->pm[v].mvp = gl->GetUniformLocation(p, "u_mvp");
+    dev->pm[v].cam_pos = gl->GetUniformLocation(p, "u_cam_pos");
+    dev->pm[v].cam_fwd = gl->GetUniformLocation(p, "u_cam_fwd");
+    dev->pm[v].ortho = gl->GetUniformLocation(p, "u_ortho");
+    dev->pm[v].ortho_z = gl->GetUniformLocation(p, "u_ortho_z");
+    dev->pm[v].mirror = gl->GetUniformLocation(p, "u_mirror");
+    dev->pm[v].has_normals = gl->GetUniformLocation(p, "u_has_normals");
+    dev->pm[v].probe_lod = gl->GetUniformLocation(p, "u_probe_lod");
+    dev->pm[v].frame = 0;
+    sy_gli_bind_samplers(gl, p);
+    return p;
+}
+
+/* The deferred shading pass for the frame's lighting variant bits v (only the lighting bits
+ * count) and light signature, built and kept on first use: its index in dev->dp, or -1 with err
+ * set when the driver rejects it. */
+int sy_gli_deferred_program(sy_gl_device *dev, int v, char *err, size_t err_len)
+{
+    v = sy_gli_variant_normalize(v & (VAR_LIGHTS | VAR_ENV | VAR_SHADOW | VAR_AREA | VAR_ASHADOW | (7 << VAR_NL_SHIFT)));
+    uint64_t sig = variant_sig(dev, v);
+    for (uint32_t i = 0; i < dev->dp_count; ++i)
+        if (dev->dp[i].var == v && dev->dp[i].sig == sig) return (int)i;
+    char defs[1024] = "", name[256] = "deferred";
+    snprintf(defs, sizeof defs, "#define SY_SAMPLES %u\n", dev->msaa);
+    variant_defines(v, sig, defs, sizeof defs, name, sizeof name);
+    const sy_gl_fns *gl = dev->gl;
+    GLuint p = 0;
+    if (sy_gl_program_build(gl, name, sy_gl_rect_vs, sy_gl_deferred_fs, defs, &p, err, err_len) != SY_GL_OK) return -1;
+    uint32_t i = dev->dp_count;
+    if (i == DEFERRED_PROGS) { /* all kept: the new one takes the slots in turn (one is used per frame) */
+        i = dev->dp_next++ % DEFERRED_PROGS;
+        gl->DeleteProgram(dev->dp[i].prog);
+    } else
+        dev->dp_count++;
+    dev->dp[i].var = v;
+    dev->dp[i].sig = sig;
+    dev->dp[i].prog = p;
+    dev->dp[i].unproj = gl->GetUniformLocation(p, "u_unproj");
+    dev->dp[i].inv_view = gl->GetUniformLocation(p, "u_inv_view");
+    dev->dp[i].px = gl->GetUniformLocation(p, "u_px");
+    dev->dp[i].cam_pos = gl->GetUniformLocation(p, "u_cam_pos");
+    dev->dp[i].cam_fwd = gl->GetUniformLocation(p, "u_cam_fwd");
+    dev->dp[i].ortho = gl->GetUniformLocation(p, "u_ortho");
+    dev->dp[i].rects = gl->GetUniformLocation(p, "u_rects");
+    sy_gli_bind_samplers(gl, p); /* the light and environment units and blocks; then its own three */
+    gl->Uniform1i(gl->GetUniformLocation(p, "t_gcol"), UNIT_GCOL);
+    gl->Uniform1i(gl->GetUniformLocation(p, "t_gdepth"), UNIT_GDEPTH);
+    gl->Uniform1i(gl->GetUniformLocation(p, "t_mtab"), UNIT_MTAB);
+    return (int)i;
+}
+
+/* >>material table: what the deferred pass knows of a material, one row per material pool index
+ * (row 0: the default material), kept on the CPU and uploaded before a deferred pass when rows
+ * changed. */
+static void mtab_row(const sy_gl_device *dev, const sy_gl_material_desc *d, float *row)
+{
+    mat_block b;
+    sy_gli_material_block(dev, d, &b);
+    /* (base colour, metallic), (emission, roughness), (ior, specular, transmission, flags) */
+    memcpy(row, b.base, 3 * sizeof *b.base);
+    row[3] = b.mrna[0];
+    memcpy(row + 4, b.emissive, 3 * sizeof *b.emissive);
+    row[7] = b.mrna[1];
+    memcpy(row + 8, b.oist + 1, 3 * sizeof *b.oist);
+    row[11] = (float)((b.modes[1] ? 1 : 0) + (b.modes[2] ? 2 : 0) + (b.modes[3] ? 4 : 0)); /* unlit, two-sided, emissive */
+}
+
+/* Writes material d into row `row`; false (the material is then shaded forward) when the table
+ * cannot hold it. */
+bool sy_gli_mtab_set(sy_gl_device *dev, uint32_t row, const sy_gl_material_desc *d)
+{
+    if (row >= dev->mtab_limit) return false;
+    if (row >= dev->mtab_cpu_rows) {
+        uint32_t n = dev->mtab_cpu_rows ? dev->mtab_cpu_rows : 64u;
+        while (n <= row) n *= 2u;
+        if (n > dev->mtab_limit) n = dev->mtab_limit;
+        float *t = realloc(dev->mtab_cpu, (size_t)n * MTAB_TEXELS * 4u * sizeof *t);
+        if (!t) return false;
+        memset(t + (size_t)dev->mtab_cpu_rows * MTAB_TEXELS * 4u, 0,
+               (size_t)(n - dev->mtab_cpu_rows) * MTAB_TEXELS * 4u * sizeof *t);
+        dev->mtab_cpu = t;
+        dev->mtab_cpu_rows = n;
+    }
+    mtab_row(dev, d, dev->mtab_cpu + (size_t)row * MTAB_TEXELS * 4u);
+    if (dev->mtab_dirty_lo >= dev->mtab_dirty_hi) dev->mtab_dirty_lo = row, dev->mtab_dirty_hi = row + 1u;
+    if (row < dev->mtab_dirty_lo) dev->mtab_dirty_lo = row;
+    if (row + 1u > dev->mtab_dirty_hi) dev->mtab_dirty_hi = row + 1u;
+    return true;
+}
+
+/* Brings the table's texture up to date (bound on UNIT_MTAB); counted as one texture upload. */
+void sy_gli_mtab_upload(sy_gl_device *dev)
+{
+    const sy_gl_fns *gl = dev->gl;
+    gl->ActiveTexture(GL_TEXTURE0 + UNIT_MTAB);
+    if (!dev->mtab) {
+        gl->GenTextures(1, &dev->mtab);
+        gl->BindTexture(GL_TEXTURE_2D, dev->mtab);
+        gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    } else gl->BindTexture(GL_TEXTURE_2D, dev->mtab);
+    if (dev->mtab_rows != dev->mtab_cpu_rows) {
+        gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, (GLsizei)MTAB_TEXELS, (GLsizei)dev->mtab_cpu_rows, 0, GL_RGBA, GL_FLOAT,
+                       dev->mtab_cpu);
+        dev->mtab_rows = dev->mtab_cpu_rows;
+    } else if (dev->mtab_dirty_lo < dev->mtab_dirty_hi) {
+        gl->TexSubImage2D(GL_TEXTURE_2D, 0, 0, (GLint)dev->mtab_dirty_lo, (GLsizei)MTAB_TEXELS,
+                          (GLsizei)(dev->mtab_dirty_hi - dev->mtab_dirty_lo), GL_RGBA, GL_FLOAT,
+                          dev->mtab_cpu + (size_t)dev->mtab_dirty_lo * MTAB_TEXELS * 4u);
+    } else return;
+    dev->mtab_dirty_lo = dev->mtab_dirty_hi = 0;
+    dev->counts.texture_uploads++;
+}

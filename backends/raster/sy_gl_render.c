@@ -1,0 +1,221 @@
+/* sy_gl_render.c — a frame: scene probes (cube maps for mirror-like and glass instances) and the
+ * frame entry points sy_gl_render and sy_gl_render_floor. */
+#include "sy_gl_internal.h"
+
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Whether an instance's material is mirror-like or glass enough to need the scene around it. */
+static bool wants_probe(const mat_o *mt)
+{
+    if (!mt || mt->d.roughness > PROBE_MAX_ROUGHNESS) return false;
+    return mt->d.metallic >= 0.5f || mt->d.transmission * (1.0f - mt->d.metallic) >= 0.5f;
+}
+
+/* The probes' side for a frame of w x h: the power of two at or above half the larger side, within
+ * [PROBE_SIZE_MIN, PROBE_SIZE_MAX], and never below the side they have (see SY_GL_MAX_PROBES). */
+static uint32_t probe_size_for(const sy_gl_device *dev, uint32_t w, uint32_t h)
+{
+    uint32_t half = (w > h ? w : h) / 2u, s = PROBE_SIZE_MIN;
+    while (s < half && s < PROBE_SIZE_MAX) s *= 2u;
+    return s > dev->probe_size ? s : dev->probe_size;
+}
+
+/* Frees the probes' cube maps and depth buffer (made again at the next render_probes). */
+void sy_gli_probes_free(sy_gl_device *dev)
+{
+    const sy_gl_fns *gl = dev->gl;
+    for (uint32_t p = 0; p < SY_GL_MAX_PROBES; ++p)
+        if (dev->probes[p].cube) {
+            gl->DeleteTextures(1, &dev->probes[p].cube);
+            dev->probes[p].cube = 0;
+        }
+    if (dev->probe_fbo) gl->DeleteFramebuffers(1, &dev->probe_fbo);
+    if (dev->probe_depth) gl->DeleteRenderbuffers(1, &dev->probe_depth);
+    dev->probe_fbo = dev->probe_depth = 0;
+}
+
+/* (Re)renders the scene probes (see SY_GL_MAX_PROBES). */
+static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
+{
+    const sy_gl_fns *gl = dev->gl;
+    dev->probe_count = 0;
+    float centres[SY_GL_MAX_PROBES][3];
+    for (uint32_t i = 0; i < dev->instances.count && dev->probe_count < SY_GL_MAX_PROBES; ++i) {
+        const inst_o *in = sy_gli_pool_at(&dev->instances, i);
+        if (!in->h.id || !in->visible) continue;
+        const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
+        if (!m || !wants_probe(sy_gli_pool_get(&dev->materials, in->material.id))) continue;
+        float *c = centres[dev->probe_count];
+        for (int a = 0; a < 3; ++a) {
+            c[a] = in->model[12 + a];
+            for (int k = 0; k < 3; ++k) c[a] += in->model[4 * k + a] * 0.5f * (m->bmin[k] + m->bmax[k]);
+        }
+        dev->probes[dev->probe_count++].inst = i;
+    }
+    if (!dev->probe_count) return SY_GL_OK;
+    const GLsizei ps = (GLsizei)dev->probe_size;
+    if (!dev->probe_fbo) {
+        gl->GenFramebuffers(1, &dev->probe_fbo);
+        gl->GenRenderbuffers(1, &dev->probe_depth);
+        gl->BindRenderbuffer(GL_RENDERBUFFER, dev->probe_depth);
+        gl->RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_DEPTH_COMPONENT32F, ps, ps);
+    }
+    float sc[3], R;
+    sy_gli_scene_bounds(dev, sc, &R);
+    const tex_o *env = dev->env_ready ? sy_gli_pool_get(&dev->textures, dev->env_tex.id) : NULL;
+    sy_gli_bind_frame_resources(dev);
+    dev->in_probe_pass = true;
+    sy_gl_result r = SY_GL_OK;
+    for (uint32_t p = 0; p < dev->probe_count && r == SY_GL_OK; ++p) {
+        if (!dev->probes[p].cube) {
+            gl->GenTextures(1, &dev->probes[p].cube);
+            gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->probes[p].cube);
+            for (int f = 0; f < 6; ++f)
+                gl->TexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, 0, GL_RGBA16F, ps, ps, 0, GL_RGBA,
+                               GL_FLOAT, NULL);
+            gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+            gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+            gl->TexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+        }
+        const float *c = centres[p];
+        float dc = sqrtf((c[0] - sc[0]) * (c[0] - sc[0]) + (c[1] - sc[1]) * (c[1] - sc[1]) + (c[2] - sc[2]) * (c[2] - sc[2]));
+        double far = dc + R, nearp = fmax(1e-4 * far, 1e-5);
+        for (int f = 0; f < 6 && r == SY_GL_OK; ++f) {
+            view_setup v;
+            memset(&v, 0, sizeof v);
+            sy_gli_cube_face_view(c, f, v.view);
+            sy_gli_projection(false, -1.0, 1.0, -1.0, 1.0, nearp, far, v.proj);
+            memcpy(v.cam_pos, c, sizeof v.cam_pos);
+            memcpy(v.cam_fwd, sy_gli_cube_faces[f][2], sizeof v.cam_fwd);
+            gl->BindFramebuffer(GL_FRAMEBUFFER, dev->probe_fbo);
+            gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f,
+                                     dev->probes[p].cube, 0);
+            gl->FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, dev->probe_depth);
+            static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+            gl->DrawBuffers(2, bufs);
+            gl->Viewport(0, 0, ps, ps);
+            gl->ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+            gl->DepthMask(GL_TRUE);
+            const float black[4] = {0, 0, 0, 1}, one = 1.0f;
+            gl->ClearBufferfv(GL_COLOR, 0, black);
+            gl->ClearBufferfv(GL_DEPTH, 0, &one);
+            gl->Disable(GL_CULL_FACE);
+            gl->Disable(GL_BLEND);
+            if (env) /* rays that leave the scene see the environment (a light) */
+                sy_gli_draw_latlong(dev, &v, env, dev->env_intensity, (uint32_t)ps, (uint32_t)ps);
+            gl->Enable(GL_DEPTH_TEST);
+            gl->DepthFunc(GL_LESS);
+            dev->frame_no++; /* the variants take this face's camera */
+            r = sy_gli_draw_scene(dev, &v, dev->probes[p].inst, err, err_len);
+        }
+        gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->probes[p].cube);
+        gl->GenerateMipmap(GL_TEXTURE_CUBE_MAP);
+    }
+    dev->in_probe_pass = false;
+    dev->frame_no++;
+    if (r == SY_GL_OK) r = sy_gli_gl_check(dev, "scene probes", err, err_len);
+    return r;
+}
+
+/* What every frame starts with: the context sy_gli_current, the view, the targets, zeroed counters. */
+static sy_gl_result frame_setup(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, view_setup *v,
+                                char *err, size_t err_len)
+{
+    sy_gl_result r = sy_gli_current(dev, err, err_len);
+    if (r == SY_GL_OK) r = sy_gli_view_make(dev, cam, d, v, err, err_len);
+    if (r == SY_GL_OK) r = sy_gli_targets_ensure(dev, d->width, d->height, err, err_len);
+    dev->tris = dev->draws = 0;
+    return r;
+}
+
+sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, float *rgba,
+                          float *depth, char *err, size_t err_len)
+{
+    view_setup v;
+    sy_gl_result r = frame_setup(dev, cam, d, &v, err, err_len);
+    if (r != SY_GL_OK) return r;
+    const sy_gl_fns *gl = dev->gl;
+    dev->frame_no++;
+    static frame_state fs_zero;
+    frame_state fs = fs_zero;
+    if (dev->env_dirty) {
+        const tex_o *et = sy_gli_pool_get(&dev->textures, dev->env_tex.id);
+        dev->env_ready = false;
+        if (et) {
+            r = sy_gl_ibl_tables(gl, &dev->ibl, err, err_len);
+            if (r == SY_GL_OK)
+                r = sy_gl_ibl_prefilter(gl, &dev->ibl, et->tex, et->width, et->height, dev->env_intensity, err, err_len);
+            if (r != SY_GL_OK) return r;
+            dev->env_ready = true;
+        }
+        dev->env_dirty = false;
+        dev->probes_dirty = true;
+    }
+    if (dev->area_count && (r = sy_gl_ibl_tables(gl, &dev->ibl, err, err_len)) != SY_GL_OK) return r;
+    if (dev->lights_dirty) {
+        sy_gli_choose_lods(dev, &v); /* shadow maps draw the levels this view picks */
+        sy_gli_lights_upload(dev, &fs);
+        if ((fs.shadow_count || fs.cube_count) && !dev->shadow_tex) { /* the maps' size is known now */
+            if ((r = sy_gli_shadow_maps_make(dev, err, err_len)) != SY_GL_OK) return r;
+            fs = fs_zero;
+            sy_gli_lights_upload(dev, &fs);
+        }
+        if (fs.shadow_count || fs.cube_count) sy_gli_render_shadows(dev, &fs);
+        else dev->shadow_maps = 0;
+        dev->lights_dirty = false;
+        dev->probes_dirty = true;
+    }
+    uint32_t psize = probe_size_for(dev, d->width, d->height);
+    if (psize != dev->probe_size) { /* a larger frame than any before: sharper probes */
+        sy_gli_probes_free(dev);
+        dev->probe_size = psize;
+        dev->probes_dirty = true;
+    }
+    if (dev->probes_dirty) {
+        if ((r = render_probes(dev, err, err_len)) != SY_GL_OK) return r;
+        dev->probes_dirty = false;
+    }
+    sy_gli_begin_target(dev, &v);
+    sy_gli_bind_frame_resources(dev);
+    r = sy_gli_draw_scene(dev, &v, UINT32_MAX, err, err_len);
+    if (r == SY_GL_OK) r = sy_gli_finish_target(dev, &v, rgba, depth, err, err_len);
+    sy_gli_frame_end(dev);
+    return r;
+}
+
+sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, bool lit,
+                                float *rgba, float *depth, char *err, size_t err_len)
+{
+    view_setup v;
+    sy_gl_result r = frame_setup(dev, cam, d, &v, err, err_len);
+    if (r != SY_GL_OK) return r;
+    const sy_gl_fns *gl = dev->gl;
+    sy_gli_begin_target(dev, NULL);
+    const int k = lit ? 1 : 0;
+    gl->UseProgram(lit ? dev->prog_floor_lit : dev->prog_floor);
+    gl->UniformMatrix4fv(dev->uf[k].view, 1, GL_FALSE, v.view);
+    gl->UniformMatrix4fv(dev->uf[k].proj, 1, GL_FALSE, v.proj);
+    float vp[16], planes[6][4];
+    sy_gli_m4_mul(v.proj, v.view, vp);
+    sy_gli_frustum_planes(vp, planes);
+    for (uint32_t i = 0; i < dev->instances.count; ++i) { /* the same culling and levels as sy_gl_render */
+        inst_o *in = sy_gli_pool_at(&dev->instances, i);
+        if (!in->h.id || !in->visible) continue;
+        const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
+        if (!m) continue;
+        float c[3], scale, r = sy_gli_world_sphere(in, m, c, &scale);
+        if (sy_gli_sphere_outside(planes, c, r)) continue;
+        in->lod = sy_gli_choose_lod(dev, m, &v, c, r, scale);
+        gl->UniformMatrix4fv(dev->uf[k].model, 1, GL_FALSE, in->model);
+        dev->tris += sy_gli_draw_mesh_lod(dev, m, in->lod);
+    }
+    r = sy_gli_finish_target(dev, NULL, rgba, depth, err, err_len);
+    sy_gli_frame_end(dev);
+    return r;
+}
