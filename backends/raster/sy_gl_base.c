@@ -2,7 +2,6 @@
  * (column-major) of views, lights and shadow cameras, GL error checks and the current context. */
 #include "sy_gl_internal.h"
 
-
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>

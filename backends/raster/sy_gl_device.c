@@ -2,7 +2,6 @@
  * buffers), destroy, statistics and the window query. */
 #include "sy_gl_internal.h"
 
-
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -3,7 +3,6 @@
  * shading pass, MSAA resolve and read-back into the shared layer conventions. */
 #include "sy_gl_internal.h"
 
-
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -2,7 +2,6 @@
  * against the mesh's simplification error) and the draw of one level. */
 #include "sy_gl_internal.h"
 
-
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

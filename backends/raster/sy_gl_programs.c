@@ -3,7 +3,6 @@
  * shading programs and the material table the deferred pass reads. */
 #include "sy_gl_internal.h"
 
-
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -2,7 +2,6 @@
  * frame entry points sy_gl_render and sy_gl_render_floor. */
 #include "sy_gl_internal.h"
 
-
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

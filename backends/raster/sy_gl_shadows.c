@@ -2,7 +2,6 @@
  * (directional/spot arrays, point-light cubes, area-light maps) with their casters. */
 #include "sy_gl_internal.h"
 
-
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
