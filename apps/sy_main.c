@@ -63,7 +63,6 @@
 #include "sy_jpeg.h"
 #include "sy_log.h"
 #ifdef SY_HAVE_EMBREE
-#include "sy_mediator_rt.h" /* sy coverage */
 #endif
 #include "sy_mediators.h"
 #include "sy_png.h"
@@ -1793,15 +1792,18 @@ static int cmd_coverage(int argc, char **argv)
     sy_viewport *vp = NULL;
     sy_context *ctx = NULL;
     sy_camera_view view;
-    sy_mediator_rt_coverage_entry *e = NULL;
+    sy_coverage_entry *e = NULL;
     uint32_t n = 0;
-    sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .backend = "coverage"};
-    sy_result r = sy_window_create(w, h, &win, &err);
+    /* the first registered class that counts per-node coverage (the Embree back-ends' "coverage") */
+    const sy_mediator_class *cls = sy_mediator_with_caps(SY_CAP_COVERAGE);
+    sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .backend = cls ? cls->name : ""};
+    sy_result r = cls ? SY_OK : sy_error_set(&err, SY_ERR_UNSUPPORTED, "sy coverage: no registered back-end counts per-node coverage");
+    if (r == SY_OK) r = sy_window_create(w, h, &win, &err);
     if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, &err);
     if (r == SY_OK) r = sy_viewport_camera_view(vp, ld.scene, w, h, &view, &err);
-    if (r == SY_OK) r = sy_context_create(ld.scene, "coverage", NULL, ld.root.id, &ctx, &err);
+    if (r == SY_OK) r = sy_context_create(ld.scene, cls->name, NULL, ld.root.id, &ctx, &err);
     if (r == SY_OK) r = sy_context_sync(ctx, &err);
-    if (r == SY_OK) r = sy_mediator_rt_coverage(sy_context_state(ctx), &view, w, h, &e, &n, &err);
+    if (r == SY_OK) r = sy_context_coverage(ctx, &view, w, h, &e, &n, &err);
     cJSON *doc = NULL;
     if (r == SY_OK) {
         uint64_t covered = 0;
@@ -1866,7 +1868,8 @@ static int cmd_backends(int argc, char **argv)
     static const struct { uint32_t bit; const char *word; } caps[] = {
         {SY_CAP_DEPTH, "depth"}, {SY_CAP_PROGRESSIVE, "progressive"}, {SY_CAP_TILES, "tiles"},
         {SY_CAP_SAMPLE_RANGES, "sample-ranges"}, {SY_CAP_AOVS, "aovs"}, {SY_CAP_FILTERS, "filters"},
-        {SY_CAP_ANALYSIS, "analysis"}, {SY_CAP_REMOTE, "remote"}, {SY_CAP_PREVIEW, "preview"}};
+        {SY_CAP_ANALYSIS, "analysis"}, {SY_CAP_REMOTE, "remote"}, {SY_CAP_PREVIEW, "preview"},
+        {SY_CAP_COVERAGE, "coverage"}};
     cJSON *doc = json ? cJSON_CreateArray() : NULL;
     for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
         const sy_mediator_class *m = sy_mediator_at(i);

@@ -165,6 +165,16 @@ const char *sy_mediator_default_name(void)
     return c ? c->name : "";
 }
 
+const sy_mediator_class *sy_mediator_with_caps(uint32_t caps)
+{
+    const sy_mediator_class *found = NULL;
+    pthread_mutex_lock(&g_registry_lock);
+    for (uint32_t i = 0; i < g_registry_count && !found; ++i)
+        if ((g_registry[i]->caps & caps) == caps) found = g_registry[i];
+    pthread_mutex_unlock(&g_registry_lock);
+    return found;
+}
+
 uint32_t sy_mediator_count(void)
 {
     pthread_mutex_lock(&g_registry_lock);
@@ -407,4 +417,14 @@ void sy_context_filter_info(const sy_context *c, sy_filter_info *out)
     memset(out, 0, sizeof *out);
     snprintf(out->name, sizeof out->name, "none");
     if ((sy_context_caps(c) & SY_CAP_FILTERS) && c->cls->filter_info) c->cls->filter_info(c->state, out);
+}
+
+sy_result sy_context_coverage(sy_context *c, const sy_camera_view *view, uint32_t width, uint32_t height,
+                              sy_coverage_entry **entries_out, uint32_t *count_out, sy_error *err)
+{
+    *entries_out = NULL;
+    *count_out = 0;
+    if (!(sy_context_caps(c) & SY_CAP_COVERAGE) || !c->cls->coverage)
+        return sy_error_set(err, SY_ERR_UNSUPPORTED, "back-end %s counts no per-node coverage", c->cls->name);
+    return c->cls->coverage(c->state, view, width, height, entries_out, count_out, err);
 }

@@ -111,6 +111,8 @@ typedef enum sy_mediator_caps {
     SY_CAP_REMOTE = 1u << 7,      /**< renders on other machines (the cluster mediator) */
     SY_CAP_PREVIEW = 1u << 8,     /**< honours sy_render_request.preview: cheaper frames of lower fidelity
                                      while a view moves (fewer samples per pixel), on the same context */
+    SY_CAP_COVERAGE = 1u << 9,    /**< counts the pixels each node covers, occlusion included: sy_context_coverage
+                                     (a culling service asks it of whichever class offers it) */
 } sy_mediator_caps;
 
 /* ---- feature buffers (SY_CAP_AOVS) ---- */
@@ -144,6 +146,13 @@ typedef struct sy_filter_info {
     uint32_t last_pass_samples; /**< samples of the last filter pass (0 = none yet, or the filter runs every frame) */
     double mean_blend;          /**< mean share of the unfiltered image in the output (1 = unfiltered everywhere) */
 } sy_filter_info;
+
+/* ---- per-node coverage (SY_CAP_COVERAGE) ---- */
+/** Pixels one node covers (sy_context_coverage). */
+typedef struct sy_coverage_entry {
+    uint32_t node_id; /**< the core node (sy_node.id) whose placement covers the pixels */
+    uint32_t pixels;  /**< pixels it covers */
+} sy_coverage_entry;
 
 /** What a class's create receives. */
 typedef struct sy_mediator_create_args {
@@ -179,6 +188,9 @@ typedef struct sy_mediator_class {
      * filter now set. */
     sy_result (*set_filter)(void *state, const char *name, const sy_params *opts, sy_error *err);
     void (*filter_info)(void *state, sy_filter_info *out); /**< SY_CAP_FILTERS: the filter now set */
+    /** SY_CAP_COVERAGE: per-node pixel coverage of view at width x height (sy_context_coverage). */
+    sy_result (*coverage)(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
+                          sy_coverage_entry **entries_out, uint32_t *count_out, sy_error *err);
     const void *user; /**< handed to create as class_user (a class registered at run time: its configuration) */
     /** The parameters an instance accepts: name, type, range or values, default, help (sy_params.h;
      * SY_PARAM_TABLE(array)). Core checks every context's parameters against it before create and
@@ -209,6 +221,9 @@ const sy_mediator_class *sy_mediator_default(void);
 /** The name of sy_mediator_default's class, or "" when no class offers itself (a name no back-end
  * has, so that a lookup of it fails naming it). */
 const char *sy_mediator_default_name(void);
+/** The first registered class (registration order) whose caps hold every bit of caps, or NULL:
+ * how a program finds a back-end by what it can do (sy_mediator_with_caps(SY_CAP_COVERAGE)). */
+const sy_mediator_class *sy_mediator_with_caps(uint32_t caps);
 /** Number of registered classes. */
 uint32_t sy_mediator_count(void);
 /** The i-th registered class (i < sy_mediator_count), or NULL. */
@@ -255,6 +270,13 @@ sy_result sy_context_aovs(sy_context *c, sy_aovs *out, sy_error *err);
 sy_result sy_context_set_filter(sy_context *c, const char *name, const sy_params *opts, sy_error *err);
 /** Fills out (name "none" for a back-end without filters). */
 void sy_context_filter_info(const sy_context *c, sy_filter_info *out);
+/** Per-node pixel coverage (SY_CAP_COVERAGE; others: SY_ERR_UNSUPPORTED naming the back-end): a ray
+ * through every pixel centre of view at width x height, the nearest visible object's node counted,
+ * sorted by pixels, most first (ties: smaller node id first); nodes covering nothing are left out.
+ * Covers what the context last synced. Ownership: *entries_out is malloc()ed, the caller frees it
+ * (NULL and 0 on failure). */
+sy_result sy_context_coverage(sy_context *c, const sy_camera_view *view, uint32_t width, uint32_t height,
+                              sy_coverage_entry **entries_out, uint32_t *count_out, sy_error *err);
 
 /** A cache of contexts keyed by (scene, back-end, parameters, root): viewports showing the same
  * scene with the same back-end share one context, so the scene is converted once and switching

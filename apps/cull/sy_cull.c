@@ -1,10 +1,10 @@
 /* sy_cull.c — the remote culling service (see sy_cull.h): an index of the objects under the root
- * (rebuilt when the scene committed since), coverage on a "coverage" context, the ranking and
- * budget cut, the JSON query / answer (cJSON) and objects as GLB (sy_gltf_write). */
+ * (rebuilt when the scene committed since), coverage on a context of the back-end that offers it
+ * (SY_CAP_COVERAGE, sy_context_coverage), the ranking and budget cut, the JSON query / answer
+ * (cJSON) and objects as GLB (sy_gltf_write). */
 #include "sy_cull.h"
 
 #include "sy_gltf_write.h"
-#include "sy_mediator_rt.h"
 
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -120,12 +120,16 @@ sy_result sy_culler_create(sy_scene *scene, sy_context_pool *pool, sy_node root,
     if (!c) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cull: out of memory");
     c->scene = scene, c->root = root;
     c->max_coverage_pixels = opts && opts->max_coverage_pixels ? opts->max_coverage_pixels : (1u << 20);
+    /* the first registered class that counts per-node coverage (the Embree back-ends' "coverage") */
+    const sy_mediator_class *cls = sy_mediator_with_caps(SY_CAP_COVERAGE);
     sy_result r;
-    if (pool) {
-        r = sy_context_pool_get(pool, scene, "coverage", NULL, root.id, &c->ctx, err);
+    if (!cls) {
+        r = sy_error_set(err, SY_ERR_UNSUPPORTED, "cull: no registered back-end counts per-node coverage (SY_CAP_COVERAGE)");
+    } else if (pool) {
+        r = sy_context_pool_get(pool, scene, cls->name, NULL, root.id, &c->ctx, err);
         if (r == SY_OK) sy_context_retain(c->ctx);
     } else {
-        r = sy_context_create(scene, "coverage", NULL, root.id, &c->ctx, err);
+        r = sy_context_create(scene, cls->name, NULL, root.id, &c->ctx, err);
     }
     if (r == SY_OK) r = index_build(c, err);
     if (r != SY_OK) {
@@ -210,9 +214,9 @@ sy_result sy_culler_query(sy_culler *c, const sy_cull_view *v, uint64_t budget, 
         cw = (uint32_t)fmax(1.0, floor(cw * f)), ch = (uint32_t)fmax(1.0, floor(ch * f));
     }
     sy_camera_view cam = sy_cull_view_camera(v);
-    sy_mediator_rt_coverage_entry *e = NULL;
+    sy_coverage_entry *e = NULL;
     uint32_t n = 0;
-    if ((r = sy_mediator_rt_coverage(sy_context_state(c->ctx), &cam, cw, ch, &e, &n, err)) != SY_OK) {
+    if ((r = sy_context_coverage(c->ctx, &cam, cw, ch, &e, &n, err)) != SY_OK) {
         sy_error_prefix(err, "cull");
         return r;
     }

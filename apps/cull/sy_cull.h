@@ -1,7 +1,8 @@
 /** @file
  * sy_cull.h — the remote culling service as a library (issue 18): for a client's view and triangle
  * budget, the objects that cover the most pixels (with occlusion, as `sy coverage` counts them:
- * sy_mediator_rt_coverage on a "coverage" context), cut at the budget; and any object's geometry and
+ * sy_context_coverage on a context of the first registered back-end with SY_CAP_COVERAGE, the
+ * Embree back-ends' "coverage"), cut at the budget; and any object's geometry and
  * material as GLB (formats/sy_gltf_write.h), so a browser draws only what matters (docs/CULLING.md).
  *
  * Objects: every node under the culler's root that carries a mesh and is visible (it and its
@@ -90,8 +91,9 @@ typedef struct sy_cull_result {
     sy_bounds bounds;         /**< bounds of every object (empty when there is none) */
 } sy_cull_result;
 
-/** Creates a culler over the objects under root (a valid node) of scene, with its "coverage" context
- * from pool (NULL: a context of its own). The scene must have been committed. */
+/** Creates a culler over the objects under root (a valid node) of scene, with its coverage context
+ * (the first registered class with SY_CAP_COVERAGE) from pool (NULL: a context of its own); none
+ * registered: SY_ERR_UNSUPPORTED. The scene must have been committed. */
 sy_result sy_culler_create(sy_scene *scene, sy_context_pool *pool, sy_node root, const sy_culler_options *opts,
                            sy_culler **out, sy_error *err);
 void sy_culler_destroy(sy_culler *c); /**< NULL-safe */

@@ -511,7 +511,7 @@ static sy_result pt_slot(rt_state *st, const sy_render_request *req, sy_error *e
 }
 
 /* Coverage as an image: every object gets a stable colour from its node id (for viewing and
- * layering); sy_mediator_rt_coverage gives the numbers. */
+ * layering); rt_coverage (sy_context_coverage) gives the numbers. */
 static sy_result coverage_render(rt_state *st, const sy_rt_camera *cam, const sy_rt_render_desc *d, sy_layer *layer,
                                  sy_error *err)
 {
@@ -540,13 +540,15 @@ static sy_result coverage_render(rt_state *st, const sy_rt_camera *cam, const sy
 
 static int coverage_order(const void *pa, const void *pb)
 {
-    const sy_mediator_rt_coverage_entry *a = pa, *b = pb;
+    const sy_coverage_entry *a = pa, *b = pb;
     if (a->pixels != b->pixels) return a->pixels > b->pixels ? -1 : 1;
     return a->node_id < b->node_id ? -1 : a->node_id > b->node_id;
 }
 
-sy_result sy_mediator_rt_coverage(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
-                                  sy_mediator_rt_coverage_entry **entries_out, uint32_t *count_out, sy_error *err)
+/* SY_CAP_COVERAGE (sy_context_coverage): works on any state of this adapter; the coverage class
+ * offers it. */
+static sy_result rt_coverage(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
+                             sy_coverage_entry **entries_out, uint32_t *count_out, sy_error *err)
 {
     rt_state *st = state;
     *entries_out = NULL;
@@ -571,7 +573,7 @@ sy_result sy_mediator_rt_coverage(void *state, const sy_camera_view *view, uint3
     }
     /* count pixels per node */
     for (size_t i = 0; i < n; ++i) ids[i] = inst_node_get(st, ids[i]);
-    sy_mediator_rt_coverage_entry *out = NULL;
+    sy_coverage_entry *out = NULL;
     uint32_t m = 0, cap = 0;
     for (size_t i = 0; i < n; ++i) {
         if (!ids[i]) continue;
@@ -581,7 +583,7 @@ sy_result sy_mediator_rt_coverage(void *state, const sy_camera_view *view, uint3
         if (k == m) {
             if (m == cap) {
                 uint32_t nc = cap ? cap * 2 : 64;
-                sy_mediator_rt_coverage_entry *no = realloc(out, sizeof *no * nc);
+                sy_coverage_entry *no = realloc(out, sizeof *no * nc);
                 if (!no) {
                     free(out);
                     free(ids);
@@ -596,7 +598,7 @@ sy_result sy_mediator_rt_coverage(void *state, const sy_camera_view *view, uint3
         }
         out[k].pixels++;
         if (k > 0) { /* move to front */
-            sy_mediator_rt_coverage_entry t = out[k];
+            sy_coverage_entry t = out[k];
             out[k] = out[0];
             out[0] = t;
         }
@@ -1295,12 +1297,13 @@ static sy_result coverage_create(const sy_mediator_create_args *args, void **sta
 static const sy_mediator_class coverage_class = {
     .name = "coverage",
     .param_table = SY_PARAM_TABLE(coverage_params),
-    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_ANALYSIS,
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_ANALYSIS | SY_CAP_COVERAGE,
     .create = coverage_create,
     .destroy = rt_destroy,
     .sync = rt_sync,
     .render = rt_render,
     .stats = rt_stats,
+    .coverage = rt_coverage,
 };
 
 const sy_mediator_class *sy_mediator_rt_coverage_class(void) { return &coverage_class; }

@@ -40,21 +40,12 @@ extern "C" {
 sy_result sy_mediator_rt_register(sy_error *err);
 /** The Whitted ray tracer class ("whitted"). Static storage. */
 const sy_mediator_class *sy_mediator_rt_whitted_class(void);
-/** The coverage class ("coverage"): no shading; the layer shows every visible object in a stable
- * colour derived from its node id (alpha 1 where covered) with depth. A culling service: which
- * objects a camera sees and how many pixels each covers, with occlusion. */
+/** The coverage class ("coverage"; caps DEPTH | TILES | ANALYSIS | COVERAGE): no shading; the layer
+ * shows every visible object in a stable colour derived from its node id (alpha 1 where covered)
+ * with depth. A culling service: which objects a camera sees and how many pixels each covers, with
+ * occlusion (sy_context_coverage, SY_CAP_COVERAGE in core/sy_mediator.h). */
 const sy_mediator_class *sy_mediator_rt_coverage_class(void);
 
-/** Pixels one node covers (sy_mediator_rt_coverage). */
-typedef struct sy_mediator_rt_coverage_entry {
-    uint32_t node_id; /**< the core node whose placement covers the pixels */
-    uint32_t pixels; /**< pixels it covers */
-} sy_mediator_rt_coverage_entry;
-/** Per-node pixel coverage (ray through every pixel centre, nearest visible object) for the view
- * at width x height, sorted by pixels, most first. Works on any context of this adapter (whitted,
- * pathtracer, coverage). Ownership: *entries_out is malloc()ed, the caller frees it. */
-sy_result sy_mediator_rt_coverage(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
-                                  sy_mediator_rt_coverage_entry **entries_out, uint32_t *count_out, sy_error *err);
 /** The progressive path tracer class ("pathtracer"; caps PROGRESSIVE | DEPTH | TILES) on the same
  * adapter. Each render adds req->sample_count samples per pixel (0 = 1) to an accumulation kept per
  * distinct request (camera view, image size, rectangle, background, seed; up to 4 at once, least

@@ -1,5 +1,6 @@
 /* test_cull.c — the remote culling service (apps/cull/sy_cull.h): ranking by covered pixels,
- * occlusion, the budget cut, the JSON answer, bad queries naming their field, unknown ids; the GLB
+ * occlusion, the budget cut, the JSON answer, bad queries naming their field, unknown ids; the
+ * coverage capability it asks (sy_context_coverage); the GLB
  * writer (formats/sy_gltf_write.h) round trip through sy_gltf_load; the generated plant's counts. */
 #include "../support/check_count.h"
 #include "sy_cull.h"
@@ -171,6 +172,30 @@ static void test_boxes(void)
           "reduced grid: same head, fewer pixels");
     sy_cull_result_free(&res);
     sy_culler_destroy(small);
+
+    /* the capability the culler asks (SY_CAP_COVERAGE, sy_context_coverage): a class offers it and
+     * counts what the culler ranks; a class without it refuses, naming itself */
+    const sy_mediator_class *cov = sy_mediator_with_caps(SY_CAP_COVERAGE);
+    CHECK(cov && cov->coverage, "a registered class offers SY_CAP_COVERAGE");
+    sy_camera_view cam = sy_cull_view_camera(&v);
+    sy_coverage_entry *ce = NULL;
+    uint32_t cn = 0;
+    sy_context *ctx;
+    if (cov) {
+        MUST(sy_context_create(s, cov->name, NULL, root.id, &ctx, &err));
+        MUST(sy_context_sync(ctx, &err));
+        MUST(sy_context_coverage(ctx, &cam, v.width, v.height, &ce, &cn, &err));
+        CHECK(cn == 3 && ce[0].node_id == full.objects[0].id && ce[0].pixels == full.objects[0].pixels,
+              "sy_context_coverage: %u nodes, the culler's head first", cn);
+        free(ce);
+        sy_context_release(ctx);
+    }
+    MUST(sy_context_create(s, "whitted", NULL, root.id, &ctx, &err));
+    sy_error ue = {0};
+    ce = (sy_coverage_entry *)&ue, cn = 7;
+    CHECK(sy_context_coverage(ctx, &cam, v.width, v.height, &ce, &cn, &ue) == SY_ERR_UNSUPPORTED && !ce && cn == 0 &&
+              strstr(ue.message, "whitted"), "whitted counts no coverage: %s", ue.message);
+    sy_context_release(ctx);
 
     /* a hidden node (visibility flag) is no object; the index follows commits */
     MUST(sy_node_set_flags(s, side, 0, &err));
