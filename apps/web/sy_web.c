@@ -864,7 +864,7 @@ typedef struct render_state {
     sy_mat4 cam_applied;
     bool cam_valid;
     uint32_t backend_applied;
-    void *filter_state;
+    const sy_context *filter_ctx; /* the pool context the filter was last set on (borrowed) */
     uint64_t filter_applied;
     bool filter_enabled;
     uint64_t seq;
@@ -942,8 +942,7 @@ static void apply_filter(sy_web *w, render_state *rs, const sy_mediator_class *c
         snprintf(status, len, "filter: %.200s", err.message);
         return;
     }
-    void *state = sy_context_state(ctx);
-    if (state == rs->filter_state && version == rs->filter_applied && enabled == rs->filter_enabled) return;
+    if (ctx == rs->filter_ctx && version == rs->filter_applied && enabled == rs->filter_enabled) return;
     sy_params opts = {0};
     char t[32];
     snprintf(t, sizeof t, "%g", (double)threshold);
@@ -952,7 +951,7 @@ static void apply_filter(sy_web *w, render_state *rs, const sy_mediator_class *c
         snprintf(status, len, "filter: %.200s", err.message);
         return;
     }
-    rs->filter_state = state;
+    rs->filter_ctx = ctx;
     rs->filter_applied = version;
     rs->filter_enabled = enabled; /* the governor keeps the filter off while the view moves */
 }
