@@ -7,4 +7,4 @@ cd "$(dirname "$0")"
 . .ci/deps.sh
 sy_install_deps
 sy_configure_build build-release sy -- -DCMAKE_BUILD_TYPE=Release
-./build-release/apps/sy demo "$@"
+./build-release/apps/sy/sy demo "$@"

@@ -72,7 +72,7 @@ sy_result sy_path_confine(const char *model, const char *uri, const char *path, 
 
 /** Removes every temporary file that an unfinished sy_atomic_file of this process holds, and makes
  * every later sy_atomic_file_begin and sy_atomic_file_commit fail ("output was cancelled"): for a
- * process that is about to end on SIGINT / SIGTERM (apps/sy_signals.c calls it from its
+ * process that is about to end on SIGINT / SIGTERM (apps/sy/sy_signals.c calls it from its
  * signal-waiting thread). A commit that already renamed its file is finished and stays. Returns
  * the number of files removed. Thread-safe (one lock shared with begin / commit / abort); it takes
  * a lock, so it is not for use inside an asynchronous signal handler. There is no way back: the
@@ -84,7 +84,7 @@ size_t sy_atomic_file_cancel_all(void);
 typedef void (*sy_atomic_file_hook)(const char *path, const char *tmp_path);
 
 /** Test support: sets the commit hook (NULL: none, the default). The sy tool sets one only when a
- * test asks it to stop at that point (SY_TEST_PAUSE=commit, apps/sy_testpoint.h), so that a test can
+ * test asks it to stop at that point (SY_TEST_PAUSE=commit, apps/sy/sy_testpoint.h), so that a test can
  * interrupt a write in progress without racing it. Process-wide; thread-safe (an atomic pointer),
  * but meant to be set once before any output begins. */
 void sy_atomic_file_set_commit_hook(sy_atomic_file_hook hook);

@@ -20,7 +20,7 @@ if ! command -v blender >/dev/null 2>&1; then
 fi
 [ -f "$gltf" ] || { echo "cornell_direct.sh: skipped: $gltf is absent"; exit 0; }
 mkdir -p "$out"
-sy=$build/apps/sy
+sy=$build/apps/sy/sy
 "$sy" render "$gltf" -b raster -w 256 -h 256 -o "$out/raster_direct.exr" --params indirect=0
 "$sy" render "$gltf" -b whitted -w 256 -h 256 -o "$out/whitted_direct.exr" --params max_depth=1
 "$sy" render "$gltf" -b pathtracer -w 256 -h 256 -o "$out/pathtracer_direct.exr" --spp 256 --filter none \

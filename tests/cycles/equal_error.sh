@@ -30,7 +30,7 @@ if ! command -v blender >/dev/null 2>&1; then
     exit 0
 fi
 [ -f "$gltf" ] && [ -f "$ref" ] || { echo "equal_error.sh: skipped: $data is absent"; exit 0; }
-sy=$build/apps/sy
+sy=$build/apps/sy/sy
 err=$build/tests/exr_error
 for tool in "$sy" "$err"; do
     [ -x "$tool" ] || { echo "equal_error.sh: error: $tool is missing (build first: cmake --build $build)" >&2; exit 1; }

@@ -146,7 +146,7 @@ run badmissing "$SY" render demo -b whitted -o "$TMP/x.png" -w
 run badword "$SY" render demo -b whitted -o "$TMP/x.png" --tonemap=bogus
 [ "$rc" -eq 2 ] && grep -q -- "--tonemap: 'bogus'" "$TMP/badword.err" || fail "a bad --tonemap: status $rc, $(cat "$TMP/badword.err")"
 # long options are matched exactly (issue 32): an abbreviation is a usage error naming the options it
-# begins, in every command (sy_getopt, apps/sy_options.c); getopt_long took "--frame 10" for --frames
+# begins, in every command (sy_getopt, apps/sy/sy_options.c); getopt_long took "--frame 10" for --frames
 mkdir -p "$TMP/o_abbrev"
 run abbrev "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_abbrev/x.png" --frame 10
 [ "$rc" -eq 2 ] && grep -q -- "unknown option '--frame': long options are not abbreviated; the option that begins so is: --frames" \
@@ -280,7 +280,7 @@ expect_error nodir "$TMP/o_nodir/missing_dir/x.png" "$TMP/o_nodir" env SY_TEST_P
 grep -q "missing_dir/x.png" "$TMP/nodir.err" && ! grep -qx tiles "$TMP/o_nodir.phases" 2>/dev/null ||
     fail "output in a missing directory: found only after rendering (phases: $(cat "$TMP/o_nodir.phases" 2>/dev/null))"
 # an output folder sy may not write to is refused before anything is rendered (it was found only
-# after the render); the phases sy announces (SY_TEST_PHASES, apps/sy_testpoint.h) show no tile
+# after the render); the phases sy announces (SY_TEST_PHASES, apps/sy/sy_testpoint.h) show no tile
 # rendered. As root every folder is writable, so sy runs as nobody there (setpriv).
 mkdir -p "$TMP/o_ro" "$TMP/ro_phases"
 chmod 555 "$TMP/o_ro"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # completion_test.sh SY COMPLETION_SCRIPT TMPDIR — integration_completion: sources
-# apps/sy-completion.bash in bash and asks it for completions as bash would (COMP_WORDS /
+# apps/sy/sy-completion.bash in bash and asks it for completions as bash would (COMP_WORDS /
 # COMP_CWORD, then _sy_complete): commands, bench kinds, a command's options (also after an option
 # of sy's own), option values from a list, back-end names from `SY backends`, scene file names
 # (only .gltf / .glb / .x3d, directories and "demo"), and any file after -o.

@@ -7,7 +7,7 @@
 #  3. one interrupt while a single-pass back-end writes: the same;
 #  4. an interrupt during a single-pass render: no file at all.
 # No step sleeps or depends on how fast sy runs (issue 32): sy announces the phase it is in
-# (SY_TEST_PHASES, apps/sy_testpoint.h) and the test polls for it; where the interrupt must land in
+# (SY_TEST_PHASES, apps/sy/sy_testpoint.h) and the test polls for it; where the interrupt must land in
 # a phase, sy stops there until the signal comes (SY_TEST_PAUSE).
 set -u
 set -m # job control: background jobs keep SIGINT (a script's background jobs otherwise ignore it)

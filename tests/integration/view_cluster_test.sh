@@ -60,7 +60,7 @@ grep -q "sy view | whitted" "$W/local.out" || fail "the local viewer did not fin
 
 # 2. cooperative path tracing; server b is killed once the viewer has rendered with both
 rm -f "$W/coop.fifo"
-mkfifo "$W/coop.fifo" && exec 3<>"$W/coop.fifo" # the viewer's announced phases (apps/sy_testpoint.h)
+mkfifo "$W/coop.fifo" && exec 3<>"$W/coop.fifo" # the viewer's announced phases (apps/sy/sy_testpoint.h)
 SY_TEST_PHASES="$W/coop.fifo" "${XVFB[@]}" "$SY" view demo -b pathtracer -w 64 -h 48 --frames 120 --cluster "$URLS" --cluster-mode cooperative \
     --secret-file "$W/secret" --screenshot "$W/coop.png" >"$W/coop.out" 2>"$W/coop.err" &
 viewer=$!

@@ -23,7 +23,7 @@ for s in "${scenes[@]}"; do
     path=$s
     [ "$s" = demo ] || path=$data/$s
     name=$(basename "${s%.*}")
-    table=$("$build/apps/sy" compare "$path" -w "$w" -h "$h" --spp "$spp" -o "$out/$name.png" 2>/dev/null)
+    table=$("$build/apps/sy/sy" compare "$path" -w "$w" -h "$h" --spp "$spp" -o "$out/$name.png" 2>/dev/null)
     if [ $? -ne 0 ]; then
         printf '%-58s %s\n' "$s" "FAILED (sy compare exit status non-zero)"
         continue

@@ -1,13 +1,13 @@
 # sy-completion.bash — bash completion for `sy` (Switchyard's command line tool).
 #
-# Use: `source apps/sy-completion.bash` (or copy it to bash-completion's directory,
+# Use: `source apps/sy/sy-completion.bash` (or copy it to bash-completion's directory,
 # $(pkg-config --variable=completionsdir bash-completion)/sy). It completes the commands, the
 # options of each command (the options every command takes included), the values of options that
 # take a word from a list (--tonemap, --stereo, ...), back-end names after -b (asked of the `sy`
 # being completed: `sy backends`), and file names: scenes (.gltf, .glb, .x3d; and the word "demo")
 # where a SCENE is expected, any file after options that take a path. Needs bash 4; does not need
-# the bash-completion package. Keep the lists in step with apps/sy_main.c (usage_text) and
-# apps/sy_cluster_cli.c; tests/integration/completion_test.sh checks a few.
+# the bash-completion package. Keep the lists in step with apps/sy/sy_main.c (usage_text) and
+# apps/sy/sy_cluster_cli.c; tests/integration/completion_test.sh checks a few.
 
 _sy_commands="info render demo compare coverage view web bench backends serve help version"
 _sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit cull web"

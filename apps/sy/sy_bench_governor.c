@@ -6,6 +6,7 @@
 #include "sy_compose.h"
 #include "sy_demo.h"
 #include "sy_governor.h"
+#include "sy_height_field.h"
 #include "sy_orbit.h"
 #include "sy_gltf.h"
 #include "sy_sniff.h"
@@ -300,7 +301,7 @@ int sy_cmd_bench_governor(int argc, char **argv)
         } else {
             gs.label = "generated height field";
             sy_node hf;
-            r = sy_bench_height_field(gs.scene, tris, &hf, &gs.tris, &err);
+            r = sy_height_field_generate(gs.scene, tris, &hf, &gs.tris, &err);
         }
         if (r == SY_OK) r = gov_add_camera(&gs, &err);
         if (r == SY_OK) r = gov_scene_run(&gs, &o, &err);

@@ -21,7 +21,7 @@
  *   sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   peak RSS per triangle (sy_bench.h)
  *   sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]
  *   sy backends [--params] [--json]     list registered back-ends (--params: their parameters)
- *   sy serve [--listen URL] [--secret-file F] [--output OUT]   render server (apps/sy_cluster_cli.c)
+ *   sy serve [--listen URL] [--secret-file F] [--output OUT]   render server (apps/sy/sy_cluster_cli.c)
  *   sy render ... --cluster URL[,URL...]|FILE.conf [--cluster-mode MODE]   render on servers
  *   sy view ... --cluster URL[,URL...]|FILE.conf [--cluster-mode MODE]     the viewer on servers
  *   sy bench cluster [-w W] [-h H] [--repeats ROUNDS]
@@ -32,7 +32,7 @@
  * -q / -v and the world and loader flags are accepted before and after the command. JSON output is
  * written with cJSON. Warnings, notes and errors go to stderr through the library's log (sy_log.h) with
  * the file and the reason. Exit status: 0 success, 1 failure, 2 usage error (the bad option or value
- * is named), 130 interrupted. Bash completion: apps/sy-completion.bash. */
+ * is named), 130 interrupted. Bash completion: apps/sy/sy-completion.bash. */
 #include "sy_bench.h"
 #include "sy_bench_governor.h"
 #ifdef SY_HAVE_EMBREE
@@ -772,7 +772,7 @@ static const char usage_text[] =
             "  images and placements together; default an eighth of the physical memory)\n"
             "exit status: 0 success, 1 failure (the error names the file, peer or value), 2 usage error,\n"
             "  130 interrupted\n"
-            "bash completion: source apps/sy-completion.bash\n";
+            "bash completion: source apps/sy/sy-completion.bash\n";
 
 /* The summary (cmd NULL) or the entries of one command ("render", "bench", "bench sync") and the
  * common part. */
@@ -2001,8 +2001,8 @@ static int cmd_bench(int argc, char **argv)
     if (!strcmp(cmd, "filters")) return cmd_bench_filters(argc, argv);
     if (!strcmp(cmd, "cluster")) return sy_cmd_bench_cluster(argc, argv);
     if (!strcmp(cmd, "governor")) return sy_cmd_bench_governor(argc, argv); /* sy_bench_governor.c */
-    if (!strcmp(cmd, "limit")) return sy_cmd_bench_limit(argc, argv); /* apps/sy_bench_limit.c */
-    if (!strcmp(cmd, "cull")) return SY_BENCH_CULL(argc, argv); /* apps/sy_bench_cull.c */
+    if (!strcmp(cmd, "limit")) return sy_cmd_bench_limit(argc, argv); /* apps/sy/sy_bench_limit.c */
+    if (!strcmp(cmd, "cull")) return SY_BENCH_CULL(argc, argv); /* apps/sy/sy_bench_cull.c */
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
     const char *scene = NULL, *params = NULL, *backend = NULL;
     bool memory = !strcmp(cmd, "memory"), instanced = !strcmp(cmd, "instances"), web = !strcmp(cmd, "web");
@@ -2071,7 +2071,7 @@ static int cmd_bench(int argc, char **argv)
         return sy_bench_load(scene ? scene : "../shared/testdata/gltf", tris == 100 ? 1000000 : tris,
                              repeats ? repeats : 3, &err) == SY_OK ? 0 : fail(&err);
 #ifdef SY_HAVE_WEB
-    if (web) { /* input-to-frame latency of sy web on loopback (apps/sy_bench_web.c) */
+    if (web) { /* input-to-frame latency of sy web on loopback (apps/sy/sy_bench_web.c) */
         loaded ld;
         if (load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return fail(&err);
         sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,

@@ -4,6 +4,7 @@
  * culling), peak memory, and the coverage of each back-end against Whitted's (IoU). */
 #include "sy_bench.h"
 
+#include "sy_height_field.h"
 #include "sy_log.h"
 #include "sy_orbit.h"
 #include "sy_stats.h"
@@ -31,13 +32,13 @@ static int cmp_d(const void *a, const void *b)
 }
 
 /* The scene: `instances` nodes on a square grid under one root, each instancing the same height
- * field of about `tris` triangles (1 x 1 m, sy_bench_height_field), turned about Y; a camera node
+ * field of about `tris` triangles (1 x 1 m, sy_height_field_generate), turned about Y; a camera node
  * (its matrix set per frame). */
 static sy_result build(sy_scene *s, uint32_t instances, uint32_t tris, sy_node *root, sy_node *cam, float *extent,
                        uint32_t *tris_out, sy_error *err)
 {
     sy_node first;
-    sy_result r = sy_bench_height_field(s, tris, &first, tris_out, err);
+    sy_result r = sy_height_field_generate(s, tris, &first, tris_out, err);
     if (r != SY_OK) return r;
     sy_mesh mesh = sy_node_get(s, first)->mesh;
     uint32_t side = (uint32_t)ceil(sqrt((double)instances));

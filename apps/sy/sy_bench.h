@@ -37,14 +37,11 @@ sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const cha
 sy_result sy_bench_load(const char *data_dir, uint32_t tris, uint32_t repeats, sy_error *err);
 
 /* Memory (issue 19): for each ray tracer (backend, or whitted and pathtracer when NULL), a forked
- * child builds a height field of about `tris` unique triangles (sy_bench_height_field; with glb,
+ * child builds a height field of about `tris` unique triangles (sy_height_field_generate, apps/scenes; with glb,
  * the same grid written to a temporary .glb first and loaded by sy_gltf_load) through the normal
  * path (scene blobs -> mediator -> back-end), renders one width x height frame, and reports its
  * peak RSS per triangle with the breakdown: scene, back-end copies, Embree's allocations. */
 sy_result sy_bench_memory(uint32_t tris, const char *backend, bool glb, uint32_t width, uint32_t height, sy_error *err);
-/* Adds a generated height field of about tris unique triangles (one mesh, one node: *node_out) to s;
- * *tris_out receives the exact count. */
-sy_result sy_bench_height_field(sy_scene *s, uint32_t tris, sy_node *node_out, uint32_t *tris_out, sy_error *err);
 
 /* Path tracer (issue 3): samples per second (1-spp passes over width x height, median and mean of
  * `passes`), Mrays/s (closest-hit + shadow rays) and the Whitted back-end's frame time on the same
@@ -76,7 +73,7 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
  * (NULL = all): that back-end alone (Whitted still renders its first frame for the IoU). */
 sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, uint32_t height, uint32_t frames,
                              const char *only, sy_error *err);
-/* Distance to the limit (issue 19, part 6; apps/sy_bench_limit.c): one path-traced frame of the
+/* Distance to the limit (issue 19, part 6; apps/sy/sy_bench_limit.c): one path-traced frame of the
  * view in vd (spp samples per pixel, width x height) is recorded ray by ray, then the frame and raw
  * Embree on exactly those rays (rtcIntersect1/rtcOccluded1, the 4/8/16-wide packets, the 1M
  * streams; the back-end's threads) are timed `repeats` times, interleaved; prints the path

@@ -6,7 +6,7 @@
  *   SY_TEST_PHASES=FILE   each phase sy reaches is appended to FILE as one line (its name), so a
  *                         test polls FILE for the line it waits for;
  *   SY_TEST_PAUSE=PHASE   on reaching PHASE (after announcing it) the thread that reached it stops
- *                         there until a signal ends the process (apps/sy_signals.h), so a test's
+ *                         there until a signal ends the process (apps/sy/sy_signals.h), so a test's
  *                         interrupt lands in that phase and nowhere else. A hang guard lets it go
  *                         on after SY_TEST_PAUSE_SECONDS (default 120), with a message on stderr.
  * The phases:
