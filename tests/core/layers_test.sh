@@ -7,6 +7,13 @@
 #      files of each archive, from nm, sort topologically with tsort), so each layer reads bottom-up.
 #   3. apps/ never decides behaviour by a back-end's name: no string comparison against a
 #      registered back-end name (capabilities are asked instead, sy_mediator.h).
+#   5. apps/ shows its plan: one folder per thing, nothing loose at its root but CMakeLists.txt and
+#      README.md, and the README names every folder.
+#   6. No library under apps/ (a folder whose CMakeLists.txt has add_library: web, cull, scenes)
+#      reaches into one mediator: no header of a mediators/NAME/ folder (sy_mediator_rt.h, ...),
+#      no sy_mediator_NAME_* call, no sy_context_state (a mediator's own state); they ask the
+#      typed capabilities of core/sy_mediator.h (sy_context_coverage, ...). Programs (apps/sy)
+#      may use a mediator's diagnostics.
 # Usage: layers_test.sh SOURCE_DIR LIBSY_CORE [MORE_LIBRARIES ...]   (archives, or shared objects:
 # then 4 is left to the static build)
 set -u
@@ -51,6 +58,33 @@ for n in $names; do
     [ -z "$hits" ] || { bad "apps/ compares against the back-end name $n:"; echo "$hits"; }
 done
 [ $fail = 0 ] && echo "ok: apps/ compares no back-end name ($(echo $names | tr '\n' ' '))"
+# 5. apps/: one folder per thing
+loose=$(find "$SRC/apps" -mindepth 1 -maxdepth 1 ! -type d ! -name CMakeLists.txt ! -name README.md -printf '%f\n' | sort)
+[ -z "$loose" ] || bad "apps/ has files loose at its root (one folder per thing, apps/README.md): $(echo $loose)"
+folders=$(find "$SRC/apps" -mindepth 1 -maxdepth 1 -type d -printf '%f\n' | sort)
+[ -n "$folders" ] || bad "apps/ has no folder (the check would see nothing)"
+for d in $folders; do
+    grep -qF "\`$d/\`" "$SRC/apps/README.md" 2>/dev/null || bad "apps/README.md does not name the folder $d/"
+done
+[ -z "$loose" ] && [ -f "$SRC/apps/README.md" ] && echo "ok: apps/ holds only folders ($(echo $folders)), CMakeLists.txt and README.md"
+# 6. no library under apps/ reaches into one mediator
+med_dirs=$(find "$SRC/mediators" -mindepth 1 -maxdepth 1 -type d -printf '%f\n' | sort)
+med_headers=$(for m in $med_dirs; do ls "$SRC/mediators/$m"/*.h 2>/dev/null; done | xargs -n1 basename 2>/dev/null | sort -u)
+app_libs=$(grep -l 'add_library' "$SRC"/apps/*/CMakeLists.txt 2>/dev/null | xargs -n1 dirname 2>/dev/null)
+[ -n "$med_headers" ] && [ -n "$app_libs" ] || bad "found no mediator header or no library under apps/ (the check would see nothing)"
+reach=0
+for lib in $app_libs; do
+    while IFS=: read -r file line inc; do
+        h=$(sed -E 's/.*#include "([^"]+)".*/\1/' <<<"$inc")
+        if grep -qxF "$(basename "$h")" <<<"$med_headers"; then
+            bad "${file#$SRC/}:$line includes \"$h\", one mediator's header (ask a capability, core/sy_mediator.h)"
+            reach=1
+        fi
+    done < <(grep -rn '#include "' "$lib" --include=*.c --include=*.h)
+    hits=$(grep -rnE "\bsy_mediator_($(echo $med_dirs | tr ' ' '|'))_[a-z0-9_]*[ ]*\(|\bsy_context_state[ ]*\(" "$lib" --include=*.c --include=*.h)
+    [ -z "$hits" ] || { bad "a library under apps/ reaches into one mediator's state:"; echo "${hits//$SRC\//}"; reach=1; }
+done
+[ $reach = 0 ] && echo "ok: the libraries under apps/ ($(echo $(for l in $app_libs; do basename "$l"; done))) use no mediator's own header, call or state"
 # 4. module call graph per archive: member -> member that defines a symbol it uses
 for lib in "$CORE_LIB" "${MORE_LIBS[@]}"; do
     [ -f "$lib" ] || { bad "library $lib not found"; continue; }
