@@ -9,7 +9,7 @@
 #ifndef SY_TEST_SERVER_PROC_H
 #define SY_TEST_SERVER_PROC_H
 
-#include "../core/check.h"
+#include "../support/sy_check.h"
 
 #include <fcntl.h>
 #include <signal.h>

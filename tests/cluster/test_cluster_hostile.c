@@ -36,7 +36,7 @@
  * server (that is how their failures there were shown; cap, ceiling, lockout and camera need
  * protocol 3). Every wait is bounded; servers stop with SIGTERM (SIGKILL after 5 s) and
  * --max-lifetime. */
-#include "../core/check.h"
+#include "../support/sy_check.h"
 #include "raw_peer.h"
 #include "server_proc.h"
 #include "sy_cluster.h"

@@ -15,7 +15,7 @@
  *   5. Set-up refusals name the node and the reason: cooperative whitted, mode=stereo, no
  *      backend=, an unknown mode.
  *   test_cluster_mediator SERVER_EXE WORK_DIR */
-#include "../core/check.h"
+#include "../support/sy_check.h"
 #include "server_proc.h"
 #include "sy_demo.h"
 #include "sy_mediator_cluster.h"

@@ -15,7 +15,7 @@
  *   test_cluster_net SERVER_EXE WORK_DIR
  * Every server is started with --max-lifetime and stopped with SIGTERM (SIGKILL after 5 s), and
  * every wait is bounded, so nothing outlives the test. */
-#include "../core/check.h"
+#include "../support/sy_check.h"
 #include "coop_double.h"
 #include "raw_peer.h"
 #include "server_proc.h"

@@ -3,7 +3,7 @@
  * lie, out-of-range fields, and a few thousand random mutations of valid frames (the decoder must
  * reject or accept cleanly, never crash, and whatever it accepts must be in range). Runs in every
  * build (the libFuzzer target in fuzz_cluster_decode.c covers the same decoder under SY_FUZZ). */
-#include "../core/check.h"
+#include "../support/sy_check.h"
 #include "sy_cluster.h"
 
 #include <math.h>
@@ -804,16 +804,13 @@ static int seeds(const char *dir, bool write)
 int main(int argc, char **argv)
 {
     if (argc == 3 && !strcmp(argv[1], "--write-seeds")) return seeds(argv[2], true);
-    int failed = 0;
-    if (argc == 2) failed += seeds(argv[1], false);
-    failed += test_round_trip();
-    failed += test_bad_headers();
-    failed += test_framing();
-    failed += test_mutations();
-    failed += test_tile_codec();
-    failed += test_half();
-    failed += test_half_tile();
-    if (failed) fprintf(stderr, "test_cluster_proto: %d test(s) failed\n", failed);
-    else printf("test_cluster_proto: all passed\n");
-    return failed ? 1 : 0;
+    if (argc == 2) EXPECT(seeds(argv[1], false) == 0);
+    RUN(test_round_trip);
+    RUN(test_bad_headers);
+    RUN(test_framing);
+    RUN(test_mutations);
+    RUN(test_tile_codec);
+    RUN(test_half);
+    RUN(test_half_tile);
+    return sy_check_finish("test_cluster_proto");
 }

@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_blob.h"
 
 static int test_hash(void)
@@ -130,9 +130,8 @@ static int test_store(void)
 
 int main(void)
 {
-    int failures = 0;
     RUN(test_hash);
     RUN(test_refcount_take);
     RUN(test_store);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_blob");
 }

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_changes.h"
 #include "sy_fields.h" /* internal to core: generic field compare for deep equality of entries */
 
@@ -1139,7 +1139,6 @@ static int test_decoder_fuzz(void)
 
 int main(void)
 {
-    int failures = 0;
     RUN(test_commit_entries);
     RUN(test_two_consumers);
     RUN(test_late_consumers);
@@ -1148,5 +1147,5 @@ int main(void)
     RUN(test_blob_once);
     RUN(test_decoder_errors);
     RUN(test_decoder_fuzz);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_changes");
 }

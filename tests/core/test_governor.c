@@ -4,7 +4,7 @@
  * scale to its minimum, a still view grows back to full size and refines by samples within the
  * budget up to max_samples then idles, sizes never exceed the display (1x1 .. 2^32-1 squared, 0),
  * a back-end switch (reset) re-learns, redraw and invalid settings. No real time is measured. */
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_governor.h"
 #include "sy_mediator.h"
 
@@ -356,7 +356,6 @@ static int test_stall(void)
  * quality; a back-end without the cap always gets full quality. */
 static int test_preview(void)
 {
-    int failures = 0;
     sy_error e = {0};
     for (int with = 0; with < 2; ++with) {
         sy_governor *g = NULL;
@@ -383,12 +382,11 @@ static int test_preview(void)
         CHECK(saw_moving && saw_still);
         sy_governor_destroy(g);
     }
-    return failures;
+    return 0;
 }
 
 int main(void)
 {
-    int failures = 0;
     RUN(test_settings);
     RUN(test_converges);
     RUN(test_fixed_over_budget);
@@ -398,5 +396,5 @@ int main(void)
     RUN(test_switch);
     RUN(test_stall);
     RUN(test_preview);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_governor");
 }

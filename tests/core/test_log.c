@@ -3,7 +3,7 @@
  * "sy: LEVEL: [item: ]message" on stderr; long messages arrive whole; calls from several threads
  * are serialised (a plain counter in the callback stays exact); sy_log inside the callback does not
  * deadlock. */
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_log.h"
 
 #include <pthread.h>
@@ -151,10 +151,9 @@ static int test_threads(void)
 
 int main(void)
 {
-    int failures = 0;
     RUN(test_callback_fields);
     RUN(test_level_filter);
     RUN(test_default_stderr);
     RUN(test_threads);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_log");
 }

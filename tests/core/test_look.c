@@ -1,7 +1,7 @@
 /* test_look.c — the scene-look rules of core/sy_look.h (which lighting and background a view gets),
  * the built-in studio environment, X3D gradients, the lat-long convention, the world fields'
  * validation in the scene, and layer statistics (core/sy_stats.h). */
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_look.h"
 #include "sy_scene.h"
 #include "sy_stats.h"
@@ -216,12 +216,11 @@ static int test_stats(void)
 
 int main(void)
 {
-    int failures = 0;
     RUN(test_resolve);
     RUN(test_latlong);
     RUN(test_studio);
     RUN(test_gradient);
     RUN(test_world_fields);
     RUN(test_stats);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_look");
 }

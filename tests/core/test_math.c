@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_math.h"
 
 #define EPS 1e-6
@@ -196,11 +196,10 @@ static int test_bounds(void)
 
 int main(void)
 {
-    int failures = 0;
     RUN(test_identity_and_mul);
     RUN(test_trs);
     RUN(test_invert);
     RUN(test_finite_equal);
     RUN(test_bounds);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_math");
 }

@@ -1,6 +1,6 @@
 /* test_orbit.c — the orbit camera (core/sy_orbit.h): matrix for hand-checked poses, the round trip
  * matrix -> orbit -> matrix, drag / pan / zoom rules and their limits. */
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_orbit.h"
 
 #include <math.h>
@@ -87,9 +87,8 @@ static int test_input(void)
 
 int main(void)
 {
-    int failures = 0;
     RUN(test_matrix);
     RUN(test_round_trip);
     RUN(test_input);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_orbit");
 }

@@ -3,7 +3,7 @@
  * malformed values are refused naming key and value, getters return the declared defaults, the
  * listing shows every declaration, and a context is never created with parameters its class did
  * not declare (the class's create is not even called). */
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_mediator.h"
 
 #include <string.h>
@@ -25,8 +25,6 @@ static sy_result check(const char *text, sy_error *e)
     sy_result r = sy_params_parse(text, &p, e);
     return r != SY_OK ? r : sy_params_check(&table, &p, 0, "back-end 'demo'", NULL, e);
 }
-
-#define CHECK_SAYS(e, needle) CHECK_MSG(strstr((e).message, needle) != NULL, "'%s' lacks '%s'", (e).message, needle)
 
 static int test_validation(void)
 {
@@ -254,15 +252,9 @@ static int test_contexts(void)
 
 int main(void)
 {
-    int failed = 0;
-    failed += test_validation();
-    failed += test_getters();
-    failed += test_listing();
-    failed += test_contexts();
-    if (failed) {
-        fprintf(stderr, "core_params: %d test(s) failed\n", failed);
-        return 1;
-    }
-    printf("core_params: ok\n");
-    return 0;
+    RUN(test_validation);
+    RUN(test_getters);
+    RUN(test_listing);
+    RUN(test_contexts);
+    return sy_check_finish("core_params");
 }

@@ -1,7 +1,7 @@
 /* test_post.c — the display post-process chain (core/sy_post.h): tone-mapping operators, exposure
  * and sRGB on premultiplied layers, and the red-cyan anaglyph. Expected values are computed here
  * independently in double precision. */
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_post.h"
 
 static double srgb_ref(double x)
@@ -79,9 +79,8 @@ static int test_anaglyph(void)
 
 int main(void)
 {
-    int failures = 0;
     RUN(test_operators);
     RUN(test_layer_post);
     RUN(test_anaglyph);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_post");
 }

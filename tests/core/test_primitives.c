@@ -2,7 +2,7 @@
  * pairs for lines, any count for points, topology and width ranges), element / triangle counts,
  * the stroke width rule, mesh bounds grown by half the width, and the change-list round trip
  * (serialise, decode, apply to a replica, compare) of a line primitive with an explicit width. */
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_changes.h"
 #include "sy_scene.h"
 
@@ -154,8 +154,7 @@ static int test_round_trip(void)
 
 int main(void)
 {
-    int failures = 0;
     RUN(test_validation);
     RUN(test_round_trip);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_primitives");
 }

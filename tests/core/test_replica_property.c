@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_changes.h"
 
 /* ------------------------------------------------------------------ PRNG */

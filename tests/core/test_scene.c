@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "check.h"
+#include "../support/sy_check.h"
 #include "sy_changes.h"
 #include "sy_scene.h"
 
@@ -919,7 +919,6 @@ static int test_attachments(void)
 
 int main(void)
 {
-    int failures = 0;
     RUN(test_handles);
     RUN(test_dirty_noop);
     RUN(test_validation);
@@ -929,5 +928,5 @@ int main(void)
     RUN(test_bounds);
     RUN(test_dag);
     RUN(test_attachments);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_scene");
 }

@@ -3,7 +3,7 @@
  * and malformed or truncated bytes get errors, and the decode limit is enforced; sy_jpeg_write
  * (sy render -o X.jpg) writes what sy_png_write would show, composited over black, and leaves no
  * file behind when it fails. */
-#include "../core/check.h"
+#include "../support/sy_check.h"
 #include "sy_jpeg.h"
 
 #include <dirent.h>
@@ -147,9 +147,8 @@ static int test_write(void)
 
 int main(void)
 {
-    int failures = 0;
     RUN(test_round_trip);
     RUN(test_bad_arguments);
     RUN(test_write);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_jpeg");
 }

@@ -28,6 +28,7 @@
  *                 another client's own budget, a still whose requester left is not rendered
  *   web_clientfiles  /client/ serves client.html, client.js and vendor/ only, not npm/ */
 #define _GNU_SOURCE /* strcasestr */
+#include "../support/sy_check.h"
 #include "sy_demo.h"
 #include "sy_jpeg.h"
 #include "sy_mediators.h"
@@ -48,22 +49,6 @@
 #include <sys/stat.h>
 #include <sys/time.h>
 #include <unistd.h>
-
-#define CHECK(expr)                                                                 \
-    do {                                                                            \
-        if (!(expr)) {                                                              \
-            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #expr); \
-            return 1;                                                               \
-        }                                                                           \
-    } while (0)
-#define CHECK_OK(call)                                                                                      \
-    do {                                                                                                    \
-        sy_result r_ = (call);                                                                              \
-        if (r_ != SY_OK) {                                                                                  \
-            fprintf(stderr, "%s:%d: %s failed: %s\n", __FILE__, __LINE__, #call, err.message);              \
-            return 1;                                                                                       \
-        }                                                                                                   \
-    } while (0)
 
 /* >>http over a plain socket: one request, Connection: close, the whole answer read */
 typedef struct http_answer {
@@ -249,7 +234,7 @@ static int check_jpeg(const uint8_t *j, size_t n, uint32_t w, uint32_t h)
     sy_error err = {0};
     uint8_t *px = NULL;
     uint32_t jw = 0, jh = 0;
-    CHECK_OK(sy_jpeg_decode_rgba8(j, n, 0, &px, &jw, &jh, &err));
+    CHECK_OK(sy_jpeg_decode_rgba8(j, n, 0, &px, &jw, &jh, &err), err);
     int lo = 255, hi = 0;
     for (size_t i = 0; i < (size_t)jw * jh * 4; ++i)
         if ((i & 3) != 3) lo = px[i] < lo ? px[i] : lo, hi = px[i] > hi ? px[i] : hi;
@@ -341,7 +326,7 @@ static int test_routes(uint16_t port)
 static int next_frame(sy_web_client *c, sy_web_frame_info *fi, uint8_t **j, size_t *n)
 {
     sy_error err = {0};
-    CHECK_OK(sy_web_client_next_frame(c, 60000, fi, j, n, &err));
+    CHECK_OK(sy_web_client_next_frame(c, 60000, fi, j, n, &err), err);
     return 0;
 }
 
@@ -350,9 +335,9 @@ static int test_stream(uint16_t port)
     sy_error err = {0};
     sy_web_client *c = NULL, *other = NULL;
     sy_web_client_opts o = {.host = "127.0.0.1", .port = port, .path = "/ws"};
-    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err));
-    CHECK_OK(sy_web_client_connect(&o, 10000, &other, &err)); /* a second viewer that never reads */
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":80,\"h\":60}", &err));
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    CHECK_OK(sy_web_client_connect(&o, 10000, &other, &err), err); /* a second viewer that never reads */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":80,\"h\":60}", &err), err);
     sy_web_frame_info fi;
     uint8_t *j0 = NULL, *j1 = NULL;
     size_t n0 = 0, n1 = 0;
@@ -366,8 +351,8 @@ static int test_stream(uint16_t port)
     const char *junk[] = {"not json", "[1,2]", "{\"t\":5}", "{\"t\":\"drag\",\"dx\":\"x\",\"dy\":1}",
                           "{\"t\":\"size\",\"w\":0,\"h\":10}", "{\"t\":\"warp\"}", "{\"t\":\"drag\",\"dx\":1e400,\"dy\":0}",
                           "{\"t\":\"key\",\"k\":\"ZZ\"}", "{\"t\":\"drag\",\"dx\":1,\"dy\":1,\"id\":-4}"};
-    for (size_t i = 0; i < sizeof junk / sizeof junk[0]; ++i) CHECK_OK(sy_web_client_send(c, junk[i], &err));
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"drag\",\"dx\":60,\"dy\":-20,\"id\":7}", &err));
+    for (size_t i = 0; i < sizeof junk / sizeof junk[0]; ++i) CHECK_OK(sy_web_client_send(c, junk[i], &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"drag\",\"dx\":60,\"dy\":-20,\"id\":7}", &err), err);
     do {
         free(j1);
         if (next_frame(c, &fi, &j1, &n1)) return 1;
@@ -383,13 +368,13 @@ static int test_stream(uint16_t port)
     memset(big, ' ', sizeof big);
     memcpy(big, "{\"t\":\"size\"", 11);
     big[sizeof big - 2] = '}', big[sizeof big - 1] = 0;
-    CHECK_OK(sy_web_client_send(other, big, &err));
+    CHECK_OK(sy_web_client_send(other, big, &err), err);
     int closed = 0;
     for (int i = 0; i < 50 && !closed; ++i)
         closed = sy_web_client_next_frame(other, 200, &fi, NULL, NULL, &err) == SY_ERR_IO && strstr(err.message, "closed");
     CHECK(closed);
     sy_web_client_close(other);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"wheel\",\"steps\":1,\"id\":8}", &err));
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"wheel\",\"steps\":1,\"id\":8}", &err), err);
     do {
         if (next_frame(c, &fi, NULL, NULL)) return 1;
     } while (fi.input_id < 8);
@@ -401,7 +386,7 @@ static int test_stream(uint16_t port)
     char own[64];
     snprintf(own, sizeof own, "127.0.0.1:%u", port);
     evil.origin = own; /* the page's own origin is welcome */
-    CHECK_OK(sy_web_client_connect(&evil, 10000, &c, &err));
+    CHECK_OK(sy_web_client_connect(&evil, 10000, &c, &err), err);
     sy_web_client_close(c);
     char req[512];
     http_answer a;
@@ -437,8 +422,8 @@ static int test_progressive(void)
     }
     sy_web_client *c = NULL;
     sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
-    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err));
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":48,\"h\":32}", &err));
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":48,\"h\":32}", &err), err);
     sy_web_frame_info fi = {0};
     do {
         if (next_frame(c, &fi, NULL, NULL)) return 1;
@@ -450,7 +435,7 @@ static int test_progressive(void)
         prev = fi.samples, rising++;
     }
     CHECK(prev >= 5);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"drag\",\"dx\":30,\"dy\":0,\"id\":1}", &err));
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"drag\",\"dx\":30,\"dy\":0,\"id\":1}", &err), err);
     do {
         if (next_frame(c, &fi, NULL, NULL)) return 1;
     } while (fi.input_id < 1);
@@ -503,7 +488,7 @@ static int test_token(void)
     CHECK(sy_web_client_connect(&o, 10000, &c, &err) == SY_ERR_PROTOCOL);
     snprintf(path, sizeof path, "/ws?token=%s", token);
     o.path = path;
-    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err));
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
     sy_web_client_close(c);
     return stop(&s);
 }
@@ -840,16 +825,16 @@ static int test_client_files(void)
     }
     server s = {0};
     sy_demo_info demo;
-    CHECK_OK(sy_scene_create(&s.scene, &err));
-    CHECK_OK(sy_demo_build(s.scene, &demo, &err));
-    CHECK_OK(sy_scene_commit(s.scene, NULL, &err));
+    CHECK_OK(sy_scene_create(&s.scene, &err), err);
+    CHECK_OK(sy_demo_build(s.scene, &demo, &err), err);
+    CHECK_OK(sy_scene_commit(s.scene, NULL, &err), err);
     sy_web_cull *cull = NULL;
     sy_web_route routes[SY_WEB_CULL_MAX_ROUTES];
     uint32_t n = 0;
-    CHECK_OK(sy_web_cull_create(s.scene, demo.root, dir, &cull, routes, &n, &err));
+    CHECK_OK(sy_web_cull_create(s.scene, demo.root, dir, &cull, routes, &n, &err), err);
     sy_web_desc d = {.scene = s.scene, .root = demo.root, .camera = demo.camera, .backend = "whitted",
                      .listen = "127.0.0.1:0", .routes = routes, .route_count = n};
-    CHECK_OK(sy_web_create(&d, &s.web, &err));
+    CHECK_OK(sy_web_create(&d, &s.web, &err), err);
     sy_web_cull_attach(cull, s.web);
     CHECK(pthread_create(&s.th, NULL, server_main, &s) == 0);
     uint16_t port = sy_web_port(s.web);

@@ -8,7 +8,7 @@
  *   3. An incremental change (the sphere moved +X) moves the image: the centre now sees the
  *      sphere's left side (normal x < 0).
  *   4. A sub-rectangle equals that part of the whole image; an unknown parameter is refused by name. */
-#include "../../core/check.h"
+#include "../../support/sy_check.h"
 #include "sy_demo.h"
 #include "sy_mediators.h"
 #include "sy_stats.h"
