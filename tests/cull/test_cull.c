@@ -2,7 +2,7 @@
  * occlusion, the budget cut, the JSON answer, bad queries naming their field, unknown ids; the
  * coverage capability it asks (sy_context_coverage); the GLB
  * writer (formats/sy_gltf_write.h) round trip through sy_gltf_load; the generated plant's counts. */
-#include "../support/check_count.h"
+#include "../support/sy_check.h"
 #include "sy_cull.h"
 #include "sy_gltf.h"
 #include "sy_gltf_write.h"
@@ -15,8 +15,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int failures;
-#define CHECK(cond, ...) SY_CHECK_COUNT(failures, cond, __VA_ARGS__)
 #define MUST(call)                                                                           \
     do {                                                                                     \
         sy_result must_r_ = (call);                                                          \
@@ -79,8 +77,8 @@ static char *query(sy_culler *c, const char *body, sy_result want, const char *n
     char *json = NULL;
     sy_error e = {0};
     sy_result r = sy_culler_query_json(c, body, strlen(body), &json, &e);
-    CHECK(r == want, "query %s: result %d (want %d): %s", body, (int)r, (int)want, e.message);
-    if (needle) CHECK(strstr(e.message, needle) != NULL, "query %s: message '%s' lacks '%s'", body, e.message, needle);
+    EXPECT_MSG(r == want, "query %s: result %d (want %d): %s", body, (int)r, (int)want, e.message);
+    if (needle) EXPECT_MSG(strstr(e.message, needle) != NULL, "query %s: message '%s' lacks '%s'", body, e.message, needle);
     return json;
 }
 
@@ -113,33 +111,33 @@ static void test_boxes(void)
     snprintf(body, sizeof body, "{%s,\"budget\":1000}", VIEW);
     char *json = query(c, body, SY_OK, NULL);
     cJSON *doc = json ? cJSON_Parse(json) : NULL;
-    CHECK(doc != NULL, "answer is JSON: %s", json ? json : "(null)");
+    EXPECT_MSG(doc != NULL, "answer is JSON: %s", json ? json : "(null)");
     if (doc) {
         cJSON *objs = cJSON_GetObjectItem(doc, "objects");
         int n = cJSON_GetArraySize(objs);
-        CHECK(n == 3, "3 visible objects (hidden is occluded), got %d: %s", n, json);
+        EXPECT_MSG(n == 3, "3 visible objects (hidden is occluded), got %d: %s", n, json);
         double last = 1e30;
         bool saw_hidden = false, saw[3] = {false, false, false};
         for (cJSON *o = objs ? objs->child : NULL; o; o = o->next) {
             double px = cJSON_GetObjectItem(o, "pixels")->valuedouble;
             uint32_t id = (uint32_t)cJSON_GetObjectItem(o, "id")->valuedouble;
-            CHECK(px <= last && px > 0, "pixels descending and positive: %g after %g", px, last);
-            CHECK(cJSON_GetObjectItem(o, "triangles")->valuedouble == 12, "a box has 12 triangles");
+            EXPECT_MSG(px <= last && px > 0, "pixels descending and positive: %g after %g", px, last);
+            EXPECT_MSG(cJSON_GetObjectItem(o, "triangles")->valuedouble == 12, "a box has 12 triangles");
             last = px;
             saw_hidden |= id == hidden.id;
             saw[0] |= id == near.id, saw[1] |= id == side.id, saw[2] |= id == far.id;
         }
-        CHECK(!saw_hidden && saw[0] && saw[1] && saw[2], "near, side, far listed; hidden not");
-        CHECK(objs && objs->child && (uint32_t)cJSON_GetObjectItem(objs->child, "id")->valuedouble == near.id,
-              "the near box covers the most pixels");
-        CHECK(cJSON_GetObjectItem(doc, "total_objects")->valuedouble == 4, "total_objects 4");
-        CHECK(cJSON_GetObjectItem(doc, "total_triangles")->valuedouble == 48, "total_triangles 48");
-        CHECK(cJSON_GetObjectItem(doc, "visible_objects")->valuedouble == 3, "visible_objects 3");
-        CHECK(cJSON_GetObjectItem(doc, "triangles")->valuedouble == 36, "triangles 36");
+        EXPECT_MSG(!saw_hidden && saw[0] && saw[1] && saw[2], "near, side, far listed; hidden not");
+        EXPECT_MSG(objs && objs->child && (uint32_t)cJSON_GetObjectItem(objs->child, "id")->valuedouble == near.id,
+                   "the near box covers the most pixels");
+        EXPECT_MSG(cJSON_GetObjectItem(doc, "total_objects")->valuedouble == 4, "total_objects 4");
+        EXPECT_MSG(cJSON_GetObjectItem(doc, "total_triangles")->valuedouble == 48, "total_triangles 48");
+        EXPECT_MSG(cJSON_GetObjectItem(doc, "visible_objects")->valuedouble == 3, "visible_objects 3");
+        EXPECT_MSG(cJSON_GetObjectItem(doc, "triangles")->valuedouble == 36, "triangles 36");
         cJSON *cov = cJSON_GetObjectItem(doc, "coverage");
-        CHECK(cJSON_GetArraySize(cov) == 2 && cov->child->valuedouble == 160, "coverage at the full size");
+        EXPECT_MSG(cJSON_GetArraySize(cov) == 2 && cov->child->valuedouble == 160, "coverage at the full size");
         cJSON *bmin = cJSON_GetObjectItem(cJSON_GetObjectItem(doc, "bounds"), "min");
-        CHECK(cJSON_GetArraySize(bmin) == 3 && fabs(bmin->child->valuedouble - -2.8) < 1e-6, "bounds.min x = far box's -2.8");
+        EXPECT_MSG(cJSON_GetArraySize(bmin) == 3 && fabs(bmin->child->valuedouble - -2.8) < 1e-6, "bounds.min x = far box's -2.8");
         cJSON_Delete(doc);
     }
     free(json);
@@ -149,17 +147,17 @@ static void test_boxes(void)
     uint64_t b;
     snprintf(body, sizeof body, "{%s,\"budget\":0}", VIEW);
     MUST(sy_cull_parse_query(body, strlen(body), &v, &b, &err));
-    CHECK(b == 0 && v.width == 160 && v.height == 120 && v.fov_degrees == 40 && v.position[2] == 10, "parsed view");
+    EXPECT_MSG(b == 0 && v.width == 160 && v.height == 120 && v.fov_degrees == 40 && v.position[2] == 10, "parsed view");
     sy_cull_result res, full;
     MUST(sy_culler_query(c, &v, 1000, &full, &err));
     uint64_t budgets[3] = {12, 30, 0};
     uint32_t want[3] = {1, 2, 0};
     for (int i = 0; i < 3; ++i) {
         MUST(sy_culler_query(c, &v, budgets[i], &res, &err));
-        CHECK(res.count == want[i] && res.triangles <= budgets[i], "budget %llu: %u objects (want %u), %llu triangles",
-              (unsigned long long)budgets[i], res.count, want[i], (unsigned long long)res.triangles);
-        for (uint32_t k = 0; k < res.count; ++k) CHECK(res.objects[k].id == full.objects[k].id, "the cut keeps the ranking's head");
-        CHECK(res.visible_objects == 3, "visible objects counted before the cut");
+        EXPECT_MSG(res.count == want[i] && res.triangles <= budgets[i], "budget %llu: %u objects (want %u), %llu triangles",
+                   (unsigned long long)budgets[i], res.count, want[i], (unsigned long long)res.triangles);
+        for (uint32_t k = 0; k < res.count; ++k) EXPECT_MSG(res.objects[k].id == full.objects[k].id, "the cut keeps the ranking's head");
+        EXPECT_MSG(res.visible_objects == 3, "visible objects counted before the cut");
         sy_cull_result_free(&res);
     }
     /* reduced resolution: at most 4800 pixels (80 x 60), the same ranking */
@@ -167,9 +165,9 @@ static void test_boxes(void)
     sy_culler_options so = {.max_coverage_pixels = 4800};
     MUST(sy_culler_create(s, NULL, root, &so, &small, &err));
     MUST(sy_culler_query(small, &v, 1000, &res, &err));
-    CHECK(res.coverage_width == 80 && res.coverage_height == 60, "coverage grid %ux%u", res.coverage_width, res.coverage_height);
-    CHECK(res.count == 3 && res.objects[0].id == near.id && res.objects[0].pixels * 3 < full.objects[0].pixels,
-          "reduced grid: same head, fewer pixels");
+    EXPECT_MSG(res.coverage_width == 80 && res.coverage_height == 60, "coverage grid %ux%u", res.coverage_width, res.coverage_height);
+    EXPECT_MSG(res.count == 3 && res.objects[0].id == near.id && res.objects[0].pixels * 3 < full.objects[0].pixels,
+               "reduced grid: same head, fewer pixels");
     sy_cull_result_free(&res);
     sy_culler_destroy(small);
 
@@ -201,11 +199,11 @@ static void test_boxes(void)
     MUST(sy_node_set_flags(s, side, 0, &err));
     MUST(sy_scene_commit(s, NULL, &err));
     MUST(sy_culler_query(c, &v, 1000, &res, &err));
-    CHECK(res.total_objects == 3 && res.count == 2, "after hiding one: total %u kept %u", res.total_objects, res.count);
+    EXPECT_MSG(res.total_objects == 3 && res.count == 2, "after hiding one: total %u kept %u", res.total_objects, res.count);
     sy_cull_result_free(&res);
     uint8_t *glb = NULL;
     size_t len = 0;
-    CHECK(sy_culler_object_glb(c, side.id, &glb, &len, &err) == SY_ERR_NOT_FOUND, "a hidden object is not found");
+    EXPECT_MSG(sy_culler_object_glb(c, side.id, &glb, &len, &err) == SY_ERR_NOT_FOUND, "a hidden object is not found");
     MUST(sy_node_set_flags(s, side, SY_NODE_VISIBLE, &err));
     MUST(sy_scene_commit(s, NULL, &err));
 
@@ -253,45 +251,45 @@ static void test_boxes(void)
 
     /* ids */
     uint32_t id;
-    CHECK(sy_cull_parse_id("123", 3, &id, &err) == SY_OK && id == 123, "id 123");
-    CHECK(sy_cull_parse_id("0", 1, &id, &err) == SY_ERR_INVALID_ARGUMENT, "id 0 refused");
-    CHECK(sy_cull_parse_id("12a", 3, &id, &err) == SY_ERR_INVALID_ARGUMENT, "id 12a refused");
-    CHECK(sy_cull_parse_id("4294967296", 10, &id, &err) == SY_ERR_INVALID_ARGUMENT, "id 2^32 refused");
-    CHECK(sy_cull_parse_id("", 0, &id, &err) == SY_ERR_INVALID_ARGUMENT, "empty id refused");
-    CHECK(sy_culler_object_glb(c, 999999, &glb, &len, &err) == SY_ERR_NOT_FOUND && !glb, "unknown id: not found");
-    CHECK(strstr(err.message, "999999") != NULL, "the message names the id: %s", err.message);
-    CHECK(sy_culler_object_glb(c, root.id, &glb, &len, &err) == SY_ERR_NOT_FOUND, "a node without a mesh is no object");
+    EXPECT_MSG(sy_cull_parse_id("123", 3, &id, &err) == SY_OK && id == 123, "id 123");
+    EXPECT_MSG(sy_cull_parse_id("0", 1, &id, &err) == SY_ERR_INVALID_ARGUMENT, "id 0 refused");
+    EXPECT_MSG(sy_cull_parse_id("12a", 3, &id, &err) == SY_ERR_INVALID_ARGUMENT, "id 12a refused");
+    EXPECT_MSG(sy_cull_parse_id("4294967296", 10, &id, &err) == SY_ERR_INVALID_ARGUMENT, "id 2^32 refused");
+    EXPECT_MSG(sy_cull_parse_id("", 0, &id, &err) == SY_ERR_INVALID_ARGUMENT, "empty id refused");
+    EXPECT_MSG(sy_culler_object_glb(c, 999999, &glb, &len, &err) == SY_ERR_NOT_FOUND && !glb, "unknown id: not found");
+    EXPECT_MSG(strstr(err.message, "999999") != NULL, "the message names the id: %s", err.message);
+    EXPECT_MSG(sy_culler_object_glb(c, root.id, &glb, &len, &err) == SY_ERR_NOT_FOUND, "a node without a mesh is no object");
 
     /* GLB round trip of one object: geometry, its world placement, the material */
     MUST(sy_culler_object_glb(c, far.id, &glb, &len, &err));
-    CHECK(len > 12 && !memcmp(glb, "glTF", 4), "GLB magic");
+    EXPECT_MSG(len > 12 && !memcmp(glb, "glTF", 4), "GLB magic");
     sy_scene *back;
     sy_gltf_info info = {0};
     MUST(sy_scene_create(&back, &err));
     MUST(sy_gltf_load_memory(glb, len, "object.glb", "", back, NULL, &info, &err));
     MUST(sy_scene_commit(back, NULL, &err));
-    CHECK(info.counts.triangles == 12 && info.counts.meshes == 1 && info.counts.nodes == 1 && info.counts.materials == 1,
-          "counts: %u triangles %u meshes %u nodes %u materials", info.counts.triangles, info.counts.meshes,
-          info.counts.nodes, info.counts.materials);
+    EXPECT_MSG(info.counts.triangles == 12 && info.counts.meshes == 1 && info.counts.nodes == 1 && info.counts.materials == 1,
+               "counts: %u triangles %u meshes %u nodes %u materials", info.counts.triangles, info.counts.meshes,
+               info.counts.nodes, info.counts.materials);
     sy_bounds wb, ob;
     MUST(sy_node_world_bounds(back, info.root, &wb, &err));
     MUST(sy_node_world_bounds(s, far, &ob, &err));
     for (int a = 0; a < 3; ++a)
-        CHECK(fabsf(wb.min[a] - ob.min[a]) < 1e-5f && fabsf(wb.max[a] - ob.max[a]) < 1e-5f, "bounds axis %d: %g..%g vs %g..%g",
-              a, wb.min[a], wb.max[a], ob.min[a], ob.max[a]);
+        EXPECT_MSG(fabsf(wb.min[a] - ob.min[a]) < 1e-5f && fabsf(wb.max[a] - ob.max[a]) < 1e-5f, "bounds axis %d: %g..%g vs %g..%g",
+                   a, wb.min[a], wb.max[a], ob.min[a], ob.max[a]);
     uint32_t nk = 0;
     const uint32_t *kids = sy_node_children(sy_node_get(back, info.root), &nk);
     const sy_node_data *kd = nk == 1 ? sy_node_get(back, (sy_node){kids[0]}) : NULL;
-    CHECK(kd && kd->name && !strcmp(kd->name, "far"), "the node keeps its name");
+    EXPECT_MSG(kd && kd->name && !strcmp(kd->name, "far"), "the node keeps its name");
     const sy_mesh_data *mdb = kd ? sy_mesh_get(back, kd->mesh) : NULL;
     const sy_material_data *mb = mdb && mdb->primitives.count == 1 ? sy_material_get(back, mdb->primitives.items[0].material) : NULL;
-    CHECK(mb != NULL, "a material came back");
+    EXPECT_MSG(mb != NULL, "a material came back");
     if (mb) {
-        for (int k = 0; k < 4; ++k) CHECK(fabsf(mb->base_color[k] - md.base_color[k]) < 1e-6f, "base colour %d", k);
-        CHECK(fabsf(mb->metallic - 0.3f) < 1e-6f && fabsf(mb->roughness - 0.6f) < 1e-6f, "metallic / roughness");
-        CHECK(fabsf(mb->emissive[0] - 0.5f) < 1e-6f && fabsf(mb->emissive[1] - 0.25f) < 1e-6f && fabsf(mb->emissive_strength - 2) < 1e-6f,
-              "emission %g %g x %g", mb->emissive[0], mb->emissive[1], mb->emissive_strength);
-        CHECK(sy_primitive_vertex_count(&mdb->primitives.items[0]) == 24 && mdb->primitives.items[0].normals, "24 vertices with normals");
+        for (int k = 0; k < 4; ++k) EXPECT_MSG(fabsf(mb->base_color[k] - md.base_color[k]) < 1e-6f, "base colour %d", k);
+        EXPECT_MSG(fabsf(mb->metallic - 0.3f) < 1e-6f && fabsf(mb->roughness - 0.6f) < 1e-6f, "metallic / roughness");
+        EXPECT_MSG(fabsf(mb->emissive[0] - 0.5f) < 1e-6f && fabsf(mb->emissive[1] - 0.25f) < 1e-6f && fabsf(mb->emissive_strength - 2) < 1e-6f,
+                   "emission %g %g x %g", mb->emissive[0], mb->emissive[1], mb->emissive_strength);
+        EXPECT_MSG(sy_primitive_vertex_count(&mdb->primitives.items[0]) == 24 && mdb->primitives.items[0].normals, "24 vertices with normals");
     }
     sy_gltf_info_free(&info);
     free(glb);
@@ -312,24 +310,24 @@ static void test_plant(void)
     sy_plant_info pi;
     MUST(sy_plant_generate(s, &d, &pi, &err));
     MUST(sy_scene_commit(s, NULL, &err));
-    CHECK(pi.objects == 300 && pi.grid == 4, "300 objects on a 4 x 4 grid: %u, %u", pi.objects, pi.grid);
-    CHECK(pi.triangles > 270000 && pi.triangles < 330000, "about 300k triangles: %llu", (unsigned long long)pi.triangles);
+    EXPECT_MSG(pi.objects == 300 && pi.grid == 4, "300 objects on a 4 x 4 grid: %u, %u", pi.objects, pi.grid);
+    EXPECT_MSG(pi.triangles > 270000 && pi.triangles < 330000, "about 300k triangles: %llu", (unsigned long long)pi.triangles);
     sy_culler *c;
     MUST(sy_culler_create(s, NULL, pi.root, NULL, &c, &err));
     /* the generator's own count equals what the meshes hold */
     sy_cull_view v = {{0, 6, 0}, {0, 0, 0, 1}, 60, 320, 180};
     sy_cull_result r;
     MUST(sy_culler_query(c, &v, 1ull << 40, &r, &err));
-    CHECK(r.total_objects == 300 && r.total_triangles == pi.triangles, "culler totals %u / %llu vs plant %llu",
-          r.total_objects, (unsigned long long)r.total_triangles, (unsigned long long)pi.triangles);
-    CHECK(r.count == r.visible_objects && r.visible_objects > 10 && r.visible_objects < 300,
-          "an unlimited budget keeps every visible object: %u of %u", r.count, r.visible_objects);
+    EXPECT_MSG(r.total_objects == 300 && r.total_triangles == pi.triangles, "culler totals %u / %llu vs plant %llu",
+               r.total_objects, (unsigned long long)r.total_triangles, (unsigned long long)pi.triangles);
+    EXPECT_MSG(r.count == r.visible_objects && r.visible_objects > 10 && r.visible_objects < 300,
+               "an unlimited budget keeps every visible object: %u of %u", r.count, r.visible_objects);
     uint64_t budget = r.visible_triangles / 3;
     sy_cull_result_free(&r);
     MUST(sy_culler_query(c, &v, budget, &r, &err));
-    CHECK(r.triangles <= budget && r.count < r.visible_objects, "budget %llu: %llu triangles, %u of %u objects",
-          (unsigned long long)budget, (unsigned long long)r.triangles, r.count, r.visible_objects);
-    for (uint32_t i = 1; i < r.count; ++i) CHECK(r.objects[i].pixels <= r.objects[i - 1].pixels, "ranked by pixels");
+    EXPECT_MSG(r.triangles <= budget && r.count < r.visible_objects, "budget %llu: %llu triangles, %u of %u objects",
+               (unsigned long long)budget, (unsigned long long)r.triangles, r.count, r.visible_objects);
+    for (uint32_t i = 1; i < r.count; ++i) EXPECT_MSG(r.objects[i].pixels <= r.objects[i - 1].pixels, "ranked by pixels");
     sy_cull_result_free(&r);
     sy_culler_destroy(c);
 
@@ -342,8 +340,8 @@ static void test_plant(void)
     MUST(sy_scene_create(&back, &err));
     MUST(sy_gltf_load_memory(glb, len, "plant.glb", "", back, NULL, &info, &err));
     MUST(sy_scene_commit(back, NULL, &err));
-    CHECK(info.counts.nodes == 300 && info.counts.meshes == pi.meshes, "nodes %u meshes %u (plant %u)", info.counts.nodes,
-          info.counts.meshes, pi.meshes);
+    EXPECT_MSG(info.counts.nodes == 300 && info.counts.meshes == pi.meshes, "nodes %u meshes %u (plant %u)", info.counts.nodes,
+               info.counts.meshes, pi.meshes);
     sy_gltf_placement *pl;
     uint32_t np;
     MUST(sy_gltf_placements_collect(back, info.root, &pl, &np, &err));
@@ -352,11 +350,11 @@ static void test_plant(void)
         const sy_mesh_data *m = sy_mesh_get(back, pl[i].mesh);
         for (uint32_t k = 0; m && k < m->primitives.count; ++k) tris += sy_primitive_triangle_count(&m->primitives.items[k]);
     }
-    CHECK(np == 300 && tris == pi.triangles, "placements %u triangles %llu", np, (unsigned long long)tris);
+    EXPECT_MSG(np == 300 && tris == pi.triangles, "placements %u triangles %llu", np, (unsigned long long)tris);
     sy_bounds wb;
     MUST(sy_node_world_bounds(back, info.root, &wb, &err));
     for (int a = 0; a < 3; ++a)
-        CHECK(fabsf(wb.min[a] - pi.bounds.min[a]) < 1e-3f && fabsf(wb.max[a] - pi.bounds.max[a]) < 1e-3f, "plant bounds axis %d", a);
+        EXPECT_MSG(fabsf(wb.min[a] - pi.bounds.min[a]) < 1e-3f && fabsf(wb.max[a] - pi.bounds.max[a]) < 1e-3f, "plant bounds axis %d", a);
     free(pl);
     sy_gltf_info_free(&info);
     sy_scene_destroy(back);
@@ -372,7 +370,5 @@ int main(void)
     }
     test_boxes();
     test_plant();
-    if (failures) fprintf(stderr, "%d check(s) failed\n", failures);
-    else printf("cull: all checks passed\n");
-    return failures ? 1 : 0;
+    return sy_check_finish("cull");
 }

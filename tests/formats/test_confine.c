@@ -32,7 +32,7 @@ static void write_gltf(const char *name, const char *buffer_uri, const char *ima
           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
           "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0%s}",
           buffer_uri, images);
-    CHECK(write_bytes(path, json, strlen(json)) == 0, "cannot write %s", path);
+    EXPECT_MSG(write_bytes(path, json, strlen(json)) == 0, "cannot write %s", path);
 }
 
 static sy_result load_gltf(const char *name, const char *const *roots, size_t nroots, sy_error *err)
@@ -64,17 +64,17 @@ static sy_result load_x3d(const char *name, const char *const *roots, size_t nro
 /* the refusal names the model file, the uri and the option that admits more folders */
 static void expect_refused(const char *what, sy_result r, const sy_error *e, const char *model, const char *uri)
 {
-    CHECK(r == SY_ERR_LIMIT, "%s: result %d, want SY_ERR_LIMIT (%s)", what, (int)r, e->message);
-    CHECK(strstr(e->message, model) != NULL, "%s: message does not name %s: %s", what, model, e->message);
-    CHECK(strstr(e->message, uri) != NULL, "%s: message does not name %s: %s", what, uri, e->message);
-    CHECK(strstr(e->message, "--allow-path") != NULL, "%s: message does not name --allow-path: %s", what, e->message);
+    EXPECT_MSG(r == SY_ERR_LIMIT, "%s: result %d, want SY_ERR_LIMIT (%s)", what, (int)r, e->message);
+    EXPECT_MSG(strstr(e->message, model) != NULL, "%s: message does not name %s: %s", what, model, e->message);
+    EXPECT_MSG(strstr(e->message, uri) != NULL, "%s: message does not name %s: %s", what, uri, e->message);
+    EXPECT_MSG(strstr(e->message, "--allow-path") != NULL, "%s: message does not name --allow-path: %s", what, e->message);
 }
 
 static void write_file(const char *rel, const void *data, size_t n)
 {
     char path[1024];
     PATHF(path, "%s/%s", g_root, rel);
-    CHECK(write_bytes(path, data, n) == 0, "cannot write %s", path);
+    EXPECT_MSG(write_bytes(path, data, n) == 0, "cannot write %s", path);
 }
 
 int main(void)
@@ -82,9 +82,9 @@ int main(void)
     make_scratch_dir(g_root, sizeof g_root, "confine");
     char dir[1024], link[1024];
     PATHF(dir, "%s/model", g_root);
-    CHECK(mkdir(dir, 0777) == 0, "mkdir model");
+    EXPECT_MSG(mkdir(dir, 0777) == 0, "mkdir model");
     PATHF(link, "%s/model/sub", g_root);
-    CHECK(mkdir(link, 0777) == 0, "mkdir model/sub");
+    EXPECT_MSG(mkdir(link, 0777) == 0, "mkdir model/sub");
     float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     write_file("outside.bin", tri, sizeof tri);
     write_file("model/in.bin", tri, sizeof tri);
@@ -93,30 +93,30 @@ int main(void)
     const char *x3d_out = "<X3D><Scene><Shape><Box/></Shape></Scene></X3D>";
     write_file("outside.x3d", x3d_out, strlen(x3d_out));
     PATHF(link, "%s/model/link.bin", g_root);
-    CHECK(symlink("../outside.bin", link) == 0, "symlink: %s", strerror(errno));
+    EXPECT_MSG(symlink("../outside.bin", link) == 0, "symlink: %s", strerror(errno));
 
     /* sy_path_confine alone */
     char joined[1024], *real = NULL;
     sy_error e = {0};
     PATHF(joined, "%s/sub/../in.bin", dir);
-    CHECK(sy_path_confine("m.gltf", "sub/../in.bin", joined, dir, NULL, 0, &real, &e) == SY_OK, "%s", e.message);
-    CHECK(real && strstr(real, "/model/in.bin"), "real path %s", real ? real : "(null)");
+    EXPECT_MSG(sy_path_confine("m.gltf", "sub/../in.bin", joined, dir, NULL, 0, &real, &e) == SY_OK, "%s", e.message);
+    EXPECT_MSG(real && strstr(real, "/model/in.bin"), "real path %s", real ? real : "(null)");
     free(real);
     PATHF(joined, "%s/../outside.bin", dir);
     expect_refused("confine ..", sy_path_confine("m.gltf", "../outside.bin", joined, dir, NULL, 0, &real, &e), &e,
                    "m.gltf", "../outside.bin");
-    CHECK(!real, "no path on refusal");
+    EXPECT_MSG(!real, "no path on refusal");
     PATHF(joined, "%s/nope.bin", dir);
-    CHECK(sy_path_confine("m.gltf", "nope.bin", joined, dir, NULL, 0, &real, &e) == SY_ERR_NOT_FOUND, "missing file");
+    EXPECT_MSG(sy_path_confine("m.gltf", "nope.bin", joined, dir, NULL, 0, &real, &e) == SY_ERR_NOT_FOUND, "missing file");
     const char *roots[1] = {g_root};
     PATHF(joined, "%s/../outside.bin", dir);
-    CHECK(sy_path_confine("m.gltf", "../outside.bin", joined, dir, roots, 1, &real, &e) == SY_OK, "allowed root: %s",
-          e.message);
+    EXPECT_MSG(sy_path_confine("m.gltf", "../outside.bin", joined, dir, roots, 1, &real, &e) == SY_OK, "allowed root: %s",
+               e.message);
     free(real);
     /* a folder whose name merely starts like the model's is not inside it */
     char sibling[1024];
     PATHF(sibling, "%s/model2", g_root);
-    CHECK(mkdir(sibling, 0777) == 0, "mkdir model2");
+    EXPECT_MSG(mkdir(sibling, 0777) == 0, "mkdir model2");
     write_file("model2/x.bin", tri, sizeof tri);
     PATHF(joined, "%s/../model2/x.bin", dir);
     expect_refused("confine sibling", sy_path_confine("m.gltf", "../model2/x.bin", joined, dir, NULL, 0, &real, &e),
@@ -132,15 +132,15 @@ int main(void)
     write_gltf("fileuri.gltf", file_uri, NULL);
     write_gltf("link.gltf", "link.bin", NULL);
     write_gltf("image.gltf", "in.bin", "../outside.png");
-    CHECK(load_gltf("ok.gltf", NULL, 0, &e) == SY_OK, "in-tree buffer: %s", e.message);
+    EXPECT_MSG(load_gltf("ok.gltf", NULL, 0, &e) == SY_OK, "in-tree buffer: %s", e.message);
     expect_refused("glTF ..", load_gltf("dotdot.gltf", NULL, 0, &e), &e, "dotdot.gltf", "../outside.bin");
     expect_refused("glTF absolute", load_gltf("abs.gltf", NULL, 0, &e), &e, "abs.gltf", abs_uri);
     expect_refused("glTF file:", load_gltf("fileuri.gltf", NULL, 0, &e), &e, "fileuri.gltf", file_uri);
     expect_refused("glTF symlink", load_gltf("link.gltf", NULL, 0, &e), &e, "link.gltf", "link.bin");
     expect_refused("glTF image", load_gltf("image.gltf", NULL, 0, &e), &e, "image.gltf", "../outside.png");
-    CHECK(load_gltf("dotdot.gltf", roots, 1, &e) == SY_OK, "allowed_roots admits ..: %s", e.message);
-    CHECK(load_gltf("abs.gltf", roots, 1, &e) == SY_OK, "allowed_roots admits an absolute path: %s", e.message);
-    CHECK(load_gltf("link.gltf", roots, 1, &e) == SY_OK, "allowed_roots admits the link: %s", e.message);
+    EXPECT_MSG(load_gltf("dotdot.gltf", roots, 1, &e) == SY_OK, "allowed_roots admits ..: %s", e.message);
+    EXPECT_MSG(load_gltf("abs.gltf", roots, 1, &e) == SY_OK, "allowed_roots admits an absolute path: %s", e.message);
+    EXPECT_MSG(load_gltf("link.gltf", roots, 1, &e) == SY_OK, "allowed_roots admits the link: %s", e.message);
 
     /* X3D: Inline and ImageTexture */
     const char *inl = "<X3D><Scene><Inline url='\"../outside.x3d\"'/></Scene></X3D>";
@@ -161,11 +161,11 @@ int main(void)
     PATHF(abs_png, "%s/outside.png", g_root);
     expect_refused("X3D ImageTexture", load_x3d("texture.x3d", NULL, 0, &xi, &e), &e, "texture.x3d", abs_png);
     sy_x3d_info_free(&xi);
-    CHECK(load_x3d("inline_ok.x3d", NULL, 0, &xi, &e) == SY_OK && xi.counts.inlines == 1, "in-tree Inline: %s",
-          e.message);
+    EXPECT_MSG(load_x3d("inline_ok.x3d", NULL, 0, &xi, &e) == SY_OK && xi.counts.inlines == 1, "in-tree Inline: %s",
+               e.message);
     sy_x3d_info_free(&xi);
-    CHECK(load_x3d("inline.x3d", roots, 1, &xi, &e) == SY_OK && xi.counts.inlines == 1,
-          "allowed_roots admits the Inline: %s (inlines %u)", e.message, xi.counts.inlines);
+    EXPECT_MSG(load_x3d("inline.x3d", roots, 1, &xi, &e) == SY_OK && xi.counts.inlines == 1,
+               "allowed_roots admits the Inline: %s (inlines %u)", e.message, xi.counts.inlines);
     sy_x3d_info_free(&xi);
 
     const char *sub[] = {"model/sub", "model", "model2"}; /* remove_scratch_dir takes flat folders */
@@ -174,5 +174,5 @@ int main(void)
         remove_scratch_dir(dir);
     }
     remove_scratch_dir(g_root);
-    return finish_tests("formats_confine");
+    return sy_check_finish("formats_confine");
 }

@@ -18,36 +18,36 @@ static int ref_byte(double v01) { return (int)floor(v01 * 255.0 + 0.5); }
 
 static void test_helpers(void)
 {
-    CHECK(sy_srgb_encode(0.0f) == 0.0f && sy_srgb_encode(1.0f) == 1.0f, "end points");
-    CHECK(sy_srgb_encode(-1.0f) == 0.0f && sy_srgb_encode(7.0f) == 1.0f && sy_srgb_encode(NAN) == 0.0f, "clamping");
-    CHECK(fabsf(sy_srgb_encode(0.5f) - 0.735357f) < 2e-6f, "0.5 -> %.7f", (double)sy_srgb_encode(0.5f));
-    CHECK(ref_byte(sy_srgb_encode(0.5f)) == 188, "0.5 must encode to byte 188");
+    EXPECT_MSG(sy_srgb_encode(0.0f) == 0.0f && sy_srgb_encode(1.0f) == 1.0f, "end points");
+    EXPECT_MSG(sy_srgb_encode(-1.0f) == 0.0f && sy_srgb_encode(7.0f) == 1.0f && sy_srgb_encode(NAN) == 0.0f, "clamping");
+    EXPECT_MSG(fabsf(sy_srgb_encode(0.5f) - 0.735357f) < 2e-6f, "0.5 -> %.7f", (double)sy_srgb_encode(0.5f));
+    EXPECT_MSG(ref_byte(sy_srgb_encode(0.5f)) == 188, "0.5 must encode to byte 188");
     /* The two pieces meet at 0.0031308 -> 0.04045 (continuous to ~1e-7). */
     float lo = sy_srgb_encode(0.0031308f), hi = sy_srgb_encode(nextafterf(0.0031308f, 1.0f));
-    CHECK(fabsf(lo - 0.04045f) < 1e-6f && fabsf(hi - lo) < 1e-6f, "boundary %.8f %.8f", (double)lo, (double)hi);
-    CHECK(fabsf(sy_srgb_encode(0.001f) - 0.01292f) < 1e-7f, "linear segment");
+    EXPECT_MSG(fabsf(lo - 0.04045f) < 1e-6f && fabsf(hi - lo) < 1e-6f, "boundary %.8f %.8f", (double)lo, (double)hi);
+    EXPECT_MSG(fabsf(sy_srgb_encode(0.001f) - 0.01292f) < 1e-7f, "linear segment");
     for (float v = 0.0f; v <= 1.0f; v += 0.001f) {
         float rt = sy_srgb_decode(sy_srgb_encode(v));
         if (fabsf(rt - v) > 1e-5f) {
-            CHECK(0, "decode(encode(%g)) = %g", (double)v, (double)rt);
+            EXPECT_MSG(0, "decode(encode(%g)) = %g", (double)v, (double)rt);
             break;
         }
         if (fabsf(sy_srgb_encode(v) - (float)ref_oetf(v)) > 2e-6f) {
-            CHECK(0, "encode(%g) = %.8f, reference %.8f", (double)v, (double)sy_srgb_encode(v), ref_oetf(v));
+            EXPECT_MSG(0, "encode(%g) = %.8f, reference %.8f", (double)v, (double)sy_srgb_encode(v), ref_oetf(v));
             break;
         }
     }
-    CHECK(fabsf(sy_srgb_decode(0.04045f) - 0.0031308f) < 1e-7f, "decode boundary");
+    EXPECT_MSG(fabsf(sy_srgb_decode(0.04045f) - 0.0031308f) < 1e-7f, "decode boundary");
 
-    CHECK(sy_tonemap_apply(SY_TONEMAP_CLAMP, 2.0f) == 1.0f, "clamp >1");
-    CHECK(sy_tonemap_apply(SY_TONEMAP_CLAMP, 0.3f) == 0.3f, "clamp passes through");
-    CHECK(sy_tonemap_apply(SY_TONEMAP_CLAMP, -0.3f) == 0.0f, "clamp negative");
-    CHECK(sy_tonemap_apply(SY_TONEMAP_REINHARD, 1.0f) == 0.5f, "reinhard 1 -> 0.5");
-    CHECK(sy_tonemap_apply(SY_TONEMAP_REINHARD, INFINITY) == 1.0f, "reinhard inf");
+    EXPECT_MSG(sy_tonemap_apply(SY_TONEMAP_CLAMP, 2.0f) == 1.0f, "clamp >1");
+    EXPECT_MSG(sy_tonemap_apply(SY_TONEMAP_CLAMP, 0.3f) == 0.3f, "clamp passes through");
+    EXPECT_MSG(sy_tonemap_apply(SY_TONEMAP_CLAMP, -0.3f) == 0.0f, "clamp negative");
+    EXPECT_MSG(sy_tonemap_apply(SY_TONEMAP_REINHARD, 1.0f) == 0.5f, "reinhard 1 -> 0.5");
+    EXPECT_MSG(sy_tonemap_apply(SY_TONEMAP_REINHARD, INFINITY) == 1.0f, "reinhard inf");
     double x = 0.8, aces = (x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14);
-    CHECK(fabs(sy_tonemap_apply(SY_TONEMAP_ACES, 0.8f) - aces) < 1e-6, "aces 0.8");
-    CHECK(sy_tonemap_apply(SY_TONEMAP_ACES, 1000.0f) == 1.0f, "aces saturates at 1");
-    CHECK(sy_tonemap_apply(SY_TONEMAP_ACES, NAN) == 0.0f, "aces NaN");
+    EXPECT_MSG(fabs(sy_tonemap_apply(SY_TONEMAP_ACES, 0.8f) - aces) < 1e-6, "aces 0.8");
+    EXPECT_MSG(sy_tonemap_apply(SY_TONEMAP_ACES, 1000.0f) == 1.0f, "aces saturates at 1");
+    EXPECT_MSG(sy_tonemap_apply(SY_TONEMAP_ACES, NAN) == 0.0f, "aces NaN");
 }
 
 typedef struct px_case {
@@ -65,19 +65,19 @@ static void check_pixels(const char *dir, const px_case *cases, int n, const cha
     float *img = malloc(sizeof(float) * 4 * (size_t)n);
     for (int i = 0; i < n; ++i) memcpy(img + 4 * i, cases[i].in, sizeof cases[i].in);
     sy_error err = {0};
-    CHECK(sy_png_write(p, n, 1, img, &cases[0].o, &err) == SY_OK, "%s: %s", label, err.message);
+    EXPECT_MSG(sy_png_write(p, n, 1, img, &cases[0].o, &err) == SY_OK, "%s: %s", label, err.message);
     int w = 0, h = 0;
     uint8_t *px = NULL;
-    CHECK(sy_png_read_rgba8(p, &w, &h, &px, &err) == SY_OK, "%s: %s", label, err.message);
-    CHECK(w == n && h == 1, "%s: size %dx%d", label, w, h);
+    EXPECT_MSG(sy_png_read_rgba8(p, &w, &h, &px, &err) == SY_OK, "%s: %s", label, err.message);
+    EXPECT_MSG(w == n && h == 1, "%s: size %dx%d", label, w, h);
     for (int i = 0; px && i < n; ++i) {
         for (int c = 0; c < 4; ++c) {
             int want = cases[i].want[c] >= 0 ? cases[i].want[c] : ref_byte(ref_oetf(cases[i].want_lin[c]));
-            CHECK(px[4 * i + c] == want, "%s pixel %d channel %d: got %d want %d", label, i, c, px[4 * i + c], want);
+            EXPECT_MSG(px[4 * i + c] == want, "%s pixel %d channel %d: got %d want %d", label, i, c, px[4 * i + c], want);
         }
         uint8_t direct[4];
         sy_png_encode_pixel(cases[i].in, &cases[i].o, direct);
-        CHECK(memcmp(direct, px + 4 * i, 4) == 0, "%s pixel %d: sy_png_encode_pixel differs from the file", label, i);
+        EXPECT_MSG(memcmp(direct, px + 4 * i, 4) == 0, "%s pixel %d: sy_png_encode_pixel differs from the file", label, i);
     }
     free(px);
     free(img);
@@ -138,29 +138,29 @@ static void test_file_properties(const char *dir)
     char p[4096];
     PATHF(p, "%s/orient.png", dir);
     sy_error err = {0};
-    CHECK(sy_png_write(p, w, h, img, NULL, &err) == SY_OK, "%s", err.message);
+    EXPECT_MSG(sy_png_write(p, w, h, img, NULL, &err) == SY_OK, "%s", err.message);
     int rw = 0, rh = 0;
     uint8_t *px = NULL;
-    CHECK(sy_png_read_rgba8(p, &rw, &rh, &px, &err) == SY_OK, "%s", err.message);
-    CHECK(rw == w && rh == h, "size %dx%d", rw, rh);
+    EXPECT_MSG(sy_png_read_rgba8(p, &rw, &rh, &px, &err) == SY_OK, "%s", err.message);
+    EXPECT_MSG(rw == w && rh == h, "size %dx%d", rw, rh);
     for (int y = 0; px && y < h; ++y)
         for (int x = 0; x < w; ++x) {
-            CHECK(px[4 * (y * w + x)] == ref_byte(ref_oetf(y / 3.0)), "row %d red", y);
-            CHECK(px[4 * (y * w + x) + 1] == ref_byte(ref_oetf(x / 2.0)), "column %d green", x);
+            EXPECT_MSG(px[4 * (y * w + x)] == ref_byte(ref_oetf(y / 3.0)), "row %d red", y);
+            EXPECT_MSG(px[4 * (y * w + x) + 1] == ref_byte(ref_oetf(x / 2.0)), "column %d green", x);
         }
     free(px);
 
     /* The file is an RGBA8 PNG with an sRGB chunk. */
     size_t n = 0;
     unsigned char *bytes = slurp(p, &n);
-    CHECK(bytes && n > 33 && memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0, "PNG signature");
+    EXPECT_MSG(bytes && n > 33 && memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0, "PNG signature");
     bool has_srgb = false;
     for (size_t i = 0; bytes && i + 4 <= n; ++i)
         if (memcmp(bytes + i, "sRGB", 4) == 0) has_srgb = true;
-    CHECK(has_srgb, "no sRGB chunk");
-    CHECK(bytes && bytes[24] == 8 && bytes[25] == 6, "IHDR: bit depth %d colour type %d", bytes ? bytes[24] : -1,
-          bytes ? bytes[25] : -1);
-    CHECK(count_entries_containing(dir, ".tmp-") == 0, "temporary file left behind");
+    EXPECT_MSG(has_srgb, "no sRGB chunk");
+    EXPECT_MSG(bytes && bytes[24] == 8 && bytes[25] == 6, "IHDR: bit depth %d colour type %d", bytes ? bytes[24] : -1,
+               bytes ? bytes[25] : -1);
+    EXPECT_MSG(count_entries_containing(dir, ".tmp-") == 0, "temporary file left behind");
 
     /* Truncated and garbage input give errors naming the file, never a crash. */
     char q[4096];
@@ -173,12 +173,12 @@ static void test_file_properties(const char *dir)
         int a = 0, b = 0;
         sy_result r = sy_png_read_rgba8(q, &a, &b, &out, &err);
         if (r == SY_OK || out) {
-            CHECK(0, "PNG cut at %zu of %zu accepted", len, n);
+            EXPECT_MSG(0, "PNG cut at %zu of %zu accepted", len, n);
             free(out);
             break;
         }
         if (!strstr(err.message, q)) {
-            CHECK(0, "message does not name the file: %s", err.message);
+            EXPECT_MSG(0, "message does not name the file: %s", err.message);
             break;
         }
     }
@@ -189,21 +189,21 @@ static void test_file_properties(const char *dir)
     write_bytes(q, junk, sizeof junk);
     uint8_t *out = NULL;
     int a = 0, b = 0;
-    CHECK(sy_png_read_rgba8(q, &a, &b, &out, &err) == SY_ERR_PARSE && out == NULL, "garbage accepted");
+    EXPECT_MSG(sy_png_read_rgba8(q, &a, &b, &out, &err) == SY_ERR_PARSE && out == NULL, "garbage accepted");
     PATHF(q, "%s/missing.png", dir);
-    CHECK(sy_png_read_rgba8(q, &a, &b, &out, &err) == SY_ERR_NOT_FOUND, "missing file: %s", err.message);
+    EXPECT_MSG(sy_png_read_rgba8(q, &a, &b, &out, &err) == SY_ERR_NOT_FOUND, "missing file: %s", err.message);
 
     /* Failed writes: missing directory (nothing created), invalid arguments (target untouched). */
     PATHF(q, "%s/no_such_dir/x.png", dir);
     sy_result r = sy_png_write(q, w, h, img, NULL, &err);
-    CHECK(r != SY_OK && strstr(err.message, q) != NULL, "missing directory: %d %s", (int)r, err.message);
-    CHECK(!path_exists(q), "file created in a missing directory");
+    EXPECT_MSG(r != SY_OK && strstr(err.message, q) != NULL, "missing directory: %d %s", (int)r, err.message);
+    EXPECT_MSG(!path_exists(q), "file created in a missing directory");
     sy_png_options bad = {.exposure_stops = NAN};
-    CHECK(sy_png_write(p, w, h, img, &bad, &err) == SY_ERR_INVALID_ARGUMENT, "NaN exposure accepted");
+    EXPECT_MSG(sy_png_write(p, w, h, img, &bad, &err) == SY_ERR_INVALID_ARGUMENT, "NaN exposure accepted");
     bad = (sy_png_options){.tonemap = (sy_tonemap)42};
-    CHECK(sy_png_write(p, w, h, img, &bad, &err) == SY_ERR_INVALID_ARGUMENT, "unknown tone map accepted");
-    CHECK(sy_png_write(p, 0, h, img, NULL, &err) == SY_ERR_INVALID_ARGUMENT, "zero width accepted");
-    CHECK(sy_png_read_rgba8(p, &rw, &rh, &px, &err) == SY_OK && rw == w && rh == h, "target damaged");
+    EXPECT_MSG(sy_png_write(p, w, h, img, &bad, &err) == SY_ERR_INVALID_ARGUMENT, "unknown tone map accepted");
+    EXPECT_MSG(sy_png_write(p, 0, h, img, NULL, &err) == SY_ERR_INVALID_ARGUMENT, "zero width accepted");
+    EXPECT_MSG(sy_png_read_rgba8(p, &rw, &rh, &px, &err) == SY_OK && rw == w && rh == h, "target damaged");
     free(px);
 }
 
@@ -218,13 +218,13 @@ static void test_metadata(const char *dir)
     char p[4096], q[4096];
     PATHF(p, "%s/meta.png", dir);
     sy_error err = {0};
-    CHECK(sy_png_write(p, w, h, img, &o, &err) == SY_OK, "%s", err.message);
+    EXPECT_MSG(sy_png_write(p, w, h, img, &o, &err) == SY_OK, "%s", err.message);
     sy_png_info pi;
-    CHECK(sy_png_read_info(p, &pi, &err) == SY_OK, "%s", err.message);
-    CHECK(pi.width == w && pi.height == h && pi.text_count == 3, "%dx%d, %d texts", pi.width, pi.height, pi.text_count);
+    EXPECT_MSG(sy_png_read_info(p, &pi, &err) == SY_OK, "%s", err.message);
+    EXPECT_MSG(pi.width == w && pi.height == h && pi.text_count == 3, "%dx%d, %d texts", pi.width, pi.height, pi.text_count);
     for (int i = 0; i < pi.text_count && i < 3; ++i)
-        CHECK(!strcmp(pi.keys[i], texts[i].key) && !strcmp(pi.values[i], texts[i].value), "text %d: %s=%s", i,
-              pi.keys[i], pi.values[i]);
+        EXPECT_MSG(!strcmp(pi.keys[i], texts[i].key) && !strcmp(pi.values[i], texts[i].value), "text %d: %s=%s", i,
+                   pi.keys[i], pi.values[i]);
     sy_png_info_free(&pi);
     sy_png_info_free(&pi); /* twice: safe */
     size_t n = 0;
@@ -233,17 +233,17 @@ static void test_metadata(const char *dir)
     for (size_t len = 0; bytes && len < 40; ++len) { /* inside the signature, IHDR or a text chunk */
         write_bytes(q, bytes, len);
         if (sy_png_read_info(q, &pi, &err) == SY_OK) {
-            CHECK(0, "PNG cut at %zu accepted", len);
+            EXPECT_MSG(0, "PNG cut at %zu accepted", len);
             sy_png_info_free(&pi);
             break;
         }
-        CHECK(strstr(err.message, q) != NULL && pi.text_count == 0, "cut at %zu: %s", len, err.message);
+        EXPECT_MSG(strstr(err.message, q) != NULL && pi.text_count == 0, "cut at %zu: %s", len, err.message);
     }
     free(bytes);
-    CHECK(sy_png_read_info(p + 0, &pi, &err) == SY_OK, "%s", err.message);
+    EXPECT_MSG(sy_png_read_info(p + 0, &pi, &err) == SY_OK, "%s", err.message);
     sy_png_info_free(&pi);
     PATHF(q, "%s/missing.png", dir);
-    CHECK(sy_png_read_info(q, &pi, &err) == SY_ERR_NOT_FOUND, "missing file: %s", err.message);
+    EXPECT_MSG(sy_png_read_info(q, &pi, &err) == SY_ERR_NOT_FOUND, "missing file: %s", err.message);
 }
 
 int main(void)
@@ -255,5 +255,5 @@ int main(void)
     test_file_properties(dir);
     test_metadata(dir);
     remove_scratch_dir(dir);
-    return finish_tests("test_png");
+    return sy_check_finish("test_png");
 }

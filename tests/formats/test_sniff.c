@@ -43,22 +43,22 @@ int main(void)
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         sy_file_format got = of(cases[i].bytes);
-        CHECK(got == cases[i].want, "case %zu: %s, expected %s", i, sy_file_format_name(got), sy_file_format_name(cases[i].want));
+        EXPECT_MSG(got == cases[i].want, "case %zu: %s, expected %s", i, sy_file_format_name(got), sy_file_format_name(cases[i].want));
     }
-    CHECK(!strcmp(sy_file_format_name(SY_FORMAT_OBJ), "Wavefront OBJ"), "OBJ's name");
-    CHECK(sy_file_format_is_scene(SY_FORMAT_GLB) && !sy_file_format_is_scene(SY_FORMAT_OBJ), "scene formats");
+    EXPECT_MSG(!strcmp(sy_file_format_name(SY_FORMAT_OBJ), "Wavefront OBJ"), "OBJ's name");
+    EXPECT_MSG(sy_file_format_is_scene(SY_FORMAT_GLB) && !sy_file_format_is_scene(SY_FORMAT_OBJ), "scene formats");
 
     char dir[4096], p[4200];
     make_scratch_dir(dir, sizeof dir, "sniff");
     snprintf(p, sizeof p, "%s/model.gltf", dir); /* an OBJ under a glTF name */
     const char obj[] = "v 0 0 0\nf 1 1 1\n";
-    CHECK(write_bytes(p, obj, sizeof obj - 1) == 0, "cannot write %s", p);
+    EXPECT_MSG(write_bytes(p, obj, sizeof obj - 1) == 0, "cannot write %s", p);
     sy_file_format got = SY_FORMAT_UNKNOWN;
     sy_error e = {0};
-    CHECK(sy_sniff_file(p, &got, &e) == SY_OK && got == SY_FORMAT_OBJ, "model.gltf holding OBJ: %s", sy_file_format_name(got));
+    EXPECT_MSG(sy_sniff_file(p, &got, &e) == SY_OK && got == SY_FORMAT_OBJ, "model.gltf holding OBJ: %s", sy_file_format_name(got));
     snprintf(p, sizeof p, "%s/missing.glb", dir);
-    CHECK(sy_sniff_file(p, &got, &e) == SY_ERR_NOT_FOUND && strstr(e.message, "missing.glb"), "missing: %s", e.message);
-    CHECK(sy_sniff_file(dir, &got, &e) != SY_OK && strstr(e.message, "folder"), "a folder: %s", e.message);
+    EXPECT_MSG(sy_sniff_file(p, &got, &e) == SY_ERR_NOT_FOUND && strstr(e.message, "missing.glb"), "missing: %s", e.message);
+    EXPECT_MSG(sy_sniff_file(dir, &got, &e) != SY_OK && strstr(e.message, "folder"), "a folder: %s", e.message);
     remove_scratch_dir(dir);
-    return finish_tests("test_sniff");
+    return sy_check_finish("test_sniff");
 }

@@ -1,9 +1,9 @@
-/* test_util.h — tiny helpers shared by the tests in tests/formats: checks that count failures,
- * a private scratch directory, and small file utilities. Test-only; header-only on purpose. */
+/* test_util.h — tiny helpers shared by the tests in tests/formats: the check kit
+ * (tests/support/sy_check.h; counted EXPECT checks, sy_check_finish), a private scratch directory, and small file utilities. Test-only; header-only on purpose. */
 #ifndef SY_TEST_UTIL_H
 #define SY_TEST_UTIL_H
 
-#include "../support/check_count.h"
+#include "../support/sy_check.h"
 #include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
@@ -11,8 +11,6 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-static int g_failures;
 
 /* snprintf into a char array, aborting on truncation (test paths must never be cut short). */
 #define PATHF(buf, ...)                                                                  \
@@ -22,8 +20,6 @@ static int g_failures;
             abort();                                                                     \
         }                                                                                \
     } while (0)
-
-#define CHECK(cond, ...) SY_CHECK_COUNT(g_failures, cond, __VA_ARGS__)
 
 /* Creates a fresh scratch directory under $TMPDIR (or /tmp); path written to buf. */
 static void make_scratch_dir(char *buf, size_t n, const char *tag)
@@ -108,16 +104,6 @@ static inline unsigned char *slurp(const char *path, size_t *n)
     fclose(f);
     *n = len;
     return b;
-}
-
-static int finish_tests(const char *name)
-{
-    if (g_failures) {
-        fprintf(stderr, "%s: %d check(s) failed\n", name, g_failures);
-        return 1;
-    }
-    printf("%s: all checks passed\n", name);
-    return 0;
 }
 
 #endif /* SY_TEST_UTIL_H */

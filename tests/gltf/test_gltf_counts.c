@@ -7,6 +7,7 @@
  * none) and tangents wherever a material with a normal map is used with texture coordinates. A file
  * that requires an extension sy does not read must be refused naming it, and only such a file.
  * Usage: test_gltf_counts TESTDATA_DIR (exit 77 when the data is absent). */
+#include "../support/sy_check.h"
 #include "sy_gltf.h"
 
 #include <cJSON.h>
@@ -18,17 +19,14 @@
 #include <string.h>
 #include <sys/stat.h>
 
-static int g_failures = 0, g_checks = 0, g_refused = 0;
+static int g_refused = 0;
 
-#define CHECK_EQ(what, got, want)                                                                                      \
-    do {                                                                                                               \
-        g_checks++;                                                                                                    \
-        if ((uint64_t)(got) != (uint64_t)(want)) {                                                                     \
-            g_failures++;                                                                                              \
-            fprintf(stderr, "FAIL %s: %s = %llu, expected %llu\n", file, what, (unsigned long long)(got),              \
-                    (unsigned long long)(want));                                                                       \
-        }                                                                                                              \
-    } while (0)
+/* One count of `file` against the value read from its JSON (the message names the file). */
+static void expect_count(const char *file, const char *what, uint64_t got, uint64_t want)
+{
+    EXPECT_MSG(got == want, "%s: %s = %llu, expected %llu", file, what, (unsigned long long)got,
+               (unsigned long long)want);
+}
 
 typedef struct expected {
     uint64_t nodes, meshes, primitives, triangles, skipped, materials, textures, images, cameras, lights, points,
@@ -137,12 +135,11 @@ static const char *unsupported_required(const cJSON *doc)
 
 static void check_file(const char *file, uint32_t *models)
 {
-    g_checks++;
     cJSON *doc = read_json(file);
     expected e;
-    if (!doc || !compute(doc, &e)) {
-        g_failures++;
-        fprintf(stderr, "FAIL %s: the test's own JSON reading failed\n", file);
+    bool read = doc && compute(doc, &e);
+    EXPECT_MSG(read, "%s: the test's own JSON reading failed", file);
+    if (!read) {
         cJSON_Delete(doc);
         return;
     }
@@ -158,37 +155,32 @@ static void check_file(const char *file, uint32_t *models)
     sy_gltf_options opts = {0};
     opts.max_image_pixels = 1;
     sy_result r = sy_gltf_load(file, scene, &opts, &info, &err);
-    g_checks++;
     const char *unsupported = unsupported_required(doc);
     if (unsupported) {
         g_refused++;
         char quoted[256];
         snprintf(quoted, sizeof quoted, "'%s'", unsupported);
-        if (r != SY_ERR_UNSUPPORTED || !strstr(err.message, quoted)) {
-            g_failures++;
-            fprintf(stderr, "FAIL %s: requires %s: want SY_ERR_UNSUPPORTED naming it, got %s: %s\n", file, unsupported,
-                    sy_result_str(r), r ? err.message : "loaded");
-        } else {
-            printf("refused as it should be (requires %s, not read by sy): %s\n", unsupported, file);
-        }
+        bool refused = r == SY_ERR_UNSUPPORTED && strstr(err.message, quoted);
+        EXPECT_MSG(refused, "%s: requires %s: want SY_ERR_UNSUPPORTED naming it, got %s: %s", file, unsupported,
+                   sy_result_str(r), r ? err.message : "loaded");
+        if (refused) printf("refused as it should be (requires %s, not read by sy): %s\n", unsupported, file);
     } else if (r != SY_OK) {
-        g_failures++;
-        fprintf(stderr, "FAIL %s: load failed: %s\n", file, err.message);
+        EXPECT_MSG(r == SY_OK, "%s: load failed: %s", file, err.message);
     } else {
         (*models)++;
         const sy_gltf_counts *c = &info.counts;
-        CHECK_EQ("nodes", c->nodes, e.nodes);
-        CHECK_EQ("meshes", c->meshes, e.meshes);
-        CHECK_EQ("primitives", c->primitives, e.primitives);
-        CHECK_EQ("triangles", c->triangles, e.triangles);
-        CHECK_EQ("skipped_primitives", c->skipped_primitives, e.skipped);
-        CHECK_EQ("points", c->points, e.points);
-        CHECK_EQ("line_segments", c->line_segments, e.segments);
-        CHECK_EQ("materials", c->materials, e.materials);
-        CHECK_EQ("textures", c->textures, e.textures);
-        CHECK_EQ("images", c->images, e.images);
-        CHECK_EQ("cameras", c->cameras, e.cameras);
-        CHECK_EQ("lights", c->lights, e.lights);
+        expect_count(file, "nodes", c->nodes, e.nodes);
+        expect_count(file, "meshes", c->meshes, e.meshes);
+        expect_count(file, "primitives", c->primitives, e.primitives);
+        expect_count(file, "triangles", c->triangles, e.triangles);
+        expect_count(file, "skipped_primitives", c->skipped_primitives, e.skipped);
+        expect_count(file, "points", c->points, e.points);
+        expect_count(file, "line_segments", c->line_segments, e.segments);
+        expect_count(file, "materials", c->materials, e.materials);
+        expect_count(file, "textures", c->textures, e.textures);
+        expect_count(file, "images", c->images, e.images);
+        expect_count(file, "cameras", c->cameras, e.cameras);
+        expect_count(file, "lights", c->lights, e.lights);
         /* the scene itself: every mesh is created, whether referenced or not */
         uint64_t tris = 0, prims = 0, without_normals = 0, missing_tangents = 0;
         for (uint32_t id = sy_scene_next(scene, SY_TYPE_MESH, 0); id; id = sy_scene_next(scene, SY_TYPE_MESH, id)) {
@@ -204,10 +196,10 @@ static void check_file(const char *file, uint32_t *models)
                     missing_tangents++;
             }
         }
-        CHECK_EQ("scene triangles", tris, e.triangles);
-        CHECK_EQ("scene primitives", prims, e.primitives - e.skipped);
-        CHECK_EQ("primitives without normals", without_normals, 0);
-        CHECK_EQ("normal-mapped primitives without tangents", missing_tangents, 0);
+        expect_count(file, "scene triangles", tris, e.triangles);
+        expect_count(file, "scene primitives", prims, e.primitives - e.skipped);
+        expect_count(file, "primitives without normals", without_normals, 0);
+        expect_count(file, "normal-mapped primitives without tangents", missing_tangents, 0);
     }
     sy_gltf_info_free(&info);
     sy_scene_destroy(scene);
@@ -284,14 +276,10 @@ int main(int argc, char **argv)
     qsort(files.items, files.count, sizeof *files.items, cmp_str);
     uint32_t models = 0;
     for (size_t i = 0; i < files.count; ++i) check_file(files.items[i], &models);
-    printf("%zu files, %u loaded, %d refused for an unsupported required extension, %d checks, %d failures\n",
-           files.count, models, g_refused, g_checks, g_failures);
-    int rc = g_failures ? 1 : 0;
-    if (files.count < 30) {
-        fprintf(stderr, "FAIL: only %zu glTF files found under %s\n", files.count, root);
-        rc = 1;
-    }
+    printf("%zu files, %u loaded, %d refused for an unsupported required extension\n", files.count, models,
+           g_refused);
+    EXPECT_MSG(files.count >= 30, "only %zu glTF files found under %s", files.count, root);
     for (size_t i = 0; i < files.count; ++i) free(files.items[i]);
     free(files.items);
-    return rc;
+    return sy_check_finish("gltf_counts");
 }

@@ -4,7 +4,7 @@
  * number of triangles (12 per non-degenerate segment + 20 per distinct vertex or point) whose bounds
  * lie within the positions grown by half the core width and reach at least 0.85 of it (the
  * icosahedron's extent). Usage: test_gltf_strokes TESTDATA_DIR (exit 77 when the sample is absent). */
-#include "../support/check_count.h"
+#include "../support/sy_check.h"
 #include "sy_gltf.h"
 #include "sy_strokes.h"
 
@@ -13,9 +13,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-
-static int g_fail;
-#define CHECK(c, ...) SY_CHECK_COUNT(g_fail, c, __VA_ARGS__)
 
 int main(int argc, char **argv)
 {
@@ -34,9 +31,9 @@ int main(int argc, char **argv)
         return 1;
     }
     /* the file: POINTS 7 indices, LINES 12 indices, LINE_LOOP 7, LINE_STRIP 7 */
-    CHECK(info.counts.points == 7 && info.counts.line_segments == 6 + 7 + 6 && info.counts.skipped_primitives == 0,
-          "counts %u points %u segments %u skipped", info.counts.points, info.counts.line_segments,
-          info.counts.skipped_primitives);
+    EXPECT_MSG(info.counts.points == 7 && info.counts.line_segments == 6 + 7 + 6 && info.counts.skipped_primitives == 0,
+               "counts %u points %u segments %u skipped", info.counts.points, info.counts.line_segments,
+               info.counts.skipped_primitives);
     uint32_t strokes = 0;
     for (uint32_t id = sy_scene_next(s, SY_TYPE_MESH, 0); id; id = sy_scene_next(s, SY_TYPE_MESH, id)) {
         const sy_mesh_data *m = sy_object_get(s, SY_TYPE_MESH, id);
@@ -62,40 +59,35 @@ int main(int argc, char **argv)
                 }
                 free(seen);
             }
-            CHECK(sy_strokes_triangle_count(p) == want, "%s primitive %u: %llu triangles predicted, expected %llu",
-                  m->name, k, (unsigned long long)sy_strokes_triangle_count(p), (unsigned long long)want);
+            EXPECT_MSG(sy_strokes_triangle_count(p) == want, "%s primitive %u: %llu triangles predicted, expected %llu",
+                       m->name, k, (unsigned long long)sy_strokes_triangle_count(p), (unsigned long long)want);
             sy_bounds pb = sy_primitive_position_bounds(p);
             float w = sy_primitive_stroke_width(p, &pb), r = 0.5f * w;
             sy_primitive t;
             sy_result res = sy_strokes_tessellate(p, w, m->name, &t, &e);
-            CHECK(res == SY_OK, "%s: %s", m->name, e.message);
+            EXPECT_MSG(res == SY_OK, "%s: %s", m->name, e.message);
             if (res != SY_OK) continue;
-            CHECK(sy_primitive_triangle_count(&t) == want && t.normals && t.topology == SY_TOPOLOGY_TRIANGLES,
-                  "%s: %u triangles, expected %llu", m->name, sy_primitive_triangle_count(&t), (unsigned long long)want);
+            EXPECT_MSG(sy_primitive_triangle_count(&t) == want && t.normals && t.topology == SY_TOPOLOGY_TRIANGLES,
+                       "%s: %u triangles, expected %llu", m->name, sy_primitive_triangle_count(&t), (unsigned long long)want);
             sy_bounds tb = sy_primitive_position_bounds(&t);
             for (int a = 0; a < 3; a++) {
-                CHECK(tb.min[a] >= pb.min[a] - r - 1e-5f && tb.max[a] <= pb.max[a] + r + 1e-5f &&
-                          tb.min[a] <= pb.min[a] - 0.85f * r && tb.max[a] >= pb.max[a] + 0.85f * r,
-                      "%s axis %d: tessellation [%g %g], positions [%g %g], r %g", m->name, a, (double)tb.min[a],
-                      (double)tb.max[a], (double)pb.min[a], (double)pb.max[a], (double)r);
+                EXPECT_MSG(tb.min[a] >= pb.min[a] - r - 1e-5f && tb.max[a] <= pb.max[a] + r + 1e-5f &&
+                           tb.min[a] <= pb.min[a] - 0.85f * r && tb.max[a] >= pb.max[a] + 0.85f * r,
+                           "%s axis %d: tessellation [%g %g], positions [%g %g], r %g", m->name, a, (double)tb.min[a],
+                           (double)tb.max[a], (double)pb.min[a], (double)pb.max[a], (double)r);
             }
             /* unit normals */
             const float *nn = sy_blob_data(t.normals);
             uint32_t off = 0;
             for (uint32_t q = 0; q < sy_primitive_vertex_count(&t); q++)
                 if (fabsf(nn[3 * q] * nn[3 * q] + nn[3 * q + 1] * nn[3 * q + 1] + nn[3 * q + 2] * nn[3 * q + 2] - 1) > 1e-4f) off++;
-            CHECK(off == 0, "%s: %u normals not unit", m->name, off);
+            EXPECT_MSG(off == 0, "%s: %u normals not unit", m->name, off);
             printf("%s: %u elements, width %.4f -> %u triangles\n", m->name, n, (double)w, sy_primitive_triangle_count(&t));
             sy_primitive_release(&t);
         }
     }
-    CHECK(strokes == 4, "4 stroke primitives, got %u", strokes);
+    EXPECT_MSG(strokes == 4, "4 stroke primitives, got %u", strokes);
     sy_gltf_info_free(&info);
     sy_scene_destroy(s);
-    if (g_fail) {
-        fprintf(stderr, "gltf_strokes: %d failure(s)\n", g_fail);
-        return 1;
-    }
-    printf("gltf_strokes: all checks passed\n");
-    return 0;
+    return sy_check_finish("gltf_strokes");
 }

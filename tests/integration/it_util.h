@@ -1,9 +1,11 @@
-/* it_util.h — small helpers shared by the integration tests: checks that report file:line and
- * keep going (the test fails at the end), test-data lookup with the "skip = exit 77" rule, scratch
+/* it_util.h — small helpers shared by the integration tests: the check kit
+ * (tests/support/sy_check.h; the tests use its counted EXPECT form, which keeps going, and end with
+ * sy_check_finish), MUST, test-data lookup with the "skip = exit 77" rule, scratch
  * directories, and scene-building shortcuts (unlit quads, camera views by hand). */
 #ifndef IT_UTIL_H
 #define IT_UTIL_H
 
+#include "../support/sy_check.h"
 #include "sy_mediator.h"
 #include "sy_mediators.h"
 #include "sy_scene.h"
@@ -14,26 +16,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-
-static int it_failures;
-
-#define CHECK(cond)                                                                                                  \
-    do {                                                                                                             \
-        if (!(cond)) {                                                                                               \
-            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond);                                 \
-            it_failures++;                                                                                           \
-        }                                                                                                            \
-    } while (0)
-
-#define CHECKF(cond, ...)                                                                                            \
-    do {                                                                                                             \
-        if (!(cond)) {                                                                                               \
-            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #cond);                                 \
-            fprintf(stderr, __VA_ARGS__);                                                                            \
-            fputc('\n', stderr);                                                                                     \
-            it_failures++;                                                                                           \
-        }                                                                                                            \
-    } while (0)
 
 /* A call returning sy_result that must succeed; aborts the test on failure (later steps depend on it). */
 #define MUST(call)                                                                                                   \
@@ -47,16 +29,6 @@ static int it_failures;
             exit(1);                                                                                                 \
         }                                                                                                            \
     } while (0)
-
-static inline int it_finish(const char *name)
-{
-    if (it_failures) {
-        fprintf(stderr, "%s: %d check(s) failed\n", name, it_failures);
-        return 1;
-    }
-    printf("%s: all checks passed\n", name);
-    return 0;
-}
 
 static inline void it_register(void)
 {

@@ -36,7 +36,7 @@ static void check_light_region(const sy_layer *img, uint32_t *count_out)
                 sx = x, sy = y;
             }
     *count_out = count;
-    CHECKF(count > 0, "no pixel shows the light's radiance (17, 12, 4) exactly");
+    EXPECT_MSG(count > 0, "no pixel shows the light's radiance (17, 12, 4) exactly");
     if (!count) return;
     /* one 4-connected region: flood fill from one light pixel reaches them all */
     static uint8_t seen[W * H];
@@ -61,15 +61,15 @@ static void check_light_region(const sy_layer *img, uint32_t *count_out)
     }
     uint32_t bw = x1 - x0 + 1, bh = y1 - y0 + 1;
     printf("light: %u pixels, bbox x %u..%u y %u..%u, connected %u\n", count, x0, x1, y0, y1, reached);
-    CHECKF(reached == count, "light pixels are not one connected region (%u of %u reached)", reached, count);
+    EXPECT_MSG(reached == count, "light pixels are not one connected region (%u of %u reached)", reached, count);
     /* compact: a (perspective) quad fills most of its bounding box */
-    CHECKF(count * 10 >= bw * bh * 6, "light region fills only %u of its %ux%u bbox", count, bw, bh);
+    EXPECT_MSG(count * 10 >= bw * bh * 6, "light region fills only %u of its %ux%u bbox", count, bw, bh);
     /* near the top centre: by hand, the light (x 0.213..0.343, y 0.5483, z 0.227..0.332) seen from
      * (0.278, 0.273, -0.8) with tan(yfov/2) = 12.5/35 spans rows ~32..41 and columns ~106..150 */
     float cx = 0.5f * (float)(x0 + x1 + 1);
-    CHECKF(fabsf(cx - W / 2.0f) <= 4.0f, "light centre column %.1f is not the image centre", cx);
-    CHECKF(y0 >= 24 && y1 <= 48, "light rows %u..%u are not near the top (expected ~32..41)", y0, y1);
-    CHECKF(bw >= 30 && bw <= 60 && bh >= 5 && bh <= 16, "light bbox %ux%u is not ~45x10", bw, bh);
+    EXPECT_MSG(fabsf(cx - W / 2.0f) <= 4.0f, "light centre column %.1f is not the image centre", cx);
+    EXPECT_MSG(y0 >= 24 && y1 <= 48, "light rows %u..%u are not near the top (expected ~32..41)", y0, y1);
+    EXPECT_MSG(bw >= 30 && bw <= 60 && bh >= 5 && bh <= 16, "light bbox %ux%u is not ~45x10", bw, bh);
 }
 
 static void band_means(const float *rgba, uint32_t x_begin, uint32_t x_end, uint32_t y_begin, uint32_t y_end,
@@ -98,10 +98,10 @@ static void check_walls_and_depth(const sy_layer *img)
     band_means(img->rgba, W - 60, W, H / 4, H - H / 4, wall);
     printf("left third mean %.4f %.4f %.4f, right third mean %.4f %.4f %.4f, green wall band %.4f %.4f %.4f\n",
            left[0], left[1], left[2], right[0], right[1], right[2], wall[0], wall[1], wall[2]);
-    CHECKF(left[0] > 2.0 * left[1], "left third is not red-dominant (R %.4f, G %.4f)", left[0], left[1]);
-    CHECKF(right[1] > right[0], "right third is not green-dominant (R %.4f, G %.4f)", right[0], right[1]);
-    CHECKF(wall[1] > 1.5 * wall[0], "green wall band: G %.4f not above 1.5 R %.4f", wall[1], wall[0]);
-    CHECKF(sy_layer_count_nonfinite(img) == 0, "%zu non-finite pixels", sy_layer_count_nonfinite(img));
+    EXPECT_MSG(left[0] > 2.0 * left[1], "left third is not red-dominant (R %.4f, G %.4f)", left[0], left[1]);
+    EXPECT_MSG(right[1] > right[0], "right third is not green-dominant (R %.4f, G %.4f)", right[0], right[1]);
+    EXPECT_MSG(wall[1] > 1.5 * wall[0], "green wall band: G %.4f not above 1.5 R %.4f", wall[1], wall[0]);
+    EXPECT_MSG(sy_layer_count_nonfinite(img) == 0, "%zu non-finite pixels", sy_layer_count_nonfinite(img));
     /* Depth = distance along the view axis (+Z here, camera at z = -0.8). The box is open at the
      * front (z = 0) and ends at the back wall (z ~ 0.56), so every interior pixel must be hit at a
      * depth in [0.8, 1.36] (small margins). Outer rows/columns may look past the front edges. */
@@ -115,32 +115,32 @@ static void check_walls_and_depth(const sy_layer *img)
             if (d > dmax) dmax = d;
         }
     printf("interior depth range %.4f .. %.4f\n", dmin, dmax);
-    CHECKF(bad == 0, "%u interior pixels have a depth outside the box", bad);
+    EXPECT_MSG(bad == 0, "%u interior pixels have a depth outside the box", bad);
 }
 
 static void check_exr_roundtrip(const sy_layer *img, uint32_t light_count)
 {
     char dir[] = "/tmp/sy_it_cornell_XXXXXX";
     if (!mkdtemp(dir)) {
-        CHECKF(false, "mkdtemp failed");
+        EXPECT_MSG(false, "mkdtemp failed");
         return;
     }
     char path[256];
     snprintf(path, sizeof path, "%s/cornell.exr", dir);
     sy_error err = {0};
     sy_result r = sy_exr_write_rgba(path, W, H, img->rgba, img->depth, SY_EXR_PIXEL_FLOAT, &err);
-    CHECKF(r == SY_OK, "sy_exr_write_rgba: %s", err.message);
+    EXPECT_MSG(r == SY_OK, "sy_exr_write_rgba: %s", err.message);
     sy_exr_image *back = NULL;
     if (r == SY_OK) {
         r = sy_exr_read(path, &back, &err);
-        CHECKF(r == SY_OK, "sy_exr_read: %s", err.message);
+        EXPECT_MSG(r == SY_OK, "sy_exr_read: %s", err.message);
     }
     if (back) {
-        CHECK(back->width == W && back->height == H);
+        EXPECT(back->width == W && back->height == H);
         const float *ch[5] = {sy_exr_image_channel(back, "R"), sy_exr_image_channel(back, "G"),
                               sy_exr_image_channel(back, "B"), sy_exr_image_channel(back, "A"),
                               sy_exr_image_channel(back, "Z")};
-        CHECK(ch[0] && ch[1] && ch[2] && ch[3] && ch[4]);
+        EXPECT(ch[0] && ch[1] && ch[2] && ch[3] && ch[4]);
         if (ch[0] && ch[1] && ch[2] && ch[3] && ch[4] && back->width == W && back->height == H) {
             uint32_t mismatches = 0, lights = 0;
             for (size_t i = 0; i < (size_t)W * H; ++i) {
@@ -150,14 +150,14 @@ static void check_exr_roundtrip(const sy_layer *img, uint32_t light_count)
                 const float p[4] = {ch[0][i], ch[1][i], ch[2][i], ch[3][i]};
                 if (is_light(p)) lights++;
             }
-            CHECKF(mismatches == 0, "%u values changed through EXR", mismatches);
-            CHECKF(lights == light_count, "EXR holds %u light pixels, the render %u", lights, light_count);
+            EXPECT_MSG(mismatches == 0, "%u values changed through EXR", mismatches);
+            EXPECT_MSG(lights == light_count, "EXR holds %u light pixels, the render %u", lights, light_count);
         }
     }
     sy_exr_image_free(back);
     unlink(path);
     /* the writer leaves nothing else behind (no temp file) */
-    CHECKF(rmdir(dir) == 0, "scratch directory %s not empty after the EXR write", dir);
+    EXPECT_MSG(rmdir(dir) == 0, "scratch directory %s not empty after the EXR write", dir);
 }
 
 /* Whole-image sanity bound against the Cycles reference (4096 spp path tracing, 64 bounces).
@@ -172,10 +172,10 @@ static void compare_reference(const sy_layer *img, const char *ref_path)
     sy_exr_image *ref = NULL;
     sy_error err = {0};
     sy_result r = sy_exr_read(ref_path, &ref, &err);
-    CHECKF(r == SY_OK, "reading the reference: %s", err.message);
+    EXPECT_MSG(r == SY_OK, "reading the reference: %s", err.message);
     if (r != SY_OK) return;
     const float *rc[3] = {sy_exr_image_channel(ref, "R"), sy_exr_image_channel(ref, "G"), sy_exr_image_channel(ref, "B")};
-    CHECK(ref->width == W && ref->height == H && rc[0] && rc[1] && rc[2]);
+    EXPECT(ref->width == W && ref->height == H && rc[0] && rc[1] && rc[2]);
     if (ref->width == W && ref->height == H && rc[0] && rc[1] && rc[2]) {
         double ours[3] = {0, 0, 0}, theirs[3] = {0, 0, 0}, ours_lit[3] = {0, 0, 0}, theirs_lit[3] = {0, 0, 0};
         uint32_t ref_lights = 0, missing = 0, lit = 0;
@@ -206,17 +206,17 @@ static void compare_reference(const sy_layer *img, const char *ref_path)
         printf("reference light pixels %u, not light here %u\n", ref_lights, missing);
         printf("surfaces only (%u pixels): whitted %.5f %.5f %.5f, reference %.5f %.5f %.5f\n", lit, ours_lit[0],
                ours_lit[1], ours_lit[2], theirs_lit[0], theirs_lit[1], theirs_lit[2]);
-        CHECKF(ref_lights > 0, "reference has no exact light pixel");
-        CHECKF(missing == 0, "%u pixels fully covered by the light in the reference miss it here", missing);
+        EXPECT_MSG(ref_lights > 0, "reference has no exact light pixel");
+        EXPECT_MSG(missing == 0, "%u pixels fully covered by the light in the reference miss it here", missing);
         for (int c = 0; c < 3; ++c) {
-            CHECKF(ours[c] < theirs[c], "channel %d: mean %.5f is not below the reference %.5f", c, ours[c], theirs[c]);
-            CHECKF(ours[c] > 0.3 * theirs[c], "channel %d: mean %.5f is below 30 %% of the reference %.5f", c, ours[c],
-                   theirs[c]);
+            EXPECT_MSG(ours[c] < theirs[c], "channel %d: mean %.5f is not below the reference %.5f", c, ours[c], theirs[c]);
+            EXPECT_MSG(ours[c] > 0.3 * theirs[c], "channel %d: mean %.5f is below 30 %% of the reference %.5f", c, ours[c],
+                       theirs[c]);
             /* the same bound without the light's own pixels (which are equal in both and make up
              * about half of the red mean), i.e. on the lit surfaces alone */
-            CHECKF(ours_lit[c] < theirs_lit[c] && ours_lit[c] > 0.3 * theirs_lit[c],
-                   "channel %d: surfaces' mean %.5f not within (30 %%, 100 %%) of the reference %.5f", c, ours_lit[c],
-                   theirs_lit[c]);
+            EXPECT_MSG(ours_lit[c] < theirs_lit[c] && ours_lit[c] > 0.3 * theirs_lit[c],
+                       "channel %d: surfaces' mean %.5f not within (30 %%, 100 %%) of the reference %.5f", c, ours_lit[c],
+                       theirs_lit[c]);
         }
     }
     sy_exr_image_free(ref);
@@ -235,7 +235,7 @@ int main(void)
     MUST(sy_gltf_load(gltf, scene, NULL, &info, err));
     sy_node cam;
     MUST(sy_gltf_find_camera(scene, &info, "camera", &cam, err));
-    CHECK(info.camera_node_count == 1 && info.camera_nodes[0].id == cam.id);
+    EXPECT(info.camera_node_count == 1 && info.camera_nodes[0].id == cam.id);
     MUST(sy_scene_commit(scene, NULL, err));
 
     sy_context_pool *pool;
@@ -248,7 +248,7 @@ int main(void)
     sy_layer img;
     MUST(sy_layer_create(W, H, &img, err));
     MUST(sy_window_render(win, scene, pool, NULL, &img, err));
-    CHECK(sy_context_pool_size(pool) == 1);
+    EXPECT(sy_context_pool_size(pool) == 1);
 
     uint32_t light_count = 0;
     check_light_region(&img, &light_count);
@@ -260,8 +260,8 @@ int main(void)
     sy_layer again;
     MUST(sy_layer_create(W, H, &again, err));
     MUST(sy_window_render(win, scene, pool, NULL, &again, err));
-    CHECKF(it_layers_identical(&img, &again), "a second render of the unchanged scene differs");
-    CHECK(sy_context_pool_size(pool) == 1);
+    EXPECT_MSG(it_layers_identical(&img, &again), "a second render of the unchanged scene differs");
+    EXPECT(sy_context_pool_size(pool) == 1);
 
     sy_layer_destroy(&again);
     sy_layer_destroy(&img);
@@ -269,5 +269,5 @@ int main(void)
     sy_context_pool_destroy(pool);
     sy_gltf_info_free(&info);
     sy_scene_destroy(scene);
-    return it_finish("integration_cornell");
+    return sy_check_finish("integration_cornell");
 }

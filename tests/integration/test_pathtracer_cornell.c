@@ -93,39 +93,39 @@ int main(void)
     MUST(sy_context_pool_get(pool, scene, "pathtracer", &pp, info.root.id, &ctx, err));
     sy_mediator_stats st;
     sy_context_stats(ctx, &st);
-    CHECKF(st.samples == spp, "stats report %llu samples, expected %u", (unsigned long long)st.samples, spp);
-    CHECKF(sy_layer_count_nonfinite(&img) == 0, "%zu non-finite pixels", sy_layer_count_nonfinite(&img));
+    EXPECT_MSG(st.samples == spp, "stats report %llu samples, expected %u", (unsigned long long)st.samples, spp);
+    EXPECT_MSG(sy_layer_count_nonfinite(&img) == 0, "%zu non-finite pixels", sy_layer_count_nonfinite(&img));
 
     /* AOVs */
     sy_mediator_rt_aovs a;
     MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
     float *var = malloc((size_t)W * W * 3 * sizeof *var);
     memcpy(var, a.planes[1], (size_t)W * W * 3 * sizeof *var);
-    CHECKF(a.nonfinite_samples == 0, "%llu samples dropped", (unsigned long long)a.nonfinite_samples);
+    EXPECT_MSG(a.nonfinite_samples == 0, "%llu samples dropped", (unsigned long long)a.nonfinite_samples);
     double worst = 0;
     for (size_t i = 0; i < (size_t)W * W; ++i)
         for (int c = 0; c < 3; ++c) {
             double dsum = a.planes[5][3 * i + c] + a.planes[6][3 * i + c], col = a.planes[0][4 * i + c];
             worst = fmax(worst, fabs(dsum - col) / fmax(1.0, fabs(col)));
         }
-    CHECKF(worst < 1e-4, "direct + indirect differs from colour by %g", worst);
+    EXPECT_MSG(worst < 1e-4, "direct + indirect differs from colour by %g", worst);
     /* the back wall centre (a little below the middle) is white: albedo 0.725 0.71 0.68 */
     const float *alb = a.planes[2] + 3 * ((size_t)(W * 55 / 100) * W + W / 2);
-    CHECKF(fabsf(alb[0] - 0.725f) < 1e-3f && fabsf(alb[1] - 0.71f) < 1e-3f && fabsf(alb[2] - 0.68f) < 1e-3f,
-           "albedo of the back wall %g %g %g", alb[0], alb[1], alb[2]);
+    EXPECT_MSG(fabsf(alb[0] - 0.725f) < 1e-3f && fabsf(alb[1] - 0.71f) < 1e-3f && fabsf(alb[2] - 0.68f) < 1e-3f,
+               "albedo of the back wall %g %g %g", alb[0], alb[1], alb[2]);
     sy_mediator_rt_aovs_free(&a);
 
     /* light pixels: exactly its radiance where fully covered */
     uint32_t exact = 0;
     for (size_t i = 0; i < (size_t)W * W; ++i)
         exact += img.rgba[4 * i] == 17.0f && img.rgba[4 * i + 1] == 12.0f && img.rgba[4 * i + 2] == 4.0f;
-    CHECKF(exact > 0, "no pixel shows the light's radiance 17 12 4 exactly");
+    EXPECT_MSG(exact > 0, "no pixel shows the light's radiance 17 12 4 exactly");
 
     sy_exr_image *ref;
     MUST(sy_exr_read(rpath, &ref, err));
-    CHECK(ref->width == 256 && ref->height == 256);
+    EXPECT(ref->width == 256 && ref->height == 256);
     const float *rc[3] = {sy_exr_image_channel(ref, "R"), sy_exr_image_channel(ref, "G"), sy_exr_image_channel(ref, "B")};
-    CHECK(rc[0] && rc[1] && rc[2]);
+    EXPECT(rc[0] && rc[1] && rc[2]);
     uint32_t f = 256 / W, bs = 8 / f ? 8 / f : 1; /* our pixels per reference pixel, block size in our pixels */
     double om[3] = {0, 0, 0}, rm[3] = {0, 0, 0}, block_sum = 0, noise_sum = 0;
     uint32_t blocks = 0;
@@ -183,14 +183,14 @@ int main(void)
            W, W, spp, secs, 100 * mean_err[0], 100 * mean_err[1], 100 * mean_err[2], 100 * block, blocks, 100 * noise);
     double tm = full ? 0.005 : THRESH_MEAN, tb = full ? 0.02 : THRESH_BLOCK_NOISE * noise + THRESH_BLOCK_ABS;
     for (int c = 0; c < 3; ++c)
-        CHECKF(fabs(mean_err[c]) < tm, "channel %d: whole-image mean differs by %.3f%% (limit %.2f%%)", c, 100 * mean_err[c],
-               100 * tm);
-    CHECKF(block < tb, "block error %.3f%% (limit %.2f%%)", 100 * block, 100 * tb);
+        EXPECT_MSG(fabs(mean_err[c]) < tm, "channel %d: whole-image mean differs by %.3f%% (limit %.2f%%)", c, 100 * mean_err[c],
+                   100 * tm);
+    EXPECT_MSG(block < tb, "block error %.3f%% (limit %.2f%%)", 100 * block, 100 * tb);
     sy_exr_image_free(ref);
     sy_layer_destroy(&img);
     sy_context_pool_destroy(pool);
     sy_window_destroy(win);
     sy_gltf_info_free(&info);
     sy_scene_destroy(scene);
-    return it_finish("integration_pathtracer_cornell");
+    return sy_check_finish("integration_pathtracer_cornell");
 }

@@ -103,9 +103,9 @@ static void expect_rejected(fixture *fx, const char *params, const char *needle)
     sy_context *ctx = NULL;
     sy_error e = {0};
     sy_result r = sy_context_pool_get(fx->pool, fx->scene, "pathtracer", &pp, fx->info.root.id, &ctx, &e);
-    CHECKF(r != SY_OK, "params '%s' accepted", params);
-    CHECKF(r == SY_OK || strstr(e.message, needle), "params '%s': message '%s' does not mention '%s'", params, e.message,
-           needle);
+    EXPECT_MSG(r != SY_OK, "params '%s' accepted", params);
+    EXPECT_MSG(r == SY_OK || strstr(e.message, needle), "params '%s': message '%s' does not mention '%s'", params, e.message,
+               needle);
     if (r != SY_OK) printf("rejected %-40s -> %s\n", params, e.message);
 }
 
@@ -182,9 +182,9 @@ static void test_hook_records(void)
     printf("hook: %zu/%d pixels with P0, mean incident %.4f; %zu pixels differ from the render without records, "
            "%zu colour values differ from the accumulation, %zu split mismatches\n",
            p0, S * S, inc_sum / (3.0 * (double)(p0 ? p0 : 1)), differ, color_bad, split_bad);
-    CHECKF(differ == 0, "records changed %zu pixels of the path-traced image", differ);
-    CHECKF(color_bad == 0 && split_bad == 0, "record colour / split mismatches: %zu / %zu", color_bad, split_bad);
-    CHECKF(p0 > S * S * 9 / 10 && inc_sum > 0, "only %zu P0 records, incident sum %g", p0, inc_sum);
+    EXPECT_MSG(differ == 0, "records changed %zu pixels of the path-traced image", differ);
+    EXPECT_MSG(color_bad == 0 && split_bad == 0, "record colour / split mismatches: %zu / %zu", color_bad, split_bad);
+    EXPECT_MSG(p0 > S * S * 9 / 10 && inc_sum > 0, "only %zu P0 records, incident sum %g", p0, inc_sum);
 
     /* NaN/Inf records: counted, output finite, kept out of every neighbourhood */
     const size_t bad[3] = {10 * S + 10, 24 * S + 24, 25 * S + 24};
@@ -204,7 +204,7 @@ static void test_hook_records(void)
                 memset(r, 0, sizeof *r);
                 continue;
             }
-            CHECK(r->flags & SY_RT_RECORD_P0);
+            EXPECT(r->flags & SY_RT_RECORD_P0);
             if (b == 0) r->incident[1] = NAN;
             if (b == 1) r->color[0] = INFINITY;
             if (b == 2) r->position[2] = NAN;
@@ -225,11 +225,11 @@ static void test_hook_records(void)
     printf("hook NaN/Inf: %llu non-finite records reported, %zu non-finite outputs, %zu values of other pixels differ "
            "from the run without those samples, %zu pixels filtered\n",
            (unsigned long long)st[0].nonfinite_samples, nonfinite, other_differ, filtered);
-    CHECKF(st[0].nonfinite_samples == 3 && st[1].nonfinite_samples == 0, "reported %llu / %llu non-finite records",
-           (unsigned long long)st[0].nonfinite_samples, (unsigned long long)st[1].nonfinite_samples);
-    CHECKF(nonfinite == 0 && other_differ == 0, "non-finite outputs %zu, other pixels changed %zu", nonfinite,
-           other_differ);
-    CHECKF(filtered > S * S / 2, "only %zu pixels were filtered (frame 1 uses the warm-up radius)", filtered);
+    EXPECT_MSG(st[0].nonfinite_samples == 3 && st[1].nonfinite_samples == 0, "reported %llu / %llu non-finite records",
+               (unsigned long long)st[0].nonfinite_samples, (unsigned long long)st[1].nonfinite_samples);
+    EXPECT_MSG(nonfinite == 0 && other_differ == 0, "non-finite outputs %zu, other pixels changed %zu", nonfinite,
+               other_differ);
+    EXPECT_MSG(filtered > S * S / 2, "only %zu pixels were filtered (frame 1 uses the warm-up radius)", filtered);
     free(out[0]), free(out[1]), free(rec), free(rgba), free(rgba2);
     sy_rt_accum_destroy(acc[0]), sy_rt_accum_destroy(acc[1]);
     sy_rt_device_destroy(dev);
@@ -258,7 +258,7 @@ int main(void)
     /* reference, box-averaged to W x W (RGBA, alpha 1) */
     sy_exr_image *ref;
     MUST(sy_exr_read(rpath, &ref, err));
-    CHECK(ref->width == 256 && ref->height == 256);
+    EXPECT(ref->width == 256 && ref->height == 256);
     const float *rc[3] = {sy_exr_image_channel(ref, "R"), sy_exr_image_channel(ref, "G"), sy_exr_image_channel(ref, "B")};
     if (!rc[0] || !rc[1] || !rc[2]) {
         fprintf(stderr, "reference lacks R, G or B\n");
@@ -300,12 +300,12 @@ int main(void)
             ctx = render_frames(&fx, win, params, 1, 1, &img);
             sy_mediator_rt_aovs a;
             MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
-            CHECKF(a.samples == frame, "%s: %u samples after frame %u", names[k], a.samples, frame);
+            EXPECT_MSG(a.samples == frame, "%s: %u samples after frame %u", names[k], a.samples, frame);
             if (k == 0 && frame < 4) { /* before the first scheduled pass: exactly unfiltered */
                 size_t diff = 0;
                 for (size_t i = 0; i < n * 4; ++i) diff += img.rgba[i] != a.planes[0][i];
-                CHECKF(diff == 0, "pixel filter, frame %u (before the first pass): %zu values differ from unfiltered",
-                       frame, diff);
+                EXPECT_MSG(diff == 0, "pixel filter, frame %u (before the first pass): %zu values differ from unfiltered",
+                           frame, diff);
             }
             if (frame == 4) {
                 double u = relmse(a.planes[0], refw, W, W), fr = relmse(img.rgba, refw, W, W);
@@ -341,21 +341,21 @@ int main(void)
                     /* radiance: 27.9x measured; the same filter without the world-space prism
                      * (rf_prism_thickness=100, rf_grazing_epsilon=1: samples leak across surfaces) gets 14.3x */
                     double want = k == 1 ? 20.0 : 8.0;
-                    CHECKF(se[0][0] >= want * se[0][1], "%s, interior pixels: relMSE only %.2fx lower (want %.0fx)",
-                           names[k], se[0][0] / se[0][1], want);
+                    EXPECT_MSG(se[0][0] >= want * se[0][1], "%s, interior pixels: relMSE only %.2fx lower (want %.0fx)",
+                               names[k], se[0][0] / se[0][1], want);
                     printf("  relMSE split: %zu edge pixels (%.1f%%) contribute unfiltered %.5f filtered %.5f; interior "
                            "pixels unfiltered %.5f filtered %.5f (%.2fx lower)\n",
                            ne, 100.0 * (double)ne / (double)n, se[1][0] / tot, se[1][1] / tot, se[0][0] / tot,
                            se[0][1] / tot, se[0][0] / se[0][1]);
                 }
-                CHECKF(!strcmp(fi.name, names[k]), "filter info names '%s'", fi.name);
-                CHECKF(fi.nonfinite_pixels == 0 && fi.nonfinite_samples == 0, "non-finite: %llu pixels %llu samples",
-                       (unsigned long long)fi.nonfinite_pixels, (unsigned long long)fi.nonfinite_samples);
-                CHECKF(sy_layer_count_nonfinite(&img) == 0, "%s: non-finite output", names[k]);
-                CHECKF(fr < u, "%s: filtered relMSE %.5f not below unfiltered %.5f", names[k], fr, u);
+                EXPECT_MSG(!strcmp(fi.name, names[k]), "filter info names '%s'", fi.name);
+                EXPECT_MSG(fi.nonfinite_pixels == 0 && fi.nonfinite_samples == 0, "non-finite: %llu pixels %llu samples",
+                           (unsigned long long)fi.nonfinite_pixels, (unsigned long long)fi.nonfinite_samples);
+                EXPECT_MSG(sy_layer_count_nonfinite(&img) == 0, "%s: non-finite output", names[k]);
+                EXPECT_MSG(fr < u, "%s: filtered relMSE %.5f not below unfiltered %.5f", names[k], fr, u);
                 if (k == 0) {
                     unfiltered_relmse = u, pixel_relmse = fr;
-                    CHECK(fi.filter_pass && fi.last_pass_samples == 4);
+                    EXPECT(fi.filter_pass && fi.last_pass_samples == 4);
                 }
                 if (k == 1) radiance_relmse = fr;
             }
@@ -364,11 +364,11 @@ int main(void)
         sy_layer_destroy(&img);
         sy_window_destroy(win);
     }
-    CHECKF(pixel_relmse * 4.0 <= unfiltered_relmse, "pixel filter relMSE %.5f is not 4x below unfiltered %.5f (%.2fx)",
-           pixel_relmse, unfiltered_relmse, unfiltered_relmse / pixel_relmse);
-    CHECKF(radiance_relmse * 4.0 <= unfiltered_relmse,
-           "radiance filter relMSE %.5f is not 4x below unfiltered %.5f (%.2fx)", radiance_relmse, unfiltered_relmse,
-           unfiltered_relmse / radiance_relmse);
+    EXPECT_MSG(pixel_relmse * 4.0 <= unfiltered_relmse, "pixel filter relMSE %.5f is not 4x below unfiltered %.5f (%.2fx)",
+               pixel_relmse, unfiltered_relmse, unfiltered_relmse / pixel_relmse);
+    EXPECT_MSG(radiance_relmse * 4.0 <= unfiltered_relmse,
+               "radiance filter relMSE %.5f is not 4x below unfiltered %.5f (%.2fx)", radiance_relmse, unfiltered_relmse,
+               unfiltered_relmse / radiance_relmse);
 
     /* 3. live changes never restart the accumulation */
     {
@@ -389,32 +389,32 @@ int main(void)
             render_frames(&fx, win, params, 1, 1, &img);
             sy_mediator_stats ms;
             sy_context_stats(ctx, &ms);
-            CHECKF(ms.samples == last + 1, "after switching to %s: %llu samples (expected %llu)", seq[i] ? seq[i] : "t=0.04",
-                   (unsigned long long)ms.samples, (unsigned long long)(last + 1));
+            EXPECT_MSG(ms.samples == last + 1, "after switching to %s: %llu samples (expected %llu)", seq[i] ? seq[i] : "t=0.04",
+                       (unsigned long long)ms.samples, (unsigned long long)(last + 1));
             last = ms.samples;
             sy_mediator_rt_filter_info fi;
             sy_mediator_rt_filter_info_get(st, &fi);
-            CHECKF(fabsf(fi.threshold - (i ? 0.04f : 0.01f)) < 1e-7f, "threshold %g after the change", (double)fi.threshold);
+            EXPECT_MSG(fabsf(fi.threshold - (i ? 0.04f : 0.01f)) < 1e-7f, "threshold %g after the change", (double)fi.threshold);
             sy_mediator_rt_aovs a;
             MUST(sy_mediator_rt_aovs_get(st, &a, err));
             size_t diff = 0;
             for (size_t j = 0; j < n * 4; ++j) diff += img.rgba[j] != a.planes[0][j];
-            if (seq[i] && !strcmp(seq[i], "none")) CHECKF(diff == 0, "filter none: %zu values differ from unfiltered", diff);
+            if (seq[i] && !strcmp(seq[i], "none")) EXPECT_MSG(diff == 0, "filter none: %zu values differ from unfiltered", diff);
             if (seq[i] && !strcmp(seq[i], "radiance")) { /* resumed on the accumulation, not restarted */
                 double rel = relmse(img.rgba, a.planes[0], W, W);
                 printf("switch to radiance at %llu spp: relMSE against the unfiltered accumulation %.5f\n",
                        (unsigned long long)ms.samples, rel);
-                CHECKF(diff > 0 && rel < 0.005, "radiance after the switch: %zu values differ, relMSE %.5f to unfiltered",
-                       diff, rel);
+                EXPECT_MSG(diff > 0 && rel < 0.005, "radiance after the switch: %zu values differ, relMSE %.5f to unfiltered",
+                           diff, rel);
             }
             if (seq[i] && !strcmp(seq[i], "pixel"))
-                CHECKF(diff > n, "pixel filter re-enabled: only %zu values differ (no pass ran?)", diff);
+                EXPECT_MSG(diff > n, "pixel filter re-enabled: only %zu values differ (no pass ran?)", diff);
             sy_mediator_rt_aovs_free(&a);
         }
         sy_mediator_rt_counters c1;
         sy_mediator_rt_counters_get(st, &c1);
-        CHECKF(c1.accum_restarts == c0.accum_restarts, "filter changes restarted the accumulation (%u -> %u)",
-               c0.accum_restarts, c1.accum_restarts);
+        EXPECT_MSG(c1.accum_restarts == c0.accum_restarts, "filter changes restarted the accumulation (%u -> %u)",
+                   c0.accum_restarts, c1.accum_restarts);
         /* a visible scene change (a node of the box moved) restarts this slot's accumulation: the
          * pixel filter's state restarts with it (no stale filtered buffer: the first frames are
          * exactly the new unfiltered estimate, the pass comes back at 4 samples) */
@@ -423,7 +423,7 @@ int main(void)
         sy_node moved = {0};
         for (uint32_t q = 0; q < nkids && !moved.id; ++q)
             if (kids[q] != fx.cam.id) moved.id = kids[q];
-        CHECK(moved.id != 0);
+        EXPECT(moved.id != 0);
         sy_mat4 m0 = sy_node_get(fx.scene, moved)->transform.matrix, m1 = m0;
         m1.m[12] += 0.01f;
         MUST(sy_node_set_matrix(fx.scene, moved, &m1, err));
@@ -434,24 +434,24 @@ int main(void)
             MUST(sy_mediator_rt_aovs_get(st, &a, err));
             size_t diff = 0;
             for (size_t j = 0; j < n * 4; ++j) diff += img.rgba[j] != a.planes[0][j];
-            CHECKF(a.samples == frame, "after the scene change: %u samples at frame %u", a.samples, frame);
-            if (frame < 4) CHECKF(diff == 0, "after the scene change, frame %u: %zu values differ from unfiltered", frame, diff);
-            else CHECKF(diff > n, "after the scene change, frame 4: no filter pass (%zu values differ)", diff);
+            EXPECT_MSG(a.samples == frame, "after the scene change: %u samples at frame %u", a.samples, frame);
+            if (frame < 4) EXPECT_MSG(diff == 0, "after the scene change, frame %u: %zu values differ from unfiltered", frame, diff);
+            else EXPECT_MSG(diff > n, "after the scene change, frame 4: no filter pass (%zu values differ)", diff);
             sy_mediator_rt_aovs_free(&a);
         }
         MUST(sy_node_set_matrix(fx.scene, moved, &m0, err));
         MUST(sy_scene_commit(fx.scene, NULL, err));
         /* a rejected change changes nothing */
         sy_error e = {0};
-        CHECK(sy_mediator_rt_set_filter(st, "bogus", NULL, &e) != SY_OK && strstr(e.message, "bogus"));
+        EXPECT(sy_mediator_rt_set_filter(st, "bogus", NULL, &e) != SY_OK && strstr(e.message, "bogus"));
         sy_params bad = {0};
         MUST(sy_params_set(&bad, "sigma_s", "0", err));
         e = (sy_error){0};
-        CHECK(sy_mediator_rt_set_filter(st, "atrous", &bad, &e) != SY_OK && strstr(e.message, "sigma_s"));
+        EXPECT(sy_mediator_rt_set_filter(st, "atrous", &bad, &e) != SY_OK && strstr(e.message, "sigma_s"));
         sy_mediator_rt_filter_info fi;
         sy_mediator_rt_filter_info_get(st, &fi);
-        CHECKF(!strcmp(fi.name, "pixel") && fabsf(fi.threshold - 0.04f) < 1e-7f, "after rejected changes: %s t=%g",
-               fi.name, (double)fi.threshold);
+        EXPECT_MSG(!strcmp(fi.name, "pixel") && fabsf(fi.threshold - 0.04f) < 1e-7f, "after rejected changes: %s t=%g",
+                   fi.name, (double)fi.threshold);
         sy_layer_destroy(&img);
         sy_window_destroy(win);
     }
@@ -485,7 +485,7 @@ int main(void)
         sy_context *ctx = render_frames(&fx, win, params, SPP / 64, 64, &img);
         sy_mediator_rt_aovs a;
         MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
-        CHECKF(a.samples == SPP, "%u samples", a.samples);
+        EXPECT_MSG(a.samples == SPP, "%u samples", a.samples);
         sy_mediator_rt_filter_info fi;
         sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
         double zu = 0, zf = 0, zd = 0, worst = 0;
@@ -518,12 +518,12 @@ int main(void)
                T, T, SPP, fname, fk == 2 ? " (unbiased buffer)" : "", fi.mean_blend, fi.last_pass_samples, exact, m,
                close, zu, zf, zd, worst);
         if (fk == 2)
-            CHECKF((double)close >= fi.mean_blend * (double)m - 0.5,
-                   "unbiased buffer: %zu pixels equal the accumulation, %.0f are in the correction phase", close,
-                   fi.mean_blend * (double)m);
-        CHECKF(fi.last_pass_samples == SPP, "last pass at %u spp", fi.last_pass_samples);
-        CHECKF(zf < zu + 0.5, "filtered image is %.3f variances from the reference (unfiltered: %.3f)", zf, zu);
-        CHECKF(zd < 0.5, "filtered differs from unfiltered by %.3f times its own variance on average", zd);
+            EXPECT_MSG((double)close >= fi.mean_blend * (double)m - 0.5,
+                       "unbiased buffer: %zu pixels equal the accumulation, %.0f are in the correction phase", close,
+                       fi.mean_blend * (double)m);
+        EXPECT_MSG(fi.last_pass_samples == SPP, "last pass at %u spp", fi.last_pass_samples);
+        EXPECT_MSG(zf < zu + 0.5, "filtered image is %.3f variances from the reference (unfiltered: %.3f)", zf, zu);
+        EXPECT_MSG(zd < 0.5, "filtered differs from unfiltered by %.3f times its own variance on average", zd);
         sy_mediator_rt_aovs_free(&a);
         sy_layer_destroy(&img);
         sy_window_destroy(win);
@@ -551,5 +551,5 @@ int main(void)
     sy_context_pool_destroy(fx.pool);
     sy_gltf_info_free(&fx.info);
     sy_scene_destroy(fx.scene);
-    return it_finish("integration_pathtracer_filter");
+    return sy_check_finish("integration_pathtracer_filter");
 }

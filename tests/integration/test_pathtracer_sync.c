@@ -109,24 +109,24 @@ int main(void)
     fixture fx;
     build(&fx);
     sy_scene *s = fx.s;
-    CHECK(render(&fx, 0) == 1);
-    CHECK(render(&fx, 1) == 2);
-    CHECK(render(&fx, 3) == 5);
-    CHECK(sy_layer_count_nonfinite(&fx.img) == 0);
+    EXPECT(render(&fx, 0) == 1);
+    EXPECT(render(&fx, 1) == 2);
+    EXPECT(render(&fx, 3) == 5);
+    EXPECT(sy_layer_count_nonfinite(&fx.img) == 0);
 
     /* invisible: attachment, name, the unused camera */
     sy_attachment att = {.key = "pt.hint", .kind = SY_ATTACH_INT, .value.i = 3};
     MUST(sy_object_set_attachment(s, SY_TYPE_NODE, fx.geo.id, &att, err));
     commit(&fx);
-    CHECKF(render(&fx, 1) == 6, "an attachment change restarted the accumulation");
+    EXPECT_MSG(render(&fx, 1) == 6, "an attachment change restarted the accumulation");
     it_set_translation(s, fx.spare_cam, 1, 2, 7);
     commit(&fx);
-    CHECKF(render(&fx, 1) == 7, "moving a camera no viewport uses restarted the accumulation");
+    EXPECT_MSG(render(&fx, 1) == 7, "moving a camera no viewport uses restarted the accumulation");
 
     /* visible changes restart */
     it_set_translation(s, fx.geo, 0.1f, 0, 0);
     commit(&fx);
-    CHECKF(render(&fx, 2) == 2, "a transform change did not restart");
+    EXPECT_MSG(render(&fx, 2) == 2, "a transform change did not restart");
     /* the restarted image equals a fresh context's render of the changed scene */
     float *after = malloc(32 * 24 * 4 * sizeof(float));
     memcpy(after, fx.img.rgba, 32 * 24 * 4 * sizeof(float));
@@ -137,7 +137,7 @@ int main(void)
         MUST(sy_layer_create(32, 24, &l2, err));
         sy_window_render_opts ro = {.sample_count = 2, .seed = 9};
         MUST(sy_window_render(fx.win, s, p2, &ro, &l2, err));
-        CHECKF(!memcmp(l2.rgba, after, 32 * 24 * 4 * sizeof(float)), "restarted image differs from a fresh render");
+        EXPECT_MSG(!memcmp(l2.rgba, after, 32 * 24 * 4 * sizeof(float)), "restarted image differs from a fresh render");
         sy_layer_destroy(&l2);
         sy_context_pool_destroy(p2);
     }
@@ -147,27 +147,27 @@ int main(void)
     md.base_color[0] = 0.3f;
     MUST(sy_material_set(s, fx.grey, &md, err));
     commit(&fx);
-    CHECKF(render(&fx, 1) == 1, "a material change did not restart");
-    CHECK(render(&fx, 1) == 2);
+    EXPECT_MSG(render(&fx, 1) == 1, "a material change did not restart");
+    EXPECT(render(&fx, 1) == 2);
 
     sy_light_data ld = *sy_light_get(s, fx.lamp);
     ld.intensity = 5.0f;
     MUST(sy_light_set(s, fx.lamp, &ld, err));
     commit(&fx);
-    CHECKF(render(&fx, 1) == 1, "a light change did not restart");
-    CHECK(render(&fx, 1) == 2);
+    EXPECT_MSG(render(&fx, 1) == 1, "a light change did not restart");
+    EXPECT(render(&fx, 1) == 2);
 
     sy_background_data bd = *sy_background_get(s, fx.bg);
     bd.color[1] = 0.7f;
     MUST(sy_background_set(s, fx.bg, &bd, err));
     commit(&fx);
-    CHECKF(render(&fx, 1) == 1, "a background change did not restart");
-    CHECK(render(&fx, 1) == 2);
+    EXPECT_MSG(render(&fx, 1) == 1, "a background change did not restart");
+    EXPECT(render(&fx, 1) == 2);
 
     it_set_translation(s, fx.cam_node, 0, 0.2f, 3);
     commit(&fx);
-    CHECKF(render(&fx, 1) == 1, "moving the viewport's camera did not restart");
-    CHECK(render(&fx, 1) == 2);
+    EXPECT_MSG(render(&fx, 1) == 1, "moving the viewport's camera did not restart");
+    EXPECT(render(&fx, 1) == 2);
 
     /* runtime switching: away to whitted and back; the cached path tracer context resumes its
      * accumulation because nothing changed meanwhile */
@@ -178,29 +178,29 @@ int main(void)
         MUST(sy_window_render(fx.win, s, fx.pool, &ro, &fx.img, err));
     }
     MUST(sy_viewport_set_backend(vp, "pathtracer", NULL, err));
-    CHECKF(render(&fx, 1) == 3, "switching back to the path tracer did not resume its accumulation");
-    CHECKF(render(&fx, 1) == 4, "accumulation after switching back");
+    EXPECT_MSG(render(&fx, 1) == 3, "switching back to the path tracer did not resume its accumulation");
+    EXPECT_MSG(render(&fx, 1) == 4, "accumulation after switching back");
     it_set_translation(s, fx.cam_node, 0, 0.2f, 3.5f);
     commit(&fx);
-    CHECK(render(&fx, 1) == 1);
-    CHECK(render(&fx, 1) == 2);
+    EXPECT(render(&fx, 1) == 1);
+    EXPECT(render(&fx, 1) == 2);
 
     /* AOVs of the viewport rectangle */
     sy_context *ctx;
     MUST(sy_context_pool_get(fx.pool, s, "pathtracer", NULL, fx.root.id, &ctx, err));
     sy_mediator_rt_aovs a;
     MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
-    CHECK(a.width == 32 && a.height == 24 && a.samples == 2 && a.nonfinite_samples == 0);
-    CHECK(!memcmp(a.planes[0], fx.img.rgba, 32 * 24 * 4 * sizeof(float)));
+    EXPECT(a.width == 32 && a.height == 24 && a.samples == 2 && a.nonfinite_samples == 0);
+    EXPECT(!memcmp(a.planes[0], fx.img.rgba, 32 * 24 * 4 * sizeof(float)));
     sy_mediator_rt_aovs_free(&a);
     sy_mediator_rt_counters cn;
     sy_mediator_rt_counters_get(sy_context_state(ctx), &cn);
-    CHECKF(cn.accum_restarts == 6, "restarts counted: %u", cn.accum_restarts);
+    EXPECT_MSG(cn.accum_restarts == 6, "restarts counted: %u", cn.accum_restarts);
     /* the Whitted context rejects the AOV request */
     sy_context *wc;
     MUST(sy_context_pool_get(fx.pool, s, "whitted", NULL, fx.root.id, &wc, err));
     sy_error e = {0};
-    CHECK(sy_mediator_rt_aovs_get(sy_context_state(wc), &a, &e) != SY_OK && e.message[0]);
+    EXPECT(sy_mediator_rt_aovs_get(sy_context_state(wc), &a, &e) != SY_OK && e.message[0]);
     destroy(&fx);
-    return it_finish("integration_pathtracer_sync");
+    return sy_check_finish("integration_pathtracer_sync");
 }

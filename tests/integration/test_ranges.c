@@ -90,9 +90,9 @@ static void test_gltf_camera_far(void)
     MUST(sy_scene_create(&s, err));
     sy_error e = {0};
     sy_result r = load_gltf(s, "{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,1e19]}", "0,1", NULL, &e);
-    CHECKF(r != SY_OK && strstr(e.message, "ranges.gltf") && strstr(e.message, "nodes[1]") &&
+    EXPECT_MSG(r != SY_OK && strstr(e.message, "ranges.gltf") && strstr(e.message, "nodes[1]") &&
                strstr(e.message, "coordinate range"),
-           "a camera at 1e19: %s (%s)", e.message, sy_result_str(r));
+               "a camera at 1e19: %s (%s)", e.message, sy_result_str(r));
     sy_scene_destroy(s);
 }
 
@@ -108,9 +108,9 @@ static void test_x3d_viewpoint_far(void)
     sy_x3d_info info = {0};
     sy_result r = sy_x3d_load_memory(doc, sizeof doc - 1, "far.x3d", ".", s, NULL, &info, &e);
     sy_x3d_info_free(&info);
-    CHECKF(r != SY_OK && strstr(e.message, "far.x3d") && strstr(e.message, "Viewpoint") &&
+    EXPECT_MSG(r != SY_OK && strstr(e.message, "far.x3d") && strstr(e.message, "Viewpoint") &&
                strstr(e.message, "coordinate range"),
-           "a Viewpoint at 1e19: %s (%s)", e.message, sy_result_str(r));
+               "a Viewpoint at 1e19: %s (%s)", e.message, sy_result_str(r));
     sy_scene_destroy(s);
 }
 
@@ -131,12 +131,12 @@ static void render_scale(const char *scale, uint32_t covered_out[BACKEND_COUNT])
     sy_node cam = {0};
     for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id))
         if (sy_node_get(s, (sy_node){id})->camera.id) cam.id = id;
-    CHECK(cam.id != 0);
+    EXPECT(cam.id != 0);
     for (size_t b = 0; b < BACKEND_COUNT; ++b) {
         uint32_t covered = 0;
         sy_error e = {0};
         sy_result r = render(s, cam, k_backends[b], &covered, &e);
-        CHECKF(r == SY_OK, "scale %s, %s: %s", scale ? scale : "(reference)", k_backends[b], e.message);
+        EXPECT_MSG(r == SY_OK, "scale %s, %s: %s", scale ? scale : "(reference)", k_backends[b], e.message);
         covered_out[b] = covered;
     }
     sy_scene_destroy(s);
@@ -150,14 +150,14 @@ static void test_scale(const char *scale, bool second_visible)
     static bool have_ref;
     if (!have_ref) {
         render_scale(NULL, ref);
-        for (size_t b = 0; b < BACKEND_COUNT; ++b) CHECKF(ref[b] > 30, "reference, %s: %u pixels", k_backends[b], ref[b]);
+        for (size_t b = 0; b < BACKEND_COUNT; ++b) EXPECT_MSG(ref[b] > 30, "reference, %s: %u pixels", k_backends[b], ref[b]);
         have_ref = true;
     }
     uint32_t covered[BACKEND_COUNT];
     render_scale(scale, covered);
     for (size_t b = 0; b < BACKEND_COUNT; ++b)
-        CHECKF(second_visible ? covered[b] > ref[b] + 30 : covered[b] <= ref[b] + 1,
-               "scale %s, %s: %u pixels covered, %u without the node", scale, k_backends[b], covered[b], ref[b]);
+        EXPECT_MSG(second_visible ? covered[b] > ref[b] + 30 : covered[b] <= ref[b] + 1,
+                   "scale %s, %s: %u pixels covered, %u without the node", scale, k_backends[b], covered[b], ref[b]);
 }
 
 /* The orbit after 25 zoom-outs and 14,000 large pans stays in range, and renders. */
@@ -168,7 +168,7 @@ static void test_orbit(void)
     for (int i = 0; i < 14000; ++i) sy_orbit_pan(&o, 1e4f, -1e4f);
     sy_mat4 m;
     sy_orbit_matrix(&o, &m);
-    CHECKF(sy_coords_in_range(m.m, 16), "orbit camera at %g %g %g", (double)m.m[12], (double)m.m[13], (double)m.m[14]);
+    EXPECT_MSG(sy_coords_in_range(m.m, 16), "orbit camera at %g %g %g", (double)m.m[12], (double)m.m[13], (double)m.m[14]);
     sy_scene *s;
     MUST(sy_scene_create(&s, err));
     MUST(load_gltf(s, "{\"mesh\":0},{\"camera\":0}", "0,1", NULL, err));
@@ -180,7 +180,7 @@ static void test_orbit(void)
     for (size_t b = 0; b < BACKEND_COUNT; ++b) {
         uint32_t covered = 0;
         sy_error e = {0};
-        CHECKF(render(s, cam, k_backends[b], &covered, &e) == SY_OK, "orbit view, %s: %s", k_backends[b], e.message);
+        EXPECT_MSG(render(s, cam, k_backends[b], &covered, &e) == SY_OK, "orbit view, %s: %s", k_backends[b], e.message);
     }
     sy_scene_destroy(s);
 }
@@ -204,17 +204,17 @@ static void test_composed(void)
         if (nd->transform.translation[2] > 10.0f) far.id = id;
         else near.id = id;
     }
-    CHECK(far.id && near.id);
+    EXPECT(far.id && near.id);
     for (size_t b = 0; b < BACKEND_COUNT; ++b) {
         uint32_t covered = 0;
         sy_error e = {0};
         sy_result r = render(s, near, k_backends[b], &covered, &e);
-        CHECKF(r == SY_OK && covered > 0, "composed beyond range, %s: %s, %u pixels", k_backends[b], e.message, covered);
+        EXPECT_MSG(r == SY_OK && covered > 0, "composed beyond range, %s: %s, %u pixels", k_backends[b], e.message, covered);
         char want[64];
         snprintf(want, sizeof want, "camera node %#x", far.id);
         r = render(s, far, k_backends[b], &covered, &e);
-        CHECKF(r != SY_OK && strstr(e.message, want) && strstr(e.message, "coordinate range"),
-               "a camera at 1e17, %s: %s", k_backends[b], e.message);
+        EXPECT_MSG(r != SY_OK && strstr(e.message, want) && strstr(e.message, "coordinate range"),
+                   "a camera at 1e17, %s: %s", k_backends[b], e.message);
     }
     sy_scene_destroy(s);
 }
@@ -254,8 +254,8 @@ static void test_dag(void)
     for (size_t b = 0; b < BACKEND_COUNT; ++b) {
         uint32_t covered = 0;
         sy_error e = {0};
-        CHECKF(render(s, (sy_node){0}, k_backends[b], &covered, &e) == SY_OK && covered > 0,
-               "2^14 placements, %s: %s, %u pixels", k_backends[b], e.message, covered);
+        EXPECT_MSG(render(s, (sy_node){0}, k_backends[b], &covered, &e) == SY_OK && covered > 0,
+                   "2^14 placements, %s: %s, %u pixels", k_backends[b], e.message, covered);
     }
     sy_scene_destroy(s);
     s = diamond(39, &root); /* 2^40: the mirror (shared by every back-end) refuses it; one back-end is enough */
@@ -263,7 +263,7 @@ static void test_dag(void)
         uint32_t covered = 0;
         sy_error e = {0};
         sy_result r = render(s, (sy_node){0}, "whitted", &covered, &e);
-        CHECKF(r == SY_ERR_LIMIT && strstr(e.message, "paths"), "2^40 placements: %s (%s)", e.message, sy_result_str(r));
+        EXPECT_MSG(r == SY_ERR_LIMIT && strstr(e.message, "paths"), "2^40 placements: %s (%s)", e.message, sy_result_str(r));
     }
     sy_scene_destroy(s);
 }
@@ -288,9 +288,9 @@ static void test_many_children(void)
     sy_error e = {0};
     sy_result r = sy_gltf_load_memory(doc, sizeof doc - 1, "instances.gltf", ".", s, NULL, &info, &e);
     /* loaded, or refused by the file's budget with a message naming the file: never a hang */
-    CHECKF(r == SY_OK || (r == SY_ERR_LIMIT && strstr(e.message, "instances.gltf")), "10^6 instances: %s (%s)",
-           e.message, sy_result_str(r));
-    if (r == SY_OK) CHECKF(sy_scene_count(s, SY_TYPE_NODE) >= 1000000, "%u nodes", sy_scene_count(s, SY_TYPE_NODE));
+    EXPECT_MSG(r == SY_OK || (r == SY_ERR_LIMIT && strstr(e.message, "instances.gltf")), "10^6 instances: %s (%s)",
+               e.message, sy_result_str(r));
+    if (r == SY_OK) EXPECT_MSG(sy_scene_count(s, SY_TYPE_NODE) >= 1000000, "%u nodes", sy_scene_count(s, SY_TYPE_NODE));
     sy_gltf_info_free(&info);
     sy_scene_destroy(s);
 }
@@ -314,9 +314,9 @@ static void test_budgets(void)
     sy_error e = {0};
     sy_result r = sy_gltf_load_memory(doc, n, "shared.gltf", ".", s, &go, &gi, &e);
     sy_gltf_info_free(&gi);
-    CHECKF(r == SY_ERR_LIMIT && strstr(e.message, "shared.gltf") && strstr(e.message, "meshes[0].primitives[") &&
+    EXPECT_MSG(r == SY_ERR_LIMIT && strstr(e.message, "shared.gltf") && strstr(e.message, "meshes[0].primitives[") &&
                strstr(e.message, "scene budget"),
-           "64 x 2^24 vertices: %s (%s)", e.message, sy_result_str(r));
+               "64 x 2^24 vertices: %s (%s)", e.message, sy_result_str(r));
     free(doc);
     /* an Extrusion of 4000 x 4000 points (51 KB) */
     size_t cap = 200000;
@@ -330,9 +330,9 @@ static void test_budgets(void)
     sy_x3d_info xi = {0};
     r = sy_x3d_load_memory(x, n, "extrusion.x3d", ".", s, &xo, &xi, &e);
     sy_x3d_info_free(&xi);
-    CHECKF(r == SY_ERR_LIMIT && strstr(e.message, "extrusion.x3d") && strstr(e.message, "Extrusion") &&
+    EXPECT_MSG(r == SY_ERR_LIMIT && strstr(e.message, "extrusion.x3d") && strstr(e.message, "Extrusion") &&
                strstr(e.message, "scene budget"),
-           "Extrusion 4000 x 4000: %s (%s)", e.message, sy_result_str(r));
+               "Extrusion 4000 x 4000: %s (%s)", e.message, sy_result_str(r));
     /* a USE graph of 2^30 paths in 30 levels (a few KB) */
     n = (size_t)snprintf(x, cap, "<?xml version=\"1.0\"?><X3D><Scene><Transform DEF=\"a0\"><Shape><Box/></Shape></Transform>");
     for (int k = 1; k <= 30; ++k)
@@ -344,10 +344,10 @@ static void test_budgets(void)
     xi = (sy_x3d_info){0};
     r = sy_x3d_load_memory(x, n, "fanout.x3d", ".", s, NULL, &xi, &e); /* the default budget */
     sy_x3d_info_free(&xi);
-    CHECKF(r == SY_ERR_LIMIT && strstr(e.message, "fanout.x3d") && strstr(e.message, "placements"),
-           "2^30 USE paths: %s (%s)", e.message, sy_result_str(r));
+    EXPECT_MSG(r == SY_ERR_LIMIT && strstr(e.message, "fanout.x3d") && strstr(e.message, "placements"),
+               "2^30 USE paths: %s (%s)", e.message, sy_result_str(r));
     free(x);
-    CHECKF(sy_scene_count(s, SY_TYPE_NODE) == 0, "refused loads leave %u nodes", sy_scene_count(s, SY_TYPE_NODE));
+    EXPECT_MSG(sy_scene_count(s, SY_TYPE_NODE) == 0, "refused loads leave %u nodes", sy_scene_count(s, SY_TYPE_NODE));
     sy_scene_destroy(s);
 }
 
@@ -389,5 +389,5 @@ int main(int argc, char **argv)
         fprintf(stderr, "test_it_ranges: no case '%s'\n", argv[1]);
         return 2;
     }
-    return it_finish("integration_ranges");
+    return sy_check_finish("integration_ranges");
 }

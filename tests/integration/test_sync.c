@@ -158,16 +158,16 @@ int main(void)
     MUST(sy_context_sync(ctx, err));
     sy_mediator_rt_counters c0 = counters(ctx);
     const uint32_t total_inst = (N + 1) + 3; /* leaf 0 has two primitives */
-    CHECKF(c0.instances == total_inst, "instances %u, expected %u", c0.instances, total_inst);
-    CHECKF(c0.meshes == 2 * 1 + (N - 1) + 1, "back-end meshes %u (one per primitive, shared mesh once)", c0.meshes);
-    CHECKF(c0.last_sync_placements == 1 + N + 1 + 3, "first sync placed %u nodes", c0.last_sync_placements);
+    EXPECT_MSG(c0.instances == total_inst, "instances %u, expected %u", c0.instances, total_inst);
+    EXPECT_MSG(c0.meshes == 2 * 1 + (N - 1) + 1, "back-end meshes %u (one per primitive, shared mesh once)", c0.meshes);
+    EXPECT_MSG(c0.last_sync_placements == 1 + N + 1 + 3, "first sync placed %u nodes", c0.last_sync_placements);
 
     sy_layer img0, img1, img2;
     MUST(sy_layer_create(IMG, IMG, &img0, err));
     MUST(sy_layer_create(IMG, IMG, &img1, err));
     MUST(sy_layer_create(IMG, IMG, &img2, err));
     render(ctx, &f, &img0);
-    CHECK(sy_layer_count_nonfinite(&img0) == 0);
+    EXPECT(sy_layer_count_nonfinite(&img0) == 0);
 
     /* every leaf and shared node shows its colour at its centre; between them there is nothing */
     for (uint32_t i = 0; i < N; ++i) {
@@ -175,25 +175,25 @@ int main(void)
         uint32_t px, py;
         leaf_pos(i, &x, &y);
         pixel_of(&f, x, y, &px, &py);
-        CHECKF(it_px_is(&img0, px, py, 0.8f, 0.6f, 0.2f, 1.0f), "leaf %u not visible at pixel %u,%u", i, px, py);
+        EXPECT_MSG(it_px_is(&img0, px, py, 0.8f, 0.6f, 0.2f, 1.0f), "leaf %u not visible at pixel %u,%u", i, px, py);
         float d = img0.depth[py * IMG + px];
-        CHECKF(fabsf(d - CAM_DIST) < 1e-3f, "leaf %u depth %f, expected %f", i, d, CAM_DIST);
+        EXPECT_MSG(fabsf(d - CAM_DIST) < 1e-3f, "leaf %u depth %f, expected %f", i, d, CAM_DIST);
         pixel_of(&f, x + 0.75f, y + 0.75f, &px, &py); /* the gap between four leaves */
-        CHECKF(it_px_is(&img0, px, py, 0, 0, 0, 0) && isinf(img0.depth[py * IMG + px]), "gap near leaf %u not empty", i);
+        EXPECT_MSG(it_px_is(&img0, px, py, 0, 0, 0, 0) && isinf(img0.depth[py * IMG + px]), "gap near leaf %u not empty", i);
     }
     for (uint32_t i = 0; i < 3; ++i) {
         float x, y;
         uint32_t px, py;
         shared_pos(i, &x, &y);
         pixel_of(&f, x, y, &px, &py);
-        CHECKF(it_px_is(&img0, px, py, 0.2f, 0.3f, 0.9f, 1.0f), "shared user %u not visible", i);
+        EXPECT_MSG(it_px_is(&img0, px, py, 0.2f, 0.3f, 0.9f, 1.0f), "shared user %u not visible", i);
     }
     {   /* leaf 0's second primitive (a small quad above its centre) */
         float x, y;
         uint32_t px, py;
         leaf_pos(0, &x, &y);
         pixel_of(&f, x, y + 0.5f, &px, &py);
-        CHECKF(it_px_is(&img0, px, py, 0.1f, 0.9f, 0.3f, 1.0f), "leaf 0's second primitive not visible");
+        EXPECT_MSG(it_px_is(&img0, px, py, 0.1f, 0.9f, 0.3f, 1.0f), "leaf 0's second primitive not visible");
     }
 
     /* ---- move one leaf: one placement, same instances, local image change ---- */
@@ -203,36 +203,36 @@ int main(void)
     it_set_translation(f.s, f.leaf[k], kx + 0.6f, ky, 0);
     commit_sync(&f, ctx);
     sy_mediator_rt_counters c1 = counters(ctx);
-    CHECKF(c1.last_sync_placements == 1, "moving one leaf recomputed %u placements", c1.last_sync_placements);
-    CHECKF(c1.last_sync_entries == 1, "moving one leaf gave %u change entries", c1.last_sync_entries);
-    CHECK(c1.instances == total_inst && c1.meshes == c0.meshes);
+    EXPECT_MSG(c1.last_sync_placements == 1, "moving one leaf recomputed %u placements", c1.last_sync_placements);
+    EXPECT_MSG(c1.last_sync_entries == 1, "moving one leaf gave %u change entries", c1.last_sync_entries);
+    EXPECT(c1.instances == total_inst && c1.meshes == c0.meshes);
     render(ctx, &f, &img1);
     {
         rect allowed[2] = {screen_rect(&f, kx, ky, HALF, 1), screen_rect(&f, kx + 0.6f, ky, HALF, 1)};
         uint32_t outside, changed = count_changed(&img0, &img1, allowed, 2, &outside);
         printf("move leaf: %u pixels changed, %u outside the old/new rectangles\n", changed, outside);
-        CHECK(changed > 0);
-        CHECKF(outside == 0, "%u pixels changed away from the moved leaf", outside);
+        EXPECT(changed > 0);
+        EXPECT_MSG(outside == 0, "%u pixels changed away from the moved leaf", outside);
         uint32_t px, py;
         pixel_of(&f, kx - 0.2f, ky, &px, &py); /* uncovered now */
-        CHECK(it_px_is(&img1, px, py, 0, 0, 0, 0) && isinf(img1.depth[py * IMG + px]));
+        EXPECT(it_px_is(&img1, px, py, 0, 0, 0, 0) && isinf(img1.depth[py * IMG + px]));
         pixel_of(&f, kx + 0.6f, ky, &px, &py); /* newly covered */
-        CHECK(it_px_is(&img1, px, py, 0.8f, 0.6f, 0.2f, 1.0f));
+        EXPECT(it_px_is(&img1, px, py, 0.8f, 0.6f, 0.2f, 1.0f));
     }
     /* move it back: bit-identical to the first image */
     it_set_translation(f.s, f.leaf[k], kx, ky, 0);
     commit_sync(&f, ctx);
-    CHECK(counters(ctx).last_sync_placements == 1);
+    EXPECT(counters(ctx).last_sync_placements == 1);
     render(ctx, &f, &img2);
-    CHECKF(it_layers_identical(&img0, &img2), "moving a leaf back does not restore the first image");
+    EXPECT_MSG(it_layers_identical(&img0, &img2), "moving a leaf back does not restore the first image");
 
     /* ---- a group's transform: the group and its 3 children are re-placed ---- */
     it_set_translation(f.s, f.group, 0.0f, 0.4f, 0.0f);
     commit_sync(&f, ctx);
     sy_mediator_rt_counters c2 = counters(ctx);
-    CHECKF(c2.last_sync_placements == 4, "moving the group recomputed %u placements, expected 4",
-           c2.last_sync_placements);
-    CHECK(c2.instances == total_inst);
+    EXPECT_MSG(c2.last_sync_placements == 4, "moving the group recomputed %u placements, expected 4",
+               c2.last_sync_placements);
+    EXPECT(c2.instances == total_inst);
     render(ctx, &f, &img1);
     {
         rect allowed[6];
@@ -243,16 +243,16 @@ int main(void)
             allowed[2 * i + 1] = screen_rect(&f, x, y + 0.4f, HALF, 1);
             uint32_t px, py;
             pixel_of(&f, x, y + 0.45f, &px, &py); /* above the old square, inside the new one */
-            CHECKF(it_px_is(&img1, px, py, 0.2f, 0.3f, 0.9f, 1.0f), "shared user %u did not move with its group", i);
+            EXPECT_MSG(it_px_is(&img1, px, py, 0.2f, 0.3f, 0.9f, 1.0f), "shared user %u did not move with its group", i);
         }
         uint32_t outside;
         count_changed(&img0, &img1, allowed, 6, &outside);
-        CHECKF(outside == 0, "%u pixels changed away from the group's children", outside);
+        EXPECT_MSG(outside == 0, "%u pixels changed away from the group's children", outside);
     }
     it_set_translation(f.s, f.group, 0.0f, 0.0f, 0.0f);
     commit_sync(&f, ctx);
     render(ctx, &f, &img2);
-    CHECKF(it_layers_identical(&img0, &img2), "moving the group back does not restore the first image");
+    EXPECT_MSG(it_layers_identical(&img0, &img2), "moving the group back does not restore the first image");
 
     /* ---- attachment-only changes: no instance or placement work, same image ---- */
     {
@@ -263,11 +263,11 @@ int main(void)
         MUST(sy_object_set_attachment(f.s, SY_TYPE_MATERIAL, f.leaf_mat.id, &a, err));
         commit_sync(&f, ctx);
         sy_mediator_rt_counters c = counters(ctx);
-        CHECKF(c.last_sync_entries == 4, "attachments gave %u entries", c.last_sync_entries);
-        CHECKF(c.last_sync_placements == 0, "attachment-only change recomputed %u placements", c.last_sync_placements);
-        CHECK(c.instances == total_inst && c.meshes == c0.meshes && c.materials == c0.materials);
+        EXPECT_MSG(c.last_sync_entries == 4, "attachments gave %u entries", c.last_sync_entries);
+        EXPECT_MSG(c.last_sync_placements == 0, "attachment-only change recomputed %u placements", c.last_sync_placements);
+        EXPECT(c.instances == total_inst && c.meshes == c0.meshes && c.materials == c0.materials);
         render(ctx, &f, &img2);
-        CHECKF(it_layers_identical(&img0, &img2), "attachment-only change altered the image");
+        EXPECT_MSG(it_layers_identical(&img0, &img2), "attachment-only change altered the image");
     }
 
     /* ---- material colour: new colour on screen, no new instances or placements ---- */
@@ -277,8 +277,8 @@ int main(void)
         MUST(sy_material_set(f.s, f.shared_mat, &d, err));
         commit_sync(&f, ctx);
         sy_mediator_rt_counters c = counters(ctx);
-        CHECK(c.instances == total_inst && c.materials == c0.materials);
-        CHECKF(c.last_sync_placements == 0, "a material change recomputed %u placements", c.last_sync_placements);
+        EXPECT(c.instances == total_inst && c.materials == c0.materials);
+        EXPECT_MSG(c.last_sync_placements == 0, "a material change recomputed %u placements", c.last_sync_placements);
         render(ctx, &f, &img1);
         rect allowed[3];
         for (uint32_t i = 0; i < 3; ++i) {
@@ -286,12 +286,12 @@ int main(void)
             uint32_t px, py;
             shared_pos(i, &x, &y);
             pixel_of(&f, x, y, &px, &py);
-            CHECKF(it_px_is(&img1, px, py, 1.0f, 0.0f, 0.5f, 1.0f), "shared user %u does not show the new colour", i);
+            EXPECT_MSG(it_px_is(&img1, px, py, 1.0f, 0.0f, 0.5f, 1.0f), "shared user %u does not show the new colour", i);
             allowed[i] = screen_rect(&f, x, y, HALF, 1);
         }
         uint32_t outside;
         count_changed(&img0, &img1, allowed, 3, &outside);
-        CHECKF(outside == 0, "material change altered %u pixels of other objects", outside);
+        EXPECT_MSG(outside == 0, "material change altered %u pixels of other objects", outside);
     }
 
     /* ---- hide via flags (inherited by children), show again ---- */
@@ -303,21 +303,21 @@ int main(void)
         MUST(sy_node_set_flags(f.s, f.leaf[7], 0, err));
         MUST(sy_node_set_flags(f.s, f.group, 0, err));
         commit_sync(&f, ctx);
-        CHECKF(counters(ctx).last_sync_placements == 5, "hiding a leaf and a group re-placed %u",
-               counters(ctx).last_sync_placements);
+        EXPECT_MSG(counters(ctx).last_sync_placements == 5, "hiding a leaf and a group re-placed %u",
+                   counters(ctx).last_sync_placements);
         render(ctx, &f, &img2);
-        CHECKF(it_px_is(&img2, lx, ly, 0, 0, 0, 0) && isinf(img2.depth[ly * IMG + lx]), "hidden leaf still visible");
+        EXPECT_MSG(it_px_is(&img2, lx, ly, 0, 0, 0, 0) && isinf(img2.depth[ly * IMG + lx]), "hidden leaf still visible");
         for (uint32_t i = 0; i < 3; ++i) {
             uint32_t px, py;
             shared_pos(i, &x, &y);
             pixel_of(&f, x, y, &px, &py);
-            CHECKF(it_px_is(&img2, px, py, 0, 0, 0, 0), "child %u of a hidden group still visible", i);
+            EXPECT_MSG(it_px_is(&img2, px, py, 0, 0, 0, 0), "child %u of a hidden group still visible", i);
         }
         MUST(sy_node_set_flags(f.s, f.leaf[7], SY_NODE_VISIBLE, err));
         MUST(sy_node_set_flags(f.s, f.group, SY_NODE_VISIBLE, err));
         commit_sync(&f, ctx);
         render(ctx, &f, &img2);
-        CHECKF(it_layers_identical(&img1, &img2), "showing hidden nodes again does not restore the image");
+        EXPECT_MSG(it_layers_identical(&img1, &img2), "showing hidden nodes again does not restore the image");
     }
 
     /* ---- destroy a node: instances drop by its primitive count (leaf 0 has 2) ---- */
@@ -326,18 +326,18 @@ int main(void)
         MUST(sy_object_destroy(f.s, SY_TYPE_NODE, f.leaf[0].id, err));
         commit_sync(&f, ctx);
         uint32_t after = counters(ctx).instances;
-        CHECKF(after + 2 == before, "destroying a 2-primitive node: instances %u -> %u", before, after);
+        EXPECT_MSG(after + 2 == before, "destroying a 2-primitive node: instances %u -> %u", before, after);
         MUST(sy_object_destroy(f.s, SY_TYPE_NODE, f.leaf[1].id, err));
         commit_sync(&f, ctx);
-        CHECKF(counters(ctx).instances + 3 == before, "destroying a 1-primitive node: instances %u -> %u", after,
-               counters(ctx).instances);
+        EXPECT_MSG(counters(ctx).instances + 3 == before, "destroying a 1-primitive node: instances %u -> %u", after,
+                   counters(ctx).instances);
         render(ctx, &f, &img2);
         for (uint32_t i = 0; i < 2; ++i) {
             float x, y;
             uint32_t px, py;
             leaf_pos(i, &x, &y);
             pixel_of(&f, x, y, &px, &py);
-            CHECKF(it_px_is(&img2, px, py, 0, 0, 0, 0), "destroyed leaf %u still visible", i);
+            EXPECT_MSG(it_px_is(&img2, px, py, 0, 0, 0, 0), "destroyed leaf %u still visible", i);
         }
         rect allowed[2];
         for (uint32_t i = 0; i < 2; ++i) {
@@ -347,7 +347,7 @@ int main(void)
         }
         uint32_t outside;
         count_changed(&img1, &img2, allowed, 2, &outside);
-        CHECKF(outside == 0, "destroying leaves altered %u other pixels", outside);
+        EXPECT_MSG(outside == 0, "destroying leaves altered %u other pixels", outside);
     }
 
     /* ---- a second context on the same scene: the snapshot path gives the same image ---- */
@@ -357,36 +357,36 @@ int main(void)
         sy_context *a, *b, *c;
         MUST(sy_context_pool_get(pool, f.s, "whitted", NULL, 0, &a, err));
         MUST(sy_context_pool_get(pool, f.s, "whitted", NULL, 0, &b, err));
-        CHECKF(a == b, "the pool created two contexts for the same arguments");
+        EXPECT_MSG(a == b, "the pool created two contexts for the same arguments");
         sy_params p;
         MUST(sy_params_parse("max_depth=3", &p, err));
         MUST(sy_context_pool_get(pool, f.s, "whitted", &p, 0, &c, err));
-        CHECKF(c != a, "different back-end parameters returned the same context");
+        EXPECT_MSG(c != a, "different back-end parameters returned the same context");
         sy_context *d;
         MUST(sy_context_pool_get(pool, f.s, "whitted", &p, 0, &d, err));
-        CHECK(d == c);
-        CHECK(sy_context_pool_size(pool) == 2);
-        CHECK(a != ctx);
+        EXPECT(d == c);
+        EXPECT(sy_context_pool_size(pool) == 2);
+        EXPECT(a != ctx);
         MUST(sy_context_sync(a, err));
         MUST(sy_context_sync(c, err));
         sy_mediator_rt_counters ca = counters(a), cc = counters(c), cx = counters(ctx);
-        CHECKF(ca.instances == cx.instances && cc.instances == cx.instances,
-               "snapshot contexts have %u / %u instances, the incremental one %u", ca.instances, cc.instances,
-               cx.instances);
+        EXPECT_MSG(ca.instances == cx.instances && cc.instances == cx.instances,
+                   "snapshot contexts have %u / %u instances, the incremental one %u", ca.instances, cc.instances,
+                   cx.instances);
         render(ctx, &f, &img1);
         render(a, &f, &img2);
-        CHECKF(it_layers_identical(&img1, &img2), "a fresh context renders differently from the incremental one");
+        EXPECT_MSG(it_layers_identical(&img1, &img2), "a fresh context renders differently from the incremental one");
         render(c, &f, &img2);
-        CHECKF(it_layers_identical(&img1, &img2), "max_depth=3 changed an image of unlit quads");
+        EXPECT_MSG(it_layers_identical(&img1, &img2), "max_depth=3 changed an image of unlit quads");
         /* a change reaches every context */
         it_set_translation(f.s, f.leaf[9], 0, 0, -100.0f);
         MUST(sy_scene_commit(f.s, NULL, err));
         MUST(sy_context_sync(a, err));
         MUST(sy_context_sync(ctx, err));
-        CHECK(counters(a).last_sync_placements == 1 && counters(ctx).last_sync_placements == 1);
+        EXPECT(counters(a).last_sync_placements == 1 && counters(ctx).last_sync_placements == 1);
         render(ctx, &f, &img1);
         render(a, &f, &img2);
-        CHECK(it_layers_identical(&img1, &img2));
+        EXPECT(it_layers_identical(&img1, &img2));
         sy_context_pool_destroy(pool);
     }
 
@@ -395,5 +395,5 @@ int main(void)
     sy_layer_destroy(&img2);
     sy_context_release(ctx);
     sy_scene_destroy(f.s);
-    return it_finish("integration_sync");
+    return sy_check_finish("integration_sync");
 }

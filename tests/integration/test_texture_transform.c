@@ -33,7 +33,7 @@ static hue classify(const float *p)
 static void square_px(const sy_camera_view *v, float cx, float cy, float h, uint32_t r[4])
 {
     float p0[3] = {cx - 0.9f * h, cy + 0.9f * h, 0}, p1[3] = {cx + 0.9f * h, cy - 0.9f * h, 0}, x0, y0, x1, y1;
-    CHECK(it_project(v, p0, W, H, &x0, &y0) && it_project(v, p1, W, H, &x1, &y1));
+    EXPECT(it_project(v, p0, W, H, &x0, &y0) && it_project(v, p1, W, H, &x1, &y1));
     r[0] = (uint32_t)fmaxf(0.0f, x0), r[1] = (uint32_t)fmaxf(0.0f, y0);
     r[2] = (uint32_t)fminf((float)W, x1), r[3] = (uint32_t)fminf((float)H, y1);
 }
@@ -53,7 +53,7 @@ static double share(const sy_layer *img, const uint32_t r[4], hue c)
 static float arrow_distance(const sy_layer *img, const sy_camera_view *v, const uint32_t r[4], float x, float y)
 {
     float p[3] = {x, y, 0}, px, py, best = INFINITY;
-    CHECK(it_project(v, p, W, H, &px, &py));
+    EXPECT(it_project(v, p, W, H, &px, &py));
     for (uint32_t j = r[1]; j < r[3]; ++j)
         for (uint32_t i = r[0]; i < r[2]; ++i)
             if (classify(it_px(img, i, j)) == HUE_BLACK) {
@@ -89,8 +89,8 @@ static void check_backend(sy_scene *s, const sy_gltf_info *info, const char *bac
         square_px(&view, top_x[q], 0.55f, 0.5f, r);
         double good = share(&img, r, want[q]), yellow = share(&img, r, HUE_YELLOW);
         printf("%s %-10s: %.1f %% expected colour, %.1f %% yellow\n", backend, names[q], 100 * good, 100 * yellow);
-        CHECKF(good > 0.5 && yellow < 0.01, "%s %s: %.1f %% expected colour, %.1f %% yellow (offset not applied?)", backend, names[q],
-               100 * good, 100 * yellow);
+        EXPECT_MSG(good > 0.5 && yellow < 0.01, "%s %s: %.1f %% expected colour, %.1f %% yellow (offset not applied?)", backend, names[q],
+                   100 * good, 100 * yellow);
     }
 
     /* bottom row: arrow quads at y = -0.55; marker positions = quad + marker node translation */
@@ -116,12 +116,12 @@ static void check_backend(sy_scene *s, const sy_gltf_info *info, const char *bac
         /* the tip ends at the correct marker's edge (half its size from its centre; the marker
          * hides the last bit of the arrow): allow 0.08 units (~14 px) more */
         float reach = (0.5f * rows[q].size + 0.08f) * px_per_unit;
-        CHECKF(d[0] < reach, "%s %s: the arrow does not reach the correct marker (%.1f px away, limit %.1f)", backend, rows[q].name,
-               d[0], reach);
+        EXPECT_MSG(d[0] < reach, "%s %s: the arrow does not reach the correct marker (%.1f px away, limit %.1f)", backend, rows[q].name,
+                   d[0], reach);
         for (int k = 1; k < 3; ++k)
             if (!isnan(d[k]))
-                CHECKF(d[k] > 2.0f * d[0] + 10.0f, "%s %s: the arrow is as near the %s marker (%.1f px) as the correct one",
-                       backend, rows[q].name, k == 1 ? "not-supported" : "error", d[k]);
+                EXPECT_MSG(d[k] > 2.0f * d[0] + 10.0f, "%s %s: the arrow is as near the %s marker (%.1f px) as the correct one",
+                           backend, rows[q].name, k == 1 ? "not-supported" : "error", d[k]);
     }
 
     sy_layer_destroy(&img);
@@ -160,5 +160,5 @@ int main(void)
 
     sy_gltf_info_free(&info);
     sy_scene_destroy(s);
-    return it_finish("integration_texture_transform");
+    return sy_check_finish("integration_texture_transform");
 }

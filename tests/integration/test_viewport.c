@@ -47,7 +47,7 @@ static void test_composite_math(void)
     sy_layer dst, src;
     /* fresh layers: transparent black, +inf depth */
     MUST(sy_layer_create(3, 2, &dst, err));
-    CHECK(px_eq(&dst, 2, 1, 0, 0, 0, 0, INFINITY));
+    EXPECT(px_eq(&dst, 2, 1, 0, 0, 0, 0, INFINITY));
     sy_layer_destroy(&dst);
 
     MUST(sy_layer_create(2, 1, &src, err));
@@ -57,23 +57,23 @@ static void test_composite_math(void)
     /* replace: src wins everywhere, depth included (also the empty pixel) */
     make_dst(&dst);
     sy_layer_composite(&dst, &src, 0, 0, SY_COMPOSITE_REPLACE);
-    CHECK(px_eq(&dst, 0, 0, 0.2f, 0.1f, 0.0f, 0.5f, 3.0f));
-    CHECK(px_eq(&dst, 1, 0, 0, 0, 0, 0, INFINITY));
+    EXPECT(px_eq(&dst, 0, 0, 0.2f, 0.1f, 0.0f, 0.5f, 3.0f));
+    EXPECT(px_eq(&dst, 1, 0, 0, 0, 0, 0, INFINITY));
     sy_layer_destroy(&dst);
 
     /* depth: nearer wins (3 < 5), +inf never wins */
     make_dst(&dst);
     sy_layer_composite(&dst, &src, 0, 0, SY_COMPOSITE_DEPTH);
-    CHECK(px_eq(&dst, 0, 0, 0.2f, 0.1f, 0.0f, 0.5f, 3.0f));
-    CHECK(px_eq(&dst, 1, 0, 0.1f, 0.2f, 0.3f, 1.0f, 2.0f));
+    EXPECT(px_eq(&dst, 0, 0, 0.2f, 0.1f, 0.0f, 0.5f, 3.0f));
+    EXPECT(px_eq(&dst, 1, 0, 0.1f, 0.2f, 0.3f, 1.0f, 2.0f));
     /* farther and equal depths keep the destination */
     sy_layer far;
     MUST(sy_layer_create(2, 1, &far, err));
     set_px(&far, 0, 0, 1, 1, 1, 1, 3.5f);
     set_px(&far, 1, 0, 1, 1, 1, 1, 2.0f);
     sy_layer_composite(&dst, &far, 0, 0, SY_COMPOSITE_DEPTH);
-    CHECK(px_eq(&dst, 0, 0, 0.2f, 0.1f, 0.0f, 0.5f, 3.0f));
-    CHECK(px_eq(&dst, 1, 0, 0.1f, 0.2f, 0.3f, 1.0f, 2.0f));
+    EXPECT(px_eq(&dst, 0, 0, 0.2f, 0.1f, 0.0f, 0.5f, 3.0f));
+    EXPECT(px_eq(&dst, 1, 0, 0.1f, 0.2f, 0.3f, 1.0f, 2.0f));
     sy_layer_destroy(&far);
     sy_layer_destroy(&dst);
 
@@ -82,19 +82,19 @@ static void test_composite_math(void)
      * the source has coverage; an empty source pixel changes nothing */
     make_dst(&dst);
     sy_layer_composite(&dst, &src, 0, 0, SY_COMPOSITE_ALPHA_OVER);
-    CHECK(px_eq(&dst, 0, 0, 0.4f, 0.3f, 0.2f, 1.0f, 3.0f));
-    CHECK(px_eq(&dst, 1, 0, 0.1f, 0.2f, 0.3f, 1.0f, 2.0f));
+    EXPECT(px_eq(&dst, 0, 0, 0.4f, 0.3f, 0.2f, 1.0f, 3.0f));
+    EXPECT(px_eq(&dst, 1, 0, 0.1f, 0.2f, 0.3f, 1.0f, 2.0f));
     /* a covering source pixel farther than the destination keeps the destination's depth */
     sy_layer over;
     MUST(sy_layer_create(1, 1, &over, err));
     set_px(&over, 0, 0, 0.25f, 0.0f, 0.0f, 0.25f, 9.0f);
     sy_layer_composite(&dst, &over, 1, 0, SY_COMPOSITE_ALPHA_OVER);
-    CHECK(px_eq(&dst, 1, 0, 0.25f + 0.1f * 0.75f, 0.2f * 0.75f, 0.3f * 0.75f, 1.0f, 2.0f));
+    EXPECT(px_eq(&dst, 1, 0, 0.25f + 0.1f * 0.75f, 0.2f * 0.75f, 0.3f * 0.75f, 1.0f, 2.0f));
     /* onto transparent black, alpha-over equals the source */
     sy_layer clear;
     MUST(sy_layer_create(1, 1, &clear, err));
     sy_layer_composite(&clear, &over, 0, 0, SY_COMPOSITE_ALPHA_OVER);
-    CHECK(px_eq(&clear, 0, 0, 0.25f, 0.0f, 0.0f, 0.25f, 9.0f));
+    EXPECT(px_eq(&clear, 0, 0, 0.25f, 0.0f, 0.0f, 0.25f, 9.0f));
     sy_layer_destroy(&clear);
     sy_layer_destroy(&over);
     sy_layer_destroy(&dst);
@@ -108,10 +108,10 @@ static void test_composite_math(void)
     sy_layer_composite(&dst, &src, 2, 1, SY_COMPOSITE_REPLACE);
     for (uint32_t y = 0; y < 2; ++y)
         for (uint32_t x = 0; x < 3; ++x)
-            if (x == 2 && y == 1) CHECK(px_eq(&dst, x, y, 1.0f, 10.0f, 0, 1, 1));
-            else CHECK(px_eq(&dst, x, y, 0, 0, 0, 0, INFINITY));
+            if (x == 2 && y == 1) EXPECT(px_eq(&dst, x, y, 1.0f, 10.0f, 0, 1, 1));
+            else EXPECT(px_eq(&dst, x, y, 0, 0, 0, 0, INFINITY));
     sy_layer_composite(&dst, &src, 3, 0, SY_COMPOSITE_REPLACE); /* entirely outside: no-op */
-    CHECK(px_eq(&dst, 2, 0, 0, 0, 0, 0, INFINITY));
+    EXPECT(px_eq(&dst, 2, 0, 0, 0, 0, 0, INFINITY));
     sy_layer_destroy(&dst);
     sy_layer_destroy(&src);
 }
@@ -173,7 +173,7 @@ static void test_layered(void)
     sy_node b = quad_node(s, "B", 0.0f, 0.0f, -1.0f, 0.5f, mb);
     sy_node cam = camera_node(s, 0, 0, 4, 0.8f);
     MUST(sy_scene_commit(s, NULL, err));
-    CHECK(sy_node_parent_count(s, a) == 0 && sy_node_parent_count(s, b) == 0);
+    EXPECT(sy_node_parent_count(s, a) == 0 && sy_node_parent_count(s, b) == 0);
 
     sy_context_pool *pool;
     MUST(sy_context_pool_create(&pool, err));
@@ -186,34 +186,34 @@ static void test_layered(void)
     sy_viewport_desc db = {.root = b, .camera = cam, .backend = "whitted", .params = "spp=1", .composite = SY_COMPOSITE_ALPHA_OVER};
     MUST(sy_window_add_viewport(win, &da, &va, err));
     MUST(sy_window_add_viewport(win, &db, &vb, err));
-    CHECK(sy_window_viewport_count(win) == 2 && sy_window_viewport(win, 1) == vb);
+    EXPECT(sy_window_viewport_count(win) == 2 && sy_window_viewport(win, 1) == vb);
     sy_layer img, only_a;
     MUST(sy_layer_create(LW, LH, &img, err));
     MUST(sy_layer_create(LW, LH, &only_a, err));
     MUST(sy_window_render(win, s, pool, NULL, &img, err));
-    CHECKF(sy_context_pool_size(pool) == 2, "pool holds %u contexts, expected one per root", sy_context_pool_size(pool));
-    CHECK(sy_layer_count_nonfinite(&img) == 0);
+    EXPECT_MSG(sy_context_pool_size(pool) == 2, "pool holds %u contexts, expected one per root", sy_context_pool_size(pool));
+    EXPECT(sy_layer_count_nonfinite(&img) == 0);
 
     sy_camera_view view;
     MUST(sy_viewport_camera_view(va, s, LW, LH, &view, err));
     uint32_t x, y;
     pixel_of(&view, -0.9f, 0.0f, 0.0f, LW, LH, &x, &y); /* A only */
-    CHECKF(it_px_is(&img, x, y, 0.9f, 0.2f, 0.1f, 1.0f), "A not visible under the overlay");
-    CHECK(fabsf(img.depth[y * LW + x] - 4.0f) < 1e-3f);
+    EXPECT_MSG(it_px_is(&img, x, y, 0.9f, 0.2f, 0.1f, 1.0f), "A not visible under the overlay");
+    EXPECT(fabsf(img.depth[y * LW + x] - 4.0f) < 1e-3f);
     pixel_of(&view, 0.5f, 0.0f, -1.0f, LW, LH, &x, &y); /* B only */
-    CHECKF(it_px_is(&img, x, y, 0.1f, 0.3f, 0.8f, 1.0f), "overlay B not visible");
-    CHECK(fabsf(img.depth[y * LW + x] - 5.0f) < 1e-3f);
+    EXPECT_MSG(it_px_is(&img, x, y, 0.1f, 0.3f, 0.8f, 1.0f), "overlay B not visible");
+    EXPECT(fabsf(img.depth[y * LW + x] - 5.0f) < 1e-3f);
     uint32_t ox, oy;
     pixel_of(&view, -0.25f, 0.0f, 0.0f, LW, LH, &ox, &oy); /* A in front of B: alpha-over draws B anyway */
-    CHECKF(it_px_is(&img, ox, oy, 0.1f, 0.3f, 0.8f, 1.0f), "alpha-over overlay does not cover A");
-    CHECKF(fabsf(img.depth[oy * LW + ox] - 4.0f) < 1e-3f, "alpha-over depth should stay the nearer (A's)");
-    CHECKF(it_px_is(&img, 1, 1, 0, 0, 0, 0) && isinf(img.depth[LW + 1]), "empty corner is not transparent");
+    EXPECT_MSG(it_px_is(&img, ox, oy, 0.1f, 0.3f, 0.8f, 1.0f), "alpha-over overlay does not cover A");
+    EXPECT_MSG(fabsf(img.depth[oy * LW + ox] - 4.0f) < 1e-3f, "alpha-over depth should stay the nearer (A's)");
+    EXPECT_MSG(it_px_is(&img, 1, 1, 0, 0, 0, 0) && isinf(img.depth[LW + 1]), "empty corner is not transparent");
 
     /* inactive overlay: exactly A's own image */
     sy_viewport_set_active(vb, false);
-    CHECK(!sy_viewport_active(vb));
+    EXPECT(!sy_viewport_active(vb));
     MUST(sy_window_render(win, s, pool, NULL, &only_a, err));
-    CHECK(it_px_is(&only_a, ox, oy, 0.9f, 0.2f, 0.1f, 1.0f));
+    EXPECT(it_px_is(&only_a, ox, oy, 0.9f, 0.2f, 0.1f, 1.0f));
     uint32_t differ = 0, differ_outside_b = 0;
     for (uint32_t j = 0; j < LH; ++j)
         for (uint32_t i = 0; i < LW; ++i)
@@ -221,7 +221,7 @@ static void test_layered(void)
                 differ++;
                 if (it_px(&img, i, j)[2] != 0.8f) differ_outside_b++;
             }
-    CHECKF(differ > 0 && differ_outside_b == 0, "overlay changed %u pixels, %u of them not B's", differ, differ_outside_b);
+    EXPECT_MSG(differ > 0 && differ_outside_b == 0, "overlay changed %u pixels, %u of them not B's", differ, differ_outside_b);
     sy_viewport_set_active(vb, true);
 
     /* the same layers with depth compositing: the nearer A wins where they overlap */
@@ -234,37 +234,37 @@ static void test_layered(void)
     sy_layer dimg;
     MUST(sy_layer_create(LW, LH, &dimg, err));
     MUST(sy_window_render(wd, s, pool, NULL, &dimg, err));
-    CHECK(sy_context_pool_size(pool) == 2); /* same scenes, back-end and roots: shared contexts */
-    CHECKF(it_px_is(&dimg, ox, oy, 0.9f, 0.2f, 0.1f, 1.0f), "depth compositing: the nearer A does not win");
+    EXPECT(sy_context_pool_size(pool) == 2); /* same scenes, back-end and roots: shared contexts */
+    EXPECT_MSG(it_px_is(&dimg, ox, oy, 0.9f, 0.2f, 0.1f, 1.0f), "depth compositing: the nearer A does not win");
     pixel_of(&view, 0.5f, 0.0f, -1.0f, LW, LH, &x, &y);
-    CHECK(it_px_is(&dimg, x, y, 0.1f, 0.3f, 0.8f, 1.0f));
+    EXPECT(it_px_is(&dimg, x, y, 0.1f, 0.3f, 0.8f, 1.0f));
 
     /* ---- 4. back-end switching ---- */
     sy_error e = {0};
     sy_result r = sy_viewport_set_backend(vb, "no-such-renderer", NULL, &e);
-    CHECKF(r != SY_OK, "switching to an unknown back-end succeeded");
-    CHECKF(strstr(e.message, "no-such-renderer") && strstr(e.message, "whitted"),
-           "message does not name the request and the available back-ends: '%s'", e.message);
+    EXPECT_MSG(r != SY_OK, "switching to an unknown back-end succeeded");
+    EXPECT_MSG(strstr(e.message, "no-such-renderer") && strstr(e.message, "whitted"),
+               "message does not name the request and the available back-ends: '%s'", e.message);
     printf("unknown back-end: %s\n", e.message);
-    CHECK(strcmp(sy_viewport_backend(vb), "whitted") == 0);
+    EXPECT(strcmp(sy_viewport_backend(vb), "whitted") == 0);
     sy_viewport *bad = NULL;
     sy_viewport_desc dbad = {.backend = "no-such-renderer"};
     memset(&e, 0, sizeof e);
-    CHECK(sy_window_add_viewport(win, &dbad, &bad, &e) != SY_OK && bad == NULL && strstr(e.message, "whitted"));
-    CHECK(sy_window_viewport_count(win) == 2);
+    EXPECT(sy_window_add_viewport(win, &dbad, &bad, &e) != SY_OK && bad == NULL && strstr(e.message, "whitted"));
+    EXPECT(sy_window_viewport_count(win) == 2);
     sy_layer again;
     MUST(sy_layer_create(LW, LH, &again, err));
     MUST(sy_window_render(win, s, pool, NULL, &again, err)); /* still renders with the old back-end */
-    CHECK(it_layers_identical(&img, &again));
+    EXPECT(it_layers_identical(&img, &again));
     /* switching to other parameters makes one new context; switching back reuses the cached one */
     MUST(sy_viewport_set_backend(vb, "whitted", "spp=1,max_depth=2", err));
     MUST(sy_window_render(win, s, pool, NULL, &again, err));
-    CHECK(sy_context_pool_size(pool) == 3);
-    CHECK(it_layers_identical(&img, &again));
+    EXPECT(sy_context_pool_size(pool) == 3);
+    EXPECT(it_layers_identical(&img, &again));
     MUST(sy_viewport_set_backend(vb, "whitted", "spp=1", err));
     MUST(sy_window_render(win, s, pool, NULL, &again, err));
-    CHECK(sy_context_pool_size(pool) == 3);
-    CHECK(it_layers_identical(&img, &again));
+    EXPECT(sy_context_pool_size(pool) == 3);
+    EXPECT(it_layers_identical(&img, &again));
 
     sy_layer_destroy(&again);
     sy_layer_destroy(&dimg);
@@ -292,15 +292,15 @@ static void test_stereo_math(void)
     sy_camera_view l = sy_camera_view_eye(&mono, SY_EYE_LEFT, sep, zp);
     sy_camera_view r = sy_camera_view_eye(&mono, SY_EYE_RIGHT, sep, zp);
     sy_camera_view m = sy_camera_view_eye(&mono, SY_EYE_MONO, sep, zp);
-    CHECK(memcmp(&m, &mono, sizeof m) == 0);
+    EXPECT(memcmp(&m, &mono, sizeof m) == 0);
     /* eyes sit at -/+ sep/2 along the camera's own X axis */
     float right_axis[3], zero[3] = {0, 0, 0}, xaxis[3] = {1, 0, 0}, lo[3], ro[3];
     sy_mat4_transform_dir(&mono.camera_to_world, xaxis, right_axis);
     sy_mat4_transform_point(&l.camera_to_world, zero, lo);
     sy_mat4_transform_point(&r.camera_to_world, zero, ro);
     for (int i = 0; i < 3; ++i) {
-        CHECK(fabsf(lo[i] - (t[i] - 0.5f * sep * right_axis[i])) < 1e-5f);
-        CHECK(fabsf(ro[i] - (t[i] + 0.5f * sep * right_axis[i])) < 1e-5f);
+        EXPECT(fabsf(lo[i] - (t[i] - 0.5f * sep * right_axis[i])) < 1e-5f);
+        EXPECT(fabsf(ro[i] - (t[i] + 0.5f * sep * right_axis[i])) < 1e-5f);
     }
     /* points given in the mono camera's frame, mapped to world */
     const float depths[3] = {zp, 1.0f, 5.0f};
@@ -308,18 +308,18 @@ static void test_stereo_math(void)
         float pc[3] = {0.3f, -0.2f, -depths[k]}, pw[3];
         sy_mat4_transform_point(&mono.camera_to_world, pc, pw);
         float lx, ly, rx, ry;
-        CHECK(it_project(&l, pw, w, h, &lx, &ly) && it_project(&r, pw, w, h, &rx, &ry));
+        EXPECT(it_project(&l, pw, w, h, &lx, &ly) && it_project(&r, pw, w, h, &rx, &ry));
         float disparity = lx - rx;
         /* by hand: x_eye = (X -/+ ...) ; disparity = sep (1/z - 1/zp) / (window width) * w */
         float expect = sep * (1.0f / depths[k] - 1.0f / zp) / (mono.window[1] - mono.window[0]) * (float)w;
         printf("stereo: depth %.1f: left %.4f,%.4f right %.4f,%.4f disparity %.4f px (expected %.4f)\n", depths[k], lx,
                ly, rx, ry, disparity, expect);
-        CHECKF(fabsf(disparity - expect) < 1e-3f, "disparity %.5f at depth %.1f, expected %.5f", disparity, depths[k],
-               expect);
-        CHECKF(fabsf(ly - ry) < 1e-3f, "vertical parallax %.5f", ly - ry);
-        if (k == 0) CHECKF(fabsf(disparity) < 1e-3f, "zero-parallax point differs by %.5f px", disparity);
-        if (k == 1) CHECKF(disparity > 1.0f, "nearer point: disparity %.4f is not positive", disparity);
-        if (k == 2) CHECKF(disparity < -1.0f, "farther point: disparity %.4f is not negative", disparity);
+        EXPECT_MSG(fabsf(disparity - expect) < 1e-3f, "disparity %.5f at depth %.1f, expected %.5f", disparity, depths[k],
+                   expect);
+        EXPECT_MSG(fabsf(ly - ry) < 1e-3f, "vertical parallax %.5f", ly - ry);
+        if (k == 0) EXPECT_MSG(fabsf(disparity) < 1e-3f, "zero-parallax point differs by %.5f px", disparity);
+        if (k == 1) EXPECT_MSG(disparity > 1.0f, "nearer point: disparity %.4f is not positive", disparity);
+        if (k == 2) EXPECT_MSG(disparity < -1.0f, "farther point: disparity %.4f is not negative", disparity);
     }
 }
 
@@ -373,12 +373,12 @@ static void test_stereo_render(void)
     sy_layer img;
     MUST(sy_layer_create(2 * half, h, &img, err));
     MUST(sy_window_render(win, s, pool, NULL, &img, err));
-    CHECKF(sy_context_pool_size(pool) == 1, "both eyes should share one context (pool size %u)", sy_context_pool_size(pool));
+    EXPECT_MSG(sy_context_pool_size(pool) == 1, "both eyes should share one context (pool size %u)", sy_context_pool_size(pool));
 
     float lzx, lzy, rzx, rzy, lnx, lny, rnx, rny;
     bool ok = centroid(&img, 0, half, cz, &lzx, &lzy) && centroid(&img, half, half, cz, &rzx, &rzy) &&
               centroid(&img, 0, half, cn, &lnx, &lny) && centroid(&img, half, half, cn, &rnx, &rny);
-    CHECKF(ok, "a quad is missing from one eye's image");
+    EXPECT_MSG(ok, "a quad is missing from one eye's image");
     if (ok) {
         sy_camera_view mono;
         sy_viewport_set_camera(vl, cam);
@@ -387,10 +387,10 @@ static void test_stereo_render(void)
         float expect = sep * (1.0f / 1.0f - 1.0f / zp) / (mono.window[1] - mono.window[0]) * (float)half;
         printf("stereo render: zero-parallax quad x %.2f / %.2f, near quad x %.2f / %.2f (expected disparity %.2f)\n",
                lzx, rzx, lnx, rnx, expect);
-        CHECKF(fabsf(lzx - rzx) <= 0.5f && fabsf(lzy - rzy) <= 0.01f, "zero-parallax quad moves between eyes");
-        CHECKF(fabsf((lnx - rnx) - expect) <= 1.0f && lnx - rnx > 0.0f, "near quad disparity %.2f, expected %.2f",
-               lnx - rnx, expect);
-        CHECK(fabsf(lny - rny) <= 0.01f);
+        EXPECT_MSG(fabsf(lzx - rzx) <= 0.5f && fabsf(lzy - rzy) <= 0.01f, "zero-parallax quad moves between eyes");
+        EXPECT_MSG(fabsf((lnx - rnx) - expect) <= 1.0f && lnx - rnx > 0.0f, "near quad disparity %.2f, expected %.2f",
+                   lnx - rnx, expect);
+        EXPECT(fabsf(lny - rny) <= 0.01f);
     }
     sy_layer_destroy(&img);
     sy_context_pool_destroy(pool);
@@ -405,5 +405,5 @@ int main(void)
     test_layered();
     test_stereo_math();
     test_stereo_render();
-    return it_finish("integration_viewport");
+    return sy_check_finish("integration_viewport");
 }

@@ -1,16 +1,14 @@
-/* gl_test.h — what the GL back-end's tests share: CHECK (counted in `failures`, the run goes on;
- * tests/support/check_count.h) and MUST (a sy_gl call that must succeed; its message is in the
+/* gl_test.h — what the GL back-end's tests share: the check kit (tests/support/sy_check.h; the
+ * tests use its counted EXPECT form and end with sy_check_finish) and MUST (a sy_gl call that must succeed; its message is in the
  * caller's char buffer `e`; exit 1 otherwise). */
 #ifndef SY_TEST_GL_TEST_H
 #define SY_TEST_GL_TEST_H
 
-#include "../support/check_count.h"
+#include "../support/sy_check.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 
-static int failures;
-#define CHECK(c, ...) SY_CHECK_COUNT(failures, c, __VA_ARGS__)
 #define MUST(call)                                                                                 \
     do {                                                                                           \
         sy_gl_result r_ = (call);                                                                  \

@@ -57,10 +57,10 @@ static void check_model(const model *m)
     }
     double iou = uni ? (double)inter / uni : 1.0;
     printf("%-40s IoU %.5f (%u / %u pixels), depth mismatches %u\n", m->path, iou, inter, uni, depth_bad);
-    CHECKF(uni > 1000, "%s: only %u covered pixels", m->path, uni);
-    CHECKF(iou >= 0.99, "%s: silhouette IoU %.5f < 0.99", m->path, iou);
-    CHECKF(depth_bad <= inter / 100, "%s: %u of %u shared pixels differ in depth by more than 0.2%%", m->path, depth_bad, inter);
-    CHECK(sy_layer_count_nonfinite(&a) == 0);
+    EXPECT_MSG(uni > 1000, "%s: only %u covered pixels", m->path, uni);
+    EXPECT_MSG(iou >= 0.99, "%s: silhouette IoU %.5f < 0.99", m->path, iou);
+    EXPECT_MSG(depth_bad <= inter / 100, "%s: %u of %u shared pixels differ in depth by more than 0.2%%", m->path, depth_bad, inter);
+    EXPECT(sy_layer_count_nonfinite(&a) == 0);
     /* levels of detail at their default (half a pixel) against the full meshes (lod=0): the same
      * silhouette (issue 32) */
     sy_layer full;
@@ -68,7 +68,7 @@ static void check_model(const model *m)
     double iou_lod = 0.0;
     MUST(sy_layer_coverage_iou(&a, &full, &iou_lod, err));
     printf("%-40s IoU %.5f levels of detail against full meshes\n", m->path, iou_lod);
-    CHECKF(iou_lod >= 0.99, "%s: levels of detail change the silhouette: IoU %.5f < 0.99", m->path, iou_lod);
+    EXPECT_MSG(iou_lod >= 0.99, "%s: levels of detail change the silhouette: IoU %.5f < 0.99", m->path, iou_lod);
     sy_layer_destroy(&full);
     sy_layer_destroy(&a);
     sy_layer_destroy(&b);
@@ -79,7 +79,7 @@ static void check_model(const model *m)
     double iou_aa = 0.0;
     MUST(sy_layer_coverage_iou(&a, &b, &iou_aa, err));
     printf("%-40s IoU %.5f with default anti-aliasing\n", m->path, iou_aa);
-    CHECKF(iou_aa >= 0.99, "%s: anti-aliased silhouette IoU %.5f < 0.99", m->path, iou_aa);
+    EXPECT_MSG(iou_aa >= 0.99, "%s: anti-aliased silhouette IoU %.5f < 0.99", m->path, iou_aa);
     sy_layer_destroy(&a);
     sy_layer_destroy(&b);
     sy_gltf_info_free(&info);
@@ -97,5 +97,5 @@ int main(void)
         {"gltf/SimpleInstancing/glTF/SimpleInstancing.gltf", NULL}, /* 125 instances, many edges */
     };
     for (size_t i = 0; i < sizeof models / sizeof models[0]; ++i) check_model(&models[i]);
-    return it_finish("raster_align");
+    return sy_check_finish("raster_align");
 }

@@ -167,10 +167,10 @@ static void compare(const char *what, double max_mean, double max_share)
     double mean = sum > 0.0 ? diff / sum : 1.0, share = (double)off / ((double)W * H);
     printf("%s: mean difference %.2e of the mean, %.3f %% of pixels off by > 2 %%, depth differs in %zu pixels\n", what, mean,
            100.0 * share, depth_off);
-    CHECK(sum > 0.0, "%s: a black image", what);
-    CHECK(mean <= max_mean, "%s: mean difference %.2e > %.2e", what, mean, max_mean);
-    CHECK(share <= max_share, "%s: %.3f %% of pixels differ (> %.3f %%)", what, 100.0 * share, 100.0 * max_share);
-    CHECK(depth_off == 0, "%s: depth differs in %zu pixels", what, depth_off);
+    EXPECT_MSG(sum > 0.0, "%s: a black image", what);
+    EXPECT_MSG(mean <= max_mean, "%s: mean difference %.2e > %.2e", what, mean, max_mean);
+    EXPECT_MSG(share <= max_share, "%s: %.3f %% of pixels differ (> %.3f %%)", what, 100.0 * share, 100.0 * max_share);
+    EXPECT_MSG(depth_off == 0, "%s: depth differs in %zu pixels", what, depth_off);
 }
 
 int main(void)
@@ -182,13 +182,13 @@ int main(void)
     uint64_t px = 0, n0 = render(&fw, 0, false), n1 = render_cam(&df, 1, &persp, &px);
     printf("deferred draws: forward device %llu, deferred device %llu, on %llu of %d pixels\n", (unsigned long long)n0,
            (unsigned long long)n1, (unsigned long long)px, W * H);
-    CHECK(n0 == 0 && n1 == 4, "deferred draws %llu / %llu (want 0 / 4)", (unsigned long long)n0, (unsigned long long)n1);
-    CHECK(px > 0 && px < (uint64_t)W * H, "the deferred pass shaded %llu of %d pixels", (unsigned long long)px, W * H);
+    EXPECT_MSG(n0 == 0 && n1 == 4, "deferred draws %llu / %llu (want 0 / 4)", (unsigned long long)n0, (unsigned long long)n1);
+    EXPECT_MSG(px > 0 && px < (uint64_t)W * H, "the deferred pass shaded %llu of %d pixels", (unsigned long long)px, W * H);
     compare("perspective", 2.5e-3, 0.006);
     /* 2. orthographic (the G-buffer pass's orthographic variant) */
     render(&fw, 0, true);
     n1 = render(&df, 1, true);
-    CHECK(n1 == 4, "orthographic: %llu deferred draws", (unsigned long long)n1);
+    EXPECT_MSG(n1 == 4, "orthographic: %llu deferred draws", (unsigned long long)n1);
     compare("orthographic", 2.5e-3, 0.006);
     /* 2b. from behind the spheres, looking along +z: the visible normals have z < 0 (world), which
      * the G-buffer keeps in the depth's sign */
@@ -196,7 +196,7 @@ int main(void)
                                .window = {-0.8f, 0.8f, -0.6f, 0.6f}, .near_clip = 0.1f};
     render_cam(&fw, 0, &back, NULL);
     n1 = render_cam(&df, 1, &back, NULL);
-    CHECK(n1 == 4, "from behind: %llu deferred draws", (unsigned long long)n1);
+    EXPECT_MSG(n1 == 4, "from behind: %llu deferred draws", (unsigned long long)n1);
     compare("from behind", 2.5e-3, 0.006);
     /* 3. a material change reaches the deferred pass (its table row) */
     sy_gl_material_desc md;
@@ -216,8 +216,8 @@ int main(void)
     render(&fw, 0, false);
     n1 = render_cam(&df, 1, &persp, &px);
     printf("small spheres: %llu deferred draws on %llu pixels\n", (unsigned long long)n1, (unsigned long long)px);
-    CHECK(n1 > 60 && px < (uint64_t)W * H * 3 / 4, "small spheres: %llu deferred draws on %llu of %d pixels",
-          (unsigned long long)n1, (unsigned long long)px, W * H);
+    EXPECT_MSG(n1 > 60 && px < (uint64_t)W * H * 3 / 4, "small spheres: %llu deferred draws on %llu of %d pixels",
+               (unsigned long long)n1, (unsigned long long)px, W * H);
     compare("small spheres", 2.5e-3, 0.006);
     /* 5. a blended instance: the frame is forward on both devices, so the images are the same */
     for (int k = 0; k < 2; ++k) {
@@ -231,10 +231,9 @@ int main(void)
     }
     render(&fw, 0, false);
     n1 = render(&df, 1, false);
-    CHECK(n1 == 0, "with a blended instance: %llu deferred draws", (unsigned long long)n1);
-    CHECK(memcmp(img[0], img[1], sizeof img[0]) == 0, "with a blended instance the images differ");
+    EXPECT_MSG(n1 == 0, "with a blended instance: %llu deferred draws", (unsigned long long)n1);
+    EXPECT_MSG(memcmp(img[0], img[1], sizeof img[0]) == 0, "with a blended instance the images differ");
     sy_gl_device_destroy(fw.d);
     sy_gl_device_destroy(df.d);
-    if (failures) fprintf(stderr, "%d check(s) failed\n", failures);
-    return failures ? 1 : 0;
+    return sy_check_finish("test_raster_deferred");
 }

@@ -107,20 +107,20 @@ int main(int argc, char **argv)
     sy_gl_set_environment(d, env, 2.0f);
     MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
     printf("Lambert under a constant environment of 3: %g (want 1.5)\n", px(16, 16)[0]);
-    CHECK(near_(px(16, 16)[0], 0.5f * 3.0f, 0.02f), "Lambert under a constant environment: %g (want %g)", px(16, 16)[0], 1.5);
+    EXPECT_MSG(near_(px(16, 16)[0], 0.5f * 3.0f, 0.02f), "Lambert under a constant environment: %g (want %g)", px(16, 16)[0], 1.5);
     MUST(sy_gl_instance_destroy(d, q));
     MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
-    CHECK(px(16, 16)[3] == 0.0f && px(16, 16)[0] == 0.0f, "the environment is not a background: %g %g", px(16, 16)[0], px(16, 16)[3]);
+    EXPECT_MSG(px(16, 16)[3] == 0.0f && px(16, 16)[0] == 0.0f, "the environment is not a background: %g %g", px(16, 16)[0], px(16, 16)[3]);
     sy_gl_texture bg = env_texture(d, 3.0f, 0.25f);
     sy_gl_set_background(d, SY_GL_BACKGROUND_TEXTURE, NULL, bg, 2.0f);
     MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
-    CHECK(near_(px(16, 2)[0], 6.0f, 1e-3f) && px(16, 2)[3] == 1.0f && isinf(depth[2 * N + 16]),
-          "sky above the horizon %g alpha %g (want 6, 1)", px(16, 2)[0], px(16, 2)[3]);
-    CHECK(near_(px(16, 29)[0], 0.5f, 1e-3f), "sky below the horizon %g (want 0.5)", px(16, 29)[0]);
+    EXPECT_MSG(near_(px(16, 2)[0], 6.0f, 1e-3f) && px(16, 2)[3] == 1.0f && isinf(depth[2 * N + 16]),
+               "sky above the horizon %g alpha %g (want 6, 1)", px(16, 2)[0], px(16, 2)[3]);
+    EXPECT_MSG(near_(px(16, 29)[0], 0.5f, 1e-3f), "sky below the horizon %g (want 0.5)", px(16, 29)[0]);
     const float red[4] = {0.25f, 0, 0, 0.5f};
     sy_gl_set_background(d, SY_GL_BACKGROUND_COLOR, red, (sy_gl_texture){0}, 1.0f);
     MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
-    CHECK(px(3, 3)[0] == 0.25f && px(3, 3)[3] == 0.5f, "colour background %g %g", px(3, 3)[0], px(3, 3)[3]);
+    EXPECT_MSG(px(3, 3)[0] == 0.25f && px(3, 3)[3] == 0.5f, "colour background %g %g", px(3, 3)[0], px(3, 3)[3]);
     sy_gl_set_background(d, SY_GL_BACKGROUND_NONE, NULL, (sy_gl_texture){0}, 1.0f);
 
     /* 2. a mirror reflects the environment sharply: tilted down it sees the lower half (0.5 x 2) */
@@ -138,13 +138,13 @@ int main(int argc, char **argv)
         sy_gl_instance mi = place(d, quad(d, tilt, tn), mm);
         MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
         printf("mirror up %g (want 2)\n", px(16, 16)[0]);
-        CHECK(near_(px(16, 16)[0], 2.0f, 0.03f), "mirror reflects the upper half: %g (want 2)", px(16, 16)[0]);
+        EXPECT_MSG(near_(px(16, 16)[0], 2.0f, 0.03f), "mirror reflects the upper half: %g (want 2)", px(16, 16)[0]);
         const float flip[12] = {-1, 0.6f, -2.5f, 1, 0.6f, -2.5f, 1, -1.2f, -3.5f, -1, -1.2f, -3.5f};
         const float fn[3] = {0, -0.866f, 0.5f};
         MUST(sy_gl_instance_destroy(d, mi));
         mi = place(d, quad(d, flip, fn), mm);
         MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
-        CHECK(near_(px(16, 16)[0], 0.5f, 0.03f), "mirror reflects the lower half: %g (want 0.5)", px(16, 16)[0]);
+        EXPECT_MSG(near_(px(16, 16)[0], 0.5f, 0.03f), "mirror reflects the lower half: %g (want 0.5)", px(16, 16)[0]);
         MUST(sy_gl_instance_destroy(d, mi));
         sy_gl_set_environment(d, (sy_gl_texture){0}, 0.0f);
 
@@ -164,8 +164,8 @@ int main(int argc, char **argv)
         sy_gl_instance ci = place(d, quad(d, ceiling, down), gm);
         MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
         printf("mirror under a green ceiling %g %g (want 0 4)\n", px(16, 16)[0], px(16, 16)[1]);
-        CHECK(near_(px(16, 16)[1], 4.0f, 0.03f) && px(16, 16)[0] < 0.01f, "mirror reflects the ceiling: %g %g (want 0 4)",
-              px(16, 16)[0], px(16, 16)[1]);
+        EXPECT_MSG(near_(px(16, 16)[1], 4.0f, 0.03f) && px(16, 16)[0] < 0.01f, "mirror reflects the ceiling: %g %g (want 0 4)",
+                   px(16, 16)[0], px(16, 16)[1]);
         /* the same quad as clear glass (no environment either): its Fresnel reflection and
          * refraction see the ceiling through the probe too */
         sy_gl_material_desc glass;
@@ -178,8 +178,8 @@ int main(int argc, char **argv)
         MUST(sy_gl_instance_set_material(d, mi, gl_m));
         MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
         printf("glass under a green ceiling %g %g\n", px(16, 16)[0], px(16, 16)[1]);
-        CHECK(px(16, 16)[1] > 0.1f && px(16, 16)[0] < 0.01f, "glass without an environment sees nothing: %g %g",
-              px(16, 16)[0], px(16, 16)[1]);
+        EXPECT_MSG(px(16, 16)[1] > 0.1f && px(16, 16)[0] < 0.01f, "glass without an environment sees nothing: %g %g",
+                   px(16, 16)[0], px(16, 16)[1]);
         /* glass by its metallic-roughness texture: a metal factor of 1 that the texture's blue channel
          * scales to 0 transmits as the glass above (such materials were drawn without transmission,
          * black where the texture says dielectric: TransmissionTest's "Metallic" row) */
@@ -196,13 +196,13 @@ int main(int argc, char **argv)
         MUST(sy_gl_instance_set_material(d, mi, tgl_m));
         MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
         printf("glass by its texture %g %g (glass %g %g)\n", px(16, 16)[0], px(16, 16)[1], glass_px[0], glass_px[1]);
-        CHECK(near_(px(16, 16)[1], glass_px[1], 1e-3f) && near_(px(16, 16)[0], glass_px[0], 1e-3f),
-              "metal factor 1, texture metallic 0, transmission 1: %g %g (want the glass's %g %g)", px(16, 16)[0],
-              px(16, 16)[1], glass_px[0], glass_px[1]);
+        EXPECT_MSG(near_(px(16, 16)[1], glass_px[1], 1e-3f) && near_(px(16, 16)[0], glass_px[0], 1e-3f),
+                   "metal factor 1, texture metallic 0, transmission 1: %g %g (want the glass's %g %g)", px(16, 16)[0],
+                   px(16, 16)[1], glass_px[0], glass_px[1]);
         MUST(sy_gl_instance_set_material(d, mi, mm));
         MUST(sy_gl_instance_set_visible(d, ci, false));
         MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
-        CHECK(px(16, 16)[1] < 0.01f, "hidden ceiling still reflected: %g", px(16, 16)[1]);
+        EXPECT_MSG(px(16, 16)[1] < 0.01f, "hidden ceiling still reflected: %g", px(16, 16)[1]);
         MUST(sy_gl_instance_destroy(d, ci));
         MUST(sy_gl_instance_destroy(d, mi));
     }
@@ -221,21 +221,21 @@ int main(int argc, char **argv)
         MUST(sy_gl_render(d, &top, &full, rgba, depth, e, sizeof e));
         float want = 0.5f * 10.0f * square_form_factor(0.5f, 1.0f);
         printf("floor under a square light %g (want %g)\n", px(16, 16)[0], want);
-        CHECK(near_(px(16, 16)[0], want, 0.04f), "floor under a square light: %g (want %g)", px(16, 16)[0], want);
+        EXPECT_MSG(near_(px(16, 16)[0], want, 0.04f), "floor under a square light: %g (want %g)", px(16, 16)[0], want);
         sy_gl_stats st;
         sy_gl_device_stats(d, &st);
-        CHECK(st.shadow_maps == 1, "area light shadow maps %u", st.shadow_maps);
+        EXPECT_MSG(st.shadow_maps == 1, "area light shadow maps %u", st.shadow_maps);
         /* reversed winding: the front faces up, the floor is behind it and stays dark */
         sy_gl_area_light up = al;
         memcpy(up.vertices[1], al.vertices[3], sizeof up.vertices[1]);
         memcpy(up.vertices[3], al.vertices[1], sizeof up.vertices[3]);
         MUST(sy_gl_set_area_lights(d, &up, 1, e, sizeof e));
         MUST(sy_gl_render(d, &top, &full, rgba, depth, e, sizeof e));
-        CHECK(px(16, 16)[0] == 0.0f, "one-sided emitter lights its back side: %g", px(16, 16)[0]);
+        EXPECT_MSG(px(16, 16)[0] == 0.0f, "one-sided emitter lights its back side: %g", px(16, 16)[0]);
         up.double_sided = true;
         MUST(sy_gl_set_area_lights(d, &up, 1, e, sizeof e));
         MUST(sy_gl_render(d, &top, &full, rgba, depth, e, sizeof e));
-        CHECK(near_(px(16, 16)[0], want, 0.04f), "double-sided emitter: %g (want %g)", px(16, 16)[0], want);
+        EXPECT_MSG(near_(px(16, 16)[0], want, 0.04f), "double-sided emitter: %g (want %g)", px(16, 16)[0], want);
         /* an occluder between light and floor: the centre is in (soft) shadow */
         const float occ_q[12] = {-0.3f, 0.5f, 0.3f, 0.3f, 0.5f, 0.3f, 0.3f, 0.5f, -0.3f, -0.3f, 0.5f, -0.3f};
         sy_gl_instance oc = place(d, quad(d, occ_q, ny), lambert(d, 0.5f));
@@ -245,7 +245,7 @@ int main(int argc, char **argv)
         under.window[0] = under.window[2] = -2.0f, under.window[1] = under.window[3] = 2.0f;
         MUST(sy_gl_render(d, &under, &full, rgba, depth, e, sizeof e));
         printf("floor under an occluder %g (unshadowed %g)\n", px(16, 16)[0], want);
-        CHECK(px(16, 16)[0] < 0.5f * want, "floor under an occluder: %g (unshadowed %g)", px(16, 16)[0], want);
+        EXPECT_MSG(px(16, 16)[0] < 0.5f * want, "floor under an occluder: %g (unshadowed %g)", px(16, 16)[0], want);
         /* 3b. a point light (intensity 10 at 1 above the floor) instead: its cube shadow map darkens
          * the floor under the occluder; beside the shadow the floor has I cos / d^2 x albedo / pi */
         MUST(sy_gl_set_area_lights(d, NULL, 0, e, sizeof e));
@@ -258,29 +258,24 @@ int main(int argc, char **argv)
         sy_gl_device_stats(d, &st);
         printf("point light: floor under the occluder %g, beside it %g (want %g), %u shadow maps\n", px(16, 16)[0],
                px(0, 16)[0], lit, st.shadow_maps);
-        CHECK(px(16, 16)[0] < 0.02f * 0.5f / PI_F * 10.0f, "point light shines through the occluder: %g", px(16, 16)[0]);
-        CHECK(near_(px(0, 16)[0], lit, 0.03f), "point light beside the shadow: %g (want %g)", px(0, 16)[0], lit);
-        CHECK(st.shadow_maps == 6, "a point light's cube shadow: %u shadow maps (want 6 faces)", st.shadow_maps);
+        EXPECT_MSG(px(16, 16)[0] < 0.02f * 0.5f / PI_F * 10.0f, "point light shines through the occluder: %g", px(16, 16)[0]);
+        EXPECT_MSG(near_(px(0, 16)[0], lit, 0.03f), "point light beside the shadow: %g (want %g)", px(0, 16)[0], lit);
+        EXPECT_MSG(st.shadow_maps == 6, "a point light's cube shadow: %u shadow maps (want 6 faces)", st.shadow_maps);
         MUST(sy_gl_light_destroy(d, pl));
         MUST(sy_gl_instance_destroy(d, oc));
         MUST(sy_gl_instance_destroy(d, fl));
         /* 4. refused input */
         sy_gl_area_light bad = al;
         bad.radiance[1] = -1.0f;
-        CHECK(sy_gl_set_area_lights(d, &bad, 1, e, sizeof e) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "area light 0") &&
-                  strstr(e, "radiance[1]"),
-              "negative radiance: %s", e);
+        EXPECT_MSG(sy_gl_set_area_lights(d, &bad, 1, e, sizeof e) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "area light 0") &&
+                   strstr(e, "radiance[1]"),
+                   "negative radiance: %s", e);
         bad = al;
         bad.vertices[2][0] = NAN;
-        CHECK(sy_gl_set_area_lights(d, &bad, 1, e, sizeof e) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "vertex 2"),
-              "NaN vertex: %s", e);
-        CHECK(sy_gl_set_area_lights(d, &al, SY_GL_MAX_AREA_LIGHTS + 1, e, sizeof e) == SY_GL_ERROR_LIMIT, "cap: %s", e);
+        EXPECT_MSG(sy_gl_set_area_lights(d, &bad, 1, e, sizeof e) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "vertex 2"),
+                   "NaN vertex: %s", e);
+        EXPECT_MSG(sy_gl_set_area_lights(d, &al, SY_GL_MAX_AREA_LIGHTS + 1, e, sizeof e) == SY_GL_ERROR_LIMIT, "cap: %s", e);
     }
     sy_gl_device_destroy(d);
-    if (failures) {
-        fprintf(stderr, "test_raster_light: %d check(s) failed\n", failures);
-        return 1;
-    }
-    printf("test_raster_light: all checks passed\n");
-    return 0;
+    return sy_check_finish("test_raster_light");
 }

@@ -59,7 +59,7 @@ int main(void)
     MUST(sy_gl_device_create(&dd, &d, e, sizeof e));
     uint32_t tris = 0;
     sy_gl_mesh big = gl_test_sphere(d, 256, 0.03f, true, &tris);
-    CHECK(tris >= SY_GL_LOD_MIN_TRIANGLES, "the sphere has %u triangles", tris);
+    EXPECT_MSG(tris >= SY_GL_LOD_MIN_TRIANGLES, "the sphere has %u triangles", tris);
     sy_gl_material_desc mdsc;
     sy_gl_material_desc_init(&mdsc);
     sy_gl_material mat;
@@ -80,36 +80,34 @@ int main(void)
         double drel, io = iou(&drel);
         printf("distance %4.1f m: %llu of %llu triangles drawn, coverage IoU %.4f, depth off by > 1 %% in %.2f %% of pixels\n",
                (double)dists[k], (unsigned long long)lod, (unsigned long long)full, io, 100.0 * drel);
-        CHECK(full == tris, "levels off: %llu triangles drawn, want %u", (unsigned long long)full, tris);
-        CHECK(io >= 0.98, "distance %g: coverage IoU %.4f against the full mesh", (double)dists[k], io);
-        CHECK(drel <= 0.02, "distance %g: depth off by > 1 %% in %.2f %% of the pixels", (double)dists[k], 100.0 * drel);
+        EXPECT_MSG(full == tris, "levels off: %llu triangles drawn, want %u", (unsigned long long)full, tris);
+        EXPECT_MSG(io >= 0.98, "distance %g: coverage IoU %.4f against the full mesh", (double)dists[k], io);
+        EXPECT_MSG(drel <= 0.02, "distance %g: depth off by > 1 %% in %.2f %% of the pixels", (double)dists[k], 100.0 * drel);
         drawn_at[k] = lod;
     }
-    CHECK(drawn_at[0] * 20 <= tris, "far: %llu of %u triangles drawn (want a simplified level, <= 5 %%)",
-          (unsigned long long)drawn_at[0], tris);
-    CHECK(drawn_at[1] > drawn_at[0], "near (%llu triangles) must draw more than far (%llu)",
-          (unsigned long long)drawn_at[1], (unsigned long long)drawn_at[0]);
+    EXPECT_MSG(drawn_at[0] * 20 <= tris, "far: %llu of %u triangles drawn (want a simplified level, <= 5 %%)",
+               (unsigned long long)drawn_at[0], tris);
+    EXPECT_MSG(drawn_at[1] > drawn_at[0], "near (%llu triangles) must draw more than far (%llu)",
+               (unsigned long long)drawn_at[1], (unsigned long long)drawn_at[0]);
 
     /* Behind the camera: culled, nothing drawn. */
     sy_gl_set_lod(d, SY_GL_LOD_PIXELS_DEFAULT);
     translate(id.transform, 0, 0, 20);
     MUST(sy_gl_instance_set_transform(d, inst, id.transform, e, sizeof e));
     uint64_t culled = 0, behind = draw(d, 3.0f, 0, &culled);
-    CHECK(behind == 0 && culled == 1, "behind the camera: %llu triangles drawn, %llu culled", (unsigned long long)behind,
-          (unsigned long long)culled);
+    EXPECT_MSG(behind == 0 && culled == 1, "behind the camera: %llu triangles drawn, %llu culled", (unsigned long long)behind,
+               (unsigned long long)culled);
 
     /* A small mesh has no levels: all its triangles at any distance. */
     MUST(sy_gl_instance_destroy(d, inst));
     uint32_t small_tris = 0;
     sy_gl_mesh small = gl_test_sphere(d, 32, 0.03f, true, &small_tris);
-    CHECK(small_tris < SY_GL_LOD_MIN_TRIANGLES, "small sphere: %u triangles", small_tris);
+    EXPECT_MSG(small_tris < SY_GL_LOD_MIN_TRIANGLES, "small sphere: %u triangles", small_tris);
     id.mesh = small;
     translate(id.transform, 0, 0, 0);
     MUST(sy_gl_instance_create(d, &id, &inst, e, sizeof e));
     uint64_t s = draw(d, 12.0f, 0, NULL);
-    CHECK(s == small_tris, "small mesh far away: %llu of %u triangles drawn", (unsigned long long)s, small_tris);
+    EXPECT_MSG(s == small_tris, "small mesh far away: %llu of %u triangles drawn", (unsigned long long)s, small_tris);
     sy_gl_device_destroy(d);
-    if (failures) fprintf(stderr, "test_raster_lod: %d check(s) failed\n", failures);
-    else printf("test_raster_lod: ok\n");
-    return failures ? 1 : 0;
+    return sy_check_finish("test_raster_lod");
 }

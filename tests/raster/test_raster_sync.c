@@ -60,27 +60,27 @@ static void incremental(void)
     render(ctx, &v, &img);
     sy_mediator_raster_counters c;
     sy_mediator_raster_counters_get(st, &c);
-    CHECKF(c.meshes == 2 && c.instances == 2 && c.lights == 1, "meshes %u instances %u lights %u", c.meshes, c.instances, c.lights);
-    CHECKF(c.vertex_buffer_uploads == 4, "first frame vertex uploads %llu (2 x vertex + index buffer)",
-           (unsigned long long)c.vertex_buffer_uploads);
+    EXPECT_MSG(c.meshes == 2 && c.instances == 2 && c.lights == 1, "meshes %u instances %u lights %u", c.meshes, c.instances, c.lights);
+    EXPECT_MSG(c.vertex_buffer_uploads == 4, "first frame vertex uploads %llu (2 x vertex + index buffer)",
+               (unsigned long long)c.vertex_buffer_uploads);
     float pa[3] = {-0.5f, 0, 0}, x, y;
     it_project(&v, pa, W, H, &x, &y);
     const float *red = it_px(&img, (uint32_t)(0.6f / 0.5f / 3.0f * W / 2 + W / 2), H / 2);
-    CHECKF(red[0] == 1.0f && red[1] == 0.0f && red[3] == 1.0f, "unlit quad %g %g %g %g", red[0], red[1], red[2], red[3]);
+    EXPECT_MSG(red[0] == 1.0f && red[1] == 0.0f && red[3] == 1.0f, "unlit quad %g %g %g %g", red[0], red[1], red[2], red[3]);
     float before = it_px(&img, (uint32_t)x, (uint32_t)y)[0];
-    CHECKF(before > 0.0f, "lit quad is black");
+    EXPECT_MSG(before > 0.0f, "lit quad is black");
 
     /* transform only: one model-matrix update per moved instance, no vertex data */
     it_set_translation(s, na, 0, 0.05f, 0);
     MUST(sy_scene_commit(s, NULL, err));
     render(ctx, &v, &img2);
     sy_mediator_raster_counters_get(st, &c);
-    CHECKF(c.vertex_buffer_uploads == 0 && c.vertex_bytes == 0 && c.texture_uploads == 0,
-           "transform-only change uploaded %llu vertex buffers (%llu bytes)", (unsigned long long)c.vertex_buffer_uploads,
-           (unsigned long long)c.vertex_bytes);
-    CHECKF(c.model_matrix_updates == 1 && c.last_sync_placements == 1, "model matrices %llu, placements %u",
-           (unsigned long long)c.model_matrix_updates, c.last_sync_placements);
-    CHECK(!it_layers_identical(&img, &img2));
+    EXPECT_MSG(c.vertex_buffer_uploads == 0 && c.vertex_bytes == 0 && c.texture_uploads == 0,
+               "transform-only change uploaded %llu vertex buffers (%llu bytes)", (unsigned long long)c.vertex_buffer_uploads,
+               (unsigned long long)c.vertex_bytes);
+    EXPECT_MSG(c.model_matrix_updates == 1 && c.last_sync_placements == 1, "model matrices %llu, placements %u",
+               (unsigned long long)c.model_matrix_updates, c.last_sync_placements);
+    EXPECT(!it_layers_identical(&img, &img2));
 
     /* material change: one uniform-buffer update */
     sy_material_data md = *sy_material_get(s, lit);
@@ -89,9 +89,9 @@ static void incremental(void)
     MUST(sy_scene_commit(s, NULL, err));
     render(ctx, &v, &img2);
     sy_mediator_raster_counters_get(st, &c);
-    CHECKF(c.uniform_buffer_uploads == 1 && c.vertex_buffer_uploads == 0 && c.model_matrix_updates == 0,
-           "material change: %llu UBO, %llu VBO, %llu matrices", (unsigned long long)c.uniform_buffer_uploads,
-           (unsigned long long)c.vertex_buffer_uploads, (unsigned long long)c.model_matrix_updates);
+    EXPECT_MSG(c.uniform_buffer_uploads == 1 && c.vertex_buffer_uploads == 0 && c.model_matrix_updates == 0,
+               "material change: %llu UBO, %llu VBO, %llu matrices", (unsigned long long)c.uniform_buffer_uploads,
+               (unsigned long long)c.vertex_buffer_uploads, (unsigned long long)c.model_matrix_updates);
 
     /* a new mesh: one upload of its buffers */
     const float q3[1][3] = {{0, 0.7f, 0.1f}};
@@ -104,17 +104,17 @@ static void incremental(void)
     MUST(sy_scene_commit(s, NULL, err));
     render(ctx, &v, &img2);
     sy_mediator_raster_counters_get(st, &c);
-    CHECKF(c.vertex_buffer_uploads == 2 && c.meshes == 3 && c.instances == 3, "new mesh: %llu vertex uploads, %u meshes",
-           (unsigned long long)c.vertex_buffer_uploads, c.meshes);
+    EXPECT_MSG(c.vertex_buffer_uploads == 2 && c.meshes == 3 && c.instances == 3, "new mesh: %llu vertex uploads, %u meshes",
+               (unsigned long long)c.vertex_buffer_uploads, c.meshes);
 
     /* unknown provider / malformed parameters */
     sy_context *bad = NULL;
     sy_params bp;
     MUST(sy_params_parse("gl=vulkan", &bp, err));
     sy_error e = {0};
-    CHECK(sy_context_create(s, "raster", &bp, root.id, &bad, &e) != SY_OK && strstr(e.message, "gl=vulkan"));
+    EXPECT(sy_context_create(s, "raster", &bp, root.id, &bad, &e) != SY_OK && strstr(e.message, "gl=vulkan"));
     MUST(sy_params_parse("msaa=0", &bp, err));
-    CHECK(sy_context_create(s, "raster", &bp, root.id, &bad, &e) != SY_OK && strstr(e.message, "msaa"));
+    EXPECT(sy_context_create(s, "raster", &bp, root.id, &bad, &e) != SY_OK && strstr(e.message, "msaa"));
 
     sy_layer_destroy(&img);
     sy_layer_destroy(&img2);
@@ -147,11 +147,11 @@ static void cornell(void)
     for (uint32_t i = 0; i < W * H; ++i) {
         const float *p = img.rgba + 4 * i;
         if (p[0] == 17.0f && p[1] == 12.0f && p[2] == 4.0f && p[3] == 1.0f) exact++;
-        CHECKF(p[0] <= 17.0f && p[1] <= 12.0f && p[2] <= 4.0f, "pixel %u brighter than the light: %g %g %g", i, p[0], p[1], p[2]);
+        EXPECT_MSG(p[0] <= 17.0f && p[1] <= 12.0f && p[2] <= 4.0f, "pixel %u brighter than the light: %g %g %g", i, p[0], p[1], p[2]);
         if (!(p[0] <= 17.0f)) break;
     }
-    CHECKF(exact >= 4, "only %u pixels show exactly the light's radiance 17 12 4", exact);
-    CHECK(sy_layer_count_nonfinite(&img) == 0);
+    EXPECT_MSG(exact >= 4, "only %u pixels show exactly the light's radiance 17 12 4", exact);
+    EXPECT(sy_layer_count_nonfinite(&img) == 0);
     /* lit by its ceiling panel alone (area light, LTC + soft shadow + the indirect estimate): the
      * mean luminance of regions of the back wall, the side walls and the floor within 20 % of the
      * path tracer's (256 spp, 256 x 256, measured with tests/raster/raster_measure) */
@@ -171,12 +171,12 @@ static void cornell(void)
             }
         double mean = n ? sum / n : 0.0, ratio = mean / regions[k].want;
         printf("cornell %-10s mean luminance %.4f, path tracer %.4f, ratio %.3f\n", regions[k].name, mean, regions[k].want, ratio);
-        CHECKF(ratio > 0.8 && ratio < 1.2, "Cornell %s: mean luminance %.4f, the path tracer's %.4f (ratio %.3f)", regions[k].name,
-               mean, regions[k].want, ratio);
+        EXPECT_MSG(ratio > 0.8 && ratio < 1.2, "Cornell %s: mean luminance %.4f, the path tracer's %.4f (ratio %.3f)", regions[k].name,
+                   mean, regions[k].want, ratio);
     }
     const float *mid = it_px(&img, W / 2, H / 2);
     float dmid = img.depth[(H / 2) * W + W / 2];
-    CHECKF(mid[3] == 1.0f && isfinite(dmid) && dmid > 0.0f, "centre alpha %g depth %g", mid[3], dmid);
+    EXPECT_MSG(mid[3] == 1.0f && isfinite(dmid) && dmid > 0.0f, "centre alpha %g depth %g", mid[3], dmid);
     sy_layer_destroy(&img);
     sy_window_destroy(win);
     sy_context_pool_destroy(pool);
@@ -189,5 +189,5 @@ int main(void)
     it_register();
     incremental();
     cornell();
-    return it_finish("raster_sync");
+    return sy_check_finish("raster_sync");
 }

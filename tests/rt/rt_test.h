@@ -1,10 +1,10 @@
-/* rt_test.h — helpers shared by the backends/rt tests: a CHECK macro that reports file:line and
- * fails the test, and small builders for quads, transforms, cameras and renders using only the
+/* rt_test.h — helpers shared by the backends/rt tests: the check kit (tests/support/sy_check.h;
+ * the tests use its counted EXPECT form and end with sy_check_finish), MUST, and small builders for quads, transforms, cameras and renders using only the
  * public sy_rt API. */
 #ifndef RT_TEST_H
 #define RT_TEST_H
 
-#include "../support/check_count.h"
+#include "../support/sy_check.h"
 #include "sy_rt.h"
 
 #include <math.h>
@@ -16,11 +16,6 @@
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-static int rt_failures;
-
-/* Records a failure with its location; the test continues so one run reports every problem. */
-#define CHECK(cond, ...) SY_CHECK_COUNT(rt_failures, cond, __VA_ARGS__)
 
 /* A call that must succeed; aborts the test (returns 1 from main's helper chain) otherwise. */
 #define MUST(call)                                                                                 \
@@ -178,13 +173,6 @@ static inline sy_rt_device *rt_device(void)
     sy_rt_device_desc dd = {0};
     MUST(sy_rt_device_create(&dd, &dev, ERR));
     return dev;
-}
-
-static inline int rt_finish(const char *name)
-{
-    if (rt_failures) fprintf(stderr, "%s: %d check(s) failed\n", name, rt_failures);
-    else printf("%s: ok\n", name);
-    return rt_failures ? 1 : 0;
 }
 
 /* The grazing-emitter scene of rt_whitted and rt_pathtracer: a Lambertian floor (albedo 0.8, z = 0,

@@ -12,32 +12,32 @@ static void test_mesh_validation(sy_rt_device *dev)
     const uint32_t bad_idx[] = {0, 1, 3};
     sy_rt_mesh_desc d = {.positions = pos, .indices = bad_idx, .vertex_count = 3, .triangle_count = 1};
     err[0] = 0;
-    CHECK(sy_rt_mesh_create(dev, &d, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "index past vertex count accepted");
-    CHECK(strstr(err, "indices[2] = 3") != NULL, "message was '%s'", err);
-    CHECK(m.id == 0, "failed create left a handle");
+    EXPECT_MSG(sy_rt_mesh_create(dev, &d, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "index past vertex count accepted");
+    EXPECT_MSG(strstr(err, "indices[2] = 3") != NULL, "message was '%s'", err);
+    EXPECT_MSG(m.id == 0, "failed create left a handle");
 
     float nan_pos[] = {0, 0, 0, 1, NAN, 0, 0, 1, 0};
     sy_rt_mesh_desc dn = {.positions = nan_pos, .vertex_count = 3, .triangle_count = 1};
     err[0] = 0;
-    CHECK(sy_rt_mesh_create(dev, &dn, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "NaN position accepted");
-    CHECK(strstr(err, "vertex 1") != NULL && strstr(err, "not finite") != NULL, "message was '%s'", err);
+    EXPECT_MSG(sy_rt_mesh_create(dev, &dn, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "NaN position accepted");
+    EXPECT_MSG(strstr(err, "vertex 1") != NULL && strstr(err, "not finite") != NULL, "message was '%s'", err);
 
     sy_rt_mesh_desc dc = {.positions = pos, .vertex_count = 3, .triangle_count = 2};
     err[0] = 0;
-    CHECK(sy_rt_mesh_create(dev, &dc, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "inconsistent counts accepted");
-    CHECK(strstr(err, "3 * triangle_count") != NULL, "message was '%s'", err);
+    EXPECT_MSG(sy_rt_mesh_create(dev, &dc, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "inconsistent counts accepted");
+    EXPECT_MSG(strstr(err, "3 * triangle_count") != NULL, "message was '%s'", err);
 
     sy_rt_mesh_desc dz = {.positions = NULL, .vertex_count = 3, .triangle_count = 1};
-    CHECK(sy_rt_mesh_create(dev, &dz, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "NULL positions accepted");
+    EXPECT_MSG(sy_rt_mesh_create(dev, &dz, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "NULL positions accepted");
 
     float inf_nrm[] = {0, 0, 1, 0, 0, INFINITY, 0, 0, 1};
     sy_rt_mesh_desc dnn = {.positions = pos, .normals = inf_nrm, .vertex_count = 3, .triangle_count = 1};
-    CHECK(sy_rt_mesh_create(dev, &dnn, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "infinite normal accepted");
+    EXPECT_MSG(sy_rt_mesh_create(dev, &dnn, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "infinite normal accepted");
 
     sy_rt_mesh_desc ok = {.positions = pos, .vertex_count = 3, .triangle_count = 1};
-    CHECK(sy_rt_mesh_create(dev, &ok, &m, err, sizeof err) == SY_RT_OK, "valid non-indexed mesh rejected: %s", err);
-    CHECK(sy_rt_mesh_destroy(dev, m, err, sizeof err) == SY_RT_OK, "destroy failed: %s", err);
-    CHECK(sy_rt_mesh_destroy(dev, m, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "double destroy not detected");
+    EXPECT_MSG(sy_rt_mesh_create(dev, &ok, &m, err, sizeof err) == SY_RT_OK, "valid non-indexed mesh rejected: %s", err);
+    EXPECT_MSG(sy_rt_mesh_destroy(dev, m, err, sizeof err) == SY_RT_OK, "destroy failed: %s", err);
+    EXPECT_MSG(sy_rt_mesh_destroy(dev, m, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "double destroy not detected");
 }
 
 static void test_other_validation(sy_rt_device *dev)
@@ -47,32 +47,32 @@ static void test_other_validation(sy_rt_device *dev)
     sy_rt_material_desc_init(&md);
     md.roughness = 1.5f;
     sy_rt_material mat;
-    CHECK(sy_rt_material_create(dev, &md, &mat, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "roughness 1.5 accepted");
-    CHECK(strstr(err, "roughness") != NULL, "message was '%s'", err);
+    EXPECT_MSG(sy_rt_material_create(dev, &md, &mat, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "roughness 1.5 accepted");
+    EXPECT_MSG(strstr(err, "roughness") != NULL, "message was '%s'", err);
     sy_rt_material_desc_init(&md);
     md.base_color_texture.texture.id = 0x00400001u; /* never issued */
-    CHECK(sy_rt_material_create(dev, &md, &mat, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "stale texture accepted");
+    EXPECT_MSG(sy_rt_material_create(dev, &md, &mat, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "stale texture accepted");
 
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_SPOT, .color = {1, 1, 1}, .intensity = 1, .direction = {0, 0, -1},
                            .inner_cone_angle = 0.8f, .outer_cone_angle = 0.4f};
     sy_rt_light light;
-    CHECK(sy_rt_light_create(dev, &ld, &light, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "inner > outer accepted");
-    CHECK(strstr(err, "cone") != NULL, "message was '%s'", err);
+    EXPECT_MSG(sy_rt_light_create(dev, &ld, &light, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "inner > outer accepted");
+    EXPECT_MSG(strstr(err, "cone") != NULL, "message was '%s'", err);
 
     uint8_t px[4] = {0};
     sy_rt_texture_desc td = {.width = 1, .height = 1, .channels = 5, .format = SY_RT_TEXEL_UNORM8, .pixels = px};
     sy_rt_texture tex;
-    CHECK(sy_rt_texture_create(dev, &td, &tex, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "5 channels accepted");
+    EXPECT_MSG(sy_rt_texture_create(dev, &td, &tex, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "5 channels accepted");
 
     sy_rt_mesh q = rt_quad(dev, 1.0f);
     float singular[16] = {0};
     sy_rt_instance_desc id = {.mesh = q};
     memcpy(id.transform, singular, sizeof singular);
     sy_rt_instance inst;
-    CHECK(sy_rt_instance_create(dev, &id, &inst, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "singular transform accepted");
-    CHECK(strstr(err, "singular") != NULL, "message was '%s'", err);
+    EXPECT_MSG(sy_rt_instance_create(dev, &id, &inst, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "singular transform accepted");
+    EXPECT_MSG(strstr(err, "singular") != NULL, "message was '%s'", err);
     MUST(sy_rt_mesh_destroy(dev, q, ERR));
-    CHECK(sy_rt_instance_create(dev, &id, &inst, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "stale mesh accepted");
+    EXPECT_MSG(sy_rt_instance_create(dev, &id, &inst, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "stale mesh accepted");
 }
 
 static void test_lifetime_and_commit(sy_rt_device *dev)
@@ -89,38 +89,38 @@ static void test_lifetime_and_commit(sy_rt_device *dev)
     sy_rt_camera cam = rt_camera(5.0f, 0.5f);
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, 9, 9);
     float rgba[9 * 9 * 4];
-    CHECK(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_INVALID_OPERATION,
-          "render with uncommitted changes accepted");
-    CHECK(strstr(err, "sy_rt_commit") != NULL, "message was '%s'", err);
+    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_INVALID_OPERATION,
+               "render with uncommitted changes accepted");
+    EXPECT_MSG(strstr(err, "sy_rt_commit") != NULL, "message was '%s'", err);
     MUST(sy_rt_commit(dev, ERR));
     MUST(sy_rt_render(dev, &cam, &rd, rgba, NULL, ERR));
     const float *c = rgba + 4 * (4 * 9 + 4);
-    CHECK(c[0] == 1.0f && c[1] == 2.0f && c[2] == 3.0f && c[3] == 1.0f, "centre %g %g %g %g", c[0], c[1], c[2], c[3]);
+    EXPECT_MSG(c[0] == 1.0f && c[1] == 2.0f && c[2] == 3.0f && c[3] == 1.0f, "centre %g %g %g %g", c[0], c[1], c[2], c[3]);
 
     sy_rt_stats st;
     sy_rt_device_stats(dev, &st);
-    CHECK(st.meshes == 0 && st.instances == 1 && st.area_light_triangles == 2, "stats %u %u %u", st.meshes, st.instances,
-          st.area_light_triangles);
+    EXPECT_MSG(st.meshes == 0 && st.instances == 1 && st.area_light_triangles == 2, "stats %u %u %u", st.meshes, st.instances,
+               st.area_light_triangles);
 
     rd.integrator = (sy_rt_integrator)99; /* 3 is the path tracer, 4 reserved */
-    CHECK(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_UNSUPPORTED, "unknown integrator accepted");
+    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_UNSUPPORTED, "unknown integrator accepted");
     rd.integrator = SY_RT_INTEGRATOR_WHITTED;
     rd.x = 5;
     rd.width = 5;
-    CHECK(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "rectangle outside accepted");
+    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "rectangle outside accepted");
     rd.x = 0;
     rd.width = 9;
     sy_rt_camera bad = cam;
     bad.window[0] = bad.window[1];
-    CHECK(sy_rt_render(dev, &bad, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "empty window accepted");
+    EXPECT_MSG(sy_rt_render(dev, &bad, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "empty window accepted");
 
     MUST(sy_rt_instance_destroy(dev, inst, ERR));
-    CHECK(sy_rt_instance_set_transform(dev, inst, xf, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "stale instance accepted");
+    EXPECT_MSG(sy_rt_instance_set_transform(dev, inst, xf, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "stale instance accepted");
     MUST(sy_rt_material_destroy(dev, em, ERR));
     MUST(sy_rt_commit(dev, ERR));
     sy_rt_device_stats(dev, &st);
-    CHECK(st.instances == 0 && st.materials == 0 && st.area_light_triangles == 0, "stats after destroy %u %u %u",
-          st.instances, st.materials, st.area_light_triangles);
+    EXPECT_MSG(st.instances == 0 && st.materials == 0 && st.area_light_triangles == 0, "stats after destroy %u %u %u",
+               st.instances, st.materials, st.area_light_triangles);
 
     /* Cancellation through the progress callback. */
     MUST(sy_rt_render(dev, &cam, &rd, rgba, NULL, ERR));
@@ -142,8 +142,8 @@ static void test_progress(sy_rt_device *dev)
     rd.progress = cancel_cb;
     rd.progress_user_data = &calls;
     float *rgba = malloc(64 * 64 * 4 * sizeof(float));
-    CHECK(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_CANCELLED, "cancel ignored");
-    CHECK(calls >= 1 && calls < 16, "progress called %d times for 16 tiles with cancel after the first", calls);
+    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_CANCELLED, "cancel ignored");
+    EXPECT_MSG(calls >= 1 && calls < 16, "progress called %d times for 16 tiles with cancel after the first", calls);
     free(rgba);
 }
 
@@ -171,18 +171,18 @@ static void test_shared_mesh(void)
         sy_rt_stats st;
         sy_rt_device_stats(dev, &st);
         if (shared)
-            CHECK(st.mesh_bytes == 0 && st.shared_bytes == sizeof pos - 4 + sizeof nrm + sizeof uv + sizeof idx,
-                  "shared mesh: %llu bytes copied, %llu shared", (unsigned long long)st.mesh_bytes,
-                  (unsigned long long)st.shared_bytes);
+            EXPECT_MSG(st.mesh_bytes == 0 && st.shared_bytes == sizeof pos - 4 + sizeof nrm + sizeof uv + sizeof idx,
+                       "shared mesh: %llu bytes copied, %llu shared", (unsigned long long)st.mesh_bytes,
+                       (unsigned long long)st.shared_bytes);
         else
-            CHECK(st.mesh_bytes == sizeof nrm + sizeof uv && st.shared_bytes == 0, "copied mesh: %llu bytes copied",
-                  (unsigned long long)st.mesh_bytes);
+            EXPECT_MSG(st.mesh_bytes == sizeof nrm + sizeof uv && st.shared_bytes == 0, "copied mesh: %llu bytes copied",
+                       (unsigned long long)st.mesh_bytes);
         sy_rt_material mat = rt_emitter(dev, 0.25f, 0.5f, 1.0f);
         float xf[16];
         rt_identity(xf);
         sy_rt_instance inst = rt_place(dev, m, xf, mat, 0);
         MUST(sy_rt_mesh_destroy(dev, m, ERR));
-        CHECK(released == 0, "released while an instance uses the mesh");
+        EXPECT_MSG(released == 0, "released while an instance uses the mesh");
         MUST(sy_rt_commit(dev, ERR));
         sy_rt_camera cam = rt_camera(5.0f, 0.5f);
         sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, 16, 16);
@@ -190,17 +190,17 @@ static void test_shared_mesh(void)
         rt_render(dev, &cam, &rd, &img[shared], &depth);
         free(depth);
         MUST(sy_rt_instance_destroy(dev, inst, ERR));
-        CHECK(released == shared, "release called %d times after the last instance went (expected %d)", released, shared);
+        EXPECT_MSG(released == shared, "release called %d times after the last instance went (expected %d)", released, shared);
         /* a failed create leaves the arrays with the caller */
         const uint32_t bad[] = {0, 1, 7};
         sy_rt_mesh_desc db = d;
         db.indices = bad;
         db.triangle_count = 1;
-        CHECK(sy_rt_mesh_create(dev, &db, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "bad index accepted");
+        EXPECT_MSG(sy_rt_mesh_create(dev, &db, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "bad index accepted");
         sy_rt_device_destroy(dev);
-        CHECK(released == shared, "release called %d times in all (expected %d)", released, shared);
+        EXPECT_MSG(released == shared, "release called %d times in all (expected %d)", released, shared);
     }
-    CHECK(memcmp(img[0], img[1], 16 * 16 * 4 * sizeof(float)) == 0, "shared and copied meshes render differently");
+    EXPECT_MSG(memcmp(img[0], img[1], 16 * 16 * 4 * sizeof(float)) == 0, "shared and copied meshes render differently");
     free(img[0]);
     free(img[1]);
 }
@@ -232,10 +232,10 @@ static void test_memory_limit(void)
     memcpy(id.transform, xf, sizeof xf);
     sy_rt_instance inst;
     err[0] = 0;
-    CHECK(sy_rt_instance_create(dev, &id, &inst, err, sizeof err) == SY_RT_ERROR_OUT_OF_MEMORY,
-          "a BVH over the device's memory limit was built");
-    CHECK(strstr(err, "20000 triangles needs about 2.4 MB") && strstr(err, "MB left under the device's memory limit"),
-          "message was '%s'", err);
+    EXPECT_MSG(sy_rt_instance_create(dev, &id, &inst, err, sizeof err) == SY_RT_ERROR_OUT_OF_MEMORY,
+               "a BVH over the device's memory limit was built");
+    EXPECT_MSG(strstr(err, "20000 triangles needs about 2.4 MB") && strstr(err, "MB left under the device's memory limit"),
+               "message was '%s'", err);
     sy_rt_device_destroy(dev);
     /* without a limit of its own the device builds it */
     MUST(sy_rt_device_create(NULL, &dev, ERR));
@@ -258,5 +258,5 @@ int main(void)
     sy_rt_device_destroy(dev);
     test_shared_mesh();
     test_memory_limit();
-    return rt_finish("test_rt_api");
+    return sy_check_finish("test_rt_api");
 }

@@ -45,11 +45,11 @@ static void test_off_axis_shift(sy_rt_device *dev)
     int f0, l0, f1, l1;
     row_extent(a, w, 20, &f0, &l0);
     row_extent(b, w, 25, &f1, &l1);
-    CHECK(f0 == 12 && l0 == 27, "reference quad spans columns %d..%d, expected 12..27", f0, l0);
-    CHECK(f1 == f0 - 3 && l1 == l0 - 3, "shifted window: columns %d..%d, expected %d..%d", f1, l1, f0 - 3, l0 - 3);
+    EXPECT_MSG(f0 == 12 && l0 == 27, "reference quad spans columns %d..%d, expected 12..27", f0, l0);
+    EXPECT_MSG(f1 == f0 - 3 && l1 == l0 - 3, "shifted window: columns %d..%d, expected %d..%d", f1, l1, f0 - 3, l0 - 3);
     col_extent(a, w, h, 20, &f0, &l0);
     col_extent(b, w, h, 17, &f1, &l1);
-    CHECK(f1 == f0 + 5 && l1 == l0 + 5, "shifted window: rows %d..%d, expected %d..%d", f1, l1, f0 + 5, l0 + 5);
+    EXPECT_MSG(f1 == f0 + 5 && l1 == l0 + 5, "shifted window: rows %d..%d, expected %d..%d", f1, l1, f0 + 5, l0 + 5);
     free(a);
     free(ad);
     free(b);
@@ -68,9 +68,9 @@ static void test_off_axis_shift(sy_rt_device *dev)
         c2.window[3] += shifts[i] * px;
         rt_render(dev, &c2, &rd, &b, &bd);
         row_extent(b, w, 20, &f1, &l1);
-        CHECK(f1 == expect_first[i], "edge moved %.2f px: first column %d, expected %d", shifts[i], f1, expect_first[i]);
+        EXPECT_MSG(f1 == expect_first[i], "edge moved %.2f px: first column %d, expected %d", shifts[i], f1, expect_first[i]);
         col_extent(b, w, h, 20, &f1, &l1);
-        CHECK(f1 == expect_first[i], "edge moved %.2f px: first row %d, expected %d", shifts[i], f1, expect_first[i]);
+        EXPECT_MSG(f1 == expect_first[i], "edge moved %.2f px: first row %d, expected %d", shifts[i], f1, expect_first[i]);
         free(b);
         free(bd);
     }
@@ -102,13 +102,13 @@ static void test_depth(void)
         int bad = 0;
         for (int i = 0; i < w * h; ++i)
             if (!(fabsf(depth[i] - dist) < 2e-5f * dist)) bad++;
-        CHECK(bad == 0, "%s: %d pixels with depth != %g (first %g)", ortho ? "ortho" : "persp", bad, dist, depth[0]);
+        EXPECT_MSG(bad == 0, "%s: %d pixels with depth != %g (first %g)", ortho ? "ortho" : "persp", bad, dist, depth[0]);
         free(rgba);
         free(depth);
         /* Near clip beyond the plane: nothing is seen. */
         cam.near_clip = dist + 0.5f;
         rt_render(dev, &cam, &rd, &rgba, &depth);
-        CHECK(isinf(depth[0]) && rgba[3] == 0.0f, "near clip: depth %g alpha %g", depth[0], rgba[3]);
+        EXPECT_MSG(isinf(depth[0]) && rgba[3] == 0.0f, "near clip: depth %g alpha %g", depth[0], rgba[3]);
         free(rgba);
         free(depth);
     }
@@ -145,14 +145,14 @@ static void test_stitch_and_determinism(sy_rt_device *dev)
         free(sub);
         free(subd);
     }
-    CHECK(mismatches == 0, "%d stitched rows differ from the full render", mismatches);
+    EXPECT_MSG(mismatches == 0, "%d stitched rows differ from the full render", mismatches);
     float *again, *ad;
     rt_render(dev, &cam, &rd, &again, &ad);
-    CHECK(memcmp(again, full, sizeof(float) * 4 * w * h) == 0, "two renders with the same seed differ");
+    EXPECT_MSG(memcmp(again, full, sizeof(float) * 4 * w * h) == 0, "two renders with the same seed differ");
     /* The scene has soft shadows: a lit, not-black image with partially shadowed pixels. */
     double sum = 0;
     for (int i = 0; i < w * h; ++i) sum += full[4 * i];
-    CHECK(sum > 1.0, "image is black (sum %g)", sum);
+    EXPECT_MSG(sum > 1.0, "image is black (sum %g)", sum);
     free(again);
     free(ad);
     free(full);
@@ -182,5 +182,5 @@ int main(void)
     test_depth();
     test_stitch_and_determinism(dev);
     sy_rt_device_destroy(dev);
-    return rt_finish("test_rt_camera");
+    return sy_check_finish("test_rt_camera");
 }

@@ -45,11 +45,11 @@ int main(void)
             uint32_t want = expected_id(x, y, t, far_q.id, near_q.id, true), got = ids[y * W + x];
             if (got != want) wrong++;
             n_far += got == far_q.id, n_near += got == near_q.id;
-            if (got == near_q.id) CHECK(fabsf(depth[y * W + x] - 4.0f) < 1e-4f, "near depth %g", depth[y * W + x]);
-            if (got == 0) CHECK(isinf(depth[y * W + x]), "miss depth %g", depth[y * W + x]);
+            if (got == near_q.id) EXPECT_MSG(fabsf(depth[y * W + x] - 4.0f) < 1e-4f, "near depth %g", depth[y * W + x]);
+            if (got == 0) EXPECT_MSG(isinf(depth[y * W + x]), "miss depth %g", depth[y * W + x]);
         }
-    CHECK(wrong == 0, "%d pixels with the wrong id", wrong);
-    CHECK(n_far > 0 && n_near > 0, "both objects covered: far %d near %d", n_far, n_near);
+    EXPECT_MSG(wrong == 0, "%d pixels with the wrong id", wrong);
+    EXPECT_MSG(n_far > 0 && n_near > 0, "both objects covered: far %d near %d", n_far, n_near);
     printf("coverage: far quad %d px, near quad %d px\n", n_far, n_near);
 
     /* a sub-rectangle equals the crop of the full image */
@@ -59,7 +59,7 @@ int main(void)
     int diff = 0;
     for (uint32_t y = 0; y < sub.height; ++y)
         for (uint32_t x = 0; x < sub.width; ++x) diff += part[y * sub.width + x] != ids[(y + sub.y) * W + x + sub.x];
-    CHECK(diff == 0, "%d sub-rectangle pixels differ from the full image", diff);
+    EXPECT_MSG(diff == 0, "%d sub-rectangle pixels differ from the full image", diff);
 
     /* hiding the near quad uncovers the far one behind it */
     MUST(sy_rt_instance_set_visible(dev, near_q, false, ERR));
@@ -68,14 +68,14 @@ int main(void)
     wrong = 0;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) wrong += ids[y * W + x] != expected_id(x, y, t, far_q.id, near_q.id, false);
-    CHECK(wrong == 0, "%d pixels wrong with the near quad hidden", wrong);
+    EXPECT_MSG(wrong == 0, "%d pixels wrong with the near quad hidden", wrong);
 
     /* uncommitted changes and NULL output are refused with a message */
     char msg[256] = "";
     MUST(sy_rt_instance_set_visible(dev, near_q, true, ERR));
-    CHECK(sy_rt_coverage(dev, &cam, &d, ids, NULL, msg, sizeof msg) == SY_RT_ERROR_INVALID_OPERATION, "%s", msg);
+    EXPECT_MSG(sy_rt_coverage(dev, &cam, &d, ids, NULL, msg, sizeof msg) == SY_RT_ERROR_INVALID_OPERATION, "%s", msg);
     MUST(sy_rt_commit(dev, ERR));
-    CHECK(sy_rt_coverage(dev, &cam, &d, NULL, NULL, msg, sizeof msg) == SY_RT_ERROR_INVALID_ARGUMENT, "%s", msg);
+    EXPECT_MSG(sy_rt_coverage(dev, &cam, &d, NULL, NULL, msg, sizeof msg) == SY_RT_ERROR_INVALID_ARGUMENT, "%s", msg);
     sy_rt_device_destroy(dev);
-    return rt_finish("rt_coverage");
+    return sy_check_finish("rt_coverage");
 }

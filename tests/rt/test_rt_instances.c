@@ -46,18 +46,18 @@ static void test_move_hide_destroy(uint32_t flags)
     MUST(sy_rt_commit(dev, ERR));
     int n;
     double c0 = render_centroid(dev, &n);
-    CHECK(n == 64 && fabs(c0 - 12.0) < 1e-9, "flags %u: emitter at x=-1: %d px centred at column %g (expected 64 at 12)", flags, n, c0);
+    EXPECT_MSG(n == 64 && fabs(c0 - 12.0) < 1e-9, "flags %u: emitter at x=-1: %d px centred at column %g (expected 64 at 12)", flags, n, c0);
 
     rt_translation(xf, 1.0f, 0.0f, 0.0f);
     MUST(sy_rt_instance_set_transform(dev, inst, xf, ERR));
     MUST(sy_rt_commit(dev, ERR));
     double c1 = render_centroid(dev, &n);
-    CHECK(n == 64 && fabs(c1 - c0 - 16.0) < 1e-9, "flags %u: moved 2 m = 16 px: centroid %g -> %g", flags, c0, c1);
+    EXPECT_MSG(n == 64 && fabs(c1 - c0 - 16.0) < 1e-9, "flags %u: moved 2 m = 16 px: centroid %g -> %g", flags, c0, c1);
 
     MUST(sy_rt_instance_set_visible(dev, inst, false, ERR));
     MUST(sy_rt_commit(dev, ERR));
     render_centroid(dev, &n);
-    CHECK(n == 0, "flags %u: hidden instance still visible (%d px)", flags, n);
+    EXPECT_MSG(n == 0, "flags %u: hidden instance still visible (%d px)", flags, n);
     MUST(sy_rt_instance_set_visible(dev, inst, true, ERR));
 
     /* A second instance of the same mesh. */
@@ -65,25 +65,25 @@ static void test_move_hide_destroy(uint32_t flags)
     sy_rt_instance second = rt_place(dev, q, xf, green, flags ^ SY_RT_INSTANCE_BAKED);
     MUST(sy_rt_commit(dev, ERR));
     double c2 = render_centroid(dev, &n);
-    CHECK(n == 128 && fabs(c2 - 20.0) < 1e-9, "flags %u: two instances: %d px centred at %g", flags, n, c2);
+    EXPECT_MSG(n == 128 && fabs(c2 - 20.0) < 1e-9, "flags %u: two instances: %d px centred at %g", flags, n, c2);
 
     MUST(sy_rt_instance_destroy(dev, inst, ERR));
     MUST(sy_rt_commit(dev, ERR));
     double c3 = render_centroid(dev, &n);
-    CHECK(n == 64 && fabs(c3 - 12.0) < 1e-9, "flags %u: after destroy: %d px at %g", flags, n, c3);
+    EXPECT_MSG(n == 64 && fabs(c3 - 12.0) < 1e-9, "flags %u: after destroy: %d px at %g", flags, n, c3);
 
     /* Material change: the remaining instance turns red. */
     MUST(sy_rt_instance_set_material(dev, second, rt_emitter(dev, 1.0f, 0.0f, 0.0f), ERR));
     MUST(sy_rt_commit(dev, ERR));
     render_centroid(dev, &n);
-    CHECK(n == 0, "flags %u: material change ignored", flags);
+    EXPECT_MSG(n == 0, "flags %u: material change ignored", flags);
     MUST(sy_rt_instance_destroy(dev, second, ERR));
     MUST(sy_rt_mesh_destroy(dev, q, ERR));
     MUST(sy_rt_commit(dev, ERR));
     sy_rt_stats st;
     sy_rt_device_stats(dev, &st);
-    CHECK(st.instances == 0 && st.meshes == 0 && st.area_light_triangles == 0, "stats %u %u %u", st.instances, st.meshes,
-          st.area_light_triangles);
+    EXPECT_MSG(st.instances == 0 && st.meshes == 0 && st.area_light_triangles == 0, "stats %u %u %u", st.instances, st.meshes,
+               st.area_light_triangles);
     sy_rt_device_destroy(dev);
 }
 
@@ -122,27 +122,27 @@ static void test_area_light_follows(void)
      * Lambert * 0.8 / pi. 16 stratified samples per pixel land within 1 %. */
     double X = 0.2, q = X / sqrt(1.0 + X * X), F = 4.0 / (2.0 * M_PI) * 2.0 * q * atan(q);
     double exact1 = 0.8 / M_PI * 5.0 * M_PI * F;
-    CHECK(rt_near(v1, exact1, 0.01), "lamp at 1 m: %g, expected %g", v1, exact1);
+    EXPECT_MSG(rt_near(v1, exact1, 0.01), "lamp at 1 m: %g, expected %g", v1, exact1);
     rt_rot_y(lamp, (float)M_PI, 0.0f, 0.0f, 2.0f);
     MUST(sy_rt_instance_set_transform(dev, li, lamp, ERR));
     MUST(sy_rt_commit(dev, ERR));
     float v2 = floor_centre(dev);
-    CHECK(rt_near(v2, v1 / 4.0, 0.05), "lamp moved to 2 m: %g, expected about %g (inverse square)", v2, v1 / 4.0);
+    EXPECT_MSG(rt_near(v2, v1 / 4.0, 0.05), "lamp moved to 2 m: %g, expected about %g (inverse square)", v2, v1 / 4.0);
     /* Emission doubled through a material update. */
     md.emissive[0] = md.emissive[1] = md.emissive[2] = 10.0f;
     MUST(sy_rt_material_update(dev, em, &md, ERR));
     MUST(sy_rt_commit(dev, ERR));
     float v3 = floor_centre(dev);
-    CHECK(rt_near(v3, 2.0 * v2, 1e-5), "emission doubled: %g, expected %g", v3, 2.0 * v2);
+    EXPECT_MSG(rt_near(v3, 2.0 * v2, 1e-5), "emission doubled: %g, expected %g", v3, 2.0 * v2);
     /* Double-sided emitter facing away still lights the floor; single-sided does not. */
     rt_rot_y(lamp, 0.0f, 0.0f, 0.0f, 2.0f);
     MUST(sy_rt_instance_set_transform(dev, li, lamp, ERR));
     MUST(sy_rt_commit(dev, ERR));
-    CHECK(floor_centre(dev) == 0.0f, "single-sided emitter facing away lights the floor");
+    EXPECT_MSG(floor_centre(dev) == 0.0f, "single-sided emitter facing away lights the floor");
     md.double_sided = true;
     MUST(sy_rt_material_update(dev, em, &md, ERR));
     MUST(sy_rt_commit(dev, ERR));
-    CHECK(rt_near(floor_centre(dev), v3, 1e-5), "double-sided emitter: %g, expected %g", floor_centre(dev), v3);
+    EXPECT_MSG(rt_near(floor_centre(dev), v3, 1e-5), "double-sided emitter: %g, expected %g", floor_centre(dev), v3);
     sy_rt_device_destroy(dev);
 }
 
@@ -195,8 +195,8 @@ static void grid_compare(grid_scene *g, const unsigned char *moved, const char *
         size_t diff = 0;
         for (size_t i = 0; i < (size_t)MW * MW * 4; ++i) diff += a[i] != b[i];
         for (size_t i = 0; i < (size_t)MW * MW; ++i) diff += ad[i] != bd[i];
-        CHECK(diff == 0, "%s: %s render differs from a device built with the same transforms in %zu values", what,
-              k ? "primary (packets)" : "whitted", diff);
+        EXPECT_MSG(diff == 0, "%s: %s render differs from a device built with the same transforms in %zu values", what,
+                   k ? "primary (packets)" : "whitted", diff);
         free(a), free(ad), free(b), free(bd);
     }
     sy_rt_device_destroy(ref.dev);
@@ -222,8 +222,8 @@ static void test_moves_match_rebuild(void)
         MUST(sy_rt_commit(g.dev, ERR));
     }
     sy_rt_device_stats(g.dev, &st);
-    CHECK(st.top_builds == builds && st.moved_instances == 4, "4 moved instances: %llu full builds (expected %llu), %u "
-          "shown by twins (expected 4)", (unsigned long long)st.top_builds, (unsigned long long)builds, st.moved_instances);
+    EXPECT_MSG(st.top_builds == builds && st.moved_instances == 4, "4 moved instances: %llu full builds (expected %llu), %u "
+               "shown by twins (expected 4)", (unsigned long long)st.top_builds, (unsigned long long)builds, st.moved_instances);
     grid_compare(&g, moved, "4 moved instances");
 
     /* Hiding and showing a moved instance is structural: a full build folds the twins back. */
@@ -232,8 +232,8 @@ static void test_moves_match_rebuild(void)
     MUST(sy_rt_instance_set_visible(g.dev, g.inst[100], true, ERR));
     MUST(sy_rt_commit(g.dev, ERR));
     sy_rt_device_stats(g.dev, &st);
-    CHECK(st.top_builds == builds + 2 && st.moved_instances == 0, "hide + show: %llu builds, %u twins",
-          (unsigned long long)(st.top_builds - builds), st.moved_instances);
+    EXPECT_MSG(st.top_builds == builds + 2 && st.moved_instances == 0, "hide + show: %llu builds, %u twins",
+               (unsigned long long)(st.top_builds - builds), st.moved_instances);
     grid_compare(&g, moved, "after hide + show");
 
     /* More moves than the fast path takes at once: one full build. */
@@ -246,8 +246,8 @@ static void test_moves_match_rebuild(void)
     }
     MUST(sy_rt_commit(g.dev, ERR));
     sy_rt_device_stats(g.dev, &st);
-    CHECK(st.top_builds == builds + 1 && st.moved_instances == 0, "108 moves in one commit: %llu builds, %u twins",
-          (unsigned long long)(st.top_builds - builds), st.moved_instances);
+    EXPECT_MSG(st.top_builds == builds + 1 && st.moved_instances == 0, "108 moves in one commit: %llu builds, %u twins",
+               (unsigned long long)(st.top_builds - builds), st.moved_instances);
     grid_compare(&g, moved, "108 moved instances");
 
     /* Destroying a moved instance. */
@@ -257,12 +257,12 @@ static void test_moves_match_rebuild(void)
     MUST(sy_rt_instance_set_transform(g.dev, g.inst[1], xf, ERR));
     MUST(sy_rt_commit(g.dev, ERR));
     sy_rt_device_stats(g.dev, &st);
-    CHECK(st.moved_instances == 1, "one moved: %u twins", st.moved_instances);
+    EXPECT_MSG(st.moved_instances == 1, "one moved: %u twins", st.moved_instances);
     MUST(sy_rt_instance_destroy(g.dev, g.inst[1], ERR));
     MUST(sy_rt_commit(g.dev, ERR));
     sy_rt_device_stats(g.dev, &st);
-    CHECK(st.moved_instances == 0 && st.instances == GRID * GRID - 1, "destroyed the moved one: %u twins, %u instances",
-          st.moved_instances, st.instances);
+    EXPECT_MSG(st.moved_instances == 0 && st.instances == GRID * GRID - 1, "destroyed the moved one: %u twins, %u instances",
+               st.moved_instances, st.instances);
     sy_rt_device_destroy(g.dev);
 }
 
@@ -272,5 +272,5 @@ int main(void)
     test_move_hide_destroy(SY_RT_INSTANCE_BAKED);
     test_area_light_follows();
     test_moves_match_rebuild();
-    return rt_finish("test_rt_instances");
+    return sy_check_finish("test_rt_instances");
 }

@@ -104,14 +104,14 @@ static void test_background_never_lights(void)
             float *rgba, *depth;
             render(dev, &cam, (sy_rt_integrator)integ, 16, 16, 4, &rgba, &depth);
             const float *corner = rgba, *centre = rgba + 4 * (8 * 16 + 8);
-            CHECK(fabsf(corner[0] - k * c[0]) < 1e-6f && fabsf(corner[1] - k * c[1]) < 1e-6f &&
-                      fabsf(corner[2] - k * c[2]) < 1e-6f && corner[3] == 1.0f,
-                  "mode %d integrator %d: background pixel %g %g %g %g, expected %g %g %g 1", mode, integ, corner[0],
-                  corner[1], corner[2], corner[3], k * c[0], k * c[1], k * c[2]);
+            EXPECT_MSG(fabsf(corner[0] - k * c[0]) < 1e-6f && fabsf(corner[1] - k * c[1]) < 1e-6f &&
+                       fabsf(corner[2] - k * c[2]) < 1e-6f && corner[3] == 1.0f,
+                       "mode %d integrator %d: background pixel %g %g %g %g, expected %g %g %g 1", mode, integ, corner[0],
+                       corner[1], corner[2], corner[3], k * c[0], k * c[1], k * c[2]);
             if (integ != SY_RT_INTEGRATOR_PRIMARY) /* eye-light shading lights everything */
-                CHECK(centre[0] == 0.0f && centre[1] == 0.0f && centre[2] == 0.0f && centre[3] == 1.0f,
-                      "mode %d integrator %d: a surface lit by the background alone: %g %g %g %g", mode, integ, centre[0],
-                      centre[1], centre[2], centre[3]);
+                EXPECT_MSG(centre[0] == 0.0f && centre[1] == 0.0f && centre[2] == 0.0f && centre[3] == 1.0f,
+                           "mode %d integrator %d: a surface lit by the background alone: %g %g %g %g", mode, integ, centre[0],
+                           centre[1], centre[2], centre[3]);
             free(rgba);
             free(depth);
         }
@@ -140,12 +140,12 @@ static void test_environment_is_a_light(void)
             float *rgba, *depth;
             render(dev, &cam, (sy_rt_integrator)integ, 16, 16, 4, &rgba, &depth);
             const float *corner = rgba, *centre = rgba + 4 * (8 * 16 + 8);
-            CHECK(corner[0] == 0.0f && corner[1] == 0.0f && corner[2] == 0.0f && corner[3] == 0.0f,
-                  "integrator %d: camera rays see the environment: %g %g %g %g", integ, corner[0], corner[1], corner[2],
-                  corner[3]);
+            EXPECT_MSG(corner[0] == 0.0f && corner[1] == 0.0f && corner[2] == 0.0f && corner[3] == 0.0f,
+                       "integrator %d: camera rays see the environment: %g %g %g %g", integ, corner[0], corner[1], corner[2],
+                       corner[3]);
             for (int c = 0; c < 3; ++c)
-                CHECK(rt_near(centre[c], 1.5 * L[c], 1e-5), "integrator %d: mirror channel %d = %g, expected %g", integ, c,
-                      centre[c], 1.5 * L[c]);
+                EXPECT_MSG(rt_near(centre[c], 1.5 * L[c], 1e-5), "integrator %d: mirror channel %d = %g, expected %g", integ, c,
+                           centre[c], 1.5 * L[c]);
             free(rgba);
             free(depth);
         }
@@ -167,8 +167,8 @@ static void test_environment_is_a_light(void)
             render(dev, &cam, integ, 32, 32, k ? 64 : 4, &rgba, &depth);
             mean_rgb(rgba, 32 * 32, m[k]);
             for (int c = 0; c < 3; ++c)
-                CHECK(rt_near(m[k][c], 0.7 * L[c], 0.01), "integrator %d: floor under the uniform environment, channel %d: "
-                      "%.5f, expected %.5f", (int)integ, c, m[k][c], 0.7 * L[c]);
+                EXPECT_MSG(rt_near(m[k][c], 0.7 * L[c], 0.01), "integrator %d: floor under the uniform environment, channel %d: "
+                           "%.5f, expected %.5f", (int)integ, c, m[k][c], 0.7 * L[c]);
             free(rgba);
             free(depth);
         }
@@ -205,9 +205,9 @@ static void test_emission_adds(void)
         for (int c = 0; c < 3; ++c) {
             double expect = md.emissive[c] + 0.5 / M_PI * 3.0;
             /* Whitted: exact; path tracer: light category chosen at random (area or punctual) */
-            CHECK(rt_near(mean[c], expect, integ == SY_RT_INTEGRATOR_WHITTED ? 1e-5 : 0.02),
-                  "integrator %d channel %d: emissive surface under a light %.5f, expected emission + reflection %.5f",
-                  integ, c, mean[c], expect);
+            EXPECT_MSG(rt_near(mean[c], expect, integ == SY_RT_INTEGRATOR_WHITTED ? 1e-5 : 0.02),
+                       "integrator %d channel %d: emissive surface under a light %.5f, expected emission + reflection %.5f",
+                       integ, c, mean[c], expect);
         }
         free(rgba);
         free(depth);
@@ -241,8 +241,8 @@ static void shadow_case(const char *name, const sy_rt_material_desc *bd, const d
         double mean[3];
         mean_rgb(rgba, 64, mean);
         for (int c = 0; c < 3; ++c)
-            CHECK(rt_near(mean[c], expect[c], 1e-4) || (expect[c] == 0 && mean[c] == 0),
-                  "%s, integrator %d, channel %d: floor %.6f, expected %.6f", name, integ, c, mean[c], expect[c]);
+            EXPECT_MSG(rt_near(mean[c], expect[c], 1e-4) || (expect[c] == 0 && mean[c] == 0),
+                       "%s, integrator %d, channel %d: floor %.6f, expected %.6f", name, integ, c, mean[c], expect[c]);
         free(rgba);
         free(depth);
     }
@@ -293,7 +293,7 @@ static void test_whitted_antialiasing(void)
     float *a, *da, *b, *db;
     render(dev, &cam, SY_RT_INTEGRATOR_WHITTED, W, W, 4, &a, &da);
     render(dev, &cam, SY_RT_INTEGRATOR_WHITTED, W, W, 4, &b, &db);
-    CHECK(!memcmp(a, b, W * W * 4 * sizeof(float)), "Whitted with 4 pixel samples is not deterministic");
+    EXPECT_MSG(!memcmp(a, b, W * W * 4 * sizeof(float)), "Whitted with 4 pixel samples is not deterministic");
     uint32_t partial = 0, inner = 0, wrong = 0;
     double coverage = 0;
     for (uint32_t i = 0; i < W * W; ++i) {
@@ -310,9 +310,9 @@ static void test_whitted_antialiasing(void)
     }
     /* the quad covers 4 m^2 of the 4 x 4 m window at distance 4 (1/4 of the image) */
     coverage /= (double)(W * W);
-    CHECK(partial > 40 && inner > 100, "anti-aliasing: %u partial and %u inner pixels", partial, inner);
-    CHECK(wrong == 0, "%u pixels are not the emitter's radiance x coverage", wrong);
-    CHECK(fabs(coverage - 0.25) < 0.01, "mean coverage %.4f, expected 0.25", coverage);
+    EXPECT_MSG(partial > 40 && inner > 100, "anti-aliasing: %u partial and %u inner pixels", partial, inner);
+    EXPECT_MSG(wrong == 0, "%u pixels are not the emitter's radiance x coverage", wrong);
+    EXPECT_MSG(fabs(coverage - 0.25) < 0.01, "mean coverage %.4f, expected 0.25", coverage);
     /* quadrants stitch */
     size_t diff = 0;
     for (uint32_t q = 0; q < 4; ++q) {
@@ -326,7 +326,7 @@ static void test_whitted_antialiasing(void)
         free(r);
         free(dp);
     }
-    CHECK(diff == 0, "%zu quadrant rows differ from the full image", diff);
+    EXPECT_MSG(diff == 0, "%zu quadrant rows differ from the full image", diff);
     free(a), free(da), free(b), free(db);
     sy_rt_device_destroy(dev);
 }
@@ -370,8 +370,8 @@ static void test_whitted_soft_shadow_noise(void)
         }
     double corr = sxx > 0 ? sxy / sxx : 0;
     printf("soft shadow, 4 samples: neighbour error correlation %.3f over %u pixels\n", corr, n);
-    CHECK(n > 500, "only %u lit pixels", n);
-    CHECK(fabs(corr) < 0.2, "the errors of neighbouring pixels are correlated (%.3f): a shared sample pattern", corr);
+    EXPECT_MSG(n > 500, "only %u lit pixels", n);
+    EXPECT_MSG(fabs(corr) < 0.2, "the errors of neighbouring pixels are correlated (%.3f): a shared sample pattern", corr);
     /* no bias: the 16-sample image's mean matches the 1024-sample one within 4 standard errors
      * of its own per-pixel noise (a wrong light pdf or a lost stratum is off by far more) */
     float *mid, *dm;
@@ -387,8 +387,8 @@ static void test_whitted_soft_shadow_noise(void)
     double se = sqrt(fmax(ess / m - (es / m) * (es / m), 0.0) / m) * m; /* standard error of the sum */
     printf("soft shadow, 16 samples: mean error %.4f %% (4 standard errors: %.4f %%)\n", 100.0 * es / rs,
            400.0 * se / rs);
-    CHECK(fabs(es) < 4.0 * se + 1e-4 * rs, "16-sample soft shadow mean differs from the 1024-sample one by %.3f %%",
-          100.0 * es / rs);
+    EXPECT_MSG(fabs(es) < 4.0 * se + 1e-4 * rs, "16-sample soft shadow mean differs from the 1024-sample one by %.3f %%",
+               100.0 * es / rs);
     free(mid), free(dm);
     free(lo), free(dl), free(hi), free(dh);
     sy_rt_device_destroy(dev);
@@ -402,5 +402,5 @@ int main(void)
     test_shadows();
     test_whitted_antialiasing();
     test_whitted_soft_shadow_noise();
-    return rt_finish("rt_look");
+    return sy_check_finish("rt_look");
 }

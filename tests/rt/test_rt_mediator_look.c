@@ -101,10 +101,10 @@ int main(void)
     /* 1. no world (the viewports name none): studio lighting, transparent misses */
     for (int k = 0; k < 2; ++k) {
         render(&fx, k);
-        CHECKF(lum(centre) > 0.05f && centre[3] == 1.0f, "%s, no world: quad luminance %g (expected studio-lit)",
-               backends[k], lum(centre));
-        CHECKF(top[0] == 0 && top[1] == 0 && top[2] == 0 && top[3] == 0, "%s, no world: miss %g %g %g %g, expected transparent",
-               backends[k], top[0], top[1], top[2], top[3]);
+        EXPECT_MSG(lum(centre) > 0.05f && centre[3] == 1.0f, "%s, no world: quad luminance %g (expected studio-lit)",
+                   backends[k], lum(centre));
+        EXPECT_MSG(top[0] == 0 && top[1] == 0 && top[2] == 0 && top[3] == 0, "%s, no world: miss %g %g %g %g, expected transparent",
+                   backends[k], top[0], top[1], top[2], top[3]);
     }
     /* the viewports now name the world */
     for (int k = 0; k < 2; ++k) {
@@ -119,23 +119,23 @@ int main(void)
     set_world(&fx, col, false, NULL);
     for (int k = 0; k < 2; ++k) {
         render(&fx, k);
-        CHECKF(centre[0] == 0 && centre[1] == 0 && centre[2] == 0 && centre[3] == 1.0f,
-               "%s: the background colour lights the quad: %g %g %g %g", backends[k], centre[0], centre[1], centre[2],
-               centre[3]);
-        CHECKF(it_px_is(&fx.img, 0, 0, col[0], col[1], col[2], 1.0f), "%s: background %g %g %g %g, expected the colour",
-               backends[k], top[0], top[1], top[2], top[3]);
+        EXPECT_MSG(centre[0] == 0 && centre[1] == 0 && centre[2] == 0 && centre[3] == 1.0f,
+                   "%s: the background colour lights the quad: %g %g %g %g", backends[k], centre[0], centre[1], centre[2],
+                   centre[3]);
+        EXPECT_MSG(it_px_is(&fx.img, 0, 0, col[0], col[1], col[2], 1.0f), "%s: background %g %g %g %g, expected the colour",
+                   backends[k], top[0], top[1], top[2], top[3]);
     }
     /* 3. default lighting on: studio-lit, coloured background; the path tracer restarts */
     uint64_t before = render(&fx, 1);
     set_world(&fx, col, true, NULL);
     uint64_t after = render(&fx, 1);
-    CHECKF(before == 32 && after == 16, "path tracer samples %llu then %llu: the look change did not restart it",
-           (unsigned long long)before, (unsigned long long)after);
+    EXPECT_MSG(before == 32 && after == 16, "path tracer samples %llu then %llu: the look change did not restart it",
+               (unsigned long long)before, (unsigned long long)after);
     for (int k = 0; k < 2; ++k) {
         render(&fx, k);
-        CHECKF(lum(centre) > 0.05f, "%s, world with default lighting: quad luminance %g", backends[k], lum(centre));
-        CHECKF(it_px_is(&fx.img, 0, 0, col[0], col[1], col[2], 1.0f), "%s: background %g %g %g %g", backends[k], top[0],
-               top[1], top[2], top[3]);
+        EXPECT_MSG(lum(centre) > 0.05f, "%s, world with default lighting: quad luminance %g", backends[k], lum(centre));
+        EXPECT_MSG(it_px_is(&fx.img, 0, 0, col[0], col[1], col[2], 1.0f), "%s: background %g %g %g %g", backends[k], top[0],
+                   top[1], top[2], top[3]);
     }
     /* 4. a sky/ground gradient: camera misses above and below the horizon */
     sy_gradient g;
@@ -146,16 +146,16 @@ int main(void)
     set_world(&fx, col, true, &g);
     for (int k = 0; k < 2; ++k) {
         render(&fx, k);
-        CHECKF(fabsf(top[0] - 0.2f) < 1e-3f && fabsf(top[1] - 0.4f) < 1e-3f && fabsf(top[2] - 0.8f) < 1e-3f && top[3] == 1.0f,
-               "%s: sky %g %g %g %g, expected 0.2 0.4 0.8 1", backends[k], top[0], top[1], top[2], top[3]);
-        CHECKF(fabsf(bottom[0] - 0.3f) < 1e-3f && fabsf(bottom[1] - 0.2f) < 1e-3f && fabsf(bottom[2] - 0.1f) < 1e-3f &&
+        EXPECT_MSG(fabsf(top[0] - 0.2f) < 1e-3f && fabsf(top[1] - 0.4f) < 1e-3f && fabsf(top[2] - 0.8f) < 1e-3f && top[3] == 1.0f,
+                   "%s: sky %g %g %g %g, expected 0.2 0.4 0.8 1", backends[k], top[0], top[1], top[2], top[3]);
+        EXPECT_MSG(fabsf(bottom[0] - 0.3f) < 1e-3f && fabsf(bottom[1] - 0.2f) < 1e-3f && fabsf(bottom[2] - 0.1f) < 1e-3f &&
                    bottom[3] == 1.0f,
-               "%s: ground %g %g %g %g, expected 0.3 0.2 0.1 1", backends[k], bottom[0], bottom[1], bottom[2], bottom[3]);
-        CHECKF(lum(centre) > 0.05f, "%s, gradient world: quad luminance %g", backends[k], lum(centre));
+                   "%s: ground %g %g %g %g, expected 0.3 0.2 0.1 1", backends[k], bottom[0], bottom[1], bottom[2], bottom[3]);
+        EXPECT_MSG(lum(centre) > 0.05f, "%s, gradient world: quad luminance %g", backends[k], lum(centre));
     }
     sy_layer_destroy(&fx.img);
     for (int k = 0; k < 2; ++k) sy_window_destroy(fx.win[k]);
     sy_context_pool_destroy(fx.pool);
     sy_scene_destroy(fx.s);
-    return it_finish("rt_mediator_look");
+    return sy_check_finish("rt_mediator_look");
 }

@@ -132,10 +132,10 @@ static void furnace_case(const char *name, const sy_rt_material_desc *md, double
     double m[3];
     mean_rgb(&im, true, m);
     for (int c = 0; c < 3; ++c)
-        CHECK(m[c] >= lo * L[c] && m[c] <= hi * L[c], "%s: channel %d mean %.5f, expected [%.4f, %.4f]", name, c, m[c],
-              lo * L[c], hi * L[c]);
+        EXPECT_MSG(m[c] >= lo * L[c] && m[c] <= hi * L[c], "%s: channel %d mean %.5f, expected [%.4f, %.4f]", name, c, m[c],
+                   lo * L[c], hi * L[c]);
     printf("%s: mean/L = %.4f %.4f %.4f\n", name, m[0] / L[0], m[1] / L[1], m[2] / L[2]);
-    CHECK(count_nonfinite(&im) == 0 && sy_rt_accum_nonfinite(im.acc) == 0, "%s: non-finite values", name);
+    EXPECT_MSG(count_nonfinite(&im) == 0 && sy_rt_accum_nonfinite(im.acc) == 0, "%s: non-finite values", name);
     img_free(&im);
     sy_rt_device_destroy(dev);
 }
@@ -223,8 +223,8 @@ static void test_integrating_sphere(void)
     MUST(sy_rt_commit(dev, ERR));
     sy_rt_stats st;
     sy_rt_device_stats(dev, &st);
-    CHECK(st.area_light_triangles >= 64 * 16 * 2 - 64 && st.area_light_triangles <= 64 * 16 * 2,
-          "area triangles %u (the pole triangles are degenerate and skipped)", st.area_light_triangles);
+    EXPECT_MSG(st.area_light_triangles >= 64 * 16 * 2 - 64 && st.area_light_triangles <= 64 * 16 * 2,
+               "area triangles %u (the pole triangles are degenerate and skipped)", st.area_light_triangles);
     double fe = down / (up + down), k = a * fe / (1.0 - a * (1.0 - fe));
     /* camera at the centre looking up (+Y): sees only the reflecting half */
     sy_rt_camera cam = rt_camera(0.0f, 1.0f);
@@ -237,15 +237,15 @@ static void test_integrating_sphere(void)
     double m[3];
     mean_rgb(&im, false, m);
     for (int c = 0; c < 3; ++c)
-        CHECK(fabs(m[c] / (k * d.emissive[c]) - 1.0) < 0.01, "integrating sphere (a) channel %d: %.5f, expected %.5f", c,
-              m[c], k * d.emissive[c]);
+        EXPECT_MSG(fabs(m[c] / (k * d.emissive[c]) - 1.0) < 0.01, "integrating sphere (a) channel %d: %.5f, expected %.5f", c,
+                   m[c], k * d.emissive[c]);
     printf("integrating sphere, emissive half: mean / expected = %.4f %.4f %.4f\n", m[0] / (k * d.emissive[0]),
            m[1] / (k * d.emissive[1]), m[2] / (k * d.emissive[2]));
     /* direct lighting only (max_depth 1): a f E; the AOVs split the full render into direct a f E
      * and indirect (the rest) */
     img im1 = pt_render(dev, &cam, 24, 24, 64, 7, 1);
     mean_rgb(&im1, false, m);
-    CHECK(fabs(m[1] / (a * fe * d.emissive[1]) - 1.0) < 0.01, "max_depth 1: %.5f, expected %.5f", m[1], a * fe * d.emissive[1]);
+    EXPECT_MSG(fabs(m[1] / (a * fe * d.emissive[1]) - 1.0) < 0.01, "max_depth 1: %.5f, expected %.5f", m[1], a * fe * d.emissive[1]);
     float *dir = malloc(24 * 24 * 3 * sizeof(float)), *ind = malloc(24 * 24 * 3 * sizeof(float));
     MUST(sy_rt_accum_read(im.acc, SY_RT_AOV_DIRECT, dir, ERR));
     MUST(sy_rt_accum_read(im.acc, SY_RT_AOV_INDIRECT, ind, ERR));
@@ -253,7 +253,7 @@ static void test_integrating_sphere(void)
     for (int i = 0; i < 24 * 24; ++i) sd += dir[3 * i + 1], si += ind[3 * i + 1];
     sd /= 24 * 24, si /= 24 * 24;
     double ed = a * fe * d.emissive[1], ei = k * d.emissive[1] - ed;
-    CHECK(fabs(sd / ed - 1.0) < 0.01 && fabs(si / ei - 1.0) < 0.02, "direct %.4f (%.4f), indirect %.4f (%.4f)", sd, ed, si, ei);
+    EXPECT_MSG(fabs(sd / ed - 1.0) < 0.01 && fabs(si / ei - 1.0) < 0.02, "direct %.4f (%.4f), indirect %.4f (%.4f)", sd, ed, si, ei);
     free(dir);
     free(ind);
     img_free(&im);
@@ -270,7 +270,7 @@ static void test_integrating_sphere(void)
     mean_rgb(&im, false, m);
     for (int c = 0; c < 3; ++c) {
         double e = 0.5 * ld.intensity * ld.color[c] / (M_PI * 4.0 * 0.5);
-        CHECK(fabs(m[c] / e - 1.0) < 0.01, "integrating sphere (b) channel %d: %.5f, expected %.5f", c, m[c], e);
+        EXPECT_MSG(fabs(m[c] / e - 1.0) < 0.01, "integrating sphere (b) channel %d: %.5f, expected %.5f", c, m[c], e);
     }
     printf("integrating sphere, point light: mean / expected = %.4f\n", m[0] / (0.5 * 10.0 / (M_PI * 2.0)));
     img_free(&im);
@@ -325,7 +325,7 @@ static void test_env_importance(void)
             for (int c = 0; c < 3; ++c) e[c] += px[(ty * EW + tx) * 3 + c] * dy * dom / M_PI;
         }
     for (int c = 0; c < 3; ++c)
-        CHECK(fabs(m[c] / e[c] - 1.0) < 0.02, "env importance channel %d: %.5f, expected %.5f", c, m[c], e[c]);
+        EXPECT_MSG(fabs(m[c] / e[c] - 1.0) < 0.02, "env importance channel %d: %.5f, expected %.5f", c, m[c], e[c]);
     printf("environment map: mean / expected = %.4f %.4f %.4f\n", m[0] / e[0], m[1] / e[1], m[2] / e[2]);
     img_free(&im);
     sy_rt_device_destroy(dev);
@@ -363,9 +363,9 @@ static void test_determinism_and_tiles(void)
     sy_rt_camera cam = rt_camera(2.5f, 0.6f);
     const uint32_t W = 32;
     img a = pt_render(dev, &cam, W, W, 4, 42, 8), b = pt_render(dev, &cam, W, W, 4, 42, 8);
-    CHECK(!memcmp(a.rgba, b.rgba, W * W * 4 * sizeof(float)), "same seed must give the same image");
+    EXPECT_MSG(!memcmp(a.rgba, b.rgba, W * W * 4 * sizeof(float)), "same seed must give the same image");
     img c = pt_render(dev, &cam, W, W, 4, 43, 8);
-    CHECK(memcmp(a.rgba, c.rgba, W * W * 4 * sizeof(float)) != 0, "another seed must change the noise");
+    EXPECT_MSG(memcmp(a.rgba, c.rgba, W * W * 4 * sizeof(float)) != 0, "another seed must change the noise");
     /* 4 calls of 1 sample */
     img p = pt_render(dev, &cam, W, W, 1, 42, 8);
     for (int k = 0; k < 3; ++k) {
@@ -376,8 +376,8 @@ static void test_determinism_and_tiles(void)
         d.max_depth = 8;
         MUST(sy_rt_render(dev, &cam, &d, p.rgba, p.depth, ERR));
     }
-    CHECK(sy_rt_accum_samples(p.acc) == 4, "accum has %u samples", sy_rt_accum_samples(p.acc));
-    CHECK(!memcmp(a.rgba, p.rgba, W * W * 4 * sizeof(float)), "4 x 1 sample must equal 1 x 4 samples bit for bit");
+    EXPECT_MSG(sy_rt_accum_samples(p.acc) == 4, "accum has %u samples", sy_rt_accum_samples(p.acc));
+    EXPECT_MSG(!memcmp(a.rgba, p.rgba, W * W * 4 * sizeof(float)), "4 x 1 sample must equal 1 x 4 samples bit for bit");
     /* quadrants */
     size_t diff = 0;
     for (uint32_t q = 0; q < 4; ++q) {
@@ -397,23 +397,23 @@ static void test_determinism_and_tiles(void)
         free(rgba);
         sy_rt_accum_destroy(acc);
     }
-    CHECK(diff == 0, "%zu quadrant rows differ from the full image", diff);
-    CHECK(count_nonfinite(&a) == 0, "non-finite pixels in the mixed scene");
+    EXPECT_MSG(diff == 0, "%zu quadrant rows differ from the full image", diff);
+    EXPECT_MSG(count_nonfinite(&a) == 0, "non-finite pixels in the mixed scene");
     /* variance AOV: finite, non-negative, not all zero */
     float *var = malloc(W * W * 3 * sizeof(float));
     MUST(sy_rt_accum_read(a.acc, SY_RT_AOV_VARIANCE, var, ERR));
     size_t bad = 0, pos = 0;
     for (size_t k = 0; k < W * W * 3; ++k) bad += !(isfinite(var[k]) && var[k] >= 0.0f), pos += var[k] > 0.0f;
-    CHECK(bad == 0 && pos > 0, "variance AOV: %zu bad, %zu positive", bad, pos);
+    EXPECT_MSG(bad == 0 && pos > 0, "variance AOV: %zu bad, %zu positive", bad, pos);
     free(var);
     /* accumulation validation */
     sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, W, W);
     char e[256] = "";
-    CHECK(sy_rt_render(dev, &cam, &d, a.rgba, NULL, e, sizeof e) == SY_RT_ERROR_INVALID_ARGUMENT, "no accum accepted");
+    EXPECT_MSG(sy_rt_render(dev, &cam, &d, a.rgba, NULL, e, sizeof e) == SY_RT_ERROR_INVALID_ARGUMENT, "no accum accepted");
     d.accum = p.acc;
     d.width = W / 2;
-    CHECK(sy_rt_render(dev, &cam, &d, a.rgba, NULL, e, sizeof e) == SY_RT_ERROR_INVALID_ARGUMENT && strstr(e, "accum"),
-          "accum size mismatch accepted: %s", e);
+    EXPECT_MSG(sy_rt_render(dev, &cam, &d, a.rgba, NULL, e, sizeof e) == SY_RT_ERROR_INVALID_ARGUMENT && strstr(e, "accum"),
+               "accum size mismatch accepted: %s", e);
     img_free(&a);
     img_free(&b);
     img_free(&c);
@@ -444,14 +444,14 @@ static void test_degenerate(void)
     MUST(sy_rt_commit(dev, ERR));
     sy_rt_stats st;
     sy_rt_device_stats(dev, &st);
-    CHECK(st.area_light_triangles == 1, "only the good emissive triangle is a light (got %u)", st.area_light_triangles);
+    EXPECT_MSG(st.area_light_triangles == 1, "only the good emissive triangle is a light (got %u)", st.area_light_triangles);
     sy_rt_camera cam = rt_camera(1.0f, 0.8f);
     img im = pt_render(dev, &cam, 32, 32, 8, 5, 8);
-    CHECK(count_nonfinite(&im) == 0, "%zu non-finite values", count_nonfinite(&im));
-    CHECK(sy_rt_accum_nonfinite(im.acc) == 0, "%llu samples dropped", (unsigned long long)sy_rt_accum_nonfinite(im.acc));
+    EXPECT_MSG(count_nonfinite(&im) == 0, "%zu non-finite values", count_nonfinite(&im));
+    EXPECT_MSG(sy_rt_accum_nonfinite(im.acc) == 0, "%llu samples dropped", (unsigned long long)sy_rt_accum_nonfinite(im.acc));
     double mm[3];
     mean_rgb(&im, true, mm);
-    CHECK(mm[0] > 0.0, "the lit quad shows light");
+    EXPECT_MSG(mm[0] > 0.0, "the lit quad shows light");
     img_free(&im);
     sy_rt_device_destroy(dev);
 }
@@ -469,7 +469,7 @@ static void test_area_light_grazing(void)
     double m[3];
     mean_rgb(&im, false, m);
     printf("area light at a grazing angle: mean / expected = %.4f\n", m[0] / expect);
-    CHECK(rt_near(m[0], expect, 0.02), "area light at a grazing angle: mean %.6g, expected %.6g", m[0], expect);
+    EXPECT_MSG(rt_near(m[0], expect, 0.02), "area light at a grazing angle: mean %.6g, expected %.6g", m[0], expect);
     img_free(&im);
     sy_rt_device_destroy(dev);
 }
@@ -482,5 +482,5 @@ int main(void)
     test_area_light_grazing();
     test_determinism_and_tiles();
     test_degenerate();
-    return rt_finish("rt_pathtracer");
+    return sy_check_finish("rt_pathtracer");
 }

@@ -99,9 +99,9 @@ static void check_replay(sy_rt_device *dev, sy_rt_ray_log *log, const char *what
         double t = sy_rt_ray_replay_run(rp, &bad);
         printf("%s: %-32s %llu rays, %llu differ (%.2f ms)\n", what, sy_rt_ray_form_name((sy_rt_ray_form)f),
                (unsigned long long)total, (unsigned long long)bad, t * 1e3);
-        if (f == SY_RT_FORM_1) CHECK(bad == 0, "%s: rtcIntersect1/rtcOccluded1: %llu answers differ", what, (unsigned long long)bad);
-        else CHECK(bad * 1000u <= total, "%s: %s: %llu of %llu answers differ", what, sy_rt_ray_form_name((sy_rt_ray_form)f),
-                   (unsigned long long)bad, (unsigned long long)total);
+        if (f == SY_RT_FORM_1) EXPECT_MSG(bad == 0, "%s: rtcIntersect1/rtcOccluded1: %llu answers differ", what, (unsigned long long)bad);
+        else EXPECT_MSG(bad * 1000u <= total, "%s: %s: %llu of %llu answers differ", what, sy_rt_ray_form_name((sy_rt_ray_form)f),
+                        (unsigned long long)bad, (unsigned long long)total);
         sy_rt_ray_replay_destroy(rp);
     }
 }
@@ -138,35 +138,35 @@ int main(void)
     MUST(sy_rt_ray_log_create(&log, ERR));
     uint64_t rays_plain = render(dev, &cam, NULL, a);
     uint64_t rays_logged = render(dev, &cam, log, b);
-    CHECK(!memcmp(a, b, W * H * 4 * sizeof(float)), "the image with a ray log differs from the one without");
-    CHECK(rays_plain == rays_logged, "rays %llu without the log, %llu with it", (unsigned long long)rays_plain,
-          (unsigned long long)rays_logged);
+    EXPECT_MSG(!memcmp(a, b, W * H * 4 * sizeof(float)), "the image with a ray log differs from the one without");
+    EXPECT_MSG(rays_plain == rays_logged, "rays %llu without the log, %llu with it", (unsigned long long)rays_plain,
+               (unsigned long long)rays_logged);
 
     /* the log holds the frame's rays */
     uint64_t total = log->intersect.n + log->occluded.n;
     printf("opaque box: %llu rays = %llu extension + %llu shadow; %zu closest-hit + %zu occlusion queries\n",
            (unsigned long long)total, (unsigned long long)log->kind_count[SY_RT_RAY_EXTENSION],
            (unsigned long long)log->kind_count[SY_RT_RAY_SHADOW], log->intersect.n, log->occluded.n);
-    CHECK(total == rays_logged, "log holds %llu rays, the frame counted %llu", (unsigned long long)total,
-          (unsigned long long)rays_logged);
-    CHECK(log->kind_count[0] + log->kind_count[1] == total, "kind counts do not add up");
-    CHECK(log->kind_count[SY_RT_RAY_EXTENSION] >= (uint64_t)W * H * SPP, "fewer extension rays (%llu) than samples",
-          (unsigned long long)log->kind_count[SY_RT_RAY_EXTENSION]);
-    CHECK(log->kind_count[SY_RT_RAY_EXTENSION] > (uint64_t)W * H * SPP, "no bounce in the box");
-    CHECK(log->occluded.n > 0 && log->occluded.n == log->kind_count[SY_RT_RAY_SHADOW],
-          "opaque scene: every shadow ray is an occlusion query (%zu of %llu)", log->occluded.n,
-          (unsigned long long)log->kind_count[SY_RT_RAY_SHADOW]);
+    EXPECT_MSG(total == rays_logged, "log holds %llu rays, the frame counted %llu", (unsigned long long)total,
+               (unsigned long long)rays_logged);
+    EXPECT_MSG(log->kind_count[0] + log->kind_count[1] == total, "kind counts do not add up");
+    EXPECT_MSG(log->kind_count[SY_RT_RAY_EXTENSION] >= (uint64_t)W * H * SPP, "fewer extension rays (%llu) than samples",
+               (unsigned long long)log->kind_count[SY_RT_RAY_EXTENSION]);
+    EXPECT_MSG(log->kind_count[SY_RT_RAY_EXTENSION] > (uint64_t)W * H * SPP, "no bounce in the box");
+    EXPECT_MSG(log->occluded.n > 0 && log->occluded.n == log->kind_count[SY_RT_RAY_SHADOW],
+               "opaque scene: every shadow ray is an occlusion query (%zu of %llu)", log->occluded.n,
+               (unsigned long long)log->kind_count[SY_RT_RAY_SHADOW]);
     uint64_t hits = 0, inst = 0, occl = 0;
     for (size_t i = 0; i < log->intersect.n; ++i) {
         hits += log->intersect.v[i].geom != RTC_INVALID_GEOMETRY_ID;
         inst += log->intersect.v[i].geom != RTC_INVALID_GEOMETRY_ID && log->intersect.v[i].inst != RTC_INVALID_GEOMETRY_ID;
     }
     for (size_t i = 0; i < log->occluded.n; ++i) occl += log->occluded.v[i].geom != 0;
-    CHECK(hits > log->intersect.n / 2, "the box: most closest-hit rays hit (%llu of %zu)", (unsigned long long)hits,
-          log->intersect.n);
-    CHECK(inst > 0, "no recorded hit on an instanced sphere");
-    CHECK(occl > 0 && occl < log->occluded.n, "shadow rays: %llu of %zu occluded (both kinds expected)",
-          (unsigned long long)occl, log->occluded.n);
+    EXPECT_MSG(hits > log->intersect.n / 2, "the box: most closest-hit rays hit (%llu of %zu)", (unsigned long long)hits,
+               log->intersect.n);
+    EXPECT_MSG(inst > 0, "no recorded hit on an instanced sphere");
+    EXPECT_MSG(occl > 0 && occl < log->occluded.n, "shadow rays: %llu of %zu occluded (both kinds expected)",
+               (unsigned long long)occl, log->occluded.n);
 
     /* the replay reproduces the answers, in every form */
     check_replay(dev, log, "opaque box");
@@ -177,7 +177,7 @@ int main(void)
     if (log->intersect.v[k].geom == RTC_INVALID_GEOMETRY_ID) log->intersect.v[k].geom = 0;
     log->occluded.v[0].geom ^= 1u;
     uint64_t bad = replay1(dev, log);
-    CHECK(bad == 2, "two altered answers, %llu found", (unsigned long long)bad);
+    EXPECT_MSG(bad == 2, "two altered answers, %llu found", (unsigned long long)bad);
 
     /* an alpha-blended pane: shadow rays step through it with closest-hit queries */
     sy_rt_material_desc md;
@@ -197,10 +197,10 @@ int main(void)
     for (size_t i = 0; i < log->intersect.n; ++i) shadow_steps += log->intersect.v[i].kind == SY_RT_RAY_SHADOW;
     printf("with a blended pane: %llu rays, %llu shadow steps as closest-hit queries\n", (unsigned long long)total,
            (unsigned long long)shadow_steps);
-    CHECK(total == rays_logged, "log holds %llu rays, the frame counted %llu", (unsigned long long)total,
-          (unsigned long long)rays_logged);
-    CHECK(shadow_steps > 0 && log->occluded.n == 0, "blend: %llu shadow steps, %zu occlusion queries",
-          (unsigned long long)shadow_steps, log->occluded.n);
+    EXPECT_MSG(total == rays_logged, "log holds %llu rays, the frame counted %llu", (unsigned long long)total,
+               (unsigned long long)rays_logged);
+    EXPECT_MSG(shadow_steps > 0 && log->occluded.n == 0, "blend: %llu shadow steps, %zu occlusion queries",
+               (unsigned long long)shadow_steps, log->occluded.n);
     check_replay(dev, log, "blended pane");
     sy_rt_ray_log_destroy(log);
 
@@ -213,15 +213,15 @@ int main(void)
     d.seed = 7;
     sy_rt_limit_result lr;
     MUST(sy_rt_bench_limit(dev, &cam, &d, 2, &lr, ERR));
-    CHECK(lr.rays == rays_logged && lr.extension_rays + lr.shadow_rays == lr.rays &&
-              lr.intersect_queries + lr.occluded_queries == lr.rays,
-          "bench counts %llu %llu %llu", (unsigned long long)lr.rays, (unsigned long long)lr.extension_rays,
-          (unsigned long long)lr.shadow_rays);
-    CHECK(lr.mismatches[SY_RT_FORM_1] == 0, "bench: %llu mismatches", (unsigned long long)lr.mismatches[0]);
+    EXPECT_MSG(lr.rays == rays_logged && lr.extension_rays + lr.shadow_rays == lr.rays &&
+               lr.intersect_queries + lr.occluded_queries == lr.rays,
+               "bench counts %llu %llu %llu", (unsigned long long)lr.rays, (unsigned long long)lr.extension_rays,
+               (unsigned long long)lr.shadow_rays);
+    EXPECT_MSG(lr.mismatches[SY_RT_FORM_1] == 0, "bench: %llu mismatches", (unsigned long long)lr.mismatches[0]);
     for (int f = 0; f < SY_RT_FORM_COUNT; ++f)
-        CHECK(lr.share[f][0] > 0.0 && lr.share[f][0] <= lr.share[f][1] && lr.share[f][1] <= lr.share[f][2] &&
-                  lr.form_seconds[f][1] > 0.0,
-              "bench: form %d spread %g %g %g", f, lr.share[f][0], lr.share[f][1], lr.share[f][2]);
+        EXPECT_MSG(lr.share[f][0] > 0.0 && lr.share[f][0] <= lr.share[f][1] && lr.share[f][1] <= lr.share[f][2] &&
+                   lr.form_seconds[f][1] > 0.0,
+                   "bench: form %d spread %g %g %g", f, lr.share[f][0], lr.share[f][1], lr.share[f][2]);
 
     /* a log with another integrator is refused */
     d.integrator = SY_RT_INTEGRATOR_WHITTED;
@@ -229,11 +229,11 @@ int main(void)
     d.ray_log = log;
     char e[256] = "";
     sy_rt_result r = sy_rt_render(dev, &cam, &d, a, NULL, e, sizeof e);
-    CHECK(r == SY_RT_ERROR_INVALID_ARGUMENT && strstr(e, "ray log"), "whitted with a ray log: %s: %s", sy_rt_result_str(r), e);
+    EXPECT_MSG(r == SY_RT_ERROR_INVALID_ARGUMENT && strstr(e, "ray log"), "whitted with a ray log: %s: %s", sy_rt_result_str(r), e);
     sy_rt_ray_log_destroy(log);
     sy_rt_accum_destroy(acc);
     free(a);
     free(b);
     sy_rt_device_destroy(dev);
-    return rt_finish("test_rt_raylog");
+    return sy_check_finish("test_rt_raylog");
 }

@@ -42,12 +42,12 @@ static void test_emitter_exact(void)
         float *rgba, *depth;
         rt_render(dev, &cam, &rd, &rgba, &depth);
         const float *c = px_at(rgba, 16, 16);
-        CHECK(c[0] == 17.0f && c[1] == 12.0f && c[2] == 4.0f && c[3] == 1.0f, "integrator %d: emitter %g %g %g %g", integ,
-              c[0], c[1], c[2], c[3]);
-        CHECK(fabsf(depth[16 * W + 16] - CAM_Z) < 1e-5f, "depth %g", depth[16 * W + 16]);
+        EXPECT_MSG(c[0] == 17.0f && c[1] == 12.0f && c[2] == 4.0f && c[3] == 1.0f, "integrator %d: emitter %g %g %g %g", integ,
+                   c[0], c[1], c[2], c[3]);
+        EXPECT_MSG(fabsf(depth[16 * W + 16] - CAM_Z) < 1e-5f, "depth %g", depth[16 * W + 16]);
         const float *bg = px_at(rgba, 0, 0);
-        CHECK(bg[0] == 0 && bg[1] == 0 && bg[2] == 0 && bg[3] == 0, "transparent background %g %g %g %g", bg[0], bg[1], bg[2], bg[3]);
-        CHECK(isinf(depth[0]) && depth[0] > 0, "background depth %g", depth[0]);
+        EXPECT_MSG(bg[0] == 0 && bg[1] == 0 && bg[2] == 0 && bg[3] == 0, "transparent background %g %g %g %g", bg[0], bg[1], bg[2], bg[3]);
+        EXPECT_MSG(isinf(depth[0]) && depth[0] > 0, "background depth %g", depth[0]);
         free(rgba);
         free(depth);
     }
@@ -59,7 +59,7 @@ static void test_emitter_exact(void)
     float *rgba, *depth;
     rt_render(dev, &cam, &rd, &rgba, &depth);
     const float *bg = px_at(rgba, 0, 0);
-    CHECK(bg[0] == 0.25f && bg[1] == 0.5f && bg[2] == 2.0f && bg[3] == 1.0f, "background %g %g %g %g", bg[0], bg[1], bg[2], bg[3]);
+    EXPECT_MSG(bg[0] == 0.25f && bg[1] == 0.5f && bg[2] == 2.0f && bg[3] == 1.0f, "background %g %g %g %g", bg[0], bg[1], bg[2], bg[3]);
     free(rgba);
     free(depth);
     sy_rt_device_destroy(dev);
@@ -118,13 +118,13 @@ static void test_point_and_directional(void)
                 const float *c = px_at(rgba, px, py);
                 for (int k = 0; k < 3; ++k) {
                     double expect = albedo[k] / M_PI * ld.color[k] * E;
-                    CHECK(rt_near(c[k], expect, 1e-3) || (expect == 0 && c[k] == 0), "light kind %d pixel (%d,%d)[%d] = %.7g, expected %.7g",
-                          kind, px, py, k, c[k], expect);
+                    EXPECT_MSG(rt_near(c[k], expect, 1e-3) || (expect == 0 && c[k] == 0), "light kind %d pixel (%d,%d)[%d] = %.7g, expected %.7g",
+                               kind, px, py, k, c[k], expect);
                 }
-                CHECK(c[3] == 1.0f, "alpha %g", c[3]);
+                EXPECT_MSG(c[3] == 1.0f, "alpha %g", c[3]);
                 checked++;
             }
-        CHECK(checked > 40, "only %d pixels checked", checked);
+        EXPECT_MSG(checked > 40, "only %d pixels checked", checked);
         free(rgba);
         free(depth);
         sy_rt_device_destroy(dev);
@@ -159,14 +159,14 @@ static void test_area_light(void)
     rt_render(dev, &cam, &rd, &rgba, &depth);
     double expect = albedo / M_PI * square_irradiance(le, 0.5, 1.0);
     const float *c = px_at(rgba, 16, 16);
-    CHECK(rt_near(c[0], expect, 0.01), "area light: centre %.6g, expected %.6g", c[0], expect);
+    EXPECT_MSG(rt_near(c[0], expect, 0.01), "area light: centre %.6g, expected %.6g", c[0], expect);
     /* Default 16 samples: still within a few percent, and smooth (no sample noise) pixel to pixel. */
     rd.area_light_samples = 0;
     free(rgba);
     free(depth);
     rt_render(dev, &cam, &rd, &rgba, &depth);
     c = px_at(rgba, 16, 16);
-    CHECK(rt_near(c[0], expect, 0.05), "area light (16 samples): centre %.6g, expected %.6g", c[0], expect);
+    EXPECT_MSG(rt_near(c[0], expect, 0.05), "area light (16 samples): centre %.6g, expected %.6g", c[0], expect);
     free(rgba);
     free(depth);
     sy_rt_device_destroy(dev);
@@ -185,7 +185,7 @@ static void test_area_light_grazing(void)
     float *rgba, *depth;
     rt_render(dev, &cam, &rd, &rgba, &depth);
     const float *c = px_at(rgba, W / 2, W / 2);
-    CHECK(rt_near(c[0], expect, 0.01), "area light at a grazing angle: %.6g, expected %.6g", c[0], expect);
+    EXPECT_MSG(rt_near(c[0], expect, 0.01), "area light at a grazing angle: %.6g, expected %.6g", c[0], expect);
     free(rgba);
     free(depth);
     sy_rt_device_destroy(dev);
@@ -219,14 +219,14 @@ static void test_hard_shadow(void)
             bool in_shadow = mx < 0.25 && my < 0.25;
             float v = rgba[4 * (py * 64 + px)];
             if (in_shadow) {
-                CHECK(v == 0.0f, "pixel (%d,%d) should be in shadow, got %g", px, py, v);
+                EXPECT_MSG(v == 0.0f, "pixel (%d,%d) should be in shadow, got %g", px, py, v);
                 shadowed++;
             } else {
-                CHECK(v > 0.01f, "pixel (%d,%d) should be lit, got %g", px, py, v);
+                EXPECT_MSG(v > 0.01f, "pixel (%d,%d) should be lit, got %g", px, py, v);
                 lit++;
             }
         }
-    CHECK(shadowed > 50 && lit > 500, "shadowed %d lit %d", shadowed, lit);
+    EXPECT_MSG(shadowed > 50 && lit > 500, "shadowed %d lit %d", shadowed, lit);
     free(rgba);
     free(depth);
     sy_rt_device_destroy(dev);
@@ -257,15 +257,15 @@ static void test_mirror(void)
     float *rgba, *depth;
     rt_render(dev, &cam, &rd, &rgba, &depth);
     const float *c = px_at(rgba, 16, 16);
-    CHECK(c[0] == 0.9f * 2.0f && c[1] == 0.8f * 3.0f && c[2] == 0.7f * 4.0f, "mirror %g %g %g", c[0], c[1], c[2]);
-    CHECK(fabsf(depth[16 * W + 16] - CAM_Z) < 1e-5f, "mirror depth is the mirror's, got %g", depth[16 * W + 16]);
+    EXPECT_MSG(c[0] == 0.9f * 2.0f && c[1] == 0.8f * 3.0f && c[2] == 0.7f * 4.0f, "mirror %g %g %g", c[0], c[1], c[2]);
+    EXPECT_MSG(fabsf(depth[16 * W + 16] - CAM_Z) < 1e-5f, "mirror depth is the mirror's, got %g", depth[16 * W + 16]);
     /* max_depth 1: no recursion, the mirror is black. */
     rd.max_depth = 1;
     free(rgba);
     free(depth);
     rt_render(dev, &cam, &rd, &rgba, &depth);
     c = px_at(rgba, 16, 16);
-    CHECK(c[0] == 0.0f && c[3] == 1.0f, "mirror at max_depth 1: %g alpha %g", c[0], c[3]);
+    EXPECT_MSG(c[0] == 0.0f && c[3] == 1.0f, "mirror at max_depth 1: %g alpha %g", c[0], c[3]);
     free(rgba);
     free(depth);
     sy_rt_device_destroy(dev);
@@ -298,15 +298,15 @@ static void test_glass(void)
     double F = pow((1.5 - 1.0) / (1.5 + 1.0), 2.0);
     double T = (1 - F) * (1 - F) / (1 - F * F); /* both faces plus inter-reflections */
     const float *c = px_at(rgba, 16, 16);
-    CHECK(rt_near(c[0], 1.0 * T, 1e-4) && rt_near(c[1], 2.0 * T, 1e-4) && rt_near(c[2], 4.0 * T, 1e-4),
-          "glass %.7g %.7g %.7g, expected %.7g * (1,2,4)", c[0], c[1], c[2], T);
+    EXPECT_MSG(rt_near(c[0], 1.0 * T, 1e-4) && rt_near(c[1], 2.0 * T, 1e-4) && rt_near(c[2], 4.0 * T, 1e-4),
+               "glass %.7g %.7g %.7g, expected %.7g * (1,2,4)", c[0], c[1], c[2], T);
     /* max_depth 2: camera ray + one refraction reach only the back face: black. max_depth 3: (1-F)^2. */
     rd.max_depth = 3;
     free(rgba);
     free(depth);
     rt_render(dev, &cam, &rd, &rgba, &depth);
     c = px_at(rgba, 16, 16);
-    CHECK(rt_near(c[0], (1 - F) * (1 - F), 1e-5), "glass depth 3: %.7g expected %.7g", c[0], (1 - F) * (1 - F));
+    EXPECT_MSG(rt_near(c[0], (1 - F) * (1 - F), 1e-5), "glass depth 3: %.7g expected %.7g", c[0], (1 - F) * (1 - F));
     free(rgba);
     free(depth);
     sy_rt_device_destroy(dev);
@@ -351,10 +351,10 @@ static void test_alpha_mask_and_texture(void)
         for (int row = 10; row <= 22; row += 12) {
             const float *l = px_at(rgba, 12, row), *r = px_at(rgba, 20, row);
             if (integ == SY_RT_INTEGRATOR_WHITTED)
-                CHECK(l[0] == 1.0f && l[1] == 0.0f && l[2] == 0.0f, "row %d: unlit red texel * factor: %g %g %g", row, l[0], l[1], l[2]);
-            CHECK(fabsf(depth[row * W + 12] - CAM_Z) < 1e-5f, "row %d: masked quad depth %g", row, depth[row * W + 12]);
-            CHECK(r[0] == 0.0f && r[1] == 0.0f && r[2] == 5.0f, "row %d: cut-out shows the emitter: %g %g %g", row, r[0], r[1], r[2]);
-            CHECK(fabsf(depth[row * W + 20] - (CAM_Z + 1.0f)) < 1e-5f, "row %d: depth through cut-out %g", row, depth[row * W + 20]);
+                EXPECT_MSG(l[0] == 1.0f && l[1] == 0.0f && l[2] == 0.0f, "row %d: unlit red texel * factor: %g %g %g", row, l[0], l[1], l[2]);
+            EXPECT_MSG(fabsf(depth[row * W + 12] - CAM_Z) < 1e-5f, "row %d: masked quad depth %g", row, depth[row * W + 12]);
+            EXPECT_MSG(r[0] == 0.0f && r[1] == 0.0f && r[2] == 5.0f, "row %d: cut-out shows the emitter: %g %g %g", row, r[0], r[1], r[2]);
+            EXPECT_MSG(fabsf(depth[row * W + 20] - (CAM_Z + 1.0f)) < 1e-5f, "row %d: depth through cut-out %g", row, depth[row * W + 20]);
         }
         free(rgba);
         free(depth);
@@ -368,7 +368,7 @@ static void test_alpha_mask_and_texture(void)
     rt_render(dev, &cam, &rd, &rgba, &depth);
     const float *r = px_at(rgba, 20, 10);
     double g = pow((128 / 255.0 + 0.055) / 1.055, 2.4);
-    CHECK(rt_near(r[0], g, 1e-6) && rt_near(r[1], 0.5 * g, 1e-6), "opaque grey %g %g expected %g", r[0], r[1], g);
+    EXPECT_MSG(rt_near(r[0], g, 1e-6) && rt_near(r[1], 0.5 * g, 1e-6), "opaque grey %g %g expected %g", r[0], r[1], g);
     free(rgba);
     free(depth);
     sy_rt_device_destroy(dev);
@@ -384,5 +384,5 @@ int main(void)
     test_mirror();
     test_glass();
     test_alpha_mask_and_texture();
-    return rt_finish("test_rt_whitted");
+    return sy_check_finish("test_rt_whitted");
 }

@@ -87,7 +87,7 @@ static double prim_area(const sy_primitive *p)
         for (int k = 0; k < 3; k++) e1[k] = q[1][k] - q[0][k], e2[k] = q[2][k] - q[0][k];
         double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
         a += 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-        CHECK(c[2] >= 0, "triangle %u of a ccw polygon in the xy plane faces -z", t);
+        EXPECT_MSG(c[2] >= 0, "triangle %u of a ccw polygon in the xy plane faces -z", t);
     }
     return a;
 }
@@ -102,19 +102,19 @@ static void test_concave_and_defaults(void)
         "<Shape><Appearance><Material/></Appearance>\n"
         "<IndexedFaceSet coordIndex='0 1 2 3 4 5 -1'><Coordinate point='0 0 0, 2 0 0, 2 1 0, 1 1 0, 1 2 0, 0 2 0'/>"
         "</IndexedFaceSet></Shape>\n" FTR);
-    CHECK(l.r == SY_OK, "concave: %s", l.err.message);
+    EXPECT_MSG(l.r == SY_OK, "concave: %s", l.err.message);
     const sy_primitive *p = first_prim(&l);
-    CHECK(p && sy_primitive_triangle_count(p) == 4, "L shape: 4 triangles, got %u", p ? sy_primitive_triangle_count(p) : 0);
-    if (p) CHECK(fabs(prim_area(p) - 3.0) < 1e-5, "L shape area %g (expected 3: ear clipping)", prim_area(p));
+    EXPECT_MSG(p && sy_primitive_triangle_count(p) == 4, "L shape: 4 triangles, got %u", p ? sy_primitive_triangle_count(p) : 0);
+    if (p) EXPECT_MSG(fabs(prim_area(p) - 3.0) < 1e-5, "L shape area %g (expected 3: ear clipping)", prim_area(p));
     if (p) {
         const float *n = sy_blob_data(p->normals);
-        CHECK(n && fabsf(n[2] - 1.0f) < 1e-5f, "generated normal +z, got %g %g %g", n ? n[0] : 0, n ? n[1] : 0, n ? n[2] : 0);
+        EXPECT_MSG(n && fabsf(n[2] - 1.0f) < 1e-5f, "generated normal +z, got %g %g %g", n ? n[0] : 0, n ? n[1] : 0, n ? n[2] : 0);
         const sy_material_data *md = sy_material_get(l.scene, p->material);
-        CHECK(md && fabsf(md->base_color[0] - 0.8f) < 1e-6f && md->base_color[3] == 1.0f,
-              "X3D default diffuseColor 0.8, alpha 1");
-        CHECK(md && md->roughness == 1.0f && md->metallic == 0.0f && !md->unlit && !md->double_sided,
-              "default Material: no specular -> roughness 1, metallic 0, lit, solid");
-        CHECK(p->texcoords0 != NULL, "IndexedFaceSet gets default texture coordinates");
+        EXPECT_MSG(md && fabsf(md->base_color[0] - 0.8f) < 1e-6f && md->base_color[3] == 1.0f,
+                   "X3D default diffuseColor 0.8, alpha 1");
+        EXPECT_MSG(md && md->roughness == 1.0f && md->metallic == 0.0f && !md->unlit && !md->double_sided,
+                   "default Material: no specular -> roughness 1, metallic 0, lit, solid");
+        EXPECT_MSG(p->texcoords0 != NULL, "IndexedFaceSet gets default texture coordinates");
     }
     unload(&l);
 
@@ -127,10 +127,10 @@ static void test_concave_and_defaults(void)
     for (size_t t = 0; t < nt; t++) {
         const float *a = pts + 3 * tris[3 * t], *b = pts + 3 * tris[3 * t + 1], *c = pts + 3 * tris[3 * t + 2];
         double z = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-        CHECK(z >= -1e-9, "comb triangle %zu is clockwise (z %g)", t, z);
+        EXPECT_MSG(z >= -1e-9, "comb triangle %zu is clockwise (z %g)", t, z);
         area += 0.5 * z;
     }
-    CHECK(nt == 8 && fabs(area - 11.0) < 1e-6, "comb: %zu triangles, area %g (expected 8, 11)", nt, area);
+    EXPECT_MSG(nt == 8 && fabs(area - 11.0) < 1e-6, "comb: %zu triangles, area %g (expected 8, 11)", nt, area);
 
     /* random star-shaped (so simple, mostly concave) polygons in both orientations, the ear clipper
      * of issue 14 (reflex vertices on a linked ring): n - 2 triangles, none clockwise (relative to
@@ -166,8 +166,8 @@ static void test_concave_and_defaults(void)
             ok = ok && z * (shoe > 0 ? 1 : -1) >= -1e-7;
             sum += z;
         }
-        CHECK(ok && fabs(sum - shoe) < 1e-4 * fabs(shoe), "star polygon %d (n %zu): %zu triangles, area %g vs %g", round, n,
-              snt, sum, shoe);
+        EXPECT_MSG(ok && fabs(sum - shoe) < 1e-4 * fabs(shoe), "star polygon %d (n %zu): %zu triangles, area %g vs %g", round, n,
+                   snt, sum, shoe);
         free(sp); free(sidx); free(st); free(sscr);
     }
 
@@ -175,16 +175,16 @@ static void test_concave_and_defaults(void)
     l = load_text("colors.x3d", HDR
         "<Shape><IndexedFaceSet ccw='false' colorPerVertex='false' coordIndex='0 2 1 -1 0 3 2'>"
         "<Coordinate point='0 0 0 1 0 0 1 1 0 0 1 0'/><Color color='1 0 0 0 0 1'/></IndexedFaceSet></Shape>" FTR);
-    CHECK(l.r == SY_OK, "colors: %s", l.err.message);
+    EXPECT_MSG(l.r == SY_OK, "colors: %s", l.err.message);
     p = first_prim(&l);
     if (p) {
-        CHECK(fabs(prim_area(p) - 1.0) < 1e-6, "unit quad");
+        EXPECT_MSG(fabs(prim_area(p) - 1.0) < 1e-6, "unit quad");
         const float *c = sy_blob_data(p->colors);
-        CHECK(c && c[0] == 1 && c[2] == 0 && c[3 * 4 + 2] == 1 && c[3 * 4] == 0, "per-face colours red then blue");
+        EXPECT_MSG(c && c[0] == 1 && c[2] == 0 && c[3 * 4 + 2] == 1 && c[3 * 4] == 0, "per-face colours red then blue");
         const sy_material_data *md = sy_material_get(l.scene, p->material);
-        CHECK(md && md->unlit && md->base_color[0] == 1.0f, "a Shape without Material is unlit white");
+        EXPECT_MSG(md && md->unlit && md->base_color[0] == 1.0f, "a Shape without Material is unlit white");
     } else {
-        CHECK(0, "colors: no primitive");
+        EXPECT_MSG(0, "colors: no primitive");
     }
     unload(&l);
 }
@@ -219,9 +219,9 @@ static void test_big_polygons(void)
         sy_x3d_info info;
         sy_error e = {0};
         sy_result r = sy_x3d_load_memory(x, len, "big.x3d", "", s, NULL, &info, &e);
-        CHECK(r == SY_OK, "big polygon: %s", e.message);
-        CHECK(info.counts.triangles == n - 2, "%s %zu-gon: %u triangles, expected %zu", concave ? "concave" : "convex",
-              n, info.counts.triangles, n - 2);
+        EXPECT_MSG(r == SY_OK, "big polygon: %s", e.message);
+        EXPECT_MSG(info.counts.triangles == n - 2, "%s %zu-gon: %u triangles, expected %zu", concave ? "concave" : "convex",
+                   n, info.counts.triangles, n - 2);
         sy_x3d_info_free(&info);
         sy_scene_destroy(s);
         free(x);
@@ -247,11 +247,11 @@ static void test_value_limits(void)
         sy_error e = {0};
         sy_result r = sy_x3d_load_memory(x, len, "limits.x3d", "", s, &o, &info, &e);
         if (pass == 0) {
-            CHECK(r == SY_ERR_LIMIT && strstr(e.message, "limits.x3d:3: IndexedFaceSet.coordIndex: 200 values exceed the limit of 120"),
-                  "coordIndex over the value limit: %s (%s)", sy_result_str(r), e.message);
-            CHECK(sy_scene_count(s, SY_TYPE_NODE) == 0 && sy_scene_count(s, SY_TYPE_MESH) == 0, "objects left behind");
+            EXPECT_MSG(r == SY_ERR_LIMIT && strstr(e.message, "limits.x3d:3: IndexedFaceSet.coordIndex: 200 values exceed the limit of 120"),
+                       "coordIndex over the value limit: %s (%s)", sy_result_str(r), e.message);
+            EXPECT_MSG(sy_scene_count(s, SY_TYPE_NODE) == 0 && sy_scene_count(s, SY_TYPE_MESH) == 0, "objects left behind");
         } else {
-            CHECK(r == SY_OK, "within the default limits: %s", e.message);
+            EXPECT_MSG(r == SY_OK, "within the default limits: %s", e.message);
         }
         sy_x3d_info_free(&info);
         sy_scene_destroy(s);
@@ -266,8 +266,8 @@ static void test_value_limits(void)
     if (sy_scene_create(&s, NULL) != SY_OK) exit(1);
     sy_error e = {0};
     sy_result r = sy_x3d_load_memory(x, len, "points.x3d", "", s, &o, NULL, &e);
-    CHECK(r == SY_ERR_LIMIT && strstr(e.message, "points.x3d:3: Coordinate.point: 123 values exceed the limit of 120"),
-          "point over the value limit: %s (%s)", sy_result_str(r), e.message);
+    EXPECT_MSG(r == SY_ERR_LIMIT && strstr(e.message, "points.x3d:3: Coordinate.point: 123 values exceed the limit of 120"),
+               "point over the value limit: %s (%s)", sy_result_str(r), e.message);
     sy_scene_destroy(s);
 }
 
@@ -275,15 +275,15 @@ static void test_value_limits(void)
 static void test_extrusion(void)
 {
     loaded l = load_text("extrusion.x3d", HDR "<Shape><Appearance><Material/></Appearance><Extrusion/></Shape>" FTR);
-    CHECK(l.r == SY_OK, "extrusion: %s", l.err.message);
+    EXPECT_MSG(l.r == SY_OK, "extrusion: %s", l.err.message);
     const sy_primitive *p = first_prim(&l);
-    CHECK(p && sy_primitive_triangle_count(p) == 12, "4 side quads + 2 caps = 12 triangles, got %u",
-          p ? sy_primitive_triangle_count(p) : 0);
+    EXPECT_MSG(p && sy_primitive_triangle_count(p) == 12, "4 side quads + 2 caps = 12 triangles, got %u",
+               p ? sy_primitive_triangle_count(p) : 0);
     if (p) {
         sy_bounds b;
         sy_node_world_bounds(l.scene, l.info.root, &b, NULL);
-        CHECK(b.min[0] == -1 && b.max[0] == 1 && b.min[1] == 0 && b.max[1] == 1 && b.min[2] == -1 && b.max[2] == 1,
-              "extrusion bounds");
+        EXPECT_MSG(b.min[0] == -1 && b.max[0] == 1 && b.min[1] == 0 && b.max[1] == 1 && b.min[2] == -1 && b.max[2] == 1,
+                   "extrusion bounds");
         const float *v = sy_blob_data(p->positions), *n = sy_blob_data(p->normals);
         uint32_t outward = 0, nv = sy_primitive_vertex_count(p);
         for (uint32_t t = 0; t < nv / 3; t++) { /* face centre . normal > 0 for a box around the y axis */
@@ -292,7 +292,7 @@ static void test_extrusion(void)
             c[1] -= 0.5f;
             outward += c[0] * n[9 * t] + c[1] * n[9 * t + 1] + c[2] * n[9 * t + 2] > 0;
         }
-        CHECK(outward == nv / 3, "%u of %u extrusion faces face outwards", outward, nv / 3);
+        EXPECT_MSG(outward == nv / 3, "%u of %u extrusion faces face outwards", outward, nv / 3);
     }
     unload(&l);
 }
@@ -318,8 +318,8 @@ static void test_strips_fans_quads(void)
                  cases[i].geo, close);
         loaded l = load_text("strips.x3d", text);
         const sy_primitive *p = first_prim(&l);
-        CHECK(l.r == SY_OK && p && sy_primitive_triangle_count(p) == cases[i].tris, "%s: %u triangles, expected %u (%s)",
-              cases[i].geo, p ? sy_primitive_triangle_count(p) : 0, cases[i].tris, l.err.message);
+        EXPECT_MSG(l.r == SY_OK && p && sy_primitive_triangle_count(p) == cases[i].tris, "%s: %u triangles, expected %u (%s)",
+                   cases[i].geo, p ? sy_primitive_triangle_count(p) : 0, cases[i].tris, l.err.message);
         if (p && strstr(cases[i].geo, "Strip")) prim_area(p); /* checks every triangle faces +z */
         unload(&l);
     }
@@ -336,7 +336,7 @@ static void test_crease(void)
         snprintf(text, sizeof text, fmt, smooth ? "1.6" : "0.5");
         loaded l = load_text("crease.x3d", text);
         const sy_primitive *p = first_prim(&l);
-        CHECK(p != NULL, "crease: %s", l.err.message);
+        EXPECT_MSG(p != NULL, "crease: %s", l.err.message);
         if (p) {
             const float *v = sy_blob_data(p->positions), *n = sy_blob_data(p->normals);
             uint32_t nv = sy_primitive_vertex_count(p);
@@ -346,10 +346,10 @@ static void test_crease(void)
                     on_ridge++;
                     smooth_on_ridge += fabsf(n[3 * k]) < 1e-5f && fabsf(n[3 * k + 1] - 1.0f) < 1e-5f;
                 }
-            CHECK(on_ridge > 0, "ridge vertices");
-            CHECK(smooth ? smooth_on_ridge == on_ridge : smooth_on_ridge == 0,
-                  "creaseAngle %s: %d of %d ridge normals point straight up", smooth ? "1.6" : "0.5", smooth_on_ridge,
-                  on_ridge);
+            EXPECT_MSG(on_ridge > 0, "ridge vertices");
+            EXPECT_MSG(smooth ? smooth_on_ridge == on_ridge : smooth_on_ridge == 0,
+                       "creaseAngle %s: %d of %d ridge normals point straight up", smooth ? "1.6" : "0.5", smooth_on_ridge,
+                       on_ridge);
         }
         unload(&l);
     }
@@ -372,12 +372,12 @@ static void test_def_use_and_scene_nodes(void)
         "<Transform DEF='Loop'><Group><Transform USE='Loop'/></Group></Transform>\n"
         "<Shape><IndexedFaceSet coordIndex='0 1 7'><Coordinate point='0 0 0 1 0 0 1 1 0'/></IndexedFaceSet></Shape>\n"
         "<FancyNode/><FancyNode/><ProtoInstance name='x'/>\n" FTR);
-    CHECK(l.r == SY_OK, "share: %s", l.err.message);
+    EXPECT_MSG(l.r == SY_OK, "share: %s", l.err.message);
     dump_warnings(&l);
-    CHECK(sy_scene_count(l.scene, SY_TYPE_MESH) == 2, "sphere shape shared + box: 2 meshes, got %u",
-          sy_scene_count(l.scene, SY_TYPE_MESH));
-    CHECK(sy_scene_count(l.scene, SY_TYPE_MATERIAL) == 1, "the USEd Appearance is one material, got %u",
-          sy_scene_count(l.scene, SY_TYPE_MATERIAL));
+    EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_MESH) == 2, "sphere shape shared + box: 2 meshes, got %u",
+               sy_scene_count(l.scene, SY_TYPE_MESH));
+    EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_MATERIAL) == 1, "the USEd Appearance is one material, got %u",
+               sy_scene_count(l.scene, SY_TYPE_MATERIAL));
     /* the mesh used by two nodes */
     uint32_t sphere = 0, users = 0;
     for (uint32_t id = sy_scene_next(l.scene, SY_TYPE_MESH, 0); id; id = sy_scene_next(l.scene, SY_TYPE_MESH, id))
@@ -385,55 +385,55 @@ static void test_def_use_and_scene_nodes(void)
             sphere = id;
     for (uint32_t id = sy_scene_next(l.scene, SY_TYPE_NODE, 0); id; id = sy_scene_next(l.scene, SY_TYPE_NODE, id))
         users += ((const sy_node_data *)sy_object_get(l.scene, SY_TYPE_NODE, id))->mesh.id == sphere;
-    CHECK(sphere && users == 1, "the USEd Shape is one node holding one mesh (got %u nodes)", users);
+    EXPECT_MSG(sphere && users == 1, "the USEd Shape is one node holding one mesh (got %u nodes)", users);
     sy_node shape_node = {0};
     for (uint32_t id = sy_scene_next(l.scene, SY_TYPE_NODE, 0); id; id = sy_scene_next(l.scene, SY_TYPE_NODE, id))
         if (((const sy_node_data *)sy_object_get(l.scene, SY_TYPE_NODE, id))->mesh.id == sphere) shape_node.id = id;
-    CHECK(sy_node_parent_count(l.scene, shape_node) == 2, "USEd Shape node has 2 parents, got %u",
-          sy_node_parent_count(l.scene, shape_node));
-    CHECK(has_warning(&l, "USE 'Nope' of an undefined DEF", "share.x3d:12"), "undefined USE warned with file:line");
-    CHECK(has_warning(&l, "cycle", "share.x3d:13"), "USE cycle warned with file:line");
-    CHECK(has_warning(&l, "coordIndex[2] = 7", "share.x3d:14"), "index past the coordinates warned with file:line");
+    EXPECT_MSG(sy_node_parent_count(l.scene, shape_node) == 2, "USEd Shape node has 2 parents, got %u",
+               sy_node_parent_count(l.scene, shape_node));
+    EXPECT_MSG(has_warning(&l, "USE 'Nope' of an undefined DEF", "share.x3d:12"), "undefined USE warned with file:line");
+    EXPECT_MSG(has_warning(&l, "cycle", "share.x3d:13"), "USE cycle warned with file:line");
+    EXPECT_MSG(has_warning(&l, "coordIndex[2] = 7", "share.x3d:14"), "index past the coordinates warned with file:line");
     uint32_t fancy = 0;
     for (uint32_t k = 0; k < l.info.stored_warning_count; k++) fancy += strstr(l.info.warnings[k], "FancyNode") != NULL;
-    CHECK(fancy == 1, "unknown node type warned once, got %u", fancy);
+    EXPECT_MSG(fancy == 1, "unknown node type warned once, got %u", fancy);
     /* material mapping */
     const sy_primitive *p = first_prim(&l);
     const sy_material_data *md = p ? sy_material_get(l.scene, p->material) : NULL;
-    CHECK(md && md->base_color[0] == 1 && md->base_color[1] == 0, "diffuseColor red");
-    CHECK(md && fabsf(md->roughness - sqrtf(sqrtf(2.0f / 130.0f))) < 1e-5f, "shininess 1 -> roughness %g",
-          md ? md->roughness : -1);
+    EXPECT_MSG(md && md->base_color[0] == 1 && md->base_color[1] == 0, "diffuseColor red");
+    EXPECT_MSG(md && fabsf(md->roughness - sqrtf(sqrtf(2.0f / 130.0f))) < 1e-5f, "shininess 1 -> roughness %g",
+               md ? md->roughness : -1);
     /* viewpoint, background, lights */
-    CHECK(l.info.camera_node_count == 1, "one viewpoint");
+    EXPECT_MSG(l.info.camera_node_count == 1, "one viewpoint");
     if (l.info.camera_node_count) {
         const sy_node_data *nd = sy_node_get(l.scene, l.info.camera_nodes[0]);
         const sy_camera_data *cd = sy_camera_get(l.scene, nd->camera);
-        CHECK(cd && fabsf(cd->yfov - 0.5f) < 1e-6f && !strcmp(cd->name, "Front"), "Viewpoint fov 0.5 and description");
-        CHECK(nd->transform.matrix.m[13] == 1.0f && nd->transform.matrix.m[14] == 5.0f, "Viewpoint position");
-        CHECK(sy_x3d_fit_cameras(l.scene, &l.info, 0.5f, NULL) == SY_OK, "fit");
+        EXPECT_MSG(cd && fabsf(cd->yfov - 0.5f) < 1e-6f && !strcmp(cd->name, "Front"), "Viewpoint fov 0.5 and description");
+        EXPECT_MSG(nd->transform.matrix.m[13] == 1.0f && nd->transform.matrix.m[14] == 5.0f, "Viewpoint position");
+        EXPECT_MSG(sy_x3d_fit_cameras(l.scene, &l.info, 0.5f, NULL) == SY_OK, "fit");
         cd = sy_camera_get(l.scene, sy_node_get(l.scene, l.info.camera_nodes[0])->camera);
         float want = 2.0f * atanf(tanf(0.25f) / 0.5f);
-        CHECK(cd && fabsf(cd->yfov - want) < 1e-5f, "portrait image: yfov %g, expected %g", cd ? cd->yfov : 0, want);
+        EXPECT_MSG(cd && fabsf(cd->yfov - want) < 1e-5f, "portrait image: yfov %g, expected %g", cd ? cd->yfov : 0, want);
         sy_node found;
-        CHECK(sy_x3d_find_camera(l.scene, &l.info, "Cam", &found, NULL) == SY_OK &&
-                  found.id == l.info.camera_nodes[0].id, "find viewpoint by DEF");
+        EXPECT_MSG(sy_x3d_find_camera(l.scene, &l.info, "Cam", &found, NULL) == SY_OK &&
+                   found.id == l.info.camera_nodes[0].id, "find viewpoint by DEF");
     }
-    CHECK(fabsf(sy_x3d_yfov(1.0f, 2.0f) - 1.0f) < 1e-6f, "landscape: yfov = fieldOfView");
+    EXPECT_MSG(fabsf(sy_x3d_yfov(1.0f, 2.0f) - 1.0f) < 1e-6f, "landscape: yfov = fieldOfView");
     const sy_background_data *bd = sy_background_get(l.scene, l.info.background);
     /* skyColor is a gradient (background only): two sky colours without skyAngle -> the first alone */
-    CHECK(bd && bd->color[3] == 0.0f && bd->gradient.sky_count == 1 && bd->gradient.sky_color[0][0] == 0.1f &&
-              bd->gradient.sky_color[0][1] == 0.2f && bd->gradient.sky_color[0][2] == 0.3f && bd->gradient.ground_count == 0,
-          "Background skyColor[0] as a one-colour gradient, colour transparent");
-    CHECK(sy_scene_count(l.scene, SY_TYPE_LIGHT) == 3, "3 lights, got %u", sy_scene_count(l.scene, SY_TYPE_LIGHT));
+    EXPECT_MSG(bd && bd->color[3] == 0.0f && bd->gradient.sky_count == 1 && bd->gradient.sky_color[0][0] == 0.1f &&
+               bd->gradient.sky_color[0][1] == 0.2f && bd->gradient.sky_color[0][2] == 0.3f && bd->gradient.ground_count == 0,
+               "Background skyColor[0] as a one-colour gradient, colour transparent");
+    EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_LIGHT) == 3, "3 lights, got %u", sy_scene_count(l.scene, SY_TYPE_LIGHT));
     for (uint32_t id = sy_scene_next(l.scene, SY_TYPE_LIGHT, 0); id; id = sy_scene_next(l.scene, SY_TYPE_LIGHT, id)) {
         const sy_light_data *ld = sy_object_get(l.scene, SY_TYPE_LIGHT, id);
         if (ld->type == SY_LIGHT_DIRECTIONAL)
-            CHECK(fabsf(ld->intensity - 0.5f * 3.14159265f) < 1e-4f, "directional: intensity * pi lux");
+            EXPECT_MSG(fabsf(ld->intensity - 0.5f * 3.14159265f) < 1e-4f, "directional: intensity * pi lux");
         else if (ld->type == SY_LIGHT_POINT)
-            CHECK(fabsf(ld->intensity - 3.14159265f / 2.0f) < 1e-4f, "point with attenuation a2 = 2: pi / 2 cd, got %g",
-                  ld->intensity);
+            EXPECT_MSG(fabsf(ld->intensity - 3.14159265f / 2.0f) < 1e-4f, "point with attenuation a2 = 2: pi / 2 cd, got %g",
+                       ld->intensity);
         else
-            CHECK(fabsf(ld->outer_cone - 0.5f) < 1e-6f && fabsf(ld->inner_cone - 0.3f) < 1e-6f, "spot cones");
+            EXPECT_MSG(fabsf(ld->outer_cone - 0.5f) < 1e-6f && fabsf(ld->inner_cone - 0.3f) < 1e-6f, "spot cones");
     }
     unload(&l);
 }
@@ -444,7 +444,7 @@ static void test_inline_css_and_bad_input(void)
     char tex[2048];
     PATHF(tex, "%s/tex.png", g_dir);
     const float rg[8] = {1, 0, 0, 1, 0, 1, 0, 1};
-    CHECK(sy_png_write(tex, 2, 1, rg, NULL, NULL) == SY_OK, "write tex.png");
+    EXPECT_MSG(sy_png_write(tex, 2, 1, rg, NULL, NULL) == SY_OK, "write tex.png");
     write_text("bad.png", "this is not an image");
     write_text("part.x3d", HDR "<Shape><Appearance><CommonSurfaceShader diffuseFactor='0.2 0.4 0.6' "
                                "specularFactor='1 1 1' shininessFactor='0.5' emissiveFactor='0 0.5 0' "
@@ -458,21 +458,21 @@ static void test_inline_css_and_bad_input(void)
     /* a FIFO inside the model's folder (absolute paths such as /dev/zero are refused before) */
     char fifo[2048];
     PATHF(fifo, "%s/dev.fifo", g_dir);
-    CHECK(mkfifo(fifo, 0600) == 0, "mkfifo %s", fifo);
+    EXPECT_MSG(mkfifo(fifo, 0600) == 0, "mkfifo %s", fifo);
     loaded l = load_text("main.x3d", HDR
         "<Inline url='\"missing.x3d\" \"part.x3d\"'/>\n"
         "<Transform translation='5 0 0'><Inline url='\"part.x3d\"'/></Transform>\n"
         "<Inline url='\"self.x3d\"'/>\n"
         "<Shape><Appearance><ImageTexture url='\"bad.png\"'/></Appearance><Box/></Shape>\n"
         "<Inline url='\"dev.fifo\"'/><Shape><Appearance><ImageTexture url='\"dev.fifo\"'/></Appearance><Sphere/></Shape>\n" FTR);
-    CHECK(l.r == SY_OK, "inline: %s", l.err.message);
+    EXPECT_MSG(l.r == SY_OK, "inline: %s", l.err.message);
     dump_warnings(&l);
-    CHECK(l.info.counts.inlines == 2, "part.x3d loaded once and shared, self.x3d once: %u", l.info.counts.inlines);
-    CHECK(has_warning(&l, "includes itself", "self.x3d:3"), "Inline cycle warned with file:line");
-    CHECK(has_warning(&l, "bad.png", "main.x3d:6"), "undecodable texture warned with file:line");
-    CHECK(has_warning(&l, "dev.fifo: not a regular file", "main.x3d:7"), "devices are not read");
-    CHECK(sy_scene_count(l.scene, SY_TYPE_MESH) == 4, "triangle + self box + main box + sphere: 4 meshes, got %u",
-          sy_scene_count(l.scene, SY_TYPE_MESH));
+    EXPECT_MSG(l.info.counts.inlines == 2, "part.x3d loaded once and shared, self.x3d once: %u", l.info.counts.inlines);
+    EXPECT_MSG(has_warning(&l, "includes itself", "self.x3d:3"), "Inline cycle warned with file:line");
+    EXPECT_MSG(has_warning(&l, "bad.png", "main.x3d:6"), "undecodable texture warned with file:line");
+    EXPECT_MSG(has_warning(&l, "dev.fifo: not a regular file", "main.x3d:7"), "devices are not read");
+    EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_MESH) == 4, "triangle + self box + main box + sphere: 4 meshes, got %u",
+               sy_scene_count(l.scene, SY_TYPE_MESH));
     const sy_material_data *css = NULL;
     const sy_primitive *tri = NULL;
     for (uint32_t id = sy_scene_next(l.scene, SY_TYPE_MESH, 0); id; id = sy_scene_next(l.scene, SY_TYPE_MESH, id)) {
@@ -482,23 +482,23 @@ static void test_inline_css_and_bad_input(void)
             css = sy_material_get(l.scene, tri->material);
         }
     }
-    CHECK(css != NULL, "CommonSurfaceShader material");
+    EXPECT_MSG(css != NULL, "CommonSurfaceShader material");
     if (css) {
-        CHECK(fabsf(css->base_color[0] - 0.2f) < 1e-6f && fabsf(css->base_color[2] - 0.6f) < 1e-6f &&
-                  fabsf(css->base_color[3] - 0.5f) < 1e-6f && css->alpha_mode == SY_ALPHA_BLEND,
-              "diffuseFactor, alphaFactor");
-        CHECK(fabsf(css->transmission - 0.9f) < 1e-6f && fabsf(css->ior - 1.0f / 0.75f) < 1e-5f,
-              "transmission 0.9, relative IOR 0.75 -> ior %g", css->ior);
-        CHECK(css->emissive[1] == 0.5f, "emissiveFactor");
-        CHECK(css->base_color_texture.texture.id && css->normal_texture.texture.id, "diffuse and normal textures");
+        EXPECT_MSG(fabsf(css->base_color[0] - 0.2f) < 1e-6f && fabsf(css->base_color[2] - 0.6f) < 1e-6f &&
+                   fabsf(css->base_color[3] - 0.5f) < 1e-6f && css->alpha_mode == SY_ALPHA_BLEND,
+                   "diffuseFactor, alphaFactor");
+        EXPECT_MSG(fabsf(css->transmission - 0.9f) < 1e-6f && fabsf(css->ior - 1.0f / 0.75f) < 1e-5f,
+                   "transmission 0.9, relative IOR 0.75 -> ior %g", css->ior);
+        EXPECT_MSG(css->emissive[1] == 0.5f, "emissiveFactor");
+        EXPECT_MSG(css->base_color_texture.texture.id && css->normal_texture.texture.id, "diffuse and normal textures");
         const sy_texture_data *td = sy_texture_get(l.scene, css->base_color_texture.texture);
-        CHECK(td && td->info.width == 2 && td->info.height == 1 && td->info.channels == 4 && ((const uint8_t *)sy_blob_data(td->pixels))[5] == 255,
-              "texture decoded (2x1, green second pixel)");
-        CHECK(tri->tangents != NULL, "tangents generated for the normal map");
+        EXPECT_MSG(td && td->info.width == 2 && td->info.height == 1 && td->info.channels == 4 && ((const uint8_t *)sy_blob_data(td->pixels))[5] == 255,
+                   "texture decoded (2x1, green second pixel)");
+        EXPECT_MSG(tri->tangents != NULL, "tangents generated for the normal map");
         if (tri->tangents) {
             const float *t = sy_blob_data(tri->tangents);
-            CHECK(fabsf(t[0] - 1.0f) < 1e-5f && fabsf(t[3] - 1.0f) < 1e-6f, "tangent +x, w +1: %g %g %g %g", t[0], t[1],
-                  t[2], t[3]);
+            EXPECT_MSG(fabsf(t[0] - 1.0f) < 1e-5f && fabsf(t[3] - 1.0f) < 1e-6f, "tangent +x, w +1: %g %g %g %g", t[0], t[1],
+                       t[2], t[3]);
         }
     }
     unload(&l);
@@ -508,30 +508,30 @@ static void test_inline_css_and_bad_input(void)
     write_text("ia.x3d", HDR "<Shape DEF='S'><Appearance><Material diffuseColor='1 0 0'/></Appearance><Box/></Shape>" FTR);
     write_text("ib.x3d", HDR "<Shape DEF='S'><Appearance><Material diffuseColor='0 1 0'/></Appearance><Sphere/></Shape>" FTR);
     l = load_text("two.x3d", HDR "<Inline url='\"ia.x3d\"'/><Inline url='\"ib.x3d\"'/>" FTR);
-    CHECK(l.r == SY_OK && sy_scene_count(l.scene, SY_TYPE_MESH) == 2 && sy_scene_count(l.scene, SY_TYPE_MATERIAL) == 2 &&
-              l.info.counts.triangles > 12 + 12,
-          "two inlines: %u meshes, %u materials, %u triangles", sy_scene_count(l.scene, SY_TYPE_MESH),
-          sy_scene_count(l.scene, SY_TYPE_MATERIAL), l.info.counts.triangles);
+    EXPECT_MSG(l.r == SY_OK && sy_scene_count(l.scene, SY_TYPE_MESH) == 2 && sy_scene_count(l.scene, SY_TYPE_MATERIAL) == 2 &&
+               l.info.counts.triangles > 12 + 12,
+               "two inlines: %u meshes, %u materials, %u triangles", sy_scene_count(l.scene, SY_TYPE_MESH),
+               sy_scene_count(l.scene, SY_TYPE_MATERIAL), l.info.counts.triangles);
     unload(&l);
 
     /* unusable files fail with file and line */
     l = load_text("broken.x3d", HDR "<Shape>\n<Box>\n</Shape>" FTR);
-    CHECK(l.r == SY_ERR_PARSE && strstr(l.err.message, "broken.x3d:") && strstr(l.err.message, "malformed XML"),
-          "malformed XML: %s", l.err.message);
-    CHECK(sy_scene_count(l.scene, SY_TYPE_NODE) == 0, "nothing left after a failed load");
+    EXPECT_MSG(l.r == SY_ERR_PARSE && strstr(l.err.message, "broken.x3d:") && strstr(l.err.message, "malformed XML"),
+               "malformed XML: %s", l.err.message);
+    EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_NODE) == 0, "nothing left after a failed load");
     unload(&l);
     l = load_text("notx3d.x3d", "<?xml version='1.0'?><html><body/></html>");
-    CHECK(l.r == SY_ERR_PARSE && strstr(l.err.message, "not an X3D file"), "not X3D: %s", l.err.message);
+    EXPECT_MSG(l.r == SY_ERR_PARSE && strstr(l.err.message, "not an X3D file"), "not X3D: %s", l.err.message);
     unload(&l);
     char p[2048];
     PATHF(p, "%s/none.x3d", g_dir);
     l = load_path(p);
-    CHECK(l.r == SY_ERR_NOT_FOUND, "missing file: %s", l.err.message);
+    EXPECT_MSG(l.r == SY_ERR_NOT_FOUND, "missing file: %s", l.err.message);
     unload(&l);
     /* an external entity is not expanded and the network is never used */
     l = load_text("xxe.x3d", "<?xml version='1.0'?><!DOCTYPE X3D [<!ENTITY e SYSTEM 'file:///etc/passwd'>]>"
                              "<X3D><Scene><WorldInfo>&e;</WorldInfo><Shape><Box/></Shape></Scene></X3D>");
-    CHECK(l.r == SY_OK && sy_scene_count(l.scene, SY_TYPE_MESH) == 1, "entity file: %s", l.err.message);
+    EXPECT_MSG(l.r == SY_OK && sy_scene_count(l.scene, SY_TYPE_MESH) == 1, "entity file: %s", l.err.message);
     unload(&l);
 }
 
@@ -553,27 +553,27 @@ static void test_samples(const char *data)
         PATHF(xp, "%s/x3d/castle_tovrmlx3d/%s/%s.x3d", data, models[i], models[i]);
         PATHF(gp, "%s/gltf/%s/glTF-Binary/%s.glb", data, models[i], models[i]);
         loaded x = load_path(xp);
-        CHECK(x.r == SY_OK, "%s: %s", xp, x.err.message);
+        EXPECT_MSG(x.r == SY_OK, "%s: %s", xp, x.err.message);
         sy_scene *gs;
         sy_gltf_info gi = {0};
         sy_error e = {0};
         if (sy_scene_create(&gs, NULL) != SY_OK) exit(1);
         sy_result gr = sy_gltf_load(gp, gs, NULL, &gi, &e);
         if (gr == SY_OK) gr = sy_scene_commit(gs, NULL, &e);
-        CHECK(gr == SY_OK, "%s: %s", gp, e.message);
+        EXPECT_MSG(gr == SY_OK, "%s: %s", gp, e.message);
         if (x.r == SY_OK && gr == SY_OK) {
             uint32_t xt, gt;
             count_scene(x.scene, &xt);
             count_scene(gs, &gt);
-            CHECK(xt == gt && xt > 0, "%s: X3D %u triangles, glTF %u", models[i], xt, gt);
+            EXPECT_MSG(xt == gt && xt > 0, "%s: X3D %u triangles, glTF %u", models[i], xt, gt);
             sy_bounds xb, gb;
             sy_node_world_bounds(x.scene, x.info.root, &xb, NULL);
             sy_node_world_bounds(gs, gi.root, &gb, NULL);
             for (int k = 0; k < 3; k++)
-                CHECK(fabsf(xb.min[k] - gb.min[k]) < 1e-4f && fabsf(xb.max[k] - gb.max[k]) < 1e-4f,
-                      "%s: bounds axis %d: X3D [%g, %g], glTF [%g, %g]", models[i], k, xb.min[k], xb.max[k], gb.min[k],
-                      gb.max[k]);
-            CHECK(sy_scene_count(x.scene, SY_TYPE_TEXTURE) == 1, "%s: texture decoded", models[i]);
+                EXPECT_MSG(fabsf(xb.min[k] - gb.min[k]) < 1e-4f && fabsf(xb.max[k] - gb.max[k]) < 1e-4f,
+                           "%s: bounds axis %d: X3D [%g, %g], glTF [%g, %g]", models[i], k, xb.min[k], xb.max[k], gb.min[k],
+                           gb.max[k]);
+            EXPECT_MSG(sy_scene_count(x.scene, SY_TYPE_TEXTURE) == 1, "%s: texture decoded", models[i]);
         }
         sy_gltf_info_free(&gi);
         sy_scene_destroy(gs);
@@ -600,30 +600,30 @@ static void test_samples(const char *data)
         char p[2048];
         PATHF(p, "%s/x3d/%s", data, expect[i].file);
         loaded l = load_path(p);
-        CHECK(l.r == SY_OK, "%s: %s", p, l.err.message);
-        CHECK(sy_scene_count(l.scene, SY_TYPE_MESH) == expect[i].meshes, "%s: %u meshes, expected %u", expect[i].file,
-              sy_scene_count(l.scene, SY_TYPE_MESH), expect[i].meshes);
-        CHECK(sy_scene_count(l.scene, SY_TYPE_LIGHT) == expect[i].lights, "%s: %u lights, expected %u", expect[i].file,
-              sy_scene_count(l.scene, SY_TYPE_LIGHT), expect[i].lights);
-        CHECK(l.info.camera_node_count == expect[i].cameras, "%s: %u viewpoints, expected %u", expect[i].file,
-              l.info.camera_node_count, expect[i].cameras);
+        EXPECT_MSG(l.r == SY_OK, "%s: %s", p, l.err.message);
+        EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_MESH) == expect[i].meshes, "%s: %u meshes, expected %u", expect[i].file,
+                   sy_scene_count(l.scene, SY_TYPE_MESH), expect[i].meshes);
+        EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_LIGHT) == expect[i].lights, "%s: %u lights, expected %u", expect[i].file,
+                   sy_scene_count(l.scene, SY_TYPE_LIGHT), expect[i].lights);
+        EXPECT_MSG(l.info.camera_node_count == expect[i].cameras, "%s: %u viewpoints, expected %u", expect[i].file,
+                   l.info.camera_node_count, expect[i].cameras);
         if (strstr(expect[i].file, "BackgroundColorsOnly")) {
             const sy_background_data *bd = sy_background_get(l.scene, l.info.background);
             /* 6 sky colours / 5 angles, 5 ground colours / 4 angles (file values) */
-            CHECK(bd && bd->color[3] == 0.0f && bd->gradient.sky_count == 6 && bd->gradient.ground_count == 5 &&
-                      bd->gradient.sky_color[0][0] == 0.8f && bd->gradient.sky_color[0][2] == 0.2f &&
-                      bd->gradient.sky_angle[4] == 1.570f && bd->gradient.ground_angle[3] == 1.5707f &&
-                      bd->gradient.ground_color[4][2] == 0.4f,
-                  "BackgroundColorsOnly: gradient sky %u ground %u", bd ? bd->gradient.sky_count : 0,
-                  bd ? bd->gradient.ground_count : 0);
+            EXPECT_MSG(bd && bd->color[3] == 0.0f && bd->gradient.sky_count == 6 && bd->gradient.ground_count == 5 &&
+                       bd->gradient.sky_color[0][0] == 0.8f && bd->gradient.sky_color[0][2] == 0.2f &&
+                       bd->gradient.sky_angle[4] == 1.570f && bd->gradient.ground_angle[3] == 1.5707f &&
+                       bd->gradient.ground_color[4][2] == 0.4f,
+                       "BackgroundColorsOnly: gradient sky %u ground %u", bd ? bd->gradient.sky_count : 0,
+                       bd ? bd->gradient.ground_count : 0);
         }
         if (strstr(expect[i].file, "default_primitives")) {
             uint32_t tris;
             count_scene(l.scene, &tris);
-            CHECK(tris > 500, "tessellated primitives: %u triangles", tris);
+            EXPECT_MSG(tris > 500, "tessellated primitives: %u triangles", tris);
             sy_bounds b;
             sy_node_world_bounds(l.scene, l.info.root, &b, NULL);
-            CHECK(fabsf(b.max[0] - 7.14221f) < 1e-3f, "Box (size 2) at x = 6.14221: max x %g", b.max[0]);
+            EXPECT_MSG(fabsf(b.max[0] - 7.14221f) < 1e-3f, "Box (size 2) at x = 6.14221: max x %g", b.max[0]);
         }
         unload(&l);
     }
@@ -648,5 +648,5 @@ int main(int argc, char **argv)
     } else {
         printf("note: shared test data not found (%s); the sample-file part is skipped\n", argc > 1 ? argv[1] : "no path");
     }
-    return finish_tests("x3d");
+    return sy_check_finish("x3d");
 }
