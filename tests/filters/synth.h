@@ -5,19 +5,12 @@
 #ifndef SY_TEST_FILTERS_SYNTH_H
 #define SY_TEST_FILTERS_SYNTH_H
 
+#include "../support/sy_check.h"
 #include "sy_filter.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-
-#define CHECK(cond)                                                                                                    \
-    do {                                                                                                               \
-        if (!(cond)) {                                                                                                 \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);                                  \
-            exit(1);                                                                                                   \
-        }                                                                                                              \
-    } while (0)
 
 typedef struct synth {
     uint32_t w, h;
@@ -37,8 +30,9 @@ static inline double synth_gauss(uint64_t *s)
     return sqrt(-2.0 * log(u)) * cos(6.283185307179586 * v);
 }
 
-/* geometry/material only (truth); rel_sd = per-sample relative std. dev. of the indirect part */
-static inline void synth_init(synth *s, uint32_t w, uint32_t h, uint64_t seed)
+/* geometry/material only (truth); rel_sd = per-sample relative std. dev. of the indirect part.
+ * 0, or 1 after a failed check. */
+static inline int synth_init(synth *s, uint32_t w, uint32_t h, uint64_t seed)
 {
     size_t n = (size_t)w * h;
     s->w = w, s->h = h, s->rng = seed ? seed : 1;
@@ -74,6 +68,7 @@ static inline void synth_init(synth *s, uint32_t w, uint32_t h, uint64_t seed)
             s->position[3 * i + 1] = ((float)h / 2 - (float)y) * 0.01f * d;
             s->position[3 * i + 2] = -d;
         }
+    return 0;
 }
 
 /* Noisy n-spp render: indirect mean + N(0, (rel_sd*ind)^2/n) per channel (fully correlated

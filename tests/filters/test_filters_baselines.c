@@ -11,10 +11,10 @@
 
 #include <string.h>
 
-static void test_atrous(void)
+static int test_atrous(void)
 {
     synth s;
-    synth_init(&s, 96, 64, 3);
+    CHECK(synth_init(&s, 96, 64, 3) == 0);
     size_t n = (size_t)s.w * s.h;
     /* noise-free: indirect = truth; the piecewise-constant variant (E constant per half) */
     for (size_t i = 0; i < n; ++i) {
@@ -55,9 +55,10 @@ static void test_atrous(void)
     CHECK(sy_filter_atrous(&p, &f, out, &st, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
     free(out);
     synth_free(&s);
+    return 0;
 }
 
-static void test_jbu(void)
+static int test_jbu(void)
 {
     const uint32_t w = 64, h = 48, k = 4, lw = w / k, lh = h / k;
     size_t n = (size_t)w * h;
@@ -110,7 +111,7 @@ static void test_jbu(void)
     free(depth), free(normal), free(out);
     /* the whole baseline on the surrogate: error reduced, NaN isolated */
     synth s;
-    synth_init(&s, 96, 64, 13);
+    CHECK(synth_init(&s, 96, 64, 13) == 0);
     synth_render(&s, 4, 1.0f);
     sy_filter_frame f = synth_frame(&s, 4);
     size_t m = (size_t)s.w * s.h;
@@ -128,12 +129,13 @@ static void test_jbu(void)
     CHECK(e < b / 2);
     free(o4);
     synth_free(&s);
+    return 0;
 }
 
-static void test_adaptive(void)
+static int test_adaptive(void)
 {
     synth s;
-    synth_init(&s, 128, 96, 17);
+    CHECK(synth_init(&s, 128, 96, 17) == 0);
     size_t n = (size_t)s.w * s.h;
     float *out = malloc(4 * n * sizeof(float)), *lvl = malloc(n * sizeof(float));
     CHECK(out && lvl);
@@ -174,9 +176,10 @@ static void test_adaptive(void)
     CHECK(sy_filter_adaptive(&p, &f, out, lvl, &st, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT && strstr(err.message, "threshold"));
     free(out), free(lvl);
     synth_free(&s);
+    return 0;
 }
 
-static void test_metrics(void)
+static int test_metrics(void)
 {
     const uint32_t w = 40, h = 30;
     size_t n = (size_t)w * h;
@@ -209,9 +212,10 @@ static void test_metrics(void)
     CHECK(sy_filter_metrics_compute(a, b, w, h, 3, &m, &err) == SY_FILTER_OK && m.nonfinite == 1);
     CHECK(sy_filter_metrics_compute(a, b, w, h, 2, &m, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
     free(a), free(b);
+    return 0;
 }
 
-static void test_position_from_depth(void)
+static int test_position_from_depth(void)
 {
     /* camera at (1, 2, 3) looking down -Z: the centre pixel at depth 4 lies at (1, 2, -1) */
     float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 1, 2, 3, 1}, depth[9], pos[27];
@@ -225,15 +229,15 @@ static void test_position_from_depth(void)
     CHECK(isfinite(pos[0]) && pos[2] < -1e17f);
     CHECK(sy_filter_position_from_depth(3, 3, m, 0.0f, depth, pos, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT &&
           strstr(err.message, "yfov"));
+    return 0;
 }
 
 int main(void)
 {
-    test_position_from_depth();
-    test_atrous();
-    test_jbu();
-    test_adaptive();
-    test_metrics();
-    printf("filters baselines: ok\n");
-    return 0;
+    RUN(test_position_from_depth);
+    RUN(test_atrous);
+    RUN(test_jbu);
+    RUN(test_adaptive);
+    RUN(test_metrics);
+    return sy_check_finish("filters baselines");
 }

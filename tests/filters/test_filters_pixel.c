@@ -8,22 +8,26 @@
 
 #include <string.h>
 
+/* The filtered frame (malloc'ed), or NULL after a failed check (the caller CHECKs it). */
 static float *run(sy_filter_pixel_params *p, const sy_filter_frame *f, uint32_t frame, sy_filter_stats *st)
 {
     sy_filter_pixel *pf = NULL;
     sy_filter_error err = {0};
-    CHECK(sy_filter_pixel_create(p, &pf, &err) == SY_FILTER_OK);
+    EXPECT(sy_filter_pixel_create(p, &pf, &err) == SY_FILTER_OK);
     float *out = malloc((size_t)f->width * f->height * 4 * sizeof(float));
-    CHECK(out);
-    if (sy_filter_pixel_run(pf, f, frame, true, out, st, &err) != SY_FILTER_OK) {
-        fprintf(stderr, "run: %s\n", err.message);
-        exit(1);
+    EXPECT(out);
+    if (pf && out) {
+        sy_filter_status r = sy_filter_pixel_run(pf, f, frame, true, out, st, &err);
+        EXPECT_MSG(r == SY_FILTER_OK, "run: %s", err.message);
+        if (r != SY_FILTER_OK) free(out), out = NULL;
+    } else {
+        free(out), out = NULL;
     }
     sy_filter_pixel_destroy(pf);
     return out;
 }
 
-static void test_params(void)
+static int test_params(void)
 {
     sy_filter_pixel_params p;
     sy_filter_error err = {0};
@@ -55,9 +59,10 @@ static void test_params(void)
     CHECK(sy_filter_pixel_run(pf, &f, 4, false, out, NULL, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "color") != NULL);
     sy_filter_pixel_destroy(pf);
+    return 0;
 }
 
-static void test_blend_factor(void)
+static int test_blend_factor(void)
 {
     /* case 2: u <= t -> exactly 1; case 1: even L_f misses t -> 0; case 3 in (0,1) and meets t */
     CHECK(sy_filter_blend_factor(0.005f, 0.001f, 0.01f, 0.0f) == 1.0f);
@@ -68,10 +73,11 @@ static void test_blend_factor(void)
     CHECK(fabsf(s * s * u + (1 - s) * (1 - s) * f - t) < 1e-5f); /* on the constraint boundary */
     /* continuity at u = t */
     CHECK(fabsf(sy_filter_blend_factor(t * 1.0001f, 0.1f * t, t, 0.0f) - 1.0f) < 0.01f);
+    return 0;
 }
 
 /* a noisy constant converges to the constant; at low variance the output IS the unfiltered value */
-static void test_constant_and_consistency(void)
+static int test_constant_and_consistency(void)
 {
     const uint32_t w = 64, h = 48;
     size_t n = (size_t)w * h;
@@ -98,6 +104,7 @@ static void test_constant_and_consistency(void)
             p.threads = 2;
             sy_filter_stats st;
             float *out = run(&p, &f, (uint32_t)spp, &st);
+            CHECK(out);
             double e = 0, eu = 0;
             for (size_t i = 0; i < n; ++i) {
                 double d = out[4 * i] - 0.5, du = col[4 * i] - 0.5;
@@ -121,10 +128,11 @@ static void test_constant_and_consistency(void)
         }
     }
     free(col), free(var), free(alb), free(dep);
+    return 0;
 }
 
 /* r of n equal weights = 1/n: 3x1 image, sigma_s huge, identical range values */
-static void test_reduction_factor(void)
+static int test_reduction_factor(void)
 {
     float col[12] = {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1}, var[3] = {1, 1, 1}, alb[9] = {.5f, .5f, .5f, .5f, .5f, .5f, .5f, .5f, .5f},
           dep[3] = {1, 1, 1};
@@ -150,10 +158,11 @@ static void test_reduction_factor(void)
         }
         sy_filter_pixel_destroy(pf);
     }
+    return 0;
 }
 
 /* no bleeding across a depth step and across an albedo (range colour) step */
-static void test_edges(void)
+static int test_edges(void)
 {
     const uint32_t w = 80, h = 40;
     size_t n = (size_t)w * h;
@@ -183,6 +192,7 @@ static void test_edges(void)
             p.threshold = 0.0f; /* pure filtered output */
             p.spike_withholding = false;
             float *out = run(&p, &f, 4, NULL);
+            CHECK(out);
             double left = 0, rightv = 0;
             for (uint32_t y = 0; y < h; ++y) left += out[4 * ((size_t)y * w + w / 2 - 1)], rightv += out[4 * ((size_t)y * w + w / 2)];
             left /= h, rightv /= h;
@@ -192,24 +202,27 @@ static void test_edges(void)
             free(out);
         }
     free(col), free(var), free(alb), free(dep);
+    return 0;
 }
 
 /* NaN/Inf pixels are counted and do not spread; their own output is finite */
-static void test_nan(void)
+static int test_nan(void)
 {
     synth s;
-    synth_init(&s, 48, 32, 5);
+    CHECK(synth_init(&s, 48, 32, 5) == 0);
     synth_render(&s, 4, 1.0f);
     sy_filter_frame f = synth_frame(&s, 4);
     sy_filter_pixel_params p;
     sy_filter_pixel_params_default(&p);
     sy_filter_stats st;
     float *ref = run(&p, &f, 4, &st);
+    CHECK(ref);
     CHECK(st.nonfinite_samples == 0);
     size_t bad = 10 * 48 + 10;
     s.indirect[3 * bad] = NAN, s.color[4 * bad] = NAN;
     s.indirect[3 * (bad + 20) + 1] = INFINITY, s.color[4 * (bad + 20) + 1] = INFINITY;
     float *out = run(&p, &f, 4, &st);
+    CHECK(out);
     printf("nan test: %llu non-finite pixels reported\n", (unsigned long long)st.nonfinite_samples);
     CHECK(st.nonfinite_samples == 2);
     for (size_t i = 0; i < 48 * 32; ++i)
@@ -219,6 +232,7 @@ static void test_nan(void)
     CHECK(fabsf(out[4 * bad] - s.truth[4 * bad]) < 0.3f);
     free(ref), free(out);
     synth_free(&s);
+    return 0;
 }
 
 /* NaN/Inf isolation, strictly: a bad pixel's contents never reach another pixel. Whatever
@@ -226,11 +240,11 @@ static void test_nan(void)
  * back-end delivers at the same pixels, every other output pixel is bit-identical, all outputs
  * are finite, the bad pixels are counted and show their neighbourhood's filtered value; with the
  * brute-force kernel too, and on the blend-only frames after a pass. */
-static void test_nan_isolation(void)
+static int test_nan_isolation(void)
 {
     enum { W = 40, H = 28 };
     synth s;
-    synth_init(&s, W, H, 11);
+    CHECK(synth_init(&s, W, H, 11) == 0);
     synth_render(&s, 4, 1.0f);
     const size_t bad[3] = {5 * W + 7, 5 * W + 8, 20 * W + 30}; /* two adjacent, one on its own */
     float keep_c[3][4], keep_i[3][3], keep_v[3], keep_a[3][3], keep_d[3]; /* variance: 1 channel */
@@ -297,14 +311,15 @@ static void test_nan_isolation(void)
         for (int v = 0; v < 4; ++v) free(out[v]), free(blend[v]);
     }
     synth_free(&s);
+    return 0;
 }
 
 /* The worker pool: the result does not depend on the thread count (rows are claimed dynamically),
  * the object keeps its pool across frames and rebuilds it when params.threads changes. */
-static void test_threads(void)
+static int test_threads(void)
 {
     synth s;
-    synth_init(&s, 77, 45, 21); /* odd sizes: partial vector chunks and row bands */
+    CHECK(synth_init(&s, 77, 45, 21) == 0); /* odd sizes: partial vector chunks and row bands */
     synth_render(&s, 4, 1.0f);
     sy_filter_frame f = synth_frame(&s, 4);
     size_t n = (size_t)77 * 45;
@@ -333,13 +348,14 @@ static void test_threads(void)
     sy_filter_pixel_destroy(pf);
     free(ref);
     synth_free(&s);
+    return 0;
 }
 
 /* image quality on the analytic surrogate: relMSE reduction >= 4x at 4 spp */
-static void test_quality(void)
+static int test_quality(void)
 {
     synth s;
-    synth_init(&s, 160, 120, 11);
+    CHECK(synth_init(&s, 160, 120, 11) == 0);
     synth_render(&s, 4, 1.0f);
     sy_filter_frame f = synth_frame(&s, 4);
     size_t n = (size_t)s.w * s.h;
@@ -350,6 +366,7 @@ static void test_quality(void)
         p.kernel = (sy_filter_pixel_kernel)kernel;
         sy_filter_stats st;
         float *out = run(&p, &f, 4, &st);
+        CHECK(out);
         double e = rel_mse(out, s.truth, n);
         printf("quality, kernel %d: relMSE unfiltered %.5f filtered %.5f (%.1fx), mean s %.3f\n", kernel, base, e,
                base / e, st.mean_blend);
@@ -357,10 +374,11 @@ static void test_quality(void)
         free(out);
     }
     synth_free(&s);
+    return 0;
 }
 
 /* range buffer: albedo x ((1 - w) + w |n . v|), depth in A, misses clamped */
-static void test_range_compose(void)
+static int test_range_compose(void)
 {
     float alb[6] = {0.5f, 0.4f, 0.2f, 0.5f, 0.4f, 0.2f}, nrm[6] = {0, 0, 1, 1, 0, 0}, pos[6] = {0, 0, -2, 0, 0, -2};
     float dep[2] = {2.0f, INFINITY}, cam[3] = {0, 0, 0}, out[8];
@@ -375,20 +393,20 @@ static void test_range_compose(void)
     CHECK(out[3] == 2.0f && out[7] == 1e18f);
     CHECK(sy_filter_range_compose(&f, cam, 1.5f, out, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT &&
           strstr(err.message, "headlight_weight"));
+    return 0;
 }
 
 int main(void)
 {
-    test_params();
-    test_range_compose();
-    test_blend_factor();
-    test_reduction_factor();
-    test_constant_and_consistency();
-    test_edges();
-    test_nan();
-    test_nan_isolation();
-    test_threads();
-    test_quality();
-    printf("filters pixel: ok\n");
-    return 0;
+    RUN(test_params);
+    RUN(test_range_compose);
+    RUN(test_blend_factor);
+    RUN(test_reduction_factor);
+    RUN(test_constant_and_consistency);
+    RUN(test_edges);
+    RUN(test_nan);
+    RUN(test_nan_isolation);
+    RUN(test_threads);
+    RUN(test_quality);
+    return sy_check_finish("filters pixel");
 }

@@ -19,7 +19,7 @@ typedef struct scene {
     uint64_t rng;
 } scene;
 
-static void scene_init(scene *s, uint32_t w, uint32_t h, bool step, float exponent)
+static int scene_init(scene *s, uint32_t w, uint32_t h, bool step, float exponent)
 {
     size_t n = (size_t)w * h;
     s->w = w, s->h = h, s->rng = 42;
@@ -54,6 +54,7 @@ static void scene_init(scene *s, uint32_t w, uint32_t h, bool step, float expone
             }
             s->truth[4 * i + 3] = 1;
         }
+    return 0;
 }
 
 /* one frame: cosine-sampled directions, radiance L (1 + rel_sd * N(0,1)) */
@@ -88,10 +89,10 @@ static sy_filter_radiance_input input(const scene *s)
                                       .samples = s->sm};
 }
 
-static void test_texture_and_convergence(void)
+static int test_texture_and_convergence(void)
 {
     scene s;
-    scene_init(&s, 96, 64, false, 0.0f);
+    CHECK(scene_init(&s, 96, 64, false, 0.0f) == 0);
     size_t n = (size_t)s.w * s.h;
     sy_filter_radiance *rf = NULL;
     sy_filter_error err = {0};
@@ -125,12 +126,13 @@ static void test_texture_and_convergence(void)
     free(out), free(pt);
     sy_filter_radiance_destroy(rf);
     scene_free(&s);
+    return 0;
 }
 
-static void test_depth_step(void)
+static int test_depth_step(void)
 {
     scene s;
-    scene_init(&s, 96, 48, true, 0.0f);
+    CHECK(scene_init(&s, 96, 48, true, 0.0f) == 0);
     size_t n = (size_t)s.w * s.h;
     sy_filter_radiance *rf = NULL;
     sy_filter_error err = {0};
@@ -153,12 +155,13 @@ static void test_depth_step(void)
     free(out);
     sy_filter_radiance_destroy(rf);
     scene_free(&s);
+    return 0;
 }
 
-static void test_correction_phase(void)
+static int test_correction_phase(void)
 {
     scene s;
-    scene_init(&s, 32, 24, false, 0.0f);
+    CHECK(scene_init(&s, 32, 24, false, 0.0f) == 0);
     size_t n = (size_t)s.w * s.h;
     sy_filter_radiance_params p;
     sy_filter_radiance_params_default(&p);
@@ -192,12 +195,13 @@ static void test_correction_phase(void)
     free(out), free(pt);
     sy_filter_radiance_destroy(rf);
     scene_free(&s);
+    return 0;
 }
 
-static void test_nan_and_params(void)
+static int test_nan_and_params(void)
 {
     scene s;
-    scene_init(&s, 32, 24, false, 0.0f);
+    CHECK(scene_init(&s, 32, 24, false, 0.0f) == 0);
     size_t n = (size_t)s.w * s.h;
     sy_filter_radiance *rf = NULL;
     sy_filter_error err = {0};
@@ -226,15 +230,16 @@ static void test_nan_and_params(void)
     CHECK(sy_filter_radiance_params_check(&p, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
     free(out);
     scene_free(&s);
+    return 0;
 }
 
 /* Seeded with a converged mean (k = 1000, per-sample variance equal to the frame noise): the next
  * frame is k + 1 = 1001 with T_k = 2001 T_u, every pixel in the correction phase, and the output is
  * the running mean (1000 * seed + plain PT) / 1001; bad seeds are rejected. */
-static void test_seed(void)
+static int test_seed(void)
 {
     scene s;
-    scene_init(&s, 32, 24, false, 0.0f);
+    CHECK(scene_init(&s, 32, 24, false, 0.0f) == 0);
     size_t n = (size_t)s.w * s.h;
     sy_filter_radiance *rf = NULL;
     sy_filter_error err = {0};
@@ -264,6 +269,7 @@ static void test_seed(void)
     sy_filter_radiance_destroy(rf);
     free(out), free(var);
     scene_free(&s);
+    return 0;
 }
 
 /* The batched BSDF path (default, vectorised Lambert case) equals one single-direction call per
@@ -273,7 +279,7 @@ static uint64_t g_batch_dirs;
 static void batch_via_single(const sy_filter_rf_shading *s, uint32_t count, const float *const wi[3],
                              float *const f_cos[3], float *pdf, void *user)
 {
-    CHECK(user == &g_batch_dirs && count >= 1 && count <= 64);
+    EXPECT(user == &g_batch_dirs && count >= 1 && count <= 64); /* a callback: counted, goes on */
     for (uint32_t m = 0; m < count; ++m) {
         float w[3] = {wi[0][m], wi[1][m], wi[2][m]}, fc[3];
         sy_filter_rf_bsdf_default(s, w, fc, pdf + m, NULL);
@@ -282,11 +288,11 @@ static void batch_via_single(const sy_filter_rf_shading *s, uint32_t count, cons
     g_batch_dirs += count;
 }
 
-static void test_batched_bsdf(void)
+static int test_batched_bsdf(void)
 {
     for (int glossy = 0; glossy < 2; ++glossy) {
         scene s;
-        scene_init(&s, 80, 48, true, glossy ? 20.0f : 0.0f);
+        CHECK(scene_init(&s, 80, 48, true, glossy ? 20.0f : 0.0f) == 0);
         size_t n = (size_t)s.w * s.h;
         /* batch vs single on the frame's own directions (some below the horizon: wi flipped) */
         scene_frame(&s, 1.0f, 1);
@@ -338,16 +344,16 @@ static void test_batched_bsdf(void)
         for (int v = 0; v < 3; ++v) sy_filter_radiance_destroy(rf[v]), free(out[v]);
         scene_free(&s);
     }
+    return 0;
 }
 
 int main(void)
 {
-    test_batched_bsdf();
-    test_texture_and_convergence();
-    test_depth_step();
-    test_correction_phase();
-    test_nan_and_params();
-    test_seed();
-    printf("filters radiance: ok\n");
-    return 0;
+    RUN(test_batched_bsdf);
+    RUN(test_texture_and_convergence);
+    RUN(test_depth_step);
+    RUN(test_correction_phase);
+    RUN(test_nan_and_params);
+    RUN(test_seed);
+    return sy_check_finish("filters radiance");
 }
