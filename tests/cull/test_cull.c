@@ -174,7 +174,7 @@ static void test_boxes(void)
     /* the capability the culler asks (SY_CAP_COVERAGE, sy_context_coverage): a class offers it and
      * counts what the culler ranks; a class without it refuses, naming itself */
     const sy_mediator_class *cov = sy_mediator_with_caps(SY_CAP_COVERAGE);
-    CHECK(cov && cov->coverage, "a registered class offers SY_CAP_COVERAGE");
+    EXPECT_MSG(cov && cov->coverage, "a registered class offers SY_CAP_COVERAGE");
     sy_camera_view cam = sy_cull_view_camera(&v);
     sy_coverage_entry *ce = NULL;
     uint32_t cn = 0;
@@ -183,16 +183,16 @@ static void test_boxes(void)
         MUST(sy_context_create(s, cov->name, NULL, root.id, &ctx, &err));
         MUST(sy_context_sync(ctx, &err));
         MUST(sy_context_coverage(ctx, &cam, v.width, v.height, &ce, &cn, &err));
-        CHECK(cn == 3 && ce[0].node_id == full.objects[0].id && ce[0].pixels == full.objects[0].pixels,
-              "sy_context_coverage: %u nodes, the culler's head first", cn);
+        EXPECT_MSG(cn == 3 && ce[0].node_id == full.objects[0].id && ce[0].pixels == full.objects[0].pixels,
+                   "sy_context_coverage: %u nodes, the culler's head first", cn);
         free(ce);
         sy_context_release(ctx);
     }
     MUST(sy_context_create(s, "whitted", NULL, root.id, &ctx, &err));
     sy_error ue = {0};
     ce = (sy_coverage_entry *)&ue, cn = 7;
-    CHECK(sy_context_coverage(ctx, &cam, v.width, v.height, &ce, &cn, &ue) == SY_ERR_UNSUPPORTED && !ce && cn == 0 &&
-              strstr(ue.message, "whitted"), "whitted counts no coverage: %s", ue.message);
+    EXPECT_MSG(sy_context_coverage(ctx, &cam, v.width, v.height, &ce, &cn, &ue) == SY_ERR_UNSUPPORTED && !ce && cn == 0 &&
+                   strstr(ue.message, "whitted"), "whitted counts no coverage: %s", ue.message);
     sy_context_release(ctx);
 
     /* a hidden node (visibility flag) is no object; the index follows commits */

@@ -108,6 +108,7 @@ cc -std=c11 -Wall -Wextra -Werror -fsyntax-only $(pkg-config --cflags switchyard
 c++ -std=c++17 -Wall -Wextra -Werror -fsyntax-only $(pkg-config --cflags switchyard) "$TMP/umbrella.cpp" 2>"$TMP/umbxx.err" ||
     fail "#include <switchyard/switchyard.h> (C++17): $(head -5 "$TMP/umbxx.err")"
 for h in "$P"/include/switchyard/sy_*.h; do # C++ programs link the C functions: extern "C" in every header
+    grep -qE '^[A-Za-z_][A-Za-z0-9_ *]*\(' "$h" || continue # only includes or macros (sy_mediator.h, sy_scene.h)
     grep -q '__cplusplus' "$h" || fail "$(basename "$h") declares its functions without extern \"C\" for C++"
 done
 grep -q '#include "sy_fields.h"' "$P/include/switchyard/switchyard.h" && fail "the umbrella names core's internal sy_fields.h"

@@ -1,0 +1,72 @@
+/** @file
+ * sy_context.h — contexts: a back-end instance with its adapted scene (a consumer of the scene
+ * plus the mediator's state), reference counted and shared by every viewport that shows the same
+ * scene with the same back-end, and the pool that caches them.
+ * Ownership: contexts are reference counted; sy_context_pool owns a reference to each cached one.
+ * Thread-safety: a context and a pool are single-threaded: sync and render of one context must not
+ * run concurrently. */
+#ifndef SY_CONTEXT_H
+#define SY_CONTEXT_H
+
+#include "sy_registry.h"
+#include "sy_scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** A back-end instance with its adapted scene, shared by reference count (opaque). */
+typedef struct sy_context sy_context;
+
+/** Creates a context: a consumer on the scene plus the mediator's state. Caller owns one ref. */
+sy_result sy_context_create(sy_scene *scene, const char *backend, const sy_params *params, uint32_t root_node_id,
+                            sy_context **out, sy_error *err);
+/** Adds a reference; returns c. */
+sy_context *sy_context_retain(sy_context *c);
+void sy_context_release(sy_context *c); /**< the last release destroys the mediator state */
+/** Pulls everything committed since the last sync and hands it to the mediator. Cost is
+ * proportional to the changes. */
+sy_result sy_context_sync(sy_context *c, sy_error *err);
+/** Renders the request into layer (rect_w x rect_h) with the context's mediator. */
+sy_result sy_context_render(sy_context *c, const sy_render_request *req, sy_layer *layer, sy_error *err);
+/** The context's mediator class. */
+const sy_mediator_class *sy_context_class(const sy_context *c);
+/** The mediator's own state (for the mediator module's diagnostics functions). Borrowed. */
+void *sy_context_state(const sy_context *c);
+/** Fills out with the mediator's statistics. */
+void sy_context_stats(const sy_context *c, sy_mediator_stats *out);
+/** The instance's capabilities (sy_mediator_caps): the class's, or what caps_of says for its parameters. */
+uint32_t sy_context_caps(const sy_context *c);
+/** Feature buffers of the last render; SY_ERR_UNSUPPORTED naming the back-end without SY_CAP_AOVS.
+ * out is the caller's: sy_aovs_free. */
+sy_result sy_context_aovs(sy_context *c, sy_aovs *out, sy_error *err);
+/** Display filter (SY_CAP_FILTERS; others: SY_ERR_UNSUPPORTED naming the back-end). opts are checked
+ * against the class's table first: only keys declared SY_PARAM_LIVE may change here. */
+sy_result sy_context_set_filter(sy_context *c, const char *name, const sy_params *opts, sy_error *err);
+/** Fills out (name "none" for a back-end without filters). */
+void sy_context_filter_info(const sy_context *c, sy_filter_info *out);
+/** Per-node pixel coverage (SY_CAP_COVERAGE; others: SY_ERR_UNSUPPORTED naming the back-end): a ray
+ * through every pixel centre of view at width x height, the nearest visible object's node counted,
+ * sorted by pixels, most first (ties: smaller node id first); nodes covering nothing are left out.
+ * Covers what the context last synced. Ownership: *entries_out is malloc()ed, the caller frees it
+ * (NULL and 0 on failure). */
+sy_result sy_context_coverage(sy_context *c, const sy_camera_view *view, uint32_t width, uint32_t height,
+                              sy_coverage_entry **entries_out, uint32_t *count_out, sy_error *err);
+
+/** A cache of contexts keyed by (scene, back-end, parameters, root): viewports showing the same
+ * scene with the same back-end share one context, so the scene is converted once and switching
+ * back to a back-end is instant. */
+typedef struct sy_context_pool sy_context_pool;
+/** Creates an empty pool. */
+sy_result sy_context_pool_create(sy_context_pool **out, sy_error *err);
+void sy_context_pool_destroy(sy_context_pool *p); /**< releases the pool's references */
+/** Returns a borrowed context (valid while the pool lives), creating it on first use. */
+sy_result sy_context_pool_get(sy_context_pool *p, sy_scene *scene, const char *backend, const sy_params *params,
+                              uint32_t root_node_id, sy_context **out, sy_error *err);
+/** Number of contexts in the pool. */
+uint32_t sy_context_pool_size(const sy_context_pool *p);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_CONTEXT_H */

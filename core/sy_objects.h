@@ -1,0 +1,524 @@
+/** @file
+ * sy_objects.h — the scene's objects: handles, the seven object types (node, mesh, material,
+ * texture, light, camera, background) with their data structs and numbered fields, attachments,
+ * and the calls that create, change, read and destroy objects of a scene (sy_scene.h).
+ *
+ * Each type has a plain data struct (sy_node_data, ...) and an enumerated list of fields, one bit
+ * each. Setters are the only way to change a field; each validates the value and marks the field
+ * dirty when it differs (sy_commit.h seals dirty fields into change lists).
+ *
+ * Handles: one-field structs {uint32_t id}; id = generation << SY_HANDLE_INDEX_BITS | index.
+ * id 0 is never valid. A destroyed object's slot gets a new generation when reused, so a stale
+ * handle is detected (SY_ERR_INVALID_HANDLE), never dereferenced. Overflow policy: a slot whose
+ * generation reaches its maximum is retired and never reused.
+ *
+ * Ownership: the scene owns every object and everything stored in fields (strings are copied,
+ * blobs retained). Getters return borrowed pointers valid until the next modification of that
+ * object or the destruction of the scene.
+ * Thread-safety: as the scene (sy_scene.h): all calls on one scene serialised by the caller. */
+#ifndef SY_OBJECTS_H
+#define SY_OBJECTS_H
+
+#include "sy_blob.h"
+#include "sy_common.h"
+#include "sy_math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+
+#define SY_HANDLE_INDEX_BITS 22u /**< bits of a handle id that hold the slot index */
+#define SY_HANDLE_INDEX_MASK ((1u << SY_HANDLE_INDEX_BITS) - 1u) /**< mask of the slot index in a handle id */
+#define SY_HANDLE_MAX_GENERATION ((1u << (32u - SY_HANDLE_INDEX_BITS)) - 1u) /**< largest generation; a slot that reaches it is retired */
+
+
+/** The application-side scene graph (opaque). */
+typedef struct sy_scene sy_scene;
+/** Handle of a node. */
+typedef struct sy_node { uint32_t id; /**< index + generation; 0 = none */ } sy_node;
+/** Handle of a mesh. */
+typedef struct sy_mesh { uint32_t id; /**< index + generation; 0 = none */ } sy_mesh;
+/** Handle of a material. */
+typedef struct sy_material { uint32_t id; /**< index + generation; 0 = none */ } sy_material; /**< id 0: the default material */
+/** Handle of a texture. */
+typedef struct sy_texture { uint32_t id; /**< index + generation; 0 = none */ } sy_texture;
+/** Handle of a light. */
+typedef struct sy_light { uint32_t id; /**< index + generation; 0 = none */ } sy_light;
+/** Handle of a camera. */
+typedef struct sy_camera { uint32_t id; /**< index + generation; 0 = none */ } sy_camera;
+/** Handle of a background (the world). */
+typedef struct sy_background { uint32_t id; /**< index + generation; 0 = none */ } sy_background;
+
+/** Object types; the order is the dependency order (referenced types first). */
+typedef enum sy_object_type {
+    SY_TYPE_NONE = 0,
+    SY_TYPE_TEXTURE = 1, /**< order = dependency order: referenced types first */
+    SY_TYPE_MATERIAL = 2,
+    SY_TYPE_MESH = 3,
+    SY_TYPE_LIGHT = 4,
+    SY_TYPE_CAMERA = 5,
+    SY_TYPE_BACKGROUND = 6,
+    SY_TYPE_NODE = 7,
+    SY_TYPE_COUNT = 8
+} sy_object_type;
+
+const char *sy_object_type_name(sy_object_type t); /**< "node", "mesh", ... */
+
+#define SY_BIT(field) (1ull << (field)) /**< the dirty-mask bit of a field number */
+/** Fields common to every type. */
+#define SY_FIELD_NAME 0u         /**< char *name (copied; may be NULL) */
+#define SY_FIELD_ATTACHMENTS 63u /**< the attachment set (see below) */
+
+/* ---------------------------------------------------------------- node */
+/** How a node's local transform is given. */
+typedef enum sy_transform_mode { SY_TRANSFORM_TRS = 0, SY_TRANSFORM_MATRIX = 1 } sy_transform_mode;
+
+/** A node's local transform: TRS or a matrix. */
+typedef struct sy_transform {
+    uint32_t mode;         /**< sy_transform_mode */
+    float translation[3];  /**< TRS (valid when mode == TRS) */
+    float rotation[4];     /**< unit quaternion x, y, z, w */
+    float scale[3]; /**< scale x, y, z (TRS) */
+    sy_mat4 matrix;        /**< always valid: the local matrix (from TRS when mode == TRS) */
+} sy_transform;
+
+/** Node flags (SY_NODE_FLAGS field). */
+typedef enum sy_node_flags {
+    SY_NODE_VISIBLE = 1u << 0,
+    SY_NODE_STATIC = 1u << 1,   /**< hint: transform rarely changes (merge into a static BVH) */
+    SY_NODE_ANIMATED = 1u << 2, /**< hint: transform or mesh changes often */
+} sy_node_flags;
+
+/** Field numbers of a node. */
+enum sy_node_field {
+    SY_NODE_NAME = 0,
+    SY_NODE_TRANSFORM = 1, /**< sy_transform */
+    SY_NODE_CHILDREN = 2,  /**< sy_blob* of uint32 node ids (NULL = none) */
+    SY_NODE_MESH = 3,      /**< sy_mesh */
+    SY_NODE_LIGHT = 4,     /**< sy_light */
+    SY_NODE_CAMERA = 5,    /**< sy_camera */
+    SY_NODE_FLAGS = 6,     /**< uint32 sy_node_flags */
+    SY_NODE_FIELD_COUNT = 7
+};
+
+/** Field values of a node. */
+typedef struct sy_node_data {
+    char *name; /**< name (copied; may be NULL) */
+    sy_transform transform; /**< local transform */
+    sy_blob *children; /**< uint32 node ids; use sy_node_children() to read */
+    sy_mesh mesh; /**< mesh instanced here ({0}: none) */
+    sy_light light; /**< light attached here ({0}: none) */
+    sy_camera camera; /**< camera attached here ({0}: none) */
+    uint32_t flags; /**< sy_node_flags */
+} sy_node_data;
+
+/* ---------------------------------------------------------------- mesh */
+/** What a primitive's indices (or, without indices, its vertices in order) form. */
+typedef enum sy_topology {
+    SY_TOPOLOGY_TRIANGLES = 0, /**< triples: indices uint32[3 * n] (default) */
+    SY_TOPOLOGY_LINES = 1,     /**< pairs: each pair is one straight segment, indices uint32[2 * n] */
+    SY_TOPOLOGY_POINTS = 2,    /**< each index (or vertex) is one point */
+    SY_TOPOLOGY_COUNT = 3
+} sy_topology;
+
+/** One primitive. Fixed vertex formats; every present attribute has vertex_count elements:
+ * positions float[3] (required), normals float[3], tangents float[4], texcoords float[2], colors
+ * float[4] (linear RGBA), indices uint32 (NULL: non-indexed). Triangles: indices hold whole
+ * triples (without indices vertex_count must be a multiple of 3). Lines: indices hold whole pairs
+ * (without indices an even vertex_count). Points: any count.
+ *
+ * Strokes (lines and points) have a width: the diameter of the tube drawn along each segment and
+ * of the ball drawn at each point and line joint, in the primitive's own coordinate units (the
+ * node transforms scale it with the positions, so it is a world-space width under unscaled
+ * transforms). Every back-end draws strokes as the same triangle geometry (the scene mirror
+ * tessellates them, mediators/sy_strokes.h), so they cover the same pixels in the rasterizer and
+ * the ray tracers. The width rule, sy_primitive_stroke_width:
+ *   - width > 0: that width;
+ *   - width == 0 (default): SY_STROKE_LINE_FRACTION (lines) or SY_STROKE_POINT_FRACTION (points)
+ *     times the diagonal of the primitive's position bounds, at least SY_STROKE_MIN_WIDTH.
+ *     (The Khronos MeshPrimitiveModes sample, 1.73 x 2 units per primitive (diagonal 2.65), gets
+ *     0.159-unit lines and 0.318-unit points: about 2 and 4 pixels in `sy render -w 200 -h 150`.)
+ * Normals, tangents and the material's normal map of a stroke are not used: a stroke is lit as a
+ * tube / ball with the tessellation's own normals; texcoords and colours are carried along. */
+#define SY_STROKE_LINE_FRACTION 0.06f
+#define SY_STROKE_POINT_FRACTION 0.12f /**< default point diameter as a fraction of the bounds diagonal */
+#define SY_STROKE_MIN_WIDTH 0.001f /**< smallest default stroke width */
+/** One primitive of a mesh: vertex attributes in blobs, a material, a topology (see above). */
+typedef struct sy_primitive {
+    sy_blob *positions; /**< float[3] per vertex (required) */
+    sy_blob *normals; /**< float[3] per vertex, or NULL */
+    sy_blob *tangents; /**< float[4] per vertex, or NULL */
+    sy_blob *texcoords0; /**< float[2] per vertex (set 0), or NULL */
+    sy_blob *texcoords1; /**< float[2] per vertex (set 1), or NULL */
+    sy_blob *colors; /**< float[4] linear RGBA per vertex, or NULL */
+    sy_blob *indices; /**< uint32 indices, or NULL (non-indexed) */
+    sy_material material; /**< {0}: default material */
+    uint32_t topology;    /**< sy_topology */
+    float width;          /**< strokes: diameter (finite, >= 0; 0 = the default rule above) */
+} sy_primitive;
+
+/** Field numbers of a mesh. */
+enum sy_mesh_field {
+    SY_MESH_NAME = 0,
+    SY_MESH_PRIMITIVES = 1, /**< sy_primitive_list */
+    SY_MESH_FIELD_COUNT = 2
+};
+
+/** An array of primitives (the SY_MESH_PRIMITIVES field). */
+typedef struct sy_primitive_list {
+    sy_primitive *items; /**< the primitives */
+    uint32_t count; /**< number of primitives */
+} sy_primitive_list;
+
+/** Field values of a mesh. */
+typedef struct sy_mesh_data {
+    char *name; /**< name (copied; may be NULL) */
+    sy_primitive_list primitives; /**< the primitives */
+} sy_mesh_data;
+
+/** Vertices of a primitive (elements of its positions blob). */
+uint32_t sy_primitive_vertex_count(const sy_primitive *p);
+/** Triangles of a triangle primitive; 0 for lines and points (their tessellation is the mirror's). */
+uint32_t sy_primitive_triangle_count(const sy_primitive *p);
+/** Elements of any topology: triangles, segments or points. */
+uint32_t sy_primitive_element_count(const sy_primitive *p);
+/** Position bounds of the primitive, without the stroke width (empty when it has no positions). */
+sy_bounds sy_primitive_position_bounds(const sy_primitive *p);
+/** The stroke width of a line or point primitive by the rule above; primitive_bounds are its
+ * position bounds (sy_primitive_position_bounds; NULL = computed here). 0 for triangles. */
+float sy_primitive_stroke_width(const sy_primitive *p, const sy_bounds *primitive_bounds);
+/** Releases the primitive's blob references (NULL ones are skipped) and zeroes it. */
+void sy_primitive_release(sy_primitive *p);
+
+/* ---------------------------------------------------------------- material (glTF 2.0 metallic-roughness) */
+/** glTF alpha modes. */
+typedef enum sy_alpha_mode { SY_ALPHA_OPAQUE = 0, SY_ALPHA_MASK = 1, SY_ALPHA_BLEND = 2 } sy_alpha_mode;
+
+/** A material's reference to a texture, with its coordinate set and KHR_texture_transform. */
+typedef struct sy_texture_ref {
+    sy_texture texture; /**< {0}: none */
+    uint32_t texcoord;  /**< which texcoord set (0 or 1) */
+    float scale;        /**< normal scale / occlusion strength; 1 otherwise */
+    float offset[2];    /**< KHR_texture_transform: uv' = T(offset) R(rotation) S(uv_scale) uv */
+    float rotation; /**< KHR_texture_transform rotation (radians) */
+    float uv_scale[2]; /**< KHR_texture_transform scale */
+} sy_texture_ref;
+/** The texture-coordinate transform of r as a row-major 2x3 affine matrix (u' = m0 u + m1 v + m2,
+ * v' = m3 u + m4 v + m5); returns false when it is the identity. */
+bool sy_texture_ref_matrix(const sy_texture_ref *r, float m[6]);
+
+/** Field numbers of a material. */
+enum sy_material_field {
+    SY_MATERIAL_NAME = 0,
+    SY_MATERIAL_BASE_COLOR = 1,          /**< float[4] linear RGBA factor */
+    SY_MATERIAL_BASE_COLOR_TEXTURE = 2,  /**< sy_texture_ref */
+    SY_MATERIAL_METALLIC = 3,            /**< float */
+    SY_MATERIAL_ROUGHNESS = 4,           /**< float */
+    SY_MATERIAL_METALLIC_ROUGHNESS_TEXTURE = 5,
+    SY_MATERIAL_NORMAL_TEXTURE = 6,
+    SY_MATERIAL_OCCLUSION_TEXTURE = 7,
+    SY_MATERIAL_EMISSIVE = 8,            /**< float[3] factor */
+    SY_MATERIAL_EMISSIVE_STRENGTH = 9,   /**< float (KHR_materials_emissive_strength) */
+    SY_MATERIAL_EMISSIVE_TEXTURE = 10,
+    SY_MATERIAL_ALPHA_MODE = 11,         /**< uint32 sy_alpha_mode */
+    SY_MATERIAL_ALPHA_CUTOFF = 12,       /**< float */
+    SY_MATERIAL_DOUBLE_SIDED = 13,       /**< uint32 0/1 */
+    SY_MATERIAL_TRANSMISSION = 14,       /**< float (KHR_materials_transmission) */
+    SY_MATERIAL_TRANSMISSION_TEXTURE = 15,
+    SY_MATERIAL_IOR = 16,                /**< float (KHR_materials_ior) */
+    SY_MATERIAL_UNLIT = 17,              /**< uint32 0/1 (KHR_materials_unlit) */
+    SY_MATERIAL_FIELD_COUNT = 18
+};
+
+/** Field values of a material (glTF 2.0 metallic-roughness). */
+typedef struct sy_material_data {
+    char *name; /**< name (copied; may be NULL) */
+    float base_color[4]; /**< linear RGBA factor */
+    sy_texture_ref base_color_texture; /**< base colour texture (sRGB) */
+    float metallic; /**< metallic factor */
+    float roughness; /**< roughness factor */
+    sy_texture_ref metallic_roughness_texture; /**< metallic (B) and roughness (G) texture */
+    sy_texture_ref normal_texture; /**< tangent-space normal map (scale = normal scale) */
+    sy_texture_ref occlusion_texture; /**< occlusion texture (R; scale = strength) */
+    float emissive[3]; /**< emissive factor, linear RGB */
+    float emissive_strength; /**< KHR_materials_emissive_strength multiplier */
+    sy_texture_ref emissive_texture; /**< emissive texture (sRGB) */
+    uint32_t alpha_mode; /**< sy_alpha_mode */
+    float alpha_cutoff; /**< alpha cutoff of SY_ALPHA_MASK */
+    uint32_t double_sided; /**< 1 = both faces are front faces */
+    float transmission; /**< KHR_materials_transmission factor */
+    sy_texture_ref transmission_texture; /**< transmission texture (R) */
+    float ior; /**< index of refraction (KHR_materials_ior) */
+    uint32_t unlit; /**< 1 = KHR_materials_unlit */
+} sy_material_data;
+
+/* ---------------------------------------------------------------- texture */
+/** Pixel formats of a texture. */
+typedef enum sy_pixel_format {
+    SY_PIXEL_U8_SRGB = 1,   /**< 8-bit, sRGB-encoded colour (alpha linear) */
+    SY_PIXEL_U8_LINEAR = 2, /**< 8-bit, linear data (normals, metallic-roughness) */
+    SY_PIXEL_F32 = 3,       /**< float, linear */
+} sy_pixel_format;
+
+/** Texture wrap modes (glTF sampler). */
+typedef enum sy_wrap { SY_WRAP_REPEAT = 0, SY_WRAP_CLAMP = 1, SY_WRAP_MIRROR = 2 } sy_wrap;
+/** Texture filters (glTF sampler). */
+typedef enum sy_filter { SY_FILTER_LINEAR = 0, SY_FILTER_NEAREST = 1 } sy_filter;
+
+/** Size and layout of a texture's pixels. */
+typedef struct sy_image_info {
+    /** @{ size in pixels */
+    uint32_t width, height; /** @} */
+    uint32_t channels; /**< 1 = grey (used for R, G and B), 2 = grey + alpha, 3 = RGB, 4 = RGBA */
+    uint32_t format;   /**< sy_pixel_format */
+} sy_image_info;
+
+/** A texture's sampler. */
+typedef struct sy_sampler {
+    /** @{ sy_wrap */
+    uint32_t wrap_s, wrap_t; /** @} */
+    /** @{ sy_filter */
+    uint32_t min_filter, mag_filter; /** @} */
+} sy_sampler;
+
+/** Field numbers of a texture. */
+enum sy_texture_field {
+    SY_TEXTURE_NAME = 0,
+    SY_TEXTURE_INFO = 1,    /**< sy_image_info */
+    SY_TEXTURE_PIXELS = 2,  /**< sy_blob*: rows top to bottom, channels interleaved */
+    SY_TEXTURE_SAMPLER = 3, /**< sy_sampler */
+    SY_TEXTURE_FIELD_COUNT = 4
+};
+
+/** Field values of a texture. */
+typedef struct sy_texture_data {
+    char *name; /**< name (copied; may be NULL) */
+    sy_image_info info; /**< size and layout */
+    sy_blob *pixels; /**< pixels: rows top to bottom, channels interleaved */
+    sy_sampler sampler; /**< wrap and filter */
+} sy_texture_data;
+
+/* ---------------------------------------------------------------- light (KHR_lights_punctual) */
+/** Punctual light types (KHR_lights_punctual). */
+typedef enum sy_light_type { SY_LIGHT_POINT = 0, SY_LIGHT_SPOT = 1, SY_LIGHT_DIRECTIONAL = 2 } sy_light_type;
+
+/** Field numbers of a light. */
+enum sy_light_field {
+    SY_LIGHT_NAME = 0,
+    SY_LIGHT_TYPE = 1,       /**< uint32 sy_light_type */
+    SY_LIGHT_COLOR = 2,      /**< float[3] linear */
+    SY_LIGHT_INTENSITY = 3,  /**< float: candela (point, spot), lux (directional) */
+    SY_LIGHT_RANGE = 4,      /**< float, 0 = infinite */
+    SY_LIGHT_INNER_CONE = 5, /**< float radians */
+    SY_LIGHT_OUTER_CONE = 6, /**< float radians */
+    SY_LIGHT_FIELD_COUNT = 7
+};
+
+/** Field values of a light (KHR_lights_punctual units). */
+typedef struct sy_light_data {
+    char *name; /**< name (copied; may be NULL) */
+    uint32_t type; /**< sy_light_type */
+    float color[3]; /**< linear RGB */
+    float intensity; /**< candela (point, spot), lux (directional) */
+    float range; /**< 0 = infinite */
+    float inner_cone; /**< spot inner cone angle (radians) */
+    float outer_cone; /**< spot outer cone angle (radians) */
+} sy_light_data;
+
+/* ---------------------------------------------------------------- camera */
+/** Camera projections. */
+typedef enum sy_projection { SY_PROJECTION_PERSPECTIVE = 0, SY_PROJECTION_ORTHOGRAPHIC = 1 } sy_projection;
+
+/** Field numbers of a camera. */
+enum sy_camera_field {
+    SY_CAMERA_NAME = 0,
+    SY_CAMERA_PROJECTION = 1, /**< uint32 sy_projection */
+    SY_CAMERA_YFOV = 2,       /**< float radians (perspective) */
+    SY_CAMERA_ASPECT = 3,     /**< float width/height; 0 = from the image */
+    SY_CAMERA_ZNEAR = 4,      /**< float */
+    SY_CAMERA_ZFAR = 5,       /**< float; 0 = infinite */
+    SY_CAMERA_XMAG = 6,       /**< float half width (orthographic) */
+    SY_CAMERA_YMAG = 7,       /**< float half height (orthographic) */
+    SY_CAMERA_FIELD_COUNT = 8
+};
+
+/** Field values of a camera (glTF camera). */
+typedef struct sy_camera_data {
+    char *name; /**< name (copied; may be NULL) */
+    uint32_t projection; /**< sy_projection */
+    float yfov; /**< vertical field of view, radians (perspective) */
+    float aspect; /**< width / height; 0 = from the image */
+    float znear; /**< near plane distance */
+    float zfar; /**< far plane distance; 0 = infinite */
+    float xmag; /**< half width (orthographic) */
+    float ymag; /**< half height (orthographic) */
+} sy_camera_data;
+
+/* ---------------------------------------------------------------- background (the world) */
+/* What the camera sees where nothing is hit, and the environment light (see sy_look.h for the
+ * rules every back-end follows). */
+#define SY_GRADIENT_MAX 8 /**< at most this many sky and ground colours */
+/** X3D Background: sky colours by angle from the zenith (sky_color[0] at the zenith, sky_color[i]
+ * at sky_angle[i-1], increasing, in (0, pi]); ground colours by angle from the nadir (ground_color[0]
+ * at the nadir, ground_angle increasing, in (0, pi/2]). sky_count 0 = no gradient; ground_count 0 =
+ * the sky continues below the horizon. Colours are linear RGB. */
+typedef struct sy_gradient {
+    /** @{ used entries of the sky and ground arrays */
+    uint32_t sky_count, ground_count; /** @} */
+    float sky_color[SY_GRADIENT_MAX][3]; /**< linear RGB sky colours */
+    float sky_angle[SY_GRADIENT_MAX]; /**< sky angles from the zenith */
+    float ground_color[SY_GRADIENT_MAX][3]; /**< linear RGB ground colours */
+    float ground_angle[SY_GRADIENT_MAX]; /**< ground angles from the nadir */
+} sy_gradient;
+
+/** Field numbers of a background (the world). */
+enum sy_background_field {
+    SY_BACKGROUND_NAME = 0,
+    SY_BACKGROUND_COLOR = 1,       /**< float[4] linear RGBA, premultiplied; alpha 0 = transparent */
+    SY_BACKGROUND_ENVIRONMENT = 2, /**< sy_texture (equirectangular), {0} = none: a light */
+    SY_BACKGROUND_INTENSITY = 3,   /**< float multiplier for the environment */
+    SY_BACKGROUND_ENVIRONMENT_VISIBLE = 4, /**< uint32: 1 (default) = camera rays see the environment */
+    SY_BACKGROUND_GRADIENT = 5,    /**< sy_gradient: shown where nothing is hit (unless the environment is) */
+    SY_BACKGROUND_DEFAULT_LIGHTING = 6, /**< uint32: 1 (default) = studio light when the scene brings none */
+    SY_BACKGROUND_FIELD_COUNT = 7
+};
+
+/** Field values of a background (the world); see the field enum. */
+typedef struct sy_background_data {
+    char *name; /**< name (copied; may be NULL) */
+    float color[4]; /**< background colour, linear RGBA premultiplied */
+    sy_texture environment; /**< equirectangular environment map ({0}: none) */
+    float intensity; /**< environment multiplier */
+    uint32_t environment_visible; /**< 1 = camera rays see the environment */
+    sy_gradient gradient; /**< X3D sky / ground gradient */
+    uint32_t default_lighting; /**< 1 = studio light when the scene brings none */
+} sy_background_data;
+
+/* ---------------------------------------------------------------- attachments */
+/** Value types of an attachment. */
+typedef enum sy_attachment_kind {
+    SY_ATTACH_INT = 1,
+    SY_ATTACH_FLOAT = 2,
+    SY_ATTACH_VEC4 = 3,
+    SY_ATTACH_STRING = 4,
+    SY_ATTACH_BLOB = 5,
+} sy_attachment_kind;
+
+/** A named, typed value on any object (back-end specific extensions). Mediators that understand
+ * a key use it; others ignore it. */
+typedef struct sy_attachment {
+    char *key; /**< key (copied) */
+    uint32_t kind; /**< sy_attachment_kind */
+    union {
+        int64_t i;
+        double f;
+        float v[4];
+        char *s;
+        sy_blob *blob;
+    } value; /**< the value, by kind */
+} sy_attachment;
+
+
+/** Default field values of a type (glTF defaults): const sy_node_data* etc. Static storage. */
+const void *sy_object_defaults(sy_object_type t);
+
+/** Create an object with default field values (name copied, may be NULL). */
+sy_result sy_node_create(sy_scene *s, const char *name, sy_node *out, sy_error *err);
+/** Creates a mesh (as sy_node_create). */
+sy_result sy_mesh_create(sy_scene *s, const char *name, sy_mesh *out, sy_error *err);
+/** Creates a material (as sy_node_create). */
+sy_result sy_material_create(sy_scene *s, const char *name, sy_material *out, sy_error *err);
+/** Creates a texture (as sy_node_create). */
+sy_result sy_texture_create(sy_scene *s, const char *name, sy_texture *out, sy_error *err);
+/** Creates a light (as sy_node_create). */
+sy_result sy_light_create(sy_scene *s, const char *name, sy_light *out, sy_error *err);
+/** Creates a camera (as sy_node_create). */
+sy_result sy_camera_create(sy_scene *s, const char *name, sy_camera *out, sy_error *err);
+/** Creates a background (as sy_node_create). */
+sy_result sy_background_create(sy_scene *s, const char *name, sy_background *out, sy_error *err);
+/** Generic form: *id_out receives the new handle id. */
+sy_result sy_object_create(sy_scene *s, sy_object_type t, const char *name, uint32_t *id_out, sy_error *err);
+
+/** Destroys the object. References to it elsewhere (a node's mesh, a child list) are NOT removed:
+ * readers treat a stale reference as absent. */
+sy_result sy_object_destroy(sy_scene *s, sy_object_type t, uint32_t id, sy_error *err);
+
+/** true when id names a live object of type t. */
+bool sy_object_is_valid(const sy_scene *s, sy_object_type t, uint32_t id);
+/** Borrowed pointer to the data struct (sy_node_data* for SY_TYPE_NODE, ...) or NULL if stale. */
+const void *sy_object_get(const sy_scene *s, sy_object_type t, uint32_t id);
+/** Iteration over live objects of a type in slot order: start with prev_id 0; returns 0 at the end. */
+uint32_t sy_scene_next(const sy_scene *s, sy_object_type t, uint32_t prev_id);
+/** Number of live objects of a type. */
+uint32_t sy_scene_count(const sy_scene *s, sy_object_type t);
+
+/** Generic setter: value points to the field's type as listed in the field enums (for strings a
+ * `const char *`, for blob fields a `sy_blob *` (retained, may be NULL), for SY_MESH_PRIMITIVES a
+ * `sy_primitive_list`). Validates the value; marks the field dirty when it differs. */
+sy_result sy_object_set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32_t field, const void *value,
+                              sy_error *err);
+
+/** Typed setters (thin wrappers over sy_object_set_field). */
+sy_result sy_node_set_trs(sy_scene *s, sy_node n, const float t[3], const float r[4], const float sc[3], sy_error *err);
+/** Sets the local transform as a matrix (mode SY_TRANSFORM_MATRIX). */
+sy_result sy_node_set_matrix(sy_scene *s, sy_node n, const sy_mat4 *m, sy_error *err);
+/** Replaces the child list. Refuses stale children and cycles (a node below itself). */
+sy_result sy_node_set_children(sy_scene *s, sy_node n, const sy_node *children, uint32_t count, sy_error *err);
+/** Appends a child (same checks as sy_node_set_children). */
+sy_result sy_node_add_child(sy_scene *s, sy_node parent, sy_node child, sy_error *err);
+/** Instances a mesh on the node ({0}: none). */
+sy_result sy_node_set_mesh(sy_scene *s, sy_node n, sy_mesh m, sy_error *err);
+/** Attaches a light to the node ({0}: none). */
+sy_result sy_node_set_light(sy_scene *s, sy_node n, sy_light l, sy_error *err);
+/** Attaches a camera to the node ({0}: none). */
+sy_result sy_node_set_camera(sy_scene *s, sy_node n, sy_camera c, sy_error *err);
+/** Sets the node's sy_node_flags. */
+sy_result sy_node_set_flags(sy_scene *s, sy_node n, uint32_t flags, sy_error *err);
+/** Retains every blob; validates sizes and index ranges of every primitive. */
+sy_result sy_mesh_set_primitives(sy_scene *s, sy_mesh m, const sy_primitive *prims, uint32_t count, sy_error *err);
+/** Sets every field of the struct (name included); only fields that differ are marked dirty. */
+sy_result sy_material_set(sy_scene *s, sy_material m, const sy_material_data *d, sy_error *err);
+/** Sets every field of a light (as sy_material_set). */
+sy_result sy_light_set(sy_scene *s, sy_light l, const sy_light_data *d, sy_error *err);
+/** Sets every field of a camera (as sy_material_set). */
+sy_result sy_camera_set(sy_scene *s, sy_camera c, const sy_camera_data *d, sy_error *err);
+/** Sets every field of a background (as sy_material_set). */
+sy_result sy_background_set(sy_scene *s, sy_background b, const sy_background_data *d, sy_error *err);
+/** Validates that the blob holds width*height*channels elements of the format. Retains pixels. */
+sy_result sy_texture_set_image(sy_scene *s, sy_texture t, const sy_image_info *info, sy_blob *pixels, sy_error *err);
+/** Sets the texture's sampler. */
+sy_result sy_texture_set_sampler(sy_scene *s, sy_texture t, const sy_sampler *smp, sy_error *err);
+
+/** Typed getters: borrowed, NULL for a stale handle. */
+const sy_node_data *sy_node_get(const sy_scene *s, sy_node n);
+/** Borrowed mesh data, NULL for a stale handle. */
+const sy_mesh_data *sy_mesh_get(const sy_scene *s, sy_mesh m);
+const sy_material_data *sy_material_get(const sy_scene *s, sy_material m); /**< {0}: defaults */
+/** Borrowed texture data, NULL for a stale handle. */
+const sy_texture_data *sy_texture_get(const sy_scene *s, sy_texture t);
+/** Borrowed light data, NULL for a stale handle. */
+const sy_light_data *sy_light_get(const sy_scene *s, sy_light l);
+/** Borrowed camera data, NULL for a stale handle. */
+const sy_camera_data *sy_camera_get(const sy_scene *s, sy_camera c);
+/** Borrowed background data, NULL for a stale handle. */
+const sy_background_data *sy_background_get(const sy_scene *s, sy_background b);
+
+/** Child ids of a node data struct (borrowed from the children blob); count may be 0. */
+const uint32_t *sy_node_children(const sy_node_data *d, uint32_t *count_out);
+
+/** Attachments. set replaces an attachment with the same key (key and strings copied, blob
+ * retained); remove returns SY_ERR_NOT_FOUND when absent. get returns a borrowed array. */
+sy_result sy_object_set_attachment(sy_scene *s, sy_object_type t, uint32_t id, const sy_attachment *a,
+                                   sy_error *err);
+/** Removes the attachment named key; SY_ERR_NOT_FOUND when absent. */
+sy_result sy_object_remove_attachment(sy_scene *s, sy_object_type t, uint32_t id, const char *key, sy_error *err);
+/** The object's attachments (borrowed array of *count_out entries). */
+const sy_attachment *sy_object_attachments(const sy_scene *s, sy_object_type t, uint32_t id, uint32_t *count_out);
+/** The attachment named key, or NULL. */
+const sy_attachment *sy_object_find_attachment(const sy_scene *s, sy_object_type t, uint32_t id, const char *key);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_OBJECTS_H */
