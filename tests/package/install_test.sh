@@ -31,6 +31,9 @@ for f in include/switchyard/sy_scene.h include/switchyard/sy_viewport.h include/
     [ -e "$P/$f" ] || fail "not installed: $f"
 done
 [ -e "$P/include/switchyard/sy_gltf_shim.h" ] && fail "an internal header (sy_gltf_shim.h) was installed"
+for h in "$P"/include/switchyard/*_internal.h; do
+    [ -e "$h" ] && fail "a loader's internal header ($(basename "$h")) was installed"
+done
 "$P/bin/sy" --version >"$TMP/version.out" 2>&1 || fail "installed sy --version: $(cat "$TMP/version.out")"
 grep -q '^sy ' "$TMP/version.out" || fail "installed sy --version printed: $(cat "$TMP/version.out")"
 
@@ -113,6 +116,7 @@ for h in "$P"/include/switchyard/sy_*.h; do # C++ programs link the C functions:
 done
 grep -q '#include "sy_fields.h"' "$P/include/switchyard/switchyard.h" && fail "the umbrella names core's internal sy_fields.h"
 [ -e "$P/include/switchyard/sy_fields.h" ] && fail "an internal header (sy_fields.h) was installed"
+grep -q '_internal\.h"' "$P/include/switchyard/switchyard.h" && fail "the umbrella names a loader's internal header"
 
 # 4. no GL in a Whitted-only program
 for exe in "$TMP/cmake/render_gltf" "$TMP/pc_render_plain" "$TMP/pc_render_--static"; do

@@ -1,0 +1,199 @@
+/* sy_x3d_internal.h — internal to the X3D loader (not installed): the loader's state and the calls
+ * between its modules. The modules, bottom-up (no module calls one above it; core_layers checks):
+ *   sy_x3d_fields.c      warnings, created objects and the element cache; field values; DEF / USE
+ *   sy_x3d_url.c         url fields: MFString, joining, confinement to the model's folder
+ *   sy_x3d_appearance.c  Appearance -> sy_material (textures, the material nodes)
+ *   sy_x3d_polygons.c    coordinate-based geometry -> triangle corners -> sy_primitive
+ *   sy_x3d_geometry.c    one geometry node -> sy_primitive (primitives, points, lines, Text)
+ *   sy_x3d_lights.c      lights, viewpoints (and the public camera calls), Background
+ *   sy_x3d_nodes.c       the walk: files and Inline, grouping nodes, Transform, Shape
+ *   sy_x3d.c             the public entry points (sy_x3d.h)
+ * Every function here starts with x3d_ (types and constants never leave these files). */
+#ifndef SY_X3D_INTERNAL_H
+#define SY_X3D_INTERNAL_H
+
+#include "sy_budget.h"
+#include "sy_x3d.h"
+
+#include <libxml/hash.h>
+#include <libxml/tree.h>
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define PI_F 3.14159265358979323846f
+
+/* >>state ------------------------------------------------------------------------------------- */
+
+/* Objects created for one element (keyed by element address + variant in loader.cache). */
+typedef struct created {
+    uint32_t node;     /* sy_node id (grouping nodes, Shape, Inline, lights, viewpoints) */
+    uint32_t mesh;     /* Shape */
+    uint32_t material; /* Appearance variant */
+    uint32_t texture;  /* ImageTexture (0 after a failed decode: no texture) */
+    uint32_t tex_channels;
+    bool done, in_progress;
+} created;
+
+typedef struct xfile {
+    char *path;   /* for messages */
+    char *dir;    /* base directory of relative URLs, "" = none, else ends with '/' */
+    xmlHashTablePtr defs; /* DEF name -> xmlNode* (this file's namespace) */
+    struct xfile *parent; /* the file that Inlines this one (cycle detection) */
+    char *real;   /* realpath, NULL for memory input */
+    uint32_t depth;
+    uint32_t serial; /* distinct per loaded document: element addresses are reused after a free */
+} xfile;
+
+typedef struct pending_light {
+    uint32_t light;
+    float pos[3];
+    float intensity; /* X3D intensity * pi */
+    float a2;        /* quadratic attenuation */
+} pending_light;
+
+typedef struct loader {
+    sy_scene *scene;
+    sy_x3d_options opt;
+    sy_budget budget; /* the load's, Inline files included (sy_budget.h) */
+    sy_x3d_info *info;
+    sy_error err;
+    xmlHashTablePtr cache;      /* "%p:variant" -> created* */
+    xmlHashTablePtr inline_roots; /* realpath -> created* (node of the Inline's scene) */
+    xmlHashTablePtr warned;     /* node types already warned about */
+    struct { uint32_t type, id; } *objs;
+    size_t obj_count, obj_cap;
+    pending_light *lights;
+    size_t light_count, light_cap;
+    sy_bounds bounds; /* world bounds of the shapes (first placement), for light intensities */
+    bool have_background;
+    uint32_t file_serial;
+    size_t max_values;    /* numbers in one attribute: 4 * max_vertices (checked before allocating) */
+    sy_result limit_r;    /* first attribute over max_values (the load fails with it) */
+    sy_error limit_err;
+    const char *model_dir; /* the top-level file's folder: urls must stay inside it (or allowed_roots) */
+} loader;
+
+/* What emit makes per vertex at most (position, normal, texcoord, colour): the budget's unit. */
+#define X3D_VERTEX_BYTES 48u
+
+static inline int x3d_line_of(const xmlNode *el) { return (int)xmlGetLineNo(el); }
+static inline const char *x3d_ename(const xmlNode *el) { return (const char *)el->name; }
+
+/* >>fields (sy_x3d_fields.c) ------------------------------------------------------------------ */
+
+/* A warning into info->warnings (at most SY_X3D_MAX_WARNINGS stored, all counted). */
+void x3d_warn(loader *L, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Creates a scene object and tracks it for the rollback. */
+sy_result x3d_new_object(loader *L, sy_object_type t, const char *name, uint32_t *id);
+/* The created objects of element el (+ variant) of file F; NULL when absent (create = false) or out
+ * of memory. */
+created *x3d_cache_get(loader *L, const xfile *F, const void *el, const char *variant, bool create);
+/* xmlHashFree deallocators: free the payload / leave it. */
+void x3d_free_created(void *payload, const xmlChar *name);
+void x3d_free_none(void *payload, const xmlChar *name);
+
+/* Attribute name of el (xmlFree it), NULL when absent. */
+char *x3d_attr(const xmlNode *el, const char *name);
+bool x3d_attr_present(const xmlNode *el, const char *name);
+size_t x3d_get_floats(loader *L, xfile *F, const xmlNode *el, const char *name, float *out, size_t max);
+float x3d_get_float(loader *L, xfile *F, const xmlNode *el, const char *name, float def);
+bool x3d_get_bool(const xmlNode *el, const char *name, bool def);
+bool x3d_get_float_array(loader *L, xfile *F, const xmlNode *el, const char *name, size_t group, float **out,
+                         size_t *count);
+bool x3d_get_int_array(loader *L, xfile *F, const xmlNode *el, const char *name, int32_t **out, size_t *count);
+/* Whether name is one of the '|'-separated names of list. */
+bool x3d_name_in(const char *name, const char *list);
+/* Clamps n values to [0, 1]. */
+void x3d_clamp01(float *v, int n);
+/* SFRotation (axis, angle) -> unit quaternion (identity for a zero axis). */
+void x3d_axis_angle_quat(const float aa[4], float q[4]);
+
+/* DEF / USE: the DEF'd element of a USE (or el itself; NULL when undefined, warned), DEF registration,
+ * and the child element of an SFNode field (USE resolved, DEFs registered). */
+const xmlNode *x3d_resolve(loader *L, xfile *F, const xmlNode *el);
+void x3d_define(loader *L, xfile *F, const xmlNode *el);
+const xmlNode *x3d_field_child(loader *L, xfile *F, const xmlNode *el, const char *names, const char *field);
+
+/* >>urls (sy_x3d_url.c) ----------------------------------------------------------------------- */
+
+/* Next string of an MFString attribute; false at the end. */
+bool x3d_next_mfstring(const char **p, char *out, size_t cap);
+bool x3d_is_remote(const char *u);
+/* Whether path is a regular file (why: the reason when not; may be NULL with cap 0). */
+bool x3d_regular_file(const char *path, char *why, size_t cap);
+bool x3d_resolve_url(const xfile *F, const char *u, char *out, size_t cap);
+/* SY_OK with out = the real path, SY_ERR_NOT_FOUND (try the next url), or the refusal in L->err. */
+sy_result x3d_confine_url(loader *L, const xfile *F, const xmlNode *el, const char *u, const char *path, char *out,
+                          size_t cap);
+
+/* >>appearance (sy_x3d_appearance.c) ---------------------------------------------------------- */
+
+/* The material of (Appearance app, solid, vertex colours, points / lines); *normal_map: the
+ * geometry needs tangents. */
+sy_result x3d_get_material(loader *L, xfile *F, const xmlNode *app, bool solid, bool vcolors, bool stroke,
+                           uint32_t *out, bool *normal_map);
+
+/* >>polygons (sy_x3d_polygons.c) -------------------------------------------------------------- */
+
+/* Corner-based geometry: every triangle corner refers to a coordinate and (optionally) to a
+ * normal, texcoord and colour; output is non-indexed. */
+typedef struct corners {
+    uint32_t *coord;  /* 3 * tris */
+    int32_t *normal;  /* index or -1 (generated) ; NULL: all generated */
+    int32_t *tc;      /* index; NULL: generated / none */
+    int32_t *color;   /* index; NULL: none */
+    size_t tris;
+} corners;
+
+typedef struct geom_src {
+    float *pts;  size_t npts;
+    float *nrm;  size_t nnrm;
+    float *tc;   size_t ntc;
+    float *col;  size_t ncol; uint32_t col_comps;
+    float crease;
+    bool ccw, generate_tc;
+    float tt[6]; /* texture transform (2x3 affine, X3D t-up space) */
+} geom_src;
+
+
+void x3d_corners_free(corners *c);
+void x3d_geom_src_free(geom_src *g);
+/* A blob that takes data (freed on failure). */
+sy_result x3d_make_blob(loader *L, void *data, size_t bytes, sy_blob **out);
+/* The budget for n vertices of geometry node el: charge = false checks where a generator sizes its
+ * arrays (before it allocates them), charge = true charges once, in emit. */
+sy_result x3d_budget_vertices(loader *L, const char *file, const xmlNode *el, uint64_t n, bool charge);
+/* The corners of g as one non-indexed triangle primitive (new blobs in *prim). */
+sy_result x3d_emit(loader *L, xfile *F, const xmlNode *el, const geom_src *g, corners *c, sy_primitive *prim);
+/* Coordinate / Normal / TextureCoordinate / Color children of a geometry node; false: skip it. */
+bool x3d_read_sources(loader *L, xfile *F, const xmlNode *el, geom_src *g);
+/* The corner builders: *ok false (warned) when the node is skipped. */
+sy_result x3d_build_faceset(loader *L, xfile *F, const xmlNode *el, geom_src *g, corners *c, bool *ok);
+sy_result x3d_build_strip_fan_quad(loader *L, xfile *F, const xmlNode *el, geom_src *g, corners *c, bool *ok);
+sy_result x3d_build_extrusion(loader *L, xfile *F, const xmlNode *el, geom_src *g, corners *c, bool *ok);
+sy_result x3d_build_triset(loader *L, xfile *F, const xmlNode *el, geom_src *g, corners *c, bool indexed, bool *ok);
+
+/* >>geometry (sy_x3d_geometry.c) -------------------------------------------------------------- */
+
+/* The primitive of geometry node el with TextureTransform ttel (may be NULL); *ok false: skipped. */
+sy_result x3d_build_geometry(loader *L, xfile *F, const xmlNode *el, const xmlNode *ttel, sy_primitive *prim,
+                             bool *ok, bool *has_colors, bool *solid);
+
+/* >>lights, viewpoints, background (sy_x3d_lights.c) ------------------------------------------ */
+
+sy_result x3d_visit_light(loader *L, xfile *F, const xmlNode *el, const sy_mat4 *world, sy_node h);
+/* Point and spot light intensities from the scene's bounds (after the walk). */
+void x3d_finish_lights(loader *L);
+sy_result x3d_visit_viewpoint(loader *L, xfile *F, const xmlNode *el, sy_node h);
+sy_result x3d_visit_background(loader *L, xfile *F, const xmlNode *el);
+
+/* >>nodes (sy_x3d_nodes.c) -------------------------------------------------------------------- */
+
+/* Loads one X3D document (the main file: parent NULL; an Inline: at / atF name the Inline element)
+ * and returns the node of its Scene. */
+sy_result x3d_load_file(loader *L, const char *path, const void *mem, size_t mem_size, const char *base_dir,
+                        xfile *parent, sy_node *root_out, const xmlNode *at, xfile *atF);
+
+#endif /* SY_X3D_INTERNAL_H */
