@@ -1,8 +1,14 @@
-# formats/gltf.cmake — the glTF 2.0 loader in sy_formats: a C loader (sy_gltf.c) over a small C++17
-# shim around tinygltf (sy_gltf_shim.cpp, the only C++ in formats/). Included at the end of
-# formats/CMakeLists.txt.
+# formats/gltf.cmake — the glTF 2.0 loader in sy_formats: a C loader (sy_gltf.c and its modules,
+# sy_gltf_internal.h) over a small C++17 shim around tinygltf (sy_gltf_shim.cpp, the only C++ in
+# formats/). Included at the end of formats/CMakeLists.txt.
 target_sources(sy_formats PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf.c
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_errors.c
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_validate.c
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_accessors.c
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_materials.c
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_meshes.c
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_nodes.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_shim.cpp
 )
 # Debian's tinygltf exports TinyGLTF::TinyGLTF; accept the lower-case spelling too.

@@ -1,0 +1,83 @@
+/* sy_gltf_errors.c — the glTF loader's bookkeeping: errors (named after the file and the place),
+ * warnings (stored in sy_gltf_info), the objects it creates (tracked, so that a failed load destroys
+ * them again: rollback) and overflow-checked allocation. Every other module of the loader builds on
+ * this file (sy_gltf_internal.h). */
+#include "sy_gltf_internal.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* >>errors ------------------------------------------------------------------------------------ */
+
+sy_result gltf_fail(loader *L, sy_result code, const char *fmt, ...)
+{
+    char msg[SY_ERROR_MESSAGE_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return sy_error_set(&L->err, code, "%s: %s", L->path, msg);
+}
+
+void gltf_warn(loader *L, const char *fmt, ...)
+{
+    sy_gltf_info *info = L->info;
+    info->warning_count++;
+    if (info->stored_warning_count >= SY_GLTF_MAX_WARNINGS) return;
+    if (!info->warnings) {
+        info->warnings = calloc(SY_GLTF_MAX_WARNINGS, sizeof(char *));
+        if (!info->warnings) return;
+    }
+    char msg[SY_ERROR_MESSAGE_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    size_t n = strlen(msg) + 1;
+    char *s = malloc(n);
+    if (!s) return;
+    memcpy(s, msg, n);
+    info->warnings[info->stored_warning_count++] = s;
+}
+
+/* Adds context to an error that a core call left in L->err. */
+sy_result gltf_context(loader *L, sy_result r, const char *what)
+{
+    sy_error_prefix(&L->err, "%s: %s", L->path, what);
+    return r;
+}
+
+sy_result gltf_track(loader *L, sy_object_type type, uint32_t id)
+{
+    if (L->obj_count == L->obj_cap) {
+        size_t cap = L->obj_cap ? L->obj_cap * 2 : 64, bytes;
+        if (!sy_size_mul(cap, sizeof(created_obj), &bytes)) return gltf_fail(L, SY_ERR_OUT_OF_MEMORY, "too many objects");
+        created_obj *n = realloc(L->objs, bytes);
+        if (!n) return gltf_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory");
+        L->objs = n;
+        L->obj_cap = cap;
+    }
+    L->objs[L->obj_count++] = (created_obj){(uint32_t)type, id};
+    return SY_OK;
+}
+
+void gltf_rollback(loader *L)
+{
+    for (size_t i = L->obj_count; i-- > 0;)
+        sy_object_destroy(L->scene, (sy_object_type)L->objs[i].type, L->objs[i].id, NULL);
+    L->obj_count = 0;
+}
+
+void *gltf_xcalloc(loader *L, size_t n, size_t size, sy_result *r)
+{
+    size_t bytes;
+    if (!sy_size_mul(n, size, &bytes)) {
+        *r = gltf_fail(L, SY_ERR_LIMIT, "allocation of %zu x %zu bytes overflows", n, size);
+        return NULL;
+    }
+    void *p = calloc(bytes ? bytes : 1, 1);
+    if (!p) *r = gltf_fail(L, SY_ERR_OUT_OF_MEMORY, "cannot allocate %zu bytes", bytes);
+    return p;
+}

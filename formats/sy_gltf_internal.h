@@ -1,0 +1,143 @@
+/* sy_gltf_internal.h — internal to the glTF loader (not installed): the loader's state and the calls
+ * between its modules. The modules, bottom-up (no module calls one above it; core_layers checks):
+ *   sy_gltf_errors.c     errors, warnings, created objects (rollback), checked allocation
+ *   sy_gltf_validate.c   GLB container, JSON depth, the one validation pass over the document
+ *   sy_gltf_accessors.c  reading accessors (components, strides, sparse substitution)
+ *   sy_gltf_materials.c  materials, textures, samplers
+ *   sy_gltf_meshes.c     the meshes' budget, primitives (triangles, points, lines) -> sy_meshes
+ *   sy_gltf_nodes.c      cameras, lights, the node graph of one scene, instancing
+ *   sy_gltf.c            the public entry points (sy_gltf.h): options, the order of the load
+ * Every function here starts with gltf_ (types and constants never leave these files). */
+#ifndef SY_GLTF_INTERNAL_H
+#define SY_GLTF_INTERNAL_H
+
+#include "sy_budget.h"
+#include "sy_gltf.h"
+#include "sy_gltf_shim.h"
+
+#include <math.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define GLTF_POINTS 0
+#define GLTF_LINES 1
+#define GLTF_LINE_LOOP 2
+#define GLTF_LINE_STRIP 3
+#define GLTF_TRIANGLES 4
+#define GLTF_TRIANGLE_STRIP 5
+#define GLTF_TRIANGLE_FAN 6
+
+#define CT_BYTE 5120
+#define CT_UBYTE 5121
+#define CT_SHORT 5122
+#define CT_USHORT 5123
+#define CT_UINT 5125
+#define CT_FLOAT 5126
+
+typedef struct created_obj {
+    uint32_t type, id;
+} created_obj;
+
+typedef struct loader {
+    const char *path;
+    sy_scene *scene;
+    sy_gltf_options opt;
+    const sy_gltf_doc *doc;
+    sy_error err; /* local; copied to the caller's at the end */
+    sy_gltf_info *info;
+    created_obj *objs;
+    size_t obj_count, obj_cap;
+    /* glTF index -> created handle (0 = not created) */
+    sy_material *materials;
+    sy_mesh *meshes;
+    sy_camera *cameras;
+    sy_light *lights;
+    sy_node *nodes;
+    sy_texture *textures; /* 2 per glTF texture: colour, data */
+    sy_blob **image_blobs;
+    int32_t *parent;      /* per glTF node: parent index, -1 none */
+    uint8_t *reached;     /* per glTF node: part of the loaded scene */
+    uint32_t *mesh_triangles;
+    sy_budget budget; /* the file's (sy_budget.h) */
+    bool warned_skin, warned_morph, warned_anim;
+} loader;
+
+/* Extensions the loader supports (NULL-terminated; sy_gltf_supported_extensions returns it). */
+extern const char *const gltf_supported[];
+
+/* >>errors (sy_gltf_errors.c) ----------------------------------------------------------------- */
+
+/* Sets L->err to "<path>: <message>" and returns code. */
+sy_result gltf_fail(loader *L, sy_result code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* A warning into info->warnings (at most SY_GLTF_MAX_WARNINGS stored, all counted). */
+void gltf_warn(loader *L, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Adds context to an error that a core call left in L->err. */
+sy_result gltf_context(loader *L, sy_result r, const char *what);
+/* Records a created object for the rollback. */
+sy_result gltf_track(loader *L, sy_object_type type, uint32_t id);
+/* Destroys every tracked object, newest first. */
+void gltf_rollback(loader *L);
+/* calloc of n x size bytes, overflow-checked; NULL with *r set (and L->err) on failure. */
+void *gltf_xcalloc(loader *L, size_t n, size_t size, sy_result *r);
+
+static inline bool gltf_to_float(double d, float *out)
+{
+    if (!isfinite(d) || d > 3.4e38 || d < -3.4e38) return false;
+    *out = (float)d;
+    return true;
+}
+
+static inline const char *gltf_nonempty(const char *s) { return (s && s[0]) ? s : NULL; }
+
+/* >>validation (sy_gltf_validate.c) ----------------------------------------------------------- */
+
+/* The GLB header and chunk table of b (size bytes); *json / *json_len: the JSON chunk. */
+sy_result gltf_check_glb(loader *L, const uint8_t *b, size_t size, const uint8_t **json, size_t *json_len);
+/* Refuses JSON nested deeper than opt.max_json_depth. */
+sy_result gltf_check_json_depth(loader *L, const uint8_t *s, size_t n);
+/* The one validation pass over L->doc (fills L->parent). */
+sy_result gltf_validate_doc(loader *L);
+/* Bytes of a component type (0: not a glTF type), of one element (matrix columns 4-byte aligned),
+ * and between elements. */
+size_t gltf_component_size(int32_t ct);
+size_t gltf_element_size(const sy_gltf_shim_accessor *a);
+size_t gltf_accessor_stride(const sy_gltf_doc *d, const sy_gltf_shim_accessor *a);
+
+/* >>accessors (sy_gltf_accessors.c) ----------------------------------------------------------- */
+
+/* Accessor ai as out_comps floats per element (missing components 0, a 4th 1); *out malloc()ed. */
+sy_result gltf_read_floats(loader *L, size_t ai, size_t out_comps, float **out);
+/* Element i of accessor ai as out_comps floats; allocates nothing. */
+sy_result gltf_read_element(loader *L, size_t ai, size_t i, size_t out_comps, float *dst);
+/* Accessor ai as unsigned integers; *out malloc()ed. */
+sy_result gltf_read_uints(loader *L, size_t ai, uint32_t **out);
+
+/* >>materials (sy_gltf_materials.c) ----------------------------------------------------------- */
+
+/* Material i (and the textures it uses) into L->materials[i]. */
+sy_result gltf_create_material(loader *L, size_t i);
+
+/* >>meshes (sy_gltf_meshes.c) ----------------------------------------------------------------- */
+
+/* The budget for every primitive of every mesh, before any is decoded. */
+sy_result gltf_charge_meshes(loader *L);
+/* Mesh m into L->meshes[m] (L->mesh_triangles[m]: its triangles). */
+sy_result gltf_create_mesh(loader *L, size_t m);
+
+/* >>cameras, lights, nodes (sy_gltf_nodes.c) -------------------------------------------------- */
+
+sy_result gltf_create_camera(loader *L, size_t i);
+sy_result gltf_create_light(loader *L, size_t i);
+/* The nodes reachable from roots and a new root node named root_name (L->info->root, camera nodes). */
+sy_result gltf_create_nodes(loader *L, const int32_t *roots, size_t root_count, const char *root_name);
+
+#endif /* SY_GLTF_INTERNAL_H */

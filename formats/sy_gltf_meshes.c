@@ -1,0 +1,352 @@
+/* sy_gltf_meshes.c — glTF meshes into sy_meshes: the file's budget for every primitive charged
+ * before any is decoded, vertex attributes, indices (range-checked; strips and fans converted),
+ * points and lines, flat normals and tangents where the file has none. */
+#include "sy_gltf_internal.h"
+
+#include "sy_mesh_util.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* >>meshes ------------------------------------------------------------------------------------ */
+
+/* Takes ownership of data (freed on failure too). */
+static sy_result make_blob(loader *L, void *data, size_t bytes, sy_blob **out)
+{
+    sy_result r = sy_blob_create_take(data, bytes, out, &L->err);
+    if (r) {
+        free(data);
+        return gltf_context(L, r, "blob");
+    }
+    return SY_OK;
+}
+
+static const char *mode_name(int32_t mode)
+{
+    static const char *const names[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+    return (mode >= 0 && mode <= GLTF_LINE_STRIP) ? names[mode] : "?";
+}
+
+/* Reads an attribute into a blob. comps: output components. */
+static sy_result read_attribute(loader *L, int32_t ai, size_t vcount, size_t comps, size_t m, size_t p,
+                                const char *name, sy_blob **out)
+{
+    *out = NULL;
+    if (ai < 0) return SY_OK;
+    const sy_gltf_shim_accessor *a = &L->doc->accessors[ai];
+    bool type_ok = !a->is_matrix && ((size_t)a->components == comps ||
+                                     (!strcmp(name, "COLOR_0") && a->components == 3));
+    if (!type_ok)
+        return gltf_fail(L, SY_ERR_PARSE, "meshes[%zu].primitives[%zu]: %s accessor %d has %d components, expected %zu", m, p, name,
+                         (int)ai, (int)a->components, comps);
+    if (a->count != vcount)
+        return gltf_fail(L, SY_ERR_PARSE, "meshes[%zu].primitives[%zu]: %s accessor %d count %zu differs from POSITION count %zu", m,
+                         p, name, (int)ai, a->count, vcount);
+    float *f;
+    sy_result r = gltf_read_floats(L, (size_t)ai, comps, &f);
+    if (r) return r;
+    size_t n = vcount * comps; /* read_floats checked the product */
+    bool is_pos = !strcmp(name, "POSITION");
+    bool fixed = false;
+    for (size_t k = 0; k < n; k++) {
+        if (isfinite(f[k])) continue;
+        if (is_pos) {
+            free(f);
+            return gltf_fail(L, SY_ERR_PARSE, "accessors[%d] (POSITION of meshes[%zu].primitives[%zu]): non-finite value in vertex %zu",
+                             (int)ai, m, p, k / comps);
+        }
+        f[k] = 0.0f;
+        fixed = true;
+    }
+    if (fixed) gltf_warn(L, "accessors[%d] (%s of meshes[%zu].primitives[%zu]): non-finite values replaced by 0", (int)ai, name, m, p);
+    return make_blob(L, f, n * sizeof(float), out);
+}
+
+static uint32_t add_sat(uint32_t a, uint32_t b) { return a > UINT32_MAX - b ? UINT32_MAX : a + b; }
+
+static sy_result read_all_attributes(loader *L, const sy_gltf_shim_primitive *pr, size_t vcount, size_t m, size_t p,
+                                     sy_primitive *out)
+{
+    sy_result r;
+    if ((r = read_attribute(L, pr->position, vcount, 3, m, p, "POSITION", &out->positions)) ||
+        (r = read_attribute(L, pr->normal, vcount, 3, m, p, "NORMAL", &out->normals)) ||
+        (r = read_attribute(L, pr->tangent, vcount, 4, m, p, "TANGENT", &out->tangents)) ||
+        (r = read_attribute(L, pr->texcoord0, vcount, 2, m, p, "TEXCOORD_0", &out->texcoords0)) ||
+        (r = read_attribute(L, pr->texcoord1, vcount, 2, m, p, "TEXCOORD_1", &out->texcoords1)) ||
+        (r = read_attribute(L, pr->color0, vcount, 4, m, p, "COLOR_0", &out->colors)))
+        sy_primitive_release(out);
+    return r;
+}
+
+/* POINTS, LINES, LINE_LOOP, LINE_STRIP: point and line primitives (loops and strips expanded to
+ * index pairs). Takes ownership of idx (icount indices, or NULL: the vertices in order). Strokes
+ * are drawn as tubes and balls with their own normals (sy_scene.h), so no flat normals are made. */
+static sy_result convert_stroke(loader *L, size_t m, size_t p, sy_primitive *out, bool *used, uint32_t *idx,
+                                size_t icount, size_t vcount)
+{
+    const sy_gltf_shim_primitive *pr = &L->doc->meshes[m].primitives[p];
+    sy_result r = SY_OK;
+    uint32_t *pairs = NULL;
+    size_t elements = 0;
+    if (pr->mode == GLTF_POINTS) {
+        elements = icount;
+        pairs = idx; /* NULL: non-indexed points */
+        idx = NULL;
+    } else if (pr->mode == GLTF_LINES) {
+        elements = icount / 2;
+        if (icount % 2)
+            gltf_warn(L, "meshes[%zu].primitives[%zu]: LINES with %zu %s (odd); the last one ignored", m, p, icount,
+                      idx ? "indices" : "vertices");
+        if (idx) {
+            pairs = idx;
+            idx = NULL;
+        } else if (icount % 2 && elements) {
+            if (!(pairs = gltf_xcalloc(L, elements * 2, sizeof(uint32_t), &r))) return r;
+            for (size_t k = 0; k < elements * 2; k++) pairs[k] = (uint32_t)k;
+        }
+    } else { /* LINE_LOOP closes back to the first vertex; LINE_STRIP does not */
+        bool loop = pr->mode == GLTF_LINE_LOOP;
+        elements = icount >= 2 ? icount - 1 + (loop && icount >= 3) : 0;
+        if (elements > L->opt.max_indices / 2) {
+            free(idx);
+            return gltf_fail(L, SY_ERR_LIMIT, "meshes[%zu].primitives[%zu]: %zu line segments exceed the index limit of %zu", m,
+                             p, elements, L->opt.max_indices);
+        }
+        if (elements && !(pairs = gltf_xcalloc(L, elements * 2, sizeof(uint32_t), &r))) {
+            free(idx);
+            return r;
+        }
+        for (size_t k = 0; k < elements; k++) {
+            size_t a = k, b = (k + 1) % icount;
+            pairs[2 * k] = idx ? idx[a] : (uint32_t)a;
+            pairs[2 * k + 1] = idx ? idx[b] : (uint32_t)b;
+        }
+        free(idx);
+        idx = NULL;
+    }
+    free(idx);
+    if (elements == 0) {
+        free(pairs);
+        gltf_warn(L, "meshes[%zu].primitives[%zu]: %s without a complete %s; skipped", m, p, mode_name(pr->mode),
+                  pr->mode == GLTF_POINTS ? "point" : "segment");
+        L->info->counts.skipped_primitives++;
+        return SY_OK;
+    }
+    if (elements > UINT32_MAX / 2) {
+        free(pairs);
+        return gltf_fail(L, SY_ERR_LIMIT, "meshes[%zu].primitives[%zu]: too many elements", m, p);
+    }
+    size_t per = pr->mode == GLTF_POINTS ? 1 : 2;
+    if (pairs && (r = make_blob(L, pairs, elements * per * sizeof(uint32_t), &out->indices))) return r;
+    if ((r = read_all_attributes(L, pr, vcount, m, p, out))) return r;
+    out->topology = per == 1 ? SY_TOPOLOGY_POINTS : SY_TOPOLOGY_LINES;
+    out->material = pr->material >= 0 ? L->materials[pr->material] : (sy_material){0};
+    if (per == 1) L->info->counts.points = add_sat(L->info->counts.points, (uint32_t)elements);
+    else L->info->counts.line_segments = add_sat(L->info->counts.line_segments, (uint32_t)elements);
+    *used = true;
+    return SY_OK;
+}
+
+/* The file's budget for every primitive of every mesh, before any is decoded: the vertex attributes
+ * as the scene stores them and the indices (one per vertex without an index accessor), for each
+ * primitive even where primitives share accessors (the back-ends copy per primitive). Accessor
+ * indices were validated (validate_doc). */
+sy_result gltf_charge_meshes(loader *L)
+{
+    const sy_gltf_doc *d = L->doc;
+    sy_result r = SY_OK;
+    for (size_t m = 0; m < d->mesh_count && r == SY_OK; m++)
+        for (size_t p = 0; p < d->meshes[m].primitive_count && r == SY_OK; p++) {
+            const sy_gltf_shim_primitive *pr = &d->meshes[m].primitives[p];
+            if (pr->position < 0) continue;
+            size_t vcount = d->accessors[pr->position].count;
+            size_t ic = pr->indices >= 0 ? d->accessors[pr->indices].count : vcount;
+            uint64_t per_vertex = 12u + (pr->normal >= 0 ? 12u : 0u) + (pr->tangent >= 0 ? 16u : 0u) +
+                                  (pr->texcoord0 >= 0 ? 8u : 0u) + (pr->texcoord1 >= 0 ? 8u : 0u) +
+                                  (pr->color0 >= 0 ? 16u : 0u);
+            if ((r = sy_budget_charge(&L->budget, vcount, per_vertex, &L->err, "meshes[%zu].primitives[%zu]: %zu vertices", m, p, vcount)) == SY_OK)
+                r = sy_budget_charge(&L->budget, ic, 4u, &L->err, "meshes[%zu].primitives[%zu]: %zu indices", m, p, ic);
+        }
+    return r;
+}
+
+static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *out, bool *used, uint32_t *tris)
+{
+    const sy_gltf_doc *d = L->doc;
+    const sy_gltf_shim_primitive *pr = &d->meshes[m].primitives[p];
+    sy_result r;
+    *used = false;
+    *tris = 0;
+    memset(out, 0, sizeof *out);
+    if (pr->has_targets && !L->warned_morph) {
+        L->warned_morph = true;
+        gltf_warn(L, "meshes[%zu].primitives[%zu]: morph targets ignored", m, p);
+    }
+    if (pr->position < 0) {
+        gltf_warn(L, "meshes[%zu].primitives[%zu]: no POSITION attribute; skipped", m, p);
+        L->info->counts.skipped_primitives++;
+        return SY_OK;
+    }
+    size_t vcount = d->accessors[pr->position].count;
+    if (vcount > L->opt.max_vertices || vcount > UINT32_MAX)
+        return gltf_fail(L, SY_ERR_LIMIT, "meshes[%zu].primitives[%zu]: %zu vertices exceed the limit of %zu", m, p, vcount,
+                         L->opt.max_vertices);
+
+    /* index list (before conversion) */
+    uint32_t *idx = NULL;
+    size_t icount = vcount;
+    if (pr->indices >= 0) {
+        const sy_gltf_shim_accessor *ia = &d->accessors[pr->indices];
+        if (ia->components != 1 || ia->is_matrix ||
+            (ia->component_type != CT_UBYTE && ia->component_type != CT_USHORT && ia->component_type != CT_UINT))
+            return gltf_fail(L, SY_ERR_PARSE, "meshes[%zu].primitives[%zu]: indices accessor %d must be SCALAR of unsigned byte, short or int",
+                             m, p, (int)pr->indices);
+        icount = ia->count;
+        if (icount > L->opt.max_indices)
+            return gltf_fail(L, SY_ERR_LIMIT, "meshes[%zu].primitives[%zu]: %zu indices exceed the limit of %zu", m, p, icount,
+                             L->opt.max_indices);
+        if ((r = gltf_read_uints(L, (size_t)pr->indices, &idx))) return r;
+        for (size_t k = 0; k < icount; k++) {
+            if (idx[k] >= vcount) {
+                unsigned bad = (unsigned)idx[k];
+                free(idx);
+                return gltf_fail(L, SY_ERR_PARSE, "meshes[%zu].primitives[%zu]: index %u at position %zu (accessor %d) >= vertex count %zu",
+                                 m, p, bad, k, (int)pr->indices, vcount);
+            }
+        }
+    }
+
+    if (pr->mode < GLTF_TRIANGLES) return convert_stroke(L, m, p, out, used, idx, icount, vcount);
+
+    /* triangle list */
+    uint32_t *tri = NULL;
+    size_t tcount = 0; /* triangles */
+    if (pr->mode == GLTF_TRIANGLES) {
+        tcount = icount / 3;
+        if (icount % 3)
+            gltf_warn(L, "meshes[%zu].primitives[%zu]: %zu %s is not a multiple of 3; the last %zu ignored", m, p, icount,
+                      idx ? "indices" : "vertices", icount % 3);
+        if (idx) {
+            tri = idx;
+            idx = NULL;
+        } else if (icount % 3) {
+            tri = gltf_xcalloc(L, tcount * 3, sizeof(uint32_t), &r);
+            if (!tri) return r;
+            for (size_t k = 0; k < tcount * 3; k++) tri[k] = (uint32_t)k;
+        }
+    } else {
+        tcount = icount >= 3 ? icount - 2 : 0;
+        size_t n;
+        if (!sy_size_mul(tcount, 3, &n) || n > L->opt.max_indices) {
+            free(idx);
+            return gltf_fail(L, SY_ERR_LIMIT, "meshes[%zu].primitives[%zu]: %zu triangles after strip/fan conversion exceed the index limit of %zu",
+                             m, p, tcount, L->opt.max_indices);
+        }
+        if (tcount) {
+            tri = gltf_xcalloc(L, n, sizeof(uint32_t), &r);
+            if (!tri) {
+                free(idx);
+                return r;
+            }
+        }
+        for (size_t k = 0; k < tcount; k++) {
+            size_t a, b, c;
+            if (pr->mode == GLTF_TRIANGLE_STRIP) { /* keeps the winding of every other triangle */
+                a = k;
+                b = k + 1 + (k % 2);
+                c = k + 2 - (k % 2);
+            } else { /* fan */
+                a = k + 1;
+                b = k + 2;
+                c = 0;
+            }
+            tri[3 * k] = idx ? idx[a] : (uint32_t)a;
+            tri[3 * k + 1] = idx ? idx[b] : (uint32_t)b;
+            tri[3 * k + 2] = idx ? idx[c] : (uint32_t)c;
+        }
+        free(idx);
+        idx = NULL;
+    }
+    if (tcount == 0) {
+        free(tri);
+        gltf_warn(L, "meshes[%zu].primitives[%zu]: no complete triangle; skipped", m, p);
+        L->info->counts.skipped_primitives++;
+        return SY_OK;
+    }
+    if (tcount > UINT32_MAX / 3) {
+        free(tri);
+        return gltf_fail(L, SY_ERR_LIMIT, "meshes[%zu].primitives[%zu]: too many triangles", m, p);
+    }
+    if (tri && (r = make_blob(L, tri, tcount * 3 * sizeof(uint32_t), &out->indices))) return r;
+
+    if ((r = read_all_attributes(L, pr, vcount, m, p, out))) return r;
+    /* glTF 2.0: without NORMAL the client computes flat normals; a normal map without TANGENT
+     * needs generated tangents (sy_mesh_util: MikkTSpace-style angle-weighted accumulation). */
+    if (!out->normals && (r = sy_prim_make_flat_normals(out, &L->err))) {
+        sy_primitive_release(out);
+        return gltf_fail(L, r, "meshes[%zu].primitives[%zu]: flat normals: %s", m, p, L->err.message);
+    }
+    if (!out->tangents && pr->material >= 0 && d->materials[pr->material].normal_texture.index >= 0) {
+        const sy_gltf_shim_texinfo *nt = &d->materials[pr->material].normal_texture;
+        int32_t tc = nt->transform_texcoord >= 0 ? nt->transform_texcoord : nt->texcoord;
+        if (tc != 1) tc = 0;
+        if (!(tc ? out->texcoords1 : out->texcoords0)) {
+            gltf_warn(L, "meshes[%zu].primitives[%zu]: normal map without TEXCOORD_%d; tangents not generated", m, p, (int)tc);
+        } else if ((r = sy_prim_generate_tangents(out, (uint32_t)tc, &L->err))) {
+            sy_primitive_release(out);
+            return gltf_fail(L, r, "meshes[%zu].primitives[%zu]: tangents: %s", m, p, L->err.message);
+        }
+    }
+    out->material = pr->material >= 0 ? L->materials[pr->material] : (sy_material){0};
+    *used = true;
+    *tris = (uint32_t)tcount;
+    return SY_OK;
+}
+
+sy_result gltf_create_mesh(loader *L, size_t m)
+{
+    const sy_gltf_shim_mesh *mesh = &L->doc->meshes[m];
+    sy_result r = SY_OK;
+    sy_primitive *prims = gltf_xcalloc(L, mesh->primitive_count, sizeof(sy_primitive), &r);
+    if (!prims) return r;
+    uint32_t used_count = 0, triangles = 0;
+    for (size_t p = 0; p < mesh->primitive_count; p++) {
+        bool used;
+        uint32_t t;
+        if ((r = convert_primitive(L, m, p, &prims[used_count], &used, &t))) goto done;
+        if (used) {
+            used_count++;
+            if (triangles > UINT32_MAX - t) {
+                r = gltf_fail(L, SY_ERR_LIMIT, "meshes[%zu]: too many triangles", m);
+                goto done;
+            }
+            triangles += t;
+        }
+    }
+    char where[48];
+    snprintf(where, sizeof where, "meshes[%zu]", m);
+    sy_mesh h;
+    if ((r = sy_mesh_create(L->scene, gltf_nonempty(mesh->name), &h, &L->err))) {
+        r = gltf_context(L, r, where);
+        goto done;
+    }
+    if ((r = gltf_track(L, SY_TYPE_MESH, h.id))) {
+        sy_object_destroy(L->scene, SY_TYPE_MESH, h.id, NULL);
+        goto done;
+    }
+    if (used_count && (r = sy_mesh_set_primitives(L->scene, h, prims, used_count, &L->err))) {
+        r = gltf_context(L, r, where);
+        goto done;
+    }
+    L->meshes[m] = h;
+    L->mesh_triangles[m] = triangles;
+done:
+    for (uint32_t k = 0; k < used_count; k++) sy_primitive_release(&prims[k]);
+    /* a primitive that failed half-way (released itself; harmless) - none when every one was made
+     * and sy_mesh_set_primitives refused them (a position beyond SY_COORD_MAX, say) */
+    if (r && used_count < mesh->primitive_count) sy_primitive_release(&prims[used_count]);
+    free(prims);
+    return r;
+}
