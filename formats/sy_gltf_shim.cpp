@@ -1,5 +1,5 @@
 // sy_gltf_shim.cpp — parses glTF with tinygltf and exposes the result as the plain C structs of
-// sy_gltf_shim.h. Parsing only: all cross-reference and range validation happens in sy_gltf.c.
+// sy_gltf_shim.h. Parsing only: all cross-reference and range validation happens in sy_gltf_validate.c.
 // Every entry point catches every exception; nothing C++ leaks through the C interface.
 #include "sy_gltf_shim.h"
 
@@ -652,7 +652,7 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
     std::string msg = one_line(terr);
     if (msg.empty()) msg = "tinygltf failed without a message";
     // an extension the file requires explains most failures of valid files (a Draco mesh's
-    // accessors have no buffer view): name it (sy_gltf.c refuses the unsupported ones by name
+    // accessors have no buffer view): name it (sy_gltf_validate.c refuses the unsupported ones by name
     // when the parse gets that far)
     for (const std::string &e : model->extensionsRequired)
         if (e == "KHR_draco_mesh_compression" || e.rfind("EXT_meshopt", 0) == 0)

@@ -3,7 +3,7 @@
  * The shim does the parsing only: JSON -> plain C structs, external and data: URI buffers/images
  * loaded, images decoded (stb_image) into 8-bit pixels. It does NOT validate cross references or
  * accessor ranges: every index in these structs is untrusted and must be range-checked by the
- * caller (formats/sy_gltf.c does, in one validation pass, before it creates anything).
+ * caller (formats/sy_gltf_validate.c does, in one pass, before it creates anything).
  *
  * The GLB container must be validated by the caller before sy_gltf_shim_parse is called with
  * binary = true (tinygltf 2.7 does not check every chunk bound itself).
