@@ -37,6 +37,20 @@ typedef struct sy_bounds {
     float max[3]; /**< empty bounds have min > max (see sy_bounds_empty) */
 } sy_bounds;
 
+/** @{ 3-vectors as float[3]: difference and cross product (out may alias an input), dot
+ * product; the one copy of each for core, mediators, formats and apps (back-ends keep their own). */
+static inline void sy_vec3_sub(const float a[3], const float b[3], float out[3])
+{
+    out[0] = a[0] - b[0], out[1] = a[1] - b[1], out[2] = a[2] - b[2];
+}
+static inline void sy_vec3_cross(const float a[3], const float b[3], float out[3])
+{
+    float x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
+    out[0] = x, out[1] = y, out[2] = z;
+}
+static inline float sy_vec3_dot(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+/** @} */
+
 /** The identity matrix. */
 sy_mat4 sy_mat4_identity(void);
 sy_mat4 sy_mat4_mul(const sy_mat4 *a, const sy_mat4 *b); /**< a * b */

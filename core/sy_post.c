@@ -11,6 +11,13 @@ float sy_srgb_encode(float linear)
     return 1.055f * powf(linear, 1.0f / 2.4f) - 0.055f;
 }
 
+uint8_t sy_unorm8(float v)
+{
+    if (!(v > 0.0f)) return 0; /* also NaN */
+    if (v >= 1.0f) return 255;
+    return (uint8_t)(v * 255.0f + 0.5f);
+}
+
 float sy_srgb_decode(float encoded)
 {
     if (!(encoded > 0.0f)) return 0.0f;

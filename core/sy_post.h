@@ -25,6 +25,9 @@ typedef enum sy_tonemap {
 float sy_srgb_encode(float linear);
 /** Exact inverse (EOTF): encoded [0, 1] -> linear [0, 1]; input is clamped, NaN gives 0. */
 float sy_srgb_decode(float encoded);
+/** One channel in [0, 1] to 8 bits, rounded to nearest: the one float-to-8-bit conversion of
+ * the library (PNG, JPEG, the window, the web stream). Clamps; NaN gives 0. */
+uint8_t sy_unorm8(float v);
 /** Applies the operator to one linear channel value; returns [0, 1]. Negative and NaN give 0,
  * +INFINITY gives 1. An unknown operator behaves as CLAMP. */
 float sy_tonemap_apply(sy_tonemap op, float linear);

@@ -86,10 +86,7 @@ sy_result sy_jpeg_write(const char *path, int width, int height, const float *rg
     size_t n = (size_t)width * (size_t)height;
     uint8_t *px = malloc(n * 4);
     if (!px) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory (%dx%d)", path, width, height);
-    for (size_t i = 0; i < n; ++i) { /* composited over black: the premultiplied colour, opaque */
-        const float c[4] = {rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2], 1.0f};
-        sy_png_encode_pixel(c, opts, px + 4 * i);
-    }
+    sy_png_encode_over_black(rgba, n, opts, px);
     uint8_t *jpeg = NULL;
     size_t len = 0;
     sy_result r = sy_jpeg_encode_rgba8(px, (uint32_t)width, (uint32_t)height, quality, &jpeg, &len, err);

@@ -8,14 +8,7 @@
 
 #define PI_F 3.14159265358979323846f
 
-static void v3_sub(const float *a, const float *b, float *o) { o[0] = a[0] - b[0]; o[1] = a[1] - b[1]; o[2] = a[2] - b[2]; }
-static void v3_cross(const float *a, const float *b, float *o)
-{
-    float x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
-    o[0] = x; o[1] = y; o[2] = z;
-}
-static float v3_dot(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static float v3_len(const float *a) { return sqrtf(v3_dot(a, a)); }
+static float v3_len(const float *a) { return sqrtf(sy_vec3_dot(a, a)); }
 static bool v3_normalize(float *a)
 {
     float l = v3_len(a);
@@ -89,9 +82,9 @@ sy_result sy_prim_make_flat_normals(sy_primitive *p, sy_error *err)
     if (!nrm) return oom(err, "flat normals");
     for (size_t t = 0; t < n / 3; t++) {
         float e1[3], e2[3], f[3];
-        v3_sub(pos + 9 * t + 3, pos + 9 * t, e1);
-        v3_sub(pos + 9 * t + 6, pos + 9 * t, e2);
-        v3_cross(e1, e2, f);
+        sy_vec3_sub(pos + 9 * t + 3, pos + 9 * t, e1);
+        sy_vec3_sub(pos + 9 * t + 6, pos + 9 * t, e2);
+        sy_vec3_cross(e1, e2, f);
         if (!v3_normalize(f)) { f[0] = 0; f[1] = 0; f[2] = 1; }
         for (int k = 0; k < 3; k++) memcpy(nrm + 9 * t + 3 * k, f, 12);
     }
@@ -102,7 +95,7 @@ static void any_orthogonal(const float *n, float *t)
 {
     float a[3] = {1, 0, 0};
     if (fabsf(n[0]) > 0.9f) { a[0] = 0; a[1] = 1; }
-    float d = v3_dot(a, n);
+    float d = sy_vec3_dot(a, n);
     for (int k = 0; k < 3; k++) t[k] = a[k] - n[k] * d;
     if (!v3_normalize(t)) { t[0] = 1; t[1] = 0; t[2] = 0; }
 }
@@ -126,8 +119,8 @@ sy_result sy_prim_generate_tangents(sy_primitive *p, uint32_t texcoord, sy_error
     for (size_t t = 0; t + 2 < n; t += 3) {
         const uint32_t i[3] = {c[t], c[t + 1], c[t + 2]};
         float e1[3], e2[3];
-        v3_sub(pos + 3 * i[1], pos + 3 * i[0], e1);
-        v3_sub(pos + 3 * i[2], pos + 3 * i[0], e2);
+        sy_vec3_sub(pos + 3 * i[1], pos + 3 * i[0], e1);
+        sy_vec3_sub(pos + 3 * i[2], pos + 3 * i[0], e2);
         float du1 = uv[2 * i[1]] - uv[2 * i[0]], dv1 = uv[2 * i[1] + 1] - uv[2 * i[0] + 1];
         float du2 = uv[2 * i[2]] - uv[2 * i[0]], dv2 = uv[2 * i[2] + 1] - uv[2 * i[0] + 1];
         float det = du1 * dv2 - du2 * dv1;
@@ -142,10 +135,10 @@ sy_result sy_prim_generate_tangents(sy_primitive *p, uint32_t texcoord, sy_error
         if (!v3_normalize(T) || !v3_normalize(B)) continue;
         for (int k = 0; k < 3; k++) { /* corner angle weight */
             float a[3], b[3];
-            v3_sub(pos + 3 * i[(k + 1) % 3], pos + 3 * i[k], a);
-            v3_sub(pos + 3 * i[(k + 2) % 3], pos + 3 * i[k], b);
+            sy_vec3_sub(pos + 3 * i[(k + 1) % 3], pos + 3 * i[k], a);
+            sy_vec3_sub(pos + 3 * i[(k + 2) % 3], pos + 3 * i[k], b);
             float la = v3_len(a), lb = v3_len(b);
-            float w = (la > 0 && lb > 0) ? acosf(fmaxf(-1.0f, fminf(1.0f, v3_dot(a, b) / (la * lb)))) : 0.0f;
+            float w = (la > 0 && lb > 0) ? acosf(fmaxf(-1.0f, fminf(1.0f, sy_vec3_dot(a, b) / (la * lb)))) : 0.0f;
             float *dst = acc + 6 * i[k];
             for (int q = 0; q < 3; q++) { dst[q] += T[q] * w; dst[3 + q] += B[q] * w; }
         }
@@ -153,14 +146,14 @@ sy_result sy_prim_generate_tangents(sy_primitive *p, uint32_t texcoord, sy_error
     for (size_t v = 0; v < nv; v++) {
         float N[3] = {nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]}, T[3], *B = acc + 6 * v + 3;
         if (!v3_normalize(N)) { N[0] = 0; N[1] = 0; N[2] = 1; }
-        float d = v3_dot(acc + 6 * v, N);
+        float d = sy_vec3_dot(acc + 6 * v, N);
         for (int k = 0; k < 3; k++) T[k] = acc[6 * v + k] - N[k] * d;
         float w = 1.0f;
         if (!v3_normalize(T)) any_orthogonal(N, T);
         else {
             float nb[3];
-            v3_cross(N, T, nb);
-            w = v3_dot(nb, B) < 0.0f ? -1.0f : 1.0f;
+            sy_vec3_cross(N, T, nb);
+            w = sy_vec3_dot(nb, B) < 0.0f ? -1.0f : 1.0f;
         }
         memcpy(out + 4 * v, T, 12);
         out[4 * v + 3] = w;
@@ -173,11 +166,11 @@ sy_result sy_prim_generate_tangents(sy_primitive *p, uint32_t texcoord, sy_error
 static float corner_angle(const float *positions, const uint32_t *tri, int k)
 {
     float a[3], b[3];
-    v3_sub(positions + 3 * (size_t)tri[(k + 1) % 3], positions + 3 * (size_t)tri[k], a);
-    v3_sub(positions + 3 * (size_t)tri[(k + 2) % 3], positions + 3 * (size_t)tri[k], b);
+    sy_vec3_sub(positions + 3 * (size_t)tri[(k + 1) % 3], positions + 3 * (size_t)tri[k], a);
+    sy_vec3_sub(positions + 3 * (size_t)tri[(k + 2) % 3], positions + 3 * (size_t)tri[k], b);
     float la = v3_len(a), lb = v3_len(b);
     if (!(la > 0) || !(lb > 0)) return 0.0f;
-    return acosf(fmaxf(-1.0f, fminf(1.0f, v3_dot(a, b) / (la * lb))));
+    return acosf(fmaxf(-1.0f, fminf(1.0f, sy_vec3_dot(a, b) / (la * lb))));
 }
 
 #define SY_CREASE_MAX_VALENCE 512u
@@ -199,9 +192,9 @@ sy_result sy_corner_normals(const float *positions, size_t position_count, const
     for (size_t t = 0; t < tri_count; t++) {
         const uint32_t *i = pos_index + 3 * t;
         float e1[3], e2[3];
-        v3_sub(positions + 3 * (size_t)i[1], positions + 3 * (size_t)i[0], e1);
-        v3_sub(positions + 3 * (size_t)i[2], positions + 3 * (size_t)i[0], e2);
-        v3_cross(e1, e2, fn + 3 * t);
+        sy_vec3_sub(positions + 3 * (size_t)i[1], positions + 3 * (size_t)i[0], e1);
+        sy_vec3_sub(positions + 3 * (size_t)i[2], positions + 3 * (size_t)i[0], e2);
+        sy_vec3_cross(e1, e2, fn + 3 * t);
         if (!v3_normalize(fn + 3 * t)) fn[3 * t] = fn[3 * t + 1] = fn[3 * t + 2] = 0;
         for (int k = 0; k < 3; k++) start[i[k] + 1]++;
         if (crease_angle > 0.0f)
@@ -241,7 +234,7 @@ sy_result sy_corner_normals(const float *positions, size_t position_count, const
                 for (uint32_t q = start[v]; q < start[v + 1]; q++) {
                     size_t g = list[q] / 3;
                     const float *gn = fn + 3 * g;
-                    if (g != t && v3_dot(gn, ft) < cos_crease - 1e-6f) continue;
+                    if (g != t && sy_vec3_dot(gn, ft) < cos_crease - 1e-6f) continue;
                     float w = ang[list[q]];
                     o[0] += gn[0] * w; o[1] += gn[1] * w; o[2] += gn[2] * w;
                 }
@@ -460,10 +453,10 @@ sy_result sy_tess_box(const float size[3], sy_primitive *out, sy_error *err)
         float e1[3], e2[3], c[3], nn[3] = {0, 0, 0};
         nn[na] = fs[f][0];
         if (b.failed) break;
-        v3_sub(b.pos + 3 * (base + 1), b.pos + 3 * base, e1);
-        v3_sub(b.pos + 3 * (base + 2), b.pos + 3 * base, e2);
-        v3_cross(e1, e2, c);
-        if (v3_dot(c, nn) >= 0) {
+        sy_vec3_sub(b.pos + 3 * (base + 1), b.pos + 3 * base, e1);
+        sy_vec3_sub(b.pos + 3 * (base + 2), b.pos + 3 * base, e2);
+        sy_vec3_cross(e1, e2, c);
+        if (sy_vec3_dot(c, nn) >= 0) {
             b_tri(&b, base, base + 1, base + 2);
             b_tri(&b, base, base + 2, base + 3);
         } else {

@@ -16,7 +16,6 @@
 
 /* ---- >>colour helpers ---- */
 
-static uint8_t quantize8(float v01) { return (uint8_t)(v01 * 255.0f + 0.5f); }
 
 /* Pixel conversion with the exposure scale already computed. */
 static void encode_pixel(const float *in, float scale, sy_tonemap op, uint8_t *out)
@@ -25,10 +24,10 @@ static void encode_pixel(const float *in, float scale, sy_tonemap op, uint8_t *o
     float inv = a > 0.0f ? 1.0f / a : 0.0f; /* alpha 0 (or NaN): nothing to show, colour 0 */
     for (int c = 0; c < 3; ++c) {
         float v = in[c] * inv * scale;
-        out[c] = quantize8(sy_srgb_encode(sy_tonemap_apply(op, v)));
+        out[c] = sy_unorm8(sy_srgb_encode(sy_tonemap_apply(op, v)));
     }
     float ac = a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f;
-    out[3] = quantize8(ac);
+    out[3] = sy_unorm8(ac);
 }
 
 void sy_png_encode_pixel(const float rgba_premultiplied[4], const sy_png_options *opts, uint8_t out[4])
@@ -36,6 +35,17 @@ void sy_png_encode_pixel(const float rgba_premultiplied[4], const sy_png_options
     float stops = opts ? opts->exposure_stops : 0.0f;
     sy_tonemap op = opts ? opts->tonemap : SY_TONEMAP_CLAMP;
     encode_pixel(rgba_premultiplied, exp2f(stops), op, out);
+}
+
+void sy_png_encode_over_black(const float *rgba_premultiplied, size_t count, const sy_png_options *opts, uint8_t *out)
+{
+    float scale = exp2f(opts ? opts->exposure_stops : 0.0f);
+    sy_tonemap op = opts ? opts->tonemap : SY_TONEMAP_CLAMP;
+    for (size_t i = 0; i < count; ++i) {
+        const float *p = rgba_premultiplied + 4 * i;
+        const float c[4] = {p[0], p[1], p[2], 1.0f};
+        encode_pixel(c, scale, op, out + 4 * i);
+    }
 }
 
 /* ---- >>writer ---- */

@@ -44,6 +44,10 @@ typedef struct sy_png_options {
 /** Converts one premultiplied linear RGBA pixel to 8-bit straight-alpha sRGB exactly as
  * sy_png_write does (opts may be NULL for the defaults). */
 void sy_png_encode_pixel(const float rgba_premultiplied[4], const sy_png_options *opts, uint8_t out[4]);
+/** Converts count premultiplied linear RGBA pixels composited over black (opaque: the
+ * premultiplied colour, alpha 1) as sy_png_encode_pixel does: the 8-bit frames of JPEG files and
+ * streams. out holds count * 4 bytes. */
+void sy_png_encode_over_black(const float *rgba_premultiplied, size_t count, const sy_png_options *opts, uint8_t *out);
 
 /** Writes w x h pixels (rgba: w*h*4 floats, premultiplied linear, row 0 on top) as an 8-bit RGBA
  * sRGB PNG at path. opts may be NULL (defaults). Errors name the file and the reason.

@@ -20,25 +20,17 @@ static const uint8_t ICO_F[SY_STROKES_BALL_TRIANGLES][3] = {
     {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1},
 };
 
-static void sub3(const float *a, const float *b, float *o) { o[0] = a[0] - b[0], o[1] = a[1] - b[1], o[2] = a[2] - b[2]; }
-static void cross3(const float *a, const float *b, float *o)
-{
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
-static float dot3(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /* Face f of the icosahedron wound counter-clockwise seen from outside. */
 static void ico_face(uint32_t f, uint32_t out[3])
 {
     const uint8_t *t = ICO_F[f];
     float e1[3], e2[3], n[3], c[3];
-    sub3(ICO_V[t[1]], ICO_V[t[0]], e1);
-    sub3(ICO_V[t[2]], ICO_V[t[0]], e2);
-    cross3(e1, e2, n);
+    sy_vec3_sub(ICO_V[t[1]], ICO_V[t[0]], e1);
+    sy_vec3_sub(ICO_V[t[2]], ICO_V[t[0]], e2);
+    sy_vec3_cross(e1, e2, n);
     for (int k = 0; k < 3; ++k) c[k] = ICO_V[t[0]][k] + ICO_V[t[1]][k] + ICO_V[t[2]][k];
-    bool flip = dot3(n, c) < 0.0f;
+    bool flip = sy_vec3_dot(n, c) < 0.0f;
     out[0] = t[0];
     out[1] = flip ? t[2] : t[1];
     out[2] = flip ? t[1] : t[2];
@@ -155,18 +147,18 @@ static void ball(out_arrays *o, const float *c, float r, uint32_t src)
 static void tube(out_arrays *o, const float *a, const float *b, float r, uint32_t va, uint32_t vb)
 {
     float d[3];
-    sub3(b, a, d);
-    float len = sqrtf(dot3(d, d));
+    sy_vec3_sub(b, a, d);
+    float len = sqrtf(sy_vec3_dot(d, d));
     for (int k = 0; k < 3; ++k) d[k] /= len;
     /* u: perpendicular to d, from the world axis least aligned with it; v = d x u */
     float ax[3] = {0, 0, 0};
     int m = fabsf(d[0]) <= fabsf(d[1]) ? (fabsf(d[0]) <= fabsf(d[2]) ? 0 : 2) : (fabsf(d[1]) <= fabsf(d[2]) ? 1 : 2);
     ax[m] = 1.0f;
     float u[3], v[3];
-    cross3(d, ax, u);
-    float ul = sqrtf(dot3(u, u));
+    sy_vec3_cross(d, ax, u);
+    float ul = sqrtf(sy_vec3_dot(u, u));
     for (int k = 0; k < 3; ++k) u[k] /= ul;
-    cross3(d, u, v);
+    sy_vec3_cross(d, u, v);
     uint32_t base = o->nv;
     for (uint32_t s = 0; s < SY_STROKES_TUBE_SIDES; ++s) {
         float ang = 6.28318531f * (float)s / (float)SY_STROKES_TUBE_SIDES, cs = cosf(ang), sn = sinf(ang);

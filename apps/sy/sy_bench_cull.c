@@ -102,10 +102,7 @@ static size_t jpeg_bytes(const sy_layer *l, uint8_t *rgba8, double *seconds)
 {
     double t0 = now_s();
     const sy_png_options clamp = {.tonemap = SY_TONEMAP_CLAMP};
-    for (size_t i = 0; i < (size_t)l->width * l->height; ++i) {
-        const float c[4] = {l->rgba[4 * i], l->rgba[4 * i + 1], l->rgba[4 * i + 2], 1.0f}; /* over black */
-        sy_png_encode_pixel(c, &clamp, rgba8 + 4 * i);
-    }
+    sy_png_encode_over_black(l->rgba, (size_t)l->width * l->height, &clamp, rgba8);
     uint8_t *jpg = NULL;
     size_t size = 0;
     sy_error err = {0};

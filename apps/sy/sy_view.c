@@ -399,7 +399,7 @@ static void *render_main(void *p)
             for (size_t i = 0; i < n * 4; ++i) {
                 float x = img.rgba[i];
                 if ((i & 3) != 3 && img.rgba[(i | 3)] > 0.0f) x /= img.rgba[(i | 3)]; /* straight for display */
-                bytes[i] = (uint8_t)(x <= 0.0f ? 0 : x >= 1.0f ? 255 : (int)(x * 255.0f + 0.5f));
+                bytes[i] = sy_unorm8(x);
             }
         /* the frame's whole time (render, tone mapping, conversion); a frame that translated the
          * scene for a new context says nothing about the next ones */

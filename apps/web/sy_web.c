@@ -896,7 +896,7 @@ static uint8_t *layer_to_rgba8(const sy_layer *img)
     if (!px) return NULL;
     for (size_t i = 0; i < n * 4; ++i) {
         float x = (i & 3) == 3 ? 1.0f : img->rgba[i];
-        px[i] = (uint8_t)(x <= 0.0f ? 0 : x >= 1.0f ? 255 : (int)(x * 255.0f + 0.5f));
+        px[i] = sy_unorm8(x);
     }
     return px;
 }

@@ -482,24 +482,16 @@ static void xform(const float *m, const float *p, float *o)
 {
     for (int a = 0; a < 3; ++a) o[a] = m[a] * p[0] + m[4 + a] * p[1] + m[8 + a] * p[2] + m[12 + a];
 }
-static void sub3(const float *a, const float *b, float *o) { o[0] = a[0] - b[0], o[1] = a[1] - b[1], o[2] = a[2] - b[2]; }
-static void cross3(const float *a, const float *b, float *o)
-{
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
-static float dot3(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 static bool same3(const float *a, const float *b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
 
 /* Tries to merge triangles A and B (world space, front = counter-clockwise) into a convex quad. */
 static bool merge_quad(const float a[3][3], const float b[3][3], float q[4][3])
 {
     float na[3], nb[3], e1[3], e2[3];
-    sub3(a[1], a[0], e1), sub3(a[2], a[0], e2), cross3(e1, e2, na);
-    sub3(b[1], b[0], e1), sub3(b[2], b[0], e2), cross3(e1, e2, nb);
-    float la = sqrtf(dot3(na, na)), lb = sqrtf(dot3(nb, nb));
-    if (!(la > 0.0f && lb > 0.0f) || dot3(na, nb) < 0.99999f * la * lb) return false;
+    sy_vec3_sub(a[1], a[0], e1), sy_vec3_sub(a[2], a[0], e2), sy_vec3_cross(e1, e2, na);
+    sy_vec3_sub(b[1], b[0], e1), sy_vec3_sub(b[2], b[0], e2), sy_vec3_cross(e1, e2, nb);
+    float la = sqrtf(sy_vec3_dot(na, na)), lb = sqrtf(sy_vec3_dot(nb, nb));
+    if (!(la > 0.0f && lb > 0.0f) || sy_vec3_dot(na, nb) < 0.99999f * la * lb) return false;
     for (int k = 0; k < 3; ++k) { /* shared edge x = a[k] -> y = a[k+1] appears in B as y -> x */
         const float *x = a[k], *y = a[(k + 1) % 3], *z = a[(k + 2) % 3];
         for (int j = 0; j < 3; ++j)
@@ -508,8 +500,8 @@ static bool merge_quad(const float a[3][3], const float b[3][3], float q[4][3])
                 const float *v[4] = {x, d, y, z};
                 for (int i = 0; i < 4; ++i) { /* convex: every corner turns the same way as the normal */
                     float u[3], w[3], c[3];
-                    sub3(v[(i + 1) % 4], v[i], u), sub3(v[(i + 2) % 4], v[(i + 1) % 4], w), cross3(u, w, c);
-                    if (dot3(c, na) <= 0.0f) return false;
+                    sy_vec3_sub(v[(i + 1) % 4], v[i], u), sy_vec3_sub(v[(i + 2) % 4], v[(i + 1) % 4], w), sy_vec3_cross(u, w, c);
+                    if (sy_vec3_dot(c, na) <= 0.0f) return false;
                 }
                 for (int i = 0; i < 4; ++i) memcpy(q[i], v[i], sizeof q[i]);
                 return true;
@@ -527,8 +519,8 @@ static int cmp_power_desc(const void *a, const void *b)
 static sy_result push_poly(poly **ps, size_t *n, size_t *cap, const float v[4][3], uint32_t nv, const emat *em, sy_error *err)
 {
     float e1[3], e2[3], c[3];
-    sub3(v[1], v[0], e1), sub3(v[2], v[0], e2), cross3(e1, e2, c);
-    float area = sqrtf(dot3(c, c)) * (nv == 4 ? 1.0f : 0.5f);
+    sy_vec3_sub(v[1], v[0], e1), sy_vec3_sub(v[2], v[0], e2), sy_vec3_cross(e1, e2, c);
+    float area = sqrtf(sy_vec3_dot(c, c)) * (nv == 4 ? 1.0f : 0.5f);
     if (!(area > 0.0f)) return SY_OK;
     if (*n == *cap) {
         size_t nc = *cap ? *cap * 2 : 64;
@@ -624,8 +616,8 @@ static sy_result rebuild_area_lights(raster_state *st, sy_error *err)
                     xform(in->world, pos + 3 * (size_t)vi, w[k]);
                     for (int a = 0; a < 3; ++a) lo[a] = fmin(lo[a], w[k][a]), hi[a] = fmax(hi[a], w[k][a]);
                 }
-                sub3(w[1], w[0], e1), sub3(w[2], w[0], e2), cross3(e1, e2, c);
-                ia += 0.5 * sqrt(dot3(c, c));
+                sy_vec3_sub(w[1], w[0], e1), sy_vec3_sub(w[2], w[0], e2), sy_vec3_cross(e1, e2, c);
+                ia += 0.5 * sqrt(sy_vec3_dot(c, c));
             }
             area += ia;
             for (int c = 0; c < 3; ++c) rho[c] += ia * alb[c];
