@@ -1,7 +1,7 @@
 /** @file
  * sy_cluster_proto.h — the cluster wire protocol: message encoder and decoder, pure (no sockets,
  * no crypto, no compression), so that it can be fuzzed and tested alone. The transport
- * (sy_cluster.c on a transport of sy_cluster_transport.h, libsodium, zstd) frames, authenticates and
+ * (sy_cluster_wire.c on a transport of sy_cluster_transport.h, libsodium, zstd) frames, authenticates and
  * compresses around it.
  * Every message is documented in docs/PROTOCOL.md.
  *

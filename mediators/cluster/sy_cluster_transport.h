@@ -3,7 +3,7 @@
  * interface: a transport listens and dials by URL scheme and yields streams that move bytes with
  * deadlines. Built in: nng (tcp://, tls+tcp://, ipc://). Registered by the application: MPI
  * (mpi://RANK, sy_cluster_mpi.h). The protocol above (framing, authentication, tags, budgets:
- * sy_cluster.c) is the same on every transport.
+ * sy_cluster_wire.c, sy_cluster_handshake.c) is the same on every transport.
  *
  * Ownership: streams and listeners belong to whoever got them (free them). Transports are static
  * tables registered for the life of the process (the registry is the only global state).

@@ -1,5 +1,5 @@
 /* test_cluster_server.c — a render server process for the cluster tests: the built-in mediators
- * plus the "coop_test" double, served through mediators/cluster/sy_cluster.c exactly as `sy serve` does.
+ * plus the "coop_test" double, served through mediators/cluster/sy_cluster_server.c exactly as `sy serve` does.
  *   test_cluster_server --port-file F [--listen URL] [--secret S] [--max-lifetime SECONDS] [--present RAW]
  *                       [--blob-cache-mb N | --blob-cache-bytes N] [--max-objects N] [--auth-backoff-ms MS]
  *                       [--max-unauthenticated N] [--handshake-timeout-ms MS] [--max-peer-memory-mb N]
