@@ -1,6 +1,7 @@
 /* sy_bench.h — `sy bench` benchmarks. They print ratios measured in one run (never pass/fail on
- * time): sync (incremental update vs translating from scratch) and rays (our primary-ray
- * throughput vs raw Embree on the same rays). Thread-safety: single-threaded callers. */
+ * time): sync (incremental update vs translating from scratch), rays (our primary-ray throughput
+ * vs raw Embree on the same rays) and the others below, one file each (sy_bench_KIND.c; what they
+ * share: sy_bench.c). Thread-safety: single-threaded callers. */
 #ifndef SY_BENCH_H
 #define SY_BENCH_H
 
@@ -91,5 +92,22 @@ typedef struct sy_bench_spread {
     double min, median, max;
 } sy_bench_spread;
 sy_bench_spread sy_bench_spread_of(double *v, uint32_t n);
+
+/* For the benchmarks' own files (sy_bench.c, sy_bench_load.c). */
+/* qsort comparison of doubles, ascending */
+int sy_bench_cmp_double(const void *a, const void *b);
+/* Resident set of this process in KiB (/proc/self/statm), 0 when unknown. */
+long sy_bench_rss_now_kib(void);
+/* One frame of win (samples: per pixel for a progressive back-end, 0 = its default pass) timed
+ * into *secs (sy bench pathtracer, sy bench filters). */
+sy_result sy_bench_frame(sy_window *win, sy_scene *scene, sy_context_pool *pool, uint32_t samples, sy_layer *out,
+                         double *secs, sy_error *err);
+/* A .glb with a (grid + 1)^2-vertex grid of 2 * grid^2 triangles: POSITION, NORMAL, TEXCOORD_0,
+ * uint32 indices; written through sy_atomic_file (sy bench load, sy bench memory). */
+sy_result sy_bench_write_grid_glb(const char *path, uint32_t grid, sy_error *err);
+/* A benchmark of a back-end this build lacks (SY_WITH_EMBREE / SY_WITH_RASTER off) says so. */
+#define SY_BENCH_WITHOUT(err, what, option)                                                                            \
+    return sy_error_set(err, SY_ERR_UNSUPPORTED, "sy bench: %s needs a back-end this sy was built without (%s=OFF)",   \
+                        what, option)
 
 #endif /* SY_BENCH_H */

@@ -1,0 +1,299 @@
+/* sy_cli.c — what every sy command shares on its command line (sy_cli.h): the options of every
+ * command (-q / -v, --help, the world and loader flags) taken by sy_cli_next_option, the usage
+ * text and its errors (exit status 2), numbers and sizes, the error exit (status 1), the default
+ * back-end. */
+#include "sy_cli.h"
+#include "sy_load.h"
+#include "sy_options.h"
+
+#include "sy_log.h"
+#include "sy_mediators.h"
+#include "sy_viewport.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+/* The world flags every command shares (taken out of the arguments in main): --env MAP.exr,
+ * --env-color R,G,B, --env-intensity X, --env-hidden, --background R,G,B[,A], --no-default-light.
+ * *used = arguments consumed (0: not a world flag). Only maps text onto sy_world_options; the
+ * meaning is the library's (sy_look.h, sy_world.h). */
+static bool parse_floats(const char *text, float *out, int min_n, int max_n, int *n_out)
+{
+    int n = 0;
+    const char *p = text;
+    while (n < max_n) {
+        char *end = NULL;
+        out[n] = strtof(p, &end);
+        if (end == p || !isfinite(out[n])) return false;
+        ++n;
+        if (*end == '\0') break;
+        if (*end != ',') return false;
+        p = end + 1;
+    }
+    *n_out = n;
+    return n >= min_n && *p && p[strlen(p) - 1] != ',';
+}
+
+/* The world flags (only maps text onto sy_world_options; the meaning is the library's: sy_look.h,
+ * sy_world.h). */
+static sy_result apply_world_option(int c, const char *v, sy_world_options *w, sy_error *err)
+{
+    int n = 0;
+    switch (c) {
+    case OPT_ENV_HIDDEN: w->env_hidden = true; break;
+    case OPT_NO_DEFAULT_LIGHT: w->no_default_light = true; break;
+    case OPT_ENV: w->env_path = v; break;
+    case OPT_ENV_COLOR:
+        if (!parse_floats(v, w->env_color, 3, 3, &n))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--env-color %s: expected R,G,B", v);
+        w->has_env_color = true;
+        break;
+    case OPT_ENV_INTENSITY:
+        if (!parse_floats(v, &w->env_intensity, 1, 1, &n))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--env-intensity %s: expected a number", v);
+        w->env_intensity_set = true;
+        break;
+    default: /* OPT_BACKGROUND */
+        if (!parse_floats(v, w->background, 3, 4, &n))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--background %s: expected R,G,B or R,G,B,A", v);
+        if (n == 3) w->background[3] = 1.0f;
+        w->has_background = true;
+    }
+    return SY_OK;
+}
+
+/* The next option of a command's arguments (argv[0]: the command's name, for messages; cmd: the
+ * command as `sy help` names it, NULL for sy's own options). Call with optind = 0 first (glibc's way
+ * to start over with new arguments and a new ordering). Returns the option's code, -1 after the last
+ * option (the operands are argv[optind..argc-1]), or OPT_STOP with *status: 0 after --help (the
+ * command's usage on stdout), 2 after a usage error (named on stderr). */
+int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *longopts,
+                       int *status)
+{
+    opterr = 0; /* the messages are ours */
+    const char *who = cmd ? cmd : "sy";
+    char prefix[64];
+    snprintf(prefix, sizeof prefix, "sy%s%s", cmd ? " " : "", cmd ? cmd : "");
+    for (;;) {
+        int c = sy_getopt(argc, argv, shortopts, longopts, prefix);
+        const char *bad = optind > 0 && optind <= argc ? argv[optind - 1] : "";
+        sy_error e = {0};
+        switch (c) {
+        case SY_GETOPT_ERROR: /* an abbreviated long option (named on stderr) */
+            *status = 2;
+            return OPT_STOP;
+        case '?':
+            if (optopt >= 0x100) fprintf(stderr, "sy %s: error: option '%s' takes no value", who, bad);
+            else if (optopt) fprintf(stderr, "sy %s: error: unknown option '-%c'", who, optopt);
+            else fprintf(stderr, "sy %s: error: unknown option '%s'", who, bad);
+            fprintf(stderr, " (sy %s%s--help lists the options)\n", cmd ? cmd : "", cmd ? " " : "");
+            *status = 2;
+            return OPT_STOP;
+        case ':':
+            fprintf(stderr, "sy %s: error: option '%s' needs a value\n", who, bad);
+            *status = 2;
+            return OPT_STOP;
+        case OPT_HELP:
+            sy_cli_usage_to(stdout, cmd);
+            *status = 0;
+            return OPT_STOP;
+        case 'q': sy_log_set_level(SY_LOG_ERROR); break;
+        case 'v': sy_log_set_level(SY_LOG_DEBUG); break;
+        case OPT_STRICT: sy_cli_load_opts.strict = true; break;
+        case OPT_MAX_SCENE_MB: { /* the loaders' budget per file, in MiB (sy_budget.h) */
+            char *end = NULL;
+            errno = 0;
+            unsigned long long mb = strtoull(optarg, &end, 10);
+            if (!*optarg || *end || errno || mb < 1 || mb > (1ull << 30)) {
+                fprintf(stderr, "sy: error: --max-scene-mb %s: expected a whole number of MiB from 1 to 2^30\n", optarg);
+                *status = 2;
+                return OPT_STOP;
+            }
+            sy_cli_load_opts.max_scene_bytes = (uint64_t)mb << 20;
+            break;
+        }
+        case OPT_ALLOW_PATH: { /* repeatable: more folders that a model's external files may lie in */
+            struct stat st;
+            if (stat(optarg, &st) != 0 || !S_ISDIR(st.st_mode)) {
+                fprintf(stderr, "sy: error: --allow-path %s: expected an existing folder\n", optarg);
+                *status = 2;
+                return OPT_STOP;
+            }
+            if (sy_cli_load_opts.root_count == SY_MAX_ALLOW_PATHS) {
+                fprintf(stderr, "sy: error: --allow-path: at most %d folders\n", SY_MAX_ALLOW_PATHS);
+                *status = 2;
+                return OPT_STOP;
+            }
+            sy_cli_load_opts.roots[sy_cli_load_opts.root_count++] = optarg;
+            break;
+        }
+        case OPT_ENV: case OPT_ENV_COLOR: case OPT_ENV_INTENSITY: case OPT_ENV_HIDDEN: case OPT_BACKGROUND:
+        case OPT_NO_DEFAULT_LIGHT:
+            if (apply_world_option(c, optarg, &sy_cli_load_opts.world, &e) != SY_OK) {
+                fprintf(stderr, "sy: error: %s\n", e.message);
+                *status = 2;
+                return OPT_STOP;
+            }
+            break;
+        default: return c;
+        }
+    }
+}
+
+int sy_cli_fail(const sy_error *e)
+{
+    sy_log(SY_LOG_ERROR, "sy", NULL, "%s", e->message);
+    return 1;
+}
+
+/* The command summary, to stdout for --help (exit 0) or stderr after a usage error (exit 2). An entry
+ * is a line "  sy COMMAND ..." and the deeper-indented lines after it; the lines from "SCENE:" on
+ * are for every command. */
+static const char usage_text[] =
+            "usage:\n"
+            "  sy [-q | -v] COMMAND [ARGS]          -q (--quiet): errors only; -v (--verbose): debug messages too\n"
+            "                                       (also accepted after COMMAND)\n"
+            "  sy --version | sy version            the Switchyard version\n"
+            "  sy --help | sy help [COMMAND]        this summary (on stdout); sy COMMAND --help: the command's\n"
+            "  sy info SCENE | IMAGE.exr | IMAGE.png  JSON summary: counts, bounds, warnings; an image's size and\n"
+            "                                       metadata (EXR channels and header attributes, PNG text chunks)\n"
+            "  sy render SCENE|DIR [-b BACKEND] [-o OUT.exr|png|jpg] [-w W] [-h H] [--camera NAME|INDEX]\n"
+            "            (-b: the default back-end, sy backends marks it; -o: STEM.png in the current folder;\n"
+            "             DIR: the one scene file in the folder, or one folder down)\n"
+            "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]  (PNG, JPEG; default aces)\n"
+            "            [--max-memory MB]   (ray tracers: refuse a scene whose BVHs need more)\n"
+            "            [--gl osmesa|egl|glfw]   (-b raster: the GL context provider)\n"
+            "            [--stereo sbs|tb|anaglyph|separate] [--eye-sep M] [--zero-parallax M]\n"
+            "            [--overlay FILE[:BACKEND]] [--composite depth|over|replace]\n"
+            "  sy render SCENE -b pathtracer [-o OUT.exr|png|jpg] [--spp N | --time SECONDS] [--aov]\n"
+            "            (+ the options above)\n"
+            "            [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]   (display filter)\n"
+            "  sy demo [-o DIR] [-w W] [-h H] [--filter pixel|none|...]   (the progressive back-end's display filter)\n"
+            "  sy compare SCENE [-w W] [-h H] [--spp N] [-o SHEET.png] [--camera C] [--backends a,b,...]\n"
+            "            (every back-end side by side: contact sheet + mean luminance, ratio and IoU table)\n"
+            "  sy view SCENE [-b BACKEND] [-w W] [-h H] [--camera C] [--overlay FILE[:BACKEND]]\n"
+            "          [--frames N --screenshot OUT.png] [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]\n"
+            "          [--keys KEYS]   (automated runs: press these keys one frame after another, e.g. F]F[)\n"
+            "          [--budget MS]   (frame time while the view moves: the resolution follows it; default 33)\n"
+            "          [--cluster URL[,URL...]|FILE.conf [--cluster-mode MODE] [--secret-file F] [--timeout-ms MS]\n"
+            "           [--spp SAMPLES_PER_SERVER_AND_FRAME]]   (the same cluster options as sy render)\n"
+            "  sy web SCENE [-b BACKEND] [--listen HOST:PORT] [--camera C] [-w MAX_W] [-h MAX_H] [--quality Q]\n"
+            "          [--filter none|pixel|...] [--threshold T] [--budget MS] [--client-render]   (the view in a browser:\n"
+            "           open the URL it prints; another address than loopback needs the printed token)\n"
+            "  sy bench web [SCENE] [-b BACKEND] [-w W] [-h H] [--repeats N]   (input-to-frame latency, loopback)\n"
+            "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"
+            "  sy bench rays [SCENE] [-w W] [-h H] [--repeats R]\n"
+            "  sy bench pathtracer [SCENE] [-w W] [-h H] [--repeats PASSES]\n"
+            "  sy bench limit [SCENE] [-w W] [-h H] [--spp N] [--repeats N]   (path tracer vs raw Embree, same rays)\n"
+            "  sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]\n"
+            "  sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params gl=egl,msaa=4]\n"
+            "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
+            "  sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]\n"
+            "  sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   (peak RSS per triangle)\n"
+            "  sy bench instances [--nodes INSTANCES] [--tris PER_MESH] [-w W] [-h H] [--repeats FRAMES] [-b BACKEND]\n"
+            "            (one mesh instanced: 10^3 x 10^6 triangles by default, every picture back-end)\n"
+            "  sy bench governor [SCENE] [--budget MS] [--frames N] [-w W] [-h H]   (frame-time governor, orbiting camera)\n"
+            "  sy bench cull [--tris N] [--objects N] [--budget T] [-w W] [-h H] [--frames N] [--write PLANT.glb]\n"
+            "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
+            "  sy backends [--params] [--json]\n"
+            "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
+            "  sy render SCENE -b BACKEND -o OUT --cluster URL[,URL...]|FILE.conf\n"
+            "            [--cluster-mode sort-first|balanced|cooperative|multi-display|stereo] [--secret-file F]\n"
+            "            [--tls-ca PEM] [--timeout-ms MS] [--frames N] [--spp N] [--cluster-pixels float|half]\n"
+            "  sy bench cluster [-w W] [-h H] [--repeats ROUNDS]\n"
+            "  sy bench cluster --soak SECONDS [--warmup S] [-b BACKEND] [-w W] [-h H]   (sy serve soak: RSS, fds, threads)\n"
+            "SCENE: a glTF (.gltf, .glb) or X3D (XML) file, recognised by its content, or 'demo' (the built-in scene)\n"
+            "world options (every command): [--env MAP.exr | --env-color R,G,B] [--env-intensity X] [--env-hidden]\n"
+            "  [--background R,G,B[,A]] [--no-default-light]: the environment is a light; the background is what\n"
+            "  the camera sees where nothing is hit; a scene with no light of its own is lit by a neutral studio\n"
+            "  environment unless --no-default-light is given\n"
+            "loading (every command): [--allow-path DIR] (more folders a model's files may lie in) [--strict]\n"
+            "  (a skipped or repaired item fails the load) [--max-scene-mb N] (budget per file: vertices, indices,\n"
+            "  images and placements together; default an eighth of the physical memory)\n"
+            "exit status: 0 success, 1 failure (the error names the file, peer or value), 2 usage error,\n"
+            "  130 interrupted\n"
+            "bash completion: source apps/sy/sy-completion.bash\n";
+
+/* The summary (cmd NULL) or the entries of one command ("render", "bench", "bench sync") and the
+ * common part. */
+void sy_cli_usage_to(FILE *f, const char *cmd)
+{
+    if (!cmd) {
+        fputs(usage_text, f);
+        return;
+    }
+    char want[64];
+    snprintf(want, sizeof want, "  sy %s ", cmd);
+    bool in = false, footer = false;
+    for (const char *l = usage_text; *l;) {
+        const char *nl = strchr(l, '\n');
+        size_t n = nl ? (size_t)(nl - l) + 1 : strlen(l);
+        if (!strncmp(l, "usage:", 6)) in = true;                          /* the heading */
+        else if (!strncmp(l, "  sy ", 5)) in = !strncmp(l, want, strlen(want)); /* an entry */
+        else if (strncmp(l, "   ", 3) != 0 && strncmp(l, "  ", 2) != 0) footer = true; /* SCENE:, world options... */
+        if (in || footer) fwrite(l, 1, n, f);
+        l += n;
+    }
+}
+
+/* A usage error without a named option (an operand missing): the command's usage on stderr, 2. */
+int sy_cli_usage_of(const char *cmd, const char *what)
+{
+    if (what) fprintf(stderr, "sy %s: error: %s\n", cmd, what);
+    sy_cli_usage_to(stderr, cmd);
+    return 2;
+}
+
+/* "--name" of a long option's code in a getopt_long table (for messages). */
+const char *sy_cli_option_name(const struct option *lo, int c)
+{
+    static char buf[64];
+    for (; lo->name; ++lo)
+        if (lo->val == c && !lo->flag) {
+            snprintf(buf, sizeof buf, "--%s", lo->name);
+            return buf;
+        }
+    return "an option";
+}
+
+/* A usage error naming the option and the value it did not accept. */
+int sy_cli_bad_value(const char *opt, const char *value)
+{
+    fprintf(stderr, "sy: error: %s: '%s' is not an accepted value\n", opt, value);
+    return 2;
+}
+
+bool sy_cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long v = strtoul(s, &end, 10);
+    if (errno || end == s || *end || v < lo || v > hi) return false;
+    *out = (uint32_t)v;
+    return true;
+}
+
+/* -w W / -h H of every command that renders: 1..16384 pixels; false names nothing (the caller does). */
+bool sy_cli_size_option(int c, const char *value, uint32_t *w, uint32_t *h)
+{
+    return sy_cli_parse_u32(value, 1, 16384, c == 'w' ? w : h);
+}
+
+bool sy_cli_ends_with(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), m = strlen(suffix);
+    return n >= m && strcasecmp(s + n - m, suffix) == 0;
+}
+
+/* The back-end a command uses without -b: the registry's default (sy_mediator_default). */
+const char *sy_cli_default_backend(sy_error *err)
+{
+    const char *name = sy_mediator_default_name();
+    if (!*name) sy_error_set(err, SY_ERR_NOT_FOUND, "no back-end offers itself as the default; name one with -b (sy backends)");
+    return *name ? name : NULL;
+}

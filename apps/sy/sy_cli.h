@@ -1,0 +1,77 @@
+/* sy_cli.h — what every sy command shares on its command line (sy_cli.c).
+ *
+ * Every command parses its options with getopt_long (GNU ordering: options and operands in any
+ * order, "--" ends the options, --name=value) through sy_getopt, which refuses abbreviated long
+ * options (sy_options.h: "--frame" is no "--frames"). The options every command takes (the world
+ * and loader flags, -q / -v, --help) are applied by sy_cli_next_option; a command's own ones come
+ * back to it. Exit status: 0 success, 1 failure (sy_cli_fail), 2 usage error (the bad option or
+ * value is named), 130 interrupted. Thread-safety: the main thread only (getopt's globals). */
+#ifndef SY_CLI_H
+#define SY_CLI_H
+
+#include "sy_common.h"
+
+#include <getopt.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+enum {
+    OPT_STOP = -2, /* sy_cli_next_option: the command ends with *status (after --help or a usage error) */
+    OPT_HELP = 0x100, OPT_VERSION, OPT_ENV, OPT_ENV_COLOR, OPT_ENV_INTENSITY, OPT_ENV_HIDDEN, OPT_BACKGROUND,
+    OPT_NO_DEFAULT_LIGHT, OPT_ALLOW_PATH, OPT_STRICT, OPT_MAX_SCENE_MB,
+    /* the commands' own long options (cluster ones: SY_CLUSTER_OPT_*, sy_cluster_cli.h) */
+    OPT_SPP, OPT_TIME, OPT_AOV, OPT_CAMERA, OPT_PARAMS, OPT_GL, OPT_FILTER, OPT_THRESHOLD, OPT_HALF, OPT_EXPOSURE,
+    OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
+    OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB, OPT_MAX_MEMORY,
+    OPT_BUDGET
+};
+/* getopt_long entries of the options of every command, with the table's terminator: the end of
+ * every command's table */
+#define COMMON_OPTIONS                                                                                     \
+    {"help", no_argument, NULL, OPT_HELP}, {"quiet", no_argument, NULL, 'q'},                              \
+    {"verbose", no_argument, NULL, 'v'}, {"env", required_argument, NULL, OPT_ENV},                        \
+    {"env-color", required_argument, NULL, OPT_ENV_COLOR},                                                 \
+    {"env-intensity", required_argument, NULL, OPT_ENV_INTENSITY},                                         \
+    {"env-hidden", no_argument, NULL, OPT_ENV_HIDDEN}, {"background", required_argument, NULL, OPT_BACKGROUND}, \
+    {"no-default-light", no_argument, NULL, OPT_NO_DEFAULT_LIGHT},                                         \
+    {"allow-path", required_argument, NULL, OPT_ALLOW_PATH}, {"strict", no_argument, NULL, OPT_STRICT},    \
+    {"max-scene-mb", required_argument, NULL, OPT_MAX_SCENE_MB},                                           \
+    {NULL, 0, NULL, 0}
+/* short options: ':' first (a missing value is told apart from an unknown option), then -q and -v */
+#define SHORT_OPTIONS(own) ":" own "qv"
+
+/* The next option of a command's arguments (argv[0]: the command's name, for messages; cmd: the
+ * command as `sy help` names it, NULL for sy's own options). Call with optind = 0 first (glibc's way
+ * to start over with new arguments and a new ordering). Returns the option's code, -1 after the last
+ * option (the operands are argv[optind..argc-1]), or OPT_STOP with *status: 0 after --help (the
+ * command's usage on stdout), 2 after a usage error (named on stderr). The world and loader flags
+ * go to sy_cli_load_opts (sy_load.h). */
+int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *longopts,
+                       int *status);
+
+/* The command summary (cmd NULL) or the entries of one command ("render", "bench", "bench sync") and
+ * the common part, to f: stdout for --help (exit 0), stderr after a usage error (exit 2). */
+void sy_cli_usage_to(FILE *f, const char *cmd);
+/* A usage error without a named option (an operand missing): what (may be NULL) and the command's
+ * usage on stderr; returns 2. */
+int sy_cli_usage_of(const char *cmd, const char *what);
+/* "--name" of a long option's code in a getopt_long table (for messages; a static buffer). */
+const char *sy_cli_option_name(const struct option *lo, int c);
+/* A usage error naming the option and the value it did not accept; returns 2. */
+int sy_cli_bad_value(const char *opt, const char *value);
+/* s as a whole number in lo..hi (decimal, nothing after it). */
+bool sy_cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out);
+/* -w W / -h H (c: 'w' or 'h') of every command that renders: 1..16384 pixels; false names nothing
+ * (the caller does). */
+bool sy_cli_size_option(int c, const char *value, uint32_t *w, uint32_t *h);
+
+/* The error on the log (stderr); returns 1, the exit status of a failure. */
+int sy_cli_fail(const sy_error *e);
+/* The back-end a command uses without -b: the registry's default (sy_mediator_default); NULL with
+ * *err when there is none. */
+const char *sy_cli_default_backend(sy_error *err);
+/* s ends in suffix, ignoring case. */
+bool sy_cli_ends_with(const char *s, const char *suffix);
+
+#endif /* SY_CLI_H */

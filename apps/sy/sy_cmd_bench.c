@@ -1,0 +1,220 @@
+/* sy_cmd_bench.c — `sy bench KIND`: the benchmarks' command line; which benchmark, its options and
+ * scene (the benchmarks: sy_bench.h, one file each; some parse their own options). */
+#include "sy_commands.h"
+#include "sy_cli.h"
+#include "sy_bench.h"
+#include "sy_bench_governor.h"
+#ifdef SY_HAVE_EMBREE
+#include "sy_bench_cull.h" /* sy bench cull: the culling service needs the coverage back-end */
+#define SY_BENCH_CULL sy_cmd_bench_cull
+#else
+#define SY_BENCH_CULL(argc, argv) ((void)(argc), (void)(argv), fprintf(stderr, "sy bench cull: error: this sy was built without the Embree back-ends (SY_WITH_EMBREE=OFF)\n"), 1)
+#endif
+#include "sy_cluster_cli.h"
+#include "sy_load.h"
+#ifdef SY_HAVE_WEB
+#include "sy_bench_web.h"
+#include "sy_web.h"
+#endif
+
+#include "sy_world.h"
+
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+/* sy bench raster [SCENE] [-w W -h H] [--repeats R] [--params k=v]: default 1280x720 on OSMesa. */
+static int cmd_bench_raster(const char *scene, uint32_t w, uint32_t h, uint32_t repeats, const char *params)
+{
+    sy_error err = {0};
+    loaded ld;
+    if (sy_cli_load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
+    sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .background = ld.background, .backend = "raster",
+                           .params = params};
+    sy_result r = sy_bench_raster(ld.scene, &vd, scene ? scene : "demo", w == 512 ? 1280 : w, h == 512 ? 720 : h,
+                                  repeats ? repeats : 10, &err);
+    sy_cli_loaded_free(&ld);
+    return r == SY_OK ? 0 : sy_cli_fail(&err);
+}
+
+/* sy bench pathtracer [SCENE] [-w W -h H] [--repeats PASSES]: the Cornell box and DamagedHelmet
+ * (under a uniform grey environment) from ../shared/testdata unless a scene is given. */
+static int cmd_bench_pathtracer(const char *scene, uint32_t w, uint32_t h, uint32_t passes)
+{
+    static const char *const defaults[2] = {"../shared/testdata/cornell/cornell_box.gltf",
+                                            "../shared/testdata/gltf/DamagedHelmet/glTF/DamagedHelmet.gltf"};
+    const char *list[2] = {scene ? scene : defaults[0], scene ? NULL : defaults[1]};
+    sy_error err = {0};
+    printf("sy bench pathtracer: %u threads (all cores), 1 sample per pixel per pass\n", (unsigned)sysconf(_SC_NPROCESSORS_ONLN));
+    for (int i = 0; i < 2 && list[i]; ++i) {
+        loaded ld;
+        if (sy_cli_load(list[i], NULL, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
+        /* the helmet under a uniform grey environment light (a 1x1 lat-long map) */
+        sy_world_options wo = {.has_env_color = i == 1, .env_color = {0.8f, 0.8f, 0.8f}};
+        sy_result r = sy_world_apply(ld.scene, &ld.background, &wo, &err);
+        if (r == SY_OK) r = sy_scene_commit(ld.scene, NULL, &err);
+        sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .background = ld.background};
+        if (r == SY_OK) r = sy_bench_pathtracer(ld.scene, &vd, list[i], w, h, passes ? passes : 8, &err);
+        sy_cli_loaded_free(&ld);
+        if (r != SY_OK) return sy_cli_fail(&err);
+    }
+    return 0;
+}
+
+/* sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W -h H] [--repeats R] (issue 7):
+ * without SCENE the analytic surrogate at 640x480; with it the path tracer's buffers at the
+ * reference's size (default 256x256). */
+static int cmd_bench_filters(int argc, char **argv)
+{
+    const char *scene = NULL, *sheet = NULL, *reference = NULL;
+    uint32_t w = 0, h = 0, repeats = 5;
+    static const struct option lo[] = {{"repeats", required_argument, NULL, OPT_REPEATS},
+                                       {"reference", required_argument, NULL, OPT_REFERENCE}, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = sy_cli_next_option("bench filters", argc, argv, SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
+        switch (c) {
+        case OPT_STOP: return status;
+        case 'w':
+            if (!sy_cli_parse_u32(optarg, 8, 16384, &w)) return sy_cli_bad_value("-w", optarg);
+            break;
+        case 'h':
+            if (!sy_cli_parse_u32(optarg, 8, 16384, &h)) return sy_cli_bad_value("-h", optarg);
+            break;
+        case OPT_REPEATS:
+            if (!sy_cli_parse_u32(optarg, 1, 1000, &repeats)) return sy_cli_bad_value("--repeats", optarg);
+            break;
+        case OPT_REFERENCE: reference = optarg; break;
+        }
+    }
+    for (; optind < argc; ++optind) { /* [SCENE] [SHEET.png] */
+        const char *a = argv[optind];
+        if (sy_cli_ends_with(a, ".png") && !sheet) sheet = a;
+        else if (!scene) scene = a;
+        else return sy_cli_usage_of("bench filters", "at most one SCENE and one SHEET.png");
+    }
+    sy_error err = {0};
+    if (!scene) return sy_bench_filters(w ? w : 640, h ? h : 480, repeats, sheet, &err) == SY_OK ? 0 : sy_cli_fail(&err);
+    if (!reference) {
+        fprintf(stderr, "sy bench filters %s: --reference REF.exr (the converged image) is required\n", scene);
+        return 2;
+    }
+    loaded ld;
+    if (sy_cli_load(scene, NULL, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
+    sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .backend = "pathtracer"};
+    sy_result r = sy_bench_filters_scene(ld.scene, &vd, scene, w ? w : 256, h ? h : 256, reference, sheet, &err);
+    sy_cli_loaded_free(&ld);
+    return r == SY_OK ? 0 : sy_cli_fail(&err);
+}
+
+/* sy bench KIND ...: argv[0] is "bench", argv[1] the kind. */
+int sy_cmd_bench(int argc, char **argv)
+{
+    static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
+                                        "viewports", "load", "cluster",    "memory", "instances", "governor",
+                                        "limit",     "cull", "web"};
+    bool known = false;
+    for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
+    if (argc >= 2 && !strcmp(argv[1], "--help")) {
+        sy_cli_usage_to(stdout, "bench");
+        return 0;
+    }
+    if (!known) {
+        if (argc >= 2) fprintf(stderr, "sy bench: error: unknown benchmark '%s'\n", argv[1]);
+        return sy_cli_usage_of("bench", argc < 2 ? "which benchmark?" : NULL);
+    }
+    const char *cmd = argv[1]; /* the benchmark */
+    argc -= 1, argv += 1; /* argv[0]: the kind */
+    if (!strcmp(cmd, "filters")) return cmd_bench_filters(argc, argv);
+    if (!strcmp(cmd, "cluster")) return sy_cmd_bench_cluster(argc, argv);
+    if (!strcmp(cmd, "governor")) return sy_cmd_bench_governor(argc, argv); /* sy_bench_governor.c */
+    if (!strcmp(cmd, "limit")) return sy_cmd_bench_limit(argc, argv); /* apps/sy/sy_bench_limit.c */
+    if (!strcmp(cmd, "cull")) return SY_BENCH_CULL(argc, argv); /* apps/sy/sy_bench_cull.c */
+    uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
+    const char *scene = NULL, *params = NULL, *backend = NULL;
+    bool memory = !strcmp(cmd, "memory"), instanced = !strcmp(cmd, "instances"), web = !strcmp(cmd, "web");
+    static const struct option lo[] = {{"params", required_argument, NULL, OPT_PARAMS},
+                                       {"nodes", required_argument, NULL, OPT_NODES},
+                                       {"tris", required_argument, NULL, OPT_TRIS},
+                                       {"glb", no_argument, NULL, OPT_GLB},
+                                       {"repeats", required_argument, NULL, OPT_REPEATS}, COMMON_OPTIONS};
+    char who[32];
+    snprintf(who, sizeof who, "bench %s", cmd);
+    bool glb = false;
+    int c, status = 0;
+    optind = 0;
+    while ((c = sy_cli_next_option(who, argc, argv, memory || instanced || web ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"), lo,
+                            &status)) != -1) {
+        switch (c) {
+        case OPT_STOP: return status;
+        case OPT_PARAMS: params = optarg; break; /* bench raster */
+        case 'b': backend = optarg; break; /* bench memory, bench instances, bench web */
+        case OPT_GLB:
+            if (!memory) return sy_cli_usage_of(who, "--glb is an option of sy bench memory");
+            glb = true;
+            break;
+        case OPT_NODES: /* bench sync: nodes; bench instances: instances */
+            if (!sy_cli_parse_u32(optarg, 1, 1u << 22, &nodes)) return sy_cli_bad_value("--nodes", optarg);
+            break;
+        case OPT_TRIS:
+            if (!sy_cli_parse_u32(optarg, 12, memory || instanced ? 1u << 30 : 1u << 20, &tris)) return sy_cli_bad_value("--tris", optarg);
+            break;
+        case OPT_REPEATS:
+            if (!sy_cli_parse_u32(optarg, 1, 100000, &repeats)) return sy_cli_bad_value("--repeats", optarg);
+            break;
+        case 'w':
+        case 'h':
+            if (!sy_cli_size_option(c, optarg, &w, &h)) return sy_cli_bad_value(c == 'w' ? "-w" : "-h", optarg);
+            break;
+        }
+    }
+    if (argc - optind > 1) return sy_cli_usage_of(who, "at most one SCENE");
+    if (optind < argc) scene = argv[optind];
+    sy_error err = {0};
+    if (!strcmp(cmd, "sync")) return sy_bench_sync(nodes, tris, repeats ? repeats : 50, &err) == SY_OK ? 0 : sy_cli_fail(&err);
+    if (!strcmp(cmd, "viewports"))
+        return sy_bench_viewports(w == 512 ? 480 : w, h == 512 ? 270 : h, repeats ? repeats : 5, &err) == SY_OK
+                   ? 0
+                   : sy_cli_fail(&err);
+    if (!strcmp(cmd, "raster")) return cmd_bench_raster(scene, w, h, repeats, params);
+    if (!strcmp(cmd, "pathtracer")) return cmd_bench_pathtracer(scene, w, h, repeats);
+    if (memory) {
+        if (optind < argc) return sy_cli_usage_of(who, "no SCENE: the height field is generated");
+        return sy_bench_memory(tris == 100 ? 1000000 : tris, backend, glb, w == 512 ? 256 : w, h == 512 ? 256 : h, &err) == SY_OK
+                   ? 0
+                   : sy_cli_fail(&err);
+    }
+    if (instanced) {
+        if (optind < argc) return sy_cli_usage_of(who, "no SCENE: the instanced height field is generated");
+#ifdef SY_HAVE_EMBREE
+        return sy_bench_instances(nodes == 10000 ? 1000 : nodes, tris == 100 ? 1000000 : tris, w == 512 ? 320 : w,
+                                  h == 512 ? 240 : h, repeats ? repeats : 10, backend, &err) == SY_OK ? 0 : sy_cli_fail(&err);
+#else
+        sy_error_set(&err, SY_ERR_UNSUPPORTED, "sy bench instances: this sy was built without the Embree back-ends");
+        return sy_cli_fail(&err);
+#endif
+    }
+    if (!strcmp(cmd, "load")) /* SCENE = the glTF sample directory; --tris: generated model (default 1M) */
+        return sy_bench_load(scene ? scene : "../shared/testdata/gltf", tris == 100 ? 1000000 : tris,
+                             repeats ? repeats : 3, &err) == SY_OK ? 0 : sy_cli_fail(&err);
+#ifdef SY_HAVE_WEB
+    if (web) { /* input-to-frame latency of sy web on loopback (apps/sy/sy_bench_web.c) */
+        loaded ld;
+        if (sy_cli_load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
+        sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,
+                         .backend = backend}; /* NULL: the default back-end */
+        sy_result r = sy_bench_web(&d, w == 512 ? 640 : w, h == 512 ? 360 : h, repeats ? repeats : 50, &err);
+        sy_cli_loaded_free(&ld);
+        return r == SY_OK ? 0 : sy_cli_fail(&err);
+    }
+#endif
+    if (!strcmp(cmd, "rays")) {
+        loaded ld;
+        if (sy_cli_load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
+        sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .backend = "whitted"};
+        sy_result r = sy_bench_rays(ld.scene, &vd, w, h, repeats ? repeats : 5, &err);
+        sy_cli_loaded_free(&ld);
+        return r == SY_OK ? 0 : sy_cli_fail(&err);
+    }
+    return sy_cli_usage_of("bench", NULL);
+}

@@ -1,0 +1,135 @@
+/* sy_cmd_info.c — `sy info SCENE | IMAGE.exr | IMAGE.png`: a JSON summary of a scene (counts,
+ * bounds, warnings) or of an image's size and metadata. */
+#include "sy_commands.h"
+#include "sy_cli.h"
+#include "sy_json.h"
+#include "sy_load.h"
+
+#include "sy_exr.h"
+#include "sy_log.h"
+#include "sy_png.h"
+#include "sy_sniff.h"
+
+#include <string.h>
+
+/* sy info IMAGE.exr: size, channels and the header's string attributes (what sy render records) as JSON. */
+static int info_exr(const char *path)
+{
+    sy_error err = {0};
+    sy_exr_image *img = NULL;
+    if (sy_exr_read(path, &img, &err) != SY_OK) return sy_cli_fail(&err);
+    cJSON *doc = cJSON_CreateObject();
+    sy_json_add(doc, "file", sy_json_str(path));
+    sy_json_add(doc, "width", cJSON_CreateNumber(img->width));
+    sy_json_add(doc, "height", cJSON_CreateNumber(img->height));
+    cJSON *ch = sy_json_add(doc, "channels", cJSON_CreateArray());
+    for (int i = 0; i < img->channel_count; ++i) sy_json_add(ch, NULL, sy_json_str(img->channels[i].name));
+    cJSON *at = sy_json_add(doc, "attributes", cJSON_CreateObject());
+    for (int i = 0; i < img->attribute_count; ++i) sy_json_add(at, img->attributes[i].name, sy_json_str(img->attributes[i].value));
+    sy_exr_image_free(img);
+    return sy_json_print(doc);
+}
+
+/* sy info IMAGE.png: the size and the text chunks (sy render writes its metadata there: sy:renderer,
+ * sy:backend, ...), in the same shape as an EXR's (attributes) */
+static int info_png(const char *path)
+{
+    sy_error err = {0};
+    sy_png_info pi;
+    if (sy_png_read_info(path, &pi, &err) != SY_OK) return sy_cli_fail(&err);
+    cJSON *doc = cJSON_CreateObject();
+    sy_json_add(doc, "file", sy_json_str(path));
+    sy_json_add(doc, "width", cJSON_CreateNumber(pi.width));
+    sy_json_add(doc, "height", cJSON_CreateNumber(pi.height));
+    cJSON *at = sy_json_add(doc, "attributes", cJSON_CreateObject());
+    for (int i = 0; i < pi.text_count; ++i) sy_json_add(at, pi.keys[i], sy_json_str(pi.values[i]));
+    sy_png_info_free(&pi);
+    return sy_json_print(doc);
+}
+
+/* counts of one kind of object in an info object */
+static void jcounts(cJSON *o, const char *const *names, const uint32_t *values, size_t n)
+{
+    for (size_t i = 0; i < n; ++i) sy_json_add(o, names[i], cJSON_CreateNumber(values[i]));
+}
+
+/* sy info's log while it loads: warnings are part of its JSON output, everything else goes to stderr. */
+static void info_log(void *user, sy_log_level level, const char *module, const char *item, const char *message)
+{
+    if (level != SY_LOG_WARNING) sy_log_stderr(user, level, module, item, message);
+}
+
+int sy_cmd_info(int argc, char **argv)
+{
+    static const struct option lo[] = {{"json", no_argument, NULL, OPT_JSON}, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = sy_cli_next_option("info", argc, argv, SHORT_OPTIONS(""), lo, &status)) != -1)
+        if (c == OPT_STOP) return status; /* --json: the output is JSON anyway */
+    if (argc - optind != 1) return sy_cli_usage_of("info", argc == optind ? "a SCENE, IMAGE.exr or IMAGE.png is required" : "one file at a time");
+    const char *path = argv[optind];
+    sy_file_format fmt = SY_FORMAT_UNKNOWN;
+    sy_error err = {0}, ignore = {0};
+    if (sy_sniff_file(path, &fmt, &ignore) != SY_OK) fmt = SY_FORMAT_UNKNOWN; /* the loader names a missing file */
+    if (fmt == SY_FORMAT_PNG) return info_png(path); /* by content, as scenes are recognised */
+    if (sy_cli_ends_with(path, ".exr")) return info_exr(path);
+    loaded ld;
+    sy_log_set_callback(info_log, NULL); /* the load's warnings go into the JSON, not also to stderr */
+    sy_result lr = sy_cli_load(path, NULL, false, &ld, &err);
+    sy_log_set_callback(NULL, NULL);
+    if (lr != SY_OK) return sy_cli_fail(&err);
+    sy_bounds b;
+    sy_node_world_bounds(ld.scene, ld.root, &b, NULL);
+    /* counts of what was loaded into the scene (less the synthetic root node) */
+    uint32_t prims = 0, tris = 0;
+    for (uint32_t id = sy_scene_next(ld.scene, SY_TYPE_MESH, 0); id; id = sy_scene_next(ld.scene, SY_TYPE_MESH, id)) {
+        const sy_mesh_data *m = sy_object_get(ld.scene, SY_TYPE_MESH, id);
+        prims += m->primitives.count;
+        for (uint32_t i = 0; i < m->primitives.count; ++i) tris += sy_primitive_triangle_count(&m->primitives.items[i]);
+    }
+    /* One layout for every format: format, the file's own counts (file_counts: what it declares,
+     * skipped items included), what was loaded into the scene (loaded), bounds, warnings. */
+    cJSON *doc = cJSON_CreateObject();
+    sy_json_add(doc, "file", sy_json_str(path));
+    sy_json_add(doc, "format", sy_json_str(ld.is_gltf ? "gltf" : ld.is_x3d ? "x3d" : "demo"));
+    static const char *const names[] = {"nodes",  "meshes", "primitives", "triangles", "materials",     "textures",
+                                        "images", "lights", "cameras",    "points",    "line_segments", "skipped"};
+    uint32_t v[12] = {0};
+    if (ld.is_gltf) {
+        const sy_gltf_counts *gc = &ld.gltf.counts;
+        const uint32_t g[12] = {gc->nodes,   gc->meshes,  gc->primitives, gc->triangles,     gc->materials,
+                                gc->textures, gc->images, gc->lights,     gc->cameras,       gc->points,
+                                gc->line_segments, gc->skipped_primitives};
+        memcpy(v, g, sizeof v);
+    } else if (ld.is_x3d) { /* X3D declares no totals: what its nodes made (an ImageTexture is one image) */
+        const sy_x3d_counts *xc = &ld.x3d.counts;
+        const uint32_t x[12] = {xc->nodes,    xc->meshes,   xc->primitives, xc->triangles, xc->materials,
+                                xc->textures, xc->textures, xc->lights,     xc->cameras,   xc->points,
+                                xc->line_segments, xc->skipped_geometry};
+        memcpy(v, x, sizeof v);
+    }
+    if (ld.is_gltf || ld.is_x3d) jcounts(sy_json_add(doc, "file_counts", cJSON_CreateObject()), names, v, 12);
+    else sy_json_add(doc, "file_counts", cJSON_CreateNull()); /* the built-in scene: no file */
+    static const char *const lnames[] = {"nodes", "meshes", "primitives", "triangles", "materials",
+                                         "textures", "lights", "cameras"};
+    const uint32_t lv[] = {sy_scene_count(ld.scene, SY_TYPE_NODE) - 1, sy_scene_count(ld.scene, SY_TYPE_MESH), prims,
+                           tris, sy_scene_count(ld.scene, SY_TYPE_MATERIAL), sy_scene_count(ld.scene, SY_TYPE_TEXTURE),
+                           sy_scene_count(ld.scene, SY_TYPE_LIGHT), sy_scene_count(ld.scene, SY_TYPE_CAMERA)};
+    jcounts(sy_json_add(doc, "loaded", cJSON_CreateObject()), lnames, lv, 8);
+    if (sy_bounds_is_empty(&b)) {
+        sy_json_add(doc, "bounds", cJSON_CreateNull());
+    } else {
+        cJSON *bo = sy_json_add(doc, "bounds", cJSON_CreateObject());
+        cJSON *mn = sy_json_add(bo, "min", cJSON_CreateArray()), *mx = sy_json_add(bo, "max", cJSON_CreateArray());
+        for (int k = 0; k < 3; ++k) {
+            sy_json_add(mn, NULL, sy_json_float((double)b.min[k]));
+            sy_json_add(mx, NULL, sy_json_float((double)b.max[k]));
+        }
+    }
+    sy_json_add(doc, "warning_count", cJSON_CreateNumber(ld.gltf.warning_count + ld.x3d.warning_count)); /* all, stored or not */
+    cJSON *wa = sy_json_add(doc, "warnings", cJSON_CreateArray());
+    for (uint32_t i = 0; i < ld.gltf.stored_warning_count; ++i) sy_json_add(wa, NULL, sy_json_str(ld.gltf.warnings[i]));
+    for (uint32_t i = 0; i < ld.x3d.stored_warning_count; ++i) sy_json_add(wa, NULL, sy_json_str(ld.x3d.warnings[i]));
+    sy_cli_loaded_free(&ld);
+    return sy_json_print(doc);
+}

@@ -1,0 +1,614 @@
+/* sy_cmd_render.c — `sy render SCENE|DIR`: one image of a scene with a back-end (options, output
+ * and its metadata, a progressive back-end's passes and feature buffers, stereo, overlays, and
+ * --cluster through sy_cluster_cli.h). */
+#include "sy_commands.h"
+#include "sy_cli.h"
+#include "sy_cluster_cli.h"
+#include "sy_compose.h"
+#include "sy_load.h"
+#include "sy_mediator_cluster.h"
+#include "sy_output.h"
+#include "sy_signals.h"
+#include "sy_testpoint.h"
+
+#include "sy_exr.h"
+#include "sy_file.h"
+#include "sy_log.h"
+#include "sy_mediators.h"
+#include "sy_viewport.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* A scene file's extension, as the loaders' names suggest (the content decides later). */
+static bool is_scene_name(const char *name)
+{
+    return sy_cli_ends_with(name, ".gltf") || sy_cli_ends_with(name, ".glb") || sy_cli_ends_with(name, ".x3d");
+}
+
+static int cmp_names(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
+
+/* `sy render DIR`: the one scene file in dir (into out), looked for directly in it and, when there
+ * is none, one folder down (a Khronos sample's glTF/, glTF-Binary/ ...); several: an error that
+ * lists them. */
+static sy_result scene_in_folder(const char *dir, char *out, size_t out_len, sy_error *err)
+{
+    enum { MAX_LISTED = 12 };
+    char *found[64];
+    uint32_t n = 0, total = 0;
+    for (int depth = 0; depth < 2 && total == 0; ++depth) {
+        DIR *d = opendir(dir);
+        if (!d) return sy_error_set(err, SY_ERR_IO, "%s: cannot read the folder: %s", dir, strerror(errno));
+        struct dirent *de;
+        while ((de = readdir(d))) {
+            if (de->d_name[0] == '.') continue;
+            char path[4096];
+            snprintf(path, sizeof path, "%s%s%s", dir, sy_cli_ends_with(dir, "/") ? "" : "/", de->d_name);
+            struct stat st;
+            if (stat(path, &st) != 0) continue;
+            if (depth == 0 && S_ISREG(st.st_mode) && is_scene_name(de->d_name)) {
+                if (n < 64) found[n++] = strdup(path);
+                total++;
+            } else if (depth == 1 && S_ISDIR(st.st_mode)) {
+                DIR *sd = opendir(path);
+                struct dirent *se;
+                while (sd && (se = readdir(sd))) {
+                    char sub[4096 + 256];
+                    snprintf(sub, sizeof sub, "%s/%s", path, se->d_name);
+                    if (se->d_name[0] == '.' || !is_scene_name(se->d_name) || stat(sub, &st) != 0 || !S_ISREG(st.st_mode))
+                        continue;
+                    if (n < 64) found[n++] = strdup(sub);
+                    total++;
+                }
+                if (sd) closedir(sd);
+            }
+        }
+        closedir(d);
+    }
+    for (uint32_t i = 0; i < n; ++i)
+        if (!found[i]) { /* strdup failed */
+            for (uint32_t k = 0; k < n; ++k) free(found[k]);
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", dir);
+        }
+    qsort(found, n, sizeof *found, cmp_names);
+    sy_result r = SY_OK;
+    if (total == 1) {
+        if (snprintf(out, out_len, "%s", found[0]) >= (int)out_len)
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: path too long", found[0]);
+    } else if (total == 0) {
+        r = sy_error_set(err, SY_ERR_NOT_FOUND, "%s: no scene file (.gltf, .glb, .x3d) in the folder or one folder down", dir);
+    } else {
+        char list[2048] = "";
+        size_t used = 0;
+        for (uint32_t i = 0; i < n && i < MAX_LISTED && used < sizeof list; ++i)
+            used += (size_t)snprintf(list + used, sizeof list - used, "\n  %s", found[i]);
+        r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: %u scene files; name one:%s%s", dir, total, list,
+                         total > MAX_LISTED ? "\n  ..." : "");
+    }
+    for (uint32_t i = 0; i < n; ++i) free(found[i]);
+    return r;
+}
+
+/* `sy render SCENE` without -o: STEM.png in the current folder (STEM: the file's name without its
+ * extension; "demo" for the built-in scene). */
+static void default_output(const char *scene, char *out, size_t out_len)
+{
+    const char *base = strrchr(scene, '/');
+    base = base ? base + 1 : scene;
+    const char *dot = strrchr(base, '.');
+    int n = dot && dot != base ? (int)(dot - base) : (int)strlen(base);
+    snprintf(out, out_len, "%.*s.png", n, base);
+}
+
+/* >>progressive (path tracer): sample budget, environment, feature buffers */
+typedef struct pt_opts {
+    uint32_t spp;         /* 0 = default (64 unless a time budget is given) */
+    double time_budget;   /* seconds, 0 = none */
+    bool aov;             /* write feature buffers as extra EXR channels */
+} pt_opts;
+
+typedef struct pt_progress {
+    double start;
+    uint64_t done, total; /* samples per pixel; total 0 = time budget */
+    double budget;
+} pt_progress;
+
+static void pt_progress_print(const pt_progress *p, bool final)
+{
+    double el = sy_time_now() - p->start, rate = el > 0 ? (double)p->done / el : 0;
+    if (final) {
+        fprintf(stderr, "\r%*s\r", 78, "");
+    } else if (p->total) {
+        double eta = rate > 0 ? (double)(p->total - p->done) / rate : 0;
+        fprintf(stderr, "\rpathtracer: %llu/%llu samples, %.2f samples/s, %.1f s, ETA %.1f s   ",
+                (unsigned long long)p->done, (unsigned long long)p->total, rate, el, eta);
+    } else {
+        fprintf(stderr, "\rpathtracer: %llu samples, %.2f samples/s, %.1f s, ETA %.1f s   ", (unsigned long long)p->done,
+                rate, el, fmax(0.0, p->budget - el));
+    }
+    fflush(stderr);
+}
+
+/* Renders a progressive back-end in passes until the sample count or the time budget is reached,
+ * through the same window composition as a single-pass render (overlays and stereo included).
+ * *out / *out_right get the final images; *samples_out the samples per pixel accumulated by the
+ * main back-end; *ctx_out its (pool-owned) context. */
+static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uint32_t w, uint32_t h, const pt_opts *po,
+                                    sy_context_pool *pool, sy_layer *out, sy_layer *out_right, double *seconds,
+                                    uint64_t *samples_out, sy_context **ctx_out, sy_error *err)
+{
+    sy_params pp;
+    sy_result r = sy_params_parse(spec->params, &pp, err);
+    uint64_t target = po->spp ? po->spp : (po->time_budget > 0 ? 0 : 64);
+    pt_progress pr = {sy_time_now(), 0, target, po->time_budget};
+    bool tty = sy_is_terminal(2);
+    double t0 = sy_time_now(), last_print = 0;
+    uint32_t chunk = 1;
+    while (r == SY_OK) {
+        uint64_t left = target ? target - pr.done : UINT32_MAX;
+        uint32_t n = (uint32_t)(left < chunk ? left : chunk);
+        double p0 = sy_time_now();
+        sy_window_render_opts ro = {.sample_count = n};
+        sy_layer_destroy(out);
+        sy_layer_destroy(out_right);
+        r = sy_compose_render(ld->scene, pool, spec, w, h, &ro, out, out_right, err);
+        if (r != SY_OK) break;
+        pr.done += n;
+        /* the samples the back-end actually holds (a cooperative cluster adds them in multiples of its
+         * server count) */
+        sy_context *mc = NULL;
+        sy_mediator_stats ms = {0};
+        if (sy_context_pool_get(pool, ld->scene, spec->backend, &pp, ld->root.id, &mc, err) == SY_OK) {
+            sy_context_stats(mc, &ms);
+            if (ms.samples > pr.done) pr.done = ms.samples;
+        }
+        double now = sy_time_now(), pass = (now - p0) / n;
+        if (tty && now - last_print > 0.1) {
+            pt_progress_print(&pr, false);
+            last_print = now;
+        }
+        if (target && pr.done >= target) break;
+        if (po->time_budget > 0 && now - t0 + pass > po->time_budget) break;
+        sy_testpoint("pass"); /* a pass is done and the graceful interrupt armed (tests wait for it) */
+        if (sy_signals_interrupted()) break; /* first Ctrl-C: keep what the finished passes gave */
+        /* passes of about a quarter of a second: responsive progress, little overhead */
+        double want = pass > 0 ? 0.25 / pass : 64;
+        chunk = want < 1 ? 1 : want > 1024 ? 1024 : (uint32_t)want;
+        if (po->time_budget > 0) {
+            double rest = (po->time_budget - (now - t0)) / (pass > 0 ? pass : 1e-3);
+            if (rest < chunk) chunk = rest < 1 ? 1 : (uint32_t)rest;
+        }
+    }
+    *seconds = sy_time_now() - t0;
+    if (tty) pt_progress_print(&pr, true);
+    sy_context *ctx = NULL;
+    if (r == SY_OK) r = sy_context_pool_get(pool, ld->scene, spec->backend, &pp, ld->root.id, &ctx, err);
+    if (r == SY_OK) {
+        sy_mediator_stats st = {0};
+        sy_context_stats(ctx, &st);
+        *samples_out = st.samples;
+        *ctx_out = ctx;
+    }
+    return r;
+}
+
+/* Writes the back-end's feature buffers (SY_CAP_AOVS) as channels of one EXR: colour and depth
+ * as R G B A Z, every other plane as NAME.{R,G,B} (normal: NAME.{X,Y,Z}), e.g. variance.R. */
+static sy_result write_aov_exr(const char *path, sy_context *ctx, const out_opts *o, sy_error *err)
+{
+    sy_aovs a;
+    sy_result r = sy_context_aovs(ctx, &a, err);
+    if (r != SY_OK) return r;
+    sy_exr_channel_desc ch[4 * SY_AOVS_MAX];
+    int n = 0;
+    static const char *const rgba[4] = {"R", "G", "B", "A"}, *const rgb[4] = {"R", "G", "B", "A"},
+                             *const xyz[3] = {"X", "Y", "Z"};
+    char names[SY_AOVS_MAX][4][48];
+    sy_exr_pixel_type ct = o->half ? SY_EXR_PIXEL_HALF : SY_EXR_PIXEL_FLOAT;
+    for (uint32_t k = 0; k < a.count; ++k) {
+        const sy_aov_plane *p = &a.planes[k];
+        if (!strcmp(p->name, "color")) {
+            for (uint32_t i = 0; i < 4 && i < p->channels; ++i) ch[n++] = (sy_exr_channel_desc){rgba[i], p->data, p->channels, i, ct};
+        } else if (!strcmp(p->name, "depth")) {
+            ch[n++] = (sy_exr_channel_desc){"Z", p->data, p->channels, 0, SY_EXR_PIXEL_FLOAT};
+        } else {
+            bool normal = !strcmp(p->name, "normal");
+            for (uint32_t i = 0; i < p->channels && i < (normal ? 3u : 4u); ++i) {
+                snprintf(names[k][i], sizeof names[k][i], "%s.%s", p->name, normal ? xyz[i] : rgb[i]);
+                ch[n++] = (sy_exr_channel_desc){names[k][i], p->data, p->channels, i, ct};
+            }
+        }
+    }
+    sy_exr_write_desc wd = {.width = (int)a.width, .height = (int)a.height, .channels = ch, .channel_count = n,
+                            .attributes = o->attrs, .attribute_count = o->attr_count};
+    r = sy_exr_write(path, &wd, err);
+    sy_aovs_free(&a);
+    return r;
+}
+
+/* NAME.EXT -> NAME_left.EXT and NAME_right.EXT */
+static sy_result eye_paths(const char *outp, char *lp, char *rp, size_t n, sy_error *err)
+{
+    const char *dot = strrchr(outp, '.');
+    size_t stem = dot ? (size_t)(dot - outp) : strlen(outp);
+    if ((size_t)snprintf(lp, n, "%.*s_left%s", (int)stem, outp, dot ? dot : "") >= n ||
+        (size_t)snprintf(rp, n, "%.*s_right%s", (int)stem, outp, dot ? dot : "") >= n)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: path too long", outp);
+    return SY_OK;
+}
+
+/* `--gl PROVIDER` (raster back-end): appended to the back-end parameters as gl=PROVIDER. */
+static const char *render_gl_params(const char *params, const char *provider, char *buf, size_t len)
+{
+    snprintf(buf, len, "%s%sgl=%s", params ? params : "", params && *params ? "," : "", provider);
+    return buf;
+}
+
+/* `--filter NAME [--threshold T]` (path tracer display filter): appended to the back-end
+ * parameters as filter=NAME,threshold=T; the mediator validates them (sy_mediator_rt.h). */
+static const char *render_filter_params(const char *params, const char *filter, const char *threshold, char *buf,
+                                        size_t len)
+{
+    snprintf(buf, len, "%s%s%s%s%s%s", params ? params : "", params && *params ? "," : "", filter ? "filter=" : "",
+             filter ? filter : "", filter && threshold ? "," : "", threshold ? "threshold=" : "");
+    if (threshold) strncat(buf, threshold, len - strlen(buf) - 1);
+    return buf;
+}
+
+/* One line per cluster frame on stderr: servers, failures, bytes (the cluster mediator's statistics). */
+static void cluster_report(sy_scene *scene, sy_context_pool *pool, const sy_compose_spec *spec, uint32_t frame,
+                           uint32_t servers)
+{
+    sy_params pp;
+    sy_context *ctx = NULL;
+    sy_error e = {0};
+    if (sy_params_parse(spec->params, &pp, &e) != SY_OK ||
+        sy_context_pool_get(pool, scene, spec->backend, &pp, spec->root.id, &ctx, &e) != SY_OK ||
+        !(sy_context_caps(ctx) & SY_CAP_REMOTE))
+        return;
+    sy_cluster_frame_stats st;
+    uint32_t mode = 0;
+    sy_cluster_cli_last_frame(ctx, &st, &mode);
+    sy_log(SY_LOG_NOTE, "sy", NULL,
+           "cluster frame %u (%s): %u/%u servers, %u failed, %u reassigned, %.3f s, "
+           "%llu bytes sent (%llu scene), %llu received",
+           frame + 1, sy_cluster_cli_mode_name(mode), st.servers_live, servers, st.servers_failed, st.reassigned,
+           st.seconds, (unsigned long long)st.bytes_sent, (unsigned long long)st.scene_bytes,
+           (unsigned long long)st.bytes_received);
+    if (mode == SY_CLUSTER_COOPERATIVE)
+        sy_log(SY_LOG_NOTE, "sy", NULL, "cluster: merged %llu samples per pixel", (unsigned long long)st.samples);
+}
+
+int sy_cmd_render(int argc, char **argv)
+{
+    const char *scene = NULL, *backend = NULL, *outp = NULL, *camera = NULL, *params = NULL;
+    const char *gl_provider = NULL;
+    const char *filter = NULL, *threshold = NULL; /* --filter / --threshold (path tracer) */
+    const char *overlay = NULL, *composite = "depth";
+    uint32_t w = 0, h = 0;
+    out_opts oo = {.png = {.tonemap = SY_TONEMAP_DISPLAY}}; /* the library's display tone map */
+    sy_compose_spec spec = {.eye_separation = 0.065f, .zero_parallax = 2.0f};
+    sy_error perr = {0};
+    sy_cluster_cli_opts clo = {0};
+    pt_opts po = {0};
+    bool progressive_opts = false; /* --spp / --time / --aov given */
+    static const struct option lo[] = {
+        {"spp", required_argument, NULL, OPT_SPP}, {"time", required_argument, NULL, OPT_TIME},
+        {"aov", no_argument, NULL, OPT_AOV}, {"camera", required_argument, NULL, OPT_CAMERA},
+        {"params", required_argument, NULL, OPT_PARAMS}, {"gl", required_argument, NULL, OPT_GL},
+        {"filter", required_argument, NULL, OPT_FILTER}, {"threshold", required_argument, NULL, OPT_THRESHOLD},
+        {"half", no_argument, NULL, OPT_HALF}, {"exposure", required_argument, NULL, OPT_EXPOSURE},
+        {"tonemap", required_argument, NULL, OPT_TONEMAP}, {"stereo", required_argument, NULL, OPT_STEREO},
+        {"eye-sep", required_argument, NULL, OPT_EYE_SEP}, {"zero-parallax", required_argument, NULL, OPT_ZERO_PARALLAX},
+        {"overlay", required_argument, NULL, OPT_OVERLAY}, {"composite", required_argument, NULL, OPT_COMPOSITE},
+        {"frames", required_argument, NULL, OPT_FRAMES}, /* cluster: frames through the same window */
+        {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
+        SY_CLUSTER_CLI_OPTIONS, COMMON_OPTIONS};
+    uint32_t max_memory_mb = 0;
+    int c, status = 0;
+    optind = 0;
+    while ((c = sy_cli_next_option("render", argc, argv, SHORT_OPTIONS("b:o:w:h:"), lo, &status)) != -1) {
+        char *end = NULL;
+        switch (c) {
+        case OPT_STOP: return status;
+        case 'b': backend = optarg; break;
+        case OPT_SPP:
+            if (!sy_cli_parse_u32(optarg, 1, 1u << 24, &po.spp)) return sy_cli_bad_value("--spp", optarg);
+            progressive_opts = true;
+            break;
+        case OPT_TIME:
+            po.time_budget = strtod(optarg, &end);
+            if (end == optarg || *end || !(po.time_budget > 0) || !isfinite(po.time_budget)) return sy_cli_bad_value("--time", optarg);
+            progressive_opts = true;
+            break;
+        case OPT_AOV: po.aov = progressive_opts = true; break;
+        case 'o': outp = optarg; break;
+        case 'w':
+        case 'h':
+            if (!sy_cli_size_option(c, optarg, &w, &h)) return sy_cli_bad_value(c == 'w' ? "-w" : "-h", optarg);
+            break;
+        case OPT_CAMERA: camera = optarg; break;
+        case OPT_PARAMS: params = optarg; break;
+        case OPT_GL: gl_provider = optarg; break;          /* raster: gl=... parameter */
+        case OPT_FILTER: filter = optarg; break;           /* pathtracer: filter=... */
+        case OPT_THRESHOLD: threshold = optarg; break;     /* pathtracer: threshold=... */
+        case OPT_HALF: oo.half = true; break;
+        case OPT_EXPOSURE:
+            oo.png.exposure_stops = strtof(optarg, &end);
+            if (end == optarg || *end || !isfinite(oo.png.exposure_stops)) return sy_cli_bad_value("--exposure", optarg);
+            break;
+        case OPT_TONEMAP:
+            if (!strcmp(optarg, "aces")) oo.png.tonemap = SY_TONEMAP_ACES;
+            else if (!strcmp(optarg, "reinhard")) oo.png.tonemap = SY_TONEMAP_REINHARD;
+            else if (!strcmp(optarg, "clamp")) oo.png.tonemap = SY_TONEMAP_CLAMP;
+            else return sy_cli_bad_value("--tonemap", optarg);
+            break;
+        case OPT_STEREO:
+            if (sy_stereo_mode_parse(optarg, &spec.stereo, &perr) != SY_OK) return sy_cli_fail(&perr);
+            break;
+        case OPT_EYE_SEP: /* the range: sy_compose says why */
+            spec.eye_separation = strtof(optarg, &end);
+            if (end == optarg || *end) return sy_cli_bad_value("--eye-sep", optarg);
+            break;
+        case OPT_ZERO_PARALLAX:
+            spec.zero_parallax = strtof(optarg, &end);
+            if (end == optarg || *end) return sy_cli_bad_value("--zero-parallax", optarg);
+            break;
+        case OPT_OVERLAY: overlay = optarg; break;
+        case OPT_COMPOSITE: composite = optarg; break;
+        case OPT_FRAMES:
+            if (!sy_cli_parse_u32(optarg, 1, 100000000u, &clo.frames)) return sy_cli_bad_value("--frames", optarg);
+            break;
+        case OPT_MAX_MEMORY:
+            if (!sy_cli_parse_u32(optarg, 1, 1u << 30, &max_memory_mb)) return sy_cli_bad_value("--max-memory", optarg);
+            break;
+        default: /* --cluster ... (sy_cluster_cli.c) */
+            if (!sy_cluster_cli_getopt(c, optarg, &clo)) return sy_cli_bad_value(sy_cli_option_name(lo, c), optarg);
+        }
+    }
+    for (; optind < argc; ++optind) {
+        if (scene) return sy_cli_usage_of("render", "one SCENE at a time");
+        scene = argv[optind];
+    }
+    if (clo.cluster && !strcmp(clo.cluster, "mpi")) { /* mpirun -np N sy render ... --cluster mpi */
+        bool served = false;
+        sy_error merr = {0};
+        sy_result mr = sy_cluster_cli_mpi_start(&clo, &served, &merr);
+        if (served) return mr == SY_OK ? 0 : sy_cli_fail(&merr); /* a server rank: rank 0 is done */
+        if (mr != SY_OK) return sy_cli_fail(&merr);
+    }
+    if (!scene) return sy_cli_usage_of("render", "a SCENE is required");
+    sy_error err = {0};
+    char in_folder[4096], auto_out[1024];
+    struct stat sst;
+    if (stat(scene, &sst) == 0 && S_ISDIR(sst.st_mode)) { /* sy render DIR: its one scene file */
+        if (scene_in_folder(scene, in_folder, sizeof in_folder, &err) != SY_OK) return sy_cli_fail(&err);
+        scene = in_folder;
+    }
+    if (!backend && !(backend = sy_cli_default_backend(&err))) return sy_cli_fail(&err);
+    if (!outp) { /* STEM.png here; the line that reports the render names it */
+        default_output(scene, auto_out, sizeof auto_out);
+        outp = auto_out;
+    }
+    char gl_params[256];
+    if (gl_provider) params = render_gl_params(params, gl_provider, gl_params, sizeof gl_params);
+    char filter_params[512];
+    if (filter || threshold) params = render_filter_params(params, filter, threshold, filter_params, sizeof filter_params);
+    char memory_params[600];
+    if (max_memory_mb) { /* --max-memory MB: the back-end's declared memory limit (max_memory_mb) */
+        const sy_mediator_class *mc = sy_mediator_find(backend);
+        if (mc && !sy_param_find(&mc->param_table, "max_memory_mb")) {
+            sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--max-memory: back-end '%s' has no memory limit (no max_memory_mb "
+                         "parameter)", backend);
+            return sy_cli_fail(&err);
+        }
+        snprintf(memory_params, sizeof memory_params, "%s%smax_memory_mb=%u", params ? params : "",
+                 params && *params ? "," : "", max_memory_mb);
+        params = memory_params;
+    }
+    /* the output's folder must take a file before anything is loaded or rendered (an unwritable
+     * one was found only after the render): a temporary file is created there and removed */
+    sy_atomic_file probe = {0};
+    if (sy_atomic_file_begin(outp, &probe, &err) != SY_OK) return sy_cli_fail(&err);
+    sy_atomic_file_abort(&probe);
+    sy_params given = {0};
+    if (sy_params_parse(params, &given, &err) != SY_OK) { /* a key twice ("spp=1,spp=2"): a usage error */
+        sy_log(SY_LOG_ERROR, "sy", NULL, "%s", err.message);
+        return 2;
+    }
+    if (!sy_cli_is_output_path(outp)) { /* before any loading or rendering */
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in " OUTPUT_KINDS, outp);
+        return sy_cli_fail(&err);
+    }
+    /* --cluster: the main viewport's back-end becomes the cluster mediator (the servers render with
+     * -b BACKEND); everything below is the same render path as a local one */
+    const char *remote = backend;
+    char cluster_params[1400];
+    uint32_t cluster_mode = 0, cluster_servers = 0;
+    if (clo.cluster) {
+        if (sy_cluster_cli_setup(&clo, backend, params, cluster_params, sizeof cluster_params, &cluster_mode,
+                                 &cluster_servers, NULL, &err) != SY_OK)
+            return sy_cli_fail(&err);
+        if (cluster_mode == SY_CLUSTER_STEREO && spec.stereo == SY_STEREO_NONE) spec.stereo = SY_STEREO_SBS;
+        backend = SY_MEDIATOR_CLUSTER_NAME;
+        params = cluster_params;
+    }
+    char shown[96]; /* the back-end as reported: "whitted", or "whitted on 2 servers (sort-first)" */
+    if (clo.cluster)
+        snprintf(shown, sizeof shown, "%s on %u server%s (%s)", remote, cluster_servers, cluster_servers == 1 ? "" : "s",
+                 sy_cluster_cli_mode_name(cluster_mode));
+    else snprintf(shown, sizeof shown, "%s", remote);
+    const sy_mediator_class *bcls = sy_mediator_find(backend);
+    sy_params bparams = {0};
+    if (!bcls) {
+        sy_context *none = NULL;
+        sy_context_create(NULL, backend, NULL, 0, &none, &err); /* the error that lists the back-ends */
+        return sy_cli_fail(&err);
+    }
+    if (sy_params_parse(params, &bparams, &err) != SY_OK) return sy_cli_fail(&err);
+    if (sy_mediator_class_check_params(bcls, &bparams, &err) != SY_OK) { /* unknown key, bad value: usage */
+        sy_log(SY_LOG_ERROR, "sy", NULL, "%s", err.message); /* --params, --filter, --threshold, --gl */
+        return 2;
+    }
+    uint32_t caps = sy_mediator_class_caps(bcls, &bparams);
+    const sy_mediator_class *rcls = sy_mediator_find(remote);
+    if ((filter || threshold) && !(caps & SY_CAP_FILTERS)) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--filter and --threshold need a back-end with display filters, "
+                     "such as a local -b pathtracer (got -b %s%s)",
+                     remote, clo.cluster ? " with --cluster: its strips would be filtered apart" : "");
+        return sy_cli_fail(&err);
+    }
+    bool progressive = (caps & SY_CAP_PROGRESSIVE) != 0;
+    /* a cluster in sort-first / balanced mode over a progressive back-end: --spp is the samples of each request */
+    bool remote_spp = clo.cluster && !progressive && rcls && (rcls->caps & SY_CAP_PROGRESSIVE) && po.spp && !po.aov &&
+                      !(po.time_budget > 0);
+    if (progressive_opts && !progressive && !remote_spp) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--spp, --time and --aov need a progressive back-end; '%s'%s is not",
+                     remote, clo.cluster ? " on the cluster in this mode (cooperative is)" : "");
+        return sy_cli_fail(&err);
+    }
+    if (po.aov && !(caps & SY_CAP_AOVS)) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--aov: back-end %s%s keeps no feature buffers", remote,
+                     clo.cluster ? " on the cluster" : "");
+        return sy_cli_fail(&err);
+    }
+    if (po.aov && (!sy_cli_ends_with(outp, ".exr") || spec.stereo != SY_STEREO_NONE || overlay)) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: --aov needs an .exr output of a local mono render without overlay",
+                     outp);
+        return sy_cli_fail(&err);
+    }
+    loaded ld;
+    if (sy_cli_load(scene, camera, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
+    /* default size: 512 high, width from the camera's aspect ratio when it has one */
+    float aspect = 1.0f;
+    const sy_node_data *cn = ld.camera.id ? sy_node_get(ld.scene, ld.camera) : NULL;
+    const sy_camera_data *cd = cn ? sy_camera_get(ld.scene, cn->camera) : NULL;
+    if (cd && cd->aspect > 0) aspect = cd->aspect;
+    if (ld.camera.id == 0 && !ld.is_gltf) aspect = 1.0f;
+    if (!w && !h) h = 512, w = (uint32_t)lroundf(512 * aspect);
+    else if (!w) w = (uint32_t)lroundf((float)h * aspect);
+    else if (!h) h = (uint32_t)lroundf((float)w / aspect);
+    if (!w) w = 1;
+    if (!h) h = 1;
+    if (ld.is_x3d) sy_cli_fit_x3d_cameras(&ld, w, h); /* X3D fieldOfView is the smaller side's angle */
+    sy_context_pool *pool = NULL;
+    sy_layer img = {0}, img_right = {0};
+    double secs = 0;
+    spec.backend = backend;
+    spec.params = params;
+    spec.root = ld.root;
+    spec.camera = ld.camera;
+    spec.background = ld.background;
+    sy_result r = overlay ? sy_cli_add_overlay(&ld, overlay, composite, &spec, &err) : SY_OK;
+    if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
+    progress_state ps = {shown, sy_time_now(), 0, sy_is_terminal(2), false};
+    sy_window_render_opts ro = {.progress = sy_cli_progress_cb, .progress_user = &ps};
+    double t0 = sy_time_now();
+    uint64_t samples = 0;
+    sy_context *pctx = NULL;
+    bool interrupted = false;
+    char samples_str[32], secs_str[32];
+    if (r == SY_OK && progressive) {
+        /* the first Ctrl-C ends the render after the pass in progress and keeps its image */
+        sy_signals_set_graceful("finishing the current pass, then writing the image accumulated so far");
+        r = render_progressive(&ld, &spec, w, h, &po, pool, &img, &img_right, &secs, &samples, &pctx, &err);
+        t0 = sy_time_now() - secs;
+        interrupted = sy_signals_interrupted();
+    } else if (r == SY_OK && clo.cluster) {
+        /* --frames N: N frames through the same window (balanced strips adapt from frame to frame) */
+        if (remote_spp) ro.sample_count = po.spp;
+        uint32_t frames = clo.frames ? clo.frames : 1;
+        for (uint32_t i = 0; i < frames && r == SY_OK; ++i) {
+            sy_layer_destroy(&img);
+            sy_layer_destroy(&img_right);
+            r = sy_compose_render(ld.scene, pool, &spec, w, h, &ro, &img, &img_right, &err);
+            if (r == SY_OK) cluster_report(ld.scene, pool, &spec, i, cluster_servers);
+        }
+    } else if (r == SY_OK) r = sy_compose_render(ld.scene, pool, &spec, w, h, &ro, &img, &img_right, &err);
+    secs = sy_time_now() - t0;
+    /* the image's metadata (EXR header attributes, PNG text chunks): what made it and how */
+    sy_exr_attribute attrs[12];
+    sy_png_text texts[12];
+    char renderer[64], size_str[48], camera_str[256];
+    if (r == SY_OK) {
+        if (!progressive) { /* what the main back-end accumulated (a single pass: 1) */
+            sy_params mp;
+            sy_context *mc = NULL;
+            sy_mediator_stats ms = {0};
+            sy_error ignore = {0};
+            if (sy_params_parse(spec.params, &mp, &ignore) == SY_OK &&
+                sy_context_pool_get(pool, ld.scene, spec.backend, &mp, ld.root.id, &mc, &ignore) == SY_OK)
+                sy_context_stats(mc, &ms);
+            samples = ms.samples;
+        }
+        snprintf(renderer, sizeof renderer, "Switchyard %s", sy_version());
+        snprintf(samples_str, sizeof samples_str, "%llu", (unsigned long long)samples);
+        snprintf(secs_str, sizeof secs_str, "%.3f", secs);
+        snprintf(size_str, sizeof size_str, "%ux%u%s", w, h,
+                 spec.stereo == SY_STEREO_NONE ? "" : spec.stereo == SY_STEREO_SEPARATE ? " per eye" : " per eye, stereo");
+        sy_mat4 cm = sy_mat4_identity();
+        bool has_cam = ld.camera.id && sy_node_world_matrix(ld.scene, ld.camera, &cm, NULL) == SY_OK;
+        if (has_cam)
+            snprintf(camera_str, sizeof camera_str, "%s at (%g, %g, %g) looking along (%g, %g, %g)",
+                     camera ? camera : "the scene's first camera", (double)cm.m[12], (double)cm.m[13], (double)cm.m[14],
+                     (double)-cm.m[8], (double)-cm.m[9], (double)-cm.m[10]);
+        else snprintf(camera_str, sizeof camera_str, "a view framing the scene's bounds");
+        const char *kv[][2] = {{"sy:renderer", renderer}, {"sy:backend", shown}, {"sy:params", params},
+                               {"sy:camera", camera_str}, {"sy:size", size_str}, {"sy:samples", samples_str},
+                               {"sy:seconds", secs_str}, {"sy:source", scene},
+                               {"sy:interrupted", interrupted ? "1" : NULL}};
+        for (size_t k = 0; k < sizeof kv / sizeof kv[0]; ++k) {
+            if (!kv[k][1] || !kv[k][1][0]) continue;
+            attrs[oo.attr_count] = (sy_exr_attribute){kv[k][0], kv[k][1]};
+            texts[oo.attr_count] = (sy_png_text){kv[k][0], kv[k][1]};
+            oo.attr_count++;
+        }
+        oo.attrs = attrs;
+        oo.png.text = texts;
+        oo.png.text_count = oo.attr_count;
+    }
+    if (r == SY_OK && clo.cluster && cluster_mode == SY_CLUSTER_MULTI_DISPLAY) {
+        printf("multi-display: %ux%u wall presented by the servers, %s, %.3f s\n", w, h, remote, secs);
+    } else if (r == SY_OK) {
+        size_t bad = sy_layer_count_nonfinite(&img) + (img_right.rgba ? sy_layer_count_nonfinite(&img_right) : 0);
+        if (bad) sy_log(SY_LOG_WARNING, "sy", outp, "%zu pixels are not finite", bad);
+        if (spec.stereo == SY_STEREO_SEPARATE) {
+            char lp[4096], rp[4096];
+            r = eye_paths(outp, lp, rp, sizeof lp, &err);
+            if (r == SY_OK) r = sy_cli_write_image(lp, &img, &oo, &err);
+            if (r == SY_OK) r = sy_cli_write_image(rp, &img_right, &oo, &err);
+            if (r == SY_OK) printf("%s, %s: %ux%u per eye, %s, %.3f s\n", lp, rp, w, h, shown, secs);
+        } else {
+            r = po.aov ? write_aov_exr(outp, pctx, &oo, &err) : sy_cli_write_image(outp, &img, &oo, &err);
+            if (r == SY_OK && progressive)
+                printf("%s: %ux%u, %s, %llu samples per pixel, %.3f s (%.2f samples/s)%s\n", outp, img.width,
+                       img.height, shown, (unsigned long long)samples, secs,
+                       secs > 0 ? (double)samples / secs : 0.0, interrupted ? ", interrupted" : "");
+            else if (r == SY_OK) printf("%s: %ux%u, %s, %.3f s\n", outp, img.width, img.height, shown, secs);
+            if (r == SY_OK && progressive && filter && pctx) { /* the display filter's report (issue 7) */
+                sy_filter_info fi;
+                sy_context_filter_info(pctx, &fi);
+                printf("filter %s: threshold %g, last filter %.1f ms, last pass at %u spp, mean blend %.3f, "
+                       "NaN/Inf: %llu pixels, %llu samples\n",
+                       fi.name, (double)fi.threshold, fi.seconds * 1e3, fi.last_pass_samples, fi.mean_blend,
+                       (unsigned long long)fi.nonfinite_pixels, (unsigned long long)fi.nonfinite_samples);
+            }
+        }
+    }
+    sy_layer_destroy(&img);
+    sy_layer_destroy(&img_right);
+    sy_context_pool_destroy(pool);
+    sy_cli_loaded_free(&ld);
+    interrupted = interrupted || (progressive && sy_signals_interrupted()); /* also while writing */
+    if (r == SY_OK && interrupted) {
+        fprintf(stderr, "sy render: interrupted: wrote the image of %llu samples per pixel (sy:samples in the EXR "
+                        "header); exit status 130\n", (unsigned long long)samples);
+        return 130;
+    }
+    return r == SY_OK ? 0 : sy_cli_fail(&err);
+}

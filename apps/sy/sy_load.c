@@ -1,0 +1,189 @@
+/* sy_load.c — how sy loads a SCENE (sy_load.h): the built-in demo, glTF or X3D recognised by content,
+ * the loader options of every command (--allow-path, --strict, --max-scene-mb), a default camera,
+ * the world flags, X3D fields of view, and --overlay FILE[:BACKEND]. */
+#include "sy_load.h"
+
+#include "sy_demo.h"
+#include "sy_log.h"
+#include "sy_mediators.h"
+#include "sy_viewport.h"
+#include "sy_sniff.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+sy_load_options sy_cli_load_opts;
+
+void sy_cli_loaded_free(loaded *l)
+{
+    sy_gltf_info_free(&l->gltf);
+    sy_x3d_info_free(&l->x3d);
+    sy_scene_destroy(l->scene);
+    memset(l, 0, sizeof *l);
+}
+
+/* A file without a camera gets one framing its bounds (as a real camera node, so every back-end
+ * sees the same view); a file with neither punctual lights nor emissive materials gets a
+ * directional headlight from that camera, so that it is not black. The headlight is reported on
+ * stderr. */
+static sy_result add_defaults(loaded *ld, sy_error *err)
+{
+    sy_scene *s = ld->scene;
+    sy_result r = SY_OK;
+    sy_mat4 cam_world;
+    if (!ld->camera.id) {
+        sy_bounds b;
+        if ((r = sy_node_world_bounds(s, ld->root, &b, err))) return r;
+        sy_camera_view v = sy_camera_view_frame_bounds(&b, 1.0f);
+        sy_camera cam;
+        sy_camera_data cd = *(const sy_camera_data *)sy_object_defaults(SY_TYPE_CAMERA);
+        cd.yfov = 2.0f * atanf(v.window[3]);
+        cd.znear = v.znear;
+        if ((r = sy_camera_create(s, "default camera", &cam, err)) || (r = sy_camera_set(s, cam, &cd, err)) ||
+            (r = sy_node_create(s, "default camera", &ld->camera, err)) ||
+            (r = sy_node_set_matrix(s, ld->camera, &v.camera_to_world, err)) ||
+            (r = sy_node_set_camera(s, ld->camera, cam, err)))
+            return r;
+        cam_world = v.camera_to_world;
+    } else if ((r = sy_node_world_matrix(s, ld->camera, &cam_world, err))) {
+        return r;
+    }
+    (void)cam_world;
+    return sy_scene_commit(s, NULL, err);
+}
+
+/* What the loader skipped or repaired is on the log already (the loaders report it through sy_log:
+ * sy: warning: FILE: item: what); with --strict any of it fails the load. */
+static sy_result report_warnings(const char *path, uint32_t total, sy_error *err)
+{
+    if (sy_cli_load_opts.strict && total)
+        return sy_error_set(err, SY_ERR_PARSE, "%s: %u warning%s and --strict given; nothing rendered", path, total,
+                            total == 1 ? "" : "s");
+    return SY_OK;
+}
+
+/* The scene format of path, from its content (sy_sniff.h): a file of another kind is refused,
+ * named for what it is; one that is not recognised goes to the loader its name suggests (which
+ * then says what is wrong with it). */
+static sy_result recognise(const char *path, sy_file_format *fmt, sy_error *err)
+{
+    *fmt = SY_FORMAT_UNKNOWN;
+    sy_error ignore = {0};
+    if (sy_sniff_file(path, fmt, &ignore) != SY_OK) return SY_OK; /* the loader reports a missing file */
+    if (*fmt == SY_FORMAT_UNKNOWN || sy_file_format_is_scene(*fmt)) return SY_OK;
+    return sy_error_set(err, SY_ERR_UNSUPPORTED,
+                        "%s: %s content, which sy does not read as a scene (it reads glTF 2.0 .gltf / .glb and X3D in XML "
+                        "encoding)",
+                        path, sy_file_format_name(*fmt));
+}
+
+sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, loaded *out, sy_error *err)
+{
+    memset(out, 0, sizeof *out);
+    sy_file_format fmt = SY_FORMAT_UNKNOWN;
+    double t0 = sy_time_now();
+    sy_result r = sy_scene_create(&out->scene, err);
+    if (r != SY_OK) return r;
+    if (strcmp(path, "demo") == 0) {
+        sy_demo_info d;
+        r = sy_demo_build(out->scene, &d, err);
+        if (r == SY_OK) {
+            out->root = d.root;
+            out->camera = d.camera;
+            out->background = d.background;
+            if (camera_sel && strcmp(camera_sel, "0") != 0 && strcmp(camera_sel, "camera") != 0)
+                r = sy_error_set(err, SY_ERR_NOT_FOUND, "demo: no camera '%s' (available: 0 \"camera\")", camera_sel);
+        }
+    } else if ((r = recognise(path, &fmt, err)) != SY_OK) {
+        /* named for what it is: not a scene format the loaders read */
+    } else if (fmt == SY_FORMAT_X3D || (fmt == SY_FORMAT_UNKNOWN && strlen(path) > 4 &&
+                                        !strcasecmp(path + strlen(path) - 4, ".x3d"))) {
+        out->is_x3d = true;
+        sy_x3d_options xo = {.allowed_roots = sy_cli_load_opts.roots, .allowed_root_count = sy_cli_load_opts.root_count,
+                             .max_scene_bytes = sy_cli_load_opts.max_scene_bytes};
+        r = sy_x3d_load(path, out->scene, &xo, &out->x3d, err);
+        if (r == SY_OK)
+            r = report_warnings(path, out->x3d.warning_count, err);
+        if (r == SY_OK) {
+            out->root = out->x3d.root;
+            out->background = out->x3d.background;
+            if (camera_sel) r = sy_x3d_find_camera(out->scene, &out->x3d, camera_sel, &out->camera, err);
+            else if (out->x3d.camera_node_count) out->camera = out->x3d.camera_nodes[0];
+            if (r != SY_OK) sy_error_prefix(err, "%s", path);
+        }
+    } else {
+        out->is_gltf = true;
+        sy_gltf_options go = {.allowed_roots = sy_cli_load_opts.roots, .allowed_root_count = sy_cli_load_opts.root_count,
+                          .max_scene_bytes = sy_cli_load_opts.max_scene_bytes};
+        r = sy_gltf_load(path, out->scene, &go, &out->gltf, err);
+        if (r == SY_OK)
+            r = report_warnings(path, out->gltf.warning_count, err);
+        if (r == SY_OK) {
+            out->root = out->gltf.root;
+            if (camera_sel) r = sy_gltf_find_camera(out->scene, &out->gltf, camera_sel, &out->camera, err);
+            else if (out->gltf.camera_node_count) out->camera = out->gltf.camera_nodes[0];
+            if (r != SY_OK) sy_error_prefix(err, "%s", path);
+        }
+    }
+    if (r == SY_OK) r = sy_scene_commit(out->scene, NULL, err);
+    if (r == SY_OK && (out->is_gltf || out->is_x3d) && defaults) r = add_defaults(out, err);
+    /* the user's world choices: sy_world (formats) maps them onto the world object */
+    if (r == SY_OK && !sy_world_options_empty(&sy_cli_load_opts.world) &&
+        (r = sy_world_apply(out->scene, &out->background, &sy_cli_load_opts.world, err)) == SY_OK)
+        r = sy_scene_commit(out->scene, NULL, err);
+    if (r != SY_OK) sy_cli_loaded_free(out);
+    else
+        sy_log(SY_LOG_DEBUG, "sy", path, "loaded in %.3f s: %u nodes, %u meshes, %u materials, %u lights, %u cameras",
+               sy_time_now() - t0, sy_scene_count(out->scene, SY_TYPE_NODE), sy_scene_count(out->scene, SY_TYPE_MESH),
+               sy_scene_count(out->scene, SY_TYPE_MATERIAL), sy_scene_count(out->scene, SY_TYPE_LIGHT),
+               sy_scene_count(out->scene, SY_TYPE_CAMERA));
+    return r;
+}
+
+/* X3D Viewpoint fieldOfView covers the smaller image side: adapt yfov to the output size. */
+void sy_cli_fit_x3d_cameras(loaded *ld, uint32_t w, uint32_t h)
+{
+    sy_error e = {0};
+    if (sy_x3d_fit_cameras(ld->scene, &ld->x3d, (float)w / (float)h, &e) != SY_OK ||
+        sy_scene_commit(ld->scene, NULL, &e) != SY_OK)
+        sy_log(SY_LOG_WARNING, "sy", NULL, "viewpoint field of view not adapted: %s", e.message);
+}
+
+/* --overlay FILE[:BACKEND]: loads FILE into the same scene under its own root and layers it over
+ * the main viewport with the --composite mode (depth, over, replace). */
+sy_result sy_cli_add_overlay(loaded *ld, const char *arg, const char *composite, sy_compose_spec *spec, sy_error *err)
+{
+    char path[4096];
+    const char *colon = strrchr(arg, ':');
+    const char *backend = colon && colon[1] && !strchr(colon, '/') ? colon + 1 : NULL;
+    size_t n = backend ? (size_t)(colon - arg) : strlen(arg);
+    if (n >= sizeof path) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--overlay: path too long");
+    memcpy(path, arg, n);
+    path[n] = '\0';
+    if (!strcmp(composite, "depth")) spec->overlay_composite = SY_COMPOSITE_DEPTH;
+    else if (!strcmp(composite, "over")) spec->overlay_composite = SY_COMPOSITE_ALPHA_OVER;
+    else if (!strcmp(composite, "replace")) spec->overlay_composite = SY_COMPOSITE_REPLACE;
+    else return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--composite %s: expected depth, over or replace", composite);
+    if (!backend) backend = sy_mediator_find("raster") ? "raster" : spec->backend;
+    if (!sy_mediator_find(backend)) return sy_error_set(err, SY_ERR_NOT_FOUND, "--overlay %s: back-end '%s' is not registered", arg, backend);
+    sy_gltf_info info = {0};
+    sy_gltf_options go = {.allowed_roots = sy_cli_load_opts.roots, .allowed_root_count = sy_cli_load_opts.root_count,
+                          .max_scene_bytes = sy_cli_load_opts.max_scene_bytes};
+    sy_result r = sy_gltf_load(path, ld->scene, &go, &info, err);
+    if (r == SY_OK) r = report_warnings(path, info.warning_count, err);
+    if (r == SY_OK) r = sy_scene_commit(ld->scene, NULL, err);
+    if (r != SY_OK) {
+        sy_gltf_info_free(&info);
+        sy_error_prefix(err, "overlay");
+        return r;
+    }
+    spec->has_overlay = true;
+    spec->overlay_root = info.root;
+    spec->overlay_backend = backend;
+    sy_gltf_info_free(&info);
+    return SY_OK;
+}

@@ -1,0 +1,49 @@
+/* sy_load.h — how sy loads a SCENE (sy_load.c): a .gltf / .glb / .x3d file, recognised by its content,
+ * or the word "demo" (the built-in scene), with the loader options and the world flags of every
+ * command (sy_cli_load_opts, filled by sy_cli_next_option). Thread-safety: the main thread only. */
+#ifndef SY_LOAD_H
+#define SY_LOAD_H
+
+#include "sy_compose.h"
+#include "sy_gltf.h"
+#include "sy_world.h"
+#include "sy_x3d.h"
+
+/* A loaded scene: its root, the camera to render from, the background, and what the loader said. */
+typedef struct loaded {
+    sy_scene *scene;
+    sy_node root;
+    sy_node camera; /* {0}: frame the bounds */
+    sy_background background;
+    sy_gltf_info gltf;
+    bool is_gltf;
+    sy_x3d_info x3d; /* .x3d files (is_x3d) */
+    bool is_x3d;
+} loaded;
+
+/* Loader options every command shares, taken out of the arguments by sy_cli_next_option:
+ * --allow-path DIR (repeatable: more folders that a model's external files may lie in), --strict
+ * (whatever a loader skips or repairs is an error), --max-scene-mb N (the budget per file,
+ * sy_budget.h) and the world flags. */
+#define SY_MAX_ALLOW_PATHS 16
+typedef struct sy_load_options {
+    const char *roots[SY_MAX_ALLOW_PATHS];
+    size_t root_count;
+    bool strict;
+    uint64_t max_scene_bytes; /* --max-scene-mb: the loaders' budget per file (sy_budget.h); 0 = default */
+    sy_world_options world; /* --env, --env-color, --env-intensity, --env-hidden, --background, --no-default-light */
+} sy_load_options;
+extern sy_load_options sy_cli_load_opts;
+
+/* Loads path ("demo": the built-in scene) into a new scene in *out; camera_sel (NULL: the file's
+ * first camera) names or numbers a camera; defaults: a file without a camera gets one framing its
+ * bounds. The world flags are applied. On failure *out is empty. */
+sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, loaded *out, sy_error *err);
+void sy_cli_loaded_free(loaded *l);
+/* X3D Viewpoint fieldOfView covers the smaller image side: adapt yfov to the output size. */
+void sy_cli_fit_x3d_cameras(loaded *ld, uint32_t w, uint32_t h);
+/* --overlay FILE[:BACKEND]: loads FILE into the same scene under its own root and layers it over
+ * the main viewport of spec with the --composite mode (depth, over, replace). */
+sy_result sy_cli_add_overlay(loaded *ld, const char *arg, const char *composite, sy_compose_spec *spec, sy_error *err);
+
+#endif /* SY_LOAD_H */
