@@ -6,7 +6,7 @@
 # take a word from a list (--tonemap, --stereo, ...), back-end names after -b (asked of the `sy`
 # being completed: `sy backends`), and file names: scenes (.gltf, .glb, .x3d; and the word "demo")
 # where a SCENE is expected, any file after options that take a path. Needs bash 4; does not need
-# the bash-completion package. Keep the lists in step with apps/sy/sy_main.c (usage_text) and
+# the bash-completion package. Keep the lists in step with apps/sy/sy_cli.c (usage_text) and
 # apps/sy/sy_cluster_cli.c; tests/integration/completion_test.sh checks a few.
 
 _sy_commands="info render demo compare coverage view web bench backends serve help version"

@@ -1,5 +1,5 @@
 /* sy_cluster_cli_off.c — the cluster parts of `sy` in a build without the cluster
- * (-DSY_WITH_CLUSTER=OFF): the same entry points as sy_cluster_cli.c, so sy_main.c and sy_view.c
+ * (-DSY_WITH_CLUSTER=OFF): the same entry points as sy_cluster_cli.c, so the commands (sy_cmd_*.c) and sy_view.c
  * need no conditional code; each one that would start cluster work says that this build does not
  * have it (exit status 1, or SY_ERR_UNSUPPORTED). Only the cluster's headers are used (types). */
 #include "sy_cluster_cli.h"
