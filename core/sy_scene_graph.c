@@ -1,0 +1,292 @@
+/* sy_scene_graph.c — the scene as a graph: parents of nodes, world matrices and subtree bounds
+ * recomputed incrementally for dirty subtrees (each node's once per commit), reachability and
+ * cycle checks, and the graph queries of sy_graph.h. */
+#include "sy_scene_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* >>graph */
+void sy_sc_mark_world_dirty(sy_scene *s, uint32_t node_id)
+{
+    node_extra *nx = sy_sc_nx_of(s, node_id);
+    if (!nx || nx->world_dirty) return;
+    nx->world_dirty = 1;
+    sy_sc_list_push(&s->world_dirty, node_id);
+}
+
+/* Marks node_id and every ancestor (along all parents) as needing new local bounds. */
+void sy_sc_mark_bounds_dirty(sy_scene *s, uint32_t node_id)
+{
+    id_list *st = &s->stack;
+    st->count = 0;
+    sy_sc_list_push(st, node_id);
+    while (st->count) {
+        uint32_t id = st->items[--st->count];
+        node_extra *nx = sy_sc_nx_of(s, id);
+        if (!nx || nx->bounds_dirty) continue;
+        nx->bounds_dirty = 1;
+        sy_sc_list_push(&s->bounds_dirty, id);
+        for (uint32_t i = 0; i < nx->parent_count; ++i) sy_sc_list_push(st, nx->parents[i]);
+    }
+}
+
+void sy_sc_mark_parents_bounds_dirty(sy_scene *s, uint32_t node_id)
+{
+    node_extra *nx = sy_sc_nx_of(s, node_id);
+    if (!nx) return;
+    for (uint32_t i = 0; i < nx->parent_count; ++i) sy_sc_mark_bounds_dirty(s, nx->parents[i]);
+}
+
+static uint32_t primary_parent(const sy_scene *s, const node_extra *nx)
+{
+    for (uint32_t i = 0; i < nx->parent_count; ++i)
+        if (sy_sc_lookup(s, SY_TYPE_NODE, nx->parents[i])) return nx->parents[i];
+    return 0;
+}
+
+const uint32_t *sy_node_children(const sy_node_data *d, uint32_t *count_out)
+{
+    *count_out = d && d->children ? (uint32_t)(sy_blob_size(d->children) / 4) : 0;
+    return *count_out ? (const uint32_t *)sy_blob_data(d->children) : NULL;
+}
+
+/* Recomputes world matrices of every world-dirty node and the part of its subtree placed
+ * through it (children whose primary parent it is). Cost: the dirty subtrees only. */
+void sy_sc_update_world(sy_scene *s)
+{
+    uint32_t updates = 0;
+    id_list *st = &s->stack;
+    for (uint32_t i = 0; i < s->world_dirty.count; ++i) {
+        uint32_t root = s->world_dirty.items[i];
+        node_extra *rnx = sy_sc_nx_of(s, root);
+        if (!rnx || !rnx->world_dirty) continue;
+        st->count = 0;
+        sy_sc_list_push(st, root);
+        s->epoch++;
+        while (st->count) {
+            uint32_t id = st->items[--st->count];
+            slot *sl = sy_sc_lookup(s, SY_TYPE_NODE, id);
+            if (!sl || sl->nx->mark == s->epoch) continue; /* guards against cycles from bad input */
+            node_extra *nx = sl->nx;
+            nx->mark = s->epoch;
+            const sy_node_data *d = sl->data;
+            uint32_t pp = primary_parent(s, nx);
+            node_extra *pnx = pp ? sy_sc_nx_of(s, pp) : NULL;
+            nx->world = pnx ? sy_mat4_mul(&pnx->world, &d->transform.matrix) : d->transform.matrix;
+            nx->world_dirty = 0;
+            updates++;
+            uint32_t nc;
+            const uint32_t *ch = sy_node_children(d, &nc);
+            for (uint32_t k = 0; k < nc; ++k) {
+                node_extra *cnx = sy_sc_nx_of(s, ch[k]);
+                if (cnx && primary_parent(s, cnx) == id) sy_sc_list_push(st, ch[k]);
+            }
+        }
+    }
+    s->world_dirty.count = 0;
+    s->last_world_updates = updates;
+}
+
+/* Recomputes local bounds of bounds-dirty nodes in post order (children first). */
+void sy_sc_update_bounds(sy_scene *s)
+{
+    id_list *st = &s->stack;
+    for (uint32_t i = 0; i < s->bounds_dirty.count; ++i) {
+        uint32_t root = s->bounds_dirty.items[i];
+        node_extra *rnx = sy_sc_nx_of(s, root);
+        if (!rnx || !rnx->bounds_dirty) continue;
+        st->count = 0;
+        sy_sc_list_push(st, root);
+        s->epoch++;
+        while (st->count) {
+            uint32_t id = st->items[st->count - 1];
+            slot *sl = sy_sc_lookup(s, SY_TYPE_NODE, id);
+            if (!sl || !sl->nx->bounds_dirty) {
+                st->count--;
+                continue;
+            }
+            const sy_node_data *d = sl->data;
+            uint32_t nc;
+            const uint32_t *ch = sy_node_children(d, &nc);
+            if (sl->nx->mark != s->epoch) { /* first visit: push dirty children */
+                sl->nx->mark = s->epoch;
+                bool pushed = false;
+                for (uint32_t k = 0; k < nc; ++k) {
+                    node_extra *cnx = sy_sc_nx_of(s, ch[k]);
+                    if (cnx && cnx->bounds_dirty && cnx->mark != s->epoch) {
+                        sy_sc_list_push(st, ch[k]);
+                        pushed = true;
+                    }
+                }
+                if (pushed) continue;
+            }
+            st->count--;
+            sy_bounds b = sy_bounds_empty();
+            slot *ms = sy_sc_lookup(s, SY_TYPE_MESH, d->mesh.id);
+            if (ms) b = ms->bounds;
+            for (uint32_t k = 0; k < nc; ++k) {
+                slot *cs = sy_sc_lookup(s, SY_TYPE_NODE, ch[k]);
+                if (!cs || cs->nx->bounds_dirty) continue; /* a cycle from bad input: ignore */
+                const sy_node_data *cd = cs->data;
+                sy_bounds cb = sy_bounds_transform(&cs->nx->local_bounds, &cd->transform.matrix);
+                sy_bounds_add_bounds(&b, &cb);
+            }
+            sl->nx->local_bounds = b;
+            sl->nx->bounds_dirty = 0;
+        }
+    }
+    s->bounds_dirty.count = 0;
+}
+
+/* true if `target` is reachable downwards from any of the n nodes `from` (used to refuse cycles):
+ * one walk that visits each node once, however many of them share subtrees. An allocation failure
+ * answers true (the change is refused rather than risking a cycle). */
+bool sy_sc_reaches(sy_scene *s, const uint32_t *from, uint32_t n, uint32_t target)
+{
+    id_list st = {0};
+    s->epoch++;
+    bool found = false;
+    for (uint32_t i = 0; i < n && !found; ++i) found = !sy_sc_list_push(&st, from[i]);
+    while (st.count && !found) {
+        uint32_t id = st.items[--st.count];
+        if (id == target) {
+            found = true;
+            break;
+        }
+        slot *sl = sy_sc_lookup(s, SY_TYPE_NODE, id);
+        if (!sl || sl->nx->mark == s->epoch) continue;
+        sl->nx->mark = s->epoch;
+        uint32_t nc;
+        const uint32_t *ch = sy_node_children(sl->data, &nc);
+        for (uint32_t k = 0; k < nc && !found; ++k) found = !sy_sc_list_push(&st, ch[k]);
+    }
+    free(st.items);
+    return found;
+}
+
+/* A cycle through a node whose children a change list set: one depth-first walk from all of them
+ * (grey = on the walk's path, black = done; each node visited once, so a snapshot of a large
+ * graph costs its size, not its size per changed node). *at names a node on the cycle. An
+ * allocation failure answers true. */
+bool sy_sc_find_cycle(sy_scene *s, const sy_changes *changes, uint32_t *at)
+{
+    typedef struct frame {
+        uint32_t id, next;
+    } frame;
+    frame *st = NULL;
+    uint32_t depth = 0, cap = 0;
+    uint32_t grey = s->epoch + 1u, black = s->epoch + 2u;
+    s->epoch += 2u;
+    bool found = false;
+    uint32_t n = sy_changes_count(changes);
+    for (uint32_t i = 0; i < n && !found; ++i) {
+        const sy_change *e = sy_changes_get(changes, i);
+        if (e->type != SY_TYPE_NODE || !(e->mask & SY_BIT(SY_NODE_CHILDREN))) continue;
+        slot *root = sy_sc_lookup(s, SY_TYPE_NODE, e->id);
+        if (!root || root->nx->mark == black) continue;
+        depth = 0;
+        uint32_t id = e->id;
+        for (;;) {
+            slot *sl = sy_sc_lookup(s, SY_TYPE_NODE, id);
+            if (sl && sl->nx->mark == grey) {
+                found = true;
+                *at = id;
+                break;
+            }
+            if (sl && sl->nx->mark != black) { /* enter */
+                if (depth == cap) {
+                    uint32_t nc = cap ? cap * 2u : 64u;
+                    frame *ns = nc > cap ? realloc(st, sizeof *ns * nc) : NULL;
+                    if (!ns) {
+                        found = true;
+                        *at = id;
+                        break;
+                    }
+                    st = ns;
+                    cap = nc;
+                }
+                sl->nx->mark = grey;
+                st[depth++] = (frame){id, 0};
+            }
+            /* next child of the deepest frame, popping finished frames */
+            id = 0;
+            while (depth) {
+                frame *f = &st[depth - 1];
+                uint32_t nc;
+                const uint32_t *ch = sy_node_children(sy_object_get(s, SY_TYPE_NODE, f->id), &nc);
+                if (f->next < nc) {
+                    id = ch[f->next++];
+                    break;
+                }
+                sy_sc_lookup(s, SY_TYPE_NODE, f->id)->nx->mark = black;
+                depth--;
+            }
+            if (!id) break;
+        }
+    }
+    free(st);
+    return found;
+}
+
+int sy_sc_cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* >>graph queries */
+uint32_t sy_node_parent_count(const sy_scene *s, sy_node n)
+{
+    node_extra *nx = sy_sc_nx_of(s, n.id);
+    return nx ? nx->parent_count : 0;
+}
+
+sy_node sy_node_parent(const sy_scene *s, sy_node n, uint32_t i)
+{
+    node_extra *nx = sy_sc_nx_of(s, n.id);
+    sy_node r = {0};
+    if (nx && i < nx->parent_count) r.id = nx->parents[i];
+    return r;
+}
+
+sy_result sy_node_world_matrix(const sy_scene *s, sy_node n, sy_mat4 *out, sy_error *err)
+{
+    node_extra *nx = sy_sc_nx_of(s, n.id);
+    if (!nx) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "world matrix: stale node handle");
+    *out = nx->world;
+    return SY_OK;
+}
+
+sy_result sy_node_world_bounds(const sy_scene *s, sy_node n, sy_bounds *out, sy_error *err)
+{
+    node_extra *nx = sy_sc_nx_of(s, n.id);
+    if (!nx) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "world bounds: stale node handle");
+    /* local_bounds are in the node's frame before its own transform; world = parent world * local */
+    *out = sy_bounds_transform(&nx->local_bounds, &nx->world);
+    return SY_OK;
+}
+
+sy_result sy_mesh_bounds(const sy_scene *s, sy_mesh m, sy_bounds *out, sy_error *err)
+{
+    slot *sl = sy_sc_lookup(s, SY_TYPE_MESH, m.id);
+    if (!sl) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "mesh bounds: stale mesh handle");
+    *out = sl->bounds;
+    return SY_OK;
+}
+
+sy_bounds sy_scene_world_bounds(const sy_scene *s)
+{
+    sy_bounds b = sy_bounds_empty();
+    const pool *p = &s->pools[SY_TYPE_NODE];
+    for (uint32_t i = 1; i < p->count; ++i) {
+        const slot *sl = &p->slots[i];
+        if (!sl->alive || primary_parent(s, sl->nx)) continue;
+        sy_bounds wb = sy_bounds_transform(&sl->nx->local_bounds, &sl->nx->world);
+        sy_bounds_add_bounds(&b, &wb);
+    }
+    return b;
+}
+
+uint32_t sy_scene_last_commit_world_updates(const sy_scene *s) { return s->last_world_updates; }

@@ -1,0 +1,557 @@
+/* sy_scene_objects.c — the object calls of sy_objects.h: create (also at a replica's exact id),
+ * destroy, the generic and typed setters that validate and mark fields dirty, typed getters and
+ * attachments. */
+#include "sy_scene_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+sy_result sy_object_create(sy_scene *s, sy_object_type t, const char *name, uint32_t *id_out, sy_error *err)
+{
+    *id_out = 0;
+    const sy_type_desc *td = sy__type_desc(t);
+    if (!td) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "create: unknown object type %d", (int)t);
+    pool *p = &s->pools[t];
+    uint32_t idx = 0;
+    while (p->free_count) {
+        uint32_t cand = p->free_list[--p->free_count];
+        p->slots[cand].in_free_list = 0;
+        if (!p->slots[cand].alive && !p->slots[cand].retired) {
+            idx = cand;
+            break;
+        }
+    }
+    if (!idx) {
+        if (p->count > SY_HANDLE_INDEX_MASK)
+            return sy_error_set(err, SY_ERR_LIMIT, "create %s: more than %u objects", td->name, SY_HANDLE_INDEX_MASK);
+        if (!sy_sc_pool_grow(p, p->count + 1)) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "create %s: out of memory", td->name);
+        idx = p->count++;
+    }
+    uint32_t gen = p->slots[idx].generation + 1; /* a fresh slot starts at generation 1 */
+    sy_result r = sy_sc_slot_init(s, t, idx, gen, name, err);
+    if (r != SY_OK) {
+        sy_sc_free_list_push(p, idx);
+        return r;
+    }
+    uint32_t id = make_id(idx, gen);
+    slot *sl = &p->slots[idx];
+    if (!sy_sc_mark_dirty(s, t, id, sl, 0, SY_CHANGE_CREATED)) {
+        sy_sc_slot_release(sl, t);
+        p->live--;
+        sy_sc_free_list_push(p, idx);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "create %s: out of memory", td->name);
+    }
+    *id_out = id;
+    return SY_OK;
+}
+
+/* Replica: create exactly this id. */
+sy_result sy_sc_object_create_at(sy_scene *s, uint32_t t, uint32_t id, sy_error *err)
+{
+    const sy_type_desc *td = sy__type_desc(t);
+    pool *p = &s->pools[t];
+    uint32_t idx = id_index(id), gen = id_generation(id);
+    if (idx == 0 || gen == 0) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "create %s %#x: invalid id", td->name, id);
+    if (s->applying && s->apply_max_slots && idx >= s->apply_max_slots)
+        return sy_error_set(err, SY_ERR_LIMIT, "create %s %#x: slot index %u exceeds this replica's limit of %u", td->name,
+                            id, idx, s->apply_max_slots);
+    if (idx >= p->count) {
+        if (!sy_sc_pool_grow(p, idx + 1)) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "create %s: out of memory", td->name);
+        for (uint32_t i = p->count; i < idx; ++i) sy_sc_free_list_push(p, i);
+        p->count = idx + 1;
+    }
+    slot *sl = &p->slots[idx];
+    if (sl->alive)
+        return sy_error_set(err, SY_ERR_INVALID_HANDLE, "create %s %#x: slot holds a live object", td->name, id);
+    if (gen <= sl->generation && sl->generation != 0)
+        return sy_error_set(err, SY_ERR_INVALID_HANDLE, "create %s %#x: generation goes backwards", td->name, id);
+    sy_result r = sy_sc_slot_init(s, t, idx, gen, NULL, err);
+    if (r != SY_OK) return r;
+    if (!sy_sc_mark_dirty(s, t, id, sl, 0, SY_CHANGE_CREATED)) {
+        sy_sc_slot_release(sl, t);
+        p->live--;
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "create %s: out of memory", td->name);
+    }
+    return SY_OK;
+}
+
+#define TYPED_CREATE(fn, T, type)                                                                       \
+    sy_result fn(sy_scene *s, const char *name, T *out, sy_error *err)                                  \
+    {                                                                                                   \
+        return sy_object_create(s, type, name, &out->id, err);                                          \
+    }
+TYPED_CREATE(sy_node_create, sy_node, SY_TYPE_NODE)
+TYPED_CREATE(sy_mesh_create, sy_mesh, SY_TYPE_MESH)
+TYPED_CREATE(sy_material_create, sy_material, SY_TYPE_MATERIAL)
+TYPED_CREATE(sy_texture_create, sy_texture, SY_TYPE_TEXTURE)
+TYPED_CREATE(sy_light_create, sy_light, SY_TYPE_LIGHT)
+TYPED_CREATE(sy_camera_create, sy_camera, SY_TYPE_CAMERA)
+TYPED_CREATE(sy_background_create, sy_background, SY_TYPE_BACKGROUND)
+#undef TYPED_CREATE
+
+/* Updates parent lists and dirty marks of a node whose child list goes from old to new. */
+static void children_changed(sy_scene *s, uint32_t id, const sy_blob *oldb, const sy_blob *newb)
+{
+    uint32_t no = oldb ? (uint32_t)(sy_blob_size(oldb) / 4) : 0, nn = newb ? (uint32_t)(sy_blob_size(newb) / 4) : 0;
+    const uint32_t *o = oldb ? sy_blob_data(oldb) : NULL, *n = newb ? sy_blob_data(newb) : NULL;
+    for (uint32_t i = 0; i < no; ++i) {
+        bool kept = false;
+        for (uint32_t j = 0; j < nn && !kept; ++j) kept = n[j] == o[i];
+        node_extra *cnx = sy_sc_nx_of(s, o[i]);
+        if (kept || !cnx) continue;
+        sy_sc_array_remove(cnx->parents, &cnx->parent_count, id);
+        sy_sc_mark_world_dirty(s, o[i]);
+    }
+    for (uint32_t j = 0; j < nn; ++j) {
+        bool existed = false;
+        for (uint32_t i = 0; i < no && !existed; ++i) existed = o[i] == n[j];
+        node_extra *cnx = sy_sc_nx_of(s, n[j]);
+        if (existed || !cnx) continue;
+        sy_sc_array_push(&cnx->parents, &cnx->parent_count, &cnx->parent_capacity, id);
+        sy_sc_mark_world_dirty(s, n[j]);
+    }
+    sy_sc_mark_bounds_dirty(s, id);
+}
+
+static void mesh_users_changed(sy_scene *s, uint32_t node_id, uint32_t old_mesh, uint32_t new_mesh)
+{
+    slot *om = sy_sc_lookup(s, SY_TYPE_MESH, old_mesh), *nm = sy_sc_lookup(s, SY_TYPE_MESH, new_mesh);
+    if (om) sy_sc_array_remove(om->users, &om->user_count, node_id);
+    if (nm) sy_sc_array_push(&nm->users, &nm->user_count, &nm->user_capacity, node_id);
+    sy_sc_mark_bounds_dirty(s, node_id);
+}
+
+static void mesh_bounds_update(sy_scene *s, slot *sl)
+{
+    const sy_mesh_data *d = sl->data;
+    sy_bounds b = sy_bounds_empty();
+    for (uint32_t i = 0; i < d->primitives.count; ++i) {
+        const sy_primitive *pr = &d->primitives.items[i];
+        sy_bounds pb = sy_primitive_position_bounds(pr);
+        if (pr->topology != SY_TOPOLOGY_TRIANGLES && !sy_bounds_is_empty(&pb)) {
+            float r = 0.5f * sy_primitive_stroke_width(pr, &pb); /* strokes reach half a width out */
+            for (int k = 0; k < 3; ++k) {
+                pb.min[k] -= r;
+                pb.max[k] += r;
+            }
+        }
+        sy_bounds_add_bounds(&b, &pb);
+    }
+    sl->bounds = b;
+    for (uint32_t i = 0; i < sl->user_count; ++i) sy_sc_mark_bounds_dirty(s, sl->users[i]);
+}
+
+sy_result sy_object_set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32_t field, const void *value,
+                              sy_error *err)
+{
+    slot *sl = sy_sc_lookup(s, t, id);
+    if (!sl) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "set: stale or invalid %s handle %#x", sy_object_type_name(t), id);
+    const sy_type_desc *td = sy__type_desc(t);
+    if (field >= td->field_count)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "set: %s has no field %u", td->name, field);
+    sy_transform trs_fixed;
+    if (t == SY_TYPE_NODE && field == SY_NODE_TRANSFORM) {
+        trs_fixed = *(const sy_transform *)value;
+        if (trs_fixed.mode == SY_TRANSFORM_TRS)
+            trs_fixed.matrix = sy_mat4_from_trs(trs_fixed.translation, trs_fixed.rotation, trs_fixed.scale);
+        value = &trs_fixed;
+    }
+    if (t == SY_TYPE_MESH && field == SY_MESH_PRIMITIVES && ((const sy_primitive_list *)value)->count &&
+        !((const sy_primitive_list *)value)->items)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh: NULL primitives");
+    /* Build a source struct holding the value at the field's offset (the generic copy reads it there). */
+#define SY_MAX2_(a, b) ((a) > (b) ? (a) : (b))
+    _Alignas(16) unsigned char src[SY_MAX2_(sizeof(sy_background_data), SY_MAX2_(sizeof(sy_material_data), sizeof(sy_node_data)))];
+#undef SY_MAX2_
+    _Static_assert(sizeof(sy_texture_data) <= sizeof src && sizeof(sy_mesh_data) <= sizeof src &&
+                       sizeof(sy_light_data) <= sizeof src && sizeof(sy_camera_data) <= sizeof src &&
+                       sizeof(sy_background_data) <= sizeof src,
+                   "scratch buffer too small");
+    const sy_field_desc *fd = &td->fields[field];
+    memcpy(src + fd->offset, value, fd->size);
+    /* The no-op test comes before validation: re-setting the value a field already holds succeeds
+     * even when it names an object destroyed since (stale references are kept, read as absent). */
+    if (sy__field_equal(t, field, sl->data, src)) return SY_OK;
+    sy_result r = sy_sc_validate_field(s, t, id, field, value, err);
+    if (r != SY_OK) return r;
+
+    sy_blob *old_children = NULL;
+    uint32_t old_mesh = 0;
+    if (t == SY_TYPE_NODE && field == SY_NODE_CHILDREN)
+        old_children = sy_blob_retain(((sy_node_data *)sl->data)->children);
+    if (t == SY_TYPE_NODE && field == SY_NODE_MESH) old_mesh = ((sy_node_data *)sl->data)->mesh.id;
+    if (!sy__field_copy(t, field, sl->data, src)) {
+        sy_blob_release(old_children);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "set %s.%s: out of memory", td->name, fd->name);
+    }
+    if (!sy_sc_mark_dirty(s, t, id, sl, SY_BIT(field), 0)) {
+        sy_blob_release(old_children);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "set %s.%s: out of memory", td->name, fd->name);
+    }
+    if (t == SY_TYPE_NODE) {
+        const sy_node_data *d = sl->data;
+        switch (field) {
+        case SY_NODE_TRANSFORM:
+            sy_sc_mark_world_dirty(s, id);
+            sy_sc_mark_parents_bounds_dirty(s, id);
+            break;
+        case SY_NODE_CHILDREN: children_changed(s, id, old_children, d->children); break;
+        case SY_NODE_MESH: mesh_users_changed(s, id, old_mesh, d->mesh.id); break;
+        default: break;
+        }
+    } else if (t == SY_TYPE_MESH && field == SY_MESH_PRIMITIVES) {
+        mesh_bounds_update(s, sl);
+    }
+    sy_blob_release(old_children);
+    return SY_OK;
+}
+
+sy_result sy_object_destroy(sy_scene *s, sy_object_type t, uint32_t id, sy_error *err)
+{
+    slot *sl = sy_sc_lookup(s, t, id);
+    if (!sl) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "destroy: stale or invalid %s handle %#x", sy_object_type_name(t), id);
+    pool *p = &s->pools[t];
+    /* record the destruction (or drop a creation nobody has seen) */
+    if (sl->dirty_pos) {
+        dirty_rec *rec = &s->dirty[sl->dirty_pos - 1];
+        if (rec->flags & SY_CHANGE_CREATED) s->dirty_dropped++;
+        rec->flags = (rec->flags & SY_CHANGE_CREATED) ? DIRTY_DROPPED : SY_CHANGE_DESTROYED;
+    } else if (!sy_sc_mark_dirty(s, t, id, sl, 0, SY_CHANGE_DESTROYED)) {
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "destroy: out of memory");
+    }
+    sl->dirty_pos = 0;
+    sl->dirty_mask = 0;
+    if (t == SY_TYPE_NODE) {
+        const sy_node_data *d = sl->data;
+        sy_sc_mark_parents_bounds_dirty(s, id);
+        /* parents keep the stale child id in their lists; readers skip it */
+        uint32_t nc;
+        const uint32_t *ch = sy_node_children(d, &nc);
+        for (uint32_t k = 0; k < nc; ++k) {
+            node_extra *cnx = sy_sc_nx_of(s, ch[k]);
+            if (!cnx) continue;
+            sy_sc_array_remove(cnx->parents, &cnx->parent_count, id);
+            sy_sc_mark_world_dirty(s, ch[k]);
+        }
+        slot *ms = sy_sc_lookup(s, SY_TYPE_MESH, d->mesh.id);
+        if (ms) sy_sc_array_remove(ms->users, &ms->user_count, id);
+    } else if (t == SY_TYPE_MESH) {
+        for (uint32_t i = 0; i < sl->user_count; ++i) sy_sc_mark_bounds_dirty(s, sl->users[i]);
+    }
+    sy_sc_slot_release(sl, t);
+    p->live--;
+    if (sl->generation >= SY_HANDLE_MAX_GENERATION) sl->retired = 1; /* never reuse: ids stay unique */
+    sy_sc_free_list_push(p, id_index(id));
+    return SY_OK;
+}
+
+sy_result sy_node_set_trs(sy_scene *s, sy_node n, const float t[3], const float r[4], const float sc[3], sy_error *err)
+{
+    sy_transform tr = {.mode = SY_TRANSFORM_TRS};
+    memcpy(tr.translation, t, sizeof tr.translation);
+    memcpy(tr.rotation, r, sizeof tr.rotation);
+    memcpy(tr.scale, sc, sizeof tr.scale);
+    tr.matrix = sy_mat4_from_trs(t, r, sc);
+    return sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_TRANSFORM, &tr, err);
+}
+
+sy_result sy_node_set_matrix(sy_scene *s, sy_node n, const sy_mat4 *m, sy_error *err)
+{
+    sy_transform tr = {.mode = SY_TRANSFORM_MATRIX, .rotation = {0, 0, 0, 1}, .scale = {1, 1, 1}, .matrix = *m};
+    return sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_TRANSFORM, &tr, err);
+}
+
+sy_result sy_node_set_children(sy_scene *s, sy_node n, const sy_node *children, uint32_t count, sy_error *err)
+{
+    sy_blob *b = NULL;
+    if (count) {
+        _Static_assert(sizeof(sy_node) == sizeof(uint32_t), "sy_node is one uint32");
+        sy_result r = sy_blob_create_copy(children, sizeof(uint32_t) * (size_t)count, &b, err);
+        if (r != SY_OK) return r;
+    }
+    sy_result r = sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_CHILDREN, &b, err);
+    sy_blob_release(b);
+    return r;
+}
+
+sy_result sy_node_add_child(sy_scene *s, sy_node parent, sy_node child, sy_error *err)
+{
+    const sy_node_data *d = sy_node_get(s, parent);
+    if (!d) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "add child: stale parent handle");
+    uint32_t nc;
+    const uint32_t *ch = sy_node_children(d, &nc);
+    sy_node *list = malloc(sizeof *list * ((size_t)nc + 1));
+    if (!list) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "add child: out of memory");
+    /* children destroyed since stay in the list as stale ids (readers skip them); drop them here,
+     * or the new list would be refused for holding a stale child */
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < nc; ++i)
+        if (sy_sc_lookup(s, SY_TYPE_NODE, ch[i])) list[n++].id = ch[i];
+    list[n] = child;
+    sy_result r = sy_node_set_children(s, parent, list, n + 1, err);
+    free(list);
+    return r;
+}
+
+sy_result sy_node_set_mesh(sy_scene *s, sy_node n, sy_mesh m, sy_error *err)
+{
+    return sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_MESH, &m, err);
+}
+
+sy_result sy_node_set_light(sy_scene *s, sy_node n, sy_light l, sy_error *err)
+{
+    return sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_LIGHT, &l, err);
+}
+
+sy_result sy_node_set_camera(sy_scene *s, sy_node n, sy_camera c, sy_error *err)
+{
+    return sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_CAMERA, &c, err);
+}
+
+sy_result sy_node_set_flags(sy_scene *s, sy_node n, uint32_t flags, sy_error *err)
+{
+    return sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_FLAGS, &flags, err);
+}
+
+sy_result sy_mesh_set_primitives(sy_scene *s, sy_mesh m, const sy_primitive *prims, uint32_t count, sy_error *err)
+{
+    sy_primitive_list l = {(sy_primitive *)prims, count};
+    return sy_object_set_field(s, SY_TYPE_MESH, m.id, SY_MESH_PRIMITIVES, &l, err);
+}
+
+/* Sets every field of a whole data struct; validation of all fields first, so a bad value leaves
+ * the object unchanged. */
+static sy_result set_all(sy_scene *s, uint32_t t, uint32_t id, const void *d, sy_error *err)
+{
+    const sy_type_desc *td = sy__type_desc(t);
+    slot *sl = sy_sc_lookup(s, t, id);
+    if (!sl) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "set: stale or invalid %s handle %#x", td->name, id);
+    for (uint32_t f = 0; f < td->field_count; ++f) {
+        if (sy__field_equal(t, f, sl->data, d)) continue; /* unchanged: may hold a stale reference */
+        sy_result r = sy_sc_validate_field(s, t, id, f, (const char *)d + td->fields[f].offset, err);
+        if (r != SY_OK) return r;
+    }
+    for (uint32_t f = 0; f < td->field_count; ++f) {
+        sy_result r = sy_object_set_field(s, t, id, f, (const char *)d + td->fields[f].offset, err);
+        if (r != SY_OK) return r;
+    }
+    return SY_OK;
+}
+
+sy_result sy_material_set(sy_scene *s, sy_material m, const sy_material_data *d, sy_error *err)
+{
+    return set_all(s, SY_TYPE_MATERIAL, m.id, d, err);
+}
+
+sy_result sy_light_set(sy_scene *s, sy_light l, const sy_light_data *d, sy_error *err)
+{
+    return set_all(s, SY_TYPE_LIGHT, l.id, d, err);
+}
+
+sy_result sy_camera_set(sy_scene *s, sy_camera c, const sy_camera_data *d, sy_error *err)
+{
+    return set_all(s, SY_TYPE_CAMERA, c.id, d, err);
+}
+
+sy_result sy_background_set(sy_scene *s, sy_background b, const sy_background_data *d, sy_error *err)
+{
+    return set_all(s, SY_TYPE_BACKGROUND, b.id, d, err);
+}
+
+sy_result sy_texture_set_image(sy_scene *s, sy_texture t, const sy_image_info *info, sy_blob *pixels, sy_error *err)
+{
+    if (!sy_sc_lookup(s, SY_TYPE_TEXTURE, t.id)) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "texture: stale handle");
+    if (info->channels < 1 || info->channels > 4 || info->format < SY_PIXEL_U8_SRGB || info->format > SY_PIXEL_F32 ||
+        info->width == 0 || info->height == 0)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "texture: bad image %ux%u, %u channels, format %u",
+                            info->width, info->height, info->channels, info->format);
+    size_t need, elem = info->format == SY_PIXEL_F32 ? 4 : 1;
+    if (!sy_size_mul(info->width, info->height, &need) || !sy_size_mul(need, info->channels, &need) ||
+        !sy_size_mul(need, elem, &need) || !pixels || sy_blob_size(pixels) != need)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "texture: %ux%ux%u image needs %zu bytes, blob has %zu",
+                            info->width, info->height, info->channels, need, sy_blob_size(pixels));
+    sy_result r = sy_object_set_field(s, SY_TYPE_TEXTURE, t.id, SY_TEXTURE_INFO, info, err);
+    if (r == SY_OK) r = sy_object_set_field(s, SY_TYPE_TEXTURE, t.id, SY_TEXTURE_PIXELS, &pixels, err);
+    return r;
+}
+
+sy_result sy_texture_set_sampler(sy_scene *s, sy_texture t, const sy_sampler *smp, sy_error *err)
+{
+    return sy_object_set_field(s, SY_TYPE_TEXTURE, t.id, SY_TEXTURE_SAMPLER, smp, err);
+}
+
+const sy_node_data *sy_node_get(const sy_scene *s, sy_node n) { return sy_object_get(s, SY_TYPE_NODE, n.id); }
+
+const sy_mesh_data *sy_mesh_get(const sy_scene *s, sy_mesh m) { return sy_object_get(s, SY_TYPE_MESH, m.id); }
+
+const sy_material_data *sy_material_get(const sy_scene *s, sy_material m)
+{
+    if (m.id == 0) return sy_object_defaults(SY_TYPE_MATERIAL);
+    return sy_object_get(s, SY_TYPE_MATERIAL, m.id);
+}
+
+const sy_texture_data *sy_texture_get(const sy_scene *s, sy_texture t) { return sy_object_get(s, SY_TYPE_TEXTURE, t.id); }
+
+const sy_light_data *sy_light_get(const sy_scene *s, sy_light l) { return sy_object_get(s, SY_TYPE_LIGHT, l.id); }
+
+const sy_camera_data *sy_camera_get(const sy_scene *s, sy_camera c) { return sy_object_get(s, SY_TYPE_CAMERA, c.id); }
+
+const sy_background_data *sy_background_get(const sy_scene *s, sy_background b)
+{
+    return sy_object_get(s, SY_TYPE_BACKGROUND, b.id);
+}
+
+uint32_t sy_primitive_vertex_count(const sy_primitive *p) { return (uint32_t)(sy_blob_size(p->positions) / 12); }
+
+uint32_t sy_primitive_triangle_count(const sy_primitive *p)
+{
+    return p->topology == SY_TOPOLOGY_TRIANGLES ? sy_primitive_element_count(p) : 0u;
+}
+
+uint32_t sy_primitive_element_count(const sy_primitive *p)
+{
+    uint32_t per = p->topology == SY_TOPOLOGY_TRIANGLES ? 3u : p->topology == SY_TOPOLOGY_LINES ? 2u : 1u;
+    return p->indices ? (uint32_t)(sy_blob_size(p->indices) / (4u * per)) : sy_primitive_vertex_count(p) / per;
+}
+
+sy_bounds sy_primitive_position_bounds(const sy_primitive *p)
+{
+    sy_bounds b = sy_bounds_empty();
+    const float *v = sy_blob_data(p->positions);
+    size_t n = sy_blob_size(p->positions) / 12;
+    for (size_t k = 0; v && k < n; ++k) sy_bounds_add_point(&b, v + 3 * k);
+    return b;
+}
+
+float sy_primitive_stroke_width(const sy_primitive *p, const sy_bounds *primitive_bounds)
+{
+    if (p->topology == SY_TOPOLOGY_TRIANGLES) return 0.0f;
+    if (p->width > 0.0f && isfinite(p->width)) return p->width;
+    sy_bounds own;
+    if (!primitive_bounds) {
+        own = sy_primitive_position_bounds(p);
+        primitive_bounds = &own;
+    }
+    float diag = 0.0f;
+    if (!sy_bounds_is_empty(primitive_bounds)) {
+        float d[3];
+        for (int k = 0; k < 3; ++k) d[k] = primitive_bounds->max[k] - primitive_bounds->min[k];
+        diag = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    }
+    float f = p->topology == SY_TOPOLOGY_POINTS ? SY_STROKE_POINT_FRACTION : SY_STROKE_LINE_FRACTION;
+    float w = f * diag;
+    return isfinite(w) && w > SY_STROKE_MIN_WIDTH ? w : SY_STROKE_MIN_WIDTH;
+}
+
+void sy_primitive_release(sy_primitive *p) { sy__primitive_release(p); }
+
+bool sy_texture_ref_matrix(const sy_texture_ref *r, float m[6])
+{
+    /* KHR_texture_transform (ratified): uv' = offset + R (uv_scale * uv), R = [cos sin; -sin cos]
+     * (GLSL mat3(cos, -sin, 0, sin, cos, 0, 0, 0, 1)); the Khronos TextureTransformTest model's
+     * markers confirm the direction (tests/integration/test_texture_transform.c). */
+    float c = cosf(r->rotation), s = sinf(r->rotation);
+    m[0] = c * r->uv_scale[0], m[1] = s * r->uv_scale[1], m[2] = r->offset[0];
+    m[3] = -s * r->uv_scale[0], m[4] = c * r->uv_scale[1], m[5] = r->offset[1];
+    return r->offset[0] != 0.0f || r->offset[1] != 0.0f || r->rotation != 0.0f || r->uv_scale[0] != 1.0f ||
+           r->uv_scale[1] != 1.0f;
+}
+
+/* >>attachments */
+sy_result sy_sc_set_attachments(sy_scene *s, uint32_t t, uint32_t id, slot *sl, sy_attachment *a, uint32_t n,
+                                 sy_error *err)
+{
+    if (!sy_sc_mark_dirty(s, t, id, sl, SY_BIT(SY_FIELD_ATTACHMENTS), 0)) {
+        sy__attachments_free(a, n);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "attachment: out of memory");
+    }
+    sy__attachments_free(sl->att, sl->natt);
+    sl->att = a;
+    sl->natt = n;
+    return SY_OK;
+}
+
+sy_result sy_object_set_attachment(sy_scene *s, sy_object_type t, uint32_t id, const sy_attachment *a, sy_error *err)
+{
+    slot *sl = sy_sc_lookup(s, t, id);
+    if (!sl) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "attachment: stale or invalid %s handle", sy_object_type_name(t));
+    if (!a->key || !a->key[0]) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "attachment: empty key");
+    if (a->kind < SY_ATTACH_INT || a->kind > SY_ATTACH_BLOB)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "attachment '%s': unknown kind %u", a->key, a->kind);
+    if (a->kind == SY_ATTACH_STRING && !a->value.s)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "attachment '%s': NULL string", a->key);
+    /* keep keys sorted: find the position */
+    uint32_t pos = 0;
+    while (pos < sl->natt && strcmp(sl->att[pos].key, a->key) < 0) pos++;
+    bool replace = pos < sl->natt && strcmp(sl->att[pos].key, a->key) == 0;
+    if (replace && sy__attachments_equal(&sl->att[pos], 1, a, 1)) return SY_OK;
+    uint32_t n = sl->natt + (replace ? 0 : 1);
+    sy_attachment *na = calloc(n, sizeof *na);
+    if (!na) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "attachment: out of memory");
+    /* build the new array as copies: old entries before/after pos plus the new one */
+    sy_attachment *tmp = NULL;
+    bool ok = true;
+    uint32_t w = 0;
+    for (uint32_t i = 0; i < sl->natt && ok; ++i) {
+        if (i == pos) {
+            ok = sy__attachments_copy(a, 1, &tmp);
+            if (ok) na[w++] = *tmp, free(tmp);
+            if (replace) continue;
+        }
+        ok = ok && sy__attachments_copy(&sl->att[i], 1, &tmp);
+        if (ok) na[w++] = *tmp, free(tmp);
+    }
+    if (ok && pos == sl->natt) {
+        ok = sy__attachments_copy(a, 1, &tmp);
+        if (ok) na[w++] = *tmp, free(tmp);
+    }
+    if (!ok) {
+        sy__attachments_free(na, w);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "attachment: out of memory");
+    }
+    return sy_sc_set_attachments(s, t, id, sl, na, w, err);
+}
+
+sy_result sy_object_remove_attachment(sy_scene *s, sy_object_type t, uint32_t id, const char *key, sy_error *err)
+{
+    slot *sl = sy_sc_lookup(s, t, id);
+    if (!sl) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "attachment: stale or invalid %s handle", sy_object_type_name(t));
+    uint32_t pos = 0;
+    while (pos < sl->natt && strcmp(sl->att[pos].key, key) != 0) pos++;
+    if (pos == sl->natt) return sy_error_set(err, SY_ERR_NOT_FOUND, "attachment '%s' not found", key);
+    sy_attachment *na = NULL;
+    uint32_t n = sl->natt - 1;
+    if (n) {
+        sy_attachment *before = NULL, *after = NULL;
+        na = calloc(n, sizeof *na);
+        bool ok = na && sy__attachments_copy(sl->att, pos, &before) &&
+                  sy__attachments_copy(sl->att + pos + 1, sl->natt - pos - 1, &after);
+        if (!ok) {
+            sy__attachments_free(before, pos);
+            free(na);
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "attachment: out of memory");
+        }
+        if (pos) memcpy(na, before, sizeof *na * pos);
+        if (n - pos) memcpy(na + pos, after, sizeof *na * (n - pos));
+        free(before);
+        free(after);
+    }
+    return sy_sc_set_attachments(s, t, id, sl, na, n, err);
+}
+
+const sy_attachment *sy_object_attachments(const sy_scene *s, sy_object_type t, uint32_t id, uint32_t *count_out)
+{
+    slot *sl = sy_sc_lookup(s, t, id);
+    *count_out = sl ? sl->natt : 0;
+    return sl ? sl->att : NULL;
+}
+
+const sy_attachment *sy_object_find_attachment(const sy_scene *s, sy_object_type t, uint32_t id, const char *key)
+{
+    uint32_t n;
+    const sy_attachment *a = sy_object_attachments(s, t, id, &n);
+    for (uint32_t i = 0; i < n; ++i)
+        if (strcmp(a[i].key, key) == 0) return &a[i];
+    return NULL;
+}

@@ -1,0 +1,314 @@
+/* sy_scene_validate.c — validation in one place: every field of every object type is checked here
+ * before a setter, a replica apply or a loader stores it (ranges, references, sizes, cycles). */
+#include "sy_scene_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* >>validation (one place for every field of every type) */
+static bool finite_n(const float *v, int n)
+{
+    for (int i = 0; i < n; ++i)
+        if (!isfinite(v[i])) return false;
+    return true;
+}
+
+static bool ref_ok(const sy_scene *s, uint32_t type, uint32_t id)
+{
+    return id == 0 || s->applying || sy_sc_lookup(s, type, id) != NULL;
+}
+
+static sy_result check_texref(const sy_scene *s, const sy_texture_ref *t, const char *what, sy_error *err)
+{
+    if (!ref_ok(s, SY_TYPE_TEXTURE, t->texture.id))
+        return sy_error_set(err, SY_ERR_INVALID_HANDLE, "material %s: stale texture handle %#x", what, t->texture.id);
+    if (t->texcoord > 1)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "material %s: texcoord set %u (0 or 1 supported)", what,
+                            t->texcoord);
+    if (!isfinite(t->scale) || !finite_n(t->offset, 2) || !isfinite(t->rotation) || !finite_n(t->uv_scale, 2))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "material %s: non-finite texture transform", what);
+    return SY_OK;
+}
+
+static sy_result check_blob_elems(const sy_blob *b, size_t elem, uint32_t count, const char *what, uint32_t prim,
+                                  sy_error *err)
+{
+    if (!b) return SY_OK;
+    size_t need;
+    if (!sy_size_mul(elem, count, &need) || sy_blob_size(b) != need)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "mesh primitive %u: %s holds %zu bytes, expected %u vertices x %zu bytes", prim, what,
+                            sy_blob_size(b), count, elem);
+    return SY_OK;
+}
+
+/* An X3D gradient: counts within SY_GRADIENT_MAX, finite non-negative colours, angles increasing
+ * within (0, pi] (sky) and (0, pi/2] (ground), one angle fewer than colours. */
+static sy_result check_gradient(const sy_gradient *g, sy_error *err)
+{
+    if (g->sky_count > SY_GRADIENT_MAX || g->ground_count > SY_GRADIENT_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "background: gradient has more than %u colours", SY_GRADIENT_MAX);
+    if (g->ground_count && !g->sky_count)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "background: ground gradient without a sky colour");
+    for (int part = 0; part < 2; ++part) {
+        uint32_t n = part ? g->ground_count : g->sky_count;
+        const float(*c)[3] = part ? g->ground_color : g->sky_color;
+        const float *a = part ? g->ground_angle : g->sky_angle;
+        float lim = part ? 1.5707964f : 3.1415927f, prev = 0.0f;
+        const char *what = part ? "ground" : "sky";
+        for (uint32_t i = 0; i < n; ++i)
+            for (int k = 0; k < 3; ++k)
+                if (!isfinite(c[i][k]) || c[i][k] < 0.0f)
+                    return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "background: %s colour %u is not finite and >= 0",
+                                        what, i);
+        for (uint32_t i = 0; i + 1 < n; ++i) {
+            if (!isfinite(a[i]) || a[i] <= prev || a[i] > lim)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "background: %s angle %u = %g must increase within (0, %g]", what, i, (double)a[i],
+                                    (double)lim);
+            prev = a[i];
+        }
+    }
+    return SY_OK;
+}
+
+static sy_result check_primitive(const sy_scene *s, const sy_primitive *p, uint32_t i, sy_error *err)
+{
+    if (!p->positions) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: no positions", i);
+    size_t psize = sy_blob_size(p->positions);
+    if (psize % 12 != 0 || psize / 12 > UINT32_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: positions size %zu not a multiple of 12",
+                            i, psize);
+    uint32_t nv = (uint32_t)(psize / 12);
+    const float *pos = sy_blob_data(p->positions);
+    for (uint32_t v = 0; v < nv * 3; ++v)
+        if (!(fabsf(pos[v]) <= SY_COORD_MAX))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "mesh primitive %u: vertex %u has a position %s (%g; at most %g in size)", i, v / 3,
+                                isfinite(pos[v]) ? "beyond the coordinate range" : "that is not finite",
+                                (double)pos[v], (double)SY_COORD_MAX);
+    sy_result r;
+    if ((r = check_blob_elems(p->normals, 12, nv, "normals", i, err)) ||
+        (r = check_blob_elems(p->tangents, 16, nv, "tangents", i, err)) ||
+        (r = check_blob_elems(p->texcoords0, 8, nv, "texcoords0", i, err)) ||
+        (r = check_blob_elems(p->texcoords1, 8, nv, "texcoords1", i, err)) ||
+        (r = check_blob_elems(p->colors, 16, nv, "colors", i, err)))
+        return r;
+    if (p->topology >= SY_TOPOLOGY_COUNT)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: unknown topology %u", i, p->topology);
+    if (!isfinite(p->width) || p->width < 0.0f)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: stroke width %g is not finite and >= 0", i,
+                            (double)p->width);
+    /* elements: triangles take index triples, lines pairs, points any count */
+    uint32_t per = p->topology == SY_TOPOLOGY_TRIANGLES ? 3u : p->topology == SY_TOPOLOGY_LINES ? 2u : 1u;
+    const char *whole = per == 3 ? "whole triangles" : "whole line segments (index pairs)";
+    if (p->indices) {
+        size_t isize = sy_blob_size(p->indices);
+        if (isize % (4u * per) != 0)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: index data %zu bytes is not %s", i,
+                                isize, per == 1 ? "whole uint32 indices" : whole);
+        const uint32_t *idx = sy_blob_data(p->indices);
+        for (size_t k = 0; k < isize / 4; ++k)
+            if (idx[k] >= nv)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "mesh primitive %u: index %zu = %u is past the vertex count %u", i, k, idx[k], nv);
+    } else if (nv % per != 0) {
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: %u vertices without indices is not %s", i,
+                            nv, whole);
+    }
+    if (!ref_ok(s, SY_TYPE_MATERIAL, p->material.id))
+        return sy_error_set(err, SY_ERR_INVALID_HANDLE, "mesh primitive %u: stale material handle", i);
+    return SY_OK;
+}
+
+sy_result sy_sc_validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_t f, const void *v, sy_error *err)
+{
+    switch (type) {
+    case SY_TYPE_NODE:
+        switch (f) {
+        case SY_NODE_TRANSFORM: {
+            const sy_transform *t = v;
+            if (t->mode > SY_TRANSFORM_MATRIX)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: unknown transform mode %u", t->mode);
+            if (!finite_n(t->translation, 3) || !finite_n(t->rotation, 4) || !finite_n(t->scale, 3) ||
+                !sy_mat4_is_finite(&t->matrix))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: non-finite transform");
+            /* SY_COORD_MAX (sy_math.h): translations, scales and every matrix element */
+            if (!sy_coords_in_range(t->translation, 3) || !sy_coords_in_range(t->scale, 3) ||
+                !sy_coords_in_range(t->matrix.m, 16))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "node: transform beyond the coordinate range (translation (%g %g %g), scale "
+                                    "(%g %g %g); at most %g in size)",
+                                    (double)t->matrix.m[12], (double)t->matrix.m[13], (double)t->matrix.m[14],
+                                    (double)t->scale[0], (double)t->scale[1], (double)t->scale[2],
+                                    (double)SY_COORD_MAX);
+            return SY_OK;
+        }
+        case SY_NODE_CHILDREN: {
+            const sy_blob *b = *(sy_blob *const *)v;
+            if (!b) return SY_OK;
+            if (sy_blob_size(b) % 4 != 0)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: child list of %zu bytes", sy_blob_size(b));
+            uint32_t n = (uint32_t)(sy_blob_size(b) / 4);
+            const uint32_t *ch = sy_blob_data(b);
+            for (uint32_t i = 0; i < n; ++i) {
+                if (ch[i] == 0 || (!s->applying && !sy_sc_lookup(s, SY_TYPE_NODE, ch[i])))
+                    return sy_error_set(err, SY_ERR_INVALID_HANDLE, "node: child %u is a stale handle %#x", i, ch[i]);
+                if (ch[i] == id)
+                    return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: child %u is the node itself", i);
+            }
+            /* duplicates by sorting a copy (n log n: child lists of a million instances stay cheap) */
+            if (n > 1) {
+                uint32_t *sorted = malloc(sizeof *sorted * n);
+                if (!sorted) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "node: %u children: out of memory", n);
+                memcpy(sorted, ch, sizeof *sorted * n);
+                qsort(sorted, n, sizeof *sorted, sy_sc_cmp_u32);
+                uint32_t dup = 0;
+                for (uint32_t i = 1; i < n && !dup; ++i)
+                    if (sorted[i] == sorted[i - 1]) dup = sorted[i];
+                free(sorted);
+                if (dup) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: child %#x listed twice", dup);
+            }
+            if (!s->applying && sy_sc_reaches(s, ch, n, id))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "node: a child is the node's ancestor (the graph would have a cycle)");
+            return SY_OK;
+        }
+        case SY_NODE_MESH:
+            return ref_ok(s, SY_TYPE_MESH, ((const sy_mesh *)v)->id)
+                       ? SY_OK
+                       : sy_error_set(err, SY_ERR_INVALID_HANDLE, "node: stale mesh handle");
+        case SY_NODE_LIGHT:
+            return ref_ok(s, SY_TYPE_LIGHT, ((const sy_light *)v)->id)
+                       ? SY_OK
+                       : sy_error_set(err, SY_ERR_INVALID_HANDLE, "node: stale light handle");
+        case SY_NODE_CAMERA:
+            return ref_ok(s, SY_TYPE_CAMERA, ((const sy_camera *)v)->id)
+                       ? SY_OK
+                       : sy_error_set(err, SY_ERR_INVALID_HANDLE, "node: stale camera handle");
+        case SY_NODE_FLAGS:
+            if (*(const uint32_t *)v & ~(uint32_t)(SY_NODE_VISIBLE | SY_NODE_STATIC | SY_NODE_ANIMATED))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: unknown flags %#x", *(const uint32_t *)v);
+            return SY_OK;
+        default: return SY_OK;
+        }
+    case SY_TYPE_MESH:
+        if (f == SY_MESH_PRIMITIVES) {
+            const sy_primitive_list *l = v;
+            if (l->count && !l->items) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh: NULL primitives");
+            for (uint32_t i = 0; i < l->count; ++i) {
+                sy_result r = check_primitive(s, &l->items[i], i, err);
+                if (r) return r;
+            }
+        }
+        return SY_OK;
+    case SY_TYPE_MATERIAL: {
+        const sy_field_desc *fd = &sy__type_desc(type)->fields[f];
+        switch (f) {
+        case SY_MATERIAL_NAME: return SY_OK;
+        case SY_MATERIAL_BASE_COLOR_TEXTURE:
+        case SY_MATERIAL_METALLIC_ROUGHNESS_TEXTURE:
+        case SY_MATERIAL_NORMAL_TEXTURE:
+        case SY_MATERIAL_OCCLUSION_TEXTURE:
+        case SY_MATERIAL_EMISSIVE_TEXTURE:
+        case SY_MATERIAL_TRANSMISSION_TEXTURE: return check_texref(s, v, fd->name, err);
+        case SY_MATERIAL_ALPHA_MODE:
+            return *(const uint32_t *)v <= SY_ALPHA_BLEND
+                       ? SY_OK
+                       : sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "material: unknown alpha mode %u",
+                                      *(const uint32_t *)v);
+        case SY_MATERIAL_DOUBLE_SIDED:
+        case SY_MATERIAL_UNLIT:
+            return *(const uint32_t *)v <= 1
+                       ? SY_OK
+                       : sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "material: %s must be 0 or 1", fd->name);
+        default: {
+            const float *fv = v;
+            int n = (int)(fd->size / sizeof(float));
+            for (int i = 0; i < n; ++i) {
+                if (!isfinite(fv[i]))
+                    return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "material: %s is not finite", fd->name);
+                if (fv[i] < 0.0f)
+                    return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "material: %s is negative (%g)", fd->name,
+                                        (double)fv[i]);
+            }
+            if (f == SY_MATERIAL_IOR && fv[0] < 1.0f && fv[0] != 0.0f)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "material: ior %g below 1", (double)fv[0]);
+            return SY_OK;
+        }
+        }
+    }
+    case SY_TYPE_TEXTURE:
+        if (f == SY_TEXTURE_INFO) {
+            const sy_image_info *in = v;
+            if (in->channels > 4 || in->format > SY_PIXEL_F32)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "texture: %u channels, format %u", in->channels,
+                                    in->format);
+        } else if (f == SY_TEXTURE_SAMPLER) {
+            const sy_sampler *sm = v;
+            if (sm->wrap_s > SY_WRAP_MIRROR || sm->wrap_t > SY_WRAP_MIRROR || sm->min_filter > SY_FILTER_NEAREST ||
+                sm->mag_filter > SY_FILTER_NEAREST)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "texture: unknown sampler mode");
+        }
+        return SY_OK;
+    case SY_TYPE_LIGHT:
+        if (f == SY_LIGHT_NAME) return SY_OK;
+        if (f == SY_LIGHT_TYPE)
+            return *(const uint32_t *)v <= SY_LIGHT_DIRECTIONAL
+                       ? SY_OK
+                       : sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "light: unknown type %u", *(const uint32_t *)v);
+        {
+            const float *fv = v;
+            int n = f == SY_LIGHT_COLOR ? 3 : 1;
+            for (int i = 0; i < n; ++i)
+                if (!isfinite(fv[i]) || fv[i] < 0.0f)
+                    return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "light: %s must be finite and >= 0",
+                                        sy__type_desc(type)->fields[f].name);
+            if (f == SY_LIGHT_RANGE && !sy_coords_in_range(fv, 1))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "light: range %g is beyond the coordinate range (%g)",
+                                    (double)fv[0], (double)SY_COORD_MAX);
+            /* KHR_lights_punctual: 0 <= inner < outer <= pi/2 (inner >= outer is read as a hard edge:
+             * every back-end gets the light through the mirror, which orders them) */
+            if ((f == SY_LIGHT_INNER_CONE || f == SY_LIGHT_OUTER_CONE) && fv[0] > 1.5707964f)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "light: %s %g is beyond pi/2",
+                                    sy__type_desc(type)->fields[f].name, (double)fv[0]);
+        }
+        return SY_OK;
+    case SY_TYPE_CAMERA:
+        if (f == SY_CAMERA_NAME) return SY_OK;
+        if (f == SY_CAMERA_PROJECTION)
+            return *(const uint32_t *)v <= SY_PROJECTION_ORTHOGRAPHIC
+                       ? SY_OK
+                       : sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera: unknown projection %u",
+                                      *(const uint32_t *)v);
+        {
+            float x = *(const float *)v;
+            const char *fn = sy__type_desc(type)->fields[f].name;
+            if (!isfinite(x) || x < 0.0f)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera: %s must be finite and >= 0", fn);
+            if (f == SY_CAMERA_YFOV && (x <= 0.0f || x >= 3.14159f))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera: yfov %g outside (0, pi)", (double)x);
+            if (f == SY_CAMERA_ZNEAR && x <= 0.0f)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera: znear must be > 0");
+            if ((f == SY_CAMERA_ZNEAR || f == SY_CAMERA_ZFAR || f == SY_CAMERA_XMAG || f == SY_CAMERA_YMAG) &&
+                x > SY_COORD_MAX)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera: %s %g is beyond the coordinate range (%g)",
+                                    fn, (double)x, (double)SY_COORD_MAX);
+        }
+        return SY_OK;
+    case SY_TYPE_BACKGROUND:
+        if (f == SY_BACKGROUND_COLOR && !finite_n(v, 4))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "background: non-finite colour");
+        if (f == SY_BACKGROUND_INTENSITY && (!isfinite(*(const float *)v) || *(const float *)v < 0.0f))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "background: intensity must be finite and >= 0");
+        if (f == SY_BACKGROUND_ENVIRONMENT && !ref_ok(s, SY_TYPE_TEXTURE, ((const sy_texture *)v)->id))
+            return sy_error_set(err, SY_ERR_INVALID_HANDLE, "background: stale environment texture");
+        if ((f == SY_BACKGROUND_ENVIRONMENT_VISIBLE || f == SY_BACKGROUND_DEFAULT_LIGHTING) && *(const uint32_t *)v > 1)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "background: %s must be 0 or 1",
+                                sy__type_desc(type)->fields[f].name);
+        if (f == SY_BACKGROUND_GRADIENT) return check_gradient(v, err);
+        return SY_OK;
+    default: return SY_OK;
+    }
+}
