@@ -6,8 +6,9 @@
 # take a word from a list (--tonemap, --stereo, ...), back-end names after -b (asked of the `sy`
 # being completed: `sy backends`), and file names: scenes (.gltf, .glb, .x3d; and the word "demo")
 # where a SCENE is expected, any file after options that take a path. Needs bash 4; does not need
-# the bash-completion package. Keep the lists in step with apps/sy/sy_cli.c (usage_text) and
-# apps/sy/sy_cluster_cli.c; tests/integration/completion_test.sh checks a few.
+# the bash-completion package. Keep the lists in step with apps/sy/sy_cli.c (usage_text) and the
+# cluster commands (apps/sy/sy_cluster_cli.h, sy_cmd_serve.c, sy_bench_cluster.c);
+# tests/integration/completion_test.sh checks a few.
 
 _sy_commands="info render demo compare coverage view web bench backends serve help version"
 _sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit cull web"

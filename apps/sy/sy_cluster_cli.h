@@ -1,7 +1,8 @@
-/* sy_cluster_cli.h — the cluster parts of the `sy` tool: `sy serve` (a render server),
- * the `--cluster ...` options of `sy render` and `sy view`, and `sy bench cluster`. Built on
- * mediators/cluster/ (sy_cluster.h, sy_mediator_cluster.h) by sy_cluster_cli.c; a build without
- * the cluster compiles sy_cluster_cli_off.c instead, whose entry points say so.
+/* sy_cluster_cli.h — the cluster parts of the `sy` tool: `sy serve` (a render server,
+ * sy_cmd_serve.c), the `--cluster ...` options of `sy render` and `sy view` (sy_cluster_cli.c;
+ * `--cluster mpi`: sy_cluster_cli_mpi.c), and `sy bench cluster` (sy_bench_cluster*.c). Built on
+ * mediators/cluster/ (sy_cluster.h, sy_mediator_cluster.h); a build without the cluster compiles
+ * sy_cluster_cli_off.c instead of those files, whose entry points say so.
  * Thread-safety: command-line entry points, single-threaded callers. */
 #ifndef SY_CLUSTER_CLI_H
 #define SY_CLUSTER_CLI_H
@@ -85,5 +86,12 @@ const char *sy_cluster_cli_mode_name(uint32_t mode);
  * a server's memory and a client's frame time under 72 hostile unauthenticated connections,
  * cooperative speed-up (--hostile-only: the hostile measurement alone). argv[0] is "cluster". */
 int sy_cmd_bench_cluster(int argc, char **argv);
+
+/* For the cluster commands' own files (sy_cmd_serve.c, sy_bench_cluster.c; defined in
+ * sy_cluster_cli.c, absent from a build without the cluster): */
+/* A whole decimal number in [lo, hi] (the option's value); false for anything else. */
+bool sy_cluster_cli_uint_arg(const char *s, unsigned long long lo, unsigned long long hi, unsigned long long *out);
+/* "-w" or "--name" of option code c in a getopt_long table (for messages); returns name. */
+const char *sy_cluster_cli_opt_label(const struct option *lo, int c, char name[48]);
 
 #endif /* SY_CLUSTER_CLI_H */

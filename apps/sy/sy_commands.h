@@ -1,7 +1,7 @@
 /* sy_commands.h — the commands of `sy`, one file each (sy_cmd_COMMAND.c), dispatched by main
  * (sy_main.c). Each takes the command's arguments (argv[0]: the command, "bench": argv[1] the
  * benchmark), parses them itself (sy_cli.h) and returns the exit status: 0 success, 1 failure,
- * 2 usage error, 130 interrupted. `sy serve`: sy_cmd_serve (sy_cluster_cli.h). */
+ * 2 usage error, 130 interrupted. `sy serve`: sy_cmd_serve (sy_cluster_cli.h, sy_cmd_serve.c). */
 #ifndef SY_COMMANDS_H
 #define SY_COMMANDS_H
 

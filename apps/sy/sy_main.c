@@ -22,7 +22,7 @@
  *   sy bench memory [--tris T] [-b whitted|pathtracer] [--glb] [-w W] [-h H]   peak RSS per triangle (sy_bench.h)
  *   sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]
  *   sy backends [--params] [--json]     list registered back-ends (--params: their parameters)
- *   sy serve [--listen URL] [--secret-file F] [--output OUT]   render server (apps/sy/sy_cluster_cli.c)
+ *   sy serve [--listen URL] [--secret-file F] [--output OUT]   render server (apps/sy/sy_cmd_serve.c)
  *   sy render ... --cluster URL[,URL...]|FILE.conf [--cluster-mode MODE]   render on servers
  *   sy view ... --cluster URL[,URL...]|FILE.conf [--cluster-mode MODE]     the viewer on servers
  *   sy bench cluster [-w W] [-h H] [--repeats ROUNDS]

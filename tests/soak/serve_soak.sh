@@ -5,7 +5,7 @@
 # are printed. Exit 0 when every frame sent came back and each of the three grew by less than 5 %
 # from the end of the warm-up (60 s, or a tenth of a shorter soak) to the end; 1 otherwise.
 #   tests/soak/serve_soak.sh [BUILD_DIR (build)] [SECONDS (600)] [BACKEND (raster, else whitted)] [OUT_LOG]
-# Runs `sy bench cluster --soak` (apps/sy/sy_cluster_cli.c, bench_soak); docs/TESTING.md.
+# Runs `sy bench cluster --soak` (apps/sy/sy_bench_cluster_soak.c); docs/TESTING.md.
 set -euo pipefail
 build=${1:-build}
 seconds=${2:-600}

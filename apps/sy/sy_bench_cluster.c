@@ -1,0 +1,317 @@
+/* sy_bench_cluster.c — `sy bench cluster` (see sy_cluster_cli.h): its options, and its default
+ * measurements on 2 servers (snapshot and change sizes, protocol overhead, request latency, the tile
+ * codec, half tiles and the blob cache); the others have a file each (sy_bench_cluster.h). */
+#define _GNU_SOURCE /* sched_setaffinity: the client keeps off the servers' cores */
+#include "sy_bench_cluster.h"
+#include "sy_cli.h"
+#include "sy_cluster_cli.h"
+#include "sy_options.h"
+
+#include "sy_log.h"
+
+#include <sched.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+static bool count_all(void *user, const sy_blob *b)
+{
+    (void)user;
+    (void)b;
+    return true;
+}
+static bool count_none(void *user, const sy_blob *b)
+{
+    (void)user;
+    (void)b;
+    return false;
+}
+
+/* Protocol 2 figures: bytes of binary16 tiles vs float32 on the same frame and the half codec's
+ * ratio on the frame's pixels; the snapshot a second client with the same model sends (the
+ * servers' blob cache answers its hashes) vs the first client's. */
+static sy_result bench_half_and_blob_cache(sy_scene *scene, const sy_cluster_client_opts *co, sy_cluster_client *c,
+                                           const sy_cluster_frame *f, sy_layer *out,
+                                           const sy_cluster_frame_stats *first, sy_error *err)
+{
+    sy_cluster_frame hf = *f;
+    sy_cluster_frame_stats sf = {0}, sh = {0}, s2 = {0};
+    sy_result r = sy_cluster_client_render(c, f, out, &sf, err);
+    hf.half = true;
+    if (r == SY_OK) r = sy_cluster_client_render(c, &hf, out, &sh, err);
+    if (r == SY_OK)
+        printf("  half tiles (--cluster-pixels half) %ux%u RGBA: %.2f MB back per frame vs %.2f MB float32 (%.2fx fewer)\n",
+               f->width, f->height, (double)sh.bytes_received / 1e6, (double)sf.bytes_received / 1e6,
+               (double)sf.bytes_received / (double)sh.bytes_received);
+    sy_cluster_buf enc = {0};
+    double te = sy_time_now();
+    if (r == SY_OK) r = sy_cluster_tile_encode_as(out, true, SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD, &enc, err);
+    te = sy_time_now() - te;
+    uint64_t raw16 = (uint64_t)out->width * out->height * 10;
+    sy_cluster_tile t = {{0, 0, out->width, out->height}, SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD, 5, raw16, enc.data,
+                         (uint32_t)enc.size};
+    double td = sy_time_now();
+    if (r == SY_OK) r = sy_cluster_tile_decode(&t, out, 0, 0, err);
+    td = sy_time_now() - td;
+    if (r == SY_OK)
+        printf("  tile codec RGBA+Z half: %.1f MB float32 -> %.1f MB binary16 -> %.2f MB zstd (%.1fx of float32, %.1fx "
+               "of the half planes); encode %.0f MB/s, decode %.0f MB/s (float32-equivalent bytes, one core)\n",
+               (double)raw16 * 2 / 1e6, (double)raw16 / 1e6, (double)enc.size / 1e6, (double)raw16 * 2 / (double)enc.size,
+               (double)raw16 / (double)enc.size, (double)raw16 * 2 / te / 1e6, (double)raw16 * 2 / td / 1e6);
+    sy_cluster_buf_free(&enc);
+    sy_cluster_client *c2 = NULL;
+    if (r == SY_OK) r = sy_cluster_client_create(scene, co, &c2, err);
+    if (r == SY_OK) r = sy_cluster_client_render(c2, f, out, &s2, err);
+    if (r == SY_OK)
+        printf("  snapshot of a second client with the same model (per server): %llu bytes, %llu of them blob payloads; "
+               "first client %llu bytes, %llu of them blob payloads (%.0fx less)\n",
+               (unsigned long long)(s2.scene_bytes / 2), (unsigned long long)(s2.blob_bytes / 2),
+               (unsigned long long)(first->scene_bytes / 2), (unsigned long long)(first->blob_bytes / 2),
+               (double)first->scene_bytes / (double)(s2.scene_bytes ? s2.scene_bytes : 1));
+    sy_cluster_client_destroy(c2);
+    return r;
+}
+int sy_cmd_bench_cluster(int argc, char **argv)
+{
+    uint32_t w = 1920, h = 1080, rounds = 3;
+    bool hostile_only = false, coop_only = false, scale = false; /* one measurement alone */
+    double coop_frame = 1.6; /* cooperative: seconds per frame on one server (each frame costs ~15 ms of sync + merge) */
+    double soak = 0, warmup = -1; /* --soak: seconds of camera changes against one server */
+    const char *soak_backend = NULL;
+    bool size_given = false;
+    static const char usage_text[] = "usage: sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only | --coop-only] "
+                                     "[--coop-frame SECONDS] | --scale\n"
+                                     "       sy bench cluster --soak SECONDS [--warmup SECONDS] [-b BACKEND] [-w W] [-h H]"
+                                     "   (exit 1 unless every frame came back and the server's RSS, fds and threads grew < 5 %)\n";
+    enum { O_REPEATS = 0x100, O_HOSTILE, O_COOP, O_SCALE, O_COOP_FRAME, O_SOAK, O_WARMUP, O_HELP };
+    static const struct option lo[] = {
+        {"repeats", required_argument, NULL, O_REPEATS}, {"hostile-only", no_argument, NULL, O_HOSTILE},
+        {"coop-only", no_argument, NULL, O_COOP}, {"scale", no_argument, NULL, O_SCALE},
+        {"soak", required_argument, NULL, O_SOAK}, {"warmup", required_argument, NULL, O_WARMUP},
+        {"backend", required_argument, NULL, 'b'},
+        {"coop-frame", required_argument, NULL, O_COOP_FRAME}, {"help", no_argument, NULL, O_HELP},
+        {"quiet", no_argument, NULL, 'q'}, {"verbose", no_argument, NULL, 'v'}, {NULL, 0, NULL, 0}};
+    int opt;
+    unsigned long long v = 0;
+    optind = 0; /* glibc: start over (new arguments, GNU ordering) */
+    opterr = 0;
+    while ((opt = sy_getopt(argc, argv, ":w:h:b:qv", lo, "sy bench cluster")) != -1) {
+        bool ok = true;
+        char *end = NULL;
+        switch (opt) {
+        case SY_GETOPT_ERROR: return 2; /* an abbreviated long option (named on stderr) */
+        case 'w': ok = sy_cluster_cli_uint_arg(optarg, 1, 16384, &v), w = (uint32_t)v, size_given = true; break;
+        case 'h': ok = sy_cluster_cli_uint_arg(optarg, 1, 16384, &v), h = (uint32_t)v, size_given = true; break;
+        case 'b': soak_backend = optarg; break;
+        case O_SOAK: ok = sy_cluster_cli_uint_arg(optarg, 1, 86400, &v), soak = (double)v; break;
+        case O_WARMUP: ok = sy_cluster_cli_uint_arg(optarg, 0, 86400, &v), warmup = (double)v; break;
+        case O_REPEATS: ok = sy_cluster_cli_uint_arg(optarg, 1, 100, &v), rounds = (uint32_t)v; break;
+        case O_HOSTILE: hostile_only = true; break;
+        case O_COOP: coop_only = true; break;
+        case O_SCALE: scale = true; break;
+        case O_COOP_FRAME: coop_frame = strtod(optarg, &end), ok = end != optarg && !*end; break;
+        case 'q': sy_log_set_level(SY_LOG_ERROR); break;
+        case 'v': sy_log_set_level(SY_LOG_DEBUG); break;
+        case O_HELP: fputs(usage_text, stdout); return 0;
+        case ':': fprintf(stderr, "sy bench cluster: error: option '%s' needs a value\n%s", argv[optind - 1], usage_text); return 2;
+        default:
+            fprintf(stderr, "sy bench cluster: error: unknown option '%s'\n%s", argv[optind - 1], usage_text);
+            return 2;
+        }
+        if (!ok) {
+            char name[48];
+            fprintf(stderr, "sy bench cluster: error: %s: '%s' is not an accepted value\n",
+                    sy_cluster_cli_opt_label(lo, opt, name), optarg);
+            return 2;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "sy bench cluster: error: unexpected argument '%s'\n%s", argv[optind], usage_text);
+        return 2;
+    }
+    if (w < 1 || h < 1 || w > 16384 || h > 16384 || rounds < 1 || rounds > 100 || !(coop_frame >= 0.05 && coop_frame <= 60)) {
+        fprintf(stderr, "sy bench cluster: error: sizes 1..16384, --repeats 1..100, --coop-frame 0.05..60\n");
+        return 2;
+    }
+    signal(SIGPIPE, SIG_IGN);
+    sy_error err = {0};
+    sy_scene *scene = NULL;
+    sy_demo_info d;
+    sy_bench_cluster_server srv[2] = {{0}};
+    sy_cluster_client *c = NULL;
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_layer out = {0};
+    sy_changes *snap = NULL;
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    sy_result r = sy_scene_create(&scene, &err);
+    if (r == SY_OK) r = sy_demo_build(scene, &d, &err);
+    if (r == SY_OK) r = sy_scene_commit(scene, NULL, &err);
+    /* snapshot size vs the scene's own data */
+    void *buf = NULL;
+    size_t with_blobs = 0, without = 0;
+    if (r == SY_OK) r = sy_scene_snapshot(scene, &snap, &err);
+    if (r == SY_OK) r = sy_changes_serialize(snap, count_all, NULL, &buf, &with_blobs, &err);
+    free(buf);
+    buf = NULL;
+    if (r == SY_OK) r = sy_changes_serialize(snap, count_none, NULL, &buf, &without, &err);
+    free(buf);
+    sy_changes_release(snap);
+    if (r == SY_OK && soak > 0) {
+        const char *backend = soak_backend ? soak_backend : sy_mediator_default_name();
+        bool passed = false;
+        if (warmup < 0) warmup = soak / 10 < 60 ? soak / 10 : 60;
+        if (warmup >= soak) {
+            sy_scene_destroy(scene);
+            fprintf(stderr, "sy bench cluster: error: --warmup must be shorter than --soak\n");
+            return 2;
+        }
+        if (!sy_mediator_find(backend)) {
+            sy_scene_destroy(scene);
+            fprintf(stderr, "sy bench cluster: error: -b: no back-end '%s' in this build\n", backend);
+            return 2;
+        }
+        r = sy_bench_cluster_soak(scene, &d, backend, soak, warmup, size_given ? w : 320, size_given ? h : 180, &passed,
+                                  &err);
+        sy_scene_destroy(scene);
+        return r == SY_OK ? (passed ? 0 : 1) : sy_cli_fail(&err);
+    }
+    if (soak_backend || warmup >= 0) {
+        sy_scene_destroy(scene);
+        fprintf(stderr, "sy bench cluster: error: -b and --warmup go with --soak\n%s", usage_text);
+        return 2;
+    }
+    if (r == SY_OK && scale) {
+        r = sy_bench_cluster_scale(scene, &d, rounds < 3 ? 3 : rounds, &err);
+        sy_scene_destroy(scene);
+        return r == SY_OK ? 0 : sy_cli_fail(&err);
+    }
+    if (r == SY_OK) r = sy_bench_cluster_spawn(ncpu >= 2 ? 0 : -1, &srv[0], &err);
+    if (r == SY_OK && hostile_only) {
+        printf("sy bench cluster --hostile-only: demo scene, one server on loopback\n");
+        r = sy_bench_cluster_hostile(scene, &d, sy_mediator_default_name(), &srv[0], &err);
+        sy_bench_cluster_stop(&srv[0]);
+        sy_scene_destroy(scene);
+        return r == SY_OK ? 0 : sy_cli_fail(&err);
+    }
+    if (r == SY_OK) r = sy_bench_cluster_spawn(ncpu >= 2 ? 1 : -1, &srv[1], &err);
+    if (r == SY_OK && ncpu >= 3) { /* the client keeps off the servers' cores where it can */
+        cpu_set_t set;
+        CPU_ZERO(&set);
+        for (long i = 2; i < ncpu && i < CPU_SETSIZE; ++i) CPU_SET((int)i, &set);
+        sched_setaffinity(0, sizeof set, &set);
+    }
+    const char *urls[2] = {srv[0].url, srv[1].url};
+    sy_cluster_client_opts co = {.urls = urls, .url_count = 2, .timeout_ms = 120000};
+    const char *backend = sy_mediator_default_name();
+    sy_viewport_desc vd = {.root = d.root, .camera = d.camera, .background = d.background, .backend = backend};
+    if (r == SY_OK && coop_only) {
+        printf("sy bench cluster --coop-only: demo scene, 2 servers on loopback\n");
+        r = sy_bench_cluster_coop(scene, &vd, srv, rounds, ncpu >= 2, coop_frame, &err);
+        sy_bench_cluster_stop(&srv[0]);
+        sy_bench_cluster_stop(&srv[1]);
+        sy_scene_destroy(scene);
+        return r == SY_OK ? 0 : sy_cli_fail(&err);
+    }
+    sy_camera_view view;
+    if (r == SY_OK) r = sy_window_create(w, h, &win, &err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, &err);
+    if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, &err);
+    if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &c, &err);
+    if (r == SY_OK) r = sy_layer_create(w, h, &out, &err);
+    sy_cluster_frame f = {.mode = SY_CLUSTER_SORT_FIRST, .backend = backend, .root_id = d.root.id,
+                          .background_id = d.background.id, .camera = view, .width = w, .height = h};
+    sy_cluster_frame_stats s1 = {0}, s2 = {0};
+    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &out, &s1, &err);
+    /* one transform change */
+    if (r == SY_OK) {
+        sy_mat4 m;
+        r = sy_node_world_matrix(scene, d.camera, &m, &err);
+        m.m[12] += 0.01f; /* the demo camera hangs under an identity root: world = local */
+        if (r == SY_OK) r = sy_node_set_matrix(scene, d.camera, &m, &err);
+    }
+    if (r == SY_OK) r = sy_scene_commit(scene, NULL, &err);
+    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &out, &s2, &err);
+    /* steady state: frames without changes */
+    double over = 0, frame = 0, bytes = 0;
+    const int reps = 5;
+    for (int i = 0; i < reps && r == SY_OK; ++i) {
+        sy_cluster_frame_stats s;
+        r = sy_cluster_client_render(c, &f, &out, &s, &err);
+        over += s.seconds - s.max_server_seconds;
+        frame += s.seconds;
+        bytes += (double)(s.bytes_sent + s.bytes_received);
+    }
+    if (r == SY_OK) {
+        printf("sy bench cluster: demo scene, 2 servers on loopback (pinned to cores 0 and 1: %s; client on %s)\n",
+               ncpu >= 2 ? "yes" : "no, 1 core", ncpu >= 3 ? "the other cores" : "any core");
+        printf("  snapshot on the wire (first frame, per server): %llu bytes; serialised scene %zu bytes "
+               "(%zu structure + %zu blob payload)\n",
+               (unsigned long long)(s1.scene_bytes / 2), with_blobs, without, with_blobs - without);
+        printf("  one-transform change on the wire (per server):  %llu bytes (target < 256)\n",
+               (unsigned long long)(s2.scene_bytes / 2));
+        printf("  sort-first %s %ux%u: frame %.4f s, protocol overhead %.4f s/frame (%.1f%% of the frame), "
+               "%.2f MB on the wire per frame (zstd float tiles)\n",
+               backend, w, h, frame / reps, over / reps, 100.0 * over / frame, bytes / reps / 1e6);
+    }
+    /* per-request latency L of the scaling model: tiny sort-first frames, where rendering and
+     * pixels cost next to nothing; what the client spends beyond the slowest server */
+    if (r == SY_OK) {
+        sy_layer tiny = {0};
+        sy_cluster_frame tf = f;
+        tf.width = 64, tf.height = 36;
+        double lat_min = 1e30, lat_sum = 0, frame_sum = 0;
+        const int lat_n = 30;
+        r = sy_layer_create(tf.width, tf.height, &tiny, &err);
+        for (int i = -1; i < lat_n && r == SY_OK; ++i) { /* i = -1: warm-up (a new image size) */
+            sy_cluster_frame_stats s;
+            r = sy_cluster_client_render(c, &tf, &tiny, &s, &err);
+            double l = s.seconds - s.max_server_seconds;
+            if (r == SY_OK && i >= 0) {
+                lat_sum += l, frame_sum += s.seconds;
+                if (l < lat_min) lat_min = l;
+            }
+        }
+        if (r == SY_OK)
+            printf("  request latency (64x36 sort-first frames, 2 servers in parallel, %d frames): L = %.2f ms min, %.2f ms "
+                   "mean beyond the slowest server (whole frame %.2f ms mean)\n",
+                   lat_n, lat_min * 1e3, lat_sum / lat_n * 1e3, frame_sum / lat_n * 1e3);
+        sy_layer_destroy(&tiny);
+    }
+    /* codec constants for the scaling model (docs/CLUSTER.md): compression and decompression
+     * throughput of the final frame's pixels (RGBA + depth float32) on this core */
+    if (r == SY_OK) {
+        sy_cluster_buf enc = {0};
+        double te = sy_time_now();
+        r = sy_cluster_tile_encode(&out, true, &enc, &err);
+        te = sy_time_now() - te;
+        sy_cluster_tile t = {{0, 0, w, h}, SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD, 5, (uint64_t)w * h * 20, enc.data,
+                             (uint32_t)enc.size};
+        double td = sy_time_now();
+        if (r == SY_OK) r = sy_cluster_tile_decode(&t, &out, 0, 0, &err);
+        td = sy_time_now() - td;
+        double raw = (double)w * h * 20;
+        if (r == SY_OK)
+            printf("  tile codec %ux%u RGBA+Z float: %.1f MB raw -> %.2f MB (%.1fx); encode %.0f MB/s, decode %.0f MB/s "
+                   "(raw bytes, one core)\n",
+                   w, h, raw / 1e6, (double)enc.size / 1e6, raw / (double)enc.size, raw / te / 1e6, raw / td / 1e6);
+        sy_cluster_buf_free(&enc);
+    }
+    if (r == SY_OK) r = bench_half_and_blob_cache(scene, &co, c, &f, &out, &s1, &err);
+    if (r == SY_OK) r = sy_bench_cluster_hostile(scene, &d, backend, &srv[0], &err);
+    sy_layer_destroy(&out);
+    sy_cluster_client_destroy(c);
+    c = NULL;
+    /* cooperative path tracing: 2 pinned servers vs 1 */
+    if (r == SY_OK && sy_mediator_find("pathtracer")) {
+        r = sy_bench_cluster_coop(scene, &vd, srv, rounds, ncpu >= 2, coop_frame, &err);
+    } else if (r == SY_OK) {
+        printf("  cooperative: skipped (no 'pathtracer' back-end registered in this build)\n");
+    }
+    sy_bench_cluster_stop(&srv[0]);
+    sy_bench_cluster_stop(&srv[1]);
+    sy_window_destroy(win);
+    sy_scene_destroy(scene);
+    return r == SY_OK ? 0 : sy_cli_fail(&err);
+}

@@ -1,0 +1,145 @@
+/* sy_bench_cluster_coop.c — `sy bench cluster`, cooperative path tracing: 2 servers against 1 in
+ * interleaved rounds, the speed-up and the samples per server CPU-second (see sy_bench_cluster.h;
+ * alone: --coop-only). */
+#include "sy_bench_cluster.h"
+#include "sy_bench.h"
+
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+/* CPU seconds (user + system) a process has used so far, from /proc/PID/stat; < 0 when unknown. */
+static double proc_cpu_seconds(pid_t pid)
+{
+    char path[64], buf[1024];
+    snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+    FILE *f = fopen(path, "r");
+    if (!f) return -1.0;
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = 0;
+    const char *p = strrchr(buf, ')'); /* the command name may hold spaces and parentheses */
+    unsigned long ut = 0, st = 0;
+    if (!p || sscanf(p + 1, " %*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %lu %lu", &ut, &st) != 2) return -1.0;
+    return (double)(ut + st) / (double)sysconf(_SC_CLK_TCK);
+}
+
+/* One cooperative measurement: merged samples per pixel per second on the first n servers. */
+typedef struct coop_run {
+    double rate;       /* merged samples per pixel per second */
+    double seconds;    /* wall time measured */
+    double cpu[2];     /* each server's CPU seconds in that time (< 0: unknown) */
+    uint64_t samples;  /* merged samples per pixel added in that time */
+    uint32_t frames;
+} coop_run;
+
+/* Cooperative path tracing on the first n servers with a fresh client (snapshot + translation in a
+ * warm-up frame that is not counted), spf samples per server and frame, frames until at least
+ * min_seconds have passed (and at least 3). *spf == 0: calibrated here from a 4-sample frame so
+ * that a frame takes about 0.4 s (the client's per-frame transfer and merge stay small next to
+ * the rendering), and returned for the other runs. */
+static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const sy_bench_cluster_server *srv, uint32_t n,
+                              uint32_t w, uint32_t h, uint32_t *spf, double frame_s, double min_seconds, coop_run *out,
+                              sy_error *err)
+{
+    memset(out, 0, sizeof *out);
+    const char *urls[2] = {srv[0].url, n > 1 ? srv[1].url : NULL};
+    sy_cluster_client_opts co = {.urls = urls, .url_count = n, .timeout_ms = 120000};
+    sy_cluster_client *c = NULL;
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_camera_view view;
+    sy_layer out_img = {0};
+    sy_result r = sy_window_create(w, h, &win, err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, vd, &vp, err);
+    if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, err);
+    if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &c, err);
+    if (r == SY_OK) r = sy_layer_create(w, h, &out_img, err);
+    sy_cluster_frame f = {.mode = SY_CLUSTER_COOPERATIVE, .backend = "pathtracer", .root_id = vd->root.id,
+                          .background_id = vd->background.id, .camera = view, .width = w, .height = h, .samples = 4};
+    sy_cluster_frame_stats st = {0};
+    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &out_img, &st, err); /* warm-up: snapshot + translation */
+    if (r == SY_OK && !*spf) {
+        double t = sy_time_now();
+        r = sy_cluster_client_render(c, &f, &out_img, &st, err);
+        t = sy_time_now() - t;
+        double k = t > 0 ? frame_s / t : 256.0;
+        *spf = k >= 256.0 ? 1024u : k <= 1.0 ? 4u : (uint32_t)(4.0 * k + 0.5);
+    }
+    f.samples = *spf;
+    uint64_t s0 = st.samples;
+    double cpu0[2] = {proc_cpu_seconds(srv[0].pid), n > 1 ? proc_cpu_seconds(srv[1].pid) : -1.0};
+    double t0 = sy_time_now();
+    while (r == SY_OK && (out->frames < 3 || sy_time_now() - t0 < min_seconds)) {
+        r = sy_cluster_client_render(c, &f, &out_img, &st, err);
+        out->frames++;
+        if (r == SY_OK && st.servers_live != n)
+            r = sy_error_set(err, SY_ERR_IO, "bench: a server dropped out of the cooperative measurement");
+    }
+    out->seconds = sy_time_now() - t0;
+    out->samples = st.samples - s0;
+    out->rate = out->seconds > 0 ? (double)out->samples / out->seconds : 0;
+    for (uint32_t i = 0; i < 2; ++i) {
+        double now = i < n ? proc_cpu_seconds(srv[i].pid) : -1.0;
+        out->cpu[i] = now >= 0 && cpu0[i] >= 0 ? now - cpu0[i] : -1.0;
+    }
+    sy_layer_destroy(&out_img);
+    sy_cluster_client_destroy(c);
+    sy_window_destroy(win);
+    return r;
+}
+
+/* Cooperative path tracing, 2 servers pinned to one core each vs 1 server: `rounds` interleaved
+ * rounds (the order alternates, so a drift in the machine's load hits both sides alike); the
+ * speed-up is best 2-server rate / best 1-server rate, each round's ratio printed beside it.
+ * Each server's CPU time shows how much of its core it got: on a machine shared with other work
+ * the wall-clock ratio drops, while samples per server CPU-second (the cost of cooperating: the
+ * sample split, transfers, merging, waiting for the other server) stay comparable. */
+sy_result sy_bench_cluster_coop(sy_scene *scene, const sy_viewport_desc *vd, const sy_bench_cluster_server *srv,
+                                uint32_t rounds, bool pinned, double frame_s, sy_error *err)
+{
+    const uint32_t w = 320, h = 180;
+    const double min_seconds = frame_s * 3.75 > 1.5 ? frame_s * 3.75 : 1.5;
+    uint32_t spf = 0;
+    enum { MAX_ROUNDS = 64 };
+    double ratio[MAX_ROUNDS], rate[2][MAX_ROUNDS], eff[2][MAX_ROUNDS]; /* per round: speed-up, spp/s, spp per CPU-s */
+    uint32_t nr = 0, ne = 0;
+    if (rounds > MAX_ROUNDS) rounds = MAX_ROUNDS;
+    sy_result r = SY_OK;
+    printf("  cooperative pathtracer %ux%u, servers %s, %u interleaved rounds of >= %.1f s per side, frames of about "
+           "%.2f s on one server:\n",
+           w, h, pinned ? "pinned to cores 0 and 1" : "not pinned (1 core)", rounds, min_seconds, frame_s);
+    for (uint32_t round = 0; round < rounds && r == SY_OK; ++round) {
+        coop_run run[2];
+        for (uint32_t k = 0; k < 2 && r == SY_OK; ++k) {
+            uint32_t n = (round & 1) ? 2 - k : 1 + k; /* 1,2 / 2,1 / 1,2 ... */
+            r = coop_measure(scene, vd, srv, n, w, h, &spf, frame_s, min_seconds, &run[n - 1], err);
+        }
+        if (r != SY_OK) break;
+        rate[0][nr] = run[0].rate, rate[1][nr] = run[1].rate;
+        ratio[nr++] = run[0].rate > 0 ? run[1].rate / run[0].rate : 0.0;
+        double cpu1 = run[0].cpu[0], cpu2 = run[1].cpu[0] + run[1].cpu[1];
+        if (run[0].cpu[0] >= 0 && run[1].cpu[0] >= 0 && run[1].cpu[1] >= 0 && cpu1 > 0 && cpu2 > 0) {
+            eff[0][ne] = (double)run[0].samples / cpu1, eff[1][ne] = (double)run[1].samples / cpu2;
+            ne++;
+        }
+        printf("    round %u (%u spp per server and frame): 1 server %.1f spp/s (busy %.2f s CPU of %.2f s); "
+               "2 servers %.1f spp/s (busy %.2f + %.2f s CPU of %.2f s): %.2fx\n",
+               round + 1, spf, run[0].rate, run[0].cpu[0], run[0].seconds, run[1].rate, run[1].cpu[0], run[1].cpu[1],
+               run[1].seconds, ratio[nr - 1]);
+    }
+    if (r == SY_OK && nr) {
+        sy_bench_spread sr = sy_bench_spread_of(ratio, nr), s1 = sy_bench_spread_of(rate[0], nr),
+                        s2 = sy_bench_spread_of(rate[1], nr);
+        printf("  cooperative speed-up (median of %u rounds, min..max): %.2fx (%.2f..%.2f; target >= 1.95x); "
+               "1 server %.1f spp/s, 2 servers %.1f spp/s (medians)\n",
+               nr, sr.median, sr.min, sr.max, s1.median, s2.median);
+    }
+    if (r == SY_OK && ne) {
+        sy_bench_spread e1 = sy_bench_spread_of(eff[0], ne), e2 = sy_bench_spread_of(eff[1], ne);
+        printf("  per server CPU-second (median of %u): 1 server %.1f spp, 2 servers %.1f spp (%.0f%% efficiency): "
+               "2 x %.2f = %.2fx with each server's core to itself\n",
+               ne, e1.median, e2.median, 100.0 * e2.median / e1.median, e2.median / e1.median, 2.0 * e2.median / e1.median);
+    }
+    return r;
+}
