@@ -3,8 +3,8 @@
  * no server): the raw request head as it arrives (sy_web_head_scan: request line, header syntax,
  * lengths), the decision on a parsed request (sy_web_check_request: Host, token, Origin, Content-Type,
  * the route, the still's size and pixel budget) and the WebSocket input messages
- * (sy_web_parse_input). The server (sy_web.c) and the fuzz targets (tests/fuzz/fuzz_web_*.c) call
- * the same functions. docs/WEB.md ("Security", "Routes") lists what is checked.
+ * (sy_web_parse_input). The server (sy_web_http.c, sy_web_ws.c) and the fuzz targets
+ * (tests/fuzz/fuzz_web_*.c) call the same functions. docs/WEB.md ("Security", "Routes") lists what is checked.
  *
  * Ownership: nothing is allocated; outputs point into the inputs or are copied into the caller's
  * structs. Thread-safety: every function is reentrant. */

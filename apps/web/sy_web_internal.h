@@ -1,0 +1,172 @@
+/* sy_web_internal.h — INTERNAL to apps/web (not installed): what the modules of the sy_web server
+ * (sy_web.h) share: the server's struct, the mailbox between the network and the render thread,
+ * and the functions one module calls in another (prefix sy_webi_; none of them is API). The
+ * modules, bottom-up (each calls only those before it; tests/core/layers_test.sh checks it), over
+ * the request checks (sy_web_check.c) and the gate (sy_web_gate.c):
+ *   sy_web_mailbox.c  what the two threads share (under mu): jobs, frames, the display filters
+ *   sy_web_http.c     HTTP on the network thread: page, stills, routes, token, body collection
+ *   sy_web_ws.c       WebSocket viewers: input messages in, newest frame out; the protocol table
+ *                     and the network thread
+ *   sy_web_render.c   the render loop on the thread in sy_web_run (frames, stills, routes)
+ *   sy_web.c          create / destroy, the accessors and the counters */
+#ifndef SY_WEB_INTERNAL_H
+#define SY_WEB_INTERNAL_H
+
+#include "sy_web.h"
+
+#include "sy_orbit.h"
+#include "sy_web_check.h"
+#include "sy_web_gate.h"
+
+#include <libwebsockets.h>
+
+#include <pthread.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define WEB_TOKEN_BYTES 16u
+
+/* Display filters the F key cycles through (as sy view), on a back-end with SY_CAP_FILTERS
+ * (sy_web_mailbox.c). */
+#define SY_WEBI_FILTER_COUNT 6u
+extern const char *const sy_webi_filters[SY_WEBI_FILTER_COUNT];
+
+/* The mailbox: what the two threads share (sy_web_mailbox.c). */
+typedef enum job_state { JOB_PENDING, JOB_RUNNING, JOB_FINISHED, JOB_DELIVERING } job_state;
+
+/* A request answered on the render thread: a still or a route. Owned by the mailbox lists while
+ * PENDING / RUNNING / FINISHED, by the HTTP connection while DELIVERING; a connection that closes
+ * earlier marks it abandoned and whoever holds it next frees it. */
+typedef struct web_job {
+    struct web_job *next;
+    job_state state;
+    bool abandoned;
+    struct lws *wsi;
+    const sy_web_route *route; /* NULL: a still */
+    uint32_t w, h;             /* still size */
+    uint64_t pixels;           /* w x h */
+    double queued_ms;          /* when the still was queued (sy_time_now, ms) */
+    char method[8], path[256], query[512], peer[64];
+    uint8_t *body;
+    size_t body_len;
+    sy_web_response resp;
+} web_job;
+
+/* The newest frame: LWS_PRE bytes of room, then the 40-byte header and the JPEG. Reference-counted:
+ * the mailbox holds one reference, a connection sending it another (network thread). */
+typedef struct web_frame {
+    uint32_t refs; /* under mu */
+    uint64_t seq, gen; /* gen: the input generation the frame answers */
+    uint8_t *buf;
+    size_t len; /* header + JPEG */
+} web_frame;
+
+typedef struct web_conn web_conn;
+
+/* A connection the gate (sy_web_gate.h) hands over with its request: adopted by libwebsockets on
+ * the network thread. */
+typedef struct web_handoff {
+    struct web_handoff *next;
+    int fd;
+    uint8_t *buf;
+    size_t len;
+} web_handoff;
+
+struct sy_web {
+    sy_web_desc d;
+    sy_web_route *routes;
+    char host[128];
+    int port;
+    char token[2 * WEB_TOKEN_BYTES + 1]; /* "" = none required */
+    char url[300];
+    bool loopback;
+    sy_node cam_node;
+    sy_orbit home;
+    uint32_t initial_backend;
+    struct lws_context *ctx;
+    struct lws_vhost *vhost;
+    sy_web_gate *gate;
+    sy_web_policy policy; /* what sy_web_check_request allows */
+    lws_retry_bo_t idle; /* the vhost's ping / hang-up policy (lws keeps a pointer) */
+    uint32_t retry_ms;
+    pthread_t net_thread;
+    bool net_started;
+    volatile int net_quit; /* read by the network thread */
+    web_conn *conns;       /* WebSocket viewers (network thread only) */
+
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    /* --- under mu: network thread -> render thread --- */
+    bool quit;
+    sy_orbit orbit;
+    uint64_t view_version; /* camera, back-end, filter or size changed */
+    uint64_t input_gen;    /* inputs received, all clients */
+    uint32_t backend;      /* registry index */
+    uint32_t filter;
+    float threshold;
+    uint64_t filter_version;
+    uint32_t display_w, display_h;
+    uint32_t clients;
+    web_job *pending, **pending_tail; /* routes */
+    web_job *stills, **stills_tail;   /* stills: one after each live frame */
+    web_job *still_running;
+    web_handoff *handoffs;            /* gate -> network thread */
+    sy_web_stats st;                  /* the still counters */
+    /* --- under mu: render thread -> network thread --- */
+    web_frame *latest;
+    web_job *finished;
+    char status[256]; /* the last back-end error or filter line, sent to the pages as JSON */
+    uint64_t status_version;
+};
+
+/* --- sy_web_mailbox.c --- */
+void sy_webi_frame_release(sy_web *w, web_frame *f);
+void sy_webi_job_free(web_job *j);
+/* Render thread -> network thread: wake the service loop (it runs EVENT_WAIT_CANCELLED). */
+void sy_webi_wake_network(sy_web *w);
+/* Network thread -> render thread: a route's job, a still's job. */
+void sy_webi_post_job(sy_web *w, web_job *j);
+void sy_webi_post_still(sy_web *w, web_job *j);
+bool sy_webi_job_abandoned(sy_web *w, const web_job *j);
+
+/* --- sy_web_http.c --- */
+/* An HTTP connection's state (the http protocol's per-session data). */
+typedef struct http_pss {
+    web_job *job;         /* a request answered on the render thread */
+    uint8_t *resp;        /* or an immediate response: owned copy */
+    size_t resp_len;
+    int status;
+    const char *ctype;
+    const uint8_t *body;  /* what is being sent (resp, a job's body or a static asset) */
+    size_t body_len, sent;
+    bool headers_done, set_cookie, responding;
+    bool close_after;     /* the request said Connection: close (the gate says so for every GET) */
+    const sy_web_route *route; /* POST: the route the body is for */
+    uint8_t *post;        /* POST: the body so far */
+    size_t post_len;
+    bool post_too_big;
+    char path[256], query[512], peer[64];
+} http_pss;
+
+/* The request's head as sy_web_check_request takes it (h points into b). */
+typedef struct head_bufs {
+    char path[SY_WEB_MAX_PATH], query[512], host[256], origin[256], ctype[128], cookie[1024], cl[32];
+} head_bufs;
+
+void sy_webi_read_head(struct lws *wsi, head_bufs *b, sy_web_head *h);
+/* The HTTP status of a failed job's error. */
+int sy_webi_http_status_of(sy_result r);
+/* The http protocol's callback (every request but the WebSocket's). */
+int sy_webi_http_callback(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len);
+/* The gate's thread: a connection whose request arrived whole (sy_web_gate_desc.deliver). */
+void sy_webi_gate_deliver(void *user, int fd, uint8_t *bytes, size_t len);
+
+/* --- sy_web_ws.c --- */
+/* The protocols (http, sy-view) and the mount: the WebSocket at /ws, the rest to http. */
+extern const struct lws_protocols sy_webi_protocols[];
+extern const struct lws_http_mount sy_webi_mount;
+/* The network thread: the libwebsockets service loop until net_quit. */
+void *sy_webi_net_main(void *p);
+
+#endif

@@ -1,0 +1,65 @@
+/* sy_web_mailbox.c — what the network thread and the render thread of the sy_web server share
+ * (under mu): the jobs they pass each other, the newest frame, the display filters
+ * (sy_web_internal.h; docs/WEB.md, "Threads"). */
+#include "sy_web_internal.h"
+
+#include <stdlib.h>
+
+const char *const sy_webi_filters[SY_WEBI_FILTER_COUNT] = {"none", "pixel", "atrous", "jbu", "adaptive", "radiance"};
+
+void sy_webi_frame_release(sy_web *w, web_frame *f)
+{
+    if (!f) return;
+    pthread_mutex_lock(&w->mu);
+    bool last = --f->refs == 0;
+    pthread_mutex_unlock(&w->mu);
+    if (last) {
+        free(f->buf);
+        free(f);
+    }
+}
+
+void sy_webi_job_free(web_job *j)
+{
+    if (!j) return;
+    free(j->body);
+    free(j->resp.body);
+    free(j);
+}
+
+/* Render thread -> network thread: wake the service loop (it runs EVENT_WAIT_CANCELLED). */
+void sy_webi_wake_network(sy_web *w)
+{
+    if (w->ctx) lws_cancel_service(w->ctx);
+}
+
+/* Network thread -> render thread. */
+void sy_webi_post_job(sy_web *w, web_job *j)
+{
+    pthread_mutex_lock(&w->mu);
+    j->state = JOB_PENDING;
+    j->next = NULL;
+    *w->pending_tail = j;
+    w->pending_tail = &j->next;
+    pthread_cond_signal(&w->cv);
+    pthread_mutex_unlock(&w->mu);
+}
+
+void sy_webi_post_still(sy_web *w, web_job *j)
+{
+    pthread_mutex_lock(&w->mu);
+    j->state = JOB_PENDING;
+    j->next = NULL;
+    *w->stills_tail = j;
+    w->stills_tail = &j->next;
+    pthread_cond_signal(&w->cv);
+    pthread_mutex_unlock(&w->mu);
+}
+
+bool sy_webi_job_abandoned(sy_web *w, const web_job *j)
+{
+    pthread_mutex_lock(&w->mu);
+    bool gone = j->abandoned;
+    pthread_mutex_unlock(&w->mu);
+    return gone;
+}

@@ -1,0 +1,436 @@
+/* sy_web_render.c — the sy_web server's render loop, on the thread in sy_web_run: live frames
+ * through the frame-time governor, stills and routes' jobs between them, the display filter; the
+ * frames and answers go to the network thread through the mailbox (sy_web_internal.h; docs/WEB.md,
+ * "Threads"). */
+#include "sy_web_internal.h"
+
+#include "sy_governor.h"
+#include "sy_jpeg.h"
+#include "sy_log.h"
+#include "sy_mediator.h"
+#include "sy_post.h"
+#include "sy_viewport.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define WEB_FRAME_MAGIC 0x31465953u /* "SYF1" little-endian */
+#define WEB_FRAME_HEADER 40u
+
+typedef struct render_state {
+    sy_context_pool *pool;
+    sy_window *win, *still_win;
+    sy_viewport *vp, *still_vp;
+    sy_mat4 cam_applied;
+    bool cam_valid;
+    uint32_t backend_applied;
+    const sy_context *filter_ctx; /* the pool context the filter was last set on (borrowed) */
+    uint64_t filter_applied;
+    bool filter_enabled;
+    uint64_t seq;
+    sy_governor *gov;
+    uint32_t prev_bi, prev_w, prev_h; /* what the last planned frame showed: a difference is a change */
+    uint64_t prev_filter_version;
+} render_state;
+
+/* The display size the governor plans for: what the page asked, capped at max_width x max_height
+ * keeping the aspect. */
+static void display_size(const sy_web *w, uint32_t dw, uint32_t dh, uint32_t *ow, uint32_t *oh)
+{
+    double s = 1.0;
+    if (dw > w->d.max_width) s = (double)w->d.max_width / dw;
+    if (dh * s > w->d.max_height) s = (double)w->d.max_height / dh;
+    *ow = dw, *oh = dh;
+    if (s < 1.0) {
+        *ow = (uint32_t)(dw * s + 0.5), *oh = (uint32_t)(dh * s + 0.5);
+        if (!*ow) *ow = 1;
+        if (!*oh) *oh = 1;
+    }
+}
+
+/* Premultiplied linear RGBA after the display chain -> 8-bit (composited over black). */
+static uint8_t *layer_to_rgba8(const sy_layer *img)
+{
+    size_t n = (size_t)img->width * img->height;
+    uint8_t *px = malloc(n * 4);
+    if (!px) return NULL;
+    for (size_t i = 0; i < n * 4; ++i) {
+        float x = (i & 3) == 3 ? 1.0f : img->rgba[i];
+        px[i] = sy_unorm8(x);
+    }
+    return px;
+}
+
+static sy_result apply_camera(sy_web *w, render_state *rs, const sy_orbit *o, sy_error *err)
+{
+    sy_mat4 m;
+    sy_orbit_matrix(o, &m);
+    if (rs->cam_valid && !memcmp(&m, &rs->cam_applied, sizeof m)) return SY_OK;
+    sy_result r = sy_node_set_matrix(w->d.scene, w->cam_node, &m, err);
+    if (r == SY_OK) r = sy_scene_commit(w->d.scene, NULL, err);
+    if (r == SY_OK) rs->cam_applied = m, rs->cam_valid = true;
+    return r;
+}
+
+/* Renders w x h with the current back-end into an 8-bit image (display chain: ACES + sRGB). */
+static sy_result render_rgba8(sy_web *w, render_state *rs, sy_window *win, uint32_t width, uint32_t height,
+                              uint32_t samples, float preview, uint8_t **out, sy_error *err)
+{
+    *out = NULL;
+    uint32_t cw = 0, ch = 0;
+    sy_window_size(win, &cw, &ch);
+    sy_result r = (cw != width || ch != height) ? sy_window_resize(win, width, height, err) : SY_OK;
+    sy_layer img = {0};
+    if (r == SY_OK) r = sy_layer_create(width, height, &img, err);
+    sy_window_render_opts ro = {.sample_count = samples, .preview = preview,
+                                .post = sy_post_display()};
+    if (r == SY_OK) r = sy_window_render(win, w->d.scene, rs->pool, &ro, &img, err);
+    if (r == SY_OK && !(*out = layer_to_rgba8(&img))) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
+    sy_layer_destroy(&img);
+    return r;
+}
+
+/* The path tracer's display filter (as sy view): applied when it changed or the context is new. */
+static void apply_filter(sy_web *w, render_state *rs, const sy_mediator_class *cls, uint32_t filter, float threshold,
+                         uint64_t version, bool enabled, char *status, size_t len)
+{
+    status[0] = 0;
+    if (!(cls->caps & SY_CAP_FILTERS)) return;
+    sy_context *ctx = NULL;
+    sy_error err = {0};
+    if (sy_context_pool_get(rs->pool, w->d.scene, cls->name, NULL, w->d.root.id, &ctx, &err) != SY_OK) {
+        snprintf(status, len, "filter: %.200s", err.message);
+        return;
+    }
+    if (ctx == rs->filter_ctx && version == rs->filter_applied && enabled == rs->filter_enabled) return;
+    sy_params opts = {0};
+    char t[32];
+    snprintf(t, sizeof t, "%g", (double)threshold);
+    if (sy_params_set(&opts, "threshold", t, &err) != SY_OK ||
+        sy_context_set_filter(ctx, enabled ? sy_webi_filters[filter % SY_WEBI_FILTER_COUNT] : "none", &opts, &err) != SY_OK) {
+        snprintf(status, len, "filter: %.200s", err.message);
+        return;
+    }
+    rs->filter_ctx = ctx;
+    rs->filter_applied = version;
+    rs->filter_enabled = enabled; /* the governor keeps the filter off while the view moves */
+}
+
+static void finish_job(sy_web *w, web_job *j)
+{
+    pthread_mutex_lock(&w->mu);
+    bool drop = j->abandoned;
+    if (!drop) {
+        j->state = JOB_FINISHED;
+        j->next = w->finished;
+        w->finished = j;
+    }
+    pthread_mutex_unlock(&w->mu);
+    if (drop) sy_webi_job_free(j);
+    else sy_webi_wake_network(w);
+}
+
+/* A failed job's answer: the status of its error and the message as text. */
+static void job_error(web_job *j, sy_result r, const sy_error *err)
+{
+    free(j->resp.body);
+    memset(&j->resp, 0, sizeof j->resp);
+    j->resp.status = sy_webi_http_status_of(r);
+    snprintf(j->resp.content_type, sizeof j->resp.content_type, "text/plain; charset=utf-8");
+    char *m = malloc(strlen(err->message) + 2);
+    if (m) {
+        j->resp.body_len = (size_t)sprintf(m, "%s\n", err->message);
+        j->resp.body = (uint8_t *)m;
+    }
+    sy_log(SY_LOG_WARNING, "web", j->peer, "%s %s: %s", j->method, j->path, err->message);
+}
+
+static void run_job(sy_web *w, web_job *j)
+{
+    sy_error err = {0};
+    memset(&j->resp, 0, sizeof j->resp);
+    sy_web_request req = {.method = j->method, .path = j->path, .query = j->query, .body = j->body,
+                          .body_len = j->body_len, .peer = j->peer};
+    sy_result r = j->route->fn(j->route->user, w->d.scene, &req, &j->resp, &err);
+    if (r != SY_OK) job_error(j, r, &err);
+    finish_job(w, j);
+}
+
+/* A still of the current view, after the live frame: answered 503 past its deadline; rendered in
+ * passes of a few samples (progressive back-ends), each pass only while the requester is still
+ * connected; the still's window is shrunk afterwards so its memory goes back. */
+static void run_still(sy_web *w, render_state *rs, web_job *j, const sy_orbit *o)
+{
+    sy_error err = {0};
+    sy_result r = SY_OK;
+    memset(&j->resp, 0, sizeof j->resp);
+    double waited = sy_time_now() * 1e3 - j->queued_ms;
+    bool cancelled = sy_webi_job_abandoned(w, j), expired = !cancelled && waited > w->d.still_deadline_ms;
+    if (expired) {
+        r = sy_error_set(&err, SY_ERR_LIMIT, "the still waited %.0f ms behind the live view (deadline %u ms): try again",
+                         waited, w->d.still_deadline_ms);
+    } else if (!cancelled) {
+        const sy_mediator_class *cls = sy_mediator_at(rs->backend_applied);
+        uint32_t spp = cls && (cls->caps & SY_CAP_PROGRESSIVE) ? w->d.still_samples : 1;
+        sy_layer img = {0};
+        r = apply_camera(w, rs, o, &err);
+        if (r == SY_OK) r = sy_viewport_set_backend(rs->still_vp, (cls ? cls : sy_mediator_at(w->initial_backend))->name, NULL, &err);
+        if (r == SY_OK) r = sy_window_resize(rs->still_win, j->w, j->h, &err);
+        if (r == SY_OK) r = sy_layer_create(j->w, j->h, &img, &err);
+        for (uint32_t done = 0; r == SY_OK && done < spp && !cancelled; ) {
+            uint32_t n = spp - done > 4 ? 4 : spp - done;
+            sy_window_render_opts ro = {.sample_count = n, .preview = 1.0f, .post = sy_post_display()};
+            r = sy_window_render(rs->still_win, w->d.scene, rs->pool, &ro, &img, &err);
+            done += n;
+            cancelled = sy_webi_job_abandoned(w, j);
+        }
+        uint8_t *px = NULL;
+        if (r == SY_OK && !cancelled && !(px = layer_to_rgba8(&img))) r = sy_error_set(&err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
+        sy_layer_destroy(&img);
+        if (px) r = sy_jpeg_encode_rgba8(px, j->w, j->h, 95, &j->resp.body, &j->resp.body_len, &err);
+        free(px);
+        sy_window_resize(rs->still_win, 64, 64, NULL);
+        if (r == SY_OK && !cancelled) j->resp.status = 200, snprintf(j->resp.content_type, sizeof j->resp.content_type, "image/jpeg");
+    }
+    pthread_mutex_lock(&w->mu);
+    w->still_running = NULL;
+    if (cancelled) w->st.stills_cancelled++;
+    else if (expired) w->st.stills_expired++;
+    else if (r == SY_OK) w->st.stills_done++;
+    pthread_mutex_unlock(&w->mu);
+    if (cancelled) {
+        sy_log(SY_LOG_NOTE, "web", j->peer, "a still of %ux%u cancelled: the requester left", j->w, j->h);
+        finish_job(w, j); /* abandoned: freed there */
+        return;
+    }
+    if (r != SY_OK) job_error(j, r, &err);
+    if (expired) j->resp.status = 503;
+    finish_job(w, j);
+}
+
+static void publish_frame(sy_web *w, web_frame *f)
+{
+    pthread_mutex_lock(&w->mu);
+    web_frame *old = w->latest;
+    w->latest = f;
+    bool last = old && --old->refs == 0;
+    pthread_mutex_unlock(&w->mu);
+    if (last) {
+        free(old->buf);
+        free(old);
+    }
+    sy_webi_wake_network(w);
+}
+
+static void set_status(sy_web *w, const char *s)
+{
+    pthread_mutex_lock(&w->mu);
+    if (strcmp(w->status, s) != 0) {
+        snprintf(w->status, sizeof w->status, "%.*s", (int)sizeof w->status - 1, s);
+        w->status_version++;
+    }
+    pthread_mutex_unlock(&w->mu);
+    sy_webi_wake_network(w);
+}
+
+/* One frame through the frame-time governor (core/sy_governor.h): plans it for the display size,
+ * renders what the plan says, reports its time. *again: plan again without waiting for input;
+ * *wait_ms > 0: plan again after that long (the view is settling). */
+static sy_result render_frame(sy_web *w, render_state *rs, const sy_orbit *o, uint32_t bi, uint32_t dw, uint32_t dh,
+                              uint64_t gen, uint32_t filter, float threshold, uint64_t filter_version, bool *again,
+                              double *wait_ms, sy_error *err)
+{
+    *again = false, *wait_ms = 0;
+    const sy_mediator_class *cls = sy_mediator_at(bi);
+    if (!cls) return sy_error_set(err, SY_ERR_NOT_FOUND, "web: back-end %u is not registered", bi);
+    uint32_t pw = 0, ph = 0;
+    display_size(w, dw, dh, &pw, &ph);
+    sy_mat4 m;
+    sy_orbit_matrix(o, &m);
+    bool changed = !rs->cam_valid || memcmp(&m, &rs->cam_applied, sizeof m) != 0 || bi != rs->prev_bi ||
+                   pw != rs->prev_w || ph != rs->prev_h;
+    sy_result r = apply_camera(w, rs, o, err);
+    if (r == SY_OK && bi != rs->backend_applied) {
+        r = sy_viewport_set_backend(rs->vp, cls->name, NULL, err);
+        if (r == SY_OK) rs->backend_applied = bi;
+    }
+    if (r != SY_OK) return r;
+    if (bi != rs->prev_bi) sy_governor_reset(rs->gov); /* another back-end: another cost */
+    if (filter_version != rs->prev_filter_version) sy_governor_redraw(rs->gov); /* shown again, same samples */
+    rs->prev_bi = bi, rs->prev_w = pw, rs->prev_h = ph, rs->prev_filter_version = filter_version;
+    sy_governor_frame gf;
+    sy_governor_plan(rs->gov, pw, ph, sy_mediator_class_caps(cls, NULL), changed, sy_time_now() * 1e3, &gf);
+    if (gf.wait_ms > 0) { /* settling after a moving frame: the refining frame comes next */
+        *wait_ms = gf.wait_ms;
+        return SY_OK;
+    }
+    if (gf.idle || !gf.width || !gf.height) return SY_OK; /* refined: sleep until input */
+    char fstatus[240];
+    apply_filter(w, rs, cls, filter, threshold, filter_version, gf.filter, fstatus, sizeof fstatus);
+    uint8_t *px = NULL, *jpeg = NULL;
+    size_t jlen = 0;
+    uint32_t contexts = sy_context_pool_size(rs->pool);
+    double t0 = sy_time_now();
+    r = render_rgba8(w, rs, rs->win, gf.width, gf.height, gf.samples, gf.preview, &px, err);
+    if (r == SY_OK) r = sy_jpeg_encode_rgba8(px, gf.width, gf.height, w->d.quality, &jpeg, &jlen, err);
+    double ms = (sy_time_now() - t0) * 1e3; /* render, display chain, JPEG: the frame's whole cost */
+    free(px);
+    if (r != SY_OK) return r;
+    /* a frame that translated the scene for a new context says nothing about the next ones */
+    if (sy_context_pool_size(rs->pool) == contexts) sy_governor_report(rs->gov, &gf, ms);
+    sy_mediator_stats st = {0};
+    sy_context *ctx = NULL;
+    if (sy_context_pool_get(rs->pool, w->d.scene, cls->name, NULL, w->d.root.id, &ctx, NULL) == SY_OK)
+        sy_context_stats(ctx, &st);
+    web_frame *f = calloc(1, sizeof *f);
+    size_t len = WEB_FRAME_HEADER + jlen;
+    if (f) f->buf = malloc(LWS_PRE + len);
+    if (!f || !f->buf) {
+        free(f);
+        free(jpeg);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %zu bytes", len);
+    }
+    uint8_t *h = f->buf + LWS_PRE;
+    uint32_t u[5] = {WEB_FRAME_MAGIC, gf.width, gf.height, bi,
+                     (uint32_t)(st.samples > UINT32_MAX ? UINT32_MAX : st.samples)};
+    float fms = (float)ms;
+    uint64_t seq = ++rs->seq, zero = 0;
+    memcpy(h, u, sizeof u); /* little-endian hosts (x86-64, arm64) */
+    memcpy(h + 20, &fms, 4);
+    memcpy(h + 24, &seq, 8);
+    memcpy(h + 32, &zero, 8);
+    memcpy(h + WEB_FRAME_HEADER, jpeg, jlen);
+    free(jpeg);
+    f->refs = 1, f->seq = seq, f->gen = gen, f->len = len;
+    publish_frame(w, f);
+    set_status(w, fstatus);
+    *again = true; /* the governor says what comes next */
+    return SY_OK;
+}
+
+/* The live frame (the governor says its size) and what a failed back-end tells the pages. */
+static void render_live(sy_web *w, render_state *rs, const sy_orbit *o, uint32_t bi, uint32_t dw, uint32_t dh, uint64_t gen,
+                        uint32_t filter, float threshold, uint64_t fv, bool *again, double *wait_until)
+{
+    *again = false, *wait_until = 0;
+    sy_error ferr = {0};
+    double wait_ms = 0;
+    if (render_frame(w, rs, o, bi, dw, dh, gen, filter, threshold, fv, again, &wait_ms, &ferr) == SY_OK) {
+        if (wait_ms > 0) *wait_until = sy_time_now() * 1e3 + wait_ms;
+    } else {
+        /* a back-end that fails is reported to the pages; the others keep serving */
+        char s[300];
+        snprintf(s, sizeof s, "%s failed: %.240s", sy_mediator_at(bi) ? sy_mediator_at(bi)->name : "back-end",
+                 ferr.message);
+        sy_log(SY_LOG_WARNING, "web", NULL, "%s", s);
+        set_status(w, s);
+        *again = false;
+    }
+}
+
+sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
+{
+    render_state rs = {0};
+    sy_viewport_desc vd = {.root = w->d.root, .camera = w->cam_node, .background = w->d.background,
+                           .backend = sy_mediator_at(w->initial_backend)->name};
+    sy_result r = sy_context_pool_create(&rs.pool, err);
+    if (r == SY_OK) r = sy_window_create(64, 64, &rs.win, err);
+    if (r == SY_OK) r = sy_window_add_viewport(rs.win, &vd, &rs.vp, err);
+    if (r == SY_OK) r = sy_window_create(64, 64, &rs.still_win, err);
+    if (r == SY_OK) r = sy_window_add_viewport(rs.still_win, &vd, &rs.still_vp, err);
+    if (r == SY_OK) r = sy_governor_create(&(sy_governor_desc){.budget_ms = w->d.budget_ms}, &rs.gov, err);
+    rs.backend_applied = w->initial_backend;
+    rs.prev_bi = UINT32_MAX;
+    uint64_t seen = 0;
+    bool again = false;    /* plan again without waiting for input */
+    double wait_until = 0; /* ms (sy_time_now): the governor's settle wait, 0 = none */
+    while (r == SY_OK) {
+        pthread_mutex_lock(&w->mu);
+        for (;;) {
+            if (w->quit || (stop && *stop) || w->pending || w->stills) break;
+            /* frames once a page said its size (the page does as it connects) */
+            bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
+            if (w->clients && w->display_w && (w->view_version != seen || due)) break;
+            double nap_ms = 100; /* polls *stop ten times a second */
+            if (wait_until > 0 && wait_until - sy_time_now() * 1e3 < nap_ms) nap_ms = wait_until - sy_time_now() * 1e3;
+            if (nap_ms < 0.1) nap_ms = 0.1;
+            struct timespec ts;
+            clock_gettime(CLOCK_REALTIME, &ts);
+            ts.tv_nsec += (long)(nap_ms * 1e6);
+            if (ts.tv_nsec >= 1000000000) ts.tv_sec++, ts.tv_nsec -= 1000000000;
+            pthread_cond_timedwait(&w->cv, &w->mu, &ts);
+        }
+        if (w->quit || (stop && *stop)) {
+            pthread_mutex_unlock(&w->mu);
+            break;
+        }
+        web_job *jobs = w->pending;
+        w->pending = NULL, w->pending_tail = &w->pending;
+        for (web_job *j = jobs; j; j = j->next) j->state = JOB_RUNNING;
+        sy_orbit o = w->orbit;
+        bool moved = w->view_version != seen;
+        seen = w->view_version;
+        uint32_t bi = w->backend, dw = w->display_w, dh = w->display_h, filter = w->filter;
+        float threshold = w->threshold;
+        uint64_t fv = w->filter_version, gen = w->input_gen;
+        bool clients = w->clients > 0 && w->display_w > 0;
+        pthread_mutex_unlock(&w->mu);
+        while (jobs) { /* stills and routes first: they wait on an HTTP connection */
+            web_job *j = jobs;
+            jobs = j->next;
+            pthread_mutex_lock(&w->mu);
+            bool gone = j->abandoned;
+            pthread_mutex_unlock(&w->mu);
+            if (gone) sy_webi_job_free(j);
+            else run_job(w, j);
+        }
+        bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
+        if (clients && (moved || due)) render_live(w, &rs, &o, bi, dw, dh, gen, filter, threshold, fv, &again, &wait_until);
+        /* then one still: stills wait behind the live view */
+        pthread_mutex_lock(&w->mu);
+        web_job *still = w->stills;
+        if (still) {
+            w->stills = still->next;
+            if (!w->stills) w->stills_tail = &w->stills;
+            still->state = JOB_RUNNING;
+            w->still_running = still;
+        }
+        pthread_mutex_unlock(&w->mu);
+        if (still) run_still(w, &rs, still, &o);
+    }
+    /* jobs still queued are answered 503 */
+    pthread_mutex_lock(&w->mu);
+    web_job *left = w->pending;
+    w->pending = NULL, w->pending_tail = &w->pending;
+    if (left) {
+        web_job **t = &left;
+        while (*t) t = &(*t)->next;
+        *t = w->stills;
+    } else {
+        left = w->stills;
+    }
+    w->stills = NULL, w->stills_tail = &w->stills;
+    pthread_mutex_unlock(&w->mu);
+    while (left) {
+        web_job *j = left;
+        left = j->next;
+        j->resp.status = 503;
+        snprintf(j->resp.content_type, sizeof j->resp.content_type, "text/plain; charset=utf-8");
+        finish_job(w, j);
+    }
+    sy_governor_destroy(rs.gov);
+    sy_window_destroy(rs.win);
+    sy_window_destroy(rs.still_win);
+    sy_context_pool_destroy(rs.pool);
+    return r;
+}
+
+void sy_web_stop(sy_web *w)
+{
+    pthread_mutex_lock(&w->mu);
+    w->quit = true;
+    pthread_cond_signal(&w->cv);
+    pthread_mutex_unlock(&w->mu);
+}
