@@ -1,0 +1,71 @@
+/* sy_mediator_rt_accum.c — the path tracer's accumulation slots: one accumulation per
+ * distinct request, restarted when the device published a change (sy_mediator_rt_internal.h). */
+#include "sy_mediator_rt_internal.h"
+
+#include <string.h>
+
+/* >>pathtracer accumulation */
+static bool same_view(const sy_camera_view *a, const sy_camera_view *b)
+{
+    return !memcmp(a->camera_to_world.m, b->camera_to_world.m, sizeof a->camera_to_world.m) &&
+           a->projection == b->projection && !memcmp(a->window, b->window, sizeof a->window) && a->znear == b->znear &&
+           a->zfar == b->zfar;
+}
+
+/* Picks (or recycles) the accumulation slot of a request and restarts it when the scene, the
+ * camera or anything else about the request changed; sets st->last_slot. */
+sy_result sy_rti_pt_slot(rt_state *st, const sy_render_request *req, sy_error *err)
+{
+    sy_rt_stats ds;
+    sy_rt_device_stats(st->dev, &ds);
+    const uint32_t rect[4] = {req->rect_x, req->rect_y, req->rect_w, req->rect_h};
+    int found = -1, lru = 0;
+    for (int i = 0; i < ACCUM_SLOTS; ++i) {
+        accum_slot *a = &st->slots[i];
+        if (a->acc && a->full_w == req->full_width && a->full_h == req->full_height && !memcmp(a->rect, rect, sizeof rect) &&
+            a->bg == req->background_id && a->seed == req->seed && same_view(&a->camera, &req->camera)) {
+            found = i;
+            break;
+        }
+        if (!a->acc || (st->slots[lru].acc && a->last_use < st->slots[lru].last_use)) lru = i;
+    }
+    accum_slot *a;
+    if (found >= 0) {
+        a = &st->slots[found];
+        if (a->version != ds.version) { /* something visible changed since the last pass */
+            sy_rt_accum_reset(a->acc);
+            st->counters.accum_restarts++;
+            sy_filter_pixel_reset(a->pixel);
+            sy_radiance_hook_reset(a->radiance);
+            a->pass_samples = 0;
+        }
+    } else {
+        found = lru;
+        a = &st->slots[found];
+        uint32_t w = 0, h = 0;
+        sy_rt_accum_size(a->acc, &w, &h);
+        if (!a->acc || w != req->rect_w || h != req->rect_h) {
+            char e[ERRLEN];
+            sy_rt_accum_destroy(a->acc);
+            a->acc = NULL;
+            sy_rt_result r = sy_rt_accum_create(req->rect_w, req->rect_h, &a->acc, e, sizeof e);
+            if (r != SY_RT_OK) return sy_rti_fail(err, r, "accumulation buffer", e);
+        } else {
+            sy_rt_accum_reset(a->acc);
+        }
+        if (st->last_slot >= 0) st->counters.accum_restarts++;
+        sy_filter_pixel_reset(a->pixel);
+        sy_radiance_hook_reset(a->radiance);
+        a->pass_samples = 0;
+        a->camera = req->camera;
+        a->full_w = req->full_width;
+        a->full_h = req->full_height;
+        memcpy(a->rect, rect, sizeof rect);
+        a->bg = req->background_id;
+        a->seed = req->seed;
+    }
+    a->version = ds.version;
+    a->last_use = ++st->use_clock;
+    st->last_slot = found;
+    return SY_OK;
+}

@@ -1,0 +1,275 @@
+/* sy_mediator_rt_filter.c — the path tracer's display filters (backends/filters): their
+ * configuration from the class's parameters, sy_mediator_rt_set_filter, and the filtered layer
+ * from the accumulation's feature buffers (sy_mediator_rt_internal.h). */
+#include "sy_mediator_rt_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel", "atrous", "jbu", "adaptive",
+                                                                   "radiance"};
+
+/* >>display filters
+ * The path tracer's layer can be filtered for display (backends/filters) from the accumulation's
+ * feature buffers. Parameters (creation and sy_mediator_rt_set_filter): filter, threshold, sigma_s,
+ * sigma_c, sigma_d, filter_kernel, filter_iterations, filter_start, atrous_iterations, jbu_factor. */
+static sy_result filter_fail(sy_error *err, const sy_filter_error *fe)
+{
+    return sy_error_set(err, fe->status == SY_FILTER_ERROR_OUT_OF_MEMORY ? SY_ERR_OUT_OF_MEMORY : SY_ERR_INVALID_ARGUMENT,
+                        "pathtracer filter: %s", fe->message);
+}
+
+void sy_rti_filter_cfg_default(pt_filter_cfg *c, uint32_t threads)
+{
+    memset(c, 0, sizeof *c);
+    c->kind = PT_FILTER_NONE;
+    sy_filter_pixel_params_default(&c->pixel);
+    sy_filter_atrous_params_default(&c->atrous);
+    sy_filter_jbu_params_default(&c->jbu);
+    sy_filter_adaptive_params_default(&c->adaptive);
+    c->adaptive.threshold = c->pixel.threshold;
+    sy_filter_radiance_params_default(&c->radiance);
+    c->radiance.threshold = c->pixel.threshold;
+    if (threads > SY_FILTER_MAX_THREADS) threads = SY_FILTER_MAX_THREADS;
+    c->pixel.threads = c->atrous.threads = c->jbu.threads = c->adaptive.threads = c->radiance.threads = threads;
+}
+
+/* One path-tracer key into *v through its table: the given value, else (all: at creation) the
+ * declared default; otherwise an absent key keeps *v. */
+static sy_result pt_float(const sy_params *p, bool all, const char *key, float *v, sy_error *err)
+{
+    if (!all && !sy_params_get(p, key)) return SY_OK;
+    double x = *v;
+    sy_result r = sy_param_float(&sy_rti_pt_table, p, key, &x, err);
+    if (r == SY_OK) *v = (float)x;
+    return r;
+}
+
+static sy_result pt_u32(const sy_params *p, bool all, const char *key, uint32_t *v, sy_error *err)
+{
+    if (!all && !sy_params_get(p, key)) return SY_OK;
+    long x = (long)*v;
+    sy_result r = sy_param_int(&sy_rti_pt_table, p, key, &x, err);
+    if (r == SY_OK) *v = (uint32_t)x;
+    return r;
+}
+
+static sy_result pt_bool(const sy_params *p, bool all, const char *key, bool *v, sy_error *err)
+{
+    return !all && !sy_params_get(p, key) ? SY_OK : sy_param_bool(&sy_rti_pt_table, p, key, v, err);
+}
+
+static sy_result pt_enum(const sy_params *p, bool all, const char *key, uint32_t *v, sy_error *err)
+{
+    return !all && !sy_params_get(p, key) ? SY_OK : sy_param_enum(&sy_rti_pt_table, p, key, v, err);
+}
+
+/* The radiance filter's own keys (rf_*); ranges as sy_filter_radiance_params. */
+static sy_result radiance_cfg_apply(sy_filter_radiance_params *rp, const sy_params *p, bool all, sy_error *err)
+{
+    sy_result r;
+    uint32_t kernel = (uint32_t)rp->kernel;
+    if ((r = pt_u32(p, all, "rf_warmup_frames", &rp->warmup_frames, err)) ||
+        (r = pt_float(p, all, "rf_warmup_radius", &rp->warmup_radius, err)) ||
+        (r = pt_float(p, all, "rf_max_radius", &rp->max_radius, err)) ||
+        (r = pt_float(p, all, "rf_prism_thickness", &rp->prism_thickness, err)) ||
+        (r = pt_float(p, all, "rf_grazing_epsilon", &rp->grazing_epsilon, err)) ||
+        (r = pt_float(p, all, "rf_glossy_limit", &rp->glossy_limit, err)) ||
+        (r = pt_float(p, all, "rf_specular_limit", &rp->specular_limit, err)) ||
+        (r = pt_bool(p, all, "rf_ao", &rp->ambient_occlusion, err)) ||
+        (r = pt_bool(p, all, "rf_unbiased", &rp->unbiased_switch, err)) ||
+        (r = pt_enum(p, all, "rf_kernel", &kernel, err)))
+        return r;
+    rp->kernel = (sy_filter_rf_kernel)kernel;
+    return SY_OK;
+}
+
+/* New configuration = *base with the filter `name` (NULL: p's "filter", absent: unchanged) and the
+ * keys present in p (all, at creation: absent keys take their declared defaults; otherwise they
+ * keep base's values). Validated as a whole; *base unchanged on error. */
+sy_result sy_rti_filter_cfg_apply(pt_filter_cfg *base, const char *name, const sy_params *p_in, bool all, sy_error *err)
+{
+    static const sy_params empty;
+    const sy_params *p = p_in ? p_in : &empty;
+    pt_filter_cfg c = *base;
+    sy_result r;
+    uint32_t kind = (uint32_t)c.kind;
+    if (name) {
+        const sy_param_decl *d = sy_param_find(&sy_rti_pt_table, "filter");
+        int k = sy_param_enum_index(d, name);
+        if (k < 0) return sy_param_check_value(d, name, "back-end 'pathtracer'", err); /* names the filters */
+        kind = (uint32_t)k;
+    } else if ((r = pt_enum(p, all, "filter", &kind, err)))
+        return r;
+    c.kind = (pt_filter_kind)kind;
+    float threshold = c.pixel.threshold;
+    uint32_t fkernel = c.pixel.kernel == SY_FILTER_PIXEL_BRUTE ? 1u : 0u;
+    if ((r = pt_float(p, all, "threshold", &threshold, err)) || (r = pt_float(p, all, "sigma_s", &c.pixel.sigma_s, err)) ||
+        (r = pt_float(p, all, "sigma_c", &c.pixel.sigma_c, err)) || (r = pt_float(p, all, "sigma_d", &c.pixel.sigma_d, err)) ||
+        (r = pt_enum(p, all, "filter_kernel", &fkernel, err)) ||
+        (r = pt_u32(p, all, "filter_iterations", &c.pixel.iterations, err)) ||
+        (r = pt_u32(p, all, "filter_start", &c.pixel.schedule_start, err)) ||
+        (r = pt_u32(p, all, "atrous_iterations", &c.atrous.iterations, err)) ||
+        (r = pt_u32(p, all, "jbu_factor", &c.jbu.factor, err)) || (r = radiance_cfg_apply(&c.radiance, p, all, err)))
+        return r;
+    c.pixel.threshold = c.adaptive.threshold = c.radiance.threshold = threshold;
+    c.pixel.kernel = fkernel ? SY_FILTER_PIXEL_BRUTE : SY_FILTER_PIXEL_SEPARABLE;
+    /* the rf_* options are checked whatever the filter; T_u = threshold only matters for radiance */
+    sy_filter_radiance_params rq = c.radiance;
+    if (c.kind != PT_FILTER_RADIANCE && !(rq.threshold > 0.0f)) rq.threshold = 0.01f;
+    sy_filter_error fe = {0};
+    if (sy_filter_pixel_params_check(&c.pixel, &fe) || sy_filter_atrous_params_check(&c.atrous, &fe) ||
+        sy_filter_jbu_params_check(&c.jbu, &fe) ||
+        (c.kind == PT_FILTER_ADAPTIVE && sy_filter_adaptive_params_check(&c.adaptive, &fe)) ||
+        sy_filter_radiance_params_check(&rq, &fe))
+        return filter_fail(err, &fe);
+    *base = c;
+    return SY_OK;
+}
+
+sy_result sy_mediator_rt_set_filter(void *state, const char *name, const sy_params *opts, sy_error *err)
+{
+    rt_state *st = state;
+    if (st->integrator != SY_RT_INTEGRATOR_PATHTRACER)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "set filter: only the pathtracer class has display filters");
+    /* the same check core makes (sy_context_set_filter), for callers of this function */
+    sy_result r = sy_params_check(&sy_rti_pt_table, opts, SY_PARAM_LIVE, "back-end 'pathtracer'", NULL, err);
+    if (r != SY_OK) return r;
+    pt_filter_cfg c = st->filter;
+    r = sy_rti_filter_cfg_apply(&c, name, opts, false, err);
+    if (r != SY_OK) return r;
+    /* Only the threshold acts on the blend alone; anything else invalidates the filtered buffers,
+     * which are recomputed at the next frame (the accumulation itself is never touched). */
+    sy_filter_pixel_params a = st->filter.pixel, b = c.pixel;
+    a.threshold = b.threshold = 0.0f;
+    bool refilter = c.kind != st->filter.kind || memcmp(&a, &b, sizeof a) != 0;
+    for (int i = 0; i < ACCUM_SLOTS; ++i) {
+        accum_slot *s = &st->slots[i];
+        if (!s->pixel) continue;
+        sy_filter_error fe = {0};
+        if (sy_filter_pixel_set_params(s->pixel, &c.pixel, &fe)) return filter_fail(err, &fe);
+        if (refilter) {
+            sy_filter_pixel_reset(s->pixel);
+            s->pass_samples = 0;
+        }
+    }
+    /* radiance: a switch to it or new options while it is on recreate the filter, which then
+     * resumes from the accumulation (sy_radiance_hook.h); other filters leave its state alone */
+    bool rf_changed = c.kind == PT_FILTER_RADIANCE &&
+                      (c.kind != st->filter.kind || memcmp(&st->filter.radiance, &c.radiance, sizeof c.radiance) != 0);
+    for (int i = 0; i < ACCUM_SLOTS && rf_changed; ++i)
+        if (st->slots[i].radiance && (r = sy_radiance_hook_set_params(st->slots[i].radiance, &c.radiance, err)) != SY_OK)
+            return r;
+    st->filter = c;
+    return SY_OK;
+}
+
+void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out)
+{
+    rt_state *st = state;
+    *out = st->finfo;
+    out->name = pt_filter_names[st->filter.kind];
+    out->threshold = st->filter.pixel.threshold;
+}
+
+/* World positions of the first hits of the rectangle's pixels from the camera-axis depth (the
+ * a-trous guide and the headlight of the pixel filter's range buffer); misses go 1e18 away. */
+static void filter_positions(const sy_render_request *req, const float *depth, float *pos)
+{
+    const sy_camera_view *v = &req->camera;
+    const float *m = v->camera_to_world.m;
+    bool ortho = v->projection == SY_PROJECTION_ORTHOGRAPHIC;
+    for (uint32_t y = 0; y < req->rect_h; ++y)
+        for (uint32_t x = 0; x < req->rect_w; ++x) {
+            size_t i = (size_t)y * req->rect_w + x;
+            float u = v->window[0] + (v->window[1] - v->window[0]) * ((float)(req->rect_x + x) + 0.5f) / (float)req->full_width;
+            float w = v->window[3] - (v->window[3] - v->window[2]) * ((float)(req->rect_y + y) + 0.5f) / (float)req->full_height;
+            float d = depth[i];
+            if (!isfinite(d)) d = 1e18f;
+            float c[3] = {ortho ? u : u * d, ortho ? w : w * d, -d};
+            for (int k = 0; k < 3; ++k) pos[3 * i + k] = m[k] * c[0] + m[4 + k] * c[1] + m[8 + k] * c[2] + m[12 + k];
+        }
+}
+
+/* Reads the slot's feature buffers (rect_w x rect_h) into st->fbuf (the filters' inputs). */
+sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_render_request *req, sy_error *err)
+{
+    size_t n = (size_t)req->rect_w * req->rect_h;
+    if (n > st->fbuf_px) {
+        for (int k = 0; k <= SY_RT_AOV_COUNT; ++k) {
+            free(st->fbuf[k]);
+            st->fbuf[k] = malloc(n * (k < SY_RT_AOV_COUNT ? sy_rt_aov_channels((sy_rt_aov)k) : 3u) * sizeof(float));
+        }
+        st->fbuf_px = n;
+        for (int k = 0; k <= SY_RT_AOV_COUNT; ++k)
+            if (!st->fbuf[k]) {
+                st->fbuf_px = 0;
+                return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "pathtracer filter: out of memory for %ux%u", req->rect_w,
+                                    req->rect_h);
+            }
+    }
+    char e[ERRLEN];
+    for (int k = 0; k < SY_RT_AOV_COUNT; ++k) {
+        sy_rt_result rr = sy_rt_accum_read(a->acc, (sy_rt_aov)k, st->fbuf[k], e, sizeof e);
+        if (rr != SY_RT_OK) return sy_rti_fail(err, rr, "pathtracer filter: feature buffers", e);
+    }
+    return SY_OK;
+}
+
+/* Filters the layer the path tracer just wrote (rectangle of the slot st->last_slot). */
+sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err)
+{
+    accum_slot *a = &st->slots[st->last_slot];
+    sy_result rd = sy_rti_filter_read_aovs(st, a, req, err);
+    if (rd != SY_OK) return rd;
+    filter_positions(req, st->fbuf[SY_RT_AOV_DEPTH], st->fbuf[SY_RT_AOV_COUNT]);
+    uint32_t samples = sy_rt_accum_samples(a->acc);
+    const float *m = req->camera.camera_to_world.m;
+    sy_filter_frame f = {
+        .width = req->rect_w,
+        .height = req->rect_h,
+        .color_channels = 4,
+        .variance_channels = 3,
+        .color = st->fbuf[SY_RT_AOV_COLOR],
+        .variance = st->fbuf[SY_RT_AOV_VARIANCE],
+        .albedo = st->fbuf[SY_RT_AOV_ALBEDO],
+        .normal = st->fbuf[SY_RT_AOV_NORMAL],
+        .depth = st->fbuf[SY_RT_AOV_DEPTH],
+        .position = st->fbuf[SY_RT_AOV_COUNT],
+        .direct = st->fbuf[SY_RT_AOV_DIRECT],
+        .indirect = st->fbuf[SY_RT_AOV_INDIRECT],
+        .spp_uniform = (float)samples,
+        .has_camera = req->camera.projection != SY_PROJECTION_ORTHOGRAPHIC,
+        .camera_position = {m[12], m[13], m[14]},
+    };
+    sy_filter_stats fs = {0};
+    sy_filter_error fe = {0};
+    sy_filter_status s = SY_FILTER_OK;
+    switch (st->filter.kind) {
+    case PT_FILTER_PIXEL: {
+        if (!a->pixel && (s = sy_filter_pixel_create(&st->filter.pixel, &a->pixel, &fe))) break;
+        /* a pass whenever the count reached the next power of two of the schedule (a render may
+         * add several samples at once and step over 2^i) */
+        uint64_t next = st->filter.pixel.schedule_start;
+        while (next <= a->pass_samples) next *= 2;
+        s = sy_filter_pixel_run(a->pixel, &f, samples, samples >= next, layer->rgba, &fs, &fe);
+        if (!s && fs.filter_pass) a->pass_samples = samples;
+        break;
+    }
+    case PT_FILTER_ATROUS: s = sy_filter_atrous(&st->filter.atrous, &f, layer->rgba, &fs, &fe); break;
+    case PT_FILTER_JBU: s = sy_filter_jbu(&st->filter.jbu, &f, layer->rgba, &fs, &fe); break;
+    case PT_FILTER_ADAPTIVE: s = sy_filter_adaptive(&st->filter.adaptive, &f, layer->rgba, NULL, &fs, &fe); break;
+    default: break;
+    }
+    if (s) return filter_fail(err, &fe);
+    st->finfo.nonfinite_pixels = fs.nonfinite_samples;
+    st->finfo.nonfinite_samples = sy_rt_accum_nonfinite(a->acc);
+    st->finfo.seconds = fs.seconds;
+    st->finfo.filter_pass = fs.filter_pass;
+    st->finfo.mean_blend = fs.mean_blend;
+    st->finfo.last_pass_samples = a->pass_samples;
+    st->finfo.frames++;
+    return SY_OK;
+}

@@ -1,0 +1,145 @@
+/* sy_mediator_rt_internal.h — INTERNAL to mediators/rt (not installed): what the modules of the
+ * core scene -> Embree back-end adapter (sy_mediator_rt.h) share: its state, the path tracer's
+ * accumulation slots and display-filter configuration, and the functions one module calls in
+ * another (prefix sy_rti_; none of them is API). The modules, bottom-up (each calls only those
+ * before it; tests/core/layers_test.sh checks it), beside the radiance hook (sy_radiance_hook.c):
+ *   sy_mediator_rt_base.c      the classes' parameter tables, error and camera translation
+ *   sy_mediator_rt_mirror.c    the scene mirror's callbacks (bad input clamped) and the sync
+ *   sy_mediator_rt_coverage.c  coverage: the image and the numbers (SY_CAP_COVERAGE)
+ *   sy_mediator_rt_accum.c     the path tracer's accumulation slots
+ *   sy_mediator_rt_filter.c    the path tracer's display filters (configuration, a filtered layer)
+ *   sy_mediator_rt_radiance.c  the radiance filter's render (1-spp passes with path records)
+ *   sy_mediator_rt_look.c      the resolved look (background, environment) on the device
+ *   sy_mediator_rt_render.c    one render request; the benchmarks
+ *   sy_mediator_rt.c           the classes: create, destroy, stats, AOVs, registration */
+#ifndef SY_MEDIATOR_RT_INTERNAL_H
+#define SY_MEDIATOR_RT_INTERNAL_H
+
+#include "sy_mediator_rt.h"
+
+#include "sy_rt.h"
+#include "sy_mirror.h"
+
+#include "sy_filter_adaptive.h"
+#include "sy_filter_atrous.h"
+#include "sy_filter_jbu.h"
+#include "sy_filter_pixel.h"
+#include "sy_radiance_hook.h"
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#define ERRLEN 256
+
+/* Path tracer: one accumulation per distinct request (camera, sizes, rectangle, background, seed);
+ * a few are kept so that viewports sharing this context (stereo eyes, tiles) do not evict each
+ * other. A slot restarts when the device published a change since its last pass. */
+#define ACCUM_SLOTS 4
+typedef struct accum_slot {
+    sy_rt_accum *acc;
+    sy_camera_view camera;
+    uint32_t full_w, full_h, rect[4], bg, seed;
+    uint64_t version;  /* device version the accumulation belongs to */
+    uint64_t last_use;
+    sy_filter_pixel *pixel;  /* pixel-filter state of this accumulation (display filter "pixel") */
+    uint32_t pass_samples;   /* sample count of its last filter pass, 0 = none since the restart */
+    sy_radiance_hook *radiance; /* radiance-filter state of this accumulation (display filter "radiance") */
+} accum_slot;
+
+/* Display filter of the path tracer (backends/filters), applied to the returned layer only: the
+ * accumulation never sees it, so changing it never restarts sampling. */
+typedef enum pt_filter_kind {
+    PT_FILTER_NONE,
+    PT_FILTER_PIXEL,
+    PT_FILTER_ATROUS,
+    PT_FILTER_JBU,
+    PT_FILTER_ADAPTIVE,
+    PT_FILTER_RADIANCE, /* not a display filter: it needs the path records of every 1-spp pass */
+    PT_FILTER_KIND_COUNT
+} pt_filter_kind;
+
+typedef struct pt_filter_cfg {
+    pt_filter_kind kind;
+    sy_filter_pixel_params pixel;       /* threshold shared with adaptive */
+    sy_filter_atrous_params atrous;
+    sy_filter_jbu_params jbu;
+    sy_filter_adaptive_params adaptive;
+    sy_filter_radiance_params radiance; /* threshold T_u = the shared threshold */
+} pt_filter_cfg;
+
+/* The scene mirror (textures, materials, meshes, lights, backgrounds, nodes and placements) is
+ * mediators/sy_mirror; this adapter turns its callbacks into Embree back-end calls. */
+typedef struct rt_state {
+    sy_rt_device *dev;
+    sy_mirror *mirror;
+    uint32_t integrator;
+    uint32_t max_depth, light_samples;
+    uint32_t pixel_samples, env_samples; /* whitted: "spp", "env_samples" */
+    float specular; /* "specular" parameter: KHR_materials_specular factor given to every material */
+    /* the look (sy_look.h) applied to the device, with the back-end textures it resolved to */
+    sy_look look;
+    bool look_applied;
+    uint32_t look_env_tex, look_bg_tex;
+    sy_rt_texture studio;   /* the built-in studio environment, made on first use */
+    sy_rt_texture gradient; /* the baked sky/ground gradient of the current look, 0 = none */
+    sy_gradient gradient_baked;
+    sy_mediator_rt_counters counters;
+    uint64_t frames_rendered;
+    accum_slot slots[ACCUM_SLOTS]; /* path tracer only */
+    int last_slot;                 /* slot of the last render, -1 = none */
+    uint64_t use_clock;
+    uint32_t *inst_node;           /* back-end instance slot index -> core node id (coverage) */
+    uint32_t inst_node_cap;
+    pt_filter_cfg filter;          /* path tracer display filter */
+    float *fbuf[SY_RT_AOV_COUNT + 1]; /* filter inputs: the AOV planes + world positions */
+    size_t fbuf_px;                /* pixels the fbuf planes hold */
+    sy_mediator_rt_filter_info finfo; /* last filtered frame */
+} rt_state;
+
+/* --- sy_mediator_rt_base.c --- */
+/* The classes' parameter tables (sy_params.h); the counts are checked where they are defined. */
+#define SY_RTI_WHITTED_PARAM_COUNT 7
+#define SY_RTI_COVERAGE_PARAM_COUNT 5
+#define SY_RTI_PATHTRACER_PARAM_COUNT 25
+#ifndef SY_RTI_DEFINING_PARAMS
+extern const sy_param_decl sy_rti_whitted_params[SY_RTI_WHITTED_PARAM_COUNT];
+extern const sy_param_decl sy_rti_coverage_params[SY_RTI_COVERAGE_PARAM_COUNT];
+extern const sy_param_decl sy_rti_pathtracer_params[SY_RTI_PATHTRACER_PARAM_COUNT];
+#endif
+extern const sy_param_table sy_rti_whitted_table, sy_rti_coverage_table, sy_rti_pt_table;
+/* A back-end failure as an sy_error: "WHAT: MSG". */
+sy_result sy_rti_fail(sy_error *err, sy_rt_result r, const char *what, const char *msg);
+void sy_rti_camera_of(const sy_camera_view *v, sy_rt_camera *cam);
+
+/* --- sy_mediator_rt_mirror.c --- */
+extern const sy_mirror_callbacks sy_rti_mirror_callbacks;
+/* The node an instance belongs to (0: unknown). */
+uint32_t sy_rti_inst_node_get(const rt_state *st, uint32_t handle);
+sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err);
+
+/* --- sy_mediator_rt_coverage.c --- */
+sy_result sy_rti_coverage_render(rt_state *st, const sy_rt_camera *cam, const sy_rt_render_desc *d, sy_layer *layer,
+                                 sy_error *err);
+sy_result sy_rti_coverage(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
+                          sy_coverage_entry **entries_out, uint32_t *count_out, sy_error *err);
+
+/* --- sy_mediator_rt_accum.c --- */
+sy_result sy_rti_pt_slot(rt_state *st, const sy_render_request *req, sy_error *err);
+
+/* --- sy_mediator_rt_filter.c --- */
+void sy_rti_filter_cfg_default(pt_filter_cfg *c, uint32_t threads);
+sy_result sy_rti_filter_cfg_apply(pt_filter_cfg *base, const char *name, const sy_params *p_in, bool all, sy_error *err);
+sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_render_request *req, sy_error *err);
+sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err);
+
+/* --- sy_mediator_rt_radiance.c --- */
+sy_result sy_rti_radiance_render(rt_state *st, const sy_render_request *req, const sy_rt_camera *cam,
+                                 sy_rt_render_desc *d, sy_layer *layer, sy_error *err);
+
+/* --- sy_mediator_rt_look.c --- */
+sy_result sy_rti_apply_look(rt_state *st, uint32_t background_id, sy_error *err);
+
+/* --- sy_mediator_rt_render.c --- */
+sy_result sy_rti_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err);
+
+#endif

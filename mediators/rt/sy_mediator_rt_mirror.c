@@ -1,0 +1,258 @@
+/* sy_mediator_rt_mirror.c — the rt adapter's side of the scene mirror (mediators/sy_mirror):
+ * its callbacks turn textures, materials, meshes, instances and lights into Embree back-end calls
+ * (what the device does not accept is clamped with a warning), and a sync ends with the device's
+ * commit (sy_mediator_rt_internal.h). */
+#include "sy_mediator_rt_internal.h"
+
+#include "sy_log.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define RT_HANDLE_INDEX(h) ((h) & 0x3fffffu) /* backends/rt handles: 22-bit slot index */
+
+/* Remembers which node an instance belongs to (node 0 forgets it). */
+static void inst_node_set(rt_state *st, uint32_t handle, uint32_t node)
+{
+    uint32_t i = RT_HANDLE_INDEX(handle);
+    if (i >= st->inst_node_cap) {
+        if (!node) return;
+        uint32_t nc = st->inst_node_cap ? st->inst_node_cap : 256;
+        while (nc <= i) nc *= 2;
+        uint32_t *n = realloc(st->inst_node, sizeof *n * nc);
+        if (!n) return; /* coverage then reports this instance as unknown (node 0) */
+        memset(n + st->inst_node_cap, 0, sizeof *n * (nc - st->inst_node_cap));
+        st->inst_node = n;
+        st->inst_node_cap = nc;
+    }
+    st->inst_node[i] = node;
+}
+
+uint32_t sy_rti_inst_node_get(const rt_state *st, uint32_t handle)
+{
+    uint32_t i = RT_HANDLE_INDEX(handle);
+    return handle && i < st->inst_node_cap ? st->inst_node[i] : 0;
+}
+
+/* >>mirror callbacks */
+/* >>bad input: the core scene refuses non-finite and negative values; what it accepts but the
+ * device does not (factors above 1, cone angles out of order) is clamped into the device's range
+ * with a warning naming the object and the value, so that one odd value never fails a render. */
+static void rt_warn(rt_state *st, const char *kind, uint32_t id, const char *field, double from, double to)
+{
+    st->counters.warnings++;
+    snprintf(st->counters.last_warning, sizeof st->counters.last_warning, "rt mediator: %s %u: %s %g clamped to %g",
+             kind, id, field, from, to);
+    char item[64];
+    snprintf(item, sizeof item, "%s %u", kind, id);
+    sy_log(SY_LOG_WARNING, "rt", item, "%s %g clamped to %g (rt mediator)", field, from, to);
+}
+
+static float clamp_warn(rt_state *st, const char *kind, uint32_t id, const char *field, float v, float lo, float hi)
+{
+    float c = !(v >= lo) ? lo : v > hi ? hi : v; /* NaN -> lo */
+    if (c != v) rt_warn(st, kind, id, field, (double)v, (double)c);
+    return c;
+}
+
+static sy_rt_texture_ref texref(const rt_state *st, const sy_texture_ref *r)
+{
+    sy_rt_texture_ref o = {{sy_mirror_texture_handle(st->mirror, r->texture.id)}, r->texcoord, false, {0}};
+    o.transformed = sy_texture_ref_matrix(r, o.transform);
+    return o;
+}
+
+static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_error *err)
+{
+    rt_state *st = user;
+    const sy_material_data *m = a->data;
+    char e[ERRLEN];
+    sy_rt_material_desc d;
+    sy_rt_material_desc_init(&d);
+    static const char *const bc[4] = {"base_color[0]", "base_color[1]", "base_color[2]", "base_color[3] (alpha)"};
+    for (int i = 0; i < 4; ++i) d.base_color[i] = clamp_warn(st, "material", a->id, bc[i], m->base_color[i], 0.0f, i == 3 ? 1.0f : INFINITY);
+    d.base_color_texture = texref(st, &m->base_color_texture);
+    d.metallic = clamp_warn(st, "material", a->id, "metallic", m->metallic, 0.0f, 1.0f);
+    d.roughness = clamp_warn(st, "material", a->id, "roughness", m->roughness, 0.0f, 1.0f);
+    d.metallic_roughness_texture = texref(st, &m->metallic_roughness_texture);
+    for (int i = 0; i < 3; ++i) {
+        float e = m->emissive[i] * m->emissive_strength;
+        d.emissive[i] = isfinite(e) && e >= 0.0f ? e : clamp_warn(st, "material", a->id, "emission", e, 0.0f, 3.0e38f);
+    }
+    d.emissive_texture = texref(st, &m->emissive_texture);
+    d.normal_texture = texref(st, &m->normal_texture);
+    d.normal_scale = m->normal_texture.scale;
+    d.transmission = clamp_warn(st, "material", a->id, "transmission", m->transmission, 0.0f, 1.0f);
+    d.ior = m->ior >= 1.0f ? m->ior : 1.5f;
+    d.specular = st->specular;
+    d.alpha_mode = (sy_rt_alpha_mode)m->alpha_mode;
+    d.alpha_cutoff = clamp_warn(st, "material", a->id, "alpha_cutoff", m->alpha_cutoff, 0.0f, 1.0f);
+    d.double_sided = m->double_sided != 0;
+    d.unlit = m->unlit != 0;
+    sy_rt_material h = {*a->handle};
+    sy_rt_result r = h.id ? sy_rt_material_update(st->dev, h, &d, e, sizeof e)
+                          : sy_rt_material_create(st->dev, &d, &h, e, sizeof e);
+    *a->handle = h.id;
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "material", e);
+}
+
+static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_error *err)
+{
+    rt_state *st = user;
+    char e[ERRLEN];
+    sy_rt_texture_desc d = {
+        .width = a->info->width,
+        .height = a->info->height,
+        .channels = a->info->channels,
+        .format = a->info->format == SY_PIXEL_U8_SRGB     ? SY_RT_TEXEL_UNORM8_SRGB
+                  : a->info->format == SY_PIXEL_U8_LINEAR ? SY_RT_TEXEL_UNORM8
+                                                          : SY_RT_TEXEL_FLOAT32,
+        .pixels = a->pixels,
+        .wrap_s = (sy_rt_wrap)a->sampler->wrap_s,
+        .wrap_t = (sy_rt_wrap)a->sampler->wrap_t,
+        .filter = a->sampler->mag_filter == SY_FILTER_NEAREST ? SY_RT_FILTER_NEAREST : SY_RT_FILTER_LINEAR,
+    };
+    sy_rt_texture h = {0};
+    sy_rt_result r = sy_rt_texture_create(st->dev, &d, &h, e, sizeof e);
+    *a->handle = h.id;
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "texture", e);
+}
+
+/* The blobs a shared back-end mesh reads in place (sy_rt_mesh_desc.release): one reference each,
+ * given back when the back-end lets the mesh go. Blobs are immutable and padded (SY_BLOB_PADDING),
+ * so Embree may use them as its vertex and index buffers: no copy in the back-end. */
+typedef struct rt_mesh_blobs {
+    sy_blob *b[6];
+} rt_mesh_blobs;
+
+static void rt_mesh_blobs_release(void *user)
+{
+    rt_mesh_blobs *h = user;
+    for (int k = 0; k < 6; ++k) sy_blob_release(h->b[k]);
+    free(h);
+}
+
+static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
+{
+    rt_state *st = user;
+    char e[ERRLEN];
+    const sy_primitive *p = a->primitive;
+    rt_mesh_blobs *held = malloc(sizeof *held);
+    if (!held) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt: mesh primitive: out of memory");
+    sy_rt_mesh_desc d = {
+        .positions = sy_blob_data(p->positions),
+        .normals = sy_blob_data(p->normals),
+        .uv = {sy_blob_data(p->texcoords0), sy_blob_data(p->texcoords1)},
+        .colors = sy_blob_data(p->colors),
+        .indices = sy_blob_data(p->indices),
+        .vertex_count = sy_primitive_vertex_count(p),
+        .triangle_count = sy_primitive_triangle_count(p),
+        .release = rt_mesh_blobs_release,
+        .release_user = held,
+    };
+    sy_blob *const used[6] = {p->positions, p->normals, p->texcoords0, p->texcoords1, p->colors, p->indices};
+    for (int k = 0; k < 6; ++k) held->b[k] = sy_blob_retain(used[k]);
+    sy_rt_mesh h = {0};
+    sy_rt_result r = sy_rt_mesh_create(st->dev, &d, &h, e, sizeof e);
+    if (r != SY_RT_OK) rt_mesh_blobs_release(held); /* a failed create keeps nothing */
+    *a->handle = h.id;
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "mesh primitive", e);
+}
+
+static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_error *err)
+{
+    rt_state *st = user;
+    char e[ERRLEN];
+    sy_rt_instance h = {*a->handle};
+    sy_rt_result r;
+    if (!h.id) {
+        sy_rt_instance_desc d = {.mesh = {a->mesh},
+                                 .material = {a->material},
+                                 .flags = (a->baked ? SY_RT_INSTANCE_BAKED : 0u) | (a->visible ? 0u : SY_RT_INSTANCE_HIDDEN)};
+        memcpy(d.transform, a->world->m, sizeof d.transform);
+        r = sy_rt_instance_create(st->dev, &d, &h, e, sizeof e);
+        *a->handle = h.id;
+        if (r == SY_RT_OK) inst_node_set(st, h.id, a->node);
+        return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "instance", e);
+    }
+    r = sy_rt_instance_set_transform(st->dev, h, a->world->m, e, sizeof e);
+    if (r == SY_RT_OK) r = sy_rt_instance_set_visible(st->dev, h, a->visible, e, sizeof e);
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "instance transform", e);
+}
+
+static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *err)
+{
+    rt_state *st = user;
+    char e[ERRLEN];
+    const sy_light_data *l = a->light;
+    sy_rt_light_desc d;
+    memset(&d, 0, sizeof d);
+    d.type = l->type == SY_LIGHT_SPOT ? SY_RT_LIGHT_SPOT : l->type == SY_LIGHT_DIRECTIONAL ? SY_RT_LIGHT_DIRECTIONAL
+                                                                                         : SY_RT_LIGHT_POINT;
+    static const char *const cn[3] = {"color[0]", "color[1]", "color[2]"};
+    for (int i = 0; i < 3; ++i) d.color[i] = clamp_warn(st, "light of node", a->node, cn[i], l->color[i], 0.0f, 3.0e38f);
+    d.intensity = clamp_warn(st, "light of node", a->node, "intensity", l->intensity, 0.0f, 3.0e38f);
+    d.range = clamp_warn(st, "light of node", a->node, "range", l->range, 0.0f, 3.0e38f);
+    if (d.type == SY_RT_LIGHT_SPOT) {
+        d.outer_cone_angle = clamp_warn(st, "light of node", a->node, "outer_cone", l->outer_cone, 0.0f, 1.5707963f);
+        d.inner_cone_angle = clamp_warn(st, "light of node", a->node, "inner_cone", l->inner_cone, 0.0f, d.outer_cone_angle);
+    }
+    memcpy(d.position, a->position, sizeof d.position);
+    memcpy(d.direction, a->direction, sizeof d.direction);
+    sy_rt_light h = {*a->handle};
+    sy_rt_result r = h.id ? sy_rt_light_update(st->dev, h, &d, e, sizeof e) : sy_rt_light_create(st->dev, &d, &h, e, sizeof e);
+    *a->handle = h.id;
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "light", e);
+}
+
+static void cb_release(void *user, const sy_mirror_release_args *a)
+{
+    rt_state *st = user;
+    switch (a->kind) {
+    case SY_MIRROR_TEXTURE: sy_rt_texture_destroy(st->dev, (sy_rt_texture){a->handle}, NULL, 0); break;
+    case SY_MIRROR_MATERIAL: sy_rt_material_destroy(st->dev, (sy_rt_material){a->handle}, NULL, 0); break;
+    case SY_MIRROR_PRIMITIVE: sy_rt_mesh_destroy(st->dev, (sy_rt_mesh){a->handle}, NULL, 0); break;
+    case SY_MIRROR_INSTANCE:
+        inst_node_set(st, a->handle, 0);
+        sy_rt_instance_destroy(st->dev, (sy_rt_instance){a->handle}, NULL, 0);
+        break;
+    case SY_MIRROR_LIGHT: sy_rt_light_destroy(st->dev, (sy_rt_light){a->handle}, NULL, 0); break;
+    }
+}
+
+const sy_mirror_callbacks sy_rti_mirror_callbacks = {
+    .texture_set = cb_texture,
+    .material_set = cb_material,
+    .primitive_set = cb_primitive,
+    .instance_set = cb_instance,
+    .light_set = cb_light,
+    .release = cb_release,
+};
+
+/* >>sync */
+sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err)
+{
+    rt_state *st = state;
+    sy_mirror_sync_stats ms;
+    sy_result r = sy_mirror_sync(st->mirror, changes, &ms, err);
+    st->counters.last_sync_placements = ms.placements;
+    st->counters.last_sync_entries = ms.entries;
+    /* The device tracks what is staged (sy_rt_commit is a no-op on a clean device), so every
+     * successful sync ends with a commit: an uncommitted device refuses to render. */
+    if (r == SY_OK) {
+        char e[ERRLEN];
+        sy_rt_result rr = sy_rt_commit(st->dev, e, sizeof e);
+        if (rr != SY_RT_OK) r = sy_rti_fail(err, rr, "commit", e);
+    }
+    sy_rt_stats s;
+    sy_rt_device_stats(st->dev, &s);
+    st->counters.instances = s.instances;
+    st->counters.meshes = s.meshes;
+    st->counters.materials = s.materials;
+    st->counters.textures = s.textures;
+    st->counters.lights = s.lights;
+    st->counters.last_sync_top_commit_seconds = s.last_top_commit_seconds;
+    return r;
+}

@@ -1,0 +1,127 @@
+/* sy_mediator_rt_render.c — one render request of the rt adapter (whitted, pathtracer,
+ * coverage): look, accumulation, filters; the ray and limit benchmarks
+ * (sy_mediator_rt_internal.h). */
+#include "sy_mediator_rt_internal.h"
+
+#include "sy_rt_bench.h"
+#include "sy_rt_limit.h"
+
+#include <math.h>
+#include <string.h>
+
+/* >>render */
+typedef struct progress_bridge {
+    sy_progress_fn fn;
+    void *user;
+} progress_bridge;
+
+static bool progress_cb(const sy_rt_progress *p, void *user)
+{
+    progress_bridge *b = user;
+    sy_progress q = {p->tiles_done, p->tiles_total};
+    b->fn(b->user, &q);
+    return true;
+}
+
+sy_result sy_mediator_rt_bench_rays(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
+                                    uint32_t repeats, sy_mediator_rt_bench *out, sy_error *err)
+{
+    rt_state *st = state;
+    char e[ERRLEN];
+    sy_rt_camera cam;
+    sy_rti_camera_of(view, &cam);
+    sy_rt_bench_result b;
+    sy_rt_result r = sy_rt_bench_rays(st->dev, &cam, width, height, repeats, &b, e, sizeof e);
+    if (r != SY_RT_OK) return sy_rti_fail(err, r, "ray benchmark", e);
+    out->ours_mrays = b.primary_mrays;
+    out->raw_mrays = b.raw_mrays;
+    out->overhead_percent = b.overhead_percent;
+    out->threads = b.threads;
+    return SY_OK;
+}
+
+sy_result sy_rti_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
+{
+    rt_state *st = state;
+    char e[ERRLEN];
+    sy_result lr = sy_rti_apply_look(st, req->background_id, err);
+    if (lr != SY_OK) return lr;
+    sy_rt_camera cam;
+    sy_rti_camera_of(&req->camera, &cam);
+    progress_bridge pb = {req->progress, req->progress_user};
+    sy_rt_render_desc d = {
+        .integrator = (sy_rt_integrator)st->integrator,
+        .image_width = req->full_width,
+        .image_height = req->full_height,
+        .x = req->rect_x,
+        .y = req->rect_y,
+        .width = req->rect_w,
+        .height = req->rect_h,
+        .max_depth = st->max_depth,
+        .area_light_samples = st->light_samples,
+        .seed = req->seed,
+        .pixel_samples = st->pixel_samples,
+        .env_light_samples = st->env_samples,
+        .progress = req->progress ? progress_cb : NULL,
+        .progress_user_data = &pb,
+    };
+    if (st->integrator == SY_RT_INTEGRATOR_WHITTED && req->preview > 0.0f && req->preview < 1.0f) {
+        /* an interactive preview (SY_CAP_PREVIEW): the share `preview` of the camera rays and of the
+         * area- and environment-light samples per pixel, at least one each (spp=1 is the pixel centre) */
+        d.pixel_samples = (uint32_t)fmaxf(1.0f, floorf((float)st->pixel_samples * req->preview + 0.5f));
+        d.area_light_samples = (uint32_t)fmaxf(1.0f, floorf((float)st->light_samples * req->preview + 0.5f));
+        d.env_light_samples = (uint32_t)fmaxf(1.0f, floorf((float)st->env_samples * req->preview + 0.5f));
+    }
+    if (st->integrator == SY_RT_INTEGRATOR_COVERAGE) return sy_rti_coverage_render(st, &cam, &d, layer, err);
+    if (st->integrator == SY_RT_INTEGRATOR_PATHTRACER) {
+        sy_result pr = sy_rti_pt_slot(st, req, err);
+        if (pr != SY_OK) return pr;
+        d.accum = st->slots[st->last_slot].acc;
+        d.samples = req->sample_count ? req->sample_count : 1u;
+        if (st->filter.kind == PT_FILTER_RADIANCE) return sy_rti_radiance_render(st, req, &cam, &d, layer, err);
+    }
+    sy_rt_result r = sy_rt_render(st->dev, &cam, &d, layer->rgba, layer->depth, e, sizeof e);
+    if (r != SY_RT_OK) return sy_rti_fail(err, r, "render", e);
+    if (d.accum) st->counters.last_render_rays = sy_rt_accum_last_rays(d.accum);
+    st->frames_rendered++;
+    if (d.accum && st->filter.kind != PT_FILTER_NONE) return sy_rti_filter_layer(st, req, layer, err);
+    return SY_OK;
+}
+
+sy_result sy_mediator_rt_bench_limit(void *state, const sy_camera_view *view, uint32_t background_id, uint32_t width,
+                                     uint32_t height, uint32_t samples, uint32_t repeats, sy_mediator_rt_limit *out,
+                                     sy_error *err)
+{
+    rt_state *st = state;
+    if (st->integrator != SY_RT_INTEGRATOR_PATHTRACER)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "rt bench limit: the context must be a pathtracer context");
+    sy_result lr = sy_rti_apply_look(st, background_id, err);
+    if (lr != SY_OK) return lr;
+    char e[ERRLEN];
+    sy_rt_camera cam;
+    sy_rti_camera_of(view, &cam);
+    sy_rt_accum *acc = NULL;
+    sy_rt_result r = sy_rt_accum_create(width, height, &acc, e, sizeof e);
+    sy_rt_render_desc d = {.integrator = SY_RT_INTEGRATOR_PATHTRACER, .image_width = width, .image_height = height,
+                           .width = width, .height = height, .max_depth = st->max_depth, .seed = 1u, .accum = acc,
+                           .samples = samples};
+    sy_rt_limit_result lim;
+    if (r == SY_RT_OK) r = sy_rt_bench_limit(st->dev, &cam, &d, repeats, &lim, e, sizeof e);
+    sy_rt_accum_destroy(acc);
+    if (r != SY_RT_OK) return sy_rti_fail(err, r, "limit benchmark", e);
+    _Static_assert(SY_MEDIATOR_RT_LIMIT_FORMS == SY_RT_FORM_COUNT, "one entry per replay form");
+    memset(out, 0, sizeof *out);
+    out->width = lim.width, out->height = lim.height, out->samples = lim.samples, out->repeats = lim.repeats;
+    out->threads = lim.threads;
+    out->rays = lim.rays, out->extension_rays = lim.extension_rays, out->shadow_rays = lim.shadow_rays;
+    out->intersect_queries = lim.intersect_queries, out->occluded_queries = lim.occluded_queries;
+    memcpy(out->frame_seconds, lim.frame_seconds, sizeof out->frame_seconds);
+    memcpy(out->form_seconds, lim.form_seconds, sizeof out->form_seconds);
+    memcpy(out->share, lim.share, sizeof out->share);
+    for (int f = 0; f < SY_RT_FORM_COUNT; ++f) {
+        out->mismatches[f] = lim.mismatches[f];
+        out->native[f] = lim.native[f];
+        out->form_names[f] = sy_rt_ray_form_name((sy_rt_ray_form)f);
+    }
+    return SY_OK;
+}
