@@ -216,10 +216,7 @@ void sy_gl_device_stats(const sy_gl_device *dev, sy_gl_stats *out)
     out->total = dev->counts;
 }
 
-
 const char *sy_gl_device_info(const sy_gl_device *dev) { return dev->info; }
-
-
 
 bool sy_gl_window_should_close(sy_gl_device *dev) { return sy_gl_context_should_close(dev->ctx); }
 

@@ -8,12 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-
 static int frame_lighting(const sy_gl_device *dev);
 
 /* The whole target as one rectangle (sy_gl_rect_vs). */
 static const float FULL_TARGET[1][4] = {{-1.0f, -1.0f, 1.0f, 1.0f}};
-
 
 void sy_gli_targets_free(sy_gl_device *dev, targets *t)
 {

@@ -56,8 +56,6 @@ enum { UNIT_GCOL = UNIT_BASE, UNIT_GDEPTH = UNIT_MR, UNIT_MTAB = UNIT_NRM };
  * faster forward, the 1M-triangle scene's meshes at 2-8 deferred). */
 #define DEFERRED_MAX_PX_PER_TRI 16.0f
 
-
-
 /* Object pools: every object struct starts with {id, gen}; id 0 = free slot. */
 typedef struct slot_head {
     uint32_t id, gen;
@@ -70,7 +68,6 @@ typedef struct pool {
 } pool;
 
 static inline void *sy_gli_pool_at(const pool *p, uint32_t i) { return (char *)p->items + (size_t)i * p->elem; }
-
 
 /* Levels of detail (meshoptimizer): level 0 is the mesh; each further level is simplified from the
  * one before to about a quarter of its triangles, all levels in one index buffer. */
@@ -247,13 +244,10 @@ struct sy_gl_device {
     size_t scratch_len;
 };
 
-
-
 static inline float sy_gli_dot3f(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 enum { CASTER_NONE, CASTER_OPAQUE, CASTER_MASKED }; /* caster_kind */
 extern const float sy_gli_cube_faces[6][3][3]; /* (right, up, forward) per GL cube face (sy_gl_base.c) */
-
 
 typedef struct mat_block {
     float base[4], emissive[4], mrna[4], oist[4];
@@ -261,15 +255,11 @@ typedef struct mat_block {
     float xf[10][4]; /* per texture slot (base, mr, nrm, occ, emis) two rows of its uv transform */
 } mat_block;
 
-
-
 /* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes, then the cube shadows' parameters
  * (SY_GL_MAX_CUBE_SHADOWS x 16 bytes) */
 #define LIGHTS_CUBE_PAR 600
 #define LIGHTS_FLOATS (LIGHTS_CUBE_PAR + 4 * SY_GL_MAX_CUBE_SHADOWS)
 #define AREAS_FLOATS (8 + SY_GL_MAX_AREA_LIGHTS * 6 * 4) /* std140 Areas block: ivec4 + vec4 + vec4[16 * 6] */
-
-
 
 typedef struct frame_state {
     float shadow_vp[SY_GL_MAX_SHADOW_MAPS][16];
@@ -278,17 +268,12 @@ typedef struct frame_state {
     uint32_t cube_count; /* point lights with a cube shadow */
 } frame_state;
 
-
-
 typedef struct view_setup {
     float view[16], proj[16], cam_pos[3], cam_fwd[3];
     bool ortho;
     float ppu; /* pixels per unit of the image plane at distance 1 (perspective) or per metre (ortho); 0 =
                 * unknown (levels of detail off) */
 } view_setup;
-
-
-
 
 typedef struct draw_ctx {
     const view_setup *v;
@@ -300,10 +285,7 @@ typedef struct draw_ctx {
 } draw_ctx;
 #define BOUND_GBUF (-2)
 
-
-
 static inline int sy_gli_mesh_lean(const mesh_o *m) { return !m->has_attr[3] && !m->has_attr[4]; }
-
 
 /* sy_gl_base.c */
 sy_gl_result sy_gli_fail(char *err, size_t len, sy_gl_result r, const char *fmt, ...);

@@ -10,10 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-
 static float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
 static float linear_to_srgb(float c) { return c <= 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f; }
-
 
 /* The levels of detail of an indexed mesh of at least SY_GL_LOD_MIN_TRIANGLES: into *out (malloc'd,
  * level 0 first) the mesh's indices followed by each simplified level; m->lod_* describe them.
