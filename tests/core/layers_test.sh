@@ -26,17 +26,20 @@ bad() { echo "FAIL: $*"; fail=1; }
 headers_of() { ls "$SRC/$1"/*.h "$SRC/$1"/*/*.h 2>/dev/null | xargs -n1 basename | sort -u; }
 check_includes() { # DIR ALLOWED_DIRS...: every quoted include of DIR names a header of DIR or of ALLOWED_DIRS
     local dir=$1; shift
-    local allowed
+    local allowed all_proj out
     allowed=$( { headers_of "$dir"; for a in "$@"; do headers_of "$a"; done; } | sort -u)
-    local all_proj
     all_proj=$(for d in core mediators backends formats apps; do headers_of $d; done | sort -u)
-    while IFS=: read -r file inc; do
-        h=$(sed -E 's/.*#include "([^"]+)".*/\1/' <<<"$inc")
-        h=$(basename "$h")
-        if grep -qxF "$h" <<<"$all_proj" && ! grep -qxF "$h" <<<"$allowed"; then
-            bad "$file includes \"$h\", which $dir/ may not use"
-        fi
-    done < <(grep -rn '#include "' "$SRC/$dir" --include=*.c --include=*.h --include=*.cpp | sed -E 's/^([^:]+):[0-9]+:/\1:/')
+    # one awk over every include line (a process per line took most of the test's time)
+    out=$(grep -rn '#include "' "$SRC/$dir" --include=*.c --include=*.h --include=*.cpp |
+        awk -v allowed="$allowed" -v proj="$all_proj" -v dir="$dir" '
+            BEGIN { n = split(allowed, a, "\n"); for (i = 1; i <= n; ++i) ok[a[i]] = 1
+                    n = split(proj, p, "\n"); for (i = 1; i <= n; ++i) pj[p[i]] = 1 }
+            { file = $0; sub(/:[0-9]+:.*/, "", file)
+              h = $0; sub(/.*#include "/, "", h); sub(/".*/, "", h); sub(/.*\//, "", h)
+              if ((h in pj) && !(h in ok)) print file " includes \"" h "\", which " dir "/ may not use" }')
+    if [ -n "$out" ]; then
+        while IFS= read -r l; do bad "$l"; done <<<"$out"
+    fi
 }
 check_includes core
 check_includes backends
