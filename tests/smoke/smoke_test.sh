@@ -12,7 +12,7 @@
 # two minutes on two cores; reduced (sanitizer and minimal builds): every third main file, every back-end.
 # Environment: SY_SMOKE_ALL=1 renders every file in every back-end; SY_SMOKE_LIMIT (seconds per
 # render, default 90: a hang guard, not a speed test; the first frame of a sample costs 1 to 19
-# seconds of CPU (TransmissionTest: 7 main variants to compile), and ctest runs other tests beside
+# seconds of CPU (TransmissionTest compiles six main-pass shaders), and ctest runs other tests beside
 # this one on a 2-core machine); SY_SMOKE_JOBS
 # (renders at once, default 2); SY_SMOKE_OUT (keep the images and logs there).
 #
