@@ -16,7 +16,6 @@
 
 /* ---- >>colour helpers ---- */
 
-
 /* Pixel conversion with the exposure scale already computed. */
 static void encode_pixel(const float *in, float scale, sy_tonemap op, uint8_t *out)
 {
