@@ -382,6 +382,21 @@ static int material_features(const sy_gl_device *dev, const mat_o *mt)
     return v;
 }
 
+/* The material_features of every visible instance, once per frame (sy_gl_render): every forward
+ * draw of the frame, probe faces included, takes them (draw_instance). */
+void sy_gli_frame_features(sy_gl_device *dev)
+{
+    int shared = 0;
+    const mat_o *last = NULL;
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        const inst_o *in = sy_gli_pool_at(&dev->instances, i);
+        if (!in->h.id || !in->visible) continue;
+        const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
+        if (mt && mt != last) shared |= material_features(dev, last = mt);
+    }
+    dev->shared_features = shared;
+}
+
 /* The variant bits for one draw: mesh attributes, material textures and mode, frame lighting,
  * whether the instance has a scene probe. */
 static int draw_variant(const sy_gl_device *dev, const mesh_o *m, const mat_o *mt, bool probe)
@@ -613,15 +628,12 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
         dev->rect_count = 0;
         dev->rect_all = false;
     }
-    const mat_o *last = NULL;
+    dc.shared = dev->shared_features;
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
         inst_o *in = sy_gli_pool_at(&dev->instances, i);
-        if (!in->h.id || !in->visible) continue;
+        if (!in->h.id || !in->visible || i == skip) continue;
         const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
         if (!m) continue;
-        const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
-        if (mt && mt != last) dc.shared |= material_features(dev, last = mt); /* the same in every pass */
-        if (i == skip) continue;
         float c[3], scale, r = sy_gli_world_sphere(in, m, c, &scale);
         if (sy_gli_sphere_outside(planes, c, r)) { /* outside the view: not drawn */
             if (skip == UINT32_MAX) dev->culled++;
@@ -629,6 +641,7 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
         }
         in->lod = sy_gli_choose_lod(dev, m, v, c, r, scale);
         in->px_per_tri = sy_gli_pixels_per_triangle(dev, m, in->lod, v, c, r);
+        const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
         sy_gl_alpha_mode mode = mt ? mt->d.alpha_mode : SY_GL_ALPHA_OPAQUE;
         int li = mode == SY_GL_ALPHA_BLEND ? 2 : mode == SY_GL_ALPHA_MASK ? 1 : 0;
         float *e = lists + 2 * ((size_t)li * cap + nl[li]++);

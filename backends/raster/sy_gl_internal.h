@@ -242,6 +242,7 @@ struct sy_gl_device {
     uint64_t culled;     /* instances outside the view in the last main pass */
     float *scratch;
     size_t scratch_len;
+    int shared_features; /* material_features of every visible instance (sy_gli_frame_features) */
 };
 
 static inline float sy_gli_dot3f(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -279,8 +280,8 @@ typedef struct draw_ctx {
     const view_setup *v;
     float viewproj[16], ortho_z[3]; /* orthographic proj[10], proj[14] (and 0) */
     int bound;                      /* the variant whose program is bound, BOUND_GBUF, or -1 */
-    int shared;                     /* material_features of every visible instance: forward draws use
-                                     * them all (draw_instance) */
+    int shared;                     /* the frame's shared_features: forward draws use them all
+                                     * (draw_instance) */
     bool deferred, gbuf_view_set;   /* opaque draws may go to the G-buffer; its view uniforms are set */
 } draw_ctx;
 #define BOUND_GBUF (-2)
@@ -337,6 +338,7 @@ sy_gl_result sy_gli_shadow_maps_make(sy_gl_device *dev, char *err, size_t err_le
 void sy_gli_render_shadows(sy_gl_device *dev, const frame_state *fs);
 
 /* sy_gl_draw.c */
+void sy_gli_frame_features(sy_gl_device *dev);
 void sy_gli_targets_free(sy_gl_device *dev, targets *t);
 void sy_gli_frame_end(sy_gl_device *dev);
 sy_gl_result sy_gli_targets_ensure(sy_gl_device *dev, uint32_t w, uint32_t h, char *err, size_t len);

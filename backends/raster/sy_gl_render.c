@@ -170,6 +170,7 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         dev->lights_dirty = false;
         dev->probes_dirty = true;
     }
+    sy_gli_frame_features(dev);
     uint32_t psize = probe_size_for(dev, d->width, d->height);
     if (psize != dev->probe_size) { /* a larger frame than any before: sharper probes */
         sy_gli_probes_free(dev);
