@@ -130,7 +130,8 @@ typedef void (*sy_gl_log_fn)(void *user, const char *message);
 typedef struct sy_gl_device_desc {
     sy_gl_provider provider; /**< OSMesa, EGL or GLFW */
     uint32_t msaa;             /**< samples per pixel: 0/1 = none, else clamped to GL_MAX_SAMPLES (warning) */
-    uint32_t shadow_map_size;  /**< texels per side; 0 = 2048 */
+    uint32_t shadow_map_size;  /**< texels per side; 0 = follow the frame: the power of two at or above twice its
+                                    larger side, 256 to 2048, never shrinking */
     uint32_t max_texture_size; /**< 0 = GL_MAX_TEXTURE_SIZE; smaller values force downscaling */
     /** @{ GLFW window size; 0 = 640 x 480 */
     uint32_t window_width, window_height; /** @} */

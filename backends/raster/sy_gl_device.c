@@ -40,7 +40,8 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     }
     dev->max_tex = (uint32_t)max_tex;
     if (dd.max_texture_size && dd.max_texture_size < dev->max_tex) dev->max_tex = dd.max_texture_size;
-    dev->shadow_size = dd.shadow_map_size ? dd.shadow_map_size : SHADOW_SIZE_DEFAULT;
+    dev->shadow_auto = dd.shadow_map_size == 0;
+    dev->shadow_size = dd.shadow_map_size ? dd.shadow_map_size : SHADOW_SIZE_AUTO_MIN;
     dev->lod_pixels = SY_GL_LOD_PIXELS_DEFAULT;
     if (dev->shadow_size > (uint32_t)max_tex) {
         sy_gli_warn(dev, "raster: shadow_map_size %u is above the GL context's texture limit; using %d", dev->shadow_size, max_tex);

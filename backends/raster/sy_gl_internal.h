@@ -25,20 +25,25 @@
 
 #define IDX_BITS 20u
 #define IDX_MASK ((1u << IDX_BITS) - 1u)
+/* shadow_map_size 0 (the default): the maps follow the frame, the power of two at or above twice
+ * its larger side, from SHADOW_SIZE_AUTO_MIN to SHADOW_SIZE_DEFAULT (a 200x150 frame renders 512,
+ * not 2048: 16 times fewer texels to zero and draw, issue 32); they never shrink */
 #define SHADOW_SIZE_DEFAULT 2048u
+#define SHADOW_SIZE_AUTO_MIN 256u
 enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_ENV_SPEC, UNIT_ENV_IRR, UNIT_BRDF,
        UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW0, UNIT_CUBE_SHADOW1, UNIT_PROBE, UNIT_COUNT };
 /* Scene probes: mirror-like and glass instances see the scene, not only the environment. Each of
  * the first SY_GL_MAX_PROBES such instances gets a cube map rendered from its bounding-box centre
  * (the instance itself left out, other probed instances showing the environment), with a mip
  * chain for roughness; re-rendered only when geometry, materials, lights or the environment
- * change, never for a camera move. Its side (probe_size_for) follows the largest frame rendered so
- * far, from PROBE_SIZE_MIN to PROBE_SIZE_MAX texels: a 90 degree face needs no more texels than
- * about half the frame's width has (a small first frame renders four times fewer probe pixels,
- * issue 32), and it never shrinks, so a view whose resolution drops while it moves (sy view, sy
- * web) does not re-render its probes. */
+ * change, and for a camera move only when a probed instance gets larger in view than its probe's
+ * side allows. Its side (probe_size_for) follows the largest probed instance in view so far, from
+ * PROBE_SIZE_MIN to PROBE_SIZE_MAX texels and at most about half the frame's width: a sphere of
+ * radius R pixels needs faces of about R texels (TransmissionTest's small glass objects at 200x150
+ * render 16 px faces, not 128: 64 times fewer probe pixels, issue 32), and it never shrinks, so a
+ * view whose resolution drops while it moves (sy view, sy web) does not re-render its probes. */
 #define SY_GL_MAX_PROBES 4u
-#define PROBE_SIZE_MIN 32u
+#define PROBE_SIZE_MIN 16u
 #define PROBE_SIZE_MAX 256u
 #define PROBE_MAX_ROUGHNESS 0.4f
 enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1, BIND_AREAS = 2 };
@@ -145,6 +150,7 @@ struct sy_gl_device {
     sy_gl_log_fn log;
     void *log_user;
     uint32_t msaa, max_tex, shadow_size;
+    bool shadow_auto; /* shadow_map_size 0: shadow_size follows the frame (sy_gli_shadow_size_follow) */
     pool meshes, textures, materials, instances, lights;
     GLuint prog_resolve, prog_floor, prog_floor_lit;
     GLint resolve_rects; /* prog_resolve's u_rects (sy_gl_rect_vs: the whole target or the tiles the deferred pass leaves) */
@@ -335,6 +341,7 @@ float sy_gli_pixels_per_triangle(const sy_gl_device *dev, const mesh_o *m, uint3
 void sy_gli_scene_bounds(const sy_gl_device *dev, float *c, float *radius);
 void sy_gli_lights_upload(sy_gl_device *dev, frame_state *fs);
 sy_gl_result sy_gli_shadow_maps_make(sy_gl_device *dev, char *err, size_t err_len);
+void sy_gli_shadow_size_follow(sy_gl_device *dev, uint32_t w, uint32_t h);
 void sy_gli_render_shadows(sy_gl_device *dev, const frame_state *fs);
 
 /* sy_gl_draw.c */

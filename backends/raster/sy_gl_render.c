@@ -14,12 +14,46 @@ static bool wants_probe(const mat_o *mt)
     return mt->d.metallic >= 0.5f || mt->d.transmission * (1.0f - mt->d.metallic) >= 0.5f;
 }
 
-/* The probes' side for a frame of w x h: the power of two at or above half the larger side, within
- * [PROBE_SIZE_MIN, PROBE_SIZE_MAX], and never below the side they have (see SY_GL_MAX_PROBES). */
-static uint32_t probe_size_for(const sy_gl_device *dev, uint32_t w, uint32_t h)
+/* The instances that get a probe: the first SY_GL_MAX_PROBES visible mirror-like or glass ones
+ * (pool indices into idx); returns how many. */
+static uint32_t pick_probes(const sy_gl_device *dev, uint32_t idx[SY_GL_MAX_PROBES])
 {
-    uint32_t half = (w > h ? w : h) / 2u, s = PROBE_SIZE_MIN;
-    while (s < half && s < PROBE_SIZE_MAX) s *= 2u;
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < dev->instances.count && n < SY_GL_MAX_PROBES; ++i) {
+        const inst_o *in = sy_gli_pool_at(&dev->instances, i);
+        if (!in->h.id || !in->visible || !sy_gli_pool_get(&dev->meshes, in->mesh.id)) continue;
+        if (wants_probe(sy_gli_pool_get(&dev->materials, in->material.id))) idx[n++] = i;
+    }
+    return n;
+}
+
+/* The probes' side for view v of a w x h frame: the power of two at or above the largest projected
+ * radius, in pixels, of a probed instance in view (a mirror sphere of radius R pixels spreads a
+ * 90-degree face over about 1.3 R pixels at its centre), within [PROBE_SIZE_MIN, PROBE_SIZE_MAX]
+ * and at most the power of two at or above half the frame's larger side; never below the side
+ * they have (see SY_GL_MAX_PROBES). */
+static uint32_t probe_size_for(const sy_gl_device *dev, const view_setup *v, uint32_t w, uint32_t h)
+{
+    uint32_t idx[SY_GL_MAX_PROBES], n = pick_probes(dev, idx), half = (w > h ? w : h) / 2u;
+    float vp[16], planes[6][4], need = 0.0f;
+    sy_gli_m4_mul(v->proj, v->view, vp);
+    sy_gli_frustum_planes(vp, planes);
+    for (uint32_t p = 0; p < n; ++p) {
+        const inst_o *in = sy_gli_pool_at(&dev->instances, idx[p]);
+        float c[3], scale, r = sy_gli_world_sphere(in, sy_gli_pool_get(&dev->meshes, in->mesh.id), c, &scale);
+        if (sy_gli_sphere_outside(planes, c, r)) continue;
+        float px = (float)half; /* unknown scale, or the view inside the sphere: the frame's cap */
+        if (v->ppu > 0.0f && v->ortho) px = r * v->ppu;
+        else if (v->ppu > 0.0f) {
+            float d = (c[0] - v->cam_pos[0]) * v->cam_fwd[0] + (c[1] - v->cam_pos[1]) * v->cam_fwd[1] +
+                      (c[2] - v->cam_pos[2]) * v->cam_fwd[2] - r;
+            if (d > 1e-6f) px = r * v->ppu / d;
+        }
+        if (px > need) need = px;
+    }
+    if (need > (float)half) need = (float)half;
+    uint32_t s = PROBE_SIZE_MIN;
+    while ((float)s < need && s < PROBE_SIZE_MAX) s *= 2u;
     return s > dev->probe_size ? s : dev->probe_size;
 }
 
@@ -41,19 +75,18 @@ void sy_gli_probes_free(sy_gl_device *dev)
 static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
 {
     const sy_gl_fns *gl = dev->gl;
-    dev->probe_count = 0;
+    uint32_t idx[SY_GL_MAX_PROBES];
+    dev->probe_count = pick_probes(dev, idx);
     float centres[SY_GL_MAX_PROBES][3];
-    for (uint32_t i = 0; i < dev->instances.count && dev->probe_count < SY_GL_MAX_PROBES; ++i) {
-        const inst_o *in = sy_gli_pool_at(&dev->instances, i);
-        if (!in->h.id || !in->visible) continue;
+    for (uint32_t p = 0; p < dev->probe_count; ++p) {
+        const inst_o *in = sy_gli_pool_at(&dev->instances, idx[p]);
         const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
-        if (!m || !wants_probe(sy_gli_pool_get(&dev->materials, in->material.id))) continue;
-        float *c = centres[dev->probe_count];
+        float *c = centres[p];
         for (int a = 0; a < 3; ++a) {
             c[a] = in->model[12 + a];
             for (int k = 0; k < 3; ++k) c[a] += in->model[4 * k + a] * 0.5f * (m->bmin[k] + m->bmax[k]);
         }
-        dev->probes[dev->probe_count++].inst = i;
+        dev->probes[p].inst = idx[p];
     }
     if (!dev->probe_count) return SY_GL_OK;
     const GLsizei ps = (GLsizei)dev->probe_size;
@@ -90,6 +123,10 @@ static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
             memset(&v, 0, sizeof v);
             sy_gli_cube_face_view(c, f, v.view);
             sy_gli_projection(false, -1.0, 1.0, -1.0, 1.0, nearp, far, v.proj);
+            /* a 90-degree face: ps pixels across 2 units of the image plane at distance 1; the
+             * levels of detail follow (before, every face drew every mesh whole: MetalRoughSpheres'
+             * four probes drew 10^6 triangles 24 times) */
+            v.ppu = (float)ps / 2.0f;
             memcpy(v.cam_pos, c, sizeof v.cam_pos);
             memcpy(v.cam_fwd, sy_gli_cube_faces[f][2], sizeof v.cam_fwd);
             gl->BindFramebuffer(GL_FRAMEBUFFER, dev->probe_fbo);
@@ -141,6 +178,7 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
     dev->frame_no++;
+    sy_gli_shadow_size_follow(dev, d->width, d->height);
     static frame_state fs_zero;
     frame_state fs = fs_zero;
     if (dev->env_dirty) {
@@ -171,8 +209,8 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         dev->probes_dirty = true;
     }
     sy_gli_frame_features(dev);
-    uint32_t psize = probe_size_for(dev, d->width, d->height);
-    if (psize != dev->probe_size) { /* a larger frame than any before: sharper probes */
+    uint32_t psize = probe_size_for(dev, &v, d->width, d->height);
+    if (psize != dev->probe_size) { /* a probed instance larger in view than before: sharper probes */
         sy_gli_probes_free(dev);
         dev->probe_size = psize;
         dev->probes_dirty = true;

@@ -257,10 +257,32 @@ sy_gl_result sy_gli_shadow_maps_make(sy_gl_device *dev, char *err, size_t err_le
         dev->shadow_tex = 0;
         dev->shadow_size /= 2u;
     }
-    if (dev->shadow_size != asked)
+    if (dev->shadow_size != asked) {
+        dev->shadow_auto = false; /* as large as the context holds: no larger frame asks again */
         sy_gli_warn(dev, "raster: shadow_map_size %u: the GL context cannot hold %d maps of that size; using %u", asked,
              SY_GL_MAX_SHADOW_MAPS, dev->shadow_size);
+    }
     return SY_GL_OK;
+}
+
+/* shadow_map_size 0: the maps' side for a w x h frame (see SHADOW_SIZE_AUTO_MIN); a larger one than
+ * the maps have frees them, so that the next shadowed frame makes and draws them again. */
+void sy_gli_shadow_size_follow(sy_gl_device *dev, uint32_t w, uint32_t h)
+{
+    if (!dev->shadow_auto) return;
+    uint32_t side = w > h ? w : h, s = SHADOW_SIZE_AUTO_MIN;
+    while (s < 2u * side && s < SHADOW_SIZE_DEFAULT) s *= 2u;
+    if (s > dev->max_tex) s = dev->max_tex;
+    if (s <= dev->shadow_size) return;
+    const sy_gl_fns *gl = dev->gl;
+    if (dev->shadow_tex) gl->DeleteTextures(1, &dev->shadow_tex);
+    dev->shadow_tex = 0;
+    for (uint32_t c = 0; c < SY_GL_MAX_CUBE_SHADOWS; ++c)
+        if (dev->cube_tex[c]) gl->DeleteTextures(1, &dev->cube_tex[c]);
+    memset(dev->cube_tex, 0, sizeof dev->cube_tex);
+    dev->shadow_size = s;
+    dev->cube_size = s / 2u > 16u ? s / 2u : 16u;
+    dev->lights_dirty = true;
 }
 
 void sy_gli_render_shadows(sy_gl_device *dev, const frame_state *fs)

@@ -741,7 +741,8 @@ static void log_warning(void *user, const char *msg)
 static const sy_param_decl raster_params[] = {
     {"gl", SY_PARAM_ENUM, 0, 0, "osmesa", "osmesa|egl|glfw", "OpenGL context provider (glfw: a window)", 0},
     {"msaa", SY_PARAM_INT, 1, 32, "4", NULL, "multisample anti-aliasing samples (clamped to the context's limit)", 0},
-    {"shadow_map_size", SY_PARAM_INT, 16, 16384, "2048", NULL, "shadow map resolution (texels per side)", 0},
+    {"shadow_map_size", SY_PARAM_INT, 0, 16384, "0", NULL,
+     "shadow map resolution, texels per side (16..16384; 0: follows the frame, twice its larger side, 256 to 2048)", 0},
     {"max_texture_size", SY_PARAM_INT, 0, 1 << 20, "0", NULL, "largest texture side; larger are downscaled (0 = the GL limit)",
      0},
     {"window_width", SY_PARAM_INT, 1, 16384, "640", NULL, "gl=glfw: window width", 0},
@@ -757,7 +758,7 @@ static const sy_param_table raster_table = SY_PARAM_TABLE(raster_params);
 static sy_result raster_create(const sy_mediator_create_args *args, void **state_out, sy_error *err)
 {
     *state_out = NULL;
-    long msaa = 4, shadow = 2048, max_tex = 0, ww = 640, wh = 480;
+    long msaa = 4, shadow = 0, max_tex = 0, ww = 640, wh = 480;
     double lod = SY_GL_LOD_PIXELS_DEFAULT;
     bool indirect = true, deferred = true;
     sy_result r;
@@ -773,6 +774,9 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
         (r = sy_param_bool(t, args->params, "deferred", &deferred, err)) ||
         (r = sy_param_float(t, args->params, "lod", &lod, err)))
         return r;
+    if (shadow > 0 && shadow < 16)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "raster: parameter shadow_map_size=%ld: expected 0 (follow the frame) or 16..16384", shadow);
     if (!sy_gl_provider_parse(gl, &provider)) /* the table's enum lists the same names */
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "raster: parameter gl=%s: expected osmesa, egl or glfw", gl);
     raster_state *st = calloc(1, sizeof *st);

@@ -11,7 +11,8 @@
  *
  * Parameters (sy_params; declared in the class's param_table, the authority that core checks and
  * `sy backends --params` prints): gl = osmesa (default) | egl | glfw, msaa (1..32, default 4; clamped to
- * the context's limit with a warning), shadow_map_size (16..16384, default 2048), max_texture_size
+ * the context's limit with a warning), shadow_map_size (16..16384; default 0: follows the frame, the power of two
+ * at or above twice its larger side, 256 to 2048), max_texture_size
  * (0 = the GL limit; larger textures are downscaled with a warning), window_width/window_height
  * (GLFW window, default 640 x 480). Warnings go to sy_log (module "raster", sy_log.h).
  *

@@ -1,8 +1,8 @@
 /* test_raster_lod.c — levels of detail and view culling in the rasterizer (sy_gl_set_lod): a sphere
  * of 130k triangles drawn far away uses a simplified level (a small fraction of its triangles)
  * while its silhouette and depth stay those of the full mesh; near the camera it draws more; an
- * instance behind the camera is culled and draws nothing; with levels off every triangle is
- * drawn; a mesh under SY_GL_LOD_MIN_TRIANGLES has no levels. OSMesa. */
+ * instance behind the camera is culled and draws nothing; a mirror's scene probe draws levels
+ * too; with levels off every triangle is drawn; a mesh under SY_GL_LOD_MIN_TRIANGLES has no levels. OSMesa. */
 #include "sy_gl.h"
 
 #include <math.h>
@@ -89,6 +89,32 @@ int main(void)
                (unsigned long long)drawn_at[0], tris);
     EXPECT_MSG(drawn_at[1] > drawn_at[0], "near (%llu triangles) must draw more than far (%llu)",
                (unsigned long long)drawn_at[1], (unsigned long long)drawn_at[0]);
+
+    /* A mirror beside it: its scene probe's faces draw the levels their size calls for too (a
+     * 16-texel face sees the sphere a pixel across), not the whole mesh (issue 32: every probe face
+     * drew every mesh whole, 10^6 triangles per face for MetalRoughSpheresNoTextures). */
+    {
+        uint32_t mtris = 0;
+        sy_gl_mesh msh = gl_test_sphere(d, 32, 0.0f, true, &mtris);
+        sy_gl_material_desc mm;
+        sy_gl_material_desc_init(&mm);
+        mm.metallic = 1.0f, mm.roughness = 0.0f;
+        sy_gl_material mirror;
+        MUST(sy_gl_material_create(d, &mm, &mirror, e, sizeof e));
+        sy_gl_instance_desc md = {.mesh = msh, .material = mirror};
+        translate(md.transform, 4.0f, 0, 0); /* a quarter-size mirror 4 m beside the sphere */
+        md.transform[0] = md.transform[5] = md.transform[10] = 0.25f;
+        sy_gl_instance mi;
+        MUST(sy_gl_instance_create(d, &md, &mi, e, sizeof e));
+        sy_gl_set_lod(d, SY_GL_LOD_PIXELS_DEFAULT);
+        uint64_t with_probe = draw(d, dists[0], 0, NULL);
+        printf("far, with a mirror's probe: %llu triangles drawn (the sphere far: %llu, the mirror: %u)\n",
+               (unsigned long long)with_probe, (unsigned long long)drawn_at[0], mtris);
+        EXPECT_MSG(with_probe <= 8 * drawn_at[0] + mtris,
+                   "with a mirror's probe: %llu triangles drawn (want at most 8 x %llu + %u: each face a level)",
+                   (unsigned long long)with_probe, (unsigned long long)drawn_at[0], mtris);
+        MUST(sy_gl_instance_destroy(d, mi));
+    }
 
     /* Behind the camera: culled, nothing drawn. */
     sy_gl_set_lod(d, SY_GL_LOD_PIXELS_DEFAULT);
