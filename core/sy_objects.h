@@ -266,7 +266,8 @@ typedef enum sy_wrap { SY_WRAP_REPEAT = 0, SY_WRAP_CLAMP = 1, SY_WRAP_MIRROR = 2
 /** Texture filters (glTF sampler). */
 typedef enum sy_filter { SY_FILTER_LINEAR = 0, SY_FILTER_NEAREST = 1 } sy_filter;
 
-/** Size and layout of a texture's pixels. */
+/** Size and layout of a texture's pixels: all zero = no image yet; an image with a size has 1 to 4
+ * channels and one of the formats (the setters refuse others). */
 typedef struct sy_image_info {
     /** @{ size in pixels */
     uint32_t width, height; /** @} */
@@ -337,7 +338,7 @@ enum sy_camera_field {
     SY_CAMERA_YFOV = 2,       /**< float radians (perspective) */
     SY_CAMERA_ASPECT = 3,     /**< float width/height; 0 = from the image */
     SY_CAMERA_ZNEAR = 4,      /**< float */
-    SY_CAMERA_ZFAR = 5,       /**< float; 0 = infinite */
+    SY_CAMERA_ZFAR = 5,       /**< float; 0 = infinite, else > znear */
     SY_CAMERA_XMAG = 6,       /**< float half width (orthographic) */
     SY_CAMERA_YMAG = 7,       /**< float half height (orthographic) */
     SY_CAMERA_FIELD_COUNT = 8
@@ -350,7 +351,7 @@ typedef struct sy_camera_data {
     float yfov; /**< vertical field of view, radians (perspective) */
     float aspect; /**< width / height; 0 = from the image */
     float znear; /**< near plane distance */
-    float zfar; /**< far plane distance; 0 = infinite */
+    float zfar; /**< far plane distance; 0 = infinite, else beyond znear (a setter refuses zfar <= znear) */
     float xmag; /**< half width (orthographic) */
     float ymag; /**< half height (orthographic) */
 } sy_camera_data;

@@ -142,8 +142,10 @@ static void mesh_bounds_update(sy_scene *s, slot *sl)
     for (uint32_t i = 0; i < sl->user_count; ++i) sy_sc_mark_bounds_dirty(s, sl->users[i]);
 }
 
-sy_result sy_object_set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32_t field, const void *value,
-                              sy_error *err)
+/* Sets one field. whole_checked: the caller checks the rules between fields on the whole object
+ * (set_all, a replica's entry); otherwise they are checked here on the object with this field set. */
+static sy_result set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32_t field, const void *value,
+                           bool whole_checked, sy_error *err)
 {
     slot *sl = sy_sc_lookup(s, t, id);
     if (!sl) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "set: stale or invalid %s handle %#x", sy_object_type_name(t), id);
@@ -175,6 +177,11 @@ sy_result sy_object_set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32
     if (sy__field_equal(t, field, sl->data, src)) return SY_OK;
     sy_result r = sy_sc_validate_field(s, t, id, field, value, err);
     if (r != SY_OK) return r;
+    if (!whole_checked && t == SY_TYPE_CAMERA) { /* the one type with rules between fields */
+        sy_camera_data merged = *(const sy_camera_data *)sl->data;
+        memcpy((unsigned char *)&merged + fd->offset, value, fd->size);
+        if ((r = sy_sc_validate_object(t, id, &merged, err)) != SY_OK) return r;
+    }
 
     sy_blob *old_children = NULL;
     uint32_t old_mesh = 0;
@@ -205,6 +212,12 @@ sy_result sy_object_set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32
     }
     sy_blob_release(old_children);
     return SY_OK;
+}
+
+sy_result sy_object_set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32_t field, const void *value,
+                              sy_error *err)
+{
+    return set_field(s, t, id, field, value, s->applying, err); /* a replica checks each entry whole */
 }
 
 sy_result sy_object_destroy(sy_scene *s, sy_object_type t, uint32_t id, sy_error *err)
@@ -332,8 +345,10 @@ static sy_result set_all(sy_scene *s, uint32_t t, uint32_t id, const void *d, sy
         sy_result r = sy_sc_validate_field(s, t, id, f, (const char *)d + td->fields[f].offset, err);
         if (r != SY_OK) return r;
     }
+    sy_result r = sy_sc_validate_object(t, id, d, err);
+    if (r != SY_OK) return r;
     for (uint32_t f = 0; f < td->field_count; ++f) {
-        sy_result r = sy_object_set_field(s, t, id, f, (const char *)d + td->fields[f].offset, err);
+        r = set_field(s, t, id, f, (const char *)d + td->fields[f].offset, true, err);
         if (r != SY_OK) return r;
     }
     return SY_OK;

@@ -245,6 +245,15 @@ sy_result sy_sc_validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_t
             if (in->channels > 4 || in->format > SY_PIXEL_F32)
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "texture: %u channels, format %u", in->channels,
                                     in->format);
+            /* an image with a size: every back-end refuses 0 channels, and no mediator can read pixels
+             * of an unknown format (all zero = no image yet, the default) */
+            if (in->width && in->height && in->channels == 0)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "texture %#x: a %ux%u image with 0 channels (1 to 4)",
+                                    id, in->width, in->height);
+            if (in->width && in->height && in->format == 0)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "texture %#x: a %ux%u image without a pixel format (SY_PIXEL_U8_SRGB, _U8_LINEAR or _F32)",
+                                    id, in->width, in->height);
         } else if (f == SY_TEXTURE_SAMPLER) {
             const sy_sampler *sm = v;
             if (sm->wrap_s > SY_WRAP_MIRROR || sm->wrap_t > SY_WRAP_MIRROR || sm->min_filter > SY_FILTER_NEAREST ||
@@ -311,4 +320,19 @@ sy_result sy_sc_validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_t
         return SY_OK;
     default: return SY_OK;
     }
+}
+
+/* Rules between fields of one object, checked on the object as a change leaves it (after every field
+ * of a whole set or of a replica's entry, so the order fields are set in does not matter). */
+sy_result sy_sc_validate_object(uint32_t type, uint32_t id, const void *data, sy_error *err)
+{
+    if (type == SY_TYPE_CAMERA) {
+        const sy_camera_data *c = data;
+        /* every back-end refuses to render a clip range whose far plane is not beyond its near one */
+        if (c->zfar != 0.0f && !(c->zfar > c->znear))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "camera %#x: zfar %g is not beyond znear %g (zfar is 0 = infinite, or > znear)", id,
+                                (double)c->zfar, (double)c->znear);
+    }
+    return SY_OK;
 }

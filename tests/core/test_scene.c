@@ -814,6 +814,83 @@ static int test_dag(void)
     return 0;
 }
 
+/* Values every back-end refuses (or misreads) are refused by the core setters, naming the object,
+ * the field and the reason (issue 33, item 8). */
+static int test_camera_clip_range(void)
+{
+    sy_error e = {0};
+    sy_scene *s;
+    CHECK_OK(sy_scene_create(&s, &e), e);
+    uint32_t con;
+    CHECK_OK(sy_scene_consumer_add(s, &con, &e), e);
+    sy_camera cam;
+    CHECK_OK(sy_camera_create(s, "c", &cam, &e), e);
+    sy_camera_data cd = *sy_camera_get(s, cam);
+    /* zfar at or in front of znear: every back-end refuses the render (raster and rt: "clip range") */
+    cd.znear = 1.0f, cd.zfar = 0.5f;
+    EXPECT_ERR(sy_camera_set(s, cam, &cd, &e), SY_ERR_INVALID_ARGUMENT, e);
+    EXPECT_SAYS(e, "zfar");
+    cd.zfar = 1.0f;
+    EXPECT_ERR(sy_camera_set(s, cam, &cd, &e), SY_ERR_INVALID_ARGUMENT, e);
+    EXPECT(sy_camera_get(s, cam)->znear == 0.01f && sy_camera_get(s, cam)->zfar == 0.0f); /* unchanged */
+    cd.zfar = 0.0f; /* 0 = infinite: any znear */
+    CHECK_OK(sy_camera_set(s, cam, &cd, &e), e);
+    cd.zfar = 2.0f;
+    CHECK_OK(sy_camera_set(s, cam, &cd, &e), e);
+    /* one field at a time: checked against the other as it is */
+    float far_in_front = 0.5f, near_behind = 3.0f, ok = 1.5f;
+    EXPECT_ERR(sy_object_set_field(s, SY_TYPE_CAMERA, cam.id, SY_CAMERA_ZFAR, &far_in_front, &e), SY_ERR_INVALID_ARGUMENT, e);
+    EXPECT_SAYS(e, "camera");
+    EXPECT_ERR(sy_object_set_field(s, SY_TYPE_CAMERA, cam.id, SY_CAMERA_ZNEAR, &near_behind, &e), SY_ERR_INVALID_ARGUMENT, e);
+    CHECK_OK(sy_object_set_field(s, SY_TYPE_CAMERA, cam.id, SY_CAMERA_ZNEAR, &ok, &e), e);
+    /* a whole set moving both planes past each other is checked as a whole, not field by field */
+    cd = *sy_camera_get(s, cam);
+    cd.znear = 10.0f, cd.zfar = 100.0f;
+    CHECK_OK(sy_camera_set(s, cam, &cd, &e), e);
+    /* and a replica applies it the same way */
+    sy_scene *rep;
+    CHECK_OK(sy_scene_create(&rep, &e), e);
+    sy_changes *c = commit_pull(s, con);
+    CHECK(c != NULL);
+    CHECK_OK(sy_scene_apply(rep, c, &e), e);
+    sy_changes_release(c);
+    cd.znear = 200.0f, cd.zfar = 300.0f; /* the replica sets znear first: 200 is past the old zfar */
+    CHECK_OK(sy_camera_set(s, cam, &cd, &e), e);
+    c = commit_pull(s, con);
+    CHECK(c != NULL);
+    CHECK_OK(sy_scene_apply(rep, c, &e), e);
+    sy_changes_release(c);
+    CHECK(sy_camera_get(rep, cam)->znear == 200.0f && sy_camera_get(rep, cam)->zfar == 300.0f);
+    sy_scene_destroy(rep);
+    sy_scene_destroy(s);
+    return 0;
+}
+
+static int test_texture_info_validation(void)
+{
+    sy_error e = {0};
+    sy_scene *s;
+    CHECK_OK(sy_scene_create(&s, &e), e);
+    sy_texture tex;
+    CHECK_OK(sy_texture_create(s, "t", &tex, &e), e);
+    /* an image with a size needs 1..4 channels (every back-end refuses 0) and a known pixel format
+     * (format 0 was read as float by the mediators, past the end of the pixels) */
+    sy_image_info info = {2, 2, 0, SY_PIXEL_U8_SRGB};
+    EXPECT_ERR(sy_object_set_field(s, SY_TYPE_TEXTURE, tex.id, SY_TEXTURE_INFO, &info, &e), SY_ERR_INVALID_ARGUMENT, e);
+    EXPECT_SAYS(e, "channels");
+    info.channels = 4;
+    info.format = 0;
+    EXPECT_ERR(sy_object_set_field(s, SY_TYPE_TEXTURE, tex.id, SY_TEXTURE_INFO, &info, &e), SY_ERR_INVALID_ARGUMENT, e);
+    EXPECT_SAYS(e, "format");
+    info.format = SY_PIXEL_U8_LINEAR;
+    CHECK_OK(sy_object_set_field(s, SY_TYPE_TEXTURE, tex.id, SY_TEXTURE_INFO, &info, &e), e);
+    /* no image (the default, all zero) stays legal */
+    sy_image_info none = {0, 0, 0, 0};
+    CHECK_OK(sy_object_set_field(s, SY_TYPE_TEXTURE, tex.id, SY_TEXTURE_INFO, &none, &e), e);
+    sy_scene_destroy(s);
+    return 0;
+}
+
 /* ------------------------------------------------------------------ attachments */
 static int test_attachments(void)
 {
@@ -922,6 +999,8 @@ int main(void)
     RUN(test_handles);
     RUN(test_dirty_noop);
     RUN(test_validation);
+    RUN(test_camera_clip_range);
+    RUN(test_texture_info_validation);
     RUN(test_children_validation);
     RUN(test_world_chain);
     RUN(test_world_incremental);
