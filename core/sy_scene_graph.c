@@ -74,7 +74,9 @@ void sy_sc_update_world(sy_scene *s)
             const sy_node_data *d = sl->data;
             uint32_t pp = primary_parent(s, nx);
             node_extra *pnx = pp ? sy_sc_nx_of(s, pp) : NULL;
-            nx->world = pnx ? sy_mat4_mul(&pnx->world, &d->transform.matrix) : d->transform.matrix;
+            sy_placement above = {.visible = true};
+            if (pnx) above.world = pnx->world;
+            nx->world = sy_placement_child(pnx ? &above : NULL, &d->transform.matrix, d->flags).world;
             nx->world_dirty = 0;
             updates++;
             uint32_t nc;
@@ -234,6 +236,77 @@ int sy_sc_cmp_u32(const void *a, const void *b)
 {
     uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
     return (x > y) - (x < y);
+}
+
+/* >>world walk (sy_graph.h): the one rule placing a node under its parent */
+sy_placement sy_placement_child(const sy_placement *parent, const sy_mat4 *local, uint32_t flags)
+{
+    bool own = (flags & SY_NODE_VISIBLE) != 0;
+    if (!parent) return (sy_placement){.world = *local, .visible = own};
+    return (sy_placement){.world = sy_mat4_mul(&parent->world, local), .visible = parent->visible && own};
+}
+
+/* Reports one node (reached under `above`, NULL for a path's start) to fn; *place receives its
+ * placement and *enter whether its children come next. */
+static sy_result walk_visit(const sy_scene *s, uint32_t id, const sy_placement *above, uint32_t depth, uint32_t flags,
+                            sy_walk_fn fn, void *user, sy_placement *place, bool *enter, sy_error *err)
+{
+    *enter = false;
+    sy_walk_step st = {.node = {id}, .data = sy_object_get(s, SY_TYPE_NODE, id), .depth = depth};
+    if (st.data) {
+        st.place = sy_placement_child(above, &st.data->transform.matrix, st.data->flags);
+        if ((flags & SY_WALK_VISIBLE_ONLY) && !st.place.visible) return SY_OK;
+    }
+    sy_result r = fn(user, &st, err);
+    *place = st.place;
+    *enter = r == SY_OK && st.data != NULL;
+    return r;
+}
+
+sy_result sy_scene_walk(const sy_scene *s, sy_node root, const sy_placement *above, uint32_t flags, sy_walk_fn fn,
+                        void *user, sy_error *err)
+{
+    typedef struct frame {
+        sy_placement place;
+        uint32_t id, depth, next; /* next: the next child to visit */
+    } frame;
+    frame *st = NULL;
+    uint32_t depth = 0, cap = 0, id = root.id, level = 0;
+    const sy_placement *parent = above;
+    sy_result r;
+    for (;;) {
+        sy_placement place;
+        bool enter;
+        r = walk_visit(s, id, parent, level, flags, fn, user, &place, &enter, err);
+        if (r != SY_OK) break;
+        if (enter) { /* its children come next */
+            if (depth == cap) {
+                uint32_t nc = cap ? cap * 2u : 32u;
+                frame *ns = realloc(st, sizeof *ns * nc);
+                if (!ns) {
+                    r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "scene walk: out of memory");
+                    break;
+                }
+                st = ns, cap = nc;
+            }
+            st[depth++] = (frame){.place = place, .id = id, .depth = level, .next = 0};
+        }
+        /* the next node: the next child of the deepest node that has one left */
+        bool found = false;
+        while (depth && !found) {
+            frame *f = &st[depth - 1];
+            uint32_t nc;
+            const uint32_t *ch = sy_node_children(sy_object_get(s, SY_TYPE_NODE, f->id), &nc);
+            if (f->next < nc) {
+                id = ch[f->next++], parent = &f->place, level = f->depth + 1u, found = true;
+            } else {
+                depth--;
+            }
+        }
+        if (!found) break;
+    }
+    free(st);
+    return r;
 }
 
 /* >>graph queries */

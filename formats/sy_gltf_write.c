@@ -11,38 +11,29 @@
 
 /* >>placements */
 typedef struct collector {
-    const sy_scene *s;
     sy_gltf_placement *items;
     uint32_t count, cap;
-    sy_error *err;
 } collector;
 
-static sy_result collect(collector *c, uint32_t node_id, const sy_mat4 *parent, uint32_t depth)
+/* One node of the walk (sy_scene_walk, visible nodes only): its mesh at its world matrix. */
+static sy_result collect(void *user, const sy_walk_step *st, sy_error *err)
 {
-    sy_node n = {node_id};
-    const sy_node_data *d = sy_node_get(c->s, n);
-    if (!d) return sy_error_set(c->err, SY_ERR_INVALID_HANDLE, "placements: node %u is stale", node_id);
-    if (!(d->flags & SY_NODE_VISIBLE)) return SY_OK;
-    if (depth >= SY_GLTF_MAX_DEPTH)
-        return sy_error_set(c->err, SY_ERR_LIMIT, "placements: node %u lies deeper than %u levels", node_id, SY_GLTF_MAX_DEPTH);
-    sy_mat4 world = sy_mat4_mul(parent, &d->transform.matrix);
-    if (d->mesh.id) {
-        if (c->count == SY_GLTF_MAX_PLACEMENTS)
-            return sy_error_set(c->err, SY_ERR_LIMIT, "placements: more than %u mesh placements", SY_GLTF_MAX_PLACEMENTS);
-        if (c->count == c->cap) {
-            uint32_t nc = c->cap ? c->cap * 2 : 64;
-            sy_gltf_placement *ni = realloc(c->items, sizeof *ni * nc);
-            if (!ni) return sy_error_set(c->err, SY_ERR_OUT_OF_MEMORY, "placements: out of memory");
-            c->items = ni, c->cap = nc;
-        }
-        c->items[c->count++] = (sy_gltf_placement){.node_id = node_id, .mesh = d->mesh, .world = world, .id = node_id};
+    collector *c = user;
+    if (!st->data) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "placements: node %u is stale", st->node.id);
+    if (st->depth >= SY_GLTF_MAX_DEPTH)
+        return sy_error_set(err, SY_ERR_LIMIT, "placements: node %u lies deeper than %u levels", st->node.id,
+                            SY_GLTF_MAX_DEPTH);
+    if (!st->data->mesh.id) return SY_OK;
+    if (c->count == SY_GLTF_MAX_PLACEMENTS)
+        return sy_error_set(err, SY_ERR_LIMIT, "placements: more than %u mesh placements", SY_GLTF_MAX_PLACEMENTS);
+    if (c->count == c->cap) {
+        uint32_t nc = c->cap ? c->cap * 2 : 64;
+        sy_gltf_placement *ni = realloc(c->items, sizeof *ni * nc);
+        if (!ni) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "placements: out of memory");
+        c->items = ni, c->cap = nc;
     }
-    uint32_t nk = 0;
-    const uint32_t *kids = sy_node_children(d, &nk);
-    for (uint32_t i = 0; i < nk; ++i) {
-        sy_result r = collect(c, kids[i], &world, depth + 1);
-        if (r != SY_OK) return r;
-    }
+    c->items[c->count++] =
+        (sy_gltf_placement){.node_id = st->node.id, .mesh = st->data->mesh, .world = st->place.world, .id = st->node.id};
     return SY_OK;
 }
 
@@ -51,9 +42,10 @@ sy_result sy_gltf_placements_collect(const sy_scene *s, sy_node root, sy_gltf_pl
 {
     *placements_out = NULL;
     *count_out = 0;
-    collector c = {.s = s, .err = err};
-    sy_mat4 id = sy_mat4_identity();
-    sy_result r = collect(&c, root.id, &id, 0);
+    collector c = {0};
+    /* under an identity (as before the walk existed: the root's world is identity x its matrix) */
+    sy_placement top = {.world = sy_mat4_identity(), .visible = true};
+    sy_result r = sy_scene_walk(s, root, &top, SY_WALK_VISIBLE_ONLY, collect, &c, err);
     if (r != SY_OK) {
         free(c.items);
         return r;

@@ -44,7 +44,8 @@ typedef struct sy_gltf_write_options {
 
 /** Every visible placement of a mesh under root (root included), depth first in child order: a node
  * is visible when it and all its ancestors on the path have SY_NODE_VISIBLE; a node reached along k
- * paths gives k placements; world = product of the local matrices from root (root's own included).
+ * paths gives k placements; world = product of the local matrices from root (root's own included:
+ * sy_scene_walk, sy_graph.h, under an identity).
  * id = the node's id. SY_ERR_INVALID_HANDLE for a stale root, SY_ERR_LIMIT past the limits above. */
 sy_result sy_gltf_placements_collect(const sy_scene *s, sy_node root, sy_gltf_placement **placements_out,
                                      uint32_t *count_out, sy_error *err);

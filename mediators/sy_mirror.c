@@ -51,8 +51,7 @@ typedef struct light_m {
 } light_m;
 
 typedef struct placement {
-    sy_mat4 world;
-    bool visible;
+    sy_placement place; /* world matrix and visibility along this path (sy_placement_child, sy_graph.h) */
     uint32_t *inst; /* one per primitive of the node's mesh */
     uint32_t inst_count;
     uint32_t light;
@@ -297,18 +296,18 @@ static sy_result default_material(sy_mirror *st, uint32_t *handle, sy_error *err
  * placement keeps its place in the graph and comes back when the transform does. */
 static bool placement_drawable(sy_mirror *st, const node_m *n, const placement *p, const mesh_m *m)
 {
-    if (sy_mat4_is_degenerate(&p->world)) return false; /* hidden, as the file meant */
-    bool in_range = sy_coords_in_range(&p->world.m[12], 3);
+    if (sy_mat4_is_degenerate(&p->place.world)) return false; /* hidden, as the file meant */
+    bool in_range = sy_coords_in_range(&p->place.world.m[12], 3);
     if (in_range && m && !sy_bounds_is_empty(&m->bounds)) {
-        sy_bounds wb = sy_bounds_transform(&m->bounds, &p->world);
+        sy_bounds wb = sy_bounds_transform(&m->bounds, &p->place.world);
         in_range = sy_coords_in_range(wb.min, 3) && sy_coords_in_range(wb.max, 3);
     }
     if (!in_range) {
         char item[32];
         snprintf(item, sizeof item, "node %#x", n->id);
         sy_log(SY_LOG_WARNING, st->name, item,
-               "placed beyond the coordinate range (origin at %g %g %g; at most %g): not drawn", (double)p->world.m[12],
-               (double)p->world.m[13], (double)p->world.m[14], (double)SY_COORD_MAX);
+               "placed beyond the coordinate range (origin at %g %g %g; at most %g): not drawn", (double)p->place.world.m[12],
+               (double)p->place.world.m[13], (double)p->place.world.m[14], (double)SY_COORD_MAX);
     }
     return in_range;
 }
@@ -325,7 +324,7 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
         return SY_OK;
     }
     uint32_t want = m ? m->prim_count : 0;
-    bool visible = p->visible && (n->flags & SY_NODE_VISIBLE);
+    bool visible = p->place.visible;
     if (mesh_changed || want != p->inst_count) {
         drop_instances(st, p);
         if (want) {
@@ -339,7 +338,7 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
                 uint32_t mh = mm ? mm->handle : 0u;
                 sy_result r = mh ? SY_OK : default_material(st, &mh, err);
                 if (r != SY_OK) return r;
-                sy_mirror_instance_args a = {n->id, index, m->prims[i].handle, mh, &p->world, visible, bake, &p->inst[i]};
+                sy_mirror_instance_args a = {n->id, index, m->prims[i].handle, mh, &p->place.world, visible, bake, &p->inst[i]};
                 r = st->cb->instance_set(st->user, &a, err);
                 if (r != SY_OK) return r;
             }
@@ -347,7 +346,7 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
     } else {
         for (uint32_t i = 0; i < p->inst_count; ++i) {
             if (!p->inst[i]) continue;
-            sy_mirror_instance_args a = {n->id, index, 0, 0, &p->world, visible, false, &p->inst[i]};
+            sy_mirror_instance_args a = {n->id, index, 0, 0, &p->place.world, visible, false, &p->inst[i]};
             sy_result r = st->cb->instance_set(st->user, &a, err);
             if (r != SY_OK) return r;
         }
@@ -358,8 +357,8 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
         if (ld.type == SY_LIGHT_SPOT && ld.inner_cone >= ld.outer_cone) ld.inner_cone = ld.outer_cone * 0.999f;
         sy_mirror_light_args a = {.node = n->id, .placement = index, .light = &ld, .handle = &p->light};
         float o[3] = {0, 0, 0}, z[3] = {0, 0, -1};
-        sy_mat4_transform_point(&p->world, o, a.position);
-        sy_mat4_transform_dir(&p->world, z, a.direction);
+        sy_mat4_transform_point(&p->place.world, o, a.position);
+        sy_mat4_transform_dir(&p->place.world, z, a.direction);
         bool had = p->light != 0;
         sy_result r = st->cb->light_set(st->user, &a, err);
         if (!had && p->light) st->light_placements++;
@@ -468,16 +467,13 @@ static sy_result replace_dirty(sy_mirror *st, sy_error *err)
         }
         uint32_t k = 0;
         if (is_root) {
-            n->pl[0].world = n->local;
-            n->pl[0].visible = true;
+            n->pl[0].place = sy_placement_child(NULL, &n->local, n->flags);
         } else {
             for (uint32_t i = 0; i < n->parent_count; ++i) {
                 node_m *pn = LOOKUP(st, node, node_cap, n->parents[i]);
                 if (!pn) continue;
-                for (uint32_t j = 0; j < pn->pl_count; ++j, ++k) {
-                    n->pl[k].world = sy_mat4_mul(&pn->pl[j].world, &n->local);
-                    n->pl[k].visible = pn->pl[j].visible && (pn->flags & SY_NODE_VISIBLE);
-                }
+                for (uint32_t j = 0; j < pn->pl_count; ++j, ++k)
+                    n->pl[k].place = sy_placement_child(&pn->pl[j].place, &n->local, n->flags);
             }
         }
         for (uint32_t i = 0; i < n->pl_count && r == SY_OK; ++i) r = placement_sync(st, n, i, false, err);

@@ -22,6 +22,7 @@
 #include "sy_log.h"
 #include "sy_look.h"
 #include "sy_mirror.h"
+#include "sy_post.h"
 
 #include <stdio.h>
 #include <math.h>
@@ -250,7 +251,7 @@ static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_erro
             if (d.format == SY_GL_TEXEL_FLOAT32) v = ((const float *)d.pixels)[i * ch + k];
             else {
                 v = ((const unsigned char *)d.pixels)[i * ch + k] / 255.0f;
-                if (d.format == SY_GL_TEXEL_UNORM8_SRGB) v = v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
+                if (d.format == SY_GL_TEXEL_UNORM8_SRGB) v = sy_srgb_decode(v);
             }
             if (isfinite(v)) sum[c] += v;
         }

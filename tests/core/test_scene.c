@@ -814,6 +814,93 @@ static int test_dag(void)
     return 0;
 }
 
+/* The world-matrix walk (sy_scene_walk): every path, depth first in child order, placements by
+ * sy_placement_child, invisible subtrees skipped on request, stale children reported. */
+typedef struct walk_log {
+    uint32_t n, ids[16], depth[16];
+    sy_placement place[16];
+    bool stale[16];
+} walk_log;
+
+static sy_result walk_record(void *user, const sy_walk_step *st, sy_error *err)
+{
+    walk_log *w = user;
+    if (w->n == 16) return sy_error_set(err, SY_ERR_LIMIT, "walk_record: too many");
+    w->ids[w->n] = st->node.id, w->depth[w->n] = st->depth, w->stale[w->n] = st->data == NULL;
+    if (st->data) w->place[w->n] = st->place;
+    w->n++;
+    return SY_OK;
+}
+
+static int test_walk(void)
+{
+    sy_error e = {0};
+    sy_scene *s;
+    CHECK_OK(sy_scene_create(&s, &e), e);
+    sy_node top, p1, p2, shared, gone;
+    CHECK_OK(sy_node_create(s, "top", &top, &e), e);
+    CHECK_OK(sy_node_create(s, "p1", &p1, &e), e);
+    CHECK_OK(sy_node_create(s, "p2", &p2, &e), e);
+    CHECK_OK(sy_node_create(s, "shared", &shared, &e), e);
+    CHECK_OK(sy_node_create(s, "gone", &gone, &e), e);
+    const float tt[3] = {0, 0, 1}, t1[3] = {10, 0, 0}, t2[3] = {-10, 0, 0}, ts[3] = {0, 5, 0}, s2[3] = {2, 2, 2};
+    CHECK_OK(sy_node_set_trs(s, top, tt, Q0, S1, &e), e);
+    CHECK_OK(sy_node_set_trs(s, p1, t1, Q0, S1, &e), e);
+    CHECK_OK(sy_node_set_trs(s, p2, t2, Q0, s2, &e), e);
+    CHECK_OK(sy_node_set_trs(s, shared, ts, Q0, S1, &e), e);
+    sy_node kids[2] = {p1, p2};
+    CHECK_OK(sy_node_set_children(s, top, kids, 2, &e), e);
+    CHECK_OK(sy_node_add_child(s, p1, shared, &e), e);
+    CHECK_OK(sy_node_add_child(s, p2, shared, &e), e);
+    CHECK_OK(sy_node_add_child(s, p2, gone, &e), e);
+    CHECK_OK(sy_object_destroy(s, SY_TYPE_NODE, gone.id, &e), e); /* p2 keeps the stale id */
+    /* no commit: the walk reads the current fields */
+    walk_log w = {0};
+    CHECK_OK(sy_scene_walk(s, top, NULL, 0, walk_record, &w, &e), e);
+    const uint32_t order[6] = {top.id, p1.id, shared.id, p2.id, shared.id, gone.id}, depth[6] = {0, 1, 2, 1, 2, 2};
+    CHECK_MSG(w.n == 6, "%u steps", w.n);
+    for (uint32_t i = 0; i < 6; ++i) EXPECT_MSG(w.ids[i] == order[i] && w.depth[i] == depth[i], "step %u", i);
+    CHECK(w.stale[5] && !w.stale[4]);
+    /* shared under p1: (0,5,0) + (10,0,0) + (0,0,1); under p2: 2 x (0,5,0) + (-10,0,0) + (0,0,1) */
+    EXPECT(w.place[2].world.m[12] == 10 && w.place[2].world.m[13] == 5 && w.place[2].world.m[14] == 1);
+    EXPECT(w.place[4].world.m[12] == -10 && w.place[4].world.m[13] == 10 && w.place[4].world.m[14] == 1);
+    EXPECT(w.place[4].world.m[0] == 2 && w.place[4].visible);
+    /* the rule itself: a path's start is its own local matrix; a child multiplies in */
+    sy_mat4 l = sy_node_get(s, p2)->transform.matrix;
+    sy_placement a = sy_placement_child(NULL, &l, SY_NODE_VISIBLE), b = sy_placement_child(&a, &l, 0);
+    EXPECT(sy_mat4_equal(&a.world, &l) && a.visible && !b.visible && b.world.m[12] == -30);
+    /* invisible p1: its subtree is skipped on request, reported as not visible otherwise */
+    CHECK_OK(sy_node_set_flags(s, p1, 0, &e), e);
+    memset(&w, 0, sizeof w);
+    CHECK_OK(sy_scene_walk(s, top, NULL, SY_WALK_VISIBLE_ONLY, walk_record, &w, &e), e);
+    CHECK_MSG(w.n == 4 && w.ids[1] == p2.id, "%u steps", w.n);
+    memset(&w, 0, sizeof w);
+    CHECK_OK(sy_scene_walk(s, top, NULL, 0, walk_record, &w, &e), e);
+    CHECK(w.n == 6 && !w.place[1].visible && !w.place[2].visible && w.place[4].visible);
+    /* above: the placement the root hangs under */
+    sy_placement up = {.world = sy_mat4_identity(), .visible = false};
+    up.world.m[13] = 100;
+    memset(&w, 0, sizeof w);
+    CHECK_OK(sy_scene_walk(s, p2, &up, 0, walk_record, &w, &e), e);
+    CHECK(w.n == 3 && w.place[0].world.m[13] == 100 && !w.place[0].visible);
+    memset(&w, 0, sizeof w);
+    CHECK_OK(sy_scene_walk(s, p2, &up, SY_WALK_VISIBLE_ONLY, walk_record, &w, &e), e);
+    CHECK(w.n == 0);
+    /* the callback's error stops the walk; a stale root is a stale step */
+    CHECK_OK(sy_node_set_flags(s, p1, SY_NODE_VISIBLE, &e), e);
+    sy_node many[16];
+    for (int i = 0; i < 16; ++i) CHECK_OK(sy_node_create(s, "k", &many[i], &e), e);
+    CHECK_OK(sy_node_set_children(s, p1, many, 16, &e), e);
+    memset(&w, 0, sizeof w);
+    CHECK_ERR(sy_scene_walk(s, top, NULL, 0, walk_record, &w, &e), SY_ERR_LIMIT, e);
+    CHECK(w.n == 16);
+    memset(&w, 0, sizeof w);
+    CHECK_OK(sy_scene_walk(s, gone, NULL, 0, walk_record, &w, &e), e);
+    CHECK(w.n == 1 && w.stale[0]);
+    sy_scene_destroy(s);
+    return 0;
+}
+
 /* Values every back-end refuses (or misreads) are refused by the core setters, naming the object,
  * the field and the reason (issue 33, item 8). */
 static int test_camera_clip_range(void)
@@ -1006,6 +1093,7 @@ int main(void)
     RUN(test_world_incremental);
     RUN(test_bounds);
     RUN(test_dag);
+    RUN(test_walk);
     RUN(test_attachments);
     return sy_check_finish("test_scene");
 }
