@@ -173,12 +173,25 @@ static GLuint cube_tex(const sy_gl_fns *gl, uint32_t size, uint32_t levels)
     return t;
 }
 
+uint32_t sy_gl_ibl_side(uint32_t w, uint32_t h)
+{
+    uint32_t half = (w > h ? w : h) / 2u, s = SY_GL_IBL_SPEC_MIN;
+    while (s < half && s < SY_GL_IBL_SPEC_SIZE) s *= 2u;
+    return s;
+}
+
 sy_gl_result sy_gl_ibl_prefilter(const sy_gl_fns *gl, sy_gl_ibl *ibl, GLuint src, uint32_t src_w, uint32_t src_h,
-                                 float intensity, char *err, size_t err_len)
+                                 float intensity, uint32_t side, char *err, size_t err_len)
 {
     sy_gl_result r = build(gl, ibl, err, err_len);
     if (r != SY_GL_OK) return r;
-    if (!ibl->spec_cube) ibl->spec_cube = cube_tex(gl, SY_GL_IBL_SPEC_SIZE, SY_GL_IBL_SPEC_LEVELS);
+    side = side < SY_GL_IBL_SPEC_MIN ? SY_GL_IBL_SPEC_MIN : side > SY_GL_IBL_SPEC_SIZE ? SY_GL_IBL_SPEC_SIZE : side;
+    if (ibl->spec_cube && ibl->spec_side != side) {
+        gl->DeleteTextures(1, &ibl->spec_cube);
+        ibl->spec_cube = 0;
+    }
+    if (!ibl->spec_cube) ibl->spec_cube = cube_tex(gl, side, SY_GL_IBL_SPEC_LEVELS);
+    ibl->spec_side = side;
     if (!ibl->irr_cube) ibl->irr_cube = cube_tex(gl, SY_GL_IBL_IRR_SIZE, 1);
     gl->Enable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
     gl->Disable(GL_DEPTH_TEST);
@@ -192,7 +205,7 @@ sy_gl_result sy_gl_ibl_prefilter(const sy_gl_fns *gl, sy_gl_ibl *ibl, GLuint src
     const float texel_sa = 2.0f * 3.14159265f * 3.14159265f / ((float)src_w * (float)src_h);
     for (int pass = 0; pass < 2 && r == SY_GL_OK; ++pass) {
         GLuint prog = pass ? ibl->prog_irr : ibl->prog_spec, cube = pass ? ibl->irr_cube : ibl->spec_cube;
-        uint32_t levels = pass ? 1u : SY_GL_IBL_SPEC_LEVELS, size0 = pass ? SY_GL_IBL_IRR_SIZE : SY_GL_IBL_SPEC_SIZE;
+        uint32_t levels = pass ? 1u : SY_GL_IBL_SPEC_LEVELS, size0 = pass ? SY_GL_IBL_IRR_SIZE : side;
         gl->UseProgram(prog);
         gl->Uniform1i(pass ? ibl->irr_src : ibl->spec_src, 0);
         for (uint32_t l = 0; l < levels && r == SY_GL_OK; ++l) {

@@ -233,6 +233,7 @@ struct sy_gl_device {
     sy_gl_texture env_tex;
     float env_intensity;
     bool env_dirty, env_ready;
+    uint32_t env_side; /* the specular cube side the frames so far want (sy_gl_ibl_side; never shrinks) */
     sy_gl_ibl ibl;
     /* emissive polygons */
     sy_gl_area_light areas[SY_GL_MAX_AREA_LIGHTS];

@@ -179,6 +179,11 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     const sy_gl_fns *gl = dev->gl;
     dev->frame_no++;
     sy_gli_shadow_size_follow(dev, d->width, d->height);
+    uint32_t env_side = sy_gl_ibl_side(d->width, d->height);
+    if (env_side > dev->env_side) { /* a larger frame than any before: a sharper specular cube */
+        dev->env_side = env_side;
+        if (dev->env_ready) dev->env_dirty = true;
+    }
     static frame_state fs_zero;
     frame_state fs = fs_zero;
     if (dev->env_dirty) {
@@ -187,7 +192,8 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         if (et) {
             r = sy_gl_ibl_tables(gl, &dev->ibl, err, err_len);
             if (r == SY_GL_OK)
-                r = sy_gl_ibl_prefilter(gl, &dev->ibl, et->tex, et->width, et->height, dev->env_intensity, err, err_len);
+                r = sy_gl_ibl_prefilter(gl, &dev->ibl, et->tex, et->width, et->height, dev->env_intensity, dev->env_side,
+                                        err, err_len);
             if (r != SY_GL_OK) return r;
             dev->env_ready = true;
         }
