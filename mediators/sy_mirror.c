@@ -169,11 +169,18 @@ static sy_result oom(const sy_mirror *st, sy_error *err)
 }
 
 /* >>textures */
-static sy_result material_upload(sy_mirror *st, mat_m *m, sy_error *err)
+static uint32_t texture_handle_of(const void *st, uint32_t texture_id) { return sy_mirror_texture_handle(st, texture_id); }
+
+static sy_result material_set(sy_mirror *st, uint32_t id, const sy_material_data *d, uint32_t *handle, sy_error *err)
 {
-    sy_mirror_material_args a = {m->id, &m->d, &m->handle};
+    if (!st->cb->material_set) return SY_OK; /* no materials: the handle stays 0 */
+    sy_mirror_flat_material flat;
+    sy_mirror_flat_material_of(d, texture_handle_of, st, &flat);
+    sy_mirror_material_args a = {id, d, handle, &flat};
     return st->cb->material_set(st->user, &a, err);
 }
+
+static sy_result material_upload(sy_mirror *st, mat_m *m, sy_error *err) { return material_set(st, m->id, &m->d, &m->handle, err); }
 
 static bool material_uses_texture(const sy_material_data *d, uint32_t tex)
 {
@@ -191,7 +198,10 @@ static sy_result texture_upload(sy_mirror *st, tex_m *t, sy_error *err)
         !sy_size_mul((size_t)t->info.width * t->info.height, (size_t)t->info.channels * elem, &need) ||
         sy_blob_size(t->pixels) != need)
         return SY_OK; /* incomplete texture: materials render without it */
-    sy_mirror_texture_args a = {t->id, &t->info, &t->sampler, sy_blob_data(t->pixels), &t->handle};
+    if (!st->cb->texture_set) return SY_OK; /* no textures: the handle stays 0 */
+    sy_mirror_flat_texture flat;
+    sy_mirror_flat_texture_of(&t->info, &t->sampler, sy_blob_data(t->pixels), &flat);
+    sy_mirror_texture_args a = {t->id, &t->info, &t->sampler, flat.pixels, &t->handle, &flat};
     sy_result r = st->cb->texture_set(st->user, &a, err);
     if (r != SY_OK) return r;
     notify(st, SY_TYPE_TEXTURE, t->id, false);
@@ -240,7 +250,9 @@ static sy_result mesh_upload(sy_mirror *st, mesh_m *m, const sy_primitive_list *
             sy_primitive tri;
             sy_result r = sy_strokes_tessellate(p, width, what, &tri, err);
             if (r != SY_OK) return r;
-            sy_mirror_primitive_args a = {m->id, i, &tri, &m->prims[i].handle};
+            sy_mirror_flat_mesh flat;
+            sy_mirror_flat_mesh_of(&tri, &flat);
+            sy_mirror_primitive_args a = {m->id, i, &tri, &m->prims[i].handle, &flat};
             r = st->cb->primitive_set(st->user, &a, err);
             sy_primitive_release(&tri); /* back-ends copy what they keep */
             if (r != SY_OK) return r;
@@ -249,7 +261,9 @@ static sy_result mesh_upload(sy_mirror *st, mesh_m *m, const sy_primitive_list *
         if (sy_primitive_triangle_count(p) == 0) continue;
         sy_bounds b = sy_primitive_position_bounds(p);
         sy_bounds_add_bounds(&m->bounds, &b);
-        sy_mirror_primitive_args a = {m->id, i, p, &m->prims[i].handle};
+        sy_mirror_flat_mesh flat;
+        sy_mirror_flat_mesh_of(p, &flat);
+        sy_mirror_primitive_args a = {m->id, i, p, &m->prims[i].handle, &flat};
         sy_result r = st->cb->primitive_set(st->user, &a, err);
         if (r != SY_OK) return r;
     }
@@ -282,8 +296,7 @@ static sy_result default_material(sy_mirror *st, uint32_t *handle, sy_error *err
     if (!st->default_material) {
         sy_material_data d = *(const sy_material_data *)sy_object_defaults(SY_TYPE_MATERIAL);
         d.name = NULL;
-        sy_mirror_material_args a = {0, &d, &st->default_material};
-        sy_result r = st->cb->material_set(st->user, &a, err);
+        sy_result r = material_set(st, 0, &d, &st->default_material, err);
         if (r != SY_OK) return r;
     }
     *handle = st->default_material;
@@ -351,7 +364,7 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
             if (r != SY_OK) return r;
         }
     }
-    if (l && visible) {
+    if (l && visible && st->cb->light_set) {
         /* one reading of a spot cone for every back-end: inner >= outer is a hard edge */
         sy_light_data ld = l->d;
         if (ld.type == SY_LIGHT_SPOT && ld.inner_cone >= ld.outer_cone) ld.inner_cone = ld.outer_cone * 0.999f;
@@ -359,6 +372,9 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
         float o[3] = {0, 0, 0}, z[3] = {0, 0, -1};
         sy_mat4_transform_point(&p->place.world, o, a.position);
         sy_mat4_transform_dir(&p->place.world, z, a.direction);
+        sy_mirror_flat_light flat;
+        sy_mirror_flat_light_of(&ld, a.position, a.direction, &flat);
+        a.flat = &flat;
         bool had = p->light != 0;
         sy_result r = st->cb->light_set(st->user, &a, err);
         if (!had && p->light) st->light_placements++;

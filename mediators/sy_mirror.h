@@ -8,7 +8,11 @@
  * the dirty tracking that re-places only the subtrees a sync touched. It talks to the back-end only
  * through a const table of callbacks on 32-bit back-end handles (0 = none): it creates, updates and
  * releases textures, materials, mesh primitives, one instance per primitive per placement and one
- * light per visible placement of a node with a light, in the same order for every back-end.
+ * light per visible placement of a node with a light, in the same order for every back-end. Each
+ * callback gets the object's core fields and its flat description (sy_mirror_flat.h: texture
+ * handles resolved, emission, texel format, arrays and counts, light type decided once for every
+ * back-end), so a mediator only copies fields into its back-end's descriptors. A back-end without
+ * textures, materials or lights leaves those callbacks NULL.
  *
  * Ownership: the mirror owns its tables and retains texture pixel blobs; back-end objects belong
  * to the back-end and are released through the release callback (sy_mirror_destroy releases the
@@ -20,6 +24,7 @@
 
 #include "sy_look.h"
 #include "sy_mediator.h"
+#include "sy_mirror_flat.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -40,6 +45,7 @@ typedef struct sy_mirror_texture_args {
     const sy_sampler *sampler; /**< wrap and filter */
     const void *pixels; /**< the pixels (borrowed for the call) */
     uint32_t *handle; /**< out */
+    const sy_mirror_flat_texture *flat; /**< the same, flat (borrowed for the call) */
 } sy_mirror_texture_args;
 
 /** Material data (merged, name NULL): create (*handle == 0) or update the back-end material. */
@@ -47,6 +53,7 @@ typedef struct sy_mirror_material_args {
     uint32_t id; /**< core material id */
     const sy_material_data *data; /**< the material's fields */
     uint32_t *handle; /**< in/out */
+    const sy_mirror_flat_material *flat; /**< the same, flat, texture handles resolved (borrowed for the call) */
 } sy_mirror_material_args;
 
 /** One primitive of a mesh as triangles (line and point primitives arrive tessellated into tubes
@@ -57,6 +64,7 @@ typedef struct sy_mirror_primitive_args {
     uint32_t mesh_id, index; /** @} */
     const sy_primitive *primitive; /**< the primitive (borrowed for the call) */
     uint32_t *handle; /**< out */
+    const sy_mirror_flat_mesh *flat; /**< its arrays and counts (borrowed for the call) */
 } sy_mirror_primitive_args;
 
 /** One instance of one placement: *handle == 0: create it from mesh/material/world/flags;
@@ -80,6 +88,7 @@ typedef struct sy_mirror_light_args {
     /** @{ world space; direction = the node's -Z */
     float position[3], direction[3]; /** @} */
     uint32_t *handle; /**< in/out */
+    const sy_mirror_flat_light *flat; /**< all of it, flat (borrowed for the call) */
 } sy_mirror_light_args;
 
 /** Kinds of back-end objects the mirror creates. */
@@ -106,14 +115,17 @@ typedef struct sy_mirror_object_args {
     bool destroyed; /**< the object was destroyed */
 } sy_mirror_object_args;
 
-/** The back-end side. Every entry but object_changed is required. Failing callbacks set err and
- * stop the sync (the mirror stays consistent: a later sync may retry). */
+/** The back-end side. primitive_set, instance_set and release are required. texture_set,
+ * material_set and light_set are NULL for a back-end without such objects: then every texture and
+ * material handle stays 0 (instances get material 0), no light is made and the look counts none.
+ * object_changed is optional. Failing callbacks set err and stop the sync (the mirror stays
+ * consistent: a later sync may retry). */
 typedef struct sy_mirror_callbacks {
-    sy_result (*texture_set)(void *user, const sy_mirror_texture_args *a, sy_error *err); /**< creates a back-end texture */
-    sy_result (*material_set)(void *user, const sy_mirror_material_args *a, sy_error *err); /**< creates or updates a back-end material */
+    sy_result (*texture_set)(void *user, const sy_mirror_texture_args *a, sy_error *err); /**< creates a back-end texture, or NULL */
+    sy_result (*material_set)(void *user, const sy_mirror_material_args *a, sy_error *err); /**< creates or updates a back-end material, or NULL */
     sy_result (*primitive_set)(void *user, const sy_mirror_primitive_args *a, sy_error *err); /**< creates a back-end mesh for one primitive */
     sy_result (*instance_set)(void *user, const sy_mirror_instance_args *a, sy_error *err); /**< creates or updates an instance */
-    sy_result (*light_set)(void *user, const sy_mirror_light_args *a, sy_error *err); /**< creates or updates a light */
+    sy_result (*light_set)(void *user, const sy_mirror_light_args *a, sy_error *err); /**< creates or updates a light, or NULL */
     void (*release)(void *user, const sy_mirror_release_args *a); /**< releases a back-end object */
     void (*object_changed)(void *user, const sy_mirror_object_args *a); /**< optional */
 } sy_mirror_callbacks;

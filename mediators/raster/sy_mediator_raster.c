@@ -22,7 +22,6 @@
 #include "sy_log.h"
 #include "sy_look.h"
 #include "sy_mirror.h"
-#include "sy_post.h"
 
 #include <stdio.h>
 #include <math.h>
@@ -152,38 +151,44 @@ static sy_result gl_fail(sy_error *err, sy_gl_result r, const char *what, const 
     return sy_error_set(err, r == SY_GL_ERROR_OUT_OF_MEMORY ? SY_ERR_OUT_OF_MEMORY : SY_ERR_BACKEND, "raster: %s: %s", what, msg);
 }
 
-/* >>mirror callbacks */
-static sy_gl_texture_ref texref(const raster_state *st, const sy_texture_ref *r)
+/* >>mirror callbacks: the flat descriptions (sy_mirror_flat.h) copied into the device's; their
+ * enumerations are numbered like the device's, so a cast translates */
+_Static_assert(SY_MIRROR_FLAT_UNORM8 == (int)SY_GL_TEXEL_UNORM8 && SY_MIRROR_FLAT_UNORM8_SRGB == (int)SY_GL_TEXEL_UNORM8_SRGB &&
+                   SY_MIRROR_FLAT_FLOAT32 == (int)SY_GL_TEXEL_FLOAT32, "texel formats");
+_Static_assert(SY_MIRROR_FLAT_POINT == (int)SY_GL_LIGHT_POINT && SY_MIRROR_FLAT_SPOT == (int)SY_GL_LIGHT_SPOT &&
+                   SY_MIRROR_FLAT_DIRECTIONAL == (int)SY_GL_LIGHT_DIRECTIONAL, "light types");
+
+static sy_gl_texture_ref texref(const sy_mirror_flat_texture_ref *r)
 {
-    sy_gl_texture_ref o = {{sy_mirror_texture_handle(st->mirror, r->texture.id)}, r->texcoord, false, {0}};
-    o.transformed = sy_texture_ref_matrix(r, o.transform);
+    sy_gl_texture_ref o = {{r->handle}, r->texcoord, r->transformed, {0}};
+    memcpy(o.transform, r->transform, sizeof o.transform);
     return o;
 }
 
 static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_error *err)
 {
     raster_state *st = user;
-    const sy_material_data *m = a->data;
+    const sy_mirror_flat_material *m = a->flat;
     char e[ERRLEN];
     sy_gl_material_desc d;
     sy_gl_material_desc_init(&d);
     memcpy(d.base_color, m->base_color, sizeof d.base_color);
-    d.base_color_texture = texref(st, &m->base_color_texture);
+    d.base_color_texture = texref(&m->base_color_texture);
     d.metallic = m->metallic;
     d.roughness = m->roughness;
-    d.metallic_roughness_texture = texref(st, &m->metallic_roughness_texture);
-    for (int i = 0; i < 3; ++i) d.emissive[i] = m->emissive[i] * m->emissive_strength;
-    d.emissive_texture = texref(st, &m->emissive_texture);
-    d.normal_texture = texref(st, &m->normal_texture);
-    d.normal_scale = m->normal_texture.scale;
-    d.occlusion_texture = texref(st, &m->occlusion_texture);
-    d.occlusion_strength = m->occlusion_texture.scale;
+    d.metallic_roughness_texture = texref(&m->metallic_roughness_texture);
+    memcpy(d.emissive, m->emissive, sizeof d.emissive);
+    d.emissive_texture = texref(&m->emissive_texture);
+    d.normal_texture = texref(&m->normal_texture);
+    d.normal_scale = m->normal_scale;
+    d.occlusion_texture = texref(&m->occlusion_texture);
+    d.occlusion_strength = m->occlusion_strength;
     d.transmission = m->transmission;
-    d.ior = m->ior >= 1.0f ? m->ior : 1.5f;
+    d.ior = m->ior;
     d.alpha_mode = (sy_gl_alpha_mode)m->alpha_mode;
     d.alpha_cutoff = m->alpha_cutoff;
-    d.double_sided = m->double_sided != 0;
-    d.unlit = m->unlit != 0;
+    d.double_sided = m->double_sided;
+    d.unlit = m->unlit;
     sy_gl_material h = {*a->handle};
     sy_gl_result r = h.id ? sy_gl_material_update(st->dev, h, &d, e, sizeof e)
                           : sy_gl_material_create(st->dev, &d, &h, e, sizeof e);
@@ -192,16 +197,16 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     /* albedo for the indirect estimate (area lights) */
     ealb *al = map_put(&st->albs, h.id);
     if (!al) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (material albedo)");
-    const etex *bt = m->base_color_texture.texture.id ? map_get(&st->texs, m->base_color_texture.texture.id) : NULL;
+    const etex *bt = m->base_color_texture.id ? map_get(&st->texs, m->base_color_texture.id) : NULL;
     for (int i = 0; i < 3; ++i) {
         float v = d.base_color[i] * (bt ? bt->mean[i] : 1.0f);
         al->albedo[i] = isfinite(v) ? fminf(fmaxf(v, 0.0f), 1.0f) : 0.0f;
     }
     /* emission as area light: factor x strength (x the emissive texture's mean) */
     emat em = {{0, 0, 0}, d.double_sided};
-    const etex *et = m->emissive_texture.texture.id ? map_get(&st->texs, m->emissive_texture.texture.id) : NULL;
+    const etex *et = m->emissive_texture.id ? map_get(&st->texs, m->emissive_texture.id) : NULL;
     for (int i = 0; i < 3; ++i) {
-        float v = d.emissive[i] * (m->emissive_texture.texture.id ? (et ? et->mean[i] : 0.0f) : 1.0f);
+        float v = d.emissive[i] * (m->emissive_texture.id ? (et ? et->mean[i] : 0.0f) : 1.0f);
         em.emission[i] = isfinite(v) && v > 0.0f ? v : 0.0f;
     }
     emat *old = map_get(&st->mats, h.id);
@@ -223,18 +228,10 @@ static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_erro
 {
     raster_state *st = user;
     char e[ERRLEN];
-    sy_gl_texture_desc d = {
-        .width = a->info->width,
-        .height = a->info->height,
-        .channels = a->info->channels,
-        .format = a->info->format == SY_PIXEL_U8_SRGB     ? SY_GL_TEXEL_UNORM8_SRGB
-                  : a->info->format == SY_PIXEL_U8_LINEAR ? SY_GL_TEXEL_UNORM8
-                                                          : SY_GL_TEXEL_FLOAT32,
-        .pixels = a->pixels,
-        .wrap_s = (sy_gl_wrap)a->sampler->wrap_s,
-        .wrap_t = (sy_gl_wrap)a->sampler->wrap_t,
-        .nearest = a->sampler->mag_filter == SY_FILTER_NEAREST,
-    };
+    const sy_mirror_flat_texture *f = a->flat;
+    sy_gl_texture_desc d = {.width = f->width, .height = f->height, .channels = f->channels,
+                            .format = (sy_gl_texel_format)f->format, .pixels = f->pixels, .wrap_s = (sy_gl_wrap)f->wrap_s,
+                            .wrap_t = (sy_gl_wrap)f->wrap_t, .nearest = f->nearest};
     sy_gl_texture h = {0};
     sy_gl_result r = sy_gl_texture_create(st->dev, &d, &h, e, sizeof e);
     *a->handle = h.id;
@@ -242,20 +239,7 @@ static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_erro
     /* mean linear RGB (for textured emitters as area lights) */
     etex *t = map_put(&st->texs, a->id);
     if (!t) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (texture means)");
-    size_t n = (size_t)d.width * d.height, ch = d.channels;
-    double sum[3] = {0, 0, 0};
-    for (size_t i = 0; i < n; ++i)
-        for (size_t c = 0; c < 3; ++c) {
-            size_t k = ch <= 2 ? 0 : c;
-            float v;
-            if (d.format == SY_GL_TEXEL_FLOAT32) v = ((const float *)d.pixels)[i * ch + k];
-            else {
-                v = ((const unsigned char *)d.pixels)[i * ch + k] / 255.0f;
-                if (d.format == SY_GL_TEXEL_UNORM8_SRGB) v = sy_srgb_decode(v);
-            }
-            if (isfinite(v)) sum[c] += v;
-        }
-    for (int c = 0; c < 3; ++c) t->mean[c] = n ? (float)(sum[c] / (double)n) : 0.0f;
+    sy_mirror_flat_texture_mean(f, t->mean);
     return SY_OK;
 }
 
@@ -264,15 +248,9 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
     raster_state *st = user;
     char e[ERRLEN];
     const sy_primitive *p = a->primitive;
-    sy_gl_mesh_desc d = {
-        .positions = sy_blob_data(p->positions),
-        .normals = sy_blob_data(p->normals),
-        .uv = {sy_blob_data(p->texcoords0), sy_blob_data(p->texcoords1)},
-        .colors = sy_blob_data(p->colors),
-        .indices = sy_blob_data(p->indices),
-        .vertex_count = sy_primitive_vertex_count(p),
-        .triangle_count = sy_primitive_triangle_count(p),
-    };
+    const sy_mirror_flat_mesh *f = a->flat;
+    sy_gl_mesh_desc d = {f->positions, f->normals, {f->uv[0], f->uv[1]}, f->colors, f->indices, f->vertex_count,
+                         f->triangle_count};
     sy_gl_mesh h = {0};
     sy_gl_result r = sy_gl_mesh_create(st->dev, &d, &h, e, sizeof e);
     *a->handle = h.id;
@@ -325,18 +303,10 @@ static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *e
 {
     raster_state *st = user;
     char e[ERRLEN];
-    const sy_light_data *l = a->light;
-    sy_gl_light_desc d;
-    memset(&d, 0, sizeof d);
-    d.type = l->type == SY_LIGHT_SPOT ? SY_GL_LIGHT_SPOT : l->type == SY_LIGHT_DIRECTIONAL ? SY_GL_LIGHT_DIRECTIONAL
-                                                                                         : SY_GL_LIGHT_POINT;
-    memcpy(d.color, l->color, sizeof d.color);
-    d.intensity = l->intensity;
-    d.range = l->range;
-    d.inner_cone_angle = l->inner_cone;
-    d.outer_cone_angle = l->outer_cone;
-    memcpy(d.position, a->position, sizeof d.position);
-    memcpy(d.direction, a->direction, sizeof d.direction);
+    const sy_mirror_flat_light *l = a->flat;
+    sy_gl_light_desc d = {(sy_gl_light_type)l->type, {l->color[0], l->color[1], l->color[2]}, l->intensity,
+                          {l->position[0], l->position[1], l->position[2]},
+                          {l->direction[0], l->direction[1], l->direction[2]}, l->range, l->inner_cone, l->outer_cone, false};
     sy_gl_light h = {*a->handle};
     sy_gl_result r = h.id ? sy_gl_light_update(st->dev, h, &d, e, sizeof e) : sy_gl_light_create(st->dev, &d, &h, e, sizeof e);
     *a->handle = h.id;

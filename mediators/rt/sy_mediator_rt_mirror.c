@@ -1,7 +1,7 @@
 /* sy_mediator_rt_mirror.c — the rt adapter's side of the scene mirror (mediators/sy_mirror):
- * its callbacks turn textures, materials, meshes, instances and lights into Embree back-end calls
- * (what the device does not accept is clamped with a warning), and a sync ends with the device's
- * commit (sy_mediator_rt_internal.h). */
+ * its callbacks copy the flat descriptions of textures, materials, meshes, instances and lights
+ * (mediators/sy_mirror_flat.h) into Embree back-end calls (what the device does not accept is
+ * clamped with a warning), and a sync ends with the device's commit (sy_mediator_rt_internal.h). */
 #include "sy_mediator_rt_internal.h"
 
 #include "sy_log.h"
@@ -57,40 +57,46 @@ static float clamp_warn(rt_state *st, const char *kind, uint32_t id, const char 
     return c;
 }
 
-static sy_rt_texture_ref texref(const rt_state *st, const sy_texture_ref *r)
+/* the flat enumerations are numbered like the back-end's (sy_mirror_flat.h): a cast translates */
+_Static_assert(SY_MIRROR_FLAT_UNORM8 == (int)SY_RT_TEXEL_UNORM8 && SY_MIRROR_FLAT_UNORM8_SRGB == (int)SY_RT_TEXEL_UNORM8_SRGB &&
+                   SY_MIRROR_FLAT_FLOAT32 == (int)SY_RT_TEXEL_FLOAT32, "texel formats");
+_Static_assert(SY_MIRROR_FLAT_POINT == (int)SY_RT_LIGHT_POINT && SY_MIRROR_FLAT_SPOT == (int)SY_RT_LIGHT_SPOT &&
+                   SY_MIRROR_FLAT_DIRECTIONAL == (int)SY_RT_LIGHT_DIRECTIONAL, "light types");
+
+static sy_rt_texture_ref texref(const sy_mirror_flat_texture_ref *r)
 {
-    sy_rt_texture_ref o = {{sy_mirror_texture_handle(st->mirror, r->texture.id)}, r->texcoord, false, {0}};
-    o.transformed = sy_texture_ref_matrix(r, o.transform);
+    sy_rt_texture_ref o = {{r->handle}, r->texcoord, r->transformed, {0}};
+    memcpy(o.transform, r->transform, sizeof o.transform);
     return o;
 }
 
 static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_error *err)
 {
     rt_state *st = user;
-    const sy_material_data *m = a->data;
+    const sy_mirror_flat_material *m = a->flat;
     char e[ERRLEN];
     sy_rt_material_desc d;
     sy_rt_material_desc_init(&d);
     static const char *const bc[4] = {"base_color[0]", "base_color[1]", "base_color[2]", "base_color[3] (alpha)"};
     for (int i = 0; i < 4; ++i) d.base_color[i] = clamp_warn(st, "material", a->id, bc[i], m->base_color[i], 0.0f, i == 3 ? 1.0f : INFINITY);
-    d.base_color_texture = texref(st, &m->base_color_texture);
+    d.base_color_texture = texref(&m->base_color_texture);
     d.metallic = clamp_warn(st, "material", a->id, "metallic", m->metallic, 0.0f, 1.0f);
     d.roughness = clamp_warn(st, "material", a->id, "roughness", m->roughness, 0.0f, 1.0f);
-    d.metallic_roughness_texture = texref(st, &m->metallic_roughness_texture);
+    d.metallic_roughness_texture = texref(&m->metallic_roughness_texture);
     for (int i = 0; i < 3; ++i) {
-        float e = m->emissive[i] * m->emissive_strength;
-        d.emissive[i] = isfinite(e) && e >= 0.0f ? e : clamp_warn(st, "material", a->id, "emission", e, 0.0f, 3.0e38f);
+        float v = m->emissive[i];
+        d.emissive[i] = isfinite(v) && v >= 0.0f ? v : clamp_warn(st, "material", a->id, "emission", v, 0.0f, 3.0e38f);
     }
-    d.emissive_texture = texref(st, &m->emissive_texture);
-    d.normal_texture = texref(st, &m->normal_texture);
-    d.normal_scale = m->normal_texture.scale;
+    d.emissive_texture = texref(&m->emissive_texture);
+    d.normal_texture = texref(&m->normal_texture);
+    d.normal_scale = m->normal_scale;
     d.transmission = clamp_warn(st, "material", a->id, "transmission", m->transmission, 0.0f, 1.0f);
-    d.ior = m->ior >= 1.0f ? m->ior : 1.5f;
+    d.ior = m->ior;
     d.specular = st->specular;
     d.alpha_mode = (sy_rt_alpha_mode)m->alpha_mode;
     d.alpha_cutoff = clamp_warn(st, "material", a->id, "alpha_cutoff", m->alpha_cutoff, 0.0f, 1.0f);
-    d.double_sided = m->double_sided != 0;
-    d.unlit = m->unlit != 0;
+    d.double_sided = m->double_sided;
+    d.unlit = m->unlit;
     sy_rt_material h = {*a->handle};
     sy_rt_result r = h.id ? sy_rt_material_update(st->dev, h, &d, e, sizeof e)
                           : sy_rt_material_create(st->dev, &d, &h, e, sizeof e);
@@ -102,18 +108,9 @@ static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_erro
 {
     rt_state *st = user;
     char e[ERRLEN];
-    sy_rt_texture_desc d = {
-        .width = a->info->width,
-        .height = a->info->height,
-        .channels = a->info->channels,
-        .format = a->info->format == SY_PIXEL_U8_SRGB     ? SY_RT_TEXEL_UNORM8_SRGB
-                  : a->info->format == SY_PIXEL_U8_LINEAR ? SY_RT_TEXEL_UNORM8
-                                                          : SY_RT_TEXEL_FLOAT32,
-        .pixels = a->pixels,
-        .wrap_s = (sy_rt_wrap)a->sampler->wrap_s,
-        .wrap_t = (sy_rt_wrap)a->sampler->wrap_t,
-        .filter = a->sampler->mag_filter == SY_FILTER_NEAREST ? SY_RT_FILTER_NEAREST : SY_RT_FILTER_LINEAR,
-    };
+    const sy_mirror_flat_texture *f = a->flat;
+    sy_rt_texture_desc d = {f->width, f->height, f->channels, (sy_rt_texel_format)f->format, f->pixels,
+                            (sy_rt_wrap)f->wrap_s, (sy_rt_wrap)f->wrap_t, f->nearest ? SY_RT_FILTER_NEAREST : SY_RT_FILTER_LINEAR};
     sy_rt_texture h = {0};
     sy_rt_result r = sy_rt_texture_create(st->dev, &d, &h, e, sizeof e);
     *a->handle = h.id;
@@ -139,19 +136,11 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
     rt_state *st = user;
     char e[ERRLEN];
     const sy_primitive *p = a->primitive;
+    const sy_mirror_flat_mesh *f = a->flat;
     rt_mesh_blobs *held = malloc(sizeof *held);
     if (!held) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt: mesh primitive: out of memory");
-    sy_rt_mesh_desc d = {
-        .positions = sy_blob_data(p->positions),
-        .normals = sy_blob_data(p->normals),
-        .uv = {sy_blob_data(p->texcoords0), sy_blob_data(p->texcoords1)},
-        .colors = sy_blob_data(p->colors),
-        .indices = sy_blob_data(p->indices),
-        .vertex_count = sy_primitive_vertex_count(p),
-        .triangle_count = sy_primitive_triangle_count(p),
-        .release = rt_mesh_blobs_release,
-        .release_user = held,
-    };
+    sy_rt_mesh_desc d = {f->positions, f->normals, {f->uv[0], f->uv[1]}, f->colors, f->indices, f->vertex_count,
+                         f->triangle_count, rt_mesh_blobs_release, held};
     sy_blob *const used[6] = {p->positions, p->normals, p->texcoords0, p->texcoords1, p->colors, p->indices};
     for (int k = 0; k < 6; ++k) held->b[k] = sy_blob_retain(used[k]);
     sy_rt_mesh h = {0};
@@ -186,11 +175,10 @@ static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *e
 {
     rt_state *st = user;
     char e[ERRLEN];
-    const sy_light_data *l = a->light;
+    const sy_mirror_flat_light *l = a->flat;
     sy_rt_light_desc d;
     memset(&d, 0, sizeof d);
-    d.type = l->type == SY_LIGHT_SPOT ? SY_RT_LIGHT_SPOT : l->type == SY_LIGHT_DIRECTIONAL ? SY_RT_LIGHT_DIRECTIONAL
-                                                                                         : SY_RT_LIGHT_POINT;
+    d.type = (sy_rt_light_type)l->type;
     static const char *const cn[3] = {"color[0]", "color[1]", "color[2]"};
     for (int i = 0; i < 3; ++i) d.color[i] = clamp_warn(st, "light of node", a->node, cn[i], l->color[i], 0.0f, 3.0e38f);
     d.intensity = clamp_warn(st, "light of node", a->node, "intensity", l->intensity, 0.0f, 3.0e38f);
@@ -199,8 +187,8 @@ static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *e
         d.outer_cone_angle = clamp_warn(st, "light of node", a->node, "outer_cone", l->outer_cone, 0.0f, 1.5707963f);
         d.inner_cone_angle = clamp_warn(st, "light of node", a->node, "inner_cone", l->inner_cone, 0.0f, d.outer_cone_angle);
     }
-    memcpy(d.position, a->position, sizeof d.position);
-    memcpy(d.direction, a->direction, sizeof d.direction);
+    memcpy(d.position, l->position, sizeof d.position);
+    memcpy(d.direction, l->direction, sizeof d.direction);
     sy_rt_light h = {*a->handle};
     sy_rt_result r = h.id ? sy_rt_light_update(st->dev, h, &d, e, sizeof e) : sy_rt_light_create(st->dev, &d, &h, e, sizeof e);
     *a->handle = h.id;

@@ -14,26 +14,11 @@ typedef struct nrm_state {
 
 static sy_result nrm_fail(sy_error *err, const char *e) { return sy_error_set(err, SY_ERR_BACKEND, "%s", e); }
 
-static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_error *err)
-{
-    (void)user, (void)err;
-    *a->handle = 0; /* normals use no texture */
-    return SY_OK;
-}
-
-static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_error *err)
-{
-    (void)user, (void)err;
-    *a->handle = 1; /* one stand-in: normals ignore materials */
-    return SY_OK;
-}
-
 static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
 {
     nrm_state *st = user;
-    const sy_primitive *p = a->primitive;
-    uint32_t nv = sy_primitive_vertex_count(p), nt = sy_primitive_triangle_count(p);
-    const uint32_t *idx = sy_blob_data(p->indices);
+    uint32_t nv = a->flat->vertex_count, nt = a->flat->triangle_count;
+    const uint32_t *idx = a->flat->indices;
     uint32_t *seq = NULL;
     if (!idx && nt) { /* non-indexed: vertices in order */
         seq = malloc((size_t)nt * 3 * sizeof *seq);
@@ -42,7 +27,7 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
         idx = seq;
     }
     char e[256];
-    *a->handle = sy_nrm_mesh_create(st->dev, sy_blob_data(p->positions), nv, idx, nt, e, sizeof e);
+    *a->handle = sy_nrm_mesh_create(st->dev, a->flat->positions, nv, idx, nt, e, sizeof e);
     free(seq);
     return *a->handle ? SY_OK : nrm_fail(err, e);
 }
@@ -57,13 +42,6 @@ static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_er
     return SY_OK;
 }
 
-static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *err)
-{
-    (void)user, (void)err;
-    *a->handle = 1; /* normals are unlit */
-    return SY_OK;
-}
-
 static void cb_release(void *user, const sy_mirror_release_args *a)
 {
     nrm_state *st = user;
@@ -71,12 +49,9 @@ static void cb_release(void *user, const sy_mirror_release_args *a)
     else if (a->kind == SY_MIRROR_INSTANCE) sy_nrm_instance_release(st->dev, a->handle);
 }
 
-static const sy_mirror_callbacks nrm_callbacks = {
-    .texture_set = cb_texture,
-    .material_set = cb_material,
+static const sy_mirror_callbacks nrm_callbacks = { /* normals: no texture, material or light */
     .primitive_set = cb_primitive,
     .instance_set = cb_instance,
-    .light_set = cb_light,
     .release = cb_release,
 };
 

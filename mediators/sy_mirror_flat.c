@@ -1,0 +1,104 @@
+/* sy_mirror_flat.c — flat descriptions of mirrored textures, materials, primitives and lights (see
+ * sy_mirror_flat.h): the one reading of the core fields that every back-end shares. */
+#include "sy_mirror_flat.h"
+
+#include "sy_post.h"
+
+#include <math.h>
+#include <string.h>
+
+void sy_mirror_flat_texture_of(const sy_image_info *info, const sy_sampler *sampler, const void *pixels,
+                               sy_mirror_flat_texture *out)
+{
+    *out = (sy_mirror_flat_texture){
+        .width = info->width,
+        .height = info->height,
+        .channels = info->channels,
+        .format = info->format == SY_PIXEL_U8_SRGB     ? SY_MIRROR_FLAT_UNORM8_SRGB
+                  : info->format == SY_PIXEL_U8_LINEAR ? SY_MIRROR_FLAT_UNORM8
+                                                       : SY_MIRROR_FLAT_FLOAT32,
+        .pixels = pixels,
+        .wrap_s = sampler->wrap_s,
+        .wrap_t = sampler->wrap_t,
+        .nearest = sampler->mag_filter == SY_FILTER_NEAREST,
+    };
+}
+
+void sy_mirror_flat_texture_mean(const sy_mirror_flat_texture *t, float mean[3])
+{
+    size_t n = (size_t)t->width * t->height, ch = t->channels;
+    double sum[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; ++i)
+        for (size_t c = 0; c < 3; ++c) {
+            size_t k = ch <= 2 ? 0 : c;
+            float v;
+            if (t->format == SY_MIRROR_FLAT_FLOAT32) v = ((const float *)t->pixels)[i * ch + k];
+            else {
+                v = ((const unsigned char *)t->pixels)[i * ch + k] / 255.0f;
+                if (t->format == SY_MIRROR_FLAT_UNORM8_SRGB) v = sy_srgb_decode(v);
+            }
+            if (isfinite(v)) sum[c] += v;
+        }
+    for (int c = 0; c < 3; ++c) mean[c] = n ? (float)(sum[c] / (double)n) : 0.0f;
+}
+
+static sy_mirror_flat_texture_ref texref(const sy_texture_ref *r, sy_mirror_flat_handle_fn handle_of, const void *user)
+{
+    sy_mirror_flat_texture_ref o = {r->texture.id, r->texture.id ? handle_of(user, r->texture.id) : 0u, r->texcoord,
+                                    false, {0}};
+    o.transformed = sy_texture_ref_matrix(r, o.transform);
+    return o;
+}
+
+void sy_mirror_flat_material_of(const sy_material_data *m, sy_mirror_flat_handle_fn handle_of, const void *user,
+                                sy_mirror_flat_material *out)
+{
+    memset(out, 0, sizeof *out);
+    memcpy(out->base_color, m->base_color, sizeof out->base_color);
+    out->base_color_texture = texref(&m->base_color_texture, handle_of, user);
+    out->metallic = m->metallic;
+    out->roughness = m->roughness;
+    out->metallic_roughness_texture = texref(&m->metallic_roughness_texture, handle_of, user);
+    for (int i = 0; i < 3; ++i) out->emissive[i] = m->emissive[i] * m->emissive_strength;
+    out->emissive_texture = texref(&m->emissive_texture, handle_of, user);
+    out->normal_texture = texref(&m->normal_texture, handle_of, user);
+    out->normal_scale = m->normal_texture.scale;
+    out->occlusion_texture = texref(&m->occlusion_texture, handle_of, user);
+    out->occlusion_strength = m->occlusion_texture.scale;
+    out->transmission = m->transmission;
+    out->ior = m->ior >= 1.0f ? m->ior : 1.5f;
+    out->alpha_mode = m->alpha_mode;
+    out->alpha_cutoff = m->alpha_cutoff;
+    out->double_sided = m->double_sided != 0;
+    out->unlit = m->unlit != 0;
+}
+
+void sy_mirror_flat_mesh_of(const sy_primitive *p, sy_mirror_flat_mesh *out)
+{
+    *out = (sy_mirror_flat_mesh){
+        .positions = sy_blob_data(p->positions),
+        .normals = sy_blob_data(p->normals),
+        .uv = {sy_blob_data(p->texcoords0), sy_blob_data(p->texcoords1)},
+        .colors = sy_blob_data(p->colors),
+        .indices = sy_blob_data(p->indices),
+        .vertex_count = sy_primitive_vertex_count(p),
+        .triangle_count = sy_primitive_triangle_count(p),
+    };
+}
+
+void sy_mirror_flat_light_of(const sy_light_data *l, const float position[3], const float direction[3],
+                             sy_mirror_flat_light *out)
+{
+    *out = (sy_mirror_flat_light){
+        .type = l->type == SY_LIGHT_SPOT          ? SY_MIRROR_FLAT_SPOT
+                : l->type == SY_LIGHT_DIRECTIONAL ? SY_MIRROR_FLAT_DIRECTIONAL
+                                                  : SY_MIRROR_FLAT_POINT,
+        .intensity = l->intensity,
+        .range = l->range,
+        .inner_cone = l->inner_cone,
+        .outer_cone = l->outer_cone,
+    };
+    memcpy(out->color, l->color, sizeof out->color);
+    memcpy(out->position, position, sizeof out->position);
+    memcpy(out->direction, direction, sizeof out->direction);
+}

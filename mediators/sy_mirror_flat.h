@@ -1,0 +1,134 @@
+/** @file
+ * sy_mirror_flat.h — flat descriptions: what a mirrored texture, material, primitive and light
+ * mean to a back-end, decided once for every back-end.
+ *
+ * The scene mirror (sy_mirror.h) hands each callback the object's core fields and, beside them,
+ * its flat description: plain numbers, array pointers and back-end handles, with the reading every
+ * back-end must share already applied (texel format and filter chosen from the pixel format and
+ * sampler; texture references resolved to back-end handles with their uv transform as a matrix;
+ * emission = factor x strength; an ior below 1 read as 1.5; the blobs of a primitive as arrays
+ * with their counts; a light's type as a back-end light type). A mediator then only copies the
+ * fields into its back-end's own descriptor; what its device cannot take (ranges, clamps) stays
+ * the mediator's. The enumerations are numbered like the back-ends' own (sy_rt.h, sy_gl.h), so a
+ * cast translates them; a mediator that casts checks the numbers with _Static_assert.
+ *
+ * Ownership: a description borrows every pointer from the mirror for the duration of the callback
+ * that receives it (pixels, vertex and index arrays); copy or retain what outlives the call.
+ * Thread-safety: the functions are pure (they read their arguments only) and reentrant. */
+#ifndef SY_MIRROR_FLAT_H
+#define SY_MIRROR_FLAT_H
+
+#include "sy_objects.h"
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Texel formats, numbered like sy_rt_texel_format and sy_gl_texel_format. */
+typedef enum sy_mirror_flat_texel {
+    SY_MIRROR_FLAT_UNORM8 = 1,      /**< 8-bit linear data */
+    SY_MIRROR_FLAT_UNORM8_SRGB = 2, /**< 8-bit, RGB sRGB-encoded, alpha linear */
+    SY_MIRROR_FLAT_FLOAT32 = 3,     /**< 32-bit float, linear */
+} sy_mirror_flat_texel;
+
+/** A complete texture. */
+typedef struct sy_mirror_flat_texture {
+    /** @{ size in pixels */
+    uint32_t width, height; /** @} */
+    uint32_t channels; /**< 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA */
+    sy_mirror_flat_texel format; /**< texel format */
+    const void *pixels; /**< width x height x channels texels, rows top first (borrowed) */
+    /** @{ sy_wrap (repeat 0, clamp 1, mirror 2: numbered like sy_rt_wrap and sy_gl_wrap) */
+    uint32_t wrap_s, wrap_t; /** @} */
+    bool nearest; /**< magnification filter nearest (else linear) */
+} sy_mirror_flat_texture;
+
+/** A material's use of a texture. */
+typedef struct sy_mirror_flat_texture_ref {
+    uint32_t id;       /**< core texture id, 0 = none */
+    uint32_t handle;   /**< back-end texture, 0 = none (no texture, or not complete) */
+    uint32_t texcoord; /**< texture-coordinate set, 0 or 1 */
+    bool transformed;  /**< false: identity */
+    float transform[6]; /**< KHR_texture_transform as a row-major 2x3 affine matrix (sy_texture_ref_matrix) */
+} sy_mirror_flat_texture_ref;
+
+/** A glTF 2.0 metallic-roughness material as a back-end reads it. */
+typedef struct sy_mirror_flat_material {
+    float base_color[4]; /**< linear RGBA factor */
+    sy_mirror_flat_texture_ref base_color_texture; /**< sRGB */
+    /** @{ factors */
+    float metallic, roughness; /** @} */
+    sy_mirror_flat_texture_ref metallic_roughness_texture; /**< B metallic, G roughness */
+    float emissive[3]; /**< emitted radiance factor: emissive factor x emissive strength */
+    sy_mirror_flat_texture_ref emissive_texture; /**< sRGB */
+    sy_mirror_flat_texture_ref normal_texture; /**< tangent space */
+    float normal_scale; /**< the normal texture's scale */
+    sy_mirror_flat_texture_ref occlusion_texture; /**< R */
+    float occlusion_strength; /**< the occlusion texture's strength */
+    float transmission; /**< KHR_materials_transmission factor */
+    float ior; /**< index of refraction; a value below 1 reads as glTF's 1.5 */
+    uint32_t alpha_mode; /**< sy_alpha_mode (opaque 0, mask 1, blend 2: numbered like the back-ends') */
+    float alpha_cutoff; /**< cutoff of the mask mode */
+    bool double_sided; /**< both faces are front faces */
+    bool unlit; /**< KHR_materials_unlit */
+} sy_mirror_flat_material;
+
+/** One triangle primitive's arrays (every per-vertex array has vertex_count entries). */
+typedef struct sy_mirror_flat_mesh {
+    const float *positions; /**< float3 */
+    const float *normals;   /**< float3 or NULL */
+    const float *uv[2];     /**< float2 per texture-coordinate set, or NULL */
+    const float *colors;    /**< float4 linear RGBA or NULL */
+    const uint32_t *indices; /**< 3 x triangle_count, or NULL: the vertices in order */
+    /** @{ counts */
+    uint32_t vertex_count, triangle_count; /** @} */
+} sy_mirror_flat_mesh;
+
+/** Light types, numbered like sy_rt_light_type and sy_gl_light_type. */
+typedef enum sy_mirror_flat_light_type {
+    SY_MIRROR_FLAT_POINT = 1,
+    SY_MIRROR_FLAT_SPOT = 2,
+    SY_MIRROR_FLAT_DIRECTIONAL = 3,
+} sy_mirror_flat_light_type;
+
+/** A punctual light of one placement, in world space. */
+typedef struct sy_mirror_flat_light {
+    sy_mirror_flat_light_type type; /**< point (also for an unknown type), spot or directional */
+    float color[3]; /**< linear RGB */
+    float intensity; /**< candela (point, spot) or lux (directional) */
+    float range; /**< 0 = infinite */
+    /** @{ spot cone angles, radians (inner < outer: the mirror reads inner >= outer as a hard edge) */
+    float inner_cone, outer_cone; /** @} */
+    float position[3]; /**< world position (point, spot) */
+    float direction[3]; /**< world direction the light travels: the node's -Z (spot, directional) */
+} sy_mirror_flat_light;
+
+/** Describes a texture whose pixels match info. */
+void sy_mirror_flat_texture_of(const sy_image_info *info, const sy_sampler *sampler, const void *pixels,
+                               sy_mirror_flat_texture *out);
+
+/** Mean linear RGB of a texture (sRGB decoded; grey read as R = G = B; non-finite texels skipped;
+ * 0 for an empty one). */
+void sy_mirror_flat_texture_mean(const sy_mirror_flat_texture *t, float mean[3]);
+
+/** Back-end handle of a core texture id (0 = none), as the caller's mirror knows it. */
+typedef uint32_t (*sy_mirror_flat_handle_fn)(const void *user, uint32_t texture_id);
+
+/** Describes a material; handle_of resolves its texture ids (called only for ids != 0). */
+void sy_mirror_flat_material_of(const sy_material_data *d, sy_mirror_flat_handle_fn handle_of, const void *user,
+                                sy_mirror_flat_material *out);
+
+/** Describes a triangle primitive (its blobs as arrays, its counts). */
+void sy_mirror_flat_mesh_of(const sy_primitive *p, sy_mirror_flat_mesh *out);
+
+/** Describes a light at a world position and direction. */
+void sy_mirror_flat_light_of(const sy_light_data *l, const float position[3], const float direction[3],
+                             sy_mirror_flat_light *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_MIRROR_FLAT_H */
