@@ -10,7 +10,7 @@
  * with their counts; a light's type as a back-end light type). A mediator then only copies the
  * fields into its back-end's own descriptor; what its device cannot take (ranges, clamps) stays
  * the mediator's. The enumerations are numbered like the back-ends' own (sy_rt.h, sy_gl.h), so a
- * cast translates them; a mediator that casts checks the numbers with _Static_assert.
+ * cast translates them; a mediator that casts checks the numbers with SY_MIRROR_FLAT_SAME_NUMBERS.
  *
  * Ownership: a description borrows every pointer from the mirror for the duration of the callback
  * that receives it (pixels, vertex and index arrays); copy or retain what outlives the call.
@@ -105,6 +105,18 @@ typedef struct sy_mirror_flat_light {
     float position[3]; /**< world position (point, spot) */
     float direction[3]; /**< world direction the light travels: the node's -Z (spot, directional) */
 } sy_mirror_flat_light;
+
+/** Checks at compile time that back-end PREFIX (SY_RT, SY_GL) numbers its texel formats
+ * (PREFIX_TEXEL_UNORM8, ...) and light types (PREFIX_LIGHT_POINT, ...) like this header, so that
+ * a cast translates them. */
+#define SY_MIRROR_FLAT_SAME_NUMBERS(PREFIX)                                                                   \
+    _Static_assert(SY_MIRROR_FLAT_UNORM8 == (int)PREFIX##_TEXEL_UNORM8 &&                                     \
+                       SY_MIRROR_FLAT_UNORM8_SRGB == (int)PREFIX##_TEXEL_UNORM8_SRGB &&                        \
+                       SY_MIRROR_FLAT_FLOAT32 == (int)PREFIX##_TEXEL_FLOAT32 &&                                \
+                       SY_MIRROR_FLAT_POINT == (int)PREFIX##_LIGHT_POINT &&                                    \
+                       SY_MIRROR_FLAT_SPOT == (int)PREFIX##_LIGHT_SPOT &&                                      \
+                       SY_MIRROR_FLAT_DIRECTIONAL == (int)PREFIX##_LIGHT_DIRECTIONAL,                          \
+                   #PREFIX " numbers texel formats and light types like sy_mirror_flat.h")
 
 /** Describes a texture whose pixels match info. */
 void sy_mirror_flat_texture_of(const sy_image_info *info, const sy_sampler *sampler, const void *pixels,

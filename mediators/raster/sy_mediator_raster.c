@@ -153,10 +153,7 @@ static sy_result gl_fail(sy_error *err, sy_gl_result r, const char *what, const 
 
 /* >>mirror callbacks: the flat descriptions (sy_mirror_flat.h) copied into the device's; their
  * enumerations are numbered like the device's, so a cast translates */
-_Static_assert(SY_MIRROR_FLAT_UNORM8 == (int)SY_GL_TEXEL_UNORM8 && SY_MIRROR_FLAT_UNORM8_SRGB == (int)SY_GL_TEXEL_UNORM8_SRGB &&
-                   SY_MIRROR_FLAT_FLOAT32 == (int)SY_GL_TEXEL_FLOAT32, "texel formats");
-_Static_assert(SY_MIRROR_FLAT_POINT == (int)SY_GL_LIGHT_POINT && SY_MIRROR_FLAT_SPOT == (int)SY_GL_LIGHT_SPOT &&
-                   SY_MIRROR_FLAT_DIRECTIONAL == (int)SY_GL_LIGHT_DIRECTIONAL, "light types");
+SY_MIRROR_FLAT_SAME_NUMBERS(SY_GL);
 
 static sy_gl_texture_ref texref(const sy_mirror_flat_texture_ref *r)
 {

@@ -58,10 +58,7 @@ static float clamp_warn(rt_state *st, const char *kind, uint32_t id, const char 
 }
 
 /* the flat enumerations are numbered like the back-end's (sy_mirror_flat.h): a cast translates */
-_Static_assert(SY_MIRROR_FLAT_UNORM8 == (int)SY_RT_TEXEL_UNORM8 && SY_MIRROR_FLAT_UNORM8_SRGB == (int)SY_RT_TEXEL_UNORM8_SRGB &&
-                   SY_MIRROR_FLAT_FLOAT32 == (int)SY_RT_TEXEL_FLOAT32, "texel formats");
-_Static_assert(SY_MIRROR_FLAT_POINT == (int)SY_RT_LIGHT_POINT && SY_MIRROR_FLAT_SPOT == (int)SY_RT_LIGHT_SPOT &&
-                   SY_MIRROR_FLAT_DIRECTIONAL == (int)SY_RT_LIGHT_DIRECTIONAL, "light types");
+SY_MIRROR_FLAT_SAME_NUMBERS(SY_RT);
 
 static sy_rt_texture_ref texref(const sy_mirror_flat_texture_ref *r)
 {
