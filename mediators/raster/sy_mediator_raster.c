@@ -22,6 +22,7 @@
 #include "sy_log.h"
 #include "sy_look.h"
 #include "sy_mirror.h"
+#include "sy_mirror_map.h"
 
 #include <stdio.h>
 #include <math.h>
@@ -32,8 +33,7 @@
 
 /* The scene mirror (textures, materials, meshes, lights, backgrounds, nodes and placements) is
  * mediators/sy_mirror; this adapter turns its callbacks into OpenGL back-end calls. */
-/* >>tables: open-addressing maps from a 32-bit key (back-end handle or core id, never 0) to a
- * record; deleted slots keep key 0 and a tombstone flag. */
+/* >>tables: the records kept per back-end object or core id (maps of mediators/sy_mirror_map.h) */
 typedef struct emesh { /* per back-end mesh: the primitive's blobs (references) */
     sy_blob *positions, *indices;
     uint32_t vertex_count, triangle_count;
@@ -54,79 +54,6 @@ typedef struct etex { /* per core texture id: mean linear RGB */
     float mean[3];
 } etex;
 
-typedef struct map {
-    uint32_t *keys;
-    uint8_t *used; /* 0 empty, 1 live, 2 tombstone */
-    void *vals;
-    uint32_t cap, live, filled;
-    size_t elem;
-} map;
-
-static uint32_t map_hash(uint32_t k) { k ^= k >> 16; k *= 0x7feb352dU; k ^= k >> 15; k *= 0x846ca68bU; return k ^ (k >> 16); }
-
-static void *map_get(const map *m, uint32_t key)
-{
-    if (!m->cap || !key) return NULL;
-    for (uint32_t i = map_hash(key) & (m->cap - 1), n = 0; n < m->cap; ++n, i = (i + 1) & (m->cap - 1)) {
-        if (m->used[i] == 0) return NULL;
-        if (m->used[i] == 1 && m->keys[i] == key) return (char *)m->vals + (size_t)i * m->elem;
-    }
-    return NULL;
-}
-
-static void map_free(map *m)
-{
-    free(m->keys);
-    free(m->used);
-    free(m->vals);
-    m->keys = NULL, m->used = NULL, m->vals = NULL;
-    m->cap = m->live = m->filled = 0;
-}
-
-/* Inserts or finds key; the record is zeroed when new. NULL when out of memory. */
-static void *map_put(map *m, uint32_t key)
-{
-    void *v = map_get(m, key);
-    if (v) return v;
-    if ((m->filled + 1) * 4 >= m->cap * 3) {
-        map old = *m;
-        uint32_t nc = m->cap ? m->cap * 2 : 64;
-        while ((m->live + 1) * 4 >= nc * 3 / 2) nc *= 2;
-        m->keys = calloc(nc, sizeof *m->keys);
-        m->used = calloc(nc, 1);
-        m->vals = calloc(nc, m->elem);
-        if (!m->keys || !m->used || !m->vals) {
-            free(m->keys), free(m->used), free(m->vals);
-            *m = old;
-            return NULL;
-        }
-        m->cap = nc;
-        m->live = m->filled = 0;
-        for (uint32_t i = 0; i < old.cap; ++i)
-            if (old.used[i] == 1) memcpy(map_put(m, old.keys[i]), (char *)old.vals + (size_t)i * old.elem, old.elem);
-        map_free(&old);
-    }
-    uint32_t i = map_hash(key) & (m->cap - 1);
-    while (m->used[i] == 1) i = (i + 1) & (m->cap - 1);
-    if (m->used[i] == 0) m->filled++;
-    m->used[i] = 1;
-    m->keys[i] = key;
-    m->live++;
-    v = (char *)m->vals + (size_t)i * m->elem;
-    memset(v, 0, m->elem);
-    return v;
-}
-
-static void map_del(map *m, uint32_t key)
-{
-    void *v = map_get(m, key);
-    if (!v) return;
-    uint32_t i = (uint32_t)(((char *)v - (char *)m->vals) / m->elem);
-    m->used[i] = 2;
-    m->keys[i] = 0;
-    m->live--;
-}
-
 typedef struct raster_state {
     sy_gl_device *dev;
     sy_mirror *mirror;
@@ -139,7 +66,7 @@ typedef struct raster_state {
     uint32_t env_handle, bg_handle; /* as applied */
     sy_gl_texture studio, gradient;
     /* emissive meshes */
-    map meshes, mats, insts, texs, albs;
+    sy_mirror_map meshes, mats, insts, texs, albs;
     bool areas_dirty;
     uint32_t area_count;
     bool warned_area_cap;
@@ -192,30 +119,30 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     *a->handle = h.id;
     if (r != SY_GL_OK) return gl_fail(err, r, "material", e);
     /* albedo for the indirect estimate (area lights) */
-    ealb *al = map_put(&st->albs, h.id);
+    ealb *al = sy_mirror_map_put(&st->albs, h.id);
     if (!al) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (material albedo)");
-    const etex *bt = m->base_color_texture.id ? map_get(&st->texs, m->base_color_texture.id) : NULL;
+    const etex *bt = m->base_color_texture.id ? sy_mirror_map_get(&st->texs, m->base_color_texture.id) : NULL;
     for (int i = 0; i < 3; ++i) {
         float v = d.base_color[i] * (bt ? bt->mean[i] : 1.0f);
         al->albedo[i] = isfinite(v) ? fminf(fmaxf(v, 0.0f), 1.0f) : 0.0f;
     }
     /* emission as area light: factor x strength (x the emissive texture's mean) */
     emat em = {{0, 0, 0}, d.double_sided};
-    const etex *et = m->emissive_texture.id ? map_get(&st->texs, m->emissive_texture.id) : NULL;
+    const etex *et = m->emissive_texture.id ? sy_mirror_map_get(&st->texs, m->emissive_texture.id) : NULL;
     for (int i = 0; i < 3; ++i) {
         float v = d.emissive[i] * (m->emissive_texture.id ? (et ? et->mean[i] : 0.0f) : 1.0f);
         em.emission[i] = isfinite(v) && v > 0.0f ? v : 0.0f;
     }
-    emat *old = map_get(&st->mats, h.id);
+    emat *old = sy_mirror_map_get(&st->mats, h.id);
     bool was = old && (old->emission[0] > 0 || old->emission[1] > 0 || old->emission[2] > 0);
     bool is = em.emission[0] > 0 || em.emission[1] > 0 || em.emission[2] > 0;
     if (is) {
-        emat *slot = map_put(&st->mats, h.id);
+        emat *slot = sy_mirror_map_put(&st->mats, h.id);
         if (!slot) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (emissive materials)");
         if (!was || memcmp(slot, &em, sizeof em)) st->areas_dirty = true;
         *slot = em;
     } else if (was) {
-        map_del(&st->mats, h.id);
+        sy_mirror_map_del(&st->mats, h.id);
         st->areas_dirty = true;
     }
     return SY_OK;
@@ -234,7 +161,7 @@ static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_erro
     *a->handle = h.id;
     if (r != SY_GL_OK) return gl_fail(err, r, "texture", e);
     /* mean linear RGB (for textured emitters as area lights) */
-    etex *t = map_put(&st->texs, a->id);
+    etex *t = sy_mirror_map_put(&st->texs, a->id);
     if (!t) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (texture means)");
     sy_mirror_flat_texture_mean(f, t->mean);
     return SY_OK;
@@ -252,7 +179,7 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
     sy_gl_result r = sy_gl_mesh_create(st->dev, &d, &h, e, sizeof e);
     *a->handle = h.id;
     if (r != SY_GL_OK) return gl_fail(err, r, "mesh primitive", e);
-    emesh *em = map_put(&st->meshes, h.id);
+    emesh *em = sy_mirror_map_put(&st->meshes, h.id);
     if (!em) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (mesh table)");
     em->positions = sy_blob_retain(p->positions);
     em->indices = sy_blob_retain(p->indices);
@@ -261,12 +188,12 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
     return SY_OK;
 }
 
-static bool material_emits(const raster_state *st, uint32_t material) { return map_get(&st->mats, material) != NULL; }
+static bool material_emits(const raster_state *st, uint32_t material) { return sy_mirror_map_get(&st->mats, material) != NULL; }
 
 /* Records the instance for the area-light list; marks it dirty when an emitter changed. */
 static sy_result track_instance(raster_state *st, uint32_t handle, const sy_mirror_instance_args *a, sy_error *err)
 {
-    einst *in = map_put(&st->insts, handle);
+    einst *in = sy_mirror_map_put(&st->insts, handle);
     if (!in) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (instance table)");
     if (material_emits(st, a->material) || (in->material && material_emits(st, in->material))) st->areas_dirty = true;
     in->mesh = a->mesh;
@@ -316,25 +243,25 @@ static void cb_release(void *user, const sy_mirror_release_args *a)
     switch (a->kind) {
     case SY_MIRROR_TEXTURE: sy_gl_texture_destroy(st->dev, (sy_gl_texture){a->handle}); break;
     case SY_MIRROR_MATERIAL:
-        if (map_get(&st->mats, a->handle)) st->areas_dirty = true;
-        map_del(&st->mats, a->handle);
-        map_del(&st->albs, a->handle);
+        if (sy_mirror_map_get(&st->mats, a->handle)) st->areas_dirty = true;
+        sy_mirror_map_del(&st->mats, a->handle);
+        sy_mirror_map_del(&st->albs, a->handle);
         sy_gl_material_destroy(st->dev, (sy_gl_material){a->handle});
         break;
     case SY_MIRROR_PRIMITIVE: {
-        emesh *em = map_get(&st->meshes, a->handle);
+        emesh *em = sy_mirror_map_get(&st->meshes, a->handle);
         if (em) {
             sy_blob_release(em->positions);
             sy_blob_release(em->indices);
-            map_del(&st->meshes, a->handle);
+            sy_mirror_map_del(&st->meshes, a->handle);
         }
         sy_gl_mesh_destroy(st->dev, (sy_gl_mesh){a->handle});
         break;
     }
     case SY_MIRROR_INSTANCE: {
-        einst *in = map_get(&st->insts, a->handle);
+        einst *in = sy_mirror_map_get(&st->insts, a->handle);
         if (in && material_emits(st, in->material)) st->areas_dirty = true;
-        map_del(&st->insts, a->handle);
+        sy_mirror_map_del(&st->insts, a->handle);
         sy_gl_instance_destroy(st->dev, (sy_gl_instance){a->handle});
         break;
     }
@@ -513,10 +440,10 @@ static sy_result rebuild_area_lights(raster_state *st, sy_error *err)
     size_t n = 0, cap = 0;
     sy_result r = SY_OK;
     for (uint32_t s = 0; s < st->insts.cap && r == SY_OK; ++s) {
-        if (st->insts.used[s] != 1) continue;
-        const einst *in = (const einst *)((const char *)st->insts.vals + (size_t)s * st->insts.elem);
-        const emat *em = map_get(&st->mats, in->material);
-        const emesh *me = map_get(&st->meshes, in->mesh);
+        const einst *in = sy_mirror_map_slot(&st->insts, s);
+        if (!in) continue;
+        const emat *em = sy_mirror_map_get(&st->mats, in->material);
+        const emesh *me = sy_mirror_map_get(&st->meshes, in->mesh);
         if (!in->visible || !em || !me || !me->positions) continue;
         const float *pos = sy_blob_data(me->positions);
         const uint32_t *idx = me->indices ? sy_blob_data(me->indices) : NULL;
@@ -567,11 +494,11 @@ static sy_result rebuild_area_lights(raster_state *st, sy_error *err)
             for (int c = 0; c < 3; ++c) phi[c] += 3.14159265 * ps[i].l.radiance[c] * a;
         }
         for (uint32_t s = 0; s < st->insts.cap; ++s) {
-            if (st->insts.used[s] != 1) continue;
-            const einst *in = (const einst *)((const char *)st->insts.vals + (size_t)s * st->insts.elem);
-            const emesh *me = map_get(&st->meshes, in->mesh);
-            if (!in->visible || !me || !me->positions || map_get(&st->mats, in->material)) continue;
-            const ealb *al = map_get(&st->albs, in->material);
+            const einst *in = sy_mirror_map_slot(&st->insts, s);
+            if (!in) continue;
+            const emesh *me = sy_mirror_map_get(&st->meshes, in->mesh);
+            if (!in->visible || !me || !me->positions || sy_mirror_map_get(&st->mats, in->material)) continue;
+            const ealb *al = sy_mirror_map_get(&st->albs, in->material);
             const float alb_def[3] = {1, 1, 1}, *alb = al ? al->albedo : alb_def;
             const float *pos = sy_blob_data(me->positions);
             const uint32_t *idx = me->indices ? sy_blob_data(me->indices) : NULL;
@@ -684,16 +611,16 @@ static void raster_destroy(void *state)
     sy_mirror_destroy(st->mirror); /* releases instances, lights and meshes while the device lives */
     sy_gl_device_destroy(st->dev);
     for (uint32_t i = 0; i < st->meshes.cap; ++i) {
-        if (st->meshes.used[i] != 1) continue;
-        emesh *em = (emesh *)((char *)st->meshes.vals + (size_t)i * st->meshes.elem);
+        emesh *em = sy_mirror_map_slot(&st->meshes, i);
+        if (!em) continue;
         sy_blob_release(em->positions);
         sy_blob_release(em->indices);
     }
-    map_free(&st->meshes);
-    map_free(&st->mats);
-    map_free(&st->insts);
-    map_free(&st->texs);
-    map_free(&st->albs);
+    sy_mirror_map_free(&st->meshes);
+    sy_mirror_map_free(&st->mats);
+    sy_mirror_map_free(&st->insts);
+    sy_mirror_map_free(&st->texs);
+    sy_mirror_map_free(&st->albs);
     free(st);
 }
 
@@ -749,11 +676,11 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "raster: parameter gl=%s: expected osmesa, egl or glfw", gl);
     raster_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster mediator: out of memory");
-    st->meshes.elem = sizeof(emesh);
-    st->mats.elem = sizeof(emat);
-    st->insts.elem = sizeof(einst);
-    st->texs.elem = sizeof(etex);
-    st->albs.elem = sizeof(ealb);
+    st->meshes = SY_MIRROR_MAP_INIT(emesh);
+    st->mats = SY_MIRROR_MAP_INIT(emat);
+    st->insts = SY_MIRROR_MAP_INIT(einst);
+    st->texs = SY_MIRROR_MAP_INIT(etex);
+    st->albs = SY_MIRROR_MAP_INIT(ealb);
     st->indirect = indirect;
     char e[ERRLEN];
     sy_gl_device_desc dd = {.provider = provider,

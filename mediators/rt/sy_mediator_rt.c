@@ -29,7 +29,7 @@ static void rt_destroy(void *state)
     }
     for (int k = 0; k <= SY_RT_AOV_COUNT; ++k) free(st->fbuf[k]);
     sy_rt_device_destroy(st->dev);
-    free(st->inst_node);
+    sy_mirror_map_free(&st->inst_node);
     free(st);
 }
 
@@ -54,6 +54,7 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
         return r;
     rt_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt mediator: out of memory");
+    st->inst_node = SY_MIRROR_MAP_INIT(uint32_t);
     char e[ERRLEN];
     sy_rt_device_desc dd = {(uint32_t)threads, (uint64_t)max_memory_mb << 20};
     sy_rt_result rr = sy_rt_device_create(&dd, &st->dev, e, sizeof e);

@@ -19,6 +19,7 @@
 
 #include "sy_rt.h"
 #include "sy_mirror.h"
+#include "sy_mirror_map.h"
 
 #include "sy_filter_adaptive.h"
 #include "sy_filter_atrous.h"
@@ -88,8 +89,7 @@ typedef struct rt_state {
     accum_slot slots[ACCUM_SLOTS]; /* path tracer only */
     int last_slot;                 /* slot of the last render, -1 = none */
     uint64_t use_clock;
-    uint32_t *inst_node;           /* back-end instance slot index -> core node id (coverage) */
-    uint32_t inst_node_cap;
+    sy_mirror_map inst_node;       /* back-end instance slot index + 1 -> core node id (coverage) */
     pt_filter_cfg filter;          /* path tracer display filter */
     float *fbuf[SY_RT_AOV_COUNT + 1]; /* filter inputs: the AOV planes + world positions */
     size_t fbuf_px;                /* pixels the fbuf planes hold */

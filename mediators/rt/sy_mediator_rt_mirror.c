@@ -13,27 +13,22 @@
 
 #define RT_HANDLE_INDEX(h) ((h) & 0x3fffffu) /* backends/rt handles: 22-bit slot index */
 
-/* Remembers which node an instance belongs to (node 0 forgets it). */
+/* Remembers which node an instance belongs to (node 0 forgets it), keyed by slot index + 1. */
 static void inst_node_set(rt_state *st, uint32_t handle, uint32_t node)
 {
-    uint32_t i = RT_HANDLE_INDEX(handle);
-    if (i >= st->inst_node_cap) {
-        if (!node) return;
-        uint32_t nc = st->inst_node_cap ? st->inst_node_cap : 256;
-        while (nc <= i) nc *= 2;
-        uint32_t *n = realloc(st->inst_node, sizeof *n * nc);
-        if (!n) return; /* coverage then reports this instance as unknown (node 0) */
-        memset(n + st->inst_node_cap, 0, sizeof *n * (nc - st->inst_node_cap));
-        st->inst_node = n;
-        st->inst_node_cap = nc;
+    uint32_t key = RT_HANDLE_INDEX(handle) + 1;
+    if (!node) {
+        sy_mirror_map_del(&st->inst_node, key);
+        return;
     }
-    st->inst_node[i] = node;
+    uint32_t *n = sy_mirror_map_put(&st->inst_node, key);
+    if (n) *n = node; /* out of memory: coverage then reports this instance as unknown (node 0) */
 }
 
 uint32_t sy_rti_inst_node_get(const rt_state *st, uint32_t handle)
 {
-    uint32_t i = RT_HANDLE_INDEX(handle);
-    return handle && i < st->inst_node_cap ? st->inst_node[i] : 0;
+    const uint32_t *n = handle ? sy_mirror_map_get(&st->inst_node, RT_HANDLE_INDEX(handle) + 1) : NULL;
+    return n ? *n : 0;
 }
 
 /* >>mirror callbacks */
