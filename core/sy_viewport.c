@@ -12,6 +12,8 @@ struct sy_viewport {
     char *params_text;
     sy_params params;
     bool active;
+    bool has_view; /* sy_viewport_set_view: view replaces the camera node's world matrix */
+    sy_mat4 view;
 };
 
 struct sy_window {
@@ -135,6 +137,18 @@ bool sy_viewport_active(const sy_viewport *v) { return v->active; }
 void sy_viewport_set_camera(sy_viewport *v, sy_node camera) { v->desc.camera = camera; }
 const char *sy_viewport_backend(const sy_viewport *v) { return v->backend; }
 
+void sy_viewport_set_view(sy_viewport *v, const sy_mat4 *camera_to_world)
+{
+    v->has_view = camera_to_world != NULL;
+    if (camera_to_world) v->view = *camera_to_world;
+}
+
+bool sy_viewport_view(const sy_viewport *v, sy_mat4 *camera_to_world)
+{
+    if (v->has_view && camera_to_world) *camera_to_world = v->view;
+    return v->has_view;
+}
+
 static void viewport_rect(const sy_viewport *v, uint32_t ww, uint32_t wh, uint32_t r[4])
 {
     r[0] = v->desc.x < ww ? v->desc.x : ww;
@@ -174,8 +188,8 @@ sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, u
         const sy_node_data *nd = sy_node_get(scene, v->desc.camera);
         const sy_camera_data *cd = nd ? sy_camera_get(scene, nd->camera) : NULL;
         if (!cd) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "viewport: camera node %#x has no camera", v->desc.camera.id);
-        sy_mat4 world;
-        sy_result res = sy_node_world_matrix(scene, v->desc.camera, &world, err);
+        sy_mat4 world = v->view;
+        sy_result res = v->has_view ? SY_OK : sy_node_world_matrix(scene, v->desc.camera, &world, err);
         if (res != SY_OK) return res;
         mono = sy_camera_view_make(cd, &world, aspect);
     } else {
@@ -187,6 +201,7 @@ sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, u
             b = sy_scene_world_bounds(scene);
         }
         mono = sy_camera_view_frame_bounds(&b, aspect);
+        if (v->has_view) mono.camera_to_world = v->view;
     }
     *out = sy_camera_view_eye(&mono, v->desc.eye, v->desc.eye_separation, v->desc.zero_parallax);
     sy_result res = sy_camera_view_check(out, err);

@@ -9,8 +9,14 @@
  * Stereo is two viewports with off-axis frusta computed here from the eye separation and the
  * zero-parallax distance; back-ends never know.
  *
- * Ownership: the window owns its viewports (sy_window_destroy frees them); contexts come from a
- * caller-owned sy_context_pool. Thread-safety: single-threaded, like the scene it renders. */
+ * A viewport's view may also be set directly (sy_viewport_set_view: an interactive camera, see
+ * sy_interactive.h): the camera-to-world matrix is the viewport's own state, used in place of the
+ * camera node's world matrix, so moving the view changes nothing in the scene and needs no commit
+ * (the application's pending changes stay pending).
+ *
+ * Ownership: the window owns its viewports (sy_window_destroy frees them); a view set directly is
+ * copied into the viewport; contexts come from a caller-owned sy_context_pool. Thread-safety:
+ * single-threaded, like the scene it renders (a viewport's view included). */
 #ifndef SY_VIEWPORT_H
 #define SY_VIEWPORT_H
 
@@ -80,11 +86,20 @@ bool sy_viewport_active(const sy_viewport *v);
 sy_result sy_viewport_set_backend(sy_viewport *v, const char *backend, const char *params, sy_error *err);
 /** Sets the viewport's camera node ({0}: frame the root's bounds). */
 void sy_viewport_set_camera(sy_viewport *v, sy_node camera);
+/** Sets the view directly: camera_to_world (copied) replaces the camera node's world matrix; the
+ * camera node's camera still gives the projection (field of view, near and far planes), and a
+ * viewport without a camera node takes the projection of the view framing the root's bounds.
+ * Nothing in the scene changes (no commit is needed or made). NULL: the camera node's world matrix
+ * again. */
+void sy_viewport_set_view(sy_viewport *v, const sy_mat4 *camera_to_world);
+/** true and *camera_to_world (may be NULL) when a view is set directly (sy_viewport_set_view). */
+bool sy_viewport_view(const sy_viewport *v, sy_mat4 *camera_to_world);
 /** The viewport's back-end name (borrowed). */
 const char *sy_viewport_backend(const sy_viewport *v);
 
-/** The camera view a viewport renders with (its camera node's world matrix as of the last commit,
- * or a view framing the root's bounds), with the eye's off-axis frustum applied. */
+/** The camera view a viewport renders with (the view set directly, else its camera node's world
+ * matrix as of the last commit, or a view framing the root's bounds), with the eye's off-axis
+ * frustum applied. */
 sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, uint32_t window_width,
                                   uint32_t window_height, sy_camera_view *out, sy_error *err);
 

@@ -55,13 +55,16 @@ static sy_result add_eye(sy_window *win, const sy_compose_spec *spec, uint32_t e
                           .zero_parallax = spec->zero_parallax,
                           .composite = SY_COMPOSITE_REPLACE};
     sy_result r = sy_window_add_viewport(win, &d, &vp, err);
+    if (r == SY_OK) sy_viewport_set_view(vp, spec->view); /* NULL: the camera node's matrix */
     if (r != SY_OK || !spec->has_overlay) return r;
     d.root = spec->overlay_root;
     d.background.id = 0; /* transparent around the overlay's geometry */
     d.backend = spec->overlay_backend;
     d.params = spec->overlay_params;
     d.composite = spec->overlay_composite;
-    return sy_window_add_viewport(win, &d, &vp, err);
+    r = sy_window_add_viewport(win, &d, &vp, err);
+    if (r == SY_OK) sy_viewport_set_view(vp, spec->view);
+    return r;
 }
 
 static sy_result render_window(sy_scene *scene, sy_context_pool *pool, const sy_compose_spec *spec, uint32_t eye,

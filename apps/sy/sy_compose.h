@@ -2,7 +2,8 @@
  * viewport, an optional overlay viewport (another root of the same scene, possibly another
  * back-end, composited by depth / alpha-over / replace), and stereo layouts (side-by-side,
  * top-bottom, red-cyan anaglyph, separate eyes) with off-axis frusta from one camera. Both eyes
- * share one context per back-end through the context pool.
+ * share one context per back-end through the context pool. An interactive view sets its camera on
+ * the viewports directly (spec.view), never in the scene.
  * Ownership: layers are created here and owned by the caller (sy_layer_destroy).
  * Thread-safety: single-threaded, like the scene. */
 #ifndef SY_COMPOSE_H
@@ -21,6 +22,8 @@ typedef enum sy_stereo_mode {
 typedef struct sy_compose_spec {
     const char *backend, *params;
     sy_node root, camera;
+    const sy_mat4 *view;        /* non-NULL: the camera-to-world matrix set on every viewport directly
+                                   (sy_viewport_set_view; camera gives the projection): no commit */
     sy_background background;
     bool has_overlay;
     sy_node overlay_root;

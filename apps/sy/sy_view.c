@@ -2,9 +2,8 @@
  * scene (see sy_view.h). */
 #include "sy_view.h"
 
-#include "sy_governor.h"
+#include "sy_interactive.h"
 #include "sy_log.h"
-#include "sy_orbit.h"
 #include "sy_mediator_cluster.h"
 #include "sy_png.h"
 #include "sy_testpoint.h"
@@ -29,20 +28,16 @@ typedef struct viewer {
      * thread only (the window thread tests it for the title) */
     view_cluster *cluster;
     sy_context_pool *pool; /* created before the threads start; used by the render thread only */
-    sy_node cam_node; /* the viewer's own top-level camera node */
     pthread_mutex_t mu;
     pthread_cond_t cv;
     /* input thread -> render thread (under mu) */
-    sy_mat4 cam;
+    sy_interactive_input in; /* the orbit and the display filter (sy_interactive.h) */
     uint64_t req_version;
     uint32_t backend; /* index into the registry */
     bool overlay;
     uint32_t stereo;
     uint32_t w, h;
     bool quit;
-    uint32_t filter;        /* path tracer display filter: index into view_filters (key F) */
-    float threshold;        /* its threshold (keys [ and ]) */
-    uint64_t filter_version;
     /* render thread -> input thread (under mu) */
     uint8_t *img;
     uint32_t img_w, img_h;
@@ -61,46 +56,25 @@ typedef struct viewer {
     bool failed;
 } viewer;
 
-/* Display filters the F key cycles through, on a back-end with SY_CAP_FILTERS (sy_context_set_filter). */
-static const char *const view_filters[] = {"none", "pixel", "atrous", "jbu", "adaptive", "radiance"};
-#define VIEW_FILTER_COUNT (sizeof view_filters / sizeof view_filters[0])
-
-/* Render thread: applies the requested filter to the path tracer's context when it changed (or the
- * context is new); fills status (empty for other back-ends). Errors go to status, not fatal. */
-static void view_apply_filter(sy_context_pool *pool, const sy_view_args *a, const sy_mediator_class *cls,
-                              uint32_t filter, float threshold, uint64_t version, bool enabled, void **applied_state,
-                              uint64_t *applied_version, bool *applied_enabled, char *status, size_t len)
+/* Render thread: applies the input's display filter to the back-end's context (sy_interactive.h)
+ * and fills status (empty for a back-end without filters). Errors go to status, not fatal. */
+static void view_filter(sy_interactive *ia, sy_context_pool *pool, const sy_view_args *a, const sy_mediator_class *cls,
+                        const sy_interactive_input *in, bool enabled, char *status, size_t len)
 {
     status[0] = 0;
     if (!(cls->caps & SY_CAP_FILTERS)) return;
-    const char *chosen = view_filters[filter % VIEW_FILTER_COUNT];
-    sy_context *ctx = NULL;
+    sy_filter_info fi;
     sy_error err = {0};
-    if (sy_context_pool_get(pool, a->scene, cls->name, NULL, a->spec.root.id, &ctx, &err) != SY_OK) {
+    if (sy_interactive_apply_filter(ia, pool, a->scene, a->spec.root.id, cls, in->filter, in->threshold,
+                                    in->filter_version, enabled, &fi, &err) != SY_OK) {
         snprintf(status, len, " | filter: %.80s", err.message);
         return;
     }
-    void *state = sy_context_state(ctx);
-    if (state != *applied_state || version != *applied_version || enabled != *applied_enabled) {
-        sy_params opts = {0};
-        char t[32];
-        snprintf(t, sizeof t, "%g", (double)threshold);
-        if (sy_params_set(&opts, "threshold", t, &err) != SY_OK ||
-            sy_context_set_filter(ctx, enabled ? chosen : "none", &opts, &err) != SY_OK) {
-            snprintf(status, len, " | filter: %.80s", err.message);
-            return;
-        }
-        *applied_state = state;
-        *applied_version = version;
-        *applied_enabled = enabled;
-    }
-    if (!enabled && strcmp(chosen, "none") != 0) { /* the governor keeps it off while the view moves */
-        snprintf(status, len, " | filter %s t=%g off while moving", chosen, (double)threshold);
-        return;
-    }
-    sy_filter_info fi;
-    sy_context_filter_info(ctx, &fi);
-    if (strcmp(fi.name, "none") != 0)
+    char chosen[32];
+    sy_interactive_filter_name(in->filter, chosen);
+    if (!enabled && strcmp(chosen, "none") != 0) /* the governor keeps it off while the view moves */
+        snprintf(status, len, " | filter %s t=%g off while moving", chosen, (double)in->threshold);
+    else if (strcmp(fi.name, "none") != 0)
         snprintf(status, len, " | filter %s t=%g %.1f ms%s", fi.name, (double)fi.threshold, fi.seconds * 1e3,
                  fi.nonfinite_pixels ? " | NaN/Inf pixels!" : "");
     else
@@ -186,14 +160,14 @@ static void view_cluster_close(view_cluster *vc)
 /* Multi-display: the window's own picture of the wall, rendered locally with the same back-end
  * (the whole wall, or the configured viewer tile: an exact crop, as the servers' tiles are). */
 static sy_result view_cluster_local(view_cluster *vc, const sy_view_args *a, sy_context_pool *pool, const char *backend,
-                                    sy_node cam, uint32_t fw, uint32_t fh, sy_layer *img, sy_error *err)
+                                    const sy_compose_spec *spec, uint32_t fw, uint32_t fh, sy_layer *img, sy_error *err)
 {
     sy_cluster_rect t = vc->viewer_tile.w ? vc->viewer_tile : (sy_cluster_rect){0, 0, fw, fh};
     sy_camera_view view = {0};
     sy_context *ctx = NULL;
     sy_result r = SY_OK;
     if (!vc->wall_vp) { /* made once: the camera node and the wall size do not change */
-        sy_viewport_desc vd = {.root = a->spec.root, .camera = cam, .backend = backend};
+        sy_viewport_desc vd = {.root = a->spec.root, .camera = spec->camera, .backend = backend};
         r = sy_window_create(fw, fh, &vc->wall_win, err);
         if (r == SY_OK) r = sy_window_add_viewport(vc->wall_win, &vd, &vc->wall_vp, err);
         if (r != SY_OK) {
@@ -202,6 +176,7 @@ static sy_result view_cluster_local(view_cluster *vc, const sy_view_args *a, sy_
             return r;
         }
     }
+    if (r == SY_OK) sy_viewport_set_view(vc->wall_vp, spec->view); /* the viewer's view, directly */
     if (r == SY_OK) r = sy_viewport_camera_view(vc->wall_vp, a->scene, fw, fh, &view, err);
     if (r == SY_OK) r = sy_context_pool_get(pool, a->scene, backend, NULL, a->spec.root.id, &ctx, err);
     if (r == SY_OK) r = sy_context_sync(ctx, err);
@@ -237,7 +212,7 @@ static sy_result view_cluster_frame(view_cluster *vc, const sy_view_args *a, sy_
     if (r == SY_OK) r = sy_compose_render(a->scene, pool, spec, wall ? vc->wall_w : w, wall ? vc->wall_h : h, &ro, img, right, err);
     if (r == SY_OK && wall) { /* the servers presented the wall; the window shows its own picture of it */
         sy_layer_destroy(img);
-        r = view_cluster_local(vc, a, pool, backend, spec->camera, vc->wall_w, vc->wall_h, img, err);
+        r = view_cluster_local(vc, a, pool, backend, spec, vc->wall_w, vc->wall_h, img, err);
     }
     sy_cluster_frame_stats st = {0};
     if (ctx) sy_cluster_cli_last_frame(ctx, &st, NULL);
@@ -285,20 +260,15 @@ static void *render_main(void *p)
     sy_context_pool *pool = v->pool;
     sy_error err = {0};
     uint64_t seen = 0, cl_seen = 0;
-    sy_mat4 cam_applied;
-    memset(&cam_applied, 0, sizeof cam_applied);
     bool again = false;     /* plan (or, cluster: render) again without waiting for input */
     double wait_until = 0;  /* ms (sy_time_now): the governor's settle wait, 0 = none */
-    void *filter_state = NULL;
-    uint64_t filter_applied = 0;
-    bool filter_enabled = false;
     char fstatus[96] = "";
-    sy_governor *gov = NULL;
-    if (sy_governor_create(&(sy_governor_desc){.budget_ms = a->budget_ms}, &gov, &err) != SY_OK) goto fail_unlocked;
-    /* what the last planned frame showed: a difference is a view change for the governor */
-    uint32_t prev_bi = UINT32_MAX, prev_stereo = 0, prev_w = 0, prev_h = 0;
+    sy_interactive *ia = NULL; /* the governor, the display filter (sy_interactive.h) */
+    if (sy_interactive_create(a->budget_ms, &ia, &err) != SY_OK) goto fail_unlocked;
+    /* what the last planned frame showed besides the view, back-end and size: a difference is a
+     * view change for the governor */
+    uint32_t prev_stereo = 0, prev_w = 0;
     bool prev_overlay = false;
-    uint64_t prev_filter_version = 0;
     for (;;) {
         pthread_mutex_lock(&v->mu);
         while (!v->quit && seen == v->req_version && !again) {
@@ -317,34 +287,23 @@ static void *render_main(void *p)
         again = false;
         wait_until = 0;
         seen = v->req_version;
-        sy_mat4 cam = v->cam;
+        sy_interactive_input in = v->in;
         uint32_t bi = v->backend, stereo = v->stereo, w = v->w, h = v->h;
         bool overlay = v->overlay;
-        uint32_t filter = v->filter;
-        float threshold = v->threshold;
-        uint64_t filter_version = v->filter_version;
         pthread_mutex_unlock(&v->mu);
 
         const sy_mediator_class *cls = sy_mediator_at(bi);
         if (!cls) cls = sy_mediator_at(0);
         if (cls->caps & SY_CAP_REMOTE) cls = sy_mediator_find(a->backend); /* the cluster is not a choice of its own */
         if (!cls) cls = sy_mediator_at(0);
-        bool changed = !sy_mat4_equal(&cam, &cam_applied) || bi != prev_bi || stereo != prev_stereo || w != prev_w ||
-                       h != prev_h || overlay != prev_overlay;
-        if (!sy_mat4_equal(&cam, &cam_applied)) {
-            if (sy_node_set_matrix(a->scene, v->cam_node, &cam, &err) != SY_OK ||
-                sy_scene_commit(a->scene, NULL, &err) != SY_OK)
-                goto fail_unlocked;
-            cam_applied = cam;
-        }
-        if (bi != prev_bi) sy_governor_reset(gov); /* another back-end: another cost */
-        if (filter_version != prev_filter_version) sy_governor_redraw(gov); /* shown again, same samples */
-        prev_bi = bi, prev_stereo = stereo, prev_w = w, prev_h = h, prev_overlay = overlay;
-        prev_filter_version = filter_version;
+        bool changed = stereo != prev_stereo || w != prev_w || overlay != prev_overlay;
+        prev_stereo = stereo, prev_w = w, prev_overlay = overlay;
+        sy_mat4 view; /* the camera, set on the viewports directly: the scene is not committed */
+        sy_orbit_matrix(&in.orbit, &view);
         sy_compose_spec spec = a->spec;
         spec.backend = cls->name;
         spec.params = NULL;
-        spec.camera = v->cam_node;
+        spec.view = &view;
         spec.has_overlay = a->spec.has_overlay && overlay;
         spec.stereo = stereo;
         uint32_t ew = stereo == SY_STEREO_SBS ? (w / 2 ? w / 2 : 1) : w;
@@ -353,7 +312,9 @@ static void *render_main(void *p)
             /* a progressive back-end refines a resting mono view; stereo renders once at full size */
             uint32_t caps = sy_mediator_class_caps(cls, NULL);
             if (stereo != SY_STEREO_NONE) caps &= ~(uint32_t)SY_CAP_PROGRESSIVE;
-            sy_governor_plan(gov, ew, h, caps, changed, sy_time_now() * 1e3, &gf);
+            sy_interactive_view iv = {.orbit = &in.orbit, .backend = cls, .caps = caps, .width = ew, .height = h,
+                                      .filter_version = in.filter_version, .changed = changed};
+            sy_interactive_plan(ia, &iv, sy_time_now() * 1e3, &gf, NULL);
             if (gf.wait_ms > 0) { /* settling after a moving frame: the refining frame comes next */
                 wait_until = sy_time_now() * 1e3 + gf.wait_ms;
                 continue;
@@ -374,8 +335,7 @@ static void *render_main(void *p)
             r = view_cluster_frame(v->cluster, a, pool, &spec, cls->name, restart, ew, h, &img, &right, &cl_spp,
                                    &cl_refine, cl_status, sizeof cl_status, &err);
         } else {
-            view_apply_filter(pool, a, cls, filter, threshold, filter_version, gf.filter, &filter_state, &filter_applied,
-                              &filter_enabled, fstatus, sizeof fstatus);
+            view_filter(ia, pool, a, cls, &in, gf.filter, fstatus, sizeof fstatus);
             sy_window_render_opts ro = {.sample_count = gf.samples, .preview = gf.preview};
             r = sy_compose_render(a->scene, pool, &spec, gf.width, gf.height, &ro, &img, &right, &err);
         }
@@ -393,18 +353,11 @@ static void *render_main(void *p)
         }
         sy_post_desc post = sy_post_display();
         sy_layer_post_apply(&img, &post);
-        size_t n = (size_t)img.width * img.height;
-        uint8_t *bytes = malloc(n * 4);
-        if (bytes)
-            for (size_t i = 0; i < n * 4; ++i) {
-                float x = img.rgba[i];
-                if ((i & 3) != 3 && img.rgba[(i | 3)] > 0.0f) x /= img.rgba[(i | 3)]; /* straight for display */
-                bytes[i] = sy_unorm8(x);
-            }
+        uint8_t *bytes = sy_interactive_rgba8(&img, SY_RGBA8_STRAIGHT); /* straight alpha for display */
         /* the frame's whole time (render, tone mapping, conversion); a frame that translated the
          * scene for a new context says nothing about the next ones */
         ms = (sy_time_now() - t0) * 1e3;
-        if (!v->cluster && sy_context_pool_size(pool) == contexts) sy_governor_report(gov, &gf, ms);
+        if (!v->cluster) sy_interactive_report(ia, &gf, ms, sy_context_pool_size(pool) != contexts);
         sy_context *ctx = NULL;
         sy_mediator_stats st = {0};
         if (v->cluster) st.samples = cl_spp; /* no local context in cluster mode */
@@ -431,10 +384,10 @@ static void *render_main(void *p)
         /* local: plan again (the governor says what comes next); cluster: keep refining */
         again = v->cluster ? cl_refine : true;
     }
-    sy_governor_destroy(gov);
+    sy_interactive_destroy(ia);
     return NULL;
 fail_unlocked:
-    sy_governor_destroy(gov);
+    sy_interactive_destroy(ia);
     pthread_mutex_lock(&v->mu);
     v->error = err;
     v->failed = true;
@@ -446,16 +399,14 @@ fail_unlocked:
 /* >>input */
 typedef struct input {
     viewer *v;
-    sy_orbit o, home;
     double mx, my;
     int drag; /* 0 none, 1 orbit, 2 pan */
     bool changed;
 } input;
 
-static void post_request(viewer *v, const input *in)
+static void post_request(viewer *v)
 {
     pthread_mutex_lock(&v->mu);
-    sy_orbit_matrix(&in->o, &v->cam);
     v->req_version++;
     pthread_cond_signal(&v->cv);
     pthread_mutex_unlock(&v->mu);
@@ -482,20 +433,14 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         v->req_version++;
         pthread_cond_signal(&v->cv);
         pthread_mutex_unlock(&v->mu);
-    } else if (key == GLFW_KEY_F || key == GLFW_KEY_LEFT_BRACKET || key == GLFW_KEY_RIGHT_BRACKET) {
-        /* path tracer display filter: F cycles it, [ ] halve / double the threshold (live: the
-         * render thread applies it to its context, the accumulation keeps its samples) */
+    } else if (key == GLFW_KEY_F || key == GLFW_KEY_LEFT_BRACKET || key == GLFW_KEY_RIGHT_BRACKET || key == GLFW_KEY_R) {
+        /* the display filter: F cycles it, [ ] halve / double the threshold (live: the render thread
+         * applies it to its context, the accumulation keeps its samples); R: the camera home */
         pthread_mutex_lock(&v->mu);
-        if (key == GLFW_KEY_F) v->filter = (v->filter + 1) % (uint32_t)VIEW_FILTER_COUNT;
-        else if (key == GLFW_KEY_LEFT_BRACKET && v->threshold > 1e-6f) v->threshold *= 0.5f;
-        else if (key == GLFW_KEY_RIGHT_BRACKET && v->threshold < 1e3f) v->threshold *= 2.0f;
-        v->filter_version++;
+        sy_interactive_key(&v->in, key); /* GLFW's codes of these keys are their characters */
         v->req_version++;
         pthread_cond_signal(&v->cv);
         pthread_mutex_unlock(&v->mu);
-    } else if (key == GLFW_KEY_R) {
-        in->o = in->home;
-        in->changed = true;
     }
 }
 
@@ -514,8 +459,9 @@ static void on_cursor(GLFWwindow *w, double x, double y)
     double dx = x - in->mx, dy = y - in->my;
     in->mx = x, in->my = y;
     if (!in->drag) return;
-    if (in->drag == 1) sy_orbit_rotate(&in->o, (float)dx, (float)dy);
-    else sy_orbit_pan(&in->o, (float)dx, (float)dy);
+    pthread_mutex_lock(&in->v->mu);
+    sy_interactive_drag(&in->v->in, in->drag == 1 ? 0 : 1, (float)dx, (float)dy);
+    pthread_mutex_unlock(&in->v->mu);
     in->changed = true;
 }
 
@@ -523,15 +469,15 @@ static void on_scroll(GLFWwindow *w, double dx, double dy)
 {
     (void)dx;
     input *in = glfwGetWindowUserPointer(w);
-    sy_orbit_zoom(&in->o, (float)dy);
+    pthread_mutex_lock(&in->v->mu);
+    sy_interactive_wheel(&in->v->in, (float)dy);
+    pthread_mutex_unlock(&in->v->mu);
     in->changed = true;
 }
 
 static void fly(GLFWwindow *w, input *in, float dt)
 {
-    sy_mat4 m;
-    sy_orbit_matrix(&in->o, &m);
-    float speed = in->o.dist * 0.8f * dt, mv[3] = {0, 0, 0};
+    float mv[3] = {0, 0, 0};
     if (glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) mv[2] -= 1;
     if (glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS) mv[2] += 1;
     if (glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS) mv[0] -= 1;
@@ -539,9 +485,9 @@ static void fly(GLFWwindow *w, input *in, float dt)
     if (glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS) mv[1] += 1;
     if (glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS) mv[1] -= 1;
     if (mv[0] == 0 && mv[1] == 0 && mv[2] == 0) return;
-    for (int i = 0; i < 3; ++i)
-        in->o.target[i] += speed * (mv[0] * m.m[i] + mv[2] * m.m[8 + i]) + speed * mv[1] * (i == 1 ? 1.0f : 0.0f);
-    in->changed = true;
+    pthread_mutex_lock(&in->v->mu);
+    if (sy_interactive_fly(&in->v->in, mv, dt)) in->changed = true;
+    pthread_mutex_unlock(&in->v->mu);
 }
 
 static sy_result write_screenshot(const char *path, int w, int h, sy_error *err)
@@ -569,21 +515,20 @@ static sy_result write_screenshot(const char *path, int w, int h, sy_error *err)
 
 static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_cluster *cluster, sy_error *err)
 {
-    uint32_t filter0 = 0;
-    if (args->filter) { /* the initial display filter, checked before any window opens */
-        while (filter0 < VIEW_FILTER_COUNT && strcmp(view_filters[filter0], args->filter) != 0) filter0++;
-        if (filter0 == VIEW_FILTER_COUNT)
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "view: unknown filter '%s' (expected none, pixel, atrous, jbu, adaptive or radiance)",
-                                args->filter);
+    /* the orbit at the camera's pose, the initial display filter and threshold: checked before any
+     * window opens (sy_interactive.h) */
+    sy_interactive_input in0;
+    sy_result r = sy_interactive_input_init(args->scene, args->spec.root, args->spec.camera,
+                                            (float)args->width / (float)args->height, args->filter, args->threshold, &in0,
+                                            err);
+    if (r != SY_OK) {
+        sy_error_prefix(err, "view");
+        return r;
     }
     for (const char *k = args->keys; k && *k; ++k)
         if (!isalnum((unsigned char)*k) && *k != '[' && *k != ']')
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: --keys: '%c' is not a key (letters, digits, [ and ])",
                                 *k);
-    if (!(args->threshold >= 0.0f) || !isfinite(args->threshold))
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: threshold %g must be a finite value >= 0",
-                            (double)args->threshold);
     if (!glfwInit()) {
         const char *desc = NULL;
         glfwGetError(&desc);
@@ -611,36 +556,24 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
     pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
     pthread_cond_init(&v.cv, &ca);
     pthread_condattr_destroy(&ca);
-    for (uint32_t i = 0; i < sy_mediator_count(); ++i)
-        if (!strcmp(sy_mediator_at(i)->name, args->backend)) v.backend = i;
+    sy_interactive_backend_index(args->backend, &v.backend, NULL); /* NULL: the registry's default */
     v.overlay = true;
     if (cluster && cluster->mode == SY_CLUSTER_STEREO) v.stereo = SY_STEREO_SBS; /* --cluster-mode stereo */
 
-    /* the viewer's own camera node: same camera object, top level, world = local */
-    sy_result r = SY_OK;
+    /* the camera: the application's camera node gives the projection, the orbit the view (set on
+     * the viewports directly: the scene is never committed) */
     input in = {.v = &v};
-    sy_mat4 world = sy_mat4_identity();
     const sy_node_data *cn = args->spec.camera.id ? sy_node_get(args->scene, args->spec.camera) : NULL;
-    sy_bounds b;
-    if (sy_node_world_bounds(args->scene, args->spec.root, &b, NULL) != SY_OK) b = sy_scene_world_bounds(args->scene);
-    if (cn) sy_node_world_matrix(args->scene, args->spec.camera, &world, NULL);
-    else world = sy_camera_view_frame_bounds(&b, (float)args->width / (float)args->height).camera_to_world;
-    if ((r = sy_node_create(args->scene, "viewer camera", &v.cam_node, err)) ||
-        (cn && (r = sy_node_set_camera(args->scene, v.cam_node, cn->camera, err))) ||
-        (!cn && (r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: the scene has no camera")))) {
+    if (!cn || !cn->camera.id) {
         glfwDestroyWindow(win);
         glfwTerminate();
-        return r;
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: the scene has no camera");
     }
-    sy_orbit_from_matrix(&world, &b, &in.o);
-    in.home = in.o;
+    v.in = in0;
     int fbw, fbh;
     glfwGetFramebufferSize(win, &fbw, &fbh);
     v.w = (uint32_t)fbw, v.h = (uint32_t)fbh;
-    sy_orbit_matrix(&in.o, &v.cam);
     v.req_version = 1;
-    v.threshold = args->threshold > 0.0f ? args->threshold : 0.01f; /* the pixel filter's default t */
-    v.filter = filter0;
 
     pthread_t th;
     if (pthread_create(&th, NULL, render_main, &v) != 0) {
@@ -714,7 +647,7 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
         }
         if (in.changed) {
             in.changed = false;
-            post_request(&v, &in);
+            post_request(&v);
         }
         glViewport(0, 0, fbw, fbh);
         glClearColor(0, 0, 0, 1);

@@ -58,11 +58,13 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     if (!desc || !desc->scene) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "web: no scene");
     const sy_node_data *cn = desc->camera.id ? sy_node_get(desc->scene, desc->camera) : NULL;
     if (!cn || !cn->camera.id) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "web: the scene has no camera");
-    const char *backend = desc->backend ? desc->backend : sy_mediator_default_name();
-    int bi = -1;
-    for (uint32_t i = 0; i < sy_mediator_count(); ++i)
-        if (!strcmp(sy_mediator_at(i)->name, backend)) bi = (int)i;
-    if (bi < 0) return sy_error_set(err, SY_ERR_NOT_FOUND, "web: back-end '%s' is not registered (see sy backends)", backend);
+    uint32_t bi = 0; /* the registry's default when none is named */
+    sy_result rb = sy_interactive_backend_index(desc->backend, &bi, err);
+    if (rb != SY_OK) {
+        sy_error_prefix(err, "web");
+        return rb;
+    }
+    const char *backend = sy_mediator_at(bi)->name;
     if (sodium_init() < 0) return sy_error_set(err, SY_ERR_BACKEND, "web: libsodium could not start");
     sy_web *w = calloc(1, sizeof *w);
     if (!w) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
@@ -80,8 +82,7 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     if (!w->d.still_deadline_ms) w->d.still_deadline_ms = 10000;
     if (!w->d.head_timeout_ms) w->d.head_timeout_ms = 5000;
     if (!w->d.max_pending) w->d.max_pending = 128;
-    w->initial_backend = w->backend = (uint32_t)bi;
-    w->threshold = desc->threshold > 0 ? desc->threshold : 0.01f;
+    w->initial_backend = w->backend = bi;
     pthread_mutex_init(&w->mu, NULL);
     pthread_cond_init(&w->cv, NULL);
     w->pending_tail = &w->pending;
@@ -95,13 +96,6 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
                          "web: a limit is out of range (frame <= 16384, clients <= 1000, message 64..16 MiB, quality "
                          "1..100, idle timeout <= 3600 s, budget 0..1e5 ms, still pixels <= 16384^2, pending "
                          "connections <= 1024, head timeout and still deadline <= 600 s)");
-    if (r == SY_OK && desc->filter) {
-        while (w->filter < SY_WEBI_FILTER_COUNT && strcmp(sy_webi_filters[w->filter], desc->filter) != 0) w->filter++;
-        if (w->filter == SY_WEBI_FILTER_COUNT)
-            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                             "web: unknown filter '%s' (expected none, pixel, atrous, jbu, adaptive or radiance)",
-                             desc->filter);
-    }
     if (r == SY_OK) r = parse_listen(desc->listen ? desc->listen : "127.0.0.1:8080", w->host, sizeof w->host, &w->port, err);
     if (r == SY_OK && desc->route_count) {
         w->routes = calloc(desc->route_count, sizeof *w->routes);
@@ -128,24 +122,12 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
         sodium_bin2hex(w->token, sizeof w->token, raw, sizeof raw);
         sodium_memzero(raw, sizeof raw);
     }
-    /* the server's camera node: the scene camera's object, top level, starting at its world pose */
-    sy_mat4 world = sy_mat4_identity();
-    sy_bounds b;
-    if (r == SY_OK) {
-        if (sy_node_world_bounds(desc->scene, desc->root.id ? desc->root : (sy_node){0}, &b, NULL) != SY_OK)
-            b = sy_scene_world_bounds(desc->scene);
-        sy_node_world_matrix(desc->scene, desc->camera, &world, NULL);
-        sy_orbit_from_matrix(&world, &b, &w->orbit);
-        w->home = w->orbit;
-        r = sy_node_create(desc->scene, "web camera", &w->cam_node, err);
-    }
-    if (r == SY_OK) r = sy_node_set_camera(desc->scene, w->cam_node, cn->camera, err);
-    if (r == SY_OK) {
-        sy_mat4 m;
-        sy_orbit_matrix(&w->orbit, &m);
-        r = sy_node_set_matrix(desc->scene, w->cam_node, &m, err);
-    }
-    if (r == SY_OK) r = sy_scene_commit(desc->scene, NULL, err);
+    /* the view every page shares starts at the camera's pose; it is set on the server's viewports,
+     * never in the scene (sy_interactive.h): the server adds nothing to the scene, commits nothing */
+    if (r == SY_OK && (r = sy_interactive_input_init(desc->scene, desc->root, desc->camera, 1.0f, desc->filter,
+                                                     desc->threshold > 0 ? desc->threshold : 0.0f, &w->in, err)))
+        sy_error_prefix(err, "web");
+    if (r == SY_OK) sy_orbit_matrix(&w->in.orbit, &w->view);
     if (r != SY_OK) {
         sy_web_destroy(w);
         return r;
@@ -216,7 +198,11 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     return SY_OK;
 }
 
-sy_node sy_web_camera(const sy_web *w) { return w ? w->cam_node : (sy_node){0}; }
+void sy_web_view(const sy_web *w, sy_mat4 *camera_to_world, sy_node *camera)
+{
+    *camera_to_world = w->view;
+    if (camera) *camera = w->d.camera;
+}
 
 uint16_t sy_web_port(const sy_web *w) { return (uint16_t)w->port; }
 
@@ -270,10 +256,6 @@ void sy_web_destroy(sy_web *w)
     if (w->latest) {
         free(w->latest->buf);
         free(w->latest);
-    }
-    if (w->cam_node.id) {
-        sy_object_destroy(w->d.scene, SY_TYPE_NODE, w->cam_node.id, NULL);
-        sy_scene_commit(w->d.scene, NULL, NULL);
     }
     free(w->routes);
     pthread_mutex_destroy(&w->mu);

@@ -106,7 +106,9 @@ typedef struct sy_web_desc {
 /** The server (opaque). */
 typedef struct sy_web sy_web;
 
-/** Binds the address (apps/web/sy_web_gate.h takes the connections until their request is whole), makes the server's camera node in the scene and starts the network thread.
+/** Binds the address (apps/web/sy_web_gate.h takes the connections until their request is whole)
+ * and starts the network thread. The scene is only read: the server adds nothing to it and never
+ * commits it (the application commits its own changes).
  * Fails with a message naming the address when it cannot be bound, the back-end when it is not
  * registered, the option when a limit is out of range. */
 sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err);
@@ -122,9 +124,12 @@ const char *sy_web_url(const sy_web *w);
  * ends serving (a back-end that fails is reported to the pages and serving goes on). */
 sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err);
 
-/** The server's camera node (made by sy_web_create; the view every page shares). Any thread; read
- * its matrix on the scene's thread. */
-sy_node sy_web_camera(const sy_web *w);
+/** The view every page shares, as last rendered (a frame or a still; before the first, the
+ * camera's pose): its camera-to-world matrix, and (camera, may be NULL) the application's camera
+ * node whose camera gives the projection. The server sets the view on its viewports directly
+ * (core/sy_interactive.h): it adds no node to the scene and never commits it. Call on the render
+ * thread (a route handler). */
+void sy_web_view(const sy_web *w, sy_mat4 *camera_to_world, sy_node *camera);
 /** The server's counters (any thread): connections (sy_web_gate.h) and stills. */
 typedef struct sy_web_stats {
     /** @{ connections accepted, handed to the HTTP server, refused, evicted and expired while
@@ -144,7 +149,7 @@ void sy_web_stats_get(sy_web *w, sy_web_stats *out);
 /** Makes sy_web_run return (any thread). */
 void sy_web_stop(sy_web *w);
 
-/** Stops the network thread, closes every connection, removes the camera node, frees w (NULL-safe). */
+/** Stops the network thread, closes every connection, frees w (NULL-safe). */
 void sy_web_destroy(sy_web *w);
 
 #ifdef __cplusplus

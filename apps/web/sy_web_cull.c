@@ -78,10 +78,9 @@ static sy_result on_view(void *user, sy_scene *scene, const sy_web_request *req,
     (void)req;
     sy_web_cull *c = user;
     if (!c->server) return sy_error_set(err, SY_ERR_NOT_FOUND, "/api/view: no server attached");
-    sy_node cam = sy_web_camera(c->server);
+    sy_node cam;
     sy_mat4 m;
-    sy_result r = sy_node_world_matrix(scene, cam, &m, err);
-    if (r != SY_OK) return r;
+    sy_web_view(c->server, &m, &cam);
     const sy_node_data *nd = sy_node_get(scene, cam);
     const sy_camera_data *cd = nd ? sy_camera_get(scene, nd->camera) : NULL;
     double fov = cd && cd->yfov > 0.0f ? (double)cd->yfov * (180.0 / 3.14159265358979323846) : 45.0;

@@ -3,7 +3,7 @@
  * and the functions one module calls in another (prefix sy_webi_; none of them is API). The
  * modules, bottom-up (each calls only those before it; tests/core/layers_test.sh checks it), over
  * the request checks (sy_web_check.c) and the gate (sy_web_gate.c):
- *   sy_web_mailbox.c  what the two threads share (under mu): jobs, frames, the display filters
+ *   sy_web_mailbox.c  what the two threads share (under mu): jobs, frames
  *   sy_web_http.c     HTTP on the network thread: page, stills, routes, token, body collection
  *   sy_web_ws.c       WebSocket viewers: input messages in, newest frame out; the protocol table
  *                     and the network thread
@@ -14,7 +14,7 @@
 
 #include "sy_web.h"
 
-#include "sy_orbit.h"
+#include "sy_interactive.h"
 #include "sy_web_check.h"
 #include "sy_web_gate.h"
 
@@ -26,11 +26,6 @@
 #include <stdint.h>
 
 #define WEB_TOKEN_BYTES 16u
-
-/* Display filters the F key cycles through (as sy view), on a back-end with SY_CAP_FILTERS
- * (sy_web_mailbox.c). */
-#define SY_WEBI_FILTER_COUNT 6u
-extern const char *const sy_webi_filters[SY_WEBI_FILTER_COUNT];
 
 /* The mailbox: what the two threads share (sy_web_mailbox.c). */
 typedef enum job_state { JOB_PENDING, JOB_RUNNING, JOB_FINISHED, JOB_DELIVERING } job_state;
@@ -81,8 +76,7 @@ struct sy_web {
     char token[2 * WEB_TOKEN_BYTES + 1]; /* "" = none required */
     char url[300];
     bool loopback;
-    sy_node cam_node;
-    sy_orbit home;
+    sy_mat4 view; /* render thread: the view last set on the viewports (sy_web_view) */
     uint32_t initial_backend;
     struct lws_context *ctx;
     struct lws_vhost *vhost;
@@ -99,13 +93,10 @@ struct sy_web {
     pthread_cond_t cv;
     /* --- under mu: network thread -> render thread --- */
     bool quit;
-    sy_orbit orbit;
+    sy_interactive_input in; /* the orbit and the display filter the pages steer (sy_interactive.h) */
     uint64_t view_version; /* camera, back-end, filter or size changed */
     uint64_t input_gen;    /* inputs received, all clients */
     uint32_t backend;      /* registry index */
-    uint32_t filter;
-    float threshold;
-    uint64_t filter_version;
     uint32_t display_w, display_h;
     uint32_t clients;
     web_job *pending, **pending_tail; /* routes */

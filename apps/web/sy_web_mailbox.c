@@ -1,11 +1,9 @@
 /* sy_web_mailbox.c — what the network thread and the render thread of the sy_web server share
- * (under mu): the jobs they pass each other, the newest frame, the display filters
+ * (under mu): the jobs they pass each other, the newest frame
  * (sy_web_internal.h; docs/WEB.md, "Threads"). */
 #include "sy_web_internal.h"
 
 #include <stdlib.h>
-
-const char *const sy_webi_filters[SY_WEBI_FILTER_COUNT] = {"none", "pixel", "atrous", "jbu", "adaptive", "radiance"};
 
 void sy_webi_frame_release(sy_web *w, web_frame *f)
 {

@@ -4,7 +4,7 @@
  * "Threads"). */
 #include "sy_web_internal.h"
 
-#include "sy_governor.h"
+#include "sy_interactive.h"
 #include "sy_jpeg.h"
 #include "sy_log.h"
 #include "sy_mediator.h"
@@ -23,16 +23,9 @@ typedef struct render_state {
     sy_context_pool *pool;
     sy_window *win, *still_win;
     sy_viewport *vp, *still_vp;
-    sy_mat4 cam_applied;
-    bool cam_valid;
     uint32_t backend_applied;
-    const sy_context *filter_ctx; /* the pool context the filter was last set on (borrowed) */
-    uint64_t filter_applied;
-    bool filter_enabled;
     uint64_t seq;
-    sy_governor *gov;
-    uint32_t prev_bi, prev_w, prev_h; /* what the last planned frame showed: a difference is a change */
-    uint64_t prev_filter_version;
+    sy_interactive *ia; /* the governor, the view on the viewports, the display filter (sy_interactive.h) */
 } render_state;
 
 /* The display size the governor plans for: what the page asked, capped at max_width x max_height
@@ -50,30 +43,6 @@ static void display_size(const sy_web *w, uint32_t dw, uint32_t dh, uint32_t *ow
     }
 }
 
-/* Premultiplied linear RGBA after the display chain -> 8-bit (composited over black). */
-static uint8_t *layer_to_rgba8(const sy_layer *img)
-{
-    size_t n = (size_t)img->width * img->height;
-    uint8_t *px = malloc(n * 4);
-    if (!px) return NULL;
-    for (size_t i = 0; i < n * 4; ++i) {
-        float x = (i & 3) == 3 ? 1.0f : img->rgba[i];
-        px[i] = sy_unorm8(x);
-    }
-    return px;
-}
-
-static sy_result apply_camera(sy_web *w, render_state *rs, const sy_orbit *o, sy_error *err)
-{
-    sy_mat4 m;
-    sy_orbit_matrix(o, &m);
-    if (rs->cam_valid && !memcmp(&m, &rs->cam_applied, sizeof m)) return SY_OK;
-    sy_result r = sy_node_set_matrix(w->d.scene, w->cam_node, &m, err);
-    if (r == SY_OK) r = sy_scene_commit(w->d.scene, NULL, err);
-    if (r == SY_OK) rs->cam_applied = m, rs->cam_valid = true;
-    return r;
-}
-
 /* Renders w x h with the current back-end into an 8-bit image (display chain: ACES + sRGB). */
 static sy_result render_rgba8(sy_web *w, render_state *rs, sy_window *win, uint32_t width, uint32_t height,
                               uint32_t samples, float preview, uint8_t **out, sy_error *err)
@@ -87,35 +56,9 @@ static sy_result render_rgba8(sy_web *w, render_state *rs, sy_window *win, uint3
     sy_window_render_opts ro = {.sample_count = samples, .preview = preview,
                                 .post = sy_post_display()};
     if (r == SY_OK) r = sy_window_render(win, w->d.scene, rs->pool, &ro, &img, err);
-    if (r == SY_OK && !(*out = layer_to_rgba8(&img))) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
+    if (r == SY_OK && !(*out = sy_interactive_rgba8(&img, SY_RGBA8_OVER_BLACK))) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
     sy_layer_destroy(&img);
     return r;
-}
-
-/* The path tracer's display filter (as sy view): applied when it changed or the context is new. */
-static void apply_filter(sy_web *w, render_state *rs, const sy_mediator_class *cls, uint32_t filter, float threshold,
-                         uint64_t version, bool enabled, char *status, size_t len)
-{
-    status[0] = 0;
-    if (!(cls->caps & SY_CAP_FILTERS)) return;
-    sy_context *ctx = NULL;
-    sy_error err = {0};
-    if (sy_context_pool_get(rs->pool, w->d.scene, cls->name, NULL, w->d.root.id, &ctx, &err) != SY_OK) {
-        snprintf(status, len, "filter: %.200s", err.message);
-        return;
-    }
-    if (ctx == rs->filter_ctx && version == rs->filter_applied && enabled == rs->filter_enabled) return;
-    sy_params opts = {0};
-    char t[32];
-    snprintf(t, sizeof t, "%g", (double)threshold);
-    if (sy_params_set(&opts, "threshold", t, &err) != SY_OK ||
-        sy_context_set_filter(ctx, enabled ? sy_webi_filters[filter % SY_WEBI_FILTER_COUNT] : "none", &opts, &err) != SY_OK) {
-        snprintf(status, len, "filter: %.200s", err.message);
-        return;
-    }
-    rs->filter_ctx = ctx;
-    rs->filter_applied = version;
-    rs->filter_enabled = enabled; /* the governor keeps the filter off while the view moves */
 }
 
 static void finish_job(sy_web *w, web_job *j)
@@ -175,8 +118,9 @@ static void run_still(sy_web *w, render_state *rs, web_job *j, const sy_orbit *o
         const sy_mediator_class *cls = sy_mediator_at(rs->backend_applied);
         uint32_t spp = cls && (cls->caps & SY_CAP_PROGRESSIVE) ? w->d.still_samples : 1;
         sy_layer img = {0};
-        r = apply_camera(w, rs, o, &err);
-        if (r == SY_OK) r = sy_viewport_set_backend(rs->still_vp, (cls ? cls : sy_mediator_at(w->initial_backend))->name, NULL, &err);
+        sy_orbit_matrix(o, &w->view);
+        sy_viewport_set_view(rs->still_vp, &w->view); /* the view directly: the scene is not committed */
+        r = sy_viewport_set_backend(rs->still_vp, (cls ? cls : sy_mediator_at(w->initial_backend))->name, NULL, &err);
         if (r == SY_OK) r = sy_window_resize(rs->still_win, j->w, j->h, &err);
         if (r == SY_OK) r = sy_layer_create(j->w, j->h, &img, &err);
         for (uint32_t done = 0; r == SY_OK && done < spp && !cancelled; ) {
@@ -187,7 +131,7 @@ static void run_still(sy_web *w, render_state *rs, web_job *j, const sy_orbit *o
             cancelled = sy_webi_job_abandoned(w, j);
         }
         uint8_t *px = NULL;
-        if (r == SY_OK && !cancelled && !(px = layer_to_rgba8(&img))) r = sy_error_set(&err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
+        if (r == SY_OK && !cancelled && !(px = sy_interactive_rgba8(&img, SY_RGBA8_OVER_BLACK))) r = sy_error_set(&err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
         sy_layer_destroy(&img);
         if (px) r = sy_jpeg_encode_rgba8(px, j->w, j->h, 95, &j->resp.body, &j->resp.body_len, &err);
         free(px);
@@ -238,37 +182,36 @@ static void set_status(sy_web *w, const char *s)
 /* One frame through the frame-time governor (core/sy_governor.h): plans it for the display size,
  * renders what the plan says, reports its time. *again: plan again without waiting for input;
  * *wait_ms > 0: plan again after that long (the view is settling). */
-static sy_result render_frame(sy_web *w, render_state *rs, const sy_orbit *o, uint32_t bi, uint32_t dw, uint32_t dh,
-                              uint64_t gen, uint32_t filter, float threshold, uint64_t filter_version, bool *again,
-                              double *wait_ms, sy_error *err)
+static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_input *in, uint32_t bi, uint32_t dw,
+                              uint32_t dh, uint64_t gen, bool *again, double *wait_ms, sy_error *err)
 {
     *again = false, *wait_ms = 0;
     const sy_mediator_class *cls = sy_mediator_at(bi);
     if (!cls) return sy_error_set(err, SY_ERR_NOT_FOUND, "web: back-end %u is not registered", bi);
     uint32_t pw = 0, ph = 0;
     display_size(w, dw, dh, &pw, &ph);
-    sy_mat4 m;
-    sy_orbit_matrix(o, &m);
-    bool changed = !rs->cam_valid || memcmp(&m, &rs->cam_applied, sizeof m) != 0 || bi != rs->prev_bi ||
-                   pw != rs->prev_w || ph != rs->prev_h;
-    sy_result r = apply_camera(w, rs, o, err);
-    if (r == SY_OK && bi != rs->backend_applied) {
+    sy_result r = SY_OK;
+    if (bi != rs->backend_applied) {
         r = sy_viewport_set_backend(rs->vp, cls->name, NULL, err);
         if (r == SY_OK) rs->backend_applied = bi;
     }
     if (r != SY_OK) return r;
-    if (bi != rs->prev_bi) sy_governor_reset(rs->gov); /* another back-end: another cost */
-    if (filter_version != rs->prev_filter_version) sy_governor_redraw(rs->gov); /* shown again, same samples */
-    rs->prev_bi = bi, rs->prev_w = pw, rs->prev_h = ph, rs->prev_filter_version = filter_version;
     sy_governor_frame gf;
-    sy_governor_plan(rs->gov, pw, ph, sy_mediator_class_caps(cls, NULL), changed, sy_time_now() * 1e3, &gf);
+    sy_interactive_view iv = {.orbit = &in->orbit, .viewports = &rs->vp, .viewport_count = 1, .backend = cls,
+                              .caps = sy_mediator_class_caps(cls, NULL), .width = pw, .height = ph,
+                              .filter_version = in->filter_version};
+    /* the view set on the viewport directly: the application's scene is not committed */
+    sy_interactive_plan(rs->ia, &iv, sy_time_now() * 1e3, &gf, &w->view);
     if (gf.wait_ms > 0) { /* settling after a moving frame: the refining frame comes next */
         *wait_ms = gf.wait_ms;
         return SY_OK;
     }
     if (gf.idle || !gf.width || !gf.height) return SY_OK; /* refined: sleep until input */
-    char fstatus[240];
-    apply_filter(w, rs, cls, filter, threshold, filter_version, gf.filter, fstatus, sizeof fstatus);
+    char fstatus[240] = "";
+    sy_error ferr = {0};
+    if (sy_interactive_apply_filter(rs->ia, rs->pool, w->d.scene, w->d.root.id, cls, in->filter, in->threshold,
+                                    in->filter_version, gf.filter, NULL, &ferr) != SY_OK)
+        snprintf(fstatus, sizeof fstatus, "filter: %.200s", ferr.message);
     uint8_t *px = NULL, *jpeg = NULL;
     size_t jlen = 0;
     uint32_t contexts = sy_context_pool_size(rs->pool);
@@ -279,7 +222,7 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_orbit *o, ui
     free(px);
     if (r != SY_OK) return r;
     /* a frame that translated the scene for a new context says nothing about the next ones */
-    if (sy_context_pool_size(rs->pool) == contexts) sy_governor_report(rs->gov, &gf, ms);
+    sy_interactive_report(rs->ia, &gf, ms, sy_context_pool_size(rs->pool) != contexts);
     sy_mediator_stats st = {0};
     sy_context *ctx = NULL;
     if (sy_context_pool_get(rs->pool, w->d.scene, cls->name, NULL, w->d.root.id, &ctx, NULL) == SY_OK)
@@ -311,13 +254,13 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_orbit *o, ui
 }
 
 /* The live frame (the governor says its size) and what a failed back-end tells the pages. */
-static void render_live(sy_web *w, render_state *rs, const sy_orbit *o, uint32_t bi, uint32_t dw, uint32_t dh, uint64_t gen,
-                        uint32_t filter, float threshold, uint64_t fv, bool *again, double *wait_until)
+static void render_live(sy_web *w, render_state *rs, const sy_interactive_input *in, uint32_t bi, uint32_t dw, uint32_t dh,
+                        uint64_t gen, bool *again, double *wait_until)
 {
     *again = false, *wait_until = 0;
     sy_error ferr = {0};
     double wait_ms = 0;
-    if (render_frame(w, rs, o, bi, dw, dh, gen, filter, threshold, fv, again, &wait_ms, &ferr) == SY_OK) {
+    if (render_frame(w, rs, in, bi, dw, dh, gen, again, &wait_ms, &ferr) == SY_OK) {
         if (wait_ms > 0) *wait_until = sy_time_now() * 1e3 + wait_ms;
     } else {
         /* a back-end that fails is reported to the pages; the others keep serving */
@@ -333,16 +276,15 @@ static void render_live(sy_web *w, render_state *rs, const sy_orbit *o, uint32_t
 sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
 {
     render_state rs = {0};
-    sy_viewport_desc vd = {.root = w->d.root, .camera = w->cam_node, .background = w->d.background,
+    sy_viewport_desc vd = {.root = w->d.root, .camera = w->d.camera, .background = w->d.background,
                            .backend = sy_mediator_at(w->initial_backend)->name};
     sy_result r = sy_context_pool_create(&rs.pool, err);
     if (r == SY_OK) r = sy_window_create(64, 64, &rs.win, err);
     if (r == SY_OK) r = sy_window_add_viewport(rs.win, &vd, &rs.vp, err);
     if (r == SY_OK) r = sy_window_create(64, 64, &rs.still_win, err);
     if (r == SY_OK) r = sy_window_add_viewport(rs.still_win, &vd, &rs.still_vp, err);
-    if (r == SY_OK) r = sy_governor_create(&(sy_governor_desc){.budget_ms = w->d.budget_ms}, &rs.gov, err);
+    if (r == SY_OK) r = sy_interactive_create(w->d.budget_ms, &rs.ia, err);
     rs.backend_applied = w->initial_backend;
-    rs.prev_bi = UINT32_MAX;
     uint64_t seen = 0;
     bool again = false;    /* plan again without waiting for input */
     double wait_until = 0; /* ms (sy_time_now): the governor's settle wait, 0 = none */
@@ -369,12 +311,11 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         web_job *jobs = w->pending;
         w->pending = NULL, w->pending_tail = &w->pending;
         for (web_job *j = jobs; j; j = j->next) j->state = JOB_RUNNING;
-        sy_orbit o = w->orbit;
+        sy_interactive_input in = w->in;
         bool moved = w->view_version != seen;
         seen = w->view_version;
-        uint32_t bi = w->backend, dw = w->display_w, dh = w->display_h, filter = w->filter;
-        float threshold = w->threshold;
-        uint64_t fv = w->filter_version, gen = w->input_gen;
+        uint32_t bi = w->backend, dw = w->display_w, dh = w->display_h;
+        uint64_t gen = w->input_gen;
         bool clients = w->clients > 0 && w->display_w > 0;
         pthread_mutex_unlock(&w->mu);
         while (jobs) { /* stills and routes first: they wait on an HTTP connection */
@@ -387,7 +328,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
             else run_job(w, j);
         }
         bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
-        if (clients && (moved || due)) render_live(w, &rs, &o, bi, dw, dh, gen, filter, threshold, fv, &again, &wait_until);
+        if (clients && (moved || due)) render_live(w, &rs, &in, bi, dw, dh, gen, &again, &wait_until);
         /* then one still: stills wait behind the live view */
         pthread_mutex_lock(&w->mu);
         web_job *still = w->stills;
@@ -398,7 +339,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
             w->still_running = still;
         }
         pthread_mutex_unlock(&w->mu);
-        if (still) run_still(w, &rs, still, &o);
+        if (still) run_still(w, &rs, still, &in.orbit);
     }
     /* jobs still queued are answered 503 */
     pthread_mutex_lock(&w->mu);
@@ -420,7 +361,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         snprintf(j->resp.content_type, sizeof j->resp.content_type, "text/plain; charset=utf-8");
         finish_job(w, j);
     }
-    sy_governor_destroy(rs.gov);
+    sy_interactive_destroy(rs.ia);
     sy_window_destroy(rs.win);
     sy_window_destroy(rs.still_win);
     sy_context_pool_destroy(rs.pool);

@@ -54,26 +54,15 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
         w->display_w = (uint32_t)in.a, w->display_h = (uint32_t)in.b;
         w->view_version++;
         break;
-    case SY_WEB_INPUT_DRAG:
-        if (in.button >= 1) sy_orbit_pan(&w->orbit, (float)in.a, (float)in.b);
-        else sy_orbit_rotate(&w->orbit, (float)in.a, (float)in.b);
-        break;
-    case SY_WEB_INPUT_WHEEL: sy_orbit_zoom(&w->orbit, (float)in.a); break;
+    case SY_WEB_INPUT_DRAG: sy_interactive_drag(&w->in, in.button >= 1 ? 1 : 0, (float)in.a, (float)in.b); break;
+    case SY_WEB_INPUT_WHEEL: sy_interactive_wheel(&w->in, (float)in.a); break;
     case SY_WEB_INPUT_KEY:
         if (in.key >= '1' && in.key <= '9') {
             uint32_t i = (uint32_t)(in.key - '1');
             if (i < sy_mediator_count()) /* the cluster is no choice of its own: the initial back-end */
                 w->backend = (sy_mediator_at(i)->caps & SY_CAP_REMOTE) ? w->initial_backend : i;
-        } else if (in.key == 'f') {
-            w->filter = (w->filter + 1) % (uint32_t)SY_WEBI_FILTER_COUNT, w->filter_version++;
-        } else if (in.key == '[') {
-            if (w->threshold > 1e-6f) w->threshold *= 0.5f;
-            w->filter_version++;
-        } else if (in.key == ']') {
-            if (w->threshold < 1e3f) w->threshold *= 2.0f;
-            w->filter_version++;
-        } else if (in.key == 'r') {
-            w->orbit = w->home;
+        } else {
+            sy_interactive_key(&w->in, in.key); /* f, [, ], r (sy_interactive.h) */
         }
         break;
     }
@@ -128,7 +117,8 @@ static int ws_writeable(sy_web *w, web_conn *c)
         c->sent_status = w->status_version;
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "t", "status");
-        cJSON_AddStringToObject(o, "filter", sy_webi_filters[w->filter % SY_WEBI_FILTER_COUNT]);
+        char fname[32];
+        cJSON_AddStringToObject(o, "filter", sy_interactive_filter_name(w->in.filter, fname));
         if (w->status[0]) cJSON_AddStringToObject(o, "error", w->status);
         char *s = cJSON_PrintUnformatted(o);
         if (s) snprintf(status, sizeof status, "%s", s);
