@@ -87,7 +87,8 @@ typedef struct sy_interactive_view {
     uint32_t viewport_count;        /**< how many */
     const sy_mediator_class *backend; /**< the back-end (a switch resets the governor's cost model) */
     uint32_t caps;                  /**< capabilities to plan with (sy_mediator_class_caps, maybe less) */
-    uint32_t width, height;         /**< the display size */
+    /** @{ the display size */
+    uint32_t width, height; /** @} */
     uint64_t filter_version;        /**< sy_interactive_input.filter_version (a change redraws) */
     bool changed;                   /**< something else shown changed (stereo, overlay) */
 } sy_interactive_view;

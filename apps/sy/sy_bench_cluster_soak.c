@@ -10,8 +10,8 @@
 #include <unistd.h>
 
 /* >>soak: one `sy serve` and one client that moves the camera every frame for a given time
- * (issue 32, item 6): the camera node orbits the scene (a change list per frame, as `sy view
- * --cluster` sends) and each frame is rendered from the moved camera. Every 10 s the server's
+ * (issue 32, item 6): the camera node orbits the scene (a change list per frame, as an application
+ * that moves its camera node sends) and each frame is rendered from the moved camera. Every 10 s the server's
  * VmRSS, open descriptors (/proc/PID/fd) and threads are sampled; growth is measured from the
  * sample at the end of the warm-up (caches, context pool, render threads) to the end. Passes when
  * every frame sent came back (no error, no failed server) and each of the three grew by less

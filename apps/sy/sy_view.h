@@ -8,17 +8,20 @@
  * With --frames the last title line is printed to stdout at exit (automated runs); only frames
  * shown after the view settled (full size) count. The window title is the heads-up line: back-end,
  * frame time, the governor's resolution scale ("moving" while reduced), samples per pixel, sync
- * time. Rendering runs on its own thread, which owns the scene (the input thread only posts camera
- * poses and switches), so the window stays responsive while a slow back-end renders and always
+ * time. Rendering runs on its own thread, which owns the scene (the input thread only changes the
+ * orbit and posts switches), so the window stays responsive while a slow back-end renders and always
  * shows the last complete image. Local rendering goes through the frame-time governor
  * (core/sy_governor.h, --budget MS): while the view moves each frame renders at the largest size
  * that fits the budget and the display scales it up, without the display filter; once the view
  * rests for 150 ms it renders at full size, a progressive back-end then adds samples per frame
- * within the budget (restarting when the view moves), and the thread sleeps until input.
+ * within the budget (restarting when the view moves), and the thread sleeps until input. The orbit,
+ * keys F [ ] R, governor, display filter and 8-bit image are core's interactive view, shared with
+ * sy web (core/sy_interactive.h): the camera is set on the viewports directly (the scene's camera
+ * node gives the projection), so the viewer adds nothing to the scene and never commits it.
  *
  * Cluster (--cluster URL[,URL...]|FILE.conf, --cluster-mode ...): the viewport's back-end is the
  * cluster mediator (sy_mediator_cluster.h), so the viewer renders through the same window path as
- * locally (overlay and stereo included); camera moves reach the servers as change lists. Sort-first
+ * locally (overlay and stereo included); camera moves reach the servers in the frame requests. Sort-first
  * / balanced are bit-identical to a local render; cooperative merges the servers' sample ranges and
  * refines while the camera rests. Deadlines (--timeout-ms, else adaptive in the mediator) drop a
  * dead or stalled server and give its work to the others; the title shows the mode, the servers
