@@ -332,6 +332,9 @@ void sy_gli_mtab_upload(sy_gl_device *dev);
 /* sy_gl_lod.c */
 uint32_t sy_gli_draw_mesh_lod(sy_gl_device *dev, const mesh_o *m, uint32_t lod);
 const mat_o *sy_gli_bind_material(sy_gl_device *dev, sy_gl_material id, bool all_textures);
+/* Pixels per world unit at the nearest point of the sphere (c, r) in view v; 0 when unknown (no
+ * scale, or the view inside the sphere). Levels of detail, deferred shading and probe sizes use it. */
+float sy_gli_sphere_px_per_unit(const view_setup *v, const float c[3], float r);
 void sy_gli_choose_lods(sy_gl_device *dev, const view_setup *v);
 uint32_t sy_gli_choose_lod(const sy_gl_device *dev, const mesh_o *m, const view_setup *v, const float c[3], float r,
                            float scale);

@@ -59,19 +59,23 @@ void sy_gl_set_lod(sy_gl_device *dev, float pixels)
     if (dev) dev->lod_pixels = isfinite(pixels) && pixels > 0.0f ? pixels : 0.0f;
 }
 
+float sy_gli_sphere_px_per_unit(const view_setup *v, const float c[3], float r)
+{
+    if (!(v->ppu > 0.0f)) return 0.0f;
+    if (v->ortho) return v->ppu;
+    float d = (c[0] - v->cam_pos[0]) * v->cam_fwd[0] + (c[1] - v->cam_pos[1]) * v->cam_fwd[1] +
+              (c[2] - v->cam_pos[2]) * v->cam_fwd[2] - r;
+    return d > 1e-6f ? v->ppu / d : 0.0f;
+}
+
 /* The coarsest level whose deviation, projected at the sphere's nearest distance, stays within
  * dev->lod_pixels pixels (0 when the view's scale is unknown or the view is inside the sphere). */
 uint32_t sy_gli_choose_lod(const sy_gl_device *dev, const mesh_o *m, const view_setup *v, const float c[3], float r,
                            float scale)
 {
-    if (m->lod_count < 2 || dev->lod_pixels <= 0.0f || v->ppu <= 0.0f) return 0;
-    float px_per_m = v->ppu;
-    if (!v->ortho) {
-        float d = (c[0] - v->cam_pos[0]) * v->cam_fwd[0] + (c[1] - v->cam_pos[1]) * v->cam_fwd[1] +
-                  (c[2] - v->cam_pos[2]) * v->cam_fwd[2] - r;
-        if (!(d > 1e-6f)) return 0;
-        px_per_m /= d;
-    }
+    if (m->lod_count < 2 || dev->lod_pixels <= 0.0f) return 0;
+    float px_per_m = sy_gli_sphere_px_per_unit(v, c, r);
+    if (!(px_per_m > 0.0f)) return 0;
     uint32_t lod = 0;
     while (lod + 1 < m->lod_count && m->lod_error[lod + 1] * scale * px_per_m <= dev->lod_pixels) ++lod;
     return lod;
@@ -83,14 +87,8 @@ uint32_t sy_gli_choose_lod(const sy_gl_device *dev, const mesh_o *m, const view_
 float sy_gli_pixels_per_triangle(const sy_gl_device *dev, const mesh_o *m, uint32_t lod, const view_setup *v,
                                  const float c[3], float r)
 {
-    float screen = (float)dev->t.w * (float)dev->t.h, px_per_m = v->ppu;
+    float screen = (float)dev->t.w * (float)dev->t.h, px_per_m = sy_gli_sphere_px_per_unit(v, c, r);
     if (!(px_per_m > 0.0f)) return screen;
-    if (!v->ortho) {
-        float d = (c[0] - v->cam_pos[0]) * v->cam_fwd[0] + (c[1] - v->cam_pos[1]) * v->cam_fwd[1] +
-                  (c[2] - v->cam_pos[2]) * v->cam_fwd[2] - r;
-        if (!(d > 1e-6f)) return screen;
-        px_per_m /= d;
-    }
     float rp = r * px_per_m, area = 3.14159265f * rp * rp;
     if (!(area < screen)) area = screen;
     uint32_t tris = m->lod_tris[lod < m->lod_count ? lod : 0];

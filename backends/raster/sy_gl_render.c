@@ -42,13 +42,8 @@ static uint32_t probe_size_for(const sy_gl_device *dev, const view_setup *v, uin
         const inst_o *in = sy_gli_pool_at(&dev->instances, idx[p]);
         float c[3], scale, r = sy_gli_world_sphere(in, sy_gli_pool_get(&dev->meshes, in->mesh.id), c, &scale);
         if (sy_gli_sphere_outside(planes, c, r)) continue;
-        float px = (float)half; /* unknown scale, or the view inside the sphere: the frame's cap */
-        if (v->ppu > 0.0f && v->ortho) px = r * v->ppu;
-        else if (v->ppu > 0.0f) {
-            float d = (c[0] - v->cam_pos[0]) * v->cam_fwd[0] + (c[1] - v->cam_pos[1]) * v->cam_fwd[1] +
-                      (c[2] - v->cam_pos[2]) * v->cam_fwd[2] - r;
-            if (d > 1e-6f) px = r * v->ppu / d;
-        }
+        float ppm = sy_gli_sphere_px_per_unit(v, c, r);
+        float px = ppm > 0.0f ? r * ppm : (float)half; /* unknown scale, or the view inside: the frame's cap */
         if (px > need) need = px;
     }
     if (need > (float)half) need = (float)half;
