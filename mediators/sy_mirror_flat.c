@@ -28,17 +28,26 @@ void sy_mirror_flat_texture_mean(const sy_mirror_flat_texture *t, float mean[3])
 {
     size_t n = (size_t)t->width * t->height, ch = t->channels;
     double sum[3] = {0, 0, 0};
-    for (size_t i = 0; i < n; ++i)
-        for (size_t c = 0; c < 3; ++c) {
-            size_t k = ch <= 2 ? 0 : c;
-            float v;
-            if (t->format == SY_MIRROR_FLAT_FLOAT32) v = ((const float *)t->pixels)[i * ch + k];
-            else {
-                v = ((const unsigned char *)t->pixels)[i * ch + k] / 255.0f;
-                if (t->format == SY_MIRROR_FLAT_UNORM8_SRGB) v = sy_srgb_decode(v);
+    if (t->format == SY_MIRROR_FLAT_FLOAT32) {
+        const float *px = t->pixels;
+        for (size_t i = 0; i < n; ++i)
+            for (size_t c = 0; c < 3; ++c) {
+                float v = px[i * ch + (ch <= 2 ? 0 : c)];
+                if (isfinite(v)) sum[c] += v;
             }
-            if (isfinite(v)) sum[c] += v;
+    } else { /* 8 bits: count each code, then decode 256 values instead of one per texel */
+        static const size_t zero[256];
+        size_t count[3][256];
+        for (size_t c = 0; c < 3; ++c) memcpy(count[c], zero, sizeof zero);
+        const unsigned char *px = t->pixels;
+        for (size_t i = 0; i < n; ++i)
+            for (size_t c = 0; c < 3; ++c) count[c][px[i * ch + (ch <= 2 ? 0 : c)]]++;
+        for (int v = 0; v < 256; ++v) {
+            float x = v / 255.0f;
+            if (t->format == SY_MIRROR_FLAT_UNORM8_SRGB) x = sy_srgb_decode(x);
+            for (size_t c = 0; c < 3; ++c) sum[c] += (double)count[c][v] * x;
         }
+    }
     for (int c = 0; c < 3; ++c) mean[c] = n ? (float)(sum[c] / (double)n) : 0.0f;
 }
 

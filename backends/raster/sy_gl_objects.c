@@ -3,6 +3,7 @@
 #include "sy_gl_internal.h"
 
 #include <meshoptimizer.h>
+#include <stb_image_resize.h>
 
 #include <math.h>
 #include <stdarg.h>
@@ -10,8 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
-static float linear_to_srgb(float c) { return c <= 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f; }
 
 /* The levels of detail of an indexed mesh of at least SY_GL_LOD_MIN_TRIANGLES: into *out (malloc'd,
  * level 0 first) the mesh's indices followed by each simplified level; m->lod_* describe them.
@@ -175,21 +174,53 @@ sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh)
     return SY_GL_OK;
 }
 
-/* Halves an RGBA float image (box filter; odd edges clamp). */
-static void halve(const float *src, uint32_t w, uint32_t h, float *dst, uint32_t *ow, uint32_t *oh)
+/* Resamples an RGBA image (8-bit, sRGB-encoded 8-bit or float; tightly packed) to nw x nh with
+ * stb_image_resize's box filter (an exact 2x2 mean when a side halves), edges as the texture wraps:
+ * sRGB texels are filtered in linear light, alpha linearly and unweighted, as glGenerateMipmap does.
+ * false without memory. */
+static bool resample(const void *src, uint32_t w, uint32_t h, void *dst, uint32_t nw, uint32_t nh, bool is_float,
+                     bool srgb, const stbir_edge edge[2])
 {
-    uint32_t nw = w > 1 ? w / 2 : 1, nh = h > 1 ? h / 2 : 1;
-    for (uint32_t y = 0; y < nh; ++y)
-        for (uint32_t x = 0; x < nw; ++x)
-            for (int c = 0; c < 4; ++c) {
-                uint32_t x0 = x * 2 < w ? x * 2 : w - 1, x1 = x * 2 + 1 < w ? x * 2 + 1 : w - 1;
-                uint32_t y0 = y * 2 < h ? y * 2 : h - 1, y1 = y * 2 + 1 < h ? y * 2 + 1 : h - 1;
-                dst[((size_t)y * nw + x) * 4 + c] =
-                    0.25f * (src[((size_t)y0 * w + x0) * 4 + c] + src[((size_t)y0 * w + x1) * 4 + c] +
-                             src[((size_t)y1 * w + x0) * 4 + c] + src[((size_t)y1 * w + x1) * 4 + c]);
-            }
-    *ow = nw;
-    *oh = nh;
+    return stbir_resize(src, (int)w, (int)h, 0, dst, (int)nw, (int)nh, 0, is_float ? STBIR_TYPE_FLOAT : STBIR_TYPE_UINT8, 4, 3,
+                        STBIR_FLAG_ALPHA_PREMULTIPLIED, edge[0], edge[1], STBIR_FILTER_BOX, STBIR_FILTER_BOX,
+                        srgb ? STBIR_COLORSPACE_SRGB : STBIR_COLORSPACE_LINEAR, NULL) == 1;
+}
+
+/* Uploads level 0 (w x h RGBA texels) to the bound texture and the whole mipmap chain below it,
+ * made on the CPU: glGenerateMipmap on llvmpipe compiles a blit shader per format and filters on the
+ * GL threads (0.53 s for a 2048x2048 sRGB texture, 0.12 s for the first texture of each format, in
+ * TransmissionTest's first frame); the box filter here costs a few tens of milliseconds. */
+static sy_gl_result upload_levels(sy_gl_device *dev, const void *level0, uint32_t w, uint32_t h, bool is_float, bool srgb,
+                                  const stbir_edge edge[2], char *err, size_t err_len)
+{
+    const sy_gl_fns *gl = dev->gl;
+    size_t texel = is_float ? 16 : 4, below = 0;
+    for (uint32_t lw = w, lh = h; lw > 1 || lh > 1;) {
+        lw = lw > 1 ? lw / 2 : 1, lh = lh > 1 ? lh / 2 : 1;
+        below += (size_t)lw * lh;
+    }
+    unsigned char *chain = below ? malloc(below * texel) : NULL;
+    if (below && !chain)
+        return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (mipmaps of %ux%u)", w, h);
+    GLint internal = is_float ? GL_RGBA32F : srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8;
+    GLenum type = is_float ? GL_FLOAT : GL_UNSIGNED_BYTE;
+    const unsigned char *prev = level0;
+    unsigned char *next = chain;
+    for (GLint level = 0;; ++level) {
+        gl->TexImage2D(GL_TEXTURE_2D, level, internal, (GLsizei)w, (GLsizei)h, 0, GL_RGBA, type, prev);
+        dev->counts.texture_bytes += (size_t)w * h * texel;
+        if (w == 1 && h == 1) break;
+        uint32_t nw = w > 1 ? w / 2 : 1, nh = h > 1 ? h / 2 : 1;
+        if (!resample(prev, w, h, next, nw, nh, is_float, srgb, edge)) {
+            free(chain);
+            return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (mipmaps of %ux%u)", w, h);
+        }
+        prev = next;
+        next += (size_t)nw * nh * texel;
+        w = nw, h = nh;
+    }
+    free(chain);
+    return SY_GL_OK;
 }
 
 sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d, sy_gl_texture *out, char *err,
@@ -204,70 +235,47 @@ sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d
     if (n / d->width != d->height || n > ((size_t)1 << 32))
         return sy_gli_fail(err, err_len, SY_GL_ERROR_LIMIT, "texture: %ux%u is too large", d->width, d->height);
     bool is_float = d->format == SY_GL_TEXEL_FLOAT32, srgb = d->format == SY_GL_TEXEL_UNORM8_SRGB;
-    bool downscale = d->width > dev->max_tex || d->height > dev->max_tex;
-    const unsigned char *u8 = d->pixels;
-    const float *f32 = d->pixels;
     uint32_t ch = d->channels, w = d->width, h = d->height;
-    float *img = NULL;          /* RGBA float: float textures, and 8-bit ones that need downscaling */
-    unsigned char *img8 = NULL; /* RGBA8: 8-bit textures within the limit (no conversion) */
-    if (!is_float && !downscale) {
-        img8 = malloc(n * 4);
-        if (!img8) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (%ux%u)", d->width, d->height);
-        for (size_t i = 0; i < n; ++i) {
-            const unsigned char *s = u8 + i * ch;
-            unsigned char *o = img8 + i * 4;
+    size_t texel = is_float ? 4 * sizeof(float) : 4;
+    /* expand to RGBA in the texel type (grey -> rgb, grey+alpha -> rgb+a) */
+    unsigned char *img = malloc(n * texel);
+    if (!img) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (%ux%u)", w, h);
+    if (is_float) {
+        const float *s = d->pixels;
+        float *o = (float *)img;
+        for (size_t i = 0; i < n; ++i, s += ch, o += 4) {
+            if (ch <= 2) o[0] = o[1] = o[2] = s[0], o[3] = ch == 2 ? s[1] : 1.0f;
+            else o[0] = s[0], o[1] = s[1], o[2] = s[2], o[3] = ch == 4 ? s[3] : 1.0f;
+        }
+    } else {
+        const unsigned char *s = d->pixels;
+        unsigned char *o = img;
+        for (size_t i = 0; i < n; ++i, s += ch, o += 4) {
             if (ch <= 2) o[0] = o[1] = o[2] = s[0], o[3] = ch == 2 ? s[1] : 255;
             else o[0] = s[0], o[1] = s[1], o[2] = s[2], o[3] = ch == 4 ? s[3] : 255;
         }
-    } else {
-        /* expand to RGBA (grey -> rgb, grey+alpha -> rgb+a) in float, filter in linear space */
-        img = malloc(n * 4 * sizeof *img);
-        if (!img) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (%ux%u)", d->width, d->height);
-        for (size_t i = 0; i < n; ++i) {
-            float v[4] = {0, 0, 0, 1};
-            for (uint32_t c = 0; c < ch; ++c) v[c] = is_float ? f32[i * ch + c] : (float)u8[i * ch + c] / 255.0f;
-            if (ch <= 2) {
-                if (ch == 2) v[3] = v[1];
-                v[1] = v[2] = v[0];
-            }
-            if (srgb)
-                for (int c = 0; c < 3; ++c) v[c] = srgb_to_linear(v[c]);
-            memcpy(img + i * 4, v, sizeof v);
-        }
     }
-    if (downscale) {
+    static const stbir_edge edges[3] = {STBIR_EDGE_WRAP, STBIR_EDGE_CLAMP, STBIR_EDGE_REFLECT};
+    const stbir_edge edge[2] = {edges[(unsigned)d->wrap_s < 3u ? d->wrap_s : 0], edges[(unsigned)d->wrap_t < 3u ? d->wrap_t : 0]};
+    if (w > dev->max_tex || h > dev->max_tex) { /* halve the sides until the GL holds them */
         uint32_t ow = w, oh = h;
-        while (w > dev->max_tex || h > dev->max_tex) {
-            float *nimg = malloc((size_t)(w > 1 ? w / 2 : 1) * (h > 1 ? h / 2 : 1) * 4 * sizeof *nimg);
-            if (!nimg) {
-                free(img);
-                return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory while downscaling");
-            }
-            halve(img, w, h, nimg, &w, &h);
+        while (w > dev->max_tex || h > dev->max_tex) w = w > 1 ? w / 2 : 1, h = h > 1 ? h / 2 : 1;
+        unsigned char *small = malloc((size_t)w * h * texel);
+        if (!small || !resample(img, ow, oh, small, w, h, is_float, srgb, edge)) {
+            free(small);
             free(img);
-            img = nimg;
+            return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory while downscaling");
         }
+        free(img);
+        img = small;
         sy_gli_warn(dev, "raster: texture %ux%u exceeds the GL limit of %u texels per side; downscaled to %ux%u", ow, oh,
-             dev->max_tex, w, h);
+                    dev->max_tex, w, h);
     }
     sy_gl_result r = sy_gli_current(dev, err, err_len);
     tex_o *t = r == SY_GL_OK ? sy_gli_pool_alloc(&dev->textures) : NULL;
     if (r == SY_GL_OK && !t) r = sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory");
-    size_t count = (size_t)w * h;
-    if (r == SY_GL_OK && !is_float && !img8) { /* downscaled 8-bit: back to bytes */
-        img8 = malloc(count * 4);
-        if (!img8) r = sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory");
-        for (size_t i = 0; img8 && i < count * 4; ++i) {
-            float v = img[i];
-            if (srgb && (i & 3u) != 3u) v = linear_to_srgb(v);
-            v = v < 0.0f ? 0.0f : v > 1.0f ? 1.0f : v;
-            img8[i] = (unsigned char)lrintf(v * 255.0f);
-        }
-    }
     if (r != SY_GL_OK) {
-        if (t) sy_gli_pool_free(&dev->textures, t);
         free(img);
-        free(img8);
         return r;
     }
     const sy_gl_fns *gl = dev->gl;
@@ -276,24 +284,15 @@ sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d
     gl->GenTextures(1, &t->tex);
     gl->BindTexture(GL_TEXTURE_2D, t->tex);
     gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    if (is_float) {
-        gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, (GLsizei)w, (GLsizei)h, 0, GL_RGBA, GL_FLOAT, img);
-        dev->counts.texture_bytes += count * 16;
-    } else {
-        gl->TexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, (GLsizei)w, (GLsizei)h, 0, GL_RGBA,
-                       GL_UNSIGNED_BYTE, img8);
-        dev->counts.texture_bytes += count * 4;
-    }
-    free(img);
-    free(img8);
-    dev->counts.texture_uploads++;
-    gl->GenerateMipmap(GL_TEXTURE_2D);
     static const GLint wraps[3] = {GL_REPEAT, GL_CLAMP_TO_EDGE, GL_MIRRORED_REPEAT};
     gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wraps[(unsigned)d->wrap_s < 3u ? d->wrap_s : 0]);
     gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wraps[(unsigned)d->wrap_t < 3u ? d->wrap_t : 0]);
     gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, d->nearest ? GL_NEAREST : GL_LINEAR);
     gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, d->nearest ? GL_NEAREST_MIPMAP_LINEAR : GL_LINEAR_MIPMAP_LINEAR);
-    r = sy_gli_gl_check(dev, "texture upload", err, err_len);
+    r = upload_levels(dev, img, w, h, is_float, srgb, edge, err, err_len);
+    free(img);
+    dev->counts.texture_uploads++;
+    if (r == SY_GL_OK) r = sy_gli_gl_check(dev, "texture upload", err, err_len);
     if (r != SY_GL_OK) {
         sy_gl_texture_destroy(dev, (sy_gl_texture){t->h.id});
         return r;

@@ -188,6 +188,34 @@ int main(int argc, char **argv)
         EXPECT_MSG(s2.total.texture_uploads == 1, "texture uploads %llu", (unsigned long long)s2.total.texture_uploads);
     }
 
+    /* 5b. the mipmap chain of an sRGB texture is filtered in linear light: a 4x4 black-and-white
+     * checker drawn into one pixel samples its 1x1 level, the linear mean 0.5 (sRGB-space averaging
+     * would give 0.21) */
+    {
+        unsigned char tex[4 * 4];
+        for (int i = 0; i < 16; ++i) tex[i] = ((i & 1) ^ ((i >> 2) & 1)) ? 255 : 0;
+        sy_gl_texture_desc td = {.width = 4, .height = 4, .channels = 1, .format = SY_GL_TEXEL_UNORM8_SRGB, .pixels = tex};
+        sy_gl_texture t;
+        MUST(sy_gl_texture_create(d, &td, &t, e, sizeof e));
+        sy_gl_material_desc md;
+        sy_gl_material_desc_init(&md);
+        md.unlit = true;
+        md.base_color_texture.texture = t;
+        sy_gl_material mt;
+        MUST(sy_gl_material_create(d, &md, &mt, e, sizeof e));
+        /* one pixel: 1/32 of the view's width of 2 at depth 1, i.e. 0.0625 at depth 2 */
+        const float one_px[12] = {0, 0, -2, 0.0625f, 0, -2, 0.0625f, 0.0625f, -2, 0, 0.0625f, -2};
+        sy_gl_instance it = place(d, quad(d, one_px, nz), mt);
+        render(d, &cam);
+        int covered = 0;
+        float v = 0.0f;
+        for (int i = 0; i < N * N; ++i)
+            if (rgba[4 * i + 3] > 0.0f) covered++, v = rgba[4 * i];
+        EXPECT_MSG(covered == 1 && near_(v, 0.5f, 0.01f), "checker in one pixel: %d pixels covered, value %g (want 1, 0.5)",
+                   covered, v);
+        MUST(sy_gl_instance_destroy(d, it));
+    }
+
     /* 6. Lambert under a directional light, with a shadow from an occluder; then a spot light */
     {
         sy_gl_camera top = {.camera_to_world = {1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 5, 0, 1}, .window = {-0.6f, 0.6f, -0.6f, 0.6f}, .near_clip = 0.1f};
