@@ -2,7 +2,8 @@
  * sy_world.h — sets up a view's world (the background object: background, environment light,
  * default lighting) from user choices, so that every program (sy's flags, an embedding
  * application) says the same thing the same way. The meaning of each field is core's (sy_look.h);
- * this module only creates and fills the objects, reading environment maps from EXR files.
+ * this module only creates and fills the objects, reading environment maps from OpenEXR and
+ * Radiance HDR (.hdr, RGBE) files, told apart by content.
  *
  * Ownership: objects are created in the caller's scene (owned by it). Thread-safety: as the scene
  * (single writer). */
@@ -17,7 +18,9 @@ extern "C" {
 
 /** What the user asks of the world (the CLI's world flags); sy_world_apply maps it onto the scene. */
 typedef struct sy_world_options {
-    const char *env_path;    /**< lat-long (2:1) EXR with R, G, B or Y channels: the environment light */
+    const char *env_path;    /**< lat-long (2:1) map, the environment light: an EXR with R, G, B or Y
+                                  channels, or a Radiance HDR (.hdr) */
+    uint64_t max_scene_bytes; /**< budget for the decoded map (sy_budget.h); 0 = sy_budget_default_bytes() */
     bool has_env_color;      /**< a uniform environment light of this radiance (a 1x1 lat-long map) */
     float env_color[3]; /**< radiance of the uniform environment (with has_env_color) */
     float env_intensity;     /**< multiplier for the environment; 0 is taken as 1 unless env_intensity_set */
@@ -41,8 +44,11 @@ sy_result sy_world_apply(sy_scene *s, sy_background *world, const sy_world_optio
 sy_result sy_world_texture_take(sy_scene *s, const char *name, float *px, uint32_t w, uint32_t h, sy_texture *out,
                                 sy_error *err);
 
-/** Reads a lat-long EXR environment map into a new float RGB texture of s. */
-sy_result sy_world_load_environment(sy_scene *s, const char *path, sy_texture *out, sy_error *err);
+/** Reads a lat-long environment map (OpenEXR, or Radiance HDR when the file starts with "#?RADIANCE"
+ * or "#?RGBE") into a new float RGB texture of s. A Radiance file's size is checked against its
+ * bytes and against max_bytes (the decoded float image; 0 = sy_budget_default_bytes()) before it
+ * is decoded. Errors name the file and the reason. */
+sy_result sy_world_load_environment(sy_scene *s, const char *path, uint64_t max_bytes, sy_texture *out, sy_error *err);
 
 #ifdef __cplusplus
 }

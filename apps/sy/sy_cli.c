@@ -18,7 +18,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 
-/* The world flags every command shares (taken out of the arguments in main): --env MAP.exr,
+/* The world flags every command shares (taken out of the arguments in main): --env MAP.exr|.hdr,
  * --env-color R,G,B, --env-intensity X, --env-hidden, --background R,G,B[,A], --no-default-light.
  * *used = arguments consumed (0: not a world flag). Only maps text onto sy_world_options; the
  * meaning is the library's (sy_look.h, sy_world.h). */
@@ -114,7 +114,7 @@ int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *short
                 *status = 2;
                 return OPT_STOP;
             }
-            sy_cli_load_opts.max_scene_bytes = (uint64_t)mb << 20;
+            sy_cli_load_opts.max_scene_bytes = sy_cli_load_opts.world.max_scene_bytes = (uint64_t)mb << 20;
             break;
         }
         case OPT_ALLOW_PATH: { /* repeatable: more folders that a model's external files may lie in */
@@ -208,7 +208,7 @@ static const char usage_text[] =
             "  sy bench cluster [-w W] [-h H] [--repeats ROUNDS]\n"
             "  sy bench cluster --soak SECONDS [--warmup S] [-b BACKEND] [-w W] [-h H]   (sy serve soak: RSS, fds, threads)\n"
             "SCENE: a glTF (.gltf, .glb) or X3D (XML) file, recognised by its content, or 'demo' (the built-in scene)\n"
-            "world options (every command): [--env MAP.exr | --env-color R,G,B] [--env-intensity X] [--env-hidden]\n"
+            "world options (every command): [--env MAP.exr|MAP.hdr | --env-color R,G,B] [--env-intensity X] [--env-hidden]\n"
             "  [--background R,G,B[,A]] [--no-default-light]: the environment is a light; the background is what\n"
             "  the camera sees where nothing is hit; a scene with no light of its own is lit by a neutral studio\n"
             "  environment unless --no-default-light is given\n"

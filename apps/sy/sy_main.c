@@ -9,7 +9,7 @@
  *             [--max-memory MB]   (ray tracers: max_memory_mb, a scene whose BVHs need more is refused)
  *             with -b pathtracer: [--spp N | --time SECONDS] [--aov]
  *             [--filter none|pixel|atrous|jbu|adaptive|radiance [--threshold T]]
- *   world options of every command: [--env MAP.exr | --env-color R,G,B] [--env-intensity X] [--env-hidden]
+ *   world options of every command: [--env MAP.exr|MAP.hdr | --env-color R,G,B] [--env-intensity X] [--env-hidden]
  *             [--background R,G,B[,A]] [--no-default-light]   (see sy_world.h and sy_look.h)
  *             [--gl osmesa|egl|glfw]  (raster back-end's GL context provider)
  *   sy demo [-o DIR] [-w W] [-h H]      render the built-in demo scene with every back-end
