@@ -4,6 +4,7 @@
 #include "sy_gltf_shim.h"
 
 #include "sy_file.h"
+#include "sy_sniff.h"
 
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
@@ -142,6 +143,12 @@ bool load_image(tinygltf::Image *image, const int image_idx, std::string *err, s
     if (len == 0 || len > size_t(INT_MAX)) {
         if (err) *err += where + ": image data is empty or larger than 2 GiB\n";
         return false;
+    }
+    const sy_file_format kind = sy_sniff_bytes(bytes, len);
+    if (!sy_file_format_is_texture_image(kind, false)) { // stb_image would take HDR, PSD, TGA... too
+        ctx->image_problems[image_idx] = std::string(sy_file_format_name(kind)) + " content, not a PNG or JPEG image";
+        image->image.clear();
+        return true;
     }
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(bytes, int(len), &w, &h, &comp) || w < 1 || h < 1 || comp < 1 || comp > 4) {

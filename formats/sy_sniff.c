@@ -51,6 +51,8 @@ sy_file_format sy_sniff_bytes(const void *data, size_t n)
     if (n >= 4 && p[0] == 0x76 && p[1] == 0x2f && p[2] == 0x31 && p[3] == 0x01) return SY_FORMAT_EXR;
     if (starts(p, n, "\x89PNG\r\n\x1a\n")) return SY_FORMAT_PNG;
     if (n >= 3 && p[0] == 0xff && p[1] == 0xd8 && p[2] == 0xff) return SY_FORMAT_JPEG;
+    if (starts(p, n, "GIF87a") || starts(p, n, "GIF89a")) return SY_FORMAT_GIF;
+    if (starts(p, n, "#?RADIANCE") || starts(p, n, "#?RGBE")) return SY_FORMAT_RADIANCE;
     if (starts(p, n, "Kaydara FBX Binary")) return SY_FORMAT_FBX;
     if (starts(p, n, "ply\n") || starts(p, n, "ply\r")) return SY_FORMAT_PLY;
     size_t i = 0;
@@ -102,8 +104,15 @@ const char *sy_file_format_name(sy_file_format f)
     case SY_FORMAT_EXR: return "OpenEXR image";
     case SY_FORMAT_PNG: return "PNG image";
     case SY_FORMAT_JPEG: return "JPEG image";
+    case SY_FORMAT_GIF: return "GIF image";
+    case SY_FORMAT_RADIANCE: return "Radiance HDR image";
     default: return "unknown";
     }
+}
+
+bool sy_file_format_is_texture_image(sy_file_format f, bool with_gif)
+{
+    return f == SY_FORMAT_PNG || f == SY_FORMAT_JPEG || (with_gif && f == SY_FORMAT_GIF);
 }
 
 bool sy_file_format_is_scene(sy_file_format f)

@@ -28,6 +28,8 @@ typedef enum sy_file_format {
     SY_FORMAT_EXR,
     SY_FORMAT_PNG,
     SY_FORMAT_JPEG,
+    SY_FORMAT_GIF,
+    SY_FORMAT_RADIANCE, /**< Radiance RGBE (.hdr) */
 } sy_file_format;
 
 /** Classifies the first n bytes of a file (a few hundred are enough). */
@@ -36,6 +38,12 @@ sy_file_format sy_sniff_bytes(const void *data, size_t n);
 sy_result sy_sniff_file(const char *path, sy_file_format *out, sy_error *err);
 /** "glTF", "Wavefront OBJ", ... ("unknown" for SY_FORMAT_UNKNOWN). */
 const char *sy_file_format_name(sy_file_format f);
+/** True for the image formats a model's textures may use: PNG and JPEG (glTF 2.0's two), and GIF
+ * where with_gif (X3D's ImageTexture). The loaders decode nothing else: stb_image would also take
+ * Radiance, PSD, TGA and more, formats no model should carry, and Debian's stb_image loops for ever on
+ * a truncated Radiance file. */
+bool sy_file_format_is_texture_image(sy_file_format f, bool with_gif);
+
 /** True for the scene formats the loaders read (glTF, GLB, X3D). */
 bool sy_file_format_is_scene(sy_file_format f);
 

@@ -4,6 +4,7 @@
 #include "sy_budget.h"
 #include "sy_exr.h"
 #include "sy_file.h"
+#include "sy_sniff.h"
 
 #include <stb_image.h>
 
@@ -144,14 +145,13 @@ static sy_result load_exr(const char *path, float **out, uint32_t *ow, uint32_t 
 
 sy_result sy_world_load_environment(sy_scene *s, const char *path, uint64_t max_bytes, sy_texture *out, sy_error *err)
 {
-    unsigned char head[10] = {0};
-    FILE *f = fopen(path, "rb");
-    size_t got = f ? fread(head, 1, sizeof head, f) : 0;
-    if (f) fclose(f);
-    bool radiance = (got >= 10 && !memcmp(head, "#?RADIANCE", 10)) || (got >= 6 && !memcmp(head, "#?RGBE", 6));
+    sy_file_format format = SY_FORMAT_UNKNOWN;
+    sy_result r = sy_sniff_file(path, &format, err);
+    if (r != SY_OK) return r;
+    bool radiance = format == SY_FORMAT_RADIANCE;
     float *px = NULL;
     uint32_t w = 0, h = 0;
-    sy_result r = radiance ? load_radiance(path, max_bytes, &px, &w, &h, err) : load_exr(path, &px, &w, &h, err);
+    r = radiance ? load_radiance(path, max_bytes, &px, &w, &h, err) : load_exr(path, &px, &w, &h, err);
     if (r != SY_OK) {
         sy_error_prefix(err, "environment");
         return r;

@@ -7,6 +7,8 @@
 
 #include "sy_file.h"
 
+#include "sy_sniff.h"
+
 #include <stb_image.h>
 
 #include <limits.h>
@@ -85,8 +87,11 @@ static sy_result load_texture(loader *L, xfile *F, const xmlNode *el, bool srgb,
             snprintf(why, sizeof why, "%s", ferr.message);
             continue;
         }
-        if (size > INT_MAX || !stbi_info_from_memory(bytes, (int)size, &w, &h, &comp) || w < 1 || h < 1 ||
-            comp < 1 || comp > 4) {
+        sy_file_format kind = sy_sniff_bytes(bytes, size);
+        if (!sy_file_format_is_texture_image(kind, true)) {
+            snprintf(why, sizeof why, "%.400s: %s content, not a PNG, JPEG or GIF image", path, sy_file_format_name(kind));
+        } else if (size > INT_MAX || !stbi_info_from_memory(bytes, (int)size, &w, &h, &comp) || w < 1 || h < 1 ||
+                   comp < 1 || comp > 4) {
             snprintf(why, sizeof why, "%.400s: cannot decode (%s)", path, size > INT_MAX ? "too large" : stbi_failure_reason());
         } else if ((uint64_t)w * (uint64_t)h > L->opt.max_image_pixels) {
             snprintf(why, sizeof why, "%.400s: %dx%d pixels exceed the limit", path, w, h);

@@ -33,6 +33,9 @@ int main(void)
         {"\x89PNG\r\n\x1a\n\x00\x00", SY_FORMAT_PNG},
         {"\x76\x2f\x31\x01\x02", SY_FORMAT_EXR},
         {"\xff\xd8\xff\xe0", SY_FORMAT_JPEG},
+        {"GIF89a\x01\x00", SY_FORMAT_GIF},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n", SY_FORMAT_RADIANCE},
+        {"#?RGBE\n", SY_FORMAT_RADIANCE},
         /* look-alikes */
         {"hello world\n", SY_FORMAT_UNKNOWN},
         {"<?xml version=\"1.0\"?><svg/>", SY_FORMAT_UNKNOWN},
@@ -47,6 +50,10 @@ int main(void)
     }
     EXPECT_MSG(!strcmp(sy_file_format_name(SY_FORMAT_OBJ), "Wavefront OBJ"), "OBJ's name");
     EXPECT_MSG(sy_file_format_is_scene(SY_FORMAT_GLB) && !sy_file_format_is_scene(SY_FORMAT_OBJ), "scene formats");
+    EXPECT_MSG(sy_file_format_is_texture_image(SY_FORMAT_PNG, false) && sy_file_format_is_texture_image(SY_FORMAT_JPEG, false) &&
+                   !sy_file_format_is_texture_image(SY_FORMAT_GIF, false) && sy_file_format_is_texture_image(SY_FORMAT_GIF, true) &&
+                   !sy_file_format_is_texture_image(SY_FORMAT_RADIANCE, true) && !sy_file_format_is_texture_image(SY_FORMAT_UNKNOWN, true),
+               "texture image formats: PNG, JPEG (and GIF for X3D), nothing else");
 
     char dir[4096], p[4200];
     make_scratch_dir(dir, sizeof dir, "sniff");

@@ -271,8 +271,12 @@ static void test_bad_json(void)
     /* a bad image is local (issue 6): the load succeeds, its textures go missing with a warning */
     local_image_case("missing_image", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, SCENES, ",\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"missing.png\"}]"),
                      "images[0] ('missing.png')");
-    local_image_case("corrupt_image", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, SCENES, ",\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,AAAAAAAAAAAAAAAA\"}]"),
+    local_image_case("corrupt_image", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, SCENES, ",\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,iVBORw0KGgoAAAAAAAAAAAAA\"}]"),
                      "images[0]: cannot decode image");
+    /* a truncated Radiance file where a PNG should be: stb_image would loop for ever on it; only PNG
+     * and JPEG are decoded (seen hanging before) */
+    local_image_case("radiance_image", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, SCENES, ",\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,Iz9SQURJQU5DRQpGT1JNQVQ9MzItYml0X3JsZV9yZ2JlCgotWSAxICtYIDI2NAoCAgEIiA==\"}]"),
+                     "images[0]: Radiance HDR image content, not a PNG or JPEG image");
     bad_json_case("image_view_range", DOC(BUF, "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6},{\"buffer\":0,\"byteOffset\":40,\"byteLength\":4000}]", ACCS, MESHES, MATS, NODES, SCENES, ",\"images\":[{\"bufferView\":2,\"mimeType\":\"image/png\"}]"),
                   SY_ERR_PARSE, "exceeds buffer 0 length 44");
     bad_json_case("missing_buffer", "{" ASSET ",\"buffers\":[{\"byteLength\":44,\"uri\":\"missing.bin\"}]}", SY_ERR_NOT_FOUND, "missing.bin");
