@@ -278,10 +278,26 @@ bool sy_cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
     return true;
 }
 
-/* -w W / -h H of every command that renders: 1..16384 pixels; false names nothing (the caller does). */
-bool sy_cli_size_option(int c, const char *value, uint32_t *w, uint32_t *h)
+/* sy_cli_next_option plus -w W / -h H: min_size..16384 pixels. */
+int sy_cli_next_sized_option(const char *cmd, int argc, char **argv, const char *shortopts,
+                             const struct option *longopts, uint32_t min_size, uint32_t *w, uint32_t *h, int *status)
 {
-    return sy_cli_parse_u32(value, 1, 16384, c == 'w' ? w : h);
+    for (;;) {
+        int c = sy_cli_next_option(cmd, argc, argv, shortopts, longopts, status);
+        if (c != 'w' && c != 'h') return c;
+        if (!sy_cli_parse_u32(optarg, min_size, 16384, c == 'w' ? w : h)) {
+            *status = sy_cli_bad_value(c == 'w' ? "-w" : "-h", optarg);
+            return OPT_STOP;
+        }
+    }
+}
+
+/* The one SCENE operand after the options. */
+int sy_cli_scene_operand(const char *cmd, int argc, char **argv, const char **scene)
+{
+    if (argc - optind != 1) return sy_cli_usage_of(cmd, argc == optind ? "a SCENE is required" : "one SCENE at a time");
+    *scene = argv[optind];
+    return 0;
 }
 
 bool sy_cli_ends_with(const char *s, const char *suffix)

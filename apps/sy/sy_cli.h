@@ -50,6 +50,15 @@ enum {
 int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *longopts,
                        int *status);
 
+/* sy_cli_next_option for a command that renders: -w W and -h H (shortopts names "w:h:") are taken
+ * too, as whole numbers of pixels from min_size to 16384, into *w and *h; a bad value is a usage error
+ * naming the option (OPT_STOP with *status 2). */
+int sy_cli_next_sized_option(const char *cmd, int argc, char **argv, const char *shortopts,
+                             const struct option *longopts, uint32_t min_size, uint32_t *w, uint32_t *h, int *status);
+/* The one SCENE operand a command takes after its options (argv[optind]) into *scene; returns 0, or 2
+ * after a usage error (none or more than one, with cmd's usage on stderr). */
+int sy_cli_scene_operand(const char *cmd, int argc, char **argv, const char **scene);
+
 /* The command summary (cmd NULL) or the entries of one command ("render", "bench", "bench sync") and
  * the common part, to f: stdout for --help (exit 0), stderr after a usage error (exit 2). */
 void sy_cli_usage_to(FILE *f, const char *cmd);
@@ -62,9 +71,6 @@ const char *sy_cli_option_name(const struct option *lo, int c);
 int sy_cli_bad_value(const char *opt, const char *value);
 /* s as a whole number in lo..hi (decimal, nothing after it). */
 bool sy_cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out);
-/* -w W / -h H (c: 'w' or 'h') of every command that renders: 1..16384 pixels; false names nothing
- * (the caller does). */
-bool sy_cli_size_option(int c, const char *value, uint32_t *w, uint32_t *h);
 
 /* The error on the log (stderr); returns 1, the exit status of a failure. */
 int sy_cli_fail(const sy_error *e);

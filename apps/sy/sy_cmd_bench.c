@@ -72,15 +72,9 @@ static int cmd_bench_filters(int argc, char **argv)
                                        {"reference", required_argument, NULL, OPT_REFERENCE}, COMMON_OPTIONS};
     int c, status = 0;
     optind = 0;
-    while ((c = sy_cli_next_option("bench filters", argc, argv, SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
+    while ((c = sy_cli_next_sized_option("bench filters", argc, argv, SHORT_OPTIONS("w:h:"), lo, 8, &w, &h, &status)) != -1) {
         switch (c) {
         case OPT_STOP: return status;
-        case 'w':
-            if (!sy_cli_parse_u32(optarg, 8, 16384, &w)) return sy_cli_bad_value("-w", optarg);
-            break;
-        case 'h':
-            if (!sy_cli_parse_u32(optarg, 8, 16384, &h)) return sy_cli_bad_value("-h", optarg);
-            break;
         case OPT_REPEATS:
             if (!sy_cli_parse_u32(optarg, 1, 1000, &repeats)) return sy_cli_bad_value("--repeats", optarg);
             break;
@@ -143,8 +137,8 @@ int sy_cmd_bench(int argc, char **argv)
     bool glb = false;
     int c, status = 0;
     optind = 0;
-    while ((c = sy_cli_next_option(who, argc, argv, memory || instanced || web ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"), lo,
-                            &status)) != -1) {
+    while ((c = sy_cli_next_sized_option(who, argc, argv, memory || instanced || web ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"),
+                                  lo, 1, &w, &h, &status)) != -1) {
         switch (c) {
         case OPT_STOP: return status;
         case OPT_PARAMS: params = optarg; break; /* bench raster */
@@ -161,10 +155,6 @@ int sy_cmd_bench(int argc, char **argv)
             break;
         case OPT_REPEATS:
             if (!sy_cli_parse_u32(optarg, 1, 100000, &repeats)) return sy_cli_bad_value("--repeats", optarg);
-            break;
-        case 'w':
-        case 'h':
-            if (!sy_cli_size_option(c, optarg, &w, &h)) return sy_cli_bad_value(c == 'w' ? "-w" : "-h", optarg);
             break;
         }
     }

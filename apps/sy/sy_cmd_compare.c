@@ -18,13 +18,9 @@ int sy_cmd_compare(int argc, char **argv)
                                        {"backends", required_argument, NULL, OPT_BACKENDS}, COMMON_OPTIONS};
     int c, status = 0;
     optind = 0;
-    while ((c = sy_cli_next_option("compare", argc, argv, SHORT_OPTIONS("w:h:o:"), lo, &status)) != -1) {
+    while ((c = sy_cli_next_sized_option("compare", argc, argv, SHORT_OPTIONS("w:h:o:"), lo, 1, &w, &h, &status)) != -1) {
         switch (c) {
         case OPT_STOP: return status;
-        case 'w':
-        case 'h':
-            if (!sy_cli_size_option(c, optarg, &w, &h)) return sy_cli_bad_value(c == 'w' ? "-w" : "-h", optarg);
-            break;
         case OPT_SPP:
             if (!sy_cli_parse_u32(optarg, 1, 1u << 20, &spp)) return sy_cli_bad_value("--spp", optarg);
             break;
@@ -33,8 +29,7 @@ int sy_cmd_compare(int argc, char **argv)
         case OPT_BACKENDS: only = optarg; break;
         }
     }
-    if (argc - optind != 1) return sy_cli_usage_of("compare", argc == optind ? "a SCENE is required" : "one SCENE at a time");
-    scene = argv[optind];
+    if ((status = sy_cli_scene_operand("compare", argc, argv, &scene))) return status;
     if (!sy_cli_ends_with(sheet, ".png")) {
         fprintf(stderr, "sy compare: %s: the contact sheet must end in .png\n", sheet);
         return 2;

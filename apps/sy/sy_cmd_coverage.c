@@ -22,13 +22,9 @@ int sy_cmd_coverage(int argc, char **argv)
                                        {"json", no_argument, NULL, OPT_JSON}, COMMON_OPTIONS};
     int c, status = 0;
     optind = 0;
-    while ((c = sy_cli_next_option("coverage", argc, argv, SHORT_OPTIONS("w:h:"), lo, &status)) != -1) {
+    while ((c = sy_cli_next_sized_option("coverage", argc, argv, SHORT_OPTIONS("w:h:"), lo, 1, &w, &h, &status)) != -1) {
         switch (c) {
         case OPT_STOP: return status;
-        case 'w':
-        case 'h':
-            if (!sy_cli_size_option(c, optarg, &w, &h)) return sy_cli_bad_value(c == 'w' ? "-w" : "-h", optarg);
-            break;
         case OPT_CAMERA: camera = optarg; break;
         case OPT_TOP:
             if (!sy_cli_parse_u32(optarg, 1, 1u << 30, &top)) return sy_cli_bad_value("--top", optarg);
@@ -36,8 +32,7 @@ int sy_cmd_coverage(int argc, char **argv)
         case OPT_JSON: break; /* the output is JSON anyway */
         }
     }
-    if (argc - optind != 1) return sy_cli_usage_of("coverage", argc == optind ? "a SCENE is required" : "one SCENE at a time");
-    scene = argv[optind];
+    if ((status = sy_cli_scene_operand("coverage", argc, argv, &scene))) return status;
     sy_error err = {0};
 #ifndef SY_HAVE_EMBREE /* the coverage back-end is one of the Embree ones */
     (void)scene, (void)camera, (void)w, (void)h, (void)top;

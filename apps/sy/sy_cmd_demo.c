@@ -20,15 +20,11 @@ int sy_cmd_demo(int argc, char **argv)
     static const struct option lo[] = {{"filter", required_argument, NULL, OPT_FILTER}, COMMON_OPTIONS};
     int c, status = 0;
     optind = 0;
-    while ((c = sy_cli_next_option("demo", argc, argv, SHORT_OPTIONS("o:w:h:"), lo, &status)) != -1) {
+    while ((c = sy_cli_next_sized_option("demo", argc, argv, SHORT_OPTIONS("o:w:h:"), lo, 1, &w, &h, &status)) != -1) {
         switch (c) {
         case OPT_STOP: return status;
         case 'o': dir = optarg; break;
         case OPT_FILTER: filter = optarg; break;
-        case 'w':
-        case 'h':
-            if (!sy_cli_size_option(c, optarg, &w, &h)) return sy_cli_bad_value(c == 'w' ? "-w" : "-h", optarg);
-            break;
         }
     }
     if (optind < argc) return sy_cli_usage_of("demo", "sy demo takes no operand (-o DIR names the folder)");

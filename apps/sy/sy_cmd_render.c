@@ -312,7 +312,7 @@ int sy_cmd_render(int argc, char **argv)
     uint32_t max_memory_mb = 0;
     int c, status = 0;
     optind = 0;
-    while ((c = sy_cli_next_option("render", argc, argv, SHORT_OPTIONS("b:o:w:h:"), lo, &status)) != -1) {
+    while ((c = sy_cli_next_sized_option("render", argc, argv, SHORT_OPTIONS("b:o:w:h:"), lo, 1, &w, &h, &status)) != -1) {
         char *end = NULL;
         switch (c) {
         case OPT_STOP: return status;
@@ -328,10 +328,6 @@ int sy_cmd_render(int argc, char **argv)
             break;
         case OPT_AOV: po.aov = progressive_opts = true; break;
         case 'o': outp = optarg; break;
-        case 'w':
-        case 'h':
-            if (!sy_cli_size_option(c, optarg, &w, &h)) return sy_cli_bad_value(c == 'w' ? "-w" : "-h", optarg);
-            break;
         case OPT_CAMERA: camera = optarg; break;
         case OPT_PARAMS: params = optarg; break;
         case OPT_GL: gl_provider = optarg; break;          /* raster: gl=... parameter */

@@ -32,17 +32,11 @@ int sy_cmd_view(int argc, char **argv)
     double budget = 0.0;
     int c, status = 0;
     optind = 0;
-    while ((c = sy_cli_next_option("view", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, &status)) != -1) {
+    while ((c = sy_cli_next_sized_option("view", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, 16, &w, &h, &status)) != -1) {
         char *end = NULL;
         switch (c) {
         case OPT_STOP: return status;
         case 'b': backend = optarg; break;
-        case 'w':
-            if (!sy_cli_parse_u32(optarg, 16, 16384, &w)) return sy_cli_bad_value("-w", optarg);
-            break;
-        case 'h':
-            if (!sy_cli_parse_u32(optarg, 16, 16384, &h)) return sy_cli_bad_value("-h", optarg);
-            break;
         case OPT_CAMERA: camera = optarg; break;
         case OPT_OVERLAY: overlay = optarg; break;
         case OPT_COMPOSITE: composite = optarg; break;
@@ -67,8 +61,7 @@ int sy_cmd_view(int argc, char **argv)
             if (!sy_cluster_cli_getopt(c, optarg, &clo)) return sy_cli_bad_value(sy_cli_option_name(lo, c), optarg);
         }
     }
-    if (argc - optind != 1) return sy_cli_usage_of("view", argc == optind ? "a SCENE is required" : "one SCENE at a time");
-    scene = argv[optind];
+    if ((status = sy_cli_scene_operand("view", argc, argv, &scene))) return status;
     sy_error err = {0};
     if (!backend && !(backend = sy_cli_default_backend(&err))) return sy_cli_fail(&err);
     if (!sy_mediator_find(backend)) {

@@ -20,7 +20,7 @@
 enum { OPT_WEB_LISTEN = 0x300, OPT_WEB_QUALITY, OPT_WEB_CLIENT_RENDER };
 int sy_cmd_web(int argc, char **argv)
 {
-    const char *backend = NULL, *camera = NULL, *listen = NULL, *filter = NULL;
+    const char *backend = NULL, *camera = NULL, *listen = NULL, *filter = NULL, *scene = NULL;
     uint32_t w = 1920, h = 1200, quality = 80;
     float threshold = 0.0f;
     double budget = 0; /* 0: the governor's default (33 ms) */
@@ -32,15 +32,11 @@ int sy_cmd_web(int argc, char **argv)
         {"client-render", no_argument, NULL, OPT_WEB_CLIENT_RENDER}, COMMON_OPTIONS};
     int c, status = 0;
     optind = 0;
-    while ((c = sy_cli_next_option("web", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, &status)) != -1) {
+    while ((c = sy_cli_next_sized_option("web", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, 1, &w, &h, &status)) != -1) {
         char *end = NULL;
         switch (c) {
         case OPT_STOP: return status;
         case 'b': backend = optarg; break;
-        case 'w':
-        case 'h':
-            if (!sy_cli_size_option(c, optarg, &w, &h)) return sy_cli_bad_value(c == 'w' ? "-w" : "-h", optarg);
-            break;
         case OPT_CAMERA: camera = optarg; break;
         case OPT_WEB_LISTEN: listen = optarg; break;
         case OPT_WEB_QUALITY:
@@ -58,11 +54,11 @@ int sy_cmd_web(int argc, char **argv)
         case OPT_WEB_CLIENT_RENDER: client_render = true; break;
         }
     }
-    if (argc - optind != 1) return sy_cli_usage_of("web", argc == optind ? "a SCENE is required" : "one SCENE at a time");
+    if ((status = sy_cli_scene_operand("web", argc, argv, &scene))) return status;
     sy_error err = {0};
     if (!backend && !(backend = sy_cli_default_backend(&err))) return sy_cli_fail(&err);
     loaded ld;
-    if (sy_cli_load(argv[optind], camera, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
+    if (sy_cli_load(scene, camera, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
     sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,
                      .backend = backend, .listen = listen, .max_width = w, .max_height = h, .quality = (int)quality,
                      .filter = filter, .threshold = threshold, .budget_ms = budget};
