@@ -54,11 +54,12 @@ static inline int raw_connect(int port, int timeout_ms)
     return raw_connect_from(NULL, port, timeout_ms);
 }
 
-static inline bool raw_write_all(int fd, const void *data, size_t n)
+/* All n bytes through send (writing) or recv; false when the peer closed or the socket timed out
+ * first. */
+static inline bool raw_transfer_all(int fd, uint8_t *p, size_t n, bool writing)
 {
-    const uint8_t *p = data;
     while (n) {
-        ssize_t k = send(fd, p, n, MSG_NOSIGNAL);
+        ssize_t k = writing ? send(fd, p, n, MSG_NOSIGNAL) : recv(fd, p, n, 0);
         if (k <= 0) {
             if (k < 0 && errno == EINTR) continue;
             return false;
@@ -69,19 +70,14 @@ static inline bool raw_write_all(int fd, const void *data, size_t n)
     return true;
 }
 
+static inline bool raw_write_all(int fd, const void *data, size_t n)
+{
+    return raw_transfer_all(fd, (uint8_t *)data, n, true); /* send only reads through p */
+}
+
 static inline bool raw_read_all(int fd, void *data, size_t n)
 {
-    uint8_t *p = data;
-    while (n) {
-        ssize_t k = recv(fd, p, n, 0);
-        if (k <= 0) {
-            if (k < 0 && errno == EINTR) continue;
-            return false;
-        }
-        p += k;
-        n -= (size_t)k;
-    }
-    return true;
+    return raw_transfer_all(fd, data, n, false);
 }
 
 /* Encodes m as one untagged frame (its header.seq as given) and writes it; 0 on success. */
@@ -175,5 +171,35 @@ static inline sy_cluster_msg raw_hello(void)
     return m;
 }
 #endif
+
+/* The serialized snapshot of a scene built for one message (payloads sent as send says; NULL: all)
+ * into *data (free()) and *size: commits sc, then destroys it, whatever happened. */
+static inline sy_result raw_scene_bytes(sy_scene *sc, sy_blob_send_fn send, void **data, size_t *size, sy_error *e)
+{
+    sy_changes *ch = NULL;
+    sy_result r = sy_scene_commit(sc, NULL, e);
+    if (r == SY_OK) r = sy_scene_snapshot(sc, &ch, e);
+    if (r == SY_OK) r = sy_changes_serialize(ch, send, NULL, data, size, e);
+    sy_changes_release(ch);
+    sy_scene_destroy(sc);
+    return r;
+}
+
+/* A RENDER of *tile (the caller's, 4x4 pixels at the origin) of an 8x8 frame by whitted, the camera
+ * framing the cube [-1, 1]^3, sequence seq: a request a server checks before it renders anything. */
+static inline sy_cluster_msg raw_small_render(sy_cluster_rect *tile, uint32_t seq)
+{
+    sy_cluster_msg r;
+    memset(&r, 0, sizeof r);
+    *tile = (sy_cluster_rect){0, 0, 4, 4};
+    r.header.type = SY_CLUSTER_RENDER;
+    r.header.seq = seq;
+    strcpy(r.u.render.backend, "whitted");
+    r.u.render.full_width = r.u.render.full_height = 8;
+    r.u.render.camera = sy_camera_view_frame_bounds(&(sy_bounds){{-1, -1, -1}, {1, 1, 1}}, 1.0f);
+    r.u.render.tile_count = 1;
+    r.u.render.tiles = tile;
+    return r;
+}
 
 #endif /* SY_TEST_RAW_PEER_H */

@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -40,6 +41,23 @@ typedef struct server {
     char log[512];
     char memory[512]; /* its --memory-file: "USED PEAK" bytes of peer memory (wait_peer_memory) */
 } server;
+
+/* The start of a cluster test's main: argv[1] the server executable (g_exe), argv[2] the work
+ * directory (g_dir, created), SIGPIPE ignored (a server that went away is an error code, not a
+ * signal). Returns 0, or 2 after printing "usage: NAME SERVER_EXE WORK_DIR MORE" when either is
+ * missing. */
+static inline int server_proc_setup(int argc, char **argv, const char *name, const char *more)
+{
+    if (argc < 3) {
+        fprintf(stderr, "usage: %s SERVER_EXE WORK_DIR%s\n", name, more);
+        return 2;
+    }
+    g_exe = argv[1];
+    g_dir = argv[2];
+    mkdir(g_dir, 0755);
+    signal(SIGPIPE, SIG_IGN);
+    return 0;
+}
 
 static inline void sleep_ms(int ms)
 {

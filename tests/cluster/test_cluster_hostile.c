@@ -452,16 +452,8 @@ static int test_counts(fixture *fx)
     if (!(type == SY_CLUSTER_ERROR && strstr(why, "truncated blob list"))) bad++;
     {
         sy_error e = {0};
-        sy_cluster_rect tile = {0, 0, 4, 4};
-        sy_cluster_msg r;
-        memset(&r, 0, sizeof r);
-        r.header.type = SY_CLUSTER_RENDER;
-        r.header.seq = 2;
-        strcpy(r.u.render.backend, "whitted");
-        r.u.render.full_width = r.u.render.full_height = 8;
-        r.u.render.camera = sy_camera_view_frame_bounds(&(sy_bounds){{-1, -1, -1}, {1, 1, 1}}, 1.0f);
-        r.u.render.tile_count = 1;
-        r.u.render.tiles = &tile;
+        sy_cluster_rect tile;
+        sy_cluster_msg r = raw_small_render(&tile, 2);
         sy_cluster_buf b = {0};
         CHECK_OK(sy_cluster_encode(&r, 0, &b, &e), e);
         const uint32_t tiles = 4096, body_size = (uint32_t)(b.size - SY_CLUSTER_HEADER_SIZE - 16);
@@ -530,7 +522,6 @@ static int test_replica_multiple(void)
     sy_error e = {0};
     /* dense: a snapshot of 20000 materials (the largest data record) with default values */
     sy_scene *sc = NULL;
-    sy_changes *ch = NULL;
     void *data = NULL;
     size_t size = 0;
     CHECK_OK(sy_scene_create(&sc, &e), e);
@@ -538,11 +529,7 @@ static int test_replica_multiple(void)
         sy_material m;
         CHECK_OK(sy_material_create(sc, NULL, &m, &e), e);
     }
-    CHECK_OK(sy_scene_commit(sc, NULL, &e), e);
-    CHECK_OK(sy_scene_snapshot(sc, &ch, &e), e);
-    CHECK_OK(sy_changes_serialize(ch, NULL, NULL, &data, &size, &e), e);
-    sy_changes_release(ch);
-    sy_scene_destroy(sc);
+    CHECK_OK(raw_scene_bytes(sc, NULL, &data, &size, &e), e);
     double dense, sparse;
     long kb_dense, kb_sparse;
     size_t dense_size = size;
@@ -1060,14 +1047,7 @@ static int test_camera(fixture *fx)
 
 int main(int argc, char **argv)
 {
-    if (argc < 3) {
-        fprintf(stderr, "usage: test_cluster_hostile SERVER_EXE WORK_DIR [rss|counts|cap|ceiling|lockout|camera]...\n");
-        return 2;
-    }
-    g_exe = argv[1];
-    g_dir = argv[2];
-    mkdir(g_dir, 0755);
-    signal(SIGPIPE, SIG_IGN);
+    if (server_proc_setup(argc, argv, "test_cluster_hostile", " [rss|counts|cap|ceiling|lockout|camera]...")) return 2;
 #ifdef HOSTILE_ASAN
     /* AddressSanitizer keeps freed memory in a quarantine (256 MiB by default) and so counts every
      * buffer a server ever freed as resident: the servers this test starts run without it (every

@@ -277,14 +277,7 @@ static int test_refusals(fixture *fx, const server *s)
 
 int main(int argc, char **argv)
 {
-    if (argc < 3) {
-        fprintf(stderr, "usage: test_cluster_mediator SERVER_EXE WORK_DIR\n");
-        return 2;
-    }
-    g_exe = argv[1];
-    g_dir = argv[2];
-    mkdir(g_dir, 0755);
-    signal(SIGPIPE, SIG_IGN);
+    if (server_proc_setup(argc, argv, "test_cluster_mediator", "")) return 2;
     atexit(kill_leftover_servers);
     sy_error e = {0};
     fixture fx = {0};

@@ -423,14 +423,8 @@ static int test_bad_messages(fixture *fx, server *all)
     CHECK_OK(sy_cluster_encode(&r, 0, &b, &e), e);
     if (raw_exchange(s, b.data, b.size, why, sizeof why)) return 1;
     CHECK_MSG(strstr(why, "before authentication"), "%s", why);
-    sy_cluster_rect tile = {0, 0, 4, 4};
-    r.header.type = SY_CLUSTER_RENDER;
-    r.header.seq = 2;
-    strcpy(r.u.render.backend, "whitted");
-    r.u.render.full_width = r.u.render.full_height = 8;
-    r.u.render.camera = sy_camera_view_frame_bounds(&(sy_bounds){{-1, -1, -1}, {1, 1, 1}}, 1.0f);
-    r.u.render.tile_count = 1;
-    r.u.render.tiles = &tile;
+    sy_cluster_rect tile;
+    r = raw_small_render(&tile, 2);
     if (raw_session(s, &r, why, sizeof why)) return 1;
     CHECK_MSG(strstr(why, "before any scene"), "%s", why);
     /* change lists naming unknown handles: an update of a node the replica never saw */
@@ -612,7 +606,6 @@ static int texture_snapshot(const uint8_t *px, size_t n, void **data, size_t *si
     sy_scene *sc = NULL;
     sy_texture t;
     sy_blob *b = NULL;
-    sy_changes *ch = NULL;
     CHECK_OK(sy_scene_create(&sc, &e), e);
     CHECK_OK(sy_texture_create(sc, "t", &t, &e), e);
     CHECK_OK(sy_blob_create_copy(px, n, &b, &e), e);
@@ -620,11 +613,7 @@ static int texture_snapshot(const uint8_t *px, size_t n, void **data, size_t *si
     sy_image_info ii = {(uint32_t)n / 4, 1, 4, SY_PIXEL_U8_LINEAR};
     CHECK_OK(sy_texture_set_image(sc, t, &ii, b, &e), e);
     sy_blob_release(b);
-    CHECK_OK(sy_scene_commit(sc, NULL, &e), e);
-    CHECK_OK(sy_scene_snapshot(sc, &ch, &e), e);
-    CHECK_OK(sy_changes_serialize(ch, no_payloads, NULL, data, size, &e), e);
-    sy_changes_release(ch);
-    sy_scene_destroy(sc);
+    CHECK_OK(raw_scene_bytes(sc, no_payloads, data, size, &e), e);
     return 0;
 }
 
@@ -718,16 +707,11 @@ static int test_slot_limit(fixture *fx, server *s)
     sy_error e = {0};
     sy_scene *sc = NULL;
     sy_node nd;
-    sy_changes *ch = NULL;
     void *data = NULL;
     size_t size = 0;
     CHECK_OK(sy_scene_create(&sc, &e), e);
     CHECK_OK(sy_node_create(sc, NULL, &nd, &e), e);
-    CHECK_OK(sy_scene_commit(sc, NULL, &e), e);
-    CHECK_OK(sy_scene_snapshot(sc, &ch, &e), e);
-    CHECK_OK(sy_changes_serialize(ch, NULL, NULL, &data, &size, &e), e);
-    sy_changes_release(ch);
-    sy_scene_destroy(sc);
+    CHECK_OK(raw_scene_bytes(sc, NULL, &data, &size, &e), e);
     /* header 32 bytes, no blobs, then the entry {u8 type, u8 flags, u16 0, u32 id}: the id at 36 */
     uint32_t id;
     memcpy(&id, (uint8_t *)data + 36, 4);
@@ -993,14 +977,7 @@ static int test_faults(fixture *fx, server *s)
 
 int main(int argc, char **argv)
 {
-    if (argc < 3) {
-        fprintf(stderr, "usage: test_cluster_net SERVER_EXE WORK_DIR\n");
-        return 2;
-    }
-    g_exe = argv[1];
-    g_dir = argv[2];
-    mkdir(g_dir, 0755);
-    signal(SIGPIPE, SIG_IGN);
+    if (server_proc_setup(argc, argv, "test_cluster_net", "")) return 2;
     sy_error e = {0};
     if (sy_mediators_register_builtin(&e) || coop_double_register(&e)) {
         fprintf(stderr, "%s\n", e.message);
