@@ -6,19 +6,14 @@
 #include <string.h>
 
 #include "../support/sy_check.h"
+#include "../support/sy_test_rng.h"
 #include "sy_changes.h"
 #include "sy_fields.h" /* internal to core: generic field compare for deep equality of entries */
 
 static const float Q0[4] = {0, 0, 0, 1}, S1[3] = {1, 1, 1};
 
 static uint64_t rng_state;
-static uint64_t rnd(void) /* splitmix64 */
-{
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
+static uint64_t rnd(void) { return sy_test_splitmix64(&rng_state); }
 
 static sy_blob *blob_of(const void *data, size_t size)
 {

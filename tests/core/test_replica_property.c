@@ -22,17 +22,12 @@
 #include <string.h>
 
 #include "../support/sy_check.h"
+#include "../support/sy_test_rng.h"
 #include "sy_changes.h"
 
 /* ------------------------------------------------------------------ PRNG */
 static uint64_t rng_state;
-static uint64_t rnd(void) /* splitmix64 */
-{
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
+static uint64_t rnd(void) { return sy_test_splitmix64(&rng_state); }
 static uint32_t rn(uint32_t n) { return n ? (uint32_t)(rnd() % n) : 0; }
 static bool chance(uint32_t percent) { return rn(100) < percent; }
 /* exactly representable values, sometimes -0 */
