@@ -1,7 +1,7 @@
 /* exr_equal.c — test helper: exit 0 when two OpenEXR files hold the same size, the same channels and
  * bit-identical pixels (headers may differ: sy render records the back-end and the render time).
  *   exr_equal A.exr B.exr */
-#include "sy_exr.h"
+#include "exr_pair.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -12,13 +12,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: exr_equal A.exr B.exr\n");
         return 2;
     }
-    sy_error e = {0};
     sy_exr_image *a = NULL, *b = NULL;
-    if (sy_exr_read(argv[1], &a, &e) != SY_OK || sy_exr_read(argv[2], &b, &e) != SY_OK) {
-        fprintf(stderr, "exr_equal: %s\n", e.message);
-        sy_exr_image_free(a);
-        return 2;
-    }
+    if (exr_read_pair("exr_equal", argv[1], argv[2], &a, &b)) return 2;
     int rc = 0;
     if (a->width != b->width || a->height != b->height || a->channel_count != b->channel_count) {
         fprintf(stderr, "exr_equal: %dx%d with %d channels against %dx%d with %d\n", a->width, a->height,

@@ -6,7 +6,7 @@
  * reference's. With --blocks N, then N rows of N numbers: the relMSE of each block of an N x N grid
  * (where the error is). Exit 0, or 2 with a message on unreadable or mismatched files.
  *   exr_error IMAGE.exr REFERENCE.exr [--blocks N] */
-#include "sy_exr.h"
+#include "exr_pair.h"
 #include "sy_filter_metrics.h"
 
 #include <math.h>
@@ -40,13 +40,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: exr_error IMAGE.exr REFERENCE.exr [--blocks N (1..64)]\n");
         return 2;
     }
-    sy_error e = {0};
     sy_exr_image *a = NULL, *b = NULL;
-    if (sy_exr_read(argv[1], &a, &e) != SY_OK || sy_exr_read(argv[2], &b, &e) != SY_OK) {
-        fprintf(stderr, "exr_error: %s\n", e.message);
-        sy_exr_image_free(a);
-        return 2;
-    }
+    if (exr_read_pair("exr_error", argv[1], argv[2], &a, &b)) return 2;
     int rc = 2;
     float *x = NULL, *y = NULL;
     if (a->width != b->width || a->height != b->height) {
