@@ -7,60 +7,9 @@
 #include "sy_gltf.h"
 #include "sy_mesh_util.h"
 #include "sy_png.h"
-#include "sy_x3d.h"
-#include "test_util.h"
+#include "x3d_loaded.h"
 
 #include <math.h>
-
-static char g_dir[1024];
-
-static void write_text(const char *name, const char *text)
-{
-    char p[2048];
-    PATHF(p, "%s/%s", g_dir, name);
-    if (write_bytes(p, text, strlen(text)) != 0) {
-        fprintf(stderr, "cannot write %s\n", p);
-        exit(1);
-    }
-}
-
-typedef struct loaded {
-    sy_scene *scene;
-    sy_x3d_info info;
-    sy_result r;
-    sy_error err;
-} loaded;
-
-static loaded load_path(const char *p)
-{
-    loaded l;
-    memset(&l, 0, sizeof l);
-    if (sy_scene_create(&l.scene, NULL) != SY_OK) exit(1);
-    l.r = sy_x3d_load(p, l.scene, NULL, &l.info, &l.err);
-    if (l.r == SY_OK && sy_scene_commit(l.scene, NULL, &l.err) != SY_OK) l.r = SY_ERR_INVALID_ARGUMENT;
-    return l;
-}
-
-static loaded load_text(const char *name, const char *text)
-{
-    char p[2048];
-    write_text(name, text);
-    PATHF(p, "%s/%s", g_dir, name);
-    return load_path(p);
-}
-
-static void unload(loaded *l)
-{
-    sy_x3d_info_free(&l->info);
-    sy_scene_destroy(l->scene);
-}
-
-static bool has_warning(const loaded *l, const char *a, const char *b)
-{
-    for (uint32_t k = 0; k < l->info.stored_warning_count; k++)
-        if (strstr(l->info.warnings[k], a) && (!b || strstr(l->info.warnings[k], b))) return true;
-    return false;
-}
 
 static void dump_warnings(const loaded *l)
 {

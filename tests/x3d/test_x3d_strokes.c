@@ -3,44 +3,9 @@
  * warned with file:line, and the shared sample files that contain these nodes (their counts
  * computed here from the file's own attributes). Usage: test_x3d_strokes [TESTDATA_DIR]. */
 #include "sy_text.h"
-#include "sy_x3d.h"
-#include "test_util.h"
+#include "x3d_loaded.h"
 
 #include <math.h>
-
-static char g_dir[1024];
-
-typedef struct loaded {
-    sy_scene *scene;
-    sy_x3d_info info;
-    sy_result r;
-    sy_error err;
-} loaded;
-
-static loaded load_text(const char *name, const char *text)
-{
-    loaded l;
-    memset(&l, 0, sizeof l);
-    char p[2048];
-    PATHF(p, "%s/%s", g_dir, name);
-    if (write_bytes(p, text, strlen(text)) != 0 || sy_scene_create(&l.scene, NULL) != SY_OK) exit(1);
-    l.r = sy_x3d_load(p, l.scene, NULL, &l.info, &l.err);
-    if (l.r == SY_OK && sy_scene_commit(l.scene, NULL, &l.err) != SY_OK) l.r = SY_ERR_INVALID_ARGUMENT;
-    return l;
-}
-
-static void unload(loaded *l)
-{
-    sy_x3d_info_free(&l->info);
-    sy_scene_destroy(l->scene);
-}
-
-static bool has_warning(const loaded *l, const char *a, const char *b)
-{
-    for (uint32_t k = 0; k < l->info.stored_warning_count; k++)
-        if (strstr(l->info.warnings[k], a) && (!b || strstr(l->info.warnings[k], b))) return true;
-    return false;
-}
 
 /* The primitive of the mesh whose node is named (DEF of the Shape). */
 static const sy_primitive *prim_named(const loaded *l, const char *name)
