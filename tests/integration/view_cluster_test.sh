@@ -10,12 +10,7 @@
 # Skipped (77) when xvfb-run is missing or sy was built without GLFW. Every wait is bounded; the
 # servers stop by themselves (--max-lifetime) and are killed on exit.
 set -u
-SY=$1
-CMP=$2
-W=$3
-rm -rf "$W"
-mkdir -p "$W"
-. "$(dirname "$0")/view_skip.sh"
+. "$(dirname "$0")/view_setup.sh"
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; }
 trap cleanup EXIT

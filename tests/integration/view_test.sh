@@ -8,30 +8,25 @@
 # switch with a moving frame and settles at full size. Skipped (77) when xvfb-run is not
 # installed or the viewer was built without GLFW.
 set -u
-SY=$1
-CMP=$2
-TMP=$3
-rm -rf "$TMP"
-mkdir -p "$TMP"
-. "$(dirname "$0")/view_skip.sh"
+. "$(dirname "$0")/view_setup.sh"
 timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w 320 -h 180 --frames 5 \
-    --screenshot "$TMP/view.png" >"$TMP/view.out" 2>"$TMP/view.err"
+    --screenshot "$W/view.png" >"$W/view.out" 2>"$W/view.err"
 rc=$?
 if [ $rc -ne 0 ]; then
-    echo "FAIL: sy view exited with status $rc: $(cat "$TMP/view.err")"
+    echo "FAIL: sy view exited with status $rc: $(cat "$W/view.err")"
     exit 1
 fi
-"$SY" render demo -b whitted -w 320 -h 180 --tonemap aces -o "$TMP/render.png" >/dev/null || exit 1
-"$CMP" "$TMP/view.png" "$TMP/render.png" 2 50 || {
+"$SY" render demo -b whitted -w 320 -h 180 --tonemap aces -o "$W/render.png" >/dev/null || exit 1
+"$CMP" "$W/view.png" "$W/render.png" 2 50 || {
     echo "FAIL: the viewer's window does not show the rendered image"
     exit 1
 }
 # the path tracer with its pixel display filter (issue 7): applied on the render thread's context
 timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b pathtracer --filter pixel --threshold 0.02 \
-    -w 64 -h 48 --frames 6 --screenshot "$TMP/view_filter.png" >"$TMP/view_filter.out" 2>"$TMP/view_filter.err"
+    -w 64 -h 48 --frames 6 --screenshot "$W/view_filter.png" >"$W/view_filter.out" 2>"$W/view_filter.err"
 rc=$?
-if [ $rc -ne 0 ] || [ ! -s "$TMP/view_filter.png" ] || ! grep -q "filter pixel t=0.02" "$TMP/view_filter.out"; then
-    echo "FAIL: sy view -b pathtracer --filter pixel: status $rc: $(cat "$TMP/view_filter.out" "$TMP/view_filter.err")"
+if [ $rc -ne 0 ] || [ ! -s "$W/view_filter.png" ] || ! grep -q "filter pixel t=0.02" "$W/view_filter.out"; then
+    echo "FAIL: sy view -b pathtracer --filter pixel: status $rc: $(cat "$W/view_filter.out" "$W/view_filter.err")"
     exit 1
 fi
 # live filter keys (issue 7) through the viewer's keyboard handler (--keys presses one key per
@@ -39,67 +34,67 @@ fi
 # the pixel filter at the default t = 0.01, ] doubles t, F moves on to a-trous keeping t, [ [
 # halve it twice
 timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b pathtracer -w 64 -h 48 --keys 'F]F[[' \
-    --frames 2 >"$TMP/view_keys.out" 2>"$TMP/view_keys.err"
+    --frames 2 >"$W/view_keys.out" 2>"$W/view_keys.err"
 rc=$?
 keys_expect() { # $1 = line number, $2 = key, $3 = expected filter status
     local line
-    line=$(grep '^sy view: after key' "$TMP/view_keys.out" | sed -n "$1p")
+    line=$(grep '^sy view: after key' "$W/view_keys.out" | sed -n "$1p")
     case "$line" in
     "sy view: after key $2: "*"| filter $3 "*) ;;
-    *) echo "FAIL: key $1 ($2): expected 'filter $3' in: '$line'"; cat "$TMP/view_keys.out" "$TMP/view_keys.err"
+    *) echo "FAIL: key $1 ($2): expected 'filter $3' in: '$line'"; cat "$W/view_keys.out" "$W/view_keys.err"
        exit 1 ;;
     esac
 }
-[ $rc -eq 0 ] || { echo "FAIL: sy view --keys: status $rc: $(cat "$TMP/view_keys.err")"; exit 1; }
-grep -q '| filter none' "$TMP/view_keys.out" && { echo "FAIL: a filter key left the filter at none"; exit 1; }
+[ $rc -eq 0 ] || { echo "FAIL: sy view --keys: status $rc: $(cat "$W/view_keys.err")"; exit 1; }
+grep -q '| filter none' "$W/view_keys.out" && { echo "FAIL: a filter key left the filter at none"; exit 1; }
 keys_expect 1 F 'pixel t=0.01'
 keys_expect 2 ']' 'pixel t=0.02'
 keys_expect 3 F 'atrous t=0.02'
 keys_expect 4 '[' 'atrous t=0.01'
 keys_expect 5 '[' 'atrous t=0.005'
-tail -n 1 "$TMP/view_keys.out" | grep -q '| filter atrous t=0.005 ' || {
+tail -n 1 "$W/view_keys.out" | grep -q '| filter atrous t=0.005 ' || {
     echo "FAIL: the last heads-up line does not show the final filter state"; exit 1; }
 # the frame-time governor (core/sy_governor.h): a back-end switch (key 2) is a view change, answered
 # by a moving frame (reduced size, "moving" in the heads-up line); --frames counts only frames shown
 # once the view settled, so the last line is at full size
 timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w 160 -h 90 --keys 2 --frames 1 \
-    >"$TMP/view_gov.out" 2>"$TMP/view_gov.err"
+    >"$W/view_gov.out" 2>"$W/view_gov.err"
 rc=$?
-[ $rc -eq 0 ] || { echo "FAIL: sy view --keys 2: status $rc: $(cat "$TMP/view_gov.err")"; exit 1; }
+[ $rc -eq 0 ] || { echo "FAIL: sy view --keys 2: status $rc: $(cat "$W/view_gov.err")"; exit 1; }
 # (the first frame answering the key: on a busy machine the window may show only a later one)
-grep -q '^sy view: key 2 first answered by: scale [0-9.]* moving$' "$TMP/view_gov.out" || {
-    echo "FAIL: the frame after a back-end switch is not a moving frame:"; cat "$TMP/view_gov.out"; exit 1; }
-tail -n 1 "$TMP/view_gov.out" | grep -q '| scale 1.00 |' || {
-    echo "FAIL: the settled frame is not at full size:"; cat "$TMP/view_gov.out"; exit 1; }
+grep -q '^sy view: key 2 first answered by: scale [0-9.]* moving$' "$W/view_gov.out" || {
+    echo "FAIL: the frame after a back-end switch is not a moving frame:"; cat "$W/view_gov.out"; exit 1; }
+tail -n 1 "$W/view_gov.out" | grep -q '| scale 1.00 |' || {
+    echo "FAIL: the settled frame is not at full size:"; cat "$W/view_gov.out"; exit 1; }
 # a budget out of range is a usage error naming the option
-if "$SY" view demo --budget 0 --frames 1 2>"$TMP/badb.err"; then
+if "$SY" view demo --budget 0 --frames 1 2>"$W/badb.err"; then
     echo "FAIL: sy view accepted --budget 0"
     exit 1
 fi
-grep -q -- "--budget" "$TMP/badb.err" || { echo "FAIL: the --budget error does not name it"; exit 1; }
+grep -q -- "--budget" "$W/badb.err" || { echo "FAIL: the --budget error does not name it"; exit 1; }
 # a scripted key that is not a key is refused before any window opens
-if "$SY" view demo -b pathtracer --keys 'F?' --frames 1 2>"$TMP/badk.err"; then
+if "$SY" view demo -b pathtracer --keys 'F?' --frames 1 2>"$W/badk.err"; then
     echo "FAIL: sy view accepted --keys with '?'"
     exit 1
 fi
-grep -q "'?' is not a key" "$TMP/badk.err" || { echo "FAIL: the --keys error does not name the key"; exit 1; }
+grep -q "'?' is not a key" "$W/badk.err" || { echo "FAIL: the --keys error does not name the key"; exit 1; }
 # a negative threshold is refused with the reason, not just the usage text
-if "$SY" view demo -b pathtracer --filter pixel --threshold -0.5 --frames 1 2>"$TMP/badt.err"; then
+if "$SY" view demo -b pathtracer --filter pixel --threshold -0.5 --frames 1 2>"$W/badt.err"; then
     echo "FAIL: sy view accepted a negative threshold"
     exit 1
 fi
-grep -q "threshold -0.5 must be a finite value >= 0" "$TMP/badt.err" || {
-    echo "FAIL: the threshold error does not say why: $(cat "$TMP/badt.err")"; exit 1; }
+grep -q "threshold -0.5 must be a finite value >= 0" "$W/badt.err" || {
+    echo "FAIL: the threshold error does not say why: $(cat "$W/badt.err")"; exit 1; }
 # an unknown filter is refused before any window opens, naming it
-if "$SY" view demo -b pathtracer --filter bogus --frames 1 2>"$TMP/badf.err"; then
+if "$SY" view demo -b pathtracer --filter bogus --frames 1 2>"$W/badf.err"; then
     echo "FAIL: sy view accepted an unknown filter"
     exit 1
 fi
-grep -q bogus "$TMP/badf.err" || { echo "FAIL: the error does not name the filter"; exit 1; }
+grep -q bogus "$W/badf.err" || { echo "FAIL: the error does not name the filter"; exit 1; }
 # a back-end that does not exist is refused before any window opens
-if "$SY" view demo -b nosuchbackend --frames 1 2>"$TMP/bad.err"; then
+if "$SY" view demo -b nosuchbackend --frames 1 2>"$W/bad.err"; then
     echo "FAIL: sy view accepted an unknown back-end"
     exit 1
 fi
-grep -q nosuchbackend "$TMP/bad.err" || { echo "FAIL: the error does not name the back-end"; exit 1; }
+grep -q nosuchbackend "$W/bad.err" || { echo "FAIL: the error does not name the back-end"; exit 1; }
 echo "integration_view: ok"
