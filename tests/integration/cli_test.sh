@@ -61,6 +61,13 @@ run() {
     "$@" >"$TMP/$name.out" 2>"$TMP/$name.err"
     rc=$?
 }
+# run_ok LABEL NAME CMD...: run, and a failure naming LABEL, the status and stderr unless CMD succeeds
+run_ok() {
+    local label=$1
+    shift
+    run "$@"
+    if [ "$rc" -ne 0 ]; then fail "$label: status $rc: $(cat "$TMP/$1.err")"; fi
+}
 
 # magic FILE HEX: the file starts with these bytes
 magic() {
@@ -301,33 +308,28 @@ mkdir -p "$TMP/o_ext"
 expect_error extension x.bmp "$TMP/o_ext" "$SY" render demo -b whitted -w 16 -h 16 -o "$TMP/o_ext/x.bmp"
 
 # benchmarks on small sizes: exit status and result lines only (speed is not tested here)
-run bench_sync "$SY" bench sync --nodes 200 --tris 48 --repeats 5
-if [ "$rc" -ne 0 ]; then fail "bench sync: status $rc: $(cat "$TMP/bench_sync.err")"; fi
+run_ok "bench sync" bench_sync "$SY" bench sync --nodes 200 --tris 48 --repeats 5
 grep -Eq 'ratio full / incremental +[0-9.]+ x' "$TMP/bench_sync.out" || fail "bench sync: no ratio line"
 grep -Eq 'placements recomputed +1$' "$TMP/bench_sync.out" || fail "bench sync: a leaf move did not re-place exactly 1"
 grep -Eq '^sy bench sync: 200 nodes' "$TMP/bench_sync.out" || fail "bench sync: wrong node count"
 cat "$TMP/bench_sync.out"
-run bench_rays "$SY" bench rays demo -w 64 -h 64 --repeats 2
-if [ "$rc" -ne 0 ]; then fail "bench rays: status $rc: $(cat "$TMP/bench_rays.err")"; fi
+run_ok "bench rays" bench_rays "$SY" bench rays demo -w 64 -h 64 --repeats 2
 grep -Eq 'raw Embree rtcIntersect1 +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fail "bench rays: no raw line"
 grep -Eq 'whitted back-end \(primary\) +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fail "bench rays: no ours line"
 grep -Eq 'overhead +-?[0-9.]+ %' "$TMP/bench_rays.out" || fail "bench rays: no overhead (ratio) line"
 cat "$TMP/bench_rays.out"
-run bench_limit "$SY" bench limit demo -w 24 -h 16 --repeats 1
-if [ "$rc" -ne 0 ]; then fail "bench limit: status $rc: $(cat "$TMP/bench_limit.err")"; fi
+run_ok "bench limit" bench_limit "$SY" bench limit demo -w 24 -h 16 --repeats 1
 [ "$(grep -Ec '^  rtcIntersect(1|4|8|16|1M) / rtcOccluded(1|4|8|16|1M) +[0-9.]+ Mrays/s .* path tracer = +[0-9.]+ %' \
     "$TMP/bench_limit.out")" -eq 5 ] || fail "bench limit: not one share line per raw Embree form"
 grep -q 'answers differ' "$TMP/bench_limit.out" && fail "bench limit: the replay does not reproduce the frame's answers"
 cat "$TMP/bench_limit.out"
 mkdir -p "$TMP/o_limit"
 expect_error bench_limit_spp "--spp: '0' is not in 1..1024" "$TMP/o_limit" "$SY" bench limit demo --spp 0
-run bench_memory "$SY" bench memory --tris 2000 -w 16 -h 16
-if [ "$rc" -ne 0 ]; then fail "bench memory: status $rc: $(cat "$TMP/bench_memory.err")"; fi
+run_ok "bench memory" bench_memory "$SY" bench memory --tris 2000 -w 16 -h 16
 [ "$(grep -Ec '^  peak RSS +[0-9.]+ MB +[0-9.]+ bytes/triangle' "$TMP/bench_memory.out")" -eq 2 ] ||
     fail "bench memory: not one peak line per ray tracer"
 grep -Eq '^  Embree peak .* [0-9.]+ bytes/triangle' "$TMP/bench_memory.out" || fail "bench memory: no Embree line"
-run bench_memory_glb "$SY" bench memory --tris 2000 -b whitted --glb -w 16 -h 16
-if [ "$rc" -ne 0 ]; then fail "bench memory --glb: status $rc: $(cat "$TMP/bench_memory_glb.err")"; fi
+run_ok "bench memory --glb" bench_memory_glb "$SY" bench memory --tris 2000 -b whitted --glb -w 16 -h 16
 grep -Eq '^whitted: 2048 triangles' "$TMP/bench_memory_glb.out" || fail "bench memory --glb: wrong triangle count"
 run bench_memory_bad "$SY" bench memory -b raster --tris 2000
 [ "$rc" -eq 1 ] && grep -q 'expected one of the ray tracers' "$TMP/bench_memory_bad.err" ||
@@ -335,8 +337,7 @@ run bench_memory_bad "$SY" bench memory -b raster --tris 2000
 cat "$TMP/bench_memory.out"
 # bench governor: one row per picture back-end of the registry (no analysis or remote class), each
 # with its numbers; a bad budget is a usage error
-run bench_governor "$SY" bench governor demo --frames 4 -w 32 -h 24
-if [ "$rc" -ne 0 ]; then fail "bench governor: status $rc: $(cat "$TMP/bench_governor.err")"; fi
+run_ok "bench governor" bench_governor "$SY" bench governor demo --frames 4 -w 32 -h 24
 for b in $("$SY" backends | grep -Ev ' (analysis|remote)( |$)' | cut -d' ' -f1); do
     grep -Eq "^  $b +[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+[ !] +[0-9]+% +[0-9.]+ +[0-9]+% " \
         "$TMP/bench_governor.out" || fail "bench governor: no row for back-end $b"
@@ -359,8 +360,7 @@ if has raster; then
 fi
 
 # demo
-run demo "$SY" demo -o "$TMP/demo" -w 64 -h 36
-if [ "$rc" -ne 0 ]; then fail "demo: status $rc: $(cat "$TMP/demo.err")"; fi
+run_ok "demo" demo "$SY" demo -o "$TMP/demo" -w 64 -h 36
 if [ -f "$TMP/demo/demo_whitted.png" ] && magic "$TMP/demo/demo_whitted.png" 89504e470d0a1a0a; then
     [ "$(u32be "$TMP/demo/demo_whitted.png" 16)x$(u32be "$TMP/demo/demo_whitted.png" 20)" = 64x36 ] ||
         fail "demo: PNG is not 64x36"
@@ -401,8 +401,7 @@ expect_error overlay_backend nosuchbackend "$TMP/o_stereo" "$SY" render demo -b 
 
 # ---------------------------------------------------------------- with test data
 if [ -f "$BOX" ] && [ -f "$GLB" ]; then
-    run info "$SY" info "$BOX"
-    if [ "$rc" -ne 0 ]; then fail "info Box.gltf: status $rc: $(cat "$TMP/info.err")"; fi
+    run_ok "info Box.gltf" info "$SY" info "$BOX"
     # one layout for every format: format, file_counts (the file's own, indented by four spaces),
     # loaded (on one line), bounds, warning_count, warnings
     grep -qxF '  "format": "gltf",' "$TMP/info.out" || fail "info Box.gltf: no format line"
@@ -439,8 +438,7 @@ if [ -f "$CORNELL" ]; then
             fail "hybrid pathtracer + raster overlay: status $rc: $(cat "$TMP/hybrid.err")"
     fi
     # coverage (culling service): the 8 Cornell objects, most pixels first, pixel counts adding up
-    run coverage "$SY" coverage "$CORNELL" -w 128 -h 128
-    if [ "$rc" -ne 0 ]; then fail "coverage: status $rc: $(cat "$TMP/coverage.err")"; fi
+    run_ok "coverage" coverage "$SY" coverage "$CORNELL" -w 128 -h 128
     [ "$(grep -c '"node":' "$TMP/coverage.out")" = 8 ] || fail "coverage: expected the 8 Cornell objects"
     grep -q '"name": "light"' "$TMP/coverage.out" || fail "coverage: the light is not listed"
     px=($(grep -o '"pixels": [0-9]*' "$TMP/coverage.out" | grep -o '[0-9]*$'))
@@ -455,16 +453,14 @@ if [ -f "$CORNELL" ]; then
     [ "$sum" = "$total" ] && [ "$total" -gt 0 ] && [ "$total" -le 16384 ] || fail "coverage: pixel counts do not add up"
 
     mkdir -p "$TMP/render"
-    run render_png "$SY" render "$CORNELL" -b whitted -w 96 -h 96 -o "$TMP/render/cornell.png"
-    if [ "$rc" -ne 0 ]; then fail "render cornell png: status $rc: $(cat "$TMP/render_png.err")"; fi
+    run_ok "render cornell png" render_png "$SY" render "$CORNELL" -b whitted -w 96 -h 96 -o "$TMP/render/cornell.png"
     if [ -f "$TMP/render/cornell.png" ] && magic "$TMP/render/cornell.png" 89504e470d0a1a0a; then
         [ "$(u32be "$TMP/render/cornell.png" 16)x$(u32be "$TMP/render/cornell.png" 20)" = 96x96 ] ||
             fail "render cornell: PNG is not 96x96"
     else
         fail "render cornell: no PNG written"
     fi
-    run render_exr "$SY" render "$CORNELL" -b whitted -w 64 -o "$TMP/render/cornell.exr"
-    if [ "$rc" -ne 0 ]; then fail "render cornell exr: status $rc: $(cat "$TMP/render_exr.err")"; fi
+    run_ok "render cornell exr" render_exr "$SY" render "$CORNELL" -b whitted -w 64 -o "$TMP/render/cornell.exr"
     [ -f "$TMP/render/cornell.exr" ] && magic "$TMP/render/cornell.exr" 762f3101 || fail "render cornell: no EXR written"
     # exactly the two outputs, no temporary files
     [ "$(ls -A "$TMP/render" | sort | tr '\n' ' ')" = "cornell.exr cornell.png " ] ||

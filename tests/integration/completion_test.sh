@@ -33,33 +33,25 @@ complete_words() {
     printf '%s\n' "${COMPREPLY[@]}" | sort
 }
 
-# expect "WORDS" WANTED... : every WANTED is offered
-expect() {
-    local words=$1
-    shift
+# offers MODE "WORDS" ITEMS...: MODE expect: every ITEM is offered; refuse: none of them is
+offers() {
+    local mode=$1 words=$2
+    shift 2
     local got
     got=$(complete_words "$words")
-    for want in "$@"; do
-        if ! grep -qxF -- "$want" <<<"$got"; then
-            echo "FAIL: 'sy $words<TAB>' does not offer '$want': $(echo $got)"
-            fails=$((fails + 1))
+    for item in "$@"; do
+        if grep -qxF -- "$item" <<<"$got"; then
+            [ "$mode" = refuse ] || continue
+            echo "FAIL: 'sy $words<TAB>' offers '$item': $(echo $got)"
+        else
+            [ "$mode" = expect ] || continue
+            echo "FAIL: 'sy $words<TAB>' does not offer '$item': $(echo $got)"
         fi
+        fails=$((fails + 1))
     done
 }
-
-# refuse "WORDS" UNWANTED... : none of them is offered
-refuse() {
-    local words=$1
-    shift
-    local got
-    got=$(complete_words "$words")
-    for bad in "$@"; do
-        if grep -qxF -- "$bad" <<<"$got"; then
-            echo "FAIL: 'sy $words<TAB>' offers '$bad': $(echo $got)"
-            fails=$((fails + 1))
-        fi
-    done
-}
+expect() { offers expect "$@"; }
+refuse() { offers refuse "$@"; }
 
 expect "re" render
 refuse "re" info

@@ -29,15 +29,26 @@ wait_phase() {
     return 1
 }
 leftovers() { compgen -G "$W/*.tmp-*" >/dev/null; }
+# render_bg NAME PAUSE ARGS...: `sy render demo ARGS` in the background (its pid in pid, output in
+# $W/NAME.out / .err), announcing its phases on NAME's FIFO and, unless PAUSE is empty, held at the
+# phase PAUSE until a signal comes
+render_bg() {
+    local name=$1 pause=$2
+    shift 2
+    phases "$name"
+    SY_TEST_PHASES="$W/$name.fifo" SY_TEST_PAUSE=$pause "$SY" render demo "$@" >"$W/$name.out" 2>"$W/$name.err" &
+    pid=$!
+}
+# ended: waits for that sy; its exit status in rc
+ended() {
+    wait $pid
+    rc=$?
+}
 
 # 1. graceful: the first SIGINT ends the progressive render after its current pass
-phases pt
-SY_TEST_PHASES="$W/pt.fifo" "$SY" render demo -b pathtracer --spp 1000000 -w 64 -h 48 -o "$W/pt.exr" \
-    >"$W/pt.out" 2>"$W/pt.err" &
-pid=$!
+render_bg pt "" -b pathtracer --spp 1000000 -w 64 -h 48 -o "$W/pt.exr"
 wait_phase pass && kill -INT $pid # after a finished pass: the interrupt is graceful
-wait $pid
-rc=$?
+ended
 if [ $rc -ne 130 ] || [ ! -s "$W/pt.exr" ]; then
     fail "graceful interrupt: status $rc (want 130), image present: $([ -s "$W/pt.exr" ] && echo yes || echo no)"
 elif ! grep -qa "sy:interrupted" "$W/pt.exr" || ! grep -qa "sy:samples" "$W/pt.exr"; then
@@ -50,18 +61,14 @@ fi
 leftovers && fail "graceful interrupt left a temporary file: $(ls "$W")"
 
 # 2. two interrupts while the (multi-channel) image is being written: abort, nothing left
-phases aov
-SY_TEST_PHASES="$W/aov.fifo" SY_TEST_PAUSE=commit \
-    "$SY" render demo -b pathtracer --spp 1 --aov -w 120 -h 120 -o "$W/aov.exr" >"$W/aov.out" 2>"$W/aov.err" &
-pid=$!
+render_bg aov commit -b pathtracer --spp 1 --aov -w 120 -h 120 -o "$W/aov.exr"
 if wait_phase commit; then # written, held before the rename
     compgen -G "$W/aov.exr.tmp-*" >/dev/null || fail "second interrupt while writing: no temporary file while writing"
     kill -TERM $pid
     # the first interrupt is graceful: the second, once sy has taken the first, aborts
     wait_phase interrupted && kill -TERM $pid
 fi
-wait $pid
-rc=$?
+ended
 if [ $rc -ne 143 ]; then fail "second interrupt while writing: status $rc (want 143, killed by SIGTERM)"
 elif [ -e "$W/aov.exr" ]; then fail "second interrupt while writing: an image was written"
 else echo "ok: second interrupt while writing -> status $rc, no image"
@@ -69,26 +76,18 @@ fi
 leftovers && fail "interrupt while writing left a temporary file: $(ls "$W")"
 
 # 3. a single-pass back-end: the first interrupt while writing aborts
-phases w
-SY_TEST_PHASES="$W/w.fifo" SY_TEST_PAUSE=commit "$SY" render demo -b whitted -w 100 -h 100 -o "$W/w.png" \
-    >"$W/w.out" 2>"$W/w.err" &
-pid=$!
+render_bg w commit -b whitted -w 100 -h 100 -o "$W/w.png"
 wait_phase commit && kill -INT $pid
-wait $pid
-rc=$?
+ended
 if [ $rc -ne 130 ] || [ -e "$W/w.png" ]; then fail "interrupt while writing a PNG: status $rc (want 130), image: $(ls "$W")"
 else echo "ok: interrupt while writing a PNG -> status $rc, no image"
 fi
 leftovers && fail "interrupt while writing a PNG left a temporary file: $(ls "$W")"
 
 # 4. an interrupt during a single-pass render: nothing written
-phases r
-SY_TEST_PHASES="$W/r.fifo" SY_TEST_PAUSE=tiles "$SY" render demo -b whitted -w 100 -h 100 -o "$W/r.exr" \
-    >"$W/r.out" 2>"$W/r.err" &
-pid=$!
+render_bg r tiles -b whitted -w 100 -h 100 -o "$W/r.exr"
 wait_phase tiles && kill -TERM $pid # a tile is done, the render held in progress
-wait $pid
-rc=$?
+ended
 if [ $rc -ne 143 ] || compgen -G "$W/r.exr*" >/dev/null; then fail "interrupt while rendering: status $rc, files: $(ls "$W")"
 else echo "ok: interrupt while rendering -> status $rc, nothing written"
 fi
