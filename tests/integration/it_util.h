@@ -50,6 +50,19 @@ static inline const char *it_testdata(const char *rel, char *buf, size_t size)
     return buf;
 }
 
+#if __has_include("sy_gltf.h") /* the tests that link the formats */
+#include "sy_gltf.h"
+/* A new scene holding the glTF file at path (not committed); *info: the loader's (sy_gltf_info_free);
+ * aborts on failure. */
+static inline sy_scene *it_load_gltf(const char *path, sy_gltf_info *info)
+{
+    sy_scene *s;
+    MUST(sy_scene_create(&s, err));
+    MUST(sy_gltf_load(path, s, NULL, info, err));
+    return s;
+}
+#endif
+
 /* Blob from a copy of memory; aborts on failure. */
 static inline sy_blob *it_blob(const void *data, size_t size)
 {

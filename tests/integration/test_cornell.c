@@ -229,10 +229,8 @@ int main(void)
     const char *gltf = it_testdata("cornell/cornell_box.gltf", gltf_buf, sizeof gltf_buf);
     const char *ref = it_testdata("cornell/cornell_box_cycles_256_4096.exr", ref_buf, sizeof ref_buf);
 
-    sy_scene *scene;
-    MUST(sy_scene_create(&scene, err));
     sy_gltf_info info;
-    MUST(sy_gltf_load(gltf, scene, NULL, &info, err));
+    sy_scene *scene = it_load_gltf(gltf, &info);
     sy_node cam;
     MUST(sy_gltf_find_camera(scene, &info, "camera", &cam, err));
     EXPECT(info.camera_node_count == 1 && info.camera_nodes[0].id == cam.id);

@@ -63,10 +63,8 @@ int main(void)
         return 1;
     }
     bool full = W != 64 || spp != DEFAULT_SPP;
-    sy_scene *scene;
-    MUST(sy_scene_create(&scene, err));
     sy_gltf_info info;
-    MUST(sy_gltf_load(gpath, scene, NULL, &info, err));
+    sy_scene *scene = it_load_gltf(gpath, &info);
     sy_node cam;
     MUST(sy_gltf_find_camera(scene, &info, "camera", &cam, err));
     MUST(sy_scene_commit(scene, NULL, err));

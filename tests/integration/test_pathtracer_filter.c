@@ -249,8 +249,7 @@ int main(void)
     }
     fixture fx;
     memset(&fx, 0, sizeof fx);
-    MUST(sy_scene_create(&fx.scene, err));
-    MUST(sy_gltf_load(gpath, fx.scene, NULL, &fx.info, err));
+    fx.scene = it_load_gltf(gpath, &fx.info);
     MUST(sy_gltf_find_camera(fx.scene, &fx.info, "camera", &fx.cam, err));
     MUST(sy_scene_commit(fx.scene, NULL, err));
     MUST(sy_context_pool_create(&fx.pool, err));

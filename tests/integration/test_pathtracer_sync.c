@@ -37,6 +37,15 @@ static uint64_t render(fixture *fx, uint32_t n)
 
 static void commit(fixture *fx) { MUST(sy_scene_commit(fx->s, NULL, err)); }
 
+/* Commits a change the accumulation must restart on: the next render is its first sample, the one
+ * after it its second. */
+static void expect_restart(fixture *fx, const char *change)
+{
+    commit(fx);
+    EXPECT_MSG(render(fx, 1) == 1, "%s did not restart", change);
+    EXPECT_MSG(render(fx, 1) == 2, "%s: no accumulation after the restart", change);
+}
+
 static sy_node camera_node(sy_scene *s, const char *name, float z)
 {
     sy_camera c;
@@ -146,28 +155,20 @@ int main(void)
     sy_material_data md = *sy_material_get(s, fx.grey);
     md.base_color[0] = 0.3f;
     MUST(sy_material_set(s, fx.grey, &md, err));
-    commit(&fx);
-    EXPECT_MSG(render(&fx, 1) == 1, "a material change did not restart");
-    EXPECT(render(&fx, 1) == 2);
+    expect_restart(&fx, "a material change");
 
     sy_light_data ld = *sy_light_get(s, fx.lamp);
     ld.intensity = 5.0f;
     MUST(sy_light_set(s, fx.lamp, &ld, err));
-    commit(&fx);
-    EXPECT_MSG(render(&fx, 1) == 1, "a light change did not restart");
-    EXPECT(render(&fx, 1) == 2);
+    expect_restart(&fx, "a light change");
 
     sy_background_data bd = *sy_background_get(s, fx.bg);
     bd.color[1] = 0.7f;
     MUST(sy_background_set(s, fx.bg, &bd, err));
-    commit(&fx);
-    EXPECT_MSG(render(&fx, 1) == 1, "a background change did not restart");
-    EXPECT(render(&fx, 1) == 2);
+    expect_restart(&fx, "a background change");
 
     it_set_translation(s, fx.cam_node, 0, 0.2f, 3);
-    commit(&fx);
-    EXPECT_MSG(render(&fx, 1) == 1, "moving the viewport's camera did not restart");
-    EXPECT(render(&fx, 1) == 2);
+    expect_restart(&fx, "moving the viewport's camera");
 
     /* runtime switching: away to whitted and back; the cached path tracer context resumes its
      * accumulation because nothing changed meanwhile */
@@ -181,9 +182,7 @@ int main(void)
     EXPECT_MSG(render(&fx, 1) == 3, "switching back to the path tracer did not resume its accumulation");
     EXPECT_MSG(render(&fx, 1) == 4, "accumulation after switching back");
     it_set_translation(s, fx.cam_node, 0, 0.2f, 3.5f);
-    commit(&fx);
-    EXPECT(render(&fx, 1) == 1);
-    EXPECT(render(&fx, 1) == 2);
+    expect_restart(&fx, "moving the viewport's camera again");
 
     /* AOVs of the viewport rectangle */
     sy_context *ctx;

@@ -134,10 +134,8 @@ int main(void)
     char buf[1024];
     const char *path = it_testdata("gltf/TextureTransformTest/glTF/TextureTransformTest.gltf", buf, sizeof buf);
 
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
     sy_gltf_info info;
-    MUST(sy_gltf_load(path, s, NULL, &info, err));
+    sy_scene *s = it_load_gltf(path, &info);
     sy_light lamp;
     MUST(sy_light_create(s, "headlight", &lamp, err));
     sy_light_data ld = *sy_light_get(s, lamp);
