@@ -278,6 +278,15 @@ bool sy_cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
     return true;
 }
 
+bool sy_cli_parse_double(const char *s, double lo, double hi, double *out)
+{
+    char *end = NULL;
+    double v = strtod(s, &end);
+    if (end == s || *end || !(v >= lo && v <= hi)) return false; /* the range refuses NaN and infinities */
+    *out = v;
+    return true;
+}
+
 /* sy_cli_next_option plus -w W / -h H: min_size..16384 pixels. */
 int sy_cli_next_sized_option(const char *cmd, int argc, char **argv, const char *shortopts,
                              const struct option *longopts, uint32_t min_size, uint32_t *w, uint32_t *h, int *status)

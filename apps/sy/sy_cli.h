@@ -69,6 +69,8 @@ int sy_cli_usage_of(const char *cmd, const char *what);
 const char *sy_cli_option_name(const struct option *lo, int c);
 /* A usage error naming the option and the value it did not accept; returns 2. */
 int sy_cli_bad_value(const char *opt, const char *value);
+/* s as a finite number in lo..hi (nothing after it). */
+bool sy_cli_parse_double(const char *s, double lo, double hi, double *out);
 /* s as a whole number in lo..hi (decimal, nothing after it). */
 bool sy_cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out);
 

@@ -19,6 +19,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -322,8 +323,7 @@ int sy_cmd_render(int argc, char **argv)
             progressive_opts = true;
             break;
         case OPT_TIME:
-            po.time_budget = strtod(optarg, &end);
-            if (end == optarg || *end || !(po.time_budget > 0) || !isfinite(po.time_budget)) return sy_cli_bad_value("--time", optarg);
+            if (!sy_cli_parse_double(optarg, DBL_TRUE_MIN, DBL_MAX, &po.time_budget)) return sy_cli_bad_value("--time", optarg);
             progressive_opts = true;
             break;
         case OPT_AOV: po.aov = progressive_opts = true; break;

@@ -10,6 +10,7 @@
 #include "sy_log.h"
 #include "sy_png.h"
 
+#include <float.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -96,12 +97,7 @@ int sy_cmd_serve(int argc, char **argv)
         case O_TLS_KEY: o.tls_key_file = optarg; break;
         case O_NAME: o.name = optarg; break;
         case O_MAX_SESSIONS: ok = sy_cluster_cli_uint_arg(optarg, 1, 65536, &v), o.max_sessions = (uint32_t)v; break;
-        case O_MAX_LIFETIME: {
-            char *end = NULL;
-            o.max_lifetime_s = strtod(optarg, &end);
-            ok = end != optarg && !*end && o.max_lifetime_s > 0 && isfinite(o.max_lifetime_s);
-            break;
-        }
+        case O_MAX_LIFETIME: ok = sy_cli_parse_double(optarg, DBL_TRUE_MIN, DBL_MAX, &o.max_lifetime_s); break;
         case O_BLOB_CACHE: ok = sy_cluster_cli_uint_arg(optarg, 1, 1u << 24, &v), o.blob_cache_bytes = (size_t)v << 20; break;
         case O_MAX_OBJECTS: ok = sy_cluster_cli_uint_arg(optarg, 1, 1u << 30, &v), o.max_objects = (uint32_t)v; break;
         case O_AUTH_BACKOFF: ok = sy_cluster_cli_uint_arg(optarg, 0, 3600000, &v), o.auth_backoff_ms = (uint32_t)v; break;

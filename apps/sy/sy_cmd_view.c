@@ -51,8 +51,7 @@ int sy_cmd_view(int argc, char **argv)
             break;
         case OPT_KEYS: view_keys = optarg; break;
         case OPT_BUDGET:
-            budget = strtod(optarg, &end);
-            if (end == optarg || *end || !(budget >= 1.0 && budget <= 10000.0)) return sy_cli_bad_value("--budget", optarg);
+            if (!sy_cli_parse_double(optarg, 1.0, 10000.0, &budget)) return sy_cli_bad_value("--budget", optarg);
             break;
         case OPT_SPP:
             if (!sy_cli_parse_u32(optarg, 1, 100000000u, &clo.samples)) return sy_cli_bad_value("--spp", optarg);

@@ -48,8 +48,7 @@ int sy_cmd_web(int argc, char **argv)
             if (end == optarg || *end || !(threshold >= 0.0f) || !isfinite(threshold)) return sy_cli_bad_value("--threshold", optarg);
             break;
         case OPT_BUDGET: /* the frame-time governor's budget (ms) */
-            budget = strtod(optarg, &end);
-            if (end == optarg || *end || !(budget >= 1.0 && budget <= 10000.0)) return sy_cli_bad_value("--budget", optarg);
+            if (!sy_cli_parse_double(optarg, 1.0, 10000.0, &budget)) return sy_cli_bad_value("--budget", optarg);
             break;
         case OPT_WEB_CLIENT_RENDER: client_render = true; break;
         }
