@@ -148,6 +148,21 @@ const sy_mediator_class *sy_mediator_find(const char *name)
     return found;
 }
 
+const sy_mediator_class *sy_mediator_require(const char *name, sy_error *err)
+{
+    const sy_mediator_class *cls = sy_mediator_find(name);
+    if (!cls) {
+        char names[256] = "";
+        for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
+            size_t l = strlen(names);
+            snprintf(names + l, sizeof names - l, "%s%s", l ? ", " : "", sy_mediator_at(i)->name);
+        }
+        sy_error_set(err, SY_ERR_NOT_FOUND, "back-end '%s' is not registered (available: %s)", name,
+                     names[0] ? names : "none");
+    }
+    return cls;
+}
+
 const sy_mediator_class *sy_mediator_default(void)
 {
     const sy_mediator_class *best = NULL;
@@ -224,16 +239,8 @@ sy_result sy_context_create(sy_scene *scene, const char *backend, const sy_param
                             sy_context **out, sy_error *err)
 {
     *out = NULL;
-    const sy_mediator_class *cls = sy_mediator_find(backend);
-    if (!cls) {
-        char names[256] = "";
-        for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
-            size_t l = strlen(names);
-            snprintf(names + l, sizeof names - l, "%s%s", l ? ", " : "", sy_mediator_at(i)->name);
-        }
-        return sy_error_set(err, SY_ERR_NOT_FOUND, "back-end '%s' is not registered (available: %s)", backend,
-                            names[0] ? names : "none");
-    }
+    const sy_mediator_class *cls = sy_mediator_require(backend, err);
+    if (!cls) return SY_ERR_NOT_FOUND;
     sy_result r = sy_mediator_class_check_params(cls, params, err);
     if (r != SY_OK) return r;
     sy_context *c = calloc(1, sizeof *c);

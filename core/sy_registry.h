@@ -134,6 +134,9 @@ typedef struct sy_mediator_class {
 sy_result sy_mediator_register(const sy_mediator_class *cls, sy_error *err);
 /** The class registered under name, or NULL. */
 const sy_mediator_class *sy_mediator_find(const char *name);
+/** The class registered under name; NULL with *err SY_ERR_NOT_FOUND "back-end 'NAME' is not
+ * registered (available: the registered names)" when there is none. */
+const sy_mediator_class *sy_mediator_require(const char *name, sy_error *err);
 /** The default back-end: the registered class of the highest default_rank above 0 (the first
  * registered of equal ranks), or NULL when none offers itself. Every program's default (sy render,
  * sy view, sy web, sy compare) is this class. */

@@ -69,14 +69,9 @@ void sy_window_size(const sy_window *w, uint32_t *width, uint32_t *height)
 sy_result sy_viewport_set_backend(sy_viewport *v, const char *backend, const char *params, sy_error *err)
 {
     if (!backend || !backend[0]) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "viewport: no back-end name");
-    if (!sy_mediator_find(backend)) { /* fail now, keeping the current back-end, not at the next render */
-        char names[256] = "";
-        for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
-            size_t l = strlen(names);
-            snprintf(names + l, sizeof names - l, "%s%s", l ? ", " : "", sy_mediator_at(i)->name);
-        }
-        return sy_error_set(err, SY_ERR_NOT_FOUND, "viewport: back-end '%s' is not registered (available: %s)", backend,
-                            names[0] ? names : "none");
+    if (!sy_mediator_require(backend, err)) { /* fail now, keeping the current back-end, not at the next render */
+        sy_error_prefix(err, "viewport");
+        return SY_ERR_NOT_FOUND;
     }
     sy_params parsed;
     sy_result r = sy_params_parse(params, &parsed, err);
