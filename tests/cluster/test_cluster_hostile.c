@@ -942,14 +942,7 @@ static int test_camera(fixture *fx)
     CHECK_OK(sy_scene_snapshot(fx->scene, &ch, &e), e);
     CHECK_OK(sy_changes_serialize(ch, NULL, NULL, &data, &size, &e), e);
     sy_changes_release(ch);
-    sy_cluster_msg m;
-    memset(&m, 0, sizeof m);
-    m.header.type = SY_CLUSTER_SCENE;
-    m.header.seq = 2;
-    m.u.scene.frame = 1;
-    m.u.scene.flags = SY_CLUSTER_SCENE_SNAPSHOT;
-    m.u.scene.changes = data;
-    m.u.scene.changes_size = (uint32_t)size;
+    sy_cluster_msg m = raw_scene_msg(2, SY_CLUSTER_SCENE_SNAPSHOT, data, size);
     CHECK(raw_expect(fd, &m, SY_CLUSTER_SCENE_ACK, why, sizeof why) == 0);
     free(data);
     /* RENDERs: valid; camera at (1e19, 0, 0); an orthographic window of 1e19; valid again */

@@ -446,13 +446,7 @@ static int test_bad_messages(fixture *fx, server *all)
     CHECK_OK(sy_changes_serialize(ch, NULL, NULL, &data, &size, &e), e);
     sy_changes_release(ch);
     sy_scene_destroy(other);
-    sy_cluster_msg sc;
-    memset(&sc, 0, sizeof sc);
-    sc.header.type = SY_CLUSTER_SCENE;
-    sc.header.seq = 2;
-    sc.u.scene.frame = 1;
-    sc.u.scene.changes = data;
-    sc.u.scene.changes_size = (uint32_t)size;
+    sy_cluster_msg sc = raw_scene_msg(2, 0, data, size);
     if (raw_session(s, &sc, why, sizeof why)) return 1;
     CHECK_MSG(strstr(why, "snapshot"), "%s", why);
     sc.u.scene.flags = SY_CLUSTER_SCENE_SNAPSHOT;
@@ -718,10 +712,7 @@ static int test_slot_limit(fixture *fx, server *s)
     CHECK(id == nd.id);
     id = (1u << SY_HANDLE_INDEX_BITS) | 3000000u;
     memcpy((uint8_t *)data + 36, &id, 4);
-    sy_cluster_msg m;
-    memset(&m, 0, sizeof m);
-    m.header.type = SY_CLUSTER_SCENE;
-    m.u.scene = (__typeof__(m.u.scene)){1, SY_CLUSTER_SCENE_SNAPSHOT, data, (uint32_t)size};
+    sy_cluster_msg m = raw_scene_msg(0, SY_CLUSTER_SCENE_SNAPSHOT, data, size);
     char why[SY_CLUSTER_REASON_MAX];
     if (raw_session(&s[3], &m, why, sizeof why)) return 1;
     CHECK_MSG(strstr(why, "slot index 3000000 exceeds this replica's limit of 1048576"), "%s", why);
