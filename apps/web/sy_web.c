@@ -221,6 +221,16 @@ void sy_web_stats_get(sy_web *w, sy_web_stats *out)
     out->evicted = g.evicted, out->expired = g.expired, out->pending = g.pending;
 }
 
+/* Frees a list of jobs linked by next. */
+static void free_jobs(web_job *j)
+{
+    while (j) {
+        web_job *next = j->next;
+        sy_webi_job_free(j);
+        j = next;
+    }
+}
+
 void sy_web_destroy(sy_web *w)
 {
     if (!w) return;
@@ -231,21 +241,9 @@ void sy_web_destroy(sy_web *w)
         pthread_join(w->net_thread, NULL);
     }
     if (w->ctx) lws_context_destroy(w->ctx); /* closes every connection (their CLOSED callbacks run here) */
-    while (w->finished) {
-        web_job *j = w->finished;
-        w->finished = j->next;
-        sy_webi_job_free(j);
-    }
-    while (w->pending) {
-        web_job *j = w->pending;
-        w->pending = j->next;
-        sy_webi_job_free(j);
-    }
-    while (w->stills) {
-        web_job *j = w->stills;
-        w->stills = j->next;
-        sy_webi_job_free(j);
-    }
+    free_jobs(w->finished);
+    free_jobs(w->pending);
+    free_jobs(w->stills);
     while (w->handoffs) {
         web_handoff *h = w->handoffs;
         w->handoffs = h->next;

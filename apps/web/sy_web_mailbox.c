@@ -31,28 +31,21 @@ void sy_webi_wake_network(sy_web *w)
     if (w->ctx) lws_cancel_service(w->ctx);
 }
 
-/* Network thread -> render thread. */
-void sy_webi_post_job(sy_web *w, web_job *j)
+/* Network thread -> render thread: j appended to the queue whose tail pointer is *tail. */
+static void post_to(sy_web *w, web_job ***tail, web_job *j)
 {
     pthread_mutex_lock(&w->mu);
     j->state = JOB_PENDING;
     j->next = NULL;
-    *w->pending_tail = j;
-    w->pending_tail = &j->next;
+    **tail = j;
+    *tail = &j->next;
     pthread_cond_signal(&w->cv);
     pthread_mutex_unlock(&w->mu);
 }
 
-void sy_webi_post_still(sy_web *w, web_job *j)
-{
-    pthread_mutex_lock(&w->mu);
-    j->state = JOB_PENDING;
-    j->next = NULL;
-    *w->stills_tail = j;
-    w->stills_tail = &j->next;
-    pthread_cond_signal(&w->cv);
-    pthread_mutex_unlock(&w->mu);
-}
+void sy_webi_post_job(sy_web *w, web_job *j) { post_to(w, &w->pending_tail, j); }
+
+void sy_webi_post_still(sy_web *w, web_job *j) { post_to(w, &w->stills_tail, j); }
 
 bool sy_webi_job_abandoned(sy_web *w, const web_job *j)
 {

@@ -185,19 +185,26 @@ static sy_result route_echo(void *user, sy_scene *scene, const sy_web_request *r
 
 static sy_result route_block(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err);
 
+/* the demo scene served on listen by backend from a thread of its own; 1 after printing why not */
 static int start(server *s, const char *listen, const char *backend, sy_error *e)
 {
     memset(s, 0, sizeof *s);
     sy_demo_info demo;
-    if (sy_scene_create(&s->scene, e) || sy_demo_build(s->scene, &demo, e) || sy_scene_commit(s->scene, NULL, e)) return 1;
-    static const sy_web_route routes[] = {{"GET", "/api/object/", route_info, NULL},
-                                          {"POST", "/api/echo", route_echo, NULL},
-                                          {"GET", "/api/block", route_block, NULL}};
-    sy_web_desc d = {.scene = s->scene, .root = demo.root, .camera = demo.camera, .background = demo.background,
-                     .backend = backend, .listen = listen, .max_body = 1000, .max_message = 256, .max_clients = 3,
-                     .routes = routes, .route_count = 3,
-                     .still_max_pixels = 20000}; /* small stills: fast on a loaded machine */
-    if (sy_web_create(&d, &s->web, e)) return 1;
+    int failed = sy_scene_create(&s->scene, e) || sy_demo_build(s->scene, &demo, e) || sy_scene_commit(s->scene, NULL, e);
+    if (!failed) {
+        static const sy_web_route routes[] = {{"GET", "/api/object/", route_info, NULL},
+                                              {"POST", "/api/echo", route_echo, NULL},
+                                              {"GET", "/api/block", route_block, NULL}};
+        sy_web_desc d = {.scene = s->scene, .root = demo.root, .camera = demo.camera, .background = demo.background,
+                         .backend = backend, .listen = listen, .max_body = 1000, .max_message = 256, .max_clients = 3,
+                         .routes = routes, .route_count = 3,
+                         .still_max_pixels = 20000}; /* small stills: fast on a loaded machine */
+        failed = sy_web_create(&d, &s->web, e) != SY_OK;
+    }
+    if (failed) {
+        fprintf(stderr, "start: %s\n", e->message);
+        return 1;
+    }
     return pthread_create(&s->th, NULL, server_main, s) != 0;
 }
 
@@ -416,10 +423,7 @@ static int test_progressive(void)
 {
     sy_error err = {0};
     server s;
-    if (start(&s, "127.0.0.1:0", "pathtracer", &err)) {
-        fprintf(stderr, "start: %s\n", err.message);
-        return 1;
-    }
+    if (start(&s, "127.0.0.1:0", "pathtracer", &err)) return 1;
     sy_web_client *c = NULL;
     sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
     CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
@@ -449,10 +453,7 @@ static int test_token(void)
 {
     sy_error err = {0};
     server s;
-    if (start(&s, "0.0.0.0:0", "whitted", &err)) {
-        fprintf(stderr, "start: %s\n", err.message);
-        return 1;
-    }
+    if (start(&s, "0.0.0.0:0", "whitted", &err)) return 1;
     uint16_t port = sy_web_port(s.web);
     const char *url = sy_web_url(s.web), *t = strstr(url, "?token=");
     CHECK(t && strlen(t + 7) == 32);
@@ -890,10 +891,7 @@ int main(int argc, char **argv)
         return f;
     }
     server s;
-    if (start(&s, "127.0.0.1:0", "whitted", &err)) {
-        fprintf(stderr, "start: %s\n", err.message);
-        return 1;
-    }
+    if (start(&s, "127.0.0.1:0", "whitted", &err)) return 1;
     uint16_t port = sy_web_port(s.web);
     int failed = 0;
     if (!strcmp(which, "page") || !strcmp(which, "all")) failed |= test_page(port);
