@@ -131,6 +131,13 @@ static void pixel_of(const fixture *f, float x, float y, uint32_t *px, uint32_t 
     *py = (uint32_t)fy;
 }
 
+/* shared user i's centre (x, y) and its pixel */
+static void shared_pixel(const fixture *f, uint32_t i, float *x, float *y, uint32_t *px, uint32_t *py)
+{
+    shared_pos(i, x, y);
+    pixel_of(f, *x, *y, px, py);
+}
+
 static uint32_t count_changed(const sy_layer *a, const sy_layer *b, const rect *allowed, uint32_t nallowed,
                               uint32_t *outside)
 {
@@ -184,8 +191,7 @@ int main(void)
     for (uint32_t i = 0; i < 3; ++i) {
         float x, y;
         uint32_t px, py;
-        shared_pos(i, &x, &y);
-        pixel_of(&f, x, y, &px, &py);
+        shared_pixel(&f, i, &x, &y, &px, &py);
         EXPECT_MSG(it_px_is(&img0, px, py, 0.2f, 0.3f, 0.9f, 1.0f), "shared user %u not visible", i);
     }
     {   /* leaf 0's second primitive (a small quad above its centre) */
@@ -284,8 +290,7 @@ int main(void)
         for (uint32_t i = 0; i < 3; ++i) {
             float x, y;
             uint32_t px, py;
-            shared_pos(i, &x, &y);
-            pixel_of(&f, x, y, &px, &py);
+            shared_pixel(&f, i, &x, &y, &px, &py);
             EXPECT_MSG(it_px_is(&img1, px, py, 1.0f, 0.0f, 0.5f, 1.0f), "shared user %u does not show the new colour", i);
             allowed[i] = screen_rect(&f, x, y, HALF, 1);
         }
@@ -309,8 +314,7 @@ int main(void)
         EXPECT_MSG(it_px_is(&img2, lx, ly, 0, 0, 0, 0) && isinf(img2.depth[ly * IMG + lx]), "hidden leaf still visible");
         for (uint32_t i = 0; i < 3; ++i) {
             uint32_t px, py;
-            shared_pos(i, &x, &y);
-            pixel_of(&f, x, y, &px, &py);
+            shared_pixel(&f, i, &x, &y, &px, &py);
             EXPECT_MSG(it_px_is(&img2, px, py, 0, 0, 0, 0), "child %u of a hidden group still visible", i);
         }
         MUST(sy_node_set_flags(f.s, f.leaf[7], SY_NODE_VISIBLE, err));
