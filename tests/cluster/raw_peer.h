@@ -172,34 +172,6 @@ static inline sy_cluster_msg raw_hello(void)
 }
 #endif
 
-/* The serialized snapshot of a scene built for one message (payloads sent as send says; NULL: all)
- * into *data (free()) and *size: commits sc, then destroys it, whatever happened. */
-static inline sy_result raw_scene_bytes(sy_scene *sc, sy_blob_send_fn send, void **data, size_t *size, sy_error *e)
-{
-    sy_changes *ch = NULL;
-    sy_result r = sy_scene_commit(sc, NULL, e);
-    if (r == SY_OK) r = sy_scene_snapshot(sc, &ch, e);
-    if (r == SY_OK) r = sy_changes_serialize(ch, send, NULL, data, size, e);
-    sy_changes_release(ch);
-    sy_scene_destroy(sc);
-    return r;
-}
-
-/* A SCENE of frame 1 carrying the serialized change list data (size bytes, the caller's), sequence
- * seq, flags SY_CLUSTER_SCENE_SNAPSHOT or 0. */
-static inline sy_cluster_msg raw_scene_msg(uint32_t seq, uint32_t flags, void *data, size_t size)
-{
-    sy_cluster_msg m;
-    memset(&m, 0, sizeof m);
-    m.header.type = SY_CLUSTER_SCENE;
-    m.header.seq = seq;
-    m.u.scene.frame = 1;
-    m.u.scene.flags = flags;
-    m.u.scene.changes = data;
-    m.u.scene.changes_size = (uint32_t)size;
-    return m;
-}
-
 /* A RENDER of *tile (the caller's, 4x4 pixels at the origin) of an 8x8 frame by whitted, the camera
  * framing the cube [-1, 1]^3, sequence seq: a request a server checks before it renders anything. */
 static inline sy_cluster_msg raw_small_render(sy_cluster_rect *tile, uint32_t seq)

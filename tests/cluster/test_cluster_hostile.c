@@ -38,6 +38,7 @@
  * --max-lifetime. */
 #include "../support/sy_check.h"
 #include "raw_peer.h"
+#include "scene_msg.h"
 #include "server_proc.h"
 #include "sy_cluster.h"
 #include "sy_demo.h"
@@ -529,7 +530,7 @@ static int test_replica_multiple(void)
         sy_material m;
         CHECK_OK(sy_material_create(sc, NULL, &m, &e), e);
     }
-    CHECK_OK(raw_scene_bytes(sc, NULL, &data, &size, &e), e);
+    CHECK_OK(scene_bytes(sc, NULL, &data, &size, &e), e);
     double dense, sparse;
     long kb_dense, kb_sparse;
     size_t dense_size = size;
@@ -942,7 +943,7 @@ static int test_camera(fixture *fx)
     CHECK_OK(sy_scene_snapshot(fx->scene, &ch, &e), e);
     CHECK_OK(sy_changes_serialize(ch, NULL, NULL, &data, &size, &e), e);
     sy_changes_release(ch);
-    sy_cluster_msg m = raw_scene_msg(2, SY_CLUSTER_SCENE_SNAPSHOT, data, size);
+    sy_cluster_msg m = scene_msg(2, SY_CLUSTER_SCENE_SNAPSHOT, data, size);
     CHECK(raw_expect(fd, &m, SY_CLUSTER_SCENE_ACK, why, sizeof why) == 0);
     free(data);
     /* RENDERs: valid; camera at (1e19, 0, 0); an orthographic window of 1e19; valid again */

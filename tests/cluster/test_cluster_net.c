@@ -18,6 +18,7 @@
 #include "../support/sy_check.h"
 #include "coop_double.h"
 #include "raw_peer.h"
+#include "scene_msg.h"
 #include "server_proc.h"
 #include "sy_cluster.h"
 #include "sy_demo.h"
@@ -446,7 +447,7 @@ static int test_bad_messages(fixture *fx, server *all)
     CHECK_OK(sy_changes_serialize(ch, NULL, NULL, &data, &size, &e), e);
     sy_changes_release(ch);
     sy_scene_destroy(other);
-    sy_cluster_msg sc = raw_scene_msg(2, 0, data, size);
+    sy_cluster_msg sc = scene_msg(2, 0, data, size);
     if (raw_session(s, &sc, why, sizeof why)) return 1;
     CHECK_MSG(strstr(why, "snapshot"), "%s", why);
     sc.u.scene.flags = SY_CLUSTER_SCENE_SNAPSHOT;
@@ -549,12 +550,6 @@ static int test_blob_cache(fixture *fx, server *s)
     return 0;
 }
 
-static bool no_payloads(void *user, const sy_blob *b)
-{
-    (void)user, (void)b;
-    return false;
-}
-
 /* A blob cache smaller than the model: the first client sends every payload, a second one only
  * what the LRU evicted (at least the model minus the budget, less than all of it); both images
  * stay exact (a replica never depends on the cache). */
@@ -593,24 +588,6 @@ static int test_blob_eviction(fixture *fx, server *unused)
     return 0;
 }
 
-/* A snapshot of a one-texture scene serialised with its blob by hash only. */
-static int texture_snapshot(const uint8_t *px, size_t n, void **data, size_t *size, sy_hash128 *hash)
-{
-    sy_error e = {0};
-    sy_scene *sc = NULL;
-    sy_texture t;
-    sy_blob *b = NULL;
-    CHECK_OK(sy_scene_create(&sc, &e), e);
-    CHECK_OK(sy_texture_create(sc, "t", &t, &e), e);
-    CHECK_OK(sy_blob_create_copy(px, n, &b, &e), e);
-    *hash = sy_blob_hash(b);
-    sy_image_info ii = {(uint32_t)n / 4, 1, 4, SY_PIXEL_U8_LINEAR};
-    CHECK_OK(sy_texture_set_image(sc, t, &ii, b, &e), e);
-    sy_blob_release(b);
-    CHECK_OK(raw_scene_bytes(sc, no_payloads, data, size, &e), e);
-    return 0;
-}
-
 /* BLOB_REQUEST / BLOBS on the wire: the server names exactly the missing hash, refuses a wrong
  * payload, a blob it did not ask for and BLOBS without a pending scene, and accepts the right one. */
 static int test_blob_requests(fixture *fx, server *s)
@@ -621,7 +598,7 @@ static int test_blob_requests(fixture *fx, server *s)
     void *data = NULL;
     size_t size = 0;
     sy_hash128 h;
-    if (texture_snapshot(px, sizeof px, &data, &size, &h)) return 1;
+    if (texture_snapshot("t", px, sizeof px, sizeof px / 4, 1, &data, &size, &h)) return 1;
     sy_cluster_msg m[3];
     memset(m, 0, sizeof m);
     m[0].header.type = SY_CLUSTER_SCENE;
@@ -705,14 +682,14 @@ static int test_slot_limit(fixture *fx, server *s)
     size_t size = 0;
     CHECK_OK(sy_scene_create(&sc, &e), e);
     CHECK_OK(sy_node_create(sc, NULL, &nd, &e), e);
-    CHECK_OK(raw_scene_bytes(sc, NULL, &data, &size, &e), e);
+    CHECK_OK(scene_bytes(sc, NULL, &data, &size, &e), e);
     /* header 32 bytes, no blobs, then the entry {u8 type, u8 flags, u16 0, u32 id}: the id at 36 */
     uint32_t id;
     memcpy(&id, (uint8_t *)data + 36, 4);
     CHECK(id == nd.id);
     id = (1u << SY_HANDLE_INDEX_BITS) | 3000000u;
     memcpy((uint8_t *)data + 36, &id, 4);
-    sy_cluster_msg m = raw_scene_msg(0, SY_CLUSTER_SCENE_SNAPSHOT, data, size);
+    sy_cluster_msg m = scene_msg(0, SY_CLUSTER_SCENE_SNAPSHOT, data, size);
     char why[SY_CLUSTER_REASON_MAX];
     if (raw_session(&s[3], &m, why, sizeof why)) return 1;
     CHECK_MSG(strstr(why, "slot index 3000000 exceeds this replica's limit of 1048576"), "%s", why);

@@ -4,6 +4,7 @@
  * reject or accept cleanly, never crash, and whatever it accepts must be in range). Runs in every
  * build (the libFuzzer target in fuzz_cluster_decode.c covers the same decoder under SY_FUZZ). */
 #include "../support/sy_check.h"
+#include "scene_msg.h"
 #include "sy_cluster.h"
 
 #include <math.h>
@@ -667,12 +668,6 @@ static int test_half_tile(void)
 /* The fuzz seed corpus (tests/cluster/fuzz_seeds): one valid frame of every message type, as
  * sample() makes them. `--write-seeds DIR` (re)generates it; given DIR, every seed must still
  * decode, so the corpus follows the protocol version. */
-static bool no_payloads(void *user, const sy_blob *b)
-{
-    (void)user, (void)b;
-    return false;
-}
-
 /* Seeds 15 and 16: a SCENE carrying a real change list (a texture, its blob by hash) and a TILES
  * carrying a real binary16 tile, so the fuzzer starts inside the nested decoders. */
 static int real_seed(uint32_t which, sy_cluster_buf *b)
@@ -682,30 +677,12 @@ static int real_seed(uint32_t which, sy_cluster_buf *b)
     memset(&m, 0, sizeof m);
     m.header.seq = 3;
     if (which == 15) {
-        sy_scene *sc = NULL;
-        sy_texture t;
-        sy_blob *px = NULL;
-        sy_changes *ch = NULL;
         void *data = NULL;
         size_t size = 0;
-        CHECK_OK(sy_scene_create(&sc, &e), e);
-        CHECK_OK(sy_texture_create(sc, "seed", &t, &e), e);
-        CHECK_OK(sy_blob_create_copy(g_payload, 16, &px, &e), e);
-        sy_image_info ii = {2, 2, 4, SY_PIXEL_U8_LINEAR};
-        CHECK_OK(sy_texture_set_image(sc, t, &ii, px, &e), e);
-        sy_blob_release(px);
-        CHECK_OK(sy_scene_commit(sc, NULL, &e), e);
-        CHECK_OK(sy_scene_snapshot(sc, &ch, &e), e);
-        CHECK_OK(sy_changes_serialize(ch, no_payloads, NULL, &data, &size, &e), e);
-        m.header.type = SY_CLUSTER_SCENE;
-        m.u.scene.frame = 1;
-        m.u.scene.flags = SY_CLUSTER_SCENE_SNAPSHOT;
-        m.u.scene.changes = data;
-        m.u.scene.changes_size = (uint32_t)size;
+        if (texture_snapshot("seed", g_payload, 16, 2, 2, &data, &size, NULL)) return 1;
+        m = scene_msg(3, SY_CLUSTER_SCENE_SNAPSHOT, data, size);
         CHECK_OK(sy_cluster_encode(&m, 0, b, &e), e);
         free(data);
-        sy_changes_release(ch);
-        sy_scene_destroy(sc);
         return 0;
     }
     sy_layer l = {0};
