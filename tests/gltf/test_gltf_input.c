@@ -119,6 +119,17 @@ static const char k_png_uri[] = "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAA
 
 /* ---- running a case ---- */
 
+/* The last node of s named name, or NULL. */
+static const sy_node_data *node_named(sy_scene *s, const char *name)
+{
+    const sy_node_data *nd = NULL;
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id)) {
+        const sy_node_data *x = sy_node_get(s, (sy_node){id});
+        if (x->name && !strcmp(x->name, name)) nd = x;
+    }
+    return nd;
+}
+
 typedef struct outcome {
     sy_result r;
     sy_error err;
@@ -427,11 +438,7 @@ static void test_valid(void)
         outcome o = run(path, NULL, &s);
         EXPECT_MSG(o.r == SY_OK, "anim.gltf: %s", o.err.message);
         if (o.r == SY_OK) {
-            const sy_node_data *nd = NULL;
-            for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id)) {
-                const sy_node_data *x = sy_node_get(s, (sy_node){id});
-                if (x->name && !strcmp(x->name, "moved")) nd = x;
-            }
+            const sy_node_data *nd = node_named(s, "moved");
             EXPECT_MSG(nd && nd->transform.translation[0] == 1 && nd->transform.translation[2] == 3,
                        "first frame translation (1, 2, 3), not the static (7, 7, 7)");
             EXPECT_MSG(nd && nd->transform.scale[0] == 2 && nd->transform.scale[2] == 2, "CUBICSPLINE first value (2, 2, 2)");
@@ -463,11 +470,7 @@ static void test_valid(void)
         outcome o = run(path, NULL, &s);
         EXPECT_MSG(o.r == SY_OK, "anim_output_count.gltf: %s", o.err.message);
         if (o.r == SY_OK) {
-            const sy_node_data *nd = NULL;
-            for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id)) {
-                const sy_node_data *x = sy_node_get(s, (sy_node){id});
-                if (x->name && !strcmp(x->name, "moved")) nd = x;
-            }
+            const sy_node_data *nd = node_named(s, "moved");
             EXPECT_MSG(nd && nd->transform.translation[0] == 4 && nd->transform.translation[2] == 6,
                        "anim_output_count: first frame translation (4, 5, 6) from the sparse value");
         }
