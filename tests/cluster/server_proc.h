@@ -65,9 +65,11 @@ static inline void sleep_ms(int ms)
     nanosleep(&ts, NULL);
 }
 
-/* port 0 = any free port; extra: NULL or up to 8 more "--option", "value" words, NULL-terminated */
+/* port 0 = any free port; extra: NULL or up to 8 more "--option", "value" words, NULL-terminated.
+ * *out is set from scratch (pid 0 when no server runs: stop_server is then a no-op). */
 static inline int start_server_args(const char *secret, int port, const char *const *extra, server *out)
 {
+    memset(out, 0, sizeof *out);
     char pf[512], listen[64];
     snprintf(pf, sizeof pf, "%s/port%d", g_dir, ++g_serial);
     snprintf(out->log, sizeof out->log, "%s/server%d.log", g_dir, g_serial);

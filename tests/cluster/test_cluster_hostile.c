@@ -257,7 +257,6 @@ static void *sampler_main(void *arg)
 static int test_rss(fixture *fx)
 {
     server sv;
-    memset(&sv, 0, sizeof sv);
     if (start_server("s3cret", 0, &sv)) return 1;
     sy_error e = {0};
     sy_layer first = {0}, out = {0};
@@ -398,7 +397,6 @@ static size_t scene_frame(uint8_t *out, const uint8_t *changes, uint32_t n, uint
 static int test_counts(fixture *fx)
 {
     server sv;
-    memset(&sv, 0, sizeof sv);
     if (start_server(NULL, 0, &sv)) return 1;
     sleep_ms(100);
     long hwm0 = server_status_kb(sv.pid, "VmHWM");
@@ -496,7 +494,6 @@ static int test_counts(fixture *fx)
 static int replica_cost(const uint8_t *changes, size_t n, const char *what, double *per_byte, long *kb_out)
 {
     server sv;
-    memset(&sv, 0, sizeof sv);
     if (start_server(NULL, 0, &sv)) return 1;
     sleep_ms(100);
     long hwm0 = server_status_kb(sv.pid, "VmHWM");
@@ -600,7 +597,6 @@ static bool scene_chunk(int fd, uint32_t n, bool last, uint64_t seq)
 static int test_ceiling(fixture *fx)
 {
     server sv;
-    memset(&sv, 0, sizeof sv);
     const char *extra[] = {"--max-peer-memory-mb", "1", "--max-frame-kb", "512", NULL};
     if (start_server_args(NULL, 0, extra, &sv)) return 1;
     const uint32_t k = 400 << 10;
@@ -710,7 +706,6 @@ static bool closed_now(int fd)
 static int test_cap(fixture *fx)
 {
     server sv;
-    memset(&sv, 0, sizeof sv);
     const char *extra[] = {"--max-unauthenticated", "8", "--handshake-timeout-ms", "600000", NULL};
     if (start_server_args("s3cret", 0, extra, &sv)) return 1;
     int fd[12];
@@ -834,7 +829,6 @@ static int test_lockout(fixture *fx)
      * open"). Now each client closes the oldest and gets in; the others stay; the flood reopens
      * the closed one (the newest then) before the next client tries. */
     server sv;
-    memset(&sv, 0, sizeof sv);
     const char *extra[] = {"--handshake-timeout-ms", "600000", NULL};
     if (start_server_args("s3cret", 0, extra, &sv)) return 1;
     int fd[32];
@@ -929,7 +923,6 @@ static int raw_expect(int fd, const sy_cluster_msg *m, uint32_t want, char *why,
 static int test_camera(fixture *fx)
 {
     server sv;
-    memset(&sv, 0, sizeof sv);
     if (start_server(NULL, 0, &sv)) return 1;
     sy_error e = {0};
     int fd = raw_connect(sv.port, 60000);

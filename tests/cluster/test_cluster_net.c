@@ -561,7 +561,6 @@ static int test_blob_eviction(fixture *fx, server *unused)
     snprintf(bs, sizeof bs, "%u", budget);
     const char *extra[] = {"--blob-cache-bytes", bs, NULL};
     server sv;
-    memset(&sv, 0, sizeof sv);
     if (start_server_args(NULL, 0, extra, &sv)) return 1;
     sy_error e = {0};
     sy_layer ref = {0}, out = {0};
@@ -792,7 +791,6 @@ static int test_auth_backoff(fixture *fx, server *unused)
 {
     (void)unused;
     server sv;
-    memset(&sv, 0, sizeof sv);
     const char *extra[] = {"--auth-backoff-ms", "1000", NULL};
     if (start_server_args("s3cret", 0, extra, &sv)) return 1;
     sy_error e = {0};
@@ -836,7 +834,6 @@ static int test_chunked(fixture *fx, server *unused)
 {
     (void)unused;
     server sv;
-    memset(&sv, 0, sizeof sv);
     const char *extra[] = {"--max-frame-kb", "64", "--max-message-mb", "1", NULL};
     if (start_server_args("s3cret", 0, extra, &sv)) return 1;
     fixture big = *fx;
