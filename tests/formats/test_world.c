@@ -52,6 +52,20 @@ static int hdr_round_trip(void)
     return 0;
 }
 
+/* Writes bytes as dir/name and expects sy_world_load_environment to refuse it (SY_ERR_PARSE) with a
+ * message naming the file and saying needle. */
+static void refused(sy_scene *s, const char *name, const void *bytes, size_t n, const char *needle)
+{
+    char path[600];
+    PATHF(path, "%s/%s", dir, name);
+    EXPECT(write_bytes(path, bytes, n) == 0);
+    sy_texture t = {0};
+    sy_error e = {0};
+    EXPECT_ERR(sy_world_load_environment(s, path, 0, &t, &e), SY_ERR_PARSE, e);
+    EXPECT_SAYS(e, name);
+    EXPECT_SAYS(e, needle);
+}
+
 static int bad_files(void)
 {
     sy_scene *s = NULL;
@@ -62,17 +76,10 @@ static int bad_files(void)
     /* 10^5 x 5 x 10^4 texels claimed by a 60-byte file: refused from the header alone (decoding would
      * allocate 60 GB) */
     static const char huge[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 50000 +X 100000\n\x02\x02";
-    PATHF(path, "%s/huge.hdr", dir);
-    CHECK(write_bytes(path, huge, sizeof huge - 1) == 0);
-    EXPECT_ERR(sy_world_load_environment(s, path, 0, &t, &e), SY_ERR_PARSE, e);
-    EXPECT_SAYS(e, "huge.hdr");
-    EXPECT_SAYS(e, "truncated");
+    refused(s, "huge.hdr", huge, sizeof huge - 1, "truncated");
     /* a header without its size line */
     static const char headless[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\nnot a size\n";
-    PATHF(path, "%s/headless.hdr", dir);
-    CHECK(write_bytes(path, headless, sizeof headless - 1) == 0);
-    EXPECT_ERR(sy_world_load_environment(s, path, 0, &t, &e), SY_ERR_PARSE, e);
-    EXPECT_SAYS(e, "headless.hdr");
+    refused(s, "headless.hdr", headless, sizeof headless - 1, "Radiance HDR header");
     /* a square map is no lat-long map */
     float sq[4 * 4 * 3];
     for (int i = 0; i < 4 * 4 * 3; ++i) sq[i] = 1.0f;

@@ -46,6 +46,18 @@ static sy_gl_instance place(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat)
     return in;
 }
 
+/* An unlit material showing texture t (white factor). */
+static sy_gl_material unlit_textured(sy_gl_device *d, sy_gl_texture t)
+{
+    sy_gl_material_desc md;
+    sy_gl_material_desc_init(&md);
+    md.unlit = true;
+    md.base_color_texture.texture = t;
+    sy_gl_material h;
+    MUST(sy_gl_material_create(d, &md, &h, e, sizeof e));
+    return h;
+}
+
 static sy_gl_material material(sy_gl_device *d, float r, float g, float b, float a, bool unlit, sy_gl_alpha_mode mode)
 {
     sy_gl_material_desc md;
@@ -171,12 +183,7 @@ int main(int argc, char **argv)
         int w0 = warnings;
         MUST(sy_gl_texture_create(d, &td, &t, e, sizeof e));
         EXPECT_MSG(warnings == w0 + 1 && strstr(last_warning, "downscaled to 4x4"), "warning: '%s'", last_warning);
-        sy_gl_material_desc md;
-        sy_gl_material_desc_init(&md);
-        md.unlit = true;
-        md.base_color_texture.texture = t;
-        sy_gl_material mt;
-        MUST(sy_gl_material_create(d, &md, &mt, e, sizeof e));
+        sy_gl_material mt = unlit_textured(d, t);
         const float near_q[12] = {-1, -1, -2, 1, -1, -2, 1, 1, -2, -1, 1, -2};
         sy_gl_instance it = place(d, quad(d, near_q, nz), mt);
         render(d, &cam);
@@ -197,12 +204,7 @@ int main(int argc, char **argv)
         sy_gl_texture_desc td = {.width = 4, .height = 4, .channels = 1, .format = SY_GL_TEXEL_UNORM8_SRGB, .pixels = tex};
         sy_gl_texture t;
         MUST(sy_gl_texture_create(d, &td, &t, e, sizeof e));
-        sy_gl_material_desc md;
-        sy_gl_material_desc_init(&md);
-        md.unlit = true;
-        md.base_color_texture.texture = t;
-        sy_gl_material mt;
-        MUST(sy_gl_material_create(d, &md, &mt, e, sizeof e));
+        sy_gl_material mt = unlit_textured(d, t);
         /* one pixel: 1/32 of the view's width of 2 at depth 1, i.e. 0.0625 at depth 2 */
         const float one_px[12] = {0, 0, -2, 0.0625f, 0, -2, 0.0625f, 0.0625f, -2, 0, 0.0625f, -2};
         sy_gl_instance it = place(d, quad(d, one_px, nz), mt);
