@@ -91,7 +91,18 @@ int sy_cmd_info(int argc, char **argv)
      * skipped items included), what was loaded into the scene (loaded), bounds, warnings. */
     cJSON *doc = cJSON_CreateObject();
     sy_json_add(doc, "file", sy_json_str(path));
-    sy_json_add(doc, "format", sy_json_str(ld.is_gltf ? "gltf" : ld.is_x3d ? "x3d" : "demo"));
+    sy_json_add(doc, "format", sy_json_str(ld.is_gltf ? "gltf" : ld.is_x3d ? "x3d" : ld.is_assimp ? "assimp" : "demo"));
+    if (ld.is_assimp) { /* which of Assimp's importers, and what the core does not hold yet */
+        const sy_assimp_info *ai = &ld.assimp;
+        const sy_assimp_counts *ac = &ai->counts;
+        sy_json_add(doc, "importer", sy_json_str(ai->format));
+        sy_json_add(doc, "unit_scale", sy_json_float((double)ai->unit_scale));
+        sy_json_add(doc, "up_axis", ai->up_axis < 0 ? cJSON_CreateNull() : sy_json_str(ai->up_axis == 0 ? "x" : ai->up_axis == 1 ? "y" : "z"));
+        static const char *const an[] = {"animations", "skinned_meshes", "bones", "morph_targets", "embedded_textures"};
+        const uint32_t av[] = {ac->animations, ac->skinned_meshes, ac->bones, ac->morph_targets, ac->embedded_textures};
+        jcounts(sy_json_add(doc, "not_loaded", cJSON_CreateObject()), an, av, 4);
+        sy_json_add(doc, "embedded_textures", cJSON_CreateNumber(av[4]));
+    }
     static const char *const names[] = {"nodes",  "meshes", "primitives", "triangles", "materials",     "textures",
                                         "images", "lights", "cameras",    "points",    "line_segments", "skipped"};
     uint32_t v[12] = {0};
@@ -107,8 +118,14 @@ int sy_cmd_info(int argc, char **argv)
                                 xc->textures, xc->textures, xc->lights,     xc->cameras,   xc->points,
                                 xc->line_segments, xc->skipped_geometry};
         memcpy(v, x, sizeof v);
+    } else if (ld.is_assimp) { /* what Assimp read, after its post-processing (one primitive per mesh) */
+        const sy_assimp_counts *ac = &ld.assimp.counts;
+        const uint32_t a[12] = {ac->nodes,    ac->meshes,     ac->meshes, ac->triangles, ac->materials,
+                                ac->textures, ac->embedded_textures, ac->lights, ac->cameras, ac->points,
+                                ac->line_segments, ac->skipped};
+        memcpy(v, a, sizeof v);
     }
-    if (ld.is_gltf || ld.is_x3d) jcounts(sy_json_add(doc, "file_counts", cJSON_CreateObject()), names, v, 12);
+    if (ld.is_gltf || ld.is_x3d || ld.is_assimp) jcounts(sy_json_add(doc, "file_counts", cJSON_CreateObject()), names, v, 12);
     else sy_json_add(doc, "file_counts", cJSON_CreateNull()); /* the built-in scene: no file */
     static const char *const lnames[] = {"nodes", "meshes", "primitives", "triangles", "materials",
                                          "textures", "lights", "cameras"};
@@ -126,10 +143,11 @@ int sy_cmd_info(int argc, char **argv)
             sy_json_add(mx, NULL, sy_json_float((double)b.max[k]));
         }
     }
-    sy_json_add(doc, "warning_count", cJSON_CreateNumber(ld.gltf.warning_count + ld.x3d.warning_count)); /* all, stored or not */
+    sy_json_add(doc, "warning_count", cJSON_CreateNumber(ld.gltf.warning_count + ld.x3d.warning_count + ld.assimp.warning_count)); /* all, stored or not */
     cJSON *wa = sy_json_add(doc, "warnings", cJSON_CreateArray());
     for (uint32_t i = 0; i < ld.gltf.stored_warning_count; ++i) sy_json_add(wa, NULL, sy_json_str(ld.gltf.warnings[i]));
     for (uint32_t i = 0; i < ld.x3d.stored_warning_count; ++i) sy_json_add(wa, NULL, sy_json_str(ld.x3d.warnings[i]));
+    for (uint32_t i = 0; i < ld.assimp.stored_warning_count; ++i) sy_json_add(wa, NULL, sy_json_str(ld.assimp.warnings[i]));
     sy_cli_loaded_free(&ld);
     return sy_json_print(doc);
 }

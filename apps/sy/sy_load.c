@@ -1,4 +1,5 @@
-/* sy_load.c — how sy loads a SCENE (sy_load.h): the built-in demo, glTF or X3D recognised by content,
+/* sy_load.c — how sy loads a SCENE (sy_load.h): the built-in demo, glTF, X3D or an Assimp format
+ * (OBJ, FBX, COLLADA, PLY, STL, ...) recognised by content,
  * the loader options of every command (--allow-path, --strict, --max-scene-mb), a default camera,
  * the world flags, X3D fields of view, and --overlay FILE[:BACKEND]. */
 #include "sy_load.h"
@@ -22,6 +23,7 @@ void sy_cli_loaded_free(loaded *l)
 {
     sy_gltf_info_free(&l->gltf);
     sy_x3d_info_free(&l->x3d);
+    sy_assimp_info_free(&l->assimp);
     sy_scene_destroy(l->scene);
     memset(l, 0, sizeof *l);
 }
@@ -68,16 +70,22 @@ static sy_result report_warnings(const char *path, uint32_t total, sy_error *err
 
 /* The scene format of path, from its content (sy_sniff.h): a file of another kind is refused,
  * named for what it is; one that is not recognised goes to the loader its name suggests (which
- * then says what is wrong with it). */
-static sy_result recognise(const char *path, sy_file_format *fmt, sy_error *err)
+ * then says what is wrong with it): .x3d to X3D, an extension Assimp reads to Assimp, the rest to
+ * glTF. */
+static sy_result recognise(const char *path, sy_file_format *fmt, bool *assimp, sy_error *err)
 {
     *fmt = SY_FORMAT_UNKNOWN;
     sy_error ignore = {0};
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    const char *ext = dot && (!slash || dot > slash) ? dot : "";
+    bool own = !strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb") || !strcasecmp(ext, ".x3d");
+    *assimp = false;
     if (sy_sniff_file(path, fmt, &ignore) != SY_OK) return SY_OK; /* the loader reports a missing file */
+    *assimp = sy_file_format_is_assimp(*fmt) || (*fmt == SY_FORMAT_UNKNOWN && !own && sy_assimp_reads_extension(ext));
     if (*fmt == SY_FORMAT_UNKNOWN || sy_file_format_is_scene(*fmt)) return SY_OK;
     return sy_error_set(err, SY_ERR_UNSUPPORTED,
-                        "%s: %s content, which sy does not read as a scene (it reads glTF 2.0 .gltf / .glb and X3D in XML "
-                        "encoding)",
+                        "%s: %s content, which sy does not read as a scene (it reads glTF 2.0, X3D in XML encoding, and "
+                        "OBJ, FBX, COLLADA, PLY, STL, 3MF, 3DS, glTF 1.0 and the other formats Assimp reads)",
                         path, sy_file_format_name(*fmt));
 }
 
@@ -85,6 +93,7 @@ sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, l
 {
     memset(out, 0, sizeof *out);
     sy_file_format fmt = SY_FORMAT_UNKNOWN;
+    bool assimp = false;
     double t0 = sy_time_now();
     sy_result r = sy_scene_create(&out->scene, err);
     if (r != SY_OK) return r;
@@ -98,8 +107,22 @@ sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, l
             if (camera_sel && strcmp(camera_sel, "0") != 0 && strcmp(camera_sel, "camera") != 0)
                 r = sy_error_set(err, SY_ERR_NOT_FOUND, "demo: no camera '%s' (available: 0 \"camera\")", camera_sel);
         }
-    } else if ((r = recognise(path, &fmt, err)) != SY_OK) {
+    } else if ((r = recognise(path, &fmt, &assimp, err)) != SY_OK) {
         /* named for what it is: not a scene format the loaders read */
+    } else if (assimp) {
+        out->is_assimp = true;
+        sy_assimp_options ao = {.allowed_roots = sy_cli_load_opts.roots, .allowed_root_count = sy_cli_load_opts.root_count,
+                                .max_scene_bytes = sy_cli_load_opts.max_scene_bytes};
+        r = sy_assimp_load(path, out->scene, &ao, &out->assimp, err);
+        if (r == SY_OK) r = report_warnings(path, out->assimp.warning_count, err);
+        if (r == SY_OK) {
+            out->root = out->assimp.root;
+            /* the glTF loader's camera selector over the same list of camera nodes */
+            sy_gltf_info view = {.camera_nodes = out->assimp.camera_nodes, .camera_node_count = out->assimp.camera_node_count};
+            if (camera_sel) r = sy_gltf_find_camera(out->scene, &view, camera_sel, &out->camera, err);
+            else if (out->assimp.camera_node_count) out->camera = out->assimp.camera_nodes[0];
+            if (r != SY_OK) sy_error_prefix(err, "%s", path);
+        }
     } else if (fmt == SY_FORMAT_X3D || (fmt == SY_FORMAT_UNKNOWN && strlen(path) > 4 &&
                                         !strcasecmp(path + strlen(path) - 4, ".x3d"))) {
         out->is_x3d = true;
@@ -130,7 +153,7 @@ sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, l
         }
     }
     if (r == SY_OK) r = sy_scene_commit(out->scene, NULL, err);
-    if (r == SY_OK && (out->is_gltf || out->is_x3d) && defaults) r = add_defaults(out, err);
+    if (r == SY_OK && (out->is_gltf || out->is_x3d || out->is_assimp) && defaults) r = add_defaults(out, err);
     /* the user's world choices: sy_world (formats) maps them onto the world object */
     if (r == SY_OK && !sy_world_options_empty(&sy_cli_load_opts.world) &&
         (r = sy_world_apply(out->scene, &out->background, &sy_cli_load_opts.world, err)) == SY_OK)

@@ -1,9 +1,11 @@
-/* sy_load.h — how sy loads a SCENE (sy_load.c): a .gltf / .glb / .x3d file, recognised by its content,
+/* sy_load.h — how sy loads a SCENE (sy_load.c): a glTF 2.0, X3D or Assimp-read (OBJ, FBX, COLLADA, PLY,
+ * STL, 3MF, 3DS, glTF 1.0, ...) file, recognised by its content,
  * or the word "demo" (the built-in scene), with the loader options and the world flags of every
  * command (sy_cli_load_opts, filled by sy_cli_next_option). Thread-safety: the main thread only. */
 #ifndef SY_LOAD_H
 #define SY_LOAD_H
 
+#include "sy_assimp.h"
 #include "sy_compose.h"
 #include "sy_gltf.h"
 #include "sy_world.h"
@@ -19,6 +21,8 @@ typedef struct loaded {
     bool is_gltf;
     sy_x3d_info x3d; /* .x3d files (is_x3d) */
     bool is_x3d;
+    sy_assimp_info assimp; /* OBJ, FBX, COLLADA, PLY, STL, ... through Assimp (is_assimp) */
+    bool is_assimp;
 } loaded;
 
 /* Loader options every command shares, taken out of the arguments by sy_cli_next_option:

@@ -225,16 +225,21 @@ run failure "$SY" render "$TMP/does_not_exist.gltf" -b whitted -o "$TMP/x.png"
 [ "$rc" -eq 1 ] && grep -q "does_not_exist.gltf" "$TMP/failure.err" || fail "a failure: status $rc (want 1), $(cat "$TMP/failure.err")"
 [ ! -e "$TMP/x.png" ] || fail "an image was written by a failed or refused command"
 
-# files are recognised by content: an OBJ (under its own name or a glTF one) is named as such, with
-# status 1 and no image
+# files are recognised by content: an OBJ (under its own name or a glTF one) is read through Assimp
+# and rendered; a VRML file (under a glTF name) is named as such, with status 1 and no image
 mkdir -p "$TMP/in"
 printf '# a triangle\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$TMP/in/tri.obj"
 cp "$TMP/in/tri.obj" "$TMP/in/tri_obj.gltf"
 for f in tri.obj tri_obj.gltf; do
-    run obj "$SY" render "$TMP/in/$f" -b whitted -o "$TMP/x.png"
-    [ "$rc" -eq 1 ] && grep -q "$f: Wavefront OBJ content, which sy does not read as a scene" "$TMP/obj.err" && [ ! -e "$TMP/x.png" ] ||
-        fail "an OBJ file ($f): status $rc, $(cat "$TMP/obj.err")"
+    rm -f "$TMP/x.png"
+    run obj "$SY" render "$TMP/in/$f" -b whitted -w 32 -h 24 -o "$TMP/x.png"
+    [ "$rc" -eq 0 ] && [ -s "$TMP/x.png" ] || fail "an OBJ file ($f): status $rc, $(cat "$TMP/obj.err")"
 done
+rm -f "$TMP/x.png"
+printf '#VRML V2.0 utf8\nShape {}\n' > "$TMP/in/shape_wrl.gltf"
+run wrl "$SY" render "$TMP/in/shape_wrl.gltf" -b whitted -o "$TMP/x.png"
+[ "$rc" -eq 1 ] && grep -q "shape_wrl.gltf: VRML / X3D classic encoding content, which sy does not read as a scene" "$TMP/wrl.err" &&
+    [ ! -e "$TMP/x.png" ] || fail "a VRML file: status $rc, $(cat "$TMP/wrl.err")"
 
 # metadata: every image records the renderer, back-end, camera, size, samples, time and source
 # (EXR string attributes, PNG text chunks); sy info IMAGE.exr prints them

@@ -1,0 +1,241 @@
+/* sy_assimp.c — the formats read through Assimp (see sy_assimp.h): the public entry points, the
+ * options, the import under the process-wide lock (Assimp's C API keeps its error string and
+ * logger in globals), then the conversion in dependency order with rollback on failure. The
+ * loader's modules, bottom-up (sy_assimp_internal.h): sy_assimp_io.c, sy_assimp_materials.c,
+ * sy_assimp_scene.c. */
+#include "sy_assimp_internal.h"
+
+#include "sy_file.h"
+#include "sy_log.h"
+#include "sy_sniff.h"
+
+#include <assimp/cimport.h>
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+/* Assimp's C API is not reentrant (aiGetErrorString, the default logger): one import at a time. */
+static pthread_mutex_t g_assimp_lock = PTHREAD_MUTEX_INITIALIZER;
+
+/* The post-processing every file gets (sy_assimp.h). */
+#define SY_ASSIMP_STEPS                                                                                              \
+    (aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |  \
+     aiProcess_FindDegenerates | aiProcess_FindInvalidData | aiProcess_TransformUVCoords | aiProcess_FlipUVs |       \
+     aiProcess_ValidateDataStructure)
+
+void sy_assimp_info_free(sy_assimp_info *info)
+{
+    if (!info) return;
+    free(info->camera_nodes);
+    for (uint32_t i = 0; i < info->stored_warning_count; i++) free(info->warnings[i]);
+    free(info->warnings);
+    memset(info, 0, sizeof *info);
+}
+
+bool sy_assimp_reads_extension(const char *ext)
+{
+    if (!ext || !*ext) return false;
+    char e[32];
+    snprintf(e, sizeof e, "%s%s", ext[0] == '.' ? "" : ".", ext);
+    return aiIsExtensionSupported(e) == AI_TRUE;
+}
+
+static sy_assimp_options resolve_options(const sy_assimp_options *o)
+{
+    sy_assimp_options r = o ? *o : (sy_assimp_options){0};
+    if (!r.max_file_bytes) r.max_file_bytes = (size_t)1 << 30;
+    if (!r.max_vertices) r.max_vertices = (size_t)1 << 28;
+    if (!r.max_image_pixels) r.max_image_pixels = (uint64_t)1 << 26;
+    if (!r.max_scene_bytes) r.max_scene_bytes = sy_budget_default_bytes();
+    return r;
+}
+
+/* The extension Assimp should read content of this kind by ("" when the content does not say). */
+static const char *extension_for(const void *data, size_t size)
+{
+    switch (sy_sniff_bytes(data, size)) {
+    case SY_FORMAT_OBJ: return ".obj";
+    case SY_FORMAT_PLY: return ".ply";
+    case SY_FORMAT_STL: return ".stl";
+    case SY_FORMAT_FBX: return ".fbx";
+    case SY_FORMAT_COLLADA: return ".dae";
+    case SY_FORMAT_3MF: return ".3mf";
+    case SY_FORMAT_3DS: return ".3ds";
+    case SY_FORMAT_GLTF1: return ".gltf";
+    default: return "";
+    }
+}
+
+/* The name Assimp opens the model by: the model's folder and file name, with the extension its
+ * content calls for appended where the name says otherwise (Assimp picks importers by extension). */
+static sy_result main_name(asp_loader *L, const char *name)
+{
+    const char *slash = strrchr(name, '/');
+    const char *base = slash ? slash + 1 : name;
+    const char *ext = extension_for(L->main_data, L->main_size);
+    size_t bl = strlen(base), el = strlen(ext);
+    bool has = el && bl > el && !strcasecmp(base + bl - el, ext);
+    if (!strcmp(ext, ".3ds") && bl > 4 && !strcasecmp(base + bl - 4, ".prj")) has = true;
+    size_t n = strlen(L->model_dir) + bl + el + 1;
+    if (!(L->main_name = malloc(n))) return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory");
+    snprintf(L->main_name, n, "%s%s%s", L->model_dir, base, has ? "" : ext);
+    return SY_OK;
+}
+
+static const char *meta_string(const struct aiMetadata *md, const char *key)
+{
+    if (!md) return NULL;
+    for (unsigned k = 0; k < md->mNumProperties; ++k)
+        if (!strcmp(asp_str(&md->mKeys[k]), key) && md->mValues[k].mType == AI_AISTRING && md->mValues[k].mData)
+            return asp_str((const struct aiString *)md->mValues[k].mData);
+    return NULL;
+}
+
+/* Assimp reads the model (under the lock); L->ai on success, Assimp's reason on failure. */
+static sy_result import(asp_loader *L)
+{
+    struct aiFileIO io = asp_file_io(L);
+    struct aiPropertyStore *ps = aiCreatePropertyStore();
+    if (!ps) return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory");
+    aiSetImportPropertyFloat(ps, AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 80.0f);
+    aiSetImportPropertyInteger(ps, AI_CONFIG_PP_FD_REMOVE, 1);
+    aiSetImportPropertyInteger(ps, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
+    pthread_mutex_lock(&g_assimp_lock);
+    asp_log_attach(L);
+    L->ai = aiImportFileExWithProperties(L->main_name, SY_ASSIMP_STEPS, &io, ps);
+    char why[SY_ERROR_MESSAGE_MAX];
+    snprintf(why, sizeof why, "%s", L->ai ? "" : aiGetErrorString());
+    asp_log_detach();
+    pthread_mutex_unlock(&g_assimp_lock);
+    aiReleasePropertyStore(ps);
+    if (L->io_result) return sy_error_set(&L->err, L->io_result, "%s", L->io_message); /* a refused file */
+    if (!L->ai) return asp_fail(L, SY_ERR_PARSE, "Assimp cannot read it: %s", why[0] ? why : "no reason given");
+    if (!L->ai->mRootNode || (L->ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE))
+        return asp_fail(L, SY_ERR_PARSE, "Assimp read no complete scene (%s)", L->ai->mRootNode ? "incomplete" : "no root node");
+    const char *fmt = meta_string(L->ai->mMetaData, "SourceAsset_Format");
+    snprintf(L->info->format, sizeof L->info->format, "%s", fmt ? fmt : "Assimp");
+    return SY_OK;
+}
+
+static sy_result convert(asp_loader *L)
+{
+    const struct aiScene *s = L->ai;
+    sy_assimp_counts *c = &L->info->counts;
+    sy_result r = SY_OK;
+    c->animations = s->mNumAnimations;
+    c->embedded_textures = s->mNumTextures;
+    if (!(L->materials = calloc((size_t)s->mNumMaterials + 1, sizeof *L->materials)) ||
+        !(L->normal_mapped = calloc((size_t)s->mNumMaterials + 1, sizeof *L->normal_mapped)) ||
+        !(L->meshes = calloc((size_t)s->mNumMeshes + 1, sizeof *L->meshes)) ||
+        !(L->mesh_bounds = calloc((size_t)s->mNumMeshes + 1, sizeof *L->mesh_bounds)))
+        return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory for %u meshes and %u materials", s->mNumMeshes, s->mNumMaterials);
+    /* dependency order: textures (on demand) + materials, meshes, then nodes, cameras, lights */
+    for (unsigned i = 0; i < s->mNumMaterials && r == SY_OK; ++i) r = asp_create_material(L, i);
+    if (r == SY_OK) r = asp_charge(L);
+    for (unsigned i = 0; i < s->mNumMeshes && r == SY_OK; ++i) r = asp_create_mesh(L, i);
+    if (r == SY_OK) r = asp_create_nodes(L);
+    if (r == SY_OK && (c->animations || c->skinned_meshes || c->morph_targets))
+        sy_log(SY_LOG_NOTE, "assimp", L->path,
+               "%u animations, %u skinned meshes (%u bones), %u morph targets: not played yet (meshes in their bind "
+               "pose)",
+               c->animations, c->skinned_meshes, c->bones, c->morph_targets);
+    return r;
+}
+
+static void log_warnings(const char *path, const sy_assimp_info *info)
+{
+    for (uint32_t i = 0; i < info->stored_warning_count; i++) sy_log(SY_LOG_WARNING, "assimp", path, "%s", info->warnings[i]);
+    if (info->warning_count > info->stored_warning_count)
+        sy_log(SY_LOG_WARNING, "assimp", path, "%u more warnings not shown", info->warning_count - info->stored_warning_count);
+}
+
+static sy_result load_common(const char *path, const void *mem, size_t mem_size, const char *base_dir, sy_scene *scene,
+                             const sy_assimp_options *opts, sy_assimp_info *info_out, sy_error *err)
+{
+    sy_assimp_info local;
+    sy_assimp_info *info = info_out ? info_out : &local;
+    memset(info, 0, sizeof *info);
+    asp_loader L;
+    memset(&L, 0, sizeof L);
+    L.path = path;
+    L.scene = scene;
+    L.opt = resolve_options(opts);
+    L.info = info;
+    L.budget = sy_budget_make(path, L.opt.max_scene_bytes);
+    info->unit_scale = 1.0f;
+    info->up_axis = -1;
+    void *bytes = NULL;
+    sy_result r = SY_OK;
+    /* the model's folder, '/'-terminated ("" = the working directory) */
+    const char *slash = strrchr(path, '/');
+    size_t dl = mem ? strlen(base_dir) : slash ? (size_t)(slash - path) + 1 : 0;
+    bool add_slash = mem && dl && base_dir[dl - 1] != '/';
+    if (!(L.model_dir = malloc(dl + 2))) {
+        r = asp_fail(&L, SY_ERR_OUT_OF_MEMORY, "out of memory");
+        goto out;
+    }
+    memcpy(L.model_dir, mem ? base_dir : path, dl);
+    strcpy(L.model_dir + dl, add_slash ? "/" : "");
+    if (!mem) {
+        if ((r = sy_file_read_all(path, L.opt.max_file_bytes, &bytes, &L.main_size, &L.err))) goto out;
+        L.main_data = bytes;
+    } else if (mem_size > L.opt.max_file_bytes) {
+        r = asp_fail(&L, SY_ERR_LIMIT, "%zu bytes exceed the file size limit of %zu", mem_size, L.opt.max_file_bytes);
+        goto out;
+    } else {
+        L.main_data = mem;
+        L.main_size = mem_size;
+    }
+    if (L.main_size == 0) {
+        r = asp_fail(&L, SY_ERR_PARSE, "empty file");
+        goto out;
+    }
+    if ((r = asp_precheck(&L)) || (r = main_name(&L, path)) || (r = import(&L))) goto out;
+    free(bytes); /* Assimp's scene holds what it read */
+    bytes = NULL;
+    if ((r = convert(&L))) asp_rollback(&L);
+out:
+    if (L.ai) aiReleaseImport(L.ai);
+    asp_free_textures(&L);
+    free(L.materials);
+    free(L.normal_mapped);
+    free(L.meshes);
+    free(L.mesh_bounds);
+    free(L.objs);
+    free(L.main_name);
+    free(L.model_dir);
+    free(bytes);
+    if (r) {
+        sy_assimp_info_free(info);
+        if (err) *err = L.err;
+        return r;
+    }
+    log_warnings(path, info);
+    if (!info_out) sy_assimp_info_free(&local);
+    return SY_OK;
+}
+
+sy_result sy_assimp_load(const char *path, sy_scene *scene, const sy_assimp_options *opts, sy_assimp_info *info_out,
+                         sy_error *err)
+{
+    if (!path || !scene) {
+        if (info_out) memset(info_out, 0, sizeof *info_out);
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_assimp_load: path and scene are required");
+    }
+    return load_common(path, NULL, 0, NULL, scene, opts, info_out, err);
+}
+
+sy_result sy_assimp_load_memory(const void *data, size_t size, const char *name, const char *base_dir, sy_scene *scene,
+                                const sy_assimp_options *opts, sy_assimp_info *info_out, sy_error *err)
+{
+    if (!data || !name || !base_dir || !scene) {
+        if (info_out) memset(info_out, 0, sizeof *info_out);
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_assimp_load_memory: data, name, base_dir and scene are required");
+    }
+    return load_common(name, data, size, base_dir, scene, opts, info_out, err);
+}

@@ -1,0 +1,105 @@
+/* sy_assimp_internal.h — internal to the Assimp loader (not installed): the loader's state and the
+ * calls between its modules. The modules, bottom-up (no module calls one above it):
+ *   sy_assimp_io.c         warnings, rollback, the confined aiFileIO (the model from memory, every
+ *                          other file through sy_path_confine), Assimp's log into sy_log, the
+ *                          pre-checks of declared counts (PLY, binary STL)
+ *   sy_assimp_materials.c  textures (files and embedded) and materials
+ *   sy_assimp_scene.c      meshes, cameras, lights, the node tree, units and up axis
+ *   sy_assimp.c            the public entry points (sy_assimp.h): options, the import, the order
+ * Every function here starts with asp_. */
+#ifndef SY_ASSIMP_INTERNAL_H
+#define SY_ASSIMP_INTERNAL_H
+
+#include "sy_assimp.h"
+#include "sy_budget.h"
+
+#include <assimp/cfileio.h>
+#include <assimp/scene.h>
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct asp_created {
+    uint32_t type, id;
+} asp_created;
+
+typedef struct asp_texture {
+    char *key;       /* the material's texture path */
+    bool srgb;       /* colour role */
+    sy_texture tex;  /* {0}: failed (warned once) */
+    uint32_t channels;
+} asp_texture;
+
+typedef struct asp_loader {
+    const char *path;      /* names the file in messages */
+    char *model_dir;       /* the model's folder ("" = the working directory), '/'-terminated or "" */
+    sy_scene *scene;
+    sy_assimp_options opt;
+    sy_assimp_info *info;
+    sy_error err;
+    sy_budget budget;
+    const struct aiScene *ai;
+    asp_created *objs;
+    size_t obj_count, obj_cap;
+    sy_material *materials;      /* per aiMaterial */
+    bool *normal_mapped;         /* per aiMaterial: has a normal texture */
+    sy_mesh *meshes;             /* per aiMesh; {0}: skipped */
+    sy_bounds *mesh_bounds;      /* per aiMesh: its positions' bounds */
+    asp_texture *textures;
+    size_t texture_count, texture_cap;
+    /* the confined file system */
+    const uint8_t *main_data;
+    size_t main_size;
+    char *main_name;        /* the name Assimp opens the model by */
+    sy_result io_result;    /* the first refused or failed file (fails the load) */
+    char io_message[SY_ERROR_MESSAGE_MAX];
+} asp_loader;
+
+/* >>io (sy_assimp_io.c) ------------------------------------------------------------------------ */
+
+/* Sets L->err to "<path>: <message>" and returns code. */
+sy_result asp_fail(asp_loader *L, sy_result code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* A warning "<message>" (at most SY_ASSIMP_MAX_WARNINGS stored, all counted). */
+void asp_warn(asp_loader *L, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Creates an object of type t (recorded for the rollback); on failure the message names `what`. */
+sy_result asp_new(asp_loader *L, sy_object_type t, const char *name, const char *what, uint32_t *id);
+/* Destroys every created object, newest first. */
+void asp_rollback(asp_loader *L);
+/* The aiFileIO that serves L's model from memory and every other file confined (UserData = L). */
+struct aiFileIO asp_file_io(asp_loader *L);
+/* Reads a file the model names (path joined to the model's folder; uri as the model gives it)
+ * within max_file_bytes, confined; *data malloc()ed. Errors name the model and the uri. */
+sy_result asp_read_named(asp_loader *L, const char *uri, void **data, size_t *size, sy_error *err);
+/* Refuses, before Assimp sees it, a file that declares more than its bytes can hold. */
+sy_result asp_precheck(asp_loader *L);
+/* Assimp's log into sy_log while attached: warnings and errors as notes, the rest as debug. */
+void asp_log_attach(asp_loader *L);
+void asp_log_detach(void);
+/* Assimp's string as a C string (bounded). */
+const char *asp_str(const struct aiString *s);
+
+/* >>materials (sy_assimp_materials.c) ---------------------------------------------------------- */
+
+/* Material i (and the textures it uses) into L->materials[i]. */
+sy_result asp_create_material(asp_loader *L, unsigned i);
+void asp_free_textures(asp_loader *L);
+
+/* >>scene (sy_assimp_scene.c) ------------------------------------------------------------------ */
+
+/* The budget for every mesh and placement, before any is made. */
+sy_result asp_charge(asp_loader *L);
+/* Mesh i into L->meshes[i] (skipped with a warning when it has nothing to draw). */
+sy_result asp_create_mesh(asp_loader *L, unsigned i);
+/* The node tree under a new root (units and up axis), cameras and lights. */
+sy_result asp_create_nodes(asp_loader *L);
+
+#endif /* SY_ASSIMP_INTERNAL_H */
