@@ -66,7 +66,7 @@ static const char *extension_for(const void *data, size_t size)
     case SY_FORMAT_COLLADA: return ".dae";
     case SY_FORMAT_3MF: return ".3mf";
     case SY_FORMAT_3DS: return ".3ds";
-    case SY_FORMAT_GLTF1: return ".gltf";
+    case SY_FORMAT_GLTF1: return size >= 4 && !memcmp(data, "glTF", 4) ? ".glb" : ".gltf";
     default: return "";
     }
 }
@@ -115,8 +115,9 @@ static sy_result import(asp_loader *L)
     aiReleasePropertyStore(ps);
     if (L->io_result) return sy_error_set(&L->err, L->io_result, "%s", L->io_message); /* a refused file */
     if (!L->ai) return asp_fail(L, SY_ERR_PARSE, "Assimp cannot read it: %s", why[0] ? why : "no reason given");
-    if (!L->ai->mRootNode || (L->ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE))
-        return asp_fail(L, SY_ERR_PARSE, "Assimp read no complete scene (%s)", L->ai->mRootNode ? "incomplete" : "no root node");
+    if (!L->ai->mRootNode) return asp_fail(L, SY_ERR_PARSE, "Assimp read no scene (no root node)");
+    if (L->ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE) /* no meshes (cameras, lights or animations only): loaded as it is */
+        asp_warn(L, "Assimp marks the scene incomplete (%u meshes)", L->ai->mNumMeshes);
     const char *fmt = meta_string(L->ai->mMetaData, "SourceAsset_Format");
     snprintf(L->info->format, sizeof L->info->format, "%s", fmt ? fmt : "Assimp");
     return SY_OK;

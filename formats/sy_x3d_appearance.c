@@ -5,6 +5,7 @@
  * ImageTexture stays one object. */
 #include "sy_x3d_internal.h"
 
+#include "sy_classic.h"
 #include "sy_file.h"
 
 #include "sy_sniff.h"
@@ -174,12 +175,10 @@ static const xmlNode *texture_field(loader *L, xfile *F, const xmlNode *el, cons
 
 /* >>materials --------------------------------------------------------------------------------- */
 
+/* X3D shininess s in [0, 1] is the Blinn-Phong exponent 128 s (sy_classic.h gives the roughness) */
 static float shininess_to_roughness(float shininess, float specular_max)
 {
-    if (!(specular_max > 0.0f)) return 1.0f;
-    float n = 128.0f * fmaxf(0.0f, fminf(1.0f, shininess));
-    float alpha = sqrtf(2.0f / (n + 2.0f));
-    return fminf(1.0f, sqrtf(alpha));
+    return sy_classic_roughness(128.0f * fmaxf(0.0f, fminf(1.0f, shininess)), specular_max);
 }
 
 static float max3(const float *v) { return fmaxf(v[0], fmaxf(v[1], v[2])); }

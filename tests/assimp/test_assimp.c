@@ -1,0 +1,186 @@
+/* test_assimp.c — the Assimp loader (formats/sy_assimp.h) on small files the test writes itself:
+ * an OBJ + MTL with a texture (counts, bounds, the classic material's conversion, the texture),
+ * ASCII and binary STL (a binary header starting with "solid"), a PLY with vertex colours, one
+ * from memory; and bad input: a truncated binary STL, a binary STL whose facet count wraps Assimp's
+ * 32-bit size check, a PLY declaring 10^12 vertices in a few bytes, an OBJ whose MTL and texture
+ * lie outside its folder (refused, then admitted by allowed_roots), a file Assimp cannot read.
+ * Every error names the file. */
+#include "sy_assimp.h"
+#include "sy_classic.h"
+#include "sy_scene.h"
+
+#include "../formats/test_util.h"
+
+#include <math.h>
+
+static sy_scene *g_scene;
+
+static sy_result load(const char *path, const sy_assimp_options *o, sy_assimp_info *info, sy_error *e)
+{
+    sy_scene_destroy(g_scene);
+    g_scene = NULL;
+    if (sy_scene_create(&g_scene, e) != SY_OK) return SY_ERR_OUT_OF_MEMORY;
+    return sy_assimp_load(path, g_scene, o, info, e);
+}
+
+static sy_bounds bounds_of(const sy_assimp_info *info)
+{
+    sy_bounds b = sy_bounds_empty();
+    sy_scene_commit(g_scene, NULL, NULL);
+    sy_node_world_bounds(g_scene, info->root, &b, NULL);
+    return b;
+}
+
+static bool near(float a, float b) { return fabsf(a - b) < 1e-4f; }
+
+static const sy_mesh_data *first_mesh(void)
+{
+    uint32_t id = sy_scene_next(g_scene, SY_TYPE_MESH, 0);
+    return id ? sy_object_get(g_scene, SY_TYPE_MESH, id) : NULL;
+}
+
+int main(void)
+{
+    char dir[4096], p[4300], q[4300];
+    make_scratch_dir(dir, sizeof dir, "assimp");
+    sy_assimp_info info = {0};
+    sy_error e = {0};
+
+    /* OBJ + MTL + a 2x1 PPM texture: a quad (two triangles) of 2 x 1 with material "red" */
+    PATHF(p, "%s/model", dir);
+    mkdir(p, 0755);
+    PATHF(p, "%s/model/quad.obj", dir);
+    const char obj[] = "# quad\nmtllib quad.mtl\nv 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\n"
+                       "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl red\nf 1/1 2/2 3/3 4/4\n";
+    EXPECT(write_bytes(p, obj, sizeof obj - 1) == 0);
+    PATHF(q, "%s/model/quad.mtl", dir);
+    const char mtl[] = "newmtl red\nKd 0.5 0.25 0.125\nKs 1 1 1\nNs 128\nillum 2\nd 0.5\nKe 0 0 0\nmap_Kd tex.ppm\n";
+    EXPECT(write_bytes(q, mtl, sizeof mtl - 1) == 0);
+    PATHF(q, "%s/model/tex.ppm", dir);
+    const char ppm[] = "P6\n2 1\n255\n\xff\x00\x00\x00\xff\x00";
+    EXPECT(write_bytes(q, ppm, sizeof ppm - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK, "quad.obj: %s", e.message);
+    EXPECT_MSG(info.counts.meshes == 1 && info.counts.triangles == 2 && info.counts.materials >= 1 &&
+                   info.counts.textures == 1 && info.warning_count == 0,
+               "quad.obj counts: %u meshes, %u triangles, %u materials, %u textures, %u warnings", info.counts.meshes,
+               info.counts.triangles, info.counts.materials, info.counts.textures, info.warning_count);
+    sy_bounds b = bounds_of(&info);
+    EXPECT_MSG(near(b.min[0], 0) && near(b.min[1], 0) && near(b.max[0], 2) && near(b.max[1], 1) && near(b.max[2], 0),
+               "quad.obj bounds %g %g %g - %g %g %g", b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]);
+    const sy_mesh_data *md = first_mesh();
+    EXPECT(md && md->primitives.count == 1 && md->primitives.items[0].normals && md->primitives.items[0].texcoords0);
+    const sy_material_data *mat = md ? sy_material_get(g_scene, md->primitives.items[0].material) : NULL;
+    EXPECT_MSG(mat && near(mat->base_color[0], 0.5f) && near(mat->base_color[1], 0.25f) && near(mat->base_color[2], 0.125f) &&
+                   near(mat->base_color[3], 0.5f) && mat->alpha_mode == SY_ALPHA_BLEND && mat->metallic == 0.0f &&
+                   near(mat->roughness, sqrtf(sqrtf(2.0f / 130.0f))) && near(mat->roughness, 0.3522f),
+               "red: base %g %g %g %g, metallic %g, roughness %g", mat ? mat->base_color[0] : -1, mat ? mat->base_color[1] : -1,
+               mat ? mat->base_color[2] : -1, mat ? mat->base_color[3] : -1, mat ? mat->metallic : -1, mat ? mat->roughness : -1);
+    const sy_texture_data *tex = mat ? sy_object_get(g_scene, SY_TYPE_TEXTURE, mat->base_color_texture.texture.id) : NULL;
+    EXPECT_MSG(tex && tex->info.width == 2 && tex->info.height == 1 && tex->info.channels == 3 &&
+                   tex->info.format == SY_PIXEL_U8_SRGB,
+               "the base colour texture");
+    EXPECT(near(sy_classic_roughness(0, 1), 1.0f) && near(sy_classic_roughness(1000, 1), 0.2114f) &&
+           sy_classic_roughness(128, 0) == 1.0f);
+    sy_assimp_info_free(&info);
+
+    /* ASCII STL: one facet */
+    PATHF(p, "%s/tri.stl", dir);
+    const char astl[] = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 3 0\nendloop\n"
+                        "endfacet\nendsolid t\n";
+    EXPECT(write_bytes(p, astl, sizeof astl - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.triangles == 1 && info.counts.meshes == 1, "tri.stl: %s", e.message);
+    b = bounds_of(&info);
+    EXPECT_MSG(near(b.max[0], 1) && near(b.max[1], 3), "tri.stl bounds");
+    sy_assimp_info_free(&info);
+
+    /* binary STL: 2 facets, header starting with "solid" (some exporters write that) */
+    unsigned char bstl[84 + 100] = "solid written by a binary exporter";
+    bstl[80] = 2;
+    float tris[2][12] = {{0, 0, 1, 0, 0, 0, 4, 0, 0, 0, 2, 0}, {0, 0, 1, 4, 0, 0, 4, 2, 0, 0, 2, 0}};
+    for (int f = 0; f < 2; ++f) memcpy(bstl + 84 + 50 * f, tris[f], 48);
+    PATHF(p, "%s/two.stl", dir);
+    EXPECT(write_bytes(p, bstl, sizeof bstl) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.triangles == 2, "two.stl: %s (%u triangles)", e.message,
+               info.counts.triangles);
+    b = bounds_of(&info);
+    EXPECT_MSG(near(b.max[0], 4) && near(b.max[1], 2) && near(b.min[0], 0), "two.stl bounds");
+    sy_assimp_info_free(&info);
+    /* the same from memory, under a name without extension: the content decides */
+    sy_scene *ms = NULL;
+    EXPECT(sy_scene_create(&ms, &e) == SY_OK);
+    EXPECT_MSG(sy_assimp_load_memory(bstl, sizeof bstl, "noext", dir, ms, NULL, &info, &e) == SY_OK && info.counts.triangles == 2,
+               "binary STL from memory: %s", e.message);
+    sy_assimp_info_free(&info);
+    sy_scene_destroy(ms);
+
+    /* truncated binary STL: 2 facets declared, 1 present */
+    PATHF(p, "%s/cut.stl", dir);
+    EXPECT(write_bytes(p, bstl, sizeof bstl - 50) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) != SY_OK && strstr(e.message, "cut.stl"), "truncated STL: %s", e.message);
+    /* a facet count whose 32-bit size wraps to the file's 88 bytes: 85899346 facets */
+    unsigned char wrap[88] = {0};
+    uint32_t facets = 85899346u;
+    memcpy(wrap + 80, &facets, 4);
+    PATHF(p, "%s/wrap.stl", dir);
+    EXPECT(write_bytes(p, wrap, sizeof wrap) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "wrap.stl") && strstr(e.message, "85899346 facets"),
+               "wrapping STL: %s", e.message);
+
+    /* PLY: 4 coloured vertices, one quad face */
+    PATHF(p, "%s/quad.ply", dir);
+    const char ply[] = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                       "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\n"
+                       "property list uchar int vertex_indices\nend_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n1 0 5 0 0 255\n"
+                       "0 0 5 255 255 255\n4 0 1 2 3\n";
+    EXPECT(write_bytes(p, ply, sizeof ply - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.triangles == 2, "quad.ply: %s", e.message);
+    md = first_mesh();
+    EXPECT_MSG(md && md->primitives.items[0].colors && sy_primitive_vertex_count(&md->primitives.items[0]) == 4,
+               "quad.ply: colours and 4 vertices");
+    b = bounds_of(&info);
+    EXPECT_MSG(near(b.max[0], 1) && near(b.max[2], 5), "quad.ply bounds");
+    sy_assimp_info_free(&info);
+    /* PLY declaring 10^12 vertices in a few bytes: refused before Assimp allocates */
+    PATHF(p, "%s/huge.ply", dir);
+    const char huge[] = "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\nproperty float x\n"
+                        "property float y\nproperty float z\nend_header\n\x00\x00\x00\x00";
+    EXPECT(write_bytes(p, huge, sizeof huge - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "huge.ply") && strstr(e.message, "1000000000000"),
+               "huge.ply: %s", e.message);
+
+    /* an OBJ whose MTL lies outside its folder: refused naming the file; admitted by allowed_roots */
+    PATHF(p, "%s/model/sub", dir);
+    mkdir(p, 0755);
+    PATHF(p, "%s/model/sub/out.obj", dir);
+    const char outobj[] = "mtllib ../quad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+    EXPECT(write_bytes(p, outobj, sizeof outobj - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_LIMIT && strstr(e.message, "out.obj") && strstr(e.message, "quad.mtl") &&
+                   strstr(e.message, "--allow-path"),
+               "MTL outside the folder: %s", e.message);
+    PATHF(q, "%s/model", dir);
+    const char *roots[] = {q};
+    sy_assimp_options ao = {.allowed_roots = roots, .allowed_root_count = 1};
+    /* the MTL is read; its texture is looked up in the model's folder (sub/), where it is not: a warning */
+    EXPECT_MSG(load(p, &ao, &info, &e) == SY_OK && info.counts.textures == 0 && info.warning_count == 1 &&
+                   strstr(info.warnings[0], "tex.ppm"),
+               "MTL in an allowed root: %s", info.warning_count ? info.warnings[0] : e.message);
+    const sy_material_data *red = NULL;
+    for (uint32_t id = sy_scene_next(g_scene, SY_TYPE_MATERIAL, 0); id; id = sy_scene_next(g_scene, SY_TYPE_MATERIAL, id)) {
+        const sy_material_data *x = sy_material_get(g_scene, (sy_material){id});
+        if (x && x->name && !strcmp(x->name, "red")) red = x;
+    }
+    EXPECT_MSG(red && near(red->base_color[1], 0.25f), "material red from the MTL in the allowed root");
+    sy_assimp_info_free(&info);
+
+    /* a file Assimp cannot read: Assimp's reason and the file name */
+    PATHF(p, "%s/junk.3ds", dir);
+    const char junk[] = "this is not a 3DS file at all, only some text";
+    EXPECT(write_bytes(p, junk, sizeof junk - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "junk.3ds") && strstr(e.message, "Assimp cannot read it"),
+               "junk.3ds: %s", e.message);
+    EXPECT_MSG(sy_scene_count(g_scene, SY_TYPE_NODE) == 0 && sy_scene_count(g_scene, SY_TYPE_MESH) == 0, "nothing left after a failure");
+
+    sy_scene_destroy(g_scene);
+    remove_scratch_dir(dir);
+    return sy_check_finish("test_assimp");
+}
