@@ -1,0 +1,33 @@
+/* fuzz_assimp.c — libFuzzer targets for the formats read through Assimp (formats/sy_assimp.h), from
+ * memory: one binary per format (assimp_obj, assimp_ply, assimp_stl, assimp_fbx, assimp_dae), built
+ * from this file with FUZZ_ASSIMP_NAME naming the input ("fuzz.obj", ...) so that Assimp's importer
+ * for that extension reads it (the content can still pick another one). Files the input names
+ * resolve in fuzz_resource_dir(), confined there. */
+#include "fuzz_util.h"
+#include "sy_assimp.h"
+
+#include <stddef.h>
+
+#ifndef FUZZ_ASSIMP_NAME
+#define FUZZ_ASSIMP_NAME "fuzz.obj"
+#endif
+
+int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
+{
+    sy_scene *s;
+    if (sy_scene_create(&s, NULL) != SY_OK) return 0;
+    sy_assimp_options o = {0};
+    o.max_file_bytes = 1u << 20;
+    o.max_vertices = 1u << 18;
+    o.max_image_pixels = 1u << 18;
+    o.max_scene_bytes = (uint64_t)64 << 20; /* the file budget, small like the other limits */
+    sy_assimp_info info = {0};
+    sy_error err = {0};
+    if (sy_assimp_load_memory(data, size, FUZZ_ASSIMP_NAME, fuzz_resource_dir(), s, &o, &info, &err) == SY_OK)
+        sy_scene_commit(s, NULL, NULL);
+    sy_assimp_info_free(&info);
+    sy_scene_destroy(s);
+    return 0;
+}
