@@ -36,10 +36,13 @@
  * embedded in the file (Assimp's aiTexture: compressed ones decoded the same way, raw ones taken
  * as they are).
  *
- * Cameras: Assimp's half horizontal field of view becomes yfov for the file's aspect (4:3 when it
- * has none); an orthographic width becomes xmag / ymag. Lights (sy_classic.h): directional, point
+ * Cameras: Assimp's horizontal field of view (the full angle, as Assimp 5.2's importers store it,
+ * whatever its header says) becomes yfov for the file's aspect (4:3 when it has none); an
+ * orthographic width becomes xmag / ymag (clip planes and widths in the camera node's units, as
+ * every camera's). Lights (sy_classic.h): directional, point
  * and spot; the colour's largest component i is the classic intensity (the colour is divided by
- * it): directional i * pi lux, point / spot i * pi / q candela with quadratic attenuation q > 0,
+ * it): directional i * pi lux, point / spot i * pi / q candela with quadratic attenuation q > 0
+ * (q per squared file unit, converted to the scene's units),
  * else i * pi * d^2 with d the distance to the centre of the scene's bounds; ambient and area lights
  * are skipped with a warning.
  *

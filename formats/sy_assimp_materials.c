@@ -10,10 +10,12 @@
 
 #include <assimp/material.h>
 
+#include <dirent.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 /* >>textures ---------------------------------------------------------------------------------- */
 
@@ -82,12 +84,24 @@ static sy_result read_texture_file(asp_loader *L, const char *path, const char *
     sy_result r = asp_read_named(L, uri, data, size, e);
     if (r == SY_ERR_NOT_FOUND || (r == SY_ERR_LIMIT && (uri[0] == '/' || (uri[0] && uri[1] == ':')))) {
         const char *b = base_name(uri);
-        if (b != uri) {
-            sy_error e2 = {0};
-            if (asp_read_named(L, b, data, size, &e2) == SY_OK) {
-                asp_warn(L, "%s: texture '%s' read as '%s' from the model's folder", where, path, b);
-                return SY_OK;
+        sy_error e2 = {0};
+        if (b != uri && asp_read_named(L, b, data, size, &e2) == SY_OK) {
+            asp_warn(L, "%s: texture '%s' read as '%s' from the model's folder", where, path, b);
+            return SY_OK;
+        }
+        /* names written on a case-insensitive file system (3DS: TEST.PNG for test.png) */
+        DIR *d = opendir(L->model_dir[0] ? L->model_dir : ".");
+        struct dirent *de;
+        char found[256] = "";
+        while (d && (de = readdir(d)))
+            if (!strcasecmp(de->d_name, b) && strlen(de->d_name) < sizeof found) {
+                snprintf(found, sizeof found, "%s", de->d_name);
+                break;
             }
+        if (d) closedir(d);
+        if (found[0] && asp_read_named(L, found, data, size, &e2) == SY_OK) {
+            asp_warn(L, "%s: texture '%s' read as '%s' (the name in another case) from the model's folder", where, path, found);
+            return SY_OK;
         }
     }
     return r;
@@ -252,9 +266,11 @@ sy_result asp_create_material(asp_loader *L, unsigned i)
     aiGetMaterialIntegerArray(m, "$mat.twosided", 0, 0, &two, NULL);
     float base[4] = {0.8f, 0.8f, 0.8f, 1.0f}, spec[4] = {0, 0, 0, 1}, emis[4] = {0, 0, 0, 1}, v;
     float metallic = 0, rough = 1;
-    bool pbr = get_float(m, "$mat.metallicFactor", &metallic) | get_float(m, "$mat.roughnessFactor", &rough);
-    pbr = get_color(m, "$clr.base", base) || pbr;
-    if (!get_color(m, "$clr.base", base)) get_color(m, "$clr.diffuse", base);
+    bool has_metallic = get_float(m, "$mat.metallicFactor", &metallic);
+    bool has_roughness = get_float(m, "$mat.roughnessFactor", &rough);
+    bool has_base = get_color(m, "$clr.base", base);
+    bool pbr = has_metallic || has_roughness || has_base;
+    if (!has_base) get_color(m, "$clr.diffuse", base);
     for (int k = 0; k < 3; ++k) md.base_color[k] = clamped(L, i, "base colour", base[k], 0, 1);
     md.base_color[3] = pbr ? clamped(L, i, "base colour alpha", base[3], 0, 1) : 1.0f;
     if (get_float(m, "$mat.opacity", &v)) md.base_color[3] *= clamped(L, i, "opacity", v, 0, 1);
@@ -281,7 +297,6 @@ sy_result asp_create_material(asp_loader *L, unsigned i)
 
     uint32_t ch = 0, alpha_ch = 0;
     sy_result r;
-    char slot[32];
     if ((r = texture_slot(L, i, aiTextureType_BASE_COLOR, true, "base colour", &md.base_color_texture, &alpha_ch)))
         return r;
     if (!md.base_color_texture.texture.id &&
@@ -317,7 +332,6 @@ sy_result asp_create_material(asp_loader *L, unsigned i)
                  asp_str(&p));
         L->info->counts.skipped++;
     }
-    (void)slot;
     md.alpha_mode = md.base_color[3] < 1.0f || alpha_ch == 2 || alpha_ch == 4 ? SY_ALPHA_BLEND : SY_ALPHA_OPAQUE;
     struct aiString am = {0};
     if (aiGetMaterialString(m, "$mat.gltf.alphaMode", 0, 0, &am) == aiReturn_SUCCESS)

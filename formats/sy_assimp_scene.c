@@ -363,7 +363,17 @@ typedef struct extra_child {
     sy_node node;
 } extra_child;
 
-static sy_result add_camera(asp_loader *L, unsigned i, walk_node *host, sy_node *out)
+/* The uniform scale of a world matrix (cube root of its 3x3 determinant; 1 when degenerate): what
+ * turns the file's lengths (clip planes, attenuation distances) into the scene's. */
+static float world_scale(const sy_mat4 *m)
+{
+    const float *a = m->m;
+    float det = a[0] * (a[5] * a[10] - a[9] * a[6]) - a[4] * (a[1] * a[10] - a[9] * a[2]) + a[8] * (a[1] * a[6] - a[5] * a[2]);
+    float s = cbrtf(fabsf(det));
+    return isfinite(s) && s > 0 ? s : 1.0f;
+}
+
+static sy_result add_camera(asp_loader *L, unsigned i, sy_node *out)
 {
     const struct aiCamera *c = L->ai->mCameras[i];
     char what[48];
@@ -372,15 +382,17 @@ static sy_result add_camera(asp_loader *L, unsigned i, walk_node *host, sy_node 
     float aspect = c->mAspect > 0 && isfinite(c->mAspect) ? c->mAspect : 4.0f / 3.0f;
     if (c->mOrthographicWidth > 0 && isfinite(c->mOrthographicWidth)) {
         cd.projection = SY_PROJECTION_ORTHOGRAPHIC;
-        cd.xmag = c->mOrthographicWidth;
-        cd.ymag = c->mOrthographicWidth / aspect;
+        cd.xmag = c->mOrthographicWidth; /* camera-local units: the node's scale applies */
+        cd.ymag = cd.xmag / aspect;
     } else {
+        /* Assimp 5.2's importers (COLLADA, FBX, 3DS, glTF 1) store the FULL horizontal angle here,
+         * although the header calls it the half angle: COLLADA xfov 49.13 arrives as 49.13 degrees */
         float h = c->mHorizontalFOV;
-        if (!(h > 0.001f && h < 1.57f)) {
-            asp_warn(L, "%s '%s': half field of view %g out of range; 45 degrees used", what, asp_str(&c->mName), (double)h);
-            h = 0.3927f;
+        if (!(h > 0.001f && h < 3.13f)) {
+            asp_warn(L, "%s '%s': horizontal field of view %g out of range; 60 degrees used", what, asp_str(&c->mName), (double)h);
+            h = 1.0472f;
         }
-        cd.yfov = 2.0f * atanf(tanf(h) / aspect);
+        cd.yfov = 2.0f * atanf(tanf(0.5f * h) / aspect);
     }
     cd.aspect = c->mAspect > 0 && isfinite(c->mAspect) ? c->mAspect : 0.0f;
     if (c->mClipPlaneNear > 0 && isfinite(c->mClipPlaneNear)) cd.znear = c->mClipPlaneNear;
@@ -390,7 +402,6 @@ static sy_result add_camera(asp_loader *L, unsigned i, walk_node *host, sy_node 
     if (!r && (r = sy_camera_set(L->scene, (sy_camera){id}, &cd, &L->err))) sy_error_prefix(&L->err, "%s: %s", L->path, what);
     if (!r) r = oriented_child(L, asp_str(&c->mName), what, &c->mPosition, &c->mLookAt, &c->mUp, out);
     if (!r && (r = sy_node_set_camera(L->scene, *out, (sy_camera){id}, &L->err))) sy_error_prefix(&L->err, "%s: %s", L->path, what);
-    (void)host;
     if (!r) L->info->counts.cameras++;
     return r;
 }
@@ -430,7 +441,9 @@ static sy_result add_light(asp_loader *L, unsigned i, walk_node *host, sy_node *
     if (!r && (r = sy_light_set(L->scene, (sy_light){id}, &ld, &L->err))) sy_error_prefix(&L->err, "%s: %s", L->path, what);
     if (!r) r = oriented_child(L, asp_str(&l->mName), what, &l->mPosition, &l->mDirection, &l->mUp, out);
     if (!r && (r = sy_node_set_light(L->scene, *out, (sy_light){id}, &L->err))) sy_error_prefix(&L->err, "%s: %s", L->path, what);
-    *quadratic = l->mAttenuationQuadratic;
+    /* attenuation is per file unit squared: in the scene's units q / s^2 */
+    float s2 = world_scale(&host->world) * world_scale(&host->world);
+    *quadratic = isfinite(l->mAttenuationQuadratic) && l->mAttenuationQuadratic > 0 ? l->mAttenuationQuadratic / s2 : 0.0f;
     float p[3] = {l->mPosition.x, l->mPosition.y, l->mPosition.z};
     sy_mat4_transform_point(&host->world, p, world_pos);
     if (!r) L->info->counts.lights++;
@@ -570,7 +583,7 @@ sy_result asp_create_nodes(asp_loader *L)
         if (!host) break;
         sy_node node;
         if (cam) {
-            if ((r = add_camera(L, j, host, &node))) break;
+            if ((r = add_camera(L, j, &node))) break;
             L->info->camera_nodes[L->info->camera_node_count++] = node;
         } else {
             pending_light *p = &pl[npl];
