@@ -271,7 +271,8 @@ static sy_result precheck_ply(asp_loader *L, const uint8_t *p, size_t n)
             if (ascii) per += 2;
             else per += !strcmp(b, "list") ? ply_type_size(c) : ply_type_size(b);
         }
-        if (i >= n) return SY_OK; /* no end of header in the file: Assimp's parser says so */
+        if (i >= n) /* Assimp 5.2 loops for ever on some headers without end_header */
+            return asp_fail(L, SY_ERR_PARSE, "PLY header has no end_header line; refused before reading");
     }
     need = sat_add(need, sat_mul(count, per ? per : 1));
     size_t body = n - i;

@@ -595,7 +595,7 @@ sy_result asp_create_nodes(asp_loader *L)
     }
     if (r) goto done;
     /* children lists, each set once */
-    qsort(ex, nex, sizeof *ex, by_parent);
+    if (nex) qsort(ex, nex, sizeof *ex, by_parent);
     size_t e = 0;
     kids = malloc((tail + nex + 1) * sizeof *kids);
     if (!kids) {

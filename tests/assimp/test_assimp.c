@@ -2,7 +2,8 @@
  * an OBJ + MTL with a texture (counts, bounds, the classic material's conversion, the texture),
  * ASCII and binary STL (a binary header starting with "solid"), a PLY with vertex colours, one
  * from memory; and bad input: a truncated binary STL, a binary STL whose facet count wraps Assimp's
- * 32-bit size check, a PLY declaring 10^12 vertices in a few bytes, an OBJ whose MTL and texture
+ * 32-bit size check, a PLY declaring 10^12 vertices in a few bytes, a PLY without end_header (Assimp
+ * hangs on it), an OBJ whose MTL and texture
  * lie outside its folder (refused, then admitted by allowed_roots), a file Assimp cannot read.
  * Every error names the file. */
 #include "sy_assimp.h"
@@ -147,6 +148,14 @@ int main(void)
     EXPECT(write_bytes(p, huge, sizeof huge - 1) == 0);
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "huge.ply") && strstr(e.message, "1000000000000"),
                "huge.ply: %s", e.message);
+
+    /* a PLY header whose end_header is broken (Assimp 5.2 loops for ever on it): refused first */
+    PATHF(p, "%s/noend.ply", dir);
+    const char noend[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                         "element face 1\nproperty list uchar int vertex_index\nend_he<x>ader\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    EXPECT(write_bytes(p, noend, sizeof noend - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "noend.ply") && strstr(e.message, "end_header"),
+               "noend.ply: %s", e.message);
 
     /* an OBJ whose MTL lies outside its folder: refused naming the file; admitted by allowed_roots */
     PATHF(p, "%s/model/sub", dir);

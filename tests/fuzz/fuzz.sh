@@ -62,7 +62,7 @@ case $target in
   assimp_obj|assimp_ply|assimp_stl|assimp_fbx|assimp_dae) # Assimp's test models (assimp-testmodels), in place
         ext=${target#assimp_}; len=65536; testdata=/usr/share/assimp/models; res_pat=('*.mtl' '*.png' '*.jpg')
         case $ext in obj) seed_dirs=(OBJ) ;; ply) seed_dirs=(PLY) ;; stl) seed_dirs=(STL) ;; fbx) seed_dirs=(FBX) ;; dae) seed_dirs=(Collada) ;; esac
-        seed_pat=("*.$ext" "*.${ext^^}"); dicts=() ;;
+        seed_pat=("*.$ext" "*.${ext^^}"); dicts=(assimp.dict) ;;
   *) echo "fuzz.sh: unknown target '$target' (gltf glb x3d exr changes web_request web_message cull_query)" >&2; exit 2 ;;
 esac
 [ -n "$max_len" ] && len=$max_len

@@ -5,6 +5,7 @@
  * resolve in fuzz_resource_dir(), confined there. */
 #include "fuzz_util.h"
 #include "sy_assimp.h"
+#include "sy_log.h"
 
 #include <stddef.h>
 
@@ -16,6 +17,7 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
 {
+    sy_log_set_level(SY_LOG_ERROR); /* Assimp's notes on every input would dominate the time */
     sy_scene *s;
     if (sy_scene_create(&s, NULL) != SY_OK) return 0;
     sy_assimp_options o = {0};
