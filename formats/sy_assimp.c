@@ -32,8 +32,7 @@ void sy_assimp_info_free(sy_assimp_info *info)
 {
     if (!info) return;
     free(info->camera_nodes);
-    for (uint32_t i = 0; i < info->stored_warning_count; i++) free(info->warnings[i]);
-    free(info->warnings);
+    sy_loader_warnings_free(asp_warnings(info));
     memset(info, 0, sizeof *info);
 }
 
@@ -148,13 +147,6 @@ static sy_result convert(asp_loader *L)
     return r;
 }
 
-static void log_warnings(const char *path, const sy_assimp_info *info)
-{
-    for (uint32_t i = 0; i < info->stored_warning_count; i++) sy_log(SY_LOG_WARNING, "assimp", path, "%s", info->warnings[i]);
-    if (info->warning_count > info->stored_warning_count)
-        sy_log(SY_LOG_WARNING, "assimp", path, "%u more warnings not shown", info->warning_count - info->stored_warning_count);
-}
-
 static sy_result load_common(const char *path, const void *mem, size_t mem_size, const char *base_dir, sy_scene *scene,
                              const sy_assimp_options *opts, sy_assimp_info *info_out, sy_error *err)
 {
@@ -216,7 +208,7 @@ out:
         if (err) *err = L.err;
         return r;
     }
-    log_warnings(path, info);
+    sy_loader_warnings_log(asp_warnings(info), "assimp", path, path);
     if (!info_out) sy_assimp_info_free(&local);
     return SY_OK;
 }

@@ -12,6 +12,7 @@
 
 #include "sy_assimp.h"
 #include "sy_budget.h"
+#include "sy_loader_log.h"
 
 #include <assimp/cfileio.h>
 #include <assimp/scene.h>
@@ -64,6 +65,8 @@ sy_result asp_fail(asp_loader *L, sy_result code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+/* The info struct's warnings (sy_loader_log.h). */
+sy_loader_warnings asp_warnings(sy_assimp_info *info);
 /* A warning "<message>" (at most SY_ASSIMP_MAX_WARNINGS stored, all counted). */
 void asp_warn(asp_loader *L, const char *fmt, ...)
 #if defined(__GNUC__)

@@ -5,6 +5,7 @@
 #include "sy_assimp_internal.h"
 
 #include "sy_file.h"
+#include "sy_loader_log.h"
 #include "sy_log.h"
 
 #include <assimp/cimport.h>
@@ -19,27 +20,24 @@
 
 sy_result asp_fail(asp_loader *L, sy_result code, const char *fmt, ...)
 {
-    char msg[SY_ERROR_MESSAGE_MAX];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    sy_result r = sy_loader_fail(&L->err, L->path, code, fmt, ap);
     va_end(ap);
-    return sy_error_set(&L->err, code, "%s: %s", L->path, msg);
+    return r;
+}
+
+sy_loader_warnings asp_warnings(sy_assimp_info *info)
+{
+    return (sy_loader_warnings){&info->warnings, &info->warning_count, &info->stored_warning_count, SY_ASSIMP_MAX_WARNINGS};
 }
 
 void asp_warn(asp_loader *L, const char *fmt, ...)
 {
-    sy_assimp_info *info = L->info;
-    info->warning_count++;
-    if (info->stored_warning_count >= SY_ASSIMP_MAX_WARNINGS) return;
-    if (!info->warnings && !(info->warnings = calloc(SY_ASSIMP_MAX_WARNINGS, sizeof(char *)))) return;
-    char msg[SY_ERROR_MESSAGE_MAX];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    sy_loader_warn(asp_warnings(L->info), fmt, ap);
     va_end(ap);
-    char *copy = strdup(msg);
-    if (copy) info->warnings[info->stored_warning_count++] = copy;
 }
 
 const char *asp_str(const struct aiString *s)

@@ -23,8 +23,7 @@ void sy_gltf_info_free(sy_gltf_info *info)
 {
     if (!info) return;
     free(info->camera_nodes);
-    for (uint32_t i = 0; i < info->stored_warning_count; i++) free(info->warnings[i]);
-    free(info->warnings);
+    sy_loader_warnings_free(gltf_warnings(info));
     memset(info, 0, sizeof *info);
 }
 
@@ -118,15 +117,9 @@ static sy_result load_doc(loader *L)
 
 /* Shared by sy_gltf_load (mem NULL: reads path; external files relative to its directory) and
  * sy_gltf_load_memory (mem borrowed, path only names it in messages, base_dir given). */
-/* What a successful load skipped or repaired, on the log (sy_log.h; module "gltf", item the file):
- * the stored warnings, then how many more there were. They stay in info->warnings as well. */
-static void log_warnings(const char *path, const sy_gltf_info *info)
-{
-    for (uint32_t i = 0; i < info->stored_warning_count; i++) sy_log(SY_LOG_WARNING, "gltf", path, "%s", info->warnings[i]);
-    if (info->warning_count > info->stored_warning_count)
-        sy_log(SY_LOG_WARNING, "gltf", path, "%u more warnings not shown", info->warning_count - info->stored_warning_count);
-}
-
+/* What a successful load skipped or repaired is on the log (sy_log.h; module "gltf", item the file):
+ * the stored warnings, then how many more there were (sy_loader_warnings_log). They stay in
+ * info->warnings as well. */
 static sy_result load_common(const char *path, const void *mem, size_t mem_size, const char *base_dir, sy_scene *scene,
                              const sy_gltf_options *opts, sy_gltf_info *info_out, sy_error *err)
 {
@@ -227,7 +220,7 @@ out:
         if (err) *err = L.err;
         return r;
     }
-    log_warnings(path, info);
+    sy_loader_warnings_log(gltf_warnings(info), "gltf", path, path);
     if (!info_out) sy_gltf_info_free(&local_info);
     return SY_OK;
 }

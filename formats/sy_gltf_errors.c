@@ -13,33 +13,24 @@
 
 sy_result gltf_fail(loader *L, sy_result code, const char *fmt, ...)
 {
-    char msg[SY_ERROR_MESSAGE_MAX];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    sy_result r = sy_loader_fail(&L->err, L->path, code, fmt, ap);
     va_end(ap);
-    return sy_error_set(&L->err, code, "%s: %s", L->path, msg);
+    return r;
+}
+
+sy_loader_warnings gltf_warnings(sy_gltf_info *info)
+{
+    return (sy_loader_warnings){&info->warnings, &info->warning_count, &info->stored_warning_count, SY_GLTF_MAX_WARNINGS};
 }
 
 void gltf_warn(loader *L, const char *fmt, ...)
 {
-    sy_gltf_info *info = L->info;
-    info->warning_count++;
-    if (info->stored_warning_count >= SY_GLTF_MAX_WARNINGS) return;
-    if (!info->warnings) {
-        info->warnings = calloc(SY_GLTF_MAX_WARNINGS, sizeof(char *));
-        if (!info->warnings) return;
-    }
-    char msg[SY_ERROR_MESSAGE_MAX];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    sy_loader_warn(gltf_warnings(L->info), fmt, ap);
     va_end(ap);
-    size_t n = strlen(msg) + 1;
-    char *s = malloc(n);
-    if (!s) return;
-    memcpy(s, msg, n);
-    info->warnings[info->stored_warning_count++] = s;
 }
 
 /* Adds context to an error that a core call left in L->err. */

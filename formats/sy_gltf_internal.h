@@ -12,6 +12,7 @@
 #define SY_GLTF_INTERNAL_H
 
 #include "sy_budget.h"
+#include "sy_loader_log.h"
 #include "sy_gltf.h"
 #include "sy_gltf_shim.h"
 
@@ -74,6 +75,8 @@ sy_result gltf_fail(loader *L, sy_result code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+/* The info struct's warnings (sy_loader_log.h). */
+sy_loader_warnings gltf_warnings(sy_gltf_info *info);
 /* A warning into info->warnings (at most SY_GLTF_MAX_WARNINGS stored, all counted). */
 void gltf_warn(loader *L, const char *fmt, ...)
 #if defined(__GNUC__)

@@ -20,22 +20,15 @@
 void sy_x3d_info_free(sy_x3d_info *info)
 {
     if (!info) return;
-    for (uint32_t k = 0; k < info->stored_warning_count; k++) free(info->warnings[k]);
-    free(info->warnings);
+    sy_loader_warnings_free(x3d_warnings(info));
     free(info->camera_nodes);
     free(info->camera_fovs);
     memset(info, 0, sizeof *info);
 }
 
-/* What a successful load skipped or repaired, on the log (sy_log.h; module "x3d"): the stored
- * warnings (each names its file and line, so the item is NULL), then how many more there were. They
- * stay in info->warnings as well. */
-static void log_warnings(const char *path, const sy_x3d_info *info)
-{
-    for (uint32_t i = 0; i < info->stored_warning_count; i++) sy_log(SY_LOG_WARNING, "x3d", NULL, "%s", info->warnings[i]);
-    if (info->warning_count > info->stored_warning_count)
-        sy_log(SY_LOG_WARNING, "x3d", path, "%u more warnings not shown", info->warning_count - info->stored_warning_count);
-}
+/* What a successful load skipped or repaired is on the log (sy_log.h; module "x3d"): the stored
+ * warnings (each names its file and line, so the item is NULL), then how many more there were
+ * (sy_loader_warnings_log). They stay in info->warnings as well. */
 
 static sy_result load_common(const char *path, const void *mem, size_t size, const char *base_dir, sy_scene *scene,
                              const sy_x3d_options *opts, sy_x3d_info *info_out, sy_error *err)
@@ -102,7 +95,7 @@ static sy_result load_common(const char *path, const void *mem, size_t size, con
         return r;
     }
     free(L.objs);
-    log_warnings(path, info);
+    sy_loader_warnings_log(x3d_warnings(info), "x3d", NULL, path);
     if (info == &local_info) sy_x3d_info_free(info);
     return SY_OK;
 }

@@ -15,22 +15,17 @@
 
 /* >>state ------------------------------------------------------------------------------------- */
 
+sy_loader_warnings x3d_warnings(sy_x3d_info *info)
+{
+    return (sy_loader_warnings){&info->warnings, &info->warning_count, &info->stored_warning_count, SY_X3D_MAX_WARNINGS};
+}
+
 void x3d_warn(loader *L, const char *fmt, ...)
 {
-    sy_x3d_info *I = L->info;
-    I->warning_count++;
-    if (I->stored_warning_count >= SY_X3D_MAX_WARNINGS) return;
-    char buf[SY_ERROR_MESSAGE_MAX];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
+    sy_loader_warn(x3d_warnings(L->info), fmt, ap);
     va_end(ap);
-    if (!I->warnings) {
-        I->warnings = calloc(SY_X3D_MAX_WARNINGS, sizeof(char *));
-        if (!I->warnings) return;
-    }
-    char *s = strdup(buf);
-    if (s) I->warnings[I->stored_warning_count++] = s;
 }
 
 

@@ -12,6 +12,7 @@
 #ifndef SY_X3D_INTERNAL_H
 #define SY_X3D_INTERNAL_H
 
+#include "sy_loader_log.h"
 #include "sy_budget.h"
 #include "sy_x3d.h"
 
@@ -85,6 +86,8 @@ static inline const char *x3d_ename(const xmlNode *el) { return (const char *)el
 
 /* A warning into info->warnings (at most SY_X3D_MAX_WARNINGS stored, all counted). */
 void x3d_warn(loader *L, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* The info struct's warnings (sy_loader_log.h). */
+sy_loader_warnings x3d_warnings(sy_x3d_info *info);
 /* Creates a scene object and tracks it for the rollback. */
 sy_result x3d_new_object(loader *L, sy_object_type t, const char *name, uint32_t *id);
 /* The created objects of element el (+ variant) of file F; NULL when absent (create = false) or out
