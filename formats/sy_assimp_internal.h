@@ -2,7 +2,9 @@
  * calls between its modules. The modules, bottom-up (no module calls one above it):
  *   sy_assimp_io.c         warnings, rollback, the confined aiFileIO (the model from memory, every
  *                          other file through sy_path_confine), Assimp's log into sy_log, the
- *                          pre-checks of declared counts (PLY, binary STL)
+ *                          checks made before Assimp reads a file (PLY counts and end_header,
+ *                          binary STL's facet count, ASCII FBX's embedded base64, COLLADA's
+ *                          integer lists)
  *   sy_assimp_materials.c  textures (files and embedded) and materials
  *   sy_assimp_scene.c      meshes, cameras, lights, the node tree, units and up axis
  *   sy_assimp.c            the public entry points (sy_assimp.h): options, the import, the order

@@ -6,6 +6,7 @@
 
 #include "sy_file.h"
 #include "sy_loader_log.h"
+#include "sy_sniff.h"
 #include "sy_log.h"
 
 #include <assimp/cimport.h>
@@ -297,10 +298,77 @@ static sy_result precheck_stl(asp_loader *L, const uint8_t *p, size_t n)
     return SY_OK;
 }
 
+static bool base64_char(uint8_t c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '+' || c == '/'; }
+
+/* ASCII FBX: the quoted base64 strings of every "Content:" (embedded images) must be whole base64
+ * (a multiple of 4 characters, '=' only as the last one or two). Assimp 5.2 decodes them into a
+ * buffer sized from the characters, frees it when fewer bytes come out and frees it again in the
+ * video's destructor (a double free, found by fuzz_assimp_fbx). */
+static sy_result precheck_fbx_ascii(asp_loader *L, const uint8_t *p, size_t n)
+{
+    static const char key[] = "Content:";
+    for (size_t i = 0; i + sizeof key - 1 <= n; ++i) {
+        if (p[i] != 'C' || memcmp(p + i, key, sizeof key - 1) != 0) continue;
+        size_t j = i + sizeof key - 1, fragment = 0;
+        for (;;) {
+            while (j < n && (p[j] == ' ' || p[j] == '\t' || p[j] == '\r' || p[j] == '\n' || p[j] == ',')) j++;
+            if (j >= n || p[j] != '"') break;
+            size_t s = ++j, pad = 0;
+            bool ok = true;
+            while (j < n && p[j] != '"') {
+                if (p[j] == '=') pad++;
+                else if (!base64_char(p[j]) || pad) ok = false;
+                j++;
+            }
+            size_t len = j - s;
+            if (j < n) j++; /* the closing quote */
+            if (!ok || pad > 2 || len % 4 != 0)
+                return asp_fail(L, SY_ERR_PARSE,
+                                "FBX embedded content (fragment %zu of the Content at byte %zu) is not whole base64 (%zu "
+                                "characters); refused before reading",
+                                fragment, i, len);
+            fragment++;
+        }
+        i = j ? j - 1 : i;
+    }
+    return SY_OK;
+}
+
+/* COLLADA: the index lists (<p>, <vcount>, <v>, <h>, <int_array>) hold integers only. Assimp 5.2's
+ * reader does not advance over another word in them and never returns (an "illum" in a <p> list,
+ * found by fuzz_assimp_dae). */
+static sy_result precheck_collada(asp_loader *L, const uint8_t *p, size_t n)
+{
+    static const char *const tags[] = {"<p>", "<p ", "<vcount>", "<vcount ", "<v>", "<v ", "<h>", "<h ", "<int_array "};
+    for (size_t i = 0; i < n; ++i) {
+        if (p[i] != '<') continue;
+        const char *tag = NULL;
+        for (size_t k = 0; k < sizeof tags / sizeof tags[0] && !tag; ++k)
+            if (n - i >= strlen(tags[k]) && !memcmp(p + i, tags[k], strlen(tags[k]))) tag = tags[k];
+        if (!tag) continue;
+        size_t j = i + 1;
+        while (j < n && p[j] != '>') j++;
+        if (j < n && p[j - 1] == '/') continue; /* empty element */
+        for (size_t k = j + 1; k < n && p[k] != '<'; ++k) {
+            uint8_t c = p[k];
+            if ((c >= '0' && c <= '9') || c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '-' || c == '+') continue;
+            size_t tl = strcspn(tag + 1, " >");
+            return asp_fail(L, SY_ERR_PARSE,
+                            "COLLADA <%.*s> list at byte %zu holds '%c', not an integer; refused before reading", (int)tl,
+                            tag + 1, k, c >= ' ' && c < 127 ? c : '?');
+        }
+        i = j;
+    }
+    return SY_OK;
+}
+
 sy_result asp_precheck(asp_loader *L)
 {
     const uint8_t *p = L->main_data;
     size_t n = L->main_size;
     if (n >= 4 && !memcmp(p, "ply", 3) && (p[3] == '\n' || p[3] == '\r')) return precheck_ply(L, p, n);
-    return precheck_stl(L, p, n);
+    sy_result r = precheck_stl(L, p, n);
+    if (r == SY_OK && !(n >= 18 && !memcmp(p, "Kaydara FBX Binary", 18))) r = precheck_fbx_ascii(L, p, n);
+    if (r == SY_OK && sy_sniff_bytes(p, n < 1024 ? n : 1024) == SY_FORMAT_COLLADA) r = precheck_collada(L, p, n);
+    return r;
 }

@@ -3,7 +3,8 @@
  * ASCII and binary STL (a binary header starting with "solid"), a PLY with vertex colours, one
  * from memory; and bad input: a truncated binary STL, a binary STL whose facet count wraps Assimp's
  * 32-bit size check, a PLY declaring 10^12 vertices in a few bytes, a PLY without end_header (Assimp
- * hangs on it), an OBJ whose MTL and texture
+ * hangs on it), an ASCII FBX whose embedded base64 Assimp frees twice, a
+ * COLLADA index list holding a word (Assimp never returns), an OBJ whose MTL and texture
  * lie outside its folder (refused, then admitted by allowed_roots), a file Assimp cannot read.
  * Every error names the file. */
 #include "sy_assimp.h"
@@ -156,6 +157,45 @@ int main(void)
     EXPECT(write_bytes(p, noend, sizeof noend - 1) == 0);
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "noend.ply") && strstr(e.message, "end_header"),
                "noend.ply: %s", e.message);
+
+    /* an ASCII FBX embedding 201 base64 characters ending in '=': Assimp 5.2 sizes the buffer for
+     * 149 bytes, decodes 150, frees it and frees it again (ASan: double free); refused first */
+    PATHF(p, "%s/video.fbx", dir);
+    char fbx[1024], b64[202];
+    for (int k = 0; k < 200; ++k) b64[k] = "QUFB"[k % 4];
+    b64[200] = '=', b64[201] = '\0';
+    int fl = snprintf(fbx, sizeof fbx,
+                      "; FBX 7.5.0 project file\nFBXHeaderExtension:  {\n\tFBXHeaderVersion: 1003\n\tFBXVersion: 7500\n}\n"
+                      "Objects:  {\n\tVideo: 1, \"Video::v\", \"Clip\" {\n\t\tType: \"Clip\"\n\t\tContent: , \"%s\"\n\t}\n"
+                      "\tTexture: 2, \"Texture::t\", \"\" {\n\t\tType: \"TextureVideoClip\"\n\t}\n}\n"
+                      "Connections:  {\n\tC: \"OO\",1,2\n}\n",
+                      b64);
+    EXPECT(fl > 0 && write_bytes(p, fbx, (size_t)fl) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "video.fbx") && strstr(e.message, "base64"),
+               "video.fbx: %s", e.message);
+
+    /* a COLLADA index list holding a word: Assimp 5.2 never returns from it; refused first */
+    PATHF(p, "%s/word.dae", dir);
+    const char dae[] =
+        "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">"
+        "<library_geometries><geometry id=\"g\"><mesh><source id=\"pos\"><float_array id=\"pa\" count=\"9\">0 0 0 1 0 0 0 1 0"
+        "</float_array><technique_common><accessor source=\"#pa\" count=\"3\" stride=\"3\"><param name=\"X\" type=\"float\"/>"
+        "<param name=\"Y\" type=\"float\"/><param name=\"Z\" type=\"float\"/></accessor></technique_common></source>"
+        "<vertices id=\"v\"><input semantic=\"POSITION\" source=\"#pos\"/></vertices><triangles count=\"1\">"
+        "<input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/><p>0 1 word 2</p></triangles></mesh></geometry>"
+        "</library_geometries><library_visual_scenes><visual_scene id=\"s\"><node id=\"n\"><instance_geometry url=\"#g\"/>"
+        "</node></visual_scene></library_visual_scenes><scene><instance_visual_scene url=\"#s\"/></scene></COLLADA>\n";
+    EXPECT(write_bytes(p, dae, sizeof dae - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "word.dae") && strstr(e.message, "<p>"),
+               "word.dae: %s", e.message);
+    /* the same triangle with a proper list loads */
+    char good[sizeof dae];
+    memcpy(good, dae, sizeof dae);
+    char *w = strstr(good, "0 1 word 2");
+    memcpy(w, "0 1 2     ", 10);
+    EXPECT(write_bytes(p, good, sizeof good - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.triangles == 1, "word.dae repaired: %s", e.message);
+    sy_assimp_info_free(&info);
 
     /* an OBJ whose MTL lies outside its folder: refused naming the file; admitted by allowed_roots */
     PATHF(p, "%s/model/sub", dir);
