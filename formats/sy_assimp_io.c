@@ -366,7 +366,8 @@ sy_result asp_precheck(asp_loader *L)
 {
     const uint8_t *p = L->main_data;
     size_t n = L->main_size;
-    if (n >= 4 && !memcmp(p, "ply", 3) && (p[3] == '\n' || p[3] == '\r')) return precheck_ply(L, p, n);
+    /* Assimp takes any file starting with "ply" in any case as PLY, whatever follows on the line */
+    if (n >= 3 && (p[0] | 0x20) == 'p' && (p[1] | 0x20) == 'l' && (p[2] | 0x20) == 'y') return precheck_ply(L, p, n);
     sy_result r = precheck_stl(L, p, n);
     if (r == SY_OK && !(n >= 18 && !memcmp(p, "Kaydara FBX Binary", 18))) r = precheck_fbx_ascii(L, p, n);
     if (r == SY_OK && sy_sniff_bytes(p, n < 1024 ? n : 1024) == SY_FORMAT_COLLADA) r = precheck_collada(L, p, n);

@@ -149,6 +149,13 @@ int main(void)
     EXPECT(write_bytes(p, huge, sizeof huge - 1) == 0);
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "huge.ply") && strstr(e.message, "1000000000000"),
                "huge.ply: %s", e.message);
+    /* the same behind a magic that is not alone on its line ("PLY" and more: Assimp still reads it as PLY) */
+    char huge2[sizeof huge + 8];
+    memcpy(huge2, "PLY[[[[[", 8);
+    memcpy(huge2 + 8, huge + 3, sizeof huge - 3);
+    EXPECT(write_bytes(p, huge2, sizeof huge2 - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "1000000000000"), "huge.ply behind 'PLY[[[[[': %s",
+               e.message);
 
     /* a PLY header whose end_header is broken (Assimp 5.2 loops for ever on it): refused first */
     PATHF(p, "%s/noend.ply", dir);
