@@ -25,8 +25,10 @@ static pthread_mutex_t g_assimp_lock = PTHREAD_MUTEX_INITIALIZER;
 /* The post-processing every file gets (sy_assimp.h). */
 #define SY_ASSIMP_STEPS                                                                                              \
     (aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |  \
-     aiProcess_FindDegenerates | aiProcess_FindInvalidData | aiProcess_TransformUVCoords | aiProcess_FlipUVs |       \
-     aiProcess_ValidateDataStructure)
+     aiProcess_FindInvalidData | aiProcess_TransformUVCoords | aiProcess_FlipUVs | aiProcess_ValidateDataStructure)
+/* FindDegenerates (degenerate triangles and segments removed) runs as a second pass over the
+ * imported scene: in the same pass as Triangulate and SortByPType it crashes Assimp 5.2 (a bus
+ * error on a wild pointer) on a PLY with a short vertex line (found by fuzz_assimp_ply). */
 
 void sy_assimp_info_free(sy_assimp_info *info)
 {
@@ -107,6 +109,7 @@ static sy_result import(asp_loader *L)
     pthread_mutex_lock(&g_assimp_lock);
     asp_log_attach(L);
     L->ai = aiImportFileExWithProperties(L->main_name, SY_ASSIMP_STEPS, &io, ps);
+    if (L->ai) L->ai = aiApplyPostProcessing(L->ai, aiProcess_FindDegenerates); /* NULL: Assimp released it */
     char why[SY_ERROR_MESSAGE_MAX];
     snprintf(why, sizeof why, "%s", L->ai ? "" : aiGetErrorString());
     asp_log_detach();

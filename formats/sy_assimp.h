@@ -16,8 +16,9 @@
  *
  * Geometry goes through Assimp's own post-processing: Triangulate, GenSmoothNormals (normals where
  * the file has none, crease angle 80 degrees), JoinIdenticalVertices, SortByPType (one primitive
- * type per mesh), FindDegenerates (degenerate triangles removed), FindInvalidData,
- * TransformUVCoords, FlipUVs (texture v down, the scene's convention) and ValidateDataStructure.
+ * type per mesh), FindInvalidData, TransformUVCoords, FlipUVs (texture v down, the scene's
+ * convention) and ValidateDataStructure, then FindDegenerates (degenerate triangles removed) as a
+ * second pass (in the first it crashes Assimp 5.2 on some malformed files).
  * Normal-mapped primitives get generated tangents (sy_mesh_util.h, as glTF's).
  *
  * Materials (documented rule, docs/FORMATS.md): Assimp's PBR properties (base colour, metallic,

@@ -17,6 +17,7 @@
 
 static uint32_t per_element(unsigned types)
 {
+    types &= ~(unsigned)aiPrimitiveType_NGONEncodingFlag; /* Triangulate marks triangles made from polygons */
     return types == aiPrimitiveType_TRIANGLE ? 3 : types == aiPrimitiveType_LINE ? 2 : types == aiPrimitiveType_POINT ? 1 : 0;
 }
 

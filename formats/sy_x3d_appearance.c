@@ -1,5 +1,5 @@
-/* sy_x3d_appearance.c — an X3D Shape's Appearance as one sy_material: ImageTexture (decoded with
- * stb_image within the image and scene budgets, TextureProperties as the sampler), Material,
+/* sy_x3d_appearance.c — an X3D Shape's Appearance as one sy_material: ImageTexture (decoded by
+ * sy_image.h within the image and scene budgets, TextureProperties as the sampler), Material,
  * PhysicalMaterial, UnlitMaterial, TwoSidedMaterial and CommonSurfaceShader, with the mappings that
  * sy_x3d.h documents. Materials and textures are cached per element, so a USEd Appearance or
  * ImageTexture stays one object. */
@@ -8,9 +8,7 @@
 #include "sy_classic.h"
 #include "sy_file.h"
 
-#include "sy_sniff.h"
-
-#include <stb_image.h>
+#include "sy_image.h"
 
 #include <limits.h>
 #include <math.h>
@@ -88,25 +86,13 @@ static sy_result load_texture(loader *L, xfile *F, const xmlNode *el, bool srgb,
             snprintf(why, sizeof why, "%s", ferr.message);
             continue;
         }
-        sy_file_format kind = sy_sniff_bytes(bytes, size);
-        if (!sy_file_format_is_texture_image(kind, true)) {
-            snprintf(why, sizeof why, "%.400s: %s content, not a PNG, JPEG or GIF image", path, sy_file_format_name(kind));
-        } else if (size > INT_MAX || !stbi_info_from_memory(bytes, (int)size, &w, &h, &comp) || w < 1 || h < 1 ||
-                   comp < 1 || comp > 4) {
-            snprintf(why, sizeof why, "%.400s: cannot decode (%s)", path, size > INT_MAX ? "too large" : stbi_failure_reason());
-        } else if ((uint64_t)w * (uint64_t)h > L->opt.max_image_pixels) {
-            snprintf(why, sizeof why, "%.400s: %dx%d pixels exceed the limit", path, w, h);
-        } else if (!sy_budget_fits(&L->budget, (uint64_t)w * (uint64_t)h, (uint64_t)comp)) {
-            snprintf(why, sizeof why, "%.400s: %dx%d pixels exceed what is left of the scene budget (%.0f MiB)", path, w,
-                     h, (double)(L->budget.limit - L->budget.used) / (1024.0 * 1024.0));
-        } else {
-            int w2, h2, c2;
-            pixels = stbi_load_from_memory(bytes, (int)size, &w2, &h2, &c2, comp);
-            if (pixels && (w2 != w || h2 != h)) {
-                stbi_image_free(pixels);
-                pixels = NULL;
-            }
-            if (!pixels) snprintf(why, sizeof why, "%.400s: cannot decode (%s)", path, stbi_failure_reason());
+        sy_image_pixels img;
+        sy_error derr = {0};
+        if (sy_image_decode(bytes, size, L->opt.max_image_pixels, &L->budget, &img, &derr) != SY_OK) {
+            snprintf(why, sizeof why, "%.300s: %.200s", path, derr.message);
+        } else { /* within the limits and charged to the budget (sy_image.h) */
+            pixels = img.pixels;
+            w = (int)img.width, h = (int)img.height, comp = (int)img.channels;
         }
         free(bytes);
     }
@@ -115,15 +101,14 @@ static sy_result load_texture(loader *L, xfile *F, const xmlNode *el, bool srgb,
         x3d_warn(L, "%s:%d: ImageTexture: %s; no texture", F->path, x3d_line_of(el), why);
         return SY_OK;
     }
-    (void)sy_budget_charge(&L->budget, (uint64_t)w * (uint64_t)h, (uint64_t)comp, &L->err, "ImageTexture"); /* fits */
     sy_result r;
     sy_blob *blob = NULL;
     size_t bytes = (size_t)w * (size_t)h * (size_t)comp;
     if ((r = sy_blob_create_copy(pixels, bytes, &blob, &L->err))) {
-        stbi_image_free(pixels);
+        free(pixels);
         return r;
     }
-    stbi_image_free(pixels);
+    free(pixels);
     char *def = x3d_attr(el, "DEF");
     uint32_t id;
     r = x3d_new_object(L, SY_TYPE_TEXTURE, def ? def : u, &id);

@@ -41,7 +41,7 @@ static bool assimp_counts(const char *path, unsigned *meshes, unsigned long *tri
     *tris = 0;
     for (unsigned i = 0; i < s->mNumMeshes; ++i) {
         const struct aiMesh *m = s->mMeshes[i];
-        unsigned t = m->mPrimitiveTypes;
+        unsigned t = m->mPrimitiveTypes & ~(unsigned)aiPrimitiveType_NGONEncodingFlag;
         if (t != aiPrimitiveType_TRIANGLE && t != aiPrimitiveType_LINE && t != aiPrimitiveType_POINT) continue;
         if (!m->mNumVertices || !m->mNumFaces) continue;
         (*meshes)++;
