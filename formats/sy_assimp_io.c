@@ -245,7 +245,7 @@ static sy_result precheck_ply(asp_loader *L, const uint8_t *p, size_t n)
     size_t i = 0;
     bool ascii = true;
     uint64_t need = 0, count = 0, per = 0;
-    char elem[64] = "", worst[64] = "";
+    char elem[64] = "", worst[64] = "", seen[1024] = " ";
     uint64_t worst_count = 0;
     while (i < n) {
         size_t s = i;
@@ -260,6 +260,15 @@ static sy_result precheck_ply(asp_loader *L, const uint8_t *p, size_t n)
         if (k >= 1 && !strcmp(a, "end_header")) break;
         if (k >= 2 && !strcmp(a, "format")) ascii = !strcmp(b, "ascii");
         if (k >= 3 && !strcmp(a, "element")) {
+            /* an element declared twice: Assimp 5.2 fails an assertion in Triangulate and aborts the
+             * process (Debian builds it with assertions; found by fuzz_assimp_ply) */
+            if (strlen(seen) + strlen(b) + 2 < sizeof seen) {
+                char key[80];
+                snprintf(key, sizeof key, " %s ", b);
+                if (strstr(seen, key))
+                    return asp_fail(L, SY_ERR_PARSE, "PLY header declares element '%s' twice; refused before reading", b);
+                strcat(seen, key + 1);
+            }
             need = sat_add(need, sat_mul(count, per ? per : 1));
             snprintf(elem, sizeof elem, "%s", b);
             count = strtoull(c, NULL, 10);
