@@ -97,25 +97,6 @@ static const char *meta_string(const struct aiMetadata *md, const char *key)
     return NULL;
 }
 
-/* Each mesh's primitive types as its faces have them (Assimp's post-processing trusts the claim);
- * false (mesh index in *bad) when a face has no index, which Assimp's validation lets through from
- * some importers (a PLY face list of count 0) and Triangulate then fails an assertion on. */
-static bool fix_primitive_types(const struct aiScene *s, unsigned *bad)
-{
-    for (unsigned i = 0; i < s->mNumMeshes; ++i) {
-        struct aiMesh *m = s->mMeshes[i]; /* the scene is the caller's until released */
-        unsigned types = 0;
-        for (unsigned f = 0; f < m->mNumFaces; ++f) {
-            unsigned n = m->mFaces[f].mNumIndices;
-            if (n == 0 || !m->mFaces[f].mIndices) return *bad = i, false;
-            types |= n == 1 ? aiPrimitiveType_POINT : n == 2 ? aiPrimitiveType_LINE : n == 3 ? aiPrimitiveType_TRIANGLE
-                                                                                           : aiPrimitiveType_POLYGON;
-        }
-        m->mPrimitiveTypes = types;
-    }
-    return true;
-}
-
 /* Assimp reads the model (under the lock); L->ai on success, Assimp's reason on failure. */
 static sy_result import(asp_loader *L)
 {
@@ -127,22 +108,14 @@ static sy_result import(asp_loader *L)
     aiSetImportPropertyInteger(ps, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
     pthread_mutex_lock(&g_assimp_lock);
     asp_log_attach(L);
-    /* three passes: read and validate; the primitive types recomputed from the faces (an importer's
-     * wrong claim fails an assertion in Triangulate and aborts the process: a fuzzer-made PLY); the
-     * post-processing; FindDegenerates (see SY_ASSIMP_STEPS). aiApplyPostProcessing releases the
-     * scene when it fails (NULL). */
-    L->ai = aiImportFileExWithProperties(L->main_name, aiProcess_ValidateDataStructure, &io, ps);
-    unsigned empty_face_mesh = 0;
-    bool empty_face = L->ai && !fix_primitive_types(L->ai, &empty_face_mesh);
-    if (L->ai && !empty_face) L->ai = aiApplyPostProcessing(L->ai, SY_ASSIMP_STEPS & ~(unsigned)aiProcess_ValidateDataStructure);
-    if (L->ai && !empty_face) L->ai = aiApplyPostProcessing(L->ai, aiProcess_FindDegenerates);
+    L->ai = aiImportFileExWithProperties(L->main_name, SY_ASSIMP_STEPS, &io, ps);
+    if (L->ai) L->ai = aiApplyPostProcessing(L->ai, aiProcess_FindDegenerates); /* NULL: Assimp released it */
     char why[SY_ERROR_MESSAGE_MAX];
     snprintf(why, sizeof why, "%s", L->ai ? "" : aiGetErrorString());
     asp_log_detach();
     pthread_mutex_unlock(&g_assimp_lock);
     aiReleasePropertyStore(ps);
     if (L->io_result) return sy_error_set(&L->err, L->io_result, "%s", L->io_message); /* a refused file */
-    if (empty_face) return asp_fail(L, SY_ERR_PARSE, "meshes[%u] has a face without indices", empty_face_mesh);
     if (!L->ai) return asp_fail(L, SY_ERR_PARSE, "Assimp cannot read it: %s", why[0] ? why : "no reason given");
     if (!L->ai->mRootNode) return asp_fail(L, SY_ERR_PARSE, "Assimp read no scene (no root node)");
     if (L->ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE) /* no meshes (cameras, lights or animations only): loaded as it is */

@@ -18,9 +18,7 @@
  * the file has none, crease angle 80 degrees), JoinIdenticalVertices, SortByPType (one primitive
  * type per mesh), FindInvalidData, TransformUVCoords, FlipUVs (texture v down, the scene's
  * convention) and ValidateDataStructure, then FindDegenerates (degenerate triangles removed) as a
- * separate pass (with the others it crashes Assimp 5.2 on some malformed files). The file is read
- * and validated first, and each mesh's primitive types are recomputed from its faces before any
- * step trusts them (a face without indices is refused: Triangulate aborts the process on it).
+ * second pass (in the first it crashes Assimp 5.2 on some malformed files).
  * Normal-mapped primitives get generated tangents (sy_mesh_util.h, as glTF's).
  *
  * Materials (documented rule, docs/FORMATS.md): Assimp's PBR properties (base colour, metallic,
