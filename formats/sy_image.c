@@ -2,6 +2,8 @@
  * sy_image.h). */
 #include "sy_image.h"
 
+#include "sy_sniff.h"
+
 #include <stb_image.h>
 
 #include <limits.h>
@@ -15,6 +17,12 @@ sy_result sy_image_decode(const void *data, size_t size, uint64_t max_pixels, sy
     int w = 0, h = 0, comp = 0;
     if (!data || size == 0) return sy_error_set(err, SY_ERR_PARSE, "cannot decode (no data)");
     if (size > INT_MAX) return sy_error_set(err, SY_ERR_LIMIT, "cannot decode (%zu bytes, larger than 2 GiB)", size);
+    /* content the sniffer knows that is no 8-bit texture (Radiance HDR above all: Debian's
+     * stb_image loops for ever on a truncated run-length file) never reaches stb_image */
+    sy_file_format kind = sy_sniff_bytes(data, size);
+    if (kind != SY_FORMAT_UNKNOWN && !sy_file_format_is_texture_image(kind, true))
+        return sy_error_set(err, SY_ERR_PARSE, "%s content, not a texture image (PNG, JPEG, GIF, BMP, TGA)",
+                            sy_file_format_name(kind));
     if (!stbi_info_from_memory(data, (int)size, &w, &h, &comp) || w < 1 || h < 1 || comp < 1 || comp > 4) {
         const char *why = stbi_failure_reason();
         return sy_error_set(err, SY_ERR_PARSE, "cannot decode (%s)", why ? why : "not an image");

@@ -1,6 +1,8 @@
 /** @file
- * sy_image.h — decoding an encoded texture image (PNG, JPEG, TGA, BMP, PSD, GIF, HDR, PIC, PNM: what
- * stb_image reads) from memory into 8-bit pixels, within a pixel limit and the load's budget
+ * sy_image.h — decoding an encoded texture image (PNG, JPEG, GIF, and the formats without a
+ * signature the sniffer knows: TGA, BMP, PSD, PIC, PNM; what stb_image reads) from memory into
+ * 8-bit pixels; content sy_sniff identifies as something else (Radiance HDR, EXR, a scene) is refused
+ * before stb_image sees it, within a pixel limit and the load's budget
  * (sy_budget.h), both checked from the image's header before anything is decoded. Used by the
  * loaders that decode their own textures (X3D ImageTexture, the Assimp formats' external and
  * embedded textures).
