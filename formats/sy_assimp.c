@@ -97,6 +97,15 @@ static const char *meta_string(const struct aiMetadata *md, const char *key)
     return NULL;
 }
 
+/* false (the mesh in *bad) when a face of the scene has no vertex index. */
+static bool faces_have_indices(const struct aiScene *s, unsigned *bad)
+{
+    for (unsigned i = 0; i < s->mNumMeshes; ++i)
+        for (unsigned f = 0; f < s->mMeshes[i]->mNumFaces; ++f)
+            if (s->mMeshes[i]->mFaces[f].mNumIndices == 0 || !s->mMeshes[i]->mFaces[f].mIndices) return *bad = i, false;
+    return true;
+}
+
 /* Assimp reads the model (under the lock); L->ai on success, Assimp's reason on failure. */
 static sy_result import(asp_loader *L)
 {
@@ -108,14 +117,22 @@ static sy_result import(asp_loader *L)
     aiSetImportPropertyInteger(ps, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
     pthread_mutex_lock(&g_assimp_lock);
     asp_log_attach(L);
-    L->ai = aiImportFileExWithProperties(L->main_name, SY_ASSIMP_STEPS, &io, ps);
-    if (L->ai) L->ai = aiApplyPostProcessing(L->ai, aiProcess_FindDegenerates); /* NULL: Assimp released it */
+    /* Triangulate and SortByPType trust each face to have indices (Triangulate fails an assertion and
+     * aborts the process on a PLY face list of count 0, which ValidateDataStructure lets through): they
+     * run as a second pass once every face is checked; FindDegenerates as a third (see above) */
+    const unsigned later = aiProcess_Triangulate | aiProcess_SortByPType;
+    L->ai = aiImportFileExWithProperties(L->main_name, SY_ASSIMP_STEPS & ~later, &io, ps);
+    unsigned empty_mesh = 0;
+    bool empty = L->ai && !faces_have_indices(L->ai, &empty_mesh);
+    if (L->ai && !empty) L->ai = aiApplyPostProcessing(L->ai, later); /* NULL: Assimp released it */
+    if (L->ai && !empty) L->ai = aiApplyPostProcessing(L->ai, aiProcess_FindDegenerates);
     char why[SY_ERROR_MESSAGE_MAX];
     snprintf(why, sizeof why, "%s", L->ai ? "" : aiGetErrorString());
     asp_log_detach();
     pthread_mutex_unlock(&g_assimp_lock);
     aiReleasePropertyStore(ps);
     if (L->io_result) return sy_error_set(&L->err, L->io_result, "%s", L->io_message); /* a refused file */
+    if (empty) return asp_fail(L, SY_ERR_PARSE, "meshes[%u] has a face without vertex indices", empty_mesh);
     if (!L->ai) return asp_fail(L, SY_ERR_PARSE, "Assimp cannot read it: %s", why[0] ? why : "no reason given");
     if (!L->ai->mRootNode) return asp_fail(L, SY_ERR_PARSE, "Assimp read no scene (no root node)");
     if (L->ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE) /* no meshes (cameras, lights or animations only): loaded as it is */

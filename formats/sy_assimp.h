@@ -14,11 +14,13 @@
  * per (image, colour role); cameras and punctual lights on child nodes of the nodes Assimp names
  * for them. Every created node has SY_NODE_VISIBLE.
  *
- * Geometry goes through Assimp's own post-processing: Triangulate, GenSmoothNormals (normals where
- * the file has none, crease angle 80 degrees), JoinIdenticalVertices, SortByPType (one primitive
- * type per mesh), FindInvalidData, TransformUVCoords, FlipUVs (texture v down, the scene's
- * convention) and ValidateDataStructure, then FindDegenerates (degenerate triangles removed) as a
- * second pass (in the first it crashes Assimp 5.2 on some malformed files).
+ * Geometry goes through Assimp's own post-processing: GenSmoothNormals (normals where the file has
+ * none, crease angle 80 degrees), JoinIdenticalVertices, FindInvalidData, TransformUVCoords, FlipUVs
+ * (texture v down, the scene's convention) and ValidateDataStructure while reading; Triangulate and
+ * SortByPType (one primitive type per mesh) as a second pass once every face is checked to have
+ * indices (a face without any is refused: Triangulate aborts the process on it); FindDegenerates
+ * (degenerate triangles removed) as a third (with the others it crashes Assimp 5.2 on some
+ * malformed files).
  * Normal-mapped primitives get generated tangents (sy_mesh_util.h, as glTF's).
  *
  * Materials (documented rule, docs/FORMATS.md): Assimp's PBR properties (base colour, metallic,

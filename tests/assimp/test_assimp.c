@@ -3,7 +3,8 @@
  * ASCII and binary STL (a binary header starting with "solid"), a PLY with vertex colours, one
  * from memory; and bad input: a truncated binary STL, a binary STL whose facet count wraps Assimp's
  * 32-bit size check, a PLY declaring 10^12 vertices in a few bytes, a PLY without end_header (Assimp
- * hangs on it), a PLY declaring an element twice (Assimp aborts), an ASCII FBX whose embedded base64 Assimp frees twice, a
+ * hangs on it), a PLY declaring an element twice and one with
+ * faces of no index (Assimp aborts on both), an ASCII FBX whose embedded base64 Assimp frees twice, a
  * COLLADA index list holding a word (Assimp never returns), an OBJ whose MTL and texture
  * lie outside its folder (refused, then admitted by allowed_roots), a file Assimp cannot read.
  * Every error names the file. */
@@ -166,6 +167,15 @@ int main(void)
     EXPECT(write_bytes(p, twice, sizeof twice - 1) == 0);
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "twice.ply") && strstr(e.message, "'vertex' twice"),
                "twice.ply: %s", e.message);
+
+    /* PLY faces of count 0: Assimp 5.2's validation lets them through and Triangulate fails an
+     * assertion on them (abort); refused after reading, before post-processing */
+    PATHF(p, "%s/empty_face.ply", dir);
+    const char empty_face[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                              "element face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0\n0\n";
+    EXPECT(write_bytes(p, empty_face, sizeof empty_face - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "empty_face.ply") && strstr(e.message, "without vertex indices"),
+               "empty_face.ply: %s", e.message);
 
     /* a PLY header whose end_header is broken (Assimp 5.2 loops for ever on it): refused first */
     PATHF(p, "%s/noend.ply", dir);
