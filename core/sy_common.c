@@ -21,6 +21,9 @@ const char *sy_result_str(sy_result r)
     case SY_ERR_NOT_FOUND: return "not found";
     case SY_ERR_BACKEND: return "back-end failure";
     case SY_ERR_PROTOCOL: return "protocol violation";
+    case SY_ERR_INVALID_OPERATION: return "invalid operation";
+    case SY_ERR_CANCELLED: return "cancelled";
+    case SY_ERR_SYSTEM: return "system error";
     default: return "unknown error";
     }
 }

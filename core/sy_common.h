@@ -5,6 +5,9 @@
  * Error convention: every fallible call returns a sy_result (SY_OK == 0) and, when the caller passed
  * a sy_error*, fills it with the code and a human-readable message naming the object / file / place
  * and the reason. The error pointer may be NULL. There is no sticky or global error state.
+ * The back-ends (backends/) cannot include this header; their result enums use the same numbers for
+ * the codes they share, so a mediator turns one into a sy_result with a cast
+ * (mediators/sy_backend_status.h checks the numbers at compile time).
  *
  * Thread-safety: everything here is pure or works on caller-owned memory. */
 #ifndef SY_COMMON_H
@@ -31,6 +34,9 @@ typedef enum sy_result {
     SY_ERR_NOT_FOUND = 8,        /**< named thing (file, camera, back-end) does not exist */
     SY_ERR_BACKEND = 9,          /**< a back-end library reported a failure */
     SY_ERR_PROTOCOL = 10,        /**< network peer violated the protocol */
+    SY_ERR_INVALID_OPERATION = 11, /**< a call out of order (rendering a back-end's uncommitted changes) */
+    SY_ERR_CANCELLED = 12,       /**< a progress callback asked to stop */
+    SY_ERR_SYSTEM = 13,          /**< an operating-system call failed (creating a mutex) */
     SY_RESULT_MAX_ENUM = 0x7fffffff
 } sy_result;
 

@@ -27,10 +27,13 @@
  * publishes them (top-level BVH commit, area-light list rebuild when needed). sy_rt_render() on a
  * device with uncommitted changes fails with SY_RT_ERROR_INVALID_OPERATION.
  *
- * Errors: every fallible call returns a sy_rt_result (SY_RT_OK == 0) and, when err != NULL and
- * err_len > 0, writes a NUL-terminated message naming the object, parameter and reason. There is no
- * sticky or global error state. Embree's own error messages are captured and returned by the call
- * that caused them.
+ * Errors (the convention of every Switchyard back-end): every fallible call returns a sy_rt_result
+ * (SY_RT_OK == 0), numbered like Switchyard's sy_result for every code they share, and reports the
+ * message (naming the object, parameter and reason) once through the device's error callback
+ * (sy_rt_device_desc.error, as Embree's rtcSetDeviceErrorFunction), on the calling thread before
+ * the call returns; sy_rt_device_error() returns the device's last message. Embree's own errors
+ * are captured and reported by the call that caused them. A call given no device (NULL) returns
+ * its code only.
  *
  * Thread-safety: one device may be used by one thread at a time (the API does not lock). Several
  * devices are independent. sy_rt_render() itself runs multithreaded over tiles on the process's
@@ -60,18 +63,19 @@ extern "C" {
 
 /* >>results */
 
-/** Result codes of every fallible sy_rt call. */
+/** Result codes of every fallible sy_rt call: the numbers of Switchyard's sy_result (core/sy_common.h),
+ * which a mediator checks at compile time, so it maps a code with a cast. */
 typedef enum sy_rt_result {
     SY_RT_OK = 0,
-    SY_RT_ERROR_INVALID_ARGUMENT = 1,  /**< a desc or parameter the API does not accept */
-    SY_RT_ERROR_INVALID_HANDLE = 2,    /**< stale, foreign or zero handle */
+    SY_RT_ERROR_INVALID_ARGUMENT = 1,   /**< a desc or parameter the API does not accept */
+    SY_RT_ERROR_INVALID_HANDLE = 2,     /**< stale, foreign or zero handle */
     SY_RT_ERROR_OUT_OF_MEMORY = 3,
-    SY_RT_ERROR_LIMIT = 4,             /**< a count or size would overflow or exceeds a pool limit */
-    SY_RT_ERROR_EMBREE = 5,            /**< Embree reported an error (message included) */
-    SY_RT_ERROR_UNSUPPORTED = 6,       /**< well-formed request this back-end does not implement */
-    SY_RT_ERROR_INVALID_OPERATION = 7, /**< e.g. rendering with uncommitted changes */
-    SY_RT_ERROR_CANCELLED = 8,         /**< the progress callback asked to stop */
-    SY_RT_ERROR_SYSTEM = 9,            /**< an OS call (creating a mutex) failed */
+    SY_RT_ERROR_UNSUPPORTED = 6,        /**< well-formed request this back-end does not implement */
+    SY_RT_ERROR_LIMIT = 7,              /**< a count or size would overflow or exceeds a pool limit */
+    SY_RT_ERROR_EMBREE = 9,             /**< Embree reported an error (message included) */
+    SY_RT_ERROR_INVALID_OPERATION = 11, /**< e.g. rendering with uncommitted changes */
+    SY_RT_ERROR_CANCELLED = 12,         /**< the progress callback asked to stop */
+    SY_RT_ERROR_SYSTEM = 13,            /**< an OS call (creating a mutex) failed */
     SY_RT_RESULT_MAX_ENUM = 0x7fffffff
 } sy_rt_result;
 
@@ -95,6 +99,10 @@ typedef struct sy_rt_light { uint32_t id; /**< index + generation; 0 = none */ }
 
 /* >>device */
 
+/** Receives the message of a failed call (no trailing newline; valid during the call only), on the
+ * thread that made the call, before the call returns with code. */
+typedef void (*sy_rt_error_fn)(void *user, sy_rt_result code, const char *message);
+
 /** Device options (sy_rt_device_create). */
 typedef struct sy_rt_device_desc {
     uint32_t thread_count; /**< render and Embree build threads; 0 = the OpenMP default
@@ -104,18 +112,22 @@ typedef struct sy_rt_device_desc {
                                 * Either way a mesh whose BVH would not fit in what is left (or in
                                 * the machine's available memory) is refused before it is built,
                                 * with the size needed and the size available. */
+    sy_rt_error_fn error; /**< every failure of a call on this device (also sy_rt_device_create's); NULL = none */
+    void *error_user;     /**< passed to error */
 } sy_rt_device_desc;
 
 /** Creates a device. desc may be NULL (defaults). Ownership: *out belongs to the caller, who
  * releases it with sy_rt_device_destroy (which destroys every object it still holds). */
-sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **out,
-                                 char *err, size_t err_len);
+sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **out);
 /** Destroys the device and all its objects. NULL is a no-op. */
 void sy_rt_device_destroy(sy_rt_device *dev);
+/** The message of the last failed call on dev ("" when none failed yet): the error callback's
+ * text. Borrowed, valid until the next call on dev. */
+const char *sy_rt_device_error(const sy_rt_device *dev);
 
 /** Publishes all staged changes (BLAS/TLAS commits, area-light list when instances or materials
  * changed). Must be called before sy_rt_render after any change. */
-sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len);
+sy_rt_result sy_rt_commit(sy_rt_device *dev);
 
 /** Live object counts, for leak diagnostics and tests. */
 typedef struct sy_rt_stats {
@@ -167,10 +179,9 @@ typedef struct sy_rt_mesh_desc {
 
 /** Creates a mesh from desc (arrays copied or shared, see sy_rt_mesh_desc). Its BLAS is built when
  * its first instance that is not SY_RT_INSTANCE_BAKED is created. */
-sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *desc, sy_rt_mesh *out,
-                               char *err, size_t err_len);
+sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *desc, sy_rt_mesh *out);
 /** Invalidates the handle; the data is freed once no instance uses it any more. */
-sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh, char *err, size_t err_len);
+sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh);
 
 /* >>texture */
 
@@ -211,9 +222,9 @@ typedef struct sy_rt_texture_desc {
 
 /** Creates a texture from desc (pixels copied). */
 sy_rt_result sy_rt_texture_create(sy_rt_device *dev, const sy_rt_texture_desc *desc,
-                                  sy_rt_texture *out, char *err, size_t err_len);
+                                  sy_rt_texture *out);
 /** Destroys a texture; references to it become stale (ignored at render time). */
-sy_rt_result sy_rt_texture_destroy(sy_rt_device *dev, sy_rt_texture tex, char *err, size_t err_len);
+sy_rt_result sy_rt_texture_destroy(sy_rt_device *dev, sy_rt_texture tex);
 
 /* >>material */
 
@@ -261,12 +272,12 @@ typedef struct sy_rt_material_desc {
 void sy_rt_material_desc_init(sy_rt_material_desc *desc);
 /** Creates a material from desc. */
 sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc *desc,
-                                   sy_rt_material *out, char *err, size_t err_len);
+                                   sy_rt_material *out);
 /** Replaces every field of a material with desc. */
 sy_rt_result sy_rt_material_update(sy_rt_device *dev, sy_rt_material mat,
-                                   const sy_rt_material_desc *desc, char *err, size_t err_len);
+                                   const sy_rt_material_desc *desc);
 /** Destroys a material; instances using it render with the default material. */
-sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat, char *err, size_t err_len);
+sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat);
 
 /* >>instance */
 
@@ -302,18 +313,17 @@ typedef struct sy_rt_instance_desc {
 
 /** Creates an instance from desc. */
 sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc *desc,
-                                   sy_rt_instance *out, char *err, size_t err_len);
+                                   sy_rt_instance *out);
 /** Cheap for non-baked instances (rtcSetGeometryTransform + top-level recommit, no BLAS rebuild). */
 sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst,
-                                          const float transform[16], char *err, size_t err_len);
+                                          const float transform[16]);
 /** Changes an instance's material (zero/stale = default). */
 sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst,
-                                         sy_rt_material material, char *err, size_t err_len);
+                                         sy_rt_material material);
 /** Shows or hides an instance (hidden: not rendered, casts no shadows, no area light). */
-sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, bool visible,
-                                        char *err, size_t err_len);
+sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, bool visible);
 /** Destroys an instance. */
-sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst, char *err, size_t err_len);
+sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst);
 
 /* >>light */
 
@@ -341,13 +351,11 @@ typedef struct sy_rt_light_desc {
 } sy_rt_light_desc;
 
 /** Creates a punctual light from desc. */
-sy_rt_result sy_rt_light_create(sy_rt_device *dev, const sy_rt_light_desc *desc, sy_rt_light *out,
-                                char *err, size_t err_len);
+sy_rt_result sy_rt_light_create(sy_rt_device *dev, const sy_rt_light_desc *desc, sy_rt_light *out);
 /** Replaces every field of a light with desc. */
-sy_rt_result sy_rt_light_update(sy_rt_device *dev, sy_rt_light light, const sy_rt_light_desc *desc,
-                                char *err, size_t err_len);
+sy_rt_result sy_rt_light_update(sy_rt_device *dev, sy_rt_light light, const sy_rt_light_desc *desc);
 /** Destroys a light. */
-sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light, char *err, size_t err_len);
+sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light);
 
 /* >>background and environment
  *
@@ -376,8 +384,7 @@ typedef struct sy_rt_background {
 } sy_rt_background;
 
 /** Default: SY_RT_BACKGROUND_NONE. Takes effect at the next commit. */
-sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg, char *err,
-                                  size_t err_len);
+sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg);
 
 /** Environment light: an equirectangular (latitude-longitude) texture times intensity, seen by every
  * ray but camera rays when it leaves the scene. Direction d (unit, world) maps to
@@ -389,8 +396,7 @@ sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg,
  * environment (escaping rays see black). The texture must stay alive while it is set (a destroyed
  * texture renders as no environment). intensity must be finite and >= 0. Takes effect at the next
  * commit. */
-sy_rt_result sy_rt_set_environment(sy_rt_device *dev, sy_rt_texture texture, float intensity, char *err,
-                                   size_t err_len);
+sy_rt_result sy_rt_set_environment(sy_rt_device *dev, sy_rt_texture texture, float intensity);
 
 /* >>render */
 
@@ -484,8 +490,7 @@ typedef struct sy_rt_render_desc {
  * transmission x (1 - F0) per crossing: straight-line, refraction and angular Fresnel ignored);
  * emission adds to the reflected light; recursive perfect mirror reflection and Fresnel refraction. */
 sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera,
-                          const sy_rt_render_desc *desc, float *rgba, float *depth, char *err,
-                          size_t err_len);
+                          const sy_rt_render_desc *desc, float *rgba, float *depth);
 
 /* >>progressive accumulation (PATHTRACER)
  *
@@ -505,8 +510,9 @@ sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera,
  *
  * Ownership: the caller owns the accum; it is not tied to a device. Thread-safety: an accum is used
  * by one render call at a time. */
-/** Creates an accumulation for a width x height rectangle (0 samples). */
-sy_rt_result sy_rt_accum_create(uint32_t width, uint32_t height, sy_rt_accum **out, char *err, size_t err_len);
+/** Creates an accumulation for a width x height rectangle (0 samples). dev (may be NULL) only receives
+ * the error report; the accum is not tied to it. */
+sy_rt_result sy_rt_accum_create(sy_rt_device *dev, uint32_t width, uint32_t height, sy_rt_accum **out);
 void sy_rt_accum_destroy(sy_rt_accum *accum); /**< NULL is a no-op */
 void sy_rt_accum_reset(sy_rt_accum *accum);   /**< back to 0 samples */
 /** Samples per pixel accumulated since the last reset. */
@@ -533,8 +539,9 @@ typedef enum sy_rt_aov {
 } sy_rt_aov;
 uint32_t sy_rt_aov_channels(sy_rt_aov aov); /**< 0 for an unknown value */
 const char *sy_rt_aov_name(sy_rt_aov aov);  /**< "color", "variance", ... ; NULL if unknown */
-/** Copies one feature buffer into out (width * height * channels floats, interleaved). */
-sy_rt_result sy_rt_accum_read(const sy_rt_accum *accum, sy_rt_aov aov, float *out, char *err, size_t err_len);
+/** Copies one feature buffer into out (width * height * channels floats, interleaved). dev (may be
+ * NULL) only receives the error report. */
+sy_rt_result sy_rt_accum_read(sy_rt_device *dev, const sy_rt_accum *accum, sy_rt_aov aov, float *out);
 
 /* >>path records (PATHTRACER): the stored-sample hook of radiance filtering
  *
@@ -596,7 +603,7 @@ void sy_rt_pt_record_bsdf_batch(const sy_rt_pt_record *record, uint32_t count, c
  * as are max_depth, area_light_samples and seed. Deterministic and tile-stitchable. */
 /** Fills ids (and depth, if not NULL) with the nearest visible instance per pixel centre. */
 sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
-                            uint32_t *ids, float *depth, char *err, size_t err_len);
+                            uint32_t *ids, float *depth);
 
 #ifdef __cplusplus
 }

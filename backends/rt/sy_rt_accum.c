@@ -4,9 +4,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define FAIL(r, ...) sy_rt_fail(err, err_len, (r), __VA_ARGS__)
+#define FAIL(r, ...) sy_rt_fail(dev, (r), __VA_ARGS__)
 
-sy_rt_result sy_rt_accum_create(uint32_t width, uint32_t height, sy_rt_accum **out, char *err, size_t err_len)
+sy_rt_result sy_rt_accum_create(sy_rt_device *dev, uint32_t width, uint32_t height, sy_rt_accum **out)
 {
     if (!out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "accum create: out is NULL");
     *out = NULL;
@@ -113,7 +113,7 @@ const char *sy_rt_aov_name(sy_rt_aov aov)
     return (unsigned)aov < SY_RT_AOV_COUNT ? names[aov] : NULL;
 }
 
-sy_rt_result sy_rt_accum_read(const sy_rt_accum *a, sy_rt_aov aov, float *out, char *err, size_t err_len)
+sy_rt_result sy_rt_accum_read(sy_rt_device *dev, const sy_rt_accum *a, sy_rt_aov aov, float *out)
 {
     if (!a || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "accum read: NULL argument");
     uint32_t ch = sy_rt_aov_channels(aov);

@@ -1,5 +1,5 @@
 /* sy_rt_base.c — the base every module of the ray-tracing back-end builds on: index + generation
- * handle pools, the error helper and the capture of Embree's errors (see sy_rt_base.h). Calls no
+ * handle pools, the error report and the capture of Embree's errors (see sy_rt_base.h). Calls no
  * other rt module. */
 #include "sy_rt_device.h"
 
@@ -7,14 +7,24 @@
 #include <stdlib.h>
 #include <string.h>
 
-sy_rt_result sy_rt_fail(char *err, size_t err_len, sy_rt_result r, const char *fmt, ...)
+sy_rt_result sy_rt_failv(sy_rt_error_fn fn, void *user, char *keep, size_t keep_len, sy_rt_result r, const char *fmt,
+                         va_list ap)
 {
-    if (err && err_len > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, err_len, fmt, ap);
-        va_end(ap);
-    }
+    char buf[SY_RT_ERROR_MAX];
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    if (keep && keep_len > 0) snprintf(keep, keep_len, "%s", buf);
+    if (fn) fn(user, r, buf);
+    return r;
+}
+
+sy_rt_result sy_rt_fail(const sy_rt_device *dev, sy_rt_result r, const char *fmt, ...)
+{
+    if (!dev) return r;
+    sy_rt_report *rep = dev->report;
+    va_list ap;
+    va_start(ap, fmt);
+    sy_rt_failv(rep->fn, rep->user, rep->message, sizeof rep->message, r, fmt, ap);
+    va_end(ap);
     return r;
 }
 
@@ -40,12 +50,12 @@ void sy_rt_embree_error_callback(void *user, enum RTCError code, const char *msg
     pthread_mutex_unlock(&dev->rtc_err_lock);
 }
 
-sy_rt_result sy_rt_check_embree(sy_rt_device *dev, char *err, size_t err_len, const char *what)
+sy_rt_result sy_rt_check_embree(sy_rt_device *dev, const char *what)
 {
     enum RTCError code = rtcGetDeviceError(dev->rtc);
     if (code == RTC_ERROR_NONE) return SY_RT_OK;
     pthread_mutex_lock(&dev->rtc_err_lock);
-    sy_rt_result r = sy_rt_fail(err, err_len, SY_RT_ERROR_EMBREE, "%s: embree: %s", what,
+    sy_rt_result r = sy_rt_fail(dev, SY_RT_ERROR_EMBREE, "%s: embree: %s", what,
                                 dev->rtc_msg[0] ? dev->rtc_msg : sy_rt_embree_error_name(code));
     dev->rtc_msg[0] = '\0';
     pthread_mutex_unlock(&dev->rtc_err_lock);

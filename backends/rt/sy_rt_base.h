@@ -1,5 +1,5 @@
 /* sy_rt_base.h — internal to the ray-tracing back-end: the base every rt module builds on (index +
- * generation handle pools, the printf-style error helper, Embree error capture). Defined in
+ * generation handle pools, the error report, Embree error capture). Defined in
  * sy_rt_base.c, which calls no other rt module, so the device, scene, texture and light modules
  * stack on it without calling each other in a loop. Not part of the public API (sy_rt.h). */
 #ifndef SY_RT_BASE_H
@@ -45,15 +45,29 @@ void sy_rt_pool_free(sy_rt_pool *p);
 
 /* >>errors */
 
-/* Writes a printf-style message to err (if non-NULL, err_len > 0) and returns r. */
-sy_rt_result sy_rt_fail(char *err, size_t err_len, sy_rt_result r, const char *fmt, ...)
+#define SY_RT_ERROR_MAX 512 /* bytes of a reported message, NUL included (as core's sy_error) */
+
+/* A device's error report: its callback and the last message. */
+typedef struct sy_rt_report {
+    sy_rt_error_fn fn;
+    void *user;
+    char message[SY_RT_ERROR_MAX];
+} sy_rt_report;
+
+/* Reports a failure: formats the printf-style message into dev's last error and hands it to dev's
+ * error callback (nothing when dev is NULL); returns r. */
+sy_rt_result sy_rt_fail(const sy_rt_device *dev, sy_rt_result r, const char *fmt, ...)
 #if defined(__GNUC__)
-    __attribute__((format(printf, 4, 5)))
+    __attribute__((format(printf, 3, 4)))
 #endif
     ;
-/* Returns SY_RT_OK, or SY_RT_ERROR_EMBREE with "what: <embree message>" when Embree recorded an
- * error since the last check. */
-sy_rt_result sy_rt_check_embree(sy_rt_device *dev, char *err, size_t err_len, const char *what);
+/* The same with a va_list, reporting to callback fn (may be NULL) and keeping the text in keep
+ * (keep_len bytes; may be NULL): sy_rt_device_create before it has a device. */
+sy_rt_result sy_rt_failv(sy_rt_error_fn fn, void *user, char *keep, size_t keep_len, sy_rt_result r, const char *fmt,
+                         va_list ap);
+/* Returns SY_RT_OK, or reports SY_RT_ERROR_EMBREE with "what: embree: <embree message>" when Embree
+ * recorded an error since the last check. */
+sy_rt_result sy_rt_check_embree(sy_rt_device *dev, const char *what);
 
 /* "invalid argument", "out of memory", ... for an Embree error code. */
 const char *sy_rt_embree_error_name(enum RTCError e);

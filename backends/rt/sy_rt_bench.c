@@ -34,33 +34,33 @@ static double now_s(void)
 }
 
 sy_rt_result sy_rt_bench_rays(sy_rt_device *dev, const sy_rt_camera *camera, uint32_t width, uint32_t height,
-                              uint32_t repeats, sy_rt_bench_result *out, char *err, size_t err_len)
+                              uint32_t repeats, sy_rt_bench_result *out)
 {
-    if (!dev || !camera || !out) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "bench: NULL argument");
-    if (repeats == 0) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "bench: repeats must be >= 1");
+    if (!dev || !camera || !out) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "bench: NULL argument");
+    if (repeats == 0) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "bench: repeats must be >= 1");
     if (dev->dirty)
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_OPERATION, "bench: the device has uncommitted changes; call sy_rt_commit first");
+        return sy_rt_fail(dev, SY_RT_ERROR_INVALID_OPERATION, "bench: the device has uncommitted changes; call sy_rt_commit first");
     size_t pixels, bytes;
     if (!sy_rt_size_mul(width, height, &pixels) || !sy_rt_size_mul(pixels, 4u * sizeof(float), &bytes))
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_LIMIT, "bench: %ux%u overflows size_t", width, height);
+        return sy_rt_fail(dev, SY_RT_ERROR_LIMIT, "bench: %ux%u overflows size_t", width, height);
     float *rgba = malloc(bytes ? bytes : 1);
     float *depth = malloc(pixels * sizeof(float) + 1), *raw = malloc(pixels * sizeof(float) + 1);
     if (!rgba || !depth || !raw) {
         free(rgba);
         free(depth);
         free(raw);
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_OUT_OF_MEMORY, "bench: cannot allocate %ux%u buffers", width, height);
+        return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY, "bench: cannot allocate %ux%u buffers", width, height);
     }
     sy_rt_render_desc rd = {.integrator = SY_RT_INTEGRATOR_PRIMARY, .image_width = width, .image_height = height,
                             .width = width, .height = height};
     sy_rt_frame f;
-    sy_rt_result r = sy_rt_frame_init(&f, dev, camera, &rd, rgba, depth, err, err_len);
+    sy_rt_result r = sy_rt_frame_init(&f, dev, camera, &rd, rgba, depth);
     double best_primary = INFINITY, best_raw = INFINITY;
     for (uint32_t i = 0; r == SY_RT_OK && i <= repeats; ++i) { /* i == 0 warms up */
         double t0 = now_s();
-        r = sy_rt_run_tiles(&f, sy_rt_primary_tile, NULL, NULL, NULL, err, err_len);
+        r = sy_rt_run_tiles(&f, sy_rt_primary_tile, NULL, NULL, NULL);
         double t1 = now_s();
-        if (r == SY_RT_OK) r = sy_rt_run_tiles(&f, raw_tile, raw, NULL, NULL, err, err_len);
+        if (r == SY_RT_OK) r = sy_rt_run_tiles(&f, raw_tile, raw, NULL, NULL);
         double t2 = now_s();
         if (i > 0) {
             best_primary = fmin(best_primary, t1 - t0);

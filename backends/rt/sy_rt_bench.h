@@ -21,6 +21,6 @@ typedef struct sy_rt_bench_result {
 /* Renders a width x height frame `repeats` times (>= 1) with each method, alternating, after one
  * warm-up frame each, and reports the best times. The device must be committed. */
 sy_rt_result sy_rt_bench_rays(sy_rt_device *dev, const sy_rt_camera *camera, uint32_t width, uint32_t height,
-                              uint32_t repeats, sy_rt_bench_result *out, char *err, size_t err_len);
+                              uint32_t repeats, sy_rt_bench_result *out);
 
 #endif /* SY_RT_BENCH_H */

@@ -3,7 +3,7 @@
 
 #include <math.h>
 
-#define FAIL(code, ...) sy_rt_fail(err, err_len, code, __VA_ARGS__)
+#define FAIL(code, ...) sy_rt_fail(dev, code, __VA_ARGS__)
 
 void sy_rt_coverage_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
 {
@@ -25,7 +25,7 @@ void sy_rt_coverage_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
 }
 
 sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
-                            uint32_t *ids, float *depth, char *err, size_t err_len)
+                            uint32_t *ids, float *depth)
 {
     if (!dev || !camera || !desc || !ids) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "coverage: NULL argument");
     if (dev->dirty)
@@ -33,7 +33,7 @@ sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const
     sy_rt_render_desc d = *desc;
     d.integrator = SY_RT_INTEGRATOR_COVERAGE;
     sy_rt_frame f;
-    sy_rt_result r = sy_rt_frame_init(&f, dev, camera, &d, NULL, depth, err, err_len);
+    sy_rt_result r = sy_rt_frame_init(&f, dev, camera, &d, NULL, depth);
     if (r != SY_RT_OK) return r;
-    return sy_rt_run_tiles(&f, sy_rt_coverage_tile, ids, desc->progress, desc->progress_user_data, err, err_len);
+    return sy_rt_run_tiles(&f, sy_rt_coverage_tile, ids, desc->progress, desc->progress_user_data);
 }

@@ -48,16 +48,39 @@ static bool embree_memory_monitor(void *user, ssize_t bytes, bool post)
     return true;
 }
 
-sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **out, char *err, size_t err_len)
+/* A failure of sy_rt_device_create before the device exists: reported to the desc's callback. */
+static sy_rt_result create_fail(const sy_rt_device_desc *desc, sy_rt_result r, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static sy_rt_result create_fail(const sy_rt_device_desc *desc, sy_rt_result r, const char *fmt, ...)
 {
-    if (!out) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "device create: out is NULL");
+    va_list ap;
+    va_start(ap, fmt);
+    sy_rt_failv(desc ? desc->error : NULL, desc ? desc->error_user : NULL, NULL, 0, r, fmt, ap);
+    va_end(ap);
+    return r;
+}
+
+const char *sy_rt_device_error(const sy_rt_device *dev)
+{
+    return dev ? dev->report->message : "";
+}
+
+sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **out)
+{
+    if (!out) return create_fail(desc, SY_RT_ERROR_INVALID_ARGUMENT, "device create: out is NULL");
     *out = NULL;
     sy_rt_device *dev = calloc(1, sizeof *dev);
-    if (!dev) return sy_rt_fail(err, err_len, SY_RT_ERROR_OUT_OF_MEMORY, "device create: out of memory");
+    if (!dev) return create_fail(desc, SY_RT_ERROR_OUT_OF_MEMORY, "device create: out of memory");
     if (pthread_mutex_init(&dev->rtc_err_lock, NULL) != 0) {
         free(dev);
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_SYSTEM, "device create: pthread_mutex_init failed");
+        return create_fail(desc, SY_RT_ERROR_SYSTEM, "device create: pthread_mutex_init failed");
     }
+    dev->report = &dev->report_store;
+    dev->report->fn = desc ? desc->error : NULL;
+    dev->report->user = desc ? desc->error_user : NULL;
     uint32_t threads = desc ? desc->thread_count : 0;
     if (threads > 1024) threads = 1024;
     dev->thread_count = threads; /* 0: the OpenMP default team size, looked up per render */
@@ -72,16 +95,16 @@ sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **o
         enum RTCError e = rtcGetDeviceError(NULL);
         pthread_mutex_destroy(&dev->rtc_err_lock);
         free(dev);
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_EMBREE, "device create: rtcNewDevice(\"%s\") failed: %s",
-                          config, sy_rt_embree_error_name(e));
+        return create_fail(desc, SY_RT_ERROR_EMBREE, "device create: rtcNewDevice(\"%s\") failed: %s", config,
+                           sy_rt_embree_error_name(e));
     }
     rtcSetDeviceErrorFunction(dev->rtc, sy_rt_embree_error_callback, dev);
     rtcSetDeviceMemoryMonitorFunction(dev->rtc, embree_memory_monitor, dev);
     dev->top = rtcNewScene(dev->rtc);
     dev->dyn = rtcNewScene(dev->rtc);
-    sy_rt_result r = sy_rt_check_embree(dev, err, err_len, "device create: top-level scenes");
+    sy_rt_result r = sy_rt_check_embree(dev, "device create: top-level scenes");
     if (r == SY_RT_OK && (!dev->top || !dev->dyn))
-        r = sy_rt_fail(err, err_len, SY_RT_ERROR_EMBREE, "device create: rtcNewScene failed");
+        r = sy_rt_fail(dev, SY_RT_ERROR_EMBREE, "device create: rtcNewScene failed");
     if (r != SY_RT_OK) {
         sy_rt_device_destroy(dev);
         return r;
@@ -148,24 +171,24 @@ void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out)
     out->embree_peak_bytes = peak > 0 ? (uint64_t)peak : 0u;
 }
 
-sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg, char *err, size_t err_len)
+sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg)
 {
-    if (!dev || !bg) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "background: NULL argument");
+    if (!dev || !bg) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "background: NULL argument");
     if (bg->mode != SY_RT_BACKGROUND_NONE && bg->mode != SY_RT_BACKGROUND_COLOR && bg->mode != SY_RT_BACKGROUND_TEXTURE)
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "background: unknown mode %d", (int)bg->mode);
+        return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "background: unknown mode %d", (int)bg->mode);
     sy_rt_background b = {.mode = bg->mode};
     if (bg->mode == SY_RT_BACKGROUND_COLOR) {
         for (int k = 0; k < 3; ++k)
             if (!isfinite(bg->color[k]) || bg->color[k] < 0.0f)
-                return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT,
+                return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT,
                                   "background: colour[%d] = %g is not a finite non-negative radiance", k, (double)bg->color[k]);
         memcpy(b.color, bg->color, sizeof b.color);
     } else if (bg->mode == SY_RT_BACKGROUND_TEXTURE) {
         if (!sy_rt_pool_get(&dev->textures, bg->texture.id))
-            return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_HANDLE, "background: texture 0x%08x is not a live texture",
+            return sy_rt_fail(dev, SY_RT_ERROR_INVALID_HANDLE, "background: texture 0x%08x is not a live texture",
                               bg->texture.id);
         if (!isfinite(bg->intensity) || bg->intensity < 0.0f)
-            return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT,
+            return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT,
                               "background: intensity %g is not a finite non-negative number", (double)bg->intensity);
         b.texture = bg->texture;
         b.intensity = bg->intensity;

@@ -114,6 +114,11 @@ struct sy_rt_device {
     /* Embree error callback output; read back by the call that triggered it. */
     pthread_mutex_t rtc_err_lock;
     char rtc_msg[256];
+    /* the error report (sy_rt_device_desc.error and the last message, sy_rt_device_error): reached
+     * through a pointer, so that calls given a const device (rendering) report too; the device is
+     * used by one thread at a time */
+    sy_rt_report report_store;
+    sy_rt_report *report; /* &report_store */
 
     sy_rt_pool meshes, instances, materials, textures, lights;
 

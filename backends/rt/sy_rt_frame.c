@@ -8,10 +8,10 @@
 #include <stdatomic.h>
 #include <string.h>
 
-#define FAIL(r, ...) sy_rt_fail(err, err_len, (r), __VA_ARGS__)
+#define FAIL(r, ...) sy_rt_fail(dev, (r), __VA_ARGS__)
 
 sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_rt_camera *cam,
-                              const sy_rt_render_desc *d, float *rgba, float *depth, char *err, size_t err_len)
+                              const sy_rt_render_desc *d, float *rgba, float *depth)
 {
     memset(f, 0, sizeof *f);
     for (int i = 0; i < 16; ++i)
@@ -127,8 +127,9 @@ void sy_rt_frame_ray_at(const sy_rt_frame *f, float fx, float fy, struct RTCRay 
  * one counter increment per skipped tile). Progress: reported after each finished tile under a
  * per-job lock, so calls are serialised, from whichever team thread finished the tile. */
 sy_rt_result sy_rt_run_tiles(const sy_rt_frame *f, sy_rt_tile_fn fn, void *user, sy_rt_progress_fn progress,
-                             void *progress_user, char *err, size_t err_len)
+                             void *progress_user)
 {
+    const sy_rt_device *dev = f->dev;
     uint64_t tiles_x64 = ((uint64_t)f->width + SY_RT_TILE_SIZE - 1u) / SY_RT_TILE_SIZE;
     uint64_t tiles_y64 = ((uint64_t)f->height + SY_RT_TILE_SIZE - 1u) / SY_RT_TILE_SIZE;
     if (tiles_x64 * tiles_y64 > INT32_MAX)

@@ -25,7 +25,7 @@ typedef struct sy_rt_frame {
 
 /* Validates camera and desc and fills a frame (output pointers included). */
 sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_rt_camera *cam,
-                              const sy_rt_render_desc *desc, float *rgba, float *depth, char *err, size_t err_len);
+                              const sy_rt_render_desc *desc, float *rgba, float *depth);
 
 /* Camera ray through the centre of full-image pixel (px, py). The direction is not normalised:
  * `*axial` receives the viewing-axis distance per unit of t (depth = t * axial), and tnear/tfar
@@ -117,6 +117,6 @@ typedef void (*sy_rt_tile_fn)(const sy_rt_frame *f, void *user, uint32_t x0, uin
  * thread that finished it; returning false skips the tiles not yet started and gives
  * SY_RT_ERROR_CANCELLED once the running ones are done. */
 sy_rt_result sy_rt_run_tiles(const sy_rt_frame *f, sy_rt_tile_fn fn, void *user, sy_rt_progress_fn progress,
-                             void *progress_user, char *err, size_t err_len);
+                             void *progress_user);
 
 #endif /* SY_RT_FRAME_H */

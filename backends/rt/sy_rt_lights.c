@@ -74,15 +74,14 @@ float sy_rt_area_pdf(const sy_rt_device *dev, const sy_rt_instance_data *inst)
 }
 
 /* >>environment */
-sy_rt_result sy_rt_set_environment(sy_rt_device *dev, sy_rt_texture texture, float intensity, char *err,
-                                   size_t err_len)
+sy_rt_result sy_rt_set_environment(sy_rt_device *dev, sy_rt_texture texture, float intensity)
 {
-    if (!dev) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "environment: NULL device");
+    if (!dev) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "environment: NULL device");
     if (!isfinite(intensity) || intensity < 0.0f)
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT,
+        return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT,
                           "environment: intensity %g is not a finite non-negative number", (double)intensity);
     if (texture.id && !sy_rt_pool_get(&dev->textures, texture.id))
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_HANDLE, "environment: texture %u is not a live texture",
+        return sy_rt_fail(dev, SY_RT_ERROR_INVALID_HANDLE, "environment: texture %u is not a live texture",
                           texture.id);
     dev->env_texture_staged = texture;
     dev->env_intensity_staged = intensity;
@@ -101,7 +100,7 @@ void sy_rt_env_free(sy_rt_device *dev)
     dev->env_dist = NULL;
 }
 
-sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev, char *err, size_t err_len)
+sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev)
 {
     sy_rt_env_free(dev);
     dev->env_texture = dev->env_texture_staged;
@@ -123,7 +122,7 @@ sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev, char *err, size_t err_len)
         free(lum);
         dev->env_dist = d;
         sy_rt_env_free(dev);
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_OUT_OF_MEMORY, "commit: environment %ux%u: out of memory", w, h);
+        return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY, "commit: environment %ux%u: out of memory", w, h);
     }
     for (uint32_t y = 0; y < h; ++y)
         for (uint32_t x = 0; x < w; ++x) {
@@ -140,7 +139,7 @@ sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev, char *err, size_t err_len)
         free(lum);
         dev->env_dist = d;
         sy_rt_env_free(dev);
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_OUT_OF_MEMORY, "commit: environment: out of memory");
+        return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY, "commit: environment: out of memory");
     }
     double lsum = 0.0;
     for (size_t i = 0; i < n; ++i) lsum += lum[i];

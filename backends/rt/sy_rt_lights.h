@@ -24,7 +24,7 @@ bool sy_rt_alias_build(sy_rt_device *dev, const double *weights, uint32_t n);
 uint32_t sy_rt_alias_pick(const sy_rt_device *dev, float u);
 
 /* Rebuilds dev->env_dist for the committed environment (NULL when there is none). */
-sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev, char *err, size_t err_len);
+sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev);
 void sy_rt_env_free(sy_rt_device *dev);
 
 /* Environment light as seen by the integrators. mode: 0 none (escaping rays see black), 2 texture

@@ -9,7 +9,7 @@
 #include <string.h>
 #include <time.h>
 
-#define FAIL(r, ...) sy_rt_fail(err, err_len, (r), __VA_ARGS__)
+#define FAIL(r, ...) sy_rt_fail(dev, (r), __VA_ARGS__)
 
 /* Rays per unit of work handed to a thread (and per rtcIntersect1M call): a multiple of 16. */
 #define RUN 64u
@@ -131,7 +131,7 @@ static void *prepare(const sy_rt_ray_buf *b, sy_rt_ray_form form, bool hits, siz
 }
 
 sy_rt_result sy_rt_ray_replay_create(const sy_rt_device *dev, const sy_rt_ray_log *log, sy_rt_ray_form form,
-                                     sy_rt_ray_replay **out, char *err, size_t err_len)
+                                     sy_rt_ray_replay **out)
 {
     if (!dev || !log || !out || (unsigned)form >= SY_RT_FORM_COUNT)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "ray replay: NULL argument or unknown form");
@@ -289,7 +289,7 @@ static void spread(double *v, uint32_t n, double out[3])
 }
 
 sy_rt_result sy_rt_bench_limit(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
-                               uint32_t repeats, sy_rt_limit_result *out, char *err, size_t err_len)
+                               uint32_t repeats, sy_rt_limit_result *out)
 {
     if (!dev || !camera || !desc || !out || !desc->accum)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "bench limit: NULL argument (a PATHTRACER desc with an accum is needed)");
@@ -304,12 +304,12 @@ sy_rt_result sy_rt_bench_limit(sy_rt_device *dev, const sy_rt_camera *camera, co
     sy_rt_ray_log *log = NULL;
     sy_rt_ray_replay *rp[SY_RT_FORM_COUNT] = {0};
     double *t = calloc((size_t)repeats * (2u * SY_RT_FORM_COUNT + 1u), sizeof *t);
-    sy_rt_result r = t ? sy_rt_ray_log_create(&log, err, err_len) : FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "bench limit: out of memory");
+    sy_rt_result r = t ? sy_rt_ray_log_create(dev, &log) : FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "bench limit: out of memory");
     /* the logged frame (also the warm-up) */
     if (r == SY_RT_OK) {
         d.ray_log = log;
         sy_rt_accum_reset(d.accum);
-        r = sy_rt_render(dev, camera, &d, NULL, NULL, err, err_len);
+        r = sy_rt_render(dev, camera, &d, NULL, NULL);
         d.ray_log = NULL;
     }
     if (r == SY_RT_OK && (log->intersect.failed || log->occluded.failed))
@@ -321,7 +321,7 @@ sy_rt_result sy_rt_bench_limit(sy_rt_device *dev, const sy_rt_camera *camera, co
                      (unsigned long long)out->rays, (unsigned long long)sy_rt_accum_last_rays(d.accum));
     }
     for (int f = 0; r == SY_RT_OK && f < SY_RT_FORM_COUNT; ++f) {
-        r = sy_rt_ray_replay_create(dev, log, (sy_rt_ray_form)f, &rp[f], err, err_len);
+        r = sy_rt_ray_replay_create(dev, log, (sy_rt_ray_form)f, &rp[f]);
         if (r == SY_RT_OK) sy_rt_ray_replay_run(rp[f], &out->mismatches[f]); /* checked, also the warm-up */
         out->native[f] = sy_rt_ray_form_native(dev, (sy_rt_ray_form)f);
     }
@@ -329,7 +329,7 @@ sy_rt_result sy_rt_bench_limit(sy_rt_device *dev, const sy_rt_camera *camera, co
     for (uint32_t i = 0; r == SY_RT_OK && i < repeats; ++i) {
         sy_rt_accum_reset(d.accum);
         double t0 = now_s();
-        r = sy_rt_render(dev, camera, &d, NULL, NULL, err, err_len);
+        r = sy_rt_render(dev, camera, &d, NULL, NULL);
         t[i] = now_s() - t0;
         for (int f = 0; r == SY_RT_OK && f < SY_RT_FORM_COUNT; ++f)
             t[(size_t)(f + 1) * repeats + i] = sy_rt_ray_replay_run(rp[f], NULL);

@@ -29,7 +29,7 @@ bool sy_rt_ray_form_native(const sy_rt_device *dev, sy_rt_ray_form form);
 /* Prepared rays of one form (the packets built before timing, so the replay times Embree alone). */
 typedef struct sy_rt_ray_replay sy_rt_ray_replay;
 sy_rt_result sy_rt_ray_replay_create(const sy_rt_device *dev, const sy_rt_ray_log *log, sy_rt_ray_form form,
-                                     sy_rt_ray_replay **out, char *err, size_t err_len);
+                                     sy_rt_ray_replay **out);
 void sy_rt_ray_replay_destroy(sy_rt_ray_replay *rp); /* NULL is a no-op */
 /* Traces every ray of the log once in the prepared form on sy_rt_render_threads(dev) threads
  * (OpenMP, dynamic chunks, in log order within a chunk) and returns the wall time. When mismatches
@@ -53,6 +53,6 @@ typedef struct sy_rt_limit_result {
 /* desc: a PATHTRACER desc (its accum, samples, max_depth, seed, rectangle; ray_log and progress
  * are ignored); the accum is reset before every frame. The device must be committed. */
 sy_rt_result sy_rt_bench_limit(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
-                               uint32_t repeats, sy_rt_limit_result *out, char *err, size_t err_len);
+                               uint32_t repeats, sy_rt_limit_result *out);
 
 #endif /* SY_RT_LIMIT_H */

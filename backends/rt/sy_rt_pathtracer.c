@@ -364,16 +364,17 @@ static void pt_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, 
     }
 }
 
-sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_desc *desc, char *err, size_t err_len)
+sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_desc *desc)
 {
+    const sy_rt_device *dev = f->dev;
     sy_rt_accum *acc = desc->accum;
-    if (!acc) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "render: the path tracer needs an accum");
+    if (!acc) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "render: the path tracer needs an accum");
     if (acc->width != f->width || acc->height != f->height)
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT,
+        return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT,
                           "render: accum is %ux%u but the rectangle is %ux%u", acc->width, acc->height, f->width, f->height);
     uint32_t count = desc->samples ? desc->samples : 1u;
     if (count > UINT32_MAX - 1u - acc->samples)
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_LIMIT, "render: %u + %u samples per pixel overflow", acc->samples, count);
+        return sy_rt_fail(dev, SY_RT_ERROR_LIMIT, "render: %u + %u samples per pixel overflow", acc->samples, count);
     pt_job j;
     memset(&j, 0, sizeof j);
     j.acc = acc;
@@ -388,7 +389,7 @@ sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_de
     j.has_punctual = f->dev->punctual_count > 0;
     j.categories = (uint32_t)j.has_area + (uint32_t)j.has_env + (uint32_t)j.has_punctual;
     atomic_store(&acc->rays, 0u);
-    sy_rt_result r = sy_rt_run_tiles(f, pt_tile, &j, desc->progress, desc->progress_user_data, err, err_len);
+    sy_rt_result r = sy_rt_run_tiles(f, pt_tile, &j, desc->progress, desc->progress_user_data);
     if (r == SY_RT_ERROR_CANCELLED) {
         /* Tiles that ran hold more samples than the others: the accumulation is inconsistent. */
         sy_rt_accum_reset(acc);

@@ -9,6 +9,6 @@
 
 /* Adds desc->samples (0 = 1) samples per pixel of the frame's rectangle to desc->accum, then
  * resolves colour into f->rgba and depth into f->depth when they are non-NULL. */
-sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_desc *desc, char *err, size_t err_len);
+sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_desc *desc);
 
 #endif /* SY_RT_PATHTRACER_H */

@@ -4,10 +4,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define FAIL(r, ...) sy_rt_fail(err, err_len, (r), __VA_ARGS__)
+#define FAIL(r, ...) sy_rt_fail(dev, (r), __VA_ARGS__)
 
 /* >>log */
-sy_rt_result sy_rt_ray_log_create(sy_rt_ray_log **out, char *err, size_t err_len)
+sy_rt_result sy_rt_ray_log_create(sy_rt_device *dev, sy_rt_ray_log **out)
 {
     if (!out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "ray log: NULL argument");
     sy_rt_ray_log *log = calloc(1, sizeof *log);

@@ -46,7 +46,7 @@ struct sy_rt_ray_log {
 };
 typedef struct sy_rt_ray_log sy_rt_ray_log;
 
-sy_rt_result sy_rt_ray_log_create(sy_rt_ray_log **out, char *err, size_t err_len);
+sy_rt_result sy_rt_ray_log_create(sy_rt_device *dev, sy_rt_ray_log **out); /* dev (may be NULL) receives the error report */
 void sy_rt_ray_log_destroy(sy_rt_ray_log *log); /* NULL is a no-op */
 void sy_rt_ray_log_clear(sy_rt_ray_log *log);   /* back to no rays (keeps the memory) */
 

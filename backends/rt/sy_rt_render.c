@@ -6,24 +6,24 @@
 #include "sy_rt_primary.h"
 #include "sy_rt_whitted.h"
 
-#define FAIL(r, ...) sy_rt_fail(err, err_len, (r), __VA_ARGS__)
+#define FAIL(r, ...) sy_rt_fail(dev, (r), __VA_ARGS__)
 
 sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc, float *rgba,
-                          float *depth, char *err, size_t err_len)
+                          float *depth)
 {
     if (!dev || !camera || !desc) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: NULL argument");
     if (dev->dirty)
         return FAIL(SY_RT_ERROR_INVALID_OPERATION, "render: the device has uncommitted changes; call sy_rt_commit first");
     sy_rt_frame f;
-    sy_rt_result r = sy_rt_frame_init(&f, dev, camera, desc, rgba, depth, err, err_len);
+    sy_rt_result r = sy_rt_frame_init(&f, dev, camera, desc, rgba, depth);
     if (r != SY_RT_OK) return r;
     if (desc->records && desc->integrator != SY_RT_INTEGRATOR_PATHTRACER)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: path records need the PATHTRACER integrator");
     if (desc->ray_log && desc->integrator != SY_RT_INTEGRATOR_PATHTRACER)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: a ray log needs the PATHTRACER integrator");
-    if (desc->integrator == SY_RT_INTEGRATOR_PATHTRACER) return sy_rt_pathtracer_render(&f, desc, err, err_len);
+    if (desc->integrator == SY_RT_INTEGRATOR_PATHTRACER) return sy_rt_pathtracer_render(&f, desc);
     if (desc->integrator == SY_RT_INTEGRATOR_COVERAGE)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: the coverage integrator writes ids: use sy_rt_coverage");
-    if (desc->integrator == SY_RT_INTEGRATOR_WHITTED) return sy_rt_whitted_render(&f, desc, err, err_len);
-    return sy_rt_run_tiles(&f, sy_rt_primary_tile, NULL, desc->progress, desc->progress_user_data, err, err_len);
+    if (desc->integrator == SY_RT_INTEGRATOR_WHITTED) return sy_rt_whitted_render(&f, desc);
+    return sy_rt_run_tiles(&f, sy_rt_primary_tile, NULL, desc->progress, desc->progress_user_data);
 }

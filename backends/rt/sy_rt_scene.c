@@ -12,7 +12,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#define FAIL(r, ...) sy_rt_fail(err, err_len, (r), __VA_ARGS__)
+#define FAIL(r, ...) sy_rt_fail(dev, (r), __VA_ARGS__)
 
 /* >>mesh */
 
@@ -64,8 +64,7 @@ static void mesh_unref(sy_rt_device *dev, sy_rt_mesh_data *m)
 
 /* Checks n floats for non-finite values, then copies them (m->own_bytes) or, for a shared mesh,
  * points at them (m->shared_bytes). */
-static sy_rt_result take_finite(sy_rt_mesh_data *m, const float *src, size_t n, const float **dst, const char *what,
-                                char *err, size_t err_len)
+static sy_rt_result take_finite(const sy_rt_device *dev, sy_rt_mesh_data *m, const float *src, size_t n, const float **dst, const char *what)
 {
     for (size_t i = 0; i < n; ++i)
         if (!isfinite(src[i]))
@@ -86,7 +85,7 @@ static sy_rt_result take_finite(sy_rt_mesh_data *m, const float *src, size_t n, 
 }
 
 /* All structural checks of a mesh desc, before anything is allocated. */
-static sy_rt_result validate_mesh_desc(const sy_rt_mesh_desc *d, char *err, size_t err_len)
+static sy_rt_result validate_mesh_desc(const sy_rt_device *dev, const sy_rt_mesh_desc *d)
 {
     if (!d->positions) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: positions is NULL");
     if (d->vertex_count == 0 || d->triangle_count == 0)
@@ -113,11 +112,11 @@ static sy_rt_result validate_mesh_desc(const sy_rt_mesh_desc *d, char *err, size
     return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *d, sy_rt_mesh *out, char *err, size_t err_len)
+sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *d, sy_rt_mesh *out)
 {
     if (!dev || !d || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh: NULL argument");
     out->id = 0;
-    sy_rt_result r = validate_mesh_desc(d, err, err_len);
+    sy_rt_result r = validate_mesh_desc(dev, d);
     if (r != SY_RT_OK) return r;
 
     sy_rt_mesh_data *m = calloc(1, sizeof *m);
@@ -128,13 +127,13 @@ sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *d, sy_r
     for (size_t i = 0; i < (size_t)d->vertex_count * 3u; ++i) m->extent = fmaxf(m->extent, fabsf(d->positions[i]));
     m->triangle_count = d->triangle_count;
     size_t vc = d->vertex_count, corners = (size_t)d->triangle_count * 3u;
-    if (d->normals && (r = take_finite(m, d->normals, vc * 3u, &m->normals, "normals", err, err_len)) != SY_RT_OK) goto fail;
-    if (d->uv[0] && (r = take_finite(m, d->uv[0], vc * 2u, &m->uv[0], "uv[0]", err, err_len)) != SY_RT_OK) goto fail;
-    if (d->uv[1] && (r = take_finite(m, d->uv[1], vc * 2u, &m->uv[1], "uv[1]", err, err_len)) != SY_RT_OK) goto fail;
-    if (d->colors && (r = take_finite(m, d->colors, vc * 4u, &m->colors, "colors", err, err_len)) != SY_RT_OK) goto fail;
+    if (d->normals && (r = take_finite(dev, m, d->normals, vc * 3u, &m->normals, "normals")) != SY_RT_OK) goto fail;
+    if (d->uv[0] && (r = take_finite(dev, m, d->uv[0], vc * 2u, &m->uv[0], "uv[0]")) != SY_RT_OK) goto fail;
+    if (d->uv[1] && (r = take_finite(dev, m, d->uv[1], vc * 2u, &m->uv[1], "uv[1]")) != SY_RT_OK) goto fail;
+    if (d->colors && (r = take_finite(dev, m, d->colors, vc * 4u, &m->colors, "colors")) != SY_RT_OK) goto fail;
 
     m->geom = rtcNewGeometry(dev->rtc, RTC_GEOMETRY_TYPE_TRIANGLE);
-    if (!m->geom) { r = sy_rt_check_embree(dev, err, err_len, "mesh: rtcNewGeometry"); goto fail; }
+    if (!m->geom) { r = sy_rt_check_embree(dev, "mesh: rtcNewGeometry"); goto fail; }
     const float *pos = NULL;
     const uint32_t *idx = NULL;
     if (m->shared) {
@@ -166,7 +165,7 @@ sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *d, sy_r
         idx = ix;
     }
     if (!pos || !idx) {
-        r = sy_rt_check_embree(dev, err, err_len, "mesh: allocating Embree buffers");
+        r = sy_rt_check_embree(dev, "mesh: allocating Embree buffers");
         if (r == SY_RT_OK) r = FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh: allocating Embree buffers failed");
         goto fail;
     }
@@ -174,7 +173,7 @@ sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *d, sy_r
     m->indices = idx;
     rtcSetGeometryUserData(m->geom, dev);
     rtcCommitGeometry(m->geom);
-    if ((r = sy_rt_check_embree(dev, err, err_len, "mesh: creating geometry")) != SY_RT_OK) goto fail;
+    if ((r = sy_rt_check_embree(dev, "mesh: creating geometry")) != SY_RT_OK) goto fail;
     if (!sy_rt_pool_insert(&dev->meshes, m, &out->id)) { r = FAIL(SY_RT_ERROR_LIMIT, "mesh: pool full or out of memory"); goto fail; }
     m->release = d->release;
     m->release_user = d->release_user;
@@ -191,7 +190,7 @@ fail:
 /* The mesh's BLAS, built on first use by an Embree instance (a mesh used only by baked instances
  * never needs one). Large meshes build with a compact layout and medium quality: a high-quality
  * build (spatial splits) of 10^7 triangles needs several times the memory of the finished BVH. */
-static sy_rt_result mesh_blas(sy_rt_device *dev, sy_rt_mesh_data *m, char *err, size_t err_len)
+static sy_rt_result mesh_blas(sy_rt_device *dev, sy_rt_mesh_data *m)
 {
     if (m->scene) return SY_RT_OK;
     bool large = m->triangle_count >= SY_RT_LARGE_MESH_TRIANGLES;
@@ -216,7 +215,7 @@ static sy_rt_result mesh_blas(sy_rt_device *dev, sy_rt_mesh_data *m, char *err, 
         rtcAttachGeometryByID(m->scene, m->geom, 0);
         rtcCommitScene(m->scene);
     }
-    sy_rt_result r = sy_rt_check_embree(dev, err, err_len, "mesh: building BLAS");
+    sy_rt_result r = sy_rt_check_embree(dev, "mesh: building BLAS");
     if (r == SY_RT_OK && !m->scene) r = FAIL(SY_RT_ERROR_EMBREE, "mesh: rtcNewScene failed");
     if (r != SY_RT_OK && dev->max_memory > 0 &&
         (double)atomic_load(&dev->embree_peak) + need > (double)dev->max_memory) /* the monitor refused it */
@@ -230,7 +229,7 @@ static sy_rt_result mesh_blas(sy_rt_device *dev, sy_rt_mesh_data *m, char *err, 
     return r;
 }
 
-sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh, char *err, size_t err_len)
+sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh destroy: NULL device");
     sy_rt_mesh_data *m = sy_rt_pool_remove(&dev->meshes, mesh.id);
@@ -255,7 +254,7 @@ void sy_rt_material_desc_init(sy_rt_material_desc *d)
     d->alpha_cutoff = 0.5f;
 }
 
-static sy_rt_result validate_texref(const sy_rt_device *dev, sy_rt_texture_ref t, const char *name, char *err, size_t err_len)
+static sy_rt_result validate_texref(const sy_rt_device *dev, sy_rt_texture_ref t, const char *name)
 {
     if (t.texture.id != 0 && !sy_rt_pool_get(&dev->textures, t.texture.id))
         return FAIL(SY_RT_ERROR_INVALID_HANDLE, "material: %s handle 0x%08x is stale", name, t.texture.id);
@@ -267,7 +266,7 @@ static sy_rt_result validate_texref(const sy_rt_device *dev, sy_rt_texture_ref t
     return SY_RT_OK;
 }
 
-static sy_rt_result validate_material(const sy_rt_device *dev, const sy_rt_material_desc *d, char *err, size_t err_len)
+static sy_rt_result validate_material(const sy_rt_device *dev, const sy_rt_material_desc *d)
 {
     const struct { const char *name; float v, lo, hi; } ranges[] = {
         {"base_color[0]", d->base_color[0], 0.0f, INFINITY}, {"base_color[1]", d->base_color[1], 0.0f, INFINITY},
@@ -285,10 +284,10 @@ static sy_rt_result validate_material(const sy_rt_device *dev, const sy_rt_mater
     if ((unsigned)d->alpha_mode > SY_RT_ALPHA_BLEND)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material: unknown alpha_mode %d", (int)d->alpha_mode);
     sy_rt_result r;
-    if ((r = validate_texref(dev, d->base_color_texture, "base_color_texture", err, err_len)) != SY_RT_OK) return r;
-    if ((r = validate_texref(dev, d->metallic_roughness_texture, "metallic_roughness_texture", err, err_len)) != SY_RT_OK) return r;
-    if ((r = validate_texref(dev, d->emissive_texture, "emissive_texture", err, err_len)) != SY_RT_OK) return r;
-    return validate_texref(dev, d->normal_texture, "normal_texture", err, err_len);
+    if ((r = validate_texref(dev, d->base_color_texture, "base_color_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->metallic_roughness_texture, "metallic_roughness_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->emissive_texture, "emissive_texture")) != SY_RT_OK) return r;
+    return validate_texref(dev, d->normal_texture, "normal_texture");
 }
 
 static void material_set(sy_rt_material_data *m, const sy_rt_material_desc *d)
@@ -300,11 +299,11 @@ static void material_set(sy_rt_material_data *m, const sy_rt_material_desc *d)
                   d->metallic_roughness_texture.texture.id || d->emissive_texture.texture.id;
 }
 
-sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc *d, sy_rt_material *out, char *err, size_t err_len)
+sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc *d, sy_rt_material *out)
 {
     if (!dev || !d || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material: NULL argument");
     out->id = 0;
-    sy_rt_result r = validate_material(dev, d, err, err_len);
+    sy_rt_result r = validate_material(dev, d);
     if (r != SY_RT_OK) return r;
     sy_rt_material_data *m = calloc(1, sizeof *m);
     if (!m) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "material: out of memory");
@@ -317,12 +316,12 @@ sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc 
     return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_material_update(sy_rt_device *dev, sy_rt_material mat, const sy_rt_material_desc *d, char *err, size_t err_len)
+sy_rt_result sy_rt_material_update(sy_rt_device *dev, sy_rt_material mat, const sy_rt_material_desc *d)
 {
     if (!dev || !d) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material update: NULL argument");
     sy_rt_material_data *m = sy_rt_pool_get(&dev->materials, mat.id);
     if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "material update: stale handle 0x%08x", mat.id);
-    sy_rt_result r = validate_material(dev, d, err, err_len);
+    sy_rt_result r = validate_material(dev, d);
     if (r != SY_RT_OK) return r;
     bool was_emissive = m->emissive, was_masked = m->masked;
     bool emission_changed = memcmp(m->desc.emissive, d->emissive, sizeof d->emissive) != 0 ||
@@ -334,7 +333,7 @@ sy_rt_result sy_rt_material_update(sy_rt_device *dev, sy_rt_material mat, const 
     return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat, char *err, size_t err_len)
+sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material destroy: NULL device");
     sy_rt_material_data *m = sy_rt_pool_remove(&dev->materials, mat.id);
@@ -352,7 +351,7 @@ sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat, char 
 /* Checks that xf is finite and invertible and computes the normal matrix (inverse transpose of
  * the upper 3x3, row-major) and *gain, the row-sum norm of the inverse (how much the inverse
  * magnifies a ray's coordinates). */
-static sy_rt_result normal_matrix(const float *xf, float nrm[9], double *gain, char *err, size_t err_len)
+static sy_rt_result normal_matrix(const sy_rt_device *dev, const float *xf, float nrm[9], double *gain)
 {
     for (int i = 0; i < 16; ++i)
         if (!isfinite(xf[i])) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance: transform[%d] = %g is not finite", i, (double)xf[i]);
@@ -378,7 +377,7 @@ static sy_rt_result normal_matrix(const float *xf, float nrm[9], double *gain, c
 }
 
 /* SY_RT_COORD_MAX for an instance of mesh m placed by xf: its translation and its world extent. */
-static sy_rt_result instance_in_range(const sy_rt_mesh_data *m, const float *xf, char *err, size_t err_len)
+static sy_rt_result instance_in_range(const sy_rt_device *dev, const sy_rt_mesh_data *m, const float *xf)
 {
     double lin = 0.0, t = fmax(fabs(xf[12]), fmax(fabs(xf[13]), fabs(xf[14])));
     for (int r = 0; r < 3; ++r)
@@ -496,13 +495,13 @@ static void apply_top_transform(sy_rt_instance_data *in)
 }
 
 /* Shows a moved instance through its twin in dyn (created on its first move). */
-static sy_rt_result twin_place(sy_rt_device *dev, sy_rt_instance_data *in, char *err, size_t err_len)
+static sy_rt_result twin_place(sy_rt_device *dev, sy_rt_instance_data *in)
 {
     if (!in->twin) {
-        sy_rt_result r = mesh_blas(dev, in->mesh, err, err_len); /* baked meshes have none yet */
+        sy_rt_result r = mesh_blas(dev, in->mesh); /* baked meshes have none yet */
         if (r != SY_RT_OK) return r;
         in->twin = rtcNewGeometry(dev->rtc, RTC_GEOMETRY_TYPE_INSTANCE);
-        if (!in->twin) return sy_rt_check_embree(dev, err, err_len, "commit: twin of a moved instance");
+        if (!in->twin) return sy_rt_check_embree(dev, "commit: twin of a moved instance");
         rtcSetGeometryInstancedScene(in->twin, in->mesh->scene);
         in->twin_id = rtcAttachGeometry(dev->dyn, in->twin);
         dev->dyn_count++;
@@ -510,7 +509,7 @@ static sy_rt_result twin_place(sy_rt_device *dev, sy_rt_instance_data *in, char 
             rtcReleaseGeometry(in->twin);
             in->twin = NULL;
             dev->dyn_count--;
-            return sy_rt_check_embree(dev, err, err_len, "commit: attaching the twin of a moved instance");
+            return sy_rt_check_embree(dev, "commit: attaching the twin of a moved instance");
         }
         if (!id_map_set(&dev->dyn_map, &dev->dyn_map_cap, in->twin_id, in)) {
             twin_drop(dev, in);
@@ -524,12 +523,12 @@ static sy_rt_result twin_place(sy_rt_device *dev, sy_rt_instance_data *in, char 
         dev->stale_count++;
     }
     dev->dyn_dirty = true;
-    return sy_rt_check_embree(dev, err, err_len, "commit: twin of a moved instance");
+    return sy_rt_check_embree(dev, "commit: twin of a moved instance");
 }
 
 /* Commit, moved instances: the fast path (twins) when nothing structural changed and few are
  * stale; otherwise every pending transform goes into the top scene, which is rebuilt. */
-static sy_rt_result commit_moved(sy_rt_device *dev, char *err, size_t err_len)
+static sy_rt_result commit_moved(sy_rt_device *dev)
 {
     if (!dev->top_dirty && dev->pending_count) {
         uint32_t stale = dev->stale_count;
@@ -544,7 +543,7 @@ static sy_rt_result commit_moved(sy_rt_device *dev, char *err, size_t err_len)
         for (uint32_t i = 0; i < dev->pending_count && !dev->top_dirty; ++i) {
             sy_rt_instance_data *in = dev->pending[i];
             if (in->flags & SY_RT_INSTANCE_HIDDEN) continue;
-            sy_rt_result r = twin_place(dev, in, err, err_len);
+            sy_rt_result r = twin_place(dev, in);
             if (r != SY_RT_OK) dev->top_dirty = true; /* the full path still shows it right */
         }
     }
@@ -555,7 +554,7 @@ static sy_rt_result commit_moved(sy_rt_device *dev, char *err, size_t err_len)
             pending_remove(dev, in);
         }
     }
-    return sy_rt_check_embree(dev, err, err_len, "commit: moved instances");
+    return sy_rt_check_embree(dev, "commit: moved instances");
 }
 
 static void instance_free(sy_rt_device *dev, sy_rt_instance_data *in)
@@ -572,7 +571,7 @@ static void instance_free(sy_rt_device *dev, sy_rt_instance_data *in)
     free(in);
 }
 
-sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc *d, sy_rt_instance *out, char *err, size_t err_len)
+sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc *d, sy_rt_instance *out)
 {
     if (!dev || !d || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance: NULL argument");
     out->id = 0;
@@ -584,11 +583,11 @@ sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc 
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance: unknown flags 0x%x", d->flags);
     float nrm[9];
     double gain;
-    sy_rt_result r = normal_matrix(d->transform, nrm, &gain, err, err_len);
-    if (r != SY_RT_OK || (r = instance_in_range(mesh, d->transform, err, err_len)) != SY_RT_OK) return r;
+    sy_rt_result r = normal_matrix(dev, d->transform, nrm, &gain);
+    if (r != SY_RT_OK || (r = instance_in_range(dev, mesh, d->transform)) != SY_RT_OK) return r;
     uint32_t flags = d->flags;
     if (gain > SY_RT_INSTANCE_GAIN_MAX) flags |= SY_RT_INSTANCE_BAKED; /* Embree never sees its inverse */
-    if (!(flags & SY_RT_INSTANCE_BAKED) && (r = mesh_blas(dev, mesh, err, err_len)) != SY_RT_OK) return r;
+    if (!(flags & SY_RT_INSTANCE_BAKED) && (r = mesh_blas(dev, mesh)) != SY_RT_OK) return r;
 
     sy_rt_instance_data *in = calloc(1, sizeof *in);
     if (!in) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance: out of memory");
@@ -623,7 +622,7 @@ sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc 
         rtcCommitGeometry(in->geom);
         in->top_id = rtcAttachGeometry(dev->top, in->geom);
     }
-    if ((r = sy_rt_check_embree(dev, err, err_len, "instance: creating geometry")) != SY_RT_OK) goto fail;
+    if ((r = sy_rt_check_embree(dev, "instance: creating geometry")) != SY_RT_OK) goto fail;
     if (!in->geom || ((flags & SY_RT_INSTANCE_BAKED) && !in->baked_positions) || in->top_id == RTC_INVALID_GEOMETRY_ID) {
         r = FAIL(SY_RT_ERROR_EMBREE, "instance: Embree geometry creation failed");
         goto fail;
@@ -641,15 +640,15 @@ fail:
     return r;
 }
 
-sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst, const float transform[16], char *err, size_t err_len)
+sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst, const float transform[16])
 {
     if (!dev || !transform) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_transform: NULL argument");
     sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
     if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_transform: stale handle 0x%08x", inst.id);
     float nrm[9];
     double gain;
-    sy_rt_result r = normal_matrix(transform, nrm, &gain, err, err_len);
-    if (r != SY_RT_OK || (r = instance_in_range(in->mesh, transform, err, err_len)) != SY_RT_OK) return r;
+    sy_rt_result r = normal_matrix(dev, transform, nrm, &gain);
+    if (r != SY_RT_OK || (r = instance_in_range(dev, in->mesh, transform)) != SY_RT_OK) return r;
     if (gain > SY_RT_INSTANCE_GAIN_MAX && !(in->flags & SY_RT_INSTANCE_BAKED))
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT,
                     "instance set_transform: the transform shrinks by %g (more than SY_RT_INSTANCE_GAIN_MAX %g allows "
@@ -673,7 +672,7 @@ sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst
     return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst, sy_rt_material material, char *err, size_t err_len)
+sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst, sy_rt_material material)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_material: NULL device");
     sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
@@ -688,7 +687,7 @@ sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst,
     return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, bool visible, char *err, size_t err_len)
+sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, bool visible)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_visible: NULL device");
     sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
@@ -705,10 +704,10 @@ sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, 
     if (sy_rt_material_lookup(dev, in->material)->emissive) dev->area_dirty = true;
     if (instance_masked(dev, in)) dev->filters_dirty = true;
     dev->dirty = dev->top_dirty = dev->shadow_dirty = true;
-    return sy_rt_check_embree(dev, err, err_len, "instance set_visible");
+    return sy_rt_check_embree(dev, "instance set_visible");
 }
 
-sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst, char *err, size_t err_len)
+sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance destroy: NULL device");
     sy_rt_instance_data *in = sy_rt_pool_remove(&dev->instances, inst.id);
@@ -717,12 +716,12 @@ sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst, char
     if (instance_masked(dev, in)) dev->filters_dirty = true;
     instance_free(dev, in);
     dev->dirty = dev->top_dirty = dev->shadow_dirty = true;
-    return sy_rt_check_embree(dev, err, err_len, "instance destroy");
+    return sy_rt_check_embree(dev, "instance destroy");
 }
 
 /* >>light */
 
-static sy_rt_result validate_light(const sy_rt_light_desc *d, char *err, size_t err_len)
+static sy_rt_result validate_light(const sy_rt_device *dev, const sy_rt_light_desc *d)
 {
     if (d->type != SY_RT_LIGHT_POINT && d->type != SY_RT_LIGHT_SPOT && d->type != SY_RT_LIGHT_DIRECTIONAL)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: unknown type %d", (int)d->type);
@@ -751,11 +750,11 @@ static sy_rt_result validate_light(const sy_rt_light_desc *d, char *err, size_t 
     return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_light_create(sy_rt_device *dev, const sy_rt_light_desc *d, sy_rt_light *out, char *err, size_t err_len)
+sy_rt_result sy_rt_light_create(sy_rt_device *dev, const sy_rt_light_desc *d, sy_rt_light *out)
 {
     if (!dev || !d || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: NULL argument");
     out->id = 0;
-    sy_rt_result r = validate_light(d, err, err_len);
+    sy_rt_result r = validate_light(dev, d);
     if (r != SY_RT_OK) return r;
     sy_rt_light_data *l = calloc(1, sizeof *l);
     if (!l) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "light: out of memory");
@@ -768,19 +767,19 @@ sy_rt_result sy_rt_light_create(sy_rt_device *dev, const sy_rt_light_desc *d, sy
     return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_light_update(sy_rt_device *dev, sy_rt_light light, const sy_rt_light_desc *d, char *err, size_t err_len)
+sy_rt_result sy_rt_light_update(sy_rt_device *dev, sy_rt_light light, const sy_rt_light_desc *d)
 {
     if (!dev || !d) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light update: NULL argument");
     sy_rt_light_data *l = sy_rt_pool_get(&dev->lights, light.id);
     if (!l) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "light update: stale handle 0x%08x", light.id);
-    sy_rt_result r = validate_light(d, err, err_len);
+    sy_rt_result r = validate_light(dev, d);
     if (r != SY_RT_OK) return r;
     l->desc = *d;
     dev->dirty = dev->punctual_dirty = true;
     return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light, char *err, size_t err_len)
+sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light destroy: NULL device");
     sy_rt_light_data *l = sy_rt_pool_remove(&dev->lights, light.id);
@@ -846,7 +845,7 @@ static void update_filters(sy_rt_device *dev)
     }
 }
 
-static sy_rt_result rebuild_area_lights(sy_rt_device *dev, char *err, size_t err_len)
+static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
 {
     size_t n = 0;
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
@@ -932,7 +931,7 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev, char *err, size_t err
     return SY_RT_OK;
 }
 
-static sy_rt_result rebuild_punctual(sy_rt_device *dev, char *err, size_t err_len)
+static sy_rt_result rebuild_punctual(sy_rt_device *dev)
 {
     free(dev->punctual);
     dev->punctual = NULL;
@@ -959,21 +958,21 @@ static sy_rt_result rebuild_punctual(sy_rt_device *dev, char *err, size_t err_le
     return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len)
+sy_rt_result sy_rt_commit(sy_rt_device *dev)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "commit: NULL device");
     if (!dev->dirty) return SY_RT_OK;
     sy_rt_result r;
     if (dev->filters_dirty) {
         update_filters(dev);
-        if ((r = sy_rt_check_embree(dev, err, err_len, "commit: alpha filters")) != SY_RT_OK) return r;
+        if ((r = sy_rt_check_embree(dev, "commit: alpha filters")) != SY_RT_OK) return r;
         dev->filters_dirty = false;
     }
     double t0 = sy_rt_seconds();
-    if ((r = commit_moved(dev, err, err_len)) != SY_RT_OK) return r;
+    if ((r = commit_moved(dev)) != SY_RT_OK) return r;
     if (dev->dyn_dirty) {
         rtcCommitScene(dev->dyn);
-        if ((r = sy_rt_check_embree(dev, err, err_len, "commit: moved instances' scene")) != SY_RT_OK) return r;
+        if ((r = sy_rt_check_embree(dev, "commit: moved instances' scene")) != SY_RT_OK) return r;
         dev->dyn_dirty = false;
     }
     dev->last_top_commit_seconds = sy_rt_seconds() - t0;
@@ -981,7 +980,7 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len)
         rtcCommitScene(dev->top);
         dev->top_builds++;
         dev->last_top_commit_seconds = sy_rt_seconds() - t0;
-        if ((r = sy_rt_check_embree(dev, err, err_len, "commit: top-level scene")) != SY_RT_OK) {
+        if ((r = sy_rt_check_embree(dev, "commit: top-level scene")) != SY_RT_OK) {
             if (dev->max_memory > 0 && (double)atomic_load(&dev->embree_peak) * 1.25 > (double)dev->max_memory)
                 r = FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "commit: the top-level BVH went past the device's memory limit of "
                          "%.1f MB (Embree held %.1f MB at its peak)", (double)dev->max_memory / 1048576.0,
@@ -991,11 +990,11 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len)
         dev->top_dirty = false;
     }
     if (dev->area_dirty) {
-        if ((r = rebuild_area_lights(dev, err, err_len)) != SY_RT_OK) return r;
+        if ((r = rebuild_area_lights(dev)) != SY_RT_OK) return r;
         dev->area_dirty = false;
     }
     if (dev->punctual_dirty) {
-        if ((r = rebuild_punctual(dev, err, err_len)) != SY_RT_OK) return r;
+        if ((r = rebuild_punctual(dev)) != SY_RT_OK) return r;
         dev->punctual_dirty = false;
     }
     dev->background = dev->background_staged;
@@ -1004,7 +1003,7 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev, char *err, size_t err_len)
         dev->shadow_dirty = false;
     }
     if (dev->env_dirty) {
-        if ((r = sy_rt_env_rebuild(dev, err, err_len)) != SY_RT_OK) return r;
+        if ((r = sy_rt_env_rebuild(dev)) != SY_RT_OK) return r;
         dev->env_dirty = false;
     }
     dev->dirty = false;

@@ -5,36 +5,35 @@
 #include <stdlib.h>
 #include <string.h>
 
-sy_rt_result sy_rt_texture_create(sy_rt_device *dev, const sy_rt_texture_desc *d, sy_rt_texture *out,
-                                  char *err, size_t err_len)
+sy_rt_result sy_rt_texture_create(sy_rt_device *dev, const sy_rt_texture_desc *d, sy_rt_texture *out)
 {
-    if (!dev || !d || !out) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "texture: NULL argument");
+    if (!dev || !d || !out) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "texture: NULL argument");
     out->id = 0;
     if (d->width == 0 || d->height == 0)
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "texture: size %ux%u is empty", d->width, d->height);
+        return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "texture: size %ux%u is empty", d->width, d->height);
     if (d->channels < 1 || d->channels > 4)
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "texture: channels = %u, expected 1..4", d->channels);
-    if (!d->pixels) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "texture: pixels is NULL");
+        return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "texture: channels = %u, expected 1..4", d->channels);
+    if (!d->pixels) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "texture: pixels is NULL");
     size_t elem;
     switch (d->format) {
     case SY_RT_TEXEL_UNORM8: case SY_RT_TEXEL_UNORM8_SRGB: elem = 1; break;
     case SY_RT_TEXEL_FLOAT32: elem = sizeof(float); break;
-    default: return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "texture: unknown texel format %d", (int)d->format);
+    default: return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "texture: unknown texel format %d", (int)d->format);
     }
     if ((unsigned)d->wrap_s > SY_RT_WRAP_MIRROR || (unsigned)d->wrap_t > SY_RT_WRAP_MIRROR)
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "texture: unknown wrap mode");
+        return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "texture: unknown wrap mode");
     if ((unsigned)d->filter > SY_RT_FILTER_NEAREST)
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "texture: unknown filter");
+        return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "texture: unknown filter");
     size_t bytes;
     if (!sy_rt_size_mul(d->width, d->height, &bytes) || !sy_rt_size_mul(bytes, d->channels, &bytes) ||
         !sy_rt_size_mul(bytes, elem, &bytes))
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_LIMIT, "texture: %ux%ux%u texels overflow size_t", d->width, d->height, d->channels);
+        return sy_rt_fail(dev, SY_RT_ERROR_LIMIT, "texture: %ux%ux%u texels overflow size_t", d->width, d->height, d->channels);
 
     sy_rt_texture_data *t = calloc(1, sizeof *t);
     void *px = t ? malloc(bytes) : NULL;
     if (!px) {
         free(t);
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_OUT_OF_MEMORY, "texture: cannot allocate %zu bytes", bytes);
+        return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY, "texture: cannot allocate %zu bytes", bytes);
     }
     memcpy(px, d->pixels, bytes);
     t->width = d->width; t->height = d->height; t->channels = d->channels;
@@ -43,17 +42,17 @@ sy_rt_result sy_rt_texture_create(sy_rt_device *dev, const sy_rt_texture_desc *d
     t->wrap_s = d->wrap_s; t->wrap_t = d->wrap_t; t->filter = d->filter;
     if (!sy_rt_pool_insert(&dev->textures, t, &out->id)) {
         sy_rt_texture_free(t);
-        return sy_rt_fail(err, err_len, SY_RT_ERROR_LIMIT, "texture: pool full or out of memory");
+        return sy_rt_fail(dev, SY_RT_ERROR_LIMIT, "texture: pool full or out of memory");
     }
     dev->dirty = true;
     return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_texture_destroy(sy_rt_device *dev, sy_rt_texture tex, char *err, size_t err_len)
+sy_rt_result sy_rt_texture_destroy(sy_rt_device *dev, sy_rt_texture tex)
 {
-    if (!dev) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_ARGUMENT, "texture destroy: NULL device");
+    if (!dev) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "texture destroy: NULL device");
     sy_rt_texture_data *t = sy_rt_pool_remove(&dev->textures, tex.id);
-    if (!t) return sy_rt_fail(err, err_len, SY_RT_ERROR_INVALID_HANDLE, "texture destroy: stale handle 0x%08x", tex.id);
+    if (!t) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_HANDLE, "texture destroy: stale handle 0x%08x", tex.id);
     sy_rt_texture_free(t);
     /* Emissive textures shape the area lights only at sample time, so no rebuild is needed. */
     dev->dirty = true;

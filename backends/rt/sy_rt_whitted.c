@@ -350,16 +350,17 @@ static void whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
     }
 }
 
-sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc *desc, char *err, size_t err_len)
+sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc *desc)
 {
+    const sy_rt_device *dev = f->dev;
     whitted_job *j = malloc(sizeof *j);
-    if (!j) return sy_rt_fail(err, err_len, SY_RT_ERROR_OUT_OF_MEMORY, "render: out of memory");
+    if (!j) return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY, "render: out of memory");
     j->sobol = &f->dev->sobol;
     sy_rt_env_get(f->dev, &j->env);
     j->spp = desc->pixel_samples ? desc->pixel_samples : 1u;
     j->n_area = (f->light_samples + j->spp - 1u) / j->spp;
     j->n_env = j->env.mode ? (desc->env_light_samples ? desc->env_light_samples : 4u) : 0u;
-    sy_rt_result r = sy_rt_run_tiles(f, whitted_tile, j, desc->progress, desc->progress_user_data, err, err_len);
+    sy_rt_result r = sy_rt_run_tiles(f, whitted_tile, j, desc->progress, desc->progress_user_data);
     free(j);
     return r;
 }

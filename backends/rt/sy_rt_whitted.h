@@ -11,6 +11,6 @@
 
 /* Renders the frame's rectangle with the Whitted integrator (desc: pixel_samples,
  * env_light_samples, progress). */
-sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc *desc, char *err, size_t err_len);
+sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc *desc);
 
 #endif /* SY_RT_WHITTED_H */

@@ -55,12 +55,12 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     rt_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt mediator: out of memory");
     st->inst_node = SY_MIRROR_MAP_INIT(uint32_t);
-    char e[ERRLEN];
-    sy_rt_device_desc dd = {(uint32_t)threads, (uint64_t)max_memory_mb << 20};
-    sy_rt_result rr = sy_rt_device_create(&dd, &st->dev, e, sizeof e);
+    sy_rt_device_desc dd = sy_rti_device_desc(st, (uint32_t)threads, (uint64_t)max_memory_mb << 20);
+    sy_rt_result rr = sy_rt_device_create(&dd, &st->dev);
     if (rr != SY_RT_OK) {
+        r = sy_rti_fail(st, err, rr, "Embree device");
         free(st);
-        return sy_rti_fail(err, rr, "Embree device", e);
+        return r;
     }
     sy_mirror_desc md = {"rt mediator", args->root_node_id, &sy_rti_mirror_callbacks, st};
     if ((r = sy_mirror_create(&md, &st->mirror, err)) != SY_OK) {
@@ -117,16 +117,15 @@ sy_result sy_mediator_rt_aovs_get(void *state, sy_mediator_rt_aovs *out, sy_erro
     size_t px = (size_t)out->width * out->height;
     for (int k = 0; k < SY_RT_AOV_COUNT; ++k) {
         float *buf = malloc(px * sy_rt_aov_channels((sy_rt_aov)k) * sizeof(float));
-        char e[ERRLEN];
         if (!buf) {
             sy_mediator_rt_aovs_free(out);
             return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "AOVs: out of memory (%ux%u)", out->width, out->height);
         }
         out->planes[k] = buf;
-        sy_rt_result r = sy_rt_accum_read(acc, (sy_rt_aov)k, buf, e, sizeof e);
+        sy_rt_result r = sy_rt_accum_read(st->dev, acc, (sy_rt_aov)k, buf);
         if (r != SY_RT_OK) {
             sy_mediator_rt_aovs_free(out);
-            return sy_rti_fail(err, r, "AOVs", e);
+            return sy_rti_fail(st, err, r, "AOVs");
         }
     }
     return SY_OK;

@@ -45,11 +45,10 @@ sy_result sy_rti_pt_slot(rt_state *st, const sy_render_request *req, sy_error *e
         uint32_t w = 0, h = 0;
         sy_rt_accum_size(a->acc, &w, &h);
         if (!a->acc || w != req->rect_w || h != req->rect_h) {
-            char e[ERRLEN];
             sy_rt_accum_destroy(a->acc);
             a->acc = NULL;
-            sy_rt_result r = sy_rt_accum_create(req->rect_w, req->rect_h, &a->acc, e, sizeof e);
-            if (r != SY_RT_OK) return sy_rti_fail(err, r, "accumulation buffer", e);
+            sy_rt_result r = sy_rt_accum_create(st->dev, req->rect_w, req->rect_h, &a->acc);
+            if (r != SY_RT_OK) return sy_rti_fail(st, err, r, "accumulation buffer");
         } else {
             sy_rt_accum_reset(a->acc);
         }

@@ -4,6 +4,7 @@
 #define SY_RTI_DEFINING_PARAMS /* the tables take their size from their initialisers, checked below */
 #include "sy_mediator_rt_internal.h"
 
+#include <stdio.h>
 #include <string.h>
 
 /* Whitted's default anti-aliasing (spp, default 4 in sy_rti_whitted_params): 4 stratified camera rays per
@@ -73,9 +74,33 @@ _Static_assert(SY_RTI_COUNT_OF(sy_rti_coverage_params) == SY_RTI_COVERAGE_PARAM_
 _Static_assert(SY_RTI_COUNT_OF(sy_rti_pathtracer_params) == SY_RTI_PATHTRACER_PARAM_COUNT,
                "SY_RTI_PATHTRACER_PARAM_COUNT");
 
-sy_result sy_rti_fail(sy_error *err, sy_rt_result r, const char *what, const char *msg)
+/* Every code the device returns has core's number (the cast in sy_backend_fail). */
+SY_BACKEND_SAME_CODE(SY_RT_ERROR_INVALID_ARGUMENT, SY_ERR_INVALID_ARGUMENT);
+SY_BACKEND_SAME_CODE(SY_RT_ERROR_INVALID_HANDLE, SY_ERR_INVALID_HANDLE);
+SY_BACKEND_SAME_CODE(SY_RT_ERROR_OUT_OF_MEMORY, SY_ERR_OUT_OF_MEMORY);
+SY_BACKEND_SAME_CODE(SY_RT_ERROR_UNSUPPORTED, SY_ERR_UNSUPPORTED);
+SY_BACKEND_SAME_CODE(SY_RT_ERROR_LIMIT, SY_ERR_LIMIT);
+SY_BACKEND_SAME_CODE(SY_RT_ERROR_EMBREE, SY_ERR_BACKEND);
+SY_BACKEND_SAME_CODE(SY_RT_ERROR_INVALID_OPERATION, SY_ERR_INVALID_OPERATION);
+SY_BACKEND_SAME_CODE(SY_RT_ERROR_CANCELLED, SY_ERR_CANCELLED);
+SY_BACKEND_SAME_CODE(SY_RT_ERROR_SYSTEM, SY_ERR_SYSTEM);
+
+sy_result sy_rti_fail(const rt_state *st, sy_error *err, sy_rt_result r, const char *what)
 {
-    return sy_error_set(err, r == SY_RT_ERROR_OUT_OF_MEMORY ? SY_ERR_OUT_OF_MEMORY : SY_ERR_BACKEND, "%s: %s", what, msg);
+    return sy_backend_fail(err, (int)r, "%s: %s", what, st->rt_msg);
+}
+
+static void rt_error(void *user, sy_rt_result code, const char *message)
+{
+    (void)code;
+    rt_state *st = user;
+    snprintf(st->rt_msg, sizeof st->rt_msg, "%s", message);
+}
+
+sy_rt_device_desc sy_rti_device_desc(rt_state *st, uint32_t threads, uint64_t max_memory_bytes)
+{
+    sy_rt_device_desc d = {threads, max_memory_bytes, rt_error, st};
+    return d;
 }
 
 void sy_rti_camera_of(const sy_camera_view *v, sy_rt_camera *cam)

@@ -11,11 +11,10 @@
 sy_result sy_rti_coverage_render(rt_state *st, const sy_rt_camera *cam, const sy_rt_render_desc *d,
                                  sy_layer *layer, sy_error *err)
 {
-    char e[ERRLEN];
     size_t n = (size_t)d->width * d->height;
     uint32_t *ids = malloc(n * sizeof *ids);
     if (!ids) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "coverage: out of memory");
-    sy_rt_result r = sy_rt_coverage(st->dev, cam, d, ids, layer->depth, e, sizeof e);
+    sy_rt_result r = sy_rt_coverage(st->dev, cam, d, ids, layer->depth);
     if (r == SY_RT_OK)
         for (size_t i = 0; i < n; ++i) {
             uint32_t node = sy_rti_inst_node_get(st, ids[i]);
@@ -31,7 +30,7 @@ sy_result sy_rti_coverage_render(rt_state *st, const sy_rt_camera *cam, const sy
             c[3] = 1.0f;
         }
     free(ids);
-    return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "coverage", e);
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "coverage");
 }
 
 static int coverage_order(const void *pa, const void *pb)
@@ -49,7 +48,6 @@ sy_result sy_rti_coverage(void *state, const sy_camera_view *view, uint32_t widt
     rt_state *st = state;
     *entries_out = NULL;
     *count_out = 0;
-    char e[ERRLEN];
     sy_rt_camera cam;
     sy_rti_camera_of(view, &cam);
     sy_rt_render_desc d = {.image_width = width, .image_height = height, .width = width, .height = height};
@@ -57,15 +55,15 @@ sy_result sy_rti_coverage(void *state, const sy_camera_view *view, uint32_t widt
     if (!sy_size_mul(width, height, &n) || n == 0) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "coverage: bad size %ux%u", width, height);
     uint32_t *ids = malloc(n * sizeof *ids);
     if (!ids) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "coverage: out of memory for %ux%u", width, height);
-    sy_rt_result cr = sy_rt_commit(st->dev, e, sizeof e); /* no-op unless a failed sync left changes */
+    sy_rt_result cr = sy_rt_commit(st->dev); /* no-op unless a failed sync left changes */
     if (cr != SY_RT_OK) {
         free(ids);
-        return sy_rti_fail(err, cr, "commit", e);
+        return sy_rti_fail(st, err, cr, "commit");
     }
-    sy_rt_result r = sy_rt_coverage(st->dev, &cam, &d, ids, NULL, e, sizeof e);
+    sy_rt_result r = sy_rt_coverage(st->dev, &cam, &d, ids, NULL);
     if (r != SY_RT_OK) {
         free(ids);
-        return sy_rti_fail(err, r, "coverage", e);
+        return sy_rti_fail(st, err, r, "coverage");
     }
     /* count pixels per node */
     for (size_t i = 0; i < n; ++i) ids[i] = sy_rti_inst_node_get(st, ids[i]);

@@ -210,10 +210,9 @@ sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_re
                                     req->rect_h);
             }
     }
-    char e[ERRLEN];
     for (int k = 0; k < SY_RT_AOV_COUNT; ++k) {
-        sy_rt_result rr = sy_rt_accum_read(a->acc, (sy_rt_aov)k, st->fbuf[k], e, sizeof e);
-        if (rr != SY_RT_OK) return sy_rti_fail(err, rr, "pathtracer filter: feature buffers", e);
+        sy_rt_result rr = sy_rt_accum_read(st->dev, a->acc, (sy_rt_aov)k, st->fbuf[k]);
+        if (rr != SY_RT_OK) return sy_rti_fail(st, err, rr, "pathtracer filter: feature buffers");
     }
     return SY_OK;
 }

@@ -17,6 +17,7 @@
 
 #include "sy_mediator_rt.h"
 
+#include "sy_backend_status.h"
 #include "sy_rt.h"
 #include "sy_mirror.h"
 #include "sy_mirror_map.h"
@@ -29,8 +30,6 @@
 
 #include <stdbool.h>
 #include <stdint.h>
-
-#define ERRLEN 256
 
 /* Path tracer: one accumulation per distinct request (camera, sizes, rectangle, background, seed);
  * a few are kept so that viewports sharing this context (stereo eyes, tiles) do not evict each
@@ -72,6 +71,9 @@ typedef struct pt_filter_cfg {
  * mediators/sy_mirror; this adapter turns its callbacks into Embree back-end calls. */
 typedef struct rt_state {
     sy_rt_device *dev;
+    /* the message of the device's last failed call: its error callback (sy_rti_device_desc) writes
+     * it on the thread of the call in progress, which is the only thread using the device */
+    char rt_msg[SY_ERROR_MESSAGE_MAX];
     sy_mirror *mirror;
     uint32_t integrator;
     uint32_t max_depth, light_samples;
@@ -107,8 +109,11 @@ extern const sy_param_decl sy_rti_coverage_params[SY_RTI_COVERAGE_PARAM_COUNT];
 extern const sy_param_decl sy_rti_pathtracer_params[SY_RTI_PATHTRACER_PARAM_COUNT];
 #endif
 extern const sy_param_table sy_rti_whitted_table, sy_rti_coverage_table, sy_rti_pt_table;
-/* A back-end failure as an sy_error: "WHAT: MSG". */
-sy_result sy_rti_fail(sy_error *err, sy_rt_result r, const char *what, const char *msg);
+/* A failed call on st's device as an sy_error: the code cast (sy_backend_status.h) and "WHAT: MSG",
+ * MSG being what the device reported through its error callback. */
+sy_result sy_rti_fail(const rt_state *st, sy_error *err, sy_rt_result r, const char *what);
+/* The device options that report the device's errors into st->rt_msg. */
+sy_rt_device_desc sy_rti_device_desc(rt_state *st, uint32_t threads, uint64_t max_memory_bytes);
 void sy_rti_camera_of(const sy_camera_view *v, sy_rt_camera *cam);
 
 /* --- sy_mediator_rt_mirror.c --- */

@@ -22,10 +22,9 @@ static sy_result studio_texture(rt_state *st, uint32_t *handle, sy_error *err)
         sy_rt_texture_desc d = {.width = SY_LOOK_STUDIO_WIDTH, .height = SY_LOOK_STUDIO_HEIGHT, .channels = 3,
                                 .format = SY_RT_TEXEL_FLOAT32, .pixels = px, .wrap_s = SY_RT_WRAP_REPEAT,
                                 .wrap_t = SY_RT_WRAP_CLAMP, .filter = SY_RT_FILTER_LINEAR};
-        char e[ERRLEN];
-        sy_rt_result r = sy_rt_texture_create(st->dev, &d, &st->studio, e, sizeof e);
+        sy_rt_result r = sy_rt_texture_create(st->dev, &d, &st->studio);
         free(px);
-        if (r != SY_RT_OK) return sy_rti_fail(err, r, "studio environment", e);
+        if (r != SY_RT_OK) return sy_rti_fail(st, err, r, "studio environment");
     }
     *handle = st->studio.id;
     return SY_OK;
@@ -40,14 +39,13 @@ static sy_result gradient_texture(rt_state *st, const sy_gradient *g, uint32_t *
         sy_rt_texture_desc d = {.width = GRADIENT_W, .height = GRADIENT_H, .channels = 3, .format = SY_RT_TEXEL_FLOAT32,
                                 .pixels = px, .wrap_s = SY_RT_WRAP_REPEAT, .wrap_t = SY_RT_WRAP_CLAMP,
                                 .filter = SY_RT_FILTER_LINEAR};
-        char e[ERRLEN];
         sy_rt_texture t = {0};
-        sy_rt_result r = sy_rt_texture_create(st->dev, &d, &t, e, sizeof e);
+        sy_rt_result r = sy_rt_texture_create(st->dev, &d, &t);
         free(px);
-        if (r != SY_RT_OK) return sy_rti_fail(err, r, "background gradient", e);
+        if (r != SY_RT_OK) return sy_rti_fail(st, err, r, "background gradient");
         /* the device's background still names the old one until the look is applied (it stays
          * valid: a destroyed background texture draws black, and the new look replaces it now) */
-        if (st->gradient.id) sy_rt_texture_destroy(st->dev, st->gradient, NULL, 0);
+        if (st->gradient.id) sy_rt_texture_destroy(st->dev, st->gradient);
         st->gradient = t;
         st->gradient_baked = *g;
     }
@@ -79,13 +77,12 @@ sy_result sy_rti_apply_look(rt_state *st, uint32_t background_id, sy_error *err)
         bg.texture.id = bg_tex;
         bg.intensity = look.background == SY_LOOK_BG_ENVIRONMENT ? look.env_intensity : 1.0f;
     }
-    char e[ERRLEN];
-    sy_rt_result rr = sy_rt_set_background(st->dev, &bg, e, sizeof e);
-    if (rr == SY_RT_OK) rr = sy_rt_set_environment(st->dev, (sy_rt_texture){env_tex}, look.env_intensity, e, sizeof e);
-    if (rr == SY_RT_OK) rr = sy_rt_commit(st->dev, e, sizeof e);
+    sy_rt_result rr = sy_rt_set_background(st->dev, &bg);
+    if (rr == SY_RT_OK) rr = sy_rt_set_environment(st->dev, (sy_rt_texture){env_tex}, look.env_intensity);
+    if (rr == SY_RT_OK) rr = sy_rt_commit(st->dev);
     if (rr != SY_RT_OK) {
         st->look_applied = false;
-        return sy_rti_fail(err, rr, "look (background, environment)", e);
+        return sy_rti_fail(st, err, rr, "look (background, environment)");
     }
     st->look = look;
     st->look_env_tex = env_tex;

@@ -66,7 +66,6 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
 {
     rt_state *st = user;
     const sy_mirror_flat_material *m = a->flat;
-    char e[ERRLEN];
     sy_rt_material_desc d;
     sy_rt_material_desc_init(&d);
     static const char *const bc[4] = {"base_color[0]", "base_color[1]", "base_color[2]", "base_color[3] (alpha)"};
@@ -90,23 +89,22 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     d.double_sided = m->double_sided;
     d.unlit = m->unlit;
     sy_rt_material h = {*a->handle};
-    sy_rt_result r = h.id ? sy_rt_material_update(st->dev, h, &d, e, sizeof e)
-                          : sy_rt_material_create(st->dev, &d, &h, e, sizeof e);
+    sy_rt_result r = h.id ? sy_rt_material_update(st->dev, h, &d)
+                          : sy_rt_material_create(st->dev, &d, &h);
     *a->handle = h.id;
-    return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "material", e);
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "material");
 }
 
 static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_error *err)
 {
     rt_state *st = user;
-    char e[ERRLEN];
     const sy_mirror_flat_texture *f = a->flat;
     sy_rt_texture_desc d = {f->width, f->height, f->channels, (sy_rt_texel_format)f->format, f->pixels,
                             (sy_rt_wrap)f->wrap_s, (sy_rt_wrap)f->wrap_t, f->nearest ? SY_RT_FILTER_NEAREST : SY_RT_FILTER_LINEAR};
     sy_rt_texture h = {0};
-    sy_rt_result r = sy_rt_texture_create(st->dev, &d, &h, e, sizeof e);
+    sy_rt_result r = sy_rt_texture_create(st->dev, &d, &h);
     *a->handle = h.id;
-    return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "texture", e);
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "texture");
 }
 
 /* The blobs a shared back-end mesh reads in place (sy_rt_mesh_desc.release): one reference each,
@@ -126,7 +124,6 @@ static void rt_mesh_blobs_release(void *user)
 static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
 {
     rt_state *st = user;
-    char e[ERRLEN];
     const sy_primitive *p = a->primitive;
     const sy_mirror_flat_mesh *f = a->flat;
     rt_mesh_blobs *held = malloc(sizeof *held);
@@ -136,16 +133,15 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
     sy_blob *const used[6] = {p->positions, p->normals, p->texcoords0, p->texcoords1, p->colors, p->indices};
     for (int k = 0; k < 6; ++k) held->b[k] = sy_blob_retain(used[k]);
     sy_rt_mesh h = {0};
-    sy_rt_result r = sy_rt_mesh_create(st->dev, &d, &h, e, sizeof e);
+    sy_rt_result r = sy_rt_mesh_create(st->dev, &d, &h);
     if (r != SY_RT_OK) rt_mesh_blobs_release(held); /* a failed create keeps nothing */
     *a->handle = h.id;
-    return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "mesh primitive", e);
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "mesh primitive");
 }
 
 static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_error *err)
 {
     rt_state *st = user;
-    char e[ERRLEN];
     sy_rt_instance h = {*a->handle};
     sy_rt_result r;
     if (!h.id) {
@@ -153,20 +149,19 @@ static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_er
                                  .material = {a->material},
                                  .flags = (a->baked ? SY_RT_INSTANCE_BAKED : 0u) | (a->visible ? 0u : SY_RT_INSTANCE_HIDDEN)};
         memcpy(d.transform, a->world->m, sizeof d.transform);
-        r = sy_rt_instance_create(st->dev, &d, &h, e, sizeof e);
+        r = sy_rt_instance_create(st->dev, &d, &h);
         *a->handle = h.id;
         if (r == SY_RT_OK) inst_node_set(st, h.id, a->node);
-        return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "instance", e);
+        return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "instance");
     }
-    r = sy_rt_instance_set_transform(st->dev, h, a->world->m, e, sizeof e);
-    if (r == SY_RT_OK) r = sy_rt_instance_set_visible(st->dev, h, a->visible, e, sizeof e);
-    return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "instance transform", e);
+    r = sy_rt_instance_set_transform(st->dev, h, a->world->m);
+    if (r == SY_RT_OK) r = sy_rt_instance_set_visible(st->dev, h, a->visible);
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "instance transform");
 }
 
 static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *err)
 {
     rt_state *st = user;
-    char e[ERRLEN];
     const sy_mirror_flat_light *l = a->flat;
     sy_rt_light_desc d;
     memset(&d, 0, sizeof d);
@@ -182,23 +177,23 @@ static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *e
     memcpy(d.position, l->position, sizeof d.position);
     memcpy(d.direction, l->direction, sizeof d.direction);
     sy_rt_light h = {*a->handle};
-    sy_rt_result r = h.id ? sy_rt_light_update(st->dev, h, &d, e, sizeof e) : sy_rt_light_create(st->dev, &d, &h, e, sizeof e);
+    sy_rt_result r = h.id ? sy_rt_light_update(st->dev, h, &d) : sy_rt_light_create(st->dev, &d, &h);
     *a->handle = h.id;
-    return r == SY_RT_OK ? SY_OK : sy_rti_fail(err, r, "light", e);
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "light");
 }
 
 static void cb_release(void *user, const sy_mirror_release_args *a)
 {
     rt_state *st = user;
     switch (a->kind) {
-    case SY_MIRROR_TEXTURE: sy_rt_texture_destroy(st->dev, (sy_rt_texture){a->handle}, NULL, 0); break;
-    case SY_MIRROR_MATERIAL: sy_rt_material_destroy(st->dev, (sy_rt_material){a->handle}, NULL, 0); break;
-    case SY_MIRROR_PRIMITIVE: sy_rt_mesh_destroy(st->dev, (sy_rt_mesh){a->handle}, NULL, 0); break;
+    case SY_MIRROR_TEXTURE: sy_rt_texture_destroy(st->dev, (sy_rt_texture){a->handle}); break;
+    case SY_MIRROR_MATERIAL: sy_rt_material_destroy(st->dev, (sy_rt_material){a->handle}); break;
+    case SY_MIRROR_PRIMITIVE: sy_rt_mesh_destroy(st->dev, (sy_rt_mesh){a->handle}); break;
     case SY_MIRROR_INSTANCE:
         inst_node_set(st, a->handle, 0);
-        sy_rt_instance_destroy(st->dev, (sy_rt_instance){a->handle}, NULL, 0);
+        sy_rt_instance_destroy(st->dev, (sy_rt_instance){a->handle});
         break;
-    case SY_MIRROR_LIGHT: sy_rt_light_destroy(st->dev, (sy_rt_light){a->handle}, NULL, 0); break;
+    case SY_MIRROR_LIGHT: sy_rt_light_destroy(st->dev, (sy_rt_light){a->handle}); break;
     }
 }
 
@@ -222,9 +217,8 @@ sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err)
     /* The device tracks what is staged (sy_rt_commit is a no-op on a clean device), so every
      * successful sync ends with a commit: an uncommitted device refuses to render. */
     if (r == SY_OK) {
-        char e[ERRLEN];
-        sy_rt_result rr = sy_rt_commit(st->dev, e, sizeof e);
-        if (rr != SY_RT_OK) r = sy_rti_fail(err, rr, "commit", e);
+        sy_rt_result rr = sy_rt_commit(st->dev);
+        if (rr != SY_RT_OK) r = sy_rti_fail(st, err, rr, "commit");
     }
     sy_rt_stats s;
     sy_rt_device_stats(st->dev, &s);

@@ -32,15 +32,14 @@ sy_result sy_rti_radiance_render(rt_state *st, const sy_render_request *req, con
     double secs = 0.0;
     uint64_t bad = 0, rays = 0;
     sy_filter_stats fs = {0};
-    char e[ERRLEN];
     for (uint32_t i = 0; i < count; ++i) {
         bool last = i + 1 == count;
         d->samples = 1;
         d->records = recs;
-        sy_rt_result rr = sy_rt_render(st->dev, cam, d, last ? layer->rgba : NULL, last ? layer->depth : NULL, e, sizeof e);
+        sy_rt_result rr = sy_rt_render(st->dev, cam, d, last ? layer->rgba : NULL, last ? layer->depth : NULL);
         if (rr != SY_RT_OK) {
             sy_radiance_hook_reset(a->radiance);
-            return sy_rti_fail(err, rr, "render", e);
+            return sy_rti_fail(st, err, rr, "render");
         }
         rays += sy_rt_accum_last_rays(d->accum);
         if ((r = sy_radiance_hook_frame(a->radiance, &fd, last ? layer->rgba : NULL, &fs, err)) != SY_OK) return r;

@@ -27,12 +27,11 @@ sy_result sy_mediator_rt_bench_rays(void *state, const sy_camera_view *view, uin
                                     uint32_t repeats, sy_mediator_rt_bench *out, sy_error *err)
 {
     rt_state *st = state;
-    char e[ERRLEN];
     sy_rt_camera cam;
     sy_rti_camera_of(view, &cam);
     sy_rt_bench_result b;
-    sy_rt_result r = sy_rt_bench_rays(st->dev, &cam, width, height, repeats, &b, e, sizeof e);
-    if (r != SY_RT_OK) return sy_rti_fail(err, r, "ray benchmark", e);
+    sy_rt_result r = sy_rt_bench_rays(st->dev, &cam, width, height, repeats, &b);
+    if (r != SY_RT_OK) return sy_rti_fail(st, err, r, "ray benchmark");
     out->ours_mrays = b.primary_mrays;
     out->raw_mrays = b.raw_mrays;
     out->overhead_percent = b.overhead_percent;
@@ -43,7 +42,6 @@ sy_result sy_mediator_rt_bench_rays(void *state, const sy_camera_view *view, uin
 sy_result sy_rti_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     rt_state *st = state;
-    char e[ERRLEN];
     sy_result lr = sy_rti_apply_look(st, req->background_id, err);
     if (lr != SY_OK) return lr;
     sy_rt_camera cam;
@@ -80,8 +78,8 @@ sy_result sy_rti_render(void *state, const sy_render_request *req, sy_layer *lay
         d.samples = req->sample_count ? req->sample_count : 1u;
         if (st->filter.kind == PT_FILTER_RADIANCE) return sy_rti_radiance_render(st, req, &cam, &d, layer, err);
     }
-    sy_rt_result r = sy_rt_render(st->dev, &cam, &d, layer->rgba, layer->depth, e, sizeof e);
-    if (r != SY_RT_OK) return sy_rti_fail(err, r, "render", e);
+    sy_rt_result r = sy_rt_render(st->dev, &cam, &d, layer->rgba, layer->depth);
+    if (r != SY_RT_OK) return sy_rti_fail(st, err, r, "render");
     if (d.accum) st->counters.last_render_rays = sy_rt_accum_last_rays(d.accum);
     st->frames_rendered++;
     if (d.accum && st->filter.kind != PT_FILTER_NONE) return sy_rti_filter_layer(st, req, layer, err);
@@ -97,18 +95,17 @@ sy_result sy_mediator_rt_bench_limit(void *state, const sy_camera_view *view, ui
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "rt bench limit: the context must be a pathtracer context");
     sy_result lr = sy_rti_apply_look(st, background_id, err);
     if (lr != SY_OK) return lr;
-    char e[ERRLEN];
     sy_rt_camera cam;
     sy_rti_camera_of(view, &cam);
     sy_rt_accum *acc = NULL;
-    sy_rt_result r = sy_rt_accum_create(width, height, &acc, e, sizeof e);
+    sy_rt_result r = sy_rt_accum_create(st->dev, width, height, &acc);
     sy_rt_render_desc d = {.integrator = SY_RT_INTEGRATOR_PATHTRACER, .image_width = width, .image_height = height,
                            .width = width, .height = height, .max_depth = st->max_depth, .seed = 1u, .accum = acc,
                            .samples = samples};
     sy_rt_limit_result lim;
-    if (r == SY_RT_OK) r = sy_rt_bench_limit(st->dev, &cam, &d, repeats, &lim, e, sizeof e);
+    if (r == SY_RT_OK) r = sy_rt_bench_limit(st->dev, &cam, &d, repeats, &lim);
     sy_rt_accum_destroy(acc);
-    if (r != SY_RT_OK) return sy_rti_fail(err, r, "limit benchmark", e);
+    if (r != SY_RT_OK) return sy_rti_fail(st, err, r, "limit benchmark");
     _Static_assert(SY_MEDIATOR_RT_LIMIT_FORMS == SY_RT_FORM_COUNT, "one entry per replay form");
     memset(out, 0, sizeof *out);
     out->width = lim.width, out->height = lim.height, out->samples = lim.samples, out->repeats = lim.repeats;

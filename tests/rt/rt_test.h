@@ -17,20 +17,31 @@
 #define M_PI 3.14159265358979323846
 #endif
 
+/* The message of the last failure any test device reported (rt_test_on_error, the error callback
+ * of every device the tests create: rt_device and rt_test_device_desc). Test programs are
+ * single-threaded outside sy_rt_render. */
+static char rt_test_msg[512];
+static inline void rt_test_on_error(void *user, sy_rt_result code, const char *message)
+{
+    (void)user, (void)code;
+    snprintf(rt_test_msg, sizeof rt_test_msg, "%s", message);
+}
+static inline sy_rt_device_desc rt_test_device_desc(void)
+{
+    sy_rt_device_desc dd = {.error = rt_test_on_error};
+    return dd;
+}
+
 /* A call that must succeed; aborts the test (returns 1 from main's helper chain) otherwise. */
 #define MUST(call)                                                                                 \
     do {                                                                                           \
-        char must_err_[256] = "";                                                                  \
         sy_rt_result must_r_ = (call);                                                             \
         if (must_r_ != SY_RT_OK) {                                                                 \
             fprintf(stderr, "%s:%d: %s failed: %s: %s\n", __FILE__, __LINE__, #call,             \
-                    sy_rt_result_str(must_r_), must_err_);                                         \
+                    sy_rt_result_str(must_r_), rt_test_msg);                                       \
             exit(1);                                                                               \
         }                                                                                          \
-        (void)must_err_;                                                                           \
     } while (0)
-/* Use ERR as the err/err_len arguments inside MUST(...). */
-#define ERR must_err_, sizeof must_err_
 
 static inline bool rt_near(double a, double b, double rel)
 {
@@ -75,7 +86,7 @@ static inline sy_rt_mesh rt_quad(sy_rt_device *dev, float h)
     sy_rt_mesh_desc d = {.positions = pos, .normals = nrm, .uv = {uv, NULL}, .indices = idx,
                          .vertex_count = 4, .triangle_count = 2};
     sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    MUST(sy_rt_mesh_create(dev, &d, &m));
     return m;
 }
 
@@ -85,7 +96,7 @@ static inline sy_rt_instance rt_place(sy_rt_device *dev, sy_rt_mesh mesh, const 
     sy_rt_instance_desc d = {.mesh = mesh, .material = mat, .flags = flags};
     memcpy(d.transform, xf, sizeof d.transform);
     sy_rt_instance inst;
-    MUST(sy_rt_instance_create(dev, &d, &inst, ERR));
+    MUST(sy_rt_instance_create(dev, &d, &inst));
     return inst;
 }
 
@@ -97,7 +108,7 @@ static inline sy_rt_material rt_emitter(sy_rt_device *dev, float r, float g, flo
     d.emissive[1] = g;
     d.emissive[2] = b;
     sy_rt_material m;
-    MUST(sy_rt_material_create(dev, &d, &m, ERR));
+    MUST(sy_rt_material_create(dev, &d, &m));
     return m;
 }
 
@@ -112,7 +123,7 @@ static inline sy_rt_material rt_lambert(sy_rt_device *dev, float r, float g, flo
     d.metallic = 0.0f;
     d.specular = 0.0f;
     sy_rt_material m;
-    MUST(sy_rt_material_create(dev, &d, &m, ERR));
+    MUST(sy_rt_material_create(dev, &d, &m));
     return m;
 }
 
@@ -148,7 +159,7 @@ static inline void rt_render(sy_rt_device *dev, const sy_rt_camera *cam, const s
         fprintf(stderr, "out of memory\n");
         exit(1);
     }
-    MUST(sy_rt_render(dev, cam, d, *rgba, *depth, ERR));
+    MUST(sy_rt_render(dev, cam, d, *rgba, *depth));
 }
 
 /* Irradiance at a floor point (normal +Z) from a Lambertian square of radiance le, half-size s,
@@ -170,8 +181,8 @@ static inline double rt_square_irradiance_at(double le, double s, double h, doub
 static inline sy_rt_device *rt_device(void)
 {
     sy_rt_device *dev = NULL;
-    sy_rt_device_desc dd = {0};
-    MUST(sy_rt_device_create(&dd, &dev, ERR));
+    sy_rt_device_desc dd = rt_test_device_desc();
+    MUST(sy_rt_device_create(&dd, &dev));
     return dev;
 }
 
@@ -188,7 +199,7 @@ static inline sy_rt_camera rt_grazing_emitter_scene(sy_rt_device *dev, double *e
     rt_place(dev, rt_quad(dev, 20.0f), xf, rt_lambert(dev, albedo, albedo, albedo), 0);
     rt_rot_y(em, (float)M_PI, 0.0f, 0.0f, 1.0f);
     rt_place(dev, rt_quad(dev, s), em, rt_emitter(dev, le, le, le), 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(0.5f, 0.02f);
     cam.camera_to_world[12] = d;
     *expect = albedo / M_PI * rt_square_irradiance_at(le, s, 1.0, d);

@@ -6,94 +6,88 @@
 
 static void test_mesh_validation(sy_rt_device *dev)
 {
-    char err[256];
     sy_rt_mesh m;
     const float pos[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     const uint32_t bad_idx[] = {0, 1, 3};
     sy_rt_mesh_desc d = {.positions = pos, .indices = bad_idx, .vertex_count = 3, .triangle_count = 1};
-    err[0] = 0;
-    EXPECT_MSG(sy_rt_mesh_create(dev, &d, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "index past vertex count accepted");
-    EXPECT_MSG(strstr(err, "indices[2] = 3") != NULL, "message was '%s'", err);
+    EXPECT_MSG(sy_rt_mesh_create(dev, &d, &m) == SY_RT_ERROR_INVALID_ARGUMENT, "index past vertex count accepted");
+    EXPECT_MSG(strstr(sy_rt_device_error(dev), "indices[2] = 3") != NULL, "message was '%s'", sy_rt_device_error(dev));
     EXPECT_MSG(m.id == 0, "failed create left a handle");
 
     float nan_pos[] = {0, 0, 0, 1, NAN, 0, 0, 1, 0};
     sy_rt_mesh_desc dn = {.positions = nan_pos, .vertex_count = 3, .triangle_count = 1};
-    err[0] = 0;
-    EXPECT_MSG(sy_rt_mesh_create(dev, &dn, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "NaN position accepted");
-    EXPECT_MSG(strstr(err, "vertex 1") != NULL && strstr(err, "not finite") != NULL, "message was '%s'", err);
+    EXPECT_MSG(sy_rt_mesh_create(dev, &dn, &m) == SY_RT_ERROR_INVALID_ARGUMENT, "NaN position accepted");
+    EXPECT_MSG(strstr(sy_rt_device_error(dev), "vertex 1") != NULL && strstr(sy_rt_device_error(dev), "not finite") != NULL, "message was '%s'", sy_rt_device_error(dev));
 
     sy_rt_mesh_desc dc = {.positions = pos, .vertex_count = 3, .triangle_count = 2};
-    err[0] = 0;
-    EXPECT_MSG(sy_rt_mesh_create(dev, &dc, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "inconsistent counts accepted");
-    EXPECT_MSG(strstr(err, "3 * triangle_count") != NULL, "message was '%s'", err);
+    EXPECT_MSG(sy_rt_mesh_create(dev, &dc, &m) == SY_RT_ERROR_INVALID_ARGUMENT, "inconsistent counts accepted");
+    EXPECT_MSG(strstr(sy_rt_device_error(dev), "3 * triangle_count") != NULL, "message was '%s'", sy_rt_device_error(dev));
 
     sy_rt_mesh_desc dz = {.positions = NULL, .vertex_count = 3, .triangle_count = 1};
-    EXPECT_MSG(sy_rt_mesh_create(dev, &dz, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "NULL positions accepted");
+    EXPECT_MSG(sy_rt_mesh_create(dev, &dz, &m) == SY_RT_ERROR_INVALID_ARGUMENT, "NULL positions accepted");
 
     float inf_nrm[] = {0, 0, 1, 0, 0, INFINITY, 0, 0, 1};
     sy_rt_mesh_desc dnn = {.positions = pos, .normals = inf_nrm, .vertex_count = 3, .triangle_count = 1};
-    EXPECT_MSG(sy_rt_mesh_create(dev, &dnn, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "infinite normal accepted");
+    EXPECT_MSG(sy_rt_mesh_create(dev, &dnn, &m) == SY_RT_ERROR_INVALID_ARGUMENT, "infinite normal accepted");
 
     sy_rt_mesh_desc ok = {.positions = pos, .vertex_count = 3, .triangle_count = 1};
-    EXPECT_MSG(sy_rt_mesh_create(dev, &ok, &m, err, sizeof err) == SY_RT_OK, "valid non-indexed mesh rejected: %s", err);
-    EXPECT_MSG(sy_rt_mesh_destroy(dev, m, err, sizeof err) == SY_RT_OK, "destroy failed: %s", err);
-    EXPECT_MSG(sy_rt_mesh_destroy(dev, m, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "double destroy not detected");
+    EXPECT_MSG(sy_rt_mesh_create(dev, &ok, &m) == SY_RT_OK, "valid non-indexed mesh rejected: %s", sy_rt_device_error(dev));
+    EXPECT_MSG(sy_rt_mesh_destroy(dev, m) == SY_RT_OK, "destroy failed: %s", sy_rt_device_error(dev));
+    EXPECT_MSG(sy_rt_mesh_destroy(dev, m) == SY_RT_ERROR_INVALID_HANDLE, "double destroy not detected");
 }
 
 static void test_other_validation(sy_rt_device *dev)
 {
-    char err[256];
     sy_rt_material_desc md;
     sy_rt_material_desc_init(&md);
     md.roughness = 1.5f;
     sy_rt_material mat;
-    EXPECT_MSG(sy_rt_material_create(dev, &md, &mat, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "roughness 1.5 accepted");
-    EXPECT_MSG(strstr(err, "roughness") != NULL, "message was '%s'", err);
+    EXPECT_MSG(sy_rt_material_create(dev, &md, &mat) == SY_RT_ERROR_INVALID_ARGUMENT, "roughness 1.5 accepted");
+    EXPECT_MSG(strstr(sy_rt_device_error(dev), "roughness") != NULL, "message was '%s'", sy_rt_device_error(dev));
     sy_rt_material_desc_init(&md);
     md.base_color_texture.texture.id = 0x00400001u; /* never issued */
-    EXPECT_MSG(sy_rt_material_create(dev, &md, &mat, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "stale texture accepted");
+    EXPECT_MSG(sy_rt_material_create(dev, &md, &mat) == SY_RT_ERROR_INVALID_HANDLE, "stale texture accepted");
 
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_SPOT, .color = {1, 1, 1}, .intensity = 1, .direction = {0, 0, -1},
                            .inner_cone_angle = 0.8f, .outer_cone_angle = 0.4f};
     sy_rt_light light;
-    EXPECT_MSG(sy_rt_light_create(dev, &ld, &light, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "inner > outer accepted");
-    EXPECT_MSG(strstr(err, "cone") != NULL, "message was '%s'", err);
+    EXPECT_MSG(sy_rt_light_create(dev, &ld, &light) == SY_RT_ERROR_INVALID_ARGUMENT, "inner > outer accepted");
+    EXPECT_MSG(strstr(sy_rt_device_error(dev), "cone") != NULL, "message was '%s'", sy_rt_device_error(dev));
 
     uint8_t px[4] = {0};
     sy_rt_texture_desc td = {.width = 1, .height = 1, .channels = 5, .format = SY_RT_TEXEL_UNORM8, .pixels = px};
     sy_rt_texture tex;
-    EXPECT_MSG(sy_rt_texture_create(dev, &td, &tex, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "5 channels accepted");
+    EXPECT_MSG(sy_rt_texture_create(dev, &td, &tex) == SY_RT_ERROR_INVALID_ARGUMENT, "5 channels accepted");
 
     sy_rt_mesh q = rt_quad(dev, 1.0f);
     float singular[16] = {0};
     sy_rt_instance_desc id = {.mesh = q};
     memcpy(id.transform, singular, sizeof singular);
     sy_rt_instance inst;
-    EXPECT_MSG(sy_rt_instance_create(dev, &id, &inst, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "singular transform accepted");
-    EXPECT_MSG(strstr(err, "singular") != NULL, "message was '%s'", err);
-    MUST(sy_rt_mesh_destroy(dev, q, ERR));
-    EXPECT_MSG(sy_rt_instance_create(dev, &id, &inst, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "stale mesh accepted");
+    EXPECT_MSG(sy_rt_instance_create(dev, &id, &inst) == SY_RT_ERROR_INVALID_ARGUMENT, "singular transform accepted");
+    EXPECT_MSG(strstr(sy_rt_device_error(dev), "singular") != NULL, "message was '%s'", sy_rt_device_error(dev));
+    MUST(sy_rt_mesh_destroy(dev, q));
+    EXPECT_MSG(sy_rt_instance_create(dev, &id, &inst) == SY_RT_ERROR_INVALID_HANDLE, "stale mesh accepted");
 }
 
 static void test_lifetime_and_commit(sy_rt_device *dev)
 {
-    char err[256];
     sy_rt_mesh q = rt_quad(dev, 1.0f);
     sy_rt_material em = rt_emitter(dev, 1, 2, 3);
     float xf[16];
     rt_identity(xf);
     sy_rt_instance inst = rt_place(dev, q, xf, em, 0);
     /* The mesh handle goes first; the instance keeps the geometry alive. */
-    MUST(sy_rt_mesh_destroy(dev, q, ERR));
+    MUST(sy_rt_mesh_destroy(dev, q));
 
     sy_rt_camera cam = rt_camera(5.0f, 0.5f);
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, 9, 9);
     float rgba[9 * 9 * 4];
-    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_INVALID_OPERATION,
+    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL) == SY_RT_ERROR_INVALID_OPERATION,
                "render with uncommitted changes accepted");
-    EXPECT_MSG(strstr(err, "sy_rt_commit") != NULL, "message was '%s'", err);
-    MUST(sy_rt_commit(dev, ERR));
-    MUST(sy_rt_render(dev, &cam, &rd, rgba, NULL, ERR));
+    EXPECT_MSG(strstr(sy_rt_device_error(dev), "sy_rt_commit") != NULL, "message was '%s'", sy_rt_device_error(dev));
+    MUST(sy_rt_commit(dev));
+    MUST(sy_rt_render(dev, &cam, &rd, rgba, NULL));
     const float *c = rgba + 4 * (4 * 9 + 4);
     EXPECT_MSG(c[0] == 1.0f && c[1] == 2.0f && c[2] == 3.0f && c[3] == 1.0f, "centre %g %g %g %g", c[0], c[1], c[2], c[3]);
 
@@ -103,27 +97,27 @@ static void test_lifetime_and_commit(sy_rt_device *dev)
                st.area_light_triangles);
 
     rd.integrator = (sy_rt_integrator)99; /* 3 is the path tracer, 4 reserved */
-    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_UNSUPPORTED, "unknown integrator accepted");
+    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL) == SY_RT_ERROR_UNSUPPORTED, "unknown integrator accepted");
     rd.integrator = SY_RT_INTEGRATOR_WHITTED;
     rd.x = 5;
     rd.width = 5;
-    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "rectangle outside accepted");
+    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL) == SY_RT_ERROR_INVALID_ARGUMENT, "rectangle outside accepted");
     rd.x = 0;
     rd.width = 9;
     sy_rt_camera bad = cam;
     bad.window[0] = bad.window[1];
-    EXPECT_MSG(sy_rt_render(dev, &bad, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "empty window accepted");
+    EXPECT_MSG(sy_rt_render(dev, &bad, &rd, rgba, NULL) == SY_RT_ERROR_INVALID_ARGUMENT, "empty window accepted");
 
-    MUST(sy_rt_instance_destroy(dev, inst, ERR));
-    EXPECT_MSG(sy_rt_instance_set_transform(dev, inst, xf, err, sizeof err) == SY_RT_ERROR_INVALID_HANDLE, "stale instance accepted");
-    MUST(sy_rt_material_destroy(dev, em, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_instance_destroy(dev, inst));
+    EXPECT_MSG(sy_rt_instance_set_transform(dev, inst, xf) == SY_RT_ERROR_INVALID_HANDLE, "stale instance accepted");
+    MUST(sy_rt_material_destroy(dev, em));
+    MUST(sy_rt_commit(dev));
     sy_rt_device_stats(dev, &st);
     EXPECT_MSG(st.instances == 0 && st.materials == 0 && st.area_light_triangles == 0, "stats after destroy %u %u %u",
                st.instances, st.materials, st.area_light_triangles);
 
     /* Cancellation through the progress callback. */
-    MUST(sy_rt_render(dev, &cam, &rd, rgba, NULL, ERR));
+    MUST(sy_rt_render(dev, &cam, &rd, rgba, NULL));
 }
 
 static bool cancel_cb(const sy_rt_progress *p, void *user)
@@ -135,14 +129,13 @@ static bool cancel_cb(const sy_rt_progress *p, void *user)
 
 static void test_progress(sy_rt_device *dev)
 {
-    char err[256];
     sy_rt_camera cam = rt_camera(5.0f, 0.5f);
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_PRIMARY, 64, 64);
     int calls = 0;
     rd.progress = cancel_cb;
     rd.progress_user_data = &calls;
     float *rgba = malloc(64 * 64 * 4 * sizeof(float));
-    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL, err, sizeof err) == SY_RT_ERROR_CANCELLED, "cancel ignored");
+    EXPECT_MSG(sy_rt_render(dev, &cam, &rd, rgba, NULL) == SY_RT_ERROR_CANCELLED, "cancel ignored");
     EXPECT_MSG(calls >= 1 && calls < 16, "progress called %d times for 16 tiles with cancel after the first", calls);
     free(rgba);
 }
@@ -154,7 +147,6 @@ static void count_release(void *user) { ++*(int *)user; }
  * create that failed. */
 static void test_shared_mesh(void)
 {
-    char err[256];
     /* positions padded by one float (Embree reads 16 bytes at the last vertex) */
     const float pos[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0, 0};
     const float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
@@ -167,7 +159,7 @@ static void test_shared_mesh(void)
         sy_rt_mesh_desc d = {.positions = pos, .normals = nrm, .uv = {uv, NULL}, .indices = idx, .vertex_count = 4,
                              .triangle_count = 2, .release = shared ? count_release : NULL, .release_user = &released};
         sy_rt_mesh m;
-        MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+        MUST(sy_rt_mesh_create(dev, &d, &m));
         sy_rt_stats st;
         sy_rt_device_stats(dev, &st);
         if (shared)
@@ -181,22 +173,22 @@ static void test_shared_mesh(void)
         float xf[16];
         rt_identity(xf);
         sy_rt_instance inst = rt_place(dev, m, xf, mat, 0);
-        MUST(sy_rt_mesh_destroy(dev, m, ERR));
+        MUST(sy_rt_mesh_destroy(dev, m));
         EXPECT_MSG(released == 0, "released while an instance uses the mesh");
-        MUST(sy_rt_commit(dev, ERR));
+        MUST(sy_rt_commit(dev));
         sy_rt_camera cam = rt_camera(5.0f, 0.5f);
         sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, 16, 16);
         float *depth = NULL;
         rt_render(dev, &cam, &rd, &img[shared], &depth);
         free(depth);
-        MUST(sy_rt_instance_destroy(dev, inst, ERR));
+        MUST(sy_rt_instance_destroy(dev, inst));
         EXPECT_MSG(released == shared, "release called %d times after the last instance went (expected %d)", released, shared);
         /* a failed create leaves the arrays with the caller */
         const uint32_t bad[] = {0, 1, 7};
         sy_rt_mesh_desc db = d;
         db.indices = bad;
         db.triangle_count = 1;
-        EXPECT_MSG(sy_rt_mesh_create(dev, &db, &m, err, sizeof err) == SY_RT_ERROR_INVALID_ARGUMENT, "bad index accepted");
+        EXPECT_MSG(sy_rt_mesh_create(dev, &db, &m) == SY_RT_ERROR_INVALID_ARGUMENT, "bad index accepted");
         sy_rt_device_destroy(dev);
         EXPECT_MSG(released == shared, "release called %d times in all (expected %d)", released, shared);
     }
@@ -209,10 +201,9 @@ static void test_shared_mesh(void)
  * available, before Embree builds anything. */
 static void test_memory_limit(void)
 {
-    char err[256];
     sy_rt_device_desc dd = {.max_memory_bytes = 1u << 20};
     sy_rt_device *dev = NULL;
-    MUST(sy_rt_device_create(&dd, &dev, ERR));
+    MUST(sy_rt_device_create(&dd, &dev));
     enum { G = 100 }; /* 2 G^2 = 20000 triangles: about 2.4 MB of BVH */
     float *pos = malloc((G + 1) * (G + 1) * 3 * sizeof(float));
     uint32_t *idx = malloc(G * G * 6 * sizeof(uint32_t));
@@ -225,31 +216,74 @@ static void test_memory_limit(void)
         }
     sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = (G + 1) * (G + 1), .triangle_count = 2 * G * G};
     sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    MUST(sy_rt_mesh_create(dev, &d, &m));
     float xf[16];
     rt_identity(xf);
     sy_rt_instance_desc id = {.mesh = m};
     memcpy(id.transform, xf, sizeof xf);
     sy_rt_instance inst;
-    err[0] = 0;
-    EXPECT_MSG(sy_rt_instance_create(dev, &id, &inst, err, sizeof err) == SY_RT_ERROR_OUT_OF_MEMORY,
+    EXPECT_MSG(sy_rt_instance_create(dev, &id, &inst) == SY_RT_ERROR_OUT_OF_MEMORY,
                "a BVH over the device's memory limit was built");
-    EXPECT_MSG(strstr(err, "20000 triangles needs about 2.4 MB") && strstr(err, "MB left under the device's memory limit"),
-               "message was '%s'", err);
+    EXPECT_MSG(strstr(sy_rt_device_error(dev), "20000 triangles needs about 2.4 MB") && strstr(sy_rt_device_error(dev), "MB left under the device's memory limit"),
+               "message was '%s'", sy_rt_device_error(dev));
     sy_rt_device_destroy(dev);
     /* without a limit of its own the device builds it */
-    MUST(sy_rt_device_create(NULL, &dev, ERR));
-    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    MUST(sy_rt_device_create(NULL, &dev));
+    MUST(sy_rt_mesh_create(dev, &d, &m));
     id.mesh = m;
-    MUST(sy_rt_instance_create(dev, &id, &inst, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_instance_create(dev, &id, &inst));
+    MUST(sy_rt_commit(dev));
     sy_rt_device_destroy(dev);
     free(pos);
     free(idx);
 }
 
+/* The error report: the desc's callback receives each failure once, with the code the call returns
+ * and the message sy_rt_device_error keeps; sy_rt_device_create's own failures reach it too. */
+typedef struct report_log {
+    int calls;
+    sy_rt_result code;
+    char message[512];
+} report_log;
+static void on_error(void *user, sy_rt_result code, const char *message)
+{
+    report_log *l = user;
+    l->calls++;
+    l->code = code;
+    snprintf(l->message, sizeof l->message, "%s", message);
+}
+
+static void test_error_report(void)
+{
+    report_log log = {0};
+    sy_rt_device_desc dd = {.error = on_error, .error_user = &log};
+    EXPECT_MSG(sy_rt_device_create(&dd, NULL) == SY_RT_ERROR_INVALID_ARGUMENT && log.calls == 1 &&
+                   log.code == SY_RT_ERROR_INVALID_ARGUMENT && strstr(log.message, "out is NULL"),
+               "device create: %d calls, code %d, '%s'", log.calls, (int)log.code, log.message);
+    sy_rt_device *dev = NULL;
+    MUST(sy_rt_device_create(&dd, &dev));
+    EXPECT_MSG(log.calls == 1 && strcmp(sy_rt_device_error(dev), "") == 0, "a new device reports '%s'",
+               sy_rt_device_error(dev));
+    sy_rt_material_desc md;
+    sy_rt_material_desc_init(&md);
+    md.roughness = -1.0f;
+    sy_rt_material mat;
+    EXPECT(sy_rt_material_create(dev, &md, &mat) == SY_RT_ERROR_INVALID_ARGUMENT);
+    EXPECT_MSG(log.calls == 2 && log.code == SY_RT_ERROR_INVALID_ARGUMENT && strstr(log.message, "roughness") &&
+                   strcmp(log.message, sy_rt_device_error(dev)) == 0,
+               "material: %d calls, code %d, '%s' / '%s'", log.calls, (int)log.code, log.message, sy_rt_device_error(dev));
+    sy_rt_accum *acc = NULL;
+    EXPECT(sy_rt_accum_create(dev, 0, 4, &acc) == SY_RT_ERROR_INVALID_ARGUMENT && log.calls == 3 && acc == NULL);
+    MUST(sy_rt_commit(dev));
+    EXPECT_MSG(log.calls == 3, "a call that succeeded reported (%d calls)", log.calls);
+    sy_rt_device_destroy(dev);
+    EXPECT(sy_rt_accum_create(NULL, 0, 4, &acc) == SY_RT_ERROR_INVALID_ARGUMENT); /* no device: the code only */
+    EXPECT(strcmp(sy_rt_device_error(NULL), "") == 0);
+}
+
 int main(void)
 {
+    test_error_report();
     sy_rt_device *dev = rt_device();
     test_mesh_validation(dev);
     test_other_validation(dev);

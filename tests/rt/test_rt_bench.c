@@ -30,7 +30,7 @@ static sy_rt_mesh sphere(sy_rt_device *dev, int n)
     sy_rt_mesh_desc md = {.positions = pos, .normals = nrm, .indices = idx, .vertex_count = (uint32_t)nv,
                           .triangle_count = (uint32_t)(2 * n * n)};
     sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &md, &m, ERR));
+    MUST(sy_rt_mesh_create(dev, &md, &m));
     free(pos);
     free(nrm);
     free(idx);
@@ -51,10 +51,10 @@ int main(void)
     rt_identity(xf);
     rt_translation(xf, 0.0f, 0.0f, -1.5f);
     rt_place(dev, rt_quad(dev, 20.0f), xf, mat, SY_RT_INSTANCE_BAKED);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(12.0f, 0.7f);
     sy_rt_bench_result r;
-    MUST(sy_rt_bench_rays(dev, &cam, 512, 512, 5, &r, ERR));
+    MUST(sy_rt_bench_rays(dev, &cam, 512, 512, 5, &r));
     printf("bench 512x512, %u threads: primary %.2f Mrays/s, raw embree %.2f Mrays/s, overhead %.1f %%\n", r.threads,
            r.primary_mrays, r.raw_mrays, r.overhead_percent);
     EXPECT_MSG(r.primary_mrays > 0 && r.raw_mrays > 0 && isfinite(r.overhead_percent), "bench numbers %g %g %g", r.primary_mrays,

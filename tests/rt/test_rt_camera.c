@@ -83,7 +83,7 @@ static void test_depth(void)
     float pxf[16];
     rt_rot_y(pxf, 0.5235988f, 0.0f, 0.0f, 0.0f);
     rt_place(dev, rt_quad(dev, 50.0f), pxf, rt_lambert(dev, 0.7f, 0.7f, 0.7f), SY_RT_INSTANCE_BAKED);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     const int w = 24, h = 16;
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, w, h);
     /* Off-axis window, camera rotated 30 degrees about Y looking at a plane perpendicular to its axis. */
@@ -176,7 +176,7 @@ int main(void)
     float blk[16];
     rt_translation(blk, 1.5f, 0.5f, 1.5f);
     rt_place(dev, rt_quad(dev, 0.3f), blk, rt_lambert(dev, 0.2f, 0.9f, 0.2f), 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
 
     test_off_axis_shift(dev);
     test_depth();

@@ -30,7 +30,7 @@ int main(void)
     sy_rt_instance far_q = rt_place(dev, big, xf, m, 0);
     rt_translation(xf, 0.503f, 0.0037f, 1); /* edges off the pixel centres */
     sy_rt_instance near_q = rt_place(dev, small, xf, m, SY_RT_INSTANCE_BAKED);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     float t = 0.2f;
     sy_rt_camera cam = rt_camera(5.0f, t);
     cam.window[0] = -t * (float)W / (float)H;
@@ -38,7 +38,7 @@ int main(void)
     sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, H); /* integrator is ignored */
     uint32_t ids[W * H], part[W * H];
     float depth[W * H];
-    MUST(sy_rt_coverage(dev, &cam, &d, ids, depth, ERR));
+    MUST(sy_rt_coverage(dev, &cam, &d, ids, depth));
     int wrong = 0, n_far = 0, n_near = 0;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
@@ -55,27 +55,26 @@ int main(void)
     /* a sub-rectangle equals the crop of the full image */
     sy_rt_render_desc sub = d;
     sub.x = 37, sub.y = 21, sub.width = 41, sub.height = 33;
-    MUST(sy_rt_coverage(dev, &cam, &sub, part, NULL, ERR));
+    MUST(sy_rt_coverage(dev, &cam, &sub, part, NULL));
     int diff = 0;
     for (uint32_t y = 0; y < sub.height; ++y)
         for (uint32_t x = 0; x < sub.width; ++x) diff += part[y * sub.width + x] != ids[(y + sub.y) * W + x + sub.x];
     EXPECT_MSG(diff == 0, "%d sub-rectangle pixels differ from the full image", diff);
 
     /* hiding the near quad uncovers the far one behind it */
-    MUST(sy_rt_instance_set_visible(dev, near_q, false, ERR));
-    MUST(sy_rt_commit(dev, ERR));
-    MUST(sy_rt_coverage(dev, &cam, &d, ids, NULL, ERR));
+    MUST(sy_rt_instance_set_visible(dev, near_q, false));
+    MUST(sy_rt_commit(dev));
+    MUST(sy_rt_coverage(dev, &cam, &d, ids, NULL));
     wrong = 0;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) wrong += ids[y * W + x] != expected_id(x, y, t, far_q.id, near_q.id, false);
     EXPECT_MSG(wrong == 0, "%d pixels wrong with the near quad hidden", wrong);
 
     /* uncommitted changes and NULL output are refused with a message */
-    char msg[256] = "";
-    MUST(sy_rt_instance_set_visible(dev, near_q, true, ERR));
-    EXPECT_MSG(sy_rt_coverage(dev, &cam, &d, ids, NULL, msg, sizeof msg) == SY_RT_ERROR_INVALID_OPERATION, "%s", msg);
-    MUST(sy_rt_commit(dev, ERR));
-    EXPECT_MSG(sy_rt_coverage(dev, &cam, &d, NULL, NULL, msg, sizeof msg) == SY_RT_ERROR_INVALID_ARGUMENT, "%s", msg);
+    MUST(sy_rt_instance_set_visible(dev, near_q, true));
+    EXPECT_MSG(sy_rt_coverage(dev, &cam, &d, ids, NULL) == SY_RT_ERROR_INVALID_OPERATION, "%s", sy_rt_device_error(dev));
+    MUST(sy_rt_commit(dev));
+    EXPECT_MSG(sy_rt_coverage(dev, &cam, &d, NULL, NULL) == SY_RT_ERROR_INVALID_ARGUMENT, "%s", sy_rt_device_error(dev));
     sy_rt_device_destroy(dev);
     return sy_check_finish("rt_coverage");
 }

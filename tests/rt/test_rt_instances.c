@@ -43,43 +43,43 @@ static void test_move_hide_destroy(uint32_t flags)
     float xf[16];
     rt_translation(xf, -1.0f, 0.0f, 0.0f);
     sy_rt_instance inst = rt_place(dev, q, xf, green, flags);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     int n;
     double c0 = render_centroid(dev, &n);
     EXPECT_MSG(n == 64 && fabs(c0 - 12.0) < 1e-9, "flags %u: emitter at x=-1: %d px centred at column %g (expected 64 at 12)", flags, n, c0);
 
     rt_translation(xf, 1.0f, 0.0f, 0.0f);
-    MUST(sy_rt_instance_set_transform(dev, inst, xf, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_instance_set_transform(dev, inst, xf));
+    MUST(sy_rt_commit(dev));
     double c1 = render_centroid(dev, &n);
     EXPECT_MSG(n == 64 && fabs(c1 - c0 - 16.0) < 1e-9, "flags %u: moved 2 m = 16 px: centroid %g -> %g", flags, c0, c1);
 
-    MUST(sy_rt_instance_set_visible(dev, inst, false, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_instance_set_visible(dev, inst, false));
+    MUST(sy_rt_commit(dev));
     render_centroid(dev, &n);
     EXPECT_MSG(n == 0, "flags %u: hidden instance still visible (%d px)", flags, n);
-    MUST(sy_rt_instance_set_visible(dev, inst, true, ERR));
+    MUST(sy_rt_instance_set_visible(dev, inst, true));
 
     /* A second instance of the same mesh. */
     rt_translation(xf, -1.0f, 0.0f, 0.0f);
     sy_rt_instance second = rt_place(dev, q, xf, green, flags ^ SY_RT_INSTANCE_BAKED);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     double c2 = render_centroid(dev, &n);
     EXPECT_MSG(n == 128 && fabs(c2 - 20.0) < 1e-9, "flags %u: two instances: %d px centred at %g", flags, n, c2);
 
-    MUST(sy_rt_instance_destroy(dev, inst, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_instance_destroy(dev, inst));
+    MUST(sy_rt_commit(dev));
     double c3 = render_centroid(dev, &n);
     EXPECT_MSG(n == 64 && fabs(c3 - 12.0) < 1e-9, "flags %u: after destroy: %d px at %g", flags, n, c3);
 
     /* Material change: the remaining instance turns red. */
-    MUST(sy_rt_instance_set_material(dev, second, rt_emitter(dev, 1.0f, 0.0f, 0.0f), ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_instance_set_material(dev, second, rt_emitter(dev, 1.0f, 0.0f, 0.0f)));
+    MUST(sy_rt_commit(dev));
     render_centroid(dev, &n);
     EXPECT_MSG(n == 0, "flags %u: material change ignored", flags);
-    MUST(sy_rt_instance_destroy(dev, second, ERR));
-    MUST(sy_rt_mesh_destroy(dev, q, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_instance_destroy(dev, second));
+    MUST(sy_rt_mesh_destroy(dev, q));
+    MUST(sy_rt_commit(dev));
     sy_rt_stats st;
     sy_rt_device_stats(dev, &st);
     EXPECT_MSG(st.instances == 0 && st.meshes == 0 && st.area_light_triangles == 0, "stats %u %u %u", st.instances, st.meshes,
@@ -110,11 +110,11 @@ static void test_area_light_follows(void)
     sy_rt_material_desc_init(&md);
     md.emissive[0] = md.emissive[1] = md.emissive[2] = 5.0f;
     sy_rt_material em;
-    MUST(sy_rt_material_create(dev, &md, &em, ERR));
+    MUST(sy_rt_material_create(dev, &md, &em));
     float lamp[16];
     rt_rot_y(lamp, (float)M_PI, 0.0f, 0.0f, 1.0f);
     sy_rt_instance li = rt_place(dev, rt_quad(dev, 0.2f), lamp, em, 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     float v1 = floor_centre(dev);
     /* Irradiance under the centre of a 0.4 x 0.4 square of radiance Le at height 1: Le * pi * F
      * with the point-to-parallel-rectangle form factor, four 0.2 x 0.2 corner rectangles:
@@ -124,24 +124,24 @@ static void test_area_light_follows(void)
     double exact1 = 0.8 / M_PI * 5.0 * M_PI * F;
     EXPECT_MSG(rt_near(v1, exact1, 0.01), "lamp at 1 m: %g, expected %g", v1, exact1);
     rt_rot_y(lamp, (float)M_PI, 0.0f, 0.0f, 2.0f);
-    MUST(sy_rt_instance_set_transform(dev, li, lamp, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_instance_set_transform(dev, li, lamp));
+    MUST(sy_rt_commit(dev));
     float v2 = floor_centre(dev);
     EXPECT_MSG(rt_near(v2, v1 / 4.0, 0.05), "lamp moved to 2 m: %g, expected about %g (inverse square)", v2, v1 / 4.0);
     /* Emission doubled through a material update. */
     md.emissive[0] = md.emissive[1] = md.emissive[2] = 10.0f;
-    MUST(sy_rt_material_update(dev, em, &md, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_material_update(dev, em, &md));
+    MUST(sy_rt_commit(dev));
     float v3 = floor_centre(dev);
     EXPECT_MSG(rt_near(v3, 2.0 * v2, 1e-5), "emission doubled: %g, expected %g", v3, 2.0 * v2);
     /* Double-sided emitter facing away still lights the floor; single-sided does not. */
     rt_rot_y(lamp, 0.0f, 0.0f, 0.0f, 2.0f);
-    MUST(sy_rt_instance_set_transform(dev, li, lamp, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_instance_set_transform(dev, li, lamp));
+    MUST(sy_rt_commit(dev));
     EXPECT_MSG(floor_centre(dev) == 0.0f, "single-sided emitter facing away lights the floor");
     md.double_sided = true;
-    MUST(sy_rt_material_update(dev, em, &md, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_material_update(dev, em, &md));
+    MUST(sy_rt_commit(dev));
     EXPECT_MSG(rt_near(floor_centre(dev), v3, 1e-5), "double-sided emitter: %g, expected %g", floor_centre(dev), v3);
     sy_rt_device_destroy(dev);
 }
@@ -172,13 +172,13 @@ static void grid_build(grid_scene *g, const unsigned char *moved)
                               rt_lambert(g->dev, 0.2f, 0.2f, 0.8f)};
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 40.0f, .position = {0, 1, 4}};
     sy_rt_light l;
-    MUST(sy_rt_light_create(g->dev, &ld, &l, ERR));
+    MUST(sy_rt_light_create(g->dev, &ld, &l));
     for (int i = 0; i < GRID * GRID; ++i) {
         float xf[16];
         grid_xf(i, moved && moved[i], xf);
         g->inst[i] = rt_place(g->dev, q, xf, mats[i % 3], i % 2 ? SY_RT_INSTANCE_BAKED : 0u);
     }
-    MUST(sy_rt_commit(g->dev, ERR));
+    MUST(sy_rt_commit(g->dev));
 }
 
 /* Whitted (shadows) and primary (ray packets) renders must match the from-scratch device bit for bit. */
@@ -218,8 +218,8 @@ static void test_moves_match_rebuild(void)
         moved[first[k]] = 1;
         grid_xf(first[k], 1, xf);
         if (k == 0) rt_translation(xf, 9.0f, 9.0f, 0.0f); /* an intermediate pose, moved again below */
-        MUST(sy_rt_instance_set_transform(g.dev, g.inst[first[k]], xf, ERR));
-        MUST(sy_rt_commit(g.dev, ERR));
+        MUST(sy_rt_instance_set_transform(g.dev, g.inst[first[k]], xf));
+        MUST(sy_rt_commit(g.dev));
     }
     sy_rt_device_stats(g.dev, &st);
     EXPECT_MSG(st.top_builds == builds && st.moved_instances == 4, "4 moved instances: %llu full builds (expected %llu), %u "
@@ -227,10 +227,10 @@ static void test_moves_match_rebuild(void)
     grid_compare(&g, moved, "4 moved instances");
 
     /* Hiding and showing a moved instance is structural: a full build folds the twins back. */
-    MUST(sy_rt_instance_set_visible(g.dev, g.inst[100], false, ERR));
-    MUST(sy_rt_commit(g.dev, ERR));
-    MUST(sy_rt_instance_set_visible(g.dev, g.inst[100], true, ERR));
-    MUST(sy_rt_commit(g.dev, ERR));
+    MUST(sy_rt_instance_set_visible(g.dev, g.inst[100], false));
+    MUST(sy_rt_commit(g.dev));
+    MUST(sy_rt_instance_set_visible(g.dev, g.inst[100], true));
+    MUST(sy_rt_commit(g.dev));
     sy_rt_device_stats(g.dev, &st);
     EXPECT_MSG(st.top_builds == builds + 2 && st.moved_instances == 0, "hide + show: %llu builds, %u twins",
                (unsigned long long)(st.top_builds - builds), st.moved_instances);
@@ -242,9 +242,9 @@ static void test_moves_match_rebuild(void)
         float xf[16];
         moved[i] = 1;
         grid_xf(i, 1, xf);
-        MUST(sy_rt_instance_set_transform(g.dev, g.inst[i], xf, ERR));
+        MUST(sy_rt_instance_set_transform(g.dev, g.inst[i], xf));
     }
-    MUST(sy_rt_commit(g.dev, ERR));
+    MUST(sy_rt_commit(g.dev));
     sy_rt_device_stats(g.dev, &st);
     EXPECT_MSG(st.top_builds == builds + 1 && st.moved_instances == 0, "108 moves in one commit: %llu builds, %u twins",
                (unsigned long long)(st.top_builds - builds), st.moved_instances);
@@ -254,12 +254,12 @@ static void test_moves_match_rebuild(void)
     float xf[16];
     grid_xf(1, 1, xf);
     moved[1] = 1;
-    MUST(sy_rt_instance_set_transform(g.dev, g.inst[1], xf, ERR));
-    MUST(sy_rt_commit(g.dev, ERR));
+    MUST(sy_rt_instance_set_transform(g.dev, g.inst[1], xf));
+    MUST(sy_rt_commit(g.dev));
     sy_rt_device_stats(g.dev, &st);
     EXPECT_MSG(st.moved_instances == 1, "one moved: %u twins", st.moved_instances);
-    MUST(sy_rt_instance_destroy(g.dev, g.inst[1], ERR));
-    MUST(sy_rt_commit(g.dev, ERR));
+    MUST(sy_rt_instance_destroy(g.dev, g.inst[1]));
+    MUST(sy_rt_commit(g.dev));
     sy_rt_device_stats(g.dev, &st);
     EXPECT_MSG(st.moved_instances == 0 && st.instances == GRID * GRID - 1, "destroyed the moved one: %u twins, %u instances",
                st.moved_instances, st.instances);

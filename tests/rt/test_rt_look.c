@@ -27,7 +27,7 @@ static sy_rt_texture const_texture(sy_rt_device *dev, const float c[3])
     sy_rt_texture_desc td = {.width = 1, .height = 1, .channels = 3, .format = SY_RT_TEXEL_FLOAT32, .pixels = c,
                              .wrap_t = SY_RT_WRAP_CLAMP};
     sy_rt_texture t;
-    MUST(sy_rt_texture_create(dev, &td, &t, ERR));
+    MUST(sy_rt_texture_create(dev, &td, &t));
     return t;
 }
 
@@ -40,7 +40,7 @@ static void render_depth(sy_rt_device *dev, const sy_rt_camera *cam, sy_rt_integ
     d.max_depth = max_depth;
     sy_rt_accum *acc = NULL;
     if (integ == SY_RT_INTEGRATOR_PATHTRACER) {
-        MUST(sy_rt_accum_create(w, h, &acc, ERR));
+        MUST(sy_rt_accum_create(dev, w, h, &acc));
         d.accum = acc;
         d.samples = spp;
     } else if (integ == SY_RT_INTEGRATOR_WHITTED) {
@@ -97,8 +97,8 @@ static void test_background_never_lights(void)
         sy_rt_background bg = {.mode = SY_RT_BACKGROUND_COLOR, .color = {c[0], c[1], c[2]}};
         if (mode == 1) bg = (sy_rt_background){.mode = SY_RT_BACKGROUND_TEXTURE, .texture = const_texture(dev, c), .intensity = 2.0f};
         const float k = mode == 1 ? 2.0f : 1.0f;
-        MUST(sy_rt_set_background(dev, &bg, ERR));
-        MUST(sy_rt_commit(dev, ERR));
+        MUST(sy_rt_set_background(dev, &bg));
+        MUST(sy_rt_commit(dev));
         sy_rt_camera cam = rt_camera(4.0f, 0.5f); /* the quad covers the middle half */
         for (int integ = SY_RT_INTEGRATOR_PRIMARY; integ <= SY_RT_INTEGRATOR_PATHTRACER; ++integ) {
             float *rgba, *depth;
@@ -125,16 +125,16 @@ static void test_environment_is_a_light(void)
     /* a mirror quad facing the camera reflects the environment exactly; misses stay transparent */
     {
         sy_rt_device *dev = rt_device();
-        MUST(sy_rt_set_environment(dev, const_texture(dev, L), 1.5f, ERR));
+        MUST(sy_rt_set_environment(dev, const_texture(dev, L), 1.5f));
         sy_rt_material_desc md;
         sy_rt_material_desc_init(&md);
         md.roughness = 0.0f; /* metallic 1, base 1: a perfect mirror */
         sy_rt_material mirror;
-        MUST(sy_rt_material_create(dev, &md, &mirror, ERR));
+        MUST(sy_rt_material_create(dev, &md, &mirror));
         float id[16];
         rt_identity(id);
         rt_place(dev, rt_quad(dev, 1.0f), id, mirror, 0);
-        MUST(sy_rt_commit(dev, ERR));
+        MUST(sy_rt_commit(dev));
         sy_rt_camera cam = rt_camera(4.0f, 0.5f);
         for (int integ = SY_RT_INTEGRATOR_WHITTED; integ <= SY_RT_INTEGRATOR_PATHTRACER; ++integ) {
             float *rgba, *depth;
@@ -154,11 +154,11 @@ static void test_environment_is_a_light(void)
     /* a white Lambert floor under the uniform environment: radiance = albedo x L */
     {
         sy_rt_device *dev = rt_device();
-        MUST(sy_rt_set_environment(dev, const_texture(dev, L), 1.0f, ERR));
+        MUST(sy_rt_set_environment(dev, const_texture(dev, L), 1.0f));
         float xf[16];
         floor_xf(xf, 100.0f);
         rt_place(dev, rt_quad(dev, 1.0f), xf, rt_lambert(dev, 0.7f, 0.7f, 0.7f), 0);
-        MUST(sy_rt_commit(dev, ERR));
+        MUST(sy_rt_commit(dev));
         sy_rt_camera cam = down_camera(1.0f, 0.2f);
         double m[2][3];
         for (int k = 0; k < 2; ++k) {
@@ -188,14 +188,14 @@ static void test_emission_adds(void)
     md.specular = 0.0f;
     md.emissive[0] = 0.1f, md.emissive[1] = 0.2f, md.emissive[2] = 0.3f;
     sy_rt_material m;
-    MUST(sy_rt_material_create(dev, &md, &m, ERR));
+    MUST(sy_rt_material_create(dev, &md, &m));
     float id[16];
     rt_identity(id);
     rt_place(dev, rt_quad(dev, 1.0f), id, m, 0);
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3.0f, .direction = {0, 0, -1}};
     sy_rt_light l;
-    MUST(sy_rt_light_create(dev, &ld, &l, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_light_create(dev, &ld, &l));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(4.0f, 0.2f); /* inside the quad */
     for (int integ = SY_RT_INTEGRATOR_WHITTED; integ <= SY_RT_INTEGRATOR_PATHTRACER; ++integ) {
         float *rgba, *depth;
@@ -223,14 +223,14 @@ static void shadow_case(const char *name, const sy_rt_material_desc *bd, const d
     floor_xf(xf, 10.0f);
     rt_place(dev, rt_quad(dev, 1.0f), xf, rt_lambert(dev, 1.0f, 1.0f, 1.0f), 0);
     sy_rt_material bm;
-    MUST(sy_rt_material_create(dev, bd, &bm, ERR));
+    MUST(sy_rt_material_create(dev, bd, &bm));
     floor_xf(xf, 5.0f);
     xf[13] = 2.0f; /* the blocker at y = 2, facing up */
     rt_place(dev, rt_quad(dev, 1.0f), xf, bm, 0);
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = (float)M_PI, .direction = {0, -1, 0}};
     sy_rt_light l;
-    MUST(sy_rt_light_create(dev, &ld, &l, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_light_create(dev, &ld, &l));
+    MUST(sy_rt_commit(dev));
     /* camera between blocker and floor, looking down: sees the lit floor (radiance 1 unshadowed) */
     sy_rt_camera cam = down_camera(1.0f, 0.2f);
     for (int integ = SY_RT_INTEGRATOR_WHITTED; integ <= (pt_too ? SY_RT_INTEGRATOR_PATHTRACER : SY_RT_INTEGRATOR_WHITTED);
@@ -282,12 +282,12 @@ static void test_whitted_antialiasing(void)
     ed.base_color[0] = ed.base_color[1] = ed.base_color[2] = 0.0f;
     ed.emissive[0] = 17, ed.emissive[1] = 12, ed.emissive[2] = 4;
     sy_rt_material em;
-    MUST(sy_rt_material_create(dev, &ed, &em, ERR));
+    MUST(sy_rt_material_create(dev, &ed, &em));
     float xf[16];
     rt_rot_y(xf, 0.0f, 0.0f, 0.0f, 0.0f);
     xf[0] = xf[5] = cosf(0.3f), xf[1] = sinf(0.3f), xf[4] = -sinf(0.3f); /* rotated about Z: slanted edges */
     rt_place(dev, rt_quad(dev, 1.0f), xf, em, 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(4.0f, 0.5f);
     const uint32_t W = 32;
     float *a, *da, *b, *db;
@@ -347,7 +347,7 @@ static void test_whitted_soft_shadow_noise(void)
     bx[0] = 0.2f, bx[13] = 1.0f;
     bx[6] = -3.0f;
     rt_place(dev, rt_quad(dev, 1.0f), bx, rt_lambert(dev, 0.0f, 0.0f, 0.0f), 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = down_camera(0.9f, 0.5f);
     const uint32_t W = 48;
     float *lo, *dl, *hi, *dh;

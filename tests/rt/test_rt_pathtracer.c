@@ -50,7 +50,7 @@ static sy_rt_mesh make_sphere(sy_rt_device *dev, float r, uint32_t seg, uint32_t
         }
     sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = nv, .triangle_count = nt};
     sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    MUST(sy_rt_mesh_create(dev, &d, &m));
     free(pos);
     free(idx);
     return m;
@@ -66,13 +66,13 @@ static img pt_render(sy_rt_device *dev, const sy_rt_camera *cam, uint32_t w, uin
                      uint32_t max_depth)
 {
     img r = {w, h, malloc((size_t)w * h * 4 * sizeof(float)), malloc((size_t)w * h * sizeof(float)), NULL};
-    MUST(sy_rt_accum_create(w, h, &r.acc, ERR));
+    MUST(sy_rt_accum_create(dev, w, h, &r.acc));
     sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, w, h);
     d.accum = r.acc;
     d.samples = spp;
     d.seed = seed;
     d.max_depth = max_depth;
-    MUST(sy_rt_render(dev, cam, &d, r.rgba, r.depth, ERR));
+    MUST(sy_rt_render(dev, cam, &d, r.rgba, r.depth));
     return r;
 }
 
@@ -117,16 +117,16 @@ static void furnace_case(const char *name, const sy_rt_material_desc *md, double
     sy_rt_texture_desc td = {.width = tw, .height = th, .channels = 3, .format = SY_RT_TEXEL_FLOAT32, .pixels = px,
                              .wrap_t = SY_RT_WRAP_CLAMP};
     sy_rt_texture tex;
-    MUST(sy_rt_texture_create(dev, &td, &tex, ERR));
-    MUST(sy_rt_set_environment(dev, tex, 1.0f / scale, ERR));
+    MUST(sy_rt_texture_create(dev, &td, &tex));
+    MUST(sy_rt_set_environment(dev, tex, 1.0f / scale));
     sy_rt_background bg = {.mode = SY_RT_BACKGROUND_TEXTURE, .texture = tex, .intensity = 1.0f / scale};
-    MUST(sy_rt_set_background(dev, &bg, ERR));
+    MUST(sy_rt_set_background(dev, &bg));
     sy_rt_material mat;
-    MUST(sy_rt_material_create(dev, md, &mat, ERR));
+    MUST(sy_rt_material_create(dev, md, &mat));
     float id[16];
     rt_identity(id);
     rt_place(dev, make_sphere(dev, 1.0f, 64, 32), id, mat, 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(3.0f, 0.4f);
     img im = pt_render(dev, &cam, 48, 48, 64, 1, 64);
     double m[3];
@@ -188,7 +188,7 @@ static double sphere_part(sy_rt_device *dev, float r, uint32_t seg, uint32_t rin
         }
     sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = nv, .triangle_count = nt};
     sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    MUST(sy_rt_mesh_create(dev, &d, &m));
     float id[16];
     rt_identity(id);
     rt_place(dev, m, id, mat, 0);
@@ -216,11 +216,11 @@ static void test_integrating_sphere(void)
     d.emissive[0] = 1.0f, d.emissive[1] = 2.0f, d.emissive[2] = 0.5f;
     d.double_sided = true;
     sy_rt_material glow;
-    MUST(sy_rt_material_create(dev, &d, &glow, ERR));
+    MUST(sy_rt_material_create(dev, &d, &glow));
     const float a = 0.6f;
     double up = sphere_part(dev, 2.0f, 64, 32, 0, 16, rt_lambert(dev, a, a, a));
     double down = sphere_part(dev, 2.0f, 64, 32, 16, 32, glow);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_stats st;
     sy_rt_device_stats(dev, &st);
     EXPECT_MSG(st.area_light_triangles >= 64 * 16 * 2 - 64 && st.area_light_triangles <= 64 * 16 * 2,
@@ -247,8 +247,8 @@ static void test_integrating_sphere(void)
     mean_rgb(&im1, false, m);
     EXPECT_MSG(fabs(m[1] / (a * fe * d.emissive[1]) - 1.0) < 0.01, "max_depth 1: %.5f, expected %.5f", m[1], a * fe * d.emissive[1]);
     float *dir = malloc(24 * 24 * 3 * sizeof(float)), *ind = malloc(24 * 24 * 3 * sizeof(float));
-    MUST(sy_rt_accum_read(im.acc, SY_RT_AOV_DIRECT, dir, ERR));
-    MUST(sy_rt_accum_read(im.acc, SY_RT_AOV_INDIRECT, ind, ERR));
+    MUST(sy_rt_accum_read(dev, im.acc, SY_RT_AOV_DIRECT, dir));
+    MUST(sy_rt_accum_read(dev, im.acc, SY_RT_AOV_INDIRECT, ind));
     double sd = 0, si = 0;
     for (int i = 0; i < 24 * 24; ++i) sd += dir[3 * i + 1], si += ind[3 * i + 1];
     sd /= 24 * 24, si /= 24 * 24;
@@ -264,8 +264,8 @@ static void test_integrating_sphere(void)
     sphere_part(dev, 2.0f, 64, 32, 0, 32, rt_lambert(dev, 0.5f, 0.5f, 0.5f));
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1.0f, 0.5f, 0.25f}, .intensity = 10.0f};
     sy_rt_light l;
-    MUST(sy_rt_light_create(dev, &ld, &l, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_light_create(dev, &ld, &l));
+    MUST(sy_rt_commit(dev));
     im = pt_render(dev, &cam, 24, 24, 64, 11, 64);
     mean_rgb(&im, false, m);
     for (int c = 0; c < 3; ++c) {
@@ -292,8 +292,8 @@ static void test_env_importance(void)
     sy_rt_texture_desc td = {.width = EW, .height = EH, .channels = 3, .format = SY_RT_TEXEL_FLOAT32, .pixels = px,
                              .wrap_t = SY_RT_WRAP_CLAMP, .filter = SY_RT_FILTER_NEAREST};
     sy_rt_texture tex;
-    MUST(sy_rt_texture_create(dev, &td, &tex, ERR));
-    MUST(sy_rt_set_environment(dev, tex, 1.0f, ERR));
+    MUST(sy_rt_texture_create(dev, &td, &tex));
+    MUST(sy_rt_set_environment(dev, tex, 1.0f));
     /* ground: a big white Lambertian quad facing +Y at y = 0 */
     float xf[16];
     rt_identity(xf);
@@ -301,7 +301,7 @@ static void test_env_importance(void)
     xf[5] = 0.0f, xf[6] = -100.0f; /* local y -> world -z */
     xf[9] = 1.0f, xf[10] = 0.0f;   /* local z -> world +y */
     rt_place(dev, rt_quad(dev, 1.0f), xf, rt_lambert(dev, 1.0f, 1.0f, 1.0f), 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     /* camera 1 m above the ground looking straight down, narrow view */
     sy_rt_camera cam = rt_camera(0.0f, 0.05f);
     memset(cam.camera_to_world, 0, sizeof cam.camera_to_world);
@@ -342,7 +342,7 @@ static sy_rt_device *mixed_scene(void)
     d.roughness = 0.3f;
     d.metallic = 0.5f;
     sy_rt_material glossy;
-    MUST(sy_rt_material_create(dev, &d, &glossy, ERR));
+    MUST(sy_rt_material_create(dev, &d, &glossy));
     rt_place(dev, rt_quad(dev, 1.0f), xf, glossy, 0);
     rt_translation(xf, 0.3f, 0.2f, 0.0f);
     rt_place(dev, make_sphere(dev, 0.3f, 16, 8), xf, rt_lambert(dev, 0.8f, 0.3f, 0.2f), 0);
@@ -350,10 +350,10 @@ static sy_rt_device *mixed_scene(void)
     rt_place(dev, rt_quad(dev, 0.2f), xf, rt_emitter(dev, 5.0f, 5.0f, 4.0f), 0);
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 2.0f, .position = {0.5f, 1.0f, 1.0f}};
     sy_rt_light l;
-    MUST(sy_rt_light_create(dev, &ld, &l, ERR));
+    MUST(sy_rt_light_create(dev, &ld, &l));
     sy_rt_background bg = {.mode = SY_RT_BACKGROUND_COLOR, .color = {0.1f, 0.1f, 0.2f}};
-    MUST(sy_rt_set_background(dev, &bg, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_set_background(dev, &bg));
+    MUST(sy_rt_commit(dev));
     return dev;
 }
 
@@ -374,7 +374,7 @@ static void test_determinism_and_tiles(void)
         d.samples = 1;
         d.seed = 42;
         d.max_depth = 8;
-        MUST(sy_rt_render(dev, &cam, &d, p.rgba, p.depth, ERR));
+        MUST(sy_rt_render(dev, &cam, &d, p.rgba, p.depth));
     }
     EXPECT_MSG(sy_rt_accum_samples(p.acc) == 4, "accum has %u samples", sy_rt_accum_samples(p.acc));
     EXPECT_MSG(!memcmp(a.rgba, p.rgba, W * W * 4 * sizeof(float)), "4 x 1 sample must equal 1 x 4 samples bit for bit");
@@ -383,7 +383,7 @@ static void test_determinism_and_tiles(void)
     for (uint32_t q = 0; q < 4; ++q) {
         uint32_t x0 = (q % 2) * (W / 2), y0 = (q / 2) * (W / 2), hw = W / 2;
         sy_rt_accum *acc;
-        MUST(sy_rt_accum_create(hw, hw, &acc, ERR));
+        MUST(sy_rt_accum_create(dev, hw, hw, &acc));
         float *rgba = malloc(hw * hw * 4 * sizeof(float));
         sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, W, W);
         d.x = x0, d.y = y0, d.width = hw, d.height = hw;
@@ -391,7 +391,7 @@ static void test_determinism_and_tiles(void)
         d.samples = 4;
         d.seed = 42;
         d.max_depth = 8;
-        MUST(sy_rt_render(dev, &cam, &d, rgba, NULL, ERR));
+        MUST(sy_rt_render(dev, &cam, &d, rgba, NULL));
         for (uint32_t y = 0; y < hw; ++y)
             diff += memcmp(rgba + 4 * y * hw, a.rgba + 4 * ((y0 + y) * W + x0), hw * 4 * sizeof(float)) != 0;
         free(rgba);
@@ -401,19 +401,18 @@ static void test_determinism_and_tiles(void)
     EXPECT_MSG(count_nonfinite(&a) == 0, "non-finite pixels in the mixed scene");
     /* variance AOV: finite, non-negative, not all zero */
     float *var = malloc(W * W * 3 * sizeof(float));
-    MUST(sy_rt_accum_read(a.acc, SY_RT_AOV_VARIANCE, var, ERR));
+    MUST(sy_rt_accum_read(dev, a.acc, SY_RT_AOV_VARIANCE, var));
     size_t bad = 0, pos = 0;
     for (size_t k = 0; k < W * W * 3; ++k) bad += !(isfinite(var[k]) && var[k] >= 0.0f), pos += var[k] > 0.0f;
     EXPECT_MSG(bad == 0 && pos > 0, "variance AOV: %zu bad, %zu positive", bad, pos);
     free(var);
     /* accumulation validation */
     sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, W, W);
-    char e[256] = "";
-    EXPECT_MSG(sy_rt_render(dev, &cam, &d, a.rgba, NULL, e, sizeof e) == SY_RT_ERROR_INVALID_ARGUMENT, "no accum accepted");
+    EXPECT_MSG(sy_rt_render(dev, &cam, &d, a.rgba, NULL) == SY_RT_ERROR_INVALID_ARGUMENT, "no accum accepted");
     d.accum = p.acc;
     d.width = W / 2;
-    EXPECT_MSG(sy_rt_render(dev, &cam, &d, a.rgba, NULL, e, sizeof e) == SY_RT_ERROR_INVALID_ARGUMENT && strstr(e, "accum"),
-               "accum size mismatch accepted: %s", e);
+    EXPECT_MSG(sy_rt_render(dev, &cam, &d, a.rgba, NULL) == SY_RT_ERROR_INVALID_ARGUMENT && strstr(sy_rt_device_error(dev), "accum"),
+               "accum size mismatch accepted: %s", sy_rt_device_error(dev));
     img_free(&a);
     img_free(&b);
     img_free(&c);
@@ -430,18 +429,18 @@ static void test_degenerate(void)
     const uint32_t idx[] = {0, 1, 2, 0, 0, 1, 1, 3, 4, 2, 2, 2};
     sy_rt_mesh_desc md = {.positions = pos, .indices = idx, .vertex_count = 5, .triangle_count = 4};
     sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &md, &m, ERR));
+    MUST(sy_rt_mesh_create(dev, &md, &m));
     float xf[16];
     rt_translation(xf, -0.5f, -0.5f, -1.0f);
     rt_place(dev, m, xf, rt_emitter(dev, 2.0f, 2.0f, 2.0f), 0);
     const float zpos[] = {0.2f, 0.2f, 0, 0.2f, 0.2f, 0, 0.2f, 0.2f, 0};
     sy_rt_mesh_desc zd = {.positions = zpos, .vertex_count = 3, .triangle_count = 1};
     sy_rt_mesh zm;
-    MUST(sy_rt_mesh_create(dev, &zd, &zm, ERR));
+    MUST(sy_rt_mesh_create(dev, &zd, &zm));
     rt_place(dev, zm, xf, rt_emitter(dev, 1e6f, 1e6f, 1e6f), 0);
     rt_translation(xf, 0.0f, 0.0f, -2.0f);
     rt_place(dev, rt_quad(dev, 3.0f), xf, rt_lambert(dev, 0.7f, 0.7f, 0.7f), 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_stats st;
     sy_rt_device_stats(dev, &st);
     EXPECT_MSG(st.area_light_triangles == 1, "only the good emissive triangle is a light (got %u)", st.area_light_triangles);

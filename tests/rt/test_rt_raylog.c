@@ -31,7 +31,7 @@ static sy_rt_mesh box(sy_rt_device *dev)
     }
     sy_rt_mesh_desc d = {.positions = p, .indices = idx, .vertex_count = 20, .triangle_count = 10};
     sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    MUST(sy_rt_mesh_create(dev, &d, &m));
     return m;
 }
 
@@ -41,7 +41,7 @@ static sy_rt_mesh light_quad(sy_rt_device *dev)
     static const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
     sy_rt_mesh_desc d = {.positions = p, .indices = idx, .vertex_count = 4, .triangle_count = 2};
     sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    MUST(sy_rt_mesh_create(dev, &d, &m));
     return m;
 }
 
@@ -64,7 +64,7 @@ static sy_rt_mesh sphere(sy_rt_device *dev, float r, uint32_t n)
         }
     sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = nv, .triangle_count = nt};
     sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &d, &m, ERR));
+    MUST(sy_rt_mesh_create(dev, &d, &m));
     free(pos);
     free(idx);
     return m;
@@ -76,13 +76,13 @@ enum { W = 32, H = 32, SPP = 2 };
 static uint64_t render(sy_rt_device *dev, const sy_rt_camera *cam, sy_rt_ray_log *log, float *rgba)
 {
     sy_rt_accum *acc = NULL;
-    MUST(sy_rt_accum_create(W, H, &acc, ERR));
+    MUST(sy_rt_accum_create(dev, W, H, &acc));
     sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, W, H);
     d.accum = acc;
     d.samples = SPP;
     d.seed = 7;
     d.ray_log = log;
-    MUST(sy_rt_render(dev, cam, &d, rgba, NULL, ERR));
+    MUST(sy_rt_render(dev, cam, &d, rgba, NULL));
     uint64_t rays = sy_rt_accum_last_rays(acc);
     sy_rt_accum_destroy(acc);
     return rays;
@@ -94,7 +94,7 @@ static void check_replay(sy_rt_device *dev, sy_rt_ray_log *log, const char *what
     uint64_t total = log->intersect.n + log->occluded.n;
     for (int f = 0; f < SY_RT_FORM_COUNT; ++f) {
         sy_rt_ray_replay *rp = NULL;
-        MUST(sy_rt_ray_replay_create(dev, log, (sy_rt_ray_form)f, &rp, ERR));
+        MUST(sy_rt_ray_replay_create(dev, log, (sy_rt_ray_form)f, &rp));
         uint64_t bad = ~0ull;
         double t = sy_rt_ray_replay_run(rp, &bad);
         printf("%s: %-32s %llu rays, %llu differ (%.2f ms)\n", what, sy_rt_ray_form_name((sy_rt_ray_form)f),
@@ -109,7 +109,7 @@ static void check_replay(sy_rt_device *dev, sy_rt_ray_log *log, const char *what
 static uint64_t replay1(sy_rt_device *dev, sy_rt_ray_log *log)
 {
     sy_rt_ray_replay *rp = NULL;
-    MUST(sy_rt_ray_replay_create(dev, log, SY_RT_FORM_1, &rp, ERR));
+    MUST(sy_rt_ray_replay_create(dev, log, SY_RT_FORM_1, &rp));
     uint64_t bad = 0;
     sy_rt_ray_replay_run(rp, &bad);
     sy_rt_ray_replay_destroy(rp);
@@ -129,13 +129,13 @@ int main(void)
     rt_place(dev, s, xf, sm, 0); /* instanced: instID matters */
     rt_translation(xf, 0.45f, -0.7f, 0.3f);
     rt_place(dev, s, xf, sm, 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(3.0f, 0.45f);
 
     /* logging changes nothing */
     float *a = malloc(W * H * 4 * sizeof(float)), *b = malloc(W * H * 4 * sizeof(float));
     sy_rt_ray_log *log = NULL;
-    MUST(sy_rt_ray_log_create(&log, ERR));
+    MUST(sy_rt_ray_log_create(dev, &log));
     uint64_t rays_plain = render(dev, &cam, NULL, a);
     uint64_t rays_logged = render(dev, &cam, log, b);
     EXPECT_MSG(!memcmp(a, b, W * H * 4 * sizeof(float)), "the image with a ray log differs from the one without");
@@ -186,10 +186,10 @@ int main(void)
     md.alpha_mode = SY_RT_ALPHA_BLEND;
     md.specular = 0.0f;
     sy_rt_material pane;
-    MUST(sy_rt_material_create(dev, &md, &pane, ERR));
+    MUST(sy_rt_material_create(dev, &md, &pane));
     rt_translation(xf, 0.0f, 0.0f, 0.2f);
     rt_place(dev, rt_quad(dev, 0.4f), xf, pane, 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_ray_log_clear(log);
     rays_logged = render(dev, &cam, log, b);
     total = log->intersect.n + log->occluded.n;
@@ -206,13 +206,13 @@ int main(void)
 
     /* the benchmark's counts */
     sy_rt_accum *acc = NULL;
-    MUST(sy_rt_accum_create(W, H, &acc, ERR));
+    MUST(sy_rt_accum_create(dev, W, H, &acc));
     sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, W, H);
     d.accum = acc;
     d.samples = SPP;
     d.seed = 7;
     sy_rt_limit_result lr;
-    MUST(sy_rt_bench_limit(dev, &cam, &d, 2, &lr, ERR));
+    MUST(sy_rt_bench_limit(dev, &cam, &d, 2, &lr));
     EXPECT_MSG(lr.rays == rays_logged && lr.extension_rays + lr.shadow_rays == lr.rays &&
                lr.intersect_queries + lr.occluded_queries == lr.rays,
                "bench counts %llu %llu %llu", (unsigned long long)lr.rays, (unsigned long long)lr.extension_rays,
@@ -225,11 +225,10 @@ int main(void)
 
     /* a log with another integrator is refused */
     d.integrator = SY_RT_INTEGRATOR_WHITTED;
-    MUST(sy_rt_ray_log_create(&log, ERR));
+    MUST(sy_rt_ray_log_create(dev, &log));
     d.ray_log = log;
-    char e[256] = "";
-    sy_rt_result r = sy_rt_render(dev, &cam, &d, a, NULL, e, sizeof e);
-    EXPECT_MSG(r == SY_RT_ERROR_INVALID_ARGUMENT && strstr(e, "ray log"), "whitted with a ray log: %s: %s", sy_rt_result_str(r), e);
+    sy_rt_result r = sy_rt_render(dev, &cam, &d, a, NULL);
+    EXPECT_MSG(r == SY_RT_ERROR_INVALID_ARGUMENT && strstr(sy_rt_device_error(dev), "ray log"), "whitted with a ray log: %s: %s", sy_rt_result_str(r), sy_rt_device_error(dev));
     sy_rt_ray_log_destroy(log);
     sy_rt_accum_destroy(acc);
     free(a);

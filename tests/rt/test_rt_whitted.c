@@ -29,13 +29,13 @@ static void test_emitter_exact(void)
     ed.base_color[0] = ed.base_color[1] = ed.base_color[2] = 0.0f;
     ed.emissive[0] = 17, ed.emissive[1] = 12, ed.emissive[2] = 4;
     sy_rt_material em;
-    MUST(sy_rt_material_create(dev, &ed, &em, ERR));
+    MUST(sy_rt_material_create(dev, &ed, &em));
     sy_rt_instance inst = rt_place(dev, rt_quad(dev, 1.0f), xf, em, 0);
     (void)inst;
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 100, .position = {0, 0, 2}};
     sy_rt_light l;
-    MUST(sy_rt_light_create(dev, &ld, &l, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_light_create(dev, &ld, &l));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(CAM_Z, TAN);
     for (int integ = SY_RT_INTEGRATOR_PRIMARY; integ <= SY_RT_INTEGRATOR_WHITTED; ++integ) {
         sy_rt_render_desc rd = rt_desc((sy_rt_integrator)integ, W, W);
@@ -53,8 +53,8 @@ static void test_emitter_exact(void)
     }
     /* A coloured background is radiance with alpha 1. */
     sy_rt_background bgd = {.mode = SY_RT_BACKGROUND_COLOR, .color = {0.25f, 0.5f, 2.0f}};
-    MUST(sy_rt_set_background(dev, &bgd, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_set_background(dev, &bgd));
+    MUST(sy_rt_commit(dev));
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
     float *rgba, *depth;
     rt_render(dev, &cam, &rd, &rgba, &depth);
@@ -92,8 +92,8 @@ static void test_point_and_directional(void)
             ld.outer_cone_angle = 0.4f;
         }
         sy_rt_light l;
-        MUST(sy_rt_light_create(dev, &ld, &l, ERR));
-        MUST(sy_rt_commit(dev, ERR));
+        MUST(sy_rt_light_create(dev, &ld, &l));
+        MUST(sy_rt_commit(dev));
         sy_rt_camera cam = rt_camera(CAM_Z, TAN);
         sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
         float *rgba, *depth;
@@ -151,7 +151,7 @@ static void test_area_light(void)
     float em[16];
     rt_rot_y(em, (float)M_PI, 0.0f, 0.0f, 1.0f);
     rt_place(dev, rt_quad(dev, 0.5f), em, rt_emitter(dev, le, le, le), 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(0.5f, 0.05f);
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
     rd.area_light_samples = 256;
@@ -202,8 +202,8 @@ static void test_hard_shadow(void)
     rt_place(dev, rt_quad(dev, 0.25f), bx, rt_lambert(dev, 0.8f, 0.8f, 0.8f), 0);
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10, .position = {0, 0, 4}};
     sy_rt_light l;
-    MUST(sy_rt_light_create(dev, &ld, &l, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_light_create(dev, &ld, &l));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(CAM_Z, 0.15f);
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, 64, 64);
     float *rgba, *depth;
@@ -245,13 +245,13 @@ static void test_mirror(void)
     md.metallic = 1.0f;
     md.roughness = 0.0f;
     sy_rt_material mirror;
-    MUST(sy_rt_material_create(dev, &md, &mirror, ERR));
+    MUST(sy_rt_material_create(dev, &md, &mirror));
     rt_place(dev, rt_quad(dev, 10.0f), xf, mirror, 0);
     /* Emitter behind the camera (z = 8) facing the mirror. */
     float em[16];
     rt_rot_y(em, (float)M_PI, 0.0f, 0.0f, 8.0f);
     rt_place(dev, rt_quad(dev, 20.0f), em, rt_emitter(dev, 2.0f, 3.0f, 4.0f), 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(CAM_Z, TAN);
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
     float *rgba, *depth;
@@ -281,7 +281,7 @@ static void test_glass(void)
     md.transmission = 1.0f;
     md.ior = 1.5f;
     sy_rt_material glass;
-    MUST(sy_rt_material_create(dev, &md, &glass, ERR));
+    MUST(sy_rt_material_create(dev, &md, &glass));
     sy_rt_mesh q = rt_quad(dev, 3.0f);
     float front[16], back[16], em[16];
     rt_identity(front);
@@ -290,7 +290,7 @@ static void test_glass(void)
     rt_place(dev, q, front, glass, 0);
     rt_place(dev, q, back, glass, SY_RT_INSTANCE_BAKED);
     rt_place(dev, rt_quad(dev, 10.0f), em, rt_emitter(dev, 1.0f, 2.0f, 4.0f), 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(CAM_Z, TAN);
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
     float *rgba, *depth;
@@ -320,7 +320,7 @@ static void test_alpha_mask_and_texture(void)
     sy_rt_texture_desc td = {.width = 2, .height = 1, .channels = 4, .format = SY_RT_TEXEL_UNORM8_SRGB, .pixels = px,
                              .wrap_s = SY_RT_WRAP_CLAMP, .wrap_t = SY_RT_WRAP_CLAMP, .filter = SY_RT_FILTER_NEAREST};
     sy_rt_texture tex;
-    MUST(sy_rt_texture_create(dev, &td, &tex, ERR));
+    MUST(sy_rt_texture_create(dev, &td, &tex));
     sy_rt_material_desc md;
     sy_rt_material_desc_init(&md);
     md.unlit = true;
@@ -328,7 +328,7 @@ static void test_alpha_mask_and_texture(void)
     md.base_color_texture.texture = tex;
     md.alpha_mode = SY_RT_ALPHA_MASK;
     sy_rt_material cut;
-    MUST(sy_rt_material_create(dev, &md, &cut, ERR));
+    MUST(sy_rt_material_create(dev, &md, &cut));
     float xf[16], em[16];
     rt_identity(xf);
     rt_translation(em, 0.0f, 0.0f, -1.0f);
@@ -340,7 +340,7 @@ static void test_alpha_mask_and_texture(void)
     rt_place(dev, q, left, cut, 0);
     rt_place(dev, q, right, cut, SY_RT_INSTANCE_BAKED);
     rt_place(dev, rt_quad(dev, 10.0f), em, rt_emitter(dev, 0.0f, 0.0f, 5.0f), 0);
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_commit(dev));
     sy_rt_camera cam = rt_camera(CAM_Z, TAN);
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
     for (int integ = SY_RT_INTEGRATOR_PRIMARY; integ <= SY_RT_INTEGRATOR_WHITTED; ++integ) {
@@ -361,8 +361,8 @@ static void test_alpha_mask_and_texture(void)
     }
     /* Opaque again: the grey right half appears as 128 sRGB * (1, 0.5, 1). */
     md.alpha_mode = SY_RT_ALPHA_OPAQUE;
-    MUST(sy_rt_material_update(dev, cut, &md, ERR));
-    MUST(sy_rt_commit(dev, ERR));
+    MUST(sy_rt_material_update(dev, cut, &md));
+    MUST(sy_rt_commit(dev));
     rd.integrator = SY_RT_INTEGRATOR_WHITTED;
     float *rgba, *depth;
     rt_render(dev, &cam, &rd, &rgba, &depth);
