@@ -67,9 +67,13 @@
  * full image; pixel (x, y) has its centre at (x + 0.5, y + 0.5) like the ray tracers. With MSAA,
  * colour is the average of the samples and depth the nearest covered sample.
  *
- * Errors: every fallible call returns sy_gl_result (SY_GL_OK == 0) and writes a NUL-terminated
- * message naming the object, the provider or the GL call, and the reason into err (when non-NULL).
- * Warnings (a texture downscaled to the GL limit, a clamped MSAA count) go to the desc's log
+ * Errors (the convention of every Switchyard back-end): every fallible call returns sy_gl_result
+ * (SY_GL_OK == 0), numbered like Switchyard's sy_result for every code they share, and reports the
+ * message (naming the object, the provider or the GL call, and the reason) once through the
+ * device's error callback (sy_gl_device_desc.error), on the calling thread before the call
+ * returns; sy_gl_device_error() returns the device's last message. A call given no device (NULL)
+ * returns its code only. Warnings (a texture downscaled to the GL limit, a clamped MSAA count) go
+ * to the desc's log
  * callback. Thread-safety: a device is used by one thread at a time (its context is made current
  * on that thread by every call); a GLFW device must be created, used and destroyed on the main
  * thread (GLFW's rule for windows and events). OSMesa and EGL devices work from any thread. Conventions: column-major float[16] matrices (glTF), right-handed,
@@ -85,15 +89,16 @@
 extern "C" {
 #endif
 
-/** Result codes of every fallible sy_gl call. */
+/** Result codes of every fallible sy_gl call: the numbers of Switchyard's sy_result (core/sy_common.h),
+ * which a mediator checks at compile time, so it maps a code with a cast. */
 typedef enum sy_gl_result {
     SY_GL_OK = 0,
     SY_GL_ERROR_INVALID_ARGUMENT = 1,
     SY_GL_ERROR_INVALID_HANDLE = 2,
     SY_GL_ERROR_OUT_OF_MEMORY = 3,
-    SY_GL_ERROR_LIMIT = 4,
-    SY_GL_ERROR_NO_CONTEXT = 5, /**< the provider could not give a GL 3.3 core context */
-    SY_GL_ERROR_GL = 6,         /**< a GL call or shader compile failed (log included) */
+    SY_GL_ERROR_NO_CONTEXT = 6, /**< the provider could not give a GL 3.3 core context (unsupported here) */
+    SY_GL_ERROR_LIMIT = 7,
+    SY_GL_ERROR_GL = 9,         /**< a GL call or shader compile failed (log included) */
     SY_GL_RESULT_MAX_ENUM = 0x7fffffff
 } sy_gl_result;
 
@@ -125,6 +130,9 @@ typedef struct sy_gl_light { uint32_t id; /**< index + generation; 0 = none */ }
 
 /** Receives one warning message. */
 typedef void (*sy_gl_log_fn)(void *user, const char *message);
+/** Receives the message of a failed call (no trailing newline; valid during the call only), on the
+ * thread that made the call, before the call returns with code. */
+typedef void (*sy_gl_error_fn)(void *user, sy_gl_result code, const char *message);
 
 /** Device options (sy_gl_device_create). */
 typedef struct sy_gl_device_desc {
@@ -137,6 +145,8 @@ typedef struct sy_gl_device_desc {
     uint32_t window_width, window_height; /** @} */
     sy_gl_log_fn log;          /**< warnings; NULL = silent */
     void *log_user; /**< passed to log */
+    sy_gl_error_fn error;      /**< every failure of a call on this device (also sy_gl_device_create's); NULL = none */
+    void *error_user; /**< passed to error */
     /** Shade every surface in the geometry pass. Default (false): with MSAA, instances of opaque,
      * untextured, non-transmissive materials (at most 256 of them) on meshes without vertex
      * colours, without a scene probe and with small triangles on screen (about 16 pixels or
@@ -151,8 +161,11 @@ typedef struct sy_gl_device_desc {
 /** Creates the context and the renderer. On a missing provider (no EGL device/display, no X
  * display for GLFW) fails with SY_GL_ERROR_NO_CONTEXT and a message naming the provider and
  * suggesting the OSMesa fallback. *out is owned by the caller (sy_gl_device_destroy). */
-sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **out, char *err, size_t err_len);
+sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **out);
 void sy_gl_device_destroy(sy_gl_device *dev); /**< destroys every object; NULL is a no-op */
+/** The message of the last failed call on dev ("" when none failed yet): the error callback's
+ * text. Borrowed, valid until the next call on dev. */
+const char *sy_gl_device_error(const sy_gl_device *dev);
 /** "OpenGL 4.5 (Core Profile) Mesa 22.3.6 on llvmpipe (...)". Borrowed, valid while dev lives. */
 const char *sy_gl_device_info(const sy_gl_device *dev);
 
@@ -198,8 +211,7 @@ typedef struct sy_gl_mesh_desc {
     uint32_t vertex_count, triangle_count; /** @} */
 } sy_gl_mesh_desc;
 /** Creates a mesh from desc (uploaded at once). */
-sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *desc, sy_gl_mesh *out, char *err,
-                               size_t err_len);
+sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *desc, sy_gl_mesh *out);
 /** Destroys a mesh. */
 sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh);
 
@@ -237,8 +249,7 @@ typedef struct sy_gl_texture_desc {
     bool nearest; /**< nearest magnification (else linear); minification is always mipmapped */
 } sy_gl_texture_desc;
 /** Creates a texture from desc. */
-sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *desc, sy_gl_texture *out, char *err,
-                                  size_t err_len);
+sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *desc, sy_gl_texture *out);
 /** Destroys a texture. */
 sy_gl_result sy_gl_texture_destroy(sy_gl_device *dev, sy_gl_texture tex);
 
@@ -274,11 +285,9 @@ typedef struct sy_gl_material_desc {
 } sy_gl_material_desc;
 void sy_gl_material_desc_init(sy_gl_material_desc *desc); /**< glTF defaults */
 /** Creates a material from desc (one UBO). */
-sy_gl_result sy_gl_material_create(sy_gl_device *dev, const sy_gl_material_desc *desc, sy_gl_material *out,
-                                   char *err, size_t err_len);
+sy_gl_result sy_gl_material_create(sy_gl_device *dev, const sy_gl_material_desc *desc, sy_gl_material *out);
 /** One UBO update. */
-sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const sy_gl_material_desc *desc,
-                                   char *err, size_t err_len);
+sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const sy_gl_material_desc *desc);
 /** Destroys a material. */
 sy_gl_result sy_gl_material_destroy(sy_gl_device *dev, sy_gl_material mat);
 
@@ -291,11 +300,9 @@ typedef struct sy_gl_instance_desc {
     bool hidden; /**< not drawn, casts no shadow */
 } sy_gl_instance_desc;
 /** Creates an instance from desc. */
-sy_gl_result sy_gl_instance_create(sy_gl_device *dev, const sy_gl_instance_desc *desc, sy_gl_instance *out,
-                                   char *err, size_t err_len);
+sy_gl_result sy_gl_instance_create(sy_gl_device *dev, const sy_gl_instance_desc *desc, sy_gl_instance *out);
 /** Updates the model matrix only (no GL upload). */
-sy_gl_result sy_gl_instance_set_transform(sy_gl_device *dev, sy_gl_instance inst, const float transform[16],
-                                          char *err, size_t err_len);
+sy_gl_result sy_gl_instance_set_transform(sy_gl_device *dev, sy_gl_instance inst, const float transform[16]);
 /** Changes an instance's material. */
 sy_gl_result sy_gl_instance_set_material(sy_gl_device *dev, sy_gl_instance inst, sy_gl_material mat);
 /** Shows or hides an instance. */
@@ -322,11 +329,9 @@ typedef struct sy_gl_light_desc {
 #define SY_GL_MAX_SHADOW_MAPS 4 /**< the first spot/directional lights, then area lights, get shadow maps */
 #define SY_GL_MAX_CUBE_SHADOWS 2 /**< the first point lights get cube shadow maps (6 faces, half the map size) */
 /** Creates a light from desc. */
-sy_gl_result sy_gl_light_create(sy_gl_device *dev, const sy_gl_light_desc *desc, sy_gl_light *out, char *err,
-                                size_t err_len);
+sy_gl_result sy_gl_light_create(sy_gl_device *dev, const sy_gl_light_desc *desc, sy_gl_light *out);
 /** Replaces every field of a light with desc. */
-sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_gl_light_desc *desc, char *err,
-                                size_t err_len);
+sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_gl_light_desc *desc);
 /** Destroys a light. */
 sy_gl_result sy_gl_light_destroy(sy_gl_device *dev, sy_gl_light light);
 
@@ -364,8 +369,7 @@ typedef struct sy_gl_area_light {
  * with a warning. */
 void sy_gl_set_ambient(sy_gl_device *dev, const float radiance[3]);
 /** Sets the area lights (at most SY_GL_MAX_AREA_LIGHTS). */
-sy_gl_result sy_gl_set_area_lights(sy_gl_device *dev, const sy_gl_area_light *lights, uint32_t count, char *err,
-                                   size_t err_len);
+sy_gl_result sy_gl_set_area_lights(sy_gl_device *dev, const sy_gl_area_light *lights, uint32_t count);
 
 /* >>render */
 /** Camera (same convention as the ray tracers). */
@@ -385,7 +389,7 @@ typedef struct sy_gl_render_desc {
 } sy_gl_render_desc;
 /** Renders and reads back: rgba (width*height*4 floats) and depth (width*height, may be NULL). */
 sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *desc, float *rgba,
-                          float *depth, char *err, size_t err_len);
+                          float *depth);
 /** GLFW provider: true once the user asked to close the window (false for other providers). */
 bool sy_gl_window_should_close(sy_gl_device *dev);
 
@@ -397,7 +401,7 @@ bool sy_gl_window_should_close(sy_gl_device *dev);
  * Lambert light) into the same targets, read back into rgba and depth (NULL: not read) as
  * sy_gl_render does. */
 sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *desc, bool lit,
-                                float *rgba, float *depth, char *err, size_t err_len);
+                                float *rgba, float *depth);
 
 #ifdef __cplusplus
 }

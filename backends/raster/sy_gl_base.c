@@ -1,4 +1,4 @@
-/* sy_gl_base.c — the rasterizer's groundwork: object pools, errors and warnings, the 4x4 math
+/* sy_gl_base.c — the rasterizer's groundwork: object pools, warnings, the 4x4 math
  * (column-major) of views, lights and shadow cameras, GL error checks and the current context. */
 #include "sy_gl_internal.h"
 
@@ -7,17 +7,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-sy_gl_result sy_gli_fail(char *err, size_t len, sy_gl_result r, const char *fmt, ...)
-{
-    if (err && len) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, len, fmt, ap);
-        va_end(ap);
-    }
-    return r;
-}
 
 void *sy_gli_pool_get(const pool *p, uint32_t id)
 {
@@ -235,20 +224,20 @@ void sy_gli_count_buffer(sy_gl_device *dev, bool uniform, size_t bytes)
     }
 }
 
-sy_gl_result sy_gli_gl_check(sy_gl_device *dev, const char *where, char *err, size_t len)
+sy_gl_result sy_gli_gl_check(sy_gl_device *dev, const char *where, sy_gl_report *rep)
 {
     GLenum e = dev->gl->GetError();
     if (e == GL_NO_ERROR) return SY_GL_OK;
     while (dev->gl->GetError() != GL_NO_ERROR) {
     }
-    return sy_gli_fail(err, len, e == GL_OUT_OF_MEMORY ? SY_GL_ERROR_OUT_OF_MEMORY : SY_GL_ERROR_GL,
+    return sy_gli_fail(rep, e == GL_OUT_OF_MEMORY ? SY_GL_ERROR_OUT_OF_MEMORY : SY_GL_ERROR_GL,
                 "%s: OpenGL error 0x%04x (%s)", where, (unsigned)e, sy_gl_provider_name(sy_gl_context_provider(dev->ctx)));
 }
 
-sy_gl_result sy_gli_current(sy_gl_device *dev, char *err, size_t len)
+sy_gl_result sy_gli_current(sy_gl_device *dev, sy_gl_report *rep)
 {
     if (!sy_gl_context_make_current(dev->ctx))
-        return sy_gli_fail(err, len, SY_GL_ERROR_NO_CONTEXT, "%s: cannot make the GL context sy_gli_current",
+        return sy_gli_fail(rep, SY_GL_ERROR_NO_CONTEXT, "%s: cannot make the GL context sy_gli_current",
                     sy_gl_provider_name(sy_gl_context_provider(dev->ctx)));
     return SY_GL_OK;
 }

@@ -1,7 +1,8 @@
 /* sy_gl_context.c — GL context providers (see sy_gl_context.h): OSMesa (OSMesaCreateContextAttribs,
  * core profile 3.3, a 1x1 default buffer since rendering goes to framebuffer objects), EGL (an EGL
  * device from EGL_EXT_device_enumeration first, then Mesa's surfaceless platform; configless
- * surfaceless context) and GLFW (a window with a 3.3 core context). */
+ * surfaceless context) and GLFW (a window with a 3.3 core context); the error report every module of
+ * the rasterizer fails through (sy_gli_fail). */
 #include "sy_gl_context.h"
 
 #include <EGL/egl.h>
@@ -38,14 +39,14 @@ struct sy_gl_context {
     GLFWwindow *window;
 };
 
-static sy_gl_result fail(char *err, size_t len, sy_gl_result r, const char *fmt, ...)
+sy_gl_result sy_gli_fail(sy_gl_report *rep, sy_gl_result r, const char *fmt, ...)
 {
-    if (err && len) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, len, fmt, ap);
-        va_end(ap);
-    }
+    if (!rep) return r;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(rep->message, sizeof rep->message, fmt, ap);
+    va_end(ap);
+    if (rep->fn) rep->fn(rep->user, r, rep->message);
     return r;
 }
 
@@ -61,47 +62,47 @@ static proc_fn get_proc(const sy_gl_context *c, const char *name)
     }
 }
 
-static sy_gl_result load_fns(sy_gl_context *c, char *err, size_t len)
+static sy_gl_result load_fns(sy_gl_context *c, sy_gl_report *rep)
 {
 #define SY_GL_LOAD(type, name)                                                                                      \
     c->gl.name = (type)get_proc(c, "gl" #name);                                                                     \
     if (!c->gl.name)                                                                                                \
-        return fail(err, len, SY_GL_ERROR_NO_CONTEXT, "%s: the GL context lacks gl" #name " (OpenGL 3.3 core needed)", \
+        return sy_gli_fail(rep, SY_GL_ERROR_NO_CONTEXT, "%s: the GL context lacks gl" #name " (OpenGL 3.3 core needed)", \
                     sy_gl_provider_name(c->provider));
     SY_GL_FUNCS(SY_GL_LOAD)
 #undef SY_GL_LOAD
     const char *ver = (const char *)c->gl.GetString(GL_VERSION);
     int major = 0, minor = 0;
     if (!ver || sscanf(ver, "%d.%d", &major, &minor) != 2 || major * 10 + minor < 33)
-        return fail(err, len, SY_GL_ERROR_NO_CONTEXT, "%s: OpenGL 3.3 core needed, the context gives '%s'",
+        return sy_gli_fail(rep, SY_GL_ERROR_NO_CONTEXT, "%s: OpenGL 3.3 core needed, the context gives '%s'",
                     sy_gl_provider_name(c->provider), ver ? ver : "(no version)");
     return SY_GL_OK;
 }
 
-static sy_gl_result create_osmesa(sy_gl_context *c, char *err, size_t len)
+static sy_gl_result create_osmesa(sy_gl_context *c, sy_gl_report *rep)
 {
     static const char *const names[] = {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"};
     for (size_t i = 0; i < sizeof names / sizeof names[0] && !c->om.lib; ++i)
         c->om.lib = dlopen(names[i], RTLD_NOW | RTLD_LOCAL);
     if (!c->om.lib)
-        return fail(err, len, SY_GL_ERROR_NO_CONTEXT, "osmesa: cannot load libOSMesa (%s); install libosmesa6",
+        return sy_gli_fail(rep, SY_GL_ERROR_NO_CONTEXT, "osmesa: cannot load libOSMesa (%s); install libosmesa6",
                     dlerror());
     *(void **)&c->om.create = dlsym(c->om.lib, "OSMesaCreateContextAttribs");
     *(void **)&c->om.make_current = dlsym(c->om.lib, "OSMesaMakeCurrent");
     *(void **)&c->om.destroy = dlsym(c->om.lib, "OSMesaDestroyContext");
     *(void **)&c->om.get_proc = dlsym(c->om.lib, "OSMesaGetProcAddress");
     if (!c->om.create || !c->om.make_current || !c->om.destroy || !c->om.get_proc)
-        return fail(err, len, SY_GL_ERROR_NO_CONTEXT,
+        return sy_gli_fail(rep, SY_GL_ERROR_NO_CONTEXT,
                     "osmesa: libOSMesa lacks OSMesaCreateContextAttribs (Mesa >= 12 needed for core contexts)");
     const int attrs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_STENCIL_BITS, 0,
                          OSMESA_PROFILE, OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 3,
                          OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
     c->osmesa = c->om.create(attrs, NULL);
     if (!c->osmesa)
-        return fail(err, len, SY_GL_ERROR_NO_CONTEXT,
+        return sy_gli_fail(rep, SY_GL_ERROR_NO_CONTEXT,
                     "osmesa: OSMesaCreateContextAttribs could not create an OpenGL 3.3 core context");
     if (!c->om.make_current(c->osmesa, c->osmesa_buf, GL_UNSIGNED_BYTE, 2, 2))
-        return fail(err, len, SY_GL_ERROR_NO_CONTEXT, "osmesa: OSMesaMakeCurrent failed");
+        return sy_gli_fail(rep, SY_GL_ERROR_NO_CONTEXT, "osmesa: OSMesaMakeCurrent failed");
     return SY_GL_OK;
 }
 
@@ -165,14 +166,14 @@ static bool egl_try(sy_gl_context *c, EGLDisplay d, char *why, size_t why_len)
     return true;
 }
 
-static sy_gl_result create_egl(sy_gl_context *c, char *err, size_t len)
+static sy_gl_result create_egl(sy_gl_context *c, sy_gl_report *rep)
 {
     const char *cext = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     PFNEGLGETPLATFORMDISPLAYEXTPROC get_display =
         (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
     char why_dev[160] = "EGL_EXT_device_enumeration not offered", why_sl[160] = "EGL_MESA_platform_surfaceless not offered";
     if (!cext || !get_display)
-        return fail(err, len, SY_GL_ERROR_NO_CONTEXT,
+        return sy_gli_fail(rep, SY_GL_ERROR_NO_CONTEXT,
                     "egl: no EGL client extensions (libEGL without a vendor library?); try --gl osmesa");
     /* 1. an EGL device (a GPU driver, or Mesa's software device) */
     if (strstr(cext, "EGL_EXT_device_enumeration") && strstr(cext, "EGL_EXT_platform_device")) {
@@ -191,7 +192,7 @@ static sy_gl_result create_egl(sy_gl_context *c, char *err, size_t len)
         if (egl_try(c, get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL), why_sl, sizeof why_sl))
             return SY_GL_OK;
     }
-    return fail(err, len, SY_GL_ERROR_NO_CONTEXT,
+    return sy_gli_fail(rep, SY_GL_ERROR_NO_CONTEXT,
                 "egl: no usable EGL display (device: %s; surfaceless: %s); try --gl osmesa", why_dev, why_sl);
 }
 
@@ -201,13 +202,13 @@ static void glfw_error(int code, const char *msg)
     (void)msg; /* reported through glfwGetError at the failing call */
 }
 
-static sy_gl_result create_glfw(sy_gl_context *c, uint32_t w, uint32_t h, char *err, size_t len)
+static sy_gl_result create_glfw(sy_gl_context *c, uint32_t w, uint32_t h, sy_gl_report *rep)
 {
     glfwSetErrorCallback(glfw_error);
     if (!glfwInit()) {
         const char *d = NULL;
         glfwGetError(&d);
-        return fail(err, len, SY_GL_ERROR_NO_CONTEXT, "glfw: cannot open a window (%s); try --gl osmesa or --gl egl",
+        return sy_gli_fail(rep, SY_GL_ERROR_NO_CONTEXT, "glfw: cannot open a window (%s); try --gl osmesa or --gl egl",
                     d ? d : "glfwInit failed");
     }
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
@@ -218,7 +219,7 @@ static sy_gl_result create_glfw(sy_gl_context *c, uint32_t w, uint32_t h, char *
     if (!c->window) {
         const char *d = NULL;
         glfwGetError(&d);
-        return fail(err, len, SY_GL_ERROR_NO_CONTEXT, "glfw: cannot create a 3.3 core window (%s); try --gl osmesa",
+        return sy_gli_fail(rep, SY_GL_ERROR_NO_CONTEXT, "glfw: cannot create a 3.3 core window (%s); try --gl osmesa",
                     d ? d : "glfwCreateWindow failed");
     }
     glfwMakeContextCurrent(c->window);
@@ -226,22 +227,22 @@ static sy_gl_result create_glfw(sy_gl_context *c, uint32_t w, uint32_t h, char *
 }
 
 sy_gl_result sy_gl_context_create(sy_gl_provider provider, uint32_t window_w, uint32_t window_h,
-                                  sy_gl_context **out, char *err, size_t err_len)
+                                  sy_gl_context **out, sy_gl_report *rep)
 {
     *out = NULL;
     sy_gl_context *c = calloc(1, sizeof *c);
-    if (!c) return fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "GL context: out of memory");
+    if (!c) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "GL context: out of memory");
     c->provider = provider;
     c->egl_display = EGL_NO_DISPLAY;
     c->egl_context = EGL_NO_CONTEXT;
     sy_gl_result r;
     switch (provider) {
-    case SY_GL_PROVIDER_OSMESA: r = create_osmesa(c, err, err_len); break;
-    case SY_GL_PROVIDER_EGL: r = create_egl(c, err, err_len); break;
-    case SY_GL_PROVIDER_GLFW: r = create_glfw(c, window_w, window_h, err, err_len); break;
-    default: r = fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "GL context: unknown provider %d", (int)provider);
+    case SY_GL_PROVIDER_OSMESA: r = create_osmesa(c, rep); break;
+    case SY_GL_PROVIDER_EGL: r = create_egl(c, rep); break;
+    case SY_GL_PROVIDER_GLFW: r = create_glfw(c, window_w, window_h, rep); break;
+    default: r = sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "GL context: unknown provider %d", (int)provider);
     }
-    if (r == SY_GL_OK) r = load_fns(c, err, err_len);
+    if (r == SY_GL_OK) r = load_fns(c, rep);
     if (r != SY_GL_OK) {
         sy_gl_context_destroy(c);
         return r;

@@ -60,9 +60,25 @@ typedef struct sy_gl_fns {
 
 typedef struct sy_gl_context sy_gl_context;
 
+/* The error report every failing call of the rasterizer goes through (a device's, or the desc's
+ * while sy_gl_device_create has no device yet): the callback and the last message. */
+#define SY_GL_ERROR_MAX 512 /* bytes of a reported message, NUL included (as core's sy_error) */
+typedef struct sy_gl_report {
+    sy_gl_error_fn fn;
+    void *user;
+    char message[SY_GL_ERROR_MAX];
+} sy_gl_report;
+/* Formats the printf-style message into rep->message and hands it to rep->fn (rep may be NULL:
+ * nothing is reported); returns r. Here, in the lowest module, as every other module reports. */
+sy_gl_result sy_gli_fail(sy_gl_report *rep, sy_gl_result r, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
 /* Creates a GL 3.3 core context with the provider and loads the table. window_w/h: GLFW only. */
 sy_gl_result sy_gl_context_create(sy_gl_provider provider, uint32_t window_w, uint32_t window_h,
-                                  sy_gl_context **out, char *err, size_t err_len);
+                                  sy_gl_context **out, sy_gl_report *rep);
 void sy_gl_context_destroy(sy_gl_context *c);
 bool sy_gl_context_make_current(sy_gl_context *c);
 const sy_gl_fns *sy_gl_context_fns(const sy_gl_context *c);

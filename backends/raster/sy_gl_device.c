@@ -7,13 +7,23 @@
 #include <stdlib.h>
 #include <string.h>
 
-sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **out, char *err, size_t err_len)
+const char *sy_gl_device_error(const sy_gl_device *dev)
 {
-    *out = NULL;
+    return dev ? dev->report->message : "";
+}
+
+sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **out)
+{
     sy_gl_device_desc dd = {0};
     if (desc) dd = *desc;
+    sy_gl_report create_report = {dd.error, dd.error_user, ""}; /* until the device exists */
+    sy_gl_report *rep = &create_report;
+    if (!out) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "GL device: out is NULL");
+    *out = NULL;
     sy_gl_device *dev = calloc(1, sizeof *dev);
-    if (!dev) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "GL device: out of memory");
+    if (!dev) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "GL device: out of memory");
+    dev->report_store = create_report;
+    rep = dev->report = &dev->report_store;
     dev->log = dd.log;
     dev->log_user = dd.log_user;
     dev->meshes.elem = sizeof(mesh_o);
@@ -21,7 +31,7 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     dev->materials.elem = sizeof(mat_o);
     dev->instances.elem = sizeof(inst_o);
     dev->lights.elem = sizeof(light_o);
-    sy_gl_result r = sy_gl_context_create(dd.provider, dd.window_width, dd.window_height, &dev->ctx, err, err_len);
+    sy_gl_result r = sy_gl_context_create(dd.provider, dd.window_width, dd.window_height, &dev->ctx, rep);
     if (r != SY_GL_OK) {
         free(dev);
         return r;
@@ -50,25 +60,25 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     static const char *const defs[4] = {NULL, "#define SY_LEAN 1\n", "#define SY_MASK 1\n",
                                         "#define SY_MASK 1\n#define SY_LEAN 1\n"};
     /* the fullest main variant now, so that a shader the driver rejects fails here */
-    if (!sy_gli_main_program(dev, VAR_TEX | VAR_NMAP | VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_SHADOW | VAR_ASHADOW | VAR_TRANS | VAR_MASK | VAR_PROBE, err, err_len))
+    if (!sy_gli_main_program(dev, VAR_TEX | VAR_NMAP | VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_SHADOW | VAR_ASHADOW | VAR_TRANS | VAR_MASK | VAR_PROBE, rep))
         r = SY_GL_ERROR_GL;
     for (int v = 0; v < 2 && r == SY_GL_OK; ++v)
         r = sy_gl_program_build(gl, v ? "shadow (alpha mask)" : "shadow", sy_gl_shadow_vs, sy_gl_shadow_fs, defs[2 * v],
-                                &dev->ps[v].prog, err, err_len);
+                                &dev->ps[v].prog, rep);
     char rdefs[40];
     snprintf(rdefs, sizeof rdefs, "#define SY_SAMPLES %u\n", dev->msaa);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "resolve", sy_gl_rect_vs, sy_gl_resolve_fs, rdefs, &dev->prog_resolve, err, err_len);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "floor", sy_gl_floor_vs, sy_gl_floor_fs, NULL, &dev->prog_floor, err, err_len);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "resolve", sy_gl_rect_vs, sy_gl_resolve_fs, rdefs, &dev->prog_resolve, rep);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "floor", sy_gl_floor_vs, sy_gl_floor_fs, NULL, &dev->prog_floor, rep);
     if (r == SY_GL_OK)
         r = sy_gl_program_build(gl, "floor (trivial lit)", sy_gl_floor_vs, sy_gl_floor_fs, "#define SY_FLOOR_LIT 1\n",
-                                &dev->prog_floor_lit, err, err_len);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "sky", sy_gl_fullscreen_vs, sy_gl_sky_fs, NULL, &dev->prog_sky, err, err_len);
+                                &dev->prog_floor_lit, rep);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "sky", sy_gl_fullscreen_vs, sy_gl_sky_fs, NULL, &dev->prog_sky, rep);
     dev->forward = dd.forward || dev->msaa < 2; /* the deferred pass is the MSAA resolve */
     for (int k = 0; k < 2 && r == SY_GL_OK && !dev->forward; ++k)
         r = sy_gl_program_build(gl, k ? "G-buffer (orthographic)" : "G-buffer", sy_gl_gbuf_vs, sy_gl_gbuf_fs,
-                                k ? "#define SY_ORTHO 1\n" : NULL, &dev->ug[k].prog, err, err_len);
+                                k ? "#define SY_ORTHO 1\n" : NULL, &dev->ug[k].prog, rep);
     if (r == SY_GL_OK && !dev->forward) { /* the fullest shading pass now, so that a driver's rejection fails here */
-        if (sy_gli_deferred_program(dev, VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_SHADOW | VAR_ASHADOW, err, err_len) < 0)
+        if (sy_gli_deferred_program(dev, VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_SHADOW | VAR_ASHADOW, rep) < 0)
             r = SY_GL_ERROR_GL;
     }
     if (r != SY_GL_OK) {
@@ -115,7 +125,7 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     dev->mtab_limit = (uint32_t)max_tex < MTAB_MAX_ROWS ? (uint32_t)max_tex : MTAB_MAX_ROWS;
     if (!dev->forward && !sy_gli_mtab_set(dev, 0, &md)) {
         sy_gl_device_destroy(dev);
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "GL device: out of memory");
+        return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "GL device: out of memory");
     }
     gl->GenBuffers(1, &dev->default_ubo);
     gl->BindBuffer(GL_UNIFORM_BUFFER, dev->default_ubo);
@@ -132,7 +142,7 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     gl->Enable(GL_TEXTURE_CUBE_MAP_SEAMLESS); /* cube shadows and probes filter across faces */
     gl->GenFramebuffers(1, &dev->shadow_fbo);
     dev->lights_dirty = true;
-    if ((r = sy_gli_gl_check(dev, "GL device setup", err, err_len)) != SY_GL_OK) {
+    if ((r = sy_gli_gl_check(dev, "GL device setup", rep)) != SY_GL_OK) {
         sy_gl_device_destroy(dev);
         return r;
     }

@@ -31,7 +31,7 @@ void sy_gli_frame_end(sy_gl_device *dev)
     dev->mark = dev->counts;
 }
 
-sy_gl_result sy_gli_targets_ensure(sy_gl_device *dev, uint32_t w, uint32_t h, char *err, size_t len)
+sy_gl_result sy_gli_targets_ensure(sy_gl_device *dev, uint32_t w, uint32_t h, sy_gl_report *rep)
 {
     targets *t = &dev->t;
     if (t->fbo && t->w == w && t->h == h && t->samples == dev->msaa) return SY_GL_OK;
@@ -64,7 +64,7 @@ sy_gl_result sy_gli_targets_ensure(sy_gl_device *dev, uint32_t w, uint32_t h, ch
     gl->FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t->depth_rb);
     GLenum st = gl->CheckFramebufferStatus(GL_FRAMEBUFFER);
     if (st != GL_FRAMEBUFFER_COMPLETE)
-        return sy_gli_fail(err, len, SY_GL_ERROR_GL, "render target %ux%u (%u samples): framebuffer incomplete (0x%04x)", w, h,
+        return sy_gli_fail(rep, SY_GL_ERROR_GL, "render target %ux%u (%u samples): framebuffer incomplete (0x%04x)", w, h,
                     t->samples, (unsigned)st);
     if (t->samples > 1) {
         gl->GenFramebuffers(1, &t->rfbo);
@@ -80,30 +80,29 @@ sy_gl_result sy_gli_targets_ensure(sy_gl_device *dev, uint32_t w, uint32_t h, ch
         }
         st = gl->CheckFramebufferStatus(GL_FRAMEBUFFER);
         if (st != GL_FRAMEBUFFER_COMPLETE)
-            return sy_gli_fail(err, len, SY_GL_ERROR_GL, "resolve target %ux%u: framebuffer incomplete (0x%04x)", w, h, (unsigned)st);
+            return sy_gli_fail(rep, SY_GL_ERROR_GL, "resolve target %ux%u: framebuffer incomplete (0x%04x)", w, h, (unsigned)st);
     }
-    return sy_gli_gl_check(dev, "render targets", err, len);
+    return sy_gli_gl_check(dev, "render targets", rep);
 }
 
-sy_gl_result sy_gli_view_make(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, view_setup *v,
-                              char *err, size_t len)
+sy_gl_result sy_gli_view_make(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, view_setup *v, sy_gl_report *rep)
 {
     const float *w = cam->window;
     for (int i = 0; i < 4; ++i)
-        if (!isfinite(w[i])) return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: camera window[%d] is not finite", i);
+        if (!isfinite(w[i])) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "render: camera window[%d] is not finite", i);
     if (!(w[0] < w[1]) || !(w[2] < w[3]))
-        return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: camera window needs left < right and bottom < top");
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "render: camera window needs left < right and bottom < top");
     if (!isfinite(cam->near_clip) || cam->near_clip < 0.0f || !isfinite(cam->far_clip) || cam->far_clip < 0.0f ||
         (cam->far_clip > 0.0f && cam->far_clip <= cam->near_clip))
-        return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: clip range near %g far %g is invalid",
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "render: clip range near %g far %g is invalid",
                     (double)cam->near_clip, (double)cam->far_clip);
     if (d->image_width == 0 || d->image_height == 0 || d->width == 0 || d->height == 0 ||
         d->x > d->image_width || d->width > d->image_width - d->x || d->y > d->image_height ||
         d->height > d->image_height - d->y)
-        return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: rectangle %u,%u %ux%u is outside the %ux%u image",
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "render: rectangle %u,%u %ux%u is outside the %ux%u image",
                     d->x, d->y, d->width, d->height, d->image_width, d->image_height);
     if (!sy_gli_m4_invert(cam->camera_to_world, v->view))
-        return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: camera matrix is not invertible");
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "render: camera matrix is not invertible");
     memcpy(v->cam_pos, cam->camera_to_world + 12, sizeof v->cam_pos);
     for (int i = 0; i < 3; ++i) v->cam_fwd[i] = -cam->camera_to_world[8 + i];
     sy_gli_v3_norm(v->cam_fwd);
@@ -268,14 +267,14 @@ static bool rect_tiles(sy_gl_device *dev, uint32_t *n_shade, uint32_t *n_rest, u
  * where it has nothing to shade as where it has (a loop body runs at least once, masked; an if
  * runs both sides): over the whole target it cost the generated bench scene (14 % of its pixels
  * covered) about 0.1x of its frame in pixels with nothing to shade (issue 19). */
-static sy_gl_result deferred_pass(sy_gl_device *dev, const view_setup *v, char *err, size_t len)
+static sy_gl_result deferred_pass(sy_gl_device *dev, const view_setup *v, sy_gl_report *rep)
 {
     const sy_gl_fns *gl = dev->gl;
     const targets *t = &dev->t;
-    int k = sy_gli_deferred_program(dev, frame_lighting(dev), err, len);
+    int k = sy_gli_deferred_program(dev, frame_lighting(dev), rep);
     if (k < 0) return SY_GL_ERROR_GL;
     float inv_view[16];
-    if (!sy_gli_m4_invert(v->view, inv_view)) return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "render: view not invertible");
+    if (!sy_gli_m4_invert(v->view, inv_view)) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "render: view not invertible");
     float unproj[4], px[2];
     view_unproject(v, t->w, t->h, unproj, px);
     uint32_t n_shade = 1, n_rest = 0;
@@ -304,8 +303,7 @@ static sy_gl_result deferred_pass(sy_gl_device *dev, const view_setup *v, char *
 
 /* Resolves (MSAA; shading the G-buffer when the main pass of view v drew into it) and reads the
  * target back into the caller's arrays, flipping rows. */
-sy_gl_result sy_gli_finish_target(sy_gl_device *dev, const view_setup *v, float *rgba, float *depth, char *err,
-                                  size_t len)
+sy_gl_result sy_gli_finish_target(sy_gl_device *dev, const view_setup *v, float *rgba, float *depth, sy_gl_report *rep)
 {
     const sy_gl_fns *gl = dev->gl;
     targets *t = &dev->t;
@@ -316,7 +314,7 @@ sy_gl_result sy_gli_finish_target(sy_gl_device *dev, const view_setup *v, float 
         gl->DrawBuffers(2, bufs);
         gl->Disable(GL_DEPTH_TEST);
         gl->Disable(GL_BLEND);
-        sy_gl_result r = deferred_pass(dev, v, err, len);
+        sy_gl_result r = deferred_pass(dev, v, rep);
         if (r != SY_GL_OK) return r;
         read_fbo = t->rfbo;
     } else if (t->samples > 1) {
@@ -331,7 +329,7 @@ sy_gl_result sy_gli_finish_target(sy_gl_device *dev, const view_setup *v, float 
     size_t n = (size_t)t->w * t->h;
     if (dev->scratch_len < n * 4) {
         float *s = realloc(dev->scratch, n * 4 * sizeof *s);
-        if (!s) return sy_gli_fail(err, len, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory for read-back");
+        if (!s) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory for read-back");
         dev->scratch = s;
         dev->scratch_len = n * 4;
     }
@@ -347,7 +345,7 @@ sy_gl_result sy_gli_finish_target(sy_gl_device *dev, const view_setup *v, float 
         for (uint32_t y = 0; y < t->h; ++y)
             memcpy(depth + (size_t)t->w * y, dev->scratch + (size_t)t->w * (t->h - 1 - y), t->w * sizeof(float));
     }
-    sy_gl_result r = sy_gli_gl_check(dev, "render read-back", err, len);
+    sy_gl_result r = sy_gli_gl_check(dev, "render read-back", rep);
     if (r != SY_GL_OK) return r;
     sy_gl_context_present(dev->ctx, read_fbo, t->w, t->h);
     return SY_GL_OK;
@@ -409,11 +407,11 @@ static int draw_variant(const sy_gl_device *dev, const mesh_o *m, const mat_o *m
 }
 
 /* Binds the variant's program (building it on first use) and, once per frame, its view uniforms. */
-static sy_gl_result use_variant(sy_gl_device *dev, draw_ctx *dc, int pv, char *err, size_t err_len)
+static sy_gl_result use_variant(sy_gl_device *dev, draw_ctx *dc, int pv, sy_gl_report *rep)
 {
     if (pv == dc->bound) return SY_GL_OK;
     const sy_gl_fns *gl = dev->gl;
-    GLuint p = sy_gli_main_program(dev, pv, err, err_len);
+    GLuint p = sy_gli_main_program(dev, pv, rep);
     if (!p) return SY_GL_ERROR_GL;
     gl->UseProgram(p);
     dc->bound = pv;
@@ -529,7 +527,7 @@ static void draw_gbuf(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const m
 }
 
 static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t index, const inst_o *in, const mesh_o *m,
-                                  const mat_o *mt, char *err, size_t err_len)
+                                  const mat_o *mt, sy_gl_report *rep)
 {
     const sy_gl_fns *gl = dev->gl;
     int probe = probe_of(dev, index);
@@ -544,7 +542,7 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
      * material's uniforms say so draws the others as they were. TransmissionTest's first frame
      * compiled 11 main-pass shaders before, 6 now (issue 32). */
     pv = sy_gli_variant_normalize(pv | dc->shared);
-    sy_gl_result r = use_variant(dev, dc, pv, err, err_len);
+    sy_gl_result r = use_variant(dev, dc, pv, rep);
     if (r != SY_GL_OK) return r;
     if (probe >= 0) {
         gl->ActiveTexture(GL_TEXTURE0 + UNIT_PROBE);
@@ -612,7 +610,7 @@ static int cmp_near_first(const void *a, const void *b) { return -cmp_far_first(
  * target: opaque near to far (early depth tests reject hidden fragments before shading), then
  * alpha-masked (the discard variant) near to far, then blended far to near with depth writes off.
  * Each list holds (view distance, instance index) pairs. */
-sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t skip, char *err, size_t err_len)
+sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t skip, sy_gl_report *rep)
 {
     const sy_gl_fns *gl = dev->gl;
     sy_gl_result r = SY_GL_OK;
@@ -620,7 +618,7 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
     sy_gli_m4_mul(v->proj, v->view, dc.viewproj);
     uint32_t cap = dev->instances.count ? dev->instances.count : 1, nl[3] = {0, 0, 0};
     float *lists = malloc(sizeof(float) * 2 * 3 * cap);
-    if (!lists) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory");
+    if (!lists) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory");
     float planes[6][4];
     sy_gli_frustum_planes(dc.viewproj, planes);
     if (skip == UINT32_MAX) {
@@ -665,7 +663,7 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
             memcpy(&i, &list[2 * k + 1], sizeof i);
             const inst_o *in = sy_gli_pool_at(&dev->instances, i);
             r = draw_instance(dev, &dc, i, in, sy_gli_pool_get(&dev->meshes, in->mesh.id),
-                              sy_gli_pool_get(&dev->materials, in->material.id), err, err_len);
+                              sy_gli_pool_get(&dev->materials, in->material.id), rep);
         }
         if (li == 2 && nl[li]) {
             gl->DepthMask(GL_TRUE);

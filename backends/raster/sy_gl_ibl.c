@@ -75,12 +75,12 @@ static const char *const brdf_fs =
     "    A += (1.0 - fc) * gv; Bv += fc * gv; }\n"
     "  o = vec4(A / float(n), Bv / float(n), 0.0, 1.0); }\n";
 
-static sy_gl_result build(const sy_gl_fns *gl, sy_gl_ibl *ibl, char *err, size_t err_len)
+static sy_gl_result build(const sy_gl_fns *gl, sy_gl_ibl *ibl, sy_gl_report *rep)
 {
     if (ibl->prog_spec) return SY_GL_OK;
-    sy_gl_result r = sy_gl_program_build(gl, "IBL specular prefilter", sy_gl_fullscreen_vs, spec_fs, NULL, &ibl->prog_spec, err, err_len);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL irradiance", sy_gl_fullscreen_vs, irr_fs, NULL, &ibl->prog_irr, err, err_len);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL BRDF table", sy_gl_fullscreen_vs, brdf_fs, NULL, &ibl->prog_brdf, err, err_len);
+    sy_gl_result r = sy_gl_program_build(gl, "IBL specular prefilter", sy_gl_fullscreen_vs, spec_fs, NULL, &ibl->prog_spec, rep);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL irradiance", sy_gl_fullscreen_vs, irr_fs, NULL, &ibl->prog_irr, rep);
+    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL BRDF table", sy_gl_fullscreen_vs, brdf_fs, NULL, &ibl->prog_brdf, rep);
     if (r != SY_GL_OK) return r;
     ibl->spec_face = gl->GetUniformLocation(ibl->prog_spec, "u_face");
     ibl->spec_rough = gl->GetUniformLocation(ibl->prog_spec, "u_rough");
@@ -108,23 +108,19 @@ static GLuint table_tex(const sy_gl_fns *gl, GLint internal, GLsizei size, GLenu
     return t;
 }
 
-static sy_gl_result fb_check(const sy_gl_fns *gl, const char *what, char *err, size_t err_len)
+static sy_gl_result fb_check(const sy_gl_fns *gl, const char *what, sy_gl_report *rep)
 {
     GLenum st = gl->CheckFramebufferStatus(GL_FRAMEBUFFER);
     if (st == GL_FRAMEBUFFER_COMPLETE) return SY_GL_OK;
-    if (err && err_len) snprintf(err, err_len, "%s: framebuffer incomplete (0x%04x)", what, (unsigned)st);
-    return SY_GL_ERROR_GL;
+    return sy_gli_fail(rep, SY_GL_ERROR_GL, "%s: framebuffer incomplete (0x%04x)", what, (unsigned)st);
 }
 
-sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, char *err, size_t err_len)
+sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, sy_gl_report *rep)
 {
     if (ibl->brdf_lut) return SY_GL_OK;
     float *ltc = malloc(2 * SY_GL_LTC_FLOATS * sizeof *ltc);
-    if (!ltc) {
-        if (err && err_len) snprintf(err, err_len, "LTC tables: out of memory");
-        return SY_GL_ERROR_OUT_OF_MEMORY;
-    }
-    sy_gl_result r = build(gl, ibl, err, err_len);
+    if (!ltc) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "LTC tables: out of memory");
+    sy_gl_result r = build(gl, ibl, rep);
     if (r != SY_GL_OK) {
         free(ltc);
         return r;
@@ -137,7 +133,7 @@ sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, char *err, si
     gl->BindFramebuffer(GL_FRAMEBUFFER, ibl->fbo);
     gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, lut, 0);
     gl->DrawBuffer(GL_COLOR_ATTACHMENT0);
-    if ((r = fb_check(gl, "BRDF table", err, err_len)) != SY_GL_OK) {
+    if ((r = fb_check(gl, "BRDF table", rep)) != SY_GL_OK) {
         gl->BindFramebuffer(GL_FRAMEBUFFER, 0);
         gl->DeleteTextures(1, &lut);
         return r;
@@ -181,9 +177,9 @@ uint32_t sy_gl_ibl_side(uint32_t w, uint32_t h)
 }
 
 sy_gl_result sy_gl_ibl_prefilter(const sy_gl_fns *gl, sy_gl_ibl *ibl, GLuint src, uint32_t src_w, uint32_t src_h,
-                                 float intensity, uint32_t side, char *err, size_t err_len)
+                                 float intensity, uint32_t side, sy_gl_report *rep)
 {
-    sy_gl_result r = build(gl, ibl, err, err_len);
+    sy_gl_result r = build(gl, ibl, rep);
     if (r != SY_GL_OK) return r;
     side = side < SY_GL_IBL_SPEC_MIN ? SY_GL_IBL_SPEC_MIN : side > SY_GL_IBL_SPEC_SIZE ? SY_GL_IBL_SPEC_SIZE : side;
     if (ibl->spec_cube && ibl->spec_side != side) {
@@ -219,7 +215,7 @@ sy_gl_result sy_gl_ibl_prefilter(const sy_gl_fns *gl, sy_gl_ibl *ibl, GLuint src
             for (int f = 0; f < 6 && r == SY_GL_OK; ++f) {
                 gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f,
                                          cube, (GLint)l);
-                if (f == 0 && l == 0) r = fb_check(gl, pass ? "irradiance cube" : "specular cube", err, err_len);
+                if (f == 0 && l == 0) r = fb_check(gl, pass ? "irradiance cube" : "specular cube", rep);
                 if (r != SY_GL_OK) break;
                 gl->Uniform1i(pass ? ibl->irr_face : ibl->spec_face, f);
                 gl->DrawArrays(GL_TRIANGLES, 0, 3);

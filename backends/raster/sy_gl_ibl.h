@@ -39,12 +39,12 @@ typedef struct sy_gl_ibl {
 uint32_t sy_gl_ibl_side(uint32_t w, uint32_t h);
 
 /* Builds the BRDF table and uploads the LTC tables (no-op when done). */
-sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, char *err, size_t err_len);
+sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, sy_gl_report *rep);
 /* (Re)computes both cube maps from a lat-long RGBA float texture with mipmaps (src_w x src_h at
  * level 0) scaled by intensity, the specular one `side` texels per side (sy_gl_ibl_side). Leaves
  * the framebuffer binding at 0 and the viewport changed. */
 sy_gl_result sy_gl_ibl_prefilter(const sy_gl_fns *gl, sy_gl_ibl *ibl, GLuint src, uint32_t src_w, uint32_t src_h,
-                                 float intensity, uint32_t side, char *err, size_t err_len);
+                                 float intensity, uint32_t side, sy_gl_report *rep);
 void sy_gl_ibl_free(const sy_gl_fns *gl, sy_gl_ibl *ibl);
 
 #endif /* SY_GL_IBL_H */

@@ -149,6 +149,10 @@ struct sy_gl_device {
     char info[256];
     sy_gl_log_fn log;
     void *log_user;
+    /* the error report (sy_gl_device_desc.error and the last message, sy_gl_device_error): reached
+     * through a pointer, so that calls given a const device report too */
+    sy_gl_report report_store;
+    sy_gl_report *report; /* &report_store */
     uint32_t msaa, max_tex, shadow_size;
     bool shadow_auto; /* shadow_map_size 0: shadow_size follows the frame (sy_gli_shadow_size_follow) */
     pool meshes, textures, materials, instances, lights;
@@ -296,7 +300,6 @@ typedef struct draw_ctx {
 static inline int sy_gli_mesh_lean(const mesh_o *m) { return !m->has_attr[3] && !m->has_attr[4]; }
 
 /* sy_gl_base.c */
-sy_gl_result sy_gli_fail(char *err, size_t len, sy_gl_result r, const char *fmt, ...);
 void *sy_gli_pool_get(const pool *p, uint32_t id);
 void *sy_gli_pool_alloc(pool *p);
 void sy_gli_pool_free(pool *p, void *item);
@@ -312,8 +315,8 @@ GLuint sy_gli_shadow_cube(const sy_gl_fns *gl, uint32_t size);
 void sy_gli_look_along(const float *eye, const float *dir, float *view);
 void sy_gli_projection(bool ortho, double l, double r, double b, double t, double n, double f, float *p);
 void sy_gli_count_buffer(sy_gl_device *dev, bool uniform, size_t bytes);
-sy_gl_result sy_gli_gl_check(sy_gl_device *dev, const char *where, char *err, size_t len);
-sy_gl_result sy_gli_current(sy_gl_device *dev, char *err, size_t len);
+sy_gl_result sy_gli_gl_check(sy_gl_device *dev, const char *where, sy_gl_report *rep);
+sy_gl_result sy_gli_current(sy_gl_device *dev, sy_gl_report *rep);
 void sy_gli_geometry_changed(sy_gl_device *dev);
 void sy_gli_frustum_planes(const float *m, float planes[6][4]);
 float sy_gli_world_sphere(const inst_o *in, const mesh_o *m, float c[3], float *scale);
@@ -324,8 +327,8 @@ GLuint sy_gli_make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], boo
 void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b);
 void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog);
 int sy_gli_variant_normalize(int v);
-GLuint sy_gli_main_program(sy_gl_device *dev, int v, char *err, size_t err_len);
-int sy_gli_deferred_program(sy_gl_device *dev, int v, char *err, size_t err_len);
+GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep);
+int sy_gli_deferred_program(sy_gl_device *dev, int v, sy_gl_report *rep);
 bool sy_gli_mtab_set(sy_gl_device *dev, uint32_t row, const sy_gl_material_desc *d);
 void sy_gli_mtab_upload(sy_gl_device *dev);
 
@@ -344,7 +347,7 @@ float sy_gli_pixels_per_triangle(const sy_gl_device *dev, const mesh_o *m, uint3
 /* sy_gl_shadows.c */
 void sy_gli_scene_bounds(const sy_gl_device *dev, float *c, float *radius);
 void sy_gli_lights_upload(sy_gl_device *dev, frame_state *fs);
-sy_gl_result sy_gli_shadow_maps_make(sy_gl_device *dev, char *err, size_t err_len);
+sy_gl_result sy_gli_shadow_maps_make(sy_gl_device *dev, sy_gl_report *rep);
 void sy_gli_shadow_size_follow(sy_gl_device *dev, uint32_t w, uint32_t h);
 void sy_gli_render_shadows(sy_gl_device *dev, const frame_state *fs);
 
@@ -352,16 +355,14 @@ void sy_gli_render_shadows(sy_gl_device *dev, const frame_state *fs);
 void sy_gli_frame_features(sy_gl_device *dev);
 void sy_gli_targets_free(sy_gl_device *dev, targets *t);
 void sy_gli_frame_end(sy_gl_device *dev);
-sy_gl_result sy_gli_targets_ensure(sy_gl_device *dev, uint32_t w, uint32_t h, char *err, size_t len);
-sy_gl_result sy_gli_view_make(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, view_setup *v,
-                              char *err, size_t len);
+sy_gl_result sy_gli_targets_ensure(sy_gl_device *dev, uint32_t w, uint32_t h, sy_gl_report *rep);
+sy_gl_result sy_gli_view_make(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, view_setup *v, sy_gl_report *rep);
 void sy_gli_draw_latlong(sy_gl_device *dev, const view_setup *v, const tex_o *tex, float intensity, uint32_t w,
                          uint32_t h);
 void sy_gli_begin_target(sy_gl_device *dev, const view_setup *v);
-sy_gl_result sy_gli_finish_target(sy_gl_device *dev, const view_setup *v, float *rgba, float *depth, char *err,
-                                  size_t len);
+sy_gl_result sy_gli_finish_target(sy_gl_device *dev, const view_setup *v, float *rgba, float *depth, sy_gl_report *rep);
 void sy_gli_bind_frame_resources(sy_gl_device *dev);
-sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t skip, char *err, size_t err_len);
+sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t skip, sy_gl_report *rep);
 
 /* sy_gl_render.c */
 void sy_gli_probes_free(sy_gl_device *dev);

@@ -65,35 +65,35 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
     *count_out = used;
 }
 
-sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_gl_mesh *out, char *err,
-                               size_t err_len)
+sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_gl_mesh *out)
 {
+    sy_gl_report *rep = dev ? dev->report : NULL;
     out->id = 0;
     if (!d || !d->positions || d->vertex_count == 0 || d->triangle_count == 0)
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: positions and a non-zero vertex and triangle count are required");
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: positions and a non-zero vertex and triangle count are required");
     if (d->triangle_count > UINT32_MAX / 3u)
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_LIMIT, "mesh: %u triangles exceed the index range", d->triangle_count);
+        return sy_gli_fail(rep, SY_GL_ERROR_LIMIT, "mesh: %u triangles exceed the index range", d->triangle_count);
     if (!d->indices && d->vertex_count != 3u * d->triangle_count)
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT,
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT,
                     "mesh: without indices vertex_count (%u) must be 3 x triangle_count (%u)", d->vertex_count,
                     d->triangle_count);
     float bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (uint32_t i = 0; i < d->vertex_count; ++i)
         for (int k = 0; k < 3; ++k) {
             float v = d->positions[3u * i + k];
-            if (!isfinite(v)) return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: position %u is not finite", i);
+            if (!isfinite(v)) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: position %u is not finite", i);
             bmin[k] = fminf(bmin[k], v);
             bmax[k] = fmaxf(bmax[k], v);
         }
     if (d->indices)
         for (uint32_t i = 0; i < 3u * d->triangle_count; ++i)
             if (d->indices[i] >= d->vertex_count)
-                return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: index %u = %u is out of range (%u vertices)",
+                return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: index %u = %u is out of range (%u vertices)",
                             i, d->indices[i], d->vertex_count);
-    sy_gl_result r = sy_gli_current(dev, err, err_len);
+    sy_gl_result r = sy_gli_current(dev, rep);
     if (r != SY_GL_OK) return r;
     mesh_o *m = sy_gli_pool_alloc(&dev->meshes);
-    if (!m) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
+    if (!m) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
     const sy_gl_fns *gl = dev->gl;
     m->vertex_count = d->vertex_count;
     m->triangle_count = d->triangle_count;
@@ -122,7 +122,7 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     float *vb = malloc(bytes);
     if (!vb) {
         sy_gli_pool_free(&dev->meshes, m);
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory (%u vertices)", d->vertex_count);
+        return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory (%u vertices)", d->vertex_count);
     }
     for (uint32_t i = 0; i < d->vertex_count; ++i)
         for (int a = 0; a < 5; ++a)
@@ -150,7 +150,7 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
         m->indexed = true;
     }
     gl->BindVertexArray(0);
-    r = sy_gli_gl_check(dev, "mesh upload", err, err_len);
+    r = sy_gli_gl_check(dev, "mesh upload", rep);
     if (r != SY_GL_OK) {
         sy_gl_mesh h = {m->h.id};
         sy_gl_mesh_destroy(dev, h);
@@ -163,8 +163,8 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
 sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh)
 {
     mesh_o *m = sy_gli_pool_get(&dev->meshes, mesh.id);
-    if (!m) return SY_GL_ERROR_INVALID_HANDLE;
-    if (sy_gli_current(dev, NULL, 0) == SY_GL_OK) {
+    if (!m) return sy_gli_fail(dev->report, SY_GL_ERROR_INVALID_HANDLE, "%s: stale handle 0x%08x", __func__, mesh.id);
+    if (sy_gli_current(dev, NULL) == SY_GL_OK) {
         dev->gl->DeleteBuffers(1, m->vbo);
         dev->gl->DeleteBuffers(1, &m->ibo);
         dev->gl->DeleteVertexArrays(1, &m->vao);
@@ -191,7 +191,7 @@ static bool resample(const void *src, uint32_t w, uint32_t h, void *dst, uint32_
  * GL threads (0.53 s for a 2048x2048 sRGB texture, 0.12 s for the first texture of each format, in
  * TransmissionTest's first frame); the box filter here costs a few tens of milliseconds. */
 static sy_gl_result upload_levels(sy_gl_device *dev, const void *level0, uint32_t w, uint32_t h, bool is_float, bool srgb,
-                                  const stbir_edge edge[2], char *err, size_t err_len)
+                                  const stbir_edge edge[2], sy_gl_report *rep)
 {
     const sy_gl_fns *gl = dev->gl;
     size_t texel = is_float ? 16 : 4, below = 0;
@@ -201,7 +201,7 @@ static sy_gl_result upload_levels(sy_gl_device *dev, const void *level0, uint32_
     }
     unsigned char *chain = below ? malloc(below * texel) : NULL;
     if (below && !chain)
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (mipmaps of %ux%u)", w, h);
+        return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (mipmaps of %ux%u)", w, h);
     GLint internal = is_float ? GL_RGBA32F : srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8;
     GLenum type = is_float ? GL_FLOAT : GL_UNSIGNED_BYTE;
     const unsigned char *prev = level0;
@@ -213,7 +213,7 @@ static sy_gl_result upload_levels(sy_gl_device *dev, const void *level0, uint32_
         uint32_t nw = w > 1 ? w / 2 : 1, nh = h > 1 ? h / 2 : 1;
         if (!resample(prev, w, h, next, nw, nh, is_float, srgb, edge)) {
             free(chain);
-            return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (mipmaps of %ux%u)", w, h);
+            return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (mipmaps of %ux%u)", w, h);
         }
         prev = next;
         next += (size_t)nw * nh * texel;
@@ -223,23 +223,23 @@ static sy_gl_result upload_levels(sy_gl_device *dev, const void *level0, uint32_
     return SY_GL_OK;
 }
 
-sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d, sy_gl_texture *out, char *err,
-                                  size_t err_len)
+sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d, sy_gl_texture *out)
 {
+    sy_gl_report *rep = dev ? dev->report : NULL;
     out->id = 0;
     if (!d || !d->pixels || d->width == 0 || d->height == 0 || d->channels < 1 || d->channels > 4)
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "texture: needs pixels, a non-zero size and 1..4 channels");
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "texture: needs pixels, a non-zero size and 1..4 channels");
     if (d->format != SY_GL_TEXEL_UNORM8 && d->format != SY_GL_TEXEL_UNORM8_SRGB && d->format != SY_GL_TEXEL_FLOAT32)
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "texture: unknown texel format %d", (int)d->format);
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "texture: unknown texel format %d", (int)d->format);
     size_t n = (size_t)d->width * d->height;
     if (n / d->width != d->height || n > ((size_t)1 << 32))
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_LIMIT, "texture: %ux%u is too large", d->width, d->height);
+        return sy_gli_fail(rep, SY_GL_ERROR_LIMIT, "texture: %ux%u is too large", d->width, d->height);
     bool is_float = d->format == SY_GL_TEXEL_FLOAT32, srgb = d->format == SY_GL_TEXEL_UNORM8_SRGB;
     uint32_t ch = d->channels, w = d->width, h = d->height;
     size_t texel = is_float ? 4 * sizeof(float) : 4;
     /* expand to RGBA in the texel type (grey -> rgb, grey+alpha -> rgb+a) */
     unsigned char *img = malloc(n * texel);
-    if (!img) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (%ux%u)", w, h);
+    if (!img) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory (%ux%u)", w, h);
     if (is_float) {
         const float *s = d->pixels;
         float *o = (float *)img;
@@ -264,16 +264,16 @@ sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d
         if (!small || !resample(img, ow, oh, small, w, h, is_float, srgb, edge)) {
             free(small);
             free(img);
-            return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory while downscaling");
+            return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory while downscaling");
         }
         free(img);
         img = small;
         sy_gli_warn(dev, "raster: texture %ux%u exceeds the GL limit of %u texels per side; downscaled to %ux%u", ow, oh,
                     dev->max_tex, w, h);
     }
-    sy_gl_result r = sy_gli_current(dev, err, err_len);
+    sy_gl_result r = sy_gli_current(dev, rep);
     tex_o *t = r == SY_GL_OK ? sy_gli_pool_alloc(&dev->textures) : NULL;
-    if (r == SY_GL_OK && !t) r = sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory");
+    if (r == SY_GL_OK && !t) r = sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "texture: out of memory");
     if (r != SY_GL_OK) {
         free(img);
         return r;
@@ -289,10 +289,10 @@ sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d
     gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wraps[(unsigned)d->wrap_t < 3u ? d->wrap_t : 0]);
     gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, d->nearest ? GL_NEAREST : GL_LINEAR);
     gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, d->nearest ? GL_NEAREST_MIPMAP_LINEAR : GL_LINEAR_MIPMAP_LINEAR);
-    r = upload_levels(dev, img, w, h, is_float, srgb, edge, err, err_len);
+    r = upload_levels(dev, img, w, h, is_float, srgb, edge, rep);
     free(img);
     dev->counts.texture_uploads++;
-    if (r == SY_GL_OK) r = sy_gli_gl_check(dev, "texture upload", err, err_len);
+    if (r == SY_GL_OK) r = sy_gli_gl_check(dev, "texture upload", rep);
     if (r != SY_GL_OK) {
         sy_gl_texture_destroy(dev, (sy_gl_texture){t->h.id});
         return r;
@@ -304,8 +304,8 @@ sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d
 sy_gl_result sy_gl_texture_destroy(sy_gl_device *dev, sy_gl_texture tex)
 {
     tex_o *t = sy_gli_pool_get(&dev->textures, tex.id);
-    if (!t) return SY_GL_ERROR_INVALID_HANDLE;
-    if (sy_gli_current(dev, NULL, 0) == SY_GL_OK) dev->gl->DeleteTextures(1, &t->tex);
+    if (!t) return sy_gli_fail(dev->report, SY_GL_ERROR_INVALID_HANDLE, "%s: stale handle 0x%08x", __func__, tex.id);
+    if (sy_gli_current(dev, NULL) == SY_GL_OK) dev->gl->DeleteTextures(1, &t->tex);
     sy_gli_pool_free(&dev->textures, t);
     if (tex.id == dev->env_tex.id) { /* the environment is gone: no environment light */
         dev->env_tex.id = 0;
@@ -327,21 +327,21 @@ void sy_gl_material_desc_init(sy_gl_material_desc *d)
     d->alpha_cutoff = 0.5f;
 }
 
-static sy_gl_result material_check(const sy_gl_material_desc *d, char *err, size_t len)
+static sy_gl_result material_check(const sy_gl_material_desc *d, sy_gl_report *rep)
 {
     const float *v[] = {d->base_color, d->base_color + 1, d->base_color + 2, d->base_color + 3, &d->metallic,
                         &d->roughness, d->emissive, d->emissive + 1, d->emissive + 2, &d->normal_scale,
                         &d->occlusion_strength, &d->specular, &d->transmission, &d->ior, &d->alpha_cutoff};
     for (size_t i = 0; i < sizeof v / sizeof v[0]; ++i)
-        if (!isfinite(*v[i])) return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "material: parameter %zu is not finite", i);
+        if (!isfinite(*v[i])) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "material: parameter %zu is not finite", i);
     if ((unsigned)d->alpha_mode > 2u)
-        return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "material: unknown alpha mode %d", (int)d->alpha_mode);
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "material: unknown alpha mode %d", (int)d->alpha_mode);
     const sy_gl_texture_ref *refs[5] = {&d->base_color_texture, &d->metallic_roughness_texture, &d->normal_texture,
                                         &d->occlusion_texture, &d->emissive_texture};
     for (int i = 0; i < 5; ++i)
         for (int k = 0; refs[i]->transformed && k < 6; ++k)
             if (!isfinite(refs[i]->transform[k]))
-                return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "material: texture %d transform[%d] is not finite", i, k);
+                return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "material: texture %d transform[%d] is not finite", i, k);
     return SY_GL_OK;
 }
 
@@ -357,15 +357,15 @@ static void material_upload(sy_gl_device *dev, mat_o *m, bool create)
     if (!dev->forward) sy_gli_mtab_set(dev, m->h.id & IDX_MASK, &m->d); /* beyond the table: shaded forward */
 }
 
-sy_gl_result sy_gl_material_create(sy_gl_device *dev, const sy_gl_material_desc *d, sy_gl_material *out, char *err,
-                                   size_t err_len)
+sy_gl_result sy_gl_material_create(sy_gl_device *dev, const sy_gl_material_desc *d, sy_gl_material *out)
 {
+    sy_gl_report *rep = dev ? dev->report : NULL;
     out->id = 0;
-    sy_gl_result r = material_check(d, err, err_len);
-    if (r == SY_GL_OK) r = sy_gli_current(dev, err, err_len);
+    sy_gl_result r = material_check(d, rep);
+    if (r == SY_GL_OK) r = sy_gli_current(dev, rep);
     if (r != SY_GL_OK) return r;
     mat_o *m = sy_gli_pool_alloc(&dev->materials);
-    if (!m) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "material: out of memory");
+    if (!m) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "material: out of memory");
     m->d = *d;
     dev->gl->GenBuffers(1, &m->ubo);
     material_upload(dev, m, true);
@@ -373,13 +373,13 @@ sy_gl_result sy_gl_material_create(sy_gl_device *dev, const sy_gl_material_desc 
     return SY_GL_OK;
 }
 
-sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const sy_gl_material_desc *d, char *err,
-                                   size_t err_len)
+sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const sy_gl_material_desc *d)
 {
+    sy_gl_report *rep = dev ? dev->report : NULL;
     mat_o *m = sy_gli_pool_get(&dev->materials, mat.id);
-    if (!m) return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "material update: stale handle %u", mat.id);
-    sy_gl_result r = material_check(d, err, err_len);
-    if (r == SY_GL_OK) r = sy_gli_current(dev, err, err_len);
+    if (!m) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_HANDLE, "material update: stale handle %u", mat.id);
+    sy_gl_result r = material_check(d, rep);
+    if (r == SY_GL_OK) r = sy_gli_current(dev, rep);
     if (r != SY_GL_OK) return r;
     bool shadows = sy_gli_caster_kind(&m->d) != sy_gli_caster_kind(d) || m->d.alpha_mode != SY_GL_ALPHA_OPAQUE ||
                    memcmp(m->d.emissive, d->emissive, sizeof d->emissive) != 0;
@@ -393,8 +393,8 @@ sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const 
 sy_gl_result sy_gl_material_destroy(sy_gl_device *dev, sy_gl_material mat)
 {
     mat_o *m = sy_gli_pool_get(&dev->materials, mat.id);
-    if (!m) return SY_GL_ERROR_INVALID_HANDLE;
-    if (sy_gli_current(dev, NULL, 0) == SY_GL_OK) dev->gl->DeleteBuffers(1, &m->ubo);
+    if (!m) return sy_gli_fail(dev->report, SY_GL_ERROR_INVALID_HANDLE, "%s: stale handle 0x%08x", __func__, mat.id);
+    if (sy_gli_current(dev, NULL) == SY_GL_OK) dev->gl->DeleteBuffers(1, &m->ubo);
     sy_gli_pool_free(&dev->materials, m);
     return SY_GL_OK;
 }
@@ -447,17 +447,17 @@ static bool set_model(inst_o *in, const float *t)
     return true;
 }
 
-sy_gl_result sy_gl_instance_create(sy_gl_device *dev, const sy_gl_instance_desc *d, sy_gl_instance *out, char *err,
-                                   size_t err_len)
+sy_gl_result sy_gl_instance_create(sy_gl_device *dev, const sy_gl_instance_desc *d, sy_gl_instance *out)
 {
+    sy_gl_report *rep = dev ? dev->report : NULL;
     out->id = 0;
     if (!sy_gli_pool_get(&dev->meshes, d->mesh.id))
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "instance: mesh handle %u is stale", d->mesh.id);
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_HANDLE, "instance: mesh handle %u is stale", d->mesh.id);
     inst_o tmp;
     if (!set_model(&tmp, d->transform))
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "instance: transform is not finite and invertible");
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "instance: transform is not finite and invertible");
     inst_o *in = sy_gli_pool_alloc(&dev->instances);
-    if (!in) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "instance: out of memory");
+    if (!in) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "instance: out of memory");
     set_model(in, d->transform);
     in->mesh = d->mesh;
     in->material = d->material;
@@ -468,13 +468,13 @@ sy_gl_result sy_gl_instance_create(sy_gl_device *dev, const sy_gl_instance_desc 
     return SY_GL_OK;
 }
 
-sy_gl_result sy_gl_instance_set_transform(sy_gl_device *dev, sy_gl_instance inst, const float t[16], char *err,
-                                          size_t err_len)
+sy_gl_result sy_gl_instance_set_transform(sy_gl_device *dev, sy_gl_instance inst, const float t[16])
 {
+    sy_gl_report *rep = dev ? dev->report : NULL;
     inst_o *in = sy_gli_pool_get(&dev->instances, inst.id);
-    if (!in) return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "instance transform: stale handle %u", inst.id);
+    if (!in) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_HANDLE, "instance transform: stale handle %u", inst.id);
     if (!set_model(in, t))
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "instance transform: not finite and invertible");
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "instance transform: not finite and invertible");
     dev->counts.model_matrix_updates++;
     sy_gli_geometry_changed(dev);
     return SY_GL_OK;
@@ -483,7 +483,7 @@ sy_gl_result sy_gl_instance_set_transform(sy_gl_device *dev, sy_gl_instance inst
 sy_gl_result sy_gl_instance_set_material(sy_gl_device *dev, sy_gl_instance inst, sy_gl_material mat)
 {
     inst_o *in = sy_gli_pool_get(&dev->instances, inst.id);
-    if (!in) return SY_GL_ERROR_INVALID_HANDLE;
+    if (!in) return sy_gli_fail(dev->report, SY_GL_ERROR_INVALID_HANDLE, "%s: stale handle 0x%08x", __func__, inst.id);
     if (in->material.id != mat.id) sy_gli_geometry_changed(dev); /* shadow casters and probes */
     in->material = mat;
     return SY_GL_OK;
@@ -492,7 +492,7 @@ sy_gl_result sy_gl_instance_set_material(sy_gl_device *dev, sy_gl_instance inst,
 sy_gl_result sy_gl_instance_set_visible(sy_gl_device *dev, sy_gl_instance inst, bool visible)
 {
     inst_o *in = sy_gli_pool_get(&dev->instances, inst.id);
-    if (!in) return SY_GL_ERROR_INVALID_HANDLE;
+    if (!in) return sy_gli_fail(dev->report, SY_GL_ERROR_INVALID_HANDLE, "%s: stale handle 0x%08x", __func__, inst.id);
     if (in->visible != visible) sy_gli_geometry_changed(dev);
     in->visible = visible;
     return SY_GL_OK;
@@ -501,46 +501,46 @@ sy_gl_result sy_gl_instance_set_visible(sy_gl_device *dev, sy_gl_instance inst, 
 sy_gl_result sy_gl_instance_destroy(sy_gl_device *dev, sy_gl_instance inst)
 {
     inst_o *in = sy_gli_pool_get(&dev->instances, inst.id);
-    if (!in) return SY_GL_ERROR_INVALID_HANDLE;
+    if (!in) return sy_gli_fail(dev->report, SY_GL_ERROR_INVALID_HANDLE, "%s: stale handle 0x%08x", __func__, inst.id);
     sy_gli_pool_free(&dev->instances, in);
     sy_gli_geometry_changed(dev);
     return SY_GL_OK;
 }
 
-static sy_gl_result light_check(const sy_gl_light_desc *d, char *err, size_t len)
+static sy_gl_result light_check(const sy_gl_light_desc *d, sy_gl_report *rep)
 {
     if (d->type != SY_GL_LIGHT_POINT && d->type != SY_GL_LIGHT_SPOT && d->type != SY_GL_LIGHT_DIRECTIONAL)
-        return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "light: unknown type %d", (int)d->type);
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "light: unknown type %d", (int)d->type);
     const float *v[] = {d->color, d->color + 1, d->color + 2, &d->intensity, d->position, d->position + 1,
                         d->position + 2, d->direction, d->direction + 1, d->direction + 2, &d->range,
                         &d->inner_cone_angle, &d->outer_cone_angle};
     for (size_t i = 0; i < sizeof v / sizeof v[0]; ++i)
-        if (!isfinite(*v[i])) return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "light: parameter %zu is not finite", i);
+        if (!isfinite(*v[i])) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "light: parameter %zu is not finite", i);
     if (d->type != SY_GL_LIGHT_POINT && !(fabsf(d->direction[0]) + fabsf(d->direction[1]) + fabsf(d->direction[2]) > 0.0f))
-        return sy_gli_fail(err, len, SY_GL_ERROR_INVALID_ARGUMENT, "light: zero direction");
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "light: zero direction");
     return SY_GL_OK;
 }
 
-sy_gl_result sy_gl_light_create(sy_gl_device *dev, const sy_gl_light_desc *d, sy_gl_light *out, char *err,
-                                size_t err_len)
+sy_gl_result sy_gl_light_create(sy_gl_device *dev, const sy_gl_light_desc *d, sy_gl_light *out)
 {
+    sy_gl_report *rep = dev ? dev->report : NULL;
     out->id = 0;
-    sy_gl_result r = light_check(d, err, err_len);
+    sy_gl_result r = light_check(d, rep);
     if (r != SY_GL_OK) return r;
     light_o *l = sy_gli_pool_alloc(&dev->lights);
-    if (!l) return sy_gli_fail(err, err_len, SY_GL_ERROR_OUT_OF_MEMORY, "light: out of memory");
+    if (!l) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "light: out of memory");
     l->d = *d;
     dev->lights_dirty = true;
     out->id = l->h.id;
     return SY_GL_OK;
 }
 
-sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_gl_light_desc *d, char *err,
-                                size_t err_len)
+sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_gl_light_desc *d)
 {
+    sy_gl_report *rep = dev ? dev->report : NULL;
     light_o *l = sy_gli_pool_get(&dev->lights, light.id);
-    if (!l) return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_HANDLE, "light update: stale handle %u", light.id);
-    sy_gl_result r = light_check(d, err, err_len);
+    if (!l) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_HANDLE, "light update: stale handle %u", light.id);
+    sy_gl_result r = light_check(d, rep);
     if (r != SY_GL_OK) return r;
     l->d = *d;
     dev->lights_dirty = true;
@@ -550,7 +550,7 @@ sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_g
 sy_gl_result sy_gl_light_destroy(sy_gl_device *dev, sy_gl_light light)
 {
     light_o *l = sy_gli_pool_get(&dev->lights, light.id);
-    if (!l) return SY_GL_ERROR_INVALID_HANDLE;
+    if (!l) return sy_gli_fail(dev->report, SY_GL_ERROR_INVALID_HANDLE, "%s: stale handle 0x%08x", __func__, light.id);
     sy_gli_pool_free(&dev->lights, l);
     dev->lights_dirty = true;
     return SY_GL_OK;
@@ -612,24 +612,24 @@ void sy_gl_set_ambient(sy_gl_device *dev, const float radiance[3])
     }
 }
 
-sy_gl_result sy_gl_set_area_lights(sy_gl_device *dev, const sy_gl_area_light *lights, uint32_t count, char *err,
-                                   size_t err_len)
+sy_gl_result sy_gl_set_area_lights(sy_gl_device *dev, const sy_gl_area_light *lights, uint32_t count)
 {
+    sy_gl_report *rep = dev ? dev->report : NULL;
     if (count > SY_GL_MAX_AREA_LIGHTS)
-        return sy_gli_fail(err, err_len, SY_GL_ERROR_LIMIT, "area lights: %u exceed the limit of %d", count, SY_GL_MAX_AREA_LIGHTS);
-    if (count && !lights) return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "area lights: NULL array");
+        return sy_gli_fail(rep, SY_GL_ERROR_LIMIT, "area lights: %u exceed the limit of %d", count, SY_GL_MAX_AREA_LIGHTS);
+    if (count && !lights) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "area lights: NULL array");
     for (uint32_t i = 0; i < count; ++i) {
         const sy_gl_area_light *a = &lights[i];
         if (a->vertex_count != 3 && a->vertex_count != 4)
-            return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "area light %u: %u vertices (3 or 4 expected)", i,
+            return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "area light %u: %u vertices (3 or 4 expected)", i,
                         a->vertex_count);
         for (uint32_t k = 0; k < a->vertex_count; ++k)
             for (int c = 0; c < 3; ++c)
                 if (!isfinite(a->vertices[k][c]))
-                    return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT, "area light %u: vertex %u is not finite", i, k);
+                    return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "area light %u: vertex %u is not finite", i, k);
         for (int c = 0; c < 3; ++c)
             if (!isfinite(a->radiance[c]) || a->radiance[c] < 0.0f)
-                return sy_gli_fail(err, err_len, SY_GL_ERROR_INVALID_ARGUMENT,
+                return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT,
                             "area light %u: radiance[%d] = %g is not a finite non-negative value", i, c, (double)a->radiance[c]);
     }
     if (count == dev->area_count && (!count || !memcmp(dev->areas, lights, count * sizeof *lights))) return SY_GL_OK;

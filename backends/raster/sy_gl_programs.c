@@ -138,7 +138,7 @@ static void variant_defines(int v, uint64_t sig, char *defs, size_t defs_len, ch
 
 /* The main program for variant bits v, built and cached on first use; 0 with err set when the
  * driver rejects it. */
-GLuint sy_gli_main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
+GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep)
 {
     v = sy_gli_variant_normalize(v);
     uint64_t sig = variant_sig(dev, v);
@@ -164,7 +164,7 @@ GLuint sy_gli_main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
     char defs[1024] = "", name[256] = "main";
     variant_defines(v, sig, defs, sizeof defs, name, sizeof name);
     GLuint p = 0;
-    if (sy_gl_program_build(gl, name, sy_gl_main_vs, sy_gl_main_fs, defs, &p, err, err_len) != SY_GL_OK) return 0;
+    if (sy_gl_program_build(gl, name, sy_gl_main_vs, sy_gl_main_fs, defs, &p, rep) != SY_GL_OK) return 0;
     dev->pm[v].prog = p;
     dev->pm[v].sig = sig;
     dev->pm[v].model = gl->GetUniformLocation(p, "u_model");
@@ -185,7 +185,7 @@ GLuint sy_gli_main_program(sy_gl_device *dev, int v, char *err, size_t err_len)
 /* The deferred shading pass for the frame's lighting variant bits v (only the lighting bits
  * count) and light signature, built and kept on first use: its index in dev->dp, or -1 with err
  * set when the driver rejects it. */
-int sy_gli_deferred_program(sy_gl_device *dev, int v, char *err, size_t err_len)
+int sy_gli_deferred_program(sy_gl_device *dev, int v, sy_gl_report *rep)
 {
     v = sy_gli_variant_normalize(v & (VAR_LIGHTS | VAR_ENV | VAR_SHADOW | VAR_AREA | VAR_ASHADOW | (7 << VAR_NL_SHIFT)));
     uint64_t sig = variant_sig(dev, v);
@@ -196,7 +196,7 @@ int sy_gli_deferred_program(sy_gl_device *dev, int v, char *err, size_t err_len)
     variant_defines(v, sig, defs, sizeof defs, name, sizeof name);
     const sy_gl_fns *gl = dev->gl;
     GLuint p = 0;
-    if (sy_gl_program_build(gl, name, sy_gl_rect_vs, sy_gl_deferred_fs, defs, &p, err, err_len) != SY_GL_OK) return -1;
+    if (sy_gl_program_build(gl, name, sy_gl_rect_vs, sy_gl_deferred_fs, defs, &p, rep) != SY_GL_OK) return -1;
     uint32_t i = dev->dp_count;
     if (i == DEFERRED_PROGS) { /* all kept: the new one takes the slots in turn (one is used per frame) */
         i = dev->dp_next++ % DEFERRED_PROGS;

@@ -67,7 +67,7 @@ void sy_gli_probes_free(sy_gl_device *dev)
 }
 
 /* (Re)renders the scene probes (see SY_GL_MAX_PROBES). */
-static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
+static sy_gl_result render_probes(sy_gl_device *dev, sy_gl_report *rep)
 {
     const sy_gl_fns *gl = dev->gl;
     uint32_t idx[SY_GL_MAX_PROBES];
@@ -143,33 +143,33 @@ static sy_gl_result render_probes(sy_gl_device *dev, char *err, size_t err_len)
             gl->Enable(GL_DEPTH_TEST);
             gl->DepthFunc(GL_LESS);
             dev->frame_no++; /* the variants take this face's camera */
-            r = sy_gli_draw_scene(dev, &v, dev->probes[p].inst, err, err_len);
+            r = sy_gli_draw_scene(dev, &v, dev->probes[p].inst, rep);
         }
         gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->probes[p].cube);
         gl->GenerateMipmap(GL_TEXTURE_CUBE_MAP);
     }
     dev->in_probe_pass = false;
     dev->frame_no++;
-    if (r == SY_GL_OK) r = sy_gli_gl_check(dev, "scene probes", err, err_len);
+    if (r == SY_GL_OK) r = sy_gli_gl_check(dev, "scene probes", rep);
     return r;
 }
 
 /* What every frame starts with: the context sy_gli_current, the view, the targets, zeroed counters. */
-static sy_gl_result frame_setup(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, view_setup *v,
-                                char *err, size_t err_len)
+static sy_gl_result frame_setup(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, view_setup *v, sy_gl_report *rep)
 {
-    sy_gl_result r = sy_gli_current(dev, err, err_len);
-    if (r == SY_GL_OK) r = sy_gli_view_make(dev, cam, d, v, err, err_len);
-    if (r == SY_GL_OK) r = sy_gli_targets_ensure(dev, d->width, d->height, err, err_len);
+    sy_gl_result r = sy_gli_current(dev, rep);
+    if (r == SY_GL_OK) r = sy_gli_view_make(dev, cam, d, v, rep);
+    if (r == SY_GL_OK) r = sy_gli_targets_ensure(dev, d->width, d->height, rep);
     dev->tris = dev->draws = 0;
     return r;
 }
 
 sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, float *rgba,
-                          float *depth, char *err, size_t err_len)
+                          float *depth)
 {
+    sy_gl_report *rep = dev ? dev->report : NULL;
     view_setup v;
-    sy_gl_result r = frame_setup(dev, cam, d, &v, err, err_len);
+    sy_gl_result r = frame_setup(dev, cam, d, &v, rep);
     if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
     dev->frame_no++;
@@ -185,22 +185,21 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         const tex_o *et = sy_gli_pool_get(&dev->textures, dev->env_tex.id);
         dev->env_ready = false;
         if (et) {
-            r = sy_gl_ibl_tables(gl, &dev->ibl, err, err_len);
+            r = sy_gl_ibl_tables(gl, &dev->ibl, rep);
             if (r == SY_GL_OK)
-                r = sy_gl_ibl_prefilter(gl, &dev->ibl, et->tex, et->width, et->height, dev->env_intensity, dev->env_side,
-                                        err, err_len);
+                r = sy_gl_ibl_prefilter(gl, &dev->ibl, et->tex, et->width, et->height, dev->env_intensity, dev->env_side, rep);
             if (r != SY_GL_OK) return r;
             dev->env_ready = true;
         }
         dev->env_dirty = false;
         dev->probes_dirty = true;
     }
-    if (dev->area_count && (r = sy_gl_ibl_tables(gl, &dev->ibl, err, err_len)) != SY_GL_OK) return r;
+    if (dev->area_count && (r = sy_gl_ibl_tables(gl, &dev->ibl, rep)) != SY_GL_OK) return r;
     if (dev->lights_dirty) {
         sy_gli_choose_lods(dev, &v); /* shadow maps draw the levels this view picks */
         sy_gli_lights_upload(dev, &fs);
         if ((fs.shadow_count || fs.cube_count) && !dev->shadow_tex) { /* the maps' size is known now */
-            if ((r = sy_gli_shadow_maps_make(dev, err, err_len)) != SY_GL_OK) return r;
+            if ((r = sy_gli_shadow_maps_make(dev, rep)) != SY_GL_OK) return r;
             fs = fs_zero;
             sy_gli_lights_upload(dev, &fs);
         }
@@ -217,22 +216,23 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         dev->probes_dirty = true;
     }
     if (dev->probes_dirty) {
-        if ((r = render_probes(dev, err, err_len)) != SY_GL_OK) return r;
+        if ((r = render_probes(dev, rep)) != SY_GL_OK) return r;
         dev->probes_dirty = false;
     }
     sy_gli_begin_target(dev, &v);
     sy_gli_bind_frame_resources(dev);
-    r = sy_gli_draw_scene(dev, &v, UINT32_MAX, err, err_len);
-    if (r == SY_GL_OK) r = sy_gli_finish_target(dev, &v, rgba, depth, err, err_len);
+    r = sy_gli_draw_scene(dev, &v, UINT32_MAX, rep);
+    if (r == SY_GL_OK) r = sy_gli_finish_target(dev, &v, rgba, depth, rep);
     sy_gli_frame_end(dev);
     return r;
 }
 
 sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *d, bool lit,
-                                float *rgba, float *depth, char *err, size_t err_len)
+                                float *rgba, float *depth)
 {
+    sy_gl_report *rep = dev ? dev->report : NULL;
     view_setup v;
-    sy_gl_result r = frame_setup(dev, cam, d, &v, err, err_len);
+    sy_gl_result r = frame_setup(dev, cam, d, &v, rep);
     if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
     sy_gli_begin_target(dev, NULL);
@@ -254,7 +254,7 @@ sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, cons
         gl->UniformMatrix4fv(dev->uf[k].model, 1, GL_FALSE, in->model);
         dev->tris += sy_gli_draw_mesh_lod(dev, m, in->lod);
     }
-    r = sy_gli_finish_target(dev, NULL, rgba, depth, err, err_len);
+    r = sy_gli_finish_target(dev, NULL, rgba, depth, rep);
     sy_gli_frame_end(dev);
     return r;
 }

@@ -633,7 +633,7 @@ const char *const sy_gl_floor_fs =
     "#endif\n";
 
 static sy_gl_result compile(const sy_gl_fns *gl, const char *name, GLenum stage, const char *src, const char *defines,
-                            GLuint *out, char *err, size_t err_len)
+                            GLuint *out, sy_gl_report *rep)
 {
     GLuint s = gl->CreateShader(stage);
     /* defines go right after the #version line */
@@ -648,21 +648,19 @@ static sy_gl_result compile(const sy_gl_fns *gl, const char *name, GLenum stage,
         char log[2048] = "";
         gl->GetShaderInfoLog(s, sizeof log, NULL, log);
         gl->DeleteShader(s);
-        if (err && err_len)
-            snprintf(err, err_len, "%s shader: %s compile failed: %s", name,
-                     stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
-        return SY_GL_ERROR_GL;
+        return sy_gli_fail(rep, SY_GL_ERROR_GL, "%s shader: %s compile failed: %s", name,
+                           stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
     }
     *out = s;
     return SY_GL_OK;
 }
 
 sy_gl_result sy_gl_program_build(const sy_gl_fns *gl, const char *name, const char *vs, const char *fs,
-                                 const char *fs_defines, GLuint *out, char *err, size_t err_len)
+                                 const char *fs_defines, GLuint *out, sy_gl_report *rep)
 {
     GLuint v = 0, f = 0;
-    sy_gl_result r = compile(gl, name, GL_VERTEX_SHADER, vs, fs_defines, &v, err, err_len);
-    if (r == SY_GL_OK) r = compile(gl, name, GL_FRAGMENT_SHADER, fs, fs_defines, &f, err, err_len);
+    sy_gl_result r = compile(gl, name, GL_VERTEX_SHADER, vs, fs_defines, &v, rep);
+    if (r == SY_GL_OK) r = compile(gl, name, GL_FRAGMENT_SHADER, fs, fs_defines, &f, rep);
     if (r != SY_GL_OK) {
         if (v) gl->DeleteShader(v);
         return r;
@@ -679,8 +677,7 @@ sy_gl_result sy_gl_program_build(const sy_gl_fns *gl, const char *name, const ch
         char log[2048] = "";
         gl->GetProgramInfoLog(p, sizeof log, NULL, log);
         gl->DeleteProgram(p);
-        if (err && err_len) snprintf(err, err_len, "%s shader: link failed: %s", name, log);
-        return SY_GL_ERROR_GL;
+        return sy_gli_fail(rep, SY_GL_ERROR_GL, "%s shader: link failed: %s", name, log);
     }
     *out = p;
     return SY_GL_OK;

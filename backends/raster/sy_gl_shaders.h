@@ -23,6 +23,6 @@ extern const char *const sy_gl_rect_vs;
  * #version line of both stages. On failure returns SY_GL_ERROR_GL with "<name> shader: <stage> compile
  * failed: <log>" (or link log) in err. */
 sy_gl_result sy_gl_program_build(const sy_gl_fns *gl, const char *name, const char *vs, const char *fs,
-                                 const char *fs_defines, GLuint *out, char *err, size_t err_len);
+                                 const char *fs_defines, GLuint *out, sy_gl_report *rep);
 
 #endif /* SY_GL_SHADERS_H */

@@ -228,10 +228,10 @@ static void draw_casters(sy_gl_device *dev, const float *vp)
  * frame). Its side is halved while the GL cannot hold it (the array of SY_GL_MAX_SHADOW_MAPS and a
  * point light's cube, made later, tried here): at 16384 texels the array alone is 4 GiB, and
  * llvmpipe refuses textures of 1 GiB and more with GL_OUT_OF_MEMORY. */
-sy_gl_result sy_gli_shadow_maps_make(sy_gl_device *dev, char *err, size_t err_len)
+sy_gl_result sy_gli_shadow_maps_make(sy_gl_device *dev, sy_gl_report *rep)
 {
     const sy_gl_fns *gl = dev->gl;
-    sy_gl_result r = sy_gli_gl_check(dev, "before the shadow maps", err, err_len);
+    sy_gl_result r = sy_gli_gl_check(dev, "before the shadow maps", rep);
     if (r != SY_GL_OK || dev->shadow_tex) return r;
     uint32_t asked = dev->shadow_size;
     for (;;) {
@@ -248,7 +248,7 @@ sy_gl_result sy_gli_shadow_maps_make(sy_gl_device *dev, char *err, size_t err_le
                 gl->DeleteTextures(1, &dev->shadow_tex);
                 dev->shadow_tex = 0;
                 dev->shadow_size = asked;
-                return sy_gli_fail(err, err_len, e == GL_OUT_OF_MEMORY ? SY_GL_ERROR_OUT_OF_MEMORY : SY_GL_ERROR_GL,
+                return sy_gli_fail(rep, e == GL_OUT_OF_MEMORY ? SY_GL_ERROR_OUT_OF_MEMORY : SY_GL_ERROR_GL,
                             "shadow maps of %u texels: OpenGL error 0x%04x", asked, (unsigned)e);
             }
             break;

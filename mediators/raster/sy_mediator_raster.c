@@ -18,6 +18,7 @@
  * >>look  >>area lights  >>render  >>class */
 #include "sy_mediator_raster.h"
 
+#include "sy_backend_status.h"
 #include "sy_gl.h"
 #include "sy_log.h"
 #include "sy_look.h"
@@ -29,7 +30,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define ERRLEN 256
 
 /* The scene mirror (textures, materials, meshes, lights, backgrounds, nodes and placements) is
  * mediators/sy_mirror; this adapter turns its callbacks into OpenGL back-end calls. */
@@ -71,11 +71,31 @@ typedef struct raster_state {
     uint32_t area_count;
     bool warned_area_cap;
     bool indirect; /* "indirect" parameter: the emitters' indirect light estimate (below); 0 = direct light only */
+    char gl_msg[SY_ERROR_MESSAGE_MAX]; /* the message of the device's last failed call (gl_error) */
 } raster_state;
 
-static sy_result gl_fail(sy_error *err, sy_gl_result r, const char *what, const char *msg)
+/* Every code the device returns has core's number (the cast in sy_backend_fail). */
+SY_BACKEND_SAME_CODE(SY_GL_ERROR_INVALID_ARGUMENT, SY_ERR_INVALID_ARGUMENT);
+SY_BACKEND_SAME_CODE(SY_GL_ERROR_INVALID_HANDLE, SY_ERR_INVALID_HANDLE);
+SY_BACKEND_SAME_CODE(SY_GL_ERROR_OUT_OF_MEMORY, SY_ERR_OUT_OF_MEMORY);
+SY_BACKEND_SAME_CODE(SY_GL_ERROR_NO_CONTEXT, SY_ERR_UNSUPPORTED);
+SY_BACKEND_SAME_CODE(SY_GL_ERROR_LIMIT, SY_ERR_LIMIT);
+SY_BACKEND_SAME_CODE(SY_GL_ERROR_GL, SY_ERR_BACKEND);
+
+/* A failed call on st's device as an sy_error: "raster: WHAT: MSG", MSG being what the device
+ * reported through its error callback (gl_error). */
+static sy_result gl_fail(const raster_state *st, sy_error *err, sy_gl_result r, const char *what)
 {
-    return sy_error_set(err, r == SY_GL_ERROR_OUT_OF_MEMORY ? SY_ERR_OUT_OF_MEMORY : SY_ERR_BACKEND, "raster: %s: %s", what, msg);
+    return sy_backend_fail(err, (int)r, "raster: %s: %s", what, st->gl_msg);
+}
+
+/* The device's error callback: runs on the thread of the call in progress, the only one using the
+ * device, before that call returns. */
+static void gl_error(void *user, sy_gl_result code, const char *message)
+{
+    (void)code;
+    raster_state *st = user;
+    snprintf(st->gl_msg, sizeof st->gl_msg, "%s", message);
 }
 
 /* >>mirror callbacks: the flat descriptions (sy_mirror_flat.h) copied into the device's; their
@@ -93,7 +113,6 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
 {
     raster_state *st = user;
     const sy_mirror_flat_material *m = a->flat;
-    char e[ERRLEN];
     sy_gl_material_desc d;
     sy_gl_material_desc_init(&d);
     memcpy(d.base_color, m->base_color, sizeof d.base_color);
@@ -114,10 +133,10 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     d.double_sided = m->double_sided;
     d.unlit = m->unlit;
     sy_gl_material h = {*a->handle};
-    sy_gl_result r = h.id ? sy_gl_material_update(st->dev, h, &d, e, sizeof e)
-                          : sy_gl_material_create(st->dev, &d, &h, e, sizeof e);
+    sy_gl_result r = h.id ? sy_gl_material_update(st->dev, h, &d)
+                          : sy_gl_material_create(st->dev, &d, &h);
     *a->handle = h.id;
-    if (r != SY_GL_OK) return gl_fail(err, r, "material", e);
+    if (r != SY_GL_OK) return gl_fail(st, err, r, "material");
     /* albedo for the indirect estimate (area lights) */
     ealb *al = sy_mirror_map_put(&st->albs, h.id);
     if (!al) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (material albedo)");
@@ -151,15 +170,14 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
 static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_error *err)
 {
     raster_state *st = user;
-    char e[ERRLEN];
     const sy_mirror_flat_texture *f = a->flat;
     sy_gl_texture_desc d = {.width = f->width, .height = f->height, .channels = f->channels,
                             .format = (sy_gl_texel_format)f->format, .pixels = f->pixels, .wrap_s = (sy_gl_wrap)f->wrap_s,
                             .wrap_t = (sy_gl_wrap)f->wrap_t, .nearest = f->nearest};
     sy_gl_texture h = {0};
-    sy_gl_result r = sy_gl_texture_create(st->dev, &d, &h, e, sizeof e);
+    sy_gl_result r = sy_gl_texture_create(st->dev, &d, &h);
     *a->handle = h.id;
-    if (r != SY_GL_OK) return gl_fail(err, r, "texture", e);
+    if (r != SY_GL_OK) return gl_fail(st, err, r, "texture");
     /* mean linear RGB (for textured emitters as area lights) */
     etex *t = sy_mirror_map_put(&st->texs, a->id);
     if (!t) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (texture means)");
@@ -170,15 +188,14 @@ static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_erro
 static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
 {
     raster_state *st = user;
-    char e[ERRLEN];
     const sy_primitive *p = a->primitive;
     const sy_mirror_flat_mesh *f = a->flat;
     sy_gl_mesh_desc d = {f->positions, f->normals, {f->uv[0], f->uv[1]}, f->colors, f->indices, f->vertex_count,
                          f->triangle_count};
     sy_gl_mesh h = {0};
-    sy_gl_result r = sy_gl_mesh_create(st->dev, &d, &h, e, sizeof e);
+    sy_gl_result r = sy_gl_mesh_create(st->dev, &d, &h);
     *a->handle = h.id;
-    if (r != SY_GL_OK) return gl_fail(err, r, "mesh primitive", e);
+    if (r != SY_GL_OK) return gl_fail(st, err, r, "mesh primitive");
     emesh *em = sy_mirror_map_put(&st->meshes, h.id);
     if (!em) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (mesh table)");
     em->positions = sy_blob_retain(p->positions);
@@ -206,35 +223,33 @@ static sy_result track_instance(raster_state *st, uint32_t handle, const sy_mirr
 static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_error *err)
 {
     raster_state *st = user;
-    char e[ERRLEN];
     sy_gl_instance h = {*a->handle};
     sy_gl_result r;
     if (!h.id) { /* the rasterizer draws everything per instance: a->baked does not apply */
         sy_gl_instance_desc d = {.mesh = {a->mesh}, .material = {a->material}, .hidden = !a->visible};
         memcpy(d.transform, a->world->m, sizeof d.transform);
-        r = sy_gl_instance_create(st->dev, &d, &h, e, sizeof e);
+        r = sy_gl_instance_create(st->dev, &d, &h);
         *a->handle = h.id;
-        if (r != SY_GL_OK) return gl_fail(err, r, "instance", e);
+        if (r != SY_GL_OK) return gl_fail(st, err, r, "instance");
         return track_instance(st, h.id, a, err);
     }
-    r = sy_gl_instance_set_transform(st->dev, h, a->world->m, e, sizeof e);
+    r = sy_gl_instance_set_transform(st->dev, h, a->world->m);
     if (r == SY_GL_OK) r = sy_gl_instance_set_visible(st->dev, h, a->visible);
-    if (r != SY_GL_OK) return gl_fail(err, r, "instance transform", e);
+    if (r != SY_GL_OK) return gl_fail(st, err, r, "instance transform");
     return track_instance(st, h.id, a, err);
 }
 
 static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *err)
 {
     raster_state *st = user;
-    char e[ERRLEN];
     const sy_mirror_flat_light *l = a->flat;
     sy_gl_light_desc d = {(sy_gl_light_type)l->type, {l->color[0], l->color[1], l->color[2]}, l->intensity,
                           {l->position[0], l->position[1], l->position[2]},
                           {l->direction[0], l->direction[1], l->direction[2]}, l->range, l->inner_cone, l->outer_cone, false};
     sy_gl_light h = {*a->handle};
-    sy_gl_result r = h.id ? sy_gl_light_update(st->dev, h, &d, e, sizeof e) : sy_gl_light_create(st->dev, &d, &h, e, sizeof e);
+    sy_gl_result r = h.id ? sy_gl_light_update(st->dev, h, &d) : sy_gl_light_create(st->dev, &d, &h);
     *a->handle = h.id;
-    return r == SY_GL_OK ? SY_OK : gl_fail(err, r, "light", e);
+    return r == SY_GL_OK ? SY_OK : gl_fail(st, err, r, "light");
 }
 
 static void cb_release(void *user, const sy_mirror_release_args *a)
@@ -312,11 +327,10 @@ static void camera_of(const sy_camera_view *v, sy_gl_camera *cam)
 static sy_result float_texture(raster_state *st, uint32_t w, uint32_t h, const float *rgb, sy_gl_texture *out,
                                const char *what, sy_error *err)
 {
-    char e[ERRLEN];
     sy_gl_texture_desc d = {.width = w, .height = h, .channels = 3, .format = SY_GL_TEXEL_FLOAT32, .pixels = rgb,
                             .wrap_s = SY_GL_WRAP_REPEAT, .wrap_t = SY_GL_WRAP_CLAMP};
-    sy_gl_result r = sy_gl_texture_create(st->dev, &d, out, e, sizeof e);
-    return r == SY_GL_OK ? SY_OK : gl_fail(err, r, what, e);
+    sy_gl_result r = sy_gl_texture_create(st->dev, &d, out);
+    return r == SY_GL_OK ? SY_OK : gl_fail(st, err, r, what);
 }
 
 static sy_result apply_look(raster_state *st, uint32_t background_id, sy_error *err)
@@ -547,9 +561,8 @@ static sy_result rebuild_area_lights(raster_state *st, sy_error *err)
     if (r == SY_OK) {
         sy_gl_area_light ls[SY_GL_MAX_AREA_LIGHTS];
         for (size_t i = 0; i < n; ++i) ls[i] = ps[i].l;
-        char e[ERRLEN];
-        sy_gl_result gr = sy_gl_set_area_lights(st->dev, ls, (uint32_t)n, e, sizeof e);
-        if (gr != SY_GL_OK) r = gl_fail(err, gr, "area lights", e);
+        sy_gl_result gr = sy_gl_set_area_lights(st->dev, ls, (uint32_t)n);
+        if (gr != SY_GL_OK) r = gl_fail(st, err, gr, "area lights");
         else st->area_count = (uint32_t)n;
     }
     free(ps);
@@ -568,7 +581,6 @@ static sy_result check_layer(const sy_render_request *req, const sy_layer *layer
 static sy_result raster_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     raster_state *st = state;
-    char e[ERRLEN];
     sy_result rr = check_layer(req, layer, err);
     if (rr != SY_OK) return rr;
     double t0 = sy_time_now();
@@ -577,8 +589,8 @@ static sy_result raster_render(void *state, const sy_render_request *req, sy_lay
     sy_gl_camera cam;
     camera_of(&req->camera, &cam);
     sy_gl_render_desc d = {req->full_width, req->full_height, req->rect_x, req->rect_y, req->rect_w, req->rect_h};
-    sy_gl_result r = sy_gl_render(st->dev, &cam, &d, layer->rgba, layer->depth, e, sizeof e);
-    if (r != SY_GL_OK) return gl_fail(err, r, "render", e);
+    sy_gl_result r = sy_gl_render(st->dev, &cam, &d, layer->rgba, layer->depth);
+    if (r != SY_GL_OK) return gl_fail(st, err, r, "render");
     if (req->progress) {
         sy_progress p = {1, 1};
         req->progress(req->progress_user, &p);
@@ -592,15 +604,14 @@ sy_result sy_mediator_raster_render_floor(void *state, const sy_render_request *
                                           sy_error *err)
 {
     raster_state *st = state;
-    char e[ERRLEN];
     sy_result rr = check_layer(req, layer, err);
     if (rr != SY_OK) return rr;
     if ((rr = apply_look(st, req->background_id, err)) != SY_OK) return rr;
     sy_gl_camera cam;
     camera_of(&req->camera, &cam);
     sy_gl_render_desc d = {req->full_width, req->full_height, req->rect_x, req->rect_y, req->rect_w, req->rect_h};
-    sy_gl_result r = sy_gl_render_floor(st->dev, &cam, &d, lit, layer->rgba, layer->depth, e, sizeof e);
-    return r == SY_GL_OK ? SY_OK : gl_fail(err, r, "floor render", e);
+    sy_gl_result r = sy_gl_render_floor(st->dev, &cam, &d, lit, layer->rgba, layer->depth);
+    return r == SY_GL_OK ? SY_OK : gl_fail(st, err, r, "floor render");
 }
 
 /* >>class */
@@ -629,7 +640,7 @@ static void log_warning(void *user, const char *msg)
     raster_state *st = user;
     st->counters.warnings++;
     snprintf(st->counters.last_warning, sizeof st->counters.last_warning, "%s", msg);
-    sy_log(SY_LOG_WARNING, "raster", NULL, "%s", msg); /* the GL back-end's own callback, forwarded */
+    sy_backend_warn("raster", msg); /* the GL back-end's own callback, forwarded */
 }
 
 /* The raster's parameters: the one source of their names, ranges, defaults and help (sy_params.h). */
@@ -682,7 +693,6 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
     st->texs = SY_MIRROR_MAP_INIT(etex);
     st->albs = SY_MIRROR_MAP_INIT(ealb);
     st->indirect = indirect;
-    char e[ERRLEN];
     sy_gl_device_desc dd = {.provider = provider,
                             .msaa = (uint32_t)msaa,
                             .shadow_map_size = (uint32_t)shadow,
@@ -691,11 +701,14 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
                             .window_height = (uint32_t)wh,
                             .log = log_warning,
                             .log_user = st,
+                            .error = gl_error,
+                            .error_user = st,
                             .forward = !deferred};
-    sy_gl_result gr = sy_gl_device_create(&dd, &st->dev, e, sizeof e);
+    sy_gl_result gr = sy_gl_device_create(&dd, &st->dev);
     if (gr != SY_GL_OK) {
+        r = sy_backend_fail(err, (int)gr, "raster: %s", st->gl_msg);
         free(st);
-        return sy_error_set(err, gr == SY_GL_ERROR_NO_CONTEXT ? SY_ERR_UNSUPPORTED : SY_ERR_BACKEND, "raster: %s", e);
+        return r;
     }
     sy_gl_set_lod(st->dev, (float)lod);
     sy_mirror_desc md = {"raster mediator", args->root_node_id, &raster_mirror_callbacks, st};

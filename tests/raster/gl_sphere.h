@@ -33,7 +33,7 @@ static sy_gl_mesh gl_test_sphere(sy_gl_device *d, uint32_t seg, float wave, bool
     sy_gl_mesh_desc md = {.positions = p, .normals = normals ? n : NULL, .indices = ix, .vertex_count = nv,
                           .triangle_count = nt};
     sy_gl_mesh m;
-    MUST(sy_gl_mesh_create(d, &md, &m, e, sizeof e));
+    MUST(sy_gl_mesh_create(d, &md, &m));
     free(p), free(n), free(ix);
     if (tris) *tris = nt;
     return m;

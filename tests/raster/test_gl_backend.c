@@ -16,7 +16,6 @@
 
 #define N 64
 #define PI_F 3.14159265358979f
-static char e[4096];
 static int warnings;
 static char last_warning[512];
 static void on_log(void *u, const char *m)
@@ -34,7 +33,7 @@ static sy_gl_mesh quad(sy_gl_device *d, const float *p4 /* 4 corners xyz */, con
     static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
     sy_gl_mesh_desc md = {.positions = p4, .normals = nrm, .uv = {uv, NULL}, .indices = idx, .vertex_count = 4, .triangle_count = 2};
     sy_gl_mesh m;
-    MUST(sy_gl_mesh_create(d, &md, &m, e, sizeof e));
+    MUST(sy_gl_mesh_create(d, &md, &m));
     return m;
 }
 
@@ -42,7 +41,7 @@ static sy_gl_instance place(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat)
 {
     sy_gl_instance_desc id = {.mesh = m, .material = mat, .transform = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
     sy_gl_instance in;
-    MUST(sy_gl_instance_create(d, &id, &in, e, sizeof e));
+    MUST(sy_gl_instance_create(d, &id, &in));
     return in;
 }
 
@@ -54,7 +53,7 @@ static sy_gl_material unlit_textured(sy_gl_device *d, sy_gl_texture t)
     md.unlit = true;
     md.base_color_texture.texture = t;
     sy_gl_material h;
-    MUST(sy_gl_material_create(d, &md, &h, e, sizeof e));
+    MUST(sy_gl_material_create(d, &md, &h));
     return h;
 }
 
@@ -68,14 +67,14 @@ static sy_gl_material material(sy_gl_device *d, float r, float g, float b, float
     md.metallic = 0.0f;
     md.specular = 0.0f; /* pure Lambert */
     sy_gl_material h;
-    MUST(sy_gl_material_create(d, &md, &h, e, sizeof e));
+    MUST(sy_gl_material_create(d, &md, &h));
     return h;
 }
 
 static float rgba[N * N * 4], depth[N * N];
 static const sy_gl_render_desc full = {N, N, 0, 0, N, N};
 
-static void render(sy_gl_device *d, const sy_gl_camera *cam) { MUST(sy_gl_render(d, cam, &full, rgba, depth, e, sizeof e)); }
+static void render(sy_gl_device *d, const sy_gl_camera *cam) { MUST(sy_gl_render(d, cam, &full, rgba, depth)); }
 static const float *px(int x, int y) { return rgba + 4 * (y * N + x); }
 
 static bool near_(float a, float b, float tol) { return fabsf(a - b) <= tol * fmaxf(1.0f, fabsf(b)); }
@@ -88,8 +87,8 @@ int main(int argc, char **argv)
         return 2;
     }
     sy_gl_device *d;
-    sy_gl_device_desc dd = {.provider = prov, .msaa = 1, .shadow_map_size = 1024, .max_texture_size = 4, .log = on_log};
-    sy_gl_result cr = sy_gl_device_create(&dd, &d, e, sizeof e);
+    sy_gl_device_desc dd = {GL_TEST_REPORT, .provider = prov, .msaa = 1, .shadow_map_size = 1024, .max_texture_size = 4, .log = on_log};
+    sy_gl_result cr = sy_gl_device_create(&dd, &d);
     if (cr == SY_GL_ERROR_NO_CONTEXT && prov != SY_GL_PROVIDER_OSMESA) {
         printf("SKIP: no %s context on this machine: %s\n", sy_gl_provider_name(prov), e);
         return 77;
@@ -107,7 +106,7 @@ int main(int argc, char **argv)
     sy_gl_material_desc_init(&emd);
     emd.emissive[0] = 17, emd.emissive[1] = 12, emd.emissive[2] = 4;
     sy_gl_material em;
-    MUST(sy_gl_material_create(d, &emd, &em, e, sizeof e));
+    MUST(sy_gl_material_create(d, &emd, &em));
     sy_gl_instance iq = place(d, mq, em);
     render(d, &cam);
     const float *c = px(30, 30);
@@ -124,7 +123,7 @@ int main(int argc, char **argv)
     {
         static float sub[40 * 30 * 4], subd[40 * 30];
         sy_gl_render_desc rd = {N, N, 16, 8, 40, 30};
-        MUST(sy_gl_render(d, &cam, &rd, sub, subd, e, sizeof e));
+        MUST(sy_gl_render(d, &cam, &rd, sub, subd));
         int bad = 0;
         for (int y = 0; y < 30; ++y)
             for (int x = 0; x < 40; ++x) {
@@ -140,14 +139,14 @@ int main(int argc, char **argv)
     EXPECT_MSG(st.total.vertex_buffer_uploads == 2, "vertex uploads so far %llu (one interleaved vertex buffer + indices)",
                (unsigned long long)st.total.vertex_buffer_uploads);
     float moved[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.1f, 0, 0, 1};
-    MUST(sy_gl_instance_set_transform(d, iq, moved, e, sizeof e));
+    MUST(sy_gl_instance_set_transform(d, iq, moved));
     render(d, &cam);
     sy_gl_device_stats(d, &st);
     EXPECT_MSG(st.frame.vertex_buffer_uploads == 0 && st.frame.vertex_bytes == 0 && st.frame.texture_uploads == 0,
                "transform-only frame uploaded %llu vertex buffers", (unsigned long long)st.frame.vertex_buffer_uploads);
     EXPECT_MSG(st.frame.model_matrix_updates == 1, "model matrix updates %llu", (unsigned long long)st.frame.model_matrix_updates);
     EXPECT_MSG(px(22, 30)[3] == 0.0f && px(46, 30)[3] == 1.0f, "the quad did not move right");
-    MUST(sy_gl_material_update(d, em, &emd, e, sizeof e));
+    MUST(sy_gl_material_update(d, em, &emd));
     render(d, &cam);
     sy_gl_device_stats(d, &st);
     EXPECT_MSG(st.frame.uniform_buffer_uploads == 1 && st.frame.vertex_buffer_uploads == 0, "material change: %llu UBO, %llu VBO uploads",
@@ -181,7 +180,7 @@ int main(int argc, char **argv)
         sy_gl_texture_desc td = {.width = 8, .height = 8, .channels = 3, .format = SY_GL_TEXEL_UNORM8_SRGB, .pixels = tex};
         sy_gl_texture t;
         int w0 = warnings;
-        MUST(sy_gl_texture_create(d, &td, &t, e, sizeof e));
+        MUST(sy_gl_texture_create(d, &td, &t));
         EXPECT_MSG(warnings == w0 + 1 && strstr(last_warning, "downscaled to 4x4"), "warning: '%s'", last_warning);
         sy_gl_material mt = unlit_textured(d, t);
         const float near_q[12] = {-1, -1, -2, 1, -1, -2, 1, 1, -2, -1, 1, -2};
@@ -203,7 +202,7 @@ int main(int argc, char **argv)
         for (int i = 0; i < 16; ++i) tex[i] = ((i & 1) ^ ((i >> 2) & 1)) ? 255 : 0;
         sy_gl_texture_desc td = {.width = 4, .height = 4, .channels = 1, .format = SY_GL_TEXEL_UNORM8_SRGB, .pixels = tex};
         sy_gl_texture t;
-        MUST(sy_gl_texture_create(d, &td, &t, e, sizeof e));
+        MUST(sy_gl_texture_create(d, &td, &t));
         sy_gl_material mt = unlit_textured(d, t);
         /* one pixel: 1/32 of the view's width of 2 at depth 1, i.e. 0.0625 at depth 2 */
         const float one_px[12] = {0, 0, -2, 0.0625f, 0, -2, 0.0625f, 0.0625f, -2, 0, 0.0625f, -2};
@@ -229,7 +228,7 @@ int main(int argc, char **argv)
         sy_gl_instance oc = place(d, quad(d, occ_q, ny), grey);
         sy_gl_light_desc ld = {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3, .direction = {1, -1, 0}};
         sy_gl_light l;
-        MUST(sy_gl_light_create(d, &ld, &l, e, sizeof e));
+        MUST(sy_gl_light_create(d, &ld, &l));
         render(d, &top);
         float lit = 3.0f * sqrtf(0.5f) * 0.5f / PI_F;
         /* world x = -2 -> column 10, x = +1 -> column 42 (row 31 ~ z = 0) */
@@ -242,7 +241,7 @@ int main(int argc, char **argv)
         /* spot at (0, 2, 0) pointing down: I / d^2 under it, zero beyond the outer cone */
         sy_gl_light_desc sd = {.type = SY_GL_LIGHT_SPOT, .color = {1, 1, 1}, .intensity = 10, .position = {0, 2, 0},
                                .direction = {0, -1, 0}, .inner_cone_angle = 0.2f, .outer_cone_angle = 0.4f};
-        MUST(sy_gl_light_create(d, &sd, &l, e, sizeof e));
+        MUST(sy_gl_light_create(d, &sd, &l));
         render(d, &top);
         /* pixel (31, 31) centre: x = z = -0.5/64*1.2*5 */
         float x = (31.5f / N * 1.2f - 0.6f) * 5.0f, r2 = 2 * x * x, dist2 = r2 + 4.0f, cosl = 2.0f / sqrtf(dist2);
@@ -258,15 +257,21 @@ int main(int argc, char **argv)
         EXPECT_MSG(near_(px(38, 31)[0], want2, 0.02f), "spot penumbra %g (want %g)", px(38, 31)[0], want2);
         MUST(sy_gl_light_destroy(d, l));
         MUST(sy_gl_instance_destroy(d, fl));
+        /* a failure is reported once through the desc's error callback (into e) and kept as the
+         * device's last message */
+        e[0] = '\0';
+        EXPECT_MSG(sy_gl_instance_destroy(d, fl) == SY_GL_ERROR_INVALID_HANDLE && strstr(e, "stale handle") &&
+                       strcmp(e, sy_gl_device_error(d)) == 0,
+                   "stale instance: '%s' / '%s'", e, sy_gl_device_error(d));
     }
     sy_gl_device_destroy(d);
 
     /* 7. MSAA: interior pixels stay exact, edge pixels get partial coverage, background stays empty */
     {
-        sy_gl_device_desc md = {.provider = prov, .msaa = 4, .shadow_map_size = 256};
-        MUST(sy_gl_device_create(&md, &d, e, sizeof e));
+        sy_gl_device_desc md = {GL_TEST_REPORT, .provider = prov, .msaa = 4, .shadow_map_size = 256};
+        MUST(sy_gl_device_create(&md, &d));
         sy_gl_mesh m = quad(d, q1, nz);
-        MUST(sy_gl_material_create(d, &emd, &em, e, sizeof e));
+        MUST(sy_gl_material_create(d, &emd, &em));
         place(d, m, em);
         render(d, &cam);
         c = px(30, 30);
@@ -284,20 +289,22 @@ int main(int argc, char **argv)
     if (prov == SY_GL_PROVIDER_OSMESA) {
         /* 8. shader compile failures return the driver's log */
         sy_gl_context *ctx;
-        MUST(sy_gl_context_create(SY_GL_PROVIDER_OSMESA, 0, 0, &ctx, e, sizeof e));
+        sy_gl_report rep = {gl_test_on_error, NULL, ""};
+        MUST(sy_gl_context_create(SY_GL_PROVIDER_OSMESA, 0, 0, &ctx, &rep));
         GLuint p = 0;
         sy_gl_result r = sy_gl_program_build(sy_gl_context_fns(ctx), "broken", sy_gl_floor_vs,
-                                             "#version 330 core\nout vec4 o; void main() { o = undefined_name; }\n", NULL, &p, e, sizeof e);
-        EXPECT_MSG(r == SY_GL_ERROR_GL && strstr(e, "broken shader: fragment compile failed") && strstr(e, "undefined_name"),
-                   "compile failure message: %s", e);
+                                             "#version 330 core\nout vec4 o; void main() { o = undefined_name; }\n", NULL, &p, &rep);
+        EXPECT_MSG(r == SY_GL_ERROR_GL && strstr(rep.message, "broken shader: fragment compile failed") &&
+                       strstr(rep.message, "undefined_name") && strcmp(rep.message, e) == 0,
+                   "compile failure message: %s", rep.message);
         sy_gl_context_destroy(ctx);
         /* 9. the largest shadow_map_size the parameter allows (16384: four maps are 4 GiB, more
          * than llvmpipe gives one texture) renders with smaller maps and says so; it failed with
          * GL_OUT_OF_MEMORY before (issue 32). The maps are made by the first frame with a
          * shadowed light: creating the device, and a frame without lights, allocate none. */
         warnings = 0;
-        sy_gl_device_desc bd = {.provider = SY_GL_PROVIDER_OSMESA, .msaa = 1, .shadow_map_size = 16384, .log = on_log};
-        r = sy_gl_device_create(&bd, &d, e, sizeof e);
+        sy_gl_device_desc bd = {GL_TEST_REPORT, .provider = SY_GL_PROVIDER_OSMESA, .msaa = 1, .shadow_map_size = 16384, .log = on_log};
+        r = sy_gl_device_create(&bd, &d);
         EXPECT_MSG(r == SY_GL_OK, "shadow_map_size 16384: %s", e);
         if (r == SY_GL_OK) {
             sy_gl_camera top = {.camera_to_world = {1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 5, 0, 1}, .window = {-0.6f, 0.6f, -0.6f, 0.6f}, .near_clip = 0.1f};
@@ -311,7 +318,7 @@ int main(int argc, char **argv)
             EXPECT_MSG(warnings == 0, "a frame without lights made shadow maps: %s", last_warning);
             sy_gl_light_desc ld = {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3, .direction = {1, -1, 0}};
             sy_gl_light l;
-            MUST(sy_gl_light_create(d, &ld, &l, e, sizeof e));
+            MUST(sy_gl_light_create(d, &ld, &l));
             render(d, &top);
             EXPECT_MSG(warnings == 1 && strstr(last_warning, "shadow_map_size 16384"), "shadow map warning (%d): %s", warnings,
                        last_warning);
@@ -323,8 +330,8 @@ int main(int argc, char **argv)
         /* 10. no display: GLFW names itself and the fallback */
         unsetenv("DISPLAY");
         unsetenv("WAYLAND_DISPLAY");
-        sy_gl_device_desc gd = {.provider = SY_GL_PROVIDER_GLFW};
-        r = sy_gl_device_create(&gd, &d, e, sizeof e);
+        sy_gl_device_desc gd = {GL_TEST_REPORT, .provider = SY_GL_PROVIDER_GLFW};
+        r = sy_gl_device_create(&gd, &d);
         EXPECT_MSG(r == SY_GL_ERROR_NO_CONTEXT && strstr(e, "glfw") && strstr(e, "--gl osmesa"), "no-display error: %s", e);
         if (r == SY_GL_OK) sy_gl_device_destroy(d);
     }

@@ -23,7 +23,6 @@
 
 #define W 196
 #define H 146
-static char e[4096];
 #include "gl_sphere.h" /* after e, which it uses */
 static float img[2][W * H * 4], dep[2][W * H];
 
@@ -33,7 +32,7 @@ static sy_gl_mesh floor_quad(sy_gl_device *d)
     static const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
     sy_gl_mesh_desc md = {.positions = p, .normals = n, .indices = ix, .vertex_count = 4, .triangle_count = 2};
     sy_gl_mesh m;
-    MUST(sy_gl_mesh_create(d, &md, &m, e, sizeof e));
+    MUST(sy_gl_mesh_create(d, &md, &m));
     return m;
 }
 
@@ -44,7 +43,7 @@ static sy_gl_material material(sy_gl_device *d, float r, float g, float b, float
     md.base_color[0] = r, md.base_color[1] = g, md.base_color[2] = b;
     md.metallic = metallic, md.roughness = rough;
     sy_gl_material h;
-    MUST(sy_gl_material_create(d, &md, &h, e, sizeof e));
+    MUST(sy_gl_material_create(d, &md, &h));
     return h;
 }
 
@@ -53,7 +52,7 @@ static sy_gl_instance place(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat, f
     sy_gl_instance_desc id = {.mesh = m, .material = mat,
                               .transform = {sx, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, x, y, z, 1}};
     sy_gl_instance h;
-    MUST(sy_gl_instance_create(d, &id, &h, e, sizeof e));
+    MUST(sy_gl_instance_create(d, &id, &h));
     return h;
 }
 
@@ -61,7 +60,7 @@ static void place_small(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat, float
 {
     sy_gl_instance_desc id = {.mesh = m, .material = mat, .transform = {s, 0, 0, 0, 0, s, 0, 0, 0, 0, s, 0, x, y, z, 1}};
     sy_gl_instance h;
-    MUST(sy_gl_instance_create(d, &id, &h, e, sizeof e));
+    MUST(sy_gl_instance_create(d, &id, &h));
 }
 
 typedef struct scene {
@@ -74,8 +73,8 @@ typedef struct scene {
 static scene build(bool forward)
 {
     scene s = {0};
-    sy_gl_device_desc dd = {.provider = SY_GL_PROVIDER_OSMESA, .msaa = 4, .shadow_map_size = 512, .forward = forward};
-    MUST(sy_gl_device_create(&dd, &s.d, e, sizeof e));
+    sy_gl_device_desc dd = {GL_TEST_REPORT, .provider = SY_GL_PROVIDER_OSMESA, .msaa = 4, .shadow_map_size = 512, .forward = forward};
+    MUST(sy_gl_device_create(&dd, &s.d));
     sy_gl_device *d = s.d;
     s.smooth = gl_test_sphere(d, 96, 0.0f, true, NULL);
     sy_gl_mesh faceted = gl_test_sphere(d, 64, 0.0f, false, NULL);
@@ -86,7 +85,7 @@ static scene build(bool forward)
     ud.base_color[0] = 0.2f, ud.base_color[1] = 0.5f, ud.base_color[2] = 0.9f;
     ud.emissive[0] = 0.3f, ud.emissive[1] = 0.2f, ud.emissive[2] = 0.0f, ud.unlit = true;
     sy_gl_material unlit;
-    MUST(sy_gl_material_create(d, &ud, &unlit, e, sizeof e));
+    MUST(sy_gl_material_create(d, &ud, &unlit));
     place(d, s.smooth, (sy_gl_material){0}, 1.0f, -1.15f, 0.0f, -4.0f); /* the default material */
     place(d, s.smooth, s.red, 1.0f, 1.15f, 0.0f, -4.2f);
     place(d, faceted, metal, 1.0f, 0.0f, 0.9f, -5.0f);
@@ -96,8 +95,8 @@ static scene build(bool forward)
     sy_gl_light_desc dl = {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {0.6f, 0.7f, 1}, .intensity = 1.5f,
                            .direction = {0.3f, -1, -0.4f}};
     sy_gl_light h;
-    MUST(sy_gl_light_create(d, &pl, &h, e, sizeof e));
-    MUST(sy_gl_light_create(d, &dl, &h, e, sizeof e));
+    MUST(sy_gl_light_create(d, &pl, &h));
+    MUST(sy_gl_light_create(d, &dl, &h));
     enum { EW = 64, EH = 32 };
     static float t[EW * EH * 3];
     for (int y = 0; y < EH; ++y)
@@ -106,11 +105,11 @@ static scene build(bool forward)
     sy_gl_texture_desc td = {.width = EW, .height = EH, .channels = 3, .format = SY_GL_TEXEL_FLOAT32, .pixels = t,
                              .wrap_t = SY_GL_WRAP_CLAMP};
     sy_gl_texture env;
-    MUST(sy_gl_texture_create(d, &td, &env, e, sizeof e));
+    MUST(sy_gl_texture_create(d, &td, &env));
     sy_gl_set_environment(d, env, 1.0f);
     sy_gl_area_light al = {.vertices = {{-2, 2.5f, -5}, {-1, 2.5f, -5}, {-1, 2.5f, -4}, {-2, 2.5f, -4}}, .vertex_count = 4,
                            .radiance = {4, 4, 3}};
-    MUST(sy_gl_set_area_lights(d, &al, 1, e, sizeof e));
+    MUST(sy_gl_set_area_lights(d, &al, 1));
     return s;
 }
 
@@ -128,7 +127,7 @@ static sy_gl_camera camera(bool ortho)
 static uint64_t render_cam(scene *s, int k, const sy_gl_camera *cam, uint64_t *px)
 {
     sy_gl_render_desc rd = {W, H, 0, 0, W, H};
-    MUST(sy_gl_render(s->d, cam, &rd, img[k], dep[k], e, sizeof e));
+    MUST(sy_gl_render(s->d, cam, &rd, img[k], dep[k]));
     sy_gl_stats st;
     sy_gl_device_stats(s->d, &st);
     if (px) *px = st.deferred_pixels;
@@ -202,8 +201,8 @@ int main(void)
     sy_gl_material_desc md;
     sy_gl_material_desc_init(&md);
     md.base_color[0] = 0.1f, md.base_color[1] = 0.7f, md.base_color[2] = 0.2f, md.roughness = 0.2f;
-    MUST(sy_gl_material_update(fw.d, fw.red, &md, e, sizeof e));
-    MUST(sy_gl_material_update(df.d, df.red, &md, e, sizeof e));
+    MUST(sy_gl_material_update(fw.d, fw.red, &md));
+    MUST(sy_gl_material_update(df.d, df.red, &md));
     render(&fw, 0, false);
     render(&df, 1, false);
     compare("after a material change", 2.5e-3, 0.006);
@@ -226,7 +225,7 @@ int main(void)
         sy_gl_material_desc_init(&bd);
         bd.alpha_mode = SY_GL_ALPHA_BLEND, bd.base_color[3] = 0.5f;
         sy_gl_material glassy;
-        MUST(sy_gl_material_create(s->d, &bd, &glassy, e, sizeof e));
+        MUST(sy_gl_material_create(s->d, &bd, &glassy));
         place(s->d, s->smooth, glassy, 0.3f, 0.6f, -0.6f, -2.5f);
     }
     render(&fw, 0, false);

@@ -24,7 +24,6 @@
 
 #define N 32
 #define PI_F 3.14159265358979f
-static char e[1024];
 static float rgba[N * N * 4], depth[N * N];
 static const sy_gl_render_desc full = {N, N, 0, 0, N, N};
 static const float *px(int x, int y) { return rgba + 4 * (y * N + x); }
@@ -37,7 +36,7 @@ static sy_gl_mesh quad(sy_gl_device *d, const float *p4, const float n[3])
     static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
     sy_gl_mesh_desc md = {.positions = p4, .normals = nrm, .indices = idx, .vertex_count = 4, .triangle_count = 2};
     sy_gl_mesh m;
-    MUST(sy_gl_mesh_create(d, &md, &m, e, sizeof e));
+    MUST(sy_gl_mesh_create(d, &md, &m));
     return m;
 }
 
@@ -45,7 +44,7 @@ static sy_gl_instance place(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat)
 {
     sy_gl_instance_desc id = {.mesh = m, .material = mat, .transform = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
     sy_gl_instance in;
-    MUST(sy_gl_instance_create(d, &id, &in, e, sizeof e));
+    MUST(sy_gl_instance_create(d, &id, &in));
     return in;
 }
 
@@ -57,7 +56,7 @@ static sy_gl_material lambert(sy_gl_device *d, float albedo)
     md.metallic = 0.0f;
     md.specular = 0.0f;
     sy_gl_material h;
-    MUST(sy_gl_material_create(d, &md, &h, e, sizeof e));
+    MUST(sy_gl_material_create(d, &md, &h));
     return h;
 }
 
@@ -70,7 +69,7 @@ static sy_gl_texture env_texture(sy_gl_device *d, float upper, float lower)
     sy_gl_texture_desc td = {.width = W, .height = H, .channels = 3, .format = SY_GL_TEXEL_FLOAT32, .pixels = t,
                              .wrap_t = SY_GL_WRAP_CLAMP};
     sy_gl_texture h;
-    MUST(sy_gl_texture_create(d, &td, &h, e, sizeof e));
+    MUST(sy_gl_texture_create(d, &td, &h));
     return h;
 }
 
@@ -88,8 +87,8 @@ int main(int argc, char **argv)
     sy_gl_provider prov = SY_GL_PROVIDER_OSMESA;
     if (argc > 1 && !sy_gl_provider_parse(argv[1], &prov)) return 2;
     sy_gl_device *d;
-    sy_gl_device_desc dd = {.provider = prov, .msaa = 1, .shadow_map_size = 512};
-    sy_gl_result cr = sy_gl_device_create(&dd, &d, e, sizeof e);
+    sy_gl_device_desc dd = {GL_TEST_REPORT, .provider = prov, .msaa = 1, .shadow_map_size = 512};
+    sy_gl_result cr = sy_gl_device_create(&dd, &d);
     if (cr == SY_GL_ERROR_NO_CONTEXT && prov != SY_GL_PROVIDER_OSMESA) {
         printf("SKIP: no %s context: %s\n", sy_gl_provider_name(prov), e);
         return 77;
@@ -105,21 +104,21 @@ int main(int argc, char **argv)
     sy_gl_mesh mq = quad(d, facing, nz);
     sy_gl_instance q = place(d, mq, lambert(d, 0.5f));
     sy_gl_set_environment(d, env, 2.0f);
-    MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+    MUST(sy_gl_render(d, &cam, &full, rgba, depth));
     printf("Lambert under a constant environment of 3: %g (want 1.5)\n", px(16, 16)[0]);
     EXPECT_MSG(near_(px(16, 16)[0], 0.5f * 3.0f, 0.02f), "Lambert under a constant environment: %g (want %g)", px(16, 16)[0], 1.5);
     MUST(sy_gl_instance_destroy(d, q));
-    MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+    MUST(sy_gl_render(d, &cam, &full, rgba, depth));
     EXPECT_MSG(px(16, 16)[3] == 0.0f && px(16, 16)[0] == 0.0f, "the environment is not a background: %g %g", px(16, 16)[0], px(16, 16)[3]);
     sy_gl_texture bg = env_texture(d, 3.0f, 0.25f);
     sy_gl_set_background(d, SY_GL_BACKGROUND_TEXTURE, NULL, bg, 2.0f);
-    MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+    MUST(sy_gl_render(d, &cam, &full, rgba, depth));
     EXPECT_MSG(near_(px(16, 2)[0], 6.0f, 1e-3f) && px(16, 2)[3] == 1.0f && isinf(depth[2 * N + 16]),
                "sky above the horizon %g alpha %g (want 6, 1)", px(16, 2)[0], px(16, 2)[3]);
     EXPECT_MSG(near_(px(16, 29)[0], 0.5f, 1e-3f), "sky below the horizon %g (want 0.5)", px(16, 29)[0]);
     const float red[4] = {0.25f, 0, 0, 0.5f};
     sy_gl_set_background(d, SY_GL_BACKGROUND_COLOR, red, (sy_gl_texture){0}, 1.0f);
-    MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+    MUST(sy_gl_render(d, &cam, &full, rgba, depth));
     EXPECT_MSG(px(3, 3)[0] == 0.25f && px(3, 3)[3] == 0.5f, "colour background %g %g", px(3, 3)[0], px(3, 3)[3]);
     sy_gl_set_background(d, SY_GL_BACKGROUND_NONE, NULL, (sy_gl_texture){0}, 1.0f);
 
@@ -131,19 +130,19 @@ int main(int argc, char **argv)
         md.metallic = 1.0f;
         md.roughness = 0.0f;
         sy_gl_material mm;
-        MUST(sy_gl_material_create(d, &md, &mm, e, sizeof e));
+        MUST(sy_gl_material_create(d, &md, &mm));
         /* a mirror tilted 30 degrees about x, facing up-forward: view rays reflect upwards */
         const float tilt[12] = {-1, -1.2f, -2.5f, 1, -1.2f, -2.5f, 1, 0.6f, -3.5f, -1, 0.6f, -3.5f};
         const float tn[3] = {0, 0.866f, 0.5f};
         sy_gl_instance mi = place(d, quad(d, tilt, tn), mm);
-        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth));
         printf("mirror up %g (want 2)\n", px(16, 16)[0]);
         EXPECT_MSG(near_(px(16, 16)[0], 2.0f, 0.03f), "mirror reflects the upper half: %g (want 2)", px(16, 16)[0]);
         const float flip[12] = {-1, 0.6f, -2.5f, 1, 0.6f, -2.5f, 1, -1.2f, -3.5f, -1, -1.2f, -3.5f};
         const float fn[3] = {0, -0.866f, 0.5f};
         MUST(sy_gl_instance_destroy(d, mi));
         mi = place(d, quad(d, flip, fn), mm);
-        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth));
         EXPECT_MSG(near_(px(16, 16)[0], 0.5f, 0.03f), "mirror reflects the lower half: %g (want 0.5)", px(16, 16)[0]);
         MUST(sy_gl_instance_destroy(d, mi));
         sy_gl_set_environment(d, (sy_gl_texture){0}, 0.0f);
@@ -158,11 +157,11 @@ int main(int argc, char **argv)
         gd.emissive[1] = 4.0f;
         gd.double_sided = true;
         sy_gl_material gm;
-        MUST(sy_gl_material_create(d, &gd, &gm, e, sizeof e));
+        MUST(sy_gl_material_create(d, &gd, &gm));
         const float ceiling[12] = {-4, 3, 1, 4, 3, 1, 4, 3, -8, -4, 3, -8};
         const float down[3] = {0, -1, 0};
         sy_gl_instance ci = place(d, quad(d, ceiling, down), gm);
-        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth));
         printf("mirror under a green ceiling %g %g (want 0 4)\n", px(16, 16)[0], px(16, 16)[1]);
         EXPECT_MSG(near_(px(16, 16)[1], 4.0f, 0.03f) && px(16, 16)[0] < 0.01f, "mirror reflects the ceiling: %g %g (want 0 4)",
                    px(16, 16)[0], px(16, 16)[1]);
@@ -174,9 +173,9 @@ int main(int argc, char **argv)
         glass.roughness = 0.0f;
         glass.transmission = 1.0f;
         sy_gl_material gl_m;
-        MUST(sy_gl_material_create(d, &glass, &gl_m, e, sizeof e));
+        MUST(sy_gl_material_create(d, &glass, &gl_m));
         MUST(sy_gl_instance_set_material(d, mi, gl_m));
-        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth));
         printf("glass under a green ceiling %g %g\n", px(16, 16)[0], px(16, 16)[1]);
         EXPECT_MSG(px(16, 16)[1] > 0.1f && px(16, 16)[0] < 0.01f, "glass without an environment sees nothing: %g %g",
                    px(16, 16)[0], px(16, 16)[1]);
@@ -187,21 +186,21 @@ int main(int argc, char **argv)
         static const unsigned char mr_px[2 * 2 * 3] = {0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0};
         sy_gl_texture_desc mtd = {.width = 2, .height = 2, .channels = 3, .format = SY_GL_TEXEL_UNORM8, .pixels = mr_px};
         sy_gl_texture mr_tex;
-        MUST(sy_gl_texture_create(d, &mtd, &mr_tex, e, sizeof e));
+        MUST(sy_gl_texture_create(d, &mtd, &mr_tex));
         sy_gl_material_desc tglass = glass;
         tglass.metallic = 1.0f;
         tglass.metallic_roughness_texture.texture = mr_tex;
         sy_gl_material tgl_m;
-        MUST(sy_gl_material_create(d, &tglass, &tgl_m, e, sizeof e));
+        MUST(sy_gl_material_create(d, &tglass, &tgl_m));
         MUST(sy_gl_instance_set_material(d, mi, tgl_m));
-        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth));
         printf("glass by its texture %g %g (glass %g %g)\n", px(16, 16)[0], px(16, 16)[1], glass_px[0], glass_px[1]);
         EXPECT_MSG(near_(px(16, 16)[1], glass_px[1], 1e-3f) && near_(px(16, 16)[0], glass_px[0], 1e-3f),
                    "metal factor 1, texture metallic 0, transmission 1: %g %g (want the glass's %g %g)", px(16, 16)[0],
                    px(16, 16)[1], glass_px[0], glass_px[1]);
         MUST(sy_gl_instance_set_material(d, mi, mm));
         MUST(sy_gl_instance_set_visible(d, ci, false));
-        MUST(sy_gl_render(d, &cam, &full, rgba, depth, e, sizeof e));
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth));
         EXPECT_MSG(px(16, 16)[1] < 0.01f, "hidden ceiling still reflected: %g", px(16, 16)[1]);
         MUST(sy_gl_instance_destroy(d, ci));
         MUST(sy_gl_instance_destroy(d, mi));
@@ -217,8 +216,8 @@ int main(int argc, char **argv)
         /* counter-clockwise seen from below: the front faces down */
         sy_gl_area_light al = {.vertices = {{-0.5f, 1, -0.5f}, {0.5f, 1, -0.5f}, {0.5f, 1, 0.5f}, {-0.5f, 1, 0.5f}},
                                .vertex_count = 4, .radiance = {10, 10, 10}};
-        MUST(sy_gl_set_area_lights(d, &al, 1, e, sizeof e));
-        MUST(sy_gl_render(d, &top, &full, rgba, depth, e, sizeof e));
+        MUST(sy_gl_set_area_lights(d, &al, 1));
+        MUST(sy_gl_render(d, &top, &full, rgba, depth));
         float want = 0.5f * 10.0f * square_form_factor(0.5f, 1.0f);
         printf("floor under a square light %g (want %g)\n", px(16, 16)[0], want);
         EXPECT_MSG(near_(px(16, 16)[0], want, 0.04f), "floor under a square light: %g (want %g)", px(16, 16)[0], want);
@@ -229,30 +228,30 @@ int main(int argc, char **argv)
         sy_gl_area_light up = al;
         memcpy(up.vertices[1], al.vertices[3], sizeof up.vertices[1]);
         memcpy(up.vertices[3], al.vertices[1], sizeof up.vertices[3]);
-        MUST(sy_gl_set_area_lights(d, &up, 1, e, sizeof e));
-        MUST(sy_gl_render(d, &top, &full, rgba, depth, e, sizeof e));
+        MUST(sy_gl_set_area_lights(d, &up, 1));
+        MUST(sy_gl_render(d, &top, &full, rgba, depth));
         EXPECT_MSG(px(16, 16)[0] == 0.0f, "one-sided emitter lights its back side: %g", px(16, 16)[0]);
         up.double_sided = true;
-        MUST(sy_gl_set_area_lights(d, &up, 1, e, sizeof e));
-        MUST(sy_gl_render(d, &top, &full, rgba, depth, e, sizeof e));
+        MUST(sy_gl_set_area_lights(d, &up, 1));
+        MUST(sy_gl_render(d, &top, &full, rgba, depth));
         EXPECT_MSG(near_(px(16, 16)[0], want, 0.04f), "double-sided emitter: %g (want %g)", px(16, 16)[0], want);
         /* an occluder between light and floor: the centre is in (soft) shadow */
         const float occ_q[12] = {-0.3f, 0.5f, 0.3f, 0.3f, 0.5f, 0.3f, 0.3f, 0.5f, -0.3f, -0.3f, 0.5f, -0.3f};
         sy_gl_instance oc = place(d, quad(d, occ_q, ny), lambert(d, 0.5f));
-        MUST(sy_gl_set_area_lights(d, &al, 1, e, sizeof e));
+        MUST(sy_gl_set_area_lights(d, &al, 1));
         sy_gl_camera under = top;
         under.camera_to_world[13] = 0.4f;
         under.window[0] = under.window[2] = -2.0f, under.window[1] = under.window[3] = 2.0f;
-        MUST(sy_gl_render(d, &under, &full, rgba, depth, e, sizeof e));
+        MUST(sy_gl_render(d, &under, &full, rgba, depth));
         printf("floor under an occluder %g (unshadowed %g)\n", px(16, 16)[0], want);
         EXPECT_MSG(px(16, 16)[0] < 0.5f * want, "floor under an occluder: %g (unshadowed %g)", px(16, 16)[0], want);
         /* 3b. a point light (intensity 10 at 1 above the floor) instead: its cube shadow map darkens
          * the floor under the occluder; beside the shadow the floor has I cos / d^2 x albedo / pi */
-        MUST(sy_gl_set_area_lights(d, NULL, 0, e, sizeof e));
+        MUST(sy_gl_set_area_lights(d, NULL, 0));
         sy_gl_light_desc pd = {.type = SY_GL_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10.0f, .position = {0, 1, 0}};
         sy_gl_light pl;
-        MUST(sy_gl_light_create(d, &pd, &pl, e, sizeof e));
-        MUST(sy_gl_render(d, &under, &full, rgba, depth, e, sizeof e));
+        MUST(sy_gl_light_create(d, &pd, &pl));
+        MUST(sy_gl_render(d, &under, &full, rgba, depth));
         float xs = 0.4f * (-2.0f + 4.0f * 0.5f / N), d2 = xs * xs + 1.0f; /* pixel (0, 16) on the floor */
         float lit = 0.5f / PI_F * 10.0f / d2 / sqrtf(d2);
         sy_gl_device_stats(d, &st);
@@ -267,14 +266,14 @@ int main(int argc, char **argv)
         /* 4. refused input */
         sy_gl_area_light bad = al;
         bad.radiance[1] = -1.0f;
-        EXPECT_MSG(sy_gl_set_area_lights(d, &bad, 1, e, sizeof e) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "area light 0") &&
+        EXPECT_MSG(sy_gl_set_area_lights(d, &bad, 1) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "area light 0") &&
                    strstr(e, "radiance[1]"),
                    "negative radiance: %s", e);
         bad = al;
         bad.vertices[2][0] = NAN;
-        EXPECT_MSG(sy_gl_set_area_lights(d, &bad, 1, e, sizeof e) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "vertex 2"),
+        EXPECT_MSG(sy_gl_set_area_lights(d, &bad, 1) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "vertex 2"),
                    "NaN vertex: %s", e);
-        EXPECT_MSG(sy_gl_set_area_lights(d, &al, SY_GL_MAX_AREA_LIGHTS + 1, e, sizeof e) == SY_GL_ERROR_LIMIT, "cap: %s", e);
+        EXPECT_MSG(sy_gl_set_area_lights(d, &al, SY_GL_MAX_AREA_LIGHTS + 1) == SY_GL_ERROR_LIMIT, "cap: %s", e);
     }
     sy_gl_device_destroy(d);
     return sy_check_finish("test_raster_light");

@@ -26,7 +26,6 @@
 
 #define W 192
 #define H 144
-static char e[4096];
 #include "gl_sphere.h" /* after e, which it uses */
 static float img[4][W * H * 4], dep[W * H];
 
@@ -47,26 +46,26 @@ static const sy_gl_light_desc lights[8] = {
 
 static sy_gl_device *build(bool forward)
 {
-    sy_gl_device_desc dd = {.provider = SY_GL_PROVIDER_OSMESA, .msaa = 4, .shadow_map_size = 512, .forward = forward};
+    sy_gl_device_desc dd = {GL_TEST_REPORT, .provider = SY_GL_PROVIDER_OSMESA, .msaa = 4, .shadow_map_size = 512, .forward = forward};
     sy_gl_device *d;
-    MUST(sy_gl_device_create(&dd, &d, e, sizeof e));
+    MUST(sy_gl_device_create(&dd, &d));
     static const float p[12] = {-6, -1, 2, 6, -1, 2, 6, -1, -12, -6, -1, -12}, n[12] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
     static const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
     sy_gl_mesh_desc fd = {.positions = p, .normals = n, .indices = ix, .vertex_count = 4, .triangle_count = 2};
     sy_gl_mesh quad, smooth = gl_test_sphere(d, 96, 0.0f, true, NULL), faceted = gl_test_sphere(d, 64, 0.0f, false, NULL);
-    MUST(sy_gl_mesh_create(d, &fd, &quad, e, sizeof e));
+    MUST(sy_gl_mesh_create(d, &fd, &quad));
     sy_gl_material_desc md;
     sy_gl_material_desc_init(&md);
     md.base_color[0] = 0.7f, md.base_color[1] = 0.6f, md.base_color[2] = 0.5f, md.roughness = 0.45f; /* rougher than gets a scene probe */
     sy_gl_material mat;
-    MUST(sy_gl_material_create(d, &md, &mat, e, sizeof e));
+    MUST(sy_gl_material_create(d, &md, &mat));
     const struct { sy_gl_mesh m; float s, x, y, z; } at[3] = {
         {quad, 1, 0, 0, 0}, {smooth, 0.9f, -1.0f, 0.0f, -4.5f}, {faceted, 0.8f, 1.2f, -0.1f, -4.0f}};
     for (int i = 0; i < 3; ++i) {
         sy_gl_instance_desc id = {.mesh = at[i].m, .material = mat,
                                   .transform = {at[i].s, 0, 0, 0, 0, at[i].s, 0, 0, 0, 0, at[i].s, 0, at[i].x, at[i].y, at[i].z, 1}};
         sy_gl_instance h;
-        MUST(sy_gl_instance_create(d, &id, &h, e, sizeof e));
+        MUST(sy_gl_instance_create(d, &id, &h));
     }
     return d;
 }
@@ -76,13 +75,13 @@ static void render(sy_gl_device *d, int k)
     sy_gl_camera cam = {.camera_to_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0.5f, 0, 1},
                         .window = {-0.8f, 0.8f, -0.6f, 0.6f}, .near_clip = 0.1f};
     sy_gl_render_desc rd = {W, H, 0, 0, W, H};
-    MUST(sy_gl_render(d, &cam, &rd, img[k], dep, e, sizeof e));
+    MUST(sy_gl_render(d, &cam, &rd, img[k], dep));
 }
 
 /* lights first .. last - 1 created on d into h */
 static void add(sy_gl_device *d, sy_gl_light *h, int first, int last)
 {
-    for (int i = first; i < last; ++i) MUST(sy_gl_light_create(d, &lights[i], &h[i], e, sizeof e));
+    for (int i = first; i < last; ++i) MUST(sy_gl_light_create(d, &lights[i], &h[i]));
 }
 
 static void remove_all(sy_gl_device *d, sy_gl_light *h)
@@ -100,12 +99,12 @@ static void areas_sum(sy_gl_device *d, const char *how)
         {.vertices = {{2, 2, -6}, {3, 2, -6}, {3, 2, -5}, {2, 2, -5}}, .vertex_count = 4, .radiance = {30, 30, 30},
          .double_sided = true},
     };
-    MUST(sy_gl_set_area_lights(d, al, 3, e, sizeof e));
+    MUST(sy_gl_set_area_lights(d, al, 3));
     render(d, 0);
     static float acc[W * H * 4];
     memset(acc, 0, sizeof acc);
     for (int k = 0; k < 3; ++k) {
-        MUST(sy_gl_set_area_lights(d, &al[k], 1, e, sizeof e));
+        MUST(sy_gl_set_area_lights(d, &al[k], 1));
         render(d, 1 + k);
         for (size_t i = 0; i < (size_t)W * H * 4; ++i) acc[i] += img[1 + k][i];
     }
@@ -121,7 +120,7 @@ static void areas_sum(sy_gl_device *d, const char *how)
     EXPECT_MSG(sum > 0.01 * 3.0 * W * H, "%s: polygons: the image is (nearly) black", how);
     EXPECT_MSG(diff <= 1e-5 * sum, "%s: three polygons differ from the sum of each alone by %.2e of the mean", how, diff / sum);
     EXPECT_MSG(worst <= 1e-3, "%s: polygons: a pixel differs by %.2e (relative)", how, worst);
-    MUST(sy_gl_set_area_lights(d, NULL, 0, e, sizeof e));
+    MUST(sy_gl_set_area_lights(d, NULL, 0));
 }
 
 static void run(bool forward)
@@ -165,7 +164,7 @@ static void run(bool forward)
     render(d, 1);
     sy_gl_light_desc off = lights[0];
     off.no_shadow = true;
-    MUST(sy_gl_light_update(d, h[0], &off, e, sizeof e));
+    MUST(sy_gl_light_update(d, h[0], &off));
     render(d, 3);
     size_t brighter = 0, darker = 0;
     for (size_t i = 0; i < (size_t)W * H * 4; ++i) {
@@ -177,7 +176,7 @@ static void run(bool forward)
     printf("%s: the point light's shadow off: %zu channel values brighter, %zu darker\n", how, brighter, darker);
     EXPECT_MSG(brighter >= 60, "%s: without the point light's shadow only %zu values brighter", how, brighter);
     EXPECT_MSG(darker == 0, "%s: without the point light's shadow %zu values darker", how, darker);
-    MUST(sy_gl_light_update(d, h[0], &lights[0], e, sizeof e));
+    MUST(sy_gl_light_update(d, h[0], &lights[0]));
     render(d, 3);
     EXPECT_MSG(memcmp(img[1], img[3], sizeof img[1]) == 0, "%s: the shadow back on does not give the first image back", how);
     /* 3. emissive polygons, the punctual lights gone */

@@ -13,7 +13,6 @@
 #include "gl_test.h"
 
 #define N 96
-static char e[4096];
 #include "gl_sphere.h" /* after e, which it uses */
 static float rgba[2][N * N * 4], depth[2][N * N];
 
@@ -30,7 +29,7 @@ static uint64_t draw(sy_gl_device *d, float dist, int k, uint64_t *culled)
     sy_gl_camera cam = {.window = {-0.5f, 0.5f, -0.5f, 0.5f}, .near_clip = 0.05f};
     translate(cam.camera_to_world, 0, 0, dist);
     sy_gl_render_desc rd = {N, N, 0, 0, N, N};
-    MUST(sy_gl_render(d, &cam, &rd, rgba[k], depth[k], e, sizeof e));
+    MUST(sy_gl_render(d, &cam, &rd, rgba[k], depth[k]));
     sy_gl_stats st;
     sy_gl_device_stats(d, &st);
     if (culled) *culled = st.instances_culled;
@@ -55,19 +54,19 @@ static double iou(double *depth_off)
 int main(void)
 {
     sy_gl_device *d;
-    sy_gl_device_desc dd = {.provider = SY_GL_PROVIDER_OSMESA, .msaa = 1};
-    MUST(sy_gl_device_create(&dd, &d, e, sizeof e));
+    sy_gl_device_desc dd = {GL_TEST_REPORT, .provider = SY_GL_PROVIDER_OSMESA, .msaa = 1};
+    MUST(sy_gl_device_create(&dd, &d));
     uint32_t tris = 0;
     sy_gl_mesh big = gl_test_sphere(d, 256, 0.03f, true, &tris);
     EXPECT_MSG(tris >= SY_GL_LOD_MIN_TRIANGLES, "the sphere has %u triangles", tris);
     sy_gl_material_desc mdsc;
     sy_gl_material_desc_init(&mdsc);
     sy_gl_material mat;
-    MUST(sy_gl_material_create(d, &mdsc, &mat, e, sizeof e));
+    MUST(sy_gl_material_create(d, &mdsc, &mat));
     sy_gl_instance_desc id = {.mesh = big, .material = mat};
     translate(id.transform, 0, 0, 0);
     sy_gl_instance inst;
-    MUST(sy_gl_instance_create(d, &id, &inst, e, sizeof e));
+    MUST(sy_gl_instance_create(d, &id, &inst));
 
     /* Far: the sphere covers ~16 px across (dist 12, window 1 wide at 1 m). */
     const float dists[2] = {12.0f, 3.0f};
@@ -100,12 +99,12 @@ int main(void)
         sy_gl_material_desc_init(&mm);
         mm.metallic = 1.0f, mm.roughness = 0.0f;
         sy_gl_material mirror;
-        MUST(sy_gl_material_create(d, &mm, &mirror, e, sizeof e));
+        MUST(sy_gl_material_create(d, &mm, &mirror));
         sy_gl_instance_desc md = {.mesh = msh, .material = mirror};
         translate(md.transform, 4.0f, 0, 0); /* a quarter-size mirror 4 m beside the sphere */
         md.transform[0] = md.transform[5] = md.transform[10] = 0.25f;
         sy_gl_instance mi;
-        MUST(sy_gl_instance_create(d, &md, &mi, e, sizeof e));
+        MUST(sy_gl_instance_create(d, &md, &mi));
         sy_gl_set_lod(d, SY_GL_LOD_PIXELS_DEFAULT);
         uint64_t with_probe = draw(d, dists[0], 0, NULL);
         printf("far, with a mirror's probe: %llu triangles drawn (the sphere far: %llu, the mirror: %u)\n",
@@ -119,7 +118,7 @@ int main(void)
     /* Behind the camera: culled, nothing drawn. */
     sy_gl_set_lod(d, SY_GL_LOD_PIXELS_DEFAULT);
     translate(id.transform, 0, 0, 20);
-    MUST(sy_gl_instance_set_transform(d, inst, id.transform, e, sizeof e));
+    MUST(sy_gl_instance_set_transform(d, inst, id.transform));
     uint64_t culled = 0, behind = draw(d, 3.0f, 0, &culled);
     EXPECT_MSG(behind == 0 && culled == 1, "behind the camera: %llu triangles drawn, %llu culled", (unsigned long long)behind,
                (unsigned long long)culled);
@@ -131,7 +130,7 @@ int main(void)
     EXPECT_MSG(small_tris < SY_GL_LOD_MIN_TRIANGLES, "small sphere: %u triangles", small_tris);
     id.mesh = small;
     translate(id.transform, 0, 0, 0);
-    MUST(sy_gl_instance_create(d, &id, &inst, e, sizeof e));
+    MUST(sy_gl_instance_create(d, &id, &inst));
     uint64_t s = draw(d, 12.0f, 0, NULL);
     EXPECT_MSG(s == small_tris, "small mesh far away: %llu of %u triangles drawn", (unsigned long long)s, small_tris);
     sy_gl_device_destroy(d);
