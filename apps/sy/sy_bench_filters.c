@@ -1,6 +1,7 @@
 /* sy_bench_filters.c — `sy bench filters` (issue 7): the noise-reduction filters of
  * backends/filters on the analytic surrogate (sy_bench_filters) and on the path tracer's buffers
  * against a reference EXR (sy_bench_filters_scene); see sy_bench.h. */
+#include "sy_backend_status.h"
 #include "sy_bench.h"
 
 #include "sy_demo.h"
@@ -36,16 +37,15 @@ static double fb_cpu_now(void)
 enum { FB_NONE, FB_PIXEL, FB_PIXEL_BRUTE, FB_RADIANCE, FB_ATROUS, FB_JBU, FB_ADAPTIVE, FB_COUNT };
 static const char *const fb_names[FB_COUNT] = {"none", "pixel", "pixel-brute", "radiance", "atrous", "jbu", "adaptive"};
 
-static sy_result fb_fail(sy_error *err, const sy_filter_error *fe, const char *what)
+static sy_result fb_fail(sy_error *err, const sy_filter_report *fe, const char *what)
 {
-    return sy_error_set(err, fe->status == SY_FILTER_ERROR_OUT_OF_MEMORY ? SY_ERR_OUT_OF_MEMORY : SY_ERR_BACKEND,
-                        "bench filters: %s: %s", what, fe->message);
+    return sy_backend_fail(err, (int)fe->code, "bench filters: %s: %s", what, fe->message);
 }
 
 /* one filter application; pixel filters: a forced pass of *keep (created on first use, as a
  * viewport keeps its filter object between frames) */
 static sy_filter_status fb_apply(int m, const sy_filter_frame *f, uint32_t threads, float *out, sy_filter_pixel **keep,
-                                 sy_filter_error *fe)
+                                 sy_filter_report *fe)
 {
     sy_filter_status s = SY_FILTER_OK;
     if (m == FB_PIXEL || m == FB_PIXEL_BRUTE) {
@@ -126,7 +126,7 @@ static sy_result fb_pt_pass(uint32_t width, uint32_t height, uint32_t repeats, d
 
 sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, const char *png_path, sy_error *err)
 {
-    sy_filter_error fe = {0};
+    sy_filter_report fe = {0};
     sy_filter_synth *syn = NULL;
     if (sy_filter_synth_create(width, height, 12345, &syn, &fe)) return fb_fail(err, &fe, "surrogate");
     size_t n = (size_t)width * height;
@@ -288,7 +288,7 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
     (void)scene, (void)vd, (void)label, (void)width, (void)height, (void)reference_exr, (void)png_path;
     SY_BENCH_WITHOUT(err, "filters on a scene (pathtracer)", "SY_WITH_EMBREE");
 #else
-    sy_filter_error fe = {0};
+    sy_filter_report fe = {0};
     sy_exr_image *refimg = NULL;
     sy_window *win = NULL;
     sy_viewport *vp = NULL;

@@ -1,4 +1,4 @@
-/* sy_filter.c — shared parts of the filter back-end: errors, parameter validation, frame checks,
+/* sy_filter.c — shared parts of the filter back-end: the error report, parameter validation, frame checks,
  * NaN/Inf scan and the row-parallel helper on OpenMP's thread team (see sy_filter.h). */
 #include "sy_filter.h"
 
@@ -13,24 +13,24 @@ const char *sy_filter_status_name(sy_filter_status s)
     case SY_FILTER_OK: return "ok";
     case SY_FILTER_ERROR_INVALID_ARGUMENT: return "invalid argument";
     case SY_FILTER_ERROR_OUT_OF_MEMORY: return "out of memory";
-    case SY_FILTER_ERROR_THREADS: return "thread creation failed";
     }
     return "unknown";
 }
 
-sy_filter_status sy_filter_fail(sy_filter_error *err, sy_filter_status status, const char *fmt, ...)
+sy_filter_status sy_filter_fail(sy_filter_report *err, sy_filter_status status, const char *fmt, ...)
 {
     if (err) {
-        err->status = status;
+        err->code = status;
         va_list ap;
         va_start(ap, fmt);
         vsnprintf(err->message, sizeof err->message, fmt, ap);
         va_end(ap);
+        if (err->error) err->error(err->user, status, err->message);
     }
     return status;
 }
 
-sy_filter_status sy_filter_check_positive(float v, const char *what, sy_filter_error *err)
+sy_filter_status sy_filter_check_positive(float v, const char *what, sy_filter_report *err)
 {
     if (!isfinite(v) || !(v > 0.0f))
         return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "%s = %g: must be a finite value > 0", what,
@@ -38,7 +38,7 @@ sy_filter_status sy_filter_check_positive(float v, const char *what, sy_filter_e
     return SY_FILTER_OK;
 }
 
-sy_filter_status sy_filter_check_nonnegative(float v, const char *what, sy_filter_error *err)
+sy_filter_status sy_filter_check_nonnegative(float v, const char *what, sy_filter_report *err)
 {
     if (!isfinite(v) || v < 0.0f)
         return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "%s = %g: must be a finite value >= 0", what,
@@ -46,7 +46,7 @@ sy_filter_status sy_filter_check_nonnegative(float v, const char *what, sy_filte
     return SY_FILTER_OK;
 }
 
-sy_filter_status sy_filter_check_range(float v, float lo, float hi, const char *what, sy_filter_error *err)
+sy_filter_status sy_filter_check_range(float v, float lo, float hi, const char *what, sy_filter_report *err)
 {
     if (!isfinite(v) || v < lo || v > hi)
         return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "%s = %g: must lie in [%g, %g]", what,
@@ -55,7 +55,7 @@ sy_filter_status sy_filter_check_range(float v, float lo, float hi, const char *
 }
 
 sy_filter_status sy_filter_check_frame(const sy_filter_frame *f, uint32_t need, const char *filter,
-                                       sy_filter_error *err)
+                                       sy_filter_report *err)
 {
     if (!f) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "%s: frame is NULL", filter);
     if (f->width == 0 || f->height == 0 || f->width > SY_FILTER_MAX_SIDE || f->height > SY_FILTER_MAX_SIDE)
@@ -141,7 +141,7 @@ float sy_filter_pixel_spp(const sy_filter_frame *f, size_t i)
 }
 
 sy_filter_status sy_filter_position_from_depth(uint32_t w, uint32_t h, const float m[16], float yfov,
-                                               const float *depth, float *out, sy_filter_error *err)
+                                               const float *depth, float *out, sy_filter_report *err)
 {
     if (w == 0 || h == 0 || w > SY_FILTER_MAX_SIDE || h > SY_FILTER_MAX_SIDE || !m || !depth || !out)
         return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "position from depth: bad size %ux%u or NULL buffer",

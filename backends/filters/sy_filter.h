@@ -14,8 +14,10 @@
  * radiance; RGBA colour is premultiplied (filters treat RGB linearly and pass alpha through);
  * depth is the camera-axis distance of the first hit in scene units (metres), +INFINITY on a miss.
  *
- * Errors: fallible calls return sy_filter_status and, when err != NULL, fill err->message with the
- * filter, parameter and reason. No global state. Thread-safety: a filter object is used by one
+ * Errors (the convention of every Switchyard back-end): fallible calls return sy_filter_status,
+ * numbered like Switchyard's sy_result, and report the message (the filter, parameter and reason)
+ * through the caller's sy_filter_report (its error callback once, and its message). No global
+ * state. Thread-safety: a filter object is used by one
  * thread at a time; distinct objects are independent; the filters themselves run multithreaded on
  * the process's OpenMP thread team (sy_filter_parallel_rows). */
 #ifndef SY_FILTER_H
@@ -29,20 +31,30 @@
 extern "C" {
 #endif
 
-/** Result of every fallible filter call. */
+/** Result of every fallible filter call: the numbers of Switchyard's sy_result (core/sy_common.h),
+ * which a mediator checks at compile time, so it maps a code with a cast. */
 typedef enum sy_filter_status {
     SY_FILTER_OK = 0,
     SY_FILTER_ERROR_INVALID_ARGUMENT = 1, /**< parameter out of range, missing buffer, bad size */
-    SY_FILTER_ERROR_OUT_OF_MEMORY = 2,
-    SY_FILTER_ERROR_THREADS = 3 /**< not returned any more (filters run on OpenMP's team); kept so
-                                 * the values stay stable */
+    SY_FILTER_ERROR_OUT_OF_MEMORY = 3
 } sy_filter_status;
 
-/** A status plus its message (the filter, parameter and reason). */
-typedef struct sy_filter_error {
-    sy_filter_status status; /**< the status */
-    char message[256]; /**< the message */
-} sy_filter_error;
+/** Receives the message of a failed call (no trailing newline; valid during the call only), on the
+ * thread that made the call, before the call returns with code. */
+typedef void (*sy_filter_error_fn)(void *user, sy_filter_status code, const char *message);
+
+#define SY_FILTER_ERROR_MAX 512 /**< bytes of a reported message, NUL included (as core's sy_error) */
+
+/** Where a filter call reports its failure. The filters have no device to hold the error callback
+ * (the rt and raster back-ends keep it in theirs), so the caller passes this to every fallible
+ * call (NULL: the code only): error(user, code, message) is called once per failure when set, and
+ * code and message keep the last failure. Zero-initialise before first use ({0}). */
+typedef struct sy_filter_report {
+    sy_filter_error_fn error; /**< optional callback; NULL = none */
+    void *user;               /**< passed to error */
+    sy_filter_status code;    /**< the last failure's code */
+    char message[SY_FILTER_ERROR_MAX]; /**< the last failure's message (the filter, parameter and reason) */
+} sy_filter_report;
 
 /** Largest accepted image side and thread count. */
 #define SY_FILTER_MAX_SIDE 32768u
@@ -88,8 +100,9 @@ typedef struct sy_filter_stats {
 /** Short name of a status. Static storage. */
 const char *sy_filter_status_name(sy_filter_status s);
 
-/** Fill err (if non-NULL) and return status; printf-style message. */
-sy_filter_status sy_filter_fail(sy_filter_error *err, sy_filter_status status, const char *fmt, ...)
+/** Reports a failure to err (if non-NULL: code, message, then the callback) and returns status;
+ * printf-style message. */
+sy_filter_status sy_filter_fail(sy_filter_report *err, sy_filter_status status, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
 #endif
@@ -97,11 +110,11 @@ sy_filter_status sy_filter_fail(sy_filter_error *err, sy_filter_status status, c
 
 /** Parameter validation, the one place every filter uses: positive finite (sigma-like), non-negative
  * finite (threshold-like), inclusive range. `what` names "filter.parameter" in the message. */
-sy_filter_status sy_filter_check_positive(float v, const char *what, sy_filter_error *err);
+sy_filter_status sy_filter_check_positive(float v, const char *what, sy_filter_report *err);
 /** Fails unless v is finite and >= 0. */
-sy_filter_status sy_filter_check_nonnegative(float v, const char *what, sy_filter_error *err);
+sy_filter_status sy_filter_check_nonnegative(float v, const char *what, sy_filter_report *err);
 /** Fails unless v is finite and within [lo, hi]. */
-sy_filter_status sy_filter_check_range(float v, float lo, float hi, const char *what, sy_filter_error *err);
+sy_filter_status sy_filter_check_range(float v, float lo, float hi, const char *what, sy_filter_report *err);
 /** Image size and the buffers flagged in `need` (SY_FILTER_NEED_*) present; channel counts valid. */
 enum {
     SY_FILTER_NEED_COLOR = 1u << 0,
@@ -114,7 +127,7 @@ enum {
 };
 /** Fails unless the frame's size and channel counts are valid and every buffer in need is present. */
 sy_filter_status sy_filter_check_frame(const sy_filter_frame *f, uint32_t need, const char *filter,
-                                       sy_filter_error *err);
+                                       sy_filter_report *err);
 
 /** Mark pixels whose used buffers hold a NaN/Inf (mask[i] = 0, else 1; +INFINITY depth is a valid
  * miss). Returns the number of bad pixels. `need` as above selects the buffers inspected. */
@@ -126,7 +139,7 @@ uint64_t sy_filter_scan_finite(const sy_filter_frame *f, uint32_t need, uint8_t 
  * NaN depth) get the point 1e18 along the pixel's ray, so guides treat them as far away. out:
  * width*height*3. Fails on a bad size or a non-positive yfov. */
 sy_filter_status sy_filter_position_from_depth(uint32_t width, uint32_t height, const float camera_to_world[16],
-                                               float yfov, const float *depth, float *out, sy_filter_error *err);
+                                               float yfov, const float *depth, float *out, sy_filter_report *err);
 
 /** Rec.709 luminance. */
 static inline float sy_filter_luminance(const float *rgb)

@@ -15,7 +15,7 @@ void sy_filter_adaptive_params_default(sy_filter_adaptive_params *p)
                                      .max_level = 5, .threads = 0};
 }
 
-sy_filter_status sy_filter_adaptive_params_check(const sy_filter_adaptive_params *p, sy_filter_error *err)
+sy_filter_status sy_filter_adaptive_params_check(const sy_filter_adaptive_params *p, sy_filter_report *err)
 {
     sy_filter_status s;
     if (!p) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "adaptive preview: params is NULL");
@@ -136,7 +136,7 @@ static void out_rows(void *vctx, uint32_t y0, uint32_t y1)
 }
 
 sy_filter_status sy_filter_adaptive(const sy_filter_adaptive_params *p, const sy_filter_frame *in, float *out,
-                                    float *level_out, sy_filter_stats *stats, sy_filter_error *err)
+                                    float *level_out, sy_filter_stats *stats, sy_filter_report *err)
 {
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);

@@ -33,11 +33,11 @@ typedef struct sy_filter_adaptive_params {
 /** Fills p with the defaults. */
 void sy_filter_adaptive_params_default(sy_filter_adaptive_params *p);
 /** Checks every field; the message names the field and the bound. */
-sy_filter_status sy_filter_adaptive_params_check(const sy_filter_adaptive_params *p, sy_filter_error *err);
+sy_filter_status sy_filter_adaptive_params_check(const sy_filter_adaptive_params *p, sy_filter_report *err);
 
 /** out_rgba: width*height*4; level_out (optional, width*height): the fractional level used. */
 sy_filter_status sy_filter_adaptive(const sy_filter_adaptive_params *p, const sy_filter_frame *in, float *out_rgba,
-                                    float *level_out, sy_filter_stats *stats, sy_filter_error *err);
+                                    float *level_out, sy_filter_stats *stats, sy_filter_report *err);
 
 #ifdef __cplusplus
 }

@@ -16,7 +16,7 @@ void sy_filter_atrous_params_default(sy_filter_atrous_params *p)
                                    .demodulate_albedo = true, .threads = 0};
 }
 
-sy_filter_status sy_filter_atrous_params_check(const sy_filter_atrous_params *p, sy_filter_error *err)
+sy_filter_status sy_filter_atrous_params_check(const sy_filter_atrous_params *p, sy_filter_report *err)
 {
     sy_filter_status s;
     if (!p) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "a-trous: params is NULL");
@@ -101,7 +101,7 @@ static void atrous_rows(void *vctx, uint32_t y0, uint32_t y1)
 }
 
 sy_filter_status sy_filter_atrous(const sy_filter_atrous_params *p, const sy_filter_frame *in, float *out,
-                                  sy_filter_stats *stats, sy_filter_error *err)
+                                  sy_filter_stats *stats, sy_filter_report *err)
 {
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);

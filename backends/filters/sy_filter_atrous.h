@@ -33,11 +33,11 @@ typedef struct sy_filter_atrous_params {
 /** Fills p with the defaults. */
 void sy_filter_atrous_params_default(sy_filter_atrous_params *p);
 /** Checks every field; the message names the field and the bound. */
-sy_filter_status sy_filter_atrous_params_check(const sy_filter_atrous_params *p, sy_filter_error *err);
+sy_filter_status sy_filter_atrous_params_check(const sy_filter_atrous_params *p, sy_filter_report *err);
 
 /** out_rgba: width*height*4 floats; stats may be NULL. */
 sy_filter_status sy_filter_atrous(const sy_filter_atrous_params *p, const sy_filter_frame *in, float *out_rgba,
-                                  sy_filter_stats *stats, sy_filter_error *err);
+                                  sy_filter_stats *stats, sy_filter_report *err);
 
 #ifdef __cplusplus
 }

@@ -13,7 +13,7 @@ void sy_filter_jbu_params_default(sy_filter_jbu_params *p)
                                 .sigma_normal = 0.25f, .demodulate_albedo = true, .threads = 0};
 }
 
-sy_filter_status sy_filter_jbu_params_check(const sy_filter_jbu_params *p, sy_filter_error *err)
+sy_filter_status sy_filter_jbu_params_check(const sy_filter_jbu_params *p, sy_filter_report *err)
 {
     sy_filter_status s;
     if (!p) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "jbu: params is NULL");
@@ -98,7 +98,7 @@ static void up_rows(void *vctx, uint32_t y0, uint32_t y1)
 
 sy_filter_status sy_filter_jbu_upsample(const sy_filter_jbu_params *p, const float *low, const float *ld,
                                         const float *ln, uint32_t lw, uint32_t lh, const sy_filter_frame *g,
-                                        float *out3, sy_filter_error *err)
+                                        float *out3, sy_filter_report *err)
 {
     sy_filter_jbu_params d;
     if (!p) sy_filter_jbu_params_default(&d), p = &d;
@@ -120,7 +120,7 @@ sy_filter_status sy_filter_jbu_upsample(const sy_filter_jbu_params *p, const flo
 }
 
 sy_filter_status sy_filter_jbu(const sy_filter_jbu_params *p, const sy_filter_frame *in, float *out,
-                               sy_filter_stats *stats, sy_filter_error *err)
+                               sy_filter_stats *stats, sy_filter_report *err)
 {
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);

@@ -37,18 +37,18 @@ typedef struct sy_filter_jbu_params {
 /** Fills p with the defaults. */
 void sy_filter_jbu_params_default(sy_filter_jbu_params *p);
 /** Checks every field; the message names the field and the bound. */
-sy_filter_status sy_filter_jbu_params_check(const sy_filter_jbu_params *p, sy_filter_error *err);
+sy_filter_status sy_filter_jbu_params_check(const sy_filter_jbu_params *p, sy_filter_report *err);
 
 /** low: lw*lh*3 values; low_depth: lw*lh; low_normal: lw*lh*3 (the guides at the block centres).
  * The full-res guides come from `guide` (depth, normal). out3: width*height*3. lw and lh must
  * equal ceil(width/k), ceil(height/k). */
 sy_filter_status sy_filter_jbu_upsample(const sy_filter_jbu_params *p, const float *low, const float *low_depth,
                                         const float *low_normal, uint32_t lw, uint32_t lh,
-                                        const sy_filter_frame *guide, float *out3, sy_filter_error *err);
+                                        const sy_filter_frame *guide, float *out3, sy_filter_report *err);
 
 /** Filters in (see above) into out_rgba (width*height*4 floats); stats may be NULL. */
 sy_filter_status sy_filter_jbu(const sy_filter_jbu_params *p, const sy_filter_frame *in, float *out_rgba,
-                               sy_filter_stats *stats, sy_filter_error *err);
+                               sy_filter_stats *stats, sy_filter_report *err);
 
 #ifdef __cplusplus
 }

@@ -61,7 +61,7 @@ double sy_filter_ssim_gray(const float *a, const float *b, uint32_t w, uint32_t 
 }
 
 sy_filter_status sy_filter_metrics_compute(const float *img, const float *ref, uint32_t w, uint32_t h, uint32_t ch,
-                                           sy_filter_metrics *out, sy_filter_error *err)
+                                           sy_filter_metrics *out, sy_filter_report *err)
 {
     if (!img || !ref || !out) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "metrics: NULL buffer");
     if (w == 0 || h == 0 || w > SY_FILTER_MAX_SIDE || h > SY_FILTER_MAX_SIDE || (ch != 3 && ch != 4))

@@ -30,7 +30,7 @@ typedef struct sy_filter_metrics {
 /** RMSE, relMSE and SSIM of image against reference (width x height x channels floats). */
 sy_filter_status sy_filter_metrics_compute(const float *image, const float *reference, uint32_t width,
                                            uint32_t height, uint32_t channels, sy_filter_metrics *out,
-                                           sy_filter_error *err);
+                                           sy_filter_report *err);
 
 /** SSIM alone on two single-channel images already in [0, 1] (dynamic range L = 1). */
 double sy_filter_ssim_gray(const float *a, const float *b, uint32_t width, uint32_t height);

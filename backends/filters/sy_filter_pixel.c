@@ -60,7 +60,7 @@ void sy_filter_pixel_params_default(sy_filter_pixel_params *p)
     };
 }
 
-sy_filter_status sy_filter_pixel_params_check(const sy_filter_pixel_params *p, sy_filter_error *err)
+sy_filter_status sy_filter_pixel_params_check(const sy_filter_pixel_params *p, sy_filter_report *err)
 {
     sy_filter_status s;
     if (!p) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "pixel filter: params is NULL");
@@ -133,7 +133,7 @@ static void compose_rows(const sy_filter_frame *f, const float *cam, float hw, f
 }
 
 sy_filter_status sy_filter_range_compose(const sy_filter_frame *f, const float *cam, float hw, float *out,
-                                         sy_filter_error *err)
+                                         sy_filter_report *err)
 {
     sy_filter_status s = sy_filter_check_frame(f, SY_FILTER_NEED_ALBEDO | SY_FILTER_NEED_DEPTH, "range buffer", err);
     if (s) return s;
@@ -612,7 +612,7 @@ void sy_filter_pixel_destroy(sy_filter_pixel *pf)
     free(pf);
 }
 
-sy_filter_status sy_filter_pixel_create(const sy_filter_pixel_params *p, sy_filter_pixel **out, sy_filter_error *err)
+sy_filter_status sy_filter_pixel_create(const sy_filter_pixel_params *p, sy_filter_pixel **out, sy_filter_report *err)
 {
     if (!out) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "pixel filter: out is NULL");
     *out = NULL;
@@ -628,7 +628,7 @@ sy_filter_status sy_filter_pixel_create(const sy_filter_pixel_params *p, sy_filt
     return SY_FILTER_OK;
 }
 
-sy_filter_status sy_filter_pixel_set_params(sy_filter_pixel *pf, const sy_filter_pixel_params *p, sy_filter_error *err)
+sy_filter_status sy_filter_pixel_set_params(sy_filter_pixel *pf, const sy_filter_pixel_params *p, sy_filter_report *err)
 {
     if (!pf) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "pixel filter: object is NULL");
     sy_filter_status s = sy_filter_pixel_params_check(p, err);
@@ -645,7 +645,7 @@ const float *sy_filter_pixel_blend(const sy_filter_pixel *pf) { return pf && pf-
 const float *sy_filter_pixel_reduction(const sy_filter_pixel *pf) { return pf && pf->have_pass ? pf->r : NULL; }
 const float *sy_filter_pixel_filtered(const sy_filter_pixel *pf) { return pf && pf->have_pass ? pf->lf3 : NULL; }
 
-static sy_filter_status ensure_size(sy_filter_pixel *pf, uint32_t w, uint32_t h, sy_filter_error *err)
+static sy_filter_status ensure_size(sy_filter_pixel *pf, uint32_t w, uint32_t h, sy_filter_report *err)
 {
     if (pf->w == w && pf->h == h && pf->guide) return SY_FILTER_OK;
     free_buffers(pf);
@@ -923,7 +923,7 @@ static void blend_rows(void *vctx, uint32_t y0, uint32_t y1)
 }
 
 sy_filter_status sy_filter_pixel_run(sy_filter_pixel *pf, const sy_filter_frame *in, uint32_t frame, bool force_pass,
-                                     float *out, sy_filter_stats *stats, sy_filter_error *err)
+                                     float *out, sy_filter_stats *stats, sy_filter_report *err)
 {
     double t0 = now_s();
     if (!pf) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "pixel filter: object is NULL");

@@ -57,7 +57,7 @@ typedef struct sy_filter_pixel_params {
 /** Fills p with the defaults. */
 void sy_filter_pixel_params_default(sy_filter_pixel_params *p);
 /** The single validation point: every field checked, message names the field and the bound. */
-sy_filter_status sy_filter_pixel_params_check(const sy_filter_pixel_params *p, sy_filter_error *err);
+sy_filter_status sy_filter_pixel_params_check(const sy_filter_pixel_params *p, sy_filter_report *err);
 
 /** Range buffer ("virtual flash image", Sec. 3.3.3) from AOVs: RGB = albedo * ((1 - w) + w * cos),
  * cos = |n . v| toward an unoccluded headlight at camera_position (position buffer needed; without
@@ -65,7 +65,7 @@ sy_filter_status sy_filter_pixel_params_check(const sy_filter_pixel_params *p, s
  * out_rgba: width*height*4 floats. [GAP spec 1.5 ambient/headlight weighting]: w = headlight_weight,
  * default 0.5 — equal parts texture edges (ambient) and normal variation (headlight). */
 sy_filter_status sy_filter_range_compose(const sy_filter_frame *f, const float *camera_position,
-                                         float headlight_weight, float *out_rgba, sy_filter_error *err);
+                                         float headlight_weight, float *out_rgba, sy_filter_report *err);
 
 /** Blend factor s (Eq. 3.13) for perceived variances u = Var[L_u]/L_b^2, f = Var[L_f]/L_b^2 and
  * threshold t; with c > 0 the covariance-aware root of spec 1.7 is used. */
@@ -79,19 +79,19 @@ bool sy_filter_pixel_scheduled(const sy_filter_pixel_params *p, uint32_t frame);
 typedef struct sy_filter_pixel sy_filter_pixel;
 
 /** Creates a pixel filter with options p. */
-sy_filter_status sy_filter_pixel_create(const sy_filter_pixel_params *p, sy_filter_pixel **out, sy_filter_error *err);
+sy_filter_status sy_filter_pixel_create(const sy_filter_pixel_params *p, sy_filter_pixel **out, sy_filter_report *err);
 /** Destroys the filter (NULL-safe). */
 void sy_filter_pixel_destroy(sy_filter_pixel *pf);
 /** Forget the filtered buffer (call on every scene/camera change; the frame counter restarts). */
 void sy_filter_pixel_reset(sy_filter_pixel *pf);
 /** Changes the options (checked first; on error nothing changes). */
-sy_filter_status sy_filter_pixel_set_params(sy_filter_pixel *pf, const sy_filter_pixel_params *p, sy_filter_error *err);
+sy_filter_status sy_filter_pixel_set_params(sy_filter_pixel *pf, const sy_filter_pixel_params *p, sy_filter_report *err);
 
 /** One presented frame: runs a filter pass when `frame` is scheduled (or force_pass), then blends.
  * frame = number of accumulated frames (1-based). Before the first pass the output is unfiltered.
  * A size change resets the state. out_rgba: width*height*4 floats. */
 sy_filter_status sy_filter_pixel_run(sy_filter_pixel *pf, const sy_filter_frame *in, uint32_t frame, bool force_pass,
-                                     float *out_rgba, sy_filter_stats *stats, sy_filter_error *err);
+                                     float *out_rgba, sy_filter_stats *stats, sy_filter_report *err);
 
 /** Per-pixel diagnostics of the last run (NULL before the first pass): blend factor s, variance
  * reduction factor r = sum a_i^2 (normalised weights), filtered HV RGB (3 ch). Owned by pf. */

@@ -42,7 +42,7 @@ void sy_filter_radiance_params_default(sy_filter_radiance_params *p)
                                      .threads = 0};
 }
 
-sy_filter_status sy_filter_radiance_params_check(const sy_filter_radiance_params *p, sy_filter_error *err)
+sy_filter_status sy_filter_radiance_params_check(const sy_filter_radiance_params *p, sy_filter_report *err)
 {
     sy_filter_status s;
     if (!p) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: params is NULL");
@@ -409,7 +409,7 @@ void sy_filter_radiance_destroy(sy_filter_radiance *rf)
 }
 
 sy_filter_status sy_filter_radiance_create(const sy_filter_radiance_params *p, sy_filter_radiance **out,
-                                           sy_filter_error *err)
+                                           sy_filter_report *err)
 {
     if (!out) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: out is NULL");
     *out = NULL;
@@ -433,7 +433,7 @@ const float *sy_filter_radiance_radius(const sy_filter_radiance *rf) { return rf
 uint32_t sy_filter_radiance_frame_index(const sy_filter_radiance *rf) { return rf ? rf->k : 0; }
 
 /* (Re)allocates the per-pixel state for width x height; a size change resets (k = 0). */
-static sy_filter_status rf_alloc(sy_filter_radiance *rf, uint32_t width, uint32_t height, sy_filter_error *err)
+static sy_filter_status rf_alloc(sy_filter_radiance *rf, uint32_t width, uint32_t height, sy_filter_report *err)
 {
     if (rf->w == width && rf->h == height && rf->accum) return SY_FILTER_OK;
     size_t n = (size_t)width * height;
@@ -461,7 +461,7 @@ static sy_filter_status rf_alloc(sy_filter_radiance *rf, uint32_t width, uint32_
 
 sy_filter_status sy_filter_radiance_seed(sy_filter_radiance *rf, uint32_t width, uint32_t height, const float *mean,
                                          uint32_t channels, const float *variance, uint32_t frames,
-                                         sy_filter_error *err)
+                                         sy_filter_report *err)
 {
     if (!rf || !mean || !variance || frames == 0 || (channels != 3 && channels != 4))
         return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT,
@@ -485,7 +485,7 @@ sy_filter_status sy_filter_radiance_seed(sy_filter_radiance *rf, uint32_t width,
 }
 
 sy_filter_status sy_filter_radiance_frame(sy_filter_radiance *rf, const sy_filter_radiance_input *in, float *out,
-                                          sy_filter_stats *stats, sy_filter_error *err)
+                                          sy_filter_stats *stats, sy_filter_report *err)
 {
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);

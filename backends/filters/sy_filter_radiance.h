@@ -122,7 +122,7 @@ typedef struct sy_filter_radiance_params {
 /** Fills p with the defaults. */
 void sy_filter_radiance_params_default(sy_filter_radiance_params *p);
 /** The single validation point: every field checked, the message names it. */
-sy_filter_status sy_filter_radiance_params_check(const sy_filter_radiance_params *p, sy_filter_error *err);
+sy_filter_status sy_filter_radiance_params_check(const sy_filter_radiance_params *p, sy_filter_report *err);
 
 /** One frame of input: per-pixel shading points and samples, and the BSDF. */
 typedef struct sy_filter_radiance_input {
@@ -142,7 +142,7 @@ typedef struct sy_filter_radiance sy_filter_radiance;
 
 /** Creates a filter with options p. */
 sy_filter_status sy_filter_radiance_create(const sy_filter_radiance_params *p, sy_filter_radiance **out,
-                                           sy_filter_error *err);
+                                           sy_filter_report *err);
 /** Destroys the filter (NULL-safe). */
 void sy_filter_radiance_destroy(sy_filter_radiance *rf);
 /** Restart accumulation (scene/camera change): frame counter k back to 0. */
@@ -151,7 +151,7 @@ void sy_filter_radiance_reset(sy_filter_radiance *rf);
  * out_rgba (width*height*4, alpha 1). A size change resets. stats->mean_blend = share of pixels in
  * the correction phase. */
 sy_filter_status sy_filter_radiance_frame(sy_filter_radiance *rf, const sy_filter_radiance_input *in, float *out_rgba,
-                                          sy_filter_stats *stats, sy_filter_error *err);
+                                          sy_filter_stats *stats, sy_filter_report *err);
 /** Resume on top of an existing progressive estimate of `frames` (>= 1) samples per pixel, e.g.
  * when the filter is switched on while the path tracer keeps accumulating: the running means
  * (filtered and plain) start at mean (width*height*channels, channels 3 or 4, RGB used), the
@@ -160,7 +160,7 @@ sy_filter_status sy_filter_radiance_frame(sy_filter_radiance *rf, const sy_filte
  * inputs are taken as 0. */
 sy_filter_status sy_filter_radiance_seed(sy_filter_radiance *rf, uint32_t width, uint32_t height, const float *mean,
                                          uint32_t channels, const float *variance, uint32_t frames,
-                                         sy_filter_error *err);
+                                         sy_filter_report *err);
 /** Diagnostics of the last frame: kernel radius in pixels per pixel (0 = correction phase). */
 const float *sy_filter_radiance_radius(const sy_filter_radiance *rf);
 /** Frames filtered since the last reset or seed (k). */

@@ -32,7 +32,7 @@ void sy_filter_synth_destroy(sy_filter_synth *s)
 }
 
 sy_filter_status sy_filter_synth_create(uint32_t w, uint32_t h, uint64_t seed, sy_filter_synth **out,
-                                        sy_filter_error *err)
+                                        sy_filter_report *err)
 {
     if (!out) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "synth: out is NULL");
     *out = NULL;

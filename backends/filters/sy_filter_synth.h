@@ -26,7 +26,7 @@ typedef struct sy_filter_synth sy_filter_synth;
 
 /** Creates a width x height surrogate with no samples; seed fixes the sample sequence. */
 sy_filter_status sy_filter_synth_create(uint32_t width, uint32_t height, uint64_t seed, sy_filter_synth **out,
-                                        sy_filter_error *err);
+                                        sy_filter_report *err);
 /** Destroys it (NULL-safe). */
 void sy_filter_synth_destroy(sy_filter_synth *s);
 /** Forget all samples (spp back to 0); the seed sequence continues. */

@@ -15,10 +15,13 @@ static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel
  * The path tracer's layer can be filtered for display (backends/filters) from the accumulation's
  * feature buffers. Parameters (creation and sy_mediator_rt_set_filter): filter, threshold, sigma_s,
  * sigma_c, sigma_d, filter_kernel, filter_iterations, filter_start, atrous_iterations, jbu_factor. */
-static sy_result filter_fail(sy_error *err, const sy_filter_error *fe)
+/* Every code a filter returns has core's number (the cast in sy_backend_fail). */
+SY_BACKEND_SAME_CODE(SY_FILTER_ERROR_INVALID_ARGUMENT, SY_ERR_INVALID_ARGUMENT);
+SY_BACKEND_SAME_CODE(SY_FILTER_ERROR_OUT_OF_MEMORY, SY_ERR_OUT_OF_MEMORY);
+
+static sy_result filter_fail(sy_error *err, const sy_filter_report *fe)
 {
-    return sy_error_set(err, fe->status == SY_FILTER_ERROR_OUT_OF_MEMORY ? SY_ERR_OUT_OF_MEMORY : SY_ERR_INVALID_ARGUMENT,
-                        "pathtracer filter: %s", fe->message);
+    return sy_backend_fail(err, (int)fe->code, "pathtracer filter: %s", fe->message);
 }
 
 void sy_rti_filter_cfg_default(pt_filter_cfg *c, uint32_t threads)
@@ -119,7 +122,7 @@ sy_result sy_rti_filter_cfg_apply(pt_filter_cfg *base, const char *name, const s
     /* the rf_* options are checked whatever the filter; T_u = threshold only matters for radiance */
     sy_filter_radiance_params rq = c.radiance;
     if (c.kind != PT_FILTER_RADIANCE && !(rq.threshold > 0.0f)) rq.threshold = 0.01f;
-    sy_filter_error fe = {0};
+    sy_filter_report fe = {0};
     if (sy_filter_pixel_params_check(&c.pixel, &fe) || sy_filter_atrous_params_check(&c.atrous, &fe) ||
         sy_filter_jbu_params_check(&c.jbu, &fe) ||
         (c.kind == PT_FILTER_ADAPTIVE && sy_filter_adaptive_params_check(&c.adaptive, &fe)) ||
@@ -148,7 +151,7 @@ sy_result sy_mediator_rt_set_filter(void *state, const char *name, const sy_para
     for (int i = 0; i < ACCUM_SLOTS; ++i) {
         accum_slot *s = &st->slots[i];
         if (!s->pixel) continue;
-        sy_filter_error fe = {0};
+        sy_filter_report fe = {0};
         if (sy_filter_pixel_set_params(s->pixel, &c.pixel, &fe)) return filter_fail(err, &fe);
         if (refilter) {
             sy_filter_pixel_reset(s->pixel);
@@ -244,7 +247,7 @@ sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_lay
         .camera_position = {m[12], m[13], m[14]},
     };
     sy_filter_stats fs = {0};
-    sy_filter_error fe = {0};
+    sy_filter_report fe = {0};
     sy_filter_status s = SY_FILTER_OK;
     switch (st->filter.kind) {
     case PT_FILTER_PIXEL: {

@@ -1,6 +1,8 @@
 /* sy_radiance_hook.c — path records of the path tracer -> radiance filter (see sy_radiance_hook.h). */
 #include "sy_radiance_hook.h"
 
+#include "sy_backend_status.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,10 +20,10 @@ struct sy_radiance_hook {
     uint32_t frames;  /* frames since the reset (Welford count) */
 };
 
-static sy_result hook_filter_fail(sy_error *err, const sy_filter_error *fe)
+/* the codes agree (sy_mediator_rt_filter.c checks them with SY_BACKEND_SAME_CODE) */
+static sy_result hook_filter_fail(sy_error *err, const sy_filter_report *fe)
 {
-    return sy_error_set(err, fe->status == SY_FILTER_ERROR_OUT_OF_MEMORY ? SY_ERR_OUT_OF_MEMORY : SY_ERR_INVALID_ARGUMENT,
-                        "pathtracer radiance filter: %s", fe->message);
+    return sy_backend_fail(err, (int)fe->code, "pathtracer radiance filter: %s", fe->message);
 }
 
 sy_result sy_radiance_hook_create(const sy_filter_radiance_params *p, sy_radiance_hook **out, sy_error *err)
@@ -29,7 +31,7 @@ sy_result sy_radiance_hook_create(const sy_filter_radiance_params *p, sy_radianc
     *out = NULL;
     sy_radiance_hook *h = calloc(1, sizeof *h);
     if (!h) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "pathtracer radiance filter: out of memory");
-    sy_filter_error fe = {0};
+    sy_filter_report fe = {0};
     if (sy_filter_radiance_create(p, &h->rf, &fe)) {
         free(h);
         return hook_filter_fail(err, &fe);
@@ -65,7 +67,7 @@ void sy_radiance_hook_reset(sy_radiance_hook *h)
 sy_result sy_radiance_hook_set_params(sy_radiance_hook *h, const sy_filter_radiance_params *p, sy_error *err)
 {
     sy_filter_radiance *rf;
-    sy_filter_error fe = {0};
+    sy_filter_report fe = {0};
     if (sy_filter_radiance_create(p, &rf, &fe)) return hook_filter_fail(err, &fe);
     sy_filter_radiance_destroy(h->rf);
     h->rf = rf;
@@ -125,7 +127,7 @@ static sy_result hook_seed(sy_radiance_hook *h, const sy_radiance_hook_frame_des
         h->wmean[i] = ind;
         h->wm2[i] = N > 1 ? var * (N - 1) : 0.0;
     }
-    sy_filter_error fe = {0};
+    sy_filter_report fe = {0};
     if (sy_filter_radiance_seed(h->rf, h->w, h->h, d->prior_color, d->prior_color_channels, h->seed_var,
                                 d->prior_samples, &fe))
         return hook_filter_fail(err, &fe);
@@ -185,7 +187,7 @@ sy_result sy_radiance_hook_frame(sy_radiance_hook *h, const sy_radiance_hook_fra
                                    .samples = h->samples,
                                    .bsdf_batch = hook_bsdf_batch,
                                    .bsdf_user = h};
-    sy_filter_error fe = {0};
+    sy_filter_report fe = {0};
     if (sy_filter_radiance_frame(h->rf, &in, h->out, stats, &fe)) {
         sy_radiance_hook_reset(h);
         return hook_filter_fail(err, &fe);

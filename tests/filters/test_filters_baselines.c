@@ -29,7 +29,7 @@ static int test_atrous(void)
     sy_filter_atrous_params p;
     sy_filter_atrous_params_default(&p);
     float *out = malloc(4 * n * sizeof(float));
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     sy_filter_stats st;
     CHECK(out && sy_filter_atrous(&p, &f, out, &st, &err) == SY_FILTER_OK);
     double maxd = 0;
@@ -78,7 +78,7 @@ static int test_jbu(void)
     sy_filter_frame g = {.width = w, .height = h, .depth = depth, .normal = normal};
     sy_filter_jbu_params p;
     sy_filter_jbu_params_default(&p);
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     CHECK(sy_filter_jbu_upsample(&p, low, ld, ln, lw, lh, &g, out, &err) == SY_FILTER_OK);
     double maxe = 0;
     for (uint32_t y = 8; y < h - 8; ++y)
@@ -141,7 +141,7 @@ static int test_adaptive(void)
     CHECK(out && lvl);
     sy_filter_adaptive_params p;
     sy_filter_adaptive_params_default(&p);
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     sy_filter_stats st;
     synth_render(&s, 1, 1.0f);
     /* 1 spp: no variance estimate yet (0) -> the spp term alone picks level 1 (target 4) */
@@ -189,7 +189,7 @@ static int test_metrics(void)
     for (size_t i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c) a[3 * i + c] = 0.2f + 0.5f * (float)((i % w) + c) / (float)w, b[3 * i + c] = a[3 * i + c];
     sy_filter_metrics m;
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     CHECK(sy_filter_metrics_compute(a, b, w, h, 3, &m, &err) == SY_FILTER_OK);
     CHECK(m.rmse == 0.0 && m.relmse == 0.0 && fabs(m.ssim - 1.0) < 1e-9);
     for (size_t i = 0; i < 3 * n; ++i) a[i] = b[i] + 0.1f;
@@ -221,7 +221,7 @@ static int test_position_from_depth(void)
     float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 1, 2, 3, 1}, depth[9], pos[27];
     for (int i = 0; i < 9; ++i) depth[i] = 4.0f;
     depth[0] = INFINITY;
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     CHECK(sy_filter_position_from_depth(3, 3, m, 1.0f, depth, pos, &err) == SY_FILTER_OK);
     CHECK(fabsf(pos[12] - 1) < 1e-6f && fabsf(pos[13] - 2) < 1e-6f && fabsf(pos[14] + 1) < 1e-6f);
     float th = tanf(0.5f), u = (2.0f * 2.5f / 3.0f - 1.0f) * th; /* right column, middle row */

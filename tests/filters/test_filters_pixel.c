@@ -12,7 +12,7 @@
 static float *run(sy_filter_pixel_params *p, const sy_filter_frame *f, uint32_t frame, sy_filter_stats *st)
 {
     sy_filter_pixel *pf = NULL;
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     EXPECT(sy_filter_pixel_create(p, &pf, &err) == SY_FILTER_OK);
     float *out = malloc((size_t)f->width * f->height * 4 * sizeof(float));
     EXPECT(out);
@@ -27,10 +27,23 @@ static float *run(sy_filter_pixel_params *p, const sy_filter_frame *f, uint32_t 
     return out;
 }
 
+/* the report's callback: called once per failure with the code and the message the report keeps */
+typedef struct report_count {
+    int calls;
+    sy_filter_status code;
+} report_count;
+static void count_error(void *user, sy_filter_status code, const char *message)
+{
+    report_count *c = user;
+    c->calls++;
+    c->code = code;
+    (void)message;
+}
+
 static int test_params(void)
 {
     sy_filter_pixel_params p;
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     sy_filter_pixel *pf = NULL;
     sy_filter_pixel_params_default(&p);
     CHECK(sy_filter_pixel_params_check(&p, &err) == SY_FILTER_OK);
@@ -58,6 +71,12 @@ static int test_params(void)
     float out[64];
     CHECK(sy_filter_pixel_run(pf, &f, 4, false, out, NULL, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "color") != NULL);
+    report_count rc = {0};
+    sy_filter_report rep = {.error = count_error, .user = &rc};
+    CHECK(sy_filter_pixel_run(pf, &f, 4, false, out, NULL, &rep) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    CHECK(rc.calls == 1 && rc.code == SY_FILTER_ERROR_INVALID_ARGUMENT && rep.code == SY_FILTER_ERROR_INVALID_ARGUMENT &&
+          strcmp(rep.message, err.message) == 0);
+    CHECK(sy_filter_pixel_params_check(&p, &rep) == SY_FILTER_OK && rc.calls == 1);
     sy_filter_pixel_destroy(pf);
     return 0;
 }
@@ -144,7 +163,7 @@ static int test_reduction_factor(void)
     for (int kernel = 0; kernel < 2; ++kernel) {
         p.kernel = (sy_filter_pixel_kernel)kernel;
         sy_filter_pixel *pf = NULL;
-        sy_filter_error err = {0};
+        sy_filter_report err = {0};
         CHECK(sy_filter_pixel_create(&p, &pf, &err) == SY_FILTER_OK);
         float out[12];
         CHECK(sy_filter_pixel_run(pf, &f, 4, true, out, NULL, &err) == SY_FILTER_OK);
@@ -275,7 +294,7 @@ static int test_nan_isolation(void)
             sy_filter_pixel_params_default(&p);
             if (kernel) p.kernel = SY_FILTER_PIXEL_BRUTE, p.aa_recovery = false;
             sy_filter_pixel *pf = NULL;
-            sy_filter_error err = {0};
+            sy_filter_report err = {0};
             sy_filter_stats st;
             CHECK(sy_filter_pixel_create(&p, &pf, &err) == SY_FILTER_OK);
             out[v] = malloc(2 * W * H * 4 * sizeof(float));
@@ -325,7 +344,7 @@ static int test_threads(void)
     size_t n = (size_t)77 * 45;
     float *ref = NULL;
     sy_filter_pixel *pf = NULL;
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     sy_filter_pixel_params p;
     sy_filter_pixel_params_default(&p);
     CHECK(sy_filter_pixel_create(&p, &pf, &err) == SY_FILTER_OK);
@@ -384,7 +403,7 @@ static int test_range_compose(void)
     float dep[2] = {2.0f, INFINITY}, cam[3] = {0, 0, 0}, out[8];
     sy_filter_frame f = {.width = 2, .height = 1, .albedo = alb, .normal = nrm, .position = pos, .depth = dep,
                          .spp_uniform = 1};
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     CHECK(sy_filter_range_compose(&f, cam, 0.5f, out, &err) == SY_FILTER_OK);
     for (int c = 0; c < 3; ++c) {
         CHECK(fabsf(out[c] - alb[c]) < 1e-6f);              /* facing the headlight: full */

@@ -95,7 +95,7 @@ static int test_texture_and_convergence(void)
     CHECK(scene_init(&s, 96, 64, false, 0.0f) == 0);
     size_t n = (size_t)s.w * s.h;
     sy_filter_radiance *rf = NULL;
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     CHECK(sy_filter_radiance_create(NULL, &rf, &err) == SY_FILTER_OK);
     float *out = malloc(4 * n * sizeof(float)), *pt = calloc(4 * n, sizeof(float));
     CHECK(out && pt);
@@ -135,7 +135,7 @@ static int test_depth_step(void)
     CHECK(scene_init(&s, 96, 48, true, 0.0f) == 0);
     size_t n = (size_t)s.w * s.h;
     sy_filter_radiance *rf = NULL;
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     CHECK(sy_filter_radiance_create(NULL, &rf, &err) == SY_FILTER_OK);
     float *out = malloc(4 * n * sizeof(float));
     CHECK(out);
@@ -167,7 +167,7 @@ static int test_correction_phase(void)
     sy_filter_radiance_params_default(&p);
     p.unbiased_switch = true;
     sy_filter_radiance *rf = NULL;
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     CHECK(sy_filter_radiance_create(&p, &rf, &err) == SY_FILTER_OK);
     float *out = malloc(4 * n * sizeof(float)), *pt = calloc(3 * n, sizeof(float));
     CHECK(out && pt);
@@ -204,7 +204,7 @@ static int test_nan_and_params(void)
     CHECK(scene_init(&s, 32, 24, false, 0.0f) == 0);
     size_t n = (size_t)s.w * s.h;
     sy_filter_radiance *rf = NULL;
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     CHECK(sy_filter_radiance_create(NULL, &rf, &err) == SY_FILTER_OK);
     float *out = malloc(4 * n * sizeof(float));
     CHECK(out);
@@ -242,7 +242,7 @@ static int test_seed(void)
     CHECK(scene_init(&s, 32, 24, false, 0.0f) == 0);
     size_t n = (size_t)s.w * s.h;
     sy_filter_radiance *rf = NULL;
-    sy_filter_error err = {0};
+    sy_filter_report err = {0};
     CHECK(sy_filter_radiance_create(NULL, &rf, &err) == SY_FILTER_OK);
     float *out = malloc(4 * n * sizeof(float)), *var = malloc(n * sizeof(float));
     CHECK(out && var);
@@ -318,7 +318,7 @@ static int test_batched_bsdf(void)
         /* the filter: default (batched) vs per-neighbour single calls vs a user batch; 1 vs all threads */
         float *out[3];
         sy_filter_radiance *rf[3];
-        sy_filter_error err = {0};
+        sy_filter_report err = {0};
         for (int v = 0; v < 3; ++v) {
             sy_filter_radiance_params p;
             sy_filter_radiance_params_default(&p);

@@ -87,7 +87,7 @@ static sy_window *make_window(fixture *fx, uint32_t w, uint32_t h, const char *p
 static double relmse(const float *img, const float *ref, uint32_t w, uint32_t h)
 {
     sy_filter_metrics m;
-    sy_filter_error fe = {0};
+    sy_filter_report fe = {0};
     if (sy_filter_metrics_compute(img, ref, w, h, 4, &m, &fe) != SY_FILTER_OK) {
         fprintf(stderr, "metrics: %s\n", fe.message);
         exit(1);

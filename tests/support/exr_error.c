@@ -51,7 +51,7 @@ int main(int argc, char **argv)
     }
     if (!(x = rgb_of(a, argv[1])) || !(y = rgb_of(b, argv[2]))) goto done;
     sy_filter_metrics m;
-    sy_filter_error fe;
+    sy_filter_report fe = {0};
     if (sy_filter_metrics_compute(x, y, (uint32_t)a->width, (uint32_t)a->height, 3, &m, &fe) != SY_FILTER_OK) {
         fprintf(stderr, "exr_error: %s\n", fe.message);
         goto done;
