@@ -28,31 +28,40 @@ struct sy_nrm_device {
     uint32_t mesh_cap;
     nrm_instance *inst;
     uint32_t inst_cap;
+    sy_nrm_error_fn error;
+    void *error_user;
 };
 
-static int fail(char *err, size_t n, const char *fmt, ...)
+/* Reports a failure to the callback (fn may be NULL) and returns code. */
+static sy_nrm_result report(sy_nrm_error_fn fn, void *user, sy_nrm_result code, const char *fmt, ...)
 {
+    char msg[512];
     va_list ap;
     va_start(ap, fmt);
-    if (err && n) vsnprintf(err, n, fmt, ap);
+    vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    return -1;
+    if (fn) fn(user, code, msg);
+    return code;
 }
+#define FAIL(d, code, ...) report((d)->error, (d)->error_user, (code), __VA_ARGS__)
 
-int sy_nrm_device_create(sy_nrm_device **out, char *err, size_t err_len)
+sy_nrm_result sy_nrm_device_create(const sy_nrm_device_desc *desc, sy_nrm_device **out)
 {
+    sy_nrm_device_desc dd = desc ? *desc : (sy_nrm_device_desc){0};
     *out = NULL;
     sy_nrm_device *d = calloc(1, sizeof *d);
-    if (!d) return fail(err, err_len, "normals: out of memory");
+    if (!d) return report(dd.error, dd.error_user, SY_NRM_ERROR_OUT_OF_MEMORY, "normals: out of memory");
+    d->error = dd.error;
+    d->error_user = dd.error_user;
     d->rtc = rtcNewDevice(NULL);
     if (!d->rtc) {
         free(d);
-        return fail(err, err_len, "normals: rtcNewDevice failed");
+        return report(dd.error, dd.error_user, SY_NRM_ERROR_EMBREE, "normals: rtcNewDevice failed");
     }
     d->top = rtcNewScene(d->rtc);
     rtcCommitScene(d->top);
     *out = d;
-    return 0;
+    return SY_NRM_OK;
 }
 
 void sy_nrm_device_destroy(sy_nrm_device *d)
@@ -84,13 +93,12 @@ static int take_slot(void **arr, uint32_t *cap, size_t size, uint32_t *out)
     return 0;
 }
 
-uint32_t sy_nrm_mesh_create(sy_nrm_device *d, const float *xyz, uint32_t nverts, const uint32_t *idx, uint32_t ntris,
-                            char *err, size_t err_len)
+uint32_t sy_nrm_mesh_create(sy_nrm_device *d, const float *xyz, uint32_t nverts, const uint32_t *idx, uint32_t ntris)
 {
     for (size_t i = 0; i < (size_t)ntris * 3; ++i)
-        if (idx[i] >= nverts) return fail(err, err_len, "normals: index %u of triangle %zu >= %u vertices", idx[i], i / 3, nverts), 0;
+        if (idx[i] >= nverts) return FAIL(d, SY_NRM_ERROR_INVALID_ARGUMENT, "normals: index %u of triangle %zu >= %u vertices", idx[i], i / 3, nverts), 0;
     uint32_t slot;
-    if (take_slot((void **)&d->meshes, &d->mesh_cap, sizeof *d->meshes, &slot)) return fail(err, err_len, "normals: out of memory"), 0;
+    if (take_slot((void **)&d->meshes, &d->mesh_cap, sizeof *d->meshes, &slot)) return FAIL(d, SY_NRM_ERROR_OUT_OF_MEMORY, "normals: out of memory"), 0;
     RTCScene s = rtcNewScene(d->rtc);
     if (ntris && nverts) {
         RTCGeometry g = rtcNewGeometry(d->rtc, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -99,7 +107,7 @@ uint32_t sy_nrm_mesh_create(sy_nrm_device *d, const float *xyz, uint32_t nverts,
         if (!v || !t) {
             rtcReleaseGeometry(g);
             rtcReleaseScene(s);
-            return fail(err, err_len, "normals: Embree could not allocate a mesh of %u triangles", ntris), 0;
+            return FAIL(d, SY_NRM_ERROR_EMBREE, "normals: Embree could not allocate a mesh of %u triangles", ntris), 0;
         }
         memcpy(v, xyz, (size_t)nverts * 3 * sizeof(float));
         memcpy(t, idx, (size_t)ntris * 3 * sizeof(unsigned));
@@ -132,22 +140,21 @@ static void normal_matrix(const float *m, float *out)
     out[6] = (b * g - c * f) * s, out[7] = (c * e - a * g) * s, out[8] = (a * f - b * e) * s;
 }
 
-uint32_t sy_nrm_instance_set(sy_nrm_device *d, uint32_t handle, uint32_t mesh, const float world[16], bool visible,
-                             char *err, size_t err_len)
+uint32_t sy_nrm_instance_set(sy_nrm_device *d, uint32_t handle, uint32_t mesh, const float world[16], bool visible)
 {
     nrm_instance *in;
     if (handle == 0) {
         if (mesh == 0 || mesh > d->mesh_cap || !d->meshes[mesh - 1].scene)
-            return fail(err, err_len, "normals: instance of unknown mesh %u", mesh), 0;
+            return FAIL(d, SY_NRM_ERROR_INVALID_ARGUMENT, "normals: instance of unknown mesh %u", mesh), 0;
         uint32_t slot;
-        if (take_slot((void **)&d->inst, &d->inst_cap, sizeof *d->inst, &slot)) return fail(err, err_len, "normals: out of memory"), 0;
+        if (take_slot((void **)&d->inst, &d->inst_cap, sizeof *d->inst, &slot)) return FAIL(d, SY_NRM_ERROR_OUT_OF_MEMORY, "normals: out of memory"), 0;
         in = &d->inst[slot];
         in->geom = rtcNewGeometry(d->rtc, RTC_GEOMETRY_TYPE_INSTANCE);
         rtcSetGeometryInstancedScene(in->geom, d->meshes[mesh - 1].scene);
         in->geom_id = rtcAttachGeometry(d->top, in->geom);
         handle = slot + 1;
     } else {
-        if (handle > d->inst_cap || !d->inst[handle - 1].geom) return fail(err, err_len, "normals: unknown instance %u", handle), 0;
+        if (handle > d->inst_cap || !d->inst[handle - 1].geom) return FAIL(d, SY_NRM_ERROR_INVALID_ARGUMENT, "normals: unknown instance %u", handle), 0;
         in = &d->inst[handle - 1];
     }
     memcpy(in->world, world, sizeof in->world);
@@ -177,10 +184,10 @@ static const nrm_instance *instance_of(const sy_nrm_device *d, unsigned id)
     return NULL;
 }
 
-int sy_nrm_render(sy_nrm_device *d, const sy_nrm_view *v, float *rgba, float *depth, char *err, size_t err_len)
+sy_nrm_result sy_nrm_render(sy_nrm_device *d, const sy_nrm_view *v, float *rgba, float *depth)
 {
     if (!v->full_width || !v->full_height || v->rect_x + v->rect_w > v->full_width || v->rect_y + v->rect_h > v->full_height)
-        return fail(err, err_len, "normals: rectangle outside the image");
+        return FAIL(d, SY_NRM_ERROR_INVALID_ARGUMENT, "normals: rectangle outside the image");
     if (d->dirty) {
         rtcCommitScene(d->top);
         d->dirty = false;
@@ -226,5 +233,5 @@ int sy_nrm_render(sy_nrm_device *d, const sy_nrm_view *v, float *rgba, float *de
             rgba[p * 4 + 3] = 1.0f;
             depth[p] = rh.ray.tfar; /* the ray's z step in camera space is 1: t is the view depth */
         }
-    return 0;
+    return SY_NRM_OK;
 }

@@ -1,18 +1,34 @@
 /* sy_mediator_nrm.c — the normals mediator (see sy_mediator_nrm.h). */
 #include "sy_mediator_nrm.h"
 
+#include "sy_backend_status.h"
 #include "sy_mirror.h"
 #include "sy_nrm.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 typedef struct nrm_state {
     sy_nrm_device *dev;
     sy_mirror *mirror;
+    sy_nrm_result code;             /* the device's last failure (nrm_error), on the thread of the call */
+    char msg[SY_ERROR_MESSAGE_MAX]; /* its message */
 } nrm_state;
 
-static sy_result nrm_fail(sy_error *err, const char *e) { return sy_error_set(err, SY_ERR_BACKEND, "%s", e); }
+SY_BACKEND_SAME_CODE(SY_NRM_ERROR_INVALID_ARGUMENT, SY_ERR_INVALID_ARGUMENT);
+SY_BACKEND_SAME_CODE(SY_NRM_ERROR_OUT_OF_MEMORY, SY_ERR_OUT_OF_MEMORY);
+SY_BACKEND_SAME_CODE(SY_NRM_ERROR_EMBREE, SY_ERR_BACKEND);
+
+/* the device's error callback */
+static void nrm_error(void *user, sy_nrm_result code, const char *message)
+{
+    nrm_state *st = user;
+    st->code = code;
+    snprintf(st->msg, sizeof st->msg, "%s", message);
+}
+
+static sy_result nrm_fail(const nrm_state *st, sy_error *err) { return sy_backend_fail(err, (int)st->code, "%s", st->msg); }
 
 static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
 {
@@ -26,18 +42,16 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
         for (uint32_t i = 0; i < nt * 3; ++i) seq[i] = i;
         idx = seq;
     }
-    char e[256];
-    *a->handle = sy_nrm_mesh_create(st->dev, a->flat->positions, nv, idx, nt, e, sizeof e);
+    *a->handle = sy_nrm_mesh_create(st->dev, a->flat->positions, nv, idx, nt);
     free(seq);
-    return *a->handle ? SY_OK : nrm_fail(err, e);
+    return *a->handle ? SY_OK : nrm_fail(st, err);
 }
 
 static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_error *err)
 {
     nrm_state *st = user;
-    char e[256];
-    uint32_t h = sy_nrm_instance_set(st->dev, *a->handle, a->mesh, a->world->m, a->visible, e, sizeof e);
-    if (!h) return nrm_fail(err, e);
+    uint32_t h = sy_nrm_instance_set(st->dev, *a->handle, a->mesh, a->world->m, a->visible);
+    if (!h) return nrm_fail(st, err);
     *a->handle = h;
     return SY_OK;
 }
@@ -69,8 +83,8 @@ static sy_result nrm_create(const sy_mediator_create_args *args, void **state_ou
     *state_out = NULL; /* args->params: always empty (the class declares none, core refuses any) */
     nrm_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "normals: out of memory");
-    char e[256];
-    sy_result r = sy_nrm_device_create(&st->dev, e, sizeof e) ? nrm_fail(err, e) : SY_OK;
+    sy_nrm_device_desc dd = {nrm_error, st};
+    sy_result r = sy_nrm_device_create(&dd, &st->dev) ? nrm_fail(st, err) : SY_OK;
     sy_mirror_desc md = {.name = "normals mediator", .root_node_id = args->root_node_id, .callbacks = &nrm_callbacks,
                          .user = st};
     if (r == SY_OK) r = sy_mirror_create(&md, &st->mirror, err);
@@ -95,8 +109,7 @@ static sy_result nrm_render(void *state, const sy_render_request *req, sy_layer 
                      .rect_x = req->rect_x, .rect_y = req->rect_y, .rect_w = req->rect_w, .rect_h = req->rect_h};
     memcpy(v.camera_to_world, req->camera.camera_to_world.m, sizeof v.camera_to_world);
     memcpy(v.window, req->camera.window, sizeof v.window);
-    char e[256];
-    return sy_nrm_render(st->dev, &v, layer->rgba, layer->depth, e, sizeof e) ? nrm_fail(err, e) : SY_OK;
+    return sy_nrm_render(st->dev, &v, layer->rgba, layer->depth) ? nrm_fail(st, err) : SY_OK;
 }
 
 static const sy_mediator_class nrm_class = {
