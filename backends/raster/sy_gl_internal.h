@@ -2,7 +2,8 @@
  * share: limits and texture units, the object pools and object structs, the device struct, the
  * per-frame structs, and the functions one module calls in another (prefix sy_gli_). The modules,
  * bottom-up (each calls only those before it; tests/core/layers_test.sh checks it):
- *   sy_gl_base.c     pools, errors, math, frustum tests, GL checks
+ *   (sy_gl_context.c, below them all: the GL context and the error report, sy_gli_fail)
+ *   sy_gl_base.c     pools, warnings, math, frustum tests, GL checks
  *   sy_gl_programs.c stand-in textures, material blocks, shader variants, the material table
  *   sy_gl_objects.c  meshes (levels of detail), textures, materials, instances, lights, environment
  *   sy_gl_lod.c      levels of detail chosen per view, drawing one level

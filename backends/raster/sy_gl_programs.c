@@ -136,7 +136,7 @@ static void variant_defines(int v, uint64_t sig, char *defs, size_t defs_len, ch
     }
 }
 
-/* The main program for variant bits v, built and cached on first use; 0 with err set when the
+/* The main program for variant bits v, built and cached on first use; 0 (the failure reported to rep) when the
  * driver rejects it. */
 GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep)
 {
@@ -183,8 +183,8 @@ GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep)
 }
 
 /* The deferred shading pass for the frame's lighting variant bits v (only the lighting bits
- * count) and light signature, built and kept on first use: its index in dev->dp, or -1 with err
- * set when the driver rejects it. */
+ * count) and light signature, built and kept on first use: its index in dev->dp, or -1
+ * (the failure reported to rep) when the driver rejects it. */
 int sy_gli_deferred_program(sy_gl_device *dev, int v, sy_gl_report *rep)
 {
     v = sy_gli_variant_normalize(v & (VAR_LIGHTS | VAR_ENV | VAR_SHADOW | VAR_AREA | VAR_ASHADOW | (7 << VAR_NL_SHIFT)));

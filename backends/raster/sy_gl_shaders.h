@@ -21,7 +21,7 @@ extern const char *const sy_gl_rect_vs;
 
 /* Compiles and links; fs_defines (NULL = none, e.g. "#define SY_MASK 1\n") is inserted after the
  * #version line of both stages. On failure returns SY_GL_ERROR_GL with "<name> shader: <stage> compile
- * failed: <log>" (or link log) in err. */
+ * failed: <log>" (or link log) reported to rep. */
 sy_gl_result sy_gl_program_build(const sy_gl_fns *gl, const char *name, const char *vs, const char *fs,
                                  const char *fs_defines, GLuint *out, sy_gl_report *rep);
 
