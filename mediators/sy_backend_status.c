@@ -9,15 +9,12 @@
 
 sy_result sy_backend_fail(sy_error *err, int code, const char *fmt, ...)
 {
-    sy_result r = code > SY_OK && code <= SY_ERR_SYSTEM ? (sy_result)code : SY_ERR_BACKEND;
-    if (err) {
-        err->code = r;
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err->message, sizeof err->message, fmt, ap);
-        va_end(ap);
-    }
-    return r;
+    char msg[SY_ERROR_MESSAGE_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return sy_error_set(err, code > SY_OK && code <= SY_ERR_SYSTEM ? (sy_result)code : SY_ERR_BACKEND, "%s", msg);
 }
 
 void sy_backend_warn(const char *module, const char *message)
