@@ -4,17 +4,11 @@
 
 #include "sy_log.h"
 
-#include <stdarg.h>
-#include <stdio.h>
-
-sy_result sy_backend_fail(sy_error *err, int code, const char *fmt, ...)
+sy_result sy_backend_fail(sy_error *err, int code, const char *module, const char *what, const char *message)
 {
-    char msg[SY_ERROR_MESSAGE_MAX];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    return sy_error_set(err, code > SY_OK && code <= SY_ERR_SYSTEM ? (sy_result)code : SY_ERR_BACKEND, "%s", msg);
+    sy_result r = code > SY_OK && code <= SY_ERR_SYSTEM ? (sy_result)code : SY_ERR_BACKEND; /* SY_ERR_SYSTEM: core's last */
+    return sy_error_set(err, r, "%s%s%s%s%s", module ? module : "", module ? ": " : "", what ? what : "", what ? ": " : "",
+                        message ? message : "");
 }
 
 void sy_backend_warn(const char *module, const char *message)

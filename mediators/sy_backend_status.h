@@ -27,14 +27,11 @@ extern "C" {
     _Static_assert((int)(backend_code) == (int)(core_code), #backend_code " is numbered like " #core_code)
 
 /** Records a back-end's failure in *err (if err is not NULL): the code cast to sy_result (a value
- * sy_result does not know, a back-end's bug, becomes SY_ERR_BACKEND) and the printf-style message;
- * returns the sy_result. Call sites read `return sy_backend_fail(err, r, "raster: %s: %s", what,
- * sy_gl_device_error(dev));`. */
-sy_result sy_backend_fail(sy_error *err, int code, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
+ * sy_result does not know, a back-end's bug, becomes SY_ERR_BACKEND) and the message
+ * "MODULE: WHAT: MESSAGE" (module and what may be NULL: left out); returns the sy_result. Call
+ * sites read `return sy_backend_fail(err, r, "raster", "material", st->gl_msg);`, the message being
+ * what the device reported through its error callback. */
+sy_result sy_backend_fail(sy_error *err, int code, const char *module, const char *what, const char *message);
 
 /** Forwards a back-end's warning to sy_log (SY_LOG_WARNING) with module ("rt", "raster",
  * "filters"). Fits a back-end's log callback whose user pointer is the module name. */

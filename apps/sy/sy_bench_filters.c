@@ -39,7 +39,7 @@ static const char *const fb_names[FB_COUNT] = {"none", "pixel", "pixel-brute", "
 
 static sy_result fb_fail(sy_error *err, const sy_filter_report *fe, const char *what)
 {
-    return sy_backend_fail(err, (int)fe->code, "bench filters: %s: %s", what, fe->message);
+    return sy_backend_fail(err, (int)fe->code, "bench filters", what, fe->message);
 }
 
 /* one filter application; pixel filters: a forced pass of *keep (created on first use, as a

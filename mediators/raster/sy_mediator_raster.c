@@ -86,7 +86,7 @@ SY_BACKEND_SAME_CODE(SY_GL_ERROR_GL, SY_ERR_BACKEND);
  * reported through its error callback (gl_error). */
 static sy_result gl_fail(const raster_state *st, sy_error *err, sy_gl_result r, const char *what)
 {
-    return sy_backend_fail(err, (int)r, "raster: %s: %s", what, st->gl_msg);
+    return sy_backend_fail(err, (int)r, "raster", what, st->gl_msg);
 }
 
 /* The device's error callback: runs on the thread of the call in progress, the only one using the
@@ -706,7 +706,7 @@ static sy_result raster_create(const sy_mediator_create_args *args, void **state
                             .forward = !deferred};
     sy_gl_result gr = sy_gl_device_create(&dd, &st->dev);
     if (gr != SY_GL_OK) {
-        r = sy_backend_fail(err, (int)gr, "raster: %s", st->gl_msg);
+        r = sy_backend_fail(err, (int)gr, "raster", NULL, st->gl_msg);
         free(st);
         return r;
     }

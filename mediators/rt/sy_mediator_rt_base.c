@@ -87,7 +87,7 @@ SY_BACKEND_SAME_CODE(SY_RT_ERROR_SYSTEM, SY_ERR_SYSTEM);
 
 sy_result sy_rti_fail(const rt_state *st, sy_error *err, sy_rt_result r, const char *what)
 {
-    return sy_backend_fail(err, (int)r, "%s: %s", what, st->rt_msg);
+    return sy_backend_fail(err, (int)r, NULL, what, st->rt_msg);
 }
 
 static void rt_error(void *user, sy_rt_result code, const char *message)

@@ -21,7 +21,7 @@ SY_BACKEND_SAME_CODE(SY_FILTER_ERROR_OUT_OF_MEMORY, SY_ERR_OUT_OF_MEMORY);
 
 static sy_result filter_fail(sy_error *err, const sy_filter_report *fe)
 {
-    return sy_backend_fail(err, (int)fe->code, "pathtracer filter: %s", fe->message);
+    return sy_backend_fail(err, (int)fe->code, "pathtracer filter", NULL, fe->message);
 }
 
 void sy_rti_filter_cfg_default(pt_filter_cfg *c, uint32_t threads)

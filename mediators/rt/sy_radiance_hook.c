@@ -23,7 +23,7 @@ struct sy_radiance_hook {
 /* the codes agree (sy_mediator_rt_filter.c checks them with SY_BACKEND_SAME_CODE) */
 static sy_result hook_filter_fail(sy_error *err, const sy_filter_report *fe)
 {
-    return sy_backend_fail(err, (int)fe->code, "pathtracer radiance filter: %s", fe->message);
+    return sy_backend_fail(err, (int)fe->code, "pathtracer radiance filter", NULL, fe->message);
 }
 
 sy_result sy_radiance_hook_create(const sy_filter_radiance_params *p, sy_radiance_hook **out, sy_error *err)

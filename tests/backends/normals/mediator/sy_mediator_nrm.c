@@ -28,7 +28,7 @@ static void nrm_error(void *user, sy_nrm_result code, const char *message)
     snprintf(st->msg, sizeof st->msg, "%s", message);
 }
 
-static sy_result nrm_fail(const nrm_state *st, sy_error *err) { return sy_backend_fail(err, (int)st->code, "%s", st->msg); }
+static sy_result nrm_fail(const nrm_state *st, sy_error *err) { return sy_backend_fail(err, (int)st->code, NULL, NULL, st->msg); }
 
 static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
 {
