@@ -1,9 +1,12 @@
 /* test_gltf_samples.c — loads every glTF sample model of the shared test data and checks counts,
  * a few values read from the models' JSON, variant equality (glTF / glTF-Binary / glTF-Embedded
- * give deep-equal scenes) and the Cornell box. Usage: test_gltf_samples TESTDATA_DIR.
+ * give deep-equal scenes), quantized variants (glTF-Quantized: same triangles, world
+ * bounds within 1e-3 of the plain variant's diagonal) and the Cornell box.
+ * Usage: test_gltf_samples TESTDATA_DIR.
  * Exits 77 (skipped) when the test data is absent. */
 #include "../support/sy_check.h"
 #include "sy_gltf.h"
+#include "sy_graph.h"
 
 #include <dirent.h>
 #include <math.h>
@@ -227,6 +230,34 @@ static bool find_file(const char *dir, const char *suffix, char *out, size_t n)
     return found;
 }
 
+/* A compressed variant (KHR_mesh_quantization) against the plain one: it loads, has the same
+ * triangles and its world bounds agree within the quantization error (1e-3 of the diagonal; 16-bit
+ * quantization is well inside it). */
+static bool compare_compressed(const char *path, loaded *plain)
+{
+    loaded l = load(path);
+    EXPECT_MSG(l.r == SY_OK, "%s: %s", path, l.err.message);
+    bool ok = l.r == SY_OK;
+    if (ok) {
+        check_generic(path, &l);
+        const sy_gltf_counts *c = &l.info.counts, *p = &plain->info.counts;
+        EXPECT_MSG(c->triangles == p->triangles && c->primitives == p->primitives,
+                   "%s: %u triangles in %u primitives, plain %u in %u", path, c->triangles, c->primitives, p->triangles,
+                   p->primitives);
+        sy_bounds a = sy_scene_world_bounds(plain->scene), b = sy_scene_world_bounds(l.scene);
+        double diag = 0;
+        for (int k = 0; k < 3; k++) diag += (double)(a.max[k] - a.min[k]) * (a.max[k] - a.min[k]);
+        diag = sqrt(diag);
+        double worst = 0;
+        for (int k = 0; k < 3; k++) worst = fmax(worst, fmax(fabs(a.min[k] - b.min[k]), fabs(a.max[k] - b.max[k])));
+        EXPECT_MSG(!sy_bounds_is_empty(&a) && diag > 0 && worst <= 1e-3 * diag, "%s: bounds differ by %g (diagonal %g)",
+                   path, worst, diag);
+        printf("ok %-70s tris %7u bounds within %.3g of diagonal %.4g\n", path, l.info.counts.triangles, worst, diag);
+    }
+    unload(&l);
+    return ok;
+}
+
 static int cmp_str(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
 
 static void test_cornell(const char *root)
@@ -289,7 +320,7 @@ int main(int argc, char **argv)
     qsort(models, nmodels, sizeof(char *), cmp_str);
 
     long blobs_before = sy_blob_live_count();
-    unsigned files = 0, loaded_ok = 0, compared = 0;
+    unsigned files = 0, loaded_ok = 0, compared = 0, compressed_ok = 0;
     const char *variants[3][2] = {{"glTF", ".gltf"}, {"glTF-Binary", ".glb"}, {"glTF-Embedded", ".gltf"}};
     for (size_t m = 0; m < nmodels; m++) {
         loaded first;
@@ -331,12 +362,23 @@ int main(int argc, char **argv)
                 unload(&l);
             }
         }
+        const char *compressed[1] = {"glTF-Quantized"};
+        for (int v = 0; v < 1 && have_first; v++) {
+            char dir[1024], path[1100];
+            int w = snprintf(dir, sizeof dir, "%s/%s/%s", gdir, models[m], compressed[v]);
+            if (w < 0 || (size_t)w >= sizeof dir || !find_file(dir, ".gltf", path, sizeof path)) continue;
+            files++;
+            loaded_ok += compare_compressed(path, &first);
+            compressed_ok++;
+        }
         if (have_first) unload(&first);
         free(models[m]);
     }
     test_cornell(argv[1]);
     EXPECT_MSG(sy_blob_live_count() == blobs_before, "blob leak: %ld live, %ld before", sy_blob_live_count(), blobs_before);
     EXPECT_MSG(files >= 30, "only %u sample files found", files);
-    printf("%u sample files, %u loaded, %u variant comparisons\n", files, loaded_ok, compared);
+    EXPECT_MSG(compressed_ok >= 2, "only %u compressed variants found", compressed_ok);
+    printf("%u sample files, %u loaded, %u variant comparisons, %u compressed variants\n", files, loaded_ok, compared,
+           compressed_ok);
     return sy_check_finish("gltf_samples");
 }
