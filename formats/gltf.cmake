@@ -10,6 +10,7 @@ target_sources(sy_formats PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_meshes.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_nodes.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_shim.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_draco.cpp
 )
 # Debian's tinygltf exports TinyGLTF::TinyGLTF; accept the lower-case spelling too.
 if(TARGET TinyGLTF::tinygltf)
@@ -20,3 +21,6 @@ endif()
 # stb_image: the shim decodes images itself (dimension limit before allocation).
 pkg_check_modules(SY_STB REQUIRED IMPORTED_TARGET stb)
 target_link_libraries(sy_formats PRIVATE ${SY_TINYGLTF_TARGET} PkgConfig::SY_STB) # Debian builds stb as libstb
+# KHR_draco_mesh_compression: Debian's libdraco-dev (sy_gltf_draco.cpp, called by the shim).
+find_package(draco REQUIRED CONFIG)
+target_link_libraries(sy_formats PRIVATE draco::draco)

@@ -177,7 +177,7 @@ static sy_result load_common(const char *path, const void *mem, size_t mem_size,
     memcpy(base, mem ? base_dir : path, dlen);
     base[dlen] = '\0';
     sy_gltf_shim_limits lim = {L.opt.max_file_bytes, L.opt.max_image_pixels, L.opt.allowed_roots,
-                               L.opt.allowed_root_count, gltf_supported, L.budget.limit};
+                               L.opt.allowed_root_count, gltf_supported, L.budget.limit, L.budget.limit};
     r = sy_gltf_shim_parse(b, size, binary, base, &lim, &doc, &L.err);
     free(base);
     /* the document holds its own copy of every buffer: the file's bytes go before the scene's blobs

@@ -4,6 +4,7 @@
 #include "sy_gltf_shim.h"
 
 #include "sy_file.h"
+#include "sy_gltf_draco.h"
 #include "sy_sniff.h"
 
 #include <nlohmann/json.hpp>
@@ -333,6 +334,7 @@ struct sy_gltf_shim_impl {
     std::vector<sy_gltf_shim_channel> channels;
     std::vector<const char *> ext_required;
     std::string warnings;
+    std::vector<std::vector<uint8_t>> decoded; // buffers made by decoding compressed meshes
 };
 
 static void fill_doc(sy_gltf_shim_impl *d)
@@ -540,6 +542,124 @@ static void fill_doc(sy_gltf_shim_impl *d)
     c.internal = d;
 }
 
+// >>KHR_draco_mesh_compression: each Draco primitive is decoded (sy_gltf_draco.cpp) into a new
+// buffer with one bufferView per accessor; its accessors are pointed at them (float attributes,
+// uint32 indices), so the loader reads them as plain accessors. The outputs are sized from the
+// glTF's accessor counts, within max_mesh_bytes for all primitives together, before decoding.
+static const uint8_t *data_at(const sy_gltf_shim_impl *d, const sy_gltf_shim_view &v)
+{
+    return d->buffers[size_t(v.buffer)].data + v.byte_offset;
+}
+
+static sy_result draco_primitive(sy_gltf_shim_impl *d, size_t mi, size_t pj, const tinygltf::Value &ext,
+                                 std::vector<bool> *rewritten, uint64_t *bytes_used, uint64_t max_bytes, sy_error *err)
+{
+    sy_gltf_shim_primitive &pr = d->prims[mi][pj];
+    const int32_t view = integer(ext, "bufferView", -1);
+    if (view < 0 || size_t(view) >= d->views.size())
+        return sy_error_set(err, SY_ERR_PARSE, "bufferView %d out of range (%zu bufferViews)", (int)view, d->views.size());
+    const sy_gltf_shim_view v = d->views[size_t(view)];
+    if (v.buffer < 0 || size_t(v.buffer) >= d->buffers.size() || v.byte_offset > d->buffers[size_t(v.buffer)].size ||
+        v.byte_length > d->buffers[size_t(v.buffer)].size - v.byte_offset)
+        return sy_error_set(err, SY_ERR_PARSE, "bufferView %d lies outside its buffer", (int)view);
+    if (pr.mode != 4) return sy_error_set(err, SY_ERR_UNSUPPORTED, "mode %d (only triangles are read)", (int)pr.mode);
+    if (pr.indices < 0 || size_t(pr.indices) >= d->accessors.size())
+        return sy_error_set(err, SY_ERR_PARSE, "indices accessor %d out of range", (int)pr.indices);
+    const tinygltf::Value *attrs = member(ext, "attributes");
+    if (!attrs || !attrs->IsObject()) return sy_error_set(err, SY_ERR_PARSE, "no attributes object");
+    // the attributes the loader reads; others (JOINTS, WEIGHTS) stay without data
+    struct slot { const char *name; int32_t *acc; } slots[] = {{"POSITION", &pr.position}, {"NORMAL", &pr.normal},
+        {"TANGENT", &pr.tangent}, {"TEXCOORD_0", &pr.texcoord0}, {"TEXCOORD_1", &pr.texcoord1}, {"COLOR_0", &pr.color0}};
+    std::vector<sy_gltf_draco_attr> req_attrs;
+    std::vector<int32_t *> req_acc;
+    size_t vertices = 0;
+    uint64_t need = 0;
+    for (const slot &s : slots) {
+        if (*s.acc < 0 || !member(*attrs, s.name)) continue;
+        if (size_t(*s.acc) >= d->accessors.size())
+            return sy_error_set(err, SY_ERR_PARSE, "attribute %s: accessor %d out of range", s.name, (int)*s.acc);
+        const sy_gltf_shim_accessor &a = d->accessors[size_t(*s.acc)];
+        if (a.components < 1 || a.components > 4 || a.is_matrix)
+            return sy_error_set(err, SY_ERR_PARSE, "attribute %s: accessor type is not SCALAR or VEC2..4", s.name);
+        if (req_attrs.empty()) vertices = a.count;
+        if (a.count != vertices)
+            return sy_error_set(err, SY_ERR_PARSE, "attribute %s: accessor count %zu differs from %zu", s.name, a.count, vertices);
+        int32_t id = integer(*attrs, s.name, -1);
+        req_attrs.push_back({s.name, id, uint32_t(a.components), nullptr});
+        req_acc.push_back(s.acc);
+        need += uint64_t(a.count) * uint64_t(a.components) * 4u;
+    }
+    if (req_attrs.empty()) return sy_error_set(err, SY_ERR_PARSE, "no POSITION attribute in the extension");
+    const size_t indices = d->accessors[size_t(pr.indices)].count;
+    need += uint64_t(indices) * 4u;
+    if (vertices > UINT32_MAX || indices > (size_t(1) << 40) || (max_bytes && need > max_bytes - std::min(*bytes_used, max_bytes)))
+        return sy_error_set(err, SY_ERR_LIMIT, "%zu vertices and %zu indices (%llu MiB decoded) exceed what is left of the scene budget",
+                            vertices, indices, (unsigned long long)(need >> 20));
+    *bytes_used += need;
+    d->decoded.emplace_back(size_t(need));
+    std::vector<uint8_t> &out = d->decoded.back();
+    uint8_t *base = out.data();
+    size_t off = indices * 4;
+    for (sy_gltf_draco_attr &a : req_attrs) {
+        a.out = reinterpret_cast<float *>(base + off);
+        off += vertices * a.components * 4;
+    }
+    sy_gltf_draco_request req = {vertices, indices, reinterpret_cast<uint32_t *>(base), req_attrs.data(), req_attrs.size()};
+    sy_result r = sy_gltf_draco_decode(data_at(d, v), v.byte_length, &req, err);
+    if (r != SY_OK) return r;
+    // the new buffer, its views and the accessors that read them
+    const int32_t buffer = int32_t(d->buffers.size());
+    d->buffers.push_back({base, out.size()});
+    auto point = [&](int32_t *acc, size_t at, size_t len, int32_t ctype) {
+        sy_gltf_shim_accessor a = d->accessors[size_t(*acc)];
+        d->views.push_back({buffer, at, len, 0});
+        a.buffer_view = int32_t(d->views.size() - 1);
+        a.byte_offset = 0;
+        a.component_type = ctype;
+        a.normalized = 0;
+        a.sparse = 0;
+        if ((*rewritten)[size_t(*acc)]) { // shared with another Draco primitive: a copy for this one
+            d->accessors.push_back(a);
+            rewritten->push_back(true);
+            *acc = int32_t(d->accessors.size() - 1);
+        } else {
+            d->accessors[size_t(*acc)] = a;
+            (*rewritten)[size_t(*acc)] = true;
+        }
+    };
+    point(&pr.indices, 0, indices * 4, 5125);
+    off = indices * 4;
+    for (size_t k = 0; k < req_attrs.size(); k++) {
+        point(req_acc[k], off, vertices * req_attrs[k].components * 4, 5126);
+        off += vertices * req_attrs[k].components * 4;
+    }
+    return SY_OK;
+}
+
+// Decodes every compressed primitive (see above); on failure err names meshes[i].primitives[j].
+static sy_result decode_compressed(sy_gltf_shim_impl *d, const sy_gltf_shim_limits *limits, sy_error *err)
+{
+    const tinygltf::Model &m = d->model;
+    std::vector<bool> rewritten(d->accessors.size(), false);
+    uint64_t used = 0;
+    for (size_t mi = 0; mi < m.meshes.size(); mi++)
+        for (size_t pj = 0; pj < m.meshes[mi].primitives.size(); pj++) {
+            const tinygltf::Value *e = extension(m.meshes[mi].primitives[pj].extensions, "KHR_draco_mesh_compression");
+            if (!e) continue;
+            sy_result r = e->IsObject() ? draco_primitive(d, mi, pj, *e, &rewritten, &used, limits->max_mesh_bytes, err)
+                                        : sy_error_set(err, SY_ERR_PARSE, "not an object");
+            if (r != SY_OK) {
+                sy_error_prefix(err, "meshes[%zu].primitives[%zu]: KHR_draco_mesh_compression", mi, pj);
+                return r;
+            }
+        }
+    sy_gltf_doc &c = d->doc; // the vectors may have grown
+    c.buffers = d->buffers.data();     c.buffer_count = d->buffers.size();
+    c.views = d->views.data();         c.view_count = d->views.size();
+    c.accessors = d->accessors.data(); c.accessor_count = d->accessors.size();
+    return SY_OK;
+}
+
 // The document's JSON (a discarded value when it does not parse: tinygltf then says why). For GLB
 // the JSON chunk is read within the container the caller validated (header 12 bytes, chunk length
 // and type 8).
@@ -612,6 +732,61 @@ static std::string unsupported_required(const nlohmann::json &doc, const char *c
     return "";
 }
 
+// tinygltf 2.8 refuses a primitive whose indices accessor has no bufferView, which is how
+// KHR_draco_mesh_compression writes them (the indices are in the Draco data). Where a Draco
+// primitive's indices accessor has none, the copy in *out gives it the extension's bufferView as a
+// placeholder (decode_compressed replaces the accessor's view with the decoded indices); GLB
+// containers (validated by the caller) are rebuilt around the new JSON chunk. false: nothing to do.
+static bool patch_draco_indices(const uint8_t *bytes, size_t size, bool binary, std::vector<uint8_t> *out)
+{
+    nlohmann::json j = json_of(bytes, size, binary);
+    if (!j.is_object() || !j.contains("meshes") || !j["meshes"].is_array() || !j.contains("accessors") ||
+        !j["accessors"].is_array())
+        return false;
+    nlohmann::json &acc = j["accessors"];
+    bool changed = false;
+    for (nlohmann::json &mesh : j["meshes"]) {
+        if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+        for (nlohmann::json &p : mesh["primitives"]) {
+            if (!p.is_object() || !p.contains("indices") || !p["indices"].is_number_unsigned() || !p.contains("extensions"))
+                continue;
+            const nlohmann::json &ext = p["extensions"];
+            if (!ext.is_object() || !ext.contains("KHR_draco_mesh_compression")) continue;
+            const nlohmann::json &dr = ext["KHR_draco_mesh_compression"];
+            if (!dr.is_object() || !dr.contains("bufferView") || !dr["bufferView"].is_number_unsigned()) continue;
+            const uint64_t ai = p["indices"].get<uint64_t>();
+            if (ai >= acc.size() || !acc[size_t(ai)].is_object() || acc[size_t(ai)].contains("bufferView")) continue;
+            // an extension bufferView out of range is reported by draco_primitive, not by tinygltf
+            const bool in_range = j.contains("bufferViews") && j["bufferViews"].is_array() &&
+                                  dr["bufferView"].get<uint64_t>() < j["bufferViews"].size();
+            acc[size_t(ai)]["bufferView"] = in_range ? dr["bufferView"] : nlohmann::json(0);
+            changed = true;
+        }
+    }
+    if (!changed) return false;
+    std::string text = j.dump();
+    if (!binary) {
+        out->assign(text.begin(), text.end());
+        return true;
+    }
+    while (text.size() % 4) text.push_back(' ');
+    const uint32_t old_len = uint32_t(bytes[12]) | uint32_t(bytes[13]) << 8 | uint32_t(bytes[14]) << 16 | uint32_t(bytes[15]) << 24;
+    const size_t rest = size - 20 - old_len; // the chunks after the JSON chunk, as they were
+    const uint64_t total = 20 + uint64_t(text.size()) + rest;
+    if (total > UINT32_MAX) return false;
+    auto put32 = [out](size_t at, uint32_t v) {
+        for (int k = 0; k < 4; k++) (*out)[at + size_t(k)] = uint8_t(v >> (8 * k));
+    };
+    out->assign(size_t(total), 0);
+    memcpy(out->data(), bytes, 12);
+    put32(8, uint32_t(total));
+    put32(12, uint32_t(text.size()));
+    memcpy(out->data() + 16, bytes + 16, 4); // chunk type JSON
+    memcpy(out->data() + 20, text.data(), text.size());
+    if (rest) memcpy(out->data() + 20 + text.size(), bytes + 20 + old_len, rest);
+    return true;
+}
+
 // Runs tinygltf on the bytes with our file-system and image callbacks (confined, size-limited).
 // On success *model is filled and twarn holds tinygltf's warnings. C++ exceptions propagate to the
 // caller's catch blocks; tinygltf failures are classified into a sy_result with its message.
@@ -641,6 +816,11 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
         if (bad_index(json_of(bytes, size, binary), &where))
             return sy_error_set(err, SY_ERR_PARSE, "%s is not an index (an integer from 0 to 2^31 - 1)", where.c_str());
     }
+    std::vector<uint8_t> patched;
+    if (patch_draco_indices(bytes, size, binary, &patched)) {
+        bytes = patched.data();
+        size = patched.size();
+    }
     std::string terr;
     bool ok = binary ? loader.LoadBinaryFromMemory(model, &terr, twarn, bytes, unsigned(size), base)
                      : loader.LoadASCIIFromString(model, &terr, twarn, reinterpret_cast<const char *>(bytes),
@@ -658,11 +838,11 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
     else if (terr.find("exceeds the limit") != std::string::npos) code = SY_ERR_LIMIT;
     std::string msg = one_line(terr);
     if (msg.empty()) msg = "tinygltf failed without a message";
-    // an extension the file requires explains most failures of valid files (a Draco mesh's
-    // accessors have no buffer view): name it (sy_gltf_validate.c refuses the unsupported ones by name
-    // when the parse gets that far)
+    // an extension the file requires explains most failures of valid files (a meshopt mesh's
+    // buffer has no data): name it (sy_gltf_validate.c refuses the unsupported ones by name when the
+    // parse gets that far)
     for (const std::string &e : model->extensionsRequired)
-        if (e == "KHR_draco_mesh_compression" || e.rfind("EXT_meshopt", 0) == 0)
+        if (e.rfind("EXT_meshopt", 0) == 0)
             return sy_error_set(err, SY_ERR_UNSUPPORTED, "extensionsRequired: '%s' is not supported (%s)", e.c_str(),
                                 msg.c_str());
     return sy_error_set(err, code, "%s", msg.c_str());
@@ -687,6 +867,10 @@ extern "C" sy_result sy_gltf_shim_parse(const uint8_t *bytes, size_t size, bool 
         d->warnings = one_line(twarn);
         d->image_problems = std::move(ctx.image_problems);
         fill_doc(d);
+        if ((r = decode_compressed(d, limits, err)) != SY_OK) {
+            delete d;
+            return r;
+        }
         *out = &d->doc;
         return SY_OK;
     } catch (const std::bad_alloc &) {

@@ -16,7 +16,13 @@
  * sy_gltf_shim_free (NULL-safe). Every pointer inside (names, arrays, buffer bytes, pixels) is
  * borrowed from the document and valid until it is freed.
  * Thread-safety: no shared state; distinct documents may be parsed and read on distinct threads.
- * Exceptions never cross this interface (everything is caught and turned into a sy_result). */
+ * Exceptions never cross this interface (everything is caught and turned into a sy_result).
+ *
+ * Compressed meshes (KHR_draco_mesh_compression) are decoded here, after tinygltf's parse: their
+ * accessors are given bufferViews of new buffers holding the decoded floats (attributes) and uint32
+ * values (indices), so the caller reads them like any accessor. A stream that does not decode, or
+ * decodes to counts other than its accessors declare, fails the parse naming
+ * meshes[i].primitives[j]. */
 #ifndef SY_GLTF_SHIM_H
 #define SY_GLTF_SHIM_H
 
@@ -39,6 +45,9 @@ typedef struct sy_gltf_shim_limits {
     /* decoded bytes of all images together (the load's budget, sy_budget.h); an image that would
      * pass it is refused before decoding, like one over max_image_pixels; 0 = no limit */
     uint64_t max_image_bytes;
+    /* decoded bytes of all compressed meshes together (KHR_draco_mesh_compression), sized from the
+     * glTF's accessor counts before decoding; 0 = no limit */
+    uint64_t max_mesh_bytes;
 } sy_gltf_shim_limits;
 
 typedef struct sy_gltf_shim_buffer {
