@@ -11,6 +11,7 @@ target_sources(sy_formats PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_nodes.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_shim.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_draco.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_meshopt.c
 )
 # Debian's tinygltf exports TinyGLTF::TinyGLTF; accept the lower-case spelling too.
 if(TARGET TinyGLTF::tinygltf)
@@ -24,3 +25,6 @@ target_link_libraries(sy_formats PRIVATE ${SY_TINYGLTF_TARGET} PkgConfig::SY_STB
 # KHR_draco_mesh_compression: Debian's libdraco-dev (sy_gltf_draco.cpp, called by the shim).
 find_package(draco REQUIRED CONFIG)
 target_link_libraries(sy_formats PRIVATE draco::draco)
+# EXT_meshopt_compression: meshoptimizer's decoders (libmeshoptimizer-dev, sy_gltf_meshopt.c).
+find_package(meshoptimizer REQUIRED)
+target_link_libraries(sy_formats PRIVATE meshoptimizer::meshoptimizer)

@@ -21,7 +21,7 @@
  * images decoded by stb_image (PNG, JPEG, ...) into 8-bit RGB or RGBA (16-bit images are rounded,
  * grey images expanded to RGBA) with sampler wrap / filter; perspective and orthographic cameras;
  * KHR_lights_punctual; KHR_mesh_quantization; KHR_draco_mesh_compression (libdraco);
- * EXT_mesh_gpu_instancing. Animated nodes are placed at the first frame of animations[0] (first
+ * EXT_meshopt_compression (meshoptimizer); EXT_mesh_gpu_instancing. Animated nodes are placed at the first frame of animations[0] (first
  * keyframe value of each translation / rotation / scale channel); skinned meshes are shown in
  * their bind pose (skins ignored) and morph targets ignored (one warning each).
  *

@@ -5,6 +5,7 @@
 
 #include "sy_file.h"
 #include "sy_gltf_draco.h"
+#include "sy_gltf_meshopt.h"
 #include "sy_sniff.h"
 
 #include <nlohmann/json.hpp>
@@ -16,6 +17,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -636,12 +638,72 @@ static sy_result draco_primitive(sy_gltf_shim_impl *d, size_t mi, size_t pj, con
     return SY_OK;
 }
 
+// >>EXT_meshopt_compression: each compressed bufferView is decoded (sy_gltf_meshopt.c) into a new
+// buffer and the view points at it (offset 0, its own byteStride), within max_mesh_bytes.
+static sy_result meshopt_view(sy_gltf_shim_impl *d, size_t vi, const tinygltf::Value &ext, uint64_t *bytes_used,
+                              uint64_t max_bytes, sy_error *err)
+{
+    const int32_t buf = integer(ext, "buffer", -1);
+    const double off = number(ext, "byteOffset", 0), len = number(ext, "byteLength", -1);
+    const double stride = number(ext, "byteStride", -1), count = number(ext, "count", -1);
+    if (buf < 0 || size_t(buf) >= d->buffers.size())
+        return sy_error_set(err, SY_ERR_PARSE, "buffer %d out of range (%zu buffers)", (int)buf, d->buffers.size());
+    const size_t bsize = d->buffers[size_t(buf)].size;
+    if (!(off >= 0 && len >= 0 && off + len <= double(bsize)) || off != std::floor(off) || len != std::floor(len))
+        return sy_error_set(err, SY_ERR_PARSE, "byteOffset %g + byteLength %g exceeds buffer %d length %zu", off, len, (int)buf, bsize);
+    if (!(stride >= 1 && stride <= 256 && count >= 1 && count <= 4294967295.0) || stride != std::floor(stride) ||
+        count != std::floor(count))
+        return sy_error_set(err, SY_ERR_PARSE, "byteStride %g / count %g not valid", stride, count);
+    const tinygltf::Value *mv = member(ext, "mode"), *fv = member(ext, "filter");
+    const std::string mode = mv && mv->IsString() ? mv->Get<std::string>() : "";
+    const std::string filter = fv && fv->IsString() ? fv->Get<std::string>() : "NONE";
+    sy_gltf_meshopt_mode m = mode == "ATTRIBUTES" ? SY_MESHOPT_ATTRIBUTES : mode == "TRIANGLES" ? SY_MESHOPT_TRIANGLES
+                           : SY_MESHOPT_INDICES;
+    if (mode != "ATTRIBUTES" && mode != "TRIANGLES" && mode != "INDICES")
+        return sy_error_set(err, SY_ERR_PARSE, "mode '%s' is not ATTRIBUTES, TRIANGLES or INDICES", mode.c_str());
+    sy_gltf_meshopt_filter f = filter == "OCTAHEDRAL" ? SY_MESHOPT_OCTAHEDRAL : filter == "QUATERNION" ? SY_MESHOPT_QUATERNION
+                             : filter == "EXPONENTIAL" ? SY_MESHOPT_EXPONENTIAL : SY_MESHOPT_NONE;
+    if (f == SY_MESHOPT_NONE && filter != "NONE")
+        return sy_error_set(err, SY_ERR_PARSE, "filter '%s' is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL", filter.c_str());
+    const size_t n = d->views[vi].byte_length;
+    if (double(n) != stride * count)
+        return sy_error_set(err, SY_ERR_PARSE, "count %g * byteStride %g is not the bufferView's byteLength %zu", count, stride, n);
+    // meshoptimizer's codecs produce at most 64 bytes per byte read (a vertex block's byte column
+    // of 16-vertex groups: 2 header bits per 16 zero bytes; indices: at least a byte per triangle
+    // or index), so a count beyond that is refused before anything is allocated
+    if (double(n) > 64.0 * len)
+        return sy_error_set(err, SY_ERR_PARSE, "count %g * byteStride %g = %zu bytes cannot come from %g compressed bytes",
+                            count, stride, n, len);
+    if (max_bytes && n > max_bytes - std::min(*bytes_used, max_bytes))
+        return sy_error_set(err, SY_ERR_LIMIT, "%zu decoded bytes exceed what is left of the scene budget", n);
+    *bytes_used += n;
+    d->decoded.emplace_back(n);
+    std::vector<uint8_t> &out = d->decoded.back();
+    sy_result r = sy_gltf_meshopt_decode(d->buffers[size_t(buf)].data + size_t(off), size_t(len), size_t(count),
+                                         size_t(stride), m, f, out.data(), n, err);
+    if (r != SY_OK) return r;
+    d->buffers.push_back({out.data(), n});
+    d->views[vi].buffer = int32_t(d->buffers.size() - 1);
+    d->views[vi].byte_offset = 0;
+    return SY_OK;
+}
+
 // Decodes every compressed primitive (see above); on failure err names meshes[i].primitives[j].
 static sy_result decode_compressed(sy_gltf_shim_impl *d, const sy_gltf_shim_limits *limits, sy_error *err)
 {
     const tinygltf::Model &m = d->model;
     std::vector<bool> rewritten(d->accessors.size(), false);
     uint64_t used = 0;
+    for (size_t vi = 0; vi < m.bufferViews.size(); vi++) {
+        const tinygltf::Value *e = extension(m.bufferViews[vi].extensions, "EXT_meshopt_compression");
+        if (!e) continue;
+        sy_result r = e->IsObject() ? meshopt_view(d, vi, *e, &used, limits->max_mesh_bytes, err)
+                                    : sy_error_set(err, SY_ERR_PARSE, "not an object");
+        if (r != SY_OK) {
+            sy_error_prefix(err, "bufferViews[%zu]: EXT_meshopt_compression", vi);
+            return r;
+        }
+    }
     for (size_t mi = 0; mi < m.meshes.size(); mi++)
         for (size_t pj = 0; pj < m.meshes[mi].primitives.size(); pj++) {
             const tinygltf::Value *e = extension(m.meshes[mi].primitives[pj].extensions, "KHR_draco_mesh_compression");
@@ -732,12 +794,12 @@ static std::string unsupported_required(const nlohmann::json &doc, const char *c
     return "";
 }
 
-// tinygltf 2.8 refuses a primitive whose indices accessor has no bufferView, which is how
-// KHR_draco_mesh_compression writes them (the indices are in the Draco data). Where a Draco
+// What tinygltf 2.8 refuses in valid compressed files, patched in a copy of the JSON: a primitive
+// whose indices accessor has no bufferView, which is how KHR_draco_mesh_compression writes them (the indices are in the Draco data). Where a Draco
 // primitive's indices accessor has none, the copy in *out gives it the extension's bufferView as a
 // placeholder (decode_compressed replaces the accessor's view with the decoded indices); GLB
 // containers (validated by the caller) are rebuilt around the new JSON chunk. false: nothing to do.
-static bool patch_draco_indices(const uint8_t *bytes, size_t size, bool binary, std::vector<uint8_t> *out)
+static bool patch_for_tinygltf(const uint8_t *bytes, size_t size, bool binary, std::vector<uint8_t> *out)
 {
     nlohmann::json j = json_of(bytes, size, binary);
     if (!j.is_object() || !j.contains("meshes") || !j["meshes"].is_array() || !j.contains("accessors") ||
@@ -760,6 +822,21 @@ static bool patch_draco_indices(const uint8_t *bytes, size_t size, bool binary, 
             const bool in_range = j.contains("bufferViews") && j["bufferViews"].is_array() &&
                                   dr["bufferView"].get<uint64_t>() < j["bufferViews"].size();
             acc[size_t(ai)]["bufferView"] = in_range ? dr["bufferView"] : nlohmann::json(0);
+            changed = true;
+        }
+    }
+    // EXT_meshopt_compression: a fallback buffer may have no data (no uri, not the GLB chunk), which
+    // tinygltf refuses; it gets a 1-byte data: URI (the compressed views that name it are replaced by
+    // their decoded data; any other view that names it fails validation as out of range)
+    if (j.contains("buffers") && j["buffers"].is_array()) {
+        nlohmann::json &bufs = j["buffers"];
+        for (size_t i = 0; i < bufs.size(); i++) {
+            nlohmann::json &b = bufs[i];
+            if (!b.is_object() || b.contains("uri") || (binary && i == 0) || !b.contains("extensions")) continue;
+            const nlohmann::json &ext = b["extensions"];
+            if (!ext.is_object() || !ext.contains("EXT_meshopt_compression")) continue;
+            b["uri"] = "data:application/octet-stream;base64,AA==";
+            b["byteLength"] = 1;
             changed = true;
         }
     }
@@ -817,7 +894,7 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
             return sy_error_set(err, SY_ERR_PARSE, "%s is not an index (an integer from 0 to 2^31 - 1)", where.c_str());
     }
     std::vector<uint8_t> patched;
-    if (patch_draco_indices(bytes, size, binary, &patched)) {
+    if (patch_for_tinygltf(bytes, size, binary, &patched)) {
         bytes = patched.data();
         size = patched.size();
     }

@@ -22,7 +22,8 @@
  * accessors are given bufferViews of new buffers holding the decoded floats (attributes) and uint32
  * values (indices), so the caller reads them like any accessor. A stream that does not decode, or
  * decodes to counts other than its accessors declare, fails the parse naming
- * meshes[i].primitives[j]. */
+ * meshes[i].primitives[j]. EXT_meshopt_compression bufferViews are decoded likewise into new
+ * buffers the views point at (failures name bufferViews[i]). */
 #ifndef SY_GLTF_SHIM_H
 #define SY_GLTF_SHIM_H
 
@@ -45,8 +46,9 @@ typedef struct sy_gltf_shim_limits {
     /* decoded bytes of all images together (the load's budget, sy_budget.h); an image that would
      * pass it is refused before decoding, like one over max_image_pixels; 0 = no limit */
     uint64_t max_image_bytes;
-    /* decoded bytes of all compressed meshes together (KHR_draco_mesh_compression), sized from the
-     * glTF's accessor counts before decoding; 0 = no limit */
+    /* decoded bytes of all compressed meshes together (KHR_draco_mesh_compression, sized from the
+     * glTF's accessor counts; EXT_meshopt_compression, from the views' lengths) before decoding;
+     * 0 = no limit */
     uint64_t max_mesh_bytes;
 } sy_gltf_shim_limits;
 

@@ -20,7 +20,8 @@
 const char *const gltf_supported[] = {
     "KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
     "KHR_materials_unlit", "KHR_texture_transform", "KHR_lights_punctual",
-    "KHR_mesh_quantization", "EXT_mesh_gpu_instancing", "KHR_draco_mesh_compression", NULL,
+    "KHR_mesh_quantization", "EXT_mesh_gpu_instancing", "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression", NULL,
 };
 
 /* >>container --------------------------------------------------------------------------------- */
@@ -305,7 +306,8 @@ sy_result gltf_validate_doc(loader *L)
             return gltf_fail(L, SY_ERR_UNSUPPORTED,
                              "extensionsRequired: '%s' is not supported (supported: KHR_materials_emissive_strength, "
                              "KHR_materials_transmission, KHR_materials_ior, KHR_materials_unlit, KHR_texture_transform, "
-                             "KHR_lights_punctual, KHR_mesh_quantization, EXT_mesh_gpu_instancing, KHR_draco_mesh_compression)", e);
+                             "KHR_lights_punctual, KHR_mesh_quantization, EXT_mesh_gpu_instancing, KHR_draco_mesh_compression, "
+                             "EXT_meshopt_compression)", e);
     }
     if ((r = validate_views(L))) return r;
     for (size_t i = 0; i < d->accessor_count; i++)
