@@ -5,7 +5,7 @@ SY_PACKAGES="cmake ninja-build gcc g++ pkg-config libembree-dev libtinygltf-dev 
  libglfw3-dev libgl-dev xvfb xauth libosmesa6-dev libegl-dev
  libnng-dev libsodium-dev libzstd-dev iproute2 libfreetype-dev fonts-dejavu-core
  libopenmpi-dev openmpi-bin libimath-dev libcjson-dev doxygen libmeshoptimizer-dev
- libwebsockets-dev libturbojpeg0-dev libassimp-dev assimp-utils assimp-testmodels libdraco-dev
+ libwebsockets-dev libturbojpeg0-dev libassimp-dev assimp-utils assimp-testmodels libdraco-dev libwebp-dev
  chromium nodejs"
 # npm (three.js for sy web's client page, playwright-core for the browser tests) comes with Node.js
 # from nodesource; Debian's own nodejs needs the npm package beside it.

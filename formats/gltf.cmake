@@ -28,3 +28,7 @@ target_link_libraries(sy_formats PRIVATE draco::draco)
 # EXT_meshopt_compression: meshoptimizer's decoders (libmeshoptimizer-dev, sy_gltf_meshopt.c).
 find_package(meshoptimizer REQUIRED)
 target_link_libraries(sy_formats PRIVATE meshoptimizer::meshoptimizer)
+# EXT_texture_webp: Debian's libwebp-dev (WebPGetInfo, then WebPDecodeRGBAInto in the shim's image callback).
+pkg_check_modules(SY_WEBP REQUIRED IMPORTED_TARGET libwebp)
+target_link_libraries(sy_formats PRIVATE PkgConfig::SY_WEBP)
+list(APPEND sy_formats_pkg "SY_WEBP|libwebp")

@@ -18,12 +18,14 @@
  * TEXCOORD_0/1, COLOR_0 of any glTF component type (normalized integers scaled) including sparse
  * accessors; glTF metallic-roughness materials with KHR_materials_emissive_strength,
  * KHR_materials_transmission, KHR_materials_ior, KHR_materials_unlit, KHR_texture_transform;
- * images decoded by stb_image (PNG, JPEG, ...) into 8-bit RGB or RGBA (16-bit images are rounded,
- * grey images expanded to RGBA) with sampler wrap / filter; perspective and orthographic cameras;
- * KHR_lights_punctual; KHR_mesh_quantization; KHR_draco_mesh_compression (libdraco);
- * EXT_meshopt_compression (meshoptimizer); EXT_mesh_gpu_instancing. Animated nodes are placed at the first frame of animations[0] (first
- * keyframe value of each translation / rotation / scale channel); skinned meshes are shown in
- * their bind pose (skins ignored) and morph targets ignored (one warning each).
+ * PNG and JPEG images decoded by stb_image into 8-bit RGB or RGBA (16-bit images are rounded, grey
+ * images expanded to RGBA), WebP images of EXT_texture_webp by libwebp into RGBA, with sampler
+ * wrap / filter; perspective and orthographic cameras; KHR_lights_punctual; KHR_mesh_quantization;
+ * KHR_draco_mesh_compression (libdraco); EXT_meshopt_compression (meshoptimizer);
+ * EXT_mesh_gpu_instancing. KHR_texture_basisu is refused when required (no packaged decoder).
+ * Animated nodes are placed at the first frame of animations[0] (first keyframe value of each
+ * translation / rotation / scale channel); skinned meshes are shown in their bind pose (skins
+ * ignored) and morph targets ignored (one warning each).
  *
  * Untrusted input: the whole document is validated (indices, accessor / bufferView / buffer ranges
  * with checked arithmetic, GLB container, index values, node graph must be a forest, limits,

@@ -12,6 +12,7 @@
 #include <tiny_gltf.h>
 
 #include <stb_image.h>
+#include <webp/decode.h>
 
 #include <sys/stat.h>
 
@@ -22,6 +23,7 @@
 #include <cstring>
 #include <new>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -41,6 +43,7 @@ struct LoadContext {
     sy_result fs_result = SY_OK;   // first file-system failure category
     std::string fs_message;
     std::map<int, std::string> image_problems; // images that failed to decode (local: missing texture)
+    std::set<int> webp_images;     // images an EXT_texture_webp source names (the only WebP decoded)
 };
 
 // >>file-system callbacks: files confined to the glTF's folder (sy_path_confine: after symbolic
@@ -148,14 +151,18 @@ bool load_image(tinygltf::Image *image, const int image_idx, std::string *err, s
         return false;
     }
     const sy_file_format kind = sy_sniff_bytes(bytes, len);
-    if (!sy_file_format_is_texture_image(kind, false)) { // stb_image would take HDR, PSD, TGA... too
-        ctx->image_problems[image_idx] = std::string(sy_file_format_name(kind)) + " content, not a PNG or JPEG image";
+    // WebP only where EXT_texture_webp references the image (libwebp decodes it; stb_image never sees it)
+    const bool webp = kind == SY_FORMAT_WEBP && ctx->webp_images.count(image_idx) != 0;
+    if (!webp && !sy_file_format_is_texture_image(kind, false)) { // stb_image would take HDR, PSD, TGA... too
+        ctx->image_problems[image_idx] = std::string(sy_file_format_name(kind)) +
+                                         (kind == SY_FORMAT_WEBP ? " content outside EXT_texture_webp" : " content, not a PNG or JPEG image");
         image->image.clear();
         return true;
     }
-    int w = 0, h = 0, comp = 0;
-    if (!stbi_info_from_memory(bytes, int(len), &w, &h, &comp) || w < 1 || h < 1 || comp < 1 || comp > 4) {
-        const char *why = stbi_failure_reason();
+    int w = 0, h = 0, comp = 4;
+    if (webp ? !WebPGetInfo(bytes, len, &w, &h) || w < 1 || h < 1
+             : !stbi_info_from_memory(bytes, int(len), &w, &h, &comp) || w < 1 || h < 1 || comp < 1 || comp > 4) {
+        const char *why = webp ? "not a decodable WebP image" : stbi_failure_reason();
         ctx->image_problems[image_idx] = "cannot decode image (" + std::string(why ? why : "unknown format") + ")";
         image->image.clear();
         return true; // a bad image is local: the texture goes missing with a warning
@@ -177,11 +184,13 @@ bool load_image(tinygltf::Image *image, const int image_idx, std::string *err, s
     }
     ctx->image_bytes += n;
     int w2 = 0, h2 = 0, c2 = 0;
-    bool is16 = stbi_is_16_bit_from_memory(bytes, int(len)) != 0;
+    bool is16 = !webp && stbi_is_16_bit_from_memory(bytes, int(len)) != 0;
     image->image.resize(n);
     // decode (16-bit sources are rounded to 8 bits); a size that differs from the header is a failure
     bool ok = false;
-    if (is16) {
+    if (webp) {
+        ok = WebPDecodeRGBAInto(bytes, len, image->image.data(), n, w * 4) != nullptr;
+    } else if (is16) {
         stbi_us *p = stbi_load_16_from_memory(bytes, int(len), &w2, &h2, &c2, req);
         ok = p && w2 == w && h2 == h;
         if (ok)
@@ -195,7 +204,7 @@ bool load_image(tinygltf::Image *image, const int image_idx, std::string *err, s
     }
     if (!ok) {
         image->image.clear();
-        const char *why = stbi_failure_reason();
+        const char *why = webp ? "WebP data does not decode" : stbi_failure_reason();
         ctx->image_problems[image_idx] = "cannot decode image (" + std::string(why ? why : "unknown") + ")";
         return true;
     }
@@ -421,7 +430,10 @@ static void fill_doc(sy_gltf_shim_impl *d)
         c.unlit = extension(mat.extensions, "KHR_materials_unlit") != nullptr;
         d->materials.push_back(c);
     }
-    for (const tinygltf::Texture &t : m.textures) d->textures.push_back({t.name.c_str(), t.source, t.sampler});
+    for (const tinygltf::Texture &t : m.textures) { // EXT_texture_webp's source before the fallback
+        const tinygltf::Value *w = extension(t.extensions, "EXT_texture_webp");
+        d->textures.push_back({t.name.c_str(), w ? integer(*w, "source", -1) : t.source, t.sampler});
+    }
     for (const tinygltf::Sampler &s : m.samplers) d->samplers.push_back({s.minFilter, s.magFilter, s.wrapS, s.wrapT});
     for (const tinygltf::Image &im : m.images) {
         sy_gltf_shim_image c = {};
@@ -794,20 +806,20 @@ static std::string unsupported_required(const nlohmann::json &doc, const char *c
     return "";
 }
 
-// What tinygltf 2.8 refuses in valid compressed files, patched in a copy of the JSON: a primitive
-// whose indices accessor has no bufferView, which is how KHR_draco_mesh_compression writes them (the indices are in the Draco data). Where a Draco
-// primitive's indices accessor has none, the copy in *out gives it the extension's bufferView as a
-// placeholder (decode_compressed replaces the accessor's view with the decoded indices); GLB
-// containers (validated by the caller) are rebuilt around the new JSON chunk. false: nothing to do.
+// What tinygltf 2.8 refuses in valid files with these extensions, patched in a copy of the JSON (GLB
+// containers, validated by the caller, rebuilt around the new JSON chunk; false: nothing to do). A
+// primitive whose indices accessor has no bufferView, which is how KHR_draco_mesh_compression writes
+// them (the indices are in the Draco data): the accessor gets the extension's bufferView as a
+// placeholder (decode_compressed replaces the accessor's view with the decoded indices).
 static bool patch_for_tinygltf(const uint8_t *bytes, size_t size, bool binary, std::vector<uint8_t> *out)
 {
     nlohmann::json j = json_of(bytes, size, binary);
-    if (!j.is_object() || !j.contains("meshes") || !j["meshes"].is_array() || !j.contains("accessors") ||
-        !j["accessors"].is_array())
-        return false;
-    nlohmann::json &acc = j["accessors"];
+    if (!j.is_object()) return false;
     bool changed = false;
-    for (nlohmann::json &mesh : j["meshes"]) {
+    nlohmann::json no_meshes = nlohmann::json::array(), no_accessors = nlohmann::json::array();
+    const bool lists = j.contains("meshes") && j["meshes"].is_array() && j.contains("accessors") && j["accessors"].is_array();
+    nlohmann::json &acc = lists ? j["accessors"] : no_accessors;
+    for (nlohmann::json &mesh : lists ? j["meshes"] : no_meshes) {
         if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
         for (nlohmann::json &p : mesh["primitives"]) {
             if (!p.is_object() || !p.contains("indices") || !p["indices"].is_number_unsigned() || !p.contains("extensions"))
@@ -840,6 +852,16 @@ static bool patch_for_tinygltf(const uint8_t *bytes, size_t size, bool binary, s
             changed = true;
         }
     }
+    // EXT_texture_webp: tinygltf does not take data:image/webp URIs as data URIs
+    if (j.contains("images") && j["images"].is_array())
+        for (nlohmann::json &im : j["images"]) {
+            static const std::string webp = "data:image/webp;base64,";
+            if (!im.is_object() || !im.contains("uri") || !im["uri"].is_string()) continue;
+            const std::string &u = im["uri"].get_ref<const std::string &>();
+            if (u.compare(0, webp.size(), webp) != 0) continue;
+            im["uri"] = "data:application/octet-stream;base64," + u.substr(webp.size());
+            changed = true;
+        }
     if (!changed) return false;
     std::string text = j.dump();
     if (!binary) {
@@ -892,6 +914,18 @@ static sy_result run_tinygltf(const uint8_t *bytes, size_t size, bool binary, co
         std::string where;
         if (bad_index(json_of(bytes, size, binary), &where))
             return sy_error_set(err, SY_ERR_PARSE, "%s is not an index (an integer from 0 to 2^31 - 1)", where.c_str());
+    }
+    { // the images EXT_texture_webp sources name: the image callback decodes WebP for those only
+        nlohmann::json j = json_of(bytes, size, binary);
+        if (j.is_object() && j.contains("textures") && j["textures"].is_array())
+            for (const nlohmann::json &t : j["textures"]) {
+                const nlohmann::json *e = t.is_object() && t.contains("extensions") ? &t["extensions"] : nullptr;
+                if (!e || !e->is_object() || !e->contains("EXT_texture_webp")) continue;
+                const nlohmann::json &w = (*e)["EXT_texture_webp"];
+                if (w.is_object() && w.contains("source") && w["source"].is_number_unsigned() &&
+                    w["source"].get<uint64_t>() <= uint64_t(INT32_MAX))
+                    ctx->webp_images.insert(int(w["source"].get<uint64_t>()));
+            }
     }
     std::vector<uint8_t> patched;
     if (patch_for_tinygltf(bytes, size, binary, &patched)) {

@@ -21,7 +21,7 @@ const char *const gltf_supported[] = {
     "KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
     "KHR_materials_unlit", "KHR_texture_transform", "KHR_lights_punctual",
     "KHR_mesh_quantization", "EXT_mesh_gpu_instancing", "KHR_draco_mesh_compression",
-    "EXT_meshopt_compression", NULL,
+    "EXT_meshopt_compression", "EXT_texture_webp", NULL,
 };
 
 /* >>container --------------------------------------------------------------------------------- */
@@ -302,12 +302,16 @@ sy_result gltf_validate_doc(loader *L)
         const char *e = d->extensions_required[i];
         bool ok = false;
         for (size_t k = 0; gltf_supported[k]; k++) ok = ok || strcmp(e, gltf_supported[k]) == 0;
+        if (!ok && !strcmp(e, "KHR_texture_basisu"))
+            return gltf_fail(L, SY_ERR_UNSUPPORTED,
+                             "extensionsRequired: 'KHR_texture_basisu' is not supported: no Debian package decodes "
+                             "Basis Universal (KTX2) textures; a file that only uses it loads its PNG / JPEG fallbacks");
         if (!ok)
             return gltf_fail(L, SY_ERR_UNSUPPORTED,
                              "extensionsRequired: '%s' is not supported (supported: KHR_materials_emissive_strength, "
                              "KHR_materials_transmission, KHR_materials_ior, KHR_materials_unlit, KHR_texture_transform, "
                              "KHR_lights_punctual, KHR_mesh_quantization, EXT_mesh_gpu_instancing, KHR_draco_mesh_compression, "
-                             "EXT_meshopt_compression)", e);
+                             "EXT_meshopt_compression, EXT_texture_webp)", e);
     }
     if ((r = validate_views(L))) return r;
     for (size_t i = 0; i < d->accessor_count; i++)

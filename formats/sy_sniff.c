@@ -77,6 +77,7 @@ sy_file_format sy_sniff_bytes_sized(const void *data, size_t n, uint64_t file_si
     if (starts(p, n, "\x89PNG\r\n\x1a\n")) return SY_FORMAT_PNG;
     if (n >= 3 && p[0] == 0xff && p[1] == 0xd8 && p[2] == 0xff) return SY_FORMAT_JPEG;
     if (starts(p, n, "GIF87a") || starts(p, n, "GIF89a")) return SY_FORMAT_GIF;
+    if (n >= 12 && starts(p, n, "RIFF") && !memcmp(p + 8, "WEBP", 4)) return SY_FORMAT_WEBP;
     if (starts(p, n, "#?RADIANCE") || starts(p, n, "#?RGBE")) return SY_FORMAT_RADIANCE;
     if (starts(p, n, "Kaydara FBX Binary")) return SY_FORMAT_FBX;
     if (starts(p, n, "ply\n") || starts(p, n, "ply\r")) return SY_FORMAT_PLY;
@@ -141,6 +142,7 @@ const char *sy_file_format_name(sy_file_format f)
     case SY_FORMAT_PNG: return "PNG image";
     case SY_FORMAT_JPEG: return "JPEG image";
     case SY_FORMAT_GIF: return "GIF image";
+    case SY_FORMAT_WEBP: return "WebP image";
     case SY_FORMAT_RADIANCE: return "Radiance HDR image";
     case SY_FORMAT_3MF: return "3MF";
     case SY_FORMAT_3DS: return "3DS";

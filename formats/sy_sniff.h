@@ -35,6 +35,7 @@ typedef enum sy_file_format {
     SY_FORMAT_3MF,    /**< 3D Manufacturing Format (a zip holding 3D/3dmodel.model) */
     SY_FORMAT_3DS,    /**< Autodesk 3DS (main chunk 0x4D4D whose length fits the file) */
     SY_FORMAT_GLTF1,  /**< glTF 1.0 JSON ("version": "1.0" in its asset), or binary glTF 1 */
+    SY_FORMAT_WEBP,   /**< WebP image ("RIFF" size "WEBP"); decoded only for glTF's EXT_texture_webp */
 } sy_file_format;
 
 /** Classifies the first n bytes of a file (a few hundred are enough; the whole file for the

@@ -44,12 +44,14 @@ int main(void)
         {"GIF89a\x01\x00", SY_FORMAT_GIF},
         {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n", SY_FORMAT_RADIANCE},
         {"#?RGBE\n", SY_FORMAT_RADIANCE},
+        {"RIFF\x1a\x01\x02\x03WEBPVP8L", SY_FORMAT_WEBP},
         /* look-alikes */
         {"hello world\n", SY_FORMAT_UNKNOWN},
         {"<?xml version=\"1.0\"?><svg/>", SY_FORMAT_UNKNOWN},
         {"very nice\n", SY_FORMAT_UNKNOWN},
         {"v\n", SY_FORMAT_UNKNOWN},
         {"solid but no facets", SY_FORMAT_UNKNOWN},
+        {"RIFF\x1a\x01\x02\x03WAVEfmt ", SY_FORMAT_UNKNOWN},
         {"", SY_FORMAT_UNKNOWN},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
@@ -59,8 +61,9 @@ int main(void)
     EXPECT_MSG(!strcmp(sy_file_format_name(SY_FORMAT_OBJ), "Wavefront OBJ"), "OBJ's name");
     EXPECT_MSG(sy_file_format_is_texture_image(SY_FORMAT_PNG, false) && sy_file_format_is_texture_image(SY_FORMAT_JPEG, false) &&
                    !sy_file_format_is_texture_image(SY_FORMAT_GIF, false) && sy_file_format_is_texture_image(SY_FORMAT_GIF, true) &&
-                   !sy_file_format_is_texture_image(SY_FORMAT_RADIANCE, true) && !sy_file_format_is_texture_image(SY_FORMAT_UNKNOWN, true),
-               "texture image formats: PNG, JPEG (and GIF for X3D), nothing else");
+                   !sy_file_format_is_texture_image(SY_FORMAT_RADIANCE, true) && !sy_file_format_is_texture_image(SY_FORMAT_UNKNOWN, true) &&
+                   !sy_file_format_is_texture_image(SY_FORMAT_WEBP, true),
+               "texture image formats: PNG, JPEG (and GIF for X3D), nothing else (WebP: only glTF's EXT_texture_webp)");
     EXPECT_MSG(sy_file_format_is_scene(SY_FORMAT_GLB) && sy_file_format_is_scene(SY_FORMAT_OBJ) &&
                    !sy_file_format_is_scene(SY_FORMAT_VRML) && !sy_file_format_is_scene(SY_FORMAT_PNG),
                "scene formats");

@@ -269,8 +269,8 @@ static void test_bad_json(void)
                   SY_ERR_PARSE, "nodes[0] is listed twice as a root");
     bad_json_case("root_not_root", DOC(BUF, VIEWS, ACCS, MESHES, MATS, "\"nodes\":[{\"children\":[1]},{\"mesh\":0}]", "\"scenes\":[{\"nodes\":[0,1]}]", ""),
                   SY_ERR_PARSE, "nodes[1] is not a root node");
-    bad_json_case("ext_required", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, SCENES, ",\"extensionsRequired\":[\"KHR_texture_basisu\"]"),
-                  SY_ERR_UNSUPPORTED, "'KHR_texture_basisu' is not supported");
+    bad_json_case("ext_required", DOC(BUF, VIEWS, ACCS, MESHES, MATS, NODES, SCENES, ",\"extensionsRequired\":[\"EXT_lights_image_based\"]"),
+                  SY_ERR_UNSUPPORTED, "'EXT_lights_image_based' is not supported");
     bad_json_case("deep_json", "{\"asset\":{\"version\":\"2.0\"},\"extras\":[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]}",
                   SY_ERR_LIMIT, "JSON nesting deeper than 64");
     bad_json_case("sparse_index", DOC(BUF, VIEWS, "\"accessors\":[{\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"sparse\":{\"count\":1,\"indices\":{\"bufferView\":0,\"byteOffset\":15,\"componentType\":5121},\"values\":{\"bufferView\":0}}}," ACC_IDX "]", MESHES, MATS, NODES, SCENES, ""),
