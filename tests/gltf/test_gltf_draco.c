@@ -8,6 +8,7 @@
  * rebuilds the GLB around its placeholder-patched JSON) as the same scene.
  * Usage: test_gltf_draco TESTDATA_DIR (the Box cases are skipped when the sample is absent). */
 #include "../support/sy_check.h"
+#include "sy_file.h"
 #include "sy_gltf.h"
 #include "sy_graph.h"
 
@@ -28,22 +29,11 @@ static const uint8_t k_quad_drc[] = {
     0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x80, 0x3f, 0x0e
 };
 
+/* The whole file (NUL-terminated) through the library's reader; NULL when it cannot be read. */
 static char *read_all(const char *path, size_t *n)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)len + 1);
-    if (!b || fread(b, 1, (size_t)len, f) != (size_t)len) {
-        fprintf(stderr, "cannot read %s\n", path);
-        exit(1);
-    }
-    fclose(f);
-    b[len] = '\0';
-    *n = (size_t)len;
-    return b;
+    void *data = NULL;
+    return sy_file_read_all(path, (size_t)1 << 30, &data, n, NULL) == SY_OK ? data : NULL;
 }
 
 static void write_all(const char *path, const void *data, size_t n)

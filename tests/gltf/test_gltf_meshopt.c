@@ -9,6 +9,7 @@
  * mode: each a clear error naming the file and bufferViews[i], no crash.
  * Usage: test_gltf_meshopt TESTDATA_DIR (exit 77 when the samples are absent). */
 #include "../support/sy_check.h"
+#include "sy_file.h"
 #include "sy_gltf.h"
 #include "sy_graph.h"
 
@@ -25,19 +26,11 @@ static char g_dir[256];
  * kept) or INDICES (meshopt_encodeIndexSequence: the exact order) */
 static bool g_triangles;
 
+/* The whole file (NUL-terminated) through the library's reader; NULL when it cannot be read. */
 static uint8_t *read_all(const char *path, size_t *n)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    uint8_t *b = malloc((size_t)len + 1);
-    if (!b || fread(b, 1, (size_t)len, f) != (size_t)len) exit(1);
-    fclose(f);
-    b[len] = 0;
-    *n = (size_t)len;
-    return b;
+    void *data = NULL;
+    return sy_file_read_all(path, (size_t)1 << 30, &data, n, NULL) == SY_OK ? data : NULL;
 }
 
 static void write_all(const char *path, const void *data, size_t n)
