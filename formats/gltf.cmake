@@ -23,8 +23,14 @@ endif()
 pkg_check_modules(SY_STB REQUIRED IMPORTED_TARGET stb)
 target_link_libraries(sy_formats PRIVATE ${SY_TINYGLTF_TARGET} PkgConfig::SY_STB) # Debian builds stb as libstb
 # KHR_draco_mesh_compression: Debian's libdraco-dev (sy_gltf_draco.cpp, called by the shim).
-find_package(draco REQUIRED CONFIG)
-target_link_libraries(sy_formats PRIVATE draco::draco)
+# Debian's libdraco.so carries and exports its own tinygltf (351 tinygltf:: symbols, built with
+# other options): it must come after libtinygltf in every link line, or tinygltf's calls bind to
+# draco's copy and crash (free(): invalid pointer in ~TinyGLTF, seen in the pkg-config consumer of
+# install_consumer). Linked here after TinyGLTF, and for pkg-config as a Requires.private module
+# listed after tinygltf (sy_formats_pkg), never in Libs.private ahead of it.
+pkg_check_modules(SY_DRACO REQUIRED IMPORTED_TARGET draco)
+target_link_libraries(sy_formats PRIVATE PkgConfig::SY_DRACO)
+list(APPEND sy_formats_pkg "SY_DRACO|draco")
 # EXT_meshopt_compression: meshoptimizer's decoders (libmeshoptimizer-dev, sy_gltf_meshopt.c).
 find_package(meshoptimizer REQUIRED)
 target_link_libraries(sy_formats PRIVATE meshoptimizer::meshoptimizer)
