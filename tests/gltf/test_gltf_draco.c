@@ -18,6 +18,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "gltf_files.h"
+
 static char g_dir[256];
 
 /* Two triangles (0,0,0) (1,0,0) (0,1,0) and (1,0,0) (1,1,0) (0,1,0), 4 points, POSITION id 0. */
@@ -28,23 +30,6 @@ static const uint8_t k_quad_drc[] = {
     0x4a, 0x04, 0x00, 0x00, 0x00, 0x00, 0xff, 0x3f, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
     0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x80, 0x3f, 0x0e
 };
-
-/* The whole file (NUL-terminated) through the library's reader; NULL when it cannot be read. */
-static char *read_all(const char *path, size_t *n)
-{
-    void *data = NULL;
-    return sy_file_read_all(path, (size_t)1 << 30, &data, n, NULL) == SY_OK ? data : NULL;
-}
-
-static void write_all(const char *path, const void *data, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    if (!f || fwrite(data, 1, n, f) != n) {
-        fprintf(stderr, "cannot write %s\n", path);
-        exit(1);
-    }
-    fclose(f);
-}
 
 /* json with every occurrence of `from` replaced by `to` (malloc()ed); fails the test when absent. */
 static char *replace(const char *json, const char *from, const char *to)

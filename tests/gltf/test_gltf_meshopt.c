@@ -21,27 +21,12 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "gltf_files.h"
+
 static char g_dir[256];
 /* index views as TRIANGLES (meshopt_encodeIndexBuffer: may rotate a triangle's vertices, winding
  * kept) or INDICES (meshopt_encodeIndexSequence: the exact order) */
 static bool g_triangles;
-
-/* The whole file (NUL-terminated) through the library's reader; NULL when it cannot be read. */
-static uint8_t *read_all(const char *path, size_t *n)
-{
-    void *data = NULL;
-    return sy_file_read_all(path, (size_t)1 << 30, &data, n, NULL) == SY_OK ? data : NULL;
-}
-
-static void write_all(const char *path, const void *data, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    if (!f || fwrite(data, 1, n, f) != n) {
-        fprintf(stderr, "cannot write %s\n", path);
-        exit(1);
-    }
-    fclose(f);
-}
 
 static int num(const cJSON *o, const char *k, int def)
 {

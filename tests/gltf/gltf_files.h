@@ -1,0 +1,30 @@
+/* gltf_files.h — whole-file reading and writing for the glTF tests that write variants of sample
+ * files (Draco, meshopt). Test-only; header-only on purpose. */
+#ifndef SY_TEST_GLTF_FILES_H
+#define SY_TEST_GLTF_FILES_H
+
+#include "sy_file.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+/* The whole file (NUL-terminated) through the library's reader (malloc()ed); NULL when it cannot
+ * be read. */
+static inline void *read_all(const char *path, size_t *n)
+{
+    void *data = NULL;
+    return sy_file_read_all(path, (size_t)1 << 30, &data, n, NULL) == SY_OK ? data : NULL;
+}
+
+/* Writes n bytes to path; ends the test (exit 1) when it cannot. */
+static inline void write_all(const char *path, const void *data, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(data, 1, n, f) != n) {
+        fprintf(stderr, "cannot write %s\n", path);
+        exit(1);
+    }
+    fclose(f);
+}
+
+#endif /* SY_TEST_GLTF_FILES_H */
