@@ -496,6 +496,13 @@ sy_result sy_changes_deserialize(const void *data, size_t size, sy_blob_store *s
             r_fail(&r, SY_ERR_PARSE, "a destruction carries fields");
             goto fail;
         }
+        /* A creation carries every field (as commits and snapshots write it): so each object a
+         * list creates costs the list its serialised record, and a few bytes cannot make a
+         * receiver allocate records hundreds of bytes large (docs/PROTOCOL.md, the multiple). */
+        if ((eflags & SY_CHANGE_CREATED) && !(eflags & SY_CHANGE_DESTROYED) && mask != sy__type_full_mask(type)) {
+            r_fail(&r, SY_ERR_PARSE, "a creation without every field of its type");
+            goto fail;
+        }
         tmp_type = type;
         tmp = sy__data_new(type);
         if (!tmp) {

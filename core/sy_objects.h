@@ -228,8 +228,40 @@ enum sy_material_field {
     SY_MATERIAL_TRANSMISSION_TEXTURE = 15,
     SY_MATERIAL_IOR = 16,                /**< float (KHR_materials_ior) */
     SY_MATERIAL_UNLIT = 17,              /**< uint32 0/1 (KHR_materials_unlit) */
-    SY_MATERIAL_FIELD_COUNT = 18
+    /* KHR_materials_specular */
+    SY_MATERIAL_SPECULAR = 18,                 /**< float specularFactor (default 1) */
+    SY_MATERIAL_SPECULAR_TEXTURE = 19,         /**< sy_texture_ref (A) */
+    SY_MATERIAL_SPECULAR_COLOR = 20,           /**< float[3] specularColorFactor (default 1, 1, 1) */
+    SY_MATERIAL_SPECULAR_COLOR_TEXTURE = 21,   /**< sy_texture_ref (RGB, sRGB) */
+    /* KHR_materials_clearcoat */
+    SY_MATERIAL_CLEARCOAT = 22,                /**< float clearcoatFactor (default 0: no coat) */
+    SY_MATERIAL_CLEARCOAT_TEXTURE = 23,        /**< sy_texture_ref (R) */
+    SY_MATERIAL_CLEARCOAT_ROUGHNESS = 24,      /**< float (default 0) */
+    SY_MATERIAL_CLEARCOAT_ROUGHNESS_TEXTURE = 25, /**< sy_texture_ref (G) */
+    SY_MATERIAL_CLEARCOAT_NORMAL_TEXTURE = 26, /**< sy_texture_ref (tangent space; scale = normal scale) */
+    /* KHR_materials_sheen */
+    SY_MATERIAL_SHEEN_COLOR = 27,              /**< float[3] sheenColorFactor (default 0: no sheen) */
+    SY_MATERIAL_SHEEN_COLOR_TEXTURE = 28,      /**< sy_texture_ref (RGB, sRGB) */
+    SY_MATERIAL_SHEEN_ROUGHNESS = 29,          /**< float (default 0) */
+    SY_MATERIAL_SHEEN_ROUGHNESS_TEXTURE = 30,  /**< sy_texture_ref (A) */
+    /* KHR_materials_volume */
+    SY_MATERIAL_THICKNESS = 31,                /**< float thicknessFactor (default 0: thin-walled) */
+    SY_MATERIAL_THICKNESS_TEXTURE = 32,        /**< sy_texture_ref (G) */
+    SY_MATERIAL_ATTENUATION_DISTANCE = 33,     /**< float (0, the default, = infinite: no absorption) */
+    SY_MATERIAL_ATTENUATION_COLOR = 34,        /**< float[3] (default 1, 1, 1) */
+    /* KHR_materials_iridescence */
+    SY_MATERIAL_IRIDESCENCE = 35,              /**< float iridescenceFactor (default 0) */
+    SY_MATERIAL_IRIDESCENCE_TEXTURE = 36,      /**< sy_texture_ref (R) */
+    SY_MATERIAL_IRIDESCENCE_IOR = 37,          /**< float (default 1.3) */
+    SY_MATERIAL_IRIDESCENCE_THICKNESS = 38,    /**< float[2] film thickness minimum, maximum in nm (100, 400) */
+    SY_MATERIAL_IRIDESCENCE_THICKNESS_TEXTURE = 39, /**< sy_texture_ref (G: minimum to maximum) */
+    /* KHR_materials_anisotropy */
+    SY_MATERIAL_ANISOTROPY = 40,               /**< float anisotropyStrength (default 0) */
+    SY_MATERIAL_ANISOTROPY_ROTATION = 41,      /**< float radians, any finite value (default 0) */
+    SY_MATERIAL_ANISOTROPY_TEXTURE = 42,       /**< sy_texture_ref (RG direction, B strength) */
+    SY_MATERIAL_FIELD_COUNT = 43
 };
+
 
 /** Field values of a material (glTF 2.0 metallic-roughness). */
 typedef struct sy_material_data {
@@ -251,7 +283,41 @@ typedef struct sy_material_data {
     sy_texture_ref transmission_texture; /**< transmission texture (R) */
     float ior; /**< index of refraction (KHR_materials_ior) */
     uint32_t unlit; /**< 1 = KHR_materials_unlit */
+    float specular; /**< KHR_materials_specular: strength of the dielectric specular layer */
+    sy_texture_ref specular_texture; /**< (A) x specular */
+    float specular_color[3]; /**< colour of the dielectric F0 (linear) */
+    sy_texture_ref specular_color_texture; /**< (RGB, sRGB) x specular_color */
+    float clearcoat; /**< KHR_materials_clearcoat: coat layer weight, 0 = none */
+    sy_texture_ref clearcoat_texture; /**< (R) x clearcoat */
+    float clearcoat_roughness; /**< the coat's roughness */
+    sy_texture_ref clearcoat_roughness_texture; /**< (G) x clearcoat_roughness */
+    sy_texture_ref clearcoat_normal_texture; /**< the coat's normal map (none: the geometric normal) */
+    float sheen_color[3]; /**< KHR_materials_sheen colour (linear), 0 = none */
+    sy_texture_ref sheen_color_texture; /**< (RGB, sRGB) x sheen_color */
+    float sheen_roughness; /**< sheen roughness */
+    sy_texture_ref sheen_roughness_texture; /**< (A) x sheen_roughness */
+    float thickness; /**< KHR_materials_volume thickness in the mesh's units; 0 = thin-walled */
+    sy_texture_ref thickness_texture; /**< (G) x thickness */
+    float attenuation_distance; /**< distance at which light has the attenuation colour; 0 = infinite */
+    float attenuation_color[3]; /**< colour white light turns after attenuation_distance (linear) */
+    float iridescence; /**< KHR_materials_iridescence thin-film weight, 0 = none */
+    sy_texture_ref iridescence_texture; /**< (R) x iridescence */
+    float iridescence_ior; /**< the film's index of refraction */
+    float iridescence_thickness[2]; /**< film thickness in nm: minimum, maximum */
+    sy_texture_ref iridescence_thickness_texture; /**< (G) mixes minimum to maximum; none: maximum */
+    float anisotropy; /**< KHR_materials_anisotropy strength, 0 = isotropic */
+    float anisotropy_rotation; /**< rotation of the direction from the tangent, radians (counter-clockwise) */
+    sy_texture_ref anisotropy_texture; /**< RG direction in tangent space ([-1, 1] as [0, 1]), B x strength */
 } sy_material_data;
+
+/** The texture slots of a material: every sy_texture_ref field, in field order. */
+#define SY_MATERIAL_TEXTURE_SLOTS 17
+/** Field numbers of the SY_MATERIAL_TEXTURE_SLOTS texture references (read-only). */
+extern const uint32_t sy_material_texture_fields[SY_MATERIAL_TEXTURE_SLOTS];
+/** Texture reference of field f of d (a field of sy_material_texture_fields), else NULL. */
+const sy_texture_ref *sy_material_texture(const sy_material_data *d, uint32_t f);
+/** Whether any texture slot of d refers to texture id tex (tex != 0). */
+bool sy_material_uses_texture(const sy_material_data *d, uint32_t tex);
 
 /* ---------------------------------------------------------------- texture */
 /** Pixel formats of a texture. */
@@ -423,6 +489,10 @@ typedef struct sy_attachment {
 
 /** Default field values of a type (glTF defaults): const sy_node_data* etc. Static storage. */
 const void *sy_object_defaults(sy_object_type t);
+/** Copies the plain fields in mask (field bits) of src into dst, both data structs of type t: a
+ * shallow merge for consumers that keep their own copy of an object's plain fields (the mirror
+ * merging a change). Names, blobs and primitive lists are not copied. Reentrant. */
+void sy_object_data_merge(sy_object_type t, void *dst, const void *src, uint64_t mask);
 
 /** Create an object with default field values (name copied, may be NULL). */
 sy_result sy_node_create(sy_scene *s, const char *name, sy_node *out, sy_error *err);

@@ -473,6 +473,43 @@ bool sy_texture_ref_matrix(const sy_texture_ref *r, float m[6])
            r->uv_scale[1] != 1.0f;
 }
 
+const uint32_t sy_material_texture_fields[SY_MATERIAL_TEXTURE_SLOTS] = {
+    SY_MATERIAL_BASE_COLOR_TEXTURE,          SY_MATERIAL_METALLIC_ROUGHNESS_TEXTURE,
+    SY_MATERIAL_NORMAL_TEXTURE,              SY_MATERIAL_OCCLUSION_TEXTURE,
+    SY_MATERIAL_EMISSIVE_TEXTURE,            SY_MATERIAL_TRANSMISSION_TEXTURE,
+    SY_MATERIAL_SPECULAR_TEXTURE,            SY_MATERIAL_SPECULAR_COLOR_TEXTURE,
+    SY_MATERIAL_CLEARCOAT_TEXTURE,           SY_MATERIAL_CLEARCOAT_ROUGHNESS_TEXTURE,
+    SY_MATERIAL_CLEARCOAT_NORMAL_TEXTURE,    SY_MATERIAL_SHEEN_COLOR_TEXTURE,
+    SY_MATERIAL_SHEEN_ROUGHNESS_TEXTURE,     SY_MATERIAL_THICKNESS_TEXTURE,
+    SY_MATERIAL_IRIDESCENCE_TEXTURE,         SY_MATERIAL_IRIDESCENCE_THICKNESS_TEXTURE,
+    SY_MATERIAL_ANISOTROPY_TEXTURE,
+};
+
+const sy_texture_ref *sy_material_texture(const sy_material_data *d, uint32_t f)
+{
+    const sy_type_desc *td = sy__type_desc(SY_TYPE_MATERIAL);
+    if (!d || f >= td->field_count || td->fields[f].size != sizeof(sy_texture_ref)) return NULL;
+    for (uint32_t i = 0; i < SY_MATERIAL_TEXTURE_SLOTS; ++i)
+        if (sy_material_texture_fields[i] == f) return (const sy_texture_ref *)((const char *)d + td->fields[f].offset);
+    return NULL;
+}
+
+bool sy_material_uses_texture(const sy_material_data *d, uint32_t tex)
+{
+    for (uint32_t i = 0; i < SY_MATERIAL_TEXTURE_SLOTS; ++i)
+        if (sy_material_texture(d, sy_material_texture_fields[i])->texture.id == tex) return true;
+    return false;
+}
+
+void sy_object_data_merge(sy_object_type t, void *dst, const void *src, uint64_t mask)
+{
+    const sy_type_desc *td = sy__type_desc(t);
+    if (!td) return;
+    for (uint32_t f = 0; f < td->field_count; ++f)
+        if ((mask & SY_BIT(f)) && td->fields[f].kind == SY_FK_POD)
+            memcpy((char *)dst + td->fields[f].offset, (const char *)src + td->fields[f].offset, td->fields[f].size);
+}
+
 /* >>attachments */
 sy_result sy_sc_set_attachments(sy_scene *s, uint32_t t, uint32_t id, slot *sl, sy_attachment *a, uint32_t n,
                                  sy_error *err)

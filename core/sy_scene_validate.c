@@ -212,7 +212,22 @@ sy_result sy_sc_validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_t
         case SY_MATERIAL_NORMAL_TEXTURE:
         case SY_MATERIAL_OCCLUSION_TEXTURE:
         case SY_MATERIAL_EMISSIVE_TEXTURE:
-        case SY_MATERIAL_TRANSMISSION_TEXTURE: return check_texref(s, v, fd->name, err);
+        case SY_MATERIAL_TRANSMISSION_TEXTURE:
+        case SY_MATERIAL_SPECULAR_TEXTURE:
+        case SY_MATERIAL_SPECULAR_COLOR_TEXTURE:
+        case SY_MATERIAL_CLEARCOAT_TEXTURE:
+        case SY_MATERIAL_CLEARCOAT_ROUGHNESS_TEXTURE:
+        case SY_MATERIAL_CLEARCOAT_NORMAL_TEXTURE:
+        case SY_MATERIAL_SHEEN_COLOR_TEXTURE:
+        case SY_MATERIAL_SHEEN_ROUGHNESS_TEXTURE:
+        case SY_MATERIAL_THICKNESS_TEXTURE:
+        case SY_MATERIAL_IRIDESCENCE_TEXTURE:
+        case SY_MATERIAL_IRIDESCENCE_THICKNESS_TEXTURE:
+        case SY_MATERIAL_ANISOTROPY_TEXTURE: return check_texref(s, v, fd->name, err);
+        case SY_MATERIAL_ANISOTROPY_ROTATION: /* an angle: any finite value */
+            return isfinite(*(const float *)v)
+                       ? SY_OK
+                       : sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "material: anisotropy_rotation is not finite");
         case SY_MATERIAL_ALPHA_MODE:
             return *(const uint32_t *)v <= SY_ALPHA_BLEND
                        ? SY_OK
@@ -233,8 +248,8 @@ sy_result sy_sc_validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_t
                     return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "material: %s is negative (%g)", fd->name,
                                         (double)fv[i]);
             }
-            if (f == SY_MATERIAL_IOR && fv[0] < 1.0f && fv[0] != 0.0f)
-                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "material: ior %g below 1", (double)fv[0]);
+            if ((f == SY_MATERIAL_IOR || f == SY_MATERIAL_IRIDESCENCE_IOR) && fv[0] < 1.0f && fv[0] != 0.0f)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "material: %s %g below 1", fd->name, (double)fv[0]);
             return SY_OK;
         }
         }

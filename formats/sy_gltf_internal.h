@@ -101,6 +101,19 @@ static inline bool gltf_to_float(double d, float *out)
 
 static inline const char *gltf_nonempty(const char *s) { return (s && s[0]) ? s : NULL; }
 
+/* >>material tables (sy_gltf_materials.c) ---------------------------------------------------- */
+
+/* A material's texture slot: where the shim holds it, where core takes it, the colour role (sRGB
+ * texture) or data, and its name in the file. One table drives validation and loading. */
+typedef struct gltf_texture_slot {
+    size_t shim;    /* offsetof(sy_gltf_shim_material, ...) of a sy_gltf_shim_texinfo */
+    size_t core;    /* offsetof(sy_material_data, ...) of a sy_texture_ref */
+    bool color;     /* sRGB colour (else linear data) */
+    const char *name; /* e.g. "KHR_materials_clearcoat.clearcoatTexture" */
+} gltf_texture_slot;
+extern const gltf_texture_slot gltf_texture_slots[];
+extern const size_t gltf_texture_slot_count;
+
 /* >>validation (sy_gltf_validate.c) ----------------------------------------------------------- */
 
 /* The GLB header and chunk table of b (size bytes); *json / *json_len: the JSON chunk. */

@@ -3,6 +3,8 @@
  * images shared as blobs), samplers and KHR_texture_transform. */
 #include "sy_gltf_internal.h"
 
+#include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -91,6 +93,86 @@ static sy_result get_texture(loader *L, const sy_gltf_shim_texinfo *ti, int role
     return SY_OK;
 }
 
+#define SLOT(member, color, name) {offsetof(sy_gltf_shim_material, member), offsetof(sy_material_data, member), color, name}
+const gltf_texture_slot gltf_texture_slots[] = {
+    SLOT(base_color_texture, true, "baseColorTexture"),
+    SLOT(metallic_roughness_texture, false, "metallicRoughnessTexture"),
+    SLOT(normal_texture, false, "normalTexture"),
+    SLOT(occlusion_texture, false, "occlusionTexture"),
+    SLOT(emissive_texture, true, "emissiveTexture"),
+    SLOT(transmission_texture, false, "KHR_materials_transmission.transmissionTexture"),
+    SLOT(specular_texture, false, "KHR_materials_specular.specularTexture"),
+    SLOT(specular_color_texture, true, "KHR_materials_specular.specularColorTexture"),
+    SLOT(clearcoat_texture, false, "KHR_materials_clearcoat.clearcoatTexture"),
+    SLOT(clearcoat_roughness_texture, false, "KHR_materials_clearcoat.clearcoatRoughnessTexture"),
+    SLOT(clearcoat_normal_texture, false, "KHR_materials_clearcoat.clearcoatNormalTexture"),
+    SLOT(sheen_color_texture, true, "KHR_materials_sheen.sheenColorTexture"),
+    SLOT(sheen_roughness_texture, false, "KHR_materials_sheen.sheenRoughnessTexture"),
+    SLOT(thickness_texture, false, "KHR_materials_volume.thicknessTexture"),
+    SLOT(iridescence_texture, false, "KHR_materials_iridescence.iridescenceTexture"),
+    SLOT(iridescence_thickness_texture, false, "KHR_materials_iridescence.iridescenceThicknessTexture"),
+    SLOT(anisotropy_texture, false, "KHR_materials_anisotropy.anisotropyTexture"),
+};
+#undef SLOT
+const size_t gltf_texture_slot_count = sizeof gltf_texture_slots / sizeof gltf_texture_slots[0];
+_Static_assert(sizeof gltf_texture_slots / sizeof gltf_texture_slots[0] == SY_MATERIAL_TEXTURE_SLOTS,
+               "every core texture slot is read from glTF");
+
+/* The factors of the material extensions with the ranges their specifications give: a value outside
+ * is clamped with a warning (the back-ends see the same clamped value). */
+typedef struct factor {
+    size_t shim, core; /* offsets of double[n] and float[n] */
+    int n;
+    float lo, hi;
+    const char *name;
+} factor;
+#define FACTOR(member, n, lo, hi, name) {offsetof(sy_gltf_shim_material, member), offsetof(sy_material_data, member), n, lo, hi, name}
+static const factor factors[] = {
+    FACTOR(specular, 1, 0.0f, 1.0f, "KHR_materials_specular.specularFactor"),
+    FACTOR(specular_color, 3, 0.0f, INFINITY, "KHR_materials_specular.specularColorFactor"),
+    FACTOR(clearcoat, 1, 0.0f, 1.0f, "KHR_materials_clearcoat.clearcoatFactor"),
+    FACTOR(clearcoat_roughness, 1, 0.0f, 1.0f, "KHR_materials_clearcoat.clearcoatRoughnessFactor"),
+    FACTOR(sheen_color, 3, 0.0f, 1.0f, "KHR_materials_sheen.sheenColorFactor"),
+    FACTOR(sheen_roughness, 1, 0.0f, 1.0f, "KHR_materials_sheen.sheenRoughnessFactor"),
+    FACTOR(thickness, 1, 0.0f, INFINITY, "KHR_materials_volume.thicknessFactor"),
+    FACTOR(attenuation_distance, 1, 0.0f, INFINITY, "KHR_materials_volume.attenuationDistance"),
+    FACTOR(attenuation_color, 3, 0.0f, 1.0f, "KHR_materials_volume.attenuationColor"),
+    FACTOR(iridescence, 1, 0.0f, 1.0f, "KHR_materials_iridescence.iridescenceFactor"),
+    FACTOR(iridescence_ior, 1, 1.0f, INFINITY, "KHR_materials_iridescence.iridescenceIor"),
+    FACTOR(iridescence_thickness, 2, 0.0f, INFINITY, "KHR_materials_iridescence.iridescenceThickness{Minimum,Maximum}"),
+    FACTOR(anisotropy, 1, 0.0f, 1.0f, "KHR_materials_anisotropy.anisotropyStrength"),
+    FACTOR(anisotropy_rotation, 1, -INFINITY, INFINITY, "KHR_materials_anisotropy.anisotropyRotation"),
+};
+#undef FACTOR
+
+static sy_result get_factors(loader *L, const sy_gltf_shim_material *m, size_t mi, sy_material_data *md)
+{
+    for (size_t k = 0; k < sizeof factors / sizeof factors[0]; k++) {
+        const factor *f = &factors[k];
+        const double *src = (const double *)((const char *)m + f->shim);
+        float *dst = (float *)((char *)md + f->core);
+        for (int c = 0; c < f->n; c++) {
+            if (!gltf_to_float(src[c], &dst[c]))
+                return gltf_fail(L, SY_ERR_PARSE, "materials[%zu].%s: non-finite value", mi, f->name);
+            if (dst[c] < f->lo || dst[c] > f->hi) {
+                float v = dst[c] < f->lo ? f->lo : f->hi;
+                gltf_warn(L, "materials[%zu].%s: %g is outside [%g, %g]; clamped to %g", mi, f->name, (double)dst[c],
+                          (double)f->lo, (double)f->hi, (double)v);
+                dst[c] = v;
+            }
+        }
+    }
+    /* glTF: attenuationDistance > 0, absent = infinite; core (and the shim for an absent one): 0 = infinite */
+    if (m->attenuation_distance <= 0.0 && m->thickness > 0.0 && m->attenuation_color[0] + m->attenuation_color[1] + m->attenuation_color[2] < 3.0)
+        gltf_warn(L, "materials[%zu].KHR_materials_volume: an attenuationColor without a positive attenuationDistance "
+                  "absorbs nothing", mi);
+    if (md->iridescence_thickness[0] > md->iridescence_thickness[1])
+        gltf_warn(L, "materials[%zu].KHR_materials_iridescence: thickness minimum %g above maximum %g (kept: the "
+                  "thickness texture then runs from thick to thin)", mi, (double)md->iridescence_thickness[0],
+                  (double)md->iridescence_thickness[1]);
+    return SY_OK;
+}
+
 sy_result gltf_create_material(loader *L, size_t i)
 {
     const sy_gltf_shim_material *m = &L->doc->materials[i];
@@ -104,14 +186,13 @@ sy_result gltf_create_material(loader *L, size_t i)
          gltf_to_float(m->transmission, &md.transmission) && gltf_to_float(m->ior, &md.ior);
     if (!ok) return gltf_fail(L, SY_ERR_PARSE, "materials[%zu]: non-finite factor", i);
     sy_result r;
-    if ((r = get_texture(L, &m->base_color_texture, ROLE_COLOR, i, "baseColorTexture", &md.base_color_texture)) ||
-        (r = get_texture(L, &m->metallic_roughness_texture, ROLE_DATA, i, "metallicRoughnessTexture",
-                         &md.metallic_roughness_texture)) ||
-        (r = get_texture(L, &m->normal_texture, ROLE_DATA, i, "normalTexture", &md.normal_texture)) ||
-        (r = get_texture(L, &m->occlusion_texture, ROLE_DATA, i, "occlusionTexture", &md.occlusion_texture)) ||
-        (r = get_texture(L, &m->emissive_texture, ROLE_COLOR, i, "emissiveTexture", &md.emissive_texture)) ||
-        (r = get_texture(L, &m->transmission_texture, ROLE_DATA, i, "transmissionTexture", &md.transmission_texture)))
-        return r;
+    if ((r = get_factors(L, m, i, &md))) return r;
+    for (size_t k = 0; k < gltf_texture_slot_count; k++) {
+        const gltf_texture_slot *ts = &gltf_texture_slots[k];
+        if ((r = get_texture(L, (const sy_gltf_shim_texinfo *)((const char *)m + ts->shim), ts->color ? ROLE_COLOR : ROLE_DATA,
+                             i, ts->name, (sy_texture_ref *)((char *)&md + ts->core))))
+            return r;
+    }
     md.alpha_mode = !strcmp(m->alpha_mode, "MASK") ? SY_ALPHA_MASK : !strcmp(m->alpha_mode, "BLEND") ? SY_ALPHA_BLEND
                                                                                                     : SY_ALPHA_OPAQUE;
     md.double_sided = m->double_sided ? 1u : 0u;

@@ -229,6 +229,15 @@ double number(const tinygltf::Value &v, const char *key, double def)
     return (m && m->IsNumber()) ? m->GetNumberAsDouble() : def;
 }
 
+/* The numbers of a fixed-length array member (def when absent or of another length). */
+void numbers(const tinygltf::Value &v, const char *key, double *out, size_t n, const double *def)
+{
+    const tinygltf::Value *m = member(v, key);
+    bool ok = m && m->IsArray() && m->ArrayLen() == n;
+    for (size_t i = 0; ok && i < n; i++) ok = m->Get(int(i)).IsNumber();
+    for (size_t i = 0; i < n; i++) out[i] = ok ? m->Get(int(i)).GetNumberAsDouble() : def[i];
+}
+
 int32_t integer(const tinygltf::Value &v, const char *key, int32_t def)
 {
     const tinygltf::Value *m = member(v, key);
@@ -296,6 +305,53 @@ sy_gltf_shim_texinfo texinfo_value(const tinygltf::Value *v)
         read_transform(map, &t);
     }
     return t;
+}
+
+/* The material extensions beyond the core set (KHR_materials_specular, _clearcoat, _sheen, _volume,
+ * _iridescence, _anisotropy): their factors with the specifications' defaults, their textures. */
+void read_material_extensions(const tinygltf::ExtensionMap &ext, sy_gltf_shim_material *c)
+{
+    static const double one3[3] = {1, 1, 1}, zero3[3] = {0, 0, 0}, film[2] = {100, 400};
+    const tinygltf::Value none;
+    const tinygltf::Value *e = extension(ext, "KHR_materials_specular");
+    const tinygltf::Value &sp = e ? *e : none;
+    c->specular = number(sp, "specularFactor", 1.0);
+    numbers(sp, "specularColorFactor", c->specular_color, 3, one3);
+    c->specular_texture = texinfo_value(member(sp, "specularTexture"));
+    c->specular_color_texture = texinfo_value(member(sp, "specularColorTexture"));
+    e = extension(ext, "KHR_materials_clearcoat");
+    const tinygltf::Value &cc = e ? *e : none;
+    c->clearcoat = number(cc, "clearcoatFactor", 0.0);
+    c->clearcoat_roughness = number(cc, "clearcoatRoughnessFactor", 0.0);
+    c->clearcoat_texture = texinfo_value(member(cc, "clearcoatTexture"));
+    c->clearcoat_roughness_texture = texinfo_value(member(cc, "clearcoatRoughnessTexture"));
+    c->clearcoat_normal_texture = texinfo_value(member(cc, "clearcoatNormalTexture"));
+    if (const tinygltf::Value *n = member(cc, "clearcoatNormalTexture")) c->clearcoat_normal_texture.scale = number(*n, "scale", 1.0);
+    e = extension(ext, "KHR_materials_sheen");
+    const tinygltf::Value &sh = e ? *e : none;
+    numbers(sh, "sheenColorFactor", c->sheen_color, 3, zero3);
+    c->sheen_roughness = number(sh, "sheenRoughnessFactor", 0.0);
+    c->sheen_color_texture = texinfo_value(member(sh, "sheenColorTexture"));
+    c->sheen_roughness_texture = texinfo_value(member(sh, "sheenRoughnessTexture"));
+    e = extension(ext, "KHR_materials_volume");
+    const tinygltf::Value &vo = e ? *e : none;
+    c->thickness = number(vo, "thicknessFactor", 0.0);
+    c->attenuation_distance = number(vo, "attenuationDistance", 0.0);
+    numbers(vo, "attenuationColor", c->attenuation_color, 3, one3);
+    c->thickness_texture = texinfo_value(member(vo, "thicknessTexture"));
+    e = extension(ext, "KHR_materials_iridescence");
+    const tinygltf::Value &ir = e ? *e : none;
+    c->iridescence = number(ir, "iridescenceFactor", 0.0);
+    c->iridescence_ior = number(ir, "iridescenceIor", 1.3);
+    c->iridescence_thickness[0] = number(ir, "iridescenceThicknessMinimum", film[0]);
+    c->iridescence_thickness[1] = number(ir, "iridescenceThicknessMaximum", film[1]);
+    c->iridescence_texture = texinfo_value(member(ir, "iridescenceTexture"));
+    c->iridescence_thickness_texture = texinfo_value(member(ir, "iridescenceThicknessTexture"));
+    e = extension(ext, "KHR_materials_anisotropy");
+    const tinygltf::Value &an = e ? *e : none;
+    c->anisotropy = number(an, "anisotropyStrength", 0.0);
+    c->anisotropy_rotation = number(an, "anisotropyRotation", 0.0);
+    c->anisotropy_texture = texinfo_value(member(an, "anisotropyTexture"));
 }
 
 int32_t components_of(int type)
@@ -428,6 +484,7 @@ static void fill_doc(sy_gltf_shim_impl *d)
         }
         if (const tinygltf::Value *e = extension(mat.extensions, "KHR_materials_ior")) c.ior = number(*e, "ior", 1.5);
         c.unlit = extension(mat.extensions, "KHR_materials_unlit") != nullptr;
+        read_material_extensions(mat.extensions, &c);
         d->materials.push_back(c);
     }
     for (const tinygltf::Texture &t : m.textures) { // EXT_texture_webp's source before the fallback

@@ -122,6 +122,24 @@ typedef struct sy_gltf_shim_material {
     sy_gltf_shim_texinfo transmission_texture;
     double ior; /* 1.5 when absent */
     int32_t unlit;
+    /* KHR_materials_specular (1, 1 1 1 when absent) */
+    double specular, specular_color[3];
+    sy_gltf_shim_texinfo specular_texture, specular_color_texture;
+    /* KHR_materials_clearcoat */
+    double clearcoat, clearcoat_roughness;
+    sy_gltf_shim_texinfo clearcoat_texture, clearcoat_roughness_texture, clearcoat_normal_texture;
+    /* KHR_materials_sheen */
+    double sheen_color[3], sheen_roughness;
+    sy_gltf_shim_texinfo sheen_color_texture, sheen_roughness_texture;
+    /* KHR_materials_volume (attenuation_distance: 0 when absent, meaning infinite) */
+    double thickness, attenuation_distance, attenuation_color[3];
+    sy_gltf_shim_texinfo thickness_texture;
+    /* KHR_materials_iridescence (ior 1.3, thickness 100 to 400 nm when absent) */
+    double iridescence, iridescence_ior, iridescence_thickness[2];
+    sy_gltf_shim_texinfo iridescence_texture, iridescence_thickness_texture;
+    /* KHR_materials_anisotropy */
+    double anisotropy, anisotropy_rotation;
+    sy_gltf_shim_texinfo anisotropy_texture;
     int32_t base_color_count, emissive_count; /* array lengths found in the file */
 } sy_gltf_shim_material;
 

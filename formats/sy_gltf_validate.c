@@ -19,7 +19,9 @@
 
 const char *const gltf_supported[] = {
     "KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
-    "KHR_materials_unlit", "KHR_texture_transform", "KHR_lights_punctual",
+    "KHR_materials_unlit", "KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen",
+    "KHR_materials_volume", "KHR_materials_iridescence", "KHR_materials_anisotropy",
+    "KHR_texture_transform", "KHR_lights_punctual",
     "KHR_mesh_quantization", "EXT_mesh_gpu_instancing", "KHR_draco_mesh_compression",
     "EXT_meshopt_compression", "EXT_texture_webp", NULL,
 };
@@ -306,12 +308,17 @@ sy_result gltf_validate_doc(loader *L)
             return gltf_fail(L, SY_ERR_UNSUPPORTED,
                              "extensionsRequired: 'KHR_texture_basisu' is not supported: no Debian package decodes "
                              "Basis Universal (KTX2) textures; a file that only uses it loads its PNG / JPEG fallbacks");
-        if (!ok)
-            return gltf_fail(L, SY_ERR_UNSUPPORTED,
-                             "extensionsRequired: '%s' is not supported (supported: KHR_materials_emissive_strength, "
-                             "KHR_materials_transmission, KHR_materials_ior, KHR_materials_unlit, KHR_texture_transform, "
-                             "KHR_lights_punctual, KHR_mesh_quantization, EXT_mesh_gpu_instancing, KHR_draco_mesh_compression, "
-                             "EXT_meshopt_compression, EXT_texture_webp)", e);
+        if (!ok) {
+            char list[768];
+            size_t used = 0;
+            list[0] = '\0';
+            for (size_t k = 0; gltf_supported[k] && used < sizeof list; k++) {
+                int n = snprintf(list + used, sizeof list - used, "%s%s", k ? ", " : "", gltf_supported[k]);
+                if (n < 0) break;
+                used += (size_t)n;
+            }
+            return gltf_fail(L, SY_ERR_UNSUPPORTED, "extensionsRequired: '%s' is not supported (supported: %s)", e, list);
+        }
     }
     if ((r = validate_views(L))) return r;
     for (size_t i = 0; i < d->accessor_count; i++)
@@ -334,13 +341,11 @@ sy_result gltf_validate_doc(loader *L)
     }
     for (size_t i = 0; i < d->material_count; i++) {
         const sy_gltf_shim_material *m = &d->materials[i];
-        if ((r = validate_texinfo(L, &m->base_color_texture, i, "baseColorTexture")) ||
-            (r = validate_texinfo(L, &m->metallic_roughness_texture, i, "metallicRoughnessTexture")) ||
-            (r = validate_texinfo(L, &m->normal_texture, i, "normalTexture")) ||
-            (r = validate_texinfo(L, &m->occlusion_texture, i, "occlusionTexture")) ||
-            (r = validate_texinfo(L, &m->emissive_texture, i, "emissiveTexture")) ||
-            (r = validate_texinfo(L, &m->transmission_texture, i, "transmissionTexture")))
-            return r;
+        for (size_t k = 0; k < gltf_texture_slot_count; k++) {
+            const gltf_texture_slot *ts = &gltf_texture_slots[k];
+            if ((r = validate_texinfo(L, (const sy_gltf_shim_texinfo *)((const char *)m + ts->shim), i, ts->name)))
+                return r;
+        }
         if (strcmp(m->alpha_mode, "OPAQUE") && strcmp(m->alpha_mode, "MASK") && strcmp(m->alpha_mode, "BLEND"))
             return gltf_fail(L, SY_ERR_PARSE, "materials[%zu]: alphaMode '%s' is not OPAQUE, MASK or BLEND", i, m->alpha_mode);
         if ((m->base_color_count != 0 && m->base_color_count != 4) || (m->emissive_count != 0 && m->emissive_count != 3))

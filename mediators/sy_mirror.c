@@ -182,13 +182,6 @@ static sy_result material_set(sy_mirror *st, uint32_t id, const sy_material_data
 
 static sy_result material_upload(sy_mirror *st, mat_m *m, sy_error *err) { return material_set(st, m->id, &m->d, &m->handle, err); }
 
-static bool material_uses_texture(const sy_material_data *d, uint32_t tex)
-{
-    return d->base_color_texture.texture.id == tex || d->metallic_roughness_texture.texture.id == tex ||
-           d->normal_texture.texture.id == tex || d->emissive_texture.texture.id == tex ||
-           d->occlusion_texture.texture.id == tex;
-}
-
 static sy_result texture_upload(sy_mirror *st, tex_m *t, sy_error *err)
 {
     if (t->handle) release(st, SY_MIRROR_TEXTURE, t->handle);
@@ -208,7 +201,7 @@ static sy_result texture_upload(sy_mirror *st, tex_m *t, sy_error *err)
     /* materials referring to this texture get the new back-end handle */
     for (uint32_t i = 0; i < st->mat_cap; ++i) {
         mat_m *m = &st->mat[i];
-        if (m->id && m->handle && material_uses_texture(&m->d, t->id)) {
+        if (m->id && m->handle && sy_material_uses_texture(&m->d, t->id)) {
             sy_result rr = material_upload(st, m, err);
             if (rr != SY_OK) return rr;
         }
@@ -601,25 +594,7 @@ static sy_result apply_material(sy_mirror *st, const sy_change *e, bool destroye
         /* partial material update: merge masked fields into the mirror */
         const sy_material_data *d = e->data;
         sy_material_data merged = m->d;
-#define TAKE(bit, member) if (e->mask & SY_BIT(bit)) memcpy(&merged.member, &d->member, sizeof merged.member)
-        TAKE(SY_MATERIAL_BASE_COLOR, base_color);
-        TAKE(SY_MATERIAL_BASE_COLOR_TEXTURE, base_color_texture);
-        TAKE(SY_MATERIAL_METALLIC, metallic);
-        TAKE(SY_MATERIAL_ROUGHNESS, roughness);
-        TAKE(SY_MATERIAL_METALLIC_ROUGHNESS_TEXTURE, metallic_roughness_texture);
-        TAKE(SY_MATERIAL_NORMAL_TEXTURE, normal_texture);
-        TAKE(SY_MATERIAL_OCCLUSION_TEXTURE, occlusion_texture);
-        TAKE(SY_MATERIAL_EMISSIVE, emissive);
-        TAKE(SY_MATERIAL_EMISSIVE_STRENGTH, emissive_strength);
-        TAKE(SY_MATERIAL_EMISSIVE_TEXTURE, emissive_texture);
-        TAKE(SY_MATERIAL_ALPHA_MODE, alpha_mode);
-        TAKE(SY_MATERIAL_ALPHA_CUTOFF, alpha_cutoff);
-        TAKE(SY_MATERIAL_DOUBLE_SIDED, double_sided);
-        TAKE(SY_MATERIAL_TRANSMISSION, transmission);
-        TAKE(SY_MATERIAL_TRANSMISSION_TEXTURE, transmission_texture);
-        TAKE(SY_MATERIAL_IOR, ior);
-        TAKE(SY_MATERIAL_UNLIT, unlit);
-#undef TAKE
+        sy_object_data_merge(SY_TYPE_MATERIAL, &merged, d, e->mask);
         st->emissive_materials += (uint32_t)material_emits(&merged) - (uint32_t)material_emits(&m->d);
         m->d = merged;
         if (e->mask & ~(SY_BIT(SY_MATERIAL_NAME) | SY_BIT(SY_FIELD_ATTACHMENTS))) return material_upload(st, m, err);

@@ -51,6 +51,9 @@ void sy_mirror_flat_texture_mean(const sy_mirror_flat_texture *t, float mean[3])
     for (int c = 0; c < 3; ++c) mean[c] = n ? (float)(sum[c] / (double)n) : 0.0f;
 }
 
+/* A factor the specifications bound to [0, 1] (core accepts any non-negative value). */
+static float unit(float x) { return x < 0.0f ? 0.0f : x > 1.0f ? 1.0f : x; }
+
 static sy_mirror_flat_texture_ref texref(const sy_texture_ref *r, sy_mirror_flat_handle_fn handle_of, const void *user)
 {
     sy_mirror_flat_texture_ref o = {r->texture.id, r->texture.id ? handle_of(user, r->texture.id) : 0u, r->texcoord,
@@ -74,12 +77,40 @@ void sy_mirror_flat_material_of(const sy_material_data *m, sy_mirror_flat_handle
     out->normal_scale = m->normal_texture.scale;
     out->occlusion_texture = texref(&m->occlusion_texture, handle_of, user);
     out->occlusion_strength = m->occlusion_texture.scale;
-    out->transmission = m->transmission;
+    out->transmission = unit(m->transmission);
+    out->transmission_texture = texref(&m->transmission_texture, handle_of, user);
     out->ior = m->ior >= 1.0f ? m->ior : 1.5f;
     out->alpha_mode = m->alpha_mode;
     out->alpha_cutoff = m->alpha_cutoff;
     out->double_sided = m->double_sided != 0;
     out->unlit = m->unlit != 0;
+    out->specular = unit(m->specular);
+    out->specular_texture = texref(&m->specular_texture, handle_of, user);
+    memcpy(out->specular_color, m->specular_color, sizeof out->specular_color);
+    out->specular_color_texture = texref(&m->specular_color_texture, handle_of, user);
+    out->clearcoat = unit(m->clearcoat);
+    out->clearcoat_texture = texref(&m->clearcoat_texture, handle_of, user);
+    out->clearcoat_roughness = unit(m->clearcoat_roughness);
+    out->clearcoat_roughness_texture = texref(&m->clearcoat_roughness_texture, handle_of, user);
+    out->clearcoat_normal_texture = texref(&m->clearcoat_normal_texture, handle_of, user);
+    out->clearcoat_normal_scale = m->clearcoat_normal_texture.scale;
+    for (int i = 0; i < 3; ++i) out->sheen_color[i] = unit(m->sheen_color[i]);
+    out->sheen_color_texture = texref(&m->sheen_color_texture, handle_of, user);
+    out->sheen_roughness = unit(m->sheen_roughness);
+    out->sheen_roughness_texture = texref(&m->sheen_roughness_texture, handle_of, user);
+    out->thickness = m->thickness;
+    out->thickness_texture = texref(&m->thickness_texture, handle_of, user);
+    out->attenuation_distance = m->attenuation_distance;
+    for (int i = 0; i < 3; ++i) out->attenuation_color[i] = unit(m->attenuation_color[i]);
+    out->iridescence = unit(m->iridescence);
+    out->iridescence_texture = texref(&m->iridescence_texture, handle_of, user);
+    out->iridescence_ior = m->iridescence_ior >= 1.0f ? m->iridescence_ior : 1.3f;
+    out->iridescence_thickness[0] = m->iridescence_thickness[0];
+    out->iridescence_thickness[1] = m->iridescence_thickness[1];
+    out->iridescence_thickness_texture = texref(&m->iridescence_thickness_texture, handle_of, user);
+    out->anisotropy = unit(m->anisotropy);
+    out->anisotropy_rotation = m->anisotropy_rotation;
+    out->anisotropy_texture = texref(&m->anisotropy_texture, handle_of, user);
 }
 
 void sy_mirror_flat_mesh_of(const sy_primitive *p, sy_mirror_flat_mesh *out)

@@ -68,12 +68,41 @@ typedef struct sy_mirror_flat_material {
     float normal_scale; /**< the normal texture's scale */
     sy_mirror_flat_texture_ref occlusion_texture; /**< R */
     float occlusion_strength; /**< the occlusion texture's strength */
-    float transmission; /**< KHR_materials_transmission factor */
+    float transmission; /**< KHR_materials_transmission factor, [0, 1] */
+    sy_mirror_flat_texture_ref transmission_texture; /**< R x transmission */
     float ior; /**< index of refraction; a value below 1 reads as glTF's 1.5 */
     uint32_t alpha_mode; /**< sy_alpha_mode (opaque 0, mask 1, blend 2: numbered like the back-ends') */
     float alpha_cutoff; /**< cutoff of the mask mode */
     bool double_sided; /**< both faces are front faces */
     bool unlit; /**< KHR_materials_unlit */
+    /* The material extensions (docs/MATERIALS.md says how each back-end reads them). Factors the
+     * specifications bound to [0, 1] arrive clamped there. */
+    float specular; /**< KHR_materials_specular factor, [0, 1] (1 without the extension) */
+    sy_mirror_flat_texture_ref specular_texture; /**< A x specular */
+    float specular_color[3]; /**< dielectric F0 colour, >= 0 (1 without the extension) */
+    sy_mirror_flat_texture_ref specular_color_texture; /**< sRGB RGB x specular_color */
+    float clearcoat; /**< KHR_materials_clearcoat weight, [0, 1]; 0 = no coat */
+    sy_mirror_flat_texture_ref clearcoat_texture; /**< R x clearcoat */
+    float clearcoat_roughness; /**< [0, 1] */
+    sy_mirror_flat_texture_ref clearcoat_roughness_texture; /**< G x clearcoat_roughness */
+    sy_mirror_flat_texture_ref clearcoat_normal_texture; /**< the coat's normal map */
+    float clearcoat_normal_scale; /**< its scale */
+    float sheen_color[3]; /**< KHR_materials_sheen colour, [0, 1]; 0 = no sheen */
+    sy_mirror_flat_texture_ref sheen_color_texture; /**< sRGB RGB x sheen_color */
+    float sheen_roughness; /**< [0, 1] */
+    sy_mirror_flat_texture_ref sheen_roughness_texture; /**< A x sheen_roughness */
+    float thickness; /**< KHR_materials_volume thickness (mesh units); 0 = thin-walled */
+    sy_mirror_flat_texture_ref thickness_texture; /**< G x thickness */
+    float attenuation_distance; /**< 0 = infinite (no absorption) */
+    float attenuation_color[3]; /**< [0, 1] */
+    float iridescence; /**< KHR_materials_iridescence weight, [0, 1]; 0 = none */
+    sy_mirror_flat_texture_ref iridescence_texture; /**< R x iridescence */
+    float iridescence_ior; /**< the film's index, >= 1 */
+    float iridescence_thickness[2]; /**< film thickness in nm: minimum, maximum */
+    sy_mirror_flat_texture_ref iridescence_thickness_texture; /**< G: minimum to maximum */
+    float anisotropy; /**< KHR_materials_anisotropy strength, [0, 1]; 0 = isotropic */
+    float anisotropy_rotation; /**< radians from the tangent, counter-clockwise */
+    sy_mirror_flat_texture_ref anisotropy_texture; /**< RG direction, B x strength */
 } sy_mirror_flat_material;
 
 /** One triangle primitive's arrays (every per-vertex array has vertex_count entries). */

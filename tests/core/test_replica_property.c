@@ -516,7 +516,7 @@ static int op_material(sy_scene *s)
     sy_material_data d = *sy_material_get(s, m);
     d.name = (char *)(chance(80) ? sy_material_get(s, m)->name : rand_name());
     int edits = 1 + (int)rn(4);
-    for (int k = 0; k < edits; ++k) switch (rn(14)) {
+    for (int k = 0; k < edits; ++k) switch (rn(20)) {
         case 0: d.base_color[rn(4)] = rf(0, 1); break;
         case 1: d.base_color_texture = rand_texref(s); break;
         case 2: d.metallic = rf(0, 1); break;
@@ -530,6 +530,18 @@ static int op_material(sy_scene *s)
         case 10: d.double_sided = rn(2), d.unlit = rn(2); break;
         case 11: d.transmission = rf(0, 1), d.transmission_texture = rand_texref(s); break;
         case 12: d.ior = chance(20) ? 0.0f : rf(1, 2.5f); break;
+        case 13: d.clearcoat = rf(0, 1), d.clearcoat_roughness = rf(0, 1), d.clearcoat_normal_texture = rand_texref(s); break;
+        case 14: d.sheen_color[rn(3)] = rf(0, 1), d.sheen_roughness = rf(0, 1), d.sheen_color_texture = rand_texref(s); break;
+        case 15: d.specular = rf(0, 1), d.specular_color[rn(3)] = rf(0, 3), d.specular_texture = rand_texref(s); break;
+        case 16:
+            d.thickness = rf(0, 2), d.attenuation_distance = rf(0, 3), d.attenuation_color[rn(3)] = rf(0, 1);
+            d.thickness_texture = rand_texref(s);
+            break;
+        case 17:
+            d.iridescence = rf(0, 1), d.iridescence_ior = rf(1, 2), d.iridescence_thickness[rn(2)] = rf(0, 800);
+            d.iridescence_thickness_texture = rand_texref(s);
+            break;
+        case 18: d.anisotropy = rf(0, 1), d.anisotropy_rotation = rf(-4, 4), d.anisotropy_texture = rand_texref(s); break;
         default: break; /* sometimes a no-op set */
         }
     CHECK_OK(sy_material_set(s, m, &d, &e), e);

@@ -540,7 +540,9 @@ static void test_valid(void)
                  "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"COLOR_0\":2},\"indices\":1,\"material\":0}]}],"
                  "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.5,0.25],\"rotation\":1.5,\"scale\":[2,3]}}}},"
                  "\"normalTexture\":{\"index\":0,\"scale\":0.5},\"emissiveFactor\":[1,1,1],"
-                 "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":3},\"KHR_materials_ior\":{\"ior\":1.3},\"KHR_materials_transmission\":{\"transmissionFactor\":0.75}}}],"
+                 "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":3},\"KHR_materials_ior\":{\"ior\":1.3},\"KHR_materials_transmission\":{\"transmissionFactor\":0.75},"
+                 "\"KHR_materials_clearcoat\":{\"clearcoatFactor\":2,\"clearcoatNormalTexture\":{\"index\":0,\"scale\":0.25}},"
+                 "\"KHR_materials_volume\":{\"thicknessFactor\":0.5,\"attenuationDistance\":-1}}}],"
                  "\"textures\":[{\"source\":0,\"sampler\":0}],\"samplers\":[{\"wrapS\":33071,\"wrapT\":33648,\"magFilter\":9728}],"
                  "\"images\":[{\"uri\":\"%s\"}],"
                  "\"cameras\":[{\"name\":\"cam\",\"type\":\"perspective\",\"perspective\":{\"yfov\":0.5,\"znear\":0.1}}],"
@@ -572,6 +574,18 @@ static void test_valid(void)
             EXPECT_MSG(m->normal_texture.scale == 0.5f && m->emissive_strength == 3.0f && fabsf(m->ior - 1.3f) < 1e-6f &&
                        m->transmission == 0.75f,
                        "material extensions");
+            /* out of range: clamped with a warning naming material and factor; the coat's normal map
+             * is the normal texture's (data role) */
+            EXPECT_MSG(m->clearcoat == 1.0f && m->clearcoat_normal_texture.scale == 0.25f &&
+                           m->clearcoat_normal_texture.texture.id == m->normal_texture.texture.id,
+                       "clearcoat %g, normal scale %g", (double)m->clearcoat, (double)m->clearcoat_normal_texture.scale);
+            EXPECT_MSG(m->thickness == 0.5f && m->attenuation_distance == 0.0f, "volume");
+            bool clamp_warned = false, attenuation_warned = false;
+            for (uint32_t w = 0; w < info.stored_warning_count; w++) {
+                clamp_warned |= strstr(info.warnings[w], "materials[0].KHR_materials_clearcoat.clearcoatFactor: 2 is outside") != NULL;
+                attenuation_warned |= strstr(info.warnings[w], "attenuationDistance: -1 is outside") != NULL;
+            }
+            EXPECT_MSG(clamp_warned && attenuation_warned, "clamping warned (%u warnings)", info.stored_warning_count);
             const sy_mesh_data *md = sy_mesh_get(s, (sy_mesh){sy_scene_next(s, SY_TYPE_MESH, 0)});
             const float *col = blob_f(md->primitives.items[0].colors);
             EXPECT_MSG(col && col[0] == 1 && col[1] == 0 && col[3] == 1 && col[5] == 1 && col[7] == 1, "vec3 unorm colours: %g %g %g %g / %g %g %g %g",

@@ -36,7 +36,6 @@ MIN_MEAN=0.02    # mean linear luminance over covered pixels (issue 15's "dark" 
 
 # Files that must fail to load, glob -> the word the error names (and why).
 EXPECT_FAIL=(
-  "*/IridescenceSuzanne/glTF-Binary/*|KHR_materials_iridescence|this form requires iridescence, which is not supported (the glTF/ form only uses it)"
 )
 # Renders that are legitimately dark: "glob|backend|reason" (backend * for all).
 DARK=(
