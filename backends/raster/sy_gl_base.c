@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 void *sy_gli_pool_get(const pool *p, uint32_t id)
 {
@@ -232,6 +233,25 @@ sy_gl_result sy_gli_gl_check(sy_gl_device *dev, const char *where, sy_gl_report 
     }
     return sy_gli_fail(rep, e == GL_OUT_OF_MEMORY ? SY_GL_ERROR_OUT_OF_MEMORY : SY_GL_ERROR_GL,
                 "%s: OpenGL error 0x%04x (%s)", where, (unsigned)e, sy_gl_provider_name(sy_gl_context_provider(dev->ctx)));
+}
+
+static double seconds(clockid_t clock)
+{
+    struct timespec ts;
+    clock_gettime(clock, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void sy_gli_profile_mark(sy_gl_device *dev, bool start, double t[2])
+{
+    t[0] = t[1] = 0.0;
+    if (!dev->profile) return;
+    dev->gl->Finish();
+    double now[2] = {seconds(CLOCK_MONOTONIC), seconds(CLOCK_PROCESS_CPUTIME_ID)};
+    for (int k = 0; k < 2; ++k) {
+        if (!start) t[k] = now[k] - dev->profile_t[k];
+        dev->profile_t[k] = now[k];
+    }
 }
 
 sy_gl_result sy_gli_current(sy_gl_device *dev, sy_gl_report *rep)

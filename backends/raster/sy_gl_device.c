@@ -37,6 +37,10 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
         return r;
     }
     const sy_gl_fns *gl = dev->gl = sy_gl_context_fns(dev->ctx);
+    const char *penv = getenv("SY_GL_PROFILE");
+    dev->profile = penv && *penv && strcmp(penv, "0") != 0;
+    double prof[2];
+    sy_gli_profile_mark(dev, true, prof);
     snprintf(dev->info, sizeof dev->info, "OpenGL %s on %s (%s)", (const char *)gl->GetString(GL_VERSION),
              (const char *)gl->GetString(GL_RENDERER), sy_gl_provider_name(dd.provider));
     GLint max_samples = 1, max_tex = 2048;
@@ -146,6 +150,8 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
         sy_gl_device_destroy(dev);
         return r;
     }
+    sy_gli_profile_mark(dev, false, prof);
+    if (dev->profile) fprintf(stderr, "raster profile: device programs and tables %.3f s (cpu %.3f)\n", prof[0], prof[1]);
     *out = dev;
     return SY_GL_OK;
 }

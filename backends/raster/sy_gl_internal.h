@@ -198,6 +198,10 @@ struct sy_gl_device {
     GLuint probe_fbo, probe_depth;
     uint32_t probe_size; /* the probes' side in texels (0: none made yet; see probe_size_for) */
     bool probes_dirty, in_probe_pass;
+    /* SY_GL_PROFILE=1 in the environment at sy_gl_device_create: sy_gl_render waits for the GL
+     * after each pass (glFinish) and prints the passes' wall and CPU times to stderr (sy_gli_profile_mark) */
+    bool profile;
+    double profile_t[2]; /* the last mark's wall and CPU time */
     targets t;
     bool lights_dirty;
     /* deferred shading */
@@ -317,6 +321,10 @@ void sy_gli_look_along(const float *eye, const float *dir, float *view);
 void sy_gli_projection(bool ortho, double l, double r, double b, double t, double n, double f, float *p);
 void sy_gli_count_buffer(sy_gl_device *dev, bool uniform, size_t bytes);
 sy_gl_result sy_gli_gl_check(sy_gl_device *dev, const char *where, sy_gl_report *rep);
+/* With dev->profile: waits for the GL and sets t to the wall and process CPU (all threads, the
+ * GL's included) seconds since the last mark (the first mark of a series passes start = true and
+ * gets 0); without it, zeros and no wait. */
+void sy_gli_profile_mark(sy_gl_device *dev, bool start, double t[2]);
 sy_gl_result sy_gli_current(sy_gl_device *dev, sy_gl_report *rep);
 void sy_gli_geometry_changed(sy_gl_device *dev);
 void sy_gli_frustum_planes(const float *m, float planes[6][4]);

@@ -172,6 +172,8 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     sy_gl_result r = frame_setup(dev, cam, d, &v, rep);
     if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
+    double prof[6][2]; /* environment, shadows, probes, main, read-back (wall, CPU); the frame */
+    sy_gli_profile_mark(dev, true, prof[0]);
     dev->frame_no++;
     sy_gli_shadow_size_follow(dev, d->width, d->height);
     uint32_t env_side = sy_gl_ibl_side(d->width, d->height);
@@ -195,6 +197,7 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         dev->probes_dirty = true;
     }
     if (dev->area_count && (r = sy_gl_ibl_tables(gl, &dev->ibl, rep)) != SY_GL_OK) return r;
+    sy_gli_profile_mark(dev, false, prof[0]);
     if (dev->lights_dirty) {
         sy_gli_choose_lods(dev, &v); /* shadow maps draw the levels this view picks */
         sy_gli_lights_upload(dev, &fs);
@@ -208,6 +211,7 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         dev->lights_dirty = false;
         dev->probes_dirty = true;
     }
+    sy_gli_profile_mark(dev, false, prof[1]);
     sy_gli_frame_features(dev);
     uint32_t psize = probe_size_for(dev, &v, d->width, d->height);
     if (psize != dev->probe_size) { /* a probed instance larger in view than before: sharper probes */
@@ -219,11 +223,23 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         if ((r = render_probes(dev, rep)) != SY_GL_OK) return r;
         dev->probes_dirty = false;
     }
+    sy_gli_profile_mark(dev, false, prof[2]);
     sy_gli_begin_target(dev, &v);
     sy_gli_bind_frame_resources(dev);
     r = sy_gli_draw_scene(dev, &v, UINT32_MAX, rep);
+    sy_gli_profile_mark(dev, false, prof[3]);
     if (r == SY_GL_OK) r = sy_gli_finish_target(dev, &v, rgba, depth, rep);
+    sy_gli_profile_mark(dev, false, prof[4]);
     sy_gli_frame_end(dev);
+    if (dev->profile) {
+        prof[5][0] = prof[5][1] = 0.0;
+        for (int i = 0; i < 5; ++i) prof[5][0] += prof[i][0], prof[5][1] += prof[i][1];
+        fprintf(stderr,
+                "raster profile: frame %.3f s (cpu %.3f): environment %.3f (%.3f), shadows %.3f (%.3f), probes %u %.3f "
+                "(%.3f), main %.3f (%.3f), resolve and read-back %.3f (%.3f)\n",
+                prof[5][0], prof[5][1], prof[0][0], prof[0][1], prof[1][0], prof[1][1], dev->probe_count, prof[2][0],
+                prof[2][1], prof[3][0], prof[3][1], prof[4][0], prof[4][1]);
+    }
     return r;
 }
 
