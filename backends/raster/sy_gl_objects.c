@@ -223,6 +223,40 @@ static sy_gl_result upload_levels(sy_gl_device *dev, const void *level0, uint32_
     return SY_GL_OK;
 }
 
+sy_gl_result sy_gli_cube_mipmaps(sy_gl_device *dev, GLuint cube, GLuint fbo, uint32_t side, sy_gl_report *rep)
+{
+    const sy_gl_fns *gl = dev->gl;
+    size_t below = 0;
+    for (uint32_t s = side; s > 1;) s /= 2, below += (size_t)s * s;
+    float *buf = malloc(((size_t)side * side + below) * 4 * sizeof(float));
+    if (!buf) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "scene probes: out of memory (mipmaps of %u texels)", side);
+    static const stbir_edge clamp[2] = {STBIR_EDGE_CLAMP, STBIR_EDGE_CLAMP};
+    gl->BindFramebuffer(GL_FRAMEBUFFER, fbo);
+    gl->ReadBuffer(GL_COLOR_ATTACHMENT0);
+    gl->PixelStorei(GL_PACK_ALIGNMENT, 4);
+    gl->BindTexture(GL_TEXTURE_CUBE_MAP, cube);
+    for (GLenum f = 0; f < 6; ++f) {
+        const GLenum face = GL_TEXTURE_CUBE_MAP_POSITIVE_X + f;
+        gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, face, cube, 0);
+        gl->ReadPixels(0, 0, (GLsizei)side, (GLsizei)side, GL_RGBA, GL_FLOAT, buf);
+        const float *prev = buf;
+        float *next = buf + (size_t)side * side * 4;
+        for (GLint level = 1, s = (GLint)side; s > 1; ++level) {
+            GLint ns = s / 2;
+            if (!resample(prev, (uint32_t)s, (uint32_t)s, next, (uint32_t)ns, (uint32_t)ns, true, false, clamp)) {
+                free(buf);
+                return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "scene probes: out of memory (mipmaps of %u texels)", side);
+            }
+            gl->TexImage2D(face, level, GL_RGBA16F, ns, ns, 0, GL_RGBA, GL_FLOAT, next);
+            prev = next;
+            next += (size_t)ns * ns * 4;
+            s = ns;
+        }
+    }
+    free(buf);
+    return SY_GL_OK;
+}
+
 sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d, sy_gl_texture *out)
 {
     sy_gl_report *rep = dev ? dev->report : NULL;

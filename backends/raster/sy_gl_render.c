@@ -145,8 +145,7 @@ static sy_gl_result render_probes(sy_gl_device *dev, sy_gl_report *rep)
             dev->frame_no++; /* the variants take this face's camera */
             r = sy_gli_draw_scene(dev, &v, dev->probes[p].inst, rep);
         }
-        gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->probes[p].cube);
-        gl->GenerateMipmap(GL_TEXTURE_CUBE_MAP);
+        if (r == SY_GL_OK) r = sy_gli_cube_mipmaps(dev, dev->probes[p].cube, dev->probe_fbo, (uint32_t)ps, rep);
     }
     dev->in_probe_pass = false;
     dev->frame_no++;
