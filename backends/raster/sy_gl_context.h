@@ -17,6 +17,7 @@
     X(PFNGLENABLEPROC, Enable) X(PFNGLDISABLEPROC, Disable) X(PFNGLENABLEIPROC, Enablei)                         \
     X(PFNGLDISABLEIPROC, Disablei) X(PFNGLVIEWPORTPROC, Viewport) X(PFNGLCLEARPROC, Clear)                       \
     X(PFNGLCLEARBUFFERFVPROC, ClearBufferfv) X(PFNGLCLEARDEPTHPROC, ClearDepth) X(PFNGLDEPTHFUNCPROC, DepthFunc) \
+    X(PFNGLCULLFACEPROC, CullFace)                                                                               \
     X(PFNGLDEPTHMASKPROC, DepthMask) X(PFNGLCOLORMASKPROC, ColorMask) X(PFNGLCOLORMASKIPROC, ColorMaski)          \
     X(PFNGLBLENDFUNCPROC, BlendFunc) X(PFNGLPOLYGONOFFSETPROC, PolygonOffset) X(PFNGLPIXELSTOREIPROC, PixelStorei) \
     X(PFNGLREADPIXELSPROC, ReadPixels) X(PFNGLREADBUFFERPROC, ReadBuffer) X(PFNGLDRAWBUFFERSPROC, DrawBuffers)   \

@@ -529,10 +529,40 @@ static void draw_gbuf(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const m
     rect_add(dev, mvp, m);
 }
 
+/* Culls the faces of a closed opaque surface that face away from the eye (mesh_o.lod_closed): the
+ * ray tracers see both sides of every triangle, but those of a closed surface wholly in front of
+ * the near plane lie behind its other faces. llvmpipe shades every fragment a multisampled draw
+ * covers, those that fail the depth test included (its per-sample depth test masks the fragments
+ * without skipping the shader, unlike the single-sampled path): TransmissionTest's glass spheres
+ * shaded their far halves (16 area lights each) for nothing, 0.3 s of its 1.2 s main pass
+ * (issue 32). Masked and blended materials show their far faces; a surface the near plane cuts
+ * shows its inside. */
+static void cull_hidden_faces(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const mesh_o *m, const mat_o *mt)
+{
+    unsigned want = 0;
+    int8_t closed = m->lod_closed[in->lod < m->lod_count ? in->lod : 0];
+    if (closed && (!mt || mt->d.alpha_mode == SY_GL_ALPHA_OPAQUE)) {
+        float c[3], scale, r = sy_gli_world_sphere(in, m, c, &scale);
+        const float *V = dc->v->view;
+        float depth = -(V[2] * c[0] + V[6] * c[1] + V[10] * c[2] + V[14]);
+        if (depth - r > dc->near + 1e-4f * fabsf(depth) && isfinite(depth - r))
+            want = (closed > 0) != in->mirror ? GL_BACK : GL_FRONT;
+    }
+    if (want == dc->cull) return;
+    const sy_gl_fns *gl = dev->gl;
+    if (!want) gl->Disable(GL_CULL_FACE);
+    else {
+        if (!dc->cull) gl->Enable(GL_CULL_FACE);
+        gl->CullFace(want);
+    }
+    dc->cull = want;
+}
+
 static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t index, const inst_o *in, const mesh_o *m,
                                   const mat_o *mt, sy_gl_report *rep)
 {
     const sy_gl_fns *gl = dev->gl;
+    cull_hidden_faces(dev, dc, in, m, mt);
     int probe = probe_of(dev, index);
     int pv = draw_variant(dev, m, mt, probe >= 0);
     if (dc->deferred && deferrable(dev, in, pv, mt)) {
@@ -619,6 +649,9 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
     sy_gl_result r = SY_GL_OK;
     draw_ctx dc = {.v = v, .ortho_z = {v->proj[10], v->proj[14], 0.0f}, .bound = -1};
     sy_gli_m4_mul(v->proj, v->view, dc.viewproj);
+    /* the near plane's distance: z_ndc = -1 (perspective: proj[14] / (proj[10] - 1), an infinite far
+     * plane included; orthographic: (1 + proj[14]) / proj[10]) */
+    dc.near = v->ortho ? (1.0f + v->proj[14]) / v->proj[10] : v->proj[14] / (v->proj[10] - 1.0f);
     uint32_t cap = dev->instances.count ? dev->instances.count : 1, nl[3] = {0, 0, 0};
     float *lists = malloc(sizeof(float) * 2 * 3 * cap);
     if (!lists) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "render: out of memory");
@@ -667,6 +700,10 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
             const inst_o *in = sy_gli_pool_at(&dev->instances, i);
             r = draw_instance(dev, &dc, i, in, sy_gli_pool_get(&dev->meshes, in->mesh.id),
                               sy_gli_pool_get(&dev->materials, in->material.id), rep);
+        }
+        if (dc.cull) { /* blended draws show their far faces; later passes expect no culling */
+            gl->Disable(GL_CULL_FACE);
+            dc.cull = 0;
         }
         if (li == 2 && nl[li]) {
             gl->DepthMask(GL_TRUE);

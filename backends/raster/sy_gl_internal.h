@@ -89,7 +89,13 @@ typedef struct mesh_o {
     uint32_t lod_count;          /* levels, 1 = the mesh only */
     uint32_t lod_first[LOD_MAX], lod_tris[LOD_MAX]; /* first index, triangles */
     float lod_error[LOD_MAX];    /* object-space deviation from level 0 (bound, metres) */
+    /* per level: 1 a closed surface (vertices welded by position, every edge in exactly two
+     * triangles of opposite direction) wound counter-clockwise seen from outside, -1 wound the other
+     * way, 0 not closed or not checked (over CLOSED_MAX_TRIANGLES); see cull_hidden_faces */
+    int8_t lod_closed[LOD_MAX];
 } mesh_o;
+/* The most triangles a level may have for the closed-surface check (a sort of 3 edges each). */
+#define CLOSED_MAX_TRIANGLES 131072u
 
 typedef struct tex_o {
     slot_head h;
@@ -299,6 +305,8 @@ typedef struct draw_ctx {
     int shared;                     /* the frame's shared_features: forward draws use them all
                                      * (draw_instance) */
     bool deferred, gbuf_view_set;   /* opaque draws may go to the G-buffer; its view uniforms are set */
+    float near;                     /* the view's near-plane distance (cull_hidden_faces) */
+    unsigned cull;                  /* the faces culled now: 0 none, GL_BACK or GL_FRONT */
 } draw_ctx;
 #define BOUND_GBUF (-2)
 

@@ -65,6 +65,54 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
     *count_out = used;
 }
 
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* mesh_o.lod_closed of the tris triangles idx (NULL: unindexed), vertices welded by weld (a vertex
+ * to the first of its position); keys: scratch for 3 tris edges. Degenerate triangles (two corners
+ * at one position) are left out: they cover no pixel. */
+static int8_t closed_surface(const sy_gl_mesh_desc *d, const uint32_t *idx, size_t tris, const uint32_t *weld, uint64_t *keys)
+{
+    size_t n = 0;
+    double vol = 0.0;
+    for (size_t t = 0; t < tris; ++t) {
+        uint32_t c[3];
+        for (int k = 0; k < 3; ++k) c[k] = weld[idx ? idx[3 * t + k] : (uint32_t)(3 * t + (size_t)k)];
+        if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
+        for (int k = 0; k < 3; ++k) keys[n++] = (uint64_t)c[k] << 32 | c[(k + 1) % 3];
+        const float *p0 = d->positions + 3u * (size_t)c[0], *p1 = d->positions + 3u * (size_t)c[1], *p2 = d->positions + 3u * (size_t)c[2];
+        vol += p0[0] * ((double)p1[1] * p2[2] - (double)p1[2] * p2[1]) + p0[1] * ((double)p1[2] * p2[0] - (double)p1[0] * p2[2]) +
+               p0[2] * ((double)p1[0] * p2[1] - (double)p1[1] * p2[0]);
+    }
+    if (!n || !(vol != 0.0)) return 0;
+    qsort(keys, n, sizeof *keys, cmp_u64);
+    for (size_t i = 0; i < n; ++i) { /* each directed edge once, and its reverse present */
+        if (i + 1 < n && keys[i] == keys[i + 1]) return 0;
+        uint64_t rev = keys[i] << 32 | keys[i] >> 32;
+        if (!bsearch(&rev, keys, n, sizeof *keys, cmp_u64)) return 0;
+    }
+    return vol > 0.0 ? 1 : -1;
+}
+
+/* mesh_o.lod_closed for every level of m (index buffer all, NULL for an unindexed mesh). */
+static void check_closed(const sy_gl_mesh_desc *d, mesh_o *m, const uint32_t *all)
+{
+    memset(m->lod_closed, 0, sizeof m->lod_closed);
+    if (d->triangle_count > CLOSED_MAX_TRIANGLES) return;
+    uint32_t *weld = malloc(sizeof *weld * d->vertex_count);
+    uint64_t *keys = malloc(sizeof *keys * 3u * d->triangle_count);
+    if (weld && keys) {
+        meshopt_generateVertexRemap(weld, NULL, d->vertex_count, d->positions, d->vertex_count, 3 * sizeof(float));
+        for (uint32_t k = 0; k < m->lod_count; ++k)
+            m->lod_closed[k] = closed_surface(d, all ? all + m->lod_first[k] : NULL, m->lod_tris[k], weld, keys);
+    }
+    free(weld);
+    free(keys);
+}
+
 sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_gl_mesh *out)
 {
     sy_gl_report *rep = dev ? dev->report : NULL;
@@ -108,6 +156,7 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     uint32_t *lods = NULL;
     size_t index_count = 0;
     build_lods(d, m, &lods, &index_count);
+    check_closed(d, m, lods ? lods : d->indices);
     gl->GenVertexArrays(1, &m->vao);
     gl->BindVertexArray(m->vao);
     /* one interleaved vertex buffer (present attributes only) + one index buffer */
