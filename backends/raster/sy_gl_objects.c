@@ -65,16 +65,21 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
     *count_out = used;
 }
 
-static int cmp_u64(const void *a, const void *b)
+/* The slot of key in the open-addressed table of 2^bits keys (0 = empty): where it is, or the empty
+ * slot where it would go. */
+static size_t edge_slot(const uint64_t *table, unsigned bits, uint64_t key)
 {
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return x < y ? -1 : x > y;
+    size_t mask = ((size_t)1 << bits) - 1u, i = (size_t)((key * 0x9E3779B97F4A7C15ull) >> (64u - bits));
+    while (table[i] && table[i] != key) i = (i + 1u) & mask;
+    return i;
 }
 
 /* mesh_o.lod_closed of the tris triangles idx (NULL: unindexed), vertices welded by weld (a vertex
- * to the first of its position); keys: scratch for 3 tris edges. Degenerate triangles (two corners
- * at one position) are left out: they cover no pixel. */
-static int8_t closed_surface(const sy_gl_mesh_desc *d, const uint32_t *idx, size_t tris, const uint32_t *weld, uint64_t *keys)
+ * to the id of its position); table: 2^bits zeroed slots, at least twice 3 tris, for the directed
+ * edges (a hash set: qsort and bsearch made MetalRoughSpheresNoTextures' 10^6 triangles cost 0.55 s). Degenerate
+ * triangles (two corners at one position) are left out: they cover no pixel. */
+static int8_t closed_surface(const sy_gl_mesh_desc *d, const uint32_t *idx, size_t tris, const uint32_t *weld,
+                             uint64_t *table, unsigned bits)
 {
     size_t n = 0;
     double vol = 0.0;
@@ -82,18 +87,20 @@ static int8_t closed_surface(const sy_gl_mesh_desc *d, const uint32_t *idx, size
         uint32_t c[3];
         for (int k = 0; k < 3; ++k) c[k] = weld[idx ? idx[3 * t + k] : (uint32_t)(3 * t + (size_t)k)];
         if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
-        for (int k = 0; k < 3; ++k) keys[n++] = (uint64_t)c[k] << 32 | c[(k + 1) % 3];
+        for (int k = 0; k < 3; ++k) { /* each directed edge once (a key is never 0: its ends differ) */
+            uint64_t key = (uint64_t)c[k] << 32 | c[(k + 1) % 3];
+            size_t i = edge_slot(table, bits, key);
+            if (table[i]) return 0;
+            table[i] = key;
+            n++;
+        }
         const float *p0 = d->positions + 3u * (size_t)c[0], *p1 = d->positions + 3u * (size_t)c[1], *p2 = d->positions + 3u * (size_t)c[2];
         vol += p0[0] * ((double)p1[1] * p2[2] - (double)p1[2] * p2[1]) + p0[1] * ((double)p1[2] * p2[0] - (double)p1[0] * p2[2]) +
                p0[2] * ((double)p1[0] * p2[1] - (double)p1[1] * p2[0]);
     }
     if (!n || !(vol != 0.0)) return 0;
-    qsort(keys, n, sizeof *keys, cmp_u64);
-    for (size_t i = 0; i < n; ++i) { /* each directed edge once, and its reverse present */
-        if (i + 1 < n && keys[i] == keys[i + 1]) return 0;
-        uint64_t rev = keys[i] << 32 | keys[i] >> 32;
-        if (!bsearch(&rev, keys, n, sizeof *keys, cmp_u64)) return 0;
-    }
+    for (size_t i = 0; i < ((size_t)1 << bits); ++i) /* and its reverse present */
+        if (table[i] && !table[edge_slot(table, bits, table[i] << 32 | table[i] >> 32)]) return 0;
     return vol > 0.0 ? 1 : -1;
 }
 
@@ -102,15 +109,19 @@ static void check_closed(const sy_gl_mesh_desc *d, mesh_o *m, const uint32_t *al
 {
     memset(m->lod_closed, 0, sizeof m->lod_closed);
     if (d->triangle_count > CLOSED_MAX_TRIANGLES) return;
+    unsigned bits = 4;
+    while (((size_t)1 << bits) < 6u * (size_t)d->triangle_count) bits++;
     uint32_t *weld = malloc(sizeof *weld * d->vertex_count);
-    uint64_t *keys = malloc(sizeof *keys * 3u * d->triangle_count);
-    if (weld && keys) {
+    uint64_t *table = malloc(sizeof *table << bits);
+    if (weld && table) {
         meshopt_generateVertexRemap(weld, NULL, d->vertex_count, d->positions, d->vertex_count, 3 * sizeof(float));
-        for (uint32_t k = 0; k < m->lod_count; ++k)
-            m->lod_closed[k] = closed_surface(d, all ? all + m->lod_first[k] : NULL, m->lod_tris[k], weld, keys);
+        for (uint32_t k = 0; k < m->lod_count; ++k) {
+            memset(table, 0, sizeof *table << bits);
+            m->lod_closed[k] = closed_surface(d, all ? all + m->lod_first[k] : NULL, m->lod_tris[k], weld, table, bits);
+        }
     }
     free(weld);
-    free(keys);
+    free(table);
 }
 
 sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_gl_mesh *out)
