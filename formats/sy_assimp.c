@@ -10,6 +10,7 @@
 #include "sy_sniff.h"
 
 #include <assimp/cimport.h>
+#include <assimp/cexport.h>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 
@@ -85,6 +86,8 @@ static sy_result main_name(asp_loader *L, const char *name)
     size_t n = strlen(L->model_dir) + bl + el + 1;
     if (!(L->main_name = malloc(n))) return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory");
     snprintf(L->main_name, n, "%s%s%s", L->model_dir, base, has ? "" : ext);
+    n = strlen(L->main_name);
+    L->obj = n > 4 && !strcasecmp(L->main_name + n - 4, ".obj");
     return SY_OK;
 }
 
@@ -221,6 +224,7 @@ out:
     free(L.mesh_bounds);
     free(L.objs);
     free(L.main_name);
+    for (size_t k = 0; k < L.mtl_dir_count; ++k) free(L.mtl_dirs[k]);
     free(L.model_dir);
     free(bytes);
     if (r) {
@@ -251,4 +255,55 @@ sy_result sy_assimp_load_memory(const void *data, size_t size, const char *name,
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_assimp_load_memory: data, name, base_dir and scene are required");
     }
     return load_common(name, data, size, base_dir, scene, opts, info_out, err);
+}
+
+/* >>reference (sy bench load) ------------------------------------------------------------------ */
+
+sy_result sy_assimp_reference_import(const char *path, sy_assimp_counts *counts_out, sy_error *err)
+{
+    if (counts_out) memset(counts_out, 0, sizeof *counts_out);
+    if (!path) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_assimp_reference_import: path is required");
+    pthread_mutex_lock(&g_assimp_lock);
+    const struct aiScene *s = aiImportFile(path, aiProcessPreset_TargetRealtime_MaxQuality);
+    char why[SY_ERROR_MESSAGE_MAX];
+    snprintf(why, sizeof why, "%s", s ? "" : aiGetErrorString());
+    pthread_mutex_unlock(&g_assimp_lock);
+    if (!s) return sy_error_set(err, SY_ERR_PARSE, "%s: Assimp cannot read it: %s", path, why);
+    if (counts_out) {
+        counts_out->meshes = s->mNumMeshes;
+        counts_out->materials = s->mNumMaterials;
+        counts_out->embedded_textures = s->mNumTextures;
+        for (unsigned i = 0; i < s->mNumMeshes; ++i)
+            for (unsigned f = 0; f < s->mMeshes[i]->mNumFaces; ++f) counts_out->triangles += s->mMeshes[i]->mFaces[f].mNumIndices == 3;
+    }
+    aiReleaseImport(s);
+    return SY_OK;
+}
+
+sy_result sy_assimp_export(const char *in, const char *format_id, const char *out, sy_error *err)
+{
+    if (!in || !format_id || !out)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_assimp_export: in, format_id and out are required");
+    bool known = false;
+    for (size_t k = 0, n = aiGetExportFormatCount(); k < n && !known; ++k) {
+        const struct aiExportFormatDesc *d = aiGetExportFormatDescription(k);
+        known = d && d->id && !strcmp(d->id, format_id);
+        aiReleaseExportFormatDescription(d);
+    }
+    if (!known) return sy_error_set(err, SY_ERR_UNSUPPORTED, "%s: Assimp has no exporter '%s'", out, format_id);
+    pthread_mutex_lock(&g_assimp_lock);
+    const struct aiScene *s = aiImportFile(in, aiProcess_Triangulate);
+    char why[SY_ERROR_MESSAGE_MAX] = "";
+    sy_result r = SY_OK;
+    if (!s) {
+        snprintf(why, sizeof why, "%s", aiGetErrorString());
+        r = SY_ERR_PARSE;
+    } else if (aiExportScene(s, format_id, out, 0) != aiReturn_SUCCESS) { /* the C API keeps no reason */
+        r = SY_ERR_IO;
+    }
+    if (s) aiReleaseImport(s);
+    pthread_mutex_unlock(&g_assimp_lock);
+    if (r == SY_ERR_PARSE) return sy_error_set(err, r, "%s: Assimp cannot read it: %s", in, why);
+    if (r) return sy_error_set(err, r, "%s: Assimp's '%s' exporter failed (it gives no reason through its C API)", out, format_id);
+    return SY_OK;
 }

@@ -140,6 +140,19 @@ sy_result sy_assimp_load_memory(const void *data, size_t size, const char *name,
 /** Frees the arrays in *info and zeroes it. NULL-safe. */
 void sy_assimp_info_free(sy_assimp_info *info);
 
+/** Assimp's own import of a trusted file, as `assimp info` makes it (Assimp 5.2's tools/assimp_cmd:
+ * aiProcessPreset_TargetRealtime_MaxQuality, Assimp's own file system, none of this loader's
+ * checks or confinement): the reference `sy bench load` times the loader against. counts_out
+ * (may be NULL): meshes, triangles (faces of three indices), materials, embedded textures of
+ * what Assimp returned. SY_ERR_PARSE with Assimp's reason. Same lock as the loads. */
+sy_result sy_assimp_reference_import(const char *path, sy_assimp_counts *counts_out, sy_error *err);
+
+/** Writes the trusted file `in` (read by Assimp with Triangulate only) to `out` through Assimp's
+ * exporter `format_id` ("fbx" binary FBX, "fbxa", "obj", "collada", ...; aiGetExportFormatDescription):
+ * how benchmarks and tests make files of formats no library here writes. SY_ERR_PARSE (cannot
+ * read), SY_ERR_IO (the exporter failed, with its reason), SY_ERR_UNSUPPORTED (no such exporter). */
+sy_result sy_assimp_export(const char *in, const char *format_id, const char *out, sy_error *err);
+
 /** Whether Assimp reads files of this extension (".3ds", "lwo", case-insensitive). */
 bool sy_assimp_reads_extension(const char *ext);
 

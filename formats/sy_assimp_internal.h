@@ -23,6 +23,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#define SY_ASSIMP_MTL_DIRS 8 /* MTL folders kept (an OBJ names its texture relative to its MTL) */
+
 typedef struct asp_created {
     uint32_t type, id;
 } asp_created;
@@ -55,6 +57,9 @@ typedef struct asp_loader {
     const uint8_t *main_data;
     size_t main_size;
     char *main_name;        /* the name Assimp opens the model by */
+    bool obj;               /* the model is Wavefront OBJ: the other files Assimp opens are MTL libraries */
+    char *mtl_dirs[SY_ASSIMP_MTL_DIRS]; /* their folders relative to the model's ("" = the same; '/'-terminated) */
+    size_t mtl_dir_count;
     sy_result io_result;    /* the first refused or failed file (fails the load) */
     char io_message[SY_ERROR_MESSAGE_MAX];
 } asp_loader;

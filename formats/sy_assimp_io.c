@@ -151,6 +151,21 @@ sy_result asp_read_named(asp_loader *L, const char *uri, void **data, size_t *si
     return r;
 }
 
+/* An MTL library the OBJ opened: its folder (as the model names it) kept once, for its textures. */
+static void note_mtl_dir(asp_loader *L, const char *uri)
+{
+    const char *slash = strrchr(uri, '/');
+    size_t n = slash ? (size_t)(slash - uri) + 1 : 0;
+    for (size_t k = 0; k < L->mtl_dir_count; ++k)
+        if (strlen(L->mtl_dirs[k]) == n && !strncmp(L->mtl_dirs[k], uri, n)) return;
+    if (L->mtl_dir_count == SY_ASSIMP_MTL_DIRS) return; /* more folders: their textures fall back to the model's folder */
+    char *d = malloc(n + 1);
+    if (!d) return; /* the same fallback */
+    memcpy(d, uri, n);
+    d[n] = '\0';
+    L->mtl_dirs[L->mtl_dir_count++] = d;
+}
+
 static struct aiFile *io_open(struct aiFileIO *io, const char *path, const char *mode)
 {
     asp_loader *L = (asp_loader *)(void *)io->UserData;
@@ -168,6 +183,7 @@ static struct aiFile *io_open(struct aiFileIO *io, const char *path, const char 
         }
         return NULL;
     }
+    if (L->obj) note_mtl_dir(L, uri_of(L, path));
     return serve(data, size, data);
 }
 

@@ -71,8 +71,11 @@ static sy_result decode_embedded(asp_loader *L, const struct aiTexture *t, sy_im
     return SY_OK;
 }
 
-/* A file the material names: as given (backslashes read as slashes) in the model's folder, else
- * its last part there (files made on another machine name their author's folders). */
+/* A file the material names: as given (backslashes read as slashes) relative to the folder of the
+ * OBJ's MTL library (the first of them where it is found; a relative name in an MTL is relative to
+ * the MTL, as Blender and three.js read it: Assimp keeps the name as written), else in the model's
+ * folder, else its last part there (files made on another machine name their author's folders).
+ * Every one confined (asp_read_named). */
 static sy_result read_texture_file(asp_loader *L, const char *path, const char *where, void **data, size_t *size,
                                    sy_error *e)
 {
@@ -81,7 +84,14 @@ static sy_result read_texture_file(asp_loader *L, const char *path, const char *
     for (char *c = uri; *c; ++c)
         if (*c == '\\') *c = '/';
     if (!strncmp(uri, "./", 2)) memmove(uri, uri + 2, strlen(uri + 2) + 1);
-    sy_result r = asp_read_named(L, uri, data, size, e);
+    sy_result r = SY_ERR_NOT_FOUND;
+    for (size_t k = 0; k < L->mtl_dir_count && uri[0] != '/' && r == SY_ERR_NOT_FOUND; ++k) {
+        if (!L->mtl_dirs[k][0]) continue; /* the model's folder: below */
+        char rel[1200];
+        snprintf(rel, sizeof rel, "%s%s", L->mtl_dirs[k], uri);
+        r = asp_read_named(L, rel, data, size, e);
+    }
+    if (r == SY_ERR_NOT_FOUND) r = asp_read_named(L, uri, data, size, e);
     if (r == SY_ERR_NOT_FOUND || (r == SY_ERR_LIMIT && (uri[0] == '/' || (uri[0] && uri[1] == ':')))) {
         const char *b = base_name(uri);
         sy_error e2 = {0};

@@ -236,9 +236,8 @@ int main(void)
     PATHF(q, "%s/model", dir);
     const char *roots[] = {q};
     sy_assimp_options ao = {.allowed_roots = roots, .allowed_root_count = 1};
-    /* the MTL is read; its texture is looked up in the model's folder (sub/), where it is not: a warning */
-    EXPECT_MSG(load(p, &ao, &info, &e) == SY_OK && info.counts.textures == 0 && info.warning_count == 1 &&
-                   strstr(info.warnings[0], "tex.ppm"),
+    /* the MTL is read; its texture is looked up relative to the MTL's folder (model/, allowed) */
+    EXPECT_MSG(load(p, &ao, &info, &e) == SY_OK && info.counts.textures == 1 && info.warning_count == 0,
                "MTL in an allowed root: %s", info.warning_count ? info.warnings[0] : e.message);
     const sy_material_data *red = NULL;
     for (uint32_t id = sy_scene_next(g_scene, SY_TYPE_MATERIAL, 0); id; id = sy_scene_next(g_scene, SY_TYPE_MATERIAL, id)) {
@@ -246,6 +245,46 @@ int main(void)
         if (x && x->name && !strcmp(x->name, "red")) red = x;
     }
     EXPECT_MSG(red && near(red->base_color[1], 0.25f), "material red from the MTL in the allowed root");
+    sy_assimp_info_free(&info);
+
+    /* an MTL in a subfolder (mtllib mtl/sub.mtl) names its texture relative to itself: tex/t.ppm is
+     * mtl/tex/t.ppm (as Blender and three.js read it), found without a warning */
+    PATHF(p, "%s/m2", dir);
+    mkdir(p, 0755);
+    PATHF(p, "%s/m2/mtl", dir);
+    mkdir(p, 0755);
+    PATHF(p, "%s/m2/mtl/tex", dir);
+    mkdir(p, 0755);
+    PATHF(p, "%s/m2/mtl/tex/t.ppm", dir);
+    EXPECT(write_bytes(p, ppm, sizeof ppm - 1) == 0);
+    PATHF(p, "%s/m2/mtl/sub.mtl", dir);
+    const char submtl[] = "newmtl m\nKd 1 1 1\nmap_Kd tex/t.ppm\n";
+    EXPECT(write_bytes(p, submtl, sizeof submtl - 1) == 0);
+    PATHF(p, "%s/m2/scene.obj", dir);
+    const char subobj[] = "mtllib mtl/sub.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n";
+    EXPECT(write_bytes(p, subobj, sizeof subobj - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.textures == 1 && info.warning_count == 0,
+               "texture relative to an MTL in a subfolder: %s", info.warning_count ? info.warnings[0] : e.message);
+    sy_assimp_info_free(&info);
+    /* still confined to the model's folder: ../../secret.ppm from m3/mtl/ is outside m3/ (refused,
+     * naming the way out), admitted by allowed_roots */
+    PATHF(p, "%s/secret.ppm", dir);
+    EXPECT(write_bytes(p, ppm, sizeof ppm - 1) == 0);
+    PATHF(p, "%s/m3", dir);
+    mkdir(p, 0755);
+    PATHF(p, "%s/m3/mtl", dir);
+    mkdir(p, 0755);
+    PATHF(p, "%s/m3/mtl/sub.mtl", dir);
+    const char outmtl[] = "newmtl m\nKd 1 1 1\nmap_Kd ../../secret.ppm\n";
+    EXPECT(write_bytes(p, outmtl, sizeof outmtl - 1) == 0);
+    PATHF(p, "%s/m3/scene.obj", dir);
+    EXPECT(write_bytes(p, subobj, sizeof subobj - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_LIMIT && strstr(e.message, "secret.ppm") && strstr(e.message, "--allow-path"),
+               "texture outside the model's folder through the MTL's folder: %s", e.message);
+    const char *droot[] = {dir};
+    sy_assimp_options dao = {.allowed_roots = droot, .allowed_root_count = 1};
+    EXPECT_MSG(load(p, &dao, &info, &e) == SY_OK && info.counts.textures == 1 && info.warning_count == 0,
+               "texture through the MTL's folder in an allowed root: %s", info.warning_count ? info.warnings[0] : e.message);
     sy_assimp_info_free(&info);
 
     /* a file Assimp cannot read: Assimp's reason and the file name */
