@@ -19,7 +19,7 @@
  * (texture v down, the scene's convention) and ValidateDataStructure while reading; Triangulate and
  * SortByPType (one primitive type per mesh) as a second pass once every face is checked to have
  * indices (a face without any is refused: Triangulate aborts the process on it); FindDegenerates
- * (degenerate triangles removed) as a third (with the others it crashes Assimp 5.2 on some
+ * (triangles and segments repeating a vertex removed; no area test) as a third (with the others it crashes Assimp 5.2 on some
  * malformed files).
  * Normal-mapped primitives get generated tangents (sy_mesh_util.h, as glTF's).
  *
@@ -35,7 +35,8 @@
  * colour texture (sRGB), emissive -> emissive texture (sRGB), normal map -> normal texture,
  * ambient occlusion -> occlusion texture; other slots (specular, shininess, opacity, height / bump,
  * displacement, light map, reflection, separate metalness / roughness maps) are skipped with a
- * warning. Textures are files in the model's folder (decoded with stb_image, sy_image.h) or
+ * warning. Textures are files in the model's folder (an OBJ's relative names first relative to the
+ * folder of its MTL library, then to the model's; decoded with stb_image, sy_image.h) or
  * embedded in the file (Assimp's aiTexture: compressed ones decoded the same way, raw ones taken
  * as they are).
  *

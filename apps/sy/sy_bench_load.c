@@ -1,8 +1,12 @@
 /* sy_bench_load.c — `sy bench load` (formats, issue 6): tinygltf's parse against the whole
  * sy_gltf_load, and the peak RSS of a load, for the glTF samples and a generated .glb; also writes
- * the generated .glb for sy bench memory (sy_bench_write_grid_glb; see sy_bench.h). */
+ * the generated .glb for sy bench memory (sy_bench_write_grid_glb; see sy_bench.h). The Assimp part
+ * (issue 34): a generated OBJ (text, written here) and the same grid as binary FBX (Assimp's own
+ * exporter), sy_assimp_load against Assimp's own import as `assimp info` makes it, each in a forked
+ * child: wall time and peak RSS against the bytes of the scene the load made. */
 #include "sy_bench.h"
 
+#include "sy_assimp.h"
 #include "sy_file.h"
 #include "sy_gltf.h"
 #include "sy_gltf_shim.h"
@@ -185,6 +189,204 @@ sy_result sy_bench_write_grid_glb(const char *path, uint32_t grid, sy_error *err
     return r;
 }
 
+/* >>assimp (issue 34) ------------------------------------------------------------------------- */
+
+/* What one forked child measured. */
+typedef struct asp_run {
+    int ok;
+    char message[sizeof(((sy_error *)0)->message)];
+    double seconds, scene_bytes; /* the call's wall time; the mesh and texture bytes of the made scene */
+    long peak_kib;               /* RSS high-water mark less the RSS at the start */
+    uint32_t meshes, tris;
+} asp_run;
+
+/* Bytes the scene's meshes and textures hold (blob payloads). */
+static double scene_bytes(sy_scene *s)
+{
+    double b = 0;
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_MESH, 0); id; id = sy_scene_next(s, SY_TYPE_MESH, id)) {
+        const sy_mesh_data *m = sy_object_get(s, SY_TYPE_MESH, id);
+        for (uint32_t i = 0; m && i < m->primitives.count; ++i) {
+            const sy_primitive *p = &m->primitives.items[i];
+            b += (double)(sy_blob_size(p->positions) + sy_blob_size(p->normals) + sy_blob_size(p->tangents) +
+                          sy_blob_size(p->texcoords0) + sy_blob_size(p->texcoords1) + sy_blob_size(p->colors) +
+                          sy_blob_size(p->indices));
+        }
+    }
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_TEXTURE, 0); id; id = sy_scene_next(s, SY_TYPE_TEXTURE, id)) {
+        const sy_texture_data *t = sy_object_get(s, SY_TYPE_TEXTURE, id);
+        if (t) b += (double)sy_blob_size(t->pixels);
+    }
+    return b;
+}
+
+/* One load in a forked child: sy's (sy_assimp_load into a fresh scene, as sy render makes it) or
+ * Assimp's own (`reference`). */
+static void asp_child(const char *path, bool reference, asp_run *o)
+{
+    sy_error e = {0};
+    memset(o, 0, sizeof *o);
+    long base = sy_bench_rss_now_kib();
+    sy_result r;
+    double t0 = sy_time_now();
+    if (reference) {
+        sy_assimp_counts c;
+        r = sy_assimp_reference_import(path, &c, &e);
+        o->seconds = sy_time_now() - t0;
+        o->meshes = c.meshes;
+        o->tris = c.triangles;
+    } else {
+        sy_scene *s = NULL;
+        sy_assimp_info info = {0};
+        r = sy_scene_create(&s, &e);
+        t0 = sy_time_now();
+        if (r == SY_OK) r = sy_assimp_load(path, s, NULL, &info, &e);
+        o->seconds = sy_time_now() - t0;
+        o->meshes = info.counts.meshes;
+        o->tris = info.counts.triangles;
+        if (r == SY_OK) o->scene_bytes = scene_bytes(s);
+        sy_assimp_info_free(&info);
+        /* the scene stays: the peak is read below, destroying it frees nothing the peak counted */
+    }
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    o->peak_kib = ru.ru_maxrss - base;
+    o->ok = r == SY_OK;
+    snprintf(o->message, sizeof o->message, "%s", e.message);
+}
+
+static sy_result asp_run_forked(const char *path, bool reference, asp_run *o, sy_error *err)
+{
+    int fds[2];
+    if (pipe(fds) != 0) return sy_error_set(err, SY_ERR_IO, "bench load: pipe failed");
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid < 0) {
+        close(fds[0]);
+        close(fds[1]);
+        return sy_error_set(err, SY_ERR_IO, "bench load: fork failed");
+    }
+    if (pid == 0) {
+        close(fds[0]);
+        asp_run run;
+        asp_child(path, reference, &run);
+        ssize_t w = write(fds[1], &run, sizeof run);
+        _exit(w == (ssize_t)sizeof run ? 0 : 1);
+    }
+    close(fds[1]);
+    ssize_t got = read(fds[0], o, sizeof *o);
+    close(fds[0]);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (got != (ssize_t)sizeof *o)
+        return sy_error_set(err, SY_ERR_IO, "%s: the measuring child died (status %d)", path, status);
+    if (!o->ok) return sy_error_set(err, SY_ERR_PARSE, "%s", o->message);
+    return SY_OK;
+}
+
+static int cmp_run_seconds(const void *a, const void *b)
+{
+    double x = ((const asp_run *)a)->seconds, y = ((const asp_run *)b)->seconds;
+    return x < y ? -1 : x > y;
+}
+
+/* Median of `repeats` forked loads each way; one row. */
+static sy_result bench_assimp_one(const char *label, const char *path, uint32_t repeats, sy_error *err)
+{
+    asp_run *runs = calloc((size_t)repeats * 2, sizeof *runs);
+    if (!runs) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench load: out of memory");
+    sy_result r = SY_OK;
+    for (uint32_t k = 0; k < repeats && r == SY_OK; ++k) {
+        r = asp_run_forked(path, true, &runs[k], err);
+        if (r == SY_OK) r = asp_run_forked(path, false, &runs[repeats + k], err);
+    }
+    if (r == SY_OK) {
+        qsort(runs, repeats, sizeof *runs, cmp_run_seconds);
+        qsort(runs + repeats, repeats, sizeof *runs, cmp_run_seconds);
+        const asp_run *a = &runs[repeats / 2], *s = &runs[repeats + repeats / 2];
+        struct stat st;
+        double file = stat(path, &st) == 0 ? (double)st.st_size : 0;
+        printf("%-24s %8.2f %9u %9u %10.1f %10.1f %7.2fx %9.1f %9.1f %9.1f %7.2fx\n", label, file / 1048576.0, a->tris,
+               s->tris, a->seconds * 1e3, s->seconds * 1e3, a->seconds > 0 ? s->seconds / a->seconds : 0.0,
+               (double)a->peak_kib / 1024.0, (double)s->peak_kib / 1024.0, s->scene_bytes / 1048576.0,
+               s->scene_bytes > 0 ? (double)s->peak_kib * 1024.0 / s->scene_bytes : 0.0);
+        fflush(stdout);
+    } else {
+        sy_error_prefix(err, "%s", label);
+    }
+    free(runs);
+    return r;
+}
+
+/* A text OBJ of the grid sy_bench_write_grid_glb makes: v, vt, vn per grid vertex, two triangles
+ * per cell (f a/a/a b/b/b c/c/c). */
+static sy_result write_grid_obj(const char *path, uint32_t grid, sy_error *err)
+{
+    sy_atomic_file af = {0};
+    sy_result r = sy_atomic_file_begin(path, &af, err);
+    if (r) return r;
+    bool ok = fprintf(af.fp, "# sy bench load: %u x %u grid, %u triangles\no grid\n", grid, grid, 2 * grid * grid) > 0;
+    for (uint32_t y = 0; ok && y <= grid; y++)
+        for (uint32_t x = 0; ok && x <= grid; x++) {
+            float fx = (float)x / (float)grid, fy = (float)y / (float)grid;
+            ok = fprintf(af.fp, "v %.6g %.6g %.6g\nvt %.6g %.6g\nvn 0 1 0\n", fx, 0.05f * sinf(12.0f * fx) * cosf(9.0f * fy),
+                         fy, fx, fy) > 0;
+        }
+    for (uint32_t y = 0; ok && y < grid; y++)
+        for (uint32_t x = 0; ok && x < grid; x++) {
+            uint32_t a = y * (grid + 1) + x + 1, c = a + grid + 1; /* 1-based */
+            ok = fprintf(af.fp, "f %u/%u/%u %u/%u/%u %u/%u/%u\nf %u/%u/%u %u/%u/%u %u/%u/%u\n", a, a, a, c, c, c, a + 1,
+                         a + 1, a + 1, a + 1, a + 1, a + 1, c, c, c, c + 1, c + 1, c + 1) > 0;
+        }
+    if (!ok) {
+        sy_atomic_file_abort(&af);
+        return sy_error_set(err, SY_ERR_IO, "%s: write failed", path);
+    }
+    return sy_atomic_file_commit(&af, err);
+}
+
+/* The Assimp part: the generated grid as OBJ and as binary FBX. */
+static sy_result bench_assimp(uint32_t tris, uint32_t repeats, sy_error *err)
+{
+    printf("\nAssimp formats: median of %u loads each way, each in a forked child; 'assimp' = Assimp's own import as\n"
+           "`assimp info` makes it (aiProcessPreset_TargetRealtime_MaxQuality), 'sy load' = sy_assimp_load into a fresh\n"
+           "scene (as sy render); peak = RSS growth of the child; scene = the mesh and texture bytes the load made\n\n",
+           (unsigned)repeats);
+    printf("%-24s %8s %9s %9s %10s %10s %8s %9s %9s %9s %8s\n", "model", "file MB", "tris", "sy tris", "assimp",
+           "sy load", "ratio", "assimp pk", "sy peak", "scene MB", "pk/scene");
+    printf("%-24s %8s %9s %9s %10s %10s %8s %9s %9s %9s %8s\n", "", "", "", "", "ms", "ms", "", "MB", "MB", "", "");
+    char dir[] = "/tmp/sy_bench_load_assimp_XXXXXX", obj[128], fbx[128];
+    if (!mkdtemp(dir)) return sy_error_set(err, SY_ERR_IO, "bench load: cannot create a temporary directory");
+    snprintf(obj, sizeof obj, "%s/grid.obj", dir);
+    snprintf(fbx, sizeof fbx, "%s/grid.fbx", dir);
+    uint32_t grid = (uint32_t)ceil(sqrt((double)tris / 2.0));
+    char label[64];
+    sy_result r = write_grid_obj(obj, grid, err);
+    if (r == SY_OK) {
+        snprintf(label, sizeof label, "grid OBJ (%u tris)", 2 * grid * grid);
+        r = bench_assimp_one(label, obj, repeats, err);
+    }
+    /* binary FBX first; Assimp 5.2's binary exporter leaves out the null records that end each node
+     * list (assimp/assimp#4686), so its own reader refuses the file ("block offset is out of range"):
+     * then the same grid as ASCII FBX, which it writes whole */
+    const char *kind = "binary";
+    sy_error e2 = {0};
+    if (r == SY_OK) r = sy_assimp_export(obj, "fbx", fbx, err);
+    if (r == SY_OK && sy_assimp_reference_import(fbx, NULL, &e2) != SY_OK) {
+        printf("(Assimp cannot read its own binary FBX export: %s; ASCII FBX instead)\n", e2.message);
+        kind = "ASCII";
+        r = sy_assimp_export(obj, "fbxa", fbx, err);
+    }
+    if (r == SY_OK) {
+        snprintf(label, sizeof label, "grid %s FBX (%u tris)", kind, 2 * grid * grid);
+        r = bench_assimp_one(label, fbx, repeats, err);
+    }
+    unlink(obj);
+    unlink(fbx);
+    rmdir(dir);
+    return r;
+}
+
 sy_result sy_bench_load(const char *data_dir, uint32_t tris, uint32_t repeats, sy_error *err)
 {
     printf("sy bench load: median of %u loads; 'tinygltf' = read + tinygltf parse alone (buffers, images decoded),\n"
@@ -241,5 +443,6 @@ sy_result sy_bench_load(const char *data_dir, uint32_t tris, uint32_t repeats, s
     if (r == SY_OK) r = bench_one_load(label, path, repeats, err);
     unlink(path);
     rmdir(dir);
+    if (r == SY_OK) r = bench_assimp(tris, repeats, err);
     return r;
 }
