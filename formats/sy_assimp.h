@@ -33,9 +33,12 @@
  * ior from the refraction index only where the material transmits; double-sided from the
  * two-sided flag; shading model "no shading" -> unlit. Textures: diffuse / base colour -> base
  * colour texture (sRGB), emissive -> emissive texture (sRGB), normal map -> normal texture,
- * ambient occlusion -> occlusion texture; other slots (specular, shininess, opacity, height / bump,
- * displacement, light map, reflection, separate metalness / roughness maps) are skipped with a
- * warning. Textures are files in the model's folder (an OBJ's relative names first relative to the
+ * ambient occlusion -> occlusion texture; separate metalness / roughness maps -> one combined
+ * metallic-roughness texture made on load (G = roughness map, B = metalness map, their first
+ * channels; a missing map's channel 255; different sizes: the smaller resampled to the larger
+ * with stb_image_resize and a warning; a mapped channel without a factor in the file gets factor
+ * 1); other slots (specular, shininess, opacity, height / bump, displacement, light map,
+ * reflection) are skipped with a warning. Textures are files in the model's folder (an OBJ's relative names first relative to the
  * folder of its MTL library, then to the model's; decoded with stb_image, sy_image.h) or
  * embedded in the file (Assimp's aiTexture: compressed ones decoded the same way, raw ones taken
  * as they are).

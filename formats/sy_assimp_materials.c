@@ -2,7 +2,8 @@
  * sy_assimp.h and docs/FORMATS.md; classic shading through sy_classic.h) and their textures: files
  * named by the material (confined to the model's folder, decoded by sy_image.h) and textures
  * embedded in the file (compressed: decoded the same way; raw BGRA texels: taken as they are),
- * one sy_texture per (image, colour role). */
+ * one sy_texture per (image, colour role); separate metalness and roughness maps combined into one
+ * metallic-roughness texture (resampled with stb_image_resize where their sizes differ). */
 #include "sy_assimp_internal.h"
 
 #include "sy_classic.h"
@@ -11,6 +12,7 @@
 #include <assimp/material.h>
 
 #include <dirent.h>
+#include <stb_image_resize.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -117,16 +119,43 @@ static sy_result read_texture_file(asp_loader *L, const char *path, const char *
     return r;
 }
 
-/* The texture for path in a colour (srgb) or data role; {0} with a warning when it cannot be made. */
-static sy_result get_texture(asp_loader *L, const char *path, bool srgb, const char *where, sy_texture *out,
-                             uint32_t *channels)
+/* The decoded pixels of the image at path (embedded or a file). SY_OK with img->pixels NULL: it
+ * cannot be made (warned, counted as skipped); an error fails the load (a refused path). */
+static sy_result image_pixels(asp_loader *L, const char *path, const char *where, sy_image_pixels *img)
 {
-    *out = (sy_texture){0};
-    *channels = 0;
+    *img = (sy_image_pixels){0};
+    sy_error e = {0};
+    sy_result r;
+    const struct aiTexture *t = embedded(L, path);
+    if (t) {
+        r = decode_embedded(L, t, img, &e);
+    } else if (path[0] == '*') {
+        r = sy_error_set(&e, SY_ERR_PARSE, "no embedded texture %s", path);
+    } else {
+        void *data = NULL;
+        size_t size = 0;
+        r = read_texture_file(L, path, where, &data, &size, &e);
+        if (r == SY_ERR_LIMIT && !strstr(e.message, "scene budget")) return sy_error_set(&L->err, r, "%s", e.message); /* refused path */
+        if (r == SY_OK) r = sy_image_decode(data, size, L->opt.max_image_pixels, &L->budget, img, &e);
+        free(data);
+    }
+    if (r == SY_OK) return SY_OK;
+    if (r == SY_ERR_NOT_FOUND) asp_warn(L, "%s: texture '%s' not found in the model's folder; no texture", where, path);
+    else asp_warn(L, "%s: texture '%s': %s; no texture", where, path, e.message);
+    L->info->counts.skipped++;
+    *img = (sy_image_pixels){0};
+    return SY_OK;
+}
+
+/* A cache slot for (key, srgb): *found when the texture was made (or failed) before. */
+static sy_result texture_slot_for(asp_loader *L, const char *key, bool srgb, const char *where, asp_texture **slot,
+                                  bool *found)
+{
+    *found = false;
     for (size_t k = 0; k < L->texture_count; ++k)
-        if (L->textures[k].srgb == srgb && !strcmp(L->textures[k].key, path)) {
-            *out = L->textures[k].tex;
-            *channels = L->textures[k].channels;
+        if (L->textures[k].srgb == srgb && !strcmp(L->textures[k].key, key)) {
+            *slot = &L->textures[k];
+            *found = true;
             return SY_OK;
         }
     if (L->texture_count == L->texture_cap) {
@@ -136,56 +165,53 @@ static sy_result get_texture(asp_loader *L, const char *path, bool srgb, const c
         L->textures = n;
         L->texture_cap = cap;
     }
-    asp_texture *slot = &L->textures[L->texture_count];
-    if (!(slot->key = strdup(path))) return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", where);
-    slot->srgb = srgb;
-    slot->tex = (sy_texture){0};
-    slot->channels = 0;
+    asp_texture *sl = &L->textures[L->texture_count];
+    if (!(sl->key = strdup(key))) return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", where);
+    sl->srgb = srgb;
+    sl->tex = (sy_texture){0};
+    sl->channels = 0;
     L->texture_count++;
+    *slot = sl;
+    return SY_OK;
+}
 
-    sy_image_pixels img = {0};
-    sy_error e = {0};
-    sy_result r;
-    const struct aiTexture *t = embedded(L, path);
-    if (t) {
-        r = decode_embedded(L, t, &img, &e);
-    } else if (path[0] == '*') {
-        r = sy_error_set(&e, SY_ERR_PARSE, "no embedded texture %s", path);
-    } else {
-        void *data = NULL;
-        size_t size = 0;
-        r = read_texture_file(L, path, where, &data, &size, &e);
-        if (r == SY_ERR_LIMIT && !strstr(e.message, "scene budget")) return sy_error_set(&L->err, r, "%s", e.message); /* refused path */
-        if (r == SY_OK) r = sy_image_decode(data, size, L->opt.max_image_pixels, &L->budget, &img, &e);
-        free(data);
-    }
-    if (r == SY_ERR_NOT_FOUND) {
-        asp_warn(L, "%s: texture '%s' not found in the model's folder; no texture", where, path);
-        L->info->counts.skipped++;
-        return SY_OK;
-    }
-    if (r) {
-        asp_warn(L, "%s: texture '%s': %s; no texture", where, path, e.message);
-        L->info->counts.skipped++;
-        return SY_OK;
-    }
+/* A texture of the pixels (taken: freed on every path) into slot. */
+static sy_result make_texture(asp_loader *L, sy_image_pixels *img, const char *name, const char *where, asp_texture *slot)
+{
     sy_blob *blob = NULL;
-    r = sy_blob_create_take(img.pixels, (size_t)img.width * img.height * img.channels, &blob, &L->err);
+    sy_result r = sy_blob_create_take(img->pixels, (size_t)img->width * img->height * img->channels, &blob, &L->err);
     if (r) {
-        sy_image_pixels_free(&img);
+        sy_image_pixels_free(img);
         return r;
     }
+    img->pixels = NULL;
     uint32_t id = 0;
-    sy_image_info ii = {img.width, img.height, img.channels, srgb ? SY_PIXEL_U8_SRGB : SY_PIXEL_U8_LINEAR};
-    if (!(r = asp_new(L, SY_TYPE_TEXTURE, base_name(path), where, &id)))
-        r = sy_texture_set_image(L->scene, (sy_texture){id}, &ii, blob, &L->err);
+    sy_image_info ii = {img->width, img->height, img->channels, slot->srgb ? SY_PIXEL_U8_SRGB : SY_PIXEL_U8_LINEAR};
+    if (!(r = asp_new(L, SY_TYPE_TEXTURE, name, where, &id))) r = sy_texture_set_image(L->scene, (sy_texture){id}, &ii, blob, &L->err);
     sy_blob_release(blob);
     if (r) return r;
     slot->tex = (sy_texture){id};
-    slot->channels = img.channels;
+    slot->channels = img->channels;
     L->info->counts.textures++;
+    return SY_OK;
+}
+
+/* The texture for path in a colour (srgb) or data role; {0} with a warning when it cannot be made. */
+static sy_result get_texture(asp_loader *L, const char *path, bool srgb, const char *where, sy_texture *out,
+                             uint32_t *channels)
+{
+    *out = (sy_texture){0};
+    *channels = 0;
+    asp_texture *slot = NULL;
+    bool found;
+    sy_result r = texture_slot_for(L, path, srgb, where, &slot, &found);
+    if (r == SY_OK && !found) {
+        sy_image_pixels img;
+        if ((r = image_pixels(L, path, where, &img)) == SY_OK && img.pixels) r = make_texture(L, &img, base_name(path), where, slot);
+    }
+    if (r) return r;
     *out = slot->tex;
-    *channels = img.channels;
+    *channels = slot->channels;
     return SY_OK;
 }
 
@@ -229,6 +255,155 @@ static sy_result texture_slot(asp_loader *L, unsigned i, enum aiTextureType type
     ref->texcoord = uv;
     ref->scale = 1.0f;
     ref->uv_scale[0] = ref->uv_scale[1] = 1.0f;
+    return SY_OK;
+}
+
+/* >>metallic-roughness ------------------------------------------------------------------------ */
+
+/* A single-channel map of material i: its path, texture coordinate set and wrap modes. */
+typedef struct asp_map {
+    struct aiString path;
+    unsigned uv;
+    enum aiTextureMapMode mm[2];
+    sy_image_pixels img;
+} asp_map;
+
+static bool get_map(asp_loader *L, unsigned i, enum aiTextureType type, const char *slot, asp_map *out)
+{
+    const struct aiMaterial *m = L->ai->mMaterials[i];
+    memset(out, 0, sizeof *out);
+    out->mm[0] = out->mm[1] = aiTextureMapMode_Wrap;
+    enum aiTextureMapping mapping = aiTextureMapping_UV;
+    if (!aiGetMaterialTextureCount(m, type) ||
+        aiGetMaterialTexture(m, type, 0, &out->path, &mapping, &out->uv, NULL, NULL, out->mm, NULL) != aiReturn_SUCCESS)
+        return false;
+    if (mapping != aiTextureMapping_UV) {
+        asp_warn(L, "materials[%u].%s: texture '%s' uses a projection (%d), not texture coordinates; no texture", i, slot,
+                 asp_str(&out->path), (int)mapping);
+        L->info->counts.skipped++;
+        return false;
+    }
+    if (out->uv > 1) {
+        asp_warn(L, "materials[%u].%s: texture coordinate set %u not kept; set 0 used", i, slot, out->uv);
+        out->uv = 0;
+    }
+    return true;
+}
+
+/* Resamples *img (the first channel kept) to w x h with stb_image_resize; false: out of memory
+ * or budget (warned). */
+static bool resample_first_channel(asp_loader *L, const char *where, const char *what, sy_image_pixels *img, uint32_t w,
+                                   uint32_t h)
+{
+    if (!sy_budget_fits(&L->budget, (uint64_t)w * h, 1)) {
+        asp_warn(L, "%s: resampling the %s map to %ux%u exceeds what is left of the scene budget; no texture", where, what, w, h);
+        return false;
+    }
+    uint8_t *grey = malloc((size_t)img->width * img->height), *out = malloc((size_t)w * h);
+    if (!grey || !out) {
+        free(grey);
+        free(out);
+        asp_warn(L, "%s: out of memory resampling the %s map; no texture", where, what);
+        return false;
+    }
+    for (size_t k = 0, n = (size_t)img->width * img->height; k < n; ++k) grey[k] = img->pixels[k * img->channels];
+    int ok = stbir_resize_uint8(grey, (int)img->width, (int)img->height, 0, out, (int)w, (int)h, 0, 1);
+    free(grey);
+    if (!ok) {
+        free(out);
+        asp_warn(L, "%s: stb_image_resize failed on the %s map; no texture", where, what);
+        return false;
+    }
+    (void)sy_budget_charge(&L->budget, (uint64_t)w * h, 1, NULL, "texture");
+    sy_image_pixels_free(img);
+    *img = (sy_image_pixels){out, w, h, 1};
+    return true;
+}
+
+/* Separate metalness and roughness maps (aiTextureType_METALNESS, _DIFFUSE_ROUGHNESS: FBX PBR,
+ * MTL map_Pm / map_Pr) into the core's one metallic-roughness texture (the rule in sy_assimp.h):
+ * G = the roughness map's first channel, B = the metalness map's, R 255; a missing map leaves
+ * its channel 255 (the factor alone). Maps of different sizes: the smaller resampled to the
+ * larger's size (stb_image_resize), with a warning. Both slots naming one image: a packed glTF
+ * texture, taken as it is. Where the file gives no factor for a mapped channel, the factor is 1
+ * (the map decides). Made once per pair of images. */
+static sy_result metallic_roughness_maps(asp_loader *L, unsigned i, const char *name, bool has_metallic,
+                                         bool has_roughness, sy_material_data *md)
+{
+    asp_map mt, rg;
+    bool hm = get_map(L, i, aiTextureType_METALNESS, "metalness", &mt);
+    bool hr = get_map(L, i, aiTextureType_DIFFUSE_ROUGHNESS, "roughness", &rg);
+    if (!hm && !hr) return SY_OK;
+    char where[96];
+    snprintf(where, sizeof where, "materials[%u] '%.40s' metallic-roughness", i, name);
+    const asp_map *first = hm ? &mt : &rg;
+    if (hm && hr && mt.uv != rg.uv)
+        asp_warn(L, "%s: metalness and roughness maps use texture coordinate sets %u and %u; set %u used for both", where,
+                 mt.uv, rg.uv, mt.uv);
+    sy_texture tex = {0};
+    uint32_t ch = 0;
+    sy_result r;
+    if (hm && hr && !strcmp(asp_str(&mt.path), asp_str(&rg.path))) { /* one packed image */
+        if ((r = get_texture(L, asp_str(&mt.path), false, where, &tex, &ch))) return r;
+    } else {
+        char key[2 * MAXLEN + 8];
+        snprintf(key, sizeof key, "\001mr\n%s\n%s", hm ? asp_str(&mt.path) : "", hr ? asp_str(&rg.path) : "");
+        asp_texture *slot = NULL;
+        bool found;
+        if ((r = texture_slot_for(L, key, false, where, &slot, &found))) return r;
+        if (!found) {
+            if (hm && (r = image_pixels(L, asp_str(&mt.path), where, &mt.img))) return r;
+            if (hr && (r = image_pixels(L, asp_str(&rg.path), where, &rg.img))) {
+                sy_image_pixels_free(&mt.img);
+                return r;
+            }
+            sy_image_pixels *a = mt.img.pixels ? &mt.img : NULL, *b = rg.img.pixels ? &rg.img : NULL;
+            uint32_t w = a ? a->width : b ? b->width : 0, h = a ? a->height : b ? b->height : 0;
+            bool ok = a || b;
+            if (a && b && (a->width != b->width || a->height != b->height)) {
+                bool grow_b = (uint64_t)a->width * a->height >= (uint64_t)b->width * b->height;
+                sy_image_pixels *small = grow_b ? b : a, *big = grow_b ? a : b;
+                w = big->width;
+                h = big->height;
+                asp_warn(L, "%s: metalness map '%s' is %ux%u, roughness map '%s' %ux%u: the %s map resampled to %ux%u", where,
+                         asp_str(&mt.path), a->width, a->height, asp_str(&rg.path), b->width, b->height,
+                         grow_b ? "roughness" : "metalness", w, h);
+                ok = resample_first_channel(L, where, grow_b ? "roughness" : "metalness", small, w, h);
+            }
+            uint8_t *px = NULL;
+            if (ok && !sy_budget_fits(&L->budget, (uint64_t)w * h, 3)) {
+                asp_warn(L, "%s: %ux%u pixels exceed what is left of the scene budget; no texture", where, w, h);
+                ok = false;
+            }
+            if (ok && !(px = malloc((size_t)w * h * 3))) {
+                sy_image_pixels_free(&mt.img);
+                sy_image_pixels_free(&rg.img);
+                return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "%s: out of memory for %ux%u pixels", where, w, h);
+            }
+            for (size_t k = 0, n = ok ? (size_t)w * h : 0; k < n; ++k) {
+                px[3 * k] = 255;
+                px[3 * k + 1] = b ? b->pixels[k * b->channels] : 255;
+                px[3 * k + 2] = a ? a->pixels[k * a->channels] : 255;
+            }
+            sy_image_pixels_free(&mt.img);
+            sy_image_pixels_free(&rg.img);
+            if (ok) {
+                (void)sy_budget_charge(&L->budget, (uint64_t)w * h, 3, NULL, "texture");
+                sy_image_pixels img = {px, w, h, 3};
+                if ((r = make_texture(L, &img, base_name(asp_str(&first->path)), where, slot))) return r;
+            } else if (a || b) {
+                L->info->counts.skipped++;
+            }
+        }
+        tex = slot->tex;
+    }
+    if (!tex.id) return SY_OK;
+    sy_sampler smp = {map_wrap(first->mm[0]), map_wrap(first->mm[1]), SY_FILTER_LINEAR, SY_FILTER_LINEAR};
+    if ((r = sy_texture_set_sampler(L->scene, tex, &smp, &L->err))) return r;
+    md->metallic_roughness_texture = (sy_texture_ref){.texture = tex, .texcoord = first->uv, .scale = 1.0f,
+                                                      .uv_scale = {1.0f, 1.0f}};
+    if (hm && !has_metallic) md->metallic = 1.0f;
+    if (hr && !has_roughness) md->roughness = 1.0f;
     return SY_OK;
 }
 
@@ -325,14 +500,21 @@ sy_result asp_create_material(asp_loader *L, unsigned i)
     if (aiGetMaterialTextureCount(m, aiTextureType_UNKNOWN) && pbr) /* glTF 1 / 2 through Assimp: metallic-roughness */
         if ((r = texture_slot(L, i, aiTextureType_UNKNOWN, false, "metallic-roughness", &md.metallic_roughness_texture, &ch)))
             return r;
+    bool separate = aiGetMaterialTextureCount(m, aiTextureType_METALNESS) || aiGetMaterialTextureCount(m, aiTextureType_DIFFUSE_ROUGHNESS);
+    if (separate && md.metallic_roughness_texture.texture.id) {
+        asp_warn(L, "materials[%u] '%s': separate metalness / roughness maps besides a combined metallic-roughness texture; "
+                    "the combined one used", i, asp_str(&name));
+        L->info->counts.skipped++;
+    } else if (separate && (r = metallic_roughness_maps(L, i, asp_str(&name), has_metallic, has_roughness, &md))) {
+        return r;
+    }
     static const struct {
         enum aiTextureType type;
         const char *name;
     } skipped[] = {{aiTextureType_SPECULAR, "specular"},     {aiTextureType_SHININESS, "shininess"},
                    {aiTextureType_OPACITY, "opacity"},       {aiTextureType_HEIGHT, "height (bump)"},
                    {aiTextureType_DISPLACEMENT, "displacement"}, {aiTextureType_LIGHTMAP, "light map"},
-                   {aiTextureType_REFLECTION, "reflection"}, {aiTextureType_METALNESS, "metalness"},
-                   {aiTextureType_DIFFUSE_ROUGHNESS, "roughness"}, {aiTextureType_SHEEN, "sheen"},
+                   {aiTextureType_REFLECTION, "reflection"}, {aiTextureType_SHEEN, "sheen"},
                    {aiTextureType_CLEARCOAT, "clearcoat"},   {aiTextureType_TRANSMISSION, "transmission"}};
     for (size_t k = 0; k < sizeof skipped / sizeof skipped[0]; ++k) {
         if (!aiGetMaterialTextureCount(m, skipped[k].type)) continue;

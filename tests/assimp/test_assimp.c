@@ -15,6 +15,7 @@
 #include "../formats/test_util.h"
 
 #include <math.h>
+#include <stdlib.h>
 
 static sy_scene *g_scene;
 
@@ -285,6 +286,62 @@ int main(void)
     sy_assimp_options dao = {.allowed_roots = droot, .allowed_root_count = 1};
     EXPECT_MSG(load(p, &dao, &info, &e) == SY_OK && info.counts.textures == 1 && info.warning_count == 0,
                "texture through the MTL's folder in an allowed root: %s", info.warning_count ? info.warnings[0] : e.message);
+    sy_assimp_info_free(&info);
+
+    /* separate metalness and roughness maps (MTL map_Pm / map_Pr: Assimp's METALNESS and
+     * DIFFUSE_ROUGHNESS) combine into one metallic-roughness texture: G = roughness, B = metallic */
+    PATHF(p, "%s/pbr", dir);
+    mkdir(p, 0755);
+    PATHF(p, "%s/pbr/rough.pgm", dir);
+    const char rough[] = "P5\n2 1\n255\n\x40\x80";
+    EXPECT(write_bytes(p, rough, sizeof rough - 1) == 0);
+    PATHF(p, "%s/pbr/metal.pgm", dir);
+    const char metal[] = "P5\n2 1\n255\n\xff\x00";
+    EXPECT(write_bytes(p, metal, sizeof metal - 1) == 0);
+    PATHF(p, "%s/pbr/metal1.pgm", dir);
+    const char metal1[] = "P5\n1 1\n255\n\xc8";
+    EXPECT(write_bytes(p, metal1, sizeof metal1 - 1) == 0);
+    PATHF(p, "%s/pbr/pbr.mtl", dir);
+    const char pbrmtl[] = "newmtl same\nKd 1 1 1\nPr 0.5\nPm 1\nmap_Pr rough.pgm\nmap_Pm metal.pgm\n"
+                          "newmtl resized\nKd 1 1 1\nPr 1\nPm 1\nmap_Pr rough.pgm\nmap_Pm metal1.pgm\n"
+                          "newmtl roughonly\nKd 1 1 1\nNs 100\nKs 1 1 1\nillum 2\nmap_Pr rough.pgm\n";
+    EXPECT(write_bytes(p, pbrmtl, sizeof pbrmtl - 1) == 0);
+    PATHF(p, "%s/pbr/pbr.obj", dir);
+    const char pbrobj[] = "mtllib pbr.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                          "o a\nusemtl same\nf 1/1 2/2 3/3\no b\nusemtl resized\nf 1/1 2/2 3/3\no c\nusemtl roughonly\nf 1/1 2/2 3/3\n";
+    EXPECT(write_bytes(p, pbrobj, sizeof pbrobj - 1) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.textures == 3 && info.warning_count == 1 &&
+                   strstr(info.warnings[0], "resized") && strstr(info.warnings[0], "resampled"),
+               "pbr.obj: %u textures, %u warnings: %s", info.counts.textures, info.warning_count,
+               info.warning_count ? info.warnings[0] : e.message);
+    int seen = 0;
+    for (uint32_t id = sy_scene_next(g_scene, SY_TYPE_MATERIAL, 0); id; id = sy_scene_next(g_scene, SY_TYPE_MATERIAL, id)) {
+        const sy_material_data *x = sy_material_get(g_scene, (sy_material){id});
+        if (!x || !x->name) continue;
+        const sy_texture_data *t = x->metallic_roughness_texture.texture.id
+                                       ? sy_object_get(g_scene, SY_TYPE_TEXTURE, x->metallic_roughness_texture.texture.id)
+                                       : NULL;
+        const uint8_t *px = t ? sy_blob_data(t->pixels) : NULL;
+        uint32_t ch = t ? t->info.channels : 0;
+        bool two = t && t->info.width == 2 && t->info.height == 1 && ch >= 3 && t->info.format == SY_PIXEL_U8_LINEAR;
+        if (!strcmp(x->name, "same")) {
+            seen++;
+            EXPECT_MSG(two && px[1] == 0x40 && px[ch + 1] == 0x80 && px[2] == 0xff && px[ch + 2] == 0 &&
+                           near(x->roughness, 0.5f) && near(x->metallic, 1.0f),
+                       "same: G %d %d B %d %d, roughness %g metallic %g", two ? px[1] : -1, two ? px[ch + 1] : -1,
+                       two ? px[2] : -1, two ? px[ch + 2] : -1, x->roughness, x->metallic);
+        } else if (!strcmp(x->name, "resized")) {
+            seen++;
+            EXPECT_MSG(two && px[1] == 0x40 && px[ch + 1] == 0x80 && abs(px[2] - 0xc8) <= 1 && abs(px[ch + 2] - 0xc8) <= 1,
+                       "resized: G %d %d B %d %d", two ? px[1] : -1, two ? px[ch + 1] : -1, two ? px[2] : -1, two ? px[ch + 2] : -1);
+        } else if (!strcmp(x->name, "roughonly")) {
+            seen++; /* a classic material: the map decides roughness (factor 1), metallic stays 0 (B 255 x 0) */
+            EXPECT_MSG(two && px[1] == 0x40 && px[2] == 0xff && px[ch + 2] == 0xff && near(x->roughness, 1.0f) && x->metallic == 0.0f,
+                       "roughonly: G %d B %d, roughness %g metallic %g", two ? px[1] : -1, two ? px[2] : -1, x->roughness,
+                       x->metallic);
+        }
+    }
+    EXPECT_MSG(seen == 3, "pbr.obj: %d of the 3 materials found", seen);
     sy_assimp_info_free(&info);
 
     /* a small but valid triangle (area 5e-7, under Assimp's FindDegenerates area threshold of 1e-6,
