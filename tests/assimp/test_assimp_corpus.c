@@ -27,6 +27,7 @@ static bool assimp_counts(const char *path, unsigned *meshes, unsigned long *tri
 {
     struct aiPropertyStore *ps = aiCreatePropertyStore();
     aiSetImportPropertyInteger(ps, AI_CONFIG_PP_FD_REMOVE, 1);
+    aiSetImportPropertyInteger(ps, AI_CONFIG_PP_FD_CHECKAREA, 0); /* as the loader: small triangles are kept */
     aiSetImportPropertyInteger(ps, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
     const struct aiScene *s = aiImportFileExWithProperties(
         path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_FindDegenerates | aiProcess_JoinIdenticalVertices |
