@@ -15,7 +15,8 @@
  * for them. Every created node has SY_NODE_VISIBLE.
  *
  * Geometry goes through Assimp's own post-processing: GenSmoothNormals (normals where the file has
- * none, crease angle 80 degrees), JoinIdenticalVertices, FindInvalidData, TransformUVCoords, FlipUVs
+ * none, crease angle 80 degrees), SplitLargeMeshes (more than 10^6 triangles or vertices: several
+ * meshes, as `assimp info` makes them), JoinIdenticalVertices, FindInvalidData, TransformUVCoords, FlipUVs
  * (texture v down, the scene's convention) and ValidateDataStructure while reading; Triangulate and
  * SortByPType (one primitive type per mesh) as a second pass once every face is checked to have
  * indices (a face without any is refused: Triangulate aborts the process on it); FindDegenerates

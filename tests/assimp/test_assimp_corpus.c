@@ -31,7 +31,8 @@ static bool assimp_counts(const char *path, unsigned *meshes, unsigned long *tri
     aiSetImportPropertyInteger(ps, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
     const struct aiScene *s = aiImportFileExWithProperties(
         path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_FindDegenerates | aiProcess_JoinIdenticalVertices |
-                  aiProcess_GenSmoothNormals | aiProcess_FindInvalidData | aiProcess_ValidateDataStructure,
+                  aiProcess_GenSmoothNormals | aiProcess_FindInvalidData | aiProcess_ValidateDataStructure |
+                  aiProcess_SplitLargeMeshes,
         NULL, ps);
     aiReleasePropertyStore(ps);
     if (!s || !s->mRootNode) {
