@@ -34,6 +34,7 @@ typedef struct asp_texture {
     bool srgb;       /* colour role */
     sy_texture tex;  /* {0}: failed (warned once) */
     uint32_t channels;
+    unsigned mr_used; /* a combined metallic-roughness texture: 1 metalness map used, 2 roughness map used */
 } asp_texture;
 
 typedef struct asp_loader {

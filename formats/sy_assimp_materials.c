@@ -170,6 +170,7 @@ static sy_result texture_slot_for(asp_loader *L, const char *key, bool srgb, con
     sl->srgb = srgb;
     sl->tex = (sy_texture){0};
     sl->channels = 0;
+    sl->mr_used = 0;
     L->texture_count++;
     *slot = sl;
     return SY_OK;
@@ -342,6 +343,7 @@ static sy_result metallic_roughness_maps(asp_loader *L, unsigned i, const char *
                  mt.uv, rg.uv, mt.uv);
     sy_texture tex = {0};
     uint32_t ch = 0;
+    unsigned used = 3; /* the maps the texture holds */
     sy_result r;
     if (hm && hr && !strcmp(asp_str(&mt.path), asp_str(&rg.path))) { /* one packed image */
         if ((r = get_texture(L, asp_str(&mt.path), false, where, &tex, &ch))) return r;
@@ -387,6 +389,7 @@ static sy_result metallic_roughness_maps(asp_loader *L, unsigned i, const char *
             }
             sy_image_pixels_free(&mt.img);
             sy_image_pixels_free(&rg.img);
+            slot->mr_used = (a ? 1u : 0u) | (b ? 2u : 0u);
             if (ok) {
                 (void)sy_budget_charge(&L->budget, (uint64_t)w * h, 3, NULL, "texture");
                 sy_image_pixels img = {px, w, h, 3};
@@ -396,14 +399,15 @@ static sy_result metallic_roughness_maps(asp_loader *L, unsigned i, const char *
             }
         }
         tex = slot->tex;
+        used = slot->mr_used;
     }
     if (!tex.id) return SY_OK;
     sy_sampler smp = {map_wrap(first->mm[0]), map_wrap(first->mm[1]), SY_FILTER_LINEAR, SY_FILTER_LINEAR};
     if ((r = sy_texture_set_sampler(L->scene, tex, &smp, &L->err))) return r;
     md->metallic_roughness_texture = (sy_texture_ref){.texture = tex, .texcoord = first->uv, .scale = 1.0f,
                                                       .uv_scale = {1.0f, 1.0f}};
-    if (hm && !has_metallic) md->metallic = 1.0f;
-    if (hr && !has_roughness) md->roughness = 1.0f;
+    if ((used & 1u) && !has_metallic) md->metallic = 1.0f; /* a map that could not be read leaves its factor */
+    if ((used & 2u) && !has_roughness) md->roughness = 1.0f;
     return SY_OK;
 }
 

@@ -304,14 +304,18 @@ int main(void)
     PATHF(p, "%s/pbr/pbr.mtl", dir);
     const char pbrmtl[] = "newmtl same\nKd 1 1 1\nPr 0.5\nPm 1\nmap_Pr rough.pgm\nmap_Pm metal.pgm\n"
                           "newmtl resized\nKd 1 1 1\nPr 1\nPm 1\nmap_Pr rough.pgm\nmap_Pm metal1.pgm\n"
-                          "newmtl roughonly\nKd 1 1 1\nNs 100\nKs 1 1 1\nillum 2\nmap_Pr rough.pgm\n";
+                          "newmtl roughonly\nKd 1 1 1\nNs 100\nKs 1 1 1\nillum 2\nmap_Pr rough.pgm\n"
+                          "newmtl nometal\nKd 1 1 1\nNs 100\nKs 1 1 1\nillum 2\nmap_Pr rough.pgm\nmap_Pm missing.pgm\n";
     EXPECT(write_bytes(p, pbrmtl, sizeof pbrmtl - 1) == 0);
     PATHF(p, "%s/pbr/pbr.obj", dir);
     const char pbrobj[] = "mtllib pbr.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
-                          "o a\nusemtl same\nf 1/1 2/2 3/3\no b\nusemtl resized\nf 1/1 2/2 3/3\no c\nusemtl roughonly\nf 1/1 2/2 3/3\n";
+                          "o a\nusemtl same\nf 1/1 2/2 3/3\no b\nusemtl resized\nf 1/1 2/2 3/3\no c\nusemtl roughonly\nf 1/1 2/2 3/3\n"
+                          "o d\nusemtl nometal\nf 1/1 2/2 3/3\n";
     EXPECT(write_bytes(p, pbrobj, sizeof pbrobj - 1) == 0);
-    EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.textures == 3 && info.warning_count == 1 &&
-                   strstr(info.warnings[0], "resized") && strstr(info.warnings[0], "resampled"),
+    /* 4 textures: "nometal" has its own pair (rough.pgm, missing.pgm), whose missing map is a warning */
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.textures == 4 && info.warning_count == 2 &&
+                   strstr(info.warnings[0], "resized") && strstr(info.warnings[0], "resampled") &&
+                   strstr(info.warnings[1], "missing.pgm"),
                "pbr.obj: %u textures, %u warnings: %s", info.counts.textures, info.warning_count,
                info.warning_count ? info.warnings[0] : e.message);
     int seen = 0;
@@ -339,9 +343,14 @@ int main(void)
             EXPECT_MSG(two && px[1] == 0x40 && px[2] == 0xff && px[ch + 2] == 0xff && near(x->roughness, 1.0f) && x->metallic == 0.0f,
                        "roughonly: G %d B %d, roughness %g metallic %g", two ? px[1] : -1, two ? px[2] : -1, x->roughness,
                        x->metallic);
+        } else if (!strcmp(x->name, "nometal")) {
+            seen++; /* the metalness map cannot be read: metallic keeps its factor 0, not 1 */
+            EXPECT_MSG(two && px[1] == 0x40 && px[2] == 0xff && near(x->roughness, 1.0f) && x->metallic == 0.0f,
+                       "nometal: G %d B %d, roughness %g metallic %g", two ? px[1] : -1, two ? px[2] : -1, x->roughness,
+                       x->metallic);
         }
     }
-    EXPECT_MSG(seen == 3, "pbr.obj: %d of the 3 materials found", seen);
+    EXPECT_MSG(seen == 4, "pbr.obj: %d of the 4 materials found", seen);
     sy_assimp_info_free(&info);
 
     /* a small but valid triangle (area 5e-7, under Assimp's FindDegenerates area threshold of 1e-6,
