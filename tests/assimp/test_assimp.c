@@ -7,7 +7,10 @@
  * faces of no index (Assimp aborts on both), an ASCII FBX whose embedded base64 Assimp frees twice, a
  * COLLADA index list holding a word (Assimp never returns), an OBJ whose MTL and texture
  * lie outside its folder (refused, then admitted by allowed_roots), a file Assimp cannot read.
- * Every error names the file. */
+ * Every error names the file. Also: an MTL in a subfolder naming its texture relative to itself
+ * (found; one leading out of the model's folder refused), separate metalness / roughness maps
+ * combined into one metallic-roughness texture (same size, resampled, one map, a missing map), a
+ * valid triangle under Assimp's default degenerate-area threshold (kept). */
 #include "sy_assimp.h"
 #include "sy_classic.h"
 #include "sy_scene.h"
@@ -36,6 +39,18 @@ static sy_bounds bounds_of(const sy_assimp_info *info)
 }
 
 static bool near(float a, float b) { return fabsf(a - b) < 1e-4f; }
+
+/* Writes dir/rel (n bytes), making the folders of rel first; the full path into path. */
+static int put_file(const char *dir, const char *rel, const void *data, size_t n, char *path, size_t cap)
+{
+    snprintf(path, cap, "%s/%s", dir, rel);
+    for (char *c = path + strlen(dir) + 1; (c = strchr(c, '/')) != NULL; ++c) {
+        *c = '\0';
+        mkdir(path, 0755);
+        *c = '/';
+    }
+    return write_bytes(path, data, n);
+}
 
 static const sy_mesh_data *first_mesh(void)
 {
@@ -250,36 +265,20 @@ int main(void)
 
     /* an MTL in a subfolder (mtllib mtl/sub.mtl) names its texture relative to itself: tex/t.ppm is
      * mtl/tex/t.ppm (as Blender and three.js read it), found without a warning */
-    PATHF(p, "%s/m2", dir);
-    mkdir(p, 0755);
-    PATHF(p, "%s/m2/mtl", dir);
-    mkdir(p, 0755);
-    PATHF(p, "%s/m2/mtl/tex", dir);
-    mkdir(p, 0755);
-    PATHF(p, "%s/m2/mtl/tex/t.ppm", dir);
-    EXPECT(write_bytes(p, ppm, sizeof ppm - 1) == 0);
-    PATHF(p, "%s/m2/mtl/sub.mtl", dir);
     const char submtl[] = "newmtl m\nKd 1 1 1\nmap_Kd tex/t.ppm\n";
-    EXPECT(write_bytes(p, submtl, sizeof submtl - 1) == 0);
-    PATHF(p, "%s/m2/scene.obj", dir);
     const char subobj[] = "mtllib mtl/sub.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n";
-    EXPECT(write_bytes(p, subobj, sizeof subobj - 1) == 0);
+    EXPECT(put_file(dir, "m2/mtl/tex/t.ppm", ppm, sizeof ppm - 1, p, sizeof p) == 0);
+    EXPECT(put_file(dir, "m2/mtl/sub.mtl", submtl, sizeof submtl - 1, p, sizeof p) == 0);
+    EXPECT(put_file(dir, "m2/scene.obj", subobj, sizeof subobj - 1, p, sizeof p) == 0);
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.textures == 1 && info.warning_count == 0,
                "texture relative to an MTL in a subfolder: %s", info.warning_count ? info.warnings[0] : e.message);
     sy_assimp_info_free(&info);
     /* still confined to the model's folder: ../../secret.ppm from m3/mtl/ is outside m3/ (refused,
      * naming the way out), admitted by allowed_roots */
-    PATHF(p, "%s/secret.ppm", dir);
-    EXPECT(write_bytes(p, ppm, sizeof ppm - 1) == 0);
-    PATHF(p, "%s/m3", dir);
-    mkdir(p, 0755);
-    PATHF(p, "%s/m3/mtl", dir);
-    mkdir(p, 0755);
-    PATHF(p, "%s/m3/mtl/sub.mtl", dir);
     const char outmtl[] = "newmtl m\nKd 1 1 1\nmap_Kd ../../secret.ppm\n";
-    EXPECT(write_bytes(p, outmtl, sizeof outmtl - 1) == 0);
-    PATHF(p, "%s/m3/scene.obj", dir);
-    EXPECT(write_bytes(p, subobj, sizeof subobj - 1) == 0);
+    EXPECT(put_file(dir, "secret.ppm", ppm, sizeof ppm - 1, p, sizeof p) == 0);
+    EXPECT(put_file(dir, "m3/mtl/sub.mtl", outmtl, sizeof outmtl - 1, p, sizeof p) == 0);
+    EXPECT(put_file(dir, "m3/scene.obj", subobj, sizeof subobj - 1, p, sizeof p) == 0);
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_LIMIT && strstr(e.message, "secret.ppm") && strstr(e.message, "--allow-path"),
                "texture outside the model's folder through the MTL's folder: %s", e.message);
     const char *droot[] = {dir};
@@ -290,28 +289,19 @@ int main(void)
 
     /* separate metalness and roughness maps (MTL map_Pm / map_Pr: Assimp's METALNESS and
      * DIFFUSE_ROUGHNESS) combine into one metallic-roughness texture: G = roughness, B = metallic */
-    PATHF(p, "%s/pbr", dir);
-    mkdir(p, 0755);
-    PATHF(p, "%s/pbr/rough.pgm", dir);
-    const char rough[] = "P5\n2 1\n255\n\x40\x80";
-    EXPECT(write_bytes(p, rough, sizeof rough - 1) == 0);
-    PATHF(p, "%s/pbr/metal.pgm", dir);
-    const char metal[] = "P5\n2 1\n255\n\xff\x00";
-    EXPECT(write_bytes(p, metal, sizeof metal - 1) == 0);
-    PATHF(p, "%s/pbr/metal1.pgm", dir);
-    const char metal1[] = "P5\n1 1\n255\n\xc8";
-    EXPECT(write_bytes(p, metal1, sizeof metal1 - 1) == 0);
-    PATHF(p, "%s/pbr/pbr.mtl", dir);
+    const char rough[] = "P5\n2 1\n255\n\x40\x80", metal[] = "P5\n2 1\n255\n\xff\x00", metal1[] = "P5\n1 1\n255\n\xc8";
+    EXPECT(put_file(dir, "pbr/rough.pgm", rough, sizeof rough - 1, p, sizeof p) == 0);
+    EXPECT(put_file(dir, "pbr/metal.pgm", metal, sizeof metal - 1, p, sizeof p) == 0);
+    EXPECT(put_file(dir, "pbr/metal1.pgm", metal1, sizeof metal1 - 1, p, sizeof p) == 0);
     const char pbrmtl[] = "newmtl same\nKd 1 1 1\nPr 0.5\nPm 1\nmap_Pr rough.pgm\nmap_Pm metal.pgm\n"
                           "newmtl resized\nKd 1 1 1\nPr 1\nPm 1\nmap_Pr rough.pgm\nmap_Pm metal1.pgm\n"
                           "newmtl roughonly\nKd 1 1 1\nNs 100\nKs 1 1 1\nillum 2\nmap_Pr rough.pgm\n"
                           "newmtl nometal\nKd 1 1 1\nNs 100\nKs 1 1 1\nillum 2\nmap_Pr rough.pgm\nmap_Pm missing.pgm\n";
-    EXPECT(write_bytes(p, pbrmtl, sizeof pbrmtl - 1) == 0);
-    PATHF(p, "%s/pbr/pbr.obj", dir);
+    EXPECT(put_file(dir, "pbr/pbr.mtl", pbrmtl, sizeof pbrmtl - 1, p, sizeof p) == 0);
     const char pbrobj[] = "mtllib pbr.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
                           "o a\nusemtl same\nf 1/1 2/2 3/3\no b\nusemtl resized\nf 1/1 2/2 3/3\no c\nusemtl roughonly\nf 1/1 2/2 3/3\n"
                           "o d\nusemtl nometal\nf 1/1 2/2 3/3\n";
-    EXPECT(write_bytes(p, pbrobj, sizeof pbrobj - 1) == 0);
+    EXPECT(put_file(dir, "pbr/pbr.obj", pbrobj, sizeof pbrobj - 1, p, sizeof p) == 0);
     /* 4 textures: "nometal" has its own pair (rough.pgm, missing.pgm), whose missing map is a warning */
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.textures == 4 && info.warning_count == 2 &&
                    strstr(info.warnings[0], "resized") && strstr(info.warnings[0], "resampled") &&
@@ -355,9 +345,8 @@ int main(void)
 
     /* a small but valid triangle (area 5e-7, under Assimp's FindDegenerates area threshold of 1e-6,
      * which Assimp 5.2 applies unless told not to): kept, as in a fine 10^6-triangle grid */
-    PATHF(p, "%s/small.obj", dir);
     const char small[] = "v 0 0 0\nv 0.001 0 0\nv 0 0.001 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 1 2 3\nf 4 5 6\n";
-    EXPECT(write_bytes(p, small, sizeof small - 1) == 0);
+    EXPECT(put_file(dir, "small.obj", small, sizeof small - 1, p, sizeof p) == 0);
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.triangles == 2 && info.warning_count == 0,
                "small.obj: %u triangles: %s", info.counts.triangles, info.warning_count ? info.warnings[0] : e.message);
     sy_assimp_info_free(&info);
