@@ -26,7 +26,8 @@
  *
  * Materials (documented rule, docs/FORMATS.md): Assimp's PBR properties (base colour, metallic,
  * roughness factors, emissive intensity, transmission) are taken as they are. Classic materials
- * (Phong, Blinn, Gouraud, Lambert: OBJ / MTL, 3DS, COLLADA common profile, FBX): base colour =
+ * (Phong, Blinn, Gouraud, Lambert: OBJ / MTL, 3DS, COLLADA common profile, FBX, whose reader's
+ * made-up roughness 1 - sqrt(shininess) / 10 is not taken for a PBR property): base colour =
  * diffuse colour, alpha = opacity (BLEND when below 1), emissive = emissive colour, metallic 0 (a
  * classic specular colour is a highlight strength, not a reflectance: Ks 0.5 is plain plastic),
  * roughness from the shininess exponent and the specular colour x shininess strength

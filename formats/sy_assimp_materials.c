@@ -458,6 +458,13 @@ sy_result asp_create_material(asp_loader *L, unsigned i)
     bool has_metallic = get_float(m, "$mat.metallicFactor", &metallic);
     bool has_roughness = get_float(m, "$mat.roughnessFactor", &rough);
     bool has_base = get_color(m, "$clr.base", base);
+    /* Assimp 5.2's FBX reader gives every material with a shininess exponent n a roughness factor
+     * 1 - sqrt(n) / 10 ("Blender's", negative past n = 100) and nothing else PBR: that one is not the
+     * file's, and the material stays classic (the rule below) */
+    float n_exp;
+    if (has_roughness && !has_metallic && !has_base && get_float(m, "$mat.shininess", &n_exp) && n_exp >= 0.0f &&
+        fabsf(rough - (1.0f - sqrtf(n_exp) / 10.0f)) < 1e-5f)
+        has_roughness = false, rough = 1.0f;
     bool pbr = has_metallic || has_roughness || has_base;
     if (!has_base) get_color(m, "$clr.diffuse", base);
     for (int k = 0; k < 3; ++k) md.base_color[k] = clamped(L, i, "base colour", base[k], 0, 1);

@@ -343,6 +343,27 @@ int main(void)
     EXPECT_MSG(seen == 4, "pbr.obj: %d of the 4 materials found", seen);
     sy_assimp_info_free(&info);
 
+    /* a classic FBX material (Phong, Ns 128, white specular: the quad's MTL written as ASCII FBX by
+     * Assimp's exporter) follows the classic rule as the OBJ does, although Assimp 5.2's FBX reader
+     * adds a roughness factor 1 - sqrt(Ns) / 10 (here -0.13) to every material with a shininess */
+    const char phongmtl[] = "newmtl shiny\nKd 0.5 0.5 0.5\nKs 1 1 1\nNs 128\nillum 2\n";
+    const char phongobj[] = "mtllib phong.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl shiny\nf 1 2 3\n";
+    EXPECT(put_file(dir, "phong/phong.mtl", phongmtl, sizeof phongmtl - 1, p, sizeof p) == 0);
+    EXPECT(put_file(dir, "phong/phong.obj", phongobj, sizeof phongobj - 1, p, sizeof p) == 0);
+    PATHF(q, "%s/phong/phong.fbx", dir);
+    EXPECT_MSG(sy_assimp_export(p, "fbxa", q, &e) == SY_OK, "export to ASCII FBX: %s", e.message);
+    EXPECT_MSG(load(q, NULL, &info, &e) == SY_OK && info.counts.triangles == 1 && info.warning_count == 0,
+               "phong.fbx: %s", info.warning_count ? info.warnings[0] : e.message);
+    const sy_material_data *shiny = NULL;
+    for (uint32_t id = sy_scene_next(g_scene, SY_TYPE_MATERIAL, 0); id; id = sy_scene_next(g_scene, SY_TYPE_MATERIAL, id)) {
+        const sy_material_data *x = sy_material_get(g_scene, (sy_material){id});
+        if (x && x->name && !strcmp(x->name, "shiny")) shiny = x;
+    }
+    EXPECT_MSG(shiny && near(shiny->roughness, 0.3522f) && shiny->metallic == 0.0f && near(shiny->base_color[0], 0.5f),
+               "shiny from FBX: roughness %g (0.3522 as from the MTL), metallic %g", shiny ? shiny->roughness : -1,
+               shiny ? shiny->metallic : -1);
+    sy_assimp_info_free(&info);
+
     /* a small but valid triangle (area 5e-7, under Assimp's FindDegenerates area threshold of 1e-6,
      * which Assimp 5.2 applies unless told not to): kept, as in a fine 10^6-triangle grid */
     const char small[] = "v 0 0 0\nv 0.001 0 0\nv 0 0.001 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 1 2 3\nf 4 5 6\n";
