@@ -23,6 +23,9 @@ void sy_gltf_info_free(sy_gltf_info *info)
 {
     if (!info) return;
     free(info->camera_nodes);
+    for (uint32_t i = 0; i < info->variant_count; i++) free(info->variant_names[i]);
+    free(info->variant_names);
+    free(info->variant_uses);
     sy_loader_warnings_free(gltf_warnings(info));
     memset(info, 0, sizeof *info);
 }
@@ -74,6 +77,16 @@ static sy_result load_doc(loader *L)
                   d->animation_count);
 
     if ((r = gltf_charge_meshes(L))) return r;
+    if (d->variant_count) {
+        if (!(L->info->variant_names = gltf_xcalloc(L, d->variant_count, sizeof(char *), &r)) ||
+            !(L->info->variant_uses = gltf_xcalloc(L, d->variant_use_count + 1, sizeof(sy_gltf_variant_use), &r)))
+            return r;
+        for (size_t i = 0; i < d->variant_count; i++) {
+            if (!(L->info->variant_names[i] = strdup(d->variant_names[i])))
+                return gltf_fail(L, SY_ERR_OUT_OF_MEMORY, "KHR_materials_variants: out of memory");
+            L->info->variant_count = (uint32_t)i + 1;
+        }
+    }
     /* dependency order: textures (on demand) + materials, meshes, lights, cameras, nodes */
     for (size_t i = 0; i < d->material_count; i++)
         if ((r = gltf_create_material(L, i))) return r;

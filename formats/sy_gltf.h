@@ -85,6 +85,17 @@ typedef struct sy_gltf_counts {
 } sy_gltf_counts;
 
 /** What a load produced: the root, camera nodes, warnings and counts (sy_gltf_info_free). */
+/** One KHR_materials_variants mapping: primitive `primitive` (an index into the mesh's sy
+ * primitives) of `mesh` takes `material` in variant `variant`; `default_material` is the material
+ * the file gives it without a variant. */
+typedef struct sy_gltf_variant_use {
+    sy_mesh mesh;
+    uint32_t primitive;
+    uint32_t variant; /**< index into sy_gltf_info.variant_names */
+    sy_material material;
+    sy_material default_material;
+} sy_gltf_variant_use;
+
 typedef struct sy_gltf_info {
     sy_node root;              /**< the new node whose children are the glTF scene's root nodes */
     int32_t scene_index;       /**< glTF scene loaded; -1: none given, all parentless nodes used */
@@ -95,6 +106,10 @@ typedef struct sy_gltf_info {
     uint32_t warning_count;    /**< total number of warnings (may exceed the stored ones) */
     uint32_t stored_warning_count; /**< entries of warnings */
     sy_gltf_counts counts; /**< what the file contains */
+    char **variant_names;  /**< KHR_materials_variants names, "" for an unnamed one (malloc()ed) */
+    uint32_t variant_count; /**< entries of variant_names */
+    sy_gltf_variant_use *variant_uses; /**< every mapping, by mesh then primitive (malloc()ed) */
+    uint32_t variant_use_count; /**< entries of variant_uses */
 } sy_gltf_info;
 
 /** Loads the glTF file at `path` into `scene`. The default glTF scene is `scene` of the file, else
@@ -120,6 +135,15 @@ void sy_gltf_info_free(sy_gltf_info *info);
  * (message lists the available cameras) when nothing matches. */
 sy_result sy_gltf_find_camera(const sy_scene *scene, const sy_gltf_info *info, const char *selector, sy_node *out,
                               sy_error *err);
+
+/** Switches the material variant (KHR_materials_variants) of a loaded file: selector is a variant
+ * name or a decimal index into info->variant_names; NULL or "" restores the file's default
+ * materials. Every primitive the file maps takes the variant's material (its default where the
+ * variant does not map it), set with sy_mesh_set_primitives so that the change reaches every
+ * back-end through the change lists. SY_ERR_NOT_FOUND (the message lists the variants) when nothing
+ * matches; SY_ERR_INVALID_HANDLE when a mapped mesh is gone. Not thread-safe with other writers of
+ * the scene. */
+sy_result sy_gltf_select_variant(sy_scene *scene, const sy_gltf_info *info, const char *selector, sy_error *err);
 
 /** Names of the extensions this loader supports (for "extensionsRequired"), NULL-terminated. */
 const char *const *sy_gltf_supported_extensions(void);

@@ -62,6 +62,8 @@ typedef struct loader {
     uint32_t *mesh_triangles;
     sy_budget budget; /* the file's (sy_budget.h) */
     bool warned_skin, warned_morph, warned_anim;
+    size_t variant_cursor;     /* next doc->variant_uses entry (meshes are created in order) */
+    uint32_t variant_uses_done; /* info->variant_uses entries whose mesh is set */
 } loader;
 
 /* Extensions the loader supports (NULL-terminated; sy_gltf_supported_extensions returns it). */

@@ -312,10 +312,21 @@ sy_result gltf_create_mesh(loader *L, size_t m)
     sy_primitive *prims = gltf_xcalloc(L, mesh->primitive_count, sizeof(sy_primitive), &r);
     if (!prims) return r;
     uint32_t used_count = 0, triangles = 0;
+    const sy_gltf_doc *d = L->doc;
+    size_t vu = L->variant_cursor; /* the uses are in mesh then primitive order */
     for (size_t p = 0; p < mesh->primitive_count; p++) {
         bool used;
         uint32_t t;
         if ((r = convert_primitive(L, m, p, &prims[used_count], &used, &t))) goto done;
+        for (; vu < d->variant_use_count && d->variant_uses[vu].mesh == (int32_t)m &&
+               d->variant_uses[vu].primitive == (int32_t)p;
+             vu++) {
+            const sy_gltf_shim_variant_use *u = &d->variant_uses[vu];
+            if (!used) continue; /* a skipped primitive (no positions) has no material to switch */
+            L->info->variant_uses[L->info->variant_use_count++] = (sy_gltf_variant_use){
+                .primitive = used_count, .variant = (uint32_t)u->variant, .material = L->materials[u->material],
+                .default_material = prims[used_count].material};
+        }
         if (used) {
             used_count++;
             if (triangles > UINT32_MAX - t) {
@@ -342,6 +353,9 @@ sy_result gltf_create_mesh(loader *L, size_t m)
     }
     L->meshes[m] = h;
     L->mesh_triangles[m] = triangles;
+    for (size_t k = L->variant_uses_done; k < L->info->variant_use_count; k++) L->info->variant_uses[k].mesh = h;
+    L->variant_uses_done = L->info->variant_use_count;
+    L->variant_cursor = vu;
 done:
     for (uint32_t k = 0; k < used_count; k++) sy_primitive_release(&prims[k]);
     /* a primitive that failed half-way (released itself; harmless) - none when every one was made

@@ -307,6 +307,25 @@ sy_gltf_shim_texinfo texinfo_value(const tinygltf::Value *v)
     return t;
 }
 
+/* A primitive's KHR_materials_variants mappings, one use per (mapping, variant); a malformed
+ * index is kept as INT32_MIN or -1 for validation to name. */
+void read_variant_uses(const tinygltf::ExtensionMap &ext, int32_t mesh, int32_t prim,
+                       std::vector<sy_gltf_shim_variant_use> *out)
+{
+    const tinygltf::Value *e = extension(ext, "KHR_materials_variants");
+    const tinygltf::Value *ms = e ? member(*e, "mappings") : nullptr;
+    for (size_t i = 0; ms && ms->IsArray() && i < ms->ArrayLen(); i++) {
+        const tinygltf::Value &mp = ms->Get(int(i));
+        int32_t material = integer(mp, "material", -1);
+        const tinygltf::Value *vs = member(mp, "variants");
+        for (size_t k = 0; vs && vs->IsArray() && k < vs->ArrayLen(); k++) {
+            const tinygltf::Value &v = vs->Get(int(k));
+            double x = v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
+            out->push_back({mesh, prim, material, x >= 0.0 && x <= double(INT32_MAX) ? int32_t(x) : -1});
+        }
+    }
+}
+
 /* The material extensions beyond the core set (KHR_materials_specular, _clearcoat, _sheen, _volume,
  * _iridescence, _anisotropy): their factors with the specifications' defaults, their textures. */
 void read_material_extensions(const tinygltf::ExtensionMap &ext, sy_gltf_shim_material *c)
@@ -400,6 +419,8 @@ struct sy_gltf_shim_impl {
     std::vector<sy_gltf_shim_scene> scenes;
     std::vector<sy_gltf_shim_channel> channels;
     std::vector<const char *> ext_required;
+    std::vector<const char *> variant_names;
+    std::vector<sy_gltf_shim_variant_use> variant_uses;
     std::string warnings;
     std::vector<std::vector<uint8_t>> decoded; // buffers made by decoding compressed meshes
 };
@@ -449,6 +470,7 @@ static void fill_doc(sy_gltf_shim_impl *d)
             c.texcoord1 = attr("TEXCOORD_1");
             c.color0 = attr("COLOR_0");
             c.has_targets = !p.targets.empty();
+            read_variant_uses(p.extensions, int32_t(d->prims.size()), int32_t(ps.size()), &d->variant_uses);
             ps.push_back(c);
         }
         d->prims.push_back(std::move(ps));
@@ -574,6 +596,13 @@ static void fill_doc(sy_gltf_shim_impl *d)
     for (size_t i = 0; i < m.scenes.size(); i++)
         d->scenes.push_back({m.scenes[i].name.c_str(), d->scene_nodes[i].data(), d->scene_nodes[i].size()});
     for (const std::string &s : m.extensionsRequired) d->ext_required.push_back(s.c_str());
+    if (const tinygltf::Value *e = extension(m.extensions, "KHR_materials_variants")) {
+        const tinygltf::Value *vs = member(*e, "variants");
+        for (size_t i = 0; vs && vs->IsArray() && i < vs->ArrayLen(); i++) {
+            const tinygltf::Value *nm = member(vs->Get(int(i)), "name");
+            d->variant_names.push_back(nm && nm->IsString() ? nm->Get<std::string>().c_str() : "");
+        }
+    }
 
     sy_gltf_doc &c = d->doc;
     c.buffers = d->buffers.data();         c.buffer_count = d->buffers.size();
@@ -591,6 +620,10 @@ static void fill_doc(sy_gltf_shim_impl *d)
     c.default_scene = m.defaultScene;
     c.extensions_required = d->ext_required.data();
     c.extensions_required_count = d->ext_required.size();
+    c.variant_names = d->variant_names.data();
+    c.variant_count = d->variant_names.size();
+    c.variant_uses = d->variant_uses.data();
+    c.variant_use_count = d->variant_uses.size();
     c.skin_count = m.skins.size();
     c.animation_count = m.animations.size();
     if (!m.animations.empty()) {

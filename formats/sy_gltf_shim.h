@@ -212,6 +212,13 @@ typedef struct sy_gltf_shim_channel {
     int32_t cubic;  /* CUBICSPLINE: outputs are (in-tangent, value, out-tangent) triples */
 } sy_gltf_shim_channel;
 
+/* KHR_materials_variants: primitive `primitive` of mesh `mesh` takes material `material` in variant
+ * `variant` (one entry per variant of each mapping, in mesh then primitive order). Indices are
+ * untrusted. */
+typedef struct sy_gltf_shim_variant_use {
+    int32_t mesh, primitive, material, variant;
+} sy_gltf_shim_variant_use;
+
 typedef struct sy_gltf_doc {
     const sy_gltf_shim_buffer *buffers;     size_t buffer_count;
     const sy_gltf_shim_view *views;         size_t view_count;
@@ -229,6 +236,8 @@ typedef struct sy_gltf_doc {
     const char *const *extensions_required; size_t extensions_required_count;
     size_t skin_count, animation_count;
     const sy_gltf_shim_channel *channels;   size_t channel_count; /* of animations[0] */
+    const char *const *variant_names;       size_t variant_count; /* KHR_materials_variants ("" unnamed) */
+    const sy_gltf_shim_variant_use *variant_uses; size_t variant_use_count;
     const char *warnings; /* tinygltf's warning text, "" when none */
     void *internal;       /* private to the shim */
 } sy_gltf_doc;

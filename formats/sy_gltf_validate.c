@@ -20,7 +20,7 @@
 const char *const gltf_supported[] = {
     "KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
     "KHR_materials_unlit", "KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen",
-    "KHR_materials_volume", "KHR_materials_iridescence", "KHR_materials_anisotropy",
+    "KHR_materials_volume", "KHR_materials_iridescence", "KHR_materials_anisotropy", "KHR_materials_variants",
     "KHR_texture_transform", "KHR_lights_punctual",
     "KHR_mesh_quantization", "EXT_mesh_gpu_instancing", "KHR_draco_mesh_compression",
     "EXT_meshopt_compression", "EXT_texture_webp", NULL,
@@ -350,6 +350,16 @@ sy_result gltf_validate_doc(loader *L)
             return gltf_fail(L, SY_ERR_PARSE, "materials[%zu]: alphaMode '%s' is not OPAQUE, MASK or BLEND", i, m->alpha_mode);
         if ((m->base_color_count != 0 && m->base_color_count != 4) || (m->emissive_count != 0 && m->emissive_count != 3))
             return gltf_fail(L, SY_ERR_PARSE, "materials[%zu]: baseColorFactor needs 4 and emissiveFactor 3 numbers", i);
+    }
+    for (size_t i = 0; i < d->variant_use_count; i++) {
+        const sy_gltf_shim_variant_use *u = &d->variant_uses[i];
+        if (u->material < 0 || (size_t)u->material >= d->material_count || u->variant < 0 ||
+            (size_t)u->variant >= d->variant_count)
+            return gltf_fail(L, SY_ERR_PARSE,
+                             "meshes[%d].primitives[%d].KHR_materials_variants: a mapping names material %d and variant %d "
+                             "(%zu materials, %zu variants)",
+                             (int)u->mesh, (int)u->primitive, (int)u->material, (int)u->variant, d->material_count,
+                             d->variant_count);
     }
     for (size_t i = 0; i < d->texture_count; i++) {
         if ((r = check_index(L, d->textures[i].source, d->image_count, true, "textures[%zu]", i, "source", "images")) ||

@@ -117,6 +117,7 @@ int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *short
             sy_cli_load_opts.max_scene_bytes = sy_cli_load_opts.world.max_scene_bytes = (uint64_t)mb << 20;
             break;
         }
+        case OPT_VARIANT: sy_cli_load_opts.variant = optarg; break; /* glTF KHR_materials_variants */
         case OPT_ALLOW_PATH: { /* repeatable: more folders that a model's external files may lie in */
             struct stat st;
             if (stat(optarg, &st) != 0 || !S_ISDIR(st.st_mode)) {

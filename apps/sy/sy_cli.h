@@ -19,7 +19,7 @@
 enum {
     OPT_STOP = -2, /* sy_cli_next_option: the command ends with *status (after --help or a usage error) */
     OPT_HELP = 0x100, OPT_VERSION, OPT_ENV, OPT_ENV_COLOR, OPT_ENV_INTENSITY, OPT_ENV_HIDDEN, OPT_BACKGROUND,
-    OPT_NO_DEFAULT_LIGHT, OPT_ALLOW_PATH, OPT_STRICT, OPT_MAX_SCENE_MB,
+    OPT_NO_DEFAULT_LIGHT, OPT_ALLOW_PATH, OPT_STRICT, OPT_MAX_SCENE_MB, OPT_VARIANT,
     /* the commands' own long options (cluster ones: SY_CLUSTER_OPT_*, sy_cluster_cli.h) */
     OPT_SPP, OPT_TIME, OPT_AOV, OPT_CAMERA, OPT_PARAMS, OPT_GL, OPT_FILTER, OPT_THRESHOLD, OPT_HALF, OPT_EXPOSURE,
     OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
@@ -37,6 +37,7 @@ enum {
     {"no-default-light", no_argument, NULL, OPT_NO_DEFAULT_LIGHT},                                         \
     {"allow-path", required_argument, NULL, OPT_ALLOW_PATH}, {"strict", no_argument, NULL, OPT_STRICT},    \
     {"max-scene-mb", required_argument, NULL, OPT_MAX_SCENE_MB},                                           \
+    {"variant", required_argument, NULL, OPT_VARIANT},                                                     \
     {NULL, 0, NULL, 0}
 /* short options: ':' first (a missing value is told apart from an unknown option), then -q and -v */
 #define SHORT_OPTIONS(own) ":" own "qv"

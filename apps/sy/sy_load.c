@@ -149,9 +149,14 @@ sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, l
             out->root = out->gltf.root;
             if (camera_sel) r = sy_gltf_find_camera(out->scene, &out->gltf, camera_sel, &out->camera, err);
             else if (out->gltf.camera_node_count) out->camera = out->gltf.camera_nodes[0];
+            if (r == SY_OK && sy_cli_load_opts.variant)
+                r = sy_gltf_select_variant(out->scene, &out->gltf, sy_cli_load_opts.variant, err);
             if (r != SY_OK) sy_error_prefix(err, "%s", path);
         }
     }
+    if (r == SY_OK && sy_cli_load_opts.variant && !out->is_gltf)
+        r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: --variant: material variants are a glTF extension "
+                         "(KHR_materials_variants); this is not a glTF file", path);
     if (r == SY_OK) r = sy_scene_commit(out->scene, NULL, err);
     if (r == SY_OK && (out->is_gltf || out->is_x3d || out->is_assimp) && defaults) r = add_defaults(out, err);
     /* the user's world choices: sy_world (formats) maps them onto the world object */

@@ -28,13 +28,14 @@ typedef struct loaded {
 /* Loader options every command shares, taken out of the arguments by sy_cli_next_option:
  * --allow-path DIR (repeatable: more folders that a model's external files may lie in), --strict
  * (whatever a loader skips or repairs is an error), --max-scene-mb N (the budget per file,
- * sy_budget.h) and the world flags. */
+ * sy_budget.h), --variant NAME (a glTF material variant) and the world flags. */
 #define SY_MAX_ALLOW_PATHS 16
 typedef struct sy_load_options {
     const char *roots[SY_MAX_ALLOW_PATHS];
     size_t root_count;
     bool strict;
     uint64_t max_scene_bytes; /* --max-scene-mb: the loaders' budget per file (sy_budget.h); 0 = default */
+    const char *variant; /* --variant: a glTF file's KHR_materials_variants variant (name or index); NULL = default */
     sy_world_options world; /* --env, --env-color, --env-intensity, --env-hidden, --background, --no-default-light */
 } sy_load_options;
 extern sy_load_options sy_cli_load_opts;

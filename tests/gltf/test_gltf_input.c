@@ -625,6 +625,55 @@ static void test_valid(void)
     }
 }
 
+/* KHR_materials_variants: the mappings land in the info, switching sets the primitives' materials
+ * (and back), an unknown variant lists the file's, a mapping naming a missing variant is refused. */
+static void test_variants(void)
+{
+    const char *mats = "\"materials\":[{\"name\":\"red\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,1]}},"
+                       "{\"name\":\"green\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,1,0,1]}},"
+                       "{\"name\":\"blue\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,1,1]}}]";
+    for (int bad = 0; bad < 2; bad++) {
+        char fmt[2048], path[512];
+        snprintf(fmt, sizeof fmt,
+                 "{" ASSET ",\"buffers\":[{\"byteLength\":44,\"uri\":\"%%s\"}]," VIEWS "," ACCS ","
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0,"
+                 "\"extensions\":{\"KHR_materials_variants\":{\"mappings\":[{\"material\":1,\"variants\":[0]},"
+                 "{\"material\":2,\"variants\":[%s]}]}}}]}],"
+                 "%s," NODES "," SCENES ","
+                 "\"extensions\":{\"KHR_materials_variants\":{\"variants\":[{\"name\":\"Leaf\"},{\"name\":\"Sky\"}]}},"
+                 "\"extensionsUsed\":[\"KHR_materials_variants\"]}",
+                 bad ? "5" : "1", mats);
+        std_buffer b = standard_buffer();
+        write_gltf(bad ? "variants_bad.gltf" : "variants.gltf", fmt, &b, sizeof b, path);
+        sy_scene *s = NULL;
+        sy_gltf_info info;
+        sy_error e = {0};
+        sy_scene_create(&s, &e);
+        sy_result r = sy_gltf_load(path, s, NULL, &info, &e);
+        if (bad) {
+            EXPECT_MSG(r == SY_ERR_PARSE && strstr(e.message, "variants_bad.gltf") &&
+                           strstr(e.message, "meshes[0].primitives[0].KHR_materials_variants") && strstr(e.message, "variant 5"),
+                       "a mapping naming variant 5 of 2: %s", e.message);
+        } else {
+            EXPECT_MSG(r == SY_OK, "variants.gltf: %s", e.message);
+            EXPECT_MSG(info.variant_count == 2 && !strcmp(info.variant_names[1], "Sky") && info.variant_use_count == 2,
+                       "variant info");
+            sy_mesh mesh = {sy_scene_next(s, SY_TYPE_MESH, 0)};
+#define PRIM_COLOR(k) (sy_material_get(s, sy_mesh_get(s, mesh)->primitives.items[0].material)->base_color[k])
+            EXPECT(PRIM_COLOR(0) == 1.0f); /* the default: red */
+            EXPECT_MSG(sy_gltf_select_variant(s, &info, "Sky", &e) == SY_OK && PRIM_COLOR(2) == 1.0f && PRIM_COLOR(0) == 0.0f,
+                       "Sky: %s", e.message);
+            EXPECT_MSG(sy_gltf_select_variant(s, &info, "0", &e) == SY_OK && PRIM_COLOR(1) == 1.0f, "variant 0: %s", e.message);
+            EXPECT_MSG(sy_gltf_select_variant(s, &info, NULL, &e) == SY_OK && PRIM_COLOR(0) == 1.0f, "default: %s", e.message);
+#undef PRIM_COLOR
+            r = sy_gltf_select_variant(s, &info, "Night", &e);
+            EXPECT_MSG(r == SY_ERR_NOT_FOUND && strstr(e.message, "0 \"Leaf\", 1 \"Sky\""), "unknown variant: %s", e.message);
+            sy_gltf_info_free(&info);
+        }
+        sy_scene_destroy(s);
+    }
+}
+
 int main(void)
 {
     snprintf(g_dir, sizeof g_dir, "/tmp/sy_gltf_test_XXXXXX");
@@ -637,6 +686,7 @@ int main(void)
     test_bad_data();
     test_bad_glb();
     test_valid();
+    test_variants();
     EXPECT_MSG(sy_blob_live_count() == blobs, "blob leak");
     char cmd[512];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);

@@ -281,6 +281,16 @@ mkdir -p "$TMP/o_missing"
 expect_error missing no_such_scene.gltf "$TMP/o_missing" "$SY" render "$TMP/in/no_such_scene.gltf" -b whitted \
     -o "$TMP/o_missing/x.png"
 
+# --variant (glTF KHR_materials_variants): refused for a scene that is not glTF, and for a variant
+# the file does not have (the message lists what it has: Box has none)
+mkdir -p "$TMP/o_variant"
+expect_error variant_demo "material variants are a glTF extension" "$TMP/o_variant" "$SY" render demo --variant red \
+    -b whitted -w 16 -h 16 -o "$TMP/o_variant/x.png"
+if [ -f "$BOX" ]; then
+    expect_error variant_none "the file has no KHR_materials_variants" "$TMP/o_variant" "$SY" render "$BOX" \
+        --variant red -b whitted -w 16 -h 16 -o "$TMP/o_variant/x.png"
+fi
+
 # unknown back-end, output in a missing directory, unknown extension (on the built-in scene)
 mkdir -p "$TMP/o_backend"
 expect_error backend no-such-backend "$TMP/o_backend" "$SY" render demo -b no-such-backend -w 16 -h 16 \
