@@ -266,6 +266,17 @@ typedef struct sy_rt_material_desc {
     float alpha_cutoff;             /**< default 0.5 */
     bool double_sided;              /**< default false: emitters emit from the front side only */
     bool unlit;                     /**< KHR_materials_unlit: pixel = base colour */
+    sy_rt_texture_ref transmission_texture; /**< R x transmission */
+    sy_rt_texture_ref specular_texture;     /**< A x specular */
+    float specular_color[3];        /**< KHR_materials_specular colour of the dielectric F0, >= 0 (default 1, 1, 1) */
+    sy_rt_texture_ref specular_color_texture; /**< RGB (sRGB) x specular_color */
+    float thickness;                /**< KHR_materials_volume: > 0 = a closed volume (default 0: thin-walled) */
+    float attenuation_distance;     /**< distance at which light turns attenuation_color; 0 = infinite (default) */
+    float attenuation_color[3];     /**< [0, 1], default 1, 1, 1 */
+    float clearcoat;                /**< KHR_materials_clearcoat weight, [0, 1] (default 0: no coat) */
+    sy_rt_texture_ref clearcoat_texture; /**< R x clearcoat */
+    float clearcoat_roughness;      /**< [0, 1] (default 0) */
+    sy_rt_texture_ref clearcoat_roughness_texture; /**< G x clearcoat_roughness */
 } sy_rt_material_desc;
 
 /** Fills desc with the glTF 2.0 defaults. */
@@ -563,7 +574,7 @@ sy_rt_result sy_rt_accum_read(sy_rt_device *dev, const sy_rt_accum *accum, sy_rt
  * P0's BSDF for any direction, so a filter can re-shade a neighbour's incident sample with this
  * pixel's own material, normal and wo. Ownership: caller-owned array; plain data. */
 enum { SY_RT_RECORD_P0 = 1u << 0 };
-#define SY_RT_RECORD_BSDF_FLOATS 18 /**< floats of the packed BSDF in a record */
+#define SY_RT_RECORD_BSDF_FLOATS 25 /**< floats of the packed BSDF in a record */
 /** One path record of the path tracer (see above). */
 typedef struct sy_rt_pt_record {
     /** @{ color = the sample's radiance; prefix = what the path gathered before wi (see above) */

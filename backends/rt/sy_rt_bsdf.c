@@ -6,11 +6,6 @@
 #define INV_PI 0.31830988618f
 
 static float maxc(sy_rt_v3 v) { return sy_rt_maxf(v.x, sy_rt_maxf(v.y, v.z)); }
-static float schlick1(float f0, float c)
-{
-    float m = 1.0f - sy_rt_clampf(c, 0.0f, 1.0f), m2 = m * m;
-    return f0 + (1.0f - f0) * m2 * m2 * m;
-}
 static sy_rt_v3 schlick3(sy_rt_v3 f0, float c)
 {
     float m = 1.0f - sy_rt_clampf(c, 0.0f, 1.0f), m2 = m * m, m5 = m2 * m2 * m;
@@ -79,32 +74,44 @@ void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
     b->b = v3(bb, sign + n.y * n.y * a, -n.y);
     b->base = v3(sy_rt_clampf(s->base.x, 0.0f, 1.0f), sy_rt_clampf(s->base.y, 0.0f, 1.0f), sy_rt_clampf(s->base.z, 0.0f, 1.0f));
     b->front = s->front;
-    float metallic = sy_rt_clampf(s->metallic, 0.0f, 1.0f), trans = sy_rt_clampf(d->transmission, 0.0f, 1.0f);
+    float metallic = sy_rt_clampf(s->metallic, 0.0f, 1.0f), trans = sy_rt_clampf(s->transmission, 0.0f, 1.0f);
     float rough = sy_rt_clampf(s->roughness, 0.0f, 1.0f);
     b->delta = rough < SY_RT_BSDF_DELTA_ROUGHNESS;
     b->alpha = sy_rt_maxf(rough * rough, 1e-4f);
     b->ior = d->ior >= 1.0f ? d->ior : 1.5f;
     float r = (b->ior - 1.0f) / (b->ior + 1.0f);
     b->f0d = r * r;
-    b->spec = sy_rt_clampf(d->specular, 0.0f, 1.0f);
-    b->w_metal = metallic;
-    b->w_diel = (1.0f - metallic) * (1.0f - trans);
-    b->w_trans = (1.0f - metallic) * trans;
-    float fd = b->spec * schlick1(b->f0d, v3_dot(b->n, wo));
+    b->f0c = v3(sy_rt_minf(b->f0d * s->specular_color.x, 1.0f), sy_rt_minf(b->f0d * s->specular_color.y, 1.0f),
+                sy_rt_minf(b->f0d * s->specular_color.z, 1.0f));
+    b->spec = sy_rt_clampf(s->specular, 0.0f, 1.0f);
+    float nv = v3_dot(b->n, wo);
+    b->cc = sy_rt_clampf(s->clearcoat, 0.0f, 1.0f);
+    float ccr = sy_rt_clampf(s->clearcoat_roughness, 0.0f, 1.0f);
+    b->cc_delta = ccr < SY_RT_BSDF_DELTA_ROUGHNESS;
+    b->cc_alpha = sy_rt_maxf(ccr * ccr, 1e-4f);
+    float fc = b->cc > 0.0f ? b->cc * schlick3(v3(0.04f, 0.04f, 0.04f), nv).x : 0.0f;
+    b->base_scale = 1.0f - fc;
+    b->w_metal = metallic * b->base_scale;
+    b->w_diel = (1.0f - metallic) * (1.0f - trans) * b->base_scale;
+    b->w_trans = (1.0f - metallic) * trans * b->base_scale;
+    float fd = b->spec * maxc(schlick3(b->f0c, nv));
     b->q_metal = b->w_metal;
     b->q_spec = b->w_diel * fd;
     b->q_diff = b->w_diel * (1.0f - fd) * maxc(b->base);
+    b->q_coat = fc;
     b->q_trans = b->w_trans;
-    float sum = b->q_metal + b->q_spec + b->q_diff + b->q_trans;
+    float sum = b->q_metal + b->q_spec + b->q_diff + b->q_coat + b->q_trans;
     if (sum > 0.0f) {
-        b->q_metal /= sum, b->q_spec /= sum, b->q_diff /= sum, b->q_trans /= sum;
+        b->q_metal /= sum, b->q_spec /= sum, b->q_diff /= sum, b->q_coat /= sum, b->q_trans /= sum;
     } else {
-        b->q_metal = b->q_spec = b->q_diff = b->q_trans = 0.0f;
+        b->q_metal = b->q_spec = b->q_diff = b->q_coat = b->q_trans = 0.0f;
     }
 }
 
-/* The GGX lobes are evaluated (not delta, some glossy weight). */
+/* The base's GGX lobes are evaluated (not delta, some glossy weight). */
 static inline bool bsdf_glossy(const sy_rt_bsdf *b) { return !b->delta && (b->q_metal > 0.0f || b->q_spec > 0.0f); }
+/* The coat's GGX lobe is evaluated. */
+static inline bool coat_glossy(const sy_rt_bsdf *b) { return !b->cc_delta && b->q_coat > 0.0f; }
 
 /* sy_rt_bsdf_eval with the wo-only terms given: nv = n . wo and lv = Lambda(nv) (< 0: computed
  * here when needed, as a single evaluation does); a batch of directions for one wo computes them
@@ -116,8 +123,8 @@ static inline sy_rt_v3 bsdf_eval_wo(const sy_rt_bsdf *b, sy_rt_v3 wo, float nv, 
     if (nl <= 0.0f || nv <= 0.0f || v3_dot(b->ng, wi) <= 0.0f) return v3(0.0f, 0.0f, 0.0f);
     sy_rt_v3 h = v3_normalize(v3_add(wo, wi));
     float vh = sy_rt_maxf(v3_dot(wo, h), 0.0f);
-    float fd = b->spec * schlick1(b->f0d, vh);
-    sy_rt_v3 f = v3_scale(b->base, b->w_diel * (1.0f - fd) * INV_PI);
+    sy_rt_v3 fs = v3_scale(schlick3(b->f0c, vh), b->spec);
+    sy_rt_v3 f = v3_scale(b->base, b->w_diel * (1.0f - maxc(fs)) * INV_PI);
     float p = b->q_diff * nl * INV_PI;
     if (bsdf_glossy(b)) {
         float a2 = b->alpha * b->alpha, nh = sy_rt_maxf(v3_dot(b->n, h), 0.0f);
@@ -126,8 +133,16 @@ static inline sy_rt_v3 bsdf_eval_wo(const sy_rt_bsdf *b, sy_rt_v3 wo, float nv, 
         if (lv < 0.0f) lv = ggx_lambda(a2, nv);
         float common = D / (1.0f + lv + ll) / (4.0f * nl * nv);
         f = v3_add(f, v3_scale(schlick3(b->base, vh), b->w_metal * common));
-        f = v3_add(f, v3_scale(v3(1.0f, 1.0f, 1.0f), b->w_diel * fd * common));
+        f = v3_add(f, v3_scale(fs, b->w_diel * common));
         p += (b->q_metal + b->q_spec) * D / (1.0f + lv) / (4.0f * nv);
+    }
+    if (coat_glossy(b)) {
+        float a2 = b->cc_alpha * b->cc_alpha, nh = sy_rt_maxf(v3_dot(b->n, h), 0.0f);
+        float D = ggx_d(a2, nh), lc = ggx_lambda(a2, nv), ll = ggx_lambda(a2, nl);
+        float F = schlick3(v3(0.04f, 0.04f, 0.04f), vh).x;
+        float fc = b->cc * F * D / (1.0f + lc + ll) / (4.0f * nl * nv);
+        f = v3_add(f, v3(fc, fc, fc));
+        p += b->q_coat * D / (1.0f + lc) / (4.0f * nv);
     }
     *pdf = p;
     return v3_scale(f, nl);
@@ -147,13 +162,23 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
     out->pdf = 0.0f;
     if (nv <= 0.0f) return false;
     sy_rt_v3 wol = to_local(b, wo);
-    int lobe; /* 0 metal, 1 spec, 2 diffuse, 3 transmission */
+    int lobe; /* 0 metal, 1 spec, 2 diffuse, 3 transmission, 4 coat */
     float lo;
     if (u0 < b->q_metal) lobe = 0, lo = 0.0f;
     else if (u0 < b->q_metal + b->q_spec) lobe = 1, lo = b->q_metal;
     else if (u0 < b->q_metal + b->q_spec + b->q_diff) lobe = 2, lo = b->q_metal + b->q_spec;
+    else if (u0 < b->q_metal + b->q_spec + b->q_diff + b->q_coat) lobe = 4, lo = b->q_metal + b->q_spec + b->q_diff;
     else if (b->q_trans > 0.0f) lobe = 3, lo = 1.0f - b->q_trans;
     else return false;
+    if (lobe == 4 && b->cc_delta) { /* a smooth coat: its mirror direction */
+        sy_rt_v3 wi = v3_sub(v3_scale(b->n, 2.0f * nv), wo);
+        if (v3_dot(b->ng, wi) <= 0.0f) return false;
+        out->wi = wi;
+        out->specular = true;
+        float F = b->cc * schlick3(v3(0.04f, 0.04f, 0.04f), nv).x / b->q_coat;
+        out->weight = v3(F, F, F);
+        return true;
+    }
     if (lobe == 3) {
         float ut = sy_rt_clampf((u0 - lo) / b->q_trans, 0.0f, 0.99999994f);
         float a2 = b->alpha * b->alpha;
@@ -183,13 +208,13 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
         out->specular = true;
         return true;
     }
-    if (b->delta && lobe != 2) {
+    if (b->delta && lobe != 2 && lobe != 4) {
         sy_rt_v3 wi = v3_sub(v3_scale(b->n, 2.0f * nv), wo);
         if (v3_dot(b->ng, wi) <= 0.0f) return false;
         out->wi = wi;
         out->specular = true;
         out->weight = lobe == 0 ? v3_scale(schlick3(b->base, nv), b->w_metal / b->q_metal)
-                                : v3_scale(v3(1.0f, 1.0f, 1.0f), b->w_diel * b->spec * schlick1(b->f0d, nv) / b->q_spec);
+                                : v3_scale(schlick3(b->f0c, nv), b->w_diel * b->spec / b->q_spec);
         return true;
     }
     sy_rt_v3 wi;
@@ -197,6 +222,9 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
         float r = sqrtf(u[1]), sp, cp;
         sy_rt_sincos_2pi(u[2], &sp, &cp);
         wi = to_world(b, v3(r * cp, r * sp, sqrtf(sy_rt_maxf(1.0f - u[1], 0.0f))));
+    } else if (lobe == 4) {
+        sy_rt_v3 h = to_world(b, sample_vndf(b->cc_alpha, wol, u[1], u[2]));
+        wi = v3_sub(v3_scale(h, 2.0f * v3_dot(wo, h)), wo);
     } else {
         sy_rt_v3 h = to_world(b, sample_vndf(b->alpha, wol, u[1], u[2]));
         wi = v3_sub(v3_scale(h, 2.0f * v3_dot(wo, h)), wo);
@@ -216,7 +244,8 @@ void sy_rt_bsdf_pack(const sy_rt_bsdf *b, float o[SY_RT_RECORD_BSDF_FLOATS])
     const float v[SY_RT_RECORD_BSDF_FLOATS] = {b->n.x,   b->n.y,   b->n.z,      b->ng.x,     b->ng.y,     b->ng.z,
                                                b->base.x, b->base.y, b->base.z, b->alpha,    b->delta ? 1.0f : 0.0f,
                                                b->f0d,   b->spec,  b->w_metal,  b->w_diel,   b->q_metal,  b->q_spec,
-                                               b->q_diff};
+                                               b->q_diff, b->f0c.x, b->f0c.y, b->f0c.z,
+                                               b->cc,    b->cc_alpha, b->cc_delta ? 1.0f : 0.0f, b->q_coat};
     memcpy(o, v, sizeof v);
 }
 
@@ -238,6 +267,8 @@ void sy_rt_pt_record_bsdf_batch(const sy_rt_pt_record *r, uint32_t count, const 
     b.delta = p[10] != 0.0f;
     b.f0d = p[11], b.spec = p[12], b.w_metal = p[13], b.w_diel = p[14];
     b.q_metal = p[15], b.q_spec = p[16], b.q_diff = p[17];
+    b.f0c = v3(p[18], p[19], p[20]);
+    b.cc = p[21], b.cc_alpha = p[22], b.cc_delta = p[23] != 0.0f, b.q_coat = p[24];
     sy_rt_v3 wo = v3(r->wo[0], r->wo[1], r->wo[2]);
     float nv = v3_dot(b.n, wo), lv = bsdf_glossy(&b) && nv > 0.0f ? ggx_lambda(b.alpha * b.alpha, nv) : -1.0f;
     for (uint32_t m = 0; m < count; ++m) {

@@ -2,10 +2,15 @@
  * based, energy-conserving mixture of
  *   - metal:       GGX microfacet reflection (Smith height-correlated masking-shadowing, Schlick
  *                  Fresnel with F0 = base colour), weight metallic;
- *   - dielectric:  GGX specular with F = specular * Schlick(F0 = ((ior-1)/(ior+1))^2) over Lambert
- *                  diffuse scaled by (1 - F), weight (1 - metallic)(1 - transmission);
+ *   - dielectric:  GGX specular with F = specular * Schlick(F0 = min(((ior-1)/(ior+1))^2 x
+ *                  specular colour, 1)) over Lambert diffuse scaled by (1 - max(F)), weight
+ *                  (1 - metallic)(1 - transmission) (KHR_materials_specular as its specification
+ *                  layers it);
  *   - transmission: solid dielectric with exact Fresnel, reflection or refraction through a GGX
- *                  microfacet (tinted by the base colour), weight (1 - metallic) transmission.
+ *                  microfacet (tinted by the base colour), weight (1 - metallic) transmission;
+ *   - clearcoat:   KHR_materials_clearcoat's coat on top of all of them: a GGX lobe with F0 0.04
+ *                  and its own roughness, weight clearcoat; the base below is scaled by
+ *                  1 - clearcoat x Fresnel(n . wo), the specification's albedo scaling.
  * Roughness below SY_RT_BSDF_DELTA_ROUGHNESS is a perfect mirror / smooth interface (delta lobes).
  * Lobes with a finite density ("evaluable") take part in next-event estimation and MIS; delta lobes
  * and the transmission lobe are sampled only. Sampling picks one lobe by its estimated albedo and
@@ -25,10 +30,14 @@ typedef struct sy_rt_bsdf {
     float alpha;        /* GGX alpha = roughness^2 */
     bool delta;         /* roughness below the delta threshold */
     bool front;         /* the ray arrived on the front side (for the refraction ratio) */
-    float ior, f0d;     /* dielectric F0 = ((ior - 1) / (ior + 1))^2 */
+    float ior, f0d;     /* ((ior - 1) / (ior + 1))^2 */
+    sy_rt_v3 f0c;       /* dielectric F0: min(f0d x KHR_materials_specular colour, 1) */
     float spec;         /* KHR_materials_specular factor: scales the dielectric Fresnel term */
-    float w_metal, w_diel, w_trans;
-    float q_metal, q_spec, q_diff, q_trans; /* lobe selection probabilities (sum 1 or all 0) */
+    float w_metal, w_diel, w_trans; /* the base's lobes, already x base_scale */
+    float cc, cc_alpha; /* KHR_materials_clearcoat: weight and GGX alpha of the coat (F0 0.04) */
+    bool cc_delta;      /* the coat is a smooth mirror */
+    float base_scale;   /* 1 - cc x Fresnel_coat(n . wo): what the coat lets through to the base */
+    float q_metal, q_spec, q_diff, q_coat, q_trans; /* lobe selection probabilities (sum 1 or all 0) */
 } sy_rt_bsdf;
 
 /* Builds the BSDF of a surface hit seen from direction wo (unit, away from the surface). */
@@ -37,7 +46,7 @@ void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo);
 /* True when some lobe has a finite density (worth a light sample). */
 static inline bool sy_rt_bsdf_evaluable(const sy_rt_bsdf *b)
 {
-    return b->q_diff > 0.0f || (!b->delta && (b->q_metal > 0.0f || b->q_spec > 0.0f));
+    return b->q_diff > 0.0f || (!b->delta && (b->q_metal > 0.0f || b->q_spec > 0.0f)) || (!b->cc_delta && b->q_coat > 0.0f);
 }
 
 /* f(wo, wi) * |cos(n, wi)| of the evaluable lobes, and their mixture pdf (solid angle) in *pdf. */

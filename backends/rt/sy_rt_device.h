@@ -42,6 +42,8 @@ typedef struct sy_rt_material_data {
     bool emissive;  /* emissive factor non-zero */
     bool masked;    /* alpha mode MASK: needs the Embree alpha filter */
     bool textured;  /* some texture slot is set: hits need texture coordinates */
+    bool volume;    /* KHR_materials_volume absorbs: thickness > 0 and a finite attenuation distance */
+    float sigma[3]; /* absorption coefficient per unit length: -ln(attenuation_color) / distance */
 } sy_rt_material_data;
 
 typedef struct sy_rt_instance_data {

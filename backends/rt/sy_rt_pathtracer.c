@@ -206,6 +206,7 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
     sy_rt_v3 beta_s = v3(0.0f, 0.0f, 0.0f), incident = beta_s;
     float path_len = 0.0f;
     if (rec) rec->flags = 0, rec->hit_distance = INFINITY;
+    const sy_rt_material_data *medium = NULL; /* the absorbing volume the ray travels in (KHR_materials_volume) */
 
     for (;;) {
         struct RTCRayHit rh;
@@ -216,6 +217,12 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
         if (rec) {
             if (want_hit) rec->hit_distance = in ? rh.ray.tfar : INFINITY, want_hit = false;
             if (!after_p0 && in) path_len += rh.ray.tfar;
+        }
+        if (medium && in) { /* Beer-Lambert absorption over the segment inside (an escaping ray: an open mesh) */
+            float t = rh.ray.tfar * v3_length(dir);
+            sy_rt_v3 tr = v3(expf(-medium->sigma[0] * t), expf(-medium->sigma[1] * t), expf(-medium->sigma[2] * t));
+            beta = v3_mul(beta, tr);
+            if (after_p0) beta_s = v3_mul(beta_s, tr);
         }
         if (!in) {
             if (bounce == 0u) { /* a camera ray (through alpha-blended crossings) sees the background */
@@ -317,6 +324,8 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
             beta_s = v3_scale(beta_s, 1.0f / q);
         }
         if (v3_is_zero(beta)) break;
+        /* refraction into a volume enters it, out of one leaves it; reflections keep the medium */
+        if (bs.transmit) medium = s.front && s.mat->volume ? s.mat : NULL;
         org = v3_madd(s.p, b.ng, bs.transmit ? -sy_rt_ray_eps(s.p) : sy_rt_ray_eps(s.p));
         dir = bs.wi;
         tnear = 0.0f;

@@ -252,6 +252,7 @@ void sy_rt_material_desc_init(sy_rt_material_desc *d)
     d->ior = 1.5f;
     d->alpha_mode = SY_RT_ALPHA_OPAQUE;
     d->alpha_cutoff = 0.5f;
+    for (int k = 0; k < 3; ++k) d->specular_color[k] = d->attenuation_color[k] = 1.0f;
 }
 
 static sy_rt_result validate_texref(const sy_rt_device *dev, sy_rt_texture_ref t, const char *name)
@@ -276,6 +277,12 @@ static sy_rt_result validate_material(const sy_rt_device *dev, const sy_rt_mater
         {"emissive[2]", d->emissive[2], 0.0f, INFINITY}, {"normal_scale", d->normal_scale, -INFINITY, INFINITY},
         {"specular", d->specular, 0.0f, 1.0f}, {"transmission", d->transmission, 0.0f, 1.0f},
         {"ior", d->ior, 1.0f, INFINITY}, {"alpha_cutoff", d->alpha_cutoff, 0.0f, 1.0f},
+        {"specular_color[0]", d->specular_color[0], 0.0f, INFINITY}, {"specular_color[1]", d->specular_color[1], 0.0f, INFINITY},
+        {"specular_color[2]", d->specular_color[2], 0.0f, INFINITY}, {"thickness", d->thickness, 0.0f, INFINITY},
+        {"attenuation_distance", d->attenuation_distance, 0.0f, INFINITY},
+        {"attenuation_color[0]", d->attenuation_color[0], 0.0f, 1.0f}, {"attenuation_color[1]", d->attenuation_color[1], 0.0f, 1.0f},
+        {"attenuation_color[2]", d->attenuation_color[2], 0.0f, 1.0f}, {"clearcoat", d->clearcoat, 0.0f, 1.0f},
+        {"clearcoat_roughness", d->clearcoat_roughness, 0.0f, 1.0f},
     };
     for (size_t i = 0; i < sizeof ranges / sizeof ranges[0]; ++i)
         if (!isfinite(ranges[i].v) || ranges[i].v < ranges[i].lo || ranges[i].v > ranges[i].hi)
@@ -287,6 +294,11 @@ static sy_rt_result validate_material(const sy_rt_device *dev, const sy_rt_mater
     if ((r = validate_texref(dev, d->base_color_texture, "base_color_texture")) != SY_RT_OK) return r;
     if ((r = validate_texref(dev, d->metallic_roughness_texture, "metallic_roughness_texture")) != SY_RT_OK) return r;
     if ((r = validate_texref(dev, d->emissive_texture, "emissive_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->transmission_texture, "transmission_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->specular_texture, "specular_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->specular_color_texture, "specular_color_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->clearcoat_texture, "clearcoat_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->clearcoat_roughness_texture, "clearcoat_roughness_texture")) != SY_RT_OK) return r;
     return validate_texref(dev, d->normal_texture, "normal_texture");
 }
 
@@ -296,7 +308,15 @@ static void material_set(sy_rt_material_data *m, const sy_rt_material_desc *d)
     m->emissive = d->emissive[0] > 0.0f || d->emissive[1] > 0.0f || d->emissive[2] > 0.0f;
     m->masked = d->alpha_mode == SY_RT_ALPHA_MASK;
     m->textured = d->base_color_texture.texture.id || d->normal_texture.texture.id ||
-                  d->metallic_roughness_texture.texture.id || d->emissive_texture.texture.id;
+                  d->metallic_roughness_texture.texture.id || d->emissive_texture.texture.id ||
+                  d->transmission_texture.texture.id || d->specular_texture.texture.id ||
+                  d->specular_color_texture.texture.id || d->clearcoat_texture.texture.id ||
+                  d->clearcoat_roughness_texture.texture.id;
+    /* KHR_materials_volume: Beer-Lambert absorption inside a closed volume (thickness > 0) */
+    m->volume = d->thickness > 0.0f && d->attenuation_distance > 0.0f && isfinite(d->attenuation_distance);
+    for (int k = 0; k < 3; ++k)
+        m->sigma[k] = m->volume ? -logf(sy_rt_maxf(d->attenuation_color[k], 1e-6f)) / d->attenuation_distance : 0.0f;
+    m->volume = m->volume && (m->sigma[0] > 0.0f || m->sigma[1] > 0.0f || m->sigma[2] > 0.0f);
 }
 
 sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc *d, sy_rt_material *out)

@@ -41,6 +41,8 @@ sy_rt_v3 sy_rt_shadow_transmittance(const sy_rt_device *dev, struct RTCIntersect
     }
     sy_rt_v3 T = one;
     float tnear = 0.0f, inv_len = 1.0f / fmaxf(v3_length(dir), 1e-30f);
+    const sy_rt_material_data *medium = NULL; /* the absorbing volume entered (KHR_materials_volume) */
+    float t_enter = 0.0f;
     for (uint32_t k = 0; k <= MAX_CROSSINGS; ++k) {
         if (!(tnear < tfar)) return T;
         struct RTCRayHit rh;
@@ -58,13 +60,22 @@ sy_rt_v3 sy_rt_shadow_transmittance(const sy_rt_device *dev, struct RTCIntersect
         sy_rt_v3 pass = v3(1.0f - a, 1.0f - a, 1.0f - a);
         if (trans) {
             const sy_rt_material_desc *d = &m->desc;
-            float r = (d->ior - 1.0f) / (d->ior + 1.0f);
-            float w = a * (1.0f - s.metallic) * d->transmission * (1.0f - r * r * d->specular);
+            float r = (d->ior - 1.0f) / (d->ior + 1.0f), f0 = sy_rt_minf(r * r * v3_max_abs(s.specular_color), 1.0f);
+            float w = a * (1.0f - s.metallic) * s.transmission * (1.0f - f0 * s.specular);
             sy_rt_v3 base = v3(sy_rt_clampf(s.base.x, 0.0f, 1.0f), sy_rt_clampf(s.base.y, 0.0f, 1.0f),
                                sy_rt_clampf(s.base.z, 0.0f, 1.0f));
             pass = v3_madd(pass, base, w);
         }
         T = v3_mul(T, pass);
+        if (trans && m->volume) { /* Beer-Lambert over the path inside, from its front face to a back face */
+            if (s.front) {
+                medium = m, t_enter = rh.ray.tfar;
+            } else if (medium == m) {
+                float len = (rh.ray.tfar - t_enter) / inv_len;
+                T = v3_mul(T, v3(expf(-m->sigma[0] * len), expf(-m->sigma[1] * len), expf(-m->sigma[2] * len)));
+                medium = NULL;
+            }
+        }
         if (v3_max_abs(T) < 1e-6f) return zero;
         tnear = rh.ray.tfar + sy_rt_ray_eps(s.p) * inv_len;
     }

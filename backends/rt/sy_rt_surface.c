@@ -137,6 +137,21 @@ void sy_rt_surface_fetch(const sy_rt_device *dev, const sy_rt_instance_data *ins
         s->roughness *= t[1];
         s->metallic *= t[2];
     }
+    s->transmission = d->transmission;
+    if (s->transmission > 0.0f && sy_rt_texture_sample_ref(dev, &d->transmission_texture, (const float(*)[2])uv, t))
+        s->transmission *= t[0];
+    s->specular = d->specular;
+    if (sy_rt_texture_sample_ref(dev, &d->specular_texture, (const float(*)[2])uv, t)) s->specular *= t[3];
+    s->specular_color = v3_load(d->specular_color);
+    if (sy_rt_texture_sample_ref(dev, &d->specular_color_texture, (const float(*)[2])uv, t))
+        s->specular_color = v3_mul(s->specular_color, v3(t[0], t[1], t[2]));
+    s->clearcoat = d->clearcoat;
+    s->clearcoat_roughness = d->clearcoat_roughness;
+    if (s->clearcoat > 0.0f) {
+        if (sy_rt_texture_sample_ref(dev, &d->clearcoat_texture, (const float(*)[2])uv, t)) s->clearcoat *= t[0];
+        if (sy_rt_texture_sample_ref(dev, &d->clearcoat_roughness_texture, (const float(*)[2])uv, t))
+            s->clearcoat_roughness *= t[1];
+    }
     s->emission = v3_load(d->emissive);
     const sy_rt_texture_ref *em = &d->emissive_texture;
     if (mat->emissive && sy_rt_texture_sample_ref(dev, em, (const float(*)[2])uv, t))

@@ -18,6 +18,10 @@ typedef struct sy_rt_surface {
     sy_rt_v3 base;      /* base colour factor * texture * vertex colour (linear RGB) */
     float alpha;
     float metallic, roughness;
+    float transmission; /* KHR_materials_transmission factor * texture R */
+    float specular;     /* KHR_materials_specular factor * texture A */
+    sy_rt_v3 specular_color; /* its colour factor * texture RGB */
+    float clearcoat, clearcoat_roughness; /* KHR_materials_clearcoat factors * textures R, G */
     sy_rt_v3 emission;  /* radiance */
 } sy_rt_surface;
 

@@ -66,11 +66,14 @@ static sy_rt_v3 shadow(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar)
 {
     return sy_rt_shadow_transmittance(c->dev, &c->ictx.rtc, org, dir, tfar, true, NULL, NULL);
 }
-/* Specular reflectance at normal incidence of the dielectric part. */
-static float dielectric_f0(const sy_rt_material_desc *d)
+/* Specular reflectance at normal incidence of the dielectric part (KHR_materials_specular: factor
+ * and colour). */
+static sy_rt_v3 dielectric_f0(const sy_rt_material_desc *d, const sy_rt_surface *s)
 {
     float r = (d->ior - 1.0f) / (d->ior + 1.0f);
-    return r * r * d->specular;
+    sy_rt_v3 c = s->specular_color;
+    return v3_scale(v3(sy_rt_minf(r * r * c.x, 1.0f), sy_rt_minf(r * r * c.y, 1.0f), sy_rt_minf(r * r * c.z, 1.0f)),
+                    s->specular);
 }
 
 static sy_rt_v3 schlick(sy_rt_v3 f0, float cos_t)
@@ -209,6 +212,18 @@ static sy_rt_v3 trace_secondary(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, uint32
     return trace(c, org, dir, 0.0f, INFINITY, depth, false, &c->ictx.rtc, NULL).rgb;
 }
 
+/* A secondary ray travelling inside material m's volume (KHR_materials_volume): its light is
+ * absorbed over the distance to the next hit (Beer-Lambert); a ray that leaves through an opening
+ * is not. */
+static sy_rt_v3 trace_inside(trace_ctx *c, const sy_rt_material_data *m, sy_rt_v3 org, sy_rt_v3 dir, uint32_t depth)
+{
+    if (!m->volume) return trace_secondary(c, org, dir, depth);
+    float t;
+    sy_rt_v3 l = trace(c, org, dir, 0.0f, INFINITY, depth, false, &c->ictx.rtc, &t).rgb;
+    if (!isfinite(t)) return l;
+    return v3_mul(l, v3(expf(-m->sigma[0] * t), expf(-m->sigma[1] * t), expf(-m->sigma[2] * t)));
+}
+
 static sy_rt_v3 reflect(sy_rt_v3 d, sy_rt_v3 n) { return v3_sub(d, v3_scale(n, 2.0f * v3_dot(d, n))); }
 
 /* Shades a hit; d is the unit ray direction; camera: the ray is a camera ray (for what an
@@ -238,17 +253,20 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
         float cos_o = fmaxf(v3_dot(s->ns, wo), 0.0f);
         if (recurse && b.delta) { /* the path tracer's delta lobes: a perfect mirror */
             sy_rt_v3 w = v3_scale(s->base, s->metallic);
-            float fd = (1.0f - s->metallic) * (1.0f - md->transmission);
-            if (fd > 0.0f) {
-                float f0 = dielectric_f0(md);
-                w = v3_add(w, v3_scale(schlick(v3(f0, f0, f0), cos_o), fd));
-            }
+            float fd = (1.0f - s->metallic) * (1.0f - s->transmission);
+            if (fd > 0.0f) w = v3_add(w, v3_scale(schlick(dielectric_f0(md, s), cos_o), fd));
+            w = v3_scale(w, b.base_scale); /* under a coat */
             if (v3_max_abs(w) > 1e-4f) {
                 sy_rt_v3 r = reflect(d, s->ns);
                 if (v3_dot(r, s->ng_facing) > 0.0f) L = v3_add(L, v3_mul(w, trace_secondary(c, p_out, r, depth + 1u)));
             }
         }
-        float wt = (1.0f - s->metallic) * md->transmission;
+        if (recurse && b.cc > 0.0f && b.cc_delta) { /* a smooth clearcoat: its mirror ray (F0 0.04) */
+            float w = b.cc * schlick(v3(0.04f, 0.04f, 0.04f), cos_o).x;
+            sy_rt_v3 r = reflect(d, s->ns);
+            if (v3_dot(r, s->ng_facing) > 0.0f) L = v3_add(L, v3_scale(trace_secondary(c, p_out, r, depth + 1u), w));
+        }
+        float wt = (1.0f - s->metallic) * s->transmission * b.base_scale;
         if (recurse && wt > 0.0f) {
             /* Exact dielectric Fresnel; eta = n_incident / n_transmitted. */
             float eta = s->front ? 1.0f / md->ior : md->ior;
@@ -263,8 +281,14 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
                 tdir = v3_normalize(v3_add(v3_scale(d, eta), v3_scale(s->ns, eta * ci - ct)));
             }
             sy_rt_v3 r = reflect(d, s->ns);
-            if (F > 0.0f) L = v3_add(L, v3_scale(trace_secondary(c, p_out, r, depth + 1u), wt * F));
-            if (F < 1.0f) L = v3_add(L, v3_scale(v3_mul(s->base, trace_secondary(c, p_in, tdir, depth + 1u)), wt * (1.0f - F)));
+            /* entering (front): the refracted ray is inside; leaving: the reflected one stays inside */
+            if (F > 0.0f)
+                L = v3_add(L, v3_scale(s->front ? trace_secondary(c, p_out, r, depth + 1u) : trace_inside(c, s->mat, p_out, r, depth + 1u),
+                                       wt * F));
+            if (F < 1.0f) {
+                sy_rt_v3 lt = s->front ? trace_inside(c, s->mat, p_in, tdir, depth + 1u) : trace_secondary(c, p_in, tdir, depth + 1u);
+                L = v3_add(L, v3_scale(v3_mul(s->base, lt), wt * (1.0f - F)));
+            }
         }
         out.rgb = L;
     }

@@ -83,7 +83,20 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     d.normal_scale = m->normal_scale;
     d.transmission = clamp_warn(st, "material", a->id, "transmission", m->transmission, 0.0f, 1.0f);
     d.ior = m->ior;
-    d.specular = st->specular;
+    d.specular = st->specular * m->specular; /* the mediator's "specular" parameter scales every material's */
+    d.specular_texture = texref(&m->specular_texture);
+    for (int i = 0; i < 3; ++i) {
+        d.specular_color[i] = m->specular_color[i];
+        d.attenuation_color[i] = m->attenuation_color[i];
+    }
+    d.specular_color_texture = texref(&m->specular_color_texture);
+    d.transmission_texture = texref(&m->transmission_texture);
+    d.thickness = m->thickness;
+    d.clearcoat = m->clearcoat;
+    d.clearcoat_texture = texref(&m->clearcoat_texture);
+    d.clearcoat_roughness = m->clearcoat_roughness;
+    d.clearcoat_roughness_texture = texref(&m->clearcoat_roughness_texture);
+    d.attenuation_distance = m->attenuation_distance;
     d.alpha_mode = (sy_rt_alpha_mode)m->alpha_mode;
     d.alpha_cutoff = clamp_warn(st, "material", a->id, "alpha_cutoff", m->alpha_cutoff, 0.0f, 1.0f);
     d.double_sided = m->double_sided;
