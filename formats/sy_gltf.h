@@ -84,18 +84,19 @@ typedef struct sy_gltf_counts {
     uint32_t points, line_segments; /** @} */
 } sy_gltf_counts;
 
-/** What a load produced: the root, camera nodes, warnings and counts (sy_gltf_info_free). */
 /** One KHR_materials_variants mapping: primitive `primitive` (an index into the mesh's sy
  * primitives) of `mesh` takes `material` in variant `variant`; `default_material` is the material
  * the file gives it without a variant. */
 typedef struct sy_gltf_variant_use {
-    sy_mesh mesh;
-    uint32_t primitive;
+    sy_mesh mesh; /**< the mesh of the primitive */
+    uint32_t primitive; /**< index into the mesh's primitives */
     uint32_t variant; /**< index into sy_gltf_info.variant_names */
-    sy_material material;
-    sy_material default_material;
+    sy_material material; /**< the primitive's material in that variant */
+    sy_material default_material; /**< its material without a variant */
 } sy_gltf_variant_use;
 
+/** What a load produced: the root, camera nodes, warnings, counts and material variants
+ * (sy_gltf_info_free). */
 typedef struct sy_gltf_info {
     sy_node root;              /**< the new node whose children are the glTF scene's root nodes */
     int32_t scene_index;       /**< glTF scene loaded; -1: none given, all parentless nodes used */

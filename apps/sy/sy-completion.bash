@@ -13,13 +13,13 @@
 _sy_commands="info render demo compare coverage view web bench backends serve help version"
 _sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit cull web"
 _sy_common="--help -q --quiet -v --verbose --env --env-color --env-intensity --env-hidden --background
-            --no-default-light --allow-path --strict --max-scene-mb"
+            --no-default-light --allow-path --strict --max-scene-mb --variant"
 _sy_cluster="--cluster --cluster-mode --secret-file --tls-ca --timeout-ms --cluster-pixels"
 # options that take a value (the next word)
 _sy_with_value=" -b -o -w -h --camera --params --max-memory --gl --filter --threshold --exposure --tonemap --stereo --eye-sep
   --zero-parallax --overlay --composite --frames --spp --time --cluster --cluster-mode --secret-file --tls-ca
   --timeout-ms --cluster-pixels --screenshot --keys --top --backends --repeats --nodes --tris --reference --env
-  --env-color --env-intensity --background --allow-path --max-scene-mb --listen --output --port-file --tls-cert --tls-key --name
+  --env-color --env-intensity --background --allow-path --max-scene-mb --variant --listen --output --port-file --tls-cert --tls-key --name
   --max-sessions --max-lifetime --blob-cache-mb --max-objects --auth-backoff-ms --max-peer-memory-mb
   --max-frame-kb --max-message-mb --max-unauthenticated --handshake-timeout-ms --coop-frame --budget --quality "
 
