@@ -51,6 +51,18 @@
  *    environment alone; re-rendered when geometry, materials, lights or the environment change;
  *  - emission (a visible front side, both when double-sided) adds to the reflected light; unlit
  *    materials show their base colour (+ emission).
+ * Layers (the glTF material extensions; the Khronos glTF Sample Viewer's model, one shader
+ * variant for all of them): KHR_materials_specular colours the dielectric F0
+ * (min(((ior-1)/(ior+1))^2 x specular_color, 1) x specular) and the diffuse keeps 1 - that
+ * Fresnel; a clear coat adds a GGX lobe (F0 0.04, its own roughness, the surface's normal without
+ * its normal map) for punctual lights and the environment and scales what lies under it by
+ * 1 - clearcoat x Fresnel(n.v); sheen adds sheen_color x Charlie distribution x Neubelt visibility
+ * for punctual lights and sheen_color x E x the irradiance for the environment, and scales the
+ * base by 1 - max(sheen_color) E(n.v, sheen_roughness), E the sheen lobe's directional albedo
+ * (a table the BRDF table's third channel holds, integrated at start-up); volume attenuates the
+ * transmitted environment by attenuation_color^(thickness x the instance's scale /
+ * attenuation_distance) (Beer-Lambert over the thickness, as the Sample Viewer). Emissive polygons
+ * see the base scaled by the coat and sheen, without their own lobes.
  * Shadows: directional and spot lights and area lights (from the polygon's centre along its
  * normal, a 150-degree frustum; a Poisson PCF over a penumbra of fixed world radius, 0.3 x the
  * square root of the polygon's area, an approximation without a blocker search) share
@@ -282,6 +294,17 @@ typedef struct sy_gl_material_desc {
     float alpha_cutoff; /**< alpha cutoff of SY_GL_ALPHA_MASK */
     /** @{ both faces are front faces; unlit (pixel = base colour) */
     bool double_sided, unlit; /** @} */
+    /* Material extensions (factors; their textures are not read). A material whose values are all
+     * the defaults below shades exactly as without them; the others draw with the layered
+     * shader variant (see "Layers" in the file comment). */
+    float specular_color[3];  /**< KHR_materials_specular: dielectric F0 colour (1, 1, 1 = none), >= 0 */
+    float clearcoat;          /**< KHR_materials_clearcoat weight, [0, 1] (0 = no coat) */
+    float clearcoat_roughness; /**< [0, 1] */
+    float sheen_color[3];     /**< KHR_materials_sheen colour, [0, 1] (0 = no sheen) */
+    float sheen_roughness;    /**< [0, 1] */
+    float thickness;          /**< KHR_materials_volume thickness, mesh units (0 = thin-walled) */
+    float attenuation_distance; /**< world distance light travels in the volume before attenuation_color remains; 0 = infinite */
+    float attenuation_color[3]; /**< [0, 1] */
 } sy_gl_material_desc;
 void sy_gl_material_desc_init(sy_gl_material_desc *desc); /**< glTF defaults */
 /** Creates a material from desc (one UBO). */

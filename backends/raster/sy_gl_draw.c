@@ -368,7 +368,8 @@ static int frame_lighting(const sy_gl_device *dev)
 }
 
 /* The material's variant bits that the shaders turn on and off per draw by the material's own
- * uniforms (m_tex, m_tex2, the transmission factor): textures, normal map, transmission. */
+ * uniforms (m_tex, m_tex2, the transmission factor, the layers' factors): textures, normal map,
+ * transmission, layers (the material extensions: their defaults shade as without them). */
 static int material_features(const sy_gl_device *dev, const mat_o *mt)
 {
     int v = 0;
@@ -380,6 +381,7 @@ static int material_features(const sy_gl_device *dev, const mat_o *mt)
      * where the texture says dielectric (TransmissionTest's striped "Metal" spheres) */
     bool mr_tex = sy_gli_pool_get(&dev->textures, mt->d.metallic_roughness_texture.texture.id) != NULL;
     if (mt->d.transmission > 0.0f && (mt->d.metallic < 1.0f || mr_tex)) v |= VAR_TRANS;
+    if (sy_gli_material_layered(&mt->d)) v |= VAR_LAYERS;
     return v;
 }
 
@@ -443,7 +445,7 @@ static int probe_of(const sy_gl_device *dev, uint32_t i)
 static bool deferrable(const sy_gl_device *dev, const inst_o *in, int pv, const mat_o *mt)
 {
     if (!(in->px_per_tri <= DEFERRED_MAX_PX_PER_TRI)) return false;
-    if ((pv & (VAR_TEX | VAR_MASK | VAR_TRANS | VAR_PROBE)) || !(pv & VAR_LEAN)) return false;
+    if ((pv & (VAR_TEX | VAR_MASK | VAR_TRANS | VAR_PROBE | VAR_LAYERS)) || !(pv & VAR_LEAN)) return false;
     if (mt && mt->d.alpha_mode != SY_GL_ALPHA_OPAQUE) return false;
     return (mt ? mt->h.id & IDX_MASK : 0u) < dev->mtab_cpu_rows;
 }

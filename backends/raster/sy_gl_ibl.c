@@ -73,7 +73,16 @@ static const char *const brdf_fs =
     "    float vis = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));\n"
     "    float gv = vis * 4.0 * nl * vh / max(H.z, 1e-6); float m = 1.0 - vh, fc = m * m * m * m * m;\n"
     "    A += (1.0 - fc) * gv; Bv += fc * gv; }\n"
-    "  o = vec4(A / float(n), Bv / float(n), 0.0, 1.0); }\n";
+    /* B: the sheen lobe's directional albedo E(n.v, sheen roughness) (KHR_materials_sheen: Charlie
+     * distribution, alpha = roughness^2, Neubelt visibility 1 / (4 (n.l + n.v - n.l n.v))), by
+     * uniform hemisphere sampling (Hammersley points); sy_gl_shaders_layers.c reads it */
+    "  float sa = max(r * r, 1e-4), inv = 1.0 / sa, E = 0.0; const uint m = 1024u;\n"
+    "  for (uint i = 0u; i < m; ++i) {\n"
+    "    float cl = (float(i) + 0.5) / float(m), sl = sqrt(max(0.0, 1.0 - cl * cl)), phi = 2.0 * PI * radinv(i);\n"
+    "    vec3 L = vec3(sl * cos(phi), sl * sin(phi), cl); vec3 H = normalize(V + L);\n"
+    "    float s2 = max(1.0 - H.z * H.z, 0.0), D = (2.0 + inv) * pow(s2, 0.5 * inv) / (2.0 * PI);\n"
+    "    E += D * cl / (4.0 * (cl + nv - cl * nv)); }\n"
+    "  o = vec4(A / float(n), Bv / float(n), min(E * 2.0 * PI / float(m), 1.0), 1.0); }\n";
 
 static sy_gl_result build(const sy_gl_fns *gl, sy_gl_ibl *ibl, sy_gl_report *rep)
 {
@@ -129,7 +138,7 @@ sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, sy_gl_report 
     ibl->ltc1 = table_tex(gl, GL_RGBA32F, SY_GL_LTC_SIZE, GL_RGBA, ltc);
     ibl->ltc2 = table_tex(gl, GL_RGBA32F, SY_GL_LTC_SIZE, GL_RGBA, ltc + SY_GL_LTC_FLOATS);
     free(ltc);
-    GLuint lut = table_tex(gl, GL_RG32F, SY_GL_IBL_BRDF_SIZE, GL_RG, NULL);
+    GLuint lut = table_tex(gl, GL_RGBA32F, SY_GL_IBL_BRDF_SIZE, GL_RGBA, NULL);
     gl->BindFramebuffer(GL_FRAMEBUFFER, ibl->fbo);
     gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, lut, 0);
     gl->DrawBuffer(GL_COLOR_ATTACHMENT0);

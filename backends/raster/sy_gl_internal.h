@@ -147,7 +147,9 @@ enum {
     VAR_ASHADOW = 2048, /* area-light shadow maps (only with VAR_AREA) */
     VAR_TRANS = 4096,   /* the material transmits (refracts the environment; only with VAR_ENV or VAR_PROBE) */
     VAR_PROBE = 8192,   /* the instance reflects and refracts its own scene probe instead of the environment */
-    VAR_COUNT = 16384
+    VAR_LAYERS = 16384, /* material extensions: specular colour, clear coat, sheen, volume (sy_gl_shaders_layers.c;
+                         * only with lighting) */
+    VAR_COUNT = 32768
 };
 
 struct sy_gl_device {
@@ -276,6 +278,9 @@ typedef struct mat_block {
     float base[4], emissive[4], mrna[4], oist[4];
     int32_t modes[4], tex[4], tex2[4];
     float xf[10][4]; /* per texture slot (base, mr, nrm, occ, emis) two rows of its uv transform */
+    /* the layers (m_l0 .. m_l2): (specular colour, clear coat), (coat roughness, sheen roughness,
+     * thickness, attenuation distance), (sheen colour, 0), (attenuation colour, 0) */
+    float layers[4][4];
 } mat_block;
 
 /* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes, then the cube shadows' parameters
@@ -342,6 +347,8 @@ bool sy_gli_sphere_outside(const float planes[6][4], const float c[3], float r);
 /* sy_gl_programs.c */
 GLuint sy_gli_make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], bool srgb);
 void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b);
+/* Whether material d uses a material extension (then it draws with VAR_LAYERS). */
+bool sy_gli_material_layered(const sy_gl_material_desc *d);
 void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog);
 int sy_gli_variant_normalize(int v);
 GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep);

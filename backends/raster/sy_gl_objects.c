@@ -419,13 +419,18 @@ void sy_gl_material_desc_init(sy_gl_material_desc *d)
     d->specular = 1.0f;
     d->ior = 1.5f;
     d->alpha_cutoff = 0.5f;
+    for (int i = 0; i < 3; ++i) d->specular_color[i] = d->attenuation_color[i] = 1.0f;
 }
 
 static sy_gl_result material_check(const sy_gl_material_desc *d, sy_gl_report *rep)
 {
     const float *v[] = {d->base_color, d->base_color + 1, d->base_color + 2, d->base_color + 3, &d->metallic,
                         &d->roughness, d->emissive, d->emissive + 1, d->emissive + 2, &d->normal_scale,
-                        &d->occlusion_strength, &d->specular, &d->transmission, &d->ior, &d->alpha_cutoff};
+                        &d->occlusion_strength, &d->specular, &d->transmission, &d->ior, &d->alpha_cutoff,
+                        d->specular_color, d->specular_color + 1, d->specular_color + 2, &d->clearcoat,
+                        &d->clearcoat_roughness, d->sheen_color, d->sheen_color + 1, d->sheen_color + 2,
+                        &d->sheen_roughness, &d->thickness, &d->attenuation_distance, d->attenuation_color,
+                        d->attenuation_color + 1, d->attenuation_color + 2};
     for (size_t i = 0; i < sizeof v / sizeof v[0]; ++i)
         if (!isfinite(*v[i])) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "material: parameter %zu is not finite", i);
     if ((unsigned)d->alpha_mode > 2u)

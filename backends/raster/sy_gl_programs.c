@@ -45,6 +45,16 @@ void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
     b->modes[1] = d->unlit;
     b->modes[2] = d->double_sided;
     b->modes[3] = d->emissive[0] > 0.0f || d->emissive[1] > 0.0f || d->emissive[2] > 0.0f;
+    for (int i = 0; i < 3; ++i) {
+        b->layers[0][i] = d->specular_color[i] > 0.0f ? d->specular_color[i] : 0.0f;
+        b->layers[2][i] = fminf(fmaxf(d->sheen_color[i], 0.0f), 1.0f);
+        b->layers[3][i] = fminf(fmaxf(d->attenuation_color[i], 0.0f), 1.0f);
+    }
+    b->layers[0][3] = fminf(fmaxf(d->clearcoat, 0.0f), 1.0f);
+    b->layers[1][0] = fminf(fmaxf(d->clearcoat_roughness, 0.0f), 1.0f);
+    b->layers[1][1] = fminf(fmaxf(d->sheen_roughness, 0.0f), 1.0f);
+    b->layers[1][2] = d->thickness > 0.0f ? d->thickness : 0.0f;
+    b->layers[1][3] = d->attenuation_distance > 0.0f ? d->attenuation_distance : 0.0f;
     const sy_gl_texture_ref *refs[5] = {&d->base_color_texture, &d->metallic_roughness_texture, &d->normal_texture,
                                         &d->occlusion_texture, &d->emissive_texture};
     for (int i = 0; i < 5; ++i) {
@@ -55,6 +65,13 @@ void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
         memcpy(b->xf[2 * i], m, 3 * sizeof(float));
         memcpy(b->xf[2 * i + 1], m + 3, 3 * sizeof(float));
     }
+}
+
+bool sy_gli_material_layered(const sy_gl_material_desc *d)
+{
+    bool l = d->clearcoat > 0.0f || (d->attenuation_distance > 0.0f && d->thickness > 0.0f && d->transmission > 0.0f);
+    for (int i = 0; i < 3; ++i) l = l || d->specular_color[i] != 1.0f || d->sheen_color[i] > 0.0f;
+    return l && !d->unlit;
 }
 
 void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog)
@@ -83,6 +100,7 @@ int sy_gli_variant_normalize(int v)
     if (!(v & VAR_LIGHTS)) v &= ~VAR_SHADOW;
     if (!(v & VAR_AREA)) v &= ~VAR_ASHADOW;
     if (!(v & (VAR_ENV | VAR_PROBE))) v &= ~VAR_TRANS;
+    if (!(v & (VAR_LIGHTS | VAR_ENV | VAR_AREA | VAR_PROBE))) v &= ~VAR_LAYERS;
     return v;
 }
 
@@ -108,14 +126,15 @@ static void variant_defines(int v, uint64_t sig, char *defs, size_t defs_len, ch
     static const struct {
         int bit;
         const char *name;
-    } more[4] = {{VAR_AREA, "AREA"}, {VAR_TRANS, "TRANS"}, {VAR_ASHADOW, "ASHADOW"}, {VAR_PROBE, "PROBE"}};
+    } more[5] = {{VAR_AREA, "AREA"}, {VAR_TRANS, "TRANS"}, {VAR_ASHADOW, "ASHADOW"}, {VAR_PROBE, "PROBE"},
+                 {VAR_LAYERS, "LAYERS"}};
     size_t dl = strlen(defs), nl = strlen(name);
     for (int b = 0; b < 7; ++b) {
         if (!(v & (1 << b))) continue;
         dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_%s 1\n", names[b]);
         nl += (size_t)snprintf(name + nl, name_len - nl, " %s", names[b]);
     }
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < 5; ++k) {
         if (!(v & more[k].bit)) continue;
         dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_%s 1\n", more[k].name);
         nl += (size_t)snprintf(name + nl, name_len - nl, " %s", more[k].name);
@@ -164,7 +183,9 @@ GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep)
     char defs[1024] = "", name[256] = "main";
     variant_defines(v, sig, defs, sizeof defs, name, sizeof name);
     GLuint p = 0;
-    if (sy_gl_program_build(gl, name, sy_gl_main_vs, sy_gl_main_fs, defs, &p, rep) != SY_GL_OK) return 0;
+    if (sy_gl_program_build_tail(gl, name, sy_gl_main_vs, sy_gl_main_fs, defs, (v & VAR_LAYERS) ? sy_gl_layers_fs : NULL,
+                                 &p, rep) != SY_GL_OK)
+        return 0;
     dev->pm[v].prog = p;
     dev->pm[v].sig = sig;
     dev->pm[v].model = gl->GetUniformLocation(p, "u_model");

@@ -212,6 +212,8 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
     }
     sy_gli_profile_mark(dev, false, prof[1]);
     sy_gli_frame_features(dev);
+    /* the layers read the sheen albedo from the BRDF table, with punctual lights alone too */
+    if ((dev->shared_features & VAR_LAYERS) && (r = sy_gl_ibl_tables(gl, &dev->ibl, rep)) != SY_GL_OK) return r;
     uint32_t psize = probe_size_for(dev, &v, d->width, d->height);
     if (psize != dev->probe_size) { /* a probed instance larger in view than before: sharper probes */
         sy_gli_probes_free(dev);

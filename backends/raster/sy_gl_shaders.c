@@ -67,6 +67,7 @@ const char *const sy_gl_main_vs =
     "layout(std140) uniform Material {\n"                                                                    \
     "  vec4 m_base; vec4 m_emissive; vec4 m_mrna; vec4 m_oist; ivec4 m_modes; ivec4 m_tex; ivec4 m_tex2;\n" \
     "  vec4 m_xf[10];\n" /* uv transform rows per slot: base, mr, nrm, occ, emis */                          \
+    "  vec4 m_l0, m_l1, m_l2, m_l3;\n" /* the layers (mat_block.layers, sy_gl_shaders_layers.c) */           \
     "};\n"                                                                                                   \
     "uniform sampler2D t_base, t_mr, t_nrm, t_occ, t_emis;\n"                                                \
     "vec2 tuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_xf[2*k].xyz, h), dot(m_xf[2*k+1].xyz, h)); }\n" \
@@ -89,6 +90,19 @@ const char *const sy_gl_main_vs =
     "uniform vec3 u_cam_pos; uniform vec3 u_cam_fwd; uniform bool u_ortho; uniform bool u_mirror;\n" \
     "uniform bool u_has_normals; uniform vec3 u_ortho_z;\n" /* orthographic: proj[10], proj[14] */ \
     "const float INV_PI = 0.31830988618;\n" \
+    /* the dielectric Fresnel: a colour where KHR_materials_specular can tint it (SY_LAYERS), else \
+     * one value; the layers' functions (sy_gl_layers_fs, linked after this source) */ \
+    "#ifdef SY_LAYERS\n" \
+    "#define FDT vec3\n#define SCHL_D schlick\n#define F0D f0c\n" \
+    "vec3 g_nc;\n" /* the clear coat's normal: the surface's, without its normal map (main) */ \
+    "vec3 layer_light(vec3 wi, vec3 wo, vec3 ns, float nl, vec3 f);\n" \
+    "float layer_scale(vec3 ns, vec3 wo);\n" \
+    "vec3 layer_env(vec3 env, vec3 ns, vec3 wo, float nv, vec3 irr);\n" \
+    "vec3 layer_f0(float f0);\n" \
+    "vec3 layer_transmittance();\n" \
+    "#else\n" \
+    "#define FDT float\n#define SCHL_D schlick1\n#define F0D f0d\n" \
+    "#endif\n" \
     "vec3 schlick(vec3 f0, float c) { float m = 1.0 - clamp(c, 0.0, 1.0); float m5 = m*m*m*m*m;\n" \
     "  return f0 + (vec3(1.0) - f0) * m5; }\n" \
     "float schlick1(float f0, float c) { float m = 1.0 - clamp(c, 0.0, 1.0); return f0 + (1.0 - f0) * m*m*m*m*m; }\n" \
@@ -186,7 +200,7 @@ const char *const sy_gl_main_vs =
      * needs. lt, its type, likewise (0 point, 1 point with a range, 2 spot, 3 directional; -1 \
      * read from the block): a point light runs no spot-cone or range code */ \
     "vec3 shade_light(int i, int kind, int lt, vec3 P, vec3 ngf, vec3 ns, vec3 wo, vec3 bc, vec3 kd, float spec,\n" \
-    "                 float f0d, float w_metal, float w_diel, float rough, float a2, float nv) {\n" \
+    "                 FDT f0d, float w_metal, float w_diel, float rough, float a2, float nv) {\n" \
     "  Light l = l_lights[i]; int type = lt < 0 ? int(l.pos_type.w) : lt == 3 ? 3 : lt == 2 ? 2 : 1; vec3 wi, e;\n" \
     "  if (type == 3) { wi = -l.dir_range.xyz; e = l.radiant.rgb; }\n" \
     "  else {\n" \
@@ -208,7 +222,7 @@ const char *const sy_gl_main_vs =
     "  float vis = 1.0;\n" \
     "#endif\n" \
     "  vec3 h = normalize(wi + wo); float vh = max(dot(wo, h), 0.0);\n" \
-    "  float fd = spec * schlick1(f0d, vh);\n" \
+    "  FDT fd = spec * SCHL_D(f0d, vh);\n" \
     "  vec3 f = kd * (1.0 - fd) * INV_PI;\n" \
     "  if (rough > 0.0) {\n" \
     "    float nl = cs, nh = max(dot(ns, h), 0.0);\n" \
@@ -216,6 +230,9 @@ const char *const sy_gl_main_vs =
     "    float V = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));\n" \
     "    f += (schlick(bc, vh) * w_metal + vec3(w_diel * fd)) * (D * V);\n" \
     "  }\n" \
+    "#ifdef SY_LAYERS\n" \
+    "  f = layer_light(wi, wo, ns, cs, f);\n" \
+    "#endif\n" \
     "  return e * f * cs * vis;\n" \
     "}\n" \
     "#endif\n" \
@@ -249,8 +266,11 @@ const char *const sy_gl_main_vs =
     "    vec3 kd = bc * w_diel;\n" \
     "    float a = max(rough * rough, 1e-4), a2 = a * a;\n" \
     "    float nv = max(dot(ns, wo), 1e-4);\n" \
+    "#ifdef SY_LAYERS\n" \
+    "    vec3 f0c = layer_f0(f0d);\n" \
+    "#endif\n" \
     "#ifdef SY_LIGHTS\n" \
-    "#define SY_LIGHT(i, kind, lt) shade_light(i, kind, lt, P, ngf, ns, wo, bc, kd, spec, f0d, w_metal, w_diel, rough, a2, nv)\n" \
+    "#define SY_LIGHT(i, kind, lt) shade_light(i, kind, lt, P, ngf, ns, wo, bc, kd, spec, F0D, w_metal, w_diel, rough, a2, nv)\n" \
     "#ifdef SY_NLIGHTS\n" /* the variant's light count (1 .. 7) and shadow kinds SY_LK0 ..: straight-line code */ \
     SY_GL_LIGHT_CALL(0) SY_GL_LIGHT_CALL(1) SY_GL_LIGHT_CALL(2) SY_GL_LIGHT_CALL(3) SY_GL_LIGHT_CALL(4) \
     SY_GL_LIGHT_CALL(5) SY_GL_LIGHT_CALL(6) \
@@ -261,7 +281,7 @@ const char *const sy_gl_main_vs =
     "#if defined(SY_AREA) || defined(SY_ENV) || defined(SY_PROBE)\n" \
     /* split-sum terms: A, B of the GGX BRDF for this view and roughness */ \
     "    vec2 ab = textureLod(t_brdf, vec2(nv, rough) * (31.0 / 32.0) + 0.5 / 32.0, 0.0).rg;\n" \
-    "    float fd_avg = spec * (f0d * ab.x + ab.y);\n" \
+    "    FDT fd_avg = spec * (F0D * ab.x + ab.y);\n" \
     "    vec3 fspec = (bc * ab.x + ab.y) * w_metal + vec3(w_diel * fd_avg);\n" \
     "#endif\n" \
     "#ifdef SY_AREA\n" \
@@ -272,8 +292,11 @@ const char *const sy_gl_main_vs =
     "      mat3 frame = transpose(mat3(T1, T2, ns));\n" \
     "      mat3 Minv = mat3(vec3(t1.x, 0.0, t1.y), vec3(0.0, 1.0, 0.0), vec3(t1.z, 0.0, t1.w)) * frame;\n" \
     /* the LTC norm replaces A, B for the polygon's specular (F0 t2.x + (1 - F0) t2.y) */ \
-    "      vec3 fl = (bc * t2.x + (1.0 - bc) * t2.y) * w_metal + vec3(w_diel * spec * (f0d * t2.x + (1.0 - f0d) * t2.y));\n" \
+    "      vec3 fl = (bc * t2.x + (1.0 - bc) * t2.y) * w_metal + vec3(w_diel * spec * (F0D * t2.x + (1.0 - F0D) * t2.y));\n" \
     "      vec3 kdl = kd * (1.0 - fd_avg);\n" \
+    "#ifdef SY_LAYERS\n" /* the polygons see the base under the coat and sheen, not their lobes */ \
+    "      { float ls = layer_scale(ns, wo); fl *= ls; kdl *= ls; }\n" \
+    "#endif\n" \
     "#define SY_AREA_L(i, sh) shade_area(i, sh, P, ngf, frame, Minv, kdl, fl, rough)\n" \
     /* two loops, not one call per polygon: sixteen inlined copies of shade_area (two LTC \
      * evaluations and eight shadow taps each) took llvmpipe's LLVM many seconds to compile. The \
@@ -312,8 +335,15 @@ const char *const sy_gl_main_vs =
     "          vec3 n2 = ns - 2.0 * dot(ns, T) * T;\n" /* the exit normal (outward) */ \
     "          vec3 T2 = refract(T, -n2, eta); T = dot(T2, T2) > 0.0 ? T2 : reflect(T, -n2);\n" \
     "        }\n" \
+    "#ifdef SY_LAYERS\n" \
+    "        env += w_trans * (F * env_spec(R, rough) + (1.0 - F) * bc * layer_transmittance() * env_spec(T, rough));\n" \
+    "#else\n" \
     "        env += w_trans * (F * env_spec(R, rough) + (1.0 - F) * bc * env_spec(T, rough));\n" \
+    "#endif\n" \
     "      }\n"    "#endif\n" \
+    "#ifdef SY_LAYERS\n" \
+    "      env = layer_env(env, ns, wo, nv, irr);\n" \
+    "#endif\n" \
     "      L += env * ao;\n" \
     "    }\n" \
     "#endif\n" \
@@ -373,6 +403,9 @@ const char *const sy_gl_main_fs =
     "    if (any(isnan(ngf))) ngf = wo;\n"
     "    vec3 n = front ? ngf : -ngf;\n"
     "    if (u_has_normals) { vec3 sn = normalize(v_nrm); if (!any(isnan(sn))) n = sn; }\n"
+    "#ifdef SY_LAYERS\n"
+    "    g_nc = front ? n : -n;\n"
+    "#endif\n"
     "#ifdef SY_NMAP\n"
     "    if (m_tex.z >= 0) {\n"
     "      vec2 t = tuv(2, UVSET(m_tex.z)); vec2 dtx = dFdx(t), dty = dFdy(t);\n"
@@ -633,14 +666,14 @@ const char *const sy_gl_floor_fs =
     "#endif\n";
 
 static sy_gl_result compile(const sy_gl_fns *gl, const char *name, GLenum stage, const char *src, const char *defines,
-                            GLuint *out, sy_gl_report *rep)
+                            const char *tail, GLuint *out, sy_gl_report *rep)
 {
     GLuint s = gl->CreateShader(stage);
-    /* defines go right after the #version line */
+    /* defines go right after the #version line, the tail (more functions) after the source */
     const char *nl = strchr(src, '\n');
-    const char *parts[3] = {src, defines ? defines : "", nl ? nl + 1 : ""};
-    GLint lens[3] = {nl ? (GLint)(nl + 1 - src) : -1, -1, -1};
-    gl->ShaderSource(s, nl ? 3 : 1, parts, nl ? lens : NULL);
+    const char *parts[4] = {src, defines ? defines : "", nl ? nl + 1 : "", tail ? tail : ""};
+    GLint lens[4] = {nl ? (GLint)(nl + 1 - src) : -1, -1, -1, -1};
+    gl->ShaderSource(s, nl ? 4 : 1, parts, nl ? lens : NULL);
     gl->CompileShader(s);
     GLint ok = 0;
     gl->GetShaderiv(s, GL_COMPILE_STATUS, &ok);
@@ -658,9 +691,15 @@ static sy_gl_result compile(const sy_gl_fns *gl, const char *name, GLenum stage,
 sy_gl_result sy_gl_program_build(const sy_gl_fns *gl, const char *name, const char *vs, const char *fs,
                                  const char *fs_defines, GLuint *out, sy_gl_report *rep)
 {
+    return sy_gl_program_build_tail(gl, name, vs, fs, fs_defines, NULL, out, rep);
+}
+
+sy_gl_result sy_gl_program_build_tail(const sy_gl_fns *gl, const char *name, const char *vs, const char *fs,
+                                      const char *fs_defines, const char *fs_tail, GLuint *out, sy_gl_report *rep)
+{
     GLuint v = 0, f = 0;
-    sy_gl_result r = compile(gl, name, GL_VERTEX_SHADER, vs, fs_defines, &v, rep);
-    if (r == SY_GL_OK) r = compile(gl, name, GL_FRAGMENT_SHADER, fs, fs_defines, &f, rep);
+    sy_gl_result r = compile(gl, name, GL_VERTEX_SHADER, vs, fs_defines, NULL, &v, rep);
+    if (r == SY_GL_OK) r = compile(gl, name, GL_FRAGMENT_SHADER, fs, fs_defines, fs_tail, &f, rep);
     if (r != SY_GL_OK) {
         if (v) gl->DeleteShader(v);
         return r;

@@ -25,4 +25,14 @@ extern const char *const sy_gl_rect_vs;
 sy_gl_result sy_gl_program_build(const sy_gl_fns *gl, const char *name, const char *vs, const char *fs,
                                  const char *fs_defines, GLuint *out, sy_gl_report *rep);
 
+/* The same with fs_tail (NULL = none) appended to the fragment source: more functions, which the
+ * source declares. */
+sy_gl_result sy_gl_program_build_tail(const sy_gl_fns *gl, const char *name, const char *vs, const char *fs,
+                                      const char *fs_defines, const char *fs_tail, GLuint *out, sy_gl_report *rep);
+
+/* sy_gl_shaders_layers.c: the material extensions' functions of the main fragment shader's
+ * SY_LAYERS variants (layer_f0, layer_light, layer_scale, layer_env, layer_transmittance), the
+ * tail of sy_gl_main_fs. */
+extern const char *const sy_gl_layers_fs;
+
 #endif /* SY_GL_SHADERS_H */

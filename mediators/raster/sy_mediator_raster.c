@@ -132,6 +132,15 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     d.alpha_cutoff = m->alpha_cutoff;
     d.double_sided = m->double_sided;
     d.unlit = m->unlit;
+    d.specular = m->specular; /* the extensions' factors (their textures are not read: docs/BACKENDS.md) */
+    memcpy(d.specular_color, m->specular_color, sizeof d.specular_color);
+    d.clearcoat = m->clearcoat;
+    d.clearcoat_roughness = m->clearcoat_roughness;
+    memcpy(d.sheen_color, m->sheen_color, sizeof d.sheen_color);
+    d.sheen_roughness = m->sheen_roughness;
+    d.thickness = m->thickness;
+    d.attenuation_distance = m->attenuation_distance;
+    memcpy(d.attenuation_color, m->attenuation_color, sizeof d.attenuation_color);
     sy_gl_material h = {*a->handle};
     sy_gl_result r = h.id ? sy_gl_material_update(st->dev, h, &d)
                           : sy_gl_material_create(st->dev, &d, &h);

@@ -1,0 +1,225 @@
+/* test_raster_layers.c — the rasterizer's glTF material extensions (sy_gl.h "Layers"), each on
+ * against off on a sphere, through the back-end API:
+ *  1. KHR_materials_clearcoat: a rough dark base under a directional light gains a sharp coat
+ *     highlight (the brightest pixel at least doubles), and under a constant environment the coat
+ *     reflects it (the mean over the sphere grows);
+ *  2. KHR_materials_specular: specular 0 removes the dielectric highlight of a black base, and a
+ *     red specular colour makes the highlight red;
+ *  3. KHR_materials_sheen: white sheen on a dark base lit from the camera brightens the rim (grazing
+ *     angles) several times and leaves the centre within a few per cent;
+ *  4. KHR_materials_volume: attenuation tints what a glass sphere shows through it towards the
+ *     attenuation colour (green and blue fall against red), and more with a larger thickness;
+ *  5. a material without extensions renders the same bits with a layered material in the frame
+ *     (it then draws with the layered shader variant) as without.
+ * argv[1] = provider (osmesa default). */
+#include "sy_gl.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl_test.h"
+
+#define N 64
+static float rgba[N * N * 4];
+static const sy_gl_render_desc full = {N, N, 0, 0, N, N};
+static const float *px(int x, int y) { return rgba + 4 * (y * N + x); }
+static float lum(const float *p) { return 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]; }
+
+/* statistics over the pixels the sphere covers (alpha 1): mean and brightest luminance */
+typedef struct stats {
+    float mean, max;
+    int at; /* the brightest pixel's index */
+} stats;
+static stats measure(void)
+{
+    stats s = {0, 0, -1};
+    int n = 0;
+    for (int i = 0; i < N * N; ++i) {
+        if (rgba[4 * i + 3] < 0.999f) continue;
+        float l = lum(rgba + 4 * i);
+        s.mean += l, n++;
+        if (l > s.max) s.max = l, s.at = i;
+    }
+    s.mean = n ? s.mean / (float)n : 0.0f;
+    return s;
+}
+
+static sy_gl_device *d;
+static sy_gl_instance sphere;
+static const sy_gl_camera cam = {.camera_to_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1},
+                                 .window = {-0.5f, 0.5f, -0.5f, 0.5f}, .near_clip = 0.1f};
+
+/* renders the sphere with material md */
+static void render_with(const sy_gl_material_desc *md)
+{
+    sy_gl_material m;
+    MUST(sy_gl_material_create(d, md, &m));
+    MUST(sy_gl_instance_set_material(d, sphere, m));
+    MUST(sy_gl_render(d, &cam, &full, rgba, NULL));
+    MUST(sy_gl_instance_set_material(d, sphere, (sy_gl_material){0}));
+    MUST(sy_gl_material_destroy(d, m));
+}
+
+static sy_gl_texture constant_env(float v)
+{
+    enum { W = 16, H = 8 };
+    static float t[W * H * 3];
+    for (int i = 0; i < W * H * 3; ++i) t[i] = v;
+    sy_gl_texture_desc td = {.width = W, .height = H, .channels = 3, .format = SY_GL_TEXEL_FLOAT32, .pixels = t};
+    sy_gl_texture h;
+    MUST(sy_gl_texture_create(d, &td, &h));
+    return h;
+}
+
+/* a unit sphere wound counter-clockwise seen from outside (gl_sphere.h's is wound the other way,
+ * so its outside shows its back face), smooth outward normals */
+static sy_gl_mesh sphere_ccw(uint32_t seg)
+{
+    uint32_t nv = (seg + 1) * (seg + 1), nt = 0;
+    float *p = malloc(nv * 3 * sizeof *p);
+    uint32_t *ix = malloc((size_t)seg * seg * 6 * sizeof *ix);
+    if (!p || !ix) exit(1);
+    for (uint32_t i = 0; i <= seg; ++i)
+        for (uint32_t j = 0; j <= seg; ++j) {
+            float th = 3.14159265f * (float)i / (float)seg, ph = 6.2831853f * (float)j / (float)seg, *v = p + 3 * (i * (seg + 1) + j);
+            v[0] = sinf(th) * cosf(ph), v[1] = cosf(th), v[2] = sinf(th) * sinf(ph);
+        }
+    for (uint32_t i = 0; i < seg; ++i)
+        for (uint32_t j = 0; j < seg; ++j) {
+            uint32_t a = i * (seg + 1) + j, b = a + seg + 1;
+            if (i > 0) ix[3 * nt] = a, ix[3 * nt + 1] = a + 1, ix[3 * nt + 2] = b, nt++;
+            if (i + 1 < seg) ix[3 * nt] = a + 1, ix[3 * nt + 1] = b + 1, ix[3 * nt + 2] = b, nt++;
+        }
+    sy_gl_mesh_desc md = {.positions = p, .normals = p, .indices = ix, .vertex_count = nv, .triangle_count = nt};
+    sy_gl_mesh m;
+    MUST(sy_gl_mesh_create(d, &md, &m));
+    free(p), free(ix);
+    return m;
+}
+
+static sy_gl_material_desc dielectric(float base, float rough)
+{
+    sy_gl_material_desc md;
+    sy_gl_material_desc_init(&md);
+    md.base_color[0] = md.base_color[1] = md.base_color[2] = base;
+    md.metallic = 0.0f;
+    md.roughness = rough;
+    return md;
+}
+
+int main(int argc, char **argv)
+{
+    sy_gl_provider prov = SY_GL_PROVIDER_OSMESA;
+    if (argc > 1 && !sy_gl_provider_parse(argv[1], &prov)) return 2;
+    sy_gl_device_desc dd = {GL_TEST_REPORT, .provider = prov, .msaa = 1, .shadow_map_size = 256};
+    MUST(sy_gl_device_create(&dd, &d));
+    sy_gl_mesh ball = sphere_ccw(64);
+    sy_gl_instance_desc id = {.mesh = ball, .transform = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -3.5f, 1}};
+    MUST(sy_gl_instance_create(d, &id, &sphere));
+    /* a directional light from behind the camera, a little from above and the left */
+    sy_gl_light_desc ld = {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3.0f,
+                           .direction = {0.25f, -0.3f, -1.0f}, .no_shadow = true};
+    sy_gl_light light;
+    MUST(sy_gl_light_create(d, &ld, &light));
+
+    /* 1. clear coat: a highlight under the light */
+    sy_gl_material_desc base = dielectric(0.1f, 0.9f), coat = base;
+    coat.clearcoat = 1.0f;
+    coat.clearcoat_roughness = 0.15f;
+    render_with(&base);
+    stats s0 = measure();
+    render_with(&coat);
+    stats s1 = measure();
+    printf("clear coat, directional light: brightest %g -> %g, mean %g -> %g\n", s0.max, s1.max, s0.mean, s1.mean);
+    EXPECT_MSG(s0.max > 0.0f && s1.max > 2.0f * s0.max, "the coat adds a highlight: brightest %g -> %g", s0.max, s1.max);
+    EXPECT_MSG(s1.mean < 1.5f * s0.mean && s1.mean > 0.8f * s0.mean, "the coat's highlight is small: mean %g -> %g", s0.mean,
+               s1.mean);
+
+    /* 2. specular: 0 removes the dielectric highlight; a red specular colour makes it red */
+    sy_gl_material_desc black = dielectric(0.0f, 0.3f), nospec = black, red = black;
+    nospec.specular = 0.0f;
+    red.specular_color[1] = red.specular_color[2] = 0.0f;
+    render_with(&black);
+    stats b0 = measure();
+    const float *hp = rgba + 4 * b0.at;
+    float white_hl[3] = {hp[0], hp[1], hp[2]};
+    render_with(&nospec);
+    stats b1 = measure();
+    render_with(&red);
+    const float *rp = rgba + 4 * b0.at;
+    printf("specular: brightest %g (specular 0: %g); highlight RGB %g %g %g, red specular colour %g %g %g\n", b0.max, b1.max,
+           white_hl[0], white_hl[1], white_hl[2], rp[0], rp[1], rp[2]);
+    EXPECT_MSG(b0.max > 0.05f && b1.max < 1e-4f, "specular 0 removes the highlight: %g -> %g", b0.max, b1.max);
+    EXPECT_MSG(fabsf(rp[0] - white_hl[0]) <= 0.02f * white_hl[0] && rp[1] < 1e-4f && rp[2] < 1e-4f,
+               "a red specular colour: highlight %g %g %g (white %g %g %g)", rp[0], rp[1], rp[2], white_hl[0], white_hl[1],
+               white_hl[2]);
+
+    /* 3. sheen: grazing angles brighten; the centre stays. The light comes from the camera. */
+    ld.direction[0] = 0.0f, ld.direction[1] = 0.0f, ld.direction[2] = -1.0f;
+    MUST(sy_gl_light_update(d, light, &ld));
+    sy_gl_material_desc dark = dielectric(0.05f, 1.0f), sheen = dark;
+    dark.specular = sheen.specular = 0.0f;
+    sheen.sheen_color[0] = sheen.sheen_color[1] = sheen.sheen_color[2] = 1.0f;
+    sheen.sheen_roughness = 0.5f;
+    /* the rim: the covered pixel of the middle row furthest right; the centre pixel */
+    render_with(&dark);
+    int rim = -1;
+    for (int x = N / 2; x < N; ++x)
+        if (px(x, N / 2)[3] >= 0.999f) rim = x;
+    EXPECT_MSG(rim > N / 2 + 4, "the sphere's rim at x = %d", rim);
+    if (rim < 1) return sy_check_finish("raster_layers");
+    rim -= 1; /* one pixel in: fully covered */
+    float rim0 = lum(px(rim, N / 2)), ctr0 = lum(px(N / 2, N / 2));
+    render_with(&sheen);
+    float rim1 = lum(px(rim, N / 2)), ctr1 = lum(px(N / 2, N / 2));
+    printf("sheen: rim %g -> %g, centre %g -> %g\n", rim0, rim1, ctr0, ctr1);
+    EXPECT_MSG(rim1 > 3.0f * rim0, "white sheen brightens the rim: %g -> %g", rim0, rim1);
+    EXPECT_MSG(ctr1 > 0.85f * ctr0 && ctr1 < 1.15f * ctr0, "sheen leaves the centre: %g -> %g", ctr0, ctr1);
+
+    /* 4. volume: a glass sphere under a constant environment, attenuation towards red */
+    MUST(sy_gl_light_destroy(d, light));
+    sy_gl_texture env = constant_env(1.0f);
+    sy_gl_set_environment(d, env, 1.0f);
+    sy_gl_material_desc glass = dielectric(1.0f, 0.0f), tinted = glass, thick = glass;
+    glass.transmission = tinted.transmission = thick.transmission = 1.0f;
+    tinted.thickness = 0.5f, thick.thickness = 2.0f;
+    tinted.attenuation_distance = thick.attenuation_distance = 1.0f;
+    float att[3] = {1.0f, 0.3f, 0.3f};
+    memcpy(tinted.attenuation_color, att, sizeof att);
+    memcpy(thick.attenuation_color, att, sizeof att);
+    float c[3][3];
+    const sy_gl_material_desc *gl3[3] = {&glass, &tinted, &thick};
+    for (int k = 0; k < 3; ++k) {
+        render_with(gl3[k]);
+        memcpy(c[k], px(N / 2, N / 2), sizeof c[k]);
+        printf("volume %d: centre %g %g %g\n", k, c[k][0], c[k][1], c[k][2]);
+    }
+    EXPECT_MSG(fabsf(c[0][1] - c[0][0]) < 0.02f * c[0][0], "clear glass is grey: %g %g", c[0][0], c[0][1]);
+    /* thickness 0.5 at distance 1: 0.3^0.5 = 0.55 of the transmitted green; 2: 0.3^2 = 0.09 */
+    float g1 = c[1][1] / c[1][0], g2 = c[2][1] / c[2][0];
+    EXPECT_MSG(g1 < 0.8f && g1 > 0.4f, "attenuation tints the glass: green/red %g (want about 0.55 + reflection)", g1);
+    EXPECT_MSG(g2 < 0.5f * g1, "a thicker volume is redder: green/red %g (thin %g)", g2, g1);
+    EXPECT_MSG(c[1][0] > 0.9f * c[0][0], "red passes: %g (clear %g)", c[1][0], c[0][0]);
+
+    /* 5. a plain material renders the same with a layered one in the frame */
+    sy_gl_material_desc plain = dielectric(0.6f, 0.4f);
+    render_with(&plain);
+    static float ref[N * N * 4];
+    memcpy(ref, rgba, sizeof ref);
+    sy_gl_material lm;
+    MUST(sy_gl_material_create(d, &coat, &lm));
+    sy_gl_instance_desc od = {.mesh = ball, .material = lm,
+                              .transform = {0.1f, 0, 0, 0, 0, 0.1f, 0, 0, 0, 0, 0.1f, 0, 0, 0, 3.0f, 1}}; /* behind the camera */
+    sy_gl_instance other;
+    MUST(sy_gl_instance_create(d, &od, &other));
+    render_with(&plain);
+    double diff = 0.0;
+    for (int i = 0; i < N * N * 4; ++i) diff = fmax(diff, fabs((double)rgba[i] - ref[i]));
+    printf("plain material with a layered one in the frame: largest difference %g\n", diff);
+    EXPECT_MSG(diff <= 1e-5 * 4.0, "a plain material shades as before in the layered variant: %g", diff);
+
+    sy_gl_device_destroy(d);
+    return sy_check_finish("raster_layers");
+}
