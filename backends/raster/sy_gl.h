@@ -294,9 +294,9 @@ typedef struct sy_gl_material_desc {
     float alpha_cutoff; /**< alpha cutoff of SY_GL_ALPHA_MASK */
     /** @{ both faces are front faces; unlit (pixel = base colour) */
     bool double_sided, unlit; /** @} */
-    /* Material extensions (factors; their textures are not read). A material whose values are all
-     * the defaults below shades exactly as without them; the others draw with the layered
-     * shader variant (see "Layers" in the file comment). */
+    /* Material extensions. A material whose values are all the defaults below (and without their
+     * textures) shades exactly as without them; the others draw with the layered shader variant
+     * (see "Layers" in the file comment). Their textures scale the factors as glTF says. */
     float specular_color[3];  /**< KHR_materials_specular: dielectric F0 colour (1, 1, 1 = none), >= 0 */
     float clearcoat;          /**< KHR_materials_clearcoat weight, [0, 1] (0 = no coat) */
     float clearcoat_roughness; /**< [0, 1] */
@@ -305,6 +305,15 @@ typedef struct sy_gl_material_desc {
     float thickness;          /**< KHR_materials_volume thickness, mesh units (0 = thin-walled) */
     float attenuation_distance; /**< world distance light travels in the volume before attenuation_color remains; 0 = infinite */
     float attenuation_color[3]; /**< [0, 1] */
+    sy_gl_texture_ref specular_texture;       /**< A x specular */
+    sy_gl_texture_ref specular_color_texture; /**< sRGB RGB x specular_color */
+    sy_gl_texture_ref clearcoat_texture;      /**< R x clearcoat */
+    sy_gl_texture_ref clearcoat_roughness_texture; /**< G x clearcoat_roughness */
+    sy_gl_texture_ref clearcoat_normal_texture; /**< the coat's tangent-space normal map */
+    float clearcoat_normal_scale;             /**< its scale */
+    sy_gl_texture_ref sheen_color_texture;    /**< sRGB RGB x sheen_color */
+    sy_gl_texture_ref sheen_roughness_texture; /**< A x sheen_roughness */
+    sy_gl_texture_ref thickness_texture;      /**< G x thickness */
 } sy_gl_material_desc;
 void sy_gl_material_desc_init(sy_gl_material_desc *desc); /**< glTF defaults */
 /** Creates a material from desc (one UBO). */

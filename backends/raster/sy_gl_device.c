@@ -46,6 +46,9 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     GLint max_samples = 1, max_tex = 2048;
     gl->GetIntegerv(GL_MAX_SAMPLES, &max_samples);
     gl->GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
+    GLint max_units = 0;
+    gl->GetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &max_units);
+    dev->layer_units = max_units >= UNIT_COUNT; /* else the layers' textures are not read (GL 3.3 promises 16) */
     dev->msaa = dd.msaa > 1 ? dd.msaa : 1;
     if (dev->msaa > (uint32_t)max_samples) {
         sy_gli_warn(dev, "raster: %u MSAA samples requested, the GL context allows %d; using %d", dev->msaa, max_samples,
@@ -120,8 +123,9 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     dev->sky_size_int = gl->GetUniformLocation(dev->prog_sky, "u_size_int");
 
     static const unsigned char white[4] = {255, 255, 255, 255}, flat[4] = {128, 128, 255, 255};
-    for (int i = 0; i < 5; ++i)
-        dev->standin[i] = sy_gli_make_standin(gl, i == UNIT_NRM ? flat : white, i == UNIT_BASE || i == UNIT_EMIS);
+    for (int i = 0; i < STANDINS; ++i) /* the layers' slots 4 (coat normal), 1 and 5 (colours, sRGB) */
+        dev->standin[i] = sy_gli_make_standin(gl, i == UNIT_NRM || i == 5 + 4 ? flat : white,
+                                              i == UNIT_BASE || i == UNIT_EMIS || i == 5 + 1 || i == 5 + 5);
     sy_gl_material_desc md;
     sy_gl_material_desc_init(&md);
     mat_block mb;
@@ -191,7 +195,7 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         sy_gl_ibl_free(gl, &dev->ibl);
         GLuint bufs[3] = {dev->default_ubo, dev->lights_ubo, dev->areas_ubo};
         gl->DeleteBuffers(3, bufs);
-        gl->DeleteTextures(5, dev->standin);
+        gl->DeleteTextures(STANDINS, dev->standin);
         gl->DeleteTextures(1, &dev->shadow_tex);
         for (uint32_t c = 0; c < SY_GL_MAX_CUBE_SHADOWS; ++c)
             if (dev->cube_tex[c]) gl->DeleteTextures(1, &dev->cube_tex[c]);

@@ -381,7 +381,13 @@ static int material_features(const sy_gl_device *dev, const mat_o *mt)
      * where the texture says dielectric (TransmissionTest's striped "Metal" spheres) */
     bool mr_tex = sy_gli_pool_get(&dev->textures, mt->d.metallic_roughness_texture.texture.id) != NULL;
     if (mt->d.transmission > 0.0f && (mt->d.metallic < 1.0f || mr_tex)) v |= VAR_TRANS;
-    if (sy_gli_material_layered(&mt->d)) v |= VAR_LAYERS;
+    if (sy_gli_material_layered(dev, &mt->d)) {
+        v |= VAR_LAYERS;
+        const sy_gl_texture_ref *lr[LAYER_TEXTURES];
+        sy_gli_layer_refs(&mt->d, lr);
+        for (int i = 0; i < LAYER_TEXTURES && dev->layer_units; ++i)
+            if (sy_gli_pool_get(&dev->textures, lr[i]->texture.id)) v |= VAR_TEX;
+    }
     return v;
 }
 

@@ -32,7 +32,17 @@
 #define SHADOW_SIZE_DEFAULT 2048u
 #define SHADOW_SIZE_AUTO_MIN 256u
 enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_ENV_SPEC, UNIT_ENV_IRR, UNIT_BRDF,
-       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW0, UNIT_CUBE_SHADOW1, UNIT_PROBE, UNIT_COUNT };
+       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW0, UNIT_CUBE_SHADOW1, UNIT_PROBE, UNIT_LAYER0, UNIT_COUNT = UNIT_LAYER0 + 8 };
+/* the layers' texture slots (units UNIT_LAYER0 + i, sy_gl_shaders_layers.c): specular, specular
+ * colour, clear coat, coat roughness, coat normal, sheen colour, sheen roughness, thickness */
+#define LAYER_TEXTURES 8
+#define STANDINS (5 + LAYER_TEXTURES) /* material units with a stand-in: the five base slots, the layers' */
+static inline void sy_gli_layer_refs(const sy_gl_material_desc *d, const sy_gl_texture_ref *r[LAYER_TEXTURES])
+{
+    r[0] = &d->specular_texture, r[1] = &d->specular_color_texture, r[2] = &d->clearcoat_texture;
+    r[3] = &d->clearcoat_roughness_texture, r[4] = &d->clearcoat_normal_texture, r[5] = &d->sheen_color_texture;
+    r[6] = &d->sheen_roughness_texture, r[7] = &d->thickness_texture;
+}
 /* Scene probes: mirror-like and glass instances see the scene, not only the environment. Each of
  * the first SY_GL_MAX_PROBES such instances gets a cube map rendered from its bounding-box centre
  * (the instance itself left out, other probed instances showing the environment), with a mip
@@ -194,7 +204,8 @@ struct sy_gl_device {
         GLint model, view, proj;
     } uf[2]; /* the floors: unlit, trivial lit */
     GLuint default_ubo, lights_ubo, empty_vao;
-    GLuint standin[5]; /* per material texture unit, bound where the material has no texture (sy_gli_make_standin) */
+    GLuint standin[STANDINS]; /* per material texture unit, bound where the material has no texture (sy_gli_make_standin) */
+    bool layer_units; /* the context has UNIT_COUNT texture units: the layers' textures are read */
     GLuint shadow_tex, shadow_fbo;
     GLuint cube_tex[SY_GL_MAX_CUBE_SHADOWS]; /* point-light depth cube maps, made on first use */
     uint32_t cube_size;
@@ -281,6 +292,8 @@ typedef struct mat_block {
     /* the layers (m_l0 .. m_l2): (specular colour, clear coat), (coat roughness, sheen roughness,
      * thickness, attenuation distance), (sheen colour, 0), (attenuation colour, 0) */
     float layers[4][4];
+    int32_t ltex[2][4];  /* the layers' textures' uv sets (-1 none), slots as sy_gli_layer_refs */
+    float lxf[16][4];    /* and their uv transforms, two rows each */
 } mat_block;
 
 /* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes, then the cube shadows' parameters
@@ -348,7 +361,7 @@ bool sy_gli_sphere_outside(const float planes[6][4], const float c[3], float r);
 GLuint sy_gli_make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], bool srgb);
 void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b);
 /* Whether material d uses a material extension (then it draws with VAR_LAYERS). */
-bool sy_gli_material_layered(const sy_gl_material_desc *d);
+bool sy_gli_material_layered(const sy_gl_device *dev, const sy_gl_material_desc *d);
 void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog);
 int sy_gli_variant_normalize(int v);
 GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep);

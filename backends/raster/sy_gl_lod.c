@@ -39,6 +39,14 @@ const mat_o *sy_gli_bind_material(sy_gl_device *dev, sy_gl_material id, bool all
         gl->ActiveTexture(GL_TEXTURE0 + (GLenum)i);
         gl->BindTexture(GL_TEXTURE_2D, t ? t->tex : dev->standin[i]);
     }
+    if (!all_textures || !dev->layer_units) return m;
+    const sy_gl_texture_ref *lr[LAYER_TEXTURES];
+    sy_gli_layer_refs(&m->d, lr);
+    for (int i = 0; i < LAYER_TEXTURES; ++i) { /* the layers' (sy_gl_shaders_layers.c reads them where m_lt says) */
+        const tex_o *t = sy_gli_pool_get(&dev->textures, lr[i]->texture.id);
+        gl->ActiveTexture(GL_TEXTURE0 + UNIT_LAYER0 + (GLenum)i);
+        gl->BindTexture(GL_TEXTURE_2D, t ? t->tex : dev->standin[5 + i]);
+    }
     return m;
 }
 

@@ -420,6 +420,7 @@ void sy_gl_material_desc_init(sy_gl_material_desc *d)
     d->ior = 1.5f;
     d->alpha_cutoff = 0.5f;
     for (int i = 0; i < 3; ++i) d->specular_color[i] = d->attenuation_color[i] = 1.0f;
+    d->clearcoat_normal_scale = 1.0f;
 }
 
 static sy_gl_result material_check(const sy_gl_material_desc *d, sy_gl_report *rep)
@@ -430,14 +431,15 @@ static sy_gl_result material_check(const sy_gl_material_desc *d, sy_gl_report *r
                         d->specular_color, d->specular_color + 1, d->specular_color + 2, &d->clearcoat,
                         &d->clearcoat_roughness, d->sheen_color, d->sheen_color + 1, d->sheen_color + 2,
                         &d->sheen_roughness, &d->thickness, &d->attenuation_distance, d->attenuation_color,
-                        d->attenuation_color + 1, d->attenuation_color + 2};
+                        d->attenuation_color + 1, d->attenuation_color + 2, &d->clearcoat_normal_scale};
     for (size_t i = 0; i < sizeof v / sizeof v[0]; ++i)
         if (!isfinite(*v[i])) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "material: parameter %zu is not finite", i);
     if ((unsigned)d->alpha_mode > 2u)
         return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "material: unknown alpha mode %d", (int)d->alpha_mode);
-    const sy_gl_texture_ref *refs[5] = {&d->base_color_texture, &d->metallic_roughness_texture, &d->normal_texture,
-                                        &d->occlusion_texture, &d->emissive_texture};
-    for (int i = 0; i < 5; ++i)
+    const sy_gl_texture_ref *refs[5 + LAYER_TEXTURES] = {&d->base_color_texture, &d->metallic_roughness_texture,
+                                                         &d->normal_texture, &d->occlusion_texture, &d->emissive_texture};
+    sy_gli_layer_refs(d, refs + 5);
+    for (int i = 0; i < 5 + LAYER_TEXTURES; ++i)
         for (int k = 0; refs[i]->transformed && k < 6; ++k)
             if (!isfinite(refs[i]->transform[k]))
                 return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "material: texture %d transform[%d] is not finite", i, k);

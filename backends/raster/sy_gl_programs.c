@@ -55,6 +55,16 @@ void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
     b->layers[1][1] = fminf(fmaxf(d->sheen_roughness, 0.0f), 1.0f);
     b->layers[1][2] = d->thickness > 0.0f ? d->thickness : 0.0f;
     b->layers[1][3] = d->attenuation_distance > 0.0f ? d->attenuation_distance : 0.0f;
+    b->layers[2][3] = d->clearcoat_normal_scale;
+    const sy_gl_texture_ref *lr[LAYER_TEXTURES];
+    sy_gli_layer_refs(d, lr);
+    for (int i = 0; i < LAYER_TEXTURES; ++i) {
+        bool has = dev->layer_units && sy_gli_pool_get(&dev->textures, lr[i]->texture.id);
+        b->ltex[i / 4][i % 4] = has ? (int32_t)(lr[i]->texcoord & 1u) : -1;
+        const float id[6] = {1, 0, 0, 0, 1, 0}, *m = lr[i]->transformed ? lr[i]->transform : id;
+        memcpy(b->lxf[2 * i], m, 3 * sizeof(float));
+        memcpy(b->lxf[2 * i + 1], m + 3, 3 * sizeof(float));
+    }
     const sy_gl_texture_ref *refs[5] = {&d->base_color_texture, &d->metallic_roughness_texture, &d->normal_texture,
                                         &d->occlusion_texture, &d->emissive_texture};
     for (int i = 0; i < 5; ++i) {
@@ -67,10 +77,13 @@ void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
     }
 }
 
-bool sy_gli_material_layered(const sy_gl_material_desc *d)
+bool sy_gli_material_layered(const sy_gl_device *dev, const sy_gl_material_desc *d)
 {
     bool l = d->clearcoat > 0.0f || (d->attenuation_distance > 0.0f && d->thickness > 0.0f && d->transmission > 0.0f);
     for (int i = 0; i < 3; ++i) l = l || d->specular_color[i] != 1.0f || d->sheen_color[i] > 0.0f;
+    /* a texture on the specular factor or colour changes a material without other extensions */
+    l = l || (dev->layer_units && (sy_gli_pool_get(&dev->textures, d->specular_texture.texture.id) ||
+                                   sy_gli_pool_get(&dev->textures, d->specular_color_texture.texture.id)));
     return l && !d->unlit;
 }
 
@@ -78,9 +91,12 @@ void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog)
 {
     static const char *names[UNIT_COUNT] = {"t_base", "t_mr",       "t_nrm",     "t_occ",  "t_emis", "t_shadow",
                                             "t_env_spec", "t_env_irr", "t_brdf", "t_ltc1", "t_ltc2", "t_cshadow0",
-                                            "t_cshadow1", "t_probe"};
+                                            "t_cshadow1", "t_probe", "t_l0", "t_l1", "t_l2", "t_l3", "t_l4",
+                                            "t_l5", "t_l6", "t_l7"};
+    GLint max_units = 0;
+    gl->GetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &max_units);
     gl->UseProgram(prog);
-    for (int i = 0; i < UNIT_COUNT; ++i) {
+    for (int i = 0; i < UNIT_COUNT && i < max_units; ++i) {
         GLint loc = gl->GetUniformLocation(prog, names[i]);
         if (loc >= 0) gl->Uniform1i(loc, i);
     }

@@ -67,7 +67,7 @@ const char *const sy_gl_main_vs =
     "layout(std140) uniform Material {\n"                                                                    \
     "  vec4 m_base; vec4 m_emissive; vec4 m_mrna; vec4 m_oist; ivec4 m_modes; ivec4 m_tex; ivec4 m_tex2;\n" \
     "  vec4 m_xf[10];\n" /* uv transform rows per slot: base, mr, nrm, occ, emis */                          \
-    "  vec4 m_l0, m_l1, m_l2, m_l3;\n" /* the layers (mat_block.layers, sy_gl_shaders_layers.c) */           \
+    "  vec4 m_l0, m_l1, m_l2, m_l3; ivec4 m_lt0, m_lt1; vec4 m_lxf[16];\n" /* the layers (mat_block, sy_gl_shaders_layers.c) */ \
     "};\n"                                                                                                   \
     "uniform sampler2D t_base, t_mr, t_nrm, t_occ, t_emis;\n"                                                \
     "vec2 tuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_xf[2*k].xyz, h), dot(m_xf[2*k+1].xyz, h)); }\n" \
@@ -99,6 +99,7 @@ const char *const sy_gl_main_vs =
     "float layer_scale(vec3 ns, vec3 wo);\n" \
     "vec3 layer_env(vec3 env, vec3 ns, vec3 wo, float nv, vec3 irr);\n" \
     "vec3 layer_f0(float f0);\n" \
+    "float layer_init(vec3 n, bool front, vec3 dpx, vec3 dpy);\n" \
     "vec3 layer_transmittance();\n" \
     "#else\n" \
     "#define FDT float\n#define SCHL_D schlick1\n#define F0D f0d\n" \
@@ -373,6 +374,21 @@ const char *const sy_gl_main_fs =
     "#endif\n"
     "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
     SY_GL_SHADE_LIT
+    "#ifdef SY_LIT\n"
+    /* n (unit) bent by the tangent-space normal map s at t with scale sc; dpx, dpy: the position's
+     * screen derivatives (the tangent frame from those of t) */
+    "vec3 map_normal(sampler2D s, vec2 t, float sc, vec3 n, vec3 dpx, vec3 dpy) {\n"
+    "  vec2 dtx = dFdx(t), dty = dFdy(t); vec3 pp2 = cross(dpy, n), pp1 = cross(n, dpx);\n"
+    "  vec3 dpdu = pp2 * dtx.x + pp1 * dty.x, dpdv = pp2 * dtx.y + pp1 * dty.y;\n"
+    "  vec3 tg = dpdu - n * dot(n, dpdu);\n"
+    "  if (dot(tg, tg) > 1e-30) {\n"
+    "    tg = normalize(tg); vec3 bt = cross(n, tg); if (dot(bt, dpdv) > 0.0) bt = -bt;\n"
+    "    vec3 tx = texture(s, t).xyz * 2.0 - 1.0;\n"
+    "    vec3 r = tg * (tx.x * sc) + bt * (tx.y * sc) + n * tx.z;\n"
+    "    if (dot(r, r) > 0.0) n = normalize(r);\n"
+    "  }\n"
+    "  return n; }\n"
+    "#endif\n"
     "void main() {\n"
     "  vec4 base = m_base * v_col;\n"
     "#ifdef SY_TEX\n"
@@ -403,22 +419,11 @@ const char *const sy_gl_main_fs =
     "    if (any(isnan(ngf))) ngf = wo;\n"
     "    vec3 n = front ? ngf : -ngf;\n"
     "    if (u_has_normals) { vec3 sn = normalize(v_nrm); if (!any(isnan(sn))) n = sn; }\n"
-    "#ifdef SY_LAYERS\n"
-    "    g_nc = front ? n : -n;\n"
+    "#ifdef SY_LAYERS\n" /* the coat's normal (its own map or none) and the layers' textures */
+    "    float spec_tex = layer_init(n, front, dpx, dpy);\n"
     "#endif\n"
     "#ifdef SY_NMAP\n"
-    "    if (m_tex.z >= 0) {\n"
-    "      vec2 t = tuv(2, UVSET(m_tex.z)); vec2 dtx = dFdx(t), dty = dFdy(t);\n"
-    "      vec3 pp2 = cross(dpy, n), pp1 = cross(n, dpx);\n"
-    "      vec3 dpdu = pp2 * dtx.x + pp1 * dty.x, dpdv = pp2 * dtx.y + pp1 * dty.y;\n"
-    "      vec3 tg = dpdu - n * dot(n, dpdu);\n"
-    "      if (dot(tg, tg) > 1e-30) {\n"
-    "        tg = normalize(tg); vec3 bt = cross(n, tg); if (dot(bt, dpdv) > 0.0) bt = -bt;\n"
-    "        vec3 tx = texture(t_nrm, t).xyz * 2.0 - 1.0;\n"
-    "        vec3 r = tg * (tx.x * m_mrna.z) + bt * (tx.y * m_mrna.z) + n * tx.z;\n"
-    "        if (dot(r, r) > 0.0) n = normalize(r);\n"
-    "      }\n"
-    "    }\n"
+    "    if (m_tex.z >= 0) n = map_normal(t_nrm, tuv(2, UVSET(m_tex.z)), m_mrna.z, n, dpx, dpy);\n"
     "#endif\n"
     "    vec3 ns = front ? n : -n;\n"
     "    float metallic = m_mrna.x, rough = m_mrna.y;\n"
@@ -428,6 +433,9 @@ const char *const sy_gl_main_fs =
     "    metallic = clamp(metallic, 0.0, 1.0); rough = clamp(rough, 0.0, 1.0);\n"
     "    vec3 bc = clamp(base.rgb, 0.0, 1.0);\n"
     "    float ior = m_oist.y, spec = clamp(m_oist.z, 0.0, 1.0), trans = clamp(m_oist.w, 0.0, 1.0);\n"
+    "#ifdef SY_LAYERS\n"
+    "    spec *= spec_tex;\n"
+    "#endif\n"
     "    float ao = 1.0;\n"
     "#if defined(SY_TEX) && (defined(SY_AREA) || defined(SY_ENV) || defined(SY_PROBE))\n"
     "    if (m_tex.w >= 0) ao = 1.0 + m_oist.x * (texture(t_occ, tuv(3, UVSET(m_tex.w))).r - 1.0);\n"

@@ -132,7 +132,7 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     d.alpha_cutoff = m->alpha_cutoff;
     d.double_sided = m->double_sided;
     d.unlit = m->unlit;
-    d.specular = m->specular; /* the extensions' factors (their textures are not read: docs/BACKENDS.md) */
+    d.specular = m->specular; /* the extensions (docs/BACKENDS.md, "Material extensions") */
     memcpy(d.specular_color, m->specular_color, sizeof d.specular_color);
     d.clearcoat = m->clearcoat;
     d.clearcoat_roughness = m->clearcoat_roughness;
@@ -141,6 +141,15 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     d.thickness = m->thickness;
     d.attenuation_distance = m->attenuation_distance;
     memcpy(d.attenuation_color, m->attenuation_color, sizeof d.attenuation_color);
+    d.specular_texture = texref(&m->specular_texture);
+    d.specular_color_texture = texref(&m->specular_color_texture);
+    d.clearcoat_texture = texref(&m->clearcoat_texture);
+    d.clearcoat_roughness_texture = texref(&m->clearcoat_roughness_texture);
+    d.clearcoat_normal_texture = texref(&m->clearcoat_normal_texture);
+    d.clearcoat_normal_scale = m->clearcoat_normal_scale;
+    d.sheen_color_texture = texref(&m->sheen_color_texture);
+    d.sheen_roughness_texture = texref(&m->sheen_roughness_texture);
+    d.thickness_texture = texref(&m->thickness_texture);
     sy_gl_material h = {*a->handle};
     sy_gl_result r = h.id ? sy_gl_material_update(st->dev, h, &d)
                           : sy_gl_material_create(st->dev, &d, &h);

@@ -2,7 +2,7 @@
  * against off on a sphere, through the back-end API:
  *  1. KHR_materials_clearcoat: a rough dark base under a directional light gains a sharp coat
  *     highlight (the brightest pixel at least doubles), and under a constant environment the coat
- *     reflects it (the mean over the sphere grows);
+ *     reflects it (the mean over the sphere grows); its texture scales the weight;
  *  2. KHR_materials_specular: specular 0 removes the dielectric highlight of a black base, and a
  *     red specular colour makes the highlight red;
  *  3. KHR_materials_sheen: white sheen on a dark base lit from the camera brightens the rim (grazing
@@ -136,6 +136,21 @@ int main(int argc, char **argv)
     EXPECT_MSG(s0.max > 0.0f && s1.max > 2.0f * s0.max, "the coat adds a highlight: brightest %g -> %g", s0.max, s1.max);
     EXPECT_MSG(s1.mean < 1.5f * s0.mean && s1.mean > 0.8f * s0.mean, "the coat's highlight is small: mean %g -> %g", s0.mean,
                s1.mean);
+    /* the clearcoat texture scales the weight (R): 0 leaves the base, 1 the coat (the sphere has no
+     * uv: every point reads texel (0, 0)) */
+    for (int k = 0; k < 2; ++k) {
+        const unsigned char v = k ? 255 : 0, texels[16] = {v, 0, 0, 255, v, 0, 0, 255, v, 0, 0, 255, v, 0, 0, 255};
+        sy_gl_texture_desc td = {.width = 2, .height = 2, .channels = 4, .format = SY_GL_TEXEL_UNORM8, .pixels = texels};
+        sy_gl_material_desc tc = coat;
+        MUST(sy_gl_texture_create(d, &td, &tc.clearcoat_texture.texture));
+        render_with(&tc);
+        stats st = measure();
+        const stats *want = k ? &s1 : &s0;
+        printf("clearcoat texture R %d: brightest %g mean %g\n", v, st.max, st.mean);
+        EXPECT_MSG(fabsf(st.max - want->max) <= 1e-3f * want->max && fabsf(st.mean - want->mean) <= 1e-3f * want->mean,
+                   "clearcoat texture %d: brightest %g mean %g (want %g %g)", v, st.max, st.mean, want->max, want->mean);
+        MUST(sy_gl_texture_destroy(d, tc.clearcoat_texture.texture));
+    }
 
     /* 2. specular: 0 removes the dielectric highlight; a red specular colour makes it red */
     sy_gl_material_desc black = dielectric(0.0f, 0.3f), nospec = black, red = black;
