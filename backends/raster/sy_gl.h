@@ -314,6 +314,14 @@ typedef struct sy_gl_material_desc {
     sy_gl_texture_ref sheen_color_texture;    /**< sRGB RGB x sheen_color */
     sy_gl_texture_ref sheen_roughness_texture; /**< A x sheen_roughness */
     sy_gl_texture_ref thickness_texture;      /**< G x thickness */
+    float anisotropy;          /**< KHR_materials_anisotropy strength, [0, 1] (0 = isotropic) */
+    float anisotropy_rotation; /**< radians from the uv tangent, counter-clockwise */
+    sy_gl_texture_ref anisotropy_texture; /**< RG direction in tangent space ([-1, 1] as [0, 1]), B x strength */
+    float iridescence;         /**< KHR_materials_iridescence thin-film weight, [0, 1] (0 = none) */
+    float iridescence_ior;     /**< the film's index of refraction (default 1.3) */
+    float iridescence_thickness[2]; /**< film thickness in nm: minimum, maximum (default 100, 400) */
+    sy_gl_texture_ref iridescence_texture; /**< R x iridescence */
+    sy_gl_texture_ref iridescence_thickness_texture; /**< G: minimum to maximum (none: maximum) */
 } sy_gl_material_desc;
 void sy_gl_material_desc_init(sy_gl_material_desc *desc); /**< glTF defaults */
 /** Creates a material from desc (one UBO). */

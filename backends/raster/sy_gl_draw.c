@@ -383,6 +383,7 @@ static int material_features(const sy_gl_device *dev, const mat_o *mt)
     if (mt->d.transmission > 0.0f && (mt->d.metallic < 1.0f || mr_tex)) v |= VAR_TRANS;
     if (sy_gli_material_layered(dev, &mt->d)) {
         v |= VAR_LAYERS;
+        if (mt->d.anisotropy > 0.0f) v |= VAR_TEX; /* its direction follows the uv tangent */
         const sy_gl_texture_ref *lr[LAYER_TEXTURES];
         sy_gli_layer_refs(&mt->d, lr);
         for (int i = 0; i < LAYER_TEXTURES && dev->layer_units; ++i)

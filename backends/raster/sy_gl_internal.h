@@ -32,16 +32,18 @@
 #define SHADOW_SIZE_DEFAULT 2048u
 #define SHADOW_SIZE_AUTO_MIN 256u
 enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_ENV_SPEC, UNIT_ENV_IRR, UNIT_BRDF,
-       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW0, UNIT_CUBE_SHADOW1, UNIT_PROBE, UNIT_LAYER0, UNIT_COUNT = UNIT_LAYER0 + 8 };
+       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW0, UNIT_CUBE_SHADOW1, UNIT_PROBE, UNIT_LAYER0, UNIT_COUNT = UNIT_LAYER0 + 11 };
 /* the layers' texture slots (units UNIT_LAYER0 + i, sy_gl_shaders_layers.c): specular, specular
- * colour, clear coat, coat roughness, coat normal, sheen colour, sheen roughness, thickness */
-#define LAYER_TEXTURES 8
+ * colour, clear coat, coat roughness, coat normal, sheen colour, sheen roughness, thickness,
+ * anisotropy, iridescence, iridescence thickness */
+#define LAYER_TEXTURES 11
 #define STANDINS (5 + LAYER_TEXTURES) /* material units with a stand-in: the five base slots, the layers' */
 static inline void sy_gli_layer_refs(const sy_gl_material_desc *d, const sy_gl_texture_ref *r[LAYER_TEXTURES])
 {
     r[0] = &d->specular_texture, r[1] = &d->specular_color_texture, r[2] = &d->clearcoat_texture;
     r[3] = &d->clearcoat_roughness_texture, r[4] = &d->clearcoat_normal_texture, r[5] = &d->sheen_color_texture;
-    r[6] = &d->sheen_roughness_texture, r[7] = &d->thickness_texture;
+    r[6] = &d->sheen_roughness_texture, r[7] = &d->thickness_texture, r[8] = &d->anisotropy_texture;
+    r[9] = &d->iridescence_texture, r[10] = &d->iridescence_thickness_texture;
 }
 /* Scene probes: mirror-like and glass instances see the scene, not only the environment. Each of
  * the first SY_GL_MAX_PROBES such instances gets a cube map rendered from its bounding-box centre
@@ -291,9 +293,10 @@ typedef struct mat_block {
     float xf[10][4]; /* per texture slot (base, mr, nrm, occ, emis) two rows of its uv transform */
     /* the layers (m_l0 .. m_l2): (specular colour, clear coat), (coat roughness, sheen roughness,
      * thickness, attenuation distance), (sheen colour, 0), (attenuation colour, 0) */
-    float layers[4][4];
-    int32_t ltex[2][4];  /* the layers' textures' uv sets (-1 none), slots as sy_gli_layer_refs */
-    float lxf[16][4];    /* and their uv transforms, two rows each */
+    float layers[6][4];  /* ..., (cos, sin of the anisotropy rotation, strength, 0), (iridescence, its ior,
+                          * thickness minimum, maximum) */
+    int32_t ltex[3][4];  /* the layers' textures' uv sets (-1 none), slots as sy_gli_layer_refs */
+    float lxf[2 * LAYER_TEXTURES][4]; /* and their uv transforms, two rows each */
 } mat_block;
 
 /* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes, then the cube shadows' parameters

@@ -421,6 +421,9 @@ void sy_gl_material_desc_init(sy_gl_material_desc *d)
     d->alpha_cutoff = 0.5f;
     for (int i = 0; i < 3; ++i) d->specular_color[i] = d->attenuation_color[i] = 1.0f;
     d->clearcoat_normal_scale = 1.0f;
+    d->iridescence_ior = 1.3f;
+    d->iridescence_thickness[0] = 100.0f;
+    d->iridescence_thickness[1] = 400.0f;
 }
 
 static sy_gl_result material_check(const sy_gl_material_desc *d, sy_gl_report *rep)
@@ -431,7 +434,9 @@ static sy_gl_result material_check(const sy_gl_material_desc *d, sy_gl_report *r
                         d->specular_color, d->specular_color + 1, d->specular_color + 2, &d->clearcoat,
                         &d->clearcoat_roughness, d->sheen_color, d->sheen_color + 1, d->sheen_color + 2,
                         &d->sheen_roughness, &d->thickness, &d->attenuation_distance, d->attenuation_color,
-                        d->attenuation_color + 1, d->attenuation_color + 2, &d->clearcoat_normal_scale};
+                        d->attenuation_color + 1, d->attenuation_color + 2, &d->clearcoat_normal_scale,
+                        &d->anisotropy, &d->anisotropy_rotation, &d->iridescence, &d->iridescence_ior,
+                        d->iridescence_thickness, d->iridescence_thickness + 1};
     for (size_t i = 0; i < sizeof v / sizeof v[0]; ++i)
         if (!isfinite(*v[i])) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "material: parameter %zu is not finite", i);
     if ((unsigned)d->alpha_mode > 2u)

@@ -56,6 +56,13 @@ void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
     b->layers[1][2] = d->thickness > 0.0f ? d->thickness : 0.0f;
     b->layers[1][3] = d->attenuation_distance > 0.0f ? d->attenuation_distance : 0.0f;
     b->layers[2][3] = d->clearcoat_normal_scale;
+    b->layers[4][0] = cosf(d->anisotropy_rotation);
+    b->layers[4][1] = sinf(d->anisotropy_rotation);
+    b->layers[4][2] = fminf(fmaxf(d->anisotropy, 0.0f), 1.0f);
+    b->layers[5][0] = fminf(fmaxf(d->iridescence, 0.0f), 1.0f);
+    b->layers[5][1] = d->iridescence_ior >= 1.0f ? d->iridescence_ior : 1.0f;
+    b->layers[5][2] = fmaxf(d->iridescence_thickness[0], 0.0f);
+    b->layers[5][3] = fmaxf(d->iridescence_thickness[1], 0.0f);
     const sy_gl_texture_ref *lr[LAYER_TEXTURES];
     sy_gli_layer_refs(d, lr);
     for (int i = 0; i < LAYER_TEXTURES; ++i) {
@@ -79,7 +86,8 @@ void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
 
 bool sy_gli_material_layered(const sy_gl_device *dev, const sy_gl_material_desc *d)
 {
-    bool l = d->clearcoat > 0.0f || (d->attenuation_distance > 0.0f && d->thickness > 0.0f && d->transmission > 0.0f);
+    bool l = d->clearcoat > 0.0f || (d->attenuation_distance > 0.0f && d->thickness > 0.0f && d->transmission > 0.0f) ||
+             d->anisotropy > 0.0f || d->iridescence > 0.0f;
     for (int i = 0; i < 3; ++i) l = l || d->specular_color[i] != 1.0f || d->sheen_color[i] > 0.0f;
     /* a texture on the specular factor or colour changes a material without other extensions */
     l = l || (dev->layer_units && (sy_gli_pool_get(&dev->textures, d->specular_texture.texture.id) ||
@@ -92,7 +100,7 @@ void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog)
     static const char *names[UNIT_COUNT] = {"t_base", "t_mr",       "t_nrm",     "t_occ",  "t_emis", "t_shadow",
                                             "t_env_spec", "t_env_irr", "t_brdf", "t_ltc1", "t_ltc2", "t_cshadow0",
                                             "t_cshadow1", "t_probe", "t_l0", "t_l1", "t_l2", "t_l3", "t_l4",
-                                            "t_l5", "t_l6", "t_l7"};
+                                            "t_l5", "t_l6", "t_l7", "t_l8", "t_l9", "t_l10"};
     GLint max_units = 0;
     gl->GetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &max_units);
     gl->UseProgram(prog);

@@ -67,7 +67,7 @@ const char *const sy_gl_main_vs =
     "layout(std140) uniform Material {\n"                                                                    \
     "  vec4 m_base; vec4 m_emissive; vec4 m_mrna; vec4 m_oist; ivec4 m_modes; ivec4 m_tex; ivec4 m_tex2;\n" \
     "  vec4 m_xf[10];\n" /* uv transform rows per slot: base, mr, nrm, occ, emis */                          \
-    "  vec4 m_l0, m_l1, m_l2, m_l3; ivec4 m_lt0, m_lt1; vec4 m_lxf[16];\n" /* the layers (mat_block, sy_gl_shaders_layers.c) */ \
+    "  vec4 m_l0, m_l1, m_l2, m_l3, m_l4, m_l5; ivec4 m_lt0, m_lt1, m_lt2; vec4 m_lxf[22];\n" /* the layers (mat_block, sy_gl_shaders_layers.c) */ \
     "};\n"                                                                                                   \
     "uniform sampler2D t_base, t_mr, t_nrm, t_occ, t_emis;\n"                                                \
     "vec2 tuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_xf[2*k].xyz, h), dot(m_xf[2*k+1].xyz, h)); }\n" \
@@ -93,16 +93,19 @@ const char *const sy_gl_main_vs =
     /* the dielectric Fresnel: a colour where KHR_materials_specular can tint it (SY_LAYERS), else \
      * one value; the layers' functions (sy_gl_layers_fs, linked after this source) */ \
     "#ifdef SY_LAYERS\n" \
-    "#define FDT vec3\n#define SCHL_D schlick\n#define F0D f0c\n" \
+    "#define FDT vec3\n#define SCHL_D schlick\n#define F0D f0c\n#define F0M f0m\n" \
     "vec3 g_nc;\n" /* the clear coat's normal: the surface's, without its normal map (main) */ \
     "vec3 layer_light(vec3 wi, vec3 wo, vec3 ns, float nl, vec3 f);\n" \
     "float layer_scale(vec3 ns, vec3 wo);\n" \
     "vec3 layer_env(vec3 env, vec3 ns, vec3 wo, float nv, vec3 irr);\n" \
-    "vec3 layer_f0(float f0);\n" \
+    "vec3 layer_f0(float f0, float nv);\n" \
+    "vec3 layer_metal_f0(vec3 bc, float nv);\n" \
+    "void layer_aniso(vec3 wi, vec3 wo, vec3 h, vec3 ns, float nl, float nv, float rough, inout float D, inout float V);\n" \
+    "vec3 layer_reflect(vec3 wo, vec3 ns, float rough);\n" \
     "float layer_init(vec3 n, bool front, vec3 dpx, vec3 dpy);\n" \
     "vec3 layer_transmittance();\n" \
     "#else\n" \
-    "#define FDT float\n#define SCHL_D schlick1\n#define F0D f0d\n" \
+    "#define FDT float\n#define SCHL_D schlick1\n#define F0D f0d\n#define F0M bc\n" \
     "#endif\n" \
     "vec3 schlick(vec3 f0, float c) { float m = 1.0 - clamp(c, 0.0, 1.0); float m5 = m*m*m*m*m;\n" \
     "  return f0 + (vec3(1.0) - f0) * m5; }\n" \
@@ -229,6 +232,9 @@ const char *const sy_gl_main_vs =
     "    float nl = cs, nh = max(dot(ns, h), 0.0);\n" \
     "    float dd = nh * nh * (a2 - 1.0) + 1.0; float D = a2 * INV_PI / (dd * dd);\n" \
     "    float V = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));\n" \
+    "#ifdef SY_LAYERS\n" \
+    "    layer_aniso(wi, wo, h, ns, nl, nv, rough, D, V);\n" \
+    "#endif\n" \
     "    f += (schlick(bc, vh) * w_metal + vec3(w_diel * fd)) * (D * V);\n" \
     "  }\n" \
     "#ifdef SY_LAYERS\n" \
@@ -268,10 +274,10 @@ const char *const sy_gl_main_vs =
     "    float a = max(rough * rough, 1e-4), a2 = a * a;\n" \
     "    float nv = max(dot(ns, wo), 1e-4);\n" \
     "#ifdef SY_LAYERS\n" \
-    "    vec3 f0c = layer_f0(f0d);\n" \
+    "    vec3 f0c = layer_f0(f0d, nv), f0m = layer_metal_f0(bc, nv);\n" \
     "#endif\n" \
     "#ifdef SY_LIGHTS\n" \
-    "#define SY_LIGHT(i, kind, lt) shade_light(i, kind, lt, P, ngf, ns, wo, bc, kd, spec, F0D, w_metal, w_diel, rough, a2, nv)\n" \
+    "#define SY_LIGHT(i, kind, lt) shade_light(i, kind, lt, P, ngf, ns, wo, F0M, kd, spec, F0D, w_metal, w_diel, rough, a2, nv)\n" \
     "#ifdef SY_NLIGHTS\n" /* the variant's light count (1 .. 7) and shadow kinds SY_LK0 ..: straight-line code */ \
     SY_GL_LIGHT_CALL(0) SY_GL_LIGHT_CALL(1) SY_GL_LIGHT_CALL(2) SY_GL_LIGHT_CALL(3) SY_GL_LIGHT_CALL(4) \
     SY_GL_LIGHT_CALL(5) SY_GL_LIGHT_CALL(6) \
@@ -283,7 +289,7 @@ const char *const sy_gl_main_vs =
     /* split-sum terms: A, B of the GGX BRDF for this view and roughness */ \
     "    vec2 ab = textureLod(t_brdf, vec2(nv, rough) * (31.0 / 32.0) + 0.5 / 32.0, 0.0).rg;\n" \
     "    FDT fd_avg = spec * (F0D * ab.x + ab.y);\n" \
-    "    vec3 fspec = (bc * ab.x + ab.y) * w_metal + vec3(w_diel * fd_avg);\n" \
+    "    vec3 fspec = (F0M * ab.x + ab.y) * w_metal + vec3(w_diel * fd_avg);\n" \
     "#endif\n" \
     "#ifdef SY_AREA\n" \
     "    {\n" \
@@ -293,7 +299,7 @@ const char *const sy_gl_main_vs =
     "      mat3 frame = transpose(mat3(T1, T2, ns));\n" \
     "      mat3 Minv = mat3(vec3(t1.x, 0.0, t1.y), vec3(0.0, 1.0, 0.0), vec3(t1.z, 0.0, t1.w)) * frame;\n" \
     /* the LTC norm replaces A, B for the polygon's specular (F0 t2.x + (1 - F0) t2.y) */ \
-    "      vec3 fl = (bc * t2.x + (1.0 - bc) * t2.y) * w_metal + vec3(w_diel * spec * (F0D * t2.x + (1.0 - F0D) * t2.y));\n" \
+    "      vec3 fl = (F0M * t2.x + (1.0 - F0M) * t2.y) * w_metal + vec3(w_diel * spec * (F0D * t2.x + (1.0 - F0D) * t2.y));\n" \
     "      vec3 kdl = kd * (1.0 - fd_avg);\n" \
     "#ifdef SY_LAYERS\n" /* the polygons see the base under the coat and sheen, not their lobes */ \
     "      { float ls = layer_scale(ns, wo); fl *= ls; kdl *= ls; }\n" \
@@ -315,7 +321,11 @@ const char *const sy_gl_main_vs =
     "#endif\n" \
     "#if defined(SY_ENV) || defined(SY_PROBE)\n" \
     "    {\n" \
+    "#ifdef SY_LAYERS\n" \
+    "      vec3 R = layer_reflect(wo, ns, rough);\n" /* anisotropy bends the normal */ \
+    "#else\n" \
     "      vec3 R = reflect(-wo, ns);\n" \
+    "#endif\n" \
     "#ifdef SY_ENV\n" \
     "      vec3 irr = textureLod(t_env_irr, ns, 0.0).rgb;\n" /* cosine-weighted mean radiance = E / pi */ \
     "#else\n" \
@@ -375,14 +385,19 @@ const char *const sy_gl_main_fs =
     "layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
     SY_GL_SHADE_LIT
     "#ifdef SY_LIT\n"
-    /* n (unit) bent by the tangent-space normal map s at t with scale sc; dpx, dpy: the position's
-     * screen derivatives (the tangent frame from those of t) */
-    "vec3 map_normal(sampler2D s, vec2 t, float sc, vec3 n, vec3 dpx, vec3 dpy) {\n"
+    /* the tangent frame (tg, bt) of uv t at the unit normal n from the screen derivatives of t and
+     * of the position (dpx, dpy); false where they give none. map_normal: n bent by the
+     * tangent-space normal map s at t with scale sc */
+    "bool uv_frame(vec2 t, vec3 n, vec3 dpx, vec3 dpy, out vec3 tg, out vec3 bt) {\n"
     "  vec2 dtx = dFdx(t), dty = dFdy(t); vec3 pp2 = cross(dpy, n), pp1 = cross(n, dpx);\n"
     "  vec3 dpdu = pp2 * dtx.x + pp1 * dty.x, dpdv = pp2 * dtx.y + pp1 * dty.y;\n"
-    "  vec3 tg = dpdu - n * dot(n, dpdu);\n"
-    "  if (dot(tg, tg) > 1e-30) {\n"
-    "    tg = normalize(tg); vec3 bt = cross(n, tg); if (dot(bt, dpdv) > 0.0) bt = -bt;\n"
+    "  tg = dpdu - n * dot(n, dpdu); bt = vec3(0.0);\n"
+    "  if (!(dot(tg, tg) > 1e-30)) return false;\n"
+    "  tg = normalize(tg); bt = cross(n, tg); if (dot(bt, dpdv) > 0.0) bt = -bt;\n"
+    "  return true; }\n"
+    "vec3 map_normal(sampler2D s, vec2 t, float sc, vec3 n, vec3 dpx, vec3 dpy) {\n"
+    "  vec3 tg, bt;\n"
+    "  if (uv_frame(t, n, dpx, dpy, tg, bt)) {\n"
     "    vec3 tx = texture(s, t).xyz * 2.0 - 1.0;\n"
     "    vec3 r = tg * (tx.x * sc) + bt * (tx.y * sc) + n * tx.z;\n"
     "    if (dot(r, r) > 0.0) n = normalize(r);\n"

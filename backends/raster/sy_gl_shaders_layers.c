@@ -14,27 +14,39 @@
  *    punctual lights; for the environment sheen_color x E(n.v) x the irradiance cube's mean
  *    radiance (the lobe is wide; the Sample Viewer prefilters a Charlie cube instead); the base x
  *    (1 - max(sheen_color) E(n.v)), E from the BRDF table's third channel (sy_gl_ibl.c);
+ *  - KHR_materials_anisotropy: anisotropic GGX (alpha along the direction mix(a, 1, s^2), across a)
+ *    for punctual lights, the environment looked up along the bent normal (the Sample Viewer's);
+ *    the direction: the rotation (or the texture's RG rotated by it) in the uv tangent frame of
+ *    screen derivatives (meshes carry no tangents), strength x the texture's B;
+ *  - KHR_materials_iridescence: the thin-film Fresnel (Belcour and Barla 2017, the Sample Viewer's
+ *    iridescence.glsl) at n.v over the dielectric F0 and the metal's base colour, turned into an
+ *    F0 (Schlick inverted) and mixed in by the weight; the film thickness mixes minimum to maximum
+ *    by its texture's G (the maximum without one);
  *  - KHR_materials_volume: the refracted environment x attenuation_color^(d / attenuation_distance),
  *    d = thickness x the instance's mean axis scale (Beer-Lambert over the thickness as the Sample
  *    Viewer takes it; thickness 0 or distance 0 = none).
  * Material uniforms: m_l0 (specular colour, clearcoat), m_l1 (coat roughness, sheen roughness,
  * thickness, attenuation distance), m_l2 (sheen colour, coat normal scale), m_l3 (attenuation
- * colour); the textures (units t_l0 .. t_l7, uv sets m_lt0, m_lt1, transforms m_lxf) scale them
+ * colour), m_l4 (cos, sin of the anisotropy rotation, strength), m_l5 (iridescence, film ior,
+ * thickness minimum, maximum); the textures (units t_l0 .. t_l7, uv sets m_lt0, m_lt1, transforms m_lxf) scale them
  * as glTF says (layer_init: specular A, specular colour RGB, clearcoat R, coat roughness G, coat
- * normal, sheen colour RGB, sheen roughness A, thickness G) into g_l0 .. g_l3. */
+ * normal, sheen colour RGB, sheen roughness A, thickness G, anisotropy RGB, iridescence R,
+ * iridescence thickness G) into g_l0 .. g_l5. */
 #include "sy_gl_shaders.h"
 
 const char *const sy_gl_layers_fs =
     "\n"
     "uniform mat4 u_model;\n" /* the vertex stage's: the instance's scale for the volume */
-    "uniform sampler2D t_l0, t_l1, t_l2, t_l3, t_l4, t_l5, t_l6, t_l7;\n"
-    "vec4 g_l0, g_l1, g_l2, g_l3;\n" /* m_l0 .. m_l3 times the textures (layer_init) */
+    "uniform sampler2D t_l0, t_l1, t_l2, t_l3, t_l4, t_l5, t_l6, t_l7, t_l8, t_l9, t_l10;\n"
+    "vec4 g_l0, g_l1, g_l2, g_l3, g_l4, g_l5;\n" /* m_l0 .. m_l5 times the textures (layer_init) */
+    "vec3 g_at;\n" /* the anisotropy direction (world; zero: none) */
     "vec2 ltuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_lxf[2*k].xyz, h), dot(m_lxf[2*k+1].xyz, h)); }\n"
     /* the factors times their textures (slots: sy_gli_layer_refs; uv sets in m_lt0, m_lt1, -1 = none)
      * and the coat's normal (the vertex normal n, bent by its own map, flipped to the side seen);
      * returns the specular texture's factor */
     "float layer_init(vec3 n, bool front, vec3 dpx, vec3 dpy) {\n"
-    "  g_l0 = m_l0; g_l1 = m_l1; g_l2 = m_l2; g_l3 = m_l3; float s = 1.0; vec3 nc = n;\n"
+    "  g_l0 = m_l0; g_l1 = m_l1; g_l2 = m_l2; g_l3 = m_l3; g_l4 = m_l4; g_l5 = m_l5; float s = 1.0; vec3 nc = n;\n"
+    "  g_at = vec3(0.0); g_l5.w = m_l5.w;\n"
     "#ifdef SY_TEX\n"
     "  if (m_lt0.x >= 0) s = texture(t_l0, ltuv(0, UVSET(m_lt0.x))).a;\n"
     "  if (m_lt0.y >= 0) g_l0.rgb *= texture(t_l1, ltuv(1, UVSET(m_lt0.y))).rgb;\n"
@@ -44,10 +56,70 @@ const char *const sy_gl_layers_fs =
     "  if (m_lt1.y >= 0) g_l2.rgb *= texture(t_l5, ltuv(5, UVSET(m_lt1.y))).rgb;\n"
     "  if (m_lt1.z >= 0) g_l1.y *= texture(t_l6, ltuv(6, UVSET(m_lt1.z))).a;\n"
     "  if (m_lt1.w >= 0) g_l1.z *= texture(t_l7, ltuv(7, UVSET(m_lt1.w))).g;\n"
+    /* anisotropy: the direction (cos, sin of the rotation) or the texture's RG rotated by it, in the
+     * uv tangent frame of the texture's set (uv 0 without one) */
+    "  if (m_l4.z > 0.0) {\n"
+    "    vec2 t = UVSET(m_lt2.x >= 0 ? m_lt2.x : 0), dir = m_l4.xy; vec3 tg, bt;\n"
+    "    if (m_lt2.x >= 0) { vec3 a = texture(t_l8, ltuv(8, t)).rgb; vec2 d = a.rg * 2.0 - 1.0;\n"
+    "      g_l4.z *= a.b; if (dot(d, d) > 0.0) dir = mat2(m_l4.x, m_l4.y, -m_l4.y, m_l4.x) * normalize(d); }\n"
+    "    if (uv_frame(t, n, dpx, dpy, tg, bt)) g_at = tg * dir.x + bt * dir.y;\n"
+    "  }\n"
+    "  if (m_lt2.y >= 0) g_l5.x *= texture(t_l9, ltuv(9, UVSET(m_lt2.y))).r;\n"
+    "  if (m_lt2.z >= 0) g_l5.w = mix(m_l5.z, m_l5.w, texture(t_l10, ltuv(10, UVSET(m_lt2.z))).g);\n"
     "#endif\n"
     "  g_nc = front ? nc : -nc; return s; }\n"
     "float layer_max3(vec3 c) { return max(c.r, max(c.g, c.b)); }\n"
-    "vec3 layer_f0(float f0) { return min(f0 * g_l0.rgb, vec3(1.0)); }\n"
+    /* KHR_materials_iridescence (Belcour and Barla 2017, as the Sample Viewer's iridescence.glsl):
+     * the Fresnel of a thin film of index eta2 and thickness d (nm) over a base of F0 f0 at cos c */
+    "const mat3 XYZ_TO_REC709 = mat3(3.2404542, -0.9692660, 0.0556434, -1.5371385, 1.8760108, -0.2040259,\n"
+    "                                -0.4985314, 0.0415560, 1.0572252);\n"
+    "vec3 irid_sensitivity(float opd, vec3 shift) {\n"
+    "  float phase = 2.0 * 3.14159265 * opd * 1.0e-9;\n"
+    "  vec3 val = vec3(5.4856e-13, 4.4201e-13, 5.2481e-13), pos = vec3(1.6810e+06, 1.7953e+06, 2.2084e+06);\n"
+    "  vec3 var = vec3(4.3278e+09, 9.3046e+09, 6.6121e+09);\n"
+    "  vec3 xyz = val * sqrt(2.0 * 3.14159265 * var) * cos(pos * phase + shift) * exp(-phase * phase * var);\n"
+    "  xyz.x += 9.7470e-14 * sqrt(2.0 * 3.14159265 * 4.5282e+09) * cos(2.2399e+06 * phase + shift.x) * exp(-4.5282e+09 * phase * phase);\n"
+    "  return XYZ_TO_REC709 * (xyz / 1.0685e-7); }\n"
+    "vec3 irid_fresnel(float eta2, float c, float d, vec3 f0) {\n"
+    "  float ior = mix(1.0, eta2, smoothstep(0.0, 0.03, d));\n"
+    "  float s2 = (1.0 - c * c) / (ior * ior), c2s = 1.0 - s2; if (c2s < 0.0) return vec3(1.0);\n"
+    "  float c2 = sqrt(c2s), r0 = (ior - 1.0) / (ior + 1.0), R12 = schlick1(r0 * r0, c), T121 = 1.0 - R12;\n"
+    "  float phi21 = 3.14159265 - (ior < 1.0 ? 3.14159265 : 0.0);\n"
+    "  vec3 sf = sqrt(clamp(f0, 0.0, 0.9999)), bior = (1.0 + sf) / (1.0 - sf);\n"
+    "  vec3 r1 = (bior - ior) / (bior + ior), R23 = schlick(r1 * r1, c2);\n"
+    "  vec3 phi23 = vec3(bior.x < ior ? 3.14159265 : 0.0, bior.y < ior ? 3.14159265 : 0.0, bior.z < ior ? 3.14159265 : 0.0);\n"
+    "  float opd = 2.0 * ior * d * c2; vec3 phi = vec3(phi21) + phi23;\n"
+    "  vec3 R123 = clamp(R12 * R23, 1e-5, 0.9999), r123 = sqrt(R123), Rs = T121 * T121 * R23 / (1.0 - R123);\n"
+    "  vec3 I = R12 + Rs, Cm = Rs - T121;\n"
+    "  Cm *= r123; I += Cm * 2.0 * irid_sensitivity(opd, phi);\n"
+    "  Cm *= r123; I += Cm * 2.0 * irid_sensitivity(2.0 * opd, 2.0 * phi);\n"
+    "  return max(I, vec3(0.0)); }\n"
+    /* the film's F0 seen at n.v = c (Schlick inverted, as the Sample Viewer) mixed in by its weight */
+    "vec3 layer_irid(vec3 f0, float c) {\n"
+    "  if (!(g_l5.x > 0.0)) return f0;\n"
+    "  float m = 1.0 - clamp(c, 0.0, 1.0), m5 = m * m * m * m * m;\n"
+    "  vec3 F = irid_fresnel(g_l5.y, c, g_l5.w, f0), fi = clamp((F - m5) / max(1.0 - m5, 1e-4), 0.0, 1.0);\n"
+    "  return mix(f0, fi, g_l5.x); }\n"
+    "vec3 layer_f0(float f0, float nv) { return layer_irid(min(f0 * g_l0.rgb, vec3(1.0)), nv); }\n"
+    "vec3 layer_metal_f0(vec3 bc, float nv) { return layer_irid(bc, nv); }\n"
+    /* KHR_materials_anisotropy: the GGX lobe stretched along g_at for lights (alpha_t = mix(a, 1,
+     * s^2), alpha_b = a) and the bent normal for the environment, as the Sample Viewer */
+    "bool layer_frame(vec3 ns, out vec3 T, out vec3 B) {\n"
+    "  T = g_at - ns * dot(ns, g_at); B = vec3(0.0); if (!(g_l4.z > 0.0) || !(dot(T, T) > 1e-20)) return false;\n"
+    "  T = normalize(T); B = cross(ns, T); return true; }\n"
+    "void layer_aniso(vec3 wi, vec3 wo, vec3 h, vec3 ns, float nl, float nv, float rough, inout float D, inout float V) {\n"
+    "  vec3 T, B; if (!layer_frame(ns, T, B)) return;\n"
+    "  float a = max(rough * rough, 1e-4), s = g_l4.z, at = mix(a, 1.0, s * s), ab = clamp(a, 1e-3, 1.0), a2 = at * ab;\n"
+    "  vec3 f = vec3(ab * dot(T, h), at * dot(B, h), a2 * dot(ns, h)); float w2 = a2 / dot(f, f);\n"
+    "  D = a2 * w2 * w2 * INV_PI;\n"
+    "  float gv = nl * length(vec3(at * dot(T, wo), ab * dot(B, wo), nv));\n"
+    "  float gl = nv * length(vec3(at * dot(T, wi), ab * dot(B, wi), nl));\n"
+    "  V = clamp(0.5 / (gv + gl), 0.0, 1.0); }\n"
+    "vec3 layer_reflect(vec3 wo, vec3 ns, float rough) {\n"
+    "  vec3 T, B; if (!layer_frame(ns, T, B)) return reflect(-wo, ns);\n"
+    "  vec3 an = cross(cross(B, wo), B); float bf = 1.0 - g_l4.z * (1.0 - rough); bf *= bf; bf *= bf;\n"
+    "  vec3 bn = mix(an, ns, bf); bn = dot(bn, bn) > 0.0 ? normalize(bn) : ns;\n"
+    "  return reflect(-wo, bn); }\n"
     "float layer_sheen_e(float nv, float r) {\n"
     "  return textureLod(t_brdf, vec2(nv, r) * (31.0 / 32.0) + 0.5 / 32.0, 0.0).b; }\n"
     /* what lies under the coat and the sheen keeps this much of its light */

@@ -150,6 +150,14 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     d.sheen_color_texture = texref(&m->sheen_color_texture);
     d.sheen_roughness_texture = texref(&m->sheen_roughness_texture);
     d.thickness_texture = texref(&m->thickness_texture);
+    d.anisotropy = m->anisotropy;
+    d.anisotropy_rotation = m->anisotropy_rotation;
+    d.anisotropy_texture = texref(&m->anisotropy_texture);
+    d.iridescence = m->iridescence;
+    d.iridescence_ior = m->iridescence_ior;
+    memcpy(d.iridescence_thickness, m->iridescence_thickness, sizeof d.iridescence_thickness);
+    d.iridescence_texture = texref(&m->iridescence_texture);
+    d.iridescence_thickness_texture = texref(&m->iridescence_thickness_texture);
     sy_gl_material h = {*a->handle};
     sy_gl_result r = h.id ? sy_gl_material_update(st->dev, h, &d)
                           : sy_gl_material_create(st->dev, &d, &h);

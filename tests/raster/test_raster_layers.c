@@ -1,14 +1,17 @@
 /* test_raster_layers.c — the rasterizer's glTF material extensions (sy_gl.h "Layers"), each on
  * against off on a sphere, through the back-end API:
  *  1. KHR_materials_clearcoat: a rough dark base under a directional light gains a sharp coat
- *     highlight (the brightest pixel at least doubles), and under a constant environment the coat
- *     reflects it (the mean over the sphere grows); its texture scales the weight;
+ *     highlight (the brightest pixel at least doubles) and leaves the mean within [0.8, 1.5]x;
+ *     its texture scales the weight;
  *  2. KHR_materials_specular: specular 0 removes the dielectric highlight of a black base, and a
  *     red specular colour makes the highlight red;
  *  3. KHR_materials_sheen: white sheen on a dark base lit from the camera brightens the rim (grazing
  *     angles) several times and leaves the centre within a few per cent;
+ *  3b. KHR_materials_anisotropy: the highlight stretches along the direction (the uv tangent, or a
+ *     quarter turn from it);
  *  4. KHR_materials_volume: attenuation tints what a glass sphere shows through it towards the
  *     attenuation colour (green and blue fall against red), and more with a larger thickness;
+ *  4b. KHR_materials_iridescence: a grey metal under a white environment takes colours;
  *  5. a material without extensions renders the same bits with a layered material in the frame
  *     (it then draws with the layered shader variant) as without.
  * argv[1] = provider (osmesa default). */
@@ -74,17 +77,19 @@ static sy_gl_texture constant_env(float v)
 }
 
 /* a unit sphere wound counter-clockwise seen from outside (gl_sphere.h's is wound the other way,
- * so its outside shows its back face), smooth outward normals */
+ * so its outside shows its back face), smooth outward normals, uv = (longitude, colatitude) / (2 pi, pi):
+ * the u tangent is horizontal */
 static sy_gl_mesh sphere_ccw(uint32_t seg)
 {
     uint32_t nv = (seg + 1) * (seg + 1), nt = 0;
-    float *p = malloc(nv * 3 * sizeof *p);
+    float *p = malloc(nv * 3 * sizeof *p), *uv = malloc(nv * 2 * sizeof *uv);
     uint32_t *ix = malloc((size_t)seg * seg * 6 * sizeof *ix);
-    if (!p || !ix) exit(1);
+    if (!p || !uv || !ix) exit(1);
     for (uint32_t i = 0; i <= seg; ++i)
         for (uint32_t j = 0; j <= seg; ++j) {
             float th = 3.14159265f * (float)i / (float)seg, ph = 6.2831853f * (float)j / (float)seg, *v = p + 3 * (i * (seg + 1) + j);
             v[0] = sinf(th) * cosf(ph), v[1] = cosf(th), v[2] = sinf(th) * sinf(ph);
+            uv[2 * (i * (seg + 1) + j)] = (float)j / (float)seg, uv[2 * (i * (seg + 1) + j) + 1] = (float)i / (float)seg;
         }
     for (uint32_t i = 0; i < seg; ++i)
         for (uint32_t j = 0; j < seg; ++j) {
@@ -92,11 +97,20 @@ static sy_gl_mesh sphere_ccw(uint32_t seg)
             if (i > 0) ix[3 * nt] = a, ix[3 * nt + 1] = a + 1, ix[3 * nt + 2] = b, nt++;
             if (i + 1 < seg) ix[3 * nt] = a + 1, ix[3 * nt + 1] = b + 1, ix[3 * nt + 2] = b, nt++;
         }
-    sy_gl_mesh_desc md = {.positions = p, .normals = p, .indices = ix, .vertex_count = nv, .triangle_count = nt};
+    sy_gl_mesh_desc md = {.positions = p, .normals = p, .uv = {uv}, .indices = ix, .vertex_count = nv, .triangle_count = nt};
     sy_gl_mesh m;
     MUST(sy_gl_mesh_create(d, &md, &m));
-    free(p), free(ix);
+    free(p), free(uv), free(ix);
     return m;
+}
+
+/* the highlight's extent through the brightest pixel: pixels above half of it along its row, its column */
+static void extent(const stats *s, int *wx, int *wy)
+{
+    int x0 = s->at % N, y0 = s->at / N;
+    *wx = *wy = 0;
+    for (int x = 0; x < N; ++x) *wx += lum(px(x, y0)) > 0.5f * s->max;
+    for (int y = 0; y < N; ++y) *wy += lum(px(x0, y)) > 0.5f * s->max;
 }
 
 static sy_gl_material_desc dielectric(float base, float rough)
@@ -171,6 +185,25 @@ int main(int argc, char **argv)
                "a red specular colour: highlight %g %g %g (white %g %g %g)", rp[0], rp[1], rp[2], white_hl[0], white_hl[1],
                white_hl[2]);
 
+    /* anisotropy: the highlight stretches along the direction (the u tangent, horizontal; rotated a
+     * quarter turn, vertical) */
+    {
+        sy_gl_material_desc iso = dielectric(0.0f, 0.25f), an = iso;
+        an.anisotropy = 1.0f;
+        int w[3][2];
+        for (int k = 0; k < 3; ++k) {
+            an.anisotropy_rotation = k == 2 ? 1.5707963f : 0.0f;
+            render_with(k ? &an : &iso);
+            stats st = measure();
+            extent(&st, &w[k][0], &w[k][1]);
+            printf("anisotropy %d: highlight %g, %d x %d pixels\n", k, st.max, w[k][0], w[k][1]);
+        }
+        EXPECT_MSG(abs(w[0][0] - w[0][1]) <= 2 + w[0][1] / 4, "isotropic highlight %d x %d", w[0][0], w[0][1]);
+        EXPECT_MSG(w[1][0] >= 2 * w[1][1] && w[1][0] >= 2 * w[0][0], "anisotropy stretches along u: %d x %d (isotropic %d x %d)",
+                   w[1][0], w[1][1], w[0][0], w[0][1]);
+        EXPECT_MSG(w[2][1] >= 2 * w[2][0] && w[2][1] >= 2 * w[0][1], "rotated a quarter turn: %d x %d", w[2][0], w[2][1]);
+    }
+
     /* 3. sheen: grazing angles brighten; the centre stays. The light comes from the camera. */
     ld.direction[0] = 0.0f, ld.direction[1] = 0.0f, ld.direction[2] = -1.0f;
     MUST(sy_gl_light_update(d, light, &ld));
@@ -217,6 +250,23 @@ int main(int argc, char **argv)
     EXPECT_MSG(g1 < 0.8f && g1 > 0.4f, "attenuation tints the glass: green/red %g (want about 0.55 + reflection)", g1);
     EXPECT_MSG(g2 < 0.5f * g1, "a thicker volume is redder: green/red %g (thin %g)", g2, g1);
     EXPECT_MSG(c[1][0] > 0.9f * c[0][0], "red passes: %g (clear %g)", c[1][0], c[0][0]);
+
+    /* iridescence: a grey metal under the white environment takes the film's colours */
+    {
+        sy_gl_material_desc metal = dielectric(0.5f, 0.2f), film;
+        metal.metallic = 1.0f;
+        film = metal;
+        film.iridescence = 1.0f;
+        film.iridescence_ior = 1.33f;
+        float spread[2];
+        for (int k = 0; k < 2; ++k) {
+            render_with(k ? &film : &metal);
+            const float *c = px(N / 2, N / 2);
+            spread[k] = (fmaxf(c[0], fmaxf(c[1], c[2])) - fminf(c[0], fminf(c[1], c[2]))) / fmaxf(lum(c), 1e-6f);
+            printf("iridescence %d: centre %g %g %g\n", k, c[0], c[1], c[2]);
+        }
+        EXPECT_MSG(spread[0] < 1e-3f && spread[1] > 0.1f, "the film colours the metal: channel spread %g -> %g", spread[0], spread[1]);
+    }
 
     /* 5. a plain material renders the same with a layered one in the frame */
     sy_gl_material_desc plain = dielectric(0.6f, 0.4f);
