@@ -76,7 +76,7 @@ static const char *const brdf_fs =
     /* B: the sheen lobe's directional albedo E(n.v, sheen roughness) (KHR_materials_sheen: Charlie
      * distribution, alpha = roughness^2, Neubelt visibility 1 / (4 (n.l + n.v - n.l n.v))), by
      * uniform hemisphere sampling (Hammersley points); sy_gl_shaders_layers.c reads it */
-    "  float sa = max(r * r, 1e-4), inv = 1.0 / sa, E = 0.0; const uint m = 1024u;\n"
+    "  float sa = max(r * r, 1e-4), inv = 1.0 / sa, E = 0.0; const uint m = 256u;\n"
     "  for (uint i = 0u; i < m; ++i) {\n"
     "    float cl = (float(i) + 0.5) / float(m), sl = sqrt(max(0.0, 1.0 - cl * cl)), phi = 2.0 * PI * radinv(i);\n"
     "    vec3 L = vec3(sl * cos(phi), sl * sin(phi), cl); vec3 H = normalize(V + L);\n"

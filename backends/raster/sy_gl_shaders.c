@@ -96,10 +96,9 @@ const char *const sy_gl_main_vs =
     "#define FDT vec3\n#define SCHL_D schlick\n#define F0D f0c\n#define F0M f0m\n" \
     "vec3 g_nc;\n" /* the clear coat's normal: the surface's, without its normal map (main) */ \
     "vec3 layer_light(vec3 wi, vec3 wo, vec3 ns, float nl, vec3 f);\n" \
-    "float layer_scale(vec3 ns, vec3 wo);\n" \
+    "float g_ls;\n" /* layer_f0: what the coat and sheen leave to the base, once per fragment */ \
     "vec3 layer_env(vec3 env, vec3 ns, vec3 wo, float nv, vec3 irr);\n" \
-    "vec3 layer_f0(float f0, float nv);\n" \
-    "vec3 layer_metal_f0(vec3 bc, float nv);\n" \
+    "void layer_f0(float f0, vec3 bc, float metallic, vec3 ns, vec3 wo, float nv, out vec3 f0c, out vec3 f0m);\n" \
     "void layer_aniso(vec3 wi, vec3 wo, vec3 h, vec3 ns, float nl, float nv, float rough, inout float D, inout float V);\n" \
     "vec3 layer_reflect(vec3 wo, vec3 ns, float rough);\n" \
     "float layer_init(vec3 n, bool front, vec3 dpx, vec3 dpy);\n" \
@@ -274,7 +273,7 @@ const char *const sy_gl_main_vs =
     "    float a = max(rough * rough, 1e-4), a2 = a * a;\n" \
     "    float nv = max(dot(ns, wo), 1e-4);\n" \
     "#ifdef SY_LAYERS\n" \
-    "    vec3 f0c = layer_f0(f0d, nv), f0m = layer_metal_f0(bc, nv);\n" \
+    "    vec3 f0c, f0m; layer_f0(f0d, bc, metallic, ns, wo, nv, f0c, f0m);\n" \
     "#endif\n" \
     "#ifdef SY_LIGHTS\n" \
     "#define SY_LIGHT(i, kind, lt) shade_light(i, kind, lt, P, ngf, ns, wo, F0M, kd, spec, F0D, w_metal, w_diel, rough, a2, nv)\n" \
@@ -302,7 +301,7 @@ const char *const sy_gl_main_vs =
     "      vec3 fl = (F0M * t2.x + (1.0 - F0M) * t2.y) * w_metal + vec3(w_diel * spec * (F0D * t2.x + (1.0 - F0D) * t2.y));\n" \
     "      vec3 kdl = kd * (1.0 - fd_avg);\n" \
     "#ifdef SY_LAYERS\n" /* the polygons see the base under the coat and sheen, not their lobes */ \
-    "      { float ls = layer_scale(ns, wo); fl *= ls; kdl *= ls; }\n" \
+    "      fl *= g_ls; kdl *= g_ls;\n" \
     "#endif\n" \
     "#define SY_AREA_L(i, sh) shade_area(i, sh, P, ngf, frame, Minv, kdl, fl, rough)\n" \
     /* two loops, not one call per polygon: sixteen inlined copies of shade_area (two LTC \

@@ -19,8 +19,8 @@
  *    the direction: the rotation (or the texture's RG rotated by it) in the uv tangent frame of
  *    screen derivatives (meshes carry no tangents), strength x the texture's B;
  *  - KHR_materials_iridescence: the thin-film Fresnel (Belcour and Barla 2017, the Sample Viewer's
- *    iridescence.glsl) at n.v over the dielectric F0 and the metal's base colour, turned into an
- *    F0 (Schlick inverted) and mixed in by the weight; the film thickness mixes minimum to maximum
+ *    iridescence.glsl) at n.v over the base's F0 (the dielectric's and the metal's mixed by
+ *    metallic), turned into an F0 (Schlick inverted) and mixed into both lobes' by the weight; the film thickness mixes minimum to maximum
  *    by its texture's G (the maximum without one);
  *  - KHR_materials_volume: the refracted environment x attenuation_color^(d / attenuation_distance),
  *    d = thickness x the instance's mean axis scale (Beer-Lambert over the thickness as the Sample
@@ -39,7 +39,8 @@ const char *const sy_gl_layers_fs =
     "uniform mat4 u_model;\n" /* the vertex stage's: the instance's scale for the volume */
     "uniform sampler2D t_l0, t_l1, t_l2, t_l3, t_l4, t_l5, t_l6, t_l7, t_l8, t_l9, t_l10;\n"
     "vec4 g_l0, g_l1, g_l2, g_l3, g_l4, g_l5;\n" /* m_l0 .. m_l5 times the textures (layer_init) */
-    "vec3 g_at;\n" /* the anisotropy direction (world; zero: none) */
+    "vec3 g_at, g_T, g_B;\n" /* the anisotropy direction (world; zero: none); its frame at ns (layer_f0) */
+    "bool g_an;\n" /* that frame exists */
     "vec2 ltuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_lxf[2*k].xyz, h), dot(m_lxf[2*k+1].xyz, h)); }\n"
     /* the factors times their textures (slots: sy_gli_layer_refs; uv sets in m_lt0, m_lt1, -1 = none)
      * and the coat's normal (the vertex normal n, bent by its own map, flipped to the side seen);
@@ -94,21 +95,28 @@ const char *const sy_gl_layers_fs =
     "  Cm *= r123; I += Cm * 2.0 * irid_sensitivity(opd, phi);\n"
     "  Cm *= r123; I += Cm * 2.0 * irid_sensitivity(2.0 * opd, 2.0 * phi);\n"
     "  return max(I, vec3(0.0)); }\n"
-    /* the film's F0 seen at n.v = c (Schlick inverted, as the Sample Viewer) mixed in by its weight */
-    "vec3 layer_irid(vec3 f0, float c) {\n"
-    "  if (!(g_l5.x > 0.0)) return f0;\n"
-    "  float m = 1.0 - clamp(c, 0.0, 1.0), m5 = m * m * m * m * m;\n"
-    "  vec3 F = irid_fresnel(g_l5.y, c, g_l5.w, f0), fi = clamp((F - m5) / max(1.0 - m5, 1e-4), 0.0, 1.0);\n"
-    "  return mix(f0, fi, g_l5.x); }\n"
-    "vec3 layer_f0(float f0, float nv) { return layer_irid(min(f0 * g_l0.rgb, vec3(1.0)), nv); }\n"
-    "vec3 layer_metal_f0(vec3 bc, float nv) { return layer_irid(bc, nv); }\n"
+    /* the dielectric lobe's F0 f0c (tinted by the specular colour) and the metal's f0m (the base
+     * colour), each mixed by the film's weight with the film's F0 seen at n.v (Schlick inverted, as
+     * the Sample Viewer). One film over the base mix(f0c, bc, metallic) serves both lobes (exact
+     * for metals and dielectrics; the Sample Viewer evaluates two, which doubles the compile) */
+    "float layer_scale(vec3 ns, vec3 wo);\n"
+    "bool layer_frame(vec3 ns, out vec3 T, out vec3 B);\n"
+    /* once per fragment: also g_ls and the anisotropy frame (not per light: every light's call is
+     * inlined, and llvmpipe compiles each copy) */
+    "void layer_f0(float f0, vec3 bc, float metallic, vec3 ns, vec3 wo, float nv, out vec3 f0c, out vec3 f0m) {\n"
+    "  g_ls = layer_scale(ns, wo); g_an = layer_frame(ns, g_T, g_B);\n"
+    "  f0c = min(f0 * g_l0.rgb, vec3(1.0)); f0m = bc; if (!(g_l5.x > 0.0)) return;\n"
+    "  float m = 1.0 - clamp(nv, 0.0, 1.0), m5 = m * m * m * m * m;\n"
+    "  vec3 F = irid_fresnel(g_l5.y, nv, g_l5.w, mix(f0c, bc, metallic));\n"
+    "  vec3 fi = clamp((F - m5) / max(1.0 - m5, 1e-4), 0.0, 1.0);\n"
+    "  f0c = mix(f0c, fi, g_l5.x); f0m = mix(bc, fi, g_l5.x); }\n"
     /* KHR_materials_anisotropy: the GGX lobe stretched along g_at for lights (alpha_t = mix(a, 1,
      * s^2), alpha_b = a) and the bent normal for the environment, as the Sample Viewer */
     "bool layer_frame(vec3 ns, out vec3 T, out vec3 B) {\n"
     "  T = g_at - ns * dot(ns, g_at); B = vec3(0.0); if (!(g_l4.z > 0.0) || !(dot(T, T) > 1e-20)) return false;\n"
     "  T = normalize(T); B = cross(ns, T); return true; }\n"
     "void layer_aniso(vec3 wi, vec3 wo, vec3 h, vec3 ns, float nl, float nv, float rough, inout float D, inout float V) {\n"
-    "  vec3 T, B; if (!layer_frame(ns, T, B)) return;\n"
+    "  if (!g_an) return; vec3 T = g_T, B = g_B;\n"
     "  float a = max(rough * rough, 1e-4), s = g_l4.z, at = mix(a, 1.0, s * s), ab = clamp(a, 1e-3, 1.0), a2 = at * ab;\n"
     "  vec3 f = vec3(ab * dot(T, h), at * dot(B, h), a2 * dot(ns, h)); float w2 = a2 / dot(f, f);\n"
     "  D = a2 * w2 * w2 * INV_PI;\n"
@@ -116,7 +124,7 @@ const char *const sy_gl_layers_fs =
     "  float gl = nv * length(vec3(at * dot(T, wi), ab * dot(B, wi), nl));\n"
     "  V = clamp(0.5 / (gv + gl), 0.0, 1.0); }\n"
     "vec3 layer_reflect(vec3 wo, vec3 ns, float rough) {\n"
-    "  vec3 T, B; if (!layer_frame(ns, T, B)) return reflect(-wo, ns);\n"
+    "  if (!g_an) return reflect(-wo, ns); vec3 B = g_B;\n"
     "  vec3 an = cross(cross(B, wo), B); float bf = 1.0 - g_l4.z * (1.0 - rough); bf *= bf; bf *= bf;\n"
     "  vec3 bn = mix(an, ns, bf); bn = dot(bn, bn) > 0.0 ? normalize(bn) : ns;\n"
     "  return reflect(-wo, bn); }\n"
@@ -128,7 +136,7 @@ const char *const sy_gl_layers_fs =
     "  return s * (1.0 - layer_max3(g_l2.rgb) * layer_sheen_e(max(dot(ns, wo), 0.0), g_l1.y)); }\n"
     /* f: the base's BRDF for light from wi (ns.wi = nl > 0); the caller multiplies by nl */
     "vec3 layer_light(vec3 wi, vec3 wo, vec3 ns, float nl, vec3 f) {\n"
-    "  vec3 h = normalize(wi + wo); vec3 r = f * layer_scale(ns, wo);\n"
+    "  vec3 h = normalize(wi + wo); vec3 r = f * g_ls;\n"
     "  if (layer_max3(g_l2.rgb) > 0.0) {\n"
     "    float nv = max(dot(ns, wo), 1e-4), sa = max(g_l1.y * g_l1.y, 1e-4), inv = 1.0 / sa;\n"
     "    float nh = dot(ns, h), s2 = max(1.0 - nh * nh, 0.0);\n"
@@ -146,7 +154,7 @@ const char *const sy_gl_layers_fs =
     "#if defined(SY_ENV) || defined(SY_PROBE)\n"
     /* env: the base's environment light; irr: the irradiance cube's mean radiance at ns */
     "vec3 layer_env(vec3 env, vec3 ns, vec3 wo, float nv, vec3 irr) {\n"
-    "  vec3 r = env * layer_scale(ns, wo) + g_l2.rgb * layer_sheen_e(nv, g_l1.y) * irr;\n"
+    "  vec3 r = env * g_ls + g_l2.rgb * layer_sheen_e(nv, g_l1.y) * irr;\n"
     "  if (g_l0.w > 0.0) {\n"
     "    float cv = max(dot(g_nc, wo), 1e-4), cr = g_l1.x, ga = cr * cr;\n"
     "    vec2 ab = textureLod(t_brdf, vec2(cv, cr) * (31.0 / 32.0) + 0.5 / 32.0, 0.0).rg;\n"
