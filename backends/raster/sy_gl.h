@@ -61,8 +61,12 @@
  * base by 1 - max(sheen_color) E(n.v, sheen_roughness), E the sheen lobe's directional albedo
  * (a table the BRDF table's third channel holds, integrated at start-up); volume attenuates the
  * transmitted environment by attenuation_color^(thickness x the instance's scale /
- * attenuation_distance) (Beer-Lambert over the thickness, as the Sample Viewer). Emissive polygons
- * see the base scaled by the coat and sheen, without their own lobes.
+ * attenuation_distance) (Beer-Lambert over the thickness, as the Sample Viewer); anisotropy
+ * stretches the GGX lobe along its direction (in the uv tangent frame) for punctual lights and
+ * bends the normal for the environment; iridescence replaces the lobes' F0 by the thin film's
+ * (mixed by its weight). The extensions' textures scale their factors as glTF says where the
+ * context has 25 texture units (else the factors alone). Emissive polygons see the base scaled by
+ * the coat and sheen, without their own lobes or anisotropy.
  * Shadows: directional and spot lights and area lights (from the polygon's centre along its
  * normal, a 150-degree frustum; a Poisson PCF over a penumbra of fixed world radius, 0.3 x the
  * square root of the polygon's area, an approximation without a blocker search) share
