@@ -8,8 +8,8 @@
  *  - KHR_materials_specular: the dielectric F0 = min(((ior-1)/(ior+1))^2 x specular_color, 1)
  *    (layer_f0; the specular factor already scales it in sy_gl_shaders.c), diffuse x (1 - F);
  *  - KHR_materials_clearcoat: a GGX lobe (F0 0.04, F90 1, its own roughness) on the coat normal g_nc
- *    (the surface's normal without the base's normal map), for punctual lights and the environment
- *    (split sum), and everything under it x (1 - clearcoat x Schlick(0.04, n_c.v));
+ *    (the surface's normal without the base's normal map), for punctual lights, the environment
+ *    (split sum) and emissive polygons (LTC, layer_area), and everything under it x (1 - clearcoat x Schlick(0.04, n_c.v));
  *  - KHR_materials_sheen: sheen_color x Charlie D (alpha = roughness^2) x Neubelt visibility for
  *    punctual lights; for the environment sheen_color x E(n.v) x the irradiance cube's mean
  *    radiance (the lobe is wide; the Sample Viewer prefilters a Charlie cube instead); the base x
@@ -163,6 +163,16 @@ const char *const sy_gl_layers_fs =
     "  }\n"
     "  return r; }\n"
     "#endif\n"
+    /* emissive polygons: the coat's GGX lobe by linearly transformed cosines (as the base's in
+     * sy_gl_shaders.c, shade_lit) about the coat normal, F0 0.04; none at roughness 0 (as the base) */
+    "void layer_area(vec3 wo) {\n"
+    "  g_fc = g_l1.x > 0.0 ? g_l0.w : 0.0; g_Mc = mat3(1.0); if (!(g_fc > 0.0)) return;\n"
+    "  vec3 n = g_nc; float cv = max(dot(n, wo), 1e-4);\n"
+    "  vec2 luv = vec2(g_l1.x, sqrt(1.0 - cv)) * (63.0 / 64.0) + 0.5 / 64.0;\n"
+    "  vec4 t1 = textureLod(t_ltc1, luv, 0.0), t2 = textureLod(t_ltc2, luv, 0.0);\n"
+    "  vec3 T1 = normalize(wo - n * dot(wo, n)), T2 = cross(n, T1);\n"
+    "  g_Mc = mat3(vec3(t1.x, 0.0, t1.y), vec3(0.0, 1.0, 0.0), vec3(t1.z, 0.0, t1.w)) * transpose(mat3(T1, T2, n));\n"
+    "  g_fc *= 0.04 * t2.x + 0.96 * t2.y; }\n"
     "vec3 layer_transmittance() {\n"
     "  if (!(g_l1.z > 0.0 && g_l1.w > 0.0)) return vec3(1.0);\n"
     "  float s = (length(u_model[0].xyz) + length(u_model[1].xyz) + length(u_model[2].xyz)) / 3.0;\n"

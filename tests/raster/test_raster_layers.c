@@ -12,6 +12,7 @@
  *  4. KHR_materials_volume: attenuation tints what a glass sphere shows through it towards the
  *     attenuation colour (green and blue fall against red), and more with a larger thickness;
  *  4b. KHR_materials_iridescence: a grey metal under a white environment takes colours;
+ *  6. an emissive polygon's reflection in the coat (LTC);
  *  5. a material without extensions renders the same bits with a layered material in the frame
  *     (it then draws with the layered shader variant) as without.
  * argv[1] = provider (osmesa default). */
@@ -284,6 +285,19 @@ int main(int argc, char **argv)
     for (int i = 0; i < N * N * 4; ++i) diff = fmax(diff, fabs((double)rgba[i] - ref[i]));
     printf("plain material with a layered one in the frame: largest difference %g\n", diff);
     EXPECT_MSG(diff <= 1e-5 * 4.0, "a plain material shades as before in the layered variant: %g", diff);
+    MUST(sy_gl_instance_destroy(d, other));
+
+    /* 6. the coat under an emissive polygon (LTC): behind the camera, above the axis */
+    sy_gl_set_environment(d, (sy_gl_texture){0}, 0.0f);
+    sy_gl_area_light al = {.vertices = {{-0.6f, 0.4f, 0.5f}, {0.6f, 0.4f, 0.5f}, {0.6f, 1.6f, 0.5f}, {-0.6f, 1.6f, 0.5f}},
+                           .vertex_count = 4, .radiance = {4, 4, 4}, .double_sided = true};
+    MUST(sy_gl_set_area_lights(d, &al, 1));
+    render_with(&base);
+    stats a0 = measure();
+    render_with(&coat);
+    stats a1 = measure();
+    printf("clear coat under an emissive polygon: brightest %g -> %g, mean %g -> %g\n", a0.max, a1.max, a0.mean, a1.mean);
+    EXPECT_MSG(a0.max > 0.0f && a1.max > 2.0f * a0.max, "the coat reflects the polygon: brightest %g -> %g", a0.max, a1.max);
 
     sy_gl_device_destroy(d);
     return sy_check_finish("raster_layers");
