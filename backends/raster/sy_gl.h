@@ -66,7 +66,7 @@
  * bends the normal for the environment; iridescence replaces the lobes' F0 by the thin film's
  * (mixed by its weight). The extensions' textures scale their factors as glTF says where the
  * context has 25 texture units (else the factors alone). Emissive polygons see the base scaled by
- * the coat and sheen and the coat's lobe (LTC), without sheen's lobe or anisotropy.
+ * the coat and sheen, the coat's lobe (LTC) and the sheen as a wide lobe of albedo E; no anisotropy.
  * Shadows: directional and spot lights and area lights (from the polygon's centre along its
  * normal, a 150-degree frustum; a Poisson PCF over a penumbra of fixed world radius, 0.3 x the
  * square root of the polygon's area, an approximation without a blocker search) share

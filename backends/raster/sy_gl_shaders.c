@@ -102,8 +102,8 @@ const char *const sy_gl_main_vs =
     "void layer_aniso(vec3 wi, vec3 wo, vec3 h, vec3 ns, float nl, float nv, float rough, inout float D, inout float V);\n" \
     "vec3 layer_reflect(vec3 wo, vec3 ns, float rough);\n" \
     "float layer_init(vec3 n, bool front, vec3 dpx, vec3 dpy);\n" \
-    "void layer_area(vec3 wo);\n" \
-    "mat3 g_Mc; float g_fc;\n" /* layer_area: the coat's LTC matrix and norm x weight (0: none) */ \
+    "void layer_area(vec3 ns, vec3 wo);\n" \
+    "mat3 g_Mc; float g_fc; vec3 g_sh;\n" /* layer_area: the coat's LTC matrix and norm x weight (0: none); the sheen's albedo */ \
     "vec3 layer_transmittance();\n" \
     "#else\n" \
     "#define FDT float\n#define SCHL_D schlick1\n#define F0D f0d\n#define F0M bc\n" \
@@ -263,7 +263,7 @@ const char *const sy_gl_main_vs =
     "  float s = rough > 0.0 ? ltc_eval(Minv, P, i, nvx) : 0.0;\n" \
     "#ifdef SY_LAYERS\n" /* the clear coat's lobe */ \
     "  float c = g_fc > 0.0 ? ltc_eval(g_Mc, P, i, nvx) : 0.0;\n" \
-    "  return rad.rgb * (kdl * d + fl * s + vec3(g_fc * c)) * vis;\n" \
+    "  return rad.rgb * ((kdl + g_sh) * d + fl * s + vec3(g_fc * c)) * vis;\n" \
     "#else\n" \
     "  return rad.rgb * (kdl * d + fl * s) * vis;\n" \
     "#endif\n" \
@@ -308,7 +308,7 @@ const char *const sy_gl_main_vs =
     "      vec3 fl = (F0M * t2.x + (1.0 - F0M) * t2.y) * w_metal + vec3(w_diel * spec * (F0D * t2.x + (1.0 - F0D) * t2.y));\n" \
     "      vec3 kdl = kd * (1.0 - fd_avg);\n" \
     "#ifdef SY_LAYERS\n" /* the polygons see the base under the coat and sheen, and the coat's lobe */ \
-    "      fl *= g_ls; kdl *= g_ls; layer_area(wo);\n" \
+    "      fl *= g_ls; kdl *= g_ls; layer_area(ns, wo);\n" \
     "#endif\n" \
     "#define SY_AREA_L(i, sh) shade_area(i, sh, P, ngf, frame, Minv, kdl, fl, rough)\n" \
     /* two loops, not one call per polygon: sixteen inlined copies of shade_area (two LTC \

@@ -9,10 +9,12 @@
  *    (layer_f0; the specular factor already scales it in sy_gl_shaders.c), diffuse x (1 - F);
  *  - KHR_materials_clearcoat: a GGX lobe (F0 0.04, F90 1, its own roughness) on the coat normal g_nc
  *    (the surface's normal without the base's normal map), for punctual lights, the environment
- *    (split sum) and emissive polygons (LTC, layer_area), and everything under it x (1 - clearcoat x Schlick(0.04, n_c.v));
+ *    (split sum) and emissive polygons (LTC, layer_area), and everything under it x
+ *    (1 - clearcoat x Schlick(0.04, n_c.v));
  *  - KHR_materials_sheen: sheen_color x Charlie D (alpha = roughness^2) x Neubelt visibility for
  *    punctual lights; for the environment sheen_color x E(n.v) x the irradiance cube's mean
- *    radiance (the lobe is wide; the Sample Viewer prefilters a Charlie cube instead); the base x
+ *    radiance (the lobe is wide; the Sample Viewer prefilters a Charlie cube instead), for
+ *    emissive polygons sheen_color x E(n.v) x the diffuse form factor; the base x
  *    (1 - max(sheen_color) E(n.v)), E from the BRDF table's third channel (sy_gl_ibl.c);
  *  - KHR_materials_anisotropy: anisotropic GGX (alpha along the direction mix(a, 1, s^2), across a)
  *    for punctual lights, the environment looked up along the bent normal (the Sample Viewer's);
@@ -164,8 +166,11 @@ const char *const sy_gl_layers_fs =
     "  return r; }\n"
     "#endif\n"
     /* emissive polygons: the coat's GGX lobe by linearly transformed cosines (as the base's in
-     * sy_gl_shaders.c, shade_lit) about the coat normal, F0 0.04; none at roughness 0 (as the base) */
-    "void layer_area(vec3 wo) {\n"
+     * sy_gl_shaders.c, shade_lit) about the coat normal, F0 0.04, none at roughness 0 (as the
+     * base); the sheen as a wide lobe of albedo sheen colour x E(n.v) on the diffuse form factor
+     * (as the environment's irradiance stands in for its prefiltered light) */
+    "void layer_area(vec3 ns, vec3 wo) {\n"
+    "  g_sh = g_l2.rgb * layer_sheen_e(max(dot(ns, wo), 0.0), g_l1.y);\n"
     "  g_fc = g_l1.x > 0.0 ? g_l0.w : 0.0; g_Mc = mat3(1.0); if (!(g_fc > 0.0)) return;\n"
     "  vec3 n = g_nc; float cv = max(dot(n, wo), 1e-4);\n"
     "  vec2 luv = vec2(g_l1.x, sqrt(1.0 - cv)) * (63.0 / 64.0) + 0.5 / 64.0;\n"

@@ -12,7 +12,7 @@
  *  4. KHR_materials_volume: attenuation tints what a glass sphere shows through it towards the
  *     attenuation colour (green and blue fall against red), and more with a larger thickness;
  *  4b. KHR_materials_iridescence: a grey metal under a white environment takes colours;
- *  6. an emissive polygon's reflection in the coat (LTC);
+ *  6. an emissive polygon's reflection in the coat (LTC), its sheen at the rim;
  *  5. a material without extensions renders the same bits with a layered material in the frame
  *     (it then draws with the layered shader variant) as without.
  * argv[1] = provider (osmesa default). */
@@ -298,6 +298,16 @@ int main(int argc, char **argv)
     stats a1 = measure();
     printf("clear coat under an emissive polygon: brightest %g -> %g, mean %g -> %g\n", a0.max, a1.max, a0.mean, a1.mean);
     EXPECT_MSG(a0.max > 0.0f && a1.max > 2.0f * a0.max, "the coat reflects the polygon: brightest %g -> %g", a0.max, a1.max);
+    /* ... and the sheen brightens the rim under it */
+    render_with(&dark);
+    float arim0 = lum(px(rim, N / 2)), actr0 = lum(px(N / 2, N / 2));
+    render_with(&sheen);
+    float arim1 = lum(px(rim, N / 2)), actr1 = lum(px(N / 2, N / 2));
+    printf("sheen under an emissive polygon: rim %g -> %g, centre %g -> %g\n", arim0, arim1, actr0, actr1);
+    /* the polygon's sheen is a wide lobe of albedo E(n.v) (sy_gl_shaders_layers.c): the rim gains
+     * several times what the centre gains */
+    EXPECT_MSG(arim1 > 3.0f * arim0 && arim1 / arim0 > 2.0f * (actr1 / actr0), "sheen under a polygon: rim %g -> %g, centre %g -> %g",
+               arim0, arim1, actr0, actr1);
 
     sy_gl_device_destroy(d);
     return sy_check_finish("raster_layers");
