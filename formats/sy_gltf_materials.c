@@ -156,8 +156,9 @@ static sy_result get_factors(loader *L, const sy_gltf_shim_material *m, size_t m
                 return gltf_fail(L, SY_ERR_PARSE, "materials[%zu].%s: non-finite value", mi, f->name);
             if (dst[c] < f->lo || dst[c] > f->hi) {
                 float v = dst[c] < f->lo ? f->lo : f->hi;
-                gltf_warn(L, "materials[%zu].%s: %g is outside [%g, %g]; clamped to %g", mi, f->name, (double)dst[c],
-                          (double)f->lo, (double)f->hi, (double)v);
+                gltf_warn(L, "materials[%zu].%s: %g is outside [%g, %g]; clamped to %g%s", mi, f->name, (double)dst[c],
+                          (double)f->lo, (double)f->hi, (double)v,
+                          f->core == offsetof(sy_material_data, attenuation_distance) ? " (infinite: no absorption)" : "");
                 dst[c] = v;
             }
         }
