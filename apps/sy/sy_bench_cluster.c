@@ -214,7 +214,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
         sy_scene_destroy(scene);
         return r == SY_OK ? 0 : sy_cli_fail(&err);
     }
-    sy_camera_view view;
+    sy_camera_view view = {0};
     if (r == SY_OK) r = sy_window_create(w, h, &win, &err);
     if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, &err);
     if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, &err);

@@ -48,7 +48,7 @@ static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const
     sy_cluster_client *c = NULL;
     sy_window *win = NULL;
     sy_viewport *vp = NULL;
-    sy_camera_view view;
+    sy_camera_view view = {0};
     sy_layer out_img = {0};
     sy_result r = sy_window_create(w, h, &win, err);
     if (r == SY_OK) r = sy_window_add_viewport(win, vd, &vp, err);

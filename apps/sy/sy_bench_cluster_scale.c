@@ -34,7 +34,7 @@ static sy_result scale_measure(sy_scene *scene, const sy_demo_info *d, const sy_
     sy_cluster_client *c = NULL;
     sy_window *win = NULL;
     sy_viewport *vp = NULL;
-    sy_camera_view view;
+    sy_camera_view view = {0};
     sy_layer img = {0};
     bool coop = mode == SY_CLUSTER_COOPERATIVE;
     bool raster = sy_mediator_find("raster") != NULL; /* the picture back-ends measured: raster, else whitted */

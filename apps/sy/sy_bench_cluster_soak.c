@@ -114,7 +114,7 @@ sy_result sy_bench_cluster_soak(sy_scene *scene, const sy_demo_info *d, const ch
         double a = (double)(i % 720) * (M_PI / 360.0);
         float q[4] = {0, (float)sin(a / 2), 0, (float)cos(a / 2)}, t3[3] = {0, 0, 0}, s3[3] = {1, 1, 1};
         sy_mat4 rot = sy_mat4_from_trs(t3, q, s3), m = sy_mat4_mul(&rot, &m0);
-        sy_camera_view view;
+        sy_camera_view view = {0};
         r = sy_node_set_matrix(scene, d->camera, &m, err);
         if (r == SY_OK) r = sy_scene_commit(scene, NULL, err);
         if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, err);

@@ -40,7 +40,7 @@ sy_result sy_bench_limit(sy_scene *scene, const sy_viewport_desc *vd, const char
     sy_window *win = NULL;
     sy_viewport *vp = NULL;
     sy_context *ctx = NULL;
-    sy_camera_view view;
+    sy_camera_view view = {0};
     sy_viewport_desc d = *vd;
     d.backend = "pathtracer";
     sy_result r = sy_window_create(width, height, &win, err);

@@ -20,7 +20,7 @@ sy_result sy_bench_rays(sy_scene *scene, const sy_viewport_desc *vd, uint32_t wi
     sy_window *win = NULL;
     sy_viewport *vp = NULL;
     sy_context *ctx = NULL;
-    sy_camera_view view;
+    sy_camera_view view = {0};
     sy_result r = sy_window_create(width, height, &win, err);
     if (r == SY_OK) r = sy_window_add_viewport(win, vd, &vp, err);
     if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, width, height, &view, err);

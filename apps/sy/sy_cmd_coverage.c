@@ -45,7 +45,7 @@ int sy_cmd_coverage(int argc, char **argv)
     sy_window *win = NULL;
     sy_viewport *vp = NULL;
     sy_context *ctx = NULL;
-    sy_camera_view view;
+    sy_camera_view view = {0};
     sy_coverage_entry *e = NULL;
     uint32_t n = 0;
     /* the first registered class that counts per-node coverage (the Embree back-ends' "coverage") */
