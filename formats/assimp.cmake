@@ -5,6 +5,7 @@ pkg_check_modules(SY_ASSIMP REQUIRED IMPORTED_TARGET assimp)
 target_sources(sy_formats PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/sy_assimp.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_assimp_io.c
+  ${CMAKE_CURRENT_LIST_DIR}/sy_assimp_isolate.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_assimp_materials.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_assimp_scene.c
 )

@@ -1,8 +1,9 @@
-/* sy_assimp.c — the formats read through Assimp (see sy_assimp.h): the public entry points, the
+/* sy_assimp.c — the formats read through Assimp (see sy_assimp.h), the load in one process: the
  * options, the import under the process-wide lock (Assimp's C API keeps its error string and
- * logger in globals), then the conversion in dependency order with rollback on failure. The
- * loader's modules, bottom-up (sy_assimp_internal.h): sy_assimp_io.c, sy_assimp_materials.c,
- * sy_assimp_scene.c. */
+ * logger in globals), then the conversion in dependency order with rollback on failure; also
+ * Assimp's reference import and export for benchmarks and tests. The loader's modules, bottom-up
+ * (sy_assimp_internal.h): sy_assimp_io.c, sy_assimp_materials.c, sy_assimp_scene.c, this file,
+ * sy_assimp_isolate.c (the public loads, in the import process). */
 #include "sy_assimp_internal.h"
 
 #include "sy_file.h"
@@ -51,7 +52,7 @@ bool sy_assimp_reads_extension(const char *ext)
     return aiIsExtensionSupported(e) == AI_TRUE;
 }
 
-static sy_assimp_options resolve_options(const sy_assimp_options *o)
+sy_assimp_options asp_resolve_options(const sy_assimp_options *o)
 {
     sy_assimp_options r = o ? *o : (sy_assimp_options){0};
     if (!r.max_file_bytes) r.max_file_bytes = (size_t)1 << 30;
@@ -126,7 +127,8 @@ static sy_result import(asp_loader *L)
      * 10^6-triangle grid */
     aiSetImportPropertyInteger(ps, AI_CONFIG_PP_FD_CHECKAREA, 0);
     aiSetImportPropertyInteger(ps, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
-    pthread_mutex_lock(&g_assimp_lock);
+    bool lock = !L->notes; /* the import process has no other thread (and the lock may be a copy held at the fork) */
+    if (lock) pthread_mutex_lock(&g_assimp_lock);
     asp_log_attach(L);
     /* Triangulate and SortByPType trust each face to have indices (Triangulate fails an assertion and
      * aborts the process on a PLY face list of count 0, which ValidateDataStructure lets through): they
@@ -140,7 +142,7 @@ static sy_result import(asp_loader *L)
     char why[SY_ERROR_MESSAGE_MAX];
     snprintf(why, sizeof why, "%s", L->ai ? "" : aiGetErrorString());
     asp_log_detach();
-    pthread_mutex_unlock(&g_assimp_lock);
+    if (lock) pthread_mutex_unlock(&g_assimp_lock);
     aiReleasePropertyStore(ps);
     if (L->io_result) return sy_error_set(&L->err, L->io_result, "%s", L->io_message); /* a refused file */
     if (empty) return asp_fail(L, SY_ERR_PARSE, "meshes[%u] has a face without vertex indices", empty_mesh);
@@ -171,15 +173,15 @@ static sy_result convert(asp_loader *L)
     for (unsigned i = 0; i < s->mNumMeshes && r == SY_OK; ++i) r = asp_create_mesh(L, i);
     if (r == SY_OK) r = asp_create_nodes(L);
     if (r == SY_OK && (c->animations || c->skinned_meshes || c->morph_targets))
-        sy_log(SY_LOG_NOTE, "assimp", L->path,
+        asp_note(L, SY_LOG_NOTE,
                "%u animations, %u skinned meshes (%u bones), %u morph targets: not played yet (meshes in their bind "
                "pose)",
                c->animations, c->skinned_meshes, c->bones, c->morph_targets);
     return r;
 }
 
-static sy_result load_common(const char *path, const void *mem, size_t mem_size, const char *base_dir, sy_scene *scene,
-                             const sy_assimp_options *opts, sy_assimp_info *info_out, sy_error *err)
+sy_result asp_load_here(const char *path, const void *mem, size_t mem_size, const char *base_dir, sy_scene *scene,
+                        const sy_assimp_options *opts, sy_assimp_info *info_out, asp_notes *notes, sy_error *err)
 {
     sy_assimp_info local;
     sy_assimp_info *info = info_out ? info_out : &local;
@@ -188,8 +190,9 @@ static sy_result load_common(const char *path, const void *mem, size_t mem_size,
     memset(&L, 0, sizeof L);
     L.path = path;
     L.scene = scene;
-    L.opt = resolve_options(opts);
+    L.opt = asp_resolve_options(opts);
     L.info = info;
+    L.notes = notes;
     L.budget = sy_budget_make(path, L.opt.max_scene_bytes);
     info->unit_scale = 1.0f;
     info->up_axis = -1;
@@ -240,29 +243,9 @@ out:
         if (err) *err = L.err;
         return r;
     }
-    sy_loader_warnings_log(asp_warnings(info), "assimp", path, path);
+    if (!notes) sy_loader_warnings_log(asp_warnings(info), "assimp", path, path);
     if (!info_out) sy_assimp_info_free(&local);
     return SY_OK;
-}
-
-sy_result sy_assimp_load(const char *path, sy_scene *scene, const sy_assimp_options *opts, sy_assimp_info *info_out,
-                         sy_error *err)
-{
-    if (!path || !scene) {
-        if (info_out) memset(info_out, 0, sizeof *info_out);
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_assimp_load: path and scene are required");
-    }
-    return load_common(path, NULL, 0, NULL, scene, opts, info_out, err);
-}
-
-sy_result sy_assimp_load_memory(const void *data, size_t size, const char *name, const char *base_dir, sy_scene *scene,
-                                const sy_assimp_options *opts, sy_assimp_info *info_out, sy_error *err)
-{
-    if (!data || !name || !base_dir || !scene) {
-        if (info_out) memset(info_out, 0, sizeof *info_out);
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_assimp_load_memory: data, name, base_dir and scene are required");
-    }
-    return load_common(name, data, size, base_dir, scene, opts, info_out, err);
 }
 
 /* >>reference (sy bench load) ------------------------------------------------------------------ */

@@ -62,6 +62,19 @@
  * Skins, morph targets and animations: the core has no objects for them yet; they are counted
  * (sy_assimp_counts), meshes are shown in their bind pose, and a note names the counts.
  *
+ * The import process: Assimp 5.2 crashes, aborts or loops on some malformed files (its fuzzers
+ * keep finding such bugs), which no check before it can foresee. So each load runs in a child
+ * process forked for it (sy_assimp_isolate.c): the child loads into its copy of the scene and sends
+ * what it created back as a change list, which the caller applies to its scene at the same ids
+ * (validated as a cluster peer's). A crash, an abort or a loop in Assimp ends the child and fails
+ * the load with SY_ERR_PARSE naming the file and the signal; the child is held to
+ * max_import_seconds of CPU, twice that plus 30 s of wall-clock time, and an address space of what
+ * the caller had plus 1 GiB and 1024 bytes per byte of the model (zlib's largest expansion), at
+ * most 1 GiB plus twice max_scene_bytes (past it: Assimp's std::bad_alloc, SY_ERR_PARSE, or the
+ * signal, SY_ERR_LIMIT). Assimp's OutOfMemory.off test file now fails in 0.05 s; in the caller's
+ * process it grew past 4 GB for more than 30 s. The caller's uncommitted changes stay uncommitted. Cost: the fork and one copy
+ * of the created objects' data (sy bench load measures it).
+ *
  * Untrusted input: the file itself is read once within max_file_bytes and handed to Assimp from
  * memory; every other file Assimp or the loader opens (MTL libraries, textures, COLLADA / FBX
  * references) goes through sy_path_confine (sy_file.h): it must lie in the model's folder or in an
@@ -75,9 +88,10 @@
  *
  * Ownership: the scene owns every created object; *info_out holds malloc()ed arrays released with
  * sy_assimp_info_free (also after a failed load). On failure nothing the call created remains.
- * Thread-safety: Assimp's C API keeps its error string and logger in globals, so loads through this
- * module are serialised by one process-wide lock (loads of other formats are not affected); the
- * conversion into the scene runs outside it. Calls on one scene must be serialised as usual. */
+ * Thread-safety: loads in import processes run in parallel. Assimp's C API keeps its error string
+ * and logger in globals, so in_process loads, the reference import and the export are serialised
+ * by one process-wide lock (loads of other formats are not affected). Calls on one scene must be
+ * serialised as usual. */
 #ifndef SY_ASSIMP_H
 #define SY_ASSIMP_H
 
@@ -101,6 +115,13 @@ typedef struct sy_assimp_options {
      * Borrowed for the call. */
     const char *const *allowed_roots;
     size_t allowed_root_count; /**< entries of allowed_roots */
+    /** CPU seconds the import process may use; 0 = 60 + 10 per MiB of the model. Its wall-clock
+     * time is bounded by twice this plus 30 s. */
+    unsigned max_import_seconds;
+    /** Load in the calling process instead of the import process (see the file comment): a crash,
+     * abort or endless loop inside Assimp then ends or blocks the caller. For fuzzing (the fuzzer
+     * must see Assimp's code run) and debuggers; never for untrusted files in an application. */
+    bool in_process;
 } sy_assimp_options;
 
 #define SY_ASSIMP_MAX_WARNINGS 32 /**< messages kept; warning_count counts them all */

@@ -7,7 +7,9 @@
  *                          integer lists)
  *   sy_assimp_materials.c  textures (files and embedded) and materials
  *   sy_assimp_scene.c      meshes, cameras, lights, the node tree, units and up axis
- *   sy_assimp.c            the public entry points (sy_assimp.h): options, the import, the order
+ *   sy_assimp.c            options, the import, the conversion in order (the load in one process)
+ *   sy_assimp_isolate.c    the public entry points (sy_assimp.h): the load in a child process (the
+ *                          import process) whose scene changes come back as a change list
  * Every function here starts with asp_. */
 #ifndef SY_ASSIMP_INTERNAL_H
 #define SY_ASSIMP_INTERNAL_H
@@ -15,6 +17,7 @@
 #include "sy_assimp.h"
 #include "sy_budget.h"
 #include "sy_loader_log.h"
+#include "sy_log.h"
 
 #include <assimp/cfileio.h>
 #include <assimp/scene.h>
@@ -36,6 +39,16 @@ typedef struct asp_texture {
     uint32_t channels;
     unsigned mr_used; /* a combined metallic-roughness texture: 1 metalness map used, 2 roughness map used */
 } asp_texture;
+
+/* Log lines kept for the parent when the load runs in the import process (sy_assimp_isolate.c),
+ * which must not call sy_log (another thread of the parent may have held its lock at the fork):
+ * records of [level u8][length u32][text], at most SY_ASSIMP_NOTES_MAX bytes, the rest counted. */
+#define SY_ASSIMP_NOTES_MAX (64u << 10)
+typedef struct asp_notes {
+    char *buf;
+    size_t len, cap;
+    uint32_t dropped;
+} asp_notes;
 
 typedef struct asp_loader {
     const char *path;      /* names the file in messages */
@@ -61,6 +74,7 @@ typedef struct asp_loader {
     bool obj;               /* the model is Wavefront OBJ: the other files Assimp opens are MTL libraries */
     char *mtl_dirs[SY_ASSIMP_MTL_DIRS]; /* their folders relative to the model's ("" = the same; '/'-terminated) */
     size_t mtl_dir_count;
+    asp_notes *notes;       /* NULL: log lines go to sy_log; else kept here (the import process) */
     sy_result io_result;    /* the first refused or failed file (fails the load) */
     char io_message[SY_ERROR_MESSAGE_MAX];
 } asp_loader;
@@ -92,7 +106,13 @@ struct aiFileIO asp_file_io(asp_loader *L);
 sy_result asp_read_named(asp_loader *L, const char *uri, void **data, size_t *size, sy_error *err);
 /* Refuses, before Assimp sees it, a file that declares more than its bytes can hold. */
 sy_result asp_precheck(asp_loader *L);
-/* Assimp's log into sy_log while attached: warnings and errors as notes, the rest as debug. */
+/* A line for the log (module "assimp", item the file): sy_log, or L->notes when it is set. */
+void asp_note(asp_loader *L, sy_log_level level, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* Assimp's log into asp_note while attached: warnings and errors as notes, the rest as debug. */
 void asp_log_attach(asp_loader *L);
 void asp_log_detach(void);
 /* Assimp's string as a C string (bounded). */
@@ -112,5 +132,17 @@ sy_result asp_charge(asp_loader *L);
 sy_result asp_create_mesh(asp_loader *L, unsigned i);
 /* The node tree under a new root (units and up axis), cameras and lights. */
 sy_result asp_create_nodes(asp_loader *L);
+
+/* >>load (sy_assimp.c) ------------------------------------------------------------------------- */
+
+/* Options with every default filled in. */
+sy_assimp_options asp_resolve_options(const sy_assimp_options *o);
+/* The whole load in this process: read, check, import under the lock (none when notes is set: the
+ * import process has no other thread), convert, roll back on failure. path names the file, mem
+ * (size mem_size, base_dir) the content when loading from memory (path then being its name).
+ * notes NULL: warnings and Assimp's log lines go to sy_log; else every line is kept there and
+ * nothing is logged. */
+sy_result asp_load_here(const char *path, const void *mem, size_t mem_size, const char *base_dir, sy_scene *scene,
+                        const sy_assimp_options *opts, sy_assimp_info *info_out, asp_notes *notes, sy_error *err);
 
 #endif /* SY_ASSIMP_INTERNAL_H */

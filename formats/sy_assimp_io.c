@@ -8,7 +8,6 @@
 #include "sy_file.h"
 #include "sy_loader_log.h"
 #include "sy_sniff.h"
-#include "sy_log.h"
 
 #include <assimp/cimport.h>
 
@@ -206,6 +205,41 @@ struct aiFileIO asp_file_io(asp_loader *L)
 
 static asp_loader *g_log_loader; /* the loader whose import runs (under sy_assimp.c's lock) */
 
+void asp_note(asp_loader *L, sy_log_level level, const char *fmt, ...)
+{
+    if (!sy_log_enabled(level)) return; /* reads an atomic: no lock, also in the import process */
+    char text[SY_ERROR_MESSAGE_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(text, sizeof text, fmt, ap);
+    va_end(ap);
+    asp_notes *n = L->notes;
+    if (!n) {
+        sy_log(level, "assimp", L->path, "%s", text);
+        return;
+    }
+    uint32_t len = (uint32_t)strlen(text);
+    size_t need = n->len + 5 + len;
+    if (need > SY_ASSIMP_NOTES_MAX) {
+        n->dropped++;
+        return;
+    }
+    if (need > n->cap) {
+        size_t cap = n->cap ? n->cap : 4096;
+        while (cap < need) cap *= 2;
+        char *b = realloc(n->buf, cap);
+        if (!b) {
+            n->dropped++;
+            return;
+        }
+        n->buf = b, n->cap = cap;
+    }
+    n->buf[n->len] = (char)level;
+    memcpy(n->buf + n->len + 1, &len, 4);
+    memcpy(n->buf + n->len + 5, text, len);
+    n->len = need;
+}
+
 static void log_cb(const char *message, char *user)
 {
     (void)user;
@@ -219,7 +253,7 @@ static void log_cb(const char *message, char *user)
     /* Assimp's own warnings and errors are notes (what its post-processing repaired, parts of a file
      * it ignores); they are not the loader's warnings, which name what the scene lacks (--strict) */
     bool loud = !strncmp(line, "Warn", 4) || !strncmp(line, "Error", 5);
-    if (L) sy_log(loud ? SY_LOG_NOTE : SY_LOG_DEBUG, "assimp", L->path, "%s", loud ? text : line);
+    if (L) asp_note(L, loud ? SY_LOG_NOTE : SY_LOG_DEBUG, "%s", loud ? text : line);
 }
 
 static struct aiLogStream g_stream = {log_cb, NULL};

@@ -220,10 +220,14 @@ static double scene_bytes(sy_scene *s)
     return b;
 }
 
-/* One load in a forked child: sy's (sy_assimp_load into a fresh scene, as sy render makes it) or
- * Assimp's own (`reference`). */
-static void asp_child(const char *path, bool reference, asp_run *o)
+/* How a forked child loads: Assimp's own import, sy_assimp_load as sy render makes it (in the
+ * import process), or sy_assimp_load in the child itself (in_process: the import process's cost). */
+enum { ASP_REFERENCE, ASP_SY, ASP_SY_IN_PROCESS };
+
+/* One load in a forked child. */
+static void asp_child(const char *path, int how, asp_run *o)
 {
+    bool reference = how == ASP_REFERENCE;
     sy_error e = {0};
     memset(o, 0, sizeof *o);
     long base = sy_bench_rss_now_kib();
@@ -240,7 +244,8 @@ static void asp_child(const char *path, bool reference, asp_run *o)
         sy_assimp_info info = {0};
         r = sy_scene_create(&s, &e);
         t0 = sy_time_now();
-        if (r == SY_OK) r = sy_assimp_load(path, s, NULL, &info, &e);
+        sy_assimp_options ao = {.in_process = how == ASP_SY_IN_PROCESS};
+        if (r == SY_OK) r = sy_assimp_load(path, s, &ao, &info, &e);
         o->seconds = sy_time_now() - t0;
         o->meshes = info.counts.meshes;
         o->tris = info.counts.triangles;
@@ -248,14 +253,16 @@ static void asp_child(const char *path, bool reference, asp_run *o)
         sy_assimp_info_free(&info);
         /* the scene stays: the peak is read below, destroying it frees nothing the peak counted */
     }
-    struct rusage ru;
+    struct rusage ru, rc;
     getrusage(RUSAGE_SELF, &ru);
     o->peak_kib = ru.ru_maxrss - base;
+    /* the import process (a fork of this one, so the same base) peaks on its own */
+    if (getrusage(RUSAGE_CHILDREN, &rc) == 0 && rc.ru_maxrss - base > o->peak_kib) o->peak_kib = rc.ru_maxrss - base;
     o->ok = r == SY_OK;
     snprintf(o->message, sizeof o->message, "%s", e.message);
 }
 
-static sy_result asp_run_forked(const char *path, bool reference, asp_run *o, sy_error *err)
+static sy_result asp_run_forked(const char *path, int how, asp_run *o, sy_error *err)
 {
     int fds[2];
     if (pipe(fds) != 0) return sy_error_set(err, SY_ERR_IO, "bench load: pipe failed");
@@ -269,7 +276,7 @@ static sy_result asp_run_forked(const char *path, bool reference, asp_run *o, sy
     if (pid == 0) {
         close(fds[0]);
         asp_run run;
-        asp_child(path, reference, &run);
+        asp_child(path, how, &run);
         ssize_t w = write(fds[1], &run, sizeof run);
         _exit(w == (ssize_t)sizeof run ? 0 : 1);
     }
@@ -293,22 +300,23 @@ static int cmp_run_seconds(const void *a, const void *b)
 /* Median of `repeats` forked loads each way; one row. */
 static sy_result bench_assimp_one(const char *label, const char *path, uint32_t repeats, sy_error *err)
 {
-    asp_run *runs = calloc((size_t)repeats * 2, sizeof *runs);
+    asp_run *runs = calloc((size_t)repeats * 3, sizeof *runs);
     if (!runs) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench load: out of memory");
     sy_result r = SY_OK;
-    for (uint32_t k = 0; k < repeats && r == SY_OK; ++k) {
-        r = asp_run_forked(path, true, &runs[k], err);
-        if (r == SY_OK) r = asp_run_forked(path, false, &runs[repeats + k], err);
+    for (uint32_t k = 0; k < repeats && r == SY_OK; ++k) { /* interleaved: the same machine state for each */
+        r = asp_run_forked(path, ASP_REFERENCE, &runs[k], err);
+        if (r == SY_OK) r = asp_run_forked(path, ASP_SY, &runs[repeats + k], err);
+        if (r == SY_OK) r = asp_run_forked(path, ASP_SY_IN_PROCESS, &runs[2 * repeats + k], err);
     }
     if (r == SY_OK) {
-        qsort(runs, repeats, sizeof *runs, cmp_run_seconds);
-        qsort(runs + repeats, repeats, sizeof *runs, cmp_run_seconds);
-        const asp_run *a = &runs[repeats / 2], *s = &runs[repeats + repeats / 2];
+        for (int m = 0; m < 3; ++m) qsort(runs + m * repeats, repeats, sizeof *runs, cmp_run_seconds);
+        const asp_run *a = &runs[repeats / 2], *s = &runs[repeats + repeats / 2], *h = &runs[2 * repeats + repeats / 2];
         struct stat st;
         double file = stat(path, &st) == 0 ? (double)st.st_size : 0;
-        printf("%-24s %8.2f %9u %9u %10.1f %10.1f %7.2fx %9.1f %9.1f %9.1f %7.2fx\n", label, file / 1048576.0, a->tris,
-               s->tris, a->seconds * 1e3, s->seconds * 1e3, a->seconds > 0 ? s->seconds / a->seconds : 0.0,
-               (double)a->peak_kib / 1024.0, (double)s->peak_kib / 1024.0, s->scene_bytes / 1048576.0,
+        printf("%-24s %8.2f %9u %9u %10.1f %10.1f %7.2fx %9.1f %7.2fx %9.1f %9.1f %9.1f %7.2fx\n", label, file / 1048576.0,
+               a->tris, s->tris, a->seconds * 1e3, s->seconds * 1e3, a->seconds > 0 ? s->seconds / a->seconds : 0.0,
+               h->seconds * 1e3, h->seconds > 0 ? s->seconds / h->seconds : 0.0, (double)a->peak_kib / 1024.0,
+               (double)s->peak_kib / 1024.0, s->scene_bytes / 1048576.0,
                s->scene_bytes > 0 ? (double)s->peak_kib * 1024.0 / s->scene_bytes : 0.0);
         fflush(stdout);
     } else {
@@ -350,11 +358,14 @@ static sy_result bench_assimp(uint32_t tris, uint32_t repeats, sy_error *err)
 {
     printf("\nAssimp formats: median of %u loads each way, each in a forked child; 'assimp' = Assimp's own import as\n"
            "`assimp info` makes it (aiProcessPreset_TargetRealtime_MaxQuality), 'sy load' = sy_assimp_load into a fresh\n"
-           "scene (as sy render); peak = RSS growth of the child; scene = the mesh and texture bytes the load made\n\n",
+           "scene (as sy render: in the import process), 'in proc' = the same load in the child itself (in_process),\n"
+           "'iso' = sy load / in proc (what the import process costs); peak = RSS growth of the child or of its\n"
+           "import process, whichever is larger; scene = the mesh and texture bytes the load made\n\n",
            (unsigned)repeats);
-    printf("%-24s %8s %9s %9s %10s %10s %8s %9s %9s %9s %8s\n", "model", "file MB", "tris", "sy tris", "assimp",
-           "sy load", "ratio", "assimp pk", "sy peak", "scene MB", "pk/scene");
-    printf("%-24s %8s %9s %9s %10s %10s %8s %9s %9s %9s %8s\n", "", "", "", "", "ms", "ms", "", "MB", "MB", "", "");
+    printf("%-24s %8s %9s %9s %10s %10s %8s %9s %8s %9s %9s %9s %8s\n", "model", "file MB", "tris", "sy tris", "assimp",
+           "sy load", "ratio", "in proc", "iso", "assimp pk", "sy peak", "scene MB", "pk/scene");
+    printf("%-24s %8s %9s %9s %10s %10s %8s %9s %8s %9s %9s %9s %8s\n", "", "", "", "", "ms", "ms", "", "ms", "", "MB", "MB", "",
+           "");
     char dir[] = "/tmp/sy_bench_load_assimp_XXXXXX", obj[128], fbx[128];
     if (!mkdtemp(dir)) return sy_error_set(err, SY_ERR_IO, "bench load: cannot create a temporary directory");
     snprintf(obj, sizeof obj, "%s/grid.obj", dir);

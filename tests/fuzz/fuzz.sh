@@ -24,7 +24,12 @@
 # target's maximum input length (bigger ones are skipped); fuzz_seeds adds generated EXR images and
 # wire-format encodings of test-data scenes. Companion files of the seeds (glTF .bin buffers and
 # images, X3D textures) are copied into a temporary resource directory that the targets resolve
-# external URIs in ($SY_FUZZ_RESOURCES; copies, since the loaders confine URIs after links). Exit status: 0 clean, 1 crash / sanitizer report / failure.
+# external URIs in ($SY_FUZZ_RESOURCES; copies, since the loaders confine URIs after links).
+# Assimp targets: Assimp's own leaks are suppressed (assimp_lsan.supp), and a crash, abort or hang
+# inside Assimp that the import process contains (formats/sy_assimp_isolate.c) is reported as
+# "contained" (reproducer kept in CORPUS.contained with --corpus) and fuzzing goes on; a fault
+# anywhere else fails the run.
+# Exit status: 0 clean, 1 crash / sanitizer report / failure.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 repo=$(cd "$here/../.." && pwd)
@@ -137,35 +142,81 @@ echo "fuzz.sh: $target for ${seconds}s x $jobs job(s), max_len $len: $nseed test
      "than max_len), $(ls "$work/generated" | wc -l) generated, $(ls "$here/corpus_regressions/$target" | wc -l) regression inputs"
 
 regress=$here/corpus_regressions/$target
-args=(-max_total_time="$seconds" -max_len="$len" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
-      -dict="$dict" -artifact_prefix="$artifacts/")
+args=(-max_len="$len" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -dict="$dict" -artifact_prefix="$artifacts/")
 [ "$jobs" -gt 1 ] && args+=(-jobs="$jobs" -workers="$jobs")
-start=$(date +%s)
-set +e
 # a smaller ASan quarantine and shorter allocation stacks: ~10% more executions (tinygltf and
 # libxml2 allocate a lot); an ASAN_OPTIONS of the caller wins
 export ASAN_OPTIONS=${ASAN_OPTIONS:-quarantine_size_mb=64:malloc_context_size=10}
-timer=()
-[ -x /usr/bin/time ] && timer=(/usr/bin/time -f '%U %S' -o "$work/cpu")
-(cd "$work" && SY_FUZZ_RESOURCES="$work/resources" "${timer[@]}" "$fuzzer" "${args[@]}" "${extra[@]}" "$corpus" \
-   "$regress" "$work/seeds" "$work/generated" >"$work/fuzz-main.log" 2>&1)
-rc=$?
+assimp=false
+case $target in assimp_*) assimp=true ;; esac
+# Assimp's own leaks on malformed files (assimp_lsan.supp says why they are not the loader's)
+$assimp && export LSAN_OPTIONS="suppressions=$here/assimp_lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+
+# assimp_fault FILE: prints the faulting frame and succeeds when the fault FILE reproduces lies inside
+# Assimp (the first stack frame outside the C / C++ runtimes, the sanitizers and libFuzzer is in
+# libassimp) AND the same input loaded as applications load it (the import process,
+# SY_FUZZ_ISOLATED=1) only fails the load. Such faults are Assimp 5.2's, contained, and do not fail
+# the run; any other fault does.
+assimp_fault() {
+  local out frame
+  out=$(cd "$work" && SY_FUZZ_RESOURCES="$work/resources" timeout 120 "$fuzzer" -timeout=10 -rss_limit_mb=2048 -runs=1 "$1" 2>&1)
+  frame=$(printf '%s\n' "$out" | awk '/^ *#[0-9]+ 0x/ {
+      if ($0 ~ /(libc\.so|libstdc\+\+|libgcc_s|libclang_rt|libasan|libubsan|ld-linux)/) next
+      if ($0 ~ / in (__sanitizer|__asan|__lsan|__ubsan|__interceptor|fuzzer::|malloc|calloc|realloc|operator new|abort|raise|gsignal|__GI_|__pthread_kill)/) next
+      print; exit }')
+  case $frame in *libassimp.so*) ;; *) return 1 ;; esac
+  (cd "$work" && SY_FUZZ_ISOLATED=1 SY_FUZZ_RESOURCES="$work/resources" timeout 300 "$fuzzer" -runs=1 "$1" >/dev/null 2>&1) || return 1
+  printf '%s\n' "$frame" | sed 's/^ *//'
+}
+
+start=$(date +%s)
+set +e
+logs=() contained=() round=0 rc=0
+while :; do
+  left=$((seconds - ($(date +%s) - start)))
+  [ "$round" -gt 0 ] && [ "$left" -lt 2 ] && break
+  [ "$left" -ge 1 ] || left=1
+  timer=()
+  [ -x /usr/bin/time ] && timer=(/usr/bin/time -a -f '%U %S' -o "$work/cpu")
+  (cd "$work" && SY_FUZZ_RESOURCES="$work/resources" "${timer[@]}" "$fuzzer" -max_total_time="$left" "${args[@]}" \
+     "${extra[@]}" "$corpus" "$regress" "$work/seeds" "$work/generated" >"$work/fuzz-main-$round.log" 2>&1)
+  rc=$?
+  logs+=("$work/fuzz-main-$round.log")
+  round=$((round + 1))
+  # an Assimp target that stopped on a fault inside Assimp that the import process contains: note
+  # it, set the reproducer aside and fuzz on for the time left (at most 20 restarts)
+  [ "$rc" -ne 0 ] && $assimp && [ "$jobs" -eq 1 ] && [ "$round" -le 20 ] || break
+  new=() ok=true
+  for f in "$artifacts"/*; do [ -e "$f" ] && new+=("$f"); done
+  [ ${#new[@]} -gt 0 ] || break
+  kept=$work/contained
+  [ "$artifacts" = "$work/artifacts" ] || kept=$corpus.contained
+  mkdir -p "$kept"
+  for f in "${new[@]}"; do
+    if frame=$(assimp_fault "$f"); then
+      contained+=("$kept/$(basename "$f") at ${frame:0:160}")
+      mv "$f" "$kept/"
+    else ok=false; fi
+  done
+  $ok || break
+  rc=0
+done
 set -e
 end=$(date +%s)
-logs=("$work/fuzz-main.log")
 [ "$jobs" -gt 1 ] && logs=("$work"/fuzz-[0-9]*.log)
 grep -hE '^#[0-9]+[[:space:]]+(INITED|DONE)|^(==[0-9]+==|SUMMARY|INFO: Seed)|ERROR|Test unit written' "${logs[@]}" | tail -n 30 || true
+for c in "${contained[@]}"; do echo "fuzz.sh: contained: a fault inside Assimp that the import process turns into a failed load: $c"; done
 execs=$(cat "${logs[@]}" | awk '/stat::number_of_executed_units/ {s += $NF} END {print s + 0}')
-corp=$(cat "${logs[@]}" | grep -oE 'corp: [0-9]+/[0-9]+[a-zA-Z]*' | tail -n 1 | cut -d' ' -f2)
+corp=$(cat "${logs[@]}" | grep -oE 'corp: [0-9]+/[0-9]+[a-zA-Z]*' | tail -n 1 | cut -d' ' -f2 || true)
 files=$(find "$corpus" -type f | wc -l)
 bytes=$(du -sb "$corpus" | cut -f1)
 crashes=$(find "$artifacts" -type f | wc -l)
 elapsed=$((end - start)); [ "$elapsed" -gt 0 ] || elapsed=1
-cpu=$(tail -n 1 "$work/cpu" 2>/dev/null | awk '{printf "%d", $1 + $2 + 0.5}' || true) # user + system, all jobs
+cpu=$(awk '{c += $1 + $2} END {if (NR) printf "%d", c + 0.5}' "$work/cpu" 2>/dev/null || true) # user + system, all jobs and rounds
 per_cpu=""
 [ -n "$cpu" ] && [ "$cpu" -gt 0 ] && per_cpu=" cpu_seconds=$cpu exec_per_cpu_s=$((execs / cpu))"
 echo "fuzz.sh: RESULT target=$target seconds=$elapsed jobs=$jobs executions=$execs exec_per_s=$((execs / elapsed))$per_cpu" \
-     "corpus=${corp:-?} (libFuzzer: inputs/bytes) new_files=$files new_bytes=$bytes crashes=$crashes exit=$rc"
+     "corpus=${corp:-?} (libFuzzer: inputs/bytes) new_files=$files new_bytes=$bytes crashes=$crashes contained=${#contained[@]} exit=$rc"
 if [ "$rc" -ne 0 ] || [ "$crashes" -ne 0 ]; then
   echo "FUZZER FAILED (exit $rc); reproducers (add them to tests/fuzz/corpus_regressions/$target with the fix):"
   for f in "$artifacts"/*; do [ -e "$f" ] && { echo "  $f"; base64 -w0 "$f" | head -c 2000; echo; }; done

@@ -2,12 +2,17 @@
  * memory: one binary per format (assimp_obj, assimp_ply, assimp_stl, assimp_fbx, assimp_dae), built
  * from this file with FUZZ_ASSIMP_NAME naming the input ("fuzz.obj", ...) so that Assimp's importer
  * for that extension reads it (the content can still pick another one). Files the input names
- * resolve in fuzz_resource_dir(), confined there. */
+ * resolve in fuzz_resource_dir(), confined there.
+ * The load runs in this process (sy_assimp_options.in_process) so that libFuzzer sees Assimp's
+ * and the loader's code run; with SY_FUZZ_ISOLATED=1 in the environment it runs in the import
+ * process as applications load, which fuzz.sh uses to check that an input crashing inside
+ * Assimp only fails the load. */
 #include "fuzz_util.h"
 #include "sy_assimp.h"
 #include "sy_log.h"
 
 #include <stddef.h>
+#include <stdlib.h>
 
 #ifndef FUZZ_ASSIMP_NAME
 #define FUZZ_ASSIMP_NAME "fuzz.obj"
@@ -25,6 +30,8 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
     o.max_vertices = 1u << 18;
     o.max_image_pixels = 1u << 18;
     o.max_scene_bytes = (uint64_t)64 << 20; /* the file budget, small like the other limits */
+    const char *iso = getenv("SY_FUZZ_ISOLATED");
+    o.in_process = !(iso && iso[0] == '1');
     sy_assimp_info info = {0};
     sy_error err = {0};
     if (sy_assimp_load_memory(data, size, FUZZ_ASSIMP_NAME, fuzz_resource_dir(), s, &o, &info, &err) == SY_OK)
