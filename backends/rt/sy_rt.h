@@ -277,6 +277,15 @@ typedef struct sy_rt_material_desc {
     sy_rt_texture_ref clearcoat_texture; /**< R x clearcoat */
     float clearcoat_roughness;      /**< [0, 1] (default 0) */
     sy_rt_texture_ref clearcoat_roughness_texture; /**< G x clearcoat_roughness */
+    float sheen_color[3];           /**< KHR_materials_sheen colour, [0, 1] (default 0: no sheen) */
+    sy_rt_texture_ref sheen_color_texture; /**< RGB (sRGB) x sheen_color */
+    float sheen_roughness;          /**< [0, 1] (default 0; evaluated at 0.07 at least) */
+    sy_rt_texture_ref sheen_roughness_texture; /**< A x sheen_roughness */
+    float iridescence;              /**< KHR_materials_iridescence weight, [0, 1] (default 0: none) */
+    sy_rt_texture_ref iridescence_texture; /**< R x iridescence */
+    float iridescence_ior;          /**< the thin film's index, >= 1 (default 1.3) */
+    float iridescence_thickness[2]; /**< film thickness in nm, minimum and maximum (default 100, 400) */
+    sy_rt_texture_ref iridescence_thickness_texture; /**< G: minimum + G x (maximum - minimum); without it: maximum */
 } sy_rt_material_desc;
 
 /** Fills desc with the glTF 2.0 defaults. */
@@ -574,7 +583,7 @@ sy_rt_result sy_rt_accum_read(sy_rt_device *dev, const sy_rt_accum *accum, sy_rt
  * P0's BSDF for any direction, so a filter can re-shade a neighbour's incident sample with this
  * pixel's own material, normal and wo. Ownership: caller-owned array; plain data. */
 enum { SY_RT_RECORD_P0 = 1u << 0 };
-#define SY_RT_RECORD_BSDF_FLOATS 25 /**< floats of the packed BSDF in a record */
+#define SY_RT_RECORD_BSDF_FLOATS 33 /**< floats of the packed BSDF in a record */
 /** One path record of the path tracer (see above). */
 typedef struct sy_rt_pt_record {
     /** @{ color = the sample's radiance; prefix = what the path gathered before wi (see above) */

@@ -1,5 +1,7 @@
 /* sy_rt_bsdf.c — glTF metallic-roughness BSDF for the path tracer (see sy_rt_bsdf.h). */
 #include "sy_rt_bsdf.h"
+#include "sy_rt_iridescence.h"
+#include "sy_rt_sheen.h"
 
 #include <string.h>
 
@@ -91,21 +93,59 @@ void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
     b->cc_alpha = sy_rt_maxf(ccr * ccr, 1e-4f);
     float fc = b->cc > 0.0f ? b->cc * schlick3(v3(0.04f, 0.04f, 0.04f), nv).x : 0.0f;
     b->base_scale = 1.0f - fc;
-    b->w_metal = metallic * b->base_scale;
-    b->w_diel = (1.0f - metallic) * (1.0f - trans) * b->base_scale;
-    b->w_trans = (1.0f - metallic) * trans * b->base_scale;
+    sy_rt_v3 sc = v3(sy_rt_clampf(s->sheen_color.x, 0.0f, 1.0f), sy_rt_clampf(s->sheen_color.y, 0.0f, 1.0f),
+                     sy_rt_clampf(s->sheen_color.z, 0.0f, 1.0f));
+    float sheen_scale = 1.0f, q_sheen = 0.0f;
+    b->sheen_r = sy_rt_clampf(s->sheen_roughness, 0.0f, 1.0f);
+    if (maxc(sc) > 0.0f && nv > 0.0f) {
+        float e = sy_rt_minf(sy_rt_sheen_albedo(nv, b->sheen_r), 1.0f);
+        sheen_scale = 1.0f - maxc(sc) * e;
+        b->sheen = v3_scale(sc, b->base_scale);
+        q_sheen = maxc(b->sheen) * sy_rt_maxf(e, 0.02f);
+    } else {
+        b->sheen = v3(0.0f, 0.0f, 0.0f);
+    }
+    b->irid = sy_rt_clampf(s->iridescence, 0.0f, 1.0f);
+    b->irid_ior = s->mat->desc.iridescence_ior;
+    b->irid_thick = s->iridescence_thickness;
+    float under = b->under = b->base_scale * sheen_scale;
+    b->w_metal = metallic * under;
+    b->w_diel = (1.0f - metallic) * (1.0f - trans) * under;
+    b->w_trans = (1.0f - metallic) * trans * under;
     float fd = b->spec * maxc(schlick3(b->f0c, nv));
     b->q_metal = b->w_metal;
     b->q_spec = b->w_diel * fd;
     b->q_diff = b->w_diel * (1.0f - fd) * maxc(b->base);
     b->q_coat = fc;
     b->q_trans = b->w_trans;
-    float sum = b->q_metal + b->q_spec + b->q_diff + b->q_coat + b->q_trans;
+    b->q_sheen = q_sheen;
+    float sum = b->q_metal + b->q_spec + b->q_diff + b->q_coat + b->q_trans + b->q_sheen;
     if (sum > 0.0f) {
-        b->q_metal /= sum, b->q_spec /= sum, b->q_diff /= sum, b->q_coat /= sum, b->q_trans /= sum;
+        b->q_metal /= sum, b->q_spec /= sum, b->q_diff /= sum, b->q_coat /= sum, b->q_trans /= sum, b->q_sheen /= sum;
     } else {
-        b->q_metal = b->q_spec = b->q_diff = b->q_coat = b->q_trans = 0.0f;
+        b->q_metal = b->q_spec = b->q_diff = b->q_coat = b->q_trans = b->q_sheen = 0.0f;
     }
+}
+
+/* The dielectric's Fresnel (x specular) and the metal's at cosine c, with the thin film mixed in
+ * (KHR_materials_iridescence). */
+static sy_rt_v3 fresnel_diel(const sy_rt_bsdf *b, float c)
+{
+    sy_rt_v3 f = schlick3(b->f0c, c);
+    if (b->irid > 0.0f) {
+        sy_rt_v3 fi = sy_rt_iridescence_fresnel(c, b->irid_ior, b->irid_thick, b->f0c);
+        f = v3_add(v3_scale(f, 1.0f - b->irid), v3_scale(fi, b->irid));
+    }
+    return v3_scale(f, b->spec);
+}
+static sy_rt_v3 fresnel_metal(const sy_rt_bsdf *b, float c)
+{
+    sy_rt_v3 f = schlick3(b->base, c);
+    if (b->irid > 0.0f) {
+        sy_rt_v3 fi = sy_rt_iridescence_fresnel(c, b->irid_ior, b->irid_thick, b->base);
+        f = v3_add(v3_scale(f, 1.0f - b->irid), v3_scale(fi, b->irid));
+    }
+    return f;
 }
 
 /* The base's GGX lobes are evaluated (not delta, some glossy weight). */
@@ -123,16 +163,21 @@ static inline sy_rt_v3 bsdf_eval_wo(const sy_rt_bsdf *b, sy_rt_v3 wo, float nv, 
     if (nl <= 0.0f || nv <= 0.0f || v3_dot(b->ng, wi) <= 0.0f) return v3(0.0f, 0.0f, 0.0f);
     sy_rt_v3 h = v3_normalize(v3_add(wo, wi));
     float vh = sy_rt_maxf(v3_dot(wo, h), 0.0f);
-    sy_rt_v3 fs = v3_scale(schlick3(b->f0c, vh), b->spec);
-    sy_rt_v3 f = v3_scale(b->base, b->w_diel * (1.0f - maxc(fs)) * INV_PI);
+    sy_rt_v3 fs = fresnel_diel(b, vh);
+    sy_rt_v3 f = v3_scale(b->base, b->w_diel * (1.0f - sy_rt_minf(maxc(fs), 1.0f)) * INV_PI);
     float p = b->q_diff * nl * INV_PI;
+    if (b->q_sheen > 0.0f) {
+        float nh = sy_rt_maxf(v3_dot(b->n, h), 0.0f);
+        f = v3_add(f, v3_scale(b->sheen, sy_rt_sheen_brdf(b->sheen_r, nl, nv, nh)));
+        p += b->q_sheen * nl * INV_PI;
+    }
     if (bsdf_glossy(b)) {
         float a2 = b->alpha * b->alpha, nh = sy_rt_maxf(v3_dot(b->n, h), 0.0f);
         float D = ggx_d(a2, nh);
         float ll = ggx_lambda(a2, nl);
         if (lv < 0.0f) lv = ggx_lambda(a2, nv);
         float common = D / (1.0f + lv + ll) / (4.0f * nl * nv);
-        f = v3_add(f, v3_scale(schlick3(b->base, vh), b->w_metal * common));
+        if (b->w_metal > 0.0f) f = v3_add(f, v3_scale(fresnel_metal(b, vh), b->w_metal * common));
         f = v3_add(f, v3_scale(fs, b->w_diel * common));
         p += (b->q_metal + b->q_spec) * D / (1.0f + lv) / (4.0f * nv);
     }
@@ -162,12 +207,13 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
     out->pdf = 0.0f;
     if (nv <= 0.0f) return false;
     sy_rt_v3 wol = to_local(b, wo);
-    int lobe; /* 0 metal, 1 spec, 2 diffuse, 3 transmission, 4 coat */
+    int lobe; /* 0 metal, 1 spec, 2 diffuse, 3 transmission, 4 coat, 5 sheen */
     float lo;
     if (u0 < b->q_metal) lobe = 0, lo = 0.0f;
     else if (u0 < b->q_metal + b->q_spec) lobe = 1, lo = b->q_metal;
     else if (u0 < b->q_metal + b->q_spec + b->q_diff) lobe = 2, lo = b->q_metal + b->q_spec;
     else if (u0 < b->q_metal + b->q_spec + b->q_diff + b->q_coat) lobe = 4, lo = b->q_metal + b->q_spec + b->q_diff;
+    else if (u0 < b->q_metal + b->q_spec + b->q_diff + b->q_coat + b->q_sheen) lobe = 5, lo = 0.0f;
     else if (b->q_trans > 0.0f) lobe = 3, lo = 1.0f - b->q_trans;
     else return false;
     if (lobe == 4 && b->cc_delta) { /* a smooth coat: its mirror direction */
@@ -208,17 +254,18 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
         out->specular = true;
         return true;
     }
-    if (b->delta && lobe != 2 && lobe != 4) {
+    if (b->delta && lobe != 2 && lobe != 4 && lobe != 5) {
         sy_rt_v3 wi = v3_sub(v3_scale(b->n, 2.0f * nv), wo);
         if (v3_dot(b->ng, wi) <= 0.0f) return false;
         out->wi = wi;
         out->specular = true;
-        out->weight = lobe == 0 ? v3_scale(schlick3(b->base, nv), b->w_metal / b->q_metal)
-                                : v3_scale(schlick3(b->f0c, nv), b->w_diel * b->spec / b->q_spec);
+        out->weight = lobe == 0 ? v3_scale(fresnel_metal(b, nv), b->w_metal / b->q_metal)
+                     : b->irid > 0.0f ? v3_scale(fresnel_diel(b, nv), b->w_diel / b->q_spec)
+                                      : v3_scale(schlick3(b->f0c, nv), b->w_diel * b->spec / b->q_spec);
         return true;
     }
     sy_rt_v3 wi;
-    if (lobe == 2) {
+    if (lobe == 2 || lobe == 5) {
         float r = sqrtf(u[1]), sp, cp;
         sy_rt_sincos_2pi(u[2], &sp, &cp);
         wi = to_world(b, v3(r * cp, r * sp, sqrtf(sy_rt_maxf(1.0f - u[1], 0.0f))));
@@ -245,7 +292,9 @@ void sy_rt_bsdf_pack(const sy_rt_bsdf *b, float o[SY_RT_RECORD_BSDF_FLOATS])
                                                b->base.x, b->base.y, b->base.z, b->alpha,    b->delta ? 1.0f : 0.0f,
                                                b->f0d,   b->spec,  b->w_metal,  b->w_diel,   b->q_metal,  b->q_spec,
                                                b->q_diff, b->f0c.x, b->f0c.y, b->f0c.z,
-                                               b->cc,    b->cc_alpha, b->cc_delta ? 1.0f : 0.0f, b->q_coat};
+                                               b->cc,    b->cc_alpha, b->cc_delta ? 1.0f : 0.0f, b->q_coat,
+                                               b->sheen.x, b->sheen.y, b->sheen.z, b->sheen_r, b->q_sheen,
+                                               b->irid,  b->irid_ior, b->irid_thick};
     memcpy(o, v, sizeof v);
 }
 
@@ -269,6 +318,8 @@ void sy_rt_pt_record_bsdf_batch(const sy_rt_pt_record *r, uint32_t count, const 
     b.q_metal = p[15], b.q_spec = p[16], b.q_diff = p[17];
     b.f0c = v3(p[18], p[19], p[20]);
     b.cc = p[21], b.cc_alpha = p[22], b.cc_delta = p[23] != 0.0f, b.q_coat = p[24];
+    b.sheen = v3(p[25], p[26], p[27]), b.sheen_r = p[28], b.q_sheen = p[29];
+    b.irid = p[30], b.irid_ior = p[31], b.irid_thick = p[32];
     sy_rt_v3 wo = v3(r->wo[0], r->wo[1], r->wo[2]);
     float nv = v3_dot(b.n, wo), lv = bsdf_glossy(&b) && nv > 0.0f ? ggx_lambda(b.alpha * b.alpha, nv) : -1.0f;
     for (uint32_t m = 0; m < count; ++m) {

@@ -10,7 +10,14 @@
  *                  microfacet (tinted by the base colour), weight (1 - metallic) transmission;
  *   - clearcoat:   KHR_materials_clearcoat's coat on top of all of them: a GGX lobe with F0 0.04
  *                  and its own roughness, weight clearcoat; the base below is scaled by
- *                  1 - clearcoat x Fresnel(n . wo), the specification's albedo scaling.
+ *                  1 - clearcoat x Fresnel(n . wo), the specification's albedo scaling;
+ *   - sheen:       KHR_materials_sheen's Charlie lobe (sy_rt_sheen.h) between the coat and the base,
+ *                  colour sheen colour; the base below is scaled by 1 - max(sheen colour) x
+ *                  E_sheen(n . wo) (the specification's albedo scaling, E clamped to 1); sampled
+ *                  cosine-weighted;
+ *   - iridescence: KHR_materials_iridescence replaces the metal's and the dielectric's Fresnel by
+ *                  mix(Schlick, thin film (sy_rt_iridescence.h), iridescence) at the half vector
+ *                  (the lobe choice uses Schlick: the estimate stays unbiased).
  * Roughness below SY_RT_BSDF_DELTA_ROUGHNESS is a perfect mirror / smooth interface (delta lobes).
  * Lobes with a finite density ("evaluable") take part in next-event estimation and MIS; delta lobes
  * and the transmission lobe are sampled only. Sampling picks one lobe by its estimated albedo and
@@ -37,7 +44,11 @@ typedef struct sy_rt_bsdf {
     float cc, cc_alpha; /* KHR_materials_clearcoat: weight and GGX alpha of the coat (F0 0.04) */
     bool cc_delta;      /* the coat is a smooth mirror */
     float base_scale;   /* 1 - cc x Fresnel_coat(n . wo): what the coat lets through to the base */
-    float q_metal, q_spec, q_diff, q_coat, q_trans; /* lobe selection probabilities (sum 1 or all 0) */
+    float under;        /* base_scale x the sheen's 1 - max(sheen) x E: what reaches the base lobes */
+    sy_rt_v3 sheen;     /* KHR_materials_sheen colour, already x the coat's base_scale (0: none) */
+    float sheen_r;      /* its roughness */
+    float irid, irid_ior, irid_thick; /* KHR_materials_iridescence weight (0: none), film index, nm */
+    float q_metal, q_spec, q_diff, q_coat, q_trans, q_sheen; /* lobe selection probabilities (sum 1 or all 0) */
 } sy_rt_bsdf;
 
 /* Builds the BSDF of a surface hit seen from direction wo (unit, away from the surface). */
@@ -46,7 +57,8 @@ void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo);
 /* True when some lobe has a finite density (worth a light sample). */
 static inline bool sy_rt_bsdf_evaluable(const sy_rt_bsdf *b)
 {
-    return b->q_diff > 0.0f || (!b->delta && (b->q_metal > 0.0f || b->q_spec > 0.0f)) || (!b->cc_delta && b->q_coat > 0.0f);
+    return b->q_diff > 0.0f || (!b->delta && (b->q_metal > 0.0f || b->q_spec > 0.0f)) || (!b->cc_delta && b->q_coat > 0.0f) ||
+           b->q_sheen > 0.0f;
 }
 
 /* f(wo, wi) * |cos(n, wi)| of the evaluable lobes, and their mixture pdf (solid angle) in *pdf. */

@@ -253,6 +253,9 @@ void sy_rt_material_desc_init(sy_rt_material_desc *d)
     d->alpha_mode = SY_RT_ALPHA_OPAQUE;
     d->alpha_cutoff = 0.5f;
     for (int k = 0; k < 3; ++k) d->specular_color[k] = d->attenuation_color[k] = 1.0f;
+    d->iridescence_ior = 1.3f;
+    d->iridescence_thickness[0] = 100.0f;
+    d->iridescence_thickness[1] = 400.0f;
 }
 
 static sy_rt_result validate_texref(const sy_rt_device *dev, sy_rt_texture_ref t, const char *name)
@@ -283,6 +286,11 @@ static sy_rt_result validate_material(const sy_rt_device *dev, const sy_rt_mater
         {"attenuation_color[0]", d->attenuation_color[0], 0.0f, 1.0f}, {"attenuation_color[1]", d->attenuation_color[1], 0.0f, 1.0f},
         {"attenuation_color[2]", d->attenuation_color[2], 0.0f, 1.0f}, {"clearcoat", d->clearcoat, 0.0f, 1.0f},
         {"clearcoat_roughness", d->clearcoat_roughness, 0.0f, 1.0f},
+        {"sheen_color[0]", d->sheen_color[0], 0.0f, 1.0f}, {"sheen_color[1]", d->sheen_color[1], 0.0f, 1.0f},
+        {"sheen_color[2]", d->sheen_color[2], 0.0f, 1.0f}, {"sheen_roughness", d->sheen_roughness, 0.0f, 1.0f},
+        {"iridescence", d->iridescence, 0.0f, 1.0f}, {"iridescence_ior", d->iridescence_ior, 1.0f, INFINITY},
+        {"iridescence_thickness[0]", d->iridescence_thickness[0], 0.0f, INFINITY},
+        {"iridescence_thickness[1]", d->iridescence_thickness[1], 0.0f, INFINITY},
     };
     for (size_t i = 0; i < sizeof ranges / sizeof ranges[0]; ++i)
         if (!isfinite(ranges[i].v) || ranges[i].v < ranges[i].lo || ranges[i].v > ranges[i].hi)
@@ -299,6 +307,10 @@ static sy_rt_result validate_material(const sy_rt_device *dev, const sy_rt_mater
     if ((r = validate_texref(dev, d->specular_color_texture, "specular_color_texture")) != SY_RT_OK) return r;
     if ((r = validate_texref(dev, d->clearcoat_texture, "clearcoat_texture")) != SY_RT_OK) return r;
     if ((r = validate_texref(dev, d->clearcoat_roughness_texture, "clearcoat_roughness_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->sheen_color_texture, "sheen_color_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->sheen_roughness_texture, "sheen_roughness_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->iridescence_texture, "iridescence_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->iridescence_thickness_texture, "iridescence_thickness_texture")) != SY_RT_OK) return r;
     return validate_texref(dev, d->normal_texture, "normal_texture");
 }
 
@@ -311,7 +323,9 @@ static void material_set(sy_rt_material_data *m, const sy_rt_material_desc *d)
                   d->metallic_roughness_texture.texture.id || d->emissive_texture.texture.id ||
                   d->transmission_texture.texture.id || d->specular_texture.texture.id ||
                   d->specular_color_texture.texture.id || d->clearcoat_texture.texture.id ||
-                  d->clearcoat_roughness_texture.texture.id;
+                  d->clearcoat_roughness_texture.texture.id || d->sheen_color_texture.texture.id ||
+                  d->sheen_roughness_texture.texture.id || d->iridescence_texture.texture.id ||
+                  d->iridescence_thickness_texture.texture.id;
     /* KHR_materials_volume: Beer-Lambert absorption inside a closed volume (thickness > 0) */
     m->volume = d->thickness > 0.0f && d->attenuation_distance > 0.0f && isfinite(d->attenuation_distance);
     for (int k = 0; k < 3; ++k)

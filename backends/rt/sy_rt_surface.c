@@ -152,6 +152,20 @@ void sy_rt_surface_fetch(const sy_rt_device *dev, const sy_rt_instance_data *ins
         if (sy_rt_texture_sample_ref(dev, &d->clearcoat_roughness_texture, (const float(*)[2])uv, t))
             s->clearcoat_roughness *= t[1];
     }
+    s->sheen_color = v3_load(d->sheen_color);
+    s->sheen_roughness = d->sheen_roughness;
+    if (!v3_is_zero(s->sheen_color)) {
+        if (sy_rt_texture_sample_ref(dev, &d->sheen_color_texture, (const float(*)[2])uv, t))
+            s->sheen_color = v3_mul(s->sheen_color, v3(t[0], t[1], t[2]));
+        if (sy_rt_texture_sample_ref(dev, &d->sheen_roughness_texture, (const float(*)[2])uv, t)) s->sheen_roughness *= t[3];
+    }
+    s->iridescence = d->iridescence;
+    s->iridescence_thickness = d->iridescence_thickness[1];
+    if (s->iridescence > 0.0f) {
+        if (sy_rt_texture_sample_ref(dev, &d->iridescence_texture, (const float(*)[2])uv, t)) s->iridescence *= t[0];
+        if (sy_rt_texture_sample_ref(dev, &d->iridescence_thickness_texture, (const float(*)[2])uv, t))
+            s->iridescence_thickness = d->iridescence_thickness[0] + t[1] * (d->iridescence_thickness[1] - d->iridescence_thickness[0]);
+    }
     s->emission = v3_load(d->emissive);
     const sy_rt_texture_ref *em = &d->emissive_texture;
     if (mat->emissive && sy_rt_texture_sample_ref(dev, em, (const float(*)[2])uv, t))

@@ -22,6 +22,10 @@ typedef struct sy_rt_surface {
     float specular;     /* KHR_materials_specular factor * texture A */
     sy_rt_v3 specular_color; /* its colour factor * texture RGB */
     float clearcoat, clearcoat_roughness; /* KHR_materials_clearcoat factors * textures R, G */
+    sy_rt_v3 sheen_color; /* KHR_materials_sheen colour factor * texture RGB */
+    float sheen_roughness; /* its roughness factor * texture A */
+    float iridescence;  /* KHR_materials_iridescence factor * texture R */
+    float iridescence_thickness; /* film thickness (nm) at the point */
     sy_rt_v3 emission;  /* radiance */
 } sy_rt_surface;
 

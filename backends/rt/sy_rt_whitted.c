@@ -255,7 +255,7 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
             sy_rt_v3 w = v3_scale(s->base, s->metallic);
             float fd = (1.0f - s->metallic) * (1.0f - s->transmission);
             if (fd > 0.0f) w = v3_add(w, v3_scale(schlick(dielectric_f0(md, s), cos_o), fd));
-            w = v3_scale(w, b.base_scale); /* under a coat */
+            w = v3_scale(w, b.under); /* under a coat and a sheen */
             if (v3_max_abs(w) > 1e-4f) {
                 sy_rt_v3 r = reflect(d, s->ns);
                 if (v3_dot(r, s->ng_facing) > 0.0f) L = v3_add(L, v3_mul(w, trace_secondary(c, p_out, r, depth + 1u)));
@@ -266,7 +266,7 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
             sy_rt_v3 r = reflect(d, s->ns);
             if (v3_dot(r, s->ng_facing) > 0.0f) L = v3_add(L, v3_scale(trace_secondary(c, p_out, r, depth + 1u), w));
         }
-        float wt = (1.0f - s->metallic) * s->transmission * b.base_scale;
+        float wt = (1.0f - s->metallic) * s->transmission * b.under;
         if (recurse && wt > 0.0f) {
             /* Exact dielectric Fresnel; eta = n_incident / n_transmitted. */
             float eta = s->front ? 1.0f / md->ior : md->ior;

@@ -97,6 +97,16 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     d.clearcoat_roughness = m->clearcoat_roughness;
     d.clearcoat_roughness_texture = texref(&m->clearcoat_roughness_texture);
     d.attenuation_distance = m->attenuation_distance;
+    for (int i = 0; i < 3; ++i) d.sheen_color[i] = m->sheen_color[i];
+    d.sheen_color_texture = texref(&m->sheen_color_texture);
+    d.sheen_roughness = m->sheen_roughness;
+    d.sheen_roughness_texture = texref(&m->sheen_roughness_texture);
+    d.iridescence = m->iridescence;
+    d.iridescence_texture = texref(&m->iridescence_texture);
+    d.iridescence_ior = m->iridescence_ior;
+    d.iridescence_thickness[0] = m->iridescence_thickness[0];
+    d.iridescence_thickness[1] = m->iridescence_thickness[1];
+    d.iridescence_thickness_texture = texref(&m->iridescence_thickness_texture);
     d.alpha_mode = (sy_rt_alpha_mode)m->alpha_mode;
     d.alpha_cutoff = clamp_warn(st, "material", a->id, "alpha_cutoff", m->alpha_cutoff, 0.0f, 1.0f);
     d.double_sided = m->double_sided;
