@@ -286,6 +286,9 @@ typedef struct sy_rt_material_desc {
     float iridescence_ior;          /**< the thin film's index, >= 1 (default 1.3) */
     float iridescence_thickness[2]; /**< film thickness in nm, minimum and maximum (default 100, 400) */
     sy_rt_texture_ref iridescence_thickness_texture; /**< G: minimum + G x (maximum - minimum); without it: maximum */
+    float anisotropy;               /**< KHR_materials_anisotropy strength, [0, 1] (default 0: isotropic) */
+    float anisotropy_rotation;      /**< radians, counter-clockwise from the tangent (+u) (default 0) */
+    sy_rt_texture_ref anisotropy_texture; /**< RG direction in tangent space ([-1, 1] as [0, 1]), B x strength */
 } sy_rt_material_desc;
 
 /** Fills desc with the glTF 2.0 defaults. */
@@ -583,7 +586,7 @@ sy_rt_result sy_rt_accum_read(sy_rt_device *dev, const sy_rt_accum *accum, sy_rt
  * P0's BSDF for any direction, so a filter can re-shade a neighbour's incident sample with this
  * pixel's own material, normal and wo. Ownership: caller-owned array; plain data. */
 enum { SY_RT_RECORD_P0 = 1u << 0 };
-#define SY_RT_RECORD_BSDF_FLOATS 33 /**< floats of the packed BSDF in a record */
+#define SY_RT_RECORD_BSDF_FLOATS 39 /**< floats of the packed BSDF in a record */
 /** One path record of the path tracer (see above). */
 typedef struct sy_rt_pt_record {
     /** @{ color = the sample's radiance; prefix = what the path gathered before wi (see above) */

@@ -41,16 +41,28 @@ static float ggx_lambda(float a2, float c)
     return 0.5f * (-1.0f + sqrtf(1.0f + a2 * t2));
 }
 
+/* Anisotropic GGX (local frame: t = x, b = y, n = z) and its Smith Lambda. */
+static float ggx_d_aniso(float ax, float ay, sy_rt_v3 h)
+{
+    float x = h.x / ax, y = h.y / ay, d = x * x + y * y + h.z * h.z;
+    return INV_PI / (ax * ay * d * d);
+}
+static float ggx_lambda_aniso(float ax, float ay, sy_rt_v3 w)
+{
+    float z2 = sy_rt_maxf(w.z * w.z, 1e-12f);
+    return 0.5f * (-1.0f + sqrtf(1.0f + (ax * ax * w.x * w.x + ay * ay * w.y * w.y) / z2));
+}
+
 static sy_rt_v3 to_local(const sy_rt_bsdf *b, sy_rt_v3 v) { return v3(v3_dot(v, b->t), v3_dot(v, b->b), v3_dot(v, b->n)); }
 static sy_rt_v3 to_world(const sy_rt_bsdf *b, sy_rt_v3 v)
 {
     return v3_add(v3_add(v3_scale(b->t, v.x), v3_scale(b->b, v.y)), v3_scale(b->n, v.z));
 }
 
-/* Visible-normal sample of an isotropic GGX (Heitz 2018), local frame, wo.z > 0. */
-static sy_rt_v3 sample_vndf(float a, sy_rt_v3 wo, float u1, float u2)
+/* Visible-normal sample of a GGX of alphas ax, ay (Heitz 2018), local frame, wo.z > 0. */
+static sy_rt_v3 sample_vndf(float ax, float ay, sy_rt_v3 wo, float u1, float u2)
 {
-    sy_rt_v3 vh = v3_normalize(v3(a * wo.x, a * wo.y, wo.z));
+    sy_rt_v3 vh = v3_normalize(v3(ax * wo.x, ay * wo.y, wo.z));
     float l2 = vh.x * vh.x + vh.y * vh.y;
     sy_rt_v3 t1 = l2 > 0.0f ? v3_scale(v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(l2)) : v3(1.0f, 0.0f, 0.0f);
     sy_rt_v3 t2 = v3_cross(vh, t1);
@@ -60,7 +72,7 @@ static sy_rt_v3 sample_vndf(float a, sy_rt_v3 wo, float u1, float u2)
     float s = 0.5f * (1.0f + vh.z);
     p2 = (1.0f - s) * sqrtf(sy_rt_maxf(1.0f - p1 * p1, 0.0f)) + s * p2;
     sy_rt_v3 nh = v3_add(v3_add(v3_scale(t1, p1), v3_scale(t2, p2)), v3_scale(vh, sqrtf(sy_rt_maxf(1.0f - p1 * p1 - p2 * p2, 0.0f))));
-    return v3_normalize(v3(a * nh.x, a * nh.y, sy_rt_maxf(nh.z, 1e-7f)));
+    return v3_normalize(v3(ax * nh.x, ay * nh.y, sy_rt_maxf(nh.z, 1e-7f)));
 }
 
 void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
@@ -80,6 +92,21 @@ void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
     float rough = sy_rt_clampf(s->roughness, 0.0f, 1.0f);
     b->delta = rough < SY_RT_BSDF_DELTA_ROUGHNESS;
     b->alpha = sy_rt_maxf(rough * rough, 1e-4f);
+    b->aniso = false;
+    b->ax = b->ay = b->alpha;
+    float an = sy_rt_clampf(s->anisotropy, 0.0f, 1.0f);
+    if (an > 0.0f) { /* the frame's t along the anisotropy direction (projected into the shading plane) */
+        sy_rt_v3 t = v3_normalize(v3_sub(s->aniso_dir, v3_scale(b->n, v3_dot(b->n, s->aniso_dir))));
+        float at = b->alpha + (1.0f - b->alpha) * an * an;
+        if (!v3_is_zero(t) && at > b->alpha) {
+            b->t = t;
+            b->b = v3_cross(b->n, t);
+            b->aniso = true;
+            b->ax = at;
+            b->ay = sy_rt_maxf(b->alpha, 1e-3f);
+            b->delta = false; /* stretched along t: never a mirror */
+        }
+    }
     b->ior = d->ior >= 1.0f ? d->ior : 1.5f;
     float r = (b->ior - 1.0f) / (b->ior + 1.0f);
     b->f0d = r * r;
@@ -172,10 +199,17 @@ static inline sy_rt_v3 bsdf_eval_wo(const sy_rt_bsdf *b, sy_rt_v3 wo, float nv, 
         p += b->q_sheen * nl * INV_PI;
     }
     if (bsdf_glossy(b)) {
-        float a2 = b->alpha * b->alpha, nh = sy_rt_maxf(v3_dot(b->n, h), 0.0f);
-        float D = ggx_d(a2, nh);
-        float ll = ggx_lambda(a2, nl);
-        if (lv < 0.0f) lv = ggx_lambda(a2, nv);
+        float D, ll;
+        if (b->aniso) {
+            D = ggx_d_aniso(b->ax, b->ay, to_local(b, h));
+            ll = ggx_lambda_aniso(b->ax, b->ay, to_local(b, wi));
+            lv = ggx_lambda_aniso(b->ax, b->ay, to_local(b, wo));
+        } else {
+            float a2 = b->alpha * b->alpha, nh = sy_rt_maxf(v3_dot(b->n, h), 0.0f);
+            D = ggx_d(a2, nh);
+            ll = ggx_lambda(a2, nl);
+            if (lv < 0.0f) lv = ggx_lambda(a2, nv);
+        }
         float common = D / (1.0f + lv + ll) / (4.0f * nl * nv);
         if (b->w_metal > 0.0f) f = v3_add(f, v3_scale(fresnel_metal(b, vh), b->w_metal * common));
         f = v3_add(f, v3_scale(fs, b->w_diel * common));
@@ -228,7 +262,7 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
     if (lobe == 3) {
         float ut = sy_rt_clampf((u0 - lo) / b->q_trans, 0.0f, 0.99999994f);
         float a2 = b->alpha * b->alpha;
-        sy_rt_v3 h = b->delta ? b->n : to_world(b, sample_vndf(b->alpha, wol, u[1], u[2]));
+        sy_rt_v3 h = b->delta ? b->n : to_world(b, sample_vndf(b->alpha, b->alpha, wol, u[1], u[2]));
         float ci = v3_dot(wo, h);
         if (ci <= 0.0f) return false;
         float eta = b->front ? 1.0f / b->ior : b->ior, ct;
@@ -270,10 +304,10 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
         sy_rt_sincos_2pi(u[2], &sp, &cp);
         wi = to_world(b, v3(r * cp, r * sp, sqrtf(sy_rt_maxf(1.0f - u[1], 0.0f))));
     } else if (lobe == 4) {
-        sy_rt_v3 h = to_world(b, sample_vndf(b->cc_alpha, wol, u[1], u[2]));
+        sy_rt_v3 h = to_world(b, sample_vndf(b->cc_alpha, b->cc_alpha, wol, u[1], u[2]));
         wi = v3_sub(v3_scale(h, 2.0f * v3_dot(wo, h)), wo);
     } else {
-        sy_rt_v3 h = to_world(b, sample_vndf(b->alpha, wol, u[1], u[2]));
+        sy_rt_v3 h = to_world(b, sample_vndf(b->ax, b->ay, wol, u[1], u[2]));
         wi = v3_sub(v3_scale(h, 2.0f * v3_dot(wo, h)), wo);
     }
     float pdf;
@@ -294,7 +328,8 @@ void sy_rt_bsdf_pack(const sy_rt_bsdf *b, float o[SY_RT_RECORD_BSDF_FLOATS])
                                                b->q_diff, b->f0c.x, b->f0c.y, b->f0c.z,
                                                b->cc,    b->cc_alpha, b->cc_delta ? 1.0f : 0.0f, b->q_coat,
                                                b->sheen.x, b->sheen.y, b->sheen.z, b->sheen_r, b->q_sheen,
-                                               b->irid,  b->irid_ior, b->irid_thick};
+                                               b->irid,  b->irid_ior, b->irid_thick,
+                                               b->aniso ? 1.0f : 0.0f, b->t.x, b->t.y, b->t.z, b->ax, b->ay};
     memcpy(o, v, sizeof v);
 }
 
@@ -320,6 +355,8 @@ void sy_rt_pt_record_bsdf_batch(const sy_rt_pt_record *r, uint32_t count, const 
     b.cc = p[21], b.cc_alpha = p[22], b.cc_delta = p[23] != 0.0f, b.q_coat = p[24];
     b.sheen = v3(p[25], p[26], p[27]), b.sheen_r = p[28], b.q_sheen = p[29];
     b.irid = p[30], b.irid_ior = p[31], b.irid_thick = p[32];
+    b.aniso = p[33] != 0.0f, b.t = v3(p[34], p[35], p[36]), b.ax = p[37], b.ay = p[38];
+    b.b = v3_cross(b.n, b.t);
     sy_rt_v3 wo = v3(r->wo[0], r->wo[1], r->wo[2]);
     float nv = v3_dot(b.n, wo), lv = bsdf_glossy(&b) && nv > 0.0f ? ggx_lambda(b.alpha * b.alpha, nv) : -1.0f;
     for (uint32_t m = 0; m < count; ++m) {

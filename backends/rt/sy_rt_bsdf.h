@@ -17,7 +17,12 @@
  *                  cosine-weighted;
  *   - iridescence: KHR_materials_iridescence replaces the metal's and the dielectric's Fresnel by
  *                  mix(Schlick, thin film (sy_rt_iridescence.h), iridescence) at the half vector
- *                  (the lobe choice uses Schlick: the estimate stays unbiased).
+ *                  (the lobe choice uses Schlick: the estimate stays unbiased);
+ *   - anisotropy:  KHR_materials_anisotropy turns the metal's and the dielectric's GGX lobes
+ *                  anisotropic (alpha_t = mix(alpha, 1, strength^2) along the anisotropy direction,
+ *                  alpha_b = alpha across it, as the specification and the Sample Viewer do), with
+ *                  the anisotropic Smith terms and visible-normal sampling; the transmission lobe
+ *                  stays isotropic.
  * Roughness below SY_RT_BSDF_DELTA_ROUGHNESS is a perfect mirror / smooth interface (delta lobes).
  * Lobes with a finite density ("evaluable") take part in next-event estimation and MIS; delta lobes
  * and the transmission lobe are sampled only. Sampling picks one lobe by its estimated albedo and
@@ -48,6 +53,8 @@ typedef struct sy_rt_bsdf {
     sy_rt_v3 sheen;     /* KHR_materials_sheen colour, already x the coat's base_scale (0: none) */
     float sheen_r;      /* its roughness */
     float irid, irid_ior, irid_thick; /* KHR_materials_iridescence weight (0: none), film index, nm */
+    bool aniso;         /* KHR_materials_anisotropy: t is its direction, ax/ay the GGX alphas along t/b */
+    float ax, ay;
     float q_metal, q_spec, q_diff, q_coat, q_trans, q_sheen; /* lobe selection probabilities (sum 1 or all 0) */
 } sy_rt_bsdf;
 

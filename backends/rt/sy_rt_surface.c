@@ -59,41 +59,79 @@ sy_rt_v3 sy_rt_surface_emission(const sy_rt_device *dev, const sy_rt_instance_da
     return e;
 }
 
-/* Perturbs the (front-side) shading normal n with the material's normal map. The tangent frame
- * comes from the triangle's uv derivatives (as glTF viewers do without stored tangents). */
-static sy_rt_v3 apply_normal_map(const sy_rt_device *dev, const sy_rt_instance_data *inst, const uint32_t *ix,
-                                 const float uv_set[2][2], sy_rt_v3 n)
+/* The tangent frame of a triangle at front-side normal n from the uv derivatives of texture
+ * coordinate set `set` (through the linear part of `xf`, a 2x3 uv transform, when given), as glTF
+ * viewers do without stored tangents: tg along increasing u, bt = n x tg turned so that texture
+ * "up" (+Y) points to decreasing v. False when the set is absent or degenerate here. */
+static bool uv_frame(const sy_rt_instance_data *inst, const uint32_t *ix, uint32_t set, const float *xf, sy_rt_v3 n,
+                     sy_rt_v3 *tg_out, sy_rt_v3 *bt_out)
 {
-    const sy_rt_material_desc *d = &sy_rt_material_lookup(dev, inst->material)->desc;
     const sy_rt_mesh_data *m = inst->mesh;
-    uint32_t s = d->normal_texture.texcoord;
-    if (!m->uv[s]) return n;
-    float t[4];
-    if (!sy_rt_texture_sample_ref(dev, &d->normal_texture, uv_set, t)) return n;
-    const float *uv = m->uv[s];
+    if (!m->uv[set]) return false;
+    const float *uv = m->uv[set];
     sy_rt_v3 p0 = v3_load(m->positions + 3u * ix[0]);
     sy_rt_v3 dp1 = v3_sub(v3_load(m->positions + 3u * ix[1]), p0), dp2 = v3_sub(v3_load(m->positions + 3u * ix[2]), p0);
     float du1 = uv[2 * ix[1]] - uv[2 * ix[0]], dv1 = uv[2 * ix[1] + 1] - uv[2 * ix[0] + 1];
     float du2 = uv[2 * ix[2]] - uv[2 * ix[0]], dv2 = uv[2 * ix[2] + 1] - uv[2 * ix[0] + 1];
-    if (d->normal_texture.transformed) { /* derivatives of the transformed coordinates (linear part) */
-        const float *x = d->normal_texture.transform;
+    if (xf) { /* derivatives of the transformed coordinates (linear part) */
+        const float *x = xf;
         float a1 = x[0] * du1 + x[1] * dv1, b1 = x[3] * du1 + x[4] * dv1;
         float a2 = x[0] * du2 + x[1] * dv2, b2 = x[3] * du2 + x[4] * dv2;
         du1 = a1, dv1 = b1, du2 = a2, dv2 = b2;
     }
     float det = du1 * dv2 - du2 * dv1;
-    if (!(fabsf(det) > 1e-20f)) return n;
+    if (!(fabsf(det) > 1e-20f)) return false;
     float inv = 1.0f / det;
     sy_rt_v3 dpdu = m4_dir(inst->xf, v3_scale(v3_sub(v3_scale(dp1, dv2), v3_scale(dp2, dv1)), inv));
     sy_rt_v3 dpdv = m4_dir(inst->xf, v3_scale(v3_sub(v3_scale(dp2, du1), v3_scale(dp1, du2)), inv));
     sy_rt_v3 tg = v3_normalize(v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu))));
-    if (v3_is_zero(tg)) return n;
+    if (v3_is_zero(tg)) return false;
     sy_rt_v3 bt = v3_cross(n, tg);
     /* Texture "up" (+Y) points to decreasing v in glTF; flip for mirrored uv layouts. */
     if (v3_dot(bt, dpdv) > 0.0f) bt = v3_scale(bt, -1.0f);
+    *tg_out = tg, *bt_out = bt;
+    return true;
+}
+
+/* Perturbs the (front-side) shading normal n with the material's normal map. */
+static sy_rt_v3 apply_normal_map(const sy_rt_device *dev, const sy_rt_instance_data *inst, const uint32_t *ix,
+                                 const float uv_set[2][2], sy_rt_v3 n)
+{
+    const sy_rt_material_desc *d = &sy_rt_material_lookup(dev, inst->material)->desc;
+    if (!inst->mesh->uv[d->normal_texture.texcoord]) return n;
+    float t[4];
+    if (!sy_rt_texture_sample_ref(dev, &d->normal_texture, uv_set, t)) return n;
+    sy_rt_v3 tg, bt;
+    if (!uv_frame(inst, ix, d->normal_texture.texcoord, d->normal_texture.transformed ? d->normal_texture.transform : NULL, n,
+                  &tg, &bt))
+        return n;
     float x = (t[0] * 2.0f - 1.0f) * d->normal_scale, y = (t[1] * 2.0f - 1.0f) * d->normal_scale, z = t[2] * 2.0f - 1.0f;
     sy_rt_v3 r = v3_normalize(v3_add(v3_add(v3_scale(tg, x), v3_scale(bt, y)), v3_scale(n, z)));
     return v3_is_zero(r) ? n : r;
+}
+
+/* KHR_materials_anisotropy: the strength and world direction at the point (front-side normal n):
+ * the texture's RG direction (else +X of tangent space) rotated counter-clockwise by the rotation,
+ * in the tangent frame of the anisotropy texture's coordinate set (else set 0; no frame there: no
+ * anisotropy). */
+static float anisotropy_at(const sy_rt_device *dev, const sy_rt_instance_data *inst, const uint32_t *ix,
+                           const float uv_set[2][2], sy_rt_v3 n, sy_rt_v3 *dir)
+{
+    const sy_rt_material_desc *d = &sy_rt_material_lookup(dev, inst->material)->desc;
+    float dx = 1.0f, dy = 0.0f, strength = d->anisotropy, t[4];
+    if (sy_rt_texture_sample_ref(dev, &d->anisotropy_texture, uv_set, t)) {
+        dx = t[0] * 2.0f - 1.0f, dy = t[1] * 2.0f - 1.0f;
+        strength *= t[2];
+    }
+    float c = cosf(d->anisotropy_rotation), sn = sinf(d->anisotropy_rotation);
+    float rx = c * dx - sn * dy, ry = sn * dx + c * dy;
+    sy_rt_v3 tg, bt;
+    uint32_t set = d->anisotropy_texture.texture.id ? d->anisotropy_texture.texcoord : 0u;
+    if (!(strength > 0.0f) || !uv_frame(inst, ix, set, NULL, n, &tg, &bt)) return 0.0f;
+    sy_rt_v3 w = v3_normalize(v3_add(v3_scale(tg, rx), v3_scale(bt, ry)));
+    if (v3_is_zero(w)) return 0.0f;
+    *dir = w;
+    return sy_rt_clampf(strength, 0.0f, 1.0f);
 }
 
 void sy_rt_surface_fetch(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u, float v,
@@ -127,6 +165,8 @@ void sy_rt_surface_fetch(const sy_rt_device *dev, const sy_rt_instance_data *ins
     if (d->normal_texture.texture.id != 0) n = apply_normal_map(dev, inst, ix, (const float(*)[2])uv, n);
     /* Shade the side the ray sees (double-sided, or interiors seen through openings). */
     s->ns = s->front ? n : v3_scale(n, -1.0f);
+    s->anisotropy = 0.0f;
+    if (d->anisotropy > 0.0f) s->anisotropy = anisotropy_at(dev, inst, ix, (const float(*)[2])uv, n, &s->aniso_dir);
 
     s->alpha = base_alpha(dev, mat, m, ix, w0, w1, w2, uv, &s->base);
     s->metallic = d->metallic;

@@ -26,6 +26,8 @@ typedef struct sy_rt_surface {
     float sheen_roughness; /* its roughness factor * texture A */
     float iridescence;  /* KHR_materials_iridescence factor * texture R */
     float iridescence_thickness; /* film thickness (nm) at the point */
+    float anisotropy;   /* KHR_materials_anisotropy strength * texture B (0: isotropic) */
+    sy_rt_v3 aniso_dir; /* its world direction (roughness stretched along it), with anisotropy > 0 */
     sy_rt_v3 emission;  /* radiance */
 } sy_rt_surface;
 

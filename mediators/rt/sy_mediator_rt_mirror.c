@@ -107,6 +107,9 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     d.iridescence_thickness[0] = m->iridescence_thickness[0];
     d.iridescence_thickness[1] = m->iridescence_thickness[1];
     d.iridescence_thickness_texture = texref(&m->iridescence_thickness_texture);
+    d.anisotropy = m->anisotropy;
+    d.anisotropy_rotation = m->anisotropy_rotation;
+    d.anisotropy_texture = texref(&m->anisotropy_texture);
     d.alpha_mode = (sy_rt_alpha_mode)m->alpha_mode;
     d.alpha_cutoff = clamp_warn(st, "material", a->id, "alpha_cutoff", m->alpha_cutoff, 0.0f, 1.0f);
     d.double_sided = m->double_sided;

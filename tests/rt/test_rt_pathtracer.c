@@ -22,7 +22,8 @@
  * Material layers (test_sheen, test_iridescence): KHR_materials_sheen's albedo scaling keeps a white
  * sheen over white Lambert in the furnace at L (without it the sum would reach 1.5 L); a white sheen
  * over a black base lights the rim several times more than the centre, in both tracers alike;
- * KHR_materials_iridescence colours a dielectric's grey reflection of a white furnace.
+ * KHR_materials_iridescence colours a dielectric's grey reflection of a white furnace;
+ * KHR_materials_anisotropy stretches a highlight along the tangent, or across it when rotated.
  * Determinism and tiling: same seed = bit-identical; 4 calls of 1 sample = 1 call of 4; the four
  * quadrants rendered separately stitch bit-identically; another seed differs.
  * Bad input: degenerate triangles and a zero-area emitter give no non-finite value and no
@@ -319,6 +320,50 @@ static void test_iridescence(void)
             printf("iridescence %s (%s): mean %.4f %.4f %.4f\n", on ? "on" : "off", name, m[0], m[1], m[2]);
             if (on) EXPECT_MSG(hi > 1.2 * lo && hi < 1.0, "%s: iridescent mean %.4f %.4f %.4f", name, m[0], m[1], m[2]);
             else EXPECT_MSG(hi < 1.02 * lo && lo > 0.0, "%s: plain mean %.4f %.4f %.4f", name, m[0], m[1], m[2]);
+            img_free(&im);
+        }
+        sy_rt_device_destroy(dev);
+    }
+}
+
+/* KHR_materials_anisotropy: a white GGX metal quad (roughness 0.3, uv u along +X) facing a camera
+ * at distance 3 with a point light beside the camera. The highlight's luminance-weighted second
+ * moments about the image centre: isotropic, X and Y within 15 % of each other; strength 0.8 stretches
+ * it along the tangent (+u = X: X/Y above 2); rotated by pi/2 along Y (X/Y below 0.5). Both tracers. */
+static void test_anisotropy(void)
+{
+    const float setups[3][2] = {{0.0f, 0.0f}, {0.8f, 0.0f}, {0.8f, 1.5707963f}};
+    for (int k = 0; k < 3; ++k) {
+        sy_rt_device *dev = rt_device();
+        sy_rt_material_desc d;
+        sy_rt_material_desc_init(&d);
+        d.roughness = 0.3f;
+        d.anisotropy = setups[k][0], d.anisotropy_rotation = setups[k][1];
+        sy_rt_material mat;
+        MUST(sy_rt_material_create(dev, &d, &mat));
+        float id[16];
+        rt_identity(id);
+        rt_place(dev, rt_quad(dev, 3.0f), id, mat, 0);
+        sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10.0f, .position = {0.0f, 0.0f, 3.0f}};
+        sy_rt_light light;
+        MUST(sy_rt_light_create(dev, &ld, &light));
+        MUST(sy_rt_commit(dev));
+        sy_rt_camera cam = rt_camera(3.0f, 0.8f);
+        for (int whitted = 0; whitted < 2; ++whitted) {
+            img im = render48(dev, &cam, whitted);
+            double sxx = 0.0, syy = 0.0;
+            for (uint32_t y = 0; y < 48; ++y)
+                for (uint32_t x = 0; x < 48; ++x) {
+                    const float *p = im.rgba + 4 * (y * 48 + x);
+                    double l = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2], dx = x - 23.5, dy = y - 23.5;
+                    sxx += l * dx * dx, syy += l * dy * dy;
+                }
+            double r = sxx / fmax(syy, 1e-12);
+            const char *name = whitted ? "whitted" : "pathtracer";
+            printf("anisotropy %.1f rotation %.2f (%s): highlight X/Y spread %.3f\n", (double)setups[k][0], (double)setups[k][1], name, r);
+            if (k == 0) EXPECT_MSG(r > 0.85 && r < 1.15, "%s: isotropic highlight X/Y %.3f", name, r);
+            else if (k == 1) EXPECT_MSG(r > 2.0, "%s: anisotropic highlight X/Y %.3f, expected stretched along X", name, r);
+            else EXPECT_MSG(r < 0.5, "%s: rotated anisotropic highlight X/Y %.3f, expected stretched along Y", name, r);
             img_free(&im);
         }
         sy_rt_device_destroy(dev);
@@ -644,6 +689,7 @@ int main(void)
     test_absorbing_glass();
     test_sheen();
     test_iridescence();
+    test_anisotropy();
     test_integrating_sphere();
     test_env_importance();
     test_area_light_grazing();
