@@ -277,6 +277,8 @@ typedef struct sy_rt_material_desc {
     sy_rt_texture_ref clearcoat_texture; /**< R x clearcoat */
     float clearcoat_roughness;      /**< [0, 1] (default 0) */
     sy_rt_texture_ref clearcoat_roughness_texture; /**< G x clearcoat_roughness */
+    sy_rt_texture_ref clearcoat_normal_texture; /**< the coat's normal map (else the coat follows the vertex normal) */
+    float clearcoat_normal_scale;   /**< its scale (default 1) */
     float sheen_color[3];           /**< KHR_materials_sheen colour, [0, 1] (default 0: no sheen) */
     sy_rt_texture_ref sheen_color_texture; /**< RGB (sRGB) x sheen_color */
     float sheen_roughness;          /**< [0, 1] (default 0; evaluated at 0.07 at least) */
@@ -586,7 +588,7 @@ sy_rt_result sy_rt_accum_read(sy_rt_device *dev, const sy_rt_accum *accum, sy_rt
  * P0's BSDF for any direction, so a filter can re-shade a neighbour's incident sample with this
  * pixel's own material, normal and wo. Ownership: caller-owned array; plain data. */
 enum { SY_RT_RECORD_P0 = 1u << 0 };
-#define SY_RT_RECORD_BSDF_FLOATS 39 /**< floats of the packed BSDF in a record */
+#define SY_RT_RECORD_BSDF_FLOATS 43 /**< floats of the packed BSDF in a record */
 /** One path record of the path tracer (see above). */
 typedef struct sy_rt_pt_record {
     /** @{ color = the sample's radiance; prefix = what the path gathered before wi (see above) */

@@ -75,17 +75,22 @@ static sy_rt_v3 sample_vndf(float ax, float ay, sy_rt_v3 wo, float u1, float u2)
     return v3_normalize(v3(ax * nh.x, ay * nh.y, sy_rt_maxf(nh.z, 1e-7f)));
 }
 
+/* An orthonormal basis t, b about n (Duff et al. 2017). */
+static void frame(sy_rt_bsdf *b)
+{
+    sy_rt_v3 n = b->n;
+    float sign = copysignf(1.0f, n.z), a = -1.0f / (sign + n.z), bb = n.x * n.y * a;
+    b->t = v3(1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
+    b->b = v3(bb, sign + n.y * n.y * a, -n.y);
+}
+
 void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
 {
     const sy_rt_material_desc *d = &s->mat->desc;
     b->ng = s->ng_facing;
     b->n = s->ns;
     if (v3_dot(b->n, wo) <= 1e-6f) b->n = s->ng_facing; /* shading normal facing away from the viewer */
-    /* orthonormal basis (Duff et al. 2017) */
-    sy_rt_v3 n = b->n;
-    float sign = copysignf(1.0f, n.z), a = -1.0f / (sign + n.z), bb = n.x * n.y * a;
-    b->t = v3(1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
-    b->b = v3(bb, sign + n.y * n.y * a, -n.y);
+    frame(b);
     b->base = v3(sy_rt_clampf(s->base.x, 0.0f, 1.0f), sy_rt_clampf(s->base.y, 0.0f, 1.0f), sy_rt_clampf(s->base.z, 0.0f, 1.0f));
     b->front = s->front;
     float metallic = sy_rt_clampf(s->metallic, 0.0f, 1.0f), trans = sy_rt_clampf(s->transmission, 0.0f, 1.0f);
@@ -118,7 +123,14 @@ void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
     float ccr = sy_rt_clampf(s->clearcoat_roughness, 0.0f, 1.0f);
     b->cc_delta = ccr < SY_RT_BSDF_DELTA_ROUGHNESS;
     b->cc_alpha = sy_rt_maxf(ccr * ccr, 1e-4f);
-    float fc = b->cc > 0.0f ? b->cc * schlick3(v3(0.04f, 0.04f, 0.04f), nv).x : 0.0f;
+    b->cc_n = false;
+    b->ncc = b->n;
+    if (b->cc > 0.0f && s->coat_normal) {
+        sy_rt_v3 nc = v3_dot(s->ns_coat, wo) > 1e-6f ? s->ns_coat : s->ng_facing;
+        if (nc.x != b->n.x || nc.y != b->n.y || nc.z != b->n.z) b->cc_n = true, b->ncc = nc;
+    }
+    float nvc = b->cc_n ? v3_dot(b->ncc, wo) : nv;
+    float fc = b->cc > 0.0f ? b->cc * schlick3(v3(0.04f, 0.04f, 0.04f), nvc).x : 0.0f;
     b->base_scale = 1.0f - fc;
     sy_rt_v3 sc = v3(sy_rt_clampf(s->sheen_color.x, 0.0f, 1.0f), sy_rt_clampf(s->sheen_color.y, 0.0f, 1.0f),
                      sy_rt_clampf(s->sheen_color.z, 0.0f, 1.0f));
@@ -215,13 +227,15 @@ static inline sy_rt_v3 bsdf_eval_wo(const sy_rt_bsdf *b, sy_rt_v3 wo, float nv, 
         f = v3_add(f, v3_scale(fs, b->w_diel * common));
         p += (b->q_metal + b->q_spec) * D / (1.0f + lv) / (4.0f * nv);
     }
-    if (coat_glossy(b)) {
-        float a2 = b->cc_alpha * b->cc_alpha, nh = sy_rt_maxf(v3_dot(b->n, h), 0.0f);
-        float D = ggx_d(a2, nh), lc = ggx_lambda(a2, nv), ll = ggx_lambda(a2, nl);
+    float nvc = b->cc_n ? v3_dot(b->ncc, wo) : nv, nlc = b->cc_n ? v3_dot(b->ncc, wi) : nl;
+    if (coat_glossy(b) && nvc > 0.0f && nlc > 0.0f) {
+        float a2 = b->cc_alpha * b->cc_alpha, nh = sy_rt_maxf(v3_dot(b->ncc, h), 0.0f);
+        float D = ggx_d(a2, nh), lc = ggx_lambda(a2, nvc), ll = ggx_lambda(a2, nlc);
         float F = schlick3(v3(0.04f, 0.04f, 0.04f), vh).x;
-        float fc = b->cc * F * D / (1.0f + lc + ll) / (4.0f * nl * nv);
+        float fc = b->cc * F * D / (1.0f + lc + ll) / (4.0f * nlc * nvc);
+        if (b->cc_n) fc *= nlc / nl; /* its own cosine (the sum is multiplied by n . wi below) */
         f = v3_add(f, v3(fc, fc, fc));
-        p += b->q_coat * D / (1.0f + lc) / (4.0f * nv);
+        p += b->q_coat * D / (1.0f + lc) / (4.0f * nvc);
     }
     *pdf = p;
     return v3_scale(f, nl);
@@ -250,12 +264,14 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
     else if (u0 < b->q_metal + b->q_spec + b->q_diff + b->q_coat + b->q_sheen) lobe = 5, lo = 0.0f;
     else if (b->q_trans > 0.0f) lobe = 3, lo = 1.0f - b->q_trans;
     else return false;
+    float nvc = b->cc_n ? v3_dot(b->ncc, wo) : nv;
     if (lobe == 4 && b->cc_delta) { /* a smooth coat: its mirror direction */
-        sy_rt_v3 wi = v3_sub(v3_scale(b->n, 2.0f * nv), wo);
+        if (nvc <= 0.0f) return false;
+        sy_rt_v3 wi = v3_sub(v3_scale(b->ncc, 2.0f * nvc), wo);
         if (v3_dot(b->ng, wi) <= 0.0f) return false;
         out->wi = wi;
         out->specular = true;
-        float F = b->cc * schlick3(v3(0.04f, 0.04f, 0.04f), nv).x / b->q_coat;
+        float F = b->cc * schlick3(v3(0.04f, 0.04f, 0.04f), nvc).x / b->q_coat;
         out->weight = v3(F, F, F);
         return true;
     }
@@ -303,6 +319,13 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
         float r = sqrtf(u[1]), sp, cp;
         sy_rt_sincos_2pi(u[2], &sp, &cp);
         wi = to_world(b, v3(r * cp, r * sp, sqrtf(sy_rt_maxf(1.0f - u[1], 0.0f))));
+    } else if (lobe == 4 && b->cc_n) { /* about the coat's own normal, in a frame of its own */
+        if (nvc <= 0.0f) return false;
+        sy_rt_bsdf c = *b;
+        c.n = b->ncc;
+        frame(&c);
+        sy_rt_v3 h = to_world(&c, sample_vndf(b->cc_alpha, b->cc_alpha, to_local(&c, wo), u[1], u[2]));
+        wi = v3_sub(v3_scale(h, 2.0f * v3_dot(wo, h)), wo);
     } else if (lobe == 4) {
         sy_rt_v3 h = to_world(b, sample_vndf(b->cc_alpha, b->cc_alpha, wol, u[1], u[2]));
         wi = v3_sub(v3_scale(h, 2.0f * v3_dot(wo, h)), wo);
@@ -329,7 +352,8 @@ void sy_rt_bsdf_pack(const sy_rt_bsdf *b, float o[SY_RT_RECORD_BSDF_FLOATS])
                                                b->cc,    b->cc_alpha, b->cc_delta ? 1.0f : 0.0f, b->q_coat,
                                                b->sheen.x, b->sheen.y, b->sheen.z, b->sheen_r, b->q_sheen,
                                                b->irid,  b->irid_ior, b->irid_thick,
-                                               b->aniso ? 1.0f : 0.0f, b->t.x, b->t.y, b->t.z, b->ax, b->ay};
+                                               b->aniso ? 1.0f : 0.0f, b->t.x, b->t.y, b->t.z, b->ax, b->ay,
+                                               b->cc_n ? 1.0f : 0.0f, b->ncc.x, b->ncc.y, b->ncc.z};
     memcpy(o, v, sizeof v);
 }
 
@@ -357,6 +381,7 @@ void sy_rt_pt_record_bsdf_batch(const sy_rt_pt_record *r, uint32_t count, const 
     b.irid = p[30], b.irid_ior = p[31], b.irid_thick = p[32];
     b.aniso = p[33] != 0.0f, b.t = v3(p[34], p[35], p[36]), b.ax = p[37], b.ay = p[38];
     b.b = v3_cross(b.n, b.t);
+    b.cc_n = p[39] != 0.0f, b.ncc = v3(p[40], p[41], p[42]);
     sy_rt_v3 wo = v3(r->wo[0], r->wo[1], r->wo[2]);
     float nv = v3_dot(b.n, wo), lv = bsdf_glossy(&b) && nv > 0.0f ? ggx_lambda(b.alpha * b.alpha, nv) : -1.0f;
     for (uint32_t m = 0; m < count; ++m) {

@@ -10,7 +10,9 @@
  *                  microfacet (tinted by the base colour), weight (1 - metallic) transmission;
  *   - clearcoat:   KHR_materials_clearcoat's coat on top of all of them: a GGX lobe with F0 0.04
  *                  and its own roughness, weight clearcoat; the base below is scaled by
- *                  1 - clearcoat x Fresnel(n . wo), the specification's albedo scaling;
+ *                  1 - clearcoat x Fresnel(n . wo), the specification's albedo scaling; the coat
+ *                  follows its own normal (the vertex normal with the coat's normal map, not the
+ *                  base's), where wi is above both;
  *   - sheen:       KHR_materials_sheen's Charlie lobe (sy_rt_sheen.h) between the coat and the base,
  *                  colour sheen colour; the base below is scaled by 1 - max(sheen colour) x
  *                  E_sheen(n . wo) (the specification's albedo scaling, E clamped to 1); sampled
@@ -48,6 +50,8 @@ typedef struct sy_rt_bsdf {
     float w_metal, w_diel, w_trans; /* the base's lobes, already x base_scale */
     float cc, cc_alpha; /* KHR_materials_clearcoat: weight and GGX alpha of the coat (F0 0.04) */
     bool cc_delta;      /* the coat is a smooth mirror */
+    bool cc_n;          /* the coat has its own shading normal ncc (else ncc = n) */
+    sy_rt_v3 ncc;       /* the coat's shading normal (vertex normal + the coat's normal map) */
     float base_scale;   /* 1 - cc x Fresnel_coat(n . wo): what the coat lets through to the base */
     float under;        /* base_scale x the sheen's 1 - max(sheen) x E: what reaches the base lobes */
     sy_rt_v3 sheen;     /* KHR_materials_sheen colour, already x the coat's base_scale (0: none) */

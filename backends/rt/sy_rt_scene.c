@@ -254,6 +254,7 @@ void sy_rt_material_desc_init(sy_rt_material_desc *d)
     d->alpha_cutoff = 0.5f;
     for (int k = 0; k < 3; ++k) d->specular_color[k] = d->attenuation_color[k] = 1.0f;
     d->iridescence_ior = 1.3f;
+    d->clearcoat_normal_scale = 1.0f;
     d->iridescence_thickness[0] = 100.0f;
     d->iridescence_thickness[1] = 400.0f;
 }
@@ -291,7 +292,7 @@ static sy_rt_result validate_material(const sy_rt_device *dev, const sy_rt_mater
         {"iridescence", d->iridescence, 0.0f, 1.0f}, {"iridescence_ior", d->iridescence_ior, 1.0f, INFINITY},
         {"iridescence_thickness[0]", d->iridescence_thickness[0], 0.0f, INFINITY},
         {"iridescence_thickness[1]", d->iridescence_thickness[1], 0.0f, INFINITY},
-        {"anisotropy", d->anisotropy, 0.0f, 1.0f}, {"anisotropy_rotation", d->anisotropy_rotation, -1.0e6f, 1.0e6f},
+        {"clearcoat_normal_scale", d->clearcoat_normal_scale, -INFINITY, INFINITY}, {"anisotropy", d->anisotropy, 0.0f, 1.0f}, {"anisotropy_rotation", d->anisotropy_rotation, -1.0e6f, 1.0e6f},
     };
     for (size_t i = 0; i < sizeof ranges / sizeof ranges[0]; ++i)
         if (!isfinite(ranges[i].v) || ranges[i].v < ranges[i].lo || ranges[i].v > ranges[i].hi)
@@ -313,6 +314,7 @@ static sy_rt_result validate_material(const sy_rt_device *dev, const sy_rt_mater
     if ((r = validate_texref(dev, d->iridescence_texture, "iridescence_texture")) != SY_RT_OK) return r;
     if ((r = validate_texref(dev, d->iridescence_thickness_texture, "iridescence_thickness_texture")) != SY_RT_OK) return r;
     if ((r = validate_texref(dev, d->anisotropy_texture, "anisotropy_texture")) != SY_RT_OK) return r;
+    if ((r = validate_texref(dev, d->clearcoat_normal_texture, "clearcoat_normal_texture")) != SY_RT_OK) return r;
     return validate_texref(dev, d->normal_texture, "normal_texture");
 }
 
@@ -327,7 +329,8 @@ static void material_set(sy_rt_material_data *m, const sy_rt_material_desc *d)
                   d->specular_color_texture.texture.id || d->clearcoat_texture.texture.id ||
                   d->clearcoat_roughness_texture.texture.id || d->sheen_color_texture.texture.id ||
                   d->sheen_roughness_texture.texture.id || d->iridescence_texture.texture.id ||
-                  d->iridescence_thickness_texture.texture.id || d->anisotropy_texture.texture.id;
+                  d->iridescence_thickness_texture.texture.id || d->anisotropy_texture.texture.id ||
+                  d->clearcoat_normal_texture.texture.id;
     /* KHR_materials_volume: Beer-Lambert absorption inside a closed volume (thickness > 0) */
     m->volume = d->thickness > 0.0f && d->attenuation_distance > 0.0f && isfinite(d->attenuation_distance);
     for (int k = 0; k < 3; ++k)

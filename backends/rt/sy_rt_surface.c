@@ -93,19 +93,17 @@ static bool uv_frame(const sy_rt_instance_data *inst, const uint32_t *ix, uint32
     return true;
 }
 
-/* Perturbs the (front-side) shading normal n with the material's normal map. */
+/* Perturbs the (front-side) shading normal n with normal map `ref` of scale `scale` (the
+ * material's, or its clear coat's). */
 static sy_rt_v3 apply_normal_map(const sy_rt_device *dev, const sy_rt_instance_data *inst, const uint32_t *ix,
-                                 const float uv_set[2][2], sy_rt_v3 n)
+                                 const float uv_set[2][2], sy_rt_v3 n, const sy_rt_texture_ref *ref, float scale)
 {
-    const sy_rt_material_desc *d = &sy_rt_material_lookup(dev, inst->material)->desc;
-    if (!inst->mesh->uv[d->normal_texture.texcoord]) return n;
+    if (!inst->mesh->uv[ref->texcoord]) return n;
     float t[4];
-    if (!sy_rt_texture_sample_ref(dev, &d->normal_texture, uv_set, t)) return n;
+    if (!sy_rt_texture_sample_ref(dev, ref, uv_set, t)) return n;
     sy_rt_v3 tg, bt;
-    if (!uv_frame(inst, ix, d->normal_texture.texcoord, d->normal_texture.transformed ? d->normal_texture.transform : NULL, n,
-                  &tg, &bt))
-        return n;
-    float x = (t[0] * 2.0f - 1.0f) * d->normal_scale, y = (t[1] * 2.0f - 1.0f) * d->normal_scale, z = t[2] * 2.0f - 1.0f;
+    if (!uv_frame(inst, ix, ref->texcoord, ref->transformed ? ref->transform : NULL, n, &tg, &bt)) return n;
+    float x = (t[0] * 2.0f - 1.0f) * scale, y = (t[1] * 2.0f - 1.0f) * scale, z = t[2] * 2.0f - 1.0f;
     sy_rt_v3 r = v3_normalize(v3_add(v3_add(v3_scale(tg, x), v3_scale(bt, y)), v3_scale(n, z)));
     return v3_is_zero(r) ? n : r;
 }
@@ -162,9 +160,24 @@ void sy_rt_surface_fetch(const sy_rt_device *dev, const sy_rt_instance_data *ins
     }
     float uv[2][2] = {{0.0f, 0.0f}, {0.0f, 0.0f}};
     if (mat->textured) fetch_uv(m, ix, w0, w1, w2, uv);
-    if (d->normal_texture.texture.id != 0) n = apply_normal_map(dev, inst, ix, (const float(*)[2])uv, n);
+    sy_rt_v3 n_vertex = n;
+    if (d->normal_texture.texture.id != 0)
+        n = apply_normal_map(dev, inst, ix, (const float(*)[2])uv, n, &d->normal_texture, d->normal_scale);
     /* Shade the side the ray sees (double-sided, or interiors seen through openings). */
     s->ns = s->front ? n : v3_scale(n, -1.0f);
+    /* KHR_materials_clearcoat: the coat's normal is the vertex normal with the coat's own normal map
+     * (never the base's) */
+    s->ns_coat = s->ns;
+    s->coat_normal = false;
+    if (d->clearcoat > 0.0f) {
+        sy_rt_v3 nc = n_vertex;
+        if (d->clearcoat_normal_texture.texture.id != 0)
+            nc = apply_normal_map(dev, inst, ix, (const float(*)[2])uv, nc, &d->clearcoat_normal_texture, d->clearcoat_normal_scale);
+        if (nc.x != n.x || nc.y != n.y || nc.z != n.z) {
+            s->ns_coat = s->front ? nc : v3_scale(nc, -1.0f);
+            s->coat_normal = true;
+        }
+    }
     s->anisotropy = 0.0f;
     if (d->anisotropy > 0.0f) s->anisotropy = anisotropy_at(dev, inst, ix, (const float(*)[2])uv, n, &s->aniso_dir);
 
@@ -273,7 +286,8 @@ sy_rt_v3 sy_rt_surface_eyelight(const sy_rt_device *dev, const sy_rt_instance_da
         sy_rt_v3 ns = v3_normalize(m3_mul(inst->nrm, v3_load(nn)));
         if (!v3_is_zero(ns)) n = ns;
     }
-    if (d->normal_texture.texture.id != 0) n = apply_normal_map(dev, inst, ix, (const float(*)[2])uv, n);
+    if (d->normal_texture.texture.id != 0)
+        n = apply_normal_map(dev, inst, ix, (const float(*)[2])uv, n, &d->normal_texture, d->normal_scale);
     sy_rt_v3 ns = front ? n : v3_scale(n, -1.0f);
     return v3_scale(base, fabsf(v3_dot(ns, v3_normalize(dir))));
 }

@@ -14,6 +14,8 @@ typedef struct sy_rt_surface {
     sy_rt_v3 ng;        /* unit geometric normal on the front side (glTF winding) */
     sy_rt_v3 ns;        /* unit shading normal, turned to the side the ray came from */
     sy_rt_v3 ng_facing; /* ng turned to the side the ray came from */
+    sy_rt_v3 ns_coat;   /* the clear coat's shading normal on that side (vertex normal + coat normal map) */
+    bool coat_normal;   /* ns_coat differs from ns */
     bool front;         /* the ray hit the front side */
     sy_rt_v3 base;      /* base colour factor * texture * vertex colour (linear RGB) */
     float alpha;

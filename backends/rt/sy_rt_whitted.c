@@ -262,8 +262,9 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
             }
         }
         if (recurse && b.cc > 0.0f && b.cc_delta) { /* a smooth clearcoat: its mirror ray (F0 0.04) */
-            float w = b.cc * schlick(v3(0.04f, 0.04f, 0.04f), cos_o).x;
-            sy_rt_v3 r = reflect(d, s->ns);
+            sy_rt_v3 nc = b.cc_n ? b.ncc : s->ns; /* the coat's own normal */
+            float w = b.cc * schlick(v3(0.04f, 0.04f, 0.04f), b.cc_n ? fmaxf(v3_dot(nc, wo), 0.0f) : cos_o).x;
+            sy_rt_v3 r = reflect(d, nc);
             if (v3_dot(r, s->ng_facing) > 0.0f) L = v3_add(L, v3_scale(trace_secondary(c, p_out, r, depth + 1u), w));
         }
         float wt = (1.0f - s->metallic) * s->transmission * b.under;

@@ -96,6 +96,8 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     d.clearcoat_texture = texref(&m->clearcoat_texture);
     d.clearcoat_roughness = m->clearcoat_roughness;
     d.clearcoat_roughness_texture = texref(&m->clearcoat_roughness_texture);
+    d.clearcoat_normal_texture = texref(&m->clearcoat_normal_texture);
+    d.clearcoat_normal_scale = m->clearcoat_normal_scale;
     d.attenuation_distance = m->attenuation_distance;
     for (int i = 0; i < 3; ++i) d.sheen_color[i] = m->sheen_color[i];
     d.sheen_color_texture = texref(&m->sheen_color_texture);

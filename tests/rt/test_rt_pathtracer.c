@@ -23,7 +23,8 @@
  * sheen over white Lambert in the furnace at L (without it the sum would reach 1.5 L); a white sheen
  * over a black base lights the rim several times more than the centre, in both tracers alike;
  * KHR_materials_iridescence colours a dielectric's grey reflection of a white furnace;
- * KHR_materials_anisotropy stretches a highlight along the tangent, or across it when rotated.
+ * KHR_materials_anisotropy stretches a highlight along the tangent, or across it when rotated; the
+ * clear coat's highlight follows the coat's own normal map and ignores the base's.
  * Determinism and tiling: same seed = bit-identical; 4 calls of 1 sample = 1 call of 4; the four
  * quadrants rendered separately stitch bit-identically; another seed differs.
  * Bad input: degenerate triangles and a zero-area emitter give no non-finite value and no
@@ -370,6 +371,58 @@ static void test_anisotropy(void)
     }
 }
 
+/* KHR_materials_clearcoat's normal: a coat (roughness 0.2) over a black base (base colour 0,
+ * specular 0) on the quad of test_anisotropy, point light by the camera. The coat's highlight sits
+ * at the image centre (luminance-weighted centroid within 1 px) without normal maps, and also with a
+ * base normal map tilted 10 degrees toward +X (the coat follows the vertex normal, not the base's
+ * map); the same tilt as the coat's own normal map moves it about 3 tan(10 deg) = 0.53 units toward
+ * -X, 5.3 px at this camera (centroid at least 3 px left). Both tracers. */
+static void test_clearcoat_normal(void)
+{
+    const float sn = sinf(10.0f * PI_F / 180.0f), cs = cosf(10.0f * PI_F / 180.0f);
+    const uint8_t texel[3] = {(uint8_t)lrintf((0.5f + 0.5f * sn) * 255.0f), 128, (uint8_t)lrintf((0.5f + 0.5f * cs) * 255.0f)};
+    for (int k = 0; k < 3; ++k) { /* 0 no maps, 1 base map, 2 coat map */
+        sy_rt_device *dev = rt_device();
+        sy_rt_texture_desc td = {.width = 1, .height = 1, .channels = 3, .format = SY_RT_TEXEL_UNORM8, .pixels = texel};
+        sy_rt_texture tex;
+        MUST(sy_rt_texture_create(dev, &td, &tex));
+        sy_rt_material_desc d;
+        sy_rt_material_desc_init(&d);
+        d.metallic = 0.0f, d.specular = 0.0f;
+        d.base_color[0] = d.base_color[1] = d.base_color[2] = 0.0f;
+        d.clearcoat = 1.0f, d.clearcoat_roughness = 0.2f;
+        if (k == 1) d.normal_texture.texture = tex;
+        if (k == 2) d.clearcoat_normal_texture.texture = tex;
+        sy_rt_material mat;
+        MUST(sy_rt_material_create(dev, &d, &mat));
+        float id[16];
+        rt_identity(id);
+        rt_place(dev, rt_quad(dev, 3.0f), id, mat, 0);
+        sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10.0f, .position = {0.0f, 0.0f, 3.0f}};
+        sy_rt_light light;
+        MUST(sy_rt_light_create(dev, &ld, &light));
+        MUST(sy_rt_commit(dev));
+        sy_rt_camera cam = rt_camera(3.0f, 0.8f);
+        for (int whitted = 0; whitted < 2; ++whitted) {
+            img im = render48(dev, &cam, whitted);
+            double sl = 0.0, sx = 0.0;
+            for (uint32_t y = 0; y < 48; ++y)
+                for (uint32_t x = 0; x < 48; ++x) {
+                    const float *p = im.rgba + 4 * (y * 48 + x);
+                    double l = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+                    sl += l, sx += l * (x + 0.5);
+                }
+            double cx = sl > 0.0 ? sx / sl - 24.0 : 99.0;
+            const char *name = whitted ? "whitted" : "pathtracer";
+            printf("clearcoat normal case %d (%s): highlight centroid x %+.2f px, total %.3f\n", k, name, cx, sl);
+            if (k < 2) EXPECT_MSG(fabs(cx) < 1.0, "%s: coat highlight at %+.2f px (case %d), expected the centre", name, cx, k);
+            else EXPECT_MSG(cx < -3.0 && cx > -8.0, "%s: coat highlight at %+.2f px with the coat's tilted normal", name, cx);
+            img_free(&im);
+        }
+        sy_rt_device_destroy(dev);
+    }
+}
+
 /* Area of the triangles of a mesh description (for form factors). */
 static double sphere_part(sy_rt_device *dev, float r, uint32_t seg, uint32_t rings, uint32_t j0, uint32_t j1,
                           sy_rt_material mat)
@@ -690,6 +743,7 @@ int main(void)
     test_sheen();
     test_iridescence();
     test_anisotropy();
+    test_clearcoat_normal();
     test_integrating_sphere();
     test_env_importance();
     test_area_light_grazing();
