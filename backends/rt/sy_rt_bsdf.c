@@ -283,15 +283,26 @@ bool sy_rt_bsdf_sample_dir(const sy_rt_bsdf *b, sy_rt_v3 wo, const float u[3], s
         if (ci <= 0.0f) return false;
         float eta = b->front ? 1.0f / b->ior : b->ior, ct;
         float F = fresnel_dielectric(ci, eta, &ct);
+        /* KHR_materials_iridescence on the way in: the film's colour mixed into the Fresnel; the
+         * split is chosen by the mean and the weights carry the colour */
+        sy_rt_v3 fr = v3(1.0f, 1.0f, 1.0f), ft = v3(1.0f, 1.0f, 1.0f);
+        if (b->irid > 0.0f && b->front && F < 1.0f) {
+            sy_rt_v3 fi = sy_rt_iridescence_fresnel(ci, b->irid_ior, b->irid_thick, v3(b->f0d, b->f0d, b->f0d));
+            sy_rt_v3 fm = v3(sy_rt_clampf(F + b->irid * (fi.x - F), 0.0f, 1.0f), sy_rt_clampf(F + b->irid * (fi.y - F), 0.0f, 1.0f),
+                             sy_rt_clampf(F + b->irid * (fi.z - F), 0.0f, 1.0f));
+            F = sy_rt_clampf((fm.x + fm.y + fm.z) / 3.0f, 1e-3f, 1.0f - 1e-3f);
+            fr = v3_scale(fm, 1.0f / F);
+            ft = v3_scale(v3(1.0f - fm.x, 1.0f - fm.y, 1.0f - fm.z), 1.0f / (1.0f - F));
+        }
         sy_rt_v3 wi;
         if (ut < F) {
             wi = v3_sub(v3_scale(h, 2.0f * ci), wo);
             if (v3_dot(b->ng, wi) <= 0.0f || v3_dot(b->n, wi) <= 0.0f) return false;
-            out->weight = v3(1.0f, 1.0f, 1.0f);
+            out->weight = fr;
         } else {
             wi = v3_normalize(v3_add(v3_scale(wo, -eta), v3_scale(h, eta * ci - ct)));
             if (v3_dot(b->ng, wi) >= 0.0f) return false;
-            out->weight = b->base;
+            out->weight = b->irid > 0.0f ? v3_mul(b->base, ft) : b->base;
             out->transmit = true;
         }
         float g = 1.0f;

@@ -27,6 +27,7 @@
  * (no banding), no change between frames (deterministic). */
 #include "sy_rt_whitted.h"
 #include "sy_rt_bsdf.h"
+#include "sy_rt_iridescence.h"
 #include "sy_rt_lights.h"
 #include "sy_rt_sampler.h"
 #include "sy_rt_shadow.h"
@@ -282,13 +283,21 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
                 tdir = v3_normalize(v3_add(v3_scale(d, eta), v3_scale(s->ns, eta * ci - ct)));
             }
             sy_rt_v3 r = reflect(d, s->ns);
+            /* KHR_materials_iridescence on the way in: the film's colour in the Fresnel split */
+            sy_rt_v3 fr = v3(F, F, F), ft = v3(1.0f - F, 1.0f - F, 1.0f - F);
+            if (b.irid > 0.0f && s->front && F < 1.0f) {
+                sy_rt_v3 fi = sy_rt_iridescence_fresnel(ci, b.irid_ior, b.irid_thick, v3(b.f0d, b.f0d, b.f0d));
+                fr = v3(sy_rt_clampf(F + b.irid * (fi.x - F), 0.0f, 1.0f), sy_rt_clampf(F + b.irid * (fi.y - F), 0.0f, 1.0f),
+                        sy_rt_clampf(F + b.irid * (fi.z - F), 0.0f, 1.0f));
+                ft = v3(1.0f - fr.x, 1.0f - fr.y, 1.0f - fr.z);
+            }
             /* entering (front): the refracted ray is inside; leaving: the reflected one stays inside */
             if (F > 0.0f)
-                L = v3_add(L, v3_scale(s->front ? trace_secondary(c, p_out, r, depth + 1u) : trace_inside(c, s->mat, p_out, r, depth + 1u),
-                                       wt * F));
+                L = v3_add(L, v3_mul(s->front ? trace_secondary(c, p_out, r, depth + 1u) : trace_inside(c, s->mat, p_out, r, depth + 1u),
+                                     v3_scale(fr, wt)));
             if (F < 1.0f) {
                 sy_rt_v3 lt = s->front ? trace_inside(c, s->mat, p_in, tdir, depth + 1u) : trace_secondary(c, p_in, tdir, depth + 1u);
-                L = v3_add(L, v3_scale(v3_mul(s->base, lt), wt * (1.0f - F)));
+                L = v3_add(L, v3_mul(v3_mul(s->base, lt), v3_scale(ft, wt)));
             }
         }
         out.rgb = L;

@@ -171,6 +171,12 @@ static void test_furnaces(void)
     d.transmission = 1.0f;
     d.ior = 1.5f;
     furnace_case("furnace smooth glass", &d, 0.99, 1.01, false);
+    /* KHR_materials_iridescence on glass: the film's colour splits reflection and refraction per
+     * channel (chosen by their mean, weighted by colour), which still sums to 1 per channel */
+    d.iridescence = 1.0f;
+    furnace_case("furnace smooth iridescent glass", &d, 0.99, 1.01, false);
+    d.roughness = 0.3f;
+    furnace_case("furnace rough iridescent glass", &d, 0.9, 1.01, false);
     /* KHR_materials_clearcoat: the coat reflects F_coat(n . wo) and lets 1 - F_coat(n . wo) of the
      * base through (the specification's albedo scaling): a smooth coat over white Lambert keeps the
      * furnace's L; a rough one loses what single-scattering GGX loses where the coat's Fresnel is
