@@ -333,6 +333,36 @@ static void test_iridescence(void)
     }
 }
 
+/* Luminance moments of an image about its centre (pixel units): m[0] = sum L, m[1] = sum L dx,
+ * m[2] = sum L dx^2, m[3] = sum L dy^2. */
+static void lum_moments(const img *im, double m[4])
+{
+    m[0] = m[1] = m[2] = m[3] = 0.0;
+    for (uint32_t y = 0; y < im->h; ++y)
+        for (uint32_t x = 0; x < im->w; ++x) {
+            const float *p = im->rgba + 4 * ((size_t)y * im->w + x);
+            double l = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+            double dx = x + 0.5 - 0.5 * im->w, dy = y + 0.5 - 0.5 * im->h;
+            m[0] += l, m[1] += l * dx, m[2] += l * dx * dx, m[3] += l * dy * dy;
+        }
+}
+
+/* A quad [-3, 3]^2 of material d facing the camera (returned) at distance 3, with a point light of
+ * 10 cd beside the camera; committed. */
+static sy_rt_camera quad_under_light(sy_rt_device *dev, const sy_rt_material_desc *d)
+{
+    sy_rt_material mat;
+    MUST(sy_rt_material_create(dev, d, &mat));
+    float id[16];
+    rt_identity(id);
+    rt_place(dev, rt_quad(dev, 3.0f), id, mat, 0);
+    sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10.0f, .position = {0.0f, 0.0f, 3.0f}};
+    sy_rt_light light;
+    MUST(sy_rt_light_create(dev, &ld, &light));
+    MUST(sy_rt_commit(dev));
+    return rt_camera(3.0f, 0.8f);
+}
+
 /* KHR_materials_anisotropy: a white GGX metal quad (roughness 0.3, uv u along +X) facing a camera
  * at distance 3 with a point light beside the camera. The highlight's luminance-weighted second
  * moments about the image centre: isotropic, X and Y within 15 % of each other; strength 0.8 stretches
@@ -346,26 +376,12 @@ static void test_anisotropy(void)
         sy_rt_material_desc_init(&d);
         d.roughness = 0.3f;
         d.anisotropy = setups[k][0], d.anisotropy_rotation = setups[k][1];
-        sy_rt_material mat;
-        MUST(sy_rt_material_create(dev, &d, &mat));
-        float id[16];
-        rt_identity(id);
-        rt_place(dev, rt_quad(dev, 3.0f), id, mat, 0);
-        sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10.0f, .position = {0.0f, 0.0f, 3.0f}};
-        sy_rt_light light;
-        MUST(sy_rt_light_create(dev, &ld, &light));
-        MUST(sy_rt_commit(dev));
-        sy_rt_camera cam = rt_camera(3.0f, 0.8f);
+        sy_rt_camera cam = quad_under_light(dev, &d);
         for (int whitted = 0; whitted < 2; ++whitted) {
             img im = render48(dev, &cam, whitted);
-            double sxx = 0.0, syy = 0.0;
-            for (uint32_t y = 0; y < 48; ++y)
-                for (uint32_t x = 0; x < 48; ++x) {
-                    const float *p = im.rgba + 4 * (y * 48 + x);
-                    double l = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2], dx = x - 23.5, dy = y - 23.5;
-                    sxx += l * dx * dx, syy += l * dy * dy;
-                }
-            double r = sxx / fmax(syy, 1e-12);
+            double m[4];
+            lum_moments(&im, m);
+            double r = m[2] / fmax(m[3], 1e-12);
             const char *name = whitted ? "whitted" : "pathtracer";
             printf("anisotropy %.1f rotation %.2f (%s): highlight X/Y spread %.3f\n", (double)setups[k][0], (double)setups[k][1], name, r);
             if (k == 0) EXPECT_MSG(r > 0.85 && r < 1.15, "%s: isotropic highlight X/Y %.3f", name, r);
@@ -399,26 +415,12 @@ static void test_clearcoat_normal(void)
         d.clearcoat = 1.0f, d.clearcoat_roughness = 0.2f;
         if (k == 1) d.normal_texture.texture = tex;
         if (k == 2) d.clearcoat_normal_texture.texture = tex;
-        sy_rt_material mat;
-        MUST(sy_rt_material_create(dev, &d, &mat));
-        float id[16];
-        rt_identity(id);
-        rt_place(dev, rt_quad(dev, 3.0f), id, mat, 0);
-        sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10.0f, .position = {0.0f, 0.0f, 3.0f}};
-        sy_rt_light light;
-        MUST(sy_rt_light_create(dev, &ld, &light));
-        MUST(sy_rt_commit(dev));
-        sy_rt_camera cam = rt_camera(3.0f, 0.8f);
+        sy_rt_camera cam = quad_under_light(dev, &d);
         for (int whitted = 0; whitted < 2; ++whitted) {
             img im = render48(dev, &cam, whitted);
-            double sl = 0.0, sx = 0.0;
-            for (uint32_t y = 0; y < 48; ++y)
-                for (uint32_t x = 0; x < 48; ++x) {
-                    const float *p = im.rgba + 4 * (y * 48 + x);
-                    double l = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-                    sl += l, sx += l * (x + 0.5);
-                }
-            double cx = sl > 0.0 ? sx / sl - 24.0 : 99.0;
+            double m[4];
+            lum_moments(&im, m);
+            double sl = m[0], cx = sl > 0.0 ? m[1] / sl : 99.0;
             const char *name = whitted ? "whitted" : "pathtracer";
             printf("clearcoat normal case %d (%s): highlight centroid x %+.2f px, total %.3f\n", k, name, cx, sl);
             if (k < 2) EXPECT_MSG(fabs(cx) < 1.0, "%s: coat highlight at %+.2f px (case %d), expected the centre", name, cx, k);
