@@ -256,6 +256,13 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
             sy_rt_v3 w = v3_scale(s->base, s->metallic);
             float fd = (1.0f - s->metallic) * (1.0f - s->transmission);
             if (fd > 0.0f) w = v3_add(w, v3_scale(schlick(dielectric_f0(md, s), cos_o), fd));
+            if (b.irid > 0.0f) { /* KHR_materials_iridescence: the thin film's Fresnel mixed into both */
+                sy_rt_v3 fm = sy_rt_iridescence_fresnel(cos_o, b.irid_ior, b.irid_thick, s->base);
+                sy_rt_v3 fi = v3_scale(sy_rt_iridescence_fresnel(cos_o, b.irid_ior, b.irid_thick, b.f0c), b.spec);
+                sy_rt_v3 wm = v3_add(v3_scale(s->base, 1.0f - b.irid), v3_scale(fm, b.irid));
+                sy_rt_v3 wd = v3_add(v3_scale(schlick(dielectric_f0(md, s), cos_o), 1.0f - b.irid), v3_scale(fi, b.irid));
+                w = v3_add(v3_scale(wm, s->metallic), v3_scale(wd, fd));
+            }
             w = v3_scale(w, b.under); /* under a coat and a sheen */
             if (v3_max_abs(w) > 1e-4f) {
                 sy_rt_v3 r = reflect(d, s->ns);
