@@ -25,6 +25,8 @@ void sy_gltf_info_free(sy_gltf_info *info)
     free(info->camera_nodes);
     for (uint32_t i = 0; i < info->variant_count; i++) free(info->variant_names[i]);
     free(info->variant_names);
+    for (uint32_t i = 0; i < info->extensions_used_count; i++) free(info->extensions_used[i]);
+    free(info->extensions_used);
     free(info->variant_uses);
     sy_loader_warnings_free(gltf_warnings(info));
     memset(info, 0, sizeof *info);
@@ -56,6 +58,7 @@ static sy_result load_doc(loader *L)
     c->images = (uint32_t)d->image_count;
     c->lights = (uint32_t)d->light_count;
     c->cameras = (uint32_t)d->camera_count;
+    c->animations = (uint32_t)d->animation_count;
     for (size_t m = 0; m < d->mesh_count; m++) c->primitives += (uint32_t)d->meshes[m].primitive_count;
 
     if (!(L->parent = gltf_xcalloc(L, d->node_count + 1, sizeof(int32_t), &r))) return r;
@@ -85,6 +88,14 @@ static sy_result load_doc(loader *L)
             if (!(L->info->variant_names[i] = strdup(d->variant_names[i])))
                 return gltf_fail(L, SY_ERR_OUT_OF_MEMORY, "KHR_materials_variants: out of memory");
             L->info->variant_count = (uint32_t)i + 1;
+        }
+    }
+    if (d->extensions_used_count) {
+        if (!(L->info->extensions_used = gltf_xcalloc(L, d->extensions_used_count, sizeof(char *), &r))) return r;
+        for (size_t i = 0; i < d->extensions_used_count; i++) {
+            if (!(L->info->extensions_used[i] = strdup(d->extensions_used[i])))
+                return gltf_fail(L, SY_ERR_OUT_OF_MEMORY, "extensionsUsed: out of memory");
+            L->info->extensions_used_count = (uint32_t)i + 1;
         }
     }
     /* dependency order: textures (on demand) + materials, meshes, lights, cameras, nodes */

@@ -82,6 +82,7 @@ typedef struct sy_gltf_counts {
     uint32_t skipped_primitives; /**< without POSITION, or without one complete element */
     /** @{ elements of POINTS and of LINES / LINE_LOOP / LINE_STRIP primitives */
     uint32_t points, line_segments; /** @} */
+    uint32_t animations; /**< animations in the file (a static load places nodes at animations[0]'s first frame) */
 } sy_gltf_counts;
 
 /** One KHR_materials_variants mapping: primitive `primitive` (an index into the mesh's sy
@@ -111,6 +112,9 @@ typedef struct sy_gltf_info {
     uint32_t variant_count; /**< entries of variant_names */
     sy_gltf_variant_use *variant_uses; /**< every mapping, by mesh then primitive (malloc()ed) */
     uint32_t variant_use_count; /**< entries of variant_uses */
+    char **extensions_used; /**< the file's extensionsUsed, in file order (malloc()ed); compare with
+                                 sy_gltf_supported_extensions() for what this loader reads */
+    uint32_t extensions_used_count; /**< entries of extensions_used */
 } sy_gltf_info;
 
 /** Loads the glTF file at `path` into `scene`. The default glTF scene is `scene` of the file, else

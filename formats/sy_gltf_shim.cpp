@@ -419,6 +419,7 @@ struct sy_gltf_shim_impl {
     std::vector<sy_gltf_shim_scene> scenes;
     std::vector<sy_gltf_shim_channel> channels;
     std::vector<const char *> ext_required;
+    std::vector<const char *> ext_used;
     std::vector<const char *> variant_names;
     std::vector<sy_gltf_shim_variant_use> variant_uses;
     std::string warnings;
@@ -596,6 +597,7 @@ static void fill_doc(sy_gltf_shim_impl *d)
     for (size_t i = 0; i < m.scenes.size(); i++)
         d->scenes.push_back({m.scenes[i].name.c_str(), d->scene_nodes[i].data(), d->scene_nodes[i].size()});
     for (const std::string &s : m.extensionsRequired) d->ext_required.push_back(s.c_str());
+    for (const std::string &s : m.extensionsUsed) d->ext_used.push_back(s.c_str());
     if (const tinygltf::Value *e = extension(m.extensions, "KHR_materials_variants")) {
         const tinygltf::Value *vs = member(*e, "variants");
         for (size_t i = 0; vs && vs->IsArray() && i < vs->ArrayLen(); i++) {
@@ -620,6 +622,8 @@ static void fill_doc(sy_gltf_shim_impl *d)
     c.default_scene = m.defaultScene;
     c.extensions_required = d->ext_required.data();
     c.extensions_required_count = d->ext_required.size();
+    c.extensions_used = d->ext_used.data();
+    c.extensions_used_count = d->ext_used.size();
     c.variant_names = d->variant_names.data();
     c.variant_count = d->variant_names.size();
     c.variant_uses = d->variant_uses.data();

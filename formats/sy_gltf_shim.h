@@ -234,6 +234,7 @@ typedef struct sy_gltf_doc {
     const sy_gltf_shim_scene *scenes;       size_t scene_count;
     int32_t default_scene; /* -1: none given */
     const char *const *extensions_required; size_t extensions_required_count;
+    const char *const *extensions_used;     size_t extensions_used_count; /* the file's extensionsUsed */
     size_t skin_count, animation_count;
     const sy_gltf_shim_channel *channels;   size_t channel_count; /* of animations[0] */
     const char *const *variant_names;       size_t variant_count; /* KHR_materials_variants ("" unnamed) */

@@ -53,6 +53,26 @@ static void jcounts(cJSON *o, const char *const *names, const uint32_t *values, 
     for (size_t i = 0; i < n; ++i) sy_json_add(o, names[i], cJSON_CreateNumber(values[i]));
 }
 
+/* glTF's extensionsUsed split by what the loader reads (sy_gltf_supported_extensions) and the
+ * KHR_materials_variants names; the same keys, empty, for every other format (gltf NULL). */
+static void add_extensions(cJSON *doc, const sy_gltf_info *gltf)
+{
+    cJSON *ex = sy_json_add(doc, "extensions", cJSON_CreateObject());
+    cJSON *used = sy_json_add(ex, "used", cJSON_CreateArray()), *sup = sy_json_add(ex, "supported", cJSON_CreateArray()),
+          *uns = sy_json_add(ex, "unsupported", cJSON_CreateArray());
+    cJSON *va = sy_json_add(doc, "variants", cJSON_CreateArray());
+    if (!gltf) return;
+    const char *const *known = sy_gltf_supported_extensions();
+    for (uint32_t i = 0; i < gltf->extensions_used_count; ++i) {
+        const char *e = gltf->extensions_used[i];
+        bool ok = false;
+        for (size_t k = 0; known[k] && !ok; ++k) ok = !strcmp(known[k], e);
+        sy_json_add(used, NULL, sy_json_str(e));
+        sy_json_add(ok ? sup : uns, NULL, sy_json_str(e));
+    }
+    for (uint32_t i = 0; i < gltf->variant_count; ++i) sy_json_add(va, NULL, sy_json_str(gltf->variant_names[i]));
+}
+
 /* sy info's log while it loads: warnings are part of its JSON output, everything else goes to stderr. */
 static void info_log(void *user, sy_log_level level, const char *module, const char *item, const char *message)
 {
@@ -104,28 +124,30 @@ int sy_cmd_info(int argc, char **argv)
         sy_json_add(doc, "embedded_textures", cJSON_CreateNumber(av[4]));
     }
     static const char *const names[] = {"nodes",  "meshes", "primitives", "triangles", "materials",     "textures",
-                                        "images", "lights", "cameras",    "points",    "line_segments", "skipped"};
-    uint32_t v[12] = {0};
+                                        "images", "lights", "cameras",    "points",    "line_segments", "skipped",
+                                        "animations"};
+    uint32_t v[13] = {0};
     if (ld.is_gltf) {
         const sy_gltf_counts *gc = &ld.gltf.counts;
-        const uint32_t g[12] = {gc->nodes,   gc->meshes,  gc->primitives, gc->triangles,     gc->materials,
+        const uint32_t g[13] = {gc->nodes,   gc->meshes,  gc->primitives, gc->triangles,     gc->materials,
                                 gc->textures, gc->images, gc->lights,     gc->cameras,       gc->points,
-                                gc->line_segments, gc->skipped_primitives};
+                                gc->line_segments, gc->skipped_primitives, gc->animations};
         memcpy(v, g, sizeof v);
-    } else if (ld.is_x3d) { /* X3D declares no totals: what its nodes made (an ImageTexture is one image) */
+    } else if (ld.is_x3d) { /* X3D declares no totals: what its nodes made (an ImageTexture is one image);
+                             * its interpolators are not counted as animations (0) */
         const sy_x3d_counts *xc = &ld.x3d.counts;
-        const uint32_t x[12] = {xc->nodes,    xc->meshes,   xc->primitives, xc->triangles, xc->materials,
+        const uint32_t x[13] = {xc->nodes,    xc->meshes,   xc->primitives, xc->triangles, xc->materials,
                                 xc->textures, xc->textures, xc->lights,     xc->cameras,   xc->points,
-                                xc->line_segments, xc->skipped_geometry};
+                                xc->line_segments, xc->skipped_geometry, 0};
         memcpy(v, x, sizeof v);
     } else if (ld.is_assimp) { /* what Assimp read, after its post-processing (one primitive per mesh) */
         const sy_assimp_counts *ac = &ld.assimp.counts;
-        const uint32_t a[12] = {ac->nodes,    ac->meshes,     ac->meshes, ac->triangles, ac->materials,
+        const uint32_t a[13] = {ac->nodes,    ac->meshes,     ac->meshes, ac->triangles, ac->materials,
                                 ac->textures, ac->embedded_textures, ac->lights, ac->cameras, ac->points,
-                                ac->line_segments, ac->skipped};
+                                ac->line_segments, ac->skipped, ac->animations};
         memcpy(v, a, sizeof v);
     }
-    if (ld.is_gltf || ld.is_x3d || ld.is_assimp) jcounts(sy_json_add(doc, "file_counts", cJSON_CreateObject()), names, v, 12);
+    if (ld.is_gltf || ld.is_x3d || ld.is_assimp) jcounts(sy_json_add(doc, "file_counts", cJSON_CreateObject()), names, v, 13);
     else sy_json_add(doc, "file_counts", cJSON_CreateNull()); /* the built-in scene: no file */
     static const char *const lnames[] = {"nodes", "meshes", "primitives", "triangles", "materials",
                                          "textures", "lights", "cameras"};
@@ -133,6 +155,7 @@ int sy_cmd_info(int argc, char **argv)
                            tris, sy_scene_count(ld.scene, SY_TYPE_MATERIAL), sy_scene_count(ld.scene, SY_TYPE_TEXTURE),
                            sy_scene_count(ld.scene, SY_TYPE_LIGHT), sy_scene_count(ld.scene, SY_TYPE_CAMERA)};
     jcounts(sy_json_add(doc, "loaded", cJSON_CreateObject()), lnames, lv, 8);
+    add_extensions(doc, ld.is_gltf ? &ld.gltf : NULL);
     if (sy_bounds_is_empty(&b)) {
         sy_json_add(doc, "bounds", cJSON_CreateNull());
     } else {

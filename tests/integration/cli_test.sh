@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # cli_test.sh SY TESTDATA TMPDIR — tests of the `sy` command line tool (integration_cli).
-#   - sy info Box.gltf: JSON in the one layout of every format (format, file_counts, loaded, bounds,
-#     warning_count, warnings): meshes/primitives/triangles/materials = 1/1/12/1, bounds +-0.5;
-#     a file's warnings only in the JSON
+#   - sy info Box.gltf: JSON in the one layout of every format (format, file_counts, loaded, extensions,
+#     variants, bounds, warning_count, warnings): meshes/primitives/triangles/materials = 1/1/12/1,
+#     bounds +-0.5; a file's warnings only in the JSON; extensionsUsed split into supported and
+#     unsupported, the variant names, BoxAnimated's 1 animation
 #   - conventions: --version, --help / help / CMD --help / help bench on stdout; a bad option, a
 #     missing or bad value named with status 2; a failure status 1; backends --json; -q / -v;
 #     an abbreviated long option (--frame for --frames) is a usage error naming the options it
@@ -193,6 +194,14 @@ printf '{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{}}]}]
 run info_warn "$SY" info "$TMP/info_warn.gltf"
 [ "$rc" -eq 0 ] && grep -qxF '  "warning_count": 1,' "$TMP/info_warn.out" && grep -q 'no POSITION attribute; skipped' "$TMP/info_warn.out" &&
     [ ! -s "$TMP/info_warn.err" ] || fail "sy info with a warning: status $rc, $(cat "$TMP/info_warn.out" "$TMP/info_warn.err")"
+# sy info lists the file's extensionsUsed, split by what the loader reads, and its material variants
+printf '{"asset":{"version":"2.0"},"extensionsUsed":["KHR_materials_variants","EXT_sy_no_such_extension"],"extensions":{"KHR_materials_variants":{"variants":[{"name":"Red"},{"name":"Blue"}]}},"nodes":[{}],"scenes":[{"nodes":[0]}]}' \
+    > "$TMP/info_ext.gltf"
+run info_ext "$SY" info "$TMP/info_ext.gltf"
+[ "$rc" -eq 0 ] &&
+    grep -qF '"extensions": {"used": ["KHR_materials_variants", "EXT_sy_no_such_extension"], "supported": ["KHR_materials_variants"], "unsupported": ["EXT_sy_no_such_extension"]},' "$TMP/info_ext.out" &&
+    grep -qF '"variants": ["Red", "Blue"],' "$TMP/info_ext.out" && grep -qxF '    "animations": 0' "$TMP/info_ext.out" ||
+    fail "sy info extensions / variants: status $rc, $(cat "$TMP/info_ext.out" "$TMP/info_ext.err")"
 # the front door (issue 33): sy backends marks the default; sy render SCENE without -b and -o
 # renders with it into STEM.png in the current folder; -o X.jpg writes a JPEG; sy render DIR takes
 # the one scene file of the folder and lists the candidates when there are several
@@ -429,6 +438,15 @@ if [ -f "$BOX" ] && [ -f "$GLB" ]; then
         fail "info Box.gltf: bounds are not +-0.5: $(grep bounds "$TMP/info.out")"
     head -c 1 "$TMP/info.out" | grep -q '{' && tail -n 1 "$TMP/info.out" | grep -qx '}' ||
         fail "info Box.gltf: output is not one JSON object"
+    grep -qF '"extensions": {"used": [], "supported": [], "unsupported": []},' "$TMP/info.out" &&
+        grep -qF '"variants": [],' "$TMP/info.out" || fail "info Box.gltf: extensions / variants not empty"
+    BOXANIM="$DATA/gltf/BoxAnimated/glTF-Binary/BoxAnimated.glb"
+    if [ -f "$BOXANIM" ]; then
+        run_ok "info BoxAnimated.glb" info_anim "$SY" info "$BOXANIM"
+        grep -qxF '    "animations": 1' "$TMP/info_anim.out" || fail "info BoxAnimated.glb: not 1 animation"
+    else
+        echo "skip: info BoxAnimated.glb ($BOXANIM absent)"
+    fi
 
     mkdir -p "$TMP/o_trunc"
     head -c 100 "$GLB" >"$TMP/in/truncated.glb"
