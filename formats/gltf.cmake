@@ -1,5 +1,6 @@
 # formats/gltf.cmake — the glTF 2.0 loader in sy_formats: a C loader (sy_gltf.c and its modules,
-# sy_gltf_internal.h) over a small C++17 shim around tinygltf (sy_gltf_shim.cpp, the only C++ in
+# sy_gltf_internal.h) over a small C++17 shim around tinygltf (sy_gltf_shim.cpp, its writer half
+# sy_gltf_shim_write.cpp and the Draco decoder sy_gltf_draco.cpp, the only C++ in
 # formats/). Included at the end of formats/CMakeLists.txt.
 target_sources(sy_formats PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf.c
@@ -11,6 +12,7 @@ target_sources(sy_formats PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_nodes.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_variants.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_shim.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_shim_write.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_draco.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_meshopt.c
 )
