@@ -272,6 +272,8 @@ typedef struct sy_gltf_shim_wprimitive {
     const float *colors;         /* float[4] per vertex or NULL */
     const uint32_t *indices;     /* NULL: non-indexed */
     uint32_t index_count;
+    const float *tangents;       /* float[4] per vertex or NULL */
+    const float *texcoords1;     /* float[2] per vertex or NULL */
 } sy_gltf_shim_wprimitive;
 
 typedef struct sy_gltf_shim_wmesh {
@@ -280,26 +282,75 @@ typedef struct sy_gltf_shim_wmesh {
     uint32_t primitive_count;
 } sy_gltf_shim_wmesh;
 
+/* A material's texture reference: texture is an index into the doc's textures + 1 (0: none). */
+typedef struct sy_gltf_shim_wtexref {
+    int32_t texture;
+    uint32_t texcoord;
+    double scale; /* normal scale / occlusion strength (written for those two only) */
+    double offset[2], rotation, uv_scale[2]; /* KHR_texture_transform, written unless the identity */
+} sy_gltf_shim_wtexref;
+
 typedef struct sy_gltf_shim_wmaterial {
     const char *name; /* may be NULL */
     double base_color[4], metallic, roughness, emissive[3], emissive_strength; /* strength 1: no extension */
     const char *alpha_mode; /* "OPAQUE", "MASK", "BLEND" */
     double alpha_cutoff;
     int32_t double_sided, unlit;
+    /* Textures and the other KHR_materials_* extensions (sy convert); written only when `full` is
+     * set, each extension only when it differs from the specification's defaults. */
+    int32_t full;
+    sy_gltf_shim_wtexref base_color_tex, metallic_roughness_tex, normal_tex, occlusion_tex, emissive_tex;
+    double transmission; sy_gltf_shim_wtexref transmission_tex;
+    double ior;
+    double specular, specular_color[3]; sy_gltf_shim_wtexref specular_tex, specular_color_tex;
+    double clearcoat, clearcoat_roughness;
+    sy_gltf_shim_wtexref clearcoat_tex, clearcoat_roughness_tex, clearcoat_normal_tex;
+    double sheen_color[3], sheen_roughness; sy_gltf_shim_wtexref sheen_color_tex, sheen_roughness_tex;
+    double thickness, attenuation_distance, attenuation_color[3]; sy_gltf_shim_wtexref thickness_tex;
+    double iridescence, iridescence_ior, iridescence_thickness[2];
+    sy_gltf_shim_wtexref iridescence_tex, iridescence_thickness_tex;
+    double anisotropy, anisotropy_rotation; sy_gltf_shim_wtexref anisotropy_tex;
 } sy_gltf_shim_wmaterial;
+
+/* One texture: its PNG bytes (one glTF image, in the buffer) and its sampler (glTF codes). */
+typedef struct sy_gltf_shim_wtexture {
+    const char *name; /* may be NULL */
+    const uint8_t *png; size_t png_size;
+    int32_t wrap_s, wrap_t, min_filter, mag_filter;
+} sy_gltf_shim_wtexture;
+
+typedef struct sy_gltf_shim_wcamera {
+    const char *name; /* may be NULL */
+    int32_t orthographic;
+    double yfov, aspect, znear, zfar, xmag, ymag; /* aspect 0, zfar 0: not written */
+} sy_gltf_shim_wcamera;
+
+typedef struct sy_gltf_shim_wlight { /* KHR_lights_punctual */
+    const char *name; /* may be NULL */
+    const char *type; /* "point", "spot", "directional" */
+    double color[3], intensity, range, inner_cone, outer_cone; /* range 0: not written */
+} sy_gltf_shim_wlight;
 
 typedef struct sy_gltf_shim_wnode {
     const char *name; /* may be NULL */
     int32_t mesh;     /* index into meshes, -1: none */
     double matrix[16]; /* column-major; the identity is not written */
     int64_t id;        /* >= 0: written as the node's extras {"id": id} */
+    int32_t trs;       /* 1: translation / rotation / scale below instead of the matrix */
+    double translation[3], rotation[4], scale[3];
+    int32_t camera, light; /* index into cameras / lights + 1; 0: none */
+    const int32_t *children; uint32_t child_count; /* indices into nodes */
 } sy_gltf_shim_wnode;
 
 typedef struct sy_gltf_shim_wdoc {
     const char *generator;
     const sy_gltf_shim_wmaterial *materials; uint32_t material_count;
     const sy_gltf_shim_wmesh *meshes;        uint32_t mesh_count;
-    const sy_gltf_shim_wnode *nodes;         uint32_t node_count; /* every node is a root of scene 0 */
+    const sy_gltf_shim_wnode *nodes;         uint32_t node_count;
+    const int32_t *roots; uint32_t root_count; /* scene 0's nodes; NULL: every node is a root */
+    const sy_gltf_shim_wtexture *textures;   uint32_t texture_count;
+    const sy_gltf_shim_wcamera *cameras;     uint32_t camera_count;
+    const sy_gltf_shim_wlight *lights;       uint32_t light_count;
 } sy_gltf_shim_wdoc;
 
 /* Writes doc as GLB into a malloc()ed buffer (*glb_out, *len_out; the caller frees it). Buffers:
@@ -311,6 +362,10 @@ typedef struct sy_gltf_shim_wdoc {
  * every buffer after the first as a data: URI of its bytes and no buffer extensions, so the
  * extension's fallback buffer (a byteLength without data) cannot be expressed. */
 sy_result sy_gltf_shim_write_glb(const sy_gltf_shim_wdoc *doc, uint8_t **glb_out, size_t *len_out, sy_error *err);
+
+/* The same document as GLB (binary) or as glTF JSON whose one buffer (geometry and PNG images) is
+ * a data: URI (binary false). Same result codes. */
+sy_result sy_gltf_shim_write(const sy_gltf_shim_wdoc *doc, bool binary, uint8_t **out, size_t *len_out, sy_error *err);
 
 #ifdef __cplusplus
 }

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <new>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -59,12 +60,142 @@ int add_accessor(tinygltf::Model &m, const void *data, size_t count, int type, i
 
 std::string str_or_empty(const char *s) { return s ? std::string(s) : std::string(); }
 
+using Obj = tinygltf::Value::Object;
+
+tinygltf::Value num(double v) { return tinygltf::Value(v); }
+
+tinygltf::Value vec(const double *v, int n)
+{
+    tinygltf::Value::Array a;
+    for (int i = 0; i < n; ++i) a.push_back(num(v[i]));
+    return tinygltf::Value(a);
+}
+
+// KHR_texture_transform of a reference, unless it is the identity (then nothing is added).
+void add_transform(const sy_gltf_shim_wtexref &r, tinygltf::ExtensionMap &ext, std::set<std::string> &used)
+{
+    if (r.offset[0] == 0 && r.offset[1] == 0 && r.rotation == 0 && r.uv_scale[0] == 1 && r.uv_scale[1] == 1) return;
+    Obj o;
+    if (r.offset[0] != 0 || r.offset[1] != 0) o["offset"] = vec(r.offset, 2);
+    if (r.rotation != 0) o["rotation"] = num(r.rotation);
+    if (r.uv_scale[0] != 1 || r.uv_scale[1] != 1) o["scale"] = vec(r.uv_scale, 2);
+    ext["KHR_texture_transform"] = tinygltf::Value(o);
+    used.insert("KHR_texture_transform");
+}
+
+template <typename Info> void set_info(Info &info, const sy_gltf_shim_wtexref &r, std::set<std::string> &used)
+{
+    info.index = r.texture - 1;
+    info.texCoord = int(r.texcoord);
+    add_transform(r, info.extensions, used);
+}
+
+// A textureInfo inside a material extension (index, texCoord, KHR_texture_transform).
+void put_tex(Obj &o, const char *key, const sy_gltf_shim_wtexref &r, std::set<std::string> &used)
+{
+    if (r.texture <= 0) return;
+    Obj t;
+    t["index"] = tinygltf::Value(r.texture - 1);
+    if (r.texcoord) t["texCoord"] = tinygltf::Value(int(r.texcoord));
+    tinygltf::ExtensionMap ext;
+    add_transform(r, ext, used);
+    if (!ext.empty()) t["extensions"] = tinygltf::Value(Obj(ext.begin(), ext.end()));
+    o[key] = tinygltf::Value(t);
+}
+
+void put_ext(tinygltf::Material &mt, const char *name, Obj o, std::set<std::string> &used)
+{
+    mt.extensions[name] = tinygltf::Value(o);
+    used.insert(name);
+}
+
+bool same3(const double *a, double v) { return a[0] == v && a[1] == v && a[2] == v; }
+
+// The KHR_materials_* extensions of a full material, each unless at its defaults.
+void material_extensions(const sy_gltf_shim_wmaterial &w, tinygltf::Material &mt, std::set<std::string> &used)
+{
+    if (w.transmission != 0 || w.transmission_tex.texture) {
+        Obj o;
+        o["transmissionFactor"] = num(w.transmission);
+        put_tex(o, "transmissionTexture", w.transmission_tex, used);
+        put_ext(mt, "KHR_materials_transmission", o, used);
+    }
+    if (w.ior != 1.5) put_ext(mt, "KHR_materials_ior", Obj{{"ior", num(w.ior)}}, used);
+    if (w.specular != 1 || !same3(w.specular_color, 1) || w.specular_tex.texture || w.specular_color_tex.texture) {
+        Obj o;
+        o["specularFactor"] = num(w.specular);
+        o["specularColorFactor"] = vec(w.specular_color, 3);
+        put_tex(o, "specularTexture", w.specular_tex, used);
+        put_tex(o, "specularColorTexture", w.specular_color_tex, used);
+        put_ext(mt, "KHR_materials_specular", o, used);
+    }
+    if (w.clearcoat != 0 || w.clearcoat_tex.texture) {
+        Obj o;
+        o["clearcoatFactor"] = num(w.clearcoat);
+        o["clearcoatRoughnessFactor"] = num(w.clearcoat_roughness);
+        put_tex(o, "clearcoatTexture", w.clearcoat_tex, used);
+        put_tex(o, "clearcoatRoughnessTexture", w.clearcoat_roughness_tex, used);
+        put_tex(o, "clearcoatNormalTexture", w.clearcoat_normal_tex, used);
+        if (w.clearcoat_normal_tex.texture && w.clearcoat_normal_tex.scale != 1)
+            o["clearcoatNormalTexture"].Get<Obj>()["scale"] = num(w.clearcoat_normal_tex.scale);
+        put_ext(mt, "KHR_materials_clearcoat", o, used);
+    }
+    if (!same3(w.sheen_color, 0) || w.sheen_color_tex.texture) {
+        Obj o;
+        o["sheenColorFactor"] = vec(w.sheen_color, 3);
+        o["sheenRoughnessFactor"] = num(w.sheen_roughness);
+        put_tex(o, "sheenColorTexture", w.sheen_color_tex, used);
+        put_tex(o, "sheenRoughnessTexture", w.sheen_roughness_tex, used);
+        put_ext(mt, "KHR_materials_sheen", o, used);
+    }
+    if (w.thickness != 0 || w.attenuation_distance != 0 || !same3(w.attenuation_color, 1) || w.thickness_tex.texture) {
+        Obj o;
+        o["thicknessFactor"] = num(w.thickness);
+        if (w.attenuation_distance > 0) o["attenuationDistance"] = num(w.attenuation_distance); // 0: infinite
+        o["attenuationColor"] = vec(w.attenuation_color, 3);
+        put_tex(o, "thicknessTexture", w.thickness_tex, used);
+        put_ext(mt, "KHR_materials_volume", o, used);
+    }
+    if (w.iridescence != 0 || w.iridescence_tex.texture) {
+        Obj o;
+        o["iridescenceFactor"] = num(w.iridescence);
+        o["iridescenceIor"] = num(w.iridescence_ior);
+        o["iridescenceThicknessMinimum"] = num(w.iridescence_thickness[0]);
+        o["iridescenceThicknessMaximum"] = num(w.iridescence_thickness[1]);
+        put_tex(o, "iridescenceTexture", w.iridescence_tex, used);
+        put_tex(o, "iridescenceThicknessTexture", w.iridescence_thickness_tex, used);
+        put_ext(mt, "KHR_materials_iridescence", o, used);
+    }
+    if (w.anisotropy != 0 || w.anisotropy_tex.texture) {
+        Obj o;
+        o["anisotropyStrength"] = num(w.anisotropy);
+        o["anisotropyRotation"] = num(w.anisotropy_rotation);
+        put_tex(o, "anisotropyTexture", w.anisotropy_tex, used);
+        put_ext(mt, "KHR_materials_anisotropy", o, used);
+    }
+}
+
 void build_model(const sy_gltf_shim_wdoc *d, tinygltf::Model &m)
 {
     m.asset.version = "2.0";
     m.asset.generator = str_or_empty(d->generator);
     m.buffers.resize(1);
-    bool emissive_strength = false, unlit = false;
+    std::set<std::string> used;
+    for (uint32_t i = 0; i < d->texture_count; ++i) { // one image, sampler and texture each
+        const sy_gltf_shim_wtexture &w = d->textures[i];
+        tinygltf::Image im;
+        im.name = str_or_empty(w.name);
+        im.mimeType = "image/png";
+        im.bufferView = add_view(m, w.png, w.png_size, 0);
+        m.images.push_back(im);
+        tinygltf::Sampler sm;
+        sm.wrapS = w.wrap_s, sm.wrapT = w.wrap_t, sm.minFilter = w.min_filter, sm.magFilter = w.mag_filter;
+        m.samplers.push_back(sm);
+        tinygltf::Texture tx;
+        tx.name = im.name;
+        tx.source = int(i), tx.sampler = int(i);
+        m.textures.push_back(tx);
+    }
     for (uint32_t i = 0; i < d->material_count; ++i) {
         const sy_gltf_shim_wmaterial &w = d->materials[i];
         tinygltf::Material mt;
@@ -77,19 +208,23 @@ void build_model(const sy_gltf_shim_wdoc *d, tinygltf::Model &m)
         mt.alphaCutoff = w.alpha_cutoff;
         mt.doubleSided = w.double_sided != 0;
         if (w.emissive_strength != 1.0) {
-            tinygltf::Value::Object o;
+            Obj o;
             o["emissiveStrength"] = tinygltf::Value(w.emissive_strength);
-            mt.extensions["KHR_materials_emissive_strength"] = tinygltf::Value(o);
-            emissive_strength = true;
+            put_ext(mt, "KHR_materials_emissive_strength", o, used);
         }
-        if (w.unlit) {
-            mt.extensions["KHR_materials_unlit"] = tinygltf::Value(tinygltf::Value::Object());
-            unlit = true;
+        if (w.unlit) put_ext(mt, "KHR_materials_unlit", Obj(), used);
+        if (w.full) {
+            if (w.base_color_tex.texture) set_info(mt.pbrMetallicRoughness.baseColorTexture, w.base_color_tex, used);
+            if (w.metallic_roughness_tex.texture)
+                set_info(mt.pbrMetallicRoughness.metallicRoughnessTexture, w.metallic_roughness_tex, used);
+            if (w.normal_tex.texture) set_info(mt.normalTexture, w.normal_tex, used), mt.normalTexture.scale = w.normal_tex.scale;
+            if (w.occlusion_tex.texture)
+                set_info(mt.occlusionTexture, w.occlusion_tex, used), mt.occlusionTexture.strength = w.occlusion_tex.scale;
+            if (w.emissive_tex.texture) set_info(mt.emissiveTexture, w.emissive_tex, used);
+            material_extensions(w, mt, used);
         }
         m.materials.push_back(mt);
     }
-    if (emissive_strength) m.extensionsUsed.push_back("KHR_materials_emissive_strength");
-    if (unlit) m.extensionsUsed.push_back("KHR_materials_unlit");
     for (uint32_t i = 0; i < d->mesh_count; ++i) {
         const sy_gltf_shim_wmesh &w = d->meshes[i];
         tinygltf::Mesh mesh;
@@ -108,6 +243,12 @@ void build_model(const sy_gltf_shim_wdoc *d, tinygltf::Model &m)
             if (p.texcoords0)
                 pr.attributes["TEXCOORD_0"] = add_accessor(m, p.texcoords0, p.vertex_count, TINYGLTF_TYPE_VEC2, 2,
                                                            TINYGLTF_COMPONENT_TYPE_FLOAT, vt, false);
+            if (p.tangents)
+                pr.attributes["TANGENT"] = add_accessor(m, p.tangents, p.vertex_count, TINYGLTF_TYPE_VEC4, 4,
+                                                        TINYGLTF_COMPONENT_TYPE_FLOAT, vt, false);
+            if (p.texcoords1)
+                pr.attributes["TEXCOORD_1"] = add_accessor(m, p.texcoords1, p.vertex_count, TINYGLTF_TYPE_VEC2, 2,
+                                                           TINYGLTF_COMPONENT_TYPE_FLOAT, vt, false);
             if (p.colors)
                 pr.attributes["COLOR_0"] = add_accessor(m, p.colors, p.vertex_count, TINYGLTF_TYPE_VEC4, 4,
                                                         TINYGLTF_COMPONENT_TYPE_FLOAT, vt, false);
@@ -123,29 +264,74 @@ void build_model(const sy_gltf_shim_wdoc *d, tinygltf::Model &m)
         }
         m.meshes.push_back(mesh);
     }
+    for (uint32_t i = 0; i < d->camera_count; ++i) {
+        const sy_gltf_shim_wcamera &w = d->cameras[i];
+        tinygltf::Camera c;
+        c.name = str_or_empty(w.name);
+        if (w.orthographic) {
+            c.type = "orthographic";
+            c.orthographic.xmag = w.xmag, c.orthographic.ymag = w.ymag;
+            c.orthographic.znear = w.znear, c.orthographic.zfar = w.zfar;
+        } else {
+            c.type = "perspective";
+            c.perspective.yfov = w.yfov, c.perspective.aspectRatio = w.aspect;
+            c.perspective.znear = w.znear, c.perspective.zfar = w.zfar;
+        }
+        m.cameras.push_back(c);
+    }
+    for (uint32_t i = 0; i < d->light_count; ++i) {
+        const sy_gltf_shim_wlight &w = d->lights[i];
+        tinygltf::Light l;
+        l.name = str_or_empty(w.name);
+        l.type = w.type;
+        l.color.assign(w.color, w.color + 3);
+        l.intensity = w.intensity;
+        l.range = w.range;
+        if (!strcmp(w.type, "spot")) l.spot.innerConeAngle = w.inner_cone, l.spot.outerConeAngle = w.outer_cone;
+        m.lights.push_back(l);
+        used.insert("KHR_lights_punctual");
+    }
     tinygltf::Scene scene;
     for (uint32_t i = 0; i < d->node_count; ++i) {
         const sy_gltf_shim_wnode &w = d->nodes[i];
         tinygltf::Node n;
         n.name = str_or_empty(w.name);
         n.mesh = w.mesh;
-        static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-        if (memcmp(w.matrix, identity, sizeof identity) != 0) n.matrix.assign(w.matrix, w.matrix + 16);
+        if (w.trs) {
+            if (!same3(w.translation, 0)) n.translation.assign(w.translation, w.translation + 3);
+            if (w.rotation[0] != 0 || w.rotation[1] != 0 || w.rotation[2] != 0 || w.rotation[3] != 1)
+                n.rotation.assign(w.rotation, w.rotation + 4);
+            if (!same3(w.scale, 1)) n.scale.assign(w.scale, w.scale + 3);
+        } else {
+            static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+            if (memcmp(w.matrix, identity, sizeof identity) != 0) n.matrix.assign(w.matrix, w.matrix + 16);
+        }
+        if (w.camera > 0) n.camera = w.camera - 1;
+        if (w.light > 0) n.extensions["KHR_lights_punctual"] = tinygltf::Value(Obj{{"light", tinygltf::Value(w.light - 1)}});
+        n.children.assign(w.children, w.children + w.child_count);
         if (w.id >= 0) {
             tinygltf::Value::Object o;
             o["id"] = tinygltf::Value(double(w.id));
             n.extras = tinygltf::Value(o);
         }
         m.nodes.push_back(n);
-        scene.nodes.push_back(int(i));
+        if (!d->roots) scene.nodes.push_back(int(i));
     }
+    if (d->roots) scene.nodes.assign(d->roots, d->roots + d->root_count);
     m.scenes.push_back(scene);
     m.defaultScene = 0;
+    m.extensionsUsed.assign(used.begin(), used.end());
 }
 
 } // namespace
 
 extern "C" sy_result sy_gltf_shim_write_glb(const sy_gltf_shim_wdoc *doc, uint8_t **glb_out, size_t *len_out, sy_error *err)
+{
+    return sy_gltf_shim_write(doc, true, glb_out, len_out, err);
+}
+
+extern "C" sy_result sy_gltf_shim_write(const sy_gltf_shim_wdoc *doc, bool binary, uint8_t **glb_out, size_t *len_out,
+                                        sy_error *err)
 {
     *glb_out = nullptr;
     *len_out = 0;
@@ -161,7 +347,7 @@ extern "C" sy_result sy_gltf_shim_write_glb(const sy_gltf_shim_wdoc *doc, uint8_
         if (model.buffers[0].data.empty()) model.buffers.clear();
         std::ostringstream os(std::ios::binary);
         tinygltf::TinyGLTF writer;
-        if (!writer.WriteGltfSceneToStream(&model, os, false, true) || !os)
+        if (!writer.WriteGltfSceneToStream(&model, os, !binary, binary) || !os)
             return sy_error_set(err, SY_ERR_IO, "write GLB: tinygltf could not serialise the model");
         const std::string bytes = os.str();
         if (bytes.size() > size_t(UINT32_MAX))

@@ -1,6 +1,6 @@
 /** @file
  * sy_gltf_write.h — writes scene geometry as glTF 2.0 binary (GLB) through tinygltf (the shim in
- * sy_gltf_shim.cpp; no glTF JSON or GLB container is written by hand here).
+ * sy_gltf_shim_write.cpp; no glTF JSON or GLB container is written by hand here).
  *
  * What is written: placements — a mesh at a world matrix — as one glTF node each (a root of scene
  * 0, its matrix unless the identity, its name, and the caller's id as extras {"id": N}); each
@@ -62,6 +62,25 @@ sy_result sy_gltf_write_subtree(const sy_scene *s, sy_node root, const sy_gltf_w
 /** Writes the subtree's GLB to path (a temporary file renamed into place: sy_file.h). */
 sy_result sy_gltf_write_subtree_file(const sy_scene *s, sy_node root, const sy_gltf_write_options *opts,
                                      const char *path, sy_error *err);
+
+/** The whole scene under root as glTF 2.0 (sy convert): GLB (binary) or glTF JSON with one embedded
+ * data: URI buffer. Root's children are scene 0's nodes when root is plain (identity, nothing
+ * attached), else root itself is. Written: the node hierarchy (TRS or matrix as each node has it;
+ * a node reached along several paths once per path; hidden nodes left out with a warning), meshes
+ * with POSITION, NORMAL, TANGENT, TEXCOORD_0/1, COLOR_0 and indices, every sy_material_data field
+ * (metallic-roughness, normal / occlusion / emissive, KHR_materials_emissive_strength,
+ * _transmission, _ior, _unlit, _specular, _clearcoat, _sheen, _volume, _iridescence, _anisotropy,
+ * each omitted at its defaults; KHR_texture_transform and texCoord on every texture slot), one
+ * PNG image + sampler + texture per core texture, cameras, KHR_lights_punctual lights. Logged as
+ * warnings (sy_log, module "gltf") and left out: backgrounds (the world) and float textures.
+ * Same result codes as sy_gltf_write_placements. */
+sy_result sy_gltf_write_scene(const sy_scene *s, sy_node root, const sy_gltf_write_options *opts, bool binary,
+                              uint8_t **out, size_t *len_out, sy_error *err);
+
+/** sy_gltf_write_scene to path: GLB for ".glb", glTF JSON for ".gltf" (else SY_ERR_INVALID_ARGUMENT),
+ * through a temporary file renamed into place (sy_file.h): nothing is left on failure. */
+sy_result sy_gltf_write_scene_file(const sy_scene *s, sy_node root, const sy_gltf_write_options *opts, const char *path,
+                                   sy_error *err);
 
 #ifdef __cplusplus
 }

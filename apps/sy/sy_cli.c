@@ -177,6 +177,8 @@ static const char usage_text[] =
             "  sy demo [-o DIR] [-w W] [-h H] [--filter pixel|none|...]   (the progressive back-end's display filter)\n"
             "  sy compare SCENE [-w W] [-h H] [--spp N] [-o SHEET.png] [--camera C] [--backends a,b,...]\n"
             "            (every back-end side by side: contact sheet + mean luminance, ratio and IoU table)\n"
+            "  sy convert SCENE -o OUT.glb|OUT.gltf   (any scene sy reads written as glTF 2.0: hierarchy, meshes,\n"
+            "            materials and their extensions, PNG textures, cameras, lights; the rest named as warnings)\n"
             "  sy view SCENE [-b BACKEND] [-w W] [-h H] [--camera C] [--overlay FILE[:BACKEND]]\n"
             "          [--frames N --screenshot OUT.png] [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]\n"
             "          [--keys KEYS]   (automated runs: press these keys one frame after another, e.g. F]F[)\n"

@@ -9,6 +9,7 @@ int sy_cmd_info(int argc, char **argv);     /* sy_cmd_info.c */
 int sy_cmd_render(int argc, char **argv);   /* sy_cmd_render.c */
 int sy_cmd_demo(int argc, char **argv);     /* sy_cmd_demo.c */
 int sy_cmd_compare(int argc, char **argv);  /* sy_cmd_compare.c */
+int sy_cmd_convert(int argc, char **argv);  /* sy_cmd_convert.c */
 int sy_cmd_bench(int argc, char **argv);    /* sy_cmd_bench.c */
 int sy_cmd_backends(int argc, char **argv); /* sy_cmd_backends.c */
 int sy_cmd_coverage(int argc, char **argv); /* sy_cmd_coverage.c */

@@ -1,5 +1,5 @@
 /* sy_main.c — the `sy` command line tool: sy's own options and the dispatch to its commands (info,
- * render, demo, compare, coverage, view, web, bench, backends, serve), one file each (sy_commands.h).
+ * render, demo, compare, convert, coverage, view, web, bench, backends, serve), one file each (sy_commands.h).
  *
  *   sy [-q | -v] [--version | --help] COMMAND ...   -q: errors only, -v: debug messages (sy_log.h)
  *   sy help [COMMAND], sy COMMAND --help            usage on stdout, exit status 0
@@ -14,6 +14,7 @@
  *             [--gl osmesa|egl|glfw]  (raster back-end's GL context provider)
  *   sy demo [-o DIR] [-w W] [-h H]      render the built-in demo scene with every back-end
  *   sy compare SCENE [-w W] [-h H] [--spp N] [-o SHEET.png]   every back-end side by side (sy_compare.h)
+ *   sy convert SCENE -o OUT.glb|OUT.gltf   any readable scene as glTF 2.0 (sy_gltf_write.h)
  *   sy bench sync [--nodes N] [--tris T] [--repeats R]
  *   sy bench rays [SCENE] [-w W] [-h H] [--repeats R]
  *   sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params k=v,...]
@@ -89,7 +90,7 @@ int main(int argc, char **argv)
         printf("sy (Switchyard) %s\n", sy_version());
         return 0;
     }
-    static const char *const commands[] = {"info", "render", "demo", "compare", "bench", "backends", "coverage",
+    static const char *const commands[] = {"info", "render", "demo", "compare", "convert", "bench", "backends", "coverage",
                                            "serve", "view", "web", "version", "help"};
     if (!strcmp(cmd, "help")) { /* sy help [COMMAND] */
         bool known = argc < 2;
@@ -109,6 +110,7 @@ int main(int argc, char **argv)
     }
     if (!strcmp(cmd, "demo")) return sy_cmd_demo(argc, argv);
     if (!strcmp(cmd, "compare")) return sy_cmd_compare(argc, argv);
+    if (!strcmp(cmd, "convert")) return sy_cmd_convert(argc, argv);
     if (!strcmp(cmd, "bench")) return sy_cmd_bench(argc, argv);
     if (!strcmp(cmd, "backends")) return sy_cmd_backends(argc, argv);
     if (!strcmp(cmd, "coverage")) return sy_cmd_coverage(argc, argv);
