@@ -314,6 +314,12 @@ void build_model(const sy_gltf_shim_wdoc *d, tinygltf::Model &m)
             o["id"] = tinygltf::Value(double(w.id));
             n.extras = tinygltf::Value(o);
         }
+        // tinygltf serialises a node without any property as null, which no reader takes: such a
+        // node gets its (identity) matrix written
+        if (n.name.empty() && n.mesh < 0 && n.camera < 0 && n.children.empty() && n.extensions.empty() &&
+            n.matrix.empty() && n.translation.empty() && n.rotation.empty() && n.scale.empty() &&
+            n.extras.Type() == tinygltf::NULL_TYPE)
+            n.matrix = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
         m.nodes.push_back(n);
         if (!d->roots) scene.nodes.push_back(int(i));
     }
