@@ -57,6 +57,8 @@ expect "re" render
 refuse "re" info
 expect "-q re" render
 expect "" info render bench backends serve help
+expect "con" convert
+expect "convert -" -o
 expect "bench " sync rays filters cluster
 expect "render demo --tone" --tonemap
 expect "render demo --tonemap " clamp reinhard aces
