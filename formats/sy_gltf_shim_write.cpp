@@ -237,21 +237,14 @@ void build_model(const sy_gltf_shim_wdoc *d, tinygltf::Model &m)
             const int vt = TINYGLTF_TARGET_ARRAY_BUFFER;
             pr.attributes["POSITION"] = add_accessor(m, p.positions, p.vertex_count, TINYGLTF_TYPE_VEC3, 3,
                                                      TINYGLTF_COMPONENT_TYPE_FLOAT, vt, true);
-            if (p.normals)
-                pr.attributes["NORMAL"] = add_accessor(m, p.normals, p.vertex_count, TINYGLTF_TYPE_VEC3, 3,
-                                                       TINYGLTF_COMPONENT_TYPE_FLOAT, vt, false);
-            if (p.texcoords0)
-                pr.attributes["TEXCOORD_0"] = add_accessor(m, p.texcoords0, p.vertex_count, TINYGLTF_TYPE_VEC2, 2,
-                                                           TINYGLTF_COMPONENT_TYPE_FLOAT, vt, false);
-            if (p.tangents)
-                pr.attributes["TANGENT"] = add_accessor(m, p.tangents, p.vertex_count, TINYGLTF_TYPE_VEC4, 4,
-                                                        TINYGLTF_COMPONENT_TYPE_FLOAT, vt, false);
-            if (p.texcoords1)
-                pr.attributes["TEXCOORD_1"] = add_accessor(m, p.texcoords1, p.vertex_count, TINYGLTF_TYPE_VEC2, 2,
-                                                           TINYGLTF_COMPONENT_TYPE_FLOAT, vt, false);
-            if (p.colors)
-                pr.attributes["COLOR_0"] = add_accessor(m, p.colors, p.vertex_count, TINYGLTF_TYPE_VEC4, 4,
-                                                        TINYGLTF_COMPONENT_TYPE_FLOAT, vt, false);
+            const struct { const char *name; const float *data; int type, components; } attrs[] = {
+                {"NORMAL", p.normals, TINYGLTF_TYPE_VEC3, 3},        {"TEXCOORD_0", p.texcoords0, TINYGLTF_TYPE_VEC2, 2},
+                {"TANGENT", p.tangents, TINYGLTF_TYPE_VEC4, 4},      {"TEXCOORD_1", p.texcoords1, TINYGLTF_TYPE_VEC2, 2},
+                {"COLOR_0", p.colors, TINYGLTF_TYPE_VEC4, 4}};
+            for (const auto &a : attrs)
+                if (a.data)
+                    pr.attributes[a.name] = add_accessor(m, a.data, p.vertex_count, a.type, a.components,
+                                                         TINYGLTF_COMPONENT_TYPE_FLOAT, vt, false);
             if (p.indices && p.vertex_count <= 65536) { // 16-bit indices where they reach every vertex
                 std::vector<uint16_t> small(p.indices, p.indices + p.index_count);
                 pr.indices = add_accessor(m, small.data(), small.size(), TINYGLTF_TYPE_SCALAR, 1,
