@@ -32,18 +32,18 @@
 #define SHADOW_SIZE_DEFAULT 2048u
 #define SHADOW_SIZE_AUTO_MIN 256u
 enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_ENV_SPEC, UNIT_ENV_IRR, UNIT_BRDF,
-       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW0, UNIT_CUBE_SHADOW1, UNIT_PROBE, UNIT_LAYER0, UNIT_COUNT = UNIT_LAYER0 + 11 };
+       UNIT_LTC1, UNIT_LTC2, UNIT_CUBE_SHADOW0, UNIT_CUBE_SHADOW1, UNIT_PROBE, UNIT_LAYER0, UNIT_COUNT = UNIT_LAYER0 + 12 };
 /* the layers' texture slots (units UNIT_LAYER0 + i, sy_gl_shaders_layers.c): specular, specular
  * colour, clear coat, coat roughness, coat normal, sheen colour, sheen roughness, thickness,
- * anisotropy, iridescence, iridescence thickness */
-#define LAYER_TEXTURES 11
+ * anisotropy, iridescence, iridescence thickness, transmission */
+#define LAYER_TEXTURES 12
 #define STANDINS (5 + LAYER_TEXTURES) /* material units with a stand-in: the five base slots, the layers' */
 static inline void sy_gli_layer_refs(const sy_gl_material_desc *d, const sy_gl_texture_ref *r[LAYER_TEXTURES])
 {
     r[0] = &d->specular_texture, r[1] = &d->specular_color_texture, r[2] = &d->clearcoat_texture;
     r[3] = &d->clearcoat_roughness_texture, r[4] = &d->clearcoat_normal_texture, r[5] = &d->sheen_color_texture;
     r[6] = &d->sheen_roughness_texture, r[7] = &d->thickness_texture, r[8] = &d->anisotropy_texture;
-    r[9] = &d->iridescence_texture, r[10] = &d->iridescence_thickness_texture;
+    r[9] = &d->iridescence_texture, r[10] = &d->iridescence_thickness_texture, r[11] = &d->transmission_texture;
 }
 /* Scene probes: mirror-like and glass instances see the scene, not only the environment. Each of
  * the first SY_GL_MAX_PROBES such instances gets a cube map rendered from its bounding-box centre

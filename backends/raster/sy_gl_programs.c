@@ -91,7 +91,8 @@ bool sy_gli_material_layered(const sy_gl_device *dev, const sy_gl_material_desc 
     for (int i = 0; i < 3; ++i) l = l || d->specular_color[i] != 1.0f || d->sheen_color[i] > 0.0f;
     /* a texture on the specular factor or colour changes a material without other extensions */
     l = l || (dev->layer_units && (sy_gli_pool_get(&dev->textures, d->specular_texture.texture.id) ||
-                                   sy_gli_pool_get(&dev->textures, d->specular_color_texture.texture.id)));
+                                   sy_gli_pool_get(&dev->textures, d->specular_color_texture.texture.id) ||
+                                   (d->transmission > 0.0f && sy_gli_pool_get(&dev->textures, d->transmission_texture.texture.id))));
     return l && !d->unlit;
 }
 
@@ -100,7 +101,7 @@ void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog)
     static const char *names[UNIT_COUNT] = {"t_base", "t_mr",       "t_nrm",     "t_occ",  "t_emis", "t_shadow",
                                             "t_env_spec", "t_env_irr", "t_brdf", "t_ltc1", "t_ltc2", "t_cshadow0",
                                             "t_cshadow1", "t_probe", "t_l0", "t_l1", "t_l2", "t_l3", "t_l4",
-                                            "t_l5", "t_l6", "t_l7", "t_l8", "t_l9", "t_l10"};
+                                            "t_l5", "t_l6", "t_l7", "t_l8", "t_l9", "t_l10", "t_l11"};
     GLint max_units = 0;
     gl->GetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &max_units);
     gl->UseProgram(prog);

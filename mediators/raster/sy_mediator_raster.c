@@ -158,6 +158,7 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     memcpy(d.iridescence_thickness, m->iridescence_thickness, sizeof d.iridescence_thickness);
     d.iridescence_texture = texref(&m->iridescence_texture);
     d.iridescence_thickness_texture = texref(&m->iridescence_thickness_texture);
+    d.transmission_texture = texref(&m->transmission_texture);
     sy_gl_material h = {*a->handle};
     sy_gl_result r = h.id ? sy_gl_material_update(st->dev, h, &d)
                           : sy_gl_material_create(st->dev, &d, &h);

@@ -12,6 +12,7 @@
  *  4. KHR_materials_volume: attenuation tints what a glass sphere shows through it towards the
  *     attenuation colour (green and blue fall against red), and more with a larger thickness;
  *  4b. KHR_materials_iridescence: a grey metal under a white environment takes colours;
+ *  4c. KHR_materials_transmission's texture: R 0 shades as transmission 0, R 1 as the factor;
  *  6. an emissive polygon's reflection in the coat (LTC), its sheen at the rim;
  *  5. a material without extensions renders the same bits with a layered material in the frame
  *     (it then draws with the layered shader variant) as without.
@@ -267,6 +268,44 @@ int main(int argc, char **argv)
             printf("iridescence %d: centre %g %g %g\n", k, c[0], c[1], c[2]);
         }
         EXPECT_MSG(spread[0] < 1e-3f && spread[1] > 0.1f, "the film colours the metal: channel spread %g -> %g", spread[0], spread[1]);
+    }
+
+    /* 4c. the transmission texture (R x transmission): a dark dielectric sphere under a dim
+     * environment and a light from the camera diffuses the light where opaque and lets the
+     * environment through where it transmits; texture 0 shades as factor 0, texture 1 as factor 1
+     * without a texture (the sphere has no uv: every point reads texel (0, 0)) */
+    {
+        sy_gl_texture dim = constant_env(0.2f);
+        sy_gl_set_environment(d, dim, 1.0f);
+        sy_gl_light_desc front = {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3.0f,
+                                  .direction = {0, 0, -1}};
+        sy_gl_light fl;
+        MUST(sy_gl_light_create(d, &front, &fl));
+        sy_gl_material_desc opaque = dielectric(0.5f, 0.3f), clear = opaque;
+        clear.transmission = 1.0f;
+        render_with(&opaque);
+        stats so = measure();
+        render_with(&clear);
+        stats sc = measure();
+        printf("transmission 0 / 1: mean %g / %g\n", so.mean, sc.mean);
+        EXPECT_MSG(so.mean > 1.5f * sc.mean, "an opaque sphere diffuses the light a clear one lets pass: %g vs %g", so.mean,
+                   sc.mean);
+        for (int k = 0; k < 2; ++k) {
+            const unsigned char v = k ? 255 : 0, texels[16] = {v, 0, 0, 255, v, 0, 0, 255, v, 0, 0, 255, v, 0, 0, 255};
+            sy_gl_texture_desc td = {.width = 2, .height = 2, .channels = 4, .format = SY_GL_TEXEL_UNORM8, .pixels = texels};
+            sy_gl_material_desc tt = clear;
+            MUST(sy_gl_texture_create(d, &td, &tt.transmission_texture.texture));
+            render_with(&tt);
+            stats st = measure();
+            const stats *want = k ? &sc : &so;
+            printf("transmission texture R %d: mean %g brightest %g (want %g %g)\n", v, st.mean, st.max, want->mean, want->max);
+            EXPECT_MSG(fabsf(st.mean - want->mean) <= 0.02f * want->mean && fabsf(st.max - want->max) <= 0.02f * want->max,
+                       "transmission texture %d: mean %g brightest %g (want %g %g)", v, st.mean, st.max, want->mean, want->max);
+            MUST(sy_gl_texture_destroy(d, tt.transmission_texture.texture));
+        }
+        MUST(sy_gl_light_destroy(d, fl));
+        sy_gl_set_environment(d, env, 1.0f);
+        MUST(sy_gl_texture_destroy(d, dim));
     }
 
     /* 5. a plain material renders the same with a layered one in the frame */
