@@ -64,9 +64,9 @@
  * attenuation_distance) (Beer-Lambert over the thickness, as the Sample Viewer); anisotropy
  * stretches the GGX lobe along its direction (in the uv tangent frame) for punctual lights and
  * bends the normal for the environment; iridescence replaces the lobes' F0 by the thin film's
- * (mixed by its weight). The extensions' textures, and the transmission texture (a material with
- * one draws with this variant), scale their factors as glTF says where the context has 26 texture
- * units (else the factors alone). Emissive polygons see the base scaled by
+ * (mixed by its weight). The extensions' textures, and the transmission texture (read by the
+ * transmissive variant, not this one), scale their factors as glTF says where the context has 26
+ * texture units (else the factors alone). Emissive polygons see the base scaled by
  * the coat and sheen, the coat's lobe (LTC) and the sheen as a wide lobe of albedo E; no anisotropy.
  * Shadows: directional and spot lights and area lights (from the polygon's centre along its
  * normal, a 150-degree frustum; a Poisson PCF over a penumbra of fixed world radius, 0.3 x the

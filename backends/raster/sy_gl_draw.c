@@ -380,7 +380,10 @@ static int material_features(const sy_gl_device *dev, const mat_o *mt)
     /* a metallic-roughness texture scales metallic per texel: a metal factor of 1 still transmits
      * where the texture says dielectric (TransmissionTest's striped "Metal" spheres) */
     bool mr_tex = sy_gli_pool_get(&dev->textures, mt->d.metallic_roughness_texture.texture.id) != NULL;
-    if (mt->d.transmission > 0.0f && (mt->d.metallic < 1.0f || mr_tex)) v |= VAR_TRANS;
+    if (mt->d.transmission > 0.0f && (mt->d.metallic < 1.0f || mr_tex)) {
+        v |= VAR_TRANS;
+        if (dev->layer_units && sy_gli_pool_get(&dev->textures, mt->d.transmission_texture.texture.id)) v |= VAR_TEX;
+    }
     if (sy_gli_material_layered(dev, &mt->d)) {
         v |= VAR_LAYERS;
         if (mt->d.anisotropy > 0.0f) v |= VAR_TEX; /* its direction follows the uv tangent */

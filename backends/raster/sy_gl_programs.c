@@ -91,8 +91,7 @@ bool sy_gli_material_layered(const sy_gl_device *dev, const sy_gl_material_desc 
     for (int i = 0; i < 3; ++i) l = l || d->specular_color[i] != 1.0f || d->sheen_color[i] > 0.0f;
     /* a texture on the specular factor or colour changes a material without other extensions */
     l = l || (dev->layer_units && (sy_gli_pool_get(&dev->textures, d->specular_texture.texture.id) ||
-                                   sy_gli_pool_get(&dev->textures, d->specular_color_texture.texture.id) ||
-                                   (d->transmission > 0.0f && sy_gli_pool_get(&dev->textures, d->transmission_texture.texture.id))));
+                                   sy_gli_pool_get(&dev->textures, d->specular_color_texture.texture.id)));
     return l && !d->unlit;
 }
 

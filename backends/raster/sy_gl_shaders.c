@@ -70,6 +70,7 @@ const char *const sy_gl_main_vs =
     "  vec4 m_l0, m_l1, m_l2, m_l3, m_l4, m_l5; ivec4 m_lt0, m_lt1, m_lt2; vec4 m_lxf[24];\n" /* the layers (mat_block, sy_gl_shaders_layers.c) */ \
     "};\n"                                                                                                   \
     "uniform sampler2D t_base, t_mr, t_nrm, t_occ, t_emis;\n"                                                \
+    "#ifdef SY_TRANS\n" "uniform sampler2D t_l11;\n" "#endif\n" /* the transmission texture */             \
     "vec2 tuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_xf[2*k].xyz, h), dot(m_xf[2*k+1].xyz, h)); }\n" \
     /* the texture coordinate set s (0, 1): a select, not an array indexed at run time (a local \
      * array read with a dynamic index made llvmpipe's LLVM spend seconds per texture look-up) */ \
@@ -96,7 +97,6 @@ const char *const sy_gl_main_vs =
     "#define FDT vec3\n#define SCHL_D schlick\n#define F0D f0c\n#define F0M f0m\n" \
     "vec3 g_nc;\n" /* the clear coat's normal: the surface's, without its normal map (main) */ \
     "vec3 layer_light(vec3 wi, vec3 wo, vec3 ns, float nl, vec3 f);\n" \
-    "float g_tr;\n" /* layer_init: the transmission texture's factor (1 without one) */ \
     "float g_ls;\n" /* layer_f0: what the coat and sheen leave to the base, once per fragment */ \
     "vec3 layer_env(vec3 env, vec3 ns, vec3 wo, float nv, vec3 irr);\n" \
     "void layer_f0(float f0, vec3 bc, float metallic, vec3 ns, vec3 wo, float nv, out vec3 f0c, out vec3 f0m);\n" \
@@ -456,7 +456,14 @@ const char *const sy_gl_main_fs =
     "    vec3 bc = clamp(base.rgb, 0.0, 1.0);\n"
     "    float ior = m_oist.y, spec = clamp(m_oist.z, 0.0, 1.0), trans = clamp(m_oist.w, 0.0, 1.0);\n"
     "#ifdef SY_LAYERS\n"
-    "    spec *= spec_tex; trans *= g_tr;\n"
+    "    spec *= spec_tex;\n"
+    "#endif\n"
+    /* the transmission texture (R), the layers' slot 11 (its uv set m_lt2.w, transform m_lxf[22..23]):
+     * read by the transmissive variant, not the layered one (whose size on every pixel of
+     * TransmissionTest's textured glass made its frame 5 times slower on llvmpipe) */
+    "#if defined(SY_TRANS) && defined(SY_TEX)\n"
+    "    if (m_lt2.w >= 0) { vec3 h = vec3(UVSET(m_lt2.w), 1.0);\n"
+    "      trans *= texture(t_l11, vec2(dot(m_lxf[22].xyz, h), dot(m_lxf[23].xyz, h))).r; }\n"
     "#endif\n"
     "    float ao = 1.0;\n"
     "#if defined(SY_TEX) && (defined(SY_AREA) || defined(SY_ENV) || defined(SY_PROBE))\n"

@@ -33,13 +33,14 @@
  * thickness minimum, maximum); the textures (units t_l0 .. t_l7, uv sets m_lt0, m_lt1, transforms m_lxf) scale them
  * as glTF says (layer_init: specular A, specular colour RGB, clearcoat R, coat roughness G, coat
  * normal, sheen colour RGB, sheen roughness A, thickness G, anisotropy RGB, iridescence R,
- * iridescence thickness G, transmission R: g_tr) into g_l0 .. g_l5 and g_tr. */
+ * iridescence thickness G) into g_l0 .. g_l5. The transmission texture (slot 11) is read by the
+ * transmissive variant itself (sy_gl_shaders.c, SY_TRANS). */
 #include "sy_gl_shaders.h"
 
 const char *const sy_gl_layers_fs =
     "\n"
     "uniform mat4 u_model;\n" /* the vertex stage's: the instance's scale for the volume */
-    "uniform sampler2D t_l0, t_l1, t_l2, t_l3, t_l4, t_l5, t_l6, t_l7, t_l8, t_l9, t_l10, t_l11;\n"
+    "uniform sampler2D t_l0, t_l1, t_l2, t_l3, t_l4, t_l5, t_l6, t_l7, t_l8, t_l9, t_l10;\n"
     "vec4 g_l0, g_l1, g_l2, g_l3, g_l4, g_l5;\n" /* m_l0 .. m_l5 times the textures (layer_init) */
     "vec3 g_at, g_T, g_B;\n" /* the anisotropy direction (world; zero: none); its frame at ns (layer_f0) */
     "bool g_an;\n" /* that frame exists */
@@ -49,7 +50,7 @@ const char *const sy_gl_layers_fs =
      * returns the specular texture's factor */
     "float layer_init(vec3 n, bool front, vec3 dpx, vec3 dpy) {\n"
     "  g_l0 = m_l0; g_l1 = m_l1; g_l2 = m_l2; g_l3 = m_l3; g_l4 = m_l4; g_l5 = m_l5; float s = 1.0; vec3 nc = n;\n"
-    "  g_at = vec3(0.0); g_l5.w = m_l5.w; g_tr = 1.0;\n"
+    "  g_at = vec3(0.0); g_l5.w = m_l5.w;\n"
     "#ifdef SY_TEX\n"
     "  if (m_lt0.x >= 0) s = texture(t_l0, ltuv(0, UVSET(m_lt0.x))).a;\n"
     "  if (m_lt0.y >= 0) g_l0.rgb *= texture(t_l1, ltuv(1, UVSET(m_lt0.y))).rgb;\n"
@@ -69,7 +70,6 @@ const char *const sy_gl_layers_fs =
     "  }\n"
     "  if (m_lt2.y >= 0) g_l5.x *= texture(t_l9, ltuv(9, UVSET(m_lt2.y))).r;\n"
     "  if (m_lt2.z >= 0) g_l5.w = mix(m_l5.z, m_l5.w, texture(t_l10, ltuv(10, UVSET(m_lt2.z))).g);\n"
-    "  if (m_lt2.w >= 0) g_tr = texture(t_l11, ltuv(11, UVSET(m_lt2.w))).r;\n"
     "#endif\n"
     "  g_nc = front ? nc : -nc; return s; }\n"
     "float layer_max3(vec3 c) { return max(c.r, max(c.g, c.b)); }\n"
