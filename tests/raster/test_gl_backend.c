@@ -173,7 +173,33 @@ int main(int argc, char **argv)
         MUST(sy_gl_instance_destroy(d, m));
     }
 
-    /* 5. sRGB texture, downscaled to max_texture_size = 4 with a warning */
+    /* 4b. depth precision under a tiny near plane: TransmissionTest's camera has znear 5.6e-5 and
+     * its labels' two faces lie 1.6e-3 apart 1.5 units away; the back face showed through in
+     * stripes. Two tilted quads that close: only the front one (red) may show */
+    {
+        const float dz = 1.6e-3f;
+        float fq[12] = {-1, -1, -1.2f, 1, -1, -1.2f, 1, 1, -1.8f, -1, 1, -1.8f}, bq[12];
+        memcpy(bq, fq, sizeof bq);
+        for (int k = 0; k < 4; ++k) bq[3 * k + 2] -= dz;
+        sy_gl_mesh mf = quad(d, fq, nz), mb = quad(d, bq, nz);
+        sy_gl_material red = material(d, 1, 0, 0, 1, true, SY_GL_ALPHA_OPAQUE), blue = material(d, 0, 0, 1, 1, true, SY_GL_ALPHA_OPAQUE);
+        sy_gl_instance b = place(d, mb, blue), f = place(d, mf, red); /* the back one first */
+        sy_gl_camera tiny = cam;
+        tiny.near_clip = 5.6e-5f;
+        tiny.far_clip = 0.0f;
+        render(d, &tiny);
+        int covered = 0, behind = 0;
+        for (int i = 0; i < N * N; ++i) {
+            covered += rgba[4 * i + 3] > 0.0f;
+            behind += rgba[4 * i + 2] > rgba[4 * i];
+        }
+        printf("near 5.6e-5: %d pixels covered, %d show the face 1.6e-3 behind\n", covered, behind);
+        EXPECT_MSG(covered > N * N / 4 && behind == 0, "%d of %d covered pixels show the back face", behind, covered);
+        MUST(sy_gl_instance_destroy(d, f));
+        MUST(sy_gl_instance_destroy(d, b));
+    }
+
+
     {
         unsigned char tex[8 * 8 * 3];
         memset(tex, 188, sizeof tex);
