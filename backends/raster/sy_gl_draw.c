@@ -96,11 +96,9 @@ static double nearest_depth(const sy_gl_device *dev, const float pos[3], const f
         const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
         if (!m) continue;
         for (int k = 0; k < 8; ++k) {
-            float p[3] = {k & 1 ? m->bmax[0] : m->bmin[0], k & 2 ? m->bmax[1] : m->bmin[1], k & 4 ? m->bmax[2] : m->bmin[2]};
-            double d = 0.0;
-            for (int a = 0; a < 3; ++a)
-                d += ((double)in->model[a] * p[0] + in->model[4 + a] * p[1] + in->model[8 + a] * p[2] + in->model[12 + a] - pos[a]) *
-                     fwd[a];
+            float w[3];
+            sy_gli_world_corner(in, m, k, w);
+            double d = ((double)w[0] - pos[0]) * fwd[0] + ((double)w[1] - pos[1]) * fwd[1] + ((double)w[2] - pos[2]) * fwd[2];
             if (d < nearest) nearest = d;
         }
     }

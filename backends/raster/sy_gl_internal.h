@@ -394,6 +394,13 @@ float sy_gli_pixels_per_triangle(const sy_gl_device *dev, const mesh_o *m, uint3
 
 /* sy_gl_shadows.c */
 void sy_gli_scene_bounds(const sy_gl_device *dev, float *c, float *radius);
+/* Corner k (0..7: bit 0 x, 1 y, 2 z at the maximum) of instance in's world box (its mesh m's box
+ * transformed). */
+static inline void sy_gli_world_corner(const inst_o *in, const mesh_o *m, int k, float out[3])
+{
+    float p[3] = {k & 1 ? m->bmax[0] : m->bmin[0], k & 2 ? m->bmax[1] : m->bmin[1], k & 4 ? m->bmax[2] : m->bmin[2]};
+    for (int a = 0; a < 3; ++a) out[a] = in->model[a] * p[0] + in->model[4 + a] * p[1] + in->model[8 + a] * p[2] + in->model[12 + a];
+}
 void sy_gli_lights_upload(sy_gl_device *dev, frame_state *fs);
 sy_gl_result sy_gli_shadow_maps_make(sy_gl_device *dev, sy_gl_report *rep);
 void sy_gli_shadow_size_follow(sy_gl_device *dev, uint32_t w, uint32_t h);

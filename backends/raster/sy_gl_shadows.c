@@ -17,12 +17,9 @@ void sy_gli_scene_bounds(const sy_gl_device *dev, float *c, float *radius)
         const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
         if (!m) continue;
         for (int k = 0; k < 8; ++k) {
-            float p[3] = {k & 1 ? m->bmax[0] : m->bmin[0], k & 2 ? m->bmax[1] : m->bmin[1], k & 4 ? m->bmax[2] : m->bmin[2]};
-            for (int a = 0; a < 3; ++a) {
-                float v = in->model[a] * p[0] + in->model[4 + a] * p[1] + in->model[8 + a] * p[2] + in->model[12 + a];
-                lo[a] = fminf(lo[a], v);
-                hi[a] = fmaxf(hi[a], v);
-            }
+            float v[3];
+            sy_gli_world_corner(in, m, k, v);
+            for (int a = 0; a < 3; ++a) lo[a] = fminf(lo[a], v[a]), hi[a] = fmaxf(hi[a], v[a]);
         }
     }
     if (!(lo[0] <= hi[0])) {

@@ -78,6 +78,16 @@ static sy_gl_texture constant_env(float v)
     return h;
 }
 
+/* a 2x2 RGBA texture whose R is v (0..255) everywhere */
+static sy_gl_texture texture_r(unsigned char v)
+{
+    const unsigned char texels[16] = {v, 0, 0, 255, v, 0, 0, 255, v, 0, 0, 255, v, 0, 0, 255};
+    sy_gl_texture_desc td = {.width = 2, .height = 2, .channels = 4, .format = SY_GL_TEXEL_UNORM8, .pixels = texels};
+    sy_gl_texture t;
+    MUST(sy_gl_texture_create(d, &td, &t));
+    return t;
+}
+
 /* a unit sphere wound counter-clockwise seen from outside (gl_sphere.h's is wound the other way,
  * so its outside shows its back face), smooth outward normals, uv = (longitude, colatitude) / (2 pi, pi):
  * the u tangent is horizontal */
@@ -155,10 +165,9 @@ int main(int argc, char **argv)
     /* the clearcoat texture scales the weight (R): 0 leaves the base, 1 the coat (the sphere has no
      * uv: every point reads texel (0, 0)) */
     for (int k = 0; k < 2; ++k) {
-        const unsigned char v = k ? 255 : 0, texels[16] = {v, 0, 0, 255, v, 0, 0, 255, v, 0, 0, 255, v, 0, 0, 255};
-        sy_gl_texture_desc td = {.width = 2, .height = 2, .channels = 4, .format = SY_GL_TEXEL_UNORM8, .pixels = texels};
+        const unsigned char v = k ? 255 : 0;
         sy_gl_material_desc tc = coat;
-        MUST(sy_gl_texture_create(d, &td, &tc.clearcoat_texture.texture));
+        tc.clearcoat_texture.texture = texture_r(v);
         render_with(&tc);
         stats st = measure();
         const stats *want = k ? &s1 : &s0;
@@ -291,10 +300,9 @@ int main(int argc, char **argv)
         EXPECT_MSG(so.mean > 1.5f * sc.mean, "an opaque sphere diffuses the light a clear one lets pass: %g vs %g", so.mean,
                    sc.mean);
         for (int k = 0; k < 2; ++k) {
-            const unsigned char v = k ? 255 : 0, texels[16] = {v, 0, 0, 255, v, 0, 0, 255, v, 0, 0, 255, v, 0, 0, 255};
-            sy_gl_texture_desc td = {.width = 2, .height = 2, .channels = 4, .format = SY_GL_TEXEL_UNORM8, .pixels = texels};
+            const unsigned char v = k ? 255 : 0;
             sy_gl_material_desc tt = clear;
-            MUST(sy_gl_texture_create(d, &td, &tt.transmission_texture.texture));
+            tt.transmission_texture.texture = texture_r(v);
             render_with(&tt);
             stats st = measure();
             const stats *want = k ? &sc : &so;
