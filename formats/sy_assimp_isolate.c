@@ -30,6 +30,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -37,6 +38,20 @@
 #include <unistd.h>
 
 #define ISO_MAGIC 0x49415953u /* "SYAI" */
+
+/* AddressSanitizer (gcc 12's libasan) deadlocks in its allocator in a child forked from a process
+ * with more than one thread (seen: `sy info` under ASan, whose signal thread was waiting in
+ * sigwait, hung in the child's first malloc every time); glibc's malloc is fork-safe. */
+#if defined(__SANITIZE_ADDRESS__)
+#define ISO_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define ISO_SANITIZER 1
+#endif
+#endif
+#ifndef ISO_SANITIZER
+#define ISO_SANITIZER 0
+#endif
 #define ISO_MAX_WARNING_BYTES (1u << 20)
 #define ISO_MAX_CAMERAS (1u << 20)
 
@@ -96,8 +111,12 @@ static uint64_t address_space_bytes(void)
     return pages * (uint64_t)(ps > 0 ? ps : 4096);
 }
 
-static void child_limits(const iso_job *j)
+static void child_limits(const iso_job *j, pid_t parent)
 {
+    /* the child must not outlive a caller killed while it waits (it would hold its limits' worth
+     * of memory and CPU for nothing) */
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(4);
     static const int deadly[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGXCPU, SIGPIPE, SIGTERM, SIGTRAP};
     for (size_t k = 0; k < sizeof deadly / sizeof deadly[0]; ++k) signal(deadly[k], SIG_DFL); /* not the caller's handlers */
     struct rlimit cpu = {j->cpu_seconds, (rlim_t)j->cpu_seconds + 5}; /* SIGXCPU, then SIGKILL */
@@ -115,9 +134,9 @@ static void child_limits(const iso_job *j)
 }
 
 /* The load on the child's copy of the scene, then the message; never returns. */
-static void child_main(int fd, const iso_job *j)
+static void child_main(int fd, const iso_job *j, pid_t parent)
 {
-    child_limits(j);
+    child_limits(j, parent);
     iso_head h;
     memset(&h, 0, sizeof h);
     h.magic = ISO_MAGIC;
@@ -308,7 +327,7 @@ static sy_result load_isolated(iso_job *j, sy_assimp_info *info, sy_error *err)
     j->wall_seconds = 2 * j->cpu_seconds + 30;
     int fds[2];
     if (pipe(fds) != 0) return sy_error_set(err, SY_ERR_IO, "%s: cannot start the import process (pipe: %s)", p, strerror(errno));
-    pid_t pid = fork();
+    pid_t parent = getpid(), pid = fork();
     if (pid < 0) {
         int e = errno;
         close(fds[0]), close(fds[1]);
@@ -316,7 +335,7 @@ static sy_result load_isolated(iso_job *j, sy_assimp_info *info, sy_error *err)
     }
     if (pid == 0) {
         close(fds[0]);
-        child_main(fds[1], j);
+        child_main(fds[1], j, parent);
     }
     close(fds[1]);
     iso_reader rd = {fds[0], pid, now_seconds() + j->wall_seconds, false, false};
@@ -358,10 +377,23 @@ static sy_result load_isolated(iso_job *j, sy_assimp_info *info, sy_error *err)
     return r;
 }
 
+/* Threads of this process (0 when /proc does not say). */
+static unsigned thread_count(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    unsigned n = 0;
+    while (f && fgets(line, sizeof line, f))
+        if (!strncmp(line, "Threads:", 8)) n = (unsigned)strtoul(line + 8, NULL, 10);
+    if (f) fclose(f);
+    return n;
+}
+
 static sy_result load(const char *path, const void *mem, size_t mem_size, const char *base_dir, sy_scene *scene,
                       const sy_assimp_options *opts, sy_assimp_info *info_out, sy_error *err)
 {
-    if (opts && opts->in_process) return asp_load_here(path, mem, mem_size, base_dir, scene, opts, info_out, NULL, err);
+    bool here = (opts && opts->in_process) || (ISO_SANITIZER && thread_count() != 1);
+    if (here) return asp_load_here(path, mem, mem_size, base_dir, scene, opts, info_out, NULL, err);
     sy_assimp_info local;
     sy_assimp_info *info = info_out ? info_out : &local;
     memset(info, 0, sizeof *info);

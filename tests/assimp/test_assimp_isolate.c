@@ -10,6 +10,7 @@
  *    max_import_seconds 1 is stopped by the CPU limit (SY_ERR_LIMIT naming the file), the caller's
  *    scene untouched;
  *  - a failed import in the child leaves the caller's scene as it was;
+ *  - loads while another thread allocates without pause complete (forks amid malloc's locks);
  *  - every input in tests/fuzz/corpus_contained/assimp_<ext>/ (faults inside Assimp that fuzz.sh
  *    found and the import process contains: crashes, aborts, endless growth) fails the load with an
  *    error naming the file, the caller's scene untouched. */
@@ -19,6 +20,8 @@
 #include "../formats/test_util.h"
 
 #include <dirent.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <math.h>
 #include <stdlib.h>
 #include <time.h>
@@ -94,6 +97,19 @@ static void compare_both_ways(const char *path, bool pending)
     sy_assimp_info_free(&ih);
     sy_scene_destroy(iso);
     sy_scene_destroy(here);
+}
+
+/* a thread that allocates and frees without pause, so that forks happen while it holds malloc's
+ * locks */
+static atomic_int g_stop;
+static void *churn(void *arg)
+{
+    (void)arg;
+    while (!atomic_load(&g_stop)) {
+        void *volatile p = malloc(4096 + (size_t)(rand() % 65536));
+        free(p);
+    }
+    return NULL;
 }
 
 static long rss_kib(void)
@@ -186,6 +202,25 @@ int main(void)
                    "the CPU limit stops the import: %d %s", (int)r, e.message);
         EXPECT_MSG(s && sy_scene_count(s, SY_TYPE_NODE) == 1 && !sy_scene_has_pending(s), "the caller's scene is as it was");
         sy_scene_destroy(s);
+    }
+
+    /* loads while another thread allocates (glibc's malloc is fork-safe; a sanitizer build loads
+     * in process when other threads exist): each completes with the same counts */
+    {
+        pthread_t th;
+        EXPECT(pthread_create(&th, NULL, churn, NULL) == 0);
+        for (int k = 0; k < 8; ++k) {
+            sy_scene *s = prepared(false);
+            sy_assimp_info info = {0};
+            PATHF(p, "%s/quad.obj", dir);
+            sy_result r = s ? sy_assimp_load(p, s, NULL, &info, &e) : SY_ERR_OUT_OF_MEMORY;
+            EXPECT_MSG(r == SY_OK && info.counts.triangles == 2, "load %d beside an allocating thread: %s", k, e.message);
+            sy_assimp_info_free(&info);
+            sy_scene_destroy(s);
+        }
+        atomic_store(&g_stop, 1);
+        pthread_join(th, NULL);
+        printf("8 loads beside an allocating thread: done\n");
     }
 
     /* the contained faults fuzz.sh kept */
