@@ -72,7 +72,10 @@
  * the caller had plus 1 GiB and 1024 bytes per byte of the model (zlib's largest expansion), at
  * most 1 GiB plus twice max_scene_bytes (past it: Assimp's std::bad_alloc, SY_ERR_PARSE, or the
  * signal, SY_ERR_LIMIT). Assimp's OutOfMemory.off test file now fails in 0.05 s; in the caller's
- * process it grew past 4 GB for more than 30 s. The caller's uncommitted changes stay uncommitted. Cost: the fork and one copy
+ * process it grew past 4 GB for more than 30 s. The child dies with its caller (PR_SET_PDEATHSIG).
+ * A build with AddressSanitizer loads in the caller's process when the caller has other threads
+ * (gcc 12's libasan deadlocks in a child forked from a multi-threaded process; glibc's malloc does
+ * not). The caller's uncommitted changes stay uncommitted. Cost: the fork and one copy
  * of the created objects' data (sy bench load measures it).
  *
  * Untrusted input: the file itself is read once within max_file_bytes and handed to Assimp from
