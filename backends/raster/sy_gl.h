@@ -210,6 +210,8 @@ typedef struct sy_gl_stats {
     uint64_t instances_culled;   /**< last frame, main pass: instances outside the view, not drawn */
     uint64_t deferred_draws;     /**< last frame, main pass: instances drawn into the G-buffer (deferred) */
     uint64_t deferred_pixels;    /**< last frame: pixels the deferred pass shaded (the tiles those instances touch) */
+    uint64_t programs_built;     /**< main-pass shader programs built since creation (the driver compiles each on
+                                      its first draw: most of a first frame's time on llvmpipe) */
     /** @{ uploads of the last frame and since creation */
     sy_gl_upload_counts frame, total; /** @} */
 } sy_gl_stats;

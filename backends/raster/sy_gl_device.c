@@ -233,6 +233,7 @@ void sy_gl_device_stats(const sy_gl_device *dev, sy_gl_stats *out)
     out->instances_culled = dev->culled;
     out->deferred_draws = dev->deferred_draws;
     out->deferred_pixels = dev->deferred_pixels;
+    out->programs_built = dev->programs_built;
     out->frame = dev->frame;
     out->total = dev->counts;
 }

@@ -615,14 +615,17 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
      * compiles each program on its first draw in each pipeline state (about 0.2-0.5 s of LLVM for a
      * lit one), and a program that samples textures, maps normals or transmits only where the
      * material's uniforms say so draws the others as they were. TransmissionTest's first frame
-     * compiled 11 main-pass shaders before, 6 now (issue 32). */
+     * compiled 11 main-pass shaders before, 6 with shared features, 4 since a draw without a probe
+     * of its own reads the environment through the probe's unit (sy_gli_draw_scene; issue 32: 8.7 ->
+     * 5.3 s cold at 200x150 on llvmpipe, 1.7 -> 1.8 s warm). */
     pv = sy_gli_variant_normalize(pv | dc->shared);
     sy_gl_result r = use_variant(dev, dc, pv, rep);
     if (r != SY_GL_OK) return r;
-    if (probe >= 0) {
+    if (pv & VAR_PROBE) { /* its own probe (the 1-texel mip for roughness 1), or the environment's cube */
         gl->ActiveTexture(GL_TEXTURE0 + UNIT_PROBE);
-        gl->BindTexture(GL_TEXTURE_CUBE_MAP, dev->probes[probe].cube);
-        gl->Uniform1f(dev->pm[pv].probe_lod, log2f((float)dev->probe_size)); /* the 1-texel mip */
+        gl->BindTexture(GL_TEXTURE_CUBE_MAP, probe >= 0 ? dev->probes[probe].cube : dev->ibl.spec_cube);
+        gl->Uniform1f(dev->pm[pv].probe_lod,
+                      probe >= 0 ? log2f((float)dev->probe_size) : (float)(SY_GL_IBL_SPEC_LEVELS - 1));
     }
     sy_gli_bind_material(dev, in->material, (pv & VAR_TEX) != 0);
     float mvp[16];
@@ -704,7 +707,9 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
         dev->rect_count = 0;
         dev->rect_all = false;
     }
-    dc.shared = dev->shared_features;
+    /* with an environment, a draw without a probe of its own reads the prefiltered environment
+     * through the probe's unit (draw_instance): one program for both, in the probe pass too */
+    dc.shared = dev->shared_features | (dev->env_ready && dev->probe_count ? VAR_PROBE : 0);
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
         inst_o *in = sy_gli_pool_at(&dev->instances, i);
         if (!in->h.id || !in->visible || i == skip) continue;

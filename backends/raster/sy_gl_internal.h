@@ -249,6 +249,7 @@ struct sy_gl_device {
     uint32_t rect_count, rect_cap;
     bool rect_all;
     uint64_t deferred_pixels; /* the pixels the last deferred pass shaded */
+    uint64_t programs_built;  /* main-pass programs built since creation (sy_gli_main_program) */
     uint8_t *tiles;       /* rect_tiles: RECT_TILE-pixel tiles the rectangles touch, then both lists of */
     float (*spans)[4];    /* tile runs in NDC (sy_gl_rect_vs) */
     uint32_t *runs;       /* rect_tiles' scratch: two per tile column */

@@ -210,6 +210,7 @@ GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep)
     if (sy_gl_program_build_tail(gl, name, sy_gl_main_vs, sy_gl_main_fs, defs, (v & VAR_LAYERS) ? sy_gl_layers_fs : NULL,
                                  &p, rep) != SY_GL_OK)
         return 0;
+    dev->programs_built++;
     dev->pm[v].prog = p;
     dev->pm[v].sig = sig;
     dev->pm[v].model = gl->GetUniformLocation(p, "u_model");

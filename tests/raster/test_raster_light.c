@@ -2,7 +2,8 @@
  * the back-end API (sy_gl.h), against analytic values:
  *  1. a constant white environment of radiance E lights a Lambert quad (no specular) to exactly
  *     base x E (irradiance pi E); the background stays transparent (the environment is no
- *     background) and a TEXTURE background shows the texel x intensity with alpha 1;
+ *     background) and a TEXTURE background shows the texel x intensity with alpha 1; beside a
+ *     mirror with a scene probe it shades the same, in one program for both;
  *  2. a mirror (metallic 1, roughness 0) under a lat-long environment whose upper half is 2 and lower
  *     half 0.5 reflects one half or the other, not their mean (the prefiltered mip 0 is sharp);
  *     without an environment it reflects the scene around it (an emissive ceiling; its scene
@@ -104,6 +105,30 @@ int main(int argc, char **argv)
     sy_gl_mesh mq = quad(d, facing, nz);
     sy_gl_instance q = place(d, mq, lambert(d, 0.5f));
     sy_gl_set_environment(d, env, 2.0f);
+    /* 1a. (the device's first frame) a mirror (it gets a scene probe) in a corner of the view: the
+     * Lambert quad shades as without it, and the frame builds one program for both (the quad reads
+     * the prefiltered environment through the probe's unit, in the probe pass too); two were built
+     * before (issue 32: each costs a compile on llvmpipe) */
+    {
+        sy_gl_material_desc md;
+        sy_gl_material_desc_init(&md);
+        md.metallic = 1.0f;
+        md.roughness = 0.0f;
+        sy_gl_material mm;
+        MUST(sy_gl_material_create(d, &md, &mm));
+        const float corner[12] = {-1.4f, 1.1f, -2.5f, -1.1f, 1.1f, -2.5f, -1.1f, 1.4f, -2.5f, -1.4f, 1.4f, -2.5f};
+        sy_gl_instance mi = place(d, quad(d, corner, nz), mm);
+        sy_gl_stats st0, st1;
+        sy_gl_device_stats(d, &st0);
+        MUST(sy_gl_render(d, &cam, &full, rgba, depth));
+        sy_gl_device_stats(d, &st1);
+        printf("Lambert beside a probed mirror %g (want 1.5), programs built %llu\n", px(16, 16)[0],
+               (unsigned long long)(st1.programs_built - st0.programs_built));
+        EXPECT_MSG(near_(px(16, 16)[0], 0.5f * 3.0f, 0.02f), "Lambert beside a probed mirror: %g (want %g)", px(16, 16)[0], 1.5);
+        EXPECT_MSG(st1.programs_built - st0.programs_built == 1, "a frame with a probe built %llu programs (want 1)",
+                   (unsigned long long)(st1.programs_built - st0.programs_built));
+        MUST(sy_gl_instance_destroy(d, mi));
+    }
     MUST(sy_gl_render(d, &cam, &full, rgba, depth));
     printf("Lambert under a constant environment of 3: %g (want 1.5)\n", px(16, 16)[0]);
     EXPECT_MSG(near_(px(16, 16)[0], 0.5f * 3.0f, 0.02f), "Lambert under a constant environment: %g (want %g)", px(16, 16)[0], 1.5);
