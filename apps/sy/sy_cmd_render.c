@@ -528,8 +528,8 @@ int sy_cmd_render(int argc, char **argv)
     } else if (r == SY_OK) r = sy_compose_render(ld.scene, pool, &spec, w, h, &ro, &img, &img_right, &err);
     secs = sy_time_now() - t0;
     /* the image's metadata (EXR header attributes, PNG text chunks): what made it and how */
-    sy_exr_attribute attrs[12];
-    sy_png_text texts[12];
+    sy_exr_attribute attrs[14];
+    sy_png_text texts[14];
     char renderer[64], size_str[48], camera_str[256];
     if (r == SY_OK) {
         if (!progressive) { /* what the main back-end accumulated (a single pass: 1) */
@@ -554,8 +554,20 @@ int sy_cmd_render(int argc, char **argv)
                      camera ? camera : "the scene's first camera", (double)cm.m[12], (double)cm.m[13], (double)cm.m[14],
                      (double)-cm.m[8], (double)-cm.m[9], (double)-cm.m[10]);
         else snprintf(camera_str, sizeof camera_str, "a view framing the scene's bounds");
+        /* the exact view, for a renderer that is to see the same (tests/cycles/materials.sh): the
+         * camera-to-world matrix (column-major, as glTF) and the projection's vertical extent */
+        char matrix_str[16 * 18] = "", proj_str[64] = "";
+        const sy_node_data *cnd = has_cam ? sy_node_get(ld.scene, ld.camera) : NULL;
+        const sy_camera_data *ccd = cnd ? sy_camera_get(ld.scene, cnd->camera) : NULL;
+        if (ccd) {
+            for (int k = 0, n = 0; k < 16; ++k)
+                n += snprintf(matrix_str + n, sizeof matrix_str - (size_t)n, "%s%.9g", k ? " " : "", (double)cm.m[k]);
+            if (ccd->projection == SY_PROJECTION_ORTHOGRAPHIC) snprintf(proj_str, sizeof proj_str, "orthographic ymag %.9g", (double)ccd->ymag);
+            else snprintf(proj_str, sizeof proj_str, "perspective yfov %.9g", (double)ccd->yfov);
+        }
         const char *kv[][2] = {{"sy:renderer", renderer}, {"sy:backend", shown}, {"sy:params", params},
-                               {"sy:camera", camera_str}, {"sy:size", size_str}, {"sy:samples", samples_str},
+                               {"sy:camera", camera_str}, {"sy:camera_to_world", matrix_str}, {"sy:projection", proj_str},
+                               {"sy:size", size_str}, {"sy:samples", samples_str},
                                {"sy:seconds", secs_str}, {"sy:source", scene},
                                {"sy:interrupted", interrupted ? "1" : NULL}};
         for (size_t k = 0; k < sizeof kv / sizeof kv[0]; ++k) {

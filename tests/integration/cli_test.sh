@@ -259,6 +259,15 @@ for kv in '"sy:renderer": "Switchyard ' '"sy:backend": "whitted"' '"sy:params": 
           '"sy:samples": "2"' '"sy:source": "demo"' '"sy:camera": "the scene' '"sy:seconds": "' '"width": 40,' '"height": 30,'; do
     grep -qF -- "$kv" "$TMP/meta_info.out" || fail "sy info m.exr lacks $kv: $(cat "$TMP/meta_info.out" "$TMP/meta_info.err")"
 done
+# the exact view, for another renderer to see the same (tests/cycles/materials_cycles.py): 16
+# numbers whose translation is the camera position of sy:camera, and the projection
+c2w=$(sed -n 's/.*"sy:camera_to_world": "\([^"]*\)".*/\1/p' "$TMP/meta_info.out")
+pos=$(sed -n 's/.*"sy:camera": "[^"]* at (\([^)]*\)).*/\1/p' "$TMP/meta_info.out" | tr -d ',')
+set -- $c2w
+[ $# -eq 16 ] && awk -v a="${13} ${14} ${15}" -v b="$pos" 'BEGIN { split(a, x, " "); split(b, y, " ");
+    for (i = 1; i <= 3; ++i) if ((x[i] - y[i]) ^ 2 > 1e-6 * (1 + y[i] ^ 2)) exit 1 }' &&
+    grep -qE '"sy:projection": "perspective yfov [0-9.]+"' "$TMP/meta_info.out" ||
+    fail "sy info m.exr: camera_to_world '$c2w' (camera at '$pos') or projection: $(grep projection "$TMP/meta_info.out")"
 run meta_png "$SY" render demo -b pathtracer --spp 3 -w 40 -h 30 -o "$TMP/meta/m.png"
 for kv in 'sy:renderer' 'sy:backend.pathtracer' 'sy:samples.3' 'sy:source.demo'; do
     tr '\0' '.' < "$TMP/meta/m.png" | grep -qa -- "$kv" || fail "the PNG's text chunks lack $kv"
