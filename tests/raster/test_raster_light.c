@@ -49,6 +49,18 @@ static sy_gl_instance place(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat)
     return in;
 }
 
+/* A perfect mirror: metallic 1, roughness 0 (it gets a scene probe). */
+static sy_gl_material mirror(sy_gl_device *d)
+{
+    sy_gl_material_desc md;
+    sy_gl_material_desc_init(&md);
+    md.metallic = 1.0f;
+    md.roughness = 0.0f;
+    sy_gl_material h;
+    MUST(sy_gl_material_create(d, &md, &h));
+    return h;
+}
+
 static sy_gl_material lambert(sy_gl_device *d, float albedo)
 {
     sy_gl_material_desc md;
@@ -110,12 +122,7 @@ int main(int argc, char **argv)
      * the prefiltered environment through the probe's unit, in the probe pass too); two were built
      * before (issue 32: each costs a compile on llvmpipe) */
     {
-        sy_gl_material_desc md;
-        sy_gl_material_desc_init(&md);
-        md.metallic = 1.0f;
-        md.roughness = 0.0f;
-        sy_gl_material mm;
-        MUST(sy_gl_material_create(d, &md, &mm));
+        sy_gl_material mm = mirror(d);
         const float corner[12] = {-1.4f, 1.1f, -2.5f, -1.1f, 1.1f, -2.5f, -1.1f, 1.4f, -2.5f, -1.4f, 1.4f, -2.5f};
         sy_gl_instance mi = place(d, quad(d, corner, nz), mm);
         sy_gl_stats st0, st1;
@@ -150,12 +157,7 @@ int main(int argc, char **argv)
     /* 2. a mirror reflects the environment sharply: tilted down it sees the lower half (0.5 x 2) */
     {
         sy_gl_set_environment(d, env_texture(d, 2.0f, 0.5f), 1.0f);
-        sy_gl_material_desc md;
-        sy_gl_material_desc_init(&md);
-        md.metallic = 1.0f;
-        md.roughness = 0.0f;
-        sy_gl_material mm;
-        MUST(sy_gl_material_create(d, &md, &mm));
+        sy_gl_material mm = mirror(d);
         /* a mirror tilted 30 degrees about x, facing up-forward: view rays reflect upwards */
         const float tilt[12] = {-1, -1.2f, -2.5f, 1, -1.2f, -2.5f, 1, 0.6f, -3.5f, -1, 0.6f, -3.5f};
         const float tn[3] = {0, 0.866f, 0.5f};
