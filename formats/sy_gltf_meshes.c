@@ -1,6 +1,7 @@
 /* sy_gltf_meshes.c — glTF meshes into sy_meshes: the file's budget for every primitive charged
  * before any is decoded, vertex attributes, indices (range-checked; strips and fans converted),
- * points and lines, flat normals and tangents where the file has none. */
+ * points and lines, tangents where the file has none (a primitive without normals stays indexed
+ * and without them: flat shading, sy_primitive). */
 #include "sy_gltf_internal.h"
 
 #include "sy_mesh_util.h"
@@ -282,13 +283,16 @@ static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *
     if (tri && (r = make_blob(L, tri, tcount * 3 * sizeof(uint32_t), &out->indices))) return r;
 
     if ((r = read_all_attributes(L, pr, vcount, m, p, out))) return r;
-    /* glTF 2.0: without NORMAL the client computes flat normals; a normal map without TANGENT
-     * needs generated tangents (sy_mesh_util: MikkTSpace-style angle-weighted accumulation). */
-    if (!out->normals && (r = sy_prim_make_flat_normals(out, &L->err))) {
-        sy_primitive_release(out);
-        return gltf_fail(L, r, "meshes[%zu].primitives[%zu]: flat normals: %s", m, p, L->err.message);
-    }
-    if (!out->tangents && pr->material >= 0 && d->materials[pr->material].normal_texture.index >= 0) {
+    /* glTF 2.0: without NORMAL the client computes flat normals, and the file's tangents are
+     * ignored. The primitive stays as it is, indexed and without normals: every back-end shades a
+     * primitive without normals flat (sy_primitive), from the geometric normal of each triangle.
+     * A normal map without TANGENT on a primitive with normals gets generated tangents (sy_mesh_util:
+     * MikkTSpace-style angle-weighted accumulation); a flat one needs none (the back-ends build the
+     * tangent frame of a normal map from the uv derivatives across the triangle). */
+    if (!out->normals) {
+        sy_blob_release(out->tangents);
+        out->tangents = NULL;
+    } else if (!out->tangents && pr->material >= 0 && d->materials[pr->material].normal_texture.index >= 0) {
         const sy_gltf_shim_texinfo *nt = &d->materials[pr->material].normal_texture;
         int32_t tc = nt->transform_texcoord >= 0 ? nt->transform_texcoord : nt->texcoord;
         if (tc != 1) tc = 0;

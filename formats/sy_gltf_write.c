@@ -239,7 +239,8 @@ static sy_result mesh_index(writer *w, sy_mesh m, int32_t *out)
         o->texcoords0 = array_of(p->texcoords0, nv, 8);
         o->colors = array_of(p->colors, nv, 16);
         if (w->full) {
-            o->tangents = array_of(p->tangents, nv, 16);
+            /* tangents without normals mean nothing in glTF (a reader ignores them): not written */
+            if (p->normals) o->tangents = array_of(p->tangents, nv, 16);
             o->texcoords1 = array_of(p->texcoords1, nv, 8);
         }
         o->indices = p->indices ? sy_blob_data(p->indices) : NULL;

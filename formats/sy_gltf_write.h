@@ -67,7 +67,8 @@ sy_result sy_gltf_write_subtree_file(const sy_scene *s, sy_node root, const sy_g
  * data: URI buffer. Root's children are scene 0's nodes when root is plain (identity, nothing
  * attached), else root itself is. Written: the node hierarchy (TRS or matrix as each node has it;
  * a node reached along several paths once per path; hidden nodes left out with a warning), meshes
- * with POSITION, NORMAL, TANGENT, TEXCOORD_0/1, COLOR_0 and indices, every sy_material_data field
+ * with POSITION, NORMAL, TANGENT, TEXCOORD_0/1, COLOR_0 and indices as present (a primitive without
+ * normals, flat-shaded, gets neither NORMAL nor TANGENT, so a reader shades it flat too), every sy_material_data field
  * (metallic-roughness, normal / occlusion / emissive, KHR_materials_emissive_strength,
  * _transmission, _ior, _unlit, _specular, _clearcoat, _sheen, _volume, _iridescence, _anisotropy,
  * each omitted at its defaults; KHR_texture_transform and texCoord on every texture slot), one

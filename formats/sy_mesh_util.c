@@ -39,56 +39,13 @@ static uint32_t *corner_indices(const sy_primitive *p, size_t *ncorners, sy_erro
     n -= n % 3;
     uint32_t *c = malloc((n ? n : 1) * sizeof *c);
     if (!c) {
-        oom(err, "mesh normals");
+        oom(err, "tangents");
         return NULL;
     }
     if (p->indices) memcpy(c, sy_blob_data(p->indices), n * 4);
     else for (size_t k = 0; k < n; k++) c[k] = (uint32_t)k;
     *ncorners = n;
     return c;
-}
-
-static sy_result deindex_attr(sy_blob **slot, const uint32_t *c, size_t n, size_t elem, sy_error *err)
-{
-    if (!*slot) return SY_OK;
-    const uint8_t *src = sy_blob_data(*slot);
-    uint8_t *dst = malloc((n ? n : 1) * elem);
-    if (!dst) return oom(err, "mesh normals");
-    for (size_t k = 0; k < n; k++) memcpy(dst + k * elem, src + (size_t)c[k] * elem, elem);
-    return take_blob(dst, n * elem, slot, err);
-}
-
-sy_result sy_prim_make_flat_normals(sy_primitive *p, sy_error *err)
-{
-    if (!p || !p->positions) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "flat normals: primitive without positions");
-    size_t n;
-    uint32_t *c = corner_indices(p, &n, err);
-    if (!c) return SY_ERR_OUT_OF_MEMORY;
-    sy_result r;
-    sy_blob_release(p->normals);
-    p->normals = NULL;
-    sy_blob_release(p->tangents);
-    p->tangents = NULL;
-    if ((r = deindex_attr(&p->positions, c, n, 12, err)) || (r = deindex_attr(&p->texcoords0, c, n, 8, err)) ||
-        (r = deindex_attr(&p->texcoords1, c, n, 8, err)) || (r = deindex_attr(&p->colors, c, n, 16, err))) {
-        free(c);
-        return r;
-    }
-    free(c);
-    sy_blob_release(p->indices);
-    p->indices = NULL;
-    const float *pos = sy_blob_data(p->positions);
-    float *nrm = malloc((n ? n : 1) * 12);
-    if (!nrm) return oom(err, "flat normals");
-    for (size_t t = 0; t < n / 3; t++) {
-        float e1[3], e2[3], f[3];
-        sy_vec3_sub(pos + 9 * t + 3, pos + 9 * t, e1);
-        sy_vec3_sub(pos + 9 * t + 6, pos + 9 * t, e2);
-        sy_vec3_cross(e1, e2, f);
-        if (!v3_normalize(f)) { f[0] = 0; f[1] = 0; f[2] = 1; }
-        for (int k = 0; k < 3; k++) memcpy(nrm + 9 * t + 3 * k, f, 12);
-    }
-    return take_blob(nrm, n * 12, &p->normals, err);
 }
 
 static void any_orthogonal(const float *n, float *t)

@@ -1,6 +1,6 @@
 /** @file
- * sy_mesh_util.h — geometry helpers shared by the file loaders (glTF, X3D): flat and crease-angle
- * normal generation, tangent generation for normal mapping, triangulation of convex and concave
+ * sy_mesh_util.h — geometry helpers shared by the file loaders (glTF, X3D, Assimp): crease-angle
+ * normal generation (X3D), tangent generation for normal mapping, triangulation of convex and concave
  * planar polygons (ear clipping), and tessellation of the X3D primitives (Box, Sphere, Cone,
  * Cylinder) into triangle lists.
  *
@@ -22,13 +22,6 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/** Replaces an indexed or non-indexed triangle primitive by a non-indexed one (every triangle gets
- * its own three vertices; all present attributes are copied) and sets flat normals (the
- * normalised geometric normal of each triangle, counter-clockwise front; degenerate triangles get
- * (0, 0, 1)). Existing normals and tangents are discarded. This is what glTF 2.0 requires when a
- * primitive has no NORMAL attribute. */
-sy_result sy_prim_make_flat_normals(sy_primitive *p, sy_error *err);
 
 /** Generates tangents (float[4]: xyz unit tangent orthogonal to the normal, w = +1 or -1 the
  * handedness of the bitangent, glTF convention B = cross(N, T) * w) from positions, normals and the

@@ -3,8 +3,10 @@
  * meshes, primitives, triangles (per mode: lists count / 3, strips and fans count - 2), skipped
  * primitives (no POSITION or no complete element), points and line segments (LINES pairs, LINE_LOOP
  * n, LINE_STRIP n - 1), materials, textures, images, cameras and KHR_lights_punctual lights; and, in
- * the loaded scene, the triangle total, normals on every primitive (generated flat when the file has
- * none) and tangents wherever a material with a normal map is used with texture coordinates. A file
+ * the loaded scene, the triangle total, the vertices of the triangle primitives (as many as the
+ * file's POSITION accessors: a primitive without NORMAL, flat-shaded, keeps its shared vertices and
+ * its indices), normals exactly where the file has NORMAL, and tangents wherever a material with a
+ * normal map is used with texture coordinates on a primitive with normals. A file
  * that requires an extension sy does not read must be refused naming it, and only such a file.
  * Usage: test_gltf_counts TESTDATA_DIR (exit 77 when the data is absent). */
 #include "../support/sy_check.h"
@@ -30,7 +32,7 @@ static void expect_count(const char *file, const char *what, uint64_t got, uint6
 
 typedef struct expected {
     uint64_t nodes, meshes, primitives, triangles, skipped, materials, textures, images, cameras, lights, points,
-        segments;
+        segments, flat, tri_vertices; /* triangle primitives without NORMAL; their POSITION counts summed */
 } expected;
 
 /* The file's JSON (a GLB's first chunk), parsed; NULL when the test's own reading fails. */
@@ -101,8 +103,9 @@ static bool compute(const cJSON *d, expected *e)
                 e->skipped++;
                 continue;
             }
-            uint64_t count = 0;
+            uint64_t count = 0, vertices = 0;
             if (!accessor_count(acc, get(attrs, "POSITION"), &count)) return false;
+            vertices = count;
             if (get(p, "indices") && !accessor_count(acc, get(p, "indices"), &count)) return false;
             if (mode < 4) { /* points; lines: pairs, loops: n (n >= 3), strips: n - 1 */
                 uint64_t el = mode == 0 ? count : mode == 1 ? count / 2 : count < 2 ? 0 : mode == 2 && count >= 3 ? count : count - 1;
@@ -114,6 +117,8 @@ static bool compute(const cJSON *d, expected *e)
             uint64_t t = mode == 4 ? count / 3 : (count >= 3 ? count - 2 : 0);
             if (t == 0) e->skipped++;
             e->triangles += t;
+            if (t && !get(attrs, "NORMAL")) e->flat++;
+            if (t) e->tri_vertices += vertices;
         }
     }
     return true;
@@ -182,23 +187,25 @@ static void check_file(const char *file, uint32_t *models)
         expect_count(file, "cameras", c->cameras, e.cameras);
         expect_count(file, "lights", c->lights, e.lights);
         /* the scene itself: every mesh is created, whether referenced or not */
-        uint64_t tris = 0, prims = 0, without_normals = 0, missing_tangents = 0;
+        uint64_t tris = 0, prims = 0, without_normals = 0, missing_tangents = 0, tri_vertices = 0;
         for (uint32_t id = sy_scene_next(scene, SY_TYPE_MESH, 0); id; id = sy_scene_next(scene, SY_TYPE_MESH, id)) {
             const sy_mesh_data *m = sy_object_get(scene, SY_TYPE_MESH, id);
             for (uint32_t k = 0; k < m->primitives.count; k++) {
                 const sy_primitive *p = &m->primitives.items[k];
                 prims++;
                 tris += sy_primitive_triangle_count(p);
+                if (p->topology == SY_TOPOLOGY_TRIANGLES) tri_vertices += sy_primitive_vertex_count(p);
                 if (!p->normals && p->topology == SY_TOPOLOGY_TRIANGLES) without_normals++; /* strokes: own normals */
                 const sy_material_data *md = sy_material_get(scene, p->material);
-                if (md && md->normal_texture.texture.id && !p->tangents &&
+                if (md && md->normal_texture.texture.id && p->normals && !p->tangents &&
                     (md->normal_texture.texcoord ? p->texcoords1 : p->texcoords0))
                     missing_tangents++;
             }
         }
         expect_count(file, "scene triangles", tris, e.triangles);
         expect_count(file, "scene primitives", prims, e.primitives - e.skipped);
-        expect_count(file, "primitives without normals", without_normals, 0);
+        expect_count(file, "triangle primitives without normals (flat)", without_normals, e.flat);
+        expect_count(file, "vertices of the triangle primitives", tri_vertices, e.tri_vertices);
         expect_count(file, "normal-mapped primitives without tangents", missing_tangents, 0);
     }
     sy_gltf_info_free(&info);

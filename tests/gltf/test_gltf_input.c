@@ -512,14 +512,75 @@ static void test_valid(void)
                     continue;
                 }
                 const uint32_t *want = !strcmp(m->name, "strip") ? want_strip : want_fan;
-                /* no NORMAL: flat normals, so the triangles are de-indexed (3 own vertices each) */
-                EXPECT_MSG(!p->indices && sy_primitive_vertex_count(p) == 6 && p->normals, "%s: 2 flat-shaded triangles",
-                           m->name);
-                const float *f = blob_f(p->positions), *n = blob_f(p->normals);
-                for (int k = 0; f && k < 6 && sy_primitive_vertex_count(p) == 6; k++)
-                    EXPECT_MSG(!memcmp(f + 3 * k, pos + 3 * want[k], 12), "%s: winding, corner %d", m->name, k);
-                if (n) EXPECT_MSG(fabsf(n[2]) == 1.0f && n[5] == n[2] && fabsf(n[17]) == 1.0f, "%s: flat normals along z", m->name);
+                /* no NORMAL: flat-shaded, which leaves the vertices as they are (no normals made, not
+                 * de-indexed); the strip or fan becomes a list of indices into them */
+                EXPECT_MSG(p->indices && sy_blob_size(p->indices) == 6 * sizeof(uint32_t) && sy_primitive_vertex_count(p) == 4 &&
+                               !p->normals,
+                           "%s: 2 flat-shaded triangles over the 4 vertices", m->name);
+                const float *f = blob_f(p->positions);
+                EXPECT_MSG(f && !memcmp(f, pos, sizeof pos), "%s: positions unchanged", m->name);
+                const uint32_t *ix = p->indices ? sy_blob_data(p->indices) : NULL;
+                for (int k = 0; ix && k < 6 && sy_blob_size(p->indices) == 24; k++)
+                    EXPECT_MSG(ix[k] == want[k], "%s: winding, corner %d: index %u, expected %u", m->name, k, ix[k], want[k]);
             }
+        }
+        sy_scene_destroy(s);
+        s = NULL;
+    }
+
+    /* issue 39: an indexed cube without NORMAL (8 shared corners, 36 indices) with TEXCOORD_0, a
+     * TANGENT the spec says to ignore without normals, and a normal-mapped material: it keeps its 8
+     * vertices and its index buffer (flat shading is the back-ends' job), has neither normals nor
+     * tangents, and the normal map loads (no tangents are generated for it) */
+    {
+        struct {
+            float pos[24], uv[16], tan[32];
+            uint16_t idx[36];
+        } cube;
+        for (int v = 0; v < 8; v++) {
+            for (int a = 0; a < 3; a++) cube.pos[3 * v + a] = (v >> a & 1) ? 0.5f : -0.5f;
+            cube.uv[2 * v] = (float)(v & 1), cube.uv[2 * v + 1] = (float)(v >> 1 & 1);
+            const float t[4] = {1, 0, 0, 1};
+            memcpy(cube.tan + 4 * v, t, sizeof t);
+        }
+        for (int f = 0; f < 6; f++) { /* face f: axis f / 2, side f % 2; corners in cyclic order */
+            int a = f / 2, u = (a + 1) % 3, w = (a + 2) % 3, side = f % 2, c[4];
+            const int cu[4] = {0, 1, 1, 0}, cw[4] = {0, 0, 1, 1};
+            for (int k = 0; k < 4; k++) c[k] = side << a | cu[k] << u | cw[k] << w;
+            /* (u, w, a) is right-handed: this order winds counter-clockwise about +a */
+            const int t6[6] = {0, 1, 2, 0, 2, 3}, r6[6] = {0, 2, 1, 0, 3, 2};
+            for (int k = 0; k < 6; k++) cube.idx[6 * f + k] = (uint16_t)c[side ? t6[k] : r6[k]];
+        }
+        char fmt[4096];
+        snprintf(fmt, sizeof fmt,
+                 "{" ASSET ",\"buffers\":[{\"byteLength\":%zu,\"uri\":\"%%s\"}],"
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":96},{\"buffer\":0,\"byteOffset\":96,\"byteLength\":64},"
+                 "{\"buffer\":0,\"byteOffset\":160,\"byteLength\":128},{\"buffer\":0,\"byteOffset\":288,\"byteLength\":72}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":8,\"type\":\"VEC3\"},"
+                 "{\"bufferView\":1,\"componentType\":5126,\"count\":8,\"type\":\"VEC2\"},"
+                 "{\"bufferView\":2,\"componentType\":5126,\"count\":8,\"type\":\"VEC4\"},"
+                 "{\"bufferView\":3,\"componentType\":5123,\"count\":36,\"type\":\"SCALAR\"}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1,\"TANGENT\":2},\"indices\":3,\"material\":0}]}],"
+                 "\"materials\":[{\"normalTexture\":{\"index\":0}}],\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"%s\"}],"
+                 "\"nodes\":[{\"mesh\":0}]," SCENES "}",
+                 sizeof cube, k_png_uri);
+        write_gltf("flat_cube.gltf", fmt, &cube, sizeof cube, path);
+        outcome o = run(path, NULL, &s);
+        EXPECT_MSG(o.r == SY_OK, "flat_cube.gltf: %s", o.err.message);
+        if (o.r == SY_OK) {
+            const sy_mesh_data *m = sy_mesh_get(s, (sy_mesh){sy_scene_next(s, SY_TYPE_MESH, 0)});
+            const sy_primitive *p = m && m->primitives.count == 1 ? &m->primitives.items[0] : NULL;
+            EXPECT_MSG(p && sy_primitive_vertex_count(p) == 8 && p->indices && sy_blob_size(p->indices) == 36 * sizeof(uint32_t),
+                       "flat_cube: 8 shared vertices and 36 indices kept (%u vertices)", p ? (unsigned)sy_primitive_vertex_count(p) : 0u);
+            EXPECT_MSG(p && !p->normals && !p->tangents && p->texcoords0, "flat_cube: no normals, the file's tangents ignored, uv kept");
+            const uint32_t *ix = p && p->indices ? sy_blob_data(p->indices) : NULL;
+            for (int k = 0; ix && k < 36 && sy_blob_size(p->indices) == 36 * sizeof(uint32_t); k++)
+                EXPECT_MSG(ix[k] == cube.idx[k], "flat_cube: index %d is %u, expected %u", k, ix[k], cube.idx[k]);
+            const float *f = p ? blob_f(p->positions) : NULL;
+            EXPECT_MSG(f && sy_blob_size(p->positions) == sizeof cube.pos && !memcmp(f, cube.pos, sizeof cube.pos),
+                       "flat_cube: positions unchanged");
+            const sy_material_data *md = p ? sy_material_get(s, p->material) : NULL;
+            EXPECT_MSG(md && md->normal_texture.texture.id, "flat_cube: the normal map is kept");
         }
         sy_scene_destroy(s);
         s = NULL;
