@@ -128,6 +128,14 @@ typedef enum sy_topology {
  * triples (without indices vertex_count must be a multiple of 3). Lines: indices hold whole pairs
  * (without indices an even vertex_count). Points: any count.
  *
+ * Triangles without normals (normals NULL) are flat-shaded: every back-end shades each triangle
+ * with its geometric normal, its front the side from which its corners run counter-clockwise
+ * (clockwise under a node transform of negative determinant), as glTF 2.0 specifies for a
+ * primitive without NORMAL. Such a primitive keeps its shared vertices and its indices; nobody
+ * needs to de-index it to give each face its own normal. Tangents are carried along (file writers)
+ * but no back-end reads them: a normal map's tangent frame comes from the uv derivatives across
+ * the triangle, with or without normals.
+ *
  * Strokes (lines and points) have a width: the diameter of the tube drawn along each segment and
  * of the ball drawn at each point and line joint, in the primitive's own coordinate units (the
  * node transforms scale it with the positions, so it is a world-space width under unscaled

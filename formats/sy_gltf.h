@@ -34,8 +34,9 @@
  * still list them as created-and-destroyed) and err names the file, the glTF element and the
  * problem, e.g. "Box.gltf: accessors[3]: count 1000000 * stride 12 exceeds bufferView 2 length 768".
  * An image that is missing, over max_image_pixels or cannot be decoded is local: a warning, and the textures using it are
- * absent (the rest loads). Primitives without NORMAL get flat normals (de-indexed, as glTF requires);
- * normal-mapped primitives without TANGENT get generated tangents (sy_mesh_util.h).
+ * absent (the rest loads). Primitives without NORMAL stay as the file has them, indexed and without
+ * normals (their TANGENT ignored): the back-ends shade them flat, as glTF requires (sy_primitive);
+ * normal-mapped primitives with NORMAL but without TANGENT get generated tangents (sy_mesh_util.h).
  *
  * Ownership: the scene owns every created object. *info_out (if given) holds malloc()ed arrays the
  * caller releases with sy_gltf_info_free (also after a failed load; it is zeroed then).
