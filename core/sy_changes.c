@@ -5,7 +5,8 @@
  *   header   u32 magic "SYCL", u16 version, u16 flags (1 = snapshot), u64 first_frame,
  *            u64 last_frame, u32 entry_count, u32 blob_count
  *   blobs    blob_count x { u64 hash_lo, u64 hash_hi, u64 size, u8 has_payload, [size bytes] }
- *   entries  entry_count x { u8 type, u8 flags, u16 reserved(0), u32 id, u64 mask, fields... }
+ *   entries  entry_count x { u8 type (sy_object_type: 1 texture .. 8 animation, version 4), u8 flags,
+ *            u16 reserved(0), u32 id, u64 mask, fields... }
  *   field    POD: its bytes; string: u32 length (0xffffffff = NULL) + bytes; blob: u32 index into
  *            the blob table (0xffffffff = NULL); primitives: u32 count + count x (7 blob indices +
  *            u32 material id + u32 topology (sy_topology, < SY_TOPOLOGY_COUNT) + f32 width (finite,

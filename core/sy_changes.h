@@ -4,7 +4,7 @@
  * A change list holds one entry per object: type, handle id, created/destroyed flags, the mask of
  * changed fields and the values of exactly those fields (blobs by reference). Entries are ordered:
  * destructions first, then by type in dependency order (textures, materials, meshes, lights,
- * cameras, backgrounds, nodes), then by id. A consumer applies them in order.
+ * cameras, backgrounds, nodes, animations), then by id. A consumer applies them in order.
  *
  * Versioned binary serialisation: blobs are referenced by 128-bit content hash; the blob payloads
  * that the receiver lacks travel in the same message (the sender decides with a callback). The
@@ -64,7 +64,7 @@ sy_changes_stats sy_changes_get_stats(const sy_changes *c);
 
 /* ---- serialisation ---- */
 #define SY_CHANGES_WIRE_MAGIC 0x4C435953u /**< "SYCL" little endian */
-#define SY_CHANGES_WIRE_VERSION 3u /**< version of the serialised format */
+#define SY_CHANGES_WIRE_VERSION 4u /**< version of the serialised format */
 
 /** Return true to send the payload of this blob inline (the receiver does not have it yet). */
 typedef bool (*sy_blob_send_fn)(void *user, const sy_blob *b);

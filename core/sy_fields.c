@@ -91,6 +91,11 @@ static const sy_field_desc background_fields[SY_BACKGROUND_FIELD_COUNT] = {
     F(sy_background_data, gradient, SY_FK_POD),
     F(sy_background_data, default_lighting, SY_FK_POD),
 };
+static const sy_field_desc animation_fields[SY_ANIMATION_FIELD_COUNT] = {
+    F(sy_animation_data, name, SY_FK_STRING),    F(sy_animation_data, samplers, SY_FK_BLOB),
+    F(sy_animation_data, channels, SY_FK_BLOB),  F(sy_animation_data, times, SY_FK_BLOB),
+    F(sy_animation_data, values, SY_FK_BLOB),
+};
 #undef F
 
 #define TEXREF_NONE {{0}, 0, 1.0f, {0.0f, 0.0f}, 0.0f, {1.0f, 1.0f}}
@@ -142,6 +147,7 @@ static const sy_camera_data camera_defaults = {
     .projection = SY_PROJECTION_PERSPECTIVE, .yfov = 0.8f, .znear = 0.01f, .xmag = 1.0f, .ymag = 1.0f};
 static const sy_background_data background_defaults = {
     .color = {0, 0, 0, 1}, .intensity = 1.0f, .environment_visible = 1, .default_lighting = 1};
+static const sy_animation_data animation_defaults = {0};
 
 #define T(name, D, fields, defaults) {name, sizeof(D), fields, sizeof fields / sizeof fields[0], &defaults}
 static const sy_type_desc type_descs[SY_TYPE_COUNT] = {
@@ -152,6 +158,7 @@ static const sy_type_desc type_descs[SY_TYPE_COUNT] = {
     [SY_TYPE_CAMERA] = T("camera", sy_camera_data, camera_fields, camera_defaults),
     [SY_TYPE_BACKGROUND] = T("background", sy_background_data, background_fields, background_defaults),
     [SY_TYPE_NODE] = T("node", sy_node_data, node_fields, node_defaults),
+    [SY_TYPE_ANIMATION] = T("animation", sy_animation_data, animation_fields, animation_defaults),
 };
 #undef T
 
@@ -178,6 +185,38 @@ const void *sy_object_defaults(sy_object_type t)
 {
     const sy_type_desc *td = sy__type_desc(t);
     return td ? td->defaults : NULL;
+}
+
+/* >>animation blobs (read by validation, the setters and the clock) */
+const sy_anim_sampler *sy_animation_samplers(const sy_animation_data *d, uint32_t *count_out)
+{
+    *count_out = d && d->samplers ? (uint32_t)(sy_blob_size(d->samplers) / sizeof(sy_anim_sampler)) : 0;
+    return *count_out ? sy_blob_data(d->samplers) : NULL;
+}
+
+const sy_anim_channel *sy_animation_channels(const sy_animation_data *d, uint32_t *count_out)
+{
+    *count_out = d && d->channels ? (uint32_t)(sy_blob_size(d->channels) / sizeof(sy_anim_channel)) : 0;
+    return *count_out ? sy_blob_data(d->channels) : NULL;
+}
+
+void sy_animation_time_range(const sy_animation_data *d, float *start_out, float *end_out)
+{
+    uint32_t n;
+    const sy_anim_sampler *sm = sy_animation_samplers(d, &n);
+    size_t nt = d && d->times ? sy_blob_size(d->times) / sizeof(float) : 0;
+    const float *t = nt ? sy_blob_data(d->times) : NULL;
+    float lo = 0.0f, hi = 0.0f;
+    bool any = false;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!sm[i].key_count || (uint64_t)sm[i].times_offset + sm[i].key_count > nt) continue; /* refused when set */
+        float a = t[sm[i].times_offset], b = t[sm[i].times_offset + sm[i].key_count - 1];
+        if (!any || a < lo) lo = a;
+        if (!any || b > hi) hi = b;
+        any = true;
+    }
+    if (start_out) *start_out = lo;
+    if (end_out) *end_out = hi;
 }
 
 /* >>generic field operations */

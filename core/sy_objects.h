@@ -1,6 +1,6 @@
 /** @file
- * sy_objects.h — the scene's objects: handles, the seven object types (node, mesh, material,
- * texture, light, camera, background) with their data structs and numbered fields, attachments,
+ * sy_objects.h — the scene's objects: handles, the eight object types (node, mesh, material,
+ * texture, light, camera, background, animation) with their data structs and numbered fields, attachments,
  * and the calls that create, change, read and destroy objects of a scene (sy_scene.h).
  *
  * Each type has a plain data struct (sy_node_data, ...) and an enumerated list of fields, one bit
@@ -49,6 +49,8 @@ typedef struct sy_light { uint32_t id; /**< index + generation; 0 = none */ } sy
 typedef struct sy_camera { uint32_t id; /**< index + generation; 0 = none */ } sy_camera;
 /** Handle of a background (the world). */
 typedef struct sy_background { uint32_t id; /**< index + generation; 0 = none */ } sy_background;
+/** Handle of an animation (one clip: samplers and channels; sy_anim.h plays it). */
+typedef struct sy_animation { uint32_t id; /**< index + generation; 0 = none */ } sy_animation;
 
 /** Object types; the order is the dependency order (referenced types first). */
 typedef enum sy_object_type {
@@ -60,7 +62,8 @@ typedef enum sy_object_type {
     SY_TYPE_CAMERA = 5,
     SY_TYPE_BACKGROUND = 6,
     SY_TYPE_NODE = 7,
-    SY_TYPE_COUNT = 8
+    SY_TYPE_ANIMATION = 8, /**< after nodes: its channels name nodes */
+    SY_TYPE_COUNT = 9
 } sy_object_type;
 
 const char *sy_object_type_name(sy_object_type t); /**< "node", "mesh", ... */
@@ -470,6 +473,102 @@ typedef struct sy_background_data {
     uint32_t default_lighting; /**< 1 = studio light when the scene brings none */
 } sy_background_data;
 
+/* ---------------------------------------------------------------- animation (glTF 2.0 animation) */
+/* One clip: keyframe samplers and the channels that drive node properties with them. Nothing of an
+ * animation is visible by itself: sy_scene_set_time (sy_anim.h) evaluates it into the target nodes'
+ * fields through the ordinary setters, so the result travels in change lists like any other edit.
+ *
+ * Storage (so an animation serialises like mesh data, in four blobs):
+ *   samplers  sy_anim_sampler[n]: interpolation, components per value, key count and where its
+ *             keys start in `times` and its values in `values` (element offsets, not bytes);
+ *   channels  sy_anim_channel[m]: target node id, path, sampler index;
+ *   times     float[]: every sampler's key times (seconds), each sampler's run strictly increasing;
+ *   values    float[]: every sampler's output values, key after key; CUBICSPLINE keys hold three
+ *             values each (in-tangent, value, out-tangent), as in glTF.
+ * The rules between them (checked by the setters and by a replica's apply, so untrusted lists are
+ * refused, naming the item): every run lies inside its blob; at least one key per sampler, at most
+ * SY_ANIM_MAX_KEYS; times finite and strictly increasing (glTF's rule; equal times are refused, so
+ * no interval has zero length); values finite; components 3 for translation and scale, 4 for
+ * rotation, 1 to SY_ANIM_MAX_COMPONENTS for weights; translation and scale values within
+ * SY_COORD_MAX; rotation key values not the zero quaternion; channel targets live nodes (a replica
+ * applying a list accepts references as its origin did) and name a sampler that exists. Set the
+ * whole clip at once (sy_animation_set_clip or sy_animation_set): a single field set on its own is
+ * checked with the other fields as they are. */
+/** Interpolation of a sampler (glTF animation.sampler.interpolation). */
+typedef enum sy_anim_interpolation {
+    SY_INTERP_LINEAR = 0,      /**< linear; rotations by spherical linear interpolation (shortest path) */
+    SY_INTERP_STEP = 1,        /**< the value of the last key at or before the time */
+    SY_INTERP_CUBICSPLINE = 2, /**< cubic Hermite spline with in / out tangents (3 values per key) */
+    SY_INTERP_COUNT = 3
+} sy_anim_interpolation;
+
+/** What a channel drives (glTF animation.channel.target.path). */
+typedef enum sy_anim_path {
+    SY_ANIM_TRANSLATION = 0, /**< node translation, 3 components */
+    SY_ANIM_ROTATION = 1,    /**< node rotation, unit quaternion x y z w, 4 components */
+    SY_ANIM_SCALE = 2,       /**< node scale, 3 components */
+    SY_ANIM_WEIGHTS = 3,     /**< morph target weights: kept, not evaluated yet (no weights field in core) */
+    SY_ANIM_PATH_COUNT = 4
+} sy_anim_path;
+
+#define SY_ANIM_MAX_KEYS (1u << 24)      /**< keys of one sampler */
+#define SY_ANIM_MAX_SAMPLERS (1u << 20)  /**< samplers of one animation */
+#define SY_ANIM_MAX_CHANNELS (1u << 20)  /**< channels of one animation */
+#define SY_ANIM_MAX_COMPONENTS 256u      /**< components of one value (morph weights: one per target) */
+
+/** One sampler as stored in the samplers blob (20 bytes, little endian on the wire like all POD). */
+typedef struct sy_anim_sampler {
+    uint32_t interpolation; /**< sy_anim_interpolation */
+    uint32_t components;    /**< floats per value */
+    uint32_t key_count;     /**< keys (>= 1) */
+    uint32_t times_offset;  /**< index of its first time in the times blob (floats) */
+    uint32_t values_offset; /**< index of its first value float in the values blob */
+} sy_anim_sampler;
+
+/** One channel as stored in the channels blob (12 bytes). */
+typedef struct sy_anim_channel {
+    uint32_t node;    /**< target node id (sy_node.id) */
+    uint32_t path;    /**< sy_anim_path */
+    uint32_t sampler; /**< index into the samplers */
+} sy_anim_channel;
+
+/** Field numbers of an animation. */
+enum sy_animation_field {
+    SY_ANIMATION_NAME = 0,
+    SY_ANIMATION_SAMPLERS = 1, /**< sy_blob* of sy_anim_sampler (NULL = none) */
+    SY_ANIMATION_CHANNELS = 2, /**< sy_blob* of sy_anim_channel (NULL = none) */
+    SY_ANIMATION_TIMES = 3,    /**< sy_blob* of float key times */
+    SY_ANIMATION_VALUES = 4,   /**< sy_blob* of float output values */
+    SY_ANIMATION_FIELD_COUNT = 5
+};
+
+/** Field values of an animation; read the blobs with sy_animation_samplers & co. */
+typedef struct sy_animation_data {
+    char *name; /**< clip name (copied; may be NULL) */
+    sy_blob *samplers; /**< sy_anim_sampler[] */
+    sy_blob *channels; /**< sy_anim_channel[] */
+    sy_blob *times; /**< float[] */
+    sy_blob *values; /**< float[] */
+} sy_animation_data;
+
+/** A sampler to build a clip from (sy_animation_set_clip): key_count times and key_count x
+ * components values (x 3 for CUBICSPLINE: in-tangent, value, out-tangent per key). Borrowed. */
+typedef struct sy_anim_sampler_desc {
+    uint32_t interpolation; /**< sy_anim_interpolation */
+    uint32_t components;    /**< floats per value */
+    uint32_t key_count;     /**< keys */
+    const float *times;     /**< key_count times */
+    const float *values;    /**< key_count x components (x 3 for CUBICSPLINE) floats */
+} sy_anim_sampler_desc;
+
+/** Samplers of an animation's data (borrowed from its blob); count may be 0. */
+const sy_anim_sampler *sy_animation_samplers(const sy_animation_data *d, uint32_t *count_out);
+/** Channels of an animation's data (borrowed); count may be 0. */
+const sy_anim_channel *sy_animation_channels(const sy_animation_data *d, uint32_t *count_out);
+/** The time range of the clip: the smallest first key time and the largest last key time over its
+ * samplers (glTF's duration is *end_out; an animation without samplers gives 0, 0). */
+void sy_animation_time_range(const sy_animation_data *d, float *start_out, float *end_out);
+
 /* ---------------------------------------------------------------- attachments */
 /** Value types of an attachment. */
 typedef enum sy_attachment_kind {
@@ -516,6 +615,8 @@ sy_result sy_light_create(sy_scene *s, const char *name, sy_light *out, sy_error
 sy_result sy_camera_create(sy_scene *s, const char *name, sy_camera *out, sy_error *err);
 /** Creates a background (as sy_node_create). */
 sy_result sy_background_create(sy_scene *s, const char *name, sy_background *out, sy_error *err);
+/** Creates an animation (as sy_node_create). */
+sy_result sy_animation_create(sy_scene *s, const char *name, sy_animation *out, sy_error *err);
 /** Generic form: *id_out receives the new handle id. */
 sy_result sy_object_create(sy_scene *s, sy_object_type t, const char *name, uint32_t *id_out, sy_error *err);
 
@@ -564,6 +665,13 @@ sy_result sy_light_set(sy_scene *s, sy_light l, const sy_light_data *d, sy_error
 sy_result sy_camera_set(sy_scene *s, sy_camera c, const sy_camera_data *d, sy_error *err);
 /** Sets every field of a background (as sy_material_set). */
 sy_result sy_background_set(sy_scene *s, sy_background b, const sy_background_data *d, sy_error *err);
+/** Sets every field of an animation (as sy_material_set); the rules between its blobs are checked
+ * on the whole (see the animation section). */
+sy_result sy_animation_set(sy_scene *s, sy_animation a, const sy_animation_data *d, sy_error *err);
+/** Builds an animation's blobs from samplers and channels (copied) and sets them at once; the name
+ * stays. Refuses what sy_animation_set refuses, naming the sampler or channel. */
+sy_result sy_animation_set_clip(sy_scene *s, sy_animation a, const sy_anim_sampler_desc *samplers, uint32_t sampler_count,
+                                const sy_anim_channel *channels, uint32_t channel_count, sy_error *err);
 /** Validates that the blob holds width*height*channels elements of the format. Retains pixels. */
 sy_result sy_texture_set_image(sy_scene *s, sy_texture t, const sy_image_info *info, sy_blob *pixels, sy_error *err);
 /** Sets the texture's sampler. */
@@ -582,6 +690,9 @@ const sy_light_data *sy_light_get(const sy_scene *s, sy_light l);
 const sy_camera_data *sy_camera_get(const sy_scene *s, sy_camera c);
 /** Borrowed background data, NULL for a stale handle. */
 const sy_background_data *sy_background_get(const sy_scene *s, sy_background b);
+
+/** Borrowed animation data, NULL for a stale handle. */
+const sy_animation_data *sy_animation_get(const sy_scene *s, sy_animation a);
 
 /** Child ids of a node data struct (borrowed from the children blob); count may be 0. */
 const uint32_t *sy_node_children(const sy_node_data *d, uint32_t *count_out);

@@ -336,7 +336,7 @@ sy_result sy_scene_apply_bounded(sy_scene *s, const sy_changes *changes, uint64_
             if (e->mask & SY_BIT(f))
                 r = sy_object_set_field(s, e->type, e->id, f, (const char *)e->data + td->fields[f].offset, err);
         const void *whole = r == SY_OK ? sy_object_get(s, e->type, e->id) : NULL; /* rules between fields */
-        if (whole) r = sy_sc_validate_object(e->type, e->id, whole, err);
+        if (whole) r = sy_sc_validate_object(s, e->type, e->id, whole, err);
         if (r == SY_OK && (e->mask & SY_BIT(SY_FIELD_ATTACHMENTS))) {
             slot *sl = sy_sc_lookup(s, e->type, e->id);
             sy_attachment *a;

@@ -110,7 +110,7 @@ int sy_sc_cmp_u32(const void *a, const void *b);
 
 /* sy_scene_validate.c */
 sy_result sy_sc_validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_t f, const void *v, sy_error *err);
-sy_result sy_sc_validate_object(uint32_t type, uint32_t id, const void *data, sy_error *err);
+sy_result sy_sc_validate_object(const sy_scene *s, uint32_t type, uint32_t id, const void *data, sy_error *err);
 
 /* sy_scene_objects.c */
 sy_result sy_sc_object_create_at(sy_scene *s, uint32_t t, uint32_t id, sy_error *err);

@@ -88,6 +88,7 @@ TYPED_CREATE(sy_texture_create, sy_texture, SY_TYPE_TEXTURE)
 TYPED_CREATE(sy_light_create, sy_light, SY_TYPE_LIGHT)
 TYPED_CREATE(sy_camera_create, sy_camera, SY_TYPE_CAMERA)
 TYPED_CREATE(sy_background_create, sy_background, SY_TYPE_BACKGROUND)
+TYPED_CREATE(sy_animation_create, sy_animation, SY_TYPE_ANIMATION)
 #undef TYPED_CREATE
 
 /* Updates parent lists and dirty marks of a node whose child list goes from old to new. */
@@ -168,7 +169,7 @@ static sy_result set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32_t 
 #undef SY_MAX2_
     _Static_assert(sizeof(sy_texture_data) <= sizeof src && sizeof(sy_mesh_data) <= sizeof src &&
                        sizeof(sy_light_data) <= sizeof src && sizeof(sy_camera_data) <= sizeof src &&
-                       sizeof(sy_background_data) <= sizeof src,
+                       sizeof(sy_background_data) <= sizeof src && sizeof(sy_animation_data) <= sizeof src,
                    "scratch buffer too small");
     const sy_field_desc *fd = &td->fields[field];
     memcpy(src + fd->offset, value, fd->size);
@@ -177,10 +178,14 @@ static sy_result set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32_t 
     if (sy__field_equal(t, field, sl->data, src)) return SY_OK;
     sy_result r = sy_sc_validate_field(s, t, id, field, value, err);
     if (r != SY_OK) return r;
-    if (!whole_checked && t == SY_TYPE_CAMERA) { /* the one type with rules between fields */
-        sy_camera_data merged = *(const sy_camera_data *)sl->data;
+    if (!whole_checked && (t == SY_TYPE_CAMERA || t == SY_TYPE_ANIMATION)) { /* the types with rules between fields */
+        union {
+            sy_camera_data camera;
+            sy_animation_data animation;
+        } merged;
+        memcpy(&merged, sl->data, td->data_size);
         memcpy((unsigned char *)&merged + fd->offset, value, fd->size);
-        if ((r = sy_sc_validate_object(t, id, &merged, err)) != SY_OK) return r;
+        if ((r = sy_sc_validate_object(s, t, id, &merged, err)) != SY_OK) return r;
     }
 
     sy_blob *old_children = NULL;
@@ -345,7 +350,7 @@ static sy_result set_all(sy_scene *s, uint32_t t, uint32_t id, const void *d, sy
         sy_result r = sy_sc_validate_field(s, t, id, f, (const char *)d + td->fields[f].offset, err);
         if (r != SY_OK) return r;
     }
-    sy_result r = sy_sc_validate_object(t, id, d, err);
+    sy_result r = sy_sc_validate_object(s, t, id, d, err);
     if (r != SY_OK) return r;
     for (uint32_t f = 0; f < td->field_count; ++f) {
         r = set_field(s, t, id, f, (const char *)d + td->fields[f].offset, true, err);
@@ -372,6 +377,76 @@ sy_result sy_camera_set(sy_scene *s, sy_camera c, const sy_camera_data *d, sy_er
 sy_result sy_background_set(sy_scene *s, sy_background b, const sy_background_data *d, sy_error *err)
 {
     return set_all(s, SY_TYPE_BACKGROUND, b.id, d, err);
+}
+
+sy_result sy_animation_set(sy_scene *s, sy_animation a, const sy_animation_data *d, sy_error *err)
+{
+    return set_all(s, SY_TYPE_ANIMATION, a.id, d, err);
+}
+
+sy_result sy_animation_set_clip(sy_scene *s, sy_animation a, const sy_anim_sampler_desc *samplers, uint32_t sampler_count,
+                                const sy_anim_channel *channels, uint32_t channel_count, sy_error *err)
+{
+    const sy_animation_data *cur = sy_animation_get(s, a);
+    if (!cur) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "animation: stale handle %#x", a.id);
+    if (sampler_count > SY_ANIM_MAX_SAMPLERS || channel_count > SY_ANIM_MAX_CHANNELS)
+        return sy_error_set(err, SY_ERR_LIMIT, "animation %#x: %u samplers, %u channels (at most %u, %u)", a.id,
+                            sampler_count, channel_count, SY_ANIM_MAX_SAMPLERS, SY_ANIM_MAX_CHANNELS);
+    if ((sampler_count && !samplers) || (channel_count && !channels))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x: NULL samplers or channels", a.id);
+    /* sizes first (checked: the counts are the caller's), then one copy into each blob */
+    uint64_t ntimes = 0, nvalues = 0;
+    for (uint32_t i = 0; i < sampler_count; ++i) {
+        const sy_anim_sampler_desc *sd = &samplers[i];
+        if (sd->key_count > SY_ANIM_MAX_KEYS || sd->components > SY_ANIM_MAX_COMPONENTS)
+            return sy_error_set(err, SY_ERR_LIMIT, "animation %#x sampler %u: %u keys of %u components (at most %u, %u)",
+                                a.id, i, sd->key_count, sd->components, SY_ANIM_MAX_KEYS, SY_ANIM_MAX_COMPONENTS);
+        if (sd->key_count && (!sd->times || !sd->values))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x sampler %u: NULL times or values", a.id, i);
+        ntimes += sd->key_count;
+        nvalues += (uint64_t)sd->key_count * sd->components * (sd->interpolation == SY_INTERP_CUBICSPLINE ? 3u : 1u);
+        if (ntimes > UINT32_MAX || nvalues > UINT32_MAX)
+            return sy_error_set(err, SY_ERR_LIMIT, "animation %#x: more than 2^32 key times or values", a.id);
+    }
+    sy_animation_data d = {.name = cur->name};
+    sy_result r = SY_OK;
+    sy_anim_sampler *rec = NULL;
+    float *times = NULL, *values = NULL;
+    if (sampler_count) {
+        rec = malloc(sizeof *rec * sampler_count);
+        times = malloc(sizeof *times * (ntimes ? ntimes : 1));
+        values = malloc(sizeof *values * (nvalues ? nvalues : 1));
+        if (!rec || !times || !values) {
+            r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "animation %#x: out of memory", a.id);
+            goto done;
+        }
+        uint32_t to = 0, vo = 0;
+        for (uint32_t i = 0; i < sampler_count; ++i) {
+            const sy_anim_sampler_desc *sd = &samplers[i];
+            uint32_t nv = sd->key_count * sd->components * (sd->interpolation == SY_INTERP_CUBICSPLINE ? 3u : 1u);
+            rec[i] = (sy_anim_sampler){sd->interpolation, sd->components, sd->key_count, to, vo};
+            if (sd->key_count) memcpy(times + to, sd->times, sizeof *times * sd->key_count);
+            if (nv) memcpy(values + vo, sd->values, sizeof *values * nv);
+            to += sd->key_count;
+            vo += nv;
+        }
+        if ((r = sy_blob_create_copy(rec, sizeof *rec * sampler_count, &d.samplers, err)) ||
+            (ntimes && (r = sy_blob_create_copy(times, sizeof *times * ntimes, &d.times, err))) ||
+            (nvalues && (r = sy_blob_create_copy(values, sizeof *values * nvalues, &d.values, err))))
+            goto done;
+    }
+    if (channel_count && (r = sy_blob_create_copy(channels, sizeof *channels * channel_count, &d.channels, err)))
+        goto done;
+    r = set_all(s, SY_TYPE_ANIMATION, a.id, &d, err);
+done:
+    sy_blob_release(d.samplers);
+    sy_blob_release(d.channels);
+    sy_blob_release(d.times);
+    sy_blob_release(d.values);
+    free(rec);
+    free(times);
+    free(values);
+    return r;
 }
 
 sy_result sy_texture_set_image(sy_scene *s, sy_texture t, const sy_image_info *info, sy_blob *pixels, sy_error *err)
@@ -415,6 +490,11 @@ const sy_camera_data *sy_camera_get(const sy_scene *s, sy_camera c) { return sy_
 const sy_background_data *sy_background_get(const sy_scene *s, sy_background b)
 {
     return sy_object_get(s, SY_TYPE_BACKGROUND, b.id);
+}
+
+const sy_animation_data *sy_animation_get(const sy_scene *s, sy_animation a)
+{
+    return sy_object_get(s, SY_TYPE_ANIMATION, a.id);
 }
 
 uint32_t sy_primitive_vertex_count(const sy_primitive *p) { return (uint32_t)(sy_blob_size(p->positions) / 12); }

@@ -73,6 +73,134 @@ static sy_result check_gradient(const sy_gradient *g, sy_error *err)
     return SY_OK;
 }
 
+/* An animation blob of whole records of `elem` bytes, at most `max` of them (NULL = none). */
+static sy_result check_records(const sy_blob *b, size_t elem, uint32_t max, uint32_t id, const char *what, sy_error *err)
+{
+    if (!b) return SY_OK;
+    size_t n = sy_blob_size(b);
+    if (n % elem != 0)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x: %s of %zu bytes is not whole %zu-byte records", id,
+                            what, n, elem);
+    if (n / elem > max)
+        return sy_error_set(err, SY_ERR_LIMIT, "animation %#x: %zu %s (at most %u)", id, n / elem, what, max);
+    return SY_OK;
+}
+
+static sy_result check_animation_field(const sy_scene *s, uint32_t id, uint32_t f, const void *v, sy_error *err)
+{
+    const sy_blob *b = f == SY_ANIMATION_NAME ? NULL : *(sy_blob *const *)v;
+    sy_result r;
+    switch (f) {
+    case SY_ANIMATION_SAMPLERS: {
+        if ((r = check_records(b, sizeof(sy_anim_sampler), SY_ANIM_MAX_SAMPLERS, id, "samplers", err))) return r;
+        const sy_anim_sampler *sm = b ? sy_blob_data(b) : NULL;
+        uint32_t n = b ? (uint32_t)(sy_blob_size(b) / sizeof *sm) : 0;
+        for (uint32_t i = 0; i < n; ++i) {
+            if (sm[i].interpolation >= SY_INTERP_COUNT)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x sampler %u: unknown interpolation %u", id,
+                                    i, sm[i].interpolation);
+            if (sm[i].components < 1 || sm[i].components > SY_ANIM_MAX_COMPONENTS)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x sampler %u: %u components (1 to %u)", id,
+                                    i, sm[i].components, SY_ANIM_MAX_COMPONENTS);
+            if (sm[i].key_count < 1 || sm[i].key_count > SY_ANIM_MAX_KEYS)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x sampler %u: %u keys (1 to %u)", id, i,
+                                    sm[i].key_count, SY_ANIM_MAX_KEYS);
+        }
+        return SY_OK;
+    }
+    case SY_ANIMATION_CHANNELS: {
+        if ((r = check_records(b, sizeof(sy_anim_channel), SY_ANIM_MAX_CHANNELS, id, "channels", err))) return r;
+        const sy_anim_channel *ch = b ? sy_blob_data(b) : NULL;
+        uint32_t n = b ? (uint32_t)(sy_blob_size(b) / sizeof *ch) : 0;
+        for (uint32_t i = 0; i < n; ++i) {
+            if (ch[i].path >= SY_ANIM_PATH_COUNT)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x channel %u: unknown path %u", id, i,
+                                    ch[i].path);
+            if (ch[i].node == 0 || !ref_ok(s, SY_TYPE_NODE, ch[i].node))
+                return sy_error_set(err, SY_ERR_INVALID_HANDLE, "animation %#x channel %u: target node %#x is not a live node",
+                                    id, i, ch[i].node);
+        }
+        return SY_OK;
+    }
+    case SY_ANIMATION_TIMES:
+    case SY_ANIMATION_VALUES: {
+        const char *what = f == SY_ANIMATION_TIMES ? "times" : "values";
+        if ((r = check_records(b, sizeof(float), UINT32_MAX, id, what, err))) return r;
+        const float *x = b ? sy_blob_data(b) : NULL;
+        size_t n = b ? sy_blob_size(b) / sizeof(float) : 0;
+        for (size_t i = 0; i < n; ++i)
+            if (!isfinite(x[i]))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x: %s[%zu] is not finite", id, what, i);
+        return SY_OK;
+    }
+    default: return SY_OK;
+    }
+}
+
+/* The rules between an animation's blobs (sy_objects.h): runs inside their blobs, times strictly
+ * increasing, components by path, values in range, channels naming samplers. O(keys + channels). */
+static sy_result check_animation(const sy_animation_data *d, uint32_t id, sy_error *err)
+{
+    uint32_t ns, nc;
+    const sy_anim_sampler *sm = sy_animation_samplers(d, &ns);
+    const sy_anim_channel *ch = sy_animation_channels(d, &nc);
+    size_t nt = d->times ? sy_blob_size(d->times) / sizeof(float) : 0;
+    size_t nv = d->values ? sy_blob_size(d->values) / sizeof(float) : 0;
+    const float *t = nt ? sy_blob_data(d->times) : NULL, *v = nv ? sy_blob_data(d->values) : NULL;
+    for (uint32_t i = 0; i < ns; ++i) {
+        uint64_t per = sm[i].interpolation == SY_INTERP_CUBICSPLINE ? 3u : 1u;
+        uint64_t need = (uint64_t)sm[i].key_count * sm[i].components * per;
+        if ((uint64_t)sm[i].times_offset + sm[i].key_count > nt)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "animation %#x sampler %u: %u key times from %u run past the %zu times", id, i,
+                                sm[i].key_count, sm[i].times_offset, nt);
+        if ((uint64_t)sm[i].values_offset + need > nv)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "animation %#x sampler %u: %llu output values from %u (%u keys x %u components%s) run "
+                                "past the %zu values",
+                                id, i, (unsigned long long)need, sm[i].values_offset, sm[i].key_count,
+                                sm[i].components, per == 3 ? " x 3 for CUBICSPLINE" : "", nv);
+        const float *ti = t + sm[i].times_offset;
+        for (uint32_t k = 1; k < sm[i].key_count; ++k)
+            if (!(ti[k] > ti[k - 1]))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "animation %#x sampler %u: key time %u (%g) is not after key time %u (%g) (times "
+                                    "must increase strictly)",
+                                    id, i, k, (double)ti[k], k - 1, (double)ti[k - 1]);
+    }
+    for (uint32_t c = 0; c < nc; ++c) {
+        if (ch[c].sampler >= ns)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x channel %u: sampler %u of %u", id, c,
+                                ch[c].sampler, ns);
+        const sy_anim_sampler *a = &sm[ch[c].sampler];
+        uint32_t want = ch[c].path == SY_ANIM_ROTATION ? 4u : 3u;
+        if (ch[c].path != SY_ANIM_WEIGHTS && a->components != want)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "animation %#x channel %u: sampler %u has %u components, the %s path takes %u", id, c,
+                                ch[c].sampler, a->components,
+                                ch[c].path == SY_ANIM_TRANSLATION ? "translation" : ch[c].path == SY_ANIM_ROTATION ? "rotation" : "scale",
+                                want);
+        uint32_t per = a->interpolation == SY_INTERP_CUBICSPLINE ? 3u : 1u;
+        const float *x = v + a->values_offset;
+        for (uint32_t k = 0; k < a->key_count; ++k) {
+            const float *key = x + ((size_t)k * per + (per == 3 ? 1u : 0u)) * a->components; /* the key's value */
+            if ((ch[c].path == SY_ANIM_TRANSLATION || ch[c].path == SY_ANIM_SCALE)) {
+                for (uint32_t j = 0; j < per * 3u; ++j) /* every value and tangent of the key */
+                    if (!sy_coords_in_range(x + ((size_t)k * per) * 3u + j, 1))
+                        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                            "animation %#x channel %u: sampler %u key %u is beyond the coordinate range (%g)",
+                                            id, c, ch[c].sampler, k, (double)SY_COORD_MAX);
+            } else if (ch[c].path == SY_ANIM_ROTATION &&
+                       !(key[0] * key[0] + key[1] * key[1] + key[2] * key[2] + key[3] * key[3] > 1e-12f)) {
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "animation %#x channel %u: sampler %u key %u is the zero quaternion", id, c,
+                                    ch[c].sampler, k);
+            }
+        }
+    }
+    return SY_OK;
+}
+
 static sy_result check_primitive(const sy_scene *s, const sy_primitive *p, uint32_t i, sy_error *err)
 {
     if (!p->positions) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: no positions", i);
@@ -333,14 +461,17 @@ sy_result sy_sc_validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_t
                                 sy__type_desc(type)->fields[f].name);
         if (f == SY_BACKGROUND_GRADIENT) return check_gradient(v, err);
         return SY_OK;
+    case SY_TYPE_ANIMATION: return check_animation_field(s, id, f, v, err);
     default: return SY_OK;
     }
 }
 
 /* Rules between fields of one object, checked on the object as a change leaves it (after every field
  * of a whole set or of a replica's entry, so the order fields are set in does not matter). */
-sy_result sy_sc_validate_object(uint32_t type, uint32_t id, const void *data, sy_error *err)
+sy_result sy_sc_validate_object(const sy_scene *s, uint32_t type, uint32_t id, const void *data, sy_error *err)
 {
+    (void)s;
+    if (type == SY_TYPE_ANIMATION) return check_animation(data, id, err);
     if (type == SY_TYPE_CAMERA) {
         const sy_camera_data *c = data;
         /* every back-end refuses to render a clip range whose far plane is not beyond its near one */

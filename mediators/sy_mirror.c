@@ -776,6 +776,7 @@ static sy_result apply_entry(sy_mirror *st, const sy_change *e, sy_error *err)
     case SY_TYPE_LIGHT: return apply_light(st, e, destroyed, err);
     case SY_TYPE_BACKGROUND: return apply_background(st, e, destroyed, err);
     case SY_TYPE_NODE: return apply_node(st, e, destroyed, err);
+    case SY_TYPE_ANIMATION: return SY_OK; /* nothing visible by itself: the clock (sy_anim.h) sets node fields */
     default: return SY_OK;
     }
 }
