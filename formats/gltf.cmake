@@ -10,6 +10,7 @@ target_sources(sy_formats PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_materials.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_meshes.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_nodes.c
+  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_animations.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_variants.c
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_shim.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_shim_write.cpp

@@ -28,6 +28,7 @@ void sy_gltf_info_free(sy_gltf_info *info)
     for (uint32_t i = 0; i < info->extensions_used_count; i++) free(info->extensions_used[i]);
     free(info->extensions_used);
     free(info->variant_uses);
+    free(info->animations);
     sy_loader_warnings_free(gltf_warnings(info));
     memset(info, 0, sizeof *info);
 }
@@ -75,9 +76,6 @@ static sy_result load_doc(loader *L)
         !(L->textures = gltf_xcalloc(L, d->texture_count * 2 + 2, sizeof(sy_texture), &r)) ||
         !(L->image_blobs = gltf_xcalloc(L, d->image_count + 1, sizeof(sy_blob *), &r)))
         return r;
-    if (d->animation_count)
-        gltf_warn(L, "%zu animation(s): nodes are placed at the first frame of animations[0], the rest is ignored",
-                  d->animation_count);
 
     if ((r = gltf_charge_meshes(L))) return r;
     if (d->variant_count) {
@@ -127,7 +125,8 @@ static sy_result load_doc(loader *L)
     if (si >= 0) {
         const sy_gltf_shim_scene *sc = &d->scenes[si];
         snprintf(name, sizeof name, "scene %d", (int)si);
-        return gltf_create_nodes(L, sc->nodes, sc->node_count, gltf_nonempty(sc->name) ? sc->name : name);
+        if ((r = gltf_create_nodes(L, sc->nodes, sc->node_count, gltf_nonempty(sc->name) ? sc->name : name))) return r;
+        return gltf_create_animations(L);
     }
     int32_t *roots = gltf_xcalloc(L, d->node_count + 1, sizeof(int32_t), &r);
     if (!roots) return r;
@@ -136,7 +135,7 @@ static sy_result load_doc(loader *L)
         if (L->parent[i] == -1) roots[nr++] = (int32_t)i;
     r = gltf_create_nodes(L, roots, nr, "scene");
     free(roots);
-    return r;
+    return r ? r : gltf_create_animations(L);
 }
 
 /* Shared by sy_gltf_load (mem NULL: reads path; external files relative to its directory) and

@@ -23,9 +23,19 @@
  * wrap / filter; perspective and orthographic cameras; KHR_lights_punctual; KHR_mesh_quantization;
  * KHR_draco_mesh_compression (libdraco); EXT_meshopt_compression (meshoptimizer);
  * EXT_mesh_gpu_instancing. KHR_texture_basisu is refused when required (no packaged decoder).
- * Animated nodes are placed at the first frame of animations[0] (first keyframe value of each
- * translation / rotation / scale channel); skinned meshes are shown in their bind pose (skins
- * ignored) and morph targets ignored (one warning each).
+ * Animations: every glTF animation becomes one sy_animation (sy_objects.h; file order, its name;
+ * info->animations) with its translation, rotation, scale and weights channels that target loaded
+ * nodes; sy_scene_set_time (sy_anim.h) plays them. A load without a time shows the nodes at the
+ * first keyframe of each channel of animations[0] (the value at time 0 for keys from 0 on, which is
+ * what sy_scene_set_time(clip 0, 0) sets; the static load keeps the file's values unnormalised).
+ * Samplers with mismatched input / output counts, times that are not finite or do not increase
+ * strictly, non-finite outputs (translation / scale beyond the coordinate range, zero quaternions)
+ * or an unknown interpolation are dropped with a warning naming animations[i].samplers[j]; channels
+ * to unknown nodes, to nodes outside the loaded scene, to matrix nodes (glTF forbids animating
+ * them) or with another path (KHR_animation_pointer) are dropped naming animations[i].channels[k].
+ * Morph weight channels are kept in the animation, not evaluated (core has no weights yet);
+ * skinned meshes are shown in their bind pose (skins ignored) and morph targets ignored (one
+ * warning each).
  *
  * Untrusted input: the whole document is validated (indices, accessor / bufferView / buffer ranges
  * with checked arithmetic, GLB container, index values, node graph must be a forest, limits,
@@ -83,7 +93,7 @@ typedef struct sy_gltf_counts {
     uint32_t skipped_primitives; /**< without POSITION, or without one complete element */
     /** @{ elements of POINTS and of LINES / LINE_LOOP / LINE_STRIP primitives */
     uint32_t points, line_segments; /** @} */
-    uint32_t animations; /**< animations in the file (a static load places nodes at animations[0]'s first frame) */
+    uint32_t animations; /**< animations in the file (each one a sy_animation: sy_gltf_info.animations) */
 } sy_gltf_counts;
 
 /** One KHR_materials_variants mapping: primitive `primitive` (an index into the mesh's sy
@@ -116,6 +126,8 @@ typedef struct sy_gltf_info {
     char **extensions_used; /**< the file's extensionsUsed, in file order (malloc()ed); compare with
                                  sy_gltf_supported_extensions() for what this loader reads */
     uint32_t extensions_used_count; /**< entries of extensions_used */
+    sy_animation *animations; /**< one per glTF animation, in file order (malloc()ed) */
+    uint32_t animation_count; /**< entries of animations */
 } sy_gltf_info;
 
 /** Loads the glTF file at `path` into `scene`. The default glTF scene is `scene` of the file, else

@@ -6,6 +6,7 @@
  *   sy_gltf_materials.c  materials, textures, samplers
  *   sy_gltf_meshes.c     the meshes' budget, primitives (triangles, points, lines) -> sy_meshes
  *   sy_gltf_nodes.c      cameras, lights, the node graph of one scene, instancing
+ *   sy_gltf_animations.c every animation into a core animation object (after the nodes)
  *   sy_gltf.c            the public entry points (sy_gltf.h): options, the order of the load
  * Every function here starts with gltf_ (types and constants never leave these files). */
 #ifndef SY_GLTF_INTERNAL_H
@@ -157,5 +158,10 @@ sy_result gltf_create_camera(loader *L, size_t i);
 sy_result gltf_create_light(loader *L, size_t i);
 /* The nodes reachable from roots and a new root node named root_name (L->info->root, camera nodes). */
 sy_result gltf_create_nodes(loader *L, const int32_t *roots, size_t root_count, const char *root_name);
+
+/* >>animations (sy_gltf_animations.c) -------------------------------------------------------- */
+
+/* Every animation of the file into L->info->animations (after gltf_create_nodes). */
+sy_result gltf_create_animations(loader *L);
 
 #endif /* SY_GLTF_INTERNAL_H */

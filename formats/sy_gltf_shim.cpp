@@ -418,6 +418,9 @@ struct sy_gltf_shim_impl {
     std::vector<std::vector<int32_t>> scene_nodes;
     std::vector<sy_gltf_shim_scene> scenes;
     std::vector<sy_gltf_shim_channel> channels;
+    std::vector<std::vector<sy_gltf_shim_anim_sampler>> anim_samplers;
+    std::vector<std::vector<sy_gltf_shim_anim_channel>> anim_channels;
+    std::vector<sy_gltf_shim_animation> animations;
     std::vector<const char *> ext_required;
     std::vector<const char *> ext_used;
     std::vector<const char *> variant_names;
@@ -646,6 +649,24 @@ static void fill_doc(sy_gltf_shim_impl *d)
     }
     c.channels = d->channels.data();
     c.channel_count = d->channels.size();
+    d->anim_samplers.resize(m.animations.size());
+    d->anim_channels.resize(m.animations.size());
+    for (size_t i = 0; i < m.animations.size(); i++) {
+        const tinygltf::Animation &a = m.animations[i];
+        for (const tinygltf::AnimationSampler &sm : a.samplers) {
+            const std::string &ip = sm.interpolation;
+            int32_t interp = ip.empty() || ip == "LINEAR" ? 0 : ip == "STEP" ? 1 : ip == "CUBICSPLINE" ? 2 : -1;
+            d->anim_samplers[i].push_back({int32_t(sm.input), int32_t(sm.output), interp});
+        }
+        for (const tinygltf::AnimationChannel &ch : a.channels) {
+            const std::string &tp = ch.target_path;
+            int32_t path = tp == "translation" ? 0 : tp == "rotation" ? 1 : tp == "scale" ? 2 : tp == "weights" ? 3 : -1;
+            d->anim_channels[i].push_back({int32_t(ch.target_node), path, int32_t(ch.sampler)});
+        }
+        d->animations.push_back({a.name.c_str(), d->anim_samplers[i].data(), d->anim_samplers[i].size(),
+                                 d->anim_channels[i].data(), d->anim_channels[i].size()});
+    }
+    c.animations = d->animations.data();
     c.warnings = d->warnings.c_str();
     c.internal = d;
 }

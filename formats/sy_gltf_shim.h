@@ -212,6 +212,22 @@ typedef struct sy_gltf_shim_channel {
     int32_t cubic;  /* CUBICSPLINE: outputs are (in-tangent, value, out-tangent) triples */
 } sy_gltf_shim_channel;
 
+/* Every animation (all clips): samplers and channels as the file gives them. Indices untrusted. */
+typedef struct sy_gltf_shim_anim_sampler {
+    int32_t input, output;  /* accessor indices */
+    int32_t interpolation;  /* 0 LINEAR (the default), 1 STEP, 2 CUBICSPLINE, -1 anything else */
+} sy_gltf_shim_anim_sampler;
+typedef struct sy_gltf_shim_anim_channel {
+    int32_t node;    /* target node, -1 none */
+    int32_t path;    /* 0 translation, 1 rotation, 2 scale, 3 weights, -1 anything else (pointer) */
+    int32_t sampler; /* index into the animation's samplers */
+} sy_gltf_shim_anim_channel;
+typedef struct sy_gltf_shim_animation {
+    const char *name;
+    const sy_gltf_shim_anim_sampler *samplers; size_t sampler_count;
+    const sy_gltf_shim_anim_channel *channels; size_t channel_count;
+} sy_gltf_shim_animation;
+
 /* KHR_materials_variants: primitive `primitive` of mesh `mesh` takes material `material` in variant
  * `variant` (one entry per variant of each mapping, in mesh then primitive order). Indices are
  * untrusted. */
@@ -237,6 +253,7 @@ typedef struct sy_gltf_doc {
     const char *const *extensions_used;     size_t extensions_used_count; /* the file's extensionsUsed */
     size_t skin_count, animation_count;
     const sy_gltf_shim_channel *channels;   size_t channel_count; /* of animations[0] */
+    const sy_gltf_shim_animation *animations; /* animation_count of them */
     const char *const *variant_names;       size_t variant_count; /* KHR_materials_variants ("" unnamed) */
     const sy_gltf_shim_variant_use *variant_uses; size_t variant_use_count;
     const char *warnings; /* tinygltf's warning text, "" when none */

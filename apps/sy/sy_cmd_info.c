@@ -150,12 +150,31 @@ int sy_cmd_info(int argc, char **argv)
     if (ld.is_gltf || ld.is_x3d || ld.is_assimp) jcounts(sy_json_add(doc, "file_counts", cJSON_CreateObject()), names, v, 13);
     else sy_json_add(doc, "file_counts", cJSON_CreateNull()); /* the built-in scene: no file */
     static const char *const lnames[] = {"nodes", "meshes", "primitives", "triangles", "materials",
-                                         "textures", "lights", "cameras"};
+                                         "textures", "lights", "cameras", "animations"};
     const uint32_t lv[] = {sy_scene_count(ld.scene, SY_TYPE_NODE) - 1, sy_scene_count(ld.scene, SY_TYPE_MESH), prims,
                            tris, sy_scene_count(ld.scene, SY_TYPE_MATERIAL), sy_scene_count(ld.scene, SY_TYPE_TEXTURE),
-                           sy_scene_count(ld.scene, SY_TYPE_LIGHT), sy_scene_count(ld.scene, SY_TYPE_CAMERA)};
-    jcounts(sy_json_add(doc, "loaded", cJSON_CreateObject()), lnames, lv, 8);
+                           sy_scene_count(ld.scene, SY_TYPE_LIGHT), sy_scene_count(ld.scene, SY_TYPE_CAMERA),
+                           sy_scene_count(ld.scene, SY_TYPE_ANIMATION)};
+    jcounts(sy_json_add(doc, "loaded", cJSON_CreateObject()), lnames, lv, 9);
     add_extensions(doc, ld.is_gltf ? &ld.gltf : NULL);
+    /* the clips (sy_anim.h): index (what --clip takes), name, time range and duration, channels */
+    cJSON *clips = sy_json_add(doc, "clips", cJSON_CreateArray());
+    uint32_t ci = 0;
+    for (uint32_t id = sy_scene_next(ld.scene, SY_TYPE_ANIMATION, 0); id; id = sy_scene_next(ld.scene, SY_TYPE_ANIMATION, id), ++ci) {
+        const sy_animation_data *ad = sy_object_get(ld.scene, SY_TYPE_ANIMATION, id);
+        float start, end;
+        uint32_t nch, nsm;
+        sy_animation_time_range(ad, &start, &end);
+        sy_animation_channels(ad, &nch);
+        sy_animation_samplers(ad, &nsm);
+        cJSON *c = sy_json_add(clips, NULL, cJSON_CreateObject());
+        sy_json_add(c, "index", cJSON_CreateNumber(ci));
+        sy_json_add(c, "name", ad->name ? sy_json_str(ad->name) : cJSON_CreateNull());
+        sy_json_add(c, "start", sy_json_float((double)start));
+        sy_json_add(c, "duration", sy_json_float((double)end)); /* glTF: the clip runs from 0 to its last key */
+        sy_json_add(c, "channels", cJSON_CreateNumber(nch));
+        sy_json_add(c, "samplers", cJSON_CreateNumber(nsm));
+    }
     if (sy_bounds_is_empty(&b)) {
         sy_json_add(doc, "bounds", cJSON_CreateNull());
     } else {
