@@ -82,8 +82,10 @@ static sy_result read_sampler(loader *L, size_t ai, size_t j, int32_t path, anim
         bool bad = !isfinite(s->values[k]);
         if (!bad && (path == SY_ANIM_TRANSLATION || path == SY_ANIM_SCALE)) bad = !sy_coords_in_range(&s->values[k], 1);
         if (bad) {
-            gltf_warn(L, "animations[%zu].samplers[%zu]: output value %zu (%g) is not finite or beyond the coordinate range; dropped",
-                      ai, j, k / comps, (double)s->values[k]);
+            gltf_warn(L,
+                      "animations[%zu].samplers[%zu]: output element %zu component %zu (%g) is not finite or beyond the "
+                      "coordinate range; dropped",
+                      ai, j, k / comps, k % comps, (double)s->values[k]);
             return SY_OK;
         }
     }

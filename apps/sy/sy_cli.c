@@ -171,6 +171,7 @@ static const char usage_text[] =
             "            [--gl osmesa|egl|glfw]   (-b raster: the GL context provider)\n"
             "            [--stereo sbs|tb|anaglyph|separate] [--eye-sep M] [--zero-parallax M]\n"
             "            [--overlay FILE[:BACKEND]] [--composite depth|over|replace]\n"
+            "            [--at SECONDS] [--clip NAME|INDEX]   (the scene at a time: every clip, or one; sy info lists clips)\n"
             "  sy render SCENE -b pathtracer [-o OUT.exr|png|jpg] [--spp N | --time SECONDS] [--aov]\n"
             "            (+ the options above)\n"
             "            [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]   (display filter)\n"

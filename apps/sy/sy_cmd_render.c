@@ -298,6 +298,9 @@ int sy_cmd_render(int argc, char **argv)
     sy_cluster_cli_opts clo = {0};
     pt_opts po = {0};
     bool progressive_opts = false; /* --spp / --time / --aov given */
+    double at = 0.0;           /* --at: the scene's time in seconds */
+    bool at_given = false;
+    const char *clip = NULL;   /* --clip: one animation (name or index); without it every clip plays */
     static const struct option lo[] = {
         {"spp", required_argument, NULL, OPT_SPP}, {"time", required_argument, NULL, OPT_TIME},
         {"aov", no_argument, NULL, OPT_AOV}, {"camera", required_argument, NULL, OPT_CAMERA},
@@ -309,6 +312,7 @@ int sy_cmd_render(int argc, char **argv)
         {"overlay", required_argument, NULL, OPT_OVERLAY}, {"composite", required_argument, NULL, OPT_COMPOSITE},
         {"frames", required_argument, NULL, OPT_FRAMES}, /* cluster: frames through the same window */
         {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
+        {"at", required_argument, NULL, OPT_AT}, {"clip", required_argument, NULL, OPT_CLIP}, /* the scene clock */
         SY_CLUSTER_CLI_OPTIONS, COMMON_OPTIONS};
     uint32_t max_memory_mb = 0;
     int c, status = 0;
@@ -363,6 +367,11 @@ int sy_cmd_render(int argc, char **argv)
         case OPT_MAX_MEMORY:
             if (!sy_cli_parse_u32(optarg, 1, 1u << 30, &max_memory_mb)) return sy_cli_bad_value("--max-memory", optarg);
             break;
+        case OPT_AT: /* seconds on the scene clock: finite, from 0 */
+            if (!sy_cli_parse_double(optarg, 0.0, 1e9, &at)) return sy_cli_bad_value("--at", optarg);
+            at_given = true;
+            break;
+        case OPT_CLIP: clip = optarg; break;
         default: /* --cluster ... (sy_cluster_cli.c) */
             if (!sy_cluster_cli_getopt(c, optarg, &clo)) return sy_cli_bad_value(sy_cli_option_name(lo, c), optarg);
         }
@@ -480,6 +489,15 @@ int sy_cmd_render(int argc, char **argv)
     }
     loaded ld;
     if (sy_cli_load(scene, camera, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
+    /* the scene clock (sy_anim.h): after the load, so the camera framed the loaded pose and the same
+     * camera shows every time; the moved nodes reach every back-end (and cluster server) as changes */
+    if (at_given || clip) {
+        int st = sy_cli_set_time(&ld, clip, at, &err);
+        if (st) {
+            sy_cli_loaded_free(&ld);
+            return st == 2 ? 2 : sy_cli_fail(&err);
+        }
+    }
     /* default size: 512 high, width from the camera's aspect ratio when it has one */
     float aspect = 1.0f;
     const sy_node_data *cn = ld.camera.id ? sy_node_get(ld.scene, ld.camera) : NULL;

@@ -4,6 +4,7 @@
  * the world flags, X3D fields of view, and --overlay FILE[:BACKEND]. */
 #include "sy_load.h"
 
+#include "sy_anim.h"
 #include "sy_demo.h"
 #include "sy_log.h"
 #include "sy_mediators.h"
@@ -170,6 +171,32 @@ sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, l
                sy_scene_count(out->scene, SY_TYPE_MATERIAL), sy_scene_count(out->scene, SY_TYPE_LIGHT),
                sy_scene_count(out->scene, SY_TYPE_CAMERA));
     return r;
+}
+
+int sy_cli_set_time(loaded *ld, const char *clip, double seconds, sy_error *err)
+{
+    sy_animation a = {0};
+    if (!sy_scene_count(ld->scene, SY_TYPE_ANIMATION)) {
+        if (clip) {
+            fprintf(stderr, "sy render: error: --clip %s: the scene has no animations\n", clip);
+            return 2;
+        }
+        sy_log(SY_LOG_NOTE, "sy", NULL, "--at %g: the scene has no animations; it is shown as loaded", seconds);
+        return 0;
+    }
+    if (clip) {
+        sy_error fe = {0};
+        if (sy_animation_find(ld->scene, clip, &a, &fe) != SY_OK) {
+            fprintf(stderr, "sy render: error: --clip %s: %s\n", clip, fe.message);
+            return 2;
+        }
+    }
+    sy_anim_stats st;
+    if (sy_scene_set_time_ex(ld->scene, a, seconds, &st, err) != SY_OK || sy_scene_commit(ld->scene, NULL, err) != SY_OK)
+        return 1;
+    sy_log(SY_LOG_DEBUG, "sy", NULL, "--at %g: %u clip(s), %u channels evaluated (%u morph weight channels not yet)", seconds,
+           st.clips, st.channels, st.weights);
+    return 0;
 }
 
 /* X3D Viewpoint fieldOfView covers the smaller image side: adapt yfov to the output size. */

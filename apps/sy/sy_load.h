@@ -45,6 +45,11 @@ extern sy_load_options sy_cli_load_opts;
  * bounds. The world flags are applied. On failure *out is empty. */
 sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, loaded *out, sy_error *err);
 void sy_cli_loaded_free(loaded *l);
+/* --at SECONDS / --clip NAME|INDEX: sets the loaded scene's time (sy_scene_set_time) on that clip, or
+ * on every clip without one, and commits. Returns 0; 2 after a usage error (an unknown clip, named
+ * with the clips there are, on stderr); 1 with *err when the scene refused a value. A scene without
+ * animations is told on the log (a note) and left as it is. */
+int sy_cli_set_time(loaded *ld, const char *clip, double seconds, sy_error *err);
 /* X3D Viewpoint fieldOfView covers the smaller image side: adapt yfov to the output size. */
 void sy_cli_fit_x3d_cameras(loaded *ld, uint32_t w, uint32_t h);
 /* --overlay FILE[:BACKEND]: loads FILE into the same scene under its own root and layers it over

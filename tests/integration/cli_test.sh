@@ -3,7 +3,10 @@
 #   - sy info Box.gltf: JSON in the one layout of every format (format, file_counts, loaded, extensions,
 #     variants, bounds, warning_count, warnings): meshes/primitives/triangles/materials = 1/1/12/1,
 #     bounds +-0.5; a file's warnings only in the JSON; extensionsUsed split into supported and
-#     unsupported, the variant names, BoxAnimated's 1 animation
+#     unsupported, the variant names, BoxAnimated's 1 animation and its clip (duration, channels)
+#   - the scene clock: sy render BoxAnimated --at 0 equals the static load pixel for pixel (EXR,
+#     exr_equal), --at 0.5 and --at 2 differ; --at -1 / nan, an unknown --clip and --clip on a scene
+#     without animations are usage errors (status 2) naming the option
 #   - conventions: --version, --help / help / CMD --help / help bench on stdout; a bad option, a
 #     missing or bad value named with status 2; a failure status 1; backends --json; -q / -v;
 #     an abbreviated long option (--frame for --frames) is a usage error naming the options it
@@ -37,6 +40,7 @@ set -u
 SY=$1
 DATA=$2
 TMP=$3
+EXR_EQUAL=${4:-} # tests/support/exr_equal (optional: the --at pixel checks are skipped without it)
 fails=0
 missing=""
 
@@ -453,6 +457,38 @@ if [ -f "$BOX" ] && [ -f "$GLB" ]; then
     if [ -f "$BOXANIM" ]; then
         run_ok "info BoxAnimated.glb" info_anim "$SY" info "$BOXANIM"
         grep -qxF '    "animations": 1' "$TMP/info_anim.out" || fail "info BoxAnimated.glb: not 1 animation"
+        grep -qF '{"index": 0, "name": null, "start": 0, "duration": 3.70832992, "channels": 2, "samplers": 2}' \
+            "$TMP/info_anim.out" || fail "info BoxAnimated.glb: clips: $(grep -A2 clips "$TMP/info_anim.out")"
+        # the scene clock: --at 0 is the static load; two times differ; bad values are usage errors
+        mkdir -p "$TMP/anim"
+        run_ok "render BoxAnimated" anim_static "$SY" render "$BOXANIM" -w 64 -h 48 -o "$TMP/anim/static.exr"
+        run_ok "render BoxAnimated --at 0" anim_0 "$SY" render "$BOXANIM" -w 64 -h 48 --at 0 -o "$TMP/anim/t0.exr"
+        run_ok "render BoxAnimated --at 0.5" anim_05 "$SY" render "$BOXANIM" -w 64 -h 48 --at 0.5 -o "$TMP/anim/t05.exr"
+        run_ok "render BoxAnimated --at 2 --clip 0" anim_2 "$SY" render "$BOXANIM" -w 64 -h 48 --at 2 --clip 0 \
+            -o "$TMP/anim/t2.exr"
+        if [ -n "$EXR_EQUAL" ]; then
+            "$EXR_EQUAL" "$TMP/anim/static.exr" "$TMP/anim/t0.exr" >/dev/null 2>&1 ||
+                fail "render BoxAnimated: --at 0 differs from the static load"
+            "$EXR_EQUAL" "$TMP/anim/t05.exr" "$TMP/anim/t2.exr" >/dev/null 2>&1 &&
+                fail "render BoxAnimated: --at 0.5 and --at 2 give the same image"
+        else
+            echo "skip: --at pixel checks (no exr_equal given)"
+        fi
+        for bad in -1 nan inf 1e99x; do
+            run anim_bad "$SY" render "$BOXANIM" -w 16 -h 16 --at "$bad" -o "$TMP/anim/bad.png"
+            [ "$rc" -eq 2 ] && grep -qF -- "--at: '$bad'" "$TMP/anim_bad.err" ||
+                fail "--at $bad: status $rc (want 2), $(cat "$TMP/anim_bad.err")"
+        done
+        run anim_clip "$SY" render "$BOXANIM" -w 16 -h 16 --clip walk -o "$TMP/anim/bad.png"
+        [ "$rc" -eq 2 ] && grep -qF -- "--clip walk: no animation named 'walk' (available: 0:(unnamed))" "$TMP/anim_clip.err" ||
+            fail "--clip walk: status $rc (want 2), $(cat "$TMP/anim_clip.err")"
+        run anim_clip1 "$SY" render "$BOXANIM" -w 16 -h 16 --clip 1 -o "$TMP/anim/bad.png"
+        [ "$rc" -eq 2 ] && grep -qF -- "--clip 1: no animation at index '1'" "$TMP/anim_clip1.err" ||
+            fail "--clip 1: status $rc (want 2), $(cat "$TMP/anim_clip1.err")"
+        [ ! -e "$TMP/anim/bad.png" ] || fail "a refused --at / --clip left an image"
+        run anim_noclip "$SY" render "$BOX" -w 16 -h 16 --clip 0 -o "$TMP/anim/bad.png"
+        [ "$rc" -eq 2 ] && grep -qF -- "--clip 0: the scene has no animations" "$TMP/anim_noclip.err" ||
+            fail "--clip on Box: status $rc (want 2), $(cat "$TMP/anim_noclip.err")"
     else
         echo "skip: info BoxAnimated.glb ($BOXANIM absent)"
     fi
