@@ -3,7 +3,7 @@
  * handles, field setters that record changes, attachments, node DAG with world matrices and
  * bounds, and commit into change lists (sy_changes.h reads them). This header creates and
  * destroys a scene and includes the one header of each of its concepts:
- *   sy_objects.h  handles, the seven object types and their fields, object calls, attachments;
+ *   sy_objects.h  handles, the eight object types and their fields, object calls, attachments;
  *   sy_graph.h    parents, world matrices and bounds;
  *   sy_commit.h   commit, consumers, snapshots and replica apply.
  *
