@@ -168,37 +168,52 @@ static sy_result check_animation(const sy_animation_data *d, uint32_t id, sy_err
                                     "must increase strictly)",
                                     id, i, k, (double)ti[k], k - 1, (double)ti[k - 1]);
     }
-    for (uint32_t c = 0; c < nc; ++c) {
-        if (ch[c].sampler >= ns)
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x channel %u: sampler %u of %u", id, c,
-                                ch[c].sampler, ns);
+    /* the values of each sampler are checked once per kind of path that uses it (bit 1: translation
+     * or scale, bit 2: rotation), so a clip of many channels sharing samplers costs its keys once */
+    uint8_t *checked = ns ? calloc(ns, 1) : NULL;
+    if (ns && !checked) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "animation %#x: out of memory", id);
+    sy_result r = SY_OK;
+    for (uint32_t c = 0; c < nc && r == SY_OK; ++c) {
+        if (ch[c].sampler >= ns) {
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x channel %u: sampler %u of %u", id, c,
+                             ch[c].sampler, ns);
+            break;
+        }
         const sy_anim_sampler *a = &sm[ch[c].sampler];
         uint32_t want = ch[c].path == SY_ANIM_ROTATION ? 4u : 3u;
-        if (ch[c].path != SY_ANIM_WEIGHTS && a->components != want)
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "animation %#x channel %u: sampler %u has %u components, the %s path takes %u", id, c,
-                                ch[c].sampler, a->components,
-                                ch[c].path == SY_ANIM_TRANSLATION ? "translation" : ch[c].path == SY_ANIM_ROTATION ? "rotation" : "scale",
-                                want);
+        if (ch[c].path != SY_ANIM_WEIGHTS && a->components != want) {
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                             "animation %#x channel %u: sampler %u has %u components, the %s path takes %u", id, c,
+                             ch[c].sampler, a->components,
+                             ch[c].path == SY_ANIM_TRANSLATION ? "translation"
+                             : ch[c].path == SY_ANIM_ROTATION  ? "rotation"
+                                                               : "scale",
+                             want);
+            break;
+        }
+        uint8_t bit = ch[c].path == SY_ANIM_ROTATION ? 2u : ch[c].path == SY_ANIM_WEIGHTS ? 0u : 1u;
+        if (!bit || (checked[ch[c].sampler] & bit)) continue;
+        checked[ch[c].sampler] |= bit;
         uint32_t per = a->interpolation == SY_INTERP_CUBICSPLINE ? 3u : 1u;
         const float *x = v + a->values_offset;
-        for (uint32_t k = 0; k < a->key_count; ++k) {
+        for (uint32_t k = 0; k < a->key_count && r == SY_OK; ++k) {
             const float *key = x + ((size_t)k * per + (per == 3 ? 1u : 0u)) * a->components; /* the key's value */
-            if ((ch[c].path == SY_ANIM_TRANSLATION || ch[c].path == SY_ANIM_SCALE)) {
+            if (bit == 1) {
                 for (uint32_t j = 0; j < per * 3u; ++j) /* every value and tangent of the key */
-                    if (!sy_coords_in_range(x + ((size_t)k * per) * 3u + j, 1))
-                        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                            "animation %#x channel %u: sampler %u key %u is beyond the coordinate range (%g)",
-                                            id, c, ch[c].sampler, k, (double)SY_COORD_MAX);
-            } else if (ch[c].path == SY_ANIM_ROTATION &&
-                       !(key[0] * key[0] + key[1] * key[1] + key[2] * key[2] + key[3] * key[3] > 1e-12f)) {
-                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                    "animation %#x channel %u: sampler %u key %u is the zero quaternion", id, c,
-                                    ch[c].sampler, k);
+                    if (!sy_coords_in_range(x + ((size_t)k * per) * 3u + j, 1)) {
+                        r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                         "animation %#x channel %u: sampler %u key %u is beyond the coordinate range (%g)",
+                                         id, c, ch[c].sampler, k, (double)SY_COORD_MAX);
+                        break;
+                    }
+            } else if (!(key[0] * key[0] + key[1] * key[1] + key[2] * key[2] + key[3] * key[3] > 1e-12f)) {
+                r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x channel %u: sampler %u key %u is the zero quaternion",
+                                 id, c, ch[c].sampler, k);
             }
         }
     }
-    return SY_OK;
+    free(checked);
+    return r;
 }
 
 static sy_result check_primitive(const sy_scene *s, const sy_primitive *p, uint32_t i, sy_error *err)
