@@ -7,7 +7,8 @@
  * meshes on nodes, a hierarchy), then ~30 random operations on the origin — create and
  * destroy every object type, set every kind of field (names, TRS and matrix transforms, acyclic
  * child lists, meshes of random small primitives with shared blobs, materials with texture refs,
- * textures, lights, cameras, backgrounds, flags) and attachments of every kind, with commits in
+ * textures, lights, cameras, backgrounds, flags, animation clips and the clock moving nodes) and
+ * attachments of every kind, with commits in
  * between. At random moments the origin commits and its consumers pull:
  *   origin --(wire)--> rep1 --(wire)--> rep2     (a replica of a replica)
  *   origin --(wire)--> rep3                      (a consumer added at a random moment, maybe with
@@ -18,11 +19,13 @@
  * are also checked against a from-scratch recomputation, and replicas' against the origin's where
  * the placement is unambiguous (single-parent chains). On failure the seed and the difference
  * are printed; rerun one seed with `test_replica_property 1 SEED`. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "../support/sy_check.h"
 #include "../support/sy_test_rng.h"
+#include "sy_anim.h"
 #include "sy_changes.h"
 
 /* ------------------------------------------------------------------ PRNG */
@@ -650,6 +653,33 @@ static int op_attachment(sy_scene *s, blob_pool *bp)
     return 0;
 }
 
+/* An animation gets a random clip (1 to 4 channels on live nodes, each with its own sampler of 1 to
+ * 5 keys, any interpolation and path); sometimes the origin's clock is set, which moves nodes. */
+static int op_animation(sy_scene *s)
+{
+    sy_error e = {0};
+    sy_animation a = {pick(s, SY_TYPE_ANIMATION)};
+    if (!a.id) CHECK_OK(sy_animation_create(s, rand_name(), &a, &e), e);
+    uint32_t nc = sy_scene_count(s, SY_TYPE_NODE) ? 1 + rn(4) : 0;
+    float times[4][5], values[4][5 * 3 * 4];
+    sy_anim_sampler_desc sd[4];
+    sy_anim_channel ch[4];
+    for (uint32_t c = 0; c < nc; ++c) {
+        uint32_t path = rn(SY_ANIM_PATH_COUNT), comps = path == SY_ANIM_ROTATION ? 4 : path == SY_ANIM_WEIGHTS ? 1 + rn(3) : 3;
+        uint32_t keys = 1 + rn(5), interp = rn(SY_INTERP_COUNT), per = interp == SY_INTERP_CUBICSPLINE ? 3 : 1;
+        float t = rf(-1, 1);
+        for (uint32_t k = 0; k < keys; ++k) times[c][k] = t += 0.0625f + fabsf(rf(0.01f, 1)); /* rf may give -0 */
+        for (uint32_t k = 0; k < keys * per * comps; ++k) values[c][k] = rf(-5, 5);
+        if (path == SY_ANIM_ROTATION)
+            for (uint32_t k = 0; k < keys * per; ++k) values[c][4 * k + 3] = 6.0f; /* never the zero quaternion */
+        sd[c] = (sy_anim_sampler_desc){interp, comps, keys, times[c], values[c]};
+        ch[c] = (sy_anim_channel){pick(s, SY_TYPE_NODE), path, c};
+    }
+    CHECK_OK(sy_animation_set_clip(s, a, sd, nc, ch, nc, &e), e);
+    if (chance(50)) CHECK_OK(sy_scene_set_time(s, chance(50) ? a : (sy_animation){0}, rf(-1, 6), &e), e);
+    return 0;
+}
+
 static int op_create_destroy(sy_scene *s)
 {
     sy_error e = {0};
@@ -746,7 +776,8 @@ static int run_seed(uint64_t seed, int ops, uint64_t *stats)
         else if (k < 61) r = op_texture(origin, &bp);
         else if (k < 68) r = op_light_camera_background(origin);
         else if (k < 76) r = op_attachment(origin, &bp);
-        else if (k < 81) r = op_name(origin);
+        else if (k < 79) r = op_name(origin);
+        else if (k < 81) r = op_animation(origin);
         else if (k < 88) {
             r = 0;
             CHECK_OK(sy_scene_commit(origin, NULL, &e), e);
