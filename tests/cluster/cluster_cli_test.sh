@@ -5,7 +5,8 @@
 # a secret, multi-display tiles written by the servers at the swap barrier. Servers stop by
 # themselves (--max-lifetime) and are killed on exit; every wait is bounded. With TESTDATA (the
 # shared test data): side-by-side stereo with a raster overlay on the cluster equals the local
-# composite (one render path: nothing the local window does is dropped).
+# composite (one render path: nothing the local window does is dropped); BoxAnimated at --at 2 on the
+# cluster equals the local render at that time (the moved nodes reach the replicas as changes).
 set -u
 SY=$1; W=$2; DATA=${3:-}; EXR_EQUAL=${4:?exr_equal}
 rm -rf "$W"; mkdir -p "$W"
@@ -50,6 +51,21 @@ if [ -n "$DATA" ] && [ -f "$DUCK" ]; then
   grep -q "server 1 (tcp://127.0.0.1:[0-9]*) renders with whitted" "$W/coopw.err" || fail "the refusal does not name the node"
 else
   echo "note: stereo + overlay part skipped: no test data at '$DATA' (Duck.glb)"
+fi
+
+# the scene clock: the client sets the time, the servers' replicas follow through the change list
+BOXANIM="$DATA/gltf/BoxAnimated/glTF-Binary/BoxAnimated.glb"
+if [ -n "$DATA" ] && [ -f "$BOXANIM" ]; then
+  "$SY" render "$BOXANIM" -b whitted -w 96 -h 72 --at 2 -o "$W/anim_local.exr" > /dev/null || fail "local render --at 2"
+  "$SY" render "$BOXANIM" -b whitted -w 96 -h 72 --at 0 -o "$W/anim_local0.exr" > /dev/null || fail "local render --at 0"
+  "$SY" render "$BOXANIM" -b whitted -w 96 -h 72 --at 2 -o "$W/anim_cluster.exr" --cluster "$URLS" \
+    --secret-file "$W/secret" --cluster-mode sort-first 2> "$W/anim.err" > /dev/null || fail "cluster render --at 2"
+  "$EXR_EQUAL" "$W/anim_local.exr" "$W/anim_cluster.exr" || fail "cluster render --at 2 differs from the local one"
+  if "$EXR_EQUAL" "$W/anim_local0.exr" "$W/anim_cluster.exr" 2> /dev/null; then
+    fail "cluster render --at 2 equals the render at 0 (the time did not travel)"
+  fi
+else
+  echo "note: animation part skipped: no test data at '$DATA' (BoxAnimated.glb)"
 fi
 
 # wrong secret: refused, reason logged on the server, exit code 2
