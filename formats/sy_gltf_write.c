@@ -509,6 +509,10 @@ sy_result sy_gltf_write_scene(const sy_scene *s, sy_node root, const sy_gltf_wri
     if (r == SY_OK) {
         for (uint32_t b = sy_scene_next(s, SY_TYPE_BACKGROUND, 0); b; b = sy_scene_next(s, SY_TYPE_BACKGROUND, b))
             sy_log(SY_LOG_WARNING, "gltf", NULL, "background %u (the world: colour, gradient, environment map): glTF cannot hold it: left out", b);
+        for (uint32_t a = sy_scene_next(s, SY_TYPE_ANIMATION, 0); a; a = sy_scene_next(s, SY_TYPE_ANIMATION, a)) {
+            const sy_animation_data *ad = sy_object_get(s, SY_TYPE_ANIMATION, a);
+            sy_log(SY_LOG_WARNING, "gltf", ad->name, "animation %#x: not written (the writer has no animations yet); the nodes are written in their current pose", a);
+        }
         sy_gltf_shim_wdoc doc = {.generator = opts && opts->generator ? opts->generator : "Switchyard",
                                  .materials = sw.w.wmats, .material_count = sw.w.mat_count,
                                  .meshes = sw.w.wmeshes, .mesh_count = sw.w.mesh_count,

@@ -9,7 +9,8 @@
  * lines, points); each material used once as a glTF metallic-roughness material: base colour,
  * metallic, roughness, emissive (+ KHR_materials_emissive_strength), alpha mode / cutoff, double
  * sided, KHR_materials_unlit. Not written: textures (and texture coordinate set 1, tangents),
- * lights, cameras, the node hierarchy (placements are flattened to world matrices), stroke widths.
+ * lights, cameras, the node hierarchy (placements are flattened to world matrices), stroke widths,
+ * animations (sy_gltf_write_subtree warns for each; nodes are written in their current pose).
  * sy_gltf_load reads the result back (tests/cull: round trip).
  *
  * Ownership: *glb_out is malloc()ed, the caller frees it; *placements_out likewise.
