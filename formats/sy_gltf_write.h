@@ -10,7 +10,7 @@
  * metallic, roughness, emissive (+ KHR_materials_emissive_strength), alpha mode / cutoff, double
  * sided, KHR_materials_unlit. Not written: textures (and texture coordinate set 1, tangents),
  * lights, cameras, the node hierarchy (placements are flattened to world matrices), stroke widths,
- * animations (sy_gltf_write_subtree warns for each; nodes are written in their current pose).
+ * animations (sy_gltf_write_scene warns for each; nodes are written in their current pose).
  * sy_gltf_load reads the result back (tests/cull: round trip).
  *
  * Ownership: *glb_out is malloc()ed, the caller frees it; *placements_out likewise.
