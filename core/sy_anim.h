@@ -53,7 +53,8 @@ typedef struct sy_anim_stats {
 } sy_anim_stats;
 
 /** Sets the scene's time: evaluates clip (or, with clip {0}, every animation of the scene in slot
- * order) at `seconds` into the target nodes' transforms with the node setters (see above). seconds
+ * order: a property several clips drive takes the last one's value) at `seconds` into the target
+ * nodes' transforms with the node setters (see above); commit the scene as after any edit. seconds
  * must be finite (SY_ERR_INVALID_ARGUMENT otherwise); times outside a clip clamp to its ends. A
  * stale clip handle is SY_ERR_INVALID_HANDLE. When a setter refuses a value the other channels are
  * still evaluated and the first error is returned, naming the animation and channel. */
