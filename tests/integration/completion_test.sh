@@ -82,6 +82,10 @@ expect "render de" demo
 # after -o any file; after a value-taking option the command's options are still found
 expect "render demo -o $TMP/scenes/no" "$TMP/scenes/notes.txt"
 expect "render -w 64 demo --ao" --aov
+# the scene clock: --at and --clip take a value, after which the options are still found
+expect "render demo --a" --at --aov
+expect "render demo --cl" --clip --cluster
+expect "render demo --at 1.5 --cl" --clip
 
 if [ "$fails" -ne 0 ]; then
     echo "$fails completion checks failed"
