@@ -123,6 +123,15 @@ sy_result sy_animation_sample(const sy_animation_data *d, uint32_t sampler, bool
 static sy_result apply_clip(sy_scene *s, uint32_t id, double t, sy_anim_stats *st, sy_result first, sy_error *err)
 {
     const sy_animation_data *d = sy_object_get(s, SY_TYPE_ANIMATION, id);
+    if (d->loop) { /* a looping clip plays scene time t at t mod its period */
+        float lo, hi;
+        sy_animation_time_range(d, &lo, &hi);
+        double period = d->cycle > 0.0f ? (double)d->cycle : (double)hi - (double)lo;
+        if (period > 0.0) {
+            double f = fmod(t - lo, period);
+            t = lo + (f < 0.0 ? f + period : f);
+        }
+    }
     uint32_t nc;
     const sy_anim_channel *ch = sy_animation_channels(d, &nc);
     st->clips++;

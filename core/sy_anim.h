@@ -11,7 +11,9 @@
  *
  * Evaluation follows glTF 2.0 exactly (its "Animations" section and appendix C, "Interpolation"):
  *   - times before a sampler's first key take the first key's value, times after the last key the
- *     last key's value (clamping); a sampler with one key is constant;
+ *     last key's value (clamping); a sampler with one key is constant; a looping clip (its loop
+ *     field, X3D's TimeSensor.loop) first maps scene time t to t mod its period (its cycle field,
+ *     else its keys' range) from its start;
  *   - STEP: the value of the last key at or before t;
  *   - LINEAR: component-wise linear; rotations by spherical linear interpolation along the shorter
  *     arc (the second quaternion negated when the dot product is negative), normalised;

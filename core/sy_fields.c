@@ -94,7 +94,8 @@ static const sy_field_desc background_fields[SY_BACKGROUND_FIELD_COUNT] = {
 static const sy_field_desc animation_fields[SY_ANIMATION_FIELD_COUNT] = {
     F(sy_animation_data, name, SY_FK_STRING),    F(sy_animation_data, samplers, SY_FK_BLOB),
     F(sy_animation_data, channels, SY_FK_BLOB),  F(sy_animation_data, times, SY_FK_BLOB),
-    F(sy_animation_data, values, SY_FK_BLOB),
+    F(sy_animation_data, values, SY_FK_BLOB),    F(sy_animation_data, cycle, SY_FK_POD),
+    F(sy_animation_data, loop, SY_FK_POD),
 };
 #undef F
 
@@ -215,6 +216,7 @@ void sy_animation_time_range(const sy_animation_data *d, float *start_out, float
         if (!any || b > hi) hi = b;
         any = true;
     }
+    if (d && d->cycle > 0.0f) lo = 0.0f, hi = d->cycle; /* a period of its own (X3D TimeSensor) */
     if (start_out) *start_out = lo;
     if (end_out) *end_out = hi;
 }

@@ -515,6 +515,7 @@ typedef enum sy_anim_path {
 #define SY_ANIM_MAX_SAMPLERS (1u << 20)  /**< samplers of one animation */
 #define SY_ANIM_MAX_CHANNELS (1u << 20)  /**< channels of one animation */
 #define SY_ANIM_MAX_COMPONENTS 256u      /**< components of one value (morph weights: one per target) */
+#define SY_ANIM_MAX_CYCLE 1.0e9f         /**< longest period of a clip, seconds */
 
 /** One sampler as stored in the samplers blob (20 bytes, little endian on the wire like all POD). */
 typedef struct sy_anim_sampler {
@@ -539,7 +540,9 @@ enum sy_animation_field {
     SY_ANIMATION_CHANNELS = 2, /**< sy_blob* of sy_anim_channel (NULL = none) */
     SY_ANIMATION_TIMES = 3,    /**< sy_blob* of float key times */
     SY_ANIMATION_VALUES = 4,   /**< sy_blob* of float output values */
-    SY_ANIMATION_FIELD_COUNT = 5
+    SY_ANIMATION_CYCLE = 5,    /**< float: the clip's period in seconds (0 = its keys' range; X3D TimeSensor.cycleInterval) */
+    SY_ANIMATION_LOOP = 6,     /**< uint32 0 or 1: scene time wraps into [0, period) (X3D TimeSensor.loop) */
+    SY_ANIMATION_FIELD_COUNT = 7
 };
 
 /** Field values of an animation; read the blobs with sy_animation_samplers & co. */
@@ -549,6 +552,8 @@ typedef struct sy_animation_data {
     sy_blob *channels; /**< sy_anim_channel[] */
     sy_blob *times; /**< float[] */
     sy_blob *values; /**< float[] */
+    float cycle; /**< period, seconds: finite, 0 to SY_ANIM_MAX_CYCLE; 0 = from the first key to the last */
+    uint32_t loop; /**< 1: the clip repeats every period (time t plays t mod period), 0: it clamps at its ends */
 } sy_animation_data;
 
 /** A sampler to build a clip from (sy_animation_set_clip): key_count times and key_count x
@@ -565,8 +570,9 @@ typedef struct sy_anim_sampler_desc {
 const sy_anim_sampler *sy_animation_samplers(const sy_animation_data *d, uint32_t *count_out);
 /** Channels of an animation's data (borrowed); count may be 0. */
 const sy_anim_channel *sy_animation_channels(const sy_animation_data *d, uint32_t *count_out);
-/** The time range of the clip: the smallest first key time and the largest last key time over its
- * samplers (glTF's duration is *end_out; an animation without samplers gives 0, 0). */
+/** The time range of the clip: [0, period] when it has a period of its own (cycle > 0), else the
+ * smallest first key time and the largest last key time over its samplers (glTF's duration is
+ * *end_out; an animation without samplers gives 0, 0). */
 void sy_animation_time_range(const sy_animation_data *d, float *start_out, float *end_out);
 
 /* ---------------------------------------------------------------- attachments */
@@ -668,8 +674,8 @@ sy_result sy_background_set(sy_scene *s, sy_background b, const sy_background_da
 /** Sets every field of an animation (as sy_material_set); the rules between its blobs are checked
  * on the whole (see the animation section). */
 sy_result sy_animation_set(sy_scene *s, sy_animation a, const sy_animation_data *d, sy_error *err);
-/** Builds an animation's blobs from samplers and channels (copied) and sets them at once; the name
- * stays. Refuses what sy_animation_set refuses, naming the sampler or channel. */
+/** Builds an animation's blobs from samplers and channels (copied) and sets them at once; the name,
+ * period and loop stay. Refuses what sy_animation_set refuses, naming the sampler or channel. */
 sy_result sy_animation_set_clip(sy_scene *s, sy_animation a, const sy_anim_sampler_desc *samplers, uint32_t sampler_count,
                                 const sy_anim_channel *channels, uint32_t channel_count, sy_error *err);
 /** Validates that the blob holds width*height*channels elements of the format. Retains pixels. */
@@ -693,6 +699,10 @@ const sy_background_data *sy_background_get(const sy_scene *s, sy_background b);
 
 /** Borrowed animation data, NULL for a stale handle. */
 const sy_animation_data *sy_animation_get(const sy_scene *s, sy_animation a);
+/** Sets a clip's period (seconds, 0 = its keys' range) and whether it loops (the X3D TimeSensor's
+ * cycleInterval and loop; glTF clips keep 0 and 0). Refuses a period that is negative, not finite
+ * or above SY_ANIM_MAX_CYCLE. */
+sy_result sy_animation_set_timing(sy_scene *s, sy_animation a, float cycle, bool loop, sy_error *err);
 
 /** Child ids of a node data struct (borrowed from the children blob); count may be 0. */
 const uint32_t *sy_node_children(const sy_node_data *d, uint32_t *count_out);

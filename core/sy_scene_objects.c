@@ -384,6 +384,16 @@ sy_result sy_animation_set(sy_scene *s, sy_animation a, const sy_animation_data 
     return set_all(s, SY_TYPE_ANIMATION, a.id, d, err);
 }
 
+sy_result sy_animation_set_timing(sy_scene *s, sy_animation a, float cycle, bool loop, sy_error *err)
+{
+    const sy_animation_data *cur = sy_animation_get(s, a);
+    if (!cur) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "animation: stale handle %#x", a.id);
+    sy_animation_data d = *cur;
+    d.cycle = cycle;
+    d.loop = loop ? 1u : 0u;
+    return set_all(s, SY_TYPE_ANIMATION, a.id, &d, err);
+}
+
 sy_result sy_animation_set_clip(sy_scene *s, sy_animation a, const sy_anim_sampler_desc *samplers, uint32_t sampler_count,
                                 const sy_anim_channel *channels, uint32_t channel_count, sy_error *err)
 {
@@ -408,7 +418,7 @@ sy_result sy_animation_set_clip(sy_scene *s, sy_animation a, const sy_anim_sampl
         if (ntimes > UINT32_MAX || nvalues > UINT32_MAX)
             return sy_error_set(err, SY_ERR_LIMIT, "animation %#x: more than 2^32 key times or values", a.id);
     }
-    sy_animation_data d = {.name = cur->name};
+    sy_animation_data d = {.name = cur->name, .cycle = cur->cycle, .loop = cur->loop};
     sy_result r = SY_OK;
     sy_anim_sampler *rec = NULL;
     float *times = NULL, *values = NULL;

@@ -88,6 +88,18 @@ static sy_result check_records(const sy_blob *b, size_t elem, uint32_t max, uint
 
 static sy_result check_animation_field(const sy_scene *s, uint32_t id, uint32_t f, const void *v, sy_error *err)
 {
+    if (f == SY_ANIMATION_CYCLE) {
+        float c = *(const float *)v;
+        if (!(c >= 0.0f && c <= SY_ANIM_MAX_CYCLE))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x: period %g s (0 to %g)", id, (double)c,
+                                (double)SY_ANIM_MAX_CYCLE);
+        return SY_OK;
+    }
+    if (f == SY_ANIMATION_LOOP) {
+        uint32_t l = *(const uint32_t *)v;
+        if (l > 1) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x: loop %u (0 or 1)", id, l);
+        return SY_OK;
+    }
     const sy_blob *b = f == SY_ANIMATION_NAME ? NULL : *(sy_blob *const *)v;
     sy_result r;
     switch (f) {

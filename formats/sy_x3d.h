@@ -96,6 +96,7 @@ typedef struct sy_x3d_counts {
     /** @{ elements of PointSet and of (Indexed)LineSet primitives */
     uint32_t points, line_segments; /** @} */
     uint32_t texts;                 /**< Text nodes loaded */
+    uint32_t animations;            /**< TimeSensors played as clips by the scene clock (sy_x3d_anim.c) */
 } sy_x3d_counts;
 
 /** What a load produced: the root, cameras, background, warnings and counts (sy_x3d_info_free). */

@@ -196,6 +196,8 @@ sy_result x3d_visit_background(loader *L, xfile *F, const xmlNode *el);
 
 /* Loads one X3D document (the main file: parent NULL; an Inline: at / atF name the Inline element)
  * and returns the node of its Scene. */
+/* The file's TimeSensors, interpolators and ROUTEs as animations (sy_x3d_anim.c); after the walk. */
+sy_result x3d_load_animations(loader *L, xfile *F, const xmlNode *scene);
 sy_result x3d_load_file(loader *L, const char *path, const void *mem, size_t mem_size, const char *base_dir,
                         xfile *parent, sy_node *root_out, const xmlNode *at, xfile *atF);
 

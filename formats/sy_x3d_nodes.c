@@ -251,6 +251,9 @@ static sy_result visit(loader *L, xfile *F, const xmlNode *el_in, const sy_mat4 
     const xmlNode *el = x3d_resolve(L, F, el_in);
     if (!el) return SY_OK;
     n = x3d_ename(el);
+    size_t nlen = strlen(n);
+    if (!strcmp(n, "TimeSensor") || (nlen > 12 && !strcmp(n + nlen - 12, "Interpolator")))
+        return SY_OK; /* the scene clock's (sy_x3d_anim.c: what is routed and does not map is reported there) */
     if (!strcmp(n, "Background") || !strcmp(n, "TextureBackground")) return x3d_visit_background(L, F, el);
     bool group = x3d_name_in(n, "Transform|Group|StaticGroup|Collision|Anchor|Billboard|Switch|LOD|CADAssembly|CADLayer|CADPart|CADFace|HAnimHumanoid|HAnimJoint|HAnimSegment|HAnimSite|ScreenGroup|LayoutGroup");
     bool leaf = x3d_name_in(n, "Shape|DirectionalLight|PointLight|SpotLight|Viewpoint|OrthoViewpoint|Inline");
@@ -445,6 +448,7 @@ sy_result x3d_load_file(loader *L, const char *path, const void *mem, size_t mem
     sy_mat4 id = sy_mat4_identity();
     if ((r = children_of(L, &F, scene, &id, h, NULL))) goto done;
     if ((r = sy_node_set_flags(L->scene, h, SY_NODE_VISIBLE, &L->err))) goto done;
+    if ((r = x3d_load_animations(L, &F, scene))) goto done;
     *root_out = h;
 done:
     if (doc) xmlFreeDoc(doc);

@@ -172,6 +172,7 @@ int sy_cmd_info(int argc, char **argv)
         sy_json_add(c, "name", ad->name ? sy_json_str(ad->name) : cJSON_CreateNull());
         sy_json_add(c, "start", sy_json_float((double)start));
         sy_json_add(c, "duration", sy_json_float((double)end)); /* glTF: the clip runs from 0 to its last key */
+        sy_json_add(c, "loop", cJSON_CreateBool(ad->loop != 0)); /* X3D TimeSensor.loop: --at wraps */
         sy_json_add(c, "channels", cJSON_CreateNumber(nch));
         sy_json_add(c, "samplers", cJSON_CreateNumber(nsm));
     }

@@ -228,7 +228,7 @@ static int test_validation(void)
     CHECK_OK(sy_blob_create_copy(&ch, sizeof ch, &bc, &e), e);
     CHECK_OK(sy_blob_create_copy(t2, sizeof t2, &bt, &e), e);
     CHECK_OK(sy_blob_create_copy(v6, sizeof v6, &bv, &e), e);
-    sy_animation_data d = {NULL, bs, bc, bt, bv};
+    sy_animation_data d = {NULL, bs, bc, bt, bv, 0.0f, 0};
     CHECK_ERR(sy_animation_set(s, a, &d, &e), SY_ERR_INVALID_ARGUMENT, e);
     EXPECT_SAYS(e, "x 3 for CUBICSPLINE");
     sy_blob_release(bc);
@@ -364,6 +364,46 @@ static int test_round_trip(void)
     return 0;
 }
 
+/* A clip with a period of its own that loops (X3D's TimeSensor cycleInterval and loop): scene time
+ * t plays t mod the period; without loop it clamps; the range is [0, period]; bad periods are
+ * refused naming the animation; the fields survive a rebuild of the clip. */
+static int test_timing(void)
+{
+    sy_scene *s = new_scene();
+    sy_error e = {0};
+    sy_node n = new_node(s, "n");
+    sy_animation a = {0};
+    const float times[2] = {0.0f, 2.0f}, tv[6] = {0, 0, 0, 2, 0, 0};
+    CHECK_OK(one_channel(s, &a, n, SY_ANIM_TRANSLATION, SY_INTERP_LINEAR, 3, 2, times, tv, &e), e);
+    CHECK_OK(sy_animation_set_timing(s, a, 4.0f, true, &e), e);
+    double lo = -1, hi = -1;
+    CHECK_OK(sy_scene_time_range(s, a, &lo, &hi, &e), e);
+    EXPECT_MSG(lo == 0.0 && hi == 4.0, "range %g %g (want 0 4)", lo, hi);
+    const double at[5] = {5.0, 9.5, -1.0, 3.0, 4.0}, want[5] = {1.0, 1.5, 2.0, 2.0, 0.0};
+    for (int i = 0; i < 5; ++i) {
+        CHECK_OK(sy_scene_set_time(s, a, at[i], &e), e);
+        float x = sy_node_get(s, n)->transform.translation[0];
+        EXPECT_MSG(fabsf(x - (float)want[i]) < 1e-6f, "looping, t = %g: x %g (want %g)", at[i], (double)x, want[i]);
+    }
+    CHECK_OK(sy_animation_set_timing(s, a, 4.0f, false, &e), e);
+    CHECK_OK(sy_scene_set_time(s, a, 5.0, &e), e);
+    EXPECT_MSG(sy_node_get(s, n)->transform.translation[0] == 2.0f, "not looping, t = 5: x %g (want 2, clamped)",
+               (double)sy_node_get(s, n)->transform.translation[0]);
+    CHECK_ERR(sy_animation_set_timing(s, a, -1.0f, true, &e), SY_ERR_INVALID_ARGUMENT, e);
+    EXPECT_SAYS(e, "period");
+    CHECK_ERR(sy_animation_set_timing(s, a, NAN, false, &e), SY_ERR_INVALID_ARGUMENT, e);
+    sy_animation_data d = *sy_animation_get(s, a);
+    d.loop = 2;
+    CHECK_ERR(sy_animation_set(s, a, &d, &e), SY_ERR_INVALID_ARGUMENT, e);
+    EXPECT_SAYS(e, "loop 2");
+    CHECK_OK(sy_animation_set_timing(s, a, 3.0f, true, &e), e);
+    CHECK_OK(one_channel(s, &a, n, SY_ANIM_TRANSLATION, SY_INTERP_LINEAR, 3, 2, times, tv, &e), e);
+    EXPECT_MSG(sy_animation_get(s, a)->cycle == 3.0f && sy_animation_get(s, a)->loop == 1, "rebuilt clip: cycle %g loop %u",
+               (double)sy_animation_get(s, a)->cycle, sy_animation_get(s, a)->loop);
+    sy_scene_destroy(s);
+    return 0;
+}
+
 static int test_clock(void)
 {
     sy_clock c = sy_clock_make(1.0, 3.0);
@@ -389,6 +429,7 @@ int main(void)
     RUN(test_what_channels_leave);
     RUN(test_validation);
     RUN(test_round_trip);
+    RUN(test_timing);
     RUN(test_clock);
     return sy_check_finish("core_anim");
 }

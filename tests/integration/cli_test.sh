@@ -457,7 +457,7 @@ if [ -f "$BOX" ] && [ -f "$GLB" ]; then
     if [ -f "$BOXANIM" ]; then
         run_ok "info BoxAnimated.glb" info_anim "$SY" info "$BOXANIM"
         grep -qxF '    "animations": 1' "$TMP/info_anim.out" || fail "info BoxAnimated.glb: not 1 animation"
-        grep -qF '{"index": 0, "name": null, "start": 0, "duration": 3.70832992, "channels": 2, "samplers": 2}' \
+        grep -qF '{"index": 0, "name": null, "start": 0, "duration": 3.70832992, "loop": false, "channels": 2, "samplers": 2}' \
             "$TMP/info_anim.out" || fail "info BoxAnimated.glb: clips: $(grep -A2 clips "$TMP/info_anim.out")"
         # the scene clock: --at 0 is the static load; two times differ; bad values are usage errors
         mkdir -p "$TMP/anim"
