@@ -19,6 +19,7 @@
 #include "sy_anim.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -27,7 +28,50 @@ typedef struct drive {
     const xmlNode *sensor, *interp, *target;
     uint32_t path; /* SY_ANIM_TRANSLATION or SY_ANIM_ROTATION */
     int line;      /* of the ROUTE to the target */
+    size_t seq;    /* order found (ties in the sorts below) */
 } drive;
+
+/* Drives a file may make (each is a channel): beyond it the rest is reported and not played. */
+#define X3D_MAX_DRIVES 65536u
+
+/* A ROUTE from an interpolator's value_changed, by the element it comes from (sorted). */
+typedef struct from_route {
+    const xmlNode *from, *route;
+} from_route;
+
+static int cmp_ptr(const void *a, const void *b)
+{
+    uintptr_t x = (uintptr_t)a, y = (uintptr_t)b;
+    return x < y ? -1 : x > y;
+}
+
+static int cmp_from(const void *a, const void *b)
+{
+    const from_route *x = a, *y = b;
+    int c = cmp_ptr(x->from, y->from);
+    return c ? c : cmp_ptr(x->route, y->route);
+}
+
+/* by element line, element, then the order found: a deterministic order that follows the file */
+static int cmp_elem_seq(const xmlNode *ea, const xmlNode *eb, size_t sa, size_t sb)
+{
+    int la = x3d_line_of(ea), lb = x3d_line_of(eb);
+    if (la != lb) return la < lb ? -1 : 1;
+    int c = cmp_ptr(ea, eb);
+    return c ? c : (sa < sb ? -1 : sa > sb);
+}
+
+static int cmp_by_sensor(const void *a, const void *b)
+{
+    const drive *x = a, *y = b;
+    return cmp_elem_seq(x->sensor, y->sensor, x->seq, y->seq);
+}
+
+static int cmp_by_interp(const void *a, const void *b)
+{
+    const drive *x = a, *y = b;
+    return cmp_elem_seq(x->interp, y->interp, x->seq, y->seq);
+}
 
 typedef struct routes {
     const xmlNode **items;
@@ -120,7 +164,7 @@ static bool read_sampler(loader *L, xfile *F, const xmlNode *el, float cycle, bo
 }
 
 /* Builds the clip of one sensor from the drives that name it (drives[0 .. n-1], same sensor). */
-static sy_result build_clip(loader *L, xfile *F, const drive *dv, size_t n)
+static sy_result build_clip(loader *L, xfile *F, drive *dv, size_t n)
 {
     const xmlNode *sensor = dv[0].sensor;
     if (!x3d_get_bool(sensor, "enabled", true)) {
@@ -143,14 +187,18 @@ static sy_result build_clip(loader *L, xfile *F, const drive *dv, size_t n)
         goto done;
     }
     uint32_t ns = 0, nc = 0;
+    qsort((drive *)dv, n, sizeof *dv, cmp_by_interp); /* an interpolator's drives together: one sampler each */
     for (size_t i = 0; i < n; ++i) {
-        uint32_t s = 0;
-        while (s < ns && owner[s] != dv[i].interp) ++s;
-        if (s == ns) {
+        uint32_t s = ns ? ns - 1 : 0;
+        if (!ns || owner[s] != dv[i].interp) {
+            s = ns;
+            owner[ns] = dv[i].interp;
             if (!read_sampler(L, F, dv[i].interp, cycle, dv[i].path == SY_ANIM_ROTATION, &sd[ns], &bufs[2 * ns],
-                              &bufs[2 * ns + 1]))
+                              &bufs[2 * ns + 1])) {
+                while (i + 1 < n && dv[i + 1].interp == dv[i].interp) ++i; /* dropped: its other drives too */
                 continue;
-            owner[ns++] = dv[i].interp;
+            }
+            ns++;
         }
         created *c = x3d_cache_get(L, F, dv[i].target, "node", false);
         if (!c || !c->done || !c->node) continue; /* a Transform outside the loaded scene graph */
@@ -226,14 +274,29 @@ sy_result x3d_load_animations(loader *L, xfile *F, const xmlNode *scene)
 {
     routes rs = {0};
     drive *dv = NULL;
-    size_t nd = 0, cap = 0;
+    from_route *vr = NULL;
+    size_t nd = 0, cap = 0, nv = 0;
     sy_result r = SY_OK;
     if (!collect(&rs, scene, 0)) {
         r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
         goto done;
     }
-    /* every sensor -> interpolator route, joined with every interpolator -> Transform route */
-    for (size_t i = 0; i < rs.count && !r; ++i) {
+    if (!rs.count) goto done;
+    /* the interpolators' value_changed routes, sorted by where they come from (O(R log R) joins) */
+    if (!(vr = malloc(rs.count * sizeof *vr))) {
+        r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+        goto done;
+    }
+    for (size_t i = 0; i < rs.count; ++i) {
+        char *fn = x3d_attr(rs.items[i], "fromNode"), *ff = x3d_attr(rs.items[i], "fromField");
+        const xmlNode *from = def_of(F, fn);
+        if (from && ff && !strcmp(ff, "value_changed")) vr[nv++] = (from_route){from, rs.items[i]};
+        xmlFree(fn), xmlFree(ff);
+    }
+    qsort(vr, nv, sizeof *vr, cmp_from);
+    /* every sensor -> interpolator route, joined with that interpolator's routes to Transforms */
+    bool capped = false;
+    for (size_t i = 0; i < rs.count && !r && !capped; ++i) {
         const xmlNode *ra = rs.items[i];
         char *fn = x3d_attr(ra, "fromNode"), *ff = x3d_attr(ra, "fromField"), *tn = x3d_attr(ra, "toNode"),
              *tf = x3d_attr(ra, "toField");
@@ -247,44 +310,46 @@ sy_result x3d_load_animations(loader *L, xfile *F, const xmlNode *scene)
                     x3d_warn(L, "%s:%d: %s: not played (the scene clock plays Position- and OrientationInterpolators; "
                              "reported once)", F->path, x3d_line_of(interp), x3d_ename(interp));
             } else {
-                for (size_t j = 0; j < rs.count; ++j) {
-                    const xmlNode *rb = rs.items[j];
-                    char *bfn = x3d_attr(rb, "fromNode"), *bff = x3d_attr(rb, "fromField"), *btn = x3d_attr(rb, "toNode"),
-                         *btf = x3d_attr(rb, "toField");
-                    drive d = {.sensor = sensor};
-                    if (def_of(F, bfn) == interp && bff && !strcmp(bff, "value_changed") &&
-                        target_of(L, F, rb, interp, btn, btf, &d)) {
-                        if (nd == cap) {
+                size_t lo = 0, hi = nv; /* the first value_changed route from interp */
+                while (lo < hi) {
+                    size_t mid = lo + (hi - lo) / 2;
+                    if (cmp_ptr(vr[mid].from, interp) < 0) lo = mid + 1;
+                    else hi = mid;
+                }
+                for (size_t j = lo; j < nv && vr[j].from == interp && !r; ++j) {
+                    const xmlNode *rb = vr[j].route;
+                    char *btn = x3d_attr(rb, "toNode"), *btf = x3d_attr(rb, "toField");
+                    drive d = {.sensor = sensor, .seq = nd};
+                    if (target_of(L, F, rb, interp, btn, btf, &d)) {
+                        if (nd == X3D_MAX_DRIVES) {
+                            x3d_warn(L, "%s:%d: more than %u interpolator routes to Transforms; the rest is not played",
+                                     F->path, x3d_line_of(rb), X3D_MAX_DRIVES);
+                            capped = true;
+                        } else if (nd == cap) {
                             size_t nc = cap ? 2 * cap : 16;
                             drive *p = realloc(dv, nc * sizeof *p);
                             if (!p) r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
                             else dv = p, cap = nc;
                         }
-                        if (!r) dv[nd++] = d;
+                        if (!r && !capped) dv[nd++] = d;
                     }
-                    xmlFree(bfn), xmlFree(bff), xmlFree(btn), xmlFree(btf);
-                    if (r) break;
+                    xmlFree(btn), xmlFree(btf);
+                    if (capped) break;
                 }
             }
         }
         xmlFree(fn), xmlFree(ff), xmlFree(tn), xmlFree(tf);
     }
-    /* one clip per sensor, in the order its first route appears */
-    for (size_t i = 0; i < nd && !r; ++i) {
-        if (!dv[i].sensor) continue;
-        const xmlNode *sensor = dv[i].sensor;
-        size_t k = i;
-        for (size_t j = i; j < nd; ++j) /* gather this sensor's drives at i.. (stable) */
-            if (dv[j].sensor == sensor) {
-                drive t = dv[j];
-                memmove(dv + k + 1, dv + k, (j - k) * sizeof *dv);
-                dv[k++] = t;
-            }
+    /* one clip per sensor, in the sensors' document order */
+    if (!r && nd) qsort(dv, nd, sizeof *dv, cmp_by_sensor);
+    for (size_t i = 0; i < nd && !r;) {
+        size_t k = i + 1;
+        while (k < nd && dv[k].sensor == dv[i].sensor) ++k;
         r = build_clip(L, F, dv + i, k - i);
-        for (size_t j = i; j < k; ++j) dv[j].sensor = NULL;
-        i = k - 1;
+        i = k;
     }
 done:
+    free(vr);
     free(dv);
     free(rs.items);
     return r;
