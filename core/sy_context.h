@@ -53,6 +53,14 @@ void sy_context_filter_info(const sy_context *c, sy_filter_info *out);
 sy_result sy_context_coverage(sy_context *c, const sy_camera_view *view, uint32_t width, uint32_t height,
                               sy_coverage_entry **entries_out, uint32_t *count_out, sy_error *err);
 
+/** What is under pixel (x, y) of view rendered at width x height (SY_CAP_PICK; others:
+ * SY_ERR_UNSUPPORTED naming the back-end): the nearest surface the ray through the pixel's centre
+ * meets in what the context last synced, as sy_pick_result says. x >= width, y >= height or a zero
+ * size: SY_ERR_INVALID_ARGUMENT naming the values; a view sy_camera_view_check refuses: its error.
+ * A miss is no error (out->hit false). out's viewport fields are left as they are. */
+sy_result sy_context_pick(sy_context *c, const sy_camera_view *view, uint32_t width, uint32_t height, uint32_t x,
+                          uint32_t y, sy_pick_result *out, sy_error *err);
+
 /** A cache of contexts keyed by (scene, back-end, parameters, root): viewports showing the same
  * scene with the same back-end share one context, so the scene is converted once and switching
  * back to a back-end is instant. */

@@ -435,3 +435,28 @@ sy_result sy_context_coverage(sy_context *c, const sy_camera_view *view, uint32_
         return sy_error_set(err, SY_ERR_UNSUPPORTED, "back-end %s counts no per-node coverage", c->cls->name);
     return c->cls->coverage(c->state, view, width, height, entries_out, count_out, err);
 }
+
+sy_result sy_context_pick(sy_context *c, const sy_camera_view *view, uint32_t width, uint32_t height, uint32_t x,
+                          uint32_t y, sy_pick_result *out, sy_error *err)
+{
+    out->hit = false;
+    out->node_id = out->placement = out->mesh_id = out->primitive = out->triangle = out->material_id = 0;
+    memset(out->barycentrics, 0, sizeof out->barycentrics);
+    memset(out->position, 0, sizeof out->position);
+    memset(out->normal, 0, sizeof out->normal);
+    out->distance = out->depth = 0.0f;
+    if (!(sy_context_caps(c) & SY_CAP_PICK) || !c->cls->pick)
+        return sy_error_set(err, SY_ERR_UNSUPPORTED, "back-end %s cannot pick (no SY_CAP_PICK)", c->cls->name);
+    if (width == 0 || height == 0 || x >= width || y >= height)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "pick: pixel (%u, %u) is outside the %ux%u image", x, y,
+                            width, height);
+    sy_result r = sy_camera_view_check(view, err);
+    if (r != SY_OK) return r;
+    r = c->cls->pick(c->state, view, width, height, x, y, out, err);
+    if (r != SY_OK || !out->hit) { /* a miss (or a failure) answers nothing but "no hit" */
+        uint32_t vp = out->viewport, eye = out->eye, px = out->pixel_x, py = out->pixel_y;
+        memset(out, 0, sizeof *out);
+        out->viewport = vp, out->eye = eye, out->pixel_x = px, out->pixel_y = py;
+    }
+    return r;
+}

@@ -33,6 +33,8 @@ typedef enum sy_mediator_caps {
                                      while a view moves (fewer samples per pixel), on the same context */
     SY_CAP_COVERAGE = 1u << 9,    /**< counts the pixels each node covers, occlusion included: sy_context_coverage
                                      (a culling service asks it of whichever class offers it) */
+    SY_CAP_PICK = 1u << 10,       /**< answers what is under a pixel (node, mesh, primitive, triangle, position,
+                                     normal, material): sy_context_pick, sy_viewport_pick */
 } sy_mediator_caps;
 
 /* ---- feature buffers (SY_CAP_AOVS) ---- */
@@ -73,6 +75,33 @@ typedef struct sy_coverage_entry {
     uint32_t node_id; /**< the core node (sy_node.id) whose placement covers the pixels */
     uint32_t pixels;  /**< pixels it covers */
 } sy_coverage_entry;
+
+/* ---- picking (SY_CAP_PICK) ---- */
+/** What is under one pixel (sy_context_pick, sy_viewport_pick, sy_window_pick): the nearest surface
+ * the ray through the pixel's centre meets, as the back-end draws it. Plain data. On a miss `hit` is
+ * false and every other field but the viewport's (viewport, eye, pixel) is zero. */
+typedef struct sy_pick_result {
+    bool hit;               /**< a surface is under the pixel */
+    uint32_t viewport;      /**< window picks: index of the viewport that answered (back to front), UINT32_MAX = none */
+    uint32_t eye;           /**< that viewport's eye (sy_eye) */
+    /** @{ the pixel in the viewport's own rectangle (row 0 = top) */
+    uint32_t pixel_x, pixel_y; /** @} */
+    uint32_t node_id;       /**< the core node (sy_node.id) whose mesh was hit */
+    uint32_t placement;     /**< which of the node's placements (DAG paths, in the mirror's order) */
+    uint32_t mesh_id;       /**< the node's mesh (sy_mesh.id) */
+    uint32_t primitive;     /**< the primitive's index in the mesh */
+    uint32_t triangle;      /**< the triangle's index in the primitive (strokes: in their tessellation) */
+    /** Barycentric weights of the triangle's vertices 0, 1 and 2 at the hit (sum 1). */
+    float barycentrics[3];
+    float position[3];      /**< world position of the hit */
+    /** Unit geometric normal of the triangle in world space, on its front side as glTF defines it
+     * (counter-clockwise in object space; a mirroring world matrix keeps it the front), whichever
+     * side was seen. */
+    float normal[3];
+    uint32_t material_id;   /**< the primitive's material (sy_material.id); 0 = the default material */
+    float distance;         /**< from the ray's origin (the eye; orthographic: the image plane) to the hit */
+    float depth;            /**< along the viewing axis (what the layer's depth plane holds) */
+} sy_pick_result;
 
 /** What a class's create receives. */
 typedef struct sy_mediator_create_args {
@@ -127,6 +156,11 @@ typedef struct sy_mediator_class {
      * registered class of the highest rank above 0 is it; 0 (the default): never. The built-in
      * ones: raster 20 (the complete look, fastest), whitted 10. */
     int default_rank;
+    /** SY_CAP_PICK: what is under pixel (x, y) (x < width, y < height) of view rendered at width x
+     * height, as last synced: fills out's hit and node .. depth fields (sy_context_pick). Optional;
+     * appended last so classes that set fields by name need no change. */
+    sy_result (*pick)(void *state, const sy_camera_view *view, uint32_t width, uint32_t height, uint32_t x,
+                      uint32_t y, sy_pick_result *out, sy_error *err);
 } sy_mediator_class;
 
 /** Registry (process-wide; the one piece of global state). The class must outlive the process's

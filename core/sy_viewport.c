@@ -8,6 +8,7 @@
 
 struct sy_viewport {
     sy_viewport_desc desc; /* backend/params point at the copies below */
+    const sy_window *window; /* the owner (its size places the viewport's rectangle) */
     char *backend;
     char *params_text;
     sy_params params;
@@ -102,6 +103,7 @@ sy_result sy_window_add_viewport(sy_window *w, const sy_viewport_desc *desc, sy_
     sy_viewport *v = calloc(1, sizeof *v);
     if (!v) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "viewport: out of memory");
     v->desc = *desc;
+    v->window = w;
     if (v->desc.eye_separation == 0.0f) v->desc.eye_separation = 0.065f;
     if (v->desc.zero_parallax == 0.0f) v->desc.zero_parallax = 2.0f;
     v->active = !desc->inactive;
@@ -291,4 +293,91 @@ sy_result sy_window_render(sy_window *w, sy_scene *scene, sy_context_pool *pool,
     }
     if (r == SY_OK) sy_layer_post_apply(out, &opts->post);
     return r;
+}
+
+/* >>picking: the ray through the pixel's centre, asked of the viewport's back-end (SY_CAP_PICK) */
+
+/* The viewport's pixel under window point (x, y); false when (x, y) is outside its rectangle. */
+static bool viewport_pixel(const sy_viewport *v, const uint32_t rect[4], double x, double y, uint32_t *px,
+                           uint32_t *py)
+{
+    double fx = floor(x) - (double)rect[0], fy = floor(y) - (double)rect[1];
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < (double)rect[2] && fy < (double)rect[3])) return false;
+    (void)v;
+    *px = (uint32_t)fx;
+    *py = (uint32_t)fy;
+    return true;
+}
+
+/* Picks pixel (px, py) of an active viewport with a non-empty rectangle. */
+static sy_result viewport_pick_pixel(sy_viewport *v, sy_scene *scene, sy_context_pool *pool, const uint32_t rect[4],
+                                     uint32_t px, uint32_t py, sy_pick_result *out, sy_error *err)
+{
+    sy_context *ctx;
+    sy_result r = sy_context_pool_get(pool, scene, v->backend, &v->params, v->desc.root.id, &ctx, err);
+    if (r == SY_OK) r = sy_context_sync(ctx, err);
+    sy_camera_view view;
+    if (r == SY_OK) r = sy_viewport_camera_view(v, scene, v->window->width, v->window->height, &view, err);
+    out->eye = v->desc.eye;
+    out->pixel_x = px;
+    out->pixel_y = py;
+    if (r == SY_OK) r = sy_context_pick(ctx, &view, rect[2], rect[3], px, py, out, err);
+    return r;
+}
+
+static sy_result pick_args(double x, double y, sy_pick_result *out, sy_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->viewport = UINT32_MAX;
+    if (!isfinite(x) || !isfinite(y))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "pick: pixel coordinates (%g, %g) are not finite", x, y);
+    return SY_OK;
+}
+
+sy_result sy_viewport_pick(sy_viewport *v, sy_scene *scene, sy_context_pool *pool, double x, double y,
+                           sy_pick_result *out, sy_error *err)
+{
+    sy_result r = pick_args(x, y, out, err);
+    if (r != SY_OK) return r;
+    uint32_t rect[4], px, py;
+    viewport_rect(v, v->window->width, v->window->height, rect);
+    if (!viewport_pixel(v, rect, x, y, &px, &py))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                            "pick: window pixel (%g, %g) is outside the viewport's rectangle %ux%u at (%u, %u)", x, y,
+                            rect[2], rect[3], rect[0], rect[1]);
+    const sy_window *w = v->window;
+    for (uint32_t i = 0; i < w->count; ++i)
+        if (w->viewports[i] == v) out->viewport = i;
+    return viewport_pick_pixel(v, scene, pool, rect, px, py, out, err);
+}
+
+sy_result sy_window_pick(sy_window *w, sy_scene *scene, sy_context_pool *pool, double x, double y,
+                         sy_pick_result *out, sy_error *err)
+{
+    sy_result r = pick_args(x, y, out, err);
+    if (r != SY_OK) return r;
+    if (!(x >= 0.0 && y >= 0.0 && x < (double)w->width && y < (double)w->height))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "pick: pixel (%g, %g) is outside the %ux%u window", x, y,
+                            w->width, w->height);
+    /* back to front, as sy_window_render composites: a replacing layer replaces the answer, a
+     * depth-composited one wins where it is nearer, an alpha-over one where it drew something */
+    for (uint32_t i = 0; i < w->count; ++i) {
+        sy_viewport *v = w->viewports[i];
+        uint32_t rect[4], px, py;
+        viewport_rect(v, w->width, w->height, rect);
+        if (!v->active || !viewport_pixel(v, rect, x, y, &px, &py)) continue;
+        sy_pick_result here;
+        memset(&here, 0, sizeof here);
+        here.viewport = i;
+        r = viewport_pick_pixel(v, scene, pool, rect, px, py, &here, err);
+        if (r != SY_OK) return r;
+        bool take;
+        switch (v->desc.composite) {
+        case SY_COMPOSITE_DEPTH: take = here.hit && (!out->hit || here.depth < out->depth); break;
+        case SY_COMPOSITE_ALPHA_OVER: take = here.hit; break;
+        default: take = true; break;
+        }
+        if (take) *out = here;
+    }
+    return SY_OK;
 }

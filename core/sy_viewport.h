@@ -107,6 +107,27 @@ sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, u
  * so that the plane at zero_parallax coincides for both eyes. MONO returns the view unchanged. */
 sy_camera_view sy_camera_view_eye(const sy_camera_view *mono, uint32_t eye, float separation, float zero_parallax);
 
+/** What is under window point (x, y) in viewport v (SY_CAP_PICK of its back-end): the pixel
+ * containing the point (floor(x), floor(y): pixel (x, y) covers [x, x+1) x [y, y+1)) is picked
+ * through its centre with the camera view, eye and back-end the viewport renders with, after
+ * syncing its context (from pool, as sy_window_render does). out->viewport is v's index, out->eye
+ * its eye, pixel_x/y the pixel in its rectangle. A point outside v's rectangle, or NaN/infinite:
+ * SY_ERR_INVALID_ARGUMENT naming the values; a back-end without SY_CAP_PICK: SY_ERR_UNSUPPORTED
+ * naming it. Nothing under the pixel is no error (out->hit false). v need not be active.
+ * Thread-safety: as sy_window_render (the scene, the pool and the window on one thread). */
+sy_result sy_viewport_pick(sy_viewport *v, sy_scene *scene, sy_context_pool *pool, double x, double y,
+                           sy_pick_result *out, sy_error *err);
+/** What is under window point (x, y) in the layer in front: every active viewport whose rectangle
+ * holds the point is picked (sy_viewport_pick) and the answers are combined back to front as
+ * sy_window_render composites the layers: a REPLACE viewport's answer (hit or miss) replaces those
+ * below, a DEPTH one wins where it hit nearer (smaller depth), an ALPHA_OVER one wherever it hit.
+ * Stereo: each eye is a viewport, so the eye is the one of the viewport that answers (side by side
+ * or top/bottom: the half the point is in; both eyes over one rectangle: the composite order).
+ * A point outside the window or not finite: SY_ERR_INVALID_ARGUMENT; no viewport there, or
+ * nothing hit: SY_OK with out->hit false (out->viewport UINT32_MAX when no viewport holds it). */
+sy_result sy_window_pick(sy_window *w, sy_scene *scene, sy_context_pool *pool, double x, double y,
+                         sy_pick_result *out, sy_error *err);
+
 /** Composites src (a viewport's layer) into dst at (x, y) with the given mode. */
 void sy_layer_composite(sy_layer *dst, const sy_layer *src, uint32_t x, uint32_t y, uint32_t mode);
 

@@ -810,6 +810,27 @@ sy_result sy_mirror_sync(sy_mirror *st, const sy_changes *changes, sy_mirror_syn
     return r;
 }
 
+bool sy_mirror_instance_find(const sy_mirror *st, uint32_t node_id, uint32_t handle, sy_mirror_instance_info *out)
+{
+    memset(out, 0, sizeof *out);
+    const node_m *n = LOOKUP(st, node, node_cap, node_id);
+    const mesh_m *m = n ? LOOKUP(st, mesh, mesh_cap, n->mesh) : NULL;
+    if (!m || !handle) return false;
+    for (uint32_t p = 0; p < n->pl_count; ++p)
+        for (uint32_t i = 0; i < n->pl[p].inst_count; ++i)
+            if (n->pl[p].inst[i] == handle) {
+                out->node = n->id;
+                out->placement = p;
+                out->mesh = m->id;
+                out->primitive = i;
+                const mat_m *mm = i < m->prim_count ? LOOKUP(st, mat, mat_cap, m->prims[i].material) : NULL;
+                out->material = mm ? mm->id : 0u; /* 0: the default material */
+                out->world = n->pl[p].place.world;
+                return true;
+            }
+    return false;
+}
+
 uint32_t sy_mirror_texture_handle(const sy_mirror *st, uint32_t texture_id)
 {
     const tex_m *t = LOOKUP(st, tex, tex_cap, texture_id);

@@ -161,6 +161,19 @@ void sy_mirror_destroy(sy_mirror *m);
 /** Applies a change list (ordered as sy_changes delivers it), then re-places dirty subtrees.
  * stats may be NULL; it is filled also when the sync fails. */
 sy_result sy_mirror_sync(sy_mirror *m, const sy_changes *changes, sy_mirror_sync_stats *stats, sy_error *err);
+/** Where a back-end instance comes from (sy_mirror_instance_find): what picking reports. */
+typedef struct sy_mirror_instance_info {
+    uint32_t node;      /**< core node id */
+    uint32_t placement; /**< which of its placements (DAG paths) */
+    uint32_t mesh;      /**< core mesh id */
+    uint32_t primitive; /**< the primitive's index in the mesh */
+    uint32_t material;  /**< core material id of the primitive (0: none or not mirrored: the default material) */
+    sy_mat4 world;      /**< the placement's world matrix */
+} sy_mirror_instance_info;
+/** Finds the back-end instance `handle` among the instances of node node_id (the node the mediator
+ * recorded for it in instance_set): true and *out filled, or false (zeroed) when the node holds no
+ * such instance. Cost: the node's placements x its mesh's primitives. */
+bool sy_mirror_instance_find(const sy_mirror *m, uint32_t node_id, uint32_t handle, sy_mirror_instance_info *out);
 /** Back-end handle of a mirrored texture (0 = unknown or incomplete). */
 uint32_t sy_mirror_texture_handle(const sy_mirror *m, uint32_t texture_id);
 /** Mirrored background or NULL. Borrowed until the next sync. */

@@ -10,7 +10,7 @@
 # cluster commands (apps/sy/sy_cluster_cli.h, sy_cmd_serve.c, sy_bench_cluster.c);
 # tests/integration/completion_test.sh checks a few.
 
-_sy_commands="info render demo compare convert coverage view web bench backends serve help version"
+_sy_commands="info render demo compare convert coverage pick view web bench backends serve help version"
 _sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit cull web"
 _sy_common="--help -q --quiet -v --verbose --env --env-color --env-intensity --env-hidden --background
             --no-default-light --allow-path --strict --max-scene-mb --variant"
@@ -35,6 +35,7 @@ _sy_options() {
     compare) echo "-w -h -o --spp --camera --backends $_sy_common" ;;
     convert) echo "-o $_sy_common" ;;
     coverage) echo "-w -h --camera --top --json $_sy_common" ;;
+    pick) echo "-b -w -h --camera --params --json $_sy_common" ;;
     demo) echo "-o -w -h --filter $_sy_common" ;;
     backends) echo "--json --params $_sy_common" ;;
     serve) echo "--listen --secret-file --output --port-file --tls-cert --tls-key --name --max-sessions
@@ -118,7 +119,7 @@ _sy_complete() {
         if [ -z "$kind" ]; then COMPREPLY=($(compgen -W "$_sy_bench_kinds" -- "$cur"))
         else _sy_files; fi ;;
     info) _sy_files ;; # a scene or an EXR image
-    render | view | web | compare | convert | coverage) [ $operands = 0 ] && _sy_files scenes ;;
+    render | view | web | compare | convert | coverage | pick) [ $operands = 0 ] && _sy_files scenes ;;
     esac
     return 0
 }

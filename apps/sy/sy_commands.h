@@ -13,6 +13,7 @@ int sy_cmd_convert(int argc, char **argv);  /* sy_cmd_convert.c */
 int sy_cmd_bench(int argc, char **argv);    /* sy_cmd_bench.c */
 int sy_cmd_backends(int argc, char **argv); /* sy_cmd_backends.c */
 int sy_cmd_coverage(int argc, char **argv); /* sy_cmd_coverage.c */
+int sy_cmd_pick(int argc, char **argv);     /* sy_cmd_pick.c */
 int sy_cmd_view(int argc, char **argv);     /* sy_cmd_view.c (built with GLFW: SY_HAVE_GLFW) */
 int sy_cmd_web(int argc, char **argv);      /* sy_cmd_web.c (built with sy_web: SY_HAVE_WEB) */
 

@@ -1,5 +1,5 @@
 /* sy_main.c — the `sy` command line tool: sy's own options and the dispatch to its commands (info,
- * render, demo, compare, convert, coverage, view, web, bench, backends, serve), one file each (sy_commands.h).
+ * render, demo, compare, convert, coverage, pick, view, web, bench, backends, serve), one file each (sy_commands.h).
  *
  *   sy [-q | -v] [--version | --help] COMMAND ...   -q: errors only, -v: debug messages (sy_log.h)
  *   sy help [COMMAND], sy COMMAND --help            usage on stdout, exit status 0
@@ -91,7 +91,7 @@ int main(int argc, char **argv)
         printf("sy (Switchyard) %s\n", sy_version());
         return 0;
     }
-    static const char *const commands[] = {"info", "render", "demo", "compare", "convert", "bench", "backends", "coverage",
+    static const char *const commands[] = {"info", "render", "demo", "compare", "convert", "bench", "backends", "coverage", "pick",
                                            "serve", "view", "web", "version", "help"};
     if (!strcmp(cmd, "help")) { /* sy help [COMMAND] */
         bool known = argc < 2;
@@ -115,6 +115,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "bench")) return sy_cmd_bench(argc, argv);
     if (!strcmp(cmd, "backends")) return sy_cmd_backends(argc, argv);
     if (!strcmp(cmd, "coverage")) return sy_cmd_coverage(argc, argv);
+    if (!strcmp(cmd, "pick")) return sy_cmd_pick(argc, argv);
     if (!strcmp(cmd, "serve")) return sy_cmd_serve(argc, argv);
 #ifdef SY_HAVE_GLFW
     if (!strcmp(cmd, "view")) return sy_cmd_view(argc, argv);

@@ -438,6 +438,20 @@ typedef struct sy_gl_render_desc {
 /** Renders and reads back: rgba (width*height*4 floats) and depth (width*height, may be NULL). */
 sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *desc, float *rgba,
                           float *depth);
+/** What is under one pixel (sy_gl_pick). Plain data. */
+typedef struct sy_gl_pick_hit {
+    sy_gl_instance instance; /**< the nearest visible instance drawn at the pixel's centre; {0}: none */
+    uint32_t triangle;       /**< the triangle's index in its mesh (the mesh as given, never a coarser level) */
+} sy_gl_pick_hit;
+/** Names the instance and triangle drawn at the centre of pixel (x, y) of an image_width x
+ * image_height image with cam: an ID pass over a 1x1 target (the pixel's own window of the image
+ * plane, no MSAA: the sample at the pixel's centre), every visible instance at its full level of
+ * detail, no face culling, alpha-masked materials cut out as in the main pass (base colour factor
+ * x base texture alpha x vertex alpha against the cutoff), alpha-blended ones drawn as opaque.
+ * Nothing there: SY_GL_OK with out->instance {0}. A pixel outside the image:
+ * SY_GL_ERROR_INVALID_ARGUMENT. Costs one pass over the instances the pixel's frustum keeps. */
+sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t image_width, uint32_t image_height,
+                        uint32_t x, uint32_t y, sy_gl_pick_hit *out);
 /** GLFW provider: true once the user asked to close the window (false for other providers). */
 bool sy_gl_window_should_close(sy_gl_device *dev);
 

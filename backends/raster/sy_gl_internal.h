@@ -10,6 +10,7 @@
  *   sy_gl_shadows.c  the lights' uniform blocks and shadow maps
  *   sy_gl_draw.c     targets, views, the forward and deferred passes, culling, MSAA resolve
  *   sy_gl_render.c   scene probes and the frame (sy_gl_render, sy_gl_render_floor)
+ *   sy_gl_pick.c     what is under one pixel: the ID pass (sy_gl_pick)
  *   sy_gl_device.c   the device: create, destroy, statistics
  * Not thread-safe: one device is used by one thread at a time (sy_gl.h). */
 #ifndef SY_GL_INTERNAL_H
@@ -24,6 +25,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#define PICK_UNIFORMS 11 /* the pick program's uniforms (sy_gl_pick.c) */
 #define IDX_BITS 20u
 #define IDX_MASK ((1u << IDX_BITS) - 1u)
 /* shadow_map_size 0 (the default): the maps follow the frame, the power of two at or above twice
@@ -205,6 +207,10 @@ struct sy_gl_device {
     struct {
         GLint model, view, proj;
     } uf[2]; /* the floors: unlit, trivial lit */
+    struct {
+        GLuint prog, fbo, color, depth; /* made on the first pick */
+        GLint u[PICK_UNIFORMS];
+    } pick; /* sy_gl_pick.c */
     GLuint default_ubo, lights_ubo, empty_vao;
     GLuint standin[STANDINS]; /* per material texture unit, bound where the material has no texture (sy_gli_make_standin) */
     bool layer_units; /* the context has UNIT_COUNT texture units: the layers' textures are read */
@@ -422,5 +428,8 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
 
 /* sy_gl_render.c */
 void sy_gli_probes_free(sy_gl_device *dev);
+
+/* sy_gl_pick.c */
+void sy_gli_pick_free(sy_gl_device *dev);
 
 #endif /* SY_GL_INTERNAL_H */

@@ -630,6 +630,27 @@ void sy_rt_pt_record_bsdf_batch(const sy_rt_pt_record *record, uint32_t count, c
 sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
                             uint32_t *ids, float *depth);
 
+/* >>pick
+ *
+ * What is under one pixel: the ray through the centre of pixel (x, y) of an image_width x
+ * image_height image (the camera ray of sy_rt_coverage and of one-sample renders), its nearest hit
+ * on a visible instance (alpha-masked holes seen through, as in every integrator). */
+/** A pick's answer (sy_rt_pick). Plain data. */
+typedef struct sy_rt_pick_hit {
+    sy_rt_instance instance; /**< the instance hit; {0}: nothing */
+    uint32_t triangle;       /**< the triangle's index in the instance's mesh */
+    /** @{ Embree's barycentrics: weights of the triangle's vertices 1 and 2 */
+    float u, v; /** @} */
+    float depth;             /**< camera-axis distance of the hit (the depth plane's value) */
+    float vertices[3][3];    /**< object-space positions of the triangle's vertices 0, 1, 2 */
+    float transform[16];     /**< the instance's object-to-world matrix, column-major */
+} sy_rt_pick_hit;
+/** Fills *out with what is under pixel (x, y) (x < image_width, y < image_height; else
+ * SY_RT_ERROR_INVALID_ARGUMENT). A miss is SY_RT_OK with out->instance {0}. The device must be
+ * committed (SY_RT_ERROR_INVALID_OPERATION otherwise). */
+sy_rt_result sy_rt_pick(sy_rt_device *dev, const sy_rt_camera *camera, uint32_t image_width, uint32_t image_height,
+                        uint32_t x, uint32_t y, sy_rt_pick_hit *out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,7 +1,9 @@
-/* sy_rt_coverage.c — per-pixel object ids for culling services (see sy_rt.h, >>coverage). */
+/* sy_rt_coverage.c — per-pixel object ids for culling services and the pick of one pixel (see
+ * sy_rt.h, >>coverage and >>pick). */
 #include "sy_rt_coverage.h"
 
 #include <math.h>
+#include <string.h>
 
 #define FAIL(code, ...) sy_rt_fail(dev, code, __VA_ARGS__)
 
@@ -36,4 +38,38 @@ sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const
     sy_rt_result r = sy_rt_frame_init(&f, dev, camera, &d, NULL, depth);
     if (r != SY_RT_OK) return r;
     return sy_rt_run_tiles(&f, sy_rt_coverage_tile, ids, desc->progress, desc->progress_user_data);
+}
+
+sy_rt_result sy_rt_pick(sy_rt_device *dev, const sy_rt_camera *camera, uint32_t image_width, uint32_t image_height,
+                        uint32_t x, uint32_t y, sy_rt_pick_hit *out)
+{
+    if (!dev || !camera || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "pick: NULL argument");
+    memset(out, 0, sizeof *out);
+    if (x >= image_width || y >= image_height)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "pick: pixel (%u, %u) is outside the %ux%u image", x, y, image_width,
+                    image_height);
+    if (dev->dirty)
+        return FAIL(SY_RT_ERROR_INVALID_OPERATION, "pick: the device has uncommitted changes; call sy_rt_commit first");
+    sy_rt_render_desc d = {.integrator = SY_RT_INTEGRATOR_COVERAGE, .image_width = image_width,
+                           .image_height = image_height, .x = x, .y = y, .width = 1, .height = 1};
+    sy_rt_frame f;
+    sy_rt_result r = sy_rt_frame_init(&f, dev, camera, &d, NULL, NULL);
+    if (r != SY_RT_OK) return r;
+    sy_rt_ictx ctx;
+    sy_rt_context_init(dev, &ctx, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+    struct RTCRayHit rh;
+    float axial;
+    sy_rt_frame_hit(&f, &ctx.rtc, x, y, &rh, &axial);
+    const sy_rt_instance_data *in =
+        rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? NULL : sy_rt_hit_instance(dev, rh.hit.geomID, rh.hit.instID[0]);
+    if (!in || rh.hit.primID >= in->mesh->triangle_count) return SY_RT_OK;
+    out->instance.id = in->handle;
+    out->triangle = rh.hit.primID;
+    out->u = rh.hit.u;
+    out->v = rh.hit.v;
+    out->depth = rh.ray.tfar * axial;
+    const uint32_t *ix = in->mesh->indices + 3u * rh.hit.primID;
+    for (int k = 0; k < 3; ++k) memcpy(out->vertices[k], in->mesh->positions + 3u * ix[k], 3 * sizeof(float));
+    memcpy(out->transform, in->xf, sizeof out->transform);
+    return SY_RT_OK;
 }

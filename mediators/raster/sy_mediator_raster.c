@@ -24,6 +24,7 @@
 #include "sy_look.h"
 #include "sy_mirror.h"
 #include "sy_mirror_map.h"
+#include "sy_pick_ray.h"
 
 #include <stdio.h>
 #include <math.h>
@@ -43,6 +44,7 @@ typedef struct emat { /* per back-end material */
     bool double_sided;
 } emat;
 typedef struct einst { /* per back-end instance */
+    uint32_t node; /* core node id (picks) */
     uint32_t mesh, material;
     float world[16];
     bool visible;
@@ -240,8 +242,9 @@ static sy_result track_instance(raster_state *st, uint32_t handle, const sy_mirr
     einst *in = sy_mirror_map_put(&st->insts, handle);
     if (!in) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (instance table)");
     if (material_emits(st, a->material) || (in->material && material_emits(st, in->material))) st->areas_dirty = true;
-    in->mesh = a->mesh;
-    in->material = a->material;
+    in->node = a->node;
+    if (a->mesh) in->mesh = a->mesh; /* updates (transform, visibility) carry no mesh */
+    if (a->mesh) in->material = a->material;
     memcpy(in->world, a->world->m, sizeof in->world);
     in->visible = a->visible;
     return SY_OK;
@@ -641,6 +644,42 @@ sy_result sy_mediator_raster_render_floor(void *state, const sy_render_request *
     return r == SY_GL_OK ? SY_OK : gl_fail(st, err, r, "floor render");
 }
 
+/* SY_CAP_PICK: the device's ID pass names the instance and the triangle (sy_gl_pick); the node,
+ * placement, mesh, primitive and material come from the mirror, the triangle's vertices from the
+ * primitive's blobs this mediator keeps, the numbers from sy_pick_ray.h (the same arithmetic as the
+ * ray tracers' picks). */
+static sy_result raster_pick(void *state, const sy_camera_view *view, uint32_t width, uint32_t height, uint32_t x,
+                             uint32_t y, sy_pick_result *out, sy_error *err)
+{
+    raster_state *st = state;
+    sy_gl_camera cam;
+    camera_of(view, &cam);
+    sy_gl_pick_hit h;
+    sy_gl_result r = sy_gl_pick(st->dev, &cam, width, height, x, y, &h);
+    if (r != SY_GL_OK) return gl_fail(st, err, r, "pick");
+    const einst *in = h.instance.id ? sy_mirror_map_get(&st->insts, h.instance.id) : NULL;
+    const emesh *em = in ? sy_mirror_map_get(&st->meshes, in->mesh) : NULL;
+    sy_mirror_instance_info info;
+    if (!em || h.triangle >= em->triangle_count || !sy_mirror_instance_find(st->mirror, in->node, h.instance.id, &info))
+        return SY_OK;
+    const float *pos = sy_blob_data(em->positions);
+    const uint32_t *idx = em->indices ? sy_blob_data(em->indices) : NULL;
+    float p[3][3];
+    for (int k = 0; k < 3; ++k) {
+        uint32_t v = idx ? idx[3u * h.triangle + (uint32_t)k] : 3u * h.triangle + (uint32_t)k;
+        if (v >= em->vertex_count) return SY_OK; /* the scene validated the indices; never here */
+        memcpy(p[k], pos + 3u * v, sizeof p[k]);
+    }
+    out->node_id = info.node;
+    out->placement = info.placement;
+    out->mesh_id = info.mesh;
+    out->primitive = info.primitive;
+    out->triangle = h.triangle;
+    out->material_id = info.material;
+    sy_pick_triangle(view, width, height, x, y, in->world, (const float(*)[3])p, out);
+    return SY_OK;
+}
+
 /* >>class */
 static void raster_destroy(void *state)
 {
@@ -759,13 +798,14 @@ static void raster_stats(void *state, sy_mediator_stats *out)
 static const sy_mediator_class raster_class = {
     .name = "raster",
     .param_table = SY_PARAM_TABLE(raster_params),
-    .caps = SY_CAP_DEPTH | SY_CAP_TILES,
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PICK,
     .create = raster_create,
     .destroy = raster_destroy,
     .sync = raster_sync,
     .render = raster_render,
     .stats = raster_stats,
     .default_rank = 20, /* the default back-end where it is built: the complete look, fastest */
+    .pick = raster_pick,
 };
 
 const sy_mediator_class *sy_mediator_raster_class(void) { return &raster_class; }

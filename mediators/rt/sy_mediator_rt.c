@@ -174,7 +174,7 @@ static void pathtracer_filter_info(void *state, sy_filter_info *out)
 static const sy_mediator_class pathtracer_class = {
     .name = "pathtracer",
     .param_table = SY_PARAM_TABLE(sy_rti_pathtracer_params),
-    .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_SAMPLE_RANGES | SY_CAP_AOVS | SY_CAP_FILTERS,
+    .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_SAMPLE_RANGES | SY_CAP_AOVS | SY_CAP_FILTERS | SY_CAP_PICK,
     .create = pathtracer_create,
     .destroy = rt_destroy,
     .sync = sy_rti_sync,
@@ -183,6 +183,7 @@ static const sy_mediator_class pathtracer_class = {
     .aovs = pathtracer_aovs,
     .set_filter = sy_mediator_rt_set_filter,
     .filter_info = pathtracer_filter_info,
+    .pick = sy_rti_pick,
 };
 
 const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtracer_class; }
@@ -190,13 +191,14 @@ const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtra
 static const sy_mediator_class whitted_class = {
     .name = "whitted",
     .param_table = SY_PARAM_TABLE(sy_rti_whitted_params),
-    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PREVIEW,
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PREVIEW | SY_CAP_PICK,
     .create = whitted_create,
     .destroy = rt_destroy,
     .sync = sy_rti_sync,
     .render = sy_rti_render,
     .stats = rt_stats,
     .default_rank = 10, /* the default back-end without the rasterizer */
+    .pick = sy_rti_pick,
 };
 
 const sy_mediator_class *sy_mediator_rt_whitted_class(void) { return &whitted_class; }
@@ -209,13 +211,14 @@ static sy_result coverage_create(const sy_mediator_create_args *args, void **sta
 static const sy_mediator_class coverage_class = {
     .name = "coverage",
     .param_table = SY_PARAM_TABLE(sy_rti_coverage_params),
-    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_ANALYSIS | SY_CAP_COVERAGE,
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_ANALYSIS | SY_CAP_COVERAGE | SY_CAP_PICK,
     .create = coverage_create,
     .destroy = rt_destroy,
     .sync = sy_rti_sync,
     .render = sy_rti_render,
     .stats = rt_stats,
     .coverage = sy_rti_coverage,
+    .pick = sy_rti_pick,
 };
 
 const sy_mediator_class *sy_mediator_rt_coverage_class(void) { return &coverage_class; }

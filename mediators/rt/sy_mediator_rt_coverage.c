@@ -1,7 +1,8 @@
 /* sy_mediator_rt_coverage.c — coverage (the coverage class, SY_CAP_COVERAGE): every object's
  * pixels in a view, as an image (a stable colour per node) and as numbers (sy_context_coverage)
- * (sy_mediator_rt_internal.h). */
+ * (sy_mediator_rt_internal.h); what is under one pixel (SY_CAP_PICK). */
 #include "sy_mediator_rt_internal.h"
+#include "sy_pick_ray.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -101,5 +102,37 @@ sy_result sy_rti_coverage(void *state, const sy_camera_view *view, uint32_t widt
     if (m > 1) qsort(out, m, sizeof *out, coverage_order);
     *entries_out = out;
     *count_out = m;
+    return SY_OK;
+}
+
+/* SY_CAP_PICK: Embree names the instance and the triangle (sy_rt_pick); the instance's node,
+ * placement, mesh, primitive and material come from the mirror; the numbers from sy_pick_ray.h. */
+sy_result sy_rti_pick(void *state, const sy_camera_view *view, uint32_t width, uint32_t height, uint32_t x, uint32_t y,
+                      sy_pick_result *out, sy_error *err)
+{
+    rt_state *st = state;
+    sy_rt_camera cam;
+    sy_rti_camera_of(view, &cam);
+    sy_rt_result r = sy_rt_commit(st->dev); /* no-op unless a failed sync left changes */
+    if (r != SY_RT_OK) return sy_rti_fail(st, err, r, "commit");
+    sy_rt_pick_hit h;
+    r = sy_rt_pick(st->dev, &cam, width, height, x, y, &h);
+    if (r != SY_RT_OK) return sy_rti_fail(st, err, r, "pick");
+    sy_mirror_instance_info info;
+    if (!h.instance.id || !sy_mirror_instance_find(st->mirror, sy_rti_inst_node_get(st, h.instance.id), h.instance.id, &info))
+        return SY_OK;
+    out->node_id = info.node;
+    out->placement = info.placement;
+    out->mesh_id = info.mesh;
+    out->primitive = info.primitive;
+    out->triangle = h.triangle;
+    out->material_id = info.material;
+    if (!sy_pick_triangle(view, width, height, x, y, h.transform, (const float(*)[3])h.vertices, out)) {
+        /* a ray along the triangle's plane: Embree's own numbers */
+        float b[3] = {1.0f - h.u - h.v, h.u, h.v};
+        out->hit = true;
+        for (int k = 0; k < 3; ++k) out->barycentrics[k] = b[k];
+        out->depth = h.depth;
+    }
     return SY_OK;
 }

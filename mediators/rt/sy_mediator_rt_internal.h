@@ -5,7 +5,7 @@
  * before it; tests/core/layers_test.sh checks it), beside the radiance hook (sy_radiance_hook.c):
  *   sy_mediator_rt_base.c      the classes' parameter tables, error and camera translation
  *   sy_mediator_rt_mirror.c    the scene mirror's callbacks (bad input clamped) and the sync
- *   sy_mediator_rt_coverage.c  coverage: the image and the numbers (SY_CAP_COVERAGE)
+ *   sy_mediator_rt_coverage.c  coverage: the image and the numbers (SY_CAP_COVERAGE); picks (SY_CAP_PICK)
  *   sy_mediator_rt_accum.c     the path tracer's accumulation slots
  *   sy_mediator_rt_filter.c    the path tracer's display filters (configuration, a filtered layer)
  *   sy_mediator_rt_radiance.c  the radiance filter's render (1-spp passes with path records)
@@ -127,6 +127,9 @@ sy_result sy_rti_coverage_render(rt_state *st, const sy_rt_camera *cam, const sy
                                  sy_error *err);
 sy_result sy_rti_coverage(void *state, const sy_camera_view *view, uint32_t width, uint32_t height,
                           sy_coverage_entry **entries_out, uint32_t *count_out, sy_error *err);
+/* SY_CAP_PICK (sy_context_pick): one ray through the pixel's centre (sy_rt_pick). */
+sy_result sy_rti_pick(void *state, const sy_camera_view *view, uint32_t width, uint32_t height, uint32_t x, uint32_t y,
+                      sy_pick_result *out, sy_error *err);
 
 /* --- sy_mediator_rt_accum.c --- */
 sy_result sy_rti_pt_slot(rt_state *st, const sy_render_request *req, sy_error *err);

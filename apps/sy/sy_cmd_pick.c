@@ -1,0 +1,185 @@
+/* sy_cmd_pick.c — `sy pick SCENE X Y [X Y ...]`: what is under pixels of the view `sy render` would
+ * draw, as JSON (the library's sy_window_pick, the back-end's SY_CAP_PICK). */
+#include "sy_commands.h"
+#include "sy_cli.h"
+#include "sy_json.h"
+#include "sy_load.h"
+
+#include "sy_log.h"
+#include "sy_viewport.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* {"id": ID, "name": NAME} of a scene object (name "" when it has none or is gone). */
+static cJSON *object_ref(const sy_scene *s, sy_object_type t, uint32_t id)
+{
+    cJSON *o = cJSON_CreateObject();
+    const char *name = NULL;
+    if (id && t == SY_TYPE_NODE) {
+        const sy_node_data *d = sy_object_get(s, t, id);
+        name = d ? d->name : NULL;
+    } else if (id && t == SY_TYPE_MESH) {
+        const sy_mesh_data *d = sy_object_get(s, t, id);
+        name = d ? d->name : NULL;
+    } else if (id && t == SY_TYPE_MATERIAL) {
+        const sy_material_data *d = sy_object_get(s, t, id);
+        name = d ? d->name : NULL;
+    }
+    sy_json_add(o, "id", cJSON_CreateNumber(id));
+    sy_json_add(o, "name", sy_json_str(name));
+    return o;
+}
+
+static cJSON *floats(const float *v, int n)
+{
+    cJSON *a = cJSON_CreateArray();
+    for (int i = 0; i < n; ++i) sy_json_add(a, NULL, sy_json_float(v[i]));
+    return a;
+}
+
+static cJSON *pick_json(const sy_scene *s, double x, double y, const sy_pick_result *p)
+{
+    static const char *const eyes[3] = {"mono", "left", "right"};
+    cJSON *o = cJSON_CreateObject();
+    sy_json_add(o, "x", cJSON_CreateNumber(x));
+    sy_json_add(o, "y", cJSON_CreateNumber(y));
+    sy_json_add(o, "hit", cJSON_CreateBool(p->hit));
+    if (p->viewport != UINT32_MAX) {
+        sy_json_add(o, "viewport", cJSON_CreateNumber(p->viewport));
+        sy_json_add(o, "eye", sy_json_str(p->eye < 3 ? eyes[p->eye] : "?"));
+    }
+    if (!p->hit) return o;
+    sy_json_add(o, "node", object_ref(s, SY_TYPE_NODE, p->node_id));
+    sy_json_add(o, "placement", cJSON_CreateNumber(p->placement));
+    sy_json_add(o, "mesh", object_ref(s, SY_TYPE_MESH, p->mesh_id));
+    sy_json_add(o, "primitive", cJSON_CreateNumber(p->primitive));
+    sy_json_add(o, "triangle", cJSON_CreateNumber(p->triangle));
+    sy_json_add(o, "barycentrics", floats(p->barycentrics, 3));
+    sy_json_add(o, "position", floats(p->position, 3));
+    sy_json_add(o, "normal", floats(p->normal, 3));
+    sy_json_add(o, "material", object_ref(s, SY_TYPE_MATERIAL, p->material_id));
+    sy_json_add(o, "distance", sy_json_float(p->distance));
+    sy_json_add(o, "depth", sy_json_float(p->depth));
+    return o;
+}
+
+/* `sy pick SCENE X Y [X Y ...]`: one JSON object per pixel (an array when more than one). */
+int sy_cmd_pick(int argc, char **argv)
+{
+    const char *scene = NULL, *camera = NULL, *backend = NULL, *params = NULL;
+    uint32_t w = 0, h = 0;
+    static const struct option lo[] = {{"camera", required_argument, NULL, OPT_CAMERA},
+                                       {"params", required_argument, NULL, OPT_PARAMS},
+                                       {"json", no_argument, NULL, OPT_JSON}, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = sy_cli_next_sized_option("pick", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, 1, &w, &h, &status)) != -1) {
+        switch (c) {
+        case OPT_STOP: return status;
+        case 'b': backend = optarg; break;
+        case OPT_CAMERA: camera = optarg; break;
+        case OPT_PARAMS: params = optarg; break;
+        case OPT_JSON: break; /* the output is JSON anyway */
+        }
+    }
+    if (optind >= argc) return sy_cli_usage_of("pick", "a SCENE and pixel coordinates X Y are required");
+    scene = argv[optind++];
+    int n = argc - optind;
+    if (n < 2 || n % 2) return sy_cli_usage_of("pick", "pixel coordinates come in pairs: X Y [X Y ...]");
+    int pairs = n / 2;
+    double *xy = malloc(sizeof *xy * (size_t)n);
+    if (!xy) {
+        sy_error e = {0};
+        sy_error_set(&e, SY_ERR_OUT_OF_MEMORY, "sy pick: out of memory");
+        return sy_cli_fail(&e);
+    }
+    for (int i = 0; i < n; ++i)
+        if (!sy_cli_parse_double(argv[optind + i], -1e9, 1e9, &xy[i])) {
+            free(xy);
+            return sy_cli_bad_value(i % 2 ? "Y" : "X", argv[optind + i]);
+        }
+    sy_error err = {0};
+    if (!backend && !(backend = sy_cli_default_backend(&err))) {
+        free(xy);
+        return sy_cli_fail(&err);
+    }
+    const sy_mediator_class *cls = sy_mediator_require(backend, &err);
+    sy_params given = {0};
+    if (!cls || sy_params_parse(params, &given, &err) != SY_OK ||
+        sy_mediator_class_check_params(cls, &given, &err) != SY_OK) {
+        free(xy);
+        sy_log(SY_LOG_ERROR, "sy", NULL, "%s", err.message);
+        return 2;
+    }
+    if (!(sy_mediator_class_caps(cls, &given) & SY_CAP_PICK)) {
+        free(xy);
+        sy_log(SY_LOG_ERROR, "sy", NULL, "sy pick: back-end %s cannot pick (sy backends lists those with 'pick')", backend);
+        return 2;
+    }
+    loaded ld;
+    if (sy_cli_load(scene, camera, true, &ld, &err) != SY_OK) {
+        free(xy);
+        return sy_cli_fail(&err);
+    }
+    /* the size sy render would use: 512 high, the width from the camera's aspect ratio */
+    float aspect = 1.0f;
+    const sy_node_data *cn = ld.camera.id ? sy_node_get(ld.scene, ld.camera) : NULL;
+    const sy_camera_data *cd = cn ? sy_camera_get(ld.scene, cn->camera) : NULL;
+    if (cd && cd->aspect > 0) aspect = cd->aspect;
+    if (ld.camera.id == 0 && !ld.is_gltf) aspect = 1.0f;
+    if (!w && !h) h = 512, w = (uint32_t)lroundf(512 * aspect);
+    else if (!w) w = (uint32_t)lroundf((float)h * aspect);
+    else if (!h) h = (uint32_t)lroundf((float)w / aspect);
+    if (!w) w = 1;
+    if (!h) h = 1;
+    for (int i = 0; i < pairs; ++i)
+        if (!(xy[2 * i] >= 0.0 && xy[2 * i] < w && xy[2 * i + 1] >= 0.0 && xy[2 * i + 1] < h)) {
+            sy_log(SY_LOG_ERROR, "sy", NULL, "sy pick: pixel (%g, %g) is outside the %ux%u image", xy[2 * i],
+                   xy[2 * i + 1], w, h);
+            free(xy);
+            sy_cli_loaded_free(&ld);
+            return 2;
+        }
+    if (ld.is_x3d) sy_cli_fit_x3d_cameras(&ld, w, h);
+    sy_window *win = NULL;
+    sy_context_pool *pool = NULL;
+    sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .backend = backend, .params = params};
+    sy_result r = sy_window_create(w, h, &win, &err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, NULL, &err);
+    if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
+    cJSON *doc = NULL, *list = NULL;
+    if (r == SY_OK && pairs > 1) doc = list = cJSON_CreateArray();
+    for (int i = 0; i < pairs && r == SY_OK; ++i) {
+        sy_pick_result p;
+        r = sy_window_pick(win, ld.scene, pool, xy[2 * i], xy[2 * i + 1], &p, &err);
+        if (r != SY_OK) break;
+        cJSON *o = pick_json(ld.scene, xy[2 * i], xy[2 * i + 1], &p);
+        if (i == 0) { /* what every pick shares, first */
+            cJSON *head = cJSON_CreateObject();
+            sy_json_add(head, "file", sy_json_str(scene));
+            sy_json_add(head, "backend", sy_json_str(backend));
+            sy_json_add(head, "width", cJSON_CreateNumber(w));
+            sy_json_add(head, "height", cJSON_CreateNumber(h));
+            for (cJSON *k = o->child; k;) { /* o's members after the shared ones */
+                cJSON *next = k->next;
+                cJSON_AddItemToObject(head, k->string, cJSON_DetachItemViaPointer(o, k));
+                k = next;
+            }
+            cJSON_Delete(o);
+            o = head;
+        }
+        if (list) sy_json_add(list, NULL, o);
+        else doc = o;
+    }
+    sy_context_pool_destroy(pool);
+    sy_window_destroy(win);
+    sy_cli_loaded_free(&ld);
+    free(xy);
+    if (r != SY_OK) {
+        cJSON_Delete(doc);
+        return sy_cli_fail(&err);
+    }
+    return sy_json_print(doc);
+}

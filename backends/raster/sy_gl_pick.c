@@ -1,0 +1,155 @@
+/* sy_gl_pick.c — what is under one pixel (sy_gl_pick): an ID pass over a 1x1 target. The pixel's
+ * own window of the image plane (the sub-rectangle view every tile uses) is drawn with a trivial
+ * program that writes the instance's handle and gl_PrimitiveID, each as two exact 16-bit halves
+ * in a float target (the GL 3.3 entry points the device loads have no integer uniforms or
+ * clears), with the depth test and no culling, every visible instance at its full level of detail
+ * (level 0 is the mesh as given, so the primitive id is the mesh's triangle index). Alpha-masked
+ * materials discard where base colour factor x base texture alpha x vertex alpha < cutoff, as the
+ * ray tracers' alpha filter does. */
+#include "sy_gl_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+static const char *const pick_vs =
+    "#version 330 core\n"
+    "layout(location=0) in vec3 a_pos; layout(location=2) in vec2 a_uv0; layout(location=3) in vec2 a_uv1;\n"
+    "layout(location=4) in vec4 a_col;\n"
+    "uniform mat4 u_model; uniform mat4 u_view; uniform mat4 u_proj; uniform int u_uvset; uniform vec3 u_xf0, u_xf1;\n"
+    "out vec2 v_uv; out float v_alpha;\n"
+    "void main() { vec3 t = vec3(u_uvset == 1 ? a_uv1 : a_uv0, 1.0); v_uv = vec2(dot(u_xf0, t), dot(u_xf1, t));\n"
+    "  v_alpha = a_col.a; gl_Position = u_proj * (u_view * (u_model * vec4(a_pos, 1.0))); }\n";
+
+static const char *const pick_fs =
+    "#version 330 core\n"
+    "in vec2 v_uv; in float v_alpha; layout(location=0) out vec4 o_id;\n"
+    "uniform int u_id; uniform int u_mask; uniform int u_tex; uniform float u_alpha; uniform float u_cutoff;\n"
+    "uniform sampler2D t_base;\n"
+    "void main() {\n"
+    "  if (u_mask != 0) { float a = u_alpha * v_alpha; if (u_tex != 0) a *= texture(t_base, v_uv).a;\n"
+    "    if (a < u_cutoff) discard; }\n"
+    "  uint id = uint(u_id), p = uint(gl_PrimitiveID) + 1u;\n"
+    "  o_id = vec4(float(id & 65535u), float(id >> 16u), float(p & 65535u), float(p >> 16u)); }\n";
+
+void sy_gli_pick_free(sy_gl_device *dev)
+{
+    const sy_gl_fns *gl = dev->gl;
+    if (dev->pick.prog) gl->DeleteProgram(dev->pick.prog);
+    if (dev->pick.fbo) gl->DeleteFramebuffers(1, &dev->pick.fbo);
+    if (dev->pick.color) gl->DeleteRenderbuffers(1, &dev->pick.color);
+    if (dev->pick.depth) gl->DeleteRenderbuffers(1, &dev->pick.depth);
+    memset(&dev->pick, 0, sizeof dev->pick);
+}
+
+/* The program and the 1x1 target, made on the first pick. */
+static sy_gl_result pick_setup(sy_gl_device *dev, sy_gl_report *rep)
+{
+    const sy_gl_fns *gl = dev->gl;
+    if (!dev->pick.prog) {
+        sy_gl_result r = sy_gl_program_build(gl, "pick", pick_vs, pick_fs, NULL, &dev->pick.prog, rep);
+        if (r != SY_GL_OK) return r;
+        static const char *const names[PICK_UNIFORMS] = {"u_model", "u_view",  "u_proj", "u_uvset", "u_xf0", "u_xf1",
+                                                         "u_id",    "u_mask",  "u_tex",  "u_alpha", "u_cutoff"};
+        for (int i = 0; i < PICK_UNIFORMS; ++i) dev->pick.u[i] = gl->GetUniformLocation(dev->pick.prog, names[i]);
+        gl->UseProgram(dev->pick.prog);
+        gl->Uniform1i(gl->GetUniformLocation(dev->pick.prog, "t_base"), 0);
+    }
+    if (!dev->pick.fbo) {
+        gl->GenFramebuffers(1, &dev->pick.fbo);
+        gl->GenRenderbuffers(1, &dev->pick.color);
+        gl->GenRenderbuffers(1, &dev->pick.depth);
+        gl->BindRenderbuffer(GL_RENDERBUFFER, dev->pick.color);
+        gl->RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_RGBA32F, 1, 1);
+        gl->BindRenderbuffer(GL_RENDERBUFFER, dev->pick.depth);
+        gl->RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_DEPTH_COMPONENT32F, 1, 1);
+        gl->BindFramebuffer(GL_FRAMEBUFFER, dev->pick.fbo);
+        gl->FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, dev->pick.color);
+        gl->FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, dev->pick.depth);
+        if (gl->CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+            return sy_gli_fail(rep, SY_GL_ERROR_GL, "pick: the 1x1 ID target is incomplete");
+    }
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t image_width, uint32_t image_height,
+                        uint32_t x, uint32_t y, sy_gl_pick_hit *out)
+{
+    sy_gl_report *rep = dev ? dev->report : NULL;
+    if (!dev || !cam || !out) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "pick: NULL argument");
+    memset(out, 0, sizeof *out);
+    if (x >= image_width || y >= image_height)
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "pick: pixel (%u, %u) is outside the %ux%u image", x, y,
+                           image_width, image_height);
+    sy_gl_result r = sy_gli_current(dev, rep);
+    const sy_gl_render_desc d = {image_width, image_height, x, y, 1, 1};
+    view_setup v;
+    if (r == SY_GL_OK) r = sy_gli_view_make(dev, cam, &d, &v, rep);
+    if (r == SY_GL_OK) r = pick_setup(dev, rep);
+    if (r != SY_GL_OK) return r;
+    const sy_gl_fns *gl = dev->gl;
+    gl->BindFramebuffer(GL_FRAMEBUFFER, dev->pick.fbo);
+    static const GLenum bufs[1] = {GL_COLOR_ATTACHMENT0};
+    gl->DrawBuffers(1, bufs);
+    gl->Viewport(0, 0, 1, 1);
+    gl->Disable(GL_BLEND);
+    gl->Disable(GL_CULL_FACE);
+    gl->Enable(GL_DEPTH_TEST);
+    gl->DepthFunc(GL_LESS);
+    gl->DepthMask(GL_TRUE);
+    gl->ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    const float zero[4] = {0, 0, 0, 0}, one = 1.0f;
+    gl->ClearBufferfv(GL_COLOR, 0, zero);
+    gl->ClearBufferfv(GL_DEPTH, 0, &one);
+    gl->UseProgram(dev->pick.prog);
+    const GLint *u = dev->pick.u;
+    gl->UniformMatrix4fv(u[1], 1, GL_FALSE, v.view);
+    gl->UniformMatrix4fv(u[2], 1, GL_FALSE, v.proj);
+    gl->ActiveTexture(GL_TEXTURE0);
+    float vp[16], planes[6][4];
+    sy_gli_m4_mul(v.proj, v.view, vp);
+    sy_gli_frustum_planes(vp, planes);
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        const inst_o *in = sy_gli_pool_at(&dev->instances, i);
+        if (!in->h.id || !in->visible) continue;
+        const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
+        if (!m) continue;
+        float c[3], scale, rad = sy_gli_world_sphere(in, m, c, &scale);
+        if (sy_gli_sphere_outside(planes, c, rad)) continue;
+        const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
+        const sy_gl_texture_ref *bt = mt ? &mt->d.base_color_texture : NULL;
+        const tex_o *tex = bt ? sy_gli_pool_get(&dev->textures, bt->texture.id) : NULL;
+        bool mask = mt && mt->d.alpha_mode == SY_GL_ALPHA_MASK;
+        gl->Uniform1i(u[7], mask ? 1 : 0);
+        if (mask) {
+            gl->Uniform1f(u[9], mt->d.base_color[3]);
+            gl->Uniform1f(u[10], mt->d.alpha_cutoff);
+            gl->Uniform1i(u[8], tex ? 1 : 0);
+            if (tex) {
+                float xf0[3] = {1, 0, 0}, xf1[3] = {0, 1, 0};
+                if (bt->transformed) memcpy(xf0, bt->transform, sizeof xf0), memcpy(xf1, bt->transform + 3, sizeof xf1);
+                gl->Uniform3fv(u[4], 1, xf0);
+                gl->Uniform3fv(u[5], 1, xf1);
+                gl->Uniform1i(u[3], (int)bt->texcoord);
+                gl->BindTexture(GL_TEXTURE_2D, tex->tex);
+            }
+        }
+        gl->Uniform1i(u[6], (GLint)in->h.id);
+        gl->UniformMatrix4fv(u[0], 1, GL_FALSE, in->model);
+        sy_gli_draw_mesh_lod(dev, m, 0);
+    }
+    float px[4] = {0, 0, 0, 0};
+    gl->ReadBuffer(GL_COLOR_ATTACHMENT0);
+    gl->PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl->ReadPixels(0, 0, 1, 1, GL_RGBA, GL_FLOAT, px);
+    r = sy_gli_gl_check(dev, "pick", rep);
+    if (r != SY_GL_OK) return r;
+    uint32_t prim = (uint32_t)px[2] | ((uint32_t)px[3] << 16);
+    if (!prim) return SY_GL_OK;
+    uint32_t id = (uint32_t)px[0] | ((uint32_t)px[1] << 16);
+    const inst_o *in = sy_gli_pool_get(&dev->instances, id);
+    const mesh_o *m = in ? sy_gli_pool_get(&dev->meshes, in->mesh.id) : NULL;
+    if (!m || prim - 1u >= m->triangle_count) return SY_GL_OK; /* cannot happen: the pass drew these */
+    out->instance.id = id;
+    out->triangle = prim - 1u;
+    return SY_GL_OK;
+}
