@@ -76,7 +76,7 @@ bool sy_pick_triangle(const sy_camera_view *view, uint32_t width, uint32_t heigh
     out->barycentrics[2] = (float)b2;
     for (int i = 0; i < 3; ++i) {
         out->position[i] = (float)pos[i];
-        out->normal[i] = (float)(n[i] / nn);
+        out->normal[i] = (float)(n[i] / nn) + 0.0f; /* no -0 */
     }
     out->distance = (float)sqrt(dist2);
     out->depth = (float)depth;

@@ -446,8 +446,9 @@ typedef struct sy_gl_pick_hit {
 /** Names the instance and triangle drawn at the centre of pixel (x, y) of an image_width x
  * image_height image with cam: an ID pass over a 1x1 target (the pixel's own window of the image
  * plane, no MSAA: the sample at the pixel's centre), every visible instance at its full level of
- * detail, no face culling, alpha-masked materials cut out as in the main pass (base colour factor
- * x base texture alpha x vertex alpha against the cutoff), alpha-blended ones drawn as opaque.
+ * detail, no face culling, alpha-masked materials cut out (base colour factor x base texture alpha
+ * at full resolution, as the ray tracers read it, x vertex alpha against the cutoff), alpha-blended
+ * ones drawn as opaque (the ray tracers' camera rays stop at them too).
  * Nothing there: SY_GL_OK with out->instance {0}. A pixel outside the image:
  * SY_GL_ERROR_INVALID_ARGUMENT. Costs one pass over the instances the pixel's frustum keeps. */
 sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t image_width, uint32_t image_height,

@@ -5,7 +5,9 @@
  * clears), with the depth test and no culling, every visible instance at its full level of detail
  * (level 0 is the mesh as given, so the primitive id is the mesh's triangle index). Alpha-masked
  * materials discard where base colour factor x base texture alpha x vertex alpha < cutoff, as the
- * ray tracers' alpha filter does. */
+ * ray tracers' alpha filter does, with the texture read at its full resolution (level 0, the
+ * magnification filter) as the ray tracers read it: the main pass's mipmapped read moves the cut
+ * by a texel or so where the alpha crosses the cutoff (AlphaBlendModeTest's 0.75 cutoff). */
 #include "sy_gl_internal.h"
 
 #include <math.h>
@@ -26,7 +28,7 @@ static const char *const pick_fs =
     "uniform int u_id; uniform int u_mask; uniform int u_tex; uniform float u_alpha; uniform float u_cutoff;\n"
     "uniform sampler2D t_base;\n"
     "void main() {\n"
-    "  if (u_mask != 0) { float a = u_alpha * v_alpha; if (u_tex != 0) a *= texture(t_base, v_uv).a;\n"
+    "  if (u_mask != 0) { float a = u_alpha * v_alpha; if (u_tex != 0) a *= textureLod(t_base, v_uv, 0.0).a;\n"
     "    if (a < u_cutoff) discard; }\n"
     "  uint id = uint(u_id), p = uint(gl_PrimitiveID) + 1u;\n"
     "  o_id = vec4(float(id & 65535u), float(id >> 16u), float(p & 65535u), float(p >> 16u)); }\n";
