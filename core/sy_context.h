@@ -57,7 +57,9 @@ sy_result sy_context_coverage(sy_context *c, const sy_camera_view *view, uint32_
  * SY_ERR_UNSUPPORTED naming the back-end): the nearest surface the ray through the pixel's centre
  * meets in what the context last synced, as sy_pick_result says. x >= width, y >= height or a zero
  * size: SY_ERR_INVALID_ARGUMENT naming the values; a view sy_camera_view_check refuses: its error.
- * A miss is no error (out->hit false). out's viewport fields are left as they are. */
+ * A miss is no error (out->hit false). out's viewport fields are left as they are. Covers what the
+ * context last synced (sy_viewport_pick syncs first). Thread-safety: as sy_context_render (never
+ * beside a sync or render of the same context). */
 sy_result sy_context_pick(sy_context *c, const sy_camera_view *view, uint32_t width, uint32_t height, uint32_t x,
                           uint32_t y, sy_pick_result *out, sy_error *err);
 

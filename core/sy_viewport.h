@@ -14,9 +14,15 @@
  * camera node's world matrix, so moving the view changes nothing in the scene and needs no commit
  * (the application's pending changes stay pending).
  *
+ * Picking (sy_window_pick, sy_viewport_pick) asks the same viewports, with the same camera views,
+ * eyes and contexts, what is under one pixel: the layer in front answers (see sy_window_pick and
+ * docs/BACKENDS.md, "Picking").
+ *
  * Ownership: the window owns its viewports (sy_window_destroy frees them); a view set directly is
- * copied into the viewport; contexts come from a caller-owned sy_context_pool. Thread-safety:
- * single-threaded, like the scene it renders (a viewport's view included). */
+ * copied into the viewport; contexts come from a caller-owned sy_context_pool; a pick's answer
+ * (sy_pick_result) is plain data in the caller's struct. Thread-safety: single-threaded, like the
+ * scene it renders (a viewport's view included); a pick syncs and uses the viewport's context, so
+ * it must not run beside a render of the same window or pool. */
 #ifndef SY_VIEWPORT_H
 #define SY_VIEWPORT_H
 

@@ -647,7 +647,8 @@ typedef struct sy_rt_pick_hit {
 } sy_rt_pick_hit;
 /** Fills *out with what is under pixel (x, y) (x < image_width, y < image_height; else
  * SY_RT_ERROR_INVALID_ARGUMENT). A miss is SY_RT_OK with out->instance {0}. The device must be
- * committed (SY_RT_ERROR_INVALID_OPERATION otherwise). */
+ * committed (SY_RT_ERROR_INVALID_OPERATION otherwise). One ray on the calling thread; like every
+ * call, not beside another call on the same device. */
 sy_rt_result sy_rt_pick(sy_rt_device *dev, const sy_rt_camera *camera, uint32_t image_width, uint32_t image_height,
                         uint32_t x, uint32_t y, sy_rt_pick_hit *out);
 
