@@ -444,8 +444,10 @@ typedef struct sy_gl_pick_hit {
     uint32_t triangle;       /**< the triangle's index in its mesh (the mesh as given, never a coarser level) */
 } sy_gl_pick_hit;
 /** Names the instance and triangle drawn at the centre of pixel (x, y) of an image_width x
- * image_height image with cam: an ID pass over a 1x1 target (the pixel's own window of the image
- * plane, no MSAA: the sample at the pixel's centre), every visible instance at its full level of
+ * image_height image with cam: an ID pass over a 1x1 target (a window of the image plane 64 times
+ * narrower than the pixel, centred on its centre, no MSAA: the sample at the pixel's centre with
+ * the rasterizer's sub-pixel snapping 64 times finer, so that a centre near an edge two triangles
+ * share goes to the one the ray meets), every visible instance at its full level of
  * detail, no face culling, alpha-masked materials cut out (base colour factor x base texture alpha
  * at full resolution, as the ray tracers read it, x vertex alpha against the cutoff), alpha-blended
  * ones drawn as opaque (the ray tracers' camera rays stop at them too).

@@ -13,6 +13,8 @@
 #include <math.h>
 #include <string.h>
 
+#define PICK_ZOOM 64.0 /* how much narrower than the pixel the ID pass's window is (see sy_gl_pick) */
+
 static const char *const pick_vs =
     "#version 330 core\n"
     "layout(location=0) in vec3 a_pos; layout(location=2) in vec2 a_uv0; layout(location=3) in vec2 a_uv1;\n"
@@ -83,9 +85,25 @@ sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t ima
         return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "pick: pixel (%u, %u) is outside the %ux%u image", x, y,
                            image_width, image_height);
     sy_gl_result r = sy_gli_current(dev, rep);
-    const sy_gl_render_desc d = {image_width, image_height, x, y, 1, 1};
+    /* the 1x1 target is a window PICK_ZOOM times narrower than the pixel, centred on its centre:
+     * the same ray, with the rasterizer's sub-pixel snapping PICK_ZOOM times finer, so a centre
+     * near a shared edge goes to the triangle the ray meets (with the pixel's own window, one in
+     * a hundred pixels of MetalRoughSpheresNoTextures' small triangles went to the neighbour) */
+    sy_gl_camera zc = *cam;
+    const float *w = cam->window;
+    double cx = w[0] + ((double)w[1] - w[0]) * (x + 0.5) / image_width;
+    double cy = w[3] - ((double)w[3] - w[2]) * (y + 0.5) / image_height;
+    double hx = ((double)w[1] - w[0]) / image_width * 0.5 / PICK_ZOOM;
+    double hy = ((double)w[3] - w[2]) / image_height * 0.5 / PICK_ZOOM;
+    zc.window[0] = (float)(cx - hx), zc.window[1] = (float)(cx + hx);
+    zc.window[2] = (float)(cy - hy), zc.window[3] = (float)(cy + hy);
+    const sy_gl_render_desc d = {1, 1, 0, 0, 1, 1};
     view_setup v;
-    if (r == SY_GL_OK) r = sy_gli_view_make(dev, cam, &d, &v, rep);
+    if (r == SY_GL_OK && !(zc.window[0] < zc.window[1] && zc.window[2] < zc.window[3])) { /* below float steps */
+        zc.window[0] = (float)cx - fmaxf(fabsf((float)cx), 1.0f) * 1e-6f, zc.window[1] = (float)cx + fmaxf(fabsf((float)cx), 1.0f) * 1e-6f;
+        zc.window[2] = (float)cy - fmaxf(fabsf((float)cy), 1.0f) * 1e-6f, zc.window[3] = (float)cy + fmaxf(fabsf((float)cy), 1.0f) * 1e-6f;
+    }
+    if (r == SY_GL_OK) r = sy_gli_view_make(dev, &zc, &d, &v, rep);
     if (r == SY_GL_OK) r = pick_setup(dev, rep);
     if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
