@@ -19,7 +19,9 @@
  * Measurement mode (issue 37's target): test_it_pick --agreement N SCENE.gltf... picks N random
  * pixels (seed 1) of each scene's framing view at 512x384 in every pick-capable back-end and prints,
  * per scene and over all: covered pixels (every back-end hit), coverage disagreements, the share
- * naming the same node and triangle, and the largest position difference over the scene size. */
+ * naming the same node and triangle, the largest position difference over the scene size, and the
+ * largest difference between a pick's depth and the depth plane of a one-ray-per-pixel Whitted
+ * render (Embree's own hit: an independent check of the shared arithmetic). */
 #include "it_util.h"
 
 #include "sy_gltf.h"
@@ -380,6 +382,7 @@ typedef struct agreement {
     uint32_t pixels, covered, coverage_differs, same, positions_far;
     uint32_t differ_near; /* covered pixels naming different triangles at points within 1e-4 x size (an edge) */
     double worst; /* largest position difference / scene size where the triangle agreed */
+    double worst_depth; /* largest |pick depth - the depth plane of a one-ray-per-pixel Whitted render| / size */
 } agreement;
 
 static uint64_t rng_next(uint64_t *s)
@@ -410,6 +413,18 @@ static void agree(const char *path, uint32_t n, uint32_t w, uint32_t h, agreemen
         sy_viewport_desc vd = {.backend = names[b]};
         MUST(sy_window_add_viewport(win[b], &vd, NULL, err));
     }
+    /* an independent check of the points: the depth plane of a Whitted render with one ray
+     * through each pixel centre (Embree's own hit distances) */
+    sy_layer depth = {0};
+    if (sy_mediator_find("whitted")) {
+        sy_window *dw;
+        MUST(sy_window_create(w, h, &dw, err));
+        sy_viewport_desc vd = {.backend = "whitted", .params = "spp=1"};
+        MUST(sy_window_add_viewport(dw, &vd, NULL, err));
+        MUST(sy_layer_create(w, h, &depth, err));
+        MUST(sy_window_render(dw, s, pool, NULL, &depth, err));
+        sy_window_destroy(dw);
+    }
     uint64_t seed = 1;
     for (uint32_t i = 0; i < n; ++i) {
         uint32_t x = (uint32_t)(rng_next(&seed) % w), y = (uint32_t)(rng_next(&seed) % h);
@@ -424,6 +439,9 @@ static void agree(const char *path, uint32_t n, uint32_t w, uint32_t h, agreemen
         if (hits && hits < nb) out->coverage_differs++;
         if (hits < nb) continue;
         out->covered++;
+        if (depth.depth)
+            for (uint32_t b = 0; b < nb; ++b)
+                out->worst_depth = fmax(out->worst_depth, fabs((double)p[b].depth - depth.depth[(size_t)y * w + x]) / size);
         bool same = true;
         for (uint32_t b = 1; b < nb; ++b)
             same &= p[b].node_id == p[0].node_id && p[b].placement == p[0].placement &&
@@ -448,6 +466,7 @@ static void agree(const char *path, uint32_t n, uint32_t w, uint32_t h, agreemen
         out->worst = fmax(out->worst, worst);
     }
     for (uint32_t b = 0; b < nb; ++b) sy_window_destroy(win[b]);
+    sy_layer_destroy(&depth);
     sy_context_pool_destroy(pool);
     sy_scene_destroy(s);
 }
@@ -455,9 +474,10 @@ static void agree(const char *path, uint32_t n, uint32_t w, uint32_t h, agreemen
 static void print_agreement(const char *name, const agreement *a)
 {
     printf("%-34s pixels %5u  covered by all %5u  coverage differs %4u  same node+triangle %5u (%.2f %%; the others "
-           "%u at one point within 1e-4 x size)  positions beyond 1e-4 x size %u, worst %.2e x size\n",
+           "%u at one point within 1e-4 x size)  positions beyond 1e-4 x size %u, worst %.2e x size; depth vs "
+           "Whitted's depth plane worst %.2e x size\n",
            name, a->pixels, a->covered, a->coverage_differs, a->same, a->covered ? 100.0 * a->same / a->covered : 100.0,
-           a->differ_near, a->positions_far, a->worst);
+           a->differ_near, a->positions_far, a->worst, a->worst_depth);
 }
 
 static void test_sample(void)
@@ -474,6 +494,8 @@ static void test_sample(void)
     EXPECT_MSG(a.covered >= 30, "only %u of 300 pixels covered", a.covered);
     EXPECT_MSG(a.same * 100 >= a.covered * 99, "%u of %u covered pixels name the same node and triangle", a.same, a.covered);
     EXPECT_MSG(a.positions_far == 0, "%u positions differ by more than 1e-4 x the scene size", a.positions_far);
+    EXPECT_MSG(a.worst_depth <= SIZE_TOL, "a pick's depth differs from Whitted's depth plane by %.2e x the scene size",
+               a.worst_depth);
 }
 
 int main(int argc, char **argv)
@@ -494,6 +516,7 @@ int main(int argc, char **argv)
             print_agreement(base ? base + 1 : argv[i], &a);
             all.pixels += a.pixels, all.covered += a.covered, all.coverage_differs += a.coverage_differs;
             all.same += a.same, all.differ_near += a.differ_near, all.positions_far += a.positions_far, all.worst = fmax(all.worst, a.worst);
+            all.worst_depth = fmax(all.worst_depth, a.worst_depth);
         }
         print_agreement("all", &all);
         return sy_check_finish("pick agreement");
