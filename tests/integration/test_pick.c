@@ -4,7 +4,8 @@
  *      a second primitive with its own material), seen from (0, 0, 3) down -Z: at chosen pixels
  *      every pick-capable back-end names the node, mesh, primitive, triangle and material computed
  *      by hand, with barycentrics, world position (within 1e-4 of the scene size), normal, distance
- *      and depth from the view's definition; a pixel beside the quads is a miss (no error). The
+ *      and depth from the view's definition; a pixel beside the quads is a miss (no error); a
+ *      frame rendered after the picks equals the one before (non-progressive classes). The
  *      rasterizer, Whitted and the path tracer must be among them (where built).
  *   2. A DAG: one quad node under two parents is told apart by its placement.
  *   3. Windows: a depth-composited layer answers where it is nearer, an alpha-over one wherever
@@ -177,6 +178,13 @@ static void test_quads(void)
         sy_viewport_set_view(vp, &cam);
         sy_camera_view view;
         MUST(sy_viewport_camera_view(vp, q.s, W, H, &view, err));
+        /* a pick leaves no trace in what the context renders next (the rasterizer's GL state) */
+        bool progressive = (sy_mediator_class_caps(sy_mediator_find(names[b]), NULL) & SY_CAP_PROGRESSIVE) != 0;
+        sy_layer before = {0}, after = {0};
+        if (!progressive) {
+            MUST(sy_layer_create(W, H, &before, err));
+            MUST(sy_window_render(win, q.s, pool, NULL, &before, err));
+        }
         uint32_t hits = 0, tested = 0;
         /* every 7th pixel of every 5th row: both quads, both triangles of each, B's two primitives,
          * the overlap (B in front) and the misses around */
@@ -204,6 +212,14 @@ static void test_quads(void)
                 hits += e.hit;
             }
         EXPECT_MSG(hits > 200 && tested - hits > 100, "%s: %u pixels tested, %u hits", names[b], tested, hits);
+        if (!progressive) {
+            MUST(sy_layer_create(W, H, &after, err));
+            MUST(sy_window_render(win, q.s, pool, NULL, &after, err));
+            EXPECT_MSG(it_layers_identical(&before, &after), "%s: the image after the picks differs from the one before",
+                       names[b]);
+            sy_layer_destroy(&before);
+            sy_layer_destroy(&after);
+        }
         sy_window_destroy(win);
     }
     sy_context_pool_destroy(pool);
