@@ -199,6 +199,48 @@ int main(int argc, char **argv)
         MUST(sy_gl_instance_destroy(d, b));
     }
 
+    /* 4c. picks (sy_gl_pick): the nearest instance and its triangle at each pixel centre, computed
+     * by hand (near quad at z = -2 over tangents |t| < 0.5, far one at z = -4 over |t| < 0.25,
+     * triangle 0 below the diagonal); an alpha-masked quad in front where its alpha is under the
+     * cutoff is seen through, one above it is hit; a pixel outside the image is refused */
+    {
+        const float near_q[12] = {-1, -1, -2, 1, -1, -2, 1, 1, -2, -1, 1, -2};
+        const float far_q[12] = {-1, -1, -4, 1, -1, -4, 1, 1, -4, -1, 1, -4};
+        const float front_q[12] = {-9, -9, -1, 9, -9, -1, 9, 9, -1, -9, 9, -1};
+        sy_gl_mesh mn = quad(d, near_q, nz), mf = quad(d, far_q, nz), mfr = quad(d, front_q, nz);
+        sy_gl_material opaque = material(d, 1, 1, 1, 1, true, SY_GL_ALPHA_OPAQUE);
+        sy_gl_instance in_n = place(d, mn, opaque), in_f = place(d, mf, opaque);
+        sy_gl_instance cut = place(d, mfr, material(d, 1, 1, 1, 0.3f, true, SY_GL_ALPHA_MASK));
+        int wrong = 0, hits = 0, tested = 0;
+        for (int y = 0; y < N; ++y)
+            for (int x = 0; x < N; ++x) {
+                float tx = -1.0f + 2.0f * ((float)x + 0.5f) / N, ty = 1.0f - 2.0f * ((float)y + 0.5f) / N;
+                /* centres within 1e-3 of an edge or the diagonal are left out (either side is right) */
+                if (fabsf(fabsf(tx) - 0.5f) < 1e-3f || fabsf(fabsf(ty) - 0.5f) < 1e-3f || fabsf(tx - ty) < 1e-3f ||
+                    fabsf(fabsf(tx) - 0.25f) < 1e-3f || fabsf(fabsf(ty) - 0.25f) < 1e-3f)
+                    continue;
+                uint32_t want = 0, tri = 0;
+                if (fabsf(tx) < 0.5f && fabsf(ty) < 0.5f) want = in_n.id, tri = tx >= ty ? 0 : 1;
+                else if (fabsf(tx) < 0.25f && fabsf(ty) < 0.25f) want = in_f.id, tri = tx >= ty ? 0 : 1;
+                sy_gl_pick_hit ph;
+                MUST(sy_gl_pick(d, &cam, N, N, (uint32_t)x, (uint32_t)y, &ph));
+                wrong += ph.instance.id != want || (want && ph.triangle != tri);
+                hits += want != 0;
+                tested++;
+            }
+        EXPECT_MSG(wrong == 0 && hits > 100, "%d of %d picks wrong (%d hits expected)", wrong, tested, hits);
+        MUST(sy_gl_instance_destroy(d, cut));
+        cut = place(d, mfr, material(d, 1, 1, 1, 0.8f, true, SY_GL_ALPHA_MASK));
+        sy_gl_pick_hit ph;
+        MUST(sy_gl_pick(d, &cam, N, N, N / 2, N / 2, &ph));
+        EXPECT_MSG(ph.instance.id == cut.id, "a masked quad above its cutoff is not picked (%#x)", ph.instance.id);
+        EXPECT_MSG(sy_gl_pick(d, &cam, N, N, N, 0, &ph) == SY_GL_ERROR_INVALID_ARGUMENT && ph.instance.id == 0 &&
+                       strstr(e, "outside"), "a pick outside the image: %s", e);
+        MUST(sy_gl_instance_destroy(d, cut));
+        MUST(sy_gl_instance_destroy(d, in_n));
+        MUST(sy_gl_instance_destroy(d, in_f));
+    }
+
 
     {
         unsigned char tex[8 * 8 * 3];

@@ -1,6 +1,9 @@
 /* test_rt_coverage.c — the coverage integrator (sy_rt_coverage): per-pixel ids of the nearest
  * visible instance. Expected ids are computed independently by intersecting each pixel-centre
- * ray with the two axis-aligned quads analytically (nearer quad wins). */
+ * ray with the two axis-aligned quads analytically (nearer quad wins). The pick of one pixel
+ * (sy_rt_pick) names the same instance at every pixel, with the coverage depth, and a triangle,
+ * barycentrics, vertices and transform that put the hit on the pixel-centre ray; bad pixels and
+ * uncommitted devices are refused. */
 #include "rt_test.h"
 
 #define W 100
@@ -52,6 +55,32 @@ int main(void)
     EXPECT_MSG(n_far > 0 && n_near > 0, "both objects covered: far %d near %d", n_far, n_near);
     printf("coverage: far quad %d px, near quad %d px\n", n_far, n_near);
 
+    /* sy_rt_pick: the same instance and depth at every pixel; its triangle, barycentrics, vertices
+     * and transform put the point on the pixel-centre ray at that depth */
+    int pick_wrong = 0, off_ray = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            sy_rt_pick_hit ph;
+            MUST(sy_rt_pick(dev, &cam, W, H, (uint32_t)x, (uint32_t)y, &ph));
+            pick_wrong += ph.instance.id != ids[y * W + x];
+            if (!ph.instance.id) continue;
+            pick_wrong += fabsf(ph.depth - depth[y * W + x]) > 1e-5f || ph.triangle > 1;
+            float b[3] = {1.0f - ph.u - ph.v, ph.u, ph.v}, o[3] = {0, 0, 0}, wp[3];
+            for (int k = 0; k < 3; ++k)
+                for (int i = 0; i < 3; ++i) o[i] += b[k] * ph.vertices[k][i];
+            for (int i = 0; i < 3; ++i)
+                wp[i] = ph.transform[i] * o[0] + ph.transform[4 + i] * o[1] + ph.transform[8 + i] * o[2] + ph.transform[12 + i];
+            float sx = t * (float)W / (float)H, ur = -sx + 2.0f * sx * ((float)x + 0.5f) / (float)W,
+                  vr = t - 2.0f * t * ((float)y + 0.5f) / (float)H, dd = ph.depth;
+            off_ray += fabsf(wp[0] - ur * dd) > 1e-5f || fabsf(wp[1] - vr * dd) > 1e-5f || fabsf(wp[2] - (5.0f - dd)) > 1e-5f;
+        }
+    EXPECT_MSG(pick_wrong == 0, "%d picks differ from the coverage ids or depths", pick_wrong);
+    EXPECT_MSG(off_ray == 0, "%d picked points are off their pixel's ray", off_ray);
+    sy_rt_pick_hit ph;
+    EXPECT_MSG(sy_rt_pick(dev, &cam, W, H, W, 0, &ph) == SY_RT_ERROR_INVALID_ARGUMENT && ph.instance.id == 0 &&
+                   strstr(rt_test_msg, "(100, 0)"),
+               "pick outside the image: %s", rt_test_msg);
+
     /* a sub-rectangle equals the crop of the full image */
     sy_rt_render_desc sub = d;
     sub.x = 37, sub.y = 21, sub.width = 41, sub.height = 33;
@@ -73,6 +102,7 @@ int main(void)
     /* uncommitted changes and NULL output are refused with a message */
     MUST(sy_rt_instance_set_visible(dev, near_q, true));
     EXPECT_MSG(sy_rt_coverage(dev, &cam, &d, ids, NULL) == SY_RT_ERROR_INVALID_OPERATION, "%s", sy_rt_device_error(dev));
+    EXPECT_MSG(sy_rt_pick(dev, &cam, W, H, 1, 1, &ph) == SY_RT_ERROR_INVALID_OPERATION, "%s", sy_rt_device_error(dev));
     MUST(sy_rt_commit(dev));
     EXPECT_MSG(sy_rt_coverage(dev, &cam, &d, NULL, NULL) == SY_RT_ERROR_INVALID_ARGUMENT, "%s", sy_rt_device_error(dev));
     sy_rt_device_destroy(dev);
