@@ -1,6 +1,7 @@
 /* sy_mediator_cluster.c — the cluster mediator class (see sy_mediator_cluster.h): a replica scene
  * fed by the context's change lists, a cluster client on it, and the translation of a render
- * request into a cluster frame. */
+ * request into a cluster frame. Picks (SY_CAP_PICK) are answered on the replica by a local context
+ * of the servers' back-end class, made on the first pick (see cluster_pick). */
 #include "sy_mediator_cluster.h"
 
 #include <stdio.h>
@@ -35,6 +36,7 @@ typedef struct cluster_state {
     sy_layer full; /* a request for a sub-rectangle renders the whole image here */
     uint32_t timeout_ms; /* adaptive deadline (the configuration gave none) */
     uint32_t servers;    /* the servers this viewport uses (servers=) */
+    sy_context *pick;    /* picks: a local context of the servers' back-end on the replica (first pick) */
 } cluster_state;
 
 /* Caps the servers' back-end `name` has, as registered in this process (same binary); unknown
@@ -85,7 +87,7 @@ static uint32_t cluster_caps_of(const sy_params *p, const void *class_user)
     const char *backend = sy_params_get(p, "backend"), *m = sy_params_get(p, "mode");
     uint32_t mode = SY_CLUSTER_SORT_FIRST;
     if (m && !sy_cluster_mode_parse(m, &mode)) mode = SY_CLUSTER_SORT_FIRST;
-    uint32_t common = SY_CAP_DEPTH | SY_CAP_ANALYSIS | SY_CAP_SAMPLE_RANGES;
+    uint32_t common = SY_CAP_DEPTH | SY_CAP_ANALYSIS | SY_CAP_SAMPLE_RANGES | SY_CAP_PICK;
     uint64_t mask = 0;
     if (parse_servers(cfg, sy_params_get(p, "servers"), &mask, NULL) != SY_OK) mask = 0;
     for (uint32_t i = 0; i < cfg->opts.url_count; ++i) {
@@ -95,6 +97,9 @@ static uint32_t cluster_caps_of(const sy_params *p, const void *class_user)
     }
     uint32_t caps = SY_CAP_REMOTE | SY_CAP_TILES | (common & (SY_CAP_DEPTH | SY_CAP_ANALYSIS));
     if (mode == SY_CLUSTER_COOPERATIVE && (common & SY_CAP_SAMPLE_RANGES)) caps |= SY_CAP_PROGRESSIVE;
+    /* picks: answered here by the viewport's back-end class (cluster_pick), so it must be registered
+     * in this process and pick, as must every server's */
+    if ((common & SY_CAP_PICK) && backend && (remote_caps(backend) & SY_CAP_PICK)) caps |= SY_CAP_PICK;
     return caps;
 }
 
@@ -157,6 +162,7 @@ static void cluster_destroy(void *state)
 {
     cluster_state *st = state;
     if (!st) return;
+    sy_context_release(st->pick); /* its consumer is on the replica */
     sy_cluster_client_destroy(st->client);
     sy_scene_destroy(st->replica);
     sy_layer_destroy(&st->full);
@@ -244,7 +250,31 @@ static sy_result cluster_sync(void *state, const sy_changes *changes, sy_error *
     cluster_state *st = state;
     sy_result r = sy_scene_apply(st->replica, changes, err);
     if (r == SY_OK) r = sy_scene_commit(st->replica, NULL, err);
+    /* the pick context follows every frame, so the replica's change log never waits for it */
+    if (r == SY_OK && st->pick) r = sy_context_sync(st->pick, err);
     return r;
+}
+
+/* SY_CAP_PICK: the servers render the same replica with the same back-end class, so what is under
+ * a pixel is what a local context of that class answers on the replica; it is made on the first
+ * pick (the class's translation of the scene, on this machine) and synced with every frame after.
+ * The servers are not asked (the protocol has no pick message). */
+static sy_result cluster_pick(void *state, const sy_camera_view *view, uint32_t width, uint32_t height, uint32_t x,
+                              uint32_t y, sy_pick_result *out, sy_error *err)
+{
+    cluster_state *st = state;
+    sy_result r = SY_OK;
+    if (!st->pick) {
+        sy_params bp;
+        r = sy_params_parse(st->params[0] ? st->params : NULL, &bp, err);
+        if (r == SY_OK) r = sy_context_create(st->replica, st->backend, &bp, st->root_id, &st->pick, err);
+        if (r != SY_OK) {
+            sy_error_prefix(err, "%s: pick", st->cfg->name);
+            return r;
+        }
+    }
+    r = sy_context_sync(st->pick, err);
+    return r == SY_OK ? sy_context_pick(st->pick, view, width, height, x, y, out, err) : r;
 }
 
 /* n samples in multiples of the live servers (0: the servers' default) */
@@ -379,6 +409,7 @@ sy_result sy_mediator_cluster_register(const char *name, const sy_cluster_client
                                  .render = cluster_render,
                                  .stats = cluster_stats,
                                  .caps_of = cluster_caps_of,
+                                 .pick = cluster_pick,
                                  .user = c,
                                  .param_table = cluster_table,
                                  .check_params = cluster_check_params};

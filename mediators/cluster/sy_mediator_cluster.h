@@ -31,6 +31,10 @@
  * servers' back-end as registered in this process (the same binary), filtered by the mode:
  * cooperative adds progressive accumulation and needs a back-end whose samples merge
  * (SY_CAP_SAMPLE_RANGES); set-up refuses what a node cannot do, naming the node and the reason.
+ * Picks (SY_CAP_PICK, when every used server's back-end picks and the viewport's back-end is
+ * registered here) are answered on the replica by a local context of the viewport's back-end
+ * class, made on the first pick and synced with every frame after: the servers are not asked
+ * (docs/CLUSTER.md, "Picking").
  *
  * Deadlines: the configuration's timeout_ms for every request, or, when it is 0, an adaptive one:
  * 60 s for the first frame (snapshot, first translation), then 1 s + 4x the last frame's time,

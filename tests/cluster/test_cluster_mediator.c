@@ -14,6 +14,10 @@
  *      path tracing is progressive, sort-first whitted is not; both are remote).
  *   5. Set-up refusals name the node and the reason: cooperative whitted, mode=stereo, no
  *      backend=, an unknown mode.
+ *   6. Picks (SY_CAP_PICK, answered on the replica by the servers' back-end class): a cluster
+ *      viewport names the same node, primitive and triangle, at the same position, as a local
+ *      whitted viewport at every pixel of a grid, and misses where it misses; a change after the
+ *      first pick (a node moved) is seen by the next.
  *   test_cluster_mediator SERVER_EXE WORK_DIR */
 #include "../support/sy_check.h"
 #include "server_proc.h"
@@ -241,6 +245,67 @@ static int test_tiles_and_caps(fixture *fx)
     return 0;
 }
 
+static int pick_grid(sy_window *cw, sy_window *lw, fixture *fx, sy_context_pool *pool, uint32_t *hits)
+{
+    sy_error e = {0};
+    *hits = 0;
+    for (uint32_t y = 2; y < H; y += 6)
+        for (uint32_t x = 3; x < W; x += 7) {
+            sy_pick_result a, b;
+            CHECK_OK(sy_window_pick(cw, fx->scene, pool, x, y, &a, &e), e);
+            CHECK_OK(sy_window_pick(lw, fx->scene, pool, x, y, &b, &e), e);
+            CHECK_MSG(a.hit == b.hit && a.node_id == b.node_id && a.primitive == b.primitive && a.triangle == b.triangle &&
+                          memcmp(a.position, b.position, sizeof a.position) == 0,
+                      "pixel %u,%u: cluster hit %d node %#x triangle %u, local hit %d node %#x triangle %u", x, y, a.hit,
+                      a.node_id, a.triangle, b.hit, b.node_id, b.triangle);
+            *hits += a.hit;
+        }
+    return 0;
+}
+
+static int test_pick(fixture *fx)
+{
+    sy_error e = {0};
+    sy_window *cw = NULL, *lw = NULL;
+    sy_context_pool *pool = NULL;
+    /* every root: the demo and the overlay sphere */
+    sy_viewport_desc cd = {.camera = fx->d.camera, .backend = "cluster", .params = "backend=whitted"};
+    sy_viewport_desc ld = {.camera = fx->d.camera, .backend = "whitted"};
+    CHECK_OK(sy_context_pool_create(&pool, &e), e);
+    CHECK_OK(sy_window_create(W, H, &cw, &e), e);
+    CHECK_OK(sy_window_create(W, H, &lw, &e), e);
+    CHECK_OK(sy_window_add_viewport(cw, &cd, NULL, &e), e);
+    CHECK_OK(sy_window_add_viewport(lw, &ld, NULL, &e), e);
+    sy_params pp;
+    CHECK_OK(sy_params_parse("backend=whitted", &pp, &e), e);
+    CHECK(sy_mediator_class_caps(sy_mediator_find("cluster"), &pp) & SY_CAP_PICK);
+    sy_layer img = {0};
+    CHECK_OK(sy_layer_create(W, H, &img, &e), e);
+    CHECK_OK(sy_window_render(cw, fx->scene, pool, NULL, &img, &e), e); /* a frame first, as a viewer does */
+    uint32_t hits = 0;
+    CHECK(pick_grid(cw, lw, fx, pool, &hits) == 0);
+    CHECK_MSG(hits > 20, "only %u grid pixels hit", hits);
+    /* a change after the first pick: the overlay sphere moves into the middle of the view (the
+     * last part of the test: the scene stays so) */
+    sy_bounds b;
+    CHECK_OK(sy_node_world_bounds(fx->scene, fx->d.root, &b, &e), e);
+    const float t[3] = {(b.min[0] + b.max[0]) / 2, (b.min[1] + b.max[1]) / 2, (b.min[2] + b.max[2]) / 2}, q[4] = {0, 0, 0, 1},
+                one[3] = {1, 1, 1};
+    CHECK_OK(sy_node_set_trs(fx->scene, fx->overlay, t, q, one, &e), e);
+    CHECK_OK(sy_scene_commit(fx->scene, NULL, &e), e);
+    CHECK_OK(sy_window_render(cw, fx->scene, pool, NULL, &img, &e), e);
+    CHECK(pick_grid(cw, lw, fx, pool, &hits) == 0);
+    sy_pick_result a;
+    CHECK_OK(sy_window_pick(cw, fx->scene, pool, W / 2, H / 2, &a, &e), e);
+    CHECK_MSG(a.hit && a.node_id == fx->overlay.id, "the moved sphere is not picked at the centre (node %#x)", a.node_id);
+    printf("picks: the cluster viewport names what a local whitted viewport names (%u grid pixels hit)\n", hits);
+    sy_layer_destroy(&img);
+    sy_window_destroy(cw);
+    sy_window_destroy(lw);
+    sy_context_pool_destroy(pool);
+    return 0;
+}
+
 static int refused(fixture *fx, const char *params, const char *needle)
 {
     sy_error e = {0};
@@ -311,6 +376,8 @@ int main(int argc, char **argv)
             printf("tiles and capabilities: %s\n", r ? "FAILED" : "ok");
             failed += r = test_refusals(&fx, s);
             printf("set-up refusals: %s\n", r ? "FAILED" : "ok");
+            failed += r = test_pick(&fx); /* last: it moves the overlay sphere */
+            printf("picks: %s\n", r ? "FAILED" : "ok");
         }
     }
     for (int i = 0; i < 2; ++i) stop_server(&s[i]);
