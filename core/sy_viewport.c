@@ -298,12 +298,10 @@ sy_result sy_window_render(sy_window *w, sy_scene *scene, sy_context_pool *pool,
 /* >>picking: the ray through the pixel's centre, asked of the viewport's back-end (SY_CAP_PICK) */
 
 /* The viewport's pixel under window point (x, y); false when (x, y) is outside its rectangle. */
-static bool viewport_pixel(const sy_viewport *v, const uint32_t rect[4], double x, double y, uint32_t *px,
-                           uint32_t *py)
+static bool viewport_pixel(const uint32_t rect[4], double x, double y, uint32_t *px, uint32_t *py)
 {
     double fx = floor(x) - (double)rect[0], fy = floor(y) - (double)rect[1];
     if (!(fx >= 0.0 && fy >= 0.0 && fx < (double)rect[2] && fy < (double)rect[3])) return false;
-    (void)v;
     *px = (uint32_t)fx;
     *py = (uint32_t)fy;
     return true;
@@ -341,7 +339,7 @@ sy_result sy_viewport_pick(sy_viewport *v, sy_scene *scene, sy_context_pool *poo
     if (r != SY_OK) return r;
     uint32_t rect[4], px, py;
     viewport_rect(v, v->window->width, v->window->height, rect);
-    if (!viewport_pixel(v, rect, x, y, &px, &py))
+    if (!viewport_pixel(rect, x, y, &px, &py))
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
                             "pick: window pixel (%g, %g) is outside the viewport's rectangle %ux%u at (%u, %u)", x, y,
                             rect[2], rect[3], rect[0], rect[1]);
@@ -365,7 +363,7 @@ sy_result sy_window_pick(sy_window *w, sy_scene *scene, sy_context_pool *pool, d
         sy_viewport *v = w->viewports[i];
         uint32_t rect[4], px, py;
         viewport_rect(v, w->width, w->height, rect);
-        if (!v->active || !viewport_pixel(v, rect, x, y, &px, &py)) continue;
+        if (!v->active || !viewport_pixel(rect, x, y, &px, &py)) continue;
         sy_pick_result here;
         memset(&here, 0, sizeof here);
         here.viewport = i;
