@@ -1,8 +1,8 @@
 /* test_raster_sync.c — the raster mediator through core: incremental sync from change lists
  * (a transform-only change uploads no vertex data, a material change is one uniform-buffer update,
  * a new mesh one upload of its buffers), exact emission of the Cornell light (17 12 4) in the float
- * layer, the Cornell walls and floor lit by that light within 20 % of the path tracer, and
- * parameter errors. */
+ * layer, the Cornell walls and floor lit by that light within 20 % of the path tracer and still
+ * lit after the light moves (a transform update keeps its area light), and parameter errors. */
 #include "it_util.h"
 #include "sy_gltf.h"
 #include "sy_mediator_raster.h"
@@ -177,6 +177,24 @@ static void cornell(void)
     const float *mid = it_px(&img, W / 2, H / 2);
     float dmid = img.depth[(H / 2) * W + W / 2];
     EXPECT_MSG(mid[3] == 1.0f && isfinite(dmid) && dmid > 0.0f, "centre alpha %g depth %g", mid[3], dmid);
+    /* the light moved a hair (a transform-only change): the room stays lit. The mediator's instance
+     * table used to drop an instance's mesh and material on a transform update, so a moved
+     * emitter lost its area light and the walls went dark */
+    double before = 0.0, after = 0.0;
+    for (uint32_t i = 0; i < W * H; ++i) before += img.rgba[4 * i + 1];
+    sy_node light = {0};
+    for (uint32_t id = sy_scene_next(scene, SY_TYPE_NODE, 0); id; id = sy_scene_next(scene, SY_TYPE_NODE, id)) {
+        const sy_node_data *nd = sy_node_get(scene, (sy_node){id});
+        if (nd && nd->name && !strcmp(nd->name, "light")) light.id = id;
+    }
+    EXPECT(light.id != 0);
+    it_set_translation(scene, light, 1e-4f, 0.0f, 0.0f);
+    MUST(sy_scene_commit(scene, NULL, err));
+    MUST(sy_window_render(win, scene, pool, NULL, &img, err));
+    for (uint32_t i = 0; i < W * H; ++i) after += img.rgba[4 * i + 1];
+    printf("cornell: green channel sum %.2f before, %.2f after the light moved 0.1 mm\n", before, after);
+    EXPECT_MSG(fabs(after - before) < 0.02 * before, "the light moved 0.1 mm: the image's green sum went %.2f -> %.2f",
+               before, after);
     sy_layer_destroy(&img);
     sy_window_destroy(win);
     sy_context_pool_destroy(pool);
