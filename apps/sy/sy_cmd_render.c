@@ -548,7 +548,7 @@ int sy_cmd_render(int argc, char **argv)
     /* the image's metadata (EXR header attributes, PNG text chunks): what made it and how */
     sy_exr_attribute attrs[14];
     sy_png_text texts[14];
-    char renderer[64], size_str[48], camera_str[256];
+    char renderer[64], size_str[48], camera_str[256], matrix_str[16 * 18] = "", proj_str[64] = "";
     if (r == SY_OK) {
         if (!progressive) { /* what the main back-end accumulated (a single pass: 1) */
             sy_params mp;
@@ -574,7 +574,6 @@ int sy_cmd_render(int argc, char **argv)
         else snprintf(camera_str, sizeof camera_str, "a view framing the scene's bounds");
         /* the exact view, for a renderer that is to see the same (tests/cycles/materials.sh): the
          * camera-to-world matrix (column-major, as glTF) and the projection's vertical extent */
-        char matrix_str[16 * 18] = "", proj_str[64] = "";
         const sy_node_data *cnd = has_cam ? sy_node_get(ld.scene, ld.camera) : NULL;
         const sy_camera_data *ccd = cnd ? sy_camera_get(ld.scene, cnd->camera) : NULL;
         if (ccd) {
