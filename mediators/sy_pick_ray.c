@@ -82,3 +82,13 @@ bool sy_pick_triangle(const sy_camera_view *view, uint32_t width, uint32_t heigh
     out->depth = (float)depth;
     return true;
 }
+
+void sy_pick_name(sy_pick_result *out, const sy_mirror_instance_info *info, uint32_t triangle)
+{
+    out->node_id = info->node;
+    out->placement = info->placement;
+    out->mesh_id = info->mesh;
+    out->primitive = info->primitive;
+    out->triangle = triangle;
+    out->material_id = info->material;
+}

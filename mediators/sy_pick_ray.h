@@ -10,6 +10,7 @@
 #define SY_PICK_RAY_H
 
 #include "sy_mediator.h"
+#include "sy_mirror.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -30,6 +31,10 @@ void sy_pick_ray(const sy_camera_view *view, uint32_t width, uint32_t height, ui
  * triangle's plane, the triangle is degenerate, or the plane lies behind the origin. */
 bool sy_pick_triangle(const sy_camera_view *view, uint32_t width, uint32_t height, uint32_t x, uint32_t y,
                       const float world[16], const float p[3][3], sy_pick_result *out);
+
+/** Names what the pick hit in out: node, placement, mesh, primitive and material from the mirror's
+ * description of the instance (sy_mirror_instance_find), and the triangle's index. */
+void sy_pick_name(sy_pick_result *out, const sy_mirror_instance_info *info, uint32_t triangle);
 
 #ifdef __cplusplus
 }

@@ -123,17 +123,7 @@ int sy_cmd_pick(int argc, char **argv)
         free(xy);
         return sy_cli_fail(&err);
     }
-    /* the size sy render would use: 512 high, the width from the camera's aspect ratio */
-    float aspect = 1.0f;
-    const sy_node_data *cn = ld.camera.id ? sy_node_get(ld.scene, ld.camera) : NULL;
-    const sy_camera_data *cd = cn ? sy_camera_get(ld.scene, cn->camera) : NULL;
-    if (cd && cd->aspect > 0) aspect = cd->aspect;
-    if (ld.camera.id == 0 && !ld.is_gltf) aspect = 1.0f;
-    if (!w && !h) h = 512, w = (uint32_t)lroundf(512 * aspect);
-    else if (!w) w = (uint32_t)lroundf((float)h * aspect);
-    else if (!h) h = (uint32_t)lroundf((float)w / aspect);
-    if (!w) w = 1;
-    if (!h) h = 1;
+    sy_cli_default_size(&ld, &w, &h); /* the size sy render would use */
     for (int i = 0; i < pairs; ++i)
         if (!(xy[2 * i] >= 0.0 && xy[2 * i] < w && xy[2 * i + 1] >= 0.0 && xy[2 * i + 1] < h)) {
             sy_log(SY_LOG_ERROR, "sy", NULL, "sy pick: pixel (%g, %g) is outside the %ux%u image", xy[2 * i],

@@ -498,17 +498,7 @@ int sy_cmd_render(int argc, char **argv)
             return st == 2 ? 2 : sy_cli_fail(&err);
         }
     }
-    /* default size: 512 high, width from the camera's aspect ratio when it has one */
-    float aspect = 1.0f;
-    const sy_node_data *cn = ld.camera.id ? sy_node_get(ld.scene, ld.camera) : NULL;
-    const sy_camera_data *cd = cn ? sy_camera_get(ld.scene, cn->camera) : NULL;
-    if (cd && cd->aspect > 0) aspect = cd->aspect;
-    if (ld.camera.id == 0 && !ld.is_gltf) aspect = 1.0f;
-    if (!w && !h) h = 512, w = (uint32_t)lroundf(512 * aspect);
-    else if (!w) w = (uint32_t)lroundf((float)h * aspect);
-    else if (!h) h = (uint32_t)lroundf((float)w / aspect);
-    if (!w) w = 1;
-    if (!h) h = 1;
+    sy_cli_default_size(&ld, &w, &h);
     if (ld.is_x3d) sy_cli_fit_x3d_cameras(&ld, w, h); /* X3D fieldOfView is the smaller side's angle */
     sy_context_pool *pool = NULL;
     sy_layer img = {0}, img_right = {0};

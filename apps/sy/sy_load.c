@@ -200,6 +200,20 @@ int sy_cli_set_time(loaded *ld, const char *clip, double seconds, sy_error *err)
 }
 
 /* X3D Viewpoint fieldOfView covers the smaller image side: adapt yfov to the output size. */
+void sy_cli_default_size(const loaded *ld, uint32_t *w, uint32_t *h)
+{
+    float aspect = 1.0f;
+    const sy_node_data *cn = ld->camera.id ? sy_node_get(ld->scene, ld->camera) : NULL;
+    const sy_camera_data *cd = cn ? sy_camera_get(ld->scene, cn->camera) : NULL;
+    if (cd && cd->aspect > 0) aspect = cd->aspect;
+    if (ld->camera.id == 0 && !ld->is_gltf) aspect = 1.0f;
+    if (!*w && !*h) *h = 512, *w = (uint32_t)lroundf(512 * aspect);
+    else if (!*w) *w = (uint32_t)lroundf((float)*h * aspect);
+    else if (!*h) *h = (uint32_t)lroundf((float)*w / aspect);
+    if (!*w) *w = 1;
+    if (!*h) *h = 1;
+}
+
 void sy_cli_fit_x3d_cameras(loaded *ld, uint32_t w, uint32_t h)
 {
     sy_error e = {0};

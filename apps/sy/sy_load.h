@@ -50,6 +50,10 @@ void sy_cli_loaded_free(loaded *l);
  * with the clips there are, on stderr); 1 with *err when the scene refused a value. A scene without
  * animations is told on the log (a note) and left as it is. */
 int sy_cli_set_time(loaded *ld, const char *clip, double seconds, sy_error *err);
+/* The image size sy render and sy pick use for *w x *h where the user gave 0: 512 high, the width
+ * from the loaded camera's aspect ratio when it has one (either given: the other from the aspect);
+ * never 0. */
+void sy_cli_default_size(const loaded *ld, uint32_t *w, uint32_t *h);
 /* X3D Viewpoint fieldOfView covers the smaller image side: adapt yfov to the output size. */
 void sy_cli_fit_x3d_cameras(loaded *ld, uint32_t w, uint32_t h);
 /* --overlay FILE[:BACKEND]: loads FILE into the same scene under its own root and layers it over

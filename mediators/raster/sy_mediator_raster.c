@@ -670,12 +670,7 @@ static sy_result raster_pick(void *state, const sy_camera_view *view, uint32_t w
         if (v >= em->vertex_count) return SY_OK; /* the scene validated the indices; never here */
         memcpy(p[k], pos + 3u * v, sizeof p[k]);
     }
-    out->node_id = info.node;
-    out->placement = info.placement;
-    out->mesh_id = info.mesh;
-    out->primitive = info.primitive;
-    out->triangle = h.triangle;
-    out->material_id = info.material;
+    sy_pick_name(out, &info, h.triangle);
     sy_pick_triangle(view, width, height, x, y, in->world, (const float(*)[3])p, out);
     return SY_OK;
 }

@@ -121,12 +121,7 @@ sy_result sy_rti_pick(void *state, const sy_camera_view *view, uint32_t width, u
     sy_mirror_instance_info info;
     if (!h.instance.id || !sy_mirror_instance_find(st->mirror, sy_rti_inst_node_get(st, h.instance.id), h.instance.id, &info))
         return SY_OK;
-    out->node_id = info.node;
-    out->placement = info.placement;
-    out->mesh_id = info.mesh;
-    out->primitive = info.primitive;
-    out->triangle = h.triangle;
-    out->material_id = info.material;
+    sy_pick_name(out, &info, h.triangle);
     if (!sy_pick_triangle(view, width, height, x, y, h.transform, (const float(*)[3])h.vertices, out)) {
         /* a ray along the triangle's plane: Embree's own numbers */
         float b[3] = {1.0f - h.u - h.v, h.u, h.v};
