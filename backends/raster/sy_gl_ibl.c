@@ -2,7 +2,7 @@
  * BRDF table and the LTC tables (see sy_gl_ibl.h). */
 #include "sy_gl_ibl.h"
 
-#include "sy_gl_ltc.h"
+#include "sy_ltc.h"
 #include "sy_gl_shaders.h"
 
 #include <stdio.h>
@@ -127,16 +127,16 @@ static sy_gl_result fb_check(const sy_gl_fns *gl, const char *what, sy_gl_report
 sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, sy_gl_report *rep)
 {
     if (ibl->brdf_lut) return SY_GL_OK;
-    float *ltc = malloc(2 * SY_GL_LTC_FLOATS * sizeof *ltc);
+    float *ltc = malloc(2 * SY_LTC_FLOATS * sizeof *ltc);
     if (!ltc) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "LTC tables: out of memory");
     sy_gl_result r = build(gl, ibl, rep);
     if (r != SY_GL_OK) {
         free(ltc);
         return r;
     }
-    sy_gl_ltc_tables(ltc, ltc + SY_GL_LTC_FLOATS);
-    ibl->ltc1 = table_tex(gl, GL_RGBA32F, SY_GL_LTC_SIZE, GL_RGBA, ltc);
-    ibl->ltc2 = table_tex(gl, GL_RGBA32F, SY_GL_LTC_SIZE, GL_RGBA, ltc + SY_GL_LTC_FLOATS);
+    sy_ltc_tables(ltc, ltc + SY_LTC_FLOATS);
+    ibl->ltc1 = table_tex(gl, GL_RGBA32F, SY_LTC_SIZE, GL_RGBA, ltc);
+    ibl->ltc2 = table_tex(gl, GL_RGBA32F, SY_LTC_SIZE, GL_RGBA, ltc + SY_LTC_FLOATS);
     free(ltc);
     GLuint lut = table_tex(gl, GL_RGBA32F, SY_GL_IBL_BRDF_SIZE, GL_RGBA, NULL);
     gl->BindFramebuffer(GL_FRAMEBUFFER, ibl->fbo);

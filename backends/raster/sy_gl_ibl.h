@@ -10,7 +10,7 @@
  *    E(n) / pi, so that Lambert is base x texel;
  * and once per device the split-sum BRDF table (32 x 32, x = n.v, y = roughness; RG = A, B of the
  * height-correlated Smith GGX with Schlick: specular = F0 A + B; B = the sheen lobe's directional
- * albedo, y = sheen roughness) and the LTC tables (sy_gl_ltc.h).
+ * albedo, y = sheen roughness) and the LTC tables (backends/ltc/sy_ltc.h).
  *
  * Ownership: the GL objects belong to the sy_gl_ibl struct (sy_gl_ibl_free). Thread-safety: the
  * caller's GL context must be current. */
