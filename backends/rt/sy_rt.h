@@ -415,9 +415,10 @@ sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg)
  * ray but camera rays when it leaves the scene. Direction d (unit, world) maps to
  * u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, so the image centre is seen looking
  * down -Z and row 0 is straight up (+Y). The PATHTRACER importance-samples it (piecewise-constant
- * distribution over the texels, luminance x sin(theta)) with MIS; WHITTED importance-samples the
- * same distribution with shadow rays (desc.env_light_samples) and shows it in mirror reflections
- * and refractions. A uniform environment is a 1x1 texture. A zero texture handle removes the
+ * distribution over the texels, luminance x sin(theta)) with MIS; WHITTED lights with it in closed
+ * form (an irradiance map and GGX maps prefiltered per roughness, built on its first render after
+ * the commit) times a visibility ratio from shadow rays toward the same distribution and the BSDF
+ * (desc.env_light_samples), and shows it in mirror reflections and refractions. A uniform environment is a 1x1 texture. A zero texture handle removes the
  * environment (escaping rays see black). The texture must stay alive while it is set (a destroyed
  * texture renders as no environment). intensity must be finite and >= 0. Takes effect at the next
  * commit. */
@@ -478,16 +479,21 @@ typedef struct sy_rt_render_desc {
     uint32_t max_depth;                 /**< WHITTED: recursion depth for reflection/refraction;
                                          * PATHTRACER: most bounces (scattering events) per path;
                                          * 0 = 8 */
-    uint32_t area_light_samples;        /**< WHITTED: area-light (emissive triangle) samples per pixel,
-                                         * shared among its pixel samples (each shading point takes
-                                         * ceil(n / pixel_samples)); 0 = 16 */
+    uint32_t area_light_samples;        /**< WHITTED: area-light (emissive triangle) shadow samples per
+                                         * pixel, shared among its pixel samples (each shading point
+                                         * takes ceil(n / pixel_samples)); they sample only the
+                                         * visibility of the closed-form light (up to 64 untextured
+                                         * emissive triangles); 0 = 16 */
     uint32_t seed;                      /**< decorrelates sample patterns; same seed = same image */
     /** WHITTED only: */
     uint32_t pixel_samples;             /**< anti-aliasing: camera rays per pixel through stratified
                                          * jittered points (Owen-scrambled Sobol per pixel), box filter
-                                         * over the pixel; 0 or 1 = one ray through the pixel centre */
-    uint32_t env_light_samples;         /**< environment-light samples (importance-sampled, with shadow
-                                         * rays) per shading point of each pixel sample; 0 = 4 */
+                                         * over the pixel, twice as many where they disagree (up to
+                                         * 64); 0 or 1 = one ray through the pixel centre */
+    uint32_t env_light_samples;         /**< environment-light shadow samples (an environment and a
+                                         * BSDF direction each) per shading point of each pixel
+                                         * sample, for the visibility of the closed-form light;
+                                         * 0 = 4 */
     sy_rt_progress_fn progress;         /**< optional */
     void *progress_user_data; /**< passed to progress */
     /** PATHTRACER only: */

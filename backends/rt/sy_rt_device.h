@@ -161,6 +161,9 @@ struct sy_rt_device {
     float env_intensity_staged, env_intensity;
     bool env_dirty;
     struct sy_rt_env_dist *env_dist;
+    /* Whitted's prefiltered environment (sy_rt_envfilter.h): built on its first render, freed with
+     * env_dist */
+    struct sy_rt_envfilter *env_filter;
 
     sy_rt_material_data default_material;
     float srgb_lut[256]; /* sRGB 8-bit -> linear */

@@ -1,6 +1,7 @@
 /* sy_rt_lights.c — alias table over emissive triangles, environment distribution and sampling,
  * sy_rt_set_environment, the background seen by camera rays (see sy_rt_lights.h). */
 #include "sy_rt_lights.h"
+#include "sy_rt_envfilter.h"
 #include "sy_rt_texture.h"
 
 #include <stdlib.h>
@@ -98,6 +99,8 @@ void sy_rt_env_free(sy_rt_device *dev)
         free(dev->env_dist);
     }
     dev->env_dist = NULL;
+    sy_rt_envfilter_free(dev->env_filter);
+    dev->env_filter = NULL;
 }
 
 sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev)
@@ -188,6 +191,7 @@ void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env)
         env->tex = t;
         env->intensity = dev->env_intensity;
         env->dist = dev->env_dist;
+        env->filter = dev->env_filter;
     }
 }
 

@@ -34,6 +34,7 @@ typedef struct sy_rt_env {
     const struct sy_rt_texture_data *tex; /* mode 2 */
     float intensity;
     const sy_rt_env_dist *dist;     /* mode 2 */
+    const struct sy_rt_envfilter *filter; /* mode 2: Whitted's prefiltered maps, once built (else NULL) */
 } sy_rt_env;
 
 /* Resolves the committed environment of dev (texture lookups happen once per frame). */

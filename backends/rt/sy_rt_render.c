@@ -1,6 +1,7 @@
 /* sy_rt_render.c — sy_rt_render (sy_rt.h): the top of the back-end's render path. Validates the
  * request, sets up the frame (sy_rt_frame.c) and hands it to the integrator it names (path tracer,
  * Whitted, primary rays); the integrators build on the frame module and never call back here. */
+#include "sy_rt_envfilter.h"
 #include "sy_rt_frame.h"
 #include "sy_rt_pathtracer.h"
 #include "sy_rt_primary.h"
@@ -24,6 +25,10 @@ sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera, const s
     if (desc->integrator == SY_RT_INTEGRATOR_PATHTRACER) return sy_rt_pathtracer_render(&f, desc);
     if (desc->integrator == SY_RT_INTEGRATOR_COVERAGE)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: the coverage integrator writes ids: use sy_rt_coverage");
-    if (desc->integrator == SY_RT_INTEGRATOR_WHITTED) return sy_rt_whitted_render(&f, desc);
+    if (desc->integrator == SY_RT_INTEGRATOR_WHITTED) {
+        /* its prefiltered environment, once per committed environment */
+        if ((r = sy_rt_envfilter_ensure(dev)) != SY_RT_OK) return r;
+        return sy_rt_whitted_render(&f, desc);
+    }
     return sy_rt_run_tiles(&f, sy_rt_primary_tile, NULL, desc->progress, desc->progress_user_data);
 }

@@ -1,41 +1,78 @@
-/* sy_rt_whitted.c — the Whitted integrator.
+/* sy_rt_whitted.c — the Whitted integrator, the deterministic preview.
  *
  * Per pixel: pixel_samples camera rays (1 = the pixel centre; more = stratified jittered points,
  * the first points of an Owen-scrambled Sobol sequence per pixel, averaged: a box filter over the
- * pixel). Per hit, shading model (glTF metallic-roughness, Whitted-style):
+ * pixel); where the standard error of those samples' (compressed) luminance exceeds REFINE_STDERR,
+ * REFINE_FACTOR x as many (at most REFINE_MAX_SPP; edges, mirror reflections, penumbrae). Per hit,
+ * shading model (glTF metallic-roughness, Whitted-style):
  *   - emission (front side, or both sides when double-sided) is ADDED to the reflected light;
  *   - unlit materials show their base colour (plus emission);
- *   - direct light from punctual lights, emissive triangles and the environment with the path
- *     tracer's BSDF (sy_rt_bsdf.h: GGX metal, GGX specular over Lambert scaled by 1 - F, the
- *     finite-density lobes), the environment with the path tracer's MIS of an environment sample
- *     and a BSDF sample, so Whitted's direct light is the path tracer's direct light;
+ *   - direct light from punctual lights with the path tracer's BSDF (sy_rt_bsdf.h) and a hard
+ *     shadow ray;
+ *   - direct light from emissive triangles and the environment by the ratio estimator: the
+ *     unshadowed light in closed form ("analytic", below) times (shadowed / unshadowed) sums of the
+ *     same stochastic samples, each weighted by the path tracer's BSDF. Unshadowed, the result is
+ *     the closed form exactly, whatever the sample count (no grain); only the visibility is
+ *     sampled. The sums of a pixel's camera samples whose first hits lie on the same instance with
+ *     similar normals are pooled (one ratio per pixel and surface: a pixel's shadow estimate uses
+ *     spp x n samples); secondary hits take their own ratio;
  *   - roughness below SY_RT_BSDF_DELTA_ROUGHNESS (the path tracer's delta lobes): recursive
  *     perfect reflection, metal part tinted by the base colour, dielectric part weighted by
  *     Schlick Fresnel * specular;
  *   - transmission: exact dielectric Fresnel between reflection and refraction (tinted by base
  *     colour), total internal reflection;
  *   - alpha blend: the surface is composited over what the continued ray sees.
- * Shadow rays pass alpha-masked holes, alpha-blended and transmissive surfaces with their
- * transmittance (sy_rt_shadow.h). Camera rays that hit nothing see the background; every other
- * escaping ray sees the environment light (black without one).
- * Light samples: area lights take n = ceil(area_light_samples / pixel_samples) samples per shading
- * point (light chosen by power through the area-light CDF, uniform point on the triangle), the
- * environment env_light_samples (each an environment and a BSDF sample, MIS); the
- * numbers come from the pixel's Owen-scrambled Sobol sequence (sy_rt_sampler.h), sample k of pixel
- * sample j being point j*n + k of a set chosen by the recursion depth, so the samples of one pixel
- * are stratified together and every pixel has its own scramble: no pattern shared between pixels
- * (no banding), no change between frames (deterministic). */
+ * Analytic: the BSDF as Lambert (plus the sheen as diffuse light of its directional albedo) and
+ * GGX lobes (base, clear coat) whose albedos and linearly transformed cosines come from the LTC
+ * tables (backends/ltc/sy_ltc.h, Heitz et al. 2016, the tables the rasterizer uses). Emitters:
+ * each emissive triangle, two coplanar ones sharing an edge merged into a quad, integrated over the
+ * polygon (clipless form, exact when wholly above the horizon) when there are at most
+ * ANALYTIC_MAX_TRIANGLES and none is textured (else the triangles are sampled by power as
+ * before); the light of a pixel's first hit is reused by its other camera samples on the same
+ * surface. Environment: split sum, diffuse from the irradiance map, glossy lobes from the GGX
+ * maps prefiltered per roughness at the lobe's dominant direction (sy_rt_envfilter.h). Materials
+ * the model does not describe (iridescence, anisotropy) keep the sampled estimates (area lights by
+ * power, the environment by MIS of an environment and a BSDF sample).
+ * Samples: area lights n = ceil(area_light_samples / pixel_samples) per shading point, each a
+ * polygon chosen in proportion to its closed-form light and a direction uniform in the solid angle
+ * of one of its triangles (Arvo 1995), so the samples' weights vary little and the ratio of few
+ * samples is nearly the visibility the BSDF sees; a point none of whose samples reached an emitter
+ * (under the horizon) draws up to RETRIES more. The environment env_light_samples per shading
+ * point, each an environment and a BSDF sample (MIS). The numbers come from the pixel's
+ * Owen-scrambled Sobol sequence (sy_rt_sampler.h), sample k of pixel sample j being point j*n + k
+ * of a set chosen by the recursion depth, so the samples of one pixel are stratified together and
+ * every pixel has its own scramble: no pattern shared between pixels (no banding), no change
+ * between frames (deterministic). Shadow rays pass alpha-masked holes, alpha-blended and
+ * transmissive surfaces with their transmittance (sy_rt_shadow.h). Camera rays that hit nothing
+ * see the background; every other escaping ray sees the environment light (black without one). */
 #include "sy_rt_whitted.h"
+#include "sy_ltc.h"
 #include "sy_rt_bsdf.h"
+#include "sy_rt_envfilter.h"
+#include "sy_rt_sheen.h"
 #include "sy_rt_iridescence.h"
 #include "sy_rt_lights.h"
 #include "sy_rt_sampler.h"
 #include "sy_rt_shadow.h"
 #include "sy_rt_surface.h"
 
+#include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 
 #define INV_PI 0.31830988618f
+
+/* Emissive triangles up to this many are integrated analytically (each costs every shading point
+ * three polygon integrals); with more, or with a textured emitter, area lights are sampled. */
+#define ANALYTIC_MAX_TRIANGLES 64u
+#define RETRIES 8u
+/* Adaptive refinement: a pixel whose first spp samples (each with its own visibility ratio) have
+ * a standard error above REFINE_STDERR in y / (1 + y) takes REFINE_FACTOR x spp samples (at most
+ * REFINE_MAX_SPP; the Sobol points continue, still stratified): edges, mirror reflections and
+ * penumbrae get them, smooth regions keep spp. */
+#define REFINE_STDERR 0.01
+#define REFINE_FACTOR 2u
+#define REFINE_MAX_SPP 64u
 
 /* Sobol sets of a pixel: 0 = sub-pixel positions; per recursion depth d, area-light samples,
  * environment samples and BSDF samples for the environment. */
@@ -46,10 +83,27 @@
 typedef struct whitted_job {
     const sy_rt_sobol *sobol; /* the device's */
     sy_rt_env env;
+    bool area_analytic; /* emissive triangles integrated analytically (LTC) */
+    struct apoly *poly; /* area_analytic: the emitters as planar polygons */
+    uint32_t n_poly;
     uint32_t spp;    /* camera rays per pixel */
+    uint32_t spp_max; /* up to this many where the first spp disagree (adaptive refinement) */
     uint32_t n_area; /* area-light samples per shading point */
     uint32_t n_env;  /* environment samples per shading point (0 without an environment) */
 } whitted_job;
+
+/* One camera sample's analytic direct light at its first hit, kept apart so that the pixel's
+ * visibility ratio pools all its samples (see the comment at the top): per kind (0 area, 1
+ * environment) the analytic light and the shadowed / unshadowed sums of its samples. */
+typedef struct psample {
+    bool used;
+    const void *inst; /* the hit's instance and shading normal: samples pool with their like */
+    sy_rt_v3 n;
+    float w;          /* what the surface's light is scaled by (alpha blending) */
+    sy_rt_v3 a[2], num[2], den[2];
+    uint32_t group;   /* the first sample it pools with */
+    sy_rt_v3 gnum[2], gden[2]; /* a group's first sample: the group's sums */
+} psample;
 
 typedef struct trace_ctx {
     const sy_rt_frame *f;
@@ -58,6 +112,17 @@ typedef struct trace_ctx {
     sy_rt_ictx ictx;
     uint32_t pseed;  /* per-pixel scramble seed */
     uint32_t sample; /* pixel sample index */
+    sy_rt_v3 eye;    /* the camera ray's origin */
+    psample *cur;    /* this camera sample's record (its depth-0 hit fills it) */
+    /* The analytic area light of the pixel's first camera hit, reused by its other camera hits on
+     * the same instance with the same normal within a hundredth of the eye distance (the
+     * unshadowed light varies far less over a pixel than its shadows) */
+    struct {
+        bool valid;
+        const void *inst;
+        sy_rt_v3 p, n, a;
+        float cdf[ANALYTIC_MAX_TRIANGLES + 1u];
+    } cache;
 } trace_ctx;
 
 typedef struct rgba_t { sy_rt_v3 rgb; float a; } rgba_t;
@@ -88,6 +153,301 @@ static sy_rt_v3 schlick(sy_rt_v3 f0, float cos_t)
 static void light_u(const trace_ctx *c, uint32_t set, uint32_t n, uint32_t k, float u[4])
 {
     sy_rt_sobol_sample4(c->job->sobol, c->pseed, set, c->sample * n + k, u);
+}
+
+/* >>analytic: the unshadowed direct light in closed form (see the comment at the top). */
+
+static float g_ltc1[SY_LTC_FLOATS], g_ltc2[SY_LTC_FLOATS];
+static pthread_once_t g_ltc_once = PTHREAD_ONCE_INIT;
+static void ltc_load(void) { sy_ltc_tables(g_ltc1, g_ltc2); }
+
+/* Bilinear look-up of an LTC table at (u, v) in [0, 1]^2 (texel centres at the ends, as the
+ * rasterizer's uv * 63/64 + 0.5/64). */
+static void ltc_fetch(const float *tab, float u, float v, float out[4])
+{
+    float x = sy_rt_clampf(u, 0.0f, 1.0f) * (float)(SY_LTC_SIZE - 1), y = sy_rt_clampf(v, 0.0f, 1.0f) * (float)(SY_LTC_SIZE - 1);
+    uint32_t x0 = (uint32_t)x, y0 = (uint32_t)y;
+    if (x0 > SY_LTC_SIZE - 2) x0 = SY_LTC_SIZE - 2;
+    if (y0 > SY_LTC_SIZE - 2) y0 = SY_LTC_SIZE - 2;
+    float tx = x - (float)x0, ty = y - (float)y0;
+    const float *a = tab + 4u * (y0 * SY_LTC_SIZE + x0), *b = a + 4, *c = a + 4 * SY_LTC_SIZE, *d = c + 4;
+    for (int k = 0; k < 4; ++k)
+        out[k] = (a[k] * (1.0f - tx) + b[k] * tx) * (1.0f - ty) + (c[k] * (1.0f - tx) + d[k] * tx) * ty;
+}
+
+/* The closed-form model of a shading point's BSDF: Lambert (plus the sheen, as diffuse light) and
+ * GGX lobes with the LTC tables' albedos. m: world -> the lobe's cosine space (row-major). */
+typedef struct amodel {
+    sy_rt_v3 kd;        /* diffuse albedo (x the form factor / irradiance) */
+    sy_rt_v3 fl;        /* the base's GGX albedo */
+    float frame[9];     /* world -> (T1, T2, N): the diffuse lobe */
+    float minv[9];      /* the base's GGX lobe (0 rows when fl = 0) */
+    sy_rt_v3 r_dir;     /* where the base's lobe looks into the prefiltered environment */
+    float rough;
+    float fc;           /* the coat's GGX albedo (0: none) */
+    float minv_c[9];
+    sy_rt_v3 rc_dir;
+    float rough_c;
+} amodel;
+
+static sy_rt_v3 m3v(const float *m, sy_rt_v3 v)
+{
+    return v3(m[0] * v.x + m[1] * v.y + m[2] * v.z, m[3] * v.x + m[4] * v.y + m[5] * v.z, m[6] * v.x + m[7] * v.y + m[8] * v.z);
+}
+
+/* (T1, T2, n) rows with T1 in the plane of n and wo. */
+static void make_frame(sy_rt_v3 n, sy_rt_v3 wo, float fr[9])
+{
+    sy_rt_v3 t1 = v3_sub(wo, v3_scale(n, v3_dot(wo, n)));
+    if (v3_dot(t1, t1) < 1e-12f) t1 = fabsf(n.x) < 0.9f ? v3_cross(n, v3(1.0f, 0.0f, 0.0f)) : v3_cross(n, v3(0.0f, 1.0f, 0.0f));
+    t1 = v3_normalize(t1);
+    sy_rt_v3 t2 = v3_cross(n, t1);
+    fr[0] = t1.x, fr[1] = t1.y, fr[2] = t1.z, fr[3] = t2.x, fr[4] = t2.y, fr[5] = t2.z, fr[6] = n.x, fr[7] = n.y, fr[8] = n.z;
+}
+
+/* One GGX lobe of perceptual roughness r seen at n . wo = nv: its M^-1 x frame and its albedo
+ * terms (t2[0] F0 + t2[1] (1 - F0)). */
+static void ggx_lobe(sy_rt_v3 n, sy_rt_v3 wo, float r, float m[9], float t2[4])
+{
+    float fr[9], t1[4];
+    float nv = sy_rt_clampf(v3_dot(n, wo), 0.0f, 1.0f);
+    make_frame(n, wo, fr);
+    float v = sqrtf(1.0f - nv);
+    ltc_fetch(g_ltc1, r, v, t1);
+    ltc_fetch(g_ltc2, r, v, t2);
+    /* M^-1 = rows (a, 0, c), (0, 1, 0), (b, 0, d) (the GLSL mat3 of columns (a,0,b), (0,1,0), (c,0,d)) */
+    for (int j = 0; j < 3; ++j) {
+        m[0 + j] = t1[0] * fr[0 + j] + t1[2] * fr[6 + j];
+        m[3 + j] = fr[3 + j];
+        m[6 + j] = t1[1] * fr[0 + j] + t1[3] * fr[6 + j];
+    }
+}
+
+/* Frostbite's dominant direction of a GGX lobe (between the mirror direction and the normal). */
+static sy_rt_v3 dominant_dir(sy_rt_v3 n, sy_rt_v3 wo, float alpha)
+{
+    sy_rt_v3 r = v3_sub(v3_scale(n, 2.0f * v3_dot(n, wo)), wo);
+    float s = 1.0f - alpha, f = s * (sqrtf(s) + alpha);
+    return v3_normalize(v3_add(v3_scale(n, 1.0f - f), v3_scale(r, f)));
+}
+
+/* The model of BSDF b; false when it has lobes the model does not describe (iridescence,
+ * anisotropy): those keep the sampled estimates. */
+static bool amodel_init(amodel *m, const sy_rt_bsdf *b, sy_rt_v3 wo)
+{
+    if (b->irid > 0.0f || b->aniso) return false;
+    pthread_once(&g_ltc_once, ltc_load);
+    float nv = sy_rt_clampf(v3_dot(b->n, wo), 1e-4f, 1.0f);
+    make_frame(b->n, wo, m->frame);
+    m->rough = sqrtf(b->alpha);
+    m->fl = v3(0.0f, 0.0f, 0.0f);
+    float t2[4] = {0, 0, 0, 0};
+    ggx_lobe(b->n, wo, m->rough, m->minv, t2);
+    sy_rt_v3 fd = v3_scale(v3_add(v3_scale(b->f0c, t2[0]), v3_scale(v3_sub(v3(1.0f, 1.0f, 1.0f), b->f0c), t2[1])), b->spec);
+    if (!b->delta) {
+        sy_rt_v3 fm = v3_add(v3_scale(b->base, t2[0]), v3_scale(v3_sub(v3(1.0f, 1.0f, 1.0f), b->base), t2[1]));
+        m->fl = v3_add(v3_scale(fm, b->w_metal), v3_scale(fd, b->w_diel));
+    }
+    /* the diffuse under the dielectric's Fresnel, as the BSDF's 1 - max(F) on average */
+    float fdm = sy_rt_minf(sy_rt_maxf(fd.x, sy_rt_maxf(fd.y, fd.z)), 1.0f);
+    m->kd = v3_scale(b->base, b->w_diel * (1.0f - fdm));
+    if (b->q_sheen > 0.0f) m->kd = v3_add(m->kd, v3_scale(b->sheen, sy_rt_sheen_albedo(nv, b->sheen_r)));
+    m->r_dir = dominant_dir(b->n, wo, b->alpha);
+    m->fc = 0.0f;
+    if (b->cc > 0.0f && !b->cc_delta && b->q_coat > 0.0f) {
+        sy_rt_v3 nc = b->cc_n ? b->ncc : b->n;
+        float tc[4];
+        m->rough_c = sqrtf(b->cc_alpha);
+        ggx_lobe(nc, wo, m->rough_c, m->minv_c, tc);
+        m->fc = b->cc * (0.04f * tc[0] + 0.96f * tc[1]);
+        m->rc_dir = dominant_dir(nc, wo, b->cc_alpha);
+    }
+    return true;
+}
+
+/* Heitz et al. 2016, clipless: the cosine-weighted integral over the triangle (v: vertices
+ * relative to the shading point) after the transform m, horizon-clipped through ltc2's sphere
+ * term; both orientations count (the caller decides the emitting side). */
+static sy_rt_v3 edge_vec(sy_rt_v3 v1, sy_rt_v3 v2)
+{
+    float x = v3_dot(v1, v2), y = fabsf(x);
+    float a = 0.8543985f + (0.4965155f + 0.0145206f * y) * y, b = 3.4175940f + (4.1616724f + y) * y, v = a / b;
+    float ts = x > 0.0f ? v : 0.5f / sqrtf(fmaxf(1.0f - x * x, 1e-7f)) - v;
+    return v3_scale(v3_cross(v1, v2), ts);
+}
+
+/* An emitter for the closed form: one emissive triangle, or two coplanar ones sharing an edge with
+ * the same emission merged into a quad (a rectangle light is one polygon: 4 edges, not 6). */
+typedef struct apoly {
+    sy_rt_v3 v[4];
+    uint32_t nv;         /* 3 or 4 */
+    uint32_t tri[2];     /* its triangles in dev->area */
+    float split;         /* area of tri[0] / the polygon's area */
+    sy_rt_v3 normal, emission;
+    bool double_sided;
+} apoly;
+
+static bool same_point(sy_rt_v3 a, sy_rt_v3 b, float eps)
+{
+    return fabsf(a.x - b.x) <= eps && fabsf(a.y - b.y) <= eps && fabsf(a.z - b.z) <= eps;
+}
+
+/* Polygons of the emissive triangles (consecutive pairs merged where they form a planar quad).
+ * Returns NULL when out of memory. */
+static apoly *build_polys(const sy_rt_device *dev, uint32_t *count)
+{
+    apoly *out = malloc((size_t)dev->area_count * sizeof *out);
+    if (!out) return NULL;
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < dev->area_count; ++i) {
+        const sy_rt_area_tri *a = &dev->area[i];
+        apoly *p = &out[n++];
+        p->v[0] = a->p0, p->v[1] = v3_add(a->p0, a->e1), p->v[2] = v3_add(a->p0, a->e2);
+        p->nv = 3;
+        p->tri[0] = p->tri[1] = i;
+        p->split = 1.0f;
+        p->normal = a->normal;
+        p->emission = a->emission;
+        p->double_sided = a->double_sided;
+        if (i + 1u >= dev->area_count) continue;
+        const sy_rt_area_tri *b = &dev->area[i + 1u];
+        if (b->inst != a->inst || b->double_sided != a->double_sided || v3_dot(a->normal, b->normal) < 0.99999f ||
+            a->emission.x != b->emission.x || a->emission.y != b->emission.y || a->emission.z != b->emission.z)
+            continue;
+        sy_rt_v3 w[3] = {b->p0, v3_add(b->p0, b->e1), v3_add(b->p0, b->e2)};
+        float eps = 1e-5f * (v3_max_abs(a->e1) + v3_max_abs(a->e2) + v3_max_abs(a->p0));
+        int shared[3], ns = 0, other = -1;
+        for (int k = 0; k < 3; ++k) {
+            shared[k] = -1;
+            for (int m = 0; m < 3; ++m)
+                if (same_point(p->v[k], w[m], eps)) shared[k] = m;
+            if (shared[k] >= 0) ns++;
+        }
+        if (ns != 2) continue;
+        for (int m = 0; m < 3; ++m)
+            if (shared[0] != m && shared[1] != m && shared[2] != m) other = m;
+        /* the shared edge (v[j], v[j+1]) of a's cycle; b's third vertex goes between them */
+        int j = shared[0] >= 0 && shared[1] >= 0 ? 0 : (shared[1] >= 0 && shared[2] >= 0 ? 1 : 2);
+        sy_rt_v3 q[4] = {p->v[j], w[other], p->v[(j + 1) % 3], p->v[(j + 2) % 3]};
+        for (int k = 0; k < 4; ++k) p->v[k] = q[k];
+        p->nv = 4;
+        p->tri[1] = i + 1u;
+        p->split = a->area / (a->area + b->area);
+        ++i;
+    }
+    *count = n;
+    return out;
+}
+
+/* Heitz et al. 2016, clipless: the cosine-weighted integral over the polygon (l: its unit vertex
+ * directions in the lobe's cosine space, ctr: a point inside it, any length) as the vector form
+ * factor; a polygon wholly above the horizon integrates to its z, one that crosses it is clipped
+ * through ltc2's sphere term. Both orientations count (the caller decides the emitting side). */
+static float ltc_integral(const sy_rt_v3 *l, uint32_t nv, sy_rt_v3 ctr, bool above)
+{
+    sy_rt_v3 f = edge_vec(l[nv - 1u], l[0]);
+    for (uint32_t k = 0; k + 1u < nv; ++k) f = v3_add(f, edge_vec(l[k], l[k + 1u]));
+    if (v3_dot(f, ctr) < 0.0f) f = v3_scale(f, -1.0f);
+    if (above) return sy_rt_maxf(f.z, 0.0f);
+    float len = v3_length(f);
+    if (!(len > 0.0f)) return 0.0f;
+    float t[4];
+    ltc_fetch(g_ltc2, f.z / len * 0.5f + 0.5f, len, t);
+    return len * t[3];
+}
+
+/* The polygon v (relative to the shading point) through the lobe transform m. */
+static float ltc_poly(const float m[9], const sy_rt_v3 *v, uint32_t nv)
+{
+    sy_rt_v3 l[4], ctr = v3(0.0f, 0.0f, 0.0f);
+    bool above = true;
+    for (uint32_t k = 0; k < nv; ++k) {
+        l[k] = m3v(m, v[k]);
+        ctr = v3_add(ctr, l[k]);
+        above = above && l[k].z >= 0.0f;
+        l[k] = v3_normalize(l[k]);
+    }
+    return ltc_integral(l, nv, ctr, above);
+}
+
+/* Unshadowed light from polygon p at the shading point x (0 behind a one-sided emitter or in its
+ * plane). The diffuse lobe is the cosine itself: its integral in world space (a rotation changes
+ * neither the edge vectors' lengths nor z = their sum . n). */
+static sy_rt_v3 area_unshadowed(const amodel *m, const apoly *p, sy_rt_v3 x)
+{
+    sy_rt_v3 v[4];
+    for (uint32_t k = 0; k < p->nv; ++k) v[k] = v3_sub(p->v[k], x);
+    float side = -v3_dot(v[0], p->normal); /* > 0: x on the front side */
+    float scale = v3_max_abs(v3_sub(p->v[1], p->v[0])) + v3_max_abs(v3_sub(p->v[2], p->v[0]));
+    if (!(fabsf(side) > 1e-6f * scale + 1e-9f) || (side < 0.0f && !p->double_sided)) return v3(0.0f, 0.0f, 0.0f);
+    sy_rt_v3 n = v3(m->frame[6], m->frame[7], m->frame[8]);
+    sy_rt_v3 l[4], ctr = v3(0.0f, 0.0f, 0.0f);
+    bool above = true, below = true;
+    for (uint32_t k = 0; k < p->nv; ++k) {
+        float z = v3_dot(v[k], n);
+        above = above && z >= 0.0f;
+        below = below && z <= 0.0f;
+        ctr = v3_add(ctr, v[k]);
+        l[k] = v3_normalize(v[k]);
+    }
+    if (below) return v3(0.0f, 0.0f, 0.0f); /* wholly under the shading point's horizon */
+    float fd;
+    {
+        sy_rt_v3 f = edge_vec(l[p->nv - 1u], l[0]);
+        for (uint32_t k = 0; k + 1u < p->nv; ++k) f = v3_add(f, edge_vec(l[k], l[k + 1u]));
+        if (v3_dot(f, ctr) < 0.0f) f = v3_scale(f, -1.0f);
+        float z = v3_dot(f, n);
+        if (above) fd = sy_rt_maxf(z, 0.0f);
+        else {
+            float len = v3_length(f), t[4];
+            fd = 0.0f;
+            if (len > 0.0f) {
+                ltc_fetch(g_ltc2, z / len * 0.5f + 0.5f, len, t);
+                fd = len * t[3];
+            }
+        }
+    }
+    sy_rt_v3 w = v3_scale(m->kd, fd);
+    if (!v3_is_zero(m->fl)) w = v3_add(w, v3_scale(m->fl, ltc_poly(m->minv, v, p->nv)));
+    if (m->fc > 0.0f) {
+        float c = m->fc * ltc_poly(m->minv_c, v, p->nv);
+        w = v3_add(w, v3(c, c, c));
+    }
+    return v3_mul(w, p->emission);
+}
+
+/* Unshadowed light from the environment: split sum over the prefiltered maps. */
+static sy_rt_v3 spec_env(const sy_rt_env *env, sy_rt_v3 d, float rough)
+{
+    const sy_rt_envfilter *ef = env->filter;
+    float lv = sy_rt_clampf(rough, 0.0f, 1.0f) * (float)(SY_RT_ENVF_LEVELS - 1);
+    uint32_t k = (uint32_t)lv;
+    if (k > SY_RT_ENVF_LEVELS - 2) k = SY_RT_ENVF_LEVELS - 2;
+    float t = lv - (float)k, u, v;
+    sy_rt_envf_uv(d, &u, &v);
+    sy_rt_v3 b = sy_rt_envf_lookup_uv(&ef->spec[k + 1u], u, v);
+    if (k == 0) /* between the map itself and the first level */
+        return v3_add(v3_scale(sy_rt_env_eval(env, d), 1.0f - t), v3_scale(b, t * env->intensity));
+    return v3_scale(v3_add(v3_scale(sy_rt_envf_lookup_uv(&ef->spec[k], u, v), 1.0f - t), v3_scale(b, t)), env->intensity);
+}
+
+static sy_rt_v3 env_unshadowed(const amodel *m, const sy_rt_env *env, sy_rt_v3 n)
+{
+    sy_rt_v3 l = v3_mul(m->kd, v3_scale(sy_rt_envf_lookup(&env->filter->irr, n), env->intensity));
+    if (!v3_is_zero(m->fl)) l = v3_add(l, v3_mul(m->fl, spec_env(env, m->r_dir, m->rough)));
+    if (m->fc > 0.0f) l = v3_add(l, v3_scale(spec_env(env, m->rc_dir, m->rough_c), m->fc));
+    return l;
+}
+
+/* The ratio estimator: analytic x (shadowed / unshadowed sums of the same samples), per channel
+ * (coloured shadows through glass); where no sample saw the light, the analytic value as it is. */
+static sy_rt_v3 ratio_apply(sy_rt_v3 a, sy_rt_v3 num, sy_rt_v3 den)
+{
+    float dl = v3_luminance(den);
+    if (!(dl > 0.0f)) return a;
+    float r = v3_luminance(num) / dl;
+    return v3(a.x * (den.x > 0.0f ? num.x / den.x : r), a.y * (den.y > 0.0f ? num.y / den.y : r),
+              a.z * (den.z > 0.0f ? num.z / den.z : r));
 }
 
 static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, sy_rt_v3 p_off, sy_rt_v3 wo,
@@ -135,6 +495,152 @@ static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bs
     return v3_scale(sum, 1.0f / (float)n);
 }
 
+/* Solid angle of triangle t seen from x (Van Oosterom and Strackee). */
+static float tri_solid_angle(const sy_rt_area_tri *t, sy_rt_v3 x)
+{
+    sy_rt_v3 a = v3_sub(t->p0, x), b = v3_add(a, t->e1), c = v3_add(a, t->e2);
+    float la = v3_length(a), lb = v3_length(b), lc = v3_length(c);
+    float num = fabsf(v3_dot(a, v3_cross(b, c)));
+    float den = la * lb * lc + v3_dot(a, b) * lc + v3_dot(a, c) * lb + v3_dot(b, c) * la;
+    float o = 2.0f * atan2f(num, den);
+    return isfinite(o) && o > 0.0f ? o : 0.0f;
+}
+
+static float angle_between(sy_rt_v3 a, sy_rt_v3 b)
+{
+    if (v3_dot(a, b) < 0.0f) return 3.14159265f - 2.0f * asinf(sy_rt_minf(v3_length(v3_add(a, b)) * 0.5f, 1.0f));
+    return 2.0f * asinf(sy_rt_minf(v3_length(v3_sub(b, a)) * 0.5f, 1.0f));
+}
+
+static sy_rt_v3 gram_schmidt(sy_rt_v3 v, sy_rt_v3 w) { return v3_sub(v, v3_scale(w, v3_dot(v, w))); }
+
+/* A direction wi from x toward triangle t, uniform in its solid angle (Arvo 1995, as pbrt-v4
+ * writes it), the point q it reaches and 1 / its pdf; a triangle under about 1e-4 sr (or
+ * degenerate) gets a uniform point on its area instead (1 / pdf = area cos / d^2). False: no
+ * direction. */
+static bool sample_tri(const sy_rt_area_tri *t, sy_rt_v3 x, float u1, float u2, sy_rt_v3 *wi, sy_rt_v3 *q, float *w)
+{
+    sy_rt_v3 p1 = v3_add(t->p0, t->e1), p2 = v3_add(t->p0, t->e2);
+    sy_rt_v3 a = v3_normalize(v3_sub(t->p0, x)), b = v3_normalize(v3_sub(p1, x)), c = v3_normalize(v3_sub(p2, x));
+    sy_rt_v3 nab = v3_cross(a, b), nbc = v3_cross(b, c), nca = v3_cross(c, a);
+    float lab = v3_length(nab), lbc = v3_length(nbc), lca = v3_length(nca);
+    float area_sa = 0.0f;
+    if (lab > 1e-6f && lbc > 1e-6f && lca > 1e-6f) {
+        nab = v3_scale(nab, 1.0f / lab), nbc = v3_scale(nbc, 1.0f / lbc), nca = v3_scale(nca, 1.0f / lca);
+        float alpha = angle_between(nab, v3_scale(nca, -1.0f)), beta = angle_between(nbc, v3_scale(nab, -1.0f));
+        float gamma = angle_between(nca, v3_scale(nbc, -1.0f));
+        float a_pi = alpha + beta + gamma;
+        area_sa = a_pi - 3.14159265f;
+        if (area_sa > 1e-4f && isfinite(area_sa)) {
+            float ap_pi = 3.14159265f + u1 * area_sa;
+            float ca = cosf(alpha), sa = sinf(alpha);
+            float sphi = sinf(ap_pi) * ca - cosf(ap_pi) * sa, cphi = cosf(ap_pi) * ca + sinf(ap_pi) * sa;
+            float k1 = cphi + ca, k2 = sphi - sa * v3_dot(a, b);
+            float cbp = (k2 + (k2 * cphi - k1 * sphi) * ca) / ((k2 * sphi + k1 * cphi) * sa);
+            cbp = sy_rt_clampf(isfinite(cbp) ? cbp : 1.0f, -1.0f, 1.0f);
+            float sbp = sqrtf(fmaxf(0.0f, 1.0f - cbp * cbp));
+            sy_rt_v3 cp = v3_add(v3_scale(a, cbp), v3_scale(v3_normalize(gram_schmidt(c, a)), sbp));
+            float ct = 1.0f - u2 * (1.0f - v3_dot(cp, b)), st = sqrtf(fmaxf(0.0f, 1.0f - ct * ct));
+            sy_rt_v3 d = v3_add(v3_scale(b, ct), v3_scale(v3_normalize(gram_schmidt(cp, b)), st));
+            float dn = v3_dot(d, t->normal);
+            float tt = v3_dot(v3_sub(t->p0, x), t->normal) / dn;
+            if (isfinite(tt) && tt > 0.0f && isfinite(d.x + d.y + d.z)) {
+                *wi = d;
+                *q = v3_madd(x, d, tt);
+                *w = area_sa;
+                return true;
+            }
+        }
+    }
+    float su = sqrtf(u1);
+    float bu = su * (1.0f - u2), bv = su * u2;
+    *q = v3_add(t->p0, v3_add(v3_scale(t->e1, bu), v3_scale(t->e2, bv)));
+    sy_rt_v3 v = v3_sub(*q, x);
+    float d2 = v3_dot(v, v);
+    if (!(d2 > 0.0f)) return false;
+    *wi = v3_scale(v, 1.0f / sqrtf(d2));
+    *w = fabsf(v3_dot(t->normal, *wi)) / d2 * t->area;
+    return true;
+}
+
+/* Area lights with the model m: the analytic unshadowed light of every emissive triangle, and
+ * n_area samples, each picking a polygon in proportion to its analytic light (luminance) and a
+ * direction uniform in its solid angle, for the visibility ratio (with weights nearly constant
+ * over the emitter, the ratio of few samples is nearly the visibility the BSDF sees). */
+static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, const amodel *m,
+                                     sy_rt_v3 p_off, sy_rt_v3 wo, uint32_t depth)
+{
+    const sy_rt_device *dev = c->dev;
+    const apoly *poly = c->job->poly;
+    uint32_t nt = c->job->n_poly;
+    float *cdf = c->cache.cdf;
+    sy_rt_v3 a = c->cache.a;
+    bool cam = depth == 0u;
+    if (!(cam && c->cache.valid && c->cache.inst == (const void *)s->inst && v3_dot(c->cache.n, b->n) > 0.9995f &&
+          v3_length(v3_sub(c->cache.p, s->p)) <= 0.01f * v3_length(v3_sub(s->p, c->eye)))) {
+        float local[ANALYTIC_MAX_TRIANGLES + 1u];
+        if (!cam) cdf = local;
+        a = v3(0.0f, 0.0f, 0.0f);
+        cdf[0] = 0.0f;
+        for (uint32_t i = 0; i < nt; ++i) {
+            sy_rt_v3 ai = area_unshadowed(m, &poly[i], s->p);
+            a = v3_add(a, ai);
+            cdf[i + 1u] = cdf[i] + sy_rt_maxf(v3_luminance(ai), 0.0f);
+        }
+        if (cam) c->cache.valid = true, c->cache.inst = s->inst, c->cache.p = s->p, c->cache.n = b->n, c->cache.a = a;
+    }
+    float total = cdf[nt];
+    if (!(total > 0.0f)) return v3(0.0f, 0.0f, 0.0f);
+    uint32_t n = c->job->n_area;
+    sy_rt_v3 num = v3(0.0f, 0.0f, 0.0f), den = v3(0.0f, 0.0f, 0.0f);
+    /* Samples that reach no light (under the horizon where an emitter straddles it) say nothing
+     * about visibility: while none has, up to RETRIES more are drawn (from a second scramble of
+     * the same set), so that few samples per point (spp >= light_samples) do not fall back on the
+     * unshadowed light where only part of an emitter is above the horizon */
+    for (uint32_t k = 0; k < n || (v3_is_zero(den) && k < n + RETRIES); ++k) {
+        float u[4];
+        if (k < n) light_u(c, SET_AREA(depth), n, k, u);
+        else sy_rt_sobol_sample4(c->job->sobol, c->pseed ^ 0x5bd1e995u, SET_AREA(depth), c->sample * RETRIES + (k - n), u);
+        float xi = u[0] * total;
+        uint32_t i = 0;
+        while (i + 1u < nt && cdf[i + 1u] <= xi) ++i;
+        float p_sel = (cdf[i + 1u] - cdf[i]) / total;
+        if (!(p_sel > 0.0f)) continue;
+        /* one of the polygon's triangles by solid angle (u[0] rescaled), a direction uniform in
+         * its solid angle (small or degenerate ones: a uniform point on it) */
+        float ut = (xi - cdf[i]) / (cdf[i + 1u] - cdf[i]);
+        const apoly *pg = &poly[i];
+        const sy_rt_area_tri *t = &dev->area[pg->tri[0]];
+        sy_rt_v3 wi, q;
+        float w_dir; /* 1 / the direction's pdf (solid angle) */
+        if (pg->nv == 4u) {
+            const sy_rt_area_tri *t1 = &dev->area[pg->tri[1]];
+            float o0 = tri_solid_angle(t, s->p), o1 = tri_solid_angle(t1, s->p);
+            float split = o0 + o1 > 0.0f ? o0 / (o0 + o1) : pg->split;
+            if (ut < split) p_sel *= split;
+            else t = t1, p_sel *= 1.0f - split;
+        }
+        if (!sample_tri(t, s->p, u[1], u[2], &wi, &q, &w_dir)) continue;
+        float cos_l = -v3_dot(t->normal, wi);
+        if (t->double_sided) cos_l = fabsf(cos_l);
+        if (cos_l <= 0.0f || v3_dot(s->ns, wi) <= 0.0f || v3_dot(s->ng_facing, wi) <= 0.0f) continue;
+        float pdf_b;
+        sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
+        if (v3_is_zero(f)) continue;
+        sy_rt_v3 e = v3_scale(v3_mul(f, t->emission), w_dir / p_sel);
+        den = v3_add(den, e);
+        sy_rt_v3 sdir;
+        float tmax;
+        sy_rt_v3 tr = sy_rt_segment_to(p_off, q, &sdir, &tmax) ? shadow(c, p_off, sdir, tmax) : v3(1.0f, 1.0f, 1.0f);
+        num = v3_add(num, v3_mul(e, tr));
+    }
+    if (depth == 0u && c->cur) {
+        c->cur->used = true, c->cur->a[0] = a, c->cur->num[0] = num, c->cur->den[0] = den;
+        return v3(0.0f, 0.0f, 0.0f);
+    }
+    return ratio_apply(a, num, den);
+}
+
 static float power_heuristic(float a, float b)
 {
     float a2 = a * a, b2 = b * b;
@@ -146,11 +652,11 @@ static float power_heuristic(float a, float b)
  * tracer's sy_rt_bsdf, so glossy lobes that the environment's distribution rarely hits are found),
  * combined with the power heuristic, each with a shadow ray. Delta lobes (roughness 0 mirrors,
  * refraction) see the environment through Whitted's recursive rays instead. */
-static sy_rt_v3 direct_env(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, sy_rt_v3 p_off, sy_rt_v3 wo,
-                           uint32_t depth)
+static sy_rt_v3 direct_env(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, const amodel *m, sy_rt_v3 p_off,
+                           sy_rt_v3 wo, uint32_t depth)
 {
     const sy_rt_env *env = &c->job->env;
-    sy_rt_v3 sum = v3(0.0f, 0.0f, 0.0f);
+    sy_rt_v3 sum = v3(0.0f, 0.0f, 0.0f), den = v3(0.0f, 0.0f, 0.0f);
     uint32_t n = c->job->n_env;
     for (uint32_t i = 0; i < n; ++i) {
         float ul[4], ub[4];
@@ -163,9 +669,10 @@ static sy_rt_v3 direct_env(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsd
             float pdf_b;
             sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
             if (!v3_is_zero(f)) {
+                sy_rt_v3 e = v3_scale(v3_mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l);
+                den = v3_add(den, e);
                 sy_rt_v3 tr = shadow(c, p_off, wi, INFINITY);
-                if (!v3_is_zero(tr))
-                    sum = v3_add(sum, v3_scale(v3_mul(v3_mul(f, le), tr), power_heuristic(pdf_l, pdf_b) / pdf_l));
+                if (!v3_is_zero(tr)) sum = v3_add(sum, v3_mul(e, tr));
             }
         }
         /* BSDF strategy */
@@ -174,13 +681,18 @@ static sy_rt_v3 direct_env(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsd
             v3_dot(s->ng_facing, bs.wi) > 0.0f) {
             sy_rt_v3 lb = sy_rt_env_eval(env, bs.wi);
             if (!v3_is_zero(lb)) {
+                sy_rt_v3 e = v3_scale(v3_mul(bs.weight, lb), power_heuristic(bs.pdf, sy_rt_env_pdf(env, bs.wi)));
+                den = v3_add(den, e);
                 sy_rt_v3 tr = shadow(c, p_off, bs.wi, INFINITY);
-                if (!v3_is_zero(tr))
-                    sum = v3_add(sum, v3_scale(v3_mul(v3_mul(bs.weight, lb), tr),
-                                               power_heuristic(bs.pdf, sy_rt_env_pdf(env, bs.wi))));
+                if (!v3_is_zero(tr)) sum = v3_add(sum, v3_mul(e, tr));
             }
         }
     }
+    if (m && depth == 0u && c->cur) {
+        c->cur->used = true, c->cur->a[1] = env_unshadowed(m, env, b->n), c->cur->num[1] = sum, c->cur->den[1] = den;
+        return v3(0.0f, 0.0f, 0.0f);
+    }
+    if (m) return ratio_apply(env_unshadowed(m, env, b->n), sum, den);
     return v3_scale(sum, 1.0f / (float)n);
 }
 
@@ -247,8 +759,13 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
         sy_rt_bsdf_init(&b, s, wo);
         if (sy_rt_bsdf_evaluable(&b)) {
             L = direct_punctual(c, s, &b, p_out, wo);
-            if (c->dev->area_count) L = v3_add(L, direct_area(c, s, &b, p_out, wo, depth));
-            if (c->job->n_env) L = v3_add(L, direct_env(c, s, &b, p_out, wo, depth));
+            amodel am;
+            bool model = (c->job->area_analytic || c->job->env.filter) && amodel_init(&am, &b, wo);
+            if (model && depth == 0u && c->cur) c->cur->inst = s->inst, c->cur->n = b.n, c->cur->w = 1.0f;
+            if (c->dev->area_count)
+                L = v3_add(L, model && c->job->area_analytic ? direct_area_analytic(c, s, &b, &am, p_out, wo, depth)
+                                                             : direct_area(c, s, &b, p_out, wo, depth));
+            if (c->job->n_env) L = v3_add(L, direct_env(c, s, &b, model && c->job->env.filter ? &am : NULL, p_out, wo, depth));
         }
         bool recurse = depth + 1u < c->f->max_depth;
         float cos_o = fmaxf(v3_dot(s->ns, wo), 0.0f);
@@ -317,6 +834,7 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
             behind = trace(c, v3_madd(s->p, s->ng_facing, -sy_rt_ray_eps(s->p)), d, 0.0f, INFINITY, depth + 1u, camera,
                            &c->ictx.rtc, NULL);
         out.rgb = v3_add(v3_scale(out.rgb, a), v3_scale(behind.rgb, 1.0f - a));
+        if (depth == 0u && c->cur) c->cur->w = a;
         out.a = a + (1.0f - a) * behind.a;
     }
     return out;
@@ -342,6 +860,40 @@ static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float
     return shade(c, &s, d, depth, camera);
 }
 
+/* Adds the pooled direct light of the pixel's samples ps[0 .. n) to *sum: samples whose depth-0 hits
+ * lie on the same instance with shading normals within about 25 degrees share their shadowed /
+ * unshadowed sums, each scaling its own analytic light by the group's ratio. */
+static void pool_resolve(psample *ps, uint32_t n, sy_rt_v3 *sum)
+{
+    uint32_t lead[256], nl = 0;
+    for (uint32_t k = 0; k < n; ++k) {
+        psample *p = &ps[k];
+        if (!p->used) continue;
+        uint32_t g = k;
+        for (uint32_t i = 0; i < nl; ++i)
+            if (ps[lead[i]].inst == p->inst && v3_dot(ps[lead[i]].n, p->n) > 0.9f) {
+                g = lead[i];
+                break;
+            }
+        if (g == k) {
+            if (nl < 256u) lead[nl++] = k;
+            for (int t = 0; t < 2; ++t) p->gnum[t] = v3(0.0f, 0.0f, 0.0f), p->gden[t] = v3(0.0f, 0.0f, 0.0f);
+        }
+        p->group = g;
+        for (int t = 0; t < 2; ++t) {
+            ps[g].gnum[t] = v3_add(ps[g].gnum[t], p->num[t]);
+            ps[g].gden[t] = v3_add(ps[g].gden[t], p->den[t]);
+        }
+    }
+    for (uint32_t k = 0; k < n; ++k) {
+        const psample *p = &ps[k];
+        if (!p->used) continue;
+        const psample *g = &ps[p->group];
+        sy_rt_v3 l = v3_add(ratio_apply(p->a[0], g->gnum[0], g->gden[0]), ratio_apply(p->a[1], g->gnum[1], g->gden[1]));
+        *sum = v3_add(*sum, v3_scale(l, p->w));
+    }
+}
+
 static void whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
 {
     const whitted_job *j = user;
@@ -352,33 +904,63 @@ static void whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
     sy_rt_context_init(f->dev, &c.ictx, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
     sy_rt_ictx primary_ctx;
     sy_rt_context_init(f->dev, &primary_ctx, RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
+    /* the pixel's samples' records (without them, when out of memory or past 256 samples, every
+     * shading point takes its own ratio) */
+    psample *ps = j->spp_max <= 256u && (j->area_analytic || j->env.filter) ? malloc(j->spp_max * sizeof *ps) : NULL;
+    c.cur = NULL;
     for (uint32_t py = y0; py < y1; ++py) {
         for (uint32_t px = x0; px < x1; ++px) {
             c.pseed = sy_rt_hash32(px ^ sy_rt_hash32(py ^ sy_rt_hash32(f->seed ^ 0x3c6ef372u)));
+            c.cache.valid = false;
             sy_rt_v3 sum = v3(0.0f, 0.0f, 0.0f);
             float alpha = 0.0f, dsum = 0.0f;
             uint32_t hits = 0;
-            for (uint32_t k = 0; k < j->spp; ++k) {
+            /* per sample: its luminance (own ratio), compressed y / (1 + y), for the refinement test */
+            double ts = 0.0, ts2 = 0.0;
+            uint32_t n_samples = j->spp;
+            for (uint32_t k = 0; k < n_samples; ++k) {
                 float fx = (float)px + 0.5f, fy = (float)py + 0.5f;
-                if (j->spp > 1u) {
+                if (j->spp_max > 1u) {
                     float u[4];
                     sy_rt_sobol_sample4(j->sobol, c.pseed, 0u, k, u);
                     fx = (float)px + u[0];
                     fy = (float)py + u[1];
                 }
                 c.sample = k;
+                if (ps) {
+                    c.cur = &ps[k];
+                    c.cur->used = false;
+                    for (int t = 0; t < 2; ++t)
+                        c.cur->a[t] = c.cur->num[t] = c.cur->den[t] = v3(0.0f, 0.0f, 0.0f);
+                }
                 struct RTCRay ray;
                 float axial, t;
                 sy_rt_frame_ray_at(f, fx, fy, &ray, &axial);
+                c.eye = v3(ray.org_x, ray.org_y, ray.org_z);
                 rgba_t r = trace(&c, v3(ray.org_x, ray.org_y, ray.org_z), v3(ray.dir_x, ray.dir_y, ray.dir_z), ray.tnear,
                                  ray.tfar, 0u, true, &primary_ctx.rtc, &t);
                 sum = v3_add(sum, r.rgb);
                 alpha += r.a;
                 if (isfinite(t)) dsum += t * axial, hits++;
+                if (n_samples < j->spp_max) {
+                    sy_rt_v3 own = r.rgb;
+                    if (ps && c.cur->used)
+                        own = v3_add(own, v3_scale(v3_add(ratio_apply(c.cur->a[0], c.cur->num[0], c.cur->den[0]),
+                                                          ratio_apply(c.cur->a[1], c.cur->num[1], c.cur->den[1])),
+                                                   c.cur->w));
+                    double y = (double)sy_rt_maxf(v3_luminance(own), 0.0f), ty = y / (1.0 + y);
+                    ts += ty, ts2 += ty * ty;
+                    /* after the first spp: the standard error of their mean, compressed */
+                    if (k + 1u == j->spp) {
+                        double m = ts / (double)j->spp, var = ts2 / (double)j->spp - m * m;
+                        if (var > 0.0 && sqrt(var / (double)j->spp) > REFINE_STDERR) n_samples = j->spp_max;
+                    }
+                }
             }
+            if (ps) pool_resolve(ps, n_samples, &sum);
             size_t o = (size_t)(py - f->y) * f->width + (px - f->x);
             float *out = f->rgba + 4u * o;
-            float n = (float)j->spp; /* divide (not multiply by 1/n): n equal samples average exactly */
+            float n = (float)n_samples; /* divide (not multiply by 1/n): n equal samples average exactly */
             out[0] = sum.x / n;
             out[1] = sum.y / n;
             out[2] = sum.z / n;
@@ -389,6 +971,7 @@ static void whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
             if (f->depth) f->depth[o] = hits ? dsum / (float)hits : INFINITY;
         }
     }
+    free(ps);
 }
 
 sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc *desc)
@@ -399,9 +982,20 @@ sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc 
     j->sobol = &f->dev->sobol;
     sy_rt_env_get(f->dev, &j->env);
     j->spp = desc->pixel_samples ? desc->pixel_samples : 1u;
+    j->spp_max = j->spp > 1u && j->spp < REFINE_MAX_SPP ? (j->spp * REFINE_FACTOR < REFINE_MAX_SPP ? j->spp * REFINE_FACTOR : REFINE_MAX_SPP) : j->spp;
     j->n_area = (f->light_samples + j->spp - 1u) / j->spp;
     j->n_env = j->env.mode ? (desc->env_light_samples ? desc->env_light_samples : 4u) : 0u;
+    j->area_analytic = dev->area_count > 0 && dev->area_count <= ANALYTIC_MAX_TRIANGLES;
+    for (uint32_t i = 0; j->area_analytic && i < dev->area_count; ++i)
+        if (dev->area[i].textured) j->area_analytic = false;
+    j->poly = NULL;
+    j->n_poly = 0;
+    if (j->area_analytic && !(j->poly = build_polys(dev, &j->n_poly))) {
+        free(j);
+        return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY, "render: out of memory");
+    }
     sy_rt_result r = sy_rt_run_tiles(f, whitted_tile, j, desc->progress, desc->progress_user_data);
+    free(j->poly);
     free(j);
     return r;
 }

@@ -1,8 +1,11 @@
-/* sy_rt_whitted.h — SY_RT_INTEGRATOR_WHITTED: anti-aliased camera rays (stratified jittered pixel
- * samples), direct light from punctual lights, emissive triangles and the environment (stratified,
- * per-pixel Owen-scrambled samples: soft shadows without banding or frame-to-frame noise) with
- * shadow rays through alpha-blended and transmissive surfaces, Lambert + GGX highlights, emission
- * added, recursive perfect mirror reflection and Fresnel refraction, alpha blending. Internal to
+/* sy_rt_whitted.h — SY_RT_INTEGRATOR_WHITTED: the deterministic preview. Anti-aliased camera rays
+ * (stratified jittered pixel samples, refined adaptively where a pixel's samples disagree); direct
+ * light from punctual lights (hard shadows), and from emissive triangles and the environment in
+ * closed form where unshadowed (linearly transformed cosines over the emitters' polygons with the
+ * tables of backends/ltc; the environment prefiltered per roughness, sy_rt_envfilter.h) times a
+ * visibility ratio from stochastic shadow rays pooled over the pixel's samples; shadow rays
+ * through alpha-blended and transmissive surfaces; the path tracer's BSDF; emission added;
+ * recursive perfect mirror reflection and Fresnel refraction; alpha blending. Internal to
  * backends/rt. */
 #ifndef SY_RT_WHITTED_H
 #define SY_RT_WHITTED_H
