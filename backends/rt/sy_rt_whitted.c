@@ -115,12 +115,14 @@ typedef struct trace_ctx {
     sy_rt_v3 eye;    /* the camera ray's origin */
     psample *cur;    /* this camera sample's record (its depth-0 hit fills it) */
     /* The analytic area light of the pixel's first camera hit, reused by its other camera hits on
-     * the same instance with the same normal within a hundredth of the eye distance (the
-     * unshadowed light varies far less over a pixel than its shadows) */
+     * the same instance with the same normal and material model (within 1 %) within a hundredth
+     * of the eye distance (the unshadowed light varies far less over a pixel than its shadows) */
     struct {
         bool valid;
         const void *inst;
         sy_rt_v3 p, n, a;
+        sy_rt_v3 kd, fl; /* the model it was computed with (textures vary it within a pixel) */
+        float rough, fc;
         float cdf[ANALYTIC_MAX_TRIANGLES + 1u];
     } cache;
 } trace_ctx;
@@ -563,6 +565,18 @@ static bool sample_tri(const sy_rt_area_tri *t, sy_rt_v3 x, float u1, float u2, 
     return true;
 }
 
+/* The cached model equals m within 1 % (albedos) and 0.01 (roughness). */
+static bool near3(sy_rt_v3 a, sy_rt_v3 b)
+{
+    return fabsf(a.x - b.x) <= 0.01f * fabsf(b.x) + 1e-6f && fabsf(a.y - b.y) <= 0.01f * fabsf(b.y) + 1e-6f &&
+           fabsf(a.z - b.z) <= 0.01f * fabsf(b.z) + 1e-6f;
+}
+
+static bool same_model(const sy_rt_v3 *kd, const sy_rt_v3 *fl, float rough, float fc, const amodel *m)
+{
+    return near3(*kd, m->kd) && near3(*fl, m->fl) && fabsf(rough - m->rough) <= 0.01f && fabsf(fc - m->fc) <= 0.01f * m->fc + 1e-6f;
+}
+
 /* Area lights with the model m: the analytic unshadowed light of every emissive triangle, and
  * n_area samples, each picking a polygon in proportion to its analytic light (luminance) and a
  * direction uniform in its solid angle, for the visibility ratio (with weights nearly constant
@@ -577,7 +591,8 @@ static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const
     sy_rt_v3 a = c->cache.a;
     bool cam = depth == 0u;
     if (!(cam && c->cache.valid && c->cache.inst == (const void *)s->inst && v3_dot(c->cache.n, b->n) > 0.9995f &&
-          v3_length(v3_sub(c->cache.p, s->p)) <= 0.01f * v3_length(v3_sub(s->p, c->eye)))) {
+          v3_length(v3_sub(c->cache.p, s->p)) <= 0.01f * v3_length(v3_sub(s->p, c->eye)) &&
+          same_model(&c->cache.kd, &c->cache.fl, c->cache.rough, c->cache.fc, m))) {
         float local[ANALYTIC_MAX_TRIANGLES + 1u];
         if (!cam) cdf = local;
         a = v3(0.0f, 0.0f, 0.0f);
@@ -587,7 +602,10 @@ static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const
             a = v3_add(a, ai);
             cdf[i + 1u] = cdf[i] + sy_rt_maxf(v3_luminance(ai), 0.0f);
         }
-        if (cam) c->cache.valid = true, c->cache.inst = s->inst, c->cache.p = s->p, c->cache.n = b->n, c->cache.a = a;
+        if (cam) {
+            c->cache.valid = true, c->cache.inst = s->inst, c->cache.p = s->p, c->cache.n = b->n, c->cache.a = a;
+            c->cache.kd = m->kd, c->cache.fl = m->fl, c->cache.rough = m->rough, c->cache.fc = m->fc;
+        }
     }
     float total = cdf[nt];
     if (!(total > 0.0f)) return v3(0.0f, 0.0f, 0.0f);
