@@ -587,13 +587,13 @@ static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const
     const sy_rt_device *dev = c->dev;
     const apoly *poly = c->job->poly;
     uint32_t nt = c->job->n_poly;
+    float local[ANALYTIC_MAX_TRIANGLES + 1u]; /* a secondary hit's table (the cache is the camera hit's) */
     float *cdf = c->cache.cdf;
     sy_rt_v3 a = c->cache.a;
     bool cam = depth == 0u;
     if (!(cam && c->cache.valid && c->cache.inst == (const void *)s->inst && v3_dot(c->cache.n, b->n) > 0.9995f &&
           v3_length(v3_sub(c->cache.p, s->p)) <= 0.01f * v3_length(v3_sub(s->p, c->eye)) &&
           same_model(&c->cache.kd, &c->cache.fl, c->cache.rough, c->cache.fc, m))) {
-        float local[ANALYTIC_MAX_TRIANGLES + 1u];
         if (!cam) cdf = local;
         a = v3(0.0f, 0.0f, 0.0f);
         cdf[0] = 0.0f;
