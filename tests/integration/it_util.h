@@ -154,6 +154,19 @@ static inline bool it_project(const sy_camera_view *v, const float p[3], uint32_
     return true;
 }
 
+/* The whole w x h image of ctx seen through view into *img (created here; the caller destroys it). */
+static inline sy_result it_render_full(sy_context *ctx, const sy_camera_view *view, uint32_t w, uint32_t h, sy_layer *img,
+                                       sy_error *err)
+{
+    sy_render_request req;
+    memset(&req, 0, sizeof req);
+    req.camera = *view;
+    req.full_width = req.rect_w = w;
+    req.full_height = req.rect_h = h;
+    sy_result r = sy_layer_create(w, h, img, err);
+    return r != SY_OK ? r : sy_context_render(ctx, &req, img, err);
+}
+
 static inline const float *it_px(const sy_layer *l, uint32_t x, uint32_t y) { return l->rgba + 4 * ((size_t)y * l->width + x); }
 
 static inline bool it_px_is(const sy_layer *l, uint32_t x, uint32_t y, float r, float g, float b, float a)

@@ -117,14 +117,8 @@ static void render_faces(const char *path, const char *backend, float means[3])
     MUST(sy_context_sync(ctx, err));
     const float eye[3] = {2.6f, 2.2f, 3.4f};
     sy_camera_view view = look_at(eye, 0.32f);
-    sy_render_request req;
-    memset(&req, 0, sizeof req);
-    req.camera = view;
-    req.full_width = req.rect_w = W;
-    req.full_height = req.rect_h = H;
     sy_layer img;
-    MUST(sy_layer_create(W, H, &img, err));
-    MUST(sy_context_render(ctx, &req, &img, err));
+    MUST(it_render_full(ctx, &view, W, H, &img, err));
     for (int a = 0; a < 3; a++) {
         int u = (a + 1) % 3, w = (a + 2) % 3;
         float lo = INFINITY, hi = -INFINITY, sum = 0.0f;
