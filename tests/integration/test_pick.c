@@ -86,6 +86,19 @@ static sy_mat4 cam_at_5(void)
     return m;
 }
 
+/* A W x H window with one full viewport of backend, the camera at 5 on +z, and that view. */
+static sy_result one_viewport(const char *backend, sy_scene *s, sy_window **win, sy_viewport **vp, sy_camera_view *view,
+                              sy_error *err)
+{
+    sy_result r = sy_window_create(W, H, win, err);
+    if (r != SY_OK) return r;
+    sy_viewport_desc vd = {.backend = backend};
+    if ((r = sy_window_add_viewport(*win, &vd, vp, err)) != SY_OK) return r;
+    sy_mat4 cam = cam_at_5();
+    sy_viewport_set_view(*vp, &cam);
+    return sy_viewport_camera_view(*vp, s, W, H, view, err);
+}
+
 /* What pixel (px, py) must answer, from the view's window and the quads' definition. */
 typedef struct expect {
     bool hit;
@@ -171,13 +184,8 @@ static void test_quads(void)
     for (uint32_t b = 0; b < n; ++b) {
         sy_window *win;
         sy_viewport *vp;
-        MUST(sy_window_create(W, H, &win, err));
-        sy_viewport_desc vd = {.backend = names[b]};
-        MUST(sy_window_add_viewport(win, &vd, &vp, err));
-        sy_mat4 cam = cam_at_5();
-        sy_viewport_set_view(vp, &cam);
         sy_camera_view view;
-        MUST(sy_viewport_camera_view(vp, q.s, W, H, &view, err));
+        MUST(one_viewport(names[b], q.s, &win, &vp, &view, err));
         /* a pick leaves no trace in what the context renders next (the rasterizer's GL state) */
         bool progressive = (sy_mediator_class_caps(sy_mediator_find(names[b]), NULL) & SY_CAP_PROGRESSIVE) != 0;
         sy_layer before = {0}, after = {0};
@@ -251,13 +259,8 @@ static void test_dag(void)
     for (uint32_t b = 0; b < n; ++b) {
         sy_window *win;
         sy_viewport *vp;
-        MUST(sy_window_create(W, H, &win, err));
-        sy_viewport_desc vd = {.backend = names[b]};
-        MUST(sy_window_add_viewport(win, &vd, &vp, err));
-        sy_mat4 cam = cam_at_5();
-        sy_viewport_set_view(vp, &cam);
         sy_camera_view view;
-        MUST(sy_viewport_camera_view(vp, s, W, H, &view, err));
+        MUST(one_viewport(names[b], s, &win, &vp, &view, err));
         uint32_t lx, ly, rx, ry;
         const float pl[3] = {-0.6f, 0.1f, 0.0f}, pr[3] = {0.6f, 0.1f, 0.0f};
         float fx, fy;
