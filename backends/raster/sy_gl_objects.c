@@ -255,6 +255,15 @@ static sy_gl_result upload_levels(sy_gl_device *dev, const void *level0, uint32_
 {
     const sy_gl_fns *gl = dev->gl;
     size_t texel = is_float ? 16 : 4, below = 0;
+    /* A 1x1 image is uploaded as 2x2 copies of its texel with a 1x1 level below, as the stand-ins
+     * are (sy_gli_make_standin): the same value under every filter and wrap, and a texture with a
+     * mip level like every other, so llvmpipe does not compile one more variant of the shader for
+     * a texture of one level (TextureEncodingTest's 1x1 colour swatches) */
+    unsigned char quad[4 * 16];
+    if (w == 1 && h == 1) {
+        for (int i = 0; i < 4; ++i) memcpy(quad + (size_t)i * texel, level0, texel);
+        level0 = quad, w = h = 2;
+    }
     for (uint32_t lw = w, lh = h; lw > 1 || lh > 1;) {
         lw = lw > 1 ? lw / 2 : 1, lh = lh > 1 ? lh / 2 : 1;
         below += (size_t)lw * lh;

@@ -144,12 +144,14 @@ const char *const sy_gl_main_vs =
     "#ifdef SY_ASHADOW\n" /* area lights: 8 Poisson taps (hardware PCF each) over the penumbra */ \
     "const vec2 POISSON[8] = vec2[8](vec2(-0.840,-0.074), vec2(0.962,-0.195), vec2(-0.203,0.621), vec2(0.185,-0.893),\n" \
     "  vec2(-0.326,-0.406), vec2(0.473,-0.480), vec2(0.519,0.767), vec2(-0.696,0.457));\n" \
-    "float shadow_area(int si, vec3 p, vec3 ngf) {\n" \
-    "  vec3 q; float r; if (!shadow_coord(si, p, ngf, q, r)) return 1.0;\n" \
+    /* taps: a_count.z (8, the Areas block) for a polygon with a map, 0 for one without. A bound \
+     * that is not a constant keeps the loop a loop (eight unrolled PCF look-ups per shadowed polygon \
+     * made LLVM's code generation about 15 % slower), and llvmpipe leaves a loop as soon as no \
+     * pixel of its block runs it, so a polygon without a map costs no look-up */ \
+    "float shadow_area(int si, int taps, vec3 p, vec3 ngf) {\n" \
+    "  vec3 q; float r; if (taps == 0 || !shadow_coord(si, p, ngf, q, r)) return 1.0;\n" \
     "  r = max(r, 1.5 / float(textureSize(t_shadow, 0).x)); float s = 0.0;\n" \
-    /* a_count.z taps (8, the Areas block): a uniform bound keeps the loop a loop (eight unrolled \
-     * PCF look-ups per shadowed polygon made LLVM's code generation about 15 % slower) */ \
-    "  for (int k = 0; k < a_count.z; ++k) s += texture(t_shadow, vec4(q.xy + POISSON[k & 7] * r, float(si), q.z));\n" \
+    "  for (int k = 0; k < taps; ++k) s += texture(t_shadow, vec4(q.xy + POISSON[k & 7] * r, float(si), q.z));\n" \
     "  return s * 0.125; }\n" \
     "#endif\n" \
     "#ifdef SY_AREA\n" \
@@ -257,13 +259,29 @@ const char *const sy_gl_main_vs =
     "  if (!(abs(side) > 1e-5 * dot(ln, ln) + 1e-9) || (side < 0.0 && rad.w < 0.5)) return vec3(0.0);\n" \
     "  float vis = 1.0;\n" \
     "#ifdef SY_ASHADOW\n" \
-    "  if (shadow != 0) { int si = int(cen.w); vis = si >= 0 ? shadow_area(max(si, 0), P, ngf) : 1.0; }\n" \
+    "  int si = int(cen.w);\n" \
+    "  vis = shadow_area(max(si, 0), shadow != 0 && si >= 0 ? a_count.z : 0, P, ngf);\n" \
     "  if (vis <= 0.0) return vec3(0.0);\n" \
     "#endif\n" \
-    "  float d = ltc_eval(frame, P, i, nvx);\n" \
-    "  float s = rough > 0.0 ? ltc_eval(Minv, P, i, nvx) : 0.0;\n" \
+    /* the lobes (0 diffuse, 1 specular where rough > 0, 2 the clear coat where it has weight) in \
+     * a loop of a bound the compiler cannot see: one inlined copy of ltc_eval, not three (each \
+     * copy is four edge integrals and a table look-up: issue 32's compile time) */ \
+    "  float d = 0.0, s = 0.0, c = 0.0;\n" \
+    "#ifdef SY_LAYERS\n" \
+    "  int lobes = g_fc > 0.0 ? 3 : rough > 0.0 ? 2 : 1;\n" \
+    "#else\n" \
+    "  int lobes = rough > 0.0 ? 2 : 1;\n" \
+    "#endif\n" \
+    "  for (int k = 0; k < lobes; ++k) {\n" \
+    "#ifdef SY_LAYERS\n" \
+    "    mat3 M = k == 0 ? frame : k == 1 ? Minv : g_Mc;\n" \
+    "#else\n" \
+    "    mat3 M = k == 0 ? frame : Minv;\n" \
+    "#endif\n" \
+    "    float e = ltc_eval(M, P, i, nvx);\n" \
+    "    if (k == 0) d = e; else if (k == 1) s = rough > 0.0 ? e : 0.0; else c = e;\n" \
+    "  }\n" \
     "#ifdef SY_LAYERS\n" /* the clear coat's lobe */ \
-    "  float c = g_fc > 0.0 ? ltc_eval(g_Mc, P, i, nvx) : 0.0;\n" \
     "  return rad.rgb * ((kdl + g_sh) * d + fl * s + vec3(g_fc * c)) * vis;\n" \
     "#else\n" \
     "  return rad.rgb * (kdl * d + fl * s) * vis;\n" \
@@ -312,14 +330,13 @@ const char *const sy_gl_main_vs =
     "      fl *= g_ls; kdl *= g_ls; layer_area(ns, wo);\n" \
     "#endif\n" \
     "#define SY_AREA_L(i, sh) shade_area(i, sh, P, ngf, frame, Minv, kdl, fl, rough)\n" \
-    /* two loops, not one call per polygon: sixteen inlined copies of shade_area (two LTC \
-     * evaluations and eight shadow taps each) took llvmpipe's LLVM many seconds to compile. The \
-     * polygons up to the last with a shadow map (a_count.y; maps go to the first polygons) run \
-     * with the look-up, the rest without (llvmpipe runs both sides of a branch). The bounds are \
-     * uniforms, not constants: the compiler cannot unroll the loops, so each body is compiled \
-     * once, and a program does not depend on the polygon count (issue 32) */ \
-    "      for (int i = 0; i < a_count.y; ++i) L += SY_AREA_L(i, 1);\n" \
-    "      for (int i = a_count.y; i < a_count.x; ++i) L += SY_AREA_L(i, 0);\n" \
+    /* one loop, not one call per polygon: sixteen inlined copies of shade_area took llvmpipe's \
+     * LLVM many seconds to compile, and two loops (with and without shadow look-ups) twice the \
+     * time of one. The polygons up to the last with a shadow map (a_count.y; maps go to the first \
+     * polygons) look theirs up, the rest run no tap (shadow_area). The bound is a uniform, not a \
+     * constant: the compiler cannot unroll the loop, so its body is compiled once, and a program \
+     * does not depend on the polygon count (issue 32) */ \
+    "      for (int i = 0; i < a_count.x; ++i) L += SY_AREA_L(i, i < a_count.y ? 1 : 0);\n" \
     /* the area lights' indirect light (sy_gl_set_ambient), stronger on surfaces facing the way the \
      * emitters shine (they see the directly lit surfaces), weaker on those facing the emitters; not \
      * on emitters (the estimate counts them as sources only) */ \
@@ -342,23 +359,33 @@ const char *const sy_gl_main_vs =
      * de Rousiers 2014, "Moving Frostbite to PBR", eq. 55); looking up R alone lights rough \
      * surfaces from below the horizon */ \
     "      float ga = rough * rough; vec3 Rd = normalize(mix(ns, R, (1.0 - ga) * (sqrt(1.0 - ga) + ga)));\n" \
-    "      vec3 env = kd * (1.0 - fd_avg) * irr + fspec * env_spec(Rd, rough);\n" \
-    "#ifdef SY_TRANS\n" \
-    "      {\n" /* glass: Fresnel reflection + refraction of the environment */ \
-    "        float F = schlick1(f0d, nv);\n" \
+    "      vec3 env = kd * (1.0 - fd_avg) * irr;\n" \
+    "#ifdef SY_TRANS\n" /* glass: Fresnel reflection + refraction of the environment */ \
+    "      float F = schlick1(f0d, nv);\n" \
     /* through a solid: refract in, cross a sphere tangent to this point, refract out (exact for \
      * a glass ball: the environment appears inverted as in the path tracer) */ \
-    "        float eta = max(ior, 1.0); vec3 T = refract(-wo, ns, 1.0 / eta);\n" \
-    "        if (dot(T, T) == 0.0) T = R; else {\n" \
-    "          vec3 n2 = ns - 2.0 * dot(ns, T) * T;\n" /* the exit normal (outward) */ \
-    "          vec3 T2 = refract(T, -n2, eta); T = dot(T2, T2) > 0.0 ? T2 : reflect(T, -n2);\n" \
-    "        }\n" \
+    "      float eta = max(ior, 1.0); vec3 T = refract(-wo, ns, 1.0 / eta);\n" \
+    "      if (dot(T, T) == 0.0) T = R; else {\n" \
+    "        vec3 n2 = ns - 2.0 * dot(ns, T) * T;\n" /* the exit normal (outward) */ \
+    "        vec3 T2 = refract(T, -n2, eta); T = dot(T2, T2) > 0.0 ? T2 : reflect(T, -n2);\n" \
+    "      }\n" \
     "#ifdef SY_LAYERS\n" \
-    "        env += w_trans * (F * env_spec(R, rough) + (1.0 - F) * bc * layer_transmittance() * env_spec(T, rough));\n" \
+    "      vec3 wt = (1.0 - F) * bc * layer_transmittance();\n" \
     "#else\n" \
-    "        env += w_trans * (F * env_spec(R, rough) + (1.0 - F) * bc * env_spec(T, rough));\n" \
+    "      vec3 wt = (1.0 - F) * bc;\n" \
     "#endif\n" \
-    "      }\n"    "#endif\n" \
+    /* the look-ups (the lobe's, the glass's reflection and refraction) in a loop of a bound the \
+     * compiler cannot see: one inlined cube look-up instead of three (issue 32's compile time), \
+     * and a pixel that transmits nothing makes one */ \
+    "      vec3 tr = vec3(0.0); int looks = w_trans > 0.0 ? 3 : 1;\n" \
+    "      for (int k = 0; k < looks; ++k) {\n" \
+    "        vec3 c = env_spec(k == 0 ? Rd : k == 1 ? R : T, rough);\n" \
+    "        if (k == 0) env += fspec * c; else if (k == 1) tr += F * c; else tr += wt * c;\n" \
+    "      }\n" \
+    "      env += w_trans * tr;\n" \
+    "#else\n" \
+    "      env += fspec * env_spec(Rd, rough);\n" \
+    "#endif\n" \
     "#ifdef SY_LAYERS\n" \
     "      env = layer_env(env, ns, wo, nv, irr);\n" \
     "#endif\n" \
