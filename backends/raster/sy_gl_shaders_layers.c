@@ -44,6 +44,7 @@ const char *const sy_gl_layers_fs =
     "vec4 g_l0, g_l1, g_l2, g_l3, g_l4, g_l5;\n" /* m_l0 .. m_l5 times the textures (layer_init) */
     "vec3 g_at, g_T, g_B;\n" /* the anisotropy direction (world; zero: none); its frame at ns (layer_f0) */
     "bool g_an;\n" /* that frame exists */
+    "float g_se;\n" /* the sheen's directional albedo E(n.v) at the sheen roughness (layer_f0) */
     "vec2 ltuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_lxf[2*k].xyz, h), dot(m_lxf[2*k+1].xyz, h)); }\n"
     /* the factors times their textures (slots: sy_gli_layer_refs; uv sets in m_lt0, m_lt1, -1 = none)
      * and the coat's normal (the vertex normal n, bent by its own map, flipped to the side seen);
@@ -95,18 +96,22 @@ const char *const sy_gl_layers_fs =
     "  float opd = 2.0 * ior * d * c2; vec3 phi = vec3(phi21) + phi23;\n"
     "  vec3 R123 = clamp(R12 * R23, 1e-5, 0.9999), r123 = sqrt(R123), Rs = T121 * T121 * R23 / (1.0 - R123);\n"
     "  vec3 I = R12 + Rs, Cm = Rs - T121;\n"
-    "  Cm *= r123; I += Cm * 2.0 * irid_sensitivity(opd, phi);\n"
-    "  Cm *= r123; I += Cm * 2.0 * irid_sensitivity(2.0 * opd, 2.0 * phi);\n"
+    /* the first two orders of the series, in a loop whose bound (2 for any film: d >= 0) the \
+     * compiler cannot see, so irid_sensitivity is inlined once (issue 32's compile time) */ \
+    "  int orders = d >= 0.0 ? 2 : 0;\n"
+    "  for (int m = 1; m <= orders; ++m) { Cm *= r123; I += Cm * 2.0 * irid_sensitivity(float(m) * opd, float(m) * phi); }\n"
     "  return max(I, vec3(0.0)); }\n"
     /* the dielectric lobe's F0 f0c (tinted by the specular colour) and the metal's f0m (the base
      * colour), each mixed by the film's weight with the film's F0 seen at n.v (Schlick inverted, as
      * the Sample Viewer). One film over the base mix(f0c, bc, metallic) serves both lobes (exact
      * for metals and dielectrics; the Sample Viewer evaluates two, which doubles the compile) */
     "float layer_scale(vec3 ns, vec3 wo);\n"
+    "float layer_sheen_e(float nv, float r);\n"
     "bool layer_frame(vec3 ns, out vec3 T, out vec3 B);\n"
     /* once per fragment: also g_ls and the anisotropy frame (not per light: every light's call is
      * inlined, and llvmpipe compiles each copy) */
     "void layer_f0(float f0, vec3 bc, float metallic, vec3 ns, vec3 wo, float nv, out vec3 f0c, out vec3 f0m) {\n"
+    "  g_se = layer_sheen_e(max(dot(ns, wo), 0.0), g_l1.y);\n" /* once: layer_scale and layer_area read it */
     "  g_ls = layer_scale(ns, wo); g_an = layer_frame(ns, g_T, g_B);\n"
     "  f0c = min(f0 * g_l0.rgb, vec3(1.0)); f0m = bc; if (!(g_l5.x > 0.0)) return;\n"
     "  float m = 1.0 - clamp(nv, 0.0, 1.0), m5 = m * m * m * m * m;\n"
@@ -136,7 +141,7 @@ const char *const sy_gl_layers_fs =
     /* what lies under the coat and the sheen keeps this much of its light */
     "float layer_scale(vec3 ns, vec3 wo) {\n"
     "  float s = 1.0 - g_l0.w * schlick1(0.04, max(dot(g_nc, wo), 0.0));\n"
-    "  return s * (1.0 - layer_max3(g_l2.rgb) * layer_sheen_e(max(dot(ns, wo), 0.0), g_l1.y)); }\n"
+    "  return s * (1.0 - layer_max3(g_l2.rgb) * g_se); }\n"
     /* f: the base's BRDF for light from wi (ns.wi = nl > 0); the caller multiplies by nl */
     "vec3 layer_light(vec3 wi, vec3 wo, vec3 ns, float nl, vec3 f) {\n"
     "  vec3 h = normalize(wi + wo); vec3 r = f * g_ls;\n"
@@ -171,7 +176,7 @@ const char *const sy_gl_layers_fs =
      * base); the sheen as a wide lobe of albedo sheen colour x E(n.v) on the diffuse form factor
      * (as the environment's irradiance stands in for its prefiltered light) */
     "void layer_area(vec3 ns, vec3 wo) {\n"
-    "  g_sh = g_l2.rgb * layer_sheen_e(max(dot(ns, wo), 0.0), g_l1.y);\n"
+    "  g_sh = g_l2.rgb * g_se;\n"
     "  g_fc = g_l1.x > 0.0 ? g_l0.w : 0.0; g_Mc = mat3(1.0); if (!(g_fc > 0.0)) return;\n"
     "  vec3 n = g_nc; float cv = max(dot(n, wo), 1e-4);\n"
     "  vec2 luv = vec2(g_l1.x, sqrt(1.0 - cv)) * (63.0 / 64.0) + 0.5 / 64.0;\n"
