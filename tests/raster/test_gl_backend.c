@@ -25,24 +25,11 @@ static void on_log(void *u, const char *m)
     snprintf(last_warning, sizeof last_warning, "%s", m);
 }
 
+/* Quads here carry texture coordinates (0,0) (1,0) (1,1) (0,1). */
 static sy_gl_mesh quad(sy_gl_device *d, const float *p4 /* 4 corners xyz */, const float n[3])
 {
-    float nrm[12];
-    for (int i = 0; i < 4; ++i) memcpy(nrm + 3 * i, n, 3 * sizeof(float));
     static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
-    static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    sy_gl_mesh_desc md = {.positions = p4, .normals = nrm, .uv = {uv, NULL}, .indices = idx, .vertex_count = 4, .triangle_count = 2};
-    sy_gl_mesh m;
-    MUST(sy_gl_mesh_create(d, &md, &m));
-    return m;
-}
-
-static sy_gl_instance place(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat)
-{
-    sy_gl_instance_desc id = {.mesh = m, .material = mat, .transform = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
-    sy_gl_instance in;
-    MUST(sy_gl_instance_create(d, &id, &in));
-    return in;
+    return gl_test_quad(d, p4, n, uv);
 }
 
 /* An unlit material showing texture t (white factor). */
@@ -107,7 +94,7 @@ int main(int argc, char **argv)
     emd.emissive[0] = 17, emd.emissive[1] = 12, emd.emissive[2] = 4;
     sy_gl_material em;
     MUST(sy_gl_material_create(d, &emd, &em));
-    sy_gl_instance iq = place(d, mq, em);
+    sy_gl_instance iq = gl_test_place(d, mq, em);
     render(d, &cam);
     const float *c = px(30, 30);
     EXPECT_MSG(c[0] == 17.0f && c[1] == 12.0f && c[2] == 4.0f && c[3] == 1.0f, "emitter pixel %g %g %g %g", c[0], c[1], c[2], c[3]);
@@ -158,8 +145,8 @@ int main(int argc, char **argv)
         const float near_q[12] = {-1, -1, -2, 1, -1, -2, 1, 1, -2, -1, 1, -2};
         const float far_q[12] = {-1, -1, -4, 1, -1, -4, 1, 1, -4, -1, 1, -4};
         sy_gl_mesh mn = quad(d, near_q, nz), mf = quad(d, far_q, nz);
-        sy_gl_instance a = place(d, mn, material(d, 1, 0, 0, 0.5f, true, SY_GL_ALPHA_BLEND));
-        sy_gl_instance b = place(d, mf, material(d, 0, 0, 1, 0.5f, true, SY_GL_ALPHA_BLEND));
+        sy_gl_instance a = gl_test_place(d, mn, material(d, 1, 0, 0, 0.5f, true, SY_GL_ALPHA_BLEND));
+        sy_gl_instance b = gl_test_place(d, mf, material(d, 0, 0, 1, 0.5f, true, SY_GL_ALPHA_BLEND));
         render(d, &cam);
         c = px(32, 32);
         EXPECT_MSG(near_(c[0], 0.5f, 1e-5f) && c[1] == 0.0f && near_(c[2], 0.25f, 1e-5f) && near_(c[3], 0.75f, 1e-5f),
@@ -167,7 +154,7 @@ int main(int argc, char **argv)
         EXPECT_MSG(near_(depth[32 * N + 32], 2.0f, 1e-5f), "blend depth %g (want the nearest surface, 2)", depth[32 * N + 32]);
         MUST(sy_gl_instance_destroy(d, a));
         MUST(sy_gl_instance_destroy(d, b));
-        sy_gl_instance m = place(d, mn, material(d, 1, 1, 1, 0.3f, true, SY_GL_ALPHA_MASK));
+        sy_gl_instance m = gl_test_place(d, mn, material(d, 1, 1, 1, 0.3f, true, SY_GL_ALPHA_MASK));
         render(d, &cam);
         EXPECT_MSG(px(32, 32)[3] == 0.0f && isinf(depth[32 * N + 32]), "masked-out quad is visible (alpha %g)", px(32, 32)[3]);
         MUST(sy_gl_instance_destroy(d, m));
@@ -183,7 +170,7 @@ int main(int argc, char **argv)
         for (int k = 0; k < 4; ++k) bq[3 * k + 2] -= dz;
         sy_gl_mesh mf = quad(d, fq, nz), mb = quad(d, bq, nz);
         sy_gl_material red = material(d, 1, 0, 0, 1, true, SY_GL_ALPHA_OPAQUE), blue = material(d, 0, 0, 1, 1, true, SY_GL_ALPHA_OPAQUE);
-        sy_gl_instance b = place(d, mb, blue), f = place(d, mf, red); /* the back one first */
+        sy_gl_instance b = gl_test_place(d, mb, blue), f = gl_test_place(d, mf, red); /* the back one first */
         sy_gl_camera tiny = cam;
         tiny.near_clip = 5.6e-5f;
         tiny.far_clip = 0.0f;
@@ -209,8 +196,8 @@ int main(int argc, char **argv)
         const float front_q[12] = {-9, -9, -1, 9, -9, -1, 9, 9, -1, -9, 9, -1};
         sy_gl_mesh mn = quad(d, near_q, nz), mf = quad(d, far_q, nz), mfr = quad(d, front_q, nz);
         sy_gl_material opaque = material(d, 1, 1, 1, 1, true, SY_GL_ALPHA_OPAQUE);
-        sy_gl_instance in_n = place(d, mn, opaque), in_f = place(d, mf, opaque);
-        sy_gl_instance cut = place(d, mfr, material(d, 1, 1, 1, 0.3f, true, SY_GL_ALPHA_MASK));
+        sy_gl_instance in_n = gl_test_place(d, mn, opaque), in_f = gl_test_place(d, mf, opaque);
+        sy_gl_instance cut = gl_test_place(d, mfr, material(d, 1, 1, 1, 0.3f, true, SY_GL_ALPHA_MASK));
         int wrong = 0, hits = 0, tested = 0;
         for (int y = 0; y < N; ++y)
             for (int x = 0; x < N; ++x) {
@@ -230,7 +217,7 @@ int main(int argc, char **argv)
             }
         EXPECT_MSG(wrong == 0 && hits > 100, "%d of %d picks wrong (%d hits expected)", wrong, tested, hits);
         MUST(sy_gl_instance_destroy(d, cut));
-        cut = place(d, mfr, material(d, 1, 1, 1, 0.8f, true, SY_GL_ALPHA_MASK));
+        cut = gl_test_place(d, mfr, material(d, 1, 1, 1, 0.8f, true, SY_GL_ALPHA_MASK));
         sy_gl_pick_hit ph;
         MUST(sy_gl_pick(d, &cam, N, N, N / 2, N / 2, &ph));
         EXPECT_MSG(ph.instance.id == cut.id, "a masked quad above its cutoff is not picked (%#x)", ph.instance.id);
@@ -252,7 +239,7 @@ int main(int argc, char **argv)
         EXPECT_MSG(warnings == w0 + 1 && strstr(last_warning, "downscaled to 4x4"), "warning: '%s'", last_warning);
         sy_gl_material mt = unlit_textured(d, t);
         const float near_q[12] = {-1, -1, -2, 1, -1, -2, 1, 1, -2, -1, 1, -2};
-        sy_gl_instance it = place(d, quad(d, near_q, nz), mt);
+        sy_gl_instance it = gl_test_place(d, quad(d, near_q, nz), mt);
         render(d, &cam);
         float want = powf((188.0f / 255.0f + 0.055f) / 1.055f, 2.4f);
         EXPECT_MSG(near_(px(32, 32)[0], want, 0.01f), "sRGB texel %g (want %g)", px(32, 32)[0], want);
@@ -274,7 +261,7 @@ int main(int argc, char **argv)
         sy_gl_material mt = unlit_textured(d, t);
         /* one pixel: 1/32 of the view's width of 2 at depth 1, i.e. 0.0625 at depth 2 */
         const float one_px[12] = {0, 0, -2, 0.0625f, 0, -2, 0.0625f, 0.0625f, -2, 0, 0.0625f, -2};
-        sy_gl_instance it = place(d, quad(d, one_px, nz), mt);
+        sy_gl_instance it = gl_test_place(d, quad(d, one_px, nz), mt);
         render(d, &cam);
         int covered = 0;
         float v = 0.0f;
@@ -292,8 +279,8 @@ int main(int argc, char **argv)
         const float occ_q[12] = {-0.5f, 1, 0.5f, 0.5f, 1, 0.5f, 0.5f, 1, -0.5f, -0.5f, 1, -0.5f};
         const float ny[3] = {0, 1, 0};
         sy_gl_material grey = material(d, 0.5f, 0.5f, 0.5f, 1, false, SY_GL_ALPHA_OPAQUE);
-        sy_gl_instance fl = place(d, quad(d, floor_q, ny), grey);
-        sy_gl_instance oc = place(d, quad(d, occ_q, ny), grey);
+        sy_gl_instance fl = gl_test_place(d, quad(d, floor_q, ny), grey);
+        sy_gl_instance oc = gl_test_place(d, quad(d, occ_q, ny), grey);
         sy_gl_light_desc ld = {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3, .direction = {1, -1, 0}};
         sy_gl_light l;
         MUST(sy_gl_light_create(d, &ld, &l));
@@ -340,7 +327,7 @@ int main(int argc, char **argv)
         MUST(sy_gl_device_create(&md, &d));
         sy_gl_mesh m = quad(d, q1, nz);
         MUST(sy_gl_material_create(d, &emd, &em));
-        place(d, m, em);
+        gl_test_place(d, m, em);
         render(d, &cam);
         c = px(30, 30);
         EXPECT_MSG(c[0] == 17.0f && c[1] == 12.0f && c[2] == 4.0f && c[3] == 1.0f, "MSAA interior %g %g %g %g", c[0], c[1], c[2], c[3]);
@@ -380,8 +367,8 @@ int main(int argc, char **argv)
             const float occ_q[12] = {-0.5f, 1, 0.5f, 0.5f, 1, 0.5f, 0.5f, 1, -0.5f, -0.5f, 1, -0.5f};
             const float ny[3] = {0, 1, 0};
             sy_gl_material grey = material(d, 0.5f, 0.5f, 0.5f, 1, false, SY_GL_ALPHA_OPAQUE);
-            place(d, quad(d, floor_q, ny), grey);
-            place(d, quad(d, occ_q, ny), grey);
+            gl_test_place(d, quad(d, floor_q, ny), grey);
+            gl_test_place(d, quad(d, occ_q, ny), grey);
             render(d, &top);
             EXPECT_MSG(warnings == 0, "a frame without lights made shadow maps: %s", last_warning);
             sy_gl_light_desc ld = {.type = SY_GL_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3, .direction = {1, -1, 0}};

@@ -30,24 +30,7 @@ static const sy_gl_render_desc full = {N, N, 0, 0, N, N};
 static const float *px(int x, int y) { return rgba + 4 * (y * N + x); }
 static bool near_(float a, float b, float tol) { return fabsf(a - b) <= tol * fmaxf(1e-3f, fabsf(b)); }
 
-static sy_gl_mesh quad(sy_gl_device *d, const float *p4, const float n[3])
-{
-    float nrm[12];
-    for (int i = 0; i < 4; ++i) memcpy(nrm + 3 * i, n, 3 * sizeof(float));
-    static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    sy_gl_mesh_desc md = {.positions = p4, .normals = nrm, .indices = idx, .vertex_count = 4, .triangle_count = 2};
-    sy_gl_mesh m;
-    MUST(sy_gl_mesh_create(d, &md, &m));
-    return m;
-}
-
-static sy_gl_instance place(sy_gl_device *d, sy_gl_mesh m, sy_gl_material mat)
-{
-    sy_gl_instance_desc id = {.mesh = m, .material = mat, .transform = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
-    sy_gl_instance in;
-    MUST(sy_gl_instance_create(d, &id, &in));
-    return in;
-}
+static sy_gl_mesh quad(sy_gl_device *d, const float *p4, const float n[3]) { return gl_test_quad(d, p4, n, NULL); }
 
 /* A perfect mirror: metallic 1, roughness 0 (it gets a scene probe). */
 static sy_gl_material mirror(sy_gl_device *d)
@@ -115,7 +98,7 @@ int main(int argc, char **argv)
     /* 1. constant environment: Lambert = base x E; no background from it */
     sy_gl_texture env = env_texture(d, 1.5f, 1.5f);
     sy_gl_mesh mq = quad(d, facing, nz);
-    sy_gl_instance q = place(d, mq, lambert(d, 0.5f));
+    sy_gl_instance q = gl_test_place(d, mq, lambert(d, 0.5f));
     sy_gl_set_environment(d, env, 2.0f);
     /* 1a. (the device's first frame) a mirror (it gets a scene probe) in a corner of the view: the
      * Lambert quad shades as without it, and the frame builds one program for both (the quad reads
@@ -124,7 +107,7 @@ int main(int argc, char **argv)
     {
         sy_gl_material mm = mirror(d);
         const float corner[12] = {-1.4f, 1.1f, -2.5f, -1.1f, 1.1f, -2.5f, -1.1f, 1.4f, -2.5f, -1.4f, 1.4f, -2.5f};
-        sy_gl_instance mi = place(d, quad(d, corner, nz), mm);
+        sy_gl_instance mi = gl_test_place(d, quad(d, corner, nz), mm);
         sy_gl_stats st0, st1;
         sy_gl_device_stats(d, &st0);
         MUST(sy_gl_render(d, &cam, &full, rgba, depth));
@@ -161,14 +144,14 @@ int main(int argc, char **argv)
         /* a mirror tilted 30 degrees about x, facing up-forward: view rays reflect upwards */
         const float tilt[12] = {-1, -1.2f, -2.5f, 1, -1.2f, -2.5f, 1, 0.6f, -3.5f, -1, 0.6f, -3.5f};
         const float tn[3] = {0, 0.866f, 0.5f};
-        sy_gl_instance mi = place(d, quad(d, tilt, tn), mm);
+        sy_gl_instance mi = gl_test_place(d, quad(d, tilt, tn), mm);
         MUST(sy_gl_render(d, &cam, &full, rgba, depth));
         printf("mirror up %g (want 2)\n", px(16, 16)[0]);
         EXPECT_MSG(near_(px(16, 16)[0], 2.0f, 0.03f), "mirror reflects the upper half: %g (want 2)", px(16, 16)[0]);
         const float flip[12] = {-1, 0.6f, -2.5f, 1, 0.6f, -2.5f, 1, -1.2f, -3.5f, -1, -1.2f, -3.5f};
         const float fn[3] = {0, -0.866f, 0.5f};
         MUST(sy_gl_instance_destroy(d, mi));
-        mi = place(d, quad(d, flip, fn), mm);
+        mi = gl_test_place(d, quad(d, flip, fn), mm);
         MUST(sy_gl_render(d, &cam, &full, rgba, depth));
         EXPECT_MSG(near_(px(16, 16)[0], 0.5f, 0.03f), "mirror reflects the lower half: %g (want 0.5)", px(16, 16)[0]);
         MUST(sy_gl_instance_destroy(d, mi));
@@ -177,7 +160,7 @@ int main(int argc, char **argv)
         /* 2b. the mirror sees the scene (its probe), not only the environment: with no environment,
          * an emissive green ceiling above it is what the upward reflections see; hiding the ceiling
          * re-renders the probe and the mirror goes black */
-        mi = place(d, quad(d, tilt, tn), mm);
+        mi = gl_test_place(d, quad(d, tilt, tn), mm);
         sy_gl_material_desc gd;
         sy_gl_material_desc_init(&gd);
         gd.base_color[0] = gd.base_color[1] = gd.base_color[2] = 0.0f;
@@ -187,7 +170,7 @@ int main(int argc, char **argv)
         MUST(sy_gl_material_create(d, &gd, &gm));
         const float ceiling[12] = {-4, 3, 1, 4, 3, 1, 4, 3, -8, -4, 3, -8};
         const float down[3] = {0, -1, 0};
-        sy_gl_instance ci = place(d, quad(d, ceiling, down), gm);
+        sy_gl_instance ci = gl_test_place(d, quad(d, ceiling, down), gm);
         MUST(sy_gl_render(d, &cam, &full, rgba, depth));
         printf("mirror under a green ceiling %g %g (want 0 4)\n", px(16, 16)[0], px(16, 16)[1]);
         EXPECT_MSG(near_(px(16, 16)[1], 4.0f, 0.03f) && px(16, 16)[0] < 0.01f, "mirror reflects the ceiling: %g %g (want 0 4)",
@@ -239,7 +222,7 @@ int main(int argc, char **argv)
                             .near_clip = 0.1f};
         const float floor_q[12] = {-5, 0, 5, 5, 0, 5, 5, 0, -5, -5, 0, -5};
         const float ny[3] = {0, 1, 0};
-        sy_gl_instance fl = place(d, quad(d, floor_q, ny), lambert(d, 0.5f));
+        sy_gl_instance fl = gl_test_place(d, quad(d, floor_q, ny), lambert(d, 0.5f));
         /* counter-clockwise seen from below: the front faces down */
         sy_gl_area_light al = {.vertices = {{-0.5f, 1, -0.5f}, {0.5f, 1, -0.5f}, {0.5f, 1, 0.5f}, {-0.5f, 1, 0.5f}},
                                .vertex_count = 4, .radiance = {10, 10, 10}};
@@ -264,7 +247,7 @@ int main(int argc, char **argv)
         EXPECT_MSG(near_(px(16, 16)[0], want, 0.04f), "double-sided emitter: %g (want %g)", px(16, 16)[0], want);
         /* an occluder between light and floor: the centre is in (soft) shadow */
         const float occ_q[12] = {-0.3f, 0.5f, 0.3f, 0.3f, 0.5f, 0.3f, 0.3f, 0.5f, -0.3f, -0.3f, 0.5f, -0.3f};
-        sy_gl_instance oc = place(d, quad(d, occ_q, ny), lambert(d, 0.5f));
+        sy_gl_instance oc = gl_test_place(d, quad(d, occ_q, ny), lambert(d, 0.5f));
         MUST(sy_gl_set_area_lights(d, &al, 1));
         sy_gl_camera under = top;
         under.camera_to_world[13] = 0.4f;
