@@ -90,26 +90,81 @@ static inline sy_rt_mesh rt_quad(sy_rt_device *dev, float h)
     return m;
 }
 
+/* An instance of mesh with material mat; xf is its object-to-world matrix, NULL for the identity. */
 static inline sy_rt_instance rt_place(sy_rt_device *dev, sy_rt_mesh mesh, const float xf[16], sy_rt_material mat,
                                       uint32_t flags)
 {
     sy_rt_instance_desc d = {.mesh = mesh, .material = mat, .flags = flags};
-    memcpy(d.transform, xf, sizeof d.transform);
+    if (xf)
+        memcpy(d.transform, xf, sizeof d.transform);
+    else
+        rt_identity(d.transform);
     sy_rt_instance inst;
     MUST(sy_rt_instance_create(dev, &d, &inst));
     return inst;
+}
+
+/* A mesh of positions and indices only, from arrays the caller malloc'd; frees both. */
+static inline sy_rt_mesh rt_mesh_take(sy_rt_device *dev, float *pos, uint32_t *idx, uint32_t nv, uint32_t nt)
+{
+    sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = nv, .triangle_count = nt};
+    sy_rt_mesh m;
+    MUST(sy_rt_mesh_create(dev, &d, &m));
+    free(pos);
+    free(idx);
+    return m;
+}
+
+/* A UV sphere of radius r at the origin: (n + 1)^2 vertices, 2 n^2 triangles; with vertex normals
+ * (the unit directions) when normals is true. */
+static inline sy_rt_mesh rt_uv_sphere(sy_rt_device *dev, float r, uint32_t n, bool normals)
+{
+    uint32_t nv = (n + 1) * (n + 1), nt = 2 * n * n, t = 0;
+    float *pos = malloc(3 * sizeof(float) * nv), *nrm = malloc(3 * sizeof(float) * nv);
+    uint32_t *idx = malloc(3 * sizeof(uint32_t) * nt);
+    if (!pos || !nrm || !idx) exit(1);
+    for (uint32_t i = 0, k = 0; i <= n; ++i)
+        for (uint32_t j = 0; j <= n; ++j, ++k) {
+            double th = M_PI * i / n, ph = 2 * M_PI * j / n;
+            float *q = nrm + 3 * k;
+            q[0] = (float)(sin(th) * cos(ph)), q[1] = (float)cos(th), q[2] = (float)(sin(th) * sin(ph));
+            for (int c = 0; c < 3; ++c) pos[3 * k + c] = r * q[c];
+        }
+    for (uint32_t i = 0; i < n; ++i)
+        for (uint32_t j = 0; j < n; ++j) {
+            uint32_t a = i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
+            idx[t++] = a, idx[t++] = c, idx[t++] = b;
+            idx[t++] = b, idx[t++] = c, idx[t++] = d;
+        }
+    sy_rt_mesh_desc md = {.positions = pos, .normals = normals ? nrm : NULL, .indices = idx, .vertex_count = nv,
+                          .triangle_count = nt};
+    sy_rt_mesh m;
+    MUST(sy_rt_mesh_create(dev, &md, &m));
+    free(pos);
+    free(nrm);
+    free(idx);
+    return m;
+}
+
+/* The material of d (which must be valid). */
+static inline sy_rt_material rt_material(sy_rt_device *dev, const sy_rt_material_desc *d)
+{
+    sy_rt_material m;
+    MUST(sy_rt_material_create(dev, d, &m));
+    return m;
+}
+
+static inline void rt_set3(float v[3], float x, float y, float z)
+{
+    v[0] = x, v[1] = y, v[2] = z;
 }
 
 static inline sy_rt_material rt_emitter(sy_rt_device *dev, float r, float g, float b)
 {
     sy_rt_material_desc d;
     sy_rt_material_desc_init(&d);
-    d.emissive[0] = r;
-    d.emissive[1] = g;
-    d.emissive[2] = b;
-    sy_rt_material m;
-    MUST(sy_rt_material_create(dev, &d, &m));
-    return m;
+    rt_set3(d.emissive, r, g, b);
+    return rt_material(dev, &d);
 }
 
 /* Pure Lambert material (no specular lobe). */
@@ -117,14 +172,21 @@ static inline sy_rt_material rt_lambert(sy_rt_device *dev, float r, float g, flo
 {
     sy_rt_material_desc d;
     sy_rt_material_desc_init(&d);
-    d.base_color[0] = r;
-    d.base_color[1] = g;
-    d.base_color[2] = b;
+    rt_set3(d.base_color, r, g, b);
     d.metallic = 0.0f;
     d.specular = 0.0f;
-    sy_rt_material m;
-    MUST(sy_rt_material_create(dev, &d, &m));
-    return m;
+    return rt_material(dev, &d);
+}
+
+/* A metal (metallic 1) of base colour (r, g, b) and the given roughness. */
+static inline sy_rt_material rt_metal(sy_rt_device *dev, float r, float g, float b, float roughness)
+{
+    sy_rt_material_desc d;
+    sy_rt_material_desc_init(&d);
+    rt_set3(d.base_color, r, g, b);
+    d.metallic = 1.0f;
+    d.roughness = roughness;
+    return rt_material(dev, &d);
 }
 
 /* Perspective camera at (0, 0, z) looking down -Z with a symmetric window of half-tangent t. */

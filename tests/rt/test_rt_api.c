@@ -170,9 +170,7 @@ static void test_shared_mesh(void)
             EXPECT_MSG(st.mesh_bytes == sizeof nrm + sizeof uv && st.shared_bytes == 0, "copied mesh: %llu bytes copied",
                        (unsigned long long)st.mesh_bytes);
         sy_rt_material mat = rt_emitter(dev, 0.25f, 0.5f, 1.0f);
-        float xf[16];
-        rt_identity(xf);
-        sy_rt_instance inst = rt_place(dev, m, xf, mat, 0);
+        sy_rt_instance inst = rt_place(dev, m, NULL, mat, 0);
         MUST(sy_rt_mesh_destroy(dev, m));
         EXPECT_MSG(released == 0, "released while an instance uses the mesh");
         MUST(sy_rt_commit(dev));

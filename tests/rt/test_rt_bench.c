@@ -6,41 +6,11 @@
 #include "rt_test.h"
 #include "sy_rt_bench.h"
 
-/* A UV sphere mesh of roughly 2 * n * n triangles. */
-static sy_rt_mesh sphere(sy_rt_device *dev, int n)
-{
-    int nv = (n + 1) * (n + 1);
-    float *pos = malloc(sizeof(float) * 3 * nv), *nrm = malloc(sizeof(float) * 3 * nv);
-    uint32_t *idx = malloc(sizeof(uint32_t) * 6 * n * n);
-    int k = 0;
-    for (int i = 0; i <= n; ++i)
-        for (int j = 0; j <= n; ++j, ++k) {
-            double th = M_PI * i / n, ph = 2 * M_PI * j / n;
-            nrm[3 * k] = pos[3 * k] = (float)(sin(th) * cos(ph));
-            nrm[3 * k + 1] = pos[3 * k + 1] = (float)cos(th);
-            nrm[3 * k + 2] = pos[3 * k + 2] = (float)(sin(th) * sin(ph));
-        }
-    int t = 0;
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-            uint32_t a = i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
-            idx[t++] = a; idx[t++] = c; idx[t++] = b;
-            idx[t++] = b; idx[t++] = c; idx[t++] = d;
-        }
-    sy_rt_mesh_desc md = {.positions = pos, .normals = nrm, .indices = idx, .vertex_count = (uint32_t)nv,
-                          .triangle_count = (uint32_t)(2 * n * n)};
-    sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &md, &m));
-    free(pos);
-    free(nrm);
-    free(idx);
-    return m;
-}
 
 int main(void)
 {
     sy_rt_device *dev = rt_device();
-    sy_rt_mesh s = sphere(dev, 64);
+    sy_rt_mesh s = rt_uv_sphere(dev, 1.0f, 64, true);
     sy_rt_material mat = rt_lambert(dev, 0.6f, 0.5f, 0.4f);
     float xf[16];
     for (int i = 0; i < 8; ++i)

@@ -103,14 +103,11 @@ static float floor_centre(sy_rt_device *dev)
 static void test_area_light_follows(void)
 {
     sy_rt_device *dev = rt_device();
-    float xf[16];
-    rt_identity(xf);
-    rt_place(dev, rt_quad(dev, 10.0f), xf, rt_lambert(dev, 0.8f, 0.8f, 0.8f), 0);
+    rt_place(dev, rt_quad(dev, 10.0f), NULL, rt_lambert(dev, 0.8f, 0.8f, 0.8f), 0);
     sy_rt_material_desc md;
     sy_rt_material_desc_init(&md);
     md.emissive[0] = md.emissive[1] = md.emissive[2] = 5.0f;
-    sy_rt_material em;
-    MUST(sy_rt_material_create(dev, &md, &em));
+    sy_rt_material em = rt_material(dev, &md);
     float lamp[16];
     rt_rot_y(lamp, (float)M_PI, 0.0f, 0.0f, 1.0f);
     sy_rt_instance li = rt_place(dev, rt_quad(dev, 0.2f), lamp, em, 0);

@@ -90,9 +90,7 @@ static void test_background_never_lights(void)
 {
     for (int mode = 0; mode < 2; ++mode) {
         sy_rt_device *dev = rt_device();
-        float id[16];
-        rt_identity(id);
-        rt_place(dev, rt_quad(dev, 1.0f), id, rt_lambert(dev, 0.8f, 0.8f, 0.8f), 0);
+        rt_place(dev, rt_quad(dev, 1.0f), NULL, rt_lambert(dev, 0.8f, 0.8f, 0.8f), 0);
         const float c[3] = {0.3f, 0.6f, 0.9f};
         sy_rt_background bg = {.mode = SY_RT_BACKGROUND_COLOR, .color = {c[0], c[1], c[2]}};
         if (mode == 1) bg = (sy_rt_background){.mode = SY_RT_BACKGROUND_TEXTURE, .texture = const_texture(dev, c), .intensity = 2.0f};
@@ -126,14 +124,8 @@ static void test_environment_is_a_light(void)
     {
         sy_rt_device *dev = rt_device();
         MUST(sy_rt_set_environment(dev, const_texture(dev, L), 1.5f));
-        sy_rt_material_desc md;
-        sy_rt_material_desc_init(&md);
-        md.roughness = 0.0f; /* metallic 1, base 1: a perfect mirror */
-        sy_rt_material mirror;
-        MUST(sy_rt_material_create(dev, &md, &mirror));
-        float id[16];
-        rt_identity(id);
-        rt_place(dev, rt_quad(dev, 1.0f), id, mirror, 0);
+        sy_rt_material mirror = rt_metal(dev, 1.0f, 1.0f, 1.0f, 0.0f); /* a perfect mirror */
+        rt_place(dev, rt_quad(dev, 1.0f), NULL, mirror, 0);
         MUST(sy_rt_commit(dev));
         sy_rt_camera cam = rt_camera(4.0f, 0.5f);
         for (int integ = SY_RT_INTEGRATOR_WHITTED; integ <= SY_RT_INTEGRATOR_PATHTRACER; ++integ) {
@@ -187,11 +179,8 @@ static void test_emission_adds(void)
     md.metallic = 0.0f;
     md.specular = 0.0f;
     md.emissive[0] = 0.1f, md.emissive[1] = 0.2f, md.emissive[2] = 0.3f;
-    sy_rt_material m;
-    MUST(sy_rt_material_create(dev, &md, &m));
-    float id[16];
-    rt_identity(id);
-    rt_place(dev, rt_quad(dev, 1.0f), id, m, 0);
+    sy_rt_material m = rt_material(dev, &md);
+    rt_place(dev, rt_quad(dev, 1.0f), NULL, m, 0);
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 3.0f, .direction = {0, 0, -1}};
     sy_rt_light l;
     MUST(sy_rt_light_create(dev, &ld, &l));
@@ -222,8 +211,7 @@ static void shadow_case(const char *name, const sy_rt_material_desc *bd, const d
     float xf[16];
     floor_xf(xf, 10.0f);
     rt_place(dev, rt_quad(dev, 1.0f), xf, rt_lambert(dev, 1.0f, 1.0f, 1.0f), 0);
-    sy_rt_material bm;
-    MUST(sy_rt_material_create(dev, bd, &bm));
+    sy_rt_material bm = rt_material(dev, bd);
     floor_xf(xf, 5.0f);
     xf[13] = 2.0f; /* the blocker at y = 2, facing up */
     rt_place(dev, rt_quad(dev, 1.0f), xf, bm, 0);
@@ -281,8 +269,7 @@ static void test_whitted_antialiasing(void)
     sy_rt_material_desc_init(&ed);
     ed.base_color[0] = ed.base_color[1] = ed.base_color[2] = 0.0f;
     ed.emissive[0] = 17, ed.emissive[1] = 12, ed.emissive[2] = 4;
-    sy_rt_material em;
-    MUST(sy_rt_material_create(dev, &ed, &em));
+    sy_rt_material em = rt_material(dev, &ed);
     float xf[16];
     rt_rot_y(xf, 0.0f, 0.0f, 0.0f, 0.0f);
     xf[0] = xf[5] = cosf(0.3f), xf[1] = sinf(0.3f), xf[4] = -sinf(0.3f); /* rotated about Z: slanted edges */

@@ -54,12 +54,7 @@ static sy_rt_mesh make_sphere(sy_rt_device *dev, float r, uint32_t seg, uint32_t
             idx[3 * t] = a, idx[3 * t + 1] = b, idx[3 * t + 2] = a + 1, ++t;
             idx[3 * t] = a + 1, idx[3 * t + 1] = b, idx[3 * t + 2] = b + 1, ++t;
         }
-    sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = nv, .triangle_count = nt};
-    sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &d, &m));
-    free(pos);
-    free(idx);
-    return m;
+    return rt_mesh_take(dev, pos, idx, nv, nt);
 }
 
 typedef struct img {
@@ -127,11 +122,8 @@ static sy_rt_device *furnace_scene(const sy_rt_material_desc *md, const float L[
     MUST(sy_rt_set_environment(dev, tex, 1.0f / scale));
     sy_rt_background bg = {.mode = SY_RT_BACKGROUND_TEXTURE, .texture = tex, .intensity = 1.0f / scale};
     MUST(sy_rt_set_background(dev, &bg));
-    sy_rt_material mat;
-    MUST(sy_rt_material_create(dev, md, &mat));
-    float id[16];
-    rt_identity(id);
-    rt_place(dev, make_sphere(dev, 1.0f, 64, 32), id, mat, 0);
+    sy_rt_material mat = rt_material(dev, md);
+    rt_place(dev, make_sphere(dev, 1.0f, 64, 32), NULL, mat, 0);
     MUST(sy_rt_commit(dev));
     return dev;
 }
@@ -353,11 +345,8 @@ static void lum_moments(const img *im, double m[4])
  * 10 cd beside the camera; committed. */
 static sy_rt_camera quad_under_light(sy_rt_device *dev, const sy_rt_material_desc *d)
 {
-    sy_rt_material mat;
-    MUST(sy_rt_material_create(dev, d, &mat));
-    float id[16];
-    rt_identity(id);
-    rt_place(dev, rt_quad(dev, 3.0f), id, mat, 0);
+    sy_rt_material mat = rt_material(dev, d);
+    rt_place(dev, rt_quad(dev, 3.0f), NULL, mat, 0);
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10.0f, .position = {0.0f, 0.0f, 3.0f}};
     sy_rt_light light;
     MUST(sy_rt_light_create(dev, &ld, &light));
@@ -462,9 +451,7 @@ static double sphere_part(sy_rt_device *dev, float r, uint32_t seg, uint32_t rin
     sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = nv, .triangle_count = nt};
     sy_rt_mesh m;
     MUST(sy_rt_mesh_create(dev, &d, &m));
-    float id[16];
-    rt_identity(id);
-    rt_place(dev, m, id, mat, 0);
+    rt_place(dev, m, NULL, mat, 0);
     free(pos);
     free(idx);
     return area;
@@ -488,8 +475,7 @@ static void test_integrating_sphere(void)
     d.specular = 0.0f; /* a black, non-reflecting emitter */
     d.emissive[0] = 1.0f, d.emissive[1] = 2.0f, d.emissive[2] = 0.5f;
     d.double_sided = true;
-    sy_rt_material glow;
-    MUST(sy_rt_material_create(dev, &d, &glow));
+    sy_rt_material glow = rt_material(dev, &d);
     const float a = 0.6f;
     double up = sphere_part(dev, 2.0f, 64, 32, 0, 16, rt_lambert(dev, a, a, a));
     double down = sphere_part(dev, 2.0f, 64, 32, 16, 32, glow);
@@ -614,8 +600,7 @@ static sy_rt_device *mixed_scene(void)
     sy_rt_material_desc_init(&d);
     d.roughness = 0.3f;
     d.metallic = 0.5f;
-    sy_rt_material glossy;
-    MUST(sy_rt_material_create(dev, &d, &glossy));
+    sy_rt_material glossy = rt_material(dev, &d);
     rt_place(dev, rt_quad(dev, 1.0f), xf, glossy, 0);
     rt_translation(xf, 0.3f, 0.2f, 0.0f);
     rt_place(dev, make_sphere(dev, 0.3f, 16, 8), xf, rt_lambert(dev, 0.8f, 0.3f, 0.2f), 0);

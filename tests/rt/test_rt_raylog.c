@@ -45,42 +45,25 @@ static sy_rt_mesh light_quad(sy_rt_device *dev)
     return m;
 }
 
-static sy_rt_mesh sphere(sy_rt_device *dev, float r, uint32_t n)
-{
-    uint32_t nv = (n + 1) * (n + 1), nt = 2 * n * n, t = 0;
-    float *pos = malloc(3 * sizeof(float) * nv);
-    uint32_t *idx = malloc(3 * sizeof(uint32_t) * nt);
-    for (uint32_t i = 0; i <= n; ++i)
-        for (uint32_t j = 0; j <= n; ++j) {
-            double th = M_PI * i / n, ph = 2 * M_PI * j / n;
-            float *q = pos + 3 * (i * (n + 1) + j);
-            q[0] = r * (float)(sin(th) * cos(ph)), q[1] = r * (float)cos(th), q[2] = r * (float)(sin(th) * sin(ph));
-        }
-    for (uint32_t i = 0; i < n; ++i)
-        for (uint32_t j = 0; j < n; ++j) {
-            uint32_t a = i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
-            idx[t++] = a, idx[t++] = c, idx[t++] = b;
-            idx[t++] = b, idx[t++] = c, idx[t++] = d;
-        }
-    sy_rt_mesh_desc d = {.positions = pos, .indices = idx, .vertex_count = nv, .triangle_count = nt};
-    sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &d, &m));
-    free(pos);
-    free(idx);
-    return m;
-}
 
 enum { W = 32, H = 32, SPP = 2 };
+
+/* The frame of every render here: path tracer, W x H, SPP samples, seed 7, into a new accumulator
+ * (the caller destroys d.accum). */
+static sy_rt_render_desc frame_desc(sy_rt_device *dev)
+{
+    sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, W, H);
+    MUST(sy_rt_accum_create(dev, W, H, &d.accum));
+    d.samples = SPP;
+    d.seed = 7;
+    return d;
+}
 
 /* Renders one frame (2 spp, seed 7) with the log (NULL = none) into rgba; returns the rays counted. */
 static uint64_t render(sy_rt_device *dev, const sy_rt_camera *cam, sy_rt_ray_log *log, float *rgba)
 {
-    sy_rt_accum *acc = NULL;
-    MUST(sy_rt_accum_create(dev, W, H, &acc));
-    sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, W, H);
-    d.accum = acc;
-    d.samples = SPP;
-    d.seed = 7;
+    sy_rt_render_desc d = frame_desc(dev);
+    sy_rt_accum *acc = d.accum;
     d.ray_log = log;
     MUST(sy_rt_render(dev, cam, &d, rgba, NULL));
     uint64_t rays = sy_rt_accum_last_rays(acc);
@@ -123,7 +106,7 @@ int main(void)
     rt_identity(id);
     rt_place(dev, box(dev), id, rt_lambert(dev, 0.7f, 0.7f, 0.7f), SY_RT_INSTANCE_BAKED);
     rt_place(dev, light_quad(dev), id, rt_emitter(dev, 8.0f, 8.0f, 8.0f), SY_RT_INSTANCE_BAKED);
-    sy_rt_mesh s = sphere(dev, 0.3f, 16);
+    sy_rt_mesh s = rt_uv_sphere(dev, 0.3f, 16, false);
     sy_rt_material sm = rt_lambert(dev, 0.8f, 0.3f, 0.2f);
     rt_translation(xf, -0.4f, -0.7f, -0.2f);
     rt_place(dev, s, xf, sm, 0); /* instanced: instID matters */
@@ -185,8 +168,7 @@ int main(void)
     md.base_color[3] = 0.5f;
     md.alpha_mode = SY_RT_ALPHA_BLEND;
     md.specular = 0.0f;
-    sy_rt_material pane;
-    MUST(sy_rt_material_create(dev, &md, &pane));
+    sy_rt_material pane = rt_material(dev, &md);
     rt_translation(xf, 0.0f, 0.0f, 0.2f);
     rt_place(dev, rt_quad(dev, 0.4f), xf, pane, 0);
     MUST(sy_rt_commit(dev));
@@ -205,12 +187,8 @@ int main(void)
     sy_rt_ray_log_destroy(log);
 
     /* the benchmark's counts */
-    sy_rt_accum *acc = NULL;
-    MUST(sy_rt_accum_create(dev, W, H, &acc));
-    sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, W, H);
-    d.accum = acc;
-    d.samples = SPP;
-    d.seed = 7;
+    sy_rt_render_desc d = frame_desc(dev);
+    sy_rt_accum *acc = d.accum;
     sy_rt_limit_result lr;
     MUST(sy_rt_bench_limit(dev, &cam, &d, 2, &lr));
     EXPECT_MSG(lr.rays == rays_logged && lr.extension_rays + lr.shadow_rays == lr.rays &&

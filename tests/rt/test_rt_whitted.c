@@ -30,8 +30,7 @@ static void test_emitter_exact(void)
     sy_rt_material_desc_init(&ed);
     ed.base_color[0] = ed.base_color[1] = ed.base_color[2] = 0.0f;
     ed.emissive[0] = 17, ed.emissive[1] = 12, ed.emissive[2] = 4;
-    sy_rt_material em;
-    MUST(sy_rt_material_create(dev, &ed, &em));
+    sy_rt_material em = rt_material(dev, &ed);
     sy_rt_instance inst = rt_place(dev, rt_quad(dev, 1.0f), xf, em, 0);
     (void)inst;
     sy_rt_light_desc ld = {.type = SY_RT_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 100, .position = {0, 0, 2}};
@@ -72,9 +71,7 @@ static void test_point_and_directional(void)
     const float albedo[3] = {0.5f, 0.6f, 0.7f};
     for (int kind = 0; kind < 3; ++kind) {
         sy_rt_device *dev = rt_device();
-        float xf[16];
-        rt_identity(xf);
-        rt_place(dev, rt_quad(dev, 10.0f), xf, rt_lambert(dev, albedo[0], albedo[1], albedo[2]), 0);
+        rt_place(dev, rt_quad(dev, 10.0f), NULL, rt_lambert(dev, albedo[0], albedo[1], albedo[2]), 0);
         const double I = 10.0, lz = 2.0, lx = 0.3;
         sy_rt_light_desc ld = {.color = {1.0f, 0.5f, 0.25f}, .intensity = (float)I};
         if (kind == 0) {
@@ -196,9 +193,7 @@ static void test_area_light_grazing(void)
 static void test_hard_shadow(void)
 {
     sy_rt_device *dev = rt_device();
-    float xf[16];
-    rt_identity(xf);
-    rt_place(dev, rt_quad(dev, 10.0f), xf, rt_lambert(dev, 0.8f, 0.8f, 0.8f), 0);
+    rt_place(dev, rt_quad(dev, 10.0f), NULL, rt_lambert(dev, 0.8f, 0.8f, 0.8f), 0);
     float bx[16];
     rt_translation(bx, 0.0f, 0.0f, 2.0f);
     rt_place(dev, rt_quad(dev, 0.25f), bx, rt_lambert(dev, 0.8f, 0.8f, 0.8f), 0);
@@ -246,8 +241,7 @@ static void test_mirror(void)
     md.base_color[2] = 0.7f;
     md.metallic = 1.0f;
     md.roughness = 0.0f;
-    sy_rt_material mirror;
-    MUST(sy_rt_material_create(dev, &md, &mirror));
+    sy_rt_material mirror = rt_material(dev, &md);
     rt_place(dev, rt_quad(dev, 10.0f), xf, mirror, 0);
     /* Emitter behind the camera (z = 8) facing the mirror. */
     float em[16];
@@ -282,8 +276,7 @@ static void test_glass(void)
     md.roughness = 0.0f;
     md.transmission = 1.0f;
     md.ior = 1.5f;
-    sy_rt_material glass;
-    MUST(sy_rt_material_create(dev, &md, &glass));
+    sy_rt_material glass = rt_material(dev, &md);
     sy_rt_mesh q = rt_quad(dev, 3.0f);
     float front[16], back[16], em[16];
     rt_identity(front);
@@ -329,8 +322,7 @@ static void test_alpha_mask_and_texture(void)
     md.base_color[1] = 0.5f;
     md.base_color_texture.texture = tex;
     md.alpha_mode = SY_RT_ALPHA_MASK;
-    sy_rt_material cut;
-    MUST(sy_rt_material_create(dev, &md, &cut));
+    sy_rt_material cut = rt_material(dev, &md);
     float xf[16], em[16];
     rt_identity(xf);
     rt_translation(em, 0.0f, 0.0f, -1.0f);
@@ -427,32 +419,6 @@ static void test_area_light_analytic(void)
     sy_rt_device_destroy(dev);
 }
 
-/* A UV sphere of radius 1 at the origin (about 2 n^2 triangles, vertex normals). */
-static sy_rt_mesh uv_sphere(sy_rt_device *dev, int n)
-{
-    int nv = (n + 1) * (n + 1);
-    float *pos = malloc(sizeof(float) * 3 * nv);
-    uint32_t *idx = malloc(sizeof(uint32_t) * 6 * n * n);
-    if (!pos || !idx) exit(1);
-    for (int i = 0, k = 0; i <= n; ++i)
-        for (int j = 0; j <= n; ++j, ++k) {
-            double th = M_PI * i / n, ph = 2 * M_PI * j / n;
-            pos[3 * k] = (float)(sin(th) * cos(ph)), pos[3 * k + 1] = (float)cos(th), pos[3 * k + 2] = (float)(sin(th) * sin(ph));
-        }
-    int t = 0;
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-            uint32_t a = (uint32_t)(i * (n + 1) + j), b = a + 1, c = a + (uint32_t)n + 1, d = c + 1;
-            idx[t++] = a, idx[t++] = c, idx[t++] = b, idx[t++] = b, idx[t++] = c, idx[t++] = d;
-        }
-    sy_rt_mesh_desc md = {.positions = pos, .normals = pos, .indices = idx, .vertex_count = (uint32_t)nv,
-                          .triangle_count = (uint32_t)(2 * n * n)};
-    sy_rt_mesh m;
-    MUST(sy_rt_mesh_create(dev, &md, &m));
-    free(pos);
-    free(idx);
-    return m;
-}
 
 /* A rough metal sphere under an environment map with a bright patch (sky gradient, a "sun" 50 x
  * brighter over 2 x 2 texels, a dark ground), 4 camera rays per pixel as `sy` renders: the image
@@ -479,16 +445,7 @@ static void test_rough_sphere_smooth_and_deterministic(void)
     sy_rt_texture tex;
     MUST(sy_rt_texture_create(dev, &td, &tex));
     MUST(sy_rt_set_environment(dev, tex, 1.0f));
-    sy_rt_material_desc d;
-    sy_rt_material_desc_init(&d);
-    d.base_color[0] = 0.95f, d.base_color[1] = 0.7f, d.base_color[2] = 0.3f;
-    d.metallic = 1.0f;
-    d.roughness = 0.5f;
-    sy_rt_material m;
-    MUST(sy_rt_material_create(dev, &d, &m));
-    float xf[16];
-    rt_identity(xf);
-    rt_place(dev, uv_sphere(dev, 96), xf, m, 0);
+    rt_place(dev, rt_uv_sphere(dev, 1.0f, 96, true), NULL, rt_metal(dev, 0.95f, 0.7f, 0.3f, 0.5f), 0);
     MUST(sy_rt_commit(dev));
     enum { S = 64 };
     sy_rt_camera cam = rt_camera(3.0f, 0.4f); /* the sphere's silhouette: radius about 0.354 / 0.4 x 32 = 28 px */
