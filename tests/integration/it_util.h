@@ -111,6 +111,27 @@ static inline sy_material it_unlit(sy_scene *s, const char *name, float r, float
     return m;
 }
 
+/* A light of the given type and intensity (the rest at the defaults), on no node yet. */
+static inline sy_light it_light(sy_scene *s, const char *name, sy_light_type type, float intensity)
+{
+    sy_light l;
+    MUST(sy_light_create(s, name, &l, err));
+    sy_light_data ld = *sy_light_get(s, l);
+    ld.type = type;
+    ld.intensity = intensity;
+    MUST(sy_light_set(s, l, &ld, err));
+    return l;
+}
+
+/* A w x h window with the one viewport vd (its handle in *vp when vp is not NULL). */
+static inline sy_window *it_window(uint32_t w, uint32_t h, const sy_viewport_desc *vd, sy_viewport **vp)
+{
+    sy_window *win;
+    MUST(sy_window_create(w, h, &win, err));
+    MUST(sy_window_add_viewport(win, vd, vp, err));
+    return win;
+}
+
 static inline void it_set_translation(sy_scene *s, sy_node n, float x, float y, float z)
 {
     const float t[3] = {x, y, z}, q[4] = {0, 0, 0, 1}, one[3] = {1, 1, 1};

@@ -237,12 +237,9 @@ int main(void)
     MUST(sy_scene_commit(scene, NULL, err));
 
     sy_context_pool *pool;
-    sy_window *win;
-    sy_viewport *vp;
     MUST(sy_context_pool_create(&pool, err));
-    MUST(sy_window_create(W, H, &win, err));
     sy_viewport_desc vd = {.root = info.root, .camera = cam, .backend = "whitted"};
-    MUST(sy_window_add_viewport(win, &vd, &vp, err));
+    sy_window *win = it_window(W, H, &vd, NULL);
     sy_layer img;
     MUST(sy_layer_create(W, H, &img, err));
     MUST(sy_window_render(win, scene, pool, NULL, &img, err));

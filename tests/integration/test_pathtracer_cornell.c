@@ -68,11 +68,8 @@ int main(void)
     sy_node cam;
     MUST(sy_gltf_find_camera(scene, &info, "camera", &cam, err));
     MUST(sy_scene_commit(scene, NULL, err));
-    sy_window *win;
-    sy_viewport *vp;
-    MUST(sy_window_create(W, W, &win, err));
     sy_viewport_desc vd = {.root = info.root, .camera = cam, .backend = "pathtracer", .params = "max_depth=64,specular=0"};
-    MUST(sy_window_add_viewport(win, &vd, &vp, err));
+    sy_window *win = it_window(W, W, &vd, NULL);
     sy_context_pool *pool;
     MUST(sy_context_pool_create(&pool, err));
     sy_layer img;

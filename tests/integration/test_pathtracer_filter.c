@@ -76,12 +76,8 @@ static sy_context *render_frames(fixture *fx, sy_window *win, const char *params
 
 static sy_window *make_window(fixture *fx, uint32_t w, uint32_t h, const char *params)
 {
-    sy_window *win;
-    sy_viewport *vp;
-    MUST(sy_window_create(w, h, &win, err));
     sy_viewport_desc vd = {.root = fx->info.root, .camera = fx->cam, .backend = "pathtracer", .params = params};
-    MUST(sy_window_add_viewport(win, &vd, &vp, err));
-    return win;
+    return it_window(w, h, &vd, NULL);
 }
 
 static double relmse(const float *img, const float *ref, uint32_t w, uint32_t h)

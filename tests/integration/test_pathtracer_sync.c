@@ -96,10 +96,8 @@ static void build(fixture *fx)
     bd.color[0] = 0.1f, bd.color[1] = 0.2f, bd.color[2] = 0.3f, bd.color[3] = 1.0f;
     MUST(sy_background_set(s, fx->bg, &bd, err));
     commit(fx);
-    MUST(sy_window_create(32, 24, &fx->win, err));
-    sy_viewport *vp;
     sy_viewport_desc vd = {.root = fx->root, .camera = fx->cam_node, .background = fx->bg, .backend = "pathtracer"};
-    MUST(sy_window_add_viewport(fx->win, &vd, &vp, err));
+    fx->win = it_window(32, 24, &vd, NULL);
     MUST(sy_context_pool_create(&fx->pool, err));
     MUST(sy_layer_create(32, 24, &fx->img, err));
 }

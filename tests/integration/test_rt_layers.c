@@ -52,12 +52,7 @@ static sy_scene *quad_scene(const sy_material_data *d, float tilt, sy_node *root
     const float t[3] = {0, 0, 0}, q[4] = {sinf(0.5f * tilt), 0, 0, cosf(0.5f * tilt)}, one[3] = {1, 1, 1};
     MUST(sy_node_set_trs(s, n, t, q, one, err));
     MUST(sy_node_add_child(s, *root, n, err));
-    sy_light lamp;
-    MUST(sy_light_create(s, "eye", &lamp, err));
-    sy_light_data ld = *sy_light_get(s, lamp);
-    ld.type = SY_LIGHT_POINT;
-    ld.intensity = 20.0f;
-    MUST(sy_light_set(s, lamp, &ld, err));
+    sy_light lamp = it_light(s, "eye", SY_LIGHT_POINT, 20.0f);
     MUST(sy_node_create(s, "eye", &ln, err));
     MUST(sy_node_set_light(s, ln, lamp, err));
     it_set_translation(s, ln, 0, 0, 4.0f);

@@ -130,12 +130,7 @@ int main(void)
 
     sy_gltf_info info;
     sy_scene *s = it_load_gltf(path, &info);
-    sy_light lamp;
-    MUST(sy_light_create(s, "headlight", &lamp, err));
-    sy_light_data ld = *sy_light_get(s, lamp);
-    ld.type = SY_LIGHT_POINT; /* at the eye: every shadow hides behind its caster */
-    ld.intensity = 40.0f;
-    MUST(sy_light_set(s, lamp, &ld, err));
+    sy_light lamp = it_light(s, "headlight", SY_LIGHT_POINT, 40.0f); /* at the eye: every shadow hides behind its caster */
     sy_node ln;
     MUST(sy_node_create(s, "headlight", &ln, err));
     MUST(sy_node_set_light(s, ln, lamp, err));

@@ -36,12 +36,7 @@ static void incremental(void)
     MUST(sy_node_create(s, "light", &nl, err));
     MUST(sy_node_set_mesh(s, na, ma, err));
     MUST(sy_node_set_mesh(s, nb, mb, err));
-    sy_light l;
-    MUST(sy_light_create(s, "sun", &l, err));
-    sy_light_data ld = *sy_light_get(s, l);
-    ld.type = SY_LIGHT_DIRECTIONAL;
-    ld.intensity = 2.0f;
-    MUST(sy_light_set(s, l, &ld, err));
+    sy_light l = it_light(s, "sun", SY_LIGHT_DIRECTIONAL, 2.0f);
     MUST(sy_node_set_light(s, nl, l, err));
     MUST(sy_node_add_child(s, root, na, err));
     MUST(sy_node_add_child(s, root, nb, err));
@@ -134,12 +129,9 @@ static void cornell(void)
     MUST(sy_gltf_find_camera(scene, &info, "camera", &cam, err));
     MUST(sy_scene_commit(scene, NULL, err));
     sy_context_pool *pool;
-    sy_window *win;
-    sy_viewport *vp;
     MUST(sy_context_pool_create(&pool, err));
-    MUST(sy_window_create(W, H, &win, err));
     sy_viewport_desc vd = {.root = info.root, .camera = cam, .backend = "raster", .params = "msaa=4,shadow_map_size=512"};
-    MUST(sy_window_add_viewport(win, &vd, &vp, err));
+    sy_window *win = it_window(W, H, &vd, NULL);
     sy_layer img;
     MUST(sy_layer_create(W, H, &img, err));
     MUST(sy_window_render(win, scene, pool, NULL, &img, err));
