@@ -198,28 +198,28 @@ int main(int argc, char **argv)
     run_case("zeros", json, garbage, bn, SY_ERR_PARSE, where);
     free(garbage);
 
-    /* the stream cut short by its bufferView */
-    char *j = replace(json, "\"byteLength\": 118", "\"byteLength\": 60");
-    run_case("truncated", j, bin, bn, SY_ERR_PARSE, where);
-    free(j);
-
-    /* accessor counts other than Draco's */
-    j = replace(json, "\"count\": 24", "\"count\": 25");
-    run_case("vertex_count", j, bin, bn, SY_ERR_PARSE, "Draco data has 24 vertices, the accessors declare 25");
-    free(j);
-    j = replace(json, "\"count\": 36", "\"count\": 39");
-    run_case("index_count", j, bin, bn, SY_ERR_PARSE, "Draco data has 12 triangles, the indices accessor declares 39");
-    free(j);
-
-    /* counts far larger than the bytes: refused by the budget before anything is decoded */
-    j = replace(json, "\"count\": 24", "\"count\": 2000000000");
-    run_case("huge_count", j, bin, bn, SY_ERR_LIMIT, "exceed what is left of the scene budget");
-    free(j);
-
-    /* the extension's bufferView out of range */
-    j = replace(json, "\"bufferView\": 0,", "\"bufferView\": 7,");
-    run_case("view_range", j, bin, bn, SY_ERR_PARSE, "bufferView 7 out of range");
-    free(j);
+    /* edits of the JSON: one text replaced, the error expected */
+    static const struct {
+        const char *name, *from, *to;
+        sy_result code;
+        const char *says; /* NULL: the primitive's extension (where) */
+    } edits[] = {
+        /* the stream cut short by its bufferView */
+        {"truncated", "\"byteLength\": 118", "\"byteLength\": 60", SY_ERR_PARSE, NULL},
+        /* accessor counts other than Draco's */
+        {"vertex_count", "\"count\": 24", "\"count\": 25", SY_ERR_PARSE, "Draco data has 24 vertices, the accessors declare 25"},
+        {"index_count", "\"count\": 36", "\"count\": 39", SY_ERR_PARSE,
+         "Draco data has 12 triangles, the indices accessor declares 39"},
+        /* counts far larger than the bytes: refused by the budget before anything is decoded */
+        {"huge_count", "\"count\": 24", "\"count\": 2000000000", SY_ERR_LIMIT, "exceed what is left of the scene budget"},
+        /* the extension's bufferView out of range */
+        {"view_range", "\"bufferView\": 0,", "\"bufferView\": 7,", SY_ERR_PARSE, "bufferView 7 out of range"},
+    };
+    for (size_t k = 0; k < sizeof edits / sizeof edits[0]; ++k) {
+        char *j = replace(json, edits[k].from, edits[k].to);
+        run_case(edits[k].name, j, bin, bn, edits[k].code, edits[k].says ? edits[k].says : where);
+        free(j);
+    }
 
     free(json);
     free(bin);
