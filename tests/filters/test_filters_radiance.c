@@ -89,147 +89,149 @@ static sy_filter_radiance_input input(const scene *s)
                                       .samples = s->sm};
 }
 
+/* What most tests here share: the scene (no glossy lobe), a filter with params p (NULL: the
+ * defaults), its input over the scene and its output image (4 floats a pixel). */
+typedef struct rig {
+    scene s;
+    size_t n; /* pixels */
+    sy_filter_radiance *rf;
+    sy_filter_report err;
+    sy_filter_radiance_input in;
+    float *out;
+} rig;
+
+static int rig_open(rig *r, uint32_t w, uint32_t h, bool step, const sy_filter_radiance_params *p)
+{
+    memset(r, 0, sizeof *r);
+    CHECK(scene_init(&r->s, w, h, step, 0.0f) == 0);
+    r->n = (size_t)w * h;
+    CHECK(sy_filter_radiance_create(p, &r->rf, &r->err) == SY_FILTER_OK);
+    r->out = malloc(4 * r->n * sizeof(float));
+    CHECK(r->out);
+    r->in = input(&r->s);
+    return 0;
+}
+
+static void rig_close(rig *r)
+{
+    free(r->out);
+    sy_filter_radiance_destroy(r->rf);
+    scene_free(&r->s);
+}
+
 static int test_texture_and_convergence(void)
 {
-    scene s;
-    CHECK(scene_init(&s, 96, 64, false, 0.0f) == 0);
-    size_t n = (size_t)s.w * s.h;
-    sy_filter_radiance *rf = NULL;
-    sy_filter_report err = {0};
-    CHECK(sy_filter_radiance_create(NULL, &rf, &err) == SY_FILTER_OK);
-    float *out = malloc(4 * n * sizeof(float)), *pt = calloc(4 * n, sizeof(float));
-    CHECK(out && pt);
-    sy_filter_radiance_input in = input(&s);
+    rig r;
+    CHECK(rig_open(&r, 96, 64, false, NULL) == 0);
+    float *pt = calloc(4 * r.n, sizeof(float));
+    CHECK(pt);
     sy_filter_stats st;
     for (uint32_t k = 1; k <= 8; ++k) {
-        scene_frame(&s, 1.0f, k);
-        CHECK(sy_filter_radiance_frame(rf, &in, out, &st, &err) == SY_FILTER_OK);
-        for (size_t i = 0; i < n; ++i)
-            for (int c = 0; c < 3; ++c) pt[4 * i + c] += (s.sh[i].direct[c] + s.sh[i].pt_indirect[c] - pt[4 * i + c]) / (float)k;
+        scene_frame(&r.s, 1.0f, k);
+        CHECK(sy_filter_radiance_frame(r.rf, &r.in, r.out, &st, &r.err) == SY_FILTER_OK);
+        for (size_t i = 0; i < r.n; ++i)
+            for (int c = 0; c < 3; ++c) pt[4 * i + c] += (r.s.sh[i].direct[c] + r.s.sh[i].pt_indirect[c] - pt[4 * i + c]) / (float)k;
     }
-    double b = rel_mse(pt, s.truth, n), e = rel_mse(out, s.truth, n);
+    double b = rel_mse(pt, r.s.truth, r.n), e = rel_mse(r.out, r.s.truth, r.n);
     printf("radiance 8 frames: relMSE PT %.5f RF %.5f (%.1fx), %.2f ms/frame, correction share %.2f\n", b, e, b / e,
            st.seconds * 1e3, st.mean_blend);
     CHECK(b / e >= 4.0);
     /* texture preserved: at checker boundaries the red channel keeps the 0.8/0.2 contrast */
     double hi = 0, lo = 0;
     uint32_t cnt = 0;
-    for (uint32_t y = 4; y < s.h - 4; ++y) {
-        size_t a = (size_t)y * s.w + 39, bb = (size_t)y * s.w + 40; /* 39 | 40: a checker edge */
+    for (uint32_t y = 4; y < r.s.h - 4; ++y) {
+        size_t a = (size_t)y * r.s.w + 39, bb = (size_t)y * r.s.w + 40; /* 39 | 40: a checker edge */
         bool ca = ((39 / 8) + (y / 8)) & 1;
-        hi += ca ? out[4 * a] : out[4 * bb], lo += ca ? out[4 * bb] : out[4 * a], ++cnt;
+        hi += ca ? r.out[4 * a] : r.out[4 * bb], lo += ca ? r.out[4 * bb] : r.out[4 * a], ++cnt;
     }
     hi /= cnt, lo /= cnt;
     /* truth: red albedo 0.8 | 0.2 times (direct 0.05 + incident 0.25) */
     printf("radiance texture edge: red %.4f | %.4f (truth %.4f | %.4f)\n", hi, lo, 0.8 * 0.3, 0.2 * 0.3);
     CHECK(fabs(hi - 0.8 * 0.3) < 0.01 && fabs(lo - 0.2 * 0.3) < 0.005);
-    free(out), free(pt);
-    sy_filter_radiance_destroy(rf);
-    scene_free(&s);
+    free(pt);
+    rig_close(&r);
     return 0;
 }
 
 static int test_depth_step(void)
 {
-    scene s;
-    CHECK(scene_init(&s, 96, 48, true, 0.0f) == 0);
-    size_t n = (size_t)s.w * s.h;
-    sy_filter_radiance *rf = NULL;
-    sy_filter_report err = {0};
-    CHECK(sy_filter_radiance_create(NULL, &rf, &err) == SY_FILTER_OK);
-    float *out = malloc(4 * n * sizeof(float));
-    CHECK(out);
-    sy_filter_radiance_input in = input(&s);
+    rig r;
+    CHECK(rig_open(&r, 96, 48, true, NULL) == 0);
     for (uint32_t k = 1; k <= 4; ++k) {
-        scene_frame(&s, 0.5f, k);
-        CHECK(sy_filter_radiance_frame(rf, &in, out, NULL, &err) == SY_FILTER_OK);
+        scene_frame(&r.s, 0.5f, k);
+        CHECK(sy_filter_radiance_frame(r.rf, &r.in, r.out, NULL, &r.err) == SY_FILTER_OK);
     }
     double left = 0, lt = 0;
-    for (uint32_t y = 0; y < s.h; ++y) {
-        size_t i = (size_t)y * s.w + s.w / 2 - 1;
-        left += out[4 * i + 1], lt += s.truth[4 * i + 1];
+    for (uint32_t y = 0; y < r.s.h; ++y) {
+        size_t i = (size_t)y * r.s.w + r.s.w / 2 - 1;
+        left += r.out[4 * i + 1], lt += r.s.truth[4 * i + 1];
     }
-    left /= s.h, lt /= s.h;
+    left /= r.s.h, lt /= r.s.h;
     printf("radiance depth step: column left of edge %.4f (truth %.4f; right side is 4x brighter)\n", left, lt);
     CHECK(fabs(left - lt) < 0.05 * lt + 0.005);
-    free(out);
-    sy_filter_radiance_destroy(rf);
-    scene_free(&s);
+    rig_close(&r);
     return 0;
 }
 
 static int test_correction_phase(void)
 {
-    scene s;
-    CHECK(scene_init(&s, 32, 24, false, 0.0f) == 0);
-    size_t n = (size_t)s.w * s.h;
     sy_filter_radiance_params p;
     sy_filter_radiance_params_default(&p);
     p.unbiased_switch = true;
-    sy_filter_radiance *rf = NULL;
-    sy_filter_report err = {0};
-    CHECK(sy_filter_radiance_create(&p, &rf, &err) == SY_FILTER_OK);
-    float *out = malloc(4 * n * sizeof(float)), *pt = calloc(3 * n, sizeof(float));
-    CHECK(out && pt);
-    sy_filter_radiance_input in = input(&s);
+    rig r;
+    CHECK(rig_open(&r, 32, 24, false, &p) == 0);
+    float *pt = calloc(3 * r.n, sizeof(float));
+    CHECK(pt);
     sy_filter_stats st;
     for (uint32_t k = 1; k <= 8; ++k) {
-        scene_frame(&s, 0.001f, k); /* tiny variance: radius < 1 right after warm-up */
-        CHECK(sy_filter_radiance_frame(rf, &in, out, &st, &err) == SY_FILTER_OK);
-        for (size_t i = 0; i < 3 * n; ++i) pt[i] += (s.sh[i / 3].direct[i % 3] + s.sh[i / 3].pt_indirect[i % 3] - pt[i]) / (float)k;
+        scene_frame(&r.s, 0.001f, k); /* tiny variance: radius < 1 right after warm-up */
+        CHECK(sy_filter_radiance_frame(r.rf, &r.in, r.out, &st, &r.err) == SY_FILTER_OK);
+        for (size_t i = 0; i < 3 * r.n; ++i) pt[i] += (r.s.sh[i / 3].direct[i % 3] + r.s.sh[i / 3].pt_indirect[i % 3] - pt[i]) / (float)k;
         if (k <= p.warmup_frames) CHECK(st.mean_blend < 0.5);
     }
     printf("radiance correction phase: share %.3f after 8 frames\n", st.mean_blend);
     CHECK(st.mean_blend == 1.0);
-    const float *rad = sy_filter_radiance_radius(rf);
-    for (size_t i = 0; i < n; ++i) {
+    const float *rad = sy_filter_radiance_radius(r.rf);
+    for (size_t i = 0; i < r.n; ++i) {
         CHECK(rad[i] == 0.0f);
-        for (int c = 0; c < 3; ++c) CHECK(out[4 * i + c] == pt[3 * i + c]); /* exactly the PT mean */
+        for (int c = 0; c < 3; ++c) CHECK(r.out[4 * i + c] == pt[3 * i + c]); /* exactly the PT mean */
     }
     /* a very glossy pixel (e > specular_limit) is never filtered */
-    sy_filter_radiance_reset(rf);
-    for (size_t i = 0; i < n; ++i) s.sh[i].exponent = 10000.0f, s.sh[i].specular[1] = 0.1f;
-    scene_frame(&s, 1.0f, 1);
-    CHECK(sy_filter_radiance_frame(rf, &in, out, &st, &err) == SY_FILTER_OK);
-    CHECK(st.mean_blend == 1.0 && sy_filter_radiance_frame_index(rf) == 1);
-    free(out), free(pt);
-    sy_filter_radiance_destroy(rf);
-    scene_free(&s);
+    sy_filter_radiance_reset(r.rf);
+    for (size_t i = 0; i < r.n; ++i) r.s.sh[i].exponent = 10000.0f, r.s.sh[i].specular[1] = 0.1f;
+    scene_frame(&r.s, 1.0f, 1);
+    CHECK(sy_filter_radiance_frame(r.rf, &r.in, r.out, &st, &r.err) == SY_FILTER_OK);
+    CHECK(st.mean_blend == 1.0 && sy_filter_radiance_frame_index(r.rf) == 1);
+    free(pt);
+    rig_close(&r);
     return 0;
 }
 
 static int test_nan_and_params(void)
 {
-    scene s;
-    CHECK(scene_init(&s, 32, 24, false, 0.0f) == 0);
-    size_t n = (size_t)s.w * s.h;
-    sy_filter_radiance *rf = NULL;
-    sy_filter_report err = {0};
-    CHECK(sy_filter_radiance_create(NULL, &rf, &err) == SY_FILTER_OK);
-    float *out = malloc(4 * n * sizeof(float));
-    CHECK(out);
-    sy_filter_radiance_input in = input(&s);
-    scene_frame(&s, 1.0f, 1);
-    s.sm[100].radiance[1] = NAN;
-    s.sh[200].pt_indirect[0] = INFINITY;
+    rig r;
+    CHECK(rig_open(&r, 32, 24, false, NULL) == 0);
+    scene_frame(&r.s, 1.0f, 1);
+    r.s.sm[100].radiance[1] = NAN;
+    r.s.sh[200].pt_indirect[0] = INFINITY;
     sy_filter_stats st;
-    CHECK(sy_filter_radiance_frame(rf, &in, out, &st, &err) == SY_FILTER_OK);
+    CHECK(sy_filter_radiance_frame(r.rf, &r.in, r.out, &st, &r.err) == SY_FILTER_OK);
     printf("radiance nan: %llu reported\n", (unsigned long long)st.nonfinite_samples);
     CHECK(st.nonfinite_samples == 2);
-    for (size_t i = 0; i < 4 * n; ++i) CHECK(isfinite(out[i]));
-    in.pixel_angle = 0;
-    CHECK(sy_filter_radiance_frame(rf, &in, out, &st, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT &&
-          strstr(err.message, "pixel_angle"));
-    sy_filter_radiance_destroy(rf);
+    for (size_t i = 0; i < 4 * r.n; ++i) CHECK(isfinite(r.out[i]));
+    r.in.pixel_angle = 0;
+    CHECK(sy_filter_radiance_frame(r.rf, &r.in, r.out, &st, &r.err) == SY_FILTER_ERROR_INVALID_ARGUMENT &&
+          strstr(r.err.message, "pixel_angle"));
+    sy_filter_radiance_destroy(r.rf);
+    r.rf = NULL; /* a refused create below leaves nothing to destroy */
     sy_filter_radiance_params p;
     sy_filter_radiance_params_default(&p);
     p.threshold = -0.01f;
-    CHECK(sy_filter_radiance_create(&p, &rf, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT && strstr(err.message, "threshold"));
+    CHECK(sy_filter_radiance_create(&p, &r.rf, &r.err) == SY_FILTER_ERROR_INVALID_ARGUMENT && strstr(r.err.message, "threshold"));
     sy_filter_radiance_params_default(&p);
     p.warmup_radius = 0.0f;
-    CHECK(sy_filter_radiance_params_check(&p, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
-    free(out);
-    scene_free(&s);
+    CHECK(sy_filter_radiance_params_check(&p, &r.err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    rig_close(&r);
     return 0;
 }
 
@@ -238,37 +240,31 @@ static int test_nan_and_params(void)
  * the running mean (1000 * seed + plain PT) / 1001; bad seeds are rejected. */
 static int test_seed(void)
 {
-    scene s;
-    CHECK(scene_init(&s, 32, 24, false, 0.0f) == 0);
-    size_t n = (size_t)s.w * s.h;
-    sy_filter_radiance *rf = NULL;
-    sy_filter_report err = {0};
-    CHECK(sy_filter_radiance_create(NULL, &rf, &err) == SY_FILTER_OK);
-    float *out = malloc(4 * n * sizeof(float)), *var = malloc(n * sizeof(float));
-    CHECK(out && var);
-    for (size_t i = 0; i < n; ++i) var[i] = 0.05f * sy_filter_luminance(s.truth + 4 * i);
-    CHECK(sy_filter_radiance_seed(rf, s.w, s.h, s.truth, 4, var, 1000, &err) == SY_FILTER_OK);
-    CHECK(sy_filter_radiance_frame_index(rf) == 1000);
-    sy_filter_radiance_input in = input(&s);
-    scene_frame(&s, 1.0f, 1001);
+    rig r;
+    CHECK(rig_open(&r, 32, 24, false, NULL) == 0);
+    float *var = malloc(r.n * sizeof(float));
+    CHECK(var);
+    for (size_t i = 0; i < r.n; ++i) var[i] = 0.05f * sy_filter_luminance(r.s.truth + 4 * i);
+    CHECK(sy_filter_radiance_seed(r.rf, r.s.w, r.s.h, r.s.truth, 4, var, 1000, &r.err) == SY_FILTER_OK);
+    CHECK(sy_filter_radiance_frame_index(r.rf) == 1000);
+    scene_frame(&r.s, 1.0f, 1001);
     sy_filter_stats st;
-    CHECK(sy_filter_radiance_frame(rf, &in, out, &st, &err) == SY_FILTER_OK);
+    CHECK(sy_filter_radiance_frame(r.rf, &r.in, r.out, &st, &r.err) == SY_FILTER_OK);
     double worst = 0;
-    for (size_t i = 0; i < n; ++i)
+    for (size_t i = 0; i < r.n; ++i)
         for (int c = 0; c < 3; ++c) {
-            double pt = s.sh[i].direct[c] + s.sh[i].pt_indirect[c];
-            double want = (1000.0 * s.truth[4 * i + c] + pt) / 1001.0;
-            worst = fmax(worst, fabs(out[4 * i + c] - want) / (want + 1e-3));
+            double pt = r.s.sh[i].direct[c] + r.s.sh[i].pt_indirect[c];
+            double want = (1000.0 * r.s.truth[4 * i + c] + pt) / 1001.0;
+            worst = fmax(worst, fabs(r.out[4 * i + c] - want) / (want + 1e-3));
         }
     printf("radiance seed: correction share %.3f, worst relative deviation from the resumed mean %.2e\n",
            st.mean_blend, worst);
     CHECK(st.mean_blend == 1.0 && worst < 1e-4);
-    CHECK(sy_filter_radiance_seed(rf, s.w, s.h, s.truth, 2, var, 10, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
-    CHECK(sy_filter_radiance_seed(rf, s.w, s.h, s.truth, 4, var, 0, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
-    CHECK(sy_filter_radiance_seed(rf, 0, s.h, s.truth, 4, var, 10, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
-    sy_filter_radiance_destroy(rf);
-    free(out), free(var);
-    scene_free(&s);
+    CHECK(sy_filter_radiance_seed(r.rf, r.s.w, r.s.h, r.s.truth, 2, var, 10, &r.err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    CHECK(sy_filter_radiance_seed(r.rf, r.s.w, r.s.h, r.s.truth, 4, var, 0, &r.err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    CHECK(sy_filter_radiance_seed(r.rf, 0, r.s.h, r.s.truth, 4, var, 10, &r.err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    free(var);
+    rig_close(&r);
     return 0;
 }
 
