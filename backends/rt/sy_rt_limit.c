@@ -159,25 +159,46 @@ void sy_rt_ray_replay_destroy(sy_rt_ray_replay *rp)
     free(rp);
 }
 
-/* Lanes [0, count) valid. */
-static void valid_mask(int *valid, uint32_t N, uint32_t count)
+/* What a run of either query needs: where it ends (RUN rays from first, or the log's end), the
+ * back-end's own context (its alpha filters read it), the scene as it renders when no instance
+ * moved since the last full build (the bench builds its scene once), and the packet width. */
+typedef struct run_setup {
+    size_t end;
+    sy_rt_ictx ictx;
+    RTCScene scene;
+    uint32_t N;
+} run_setup;
+
+static void run_begin(const sy_rt_ray_replay *rp, const sy_rt_ray_buf *b, size_t first, run_setup *rs)
 {
+    rs->end = first + RUN < b->n ? first + RUN : b->n;
+    sy_rt_context_init(rp->dev, &rs->ictx, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+    rs->scene = rp->dev->top;
+    rs->N = form_width[rp->form];
+}
+
+/* Packet p of N lanes (of sz bytes in the form's layout) from base into local; lanes [0, count)
+ * valid in the mask, the rest off. Returns count. */
+static uint32_t packet_load(const void *base, size_t sz, size_t p, uint32_t N, size_t end, int *valid,
+                            unsigned char *local)
+{
+    uint32_t count = (uint32_t)(end - p * N < N ? end - p * N : N);
     for (uint32_t k = 0; k < N; ++k) valid[k] = k < count ? -1 : 0;
+    memcpy(local, (const char *)base + p * sz, sz);
+    return count;
 }
 
 /* One run (RUN rays from index first) of closest-hit queries; returns mismatches when check. */
 static uint64_t run_hits(const sy_rt_ray_replay *rp, size_t first, bool check)
 {
     const sy_rt_ray_buf *b = &rp->log->intersect;
-    size_t end = first + RUN < b->n ? first + RUN : b->n;
-    /* the back-end's own context (its alpha filters read it); the scene as it renders when no
-     * instance moved since the last full build (the bench builds its scene once) */
-    sy_rt_ictx ictx;
-    sy_rt_context_init(rp->dev, &ictx, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
-    struct RTCIntersectContext *ctx = &ictx.rtc;
-    RTCScene scene = rp->dev->top;
+    run_setup rs;
+    run_begin(rp, b, first, &rs);
+    const size_t end = rs.end;
+    const uint32_t N = rs.N;
+    struct RTCIntersectContext *ctx = &rs.ictx.rtc;
+    RTCScene scene = rs.scene;
     uint64_t bad = 0;
-    const uint32_t N = form_width[rp->form];
     if (rp->form == SY_RT_FORM_1 || rp->form == SY_RT_FORM_STREAM) {
         const struct RTCRayHit *src = (const struct RTCRayHit *)rp->hits + first;
         struct RTCRayHit local[RUN];
@@ -198,10 +219,8 @@ static uint64_t run_hits(const sy_rt_ray_replay *rp, size_t first, bool check)
     size_t sz = hit_size(rp->form);
     _Alignas(64) unsigned char local[sizeof(struct RTCRayHit16)];
     for (size_t p = first / N; p * N < end; ++p) {
-        uint32_t count = (uint32_t)(end - p * N < N ? end - p * N : N);
         _Alignas(64) int valid[16]; /* Embree loads the mask with aligned SIMD loads */
-        valid_mask(valid, N, count);
-        memcpy(local, (const char *)rp->hits + p * sz, sz);
+        uint32_t count = packet_load(rp->hits, sz, p, N, end, valid, local);
         if (N == 4u) rtcIntersect4(valid, scene, ctx, (struct RTCRayHit4 *)local);
         else if (N == 8u) rtcIntersect8(valid, scene, ctx, (struct RTCRayHit8 *)local);
         else rtcIntersect16(valid, scene, ctx, (struct RTCRayHit16 *)local);
@@ -220,15 +239,13 @@ static uint64_t run_hits(const sy_rt_ray_replay *rp, size_t first, bool check)
 static uint64_t run_occluded(const sy_rt_ray_replay *rp, size_t first, bool check)
 {
     const sy_rt_ray_buf *b = &rp->log->occluded;
-    size_t end = first + RUN < b->n ? first + RUN : b->n;
-    /* the back-end's own context (its alpha filters read it); the scene as it renders when no
-     * instance moved since the last full build (the bench builds its scene once) */
-    sy_rt_ictx ictx;
-    sy_rt_context_init(rp->dev, &ictx, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
-    struct RTCIntersectContext *ctx = &ictx.rtc;
-    RTCScene scene = rp->dev->top;
+    run_setup rs;
+    run_begin(rp, b, first, &rs);
+    const size_t end = rs.end;
+    const uint32_t N = rs.N;
+    struct RTCIntersectContext *ctx = &rs.ictx.rtc;
+    RTCScene scene = rs.scene;
     uint64_t bad = 0;
-    const uint32_t N = form_width[rp->form];
     if (rp->form == SY_RT_FORM_1 || rp->form == SY_RT_FORM_STREAM) {
         const struct RTCRay *src = (const struct RTCRay *)rp->rays + first;
         struct RTCRay local[RUN];
@@ -244,10 +261,8 @@ static uint64_t run_occluded(const sy_rt_ray_replay *rp, size_t first, bool chec
     size_t sz = ray_size(rp->form);
     _Alignas(64) unsigned char local[sizeof(struct RTCRay16)];
     for (size_t p = first / N; p * N < end; ++p) {
-        uint32_t count = (uint32_t)(end - p * N < N ? end - p * N : N);
         _Alignas(64) int valid[16]; /* Embree loads the mask with aligned SIMD loads */
-        valid_mask(valid, N, count);
-        memcpy(local, (const char *)rp->rays + p * sz, sz);
+        uint32_t count = packet_load(rp->rays, sz, p, N, end, valid, local);
         if (N == 4u) rtcOccluded4(valid, scene, ctx, (struct RTCRay4 *)local);
         else if (N == 8u) rtcOccluded8(valid, scene, ctx, (struct RTCRay8 *)local);
         else rtcOccluded16(valid, scene, ctx, (struct RTCRay16 *)local);
