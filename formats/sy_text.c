@@ -379,19 +379,28 @@ typedef struct rings {
     bool oom;
 } rings;
 
+/* buf (of *cap elements of elem bytes) with room for need elements: the same buffer when it has,
+ * else reallocated to first elements or twice the capacity, doubled until need fits (*cap
+ * updated). NULL when out of memory (buf and *cap unchanged). */
+static void *grow(void *buf, size_t *cap, size_t need, size_t first, size_t elem)
+{
+    if (need <= *cap) return buf;
+    size_t c = *cap ? *cap * 2 : first;
+    while (c < need) c *= 2;
+    void *p = realloc(buf, c * elem);
+    if (p) *cap = c;
+    return p;
+}
+
 static void r_point(rings *R, double x, double y)
 {
     if (R->oom) return;
-    if (R->n == R->cap) {
-        size_t c = R->cap ? R->cap * 2 : 256;
-        double *p = realloc(R->xy, c * 2 * sizeof *p);
-        if (!p) {
-            R->oom = true;
-            return;
-        }
-        R->xy = p;
-        R->cap = c;
+    double *xy = grow(R->xy, &R->cap, R->n + 1, 256, 2 * sizeof *xy);
+    if (!xy) {
+        R->oom = true;
+        return;
     }
+    R->xy = xy;
     R->xy[2 * R->n] = x;
     R->xy[2 * R->n + 1] = y;
     R->n++;
@@ -402,16 +411,12 @@ static void r_point(rings *R, double x, double y)
 static void r_close(rings *R)
 {
     if (R->oom) return;
-    if (R->count + 2 > R->scap) {
-        size_t c = R->scap ? R->scap * 2 : 16;
-        size_t *p = realloc(R->start, c * sizeof *p);
-        if (!p) {
-            R->oom = true;
-            return;
-        }
-        R->start = p;
-        R->scap = c;
+    size_t *start = grow(R->start, &R->scap, R->count + 2, 16, sizeof *start);
+    if (!start) {
+        R->oom = true;
+        return;
     }
+    R->start = start;
     if (R->count == 0) R->start[0] = 0;
     size_t begin = R->start[R->count];
     /* the closing point repeats the first: drop it */
@@ -495,22 +500,12 @@ static bool b_reserve(builder *B, size_t nv, size_t nt, sy_error *err)
         B->r = sy_error_set(err, SY_ERR_LIMIT, "text: more than %zu triangles", B->max_t);
         return false;
     }
-    if (B->nv + nv > B->cap_v) {
-        size_t c = B->cap_v ? B->cap_v : 1024;
-        while (c < B->nv + nv) c *= 2;
-        float *p = realloc(B->pos, c * 12);
-        if (!p) goto oom;
-        B->pos = p;
-        B->cap_v = c;
-    }
-    if (B->nt + nt > B->cap_t) {
-        size_t c = B->cap_t ? B->cap_t : 1024;
-        while (c < B->nt + nt) c *= 2;
-        uint32_t *p = realloc(B->idx, c * 12);
-        if (!p) goto oom;
-        B->idx = p;
-        B->cap_t = c;
-    }
+    float *pos = grow(B->pos, &B->cap_v, B->nv + nv, 1024, 3 * sizeof *pos);
+    if (!pos) goto oom;
+    B->pos = pos;
+    uint32_t *idx = grow(B->idx, &B->cap_t, B->nt + nt, 1024, 3 * sizeof *idx);
+    if (!idx) goto oom;
+    B->idx = idx;
     return true;
 oom:
     B->r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "text: out of memory");
