@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "../support/sy_check.h"
+#include "wire_copy.h"
 #include "sy_anim.h"
 #include "sy_changes.h"
 
@@ -276,15 +277,8 @@ static int test_round_trip(void)
     CHECK_OK(sy_animation_create(o, "dance", &a, &e), e);
     CHECK_OK(sy_animation_set_clip(o, a, sd, 3, ch, 3, &e), e);
     CHECK_OK(sy_scene_commit(o, NULL, &e), e);
-    sy_changes *snap = NULL, *back = NULL;
-    CHECK_OK(sy_scene_snapshot(o, &snap, &e), e);
-    void *buf = NULL;
-    size_t size = 0;
-    CHECK_OK(sy_changes_serialize(snap, NULL, NULL, &buf, &size, &e), e);
-    sy_blob_store *store = NULL;
-    CHECK_OK(sy_blob_store_create(&store, &e), e);
-    CHECK_OK(sy_changes_deserialize(buf, size, store, NULL, &back, &e), e);
-    CHECK_OK(sy_scene_apply(r, back, &e), e);
+    wire_copy wc;
+    if (wire_copy_send(&wc, o, r)) return 1;
     sy_error diff = {0};
     CHECK_MSG(sy_scene_equal(o, r, &diff), "%s", diff.message);
     const sy_animation_data *ra = sy_animation_get(r, a);
@@ -357,9 +351,7 @@ static int test_round_trip(void)
     free(b2);
     sy_scene_destroy(o2), sy_scene_destroy(r2);
 
-    free(buf);
-    sy_changes_release(snap), sy_changes_release(back);
-    sy_blob_store_destroy(store);
+    wire_copy_free(&wc);
     sy_scene_destroy(o), sy_scene_destroy(r);
     return 0;
 }

@@ -3,6 +3,7 @@
  * the stroke width rule, mesh bounds grown by half the width, and the change-list round trip
  * (serialise, decode, apply to a replica, compare) of a line primitive with an explicit width. */
 #include "../support/sy_check.h"
+#include "wire_copy.h"
 #include "sy_changes.h"
 #include "sy_scene.h"
 
@@ -99,15 +100,8 @@ static int test_round_trip(void)
     sy_primitive p = {.positions = bp, .indices = bi, .topology = SY_TOPOLOGY_LINES, .width = 0.125f};
     CHECK_OK(sy_mesh_set_primitives(a, m, &p, 1, &e), e);
     CHECK_OK(sy_scene_commit(a, NULL, &e), e);
-    sy_changes *snap = NULL, *back = NULL;
-    CHECK_OK(sy_scene_snapshot(a, &snap, &e), e);
-    void *wire = NULL;
-    size_t size = 0;
-    CHECK_OK(sy_changes_serialize(snap, NULL, NULL, &wire, &size, &e), e);
-    sy_blob_store *store;
-    CHECK_OK(sy_blob_store_create(&store, &e), e);
-    CHECK_OK(sy_changes_deserialize(wire, size, store, NULL, &back, &e), e);
-    CHECK_OK(sy_scene_apply(r, back, &e), e);
+    wire_copy wc;
+    if (wire_copy_send(&wc, a, r)) return 1;
     CHECK_OK(sy_scene_commit(r, NULL, &e), e);
     CHECK_MSG(sy_scene_equal(a, r, &e), "replica differs: %s", e.message);
     const sy_mesh_data *md = sy_mesh_get(r, m);
@@ -120,9 +114,9 @@ static int test_round_trip(void)
     CHECK_OK(sy_scene_commit(r, NULL, &e), e);
     CHECK(!sy_scene_equal(a, r, &e));
     /* strict decoder: a topology past the enum or a negative width in the wire is refused */
-    unsigned char *w = wire;
+    unsigned char *w = wc.wire;
     size_t at = SIZE_MAX;
-    for (size_t k = 0; k + 8 <= size; k++) {
+    for (size_t k = 0; k + 8 <= wc.size; k++) {
         float f;
         uint32_t t;
         memcpy(&t, w + k, 4);
@@ -133,18 +127,15 @@ static int test_round_trip(void)
     sy_changes *bad = NULL;
     uint32_t seven = 7;
     memcpy(w + at, &seven, 4);
-    CHECK_ERR(sy_changes_deserialize(wire, size, store, NULL, &bad, &e), SY_ERR_PARSE, e);
+    CHECK_ERR(sy_changes_deserialize(wc.wire, wc.size, wc.store, NULL, &bad, &e), SY_ERR_PARSE, e);
     CHECK_MSG(strstr(e.message, "topology"), "message: %s", e.message);
     uint32_t lines = SY_TOPOLOGY_LINES;
     float neg = -1.0f;
     memcpy(w + at, &lines, 4);
     memcpy(w + at + 4, &neg, 4);
-    CHECK_ERR(sy_changes_deserialize(wire, size, store, NULL, &bad, &e), SY_ERR_PARSE, e);
+    CHECK_ERR(sy_changes_deserialize(wc.wire, wc.size, wc.store, NULL, &bad, &e), SY_ERR_PARSE, e);
     CHECK_MSG(strstr(e.message, "width"), "message: %s", e.message);
-    free(wire);
-    sy_changes_release(snap);
-    sy_changes_release(back);
-    sy_blob_store_destroy(store);
+    wire_copy_free(&wc);
     sy_blob_release(bp);
     sy_blob_release(bi);
     sy_scene_destroy(a);
