@@ -116,6 +116,13 @@ static sy_gl_mesh sphere_ccw(uint32_t seg)
     return m;
 }
 
+/* render_with, then measure. */
+static stats render_measure(const sy_gl_material_desc *md)
+{
+    render_with(md);
+    return measure();
+}
+
 /* the highlight's extent through the brightest pixel: pixels above half of it along its row, its column */
 static void extent(const stats *s, int *wx, int *wy)
 {
@@ -124,6 +131,28 @@ static void extent(const stats *s, int *wx, int *wy)
     for (int x = 0; x < N; ++x) *wx += lum(px(x, y0)) > 0.5f * s->max;
     for (int y = 0; y < N; ++y) *wy += lum(px(x0, y)) > 0.5f * s->max;
 }
+
+/* A layer's weight texture (R x its factor) scales the layer: with a 1 x 1 texture of R = 0 the
+ * picture is want[0] (the material without the layer), with R = 255 want[1] (the layer, untextured),
+ * brightest and mean within tol (relative). slot picks the texture in the material; the sphere has
+ * no uv: every point reads texel (0, 0). */
+static void expect_texture_scales(const char *what, const sy_gl_material_desc *with,
+                                  sy_gl_texture_ref *(*slot)(sy_gl_material_desc *), const stats want[2], float tol)
+{
+    for (int k = 0; k < 2; ++k) {
+        const unsigned char v = k ? 255 : 0;
+        sy_gl_material_desc t = *with;
+        sy_gl_texture_ref *ref = slot(&t);
+        ref->texture = texture_r(v);
+        stats st = render_measure(&t);
+        printf("%s texture R %d: brightest %g mean %g (want %g %g)\n", what, v, st.max, st.mean, want[k].max, want[k].mean);
+        EXPECT_MSG(fabsf(st.max - want[k].max) <= tol * want[k].max && fabsf(st.mean - want[k].mean) <= tol * want[k].mean,
+                   "%s texture %d: brightest %g mean %g (want %g %g)", what, v, st.max, st.mean, want[k].max, want[k].mean);
+        MUST(sy_gl_texture_destroy(d, ref->texture));
+    }
+}
+static sy_gl_texture_ref *clearcoat_slot(sy_gl_material_desc *m) { return &m->clearcoat_texture; }
+static sy_gl_texture_ref *transmission_slot(sy_gl_material_desc *m) { return &m->transmission_texture; }
 
 static sy_gl_material_desc dielectric(float base, float rough)
 {
@@ -154,39 +183,23 @@ int main(int argc, char **argv)
     sy_gl_material_desc base = dielectric(0.1f, 0.9f), coat = base;
     coat.clearcoat = 1.0f;
     coat.clearcoat_roughness = 0.15f;
-    render_with(&base);
-    stats s0 = measure();
-    render_with(&coat);
-    stats s1 = measure();
+    stats s0 = render_measure(&base);
+    stats s1 = render_measure(&coat);
     printf("clear coat, directional light: brightest %g -> %g, mean %g -> %g\n", s0.max, s1.max, s0.mean, s1.mean);
     EXPECT_MSG(s0.max > 0.0f && s1.max > 2.0f * s0.max, "the coat adds a highlight: brightest %g -> %g", s0.max, s1.max);
     EXPECT_MSG(s1.mean < 1.5f * s0.mean && s1.mean > 0.8f * s0.mean, "the coat's highlight is small: mean %g -> %g", s0.mean,
                s1.mean);
-    /* the clearcoat texture scales the weight (R): 0 leaves the base, 1 the coat (the sphere has no
-     * uv: every point reads texel (0, 0)) */
-    for (int k = 0; k < 2; ++k) {
-        const unsigned char v = k ? 255 : 0;
-        sy_gl_material_desc tc = coat;
-        tc.clearcoat_texture.texture = texture_r(v);
-        render_with(&tc);
-        stats st = measure();
-        const stats *want = k ? &s1 : &s0;
-        printf("clearcoat texture R %d: brightest %g mean %g\n", v, st.max, st.mean);
-        EXPECT_MSG(fabsf(st.max - want->max) <= 1e-3f * want->max && fabsf(st.mean - want->mean) <= 1e-3f * want->mean,
-                   "clearcoat texture %d: brightest %g mean %g (want %g %g)", v, st.max, st.mean, want->max, want->mean);
-        MUST(sy_gl_texture_destroy(d, tc.clearcoat_texture.texture));
-    }
+    /* the clearcoat texture scales the weight (R): 0 leaves the base, 1 the coat */
+    expect_texture_scales("clearcoat", &coat, clearcoat_slot, (stats[2]){s0, s1}, 1e-3f);
 
     /* 2. specular: 0 removes the dielectric highlight; a red specular colour makes it red */
     sy_gl_material_desc black = dielectric(0.0f, 0.3f), nospec = black, red = black;
     nospec.specular = 0.0f;
     red.specular_color[1] = red.specular_color[2] = 0.0f;
-    render_with(&black);
-    stats b0 = measure();
+    stats b0 = render_measure(&black);
     const float *hp = rgba + 4 * b0.at;
     float white_hl[3] = {hp[0], hp[1], hp[2]};
-    render_with(&nospec);
-    stats b1 = measure();
+    stats b1 = render_measure(&nospec);
     render_with(&red);
     const float *rp = rgba + 4 * b0.at;
     printf("specular: brightest %g (specular 0: %g); highlight RGB %g %g %g, red specular colour %g %g %g\n", b0.max, b1.max,
@@ -204,8 +217,7 @@ int main(int argc, char **argv)
         int w[3][2];
         for (int k = 0; k < 3; ++k) {
             an.anisotropy_rotation = k == 2 ? 1.5707963f : 0.0f;
-            render_with(k ? &an : &iso);
-            stats st = measure();
+            stats st = render_measure(k ? &an : &iso);
             extent(&st, &w[k][0], &w[k][1]);
             printf("anisotropy %d: highlight %g, %d x %d pixels\n", k, st.max, w[k][0], w[k][1]);
         }
@@ -292,25 +304,12 @@ int main(int argc, char **argv)
         MUST(sy_gl_light_create(d, &front, &fl));
         sy_gl_material_desc opaque = dielectric(0.5f, 0.3f), clear = opaque;
         clear.transmission = 1.0f;
-        render_with(&opaque);
-        stats so = measure();
-        render_with(&clear);
-        stats sc = measure();
+        stats so = render_measure(&opaque);
+        stats sc = render_measure(&clear);
         printf("transmission 0 / 1: mean %g / %g\n", so.mean, sc.mean);
         EXPECT_MSG(so.mean > 1.5f * sc.mean, "an opaque sphere diffuses the light a clear one lets pass: %g vs %g", so.mean,
                    sc.mean);
-        for (int k = 0; k < 2; ++k) {
-            const unsigned char v = k ? 255 : 0;
-            sy_gl_material_desc tt = clear;
-            tt.transmission_texture.texture = texture_r(v);
-            render_with(&tt);
-            stats st = measure();
-            const stats *want = k ? &sc : &so;
-            printf("transmission texture R %d: mean %g brightest %g (want %g %g)\n", v, st.mean, st.max, want->mean, want->max);
-            EXPECT_MSG(fabsf(st.mean - want->mean) <= 0.02f * want->mean && fabsf(st.max - want->max) <= 0.02f * want->max,
-                       "transmission texture %d: mean %g brightest %g (want %g %g)", v, st.mean, st.max, want->mean, want->max);
-            MUST(sy_gl_texture_destroy(d, tt.transmission_texture.texture));
-        }
+        expect_texture_scales("transmission", &clear, transmission_slot, (stats[2]){so, sc}, 0.02f);
         MUST(sy_gl_light_destroy(d, fl));
         sy_gl_set_environment(d, env, 1.0f);
         MUST(sy_gl_texture_destroy(d, dim));
@@ -339,10 +338,8 @@ int main(int argc, char **argv)
     sy_gl_area_light al = {.vertices = {{-0.6f, 0.4f, 0.5f}, {0.6f, 0.4f, 0.5f}, {0.6f, 1.6f, 0.5f}, {-0.6f, 1.6f, 0.5f}},
                            .vertex_count = 4, .radiance = {4, 4, 4}, .double_sided = true};
     MUST(sy_gl_set_area_lights(d, &al, 1));
-    render_with(&base);
-    stats a0 = measure();
-    render_with(&coat);
-    stats a1 = measure();
+    stats a0 = render_measure(&base);
+    stats a1 = render_measure(&coat);
     printf("clear coat under an emissive polygon: brightest %g -> %g, mean %g -> %g\n", a0.max, a1.max, a0.mean, a1.mean);
     EXPECT_MSG(a0.max > 0.0f && a1.max > 2.0f * a0.max, "the coat reflects the polygon: brightest %g -> %g", a0.max, a1.max);
     /* ... and the sheen brightens the rim under it */
