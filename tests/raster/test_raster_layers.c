@@ -25,6 +25,7 @@
 #include <string.h>
 
 #include "gl_test.h"
+#include "gl_sphere.h"
 
 #define N 64
 static float rgba[N * N * 4];
@@ -88,34 +89,6 @@ static sy_gl_texture texture_r(unsigned char v)
     return t;
 }
 
-/* a unit sphere wound counter-clockwise seen from outside (gl_sphere.h's is wound the other way,
- * so its outside shows its back face), smooth outward normals, uv = (longitude, colatitude) / (2 pi, pi):
- * the u tangent is horizontal */
-static sy_gl_mesh sphere_ccw(uint32_t seg)
-{
-    uint32_t nv = (seg + 1) * (seg + 1), nt = 0;
-    float *p = malloc(nv * 3 * sizeof *p), *uv = malloc(nv * 2 * sizeof *uv);
-    uint32_t *ix = malloc((size_t)seg * seg * 6 * sizeof *ix);
-    if (!p || !uv || !ix) exit(1);
-    for (uint32_t i = 0; i <= seg; ++i)
-        for (uint32_t j = 0; j <= seg; ++j) {
-            float th = 3.14159265f * (float)i / (float)seg, ph = 6.2831853f * (float)j / (float)seg, *v = p + 3 * (i * (seg + 1) + j);
-            v[0] = sinf(th) * cosf(ph), v[1] = cosf(th), v[2] = sinf(th) * sinf(ph);
-            uv[2 * (i * (seg + 1) + j)] = (float)j / (float)seg, uv[2 * (i * (seg + 1) + j) + 1] = (float)i / (float)seg;
-        }
-    for (uint32_t i = 0; i < seg; ++i)
-        for (uint32_t j = 0; j < seg; ++j) {
-            uint32_t a = i * (seg + 1) + j, b = a + seg + 1;
-            if (i > 0) ix[3 * nt] = a, ix[3 * nt + 1] = a + 1, ix[3 * nt + 2] = b, nt++;
-            if (i + 1 < seg) ix[3 * nt] = a + 1, ix[3 * nt + 1] = b + 1, ix[3 * nt + 2] = b, nt++;
-        }
-    sy_gl_mesh_desc md = {.positions = p, .normals = p, .uv = {uv}, .indices = ix, .vertex_count = nv, .triangle_count = nt};
-    sy_gl_mesh m;
-    MUST(sy_gl_mesh_create(d, &md, &m));
-    free(p), free(uv), free(ix);
-    return m;
-}
-
 /* render_with, then measure. */
 static stats render_measure(const sy_gl_material_desc *md)
 {
@@ -170,7 +143,7 @@ int main(int argc, char **argv)
     if (argc > 1 && !sy_gl_provider_parse(argv[1], &prov)) return 2;
     sy_gl_device_desc dd = {GL_TEST_REPORT, .provider = prov, .msaa = 1, .shadow_map_size = 256};
     MUST(sy_gl_device_create(&dd, &d));
-    sy_gl_mesh ball = sphere_ccw(64);
+    sy_gl_mesh ball = gl_test_sphere_mesh(d, 64, 0.0f, GL_SPHERE_NORMALS | GL_SPHERE_UV | GL_SPHERE_CCW, NULL);
     sy_gl_instance_desc id = {.mesh = ball, .transform = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -3.5f, 1}};
     MUST(sy_gl_instance_create(d, &id, &sphere));
     /* a directional light from behind the camera, a little from above and the left */
