@@ -16,6 +16,7 @@
 #include "sy_scene.h"
 
 #include "../formats/test_util.h"
+#include "assimp_quad.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -52,6 +53,19 @@ static int put_file(const char *dir, const char *rel, const void *data, size_t n
     return write_bytes(path, data, n);
 }
 
+/* Writes dir/name (n bytes) and loads it: refused with code, the message naming the file and
+ * saying says. */
+static void expect_refused(const char *dir, const char *name, const void *data, size_t n, sy_result code, const char *says)
+{
+    char path[4300];
+    sy_assimp_info info = {0};
+    sy_error e = {0};
+    PATHF(path, "%s/%s", dir, name);
+    EXPECT(write_bytes(path, data, n) == 0);
+    EXPECT_MSG(load(path, NULL, &info, &e) == code && strstr(e.message, name) && strstr(e.message, says), "%s: %s", name,
+               e.message);
+}
+
 static const sy_mesh_data *first_mesh(void)
 {
     uint32_t id = sy_scene_next(g_scene, SY_TYPE_MESH, 0);
@@ -66,18 +80,10 @@ int main(void)
     sy_error e = {0};
 
     /* OBJ + MTL + a 2x1 PPM texture: a quad (two triangles) of 2 x 1 with material "red" */
-    PATHF(p, "%s/model", dir);
-    mkdir(p, 0755);
-    PATHF(p, "%s/model/quad.obj", dir);
-    const char obj[] = "# quad\nmtllib quad.mtl\nv 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\n"
-                       "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl red\nf 1/1 2/2 3/3 4/4\n";
-    EXPECT(write_bytes(p, obj, sizeof obj - 1) == 0);
-    PATHF(q, "%s/model/quad.mtl", dir);
-    const char mtl[] = "newmtl red\nKd 0.5 0.25 0.125\nKs 1 1 1\nNs 128\nillum 2\nd 0.5\nKe 0 0 0\nmap_Kd tex.ppm\n";
-    EXPECT(write_bytes(q, mtl, sizeof mtl - 1) == 0);
-    PATHF(q, "%s/model/tex.ppm", dir);
-    const char ppm[] = "P6\n2 1\n255\n\xff\x00\x00\x00\xff\x00";
-    EXPECT(write_bytes(q, ppm, sizeof ppm - 1) == 0);
+    PATHF(q, "%s/model", dir);
+    mkdir(q, 0755);
+    write_assimp_quad(q, "newmtl red\nKd 0.5 0.25 0.125\nKs 1 1 1\nNs 128\nillum 2\nd 0.5\nKe 0 0 0\nmap_Kd tex.ppm\n", p,
+                      sizeof p);
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK, "quad.obj: %s", e.message);
     EXPECT_MSG(info.counts.meshes == 1 && info.counts.triangles == 2 && info.counts.materials >= 1 &&
                    info.counts.textures == 1 && info.warning_count == 0,
@@ -140,10 +146,7 @@ int main(void)
     unsigned char wrap[88] = {0};
     uint32_t facets = 85899346u;
     memcpy(wrap + 80, &facets, 4);
-    PATHF(p, "%s/wrap.stl", dir);
-    EXPECT(write_bytes(p, wrap, sizeof wrap) == 0);
-    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "wrap.stl") && strstr(e.message, "85899346 facets"),
-               "wrapping STL: %s", e.message);
+    expect_refused(dir, "wrap.stl", wrap, sizeof wrap, SY_ERR_PARSE, "85899346 facets");
 
     /* PLY: 4 coloured vertices, one quad face */
     PATHF(p, "%s/quad.ply", dir);
@@ -160,12 +163,10 @@ int main(void)
     EXPECT_MSG(near(b.max[0], 1) && near(b.max[2], 5), "quad.ply bounds");
     sy_assimp_info_free(&info);
     /* PLY declaring 10^12 vertices in a few bytes: refused before Assimp allocates */
-    PATHF(p, "%s/huge.ply", dir);
     const char huge[] = "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\nproperty float x\n"
                         "property float y\nproperty float z\nend_header\n\x00\x00\x00\x00";
-    EXPECT(write_bytes(p, huge, sizeof huge - 1) == 0);
-    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "huge.ply") && strstr(e.message, "1000000000000"),
-               "huge.ply: %s", e.message);
+    expect_refused(dir, "huge.ply", huge, sizeof huge - 1, SY_ERR_PARSE, "1000000000000");
+    PATHF(p, "%s/huge.ply", dir);
     /* the same behind a magic that is not alone on its line ("PLY" and more: Assimp still reads it as PLY) */
     char huge2[sizeof huge + 8];
     memcpy(huge2, "PLY[[[[[", 8);
@@ -176,30 +177,21 @@ int main(void)
 
     /* a PLY declaring one element twice (Assimp 5.2 fails an assertion in Triangulate on such a file
      * and aborts the process): refused first */
-    PATHF(p, "%s/twice.ply", dir);
     const char twice[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nelement vertex 3\n"
                          "property float x\nproperty float y\nproperty float z\nelement face 1\n"
                          "property list uchar int vertex_indices\nend_header\n0 0\n1 0\n0 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
-    EXPECT(write_bytes(p, twice, sizeof twice - 1) == 0);
-    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "twice.ply") && strstr(e.message, "'vertex' twice"),
-               "twice.ply: %s", e.message);
+    expect_refused(dir, "twice.ply", twice, sizeof twice - 1, SY_ERR_PARSE, "'vertex' twice");
 
     /* PLY faces of count 0: Assimp 5.2's validation lets them through and Triangulate fails an
      * assertion on them (abort); refused after reading, before post-processing */
-    PATHF(p, "%s/empty_face.ply", dir);
     const char empty_face[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                               "element face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0\n0\n";
-    EXPECT(write_bytes(p, empty_face, sizeof empty_face - 1) == 0);
-    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "empty_face.ply") && strstr(e.message, "without vertex indices"),
-               "empty_face.ply: %s", e.message);
+    expect_refused(dir, "empty_face.ply", empty_face, sizeof empty_face - 1, SY_ERR_PARSE, "without vertex indices");
 
     /* a PLY header whose end_header is broken (Assimp 5.2 loops for ever on it): refused first */
-    PATHF(p, "%s/noend.ply", dir);
     const char noend[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                          "element face 1\nproperty list uchar int vertex_index\nend_he<x>ader\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
-    EXPECT(write_bytes(p, noend, sizeof noend - 1) == 0);
-    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "noend.ply") && strstr(e.message, "end_header"),
-               "noend.ply: %s", e.message);
+    expect_refused(dir, "noend.ply", noend, sizeof noend - 1, SY_ERR_PARSE, "end_header");
 
     /* an ASCII FBX embedding 201 base64 characters ending in '=': Assimp 5.2 sizes the buffer for
      * 149 bytes, decodes 150, frees it and frees it again (ASan: double free); refused first */
@@ -218,7 +210,6 @@ int main(void)
                "video.fbx: %s", e.message);
 
     /* a COLLADA index list holding a word: Assimp 5.2 never returns from it; refused first */
-    PATHF(p, "%s/word.dae", dir);
     const char dae[] =
         "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">"
         "<library_geometries><geometry id=\"g\"><mesh><source id=\"pos\"><float_array id=\"pa\" count=\"9\">0 0 0 1 0 0 0 1 0"
@@ -228,10 +219,9 @@ int main(void)
         "<input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/><p>0 1 word 2</p></triangles></mesh></geometry>"
         "</library_geometries><library_visual_scenes><visual_scene id=\"s\"><node id=\"n\"><instance_geometry url=\"#g\"/>"
         "</node></visual_scene></library_visual_scenes><scene><instance_visual_scene url=\"#s\"/></scene></COLLADA>\n";
-    EXPECT(write_bytes(p, dae, sizeof dae - 1) == 0);
-    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "word.dae") && strstr(e.message, "<p>"),
-               "word.dae: %s", e.message);
+    expect_refused(dir, "word.dae", dae, sizeof dae - 1, SY_ERR_PARSE, "<p>");
     /* the same triangle with a proper list loads */
+    PATHF(p, "%s/word.dae", dir);
     char good[sizeof dae];
     memcpy(good, dae, sizeof dae);
     char *w = strstr(good, "0 1 word 2");
@@ -267,7 +257,7 @@ int main(void)
      * mtl/tex/t.ppm (as Blender and three.js read it), found without a warning */
     const char submtl[] = "newmtl m\nKd 1 1 1\nmap_Kd tex/t.ppm\n";
     const char subobj[] = "mtllib mtl/sub.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n";
-    EXPECT(put_file(dir, "m2/mtl/tex/t.ppm", ppm, sizeof ppm - 1, p, sizeof p) == 0);
+    EXPECT(put_file(dir, "m2/mtl/tex/t.ppm", assimp_quad_ppm, sizeof assimp_quad_ppm - 1, p, sizeof p) == 0);
     EXPECT(put_file(dir, "m2/mtl/sub.mtl", submtl, sizeof submtl - 1, p, sizeof p) == 0);
     EXPECT(put_file(dir, "m2/scene.obj", subobj, sizeof subobj - 1, p, sizeof p) == 0);
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.textures == 1 && info.warning_count == 0,
@@ -276,7 +266,7 @@ int main(void)
     /* still confined to the model's folder: ../../secret.ppm from m3/mtl/ is outside m3/ (refused,
      * naming the way out), admitted by allowed_roots */
     const char outmtl[] = "newmtl m\nKd 1 1 1\nmap_Kd ../../secret.ppm\n";
-    EXPECT(put_file(dir, "secret.ppm", ppm, sizeof ppm - 1, p, sizeof p) == 0);
+    EXPECT(put_file(dir, "secret.ppm", assimp_quad_ppm, sizeof assimp_quad_ppm - 1, p, sizeof p) == 0);
     EXPECT(put_file(dir, "m3/mtl/sub.mtl", outmtl, sizeof outmtl - 1, p, sizeof p) == 0);
     EXPECT(put_file(dir, "m3/scene.obj", subobj, sizeof subobj - 1, p, sizeof p) == 0);
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_LIMIT && strstr(e.message, "secret.ppm") && strstr(e.message, "--allow-path"),
@@ -373,11 +363,8 @@ int main(void)
     sy_assimp_info_free(&info);
 
     /* a file Assimp cannot read: Assimp's reason and the file name */
-    PATHF(p, "%s/junk.3ds", dir);
     const char junk[] = "this is not a 3DS file at all, only some text";
-    EXPECT(write_bytes(p, junk, sizeof junk - 1) == 0);
-    EXPECT_MSG(load(p, NULL, &info, &e) == SY_ERR_PARSE && strstr(e.message, "junk.3ds") && strstr(e.message, "Assimp cannot read it"),
-               "junk.3ds: %s", e.message);
+    expect_refused(dir, "junk.3ds", junk, sizeof junk - 1, SY_ERR_PARSE, "Assimp cannot read it");
     EXPECT_MSG(sy_scene_count(g_scene, SY_TYPE_NODE) == 0 && sy_scene_count(g_scene, SY_TYPE_MESH) == 0, "nothing left after a failure");
 
     sy_scene_destroy(g_scene);

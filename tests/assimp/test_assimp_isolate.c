@@ -18,6 +18,7 @@
 #include "sy_scene.h"
 
 #include "../formats/test_util.h"
+#include "assimp_quad.h"
 
 #include <dirent.h>
 #include <pthread.h>
@@ -137,16 +138,7 @@ int main(void)
     sy_error e = {0};
 
     /* an OBJ + MTL + PPM texture the test writes */
-    PATHF(p, "%s/quad.obj", dir);
-    const char obj[] = "mtllib quad.mtl\nv 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
-                       "usemtl red\nf 1/1 2/2 3/3 4/4\n";
-    EXPECT(write_bytes(p, obj, sizeof obj - 1) == 0);
-    PATHF(q, "%s/quad.mtl", dir);
-    const char mtl[] = "newmtl red\nKd 0.5 0.25 0.125\nKs 1 1 1\nNs 128\nmap_Kd tex.ppm\nmap_Ka missing.png\n";
-    EXPECT(write_bytes(q, mtl, sizeof mtl - 1) == 0);
-    PATHF(q, "%s/tex.ppm", dir);
-    const char ppm[] = "P6\n2 1\n255\n\xff\x00\x00\x00\xff\x00";
-    EXPECT(write_bytes(q, ppm, sizeof ppm - 1) == 0);
+    write_assimp_quad(dir, "newmtl red\nKd 0.5 0.25 0.125\nKs 1 1 1\nNs 128\nmap_Kd tex.ppm\nmap_Ka missing.png\n", p, sizeof p);
     compare_both_ways(p, true);
     compare_both_ways(p, false);
 
