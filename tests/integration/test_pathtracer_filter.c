@@ -523,21 +523,26 @@ int main(void)
         sy_window_destroy(win);
     }
 
-    /* 4. bad parameters */
-    expect_rejected(&fx, PT_PARAMS ",filter=bogus", "bogus");
-    expect_rejected(&fx, PT_PARAMS ",filter=radiance,threshold=0", "threshold");
-    expect_rejected(&fx, PT_PARAMS ",filter=radiance,rf_max_radius=0.5", "rf_max_radius");
-    expect_rejected(&fx, PT_PARAMS ",filter=radiance,rf_warmup_radius=0", "warmup_radius");
-    expect_rejected(&fx, PT_PARAMS ",filter=radiance,rf_warmup_frames=65", "rf_warmup_frames");
-    expect_rejected(&fx, PT_PARAMS ",filter=radiance,rf_kernel=box", "rf_kernel");
-    expect_rejected(&fx, PT_PARAMS ",filter=radiance,rf_unbiased=2", "rf_unbiased");
-    expect_rejected(&fx, PT_PARAMS ",filter=pixel,rf_prism_thickness=0", "prism_thickness"); /* checked whatever the filter */
-    expect_rejected(&fx, PT_PARAMS ",filter=pixel,threshold=-1", "threshold");
-    expect_rejected(&fx, PT_PARAMS ",filter=pixel,sigma_s=0", "sigma_s");
-    expect_rejected(&fx, PT_PARAMS ",filter=pixel,sigma_c=0", "sigma_c");
-    expect_rejected(&fx, PT_PARAMS ",filter=pixel,filter_kernel=box", "filter_kernel");
-    expect_rejected(&fx, PT_PARAMS ",filter=pixel,filter_start=3", "schedule_start");
-    expect_rejected(&fx, PT_PARAMS ",filter=adaptive,threshold=0", "threshold");
+    /* 4. bad parameters: refused, the message naming the parameter */
+    static const struct {
+        const char *params, *names;
+    } bad[] = {
+        {PT_PARAMS ",filter=bogus", "bogus"},
+        {PT_PARAMS ",filter=radiance,threshold=0", "threshold"},
+        {PT_PARAMS ",filter=radiance,rf_max_radius=0.5", "rf_max_radius"},
+        {PT_PARAMS ",filter=radiance,rf_warmup_radius=0", "warmup_radius"},
+        {PT_PARAMS ",filter=radiance,rf_warmup_frames=65", "rf_warmup_frames"},
+        {PT_PARAMS ",filter=radiance,rf_kernel=box", "rf_kernel"},
+        {PT_PARAMS ",filter=radiance,rf_unbiased=2", "rf_unbiased"},
+        {PT_PARAMS ",filter=pixel,rf_prism_thickness=0", "prism_thickness"}, /* checked whatever the filter */
+        {PT_PARAMS ",filter=pixel,threshold=-1", "threshold"},
+        {PT_PARAMS ",filter=pixel,sigma_s=0", "sigma_s"},
+        {PT_PARAMS ",filter=pixel,sigma_c=0", "sigma_c"},
+        {PT_PARAMS ",filter=pixel,filter_kernel=box", "filter_kernel"},
+        {PT_PARAMS ",filter=pixel,filter_start=3", "schedule_start"},
+        {PT_PARAMS ",filter=adaptive,threshold=0", "threshold"},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) expect_rejected(&fx, bad[k].params, bad[k].names);
 
     test_hook_records();
 
