@@ -44,6 +44,17 @@ static double step(sy_governor *g, cost_model *m, uint32_t w, uint32_t h, uint32
     return t;
 }
 
+/* A governor with the default settings after `frames` moving frames of w x h (no caps) under m,
+ * the clock from *now; *f the last frame. NULL (a failed, counted check) when it cannot be made. */
+static sy_governor *moving_for(cost_model *m, uint32_t w, uint32_t h, int frames, double *now, sy_governor_frame *f)
+{
+    sy_error e = {0};
+    sy_governor *g = NULL;
+    EXPECT_OK(sy_governor_create(NULL, &g, &e), e);
+    for (int i = 0; g && i < frames; ++i) step(g, m, w, h, 0, true, now, f);
+    return g;
+}
+
 static int test_settings(void)
 {
     sy_error e = {0};
@@ -111,13 +122,11 @@ static int test_converges(void)
     if (converge_case(0.5, 1500.0, SY_CAP_PROGRESSIVE)) return 1; /* very slow: near the minimum scale */
     if (converge_case(1.0, 20.0, 0)) return 1;                   /* full size fits */
     /* full size fits: it gets there */
-    sy_error e = {0};
-    sy_governor *g = NULL;
-    CHECK_OK(sy_governor_create(NULL, &g, &e), e);
     cost_model m = {.fixed = 1.0, .per = 10.0 / (640.0 * 480.0), .rng = 3};
     double now = 0.0;
     sy_governor_frame f;
-    for (int i = 0; i < 20; ++i) step(g, &m, 640, 480, 0, true, &now, &f);
+    sy_governor *g = moving_for(&m, 640, 480, 20, &now, &f);
+    if (!g) return 1;
     CHECK(f.width == 640 && f.height == 480 && f.scale == 1.0f);
     sy_governor_destroy(g);
     return 0;
@@ -298,15 +307,13 @@ static int test_noisy(void)
  * scale within a few frames; without, the model still follows within a few more. */
 static int switch_case(bool reset)
 {
-    sy_error e = {0};
-    sy_governor *g = NULL;
-    CHECK_OK(sy_governor_create(NULL, &g, &e), e);
     const uint32_t W = 1024, H = 768;
     cost_model slow = {.fixed = 1.0, .per = 400.0 / ((double)W * H), .rng = 1};
     cost_model fast = {.fixed = 1.0, .per = 20.0 / ((double)W * H), .rng = 2};
     double now = 0.0;
     sy_governor_frame f;
-    for (int i = 0; i < 30; ++i) step(g, &slow, W, H, 0, true, &now, &f);
+    sy_governor *g = moving_for(&slow, W, H, 30, &now, &f);
+    if (!g) return 1;
     float slow_scale = f.scale;
     CHECK(slow_scale < 0.4f);
     if (reset) sy_governor_reset(g);
@@ -336,13 +343,11 @@ static int test_switch(void)
 /* One stall (a frame 50x slower) moves the scale down a bounded step, not to the minimum for long. */
 static int test_stall(void)
 {
-    sy_error e = {0};
-    sy_governor *g = NULL;
-    CHECK_OK(sy_governor_create(NULL, &g, &e), e);
     cost_model m = {.fixed = 1.0, .per = 60.0 / (800.0 * 600.0), .rng = 4};
     double now = 0.0;
     sy_governor_frame f;
-    for (int i = 0; i < 30; ++i) step(g, &m, 800, 600, 0, true, &now, &f);
+    sy_governor *g = moving_for(&m, 800, 600, 30, &now, &f);
+    if (!g) return 1;
     float before = f.scale;
     sy_governor_plan(g, 800, 600, 0, true, now, &f);
     sy_governor_report(g, &f, 50.0 * true_cost(&m, &f));

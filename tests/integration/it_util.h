@@ -1,7 +1,8 @@
 /* it_util.h — small helpers shared by the integration tests: the check kit
  * (tests/support/sy_check.h; the tests use its counted EXPECT form, which keeps going, and end with
  * sy_check_finish), MUST, test-data lookup with the "skip = exit 77" rule, scratch
- * directories, and scene-building shortcuts (unlit quads, camera views by hand). */
+ * directories, and scene-building shortcuts (unlit quads, lights, one-viewport windows, camera
+ * views by hand). */
 #ifndef IT_UTIL_H
 #define IT_UTIL_H
 

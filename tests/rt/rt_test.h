@@ -1,5 +1,6 @@
 /* rt_test.h — helpers shared by the backends/rt tests: the check kit (tests/support/sy_check.h;
- * the tests use its counted EXPECT form and end with sy_check_finish), MUST, and small builders for quads, transforms, cameras and renders using only the
+ * the tests use its counted EXPECT form and end with sy_check_finish), MUST, and small builders
+ * for quads, UV spheres, materials, instances, transforms, cameras and renders using only the
  * public sy_rt API. */
 #ifndef RT_TEST_H
 #define RT_TEST_H
