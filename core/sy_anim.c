@@ -142,7 +142,26 @@ static sy_result apply_clip(sy_scene *s, uint32_t id, double t, sy_anim_stats *s
             st->skipped_stale++;
             continue;
         }
-        if (ci.path == SY_ANIM_WEIGHTS || ci.path >= SY_ANIM_PATH_COUNT) {
+        if (ci.path >= SY_ANIM_PATH_COUNT) continue; /* refused by the setters; never stored */
+        if (ci.path == SY_ANIM_WEIGHTS) { /* one component per morph target, into the node's weights */
+            uint32_t ns;
+            const sy_anim_sampler *sm = sy_animation_samplers(d, &ns);
+            float w[SY_ANIM_MAX_COMPONENTS];
+            uint32_t nw = ci.sampler < ns ? sm[ci.sampler].components : 0u;
+            sy_error e = {0};
+            sy_result r = nw && nw <= SY_ANIM_MAX_COMPONENTS
+                              ? sy_animation_sample(d, ci.sampler, false, t, w, SY_ANIM_MAX_COMPONENTS, &e)
+                              : sy_error_set(&e, SY_ERR_INVALID_ARGUMENT, "sampler %u has no weights", ci.sampler);
+            if (r == SY_OK) r = sy_node_set_weights(s, (sy_node){ci.node}, w, nw, &e);
+            if (r != SY_OK) {
+                st->failed++;
+                if (first == SY_OK) {
+                    first = r;
+                    sy_error_set(err, r, "animation %#x (%s) channel %u: %s", id, d->name ? d->name : "unnamed", c,
+                                 e.message);
+                }
+                continue;
+            }
             st->weights++;
             continue;
         }

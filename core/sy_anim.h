@@ -1,6 +1,6 @@
 /** @file
  * sy_anim.h — the scene clock: evaluates animations (sy_objects.h, SY_TYPE_ANIMATION) at a time
- * into the fields of the nodes they target, and a small play state for interactive tools.
+ * into the fields of the nodes they target (transforms and morph weights), and a small play state for interactive tools.
  *
  * Where it sits: the application (or `sy render --at`, a viewer's play loop, a cluster client)
  * calls sy_scene_set_time on the scene it owns; the evaluated values are stored with the ordinary
@@ -30,8 +30,9 @@
  * set: its static value, or what an earlier call with another clip left there). Channels whose
  * node is gone are skipped; channels targeting a node whose transform is a matrix are skipped too
  * (glTF forbids animating such nodes; the glTF loader drops those channels with a warning). Morph
- * weight channels are kept in the animation but not evaluated: core has no weights field yet (the
- * issue's phase 2, skins and morph targets, adds one). Each skip is counted in sy_anim_stats.
+ * weight channels set the node's whole weights field (SY_NODE_WEIGHTS, one value per target, with
+ * sy_node_set_weights), whatever its transform; the mirror deforms the mesh from them
+ * (sy_objects.h, "Skins and morph targets"). Each skip is counted in sy_anim_stats.
  *
  * Thread-safety: as the scene (sy_scene.h): calls that take a scene are serialised by the caller
  * with every other write to it. The sampler and clock functions are reentrant. */
@@ -50,7 +51,7 @@ typedef struct sy_anim_stats {
     uint32_t channels;       /**< channels evaluated into a node */
     uint32_t skipped_stale;  /**< channels whose target node is gone */
     uint32_t skipped_matrix; /**< channels whose target node has a matrix transform */
-    uint32_t weights;        /**< morph weight channels (kept, not evaluated in this version) */
+    uint32_t weights;        /**< morph weight channels evaluated into a node's weights */
     uint32_t failed;         /**< channels whose value a node setter refused (a spline beyond SY_COORD_MAX) */
 } sy_anim_stats;
 

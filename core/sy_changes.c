@@ -8,9 +8,12 @@
  *   entries  entry_count x { u8 type (sy_object_type: 1 texture .. 8 animation, version 4), u8 flags,
  *            u16 reserved(0), u32 id, u64 mask, fields... }
  *   field    POD: its bytes; string: u32 length (0xffffffff = NULL) + bytes; blob: u32 index into
- *            the blob table (0xffffffff = NULL); primitives: u32 count + count x (7 blob indices +
+ *            the blob table (0xffffffff = NULL); primitives: u32 count + count x (12 blob indices:
+ *            positions, normals, tangents, texcoords0, texcoords1, colors, indices, joints, weights,
+ *            target positions, normals, tangents (version 5; up to version 4 the first 7) +
  *            u32 material id + u32 topology (sy_topology, < SY_TOPOLOGY_COUNT) + f32 width (finite,
- *            >= 0)) (version 2; version 1 had neither); attachments (mask bit 63): u32 count + count x {string key, u8 kind,
+ *            >= 0)) (version 2; version 1 had neither); node fields weights, skin, skeleton and mesh
+ *            field weights (version 5); attachments (mask bit 63): u32 count + count x {string key, u8 kind,
  *            value: i64 | f64 | 4 x f32 | string | blob index}
  *
  * The decoder never trusts a length: every read is checked against what remains, counts are
@@ -186,7 +189,9 @@ static bool collect_blobs(const sy_changes *c, blob_table *t)
                     if (!bt_add(t, pr->positions, &idx) || !bt_add(t, pr->normals, &idx) ||
                         !bt_add(t, pr->tangents, &idx) || !bt_add(t, pr->texcoords0, &idx) ||
                         !bt_add(t, pr->texcoords1, &idx) || !bt_add(t, pr->colors, &idx) ||
-                        !bt_add(t, pr->indices, &idx))
+                        !bt_add(t, pr->indices, &idx) || !bt_add(t, pr->joints, &idx) ||
+                        !bt_add(t, pr->weights, &idx) || !bt_add(t, pr->target_positions, &idx) ||
+                        !bt_add(t, pr->target_normals, &idx) || !bt_add(t, pr->target_tangents, &idx))
                         return false;
                 }
             }
@@ -260,6 +265,11 @@ sy_result sy_changes_serialize(const sy_changes *c, sy_blob_send_fn send_blob, v
                     w_blobref(&w, &t, pr->texcoords1);
                     w_blobref(&w, &t, pr->colors);
                     w_blobref(&w, &t, pr->indices);
+                    w_blobref(&w, &t, pr->joints);
+                    w_blobref(&w, &t, pr->weights);
+                    w_blobref(&w, &t, pr->target_positions);
+                    w_blobref(&w, &t, pr->target_normals);
+                    w_blobref(&w, &t, pr->target_tangents);
                     w_u32(&w, pr->material.id);
                     w_u32(&w, pr->topology);
                     w_bytes(&w, &pr->width, sizeof pr->width);
@@ -526,7 +536,7 @@ sy_result sy_changes_deserialize(const void *data, size_t size, sy_blob_store *s
             case SY_FK_PRIMS: {
                 uint32_t n;
                 if (!r_u32(&r, &n, "primitive count")) goto fail;
-                if (n > (r.size - r.pos) / 40) { /* 7 blob indices, material, topology, width */
+                if (n > (r.size - r.pos) / 60) { /* 12 blob indices, material, topology, width */
                     r_fail(&r, SY_ERR_PARSE, "primitive count larger than the message can hold");
                     goto fail;
                 }
@@ -538,10 +548,12 @@ sy_result sy_changes_deserialize(const void *data, size_t size, sy_blob_store *s
                 }
                 for (uint32_t k = 0; k < n; ++k) {
                     sy_primitive *pr = &l->items[k];
-                    sy_blob **slots[7] = {&pr->positions,  &pr->normals, &pr->tangents, &pr->texcoords0,
-                                          &pr->texcoords1, &pr->colors,  &pr->indices};
+                    sy_blob **slots[12] = {&pr->positions,      &pr->normals,        &pr->tangents,
+                                           &pr->texcoords0,     &pr->texcoords1,     &pr->colors,
+                                           &pr->indices,        &pr->joints,         &pr->weights,
+                                           &pr->target_positions, &pr->target_normals, &pr->target_tangents};
                     l->count = k + 1; /* so a failure frees what was retained */
-                    for (int s = 0; s < 7; ++s) {
+                    for (int s = 0; s < 12; ++s) {
                         sy_blob *b;
                         if (!r_blobref(&r, blobs, nblobs, &b)) goto fail;
                         *slots[s] = sy_blob_retain(b);

@@ -13,11 +13,13 @@ static const sy_field_desc node_fields[SY_NODE_FIELD_COUNT] = {
     F(sy_node_data, name, SY_FK_STRING),    F(sy_node_data, transform, SY_FK_POD),
     F(sy_node_data, children, SY_FK_BLOB),  F(sy_node_data, mesh, SY_FK_POD),
     F(sy_node_data, light, SY_FK_POD),      F(sy_node_data, camera, SY_FK_POD),
-    F(sy_node_data, flags, SY_FK_POD),
+    F(sy_node_data, flags, SY_FK_POD),      F(sy_node_data, weights, SY_FK_BLOB),
+    F(sy_node_data, skin, SY_FK_BLOB),      F(sy_node_data, skeleton, SY_FK_POD),
 };
 static const sy_field_desc mesh_fields[SY_MESH_FIELD_COUNT] = {
     F(sy_mesh_data, name, SY_FK_STRING),
     F(sy_mesh_data, primitives, SY_FK_PRIMS),
+    F(sy_mesh_data, weights, SY_FK_BLOB),
 };
 static const sy_field_desc material_fields[SY_MATERIAL_FIELD_COUNT] = {
     F(sy_material_data, name, SY_FK_STRING),
@@ -224,8 +226,10 @@ void sy_animation_time_range(const sy_animation_data *d, float *start_out, float
 /* >>generic field operations */
 void sy__primitive_release(sy_primitive *p)
 {
-    sy_blob *blobs[7] = {p->positions, p->texcoords0, p->texcoords1, p->normals, p->tangents, p->colors, p->indices};
-    for (int i = 0; i < 7; ++i) sy_blob_release(blobs[i]);
+    sy_blob *blobs[12] = {p->positions, p->texcoords0, p->texcoords1,      p->normals,          p->tangents,
+                          p->colors,    p->indices,    p->joints,          p->weights,          p->target_positions,
+                          p->target_normals, p->target_tangents};
+    for (int i = 0; i < 12; ++i) sy_blob_release(blobs[i]);
     memset(p, 0, sizeof *p);
 }
 
@@ -259,6 +263,11 @@ static bool prims_copy(sy_primitive_list *dst, const sy_primitive_list *src)
         sy_blob_retain(p->texcoords1);
         sy_blob_retain(p->colors);
         sy_blob_retain(p->indices);
+        sy_blob_retain(p->joints);
+        sy_blob_retain(p->weights);
+        sy_blob_retain(p->target_positions);
+        sy_blob_retain(p->target_normals);
+        sy_blob_retain(p->target_tangents);
     }
     dst->count = src->count;
     return true;
@@ -359,7 +368,10 @@ bool sy__field_equal(uint32_t type, uint32_t f, const void *a, const void *b)
             if (!blob_same(x->positions, y->positions) || !blob_same(x->normals, y->normals) ||
                 !blob_same(x->tangents, y->tangents) || !blob_same(x->texcoords0, y->texcoords0) ||
                 !blob_same(x->texcoords1, y->texcoords1) || !blob_same(x->colors, y->colors) ||
-                !blob_same(x->indices, y->indices) || x->material.id != y->material.id ||
+                !blob_same(x->indices, y->indices) || !blob_same(x->joints, y->joints) ||
+                !blob_same(x->weights, y->weights) || !blob_same(x->target_positions, y->target_positions) ||
+                !blob_same(x->target_normals, y->target_normals) ||
+                !blob_same(x->target_tangents, y->target_tangents) || x->material.id != y->material.id ||
                 x->topology != y->topology || memcmp(&x->width, &y->width, sizeof x->width) != 0)
                 return false;
         }

@@ -102,8 +102,17 @@ enum sy_node_field {
     SY_NODE_LIGHT = 4,     /**< sy_light */
     SY_NODE_CAMERA = 5,    /**< sy_camera */
     SY_NODE_FLAGS = 6,     /**< uint32 sy_node_flags */
-    SY_NODE_FIELD_COUNT = 7
+    SY_NODE_WEIGHTS = 7,   /**< sy_blob* of float morph weights of the node's mesh (NULL = the mesh's; glTF node.weights) */
+    SY_NODE_SKIN = 8,      /**< sy_blob* of sy_skin_joint: the skin of the node's mesh (NULL = none; glTF node.skin) */
+    SY_NODE_SKELETON = 9,  /**< sy_node: the skin's skeleton root ({0}: none; informative, glTF skin.skeleton) */
+    SY_NODE_FIELD_COUNT = 10
 };
+
+/** One joint of a skin (the SY_NODE_SKIN blob; 68 bytes, little endian on the wire like all POD). */
+typedef struct sy_skin_joint {
+    uint32_t node;     /**< the joint node (sy_node.id) */
+    sy_mat4 inverse_bind; /**< its inverse bind matrix (glTF skin.inverseBindMatrices; identity when absent) */
+} sy_skin_joint;
 
 /** Field values of a node. */
 typedef struct sy_node_data {
@@ -114,6 +123,9 @@ typedef struct sy_node_data {
     sy_light light; /**< light attached here ({0}: none) */
     sy_camera camera; /**< camera attached here ({0}: none) */
     uint32_t flags; /**< sy_node_flags */
+    sy_blob *weights; /**< float morph weights (NULL = the mesh's) */
+    sy_blob *skin; /**< sy_skin_joint[] (NULL = not skinned) */
+    sy_node skeleton; /**< skeleton root of the skin ({0}: none) */
 } sy_node_data;
 
 /* ---------------------------------------------------------------- mesh */
@@ -167,13 +179,39 @@ typedef struct sy_primitive {
     sy_material material; /**< {0}: default material */
     uint32_t topology;    /**< sy_topology */
     float width;          /**< strokes: diameter (finite, >= 0; 0 = the default rule above) */
+    sy_blob *joints;      /**< skin: uint32 joint indices (into the skin of the node instancing the mesh), influences per vertex, or NULL */
+    sy_blob *weights;     /**< skin: float weights, influences per vertex (present exactly when joints is), or NULL */
+    sy_blob *target_positions; /**< morph targets: float[3] position deltas, vertex_count per target, target after target, or NULL */
+    sy_blob *target_normals;   /**< morph targets: float[3] normal deltas (layout as target_positions), or NULL */
+    sy_blob *target_tangents;  /**< morph targets: float[3] tangent xyz deltas (layout as target_positions), or NULL */
 } sy_primitive;
+
+/** Skins and morph targets (glTF 2.0 "Skins" and "Morph Targets"). A primitive may carry
+ * per-vertex joint indices and weights (joints and weights: `influences` values per vertex, 1 to
+ * SY_SKIN_MAX_INFLUENCES: glTF's JOINTS_0/WEIGHTS_0, then JOINTS_1/WEIGHTS_1, interleaved per
+ * vertex) and morph target deltas (target_positions / target_normals / target_tangents: the same
+ * number of targets in each present blob, at most SY_MORPH_MAX_TARGETS). The setters check sizes,
+ * finiteness and counts; joint indices are checked against the skin where it is used (a vertex
+ * whose joint index is past its node's skin is drawn in its bind pose, undeformed). The values that
+ * drive them are node fields: SY_NODE_SKIN (the joints and their inverse bind matrices) and
+ * SY_NODE_WEIGHTS (morph weights; NULL = the mesh's SY_MESH_WEIGHTS; missing weights are 0).
+ * The scene mirror deforms (mediators/sy_mirror.h): position = sum_j w_j (J_j x IBM_j) (p + sum_t
+ * weight_t dp_t), normals likewise with the inverse transpose, so every back-end draws the same
+ * pose. A skinned mesh's node transform is ignored, as glTF says: its joints place it. */
+#define SY_SKIN_MAX_INFLUENCES 8u   /**< joints per vertex (JOINTS_0 + JOINTS_1) */
+#define SY_SKIN_MAX_JOINTS 65536u   /**< joints of one skin */
+#define SY_MORPH_MAX_TARGETS 256u   /**< morph targets of one primitive (= SY_ANIM_MAX_COMPONENTS) */
+/** Joint influences per vertex of a primitive (0 without joints). */
+uint32_t sy_primitive_influences(const sy_primitive *p);
+/** Morph targets of a primitive (0 without). */
+uint32_t sy_primitive_target_count(const sy_primitive *p);
 
 /** Field numbers of a mesh. */
 enum sy_mesh_field {
     SY_MESH_NAME = 0,
     SY_MESH_PRIMITIVES = 1, /**< sy_primitive_list */
-    SY_MESH_FIELD_COUNT = 2
+    SY_MESH_WEIGHTS = 2,    /**< sy_blob* of float default morph weights (glTF mesh.weights; NULL = all 0) */
+    SY_MESH_FIELD_COUNT = 3
 };
 
 /** An array of primitives (the SY_MESH_PRIMITIVES field). */
@@ -186,6 +224,7 @@ typedef struct sy_primitive_list {
 typedef struct sy_mesh_data {
     char *name; /**< name (copied; may be NULL) */
     sy_primitive_list primitives; /**< the primitives */
+    sy_blob *weights; /**< float default morph weights, one per target (NULL = all 0) */
 } sy_mesh_data;
 
 /** Vertices of a primitive (elements of its positions blob). */
@@ -507,7 +546,7 @@ typedef enum sy_anim_path {
     SY_ANIM_TRANSLATION = 0, /**< node translation, 3 components */
     SY_ANIM_ROTATION = 1,    /**< node rotation, unit quaternion x y z w, 4 components */
     SY_ANIM_SCALE = 2,       /**< node scale, 3 components */
-    SY_ANIM_WEIGHTS = 3,     /**< morph target weights: kept, not evaluated yet (no weights field in core) */
+    SY_ANIM_WEIGHTS = 3,     /**< morph target weights of the node (SY_NODE_WEIGHTS), one component per target */
     SY_ANIM_PATH_COUNT = 4
 } sy_anim_path;
 
@@ -661,6 +700,16 @@ sy_result sy_node_set_light(sy_scene *s, sy_node n, sy_light l, sy_error *err);
 sy_result sy_node_set_camera(sy_scene *s, sy_node n, sy_camera c, sy_error *err);
 /** Sets the node's sy_node_flags. */
 sy_result sy_node_set_flags(sy_scene *s, sy_node n, uint32_t flags, sy_error *err);
+/** Sets the node's morph weights (count 0: NULL, the mesh's apply). Finite, at most SY_MORPH_MAX_TARGETS. */
+sy_result sy_node_set_weights(sy_scene *s, sy_node n, const float *weights, uint32_t count, sy_error *err);
+/** Sets the node's skin: count joints (live nodes) with their inverse bind matrices (NULL: identity);
+ * count 0 removes it. skeleton ({0}: none) is stored as given. */
+sy_result sy_node_set_skin(sy_scene *s, sy_node n, const sy_node *joints, const sy_mat4 *inverse_bind, uint32_t count,
+                           sy_node skeleton, sy_error *err);
+/** Sets a mesh's default morph weights (count 0: NULL). As sy_node_set_weights. */
+sy_result sy_mesh_set_weights(sy_scene *s, sy_mesh m, const float *weights, uint32_t count, sy_error *err);
+/** Skin joints of a node data struct (borrowed from its blob); count may be 0. */
+const sy_skin_joint *sy_node_skin(const sy_node_data *d, uint32_t *count_out);
 /** Retains every blob; validates sizes and index ranges of every primitive. */
 sy_result sy_mesh_set_primitives(sy_scene *s, sy_mesh m, const sy_primitive *prims, uint32_t count, sy_error *err);
 /** Sets every field of the struct (name included); only fields that differ are marked dirty. */

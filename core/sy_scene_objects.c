@@ -332,6 +332,73 @@ sy_result sy_node_set_flags(sy_scene *s, sy_node n, uint32_t flags, sy_error *er
     return sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_FLAGS, &flags, err);
 }
 
+/* A float blob field (morph weights) from count floats; count 0 sets NULL. */
+static sy_result set_weights(sy_scene *s, sy_object_type t, uint32_t id, uint32_t field, const float *w, uint32_t count,
+                             sy_error *err)
+{
+    sy_blob *b = NULL;
+    if (count) {
+        if (!w) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: %u weights from NULL", sy_object_type_name(t), count);
+        sy_result r = sy_blob_create_copy(w, sizeof(float) * (size_t)count, &b, err);
+        if (r != SY_OK) return r;
+    }
+    sy_result r = sy_object_set_field(s, t, id, field, &b, err);
+    sy_blob_release(b);
+    return r;
+}
+
+sy_result sy_node_set_weights(sy_scene *s, sy_node n, const float *weights, uint32_t count, sy_error *err)
+{
+    return set_weights(s, SY_TYPE_NODE, n.id, SY_NODE_WEIGHTS, weights, count, err);
+}
+
+sy_result sy_mesh_set_weights(sy_scene *s, sy_mesh m, const float *weights, uint32_t count, sy_error *err)
+{
+    return set_weights(s, SY_TYPE_MESH, m.id, SY_MESH_WEIGHTS, weights, count, err);
+}
+
+sy_result sy_node_set_skin(sy_scene *s, sy_node n, const sy_node *joints, const sy_mat4 *inverse_bind, uint32_t count,
+                           sy_node skeleton, sy_error *err)
+{
+    sy_blob *b = NULL;
+    if (count) {
+        if (!joints) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node skin: %u joints from NULL", count);
+        if (count > SY_SKIN_MAX_JOINTS)
+            return sy_error_set(err, SY_ERR_LIMIT, "node skin: %u joints (at most %u)", count, SY_SKIN_MAX_JOINTS);
+        sy_skin_joint *list = malloc(sizeof *list * count);
+        if (!list) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "node skin: out of memory");
+        for (uint32_t i = 0; i < count; ++i) {
+            list[i].node = joints[i].id;
+            list[i].inverse_bind = inverse_bind ? inverse_bind[i] : sy_mat4_identity();
+        }
+        sy_result r = sy_blob_create_take(list, sizeof *list * count, &b, err);
+        if (r != SY_OK) return r;
+    }
+    sy_result r = sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_SKIN, &b, err);
+    sy_blob_release(b);
+    if (r == SY_OK) r = sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_SKELETON, &skeleton, err);
+    return r;
+}
+
+const sy_skin_joint *sy_node_skin(const sy_node_data *d, uint32_t *count_out)
+{
+    *count_out = d && d->skin ? (uint32_t)(sy_blob_size(d->skin) / sizeof(sy_skin_joint)) : 0;
+    return *count_out ? (const sy_skin_joint *)sy_blob_data(d->skin) : NULL;
+}
+
+uint32_t sy_primitive_influences(const sy_primitive *p)
+{
+    uint32_t nv = sy_primitive_vertex_count(p);
+    return p->joints && nv ? (uint32_t)(sy_blob_size(p->joints) / 4 / nv) : 0u;
+}
+
+uint32_t sy_primitive_target_count(const sy_primitive *p)
+{
+    uint32_t nv = sy_primitive_vertex_count(p);
+    const sy_blob *b = p->target_positions ? p->target_positions : p->target_normals ? p->target_normals : p->target_tangents;
+    return b && nv ? (uint32_t)(sy_blob_size(b) / 12 / nv) : 0u;
+}
+
 sy_result sy_mesh_set_primitives(sy_scene *s, sy_mesh m, const sy_primitive *prims, uint32_t count, sy_error *err)
 {
     sy_primitive_list l = {(sy_primitive *)prims, count};

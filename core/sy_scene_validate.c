@@ -228,6 +228,68 @@ static sy_result check_animation(const sy_animation_data *d, uint32_t id, sy_err
     return r;
 }
 
+/* Finite floats in a blob (size a multiple of 4). */
+static bool blob_finite(const sy_blob *b)
+{
+    const float *f = sy_blob_data(b);
+    size_t n = sy_blob_size(b) / 4;
+    for (size_t k = 0; k < n; ++k)
+        if (!isfinite(f[k])) return false;
+    return true;
+}
+
+/* Skin attributes and morph targets of a primitive of nv vertices (sy_objects.h, "Skins and morph
+ * targets"): joints and weights together, 1 to SY_SKIN_MAX_INFLUENCES per vertex, weights finite;
+ * target blobs whole targets, the same count in each, at most SY_MORPH_MAX_TARGETS, finite deltas
+ * within SY_COORD_MAX. */
+static sy_result check_deform(const sy_primitive *p, uint32_t nv, uint32_t i, sy_error *err)
+{
+    if (!p->joints != !p->weights)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: joints without weights or weights without joints", i);
+    if (p->joints) {
+        size_t js = sy_blob_size(p->joints);
+        if (nv == 0 || js % (4u * (size_t)nv) != 0 || js / (4u * (size_t)nv) < 1 ||
+            js / (4u * (size_t)nv) > SY_SKIN_MAX_INFLUENCES || sy_blob_size(p->weights) != js)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "mesh primitive %u: joints (%zu bytes) and weights (%zu bytes) are not 1 to %u influences "
+                                "x %u vertices x 4 bytes",
+                                i, js, sy_blob_size(p->weights), SY_SKIN_MAX_INFLUENCES, nv);
+        if (!blob_finite(p->weights))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: a skin weight is not finite", i);
+    }
+    const sy_blob *tb[3] = {p->target_positions, p->target_normals, p->target_tangents};
+    const char *tn[3] = {"target_positions", "target_normals", "target_tangents"};
+    size_t targets = 0;
+    for (int k = 0; k < 3; ++k) {
+        if (!tb[k]) continue;
+        size_t sz = sy_blob_size(tb[k]), per = 12u * (size_t)nv;
+        if (nv == 0 || sz % per != 0 || sz / per == 0 || sz / per > SY_MORPH_MAX_TARGETS || (targets && sz / per != targets))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "mesh primitive %u: %s holds %zu bytes, not 1 to %u whole targets of %u vertices x 12 "
+                                "bytes (the same count in every target blob)",
+                                i, tn[k], sz, SY_MORPH_MAX_TARGETS, nv);
+        targets = sz / per;
+        const float *f = sy_blob_data(tb[k]);
+        for (size_t e = 0; e < sz / 4; ++e)
+            if (!(fabsf(f[e]) <= SY_COORD_MAX))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "mesh primitive %u: %s value %zu (%g) is not finite or beyond the coordinate range", i,
+                                    tn[k], e, (double)f[e]);
+    }
+    return SY_OK;
+}
+
+/* Morph weights: a float blob, at most SY_MORPH_MAX_TARGETS, finite. */
+static sy_result check_weights(const sy_blob *b, const char *what, sy_error *err)
+{
+    if (!b) return SY_OK;
+    if (sy_blob_size(b) % 4 != 0 || sy_blob_size(b) / 4 > SY_MORPH_MAX_TARGETS)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: morph weights of %zu bytes (whole floats, at most %u)", what,
+                            sy_blob_size(b), SY_MORPH_MAX_TARGETS);
+    if (!blob_finite(b)) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: a morph weight is not finite", what);
+    return SY_OK;
+}
+
 static sy_result check_primitive(const sy_scene *s, const sy_primitive *p, uint32_t i, sy_error *err)
 {
     if (!p->positions) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: no positions", i);
@@ -250,6 +312,7 @@ static sy_result check_primitive(const sy_scene *s, const sy_primitive *p, uint3
         (r = check_blob_elems(p->texcoords1, 8, nv, "texcoords1", i, err)) ||
         (r = check_blob_elems(p->colors, 16, nv, "colors", i, err)))
         return r;
+    if ((r = check_deform(p, nv, i, err))) return r;
     if (p->topology >= SY_TOPOLOGY_COUNT)
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: unknown topology %u", i, p->topology);
     if (!isfinite(p->width) || p->width < 0.0f)
@@ -346,9 +409,34 @@ sy_result sy_sc_validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_t
             if (*(const uint32_t *)v & ~(uint32_t)(SY_NODE_VISIBLE | SY_NODE_STATIC | SY_NODE_ANIMATED))
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: unknown flags %#x", *(const uint32_t *)v);
             return SY_OK;
+        case SY_NODE_WEIGHTS: return check_weights(*(sy_blob *const *)v, "node", err);
+        case SY_NODE_SKIN: {
+            const sy_blob *b = *(sy_blob *const *)v;
+            if (!b) return SY_OK;
+            if (sy_blob_size(b) % sizeof(sy_skin_joint) != 0 || sy_blob_size(b) / sizeof(sy_skin_joint) > SY_SKIN_MAX_JOINTS)
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: skin of %zu bytes (whole joints of %zu bytes, at most %u)",
+                                    sy_blob_size(b), sizeof(sy_skin_joint), SY_SKIN_MAX_JOINTS);
+            uint32_t n = (uint32_t)(sy_blob_size(b) / sizeof(sy_skin_joint));
+            const sy_skin_joint *j = sy_blob_data(b);
+            for (uint32_t k = 0; k < n; ++k) {
+                if (j[k].node == 0 || !ref_ok(s, SY_TYPE_NODE, j[k].node))
+                    return sy_error_set(err, SY_ERR_INVALID_HANDLE, "node: skin joint %u is a stale handle %#x", k, j[k].node);
+                if (!sy_mat4_is_finite(&j[k].inverse_bind) || !sy_coords_in_range(j[k].inverse_bind.m, 16))
+                    return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                        "node: skin joint %u has an inverse bind matrix that is not finite or beyond the "
+                                        "coordinate range",
+                                        k);
+            }
+            return SY_OK;
+        }
+        case SY_NODE_SKELETON:
+            return ref_ok(s, SY_TYPE_NODE, ((const sy_node *)v)->id)
+                       ? SY_OK
+                       : sy_error_set(err, SY_ERR_INVALID_HANDLE, "node: stale skeleton handle");
         default: return SY_OK;
         }
     case SY_TYPE_MESH:
+        if (f == SY_MESH_WEIGHTS) return check_weights(*(sy_blob *const *)v, "mesh", err);
         if (f == SY_MESH_PRIMITIVES) {
             const sy_primitive_list *l = v;
             if (l->count && !l->items) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh: NULL primitives");

@@ -1,7 +1,7 @@
 /* test_anim.c — the scene clock (sy_anim.h) and animation objects (sy_objects.h): the evaluator
  * against hand-computed values (STEP, LINEAR, slerp with the shortest-path flip, CUBICSPLINE by the
  * glTF spec formula, clamping, one key), what a channel leaves alone (other TRS parts, matrix nodes,
- * weights, destroyed nodes), validation of bad samplers and channels (each refused naming the item),
+ * destroyed nodes), weight channels into the node's morph weights, validation of bad samplers and channels (each refused naming the item),
  * a change-list round trip (serialize -> deserialize -> apply: the same animation, and set_time on
  * both scenes gives equal nodes; the origin's set_time reaches the replica as a plain node change),
  * clip lookup and the play clock. */
@@ -165,7 +165,23 @@ static int test_what_channels_leave(void)
     EXPECT_NEAR(sy_node_get(s, n)->transform.scale[0], 2.0, 0.0); /* the part no channel drives stays */
     EXPECT(sy_node_get(s, m)->transform.mode == SY_TRANSFORM_MATRIX);
     EXPECT_NEAR(sy_node_get(s, m)->transform.matrix.m[12], 5.0, 0.0);
-    /* the weights are kept in the animation and can be sampled */
+    /* the weights channel set the node's morph weights (linear at 0.5: 0.5 0.5), a matrix node too */
+    uint32_t nw = 0;
+    const sy_node_data *nd = sy_node_get(s, n);
+    EXPECT(nd->weights && (nw = (uint32_t)(sy_blob_size(nd->weights) / 4)) == 2);
+    if (nw == 2) {
+        EXPECT_NEAR(((const float *)sy_blob_data(nd->weights))[0], 0.5, 1e-6);
+        EXPECT_NEAR(((const float *)sy_blob_data(nd->weights))[1], 0.5, 1e-6);
+    }
+    CHECK_OK(sy_scene_set_time_ex(s, (sy_animation){0}, 0.25, &st, &e), e);
+    nd = sy_node_get(s, n);
+    EXPECT(nd->weights && sy_blob_size(nd->weights) == 8);
+    if (nd->weights && sy_blob_size(nd->weights) == 8) EXPECT_NEAR(((const float *)sy_blob_data(nd->weights))[1], 0.75, 1e-6);
+    /* bad weights refused by the setter, naming what */
+    const float bad[2] = {0, NAN};
+    CHECK_ERR(sy_node_set_weights(s, n, bad, 2, &e), SY_ERR_INVALID_ARGUMENT, e);
+    EXPECT_SAYS(e, "not finite");
+    /* the sampler can be read on its own too */
     float out[2];
     CHECK_OK(sy_animation_sample(sy_animation_get(s, a), 1, false, 0.25, out, 2, &e), e);
     EXPECT_NEAR(out[0], 0.25, 1e-6);

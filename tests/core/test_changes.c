@@ -130,12 +130,21 @@ static int build_rich(sy_scene *s, rich *r)
     sy_blob *bn = blob_of(nrm, sizeof nrm), *bt = blob_of(tan, sizeof tan), *buv = blob_of(uv, sizeof uv);
     sy_blob *bc = blob_of(col, sizeof col), *bi = blob_of(idx, sizeof idx);
     sy_blob *tri = blob_of(pos, 36);
+    /* skin attributes (4 influences) and two morph targets on the first primitive: version 5 */
+    const uint32_t jnt[16] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    const float wgt[16] = {1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0, 1, 0, 0, 0};
+    float dpos[24];
+    for (int k = 0; k < 24; ++k) dpos[k] = 0.125f * (float)(k % 5);
+    sy_blob *bj = blob_of(jnt, sizeof jnt), *bw = blob_of(wgt, sizeof wgt), *bdp = blob_of(dpos, sizeof dpos);
     sy_primitive prims[3] = {
-        {r->pos, bn, bt, buv, buv, bc, bi, r->mat, SY_TOPOLOGY_TRIANGLES, 0.0f},
-        {r->pos, NULL, NULL, NULL, NULL, NULL, bi, {0}, SY_TOPOLOGY_TRIANGLES, 0.0f}, /* shares positions and indices */
-        {tri, NULL, NULL, NULL, NULL, NULL, NULL, r->mat, SY_TOPOLOGY_TRIANGLES, 0.0f},
+        {r->pos, bn, bt, buv, buv, bc, bi, r->mat, SY_TOPOLOGY_TRIANGLES, 0.0f, bj, bw, bdp, bdp, NULL},
+        {r->pos, NULL, NULL, NULL, NULL, NULL, bi, {0}, SY_TOPOLOGY_TRIANGLES, 0.0f, NULL, NULL, NULL, NULL, NULL}, /* shares positions and indices */
+        {tri, NULL, NULL, NULL, NULL, NULL, NULL, r->mat, SY_TOPOLOGY_TRIANGLES, 0.0f, NULL, NULL, NULL, NULL, NULL},
     };
     CHECK_OK(sy_mesh_set_primitives(s, r->mesh, prims, 3, &e), e);
+    sy_blob_release(bj);
+    sy_blob_release(bw);
+    sy_blob_release(bdp);
     sy_blob_release(bn);
     sy_blob_release(bt);
     sy_blob_release(buv);
@@ -178,6 +187,12 @@ static int build_rich(sy_scene *s, rich *r)
     CHECK_OK(sy_node_set_light(s, r->root, r->light, &e), e);
     CHECK_OK(sy_node_set_camera(s, r->b, r->cam, &e), e);
     CHECK_OK(sy_node_set_flags(s, r->b, SY_NODE_STATIC | SY_NODE_ANIMATED, &e), e);
+    const float mw[2] = {0.25f, 0.5f}, nw[2] = {1, -0.5f};
+    sy_mat4 ibm = sy_mat4_identity();
+    ibm.m[12] = -1;
+    CHECK_OK(sy_mesh_set_weights(s, r->mesh, mw, 2, &e), e);
+    CHECK_OK(sy_node_set_weights(s, r->a, nw, 2, &e), e);
+    CHECK_OK(sy_node_set_skin(s, r->a, &r->b, &ibm, 1, r->root, &e), e);
 
     r->attach_blob = blob_of("volume shader bytes", 19);
     sy_attachment at[5] = {
@@ -754,7 +769,8 @@ static int test_blob_once(void)
     CHECK(lists_equal(snap, d) == 0);
     sy_changes_release(d);
     size_t stored = sy_blob_store_count(recv), bytes = sy_blob_store_bytes(recv);
-    CHECK_MSG(stored == 11, "%zu", stored); /* pixels, pos, normals, tangents, uv, colours, indices, tri, 2 child lists, attach blob */
+    CHECK_MSG(stored == 17, "%zu", stored); /* pixels, pos, normals, tangents, uv, colours, indices, tri, 2 child lists, attach blob,
+                                               joints, skin weights, target deltas (twice), mesh and node morph weights, node skin */
     /* the same list again: every payload is already there, none travels */
     CHECK_OK(sy_changes_serialize(snap, send_if_missing, recv, &lean, &lean_size, &e), e);
     CHECK_MSG(lean_size + bytes == full_size, "lean %zu + payloads %zu != full %zu", lean_size, bytes, full_size);

@@ -1,7 +1,8 @@
 /* test_primitives.c — line and point primitives in core (issue 15 part 4): validation (whole index
  * pairs for lines, any count for points, topology and width ranges), element / triangle counts,
  * the stroke width rule, mesh bounds grown by half the width, and the change-list round trip
- * (serialise, decode, apply to a replica, compare) of a line primitive with an explicit width. */
+ * (serialise, decode, apply to a replica, compare) of a line primitive with an explicit width; skin
+ * attributes and morph targets refused when malformed. */
 #include "../support/sy_check.h"
 #include "wire_copy.h"
 #include "sy_changes.h"
@@ -143,9 +144,64 @@ static int test_round_trip(void)
     return 0;
 }
 
+/* Skin attributes and morph targets: sizes, pairing, finiteness and target counts refused naming
+ * the primitive; a valid set counted (influences, targets); skins on nodes check their joints. */
+static int test_deform_validation(void)
+{
+    sy_scene *s;
+    sy_error e = {0};
+    CHECK_OK(sy_scene_create(&s, &e), e);
+    sy_mesh m;
+    CHECK_OK(sy_mesh_create(s, "m", &m, &e), e);
+    uint32_t j4[16] = {0}, j3[12] = {0};
+    float w4[16] = {0}, dp[24] = {0};
+    for (int v = 0; v < 4; ++v) w4[4 * v] = 1.0f;
+    sy_blob *bp = blob(POS, sizeof POS), *bj = blob(j4, sizeof j4), *bw = blob(w4, sizeof w4), *bj3 = blob(j3, sizeof j3);
+    sy_blob *bd2 = blob(dp, sizeof dp), *bd1 = blob(dp, 48);
+    sy_primitive p = {.positions = bp, .joints = bj, .topology = SY_TOPOLOGY_POINTS};
+    CHECK_ERR(sy_mesh_set_primitives(s, m, &p, 1, &e), SY_ERR_INVALID_ARGUMENT, e);
+    CHECK_MSG(strstr(e.message, "primitive 0") && strstr(e.message, "joints without weights"), "message: %s", e.message);
+    p.weights = bw;
+    p.joints = bj3; /* 3 per vertex vs 4 weights */
+    CHECK_ERR(sy_mesh_set_primitives(s, m, &p, 1, &e), SY_ERR_INVALID_ARGUMENT, e);
+    p.joints = bj;
+    w4[5] = NAN;
+    sy_blob *bwn = blob(w4, sizeof w4);
+    p.weights = bwn;
+    CHECK_ERR(sy_mesh_set_primitives(s, m, &p, 1, &e), SY_ERR_INVALID_ARGUMENT, e);
+    CHECK_MSG(strstr(e.message, "not finite"), "message: %s", e.message);
+    p.weights = bw;
+    p.target_positions = bd2;
+    p.target_normals = bd1; /* 2 targets vs 1 */
+    CHECK_ERR(sy_mesh_set_primitives(s, m, &p, 1, &e), SY_ERR_INVALID_ARGUMENT, e);
+    CHECK_MSG(strstr(e.message, "target_normals"), "message: %s", e.message);
+    p.target_normals = bd2;
+    CHECK_OK(sy_mesh_set_primitives(s, m, &p, 1, &e), e);
+    const sy_primitive *q = &sy_mesh_get(s, m)->primitives.items[0];
+    CHECK(sy_primitive_influences(q) == 4 && sy_primitive_target_count(q) == 2);
+    /* skins: joints live nodes, matrices finite */
+    sy_node n, j;
+    CHECK_OK(sy_node_create(s, "skinned", &n, &e), e);
+    CHECK_OK(sy_node_create(s, "joint", &j, &e), e);
+    sy_mat4 ibm = sy_mat4_identity();
+    ibm.m[5] = NAN;
+    CHECK_ERR(sy_node_set_skin(s, n, &j, &ibm, 1, (sy_node){0}, &e), SY_ERR_INVALID_ARGUMENT, e);
+    sy_node stale = {j.id ^ (1u << SY_HANDLE_INDEX_BITS)};
+    CHECK_ERR(sy_node_set_skin(s, n, &stale, NULL, 1, (sy_node){0}, &e), SY_ERR_INVALID_HANDLE, e);
+    CHECK_OK(sy_node_set_skin(s, n, &j, NULL, 1, j, &e), e);
+    uint32_t nj;
+    const sy_skin_joint *sj = sy_node_skin(sy_node_get(s, n), &nj);
+    CHECK(nj == 1 && sj[0].node == j.id && sj[0].inverse_bind.m[0] == 1.0f && sy_node_get(s, n)->skeleton.id == j.id);
+    sy_blob *all[] = {bp, bj, bw, bj3, bd2, bd1, bwn};
+    for (size_t k = 0; k < sizeof all / sizeof all[0]; ++k) sy_blob_release(all[k]);
+    sy_scene_destroy(s);
+    return 0;
+}
+
 int main(void)
 {
     RUN(test_validation);
     RUN(test_round_trip);
+    RUN(test_deform_validation);
     return sy_check_finish("test_primitives");
 }
