@@ -70,6 +70,7 @@ static sy_result load_doc(loader *L)
         !(L->materials = gltf_xcalloc(L, d->material_count + 1, sizeof(sy_material), &r)) ||
         !(L->meshes = gltf_xcalloc(L, d->mesh_count + 1, sizeof(sy_mesh), &r)) ||
         !(L->mesh_triangles = gltf_xcalloc(L, d->mesh_count + 1, sizeof(uint32_t), &r)) ||
+        !(L->mesh_joints = gltf_xcalloc(L, d->mesh_count + 1, sizeof(uint32_t), &r)) ||
         !(L->cameras = gltf_xcalloc(L, d->camera_count + 1, sizeof(sy_camera), &r)) ||
         !(L->lights = gltf_xcalloc(L, d->light_count + 1, sizeof(sy_light), &r)) ||
         !(L->nodes = gltf_xcalloc(L, d->node_count + 1, sizeof(sy_node), &r)) ||
@@ -228,6 +229,7 @@ out:
     free(L.materials);
     free(L.meshes);
     free(L.mesh_triangles);
+    free(L.mesh_joints);
     free(L.cameras);
     free(L.lights);
     free(L.nodes);

@@ -33,9 +33,14 @@
  * or an unknown interpolation are dropped with a warning naming animations[i].samplers[j]; channels
  * to unknown nodes, to nodes outside the loaded scene, to matrix nodes (glTF forbids animating
  * them) or with another path (KHR_animation_pointer) are dropped naming animations[i].channels[k].
- * Morph weight channels are kept in the animation, not evaluated (core has no weights yet);
- * skinned meshes are shown in their bind pose (skins ignored) and morph targets ignored (one
- * warning each).
+ * Weight channels set the target node's morph weights. Skins (node.skin: joints, inverse bind
+ * matrices, skeleton) become the node's SY_NODE_SKIN, JOINTS_0/WEIGHTS_0 and JOINTS_1/WEIGHTS_1 (up
+ * to 8 influences) and morph targets (POSITION / NORMAL / TANGENT deltas) the primitive's, mesh and
+ * node weights their SY_MESH_WEIGHTS / SY_NODE_WEIGHTS; the scene mirror deforms them for every
+ * back-end. Unusable skin data is dropped with a warning, never read past: a joint index past the
+ * skin's joints names skins[i] and the mesh (the node is drawn in its bind pose), joints without
+ * weights, a non-finite or negative weight or non-VEC4 accessors name meshes[m].primitives[p]
+ * (that primitive unskinned), as does a non-finite morph delta (its targets dropped).
  *
  * Untrusted input: the whole document is validated (indices, accessor / bufferView / buffer ranges
  * with checked arithmetic, GLB container, index values, node graph must be a forest, limits,

@@ -61,6 +61,7 @@ typedef struct loader {
     int32_t *parent;      /* per glTF node: parent index, -1 none */
     uint8_t *reached;     /* per glTF node: part of the loaded scene */
     uint32_t *mesh_triangles;
+    uint32_t *mesh_joints; /* per glTF mesh: 1 + its largest JOINTS_n index (0: not skinned) */
     sy_budget budget; /* the file's (sy_budget.h) */
     bool warned_skin, warned_morph, warned_anim;
     size_t variant_cursor;     /* next doc->variant_uses entry (meshes are created in order) */
@@ -151,6 +152,8 @@ sy_result gltf_create_material(loader *L, size_t i);
 sy_result gltf_charge_meshes(loader *L);
 /* Mesh m into L->meshes[m] (L->mesh_triangles[m]: its triangles). */
 sy_result gltf_create_mesh(loader *L, size_t m);
+/* Morph weights (a glTF weights array) into mesh or node id; unusable ones warned about and left. */
+sy_result gltf_set_weights(loader *L, const double *w, size_t count, uint32_t id, sy_object_type type, const char *where);
 
 /* >>cameras, lights, nodes (sy_gltf_nodes.c) -------------------------------------------------- */
 

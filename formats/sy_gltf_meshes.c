@@ -1,7 +1,7 @@
 /* sy_gltf_meshes.c — glTF meshes into sy_meshes: the file's budget for every primitive charged
  * before any is decoded, vertex attributes, indices (range-checked; strips and fans converted),
  * points and lines, tangents where the file has none (a primitive without normals stays indexed
- * and without them: flat shading, sy_primitive). */
+ * and without them: flat shading, sy_primitive), skin attributes and morph targets. */
 #include "sy_gltf_internal.h"
 
 #include "sy_mesh_util.h"
@@ -81,6 +81,131 @@ static sy_result read_all_attributes(loader *L, const sy_gltf_shim_primitive *pr
     return r;
 }
 
+/* Skin attributes (JOINTS_0/WEIGHTS_0, then JOINTS_1/WEIGHTS_1: up to 8 influences per vertex,
+ * interleaved per vertex as sy_primitive wants them) and morph targets (POSITION / NORMAL / TANGENT
+ * deltas; an attribute some targets lack is 0 in those). What cannot be used is dropped with a
+ * warning naming the primitive (the rest of it loads): joints without weights, counts that differ
+ * from POSITION's, a non-finite or negative weight, a non-finite delta. L->mesh_joints[m] learns
+ * the largest joint index, which the nodes check against their skin (sy_gltf_nodes.c). */
+static sy_result read_deform(loader *L, const sy_gltf_shim_primitive *pr, size_t vcount, size_t m, size_t p,
+                             sy_primitive *out)
+{
+    const sy_gltf_doc *d = L->doc;
+    sy_result r = SY_OK;
+    int32_t ja[2] = {pr->joints0, pr->joints1}, wa[2] = {pr->weights0, pr->weights1};
+    size_t sets = ja[0] >= 0 && wa[0] >= 0 ? (ja[1] >= 0 && wa[1] >= 0 ? 2u : 1u) : 0u;
+    if ((ja[0] >= 0) != (wa[0] >= 0))
+        gltf_warn(L, "meshes[%zu].primitives[%zu]: JOINTS_0 without WEIGHTS_0 (or the reverse); not skinned", m, p);
+    const char *why = NULL;
+    for (size_t k = 0; k < sets && !why; k++) {
+        if ((size_t)ja[k] >= d->accessor_count || (size_t)wa[k] >= d->accessor_count) {
+            why = "an accessor index is out of range";
+            break;
+        }
+        const sy_gltf_shim_accessor *a = &d->accessors[ja[k]], *b = &d->accessors[wa[k]];
+        if (a->components != 4 || a->is_matrix || b->components != 4 || b->is_matrix) why = "JOINTS_n / WEIGHTS_n are not VEC4";
+        else if (a->count != vcount || b->count != vcount) why = "JOINTS_n / WEIGHTS_n count differs from POSITION's";
+        else if (a->component_type != CT_UBYTE && a->component_type != CT_USHORT) why = "JOINTS_n is not unsigned byte or short";
+        else if ((a->buffer_view < 0 && !a->sparse) || (b->buffer_view < 0 && !b->sparse))
+            why = "JOINTS_n / WEIGHTS_n hold no data (a Draco primitive's skin attributes are not decoded)";
+    }
+    if (sets && !why) {
+        size_t inf = 4 * sets, n;
+        if (!sy_size_mul(vcount, inf, &n)) return gltf_fail(L, SY_ERR_LIMIT, "meshes[%zu].primitives[%zu]: joints", m, p);
+        uint32_t *joints = gltf_xcalloc(L, n ? n : 1, sizeof(uint32_t), &r);
+        float *weights = joints ? gltf_xcalloc(L, n ? n : 1, sizeof(float), &r) : NULL;
+        uint32_t jmax = 0;
+        for (size_t k = 0; k < sets && weights && !why; k++) {
+            float *jf = NULL, *wf = NULL;
+            if ((r = gltf_read_floats(L, (size_t)ja[k], 4, &jf)) || (r = gltf_read_floats(L, (size_t)wa[k], 4, &wf))) {
+                free(jf);
+                break;
+            }
+            for (size_t v = 0; v < vcount && !why; v++)
+                for (size_t c = 0; c < 4; c++) {
+                    float w = wf[4 * v + c];
+                    if (!isfinite(w) || w < 0.0f) {
+                        why = "a weight is not finite and >= 0";
+                        break;
+                    }
+                    uint32_t j = (uint32_t)jf[4 * v + c];
+                    joints[inf * v + 4 * k + c] = j;
+                    weights[inf * v + 4 * k + c] = w;
+                    if (w > 0.0f && j + 1 > jmax) jmax = j + 1;
+                }
+            free(jf);
+            free(wf);
+        }
+        if (r == SY_OK && !why && weights) {
+            sy_result r1 = make_blob(L, joints, n * sizeof(uint32_t), &out->joints); /* both take their array */
+            sy_result r2 = make_blob(L, weights, n * sizeof(float), &out->weights);
+            joints = NULL;
+            weights = NULL;
+            r = r1 ? r1 : r2;
+            if (r == SY_OK && jmax > L->mesh_joints[m]) L->mesh_joints[m] = jmax;
+        }
+        free(joints);
+        free(weights);
+        if (r) return r;
+    }
+    if (why) gltf_warn(L, "meshes[%zu].primitives[%zu]: skin attributes dropped (%s); drawn in the bind pose", m, p, why);
+
+    if (!pr->target_count) return SY_OK;
+    if (pr->target_count > SY_MORPH_MAX_TARGETS) {
+        gltf_warn(L, "meshes[%zu].primitives[%zu]: %zu morph targets (at most %u); targets dropped", m, p, pr->target_count,
+                  SY_MORPH_MAX_TARGETS);
+        return SY_OK;
+    }
+    sy_blob **dst[3] = {&out->target_positions, &out->target_normals, &out->target_tangents};
+    static const char *const names[3] = {"POSITION", "NORMAL", "TANGENT"};
+    why = NULL;
+    for (int at = 0; at < 3 && !why && r == SY_OK; at++) {
+        bool any = false;
+        for (size_t t = 0; t < pr->target_count; t++) any = any || pr->targets[3 * t + at] >= 0;
+        if (!any) continue;
+        size_t per = vcount * 3, n;
+        if (!sy_size_mul(per, pr->target_count, &n)) return gltf_fail(L, SY_ERR_LIMIT, "meshes[%zu].primitives[%zu]: targets", m, p);
+        float *all = gltf_xcalloc(L, n ? n : 1, sizeof(float), &r);
+        if (!all) break;
+        for (size_t t = 0; t < pr->target_count && !why; t++) {
+            int32_t ai = pr->targets[3 * t + at];
+            if (ai < 0) continue;
+            if ((size_t)ai >= d->accessor_count) {
+                why = "a target accessor index is out of range";
+                break;
+            }
+            const sy_gltf_shim_accessor *a = &d->accessors[ai];
+            if (a->components != 3 || a->is_matrix || a->count != vcount) {
+                why = "a target accessor is not VEC3 with POSITION's count";
+                break;
+            }
+            float *f;
+            if ((r = gltf_read_floats(L, (size_t)ai, 3, &f))) break;
+            for (size_t k = 0; k < per; k++) {
+                if (!(fabsf(f[k]) <= SY_COORD_MAX)) {
+                    why = "a delta is not finite or beyond the coordinate range";
+                    break;
+                }
+                all[t * per + k] = f[k];
+            }
+            free(f);
+        }
+        if (r == SY_OK && !why) {
+            r = make_blob(L, all, n * sizeof(float), dst[at]);
+            all = NULL;
+        }
+        free(all);
+        if (why) gltf_warn(L, "meshes[%zu].primitives[%zu]: morph targets dropped (%s: %s)", m, p, names[at], why);
+    }
+    if (why || r) {
+        for (int at = 0; at < 3; at++) {
+            sy_blob_release(*dst[at]);
+            *dst[at] = NULL;
+        }
+    }
+    return r;
+}
+
 /* POINTS, LINES, LINE_LOOP, LINE_STRIP: point and line primitives (loops and strips expanded to
  * index pairs). Takes ownership of idx (icount indices, or NULL: the vertices in order). Strokes
  * are drawn as tubes and balls with their own normals (sy_scene.h), so no flat normals are made. */
@@ -142,6 +267,10 @@ static sy_result convert_stroke(loader *L, size_t m, size_t p, sy_primitive *out
     size_t per = pr->mode == GLTF_POINTS ? 1 : 2;
     if (pairs && (r = make_blob(L, pairs, elements * per * sizeof(uint32_t), &out->indices))) return r;
     if ((r = read_all_attributes(L, pr, vcount, m, p, out))) return r;
+    if ((r = read_deform(L, pr, vcount, m, p, out))) {
+        sy_primitive_release(out);
+        return r;
+    }
     out->topology = per == 1 ? SY_TOPOLOGY_POINTS : SY_TOPOLOGY_LINES;
     out->material = pr->material >= 0 ? L->materials[pr->material] : (sy_material){0};
     if (per == 1) L->info->counts.points = add_sat(L->info->counts.points, (uint32_t)elements);
@@ -166,7 +295,9 @@ sy_result gltf_charge_meshes(loader *L)
             size_t ic = pr->indices >= 0 ? d->accessors[pr->indices].count : vcount;
             uint64_t per_vertex = 12u + (pr->normal >= 0 ? 12u : 0u) + (pr->tangent >= 0 ? 16u : 0u) +
                                   (pr->texcoord0 >= 0 ? 8u : 0u) + (pr->texcoord1 >= 0 ? 8u : 0u) +
-                                  (pr->color0 >= 0 ? 16u : 0u);
+                                  (pr->color0 >= 0 ? 16u : 0u) + (pr->joints0 >= 0 ? 32u : 0u) +
+                                  (pr->joints1 >= 0 ? 32u : 0u) +
+                                  36u * (uint64_t)(pr->target_count < 1024 ? pr->target_count : 1024);
             if ((r = sy_budget_charge(&L->budget, vcount, per_vertex, &L->err, "meshes[%zu].primitives[%zu]: %zu vertices", m, p, vcount)) == SY_OK)
                 r = sy_budget_charge(&L->budget, ic, 4u, &L->err, "meshes[%zu].primitives[%zu]: %zu indices", m, p, ic);
         }
@@ -181,10 +312,6 @@ static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *
     *used = false;
     *tris = 0;
     memset(out, 0, sizeof *out);
-    if (pr->has_targets && !L->warned_morph) {
-        L->warned_morph = true;
-        gltf_warn(L, "meshes[%zu].primitives[%zu]: morph targets ignored", m, p);
-    }
     if (pr->position < 0) {
         gltf_warn(L, "meshes[%zu].primitives[%zu]: no POSITION attribute; skipped", m, p);
         L->info->counts.skipped_primitives++;
@@ -283,6 +410,10 @@ static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *
     if (tri && (r = make_blob(L, tri, tcount * 3 * sizeof(uint32_t), &out->indices))) return r;
 
     if ((r = read_all_attributes(L, pr, vcount, m, p, out))) return r;
+    if ((r = read_deform(L, pr, vcount, m, p, out))) {
+        sy_primitive_release(out);
+        return r;
+    }
     /* glTF 2.0: without NORMAL the client computes flat normals, and the file's tangents are
      * ignored. The primitive stays as it is, indexed and without normals: every back-end shades a
      * primitive without normals flat (sy_primitive), from the geometric normal of each triangle.
@@ -307,6 +438,25 @@ static sy_result convert_primitive(loader *L, size_t m, size_t p, sy_primitive *
     *used = true;
     *tris = (uint32_t)tcount;
     return SY_OK;
+}
+
+sy_result gltf_set_weights(loader *L, const double *w, size_t count, uint32_t id, sy_object_type type, const char *where)
+{
+    if (count > SY_MORPH_MAX_TARGETS) {
+        gltf_warn(L, "%s: %zu morph weights (at most %u); ignored", where, count, SY_MORPH_MAX_TARGETS);
+        return SY_OK;
+    }
+    float f[SY_MORPH_MAX_TARGETS];
+    for (size_t k = 0; k < count; k++) {
+        f[k] = (float)w[k];
+        if (!isfinite(f[k])) {
+            gltf_warn(L, "%s: a morph weight is not finite; weights ignored", where);
+            return SY_OK;
+        }
+    }
+    sy_result r = type == SY_TYPE_MESH ? sy_mesh_set_weights(L->scene, (sy_mesh){id}, f, (uint32_t)count, &L->err)
+                                       : sy_node_set_weights(L->scene, (sy_node){id}, f, (uint32_t)count, &L->err);
+    return r ? gltf_context(L, r, where) : SY_OK;
 }
 
 sy_result gltf_create_mesh(loader *L, size_t m)
@@ -355,6 +505,8 @@ sy_result gltf_create_mesh(loader *L, size_t m)
         r = gltf_context(L, r, where);
         goto done;
     }
+    if (mesh->weight_count && (r = gltf_set_weights(L, mesh->weights, mesh->weight_count, h.id, SY_TYPE_MESH, where)))
+        goto done;
     L->meshes[m] = h;
     L->mesh_triangles[m] = triangles;
     for (size_t k = L->variant_uses_done; k < L->info->variant_use_count; k++) L->info->variant_uses[k].mesh = h;

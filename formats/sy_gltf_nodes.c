@@ -176,6 +176,70 @@ static sy_result first_frame(loader *L, size_t ni, float t[3], float q[4], float
     return SY_OK;
 }
 
+/* Skin d->nodes[i].skin onto node i (a node with a mesh): the joints (reached nodes), the inverse
+ * bind matrices (a MAT4 float accessor with at least one per joint; identity without one) and the
+ * skeleton. A skin that cannot be used is dropped with a warning naming skins[k] (and the mesh
+ * primitive whose joint index it cannot serve): the mesh is drawn in its bind pose, never read past
+ * the skin. */
+static sy_result set_skin(loader *L, size_t i)
+{
+    const sy_gltf_doc *d = L->doc;
+    const sy_gltf_shim_node *n = &d->nodes[i];
+    size_t k = (size_t)n->skin;
+    const sy_gltf_shim_skin *sk = &d->skins[k];
+    const char *why = NULL;
+    if (sk->joint_count == 0 || sk->joint_count > SY_SKIN_MAX_JOINTS) why = "no joints, or more than SY_SKIN_MAX_JOINTS";
+    for (size_t j = 0; j < sk->joint_count && !why; j++)
+        if (sk->joints[j] < 0 || (size_t)sk->joints[j] >= d->node_count || !L->reached[sk->joints[j]])
+            why = "a joint is not a node of the loaded scene";
+    if (!why && sk->skeleton >= 0 && (size_t)sk->skeleton >= d->node_count) why = "skeleton is not a node";
+    if (!why && L->mesh_joints[n->mesh] > sk->joint_count) {
+        gltf_warn(L, "skins[%zu]: meshes[%d] uses joint index %u, past the skin's %zu joints; skin dropped (nodes[%zu] drawn in "
+                     "its bind pose)",
+                  k, (int)n->mesh, L->mesh_joints[n->mesh] - 1, sk->joint_count, i);
+        return SY_OK;
+    }
+    if (!why && sk->inverse_bind_matrices >= 0) {
+        const sy_gltf_shim_accessor *a = (size_t)sk->inverse_bind_matrices < d->accessor_count ? &d->accessors[sk->inverse_bind_matrices] : NULL;
+        if (!a || a->components != 16 || a->count < sk->joint_count || a->component_type != CT_FLOAT)
+            why = "inverseBindMatrices is not a float MAT4 accessor with one matrix per joint";
+    }
+    if (why) {
+        gltf_warn(L, "skins[%zu] (of nodes[%zu]): %s; skin dropped (drawn in the bind pose)", k, i, why);
+        return SY_OK;
+    }
+    sy_result r = SY_OK;
+    sy_node *joints = gltf_xcalloc(L, sk->joint_count, sizeof *joints, &r);
+    sy_mat4 *ibm = joints ? gltf_xcalloc(L, sk->joint_count, sizeof *ibm, &r) : NULL;
+    if (!ibm) {
+        free(joints);
+        return r;
+    }
+    for (size_t j = 0; j < sk->joint_count; j++) {
+        joints[j] = L->nodes[sk->joints[j]];
+        ibm[j] = sy_mat4_identity();
+        if (sk->inverse_bind_matrices >= 0 &&
+            (r = gltf_read_element(L, (size_t)sk->inverse_bind_matrices, j, 16, ibm[j].m)))
+            break;
+        if (!sy_mat4_is_finite(&ibm[j]) || !sy_coords_in_range(ibm[j].m, 16)) {
+            why = "an inverse bind matrix is not finite or beyond the coordinate range";
+            break;
+        }
+    }
+    if (r == SY_OK && why) gltf_warn(L, "skins[%zu] (of nodes[%zu]): %s; skin dropped (drawn in the bind pose)", k, i, why);
+    if (r == SY_OK && !why) {
+        sy_node skeleton = sk->skeleton >= 0 ? L->nodes[sk->skeleton] : (sy_node){0};
+        if ((r = sy_node_set_skin(L->scene, L->nodes[i], joints, ibm, (uint32_t)sk->joint_count, skeleton, &L->err))) {
+            char where[48];
+            snprintf(where, sizeof where, "skins[%zu]", k);
+            r = gltf_context(L, r, where);
+        }
+    }
+    free(joints);
+    free(ibm);
+    return r;
+}
+
 sy_result gltf_create_nodes(loader *L, const int32_t *roots, size_t root_count, const char *root_name)
 {
     const sy_gltf_doc *d = L->doc;
@@ -258,10 +322,7 @@ sy_result gltf_create_nodes(loader *L, const int32_t *roots, size_t root_count, 
             r = gltf_context(L, r, where);
             goto done;
         }
-        if (n->skin >= 0 && !L->warned_skin) {
-            L->warned_skin = true;
-            gltf_warn(L, "%s: skinning ignored (meshes are used in their bind pose)", where);
-        }
+        if (n->weight_count && (r = gltf_set_weights(L, n->weights, n->weight_count, h.id, SY_TYPE_NODE, where))) goto done;
         if (n->instancing && (r = create_instances(L, i, &inst[i], &inst_count[i]))) goto done;
     }
     /* children (all reached, hence created) */
@@ -287,6 +348,11 @@ sy_result gltf_create_nodes(loader *L, const int32_t *roots, size_t root_count, 
         free(kids);
         kids = NULL;
     }
+    /* skins, once every joint node exists */
+    for (size_t i = 0; i < d->node_count; i++)
+        if (L->reached[i] && d->nodes[i].skin >= 0 && d->nodes[i].mesh >= 0 && !d->nodes[i].instancing &&
+            (r = set_skin(L, i)))
+            goto done;
     /* the new root */
     sy_node root;
     if ((r = new_node(L, root_name, &root, "scene root"))) goto done;

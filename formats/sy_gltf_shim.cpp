@@ -421,6 +421,9 @@ struct sy_gltf_shim_impl {
     std::vector<std::vector<sy_gltf_shim_anim_sampler>> anim_samplers;
     std::vector<std::vector<sy_gltf_shim_anim_channel>> anim_channels;
     std::vector<sy_gltf_shim_animation> animations;
+    std::vector<int32_t> targets; // every primitive's morph target accessors, 3 per target
+    std::vector<std::vector<int32_t>> skin_joints;
+    std::vector<sy_gltf_shim_skin> skins;
     std::vector<const char *> ext_required;
     std::vector<const char *> ext_used;
     std::vector<const char *> variant_names;
@@ -474,13 +477,33 @@ static void fill_doc(sy_gltf_shim_impl *d)
             c.texcoord1 = attr("TEXCOORD_1");
             c.color0 = attr("COLOR_0");
             c.has_targets = !p.targets.empty();
+            c.joints0 = attr("JOINTS_0");
+            c.weights0 = attr("WEIGHTS_0");
+            c.joints1 = attr("JOINTS_1");
+            c.weights1 = attr("WEIGHTS_1");
+            // offset into d->targets for now; made a pointer once the vector stops growing
+            c.targets = reinterpret_cast<const int32_t *>(uintptr_t(d->targets.size()));
+            c.target_count = p.targets.size();
+            for (const std::map<std::string, int> &t : p.targets)
+                for (const char *k : {"POSITION", "NORMAL", "TANGENT"}) {
+                    auto it = t.find(k);
+                    d->targets.push_back(it == t.end() ? -1 : int32_t(it->second));
+                }
             read_variant_uses(p.extensions, int32_t(d->prims.size()), int32_t(ps.size()), &d->variant_uses);
             ps.push_back(c);
         }
         d->prims.push_back(std::move(ps));
     }
+    for (std::vector<sy_gltf_shim_primitive> &ps : d->prims)
+        for (sy_gltf_shim_primitive &c : ps)
+            c.targets = c.target_count ? d->targets.data() + uintptr_t(c.targets) : nullptr;
     for (size_t i = 0; i < m.meshes.size(); i++)
-        d->meshes.push_back({m.meshes[i].name.c_str(), d->prims[i].data(), d->prims[i].size()});
+        d->meshes.push_back({m.meshes[i].name.c_str(), d->prims[i].data(), d->prims[i].size(), m.meshes[i].weights.data(),
+                             m.meshes[i].weights.size()});
+    for (const tinygltf::Skin &sk : m.skins) d->skin_joints.emplace_back(sk.joints.begin(), sk.joints.end());
+    for (size_t i = 0; i < m.skins.size(); i++)
+        d->skins.push_back({m.skins[i].name.c_str(), int32_t(m.skins[i].inverseBindMatrices), int32_t(m.skins[i].skeleton),
+                            d->skin_joints[i].data(), d->skin_joints[i].size()});
     for (const tinygltf::Material &mat : m.materials) {
         sy_gltf_shim_material c = {};
         c.name = mat.name.c_str();
@@ -594,6 +617,8 @@ static void fill_doc(sy_gltf_shim_impl *d)
         c.scale = n.scale.data();
         c.scale_count = n.scale.size();
         c.has_weights = !n.weights.empty();
+        c.weights = n.weights.data();
+        c.weight_count = n.weights.size();
         d->nodes.push_back(c);
     }
     for (const tinygltf::Scene &s : m.scenes) d->scene_nodes.emplace_back(s.nodes.begin(), s.nodes.end());
@@ -632,6 +657,7 @@ static void fill_doc(sy_gltf_shim_impl *d)
     c.variant_uses = d->variant_uses.data();
     c.variant_use_count = d->variant_uses.size();
     c.skin_count = m.skins.size();
+    c.skins = d->skins.data();
     c.animation_count = m.animations.size();
     if (!m.animations.empty()) {
         const tinygltf::Animation &a = m.animations[0];

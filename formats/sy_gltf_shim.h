@@ -87,14 +87,25 @@ typedef struct sy_gltf_shim_primitive {
     int32_t indices;
     int32_t material;
     int32_t position, normal, tangent, texcoord0, texcoord1, color0; /* accessor index or -1 */
-    int32_t has_targets; /* morph targets present (ignored) */
+    int32_t has_targets; /* morph targets present */
+    int32_t joints0, weights0, joints1, weights1; /* skin attributes: accessor index or -1 */
+    const int32_t *targets; /* target_count x {POSITION, NORMAL, TANGENT} accessor indices (-1: absent) */
+    size_t target_count;
 } sy_gltf_shim_primitive;
 
 typedef struct sy_gltf_shim_mesh {
     const char *name;
     const sy_gltf_shim_primitive *primitives;
     size_t primitive_count;
+    const double *weights; size_t weight_count; /* default morph weights (mesh.weights) */
 } sy_gltf_shim_mesh;
+
+typedef struct sy_gltf_shim_skin {
+    const char *name;
+    int32_t inverse_bind_matrices; /* accessor index or -1 (identity) */
+    int32_t skeleton;              /* node index or -1 */
+    const int32_t *joints; size_t joint_count; /* node indices (untrusted) */
+} sy_gltf_shim_skin;
 
 typedef struct sy_gltf_shim_texinfo {
     int32_t index;    /* texture index or -1 */
@@ -192,6 +203,7 @@ typedef struct sy_gltf_shim_node {
     const double *rotation;    size_t rotation_count;    /* 0 or 4 */
     const double *scale;       size_t scale_count;       /* 0 or 3 */
     int32_t has_weights;
+    const double *weights; size_t weight_count; /* morph weights (node.weights) */
     /* EXT_mesh_gpu_instancing: accessor indices or -1 */
     int32_t instancing; /* extension present */
     int32_t inst_translation, inst_rotation, inst_scale;
@@ -252,6 +264,7 @@ typedef struct sy_gltf_doc {
     const char *const *extensions_required; size_t extensions_required_count;
     const char *const *extensions_used;     size_t extensions_used_count; /* the file's extensionsUsed */
     size_t skin_count, animation_count;
+    const sy_gltf_shim_skin *skins; /* skin_count of them */
     const sy_gltf_shim_channel *channels;   size_t channel_count; /* of animations[0] */
     const sy_gltf_shim_animation *animations; /* animation_count of them */
     const char *const *variant_names;       size_t variant_count; /* KHR_materials_variants ("" unnamed) */
