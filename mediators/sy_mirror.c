@@ -3,6 +3,7 @@
  * Sections: >>tables (id-indexed mirrors)  >>textures/materials/meshes  >>nodes and placements
  * >>entries  >>sync  >>lifetime */
 #include "sy_mirror.h"
+#include "sy_deform.h"
 #include "sy_log.h"
 #include "sy_strokes.h"
 
@@ -41,6 +42,10 @@ typedef struct mesh_m {
     sy_bounds bounds; /* of the drawn triangles, strokes' tubes included (placements are checked with it) */
     uint32_t *users; /* node ids */
     uint32_t user_count, user_capacity;
+    sy_primitive *src;  /* the primitives (blobs retained) when one has morph targets or joints; else NULL */
+    uint32_t src_count;
+    sy_blob *weights;   /* default morph weights (retained) */
+    bool has_joints;    /* some primitive has joints and weights */
 } mesh_m;
 
 typedef struct light_m {
@@ -71,6 +76,14 @@ typedef struct node_m {
     uint32_t pending; /* parents in the set being re-placed that are not done yet */
     uint32_t dry_pending; /* the same, for the counting pass */
     uint64_t paths;       /* the counting pass: placements it will have (saturating) */
+    /* deformation (sy_deform.h): a node whose mesh has morph targets or joints */
+    sy_blob *weights, *skin; /* SY_NODE_WEIGHTS, SY_NODE_SKIN (retained) */
+    uint32_t *dprims;        /* its own back-end primitives, deformed (one per mesh primitive; NULL: not made) */
+    uint32_t dprim_count;
+    sy_bounds dbounds;       /* of the deformed positions (world space when skinned) */
+    bool deformer;           /* listed in the mirror's deformers */
+    bool deform_dirty;       /* weights, skin or mesh changed: deform in this sync */
+    bool skinned;            /* deformed by a skin: its instances take the identity, not the placement */
 } node_m;
 
 struct sy_mirror {
@@ -99,7 +112,13 @@ struct sy_mirror {
     uint32_t default_material;   /* back-end handle of glTF's default material (0 = not made yet) */
     uint32_t placements;         /* placements of every node */
     uint32_t placements_max;     /* SY_MIRROR_PLACEMENTS_MAX */
+    uint32_t *deformers;         /* node ids whose mesh has morph targets or joints */
+    uint32_t deformer_count, deformer_cap;
+    sy_mat4 *joint_scratch;      /* composed joint matrices of the node being deformed */
+    uint32_t joint_scratch_cap;
 };
+
+static const sy_mat4 identity_world = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
 
 /* An emitter that lights the scene (sy_look.h): emitted radiance above 1 in some channel. */
 static bool material_emits(const sy_material_data *d)
@@ -210,6 +229,38 @@ static sy_result texture_upload(sy_mirror *st, tex_m *t, sy_error *err)
 }
 
 /* >>meshes */
+static void mesh_free_src(mesh_m *m)
+{
+    for (uint32_t i = 0; i < m->src_count; ++i) sy_primitive_release(&m->src[i]);
+    free(m->src);
+    m->src = NULL;
+    m->src_count = 0;
+    m->has_joints = false;
+}
+
+/* Keeps the primitives (their blobs retained) of a mesh with something to deform. */
+static bool mesh_keep_src(mesh_m *m, const sy_primitive_list *pl)
+{
+    mesh_free_src(m);
+    bool any = false;
+    for (uint32_t i = 0; i < pl->count; ++i) {
+        any = any || sy_deform_has_data(&pl->items[i]);
+        m->has_joints = m->has_joints || sy_primitive_influences(&pl->items[i]) > 0;
+    }
+    if (!any) return true;
+    m->src = calloc(pl->count, sizeof *m->src);
+    if (!m->src) return false;
+    m->src_count = pl->count;
+    for (uint32_t i = 0; i < pl->count; ++i) {
+        sy_primitive *q = &m->src[i];
+        *q = pl->items[i];
+        sy_blob *bl[12] = {q->positions, q->normals, q->tangents, q->texcoords0, q->texcoords1, q->colors,
+                           q->indices,   q->joints,  q->weights,  q->target_positions, q->target_normals, q->target_tangents};
+        for (int k = 0; k < 12; ++k) sy_blob_retain(bl[k]);
+    }
+    return true;
+}
+
 static void mesh_free_prims(sy_mirror *st, mesh_m *m)
 {
     for (uint32_t i = 0; i < m->prim_count; ++i)
@@ -304,8 +355,9 @@ static bool placement_drawable(sy_mirror *st, const node_m *n, const placement *
 {
     if (sy_mat4_is_degenerate(&p->place.world)) return false; /* hidden, as the file meant */
     bool in_range = sy_coords_in_range(&p->place.world.m[12], 3);
-    if (in_range && m && !sy_bounds_is_empty(&m->bounds)) {
-        sy_bounds wb = sy_bounds_transform(&m->bounds, &p->place.world);
+    const sy_bounds *mb = m ? (n->dprims ? &n->dbounds : &m->bounds) : NULL;
+    if (in_range && mb && !sy_bounds_is_empty(mb)) {
+        sy_bounds wb = sy_bounds_transform(mb, n->skinned && n->dprims ? &identity_world : &p->place.world);
         in_range = sy_coords_in_range(wb.min, 3) && sy_coords_in_range(wb.max, 3);
     }
     if (!in_range) {
@@ -329,7 +381,11 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
         placement_clear(st, p); /* its instances and light go; they come back with a drawable transform */
         return SY_OK;
     }
-    uint32_t want = m ? m->prim_count : 0;
+    /* a deformer draws its own deformed primitives, once they are made (the deform pass, after the
+     * placements: its joints' placements drive it); skinned ones in world space */
+    uint32_t want = m && (!n->deformer || n->dprims) ? m->prim_count : 0;
+    const uint32_t *prim_handles = NULL;
+    const sy_mat4 *world = n->skinned && n->dprims ? &identity_world : &p->place.world;
     bool visible = p->place.visible;
     if (mesh_changed || want != p->inst_count) {
         drop_instances(st, p);
@@ -339,12 +395,14 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
             p->inst_count = want;
             bool bake = (n->flags & SY_NODE_STATIC) && m->user_count == 1 && n->pl_count == 1;
             for (uint32_t i = 0; i < want; ++i) {
-                if (!m->prims[i].handle) continue;
+                prim_handles = n->dprims && i < n->dprim_count ? n->dprims : NULL;
+                uint32_t ph = prim_handles ? prim_handles[i] : m->prims[i].handle;
+                if (!ph) continue;
                 const mat_m *mm = LOOKUP(st, mat, mat_cap, m->prims[i].material);
                 uint32_t mh = mm ? mm->handle : 0u;
                 sy_result r = mh ? SY_OK : default_material(st, &mh, err);
                 if (r != SY_OK) return r;
-                sy_mirror_instance_args a = {n->id, index, m->prims[i].handle, mh, &p->place.world, visible, bake, &p->inst[i]};
+                sy_mirror_instance_args a = {n->id, index, ph, mh, world, visible, bake && !n->deformer, &p->inst[i]};
                 r = st->cb->instance_set(st->user, &a, err);
                 if (r != SY_OK) return r;
             }
@@ -352,7 +410,7 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
     } else {
         for (uint32_t i = 0; i < p->inst_count; ++i) {
             if (!p->inst[i]) continue;
-            sy_mirror_instance_args a = {n->id, index, 0, 0, &p->place.world, visible, false, &p->inst[i]};
+            sy_mirror_instance_args a = {n->id, index, 0, 0, world, visible, false, &p->inst[i]};
             sy_result r = st->cb->instance_set(st->user, &a, err);
             if (r != SY_OK) return r;
         }
@@ -499,8 +557,170 @@ static sy_result replace_dirty(sy_mirror *st, sy_error *err)
     return r;
 }
 
+
+/* >>deformation: nodes whose mesh has morph targets or joints get their own back-end primitives,
+ * deformed on the CPU (sy_deform.h) whenever their weights, skin, mesh or a joint's placement
+ * changed, after the placements of the sync (a joint's world matrix is its first placement's). A
+ * back-end with primitive_update rewrites the vertices of the primitive it has (the ray tracers
+ * refit, the rasterizer re-uploads); without it the primitive is made anew and the node's instances
+ * with it. */
+static void dprims_free(sy_mirror *st, node_m *n)
+{
+    for (uint32_t k = 0; k < n->pl_count; ++k) drop_instances(st, &n->pl[k]); /* they use the primitives */
+    for (uint32_t i = 0; i < n->dprim_count; ++i)
+        if (n->dprims[i]) release(st, SY_MIRROR_PRIMITIVE, n->dprims[i]);
+    free(n->dprims);
+    n->dprims = NULL;
+    n->dprim_count = 0;
+    n->skinned = false;
+}
+
+/* After n's mesh (or the mesh's primitives) changed: its deformed primitives go; it is listed as a
+ * deformer, to deform in this sync, when the mesh has something to deform. */
+static sy_result deform_refresh(sy_mirror *st, node_m *n, sy_error *err)
+{
+    dprims_free(st, n);
+    const mesh_m *m = LOOKUP(st, mesh, mesh_cap, n->mesh);
+    bool want = m && m->src;
+    if (want && !n->deformer && !push_u32(&st->deformers, &st->deformer_count, &st->deformer_cap, n->id)) return oom(st, err);
+    if (!want && n->deformer) remove_u32(st->deformers, &st->deformer_count, n->id);
+    n->deformer = want;
+    n->deform_dirty = want;
+    mark_node_dirty(st, n->id);
+    return SY_OK;
+}
+
+static sy_result deform_node(sy_mirror *st, node_m *n, sy_error *err)
+{
+    mesh_m *m = LOOKUP(st, mesh, mesh_cap, n->mesh);
+    n->deform_dirty = false;
+    if (!m || !m->src) return SY_OK;
+    /* the skin's matrices: joint world x inverse bind (a joint not placed counts as the identity) */
+    uint32_t nj = 0;
+    const sy_skin_joint *sj = NULL;
+    if (n->skin && m->has_joints) {
+        nj = (uint32_t)(sy_blob_size(n->skin) / sizeof(sy_skin_joint));
+        sj = sy_blob_data(n->skin);
+    }
+    if (nj > st->joint_scratch_cap) {
+        sy_mat4 *js = realloc(st->joint_scratch, sizeof *js * nj);
+        if (!js) return oom(st, err);
+        st->joint_scratch = js;
+        st->joint_scratch_cap = nj;
+    }
+    for (uint32_t j = 0; j < nj; ++j) {
+        const node_m *jn = LOOKUP(st, node, node_cap, sj[j].node);
+        const sy_mat4 *w = jn && jn->pl_count ? &jn->pl[0].place.world : &identity_world;
+        st->joint_scratch[j] = sy_mat4_mul(w, &sj[j].inverse_bind);
+    }
+    const sy_blob *wb = n->weights ? n->weights : m->weights;
+    sy_deform_input in = {.weights = wb ? sy_blob_data(wb) : NULL,
+                          .weight_count = wb ? (uint32_t)(sy_blob_size(wb) / 4) : 0u,
+                          .joints = nj ? st->joint_scratch : NULL,
+                          .joint_count = nj};
+    bool skinned = nj > 0;
+    uint32_t count = m->src_count < m->prim_count ? m->src_count : m->prim_count;
+    bool in_place = st->cb->primitive_update && n->dprims && n->dprim_count == count && skinned == n->skinned;
+    for (uint32_t i = 0; i < count && in_place; ++i) in_place = m->src[i].topology == SY_TOPOLOGY_TRIANGLES;
+    if (!in_place) {
+        dprims_free(st, n);
+        n->dprims = calloc(count ? count : 1, sizeof *n->dprims);
+        if (!n->dprims) return oom(st, err);
+        n->dprim_count = count;
+    }
+    n->skinned = skinned;
+    n->dbounds = sy_bounds_empty();
+    sy_result r = SY_OK;
+    for (uint32_t i = 0; i < count && r == SY_OK; ++i) {
+        const sy_primitive *src = &m->src[i];
+        if (!m->prims[i].handle) continue; /* nothing the mesh draws either */
+        uint32_t nv = sy_primitive_vertex_count(src);
+        float *pos = malloc(sizeof(float) * 3 * (size_t)nv + 1);
+        float *nrm = src->normals ? malloc(sizeof(float) * 3 * (size_t)nv + 1) : NULL;
+        float *tan = src->tangents ? malloc(sizeof(float) * 4 * (size_t)nv + 1) : NULL;
+        if (!pos || (src->normals && !nrm) || (src->tangents && !tan)) {
+            free(pos), free(nrm), free(tan);
+            return oom(st, err);
+        }
+        in.primitive = src;
+        sy_bounds b;
+        if (!sy_deform_primitive(&in, pos, nrm, tan, &b)) {
+            char item[48];
+            snprintf(item, sizeof item, "node %#x primitive %u", n->id, i);
+            sy_log(SY_LOG_WARNING, st->name, item, "deformed beyond the coordinate range: not updated");
+            free(pos), free(nrm), free(tan);
+            continue;
+        }
+        sy_bounds_add_bounds(&n->dbounds, &b);
+        sy_blob *bp = NULL, *bn = NULL, *bt = NULL;
+        if ((r = sy_blob_create_take(pos, sizeof(float) * 3 * (size_t)nv, &bp, err)) ||
+            (nrm && (r = sy_blob_create_take(nrm, sizeof(float) * 3 * (size_t)nv, &bn, err))) ||
+            (tan && (r = sy_blob_create_take(tan, sizeof(float) * 4 * (size_t)nv, &bt, err)))) {
+            if (!bp) free(pos);
+            if (!bn) free(nrm);
+            if (!bt) free(tan);
+            sy_blob_release(bp), sy_blob_release(bn), sy_blob_release(bt);
+            return r;
+        }
+        sy_primitive q = *src; /* borrowed blobs, the deformed three replaced */
+        q.positions = bp;
+        if (bn) q.normals = bn;
+        if (bt) q.tangents = bt;
+        q.joints = q.weights = q.target_positions = q.target_normals = q.target_tangents = NULL;
+        sy_mirror_flat_mesh flat;
+        if (q.topology != SY_TOPOLOGY_TRIANGLES) {
+            char what[96];
+            snprintf(what, sizeof what, "%s: node %#x primitive %u", st->name, n->id, i);
+            sy_primitive tri;
+            float width = sy_primitive_stroke_width(&q, &b);
+            if ((r = sy_strokes_tessellate(&q, width, what, &tri, err)) == SY_OK) {
+                sy_mirror_flat_mesh_of(&tri, &flat);
+                sy_mirror_primitive_args a = {m->id, i, &tri, &n->dprims[i], &flat};
+                r = st->cb->primitive_set(st->user, &a, err);
+                sy_primitive_release(&tri);
+            }
+        } else {
+            sy_mirror_flat_mesh_of(&q, &flat);
+            sy_mirror_primitive_args a = {m->id, i, &q, &n->dprims[i], &flat};
+            r = in_place ? st->cb->primitive_update(st->user, &a, err) : st->cb->primitive_set(st->user, &a, err);
+        }
+        sy_blob_release(bp), sy_blob_release(bn), sy_blob_release(bt); /* back-ends copy what they keep */
+        if (r == SY_OK) st->stats->deformed++;
+    }
+    if (r == SY_OK && !in_place)
+        for (uint32_t k = 0; k < n->pl_count && r == SY_OK; ++k) r = placement_sync(st, n, k, true, err);
+    return r;
+}
+
+/* Deforms every listed node whose weights, skin or mesh changed or one of whose joints was
+ * re-placed in this sync (visit == epoch). Cost: the listed nodes' joints, plus the vertices of
+ * those that move. */
+static sy_result deform_pass(sy_mirror *st, sy_error *err)
+{
+    sy_result r = SY_OK;
+    for (uint32_t i = 0; i < st->deformer_count && r == SY_OK; ++i) {
+        node_m *n = LOOKUP(st, node, node_cap, st->deformers[i]);
+        if (!n || n->pl_count == 0) continue; /* not drawn: deformed when it is placed */
+        bool need = n->deform_dirty || !n->dprims;
+        if (!need && n->skin) {
+            uint32_t nj = (uint32_t)(sy_blob_size(n->skin) / sizeof(sy_skin_joint));
+            const sy_skin_joint *sj = sy_blob_data(n->skin);
+            for (uint32_t j = 0; j < nj && !need; ++j) {
+                const node_m *jn = LOOKUP(st, node, node_cap, sj[j].node);
+                need = jn && jn->visit == st->epoch;
+            }
+        }
+        if (need) r = deform_node(st, n, err);
+    }
+    return r;
+}
+
 static void node_free(sy_mirror *st, node_m *n)
 {
+    dprims_free(st, n);
+    if (n->deformer) remove_u32(st->deformers, &st->deformer_count, n->id);
+    sy_blob_release(n->weights);
+    sy_blob_release(n->skin);
     for (uint32_t i = 0; i < n->pl_count; ++i) placement_clear(st, &n->pl[i]);
     st->placements -= n->pl_count;
     free(n->pl);
@@ -621,10 +841,25 @@ static sy_result apply_mesh(sy_mirror *st, const sy_change *e, bool destroyed, s
     mesh_m *m = LOOKUP(st, mesh, mesh_cap, e->id);
     if (destroyed) {
         if (m) {
-            for (uint32_t i = 0; i < m->user_count; ++i) mark_node_dirty(st, m->users[i]);
+            for (uint32_t i = 0; i < m->user_count; ++i) {
+                node_m *n = LOOKUP(st, node, node_cap, m->users[i]);
+                if (n) dprims_free(st, n); /* before the mesh's own primitives go */
+                mark_node_dirty(st, m->users[i]);
+            }
             mesh_free_prims(st, m);
-            free(m->users);
+            mesh_free_src(m);
+            sy_blob_release(m->weights);
+            uint32_t *users = m->users, nu = m->user_count;
             memset(m, 0, sizeof *m);
+            for (uint32_t i = 0; i < nu; ++i) {
+                node_m *n = LOOKUP(st, node, node_cap, users[i]);
+                sy_result r = n ? deform_refresh(st, n, err) : SY_OK;
+                if (r != SY_OK) {
+                    free(users);
+                    return r;
+                }
+            }
+            free(users);
         }
         return SY_OK;
     }
@@ -634,14 +869,29 @@ static sy_result apply_mesh(sy_mirror *st, const sy_change *e, bool destroyed, s
         memset(m, 0, sizeof *m);
         m->id = e->id;
     }
+    if (e->mask & SY_BIT(SY_MESH_WEIGHTS)) {
+        sy_blob_release(m->weights);
+        m->weights = sy_blob_retain(((const sy_mesh_data *)e->data)->weights);
+        for (uint32_t i = 0; i < m->user_count; ++i) {
+            node_m *n = LOOKUP(st, node, node_cap, m->users[i]);
+            if (n && n->deformer) n->deform_dirty = true;
+        }
+    }
     if (e->mask & SY_BIT(SY_MESH_PRIMITIVES)) {
+        for (uint32_t i = 0; i < m->user_count; ++i) { /* deformed copies go before the primitives they copy */
+            node_m *n = LOOKUP(st, node, node_cap, m->users[i]);
+            if (n) dprims_free(st, n);
+        }
         sy_result r = mesh_upload(st, m, &((const sy_mesh_data *)e->data)->primitives, err);
         if (r != SY_OK) return r;
+        if (!mesh_keep_src(m, &((const sy_mesh_data *)e->data)->primitives)) return oom(st, err);
         /* users need new instances: drop the old ones, then re-place the users */
         for (uint32_t i = 0; i < m->user_count; ++i) {
             node_m *n = LOOKUP(st, node, node_cap, m->users[i]);
-            if (n)
+            if (n) {
                 for (uint32_t k = 0; k < n->pl_count; ++k) drop_instances(st, &n->pl[k]);
+                if ((r = deform_refresh(st, n, err)) != SY_OK) return r;
+            }
             mark_node_dirty(st, m->users[i]);
         }
     }
@@ -747,7 +997,19 @@ static sy_result apply_node(sy_mirror *st, const sy_change *e, bool destroyed, s
         if (nm) push_u32(&nm->users, &nm->user_count, &nm->user_capacity, n->id);
         n->mesh = d->mesh.id;
         for (uint32_t k = 0; k < n->pl_count; ++k) drop_instances(st, &n->pl[k]); /* force new instances */
+        sy_result r = deform_refresh(st, n, err);
+        if (r != SY_OK) return r;
         dirty = true;
+    }
+    if (e->mask & SY_BIT(SY_NODE_WEIGHTS)) {
+        sy_blob_release(n->weights);
+        n->weights = sy_blob_retain(d->weights);
+        if (n->deformer) n->deform_dirty = true;
+    }
+    if (e->mask & SY_BIT(SY_NODE_SKIN)) {
+        sy_blob_release(n->skin);
+        n->skin = sy_blob_retain(d->skin);
+        if (n->deformer) n->deform_dirty = true;
     }
     if (e->mask & SY_BIT(SY_NODE_LIGHT)) {
         light_m *ol = LOOKUP(st, light, light_cap, n->light), *nl = LOOKUP(st, light, light_cap, d->light.id);
@@ -805,6 +1067,7 @@ sy_result sy_mirror_sync(sy_mirror *st, const sy_changes *changes, sy_mirror_syn
     for (uint32_t i = 0; i < sy_changes_count(changes) && r == SY_OK; ++i) r = apply_entry(st, sy_changes_get(changes, i), err);
     st->epoch++;
     if (r == SY_OK) r = replace_dirty(st, err);
+    if (r == SY_OK) r = deform_pass(st, err);
     st->dirty_count = 0;
     st->stats = NULL;
     return r;
@@ -876,8 +1139,12 @@ void sy_mirror_destroy(sy_mirror *st)
         if (st->node[i].id) node_free(st, &st->node[i]);
     for (uint32_t i = 0; i < st->mesh_cap; ++i) {
         mesh_free_prims(st, &st->mesh[i]);
+        mesh_free_src(&st->mesh[i]);
+        sy_blob_release(st->mesh[i].weights);
         free(st->mesh[i].users);
     }
+    free(st->deformers);
+    free(st->joint_scratch);
     for (uint32_t i = 0; i < st->light_cap; ++i) free(st->light[i].users);
     for (uint32_t i = 0; i < st->tex_cap; ++i) sy_blob_release(st->tex[i].pixels);
     free(st->tex);

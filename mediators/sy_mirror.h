@@ -8,7 +8,10 @@
  * the dirty tracking that re-places only the subtrees a sync touched. It talks to the back-end only
  * through a const table of callbacks on 32-bit back-end handles (0 = none): it creates, updates and
  * releases textures, materials, mesh primitives, one instance per primitive per placement and one
- * light per visible placement of a node with a light, in the same order for every back-end. Each
+ * light per visible placement of a node with a light, in the same order for every back-end. A node
+ * whose mesh has morph targets or joints gets its own primitives, deformed on the CPU once for
+ * every back-end (sy_deform.h) after each sync that changed its weights, skin, mesh or a joint's
+ * placement, and updated in place through primitive_update where the back-end has it. Each
  * callback gets the object's core fields and its flat description (sy_mirror_flat.h: texture
  * handles resolved, emission, texel format, arrays and counts, light type decided once for every
  * back-end), so a mediator only copies fields into its back-end's descriptors. A back-end without
@@ -128,6 +131,12 @@ typedef struct sy_mirror_callbacks {
     sy_result (*light_set)(void *user, const sy_mirror_light_args *a, sy_error *err); /**< creates or updates a light, or NULL */
     void (*release)(void *user, const sy_mirror_release_args *a); /**< releases a back-end object */
     void (*object_changed)(void *user, const sy_mirror_object_args *a); /**< optional */
+    /** Optional: rewrites the vertices of back-end primitive *a->handle in place with a deformed
+     * version of the primitive it was made from (same vertex count, indices, topology and
+     * attributes present; positions, normals and tangents changed): the ray tracers refit its BVH,
+     * the rasterizer re-uploads the vertex buffer. NULL: the mirror releases the primitive, makes a
+     * new one with primitive_set and new instances for it. */
+    sy_result (*primitive_update)(void *user, const sy_mirror_primitive_args *a, sy_error *err);
 } sy_mirror_callbacks;
 
 /** How a mediator sets up its mirror. */
@@ -143,6 +152,7 @@ typedef struct sy_mirror_sync_stats {
     uint32_t entries;         /**< change entries handled */
     uint32_t placements;      /**< node placements recomputed */
     uint32_t nodes_destroyed; /**< mirrored nodes removed */
+    uint32_t deformed;        /**< primitive instances deformed (skins, morph targets: sy_deform.h) */
 } sy_mirror_sync_stats;
 
 /** A mirrored background (defaults for fields never set). */

@@ -233,6 +233,12 @@ typedef struct sy_gl_mesh_desc {
 sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *desc, sy_gl_mesh *out);
 /** Destroys a mesh. */
 sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh);
+/** Re-uploads a mesh's vertices (a skinned or morphed mesh's next pose) with one glBufferSubData of
+ * its vertex buffer: desc has the mesh's vertex and triangle counts and the same attributes present
+ * (positions and normals change; texture coordinates and colours are sent again as given, as the
+ * buffer interleaves them); indices are not read (the mesh keeps its own and its levels of detail).
+ * Bounds follow. */
+sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_mesh_desc *desc);
 
 /** Levels of detail: an indexed mesh of at least this many triangles gets, at creation, a chain of
  * simplified levels (meshoptimizer's meshopt_simplify, each about a quarter of the one before, all

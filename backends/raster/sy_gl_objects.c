@@ -220,6 +220,59 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     return SY_GL_OK;
 }
 
+sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_mesh_desc *d)
+{
+    sy_gl_report *rep = dev ? dev->report : NULL;
+    mesh_o *m = dev ? sy_gli_pool_get(&dev->meshes, mesh.id) : NULL;
+    if (!m) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_HANDLE, "mesh update: stale handle 0x%08x", mesh.id);
+    const float *arrays[5] = {d ? d->positions : NULL, d ? d->normals : NULL, d ? d->uv[0] : NULL, d ? d->uv[1] : NULL,
+                              d ? d->colors : NULL};
+    if (!d || d->vertex_count != m->vertex_count || d->triangle_count != m->triangle_count)
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "mesh update: counts differ from the mesh's (%u vertices, %u triangles)",
+                           m->vertex_count, m->triangle_count);
+    for (int a = 0; a < 5; ++a)
+        if (!arrays[a] != !m->has_attr[a])
+            return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "mesh update: attribute %d present in one and not the other", a);
+    float bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < d->vertex_count; ++i)
+        for (int k = 0; k < 3; ++k) {
+            float v = d->positions[3u * i + k];
+            if (!isfinite(v)) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "mesh update: position %u is not finite", i);
+            bmin[k] = fminf(bmin[k], v);
+            bmax[k] = fmaxf(bmax[k], v);
+        }
+    sy_gl_result r = sy_gli_current(dev, rep);
+    if (r != SY_GL_OK) return r;
+    static const int comps[5] = {3, 3, 2, 2, 4};
+    int stride = 0, offs[5];
+    for (int a = 0; a < 5; ++a) {
+        offs[a] = stride;
+        if (arrays[a]) stride += comps[a];
+    }
+    size_t bytes = (size_t)d->vertex_count * (size_t)stride * sizeof(float);
+    float *vb = malloc(bytes);
+    if (!vb) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh update: out of memory (%u vertices)", d->vertex_count);
+    for (uint32_t i = 0; i < d->vertex_count; ++i)
+        for (int a = 0; a < 5; ++a)
+            if (arrays[a]) memcpy(vb + (size_t)i * stride + offs[a], arrays[a] + (size_t)i * comps[a], comps[a] * sizeof(float));
+    const sy_gl_fns *gl = dev->gl;
+    gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
+    gl->BufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)bytes, vb);
+    gl->BindBuffer(GL_ARRAY_BUFFER, 0);
+    free(vb);
+    sy_gli_count_buffer(dev, false, bytes);
+    memcpy(m->bmin, bmin, sizeof bmin);
+    memcpy(m->bmax, bmax, sizeof bmax);
+    float r2 = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+        m->centre[k] = 0.5f * (bmin[k] + bmax[k]);
+        r2 += 0.25f * (bmax[k] - bmin[k]) * (bmax[k] - bmin[k]);
+    }
+    m->radius = sqrtf(r2);
+    sy_gli_geometry_changed(dev);
+    return sy_gli_gl_check(dev, "mesh update", rep);
+}
+
 sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh)
 {
     mesh_o *m = sy_gli_pool_get(&dev->meshes, mesh.id);

@@ -182,6 +182,15 @@ typedef struct sy_rt_mesh_desc {
 sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *desc, sy_rt_mesh *out);
 /** Invalidates the handle; the data is freed once no instance uses it any more. */
 sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh);
+/** Rewrites a mesh's vertices in place (a skinned or morphed mesh's next pose): positions (float3
+ * x vertex_count, finite, within the device's coordinate limit) and, exactly when the mesh has
+ * normals, normals. Indices, texture coordinates and colours stay. The vertex buffer becomes the
+ * device's own (a shared mesh's caller arrays are no longer read for positions and normals) and
+ * its BVH is refitted, not rebuilt (Embree RTC_BUILD_QUALITY_REFIT, rtcUpdateGeometryBuffer,
+ * rtcCommitGeometry, then the mesh's BLAS and, at the next sy_rt_commit, the top level): the
+ * triangles keep their tree, only the boxes grow or shrink, O(triangles) and no allocation after the
+ * first update. Instances of the mesh see the new shape at the next sy_rt_commit. */
+sy_rt_result sy_rt_mesh_update(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals);
 
 /* >>texture */
 

@@ -44,6 +44,7 @@ static void mesh_free(sy_rt_device *dev, sy_rt_mesh_data *m)
     if (!m) return;
     if (m->geom) rtcReleaseGeometry(m->geom);
     if (m->scene) rtcReleaseScene(m->scene);
+    free(m->updated_normals);
     if (m->shared) {
         if (m->release) m->release(m->release_user);
     } else {
@@ -170,6 +171,7 @@ sy_rt_result sy_rt_mesh_create(sy_rt_device *dev, const sy_rt_mesh_desc *d, sy_r
         goto fail;
     }
     m->positions = pos;
+    m->own_positions = !m->shared;
     m->indices = idx;
     rtcSetGeometryUserData(m->geom, dev);
     rtcCommitGeometry(m->geom);
@@ -185,6 +187,53 @@ fail:
     m->own_bytes = m->shared_bytes = 0; /* not yet counted in dev */
     mesh_free(dev, m); /* m->release is still NULL: the caller keeps its arrays */
     return r;
+}
+
+sy_rt_result sy_rt_mesh_update(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals)
+{
+    if (!dev || !positions) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh update: NULL argument");
+    sy_rt_mesh_data *m = sy_rt_pool_get(&dev->meshes, mesh.id);
+    if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "mesh update: mesh handle 0x%08x is stale", mesh.id);
+    if (!normals != !m->normals)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh update: normals %s, the mesh was made %s them",
+                    normals ? "given" : "missing", m->normals ? "with" : "without");
+    size_t vc = m->vertex_count;
+    float extent = 0.0f;
+    for (size_t i = 0; i < vc * 3u; ++i) {
+        if (!isfinite(positions[i]) || (normals && !isfinite(normals[i])))
+            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh update: %s[%zu] is not finite", isfinite(positions[i]) ? "normals" : "positions", i);
+        extent = fmaxf(extent, fabsf(positions[i]));
+    }
+    if (!(extent <= SY_RT_COORD_MAX))
+        return FAIL(SY_RT_ERROR_LIMIT, "mesh update: a position of %g is beyond SY_RT_COORD_MAX (1e13)", (double)extent);
+    if (!m->own_positions) { /* a shared mesh's first update: a vertex buffer of its own, padded by Embree */
+        float *p = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m->vertex_count);
+        if (!p) {
+            sy_rt_result r = sy_rt_check_embree(dev, "mesh update: vertex buffer");
+            return r != SY_RT_OK ? r : FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh update: vertex buffer: out of memory");
+        }
+        m->positions = p;
+        m->own_positions = true;
+        m->own_bytes += vc * 3u * sizeof(float);
+        dev->mesh_bytes += vc * 3u * sizeof(float);
+    }
+    if (normals && m->shared && !m->updated_normals) {
+        if (!(m->updated_normals = malloc(vc * 3u * sizeof(float) + 1)))
+            return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh update: normals: out of memory");
+        m->normals = m->updated_normals;
+        m->own_bytes += vc * 3u * sizeof(float);
+        dev->mesh_bytes += vc * 3u * sizeof(float);
+    }
+    memcpy((float *)m->positions, positions, vc * 3u * sizeof(float));
+    if (normals) memcpy((float *)m->normals, normals, vc * 3u * sizeof(float));
+    m->extent = extent;
+    rtcUpdateGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcSetGeometryBuildQuality(m->geom, RTC_BUILD_QUALITY_REFIT);
+    rtcCommitGeometry(m->geom);
+    if (m->scene) rtcCommitScene(m->scene); /* the BLAS refits */
+    /* the top level (instance bounds), shadows and area lights follow at the next commit */
+    dev->dirty = dev->top_dirty = dev->shadow_dirty = dev->area_dirty = true;
+    return sy_rt_check_embree(dev, "mesh update");
 }
 
 /* The mesh's BLAS, built on first use by an Embree instance (a mesh used only by baked instances

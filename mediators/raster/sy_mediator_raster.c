@@ -234,6 +234,25 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
     return SY_OK;
 }
 
+/* A deformed pose of a primitive made by cb_primitive: its vertex buffer re-uploaded in place
+ * (sy_gl_mesh_update); the area lights read the new positions. */
+static sy_result cb_primitive_update(void *user, const sy_mirror_primitive_args *a, sy_error *err)
+{
+    raster_state *st = user;
+    const sy_mirror_flat_mesh *f = a->flat;
+    sy_gl_mesh_desc d = {f->positions, f->normals, {f->uv[0], f->uv[1]}, f->colors, f->indices, f->vertex_count,
+                         f->triangle_count};
+    sy_gl_result r = sy_gl_mesh_update(st->dev, (sy_gl_mesh){*a->handle}, &d);
+    if (r != SY_GL_OK) return gl_fail(st, err, r, "mesh primitive update");
+    emesh *em = sy_mirror_map_get(&st->meshes, *a->handle);
+    if (em) {
+        sy_blob_release(em->positions);
+        em->positions = sy_blob_retain(a->primitive->positions);
+    }
+    st->areas_dirty = true; /* an emissive deformed mesh moves its area lights */
+    return SY_OK;
+}
+
 static bool material_emits(const raster_state *st, uint32_t material) { return sy_mirror_map_get(&st->mats, material) != NULL; }
 
 /* Records the instance for the area-light list; marks it dirty when an emitter changed. */
@@ -321,6 +340,7 @@ static const sy_mirror_callbacks raster_mirror_callbacks = {
     .instance_set = cb_instance,
     .light_set = cb_light,
     .release = cb_release,
+    .primitive_update = cb_primitive_update,
 };
 
 /* >>sync */

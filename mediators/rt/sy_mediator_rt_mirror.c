@@ -167,6 +167,15 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
     return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "mesh primitive");
 }
 
+/* A deformed pose of a primitive made by cb_primitive: its vertices rewritten and its BVH refitted
+ * (sy_rt_mesh_update); the blobs cb_primitive holds stay until the mesh goes. */
+static sy_result cb_primitive_update(void *user, const sy_mirror_primitive_args *a, sy_error *err)
+{
+    rt_state *st = user;
+    sy_rt_result r = sy_rt_mesh_update(st->dev, (sy_rt_mesh){*a->handle}, a->flat->positions, a->flat->normals);
+    return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "mesh primitive update");
+}
+
 static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_error *err)
 {
     rt_state *st = user;
@@ -232,6 +241,7 @@ const sy_mirror_callbacks sy_rti_mirror_callbacks = {
     .instance_set = cb_instance,
     .light_set = cb_light,
     .release = cb_release,
+    .primitive_update = cb_primitive_update,
 };
 
 /* >>sync */

@@ -45,7 +45,7 @@ static sy_result inst_set(void *user, const sy_mirror_instance_args *a, sy_error
 }
 static void release(void *user, const sy_mirror_release_args *a) { (void)user, (void)a; }
 
-static const sy_mirror_callbacks k_callbacks = {tex_set, mat_set, prim_set, inst_set, NULL, release, NULL};
+static const sy_mirror_callbacks k_callbacks = {tex_set, mat_set, prim_set, inst_set, NULL, release, NULL, NULL};
 
 /* a 1x1 RGBA texture with pixel value v */
 static sy_texture make_texture(sy_scene *s, uint8_t v)

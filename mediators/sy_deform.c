@@ -1,0 +1,104 @@
+/* sy_deform.c — skinning and morph targets on the CPU (see sy_deform.h). */
+#include "sy_deform.h"
+
+#include <math.h>
+#include <string.h>
+
+bool sy_deform_has_data(const sy_primitive *p)
+{
+    return sy_primitive_target_count(p) > 0 || sy_primitive_influences(p) > 0;
+}
+
+static void normalize3(float *v)
+{
+    float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (l > 0.0f && isfinite(l)) v[0] /= l, v[1] /= l, v[2] /= l;
+}
+
+bool sy_deform_primitive(const sy_deform_input *in, float *pos, float *nrm, float *tan, sy_bounds *bounds_out)
+{
+    const sy_primitive *p = in->primitive;
+    uint32_t nv = sy_primitive_vertex_count(p);
+    const float *p0 = sy_blob_data(p->positions), *n0 = p->normals ? sy_blob_data(p->normals) : NULL;
+    const float *t0 = p->tangents ? sy_blob_data(p->tangents) : NULL;
+    if (!nrm) n0 = NULL;
+    if (!tan) t0 = NULL;
+    memcpy(pos, p0, sizeof(float) * 3 * (size_t)nv);
+    if (n0) memcpy(nrm, n0, sizeof(float) * 3 * (size_t)nv);
+    if (t0) memcpy(tan, t0, sizeof(float) * 4 * (size_t)nv);
+    /* morph targets: target after target, so each delta array is read in order */
+    uint32_t nt = sy_primitive_target_count(p);
+    if (nt && in->weights) {
+        uint32_t use = in->weight_count < nt ? in->weight_count : nt;
+        const float *dp = p->target_positions ? sy_blob_data(p->target_positions) : NULL;
+        const float *dn = n0 && p->target_normals ? sy_blob_data(p->target_normals) : NULL;
+        const float *dt = t0 && p->target_tangents ? sy_blob_data(p->target_tangents) : NULL;
+        size_t per = 3 * (size_t)nv;
+        for (uint32_t t = 0; t < use; ++t) {
+            float w = in->weights[t];
+            if (w == 0.0f) continue;
+            if (dp)
+                for (size_t k = 0; k < per; ++k) pos[k] += w * dp[t * per + k];
+            if (dn)
+                for (size_t k = 0; k < per; ++k) nrm[k] += w * dn[t * per + k];
+            if (dt)
+                for (size_t v = 0; v < nv; ++v)
+                    for (int c = 0; c < 3; ++c) tan[4 * v + c] += w * dt[t * per + 3 * v + c];
+        }
+        if (n0)
+            for (uint32_t v = 0; v < nv; ++v) normalize3(&nrm[3 * v]);
+        if (t0)
+            for (uint32_t v = 0; v < nv; ++v) normalize3(&tan[4 * v]);
+    }
+    /* skin */
+    uint32_t inf = sy_primitive_influences(p);
+    if (inf && in->joints && in->joint_count) {
+        const uint32_t *jj = sy_blob_data(p->joints);
+        const float *ww = sy_blob_data(p->weights);
+        for (uint32_t v = 0; v < nv; ++v) {
+            float m[12] = {0}; /* the upper 3 rows of sum s_k J[j_k], column-major 3x4 */
+            float sum = 0.0f;
+            for (uint32_t k = 0; k < inf; ++k) {
+                float s = ww[(size_t)inf * v + k];
+                uint32_t j = jj[(size_t)inf * v + k];
+                if (s == 0.0f || j >= in->joint_count) continue;
+                const float *J = in->joints[j].m;
+                for (int c = 0; c < 4; ++c)
+                    for (int r = 0; r < 3; ++r) m[3 * c + r] += s * J[4 * c + r];
+                sum += s;
+            }
+            if (sum == 0.0f) continue;
+            float *q = &pos[3 * v], x = q[0], y = q[1], z = q[2];
+            q[0] = m[0] * x + m[3] * y + m[6] * z + m[9];
+            q[1] = m[1] * x + m[4] * y + m[7] * z + m[10];
+            q[2] = m[2] * x + m[5] * y + m[8] * z + m[11];
+            if (n0) {
+                float *a = &nrm[3 * v], ax = a[0], ay = a[1], az = a[2];
+                a[0] = m[0] * ax + m[3] * ay + m[6] * az;
+                a[1] = m[1] * ax + m[4] * ay + m[7] * az;
+                a[2] = m[2] * ax + m[5] * ay + m[8] * az;
+                normalize3(a);
+            }
+            if (t0) {
+                float *a = &tan[4 * v], ax = a[0], ay = a[1], az = a[2];
+                a[0] = m[0] * ax + m[3] * ay + m[6] * az;
+                a[1] = m[1] * ax + m[4] * ay + m[7] * az;
+                a[2] = m[2] * ax + m[5] * ay + m[8] * az;
+                normalize3(a);
+            }
+        }
+    }
+    sy_bounds b = sy_bounds_empty();
+    for (uint32_t v = 0; v < nv; ++v) {
+        if (!sy_coords_in_range(&pos[3 * v], 3)) return false;
+        sy_bounds_add_point(&b, &pos[3 * v]);
+    }
+    if (n0)
+        for (size_t k = 0; k < 3 * (size_t)nv; ++k)
+            if (!isfinite(nrm[k])) nrm[k] = 0.0f;
+    if (t0)
+        for (size_t k = 0; k < 4 * (size_t)nv; ++k)
+            if (!isfinite(tan[k])) tan[k] = 0.0f;
+    if (bounds_out) *bounds_out = b;
+    return true;
+}

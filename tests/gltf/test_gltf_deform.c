@@ -1,0 +1,463 @@
+/* test_gltf_deform.c — skins and morph targets from glTF through the scene clock and the mirror's
+ * deformer (gltf_deform): the load, sy_scene_set_time, commit, a consumer's change list and
+ * sy_mirror_sync into a recording back-end, whose primitives and instances give the vertices every
+ * back-end would draw.
+ *   1. Khronos samples (../shared/testdata/gltf; each skipped with the reason when absent): a
+ *      vertex and the bounds of the deformed mesh at two times equal values computed from the files'
+ *      accessors by an independent Python reading of glTF 2.0 (node TRS, LINEAR / slerp, joint
+ *      world x inverse bind, weighted sum; morph deltas x weights): SimpleSkin, CesiumMan (updated
+ *      in place by a back-end with primitive_update), SimpleMorph; AnimatedMorphCube's weight
+ *      channel moves vertices; MorphPrimitivesTest's mesh.weights deform both primitives;
+ *      RiggedSimple's bounds change with time.
+ *   2. Malformed skins (a joint index past the skin, a NaN weight): the load and the sync succeed,
+ *      a warning names skins[0] / meshes[0].primitives[0], the mesh is drawn in its bind pose. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../support/sy_check.h"
+#include "sy_anim.h"
+#include "sy_commit.h"
+#include "sy_gltf.h"
+#include "sy_mirror.h"
+
+static char g_dir[512];
+static const char *g_data;
+static int g_skipped; /* samples absent */
+
+/* >>a recording back-end: primitives keep a copy of their positions, instances their node, primitive and world */
+typedef struct rprim {
+    float *pos;
+    uint32_t nv;
+    bool live;
+} rprim;
+typedef struct rinst {
+    uint32_t node, prim;
+    sy_mat4 world;
+    bool live;
+} rinst;
+typedef struct recorder {
+    rprim *prims;
+    rinst *inst;
+    uint32_t cap, next;
+    uint32_t updates, sets;
+} recorder;
+
+static uint32_t new_handle(recorder *r)
+{
+    if (r->next + 1 >= r->cap) {
+        uint32_t cap = r->cap ? 2 * r->cap : 64;
+        r->prims = realloc(r->prims, sizeof *r->prims * cap);
+        r->inst = realloc(r->inst, sizeof *r->inst * cap);
+        memset(r->prims + r->cap, 0, sizeof *r->prims * (cap - r->cap));
+        memset(r->inst + r->cap, 0, sizeof *r->inst * (cap - r->cap));
+        r->cap = cap;
+    }
+    return ++r->next;
+}
+static sy_result keep_positions(recorder *r, uint32_t h, const sy_mirror_primitive_args *a)
+{
+    rprim *p = &r->prims[h];
+    free(p->pos);
+    p->nv = a->flat->vertex_count;
+    p->pos = malloc(sizeof(float) * 3 * p->nv + 1);
+    memcpy(p->pos, a->flat->positions, sizeof(float) * 3 * p->nv);
+    p->live = true;
+    return SY_OK;
+}
+static sy_result prim_set(void *user, const sy_mirror_primitive_args *a, sy_error *err)
+{
+    (void)err;
+    recorder *r = user;
+    *a->handle = new_handle(r);
+    r->sets++;
+    return keep_positions(r, *a->handle, a);
+}
+static sy_result prim_update(void *user, const sy_mirror_primitive_args *a, sy_error *err)
+{
+    (void)err;
+    recorder *r = user;
+    if (!*a->handle || !r->prims[*a->handle].live || r->prims[*a->handle].nv != a->flat->vertex_count) return SY_ERR_INVALID_ARGUMENT;
+    r->updates++;
+    return keep_positions(r, *a->handle, a);
+}
+static sy_result inst_set(void *user, const sy_mirror_instance_args *a, sy_error *err)
+{
+    (void)err;
+    recorder *r = user;
+    if (!*a->handle) {
+        *a->handle = new_handle(r);
+        r->inst[*a->handle] = (rinst){a->node, a->mesh, *a->world, true};
+    }
+    r->inst[*a->handle].world = *a->world;
+    return SY_OK;
+}
+static void release(void *user, const sy_mirror_release_args *a)
+{
+    recorder *r = user;
+    if (a->kind == SY_MIRROR_PRIMITIVE) {
+        free(r->prims[a->handle].pos);
+        r->prims[a->handle] = (rprim){0};
+    } else if (a->kind == SY_MIRROR_INSTANCE) {
+        r->inst[a->handle].live = false;
+    }
+}
+static const sy_mirror_callbacks k_rebuild = {.primitive_set = prim_set, .instance_set = inst_set, .release = release};
+static const sy_mirror_callbacks k_refit = {.primitive_set = prim_set, .instance_set = inst_set, .release = release,
+                                            .primitive_update = prim_update};
+
+static void recorder_free(recorder *r)
+{
+    for (uint32_t i = 0; i < r->cap; ++i) free(r->prims[i].pos);
+    free(r->prims);
+    free(r->inst);
+}
+
+/* World position of vertex v of the first live instance of node (its k-th instance in handle order). */
+static bool node_vertex(const recorder *r, uint32_t node, uint32_t k, uint32_t v, float out[3])
+{
+    for (uint32_t h = 1; h <= r->next; ++h) {
+        const rinst *in = &r->inst[h];
+        if (!in->live || in->node != node || k--) continue;
+        const rprim *p = &r->prims[in->prim];
+        if (!p->live || v >= p->nv) return false;
+        sy_mat4_transform_point(&in->world, &p->pos[3 * v], out);
+        return true;
+    }
+    return false;
+}
+
+/* Bounds of every live instance's vertices. */
+static sy_bounds drawn_bounds(const recorder *r)
+{
+    sy_bounds b = sy_bounds_empty();
+    for (uint32_t h = 1; h <= r->next; ++h) {
+        const rinst *in = &r->inst[h];
+        if (!in->live || !r->prims[in->prim].live) continue;
+        for (uint32_t v = 0; v < r->prims[in->prim].nv; ++v) {
+            float w[3];
+            sy_mat4_transform_point(&in->world, &r->prims[in->prim].pos[3 * v], w);
+            sy_bounds_add_point(&b, w);
+        }
+    }
+    return b;
+}
+
+typedef struct rig {
+    sy_scene *s;
+    sy_mirror *m;
+    uint32_t consumer;
+    recorder rec;
+    sy_gltf_info info;
+} rig;
+
+/* Loads a sample into a rig: 1 done, 0 absent (skip printed), -1 failed. */
+static int rig_open(rig *g, const char *rel, const sy_mirror_callbacks *cb)
+{
+    memset(g, 0, sizeof *g);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/gltf/%s", g_data, rel);
+    if (access(path, R_OK) != 0) {
+        printf("skip: %s absent\n", path);
+        return 0;
+    }
+    sy_error e = {0};
+    CHECK_OK(sy_scene_create(&g->s, &e), e);
+    CHECK_OK(sy_gltf_load(path, g->s, NULL, &g->info, &e), e);
+    EXPECT_MSG(g->info.warning_count == 0, "%s: %u warnings, the first: %s", rel, g->info.warning_count,
+               g->info.stored_warning_count ? g->info.warnings[0] : "");
+    sy_mirror_desc d = {"test mirror", 0, cb, &g->rec};
+    CHECK_OK(sy_mirror_create(&d, &g->m, &e), e);
+    CHECK_OK(sy_scene_consumer_add(g->s, &g->consumer, &e), e);
+    return 1;
+}
+
+static void rig_close(rig *g)
+{
+    sy_mirror_destroy(g->m);
+    recorder_free(&g->rec);
+    sy_gltf_info_free(&g->info);
+    sy_scene_destroy(g->s);
+}
+
+/* The scene at time t, synced into the mirror; the sync's stats in *st. */
+static int rig_pose(rig *g, double t, sy_mirror_sync_stats *st)
+{
+    sy_error e = {0};
+    sy_changes *c;
+    CHECK_OK(sy_scene_set_time(g->s, (sy_animation){0}, t, &e), e);
+    CHECK_OK(sy_scene_commit(g->s, NULL, &e), e);
+    CHECK_OK(sy_scene_consumer_pull(g->s, g->consumer, &c, &e), e);
+    sy_result r = sy_mirror_sync(g->m, c, st, &e);
+    sy_changes_release(c);
+    CHECK_OK(r, e);
+    return 0;
+}
+
+/* The first node with a mesh (the skinned / morphed one in these samples). */
+static uint32_t mesh_node(const sy_scene *s)
+{
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id))
+        if (((const sy_node_data *)sy_object_get(s, SY_TYPE_NODE, id))->mesh.id) return id;
+    return 0;
+}
+
+#define EXPECT_VEC(a, x, y, z, eps)                                                                                     \
+    EXPECT_MSG(fabsf((a)[0] - (x)) < (eps) && fabsf((a)[1] - (y)) < (eps) && fabsf((a)[2] - (z)) < (eps),             \
+               "(%g %g %g), expected (%g %g %g)", (double)(a)[0], (double)(a)[1], (double)(a)[2], (double)(x), (double)(y), \
+               (double)(z))
+
+/* Expected values: python3 over the files' accessors (the formulas in the header comment). */
+static int test_simple_skin(void)
+{
+    rig g;
+    int o = rig_open(&g, "SimpleSkin/glTF/SimpleSkin.gltf", &k_rebuild);
+    if (o <= 0) return o < 0 ? 1 : (g_skipped++, 0);
+    uint32_t n = mesh_node(g.s);
+    uint32_t nj;
+    const sy_skin_joint *sj = sy_node_skin(sy_node_get(g.s, (sy_node){n}), &nj);
+    CHECK(nj == 2 && sj);
+    CHECK(sy_primitive_influences(&sy_mesh_get(g.s, sy_node_get(g.s, (sy_node){n})->mesh)->primitives.items[0]) == 4);
+    sy_mirror_sync_stats st;
+    float p[3];
+    CHECK(rig_pose(&g, 0.0, &st) == 0);
+    EXPECT(st.deformed == 1);
+    sy_bounds b = drawn_bounds(&g.rec);
+    EXPECT_VEC(b.min, -0.5f, 0.0f, 0.0f, 1e-4f);
+    EXPECT_VEC(b.max, 0.5f, 2.0f, 0.0f, 1e-4f);
+    CHECK(rig_pose(&g, 0.5, &st) == 0);
+    EXPECT(st.deformed == 1);
+    EXPECT(node_vertex(&g.rec, n, 0, 9, p));
+    EXPECT_VEC(p, -0.354076f, 2.060486f, 0.0f, 1e-4f);
+    CHECK(rig_pose(&g, 1.0, &st) == 0);
+    b = drawn_bounds(&g.rec);
+    EXPECT_VEC(b.min, -1.0f, 0.0f, 0.0f, 1e-4f);
+    EXPECT_VEC(b.max, 0.5f, 1.5f, 0.0f, 1e-4f);
+    /* the same time again: nothing moved, nothing deformed */
+    CHECK(rig_pose(&g, 1.0, &st) == 0);
+    EXPECT(st.deformed == 0);
+    EXPECT(g.rec.updates == 0); /* no primitive_update: made anew each time */
+    rig_close(&g);
+    return 0;
+}
+
+static int test_cesium_man(void)
+{
+    rig g;
+    int o = rig_open(&g, "CesiumMan/glTF/CesiumMan.gltf", &k_refit);
+    if (o <= 0) return o < 0 ? 1 : (g_skipped++, 0);
+    uint32_t n = mesh_node(g.s), nj;
+    sy_node_skin(sy_node_get(g.s, (sy_node){n}), &nj);
+    EXPECT(nj == 19);
+    sy_mirror_sync_stats st;
+    float p[3];
+    CHECK(rig_pose(&g, 0.0, &st) == 0);
+    EXPECT(node_vertex(&g.rec, n, 0, 0, p));
+    EXPECT_VEC(p, 0.025713f, 0.923724f, 0.116109f, 1e-4f);
+    sy_bounds b0 = drawn_bounds(&g.rec);
+    EXPECT_VEC(b0.min, -0.310509f, -0.010645f, -0.446594f, 1e-4f);
+    EXPECT_VEC(b0.max, 0.194655f, 1.447161f, 0.449895f, 1e-4f);
+    uint32_t sets = g.rec.sets;
+    CHECK(rig_pose(&g, 1.0, &st) == 0);
+    EXPECT(st.deformed == 1);
+    EXPECT_MSG(g.rec.updates == 1 && g.rec.sets == sets, "updates %u, sets %u -> %u", g.rec.updates, sets, g.rec.sets);
+    EXPECT(node_vertex(&g.rec, n, 0, 0, p));
+    EXPECT_VEC(p, 0.019726f, 0.929301f, 0.108111f, 1e-4f);
+    sy_bounds b1 = drawn_bounds(&g.rec);
+    EXPECT_VEC(b1.min, -0.202182f, -0.001426f, -0.507517f, 1e-4f);
+    EXPECT_VEC(b1.max, 0.166843f, 1.457235f, 0.462330f, 1e-4f);
+    rig_close(&g);
+    return 0;
+}
+
+static int test_simple_morph(void)
+{
+    rig g;
+    int o = rig_open(&g, "SimpleMorph/glTF/SimpleMorph.gltf", &k_refit);
+    if (o <= 0) return o < 0 ? 1 : (g_skipped++, 0);
+    uint32_t n = mesh_node(g.s);
+    const sy_primitive *pr = &sy_mesh_get(g.s, sy_node_get(g.s, (sy_node){n})->mesh)->primitives.items[0];
+    EXPECT(sy_primitive_target_count(pr) == 2);
+    sy_mirror_sync_stats st;
+    float p[3];
+    CHECK(rig_pose(&g, 0.0, &st) == 0);
+    EXPECT(node_vertex(&g.rec, n, 0, 2, p));
+    EXPECT_VEC(p, 0.5f, 0.5f, 0.0f, 1e-5f);
+    CHECK(rig_pose(&g, 1.0, &st) == 0); /* weights 0, 1 */
+    EXPECT(node_vertex(&g.rec, n, 0, 2, p));
+    EXPECT_VEC(p, 1.5f, 1.5f, 0.0f, 1e-5f);
+    CHECK(rig_pose(&g, 1.5, &st) == 0); /* weights 0.5, 1 */
+    EXPECT(node_vertex(&g.rec, n, 0, 2, p));
+    EXPECT_VEC(p, 1.0f, 2.0f, 0.0f, 1e-5f);
+    rig_close(&g);
+    return 0;
+}
+
+static int test_morph_cube_and_primitives(void)
+{
+    rig g;
+    int o = rig_open(&g, "AnimatedMorphCube/glTF/AnimatedMorphCube.gltf", &k_refit);
+    if (o < 0) return 1;
+    if (o == 0) {
+        g_skipped++;
+    } else {
+        sy_mirror_sync_stats st;
+        CHECK(rig_pose(&g, 0.0, &st) == 0);
+        sy_bounds b0 = drawn_bounds(&g.rec);
+        CHECK(rig_pose(&g, 1.0, &st) == 0);
+        EXPECT(st.deformed == 1);
+        sy_bounds b1 = drawn_bounds(&g.rec);
+        const sy_node_data *nd = sy_node_get(g.s, (sy_node){mesh_node(g.s)});
+        EXPECT(nd->weights && sy_blob_size(nd->weights) == 8);
+        if (nd->weights) EXPECT_NEAR(((const float *)sy_blob_data(nd->weights))[0], 0.6835937, 1e-5);
+        float moved = 0;
+        for (int k = 0; k < 3; ++k) moved += fabsf(b1.min[k] - b0.min[k]) + fabsf(b1.max[k] - b0.max[k]);
+        EXPECT_MSG(moved > 1e-3f, "the weight channel moved the bounds by %g", (double)moved);
+        rig_close(&g);
+    }
+    o = rig_open(&g, "MorphPrimitivesTest/glTF/MorphPrimitivesTest.gltf", &k_refit);
+    if (o < 0) return 1;
+    if (o == 0) {
+        g_skipped++;
+        return 0;
+    }
+    uint32_t n = mesh_node(g.s);
+    const sy_mesh_data *md = sy_mesh_get(g.s, sy_node_get(g.s, (sy_node){n})->mesh);
+    EXPECT(md->weights && sy_blob_size(md->weights) == 4);
+    EXPECT(md->primitives.count == 2 && sy_primitive_target_count(&md->primitives.items[0]) == 1 &&
+           sy_primitive_target_count(&md->primitives.items[1]) == 1);
+    sy_mirror_sync_stats st;
+    CHECK(rig_pose(&g, 0.0, &st) == 0);
+    EXPECT(st.deformed == 2);
+    /* deformed = base + 0.5 x delta, for a vertex whose delta is not 0 */
+    bool checked = false;
+    for (uint32_t v = 0; v < sy_primitive_vertex_count(&md->primitives.items[0]) && !checked; ++v) {
+        const float *base = (const float *)sy_blob_data(md->primitives.items[0].positions) + 3 * v;
+        const float *dp = (const float *)sy_blob_data(md->primitives.items[0].target_positions) + 3 * v;
+        if (fabsf(dp[0]) + fabsf(dp[1]) + fabsf(dp[2]) < 1e-3f) continue;
+        float p[3], local[3];
+        EXPECT(node_vertex(&g.rec, n, 0, v, p));
+        sy_mat4 inv, w;
+        sy_error e = {0};
+        EXPECT_OK(sy_node_world_matrix(g.s, (sy_node){n}, &w, &e), e);
+        EXPECT(sy_mat4_invert(&w, &inv));
+        sy_mat4_transform_point(&inv, p, local);
+        EXPECT_VEC(local, base[0] + 0.5f * dp[0], base[1] + 0.5f * dp[1], base[2] + 0.5f * dp[2], 1e-4f);
+        checked = true;
+    }
+    EXPECT(checked);
+    rig_close(&g);
+    return 0;
+}
+
+static int test_rigged_simple(void)
+{
+    rig g;
+    int o = rig_open(&g, "RiggedSimple/glTF/RiggedSimple.gltf", &k_rebuild);
+    if (o <= 0) return o < 0 ? 1 : (g_skipped++, 0);
+    sy_mirror_sync_stats st;
+    CHECK(rig_pose(&g, 0.0, &st) == 0);
+    sy_bounds b0 = drawn_bounds(&g.rec);
+    CHECK(rig_pose(&g, 1.0, &st) == 0);
+    sy_bounds b1 = drawn_bounds(&g.rec);
+    float moved = 0;
+    for (int k = 0; k < 3; ++k) moved += fabsf(b1.min[k] - b0.min[k]) + fabsf(b1.max[k] - b0.max[k]);
+    EXPECT_MSG(moved > 1e-2f, "the bounds moved by %g", (double)moved);
+    rig_close(&g);
+    return 0;
+}
+
+/* >>malformed skins: a triangle with one joint; joints, weights and the skin as each case says */
+static int load_bad(const char *name, const uint8_t joints[12], const float weights[12], const char *const *want, int nwant)
+{
+    /* buffer: 3 positions (36 bytes), joints 3 x u8[4] (12), weights 3 x f32[4] (48), one inverse bind matrix (64) */
+    uint8_t buf[36 + 12 + 48 + 64];
+    const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const float ibm[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    memcpy(buf, pos, 36);
+    memcpy(buf + 36, joints, 12);
+    memcpy(buf + 48, weights, 48);
+    memcpy(buf + 96, ibm, 64);
+    char bin[600], gltf[640];
+    snprintf(bin, sizeof bin, "%s/%s.bin", g_dir, name);
+    snprintf(gltf, sizeof gltf, "%s/%s.gltf", g_dir, name);
+    FILE *f = fopen(bin, "wb");
+    CHECK(f && fwrite(buf, sizeof buf, 1, f) == 1);
+    fclose(f);
+    char json[2048];
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":160,\"uri\":\"%s.bin\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":160}],"
+             "\"accessors\":["
+             "{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},"
+             "{\"bufferView\":0,\"byteOffset\":36,\"componentType\":5121,\"count\":3,\"type\":\"VEC4\"},"
+             "{\"bufferView\":0,\"byteOffset\":48,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"},"
+             "{\"bufferView\":0,\"byteOffset\":96,\"componentType\":5126,\"count\":1,\"type\":\"MAT4\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":1,\"WEIGHTS_0\":2}}]}],"
+             "\"skins\":[{\"joints\":[1],\"inverseBindMatrices\":3}],"
+             "\"nodes\":[{\"mesh\":0,\"skin\":0},{\"name\":\"joint\",\"translation\":[0,5,0]}],"
+             "\"scenes\":[{\"nodes\":[0,1]}]}",
+             name);
+    f = fopen(gltf, "wb");
+    CHECK(f && fwrite(json, strlen(json), 1, f) == 1);
+    fclose(f);
+    rig g;
+    memset(&g, 0, sizeof g);
+    sy_error e = {0};
+    CHECK_OK(sy_scene_create(&g.s, &e), e);
+    CHECK_OK(sy_gltf_load(gltf, g.s, NULL, &g.info, &e), e);
+    for (int w = 0; w < nwant; ++w) {
+        bool found = false;
+        for (uint32_t i = 0; i < g.info.stored_warning_count && !found; ++i) found = strstr(g.info.warnings[i], want[w]) != NULL;
+        EXPECT_MSG(found, "%s: no warning '%s' (first: %s)", name, want[w], g.info.stored_warning_count ? g.info.warnings[0] : "none");
+    }
+    sy_mirror_desc d = {"test mirror", 0, &k_refit, &g.rec};
+    CHECK_OK(sy_mirror_create(&d, &g.m, &e), e);
+    CHECK_OK(sy_scene_consumer_add(g.s, &g.consumer, &e), e);
+    sy_mirror_sync_stats st;
+    CHECK(rig_pose(&g, 0.0, &st) == 0);
+    /* the bind pose: the triangle where the file put it, not moved 5 up by the joint */
+    sy_bounds b = drawn_bounds(&g.rec);
+    EXPECT_VEC(b.min, 0.0f, 0.0f, 0.0f, 1e-6f);
+    EXPECT_VEC(b.max, 1.0f, 1.0f, 0.0f, 1e-6f);
+    rig_close(&g);
+    return 0;
+}
+
+static int test_malformed(void)
+{
+    const uint8_t j_ok[12] = {0}, j_bad[12] = {0, 0, 0, 0, 3, 0, 0, 0, 0, 0, 0, 0};
+    const float w_ok[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}, w_nan[12] = {1, 0, 0, 0, NAN, 0, 0, 0, 1, 0, 0, 0};
+    const char *past[] = {"skins[0]: meshes[0] uses joint index 3, past the skin's 1 joints"};
+    const char *nan[] = {"meshes[0].primitives[0]: skin attributes dropped (a weight is not finite and >= 0)"};
+    if (load_bad("joint_past", j_bad, w_ok, past, 1)) return 1;
+    if (load_bad("weight_nan", j_ok, w_nan, nan, 1)) return 1;
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    g_data = argc > 1 ? argv[1] : "../shared/testdata";
+    snprintf(g_dir, sizeof g_dir, "%s/sy_gltf_deform_XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+    if (!mkdtemp(g_dir)) {
+        perror("mkdtemp");
+        return 1;
+    }
+    RUN(test_malformed);
+    RUN(test_simple_skin);
+    RUN(test_cesium_man);
+    RUN(test_simple_morph);
+    RUN(test_morph_cube_and_primitives);
+    RUN(test_rigged_simple);
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
+    if (system(cmd) != 0) fprintf(stderr, "note: could not remove %s\n", g_dir);
+    int st = sy_check_finish("gltf_deform");
+    if (st == 0 && g_skipped == 7) {
+        printf("skip: none of the sample models is in %s/gltf\n", g_data);
+        return 77;
+    }
+    return st;
+}
