@@ -86,6 +86,11 @@ sy_result sy_bench_limit(sy_scene *scene, const sy_viewport_desc *vd, const char
  * Cornell box (../shared/testdata/cornell) and the demo. Returns the exit status. */
 int sy_cmd_bench_limit(int argc, char **argv);
 
+/* sy bench deform (issue 35): a generated tube of about `vertices` vertices skinned to 16 joints;
+ * the deform step, the mirror's sync and, per back-end (whitted, raster), a posed frame's set +
+ * commit + sync against building the scene from scratch, `repeats` frames (sy_bench_deform.c). */
+sy_result sy_bench_deform(uint32_t vertices, uint32_t repeats, sy_error *err);
+
 /* Minimum, median and maximum of n > 0 values (sorts v in place): benchmarks report the median of
  * their rounds with the spread. */
 typedef struct sy_bench_spread {

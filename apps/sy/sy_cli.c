@@ -202,6 +202,7 @@ static const char usage_text[] =
             "  sy bench instances [--nodes INSTANCES] [--tris PER_MESH] [-w W] [-h H] [--repeats FRAMES] [-b BACKEND]\n"
             "            (one mesh instanced: 10^3 x 10^6 triangles by default, every picture back-end)\n"
             "  sy bench governor [SCENE] [--budget MS] [--frames N] [-w W] [-h H]   (frame-time governor, orbiting camera)\n"
+            "  sy bench deform [--tris VERTICES] [--repeats FRAMES]   (a skinned frame: deform, refit, re-upload)\n"
             "  sy bench cull [--tris N] [--objects N] [--budget T] [-w W] [-h H] [--frames N] [--write PLANT.glb]\n"
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy pick SCENE X Y [X Y ...] [-b BACKEND] [-w W] [-h H] [--camera NAME|INDEX] [--params k=v,...]\n"

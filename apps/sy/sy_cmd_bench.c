@@ -106,7 +106,7 @@ int sy_cmd_bench(int argc, char **argv)
 {
     static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
                                         "viewports", "load", "cluster",    "memory", "instances", "governor",
-                                        "limit",     "cull", "web"};
+                                        "limit",     "cull", "web", "deform"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -161,6 +161,10 @@ int sy_cmd_bench(int argc, char **argv)
     if (argc - optind > 1) return sy_cli_usage_of(who, "at most one SCENE");
     if (optind < argc) scene = argv[optind];
     sy_error err = {0};
+    if (!strcmp(cmd, "deform")) { /* --tris: vertices of the skinned tube */
+        if (optind < argc) return sy_cli_usage_of(who, "no SCENE: the skinned tube is generated");
+        return sy_bench_deform(tris == 100 ? 100000 : tris, repeats ? repeats : 50, &err) == SY_OK ? 0 : sy_cli_fail(&err);
+    }
     if (!strcmp(cmd, "sync")) return sy_bench_sync(nodes, tris, repeats ? repeats : 50, &err) == SY_OK ? 0 : sy_cli_fail(&err);
     if (!strcmp(cmd, "viewports"))
         return sy_bench_viewports(w == 512 ? 480 : w, h == 512 ? 270 : h, repeats ? repeats : 5, &err) == SY_OK

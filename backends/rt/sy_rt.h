@@ -188,8 +188,10 @@ sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh);
  * device's own (a shared mesh's caller arrays are no longer read for positions and normals) and
  * its BVH is refitted, not rebuilt (Embree RTC_BUILD_QUALITY_REFIT, rtcUpdateGeometryBuffer,
  * rtcCommitGeometry, then the mesh's BLAS and, at the next sy_rt_commit, the top level): the
- * triangles keep their tree, only the boxes grow or shrink, O(triangles) and no allocation after the
- * first update. Instances of the mesh see the new shape at the next sy_rt_commit. */
+ * triangles keep their tree, only the boxes grow or shrink, O(triangles). Embree refits only in a
+ * dynamic scene (RTC_SCENE_FLAG_DYNAMIC) of build quality LOW, so the first update rebuilds the
+ * mesh's BLAS once that way (a tree of lower quality than the static meshes' HIGH); later updates
+ * refit. Instances of the mesh see the new shape at the next sy_rt_commit. */
 sy_rt_result sy_rt_mesh_update(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals);
 
 /* >>texture */

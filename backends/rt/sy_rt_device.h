@@ -31,6 +31,7 @@ typedef struct sy_rt_mesh_data {
     bool shared;              /* the arrays are the caller's (not freed here) */
     bool own_positions;       /* positions is an Embree buffer of its own (a copy, or rewritten by sy_rt_mesh_update) */
     float *updated_normals;   /* a shared mesh's normals rewritten by sy_rt_mesh_update (own; freed with it) */
+    bool refitting;           /* updated by sy_rt_mesh_update: its BLAS is built LOW, its geometry REFIT */
     uint64_t own_bytes, shared_bytes; /* accounting (sy_rt_device_stats) */
     uint32_t vertex_count, triangle_count;
     float extent;         /* largest |coordinate| of its positions */
