@@ -621,7 +621,8 @@ static sy_result deform_node(sy_mirror *st, node_m *n, sy_error *err)
     bool skinned = nj > 0;
     uint32_t count = m->src_count < m->prim_count ? m->src_count : m->prim_count;
     bool in_place = st->cb->primitive_update && n->dprims && n->dprim_count == count && skinned == n->skinned;
-    for (uint32_t i = 0; i < count && in_place; ++i) in_place = m->src[i].topology == SY_TOPOLOGY_TRIANGLES;
+    for (uint32_t i = 0; i < count && in_place; ++i) /* triangles only, each made (a pose out of range made none) */
+        in_place = m->src[i].topology == SY_TOPOLOGY_TRIANGLES && (n->dprims[i] || !m->prims[i].handle);
     if (!in_place) {
         dprims_free(st, n);
         n->dprims = calloc(count ? count : 1, sizeof *n->dprims);
