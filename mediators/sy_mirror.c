@@ -1089,7 +1089,7 @@ bool sy_mirror_instance_find(const sy_mirror *st, uint32_t node_id, uint32_t han
                 out->primitive = i;
                 const mat_m *mm = i < m->prim_count ? LOOKUP(st, mat, mat_cap, m->prims[i].material) : NULL;
                 out->material = mm ? mm->id : 0u; /* 0: the default material */
-                out->world = n->pl[p].place.world;
+                out->world = n->skinned && n->dprims ? identity_world : n->pl[p].place.world; /* skinned: world-space vertices */
                 return true;
             }
     return false;

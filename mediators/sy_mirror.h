@@ -178,7 +178,7 @@ typedef struct sy_mirror_instance_info {
     uint32_t mesh;      /**< core mesh id */
     uint32_t primitive; /**< the primitive's index in the mesh */
     uint32_t material;  /**< core material id of the primitive (0: none or not mirrored: the default material) */
-    sy_mat4 world;      /**< the placement's world matrix */
+    sy_mat4 world;      /**< the placement's world matrix (the identity for a skinned node: its deformed vertices are in world space) */
 } sy_mirror_instance_info;
 /** Finds the back-end instance `handle` among the instances of node node_id (the node the mediator
  * recorded for it in instance_set): true and *out filled, or false (zeroed) when the node holds no

@@ -3,7 +3,8 @@
  * and pathtracer contexts that were synced at t = 0 first, so the second pose reaches them as an
  * update of the deformed vertices (the ray tracers refit, the rasterizer re-uploads). Their
  * silhouettes (alpha coverage) agree at t = 1 (IoU >= 0.97), and differ from their own t = 0 pose
- * (IoU < 0.95: the walk moved the legs and arms). Skipped when the sample is absent. */
+ * (IoU < 0.95: the walk moved the legs and arms); a pick names the skinned node at the depth the
+ * t = 1 image has there, in every back-end. Skipped when the sample is absent. */
 #include "it_util.h"
 #include "sy_anim.h"
 #include "sy_stats.h"
@@ -60,6 +61,20 @@ int main(void)
         MUST(sy_layer_coverage_iou(&t0[b], &t1[b], &iou, err));
         printf("%s: IoU of t=0 and t=1: %.4f\n", k_backends[b], iou);
         EXPECT_MSG(iou < 0.95, "%s: the pose at t=1 looks like t=0 (IoU %.4f)", k_backends[b], iou);
+    }
+    /* a pick at the chest names the skinned node and the same deformed point in every back-end (the
+     * depth of that pixel in the t = 1 layer, whose vertices were updated in place) */
+    sy_pick_result pk[NB];
+    for (size_t b = 0; b < NB; ++b) {
+        MUST(sy_context_pick(ctx[b], &view, W, H, W / 2, (uint32_t)(0.4 * H), &pk[b], err));
+        float d = t1[b].depth[(size_t)(0.4 * H) * W + W / 2];
+        printf("%s: pick node %#x, position (%.4f %.4f %.4f), depth %.4f (layer %.4f)\n", k_backends[b], pk[b].node_id,
+               (double)pk[b].position[0], (double)pk[b].position[1], (double)pk[b].position[2], (double)pk[b].depth, (double)d);
+        EXPECT_MSG(pk[b].hit && pk[b].node_id == pk[0].node_id, "%s: the pick missed the figure", k_backends[b]);
+        EXPECT_MSG(fabsf(pk[b].depth - d) < 2e-3f, "%s: pick depth %.4f, the layer's %.4f", k_backends[b], (double)pk[b].depth,
+                   (double)d);
+        EXPECT_MSG(fabsf(pk[b].depth - pk[0].depth) < 5e-3f, "%s: pick depth %.4f, %s's %.4f", k_backends[b], (double)pk[b].depth,
+                   k_backends[0], (double)pk[0].depth);
     }
     for (size_t b = 1; b < NB; ++b)
         for (int t = 0; t < 2; ++t) {
