@@ -2,7 +2,9 @@
 #include "sy_deform.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <string.h>
+#include <unistd.h>
 
 bool sy_deform_has_data(const sy_primitive *p)
 {
@@ -15,17 +17,26 @@ static void normalize3(float *v)
     if (l > 0.0f && isfinite(l)) v[0] /= l, v[1] /= l, v[2] /= l;
 }
 
-bool sy_deform_primitive(const sy_deform_input *in, float *pos, float *nrm, float *tan, sy_bounds *bounds_out)
+/* One vertex range [v0, v1) of a deformation; false when a position leaves SY_COORD_MAX. */
+typedef struct deform_job {
+    const sy_deform_input *in;
+    float *pos, *nrm, *tan;
+    uint32_t v0, v1;
+    sy_bounds bounds;
+    bool ok;
+} deform_job;
+
+static void deform_range(deform_job *j)
 {
+    const sy_deform_input *in = j->in;
     const sy_primitive *p = in->primitive;
-    uint32_t nv = sy_primitive_vertex_count(p);
-    const float *p0 = sy_blob_data(p->positions), *n0 = p->normals ? sy_blob_data(p->normals) : NULL;
-    const float *t0 = p->tangents ? sy_blob_data(p->tangents) : NULL;
-    if (!nrm) n0 = NULL;
-    if (!tan) t0 = NULL;
-    memcpy(pos, p0, sizeof(float) * 3 * (size_t)nv);
-    if (n0) memcpy(nrm, n0, sizeof(float) * 3 * (size_t)nv);
-    if (t0) memcpy(tan, t0, sizeof(float) * 4 * (size_t)nv);
+    uint32_t nv = sy_primitive_vertex_count(p), v0 = j->v0, v1 = j->v1;
+    float *pos = j->pos, *nrm = j->nrm, *tan = j->tan;
+    const float *p0 = sy_blob_data(p->positions), *n0 = p->normals && nrm ? sy_blob_data(p->normals) : NULL;
+    const float *t0 = p->tangents && tan ? sy_blob_data(p->tangents) : NULL;
+    memcpy(pos + 3 * (size_t)v0, p0 + 3 * (size_t)v0, sizeof(float) * 3 * (size_t)(v1 - v0));
+    if (n0) memcpy(nrm + 3 * (size_t)v0, n0 + 3 * (size_t)v0, sizeof(float) * 3 * (size_t)(v1 - v0));
+    if (t0) memcpy(tan + 4 * (size_t)v0, t0 + 4 * (size_t)v0, sizeof(float) * 4 * (size_t)(v1 - v0));
     /* morph targets: target after target, so each delta array is read in order */
     uint32_t nt = sy_primitive_target_count(p);
     if (nt && in->weights) {
@@ -38,31 +49,31 @@ bool sy_deform_primitive(const sy_deform_input *in, float *pos, float *nrm, floa
             float w = in->weights[t];
             if (w == 0.0f) continue;
             if (dp)
-                for (size_t k = 0; k < per; ++k) pos[k] += w * dp[t * per + k];
+                for (size_t k = 3 * (size_t)v0; k < 3 * (size_t)v1; ++k) pos[k] += w * dp[t * per + k];
             if (dn)
-                for (size_t k = 0; k < per; ++k) nrm[k] += w * dn[t * per + k];
+                for (size_t k = 3 * (size_t)v0; k < 3 * (size_t)v1; ++k) nrm[k] += w * dn[t * per + k];
             if (dt)
-                for (size_t v = 0; v < nv; ++v)
+                for (size_t v = v0; v < v1; ++v)
                     for (int c = 0; c < 3; ++c) tan[4 * v + c] += w * dt[t * per + 3 * v + c];
         }
         if (n0)
-            for (uint32_t v = 0; v < nv; ++v) normalize3(&nrm[3 * v]);
+            for (uint32_t v = v0; v < v1; ++v) normalize3(&nrm[3 * v]);
         if (t0)
-            for (uint32_t v = 0; v < nv; ++v) normalize3(&tan[4 * v]);
+            for (uint32_t v = v0; v < v1; ++v) normalize3(&tan[4 * v]);
     }
     /* skin */
     uint32_t inf = sy_primitive_influences(p);
     if (inf && in->joints && in->joint_count) {
         const uint32_t *jj = sy_blob_data(p->joints);
         const float *ww = sy_blob_data(p->weights);
-        for (uint32_t v = 0; v < nv; ++v) {
+        for (uint32_t v = v0; v < v1; ++v) {
             float m[12] = {0}; /* the upper 3 rows of sum s_k J[j_k], column-major 3x4 */
             float sum = 0.0f;
             for (uint32_t k = 0; k < inf; ++k) {
                 float s = ww[(size_t)inf * v + k];
-                uint32_t j = jj[(size_t)inf * v + k];
-                if (s == 0.0f || j >= in->joint_count) continue;
-                const float *J = in->joints[j].m;
+                uint32_t jn = jj[(size_t)inf * v + k];
+                if (s == 0.0f || jn >= in->joint_count) continue;
+                const float *J = in->joints[jn].m;
                 for (int c = 0; c < 4; ++c)
                     for (int r = 0; r < 3; ++r) m[3 * c + r] += s * J[4 * c + r];
                 sum += s;
@@ -88,17 +99,53 @@ bool sy_deform_primitive(const sy_deform_input *in, float *pos, float *nrm, floa
             }
         }
     }
-    sy_bounds b = sy_bounds_empty();
-    for (uint32_t v = 0; v < nv; ++v) {
-        if (!sy_coords_in_range(&pos[3 * v], 3)) return false;
-        sy_bounds_add_point(&b, &pos[3 * v]);
+    j->bounds = sy_bounds_empty();
+    j->ok = true;
+    for (uint32_t v = v0; v < v1 && j->ok; ++v) {
+        if (!sy_coords_in_range(&pos[3 * v], 3)) j->ok = false;
+        else sy_bounds_add_point(&j->bounds, &pos[3 * v]);
     }
     if (n0)
-        for (size_t k = 0; k < 3 * (size_t)nv; ++k)
+        for (size_t k = 3 * (size_t)v0; k < 3 * (size_t)v1; ++k)
             if (!isfinite(nrm[k])) nrm[k] = 0.0f;
     if (t0)
-        for (size_t k = 0; k < 4 * (size_t)nv; ++k)
+        for (size_t k = 4 * (size_t)v0; k < 4 * (size_t)v1; ++k)
             if (!isfinite(tan[k])) tan[k] = 0.0f;
-    if (bounds_out) *bounds_out = b;
-    return true;
+}
+
+static void *deform_thread(void *arg)
+{
+    deform_range(arg);
+    return NULL;
+}
+
+bool sy_deform_primitive(const sy_deform_input *in, float *pos, float *nrm, float *tan, sy_bounds *bounds_out)
+{
+    uint32_t nv = sy_primitive_vertex_count(in->primitive);
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    uint32_t n = nv / SY_DEFORM_VERTICES_PER_THREAD;
+    if (cpus > 0 && n > (uint32_t)cpus) n = (uint32_t)cpus;
+    if (n > SY_DEFORM_MAX_THREADS) n = SY_DEFORM_MAX_THREADS;
+    if (in->max_threads && n > in->max_threads) n = in->max_threads;
+    if (n < 1) n = 1;
+    deform_job jobs[SY_DEFORM_MAX_THREADS];
+    pthread_t th[SY_DEFORM_MAX_THREADS];
+    bool started[SY_DEFORM_MAX_THREADS] = {false};
+    for (uint32_t k = 0; k < n; ++k)
+        jobs[k] = (deform_job){in, pos, nrm, tan, (uint32_t)((uint64_t)nv * k / n), (uint32_t)((uint64_t)nv * (k + 1) / n),
+                               {{0}, {0}}, false};
+    for (uint32_t k = 1; k < n; ++k) started[k] = pthread_create(&th[k], NULL, deform_thread, &jobs[k]) == 0;
+    deform_range(&jobs[0]);
+    for (uint32_t k = 1; k < n; ++k) {
+        if (started[k]) pthread_join(th[k], NULL);
+        else deform_range(&jobs[k]); /* no thread: this one does it */
+    }
+    sy_bounds b = sy_bounds_empty();
+    bool ok = true;
+    for (uint32_t k = 0; k < n; ++k) {
+        ok = ok && jobs[k].ok;
+        sy_bounds_add_bounds(&b, &jobs[k].bounds);
+    }
+    if (ok && bounds_out) *bounds_out = b;
+    return ok;
 }

@@ -14,8 +14,12 @@
  * Normals use M's upper 3x3 rather than its inverse transpose, as the Khronos sample viewer does:
  * the same for rigid joints and uniform scales, which skins almost always have.
  *
- * Cost: O(vertices x (targets + influences)); the joint matrices are composed once per call
- * (O(joints)). No allocation. Thread-safety: reentrant (distinct outputs may be filled in parallel). */
+ * Cost: O(vertices x (targets + influences)), spread over up to SY_DEFORM_MAX_THREADS threads of
+ * its own (one per SY_DEFORM_VERTICES_PER_THREAD vertices, at most one per online CPU; each a range
+ * of vertices), joined before it returns; where a thread cannot be started the caller's does that
+ * range. No heap allocation. Thread-safety: reentrant (distinct outputs may be filled at once). */
+#define SY_DEFORM_MAX_THREADS 8u               /**< threads one call uses at most */
+#define SY_DEFORM_VERTICES_PER_THREAD 32768u   /**< vertices that make one more thread worth starting */
 #ifndef SY_DEFORM_H
 #define SY_DEFORM_H
 
@@ -32,6 +36,7 @@ typedef struct sy_deform_input {
     uint32_t weight_count;         /**< their count */
     const sy_mat4 *joints;         /**< joint world x inverse bind matrices, composed (NULL: not skinned) */
     uint32_t joint_count;          /**< their count */
+    uint32_t max_threads;          /**< threads at most (0: SY_DEFORM_MAX_THREADS) */
 } sy_deform_input;
 
 /** Deforms in->primitive into positions (float[3] x vertices), normals (float[3], filled when the

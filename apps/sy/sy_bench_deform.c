@@ -2,7 +2,8 @@
  * frame (issue 35). A generated tube of about VERTICES vertices (default 10^5; 64 per ring, two
  * triangles per quad) skinned to a chain of 16 joints (two influences per vertex), each frame every
  * joint turned a little (16 node transforms set, commit, sync). Reported, median (min .. max) in ms:
- *   - the deform step alone: sy_deform_primitive over the mesh (what the mirror runs per pose);
+ *   - the deform step alone: sy_deform_primitive over the mesh (what the mirror runs per pose), on
+ *     one thread and on its own threads (the ratio);
  *   - the mirror's sync with a back-end that does nothing (deform + the new blobs + bookkeeping);
  *   - per back-end (whitted, raster): a frame's set + commit + sync (the deformed mesh refitted /
  *     re-uploaded in place) against building that back-end's scene from scratch (context creation
@@ -141,18 +142,28 @@ sy_result sy_bench_deform(uint32_t vertices, uint32_t repeats, sy_error *err)
         const sy_primitive *p = &md->primitives.items[0];
         float *pos = malloc(sizeof(float) * 3 * t.vertices), *nrm = malloc(sizeof(float) * 3 * t.vertices);
         sy_mat4 jm[JOINTS];
-        for (uint32_t i = 0; i < repeats && pos && nrm; ++i) {
-            for (uint32_t k = 0; k < JOINTS; ++k) {
-                jm[k] = sy_mat4_identity();
-                jm[k].m[12] = 0.001f * (float)i;
-                jm[k] = sy_mat4_mul(&jm[k], &t.ibm[k]);
+        double one = 0.0; /* the single-thread median, for the ratio */
+        for (int pass = 0; pass < 2 && pos && nrm; ++pass) {
+            for (uint32_t i = 0; i < repeats; ++i) {
+                for (uint32_t k = 0; k < JOINTS; ++k) {
+                    jm[k] = sy_mat4_identity();
+                    jm[k].m[12] = 0.001f * (float)i;
+                    jm[k] = sy_mat4_mul(&jm[k], &t.ibm[k]);
+                }
+                sy_deform_input in = {.primitive = p, .joints = jm, .joint_count = JOINTS, .max_threads = pass ? 0u : 1u};
+                double a = sy_time_now();
+                sy_deform_primitive(&in, pos, nrm, NULL, NULL);
+                v[i] = sy_time_now() - a;
             }
-            sy_deform_input in = {.primitive = p, .joints = jm, .joint_count = JOINTS};
-            double a = sy_time_now();
-            sy_deform_primitive(&in, pos, nrm, NULL, NULL);
-            v[i] = sy_time_now() - a;
+            if (pass == 0) {
+                print_row("deform step, 1 thread", v, repeats, 0);
+                one = sy_bench_spread_of(v, repeats).median;
+            } else {
+                sy_bench_spread sp = sy_bench_spread_of(v, repeats);
+                print_row("deform step, threads (sy_deform_primitive)", v, repeats, 0);
+                printf("    threads against 1 thread: %.3f\n", sp.median / one);
+            }
         }
-        if (pos && nrm) print_row("deform step (sy_deform_primitive)", v, repeats, 0);
         free(pos), free(nrm);
     }
     /* the mirror with a back-end that does nothing */

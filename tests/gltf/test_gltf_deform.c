@@ -10,7 +10,8 @@
  *      channel moves vertices; MorphPrimitivesTest's mesh.weights deform both primitives;
  *      RiggedSimple's bounds change with time.
  *   2. Malformed skins (a joint index past the skin, a NaN weight): the load and the sync succeed,
- *      a warning names skins[0] / meshes[0].primitives[0], the mesh is drawn in its bind pose. */
+ *      a warning names skins[0] / meshes[0].primitives[0], the mesh is drawn in its bind pose.
+ *   3. sy_deform_primitive over several threads gives the same floats and bounds as over one. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,6 +21,7 @@
 #include "../support/sy_check.h"
 #include "sy_anim.h"
 #include "sy_commit.h"
+#include "sy_deform.h"
 #include "sy_gltf.h"
 #include "sy_mirror.h"
 
@@ -437,6 +439,57 @@ static int test_malformed(void)
     return 0;
 }
 
+/* >>threads: a primitive large enough for several threads deforms to the very same floats as with
+ * one (each thread a vertex range; bounds merged) */
+static int test_threads_agree(void)
+{
+    const uint32_t nv = 4 * SY_DEFORM_VERTICES_PER_THREAD + 17, nj = 5;
+    float *pos = malloc(sizeof(float) * 3 * nv), *nrm = malloc(sizeof(float) * 3 * nv), *w = malloc(sizeof(float) * 4 * nv);
+    float *dp = malloc(sizeof(float) * 3 * nv);
+    uint32_t *j = malloc(sizeof(uint32_t) * 4 * nv);
+    CHECK(pos && nrm && w && dp && j);
+    for (uint32_t v = 0; v < nv; ++v) {
+        for (int c = 0; c < 3; ++c) {
+            pos[3 * v + c] = (float)((v * (7 + c)) % 1000) * 0.001f;
+            nrm[3 * v + c] = c == 1 ? 1.0f : 0.0f;
+            dp[3 * v + c] = 0.01f * (float)((v + (uint32_t)c) % 7);
+        }
+        for (int k = 0; k < 4; ++k) {
+            j[4 * v + k] = (v + (uint32_t)k) % (nj + 1); /* now and then past the joints: left out */
+            w[4 * v + k] = 0.25f;
+        }
+    }
+    sy_primitive p = {0};
+    sy_error e = {0};
+    CHECK_OK(sy_blob_create_take(pos, sizeof(float) * 3 * nv, &p.positions, &e), e);
+    CHECK_OK(sy_blob_create_take(nrm, sizeof(float) * 3 * nv, &p.normals, &e), e);
+    CHECK_OK(sy_blob_create_take(w, sizeof(float) * 4 * nv, &p.weights, &e), e);
+    CHECK_OK(sy_blob_create_take(j, sizeof(uint32_t) * 4 * nv, &p.joints, &e), e);
+    CHECK_OK(sy_blob_create_take(dp, sizeof(float) * 3 * nv, &p.target_positions, &e), e);
+    sy_mat4 jm[5];
+    for (uint32_t k = 0; k < nj; ++k) {
+        const float t[3] = {0.1f * (float)k, 0.0f, -0.2f}, q[4] = {0.0f, sinf(0.1f * (float)k), 0.0f, cosf(0.1f * (float)k)},
+                    sc[3] = {1, 1, 1};
+        jm[k] = sy_mat4_from_trs(t, q, sc);
+    }
+    const float mw[1] = {0.5f};
+    float *out[2][2];
+    sy_bounds b[2];
+    for (int pass = 0; pass < 2; ++pass) {
+        out[pass][0] = malloc(sizeof(float) * 3 * nv);
+        out[pass][1] = malloc(sizeof(float) * 3 * nv);
+        CHECK(out[pass][0] && out[pass][1]);
+        sy_deform_input in = {&p, mw, 1, jm, nj, pass ? 0u : 1u};
+        CHECK(sy_deform_primitive(&in, out[pass][0], out[pass][1], NULL, &b[pass]));
+    }
+    EXPECT(memcmp(out[0][0], out[1][0], sizeof(float) * 3 * nv) == 0);
+    EXPECT(memcmp(out[0][1], out[1][1], sizeof(float) * 3 * nv) == 0);
+    EXPECT(memcmp(&b[0], &b[1], sizeof b[0]) == 0);
+    for (int pass = 0; pass < 2; ++pass) free(out[pass][0]), free(out[pass][1]);
+    sy_primitive_release(&p);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     g_data = argc > 1 ? argv[1] : "../shared/testdata";
@@ -446,6 +499,7 @@ int main(int argc, char **argv)
         return 1;
     }
     RUN(test_malformed);
+    RUN(test_threads_agree);
     RUN(test_simple_skin);
     RUN(test_cesium_man);
     RUN(test_simple_morph);
