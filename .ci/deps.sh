@@ -6,7 +6,10 @@ SY_PACKAGES="cmake ninja-build gcc g++ pkg-config libembree-dev libtinygltf-dev 
  libnng-dev libsodium-dev libzstd-dev iproute2 libfreetype-dev fonts-dejavu-core
  libopenmpi-dev openmpi-bin libimath-dev libcjson-dev doxygen libmeshoptimizer-dev
  libwebsockets-dev libturbojpeg0-dev libassimp-dev assimp-utils assimp-testmodels libdraco-dev libwebp-dev
- chromium nodejs"
+ chromium nodejs
+ python3-dev python3-numpy python3-pytest python3-setuptools python3-wheel python3-pip"
+# python3-*: the Python package (apps/python: development files, NumPy; pytest for its tests; pip,
+# setuptools and wheel for `pip install --no-build-isolation ./apps/python`)
 # npm (three.js for sy web's client page, playwright-core for the browser tests) comes with Node.js
 # from nodesource; Debian's own nodejs needs the npm package beside it.
 command -v npm >/dev/null 2>&1 || SY_PACKAGES="$SY_PACKAGES npm"

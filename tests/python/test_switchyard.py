@@ -1,0 +1,253 @@
+"""tests/python: the Python package switchyard (apps/python, docs/PYTHON.md), run by ctest as
+python_package with PYTHONPATH=BUILD/python, SY_BIN (the sy program) and SY_TESTDATA_DIR."""
+import gc
+import os
+import subprocess
+import threading
+
+import numpy
+import pytest
+
+import switchyard
+
+TESTDATA = os.environ.get("SY_TESTDATA_DIR", os.path.join(os.path.dirname(__file__), "../../../shared/testdata"))
+BOX = os.path.join(TESTDATA, "gltf/Box/glTF/Box.gltf")
+CORNELL = os.path.join(TESTDATA, "cornell/cornell_box.gltf")
+SY = os.environ.get("SY_BIN")
+NAMES = [b.name for b in switchyard.backends()]
+needs_whitted = pytest.mark.skipif("whitted" not in NAMES, reason="built without the Embree back-ends (no whitted)")
+needs_pt = pytest.mark.skipif("pathtracer" not in NAMES, reason="built without the Embree back-ends (no pathtracer)")
+
+
+def need(path):
+    if not os.path.exists(path):
+        pytest.skip("test data absent: %s (../shared/testdata)" % path)
+
+
+def sy_render(scene, out, *args):
+    if not SY or not os.path.exists(SY):
+        pytest.skip("the sy program is not given (SY_BIN)")
+    subprocess.run([SY, "render", scene, "-o", out, *args], check=True, capture_output=True)
+    return switchyard.read_exr(out)
+
+
+def triangle_scene():
+    """A triangle over the lower-left half of an orthographic camera's square view."""
+    s = switchyard.Scene()
+    pos = numpy.array([[-1, -1, 0], [1, -1, 0], [-1, 1, 0]], dtype=numpy.float32)
+    s.add_mesh(pos, numpy.array([0, 1, 2], dtype=numpy.uint32))
+    s.camera = s.add_camera("ortho", projection=switchyard.Camera.ORTHOGRAPHIC, xmag=1.0, ymag=1.0, znear=0.1,
+                            zfar=10.0)
+    s.camera.translation = (0.0, 0.0, 2.0)
+    return s
+
+
+def test_backends_from_the_registry():
+    bs = switchyard.backends()
+    assert bs, "no back-end registered"
+    assert sum(b.default for b in bs) <= 1
+    assert all(isinstance(b.name, str) and b.name for b in bs)
+    if "pathtracer" in NAMES:
+        assert next(b for b in bs if b.name == "pathtracer").progressive
+
+
+@needs_whitted
+def test_three_line_render_equals_sy_render(tmp_path):
+    """The three-line path gives the pixels `sy render` writes (float EXR), bit for bit (Whitted)."""
+    need(BOX)
+    img = switchyard.render(BOX, backend="whitted", width=96, height=64)
+    assert isinstance(img, numpy.ndarray) and img.shape == (64, 96, 4) and img.dtype == numpy.float32
+    covered = img[..., 3] > 0.5
+    assert 0.1 < covered.mean() < 0.9, "the box covers part of the image"
+    assert img[..., :3][covered].mean() > 0.05, "the box is lit"
+    ref = sy_render(BOX, str(tmp_path / "box.exr"), "-b", "whitted", "-w", "96", "-h", "64")
+    for i, c in enumerate("RGBA"):
+        assert numpy.array_equal(img[..., i], ref[c]), "channel %s differs from sy render" % c
+
+
+@needs_pt
+def test_pathtracer_same_seed_and_spp_equals_sy_render(tmp_path):
+    """The Cornell box through the path tracer: same spp and seed as sy render, bit for bit."""
+    need(CORNELL)
+    img, aovs = switchyard.render(CORNELL, backend="pathtracer", width=48, height=48, spp=4, aovs=True)
+    ref = sy_render(CORNELL, str(tmp_path / "cb.exr"), "-b", "pathtracer", "-w", "48", "-h", "48", "--spp", "4")
+    for i, c in enumerate("RGBA"):
+        assert numpy.array_equal(img[..., i], ref[c]), "channel %s differs from sy render" % c
+    assert "depth" in aovs and aovs["depth"].shape == (48, 48)
+    assert numpy.isfinite(aovs["depth"]).mean() > 0.9, "the closed box is hit nearly everywhere"
+    assert set(aovs) - {"depth"}, "the path tracer's feature buffers come along"
+
+
+@needs_whitted
+def test_triangle_from_arrays_covers_half_the_image():
+    s = triangle_scene()
+    img = s.render(backend="whitted", width=64, height=64)
+    n = int((img[..., 3] > 0.5).sum())
+    # the lower-left half of the square: 64*63/2 pixels strictly inside, the diagonal split
+    assert abs(n - 64 * 64 / 2) <= 64, "covered %d pixels" % n
+    assert img[48, 8, 3] > 0.5 and img[8, 48, 3] == 0.0, "lower-left covered, upper-right empty (row 0 = top)"
+
+
+def test_bad_input_raises():
+    s = switchyard.Scene()
+    good = numpy.zeros((3, 3), dtype=numpy.float32)
+    good[1, 0] = good[2, 1] = 1
+    idx = numpy.array([0, 1, 2], dtype=numpy.uint32)
+    E = switchyard.InvalidArgumentError
+    with pytest.raises(E, match="dtype must be float32"):
+        s.add_mesh(good.astype(numpy.float64), idx)
+    with pytest.raises(E, match="dtype must be uint32"):
+        s.add_mesh(good, idx.astype(numpy.int64))
+    with pytest.raises(E, match=r"shape \(3, 2\)"):
+        s.add_mesh(good[:, :2].copy(), idx)
+    with pytest.raises(E, match="not C-contiguous"):
+        s.add_mesh(numpy.zeros((6, 3), dtype=numpy.float32)[::2], idx)
+    bad = good.copy()
+    bad[1, 2] = numpy.nan
+    with pytest.raises(E, match="vertex 1 has a NaN"):
+        s.add_mesh(bad, idx)
+    with pytest.raises(E, match="index 2 is 7"):
+        s.add_mesh(good, numpy.array([0, 1, 7], dtype=numpy.uint32))
+    with pytest.raises(E, match="multiple of 3"):
+        s.add_mesh(good, idx[:2].copy())
+    with pytest.raises(E, match="buffer"):
+        s.add_mesh("not an array", idx)
+    assert isinstance(E("x"), ValueError), "InvalidArgumentError is a ValueError too"
+    with pytest.raises(switchyard.Error) as e:
+        switchyard.load("/nonexistent/scene.gltf")
+    assert "/nonexistent/scene.gltf" in str(e.value), "the library's message names the file"
+    with pytest.raises(switchyard.NotFoundError, match="not registered"):
+        s.render(backend="no-such-backend", width=8, height=8)
+    if "whitted" in NAMES:
+        with pytest.raises(E, match="not progressive"):
+            s.render(backend="whitted", width=8, height=8, spp=4)
+    n = s.add_mesh(good, idx)
+    n.destroy()
+    assert not n.valid
+    with pytest.raises(switchyard.InvalidHandleError):
+        n.translation = (1, 2, 3)
+    s.close()
+    with pytest.raises(switchyard.InvalidOperationError, match="closed"):
+        s.add_mesh(good, idx)
+
+
+def test_objects_read_and_write_fields():
+    s = switchyard.Scene()
+    m = s.add_material("red", base_color=(1, 0, 0, 1), roughness=0.25)
+    node = s.add_mesh(numpy.eye(3, dtype=numpy.float32), material=m, name="tri")
+    assert node.name == "tri" and node.mesh is not None
+    assert m.base_color == (1.0, 0.0, 0.0, 1.0) and m.roughness == 0.25
+    node.translation = (1, 2, 3)
+    assert node.translation == (1.0, 2.0, 3.0)
+    assert numpy.allclose(node.matrix[:3, 3], [1, 2, 3]), "matrix[row, col]: translation in the last column"
+    li = s.add_light(switchyard.Light.POINT, intensity=5.0)
+    assert li.intensity == 5.0 and li.type == switchyard.Light.POINT
+    with pytest.raises(switchyard.InvalidArgumentError):
+        m.roughness = float("nan")
+    assert len(s.nodes) == 2 and len(s.materials) == 1
+
+
+@needs_whitted
+def test_window_switches_backends_on_a_live_viewport():
+    s = triangle_scene()
+    with switchyard.Window(s, 32, 32) as w:
+        vp = w.add_viewport("whitted")
+        a = numpy.array(w.render())
+        other = next((n for n in ("pathtracer", "raster") if n in NAMES), None)
+        if other:
+            vp.backend = other
+            assert vp.backend == other
+            w.render()
+            vp.backend = "whitted"
+        b = numpy.array(w.render())
+        assert numpy.array_equal(a, b), "back to whitted: the same image"
+        with pytest.raises(switchyard.InvalidOperationError, match="Window"):
+            s.close()  # a window still shows it
+    s.close()
+
+
+@needs_whitted
+def test_two_renders_in_two_threads():
+    need(BOX)
+    ref = switchyard.render(BOX, backend="whitted", width=48, height=32)
+    out = [None, None]
+    errors = []
+
+    def work(i):
+        try:
+            out[i] = switchyard.render(BOX, backend="whitted", width=48, height=32)
+        except Exception as e:  # noqa: BLE001 (reported below)
+            errors.append(e)
+    ts = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    assert not errors
+    assert all(numpy.array_equal(o, ref) for o in out)
+
+
+def rss_kb():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") // 1024
+
+
+@needs_whitted
+def test_no_growth_over_repeated_renders_and_scenes():
+    """Render in a loop and build / drop object graphs: blobs and RSS come back (no leak)."""
+    blobs0 = switchyard._c.blob_live_count()
+    pos = numpy.random.default_rng(1).random((300, 3), dtype=numpy.float32)
+    idx = numpy.arange(300, dtype=numpy.uint32)
+
+    def once():
+        with switchyard.Scene() as s:
+            m = s.add_material(base_color=(0.5, 0.5, 0.5, 1))
+            s.add_mesh(pos, idx, material=m)
+            img = s.render(backend="whitted", width=16, height=16)
+            assert img.shape == (16, 16, 4)
+    for _ in range(20):
+        once()
+    gc.collect()
+    before = rss_kb()
+    for _ in range(200):
+        once()
+    for _ in range(2000):
+        s = switchyard.Scene()
+        s.add_mesh(pos, idx)
+        del s
+    gc.collect()
+    grown = rss_kb() - before
+    assert switchyard._c.blob_live_count() == blobs0, "every blob is released"
+    assert grown < 4096, "RSS grew by %d KiB over 200 renders and 2000 scenes" % grown
+
+
+def test_png_repr_and_exr_round_trip(tmp_path):
+    img = switchyard.Image._of(_flat_image())
+    png = img._repr_png_()
+    assert png.startswith(b"\x89PNG")
+    p = str(tmp_path / "x.exr")
+    switchyard.write_exr(p, img)
+    back = switchyard.read_exr(p)
+    assert numpy.array_equal(back["G"], numpy.asarray(img)[..., 1])
+
+
+def _flat_image():
+    s = switchyard.Scene()
+    s.add_mesh(numpy.eye(3, dtype=numpy.float32))
+    if "whitted" in NAMES:
+        rgba, _, _ = s._c._render("whitted", 8, 6)
+        return rgba
+    pytest.skip("no whitted back-end")
+
+
+def test_log_goes_to_logging(caplog):
+    """The library's log callback reaches the logging logger "switchyard" (a load's debug line)."""
+    import logging
+    need(BOX)
+    switchyard.set_log_level(logging.DEBUG)
+    try:
+        with caplog.at_level(logging.DEBUG, logger="switchyard"):
+            switchyard.load(BOX).close()
+        assert any(r.name == "switchyard" and "loaded in" in r.getMessage() for r in caplog.records), caplog.records
+    finally:
+        switchyard.set_log_level(logging.INFO)
