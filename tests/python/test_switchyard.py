@@ -251,3 +251,40 @@ def test_log_goes_to_logging(caplog):
         assert any(r.name == "switchyard" and "loaded in" in r.getMessage() for r in caplog.records), caplog.records
     finally:
         switchyard.set_log_level(logging.INFO)
+
+
+@needs_pt
+def test_progress_and_ctrl_c_after_a_pass():
+    """progress(done, total) after each pass up to (spp, spp); SIGINT raises KeyboardInterrupt
+    after the pass in progress instead of running on."""
+    import signal
+    s = triangle_scene()
+    calls = []
+    s.render(backend="pathtracer", width=16, height=16, spp=8, progress=lambda d, t: calls.append((d, t)))
+    assert calls and calls[-1] == (8, 8) and all(t == 8 for _, t in calls)
+    assert [d for d, _ in calls] == sorted(d for d, _ in calls)
+    calls.clear()
+
+    def interrupt(d, t):
+        calls.append(d)
+        signal.raise_signal(signal.SIGINT)
+    with pytest.raises(KeyboardInterrupt):
+        s.render(backend="pathtracer", width=16, height=16, spp=1 << 20, progress=interrupt)
+    assert len(calls) == 1, "stopped after the first pass"
+
+
+@needs_pt
+def test_sigint_during_a_render_without_the_gil():
+    """A SIGINT arriving while the render runs without the GIL (from a timer thread) raises
+    KeyboardInterrupt after the pass in progress, long before the samples asked for are done."""
+    import signal
+    s = triangle_scene()
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            s.render(backend="pathtracer", width=32, height=32, spp=1 << 24)
+    finally:
+        timer.cancel()
+    img = s.render(backend="whitted", width=8, height=8) if "whitted" in NAMES else None
+    assert img is None or img.shape == (8, 8, 4), "the scene is usable after the interrupt"

@@ -632,6 +632,45 @@ static PyObject *scene_node_set(PyObject *self, PyObject *args, PyObject *kw)
     Py_RETURN_NONE;
 }
 
+/* _node_trs(id, which, values): which 0 translation (3), 1 rotation (4, x y z w), 2 scale (3): the
+ * one-field path of Node.translation = ... (positional arguments, a tuple read in place: the
+ * call costs about what the keyword path of _node_set costs a third of) */
+static PyObject *scene_node_trs(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 3) return PyErr_Format(PyExc_TypeError, "_node_trs(id, which, values)");
+    unsigned long id = PyLong_AsUnsignedLong(args[0]);
+    long which = PyLong_AsLong(args[1]);
+    PyObject *v = args[2];
+    if (PyErr_Occurred()) return NULL;
+    if (id > UINT32_MAX) return stale("node", (unsigned)id);
+    sy_scene *sc = scene_use((SceneObject *)self);
+    if (!sc) return NULL;
+    if (which < 0 || which > 2) return PyErr_Format(PyExc_ValueError, "_node_trs: field %ld", which);
+    static const char *const names[3] = {"translation", "rotation", "scale"};
+    float val[4];
+    Py_ssize_t n = which == 1 ? 4 : 3;
+    if (PyTuple_Check(v) && PyTuple_Size(v) == n) {
+        for (Py_ssize_t i = 0; i < n; ++i) {
+            double d = PyFloat_AsDouble(PyTuple_GetItem(v, i));
+            if (d == -1.0 && PyErr_Occurred()) return NULL;
+            val[i] = (float)d;
+        }
+    } else if (float_seq(v, names[which], val, n)) {
+        return NULL;
+    }
+    sy_node node = {(uint32_t)id};
+    const sy_node_data *d = sy_node_get(sc, node);
+    if (!d) return stale("node", (unsigned)id);
+    float t[3], r[4], scale[3];
+    memcpy(t, which == 0 ? val : d->transform.translation, sizeof t);
+    memcpy(r, which == 1 ? val : d->transform.rotation, sizeof r);
+    memcpy(scale, which == 2 ? val : d->transform.scale, sizeof scale);
+    sy_error err = {0};
+    sy_result res = sy_node_set_trs(sc, node, t, r, scale, &err);
+    if (res != SY_OK) return raise_sy(res, &err);
+    Py_RETURN_NONE;
+}
+
 /* _material(id) -> dict; _material_set(id, **fields) */
 static PyObject *scene_material(PyObject *self, PyObject *args)
 {
@@ -1009,6 +1048,7 @@ static PyMethodDef scene_methods[] = {
     {"_valid", scene_valid, METH_VARARGS, NULL},
     {"_node", scene_node, METH_VARARGS, NULL},
     {"_node_set", (PyCFunction)(void (*)(void))scene_node_set, METH_VARARGS | METH_KEYWORDS, NULL},
+    {"_node_trs", (PyCFunction)(void (*)(void))scene_node_trs, METH_FASTCALL, NULL},
     {"_material", scene_material, METH_VARARGS, NULL},
     {"_material_set", (PyCFunction)(void (*)(void))scene_material_set, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_light", scene_light, METH_VARARGS, NULL},

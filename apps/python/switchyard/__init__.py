@@ -219,12 +219,12 @@ class Node(_Object):
         self.scene._c._node_set(self.id, matrix=numpy.asarray(m, dtype=numpy.float32).reshape(4, 4).T.ravel().tolist())
 
     translation = property(lambda self: self._fields()["translation"],
-                           lambda self, v: self.scene._c._node_set(self.id, translation=v),
+                           lambda self, v: self.scene._c._node_trs(self.id, 0, v),
                            doc="TRS translation (x, y, z)")
     rotation = property(lambda self: self._fields()["rotation"],
-                        lambda self, v: self.scene._c._node_set(self.id, rotation=v),
+                        lambda self, v: self.scene._c._node_trs(self.id, 1, v),
                         doc="TRS rotation, unit quaternion (x, y, z, w)")
-    scale = property(lambda self: self._fields()["scale"], lambda self, v: self.scene._c._node_set(self.id, scale=v),
+    scale = property(lambda self: self._fields()["scale"], lambda self, v: self.scene._c._node_trs(self.id, 2, v),
                      doc="TRS scale (x, y, z)")
     flags = property(lambda self: self._fields()["flags"], lambda self, v: self.scene._c._node_set(self.id, flags=v))
 
