@@ -301,7 +301,6 @@ static PyObject *py_load(PyObject *self, PyObject *args, PyObject *kw)
     sy_cli_load_opts.strict = strict != 0;
     sy_cli_load_opts.max_scene_bytes = (uint64_t)max_mb * 1024 * 1024;
     sy_cli_load_opts.variant = variant;
-    /* "demo" is the built-in scene only when asked for by that name, not a file called demo */
     r = sy_cli_load(path, camera, true, &s->ld, &err);
     memset(&sy_cli_load_opts, 0, sizeof sy_cli_load_opts);
     pthread_mutex_unlock(&g_load_lock);
