@@ -163,6 +163,10 @@ def test_window_switches_backends_on_a_live_viewport():
         assert numpy.array_equal(a, b), "back to whitted: the same image"
         with pytest.raises(switchyard.InvalidOperationError, match="Window"):
             s.close()  # a window still shows it
+    with pytest.raises(switchyard.InvalidOperationError, match="window is closed"):
+        w.render()
+    with pytest.raises(switchyard.InvalidOperationError):
+        vp.backend = "whitted"
     s.close()
 
 
@@ -305,3 +309,25 @@ def test_examples_run_as_written(tmp_path):
         out = str(tmp_path / "box.exr")
         subprocess.run([sys.executable, os.path.join(ex, "render_file.py"), BOX, out], check=True, capture_output=True)
         assert switchyard.read_exr(out)["A"].shape == (480, 640)
+
+
+@needs_whitted
+def test_reference_counts_and_ownership():
+    """Renders and object access leave the scene's reference count as it was; an image outlives its
+    scene (it owns the library's pixels); objects keep their scene alive, not the other way round."""
+    import sys
+    s = triangle_scene()
+    node = s.nodes[0]
+    before = sys.getrefcount(s), sys.getrefcount(s._c)
+    for _ in range(10):
+        img = s.render(backend="whitted", width=8, height=8)
+        _ = node.translation, s.materials, s.camera
+    del _
+    assert (sys.getrefcount(s), sys.getrefcount(s._c)) == before
+    buf = numpy.asarray(img).base
+    while isinstance(buf, (numpy.ndarray, memoryview)):
+        buf = buf.obj if isinstance(buf, memoryview) else buf.base
+    assert isinstance(buf, switchyard._c._Buffer), "the array views the library's allocation"
+    s.close()
+    assert float(numpy.asarray(img)[..., 3].sum()) > 0, "the image outlives its scene"
+    assert not node.valid
