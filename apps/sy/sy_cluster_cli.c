@@ -208,18 +208,33 @@ static sy_result cli_client_opts_make(const sy_cluster_cli_opts *o, cli_client_o
     return r;
 }
 
-sy_result sy_cluster_cli_setup(const sy_cluster_cli_opts *o, const char *backend, const char *params, char *params_out,
-                               size_t len, uint32_t *mode_out, uint32_t *servers_out, sy_cluster_rect *viewer_tile,
-                               sy_error *err)
+/* Registers the cluster class `name` for o (the URLs or configuration file, mode, secret, TLS);
+ * *mode_out and *servers_out: its mode and server count; viewer_tile (may be NULL): a wall's viewer tile. */
+static sy_result cluster_register(const sy_cluster_cli_opts *o, const char *name, uint32_t *mode_out,
+                                  uint32_t *servers_out, sy_cluster_rect *viewer_tile, sy_error *err)
 {
     cli_client_opts c;
     sy_result r = cli_client_opts_make(o, &c, err);
-    if (r == SY_OK) r = sy_mediator_cluster_register(SY_MEDIATOR_CLUSTER_NAME, &c.co, err); /* copies */
-    if (r == SY_OK) r = sy_cluster_cli_params(o, backend, c.mode, params, params_out, len, err);
+    if (r == SY_OK) r = sy_mediator_cluster_register(name, &c.co, err); /* copies */
     *mode_out = c.mode;
     *servers_out = c.n;
     if (viewer_tile) *viewer_tile = c.viewer_tile;
     cli_client_opts_free(&c);
+    return r;
+}
+
+sy_result sy_cluster_cli_register(const sy_cluster_cli_opts *o, const char *name, uint32_t *mode_out,
+                                  uint32_t *servers_out, sy_error *err)
+{
+    return cluster_register(o, name, mode_out, servers_out, NULL, err);
+}
+
+sy_result sy_cluster_cli_setup(const sy_cluster_cli_opts *o, const char *backend, const char *params, char *params_out,
+                               size_t len, uint32_t *mode_out, uint32_t *servers_out, sy_cluster_rect *viewer_tile,
+                               sy_error *err)
+{
+    sy_result r = cluster_register(o, SY_MEDIATOR_CLUSTER_NAME, mode_out, servers_out, viewer_tile, err);
+    if (r == SY_OK) r = sy_cluster_cli_params(o, backend, *mode_out, params, params_out, len, err);
     return r;
 }
 

@@ -71,6 +71,10 @@ bool sy_cluster_cli_getopt(int c, const char *value, sy_cluster_cli_opts *o);
 sy_result sy_cluster_cli_setup(const sy_cluster_cli_opts *o, const char *backend, const char *params, char *params_out,
                                size_t len, uint32_t *mode_out, uint32_t *servers_out, sy_cluster_rect *viewer_tile,
                                sy_error *err);
+/* Registers the cluster mediator class `name` for o as sy_cluster_cli_setup does for "cluster" (the
+ * Python package registers one per distinct configuration); *mode_out / *servers_out as there. */
+sy_result sy_cluster_cli_register(const sy_cluster_cli_opts *o, const char *name, uint32_t *mode_out,
+                                  uint32_t *servers_out, sy_error *err);
 /* The cluster viewport's parameters for back-end `backend` in `mode` (stereo: sort-first) with the
  * options' pixel format and the back-end's own params (may be NULL). */
 sy_result sy_cluster_cli_params(const sy_cluster_cli_opts *o, const char *backend, uint32_t mode, const char *params,

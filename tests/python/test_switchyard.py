@@ -331,3 +331,38 @@ def test_reference_counts_and_ownership():
     s.close()
     assert float(numpy.asarray(img)[..., 3].sum()) > 0, "the image outlives its scene"
     assert not node.valid
+
+
+def test_render_on_a_cluster_equals_the_local_render(tmp_path):
+    """servers=: two `sy serve` processes on loopback render sort-first; the image equals the local
+    one bit for bit (float pixels), as sy render --cluster's does (tests/cluster/cluster_cli_test.sh)."""
+    import time
+    if "whitted" not in NAMES:
+        pytest.skip("built without the Embree back-ends (no whitted)")
+    if not SY or not os.path.exists(SY):
+        pytest.skip("the sy program is not given (SY_BIN)")
+    secret = tmp_path / "secret"
+    secret.write_text("python-test-secret\n")
+    secret.chmod(0o600)
+    procs, urls = [], []
+    try:
+        for k in range(2):
+            port = tmp_path / ("%d.port" % k)
+            procs.append(subprocess.Popen([SY, "serve", "--listen", "tcp://127.0.0.1:0", "--port-file", str(port),
+                                           "--secret-file", str(secret), "--max-lifetime", "300"],
+                                          stderr=subprocess.DEVNULL))
+            while not (port.exists() and port.read_text().strip()):  # the server writes it once listening
+                if procs[-1].poll() is not None:
+                    pytest.fail("sy serve exited with %s" % procs[-1].returncode)
+                time.sleep(0.01)
+            urls.append("tcp://127.0.0.1:%s" % port.read_text().strip())
+        s = switchyard.load("demo")
+        local = s.render(backend="whitted", width=120, height=80)
+        remote = s.render(backend="whitted", width=120, height=80, servers=urls, secret_file=secret)
+        assert numpy.array_equal(local, remote)
+        with pytest.raises(switchyard.Error):
+            s.render(backend="whitted", width=8, height=8, servers="tcp://127.0.0.1:1", secret_file=secret)
+    finally:
+        for p in procs:
+            p.terminate()
+            p.wait()

@@ -28,6 +28,9 @@
 #include "sy_log.h"
 #include "sy_mediators.h"
 #include "sy_viewport.h"
+#ifdef SY_PY_HAVE_CLUSTER
+#include "sy_cluster_cli.h"
+#endif
 
 #include <math.h>
 #include <pthread.h>
@@ -874,6 +877,7 @@ typedef struct render_job {
     sy_scene *scene;
     uint32_t seed;
     uint64_t spp;      /* progressive: samples to accumulate; 0: one pass (non-progressive) */
+    uint32_t once_samples; /* spp == 0: the sample count of the one pass (a cluster over a progressive back-end) */
     PyObject *progress; /* callable or NULL */
     sy_layer out;
 } render_job;
@@ -895,7 +899,7 @@ static int render_run(render_job *job)
     uint32_t chunk = 1;
     for (;;) {
         uint64_t left = job->spp ? job->spp - done : 0;
-        uint32_t n = job->spp ? (uint32_t)(left < chunk ? left : chunk) : 0;
+        uint32_t n = job->spp ? (uint32_t)(left < chunk ? left : chunk) : job->once_samples;
         sy_window_render_opts ro = {.seed = job->seed, .sample_count = n};
         ts = PyEval_SaveThread();
         double p0 = sy_time_now();
@@ -903,7 +907,7 @@ static int render_run(render_job *job)
         double pass = (sy_time_now() - p0) / (n ? n : 1);
         PyEval_RestoreThread(ts);
         if (r != SY_OK) return raise_sy(r, &err), -1;
-        done += n;
+        done += job->spp ? n : 0;
         if (job->progress) {
             PyObject *res = PyObject_CallFunction(job->progress, "KK", (unsigned long long)(job->spp ? done : 1),
                                                   (unsigned long long)(job->spp ? job->spp : 1));
@@ -973,19 +977,70 @@ static int check_backend(const char *backend, const char *params, sy_params *pp,
     return 0;
 }
 
+/* servers= (the cluster, docs/CLUSTER.md): the back-end runs on `sy serve` servers through a
+ * cluster mediator class, set up exactly as `sy render --cluster` sets it up (apps/sy/sy_cluster_cli.c:
+ * a comma-separated URL list or a configuration file, --cluster-mode, --secret-file or
+ * $SY_CLUSTER_SECRET). A class is registered per distinct (servers, mode, secret file) and reused:
+ * the registry holds classes for the process's lifetime and refuses a name twice. Fills
+ * cluster_name and cluster_params; 0, or -1 with an exception. */
+#define SY_PY_MAX_CLUSTERS 16
+static int cluster_setup(const char *servers, const char *mode, const char *secret_file, const char *backend,
+                         const char *params, char *cluster_name, size_t name_len, char *cluster_params,
+                         size_t params_len, uint64_t *spp_per_request)
+{
+#ifdef SY_PY_HAVE_CLUSTER
+    static struct {
+        char key[1024];
+        uint32_t mode;
+    } known[SY_PY_MAX_CLUSTERS];
+    static uint32_t known_count;
+    char key[1024];
+    int kn = snprintf(key, sizeof key, "%s\n%s\n%s", servers, mode ? mode : "", secret_file ? secret_file : "");
+    if (kn < 0 || (size_t)kn >= sizeof key) return PyErr_Format(PyExc_ValueError, "servers: too long"), -1;
+    sy_error err = {0};
+    sy_result r = SY_OK;
+    uint32_t k = 0, cmode = 0, nservers = 0;
+    while (k < known_count && strcmp(known[k].key, key) != 0) ++k;
+    sy_cluster_cli_opts o = {.cluster = servers, .mode = mode, .secret_file = secret_file};
+    if (k == known_count) { /* a new configuration: connect options checked and a class registered */
+        if (known_count == SY_PY_MAX_CLUSTERS)
+            return raise_sy(SY_ERR_LIMIT, &(sy_error){SY_ERR_LIMIT, "servers: at most 16 distinct cluster "
+                                                                    "configurations in one process"}), -1;
+        char name[32];
+        snprintf(name, sizeof name, "cluster-python-%u", k);
+        r = sy_cluster_cli_register(&o, name, &cmode, &nservers, &err);
+        if (r != SY_OK) return raise_sy(r, &err), -1;
+        snprintf(known[k].key, sizeof known[k].key, "%s", key);
+        known[k].mode = cmode;
+        known_count++;
+    }
+    snprintf(cluster_name, name_len, "cluster-python-%u", k);
+    r = sy_cluster_cli_params(&o, backend, known[k].mode, params, cluster_params, params_len, &err);
+    if (r != SY_OK) return raise_sy(r, &err), -1;
+    (void)spp_per_request;
+    return 0;
+#else
+    (void)servers, (void)mode, (void)secret_file, (void)backend, (void)params, (void)cluster_name, (void)name_len;
+    (void)cluster_params, (void)params_len, (void)spp_per_request;
+    return raise_sy(SY_ERR_UNSUPPORTED, &(sy_error){SY_ERR_UNSUPPORTED, "servers: this build has no cluster "
+                                                                        "(SY_WITH_CLUSTER off)"}), -1;
+#endif
+}
+
 /* _render(backend=None, width=0, height=0, spp=0, seed=0, params=None, aovs=False, progress=None)
  * -> (rgba, aovs or None, samples): one viewport over the whole image with the scene's root,
  * camera and background, the back-end's parameters, as `sy render` composes a mono render. */
 static PyObject *scene_render(PyObject *self, PyObject *args, PyObject *kw)
 {
-    static char *kwlist[] = {"backend", "width", "height", "spp", "seed", "params", "aovs", "progress", NULL};
-    const char *backend = NULL, *params = NULL;
+    static char *kwlist[] = {"backend", "width", "height", "spp", "seed", "params", "aovs", "progress",
+                             "servers", "cluster_mode", "secret_file", NULL};
+    const char *backend = NULL, *params = NULL, *servers = NULL, *cluster_mode = NULL, *secret_file = NULL;
     unsigned int width = 0, height = 0, seed = 0;
     unsigned long long spp = 0;
     int want_aovs = 0;
     PyObject *progress = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "|zIIKIzpO", kwlist, &backend, &width, &height, &spp, &seed, &params,
-                                     &want_aovs, &progress))
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|zIIKIzpOzzz", kwlist, &backend, &width, &height, &spp, &seed, &params,
+                                     &want_aovs, &progress, &servers, &cluster_mode, &secret_file))
         return NULL;
     SceneObject *s = (SceneObject *)self;
     sy_scene *sc = scene_use(s);
@@ -998,10 +1053,25 @@ static PyObject *scene_render(PyObject *self, PyObject *args, PyObject *kw)
     sy_params pp;
     const sy_mediator_class *cls;
     uint32_t caps;
-    if (check_backend(backend, params, &pp, &cls, &caps)) return NULL;
+    if (check_backend(backend, params, &pp, &cls, &caps)) return NULL; /* the back-end the servers run */
+    /* servers=: the main viewport's back-end becomes a cluster class over `backend`, as sy render --cluster */
+    char cluster_name[32], cluster_params[1400];
+    uint64_t spp_per_request = 0;
+    const char *shown = backend;
+    if (servers) {
+        bool remote_progressive = (caps & SY_CAP_PROGRESSIVE) != 0;
+        if (cluster_setup(servers, cluster_mode, secret_file, backend, params, cluster_name, sizeof cluster_name,
+                          cluster_params, sizeof cluster_params, &spp_per_request))
+            return NULL;
+        backend = cluster_name;
+        params = cluster_params;
+        if (check_backend(backend, params, &pp, &cls, &caps)) return NULL;
+        /* sort-first / balanced over a progressive back-end: spp is the samples of the one request */
+        if (spp && remote_progressive && !(caps & SY_CAP_PROGRESSIVE)) spp_per_request = spp, spp = 0;
+    }
     bool progressive = (caps & SY_CAP_PROGRESSIVE) != 0;
     if (spp && !progressive)
-        return PyErr_Format(argerr, "spp=%llu: back-end '%s' is not progressive (one pass renders the image)", spp, backend);
+        return PyErr_Format(argerr, "spp=%llu: back-end '%s' is not progressive (one pass renders the image)", spp, shown);
     if (spp > (1u << 24)) return PyErr_Format(argerr, "spp=%llu: at most 16777216", spp);
     if (progressive && !spp) spp = 64; /* as sy render */
     uint32_t w = width, h = height;
@@ -1011,7 +1081,7 @@ static PyObject *scene_render(PyObject *self, PyObject *args, PyObject *kw)
     if (s->ld.is_x3d) sy_cli_fit_x3d_cameras(&s->ld, w, h); /* X3D fieldOfView is the smaller side's angle */
     r = sy_scene_commit(sc, NULL, &err);
     if (r != SY_OK) return raise_sy(r, &err);
-    render_job job = {.scene = sc, .seed = seed, .spp = progressive ? spp : 0,
+    render_job job = {.scene = sc, .seed = seed, .spp = progressive ? spp : 0, .once_samples = (uint32_t)spp_per_request,
                       .progress = progress == Py_None ? NULL : progress};
     sy_viewport_desc d = {.root = s->ld.root, .camera = s->ld.camera, .background = s->ld.background,
                           .backend = backend, .params = params, .composite = SY_COMPOSITE_REPLACE};

@@ -413,7 +413,8 @@ class Scene:
         node.camera = c
         return node
 
-    def render(self, backend=None, width=0, height=0, spp=0, seed=0, params=None, aovs=False, progress=None):
+    def render(self, backend=None, width=0, height=0, spp=0, seed=0, params=None, aovs=False, progress=None,
+               servers=None, cluster_mode=None, secret_file=None):
         """Renders the scene; returns an (height, width, 4) float32 array (linear, premultiplied).
 
         backend: a registered name (switchyard.backends(); None: the library's default); width /
@@ -423,8 +424,16 @@ class Scene:
         (tqdm: ``lambda d, t: bar.update(d - bar.n)``); Ctrl-C stops after the pass in progress
         with KeyboardInterrupt. aovs=True returns (image, dict): "depth" always (linear distance
         along the view axis, inf where nothing was hit) and the back-end's feature buffers
-        (variance, albedo, normal, ...) where it keeps them."""
-        rgba, planes, _ = self._c._render(backend, width, height, spp, seed, params, aovs, progress)
+        (variance, albedo, normal, ...) where it keeps them.
+
+        servers: render on a cluster of ``sy serve`` servers (docs/CLUSTER.md) exactly as ``sy render
+        --cluster`` does: "tcp://host:port,..." or a cluster configuration file; cluster_mode:
+        "sort-first" (default), "balanced", "cooperative", ...; secret_file: the shared secret (else
+        $SY_CLUSTER_SECRET). backend is what the servers run."""
+        if servers is not None and not isinstance(servers, str):
+            servers = ",".join(servers)
+        rgba, planes, _ = self._c._render(backend, width, height, spp, seed, params, aovs, progress, servers,
+                                          cluster_mode, None if secret_file is None else str(secret_file))
         img = Image._of(rgba)
         if not aovs:
             return img
@@ -475,12 +484,15 @@ def load(path, camera=None, strict=False, allow_paths=(), max_scene_mb=0, varian
                          variant))
 
 
-def render(scene, backend=None, width=0, height=0, spp=0, seed=0, params=None, aovs=False, progress=None, **load_options):
+def render(scene, backend=None, width=0, height=0, spp=0, seed=0, params=None, aovs=False, progress=None,
+           servers=None, cluster_mode=None, secret_file=None, **load_options):
     """Renders a file (loaded with load_options) or a Scene: ``Scene.render`` in one call."""
+    opts = dict(backend=backend, width=width, height=height, spp=spp, seed=seed, params=params, aovs=aovs,
+                progress=progress, servers=servers, cluster_mode=cluster_mode, secret_file=secret_file)
     if isinstance(scene, Scene):
-        return scene.render(backend, width, height, spp, seed, params, aovs, progress)
+        return scene.render(**opts)
     with load(scene, **load_options) as s:
-        out = s.render(backend, width, height, spp, seed, params, aovs, progress)
+        out = s.render(**opts)
     return out
 
 # ---------------------------------------------------------------- windows and viewports
