@@ -142,9 +142,14 @@ def test_objects_read_and_write_fields():
     assert numpy.allclose(node.matrix[:3, 3], [1, 2, 3]), "matrix[row, col]: translation in the last column"
     li = s.add_light(switchyard.Light.POINT, intensity=5.0)
     assert li.intensity == 5.0 and li.type == switchyard.Light.POINT
+    assert len(s.nodes) == 2 and len(s.materials) == 1
     with pytest.raises(switchyard.InvalidArgumentError):
         m.roughness = float("nan")
-    assert len(s.nodes) == 2 and len(s.materials) == 1
+    with pytest.raises(TypeError, match="no field 'shininess'"):
+        m.set(shininess=3)
+    cam = s.add_camera(znear=0.5).camera
+    with pytest.raises(switchyard.InvalidArgumentError):
+        cam.zfar = 0.25  # before znear: the library's setter refuses it
 
 
 @needs_whitted
@@ -199,6 +204,7 @@ def rss_kb():
 @needs_whitted
 def test_no_growth_over_repeated_renders_and_scenes():
     """Render in a loop and build / drop object graphs: blobs and RSS come back (no leak)."""
+    gc.collect()
     blobs0 = switchyard._c.blob_live_count()
     pos = numpy.random.default_rng(1).random((300, 3), dtype=numpy.float32)
     idx = numpy.arange(300, dtype=numpy.uint32)
@@ -221,7 +227,7 @@ def test_no_growth_over_repeated_renders_and_scenes():
         del s
     gc.collect()
     grown = rss_kb() - before
-    assert switchyard._c.blob_live_count() == blobs0, "every blob is released"
+    assert switchyard._c.blob_live_count() <= blobs0, "every blob is released"
     if "libasan" in os.environ.get("LD_PRELOAD", ""):
         return  # AddressSanitizer keeps freed memory in quarantine; LeakSanitizer checks instead
     assert grown < 4096, "RSS grew by %d KiB over 200 renders and 2000 scenes" % grown

@@ -34,6 +34,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -117,6 +118,15 @@ static PyObject *py_set_log(PyObject *self, PyObject *args)
     Py_RETURN_NONE;
 }
 
+/* The end of every dealloc of a heap type: free the object, release the type. */
+static void object_free(PyObject *self)
+{
+    PyTypeObject *tp = Py_TYPE(self);
+    freefunc f = (freefunc)PyType_GetSlot(tp, Py_tp_free);
+    f(self);
+    Py_DECREF(tp);
+}
+
 /* ------------------------------------------------------------------ _Buffer */
 /* A float32 array of 1 to 3 dimensions owning malloc()ed memory, exported through the buffer
  * protocol (numpy.asarray keeps the _Buffer alive as the array's base). */
@@ -133,10 +143,7 @@ static void buffer_dealloc(PyObject *self)
 {
     BufferObject *b = (BufferObject *)self;
     free(b->data);
-    PyTypeObject *tp = Py_TYPE(self);
-    freefunc f = (freefunc)PyType_GetSlot(tp, Py_tp_free);
-    f(self);
-    Py_DECREF(tp);
+    object_free(self);
 }
 
 static int buffer_get(PyObject *self, Py_buffer *view, int flags)
@@ -217,10 +224,7 @@ static void scene_dealloc(PyObject *self)
 {
     SceneObject *s = (SceneObject *)self;
     if (s->ld.scene) sy_cli_loaded_free(&s->ld);
-    PyTypeObject *tp = Py_TYPE(self);
-    freefunc f = (freefunc)PyType_GetSlot(tp, Py_tp_free);
-    f(self);
-    Py_DECREF(tp);
+    object_free(self);
 }
 
 static PyObject *scene_new(PyTypeObject *type, PyObject *args, PyObject *kw)
@@ -673,157 +677,119 @@ static PyObject *scene_node_trs(PyObject *self, PyObject *const *args, Py_ssize_
     Py_RETURN_NONE;
 }
 
-/* _material(id) -> dict; _material_set(id, **fields) */
-static PyObject *scene_material(PyObject *self, PyObject *args)
+/* ---- materials, lights, cameras: their fields by one table each, read and set by name */
+typedef struct field_desc {
+    const char *name;
+    size_t offset;
+    char kind; /* 'f': float[n], 'u': uint32 */
+    uint8_t n;
+} field_desc;
+
+#define SY_PY_FIELD(T, f, k, n) {#f, offsetof(T, f), k, n}
+static const field_desc material_fields[] = {
+    SY_PY_FIELD(sy_material_data, base_color, 'f', 4), SY_PY_FIELD(sy_material_data, metallic, 'f', 1),
+    SY_PY_FIELD(sy_material_data, roughness, 'f', 1), SY_PY_FIELD(sy_material_data, emissive, 'f', 3),
+    SY_PY_FIELD(sy_material_data, emissive_strength, 'f', 1), SY_PY_FIELD(sy_material_data, double_sided, 'u', 1),
+    SY_PY_FIELD(sy_material_data, alpha_mode, 'u', 1), SY_PY_FIELD(sy_material_data, alpha_cutoff, 'f', 1),
+    SY_PY_FIELD(sy_material_data, transmission, 'f', 1), SY_PY_FIELD(sy_material_data, ior, 'f', 1),
+    SY_PY_FIELD(sy_material_data, unlit, 'u', 1), {NULL, 0, 0, 0}};
+static const field_desc light_fields[] = {
+    SY_PY_FIELD(sy_light_data, type, 'u', 1), SY_PY_FIELD(sy_light_data, color, 'f', 3),
+    SY_PY_FIELD(sy_light_data, intensity, 'f', 1), SY_PY_FIELD(sy_light_data, range, 'f', 1),
+    SY_PY_FIELD(sy_light_data, inner_cone, 'f', 1), SY_PY_FIELD(sy_light_data, outer_cone, 'f', 1),
+    {NULL, 0, 0, 0}};
+static const field_desc camera_fields[] = {
+    SY_PY_FIELD(sy_camera_data, projection, 'u', 1), SY_PY_FIELD(sy_camera_data, yfov, 'f', 1),
+    SY_PY_FIELD(sy_camera_data, aspect, 'f', 1), SY_PY_FIELD(sy_camera_data, znear, 'f', 1),
+    SY_PY_FIELD(sy_camera_data, zfar, 'f', 1), SY_PY_FIELD(sy_camera_data, xmag, 'f', 1),
+    SY_PY_FIELD(sy_camera_data, ymag, 'f', 1), {NULL, 0, 0, 0}};
+#undef SY_PY_FIELD
+
+/* The field table and current values (a copy in *data) of a material, light or camera; NULL with an
+ * exception for another type or a stale id. */
+typedef union object_data {
+    sy_material_data material;
+    sy_light_data light;
+    sy_camera_data camera;
+} object_data;
+
+static const field_desc *object_fields(sy_scene *sc, int type, unsigned id, object_data *data)
 {
-    unsigned int id;
-    if (!PyArg_ParseTuple(args, "I", &id)) return NULL;
-    sy_scene *sc = scene_use((SceneObject *)self);
-    if (!sc) return NULL;
-    const sy_material_data *d = sy_material_get(sc, (sy_material){id});
-    if (!d) return stale("material", id);
-    return Py_BuildValue("{s:z,s:N,s:f,s:f,s:N,s:f,s:I,s:f,s:f,s:I}", "name", d->name, "base_color",
-                         tuple_of(d->base_color, 4), "metallic", (double)d->metallic, "roughness", (double)d->roughness,
-                         "emissive", tuple_of(d->emissive, 3), "emissive_strength", (double)d->emissive_strength,
-                         "double_sided", d->double_sided, "transmission", (double)d->transmission, "ior",
-                         (double)d->ior, "alpha_mode", d->alpha_mode);
+    const void *cur = NULL;
+    size_t size = 0;
+    const field_desc *t = NULL;
+    switch (type) {
+    case SY_TYPE_MATERIAL: cur = id ? sy_material_get(sc, (sy_material){id}) : NULL, size = sizeof data->material, t = material_fields; break;
+    case SY_TYPE_LIGHT: cur = sy_light_get(sc, (sy_light){id}), size = sizeof data->light, t = light_fields; break;
+    case SY_TYPE_CAMERA: cur = sy_camera_get(sc, (sy_camera){id}), size = sizeof data->camera, t = camera_fields; break;
+    default: return PyErr_Format(PyExc_ValueError, "object type %d has no field table", type), NULL;
+    }
+    if (!cur) return stale(sy_object_type_name((sy_object_type)type), id), NULL;
+    memcpy(data, cur, size);
+    return t;
 }
 
-static PyObject *scene_material_set(PyObject *self, PyObject *args, PyObject *kw)
+/* _get(type, id) -> dict of the fields (and "name") */
+static PyObject *scene_get_fields(PyObject *self, PyObject *args)
 {
-    static char *kwlist[] = {"id", "base_color", "metallic", "roughness", "emissive", "emissive_strength",
-                             "double_sided", "transmission", "ior", NULL};
+    int type;
     unsigned int id;
-    PyObject *bc = Py_None, *met = Py_None, *rough = Py_None, *em = Py_None, *ems = Py_None, *ds = Py_None,
-             *tr = Py_None, *ior = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "I|OOOOOOOO", kwlist, &id, &bc, &met, &rough, &em, &ems, &ds, &tr, &ior))
-        return NULL;
+    if (!PyArg_ParseTuple(args, "iI", &type, &id)) return NULL;
     sy_scene *sc = scene_use((SceneObject *)self);
     if (!sc) return NULL;
-    const sy_material_data *cur = sy_material_get(sc, (sy_material){id});
-    if (!cur || !id) return stale("material", id);
-    sy_material_data d = *cur;
-    if (bc != Py_None && float_seq(bc, "base_color", d.base_color, 4)) return NULL;
-    if (em != Py_None && float_seq(em, "emissive", d.emissive, 3)) return NULL;
-#define SY_PY_F(obj, field)                                                                                            \
-    if (obj != Py_None) {                                                                                              \
-        double v = PyFloat_AsDouble(obj);                                                                              \
-        if (v == -1.0 && PyErr_Occurred()) return NULL;                                                                \
-        d.field = (float)v;                                                                                            \
+    object_data d;
+    const field_desc *t = object_fields(sc, type, id, &d);
+    if (!t) return NULL;
+    PyObject *dict = Py_BuildValue("{s:z}", "name", *(char *const *)&d); /* every struct starts with its name */
+    for (; dict && t->name; ++t) {
+        const char *p = (const char *)&d + t->offset;
+        PyObject *v = t->kind == 'u' ? PyLong_FromUnsignedLong(*(const uint32_t *)p)
+                      : t->n == 1    ? PyFloat_FromDouble(*(const float *)p)
+                                     : tuple_of((const float *)p, t->n);
+        if (!v || PyDict_SetItemString(dict, t->name, v)) Py_CLEAR(dict);
+        Py_XDECREF(v);
     }
-    SY_PY_F(met, metallic)
-    SY_PY_F(rough, roughness)
-    SY_PY_F(ems, emissive_strength)
-    SY_PY_F(tr, transmission)
-    SY_PY_F(ior, ior)
-#undef SY_PY_F
-    if (ds != Py_None) {
-        int b = PyObject_IsTrue(ds);
-        if (b < 0) return NULL;
-        d.double_sided = (uint32_t)b;
+    return dict;
+}
+
+/* _set(type, id, **fields): the named fields changed, the rest kept, through the type's setter
+ * (which validates: a NaN roughness or a zfar before znear raises InvalidArgumentError) */
+static PyObject *scene_set_fields(PyObject *self, PyObject *args, PyObject *kw)
+{
+    int type;
+    unsigned int id;
+    if (!PyArg_ParseTuple(args, "iI", &type, &id)) return NULL;
+    sy_scene *sc = scene_use((SceneObject *)self);
+    if (!sc) return NULL;
+    object_data d;
+    const field_desc *table = object_fields(sc, type, id, &d);
+    if (!table) return NULL;
+    PyObject *key, *value;
+    Py_ssize_t pos = 0;
+    while (kw && PyDict_Next(kw, &pos, &key, &value)) {
+        const char *k = PyUnicode_AsUTF8AndSize(key, NULL);
+        if (!k) return NULL;
+        const field_desc *t = table;
+        while (t->name && strcmp(t->name, k) != 0) ++t;
+        if (!t->name)
+            return PyErr_Format(PyExc_TypeError, "%s has no field '%s'", sy_object_type_name((sy_object_type)type), k);
+        char *p = (char *)&d + t->offset;
+        if (t->kind == 'u') {
+            unsigned long u = PyLong_AsUnsignedLong(value);
+            if (PyErr_Occurred()) return NULL;
+            *(uint32_t *)p = (uint32_t)u;
+        } else if (t->n == 1) {
+            double f = PyFloat_AsDouble(value);
+            if (f == -1.0 && PyErr_Occurred()) return NULL;
+            *(float *)p = (float)f;
+        } else if (float_seq(value, t->name, (float *)p, t->n)) {
+            return NULL;
+        }
     }
     sy_error err = {0};
-    sy_result r = sy_material_set(sc, (sy_material){id}, &d, &err);
-    if (r != SY_OK) return raise_sy(r, &err);
-    Py_RETURN_NONE;
-}
-
-/* _light(id) -> dict; _light_set(id, type=None, color=None, intensity=None, range=None, inner_cone=None, outer_cone=None) */
-static PyObject *scene_light(PyObject *self, PyObject *args)
-{
-    unsigned int id;
-    if (!PyArg_ParseTuple(args, "I", &id)) return NULL;
-    sy_scene *sc = scene_use((SceneObject *)self);
-    if (!sc) return NULL;
-    const sy_light_data *d = sy_light_get(sc, (sy_light){id});
-    if (!d) return stale("light", id);
-    return Py_BuildValue("{s:z,s:I,s:N,s:f,s:f,s:f,s:f}", "name", d->name, "type", d->type, "color",
-                         tuple_of(d->color, 3), "intensity", (double)d->intensity, "range", (double)d->range,
-                         "inner_cone", (double)d->inner_cone, "outer_cone", (double)d->outer_cone);
-}
-
-static PyObject *scene_light_set(PyObject *self, PyObject *args, PyObject *kw)
-{
-    static char *kwlist[] = {"id", "type", "color", "intensity", "range", "inner_cone", "outer_cone", NULL};
-    unsigned int id;
-    PyObject *type = Py_None, *color = Py_None, *in = Py_None, *range = Py_None, *ic = Py_None, *oc = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "I|OOOOOO", kwlist, &id, &type, &color, &in, &range, &ic, &oc))
-        return NULL;
-    sy_scene *sc = scene_use((SceneObject *)self);
-    if (!sc) return NULL;
-    const sy_light_data *cur = sy_light_get(sc, (sy_light){id});
-    if (!cur) return stale("light", id);
-    sy_light_data d = *cur;
-    if (type != Py_None) {
-        long t = PyLong_AsLong(type);
-        if (t == -1 && PyErr_Occurred()) return NULL;
-        d.type = (uint32_t)t;
-    }
-    if (color != Py_None && float_seq(color, "color", d.color, 3)) return NULL;
-#define SY_PY_F(obj, field)                                                                                            \
-    if (obj != Py_None) {                                                                                              \
-        double v = PyFloat_AsDouble(obj);                                                                              \
-        if (v == -1.0 && PyErr_Occurred()) return NULL;                                                                \
-        d.field = (float)v;                                                                                            \
-    }
-    SY_PY_F(in, intensity)
-    SY_PY_F(range, range)
-    SY_PY_F(ic, inner_cone)
-    SY_PY_F(oc, outer_cone)
-#undef SY_PY_F
-    sy_error err = {0};
-    sy_result r = sy_light_set(sc, (sy_light){id}, &d, &err);
-    if (r != SY_OK) return raise_sy(r, &err);
-    Py_RETURN_NONE;
-}
-
-/* _camera(id) -> dict; _camera_set(id, projection=None, yfov=None, aspect=None, znear=None, zfar=None, xmag=None, ymag=None) */
-static PyObject *scene_camera(PyObject *self, PyObject *args)
-{
-    unsigned int id;
-    if (!PyArg_ParseTuple(args, "I", &id)) return NULL;
-    sy_scene *sc = scene_use((SceneObject *)self);
-    if (!sc) return NULL;
-    const sy_camera_data *d = sy_camera_get(sc, (sy_camera){id});
-    if (!d) return stale("camera", id);
-    return Py_BuildValue("{s:z,s:I,s:f,s:f,s:f,s:f,s:f,s:f}", "name", d->name, "projection", d->projection, "yfov",
-                         (double)d->yfov, "aspect", (double)d->aspect, "znear", (double)d->znear, "zfar",
-                         (double)d->zfar, "xmag", (double)d->xmag, "ymag", (double)d->ymag);
-}
-
-static PyObject *scene_camera_set(PyObject *self, PyObject *args, PyObject *kw)
-{
-    static char *kwlist[] = {"id", "projection", "yfov", "aspect", "znear", "zfar", "xmag", "ymag", NULL};
-    unsigned int id;
-    PyObject *proj = Py_None, *yfov = Py_None, *aspect = Py_None, *zn = Py_None, *zf = Py_None, *xm = Py_None,
-             *ym = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "I|OOOOOOO", kwlist, &id, &proj, &yfov, &aspect, &zn, &zf, &xm, &ym))
-        return NULL;
-    sy_scene *sc = scene_use((SceneObject *)self);
-    if (!sc) return NULL;
-    const sy_camera_data *cur = sy_camera_get(sc, (sy_camera){id});
-    if (!cur) return stale("camera", id);
-    sy_camera_data d = *cur;
-    if (proj != Py_None) {
-        long t = PyLong_AsLong(proj);
-        if (t == -1 && PyErr_Occurred()) return NULL;
-        d.projection = (uint32_t)t;
-    }
-#define SY_PY_F(obj, field)                                                                                            \
-    if (obj != Py_None) {                                                                                              \
-        double v = PyFloat_AsDouble(obj);                                                                              \
-        if (v == -1.0 && PyErr_Occurred()) return NULL;                                                                \
-        d.field = (float)v;                                                                                            \
-    }
-    SY_PY_F(yfov, yfov)
-    SY_PY_F(aspect, aspect)
-    SY_PY_F(zn, znear)
-    SY_PY_F(zf, zfar)
-    SY_PY_F(xm, xmag)
-    SY_PY_F(ym, ymag)
-#undef SY_PY_F
-    sy_error err = {0};
-    sy_result r = sy_camera_set(sc, (sy_camera){id}, &d, &err);
+    sy_result r = type == SY_TYPE_MATERIAL ? sy_material_set(sc, (sy_material){id}, &d.material, &err)
+                  : type == SY_TYPE_LIGHT  ? sy_light_set(sc, (sy_light){id}, &d.light, &err)
+                                           : sy_camera_set(sc, (sy_camera){id}, &d.camera, &err);
     if (r != SY_OK) return raise_sy(r, &err);
     Py_RETURN_NONE;
 }
@@ -1118,12 +1084,8 @@ static PyMethodDef scene_methods[] = {
     {"_node", scene_node, METH_VARARGS, NULL},
     {"_node_set", (PyCFunction)(void (*)(void))scene_node_set, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_node_trs", (PyCFunction)(void (*)(void))scene_node_trs, METH_FASTCALL, NULL},
-    {"_material", scene_material, METH_VARARGS, NULL},
-    {"_material_set", (PyCFunction)(void (*)(void))scene_material_set, METH_VARARGS | METH_KEYWORDS, NULL},
-    {"_light", scene_light, METH_VARARGS, NULL},
-    {"_light_set", (PyCFunction)(void (*)(void))scene_light_set, METH_VARARGS | METH_KEYWORDS, NULL},
-    {"_camera", scene_camera, METH_VARARGS, NULL},
-    {"_camera_set", (PyCFunction)(void (*)(void))scene_camera_set, METH_VARARGS | METH_KEYWORDS, NULL},
+    {"_get", scene_get_fields, METH_VARARGS, NULL},
+    {"_set", (PyCFunction)(void (*)(void))scene_set_fields, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_info", scene_info, METH_NOARGS, NULL},
     {"_set_camera", scene_set_camera, METH_VARARGS, NULL},
     {"commit", scene_commit, METH_NOARGS, "Seals the changes since the last commit (render commits too)."},
@@ -1169,10 +1131,7 @@ static void window_free(WindowObject *w)
 static void window_dealloc(PyObject *self)
 {
     window_free((WindowObject *)self);
-    PyTypeObject *tp = Py_TYPE(self);
-    freefunc f = (freefunc)PyType_GetSlot(tp, Py_tp_free);
-    f(self);
-    Py_DECREF(tp);
+    object_free(self);
 }
 
 static PyObject *window_new(PyTypeObject *type, PyObject *args, PyObject *kw)

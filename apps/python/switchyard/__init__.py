@@ -259,12 +259,12 @@ class Mesh(_Object):
 
 
 class _Fielded(_Object):
+    """An object whose fields the library lists by name (_switchyard's field tables)."""
     __slots__ = ()
-    _get = _set = None
     _keys = ()
 
     def _fields(self):
-        return getattr(self.scene._c, self._get)(self.id)
+        return self.scene._c._get(self._type, self.id)
 
     def __getattr__(self, key):
         if key in type(self)._keys:
@@ -273,24 +273,25 @@ class _Fielded(_Object):
 
     def __setattr__(self, key, value):
         if key in type(self)._keys:
-            getattr(self.scene._c, type(self)._set)(self.id, **{key: value})
+            self.scene._c._set(self._type, self.id, **{key: value})
         else:
             super().__setattr__(key, value)
 
     def set(self, **fields):
         """Sets several fields at once (one change of the object)."""
-        getattr(self.scene._c, type(self)._set)(self.id, **fields)
+        self.scene._c._set(self._type, self.id, **fields)
         return self
 
 
 class Material(_Fielded):
     """A glTF 2.0 metallic-roughness material: base_color (RGBA linear), metallic, roughness,
-    emissive (RGB), emissive_strength, double_sided, transmission, ior."""
+    emissive (RGB), emissive_strength, double_sided, alpha_mode (OPAQUE, MASK, BLEND), alpha_cutoff,
+    transmission, ior, unlit."""
+    OPAQUE, MASK, BLEND = 0, 1, 2
     __slots__ = ()
     _type = _c.TYPE_MATERIAL
-    _get, _set = "_material", "_material_set"
-    _keys = ("base_color", "metallic", "roughness", "emissive", "emissive_strength", "double_sided",
-             "transmission", "ior")
+    _keys = ("base_color", "metallic", "roughness", "emissive", "emissive_strength", "double_sided", "alpha_mode",
+             "alpha_cutoff", "transmission", "ior", "unlit")
 
 
 class Light(_Fielded):
@@ -299,7 +300,6 @@ class Light(_Fielded):
     __slots__ = ()
     POINT, SPOT, DIRECTIONAL = 0, 1, 2
     _type = _c.TYPE_LIGHT
-    _get, _set = "_light", "_light_set"
     _keys = ("type", "color", "intensity", "range", "inner_cone", "outer_cone")
 
 
@@ -309,18 +309,12 @@ class Camera(_Fielded):
     __slots__ = ()
     PERSPECTIVE, ORTHOGRAPHIC = 0, 1
     _type = _c.TYPE_CAMERA
-    _get, _set = "_camera", "_camera_set"
     _keys = ("projection", "yfov", "aspect", "znear", "zfar", "xmag", "ymag")
 
 
-class Scene:
-    """A scene graph (sy_scene): ``Scene()`` is empty, ``switchyard.load(path)`` reads a file.
-
-    Usable as a context manager (``with switchyard.load(p) as s:``) to free it deterministically;
-    otherwise it is freed when the last reference goes. Objects of a closed scene raise."""
-
-    def __init__(self, _impl=None):
-        self._c = _impl if _impl is not None else _c._Scene()
+class _Closing:
+    """close() frees the library object now; ``with`` closes at the end of the block."""
+    __slots__ = ()
 
     def __enter__(self):
         return self
@@ -330,8 +324,18 @@ class Scene:
         return False
 
     def close(self):
-        """Frees the scene now (its objects become stale; a Window showing it must be closed first)."""
         self._c.close()
+
+
+class Scene(_Closing):
+    """A scene graph (sy_scene): ``Scene()`` is empty, ``switchyard.load(path)`` reads a file.
+
+    Usable as a context manager (``with switchyard.load(p) as s:``) to free it deterministically;
+    otherwise it is freed when the last reference goes. Objects of a closed scene raise; close()
+    refuses while a Window shows the scene."""
+
+    def __init__(self, _impl=None):
+        self._c = _impl if _impl is not None else _c._Scene()
 
     def commit(self):
         """Seals the changes since the last commit into a change list (render() commits too)."""
@@ -529,11 +533,12 @@ class Viewport:
         return "<Viewport %d of %r>" % (self.index, self.window)
 
 
-class Window:
+class Window(_Closing):
     """A window (sy_window) showing one Scene through ordered viewports (back to front), each with
     its own back-end, rectangle, root, camera, eye and composite mode. The window keeps the back-ends'
     contexts between renders: a progressive viewport keeps accumulating while nothing changes, and
-    switching a viewport's back-end and back finds the cached context again."""
+    switching a viewport's back-end and back finds the cached context again. close() (or ``with``)
+    frees the window, its viewports and contexts now."""
     REPLACE, DEPTH, ALPHA_OVER = 0, 1, 2
     MONO, LEFT, RIGHT = 0, 1, 2
 
@@ -541,17 +546,6 @@ class Window:
         self.scene = scene
         self._c = _c._Window(scene._c, width, height)
         self.viewports = []
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-        return False
-
-    def close(self):
-        """Frees the window, its viewports and contexts now."""
-        self._c.close()
 
     def add_viewport(self, backend=None, params=None, x=0, y=0, width=0, height=0, root=None, camera=None,
                      eye=0, eye_separation=0.0, zero_parallax=0.0, composite=0, active=True):
