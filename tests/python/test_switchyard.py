@@ -372,3 +372,17 @@ def test_render_on_a_cluster_equals_the_local_render(tmp_path):
         for p in procs:
             p.terminate()
             p.wait()
+
+
+@needs_pt
+@needs_whitted
+def test_notebook_block_of_the_docs_runs_as_written():
+    """docs/PYTHON.md, "In a notebook": the block runs as written and shows two images side by side."""
+    import re
+    doc = open(os.path.join(os.path.dirname(__file__), "../../docs/PYTHON.md")).read()
+    block = re.search(r"## In a notebook.*?```python\n(.*?)```", doc, re.S).group(1)
+    env = {}
+    exec(compile(block, "docs/PYTHON.md", "exec"), env)
+    img = env["side_by_side"]
+    assert isinstance(img, switchyard.Image) and img.shape == (240, 640, 4)
+    assert img._repr_png_().startswith(b"\x89PNG")
