@@ -343,8 +343,10 @@ static int get_array(PyObject *obj, const char *what, char code, Py_ssize_t cols
     const char *dtype = code == 'f' ? "float32" : "uint32";
     if (PyObject_GetBuffer(obj, view, PyBUF_FORMAT | PyBUF_STRIDES) != 0) {
         PyErr_Clear();
-        PyErr_Format(argerr, "%s: expected an array of %s (numpy.ndarray or another buffer-protocol object), got %s",
-                     what, dtype, Py_TYPE(obj) == NULL ? "?" : "an object without the buffer protocol");
+        PyObject *tn = PyType_GetName(Py_TYPE(obj));
+        PyErr_Format(argerr, "%s: expected an array of %s (numpy.ndarray or another buffer-protocol object), got %S "
+                     "(no buffer protocol)", what, dtype, tn ? tn : Py_None);
+        Py_XDECREF(tn);
         return -1;
     }
     if (!format_is(view, code) || view->itemsize != 4) {
