@@ -152,6 +152,40 @@ def test_objects_read_and_write_fields():
         cam.zfar = 0.25  # before znear: the library's setter refuses it
 
 
+def test_node_trs_fields_are_the_c_base():
+    """Node's TRS fields are getset descriptors of the C base (the call-overhead path): any
+    3-/4-sequence, a clear error for anything else, no deletion, cycles through the scene collected."""
+    import weakref
+    s = switchyard.Scene()
+    node = s.add_mesh(numpy.eye(3, dtype=numpy.float32))
+    assert isinstance(node, switchyard._c._Node) and node.scene is s
+    node.translation = [4, 5, 6]
+    node.scale = numpy.array([2, 2, 2], numpy.float32)
+    node.rotation = (0.0, 0.0, 0.0, 1.0)
+    assert node.translation == (4.0, 5.0, 6.0) and node.scale == (2.0, 2.0, 2.0)
+    assert numpy.allclose(node.matrix[:3, 3], [4, 5, 6]) and numpy.allclose(node.matrix[0, 0], 2)
+    assert node == s.nodes[0] and hash(node) == hash(s.nodes[0])
+    E = switchyard.InvalidArgumentError
+    with pytest.raises(E, match="translation: expected 3 numbers, got 2"):
+        node.translation = (1, 2)
+    with pytest.raises(E, match="rotation: expected a sequence of 4 numbers"):
+        node.rotation = 5
+    with pytest.raises(TypeError):
+        node.translation = ("a", 0, 0)
+    with pytest.raises(E):
+        node.translation = (float("nan"), 0, 0)
+    with pytest.raises(AttributeError, match="cannot be deleted"):
+        del node.scale
+    assert node.translation == (4.0, 5.0, 6.0), "a refused value leaves the node as it was"
+    with pytest.raises(TypeError):
+        switchyard.Node(object(), 1)
+    s.keep = node  # a cycle scene -> node -> scene: the collector frees it
+    ref = weakref.ref(s)
+    del s, node
+    gc.collect()
+    assert ref() is None
+
+
 @needs_whitted
 def test_window_switches_backends_on_a_live_viewport():
     s = triangle_scene()

@@ -10,6 +10,8 @@
  *     mono render (apps/sy/sy_compose.c), progressive back-ends in passes.
  *   - _Window: a sy_window with its own context pool and viewports, for layering, stereo and
  *     switching back-ends on a live viewport (contexts stay cached in its pool).
+ *   - _Node: the C base of switchyard.Node (its TRS fields are getset descriptors: one C call
+ *     per `node.translation = v`, the call-overhead target).
  *   - _Buffer: a float32 array that owns library memory (a rendered layer's planes) and exports
  *     it through the buffer protocol, so numpy.asarray takes it without a copy.
  *   - the registry (backends), EXR reading and writing, the log callback, sy_result -> exception.
@@ -38,6 +40,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* ------------------------------------------------------------------ errors */
 /* switchyard.Error subclasses by sy_result code, handed over by __init__.py (_set_errors). */
@@ -640,43 +643,187 @@ static PyObject *scene_node_set(PyObject *self, PyObject *args, PyObject *kw)
     Py_RETURN_NONE;
 }
 
-/* _node_trs(id, which, values): which 0 translation (3), 1 rotation (4, x y z w), 2 scale (3): the
- * one-field path of Node.translation = ... (positional arguments, a tuple read in place: the
- * call costs about what the keyword path of _node_set costs a third of) */
-static PyObject *scene_node_trs(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+/* ------------------------------------------------------------------ _Node */
+/* The base of switchyard.Node: the Python Scene (strong), its _Scene (strong, cached so the hot
+ * path needs no attribute lookup) and the node's handle id. translation / rotation / scale are
+ * getset descriptors: `node.translation = (x, y, z)` is one C call from the interpreter's STORE_ATTR
+ * (no Python-level property, no argument-format parsing), the call-overhead target of issue 38
+ * (apps/python/bench_overhead.py measures it). Holds no library pointer: a stale id raises
+ * InvalidHandleError through the generation check, a closed scene InvalidOperationError. */
+typedef struct {
+    PyObject_HEAD
+    PyObject *scene;     /* switchyard.Scene */
+    SceneObject *impl;   /* scene._c */
+    uint32_t id;
+} NodeObject;
+
+static PyObject *node_new(PyTypeObject *type, PyObject *args, PyObject *kw)
 {
-    if (nargs != 3) return PyErr_Format(PyExc_TypeError, "_node_trs(id, which, values)");
-    unsigned long id = PyLong_AsUnsignedLong(args[0]);
-    long which = PyLong_AsLong(args[1]);
-    PyObject *v = args[2];
-    if (PyErr_Occurred()) return NULL;
-    if (id > UINT32_MAX) return stale("node", (unsigned)id);
-    sy_scene *sc = scene_use((SceneObject *)self);
-    if (!sc) return NULL;
-    if (which < 0 || which > 2) return PyErr_Format(PyExc_ValueError, "_node_trs: field %ld", which);
-    static const char *const names[3] = {"translation", "rotation", "scale"};
-    float val[4];
-    Py_ssize_t n = which == 1 ? 4 : 3;
-    if (PyTuple_Check(v) && PyTuple_Size(v) == n) {
-        for (Py_ssize_t i = 0; i < n; ++i) {
-            double d = PyFloat_AsDouble(PyTuple_GetItem(v, i));
-            if (d == -1.0 && PyErr_Occurred()) return NULL;
-            val[i] = (float)d;
-        }
-    } else if (float_seq(v, names[which], val, n)) {
+    PyObject *scene;
+    unsigned long id;
+    if (kw && PyDict_Size(kw)) return PyErr_Format(PyExc_TypeError, "Node(scene, id) takes no keyword arguments");
+    if (!PyArg_ParseTuple(args, "Ok", &scene, &id)) return NULL;
+    if (id > UINT32_MAX) return PyErr_Format(PyExc_ValueError, "Node: id %lu out of range", id);
+    PyObject *impl = PyObject_GetAttrString(scene, "_c");
+    if (!impl) PyErr_Clear();
+    if (!impl || !PyObject_TypeCheck(impl, g_scene_type)) {
+        Py_XDECREF(impl);
+        return PyErr_Format(PyExc_TypeError, "Node: the scene must be a switchyard.Scene");
+    }
+    NodeObject *n = (NodeObject *)((allocfunc)PyType_GetSlot(type, Py_tp_alloc))(type, 0);
+    if (!n) {
+        Py_DECREF(impl);
         return NULL;
     }
+    n->scene = Py_NewRef(scene);
+    n->impl = (SceneObject *)impl;
+    n->id = (uint32_t)id;
+    return (PyObject *)n;
+}
+
+static int node_traverse(PyObject *self, visitproc visit, void *arg)
+{
+    NodeObject *n = (NodeObject *)self;
+    Py_VISIT(Py_TYPE(self));
+    Py_VISIT(n->scene);
+    Py_VISIT((PyObject *)n->impl);
+    return 0;
+}
+
+static int node_clear(PyObject *self)
+{
+    NodeObject *n = (NodeObject *)self;
+    Py_CLEAR(n->scene);
+    Py_CLEAR(n->impl);
+    return 0;
+}
+
+static void node_dealloc(PyObject *self)
+{
+    PyObject_GC_UnTrack(self);
+    node_clear(self);
+    object_free(self);
+}
+
+/* A 3- or 4-number value: a tuple or list read in place, anything else through float_seq. */
+static int node_values(PyObject *v, const char *what, float *out, Py_ssize_t n)
+{
+    PyObject *(*item)(PyObject *, Py_ssize_t) = NULL;
+    Py_ssize_t size = -1;
+    if (PyTuple_Check(v)) item = PyTuple_GetItem, size = PyTuple_Size(v);
+    else if (PyList_Check(v)) item = PyList_GetItem, size = PyList_Size(v);
+    if (!item || size != n) return float_seq(v, what, out, n);
+    for (Py_ssize_t i = 0; i < n; ++i) {
+        double d = PyFloat_AsDouble(item(v, i));
+        if (d == -1.0 && PyErr_Occurred()) return -1;
+        out[i] = (float)d;
+    }
+    return 0;
+}
+
+static const char *const g_trs_names[3] = {"translation", "rotation", "scale"};
+
+static PyObject *node_get_trs(PyObject *self, void *which_p)
+{
+    NodeObject *n = (NodeObject *)self;
+    int which = (int)(intptr_t)which_p;
+    sy_scene *sc = scene_use(n->impl);
+    if (!sc) return NULL;
+    const sy_node_data *d = sy_node_get(sc, (sy_node){n->id});
+    if (!d) return stale("node", n->id);
+    return which == 0 ? tuple_of(d->transform.translation, 3)
+                      : which == 1 ? tuple_of(d->transform.rotation, 4) : tuple_of(d->transform.scale, 3);
+}
+
+static int node_set_trs(PyObject *self, PyObject *v, void *which_p)
+{
+    NodeObject *n = (NodeObject *)self;
+    int which = (int)(intptr_t)which_p;
+    if (!v) {
+        PyErr_Format(PyExc_AttributeError, "Node.%s cannot be deleted", g_trs_names[which]);
+        return -1;
+    }
+    sy_scene *sc = scene_use(n->impl);
+    if (!sc) return -1;
+    float val[4];
+    if (node_values(v, g_trs_names[which], val, which == 1 ? 4 : 3)) return -1;
+    sy_node node = {n->id};
+    const sy_node_data *d = sy_node_get(sc, node);
+    if (!d) {
+        stale("node", n->id);
+        return -1;
+    }
+    const float *t = which == 0 ? val : d->transform.translation, *r = which == 1 ? val : d->transform.rotation,
+                *s = which == 2 ? val : d->transform.scale;
+    sy_error err = {0};
+    sy_result res = sy_node_set_trs(sc, node, t, r, s, &err);
+    if (res != SY_OK) {
+        raise_sy(res, &err);
+        return -1;
+    }
+    return 0;
+}
+
+static PyObject *node_get_scene(PyObject *self, void *unused)
+{
+    (void)unused;
+    return Py_NewRef(((NodeObject *)self)->scene);
+}
+
+static PyObject *node_get_id(PyObject *self, void *unused)
+{
+    (void)unused;
+    return PyLong_FromUnsignedLong(((NodeObject *)self)->id);
+}
+
+static PyGetSetDef node_getset[] = {
+    {"scene", node_get_scene, NULL, "the Scene the node belongs to", NULL},
+    {"id", node_get_id, NULL, "the library's handle id (index and generation)", NULL},
+    {"translation", node_get_trs, node_set_trs, "TRS translation (x, y, z)", (void *)0},
+    {"rotation", node_get_trs, node_set_trs, "TRS rotation, unit quaternion (x, y, z, w)", (void *)1},
+    {"scale", node_get_trs, node_set_trs, "TRS scale (x, y, z)", (void *)2},
+    {NULL, NULL, NULL, NULL, NULL}};
+
+static PyType_Slot node_slots[] = {{Py_tp_dealloc, node_dealloc},
+                                   {Py_tp_new, node_new},
+                                   {Py_tp_traverse, node_traverse},
+                                   {Py_tp_clear, node_clear},
+                                   {Py_tp_getset, node_getset},
+                                   {Py_tp_doc, "the C base of switchyard.Node (scene, id, the TRS fields)"},
+                                   {0, NULL}};
+static PyType_Spec node_spec = {"switchyard._switchyard._Node", sizeof(NodeObject), 0,
+                                Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE | Py_TPFLAGS_HAVE_GC, node_slots};
+
+/* _bench_trs(scene_c, id, n) -> (wall seconds, thread CPU seconds): n calls of sy_node_set_trs from C (translation x = i), the
+ * C side of the call-overhead comparison (apps/python/bench_overhead.py); not a public name. */
+static PyObject *py_bench_trs(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *impl;
+    unsigned long id, count;
+    if (!PyArg_ParseTuple(args, "O!kk", g_scene_type, &impl, &id, &count)) return NULL;
+    sy_scene *sc = scene_use((SceneObject *)impl);
+    if (!sc) return NULL;
     sy_node node = {(uint32_t)id};
     const sy_node_data *d = sy_node_get(sc, node);
     if (!d) return stale("node", (unsigned)id);
-    float t[3], r[4], scale[3];
-    memcpy(t, which == 0 ? val : d->transform.translation, sizeof t);
-    memcpy(r, which == 1 ? val : d->transform.rotation, sizeof r);
-    memcpy(scale, which == 2 ? val : d->transform.scale, sizeof scale);
+    float t[3], r[4], s[3];
+    memcpy(t, d->transform.translation, sizeof t);
+    memcpy(r, d->transform.rotation, sizeof r);
+    memcpy(s, d->transform.scale, sizeof s);
     sy_error err = {0};
-    sy_result res = sy_node_set_trs(sc, node, t, r, scale, &err);
-    if (res != SY_OK) return raise_sy(res, &err);
-    Py_RETURN_NONE;
+    struct timespec a, b, ca, cb;
+    clock_gettime(CLOCK_MONOTONIC, &a);
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ca);
+    for (unsigned long i = 0; i < count; ++i) {
+        t[0] = (float)i;
+        sy_result res = sy_node_set_trs(sc, node, t, r, s, &err);
+        if (res != SY_OK) return raise_sy(res, &err);
+    }
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &cb);
+    clock_gettime(CLOCK_MONOTONIC, &b);
+    return Py_BuildValue("(dd)", (double)(b.tv_sec - a.tv_sec) + 1e-9 * (double)(b.tv_nsec - a.tv_nsec),
+                         (double)(cb.tv_sec - ca.tv_sec) + 1e-9 * (double)(cb.tv_nsec - ca.tv_nsec));
 }
 
 /* ---- materials, lights, cameras: their fields by one table each, read and set by name */
@@ -1085,7 +1232,6 @@ static PyMethodDef scene_methods[] = {
     {"_valid", scene_valid, METH_VARARGS, NULL},
     {"_node", scene_node, METH_VARARGS, NULL},
     {"_node_set", (PyCFunction)(void (*)(void))scene_node_set, METH_VARARGS | METH_KEYWORDS, NULL},
-    {"_node_trs", (PyCFunction)(void (*)(void))scene_node_trs, METH_FASTCALL, NULL},
     {"_get", scene_get_fields, METH_VARARGS, NULL},
     {"_set", (PyCFunction)(void (*)(void))scene_set_fields, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_info", scene_info, METH_NOARGS, NULL},
@@ -1428,6 +1574,7 @@ static PyMethodDef module_methods[] = {
     {"write_exr", (PyCFunction)(void (*)(void))py_write_exr, METH_VARARGS | METH_KEYWORDS, NULL},
     {"version", py_version, METH_NOARGS, NULL},
     {"blob_live_count", py_blob_live_count, METH_NOARGS, NULL},
+    {"_bench_trs", py_bench_trs, METH_VARARGS, NULL},
     {"_set_errors", py_set_errors, METH_VARARGS, NULL},
     {"_set_log", py_set_log, METH_VARARGS, NULL},
     {NULL, NULL, 0, NULL}};
@@ -1448,7 +1595,8 @@ PyMODINIT_FUNC PyInit__switchyard(void)
     g_buffer_type = (PyTypeObject *)PyType_FromSpec(&buffer_spec);
     g_scene_type = (PyTypeObject *)PyType_FromSpec(&scene_spec);
     PyObject *window_type = PyType_FromSpec(&window_spec);
-    if (!g_buffer_type || !g_scene_type || !window_type ||
+    PyObject *node_type = PyType_FromSpec(&node_spec);
+    if (!g_buffer_type || !g_scene_type || !window_type || !node_type || PyModule_AddObjectRef(m, "_Node", node_type) ||
         PyModule_AddObjectRef(m, "_Buffer", (PyObject *)g_buffer_type) ||
         PyModule_AddObjectRef(m, "_Scene", (PyObject *)g_scene_type) || PyModule_AddObjectRef(m, "_Window", window_type) ||
         PyModule_AddIntConstant(m, "CAP_DEPTH", SY_CAP_DEPTH) ||
@@ -1460,9 +1608,11 @@ PyMODINIT_FUNC PyInit__switchyard(void)
         PyModule_AddIntConstant(m, "TYPE_MATERIAL", SY_TYPE_MATERIAL) ||
         PyModule_AddIntConstant(m, "TYPE_LIGHT", SY_TYPE_LIGHT) || PyModule_AddIntConstant(m, "TYPE_CAMERA", SY_TYPE_CAMERA)) {
         Py_XDECREF(window_type);
+        Py_XDECREF(node_type);
         Py_DECREF(m);
         return NULL;
     }
     Py_DECREF(window_type);
+    Py_DECREF(node_type);
     return m;
 }

@@ -162,14 +162,10 @@ CAP_DEPTH, CAP_PROGRESSIVE, CAP_AOVS = _c.CAP_DEPTH, _c.CAP_PROGRESSIVE, _c.CAP_
 # ---------------------------------------------------------------- scene objects
 
 
-class _Object:
-    """An object of a scene: the scene (kept alive by it) and the library's handle id."""
-    __slots__ = ("scene", "id")
+class _Methods:
+    """What every scene object offers, given ``scene`` (a Scene), ``id`` and ``_type``."""
+    __slots__ = ()
     _type = None
-
-    def __init__(self, scene, id):
-        self.scene = scene
-        self.id = id
 
     def __eq__(self, other):
         return type(self) is type(other) and self.scene is other.scene and self.id == other.id
@@ -201,8 +197,20 @@ class _Object:
         return "<%s %d%s>" % (type(self).__name__, self.id, " %r" % n if n else "")
 
 
-class Node(_Object):
-    """A node: transform (TRS or matrix), children, optional mesh, light and camera."""
+class _Object(_Methods):
+    """An object of a scene: the scene (kept alive by it) and the library's handle id."""
+    __slots__ = ("scene", "id")
+
+    def __init__(self, scene, id):
+        self.scene = scene
+        self.id = id
+
+
+class Node(_c._Node, _Methods):
+    """A node: transform (TRS or matrix), children, optional mesh, light and camera.
+
+    ``scene``, ``id``, ``translation``, ``rotation`` and ``scale`` are the C base's (_c._Node):
+    setting a TRS field is one C call (the call-overhead target; apps/python/bench_overhead.py)."""
     __slots__ = ()
     _type = _c.TYPE_NODE
 
@@ -218,14 +226,6 @@ class Node(_Object):
     def matrix(self, m):
         self.scene._c._node_set(self.id, matrix=numpy.asarray(m, dtype=numpy.float32).reshape(4, 4).T.ravel().tolist())
 
-    translation = property(lambda self: self._fields()["translation"],
-                           lambda self, v: self.scene._c._node_trs(self.id, 0, v),
-                           doc="TRS translation (x, y, z)")
-    rotation = property(lambda self: self._fields()["rotation"],
-                        lambda self, v: self.scene._c._node_trs(self.id, 1, v),
-                        doc="TRS rotation, unit quaternion (x, y, z, w)")
-    scale = property(lambda self: self._fields()["scale"], lambda self, v: self.scene._c._node_trs(self.id, 2, v),
-                     doc="TRS scale (x, y, z)")
     flags = property(lambda self: self._fields()["flags"], lambda self, v: self.scene._c._node_set(self.id, flags=v))
 
     @property
