@@ -186,6 +186,39 @@ def test_node_trs_fields_are_the_c_base():
     assert ref() is None
 
 
+def test_serve_the_web_view_over_http():
+    """serve() as sy web: a loopback server on an ephemeral port answers the page and a still (JPEG)
+    over HTTP, owns the scene while it serves, and stop() hands it back."""
+    import urllib.request
+    if not hasattr(switchyard._c, "_Web"):
+        pytest.skip("built without the web view (SY_WITH_WEB)")
+    s = switchyard.load("demo")
+    with switchyard.serve(s, port=0, backend=NAMES[0]) as srv:
+        assert srv.port > 0 and srv.url.startswith("http://127.0.0.1:%d/" % srv.port) and srv.running
+        page = urllib.request.urlopen(srv.url, timeout=30).read()
+        assert b"<canvas" in page
+        origin = "http://127.0.0.1:%d" % srv.port
+        req = urllib.request.Request(origin + "/api/frame.jpg?w=64&h=48", headers={"Origin": origin})
+        jpg = urllib.request.urlopen(req, timeout=60).read()
+        assert jpg[:3] == b"\xff\xd8\xff", "a JPEG still"
+        with pytest.raises(RuntimeError, match="in use"):
+            s.nodes
+    assert not srv.running and "stopped" in repr(srv)
+    assert len(s.nodes) > 0, "the scene is usable again after stop()"
+    with pytest.raises(switchyard.NotFoundError):
+        switchyard.serve(s, port=0, backend="no-such-backend")
+    s.close()
+    t = switchyard.Scene()
+    t.add_mesh(numpy.eye(3, dtype=numpy.float32))
+    with pytest.raises(switchyard.InvalidArgumentError, match="no camera"):
+        switchyard.serve(t, port=0)
+    srv = switchyard.serve("demo", port=0)  # from a path: the server's own scene, closed by stop()
+    srv.stop()
+    srv.stop()
+    with pytest.raises(switchyard.InvalidOperationError, match="closed"):
+        srv.scene.nodes
+
+
 @needs_whitted
 def test_window_switches_backends_on_a_live_viewport():
     s = triangle_scene()

@@ -12,6 +12,7 @@
  *     switching back-ends on a live viewport (contexts stay cached in its pool).
  *   - _Node: the C base of switchyard.Node (its TRS fields are getset descriptors: one C call
  *     per `node.translation = v`, the call-overhead target).
+ *   - _Web: the web view (apps/web/sy_web.h, as `sy web`) served by a thread of its own.
  *   - _Buffer: a float32 array that owns library memory (a rendered layer's planes) and exports
  *     it through the buffer protocol, so numpy.asarray takes it without a copy.
  *   - the registry (backends), EXR reading and writing, the log callback, sy_result -> exception.
@@ -32,6 +33,9 @@
 #include "sy_viewport.h"
 #ifdef SY_PY_HAVE_CLUSTER
 #include "sy_cluster_cli.h"
+#endif
+#ifdef SY_PY_HAVE_WEB
+#include "sy_web.h"
 #endif
 
 #include <math.h>
@@ -211,8 +215,8 @@ static PyTypeObject *g_scene_type;
 static sy_scene *scene_use(SceneObject *s)
 {
     if (s->busy) {
-        PyErr_SetString(PyExc_RuntimeError, "switchyard: the scene is in use by another thread (a render); "
-                                            "give each thread its own Scene or wait for the render");
+        PyErr_SetString(PyExc_RuntimeError, "switchyard: the scene is in use by another thread (a render, or "
+                                            "serve() until stopped); give each thread its own Scene or wait");
         return NULL;
     }
     if (!s->ld.scene) {
@@ -1248,6 +1252,141 @@ static PyType_Slot scene_slots[] = {{Py_tp_dealloc, scene_dealloc},
 static PyType_Spec scene_spec = {"switchyard._switchyard._Scene", sizeof(SceneObject), 0,
                                  Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE, scene_slots};
 
+#ifdef SY_PY_HAVE_WEB
+/* ------------------------------------------------------------------ _Web */
+/* The web view of a _Scene (apps/web/sy_web.h, as `sy web` serves it): sy_web_run on a thread of
+ * its own, which never holds the GIL (the log callback takes it for a message). While it serves,
+ * the server's render thread owns the scene: the _Scene is marked busy, so Python calls on it
+ * raise RuntimeError instead of racing; stop() (or dealloc) stops the server, joins the thread and
+ * frees it, and the scene is usable again. Holds a strong reference to the _Scene. */
+typedef struct {
+    PyObject_HEAD
+    SceneObject *scene;
+    sy_web *web;
+    pthread_t thread;
+    int running;        /* the thread was started and not joined yet */
+    sy_result result;   /* what sy_web_run returned */
+    sy_error err;
+} WebObject;
+
+static void *web_thread(void *arg)
+{
+    WebObject *w = arg;
+    w->result = sy_web_run(w->web, NULL, &w->err);
+    return NULL;
+}
+
+/* Stops the server and frees it; 0, or -1 with an exception when serving had ended with an error. */
+static int web_stop(WebObject *w, int report)
+{
+    if (w->running) {
+        sy_web_stop(w->web);
+        Py_BEGIN_ALLOW_THREADS
+        pthread_join(w->thread, NULL);
+        Py_END_ALLOW_THREADS
+        w->running = 0;
+    }
+    if (w->web) {
+        sy_web_destroy(w->web);
+        w->web = NULL;
+        if (w->scene) w->scene->busy = 0;
+    }
+    if (report && w->result != SY_OK) {
+        sy_result r = w->result;
+        w->result = SY_OK;
+        raise_sy(r, &w->err);
+        return -1;
+    }
+    return 0;
+}
+
+static void web_dealloc(PyObject *self)
+{
+    WebObject *w = (WebObject *)self;
+    web_stop(w, 0);
+    Py_CLEAR(w->scene);
+    object_free(self);
+}
+
+/* _Web(scene, backend=None, listen=None, token=None, max_width=0, max_height=0, quality=0,
+ * filter=None, threshold=0, budget_ms=0): serving starts at once */
+static PyObject *web_new(PyTypeObject *type, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"scene", "backend", "listen", "token", "max_width", "max_height", "quality", "filter",
+                             "threshold", "budget_ms", NULL};
+    PyObject *scene;
+    const char *backend = NULL, *listen = NULL, *token = NULL, *filter = NULL;
+    unsigned int mw = 0, mh = 0;
+    int quality = 0;
+    float threshold = 0.0f;
+    double budget = 0.0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O!|zzzIIizfd", kwlist, g_scene_type, &scene, &backend, &listen, &token,
+                                     &mw, &mh, &quality, &filter, &threshold, &budget))
+        return NULL;
+    SceneObject *s = (SceneObject *)scene;
+    sy_scene *sc = scene_use(s);
+    if (!sc) return NULL;
+    sy_error err = {0};
+    sy_result r = sy_scene_commit(sc, NULL, &err); /* the server never commits: what Python built is sealed now */
+    if (r != SY_OK) return raise_sy(r, &err);
+    if (!s->ld.camera.id)
+        return raise_sy(SY_ERR_INVALID_ARGUMENT,
+                        &(sy_error){SY_ERR_INVALID_ARGUMENT, "serve: the scene has no camera (add one: scene.camera = "
+                                                             "scene.add_camera(...))"});
+    WebObject *w = (WebObject *)PyType_GenericNew(type, NULL, NULL);
+    if (!w) return NULL;
+    sy_web_desc d = {.scene = sc, .root = s->ld.root, .camera = s->ld.camera, .background = s->ld.background,
+                     .backend = backend, .listen = listen, .token = token, .max_width = mw, .max_height = mh,
+                     .quality = quality, .filter = filter, .threshold = threshold, .budget_ms = budget};
+    s->busy = 1; /* from here the scene belongs to the server (released in web_stop) */
+    Py_BEGIN_ALLOW_THREADS
+    r = sy_web_create(&d, &w->web, &err);
+    Py_END_ALLOW_THREADS
+    if (r != SY_OK) {
+        s->busy = 0;
+        Py_DECREF(w);
+        return raise_sy(r, &err);
+    }
+    w->scene = (SceneObject *)Py_NewRef(scene);
+    if (pthread_create(&w->thread, NULL, web_thread, w) != 0) {
+        Py_DECREF(w); /* destroys the server, the scene is free again */
+        return raise_sy(SY_ERR_SYSTEM, &(sy_error){SY_ERR_SYSTEM, "serve: could not start the server's thread"});
+    }
+    w->running = 1;
+    return (PyObject *)w;
+}
+
+static PyObject *web_stop_method(PyObject *self, PyObject *unused)
+{
+    (void)unused;
+    if (web_stop((WebObject *)self, 1)) return NULL;
+    Py_RETURN_NONE;
+}
+
+static PyObject *web_info(PyObject *self, PyObject *unused)
+{
+    (void)unused;
+    WebObject *w = (WebObject *)self;
+    if (!w->web) return Py_BuildValue("{s:O,s:i,s:O}", "url", Py_None, "port", 0, "running", Py_False);
+    sy_web_stats st;
+    sy_web_stats_get(w->web, &st);
+    return Py_BuildValue("{s:s,s:i,s:O,s:K,s:K}", "url", sy_web_url(w->web), "port", (int)sy_web_port(w->web),
+                         "running", Py_True, "stills_done", (unsigned long long)st.stills_done, "accepted",
+                         (unsigned long long)st.accepted);
+}
+
+static PyMethodDef web_methods[] = {
+    {"stop", web_stop_method, METH_NOARGS, "Stops serving, joins the server's thread, frees the server."},
+    {"_info", web_info, METH_NOARGS, NULL},
+    {NULL, NULL, 0, NULL}};
+static PyType_Slot web_slots[] = {{Py_tp_dealloc, web_dealloc},
+                                  {Py_tp_new, web_new},
+                                  {Py_tp_methods, web_methods},
+                                  {Py_tp_doc, "the web view of a _Scene (sy_web, served by a thread of its own)"},
+                                  {0, NULL}};
+static PyType_Spec web_spec = {"switchyard._switchyard._Web", sizeof(WebObject), 0, Py_TPFLAGS_DEFAULT, web_slots};
+#endif
+
 /* ------------------------------------------------------------------ _Window */
 #define SY_PY_MAX_VIEWPORTS 64
 typedef struct {
@@ -1614,5 +1753,14 @@ PyMODINIT_FUNC PyInit__switchyard(void)
     }
     Py_DECREF(window_type);
     Py_DECREF(node_type);
+#ifdef SY_PY_HAVE_WEB
+    PyObject *web_type = PyType_FromSpec(&web_spec);
+    if (!web_type || PyModule_AddObjectRef(m, "_Web", web_type)) {
+        Py_XDECREF(web_type);
+        Py_DECREF(m);
+        return NULL;
+    }
+    Py_DECREF(web_type);
+#endif
     return m;
 }

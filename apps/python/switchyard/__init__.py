@@ -28,7 +28,7 @@ __all__ = [
     "UnsupportedError", "LimitError", "NotFoundError", "BackendError", "ProtocolError",
     "InvalidOperationError", "CancelledError", "SystemError_",
     "Scene", "Node", "Mesh", "Material", "Light", "Camera", "Window", "Viewport", "Backend",
-    "load", "render", "backends", "read_exr", "write_exr", "version",
+    "Server", "load", "render", "serve", "backends", "read_exr", "write_exr", "version",
 ]
 
 # ---------------------------------------------------------------- errors (one per sy_result)
@@ -498,6 +498,81 @@ def render(scene, backend=None, width=0, height=0, spp=0, seed=0, params=None, a
     with load(scene, **load_options) as s:
         out = s.render(**opts)
     return out
+
+# ---------------------------------------------------------------- the web view
+
+
+class Server:
+    """The web view of a scene, served by a thread of its own (``serve()`` returns it): ``url`` (the
+    address to open, with ``?token=`` when one is required), ``port``; ``stop()`` (or ``with``) stops
+    serving. While it serves, the server owns the scene: calls on the Scene raise RuntimeError."""
+
+    def __init__(self, scene, impl, owns_scene):
+        self.scene, self._c, self._owns = scene, impl, owns_scene
+        info = impl._info()
+        self.url, self.port = info["url"], info["port"]
+
+    @property
+    def running(self):
+        return self._c is not None and self._c._info()["running"]
+
+    def stop(self):
+        """Stops serving (waits for the server's thread); the scene is usable again (a scene the
+        server loaded from a path is closed). Raises the error that ended serving, if any."""
+        if self._c is None:
+            return
+        impl, self._c = self._c, None
+        try:
+            impl.stop()
+        finally:
+            if self._owns:
+                self.scene.close()
+
+    close = stop
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.stop()
+        return False
+
+    def __repr__(self):
+        return "<Server %s%s>" % (self.url, "" if self._c is not None else " (stopped)")
+
+
+def serve(scene, port=8080, host="127.0.0.1", backend=None, token=None, width=1920, height=1200, quality=80,
+          filter=None, threshold=0.0, budget_ms=0.0, **load_options):
+    """Serves the web view of a Scene or a file (loaded with load_options) as ``sy web`` does
+    (docs/WEB.md): an HTTP + WebSocket server whose page shows ``backend``'s view of the scene,
+    streamed as JPEG and steered by the page; stills at ``/api/frame.jpg?w=W&h=H``. Returns a
+    :class:`Server` at once (``url``, ``port``, ``stop()``, a context manager); it serves on a
+    thread of its own, without the GIL.
+
+    host: the address to listen on (default loopback, served to this machine only; any other needs
+    the access token, generated unless ``token`` is given, and is in ``url``); port: 0 takes a free
+    one; width / height: the largest frame (sy web's -w/-h); quality: JPEG quality; filter /
+    threshold: a display filter of a back-end with filters; budget_ms: the frame-time budget while
+    the view moves (0: 33 ms)."""
+    owns = not isinstance(scene, Scene)
+    if owns:
+        scene = load(scene, **load_options)
+    elif load_options:
+        raise TypeError("serve: load options given with a Scene: %s" % ", ".join(sorted(load_options)))
+    if not hasattr(_c, "_Web"):
+        if owns:
+            scene.close()
+        raise UnsupportedError("serve: this switchyard was built without the web view (SY_WITH_WEB: libwebsockets, "
+                               "libturbojpeg, libsodium, cJSON)", 6)
+    listen = "[%s]:%d" % (host, port) if ":" in host else "%s:%d" % (host, port)
+    try:
+        impl = _c._Web(scene._c, backend, listen, token, width, height, quality, filter, threshold, budget_ms)
+    except BaseException:
+        if owns:
+            scene.close()
+        raise
+    return Server(scene, impl, owns)
+
 
 # ---------------------------------------------------------------- windows and viewports
 
