@@ -220,6 +220,32 @@ def test_serve_the_web_view_over_http():
 
 
 @needs_whitted
+def test_load_world_and_time_options_equal_sy_render(tmp_path):
+    """load()'s world and time options are sy render's --background / --at: the same pixels."""
+    path = os.path.join(TESTDATA, "gltf/AnimatedCube/glTF/AnimatedCube.gltf")
+    need(path)
+    ref = sy_render(path, str(tmp_path / "ref.exr"), "-b", "whitted", "-w", "48", "-h", "40", "--at", "0.5",
+                    "--background", "0.2,0.3,0.4")
+    img = switchyard.render(path, backend="whitted", width=48, height=40, at=0.5, background=(0.2, 0.3, 0.4))
+    for i, c in enumerate("RGBA"):
+        assert numpy.array_equal(img[..., i], ref[c]), c
+    assert numpy.allclose(img[0, 0], (0.2, 0.3, 0.4, 1.0)), "the background where nothing is hit"
+    still = switchyard.render(path, backend="whitted", width=48, height=40)
+    assert not numpy.array_equal(img[..., :3] * (img[..., 3:] > 0.99), still[..., :3] * (img[..., 3:] > 0.99))
+    with switchyard.load(path) as s:
+        s.set_time(0.5, clip=0)
+        assert numpy.array_equal(s.render(backend="whitted", width=48, height=40),
+                                 switchyard.render(path, backend="whitted", width=48, height=40, at=0.5))
+    E = switchyard.InvalidArgumentError
+    for kw, err, msg in ((dict(env_color=(1, 2)), E, "env_color"), (dict(background=(1, 2, 3, 4, 5)), E, "background"),
+                         (dict(at=float("nan")), E, "finite"), (dict(env_intensity=-1), E, "env_intensity"),
+                         (dict(clip="nope"), switchyard.NotFoundError, "nope"),
+                         (dict(env=str(tmp_path / "missing.exr")), switchyard.NotFoundError, "missing.exr")):
+        with pytest.raises(err, match=msg):
+            switchyard.load(path, **kw)
+
+
+@needs_whitted
 def test_window_switches_backends_on_a_live_viewport():
     s = triangle_scene()
     with switchyard.Window(s, 32, 32) as w:

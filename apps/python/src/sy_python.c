@@ -26,6 +26,7 @@
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
+#include "sy_anim.h"
 #include "sy_exr.h"
 #include "sy_load.h"
 #include "sy_log.h"
@@ -262,6 +263,94 @@ static PyObject *scene_close(PyObject *self, PyObject *unused)
     Py_RETURN_NONE;
 }
 
+/* The world options of load() (sy's --env, --env-color, --env-intensity, --background; the flags
+ * are set by the caller) into *w; *env_bytes keeps the map's path alive. -1 with an exception. */
+static int float_seq(PyObject *o, const char *what, float *out, Py_ssize_t n);
+static int finite_floats(PyObject *o, const char *what, float *out, Py_ssize_t min_n, Py_ssize_t max_n, Py_ssize_t *n)
+{
+    PyObject *argerr = g_errors[SY_ERR_INVALID_ARGUMENT] ? g_errors[SY_ERR_INVALID_ARGUMENT] : PyExc_ValueError;
+    Py_ssize_t len = PySequence_Check(o) ? PySequence_Size(o) : -1;
+    if (len < 0) PyErr_Clear();
+    *n = len >= min_n && len <= max_n ? len : max_n;
+    if (float_seq(o, what, out, *n)) return -1;
+    for (Py_ssize_t i = 0; i < *n; ++i)
+        if (!isfinite(out[i])) {
+            PyErr_Format(argerr, "%s: value %zd is not finite", what, i);
+            return -1;
+        }
+    return 0;
+}
+
+static int world_from_python(PyObject *env, PyObject *env_color, PyObject *env_intensity, PyObject *background,
+                             sy_world_options *w, PyObject **env_bytes)
+{
+    PyObject *argerr = g_errors[SY_ERR_INVALID_ARGUMENT] ? g_errors[SY_ERR_INVALID_ARGUMENT] : PyExc_ValueError;
+    Py_ssize_t n = 0;
+    if (env != Py_None) {
+        if (!PyUnicode_FSConverter(env, env_bytes)) return -1;
+        w->env_path = PyBytes_AsString(*env_bytes);
+    }
+    if (env_color != Py_None) {
+        if (finite_floats(env_color, "env_color", w->env_color, 3, 3, &n)) return -1;
+        w->has_env_color = true;
+    }
+    if (env_intensity != Py_None) {
+        double v = PyFloat_AsDouble(env_intensity);
+        if (v == -1.0 && PyErr_Occurred()) return -1;
+        if (!isfinite(v) || v < 0) {
+            PyErr_Format(argerr, "env_intensity: %R is not a finite number >= 0", env_intensity);
+            return -1;
+        }
+        w->env_intensity = (float)v;
+        w->env_intensity_set = true;
+    }
+    if (background != Py_None) {
+        if (finite_floats(background, "background (R, G, B[, A])", w->background, 3, 4, &n)) return -1;
+        if (n == 3) w->background[3] = 1.0f;
+        w->has_background = true;
+    }
+    return 0;
+}
+
+static int time_from_python(PyObject *at, double *seconds)
+{
+    *seconds = PyFloat_AsDouble(at);
+    if (*seconds == -1.0 && PyErr_Occurred()) return -1;
+    if (!isfinite(*seconds)) {
+        PyErr_Format(g_errors[SY_ERR_INVALID_ARGUMENT] ? g_errors[SY_ERR_INVALID_ARGUMENT] : PyExc_ValueError,
+                     "at: %R is not a finite number of seconds", at);
+        return -1;
+    }
+    return 0;
+}
+
+/* The scene's time (sy render --at / --clip): every clip (clip NULL) or one, evaluated at seconds,
+ * committed. A scene without animations is left as it is (a note on the log) unless a clip is
+ * named (NotFoundError). 0, or -1 with an exception. */
+static int scene_time(sy_scene *sc, const char *clip, double seconds)
+{
+    sy_error err = {0};
+    sy_animation a = {0};
+    if (!sy_scene_count(sc, SY_TYPE_ANIMATION)) {
+        if (clip) {
+            sy_error_set(&err, SY_ERR_NOT_FOUND, "clip %s: the scene has no animations", clip);
+            raise_sy(err.code, &err);
+            return -1;
+        }
+        sy_log(SY_LOG_NOTE, "switchyard", NULL, "at=%g: the scene has no animations; it is shown as loaded", seconds);
+        return 0;
+    }
+    sy_result r = clip ? sy_animation_find(sc, clip, &a, &err) : SY_OK;
+    sy_anim_stats st;
+    if (r == SY_OK) r = sy_scene_set_time_ex(sc, a, seconds, &st, &err);
+    if (r == SY_OK) r = sy_scene_commit(sc, NULL, &err);
+    if (r != SY_OK) {
+        raise_sy(r, &err);
+        return -1;
+    }
+    return 0;
+}
+
 /* load(path, camera=None, strict=False, allow_paths=(), max_scene_mb=0, variant=None) -> _Scene.
  * sy_cli_load reads its options from one global (sy_cli_load_opts): loads take turns on g_load_lock
  * while the GIL is released. */
@@ -270,14 +359,25 @@ static pthread_mutex_t g_load_lock = PTHREAD_MUTEX_INITIALIZER;
 static PyObject *py_load(PyObject *self, PyObject *args, PyObject *kw)
 {
     (void)self;
-    static char *kwlist[] = {"path", "camera", "strict", "allow_paths", "max_scene_mb", "variant", NULL};
-    PyObject *path_obj = NULL, *roots = NULL;
-    const char *camera = NULL, *variant = NULL;
-    int strict = 0;
+    static char *kwlist[] = {"path", "camera", "strict", "allow_paths", "max_scene_mb", "variant", "env", "env_color",
+                             "env_intensity", "env_hidden", "background", "no_default_light", "at", "clip", NULL};
+    PyObject *path_obj = NULL, *roots = NULL, *env = Py_None, *env_color = Py_None, *env_intensity = Py_None,
+             *background = Py_None, *at = Py_None;
+    const char *camera = NULL, *variant = NULL, *clip = NULL;
+    int strict = 0, env_hidden = 0, no_default_light = 0;
     unsigned long long max_mb = 0;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|zpOKz", kwlist, PyUnicode_FSConverter, &path_obj, &camera, &strict,
-                                     &roots, &max_mb, &variant))
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|zpOKzOOOpOpOz", kwlist, PyUnicode_FSConverter, &path_obj, &camera,
+                                     &strict, &roots, &max_mb, &variant, &env, &env_color, &env_intensity, &env_hidden,
+                                     &background, &no_default_light, &at, &clip))
         return NULL;
+    PyObject *env_bytes = NULL;
+    sy_world_options world = {.env_hidden = env_hidden != 0, .no_default_light = no_default_light != 0};
+    double seconds = 0.0;
+    if (world_from_python(env, env_color, env_intensity, background, &world, &env_bytes) ||
+        (at != Py_None && time_from_python(at, &seconds))) {
+        Py_XDECREF(path_obj);
+        return NULL;
+    }
     PyObject *root_bytes[SY_MAX_ALLOW_PATHS] = {0};
     Py_ssize_t nroots = 0;
     PyObject *result = NULL;
@@ -315,6 +415,8 @@ static PyObject *py_load(PyObject *self, PyObject *args, PyObject *kw)
     sy_cli_load_opts.strict = strict != 0;
     sy_cli_load_opts.max_scene_bytes = (uint64_t)max_mb * 1024 * 1024;
     sy_cli_load_opts.variant = variant;
+    sy_cli_load_opts.world = world;
+    sy_cli_load_opts.world.max_scene_bytes = sy_cli_load_opts.max_scene_bytes;
     r = sy_cli_load(path, camera, true, &s->ld, &err);
     memset(&sy_cli_load_opts, 0, sizeof sy_cli_load_opts);
     pthread_mutex_unlock(&g_load_lock);
@@ -324,10 +426,15 @@ static PyObject *py_load(PyObject *self, PyObject *args, PyObject *kw)
         raise_sy(r, &err);
         goto done;
     }
+    if ((at != Py_None || clip) && scene_time(s->ld.scene, clip, seconds)) {
+        Py_DECREF(s);
+        goto done;
+    }
     result = (PyObject *)s;
 done:
     for (Py_ssize_t i = 0; i < SY_MAX_ALLOW_PATHS; ++i) Py_XDECREF(root_bytes[i]);
     Py_XDECREF(path_obj);
+    Py_XDECREF(env_bytes);
     return result;
 }
 
@@ -1227,7 +1334,20 @@ static PyObject *scene_render(PyObject *self, PyObject *args, PyObject *kw)
     return result;
 }
 
+/* _set_time(seconds, clip=None): the scene's animation clock (load's at= / clip=) */
+static PyObject *scene_set_time(PyObject *self, PyObject *args)
+{
+    PyObject *at;
+    const char *clip = NULL;
+    double seconds;
+    if (!PyArg_ParseTuple(args, "O|z", &at, &clip) || time_from_python(at, &seconds)) return NULL;
+    sy_scene *sc = scene_use((SceneObject *)self);
+    if (!sc || scene_time(sc, clip, seconds)) return NULL;
+    Py_RETURN_NONE;
+}
+
 static PyMethodDef scene_methods[] = {
+    {"_set_time", scene_set_time, METH_VARARGS, NULL},
     {"close", scene_close, METH_NOARGS, "Frees the scene now (objects of it become stale)."},
     {"_add_mesh", (PyCFunction)(void (*)(void))scene_add_mesh, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_create", scene_create, METH_VARARGS, NULL},

@@ -366,6 +366,11 @@ class Scene(_Closing):
     def camera(self, node):
         self._c._set_camera(node.id if node is not None else 0)
 
+    def set_time(self, seconds, clip=None):
+        """Sets the animation clock (every clip, or the one named or numbered by clip) and commits, as
+        ``load(at=, clip=)`` and ``sy render --at/--clip`` do."""
+        self._c._set_time(seconds, None if clip is None else str(clip))
+
     def info(self):
         """Counts of the objects and the root / camera / background ids."""
         return self._c._info()
@@ -476,16 +481,25 @@ def _png(rgba):
             chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
 
 
-def load(path, camera=None, strict=False, allow_paths=(), max_scene_mb=0, variant=None):
+def load(path, camera=None, strict=False, allow_paths=(), max_scene_mb=0, variant=None, env=None, env_color=None,
+         env_intensity=None, env_hidden=False, background=None, no_default_light=False, at=None, clip=None):
     """Reads a scene file into a new Scene: glTF 2.0 (.gltf, .glb), X3D, and what Assimp reads (OBJ,
     FBX, COLLADA, PLY, STL, ...), recognised by content, exactly as ``sy render`` loads it (a file
     without a camera gets one framing it). camera: a camera's name or number; strict: whatever the
     loader would skip or repair is an error; allow_paths: more folders external files may lie in;
     max_scene_mb: the file's memory budget (0: the default); variant: a glTF material variant.
+
+    The world, as sy's flags: env: a lat-long environment map (EXR or .hdr; --env); env_color: a
+    uniform environment (R, G, B) (--env-color); env_intensity (--env-intensity); env_hidden: camera
+    rays see the background, not the environment (--env-hidden); background: (R, G, B[, A]) linear,
+    what camera rays see where nothing is hit (--background); no_default_light (--no-default-light).
+    The time, as sy render's --at / --clip: at: seconds on the animation clock (every clip, or the
+    one named or numbered by clip); a scene without animations is left as loaded (a note on the log).
     The GIL is released while the file loads."""
     import os
     return Scene(_c.load(os.fspath(path), camera, strict, tuple(os.fspath(p) for p in allow_paths), max_scene_mb,
-                         variant))
+                         variant, None if env is None else os.fspath(env), env_color, env_intensity, env_hidden,
+                         background, no_default_light, at, None if clip is None else str(clip)))
 
 
 def render(scene, backend=None, width=0, height=0, spp=0, seed=0, params=None, aovs=False, progress=None,
