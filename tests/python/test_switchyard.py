@@ -461,6 +461,14 @@ def test_render_on_a_cluster_equals_the_local_render(tmp_path):
         assert numpy.array_equal(local, remote)
         with pytest.raises(switchyard.Error):
             s.render(backend="whitted", width=8, height=8, servers="tcp://127.0.0.1:1", secret_file=secret)
+        with switchyard.Window(s, 120, 80) as win:  # a Window viewport on the same servers
+            vp = win.add_viewport("whitted", servers=urls, secret_file=secret)
+            assert vp.backend.startswith("cluster-python-")
+            assert numpy.array_equal(win.render(), local)
+            vp.backend = "whitted"  # back to local on the live viewport
+            assert numpy.array_equal(win.render(), local)
+            vp.set_backend("whitted", servers=urls, secret_file=secret)
+            assert numpy.array_equal(win.render(), local)
     finally:
         for p in procs:
             p.terminate()

@@ -1210,6 +1210,7 @@ static int check_backend(const char *backend, const char *params, sy_params *pp,
  * the registry holds classes for the process's lifetime and refuses a name twice. Fills
  * cluster_name and cluster_params; 0, or -1 with an exception. */
 #define SY_PY_MAX_CLUSTERS 16
+#define SY_PY_PARAMS_MAX 1400 /* a back-end's parameter text (a cluster class's names every server) */
 static int cluster_setup(const char *servers, const char *mode, const char *secret_file, const char *backend,
                          const char *params, char *cluster_name, size_t name_len, char *cluster_params,
                          size_t params_len, uint64_t *spp_per_request)
@@ -1281,7 +1282,7 @@ static PyObject *scene_render(PyObject *self, PyObject *args, PyObject *kw)
     uint32_t caps;
     if (check_backend(backend, params, &pp, &cls, &caps)) return NULL; /* the back-end the servers run */
     /* servers=: the main viewport's back-end becomes a cluster class over `backend`, as sy render --cluster */
-    char cluster_name[32], cluster_params[1400];
+    char cluster_name[32], cluster_params[SY_PY_PARAMS_MAX];
     uint64_t spp_per_request = 0;
     const char *shown = backend;
     if (servers) {
@@ -1516,7 +1517,7 @@ typedef struct {
     SceneObject *scene; /* strong reference */
     sy_viewport *vps[SY_PY_MAX_VIEWPORTS];
     char backends[SY_PY_MAX_VIEWPORTS][64];
-    char params[SY_PY_MAX_VIEWPORTS][256];
+    char params[SY_PY_MAX_VIEWPORTS][SY_PY_PARAMS_MAX];
     uint32_t roots[SY_PY_MAX_VIEWPORTS];
     uint32_t count;
     int busy;
@@ -1588,22 +1589,46 @@ static PyObject *window_close(PyObject *self, PyObject *unused)
 /* _add_viewport(backend=None, params=None, x=0, y=0, width=0, height=0, root=-1, camera=-1,
  * background=-1, eye=0, eye_separation=0, zero_parallax=0, composite=0, active=True) -> index.
  * root / camera / background -1: the scene's own (as loaded). */
+/* servers= of a viewport: backend / params become a cluster class over them (cluster_setup, as
+ * Scene.render's servers=); the buffers hold the result. 0, or -1 with an exception. */
+static int viewport_cluster(const char *servers, const char *mode, const char *secret_file, const char **backend,
+                            const char **params, char *name, size_t name_len, char *cparams, size_t cparams_len)
+{
+    if (!servers) return 0;
+    uint64_t unused = 0;
+    const sy_mediator_class *cls;
+    sy_params pp;
+    uint32_t caps;
+    if (check_backend(*backend, *params, &pp, &cls, &caps) || /* the back-end the servers run */
+        cluster_setup(servers, mode, secret_file, *backend, *params, name, name_len, cparams, cparams_len, &unused))
+        return -1;
+    *backend = name;
+    *params = cparams;
+    return 0;
+}
+
 static PyObject *window_add_viewport(PyObject *self, PyObject *args, PyObject *kw)
 {
     static char *kwlist[] = {"backend", "params", "x", "y", "width", "height", "root", "camera", "background",
-                             "eye", "eye_separation", "zero_parallax", "composite", "active", NULL};
+                             "eye", "eye_separation", "zero_parallax", "composite", "active", "servers",
+                             "cluster_mode", "secret_file", NULL};
     WindowObject *w = (WindowObject *)self;
-    const char *backend = NULL, *params = NULL;
+    const char *backend = NULL, *params = NULL, *servers = NULL, *cluster_mode = NULL, *secret_file = NULL;
     unsigned int x = 0, y = 0, vw = 0, vh = 0, eye = 0, composite = 0;
     long long root = -1, camera = -1, background = -1;
     float sep = 0, zp = 0;
     int active = 1;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "|zzIIIILLLIffIp", kwlist, &backend, &params, &x, &y, &vw, &vh, &root,
-                                     &camera, &background, &eye, &sep, &zp, &composite, &active))
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|zzIIIILLLIffIpzzz", kwlist, &backend, &params, &x, &y, &vw, &vh, &root,
+                                     &camera, &background, &eye, &sep, &zp, &composite, &active, &servers,
+                                     &cluster_mode, &secret_file))
         return NULL;
     if (window_use(w)) return NULL;
     if (w->count >= SY_PY_MAX_VIEWPORTS) return PyErr_Format(PyExc_ValueError, "at most %d viewports", SY_PY_MAX_VIEWPORTS);
     if (!backend) backend = sy_mediator_default_name();
+    char cname[32], cparams[SY_PY_PARAMS_MAX];
+    if (viewport_cluster(servers, cluster_mode, secret_file, &backend, &params, cname, sizeof cname, cparams,
+                         sizeof cparams))
+        return NULL;
     if (strlen(backend) >= sizeof w->backends[0] || (params && strlen(params) >= sizeof w->params[0]))
         return PyErr_Format(PyExc_ValueError, "backend or params too long");
     loaded *ld = &w->scene->ld;
@@ -1636,10 +1661,14 @@ static PyObject *window_set_backend(PyObject *self, PyObject *args)
 {
     WindowObject *w = (WindowObject *)self;
     unsigned int i;
-    const char *backend, *params = NULL;
-    if (!PyArg_ParseTuple(args, "Is|z", &i, &backend, &params)) return NULL;
+    const char *backend, *params = NULL, *servers = NULL, *cluster_mode = NULL, *secret_file = NULL;
+    if (!PyArg_ParseTuple(args, "Is|zzzz", &i, &backend, &params, &servers, &cluster_mode, &secret_file)) return NULL;
     sy_viewport *vp = window_vp(w, i);
     if (!vp) return NULL;
+    char cname[32], cparams[SY_PY_PARAMS_MAX];
+    if (viewport_cluster(servers, cluster_mode, secret_file, &backend, &params, cname, sizeof cname, cparams,
+                         sizeof cparams))
+        return NULL;
     if (strlen(backend) >= sizeof w->backends[0] || (params && strlen(params) >= sizeof w->params[0]))
         return PyErr_Format(PyExc_ValueError, "backend or params too long");
     sy_error err = {0};

@@ -439,14 +439,23 @@ class Scene(_Closing):
         --cluster`` does: "tcp://host:port,..." or a cluster configuration file; cluster_mode:
         "sort-first" (default), "balanced", "cooperative", ...; secret_file: the shared secret (else
         $SY_CLUSTER_SECRET). backend is what the servers run."""
-        if servers is not None and not isinstance(servers, str):
-            servers = ",".join(servers)
+        servers = _servers(servers)
         rgba, planes, _ = self._c._render(backend, width, height, spp, seed, params, aovs, progress, servers,
                                           cluster_mode, None if secret_file is None else str(secret_file))
         img = Image._of(rgba)
         if not aovs:
             return img
         return img, {k: _array(v) for k, v in planes.items()}
+
+
+def _servers(servers):
+    """servers= as the C half takes it: "url,url,..." or a configuration file's path (or None)."""
+    import os
+    if servers is None or isinstance(servers, str):
+        return servers
+    if isinstance(servers, os.PathLike):
+        return os.fspath(servers)
+    return ",".join(servers)
 
 
 class Image(numpy.ndarray):
@@ -606,9 +615,11 @@ class Viewport:
     def backend(self, name):
         self.set_backend(name)
 
-    def set_backend(self, name, params=None):
-        """Switches the back-end (the previous one's context stays cached in the window's pool)."""
-        self.window._c._set_backend(self.index, name, params)
+    def set_backend(self, name, params=None, servers=None, cluster_mode=None, secret_file=None):
+        """Switches the back-end (the previous one's context stays cached in the window's pool);
+        servers= etc.: ``name`` rendered on a cluster, as ``Window.add_viewport``."""
+        self.window._c._set_backend(self.index, name, params, _servers(servers), cluster_mode,
+                                    None if secret_file is None else str(secret_file))
 
     @property
     def active(self):
@@ -637,11 +648,17 @@ class Window(_Closing):
         self.viewports = []
 
     def add_viewport(self, backend=None, params=None, x=0, y=0, width=0, height=0, root=None, camera=None,
-                     eye=0, eye_separation=0.0, zero_parallax=0.0, composite=0, active=True):
-        """Adds a viewport (0 size: the whole window; root / camera None: the scene's own)."""
+                     eye=0, eye_separation=0.0, zero_parallax=0.0, composite=0, active=True, servers=None,
+                     cluster_mode=None, secret_file=None):
+        """Adds a viewport (0 size: the whole window; root / camera None: the scene's own).
+
+        servers / cluster_mode / secret_file: the viewport renders ``backend`` on a cluster of ``sy
+        serve`` servers, set up as ``Scene.render(servers=)`` (the viewport's back-end is then the
+        cluster class, named cluster-python-N)."""
         i = self._c._add_viewport(backend, params, x, y, width, height, -1 if root is None else root.id,
                                   -1 if camera is None else camera.id, -1, eye, eye_separation, zero_parallax,
-                                  composite, active)
+                                  composite, active, _servers(servers), cluster_mode,
+                                  None if secret_file is None else str(secret_file))
         v = Viewport(self, i)
         self.viewports.append(v)
         return v
