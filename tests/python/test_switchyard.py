@@ -245,6 +245,38 @@ def test_load_world_and_time_options_equal_sy_render(tmp_path):
             switchyard.load(path, **kw)
 
 
+def test_mesh_data_as_read_only_views():
+    """Mesh.positions / indices / normals / primitives: read-only NumPy views of the library's blobs
+    (no copy) that keep their data alive after the scene is closed."""
+    s = switchyard.Scene()
+    pos = numpy.random.default_rng(1).random((6, 3), dtype=numpy.float32)
+    nrm = numpy.tile(numpy.array([0, 0, 1], numpy.float32), (6, 1))
+    mesh = s.add_mesh(pos, numpy.arange(6, dtype=numpy.uint32), normals=nrm, name="m").mesh
+    p, idx = mesh.positions, mesh.indices
+    assert p.dtype == numpy.float32 and p.shape == (6, 3) and numpy.array_equal(p, pos)
+    assert idx.dtype == numpy.uint32 and idx.shape == (2, 3) and numpy.array_equal(idx.ravel(), numpy.arange(6))
+    assert numpy.array_equal(mesh.normals, nrm) and mesh.name == "m"
+    assert not p.flags.writeable
+    with pytest.raises(ValueError, match="read-only"):
+        p[0, 0] = 1.0
+    base = p.base
+    while isinstance(base, (numpy.ndarray, memoryview)):
+        base = base.obj if isinstance(base, memoryview) else base.base
+    assert isinstance(base, switchyard._c._BlobView), "a view of the blob, not a copy"
+    prim, = mesh.primitives
+    assert prim.topology == switchyard.Primitive.TRIANGLES and prim.material is None and prim.colors is None
+    assert numpy.array_equal(prim["positions"], pos)
+    live = switchyard._c.blob_live_count()
+    s.close()
+    assert numpy.array_equal(p, pos), "the view keeps its blob after the scene is closed"
+    assert switchyard._c.blob_live_count() > 0
+    del p, idx, prim, base
+    gc.collect()
+    assert switchyard._c.blob_live_count() < live
+    with pytest.raises(switchyard.InvalidOperationError):
+        mesh.positions
+
+
 @needs_whitted
 def test_window_switches_backends_on_a_live_viewport():
     s = triangle_scene()

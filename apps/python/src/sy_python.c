@@ -13,6 +13,8 @@
  *   - _Node: the C base of switchyard.Node (its TRS fields are getset descriptors: one C call
  *     per `node.translation = v`, the call-overhead target).
  *   - _Web: the web view (apps/web/sy_web.h, as `sy web`) served by a thread of its own.
+ *   - _BlobView: a read-only view of a mesh's blob (immutable, reference-counted), so Mesh data
+ *     reaches NumPy without a copy.
  *   - _Buffer: a float32 array that owns library memory (a rendered layer's planes) and exports
  *     it through the buffer protocol, so numpy.asarray takes it without a copy.
  *   - the registry (backends), EXR reading and writing, the log callback, sy_result -> exception.
@@ -754,6 +756,100 @@ static PyObject *scene_node_set(PyObject *self, PyObject *args, PyObject *kw)
     Py_RETURN_NONE;
 }
 
+/* ------------------------------------------------------------------ _BlobView */
+/* A read-only view of a mesh blob (sy_blob.h: immutable, reference-counted), exported through the
+ * buffer protocol as float32 or uint32 rows x cols: numpy.asarray views it without a copy. It holds
+ * its own reference to the blob, so the array stays valid after the mesh changes, is destroyed or
+ * its scene is closed (it keeps the data it was made from). */
+typedef struct {
+    PyObject_HEAD
+    sy_blob *blob;
+    char format[2];
+    int ndim;
+    Py_ssize_t shape[2], strides[2];
+} BlobViewObject;
+
+static PyTypeObject *g_blobview_type;
+
+static void blobview_dealloc(PyObject *self)
+{
+    sy_blob_release(((BlobViewObject *)self)->blob);
+    object_free(self);
+}
+
+static int blobview_get(PyObject *self, Py_buffer *view, int flags)
+{
+    BlobViewObject *b = (BlobViewObject *)self;
+    if (flags & PyBUF_WRITABLE) {
+        PyErr_SetString(PyExc_BufferError, "switchyard: mesh data is read-only (the library's immutable blob); copy it "
+                                           "to change it and set it with add_mesh");
+        view->obj = NULL;
+        return -1;
+    }
+    view->buf = (void *)sy_blob_data(b->blob);
+    view->obj = Py_NewRef(self);
+    view->len = b->shape[0] * (b->ndim == 2 ? b->shape[1] : 1) * 4;
+    view->readonly = 1;
+    view->itemsize = 4;
+    view->format = b->format;
+    view->ndim = b->ndim;
+    view->shape = b->shape;
+    view->strides = b->strides;
+    view->suboffsets = NULL;
+    view->internal = NULL;
+    return 0;
+}
+
+static PyType_Slot blobview_slots[] = {
+    {Py_tp_dealloc, blobview_dealloc},
+    {Py_bf_getbuffer, blobview_get},
+    {Py_tp_doc, "a read-only view of a mesh's blob (numpy.asarray views it without a copy)"},
+    {0, NULL}};
+static PyType_Spec blobview_spec = {"switchyard._switchyard._BlobView", sizeof(BlobViewObject), 0, Py_TPFLAGS_DEFAULT,
+                                    blobview_slots};
+
+/* A view of blob as rows of cols 4-byte values (code 'f' or 'I'; cols 1: flat); None for NULL. */
+static PyObject *blobview_of(sy_blob *blob, char code, Py_ssize_t cols)
+{
+    if (!blob) Py_RETURN_NONE;
+    BlobViewObject *b = (BlobViewObject *)PyType_GenericNew(g_blobview_type, NULL, NULL);
+    if (!b) return NULL;
+    b->blob = sy_blob_retain(blob);
+    b->format[0] = code;
+    b->ndim = cols > 1 ? 2 : 1;
+    b->shape[0] = (Py_ssize_t)(sy_blob_size(blob) / 4 / (size_t)cols);
+    b->shape[1] = cols;
+    b->strides[0] = 4 * cols;
+    b->strides[1] = 4;
+    return (PyObject *)b;
+}
+
+/* _mesh(id) -> {"name": str or None, "primitives": [dict of views, material id, topology]} */
+static PyObject *scene_mesh(PyObject *self, PyObject *args)
+{
+    unsigned int id;
+    if (!PyArg_ParseTuple(args, "I", &id)) return NULL;
+    sy_scene *sc = scene_use((SceneObject *)self);
+    if (!sc) return NULL;
+    const sy_mesh_data *d = sy_mesh_get(sc, (sy_mesh){id});
+    if (!d) return stale("mesh", id);
+    PyObject *prims = PyList_New(d->primitives.count);
+    for (uint32_t i = 0; prims && i < d->primitives.count; ++i) {
+        const sy_primitive *p = &d->primitives.items[i];
+        Py_ssize_t per = p->topology == SY_TOPOLOGY_TRIANGLES ? 3 : p->topology == SY_TOPOLOGY_LINES ? 2 : 1;
+        PyObject *e = Py_BuildValue("{s:N,s:N,s:N,s:N,s:N,s:N,s:N,s:I,s:I}", "positions", blobview_of(p->positions, 'f', 3),
+                                    "normals", blobview_of(p->normals, 'f', 3), "tangents", blobview_of(p->tangents, 'f', 4),
+                                    "texcoords0", blobview_of(p->texcoords0, 'f', 2), "texcoords1",
+                                    blobview_of(p->texcoords1, 'f', 2), "colors", blobview_of(p->colors, 'f', 4),
+                                    "indices", blobview_of(p->indices, 'I', per), "material", p->material.id,
+                                    "topology", p->topology);
+        if (!e) Py_CLEAR(prims);
+        else PyList_SetItem(prims, i, e);
+    }
+    if (!prims) return NULL;
+    return Py_BuildValue("{s:z,s:N}", "name", d->name, "primitives", prims);
+}
+
 /* ------------------------------------------------------------------ _Node */
 /* The base of switchyard.Node: the Python Scene (strong), its _Scene (strong, cached so the hot
  * path needs no attribute lookup) and the node's handle id. translation / rotation / scale are
@@ -1356,6 +1452,7 @@ static PyMethodDef scene_methods[] = {
     {"_ids", scene_ids, METH_VARARGS, NULL},
     {"_valid", scene_valid, METH_VARARGS, NULL},
     {"_node", scene_node, METH_VARARGS, NULL},
+    {"_mesh", scene_mesh, METH_VARARGS, NULL},
     {"_node_set", (PyCFunction)(void (*)(void))scene_node_set, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_get", scene_get_fields, METH_VARARGS, NULL},
     {"_set", (PyCFunction)(void (*)(void))scene_set_fields, METH_VARARGS | METH_KEYWORDS, NULL},
@@ -1881,10 +1978,12 @@ PyMODINIT_FUNC PyInit__switchyard(void)
     PyObject *m = PyModule_Create(&module_def);
     if (!m) return NULL;
     g_buffer_type = (PyTypeObject *)PyType_FromSpec(&buffer_spec);
+    g_blobview_type = (PyTypeObject *)PyType_FromSpec(&blobview_spec);
     g_scene_type = (PyTypeObject *)PyType_FromSpec(&scene_spec);
     PyObject *window_type = PyType_FromSpec(&window_spec);
     PyObject *node_type = PyType_FromSpec(&node_spec);
-    if (!g_buffer_type || !g_scene_type || !window_type || !node_type || PyModule_AddObjectRef(m, "_Node", node_type) ||
+    if (!g_buffer_type || !g_scene_type || !window_type || !node_type || !g_blobview_type ||
+        PyModule_AddObjectRef(m, "_BlobView", (PyObject *)g_blobview_type) || PyModule_AddObjectRef(m, "_Node", node_type) ||
         PyModule_AddObjectRef(m, "_Buffer", (PyObject *)g_buffer_type) ||
         PyModule_AddObjectRef(m, "_Scene", (PyObject *)g_scene_type) || PyModule_AddObjectRef(m, "_Window", window_type) ||
         PyModule_AddIntConstant(m, "CAP_DEPTH", SY_CAP_DEPTH) ||

@@ -27,7 +27,7 @@ __all__ = [
     "Error", "InvalidArgumentError", "InvalidHandleError", "OutOfMemoryError", "FileError", "ParseError",
     "UnsupportedError", "LimitError", "NotFoundError", "BackendError", "ProtocolError",
     "InvalidOperationError", "CancelledError", "SystemError_",
-    "Scene", "Node", "Mesh", "Material", "Light", "Camera", "Window", "Viewport", "Backend",
+    "Scene", "Node", "Mesh", "Primitive", "Material", "Light", "Camera", "Window", "Viewport", "Backend",
     "Server", "load", "render", "serve", "backends", "read_exr", "write_exr", "version",
 ]
 
@@ -247,15 +247,54 @@ class Node(_c._Node, _Methods):
                       lambda self, v: self.scene._c._node_set(self.id, camera=v.id if v else 0))
 
 
+class Primitive(dict):
+    """One primitive of a Mesh: ``positions`` (N, 3) float32, ``normals`` (N, 3) / ``tangents``
+    (N, 4) / ``texcoords0``, ``texcoords1`` (N, 2) / ``colors`` (N, 4) float32 or None, ``indices``
+    uint32 ((M, 3) triangles, (M, 2) lines, flat points; None: non-indexed), ``material`` (a
+    Material or None), ``topology`` (TRIANGLES, LINES, POINTS). The arrays are read-only views of
+    the library's immutable blobs (no copy); each keeps its data alive on its own, so it stays valid
+    after the mesh changes or its scene is closed (it shows the data it was read from)."""
+    TRIANGLES, LINES, POINTS = 0, 1, 2
+    __slots__ = ()
+
+    def __getattr__(self, key):
+        try:
+            return self[key]
+        except KeyError:
+            raise AttributeError(key) from None
+
+
 class Mesh(_Object):
-    """A mesh: primitives whose vertex data lives in the library's blobs."""
+    """A mesh: primitives whose vertex data lives in the library's blobs. ``primitives`` lists them
+    (:class:`Primitive`); ``positions``, ``normals`` and ``indices`` are those of a mesh with one
+    primitive (read-only NumPy views, no copy)."""
     __slots__ = ()
     _type = _c.TYPE_MESH
 
     def _fields(self):
-        if not self.valid:
-            raise InvalidHandleError("mesh %d: stale or foreign handle" % self.id, 2)
-        return {"name": None}
+        return self.scene._c._mesh(self.id)
+
+    @property
+    def primitives(self):
+        out = []
+        for p in self._fields()["primitives"]:
+            q = Primitive((k, None if v is None else _array(v)) for k, v in p.items() if k not in ("material", "topology"))
+            q["material"] = Material(self.scene, p["material"]) if p["material"] else None
+            q["topology"] = p["topology"]
+            out.append(q)
+        return out
+
+    def _one(self, key):
+        prims = self._fields()["primitives"]
+        if len(prims) != 1:
+            raise InvalidOperationError("mesh %d has %d primitives: read them with Mesh.primitives" %
+                                        (self.id, len(prims)), 11)
+        v = prims[0][key]
+        return None if v is None else _array(v)
+
+    positions = property(lambda self: self._one("positions"), doc="(N, 3) float32, read-only (one primitive)")
+    normals = property(lambda self: self._one("normals"), doc="(N, 3) float32 or None, read-only (one primitive)")
+    indices = property(lambda self: self._one("indices"), doc="uint32 (M, 3) for triangles, or None (one primitive)")
 
 
 class _Fielded(_Object):

@@ -18,6 +18,9 @@ TYPE_CAMERA: int
 class _Buffer:
     """float32 pixels owned by the library's allocation (buffer protocol, no copy)."""
 
+class _BlobView:
+    """A read-only view of a mesh's blob (buffer protocol, no copy)."""
+
 _RenderResult = tuple[_Buffer, Optional[dict[str, _Buffer]], int]
 _Progress = Optional[Callable[[int, int], Any]]
 
@@ -32,6 +35,7 @@ class _Scene:
     def _ids(self, type: int) -> list[int]: ...
     def _valid(self, type: int, id: int) -> bool: ...
     def _node(self, id: int) -> dict[str, Any]: ...
+    def _mesh(self, id: int) -> dict[str, Any]: ...
     def _node_set(self, id: int, matrix: Optional[Sequence[float]] = ..., translation: Optional[Sequence[float]] = ...,
                   rotation: Optional[Sequence[float]] = ..., scale: Optional[Sequence[float]] = ...,
                   mesh: Optional[int] = ..., light: Optional[int] = ..., camera: Optional[int] = ...,
