@@ -569,10 +569,17 @@ class Server:
     address to open, with ``?token=`` when one is required), ``port``; ``stop()`` (or ``with``) stops
     serving. While it serves, the server owns the scene: calls on the Scene raise RuntimeError."""
 
+    _live = None  # the servers not stopped yet (a WeakSet): stopped at interpreter exit
+
     def __init__(self, scene, impl, owns_scene):
+        import weakref
         self.scene, self._c, self._owns = scene, impl, owns_scene
         info = impl._info()
         self.url, self.port = info["url"], info["port"]
+        if Server._live is None:
+            Server._live = weakref.WeakSet()
+            atexit.register(lambda: [srv.stop() for srv in list(Server._live)])
+        Server._live.add(self)
 
     @property
     def running(self):
