@@ -378,6 +378,7 @@ static PyObject *py_load(PyObject *self, PyObject *args, PyObject *kw)
     if (world_from_python(env, env_color, env_intensity, background, &world, &env_bytes) ||
         (at != Py_None && time_from_python(at, &seconds))) {
         Py_XDECREF(path_obj);
+        Py_XDECREF(env_bytes);
         return NULL;
     }
     PyObject *root_bytes[SY_MAX_ALLOW_PATHS] = {0};
@@ -921,7 +922,11 @@ static int node_values(PyObject *v, const char *what, float *out, Py_ssize_t n)
     else if (PyList_Check(v)) item = PyList_GetItem, size = PyList_Size(v);
     if (!item || size != n) return float_seq(v, what, out, n);
     for (Py_ssize_t i = 0; i < n; ++i) {
-        double d = PyFloat_AsDouble(item(v, i));
+        PyObject *it = item(v, i); /* borrowed: held while a __float__ might change the list */
+        if (!it) return -1;
+        Py_INCREF(it);
+        double d = PyFloat_AsDouble(it);
+        Py_DECREF(it);
         if (d == -1.0 && PyErr_Occurred()) return -1;
         out[i] = (float)d;
     }
