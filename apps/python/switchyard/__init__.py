@@ -12,7 +12,8 @@ row 0 at the top: the same pixels ``sy render`` writes for the same file, back-e
 Objects, not handles: ``load()`` returns a :class:`Scene`; its :class:`Node`, :class:`Mesh`,
 :class:`Material`, :class:`Light` and :class:`Camera` objects read and write the library's fields
 as attributes. A :class:`Window` with :class:`Viewport` objects layers back-ends, renders stereo
-and switches a live viewport's back-end. Errors raise :class:`Error` subclasses carrying the
+and switches a live viewport's back-end; ``serve()`` shows a scene in a web browser as ``sy web``
+does. Errors raise :class:`Error` subclasses carrying the
 library's message; the library's log goes to the ``logging`` logger ``"switchyard"``. Loads and
 renders release the GIL.
 """
