@@ -65,6 +65,17 @@ def test_three_line_render_equals_sy_render(tmp_path):
         assert numpy.array_equal(img[..., i], ref[c]), "channel %s differs from sy render" % c
 
 
+@needs_whitted
+def test_cornell_whitted_equals_sy_render(tmp_path):
+    """Issue 38's target: the Cornell box rendered from Python equals sy render's EXR (Whitted), bit for bit."""
+    need(CORNELL)
+    img = switchyard.render(CORNELL, backend="whitted", width=64, height=48)
+    assert (img[..., 3] > 0.5).mean() > 0.5 and img[..., :3].mean() > 0.01, "the box covers most of the view, lit"
+    ref = sy_render(CORNELL, str(tmp_path / "cbw.exr"), "-b", "whitted", "-w", "64", "-h", "48")
+    for i, c in enumerate("RGBA"):
+        assert numpy.array_equal(img[..., i], ref[c]), "channel %s differs from sy render" % c
+
+
 @needs_pt
 def test_pathtracer_same_seed_and_spp_equals_sy_render(tmp_path):
     """The Cornell box through the path tracer: same spp and seed as sy render, bit for bit."""
@@ -429,7 +440,7 @@ def test_sigint_during_a_render_without_the_gil():
 
 @needs_whitted
 def test_examples_run_as_written(tmp_path):
-    """apps/examples/python: both programs run and write their images."""
+    """apps/examples/python: the programs run and write their images (animate.py: what its frames cost)."""
     import sys
     ex = os.path.join(os.path.dirname(__file__), "../../apps/examples/python")
     out = str(tmp_path / "arrays.exr")
@@ -440,6 +451,9 @@ def test_examples_run_as_written(tmp_path):
         out = str(tmp_path / "box.exr")
         subprocess.run([sys.executable, os.path.join(ex, "render_file.py"), BOX, out], check=True, capture_output=True)
         assert switchyard.read_exr(out)["A"].shape == (480, 640)
+    r = subprocess.run([sys.executable, os.path.join(ex, "animate.py"), "demo", "3"], check=True, capture_output=True,
+                       text=True)
+    assert "first frame" in r.stdout and "moving frames: median" in r.stdout, r.stdout
 
 
 @needs_whitted
