@@ -117,6 +117,28 @@ bool sy_coords_in_range(const float *v, size_t n)
     return true;
 }
 
+bool sy_mat4_look_at(const float eye[3], const float target[3], const float up[3], sy_mat4 *out)
+{
+    for (int i = 0; i < 3; ++i)
+        if (!isfinite(eye[i]) || !isfinite(target[i]) || !isfinite(up[i])) return false;
+    float z[3], x[3], y[3];
+    sy_vec3_sub(eye, target, z); /* the camera looks down -z: z points back from target to eye */
+    float zl = sqrtf(sy_vec3_dot(z, z));
+    if (!(zl > 0.0f) || !isfinite(zl)) return false;
+    for (int i = 0; i < 3; ++i) z[i] /= zl;
+    float ul = sqrtf(sy_vec3_dot(up, up));
+    if (!(ul > 0.0f) || !isfinite(ul)) return false;
+    float u[3] = {up[0] / ul, up[1] / ul, up[2] / ul};
+    sy_vec3_cross(u, z, x);
+    float xl = sqrtf(sy_vec3_dot(x, x));
+    if (!(xl > 1e-6f)) return false; /* up parallel to the viewing direction */
+    for (int i = 0; i < 3; ++i) x[i] /= xl;
+    sy_vec3_cross(z, x, y);
+    sy_mat4 m = {{x[0], x[1], x[2], 0, y[0], y[1], y[2], 0, z[0], z[1], z[2], 0, eye[0], eye[1], eye[2], 1}};
+    *out = m;
+    return true;
+}
+
 bool sy_mat4_is_degenerate(const sy_mat4 *a)
 {
     const float *m = a->m; /* column-major: m[c * 4 + r] */

@@ -62,6 +62,11 @@ bool sy_mat4_invert(const sy_mat4 *a, sy_mat4 *out);
 void sy_mat4_transform_point(const sy_mat4 *a, const float p[3], float out[3]);
 /** a applied to a direction (w = 0). */
 void sy_mat4_transform_dir(const sy_mat4 *a, const float d[3], float out[3]);
+/** The camera-to-world matrix of a camera at eye looking at target with up as the image's upward
+ * direction (the camera looks down its -z, y up, as glTF): columns x, y, z (unit, orthogonal) and eye.
+ * Returns false (out untouched) when a value is not finite, eye equals target, or up is zero or
+ * parallel to the viewing direction. */
+bool sy_mat4_look_at(const float eye[3], const float target[3], const float up[3], sy_mat4 *out);
 /** true when the upper 3x3 collapses space: it is singular or so near it that its inverse is
  * meaningless in float (|det| <= 1e-30 s^3, s its largest element; a zero scale on any axis). A
  * placement with such a world matrix is not drawn (glTF hides parts with a zero scale). */

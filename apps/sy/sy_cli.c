@@ -118,6 +118,9 @@ int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *short
             break;
         }
         case OPT_VARIANT: sy_cli_load_opts.variant = optarg; break; /* glTF KHR_materials_variants */
+        case OPT_LOOK_AT: case OPT_FOV: case OPT_ORBIT: /* the camera's placement (sy_load.h) */
+            if ((*status = sy_cli_view_option(c, optarg)) != 0) return OPT_STOP;
+            break;
         case OPT_ALLOW_PATH: { /* repeatable: more folders that a model's external files may lie in */
             struct stat st;
             if (stat(optarg, &st) != 0 || !S_ISDIR(st.st_mode)) {

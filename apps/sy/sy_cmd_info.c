@@ -10,6 +10,7 @@
 #include "sy_png.h"
 #include "sy_sniff.h"
 
+#include <math.h>
 #include <string.h>
 
 /* sy info IMAGE.exr: size, channels and the header's string attributes (what sy render records) as JSON. */
@@ -175,6 +176,40 @@ int sy_cmd_info(int argc, char **argv)
         sy_json_add(c, "loop", cJSON_CreateBool(ad->loop != 0)); /* X3D TimeSensor.loop: --at wraps */
         sy_json_add(c, "channels", cJSON_CreateNumber(nch));
         sy_json_add(c, "samplers", cJSON_CreateNumber(nsm));
+    }
+    /* the cameras (what --camera takes: the index, or the node or camera name): the projection, its
+     * angle or half extents, and the world position and viewing direction at load time */
+    cJSON *cams = sy_json_add(doc, "cameras", cJSON_CreateArray());
+    const sy_node *cn = ld.is_gltf ? ld.gltf.camera_nodes : ld.is_x3d ? ld.x3d.camera_nodes : ld.is_assimp ? ld.assimp.camera_nodes : NULL;
+    uint32_t ncam = ld.is_gltf ? ld.gltf.camera_node_count : ld.is_x3d ? ld.x3d.camera_node_count
+                  : ld.is_assimp ? ld.assimp.camera_node_count : 0;
+    sy_node demo_cam = {0};
+    if (!ld.is_gltf && !ld.is_x3d && !ld.is_assimp && ld.camera.id) demo_cam = ld.camera, cn = &demo_cam, ncam = 1;
+    for (uint32_t i = 0; i < ncam; ++i) {
+        const sy_node_data *nd = sy_node_get(ld.scene, cn[i]);
+        const sy_camera_data *cd = nd ? sy_camera_get(ld.scene, nd->camera) : NULL;
+        sy_mat4 m;
+        if (!cd || sy_node_world_matrix(ld.scene, cn[i], &m, NULL) != SY_OK) continue;
+        cJSON *c = sy_json_add(cams, NULL, cJSON_CreateObject());
+        sy_json_add(c, "index", cJSON_CreateNumber(i));
+        sy_json_add(c, "name", nd->name && *nd->name ? sy_json_str(nd->name) : cJSON_CreateNull());
+        sy_json_add(c, "camera_name", cd->name && *cd->name ? sy_json_str(cd->name) : cJSON_CreateNull());
+        bool ortho = cd->projection == SY_PROJECTION_ORTHOGRAPHIC;
+        sy_json_add(c, "type", sy_json_str(ortho ? "orthographic" : "perspective"));
+        if (ortho) {
+            sy_json_add(c, "xmag", sy_json_float((double)cd->xmag));
+            sy_json_add(c, "ymag", sy_json_float((double)cd->ymag));
+        } else {
+            sy_json_add(c, "yfov", sy_json_float((double)cd->yfov)); /* radians */
+            sy_json_add(c, "yfov_degrees", sy_json_float((double)cd->yfov * 57.29577951308232));
+        }
+        if (cd->aspect > 0) sy_json_add(c, "aspect", sy_json_float((double)cd->aspect));
+        cJSON *pos = sy_json_add(c, "position", cJSON_CreateArray()), *dir = sy_json_add(c, "direction", cJSON_CreateArray());
+        float back[3] = {m.m[8], m.m[9], m.m[10]}, bl = sqrtf(back[0] * back[0] + back[1] * back[1] + back[2] * back[2]);
+        for (int k = 0; k < 3; ++k) {
+            sy_json_add(pos, NULL, sy_json_float((double)m.m[12 + k]));
+            sy_json_add(dir, NULL, sy_json_float(bl > 0 ? -(double)back[k] / bl + 0.0 : 0.0)); /* + 0.0: no "-0" */
+        }
     }
     if (sy_bounds_is_empty(&b)) {
         sy_json_add(doc, "bounds", cJSON_CreateNull());

@@ -72,7 +72,7 @@ int sy_cmd_pick(int argc, char **argv)
     uint32_t w = 0, h = 0;
     static const struct option lo[] = {{"camera", required_argument, NULL, OPT_CAMERA},
                                        {"params", required_argument, NULL, OPT_PARAMS},
-                                       {"json", no_argument, NULL, OPT_JSON}, COMMON_OPTIONS};
+                                       {"json", no_argument, NULL, OPT_JSON}, VIEW_OPTIONS, COMMON_OPTIONS};
     int c, status = 0;
     optind = 0;
     while ((c = sy_cli_next_sized_option("pick", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, 1, &w, &h, &status)) != -1) {

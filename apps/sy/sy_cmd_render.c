@@ -313,7 +313,7 @@ int sy_cmd_render(int argc, char **argv)
         {"frames", required_argument, NULL, OPT_FRAMES}, /* cluster: frames through the same window */
         {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
         {"at", required_argument, NULL, OPT_AT}, {"clip", required_argument, NULL, OPT_CLIP}, /* the scene clock */
-        SY_CLUSTER_CLI_OPTIONS, COMMON_OPTIONS};
+        SY_CLUSTER_CLI_OPTIONS, VIEW_OPTIONS, COMMON_OPTIONS};
     uint32_t max_memory_mb = 0;
     int c, status = 0;
     optind = 0;
@@ -559,7 +559,8 @@ int sy_cmd_render(int argc, char **argv)
         bool has_cam = ld.camera.id && sy_node_world_matrix(ld.scene, ld.camera, &cm, NULL) == SY_OK;
         if (has_cam)
             snprintf(camera_str, sizeof camera_str, "%s at (%g, %g, %g) looking along (%g, %g, %g)",
-                     camera ? camera : "the scene's first camera", (double)cm.m[12], (double)cm.m[13], (double)cm.m[14],
+                     sy_cli_load_opts.view.look_at ? "the --look-at camera" : sy_cli_load_opts.view.orbit ? "the --orbit camera"
+                     : camera ? camera : "the scene's first camera", (double)cm.m[12], (double)cm.m[13], (double)cm.m[14],
                      (double)-cm.m[8], (double)-cm.m[9], (double)-cm.m[10]);
         else snprintf(camera_str, sizeof camera_str, "a view framing the scene's bounds");
         /* the exact view, for a renderer that is to see the same (tests/cycles/materials.sh): the

@@ -28,7 +28,7 @@ int sy_cmd_view(int argc, char **argv)
         {"threshold", required_argument, NULL, OPT_THRESHOLD}, {"keys", required_argument, NULL, OPT_KEYS},
         {"spp", required_argument, NULL, OPT_SPP}, /* cluster: samples per server and frame */
         {"budget", required_argument, NULL, OPT_BUDGET}, /* the frame-time governor's budget (ms) */
-        SY_CLUSTER_CLI_OPTIONS, COMMON_OPTIONS};
+        SY_CLUSTER_CLI_OPTIONS, VIEW_OPTIONS, COMMON_OPTIONS};
     double budget = 0.0;
     int c, status = 0;
     optind = 0;

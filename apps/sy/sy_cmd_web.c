@@ -29,7 +29,7 @@ int sy_cmd_web(int argc, char **argv)
         {"camera", required_argument, NULL, OPT_CAMERA}, {"listen", required_argument, NULL, OPT_WEB_LISTEN},
         {"quality", required_argument, NULL, OPT_WEB_QUALITY}, {"filter", required_argument, NULL, OPT_FILTER},
         {"threshold", required_argument, NULL, OPT_THRESHOLD}, {"budget", required_argument, NULL, OPT_BUDGET},
-        {"client-render", no_argument, NULL, OPT_WEB_CLIENT_RENDER}, COMMON_OPTIONS};
+        {"client-render", no_argument, NULL, OPT_WEB_CLIENT_RENDER}, VIEW_OPTIONS, COMMON_OPTIONS};
     int c, status = 0;
     optind = 0;
     while ((c = sy_cli_next_sized_option("web", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, 1, &w, &h, &status)) != -1) {

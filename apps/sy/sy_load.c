@@ -3,6 +3,7 @@
  * the loader options of every command (--allow-path, --strict, --max-scene-mb), a default camera,
  * the world flags, X3D fields of view, and --overlay FILE[:BACKEND]. */
 #include "sy_load.h"
+#include "sy_cli.h"
 
 #include "sy_anim.h"
 #include "sy_demo.h"
@@ -56,6 +57,158 @@ static sy_result add_defaults(loaded *ld, sy_error *err)
         return r;
     }
     (void)cam_world;
+    return sy_scene_commit(s, NULL, err);
+}
+
+/* "x,y,z" (exactly three finite numbers) from text up to end into v. */
+static bool parse_vec3(const char *text, const char *stop, float v[3])
+{
+    const char *p = text;
+    for (int i = 0; i < 3; ++i) {
+        char *e = NULL;
+        if (p >= stop || *p == ',' || *p == ':' || *p == ' ') return false;
+        v[i] = strtof(p, &e);
+        if (e == p || e > stop || !isfinite(v[i])) return false;
+        p = e;
+        if (i < 2) {
+            if (p >= stop || *p != ',') return false;
+            p++;
+        }
+    }
+    return p == stop;
+}
+
+static int view_usage(const char *opt, const char *value, const char *why)
+{
+    fprintf(stderr, "sy: error: %s %s: %s\n", opt, value, why);
+    return 2;
+}
+
+int sy_cli_view_option(int c, const char *value)
+{
+    sy_view_options *v = &sy_cli_load_opts.view;
+    if (c == OPT_FOV) {
+        double deg = 0;
+        if (!sy_cli_parse_double(value, 0.0, 180.0, &deg) || !(deg > 0.0 && deg < 180.0))
+            return view_usage("--fov", value, "expected the vertical field of view in degrees, above 0 and below 180");
+        v->fov = (float)(deg * 3.14159265358979323846 / 180.0);
+        return 0;
+    }
+    if (c == OPT_LOOK_AT) {
+        const char *c1 = strchr(value, ':'), *c2 = c1 ? strchr(c1 + 1, ':') : NULL, *end = value + strlen(value);
+        if (!c1 || (c2 && strchr(c2 + 1, ':')))
+            return view_usage("--look-at", value, "expected EYE:TARGET or EYE:TARGET:UP, each x,y,z (e.g. 0,1,5:0,0,0)");
+        float up[3] = {0, 1, 0};
+        if (!parse_vec3(value, c1, v->eye))
+            return view_usage("--look-at", value, "EYE is not x,y,z (three finite numbers)");
+        if (!parse_vec3(c1 + 1, c2 ? c2 : end, v->target))
+            return view_usage("--look-at", value, "TARGET is not x,y,z (three finite numbers)");
+        if (c2 && !parse_vec3(c2 + 1, end, up)) return view_usage("--look-at", value, "UP is not x,y,z (three finite numbers)");
+        if (!sy_coords_in_range(v->eye, 3) || !sy_coords_in_range(v->target, 3))
+            return view_usage("--look-at", value, "a coordinate beyond 1e12 (SY_COORD_MAX)");
+        sy_mat4 m;
+        if (v->eye[0] == v->target[0] && v->eye[1] == v->target[1] && v->eye[2] == v->target[2])
+            return view_usage("--look-at", value, "EYE and TARGET are the same point");
+        if (!sy_mat4_look_at(v->eye, v->target, up, &m))
+            return view_usage("--look-at", value, "UP is zero or parallel to the viewing direction (give another UP)");
+        memcpy(v->up, up, sizeof up);
+        v->look_at = true;
+    } else { /* OPT_ORBIT */
+        float a[3] = {0, 0, 0};
+        int n = 0;
+        const char *p = value;
+        while (n < 3) {
+            char *e = NULL;
+            if (!*p || *p == ',' || *p == ' ') break;
+            a[n] = strtof(p, &e);
+            if (e == p || !isfinite(a[n])) break;
+            n++;
+            p = e;
+            if (*p != ',') break;
+            p++;
+        }
+        if (n < 2 || *p || p[-1] == ',')
+            return view_usage("--orbit", value, "expected AZ,EL or AZ,EL,DIST (degrees, degrees, scene units; finite numbers)");
+        if (!(a[1] >= -90.0f && a[1] <= 90.0f)) return view_usage("--orbit", value, "EL must be from -90 to 90 degrees");
+        if (n == 3 && !(a[2] > 0.0f && a[2] <= SY_COORD_MAX))
+            return view_usage("--orbit", value, "DIST must be above 0 (and at most 1e12)");
+        if (!(fabsf(a[0]) <= 1e6f)) return view_usage("--orbit", value, "AZ must be within +-1e6 degrees");
+        v->azimuth = a[0], v->elevation = a[1], v->dist = n == 3 ? a[2] : 0.0f;
+        v->orbit = true;
+    }
+    if (v->look_at && v->orbit) {
+        fprintf(stderr, "sy: error: --look-at and --orbit both place the camera; give one of them\n");
+        return 2;
+    }
+    return 0;
+}
+
+/* The view options (sy_cli_load_opts.view) on the loaded scene: see sy_cli_load in sy_load.h. */
+static sy_result apply_view(loaded *ld, sy_error *err)
+{
+    const sy_view_options *v = &sy_cli_load_opts.view;
+    if (!v->look_at && !v->orbit && !(v->fov > 0)) return SY_OK;
+    sy_scene *s = ld->scene;
+    const sy_node_data *nd = ld->camera.id ? sy_node_get(s, ld->camera) : NULL;
+    const sy_camera_data *cur = nd ? sy_camera_get(s, nd->camera) : NULL;
+    sy_camera_data c = cur ? *cur : *(const sy_camera_data *)sy_object_defaults(SY_TYPE_CAMERA);
+    if (!cur) c.yfov = 0.7853982f; /* the default camera's (sy_camera_view_frame_bounds) */
+    c.name = (char *)"command-line camera";
+    if (v->fov > 0) {
+        if (c.projection == SY_PROJECTION_ORTHOGRAPHIC)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--fov: the camera is orthographic (it has no field of view)");
+        c.yfov = v->fov;
+    }
+    sy_mat4 m;
+    if (v->look_at) {
+        if (!sy_mat4_look_at(v->eye, v->target, v->up, &m))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--look-at: no view (eye == target or up along the view)");
+    } else if (v->orbit) {
+        sy_bounds b;
+        sy_result r = sy_node_world_bounds(s, ld->root, &b, err);
+        if (r) return r;
+        float ctr[3] = {0, 0, 0}, rad = 1.0f, ext2 = 0.0f;
+        if (!sy_bounds_is_empty(&b)) { /* as sy_camera_view_frame_bounds: the bounds' sphere */
+            for (int i = 0; i < 3; ++i) {
+                float e = 0.5f * (b.max[i] - b.min[i]);
+                ctr[i] = 0.5f * (b.min[i] + b.max[i]);
+                ext2 += e * e;
+            }
+            rad = sqrtf(ext2);
+            if (!(rad > 1e-6f)) rad = 1.0f;
+        }
+        float dist = v->dist;
+        if (!(dist > 0)) {
+            if (c.projection == SY_PROJECTION_ORTHOGRAPHIC) dist = 2.0f * rad;
+            else {
+                float half = 0.5f * c.yfov;
+                if (c.aspect > 0.0f && c.aspect < 1.0f) half = atanf(tanf(half) * c.aspect); /* the narrower side */
+                dist = rad / sinf(half) * 1.05f;
+            }
+        }
+        double az = v->azimuth * 3.14159265358979323846 / 180.0, el = v->elevation * 3.14159265358979323846 / 180.0;
+        float back[3] = {(float)(cos(el) * sin(az)), (float)sin(el), (float)(cos(el) * cos(az))};
+        float eye[3] = {ctr[0] + back[0] * dist, ctr[1] + back[1] * dist, ctr[2] + back[2] * dist};
+        float up[3] = {0, 1, 0};
+        if (fabsf(v->elevation) > 89.99f) { /* straight down (up): the image's up is away from (towards) AZ */
+            float k = v->elevation > 0 ? -1.0f : 1.0f;
+            up[0] = k * (float)sin(az), up[1] = 0.0f, up[2] = k * (float)cos(az);
+        }
+        if (!sy_mat4_look_at(eye, ctr, up, &m))
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--orbit: no view at distance %g", (double)dist);
+    }
+    sy_camera cam;
+    sy_result r;
+    if ((r = sy_camera_create(s, "command-line camera", &cam, err)) || (r = sy_camera_set(s, cam, &c, err))) return r;
+    if (v->look_at || v->orbit) {
+        sy_node node;
+        if ((r = sy_node_create(s, "command-line camera", &node, err)) || (r = sy_node_set_matrix(s, node, &m, err)) ||
+            (r = sy_node_set_camera(s, node, cam, err)))
+            return r;
+        ld->camera = node;
+    } else if ((r = sy_node_set_camera(s, ld->camera, cam, err))) { /* --fov alone: the chosen camera, in place */
+        return r;
+    }
     return sy_scene_commit(s, NULL, err);
 }
 
@@ -160,6 +313,7 @@ sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, l
                          "(KHR_materials_variants); this is not a glTF file", path);
     if (r == SY_OK) r = sy_scene_commit(out->scene, NULL, err);
     if (r == SY_OK && (out->is_gltf || out->is_x3d || out->is_assimp) && defaults) r = add_defaults(out, err);
+    if (r == SY_OK) r = apply_view(out, err); /* --look-at, --orbit, --fov */
     /* the user's world choices: sy_world (formats) maps them onto the world object */
     if (r == SY_OK && !sy_world_options_empty(&sy_cli_load_opts.world) &&
         (r = sy_world_apply(out->scene, &out->background, &sy_cli_load_opts.world, err)) == SY_OK)
@@ -217,6 +371,7 @@ void sy_cli_default_size(const loaded *ld, uint32_t *w, uint32_t *h)
 void sy_cli_fit_x3d_cameras(loaded *ld, uint32_t w, uint32_t h)
 {
     sy_error e = {0};
+    if (sy_cli_load_opts.view.fov > 0) return; /* --fov: the user's vertical angle stands */
     if (sy_x3d_fit_cameras(ld->scene, &ld->x3d, (float)w / (float)h, &e) != SY_OK ||
         sy_scene_commit(ld->scene, NULL, &e) != SY_OK)
         sy_log(SY_LOG_WARNING, "sy", NULL, "viewpoint field of view not adapted: %s", e.message);

@@ -30,6 +30,15 @@ typedef struct loaded {
  * (whatever a loader skips or repairs is an error), --max-scene-mb N (the budget per file,
  * sy_budget.h), --variant NAME (a glTF material variant) and the world flags. */
 #define SY_MAX_ALLOW_PATHS 16
+/* Where the camera is put (sy render, pick, view, web): --look-at EYE:TARGET[:UP], --orbit AZ,EL[,DIST]
+ * (exclusive), --fov DEG (the vertical field of view of whichever camera is used). */
+typedef struct sy_view_options {
+    bool look_at;                   /* --look-at given */
+    float eye[3], target[3], up[3]; /* up (0,1,0) when not given */
+    bool orbit;                     /* --orbit given */
+    float azimuth, elevation, dist; /* degrees, degrees, scene units (0 = frame the bounds) */
+    float fov;                      /* --fov in radians; 0 = the camera's */
+} sy_view_options;
 typedef struct sy_load_options {
     const char *roots[SY_MAX_ALLOW_PATHS];
     size_t root_count;
@@ -37,12 +46,24 @@ typedef struct sy_load_options {
     uint64_t max_scene_bytes; /* --max-scene-mb: the loaders' budget per file (sy_budget.h); 0 = default */
     const char *variant; /* --variant: a glTF file's KHR_materials_variants variant (name or index); NULL = default */
     sy_world_options world; /* --env, --env-color, --env-intensity, --env-hidden, --background, --no-default-light */
+    sy_view_options view;   /* --look-at, --orbit, --fov (applied by sy_cli_load) */
 } sy_load_options;
 extern sy_load_options sy_cli_load_opts;
 
+/* --look-at, --orbit or --fov (code OPT_LOOK_AT, OPT_ORBIT, OPT_FOV) with its value into
+ * sy_cli_load_opts.view. Returns 0, or 2 after a usage error naming the option and the reason (a
+ * missing part, NaN, eye == target, up parallel to the view, a range; --look-at with --orbit) on
+ * stderr. */
+int sy_cli_view_option(int c, const char *value);
+
 /* Loads path ("demo": the built-in scene) into a new scene in *out; camera_sel (NULL: the file's
  * first camera) names or numbers a camera; defaults: a file without a camera gets one framing its
- * bounds. The world flags are applied. On failure *out is empty. */
+ * bounds. The world flags are applied, and the view options (sy_cli_load_opts.view): --look-at and
+ * --orbit put a new camera node "command-line camera" with the chosen camera's projection at the
+ * given place (--orbit: around the centre of the root's world bounds, at AZ degrees about +y from +z
+ * and EL degrees above the horizon, by default at the distance where the bounds' sphere fills the
+ * view, as the default camera frames it); --fov sets the vertical field of view of the camera used
+ * (an orthographic one refuses it). On failure *out is empty. */
 sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, loaded *out, sy_error *err);
 void sy_cli_loaded_free(loaded *l);
 /* --at SECONDS / --clip NAME|INDEX: sets the loaded scene's time (sy_scene_set_time) on that clip, or

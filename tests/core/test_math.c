@@ -194,8 +194,33 @@ static int test_bounds(void)
     return 0;
 }
 
+/* sy_mat4_look_at: an orthonormal basis looking down -z at the target, and the refusals */
+static int test_look_at(void)
+{
+    sy_mat4 m;
+    float eye[3] = {0.5f, 0.5f, 3}, tgt[3] = {0.5f, 0.5f, 0}, up[3] = {0, 1, 0};
+    CHECK(sy_mat4_look_at(eye, tgt, up, &m));
+    sy_mat4 want = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.5f, 0.5f, 3, 1}};
+    CHECK(sy_mat4_equal(&m, &want));
+    float e2[3] = {3, 4, 0}, t2[3] = {0, 0, 0}, u2[3] = {0, 0, 2};
+    CHECK(sy_mat4_look_at(e2, t2, u2, &m));
+    float fwd[3] = {-m.m[8], -m.m[9], -m.m[10]};
+    CHECK(fabsf(fwd[0] + 0.6f) < 1e-6f && fabsf(fwd[1] + 0.8f) < 1e-6f && fabsf(fwd[2]) < 1e-6f); /* towards the target */
+    CHECK(fabsf(m.m[6] - 1.0f) < 1e-6f); /* the image's up is +z */
+    CHECK(fabsf(sy_vec3_dot(&m.m[0], &m.m[4])) < 1e-6f && fabsf(sy_vec3_dot(&m.m[0], &m.m[8])) < 1e-6f);
+    sy_mat4 keep = m;
+    CHECK(!sy_mat4_look_at(e2, e2, up, &m));                 /* eye == target */
+    float upx[3] = {3, 4, 0}, zero[3] = {0, 0, 0}, nan3[3] = {NAN, 0, 0};
+    CHECK(!sy_mat4_look_at(e2, t2, upx, &m));                /* up along the view */
+    CHECK(!sy_mat4_look_at(e2, t2, zero, &m));               /* no up */
+    CHECK(!sy_mat4_look_at(nan3, t2, up, &m));               /* not finite */
+    CHECK(sy_mat4_equal(&m, &keep));                         /* untouched after a refusal */
+    return 0;
+}
+
 int main(void)
 {
+    RUN(test_look_at);
     RUN(test_identity_and_mul);
     RUN(test_trs);
     RUN(test_invert);
