@@ -9,6 +9,8 @@
 #   - Box.gltf: --orbit 0,0,3 equals --look-at 0,0,3:0,0,0 (exr_equal); --orbit 0,0 stands at the
 #     default framing distance r / sin(fov/2) * 1.05 (r = the bounds' radius, fov the default 45
 #     degrees) on +z, as sy:camera_to_world says, and renders as --look-at from that eye (exr_error)
+#   - --orbit 0,20 renders as the default camera (exr_error relmse < 1e-6); --fov on Cameras.gltf's
+#     orthographic camera fails (status 1) naming --fov
 #   - --fov: the front face of the Box (half width 0.5 at distance 2.5) covers W * 0.2 / tan(fov/2)
 #     pixels of the middle row (counted with sy pick), for 40 and 60 degrees, within 2 pixels
 #   - sy info Cameras.gltf lists 2 cameras: 0 perspective yfov 0.7, 1 orthographic xmag 1 ymag 1,
@@ -100,6 +102,16 @@ echo "$mo" | awk -v d="$dist" '{ e = $15 - d; if (e < 0) e = -e; exit !($1 == 1 
     fail "--orbit 0,0 camera_to_world '$mo' (want the identity rotation at (0, 0, $dist))"
 "$EXR_ERROR" "$TMP/orbit.exr" "$TMP/lookd.exr" >"$TMP/orbit_err.txt" || fail "exr_error --orbit 0,0"
 awk '{ exit !($2 < 1e-4) }' "$TMP/orbit_err.txt" || fail "--orbit 0,0 vs --look-at 0,0,$dist: $(cat "$TMP/orbit_err.txt")"
+# --orbit 0,20 is the default camera's view (from the front, 20 degrees up, the same distance)
+"$SY" render "$BOX" -w 64 -h 64 -o "$TMP/default.exr" 2>/dev/null || fail "render Box"
+"$SY" render "$BOX" -w 64 -h 64 -o "$TMP/orbit20.exr" --orbit 0,20 2>/dev/null || fail "render --orbit 0,20"
+"$EXR_ERROR" "$TMP/orbit20.exr" "$TMP/default.exr" >"$TMP/orbit20_err.txt" || fail "exr_error --orbit 0,20"
+awk '{ exit !($2 < 1e-6) }' "$TMP/orbit20_err.txt" || fail "--orbit 0,20 vs the default camera: $(cat "$TMP/orbit20_err.txt")"
+# an orthographic camera has no field of view: --fov is refused naming it
+"$SY" render "$CAMS" -w 16 -h 16 -o "$TMP/ortho.png" --camera 1 --fov 30 2>"$TMP/ortho.err"
+rc=$?
+[ $rc -eq 1 ] && grep -qF -- "--fov: the camera is orthographic" "$TMP/ortho.err" && [ ! -f "$TMP/ortho.png" ] ||
+    fail "--fov on an orthographic camera: status $rc, $(cat "$TMP/ortho.err")"
 "$SY" render "$BOX" -w 16 -h 16 -o "$TMP/orbit90.exr" --orbit 90,0,3 2>/dev/null || fail "render --orbit 90,0,3"
 attr "$TMP/orbit90.exr" sy:camera_to_world | awk '{ exit !($13 > 2.9999 && $13 < 3.0001 && $14 * $14 < 1e-8 && $15 * $15 < 1e-8) }' ||
     fail "--orbit 90,0,3 stands at (3, 0, 0): $(attr "$TMP/orbit90.exr" sy:camera_to_world)"

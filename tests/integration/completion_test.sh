@@ -86,6 +86,13 @@ expect "render -w 64 demo --ao" --aov
 expect "render demo --a" --at --aov
 expect "render demo --cl" --clip --cluster
 expect "render demo --at 1.5 --cl" --clip
+# the camera placement: --look-at, --orbit and --fov in render, pick, view and web; they take a value
+expect "render demo --lo" --look-at
+expect "render demo --or" --orbit
+expect "pick demo --f" --fov
+expect "view demo --look-at 0,1,5:0,0,0 --or" --orbit
+expect "web demo --orbit 30,20 --fo" --fov
+refuse "info demo --lo" --look-at
 
 if [ "$fails" -ne 0 ]; then
     echo "$fails completion checks failed"
