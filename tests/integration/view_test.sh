@@ -4,7 +4,8 @@
 # render` of the same view with the same tone mapping, within 2 of 255 per channel (the screenshot
 # goes through an sRGB decode / encode round trip). The path tracer's display filter keys (F cycles
 # the filter, [ / ] halve / double the threshold) are pressed through the keyboard handler with
-# --keys and checked in the heads-up line after each key; the frame-time governor answers a back-end
+# --keys and checked in the heads-up line after each key; the start view of --look-at and --fov
+# matches sy render's; the frame-time governor answers a back-end
 # switch with a moving frame and settles at full size. Skipped (77) when xvfb-run is not
 # installed or the viewer was built without GLFW.
 set -u
@@ -21,6 +22,16 @@ fi
     echo "FAIL: the viewer's window does not show the rendered image"
     exit 1
 }
+# the start view from --look-at and --fov (issue 37): the window shows what sy render draws with them
+timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w 160 -h 90 --frames 5 \
+    --look-at 3,2,4:0,0.5,0 --fov 50 --screenshot "$W/view_look.png" >"$W/view_look.out" 2>"$W/view_look.err"
+rc=$?
+"$SY" render demo -b whitted -w 160 -h 90 --tonemap aces --look-at 3,2,4:0,0.5,0 --fov 50 -o "$W/render_look.png" \
+    >/dev/null || exit 1
+if [ $rc -ne 0 ] || ! "$CMP" "$W/view_look.png" "$W/render_look.png" 2 50; then
+    echo "FAIL: sy view --look-at --fov (status $rc) does not show what sy render draws: $(cat "$W/view_look.err")"
+    exit 1
+fi
 # the path tracer with its pixel display filter (issue 7): applied on the render thread's context
 timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b pathtracer --filter pixel --threshold 0.02 \
     -w 64 -h 48 --frames 6 --screenshot "$W/view_filter.png" >"$W/view_filter.out" 2>"$W/view_filter.err"
