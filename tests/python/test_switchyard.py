@@ -533,3 +533,25 @@ def test_notebook_block_of_the_docs_runs_as_written():
     img = env["side_by_side"]
     assert isinstance(img, switchyard.Image) and img.shape == (240, 640, 4)
     assert img._repr_png_().startswith(b"\x89PNG")
+
+
+def test_type_stubs_name_every_public_name():
+    """switchyard/__init__.pyi declares every name of __all__, and every public method of the classes."""
+    import ast
+    stub = os.path.join(os.path.dirname(switchyard.__file__), "__init__.pyi")
+    tree = ast.parse(open(stub).read())
+    declared, members = set(), {}
+    for n in tree.body:
+        if isinstance(n, (ast.ClassDef, ast.FunctionDef)):
+            declared.add(n.name)
+            if isinstance(n, ast.ClassDef):
+                members[n.name] = {b.name for b in n.body if isinstance(b, ast.FunctionDef)} | \
+                    {b.target.id for b in n.body if isinstance(b, ast.AnnAssign)}
+        elif isinstance(n, ast.Assign):
+            declared.update(t.id for t in n.targets if isinstance(t, ast.Name))
+    missing = [n for n in switchyard.__all__ if n not in declared]
+    assert not missing, "names of __all__ without a stub: %s" % missing
+    for cls in ("Scene", "Window", "Viewport", "Server", "Mesh", "Node", "Material", "Light", "Camera", "Backend"):
+        have = members[cls] | members.get("_Object", set())
+        public = {m for m in vars(getattr(switchyard, cls)) if not m.startswith("_")}
+        assert public <= have, "%s: %s without a stub" % (cls, sorted(public - have))
