@@ -290,6 +290,37 @@ sy_result sy_context_sync(sy_context *c, sy_error *err)
     return r;
 }
 
+sy_result sy_clip_planes_check(const float (*planes)[4], uint32_t count, sy_error *err)
+{
+    if (count > SY_CLIP_PLANES_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%u section planes: at most %d", (unsigned)count,
+                            SY_CLIP_PLANES_MAX);
+    if (count && !planes) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%u section planes but none given", (unsigned)count);
+    for (uint32_t i = 0; i < count; ++i) {
+        const float *q = planes[i];
+        for (int k = 0; k < 4; ++k)
+            if (!sy_coords_in_range(&q[k], 1))
+                return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                    "section plane %u (%g, %g, %g, %g): %c = %g is not finite or beyond %g", (unsigned)i,
+                                    (double)q[0], (double)q[1], (double)q[2], (double)q[3], "abcd"[k], (double)q[k],
+                                    (double)SY_COORD_MAX);
+        if (q[0] == 0.0f && q[1] == 0.0f && q[2] == 0.0f)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "section plane %u (%g, %g, %g, %g): the normal (a, b, c) is zero", (unsigned)i,
+                                (double)q[0], (double)q[1], (double)q[2], (double)q[3]);
+    }
+    return SY_OK;
+}
+
+/* A view with section planes needs SY_CAP_CLIP of the context's class. */
+static sy_result clip_supported(const sy_context *c, const sy_camera_view *v, sy_error *err)
+{
+    if (v->clip_count && !(sy_context_caps(c) & SY_CAP_CLIP))
+        return sy_error_set(err, SY_ERR_UNSUPPORTED, "back-end %s cannot cut with section planes (no SY_CAP_CLIP)",
+                            c->cls->name);
+    return SY_OK;
+}
+
 sy_result sy_camera_view_check(const sy_camera_view *v, sy_error *err)
 {
     const float *m = v->camera_to_world.m;
@@ -304,12 +335,13 @@ sy_result sy_camera_view_check(const sy_camera_view *v, sy_error *err)
     if (!isfinite(v->znear) || !isfinite(v->zfar))
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera clip range %g..%g is not finite", (double)v->znear,
                             (double)v->zfar);
-    return SY_OK;
+    return sy_clip_planes_check((const float(*)[4])v->clip_planes, v->clip_count, err);
 }
 
 sy_result sy_context_render(sy_context *c, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     sy_result rc = sy_camera_view_check(&req->camera, err);
+    if (rc == SY_OK) rc = clip_supported(c, &req->camera, err);
     if (rc != SY_OK) {
         sy_error_prefix(err, "%s render", c->cls->name);
         return rc;
@@ -433,6 +465,9 @@ sy_result sy_context_coverage(sy_context *c, const sy_camera_view *view, uint32_
     *count_out = 0;
     if (!(sy_context_caps(c) & SY_CAP_COVERAGE) || !c->cls->coverage)
         return sy_error_set(err, SY_ERR_UNSUPPORTED, "back-end %s counts no per-node coverage", c->cls->name);
+    sy_result r = sy_camera_view_check(view, err);
+    if (r == SY_OK) r = clip_supported(c, view, err);
+    if (r != SY_OK) return r;
     return c->cls->coverage(c->state, view, width, height, entries_out, count_out, err);
 }
 
@@ -451,6 +486,7 @@ sy_result sy_context_pick(sy_context *c, const sy_camera_view *view, uint32_t wi
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "pick: pixel (%u, %u) is outside the %ux%u image", x, y,
                             width, height);
     sy_result r = sy_camera_view_check(view, err);
+    if (r == SY_OK) r = clip_supported(c, view, err);
     if (r != SY_OK) return r;
     r = c->cls->pick(c->state, view, width, height, x, y, out, err);
     if (r != SY_OK || !out->hit) { /* a miss (or a failure) answers nothing but "no hit" */

@@ -35,6 +35,9 @@ typedef enum sy_mediator_caps {
                                      (a culling service asks it of whichever class offers it) */
     SY_CAP_PICK = 1u << 10,       /**< answers what is under a pixel (node, mesh, primitive, triangle, position,
                                      normal, material): sy_context_pick, sy_viewport_pick */
+    SY_CAP_CLIP = 1u << 11,       /**< honours the view's section planes (sy_camera_view.clip_planes) in renders,
+                                     picks and coverage; a view with planes is refused (SY_ERR_UNSUPPORTED)
+                                     by a class without it */
 } sy_mediator_caps;
 
 /* ---- feature buffers (SY_CAP_AOVS) ---- */

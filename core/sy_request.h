@@ -12,7 +12,10 @@
 extern "C" {
 #endif
 
-/** What a back-end renders: camera placement, projection and image-plane window. */
+#define SY_CLIP_PLANES_MAX 6 /**< most section planes in a view (sy_camera_view.clip_planes) */
+
+/** What a back-end renders: camera placement, projection and image-plane window, and the section
+ * planes that cut the scene open (back-ends with SY_CAP_CLIP). */
 typedef struct sy_camera_view {
     sy_mat4 camera_to_world; /**< the camera looks down its local -Z, +Y up */
     uint32_t projection;     /**< sy_projection */
@@ -22,11 +25,30 @@ typedef struct sy_camera_view {
     float window[4];
     /** @{ zfar 0 = infinite */
     float znear, zfar; /** @} */
+    uint32_t clip_count; /**< section planes in use (0..SY_CLIP_PLANES_MAX); 0 = nothing cut */
+    /** Section planes {a, b, c, d} in world coordinates: a surface point p is drawn (and hit by every
+     * ray: primary, reflected, refracted, shadow) only where a*p.x + b*p.y + c*p.z + d >= 0 for every
+     * plane in use. Checked by sy_clip_planes_check. */
+    float clip_planes[SY_CLIP_PLANES_MAX][4];
 } sy_camera_view;
+
+/** SY_OK when count <= SY_CLIP_PLANES_MAX and every plane's a, b, c, d is finite, within
+ * SY_COORD_MAX, with a non-zero normal (a, b, c); otherwise SY_ERR_INVALID_ARGUMENT naming the plane
+ * and the value. */
+sy_result sy_clip_planes_check(const float (*planes)[4], uint32_t count, sy_error *err);
+/** true when world point p is on the kept side of every section plane of v (or v has none). */
+static inline bool sy_camera_view_clip_keeps(const sy_camera_view *v, const float p[3])
+{
+    for (uint32_t i = 0; i < v->clip_count && i < SY_CLIP_PLANES_MAX; ++i) {
+        const float *q = v->clip_planes[i];
+        if (q[0] * p[0] + q[1] * p[1] + q[2] * p[2] + q[3] < 0.0f) return false;
+    }
+    return true;
+}
 
 /** SY_OK when the view is one every back-end can render: finite, the camera's position and every
  * element of its matrix within SY_COORD_MAX (sy_math.h), an orthographic window within it too;
- * otherwise SY_ERR_INVALID_ARGUMENT saying which value is out of range. sy_context_render checks
+ * its section planes pass sy_clip_planes_check; otherwise SY_ERR_INVALID_ARGUMENT saying which value is out of range. sy_context_render checks
  * every request with it, so no back-end is given a camera beyond the range. */
 sy_result sy_camera_view_check(const sy_camera_view *v, sy_error *err);
 

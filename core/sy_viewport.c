@@ -15,6 +15,8 @@ struct sy_viewport {
     bool active;
     bool has_view; /* sy_viewport_set_view: view replaces the camera node's world matrix */
     sy_mat4 view;
+    uint32_t clip_count; /* sy_viewport_set_clip_planes */
+    float clip_planes[SY_CLIP_PLANES_MAX][4];
 };
 
 struct sy_window {
@@ -140,6 +142,24 @@ void sy_viewport_set_view(sy_viewport *v, const sy_mat4 *camera_to_world)
     if (camera_to_world) v->view = *camera_to_world;
 }
 
+sy_result sy_viewport_set_clip_planes(sy_viewport *v, const float (*planes)[4], uint32_t count, sy_error *err)
+{
+    sy_result r = sy_clip_planes_check(planes, count, err);
+    if (r != SY_OK) {
+        sy_error_prefix(err, "viewport");
+        return r;
+    }
+    if (count) memcpy(v->clip_planes, planes, (size_t)count * sizeof v->clip_planes[0]);
+    v->clip_count = count;
+    return SY_OK;
+}
+
+uint32_t sy_viewport_clip_planes(const sy_viewport *v, float (*planes)[4])
+{
+    if (planes && v->clip_count) memcpy(planes, v->clip_planes, (size_t)v->clip_count * sizeof v->clip_planes[0]);
+    return v->clip_count;
+}
+
 bool sy_viewport_view(const sy_viewport *v, sy_mat4 *camera_to_world)
 {
     if (v->has_view && camera_to_world) *camera_to_world = v->view;
@@ -201,6 +221,8 @@ sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, u
         if (v->has_view) mono.camera_to_world = v->view;
     }
     *out = sy_camera_view_eye(&mono, v->desc.eye, v->desc.eye_separation, v->desc.zero_parallax);
+    out->clip_count = v->clip_count;
+    memcpy(out->clip_planes, v->clip_planes, sizeof out->clip_planes);
     sy_result res = sy_camera_view_check(out, err);
     if (res != SY_OK) {
         if (v->desc.camera.id) sy_error_prefix(err, "viewport: camera node %#x", v->desc.camera.id);

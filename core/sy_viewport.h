@@ -98,6 +98,17 @@ void sy_viewport_set_camera(sy_viewport *v, sy_node camera);
  * Nothing in the scene changes (no commit is needed or made). NULL: the camera node's world matrix
  * again. */
 void sy_viewport_set_view(sy_viewport *v, const sy_mat4 *camera_to_world);
+/** Sets the viewport's section planes (SY_CAP_CLIP back-ends): up to SY_CLIP_PLANES_MAX planes
+ * {a, b, c, d} in world coordinates (copied); what a*x + b*y + c*z + d >= 0 for all of them keeps
+ * is drawn, picked and seen by every ray, the rest is cut away. count 0 removes them. Planes
+ * sy_clip_planes_check refuses (more than SY_CLIP_PLANES_MAX, a value not finite or beyond
+ * SY_COORD_MAX, a zero normal) fail with SY_ERR_INVALID_ARGUMENT naming the plane, keeping the
+ * planes set before. They travel in the viewport's camera view (sy_viewport_camera_view), so a
+ * back-end without SY_CAP_CLIP refuses to render or pick with them (SY_ERR_UNSUPPORTED). */
+sy_result sy_viewport_set_clip_planes(sy_viewport *v, const float (*planes)[4], uint32_t count, sy_error *err);
+/** The number of section planes set; copies them into planes (may be NULL; room for
+ * SY_CLIP_PLANES_MAX). */
+uint32_t sy_viewport_clip_planes(const sy_viewport *v, float (*planes)[4]);
 /** true and *camera_to_world (may be NULL) when a view is set directly (sy_viewport_set_view). */
 bool sy_viewport_view(const sy_viewport *v, sy_mat4 *camera_to_world);
 /** The viewport's back-end name (borrowed). */
@@ -105,7 +116,7 @@ const char *sy_viewport_backend(const sy_viewport *v);
 
 /** The camera view a viewport renders with (the view set directly, else its camera node's world
  * matrix as of the last commit, or a view framing the root's bounds), with the eye's off-axis
- * frustum applied. */
+ * frustum applied and the viewport's section planes. */
 sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, uint32_t window_width,
                                   uint32_t window_height, sy_camera_view *out, sy_error *err);
 

@@ -180,6 +180,7 @@ static const char usage_text[] =
             "            [--stereo sbs|tb|anaglyph|separate] [--eye-sep M] [--zero-parallax M]\n"
             "            [--overlay FILE[:BACKEND]] [--composite depth|over|replace]\n"
             "            [--at SECONDS] [--clip NAME|INDEX]   (the scene at a time: every clip, or one; sy info lists clips)\n"
+            "            [--clip A,B,C,D ...]   (section planes, up to 6: keeps A*x + B*y + C*z + D >= 0, world units)\n"
             "  sy render SCENE -b pathtracer [-o OUT.exr|png|jpg] [--spp N | --time SECONDS] [--aov]\n"
             "            (+ the options above)\n"
             "            [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]   (display filter)\n"
@@ -217,6 +218,7 @@ static const char usage_text[] =
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy pick SCENE X Y [X Y ...] [-b BACKEND] [-w W] [-h H] [--camera NAME|INDEX] [--params k=v,...]\n"
             "            [--look-at EYE:TARGET[:UP] | --orbit AZ,EL[,DIST]] [--fov DEG]   (the view; as sy render)\n"
+            "            [--clip A,B,C,D ...]\n"
             "            (what is under pixel (X, Y) of the view sy render draws, as JSON: node, mesh, primitive,\n"
             "             triangle, barycentrics, position, normal, material, distance; \"hit\": false on a miss)\n"
             "  sy backends [--params] [--json]\n"
@@ -285,6 +287,37 @@ int sy_cli_bad_value(const char *opt, const char *value)
 {
     fprintf(stderr, "sy: error: %s: '%s' is not an accepted value\n", opt, value);
     return 2;
+}
+
+bool sy_cli_is_clip_plane(const char *value) { return strchr(value, ',') != NULL; }
+
+int sy_cli_add_clip_plane(const char *value, float (*planes)[4], uint32_t *count)
+{
+    if (*count >= SY_CLIP_PLANES_MAX) {
+        fprintf(stderr, "sy: error: --clip: '%s' is one section plane too many (at most %d)\n", value,
+                SY_CLIP_PLANES_MAX);
+        return 2;
+    }
+    float q[4];
+    const char *s = value;
+    for (int k = 0; k < 4; ++k) {
+        char *end;
+        double d = strtod(s, &end);
+        if (end == s || !isfinite(d) || fabs(d) > SY_COORD_MAX || *end != (k < 3 ? ',' : '\0')) {
+            fprintf(stderr, "sy: error: --clip: '%s' is not a section plane A,B,C,D (four finite numbers: "
+                            "A*x + B*y + C*z + D >= 0 is kept)\n", value);
+            return 2;
+        }
+        q[k] = (float)d;
+        s = end + 1;
+    }
+    sy_error e = {0};
+    if (sy_clip_planes_check((const float(*)[4])q, 1, &e) != SY_OK) {
+        fprintf(stderr, "sy: error: --clip: '%s': %s\n", value, e.message);
+        return 2;
+    }
+    memcpy(planes[(*count)++], q, sizeof q);
+    return 0;
 }
 
 bool sy_cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)

@@ -77,6 +77,13 @@ const char *sy_cli_option_name(const struct option *lo, int c);
 int sy_cli_bad_value(const char *opt, const char *value);
 /* s as a finite number in lo..hi (nothing after it). */
 bool sy_cli_parse_double(const char *s, double lo, double hi, double *out);
+/* --clip A,B,C,D of command cmd: appends the section plane (four finite numbers, a non-zero normal)
+ * to planes (room for SY_CLIP_PLANES_MAX) and returns 0; a bad value or a seventh plane: a usage
+ * error naming --clip on stderr, returns 2. */
+int sy_cli_add_clip_plane(const char *value, float (*planes)[4], uint32_t *count);
+/* true when an --clip value is a section plane (it has a comma) rather than an animation clip's
+ * name or index (sy render --clip NAME|INDEX). */
+bool sy_cli_is_clip_plane(const char *value);
 /* s as a whole number in lo..hi (decimal, nothing after it). */
 bool sy_cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out);
 

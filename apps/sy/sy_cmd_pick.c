@@ -70,7 +70,10 @@ int sy_cmd_pick(int argc, char **argv)
 {
     const char *scene = NULL, *camera = NULL, *backend = NULL, *params = NULL;
     uint32_t w = 0, h = 0;
+    float planes[SY_CLIP_PLANES_MAX][4];
+    uint32_t nplanes = 0;
     static const struct option lo[] = {{"camera", required_argument, NULL, OPT_CAMERA},
+                                       {"clip", required_argument, NULL, OPT_CLIP},
                                        {"params", required_argument, NULL, OPT_PARAMS},
                                        {"json", no_argument, NULL, OPT_JSON}, VIEW_OPTIONS, COMMON_OPTIONS};
     int c, status = 0;
@@ -82,6 +85,9 @@ int sy_cmd_pick(int argc, char **argv)
         case OPT_CAMERA: camera = optarg; break;
         case OPT_PARAMS: params = optarg; break;
         case OPT_JSON: break; /* the output is JSON anyway */
+        case OPT_CLIP:
+            if (sy_cli_add_clip_plane(optarg, planes, &nplanes)) return 2;
+            break;
         }
     }
     if (optind >= argc) return sy_cli_usage_of("pick", "a SCENE and pixel coordinates X Y are required");
@@ -118,6 +124,12 @@ int sy_cmd_pick(int argc, char **argv)
         sy_log(SY_LOG_ERROR, "sy", NULL, "sy pick: back-end %s cannot pick (sy backends lists those with 'pick')", backend);
         return 2;
     }
+    if (nplanes && !(sy_mediator_class_caps(cls, &given) & SY_CAP_CLIP)) {
+        free(xy);
+        sy_log(SY_LOG_ERROR, "sy", NULL, "--clip: back-end %s cannot cut with section planes (sy backends lists those with 'clip')",
+               backend);
+        return 2;
+    }
     loaded ld;
     if (sy_cli_load(scene, camera, true, &ld, &err) != SY_OK) {
         free(xy);
@@ -136,8 +148,10 @@ int sy_cmd_pick(int argc, char **argv)
     sy_window *win = NULL;
     sy_context_pool *pool = NULL;
     sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .backend = backend, .params = params};
+    sy_viewport *vp = NULL;
     sy_result r = sy_window_create(w, h, &win, &err);
-    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, NULL, &err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, &err);
+    if (r == SY_OK && nplanes) r = sy_viewport_set_clip_planes(vp, (const float(*)[4])planes, nplanes, &err);
     if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
     cJSON *doc = NULL, *list = NULL;
     if (r == SY_OK && pairs > 1) doc = list = cJSON_CreateArray();

@@ -300,7 +300,7 @@ int sy_cmd_render(int argc, char **argv)
     bool progressive_opts = false; /* --spp / --time / --aov given */
     double at = 0.0;           /* --at: the scene's time in seconds */
     bool at_given = false;
-    const char *clip = NULL;   /* --clip: one animation (name or index); without it every clip plays */
+    const char *clip = NULL;   /* --clip NAME|INDEX: one animation; without it every clip plays */
     static const struct option lo[] = {
         {"spp", required_argument, NULL, OPT_SPP}, {"time", required_argument, NULL, OPT_TIME},
         {"aov", no_argument, NULL, OPT_AOV}, {"camera", required_argument, NULL, OPT_CAMERA},
@@ -371,7 +371,10 @@ int sy_cmd_render(int argc, char **argv)
             if (!sy_cli_parse_double(optarg, 0.0, 1e9, &at)) return sy_cli_bad_value("--at", optarg);
             at_given = true;
             break;
-        case OPT_CLIP: clip = optarg; break;
+        case OPT_CLIP: /* A,B,C,D (a comma): a section plane; else an animation clip */
+            if (!sy_cli_is_clip_plane(optarg)) clip = optarg;
+            else if (sy_cli_add_clip_plane(optarg, spec.clip_planes, &spec.clip_count)) return 2;
+            break;
         default: /* --cluster ... (sy_cluster_cli.c) */
             if (!sy_cluster_cli_getopt(c, optarg, &clo)) return sy_cli_bad_value(sy_cli_option_name(lo, c), optarg);
         }
@@ -462,6 +465,11 @@ int sy_cmd_render(int argc, char **argv)
     }
     uint32_t caps = sy_mediator_class_caps(bcls, &bparams);
     const sy_mediator_class *rcls = sy_mediator_find(remote);
+    if (spec.clip_count && !(caps & SY_CAP_CLIP)) {
+        sy_log(SY_LOG_ERROR, "sy", NULL, "--clip: back-end %s%s cannot cut with section planes (sy backends lists those with 'clip')",
+               remote, clo.cluster ? " on the cluster" : "");
+        return 2;
+    }
     if ((filter || threshold) && !(caps & SY_CAP_FILTERS)) {
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--filter and --threshold need a back-end with display filters, "
                      "such as a local -b pathtracer (got -b %s%s)",

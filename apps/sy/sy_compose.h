@@ -32,6 +32,8 @@ typedef struct sy_compose_spec {
     uint32_t stereo;            /* sy_stereo_mode */
     float eye_separation;       /* metres, > 0 (default 0.065) */
     float zero_parallax;        /* metres, > 0 (default 2) */
+    uint32_t clip_count;        /* section planes on the main viewports (--clip A,B,C,D; sy_viewport_set_clip_planes) */
+    float clip_planes[SY_CLIP_PLANES_MAX][4];
 } sy_compose_spec;
 
 /* Parses "sbs", "tb", "anaglyph", "separate" (or "none"). */

@@ -454,7 +454,16 @@ typedef struct sy_rt_camera {
     float window[4]; /**< image-plane window {left, right, bottom, top} (see above) */
     /** @{ near and far clip distances along the viewing axis (far 0 = infinite) */
     float near_clip, far_clip; /** @} */
+    /** Section planes {a, b, c, d} in world coordinates (at most SY_RT_CLIP_PLANES_MAX; the caller
+     * checks them: finite, non-zero normal): a surface point p exists for every ray of the call
+     * (camera, reflection, refraction, shadow, pick, coverage) only where a*p.x + b*p.y + c*p.z + d >= 0
+     * for each plane. Hits are filtered (an Embree context filter rejects a hit whose point is on a
+     * cut side), so a ray that starts in the kept part and crosses a plane still finds what is
+     * behind. 0 = nothing cut. */
+    uint32_t clip_count;
+    float clip_planes[6][4];
 } sy_rt_camera;
+#define SY_RT_CLIP_PLANES_MAX 6 /**< most section planes in a sy_rt_camera */
 
 /** Integrators sy_rt_render can run. */
 typedef enum sy_rt_integrator {

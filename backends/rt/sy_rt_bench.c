@@ -36,6 +36,7 @@ static double now_s(void)
 sy_rt_result sy_rt_bench_rays(sy_rt_device *dev, const sy_rt_camera *camera, uint32_t width, uint32_t height,
                               uint32_t repeats, sy_rt_bench_result *out)
 {
+    if (dev && camera) sy_rt_clip_begin(dev, camera);
     if (!dev || !camera || !out) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "bench: NULL argument");
     if (repeats == 0) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "bench: repeats must be >= 1");
     if (dev->dirty)

@@ -29,6 +29,7 @@ void sy_rt_coverage_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
 sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
                             uint32_t *ids, float *depth)
 {
+    if (dev && camera) sy_rt_clip_begin(dev, camera);
     if (!dev || !camera || !desc || !ids) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "coverage: NULL argument");
     if (dev->dirty)
         return FAIL(SY_RT_ERROR_INVALID_OPERATION, "coverage: the device has uncommitted changes; call sy_rt_commit first");
@@ -43,6 +44,7 @@ sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const
 sy_rt_result sy_rt_pick(sy_rt_device *dev, const sy_rt_camera *camera, uint32_t image_width, uint32_t image_height,
                         uint32_t x, uint32_t y, sy_rt_pick_hit *out)
 {
+    if (dev && camera) sy_rt_clip_begin(dev, camera);
     if (!dev || !camera || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "pick: NULL argument");
     memset(out, 0, sizeof *out);
     if (x >= image_width || y >= image_height)

@@ -12,6 +12,7 @@
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdarg.h>
+#include <string.h>
 
 #include "sy_rt_base.h"
 
@@ -100,7 +101,7 @@ struct sy_rt_device {
     RTCScene top;
     /* Instances moved since the top-level BVH was last built: rebuilding the top scene costs
      * O(instances) (about 5 ms at 10^4), so a moved instance's copy in `top` is filtered out (the
-     * context filter sy_rt_stale_filter, installed only while stale_count > 0) and a twin instance
+     * context filter sy_rt_context_filter, installed only while stale_count > 0) and a twin instance
      * in the small scene `dyn`, attached under the same geometry id, shows it where it is now. Every
      * ray cast traces `top`, then `dyn` when dyn_count > 0 (sy_rt_frame.h). The next full rebuild
      * (anything structural, or more than sy_rt_stale_limit stale instances) folds them back. */
@@ -110,6 +111,10 @@ struct sy_rt_device {
                                     * walks every id up to the largest) */
     uint32_t dyn_map_cap;
     uint32_t stale_count;  /* instances with stale set */
+    /* Section planes of the call in progress (sy_rt_clip_begin: the camera's), read by the context
+     * filter sy_rt_context_filter on every hit. */
+    uint32_t clip_count;
+    float clip_planes[SY_RT_CLIP_PLANES_MAX][4];
     sy_rt_instance_data **pending; /* instances with xf_pending */
     uint32_t pending_count, pending_cap;
     bool dyn_dirty;        /* dyn needs rtcCommitScene */
@@ -197,8 +202,18 @@ static inline const sy_rt_material_data *sy_rt_material_lookup(const sy_rt_devic
 }
 
 /* The instance a hit belongs to (instance id for Embree instances, geometry id for baked). */
-/* The context filter that hides the top scene's stale copies of moved instances (sy_rt_scene.c). */
-void sy_rt_stale_filter(const struct RTCFilterFunctionNArguments *args);
+/* The context filter of every trace while some instance is stale or the call cuts with section
+ * planes (sy_rt_scene.c): it hides the top scene's stale copies of moved instances and rejects hits
+ * whose world point is on the cut side of a section plane (the exact rule for closed meshes: a ray
+ * leaving the kept part across a plane goes on to what is behind). */
+void sy_rt_context_filter(const struct RTCFilterFunctionNArguments *args);
+/* Takes the camera's section planes for the call that begins (render, pick, coverage, benchmarks). */
+static inline void sy_rt_clip_begin(sy_rt_device *dev, const sy_rt_camera *cam)
+{
+    uint32_t n = cam->clip_count < SY_RT_CLIP_PLANES_MAX ? cam->clip_count : SY_RT_CLIP_PLANES_MAX;
+    dev->clip_count = n;
+    if (n) memcpy(dev->clip_planes, cam->clip_planes, n * sizeof dev->clip_planes[0]);
+}
 
 /* Every intersection context of the back-end: Embree's, then which scene is being traced. Filter
  * functions receive &rtc and read the rest (every context comes from sy_rt_context_init). */
@@ -206,6 +221,9 @@ typedef struct sy_rt_ictx {
     struct RTCIntersectContext rtc; /* first member */
     int in_dyn;                     /* tracing dev->dyn: instance ids are dyn ids (dev->dyn_map) */
     RTCFilterFunctionN saved;       /* the filter while tracing dev->dyn */
+    RTCFilterFunctionN dyn_filter;  /* the filter while tracing dev->dyn: the context filter when the call
+                                       cuts with section planes, else none (set by sy_rt_context_init, so
+                                       that a module tracing dyn needs no reference to the filter) */
 } sy_rt_ictx;
 
 /* Every intersection context starts here: the stale filter is on exactly while some instance's
@@ -216,14 +234,16 @@ static inline void sy_rt_context_init(const sy_rt_device *dev, sy_rt_ictx *ctx, 
     ctx->rtc.flags = flags;
     ctx->in_dyn = 0;
     ctx->saved = NULL;
-    if (dev->stale_count) ctx->rtc.filter = sy_rt_stale_filter;
+    ctx->dyn_filter = dev->clip_count ? sy_rt_context_filter : NULL;
+    if (dev->stale_count || dev->clip_count) ctx->rtc.filter = sy_rt_context_filter;
 }
 
-/* Around a trace of dev->dyn: no stale filter, ids read through dev->dyn_map. */
+/* Around a trace of dev->dyn: no stale copies there (the filter only cuts), ids read through
+ * dev->dyn_map. */
 static inline void sy_rt_ictx_enter_dyn(sy_rt_ictx *ctx)
 {
     ctx->saved = ctx->rtc.filter;
-    ctx->rtc.filter = NULL;
+    ctx->rtc.filter = ctx->dyn_filter;
     ctx->in_dyn = 1;
 }
 static inline void sy_rt_ictx_leave_dyn(sy_rt_ictx *ctx)

@@ -306,6 +306,7 @@ static void spread(double *v, uint32_t n, double out[3])
 sy_rt_result sy_rt_bench_limit(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
                                uint32_t repeats, sy_rt_limit_result *out)
 {
+    if (dev && camera) sy_rt_clip_begin(dev, camera);
     if (!dev || !camera || !desc || !out || !desc->accum)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "bench limit: NULL argument (a PATHTRACER desc with an accum is needed)");
     if (desc->integrator != SY_RT_INTEGRATOR_PATHTRACER)

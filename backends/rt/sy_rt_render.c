@@ -12,6 +12,7 @@
 sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc, float *rgba,
                           float *depth)
 {
+    if (dev && camera) sy_rt_clip_begin(dev, camera);
     if (!dev || !camera || !desc) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: NULL argument");
     if (dev->dirty)
         return FAIL(SY_RT_ERROR_INVALID_OPERATION, "render: the device has uncommitted changes; call sy_rt_commit first");

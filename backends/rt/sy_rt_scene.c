@@ -544,16 +544,53 @@ static bool top_map_set(sy_rt_device *dev, unsigned id, sy_rt_instance_data *in)
  * every ray a little (a filtered leaf in the top scene, a twin in dyn). */
 static uint32_t stale_limit(const sy_rt_device *dev) { return 64u + dev->instances.live / 64u; }
 
-void sy_rt_stale_filter(const struct RTCFilterFunctionNArguments *args)
+/* The world point of a hit at barycentrics (u, v) of triangle prim of instance in. */
+static void hit_world_point(const sy_rt_instance_data *in, unsigned prim, float u, float v, float p[3])
+{
+    const sy_rt_mesh_data *m = in->mesh;
+    if (!m || prim >= m->triangle_count) {
+        p[0] = p[1] = p[2] = 0.0f;
+        return;
+    }
+    const uint32_t *ix = m->indices + 3u * prim;
+    const bool baked = (in->flags & SY_RT_INSTANCE_BAKED) && in->baked_positions;
+    const float *pos = baked ? in->baked_positions : m->positions;
+    const float w = 1.0f - u - v;
+    float q[3];
+    for (int k = 0; k < 3; ++k) q[k] = w * pos[3u * ix[0] + k] + u * pos[3u * ix[1] + k] + v * pos[3u * ix[2] + k];
+    if (baked) {
+        memcpy(p, q, sizeof q);
+        return;
+    }
+    const float *x = in->xf; /* column-major object-to-world */
+    for (int k = 0; k < 3; ++k) p[k] = x[k] * q[0] + x[4 + k] * q[1] + x[8 + k] * q[2] + x[12 + k];
+}
+
+void sy_rt_context_filter(const struct RTCFilterFunctionNArguments *args)
 {
     const sy_rt_device *dev = args->geometryUserPtr;
+    const sy_rt_ictx *ctx = (const sy_rt_ictx *)args->context;
     const unsigned N = args->N;
     const unsigned *hu = (const unsigned *)args->hit;
+    const float *hf = (const float *)args->hit;
     for (unsigned i = 0; i < N; ++i) {
         if (args->valid[i] != -1) continue;
-        /* installed only while tracing the top scene: ids are top-level ids */
-        const sy_rt_instance_data *in = sy_rt_hit_instance(dev, hu[6 * N + i], hu[7 * N + i]);
-        if (in && in->stale) args->valid[i] = 0;
+        const sy_rt_instance_data *in = sy_rt_filter_instance(dev, args->context, hu[6 * N + i], hu[7 * N + i]);
+        if (!in) continue;
+        if (!ctx->in_dyn && in->stale) { /* the top scene's stale copy: its twin in dyn shows it */
+            args->valid[i] = 0;
+            continue;
+        }
+        if (!dev->clip_count) continue;
+        float p[3];
+        hit_world_point(in, hu[5 * N + i], hf[3 * N + i], hf[4 * N + i], p);
+        for (uint32_t c = 0; c < dev->clip_count; ++c) {
+            const float *q = dev->clip_planes[c];
+            if (q[0] * p[0] + q[1] * p[1] + q[2] * p[2] + q[3] < 0.0f) {
+                args->valid[i] = 0;
+                break;
+            }
+        }
     }
 }
 

@@ -174,7 +174,7 @@ static void pathtracer_filter_info(void *state, sy_filter_info *out)
 static const sy_mediator_class pathtracer_class = {
     .name = "pathtracer",
     .param_table = SY_PARAM_TABLE(sy_rti_pathtracer_params),
-    .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_SAMPLE_RANGES | SY_CAP_AOVS | SY_CAP_FILTERS | SY_CAP_PICK,
+    .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_SAMPLE_RANGES | SY_CAP_AOVS | SY_CAP_FILTERS | SY_CAP_PICK | SY_CAP_CLIP,
     .create = pathtracer_create,
     .destroy = rt_destroy,
     .sync = sy_rti_sync,
@@ -191,7 +191,7 @@ const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtra
 static const sy_mediator_class whitted_class = {
     .name = "whitted",
     .param_table = SY_PARAM_TABLE(sy_rti_whitted_params),
-    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PREVIEW | SY_CAP_PICK,
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PREVIEW | SY_CAP_PICK | SY_CAP_CLIP,
     .create = whitted_create,
     .destroy = rt_destroy,
     .sync = sy_rti_sync,
@@ -211,7 +211,7 @@ static sy_result coverage_create(const sy_mediator_create_args *args, void **sta
 static const sy_mediator_class coverage_class = {
     .name = "coverage",
     .param_table = SY_PARAM_TABLE(sy_rti_coverage_params),
-    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_ANALYSIS | SY_CAP_COVERAGE | SY_CAP_PICK,
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_ANALYSIS | SY_CAP_COVERAGE | SY_CAP_PICK | SY_CAP_CLIP,
     .create = coverage_create,
     .destroy = rt_destroy,
     .sync = sy_rti_sync,

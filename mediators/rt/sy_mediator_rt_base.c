@@ -111,4 +111,7 @@ void sy_rti_camera_of(const sy_camera_view *v, sy_rt_camera *cam)
     memcpy(cam->window, v->window, sizeof cam->window);
     cam->near_clip = v->znear;
     cam->far_clip = v->zfar;
+    _Static_assert(SY_RT_CLIP_PLANES_MAX == SY_CLIP_PLANES_MAX, "one section plane array");
+    cam->clip_count = v->clip_count < SY_CLIP_PLANES_MAX ? v->clip_count : SY_CLIP_PLANES_MAX;
+    memcpy(cam->clip_planes, v->clip_planes, sizeof cam->clip_planes);
 }
