@@ -433,7 +433,13 @@ typedef struct sy_gl_camera {
     float window[4]; /**< {left, right, bottom, top}: tangent space at distance 1 (perspective) or camera units */
     /** @{ far 0 = infinite */
     float near_clip, far_clip; /** @} */
+    /** Section planes {a, b, c, d} in world coordinates (the caller checks them: finite, non-zero
+     * normal): only surface points with a*x + b*y + c*z + d >= 0 for each plane are drawn, in the
+     * main (forward and deferred), shadow-map, probe and pick passes alike (gl_ClipDistance). */
+    uint32_t clip_count; /**< 0..SY_GL_CLIP_PLANES_MAX; 0 = nothing cut */
+    float clip_planes[6][4];
 } sy_gl_camera;
+#define SY_GL_CLIP_PLANES_MAX 6 /**< most section planes in a sy_gl_camera */
 /** What to render: the full image and the rectangle to fill. */
 typedef struct sy_gl_render_desc {
     /** @{ the full image the camera window maps onto */

@@ -112,6 +112,8 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
         if (!g) continue;
         dev->ug[k].normal_mat = gl->GetUniformLocation(g, "u_normal_mat");
         dev->ug[k].mvp = gl->GetUniformLocation(g, "u_mvp");
+        dev->ug[k].model = gl->GetUniformLocation(g, "u_model");
+        sy_gli_bind_clip_block(gl, g);
         dev->ug[k].ppu = gl->GetUniformLocation(g, "u_ppu");
         dev->ug[k].ortho_z = gl->GetUniformLocation(g, "u_ortho_z");
         dev->ug[k].has_normals = gl->GetUniformLocation(g, "u_has_normals");
@@ -194,8 +196,8 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         if (dev->ug[1].prog) gl->DeleteProgram(dev->ug[1].prog);
         if (dev->mtab) gl->DeleteTextures(1, &dev->mtab);
         sy_gl_ibl_free(gl, &dev->ibl);
-        GLuint bufs[3] = {dev->default_ubo, dev->lights_ubo, dev->areas_ubo};
-        gl->DeleteBuffers(3, bufs);
+        GLuint bufs[4] = {dev->default_ubo, dev->lights_ubo, dev->areas_ubo, dev->clip_ubo};
+        gl->DeleteBuffers(dev->clip_ubo ? 4 : 3, bufs);
         gl->DeleteTextures(STANDINS, dev->standin);
         gl->DeleteTextures(1, &dev->shadow_tex);
         for (uint32_t c = 0; c < SY_GL_MAX_CUBE_SHADOWS; ++c)

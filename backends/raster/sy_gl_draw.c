@@ -561,6 +561,7 @@ static void draw_gbuf(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const m
     float mvp[16];
     sy_gli_m4_mul(dc->viewproj, in->model, mvp);
     gl->UniformMatrix4fv(dev->ug[k].mvp, 1, GL_FALSE, mvp);
+    gl->UniformMatrix4fv(dev->ug[k].model, 1, GL_FALSE, in->model);
     gl->UniformMatrix3fv(dev->ug[k].normal_mat, 1, GL_FALSE, in->normal_mat);
     gl->Uniform1i(dev->ug[k].has_normals, m->has_normals);
     /* the key without geo (sy_gl_gbuf_fs): 4 x material row + front, plus 1 */
@@ -732,6 +733,7 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
     /* deferred shading in the main pass of a frame without blended instances (they would blend
      * over G-buffer samples) */
     dc.deferred = !dev->forward && !dev->in_probe_pass && skip == UINT32_MAX && nl[2] == 0;
+    sy_gli_clip_enable(dev, true);
     for (int li = 0; li < 3 && r == SY_GL_OK; ++li) {
         float *list = lists + 2 * (size_t)li * cap;
         qsort(list, nl[li], 2 * sizeof(float), li == 2 ? cmp_far_first : cmp_near_first);
@@ -757,6 +759,7 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
             gl->Disable(GL_BLEND);
         }
     }
+    sy_gli_clip_enable(dev, false);
     free(lists);
     return r;
 }

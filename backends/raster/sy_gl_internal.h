@@ -61,7 +61,7 @@ static inline void sy_gli_layer_refs(const sy_gl_material_desc *d, const sy_gl_t
 #define PROBE_SIZE_MIN 16u
 #define PROBE_SIZE_MAX 256u
 #define PROBE_MAX_ROUGHNESS 0.4f
-enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1, BIND_AREAS = 2 };
+enum { BIND_MATERIAL = 0, BIND_LIGHTS = 1, BIND_AREAS = 2, BIND_CLIP = 3 };
 /* Deferred shading (see sy_gl_shaders.c, sy_gl_gbuf_fs): the shading pass samples no material
  * texture, so the G-buffer and the material table use the material units. */
 enum { UNIT_GCOL = UNIT_BASE, UNIT_GDEPTH = UNIT_MR, UNIT_MTAB = UNIT_NRM };
@@ -231,11 +231,16 @@ struct sy_gl_device {
     double profile_t[2]; /* the last mark's wall and CPU time */
     targets t;
     bool lights_dirty;
+    /* section planes (sy_gl_camera.clip_planes) of the last render or pick: the Clip block's buffer
+     * (SY_GL_CLIP_VS), made on first use; a change re-renders the shadow maps and probes */
+    GLuint clip_ubo;
+    uint32_t clip_count;
+    float clip_planes[SY_GL_CLIP_PLANES_MAX][4];
     /* deferred shading */
     bool forward; /* sy_gl_device_desc.forward */
     struct { /* the G-buffer pass: perspective, orthographic */
         GLuint prog;
-        GLint normal_mat, mvp, ppu, ortho_z, has_normals, keys;
+        GLint normal_mat, mvp, model, ppu, ortho_z, has_normals, keys;
     } ug[2];
     struct {
         int var;        /* the lighting variant bits */
@@ -373,6 +378,14 @@ void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
 /* Whether material d uses a material extension (then it draws with VAR_LAYERS). */
 bool sy_gli_material_layered(const sy_gl_device *dev, const sy_gl_material_desc *d);
 void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog);
+/* Binds prog's Clip block (SY_GL_CLIP_VS), when it has one, to BIND_CLIP (bind_samplers does too). */
+void sy_gli_bind_clip_block(const sy_gl_fns *gl, GLuint prog);
+/* Takes the camera's section planes for the render or pick that begins: uploads the Clip block and
+ * binds it; planes other than the last call's re-render the shadow maps and probes (lights_dirty). */
+void sy_gli_clip_set(sy_gl_device *dev, const sy_gl_camera *cam);
+/* Enables (on) the clip distances of the planes in use around the passes that draw the scene with
+ * SY_GL_CLIP_VS shaders, and disables them after (the other passes' shaders write none). */
+void sy_gli_clip_enable(sy_gl_device *dev, bool on);
 int sy_gli_variant_normalize(int v);
 GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep);
 int sy_gli_deferred_program(sy_gl_device *dev, int v, sy_gl_report *rep);

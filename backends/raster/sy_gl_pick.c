@@ -16,13 +16,13 @@
 #define PICK_ZOOM 64.0 /* how much narrower than the pixel the ID pass's window is (see sy_gl_pick) */
 
 static const char *const pick_vs =
-    "#version 330 core\n"
+    "#version 330 core\n" SY_GL_CLIP_VS
     "layout(location=0) in vec3 a_pos; layout(location=2) in vec2 a_uv0; layout(location=3) in vec2 a_uv1;\n"
     "layout(location=4) in vec4 a_col;\n"
     "uniform mat4 u_model; uniform mat4 u_view; uniform mat4 u_proj; uniform int u_uvset; uniform vec3 u_xf0, u_xf1;\n"
     "out vec2 v_uv; out float v_alpha;\n"
     "void main() { vec3 t = vec3(u_uvset == 1 ? a_uv1 : a_uv0, 1.0); v_uv = vec2(dot(u_xf0, t), dot(u_xf1, t));\n"
-    "  v_alpha = a_col.a; gl_Position = u_proj * (u_view * (u_model * vec4(a_pos, 1.0))); }\n";
+    "  v_alpha = a_col.a; vec4 w = u_model * vec4(a_pos, 1.0); sy_clip(w.xyz); gl_Position = u_proj * (u_view * w); }\n";
 
 static const char *const pick_fs =
     "#version 330 core\n"
@@ -57,6 +57,7 @@ static sy_gl_result pick_setup(sy_gl_device *dev, sy_gl_report *rep)
         for (int i = 0; i < PICK_UNIFORMS; ++i) dev->pick.u[i] = gl->GetUniformLocation(dev->pick.prog, names[i]);
         gl->UseProgram(dev->pick.prog);
         gl->Uniform1i(gl->GetUniformLocation(dev->pick.prog, "t_base"), 0);
+        sy_gli_bind_clip_block(gl, dev->pick.prog);
     }
     if (!dev->pick.fbo) {
         gl->GenFramebuffers(1, &dev->pick.fbo);
@@ -85,6 +86,7 @@ sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t ima
         return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "pick: pixel (%u, %u) is outside the %ux%u image", x, y,
                            image_width, image_height);
     sy_gl_result r = sy_gli_current(dev, rep);
+    if (r == SY_GL_OK) sy_gli_clip_set(dev, cam);
     /* the 1x1 target is a window PICK_ZOOM times narrower than the pixel, centred on its centre:
      * the same ray, with the rasterizer's sub-pixel snapping PICK_ZOOM times finer, so a centre
      * near a shared edge goes to the triangle the ray meets (with the pixel's own window, one in
@@ -128,6 +130,7 @@ sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t ima
     float vp[16], planes[6][4];
     sy_gli_m4_mul(v.proj, v.view, vp);
     sy_gli_frustum_planes(vp, planes);
+    sy_gli_clip_enable(dev, true);
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
         const inst_o *in = sy_gli_pool_at(&dev->instances, i);
         if (!in->h.id || !in->visible) continue;
@@ -157,6 +160,7 @@ sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t ima
         gl->UniformMatrix4fv(u[0], 1, GL_FALSE, in->model);
         sy_gli_draw_mesh_lod(dev, m, 0);
     }
+    sy_gli_clip_enable(dev, false);
     float px[4] = {0, 0, 0, 0};
     gl->ReadBuffer(GL_COLOR_ATTACHMENT0);
     gl->PixelStorei(GL_PACK_ALIGNMENT, 1);

@@ -114,6 +114,47 @@ void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog)
     if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_LIGHTS);
     b = gl->GetUniformBlockIndex(prog, "Areas");
     if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_AREAS);
+    sy_gli_bind_clip_block(gl, prog);
+}
+
+void sy_gli_bind_clip_block(const sy_gl_fns *gl, GLuint prog)
+{
+    GLuint b = gl->GetUniformBlockIndex(prog, "Clip");
+    if (b != GL_INVALID_INDEX) gl->UniformBlockBinding(prog, b, BIND_CLIP);
+}
+
+void sy_gli_clip_set(sy_gl_device *dev, const sy_gl_camera *cam)
+{
+    const sy_gl_fns *gl = dev->gl;
+    uint32_t n = cam->clip_count < SY_GL_CLIP_PLANES_MAX ? cam->clip_count : SY_GL_CLIP_PLANES_MAX;
+    bool changed = n != dev->clip_count || (n && memcmp(dev->clip_planes, cam->clip_planes, n * sizeof dev->clip_planes[0]));
+    if (!dev->clip_ubo) {
+        gl->GenBuffers(1, &dev->clip_ubo);
+        changed = true;
+    }
+    if (changed) {
+        float block[SY_GL_CLIP_PLANES_MAX][4];
+        for (uint32_t i = 0; i < SY_GL_CLIP_PLANES_MAX; ++i) {
+            static const float keep_all[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+            memcpy(block[i], i < n ? cam->clip_planes[i] : keep_all, sizeof block[i]);
+        }
+        gl->BindBuffer(GL_UNIFORM_BUFFER, dev->clip_ubo);
+        gl->BufferData(GL_UNIFORM_BUFFER, sizeof block, block, GL_DYNAMIC_DRAW);
+        gl->BindBuffer(GL_UNIFORM_BUFFER, 0);
+        if (n != dev->clip_count || n) dev->lights_dirty = true; /* the shadow maps and probes see the cut */
+        dev->clip_count = n;
+        if (n) memcpy(dev->clip_planes, cam->clip_planes, n * sizeof dev->clip_planes[0]);
+    }
+    gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_CLIP, dev->clip_ubo);
+}
+
+void sy_gli_clip_enable(sy_gl_device *dev, bool on)
+{
+    const sy_gl_fns *gl = dev->gl;
+    for (uint32_t i = 0; i < dev->clip_count; ++i) {
+        if (on) gl->Enable(GL_CLIP_DISTANCE0 + i);
+        else gl->Disable(GL_CLIP_DISTANCE0 + i);
+    }
 }
 
 /* Drops variant bits that cannot matter, so that equivalent draws share one program. */

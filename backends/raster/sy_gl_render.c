@@ -158,6 +158,7 @@ static sy_gl_result frame_setup(sy_gl_device *dev, const sy_gl_camera *cam, cons
 {
     sy_gl_result r = sy_gli_current(dev, rep);
     if (r == SY_GL_OK) r = sy_gli_view_make(dev, cam, d, v, rep);
+    if (r == SY_GL_OK) sy_gli_clip_set(dev, cam);
     if (r == SY_GL_OK) r = sy_gli_targets_ensure(dev, d->width, d->height, rep);
     dev->tris = dev->draws = 0;
     return r;

@@ -31,7 +31,7 @@
     "#endif\n"
 
 const char *const sy_gl_main_vs =
-    "#version 330 core\n" SY_GL_VARIANT_PRELUDE
+    "#version 330 core\n" SY_GL_VARIANT_PRELUDE SY_GL_CLIP_VS
     "layout(location=0) in vec3 a_pos; layout(location=1) in vec3 a_nrm; layout(location=2) in vec2 a_uv0;\n"
     "layout(location=3) in vec2 a_uv1; layout(location=4) in vec4 a_col;\n"
     "uniform mat4 u_model; uniform mat3 u_normal_mat; uniform mat4 u_mvp;\n" /* u_mvp = proj * view * model (CPU) */
@@ -48,8 +48,9 @@ const char *const sy_gl_main_vs =
     "out vec4 v_col;\n"
     "#endif\n"
     "void main() {\n"
+    "  vec3 wpos = (u_model * vec4(a_pos, 1.0)).xyz; sy_clip(wpos);\n"
     "#ifdef SY_LIT\n"
-    "  v_wpos = (u_model * vec4(a_pos, 1.0)).xyz; v_nrm = u_normal_mat * a_nrm;\n"
+    "  v_wpos = wpos; v_nrm = u_normal_mat * a_nrm;\n"
     "#endif\n"
     "#ifdef SY_TEX\n"
     "  v_uv0 = a_uv0;\n"
@@ -538,10 +539,11 @@ const char *const sy_gl_main_fs =
  * pass, which turns the slope into a world-space normal. (Measured: a third target for the slope,
  * or the slope in a wider depth target, costs as much as the arithmetic it saves.) */
 const char *const sy_gl_gbuf_vs =
-    "#version 330 core\n"
+    "#version 330 core\n" SY_GL_CLIP_VS
     "layout(location=0) in vec3 a_pos; layout(location=1) in vec3 a_nrm;\n"
-    "uniform mat3 u_normal_mat; uniform mat4 u_mvp; uniform bool u_has_normals; out vec3 v_nrm;\n"
-    "void main() { v_nrm = u_has_normals ? u_normal_mat * a_nrm : vec3(0.0); gl_Position = u_mvp * vec4(a_pos, 1.0); }\n";
+    "uniform mat3 u_normal_mat; uniform mat4 u_mvp; uniform mat4 u_model; uniform bool u_has_normals; out vec3 v_nrm;\n"
+    "void main() { v_nrm = u_has_normals ? u_normal_mat * a_nrm : vec3(0.0); gl_Position = u_mvp * vec4(a_pos, 1.0);\n"
+    "  sy_clip((u_model * vec4(a_pos, 1.0)).xyz); }\n";
 
 /* u_ppu: pixels per unit of the view plane at distance 1 (perspective) or per metre (SY_ORTHO);
  * u_ortho_z (SY_ORTHO): proj[10], proj[14]; u_keys: 1 + the key without geo for front-facing
@@ -658,11 +660,12 @@ const char *const sy_gl_deferred_fs =
     "}\n";
 
 const char *const sy_gl_shadow_vs =
-    "#version 330 core\n"
+    "#version 330 core\n" SY_GL_CLIP_VS
     "layout(location=0) in vec3 a_pos; layout(location=2) in vec2 a_uv0; layout(location=3) in vec2 a_uv1;\n"
     "layout(location=4) in vec4 a_col;\n"
     "uniform mat4 u_model; uniform mat4 u_lightvp; out vec2 v_uv0; out vec2 v_uv1; out float v_a;\n"
-    "void main() { v_uv0 = a_uv0; v_uv1 = a_uv1; v_a = a_col.a; gl_Position = u_lightvp * u_model * vec4(a_pos, 1.0); }\n";
+    "void main() { v_uv0 = a_uv0; v_uv1 = a_uv1; v_a = a_col.a; vec4 w = u_model * vec4(a_pos, 1.0); sy_clip(w.xyz);\n"
+    "  gl_Position = u_lightvp * w; }\n";
 
 const char *const sy_gl_shadow_fs =
     "#version 330 core\n" SY_GL_MATERIAL_BLOCK

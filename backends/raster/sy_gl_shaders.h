@@ -6,6 +6,18 @@
 
 #include "sy_gl_context.h"
 
+/* Section planes in the vertex shaders that draw the scene (main, G-buffer, shadow and pick passes):
+ * the Clip block (binding BIND_CLIP, sy_gli_clip_set) holds 6 planes in world space, the unused ones
+ * {0, 0, 0, 1}; sy_clip(world position) writes gl_ClipDistance[0..5], and the passes enable
+ * GL_CLIP_DISTANCE0 + i for the planes in use only while they draw the scene (sy_gli_clip_enable). */
+#define SY_GL_CLIP_VS                                                                                    \
+    "layout(std140) uniform Clip { vec4 c_planes[6]; };\n"                                                \
+    "out float gl_ClipDistance[6];\n"                                                                     \
+    "void sy_clip(vec3 w) { vec4 h = vec4(w, 1.0);\n"                                                     \
+    "  gl_ClipDistance[0] = dot(c_planes[0], h); gl_ClipDistance[1] = dot(c_planes[1], h);\n"            \
+    "  gl_ClipDistance[2] = dot(c_planes[2], h); gl_ClipDistance[3] = dot(c_planes[3], h);\n"            \
+    "  gl_ClipDistance[4] = dot(c_planes[4], h); gl_ClipDistance[5] = dot(c_planes[5], h); }\n"
+
 extern const char *const sy_gl_main_vs, *const sy_gl_main_fs;
 extern const char *const sy_gl_shadow_vs, *const sy_gl_shadow_fs;
 extern const char *const sy_gl_fullscreen_vs; /* a full-screen triangle (the sky, the IBL tables) */

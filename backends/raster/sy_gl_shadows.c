@@ -295,6 +295,7 @@ void sy_gli_render_shadows(sy_gl_device *dev, const frame_state *fs)
     gl->Enable(GL_POLYGON_OFFSET_FILL);
     gl->PolygonOffset(1.5f, 4.0f);
     gl->Viewport(0, 0, (GLsizei)dev->shadow_size, (GLsizei)dev->shadow_size);
+    sy_gli_clip_enable(dev, true); /* the shadow maps see the cut model */
     for (uint32_t s = 0; s < fs->shadow_count; ++s) {
         gl->FramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, dev->shadow_tex, 0, (GLint)s);
         draw_casters(dev, fs->shadow_vp[s]);
@@ -312,6 +313,7 @@ void sy_gli_render_shadows(sy_gl_device *dev, const frame_state *fs)
             draw_casters(dev, vp);
         }
     }
+    sy_gli_clip_enable(dev, false);
     gl->Disable(GL_POLYGON_OFFSET_FILL);
     dev->shadow_maps = fs->shadow_count + 6u * fs->cube_count;
 }

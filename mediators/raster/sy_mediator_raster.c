@@ -371,6 +371,9 @@ static void camera_of(const sy_camera_view *v, sy_gl_camera *cam)
     memcpy(cam->window, v->window, sizeof cam->window);
     cam->near_clip = v->znear;
     cam->far_clip = v->zfar;
+    _Static_assert(SY_GL_CLIP_PLANES_MAX == SY_CLIP_PLANES_MAX, "one section plane array");
+    cam->clip_count = v->clip_count < SY_CLIP_PLANES_MAX ? v->clip_count : SY_CLIP_PLANES_MAX;
+    memcpy(cam->clip_planes, v->clip_planes, sizeof cam->clip_planes);
 }
 
 /* >>look: the resolved look -> the device's environment light and background. */
@@ -813,7 +816,7 @@ static void raster_stats(void *state, sy_mediator_stats *out)
 static const sy_mediator_class raster_class = {
     .name = "raster",
     .param_table = SY_PARAM_TABLE(raster_params),
-    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PICK,
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PICK | SY_CAP_CLIP,
     .create = raster_create,
     .destroy = raster_destroy,
     .sync = raster_sync,
