@@ -196,6 +196,9 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
         for (int i = 0; i < 4; ++i) w_f32(&w, r->camera.window[i]);
         w_f32(&w, r->camera.znear);
         w_f32(&w, r->camera.zfar);
+        w_u32(&w, r->camera.clip_count); /* section planes (protocol 4) */
+        for (uint32_t i = 0; i < r->camera.clip_count && i < SY_CLIP_PLANES_MAX; ++i)
+            for (int k = 0; k < 4; ++k) w_f32(&w, r->camera.clip_planes[i][k]);
         w_u32(&w, r->tile_count);
         for (uint32_t i = 0; i < r->tile_count; ++i) {
             w_u32(&w, r->tiles[i].x);
@@ -501,6 +504,11 @@ sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, 
         for (int i = 0; i < 4; ++i) q->camera.window[i] = rd_f32(&rd);
         q->camera.znear = rd_f32(&rd);
         q->camera.zfar = rd_f32(&rd);
+        q->camera.clip_count = rd_u32(&rd);
+        if (!rd.r && q->camera.clip_count > SY_CLIP_PLANES_MAX)
+            rd_fail(&rd, SY_ERR_LIMIT, "more than 6 section planes");
+        for (uint32_t i = 0; !rd.r && i < q->camera.clip_count; ++i)
+            for (int k = 0; k < 4; ++k) q->camera.clip_planes[i][k] = rd_f32(&rd);
         q->tile_count = rd_u32(&rd);
         if (!rd.r) {
             if (q->eye > 2) rd_fail(&rd, SY_ERR_PARSE, "eye must be 0 (mono), 1 (left) or 2 (right)");

@@ -30,7 +30,7 @@ extern "C" {
 #endif
 
 #define SY_CLUSTER_MAGIC 0x50435953u /**< "SYCP" little endian */
-#define SY_CLUSTER_VERSION 3u /**< protocol version this build speaks */
+#define SY_CLUSTER_VERSION 4u /**< protocol version this build speaks (4: RENDER carries section planes) */
 #define SY_CLUSTER_HEADER_SIZE 24u /**< bytes of a frame header */
 #define SY_CLUSTER_TAG_SIZE 32u /**< bytes of a frame's authentication tag */
 #define SY_CLUSTER_NONCE_SIZE 32u /**< bytes of a handshake nonce */

@@ -87,7 +87,7 @@ static uint32_t cluster_caps_of(const sy_params *p, const void *class_user)
     const char *backend = sy_params_get(p, "backend"), *m = sy_params_get(p, "mode");
     uint32_t mode = SY_CLUSTER_SORT_FIRST;
     if (m && !sy_cluster_mode_parse(m, &mode)) mode = SY_CLUSTER_SORT_FIRST;
-    uint32_t common = SY_CAP_DEPTH | SY_CAP_ANALYSIS | SY_CAP_SAMPLE_RANGES | SY_CAP_PICK;
+    uint32_t common = SY_CAP_DEPTH | SY_CAP_ANALYSIS | SY_CAP_SAMPLE_RANGES | SY_CAP_PICK | SY_CAP_CLIP;
     uint64_t mask = 0;
     if (parse_servers(cfg, sy_params_get(p, "servers"), &mask, NULL) != SY_OK) mask = 0;
     for (uint32_t i = 0; i < cfg->opts.url_count; ++i) {
@@ -100,6 +100,8 @@ static uint32_t cluster_caps_of(const sy_params *p, const void *class_user)
     /* picks: answered here by the viewport's back-end class (cluster_pick), so it must be registered
      * in this process and pick, as must every server's */
     if ((common & SY_CAP_PICK) && backend && (remote_caps(backend) & SY_CAP_PICK)) caps |= SY_CAP_PICK;
+    /* section planes travel in the RENDER's camera view (protocol 4) to servers whose back-end cuts */
+    if (common & SY_CAP_CLIP) caps |= SY_CAP_CLIP;
     return caps;
 }
 

@@ -18,6 +18,9 @@
  *      viewport names the same node, primitive and triangle, at the same position, as a local
  *      whitted viewport at every pixel of a grid, and misses where it misses; a change after the
  *      first pick (a node moved) is seen by the next.
+ *   7. Section planes travel with the view (SY_CAP_CLIP, protocol 4): the demo cut through its
+ *      centre by whitted on the cluster (sort-first, balanced) equals the same cut rendered
+ *      locally (rmse <= 1e-6) and differs from the uncut image.
  *   test_cluster_mediator SERVER_EXE WORK_DIR */
 #include "../support/sy_check.h"
 #include "server_proc.h"
@@ -59,6 +62,10 @@ static sy_result add_overlay_root(fixture *fx, sy_error *e)
 /* Side-by-side stereo: per eye the main viewport (backend/params) and a raster overlay composited
  * by depth (overlay_backend/overlay_params; NULL = local raster); renders into out (2W x H) with a
  * fresh context pool (a fresh accumulation). */
+/* Section planes set on the main viewports of render_sbs_with (part 7). */
+static uint32_t g_clip_count;
+static float g_clip[SY_CLIP_PLANES_MAX][4];
+
 static int render_sbs_with(fixture *fx, const char *backend, const char *params, const char *overlay_backend,
                            const char *overlay_params, uint32_t spp, uint32_t seed, sy_layer *out, uint64_t *samples_out)
 {
@@ -78,6 +85,7 @@ static int render_sbs_with(fixture *fx, const char *backend, const char *params,
         overlay.composite = SY_COMPOSITE_DEPTH;
         sy_viewport *v = NULL;
         CHECK_OK(sy_window_add_viewport(win, &main, &v, &e), e);
+        CHECK_OK(sy_viewport_set_clip_planes(v, (const float(*)[4])g_clip, g_clip_count, &e), e);
         CHECK_OK(sy_window_add_viewport(win, &overlay, &v, &e), e);
     }
     sy_context_pool *pool = NULL;
@@ -152,6 +160,27 @@ static int test_sort_first_and_balanced(fixture *fx)
     CHECK_MSG(e1 <= 1e-6 && e2 <= 1e-6, "cluster composite differs from the local one");
     CHECK_MSG(mean_rgb(&local) > 0.01, "the reference image is black: the comparison would see nothing");
     sy_layer_destroy(&local), sy_layer_destroy(&sf), sy_layer_destroy(&bal);
+    return 0;
+}
+
+static int test_clip(fixture *fx)
+{
+    sy_bounds b = sy_scene_world_bounds(fx->scene);
+    const float cx = 0.5f * (b.min[0] + b.max[0]);
+    g_clip_count = 1;
+    g_clip[0][0] = 1.0f, g_clip[0][1] = 0.0f, g_clip[0][2] = 0.0f, g_clip[0][3] = -cx; /* keeps x >= centre */
+    sy_layer uncut = {0}, local = {0}, sf = {0}, bal = {0};
+    int failed = render_sbs(fx, "whitted", NULL, 0, 0, &local, NULL) || render_sbs(fx, "cluster", "backend=whitted,mode=sort-first", 0, 0, &sf, NULL) ||
+                 render_sbs(fx, "cluster", "backend=whitted,mode=balanced", 0, 0, &bal, NULL);
+    g_clip_count = 0;
+    CHECK(!failed);
+    CHECK(render_sbs(fx, "whitted", NULL, 0, 0, &uncut, NULL) == 0);
+    double e1 = rmse(&local, &sf), e2 = rmse(&local, &bal), d = mean_abs_diff(&local, &uncut);
+    printf("section plane x >= %.3f, whitted: sort-first rmse %.3g, balanced rmse %.3g; cut vs uncut mean |diff| %.4f\n",
+           (double)cx, e1, e2, d);
+    CHECK_MSG(e1 <= 1e-6 && e2 <= 1e-6, "the cluster's cut image differs from the local one");
+    CHECK_MSG(d > 0.01, "the plane cut nothing away: the comparison would see nothing");
+    sy_layer_destroy(&uncut), sy_layer_destroy(&local), sy_layer_destroy(&sf), sy_layer_destroy(&bal);
     return 0;
 }
 
@@ -376,6 +405,8 @@ int main(int argc, char **argv)
             printf("tiles and capabilities: %s\n", r ? "FAILED" : "ok");
             failed += r = test_refusals(&fx, s);
             printf("set-up refusals: %s\n", r ? "FAILED" : "ok");
+            failed += r = test_clip(&fx);
+            printf("section planes: %s\n", r ? "FAILED" : "ok");
             failed += r = test_pick(&fx); /* last: it moves the overlay sphere */
             printf("picks: %s\n", r ? "FAILED" : "ok");
         }

@@ -74,6 +74,9 @@ static sy_cluster_msg sample(uint32_t type)
         m.u.render.camera.window[2] = -0.5f;
         m.u.render.camera.window[3] = 0.5f;
         m.u.render.camera.znear = 0.1f;
+        m.u.render.camera.clip_count = 2; /* section planes (protocol 4) */
+        const float planes[2][4] = {{1, 0, 0, -0.25f}, {0, -0.5f, 0.5f, 2}};
+        memcpy(m.u.render.camera.clip_planes, planes, sizeof planes);
         m.u.render.tile_count = 3;
         m.u.render.tiles = g_tiles;
         break;
@@ -167,9 +170,9 @@ static int test_bad_headers(void)
     CHECK(strstr(e.message, "magic"));
     /* wrong version */
     memcpy(c, b.data, b.size);
-    c[4] = 2; /* a version-2 peer */
+    c[4] = 3; /* a version-3 peer (RENDER without section planes) */
     CHECK_ERR(sy_cluster_decode(c, b.size, NULL, &d, &e), SY_ERR_UNSUPPORTED, e);
-    CHECK(strstr(e.message, "version 2, this peer speaks 3"));
+    CHECK(strstr(e.message, "version 3, this peer speaks 4"));
     /* unknown type, unknown flags */
     memcpy(c, b.data, b.size);
     c[6] = 200;
@@ -244,6 +247,49 @@ static int test_bad_headers(void)
         CHECK_OK(sy_cluster_encode(&q, 0, &b, &e), e);
         CHECK_OK(sy_cluster_decode(b.data, b.size, NULL, &d, &e), e);
         sy_cluster_msg_free(&d);
+    }
+    /* section planes forged on the wire: NaN, a zero normal, 7 planes: refused by the decoder */
+    {
+        const float marker = 4343.5f;
+        static const struct { int k; float value; const char *reason; } bad[] = {
+            {0, NAN, "section plane 1"}, {3, INFINITY, "section plane 1"}, {-1, 0.0f, "the normal (a, b, c) is zero"}};
+        for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+            sy_cluster_msg q = m;
+            if (bad[i].k >= 0) {
+                q.u.render.camera.clip_planes[1][bad[i].k] = marker;
+            } else { /* the normal (0, -0.5, 0.5) of plane 1 zeroed on the wire: b and c */
+                q.u.render.camera.clip_planes[1][1] = marker, q.u.render.camera.clip_planes[1][2] = -marker;
+            }
+            b.size = 0;
+            CHECK_OK(sy_cluster_encode(&q, 0, &b, &e), e);
+            memcpy(c, b.data, b.size);
+            const float neg = -marker;
+            for (size_t j = 0; j + 4 <= b.size; ++j)
+                if (!memcmp(c + j, &marker, 4) || !memcmp(c + j, &neg, 4)) memcpy(c + j, &bad[i].value, 4);
+            CHECK_ERR(sy_cluster_decode(c, b.size, NULL, &d, &e), SY_ERR_PARSE, e);
+            CHECK_MSG(strstr(e.message, "cluster RENDER") && strstr(e.message, bad[i].reason), "%s", e.message);
+        }
+        sy_cluster_msg q = m;
+        b.size = 0;
+        CHECK_OK(sy_cluster_encode(&q, 0, &b, &e), e);
+        CHECK_OK(sy_cluster_decode(b.data, b.size, NULL, &d, &e), e);
+        CHECK(d.u.render.camera.clip_count == 2 &&
+              !memcmp(d.u.render.camera.clip_planes, m.u.render.camera.clip_planes, 2 * sizeof(float[4])));
+        sy_cluster_msg_free(&d);
+        /* the count itself: 7 on the wire */
+        memcpy(c, b.data, b.size);
+        const uint32_t two = 2, seven = 7;
+        int found = 0;
+        for (size_t j = 0; j + 4 <= b.size && !found; ++j)
+            if (!memcmp(c + j, &two, 4) && j + 4 + 32 <= b.size && !memcmp(c + j + 4, m.u.render.camera.clip_planes, 32))
+                memcpy(c + j, &seven, 4), found = 1;
+        CHECK(found);
+        CHECK_ERR(sy_cluster_decode(c, b.size, NULL, &d, &e), SY_ERR_LIMIT, e);
+        CHECK_MSG(strstr(e.message, "more than 6 section planes"), "%s", e.message);
+        /* the encoder refuses bad planes too */
+        q.u.render.camera.clip_planes[0][0] = NAN;
+        b.size = 0;
+        CHECK_ERR(sy_cluster_encode(&q, 0, &b, &e), SY_ERR_INVALID_ARGUMENT, e);
     }
     /* NaN in the camera */
     m.u.render.camera.znear = NAN;
