@@ -3,6 +3,9 @@
 #   - bad arguments: no pixel, an odd number of coordinates, NaN, a pixel outside the image, a
 #     negative one, an unknown back-end, an unreadable scene: non-zero exit (2 for usage errors, 1
 #     for the file) and a message naming the value; a pixel that hits nothing: exit 0, "hit": false.
+#   - section planes (--clip A,B,C,D): a malformed plane, a zero normal, NaN, a seventh plane: exit 2
+#     naming --clip (sy pick and sy render); a plane that removes the whole demo turns the hit at the
+#     image centre into "hit": false.
 #   - agreement on a Khronos sample (DamagedHelmet, 256x192): at a grid of 64 pixels over the model, raster,
 #     whitted and pathtracer hit the same pixels, and where they all hit they name the same node
 #     and triangle and report positions within 1e-4 x the scene size (its bounds' diagonal, from
@@ -32,6 +35,19 @@ expect_status 2 "nosuch" demo 1 1 -b nosuch
 expect_status 1 "$TMP/missing.gltf" "$TMP/missing.gltf" 1 1
 "$SY" pick demo 0 0 -b whitted -w 64 -h 48 >"$TMP/miss" 2>"$TMP/err" || fail "a miss exits non-zero: $(cat "$TMP/err")"
 grep -q '"hit": false' "$TMP/miss" || fail "a miss does not say \"hit\": false: $(cat "$TMP/miss")"
+
+# section planes
+expect_status 2 "--clip: '1,0,0' is not a section plane" demo 32 30 -b whitted -w 64 -h 48 --clip 1,0,0
+expect_status 2 "the normal (a, b, c) is zero" demo 32 30 -b whitted -w 64 -h 48 --clip 0,0,0,1
+expect_status 2 "--clip: 'nan,0,0,1'" demo 32 30 -b whitted -w 64 -h 48 --clip nan,0,0,1
+seven=(); for i in 1 2 3 4 5 6 7; do seven+=(--clip "1,0,0,$i"); done
+expect_status 2 "one section plane too many (at most 6)" demo 32 30 -b whitted -w 64 -h 48 "${seven[@]}"
+"$SY" render demo -b whitted -w 64 -h 48 --clip 1,0 -o "$TMP/x.png" 2>"$TMP/err"
+rc=$?; [ $rc = 2 ] && grep -qF -- "--clip: '1,0'" "$TMP/err" || fail "sy render --clip 1,0: exit $rc: $(cat "$TMP/err")"
+"$SY" pick demo 32 30 -b whitted -w 64 -h 48 >"$TMP/whole" 2>"$TMP/err" && grep -q '"hit": true' "$TMP/whole" ||
+    fail "the demo's centre is not a hit: $(cat "$TMP/whole" "$TMP/err")"
+"$SY" pick demo 32 30 -b whitted -w 64 -h 48 --clip 1,0,0,-1e6 >"$TMP/cut" 2>"$TMP/err" && grep -q '"hit": false' "$TMP/cut" ||
+    fail "a plane removing the whole demo left a hit: $(cat "$TMP/cut" "$TMP/err")"
 
 SCENE=$DATA/gltf/DamagedHelmet/glTF/DamagedHelmet.gltf
 if [ ! -f "$SCENE" ]; then
