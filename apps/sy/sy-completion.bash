@@ -35,7 +35,7 @@ _sy_options() {
     compare) echo "-w -h -o --spp --camera --backends $_sy_common" ;;
     convert) echo "-o $_sy_common" ;;
     coverage) echo "-w -h --camera --top --json $_sy_common" ;;
-    pick) echo "-b -w -h --camera --look-at --orbit --fov --params --json $_sy_common" ;;
+    pick) echo "-b -w -h --camera --look-at --orbit --fov --params --clip --json $_sy_common" ;;
     demo) echo "-o -w -h --filter $_sy_common" ;;
     backends) echo "--json --params $_sy_common" ;;
     serve) echo "--listen --secret-file --output --port-file --tls-cert --tls-key --name --max-sessions

@@ -437,7 +437,7 @@ typedef struct sy_gl_camera {
      * normal): only surface points with a*x + b*y + c*z + d >= 0 for each plane are drawn, in the
      * main (forward and deferred), shadow-map, probe and pick passes alike (gl_ClipDistance). */
     uint32_t clip_count; /**< 0..SY_GL_CLIP_PLANES_MAX; 0 = nothing cut */
-    float clip_planes[6][4];
+    float clip_planes[6][4]; /**< the planes {a, b, c, d}, world coordinates */
 } sy_gl_camera;
 #define SY_GL_CLIP_PLANES_MAX 6 /**< most section planes in a sy_gl_camera */
 /** What to render: the full image and the rectangle to fill. */

@@ -461,7 +461,7 @@ typedef struct sy_rt_camera {
      * cut side), so a ray that starts in the kept part and crosses a plane still finds what is
      * behind. 0 = nothing cut. */
     uint32_t clip_count;
-    float clip_planes[6][4];
+    float clip_planes[6][4]; /**< the planes {a, b, c, d}, world coordinates */
 } sy_rt_camera;
 #define SY_RT_CLIP_PLANES_MAX 6 /**< most section planes in a sy_rt_camera */
 

@@ -8,6 +8,7 @@ CAP_AOVS: int
 CAP_FILTERS: int
 CAP_REMOTE: int
 CAP_PICK: int
+CAP_CLIP: int
 CAP_COVERAGE: int
 TYPE_NODE: int
 TYPE_MESH: int
