@@ -3,7 +3,8 @@
  *
  *   1. Bad planes: NaN, infinite, beyond SY_COORD_MAX, a zero normal, seven planes: refused by
  *      sy_viewport_set_clip_planes with SY_ERR_INVALID_ARGUMENT naming the plane, the planes set
- *      before kept; count 0 removes them.
+ *      before kept; count 0 removes them; a class without SY_CAP_CLIP refuses a cut view
+ *      (SY_ERR_UNSUPPORTED naming it, never called) and renders the uncut one.
  *   2. Picks respect the cut: quad B (z = 1) in front of quad A (z = 0); a plane keeping z <= 0.5
  *      removes B, and a pick where B covered A names A (at A's depth) in every clip-capable back-end.
  *   3. Shadows see the cut: a ground quad lit by a directional light at 45 degrees, a caster quad
@@ -51,6 +52,30 @@ static void render(sy_scene *s, const char *backend, const char *params, const s
 }
 
 /* ---------------------------------------------------------------- 1. bad planes */
+/* A class without SY_CAP_CLIP (it would draw the uncut model): a cut view must not reach it. */
+static int noclip_renders;
+static sy_result noclip_create(const sy_mediator_create_args *a, void **st, sy_error *e)
+{
+    (void)a, (void)e;
+    *st = malloc(1);
+    return SY_OK;
+}
+static void noclip_destroy(void *st) { free(st); }
+static sy_result noclip_sync(void *st, const sy_changes *c, sy_error *e)
+{
+    (void)st, (void)c, (void)e;
+    return SY_OK;
+}
+static sy_result noclip_render(void *st, const sy_render_request *r, sy_layer *l, sy_error *e)
+{
+    (void)st, (void)r, (void)e;
+    noclip_renders++;
+    sy_layer_clear(l);
+    return SY_OK;
+}
+static const sy_mediator_class noclip_class = {.name = "test_noclip", .caps = SY_CAP_DEPTH, .create = noclip_create,
+                                               .destroy = noclip_destroy, .sync = noclip_sync, .render = noclip_render};
+
 static void test_bad_planes(void)
 {
     sy_scene *s;
@@ -81,26 +106,25 @@ static void test_bad_planes(void)
           "the planes set before were not kept");
     MUST(sy_viewport_set_clip_planes(vp, NULL, 0, err));
     EXPECT_MSG(sy_viewport_clip_planes(vp, NULL) == 0, "count 0 did not remove the planes");
-    /* a back-end without SY_CAP_CLIP refuses a cut view */
-    const sy_mediator_class *none = NULL;
-    for (uint32_t i = 0; i < sy_mediator_count() && !none; ++i)
-        if (!(sy_mediator_class_caps(sy_mediator_at(i), NULL) & (SY_CAP_CLIP | SY_CAP_REMOTE))) none = sy_mediator_at(i);
-    if (none) {
-        sy_context *ctx;
-        MUST(sy_context_create(s, none->name, NULL, 0, &ctx, err));
-        MUST(sy_context_sync(ctx, err));
-        sy_camera_view v = it_view_down_z(3.0f, 0.5f);
-        v.clip_count = 1;
-        memcpy(v.clip_planes[0], good[0], sizeof good[0]);
-        sy_layer img = {0};
-        e = (sy_error){0};
-        sy_result r = it_render_full(ctx, &v, 8, 8, &img, &e);
-        EXPECT_MSG(r == SY_ERR_UNSUPPORTED && strstr(e.message, none->name) && strstr(e.message, "SY_CAP_CLIP"),
-              "%s rendered a cut view: %s", none->name, e.message);
-        printf("bad planes: refused; %s without SY_CAP_CLIP: %s\n", none->name, e.message);
-        sy_layer_destroy(&img);
-        sy_context_release(ctx);
-    }
+    /* a back-end without SY_CAP_CLIP refuses a cut view, in a window render and a context render */
+    MUST(sy_mediator_register(&noclip_class, err));
+    MUST(sy_viewport_set_clip_planes(vp, good, 1, err));
+    MUST(sy_viewport_set_backend(vp, "test_noclip", NULL, err));
+    sy_context_pool *pool;
+    MUST(sy_context_pool_create(&pool, err));
+    sy_layer img = {0};
+    MUST(sy_layer_create(W, H, &img, err));
+    e = (sy_error){0};
+    sy_result r = sy_window_render(win, s, pool, NULL, &img, &e);
+    EXPECT_MSG(r == SY_ERR_UNSUPPORTED && strstr(e.message, "test_noclip") && strstr(e.message, "SY_CAP_CLIP") &&
+                   noclip_renders == 0,
+               "a class without SY_CAP_CLIP rendered a cut view: %s (%d renders)", e.message, noclip_renders);
+    printf("bad planes: refused; test_noclip without SY_CAP_CLIP: %s\n", e.message);
+    MUST(sy_viewport_set_clip_planes(vp, NULL, 0, err));
+    MUST(sy_window_render(win, s, pool, NULL, &img, err)); /* uncut: fine */
+    EXPECT_MSG(noclip_renders == 1, "the uncut view was not rendered (%d renders)", noclip_renders);
+    sy_layer_destroy(&img);
+    sy_context_pool_destroy(pool);
     sy_window_destroy(win);
     sy_scene_destroy(s);
 }
