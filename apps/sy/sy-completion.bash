@@ -17,7 +17,7 @@ _sy_common="--help -q --quiet -v --verbose --env --env-color --env-intensity --e
 _sy_cluster="--cluster --cluster-mode --secret-file --tls-ca --timeout-ms --cluster-pixels"
 # options that take a value (the next word)
 _sy_with_value=" -b -o -w -h --camera --look-at --orbit --fov --params --at --clip --max-memory --gl --filter --threshold --exposure --tonemap --stereo --eye-sep
-  --zero-parallax --overlay --composite --frames --spp --time --cluster --cluster-mode --secret-file --tls-ca
+  --zero-parallax --overlay --composite --frames --fps --repeat --spp --time --cluster --cluster-mode --secret-file --tls-ca
   --timeout-ms --cluster-pixels --screenshot --keys --top --backends --repeats --nodes --tris --reference --env
   --env-color --env-intensity --background --allow-path --max-scene-mb --variant --listen --output --port-file --tls-cert --tls-key --name
   --max-sessions --max-lifetime --blob-cache-mb --max-objects --auth-backoff-ms --max-peer-memory-mb
@@ -27,7 +27,8 @@ _sy_with_value=" -b -o -w -h --camera --look-at --orbit --fov --params --at --cl
 _sy_options() {
     case "${1:-}" in
     render) echo "-b -o -w -h --camera --look-at --orbit --fov --params --at --clip --max-memory --gl --filter --threshold --half --exposure --tonemap --stereo
-                  --eye-sep --zero-parallax --overlay --composite --frames --spp --time --aov $_sy_cluster $_sy_common" ;;
+                  --eye-sep --zero-parallax --overlay --composite --frames --fps --resume --repeat --spp --time --aov
+                  $_sy_cluster $_sy_common" ;;
     view) echo "-b -w -h --camera --look-at --orbit --fov --overlay --composite --frames --screenshot --filter --threshold --keys --spp --budget
                 $_sy_cluster $_sy_common" ;;
     web) echo "-b -w -h --camera --look-at --orbit --fov --listen --quality --filter --threshold --budget --client-render $_sy_common" ;;

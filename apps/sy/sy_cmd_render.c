@@ -106,6 +106,38 @@ static void default_output(const char *scene, char *out, size_t out_len)
     snprintf(out, out_len, "%.*s.png", n, base);
 }
 
+/* --frames A:B[:STEP]: frame numbers A..B inclusive (A <= B), every STEP-th (default 1); false on
+ * anything else. "N" alone (the cluster's old repeat count, now --repeat) is false too. */
+static bool parse_frame_range(const char *s, uint32_t *a, uint32_t *b, uint32_t *step)
+{
+    char *end = NULL;
+    if (!strchr(s, ':')) return false;
+    errno = 0;
+    unsigned long x = strtoul(s, &end, 10);
+    if (end == s || *end != ':' || s[0] == '-' || x > 100000000ul) return false;
+    const char *q = end + 1;
+    unsigned long y = strtoul(q, &end, 10);
+    if (end == q || q[0] == '-' || y > 100000000ul || y < x) return false;
+    unsigned long z = 1;
+    if (*end == ':') {
+        q = end + 1;
+        z = strtoul(q, &end, 10);
+        if (end == q || q[0] == '-' || z < 1 || z > 100000000ul) return false;
+    }
+    if (*end || errno) return false;
+    *a = (uint32_t)x, *b = (uint32_t)y, *step = (uint32_t)z;
+    return true;
+}
+
+/* The output of one frame of a sequence: the pattern's first run of '#' replaced by the frame
+ * number, zero-padded to the run's length (longer numbers are written in full). */
+static void frame_path(const char *pattern, uint32_t frame, char *out, size_t out_len)
+{
+    const char *p = strchr(pattern, '#');
+    size_t run = strspn(p, "#");
+    snprintf(out, out_len, "%.*s%0*u%s", (int)(p - pattern), pattern, (int)run, frame, p + run);
+}
+
 /* >>progressive (path tracer): sample budget, environment, feature buffers */
 typedef struct pt_opts {
     uint32_t spp;         /* 0 = default (64 unless a time budget is given) */
@@ -301,6 +333,10 @@ int sy_cmd_render(int argc, char **argv)
     double at = 0.0;           /* --at: the scene's time in seconds */
     bool at_given = false;
     const char *clip = NULL;   /* --clip NAME|INDEX: one animation; without it every clip plays */
+    bool seq = false, resume = false; /* --frames A:B[:STEP]: an image sequence; --resume */
+    uint32_t fa = 0, fb = 0, fstep = 1;
+    double fps = 24.0;
+    bool fps_given = false;
     static const struct option lo[] = {
         {"spp", required_argument, NULL, OPT_SPP}, {"time", required_argument, NULL, OPT_TIME},
         {"aov", no_argument, NULL, OPT_AOV}, {"camera", required_argument, NULL, OPT_CAMERA},
@@ -310,7 +346,9 @@ int sy_cmd_render(int argc, char **argv)
         {"tonemap", required_argument, NULL, OPT_TONEMAP}, {"stereo", required_argument, NULL, OPT_STEREO},
         {"eye-sep", required_argument, NULL, OPT_EYE_SEP}, {"zero-parallax", required_argument, NULL, OPT_ZERO_PARALLAX},
         {"overlay", required_argument, NULL, OPT_OVERLAY}, {"composite", required_argument, NULL, OPT_COMPOSITE},
-        {"frames", required_argument, NULL, OPT_FRAMES}, /* cluster: frames through the same window */
+        {"frames", required_argument, NULL, OPT_FRAMES}, {"fps", required_argument, NULL, OPT_FPS}, /* a sequence */
+        {"resume", no_argument, NULL, OPT_RESUME},
+        {"repeat", required_argument, NULL, OPT_REPEAT}, /* cluster: frames through the same window */
         {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
         {"at", required_argument, NULL, OPT_AT}, {"clip", required_argument, NULL, OPT_CLIP}, /* the scene clock */
         SY_CLUSTER_CLI_OPTIONS, VIEW_OPTIONS, COMMON_OPTIONS};
@@ -362,7 +400,21 @@ int sy_cmd_render(int argc, char **argv)
         case OPT_OVERLAY: overlay = optarg; break;
         case OPT_COMPOSITE: composite = optarg; break;
         case OPT_FRAMES:
-            if (!sy_cli_parse_u32(optarg, 1, 100000000u, &clo.frames)) return sy_cli_bad_value("--frames", optarg);
+            if (!strchr(optarg, ':')) {
+                fprintf(stderr, "sy render: error: --frames %s: a sequence is --frames A:B[:STEP] (frame numbers); "
+                                "the cluster's repeat count is --repeat N\n", optarg);
+                return 2;
+            }
+            if (!parse_frame_range(optarg, &fa, &fb, &fstep)) return sy_cli_bad_value("--frames", optarg);
+            seq = true;
+            break;
+        case OPT_FPS:
+            if (!sy_cli_parse_double(optarg, 1e-3, 1e6, &fps)) return sy_cli_bad_value("--fps", optarg);
+            fps_given = true;
+            break;
+        case OPT_RESUME: resume = true; break;
+        case OPT_REPEAT:
+            if (!sy_cli_parse_u32(optarg, 1, 100000000u, &clo.frames)) return sy_cli_bad_value("--repeat", optarg);
             break;
         case OPT_MAX_MEMORY:
             if (!sy_cli_parse_u32(optarg, 1, 1u << 30, &max_memory_mb)) return sy_cli_bad_value("--max-memory", optarg);
@@ -391,6 +443,11 @@ int sy_cmd_render(int argc, char **argv)
         if (mr != SY_OK) return sy_cli_fail(&merr);
     }
     if (!scene) return sy_cli_usage_of("render", "a SCENE is required");
+    if ((fps_given || resume) && !seq) return sy_cli_usage_of("render", "--fps and --resume belong to --frames A:B");
+    if (seq && at_given) return sy_cli_usage_of("render", "--frames sets the time of each frame; --at is one time");
+    if (seq && (!outp || !strchr(outp, '#')))
+        return sy_cli_usage_of("render", "--frames needs -o with a run of '#' for the frame number (out_####.png)");
+    if (seq && clo.frames) return sy_cli_usage_of("render", "--frames and --repeat: one or the other");
     sy_error err = {0};
     char in_folder[4096], auto_out[1024];
     struct stat sst;
@@ -518,12 +575,37 @@ int sy_cmd_render(int argc, char **argv)
     spec.background = ld.background;
     sy_result r = overlay ? sy_cli_add_overlay(&ld, overlay, composite, &spec, &err) : SY_OK;
     if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
-    progress_state ps = {shown, sy_time_now(), 0, sy_is_terminal(2), false};
+    uint64_t samples = 0;
+    bool interrupted = false;
+    /* --frames A:B[:STEP]: every frame through the same loaded scene, pool and window (the scene
+     * clock moves nodes; the back-ends sync the changes); one frame otherwise */
+    const char *pattern = outp;
+    char frame_out[4096];
+    uint32_t nseq = seq ? (fb - fa) / fstep + 1 : 1, written = 0, skipped = 0;
+    double seq_t0 = sy_time_now();
+    bool seq_tty = seq && sy_is_terminal(2);
+    for (uint32_t fi = 0; fi < nseq && r == SY_OK && !interrupted; ++fi) {
+    if (seq) {
+        uint32_t frame = fa + fi * fstep;
+        frame_path(pattern, frame, frame_out, sizeof frame_out);
+        outp = frame_out;
+        struct stat ost;
+        if (resume && stat(outp, &ost) == 0) {
+            skipped++;
+            continue;
+        }
+        int st = sy_cli_set_time(&ld, clip, frame / fps, &err);
+        if (st) {
+            sy_context_pool_destroy(pool);
+            sy_cli_loaded_free(&ld);
+            return st == 2 ? 2 : sy_cli_fail(&err);
+        }
+        oo.attr_count = 0;
+    }
+    progress_state ps = {shown, sy_time_now(), 0, sy_is_terminal(2) && !seq, false};
     sy_window_render_opts ro = {.progress = sy_cli_progress_cb, .progress_user = &ps};
     double t0 = sy_time_now();
-    uint64_t samples = 0;
     sy_context *pctx = NULL;
-    bool interrupted = false;
     char samples_str[32], secs_str[32];
     if (r == SY_OK && progressive) {
         /* the first Ctrl-C ends the render after the pass in progress and keeps its image */
@@ -596,6 +678,7 @@ int sy_cmd_render(int argc, char **argv)
         oo.png.text = texts;
         oo.png.text_count = oo.attr_count;
     }
+    bool say = !seq; /* a sequence: progress on a terminal, one line at the end */
     if (r == SY_OK && clo.cluster && cluster_mode == SY_CLUSTER_MULTI_DISPLAY) {
         printf("multi-display: %ux%u wall presented by the servers, %s, %.3f s\n", w, h, remote, secs);
     } else if (r == SY_OK) {
@@ -606,15 +689,16 @@ int sy_cmd_render(int argc, char **argv)
             r = eye_paths(outp, lp, rp, sizeof lp, &err);
             if (r == SY_OK) r = sy_cli_write_image(lp, &img, &oo, &err);
             if (r == SY_OK) r = sy_cli_write_image(rp, &img_right, &oo, &err);
-            if (r == SY_OK) printf("%s, %s: %ux%u per eye, %s, %.3f s\n", lp, rp, w, h, shown, secs);
+            if (r == SY_OK && say) printf("%s, %s: %ux%u per eye, %s, %.3f s\n", lp, rp, w, h, shown, secs);
         } else {
             r = po.aov ? write_aov_exr(outp, pctx, &oo, &err) : sy_cli_write_image(outp, &img, &oo, &err);
-            if (r == SY_OK && progressive)
+            if (r == SY_OK && !say) {
+            } else if (r == SY_OK && progressive)
                 printf("%s: %ux%u, %s, %llu samples per pixel, %.3f s (%.2f samples/s)%s\n", outp, img.width,
                        img.height, shown, (unsigned long long)samples, secs,
                        secs > 0 ? (double)samples / secs : 0.0, interrupted ? ", interrupted" : "");
             else if (r == SY_OK) printf("%s: %ux%u, %s, %.3f s\n", outp, img.width, img.height, shown, secs);
-            if (r == SY_OK && progressive && filter && pctx) { /* the display filter's report (issue 7) */
+            if (r == SY_OK && say && progressive && filter && pctx) { /* the display filter's report (issue 7) */
                 sy_filter_info fi;
                 sy_context_filter_info(pctx, &fi);
                 printf("filter %s: threshold %g, last filter %.1f ms, last pass at %u spp, mean blend %.3f, "
@@ -626,6 +710,20 @@ int sy_cmd_render(int argc, char **argv)
     }
     sy_layer_destroy(&img);
     sy_layer_destroy(&img_right);
+    if (r == SY_OK && seq) {
+        written++;
+        double el = sy_time_now() - seq_t0, per = el / written;
+        uint32_t left = nseq - fi - 1;
+        if (seq_tty)
+            fprintf(stderr, "\rframe %u (%u of %u), %.1f frames/min, ETA %.0f s   ", fa + fi * fstep, fi + 1, nseq,
+                    per > 0 ? 60.0 / per : 0.0, per * left), fflush(stderr);
+    }
+    interrupted = interrupted || sy_signals_interrupted();
+    } /* the frames */
+    if (seq_tty) fprintf(stderr, "\r%*s\r", 78, "");
+    if (r == SY_OK && seq)
+        printf("%s: frames %u..%u step %u at %g fps: %u written, %u skipped (existing), %ux%u, %s, %.3f s\n", pattern, fa,
+               fb, fstep, fps, written, skipped, w, h, shown, sy_time_now() - seq_t0);
     sy_context_pool_destroy(pool);
     sy_cli_loaded_free(&ld);
     interrupted = interrupted || (progressive && sy_signals_interrupted()); /* also while writing */

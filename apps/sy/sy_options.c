@@ -20,6 +20,9 @@ static bool report_prefix(const char *arg, const struct option *lo, const char *
     int k = 0;
     for (const struct option *o = lo; o->name; ++o)
         if (strlen(o->name) > n && !strncmp(o->name, name, n)) fprintf(stderr, "%s--%s", k++ ? ", " : "", o->name);
+    bool has_at = false; /* --frame in sy render: a sequence (--frames) or one time (--at)? */
+    for (const struct option *o = lo; o->name; ++o) has_at = has_at || !strcmp(o->name, "at");
+    if (has_at && n == 5 && !strncmp(name, "frame", 5)) fprintf(stderr, "; one time on the scene clock: --at SECONDS");
     fprintf(stderr, " (%s --help lists the options)\n", who);
     return true;
 }

@@ -33,7 +33,7 @@ URLS="tcp://127.0.0.1:$(cat "$W/a.port"),tcp://127.0.0.1:$(cat "$W/b.port")"
   --cluster-mode sort-first 2> "$W/client.log" > /dev/null || fail "cluster render"
 "$EXR_EQUAL" "$W/local.exr" "$W/cluster.exr" || fail "sort-first EXR differs from the local render"
 SY_CLUSTER_SECRET=cli-test-secret "$SY" render demo -b whitted -w 120 -h 80 -o "$W/balanced.exr" --cluster "$URLS" \
-  --cluster-mode balanced --frames 3 2> "$W/client2.log" > /dev/null || fail "balanced render (secret from env)"
+  --cluster-mode balanced --repeat 3 2> "$W/client2.log" > /dev/null || fail "balanced render (secret from env)"
 "$EXR_EQUAL" "$W/local.exr" "$W/balanced.exr" || fail "balanced EXR differs from the local render"
 
 # stereo + a raster overlay: the same window as locally, the main viewport on the cluster

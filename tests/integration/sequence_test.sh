@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# sequence_test.sh — sy render --frames A:B[:STEP] (image sequences, issue 35):
+#   - a 6-frame EXR and PNG sequence of BoxAnimated at 24 fps: every frame written, frame k equal
+#     pixel for pixel (exr_equal) to `sy render --at k/24` of a fresh load (the same loaded scene
+#     moved frame by frame gives what a single render at that time gives); frames differ over time
+#   - --frames 0:8:4: frames 0, 4, 8 only; --fps 12 changes the time of a frame
+#   - --resume: an existing frame is left alone (its file is not rewritten), the missing ones written
+#   - usage errors (status 2, nothing written): -o without '#', --frames N (names --repeat), a bad
+#     range (5:2, 1:, a:b, 0:4:0), --fps without --frames, --frames with --at, --frame (names --frames
+#     and --at)
+# Usage: sequence_test.sh SY TESTDATA_DIR TMP EXR_EQUAL
+SY=$1
+DATA=$2
+TMP=$3
+EXR_EQUAL=$4
+fails=0
+fail() {
+    echo "FAIL: $*" >&2
+    fails=$((fails + 1))
+}
+run() {
+    local name=$1
+    shift
+    "$@" >"$TMP/$name.out" 2>"$TMP/$name.err"
+    rc=$?
+}
+run_ok() {
+    local label=$1
+    shift
+    run "$@"
+    if [ "$rc" -ne 0 ]; then fail "$label: status $rc: $(cat "$TMP/$1.err")"; fi
+}
+rm -rf "$TMP"
+mkdir -p "$TMP"
+
+# usage errors need no test data (the built-in demo scene)
+mkdir -p "$TMP/u"
+usage() { # usage LABEL EXPECTED-TEXT ARGS...
+    local label=$1 want=$2
+    shift 2
+    run usage "$SY" render demo -b whitted -w 16 -h 16 "$@"
+    [ "$rc" -eq 2 ] && grep -qF -- "$want" "$TMP/usage.err" || fail "$label: status $rc (want 2), $(cat "$TMP/usage.err")"
+}
+usage "no #" "--frames needs -o with a run of '#'" --frames 0:2 -o "$TMP/u/x.png"
+usage "--frames N" "the cluster's repeat count is --repeat N" --frames 3 -o "$TMP/u/x_##.png"
+for bad in 5:2 1: a:b 0:4:0 -1:2 0:2:; do
+    usage "--frames $bad" "--frames: '$bad'" --frames "$bad" -o "$TMP/u/x_##.png"
+done
+usage "--fps alone" "--fps and --resume belong to --frames" --fps 30 -o "$TMP/u/x.png"
+usage "--resume alone" "--fps and --resume belong to --frames" --resume -o "$TMP/u/x.png"
+usage "--fps 0" "--fps: '0'" --frames 0:1 --fps 0 -o "$TMP/u/x_##.png"
+usage "--frames and --at" "--at is one time" --frames 0:1 --at 1 -o "$TMP/u/x_##.png"
+usage "--frame" "the option that begins so is: --frames; one time on the scene clock: --at SECONDS" --frame 3 -o "$TMP/u/x.png"
+[ -z "$(ls -A "$TMP/u")" ] || fail "a refused sequence left files: $(ls "$TMP/u")"
+
+BOXANIM="$DATA/gltf/BoxAnimated/glTF-Binary/BoxAnimated.glb"
+if [ ! -f "$BOXANIM" ]; then
+    echo "skip: the BoxAnimated sequence checks ($BOXANIM absent)"
+    [ "$fails" -eq 0 ] || exit 1
+    exit 77
+fi
+run_ok "exr sequence" seq_exr "$SY" render "$BOXANIM" -b whitted -w 48 -h 36 --frames 0:5 -o "$TMP/f_####.exr"
+grep -qF "frames 0..5 step 1 at 24 fps: 6 written, 0 skipped" "$TMP/seq_exr.out" || fail "exr sequence: $(cat "$TMP/seq_exr.out")"
+[ ! -s "$TMP/seq_exr.err" ] || fail "exr sequence: not quiet off a terminal: $(cat "$TMP/seq_exr.err")"
+for k in 0 1 2 3 4 5; do
+    f=$TMP/f_000$k.exr
+    [ -f "$f" ] || { fail "frame $k: $f not written"; continue; }
+    run_ok "--at $k/24" at_$k "$SY" render "$BOXANIM" -b whitted -w 48 -h 36 --at "$(awk "BEGIN{printf \"%.17g\", $k/24}")" \
+        -o "$TMP/at_$k.exr"
+    "$EXR_EQUAL" "$f" "$TMP/at_$k.exr" >/dev/null 2>&1 || fail "frame $k differs from sy render --at $k/24"
+done
+"$EXR_EQUAL" "$TMP/f_0000.exr" "$TMP/f_0005.exr" >/dev/null 2>&1 && fail "frames 0 and 5 are the same image"
+ls "$TMP" | grep -q '^\.' && fail "temporary files left: $(ls -a "$TMP")"
+run_ok "png sequence" seq_png "$SY" render "$BOXANIM" -b whitted -w 48 -h 36 --frames 0:8:4 --fps 12 -o "$TMP/p_##.png"
+[ -f "$TMP/p_00.png" ] && [ -f "$TMP/p_04.png" ] && [ -f "$TMP/p_08.png" ] && [ ! -e "$TMP/p_01.png" ] ||
+    fail "png --frames 0:8:4: $(ls "$TMP" | grep '^p_')"
+[ "$(head -c 8 "$TMP/p_04.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a ] || fail "p_04.png is not a PNG"
+# --resume: frame 1 is kept as it was (a marker file), 0 and 2 are written
+mkdir -p "$TMP/r"
+echo keep >"$TMP/r/r_1.exr"
+run_ok "--resume" seq_resume "$SY" render "$BOXANIM" -b whitted -w 48 -h 36 --frames 0:2 --resume -o "$TMP/r/r_#.exr"
+[ "$(cat "$TMP/r/r_1.exr")" = keep ] || fail "--resume rewrote an existing frame"
+[ -f "$TMP/r/r_0.exr" ] && [ -f "$TMP/r/r_2.exr" ] || fail "--resume: missing frames not written: $(ls "$TMP/r")"
+grep -qF "2 written, 1 skipped" "$TMP/seq_resume.out" || fail "--resume: $(cat "$TMP/seq_resume.out")"
+"$EXR_EQUAL" "$TMP/r/r_2.exr" "$TMP/at_2.exr" >/dev/null 2>&1 || fail "--resume: frame 2 differs from --at 2/24"
+
+[ "$fails" -eq 0 ] || { echo "$fails failure(s)"; exit 1; }
+echo "sequence_test: all checks passed"
