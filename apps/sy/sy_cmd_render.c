@@ -170,10 +170,12 @@ static void pt_progress_print(const pt_progress *p, bool final)
 /* Renders a progressive back-end in passes until the sample count or the time budget is reached,
  * through the same window composition as a single-pass render (overlays and stereo included).
  * *out / *out_right get the final images; *samples_out the samples per pixel accumulated by the
- * main back-end; *ctx_out its (pool-owned) context. */
+ * main back-end; *ctx_out its (pool-owned) context. prior: the samples the main back-end held before
+ * (the previous frame of a sequence): when it goes on accumulating (nothing visible changed, so no
+ * restart) the passes of this call are counted from there, so every frame renders its own --spp. */
 static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uint32_t w, uint32_t h, const pt_opts *po,
                                     sy_context_pool *pool, sy_layer *out, sy_layer *out_right, double *seconds,
-                                    uint64_t *samples_out, sy_context **ctx_out, sy_error *err)
+                                    uint64_t *samples_out, sy_context **ctx_out, uint64_t prior, sy_error *err)
 {
     sy_params pp;
     sy_result r = sy_params_parse(spec->params, &pp, err);
@@ -182,6 +184,7 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
     bool tty = sy_is_terminal(2);
     double t0 = sy_time_now(), last_print = 0;
     uint32_t chunk = 1;
+    uint64_t base = UINT64_MAX; /* the back-end's samples that are not this call's (set after the first pass) */
     while (r == SY_OK) {
         uint64_t left = target ? target - pr.done : UINT32_MAX;
         uint32_t n = (uint32_t)(left < chunk ? left : chunk);
@@ -198,7 +201,8 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
         sy_mediator_stats ms = {0};
         if (sy_context_pool_get(pool, ld->scene, spec->backend, &pp, ld->root.id, &mc, err) == SY_OK) {
             sy_context_stats(mc, &ms);
-            if (ms.samples > pr.done) pr.done = ms.samples;
+            if (base == UINT64_MAX) base = prior && ms.samples > prior ? prior : 0;
+            if (ms.samples - base > pr.done) pr.done = ms.samples - base;
         }
         double now = sy_time_now(), pass = (now - p0) / n;
         if (tty && now - last_print > 0.1) {
@@ -594,7 +598,9 @@ int sy_cmd_render(int argc, char **argv)
             skipped++;
             continue;
         }
-        int st = sy_cli_set_time(&ld, clip, frame / fps, &err);
+        /* a scene without animations: the note (or --clip's usage error) once */
+        bool once = written + skipped && !sy_scene_count(ld.scene, SY_TYPE_ANIMATION);
+        int st = once ? 0 : sy_cli_set_time(&ld, clip, frame / fps, &err);
         if (st) {
             sy_context_pool_destroy(pool);
             sy_cli_loaded_free(&ld);
@@ -610,7 +616,7 @@ int sy_cmd_render(int argc, char **argv)
     if (r == SY_OK && progressive) {
         /* the first Ctrl-C ends the render after the pass in progress and keeps its image */
         sy_signals_set_graceful("finishing the current pass, then writing the image accumulated so far");
-        r = render_progressive(&ld, &spec, w, h, &po, pool, &img, &img_right, &secs, &samples, &pctx, &err);
+        r = render_progressive(&ld, &spec, w, h, &po, pool, &img, &img_right, &secs, &samples, &pctx, samples, &err);
         t0 = sy_time_now() - secs;
         interrupted = sy_signals_interrupted();
     } else if (r == SY_OK && clo.cluster) {

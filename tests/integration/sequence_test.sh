@@ -83,6 +83,15 @@ run_ok "--resume" seq_resume "$SY" render "$BOXANIM" -b whitted -w 48 -h 36 --fr
 [ -f "$TMP/r/r_0.exr" ] && [ -f "$TMP/r/r_2.exr" ] || fail "--resume: missing frames not written: $(ls "$TMP/r")"
 grep -qF "2 written, 1 skipped" "$TMP/seq_resume.out" || fail "--resume: $(cat "$TMP/seq_resume.out")"
 "$EXR_EQUAL" "$TMP/r/r_2.exr" "$TMP/at_2.exr" >/dev/null 2>&1 || fail "--resume: frame 2 differs from --at 2/24"
+# a progressive back-end renders its --spp per frame: a moved pose restarts the accumulation (2
+# samples), an unchanged one (past the clip's end at 3.7 s) goes on from the previous frame (4)
+run_ok "pathtracer sequence" seq_pt "$SY" render "$BOXANIM" -b pathtracer --spp 2 -w 24 -h 18 --frames 1:2 -o "$TMP/pt_#.exr"
+run_ok "pathtracer sequence, still" seq_pt2 "$SY" render "$BOXANIM" -b pathtracer --spp 2 -w 24 -h 18 --frames 199:200 \
+    -o "$TMP/pt_#.exr"
+for fs in 1:2 2:2 199:2 200:4; do
+    "$SY" info "$TMP/pt_${fs%%:*}.exr" | grep -qF "\"sy:samples\": \"${fs##*:}\"" ||
+        fail "pathtracer frame ${fs%%:*}: not ${fs##*:} samples: $("$SY" info "$TMP/pt_${fs%%:*}.exr" | grep sy:samples)"
+done
 
 [ "$fails" -eq 0 ] || { echo "$fails failure(s)"; exit 1; }
 echo "sequence_test: all checks passed"
