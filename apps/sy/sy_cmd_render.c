@@ -452,6 +452,7 @@ int sy_cmd_render(int argc, char **argv)
     if (seq && (!outp || !strchr(outp, '#')))
         return sy_cli_usage_of("render", "--frames needs -o with a run of '#' for the frame number (out_####.png)");
     if (seq && clo.frames) return sy_cli_usage_of("render", "--frames and --repeat: one or the other");
+    if (seq && strlen(outp) > 4000) return sy_cli_usage_of("render", "-o: the frames' path is too long");
     sy_error err = {0};
     char in_folder[4096], auto_out[1024];
     struct stat sst;
