@@ -33,11 +33,12 @@ step "build (ASan+UBSan)" sy_configure_build build-asan -- -DCMAKE_BUILD_TYPE=De
   LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0" \
   step "ctest (ASan+UBSan)" ctest --test-dir build-asan --output-on-failure -j "$jobs" -LE browser
 # Minimal configuration (the modular build): only the Embree back-ends, as shared libraries (no sy web); GL,
-# GLFW, nng, libsodium, zstd and MPI are not even looked for (package_parts checks that). Its code
+# GLFW, nng, libsodium, zstd and MPI are not even looked for (package_parts checks that; video is
+# off too: Debian's libavformat links libsodium). Its code
 # is the main configuration's: it runs the tests of what its shape changes (label linkage: the
 # installed package, the parts linked, the CLI, every sample, a back-end added from outside).
 step "build (minimal: Embree only, shared)" sy_configure_build build-min -- -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DSY_WITH_RASTER=OFF -DSY_WITH_CLUSTER=OFF -DSY_WITH_WEB=OFF -DBUILD_SHARED_LIBS=ON &&
+  -DSY_WITH_RASTER=OFF -DSY_WITH_CLUSTER=OFF -DSY_WITH_WEB=OFF -DSY_WITH_VIDEO=OFF -DBUILD_SHARED_LIBS=ON &&
   step "ctest (minimal)" ctest --test-dir build-min --output-on-failure -j "$jobs" -L linkage
 # Fuzzing (tests/fuzz): clang + libFuzzer, only the fuzz targets; each fuzz_run_* test fuzzes
 # SY_FUZZ_SECONDS on seeds from ../shared/testdata, one target per core (tests/fuzz/fuzz.sh runs

@@ -1,6 +1,6 @@
 # .ci/deps.sh — sourced by run.sh and test.sh: installs the Debian packages the build needs (only
 # when one is missing) and configures + builds with CMake (Ninja when present).
-SY_PACKAGES="cmake ninja-build gcc g++ pkg-config libembree-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
+SY_PACKAGES="cmake ninja-build libavcodec-dev libavformat-dev libswscale-dev gcc g++ pkg-config libembree-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
  libopenexr-dev libpng-dev libxxhash-dev libxml2-dev clang libclang-rt-14-dev
  libglfw3-dev libgl-dev xvfb xauth libosmesa6-dev libegl-dev
  libnng-dev libsodium-dev libzstd-dev iproute2 libfreetype-dev fonts-dejavu-core

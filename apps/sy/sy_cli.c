@@ -183,7 +183,7 @@ static const char usage_text[] =
             "            [--clip A,B,C,D ...]   (section planes, up to 6: keeps A*x + B*y + C*z + D >= 0, world units)\n"
             "            [--frames A:B[:STEP] [--fps F] [--resume] -o OUT_####.exr|png]   (an image sequence: frames A..B\n"
             "             inclusive at time frame/F, F default 24; #### the zero-padded frame number; --resume skips\n"
-            "             frames whose file exists)\n"
+            "             frames whose file exists; -o anim.mp4|anim.webm: one H.264 / VP9 video of the frames)\n"
             "  sy render SCENE -b pathtracer [-o OUT.exr|png|jpg] [--spp N | --time SECONDS] [--aov]\n"
             "            (+ the options above)\n"
             "            [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]   (display filter)\n"

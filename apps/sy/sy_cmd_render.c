@@ -10,6 +10,7 @@
 #include "sy_output.h"
 #include "sy_signals.h"
 #include "sy_testpoint.h"
+#include "sy_video.h"
 
 #include "sy_exr.h"
 #include "sy_file.h"
@@ -449,7 +450,11 @@ int sy_cmd_render(int argc, char **argv)
     if (!scene) return sy_cli_usage_of("render", "a SCENE is required");
     if ((fps_given || resume) && !seq) return sy_cli_usage_of("render", "--fps and --resume belong to --frames A:B");
     if (seq && at_given) return sy_cli_usage_of("render", "--frames sets the time of each frame; --at is one time");
-    if (seq && (!outp || !strchr(outp, '#')))
+    bool video = outp && sy_video_is_path(outp); /* -o anim.mp4|webm: one video of the frames */
+    if (video && !seq) return sy_cli_usage_of("render", "a video (-o .mp4, .webm) needs --frames A:B");
+    if (video && (resume || spec.stereo == SY_STEREO_SEPARATE || po.aov))
+        return sy_cli_usage_of("render", "a video is written whole: no --resume, --stereo separate or --aov");
+    if (seq && !video && (!outp || !strchr(outp, '#')))
         return sy_cli_usage_of("render", "--frames needs -o with a run of '#' for the frame number (out_####.png)");
     if (seq && clo.frames) return sy_cli_usage_of("render", "--frames and --repeat: one or the other");
     if (seq && strlen(outp) > 4000) return sy_cli_usage_of("render", "-o: the frames' path is too long");
@@ -491,7 +496,8 @@ int sy_cmd_render(int argc, char **argv)
         sy_log(SY_LOG_ERROR, "sy", NULL, "%s", err.message);
         return 2;
     }
-    if (!sy_cli_is_output_path(outp)) { /* before any loading or rendering */
+    if (video && sy_video_check(outp, &err) != SY_OK) return sy_cli_fail(&err); /* built without video */
+    if (!video && !sy_cli_is_output_path(outp)) { /* before any loading or rendering */
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "%s: output must end in " OUTPUT_KINDS, outp);
         return sy_cli_fail(&err);
     }
@@ -589,11 +595,13 @@ int sy_cmd_render(int argc, char **argv)
     uint32_t nseq = seq ? (fb - fa) / fstep + 1 : 1, written = 0, skipped = 0;
     double seq_t0 = sy_time_now();
     bool seq_tty = seq && sy_is_terminal(2);
+    sy_video *vid = NULL; /* -o anim.mp4|webm: opened at the first frame */
+    uint8_t *vid_rgba = NULL;
     for (uint32_t fi = 0; fi < nseq && r == SY_OK && !interrupted; ++fi) {
     if (seq) {
         uint32_t frame = fa + fi * fstep;
-        frame_path(pattern, frame, frame_out, sizeof frame_out);
-        outp = frame_out;
+        if (!video) frame_path(pattern, frame, frame_out, sizeof frame_out);
+        outp = video ? pattern : frame_out;
         struct stat ost;
         if (resume && stat(outp, &ost) == 0) {
             skipped++;
@@ -698,7 +706,15 @@ int sy_cmd_render(int argc, char **argv)
             if (r == SY_OK) r = sy_cli_write_image(rp, &img_right, &oo, &err);
             if (r == SY_OK && say) printf("%s, %s: %ux%u per eye, %s, %.3f s\n", lp, rp, w, h, shown, secs);
         } else {
-            r = po.aov ? write_aov_exr(outp, pctx, &oo, &err) : sy_cli_write_image(outp, &img, &oo, &err);
+            if (video) { /* tone mapped as for PNG, over black */
+                if (!vid && (r = sy_video_open(outp, img.width, img.height, fps, &vid, &err)) == SY_OK &&
+                    !(vid_rgba = malloc((size_t)img.width * img.height * 4)))
+                    r = sy_error_set(&err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", outp);
+                if (r == SY_OK) {
+                    sy_png_encode_over_black(img.rgba, (size_t)img.width * img.height, &oo.png, vid_rgba);
+                    r = sy_video_add(vid, vid_rgba, &err);
+                }
+            } else r = po.aov ? write_aov_exr(outp, pctx, &oo, &err) : sy_cli_write_image(outp, &img, &oo, &err);
             if (r == SY_OK && !say) {
             } else if (r == SY_OK && progressive)
                 printf("%s: %ux%u, %s, %llu samples per pixel, %.3f s (%.2f samples/s)%s\n", outp, img.width,
@@ -728,6 +744,9 @@ int sy_cmd_render(int argc, char **argv)
     interrupted = interrupted || sy_signals_interrupted();
     } /* the frames */
     if (seq_tty) fprintf(stderr, "\r%*s\r", 78, "");
+    if (vid && r == SY_OK && !interrupted) r = sy_video_finish(vid, NULL, &err);
+    else sy_video_abort(vid); /* an error or an interrupt: no half video */
+    free(vid_rgba);
     if (r == SY_OK && seq)
         printf("%s: frames %u..%u step %u at %g fps: %u written, %u skipped (existing), %ux%u, %s, %.3f s\n", pattern, fa,
                fb, fstep, fps, written, skipped, w, h, shown, sy_time_now() - seq_t0);

@@ -8,11 +8,16 @@
 #   - usage errors (status 2, nothing written): -o without '#', --frames N (names --repeat), a bad
 #     range (5:2, 1:, a:b, 0:4:0), --fps without --frames, --frames with --at, --frame (names --frames
 #     and --at)
-# Usage: sequence_test.sh SY TESTDATA_DIR TMP EXR_EQUAL
+#   - video (where sy was built with SY_WITH_VIDEO and tests/support/video_probe is given): 48 frames
+#     at 24 fps to .mp4 (H.264) and .webm (VP9) read back through libavformat as 48 frames at 24 fps,
+#     decoded frame 24's mean colour within 3 (of 255) of `sy render --at 1 -o .png`'s; a video
+#     without --frames or with --resume is a usage error
+# Usage: sequence_test.sh SY TESTDATA_DIR TMP EXR_EQUAL [VIDEO_PROBE]
 SY=$1
 DATA=$2
 TMP=$3
 EXR_EQUAL=$4
+VIDEO_PROBE=${5:-}
 fails=0
 fail() {
     echo "FAIL: $*" >&2
@@ -51,6 +56,8 @@ usage "--resume alone" "--fps and --resume belong to --frames" --resume -o "$TMP
 usage "--fps 0" "--fps: '0'" --frames 0:1 --fps 0 -o "$TMP/u/x_##.png"
 usage "--frames and --at" "--at is one time" --frames 0:1 --at 1 -o "$TMP/u/x_##.png"
 usage "--frame" "the option that begins so is: --frames; one time on the scene clock: --at SECONDS" --frame 3 -o "$TMP/u/x.png"
+usage "video without --frames" "a video (-o .mp4, .webm) needs --frames A:B" -o "$TMP/u/x.mp4"
+usage "video --resume" "a video is written whole" --frames 0:1 --resume -o "$TMP/u/x.webm"
 [ -z "$(ls -A "$TMP/u")" ] || fail "a refused sequence left files: $(ls "$TMP/u")"
 
 BOXANIM="$DATA/gltf/BoxAnimated/glTF-Binary/BoxAnimated.glb"
@@ -92,6 +99,24 @@ for fs in 1:2 2:2 199:2 200:4; do
     "$SY" info "$TMP/pt_${fs%%:*}.exr" | grep -qF "\"sy:samples\": \"${fs##*:}\"" ||
         fail "pathtracer frame ${fs%%:*}: not ${fs##*:} samples: $("$SY" info "$TMP/pt_${fs%%:*}.exr" | grep sy:samples)"
 done
+# video: 2 s at 24 fps, read back through libavformat (video_probe)
+if [ -n "$VIDEO_PROBE" ]; then
+    run_ok "png --at 1" at_png "$SY" render "$BOXANIM" -b whitted -w 64 -h 48 --at 1 -o "$TMP/at1.png"
+    for kind in mp4:h264 webm:vp9; do
+        ext=${kind%%:*}
+        run_ok "video .$ext" vid_$ext "$SY" render "$BOXANIM" -b whitted -w 64 -h 48 --frames 0:47 -o "$TMP/anim.$ext"
+        "$VIDEO_PROBE" "$TMP/anim.$ext" 24 "$TMP/at1.png" >"$TMP/probe_$ext.out" 2>&1 ||
+            fail "video .$ext: not readable: $(cat "$TMP/probe_$ext.out")"
+        grep -qxF "frames 48 fps 24 codec ${kind##*:}" "$TMP/probe_$ext.out" ||
+            fail "video .$ext: want 48 frames at 24 fps (${kind##*:}): $(cat "$TMP/probe_$ext.out")"
+        awk '/^mean video/ { for (c = 0; c < 3; ++c) { d = $(3 + c) - $(7 + c); if (d < -3 || d > 3) bad = 1 } ok = 1 }
+             END { exit !(ok && !bad) }' "$TMP/probe_$ext.out" ||
+            fail "video .$ext: frame 24's mean colour is not the PNG's: $(grep mean "$TMP/probe_$ext.out")"
+    done
+    ls -a "$TMP" | grep -q '\.tmp-' && fail "video: temporary files left: $(ls -a "$TMP" | grep tmp)"
+else
+    echo "skip: the video checks (sy built without SY_WITH_VIDEO: no video_probe)"
+fi
 
 [ "$fails" -eq 0 ] || { echo "$fails failure(s)"; exit 1; }
 echo "sequence_test: all checks passed"
