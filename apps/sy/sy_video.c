@@ -55,6 +55,8 @@ struct sy_video {
     struct SwsContext *sws;
     AVFrame *frame;
     AVPacket *pkt;
+    uint8_t *rgba;  /* the frame in rows of `stride` bytes, padded: libswscale reads past a row's end */
+    int stride;
     uint32_t w, h;
     int64_t pts;
     bool header;
@@ -99,6 +101,7 @@ void sy_video_abort(sy_video *v)
     sws_freeContext(v->sws);
     av_frame_free(&v->frame);
     av_packet_free(&v->pkt);
+    av_free(v->rgba);
     free(v->path);
     free(v->tmp);
     free(v);
@@ -134,7 +137,9 @@ sy_result sy_video_open(const char *path, uint32_t w, uint32_t h, double fps, sy
     else if (!(codec = avcodec_find_encoder(AV_CODEC_ID_H264))) codec = avcodec_find_encoder(AV_CODEC_ID_MPEG4);
     int e = 0;
     sy_result r = SY_OK;
-    if (!codec) r = sy_error_set(err, SY_ERR_UNSUPPORTED, "%s: libavcodec has no %s encoder", path, webm ? "VP9 (libvpx-vp9)" : "H.264 or MPEG-4");
+    if (!codec)
+        r = sy_error_set(err, SY_ERR_UNSUPPORTED, "%s: libavcodec has no %s encoder", path,
+                         webm ? "VP9 (libvpx-vp9)" : "H.264 or MPEG-4");
     if (r == SY_OK && (e = avformat_alloc_output_context2(&v->fmt, NULL, webm ? "webm" : "mp4", v->tmp)) < 0)
         r = av_fail(v, err, "output format", e);
     if (r == SY_OK && (!(v->st = avformat_new_stream(v->fmt, NULL)) || !(v->enc = avcodec_alloc_context3(codec)) ||
@@ -157,16 +162,20 @@ sy_result sy_video_open(const char *path, uint32_t w, uint32_t h, double fps, sy
         if (v->fmt->oformat->flags & AVFMT_GLOBALHEADER) v->enc->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
         if ((e = avcodec_open2(v->enc, codec, NULL)) < 0) r = av_fail(v, err, "opening the encoder", e);
     }
-    if (r == SY_OK && (e = avcodec_parameters_from_context(v->st->codecpar, v->enc)) < 0) r = av_fail(v, err, "stream", e);
+    if (r == SY_OK && (e = avcodec_parameters_from_context(v->st->codecpar, v->enc)) < 0)
+        r = av_fail(v, err, "stream", e);
     if (r == SY_OK) {
         v->st->time_base = v->enc->time_base;
         v->st->avg_frame_rate = v->enc->framerate;
         v->frame->format = AV_PIX_FMT_YUV420P, v->frame->width = vw, v->frame->height = vh;
         if ((e = av_frame_get_buffer(v->frame, 0)) < 0) r = av_fail(v, err, "frame buffer", e);
     }
-    if (r == SY_OK && !(v->sws = sws_getContext((int)w, (int)h, AV_PIX_FMT_RGBA, vw, vh, AV_PIX_FMT_YUV420P, SWS_BICUBIC,
-                                                NULL, NULL, NULL)))
+    if (r == SY_OK && !(v->sws = sws_getContext((int)w, (int)h, AV_PIX_FMT_RGBA, vw, vh, AV_PIX_FMT_YUV420P,
+                                                SWS_BICUBIC, NULL, NULL, NULL)))
         r = sy_error_set(err, SY_ERR_UNSUPPORTED, "%s: no RGBA to YUV 4:2:0 conversion", path);
+    v->stride = (int)((w * 4 + 63) & ~63u);
+    if (r == SY_OK && !(v->rgba = av_mallocz((size_t)v->stride * (h + 1) + 64)))
+        r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
     if (r == SY_OK && (e = avio_open(&v->fmt->pb, v->tmp, AVIO_FLAG_WRITE)) < 0) r = av_fail(v, err, "opening", e);
     if (r == SY_OK && (e = avformat_write_header(v->fmt, NULL)) < 0) r = av_fail(v, err, "writing the header", e);
     if (r != SY_OK) {
@@ -182,8 +191,10 @@ sy_result sy_video_add(sy_video *v, const uint8_t *rgba, sy_error *err)
 {
     int e = av_frame_make_writable(v->frame);
     if (e < 0) return av_fail(v, err, "frame buffer", e);
-    const uint8_t *src[1] = {rgba};
-    const int stride[1] = {(int)v->w * 4};
+    for (uint32_t y = 0; y < v->h; ++y)
+        memcpy(v->rgba + (size_t)y * v->stride, rgba + (size_t)y * v->w * 4, (size_t)v->w * 4);
+    const uint8_t *src[1] = {v->rgba};
+    const int stride[1] = {v->stride};
     sws_scale(v->sws, src, stride, 0, (int)v->h, v->frame->data, v->frame->linesize);
     v->frame->pts = v->pts++;
     return encode(v, v->frame, err);

@@ -48,8 +48,9 @@ int main(int argc, char **argv)
         while (avcodec_receive_frame(dec, fr) == 0) {
             if (frames == want) {
                 int w = fr->width, h = fr->height;
-                struct SwsContext *sws = sws_getContext(w, h, fr->format, w, h, AV_PIX_FMT_RGB24, SWS_BICUBIC, NULL, NULL, NULL);
-                uint8_t *rgb = malloc((size_t)w * h * 3);
+                struct SwsContext *sws =
+                    sws_getContext(w, h, fr->format, w, h, AV_PIX_FMT_RGB24, SWS_BICUBIC, NULL, NULL, NULL);
+                uint8_t *rgb = malloc((size_t)w * h * 3 + 64); /* libswscale may write past the last row */
                 uint8_t *dst[1] = {rgb};
                 int stride[1] = {w * 3};
                 sws_scale(sws, (const uint8_t *const *)fr->data, fr->linesize, 0, h, dst, stride);
