@@ -2,6 +2,8 @@
  * scene (see sy_view.h). */
 #include "sy_view.h"
 
+#include "sy_anim.h"
+#include "sy_commit.h"
 #include "sy_interactive.h"
 #include "sy_log.h"
 #include "sy_mediator_cluster.h"
@@ -38,6 +40,8 @@ typedef struct viewer {
     uint32_t stereo;
     uint32_t w, h;
     bool quit;
+    bool playing;    /* space: the scene clock plays (the render thread advances it) */
+    uint32_t steps;  /* '.': steps of 1/24 s asked for since the last frame */
     /* render thread -> input thread (under mu) */
     uint8_t *img;
     uint32_t img_w, img_h;
@@ -46,6 +50,8 @@ typedef struct viewer {
     double frame_ms, sync_ms;
     uint64_t spp;
     float img_scale;  /* the governor's resolution scale of the image (1 = full size) */
+    bool animated;    /* the scene has animations (then anim_time is in the heads-up line) */
+    double anim_time; /* the scene clock's time the image shows */
     bool img_moving;  /* a moving frame (reduced size): --frames counts only settled ones */
     float first_scale; /* the first frame answering img_req: its scale and whether it moved (the main */
     bool first_moving; /* thread may see only a later frame of the same request on a busy machine) */
@@ -269,6 +275,14 @@ static void *render_main(void *p)
      * view change for the governor */
     uint32_t prev_stereo = 0, prev_w = 0;
     bool prev_overlay = false;
+    /* the scene clock (space plays and pauses, '.' steps 1/24 s): the render thread owns the scene,
+     * so it sets the time and commits; the moved nodes reach the back-ends as any change does, and
+     * a frame whose time moved is a changed view for the governor */
+    double t_start = 0, t_end = 0, wall_last = 0;
+    bool was_playing = false;
+    bool animated = sy_scene_time_range(a->scene, (sy_animation){0}, &t_start, &t_end, NULL) == SY_OK && t_end > t_start;
+    sy_clock clock = sy_clock_make(t_start, t_end);
+    clock.playing = false;
     for (;;) {
         pthread_mutex_lock(&v->mu);
         while (!v->quit && seen == v->req_version && !again) {
@@ -289,14 +303,32 @@ static void *render_main(void *p)
         seen = v->req_version;
         sy_interactive_input in = v->in;
         uint32_t bi = v->backend, stereo = v->stereo, w = v->w, h = v->h;
-        bool overlay = v->overlay;
+        bool overlay = v->overlay, playing = v->playing && animated;
+        uint32_t steps = animated ? v->steps : 0;
+        v->steps = 0;
         pthread_mutex_unlock(&v->mu);
+        bool time_moved = false;
+        if (playing || steps) {
+            double now = sy_time_now();
+            clock.playing = true;
+            if (playing && was_playing) sy_clock_advance(&clock, now - wall_last);
+            for (uint32_t k = 0; k < steps; ++k) {
+                clock.playing = true;
+                sy_clock_advance(&clock, 1.0 / 24.0);
+            }
+            wall_last = now;
+            if (sy_scene_set_time(a->scene, (sy_animation){0}, clock.time, &err) != SY_OK ||
+                sy_scene_commit(a->scene, NULL, &err) != SY_OK)
+                goto fail_unlocked;
+            time_moved = true;
+        }
+        was_playing = playing;
 
         const sy_mediator_class *cls = sy_mediator_at(bi);
         if (!cls) cls = sy_mediator_at(0);
         if (cls->caps & SY_CAP_REMOTE) cls = sy_mediator_find(a->backend); /* the cluster is not a choice of its own */
         if (!cls) cls = sy_mediator_at(0);
-        bool changed = stereo != prev_stereo || w != prev_w || overlay != prev_overlay;
+        bool changed = stereo != prev_stereo || w != prev_w || overlay != prev_overlay || time_moved;
         prev_stereo = stereo, prev_w = w, prev_overlay = overlay;
         sy_mat4 view; /* the camera, set on the viewports directly: the scene is not committed */
         sy_orbit_matrix(&in.orbit, &view);
@@ -330,7 +362,7 @@ static void *render_main(void *p)
         sy_result r;
         if (v->cluster) {
             /* a restart: anything asked since the last frame (camera, back-end, size, stereo) */
-            bool restart = seen != cl_seen;
+            bool restart = seen != cl_seen || time_moved;
             cl_seen = seen;
             r = view_cluster_frame(v->cluster, a, pool, &spec, cls->name, restart, ew, h, &img, &right, &cl_spp,
                                    &cl_refine, cl_status, sizeof cl_status, &err);
@@ -373,6 +405,8 @@ static void *render_main(void *p)
         v->spp = st.samples;
         v->img_scale = gf.scale;
         v->img_moving = gf.moving;
+        v->animated = animated;
+        v->anim_time = clock.time;
         v->governed = !v->cluster;
         snprintf(v->status, sizeof v->status, "%s", v->cluster ? cl_status : cls->name);
         snprintf(v->filter_status, sizeof v->filter_status, "%s", fstatus);
@@ -381,8 +415,9 @@ static void *render_main(void *p)
         v->img_req = seen;
         pthread_mutex_unlock(&v->mu);
         sy_layer_destroy(&img);
-        /* local: plan again (the governor says what comes next); cluster: keep refining */
-        again = v->cluster ? cl_refine : true;
+        /* local: plan again (the governor says what comes next); cluster: keep refining; playing:
+         * the next frame's time */
+        again = v->cluster ? cl_refine || playing : true;
     }
     sy_interactive_destroy(ia);
     return NULL;
@@ -430,6 +465,13 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         if (key == GLFW_KEY_O) v->overlay = !v->overlay;
         else v->stereo = v->stereo == SY_STEREO_NONE ? SY_STEREO_SBS : v->stereo == SY_STEREO_SBS ? SY_STEREO_ANAGLYPH
                                                                                                    : SY_STEREO_NONE;
+        v->req_version++;
+        pthread_cond_signal(&v->cv);
+        pthread_mutex_unlock(&v->mu);
+    } else if (key == GLFW_KEY_SPACE || key == GLFW_KEY_PERIOD) { /* the scene clock: play / pause, one step */
+        pthread_mutex_lock(&v->mu);
+        if (key == GLFW_KEY_SPACE) v->playing = !v->playing;
+        else if (v->steps < 1000u) v->steps++;
         v->req_version++;
         pthread_cond_signal(&v->cv);
         pthread_mutex_unlock(&v->mu);
@@ -526,9 +568,9 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
         return r;
     }
     for (const char *k = args->keys; k && *k; ++k)
-        if (!isalnum((unsigned char)*k) && *k != '[' && *k != ']')
-            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: --keys: '%c' is not a key (letters, digits, [ and ])",
-                                *k);
+        if (!isalnum((unsigned char)*k) && *k != '[' && *k != ']' && *k != ' ' && *k != '.')
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "view: --keys: '%c' is not a key (letters, digits, [ ], space and .)", *k);
     if (!glfwInit()) {
         const char *desc = NULL;
         glfwGetError(&desc);
@@ -620,13 +662,16 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
             if (!v.cluster) snprintf(sync, sizeof sync, " | sync %.2f ms", v.sync_ms);
             if (v.governed) /* the governor's resolution scale: reduced while the view moves */
                 snprintf(scale, sizeof scale, " | scale %.2f%s", (double)v.img_scale, v.img_moving ? " moving" : "");
-            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms%s | %llu spp%s%s%s", v.status, v.frame_ms, scale,
+            char clock_s[48] = ""; /* the scene clock, when the scene moves */
+            if (v.animated) snprintf(clock_s, sizeof clock_s, " | t %.3f s %s", v.anim_time, v.playing ? "playing" : "paused");
+            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms%s | %llu spp%s%s%s%s", v.status, v.frame_ms, scale,
                      (unsigned long long)v.spp, sync,
                      v.stereo == SY_STEREO_SBS ? " | stereo sbs" : v.stereo == SY_STEREO_ANAGLYPH ? " | anaglyph" : "",
-                     v.filter_status);
+                     v.filter_status, clock_s);
             glfwSetWindowTitle(win, title);
         }
-        bool failed = v.failed, answered = fresh && v.img_req >= key_req, settled = !v.img_moving;
+        /* a frame counts for --frames once settled, or any frame while the scene clock plays (it never settles) */
+        bool failed = v.failed, answered = fresh && v.img_req >= key_req, settled = !v.img_moving || v.playing;
         float first_scale = v.first_scale;
         bool first_moving = v.first_moving, governed = v.governed;
         pthread_mutex_unlock(&v.mu);

@@ -5,6 +5,9 @@
  * side-by-side, anaglyph), R resets the camera, Esc quits. With the path tracer, F cycles the display
  * filter (none, pixel, atrous, jbu, adaptive) and [ / ] halve / double its threshold (default 0.01),
  * live and without restarting the accumulation; the title shows the filter, threshold and its time.
+ * A scene with animations plays on its clock: space plays and pauses it (real time, looping), '.'
+ * steps it by 1/24 s; the render thread sets the time and commits, so every back-end (and a
+ * cluster's servers) moves through the change lists; the title shows the time.
  * With --frames the last title line is printed to stdout at exit (automated runs); only frames
  * shown after the view settled (full size) count. The window title is the heads-up line: back-end,
  * frame time, the governor's resolution scale ("moving" while reduced), samples per pixel, sync
@@ -48,7 +51,8 @@ typedef struct sy_view_args {
     float threshold;        /* its initial threshold (0 = the default 0.01; must be >= 0) */
     const char *keys;       /* automated runs: keys pressed one at a time through the keyboard handler,
                                each once the frame answering the previous one is shown (letters, digits,
-                               [ ]); the heads-up line after each is printed; --frames counts after them */
+                               [ ], space, .); the heads-up line after each is printed; --frames counts after
+                               them (settled frames; while the scene clock plays, every frame) */
     const sy_cluster_cli_opts *cluster; /* non-NULL: render on these servers (sy view --cluster) */
     double budget_ms;       /* the frame-time governor's budget while the view moves (0 = 33 ms; --budget) */
 } sy_view_args;

@@ -5,7 +5,8 @@
 # goes through an sRGB decode / encode round trip). The path tracer's display filter keys (F cycles
 # the filter, [ / ] halve / double the threshold) are pressed through the keyboard handler with
 # --keys and checked in the heads-up line after each key; the start view of --look-at and --fov
-# matches sy render's; the frame-time governor answers a back-end
+# matches sy render's; '.' steps the scene clock and space plays it (BoxAnimated from the test data,
+# the 4th argument); the frame-time governor answers a back-end
 # switch with a moving frame and settles at full size. Skipped (77) when xvfb-run is not
 # installed or the viewer was built without GLFW.
 set -u
@@ -108,4 +109,32 @@ if "$SY" view demo -b nosuchbackend --frames 1 2>"$W/bad.err"; then
     exit 1
 fi
 grep -q nosuchbackend "$W/bad.err" || { echo "FAIL: the error does not name the back-end"; exit 1; }
+# the scene clock (issue 35): '.' steps it by 1/24 s through the keyboard handler, so two steps show
+# what sy render --at 2/24 draws (and not the pose at 0: the check can fail); space plays
+BOX="${4:-}/gltf/BoxAnimated/glTF/BoxAnimated.gltf"
+if [ -f "$BOX" ]; then
+    timeout 500 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view "$BOX" -b raster -w 160 -h 120 \
+        --background 0.2,0.3,0.4 --keys '..' --frames 1 --screenshot "$W/view_t.png" >"$W/view_t.out" 2>"$W/view_t.err"
+    rc=$?
+    grep -q "t 0.083 s paused" "$W/view_t.out" || {
+        echo "FAIL: sy view's heads-up line does not show the clock after two steps (status $rc): $(cat "$W/view_t.out" "$W/view_t.err")"
+        exit 1; }
+    for t in 0.08333333333333333 0; do
+        "$SY" render "$BOX" -b raster -w 160 -h 120 --tonemap aces --background 0.2,0.3,0.4 --at $t \
+            -o "$W/render_t$t.png" >/dev/null || exit 1
+    done
+    "$CMP" "$W/view_t.png" "$W/render_t0.08333333333333333.png" 2 20 || {
+        echo "FAIL: two clock steps in sy view do not show sy render --at 2/24"; exit 1; }
+    if "$CMP" "$W/view_t.png" "$W/render_t0.png" 2 20 >/dev/null; then
+        echo "FAIL: the view after two clock steps still shows the pose at 0"; exit 1
+    fi
+    # space plays: the clock moves on by itself at real time; while it plays every shown frame counts
+    # for --frames (they never settle), so five frames later the clock is past 0
+    timeout 300 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view "$BOX" -b raster -w 160 -h 120 \
+        --keys ' ' --frames 5 >"$W/view_p.out" 2>"$W/view_p.err"
+    tail -1 "$W/view_p.out" | grep -q "playing" && ! tail -1 "$W/view_p.out" | grep -q "t 0.000 s" || {
+        echo "FAIL: space does not play the scene clock: $(cat "$W/view_p.out" "$W/view_p.err")"; exit 1; }
+else
+    echo "integration_view: the scene clock part skipped: $BOX is absent"
+fi
 echo "integration_view: ok"
