@@ -156,24 +156,32 @@ static void buffer_dealloc(PyObject *self)
     object_free(self);
 }
 
+/* Fills view for exporter self: ndim dimensions of 4-byte items (format "f" or "I") at buf, C order
+ * as shape and strides say (the exporter keeps both arrays alive); the view holds a reference to self. */
+static int export_view(PyObject *self, Py_buffer *view, void *buf, int readonly, const char *format, int ndim,
+                       Py_ssize_t *shape, Py_ssize_t *strides)
+{
+    Py_ssize_t n = 1;
+    for (int i = 0; i < ndim; ++i) n *= shape[i];
+    view->buf = buf;
+    view->obj = Py_NewRef(self);
+    view->len = n * 4;
+    view->readonly = readonly;
+    view->itemsize = 4;
+    view->format = (char *)format;
+    view->ndim = ndim;
+    view->shape = shape;
+    view->strides = strides;
+    view->suboffsets = NULL;
+    view->internal = NULL;
+    return 0;
+}
+
 static int buffer_get(PyObject *self, Py_buffer *view, int flags)
 {
     (void)flags;
     BufferObject *b = (BufferObject *)self;
-    Py_ssize_t n = 1;
-    for (int i = 0; i < b->ndim; ++i) n *= b->shape[i];
-    view->buf = b->data;
-    view->obj = Py_NewRef(self);
-    view->len = n * (Py_ssize_t)sizeof(float);
-    view->readonly = 0;
-    view->itemsize = sizeof(float);
-    view->format = "f";
-    view->ndim = b->ndim;
-    view->shape = b->shape;
-    view->strides = b->strides;
-    view->suboffsets = NULL;
-    view->internal = NULL;
-    return 0;
+    return export_view(self, view, b->data, 0, "f", b->ndim, b->shape, b->strides);
 }
 
 static PyType_Slot buffer_slots[] = {
@@ -787,18 +795,7 @@ static int blobview_get(PyObject *self, Py_buffer *view, int flags)
         view->obj = NULL;
         return -1;
     }
-    view->buf = (void *)sy_blob_data(b->blob);
-    view->obj = Py_NewRef(self);
-    view->len = b->shape[0] * (b->ndim == 2 ? b->shape[1] : 1) * 4;
-    view->readonly = 1;
-    view->itemsize = 4;
-    view->format = b->format;
-    view->ndim = b->ndim;
-    view->shape = b->shape;
-    view->strides = b->strides;
-    view->suboffsets = NULL;
-    view->internal = NULL;
-    return 0;
+    return export_view(self, view, (void *)sy_blob_data(b->blob), 1, b->format, b->ndim, b->shape, b->strides);
 }
 
 static PyType_Slot blobview_slots[] = {
