@@ -124,6 +124,29 @@ static void check_closed(const sy_gl_mesh_desc *d, mesh_o *m, const uint32_t *al
     free(table);
 }
 
+static const int vertex_comps[5] = {3, 3, 2, 2, 4}; /* floats of position, normal, uv0, uv1, colour */
+
+/* The vertex attributes of d present in arrays (position, normal, uv0, uv1, colour; NULL = absent)
+ * interleaved into one malloc()ed buffer (the caller frees it): offs the attributes' offsets and
+ * *stride the vertex size, in floats; *bytes the buffer's size. NULL without memory. */
+static float *interleave(const sy_gl_mesh_desc *d, const float *const arrays[5], int offs[5], int *stride, size_t *bytes)
+{
+    *stride = 0;
+    for (int a = 0; a < 5; ++a) {
+        offs[a] = *stride;
+        if (arrays[a]) *stride += vertex_comps[a];
+    }
+    *bytes = (size_t)d->vertex_count * (size_t)*stride * sizeof(float);
+    float *vb = malloc(*bytes);
+    if (!vb) return NULL;
+    for (uint32_t i = 0; i < d->vertex_count; ++i)
+        for (int a = 0; a < 5; ++a)
+            if (arrays[a])
+                memcpy(vb + (size_t)i * (size_t)*stride + offs[a], arrays[a] + (size_t)i * vertex_comps[a],
+                       vertex_comps[a] * sizeof(float));
+    return vb;
+}
+
 sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_gl_mesh *out)
 {
     sy_gl_report *rep = dev ? dev->report : NULL;
@@ -172,21 +195,13 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     gl->BindVertexArray(m->vao);
     /* one interleaved vertex buffer (present attributes only) + one index buffer */
     const float *arrays[5] = {d->positions, d->normals, d->uv[0], d->uv[1], d->colors};
-    static const int comps[5] = {3, 3, 2, 2, 4};
-    int stride = 0, offs[5];
-    for (int a = 0; a < 5; ++a) {
-        offs[a] = stride;
-        if (arrays[a]) stride += comps[a];
-    }
-    size_t bytes = (size_t)d->vertex_count * (size_t)stride * sizeof(float);
-    float *vb = malloc(bytes);
+    int stride, offs[5];
+    size_t bytes;
+    float *vb = interleave(d, arrays, offs, &stride, &bytes);
     if (!vb) {
         sy_gli_pool_free(&dev->meshes, m);
         return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory (%u vertices)", d->vertex_count);
     }
-    for (uint32_t i = 0; i < d->vertex_count; ++i)
-        for (int a = 0; a < 5; ++a)
-            if (arrays[a]) memcpy(vb + (size_t)i * stride + offs[a], arrays[a] + (size_t)i * comps[a], comps[a] * sizeof(float));
     gl->GenBuffers(1, &m->vbo[0]);
     gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
     gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, vb, GL_STATIC_DRAW);
@@ -196,7 +211,7 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
         m->has_attr[a] = arrays[a] != NULL;
         if (!arrays[a]) continue;
         gl->EnableVertexAttribArray((GLuint)a);
-        gl->VertexAttribPointer((GLuint)a, comps[a], GL_FLOAT, GL_FALSE, stride * (GLsizei)sizeof(float),
+        gl->VertexAttribPointer((GLuint)a, vertex_comps[a], GL_FLOAT, GL_FALSE, stride * (GLsizei)sizeof(float),
                                 (const void *)(uintptr_t)(offs[a] * sizeof(float)));
     }
     m->has_normals = d->normals != NULL;
@@ -243,18 +258,10 @@ sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_m
         }
     sy_gl_result r = sy_gli_current(dev, rep);
     if (r != SY_GL_OK) return r;
-    static const int comps[5] = {3, 3, 2, 2, 4};
-    int stride = 0, offs[5];
-    for (int a = 0; a < 5; ++a) {
-        offs[a] = stride;
-        if (arrays[a]) stride += comps[a];
-    }
-    size_t bytes = (size_t)d->vertex_count * (size_t)stride * sizeof(float);
-    float *vb = malloc(bytes);
+    int stride, offs[5];
+    size_t bytes;
+    float *vb = interleave(d, arrays, offs, &stride, &bytes);
     if (!vb) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh update: out of memory (%u vertices)", d->vertex_count);
-    for (uint32_t i = 0; i < d->vertex_count; ++i)
-        for (int a = 0; a < 5; ++a)
-            if (arrays[a]) memcpy(vb + (size_t)i * stride + offs[a], arrays[a] + (size_t)i * comps[a], comps[a] * sizeof(float));
     const sy_gl_fns *gl = dev->gl;
     gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
     gl->BufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)bytes, vb);
