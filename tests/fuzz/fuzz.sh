@@ -152,20 +152,34 @@ case $target in assimp_*) assimp=true ;; esac
 # Assimp's own leaks on malformed files (assimp_lsan.supp says why they are not the loader's)
 $assimp && export LSAN_OPTIONS="suppressions=$here/assimp_lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 
-# assimp_fault FILE: prints the faulting frame and succeeds when the fault FILE reproduces lies inside
-# Assimp (the first stack frame outside the C / C++ runtimes, the sanitizers and libFuzzer is in
-# libassimp) AND the same input loaded as applications load it (the import process,
-# SY_FUZZ_ISOLATED=1) only fails the load. Such faults are Assimp 5.2's, contained, and do not fail
+# assimp_fault FILE LOG: prints the faulting frame and succeeds when the fault FILE reproduces (or,
+# when it does not come again alone, the one in the run's LOG) lies inside Assimp (the first stack
+# frame outside the C / C++ runtimes, the sanitizers and libFuzzer is in libassimp; or only
+# libFuzzer's own frames: its heap overwritten by Assimp on an earlier input) AND the same input
+# loaded as applications load it (the import process, SY_FUZZ_ISOLATED=1) only fails the load. Such faults are Assimp 5.2's, contained, and do not fail
 # the run; any other fault does. The re-run has no RSS thread (-rss_limit_mb=0): a sanitizer build
 # loads in process when other threads exist (formats/sy_assimp_isolate.c).
 assimp_fault() {
   local out frame
   out=$(cd "$work" && SY_FUZZ_RESOURCES="$work/resources" timeout 120 "$fuzzer" -timeout=10 -rss_limit_mb=2048 -runs=1 "$1" 2>&1)
+  # a fault found inside libFuzzer's own code (its mutator's buffers) does not come again from the
+  # input alone: then the run's log ($2) has the stack
+  grep -q "ERROR: AddressSanitizer" <<<"$out" || out=$(cat "$2" 2>/dev/null)
   frame=$(printf '%s\n' "$out" | awk '/^ *#[0-9]+ 0x/ {
       if ($0 ~ /(libc\.so|libstdc\+\+|libgcc_s|libclang_rt|libasan|libubsan|ld-linux)/) next
-      if ($0 ~ / in (__sanitizer|__asan|__lsan|__ubsan|__interceptor|fuzzer::|malloc|calloc|realloc|operator new|abort|raise|gsignal|__GI_|__pthread_kill)/) next
+      if ($0 ~ / in (__sanitizer|__asan|__lsan|__ubsan|__interceptor|fuzzer::|malloc|calloc|realloc|free|operator new|operator delete|abort|raise|gsignal|__GI_|__pthread_kill)/) next
       print; exit }')
-  case $frame in *libassimp.so*) ;; *) return 1 ;; esac
+  case $frame in
+    *libassimp.so*) ;;
+    # inside libFuzzer with none of our frames on any stack of the report: its own buffers (heap an
+    # uninstrumented library overwrote on an earlier input, or libFuzzer's own fault), not ours
+    # (our code is instrumented: ASan stops at our own bad access, with our frames on the stack)
+    *" in main "*)
+      grep -Eq '^ *#[0-9]+ 0x.* in fuzzer::' <<<"$out" && ! grep -Eq '^ *#[0-9]+ 0x.* in (sy_|LLVMFuzzerTestOneInput)' <<<"$out" ||
+        return 1
+      frame="libFuzzer's heap, overwritten earlier (uninstrumented Assimp): $frame" ;;
+    *) return 1 ;;
+  esac
   (cd "$work" && SY_FUZZ_ISOLATED=1 SY_FUZZ_RESOURCES="$work/resources" timeout 300 "$fuzzer" -rss_limit_mb=0 -runs=1 "$1" >/dev/null 2>&1) || return 1
   printf '%s\n' "$frame" | sed 's/^ *//'
 }
@@ -194,7 +208,7 @@ while :; do
   [ "$artifacts" = "$work/artifacts" ] || kept=$corpus.contained
   mkdir -p "$kept"
   for f in "${new[@]}"; do
-    if frame=$(assimp_fault "$f"); then
+    if frame=$(assimp_fault "$f" "${logs[-1]}"); then
       contained+=("$kept/$(basename "$f") at ${frame:0:160}")
       mv "$f" "$kept/"
     else ok=false; fi
