@@ -124,6 +124,19 @@ static void check_closed(const sy_gl_mesh_desc *d, mesh_o *m, const uint32_t *al
     free(table);
 }
 
+/* The mesh's box, and the sphere around it that culling and levels of detail use. */
+static void set_bounds(mesh_o *m, const float bmin[3], const float bmax[3])
+{
+    memcpy(m->bmin, bmin, 3 * sizeof *bmin);
+    memcpy(m->bmax, bmax, 3 * sizeof *bmax);
+    float r2 = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+        m->centre[k] = 0.5f * (bmin[k] + bmax[k]);
+        r2 += 0.25f * (bmax[k] - bmin[k]) * (bmax[k] - bmin[k]);
+    }
+    m->radius = sqrtf(r2);
+}
+
 static const int vertex_comps[5] = {3, 3, 2, 2, 4}; /* floats of position, normal, uv0, uv1, colour */
 
 /* The vertex attributes of d present in arrays (position, normal, uv0, uv1, colour; NULL = absent)
@@ -179,14 +192,7 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     const sy_gl_fns *gl = dev->gl;
     m->vertex_count = d->vertex_count;
     m->triangle_count = d->triangle_count;
-    memcpy(m->bmin, bmin, sizeof bmin);
-    memcpy(m->bmax, bmax, sizeof bmax);
-    float r2 = 0.0f;
-    for (int k = 0; k < 3; ++k) {
-        m->centre[k] = 0.5f * (bmin[k] + bmax[k]);
-        r2 += 0.25f * (bmax[k] - bmin[k]) * (bmax[k] - bmin[k]);
-    }
-    m->radius = sqrtf(r2);
+    set_bounds(m, bmin, bmax);
     uint32_t *lods = NULL;
     size_t index_count = 0;
     build_lods(d, m, &lods, &index_count);
@@ -268,14 +274,7 @@ sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_m
     gl->BindBuffer(GL_ARRAY_BUFFER, 0);
     free(vb);
     sy_gli_count_buffer(dev, false, bytes);
-    memcpy(m->bmin, bmin, sizeof bmin);
-    memcpy(m->bmax, bmax, sizeof bmax);
-    float r2 = 0.0f;
-    for (int k = 0; k < 3; ++k) {
-        m->centre[k] = 0.5f * (bmin[k] + bmax[k]);
-        r2 += 0.25f * (bmax[k] - bmin[k]) * (bmax[k] - bmin[k]);
-    }
-    m->radius = sqrtf(r2);
+    set_bounds(m, bmin, bmax);
     sy_gli_geometry_changed(dev);
     return sy_gli_gl_check(dev, "mesh update", rep);
 }
