@@ -120,6 +120,17 @@ sy_result sy_animation_sample(const sy_animation_data *d, uint32_t sampler, bool
 }
 
 /* >>the clock into node fields */
+/* Counts channel c of animation id (data d) as failed with r (e its reason); the first failure of
+ * the call goes into *first and err, naming the animation and the channel. */
+static void channel_failed(sy_anim_stats *st, sy_result *first, sy_result r, sy_error *err, uint32_t id,
+                           const sy_animation_data *d, uint32_t c, const sy_error *e)
+{
+    st->failed++;
+    if (*first != SY_OK) return;
+    *first = r;
+    sy_error_set(err, r, "animation %#x (%s) channel %u: %s", id, d->name ? d->name : "unnamed", c, e->message);
+}
+
 static sy_result apply_clip(sy_scene *s, uint32_t id, double t, sy_anim_stats *st, sy_result first, sy_error *err)
 {
     const sy_animation_data *d = sy_object_get(s, SY_TYPE_ANIMATION, id);
@@ -154,12 +165,7 @@ static sy_result apply_clip(sy_scene *s, uint32_t id, double t, sy_anim_stats *s
                               : sy_error_set(&e, SY_ERR_INVALID_ARGUMENT, "sampler %u has no weights", ci.sampler);
             if (r == SY_OK) r = sy_node_set_weights(s, (sy_node){ci.node}, w, nw, &e);
             if (r != SY_OK) {
-                st->failed++;
-                if (first == SY_OK) {
-                    first = r;
-                    sy_error_set(err, r, "animation %#x (%s) channel %u: %s", id, d->name ? d->name : "unnamed", c,
-                                 e.message);
-                }
+                channel_failed(st, &first, r, err, id, d, c, &e);
                 continue;
             }
             st->weights++;
@@ -176,12 +182,7 @@ static sy_result apply_clip(sy_scene *s, uint32_t id, double t, sy_anim_stats *s
                                           ci.path == SY_ANIM_ROTATION ? 4u : 3u, &e);
         if (r == SY_OK) r = sy_object_set_field(s, SY_TYPE_NODE, ci.node, SY_NODE_TRANSFORM, &tr, &e);
         if (r != SY_OK) {
-            st->failed++;
-            if (first == SY_OK) {
-                first = r;
-                sy_error_set(err, r, "animation %#x (%s) channel %u: %s", id, d->name ? d->name : "unnamed", c,
-                             e.message);
-            }
+            channel_failed(st, &first, r, err, id, d, c, &e);
             continue;
         }
         st->channels++;
