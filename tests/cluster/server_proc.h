@@ -168,18 +168,33 @@ static inline bool read_peer_memory(const server *s, size_t *used, size_t *peak)
     return ok;
 }
 
-/* Waits until the server holds at least `bytes` for peers' messages in flight (its --memory-file);
- * false after 300 s (a hang guard) or when the server is gone. *used_out: the last value read. */
-static inline bool wait_peer_memory(const server *s, size_t bytes, size_t *used_out)
+/* Waits until the server holds at least (at_least) or at most (!at_least) `bytes` for peers'
+ * messages in flight (its --memory-file); false after 300 s (a hang guard) or when the server is
+ * gone. *used_out: the last value read. The file is written by a thread that polls every 2 ms, so
+ * on a loaded machine a value can be stale: a test that waits for new reservations first waits
+ * for the old ones to be seen released (wait_peer_memory_at_most), or a stale value passes. */
+static inline bool wait_peer_memory_cmp(const server *s, bool at_least, size_t bytes, size_t *used_out)
 {
     size_t used = 0, peak = 0;
+    bool ok = false;
     for (int i = 0; i < 60000; ++i) {
-        if (read_peer_memory(s, &used, &peak) && used >= bytes) break;
+        ok = read_peer_memory(s, &used, &peak) && (at_least ? used >= bytes : used <= bytes);
+        if (ok) break;
         if (s->pid <= 0 || waitpid(s->pid, NULL, WNOHANG) == s->pid) break;
         sleep_ms(5);
     }
     if (used_out) *used_out = used;
-    return used >= bytes;
+    return ok;
+}
+
+static inline bool wait_peer_memory(const server *s, size_t bytes, size_t *used_out)
+{
+    return wait_peer_memory_cmp(s, true, bytes, used_out);
+}
+
+static inline bool wait_peer_memory_at_most(const server *s, size_t bytes, size_t *used_out)
+{
+    return wait_peer_memory_cmp(s, false, bytes, used_out);
 }
 
 static inline bool log_contains(const server *s, const char *needle)

@@ -680,6 +680,10 @@ static int test_ceiling(fixture *fx)
     sy_cluster_msg_free(&rep);
     free(raw);
     close(b);
+    /* B's message was released before its reply; until the file shows it, a stale 800 KiB would
+     * pass the wait below before the server took A's and C's first frames, and C's second frame
+     * could then take A's place (seen on a loaded machine: C waited 20 s for a reply) */
+    CHECK_MSG(wait_peer_memory_at_most(&sv, 0, &held), "the server still holds %zu bytes after B's reply", held);
     /* A holds 400 KiB for good: C's second frame is refused after the wait */
     a = open_session(sv.port);
     int c = open_session(sv.port);
