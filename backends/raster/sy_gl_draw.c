@@ -620,6 +620,9 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
      * of its own reads the environment through the probe's unit (sy_gli_draw_scene; issue 32: 8.7 ->
      * 5.3 s cold at 200x150 on llvmpipe, 1.7 -> 1.8 s warm). */
     pv = sy_gli_variant_normalize(pv | dc->shared);
+    /* probe faces (16-256 px, seen blurred) shade without normal maps and material layers: a
+     * smaller program that llvmpipe compiles in about half the time (docs/BACKENDS.md) */
+    if (dev->in_probe_pass) pv = sy_gli_variant_normalize(pv & ~(VAR_NMAP | VAR_LAYERS));
     sy_gl_result r = use_variant(dev, dc, pv, rep);
     if (r != SY_GL_OK) return r;
     if (pv & VAR_PROBE) { /* its own probe (the 1-texel mip for roughness 1), or the environment's cube */
