@@ -33,6 +33,16 @@ sy_result sy_context_render(sy_context *c, const sy_render_request *req, sy_laye
 const sy_mediator_class *sy_context_class(const sy_context *c);
 /** The mediator's own state (for the mediator module's diagnostics functions). Borrowed. */
 void *sy_context_state(const sy_context *c);
+/** The next sync and render of this context give what a new context on the scene as it then is
+ * would give, bit for bit: progressive back-ends (SY_CAP_PROGRESSIVE) start a new accumulation at
+ * sample 0 with the request's seed even when nothing visible changed (without it an unchanged scene
+ * goes on accumulating), and the ray tracers place the next sync's moved nodes as a fresh build does
+ * (their fast path for moves hits in the last bits differently; the next commit rebuilds the top
+ * level instead). Call it before each frame of an image sequence, so that frame k is what a fresh
+ * `sy render --at T` of its time renders (sy render --frames does, per frame). A cluster context
+ * forwards it to its servers with its next frame. Back-ends without the class hook: nothing.
+ * Thread-safety: as sy_context_render. */
+void sy_context_restart(sy_context *c);
 /** Fills out with the mediator's statistics. */
 void sy_context_stats(const sy_context *c, sy_mediator_stats *out);
 /** The instance's capabilities (sy_mediator_caps): the class's, or what caps_of says for its parameters. */

@@ -363,6 +363,11 @@ sy_result sy_context_render(sy_context *c, const sy_render_request *req, sy_laye
 const sy_mediator_class *sy_context_class(const sy_context *c) { return c->cls; }
 void *sy_context_state(const sy_context *c) { return c->state; }
 
+void sy_context_restart(sy_context *c)
+{
+    if (c && c->cls->restart) c->cls->restart(c->state);
+}
+
 void sy_context_stats(const sy_context *c, sy_mediator_stats *out)
 {
     memset(out, 0, sizeof *out);

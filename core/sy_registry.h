@@ -164,6 +164,11 @@ typedef struct sy_mediator_class {
      * appended last so classes that set fields by name need no change. */
     sy_result (*pick)(void *state, const sy_camera_view *view, uint32_t width, uint32_t height, uint32_t x,
                       uint32_t y, sy_pick_result *out, sy_error *err);
+    /** Optional (sy_context_restart): the next render is what a new instance holding the same scene
+     * renders: progressive back-ends start new accumulations (sample 0, the request's seed) even where
+     * nothing visible changed; back-ends with fast paths for moves (the ray tracers' twin instances)
+     * place the next sync's moves as a fresh build does. NULL: nothing to do. */
+    void (*restart)(void *state);
 } sy_mediator_class;
 
 /** Registry (process-wide; the one piece of global state). The class must outlive the process's

@@ -171,12 +171,11 @@ static void pt_progress_print(const pt_progress *p, bool final)
 /* Renders a progressive back-end in passes until the sample count or the time budget is reached,
  * through the same window composition as a single-pass render (overlays and stereo included).
  * *out / *out_right get the final images; *samples_out the samples per pixel accumulated by the
- * main back-end; *ctx_out its (pool-owned) context. prior: the samples the main back-end held before
- * (the previous frame of a sequence): when it goes on accumulating (nothing visible changed, so no
- * restart) the passes of this call are counted from there, so every frame renders its own --spp. */
+ * main back-end; *ctx_out its (pool-owned) context. A sequence restarts the accumulation before each
+ * frame (sy_context_restart), so the passes are counted from 0. */
 static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uint32_t w, uint32_t h, const pt_opts *po,
                                     sy_context_pool *pool, sy_layer *out, sy_layer *out_right, double *seconds,
-                                    uint64_t *samples_out, sy_context **ctx_out, uint64_t prior, sy_error *err)
+                                    uint64_t *samples_out, sy_context **ctx_out, sy_error *err)
 {
     sy_params pp;
     sy_result r = sy_params_parse(spec->params, &pp, err);
@@ -185,7 +184,6 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
     bool tty = sy_is_terminal(2);
     double t0 = sy_time_now(), last_print = 0;
     uint32_t chunk = 1;
-    uint64_t base = UINT64_MAX; /* the back-end's samples that are not this call's (set after the first pass) */
     while (r == SY_OK) {
         uint64_t left = target ? target - pr.done : UINT32_MAX;
         uint32_t n = (uint32_t)(left < chunk ? left : chunk);
@@ -202,8 +200,7 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
         sy_mediator_stats ms = {0};
         if (sy_context_pool_get(pool, ld->scene, spec->backend, &pp, ld->root.id, &mc, err) == SY_OK) {
             sy_context_stats(mc, &ms);
-            if (base == UINT64_MAX) base = prior && ms.samples > prior ? prior : 0;
-            if (ms.samples - base > pr.done) pr.done = ms.samples - base;
+            if (ms.samples > pr.done) pr.done = ms.samples;
         }
         double now = sy_time_now(), pass = (now - p0) / n;
         if (tty && now - last_print > 0.1) {
@@ -616,6 +613,14 @@ int sy_cmd_render(int argc, char **argv)
             return st == 2 ? 2 : sy_cli_fail(&err);
         }
         oo.attr_count = 0;
+        /* every frame starts its own accumulation (sample 0, the same seed), moved or not: frame k is
+         * what `sy render --at T` of a fresh load renders, bit for bit (sy_context_restart) */
+        sy_params rp;
+        sy_context *rc = NULL;
+        sy_error ignore = {0};
+        if (sy_params_parse(spec.params, &rp, &ignore) == SY_OK &&
+            sy_context_pool_get(pool, ld.scene, spec.backend, &rp, ld.root.id, &rc, &ignore) == SY_OK)
+            sy_context_restart(rc);
     }
     progress_state ps = {shown, sy_time_now(), 0, sy_is_terminal(2) && !seq, false};
     sy_window_render_opts ro = {.progress = sy_cli_progress_cb, .progress_user = &ps};
@@ -625,7 +630,7 @@ int sy_cmd_render(int argc, char **argv)
     if (r == SY_OK && progressive) {
         /* the first Ctrl-C ends the render after the pass in progress and keeps its image */
         sy_signals_set_graceful("finishing the current pass, then writing the image accumulated so far");
-        r = render_progressive(&ld, &spec, w, h, &po, pool, &img, &img_right, &secs, &samples, &pctx, samples, &err);
+        r = render_progressive(&ld, &spec, w, h, &po, pool, &img, &img_right, &secs, &samples, &pctx, &err);
         t0 = sy_time_now() - secs;
         interrupted = sy_signals_interrupted();
     } else if (r == SY_OK && clo.cluster) {

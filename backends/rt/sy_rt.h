@@ -129,6 +129,13 @@ const char *sy_rt_device_error(const sy_rt_device *dev);
  * changed). Must be called before sy_rt_render after any change. */
 sy_rt_result sy_rt_commit(sy_rt_device *dev);
 
+/** Makes the next sy_rt_commit place every moved instance as a device built from scratch would: in
+ * the top-level scene (baked instances re-baked, the top level rebuilt), not through the fast path's
+ * twin instances, whose ray transform gives hits that differ from the baked ones in the last bits.
+ * Renders after it are bit for bit those of a new device holding the same objects (an image
+ * sequence's frame k equals a fresh render at its time); the commit costs a top-level rebuild. */
+sy_rt_result sy_rt_settle(sy_rt_device *dev);
+
 /** Live object counts, for leak diagnostics and tests. */
 typedef struct sy_rt_stats {
     /** @{ live objects of each kind */

@@ -141,6 +141,7 @@ struct sy_rt_device {
     bool dirty;          /* anything changed since the last commit */
     uint64_t version;    /* commits that published a change */
     bool top_dirty;      /* top scene needs rtcCommitScene */
+    bool settle;         /* sy_rt_settle: the next commit moves instances through the top scene, no twins */
     bool area_dirty;     /* area-light list needs a rebuild */
     bool filters_dirty;  /* alpha filters may need (un)installing */
     bool punctual_dirty; /* punctual light array needs a rebuild */

@@ -667,6 +667,8 @@ static sy_rt_result twin_place(sy_rt_device *dev, sy_rt_instance_data *in)
  * stale; otherwise every pending transform goes into the top scene, which is rebuilt. */
 static sy_rt_result commit_moved(sy_rt_device *dev)
 {
+    if (dev->settle && dev->pending_count) dev->top_dirty = true; /* sy_rt_settle: no twins this commit */
+    dev->settle = false;
     if (!dev->top_dirty && dev->pending_count) {
         uint32_t stale = dev->stale_count;
         for (uint32_t i = 0; i < dev->pending_count && !dev->top_dirty; ++i) {
@@ -777,6 +779,39 @@ fail:
     return r;
 }
 
+/* Puts a moved instance on the pending list (once); Embree sees the move at sy_rt_commit
+ * (commit_moved). False when out of memory. */
+static bool pending_add(sy_rt_device *dev, sy_rt_instance_data *in)
+{
+    if (in->xf_pending) return true;
+    if (dev->pending_count == dev->pending_cap) {
+        uint32_t ncap = dev->pending_cap ? dev->pending_cap * 2u : 64u;
+        sy_rt_instance_data **p = ncap > dev->pending_cap ? realloc(dev->pending, (size_t)ncap * sizeof *p) : NULL;
+        if (!p) return false;
+        dev->pending = p;
+        dev->pending_cap = ncap;
+    }
+    dev->pending[dev->pending_count++] = in;
+    in->xf_pending = true;
+    return true;
+}
+
+sy_rt_result sy_rt_settle(sy_rt_device *dev)
+{
+    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "settle: NULL device");
+    /* every instance shown through a twin goes back into the top scene (commit_moved's full path) */
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        sy_rt_instance_data *in = dev->instances.items[i];
+        if (in && in->stale && !pending_add(dev, in)) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "settle: out of memory");
+    }
+    if (dev->pending_count || dev->stale_count) {
+        dev->top_dirty = true;
+        dev->dirty = true;
+    }
+    dev->settle = true;
+    return SY_RT_OK;
+}
+
 sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst, const float transform[16])
 {
     if (!dev || !transform) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_transform: NULL argument");
@@ -791,17 +826,7 @@ sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst
                     "instance set_transform: the transform shrinks by %g (more than SY_RT_INSTANCE_GAIN_MAX %g allows "
                     "for an instance created unbaked); create it again",
                     1.0 / gain, (double)SY_RT_INSTANCE_GAIN_MAX);
-    if (!in->xf_pending) { /* Embree sees the move at sy_rt_commit (commit_moved) */
-        if (dev->pending_count == dev->pending_cap) {
-            uint32_t ncap = dev->pending_cap ? dev->pending_cap * 2u : 64u;
-            sy_rt_instance_data **p = ncap > dev->pending_cap ? realloc(dev->pending, (size_t)ncap * sizeof *p) : NULL;
-            if (!p) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance set_transform: out of memory");
-            dev->pending = p;
-            dev->pending_cap = ncap;
-        }
-        dev->pending[dev->pending_count++] = in;
-        in->xf_pending = true;
-    }
+    if (!pending_add(dev, in)) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance set_transform: out of memory");
     memcpy(in->xf, transform, sizeof in->xf);
     memcpy(in->nrm, nrm, sizeof in->nrm);
     if (instance_emissive(dev, in)) dev->area_dirty = true;

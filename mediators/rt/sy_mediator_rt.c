@@ -184,6 +184,7 @@ static const sy_mediator_class pathtracer_class = {
     .set_filter = sy_mediator_rt_set_filter,
     .filter_info = pathtracer_filter_info,
     .pick = sy_rti_pick,
+    .restart = sy_rti_pt_restart,
 };
 
 const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtracer_class; }
@@ -199,6 +200,7 @@ static const sy_mediator_class whitted_class = {
     .stats = rt_stats,
     .default_rank = 10, /* the default back-end without the rasterizer */
     .pick = sy_rti_pick,
+    .restart = sy_rti_pt_restart,
 };
 
 const sy_mediator_class *sy_mediator_rt_whitted_class(void) { return &whitted_class; }
@@ -219,6 +221,7 @@ static const sy_mediator_class coverage_class = {
     .stats = rt_stats,
     .coverage = sy_rti_coverage,
     .pick = sy_rti_pick,
+    .restart = sy_rti_pt_restart,
 };
 
 const sy_mediator_class *sy_mediator_rt_coverage_class(void) { return &coverage_class; }

@@ -55,6 +55,7 @@ const sy_mediator_class *sy_mediator_rt_coverage_class(void);
  * names, a camera no request uses) keep it. sy_mediator_stats.samples = samples so far of the last
  * render. req->sample_first is ignored: samples are numbered by the accumulation itself, and a
  * different req->seed gives an independent stream (cooperative cluster rendering relies on that).
+ * sy_context_restart restarts every accumulation at the next request (sample 0), changed or not.
  * Parameters: max_depth (bounces, 1..1024, default 64), specular, threads. */
 const sy_mediator_class *sy_mediator_rt_pathtracer_class(void);
 

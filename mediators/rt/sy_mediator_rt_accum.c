@@ -69,3 +69,17 @@ sy_result sy_rti_pt_slot(rt_state *st, const sy_render_request *req, sy_error *e
     st->last_slot = found;
     return SY_OK;
 }
+
+/* sy_context_restart (every class of the adapter): every slot's next request restarts it (no device
+ * version is UINT64_MAX, so sy_rti_pt_slot takes it for a change and resets the accumulation, the
+ * pixel filter and the radiance hook as after any visible change). */
+void sy_rti_pt_restart(void *state)
+{
+    rt_state *st = state;
+    for (int i = 0; i < ACCUM_SLOTS; ++i)
+        if (st->slots[i].acc) st->slots[i].version = UINT64_MAX;
+    /* and the moves of the next sync placed as a fresh device places them (sy_rt_settle): without
+     * it a moved instance's hits differ from a fresh render's in the last bits; only out of memory
+     * fails, and then the fast path still shows the scene right */
+    (void)sy_rt_settle(st->dev);
+}

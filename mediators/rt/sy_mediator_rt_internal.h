@@ -133,6 +133,7 @@ sy_result sy_rti_pick(void *state, const sy_camera_view *view, uint32_t width, u
 
 /* --- sy_mediator_rt_accum.c --- */
 sy_result sy_rti_pt_slot(rt_state *st, const sy_render_request *req, sy_error *err);
+void sy_rti_pt_restart(void *state); /* sy_context_restart: every slot restarts at its next request */
 
 /* --- sy_mediator_rt_filter.c --- */
 void sy_rti_filter_cfg_default(pt_filter_cfg *c, uint32_t threads);

@@ -5,6 +5,8 @@
 #     moved frame by frame gives what a single render at that time gives); frames differ over time
 #   - --frames 0:8:4: frames 0, 4, 8 only; --fps 12 changes the time of a frame
 #   - --resume: an existing frame is left alone (its file is not rewritten), the missing ones written
+#   - the path tracer: every frame has its --spp from sample 0 and equals a fresh --at render, also a
+#     frame where nothing moved (sy_context_restart)
 #   - usage errors (status 2, nothing written): -o without '#', --frames N (names --repeat), a bad
 #     range (5:2, 1:, a:b, 0:4:0), --fps without --frames, --frames with --at, --frame (names --frames
 #     and --at)
@@ -90,14 +92,20 @@ run_ok "--resume" seq_resume "$SY" render "$BOXANIM" -b whitted -w 48 -h 36 --fr
 [ -f "$TMP/r/r_0.exr" ] && [ -f "$TMP/r/r_2.exr" ] || fail "--resume: missing frames not written: $(ls "$TMP/r")"
 grep -qF "2 written, 1 skipped" "$TMP/seq_resume.out" || fail "--resume: $(cat "$TMP/seq_resume.out")"
 "$EXR_EQUAL" "$TMP/r/r_2.exr" "$TMP/at_2.exr" >/dev/null 2>&1 || fail "--resume: frame 2 differs from --at 2/24"
-# a progressive back-end renders its --spp per frame: a moved pose restarts the accumulation (2
-# samples), an unchanged one (past the clip's end at 3.7 s) goes on from the previous frame (4)
+# a progressive back-end renders its --spp per frame from sample 0 (sy_context_restart), moved or
+# not: frame k is bit for bit a fresh `sy render --at k/24` (the same samples), also where nothing
+# moved since the frame before (past the clip's end at 3.7 s: 199, 200), which before the restart
+# went on accumulating (4 samples, other random numbers)
 run_ok "pathtracer sequence" seq_pt "$SY" render "$BOXANIM" -b pathtracer --spp 2 -w 24 -h 18 --frames 1:2 -o "$TMP/pt_#.exr"
 run_ok "pathtracer sequence, still" seq_pt2 "$SY" render "$BOXANIM" -b pathtracer --spp 2 -w 24 -h 18 --frames 199:200 \
     -o "$TMP/pt_#.exr"
-for fs in 1:2 2:2 199:2 200:4; do
-    "$SY" info "$TMP/pt_${fs%%:*}.exr" | grep -qF "\"sy:samples\": \"${fs##*:}\"" ||
-        fail "pathtracer frame ${fs%%:*}: not ${fs##*:} samples: $("$SY" info "$TMP/pt_${fs%%:*}.exr" | grep sy:samples)"
+for k in 1 2 199 200; do
+    "$SY" info "$TMP/pt_$k.exr" | grep -qF '"sy:samples": "2"' ||
+        fail "pathtracer frame $k: not 2 samples: $("$SY" info "$TMP/pt_$k.exr" | grep sy:samples)"
+    run_ok "pathtracer --at $k/24" pt_at_$k "$SY" render "$BOXANIM" -b pathtracer --spp 2 -w 24 -h 18 \
+        --at "$(awk "BEGIN{printf \"%.17g\", $k/24}")" -o "$TMP/pt_at_$k.exr"
+    "$EXR_EQUAL" "$TMP/pt_$k.exr" "$TMP/pt_at_$k.exr" >/dev/null 2>&1 ||
+        fail "pathtracer frame $k differs from a fresh sy render --at $k/24"
 done
 # video: 2 s at 24 fps, read back through libavformat (video_probe)
 if [ -n "$VIDEO_PROBE" ]; then
