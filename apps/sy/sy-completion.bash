@@ -98,7 +98,7 @@ _sy_complete() {
         --composite) words="depth over replace" ;;
         --filter) words="none pixel atrous jbu adaptive radiance" ;;
         --gl) words="osmesa egl glfw" ;;
-        --cluster-mode) words="sort-first balanced cooperative multi-display stereo" ;;
+        --cluster-mode) words="sort-first balanced cooperative multi-display stereo frames" ;;
         --cluster-pixels) words="float half" ;;
         -o | --output | --screenshot | --env | --allow-path | --overlay | --secret-file | --tls-ca | --tls-cert | \
             --tls-key | --port-file | --reference | --cluster)

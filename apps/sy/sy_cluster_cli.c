@@ -76,7 +76,7 @@ static sy_result parse_conf_tile(char **tok, const char *path, uint32_t line, sy
 }
 
 /* A cluster configuration file (`--cluster FILE`), one directive per line, '#' comments:
- *   mode sort-first|balanced|cooperative|multi-display|stereo
+ *   mode sort-first|balanced|cooperative|multi-display|stereo   (frames: only as --cluster-mode)
  *   server URL [backend NAME] [tile X Y W H]
  *   viewer full | viewer tile X Y W H     (sy view, multi-display: what the client's window shows)
  * The tokens are stored in *text (owned by the caller) and pointed to from the arrays. */
@@ -234,7 +234,24 @@ sy_result sy_cluster_cli_setup(const sy_cluster_cli_opts *o, const char *backend
                                sy_error *err)
 {
     sy_result r = cluster_register(o, SY_MEDIATOR_CLUSTER_NAME, mode_out, servers_out, viewer_tile, err);
+    if (r == SY_OK && *mode_out == SY_CLUSTER_FRAMES) /* a configuration file's 'mode frames', sy view */
+        r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster mode frames renders image sequences: sy render "
+                         "--frames A:B --cluster-mode frames; a window (sy view, one sy render image) uses another mode");
     if (r == SY_OK) r = sy_cluster_cli_params(o, backend, *mode_out, params, params_out, len, err);
+    return r;
+}
+
+sy_result sy_cluster_cli_render_frames(const sy_cluster_cli_opts *o, sy_scene *scene, const sy_cluster_frames_job *job,
+                                       sy_cluster_frames_stats *stats, uint32_t *servers_out, sy_error *err)
+{
+    cli_client_opts c;
+    sy_cluster_client *client = NULL;
+    sy_result r = cli_client_opts_make(o, &c, err);
+    *servers_out = c.n;
+    if (r == SY_OK) r = sy_cluster_client_create(scene, &c.co, &client, err);
+    if (r == SY_OK) r = sy_cluster_client_render_frames(client, job, stats, err);
+    sy_cluster_client_destroy(client);
+    cli_client_opts_free(&c);
     return r;
 }
 

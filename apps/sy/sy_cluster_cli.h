@@ -80,6 +80,13 @@ sy_result sy_cluster_cli_register(const sy_cluster_cli_opts *o, const char *name
 sy_result sy_cluster_cli_params(const sy_cluster_cli_opts *o, const char *backend, uint32_t mode, const char *params,
                                 char *out, size_t len, sy_error *err);
 
+/* `sy render --frames A:B --cluster-mode frames`: connects to o's servers (URLs or configuration
+ * file, secret, TLS) with scene as the client's scene, renders the job (sy_cluster_client_render_frames:
+ * a work queue of whole frames, re-queued when a server fails), says BYE. *servers_out: the servers
+ * configured. */
+sy_result sy_cluster_cli_render_frames(const sy_cluster_cli_opts *o, sy_scene *scene, const sy_cluster_frames_job *job,
+                                       sy_cluster_frames_stats *stats, uint32_t *servers_out, sy_error *err);
+
 /* The cluster mediator's statistics of its last frame and its configured mode (mode may be NULL);
  * ctx is a context of the cluster class (caps SY_CAP_REMOTE). */
 void sy_cluster_cli_last_frame(const sy_context *ctx, sy_cluster_frame_stats *stats, uint32_t *mode);

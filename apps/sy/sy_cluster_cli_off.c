@@ -66,3 +66,11 @@ const char *sy_cluster_cli_mode_name(uint32_t mode)
     (void)mode;
     return "none";
 }
+
+sy_result sy_cluster_cli_render_frames(const sy_cluster_cli_opts *o, sy_scene *scene, const sy_cluster_frames_job *job,
+                                       sy_cluster_frames_stats *stats, uint32_t *servers_out, sy_error *err)
+{
+    (void)o, (void)scene, (void)job, (void)stats;
+    *servers_out = 0;
+    return sy_error_set(err, SY_ERR_UNSUPPORTED, "--cluster-mode frames: %s", SY_NO_CLUSTER);
+}

@@ -12,6 +12,7 @@
 #include "sy_testpoint.h"
 #include "sy_video.h"
 
+#include "sy_anim.h"
 #include "sy_exr.h"
 #include "sy_file.h"
 #include "sy_log.h"
@@ -319,6 +320,144 @@ static void cluster_report(sy_scene *scene, sy_context_pool *pool, const sy_comp
         sy_log(SY_LOG_NOTE, "sy", NULL, "cluster: merged %llu samples per pixel", (unsigned long long)st.samples);
 }
 
+/* >>frames mode: `--frames A:B --cluster-mode frames`, whole frames on the servers from a work queue */
+typedef struct frames_run {
+    const char *pattern, *shown, *scene, *params;
+    const uint32_t *numbers;     /* frame numbers of the job's frames */
+    const out_opts *oo;
+    uint32_t w, h, samples, total, skipped, written;
+    double t0, last_print;
+    bool tty;
+} frames_run;
+
+/* Writes a finished frame (on the cluster client's threads, one call at a time) and shows progress
+ * on a terminal: frames done, frames per minute, ETA. */
+static sy_result frames_done(void *user, uint32_t index, const sy_layer *img, uint32_t server, sy_error *err)
+{
+    frames_run *fr = user;
+    char path[4096], renderer[64], size_str[48], samples_str[32], server_str[16];
+    frame_path(fr->pattern, fr->numbers[index], path, sizeof path);
+    snprintf(renderer, sizeof renderer, "Switchyard %s", sy_version());
+    snprintf(size_str, sizeof size_str, "%ux%u", fr->w, fr->h);
+    snprintf(samples_str, sizeof samples_str, "%u", fr->samples ? fr->samples : 1u);
+    snprintf(server_str, sizeof server_str, "%u", server + 1);
+    const char *kv[][2] = {{"sy:renderer", renderer}, {"sy:backend", fr->shown}, {"sy:params", fr->params},
+                           {"sy:size", size_str},     {"sy:samples", samples_str}, {"sy:source", fr->scene},
+                           {"sy:server", server_str}};
+    sy_exr_attribute attrs[8];
+    sy_png_text texts[8];
+    out_opts o = *fr->oo;
+    o.attr_count = 0;
+    for (size_t k = 0; k < sizeof kv / sizeof kv[0]; ++k) {
+        if (!kv[k][1] || !kv[k][1][0]) continue;
+        attrs[o.attr_count] = (sy_exr_attribute){kv[k][0], kv[k][1]};
+        texts[o.attr_count] = (sy_png_text){kv[k][0], kv[k][1]};
+        o.attr_count++;
+    }
+    o.attrs = attrs;
+    o.png.text = texts;
+    o.png.text_count = o.attr_count;
+    size_t bad = sy_layer_count_nonfinite(img);
+    if (bad) sy_log(SY_LOG_WARNING, "sy", path, "%zu pixels are not finite", bad);
+    sy_result r = sy_cli_write_image(path, img, &o, err); /* atomically: --resume trusts what exists */
+    if (r != SY_OK) return r;
+    fr->written++;
+    double now = sy_time_now(), el = now - fr->t0;
+    if (fr->tty && (now - fr->last_print > 0.1 || fr->written == fr->total)) {
+        double fpm = el > 0 ? 60.0 * fr->written / el : 0.0;
+        fprintf(stderr, "\rframes: %u of %u done, %.1f frames/min, ETA %.0f s   ", fr->written, fr->total, fpm,
+                fpm > 0 ? 60.0 * (fr->total - fr->written) / fpm : 0.0);
+        fflush(stderr);
+        fr->last_print = now;
+    }
+    return SY_OK;
+}
+
+/* The whole sequence in frames mode: the frames --resume does not skip, each one's time and camera
+ * view (the client's scene is moved frame by frame to compute the view; the servers set the time on
+ * their replicas), rendered by the servers as they come free. Returns the exit status. */
+static int render_frames_mode(loaded *ld, const sy_compose_spec *spec, const sy_cluster_cli_opts *clo, const char *remote,
+                              const char *params, uint32_t w, uint32_t h, uint32_t samples, const char *clip, uint32_t fa,
+                              uint32_t fb, uint32_t fstep, double fps, bool resume, const char *pattern, const out_opts *oo,
+                              const char *scene)
+{
+    uint32_t nseq = (fb - fa) / fstep + 1, n = 0, skipped = 0;
+    uint32_t *numbers = malloc((size_t)nseq * sizeof *numbers);
+    double *times = malloc((size_t)nseq * sizeof *times);
+    sy_camera_view *views = malloc((size_t)nseq * sizeof *views);
+    sy_error err = {0};
+    sy_result r = numbers && times && views ? SY_OK : sy_error_set(&err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+    bool animated = sy_scene_count(ld->scene, SY_TYPE_ANIMATION) > 0;
+    sy_animation clip_h = {0};
+    if (r == SY_OK && clip && animated && sy_animation_find(ld->scene, clip, &clip_h, &err) != SY_OK) {
+        fprintf(stderr, "sy render: error: --clip %s: %s\n", clip, err.message);
+        free(numbers), free(times), free(views);
+        return 2;
+    }
+    for (uint32_t fi = 0; fi < nseq && r == SY_OK; ++fi) {
+        uint32_t frame = fa + fi * fstep;
+        char path[4096];
+        struct stat ost;
+        frame_path(pattern, frame, path, sizeof path);
+        if (resume && stat(path, &ost) == 0) { /* written whole (atomically) or not at all */
+            skipped++;
+            continue;
+        }
+        /* the camera may be animated: its view at this frame's time */
+        int st = animated || n == 0 ? sy_cli_set_time(ld, clip, frame / fps, &err) : 0;
+        if (st) {
+            free(numbers), free(times), free(views);
+            return st == 2 ? 2 : sy_cli_fail(&err);
+        }
+        numbers[n] = frame;
+        times[n] = frame / fps;
+        r = sy_compose_camera_view(ld->scene, spec, w, h, &views[n], &err);
+        n++;
+    }
+    char shown[160];
+    frames_run fr = {.pattern = pattern, .shown = shown, .scene = scene, .params = params, .numbers = numbers, .oo = oo,
+                     .w = w, .h = h, .samples = samples, .total = n, .skipped = skipped, .t0 = sy_time_now(),
+                     .tty = sy_is_terminal(2)};
+    sy_cluster_frames_stats fs;
+    memset(&fs, 0, sizeof fs);
+    uint32_t servers = 0;
+    snprintf(shown, sizeof shown, "%s in frames mode", remote);
+    if (r == SY_OK && n) {
+        sy_cluster_frames_job job = {.frame = {.mode = SY_CLUSTER_FRAMES,
+                                               .backend = remote,
+                                               .params = params,
+                                               .root_id = ld->root.id,
+                                               .background_id = ld->background.id,
+                                               .width = w,
+                                               .height = h,
+                                               .samples = samples,
+                                               .depth = true,
+                                               .half = clo->half_pixels},
+                                     .count = n,
+                                     .times = animated ? times : NULL,
+                                     .cameras = views,
+                                     .clip_id = clip_h.id,
+                                     .done = frames_done,
+                                     .done_user = &fr};
+        r = sy_cluster_cli_render_frames(clo, ld->scene, &job, &fs, &servers, &err);
+        if (fr.tty) fprintf(stderr, "\r%*s\r", 78, "");
+    }
+    if (r == SY_OK) {
+        printf("%s: frames %u..%u step %u at %g fps: %u written, %u skipped (existing), %ux%u, %s, %.3f s\n", pattern, fa,
+               fb, fstep, fps, fr.written, skipped, w, h, shown, sy_time_now() - fr.t0);
+        if (n) {
+            char per[512] = "";
+            size_t used = 0;
+            for (uint32_t i = 0; i < servers && i < SY_CLUSTER_MAX_SERVERS && used < sizeof per; ++i)
+                used += (size_t)snprintf(per + used, sizeof per - used, "%s%u", i ? " " : "", fs.per_server[i]);
+            printf("frames mode: %u servers, frames per server %s, %u re-queued, %u server failures, %.1f frames/min\n",
+                   servers, per, fs.requeued, fs.servers_failed, fs.seconds > 0 ? 60.0 * fs.frames / fs.seconds : 0.0);
+        }
+    }
+    free(numbers), free(times), free(views);
+    return r == SY_OK ? 0 : sy_cli_fail(&err);
+}
+
 int sy_cmd_render(int argc, char **argv)
 {
     const char *scene = NULL, *backend = NULL, *outp = NULL, *camera = NULL, *params = NULL;
@@ -455,6 +594,13 @@ int sy_cmd_render(int argc, char **argv)
         return sy_cli_usage_of("render", "--frames needs -o with a run of '#' for the frame number (out_####.png)");
     if (seq && clo.frames) return sy_cli_usage_of("render", "--frames and --repeat: one or the other");
     if (seq && strlen(outp) > 4000) return sy_cli_usage_of("render", "-o: the frames' path is too long");
+    bool frames_mode = clo.cluster && clo.mode && !strcmp(clo.mode, "frames");
+    if (frames_mode && !seq)
+        return sy_cli_usage_of("render", "--cluster-mode frames renders sequences: give --frames A:B and -o out_####.exr");
+    if (frames_mode && (video || spec.stereo != SY_STEREO_NONE || overlay || po.aov || po.time_budget > 0 || filter ||
+                        threshold))
+        return sy_cli_usage_of("render", "--cluster-mode frames writes each frame as an image of a mono render at fixed "
+                                         "samples: no video, --stereo, --overlay, --aov, --time, --filter or --threshold");
     sy_error err = {0};
     char in_folder[4096], auto_out[1024];
     struct stat sst;
@@ -503,7 +649,7 @@ int sy_cmd_render(int argc, char **argv)
     const char *remote = backend;
     char cluster_params[1400];
     uint32_t cluster_mode = 0, cluster_servers = 0;
-    if (clo.cluster) {
+    if (clo.cluster && !frames_mode) {
         if (sy_cluster_cli_setup(&clo, backend, params, cluster_params, sizeof cluster_params, &cluster_mode,
                                  &cluster_servers, NULL, &err) != SY_OK)
             return sy_cli_fail(&err);
@@ -512,7 +658,7 @@ int sy_cmd_render(int argc, char **argv)
         params = cluster_params;
     }
     char shown[96]; /* the back-end as reported: "whitted", or "whitted on 2 servers (sort-first)" */
-    if (clo.cluster)
+    if (clo.cluster && !frames_mode)
         snprintf(shown, sizeof shown, "%s on %u server%s (%s)", remote, cluster_servers, cluster_servers == 1 ? "" : "s",
                  sy_cluster_cli_mode_name(cluster_mode));
     else snprintf(shown, sizeof shown, "%s", remote);
@@ -581,6 +727,13 @@ int sy_cmd_render(int argc, char **argv)
     spec.root = ld.root;
     spec.camera = ld.camera;
     spec.background = ld.background;
+    if (frames_mode) { /* the servers render the frames; nothing is rendered here */
+        uint32_t fsamples = progressive ? (po.spp ? po.spp : 64) : po.spp;
+        int fst = render_frames_mode(&ld, &spec, &clo, remote, params, w, h, fsamples, clip, fa, fb, fstep, fps, resume,
+                                     outp, &oo, scene);
+        sy_cli_loaded_free(&ld);
+        return fst;
+    }
     sy_result r = overlay ? sy_cli_add_overlay(&ld, overlay, composite, &spec, &err) : SY_OK;
     if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
     uint64_t samples = 0;

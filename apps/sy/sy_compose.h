@@ -47,4 +47,10 @@ sy_result sy_compose_render(sy_scene *scene, sy_context_pool *pool, const sy_com
                             uint32_t h, const sy_window_render_opts *opts, sy_layer *out, sy_layer *out_right,
                             sy_error *err);
 
+/* The main viewport's mono camera view at w x h (the camera node as the scene holds it now, the
+ * section planes included): what a render of spec would ask its back-end for (sy render
+ * --cluster-mode frames sends it with each frame). */
+sy_result sy_compose_camera_view(const sy_scene *scene, const sy_compose_spec *spec, uint32_t w, uint32_t h,
+                                 sy_camera_view *out, sy_error *err);
+
 #endif /* SY_COMPOSE_H */

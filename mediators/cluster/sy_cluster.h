@@ -150,6 +150,8 @@ typedef enum sy_cluster_mode {
     SY_CLUSTER_COOPERATIVE = 2,   /**< servers render disjoint sample ranges of every pixel; merged */
     SY_CLUSTER_MULTI_DISPLAY = 3, /**< each server renders and presents its column of a wall; swap barrier */
     SY_CLUSTER_STEREO = 4,        /**< left eye on even servers, right eye on odd ones; side by side */
+    SY_CLUSTER_FRAMES = 5,        /**< sequences: whole frames to servers from a work queue
+                                     (sy_cluster_client_render_frames; sy_cluster_client_render refuses it) */
 } sy_cluster_mode;
 
 /** "sort-first" -> SY_CLUSTER_SORT_FIRST, ...; false when unknown. */
@@ -172,6 +174,7 @@ typedef struct sy_cluster_frame {
     uint32_t seed; /**< seed for the back-ends' sampling */
     bool depth;              /**< fetch depth too */
     bool half;               /**< tiles as binary16 (display walls, previews); false = float32, bit-exact */
+    bool restart;            /**< progressive back-ends start new accumulations (sy_context_restart) on the servers */
     /** @{ stereo (0 = defaults 0.065 / 2) */
     float eye_separation, zero_parallax; /** @} */
 } sy_cluster_frame;
@@ -199,6 +202,48 @@ sy_result sy_cluster_client_create(sy_scene *scene, const sy_cluster_client_opts
  * created by the caller with sy_layer_create). Multi-display leaves out untouched. */
 sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame *f, sy_layer *out,
                                    sy_cluster_frame_stats *stats, sy_error *err);
+/** Receives a finished frame of sy_cluster_client_render_frames: `index` into the job's frames, the
+ * whole image (borrowed for the call), the server (index into the URLs) that rendered it. Called on
+ * the client's threads, one call at a time. Non-SY_OK (with err set) ends the job with that error. */
+typedef sy_result (*sy_cluster_frame_done_fn)(void *user, uint32_t index, const sy_layer *image, uint32_t server,
+                                              sy_error *err);
+
+/** A sequence for sy_cluster_client_render_frames. */
+typedef struct sy_cluster_frames_job {
+    sy_cluster_frame frame;        /**< what every frame shares: back-end, params, root, background, size, samples
+                                      (progressive: per frame), seed, depth, half; mode, camera, restart ignored */
+    uint32_t count;                /**< frames */
+    const double *times;           /**< count scene times in seconds, [0, SY_CLUSTER_MAX_TIME]; NULL = no clock
+                                      (the replica renders as synced) */
+    const sy_camera_view *cameras; /**< count views, one per frame (an animated camera moves) */
+    uint32_t clip_id;              /**< with times: the animation's core id (0 = every clip), as sy_scene_set_time */
+    sy_cluster_frame_done_fn done; /**< receives each frame once */
+    void *done_user;               /**< passed to done */
+} sy_cluster_frames_job;
+
+/** What a sequence cost (sy_cluster_client_render_frames). */
+typedef struct sy_cluster_frames_stats {
+    uint32_t frames;         /**< frames delivered */
+    uint32_t requeued;       /**< frames given back to the queue by a server that failed on them */
+    uint32_t servers_failed; /**< server failures (a server that fails is redialled between rounds) */
+    uint32_t rounds;         /**< rounds of the queue (1 when no server failed) */
+    uint32_t per_server[SY_CLUSTER_MAX_SERVERS]; /**< frames each server rendered */
+    uint64_t bytes_sent, bytes_received; /**< everything on the wire */
+    double seconds;          /**< the whole sequence */
+} sy_cluster_frames_stats;
+
+/** Frames mode: renders a sequence with whole frames on servers from a work queue. The scene's
+ * committed changes go to every live server first (a new one: a snapshot); then one thread per
+ * server takes the next frame as soon as its last one is back (no static split), and the server sets
+ * its replica's scene clock to the frame's time (RENDER with SY_CLUSTER_RENDER_TIME, clip_id),
+ * restarts progressive accumulation (SY_CLUSTER_RENDER_RESTART) and renders the whole image, so a
+ * frame is bit for bit what a local context renders at that time. A server that fails or misses the
+ * deadline mid-frame is disconnected and its frame goes back to the queue for the others; when the
+ * queue stalls with frames left, the servers down are redialled (a snapshot) and the queue runs
+ * again, while a round delivers frames; SY_ERR_IO when one delivers none. Frames are delivered
+ * through job->done in completion order. stats may be NULL. */
+sy_result sy_cluster_client_render_frames(sy_cluster_client *c, const sy_cluster_frames_job *job,
+                                          sy_cluster_frames_stats *stats, sy_error *err);
 /** Number of servers connected now. */
 uint32_t sy_cluster_client_live(const sy_cluster_client *c);
 /** Changes the per-request deadline (0 = 60000 ms) for the following frames. */

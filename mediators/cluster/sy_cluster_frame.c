@@ -10,11 +10,11 @@
 #include <string.h>
 
 /* ---- modes ---- */
-static const char *mode_names[] = {"sort-first", "balanced", "cooperative", "multi-display", "stereo"};
+static const char *mode_names[] = {"sort-first", "balanced", "cooperative", "multi-display", "stereo", "frames"};
 
 bool sy_cluster_mode_parse(const char *name, uint32_t *out)
 {
-    for (uint32_t i = 0; i < 5; ++i)
+    for (uint32_t i = 0; i < 6; ++i)
         if (!strcmp(name, mode_names[i])) {
             *out = i;
             return true;
@@ -24,7 +24,7 @@ bool sy_cluster_mode_parse(const char *name, uint32_t *out)
 
 const char *sy_cluster_mode_name(uint32_t mode)
 {
-    return mode < 5 ? mode_names[mode] : "?";
+    return mode < 6 ? mode_names[mode] : "?";
 }
 
 /* ---- per-frame work ---- */
@@ -77,7 +77,7 @@ static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, s
     q->frame = c->frame;
     q->job = (uint32_t)(it - fc->items);
     q->flags = (f->depth ? SY_CLUSTER_RENDER_DEPTH : 0) | (f->mode == SY_CLUSTER_MULTI_DISPLAY ? SY_CLUSTER_RENDER_PRESENT : 0) |
-               (f->half ? SY_CLUSTER_RENDER_HALF : 0);
+               (f->half ? SY_CLUSTER_RENDER_HALF : 0) | (f->restart ? SY_CLUSTER_RENDER_RESTART : 0);
     sy_clu_copy_str(q->backend, sizeof q->backend, k->backend[0] ? k->backend : f->backend);
     sy_clu_copy_str(q->params, sizeof q->params, f->params ? f->params : "");
     q->root_id = f->root_id;
@@ -127,7 +127,7 @@ static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, s
 
 /* Sends the frame's SCENE; while the server answers BLOB_REQUEST, sends the blobs it names (BLOBS
  * messages of at most a quarter of the message limit each, at least one blob) until SCENE_ACK. */
-static sy_result send_scene(sy_cluster_client *c, conn *k, sy_error *err)
+sy_result sy_clu_send_scene(sy_cluster_client *c, conn *k, sy_error *err)
 {
     sy_cluster_msg rep;
     uint8_t *raw = NULL;
@@ -185,7 +185,7 @@ static void *conn_thread(void *p)
     conn *k = &c->conns[a->conn];
     sy_error err = {0};
     sy_result r = SY_OK;
-    if (a->send_scene && k->scene_msg.size) r = send_scene(c, k, &err);
+    if (a->send_scene && k->scene_msg.size) r = sy_clu_send_scene(c, k, &err);
     for (uint32_t i = 0; r == SY_OK && i < fc->item_count; ++i) {
         work_item *it = &fc->items[i];
         if (it->owner != (int)a->conn || it->done) continue;
@@ -330,30 +330,9 @@ static void split_rows(uint32_t h, uint32_t n, const double *w, uint32_t *starts
     starts[n] = h;
 }
 
-sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame *f, sy_layer *out,
-                                   sy_cluster_frame_stats *stats, sy_error *err)
+/* Steps 1 and 2 of a frame (sy_clu_sync_servers in sy_cluster_internal.h). */
+sy_result sy_clu_sync_servers(sy_cluster_client *c, uint64_t *scene_bytes, sy_error *err)
 {
-    double t0 = sy_time_now();
-    sy_cluster_frame_stats st;
-    memset(&st, 0, sizeof st);
-    if (f->mode > SY_CLUSTER_STEREO || !f->backend || f->width < 1 || f->height < 1 ||
-        f->width > SY_CLUSTER_MAX_IMAGE || f->height > SY_CLUSTER_MAX_IMAGE)
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster render: bad mode, back-end or image size");
-    uint32_t out_w = f->mode == SY_CLUSTER_STEREO ? 2 * f->width : f->width;
-    if (f->mode != SY_CLUSTER_MULTI_DISPLAY && (!out || out->width != out_w || out->height != f->height))
-        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster render: output layer must be %ux%u", out_w, f->height);
-    sy_result cr = sy_cluster_camera_check(&f->camera, err); /* refused here, before any server is involved */
-    if (cr != SY_OK) {
-        sy_error_prefix(err, "cluster render");
-        return cr;
-    }
-    c->frame++;
-    uint64_t sent0 = 0, recv0 = 0;
-    uint64_t blobf0 = 0, blobp0 = 0;
-    for (uint32_t i = 0; i < c->n; ++i) {
-        sent0 += c->conns[i].bytes_sent, recv0 += c->conns[i].bytes_received;
-        blobf0 += c->conns[i].blob_frames_bytes, blobp0 += c->conns[i].blob_payload_bytes;
-    }
     /* 1. reconnect servers that are down (they will get a snapshot) */
     for (uint32_t i = 0; i < c->n; ++i) {
         conn *k = &c->conns[i];
@@ -402,12 +381,43 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
                 m.u.scene.changes_size = (uint32_t)size;
                 k->scene_msg.size = 0;
                 r = sy_cluster_encode(&m, 0, &k->scene_msg, err); /* tagged frame by frame when sent */
-                st.scene_bytes += k->scene_msg.size;
+                *scene_bytes += k->scene_msg.size;
             }
             free(data);
         }
         sy_changes_release(ch);
     }
+    return r;
+}
+
+sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame *f, sy_layer *out,
+                                   sy_cluster_frame_stats *stats, sy_error *err)
+{
+    double t0 = sy_time_now();
+    sy_cluster_frame_stats st;
+    memset(&st, 0, sizeof st);
+    if (f->mode == SY_CLUSTER_FRAMES)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster render: frames mode renders sequences "
+                            "(sy_cluster_client_render_frames)");
+    if (f->mode > SY_CLUSTER_STEREO || !f->backend || f->width < 1 || f->height < 1 ||
+        f->width > SY_CLUSTER_MAX_IMAGE || f->height > SY_CLUSTER_MAX_IMAGE)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster render: bad mode, back-end or image size");
+    uint32_t out_w = f->mode == SY_CLUSTER_STEREO ? 2 * f->width : f->width;
+    if (f->mode != SY_CLUSTER_MULTI_DISPLAY && (!out || out->width != out_w || out->height != f->height))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster render: output layer must be %ux%u", out_w, f->height);
+    sy_result cr = sy_cluster_camera_check(&f->camera, err); /* refused here, before any server is involved */
+    if (cr != SY_OK) {
+        sy_error_prefix(err, "cluster render");
+        return cr;
+    }
+    c->frame++;
+    uint64_t sent0 = 0, recv0 = 0;
+    uint64_t blobf0 = 0, blobp0 = 0;
+    for (uint32_t i = 0; i < c->n; ++i) {
+        sent0 += c->conns[i].bytes_sent, recv0 += c->conns[i].bytes_received;
+        blobf0 += c->conns[i].blob_frames_bytes, blobp0 += c->conns[i].blob_payload_bytes;
+    }
+    sy_result r = sy_clu_sync_servers(c, &st.scene_bytes, err);
     if (r) return r;
     /* 3. work items */
     uint32_t live[SY_CLUSTER_MAX_SERVERS], nl = 0;

@@ -14,6 +14,7 @@
  *   sy_cluster_server.c      the server: create, destroy, run; connections and their reader threads
  *   sy_cluster_client.c      the client's connections: handshake, request / reply, create, destroy
  *   sy_cluster_frame.c       modes and one frame: work items, rounds, reassignment, merge, swap
+ *   sy_cluster_frames.c      frames mode: a sequence's whole frames from a work queue, re-queued on failure
  * The cluster mediator (sy_mediator_cluster.c) sits on top and uses only sy_cluster.h. */
 #ifndef SY_CLUSTER_INTERNAL_H
 #define SY_CLUSTER_INTERNAL_H
@@ -276,5 +277,13 @@ void sy_clu_conn_close(conn *k);
 sy_result sy_clu_conn_call(sy_cluster_client *c, conn *k, sy_cluster_msg *req, const sy_cluster_buf *preencoded,
                            uint32_t expect, sy_cluster_msg *reply, uint8_t **raw, sy_error *err);
 sy_result sy_clu_conn_connect(sy_cluster_client *c, conn *k, sy_error *err); /* dial + handshake */
+
+/* sy_cluster_frame.c */
+/* A frame's start: redials the servers that are down (they get a snapshot), and encodes each live
+ * connection's SCENE (k->scene_msg; size 0 = nothing to send) from its consumer; adds the bytes
+ * to *scene_bytes. */
+sy_result sy_clu_sync_servers(sy_cluster_client *c, uint64_t *scene_bytes, sy_error *err);
+/* Sends k->scene_msg and the blobs the server asks for, until SCENE_ACK. */
+sy_result sy_clu_send_scene(sy_cluster_client *c, conn *k, sy_error *err);
 
 #endif

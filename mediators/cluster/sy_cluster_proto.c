@@ -175,6 +175,11 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
         sy_error ce = {0};
         if (sy_cluster_camera_check(&r->camera, &ce) != SY_OK)
             return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: %s", ce.message);
+        if (!(r->time >= 0.0 && r->time <= SY_CLUSTER_MAX_TIME) ||
+            (!(r->flags & SY_CLUSTER_RENDER_TIME) && (r->time != 0.0 || r->clip_id != 0)))
+            return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                                   "cluster encode RENDER: scene time %g outside 0..1e9 s or without the time flag",
+                                                   r->time);
         for (uint32_t i = 0; i < r->tile_count; ++i)
             if (!rect_ok(&r->tiles[i], r->full_width, r->full_height))
                 return out->size = start, sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "cluster encode RENDER: tile %u outside the image", i);
@@ -199,6 +204,8 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
         w_u32(&w, r->camera.clip_count); /* section planes (protocol 4) */
         for (uint32_t i = 0; i < r->camera.clip_count && i < SY_CLIP_PLANES_MAX; ++i)
             for (int k = 0; k < 4; ++k) w_f32(&w, r->camera.clip_planes[i][k]);
+        w_f64(&w, r->time); /* the scene clock (protocol 5) */
+        w_u32(&w, r->clip_id);
         w_u32(&w, r->tile_count);
         for (uint32_t i = 0; i < r->tile_count; ++i) {
             w_u32(&w, r->tiles[i].x);
@@ -487,7 +494,8 @@ sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, 
         q->frame = rd_u64(&rd);
         q->job = rd_u32(&rd);
         q->flags = rd_u32(&rd);
-        if (!rd.r && (q->flags & ~(uint32_t)(SY_CLUSTER_RENDER_DEPTH | SY_CLUSTER_RENDER_PRESENT | SY_CLUSTER_RENDER_HALF)))
+        if (!rd.r && (q->flags & ~(uint32_t)(SY_CLUSTER_RENDER_DEPTH | SY_CLUSTER_RENDER_PRESENT | SY_CLUSTER_RENDER_HALF |
+                                             SY_CLUSTER_RENDER_RESTART | SY_CLUSTER_RENDER_TIME)))
             rd_fail(&rd, SY_ERR_PARSE, "unknown render flags");
         rd_str(&rd, q->backend, SY_CLUSTER_BACKEND_MAX, "back-end name");
         rd_str(&rd, q->params, SY_CLUSTER_PARAMS_MAX, "parameters");
@@ -509,6 +517,12 @@ sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, 
             rd_fail(&rd, SY_ERR_LIMIT, "more than 6 section planes");
         for (uint32_t i = 0; !rd.r && i < q->camera.clip_count; ++i)
             for (int k = 0; k < 4; ++k) q->camera.clip_planes[i][k] = rd_f32(&rd);
+        q->time = rd_f64(&rd);
+        q->clip_id = rd_u32(&rd);
+        if (!rd.r && !(q->time >= 0.0 && q->time <= SY_CLUSTER_MAX_TIME)) /* NaN fails too */
+            rd_fail(&rd, SY_ERR_PARSE, "scene time outside 0..1e9 seconds");
+        else if (!rd.r && !(q->flags & SY_CLUSTER_RENDER_TIME) && (q->time != 0.0 || q->clip_id != 0))
+            rd_fail(&rd, SY_ERR_PARSE, "a scene time or clip without the time flag");
         q->tile_count = rd_u32(&rd);
         if (!rd.r) {
             if (q->eye > 2) rd_fail(&rd, SY_ERR_PARSE, "eye must be 0 (mono), 1 (left) or 2 (right)");

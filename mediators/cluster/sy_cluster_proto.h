@@ -30,7 +30,8 @@ extern "C" {
 #endif
 
 #define SY_CLUSTER_MAGIC 0x50435953u /**< "SYCP" little endian */
-#define SY_CLUSTER_VERSION 4u /**< protocol version this build speaks (4: RENDER carries section planes) */
+#define SY_CLUSTER_VERSION 5u /**< protocol version this build speaks (4: RENDER carries section planes; 5: RENDER
+                                  carries a scene time and a restart flag, for frames mode) */
 #define SY_CLUSTER_HEADER_SIZE 24u /**< bytes of a frame header */
 #define SY_CLUSTER_TAG_SIZE 32u /**< bytes of a frame's authentication tag */
 #define SY_CLUSTER_NONCE_SIZE 32u /**< bytes of a handshake nonce */
@@ -84,7 +85,10 @@ typedef enum sy_cluster_render_flags {
     SY_CLUSTER_RENDER_DEPTH = 1u << 0,   /**< send the depth channel too */
     SY_CLUSTER_RENDER_PRESENT = 1u << 1, /**< keep the tiles on the server for SWAP (multi-display) */
     SY_CLUSTER_RENDER_HALF = 1u << 2,    /**< send tiles as binary16 planes (SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD) */
+    SY_CLUSTER_RENDER_RESTART = 1u << 3, /**< progressive back-ends start a new accumulation (sy_context_restart) */
+    SY_CLUSTER_RENDER_TIME = 1u << 4,    /**< set the replica's scene clock to `time` (clip `clip_id`) first */
 } sy_cluster_render_flags;
+#define SY_CLUSTER_MAX_TIME 1e9 /**< RENDER time: seconds in [0, this] (as sy render --at) */
 
 /** Tile encodings. */
 typedef enum sy_cluster_encoding {
@@ -170,6 +174,8 @@ typedef struct sy_cluster_msg {
             uint32_t sample_first, sample_count;
             uint32_t full_width, full_height;
             sy_camera_view camera;
+            double time;      /**< SY_CLUSTER_RENDER_TIME: the scene time, seconds in [0, SY_CLUSTER_MAX_TIME] (else 0) */
+            uint32_t clip_id; /**< SY_CLUSTER_RENDER_TIME: the animation's core id (0 = every clip; else 0) */
             uint32_t tile_count;
             sy_cluster_rect *tiles; /**< allocated by the decoder; caller's array when encoding */
         } render;

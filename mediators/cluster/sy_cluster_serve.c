@@ -5,6 +5,8 @@
  * session table (the longest idle session makes room). */
 #include "sy_cluster_internal.h"
 
+#include "sy_anim.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,6 +55,17 @@ static sy_result handle_render(sy_cluster_server *s, session *se, const sy_clust
     sy_context *ctx = NULL;
     if (r == SY_OK) r = sy_context_pool_get(se->pool, se->scene, q->backend, &params, q->root_id, &ctx, err);
     double t0 = sy_time_now();
+    if (r == SY_OK && (q->flags & SY_CLUSTER_RENDER_TIME)) {
+        /* frames mode: the replica's scene clock (a pure function of the time: the replica's earlier
+         * times leave nothing behind); committed even when a channel failed, so no edit is left pending */
+        sy_animation clip = {q->clip_id};
+        r = sy_scene_set_time(se->scene, clip, q->time, err);
+        sy_error ce = {0};
+        sy_result cr = sy_scene_commit(se->scene, NULL, &ce);
+        if (r == SY_OK && cr != SY_OK) r = cr, *err = ce;
+        if (r != SY_OK) sy_error_prefix(err, "RENDER at scene time %g", q->time);
+    }
+    if (r == SY_OK && (q->flags & SY_CLUSTER_RENDER_RESTART)) sy_context_restart(ctx);
     if (r == SY_OK) r = sy_context_sync(ctx, err);
     double t1 = sy_time_now();
     if (r) return r;

@@ -37,6 +37,7 @@ typedef struct cluster_state {
     uint32_t timeout_ms; /* adaptive deadline (the configuration gave none) */
     uint32_t servers;    /* the servers this viewport uses (servers=) */
     sy_context *pick;    /* picks: a local context of the servers' back-end on the replica (first pick) */
+    bool restart;        /* sy_context_restart: the next frame's requests restart the servers' accumulations */
 } cluster_state;
 
 /* Caps the servers' back-end `name` has, as registered in this process (same binary); unknown
@@ -287,6 +288,8 @@ static uint32_t coop_total(uint32_t n, uint32_t live)
     return t > SY_CLUSTER_MAX_SAMPLES ? n : (uint32_t)t;
 }
 
+static void cluster_restart(void *state) { ((cluster_state *)state)->restart = true; }
+
 static sy_result cluster_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     cluster_state *st = state;
@@ -306,7 +309,8 @@ static sy_result cluster_render(void *state, const sy_render_request *req, sy_la
                           .samples_total = st->mode == SY_CLUSTER_COOPERATIVE ? coop_total(req->sample_count, live) : 0,
                           .seed = req->seed,
                           .depth = true,
-                          .half = st->half};
+                          .half = st->half,
+                          .restart = st->restart};
     bool whole = req->rect_x == 0 && req->rect_y == 0 && req->rect_w == req->full_width && req->rect_h == req->full_height;
     sy_layer *out = layer;
     sy_result r = SY_OK;
@@ -327,6 +331,7 @@ static sy_result cluster_render(void *state, const sy_render_request *req, sy_la
         double next = r != SY_OK || st->last.servers_failed ? 2.0 * st->timeout_ms : 1000.0 + 4000.0 * st->last.seconds;
         st->timeout_ms = next > 60000.0 ? 60000u : next < 1000.0 ? 1000u : (uint32_t)next;
     }
+    if (r == SY_OK) st->restart = false;
     if (r == SY_OK && st->mode == SY_CLUSTER_COOPERATIVE) st->merged_samples = st->last.samples;
     if (r == SY_OK && !whole)
         for (uint32_t y = 0; y < req->rect_h; ++y) {
@@ -412,6 +417,7 @@ sy_result sy_mediator_cluster_register(const char *name, const sy_cluster_client
                                  .stats = cluster_stats,
                                  .caps_of = cluster_caps_of,
                                  .pick = cluster_pick,
+                                 .restart = cluster_restart,
                                  .user = c,
                                  .param_table = cluster_table,
                                  .check_params = cluster_check_params};

@@ -4,6 +4,7 @@
 # machine: oversubscribed, stated as such).
 #   1. sort-first whitted over two server ranks: the EXR equals the local render byte for byte;
 #   2. cooperative path tracing in side-by-side stereo: exactly the requested samples merged;
+#      frames mode (--frames 0:3 --cluster-mode frames): every frame equal to a local sequence's;
 #   3. bad input on rank 0 (a missing scene) ends every rank with an error, no hang; one rank
 #      alone is refused with the reason; without a launcher, the reason is named.
 # Skipped (77) when mpirun is missing or sy was built without MPI.
@@ -30,6 +31,14 @@ grep -q "mpi rank 0 (stream [0-9]*): authenticated" "$W/sf.log" || fail "the ser
   --cluster-mode cooperative > "$W/coop.out" 2> "$W/coop.log" || fail "mpirun cooperative stereo render"
 grep -q "192x64, pathtracer on 2 servers (cooperative), 24 samples per pixel" "$W/coop.out" ||
   fail "cooperative stereo: not 192x64 with exactly 24 merged samples"
+
+# frames mode over MPI: a 4-frame sequence, whole frames on the two server ranks, equal to a local one
+"$SY" render demo -b whitted -w 48 -h 32 --frames 0:3 -o "$W/seq_l_#.exr" > /dev/null || fail "local sequence"
+"${MPIRUN[@]}" "$SY" render demo -b whitted -w 48 -h 32 --frames 0:3 -o "$W/seq_m_#.exr" --cluster mpi \
+  --cluster-mode frames > "$W/frames.out" 2> "$W/frames.log" || fail "mpirun frames mode"
+grep -q "4 written, 0 skipped" "$W/frames.out" && grep -q "frames mode: 2 servers" "$W/frames.out" ||
+  fail "frames mode over MPI: $(cat "$W/frames.out")"
+for k in 0 1 2 3; do "$EXR_EQUAL" "$W/seq_l_$k.exr" "$W/seq_m_$k.exr" || fail "frames mode over MPI: frame $k differs"; done
 
 "${MPIRUN[@]}" "$SY" render "$W/missing.gltf" -b whitted -o "$W/y.exr" --cluster mpi > /dev/null 2> "$W/bad.log"
 rc=$?

@@ -60,7 +60,9 @@ static sy_cluster_msg sample(uint32_t type)
     case SY_CLUSTER_RENDER:
         m.u.render.frame = 3;
         m.u.render.job = 2;
-        m.u.render.flags = SY_CLUSTER_RENDER_DEPTH;
+        m.u.render.flags = SY_CLUSTER_RENDER_DEPTH | SY_CLUSTER_RENDER_RESTART | SY_CLUSTER_RENDER_TIME;
+        m.u.render.time = 2.5; /* the scene clock (protocol 5, frames mode) */
+        m.u.render.clip_id = 0x20003;
         strcpy(m.u.render.backend, "whitted");
         strcpy(m.u.render.params, "max_depth=4");
         m.u.render.root_id = 0x10001;
@@ -127,6 +129,8 @@ static int test_round_trip(void)
             CHECK(d.u.render.tile_count == 3 && d.u.render.tiles[2].x == 10 && d.u.render.tiles[2].h == 2);
             CHECK(d.u.render.sample_first == 16 && d.u.render.sample_count == 8 && d.u.render.root_id == 0x10001);
             CHECK(d.u.render.camera.window[2] == -0.5f && d.u.render.camera.camera_to_world.m[15] == 1.0f);
+            CHECK(d.u.render.time == 2.5 && d.u.render.clip_id == 0x20003 &&
+                  d.u.render.flags == (SY_CLUSTER_RENDER_DEPTH | SY_CLUSTER_RENDER_RESTART | SY_CLUSTER_RENDER_TIME));
         }
         if (t == SY_CLUSTER_TILES) {
             CHECK(d.u.tiles.tile_count == 2 && d.u.tiles.tiles[1].channels == 5 && d.u.tiles.tiles[1].data_size == 5);
@@ -170,9 +174,9 @@ static int test_bad_headers(void)
     CHECK(strstr(e.message, "magic"));
     /* wrong version */
     memcpy(c, b.data, b.size);
-    c[4] = 3; /* a version-3 peer (RENDER without section planes) */
+    c[4] = 4; /* a version-4 peer (RENDER without the scene time) */
     CHECK_ERR(sy_cluster_decode(c, b.size, NULL, &d, &e), SY_ERR_UNSUPPORTED, e);
-    CHECK(strstr(e.message, "version 3, this peer speaks 4"));
+    CHECK(strstr(e.message, "version 4, this peer speaks 5"));
     /* unknown type, unknown flags */
     memcpy(c, b.data, b.size);
     c[6] = 200;
@@ -824,11 +828,55 @@ static int seeds(const char *dir, bool write)
     return 0;
 }
 
+/* RENDER's scene time (protocol 5): the encoder refuses what the decoder refuses; a decoder given a
+ * NaN, negative or too large time, or a time without the time flag, refuses the message naming it. */
+static int test_render_time(void)
+{
+    sy_error e = {0};
+    sy_cluster_msg m = sample(SY_CLUSTER_RENDER), d;
+    sy_cluster_buf b = {0};
+    const double bad[] = {NAN, -1.0, 2e9, INFINITY};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        m.u.render.time = bad[i];
+        CHECK(sy_cluster_encode(&m, 0, &b, &e) == SY_ERR_INVALID_ARGUMENT && b.size == 0);
+        CHECK_SAYS(e, "scene time");
+    }
+    m.u.render.time = 2.5;
+    m.u.render.flags &= ~(uint32_t)SY_CLUSTER_RENDER_TIME;
+    CHECK(sy_cluster_encode(&m, 0, &b, &e) == SY_ERR_INVALID_ARGUMENT && b.size == 0);
+    m.u.render.flags |= SY_CLUSTER_RENDER_TIME;
+    CHECK_OK(sy_cluster_encode(&m, 0, &b, &e), e);
+    size_t at = 0; /* where the time's 8 bytes lie (the only 2.5 in the message) */
+    const double good = 2.5;
+    for (size_t i = SY_CLUSTER_HEADER_SIZE; i + 8 <= b.size && !at; ++i)
+        if (!memcmp(b.data + i, &good, 8)) at = i;
+    CHECK(at > 0);
+    uint8_t *c = malloc(b.size);
+    CHECK(c != NULL);
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        memcpy(c, b.data, b.size);
+        memcpy(c + at, &bad[i], 8);
+        CHECK(sy_cluster_decode(c, b.size, NULL, &d, &e) == SY_ERR_PARSE);
+        CHECK_SAYS(e, "scene time outside 0..1e9 seconds");
+    }
+    memcpy(c, b.data, b.size);
+    c[SY_CLUSTER_HEADER_SIZE + 12] &= (uint8_t)~SY_CLUSTER_RENDER_TIME; /* flags: after frame (8) and job (4) */
+    CHECK(sy_cluster_decode(c, b.size, NULL, &d, &e) == SY_ERR_PARSE);
+    CHECK_SAYS(e, "without the time flag");
+    c[SY_CLUSTER_HEADER_SIZE + 12] |= 1u << 7; /* an unknown flag */
+    CHECK(sy_cluster_decode(c, b.size, NULL, &d, &e) == SY_ERR_PARSE);
+    CHECK_SAYS(e, "unknown render flags");
+    free(c);
+    sy_cluster_buf_free(&b);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 3 && !strcmp(argv[1], "--write-seeds")) return seeds(argv[2], true);
     if (argc == 2) EXPECT(seeds(argv[1], false) == 0);
     RUN(test_round_trip);
+    RUN(test_render_time);
     RUN(test_bad_headers);
     RUN(test_framing);
     RUN(test_mutations);
