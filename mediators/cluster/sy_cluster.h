@@ -228,7 +228,8 @@ typedef struct sy_cluster_frames_stats {
     uint32_t servers_failed; /**< server failures (a server that fails is redialled between rounds) */
     uint32_t rounds;         /**< rounds of the queue (1 when no server failed) */
     uint32_t per_server[SY_CLUSTER_MAX_SERVERS]; /**< frames each server rendered */
-    uint64_t bytes_sent, bytes_received; /**< everything on the wire */
+    /** @{ everything on the wire */
+    uint64_t bytes_sent, bytes_received; /** @} */
     double seconds;          /**< the whole sequence */
 } sy_cluster_frames_stats;
 
