@@ -5,6 +5,7 @@
 # accumulation per frame:
 #   - 10 frames of BoxAnimated with the path tracer (fixed spp): every frame written and equal, pixel
 #     for pixel (exr_equal), to the same frame of a local sequence; both servers took frames;
+#   - a sort-first sequence (the cluster mediator) equals the local frames too, a still one included;
 #   - --resume: only the frames whose output is missing are rendered (an existing one is left alone);
 #   - a server killed with SIGKILL mid-sequence (12 costlier frames; killed once the first is written):
 #     every frame is still written, equal to the local one, and the summary counts the re-queued frame;
@@ -54,6 +55,18 @@ done
 "$EXR_EQUAL" "$W/farm_0000.exr" "$W/farm_0009.exr" > /dev/null 2>&1 && fail "frames 0 and 9 are the same image"
 # the work queue gave both servers frames (each renders one at a time while 10 wait)
 grep -qE "frames per server [1-9][0-9]* [1-9][0-9]*," "$W/farm.out" || fail "not both servers rendered: $(cat "$W/farm.out")"
+
+# a sequence through the cluster mediator (sort-first) restarts the servers' accumulations per frame
+# too (sy_context_restart travels as RENDER's RESTART): equal to the local frames, also where nothing
+# moved (past the clip's end, 199 and 200: without the restart the servers would go on accumulating)
+"$SY" render "$BOXANIM" "${ARGS[@]}" --frames 199:200 -o "$W/local_####.exr" > /dev/null 2>&1 || fail "local 199:200"
+for fr in 0:2 199:200; do
+  "$SY" render "$BOXANIM" "${ARGS[@]}" --frames "$fr" -o "$W/sf_####.exr" --cluster "$URLS" --secret-file "$W/secret" \
+    --cluster-mode sort-first > "$W/sf.out" 2> "$W/sf.err" || fail "sort-first sequence $fr"
+done
+for k in 0000 0001 0002 0199 0200; do
+  "$EXR_EQUAL" "$W/local_$k.exr" "$W/sf_$k.exr" > /dev/null 2>&1 || fail "sort-first sequence: frame $k differs"
+done
 
 # --resume: frames 3 and 7 missing, frame 5 a marker that must stay
 rm "$W/farm_0003.exr" "$W/farm_0007.exr"
