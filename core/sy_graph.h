@@ -34,13 +34,14 @@ sy_bounds sy_scene_world_bounds(const sy_scene *s);
 /* ---- the world-matrix walk: one rule for every path through the graph ----
  * A node's placement along one path from a root: world = the local matrices multiplied from the
  * root down (the node's own last); visible = the node and every node above it on the path have
- * SY_NODE_VISIBLE. The committed queries above (primary paths), sy_scene_walk below (every path of
+ * SY_NODE_VISIBLE; selected = one of them has SY_NODE_SELECTED. The committed queries above (primary paths), sy_scene_walk below (every path of
  * the current fields), the scene mirror of the mediators (every path, from change lists) and the
  * glTF writer all place nodes by sy_placement_child. */
 /** A node's world matrix and visibility along one path. */
 typedef struct sy_placement {
     sy_mat4 world; /**< the node's world matrix along the path */
     bool visible;  /**< the node and all its ancestors on the path are visible */
+    bool selected; /**< the node or one of its ancestors on the path is selected (SY_NODE_SELECTED) */
 } sy_placement;
 
 /** The placement of a node with this local matrix and these flags (sy_node_flags) under its

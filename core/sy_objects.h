@@ -91,6 +91,11 @@ typedef enum sy_node_flags {
     SY_NODE_VISIBLE = 1u << 0,
     SY_NODE_STATIC = 1u << 1,   /**< hint: transform rarely changes (merge into a static BVH) */
     SY_NODE_ANIMATED = 1u << 2, /**< hint: transform or mesh changes often */
+    /** Selected: the node and its subtree are highlighted alike by every back-end (mediators/
+     * sy_highlight.h: the pixels they cover blended halfway toward the selection colour, and a
+     * one-pixel outline of that colour around them). Changes nothing else (shading, shadows,
+     * picks, coverage). Change-list version 6. */
+    SY_NODE_SELECTED = 1u << 3,
 } sy_node_flags;
 
 /** Field numbers of a node. */
@@ -700,6 +705,19 @@ sy_result sy_node_set_light(sy_scene *s, sy_node n, sy_light l, sy_error *err);
 sy_result sy_node_set_camera(sy_scene *s, sy_node n, sy_camera c, sy_error *err);
 /** Sets the node's sy_node_flags. */
 sy_result sy_node_set_flags(sy_scene *s, sy_node n, uint32_t flags, sy_error *err);
+/** Shows (SY_NODE_VISIBLE set) or hides the node: a hidden node and its subtree are not drawn, hit,
+ * picked or counted by coverage, cast no shadow and light nothing. The other flags are kept. An
+ * unknown or destroyed node: SY_ERR_INVALID_HANDLE naming its id. */
+sy_result sy_node_set_visible(sy_scene *s, sy_node n, bool visible, sy_error *err);
+/** Selects or deselects the node (SY_NODE_SELECTED; the other flags kept); errors as sy_node_set_visible. */
+sy_result sy_node_set_selected(sy_scene *s, sy_node n, bool selected, sy_error *err);
+/** Isolate: hides every node with a mesh that is neither one of the count nodes, nor above one (an
+ * ancestor: its own mesh stays drawn, since hiding it would hide the kept ones), nor below one
+ * (their subtrees), and shows those that are; nodes without a mesh that are not kept (lights,
+ * cameras, other groups) keep their visibility, so the scene's lights stay. Every id is checked
+ * first (nothing changes when one is unknown: SY_ERR_INVALID_HANDLE naming it); count 0 shows
+ * every node. */
+sy_result sy_scene_isolate(sy_scene *s, const sy_node *nodes, uint32_t count, sy_error *err);
 /** Sets the node's morph weights (count 0: NULL, the mesh's apply). Finite, at most SY_MORPH_MAX_TARGETS. */
 sy_result sy_node_set_weights(sy_scene *s, sy_node n, const float *weights, uint32_t count, sy_error *err);
 /** Sets the node's skin: count joints (live nodes) with their inverse bind matrices (NULL: identity);

@@ -241,9 +241,10 @@ int sy_sc_cmp_u32(const void *a, const void *b)
 /* >>world walk (sy_graph.h): the one rule placing a node under its parent */
 sy_placement sy_placement_child(const sy_placement *parent, const sy_mat4 *local, uint32_t flags)
 {
-    bool own = (flags & SY_NODE_VISIBLE) != 0;
-    if (!parent) return (sy_placement){.world = *local, .visible = own};
-    return (sy_placement){.world = sy_mat4_mul(&parent->world, local), .visible = parent->visible && own};
+    bool own = (flags & SY_NODE_VISIBLE) != 0, sel = (flags & SY_NODE_SELECTED) != 0;
+    if (!parent) return (sy_placement){.world = *local, .visible = own, .selected = sel};
+    return (sy_placement){.world = sy_mat4_mul(&parent->world, local), .visible = parent->visible && own,
+                          .selected = parent->selected || sel};
 }
 
 /* Reports one node (reached under `above`, NULL for a path's start) to fn; *place receives its

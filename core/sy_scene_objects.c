@@ -332,6 +332,101 @@ sy_result sy_node_set_flags(sy_scene *s, sy_node n, uint32_t flags, sy_error *er
     return sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_FLAGS, &flags, err);
 }
 
+/* One flag of a live node set or cleared, the others kept. */
+static sy_result node_flag(sy_scene *s, sy_node n, uint32_t flag, bool on, const char *what, sy_error *err)
+{
+    const sy_node_data *d = sy_node_get(s, n);
+    if (!d) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "%s: no node with id %u", what, n.id);
+    uint32_t f = on ? d->flags | flag : d->flags & ~flag;
+    return f == d->flags ? SY_OK : sy_node_set_flags(s, n, f, err);
+}
+
+sy_result sy_node_set_visible(sy_scene *s, sy_node n, bool visible, sy_error *err)
+{
+    return node_flag(s, n, SY_NODE_VISIBLE, visible, visible ? "show" : "hide", err);
+}
+
+sy_result sy_node_set_selected(sy_scene *s, sy_node n, bool selected, sy_error *err)
+{
+    return node_flag(s, n, SY_NODE_SELECTED, selected, selected ? "select" : "deselect", err);
+}
+
+/* >>isolate: the kept nodes are the given ones, everything below them (their subtrees) and
+ * everything above them (so that they stay reachable: an ancestor's own mesh stays drawn, since
+ * hiding it would hide its whole subtree) */
+#define ISO_GIVEN 1u
+#define ISO_BELOW 2u
+#define ISO_ABOVE 4u
+static uint32_t iso_index(const uint32_t *ids, uint32_t n, uint32_t id)
+{
+    uint32_t lo = 0, hi = n;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (ids[mid] < id) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < n && ids[lo] == id ? lo : UINT32_MAX;
+}
+
+sy_result sy_scene_isolate(sy_scene *s, const sy_node *nodes, uint32_t count, sy_error *err)
+{
+    if (count && !nodes) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "isolate: NULL node list");
+    for (uint32_t i = 0; i < count; ++i)
+        if (!sy_node_get(s, nodes[i])) return sy_error_set(err, SY_ERR_INVALID_HANDLE, "isolate: no node with id %u", nodes[i].id);
+    uint32_t n = sy_scene_count(s, SY_TYPE_NODE);
+    uint32_t *ids = malloc(((size_t)n + 1) * sizeof *ids);
+    uint8_t *mark = calloc((size_t)n + 1, 1);
+    uint32_t *stack = malloc(((size_t)n + 1) * sizeof *stack);
+    if (!ids || !mark || !stack) {
+        free(ids), free(mark), free(stack);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "isolate: out of memory (%u nodes)", n);
+    }
+    uint32_t m = 0;
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id && m < n; id = sy_scene_next(s, SY_TYPE_NODE, id)) ids[m++] = id;
+    qsort(ids, m, sizeof *ids, sy_sc_cmp_u32);
+    /* the given nodes and their subtrees (each node pushed once: cycles from bad input end) */
+    uint32_t sp = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+        uint32_t k = iso_index(ids, m, nodes[i].id);
+        if (k == UINT32_MAX || (mark[k] & ISO_GIVEN)) continue;
+        mark[k] |= ISO_GIVEN;
+        if (!(mark[k] & ISO_BELOW)) mark[k] |= ISO_BELOW, stack[sp++] = k;
+    }
+    while (sp) {
+        uint32_t nc, k = stack[--sp];
+        const uint32_t *ch = sy_node_children(sy_node_get(s, (sy_node){ids[k]}), &nc);
+        for (uint32_t c = 0; c < nc; ++c) {
+            uint32_t j = iso_index(ids, m, ch[c]);
+            if (j != UINT32_MAX && !(mark[j] & ISO_BELOW)) mark[j] |= ISO_BELOW, stack[sp++] = j;
+        }
+    }
+    /* their ancestors: a node with a given or above-given child, until nothing changes */
+    for (bool grew = count > 0; grew;) {
+        grew = false;
+        for (uint32_t k = 0; k < m; ++k) {
+            if (mark[k] & ISO_ABOVE) continue;
+            uint32_t nc;
+            const uint32_t *ch = sy_node_children(sy_node_get(s, (sy_node){ids[k]}), &nc);
+            for (uint32_t c = 0; c < nc; ++c) {
+                uint32_t j = iso_index(ids, m, ch[c]);
+                if (j != UINT32_MAX && (mark[j] & (ISO_GIVEN | ISO_ABOVE))) {
+                    mark[k] |= ISO_ABOVE;
+                    grew = true;
+                    break;
+                }
+            }
+        }
+    }
+    sy_result r = SY_OK;
+    for (uint32_t k = 0; k < m && r == SY_OK; ++k) {
+        const sy_node_data *d = sy_node_get(s, (sy_node){ids[k]});
+        if (count == 0 || mark[k]) r = sy_node_set_visible(s, (sy_node){ids[k]}, true, err);
+        else if (d->mesh.id) r = sy_node_set_visible(s, (sy_node){ids[k]}, false, err); /* lights, cameras stay */
+    }
+    free(ids), free(mark), free(stack);
+    return r;
+}
+
 /* A float blob field (morph weights) from count floats; count 0 sets NULL. */
 static sy_result set_weights(sy_scene *s, sy_object_type t, uint32_t id, uint32_t field, const float *w, uint32_t count,
                              sy_error *err)

@@ -406,7 +406,7 @@ sy_result sy_sc_validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_t
                        ? SY_OK
                        : sy_error_set(err, SY_ERR_INVALID_HANDLE, "node: stale camera handle");
         case SY_NODE_FLAGS:
-            if (*(const uint32_t *)v & ~(uint32_t)(SY_NODE_VISIBLE | SY_NODE_STATIC | SY_NODE_ANIMATED))
+            if (*(const uint32_t *)v & ~(uint32_t)(SY_NODE_VISIBLE | SY_NODE_STATIC | SY_NODE_ANIMATED | SY_NODE_SELECTED))
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "node: unknown flags %#x", *(const uint32_t *)v);
             return SY_OK;
         case SY_NODE_WEIGHTS: return check_weights(*(sy_blob *const *)v, "node", err);

@@ -402,7 +402,8 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
                 uint32_t mh = mm ? mm->handle : 0u;
                 sy_result r = mh ? SY_OK : default_material(st, &mh, err);
                 if (r != SY_OK) return r;
-                sy_mirror_instance_args a = {n->id, index, ph, mh, world, visible, bake && !n->deformer, &p->inst[i]};
+                sy_mirror_instance_args a = {n->id, index, ph, mh, world, visible, bake && !n->deformer, &p->inst[i],
+                                              p->place.selected};
                 r = st->cb->instance_set(st->user, &a, err);
                 if (r != SY_OK) return r;
             }
@@ -410,7 +411,7 @@ static sy_result placement_sync(sy_mirror *st, node_m *n, uint32_t index, bool m
     } else {
         for (uint32_t i = 0; i < p->inst_count; ++i) {
             if (!p->inst[i]) continue;
-            sy_mirror_instance_args a = {n->id, index, 0, 0, world, visible, false, &p->inst[i]};
+            sy_mirror_instance_args a = {n->id, index, 0, 0, world, visible, false, &p->inst[i], p->place.selected};
             sy_result r = st->cb->instance_set(st->user, &a, err);
             if (r != SY_OK) return r;
         }

@@ -71,7 +71,7 @@ typedef struct sy_mirror_primitive_args {
 } sy_mirror_primitive_args;
 
 /** One instance of one placement: *handle == 0: create it from mesh/material/world/flags;
- * otherwise update its world matrix and visibility. */
+ * otherwise update its world matrix, visibility and selection. */
 typedef struct sy_mirror_instance_args {
     /** @{ core node id and which of its placements (DAG paths) */
     uint32_t node, placement; /** @} */
@@ -81,6 +81,8 @@ typedef struct sy_mirror_instance_args {
     bool visible; /**< visible along this path */
     bool baked; /**< SY_NODE_STATIC node, mesh used once, one placement: may be baked into the scene */
     uint32_t *handle; /**< in/out */
+    bool selected; /**< selected along this path (SY_NODE_SELECTED on the node or above): the back-end
+                    * highlights its pixels (sy_highlight.h) */
 } sy_mirror_instance_args;
 
 /** The light of one visible placement: create (*handle == 0) or update. */

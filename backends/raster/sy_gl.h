@@ -467,6 +467,12 @@ typedef struct sy_gl_pick_hit {
  * SY_GL_ERROR_INVALID_ARGUMENT. Costs one pass over the instances the pixel's frustum keeps. */
 sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t image_width, uint32_t image_height,
                         uint32_t x, uint32_t y, sy_gl_pick_hit *out);
+/** An ID image: for every pixel centre of desc's rectangle (row 0 = top), the handle id of the
+ * nearest visible instance drawn there (0: none), by the pick's ID pass (every visible instance at
+ * full detail, no culling, alpha-masked materials cut out) over a width x height target with one
+ * sample per pixel at its centre. ids: desc->width * desc->height. Costs one pass over the
+ * instances in the rectangle's frustum and one read-back. */
+sy_gl_result sy_gl_ids(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *desc, uint32_t *ids);
 /** GLFW provider: true once the user asked to close the window (false for other providers). */
 bool sy_gl_window_should_close(sy_gl_device *dev);
 

@@ -10,7 +10,7 @@
  *   sy_gl_shadows.c  the lights' uniform blocks and shadow maps
  *   sy_gl_draw.c     targets, views, the forward and deferred passes, culling, MSAA resolve
  *   sy_gl_render.c   scene probes and the frame (sy_gl_render, sy_gl_render_floor)
- *   sy_gl_pick.c     what is under one pixel: the ID pass (sy_gl_pick)
+ *   sy_gl_pick.c     what is under one pixel: the ID pass (sy_gl_pick); ID images (sy_gl_ids)
  *   sy_gl_device.c   the device: create, destroy, statistics
  * Not thread-safe: one device is used by one thread at a time (sy_gl.h). */
 #ifndef SY_GL_INTERNAL_H
@@ -209,6 +209,8 @@ struct sy_gl_device {
     } uf[2]; /* the floors: unlit, trivial lit */
     struct {
         GLuint prog, fbo, color, depth; /* made on the first pick */
+        GLuint ifbo, icolor, idepth;    /* sy_gl_ids' target, iw x ih, made on its first call */
+        uint32_t iw, ih;
         GLint u[PICK_UNIFORMS];
     } pick; /* sy_gl_pick.c */
     GLuint default_ubo, lights_ubo, empty_vao;

@@ -11,6 +11,7 @@
 #include "sy_gl_internal.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define PICK_ZOOM 64.0 /* how much narrower than the pixel the ID pass's window is (see sy_gl_pick) */
@@ -42,6 +43,9 @@ void sy_gli_pick_free(sy_gl_device *dev)
     if (dev->pick.fbo) gl->DeleteFramebuffers(1, &dev->pick.fbo);
     if (dev->pick.color) gl->DeleteRenderbuffers(1, &dev->pick.color);
     if (dev->pick.depth) gl->DeleteRenderbuffers(1, &dev->pick.depth);
+    if (dev->pick.ifbo) gl->DeleteFramebuffers(1, &dev->pick.ifbo);
+    if (dev->pick.icolor) gl->DeleteRenderbuffers(1, &dev->pick.icolor);
+    if (dev->pick.idepth) gl->DeleteRenderbuffers(1, &dev->pick.idepth);
     memset(&dev->pick, 0, sizeof dev->pick);
 }
 
@@ -76,43 +80,15 @@ static sy_gl_result pick_setup(sy_gl_device *dev, sy_gl_report *rep)
     return SY_GL_OK;
 }
 
-sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t image_width, uint32_t image_height,
-                        uint32_t x, uint32_t y, sy_gl_pick_hit *out)
+/* The ID pass into fbo (w x h): every visible instance's handle and primitive + 1 (two 16-bit
+ * halves each) at every sample, nearest first by the depth test. */
+static void id_draw(sy_gl_device *dev, const view_setup *v, GLuint fbo, uint32_t w, uint32_t h)
 {
-    sy_gl_report *rep = dev ? dev->report : NULL;
-    if (!dev || !cam || !out) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "pick: NULL argument");
-    memset(out, 0, sizeof *out);
-    if (x >= image_width || y >= image_height)
-        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "pick: pixel (%u, %u) is outside the %ux%u image", x, y,
-                           image_width, image_height);
-    sy_gl_result r = sy_gli_current(dev, rep);
-    if (r == SY_GL_OK) sy_gli_clip_set(dev, cam);
-    /* the 1x1 target is a window PICK_ZOOM times narrower than the pixel, centred on its centre:
-     * the same ray, with the rasterizer's sub-pixel snapping PICK_ZOOM times finer, so a centre
-     * near a shared edge goes to the triangle the ray meets (with the pixel's own window, one in
-     * a hundred pixels of MetalRoughSpheresNoTextures' small triangles went to the neighbour) */
-    sy_gl_camera zc = *cam;
-    const float *w = cam->window;
-    double cx = w[0] + ((double)w[1] - w[0]) * (x + 0.5) / image_width;
-    double cy = w[3] - ((double)w[3] - w[2]) * (y + 0.5) / image_height;
-    double hx = ((double)w[1] - w[0]) / image_width * 0.5 / PICK_ZOOM;
-    double hy = ((double)w[3] - w[2]) / image_height * 0.5 / PICK_ZOOM;
-    zc.window[0] = (float)(cx - hx), zc.window[1] = (float)(cx + hx);
-    zc.window[2] = (float)(cy - hy), zc.window[3] = (float)(cy + hy);
-    const sy_gl_render_desc d = {1, 1, 0, 0, 1, 1};
-    view_setup v;
-    if (r == SY_GL_OK && !(zc.window[0] < zc.window[1] && zc.window[2] < zc.window[3])) { /* below float steps */
-        zc.window[0] = (float)cx - fmaxf(fabsf((float)cx), 1.0f) * 1e-6f, zc.window[1] = (float)cx + fmaxf(fabsf((float)cx), 1.0f) * 1e-6f;
-        zc.window[2] = (float)cy - fmaxf(fabsf((float)cy), 1.0f) * 1e-6f, zc.window[3] = (float)cy + fmaxf(fabsf((float)cy), 1.0f) * 1e-6f;
-    }
-    if (r == SY_GL_OK) r = sy_gli_view_make(dev, &zc, &d, &v, rep);
-    if (r == SY_GL_OK) r = pick_setup(dev, rep);
-    if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
-    gl->BindFramebuffer(GL_FRAMEBUFFER, dev->pick.fbo);
+    gl->BindFramebuffer(GL_FRAMEBUFFER, fbo);
     static const GLenum bufs[1] = {GL_COLOR_ATTACHMENT0};
     gl->DrawBuffers(1, bufs);
-    gl->Viewport(0, 0, 1, 1);
+    gl->Viewport(0, 0, (GLsizei)w, (GLsizei)h);
     gl->Disable(GL_BLEND);
     gl->Disable(GL_CULL_FACE);
     gl->Enable(GL_DEPTH_TEST);
@@ -124,11 +100,11 @@ sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t ima
     gl->ClearBufferfv(GL_DEPTH, 0, &one);
     gl->UseProgram(dev->pick.prog);
     const GLint *u = dev->pick.u;
-    gl->UniformMatrix4fv(u[1], 1, GL_FALSE, v.view);
-    gl->UniformMatrix4fv(u[2], 1, GL_FALSE, v.proj);
+    gl->UniformMatrix4fv(u[1], 1, GL_FALSE, v->view);
+    gl->UniformMatrix4fv(u[2], 1, GL_FALSE, v->proj);
     gl->ActiveTexture(GL_TEXTURE0);
     float vp[16], planes[6][4];
-    sy_gli_m4_mul(v.proj, v.view, vp);
+    sy_gli_m4_mul(v->proj, v->view, vp);
     sy_gli_frustum_planes(vp, planes);
     sy_gli_clip_enable(dev, true);
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
@@ -161,6 +137,42 @@ sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t ima
         sy_gli_draw_mesh_lod(dev, m, 0);
     }
     sy_gli_clip_enable(dev, false);
+}
+
+sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t image_width, uint32_t image_height,
+                        uint32_t x, uint32_t y, sy_gl_pick_hit *out)
+{
+    sy_gl_report *rep = dev ? dev->report : NULL;
+    if (!dev || !cam || !out) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "pick: NULL argument");
+    memset(out, 0, sizeof *out);
+    if (x >= image_width || y >= image_height)
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "pick: pixel (%u, %u) is outside the %ux%u image", x, y,
+                           image_width, image_height);
+    sy_gl_result r = sy_gli_current(dev, rep);
+    if (r == SY_GL_OK) sy_gli_clip_set(dev, cam);
+    /* the 1x1 target is a window PICK_ZOOM times narrower than the pixel, centred on its centre:
+     * the same ray, with the rasterizer's sub-pixel snapping PICK_ZOOM times finer, so a centre
+     * near a shared edge goes to the triangle the ray meets (with the pixel's own window, one in
+     * a hundred pixels of MetalRoughSpheresNoTextures' small triangles went to the neighbour) */
+    sy_gl_camera zc = *cam;
+    const float *w = cam->window;
+    double cx = w[0] + ((double)w[1] - w[0]) * (x + 0.5) / image_width;
+    double cy = w[3] - ((double)w[3] - w[2]) * (y + 0.5) / image_height;
+    double hx = ((double)w[1] - w[0]) / image_width * 0.5 / PICK_ZOOM;
+    double hy = ((double)w[3] - w[2]) / image_height * 0.5 / PICK_ZOOM;
+    zc.window[0] = (float)(cx - hx), zc.window[1] = (float)(cx + hx);
+    zc.window[2] = (float)(cy - hy), zc.window[3] = (float)(cy + hy);
+    const sy_gl_render_desc d = {1, 1, 0, 0, 1, 1};
+    view_setup v;
+    if (r == SY_GL_OK && !(zc.window[0] < zc.window[1] && zc.window[2] < zc.window[3])) { /* below float steps */
+        zc.window[0] = (float)cx - fmaxf(fabsf((float)cx), 1.0f) * 1e-6f, zc.window[1] = (float)cx + fmaxf(fabsf((float)cx), 1.0f) * 1e-6f;
+        zc.window[2] = (float)cy - fmaxf(fabsf((float)cy), 1.0f) * 1e-6f, zc.window[3] = (float)cy + fmaxf(fabsf((float)cy), 1.0f) * 1e-6f;
+    }
+    if (r == SY_GL_OK) r = sy_gli_view_make(dev, &zc, &d, &v, rep);
+    if (r == SY_GL_OK) r = pick_setup(dev, rep);
+    if (r != SY_GL_OK) return r;
+    id_draw(dev, &v, dev->pick.fbo, 1, 1);
+    const sy_gl_fns *gl = dev->gl;
     float px[4] = {0, 0, 0, 0};
     gl->ReadBuffer(GL_COLOR_ATTACHMENT0);
     gl->PixelStorei(GL_PACK_ALIGNMENT, 1);
@@ -176,4 +188,64 @@ sy_gl_result sy_gl_pick(sy_gl_device *dev, const sy_gl_camera *cam, uint32_t ima
     out->instance.id = id;
     out->triangle = prim - 1u;
     return SY_GL_OK;
+}
+
+/* sy_gl_ids' w x h target, (re)made when the size changes. */
+static sy_gl_result ids_target(sy_gl_device *dev, uint32_t w, uint32_t h, sy_gl_report *rep)
+{
+    const sy_gl_fns *gl = dev->gl;
+    if (dev->pick.ifbo && dev->pick.iw == w && dev->pick.ih == h) return SY_GL_OK;
+    if (!dev->pick.ifbo) {
+        gl->GenFramebuffers(1, &dev->pick.ifbo);
+        gl->GenRenderbuffers(1, &dev->pick.icolor);
+        gl->GenRenderbuffers(1, &dev->pick.idepth);
+    }
+    gl->BindRenderbuffer(GL_RENDERBUFFER, dev->pick.icolor);
+    gl->RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
+    gl->BindRenderbuffer(GL_RENDERBUFFER, dev->pick.idepth);
+    gl->RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_DEPTH_COMPONENT32F, (GLsizei)w, (GLsizei)h);
+    gl->BindFramebuffer(GL_FRAMEBUFFER, dev->pick.ifbo);
+    gl->FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, dev->pick.icolor);
+    gl->FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, dev->pick.idepth);
+    if (gl->CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        return sy_gli_fail(rep, SY_GL_ERROR_GL, "ids: the %ux%u ID target is incomplete", w, h);
+    dev->pick.iw = w, dev->pick.ih = h;
+    return SY_GL_OK;
+}
+
+sy_gl_result sy_gl_ids(sy_gl_device *dev, const sy_gl_camera *cam, const sy_gl_render_desc *desc, uint32_t *ids)
+{
+    sy_gl_report *rep = dev ? dev->report : NULL;
+    if (!dev || !cam || !desc || !ids) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "ids: NULL argument");
+    uint32_t w = desc->width, h = desc->height;
+    if (!w || !h || w > 16384 || h > 16384 || desc->x > desc->image_width || desc->y > desc->image_height ||
+        w > desc->image_width - desc->x || h > desc->image_height - desc->y)
+        return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "ids: rectangle %ux%u at (%u, %u) is not inside the %ux%u image",
+                           w, h, desc->x, desc->y, desc->image_width, desc->image_height);
+    float *px = malloc((size_t)w * h * 4 * sizeof *px);
+    if (!px) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "ids: out of memory (%ux%u)", w, h);
+    sy_gl_result r = sy_gli_current(dev, rep);
+    if (r == SY_GL_OK) sy_gli_clip_set(dev, cam);
+    view_setup v;
+    if (r == SY_GL_OK) r = sy_gli_view_make(dev, cam, desc, &v, rep);
+    if (r == SY_GL_OK) r = pick_setup(dev, rep);
+    if (r == SY_GL_OK) r = ids_target(dev, w, h, rep);
+    if (r != SY_GL_OK) {
+        free(px);
+        return r;
+    }
+    id_draw(dev, &v, dev->pick.ifbo, w, h);
+    const sy_gl_fns *gl = dev->gl;
+    gl->ReadBuffer(GL_COLOR_ATTACHMENT0);
+    gl->PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl->ReadPixels(0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT, px);
+    r = sy_gli_gl_check(dev, "ids", rep);
+    for (uint32_t j = 0; j < h && r == SY_GL_OK; ++j) /* GL rows go bottom up */
+        for (uint32_t i = 0; i < w; ++i) {
+            const float *p = px + 4 * ((size_t)(h - 1 - j) * w + i);
+            uint32_t prim = (uint32_t)p[2] | ((uint32_t)p[3] << 16);
+            ids[(size_t)j * w + i] = prim ? (uint32_t)p[0] | ((uint32_t)p[1] << 16) : 0u;
+        }
+    free(px);
+    return r;
 }

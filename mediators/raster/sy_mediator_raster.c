@@ -20,6 +20,7 @@
 
 #include "sy_backend_status.h"
 #include "sy_gl.h"
+#include "sy_highlight.h"
 #include "sy_log.h"
 #include "sy_look.h"
 #include "sy_mirror.h"
@@ -48,6 +49,7 @@ typedef struct einst { /* per back-end instance */
     uint32_t mesh, material;
     float world[16];
     bool visible;
+    bool selected; /* highlighted (sy_highlight.h) */
 } einst;
 typedef struct ealb { /* per back-end material: diffuse-ish albedo (base x base texture mean) */
     float albedo[3];
@@ -70,6 +72,7 @@ typedef struct raster_state {
     /* emissive meshes */
     sy_mirror_map meshes, mats, insts, texs, albs;
     bool areas_dirty;
+    uint32_t selected_count; /* instances with einst.selected: a frame is highlighted while any is */
     uint32_t area_count;
     bool warned_area_cap;
     bool indirect; /* "indirect" parameter: the emitters' indirect light estimate (below); 0 = direct light only */
@@ -266,6 +269,8 @@ static sy_result track_instance(raster_state *st, uint32_t handle, const sy_mirr
     if (a->mesh) in->material = a->material;
     memcpy(in->world, a->world->m, sizeof in->world);
     in->visible = a->visible;
+    if (in->selected != a->selected) st->selected_count += a->selected ? 1u : (uint32_t)-1;
+    in->selected = a->selected;
     return SY_OK;
 }
 
@@ -325,6 +330,7 @@ static void cb_release(void *user, const sy_mirror_release_args *a)
     case SY_MIRROR_INSTANCE: {
         einst *in = sy_mirror_map_get(&st->insts, a->handle);
         if (in && material_emits(st, in->material)) st->areas_dirty = true;
+        if (in && in->selected) st->selected_count--;
         sy_mirror_map_del(&st->insts, a->handle);
         sy_gl_instance_destroy(st->dev, (sy_gl_instance){a->handle});
         break;
@@ -631,6 +637,35 @@ static sy_result check_layer(const sy_render_request *req, const sy_layer *layer
     return SY_OK;
 }
 
+/* The selection highlight (sy_highlight.h): the ID image of the rectangle and its margin (the
+ * pick's ID pass, sy_gl_ids), the selected instances' pixels tinted and outlined. */
+static sy_result highlight(raster_state *st, const sy_gl_camera *cam, const sy_render_request *req, sy_layer *layer,
+                           sy_error *err)
+{
+    sy_highlight_rect m = sy_highlight_margin(req->full_width, req->full_height, req->rect_x, req->rect_y, req->rect_w,
+                                              req->rect_h);
+    size_t n = (size_t)m.w * m.h;
+    uint32_t *ids = malloc((n ? n : 1) * sizeof *ids);
+    uint8_t *sel = malloc(n ? n : 1);
+    if (!ids || !sel) {
+        free(ids), free(sel);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: selection highlight: out of memory (%ux%u)", m.w, m.h);
+    }
+    sy_gl_render_desc d = {req->full_width, req->full_height, m.x, m.y, m.w, m.h};
+    sy_gl_result r = n ? sy_gl_ids(st->dev, cam, &d, ids) : SY_GL_OK;
+    if (r != SY_GL_OK) {
+        free(ids), free(sel);
+        return gl_fail(st, err, r, "selection highlight");
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const einst *in = ids[i] ? sy_mirror_map_get(&st->insts, ids[i]) : NULL;
+        sel[i] = in && in->selected;
+    }
+    sy_highlight_apply(layer->rgba, req->rect_x, req->rect_y, req->rect_w, req->rect_h, sel, m);
+    free(ids), free(sel);
+    return SY_OK;
+}
+
 static sy_result raster_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     raster_state *st = state;
@@ -644,6 +679,7 @@ static sy_result raster_render(void *state, const sy_render_request *req, sy_lay
     sy_gl_render_desc d = {req->full_width, req->full_height, req->rect_x, req->rect_y, req->rect_w, req->rect_h};
     sy_gl_result r = sy_gl_render(st->dev, &cam, &d, layer->rgba, layer->depth);
     if (r != SY_GL_OK) return gl_fail(st, err, r, "render");
+    if (st->selected_count && (rr = highlight(st, &cam, req, layer, err)) != SY_OK) return rr;
     if (req->progress) {
         sy_progress p = {1, 1};
         req->progress(req->progress_user, &p);

@@ -30,6 +30,8 @@ static void rt_destroy(void *state)
     for (int k = 0; k <= SY_RT_AOV_COUNT; ++k) free(st->fbuf[k]);
     sy_rt_device_destroy(st->dev);
     sy_mirror_map_free(&st->inst_node);
+    sy_mirror_map_free(&st->inst_sel);
+    sy_mirror_map_free(&st->inst_place);
     free(st);
 }
 
@@ -55,6 +57,8 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     rt_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt mediator: out of memory");
     st->inst_node = SY_MIRROR_MAP_INIT(uint32_t);
+    st->inst_sel = SY_MIRROR_MAP_INIT(uint8_t);
+    st->inst_place = SY_MIRROR_MAP_INIT(uint32_t);
     sy_rt_device_desc dd = sy_rti_device_desc(st, (uint32_t)threads, (uint64_t)max_memory_mb << 20);
     sy_rt_result rr = sy_rt_device_create(&dd, &st->dev);
     if (rr != SY_RT_OK) {
@@ -140,6 +144,35 @@ void sy_mediator_rt_aovs_free(sy_mediator_rt_aovs *a)
 const char *sy_mediator_rt_aov_name(uint32_t index) { return sy_rt_aov_name((sy_rt_aov)index); }
 uint32_t sy_mediator_rt_aov_channels(uint32_t index) { return sy_rt_aov_channels((sy_rt_aov)index); }
 
+/* The ID planes of the last accumulation's rectangle: "object_id" (the node id, 0 where nothing is
+ * hit) and "instance_id" (which of the node's placements) of the nearest visible surface through
+ * each pixel's centre: the ray and the numbers of a pick (sy_context_pick). */
+static sy_result pathtracer_id_aovs(rt_state *st, sy_aovs *out, sy_error *err)
+{
+    const sy_rt_render_desc *ld = &st->last_desc;
+    if (out->count + 2 > SY_AOVS_MAX || ld->width != out->width || ld->height != out->height) return SY_OK;
+    size_t n = (size_t)out->width * out->height;
+    uint32_t *ids = malloc((n ? n : 1) * sizeof *ids);
+    float *obj = malloc((n ? n : 1) * sizeof *obj), *ins = malloc((n ? n : 1) * sizeof *ins);
+    sy_rt_render_desc d = {.image_width = ld->image_width, .image_height = ld->image_height, .x = ld->x, .y = ld->y,
+                           .width = ld->width, .height = ld->height};
+    sy_rt_result r = ids && obj && ins ? sy_rt_coverage(st->dev, &st->last_cam, &d, ids, NULL) : SY_RT_ERROR_OUT_OF_MEMORY;
+    if (r != SY_RT_OK) {
+        free(ids), free(obj), free(ins);
+        sy_aovs_free(out);
+        return r == SY_RT_ERROR_OUT_OF_MEMORY ? sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "AOVs: ID planes: out of memory")
+                                              : sy_rti_fail(st, err, r, "AOVs: ID planes");
+    }
+    for (size_t i = 0; i < n; ++i) {
+        obj[i] = (float)sy_rti_inst_node_get(st, ids[i]);
+        ins[i] = (float)sy_rti_inst_placement_get(st, ids[i]);
+    }
+    free(ids);
+    out->planes[out->count++] = (sy_aov_plane){"object_id", 1, obj};
+    out->planes[out->count++] = (sy_aov_plane){"instance_id", 1, ins};
+    return SY_OK;
+}
+
 /* The generic feature-buffer and filter hooks of the path tracer's class (sy_context_aovs, ...). */
 static sy_result pathtracer_aovs(void *state, sy_aovs *out, sy_error *err)
 {
@@ -154,7 +187,7 @@ static sy_result pathtracer_aovs(void *state, sy_aovs *out, sy_error *err)
         a.planes[k] = NULL; /* moved */
         out->count = k + 1;
     }
-    return SY_OK;
+    return pathtracer_id_aovs(state, out, err);
 }
 
 static void pathtracer_filter_info(void *state, sy_filter_info *out)

@@ -21,6 +21,7 @@
 #include "sy_rt.h"
 #include "sy_mirror.h"
 #include "sy_mirror_map.h"
+#include "sy_highlight.h"
 
 #include "sy_filter_adaptive.h"
 #include "sy_filter_atrous.h"
@@ -92,6 +93,10 @@ typedef struct rt_state {
     int last_slot;                 /* slot of the last render, -1 = none */
     uint64_t use_clock;
     sy_mirror_map inst_node;       /* back-end instance slot index + 1 -> core node id (coverage) */
+    sy_mirror_map inst_sel;        /* the same keys, only the selected instances (uint8_t 1; sy_highlight.h) */
+    sy_mirror_map inst_place;      /* the same keys -> the placement (ID AOVs) */
+    sy_rt_camera last_cam;         /* the camera and rectangle of the last render (ID AOVs) */
+    sy_rt_render_desc last_desc;
     pt_filter_cfg filter;          /* path tracer display filter */
     float *fbuf[SY_RT_AOV_COUNT + 1]; /* filter inputs: the AOV planes + world positions */
     size_t fbuf_px;                /* pixels the fbuf planes hold */
@@ -120,6 +125,10 @@ void sy_rti_camera_of(const sy_camera_view *v, sy_rt_camera *cam);
 extern const sy_mirror_callbacks sy_rti_mirror_callbacks;
 /* The node an instance belongs to (0: unknown). */
 uint32_t sy_rti_inst_node_get(const rt_state *st, uint32_t handle);
+/* Whether an instance is selected (highlighted, sy_highlight.h). */
+bool sy_rti_inst_selected(const rt_state *st, uint32_t handle);
+/* Placement of an instance (which of its node's paths; 0 when unknown), as picks report it. */
+uint32_t sy_rti_inst_placement_get(const rt_state *st, uint32_t handle);
 sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err);
 
 /* --- sy_mediator_rt_coverage.c --- */
@@ -149,6 +158,10 @@ sy_result sy_rti_radiance_render(rt_state *st, const sy_render_request *req, con
 sy_result sy_rti_apply_look(rt_state *st, uint32_t background_id, sy_error *err);
 
 /* --- sy_mediator_rt_render.c --- */
+/* The selection flags (sy_highlight.h) of rectangle m of a full_w x full_h image: m.w * m.h bytes,
+ * malloc()ed; NULL when out of memory or the device failed (then the frame goes unhighlighted). */
+uint8_t *sy_rti_selection_flags(rt_state *st, const sy_rt_camera *cam, uint32_t full_w, uint32_t full_h,
+                                sy_highlight_rect m);
 sy_result sy_rti_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err);
 
 #endif

@@ -14,15 +14,41 @@
 #define RT_HANDLE_INDEX(h) ((h) & 0x3fffffu) /* backends/rt handles: 22-bit slot index */
 
 /* Remembers which node an instance belongs to (node 0 forgets it), keyed by slot index + 1. */
-static void inst_node_set(rt_state *st, uint32_t handle, uint32_t node)
+static void inst_node_set(rt_state *st, uint32_t handle, uint32_t node, uint32_t placement)
 {
     uint32_t key = RT_HANDLE_INDEX(handle) + 1;
     if (!node) {
         sy_mirror_map_del(&st->inst_node, key);
+        sy_mirror_map_del(&st->inst_place, key);
         return;
     }
     uint32_t *n = sy_mirror_map_put(&st->inst_node, key);
     if (n) *n = node; /* out of memory: coverage then reports this instance as unknown (node 0) */
+    uint32_t *p = sy_mirror_map_put(&st->inst_place, key);
+    if (p) *p = placement;
+}
+
+uint32_t sy_rti_inst_placement_get(const rt_state *st, uint32_t handle)
+{
+    const uint32_t *p = handle ? sy_mirror_map_get(&st->inst_place, RT_HANDLE_INDEX(handle) + 1) : NULL;
+    return p ? *p : 0;
+}
+
+/* Remembers whether an instance is selected (only selected ones are in the map). */
+static void inst_sel_set(rt_state *st, uint32_t handle, bool selected)
+{
+    uint32_t key = RT_HANDLE_INDEX(handle) + 1;
+    if (!selected) {
+        sy_mirror_map_del(&st->inst_sel, key);
+        return;
+    }
+    uint8_t *v = sy_mirror_map_put(&st->inst_sel, key);
+    if (v) *v = 1; /* out of memory: the instance is drawn without the highlight */
+}
+
+bool sy_rti_inst_selected(const rt_state *st, uint32_t handle)
+{
+    return handle && sy_mirror_map_get(&st->inst_sel, RT_HANDLE_INDEX(handle) + 1) != NULL;
 }
 
 uint32_t sy_rti_inst_node_get(const rt_state *st, uint32_t handle)
@@ -188,11 +214,12 @@ static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_er
         memcpy(d.transform, a->world->m, sizeof d.transform);
         r = sy_rt_instance_create(st->dev, &d, &h);
         *a->handle = h.id;
-        if (r == SY_RT_OK) inst_node_set(st, h.id, a->node);
+        if (r == SY_RT_OK) inst_node_set(st, h.id, a->node, a->placement), inst_sel_set(st, h.id, a->selected);
         return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "instance");
     }
     r = sy_rt_instance_set_transform(st->dev, h, a->world->m);
     if (r == SY_RT_OK) r = sy_rt_instance_set_visible(st->dev, h, a->visible);
+    if (r == SY_RT_OK) inst_sel_set(st, h.id, a->selected);
     return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "instance transform");
 }
 
@@ -227,7 +254,8 @@ static void cb_release(void *user, const sy_mirror_release_args *a)
     case SY_MIRROR_MATERIAL: sy_rt_material_destroy(st->dev, (sy_rt_material){a->handle}); break;
     case SY_MIRROR_PRIMITIVE: sy_rt_mesh_destroy(st->dev, (sy_rt_mesh){a->handle}); break;
     case SY_MIRROR_INSTANCE:
-        inst_node_set(st, a->handle, 0);
+        inst_node_set(st, a->handle, 0, 0);
+        inst_sel_set(st, a->handle, false);
         sy_rt_instance_destroy(st->dev, (sy_rt_instance){a->handle});
         break;
     case SY_MIRROR_LIGHT: sy_rt_light_destroy(st->dev, (sy_rt_light){a->handle}); break;

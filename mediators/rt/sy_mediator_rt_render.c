@@ -7,6 +7,7 @@
 #include "sy_rt_limit.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* >>render */
@@ -39,9 +40,46 @@ sy_result sy_mediator_rt_bench_rays(void *state, const sy_camera_view *view, uin
     return SY_OK;
 }
 
+uint8_t *sy_rti_selection_flags(rt_state *st, const sy_rt_camera *cam, uint32_t full_w, uint32_t full_h,
+                                sy_highlight_rect m)
+{
+    size_t n = (size_t)m.w * m.h;
+    uint32_t *ids = malloc((n ? n : 1) * sizeof *ids);
+    uint8_t *sel = malloc(n ? n : 1);
+    sy_rt_render_desc d = {.image_width = full_w, .image_height = full_h, .x = m.x, .y = m.y, .width = m.w, .height = m.h};
+    if (!ids || !sel || (n && sy_rt_coverage(st->dev, cam, &d, ids, NULL) != SY_RT_OK)) {
+        free(ids);
+        free(sel);
+        return NULL;
+    }
+    for (size_t i = 0; i < n; ++i) sel[i] = sy_rti_inst_selected(st, ids[i]);
+    free(ids);
+    return sel;
+}
+
+static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err);
+
+/* A frame, then the selection highlight (sy_highlight.h) over it when an instance is selected:
+ * the ID image of the pixel centres is one coverage pass over the rectangle and its margin. */
 sy_result sy_rti_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err)
 {
     rt_state *st = state;
+    sy_result r = render_frame(st, req, layer, err);
+    if (r != SY_OK || st->integrator == SY_RT_INTEGRATOR_COVERAGE || !st->inst_sel.live) return r;
+    sy_rt_camera cam;
+    sy_rti_camera_of(&req->camera, &cam);
+    sy_highlight_rect m = sy_highlight_margin(req->full_width, req->full_height, req->rect_x, req->rect_y, req->rect_w,
+                                              req->rect_h);
+    uint8_t *sel = sy_rti_selection_flags(st, &cam, req->full_width, req->full_height, m);
+    if (!sel) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "%s: selection highlight: out of memory or device failure",
+                                  st->integrator == SY_RT_INTEGRATOR_PATHTRACER ? "pathtracer" : "whitted");
+    sy_highlight_apply(layer->rgba, req->rect_x, req->rect_y, req->rect_w, req->rect_h, sel, m);
+    free(sel);
+    return SY_OK;
+}
+
+static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err)
+{
     sy_result lr = sy_rti_apply_look(st, req->background_id, err);
     if (lr != SY_OK) return lr;
     sy_rt_camera cam;
@@ -76,6 +114,7 @@ sy_result sy_rti_render(void *state, const sy_render_request *req, sy_layer *lay
         if (pr != SY_OK) return pr;
         d.accum = st->slots[st->last_slot].acc;
         d.samples = req->sample_count ? req->sample_count : 1u;
+        st->last_cam = cam, st->last_desc = d; /* the ID AOVs of this accumulation */
         if (st->filter.kind == PT_FILTER_RADIANCE) return sy_rti_radiance_render(st, req, &cam, &d, layer, err);
     }
     sy_rt_result r = sy_rt_render(st->dev, &cam, &d, layer->rgba, layer->depth);

@@ -21,6 +21,10 @@
  *   7. Section planes travel with the view (SY_CAP_CLIP, protocol 4): the demo cut through its
  *      centre by whitted on the cluster (sort-first, balanced) equals the same cut rendered
  *      locally (rmse <= 1e-6) and differs from the uncut image.
+ *   8. Visibility and selection are scene changes (issue 37 item 4): one of the demo's objects
+ *      hidden and another selected reach the servers' replicas through the change lists: the
+ *      cluster image (sort-first, balanced) equals the local one (rmse <= 1e-6) and differs from
+ *      the plain image; shown and deselected again, it equals the plain one.
  *   test_cluster_mediator SERVER_EXE WORK_DIR */
 #include "../support/sy_check.h"
 #include "server_proc.h"
@@ -181,6 +185,44 @@ static int test_clip(fixture *fx)
     CHECK_MSG(e1 <= 1e-6 && e2 <= 1e-6, "the cluster's cut image differs from the local one");
     CHECK_MSG(d > 0.01, "the plane cut nothing away: the comparison would see nothing");
     sy_layer_destroy(&uncut), sy_layer_destroy(&local), sy_layer_destroy(&sf), sy_layer_destroy(&bal);
+    return 0;
+}
+
+/* Part 8: the first mesh child of the demo's root hidden, the second selected. */
+static int test_visibility(fixture *fx)
+{
+    sy_error e = {0};
+    uint32_t nc;
+    const uint32_t *ch = sy_node_children(sy_node_get(fx->scene, fx->d.root), &nc);
+    sy_node hide = {0}, sel = {0};
+    for (uint32_t i = 0; i < nc && !sel.id; ++i) {
+        const sy_node_data *d = sy_node_get(fx->scene, (sy_node){ch[i]});
+        if (!d || !d->mesh.id) continue;
+        if (!hide.id) hide = (sy_node){ch[i]};
+        else sel = (sy_node){ch[i]};
+    }
+    CHECK_MSG(hide.id && sel.id, "the demo has fewer than two mesh objects under its root");
+    sy_layer plain = {0}, local = {0}, sf = {0}, bal = {0}, back = {0};
+    CHECK(render_sbs(fx, "whitted", NULL, 0, 0, &plain, NULL) == 0);
+    CHECK_OK(sy_node_set_visible(fx->scene, hide, false, &e), e);
+    CHECK_OK(sy_node_set_selected(fx->scene, sel, true, &e), e);
+    CHECK_OK(sy_scene_commit(fx->scene, NULL, &e), e);
+    int failed = render_sbs(fx, "whitted", NULL, 0, 0, &local, NULL) ||
+                 render_sbs(fx, "cluster", "backend=whitted,mode=sort-first", 0, 0, &sf, NULL) ||
+                 render_sbs(fx, "cluster", "backend=whitted,mode=balanced", 0, 0, &bal, NULL);
+    CHECK_OK(sy_node_set_visible(fx->scene, hide, true, &e), e);
+    CHECK_OK(sy_node_set_selected(fx->scene, sel, false, &e), e);
+    CHECK_OK(sy_scene_commit(fx->scene, NULL, &e), e);
+    CHECK(!failed);
+    CHECK(render_sbs(fx, "cluster", "backend=whitted,mode=sort-first", 0, 0, &back, NULL) == 0);
+    double e1 = rmse(&local, &sf), e2 = rmse(&local, &bal), d = mean_abs_diff(&local, &plain), e3 = rmse(&back, &plain);
+    printf("node %u hidden, node %u selected, whitted: sort-first rmse %.3g, balanced rmse %.3g; vs plain mean |diff| "
+           "%.4f; shown again: rmse %.3g\n",
+           hide.id, sel.id, e1, e2, d, e3);
+    CHECK_MSG(e1 <= 1e-6 && e2 <= 1e-6, "the servers' replicas did not hide / select as the local scene does");
+    CHECK_MSG(d > 0.001, "hiding and selecting changed nothing: the comparison would see nothing");
+    CHECK_MSG(e3 <= 1e-6, "shown and deselected again, the cluster image is not the plain one");
+    sy_layer_destroy(&plain), sy_layer_destroy(&local), sy_layer_destroy(&sf), sy_layer_destroy(&bal), sy_layer_destroy(&back);
     return 0;
 }
 
@@ -407,6 +449,8 @@ int main(int argc, char **argv)
             printf("set-up refusals: %s\n", r ? "FAILED" : "ok");
             failed += r = test_clip(&fx);
             printf("section planes: %s\n", r ? "FAILED" : "ok");
+            failed += r = test_visibility(&fx);
+            printf("visibility and selection: %s\n", r ? "FAILED" : "ok");
             failed += r = test_pick(&fx); /* last: it moves the overlay sphere */
             printf("picks: %s\n", r ? "FAILED" : "ok");
         }
