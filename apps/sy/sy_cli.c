@@ -121,6 +121,9 @@ int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *short
         case OPT_LOOK_AT: case OPT_FOV: case OPT_ORBIT: /* the camera's placement (sy_load.h) */
             if ((*status = sy_cli_view_option(c, optarg)) != 0) return OPT_STOP;
             break;
+        case OPT_HIDE: case OPT_ISOLATE: case OPT_SELECT: /* node visibility and selection (sy_load.h) */
+            if ((*status = sy_cli_node_option(c, optarg)) != 0) return OPT_STOP;
+            break;
         case OPT_ALLOW_PATH: { /* repeatable: more folders that a model's external files may lie in */
             struct stat st;
             if (stat(optarg, &st) != 0 || !S_ISDIR(st.st_mode)) {
@@ -174,6 +177,9 @@ static const char usage_text[] =
             "             UP each x,y,z, UP default 0,1,0; --orbit: AZ degrees about +y from +z, EL degrees above the\n"
             "             horizon (-90..90), around the bounds' centre, DIST default: the bounds fill the view; --fov:\n"
             "             the vertical field of view in degrees (0..180) of whichever camera is used)\n"
+            "            [--hide NODE] [--isolate NODE] [--select NODE]   (repeatable; NODE: a node name, the node id sy\n"
+            "             pick prints, or an index in creation order; --isolate hides every other mesh node; --select\n"
+            "             highlights it: pixels tinted orange and outlined, in every back-end)\n"
             "            [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]  (PNG, JPEG; default aces)\n"
             "            [--max-memory MB]   (ray tracers: refuse a scene whose BVHs need more)\n"
             "            [--gl osmesa|egl|glfw]   (-b raster: the GL context provider)\n"
@@ -185,7 +191,8 @@ static const char usage_text[] =
             "             inclusive at time frame/F, F default 24; #### the zero-padded frame number; --resume skips\n"
             "             frames whose file exists; -o anim.mp4|anim.webm: one H.264 / VP9 video of the frames)\n"
             "  sy render SCENE -b pathtracer [-o OUT.exr|png|jpg] [--spp N | --time SECONDS] [--aov]\n"
-            "            (+ the options above)\n"
+            "            (+ the options above; --aov: one EXR of the feature buffers, object_id and instance_id\n"
+            "             included: the node id and placement sy pick reports at each pixel centre)\n"
             "            [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]   (display filter)\n"
             "  sy demo [-o DIR] [-w W] [-h H] [--filter pixel|none|...]   (the progressive back-end's display filter)\n"
             "  sy compare SCENE [-w W] [-h H] [--spp N] [-o SHEET.png] [--camera C] [--backends a,b,...]\n"
@@ -195,12 +202,16 @@ static const char usage_text[] =
             "  sy view SCENE [-b BACKEND] [-w W] [-h H] [--camera C] [--overlay FILE[:BACKEND]]\n"
             "          [--look-at EYE:TARGET[:UP] | --orbit AZ,EL[,DIST]] [--fov DEG]   (the start view; as sy render)\n"
             "          [--frames N --screenshot OUT.png] [--filter none|pixel|atrous|jbu|adaptive|radiance] [--threshold T]\n"
+            "          [--hide NODE] [--isolate NODE] [--select NODE]   (as sy render)\n"
             "          [--keys KEYS]   (automated runs: press these keys one frame after another, e.g. F]F[)\n"
+            "          (click: pick and select the node, shift-click: add or remove it, click on nothing: clear;\n"
+            "           H hides the selection, I isolates it, U shows every node again)\n"
             "          [--budget MS]   (frame time while the view moves: the resolution follows it; default 33)\n"
             "          [--cluster URL[,URL...]|FILE.conf [--cluster-mode MODE] [--secret-file F] [--timeout-ms MS]\n"
             "           [--spp SAMPLES_PER_SERVER_AND_FRAME]]   (the same cluster options as sy render)\n"
             "  sy web SCENE [-b BACKEND] [--listen HOST:PORT] [--camera C] [-w MAX_W] [-h MAX_H] [--quality Q]\n"
             "          [--look-at EYE:TARGET[:UP] | --orbit AZ,EL[,DIST]] [--fov DEG]   (the start view; as sy render)\n"
+            "          [--hide NODE] [--isolate NODE] [--select NODE]   (the start state; as sy render)\n"
             "          [--filter none|pixel|...] [--threshold T] [--budget MS] [--client-render]   (the view in a browser:\n"
             "           open the URL it prints; another address than loopback needs the printed token)\n"
             "  sy bench web [SCENE] [-b BACKEND] [-w W] [-h H] [--repeats N]   (input-to-frame latency, loopback)\n"
@@ -221,7 +232,7 @@ static const char usage_text[] =
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy pick SCENE X Y [X Y ...] [-b BACKEND] [-w W] [-h H] [--camera NAME|INDEX] [--params k=v,...]\n"
             "            [--look-at EYE:TARGET[:UP] | --orbit AZ,EL[,DIST]] [--fov DEG]   (the view; as sy render)\n"
-            "            [--clip A,B,C,D ...]\n"
+            "            [--clip A,B,C,D ...] [--hide NODE] [--isolate NODE] [--select NODE]   (as sy render)\n"
             "            (what is under pixel (X, Y) of the view sy render draws, as JSON: node, mesh, primitive,\n"
             "             triangle, barycentrics, position, normal, material, distance; \"hit\": false on a miss)\n"
             "  sy backends [--params] [--json]\n"

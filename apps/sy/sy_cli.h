@@ -24,13 +24,15 @@ enum {
     OPT_SPP, OPT_TIME, OPT_AOV, OPT_CAMERA, OPT_PARAMS, OPT_GL, OPT_FILTER, OPT_THRESHOLD, OPT_HALF, OPT_EXPOSURE,
     OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
     OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB, OPT_MAX_MEMORY,
-    OPT_BUDGET, OPT_AT, OPT_CLIP, OPT_LOOK_AT, OPT_FOV, OPT_ORBIT, OPT_REPEAT, OPT_FPS, OPT_RESUME
+    OPT_BUDGET, OPT_AT, OPT_CLIP, OPT_LOOK_AT, OPT_FOV, OPT_ORBIT, OPT_REPEAT, OPT_FPS, OPT_RESUME, OPT_HIDE,
+    OPT_ISOLATE, OPT_SELECT
 };
-/* getopt_long entries of the camera placement options (sy render, pick, view, web), taken by
- * sy_cli_next_option into sy_cli_load_opts.view (sy_load.h) */
+/* getopt_long entries of the camera placement and node visibility options (sy render, pick, view,
+ * web), taken by sy_cli_next_option into sy_cli_load_opts.view and .nodes (sy_load.h) */
 #define VIEW_OPTIONS                                                                                       \
     {"look-at", required_argument, NULL, OPT_LOOK_AT}, {"fov", required_argument, NULL, OPT_FOV},        \
-    {"orbit", required_argument, NULL, OPT_ORBIT}
+    {"orbit", required_argument, NULL, OPT_ORBIT}, {"hide", required_argument, NULL, OPT_HIDE},          \
+    {"isolate", required_argument, NULL, OPT_ISOLATE}, {"select", required_argument, NULL, OPT_SELECT}
 /* getopt_long entries of the options of every command, with the table's terminator: the end of
  * every command's table */
 #define COMMON_OPTIONS                                                                                     \

@@ -234,7 +234,8 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
 }
 
 /* Writes the back-end's feature buffers (SY_CAP_AOVS) as channels of one EXR: colour and depth
- * as R G B A Z, every other plane as NAME.{R,G,B} (normal: NAME.{X,Y,Z}), e.g. variance.R. */
+ * as R G B A Z, the ID planes as object_id and instance_id (float even with --half), every other
+ * plane as NAME.{R,G,B} (normal: NAME.{X,Y,Z}), e.g. variance.R. */
 static sy_result write_aov_exr(const char *path, sy_context *ctx, const out_opts *o, sy_error *err)
 {
     sy_aovs a;
@@ -252,6 +253,8 @@ static sy_result write_aov_exr(const char *path, sy_context *ctx, const out_opts
             for (uint32_t i = 0; i < 4 && i < p->channels; ++i) ch[n++] = (sy_exr_channel_desc){rgba[i], p->data, p->channels, i, ct};
         } else if (!strcmp(p->name, "depth")) {
             ch[n++] = (sy_exr_channel_desc){"Z", p->data, p->channels, 0, SY_EXR_PIXEL_FLOAT};
+        } else if (!strcmp(p->name, "object_id") || !strcmp(p->name, "instance_id")) { /* ids: exact floats */
+            ch[n++] = (sy_exr_channel_desc){p->name, p->data, p->channels, 0, SY_EXR_PIXEL_FLOAT};
         } else {
             bool normal = !strcmp(p->name, "normal");
             for (uint32_t i = 0; i < p->channels && i < (normal ? 3u : 4u); ++i) {

@@ -143,6 +143,72 @@ int sy_cli_view_option(int c, const char *value)
     return 0;
 }
 
+int sy_cli_node_option(int c, const char *value)
+{
+    sy_node_options *o = &sy_cli_load_opts.nodes;
+    const char *opt = c == OPT_HIDE ? "--hide" : c == OPT_ISOLATE ? "--isolate" : "--select";
+    const char **list = c == OPT_HIDE ? o->hide : c == OPT_ISOLATE ? o->isolate : o->select;
+    uint32_t *n = c == OPT_HIDE ? &o->hide_count : c == OPT_ISOLATE ? &o->isolate_count : &o->select_count;
+    if (!*value) return view_usage(opt, "''", "expected a node name or number");
+    if (*n == SY_MAX_NODE_OPTIONS) {
+        fprintf(stderr, "sy: error: %s: at most %d nodes\n", opt, SY_MAX_NODE_OPTIONS);
+        return 2;
+    }
+    list[(*n)++] = value;
+    return 0;
+}
+
+sy_result sy_cli_find_nodes(const sy_scene *s, const char *opt, const char *node, sy_node *out, uint32_t max,
+                            uint32_t *count_out, sy_error *err)
+{
+    *count_out = 0;
+    char *end = NULL;
+    errno = 0;
+    unsigned long long num = *node >= '0' && *node <= '9' ? strtoull(node, &end, 10) : 0;
+    bool is_num = end && !*end && !errno && num <= UINT32_MAX;
+    if (is_num && sy_node_get(s, (sy_node){(uint32_t)num})) { /* the id sy pick prints */
+        out[(*count_out)++] = (sy_node){(uint32_t)num};
+        return SY_OK;
+    }
+    uint32_t k = 0;
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id), ++k) {
+        const sy_node_data *d = sy_node_get(s, (sy_node){id});
+        bool match = is_num ? k == num : d && d->name && !strcmp(d->name, node);
+        if (match && *count_out < max) out[(*count_out)++] = (sy_node){id};
+        if (match && is_num) break;
+    }
+    if (*count_out) return SY_OK;
+    return sy_error_set(err, SY_ERR_NOT_FOUND,
+                        "%s %s: no such node (a node name, the node id sy pick prints, or an index below %u)", opt,
+                        node, sy_scene_count(s, SY_TYPE_NODE));
+}
+
+/* The node options (sy_cli_load_opts.nodes) on the loaded scene: see sy_cli_load in sy_load.h. */
+static sy_result apply_nodes(loaded *ld, sy_error *err)
+{
+    const sy_node_options *o = &sy_cli_load_opts.nodes;
+    if (!o->hide_count && !o->isolate_count && !o->select_count) return SY_OK;
+    enum { MAX_MATCHES = 4096 };
+    sy_node *found = malloc(MAX_MATCHES * sizeof *found);
+    if (!found) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "node options: out of memory");
+    uint32_t nf = 0, m;
+    sy_result r = SY_OK;
+    for (uint32_t i = 0; i < o->isolate_count && r == SY_OK; ++i)
+        if ((r = sy_cli_find_nodes(ld->scene, "--isolate", o->isolate[i], found + nf, MAX_MATCHES - nf, &m, err)) == SY_OK)
+            nf += m;
+    if (r == SY_OK && o->isolate_count) r = sy_scene_isolate(ld->scene, found, nf, err);
+    for (uint32_t i = 0; i < o->hide_count && r == SY_OK; ++i) {
+        r = sy_cli_find_nodes(ld->scene, "--hide", o->hide[i], found, MAX_MATCHES, &m, err);
+        for (uint32_t k = 0; k < m && r == SY_OK; ++k) r = sy_node_set_visible(ld->scene, found[k], false, err);
+    }
+    for (uint32_t i = 0; i < o->select_count && r == SY_OK; ++i) {
+        r = sy_cli_find_nodes(ld->scene, "--select", o->select[i], found, MAX_MATCHES, &m, err);
+        for (uint32_t k = 0; k < m && r == SY_OK; ++k) r = sy_node_set_selected(ld->scene, found[k], true, err);
+    }
+    free(found);
+    return r == SY_OK ? sy_scene_commit(ld->scene, NULL, err) : r;
+}
+
 /* The view options (sy_cli_load_opts.view) on the loaded scene: see sy_cli_load in sy_load.h. */
 static sy_result apply_view(loaded *ld, sy_error *err)
 {
@@ -314,6 +380,7 @@ sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, l
     if (r == SY_OK) r = sy_scene_commit(out->scene, NULL, err);
     if (r == SY_OK && (out->is_gltf || out->is_x3d || out->is_assimp) && defaults) r = add_defaults(out, err);
     if (r == SY_OK) r = apply_view(out, err); /* --look-at, --orbit, --fov */
+    if (r == SY_OK) r = apply_nodes(out, err); /* --isolate, --hide, --select */
     /* the user's world choices: sy_world (formats) maps them onto the world object */
     if (r == SY_OK && !sy_world_options_empty(&sy_cli_load_opts.world) &&
         (r = sy_world_apply(out->scene, &out->background, &sy_cli_load_opts.world, err)) == SY_OK)

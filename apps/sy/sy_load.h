@@ -39,6 +39,15 @@ typedef struct sy_view_options {
     float azimuth, elevation, dist; /* degrees, degrees, scene units (0 = frame the bounds) */
     float fov;                      /* --fov in radians; 0 = the camera's */
 } sy_view_options;
+/* Which nodes are hidden, isolated and selected (sy render, pick, view, web): --hide NODE,
+ * --isolate NODE, --select NODE, each repeatable; NODE is a node name (every node of that name) or
+ * a whole number: the node id `sy pick` prints (node.id), else the node's index in the scene's
+ * creation order (0 = the first node made; sy_scene_next order). */
+#define SY_MAX_NODE_OPTIONS 64
+typedef struct sy_node_options {
+    const char *hide[SY_MAX_NODE_OPTIONS], *isolate[SY_MAX_NODE_OPTIONS], *select[SY_MAX_NODE_OPTIONS];
+    uint32_t hide_count, isolate_count, select_count;
+} sy_node_options;
 typedef struct sy_load_options {
     const char *roots[SY_MAX_ALLOW_PATHS];
     size_t root_count;
@@ -47,6 +56,7 @@ typedef struct sy_load_options {
     const char *variant; /* --variant: a glTF file's KHR_materials_variants variant (name or index); NULL = default */
     sy_world_options world; /* --env, --env-color, --env-intensity, --env-hidden, --background, --no-default-light */
     sy_view_options view;   /* --look-at, --orbit, --fov (applied by sy_cli_load) */
+    sy_node_options nodes;  /* --hide, --isolate, --select (applied by sy_cli_load) */
 } sy_load_options;
 extern sy_load_options sy_cli_load_opts;
 
@@ -55,6 +65,13 @@ extern sy_load_options sy_cli_load_opts;
  * missing part, NaN, eye == target, up parallel to the view, a range; --look-at with --orbit) on
  * stderr. */
 int sy_cli_view_option(int c, const char *value);
+/* --hide, --isolate or --select (OPT_HIDE, OPT_ISOLATE, OPT_SELECT) with its NODE into
+ * sy_cli_load_opts.nodes. Returns 0, or 2 after a usage error (an empty value, too many) on stderr. */
+int sy_cli_node_option(int c, const char *value);
+/* The nodes NODE names in s (see sy_node_options): *count_out of them into out (at most max);
+ * SY_ERR_NOT_FOUND naming NODE and opt when there is none. */
+sy_result sy_cli_find_nodes(const sy_scene *s, const char *opt, const char *node, sy_node *out, uint32_t max,
+                            uint32_t *count_out, sy_error *err);
 
 /* Loads path ("demo": the built-in scene) into a new scene in *out; camera_sel (NULL: the file's
  * first camera) names or numbers a camera; defaults: a file without a camera gets one framing its
@@ -63,7 +80,9 @@ int sy_cli_view_option(int c, const char *value);
  * given place (--orbit: around the centre of the root's world bounds, at AZ degrees about +y from +z
  * and EL degrees above the horizon, by default at the distance where the bounds' sphere fills the
  * view, as the default camera frames it); --fov sets the vertical field of view of the camera used
- * (an orthographic one refuses it). On failure *out is empty. */
+ * (an orthographic one refuses it). Then the node options (sy_cli_load_opts.nodes): --isolate hides
+ * every node but the named ones (sy_scene_isolate), --hide hides the named nodes, --select selects
+ * them; an unknown NODE fails the load naming the option and NODE. On failure *out is empty. */
 sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, loaded *out, sy_error *err);
 void sy_cli_loaded_free(loaded *l);
 /* --at SECONDS / --clip NAME|INDEX: sets the loaded scene's time (sy_scene_set_time) on that clip, or

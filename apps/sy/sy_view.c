@@ -42,6 +42,10 @@ typedef struct viewer {
     bool quit;
     bool playing;    /* space: the scene clock plays (the render thread advances it) */
     uint32_t steps;  /* '.': steps of 1/24 s asked for since the last frame */
+    bool pick;          /* a click to pick and select at (pick_x, pick_y) (window pixels of the image) */
+    bool pick_add;      /* shift-click: toggle the node in the selection instead of replacing it */
+    double pick_x, pick_y;
+    int vis_key;        /* 'H' hide the selection, 'I' isolate it, 'U' show every node; 0 none */
     /* render thread -> input thread (under mu) */
     uint8_t *img;
     uint32_t img_w, img_h;
@@ -58,6 +62,7 @@ typedef struct viewer {
     bool governed;    /* local rendering (the governor's scale is in the title) */
     char status[256];
     char filter_status[96];
+    char sel_status[160]; /* the last pick and the selection, for the title */
     sy_error error;
     bool failed;
 } viewer;
@@ -242,6 +247,78 @@ static sy_result view_cluster_frame(view_cluster *vc, const sy_view_args *a, sy_
     return SY_OK;
 }
 
+/* >>selection (render thread: it owns the scene): a click picks through the view's back-end (or
+ * the first that can pick) and selects the node hit (shift: toggles it; nothing hit: clears the
+ * selection); H hides the selected nodes, I isolates them (sy_scene_isolate), U shows every node.
+ * The flags are scene changes, committed here: every context (and cluster server) sees them. */
+static uint32_t selected_nodes(const sy_scene *s, sy_node *out, uint32_t max)
+{
+    uint32_t n = 0;
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id)) {
+        const sy_node_data *d = sy_node_get(s, (sy_node){id});
+        if (d && (d->flags & SY_NODE_SELECTED)) {
+            if (n < max) out[n] = (sy_node){id};
+            n++;
+        }
+    }
+    return n;
+}
+
+static sy_result view_selection(sy_scene *scene, sy_context_pool *pool, const sy_compose_spec *spec, const char *backend,
+                                uint32_t w, uint32_t h, bool pick, double px, double py, bool add, int key, char *status,
+                                size_t len, sy_error *err)
+{
+    enum { MAX_SEL = 4096 };
+    sy_node *sel = malloc(MAX_SEL * sizeof *sel);
+    if (!sel) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "view: selection: out of memory");
+    uint32_t n = selected_nodes(scene, sel, MAX_SEL);
+    if (n > MAX_SEL) n = MAX_SEL;
+    sy_result r = SY_OK;
+    if (pick) {
+        const sy_mediator_class *cls = sy_mediator_find(backend);
+        if (!cls || !(cls->caps & SY_CAP_PICK)) cls = sy_mediator_with_caps(SY_CAP_PICK);
+        sy_window *win = NULL;
+        sy_viewport *vp = NULL;
+        sy_viewport_desc vd = {.root = spec->root, .camera = spec->camera, .backend = cls ? cls->name : backend};
+        sy_pick_result p = {0};
+        if (!cls) r = sy_error_set(err, SY_ERR_UNSUPPORTED, "view: no back-end can pick");
+        if (r == SY_OK) r = sy_window_create(w, h, &win, err);
+        if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
+        if (r == SY_OK) sy_viewport_set_view(vp, spec->view);
+        if (r == SY_OK && spec->clip_count)
+            r = sy_viewport_set_clip_planes(vp, (const float(*)[4])spec->clip_planes, spec->clip_count, err);
+        if (r == SY_OK) r = sy_window_pick(win, scene, pool, px, py, &p, err);
+        sy_window_destroy(win);
+        bool was = false;
+        for (uint32_t i = 0; r == SY_OK && i < n; ++i) {
+            if (p.hit && sel[i].id == p.node_id) was = true;
+            else if (!add) r = sy_node_set_selected(scene, sel[i], false, err);
+        }
+        if (r == SY_OK && p.hit) r = sy_node_set_selected(scene, (sy_node){p.node_id}, !(add && was), err);
+        const sy_node_data *d = p.hit ? sy_node_get(scene, (sy_node){p.node_id}) : NULL;
+        if (r == SY_OK)
+            snprintf(status, len, " | picked %s%.60s%s (node %u, triangle %u)", d && d->name ? "'" : "",
+                     d && d->name ? d->name : p.hit ? "unnamed" : "nothing", d && d->name ? "'" : "", p.node_id, p.triangle);
+    } else if (key == 'H') {
+        for (uint32_t i = 0; r == SY_OK && i < n; ++i) r = sy_node_set_visible(scene, sel[i], false, err);
+        if (r == SY_OK) snprintf(status, len, " | hid %u node%s", n, n == 1 ? "" : "s");
+    } else if (key == 'I') {
+        r = n ? sy_scene_isolate(scene, sel, n, err) : SY_OK;
+        if (r == SY_OK) snprintf(status, len, n ? " | isolated %u node%s" : " | nothing selected to isolate", n, n == 1 ? "" : "s");
+    } else if (key == 'U') {
+        r = sy_scene_isolate(scene, NULL, 0, err);
+        if (r == SY_OK) snprintf(status, len, " | every node shown");
+    }
+    free(sel);
+    if (r == SY_OK) r = sy_scene_commit(scene, NULL, err);
+    if (r == SY_OK) {
+        size_t k = strlen(status);
+        uint32_t now = selected_nodes(scene, NULL, 0);
+        if (k < len) snprintf(status + k, len - k, " | %u selected", now);
+    }
+    return r;
+}
+
 /* >>render thread */
 /* Waits on the viewer's condition variable until ms_left ms passed (monotonic clock: view_run sets
  * the condition's clock). */
@@ -306,6 +383,10 @@ static void *render_main(void *p)
         bool overlay = v->overlay, playing = v->playing && animated;
         uint32_t steps = animated ? v->steps : 0;
         v->steps = 0;
+        bool pick = v->pick, pick_add = v->pick_add;
+        double pick_x = v->pick_x, pick_y = v->pick_y;
+        int vis_key = v->vis_key;
+        v->pick = false, v->vis_key = 0;
         pthread_mutex_unlock(&v->mu);
         bool time_moved = false;
         if (playing || steps) {
@@ -339,6 +420,18 @@ static void *render_main(void *p)
         spec.has_overlay = a->spec.has_overlay && overlay;
         spec.stereo = stereo;
         uint32_t ew = stereo == SY_STEREO_SBS ? (w / 2 ? w / 2 : 1) : w;
+        if (pick || vis_key) { /* click: pick and select; H, I, U: visibility (mono picks: the left eye's half) */
+            char sst[160] = "";
+            sy_error serr = {0};
+            double sx = stereo == SY_STEREO_SBS && pick_x >= ew ? pick_x - ew : pick_x;
+            sy_result sr = view_selection(a->scene, pool, &spec, cls->name, ew, h, pick && sx < ew && pick_y < h, sx,
+                                          pick_y, pick_add, vis_key, sst, sizeof sst, &serr);
+            if (sr != SY_OK) snprintf(sst, sizeof sst, " | select: %.120s", serr.message);
+            pthread_mutex_lock(&v->mu);
+            snprintf(v->sel_status, sizeof v->sel_status, "%s", sst);
+            pthread_mutex_unlock(&v->mu);
+            changed = true;
+        }
         sy_governor_frame gf = {.width = ew, .height = h, .scale = 1.0f, .samples = 1};
         if (!v->cluster) {
             /* a progressive back-end refines a resting mono view; stereo renders once at full size */
@@ -435,6 +528,7 @@ fail_unlocked:
 typedef struct input {
     viewer *v;
     double mx, my;
+    double press_x, press_y; /* where the left button went down: a release there is a click (pick) */
     int drag; /* 0 none, 1 orbit, 2 pan */
     bool changed;
 } input;
@@ -475,6 +569,12 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         v->req_version++;
         pthread_cond_signal(&v->cv);
         pthread_mutex_unlock(&v->mu);
+    } else if (key == GLFW_KEY_H || key == GLFW_KEY_I || key == GLFW_KEY_U) { /* hide / isolate / show all */
+        pthread_mutex_lock(&v->mu);
+        v->vis_key = key; /* GLFW's codes of letters are their capitals */
+        v->req_version++;
+        pthread_cond_signal(&v->cv);
+        pthread_mutex_unlock(&v->mu);
     } else if (key == GLFW_KEY_F || key == GLFW_KEY_LEFT_BRACKET || key == GLFW_KEY_RIGHT_BRACKET || key == GLFW_KEY_R) {
         /* the display filter: F cycles it, [ ] halve / double the threshold (live: the render thread
          * applies it to its context, the accumulation keeps its samples); R: the camera home */
@@ -488,9 +588,24 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
 
 static void on_button(GLFWwindow *w, int button, int action, int mods)
 {
-    (void)mods;
     input *in = glfwGetWindowUserPointer(w);
     glfwGetCursorPos(w, &in->mx, &in->my);
+    if (action == GLFW_RELEASE && in->drag == 1 && fabs(in->mx - in->press_x) < 3 && fabs(in->my - in->press_y) < 3) {
+        /* a click (the button went up where it went down): pick and select, in image pixels */
+        int ww, wh, fw, fh;
+        glfwGetWindowSize(w, &ww, &wh);
+        glfwGetFramebufferSize(w, &fw, &fh);
+        viewer *v = in->v;
+        pthread_mutex_lock(&v->mu);
+        v->pick = true;
+        v->pick_add = (mods & GLFW_MOD_SHIFT) != 0;
+        v->pick_x = ww > 0 ? in->mx * fw / ww : in->mx;
+        v->pick_y = wh > 0 ? in->my * fh / wh : in->my;
+        v->req_version++;
+        pthread_cond_signal(&v->cv);
+        pthread_mutex_unlock(&v->mu);
+    }
+    if (action == GLFW_PRESS) in->press_x = in->mx, in->press_y = in->my;
     if (action == GLFW_RELEASE) in->drag = 0;
     else in->drag = button == GLFW_MOUSE_BUTTON_LEFT ? 1 : 2;
 }
@@ -664,10 +779,10 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
                 snprintf(scale, sizeof scale, " | scale %.2f%s", (double)v.img_scale, v.img_moving ? " moving" : "");
             char clock_s[48] = ""; /* the scene clock, when the scene moves */
             if (v.animated) snprintf(clock_s, sizeof clock_s, " | t %.3f s %s", v.anim_time, v.playing ? "playing" : "paused");
-            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms%s | %llu spp%s%s%s%s", v.status, v.frame_ms, scale,
+            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms%s | %llu spp%s%s%s%s%s", v.status, v.frame_ms, scale,
                      (unsigned long long)v.spp, sync,
                      v.stereo == SY_STEREO_SBS ? " | stereo sbs" : v.stereo == SY_STEREO_ANAGLYPH ? " | anaglyph" : "",
-                     v.filter_status, clock_s);
+                     v.filter_status, clock_s, v.sel_status);
             glfwSetWindowTitle(win, title);
         }
         /* a frame counts for --frames once settled, or any frame while the scene clock plays (it never settles) */

@@ -6,6 +6,9 @@
 #   - section planes (--clip A,B,C,D): a malformed plane, a zero normal, NaN, a seventh plane: exit 2
 #     naming --clip (sy pick and sy render); a plane that removes the whole demo turns the hit at the
 #     image centre into "hit": false.
+#   - --hide NODE (by id and by name) makes the centre's pick name another node, --select and
+#     --isolate keep it; an unknown NODE: exit 1 naming the option and the value; an empty one:
+#     exit 2; sy render --aov writes object_id and instance_id channels (sy info lists them).
 #   - agreement on a Khronos sample (DamagedHelmet, 256x192): at a grid of 64 pixels over the model, raster,
 #     whitted and pathtracer hit the same pixels, and where they all hit they name the same node
 #     and triangle and report positions within 1e-4 x the scene size (its bounds' diagonal, from
@@ -48,6 +51,31 @@ rc=$?; [ $rc = 2 ] && grep -qF -- "--clip: '1,0'" "$TMP/err" || fail "sy render 
     fail "the demo's centre is not a hit: $(cat "$TMP/whole" "$TMP/err")"
 "$SY" pick demo 32 30 -b whitted -w 64 -h 48 --clip 1,0,0,-1e6 >"$TMP/cut" 2>"$TMP/err" && grep -q '"hit": false' "$TMP/cut" ||
     fail "a plane removing the whole demo left a hit: $(cat "$TMP/cut" "$TMP/err")"
+
+# visibility and selection (--hide, --isolate, --select NODE: a name, the id sy pick prints, an index)
+node_of() { tr -d '\n' <"$1" | sed -n 's/.*"node": {"id": \([0-9]*\), "name": "\([^"]*\)".*/\1 \2/p'; }
+read -r nid nname <<<"$(node_of "$TMP/whole")"
+[ -n "${nid:-}" ] || fail "no node in the demo's centre pick: $(cat "$TMP/whole")"
+for sel in "$nid" "$nname"; do
+    "$SY" pick demo 32 30 -b whitted -w 64 -h 48 --hide "$sel" >"$TMP/hidden" 2>"$TMP/err" ||
+        fail "sy pick --hide $sel: $(cat "$TMP/err")"
+    read -r hid _ <<<"$(node_of "$TMP/hidden")"
+    [ "${hid:-none}" != "$nid" ] || fail "--hide $sel: the pick still names node $nid"
+done
+for opt in --select --isolate; do
+    "$SY" pick demo 32 30 -b whitted -w 64 -h 48 $opt "$nid" >"$TMP/kept" 2>"$TMP/err" || fail "sy pick $opt $nid: $(cat "$TMP/err")"
+    read -r kid _ <<<"$(node_of "$TMP/kept")"
+    [ "${kid:-none}" = "$nid" ] || fail "$opt $nid: the pick names ${kid:-nothing}, not node $nid"
+done
+expect_status 1 "--hide no-such-node: no such node" demo 32 30 -b whitted -w 64 -h 48 --hide no-such-node
+expect_status 1 "--select 999999: no such node" demo 32 30 -b whitted -w 64 -h 48 --select 999999
+expect_status 2 "--isolate" demo 32 30 -b whitted -w 64 -h 48 --isolate ""
+# the ID channels of --aov name the node a pick names
+"$SY" render demo -b pathtracer -w 64 -h 48 --spp 1 --aov --select "$nid" -o "$TMP/aov.exr" 2>"$TMP/err" ||
+    fail "sy render --aov: $(cat "$TMP/err")"
+"$SY" info "$TMP/aov.exr" >"$TMP/aov.json" 2>&1
+grep -q '"object_id"' "$TMP/aov.json" && grep -q '"instance_id"' "$TMP/aov.json" ||
+    fail "the --aov EXR has no object_id / instance_id channels: $(cat "$TMP/aov.json")"
 
 SCENE=$DATA/gltf/DamagedHelmet/glTF/DamagedHelmet.gltf
 if [ ! -f "$SCENE" ]; then

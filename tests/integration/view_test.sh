@@ -7,7 +7,8 @@
 # --keys and checked in the heads-up line after each key; the start view of --look-at and --fov
 # matches sy render's; '.' steps the scene clock and space plays it (BoxAnimated from the test data,
 # the 4th argument); the frame-time governor answers a back-end
-# switch with a moving frame and settles at full size. Skipped (77) when xvfb-run is not
+# switch with a moving frame and settles at full size; the visibility keys (H, I, U) on a node
+# selected with --select. Skipped (77) when xvfb-run is not
 # installed or the viewer was built without GLFW.
 set -u
 . "$(dirname "$0")/view_setup.sh"
@@ -137,4 +138,17 @@ if [ -f "$BOX" ]; then
 else
     echo "integration_view: the scene clock part skipped: $BOX is absent"
 fi
+# visibility keys (issue 37): with the demo's centre node selected (--select), I isolates it, U shows
+# every node, H hides the selection: the heads-up line says so and the isolated view is sy render's
+NID=$("$SY" pick demo 80 45 -b whitted -w 160 -h 90 | tr -d '\n' | sed -n 's/.*"node": {"id": \([0-9]*\).*/\1/p')
+[ -n "$NID" ] || { echo "FAIL: no node at the demo's centre"; exit 1; }
+timeout 300 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w 160 -h 90 --select "$NID" \
+    --keys 'UHUI' --frames 3 --screenshot "$W/view_iso.png" >"$W/view_vis.out" 2>"$W/view_vis.err" || {
+    echo "FAIL: sy view --select --keys UHUI: $(cat "$W/view_vis.err")"; exit 1; }
+for want in "after key U:.*every node shown | 1 selected" "after key H:.*hid 1 node | 1 selected" \
+            "after key I:.*isolated 1 node | 1 selected"; do
+    grep -q "$want" "$W/view_vis.out" || { echo "FAIL: '$want' not in: $(cat "$W/view_vis.out")"; exit 1; }
+done
+"$SY" render demo -b whitted -w 160 -h 90 --tonemap aces --select "$NID" --isolate "$NID" -o "$W/render_iso.png" >/dev/null || exit 1
+"$CMP" "$W/view_iso.png" "$W/render_iso.png" 2 50 || { echo "FAIL: the isolated view is not sy render --isolate"; exit 1; }
 echo "integration_view: ok"

@@ -1996,7 +1996,11 @@ PyMODINIT_FUNC PyInit__switchyard(void)
         PyModule_AddIntConstant(m, "CAP_COVERAGE", SY_CAP_COVERAGE) ||
         PyModule_AddIntConstant(m, "TYPE_NODE", SY_TYPE_NODE) || PyModule_AddIntConstant(m, "TYPE_MESH", SY_TYPE_MESH) ||
         PyModule_AddIntConstant(m, "TYPE_MATERIAL", SY_TYPE_MATERIAL) ||
-        PyModule_AddIntConstant(m, "TYPE_LIGHT", SY_TYPE_LIGHT) || PyModule_AddIntConstant(m, "TYPE_CAMERA", SY_TYPE_CAMERA)) {
+        PyModule_AddIntConstant(m, "TYPE_LIGHT", SY_TYPE_LIGHT) || PyModule_AddIntConstant(m, "TYPE_CAMERA", SY_TYPE_CAMERA) ||
+        PyModule_AddIntConstant(m, "NODE_VISIBLE", SY_NODE_VISIBLE) ||
+        PyModule_AddIntConstant(m, "NODE_STATIC", SY_NODE_STATIC) ||
+        PyModule_AddIntConstant(m, "NODE_ANIMATED", SY_NODE_ANIMATED) ||
+        PyModule_AddIntConstant(m, "NODE_SELECTED", SY_NODE_SELECTED)) {
         Py_XDECREF(window_type);
         Py_XDECREF(node_type);
         Py_DECREF(m);

@@ -159,6 +159,9 @@ def backends():
 
 
 CAP_DEPTH, CAP_PROGRESSIVE, CAP_AOVS = _c.CAP_DEPTH, _c.CAP_PROGRESSIVE, _c.CAP_AOVS
+# Node.flags bits: shown (a hidden node's subtree is not drawn, hit or picked), hints, selected
+# (highlighted alike by every back-end: a tint and an outline, mediators/sy_highlight.h)
+NODE_VISIBLE, NODE_STATIC, NODE_ANIMATED, NODE_SELECTED = _c.NODE_VISIBLE, _c.NODE_STATIC, _c.NODE_ANIMATED, _c.NODE_SELECTED
 
 # ---------------------------------------------------------------- scene objects
 

@@ -15,6 +15,10 @@ TYPE_MESH: int
 TYPE_MATERIAL: int
 TYPE_LIGHT: int
 TYPE_CAMERA: int
+NODE_VISIBLE: int
+NODE_STATIC: int
+NODE_ANIMATED: int
+NODE_SELECTED: int
 
 class _Buffer:
     """float32 pixels owned by the library's allocation (buffer protocol, no copy)."""
