@@ -683,9 +683,9 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
         return r;
     }
     for (const char *k = args->keys; k && *k; ++k)
-        if (!isalnum((unsigned char)*k) && *k != '[' && *k != ']' && *k != ' ' && *k != '.')
+        if (!isalnum((unsigned char)*k) && *k != '[' && *k != ']' && *k != ' ' && *k != '.' && *k != '*')
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "view: --keys: '%c' is not a key (letters, digits, [ ], space and .)", *k);
+                                "view: --keys: '%c' is not a key (letters, digits, [ ], space, . and * for a click)", *k);
     if (!glfwInit()) {
         const char *desc = NULL;
         glfwGetError(&desc);
@@ -800,7 +800,15 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
         }
         if (answered && keys && *keys) { /* the next scripted key, through the keyboard handler */
             key_last = *keys++;
-            on_key(win, toupper((unsigned char)key_last), 0, GLFW_PRESS, 0);
+            if (key_last == '*') { /* a scripted click at the window's centre: pick and select there */
+                pthread_mutex_lock(&v.mu);
+                v.pick = true, v.pick_add = false, v.pick_x = fbw / 2.0, v.pick_y = fbh / 2.0;
+                v.req_version++;
+                pthread_cond_signal(&v.cv);
+                pthread_mutex_unlock(&v.mu);
+            } else {
+                on_key(win, toupper((unsigned char)key_last), 0, GLFW_PRESS, 0);
+            }
             pthread_mutex_lock(&v.mu);
             key_req = v.req_version;
             pthread_mutex_unlock(&v.mu);

@@ -149,6 +149,14 @@ for want in "after key U:.*every node shown | 1 selected" "after key H:.*hid 1 n
             "after key I:.*isolated 1 node | 1 selected"; do
     grep -q "$want" "$W/view_vis.out" || { echo "FAIL: '$want' not in: $(cat "$W/view_vis.out")"; exit 1; }
 done
+# a click (scripted: '*' clicks the window's centre) picks and selects the node under it
+timeout 300 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w 160 -h 90 --keys '*' --frames 3 \
+    --screenshot "$W/view_click.png" >"$W/view_click.out" 2>"$W/view_click.err" || {
+    echo "FAIL: sy view --keys '*': $(cat "$W/view_click.err")"; exit 1; }
+grep -q "after key \*:.*picked .*(node $NID, triangle [0-9]*) | 1 selected" "$W/view_click.out" || {
+    echo "FAIL: the click did not pick and select node $NID: $(cat "$W/view_click.out")"; exit 1; }
+"$SY" render demo -b whitted -w 160 -h 90 --tonemap aces --select "$NID" -o "$W/render_sel.png" >/dev/null || exit 1
+"$CMP" "$W/view_click.png" "$W/render_sel.png" 2 50 || { echo "FAIL: the clicked view is not sy render --select"; exit 1; }
 "$SY" render demo -b whitted -w 160 -h 90 --tonemap aces --select "$NID" --isolate "$NID" -o "$W/render_iso.png" >/dev/null || exit 1
 "$CMP" "$W/view_iso.png" "$W/render_iso.png" 2 50 || { echo "FAIL: the isolated view is not sy render --isolate"; exit 1; }
 echo "integration_view: ok"
