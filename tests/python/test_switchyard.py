@@ -535,6 +535,26 @@ def test_notebook_block_of_the_docs_runs_as_written():
     assert img._repr_png_().startswith(b"\x89PNG")
 
 
+@needs_whitted
+@needs_pt
+def test_hidden_and_selected_nodes_and_the_id_aovs():
+    """Node.flags: clearing NODE_VISIBLE hides a node (its pixels change), NODE_SELECTED highlights one
+    (orange tint); the path tracer's AOVs hold object_id / instance_id planes naming scene nodes."""
+    s = switchyard.load("demo")
+    ns = [n for n in s.nodes if n.mesh is not None]
+    plain = s.render(backend="whitted", width=96, height=64)
+    ns[0].flags = ns[0].flags | switchyard.NODE_SELECTED
+    ns[1].flags = ns[1].flags & ~switchyard.NODE_VISIBLE
+    s.commit()
+    changed = s.render(backend="whitted", width=96, height=64)
+    assert float(numpy.abs(plain - changed).mean()) > 0.01
+    _, aovs = s.render(backend="pathtracer", width=96, height=64, spp=1, aovs=True)
+    ids = {int(v) for v in numpy.unique(aovs["object_id"])} - {0}
+    assert aovs["instance_id"].shape[:2] == (64, 96)
+    assert ids and ids <= {n.id for n in s.nodes}
+    assert ns[1].id not in ids  # hidden: never under a pixel
+
+
 def test_type_stubs_name_every_public_name():
     """switchyard/__init__.pyi declares every name of __all__, and every public method of the classes."""
     import ast
