@@ -156,6 +156,21 @@ typedef struct sy_rt_stats {
      * (sy_rt_mesh_desc.release), and Embree's own allocations now and at their peak (geometry
      * buffers, BVHs, build scratch; counted by rtcSetDeviceMemoryMonitorFunction) */
     uint64_t mesh_bytes, shared_bytes, embree_bytes, embree_peak_bytes; /** @} */
+    /** @{ the light tree (sy_rt_render_desc.light_tree), built by the first render that uses it
+     * after the lights changed: lights in it (area triangles + punctual lights), bytes it holds
+     * (counted with Embree's against max_memory_bytes), seconds of its last full build and of its
+     * last refit (lights moved or changed power, the same set), lights that refit changed, full
+     * builds and refits so far */
+    uint32_t light_tree_lights;
+    uint64_t light_tree_bytes;
+    double light_tree_build_seconds, light_tree_refit_seconds;
+    uint32_t light_tree_refit_changed;
+    uint64_t light_tree_builds, light_tree_refits; /** @} */
+    /** Emitters the light sampling leaves out (zero-area triangles; lights of zero, negative or
+     * non-finite power), counted since the device was created, and the message of the last one
+     * (naming the light; "" when none) */
+    uint32_t light_warnings;
+    char light_warning[256];
 } sy_rt_stats;
 /** Fills *out with the device's live object counts and version. */
 void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out);
@@ -497,6 +512,21 @@ typedef bool (*sy_rt_progress_fn)(const sy_rt_progress *progress, void *user_dat
 typedef struct sy_rt_accum sy_rt_accum;
 
 /** What to render: integrator, image and rectangle, sampling settings. */
+/** Light selection of the integrators. OFF: the alias table over the emissive triangles by power,
+ * punctual lights uniformly (PATHTRACER) or every punctual light at every point (WHITTED). ON: the
+ * light tree (backends/rt/sy_rt_lighttree.h), one hierarchy over emissive triangles and punctual
+ * lights, each light picked in proportion to its estimated contribution at the shading point
+ * (WHITTED then samples punctual lights too, area_light_samples of both per point, instead of the
+ * closed-form area light). AUTO: ON from SY_RT_LIGHT_TREE_AUTO_MIN lights (emissive triangles +
+ * punctual lights), OFF below. */
+typedef enum sy_rt_light_tree_mode {
+    SY_RT_LIGHT_TREE_AUTO = 0,
+    SY_RT_LIGHT_TREE_ON = 1,
+    SY_RT_LIGHT_TREE_OFF = 2
+} sy_rt_light_tree_mode;
+/** AUTO's threshold (lights). */
+#define SY_RT_LIGHT_TREE_AUTO_MIN 64u
+
 typedef struct sy_rt_render_desc {
     sy_rt_integrator integrator; /**< which integrator runs */
     /** @{ the full image the camera window maps onto */
@@ -528,6 +558,8 @@ typedef struct sy_rt_render_desc {
     uint32_t samples;                   /**< samples per pixel to add in this call; 0 = 1 */
     struct sy_rt_pt_record *records;    /**< optional: width * height path records (see >>path records);
                                          * NULL = none (no cost) */
+    sy_rt_light_tree_mode light_tree;   /**< WHITTED and PATHTRACER: light selection (see
+                                         * sy_rt_light_tree_mode); 0 = AUTO */
     struct sy_rt_ray_log *ray_log;      /**< optional: every ray the frame casts (extension and shadow
                                          * rays, with Embree's answers) is appended to this log, for
                                          * the "distance to the limit" benchmark (backends/rt/

@@ -2,6 +2,8 @@
  * Above the scene and texture modules (it releases their objects with the device); the handle pools
  * and error helpers they all use are sy_rt_base.c. */
 #include "sy_rt_device.h"
+#include "sy_rt_lights.h"
+#include "sy_rt_lighttree.h"
 #include "sy_rt_scene.h"
 #include "sy_rt_texture.h"
 
@@ -38,7 +40,8 @@ static bool embree_memory_monitor(void *user, ssize_t bytes, bool post)
     (void)post;
     sy_rt_device *dev = user;
     if (bytes > 0 && dev->max_memory > 0 &&
-        atomic_load_explicit(&dev->embree_bytes, memory_order_relaxed) + (int64_t)bytes > dev->max_memory)
+        atomic_load_explicit(&dev->embree_bytes, memory_order_relaxed) + (int64_t)bytes +
+                (int64_t)sy_rt_light_tree_bytes(dev) > dev->max_memory) /* the light tree counts too */
         return false; /* Embree reports RTC_ERROR_OUT_OF_MEMORY */
     int64_t now = atomic_fetch_add_explicit(&dev->embree_bytes, (int64_t)bytes, memory_order_relaxed) + (int64_t)bytes;
     int64_t peak = atomic_load_explicit(&dev->embree_peak, memory_order_relaxed);
@@ -169,6 +172,16 @@ void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out)
     int64_t now = atomic_load(&((sy_rt_device *)dev)->embree_bytes), peak = atomic_load(&((sy_rt_device *)dev)->embree_peak);
     out->embree_bytes = now > 0 ? (uint64_t)now : 0u;
     out->embree_peak_bytes = peak > 0 ? (uint64_t)peak : 0u;
+    const sy_rt_lighttree *lt = dev->light_tree;
+    out->light_tree_lights = lt ? lt->light_count - lt->skipped : 0u;
+    out->light_tree_bytes = sy_rt_light_tree_bytes(dev);
+    out->light_tree_build_seconds = dev->light_tree_build_seconds;
+    out->light_tree_refit_seconds = dev->light_tree_refit_seconds;
+    out->light_tree_refit_changed = dev->light_tree_refit_changed;
+    out->light_tree_builds = dev->light_tree_builds;
+    out->light_tree_refits = dev->light_tree_refits;
+    out->light_warnings = dev->light_warnings;
+    memcpy(out->light_warning, dev->light_warning, sizeof out->light_warning);
 }
 
 sy_rt_result sy_rt_set_background(sy_rt_device *dev, const sy_rt_background *bg)

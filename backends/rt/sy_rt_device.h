@@ -66,6 +66,8 @@ typedef struct sy_rt_instance_data {
     bool stale;                /* the top scene's copy is filtered out; `twin` in dev->dyn shows the instance */
     RTCGeometry twin;          /* instance of the mesh's BLAS in dev->dyn, or NULL */
     unsigned twin_id;          /* its geometry id in dev->dyn */
+    uint32_t area_base;        /* committed emissive instance: its triangles' entries in dev->area_map
+                                * start here (UINT32_MAX: none) */
 } sy_rt_instance_data;
 
 typedef struct sy_rt_light_data {
@@ -74,6 +76,7 @@ typedef struct sy_rt_light_data {
 
 /* A committed punctual light, precomputed for shading. */
 typedef struct sy_rt_punctual {
+    uint32_t handle;    /* its sy_rt_light id (messages) */
     sy_rt_light_type type;
     sy_rt_v3 radiant;   /* color * intensity */
     sy_rt_v3 position;
@@ -159,6 +162,19 @@ struct sy_rt_device {
     /* Vose alias table over the same triangles and weights (path tracer: O(1) selection) */
     float *area_alias_prob;
     uint32_t *area_alias_idx;
+    /* emissive instance triangle -> its index in area (UINT32_MAX: degenerate, left out), from
+     * instance->area_base; what a BSDF ray's emitter hit needs for the light tree's pdf */
+    uint32_t *area_map;
+    /* the light tree (sy_rt_lighttree.h) over area (indices 0 .. area_count - 1) then punctual
+     * (area_count + i): built by sy_rt_light_tree_ensure when a render uses it; light_tree_dirty
+     * after the lights changed (refit when the set is the same) */
+    struct sy_rt_lighttree *light_tree;
+    bool light_tree_dirty;
+    double light_tree_build_seconds, light_tree_refit_seconds;
+    uint32_t light_tree_refit_changed;
+    uint64_t light_tree_builds, light_tree_refits;
+    uint32_t light_warnings;     /* emitters left out (sy_rt_stats) */
+    char light_warning[256];
 
     /* committed: some visible instance's material lets shadow rays through in part (alpha blend;
      * transmission); without one, shadow rays are plain occlusion queries (sy_rt_shadow.h) */

@@ -2,10 +2,13 @@
  * sy_rt_set_environment, the background seen by camera rays (see sy_rt_lights.h). */
 #include "sy_rt_lights.h"
 #include "sy_rt_envfilter.h"
+#include "sy_rt_lighttree.h"
 #include "sy_rt_texture.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #define PI_F 3.14159265358979f
 
@@ -309,4 +312,135 @@ bool sy_rt_punctual_incident(const sy_rt_punctual *l, sy_rt_v3 p, sy_rt_v3 *wi, 
     *e = v3_scale(l->radiant, att);
     *tmax = d - sy_rt_ray_eps(p);
     return true;
+}
+
+/* >>light tree glue */
+static double lt_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+bool sy_rt_light_tree_wanted(const sy_rt_device *dev, sy_rt_light_tree_mode mode)
+{
+    uint64_t n = (uint64_t)dev->area_count + dev->punctual_count;
+    if (n == 0 || mode == SY_RT_LIGHT_TREE_OFF) return false;
+    return mode == SY_RT_LIGHT_TREE_ON || n >= SY_RT_LIGHT_TREE_AUTO_MIN;
+}
+
+const struct sy_rt_lighttree *sy_rt_light_tree_get(const sy_rt_device *dev, sy_rt_light_tree_mode mode)
+{
+    return dev->light_tree && !dev->light_tree_dirty && sy_rt_light_tree_wanted(dev, mode) ? dev->light_tree : NULL;
+}
+
+size_t sy_rt_light_tree_bytes(const sy_rt_device *dev) { return dev->light_tree ? dev->light_tree->bytes : 0u; }
+
+void sy_rt_light_tree_free(sy_rt_device *dev)
+{
+    if (dev->light_tree) sy_rt_lighttree_free(dev->light_tree);
+    free(dev->light_tree);
+    dev->light_tree = NULL;
+}
+
+/* The tree's record of area triangle a and of punctual light l. */
+static void area_record(const sy_rt_area_tri *a, sy_rt_lt_light *o)
+{
+    memset(o, 0, sizeof *o);
+    sy_rt_v3 p1 = v3_add(a->p0, a->e1), p2 = v3_add(a->p0, a->e2);
+    o->b.lo[0] = fminf(a->p0.x, fminf(p1.x, p2.x)), o->b.hi[0] = fmaxf(a->p0.x, fmaxf(p1.x, p2.x));
+    o->b.lo[1] = fminf(a->p0.y, fminf(p1.y, p2.y)), o->b.hi[1] = fmaxf(a->p0.y, fmaxf(p1.y, p2.y));
+    o->b.lo[2] = fminf(a->p0.z, fminf(p1.z, p2.z)), o->b.hi[2] = fmaxf(a->p0.z, fmaxf(p1.z, p2.z));
+    o->b.axis[0] = a->normal.x, o->b.axis[1] = a->normal.y, o->b.axis[2] = a->normal.z;
+    o->b.theta_o = a->double_sided ? PI_F : 0.0f;
+    o->b.theta_e = 0.5f * PI_F;
+    float lum = v3_luminance(a->emission);
+    if (!(lum > 0.0f)) lum = fmaxf(a->emission.x, fmaxf(a->emission.y, a->emission.z));
+    o->b.power = lum * a->area;
+}
+
+static void punctual_record(const sy_rt_punctual *l, sy_rt_lt_light *o)
+{
+    memset(o, 0, sizeof *o);
+    float lum = v3_luminance(l->radiant);
+    if (!(lum > 0.0f)) lum = fmaxf(l->radiant.x, fmaxf(l->radiant.y, l->radiant.z));
+    o->b.power = lum;
+    o->b.lo[0] = o->b.hi[0] = l->position.x;
+    o->b.lo[1] = o->b.hi[1] = l->position.y;
+    o->b.lo[2] = o->b.hi[2] = l->position.z;
+    o->b.axis[0] = l->direction.x, o->b.axis[1] = l->direction.y, o->b.axis[2] = l->direction.z;
+    if (l->type == SY_RT_LIGHT_DIRECTIONAL) {
+        o->distant = true;
+    } else if (l->type == SY_RT_LIGHT_SPOT) { /* attenuation > 0 inside the outer cone: cos > -offset / scale */
+        o->b.theta_o = acosf(sy_rt_clampf(-l->cone_offset / l->cone_scale, -1.0f, 1.0f)) + 1e-3f;
+        o->b.theta_e = 0.0f;
+        if (o->b.theta_o >= PI_F) o->b.theta_o = PI_F, o->b.theta_e = 0.5f * PI_F;
+    } else {
+        o->b.axis[0] = 0.0f, o->b.axis[1] = 0.0f, o->b.axis[2] = 1.0f;
+        o->b.theta_o = PI_F;
+        o->b.theta_e = 0.5f * PI_F;
+    }
+}
+
+sy_rt_result sy_rt_light_tree_ensure(sy_rt_device *dev, sy_rt_light_tree_mode mode)
+{
+    if (!sy_rt_light_tree_wanted(dev, mode) || (dev->light_tree && !dev->light_tree_dirty)) return SY_RT_OK;
+    uint64_t n64 = (uint64_t)dev->area_count + dev->punctual_count;
+    if (n64 > UINT32_MAX - 1u) return sy_rt_fail(dev, SY_RT_ERROR_LIMIT, "light tree: %llu lights exceed the limit",
+                                                 (unsigned long long)n64);
+    uint32_t n = (uint32_t)n64;
+    sy_rt_lt_light *rec = malloc((size_t)n * sizeof *rec);
+    if (!rec) return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY, "light tree: out of memory (%u lights)", n);
+    double t0 = lt_seconds();
+    for (uint32_t i = 0; i < dev->area_count; ++i) area_record(&dev->area[i], &rec[i]);
+    for (uint32_t i = 0; i < dev->punctual_count; ++i) punctual_record(&dev->punctual[i], &rec[dev->area_count + i]);
+    uint32_t changed = 0;
+    if (dev->light_tree && sy_rt_lighttree_refit(dev->light_tree, rec, n, &changed)) {
+        dev->light_tree_refit_seconds = lt_seconds() - t0;
+        dev->light_tree_refit_changed = changed;
+        dev->light_tree_refits++;
+        dev->light_tree_dirty = false;
+        free(rec);
+        return SY_RT_OK;
+    }
+    sy_rt_light_tree_free(dev);
+    sy_rt_lighttree *t = calloc(1, sizeof *t);
+    if (!t) {
+        free(rec);
+        return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY, "light tree: out of memory (%u lights)", n);
+    }
+    size_t left = 0;
+    if (dev->max_memory > 0) {
+        int64_t l = dev->max_memory - atomic_load(&((sy_rt_device *)dev)->embree_bytes);
+        left = l > 0 ? (size_t)l : 1u;
+    }
+    bool oom = false;
+    bool ok = sy_rt_lighttree_build(t, rec, n, left, &oom);
+    free(rec);
+    if (!ok) {
+        size_t need = t->bytes;
+        sy_rt_lighttree_free(t);
+        free(t);
+        if (oom) return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY, "light tree: out of memory (%u lights)", n);
+        return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY,
+                          "light tree: %u lights need %.1f MB, more than the %.1f MB left of the device's memory limit",
+                          n, (double)need / 1048576.0, (double)left / 1048576.0);
+    }
+    dev->light_tree_build_seconds = lt_seconds() - t0;
+    dev->light_tree_builds++;
+    if (t->skipped) {
+        char msg[200];
+        uint32_t i = t->first_skipped;
+        if (i < dev->area_count)
+            snprintf(msg, sizeof msg, "light tree: emissive triangle %u of instance 0x%08x has no usable power: left out",
+                     dev->area[i].prim, dev->area[i].inst->handle);
+        else
+            snprintf(msg, sizeof msg, "light tree: light 0x%08x has zero, negative or non-finite power: left out",
+                     dev->punctual[i - dev->area_count].handle);
+        dev->light_warnings += t->skipped;
+        snprintf(dev->light_warning, sizeof dev->light_warning, "%s%s", msg, t->skipped > 1u ? " (and others)" : "");
+    }
+    dev->light_tree = t;
+    dev->light_tree_dirty = false;
+    return SY_RT_OK;
 }

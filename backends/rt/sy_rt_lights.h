@@ -61,4 +61,30 @@ float sy_rt_area_pdf(const sy_rt_device *dev, const sy_rt_instance_data *inst);
 /* The power proxy of an emissive material (luminance of the factor, or its largest channel). */
 float sy_rt_emission_weight(const sy_rt_material_data *mat);
 
+/* >>light tree glue (sy_rt_lighttree.h): the device's tree over its area triangles (light i) and
+ * punctual lights (light area_count + i). */
+/* Whether a render with this mode selects lights with the tree (AUTO: SY_RT_LIGHT_TREE_AUTO_MIN
+ * lights or more). */
+bool sy_rt_light_tree_wanted(const sy_rt_device *dev, sy_rt_light_tree_mode mode);
+/* Builds (or, when the same lights only moved or changed power, refits) the tree when mode wants
+ * it and the lights changed since; the memory it needs counts against the device's max_memory.
+ * Emitters the tree leaves out are reported in sy_rt_stats (light_warnings). */
+sy_rt_result sy_rt_light_tree_ensure(sy_rt_device *dev, sy_rt_light_tree_mode mode);
+/* The tree a render with this mode uses, or NULL (OFF, AUTO below the threshold, not built). */
+const struct sy_rt_lighttree *sy_rt_light_tree_get(const sy_rt_device *dev, sy_rt_light_tree_mode mode);
+void sy_rt_light_tree_free(sy_rt_device *dev);
+size_t sy_rt_light_tree_bytes(const sy_rt_device *dev);
+/* The area-light index of triangle prim of an emissive instance (UINT32_MAX: none). */
+static inline uint32_t sy_rt_area_index(const sy_rt_device *dev, const sy_rt_instance_data *in, uint32_t prim)
+{
+    return dev->area_map && in->area_base != UINT32_MAX && dev->area_count ? dev->area_map[in->area_base + prim]
+                                                                           : UINT32_MAX;
+}
+/* The normal the tree weighs the surface cosine with: the facing geometric normal, none (zero) for
+ * a BSDF that transmits (light from behind counts). */
+static inline sy_rt_v3 sy_rt_light_tree_normal(sy_rt_v3 ng_facing, float q_trans)
+{
+    return q_trans > 0.0f ? v3(0.0f, 0.0f, 0.0f) : ng_facing;
+}
+
 #endif /* SY_RT_LIGHTS_H */

@@ -32,6 +32,7 @@
 #include "sy_rt_accum.h"
 #include "sy_rt_bsdf.h"
 #include "sy_rt_lights.h"
+#include "sy_rt_lighttree.h"
 #include "sy_rt_raylog.h"
 #include "sy_rt_sampler.h"
 #include "sy_rt_shadow.h"
@@ -48,6 +49,7 @@ typedef struct pt_job {
     sy_rt_env env;
     uint32_t categories;     /* light categories present */
     bool has_area, has_env, has_punctual;
+    const sy_rt_lighttree *lt; /* light_tree: area and punctual lights are one category, picked by the tree */
 } pt_job;
 
 typedef struct pt_ctx {
@@ -89,15 +91,35 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
     if (cat >= j->categories) cat = j->categories - 1u;
     float ur = sy_rt_clampf(x - (float)cat, 0.0f, 0.99999994f);
     float p_cat = 1.0f / (float)j->categories;
-    /* category order: area, environment, punctual (only those present) */
+    /* category order: area, environment, punctual (only those present); with the light tree:
+     * the tree (area and punctual), environment */
     int kind = -1;
     uint32_t k = 0;
-    if (j->has_area && k++ == cat) kind = 0;
+    if (j->lt) kind = cat == 0u ? 3 : 1;
+    else if (j->has_area && k++ == cat) kind = 0;
     else if (j->has_env && k++ == cat) kind = 1;
     else if (j->has_punctual) kind = 2;
     sy_rt_v3 p_off = v3_madd(s->p, b->ng, sy_rt_ray_eps(s->p));
-    if (kind == 0) {
-        const sy_rt_area_tri *t = &dev->area[sy_rt_alias_pick(dev, ur)];
+    float p_tree = 1.0f; /* kind 3: the tree's selection probability and the triangle it picked */
+    uint32_t tree_tri = 0;
+    if (kind == 3) {
+        uint32_t li = sy_rt_lighttree_pick(j->lt, s->p, sy_rt_light_tree_normal(b->ng, b->q_trans), ur, &p_tree);
+        if (li == SY_RT_LT_NONE || !(p_tree > 0.0f)) return zero;
+        if (li >= dev->area_count) { /* a punctual light */
+            sy_rt_v3 wi, e;
+            float tmax;
+            if (!sy_rt_punctual_incident(&dev->punctual[li - dev->area_count], s->p, &wi, &e, &tmax)) return zero;
+            float pdf_b;
+            sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
+            if (v3_is_zero(f)) return zero;
+            sy_rt_v3 tr = unoccluded(c, p_off, wi, tmax, true);
+            if (v3_is_zero(tr)) return zero;
+            return v3_scale(v3_mul(f, v3_mul(tr, e)), 1.0f / (p_tree * p_cat));
+        }
+        tree_tri = li; /* a triangle: below */
+    }
+    if (kind == 0 || kind == 3) {
+        const sy_rt_area_tri *t = &dev->area[kind == 3 ? tree_tri : sy_rt_alias_pick(dev, ur)];
         float su = sqrtf(u[1]), bu = su * (1.0f - u[2]), bv = su * u[2];
         sy_rt_v3 q = v3_add(t->p0, v3_add(v3_scale(t->e1, bu), v3_scale(t->e2, bv)));
         sy_rt_v3 wi = v3_sub(q, s->p);
@@ -111,7 +133,7 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
         float pdf_b;
         sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
         if (v3_is_zero(f)) return zero;
-        float pdf_l = t->pdf_select * d2 / cos_l * p_cat;
+        float pdf_l = (kind == 3 ? p_tree / t->area : t->pdf_select) * d2 / cos_l * p_cat;
         if (!(pdf_l > 0.0f)) return zero;
         sy_rt_v3 sdir;
         float tmax;
@@ -194,6 +216,7 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
     sy_rt_v3 beta = v3(1.0f, 1.0f, 1.0f), L = v3(0.0f, 0.0f, 0.0f), direct = L;
     bool specular = true, features = false, first = true;
     float pdf_prev = 0.0f;
+    sy_rt_v3 prev_p = v3(0.0f, 0.0f, 0.0f), prev_n = prev_p; /* light tree: the previous vertex's point and normal */
     uint32_t bounce = 0, crossings = 0;
     out->alpha = 0.0f;
     out->depth = INFINITY;
@@ -264,7 +287,15 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
             float w = 1.0f;
             if (!specular) {
                 float dist = rh.ray.tfar, cos_l = fabsf(v3_dot(s.ng, d));
-                float pdf_l = cos_l > 0.0f ? sy_rt_area_pdf(dev, in) * dist * dist / cos_l * p_area_sel : 0.0f;
+                float pdf_a = 0.0f; /* area-measure pdf of light sampling at this point */
+                if (!j->lt) {
+                    pdf_a = sy_rt_area_pdf(dev, in);
+                } else {
+                    uint32_t ai = sy_rt_area_index(dev, in, rh.hit.primID);
+                    if (ai != UINT32_MAX)
+                        pdf_a = sy_rt_lighttree_pdf(j->lt, prev_p, prev_n, ai) / dev->area[ai].area;
+                }
+                float pdf_l = cos_l > 0.0f ? pdf_a * dist * dist / cos_l * p_area_sel : 0.0f;
                 w = power_heuristic(pdf_prev, pdf_l);
             }
             sy_rt_v3 contrib = v3_scale(v3_mul(beta, s.emission), w);
@@ -316,6 +347,7 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
         beta = v3_mul(beta, bs.weight);
         specular = bs.specular;
         pdf_prev = bs.pdf;
+        if (j->lt) prev_p = s.p, prev_n = sy_rt_light_tree_normal(b.ng, b.q_trans);
         bounce++;
         if (bounce >= 5u) {
             float q = sy_rt_minf(sqrtf(maxc(beta)), 1.0f);
@@ -396,7 +428,10 @@ sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_de
     j.has_area = f->dev->area_count > 0 && f->dev->area_alias_prob;
     j.has_env = j.env.mode != 0;
     j.has_punctual = f->dev->punctual_count > 0;
-    j.categories = (uint32_t)j.has_area + (uint32_t)j.has_env + (uint32_t)j.has_punctual;
+    j.lt = sy_rt_light_tree_get(f->dev, desc->light_tree);
+    if (j.lt && j.lt->node_count + j.lt->distant_count == 0) j.lt = NULL; /* every light left out */
+    j.categories = j.lt ? 1u + (uint32_t)j.has_env
+                        : (uint32_t)j.has_area + (uint32_t)j.has_env + (uint32_t)j.has_punctual;
     atomic_store(&acc->rays, 0u);
     sy_rt_result r = sy_rt_run_tiles(f, pt_tile, &j, desc->progress, desc->progress_user_data);
     if (r == SY_RT_ERROR_CANCELLED) {

@@ -3,6 +3,7 @@
  * Whitted, primary rays); the integrators build on the frame module and never call back here. */
 #include "sy_rt_envfilter.h"
 #include "sy_rt_frame.h"
+#include "sy_rt_lights.h"
 #include "sy_rt_pathtracer.h"
 #include "sy_rt_primary.h"
 #include "sy_rt_whitted.h"
@@ -23,6 +24,9 @@ sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera, const s
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: path records need the PATHTRACER integrator");
     if (desc->ray_log && desc->integrator != SY_RT_INTEGRATOR_PATHTRACER)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: a ray log needs the PATHTRACER integrator");
+    if ((desc->integrator == SY_RT_INTEGRATOR_PATHTRACER || desc->integrator == SY_RT_INTEGRATOR_WHITTED) &&
+        (r = sy_rt_light_tree_ensure(dev, desc->light_tree)) != SY_RT_OK) /* the light tree, when it is used */
+        return r;
     if (desc->integrator == SY_RT_INTEGRATOR_PATHTRACER) return sy_rt_pathtracer_render(&f, desc);
     if (desc->integrator == SY_RT_INTEGRATOR_COVERAGE)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: the coverage integrator writes ids: use sy_rt_coverage");

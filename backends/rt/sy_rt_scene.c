@@ -1007,43 +1007,62 @@ static void update_filters(sy_rt_device *dev)
     }
 }
 
+/* An emitter left out of light sampling: counted, and the message kept (sy_rt_stats). */
+static void light_warn(sy_rt_device *dev, uint32_t count, const char *what)
+{
+    if (!count) return;
+    dev->light_warnings += count;
+    snprintf(dev->light_warning, sizeof dev->light_warning, "%s%s", what,
+             count > 1u ? " (and others: see light_warnings)" : "");
+}
+
 static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
 {
     size_t n = 0;
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
-        const sy_rt_instance_data *in = dev->instances.items[i];
+        sy_rt_instance_data *in = dev->instances.items[i];
+        if (in) in->area_base = UINT32_MAX;
         if (in && instance_emissive(dev, in)) n += in->mesh->triangle_count;
     }
     free(dev->area);
     free(dev->area_cdf);
+    free(dev->area_map);
     dev->area = NULL;
     dev->area_cdf = NULL;
+    dev->area_map = NULL;
     dev->area_count = 0;
     dev->area_power = 0.0f;
+    dev->light_tree_dirty = true;
     (void)sy_rt_alias_build(dev, NULL, 0); /* frees the old table */
     if (n == 0) return SY_RT_OK;
     if (n > UINT32_MAX - 1u) return FAIL(SY_RT_ERROR_LIMIT, "commit: %zu emissive triangles exceed the limit", n);
     dev->area = malloc(n * sizeof *dev->area);
     double *cdf = malloc((n + 1u) * sizeof *cdf);
     dev->area_cdf = malloc((n + 1u) * sizeof *dev->area_cdf);
-    if (!dev->area || !cdf || !dev->area_cdf) {
+    dev->area_map = malloc(n * sizeof *dev->area_map);
+    if (!dev->area || !cdf || !dev->area_cdf || !dev->area_map) {
         free(cdf);
         free(dev->area);
         free(dev->area_cdf);
+        free(dev->area_map);
         dev->area = NULL;
         dev->area_cdf = NULL;
+        dev->area_map = NULL;
         return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "commit: cannot allocate the area-light list (%zu triangles)", n);
     }
-    uint32_t count = 0;
+    uint32_t count = 0, base = 0, degenerate = 0;
+    char first[200] = "";
     cdf[0] = 0.0;
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
-        const sy_rt_instance_data *in = dev->instances.items[i];
+        sy_rt_instance_data *in = dev->instances.items[i];
         if (!in || !instance_emissive(dev, in)) continue;
+        in->area_base = base;
         const sy_rt_material_data *mat = sy_rt_material_lookup(dev, in->material);
         float lum = v3_luminance(v3_load(mat->desc.emissive));
         if (!(lum > 0.0f)) lum = fmaxf(mat->desc.emissive[0], fmaxf(mat->desc.emissive[1], mat->desc.emissive[2]));
         const sy_rt_mesh_data *m = in->mesh;
         for (uint32_t t = 0; t < m->triangle_count; ++t) {
+            dev->area_map[base + t] = UINT32_MAX;
             const uint32_t *ix = m->indices + 3u * t;
             sy_rt_v3 o0 = v3_load(m->positions + 3u * ix[0]), o1 = v3_load(m->positions + 3u * ix[1]),
                      o2 = v3_load(m->positions + 3u * ix[2]);
@@ -1055,23 +1074,33 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
             a->area = 0.5f * v3_length(v3_cross(a->e1, a->e2));
             /* glTF front side: object-space winding normal through the normal matrix. */
             a->normal = v3_normalize(m3_mul(in->nrm, v3_cross(v3_sub(o1, o0), v3_sub(o2, o0))));
-            if (!(a->area > 0.0f) || v3_is_zero(a->normal)) continue; /* degenerate: emits nothing */
+            if (!(a->area > 0.0f) || v3_is_zero(a->normal)) { /* degenerate: emits nothing */
+                if (degenerate++ == 0)
+                    snprintf(first, sizeof first, "light sampling: emissive triangle %u of instance 0x%08x has zero area: "
+                             "left out", t, in->handle);
+                continue;
+            }
             a->inst = in;
             a->prim = t;
             a->double_sided = mat->desc.double_sided;
             a->emission = v3_load(mat->desc.emissive);
             a->textured = mat->desc.emissive_texture.texture.id != 0;
             cdf[count + 1] = cdf[count] + (double)lum * a->area * (a->double_sided ? 2.0 : 1.0);
+            dev->area_map[base + t] = count;
             count++;
         }
+        base += m->triangle_count;
     }
+    light_warn(dev, degenerate, first);
     double total = cdf[count];
     if (count == 0 || !(total > 0.0)) {
         free(cdf);
         free(dev->area);
         free(dev->area_cdf);
+        free(dev->area_map);
         dev->area = NULL;
         dev->area_cdf = NULL;
+        dev->area_map = NULL;
         return SY_RT_OK;
     }
     for (uint32_t i = 0; i <= count; ++i) dev->area_cdf[i] = (float)(cdf[i] / total);
@@ -1083,8 +1112,10 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
     if (!alias_ok) {
         free(dev->area);
         free(dev->area_cdf);
+        free(dev->area_map);
         dev->area = NULL;
         dev->area_cdf = NULL;
+        dev->area_map = NULL;
         return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "commit: cannot allocate the area-light alias table (%u triangles)", count);
     }
     dev->area_count = count;
@@ -1098,6 +1129,7 @@ static sy_rt_result rebuild_punctual(sy_rt_device *dev)
     free(dev->punctual);
     dev->punctual = NULL;
     dev->punctual_count = 0;
+    dev->light_tree_dirty = true;
     uint32_t n = dev->lights.live;
     if (n == 0) return SY_RT_OK;
     dev->punctual = malloc((size_t)n * sizeof *dev->punctual);
@@ -1107,6 +1139,7 @@ static sy_rt_result rebuild_punctual(sy_rt_device *dev)
         if (!l) continue;
         const sy_rt_light_desc *d = &l->desc;
         sy_rt_punctual *p = &dev->punctual[dev->punctual_count++];
+        p->handle = (dev->lights.gens[i] << SY_RT_INDEX_BITS) | (i + 1u);
         p->type = d->type;
         p->radiant = v3_scale(v3_load(d->color), d->intensity);
         p->position = v3_load(d->position);
@@ -1197,8 +1230,11 @@ void sy_rt_scene_release_all(sy_rt_device *dev)
     free(dev->area_cdf);
     free(dev->area_alias_prob);
     free(dev->area_alias_idx);
+    free(dev->area_map);
+    dev->area_map = NULL;
     dev->area_alias_prob = NULL;
     dev->area_alias_idx = NULL;
+    sy_rt_light_tree_free(dev);
     sy_rt_env_free(dev);
     dev->top_map = NULL;
     dev->punctual = NULL;

@@ -52,6 +52,7 @@
 #include "sy_rt_sheen.h"
 #include "sy_rt_iridescence.h"
 #include "sy_rt_lights.h"
+#include "sy_rt_lighttree.h"
 #include "sy_rt_sampler.h"
 #include "sy_rt_shadow.h"
 #include "sy_rt_surface.h"
@@ -90,6 +91,7 @@ typedef struct whitted_job {
     uint32_t spp_max; /* up to this many where the first spp disagree (adaptive refinement) */
     uint32_t n_area; /* area-light samples per shading point */
     uint32_t n_env;  /* environment samples per shading point (0 without an environment) */
+    const sy_rt_lighttree *lt; /* light_tree: area and punctual lights sampled together through it */
 } whitted_job;
 
 /* One camera sample's analytic direct light at its first hit, kept apart so that the pixel's
@@ -714,6 +716,58 @@ static sy_rt_v3 direct_env(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsd
     return v3_scale(sum, 1.0f / (float)n);
 }
 
+/* light_tree: n_area samples of area and punctual lights together, each light picked by the tree
+ * (its estimated contribution at the point), a uniform point on a triangle. */
+static sy_rt_v3 direct_tree(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, sy_rt_v3 p_off, sy_rt_v3 wo,
+                            uint32_t depth)
+{
+    const sy_rt_device *dev = c->dev;
+    const sy_rt_lighttree *lt = c->job->lt;
+    uint32_t n = c->job->n_area;
+    sy_rt_v3 sum = v3(0.0f, 0.0f, 0.0f), nl = sy_rt_light_tree_normal(s->ng_facing, b->q_trans);
+    for (uint32_t i = 0; i < n; ++i) {
+        float u[4], p_sel;
+        light_u(c, SET_AREA(depth), n, i, u);
+        uint32_t li = sy_rt_lighttree_pick(lt, s->p, nl, u[0], &p_sel);
+        if (li == SY_RT_LT_NONE || !(p_sel > 0.0f)) continue;
+        sy_rt_v3 wi, le, q = s->p;
+        float g, tmax = INFINITY, bu = 0.0f, bv = 0.0f;
+        const sy_rt_area_tri *t = NULL;
+        if (li < dev->area_count) {
+            t = &dev->area[li];
+            float su = sqrtf(u[1]);
+            bu = su * (1.0f - u[2]), bv = su * u[2];
+            q = v3_add(t->p0, v3_add(v3_scale(t->e1, bu), v3_scale(t->e2, bv)));
+            wi = v3_sub(q, s->p);
+            float d2 = v3_dot(wi, wi);
+            if (!(d2 > 0.0f)) continue;
+            wi = v3_scale(wi, 1.0f / sqrtf(d2));
+            float cos_l = -v3_dot(t->normal, wi);
+            if (t->double_sided) cos_l = fabsf(cos_l);
+            if (cos_l <= 0.0f) continue;
+            le = t->emission;
+            g = cos_l / d2 * t->area / p_sel;
+        } else {
+            if (!sy_rt_punctual_incident(&dev->punctual[li - dev->area_count], s->p, &wi, &le, &tmax)) continue;
+            g = 1.0f / p_sel;
+        }
+        if (v3_dot(s->ns, wi) <= 0.0f || v3_dot(s->ng_facing, wi) <= 0.0f) continue;
+        float pdf_b;
+        sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b); /* includes cos_s */
+        if (v3_is_zero(f)) continue;
+        sy_rt_v3 sdir, tr;
+        if (t) {
+            tr = sy_rt_segment_to(p_off, q, &sdir, &tmax) ? shadow(c, p_off, sdir, tmax) : v3(1.0f, 1.0f, 1.0f);
+            if (!v3_is_zero(tr) && t->textured) le = sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv);
+        } else {
+            tr = shadow(c, p_off, wi, tmax);
+        }
+        if (v3_is_zero(tr)) continue;
+        sum = v3_add(sum, v3_scale(v3_mul(v3_mul(le, tr), f), g));
+    }
+    return v3_scale(sum, 1.0f / (float)n);
+}
+
 static sy_rt_v3 direct_punctual(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, sy_rt_v3 p_off, sy_rt_v3 wo)
 {
     const sy_rt_device *dev = c->dev;
@@ -776,11 +830,11 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
         sy_rt_bsdf b;
         sy_rt_bsdf_init(&b, s, wo);
         if (sy_rt_bsdf_evaluable(&b)) {
-            L = direct_punctual(c, s, &b, p_out, wo);
+            L = c->job->lt ? direct_tree(c, s, &b, p_out, wo, depth) : direct_punctual(c, s, &b, p_out, wo);
             amodel am;
             bool model = (c->job->area_analytic || c->job->env.filter) && amodel_init(&am, &b, wo);
             if (model && depth == 0u && c->cur) c->cur->inst = s->inst, c->cur->n = b.n, c->cur->w = 1.0f;
-            if (c->dev->area_count)
+            if (c->dev->area_count && !c->job->lt)
                 L = v3_add(L, model && c->job->area_analytic ? direct_area_analytic(c, s, &b, &am, p_out, wo, depth)
                                                              : direct_area(c, s, &b, p_out, wo, depth));
             if (c->job->n_env) L = v3_add(L, direct_env(c, s, &b, model && c->job->env.filter ? &am : NULL, p_out, wo, depth));
@@ -1003,7 +1057,9 @@ sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc 
     j->spp_max = j->spp > 1u && j->spp < REFINE_MAX_SPP ? (j->spp * REFINE_FACTOR < REFINE_MAX_SPP ? j->spp * REFINE_FACTOR : REFINE_MAX_SPP) : j->spp;
     j->n_area = (f->light_samples + j->spp - 1u) / j->spp;
     j->n_env = j->env.mode ? (desc->env_light_samples ? desc->env_light_samples : 4u) : 0u;
-    j->area_analytic = dev->area_count > 0 && dev->area_count <= ANALYTIC_MAX_TRIANGLES;
+    j->lt = sy_rt_light_tree_get(dev, desc->light_tree);
+    if (j->lt && j->lt->node_count + j->lt->distant_count == 0) j->lt = NULL; /* every light left out */
+    j->area_analytic = !j->lt && dev->area_count > 0 && dev->area_count <= ANALYTIC_MAX_TRIANGLES;
     for (uint32_t i = 0; j->area_analytic && i < dev->area_count; ++i)
         if (dev->area[i].textured) j->area_analytic = false;
     j->poly = NULL;

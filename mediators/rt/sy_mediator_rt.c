@@ -44,7 +44,10 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
                                                                           : &sy_rti_coverage_table;
     long max_depth = 8, light_samples = 16, threads = 0, spp = 1, env_samples = 4, max_memory_mb = 0; /* spp, env: Whitted's */
     double specular = 1.0;
+    uint32_t light_tree = 0;
     sy_result r;
+    if (integrator != SY_RT_INTEGRATOR_COVERAGE && (r = sy_param_enum(t, args->params, "light_tree", &light_tree, err)))
+        return r;
     if (integrator == SY_RT_INTEGRATOR_WHITTED && ((r = sy_param_int(t, args->params, "spp", &spp, err)) ||
                                                    (r = sy_param_int(t, args->params, "env_samples", &env_samples, err))))
         return r;
@@ -75,6 +78,7 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     st->integrator = integrator;
     st->max_depth = (uint32_t)max_depth;
     st->light_samples = (uint32_t)light_samples;
+    st->light_tree = light_tree;
     st->pixel_samples = (uint32_t)spp;
     st->env_samples = (uint32_t)env_samples;
     st->specular = (float)specular;

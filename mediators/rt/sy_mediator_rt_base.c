@@ -27,7 +27,13 @@
     {"max_memory_mb", SY_PARAM_INT, 0, 1 << 30, "0", NULL,                                                          \
      "MB Embree may hold (0: no limit of its own); a mesh whose BVH needs more than is left, or than the machine "  \
      "has available, is refused with both sizes", 0}
+/* light_tree: enum order is sy_rt_light_tree_mode's (auto, on, off) */
+#define RT_LIGHT_TREE_PARAM                                                                                         \
+    {"light_tree", SY_PARAM_ENUM, 0, 0, "auto", "auto|on|off",                                                     \
+     "light selection: on = the light tree (many lights), off = by power (alias table), auto = the tree from 64 "   \
+     "lights (emissive triangles + punctual lights)", 0}
 const sy_param_decl sy_rti_whitted_params[] = {
+    RT_LIGHT_TREE_PARAM,
     {"spp", SY_PARAM_INT, 1, 256, "4", NULL, "camera rays per pixel (stratified, jittered; 1 = the pixel centre)", 0},
     {"env_samples", SY_PARAM_INT, 1, 256, "4", NULL, "environment-light samples per shading point and pixel sample", 0},
     RT_COMMON_PARAMS("8", 64, "longest ray path: depth of mirror and glass recursion"),
@@ -38,6 +44,7 @@ const sy_param_decl sy_rti_coverage_params[] = {
 #define LIVE SY_PARAM_LIVE
 const sy_param_decl sy_rti_pathtracer_params[] = {
     RT_COMMON_PARAMS("64", 1024, "bounces per path"),
+    RT_LIGHT_TREE_PARAM,
     {"filter", SY_PARAM_ENUM, 0, 0, "none", "none|pixel|atrous|jbu|adaptive|radiance", "display noise filter", LIVE},
     {"threshold", SY_PARAM_FLOAT, 0, 1e6, "0.01", NULL,
      "perceived-variance threshold of the pixel filter's blend, the adaptive preview and radiance's T_u", LIVE},

@@ -78,6 +78,8 @@ typedef struct rt_state {
     sy_mirror *mirror;
     uint32_t integrator;
     uint32_t max_depth, light_samples;
+    uint32_t light_tree; /* sy_rt_light_tree_mode (the light_tree parameter) */
+    uint32_t light_warnings_seen; /* the device's light_warnings already logged */
     uint32_t pixel_samples, env_samples; /* whitted: "spp", "env_samples" */
     float specular; /* "specular" parameter: KHR_materials_specular factor given to every material */
     /* the look (sy_look.h) applied to the device, with the back-end textures it resolved to */
@@ -105,9 +107,9 @@ typedef struct rt_state {
 
 /* --- sy_mediator_rt_base.c --- */
 /* The classes' parameter tables (sy_params.h); the counts are checked where they are defined. */
-#define SY_RTI_WHITTED_PARAM_COUNT 7
+#define SY_RTI_WHITTED_PARAM_COUNT 8
 #define SY_RTI_COVERAGE_PARAM_COUNT 5
-#define SY_RTI_PATHTRACER_PARAM_COUNT 25
+#define SY_RTI_PATHTRACER_PARAM_COUNT 26
 #ifndef SY_RTI_DEFINING_PARAMS
 extern const sy_param_decl sy_rti_whitted_params[SY_RTI_WHITTED_PARAM_COUNT];
 extern const sy_param_decl sy_rti_coverage_params[SY_RTI_COVERAGE_PARAM_COUNT];
@@ -162,6 +164,8 @@ sy_result sy_rti_apply_look(rt_state *st, uint32_t background_id, sy_error *err)
  * malloc()ed; NULL when out of memory or the device failed (then the frame goes unhighlighted). */
 uint8_t *sy_rti_selection_flags(rt_state *st, const sy_rt_camera *cam, uint32_t full_w, uint32_t full_h,
                                 sy_highlight_rect m);
+/* Logs the device's light warnings not logged yet (sy_mediator_rt_render.c). */
+void sy_rti_log_light_warnings(rt_state *st);
 sy_result sy_rti_render(void *state, const sy_render_request *req, sy_layer *layer, sy_error *err);
 
 #endif

@@ -3,6 +3,7 @@
  * (sy_mediator_rt_internal.h). */
 #include "sy_mediator_rt_internal.h"
 
+#include "sy_log.h"
 #include "sy_rt_bench.h"
 #include "sy_rt_limit.h"
 
@@ -38,6 +39,17 @@ sy_result sy_mediator_rt_bench_rays(void *state, const sy_camera_view *view, uin
     out->overhead_percent = b.overhead_percent;
     out->threads = b.threads;
     return SY_OK;
+}
+
+/* Emitters the device's light sampling left out since the last look: one warning naming the
+ * light (the device keeps the count and the last message). */
+void sy_rti_log_light_warnings(rt_state *st)
+{
+    sy_rt_stats s;
+    sy_rt_device_stats(st->dev, &s);
+    if (s.light_warnings == st->light_warnings_seen) return;
+    sy_log(SY_LOG_WARNING, "rt", NULL, "%s (%u emitter(s) left out so far)", s.light_warning, s.light_warnings);
+    st->light_warnings_seen = s.light_warnings;
 }
 
 uint8_t *sy_rti_selection_flags(rt_state *st, const sy_rt_camera *cam, uint32_t full_w, uint32_t full_h,
@@ -98,6 +110,7 @@ static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_lay
         .seed = req->seed,
         .pixel_samples = st->pixel_samples,
         .env_light_samples = st->env_samples,
+        .light_tree = (sy_rt_light_tree_mode)st->light_tree,
         .progress = req->progress ? progress_cb : NULL,
         .progress_user_data = &pb,
     };
@@ -119,6 +132,7 @@ static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_lay
     }
     sy_rt_result r = sy_rt_render(st->dev, &cam, &d, layer->rgba, layer->depth);
     if (r != SY_RT_OK) return sy_rti_fail(st, err, r, "render");
+    sy_rti_log_light_warnings(st);
     if (d.accum) st->counters.last_render_rays = sy_rt_accum_last_rays(d.accum);
     st->frames_rendered++;
     if (d.accum && st->filter.kind != PT_FILTER_NONE) return sy_rti_filter_layer(st, req, layer, err);

@@ -1,0 +1,525 @@
+/* sy_rt_lighttree.c — the light hierarchy: binned SAOH build, refit, importance, stochastic
+ * traversal and the selection pdf (see sy_rt_lighttree.h). */
+#include "sy_rt_lighttree.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI_F 3.14159265358979f
+#define LT_BINS 12
+#define LT_BINNED_DEPTH 40u   /* deeper: split at the middle index (bounds the depth on any input) */
+#define LT_MAX_DEPTH 128u     /* > LT_BINNED_DEPTH + 32: the path array of the pdf */
+#define LT_CONE_EPS 1e-4f     /* cone unions widen by this much (radians): float rounding never cuts a light off */
+
+/* >>bounds */
+static bool bounds_valid(const sy_rt_lt_bounds *b, bool distant)
+{
+    if (!(b->power > 0.0f) || !isfinite(b->power)) return false;
+    for (int k = 0; k < 3; ++k)
+        if (!isfinite(b->axis[k])) return false;
+    if (distant) return true;
+    for (int k = 0; k < 3; ++k)
+        if (!isfinite(b->lo[k]) || !isfinite(b->hi[k]) || b->lo[k] > b->hi[k]) return false;
+    return isfinite(b->theta_o) && isfinite(b->theta_e);
+}
+
+/* Conty & Kulla 2018, algorithm 1: the smallest cone (of the two's form) holding both. */
+static void cone_union(sy_rt_lt_bounds *out, const sy_rt_lt_bounds *a, const sy_rt_lt_bounds *b)
+{
+    float te = fmaxf(a->theta_e, b->theta_e);
+    if (b->theta_o > a->theta_o) {
+        const sy_rt_lt_bounds *s = a;
+        a = b, b = s;
+    }
+    sy_rt_v3 aa = v3_load(a->axis), ab = v3_load(b->axis);
+    float cd = sy_rt_clampf(v3_dot(aa, ab), -1.0f, 1.0f), td = acosf(cd);
+    sy_rt_v3 ax = aa;
+    float to;
+    if (fminf(td + b->theta_o, PI_F) <= a->theta_o) {
+        to = a->theta_o;
+    } else {
+        float o = 0.5f * (a->theta_o + td + b->theta_o) + LT_CONE_EPS;
+        sy_rt_v3 perp = v3_sub(ab, v3_scale(aa, cd));
+        float len = v3_length(perp);
+        if (o >= PI_F || !(len > 1e-6f)) {
+            to = PI_F;
+        } else {
+            float rot = o - a->theta_o;
+            ax = v3_normalize(v3_add(v3_scale(aa, cosf(rot)), v3_scale(perp, sinf(rot) / len)));
+            to = o;
+        }
+    }
+    out->axis[0] = ax.x, out->axis[1] = ax.y, out->axis[2] = ax.z;
+    out->theta_o = fminf(to, PI_F);
+    out->theta_e = te;
+}
+
+static void bounds_union(sy_rt_lt_bounds *out, const sy_rt_lt_bounds *a, const sy_rt_lt_bounds *b)
+{
+    sy_rt_lt_bounds r;
+    for (int k = 0; k < 3; ++k) r.lo[k] = fminf(a->lo[k], b->lo[k]), r.hi[k] = fmaxf(a->hi[k], b->hi[k]);
+    r.power = a->power + b->power;
+    cone_union(&r, a, b);
+    *out = r;
+}
+
+static float box_area(const sy_rt_lt_bounds *b)
+{
+    float dx = b->hi[0] - b->lo[0], dy = b->hi[1] - b->lo[1], dz = b->hi[2] - b->lo[2];
+    return 2.0f * (dx * dy + dy * dz + dz * dx);
+}
+
+/* Orientation measure M_Omega of Conty & Kulla (eq. 1). */
+static float cone_measure(const sy_rt_lt_bounds *b)
+{
+    float to = b->theta_o, tw = fminf(to + b->theta_e, PI_F);
+    float so = sinf(to), co = cosf(to);
+    return 2.0f * PI_F * (1.0f - co) + 0.5f * PI_F * (2.0f * tw * so - cosf(to - 2.0f * tw) - 2.0f * to * so + co);
+}
+
+/* >>importance */
+float sy_rt_lighttree_importance(const sy_rt_lt_bounds *b, sy_rt_v3 p, sy_rt_v3 n)
+{
+    sy_rt_v3 lo = v3_load(b->lo), hi = v3_load(b->hi);
+    sy_rt_v3 c = v3_scale(v3_add(lo, hi), 0.5f), v = v3_sub(p, c), ext = v3_sub(hi, lo);
+    float d2 = v3_dot(v, v), r2 = 0.25f * v3_dot(ext, ext);
+    bool inside = p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+    float ce = 1.0f, ci = 1.0f;
+    if (!inside && d2 > r2) {
+        float d = sqrtf(d2);
+        sy_rt_v3 wp = v3_scale(v, 1.0f / d); /* from the light toward p */
+        float tu = asinf(sy_rt_minf(sqrtf(r2 / d2), 1.0f));
+        /* emission: the angle off the cone, less the cone and the box's angular radius */
+        if (b->theta_o < PI_F) {
+            float t = acosf(sy_rt_clampf(v3_dot(v3_load(b->axis), wp), -1.0f, 1.0f));
+            float tp = t - b->theta_o - tu;
+            if (tp > 0.0f) {
+                if (tp >= b->theta_e || tp >= 0.5f * PI_F) return 0.0f;
+                ce = cosf(tp);
+            }
+        }
+        /* the surface: the angle of the light off its normal, less the box's angular radius */
+        if (!v3_is_zero(n)) {
+            float ti = acosf(sy_rt_clampf(-v3_dot(n, wp), -1.0f, 1.0f)) - tu;
+            if (ti > 0.0f) {
+                if (ti >= 0.5f * PI_F) return 0.0f;
+                ci = cosf(ti);
+            }
+        }
+    }
+    float dc = fmaxf(fmaxf(d2, r2), 1e-12f);
+    float w = b->power * ce * ci / dc;
+    return isfinite(w) && w > 0.0f ? w : 0.0f;
+}
+
+static float distant_importance(const sy_rt_lt_bounds *b, sy_rt_v3 n)
+{
+    if (v3_is_zero(n)) return b->power;
+    float c = -v3_dot(n, v3_load(b->axis));
+    return c > 0.0f ? b->power * c : 0.0f;
+}
+
+/* >>build */
+typedef struct build_task {
+    uint32_t node, begin, end, depth;
+} build_task;
+
+typedef struct bin {
+    sy_rt_lt_bounds b;
+    uint32_t count;
+} bin;
+
+static sy_rt_v3 centroid(const sy_rt_lt_bounds *b)
+{
+    return v3(0.5f * (b->lo[0] + b->hi[0]), 0.5f * (b->lo[1] + b->hi[1]), 0.5f * (b->lo[2] + b->hi[2]));
+}
+static float v3_at(sy_rt_v3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+
+static void bin_add(bin *bn, const sy_rt_lt_bounds *b)
+{
+    if (bn->count++ == 0) bn->b = *b;
+    else bounds_union(&bn->b, &bn->b, b);
+}
+
+static int bin_of(float c, float lo, float scale)
+{
+    int i = (int)((c - lo) * scale);
+    return i < 0 ? 0 : (i >= LT_BINS ? LT_BINS - 1 : i);
+}
+
+/* Finds the best binned SAOH split of refs[begin, end) (node bounds nb): axis and bin boundary
+ * (the left side takes bins < *split). False when no split separates anything. */
+static bool find_split(const sy_rt_lt_light *lights, const uint32_t *refs, uint32_t begin, uint32_t end,
+                       const sy_rt_lt_bounds *nb, int *axis_out, int *split_out, float *clo_out, float *scale_out)
+{
+    sy_rt_v3 clo = v3(INFINITY, INFINITY, INFINITY), chi = v3(-INFINITY, -INFINITY, -INFINITY);
+    for (uint32_t i = begin; i < end; ++i) {
+        sy_rt_v3 c = centroid(&lights[refs[i]].b);
+        clo = v3(fminf(clo.x, c.x), fminf(clo.y, c.y), fminf(clo.z, c.z));
+        chi = v3(fmaxf(chi.x, c.x), fmaxf(chi.y, c.y), fmaxf(chi.z, c.z));
+    }
+    float ext[3] = {nb->hi[0] - nb->lo[0], nb->hi[1] - nb->lo[1], nb->hi[2] - nb->lo[2]};
+    float lmax = fmaxf(ext[0], fmaxf(ext[1], ext[2]));
+    float cext[3] = {chi.x - clo.x, chi.y - clo.y, chi.z - clo.z};
+    int widest = cext[0] >= cext[1] ? (cext[0] >= cext[2] ? 0 : 2) : (cext[1] >= cext[2] ? 1 : 2);
+    float best = INFINITY;
+    bool found = false;
+    for (int k = 0; k < 3; ++k) {
+        if (!(cext[k] > 0.0f)) continue;
+        if (end - begin > 4096u && k != widest) continue; /* large nodes: the widest axis only */
+        bin bins[LT_BINS];
+        memset(bins, 0, sizeof bins);
+        float lo = v3_at(clo, k), scale = (float)LT_BINS * (1.0f - 1e-6f) / cext[k];
+        for (uint32_t i = begin; i < end; ++i) {
+            const sy_rt_lt_bounds *b = &lights[refs[i]].b;
+            bin_add(&bins[bin_of(v3_at(centroid(b), k), lo, scale)], b);
+        }
+        /* suffix costs, then a sweep from the left */
+        float right_cost[LT_BINS];
+        bin acc = {0};
+        for (int i = LT_BINS - 1; i > 0; --i) {
+            if (bins[i].count) {
+                if (acc.count) bounds_union(&acc.b, &acc.b, &bins[i].b);
+                else acc.b = bins[i].b;
+                acc.count += bins[i].count;
+            }
+            right_cost[i] = acc.count ? acc.b.power * box_area(&acc.b) * cone_measure(&acc.b) : -1.0f;
+        }
+        float kr = ext[k] > 0.0f ? lmax / ext[k] : 1.0f;
+        bin left = {0};
+        for (int i = 1; i < LT_BINS; ++i) {
+            if (bins[i - 1].count) {
+                if (left.count) bounds_union(&left.b, &left.b, &bins[i - 1].b);
+                else left.b = bins[i - 1].b;
+                left.count += bins[i - 1].count;
+            }
+            if (!left.count || right_cost[i] < 0.0f) continue;
+            float cost = kr * (left.b.power * box_area(&left.b) * cone_measure(&left.b) + right_cost[i]);
+            if (cost < best || !found) {
+                best = cost;
+                found = true;
+                *axis_out = k;
+                *split_out = i;
+                *clo_out = lo;
+                *scale_out = scale;
+            }
+        }
+    }
+    return found;
+}
+
+static void tree_reset(sy_rt_lighttree *t) { memset(t, 0, sizeof *t), t->first_skipped = SY_RT_LT_NONE; }
+
+void sy_rt_lighttree_free(sy_rt_lighttree *t)
+{
+    if (!t) return;
+    free(t->nodes);
+    free(t->prims);
+    free(t->prim_light);
+    free(t->prim_leaf);
+    free(t->light_prim);
+    free(t->distant);
+    free(t->distant_b);
+    free(t->light_distant);
+    tree_reset(t);
+}
+
+/* The bounds of node x from its leaf's lights or its children. */
+static void node_fit(sy_rt_lighttree *t, uint32_t x)
+{
+    sy_rt_lt_node *nd = &t->nodes[x];
+    if (nd->count) {
+        nd->b = t->prims[nd->child];
+        for (uint32_t i = 1; i < nd->count; ++i) bounds_union(&nd->b, &nd->b, &t->prims[nd->child + i]);
+    } else {
+        bounds_union(&nd->b, &t->nodes[nd->child].b, &t->nodes[nd->child + 1u].b);
+    }
+}
+
+bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uint32_t n, size_t max_bytes, bool *oom)
+{
+    tree_reset(t);
+    *oom = false;
+    uint32_t m = 0, nd = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!bounds_valid(&lights[i].b, lights[i].distant)) {
+            if (t->skipped++ == 0) t->first_skipped = i;
+        } else if (lights[i].distant) {
+            nd++;
+        } else {
+            m++;
+        }
+    }
+    t->light_count = n;
+    /* what the tree will hold, nodes at their bound (2m - 1) */
+    size_t est = (size_t)n * sizeof(uint32_t) + (size_t)m * (sizeof(sy_rt_lt_bounds) + 2u * sizeof(uint32_t)) +
+                 (size_t)(m ? 2u * m - 1u : 0u) * sizeof(sy_rt_lt_node) +
+                 (size_t)nd * (sizeof(uint32_t) + sizeof(sy_rt_lt_bounds)) + (nd ? (size_t)n * sizeof(uint32_t) : 0u);
+    if (max_bytes && est > max_bytes) {
+        uint32_t skipped = t->skipped, first = t->first_skipped;
+        tree_reset(t);
+        t->skipped = skipped, t->first_skipped = first, t->bytes = est;
+        return false;
+    }
+    t->light_prim = malloc((size_t)n * sizeof *t->light_prim + 1u);
+    t->prims = malloc((size_t)m * sizeof *t->prims + 1u);
+    t->prim_light = malloc((size_t)m * sizeof *t->prim_light + 1u);
+    t->prim_leaf = malloc((size_t)m * sizeof *t->prim_leaf + 1u);
+    t->nodes = malloc((size_t)(m ? 2u * m - 1u : 1u) * sizeof *t->nodes);
+    if (nd) {
+        t->distant = malloc((size_t)nd * sizeof *t->distant);
+        t->distant_b = malloc((size_t)nd * sizeof *t->distant_b);
+        t->light_distant = malloc((size_t)n * sizeof *t->light_distant);
+    }
+    build_task *stack = malloc((LT_MAX_DEPTH + 2u) * sizeof *stack);
+    if (!t->light_prim || !t->prims || !t->prim_light || !t->prim_leaf || !t->nodes || !stack ||
+        (nd && (!t->distant || !t->distant_b || !t->light_distant))) {
+        free(stack);
+        sy_rt_lighttree_free(t);
+        *oom = true;
+        return false;
+    }
+    uint32_t *refs = t->prim_light; /* partitioned in place: ends in leaf order */
+    for (uint32_t i = 0; i < n; ++i) {
+        t->light_prim[i] = SY_RT_LT_NONE;
+        if (nd) t->light_distant[i] = SY_RT_LT_NONE;
+        if (!bounds_valid(&lights[i].b, lights[i].distant)) continue;
+        if (lights[i].distant) {
+            t->light_distant[i] = t->distant_count;
+            t->distant_b[t->distant_count] = lights[i].b;
+            t->distant[t->distant_count++] = i;
+        } else {
+            refs[t->prim_count++] = i;
+        }
+    }
+    if (m) {
+        uint32_t sp = 0;
+        t->node_count = 1;
+        t->nodes[0].parent = SY_RT_LT_NONE;
+        stack[sp++] = (build_task){0, 0, m, 0};
+        while (sp) {
+            build_task k = stack[--sp];
+            sy_rt_lt_node *node = &t->nodes[k.node];
+            node->b = lights[refs[k.begin]].b;
+            for (uint32_t i = k.begin + 1u; i < k.end; ++i) bounds_union(&node->b, &node->b, &lights[refs[i]].b);
+            uint32_t cnt = k.end - k.begin;
+            if (k.depth + 1u > t->depth) t->depth = k.depth + 1u;
+            if (cnt <= SY_RT_LT_LEAF_MAX) {
+                node->child = k.begin;
+                node->count = cnt;
+                continue;
+            }
+            uint32_t mid = k.begin + cnt / 2u;
+            int axis, split;
+            float clo, scale;
+            if (k.depth < LT_BINNED_DEPTH && find_split(lights, refs, k.begin, k.end, &node->b, &axis, &split, &clo, &scale)) {
+                uint32_t i = k.begin, j = k.end;
+                while (i < j) {
+                    if (bin_of(v3_at(centroid(&lights[refs[i]].b), axis), clo, scale) < split) {
+                        ++i;
+                    } else {
+                        uint32_t s = refs[i];
+                        refs[i] = refs[--j];
+                        refs[j] = s;
+                    }
+                }
+                if (i > k.begin && i < k.end) mid = i;
+            }
+            uint32_t c = t->node_count;
+            t->node_count += 2u;
+            node->child = c;
+            node->count = 0;
+            t->nodes[c].parent = t->nodes[c + 1u].parent = k.node;
+            stack[sp++] = (build_task){c + 1u, mid, k.end, k.depth + 1u};
+            stack[sp++] = (build_task){c, k.begin, mid, k.depth + 1u};
+        }
+        /* leaf order is refs order: copy the records, note each light's leaf */
+        for (uint32_t i = 0; i < m; ++i) {
+            t->prims[i] = lights[refs[i]].b;
+            t->light_prim[refs[i]] = i;
+        }
+        for (uint32_t x = 0; x < t->node_count; ++x)
+            if (t->nodes[x].count)
+                for (uint32_t i = 0; i < t->nodes[x].count; ++i) t->prim_leaf[t->nodes[x].child + i] = x;
+        /* the nodes' bounds again from the records (the same unions refit makes) */
+        for (uint32_t x = t->node_count; x-- > 0;) node_fit(t, x);
+        sy_rt_lt_node *shrunk = realloc(t->nodes, (size_t)t->node_count * sizeof *t->nodes);
+        if (shrunk) t->nodes = shrunk;
+    }
+    free(stack);
+    t->bytes = (size_t)n * sizeof(uint32_t) * (nd ? 2u : 1u) + (size_t)m * (sizeof(sy_rt_lt_bounds) + 2u * sizeof(uint32_t)) +
+               (size_t)t->node_count * sizeof(sy_rt_lt_node) + (size_t)nd * (sizeof(uint32_t) + sizeof(sy_rt_lt_bounds));
+    return true;
+}
+
+bool sy_rt_lighttree_refit(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uint32_t n, uint32_t *changed)
+{
+    *changed = 0;
+    if (n != t->light_count) return false;
+    for (uint32_t i = 0; i < n; ++i) { /* the same lights in the same places, or a rebuild */
+        bool valid = bounds_valid(&lights[i].b, lights[i].distant);
+        bool in_tree = t->light_prim[i] != SY_RT_LT_NONE, in_distant = t->light_distant && t->light_distant[i] != SY_RT_LT_NONE;
+        if (valid != (in_tree || in_distant)) return false;
+        if (valid && lights[i].distant != in_distant) return false;
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+        if (t->light_distant && t->light_distant[i] != SY_RT_LT_NONE) {
+            sy_rt_lt_bounds *d = &t->distant_b[t->light_distant[i]];
+            if (memcmp(d, &lights[i].b, sizeof *d)) *d = lights[i].b, (*changed)++;
+            continue;
+        }
+        uint32_t k = t->light_prim[i];
+        if (k == SY_RT_LT_NONE || !memcmp(&t->prims[k], &lights[i].b, sizeof t->prims[k])) continue;
+        t->prims[k] = lights[i].b;
+        (*changed)++;
+        for (uint32_t x = t->prim_leaf[k]; x != SY_RT_LT_NONE; x = t->nodes[x].parent) node_fit(t, x);
+    }
+    return true;
+}
+
+/* >>traversal */
+
+/* Probabilities of k (<= SY_RT_LT_LEAF_MAX) choices with weights w: by importance, or by power
+ * (pw) where no choice has any (a point no light reaches keeps a proper distribution). */
+static void choice_probs(float *w, const float *pw, uint32_t k)
+{
+    float s = 0.0f;
+    for (uint32_t i = 0; i < k; ++i) s += w[i];
+    if (!(s > 0.0f) || !isfinite(s)) {
+        s = 0.0f;
+        for (uint32_t i = 0; i < k; ++i) w[i] = pw[i], s += w[i];
+    }
+    for (uint32_t i = 0; i < k; ++i) w[i] = w[i] / s;
+}
+
+/* Picks among k probabilities with u; rescales u to [0, 1) within the choice. */
+static uint32_t choose(const float *p, uint32_t k, float *u)
+{
+    float acc = 0.0f;
+    for (uint32_t i = 0; i + 1u < k; ++i) {
+        if (p[i] > 0.0f && *u < acc + p[i]) {
+            *u = sy_rt_clampf((*u - acc) / p[i], 0.0f, 0.99999994f);
+            return i;
+        }
+        acc += p[i];
+    }
+    uint32_t last = k - 1u;
+    while (last > 0 && !(p[last] > 0.0f)) --last;
+    *u = p[last] > 0.0f ? sy_rt_clampf((*u - acc) / p[last], 0.0f, 0.99999994f) : 0.0f;
+    return last;
+}
+
+/* The top level: the root (when there is a tree) then the directional lights. Only 1 + 3 entries
+ * at most are kept on the stack; beyond that the directional lights are scanned. */
+static float top_prob(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint32_t which, float *u, uint32_t *chosen)
+{
+    /* weights, summed in a fixed order: pick and pdf agree */
+    float s = 0.0f, ps = 0.0f;
+    uint32_t k = (t->node_count ? 1u : 0u) + t->distant_count;
+    for (uint32_t i = 0; i < k; ++i) {
+        bool root = t->node_count && i == 0;
+        const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->distant_b[i - (t->node_count ? 1u : 0u)];
+        s += root ? sy_rt_lighttree_importance(b, p, n) : distant_importance(b, n);
+        ps += b->power;
+    }
+    bool by_power = !(s > 0.0f) || !isfinite(s);
+    float total = by_power ? ps : s, acc = 0.0f;
+    for (uint32_t i = 0; i < k; ++i) {
+        bool root = t->node_count && i == 0;
+        const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->distant_b[i - (t->node_count ? 1u : 0u)];
+        float w = by_power ? b->power : (root ? sy_rt_lighttree_importance(b, p, n) : distant_importance(b, n));
+        float pr = w / total;
+        if (u) {
+            if (pr > 0.0f && (*u < acc + pr || i + 1u == k)) {
+                *u = sy_rt_clampf((*u - acc) / pr, 0.0f, 0.99999994f);
+                *chosen = i;
+                return pr;
+            }
+            acc += pr;
+        } else if (i == which) {
+            return pr;
+        }
+    }
+    if (u) { /* rounding left u past the last nonzero entry */
+        for (uint32_t i = k; i-- > 0;) {
+            bool root = t->node_count && i == 0;
+            const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->distant_b[i - (t->node_count ? 1u : 0u)];
+            float w = by_power ? b->power : (root ? sy_rt_lighttree_importance(b, p, n) : distant_importance(b, n));
+            if (w > 0.0f) {
+                *u = 0.99999994f;
+                *chosen = i;
+                return w / total;
+            }
+        }
+    }
+    return 0.0f;
+}
+
+static void inner_probs(const sy_rt_lighttree *t, const sy_rt_lt_node *nd, sy_rt_v3 p, sy_rt_v3 n, float pr[2])
+{
+    const sy_rt_lt_node *l = &t->nodes[nd->child], *r = l + 1;
+    float pw[2] = {l->b.power, r->b.power};
+    pr[0] = sy_rt_lighttree_importance(&l->b, p, n);
+    pr[1] = sy_rt_lighttree_importance(&r->b, p, n);
+    choice_probs(pr, pw, 2u);
+}
+
+static void leaf_probs(const sy_rt_lighttree *t, const sy_rt_lt_node *nd, sy_rt_v3 p, sy_rt_v3 n, float *pr)
+{
+    float pw[SY_RT_LT_LEAF_MAX];
+    for (uint32_t i = 0; i < nd->count; ++i) {
+        pw[i] = t->prims[nd->child + i].power;
+        pr[i] = sy_rt_lighttree_importance(&t->prims[nd->child + i], p, n);
+    }
+    choice_probs(pr, pw, nd->count);
+}
+
+uint32_t sy_rt_lighttree_pick(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, float u, float *pdf)
+{
+    *pdf = 0.0f;
+    if (!t->node_count && !t->distant_count) return SY_RT_LT_NONE;
+    uint32_t top = 0;
+    float prob = top_prob(t, p, n, 0, &u, &top);
+    if (!(prob > 0.0f)) return SY_RT_LT_NONE;
+    if (!t->node_count || top > 0) {
+        *pdf = prob;
+        return t->distant[top - (t->node_count ? 1u : 0u)];
+    }
+    const sy_rt_lt_node *nd = t->nodes;
+    while (!nd->count) {
+        float pr[2];
+        inner_probs(t, nd, p, n, pr);
+        uint32_t c = choose(pr, 2u, &u);
+        prob *= pr[c];
+        nd = &t->nodes[nd->child + c];
+    }
+    float pr[SY_RT_LT_LEAF_MAX];
+    leaf_probs(t, nd, p, n, pr);
+    uint32_t c = choose(pr, nd->count, &u);
+    prob *= pr[c];
+    *pdf = prob;
+    return prob > 0.0f ? t->prim_light[nd->child + c] : SY_RT_LT_NONE;
+}
+
+float sy_rt_lighttree_pdf(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint32_t light)
+{
+    if (light >= t->light_count) return 0.0f;
+    if (t->light_distant && t->light_distant[light] != SY_RT_LT_NONE)
+        return top_prob(t, p, n, t->light_distant[light] + (t->node_count ? 1u : 0u), NULL, NULL);
+    uint32_t k = t->light_prim[light];
+    if (k == SY_RT_LT_NONE) return 0.0f;
+    /* the path from the root, then the same products in the same order as pick */
+    uint32_t path[LT_MAX_DEPTH + 1u], depth = 0;
+    for (uint32_t x = t->prim_leaf[k]; x != SY_RT_LT_NONE && depth <= LT_MAX_DEPTH; x = t->nodes[x].parent) path[depth++] = x;
+    float prob = top_prob(t, p, n, 0, NULL, NULL);
+    for (uint32_t d = depth; d-- > 1u;) {
+        float pr[2];
+        inner_probs(t, &t->nodes[path[d]], p, n, pr);
+        prob *= pr[path[d - 1u] - t->nodes[path[d]].child];
+    }
+    const sy_rt_lt_node *leaf = &t->nodes[path[0]];
+    float pr[SY_RT_LT_LEAF_MAX];
+    leaf_probs(t, leaf, p, n, pr);
+    return prob * pr[k - leaf->child];
+}
