@@ -91,6 +91,15 @@ int sy_cmd_bench_limit(int argc, char **argv);
  * commit + sync against building the scene from scratch, `repeats` frames (sy_bench_deform.c). */
 sy_result sy_bench_deform(uint32_t vertices, uint32_t repeats, sy_error *err);
 
+/* sy bench lights (issue 39, apps/sy/sy_bench_lights.c): a generated many-lights scene (`quads`
+ * small emissive quads, `points` point lights of varied power, 30 boxes over a large floor) written
+ * to out_dir/many_lights.gltf (NULL: a new temporary directory) and loaded by the normal loader;
+ * the path tracer with light_tree=on and =off, 1-spp passes interleaved until each has `seconds`
+ * of render time, each compared (relMSE) with a reference (the tree, another seed, 8 x the time);
+ * then the tree's size and build time and one light's update (its refit). Writes the three images
+ * as PNG beside the scene. */
+sy_result sy_bench_lights(uint32_t quads, uint32_t points, uint32_t width, uint32_t height, double seconds,
+                          const char *out_dir, sy_error *err);
 /* Minimum, median and maximum of n > 0 values (sorts v in place): benchmarks report the median of
  * their rounds with the spread. */
 typedef struct sy_bench_spread {

@@ -106,7 +106,7 @@ int sy_cmd_bench(int argc, char **argv)
 {
     static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
                                         "viewports", "load", "cluster",    "memory", "instances", "governor",
-                                        "limit",     "cull", "web", "deform"};
+                                        "limit",     "cull", "web", "deform", "lights"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -164,6 +164,11 @@ int sy_cmd_bench(int argc, char **argv)
     if (!strcmp(cmd, "deform")) { /* --tris: vertices of the skinned tube */
         if (optind < argc) return sy_cli_usage_of(who, "no SCENE: the skinned tube is generated");
         return sy_bench_deform(tris == 100 ? 100000 : tris, repeats ? repeats : 50, &err) == SY_OK ? 0 : sy_cli_fail(&err);
+    }
+    if (!strcmp(cmd, "lights")) { /* --nodes: emissive quads, --tris: point lights, --repeats: seconds per method */
+        if (optind < argc) return sy_cli_usage_of(who, "no SCENE: the many-lights scene is generated");
+        return sy_bench_lights(nodes, tris == 100 ? 1000 : tris, w == 512 ? 320 : w, h == 512 ? 240 : h,
+                               repeats ? repeats : 20, NULL, &err) == SY_OK ? 0 : sy_cli_fail(&err);
     }
     if (!strcmp(cmd, "sync")) return sy_bench_sync(nodes, tris, repeats ? repeats : 50, &err) == SY_OK ? 0 : sy_cli_fail(&err);
     if (!strcmp(cmd, "viewports"))

@@ -363,6 +363,15 @@ bool sy_rt_lighttree_refit(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
         if (valid != (in_tree || in_distant)) return false;
         if (valid && lights[i].distant != in_distant) return false;
     }
+    uint32_t differ = 0, limit = n / 64u + 1u;
+    for (uint32_t i = 0; i < n && differ <= limit; ++i) {
+        uint32_t k = t->light_prim[i];
+        if (t->light_distant && t->light_distant[i] != SY_RT_LT_NONE)
+            differ += memcmp(&t->distant_b[t->light_distant[i]], &lights[i].b, sizeof lights[i].b) != 0;
+        else if (k != SY_RT_LT_NONE)
+            differ += memcmp(&t->prims[k], &lights[i].b, sizeof lights[i].b) != 0;
+    }
+    if (differ > limit) return false; /* many changed: a fresh build (better bounds, and the image a new device gives) */
     for (uint32_t i = 0; i < n; ++i) {
         if (t->light_distant && t->light_distant[i] != SY_RT_LT_NONE) {
             sy_rt_lt_bounds *d = &t->distant_b[t->light_distant[i]];

@@ -80,9 +80,11 @@ typedef struct sy_rt_lighttree {
 bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uint32_t n, size_t max_bytes, bool *oom);
 void sy_rt_lighttree_free(sy_rt_lighttree *t);
 /* Refits *t to lights whose bounds or power changed (same count, same distant flags, none newly
- * skipped or unskipped: else false and *t unchanged, the caller rebuilds). Each changed light
- * updates its leaf and the path to the root: O(changed x depth) plus one pass comparing records.
- * *changed gets how many lights changed. */
+ * skipped or unskipped, at most n / 64 + 1 changed: else false and *t unchanged, the caller
+ * rebuilds). Each changed light updates its leaf and the path to the root: O(changed x depth)
+ * plus one pass comparing records. *changed gets how many lights changed. A refitted tree samples
+ * differently from a fresh build over the same lights (the same expected image, not the same
+ * noise). */
 bool sy_rt_lighttree_refit(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uint32_t n, uint32_t *changed);
 
 /* Picks a light for shading point p with normal n (zero vector: none, e.g. a transmissive

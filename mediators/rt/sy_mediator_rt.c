@@ -273,6 +273,13 @@ void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out)
     out->shared_bytes = rs.shared_bytes;
     out->embree_bytes = rs.embree_bytes;
     out->embree_peak_bytes = rs.embree_peak_bytes;
+    out->light_tree_lights = rs.light_tree_lights;
+    out->light_tree_bytes = rs.light_tree_bytes;
+    out->light_tree_build_seconds = rs.light_tree_build_seconds;
+    out->light_tree_refit_seconds = rs.light_tree_refit_seconds;
+    out->light_tree_refit_changed = rs.light_tree_refit_changed;
+    out->light_tree_builds = rs.light_tree_builds;
+    out->light_tree_refits = rs.light_tree_refits;
 }
 
 sy_result sy_mediator_rt_register(sy_error *err)

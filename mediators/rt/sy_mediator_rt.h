@@ -140,6 +140,13 @@ typedef struct sy_mediator_rt_counters {
     /** @{ memory of the back-end (sy_rt_stats): mesh arrays it copied, mesh arrays it shares with
      * the scene's blobs, Embree's allocations now and at their peak */
     uint64_t mesh_bytes, shared_bytes, embree_bytes, embree_peak_bytes; /** @} */
+    /** @{ the light tree (light_tree parameter; sy_rt_stats): lights in it, bytes it holds, seconds
+     * of its last full build and of its last refit, lights that refit changed, builds and refits */
+    uint32_t light_tree_lights;
+    uint64_t light_tree_bytes;
+    double light_tree_build_seconds, light_tree_refit_seconds;
+    uint32_t light_tree_refit_changed;
+    uint64_t light_tree_builds, light_tree_refits; /** @} */
 } sy_mediator_rt_counters;
 /** state is the mediator state of a context whose class is one of this adapter's classes. */
 void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out);
