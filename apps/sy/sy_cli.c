@@ -220,6 +220,8 @@ static const char usage_text[] =
             "  sy bench rays [SCENE] [-w W] [-h H] [--repeats R]\n"
             "  sy bench pathtracer [SCENE] [-w W] [-h H] [--repeats PASSES]\n"
             "  sy bench limit [SCENE] [-w W] [-h H] [--spp N] [--repeats N]   (path tracer vs raw Embree, same rays)\n"
+            "  sy bench lights [--nodes QUADS] [--tris POINT_LIGHTS] [-w W] [-h H] [--repeats SECONDS]\n"
+            "            (many lights: the light tree vs the alias table at equal time, 10^4 + 10^3 by default)\n"
             "  sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]\n"
             "  sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params gl=egl,msaa=4]\n"
             "  sy bench viewports [-w W] [-h H] [--repeats R]\n"

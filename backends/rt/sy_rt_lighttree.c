@@ -55,12 +55,21 @@ static void cone_union(sy_rt_lt_bounds *out, const sy_rt_lt_bounds *a, const sy_
     out->theta_e = te;
 }
 
+/* The cosines the importance reads. */
+static void bounds_finish(sy_rt_lt_bounds *b)
+{
+    b->cos_o = cosf(b->theta_o);
+    b->sin_o = sinf(b->theta_o);
+    b->cos_e = cosf(fminf(b->theta_e, 0.5f * PI_F));
+}
+
 static void bounds_union(sy_rt_lt_bounds *out, const sy_rt_lt_bounds *a, const sy_rt_lt_bounds *b)
 {
     sy_rt_lt_bounds r;
     for (int k = 0; k < 3; ++k) r.lo[k] = fminf(a->lo[k], b->lo[k]), r.hi[k] = fmaxf(a->hi[k], b->hi[k]);
     r.power = a->power + b->power;
     cone_union(&r, a, b);
+    bounds_finish(&r);
     *out = r;
 }
 
@@ -87,24 +96,32 @@ float sy_rt_lighttree_importance(const sy_rt_lt_bounds *b, sy_rt_v3 p, sy_rt_v3 
     bool inside = p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
     float ce = 1.0f, ci = 1.0f;
     if (!inside && d2 > r2) {
-        float d = sqrtf(d2);
-        sy_rt_v3 wp = v3_scale(v, 1.0f / d); /* from the light toward p */
-        float tu = asinf(sy_rt_minf(sqrtf(r2 / d2), 1.0f));
-        /* emission: the angle off the cone, less the cone and the box's angular radius */
+        /* angles by their cosines and sines (no inverse trigonometry): theta_u, the box's angular
+         * radius seen from p, is subtracted from each angle as a bound */
+        float inv_d = 1.0f / sqrtf(d2);
+        sy_rt_v3 wp = v3_scale(v, inv_d); /* from the light toward p */
+        float sin_u = sy_rt_minf(sqrtf(r2) * inv_d, 1.0f), cos_u = sqrtf(fmaxf(0.0f, 1.0f - sin_u * sin_u));
+        /* emission: theta' = theta - theta_o - theta_u, clamped at 0 */
         if (b->theta_o < PI_F) {
-            float t = acosf(sy_rt_clampf(v3_dot(v3_load(b->axis), wp), -1.0f, 1.0f));
-            float tp = t - b->theta_o - tu;
-            if (tp > 0.0f) {
-                if (tp >= b->theta_e || tp >= 0.5f * PI_F) return 0.0f;
-                ce = cosf(tp);
+            float ct = sy_rt_clampf(v3_dot(v3_load(b->axis), wp), -1.0f, 1.0f);
+            if (ct < b->cos_o) { /* theta > theta_o */
+                float st = sqrtf(fmaxf(0.0f, 1.0f - ct * ct));
+                float c1 = ct * b->cos_o + st * b->sin_o, s1 = st * b->cos_o - ct * b->sin_o; /* of theta - theta_o */
+                if (c1 < cos_u) { /* theta - theta_o > theta_u */
+                    float c2 = c1 * cos_u + s1 * sin_u;
+                    if (c2 <= b->cos_e || c2 <= 0.0f) return 0.0f; /* theta' >= theta_e, or past the horizon */
+                    ce = c2;
+                }
             }
         }
-        /* the surface: the angle of the light off its normal, less the box's angular radius */
+        /* the surface: theta_i - theta_u, clamped at 0 */
         if (!v3_is_zero(n)) {
-            float ti = acosf(sy_rt_clampf(-v3_dot(n, wp), -1.0f, 1.0f)) - tu;
-            if (ti > 0.0f) {
-                if (ti >= 0.5f * PI_F) return 0.0f;
-                ci = cosf(ti);
+            float cti = sy_rt_clampf(-v3_dot(n, wp), -1.0f, 1.0f);
+            if (cti < cos_u) {
+                float sti = sqrtf(fmaxf(0.0f, 1.0f - cti * cti));
+                float c2 = cti * cos_u + sti * sin_u;
+                if (c2 <= 0.0f) return 0.0f;
+                ci = c2;
             }
         }
     }
@@ -288,6 +305,7 @@ bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
         if (lights[i].distant) {
             t->light_distant[i] = t->distant_count;
             t->distant_b[t->distant_count] = lights[i].b;
+            bounds_finish(&t->distant_b[t->distant_count]);
             t->distant[t->distant_count++] = i;
         } else {
             refs[t->prim_count++] = i;
@@ -337,6 +355,7 @@ bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
         /* leaf order is refs order: copy the records, note each light's leaf */
         for (uint32_t i = 0; i < m; ++i) {
             t->prims[i] = lights[refs[i]].b;
+            bounds_finish(&t->prims[i]);
             t->light_prim[refs[i]] = i;
         }
         for (uint32_t x = 0; x < t->node_count; ++x)
@@ -366,21 +385,25 @@ bool sy_rt_lighttree_refit(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
     uint32_t differ = 0, limit = n / 64u + 1u;
     for (uint32_t i = 0; i < n && differ <= limit; ++i) {
         uint32_t k = t->light_prim[i];
+        sy_rt_lt_bounds b = lights[i].b;
+        bounds_finish(&b);
         if (t->light_distant && t->light_distant[i] != SY_RT_LT_NONE)
-            differ += memcmp(&t->distant_b[t->light_distant[i]], &lights[i].b, sizeof lights[i].b) != 0;
+            differ += memcmp(&t->distant_b[t->light_distant[i]], &b, sizeof b) != 0;
         else if (k != SY_RT_LT_NONE)
-            differ += memcmp(&t->prims[k], &lights[i].b, sizeof lights[i].b) != 0;
+            differ += memcmp(&t->prims[k], &b, sizeof b) != 0;
     }
     if (differ > limit) return false; /* many changed: a fresh build (better bounds, and the image a new device gives) */
     for (uint32_t i = 0; i < n; ++i) {
+        sy_rt_lt_bounds b = lights[i].b;
+        bounds_finish(&b);
         if (t->light_distant && t->light_distant[i] != SY_RT_LT_NONE) {
             sy_rt_lt_bounds *d = &t->distant_b[t->light_distant[i]];
-            if (memcmp(d, &lights[i].b, sizeof *d)) *d = lights[i].b, (*changed)++;
+            if (memcmp(d, &b, sizeof *d)) *d = b, (*changed)++;
             continue;
         }
         uint32_t k = t->light_prim[i];
-        if (k == SY_RT_LT_NONE || !memcmp(&t->prims[k], &lights[i].b, sizeof t->prims[k])) continue;
-        t->prims[k] = lights[i].b;
+        if (k == SY_RT_LT_NONE || !memcmp(&t->prims[k], &b, sizeof b)) continue;
+        t->prims[k] = b;
         (*changed)++;
         for (uint32_t x = t->prim_leaf[k]; x != SY_RT_LT_NONE; x = t->nodes[x].parent) node_fit(t, x);
     }

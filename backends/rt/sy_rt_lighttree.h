@@ -31,7 +31,7 @@
 #define SY_RT_LT_NONE UINT32_MAX
 
 /* What a light or a node bounds: its box, orientation cone (unit axis, theta_o: the normals'
- * spread around it, theta_e: the emission's spread around each normal, radians) and power (the
+ * spread around it, theta_e <= pi / 2: the emission's spread around each normal, radians) and power (the
  * radiant intensity of a point light, emitted radiance x area for a triangle: both give
  * power / d^2 on axis at distance d). */
 typedef struct sy_rt_lt_bounds {
@@ -39,6 +39,7 @@ typedef struct sy_rt_lt_bounds {
     float axis[3];
     float theta_o, theta_e;
     float power;
+    float cos_o, sin_o, cos_e; /* of theta_o and theta_e: filled by the tree (callers leave them 0) */
 } sy_rt_lt_bounds;
 
 /* One light given to the build. distant: a directional light (only axis = its direction of travel
