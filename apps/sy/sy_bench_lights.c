@@ -51,12 +51,11 @@ static sy_result write_scene(const char *stem, uint32_t quads, uint32_t points, 
 {
     /* meshes: 0 floor, 1 cube, 2 + g emissive group g; each one primitive */
     gbuf g[2 + GROUPS];
-    uint32_t per = (quads + GROUPS - 1) / GROUPS;
+    const int ng = quads < GROUPS ? (int)quads : GROUPS; /* emissive meshes (none empty) */
+    uint32_t per = (quads + (uint32_t)ng - 1) / (uint32_t)ng;
     memset(g, 0, sizeof g);
-    size_t cap[2 + GROUPS];
-    for (int m = 0; m < 2 + GROUPS; ++m) {
+    for (int m = 0; m < 2 + ng; ++m) {
         uint32_t nq = m == 0 ? 1 : m == 1 ? 3 : per;
-        cap[m] = nq;
         g[m].pos = malloc((size_t)nq * 4 * 3 * sizeof(float) + 8 * 3 * sizeof(float));
         g[m].idx = malloc((size_t)nq * 6 * sizeof(uint32_t) + 36 * sizeof(uint32_t));
         if (!g[m].pos || !g[m].idx) {
@@ -64,7 +63,6 @@ static sy_result write_scene(const char *stem, uint32_t quads, uint32_t points, 
             return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench lights: out of memory");
         }
     }
-    (void)cap;
     const float L = 60.0f;
     put_v(&g[0], -L, 0, -L), put_v(&g[0], -L, 0, L), put_v(&g[0], L, 0, L), put_v(&g[0], L, 0, -L);
     static const uint32_t quad_idx[6] = {0, 1, 2, 0, 2, 3};
@@ -78,7 +76,7 @@ static sy_result write_scene(const char *stem, uint32_t quads, uint32_t points, 
     uint32_t rs = 0x1234567u;
     const float s = 0.3f;
     for (uint32_t q = 0; q < quads; ++q) {
-        gbuf *e = &g[2 + q % GROUPS];
+        gbuf *e = &g[2 + q % (uint32_t)ng];
         float x = frnd(&rs) * 80.0f - 40.0f, z = frnd(&rs) * 80.0f - 40.0f, h = 2.0f + 4.0f * frnd(&rs);
         uint32_t b = e->nv;
         put_v(e, x, h, z), put_v(e, x + s, h, z), put_v(e, x + s, h, z + s), put_v(e, x, h, z + s); /* faces -y */
@@ -89,11 +87,11 @@ static sy_result write_scene(const char *stem, uint32_t quads, uint32_t points, 
     snprintf(path, sizeof path, "%s.bin", stem);
     FILE *fb = fopen(path, "wb");
     if (!fb) {
-        for (int m = 0; m < 2 + GROUPS; ++m) free(g[m].pos), free(g[m].idx);
+        for (int m = 0; m < 2 + ng; ++m) free(g[m].pos), free(g[m].idx);
         return sy_error_set(err, SY_ERR_IO, "bench lights: cannot write %s", path);
     }
     size_t off[2 + GROUPS][2], total = 0;
-    for (int m = 0; m < 2 + GROUPS; ++m) {
+    for (int m = 0; m < 2 + ng; ++m) {
         off[m][0] = total;
         fwrite(g[m].pos, sizeof(float), 3u * g[m].nv, fb);
         total += 12u * g[m].nv;
@@ -105,7 +103,7 @@ static sy_result write_scene(const char *stem, uint32_t quads, uint32_t points, 
     snprintf(path, sizeof path, "%s.gltf", stem);
     FILE *f = bin_ok ? fopen(path, "w") : NULL;
     if (!f) {
-        for (int m = 0; m < 2 + GROUPS; ++m) free(g[m].pos), free(g[m].idx);
+        for (int m = 0; m < 2 + ng; ++m) free(g[m].pos), free(g[m].idx);
         return sy_error_set(err, SY_ERR_IO, "bench lights: cannot write %s", path);
     }
     const char *base = strrchr(stem, '/');
@@ -113,12 +111,12 @@ static sy_result write_scene(const char *stem, uint32_t quads, uint32_t points, 
     fprintf(f, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"sy bench lights\"},\n");
     fprintf(f, "\"extensionsUsed\":[\"KHR_lights_punctual\",\"KHR_materials_emissive_strength\"],\n");
     fprintf(f, "\"buffers\":[{\"uri\":\"%s.bin\",\"byteLength\":%zu}],\n\"bufferViews\":[", base, total);
-    for (int m = 0; m < 2 + GROUPS; ++m)
+    for (int m = 0; m < 2 + ng; ++m)
         fprintf(f, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%u,\"target\":34962},"
                    "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%u,\"target\":34963}",
                 m ? "," : "", off[m][0], 12u * g[m].nv, off[m][1], 4u * g[m].ni);
     fprintf(f, "],\n\"accessors\":[");
-    for (int m = 0; m < 2 + GROUPS; ++m) {
+    for (int m = 0; m < 2 + ng; ++m) {
         float lo[3], hi[3];
         minmax(g[m].pos, g[m].nv, lo, hi);
         fprintf(f, "%s{\"bufferView\":%d,\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\",\"min\":[%g,%g,%g],"
@@ -138,7 +136,7 @@ static sy_result write_scene(const char *stem, uint32_t quads, uint32_t points, 
                 k, (double)c[0], (double)c[1], (double)c[2], strength);
     }
     fprintf(f, "],\n\"meshes\":[");
-    for (int m = 0; m < 2 + GROUPS; ++m)
+    for (int m = 0; m < 2 + ng; ++m)
         fprintf(f, "%s{\"primitives\":[{\"attributes\":{\"POSITION\":%d},\"indices\":%d,\"material\":%d}]}", m ? "," : "",
                 2 * m, 2 * m + 1, m);
     fprintf(f, "],\n\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[");
@@ -155,7 +153,7 @@ static sy_result write_scene(const char *stem, uint32_t quads, uint32_t points, 
     double a = atan2(30.0, 62.0);
     fprintf(f, "{\"camera\":0,\"translation\":[0,30,62],\"rotation\":[%g,0,0,%g]}", -sin(a / 2), cos(a / 2));
     fprintf(f, ",{\"mesh\":0}");
-    for (int m = 0; m < GROUPS; ++m) fprintf(f, ",{\"mesh\":%d}", 2 + m);
+    for (int m = 0; m < ng; ++m) fprintf(f, ",{\"mesh\":%d}", 2 + m);
     for (int i = 0; i < 30; ++i) {
         float sx = 2.0f + 4.0f * frnd(&rs), sy = 1.0f + 3.0f * frnd(&rs), sz = 2.0f + 4.0f * frnd(&rs);
         float x = frnd(&rs) * 70.0f - 35.0f, z = frnd(&rs) * 70.0f - 35.0f;
@@ -167,11 +165,11 @@ static sy_result write_scene(const char *stem, uint32_t quads, uint32_t points, 
         fprintf(f, ",{\"translation\":[%g,%g,%g],\"extensions\":{\"KHR_lights_punctual\":{\"light\":%u}}}", (double)x,
                 (double)h, (double)z, i);
     }
-    uint32_t nn = 1 + 1 + GROUPS + 30 + points;
+    uint32_t nn = 1 + 1 + (uint32_t)ng + 30 + points;
     fprintf(f, "],\n\"scenes\":[{\"nodes\":[");
     for (uint32_t i = 0; i < nn; ++i) fprintf(f, "%s%u", i ? "," : "", i);
     fprintf(f, "]}],\"scene\":0}\n");
-    for (int m = 0; m < 2 + GROUPS; ++m) free(g[m].pos), free(g[m].idx);
+    for (int m = 0; m < 2 + ng; ++m) free(g[m].pos), free(g[m].idx);
     if (fclose(f) != 0) return sy_error_set(err, SY_ERR_IO, "bench lights: cannot write %s", path);
     return SY_OK;
 }
@@ -223,6 +221,7 @@ sy_result sy_bench_lights(uint32_t quads, uint32_t points, uint32_t width, uint3
     (void)quads, (void)points, (void)width, (void)height, (void)seconds, (void)out_dir;
     SY_BENCH_WITHOUT(err, "lights", "SY_WITH_EMBREE");
 #else
+    if (quads == 0) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "bench lights: at least one emissive quad");
     char dir[512];
     if (out_dir) {
         snprintf(dir, sizeof dir, "%s", out_dir);
