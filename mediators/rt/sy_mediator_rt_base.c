@@ -33,10 +33,10 @@
      "light selection: on = the light tree (many lights), off = by power (alias table), auto = the tree from 64 "   \
      "lights (emissive triangles + punctual lights)", 0}
 const sy_param_decl sy_rti_whitted_params[] = {
-    RT_LIGHT_TREE_PARAM,
     {"spp", SY_PARAM_INT, 1, 256, "4", NULL, "camera rays per pixel (stratified, jittered; 1 = the pixel centre)", 0},
     {"env_samples", SY_PARAM_INT, 1, 256, "4", NULL, "environment-light samples per shading point and pixel sample", 0},
     RT_COMMON_PARAMS("8", 64, "longest ray path: depth of mirror and glass recursion"),
+    RT_LIGHT_TREE_PARAM,
 };
 const sy_param_decl sy_rti_coverage_params[] = {
     RT_COMMON_PARAMS("8", 64, "longest ray path: depth of mirror and glass recursion"),
