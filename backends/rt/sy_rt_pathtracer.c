@@ -6,7 +6,10 @@
  * emitters such as DamagedHelmet's need the reflection too); at every vertex emission is added with its MIS weight (the previous vertex's BSDF pdf
  * against the light-selection pdf), one light sample is taken (light category uniformly among
  * area / environment / punctual, an emissive triangle by power through the alias table, a uniform
- * point on it), then the BSDF is sampled. max_depth bounds the number of scattering events;
+ * point on it; with the light tree, render desc light_tree and sy_rt_lighttree.h, two categories:
+ * the tree's pick among area and punctual lights by their importance at the point, and the
+ * environment; an emitter hit by a BSDF ray then takes its MIS weight from the tree's pdf at the
+ * previous vertex), then the BSDF is sampled. max_depth bounds the number of scattering events;
  * Russian roulette (survival = min(1, sqrt(max throughput)), as Cycles does) starts at the fifth
  * bounce: on the Cornell box it cost 41 % more error per sample from the third with survival
  * min(0.95, max throughput), for 8 % less time (tests/cycles/equal_error.sh). Alpha-blended

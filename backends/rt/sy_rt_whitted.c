@@ -8,7 +8,9 @@
  *   - emission (front side, or both sides when double-sided) is ADDED to the reflected light;
  *   - unlit materials show their base colour (plus emission);
  *   - direct light from punctual lights with the path tracer's BSDF (sy_rt_bsdf.h) and a hard
- *     shadow ray;
+ *     shadow ray; with the light tree (render desc light_tree, sy_rt_lighttree.h) instead
+ *     n_area samples per point of area and punctual lights together, each picked by the tree
+ *     (direct_tree: many lights cost n_area shadow rays, not one per light);
  *   - direct light from emissive triangles and the environment by the ratio estimator: the
  *     unshadowed light in closed form ("analytic", below) times (shadowed / unshadowed) sums of the
  *     same stochastic samples, each weighted by the path tracer's BSDF. Unshadowed, the result is
