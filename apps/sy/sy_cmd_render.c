@@ -442,7 +442,11 @@ static int render_frames_mode(loaded *ld, const sy_compose_spec *spec, const sy_
                                      .clip_id = clip_h.id,
                                      .done = frames_done,
                                      .done_user = &fr};
-        r = sy_cluster_cli_render_frames(clo, ld->scene, &job, &fs, &servers, &err);
+        /* a whole path-traced frame may take minutes: without --timeout-ms a server has 10 minutes per
+         * frame (a killed server's connection fails at once; the deadline only catches a stalled one) */
+        sy_cluster_cli_opts fclo = *clo;
+        if (!fclo.timeout_ms) fclo.timeout_ms = 600000;
+        r = sy_cluster_cli_render_frames(&fclo, ld->scene, &job, &fs, &servers, &err);
         if (fr.tty) fprintf(stderr, "\r%*s\r", 78, "");
     }
     if (r == SY_OK) {
