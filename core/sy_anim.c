@@ -131,6 +131,38 @@ static void channel_failed(sy_anim_stats *st, sy_result *first, sy_result r, sy_
     sy_error_set(err, r, "animation %#x (%s) channel %u: %s", id, d->name ? d->name : "unnamed", c, e->message);
 }
 
+/* Channel ci (a material, light or camera path) at time t into its object's field with the object's
+ * setter, which checks the value like any edit. SY_ERR_NOT_FOUND: the object is gone. */
+static sy_result apply_property(sy_scene *s, const sy_animation_data *d, sy_anim_channel ci, double t, sy_error *e)
+{
+    float v[4];
+    sy_result r = sy_animation_sample(d, ci.sampler, false, t, v, 4, e);
+    if (r != SY_OK) return r;
+    uint32_t type = sy_anim_path_target(ci.path);
+    if (type == SY_TYPE_MATERIAL) {
+        const sy_material_data *m = sy_object_get(s, SY_TYPE_MATERIAL, ci.node);
+        if (!m) return SY_ERR_NOT_FOUND;
+        float c[4];
+        memcpy(c, m->base_color, sizeof c);
+        switch (ci.path) {
+        case SY_ANIM_BASE_COLOR: return sy_object_set_field(s, type, ci.node, SY_MATERIAL_BASE_COLOR, v, e);
+        case SY_ANIM_DIFFUSE:
+            memcpy(c, v, 3 * sizeof(float));
+            return sy_object_set_field(s, type, ci.node, SY_MATERIAL_BASE_COLOR, c, e);
+        case SY_ANIM_OPACITY:
+            c[3] = v[0];
+            return sy_object_set_field(s, type, ci.node, SY_MATERIAL_BASE_COLOR, c, e);
+        case SY_ANIM_EMISSIVE: return sy_object_set_field(s, type, ci.node, SY_MATERIAL_EMISSIVE, v, e);
+        case SY_ANIM_METALLIC: return sy_object_set_field(s, type, ci.node, SY_MATERIAL_METALLIC, v, e);
+        default: return sy_object_set_field(s, type, ci.node, SY_MATERIAL_ROUGHNESS, v, e);
+        }
+    }
+    if (!sy_object_get(s, type, ci.node)) return SY_ERR_NOT_FOUND;
+    if (type == SY_TYPE_LIGHT)
+        return sy_object_set_field(s, type, ci.node, ci.path == SY_ANIM_LIGHT_COLOR ? SY_LIGHT_COLOR : SY_LIGHT_INTENSITY, v, e);
+    return sy_object_set_field(s, type, ci.node, SY_CAMERA_YFOV, v, e);
+}
+
 static sy_result apply_clip(sy_scene *s, uint32_t id, double t, sy_anim_stats *st, sy_result first, sy_error *err)
 {
     const sy_animation_data *d = sy_object_get(s, SY_TYPE_ANIMATION, id);
@@ -148,12 +180,20 @@ static sy_result apply_clip(sy_scene *s, uint32_t id, double t, sy_anim_stats *s
     st->clips++;
     for (uint32_t c = 0; c < nc; ++c) {
         const sy_anim_channel ci = ch[c];
+        if (ci.path >= SY_ANIM_PATH_COUNT) continue; /* refused by the setters; never stored */
+        if (sy_anim_path_target(ci.path) != SY_TYPE_NODE) { /* a material, light or camera field */
+            sy_error e = {0};
+            sy_result r = apply_property(s, d, ci, t, &e);
+            if (r == SY_ERR_NOT_FOUND) st->skipped_stale++;
+            else if (r != SY_OK) channel_failed(st, &first, r, err, id, d, c, &e);
+            else st->properties++;
+            continue;
+        }
         const sy_node_data *nd = sy_node_get(s, (sy_node){ci.node});
         if (!nd) {
             st->skipped_stale++;
             continue;
         }
-        if (ci.path >= SY_ANIM_PATH_COUNT) continue; /* refused by the setters; never stored */
         if (ci.path == SY_ANIM_WEIGHTS) { /* one component per morph target, into the node's weights */
             uint32_t ns;
             const sy_anim_sampler *sm = sy_animation_samplers(d, &ns);

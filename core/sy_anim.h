@@ -32,7 +32,12 @@
  * (glTF forbids animating such nodes; the glTF loader drops those channels with a warning). Morph
  * weight channels set the node's whole weights field (SY_NODE_WEIGHTS, one value per target, with
  * sy_node_set_weights), whatever its transform; the mirror deforms the mesh from them
- * (sy_objects.h, "Skins and morph targets"). Each skip is counted in sy_anim_stats.
+ * (sy_objects.h, "Skins and morph targets"). Material, light and camera channels (sy_anim_path
+ * from SY_ANIM_BASE_COLOR on: glTF KHR_animation_pointer, X3D Color- and ScalarInterpolators) set
+ * that field of their object with its setter (base colour, or its RGB or alpha alone; emissive;
+ * metallic; roughness; light colour and intensity; camera yfov), so every mediator sees an ordinary
+ * material / light / camera change. A camera or light moves with its node: an animated node carries
+ * it, and the back-ends read its world matrix at each sync. Each skip is counted in sy_anim_stats.
  *
  * Thread-safety: as the scene (sy_scene.h): calls that take a scene are serialised by the caller
  * with every other write to it. The sampler and clock functions are reentrant. */
@@ -49,9 +54,10 @@ extern "C" {
 typedef struct sy_anim_stats {
     uint32_t clips;          /**< animations evaluated */
     uint32_t channels;       /**< channels evaluated into a node */
-    uint32_t skipped_stale;  /**< channels whose target node is gone */
+    uint32_t skipped_stale;  /**< channels whose target node (material, light, camera) is gone */
     uint32_t skipped_matrix; /**< channels whose target node has a matrix transform */
     uint32_t weights;        /**< morph weight channels evaluated into a node's weights */
+    uint32_t properties;     /**< material, light and camera channels evaluated into their object */
     uint32_t failed;         /**< channels whose value a node setter refused (a spline beyond SY_COORD_MAX) */
 } sy_anim_stats;
 

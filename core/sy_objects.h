@@ -533,9 +533,12 @@ typedef struct sy_background_data {
  * refused, naming the item): every run lies inside its blob; at least one key per sampler, at most
  * SY_ANIM_MAX_KEYS; times finite and strictly increasing (glTF's rule; equal times are refused, so
  * no interval has zero length); values finite; components 3 for translation and scale, 4 for
- * rotation, 1 to SY_ANIM_MAX_COMPONENTS for weights; translation and scale values within
- * SY_COORD_MAX; rotation key values not the zero quaternion; channel targets live nodes (a replica
- * applying a list accepts references as its origin did) and name a sampler that exists. Set the
+ * rotation, 1 to SY_ANIM_MAX_COMPONENTS for weights, sy_anim_path_components for the material,
+ * light and camera paths; translation and scale values within SY_COORD_MAX; rotation key values not
+ * the zero quaternion; channel targets live objects of the path's type (sy_anim_path_target: nodes,
+ * materials, lights, cameras; a replica applying a list accepts references as its origin did) and
+ * name a sampler that exists. Material, light and camera values are checked when they are set (the
+ * clock's setter refuses an out-of-range colour or field of view and counts the channel failed). Set the
  * whole clip at once (sy_animation_set_clip or sy_animation_set): a single field set on its own is
  * checked with the other fields as they are. */
 /** Interpolation of a sampler (glTF animation.sampler.interpolation). */
@@ -552,8 +555,26 @@ typedef enum sy_anim_path {
     SY_ANIM_ROTATION = 1,    /**< node rotation, unit quaternion x y z w, 4 components */
     SY_ANIM_SCALE = 2,       /**< node scale, 3 components */
     SY_ANIM_WEIGHTS = 3,     /**< morph target weights of the node (SY_NODE_WEIGHTS), one component per target */
-    SY_ANIM_PATH_COUNT = 4
+    /* paths whose channel targets another object (sy_anim_path_target): the channel's `node` holds its id */
+    SY_ANIM_BASE_COLOR = 4,       /**< material base colour RGBA (SY_MATERIAL_BASE_COLOR), 4 components */
+    SY_ANIM_DIFFUSE = 5,          /**< material base colour RGB, its alpha kept (X3D Material.diffuseColor), 3 */
+    SY_ANIM_OPACITY = 6,          /**< material base colour alpha (X3D 1 - Material.transparency), 1 */
+    SY_ANIM_EMISSIVE = 7,         /**< material emissive factor RGB (SY_MATERIAL_EMISSIVE), 3 */
+    SY_ANIM_METALLIC = 8,         /**< material metallic factor, 1 */
+    SY_ANIM_ROUGHNESS = 9,        /**< material roughness factor, 1 */
+    SY_ANIM_LIGHT_COLOR = 10,     /**< light colour RGB (SY_LIGHT_COLOR), 3 */
+    SY_ANIM_LIGHT_INTENSITY = 11, /**< light intensity (SY_LIGHT_INTENSITY), 1 */
+    SY_ANIM_CAMERA_YFOV = 12,     /**< camera vertical field of view, radians (SY_CAMERA_YFOV), 1 */
+    SY_ANIM_PATH_COUNT = 13
 } sy_anim_path;
+
+/** The type of object a channel of `path` targets: SY_TYPE_NODE for translation, rotation, scale and
+ * weights, SY_TYPE_MATERIAL, SY_TYPE_LIGHT or SY_TYPE_CAMERA for the others; 0 for an unknown path. */
+uint32_t sy_anim_path_target(uint32_t path);
+/** Components a sampler of a channel of `path` has (weights: 0, any from 1 to SY_ANIM_MAX_COMPONENTS). */
+uint32_t sy_anim_path_components(uint32_t path);
+/** The path's name ("translation", "base_color", ... ; "unknown" past SY_ANIM_PATH_COUNT). */
+const char *sy_anim_path_name(uint32_t path);
 
 #define SY_ANIM_MAX_KEYS (1u << 24)      /**< keys of one sampler */
 #define SY_ANIM_MAX_SAMPLERS (1u << 20)  /**< samplers of one animation */
@@ -572,7 +593,7 @@ typedef struct sy_anim_sampler {
 
 /** One channel as stored in the channels blob (12 bytes). */
 typedef struct sy_anim_channel {
-    uint32_t node;    /**< target node id (sy_node.id) */
+    uint32_t node;    /**< target id: a node (sy_node.id), or the material, light or camera of the path (sy_anim_path_target) */
     uint32_t path;    /**< sy_anim_path */
     uint32_t sampler; /**< index into the samplers */
 } sy_anim_channel;

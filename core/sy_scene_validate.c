@@ -73,6 +73,33 @@ static sy_result check_gradient(const sy_gradient *g, sy_error *err)
     return SY_OK;
 }
 
+uint32_t sy_anim_path_target(uint32_t path)
+{
+    if (path <= SY_ANIM_WEIGHTS) return SY_TYPE_NODE;
+    if (path <= SY_ANIM_ROUGHNESS) return SY_TYPE_MATERIAL;
+    if (path <= SY_ANIM_LIGHT_INTENSITY) return SY_TYPE_LIGHT;
+    return path == SY_ANIM_CAMERA_YFOV ? SY_TYPE_CAMERA : 0u;
+}
+
+uint32_t sy_anim_path_components(uint32_t path)
+{
+    static const uint8_t comps[SY_ANIM_PATH_COUNT] = {3, 4, 3, 0, 4, 3, 1, 3, 1, 1, 3, 1, 1};
+    return path < SY_ANIM_PATH_COUNT ? comps[path] : 0u;
+}
+
+const char *sy_anim_path_name(uint32_t path)
+{
+    static const char *const names[SY_ANIM_PATH_COUNT] = {
+        "translation", "rotation",  "scale",       "weights",         "base_color",      "diffuse",    "opacity",
+        "emissive",    "metallic", "roughness", "light_color", "light_intensity", "camera_yfov"};
+    return path < SY_ANIM_PATH_COUNT ? names[path] : "unknown";
+}
+
+static const char *type_word(uint32_t t)
+{
+    return t == SY_TYPE_NODE ? "node" : t == SY_TYPE_MATERIAL ? "material" : t == SY_TYPE_LIGHT ? "light" : "camera";
+}
+
 /* An animation blob of whole records of `elem` bytes, at most `max` of them (NULL = none). */
 static sy_result check_records(const sy_blob *b, size_t elem, uint32_t max, uint32_t id, const char *what, sy_error *err)
 {
@@ -128,9 +155,11 @@ static sy_result check_animation_field(const sy_scene *s, uint32_t id, uint32_t 
             if (ch[i].path >= SY_ANIM_PATH_COUNT)
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x channel %u: unknown path %u", id, i,
                                     ch[i].path);
-            if (ch[i].node == 0 || !ref_ok(s, SY_TYPE_NODE, ch[i].node))
-                return sy_error_set(err, SY_ERR_INVALID_HANDLE, "animation %#x channel %u: target node %#x is not a live node",
-                                    id, i, ch[i].node);
+            uint32_t tt = sy_anim_path_target(ch[i].path);
+            if (ch[i].node == 0 || !ref_ok(s, tt, ch[i].node))
+                return sy_error_set(err, SY_ERR_INVALID_HANDLE,
+                                    "animation %#x channel %u: target %s %#x of its %s path is not a live %s", id, i,
+                                    type_word(tt), ch[i].node, sy_anim_path_name(ch[i].path), type_word(tt));
         }
         return SY_OK;
     }
@@ -192,18 +221,18 @@ static sy_result check_animation(const sy_animation_data *d, uint32_t id, sy_err
             break;
         }
         const sy_anim_sampler *a = &sm[ch[c].sampler];
-        uint32_t want = ch[c].path == SY_ANIM_ROTATION ? 4u : 3u;
+        uint32_t want = sy_anim_path_components(ch[c].path);
         if (ch[c].path != SY_ANIM_WEIGHTS && a->components != want) {
             r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
                              "animation %#x channel %u: sampler %u has %u components, the %s path takes %u", id, c,
-                             ch[c].sampler, a->components,
-                             ch[c].path == SY_ANIM_TRANSLATION ? "translation"
-                             : ch[c].path == SY_ANIM_ROTATION  ? "rotation"
-                                                               : "scale",
-                             want);
+                             ch[c].sampler, a->components, sy_anim_path_name(ch[c].path), want);
             break;
         }
-        uint8_t bit = ch[c].path == SY_ANIM_ROTATION ? 2u : ch[c].path == SY_ANIM_WEIGHTS ? 0u : 1u;
+        /* values in range: node translation and scale (bit 1), rotation (bit 2); the other paths'
+         * values are checked by their object's setter when the clock sets them */
+        uint8_t bit = ch[c].path == SY_ANIM_ROTATION                                   ? 2u
+                      : ch[c].path == SY_ANIM_TRANSLATION || ch[c].path == SY_ANIM_SCALE ? 1u
+                                                                                       : 0u;
         if (!bit || (checked[ch[c].sampler] & bit)) continue;
         checked[ch[c].sampler] |= bit;
         uint32_t per = a->interpolation == SY_INTERP_CUBICSPLINE ? 3u : 1u;

@@ -81,12 +81,15 @@ static sy_result load_common(const char *path, const void *mem, size_t size, con
     if (r && strncmp(L.err.message, path, strlen(path)) != 0) sy_error_prefix(&L.err, "%s", path);
     if (!r) {
         x3d_finish_lights(&L);
+        r = x3d_fix_light_animations(&L);
         info->root = root;
     }
     if (L.cache) xmlHashFree(L.cache, x3d_free_created);
     if (L.inline_roots) xmlHashFree(L.inline_roots, x3d_free_created);
     if (L.warned) xmlHashFree(L.warned, x3d_free_none);
     free(L.lights);
+    free(L.mat_links);
+    free(L.ifix);
     if (r) {
         for (size_t k = L.obj_count; k-- > 0;) sy_object_destroy(scene, L.objs[k].type, L.objs[k].id, NULL);
         free(L.objs);

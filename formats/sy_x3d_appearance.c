@@ -300,6 +300,7 @@ sy_result x3d_get_material(loader *L, xfile *F, const xmlNode *app, bool solid, 
         md.base_color[0] = md.base_color[1] = md.base_color[2] = 1.0f;
         md.roughness = 1.0f;
     }
+    bool rgb_replaced = false; /* the diffuse colour does not show (a texture or vertex colours replace it) */
     /* Appearance-level texture (X3D 3: replaces the diffuse colour for RGB textures) */
     if (app && !md.base_color_texture.texture.id) {
         const xmlNode *t = x3d_field_child(L, F, app, "ImageTexture|MultiTexture|MovieTexture|PixelTexture", "texture");
@@ -309,14 +310,14 @@ sy_result x3d_get_material(loader *L, xfile *F, const xmlNode *app, bool solid, 
             alpha_channels = (ch == 2 || ch == 4);
             if (mat && strcmp(x3d_ename(mat), "PhysicalMaterial") != 0 && !css) {
                 /* X3D lighting model: an RGB texture replaces the diffuse colour, grey modulates it */
-                if (ch >= 3) md.base_color[0] = md.base_color[1] = md.base_color[2] = 1.0f;
+                if (ch >= 3) md.base_color[0] = md.base_color[1] = md.base_color[2] = 1.0f, rgb_replaced = true;
             } else if (!mat && !css) {
                 md.base_color[0] = md.base_color[1] = md.base_color[2] = 1.0f;
             }
         }
     }
     if (vcolors && !css && !(mat && !strcmp(x3d_ename(mat), "PhysicalMaterial")))
-        md.base_color[0] = md.base_color[1] = md.base_color[2] = 1.0f; /* X3D: Color replaces diffuseColor */
+        md.base_color[0] = md.base_color[1] = md.base_color[2] = 1.0f, rgb_replaced = true; /* X3D: Color replaces diffuseColor */
     if (stroke && !css) {
         /* X3D points and lines are unlit: the Material's emissiveColor (UnlitMaterial: its colour;
          * no Material: white), replaced by the Color node's colours when present */
@@ -358,6 +359,20 @@ sy_result x3d_get_material(loader *L, xfile *F, const xmlNode *app, bool solid, 
         return r;
     }
     L->info->counts.materials++;
+    if (mat && !css) { /* where ROUTEs to the Material's colours go in this variant (sy_x3d_anim.c) */
+        bool unlit = !strcmp(x3d_ename(mat), "UnlitMaterial"), phys = !strcmp(x3d_ename(mat), "PhysicalMaterial");
+        mat_link ml = {mat, F->serial, id, X3D_NO_PATH, X3D_NO_PATH};
+        if (!unlit && !stroke && !rgb_replaced) ml.diffuse = SY_ANIM_DIFFUSE;
+        if ((unlit || stroke) && !(vcolors && !phys)) ml.emissive = SY_ANIM_DIFFUSE; /* unlit: emissive is the colour */
+        else if (!unlit && !stroke) ml.emissive = SY_ANIM_EMISSIVE;
+        if (L->mat_link_count == L->mat_link_cap) {
+            size_t cap = L->mat_link_cap ? 2 * L->mat_link_cap : 16;
+            mat_link *p = realloc(L->mat_links, cap * sizeof *p);
+            if (!p) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+            L->mat_links = p, L->mat_link_cap = cap;
+        }
+        L->mat_links[L->mat_link_count++] = ml;
+    }
     c->done = true;
     c->material = id;
     c->tex_channels = md.normal_texture.texture.id != 0;

@@ -7,6 +7,7 @@
  *   sy_x3d_geometry.c    one geometry node -> sy_primitive (primitives, points, lines, Text)
  *   sy_x3d_lights.c      lights, viewpoints (and the public camera calls), Background
  *   sy_x3d_nodes.c       the walk: files and Inline, grouping nodes, Transform, Shape
+ *   sy_x3d_anim.c        TimeSensors, interpolators and ROUTEs -> animations (after each file's walk)
  *   sy_x3d.c             the public entry points (sy_x3d.h)
  * Every function here starts with x3d_ (types and constants never leave these files). */
 #ifndef SY_X3D_INTERNAL_H
@@ -52,7 +53,24 @@ typedef struct pending_light {
     float pos[3];
     float intensity; /* X3D intensity * pi */
     float a2;        /* quadratic attenuation */
+    float mult;      /* what x3d_finish_lights multiplies intensity by (1 / a2, or the squared distance) */
 } pending_light;
+
+/* A routed intensity of a point or spot light (sy_x3d_anim.c): its sampler holds X3D intensity x pi
+ * until x3d_fix_light_animations multiplies it by the light's mult. */
+typedef struct intensity_fix {
+    uint32_t animation, sampler, light;
+} intensity_fix;
+
+/* A Material element's sy_material (one per Appearance variant: solid, vertex colours, strokes)
+ * and the animation paths its colour fields drive there (sy_anim_path, X3D_NO_PATH when that
+ * field does not show in this variant): ROUTEs to a Material's fields (sy_x3d_anim.c). */
+typedef struct mat_link {
+    const xmlNode *mat;
+    uint32_t serial, material;
+    uint8_t diffuse, emissive; /* diffuseColor / baseColor, emissiveColor */
+} mat_link;
+#define X3D_NO_PATH 0xFFu
 
 typedef struct loader {
     sy_scene *scene;
@@ -67,6 +85,10 @@ typedef struct loader {
     size_t obj_count, obj_cap;
     pending_light *lights;
     size_t light_count, light_cap;
+    mat_link *mat_links;
+    size_t mat_link_count, mat_link_cap;
+    intensity_fix *ifix;
+    size_t ifix_count, ifix_cap;
     sy_bounds bounds; /* world bounds of the shapes (first placement), for light intensities */
     bool have_background;
     uint32_t file_serial;
@@ -187,6 +209,8 @@ sy_result x3d_build_geometry(loader *L, xfile *F, const xmlNode *el, const xmlNo
 /* >>lights, viewpoints, background (sy_x3d_lights.c) ------------------------------------------ */
 
 sy_result x3d_visit_light(loader *L, xfile *F, const xmlNode *el, const sy_mat4 *world, sy_node h);
+/* Quaternion rotating -Z onto direction d (normalised; a zero d: identity). */
+void x3d_quat_from_neg_z(const float d[3], float q[4]);
 /* Point and spot light intensities from the scene's bounds (after the walk). */
 void x3d_finish_lights(loader *L);
 sy_result x3d_visit_viewpoint(loader *L, xfile *F, const xmlNode *el, sy_node h);
@@ -198,6 +222,8 @@ sy_result x3d_visit_background(loader *L, xfile *F, const xmlNode *el);
  * and returns the node of its Scene. */
 /* The file's TimeSensors, interpolators and ROUTEs as animations (sy_x3d_anim.c); after the walk. */
 sy_result x3d_load_animations(loader *L, xfile *F, const xmlNode *scene);
+/* After x3d_finish_lights: routed point and spot light intensities scaled like their lights. */
+sy_result x3d_fix_light_animations(loader *L);
 sy_result x3d_load_file(loader *L, const char *path, const void *mem, size_t mem_size, const char *base_dir,
                         xfile *parent, sy_node *root_out, const xmlNode *at, xfile *atF);
 

@@ -11,8 +11,7 @@
 
 /* >>lights ------------------------------------------------------------------------------------ */
 
-/* Quaternion rotating -Z onto d (unit). */
-static void quat_from_neg_z(const float d_in[3], float q[4])
+void x3d_quat_from_neg_z(const float d_in[3], float q[4])
 {
     float d[3] = {d_in[0], d_in[1], d_in[2]};
     float l = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -44,7 +43,7 @@ sy_result x3d_visit_light(loader *L, xfile *F, const xmlNode *el, const sy_mat4 
     if (!strcmp(n, "DirectionalLight")) {
         ld.type = SY_LIGHT_DIRECTIONAL;
         ld.intensity = inten * PI_F;
-        quat_from_neg_z(dir, q);
+        x3d_quat_from_neg_z(dir, q);
         loc[0] = loc[1] = loc[2] = 0;
     } else if (!strcmp(n, "PointLight")) {
         ld.type = SY_LIGHT_POINT;
@@ -56,7 +55,7 @@ sy_result x3d_visit_light(loader *L, xfile *F, const xmlNode *el, const sy_mat4 
         cut = fmaxf(1e-4f, fminf(PI_F / 2, cut));
         ld.outer_cone = cut;
         ld.inner_cone = fmaxf(0.0f, fminf(beam, cut * 0.999f));
-        quat_from_neg_z(dir, q);
+        x3d_quat_from_neg_z(dir, q);
     }
     sy_result r;
     char *def = x3d_attr(el, "DEF");
@@ -84,6 +83,7 @@ sy_result x3d_visit_light(loader *L, xfile *F, const xmlNode *el, const sy_mat4 
         sy_mat4_transform_point(world, loc, pl->pos);
         pl->intensity = inten * PI_F;
         pl->a2 = att[2] > 0 && isfinite(att[2]) ? att[2] : 0.0f;
+        pl->mult = 1.0f;
     }
     return SY_OK;
 }
@@ -103,12 +103,13 @@ void x3d_finish_lights(loader *L)
         if (!cur) continue;
         sy_light_data ld = *cur;
         if (pl->a2 > 0) {
-            ld.intensity = pl->intensity / pl->a2;
+            pl->mult = 1.0f / pl->a2;
         } else {
             float d[3] = {pl->pos[0] - centre[0], pl->pos[1] - centre[1], pl->pos[2] - centre[2]};
             float dist = fmaxf(sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), 0.05f * diag);
-            ld.intensity = pl->intensity * dist * dist;
+            pl->mult = dist * dist;
         }
+        ld.intensity = pl->intensity * pl->mult;
         sy_light_set(L->scene, (sy_light){pl->light}, &ld, NULL);
     }
 }

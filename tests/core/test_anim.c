@@ -4,7 +4,7 @@
  * destroyed nodes), weight channels into the node's morph weights, validation of bad samplers and channels (each refused naming the item),
  * a change-list round trip (serialize -> deserialize -> apply: the same animation, and set_time on
  * both scenes gives equal nodes; the origin's set_time reaches the replica as a plain node change),
- * clip lookup and the play clock. */
+ * clip lookup and the play clock; material, light and camera channels (test_properties). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -229,7 +229,7 @@ static int test_validation(void)
     CHECK_ERR(one_channel(s, &a, (sy_node){0x7777}, SY_ANIM_TRANSLATION, SY_INTERP_LINEAR, 3, 2, t2, v6, &e),
               SY_ERR_INVALID_HANDLE, e);
     EXPECT_SAYS(e, "channel 0: target node");
-    CHECK_ERR(one_channel(s, &a, n, 9, SY_INTERP_LINEAR, 3, 2, t2, v6, &e), SY_ERR_INVALID_ARGUMENT, e);
+    CHECK_ERR(one_channel(s, &a, n, SY_ANIM_PATH_COUNT, SY_INTERP_LINEAR, 3, 2, t2, v6, &e), SY_ERR_INVALID_ARGUMENT, e);
     EXPECT_SAYS(e, "unknown path");
     CHECK_ERR(one_channel(s, &a, n, SY_ANIM_TRANSLATION, 7, 3, 2, t2, v6, &e), SY_ERR_INVALID_ARGUMENT, e);
     EXPECT_SAYS(e, "unknown interpolation");
@@ -429,6 +429,94 @@ static int test_clock(void)
     return 0;
 }
 
+/* Material, light and camera channels: each sets its object's field (base colour, its RGB or alpha
+ * alone, emissive, metallic, roughness, light colour and intensity, camera yfov) at the sampled
+ * value; a channel whose path names another type of object, or whose sampler has the wrong
+ * component count, is refused naming it; an out-of-range value is refused by the setter and
+ * counted failed; a destroyed target is skipped; a replica gets the same clip and the same values. */
+static int test_properties(void)
+{
+    sy_error e = {0};
+    sy_scene *s = new_scene();
+    sy_material m;
+    sy_light l;
+    sy_camera c;
+    CHECK_OK(sy_material_create(s, "paint", &m, &e), e);
+    CHECK_OK(sy_light_create(s, "lamp", &l, &e), e);
+    CHECK_OK(sy_camera_create(s, "eye", &c, &e), e);
+    const float times[2] = {0, 2}, rgba[8] = {1, 0, 0, 1, 0, 1, 0, 0.5f}, rgb[6] = {0, 0, 1, 1, 1, 0}, one[2] = {0.2f, 0.6f};
+    const float fov[2] = {0.5f, 1.0f}, inten[2] = {10, 30};
+    sy_anim_sampler_desc sd[5] = {{SY_INTERP_LINEAR, 4, 2, times, rgba}, {SY_INTERP_LINEAR, 3, 2, times, rgb},
+                                  {SY_INTERP_LINEAR, 1, 2, times, one},  {SY_INTERP_LINEAR, 1, 2, times, fov},
+                                  {SY_INTERP_STEP, 1, 2, times, inten}};
+    sy_anim_channel ch[7] = {{m.id, SY_ANIM_BASE_COLOR, 0}, {m.id, SY_ANIM_EMISSIVE, 1}, {m.id, SY_ANIM_ROUGHNESS, 2},
+                             {l.id, SY_ANIM_LIGHT_COLOR, 1}, {l.id, SY_ANIM_LIGHT_INTENSITY, 4},
+                             {c.id, SY_ANIM_CAMERA_YFOV, 3}, {m.id, SY_ANIM_OPACITY, 2}};
+    sy_animation a;
+    CHECK_OK(sy_animation_create(s, "props", &a, &e), e);
+    CHECK_OK(sy_animation_set_clip(s, a, sd, 5, ch, 7, &e), e);
+    sy_anim_stats st;
+    CHECK_OK(sy_scene_set_time_ex(s, (sy_animation){0}, 0.5, &st, &e), e); /* u = 0.25 */
+    EXPECT(st.properties == 7 && st.failed == 0 && st.channels == 0);
+    const sy_material_data *md = sy_material_get(s, m);
+    EXPECT_NEAR(md->base_color[0], 0.75, 1e-6);
+    EXPECT_NEAR(md->base_color[1], 0.25, 1e-6);
+    EXPECT_NEAR(md->base_color[3], 0.3, 1e-6); /* the opacity channel (later in the clip) set the alpha alone */
+    EXPECT_NEAR(md->emissive[0], 0.25, 1e-6);
+    EXPECT_NEAR(md->emissive[2], 0.75, 1e-6);
+    EXPECT_NEAR(md->roughness, 0.3, 1e-6);
+    EXPECT_NEAR(sy_light_get(s, l)->color[1], 0.25, 1e-6);
+    EXPECT_NEAR(sy_light_get(s, l)->intensity, 10.0, 0.0); /* STEP */
+    EXPECT_NEAR(sy_camera_get(s, c)->yfov, 0.625, 1e-6);
+    /* a replica holds the same clip and evaluates to the same values */
+    CHECK_OK(sy_scene_commit(s, NULL, &e), e);
+    sy_scene *r = new_scene();
+    wire_copy wc;
+    if (wire_copy_send(&wc, s, r)) return 1;
+    wire_copy_free(&wc);
+    CHECK_OK(sy_scene_set_time(s, (sy_animation){0}, 1.5, &e), e);
+    CHECK_OK(sy_scene_set_time(r, (sy_animation){0}, 1.5, &e), e);
+    EXPECT(memcmp(sy_material_get(s, m)->base_color, sy_material_get(r, m)->base_color, 16) == 0);
+    EXPECT_NEAR(sy_camera_get(r, c)->yfov, 0.875, 1e-6);
+    EXPECT_NEAR(sy_light_get(r, l)->intensity, 10.0, 0.0);
+    sy_scene_destroy(r);
+    /* the DIFFUSE path sets the RGB and keeps the alpha */
+    sy_animation d = {0};
+    CHECK_OK(one_channel(s, &d, (sy_node){m.id}, SY_ANIM_DIFFUSE, SY_INTERP_LINEAR, 3, 2, times, rgb, &e), e);
+    CHECK_OK(sy_scene_set_time(s, d, 1.0, &e), e);
+    EXPECT_NEAR(sy_material_get(s, m)->base_color[0], 0.5, 1e-6);
+    EXPECT_NEAR(sy_material_get(s, m)->base_color[2], 0.5, 1e-6);
+    EXPECT_NEAR(sy_material_get(s, m)->base_color[3], 0.5, 1e-6); /* left by the last call (alpha 1 - 0.5) */
+    /* refused: an id that is no material on a material path, a material on a node path (ids are per
+     * type: the scene's second material is no object yet), the wrong component count */
+    sy_animation b = {0};
+    sy_material m2;
+    CHECK_OK(sy_material_create(s, "second", &m2, &e), e);
+    CHECK_OK(sy_object_destroy(s, SY_TYPE_MATERIAL, m2.id, &e), e);
+    CHECK_ERR(one_channel(s, &b, (sy_node){m2.id}, SY_ANIM_BASE_COLOR, SY_INTERP_LINEAR, 4, 2, times, rgba, &e), SY_ERR_INVALID_HANDLE, e);
+    EXPECT_SAYS(e, "base_color");
+    EXPECT_SAYS(e, "material");
+    sy_node n2 = new_node(s, "n2");
+    CHECK_OK(sy_object_destroy(s, SY_TYPE_NODE, n2.id, &e), e);
+    CHECK_ERR(one_channel(s, &b, n2, SY_ANIM_TRANSLATION, SY_INTERP_LINEAR, 3, 2, times, rgb, &e), SY_ERR_INVALID_HANDLE, e);
+    EXPECT_SAYS(e, "not a live node");
+    CHECK_ERR(one_channel(s, &b, (sy_node){l.id}, SY_ANIM_LIGHT_INTENSITY, SY_INTERP_LINEAR, 3, 2, times, rgb, &e),
+              SY_ERR_INVALID_ARGUMENT, e);
+    EXPECT_SAYS(e, "light_intensity path takes 1");
+    /* an out-of-range value (a negative intensity) is refused by the light's setter: counted failed */
+    const float neg[2] = {-5, -5};
+    sy_animation g = {0};
+    CHECK_OK(one_channel(s, &g, (sy_node){l.id}, SY_ANIM_LIGHT_INTENSITY, SY_INTERP_LINEAR, 1, 2, times, neg, &e), e);
+    EXPECT(sy_scene_set_time_ex(s, g, 1.0, &st, &e) != SY_OK && st.failed == 1);
+    EXPECT_SAYS(e, "channel 0");
+    /* a destroyed target is skipped */
+    CHECK_OK(sy_object_destroy(s, SY_TYPE_CAMERA, c.id, &e), e);
+    CHECK_OK(sy_scene_set_time_ex(s, a, 1.0, &st, &e), e);
+    EXPECT(st.skipped_stale == 1 && st.properties == 6);
+    sy_scene_destroy(s);
+    return 0;
+}
+
 int main(void)
 {
     RUN(test_step_linear_clamp);
@@ -437,6 +525,7 @@ int main(void)
     RUN(test_what_channels_leave);
     RUN(test_validation);
     RUN(test_round_trip);
+    RUN(test_properties);
     RUN(test_timing);
     RUN(test_clock);
     return sy_check_finish("core_anim");

@@ -665,7 +665,7 @@ static int op_animation(sy_scene *s)
     sy_anim_sampler_desc sd[4];
     sy_anim_channel ch[4];
     for (uint32_t c = 0; c < nc; ++c) {
-        uint32_t path = rn(SY_ANIM_PATH_COUNT), comps = path == SY_ANIM_ROTATION ? 4 : path == SY_ANIM_WEIGHTS ? 1 + rn(3) : 3;
+        uint32_t path = rn(SY_ANIM_WEIGHTS + 1), comps = path == SY_ANIM_ROTATION ? 4 : path == SY_ANIM_WEIGHTS ? 1 + rn(3) : 3;
         uint32_t keys = 1 + rn(5), interp = rn(SY_INTERP_COUNT), per = interp == SY_INTERP_CUBICSPLINE ? 3 : 1;
         float t = rf(-1, 1);
         for (uint32_t k = 0; k < keys; ++k) times[c][k] = t += 0.0625f + fabsf(rf(0.01f, 1)); /* rf may give -0 */

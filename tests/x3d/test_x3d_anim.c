@@ -3,8 +3,13 @@
  * per sensor (DEF name, cycleInterval as its period, loop), node transforms at given times equal
  * the X3D interpolation computed here (key x cycleInterval, linear positions, orientations along
  * the shorter arc, looping sensors wrapping), equal keys jump, and what does not map is reported
- * naming the file and line: mismatched key / keyValue counts, decreasing keys, other
- * interpolators, routes to other fields or undefined nodes, Transforms with a center; the
+ * naming the file and line: mismatched key / keyValue counts, decreasing keys, routes to undefined
+ * nodes, Transforms with a center. test_fields: Color- and ScalarInterpolators into Material,
+ * PhysicalMaterial, light and Viewpoint fields, positions and orientations into a Viewpoint and
+ * a light's direction, at two times against X3D's interpolation computed here (HSV colours,
+ * 1 - transparency, intensities scaled as the loader scales the lights); routes whose types differ,
+ * that close a loop or come from undefined nodes, and the interpolators whose targets are baked
+ * (Coordinate, PositionInterpolator2D) are warned about, naming the ROUTE's line; the
  * shared sample HelloX3dTrademark.x3d (a spinning Earth) turns a quarter every 3 s.
  * Usage: test_x3d_anim [TESTDATA_DIR]. */
 #include "sy_anim.h"
@@ -71,16 +76,13 @@ static void test_routes(void)
     const sy_animation_data *ad = sy_animation_get(l.scene, clip);
     uint32_t nch = 0;
     if (ad) sy_animation_channels(ad, &nch);
-    EXPECT_MSG(ad && ad->name && !strcmp(ad->name, "Clock") && ad->cycle == 4.0f && ad->loop == 1 && nch == 2,
-               "clip Clock, period 4, loop, 2 channels: %s %g %u %u", ad && ad->name ? ad->name : "-",
+    EXPECT_MSG(ad && ad->name && !strcmp(ad->name, "Clock") && ad->cycle == 4.0f && ad->loop == 1 && nch == 3,
+               "clip Clock, period 4, loop, 3 channels: %s %g %u %u", ad && ad->name ? ad->name : "-",
                ad ? (double)ad->cycle : 0.0, ad ? ad->loop : 0, nch);
     EXPECT_MSG(has_warning(&l, "anim.x3d:8: PositionInterpolator: 2 keys and 1 key values", NULL), "Short's counts");
     EXPECT_MSG(has_warning(&l, "anim.x3d:9: PositionInterpolator: key 2 (0.5) is less than the key before it", NULL),
                "Back's keys");
-    EXPECT_MSG(has_warning(&l, "anim.x3d:10: ColorInterpolator: not played", NULL), "ColorInterpolator");
     EXPECT_MSG(has_warning(&l, "anim.x3d:16:", "center or scaleOrientation"), "Pivot has a center");
-    EXPECT_MSG(has_warning(&l, "anim.x3d:22: ROUTE from a PositionInterpolator to Transform.scale: not played", NULL),
-               "route to scale");
     EXPECT_MSG(has_warning(&l, "anim.x3d:23: ROUTE to 'Nowhere'", "not DEFined"), "route to an undefined node");
     sy_node mover = node_named(&l, "Mover"), spinner = node_named(&l, "Spinner");
     /* Path: fraction f = (t mod 4) / 4; 0 -> (0,0,0), 0.5 -> (2,0,0) then the jump to (2,4,0) (one
@@ -89,7 +91,10 @@ static void test_routes(void)
                                                {3.0, 2, 4, 4}, {5.0, 1, 0, 0}, {-3.0, 1, 0, 0}};
     for (size_t i = 0; i < sizeof pt / sizeof pt[0]; ++i) {
         set_time(&l, pt[i].t);
-        const float *p = pos(&l, mover);
+        const float *p = pos(&l, mover), *sc = sy_node_get(l.scene, mover)->transform.scale;
+        /* Path also drives Mover's scale (a later route in the file: both apply, in the clip's order) */
+        EXPECT_MSG(fabsf(sc[0] - pt[i].x) < 2e-3f && fabsf(sc[1] - pt[i].y) < 2e-3f && fabsf(sc[2] - pt[i].z) < 2e-3f,
+                   "Mover's scale at t = %g: (%g %g %g)", pt[i].t, (double)sc[0], (double)sc[1], (double)sc[2]);
         EXPECT_MSG(fabsf(p[0] - pt[i].x) < 2e-3f && fabsf(p[1] - pt[i].y) < 2e-3f && fabsf(p[2] - pt[i].z) < 2e-3f,
                    "Mover at t = %g: (%g %g %g), want (%g %g %g)", pt[i].t, (double)p[0], (double)p[1], (double)p[2],
                    (double)pt[i].x, (double)pt[i].y, (double)pt[i].z);
@@ -99,6 +104,132 @@ static void test_routes(void)
     set_time(&l, 2.0);
     EXPECT_MSG(fabsf(yaw(rot(&l, spinner)) - 1.5f) < 1e-4f && pos(&l, spinner)[0] == 5.0f, "Spinner at t = 2: yaw %g (want 1.5)",
                (double)yaw(rot(&l, spinner)));
+    unload(&l);
+}
+
+static const sy_material_data *material_named(const loaded *l, const char *name)
+{
+    for (uint32_t id = sy_scene_next(l->scene, SY_TYPE_MATERIAL, 0); id; id = sy_scene_next(l->scene, SY_TYPE_MATERIAL, id)) {
+        const sy_material_data *m = sy_object_get(l->scene, SY_TYPE_MATERIAL, id);
+        if (m->name && !strcmp(m->name, name)) return m;
+    }
+    return NULL;
+}
+
+/* X3D's HSV interpolation of red (hue 0) to blue (hue 240 degrees), the shorter way (through
+ * magenta, 300): hue 360 - 120 u, full saturation and value */
+static void red_to_blue(float u, float c[3])
+{
+    float h = 360.0f - 120.0f * u; /* in [240, 360]: from blue (240) through magenta (300) to red */
+    if (h >= 300.0f) c[0] = 1.0f, c[1] = 0.0f, c[2] = (360.0f - h) / 60.0f;
+    else c[0] = (h - 240.0f) / 60.0f, c[1] = 0.0f, c[2] = 1.0f;
+}
+
+static bool near3(const float *a, const float *b, float tol)
+{
+    return fabsf(a[0] - b[0]) < tol && fabsf(a[1] - b[1]) < tol && fabsf(a[2] - b[2]) < tol;
+}
+
+static void test_fields(void)
+{
+    loaded l = load_text("fields.x3d",
+        "<X3D><Scene>\n"
+        "<Viewpoint DEF='Cam' position='0 0 10'/>\n"                                                            /* 2 */
+        "<PointLight DEF='Lamp' location='0 5 0' attenuation='0 0 2'/>\n"                                       /* 3 */
+        "<DirectionalLight DEF='Sun' direction='0 0 -1' intensity='0.5'/>\n"                                    /* 4 */
+        "<Shape><Appearance><Material DEF='Paint' diffuseColor='1 0 0'/></Appearance><Box/></Shape>\n"          /* 5 */
+        "<Shape><Appearance><PhysicalMaterial DEF='Metal' baseColor='1 1 1'/></Appearance><Sphere/></Shape>\n"  /* 6 */
+        "<Shape><IndexedFaceSet coordIndex='0 1 2'><Coordinate DEF='Pts' point='0 0 0 1 0 0 0 1 0'/></IndexedFaceSet></Shape>\n" /* 7 */
+        "<TimeSensor DEF='Clock' cycleInterval='2'/>\n"                                                         /* 8 */
+        "<ColorInterpolator DEF='Hue' key='0 1' keyValue='1 0 0 0 0 1'/>\n"                                     /* 9 */
+        "<ScalarInterpolator DEF='Fade' key='0 1' keyValue='0 0.8'/>\n"                                         /* 10 */
+        "<ScalarInterpolator DEF='Bright' key='0 1' keyValue='1 3'/>\n"                                         /* 11 */
+        "<ScalarInterpolator DEF='Zoom' key='0 1' keyValue='0.5 1.0'/>\n"                                       /* 12 */
+        "<PositionInterpolator DEF='Dolly' key='0 1' keyValue='0 0 10 0 0 20'/>\n"                              /* 13 */
+        "<OrientationInterpolator DEF='Pan' key='0 1' keyValue='0 1 0 0 0 1 0 1'/>\n"                           /* 14 */
+        "<PositionInterpolator DEF='Aim' key='0 1' keyValue='0 0 -1 1 0 0'/>\n"                                 /* 15 */
+        "<ScalarInterpolator DEF='Rough' key='0 1' keyValue='0.2 0.6'/>\n"                                      /* 16 */
+        "<CoordinateInterpolator DEF='Morph' key='0 1' keyValue='0 0 0 1 1 1'/>\n"                              /* 17 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Hue' toField='set_fraction'/>\n"          /* 18 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Fade' toField='set_fraction'/>\n"         /* 19 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Bright' toField='set_fraction'/>\n"       /* 20 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Zoom' toField='set_fraction'/>\n"         /* 21 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Dolly' toField='set_fraction'/>\n"        /* 22 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Pan' toField='set_fraction'/>\n"          /* 23 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Aim' toField='set_fraction'/>\n"          /* 24 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Rough' toField='set_fraction'/>\n"        /* 25 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Morph' toField='set_fraction'/>\n"        /* 26 */
+        "<ROUTE fromNode='Hue' fromField='value_changed' toNode='Paint' toField='set_diffuseColor'/>\n"         /* 27 */
+        "<ROUTE fromNode='Hue' fromField='value_changed' toNode='Lamp' toField='color'/>\n"                     /* 28 */
+        "<ROUTE fromNode='Hue' fromField='value_changed' toNode='Metal' toField='emissiveColor'/>\n"            /* 29 */
+        "<ROUTE fromNode='Fade' fromField='value_changed' toNode='Paint' toField='transparency'/>\n"            /* 30 */
+        "<ROUTE fromNode='Bright' fromField='value_changed' toNode='Sun' toField='intensity'/>\n"               /* 31 */
+        "<ROUTE fromNode='Bright' fromField='value_changed' toNode='Lamp' toField='intensity'/>\n"              /* 32 */
+        "<ROUTE fromNode='Zoom' fromField='value_changed' toNode='Cam' toField='fieldOfView'/>\n"               /* 33 */
+        "<ROUTE fromNode='Dolly' fromField='value_changed' toNode='Cam' toField='position'/>\n"                 /* 34 */
+        "<ROUTE fromNode='Pan' fromField='value_changed' toNode='Cam' toField='orientation'/>\n"                /* 35 */
+        "<ROUTE fromNode='Aim' fromField='value_changed' toNode='Sun' toField='direction'/>\n"                  /* 36 */
+        "<ROUTE fromNode='Rough' fromField='value_changed' toNode='Metal' toField='roughness'/>\n"              /* 37 */
+        "<ROUTE fromNode='Dolly' fromField='value_changed' toNode='Paint' toField='diffuseColor'/>\n"           /* 38 */
+        "<ROUTE fromNode='Morph' fromField='value_changed' toNode='Pts' toField='point'/>\n"                    /* 39 */
+        "<ROUTE fromNode='Clock' fromField='isActive' toNode='Clock' toField='enabled'/>\n"                     /* 40 */
+        "<ROUTE fromNode='Ghost' fromField='value_changed' toNode='Cam' toField='position'/>\n"                 /* 41 */
+        "<ROUTE fromNode='Fade' fromField='value_changed' toNode='Rough' toField='set_fraction'/>\n"            /* 42 */
+        "<ROUTE fromNode='Rough' fromField='value_changed' toNode='Fade' toField='set_fraction'/>\n"            /* 43 */
+        "</Scene></X3D>\n");
+    EXPECT_MSG(l.r == SY_OK, "fields.x3d: %s", l.err.message);
+    if (l.r != SY_OK) return unload(&l);
+    EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_ANIMATION) == 1, "%u clips (want 1)", sy_scene_count(l.scene, SY_TYPE_ANIMATION));
+    EXPECT_MSG(has_warning(&l, "fields.x3d:38: ROUTE from PositionInterpolator.value_changed (SFVec3f) to "
+                           "Material.diffuseColor (SFColor): the types differ; dropped", NULL), "types differ");
+    EXPECT_MSG(has_warning(&l, "fields.x3d:17: CoordinateInterpolator: not played", NULL), "CoordinateInterpolator");
+    EXPECT_MSG(has_warning(&l, "fields.x3d:40: ROUTE from TimeSensor.isActive to TimeSensor.enabled closes a loop", NULL),
+               "a route to its own node");
+    EXPECT_MSG(has_warning(&l, "fields.x3d:42: ", "closes a loop") || has_warning(&l, "fields.x3d:43: ", "closes a loop"),
+               "Fade <-> Rough");
+    EXPECT_MSG(has_warning(&l, "fields.x3d:41: ROUTE from 'Ghost', which is not DEFined", NULL), "from an undefined node");
+    const sy_material_data *paint = material_named(&l, "Paint"), *metal = material_named(&l, "Metal");
+    sy_node cam = node_named(&l, "Cam"), lamp = node_named(&l, "Lamp"), sun = node_named(&l, "Sun");
+    EXPECT_MSG(paint && metal && cam.id && lamp.id && sun.id, "objects: %p %p %u %u %u", (const void *)paint,
+               (const void *)metal, cam.id, lamp.id, sun.id);
+    if (!paint || !metal || !cam.id || !lamp.id || !sun.id) return unload(&l);
+    const double times[2] = {0.5, 1.5}; /* fractions 0.25 and 0.75 (cycle 2 s, no loop) */
+    for (int i = 0; i < 2; ++i) {
+        float u = (float)times[i] / 2.0f, c[3];
+        set_time(&l, times[i]);
+        paint = material_named(&l, "Paint"), metal = material_named(&l, "Metal");
+        red_to_blue(u, c);
+        EXPECT_MSG(near3(paint->base_color, c, 1e-3f), "t %g: Paint diffuse (%g %g %g), want (%g %g %g)", times[i],
+                   (double)paint->base_color[0], (double)paint->base_color[1], (double)paint->base_color[2], (double)c[0],
+                   (double)c[1], (double)c[2]);
+        EXPECT_MSG(fabsf(paint->base_color[3] - (1.0f - 0.8f * u)) < 1e-4f, "t %g: Paint alpha %g, want %g", times[i],
+                   (double)paint->base_color[3], (double)(1.0f - 0.8f * u));
+        EXPECT_MSG(near3(metal->emissive, c, 1e-3f) && fabsf(metal->roughness - (0.2f + 0.4f * u)) < 1e-4f,
+                   "t %g: Metal emissive (%g %g %g), roughness %g", times[i], (double)metal->emissive[0],
+                   (double)metal->emissive[1], (double)metal->emissive[2], (double)metal->roughness);
+        const sy_light_data *ll = sy_light_get(l.scene, sy_node_get(l.scene, lamp)->light);
+        const sy_light_data *sl = sy_light_get(l.scene, sy_node_get(l.scene, sun)->light);
+        float bright = 1.0f + 2.0f * u;
+        /* X3D intensity x pi; the point light with attenuation (0 0 2): / 2 as well (sy_x3d.h) */
+        EXPECT_MSG(ll && near3(ll->color, c, 1e-3f) && fabsf(ll->intensity - bright * PI_F_TEST / 2.0f) < 1e-3f,
+                   "t %g: Lamp colour (%g %g %g), intensity %g (want %g)", times[i], ll ? (double)ll->color[0] : -1.0,
+                   ll ? (double)ll->color[1] : -1.0, ll ? (double)ll->color[2] : -1.0, ll ? (double)ll->intensity : -1.0,
+                   (double)(bright * PI_F_TEST / 2.0f));
+        EXPECT_MSG(sl && fabsf(sl->intensity - bright * PI_F_TEST) < 1e-3f, "t %g: Sun intensity %g (want %g)", times[i],
+                   sl ? (double)sl->intensity : -1.0, (double)(bright * PI_F_TEST));
+        /* the Sun's direction: X3D's (1 - u) (0 0 -1) + u (1 0 0), normalised, is where the node turns -Z */
+        const float *q = rot(&l, sun);
+        float dz[3] = {-(2 * (q[0] * q[2] + q[1] * q[3])), -(2 * (q[1] * q[2] - q[0] * q[3])),
+                       -(1 - 2 * (q[0] * q[0] + q[1] * q[1]))}; /* R (0 0 -1) */
+        float want[3] = {u, 0.0f, -(1.0f - u)}, n = sqrtf(want[0] * want[0] + want[2] * want[2]);
+        want[0] /= n, want[2] /= n;
+        EXPECT_MSG(near3(dz, want, 1e-3f), "t %g: Sun direction (%g %g %g), want (%g %g %g)", times[i], (double)dz[0],
+                   (double)dz[1], (double)dz[2], (double)want[0], (double)want[1], (double)want[2]);
+        const sy_camera_data *cd = sy_camera_get(l.scene, sy_node_get(l.scene, cam)->camera);
+        EXPECT_MSG(cd && fabsf(cd->yfov - (0.5f + 0.5f * u)) < 1e-4f, "t %g: Cam yfov %g", times[i], cd ? (double)cd->yfov : -1.0);
+        EXPECT_MSG(fabsf(pos(&l, cam)[2] - (10.0f + 10.0f * u)) < 1e-3f && fabsf(yaw(rot(&l, cam)) - u) < 1e-4f,
+                   "t %g: Cam at z %g, yaw %g", times[i], (double)pos(&l, cam)[2], (double)yaw(rot(&l, cam)));
+    }
     unload(&l);
 }
 
@@ -137,6 +268,7 @@ int main(int argc, char **argv)
 {
     make_scratch_dir(g_dir, sizeof g_dir, "x3d_anim");
     test_routes();
+    test_fields();
     test_sample(argc > 1 ? argv[1] : NULL);
     remove_scratch_dir(g_dir);
     return sy_check_finish("x3d_anim");
