@@ -1,7 +1,10 @@
 /* sy_gltf_animations.c — glTF animations into core animation objects (sy_objects.h; played by
  * sy_anim.h): every animation of the file becomes one sy_animation (file order, its name), with the
  * channels that target a loaded node's translation, rotation, scale or weights and the samplers they
- * use. Sampler accessors are read like every other accessor (sy_gltf_accessors.c, after the one
+ * use. KHR_animation_pointer channels whose pointer names a node's TRS or weights, a material's
+ * baseColorFactor, emissiveFactor, metallicFactor or roughnessFactor, a KHR_lights_punctual light's
+ * color or intensity, or a camera's perspective yfov map onto the same paths (sy_anim_path); any
+ * other pointer is dropped with a warning naming the channel and the pointer. Sampler accessors are read like every other accessor (sy_gltf_accessors.c, after the one
  * validation pass), their counts checked and charged to the file's budget before anything is read.
  * A bad sampler or channel is dropped with a warning naming animations[i].samplers[j] /
  * .channels[k]; the rest of the clip stays. */
@@ -10,6 +13,51 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* A KHR_animation_pointer target: the JSON pointer's object index and the path it maps onto;
+ * false (with *why) when the pointer names nothing the clock drives or nothing in this file. */
+static bool pointer_target(const loader *L, const char *ptr, uint32_t *index, int32_t *path, const char **why)
+{
+    static const struct {
+        const char *prefix, *suffix;
+        int32_t path;
+    } maps[] = {
+        {"/nodes/", "/translation", SY_ANIM_TRANSLATION},
+        {"/nodes/", "/rotation", SY_ANIM_ROTATION},
+        {"/nodes/", "/scale", SY_ANIM_SCALE},
+        {"/nodes/", "/weights", SY_ANIM_WEIGHTS},
+        {"/materials/", "/pbrMetallicRoughness/baseColorFactor", SY_ANIM_BASE_COLOR},
+        {"/materials/", "/pbrMetallicRoughness/metallicFactor", SY_ANIM_METALLIC},
+        {"/materials/", "/pbrMetallicRoughness/roughnessFactor", SY_ANIM_ROUGHNESS},
+        {"/materials/", "/emissiveFactor", SY_ANIM_EMISSIVE},
+        {"/extensions/KHR_lights_punctual/lights/", "/color", SY_ANIM_LIGHT_COLOR},
+        {"/extensions/KHR_lights_punctual/lights/", "/intensity", SY_ANIM_LIGHT_INTENSITY},
+        {"/cameras/", "/perspective/yfov", SY_ANIM_CAMERA_YFOV},
+    };
+    *why = "is not one the scene clock drives (node TRS and weights, material base colour, emissive, metallic and "
+           "roughness factors, light colour and intensity, camera yfov)";
+    for (size_t i = 0; i < sizeof maps / sizeof maps[0]; i++) {
+        size_t np = strlen(maps[i].prefix);
+        if (strncmp(ptr, maps[i].prefix, np) != 0) continue;
+        const char *p = ptr + np;
+        if (*p < '0' || *p > '9' || (*p == '0' && p[1] >= '0' && p[1] <= '9')) continue;
+        uint64_t v = 0;
+        while (*p >= '0' && *p <= '9' && v <= UINT32_MAX) v = v * 10 + (uint64_t)(*p++ - '0');
+        if (strcmp(p, maps[i].suffix) != 0) continue;
+        const sy_gltf_doc *d = L->doc;
+        uint32_t t = sy_anim_path_target((uint32_t)maps[i].path);
+        size_t count = t == SY_TYPE_NODE ? d->node_count : t == SY_TYPE_MATERIAL ? d->material_count
+                       : t == SY_TYPE_LIGHT  ? d->light_count : d->camera_count;
+        if (v >= count) {
+            *why = "names an object the file does not have";
+            return false;
+        }
+        *index = (uint32_t)v;
+        *path = maps[i].path;
+        return true;
+    }
+    return false;
+}
 
 /* One read sampler: times and values (malloc()ed), components per value, or dropped (keys 0). */
 typedef struct anim_sampler {
@@ -54,13 +102,12 @@ static sy_result read_sampler(loader *L, size_t ai, size_t j, int32_t path, anim
             return SY_OK;
         }
     } else {
-        comps = path == SY_ANIM_ROTATION ? 4 : 3;
+        comps = sy_anim_path_components((uint32_t)path);
         if ((size_t)oa->components != comps || oa->is_matrix || oa->count != ia->count * per) {
             gltf_warn(L,
                       "animations[%zu].samplers[%zu]: output accessor %d has %zu elements of %d components, the %s "
                       "path needs %zu x %zu%s; dropped",
-                      ai, j, (int)in->output, oa->count, (int)oa->components,
-                      path == SY_ANIM_TRANSLATION ? "translation" : path == SY_ANIM_ROTATION ? "rotation" : "scale",
+                      ai, j, (int)in->output, oa->count, (int)oa->components, sy_anim_path_name((uint32_t)path),
                       ia->count * per, comps, per == 3 ? " (CUBICSPLINE: 3 per key)" : "");
             return SY_OK;
         }
@@ -104,9 +151,11 @@ static sy_result read_sampler(loader *L, size_t ai, size_t j, int32_t path, anim
     return SY_OK;
 }
 
-static const char *path_name(int32_t p)
+/* Paths whose samplers read alike (components and value checks): one sampler may serve several. */
+static int32_t sampler_kind(int32_t p)
 {
-    return p == 0 ? "translation" : p == 1 ? "rotation" : p == 2 ? "scale" : "weights";
+    if (p == SY_ANIM_SCALE) return SY_ANIM_TRANSLATION;
+    return p <= SY_ANIM_WEIGHTS ? p : 100 + (int32_t)sy_anim_path_components((uint32_t)p);
 }
 
 /* Animation ai into one sy_animation (L->info->animations[ai]). */
@@ -132,17 +181,37 @@ static sy_result create_animation(loader *L, size_t ai)
     if (!chans) goto done;
     uint32_t nd = 0, nc = 0;
     for (size_t k = 0; k < an->channel_count; k++) {
-        const sy_gltf_shim_anim_channel *c = &an->channels[k];
-        if (c->path < 0) {
-            gltf_warn(L, "animations[%zu].channels[%zu]: unsupported target path (KHR_animation_pointer?); dropped", ai, k);
+        sy_gltf_shim_anim_channel cv = an->channels[k];
+        const sy_gltf_shim_anim_channel *c = &cv;
+        uint32_t target = 0; /* the material, light or camera of a pointer */
+        if (c->path == 4) { /* KHR_animation_pointer */
+            uint32_t index = 0;
+            const char *why = "has no pointer";
+            if (!c->pointer || !pointer_target(L, c->pointer, &index, &cv.path, &why)) {
+                if (!L->pointers_dropped++) /* once: the rest are counted (gltf_create_animations) */
+                    gltf_warn(L, "animations[%zu].channels[%zu]: KHR_animation_pointer '%s' %s; dropped", ai, k,
+                              c->pointer ? c->pointer : "", why);
+                continue;
+            }
+            uint32_t t = sy_anim_path_target((uint32_t)cv.path);
+            if (t == SY_TYPE_NODE) cv.node = (int32_t)index;
+            else target = t == SY_TYPE_MATERIAL ? L->materials[index].id : t == SY_TYPE_LIGHT ? L->lights[index].id
+                                                                                             : L->cameras[index].id;
+            if (t != SY_TYPE_NODE && !target) {
+                gltf_warn(L, "animations[%zu].channels[%zu]: KHR_animation_pointer '%s' names an object that was not "
+                          "loaded; dropped", ai, k, c->pointer);
+                continue;
+            }
+        } else if (c->path < 0) {
+            gltf_warn(L, "animations[%zu].channels[%zu]: unsupported target path; dropped", ai, k);
             continue;
         }
-        if (c->node < 0 || (size_t)c->node >= d->node_count || !L->nodes[c->node].id) {
+        if (!target && (c->node < 0 || (size_t)c->node >= d->node_count || !L->nodes[c->node].id)) {
             gltf_warn(L, "animations[%zu].channels[%zu]: target node %d %s; dropped", ai, k, (int)c->node,
                       c->node < 0 || (size_t)c->node >= d->node_count ? "does not exist" : "is not in the loaded scene");
             continue;
         }
-        if (c->path != SY_ANIM_WEIGHTS && d->nodes[c->node].matrix_count == 16) {
+        if (!target && c->path != SY_ANIM_WEIGHTS && d->nodes[c->node].matrix_count == 16) {
             gltf_warn(L, "animations[%zu].channels[%zu]: nodes[%d] has a matrix, which glTF forbids animating; dropped", ai, k,
                       (int)c->node);
             continue;
@@ -152,14 +221,13 @@ static sy_result create_animation(loader *L, size_t ai)
             continue;
         }
         anim_sampler *s = &sm[c->sampler];
-        int32_t as = c->path == SY_ANIM_SCALE ? SY_ANIM_TRANSLATION : c->path; /* same components */
-        if (s->tried && sampler_path[c->sampler] != as) {
+        if (s->tried && sampler_kind(sampler_path[c->sampler]) != sampler_kind(c->path)) {
             gltf_warn(L, "animations[%zu].channels[%zu]: samplers[%d] already drives a %s channel; dropped", ai, k,
-                      (int)c->sampler, path_name(sampler_path[c->sampler]));
+                      (int)c->sampler, sy_anim_path_name((uint32_t)sampler_path[c->sampler]));
             continue;
         }
         if (!s->tried) {
-            sampler_path[c->sampler] = as;
+            sampler_path[c->sampler] = c->path;
             if ((r = read_sampler(L, ai, (size_t)c->sampler, c->path, s))) goto done;
             if (s->ok) {
                 s->used_as = (int32_t)nd;
@@ -170,7 +238,7 @@ static sy_result create_animation(loader *L, size_t ai)
             gltf_warn(L, "animations[%zu].channels[%zu]: its sampler %d was dropped; dropped", ai, k, (int)c->sampler);
             continue;
         }
-        chans[nc++] = (sy_anim_channel){L->nodes[c->node].id, (uint32_t)c->path, (uint32_t)s->used_as};
+        chans[nc++] = (sy_anim_channel){target ? target : L->nodes[c->node].id, (uint32_t)c->path, (uint32_t)s->used_as};
     }
     sy_error e = {0};
     if (nc && sy_animation_set_clip(L->scene, h, descs, nd, chans, nc, &e) != SY_OK)
@@ -193,5 +261,8 @@ sy_result gltf_create_animations(loader *L)
     if (!(L->info->animations = gltf_xcalloc(L, d->animation_count, sizeof(sy_animation), &r))) return r;
     for (size_t i = 0; i < d->animation_count; i++)
         if ((r = create_animation(L, i))) return r;
+    if (L->pointers_dropped > 1)
+        gltf_warn(L, "animations: %u more KHR_animation_pointer channels dropped (pointers the scene clock does not drive)",
+                  L->pointers_dropped - 1);
     return SY_OK;
 }

@@ -64,6 +64,7 @@ typedef struct loader {
     uint32_t *mesh_joints; /* per glTF mesh: 1 + its largest JOINTS_n index (0: not skinned) */
     sy_budget budget; /* the file's (sy_budget.h) */
     bool warned_skin, warned_morph, warned_anim;
+    uint32_t pointers_dropped; /* KHR_animation_pointer channels dropped: the first is named, the rest counted */
     size_t variant_cursor;     /* next doc->variant_uses entry (meshes are created in order) */
     uint32_t variant_uses_done; /* info->variant_uses entries whose mesh is set */
 } loader;

@@ -686,8 +686,16 @@ static void fill_doc(sy_gltf_shim_impl *d)
         }
         for (const tinygltf::AnimationChannel &ch : a.channels) {
             const std::string &tp = ch.target_path;
-            int32_t path = tp == "translation" ? 0 : tp == "rotation" ? 1 : tp == "scale" ? 2 : tp == "weights" ? 3 : -1;
-            d->anim_channels[i].push_back({int32_t(ch.target_node), path, int32_t(ch.sampler)});
+            int32_t path = tp == "translation" ? 0 : tp == "rotation" ? 1 : tp == "scale" ? 2 : tp == "weights" ? 3
+                           : tp == "pointer"   ? 4 : -1;
+            const char *pointer = nullptr;
+            if (path == 4) { // KHR_animation_pointer (patch_for_tinygltf gave the target a placeholder node)
+                auto e = ch.target_extensions.find("KHR_animation_pointer");
+                if (e != ch.target_extensions.end() && e->second.IsObject() && e->second.Has("pointer") &&
+                    e->second.Get("pointer").IsString())
+                    pointer = e->second.Get("pointer").Get<std::string>().c_str();
+            }
+            d->anim_channels[i].push_back({path == 4 ? -1 : int32_t(ch.target_node), path, int32_t(ch.sampler), pointer});
         }
         d->animations.push_back({a.name.c_str(), d->anim_samplers[i].data(), d->anim_samplers[i].size(),
                                  d->anim_channels[i].data(), d->anim_channels[i].size()});
@@ -993,6 +1001,20 @@ static bool patch_for_tinygltf(const uint8_t *bytes, size_t size, bool binary, s
             changed = true;
         }
     }
+    // KHR_animation_pointer: a channel's target has no node, which tinygltf 2.7 requires (it drops
+    // the channel, and the channels after it move up one index): a placeholder node 0 keeps it (the
+    // shim reports its node as -1 and its pointer)
+    if (j.contains("animations") && j["animations"].is_array())
+        for (nlohmann::json &an : j["animations"]) {
+            if (!an.is_object() || !an.contains("channels") || !an["channels"].is_array()) continue;
+            for (nlohmann::json &ch : an["channels"]) {
+                if (!ch.is_object() || !ch.contains("target") || !ch["target"].is_object()) continue;
+                nlohmann::json &t = ch["target"];
+                if (t.contains("node") || !t.contains("path") || t["path"] != "pointer") continue;
+                t["node"] = 0;
+                changed = true;
+            }
+        }
     // EXT_texture_webp: tinygltf does not take data:image/webp URIs as data URIs
     if (j.contains("images") && j["images"].is_array())
         for (nlohmann::json &im : j["images"]) {

@@ -231,8 +231,9 @@ typedef struct sy_gltf_shim_anim_sampler {
 } sy_gltf_shim_anim_sampler;
 typedef struct sy_gltf_shim_anim_channel {
     int32_t node;    /* target node, -1 none */
-    int32_t path;    /* 0 translation, 1 rotation, 2 scale, 3 weights, -1 anything else (pointer) */
+    int32_t path;    /* 0 translation, 1 rotation, 2 scale, 3 weights, 4 "pointer", -1 anything else */
     int32_t sampler; /* index into the animation's samplers */
+    const char *pointer; /* path "pointer": its KHR_animation_pointer JSON pointer (untrusted), else NULL */
 } sy_gltf_shim_anim_channel;
 typedef struct sy_gltf_shim_animation {
     const char *name;

@@ -23,7 +23,7 @@ const char *const gltf_supported[] = {
     "KHR_materials_volume", "KHR_materials_iridescence", "KHR_materials_anisotropy", "KHR_materials_variants",
     "KHR_texture_transform", "KHR_lights_punctual",
     "KHR_mesh_quantization", "EXT_mesh_gpu_instancing", "KHR_draco_mesh_compression",
-    "EXT_meshopt_compression", "EXT_texture_webp", NULL,
+    "EXT_meshopt_compression", "EXT_texture_webp", "KHR_animation_pointer", NULL,
 };
 
 /* >>container --------------------------------------------------------------------------------- */
