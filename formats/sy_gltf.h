@@ -32,7 +32,13 @@
  * strictly, non-finite outputs (translation / scale beyond the coordinate range, zero quaternions)
  * or an unknown interpolation are dropped with a warning naming animations[i].samplers[j]; channels
  * to unknown nodes, to nodes outside the loaded scene, to matrix nodes (glTF forbids animating
- * them) or with another path (KHR_animation_pointer) are dropped naming animations[i].channels[k].
+ * them) or with an unknown path are dropped naming animations[i].channels[k]. KHR_animation_pointer
+ * channels drive what maps onto the clock's paths (sy_anim_path): /nodes/N/translation, rotation,
+ * scale, weights; /materials/N/pbrMetallicRoughness/baseColorFactor, metallicFactor,
+ * roughnessFactor and /materials/N/emissiveFactor; /extensions/KHR_lights_punctual/lights/N/color
+ * and intensity; /cameras/N/perspective/yfov. Any other pointer (or an index the file does not
+ * have) is dropped: the first named with its channel, the rest counted in one warning. Cameras
+ * and lights sit on nodes, so an animated node carries its camera or light along.
  * Weight channels set the target node's morph weights. Skins (node.skin: joints, inverse bind
  * matrices, skeleton) become the node's SY_NODE_SKIN, JOINTS_0/WEIGHTS_0 and JOINTS_1/WEIGHTS_1 (up
  * to 8 influences) and morph targets (POSITION / NORMAL / TANGENT deltas) the primitive's, mesh and

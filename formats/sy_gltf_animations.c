@@ -222,7 +222,7 @@ static sy_result create_animation(loader *L, size_t ai)
         }
         anim_sampler *s = &sm[c->sampler];
         if (s->tried && sampler_kind(sampler_path[c->sampler]) != sampler_kind(c->path)) {
-            gltf_warn(L, "animations[%zu].channels[%zu]: samplers[%d] already drives a %s channel; dropped", ai, k,
+            gltf_warn(L, "animations[%zu].channels[%zu]: samplers[%d] already drives a channel of the %s path; dropped", ai, k,
                       (int)c->sampler, sy_anim_path_name((uint32_t)sampler_path[c->sampler]));
             continue;
         }

@@ -130,7 +130,9 @@ void sy_x3d_info_free(sy_x3d_info *info); /**< NULL-safe; zeroes *info */
  * aspect = width / height. */
 float sy_x3d_yfov(float fov, float aspect);
 
-/** Sets the yfov of every Viewpoint camera in info for an image of the given aspect. */
+/** Sets the yfov of every Viewpoint camera in info for an image of the given aspect; a camera whose
+ * yfov an animation drives (a ROUTE to Viewpoint.fieldOfView) is left to the clock, which sets the
+ * routed angle as yfov (right for landscape images). */
 sy_result sy_x3d_fit_cameras(sy_scene *scene, const sy_x3d_info *info, float aspect, sy_error *err);
 
 /** Picks a Viewpoint: decimal index into camera_nodes or a node name (the DEF or description). */

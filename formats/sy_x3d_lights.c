@@ -175,6 +175,18 @@ float sy_x3d_yfov(float fov, float aspect)
     return 2.0f * atanf(tanf(0.5f * fov) / aspect);
 }
 
+/* Whether an animation of the scene drives camera c's yfov (a routed Viewpoint.fieldOfView). */
+static bool yfov_animated(const sy_scene *scene, sy_camera c)
+{
+    for (uint32_t id = sy_scene_next(scene, SY_TYPE_ANIMATION, 0); id; id = sy_scene_next(scene, SY_TYPE_ANIMATION, id)) {
+        uint32_t nc;
+        const sy_anim_channel *ch = sy_animation_channels(sy_object_get(scene, SY_TYPE_ANIMATION, id), &nc);
+        for (uint32_t i = 0; i < nc; i++)
+            if (ch[i].path == SY_ANIM_CAMERA_YFOV && ch[i].node == c.id) return true;
+    }
+    return false;
+}
+
 sy_result sy_x3d_fit_cameras(sy_scene *scene, const sy_x3d_info *info, float aspect, sy_error *err)
 {
     for (uint32_t k = 0; k < info->camera_node_count; k++) {
@@ -182,7 +194,7 @@ sy_result sy_x3d_fit_cameras(sy_scene *scene, const sy_x3d_info *info, float asp
         const sy_node_data *nd = sy_node_get(scene, info->camera_nodes[k]);
         if (!nd) continue;
         const sy_camera_data *cd = sy_camera_get(scene, nd->camera);
-        if (!cd) continue;
+        if (!cd || yfov_animated(scene, nd->camera)) continue; /* the clock sets it: the routed angle as yfov */
         sy_camera_data c = *cd;
         c.yfov = fminf(sy_x3d_yfov(info->camera_fovs[k], aspect), 3.1f);
         sy_result r = sy_camera_set(scene, nd->camera, &c, err);

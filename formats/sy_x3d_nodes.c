@@ -252,7 +252,8 @@ static sy_result visit(loader *L, xfile *F, const xmlNode *el_in, const sy_mat4 
     if (!el) return SY_OK;
     n = x3d_ename(el);
     size_t nlen = strlen(n);
-    if (!strcmp(n, "TimeSensor") || (nlen > 12 && !strcmp(n + nlen - 12, "Interpolator")))
+    if (!strcmp(n, "TimeSensor") || (nlen > 12 && !strcmp(n + nlen - 12, "Interpolator")) ||
+        (nlen > 14 && !strcmp(n + nlen - 14, "Interpolator2D")))
         return SY_OK; /* the scene clock's (sy_x3d_anim.c: what is routed and does not map is reported there) */
     if (!strcmp(n, "Background") || !strcmp(n, "TextureBackground")) return x3d_visit_background(L, F, el);
     bool group = x3d_name_in(n, "Transform|Group|StaticGroup|Collision|Anchor|Billboard|Switch|LOD|CADAssembly|CADLayer|CADPart|CADFace|HAnimHumanoid|HAnimJoint|HAnimSegment|HAnimSite|ScreenGroup|LayoutGroup");

@@ -12,7 +12,10 @@
  *     in front of a large diffuse plane (no specular), seen by a still camera: the brightest column
  *     is under the light at each time (its projection computed here), within 2 pixels; a
  *     KHR_animation_pointer intensity channel (10 -> 30 cd) makes the plane's brightness at the
- *     light's foot three times brighter at t = 1 than at t = 0 (within 10 %; the path tracer 20 %).
+ *     light's foot three times brighter at t = 1 than at t = 0 (within 10 %; the path tracer 20 %)
+ *   - pointers the clock does not drive (a material's alphaCutoff, a camera the file does not
+ *     have, no pointer): the first warned naming its channel, the rest counted in one warning; the
+ *     good /nodes/0/translation pointer channel plays.
  * Usage: test_it_anim_view. */
 #include "it_util.h"
 #include "sy_anim.h"
@@ -261,6 +264,48 @@ static void test_light(void)
     rig_close(&g);
 }
 
+/* Pointers the clock does not drive: the first named with its channel, the rest counted; the
+ * file still loads with its good channel. */
+static void test_bad_pointers(void)
+{
+    const float k0[3] = {0, 0, 0}, k1[3] = {1, 1, 1};
+    buf b = make_buf(0.5f, k0, k1, 0.1f, 0.2f, 0, 0);
+    write_gltf("pointers.gltf", &b,
+               "\"materials\":[{}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0,\n"
+               "\"animations\":[{\"samplers\":[{\"input\":3,\"output\":5},{\"input\":3,\"output\":4}],\"channels\":["
+               "{\"sampler\":0,\"target\":{\"path\":\"pointer\",\"extensions\":{\"KHR_animation_pointer\":"
+               "{\"pointer\":\"/materials/0/alphaCutoff\"}}}},"
+               "{\"sampler\":0,\"target\":{\"path\":\"pointer\",\"extensions\":{\"KHR_animation_pointer\":"
+               "{\"pointer\":\"/cameras/3/perspective/yfov\"}}}},"
+               "{\"sampler\":0,\"target\":{\"path\":\"pointer\"}},"
+               "{\"sampler\":1,\"target\":{\"path\":\"pointer\",\"extensions\":{\"KHR_animation_pointer\":"
+               "{\"pointer\":\"/nodes/0/translation\"}}}}]}]");
+    char path[512];
+    snprintf(path, sizeof path, "%s/pointers.gltf", g_dir);
+    sy_gltf_info info;
+    sy_scene *s = it_load_gltf(path, &info);
+    bool named = false, counted = false;
+    for (uint32_t k = 0; k < info.stored_warning_count; k++) {
+        named = named || strstr(info.warnings[k], "animations[0].channels[0]: KHR_animation_pointer "
+                                                  "'/materials/0/alphaCutoff' is not one the scene clock drives");
+        counted = counted || strstr(info.warnings[k], "2 more KHR_animation_pointer channels dropped");
+    }
+    EXPECT_MSG(named && counted, "bad pointers: the first named (%d), the other two counted (%d)", named, counted);
+    sy_animation a = info.animation_count ? info.animations[0] : (sy_animation){0};
+    uint32_t nc = 0;
+    if (a.id) sy_animation_channels(sy_animation_get(s, a), &nc);
+    EXPECT_MSG(nc == 1, "bad pointers: %u channels kept (want the node translation)", nc);
+    MUST(sy_scene_set_time(s, a, 0.5, err));
+    const sy_node_data *nd = sy_node_get(s, info.root);
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id))
+        if (sy_node_get(s, (sy_node){id})->mesh.id) nd = sy_node_get(s, (sy_node){id});
+    EXPECT_MSG(nd && fabsf(nd->transform.translation[0] - 0.5f) < 1e-6f, "bad pointers: the pointer translation at 0.5: %g",
+               nd ? (double)nd->transform.translation[0] : -1.0);
+    sy_gltf_info_free(&info);
+    sy_scene_destroy(s);
+    remove(path);
+}
+
 int main(void)
 {
     snprintf(g_dir, sizeof g_dir, "/tmp/sy_anim_view_XXXXXX");
@@ -271,6 +316,7 @@ int main(void)
     it_register();
     test_camera();
     test_light();
+    test_bad_pointers();
     char p[512];
     snprintf(p, sizeof p, "%s/camera.gltf", g_dir);
     remove(p);

@@ -225,6 +225,9 @@ static void test_fields(void)
         want[0] /= n, want[2] /= n;
         EXPECT_MSG(near3(dz, want, 1e-3f), "t %g: Sun direction (%g %g %g), want (%g %g %g)", times[i], (double)dz[0],
                    (double)dz[1], (double)dz[2], (double)want[0], (double)want[1], (double)want[2]);
+        /* fitting the cameras to a portrait image leaves the routed fieldOfView to the clock */
+        sy_error fe = {0};
+        EXPECT_MSG(sy_x3d_fit_cameras(l.scene, &l.info, 0.5f, &fe) == SY_OK, "fit cameras: %s", fe.message);
         const sy_camera_data *cd = sy_camera_get(l.scene, sy_node_get(l.scene, cam)->camera);
         EXPECT_MSG(cd && fabsf(cd->yfov - (0.5f + 0.5f * u)) < 1e-4f, "t %g: Cam yfov %g", times[i], cd ? (double)cd->yfov : -1.0);
         EXPECT_MSG(fabsf(pos(&l, cam)[2] - (10.0f + 10.0f * u)) < 1e-3f && fabsf(yaw(rot(&l, cam)) - u) < 1e-4f,
