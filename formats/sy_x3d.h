@@ -12,9 +12,12 @@
  * MultiTextureCoordinate (first set), Color, ColorRGBA, Extrusion (crossSection / spine / scale /
  * orientation / caps, as an IndexedFaceSet), Box, Sphere, Cone, Cylinder (tessellated),
  * DirectionalLight, PointLight, SpotLight, Viewpoint, Background / TextureBackground (skyColor[0]),
- * Inline (relative files; each file is loaded once and shared), DEF / USE.
- * Non-visual nodes (WorldInfo, NavigationInfo, ROUTE, EXPORT, IMPORT, metadata) are ignored
- * silently; any other node type is skipped with one warning per type.
+ * Inline (relative files; each file is loaded once and shared), DEF / USE. TimeSensors with the
+ * Position-, Orientation-, Color- and ScalarInterpolators and ROUTEs they drive become animations
+ * (clips) of the scene clock, into Transform, Viewpoint, light and Material fields (sy_x3d_anim.c,
+ * docs/FORMATS.md); bad ROUTEs (undefined names, differing field types, loops) are dropped with a
+ * warning naming the ROUTE's line. Non-visual nodes (WorldInfo, NavigationInfo, EXPORT, IMPORT,
+ * metadata) are ignored silently; any other node type is skipped with one warning per type.
  *
  * Sharing: a USEd Shape (or a Shape whose geometry and appearance are both USEd) stays one sy_mesh
  * referenced by several nodes; a USEd grouping node is the same sy_node under several parents
