@@ -90,6 +90,7 @@ static sy_result load_common(const char *path, const void *mem, size_t size, con
     free(L.lights);
     free(L.mat_links);
     free(L.ifix);
+    x3d_free_morphs(&L);
     if (r) {
         for (size_t k = L.obj_count; k-- > 0;) sy_object_destroy(scene, L.objs[k].type, L.objs[k].id, NULL);
         free(L.objs);

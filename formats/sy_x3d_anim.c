@@ -20,7 +20,14 @@
  *   ScalarInterpolator       -> Material / PhysicalMaterial / UnlitMaterial transparency (base
  *                               colour alpha = 1 - value), PhysicalMaterial metallic / roughness,
  *                               light intensity (scaled as the loader scales the light's, sy_x3d.h),
- *                               Viewpoint fieldOfView (camera yfov).
+ *                               Viewpoint fieldOfView (camera yfov);
+ *   CoordinateInterpolator   -> Coordinate.point: x3d_scan_morphs finds such Coordinates before the
+ *                               walk, x3d_emit gives every primitive built on one a morph target per
+ *                               key (its points; normals generated again per key where the geometry
+ *                               generates them), and each node showing such a mesh gets a weights
+ *                               channel whose key k is the k-th unit vector (LINEAR weights blend
+ *                               consecutive keys exactly as X3D interpolates the points; at most
+ *                               SY_MORPH_MAX_TARGETS keys); the mirror deforms it for every back-end.
  * ROUTEs are read per file, so DEF names resolve in the file's own namespace (an Inline's routes
  * see the Inline's DEFs).
  *
@@ -31,8 +38,8 @@
  * fields' types differ (SFVec3f into SFColor: X3D forbids it); a route that closes a loop of routes
  * (X3D passes one event per route per timestamp, so a loop never runs away; the clock has no event
  * cascade at all, and the route is dropped). What has no target here is reported once per kind:
- * Coordinate-, Normal- and PositionInterpolator2D (Coordinate.point, Normal.vector and
- * TextureTransform are baked into the meshes' vertices and texture coordinates when loading), other
+ * Normal- and PositionInterpolator2D (Normal.vector and TextureTransform are baked into the meshes'
+ * vertices and texture coordinates when loading), other
  * mapped-but-not-animated fields (Material.shininess, Transform.center, ...), Transforms with a
  * center or scaleOrientation (their node holds a matrix, which the clock does not drive). Bad
  * interpolators (key and keyValue counts that differ, keys that decrease) are dropped with a warning
@@ -54,7 +61,7 @@ enum { T_NONE, T_SFFLOAT, T_SFVEC2F, T_SFVEC3F, T_SFCOLOR, T_SFROTATION, T_MFVEC
 static const char *const type_names[] = {"?", "SFFloat", "SFVec2f", "SFVec3f", "SFColor", "SFRotation", "MFVec3f", "MFVec2f"};
 
 /* What a routed value becomes on the way into its sampler. */
-enum { CONV_NONE, CONV_AXIS_ANGLE, CONV_DIRECTION, CONV_HSV, CONV_ONE_MINUS, CONV_SCALE };
+enum { CONV_NONE, CONV_AXIS_ANGLE, CONV_DIRECTION, CONV_HSV, CONV_ONE_MINUS, CONV_SCALE, CONV_ONE_HOT };
 
 /* Key intervals of a ColorInterpolator (and of directions) are sampled at this many steps along
  * X3D's path: HSV for colours, the normalised straight line for directions. */
@@ -64,7 +71,7 @@ enum { CONV_NONE, CONV_AXIS_ANGLE, CONV_DIRECTION, CONV_HSV, CONV_ONE_MINUS, CON
 /* What a target field does: a node path, a material path (through the Material's links), a light
  * or camera field, or nothing (reported). */
 enum { W_NONE, W_TRANSLATION, W_ROTATION, W_SCALE, W_DIRECTION, W_FOV, W_LIGHT_COLOR, W_LIGHT_INTENSITY, W_DIFFUSE,
-       W_EMISSIVE, W_TRANSPARENCY, W_METALLIC, W_ROUGHNESS };
+       W_EMISSIVE, W_TRANSPARENCY, W_METALLIC, W_ROUGHNESS, W_MORPH };
 
 typedef struct field_map {
     const char *nodes, *fields; /* '|'-separated */
@@ -97,7 +104,8 @@ static const field_map field_maps[] = {
     {"PhysicalMaterial", "roughness", T_SFFLOAT, W_ROUGHNESS},
     {"Material", "specularColor", T_SFCOLOR, W_NONE},
     {"Material", "shininess|ambientIntensity|occlusionStrength|normalScale", T_SFFLOAT, W_NONE},
-    {"Coordinate|Normal", "point|vector", T_MFVEC3F, W_NONE},
+    {"Coordinate|CoordinateDouble", "point", T_MFVEC3F, W_MORPH},
+    {"Normal", "vector", T_MFVEC3F, W_NONE},
     {"TextureCoordinate", "point", T_MFVEC2F, W_NONE},
     {"TextureTransform", "translation|scale|center", T_SFVEC2F, W_NONE},
     {"TextureTransform", "rotation", T_SFFLOAT, W_NONE},
@@ -113,7 +121,7 @@ typedef struct interp_kind {
 static const interp_kind interp_kinds[] = {
     {"PositionInterpolator", T_SFVEC3F, 3, true},    {"OrientationInterpolator", T_SFROTATION, 4, true},
     {"ColorInterpolator", T_SFCOLOR, 3, true},       {"ScalarInterpolator", T_SFFLOAT, 1, true},
-    {"PositionInterpolator2D", T_SFVEC2F, 2, false}, {"CoordinateInterpolator", T_MFVEC3F, 3, false},
+    {"PositionInterpolator2D", T_SFVEC2F, 2, false}, {"CoordinateInterpolator", T_MFVEC3F, 3, true},
     {"NormalInterpolator", T_MFVEC3F, 3, false},     {"CoordinateInterpolator2D", T_MFVEC2F, 2, false},
 };
 
@@ -131,6 +139,7 @@ typedef struct drive {
     uint8_t conv;          /* CONV_* */
     float scale;           /* CONV_SCALE */
     uint32_t fix_light;    /* a point / spot light whose intensity x3d_fix_light_animations scales, else 0 */
+    size_t scale_index;    /* CONV_ONE_HOT: the L->morphs entry */
     size_t seq;            /* order found (ties in the sorts below) */
 } drive;
 
@@ -156,6 +165,9 @@ static int cmp_ptr(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+/* qsort / bsearch over an array of element pointers */
+static int cmp_ptr_el(const void *a, const void *b) { return cmp_ptr(*(const void *const *)a, *(const void *const *)b); }
+
 /* by element line, element, then the order found: a deterministic order that follows the file */
 static int cmp_elem_seq(const xmlNode *ea, const xmlNode *eb, size_t sa, size_t sb)
 {
@@ -180,12 +192,14 @@ static int cmp_by_sampler(const void *a, const void *b)
     if (x->conv != y->conv) return x->conv < y->conv ? -1 : 1;
     if (x->scale != y->scale) return x->scale < y->scale ? -1 : 1;
     if (x->fix_light != y->fix_light) return x->fix_light < y->fix_light ? -1 : 1;
+    if (x->scale_index != y->scale_index) return x->scale_index < y->scale_index ? -1 : 1;
     return x->seq < y->seq ? -1 : x->seq > y->seq;
 }
 
 static bool same_sampler(const drive *a, const drive *b)
 {
-    return a->interp == b->interp && a->conv == b->conv && a->scale == b->scale && a->fix_light == b->fix_light;
+    return a->interp == b->interp && a->conv == b->conv && a->scale == b->scale && a->fix_light == b->fix_light &&
+           a->scale_index == b->scale_index;
 }
 
 typedef struct elems {
@@ -404,6 +418,45 @@ static void hsv_lerp(const float a[3], const float b[3], float u, float out[3])
     hsv_to_rgb(h, out);
 }
 
+/* The weights sampler of a CoordinateInterpolator's morph targets (x3d_scan_morphs read its keys):
+ * one weight per key, key k's value the k-th unit vector, so LINEAR blends consecutive keys as X3D
+ * interpolates their points. Equal keys jump one float step later, as in read_sampler. */
+static int read_one_hot(loader *L, xfile *F, const drive *d, float cycle, sy_anim_sampler_desc *sd, float **times_out,
+                        float **values_out)
+{
+    const morph_src *m = &L->morphs[d->scale_index];
+    float *key = NULL;
+    size_t nk = 0;
+    *times_out = *values_out = NULL;
+    if (!x3d_get_float_array(L, F, m->interp, "key", 1, &key, &nk)) return 0;
+    if (nk != m->keys) { /* x3d_scan_morphs counted the same attribute */
+        free(key);
+        return 0;
+    }
+    float prev = -INFINITY;
+    for (size_t k = 0; k < nk; ++k) {
+        float raw = key[k], t = raw * cycle;
+        if (!isfinite(t) || raw < prev) {
+            x3d_warn(L, "%s:%d: CoordinateInterpolator: key %zu (%g) %s; not played", F->path, x3d_line_of(m->interp), k,
+                     (double)raw, isfinite(t) ? "is less than the key before it" : "is not finite");
+            free(key);
+            return 0;
+        }
+        prev = raw;
+        key[k] = k && !(t > key[k - 1]) ? nextafterf(key[k - 1], INFINITY) : t;
+    }
+    float *ov = calloc(nk * nk, sizeof *ov);
+    if (!ov) {
+        free(key);
+        sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+        return -1;
+    }
+    for (size_t k = 0; k < nk; ++k) ov[k * nk + k] = 1.0f;
+    *sd = (sy_anim_sampler_desc){SY_INTERP_LINEAR, (uint32_t)nk, (uint32_t)nk, key, ov};
+    *times_out = key, *values_out = ov;
+    return 1;
+}
+
 /* Between key values a and b at u, as X3D interpolates them, into the sampler's value o: colours
  * in HSV (CONV_HSV), directions linearly and then as the rotation of -Z onto the direction
  * (CONV_DIRECTION, 4 components). */
@@ -425,6 +478,7 @@ static int read_sampler(loader *L, xfile *F, const drive *d, float cycle, sy_ani
     const xmlNode *el = d->interp;
     const interp_kind *ik = kind_of(el);
     float *key = NULL, *kv = NULL, *ot = NULL, *ov = NULL;
+    if (d->conv == CONV_ONE_HOT) return read_one_hot(L, F, d, cycle, sd, times_out, values_out);
     size_t nk = 0, nv = 0;
     const size_t group = ik->group;
     *times_out = *values_out = NULL;
@@ -648,6 +702,28 @@ static bool add_targets(loader *L, xfile *F, const route *ro, const xmlNode *sen
         return true;
     }
     drive d = {.sensor = sensor, .interp = ro->from, .route = ro->el, .conv = CONV_NONE, .scale = 1.0f, .seq = ds->count};
+    if (fm->what == W_MORPH) { /* the weights of every node showing a mesh built on the Coordinate */
+        const morph_src *m = NULL;
+        for (size_t i = 0; i < L->morph_count && !m; ++i)
+            if (L->morphs[i].coord == t && L->morphs[i].interp == ro->from && L->morphs[i].serial == F->serial)
+                m = &L->morphs[i];
+        if (!m || !m->mesh_count) {
+            x3d_warn(L, "%s:%d: ROUTE to %s.%s: no Shape shows that %s (line %d) with the interpolator's points; not played",
+                     F->path, x3d_line_of(ro->el), x3d_ename(t), ro->tf, x3d_ename(t), x3d_line_of(t));
+            return true;
+        }
+        d.path = SY_ANIM_WEIGHTS, d.conv = CONV_ONE_HOT, d.scale_index = (size_t)(m - L->morphs);
+        for (size_t i = 0; i < L->obj_count; ++i) {
+            if (L->objs[i].type != SY_TYPE_NODE) continue;
+            const sy_node_data *nd = sy_node_get(L->scene, (sy_node){L->objs[i].id});
+            bool shows = false;
+            for (size_t k = 0; nd && nd->mesh.id && k < m->mesh_count && !shows; ++k) shows = nd->mesh.id == m->meshes[k];
+            if (!shows) continue;
+            d.target = L->objs[i].id;
+            if (!push(L, F, ds, &d)) return false;
+        }
+        return true;
+    }
     if (fm->what == W_DIFFUSE || fm->what == W_EMISSIVE || fm->what == W_TRANSPARENCY || fm->what == W_METALLIC ||
         fm->what == W_ROUGHNESS) {
         bool any = false;
@@ -842,4 +918,128 @@ sy_result x3d_fix_light_animations(loader *L)
         if (r) return r;
     }
     return SY_OK;
+}
+
+/* >>morphs: Coordinates that CoordinateInterpolators animate, found before the walk */
+
+typedef struct scan {
+    elems routes;
+    xmlHashTablePtr defs; /* DEF -> element (first wins), of the kinds that matter here */
+} scan;
+
+static bool scan_collect(scan *sc, const xmlNode *el, unsigned depth)
+{
+    for (const xmlNode *c = el->children; c; c = c->next) {
+        if (c->type != XML_ELEMENT_NODE) continue;
+        const char *n = x3d_ename(c);
+        if (!strcmp(n, "ROUTE")) {
+            elems *rs = &sc->routes;
+            if (rs->count == rs->cap) {
+                size_t cap = rs->cap ? 2 * rs->cap : 16;
+                const xmlNode **p = realloc(rs->items, cap * sizeof *p);
+                if (!p) return false;
+                rs->items = p, rs->cap = cap;
+            }
+            rs->items[rs->count++] = c;
+            continue;
+        }
+        if (x3d_name_in(n, "ProtoDeclare|ExternProtoDeclare|Script")) continue;
+        if (x3d_name_in(n, "Coordinate|CoordinateDouble|CoordinateInterpolator|TimeSensor")) {
+            char *def = x3d_attr(c, "DEF");
+            if (def && !xmlHashLookup(sc->defs, (const xmlChar *)def)) xmlHashAddEntry(sc->defs, (const xmlChar *)def, (void *)c);
+            xmlFree(def);
+        }
+        if (depth < 256 && !scan_collect(sc, c, depth + 1)) return false;
+    }
+    return true;
+}
+
+static const xmlNode *scan_def(const scan *sc, const xmlNode *route, const char *attr, const char *kinds)
+{
+    char *name = x3d_attr(route, attr);
+    const xmlNode *el = name ? xmlHashLookup(sc->defs, (const xmlChar *)name) : NULL;
+    xmlFree(name);
+    return el && x3d_name_in(x3d_ename(el), kinds) ? el : NULL;
+}
+
+static bool route_fields(const xmlNode *route, const char *from, const char *to)
+{
+    char *ff = x3d_attr(route, "fromField"), *tf = x3d_attr(route, "toField");
+    bool ok = ff && tf && !strcmp(ff, from) && field_is(tf, to);
+    xmlFree(ff), xmlFree(tf);
+    return ok;
+}
+
+sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
+{
+    scan sc = {{0}, xmlHashCreate(16)};
+    const xmlNode **driven = NULL;
+    sy_result r = SY_OK;
+    if (!sc.defs || !scan_collect(&sc, scene, 0)) {
+        r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+        goto done;
+    }
+    size_t nd = 0;
+    if (sc.routes.count && !(driven = malloc(sc.routes.count * sizeof *driven))) {
+        r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+        goto done;
+    }
+    /* the interpolators a TimeSensor drives */
+    for (size_t i = 0; i < sc.routes.count; ++i) {
+        const xmlNode *ro = sc.routes.items[i], *in = scan_def(&sc, ro, "toNode", "CoordinateInterpolator");
+        if (in && scan_def(&sc, ro, "fromNode", "TimeSensor") && route_fields(ro, "fraction_changed", "fraction"))
+            driven[nd++] = in;
+    }
+    qsort(driven, nd, sizeof *driven, cmp_ptr_el);
+    for (size_t i = 0; i < sc.routes.count && !r; ++i) {
+        const xmlNode *ro = sc.routes.items[i];
+        const xmlNode *in = scan_def(&sc, ro, "fromNode", "CoordinateInterpolator");
+        const xmlNode *co = scan_def(&sc, ro, "toNode", "Coordinate|CoordinateDouble");
+        if (!in || !co || !route_fields(ro, "value_changed", "point") || !nd ||
+            !bsearch(&in, driven, nd, sizeof *driven, cmp_ptr_el))
+            continue;
+        bool seen = false; /* one interpolator per Coordinate: the first route in the file */
+        for (size_t k = 0; k < L->morph_count && !seen; ++k) seen = L->morphs[k].coord == co && L->morphs[k].serial == F->serial;
+        if (seen) {
+            x3d_warn(L, "%s:%d: ROUTE: a second CoordinateInterpolator into the Coordinate of line %d; not played",
+                     F->path, x3d_line_of(ro), x3d_line_of(co));
+            continue;
+        }
+        float *key = NULL, *kv = NULL;
+        size_t nk = 0, nv = 0;
+        if (!x3d_get_float_array(L, F, in, "key", 1, &key, &nk) || !x3d_get_float_array(L, F, in, "keyValue", 3, &kv, &nv) ||
+            nk == 0 || nk > SY_MORPH_MAX_TARGETS || nv % nk != 0 || nv / nk == 0) {
+            if (L->limit_r) r = L->limit_r, L->err = L->limit_err;
+            else
+                x3d_warn(L, "%s:%d: CoordinateInterpolator: %zu keys and %zu key values (1 to %u keys, the same number of "
+                         "points for each); not played", F->path, x3d_line_of(in), nk, nv, SY_MORPH_MAX_TARGETS);
+            free(key), free(kv);
+            continue;
+        }
+        free(key);
+        if (L->morph_count == L->morph_cap) {
+            size_t cap = L->morph_cap ? 2 * L->morph_cap : 4;
+            morph_src *p = realloc(L->morphs, cap * sizeof *p);
+            if (!p) {
+                free(kv);
+                r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+                break;
+            }
+            L->morphs = p, L->morph_cap = cap;
+        }
+        L->morphs[L->morph_count++] = (morph_src){co, in, F->serial, kv, nk, nv / nk, NULL, 0, 0};
+    }
+done:
+    free(driven);
+    free(sc.routes.items);
+    if (sc.defs) xmlHashFree(sc.defs, NULL);
+    return r;
+}
+
+void x3d_free_morphs(loader *L)
+{
+    for (size_t i = 0; i < L->morph_count; ++i) free(L->morphs[i].values), free(L->morphs[i].meshes);
+    free(L->morphs);
+    L->morphs = NULL;
+    L->morph_count = L->morph_cap = 0;
 }

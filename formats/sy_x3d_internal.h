@@ -72,6 +72,19 @@ typedef struct mat_link {
 } mat_link;
 #define X3D_NO_PATH 0xFFu
 
+/* A Coordinate that a CoordinateInterpolator driven by a TimeSensor animates (found before the
+ * walk, sy_x3d_anim.c): x3d_emit gives the primitives built on it one morph target per key (the
+ * key's points, and normals generated again when the geometry generates them); the mesh is noted
+ * for the weights channels (one-hot per key: linear weights blend consecutive keys exactly). */
+typedef struct morph_src {
+    const xmlNode *coord, *interp;
+    uint32_t serial;
+    float *values;     /* keys x points x 3 (malloc()ed) */
+    size_t keys, points;
+    uint32_t *meshes;  /* the meshes built on it (malloc()ed) */
+    size_t mesh_count, mesh_cap;
+} morph_src;
+
 typedef struct loader {
     sy_scene *scene;
     sy_x3d_options opt;
@@ -89,6 +102,9 @@ typedef struct loader {
     size_t mat_link_count, mat_link_cap;
     intensity_fix *ifix;
     size_t ifix_count, ifix_cap;
+    morph_src *morphs;
+    size_t morph_count, morph_cap;
+    size_t morph_pending; /* 1 + the morph_src x3d_emit just used for a primitive, 0 none (visit_shape notes the mesh) */
     sy_bounds bounds; /* world bounds of the shapes (first placement), for light intensities */
     bool have_background;
     uint32_t file_serial;
@@ -180,6 +196,7 @@ typedef struct geom_src {
     float crease;
     bool ccw, generate_tc;
     float tt[6]; /* texture transform (2x3 affine, X3D t-up space) */
+    const xmlNode *coord_el; /* the Coordinate node the points come from (NULL: generated) */
 } geom_src;
 
 
@@ -222,6 +239,10 @@ sy_result x3d_visit_background(loader *L, xfile *F, const xmlNode *el);
  * and returns the node of its Scene. */
 /* The file's TimeSensors, interpolators and ROUTEs as animations (sy_x3d_anim.c); after the walk. */
 sy_result x3d_load_animations(loader *L, xfile *F, const xmlNode *scene);
+/* Before the walk of a file: its Coordinates that CoordinateInterpolators animate (L->morphs). */
+sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene);
+/* Frees L->morphs. */
+void x3d_free_morphs(loader *L);
 /* After x3d_finish_lights: routed point and spot light intensities scaled like their lights. */
 sy_result x3d_fix_light_animations(loader *L);
 sy_result x3d_load_file(loader *L, const char *path, const void *mem, size_t mem_size, const char *base_dir,

@@ -169,7 +169,10 @@ static sy_result visit_shape(loader *L, xfile *F, const xmlNode *el, const sy_ma
         const xmlNode *tt = app ? x3d_field_child(L, F, app, "TextureTransform", "textureTransform") : NULL;
         sy_primitive prim;
         bool ok, colors, solid;
+        L->morph_pending = 0;
         if ((r = x3d_build_geometry(L, F, geo, tt, &prim, &ok, &colors, &solid))) return r;
+        size_t morph = L->morph_pending; /* built on an animated Coordinate (sy_x3d_anim.c) */
+        L->morph_pending = 0;
         if (!ok) {
             L->info->counts.skipped_geometry++;
             return SY_OK;
@@ -194,6 +197,14 @@ static sy_result visit_shape(loader *L, xfile *F, const xmlNode *el, const sy_ma
             if (!strcmp(x3d_ename(geo), "Text")) L->info->counts.texts++;
             c->mesh = mid;
             bounds_add_prim(L, &prim, world);
+            morph_src *m = morph ? &L->morphs[morph - 1] : NULL;
+            if (m && m->mesh_count == m->mesh_cap) {
+                size_t cap = m->mesh_cap ? 2 * m->mesh_cap : 4;
+                uint32_t *p = realloc(m->meshes, cap * sizeof *p);
+                if (!p) r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+                else m->meshes = p, m->mesh_cap = cap;
+            }
+            if (m && !r) m->meshes[m->mesh_count++] = mid;
         } else {
             sy_error_prefix(&L->err, "%s:%d: Shape", F->path, x3d_line_of(el));
         }
@@ -447,6 +458,7 @@ sy_result x3d_load_file(loader *L, const char *path, const void *mem, size_t mem
         ic->node = h.id;
     }
     sy_mat4 id = sy_mat4_identity();
+    if ((r = x3d_scan_morphs(L, &F, scene))) goto done;
     if ((r = children_of(L, &F, scene, &id, h, NULL))) goto done;
     if ((r = sy_node_set_flags(L->scene, h, SY_NODE_VISIBLE, &L->err))) goto done;
     if ((r = x3d_load_animations(L, &F, scene))) goto done;

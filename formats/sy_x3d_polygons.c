@@ -38,6 +38,54 @@ sy_result x3d_budget_vertices(loader *L, const char *file, const xmlNode *el, ui
                             x3d_ename(el), (unsigned long long)n);
 }
 
+/* When g's Coordinate is animated (L->morphs): one morph target per key on the primitive (position
+ * deltas of its corners; normal deltas from the key's generated normals when gen, else none), and
+ * L->morph_pending names the source. Charged to the load's budget; a key count that does not
+ * match the points is warned about and leaves the geometry static. */
+static sy_result morph_targets(loader *L, xfile *F, const xmlNode *el, const geom_src *g, const corners *c,
+                               const float *pos, const float *nrm, bool gen, sy_primitive *prim)
+{
+    if (!g->coord_el) return SY_OK;
+    morph_src *m = NULL;
+    for (size_t i = 0; i < L->morph_count && !m; i++)
+        if (L->morphs[i].coord == g->coord_el && L->morphs[i].serial == F->serial) m = &L->morphs[i];
+    if (!m) return SY_OK;
+    if (m->points != g->npts) {
+        x3d_warn(L, "%s:%d: CoordinateInterpolator (line %d): %zu points per key, the Coordinate (line %d) has %zu; not "
+                 "played", F->path, x3d_line_of(el), x3d_line_of(m->interp), m->points, x3d_line_of(m->coord), g->npts);
+        return SY_OK;
+    }
+    size_t nv = c->tris * 3;
+    sy_result r = sy_budget_charge(&L->budget, (uint64_t)m->keys * nv * (gen ? 2u : 1u), 12, &L->err,
+                                   "%s:%d: %s: morph targets of a CoordinateInterpolator", F->path, x3d_line_of(el),
+                                   x3d_ename(el));
+    if (r) return r;
+    float *tp = malloc(m->keys * nv * 12), *tn = gen ? malloc(m->keys * nv * 12) : NULL;
+    if (!tp || (gen && !tn)) {
+        free(tp), free(tn);
+        return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+    }
+    for (size_t k = 0; k < m->keys; k++) {
+        const float *pk = m->values + k * m->points * 3;
+        float *dk = tp + k * nv * 3;
+        for (size_t i = 0; i < nv; i++)
+            for (int a = 0; a < 3; a++) dk[3 * i + a] = pk[3 * (size_t)c->coord[i] + a] - pos[3 * i + a];
+        if (!gen) continue;
+        float *nk = NULL;
+        if ((r = sy_corner_normals(pk, m->points, c->coord, c->tris, g->crease, &nk, &L->err))) {
+            free(tp), free(tn);
+            return r;
+        }
+        for (size_t i = 0; i < 3 * nv; i++) tn[k * nv * 3 + i] = nk[i] - nrm[i];
+        free(nk);
+    }
+    r = x3d_make_blob(L, tp, m->keys * nv * 12, &prim->target_positions);
+    if (!r && tn) r = x3d_make_blob(L, tn, m->keys * nv * 12, &prim->target_normals);
+    else if (tn && r) free(tn);
+    if (!r) L->morph_pending = (size_t)(m - L->morphs) + 1;
+    return r;
+}
+
 sy_result x3d_emit(loader *L, xfile *F, const xmlNode *el, const geom_src *g, corners *c, sy_primitive *prim)
 {
     size_t nv = c->tris * 3;
@@ -123,6 +171,7 @@ sy_result x3d_emit(loader *L, xfile *F, const xmlNode *el, const geom_src *g, co
             col[4 * k + 3] = g->col_comps == 4 ? s[3] : 1.0f;
         }
     }
+    if ((r = morph_targets(L, F, el, g, c, pos, nrm, need_gen, prim))) goto fail;
     r = x3d_make_blob(L, pos, nv * 12, &prim->positions);
     pos = NULL;
     if (!r) r = x3d_make_blob(L, nrm, nv * 12, &prim->normals);
@@ -139,6 +188,7 @@ fail:
     free(pos); free(nrm); free(uv); free(col); free(gen);
     sy_blob_release(prim->positions); sy_blob_release(prim->normals);
     sy_blob_release(prim->texcoords0); sy_blob_release(prim->colors);
+    sy_blob_release(prim->target_positions); sy_blob_release(prim->target_normals);
     memset(prim, 0, sizeof *prim);
     return r;
 }
@@ -150,6 +200,7 @@ bool x3d_read_sources(loader *L, xfile *F, const xmlNode *el, geom_src *g)
     if ((n = x3d_field_child(L, F, el, "Coordinate|CoordinateDouble", "coord")) &&
         !x3d_get_float_array(L, F, n, "point", 3, &g->pts, &g->npts))
         return false;
+    g->coord_el = n;
     if ((n = x3d_field_child(L, F, el, "Normal", "normal")) && !x3d_get_float_array(L, F, n, "vector", 3, &g->nrm, &g->nnrm))
         return false;
     n = x3d_field_child(L, F, el, "TextureCoordinate|MultiTextureCoordinate|TextureCoordinateGenerator", "texCoord");

@@ -9,7 +9,8 @@
  * a light's direction, at two times against X3D's interpolation computed here (HSV colours,
  * 1 - transparency, intensities scaled as the loader scales the lights); routes whose types differ,
  * that close a loop or come from undefined nodes, and the interpolators whose targets are baked
- * (Coordinate, PositionInterpolator2D) are warned about, naming the ROUTE's line; the
+ * (Normal, PositionInterpolator2D) are warned about, naming the ROUTE's line; test_coordinates:
+ * a CoordinateInterpolator becomes morph targets and weights on every node showing the mesh; the
  * shared sample HelloX3dTrademark.x3d (a spinning Earth) turns a quarter every 3 s.
  * Usage: test_x3d_anim [TESTDATA_DIR]. */
 #include "sy_anim.h"
@@ -182,7 +183,10 @@ static void test_fields(void)
     EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_ANIMATION) == 1, "%u clips (want 1)", sy_scene_count(l.scene, SY_TYPE_ANIMATION));
     EXPECT_MSG(has_warning(&l, "fields.x3d:38: ROUTE from PositionInterpolator.value_changed (SFVec3f) to "
                            "Material.diffuseColor (SFColor): the types differ; dropped", NULL), "types differ");
-    EXPECT_MSG(has_warning(&l, "fields.x3d:17: CoordinateInterpolator: not played", NULL), "CoordinateInterpolator");
+    EXPECT_MSG(has_warning(&l, "fields.x3d:7: CoordinateInterpolator (line 17): 1 points per key, the Coordinate (line 7) has 3",
+                           NULL), "CoordinateInterpolator with too few points");
+    EXPECT_MSG(has_warning(&l, "fields.x3d:39: ROUTE to Coordinate.point: no Shape shows that Coordinate", NULL),
+               "its route not played");
     EXPECT_MSG(has_warning(&l, "fields.x3d:40: ROUTE from TimeSensor.isActive to TimeSensor.enabled closes a loop", NULL),
                "a route to its own node");
     EXPECT_MSG(has_warning(&l, "fields.x3d:42: ", "closes a loop") || has_warning(&l, "fields.x3d:43: ", "closes a loop"),
@@ -236,6 +240,86 @@ static void test_fields(void)
     unload(&l);
 }
 
+/* CoordinateInterpolator -> Coordinate.point: the IndexedFaceSet's primitive gets one morph target
+ * per key and every node showing it (two Shapes with the one IndexedFaceSet) a weights channel; base + weights x
+ * targets at a time equals X3D's linear interpolation of the key points at each corner, and the
+ * generated normals follow (the quad folds up, its normal turns). Two NormalInterpolators: not
+ * played, reported once. */
+static void test_coordinates(void)
+{
+    loaded l = load_text("coords.x3d",
+        "<X3D><Scene>\n"
+        "<Transform DEF='A'><Shape><IndexedFaceSet DEF='Sheet' coordIndex='0 1 2 3 -1'>"
+        "<Coordinate DEF='Pts' point='0 0 0 1 0 0 1 1 0 0 1 0'/></IndexedFaceSet></Shape></Transform>\n" /* 2 */
+        "<Transform translation='3 0 0'><Shape><IndexedFaceSet USE='Sheet'/></Shape></Transform>\n"       /* 3 */
+        "<TimeSensor DEF='Clock' cycleInterval='4'/>\n"                                                   /* 4 */
+        "<CoordinateInterpolator DEF='Fold' key='0 0.5 1' keyValue='0 0 0 1 0 0 1 1 0 0 1 0  "
+        "0 0 0 1 0 0 1 1 1 0 1 1  0 0 0 2 0 0 2 2 0 0 2 0'/>\n"                                          /* 5 */
+        "<NormalInterpolator DEF='N' key='0 1' keyValue='0 0 1 0 1 0'/>\n"                                 /* 6 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Fold' toField='set_fraction'/>\n"   /* 7 */
+        "<ROUTE fromNode='Fold' fromField='value_changed' toNode='Pts' toField='set_point'/>\n"           /* 8 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='N' toField='set_fraction'/>\n"      /* 9 */
+        "</Scene></X3D>\n");
+    EXPECT_MSG(l.r == SY_OK, "coords.x3d: %s", l.err.message);
+    if (l.r != SY_OK) return unload(&l);
+    EXPECT_MSG(has_warning(&l, "coords.x3d:6: NormalInterpolator: not played", NULL), "NormalInterpolator");
+    const float keys[3][12] = {{0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, {0, 0, 0, 1, 0, 0, 1, 1, 1, 0, 1, 1},
+                               {0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0}};
+    sy_node nodes[2] = {{0}, {0}};
+    uint32_t nn = 0;
+    for (uint32_t id = sy_scene_next(l.scene, SY_TYPE_NODE, 0); id; id = sy_scene_next(l.scene, SY_TYPE_NODE, id))
+        if (sy_node_get(l.scene, (sy_node){id})->mesh.id && nn < 2) nodes[nn++] = (sy_node){id};
+    EXPECT_MSG(nn == 2, "%u nodes show the sheet (want 2)", nn);
+    const sy_mesh_data *md = nn ? sy_mesh_get(l.scene, sy_node_get(l.scene, nodes[0])->mesh) : NULL;
+    uint32_t np = 0;
+    const sy_primitive *pr = md ? md->primitives.items : NULL;
+    np = md ? md->primitives.count : 0;
+    EXPECT_MSG(pr && np == 1 && pr->target_positions && pr->target_normals, "the sheet's primitive has morph targets");
+    if (!pr || np != 1 || !pr->target_positions || !pr->target_normals || nn != 2) return unload(&l);
+    size_t nv = sy_blob_size(pr->positions) / 12;
+    EXPECT_MSG(sy_blob_size(pr->target_positions) == 3 * nv * 12, "3 targets of %zu vertices: %zu bytes", nv,
+               sy_blob_size(pr->target_positions));
+    const float *base = sy_blob_data(pr->positions), *tp = sy_blob_data(pr->target_positions);
+    const float *bn = sy_blob_data(pr->normals), *tn = sy_blob_data(pr->target_normals);
+    const double times[2] = {1.0, 3.0}; /* fractions 0.25 (keys 0 and 1, u 0.5) and 0.75 (keys 1 and 2, u 0.5) */
+    for (int ti = 0; ti < 2; ++ti) {
+        set_time(&l, times[ti]);
+        int k0 = ti, k1 = ti + 1;
+        for (uint32_t n = 0; n < 2; ++n) {
+            const sy_node_data *nd = sy_node_get(l.scene, nodes[n]);
+            uint32_t nw = nd->weights ? (uint32_t)(sy_blob_size(nd->weights) / 4) : 0;
+            EXPECT_MSG(nw == 3, "t %g node %u: %u weights (want 3)", times[ti], n, nw);
+            if (nw != 3) continue;
+            const float *w = sy_blob_data(nd->weights);
+            /* every corner: base + sum w_k target_k = X3D's (1 - u) key k0 + u key k1 at its point */
+            for (size_t v = 0; v < nv; ++v) {
+                float p[3], best = INFINITY;
+                for (int a = 0; a < 3; ++a) {
+                    p[a] = base[3 * v + a];
+                    for (int k = 0; k < 3; ++k) p[a] += w[k] * tp[(size_t)k * nv * 3 + 3 * v + a];
+                }
+                for (int q = 0; q < 4; ++q) { /* the point this corner is: the nearest of the interpolated points */
+                    float d = 0;
+                    for (int a = 0; a < 3; ++a) {
+                        float x = 0.5f * keys[k0][3 * q + a] + 0.5f * keys[k1][3 * q + a] - p[a];
+                        d += x * x;
+                    }
+                    best = fminf(best, d);
+                }
+                EXPECT_MSG(best < 1e-10f, "t %g node %u corner %zu: (%g %g %g) is no interpolated point", times[ti], n, v,
+                           (double)p[0], (double)p[1], (double)p[2]);
+            }
+            /* the normal at t = 1 (halfway to the fold) tilts from +z towards -y; at t = 3 it comes back */
+            float nz = bn[2], ny = bn[1];
+            for (int k = 0; k < 3; ++k) nz += w[k] * tn[(size_t)k * nv * 3 + 2], ny += w[k] * tn[(size_t)k * nv * 3 + 1];
+            if (n == 0) printf("t %g: corner 0 normal y %.3f z %.3f\n", times[ti], (double)ny, (double)nz);
+            EXPECT_MSG(ny < -0.05f && nz > 0.5f, "t %g node %u: corner 0's normal (y %g, z %g) did not tilt", times[ti], n,
+                       (double)ny, (double)nz);
+        }
+    }
+    unload(&l);
+}
+
 /* the shared sample: OrbitalTimeInterval (12 s, loop) turns EarthCoordinateSystem 2 pi about +y in
  * four quarter keys */
 static void test_sample(const char *data)
@@ -272,6 +356,7 @@ int main(int argc, char **argv)
     make_scratch_dir(g_dir, sizeof g_dir, "x3d_anim");
     test_routes();
     test_fields();
+    test_coordinates();
     test_sample(argc > 1 ? argv[1] : NULL);
     remove_scratch_dir(g_dir);
     return sy_check_finish("x3d_anim");
