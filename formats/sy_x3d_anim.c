@@ -704,9 +704,13 @@ static bool add_targets(loader *L, xfile *F, const route *ro, const xmlNode *sen
     drive d = {.sensor = sensor, .interp = ro->from, .route = ro->el, .conv = CONV_NONE, .scale = 1.0f, .seq = ds->count};
     if (fm->what == W_MORPH) { /* the weights of every node showing a mesh built on the Coordinate */
         const morph_src *m = NULL;
+        bool other = false; /* another interpolator drives it (x3d_scan_morphs warned) */
         for (size_t i = 0; i < L->morph_count && !m; ++i)
-            if (L->morphs[i].coord == t && L->morphs[i].interp == ro->from && L->morphs[i].serial == F->serial)
-                m = &L->morphs[i];
+            if (L->morphs[i].coord == t && L->morphs[i].serial == F->serial) {
+                if (L->morphs[i].interp == ro->from) m = &L->morphs[i];
+                else other = true;
+            }
+        if (!m && other) return true;
         if (!m || !m->mesh_count) {
             x3d_warn(L, "%s:%d: ROUTE to %s.%s: no Shape shows that %s (line %d) with the interpolator's points; not played",
                      F->path, x3d_line_of(ro->el), x3d_ename(t), ro->tf, x3d_ename(t), x3d_line_of(t));
