@@ -653,8 +653,9 @@ static int op_attachment(sy_scene *s, blob_pool *bp)
     return 0;
 }
 
-/* An animation gets a random clip (1 to 4 channels on live nodes, each with its own sampler of 1 to
- * 5 keys, any interpolation and path); sometimes the origin's clock is set, which moves nodes. */
+/* An animation gets a random clip (1 to 4 channels on live nodes, materials, lights or cameras, each
+ * with its own sampler of 1 to 5 keys, any path; interpolation any for node paths, LINEAR or STEP
+ * for the others); sometimes the origin's clock is set, which moves nodes and changes the others. */
 static int op_animation(sy_scene *s)
 {
     sy_error e = {0};
@@ -665,15 +666,21 @@ static int op_animation(sy_scene *s)
     sy_anim_sampler_desc sd[4];
     sy_anim_channel ch[4];
     for (uint32_t c = 0; c < nc; ++c) {
-        uint32_t path = rn(SY_ANIM_WEIGHTS + 1), comps = path == SY_ANIM_ROTATION ? 4 : path == SY_ANIM_WEIGHTS ? 1 + rn(3) : 3;
-        uint32_t keys = 1 + rn(5), interp = rn(SY_INTERP_COUNT), per = interp == SY_INTERP_CUBICSPLINE ? 3 : 1;
+        /* a node path, or a material / light / camera one when such an object lives */
+        uint32_t path = rn(SY_ANIM_PATH_COUNT), target = pick(s, sy_anim_path_target(path));
+        if (!target) path = rn(SY_ANIM_WEIGHTS + 1), target = pick(s, SY_TYPE_NODE);
+        bool property = path > SY_ANIM_WEIGHTS;
+        uint32_t comps = path == SY_ANIM_WEIGHTS ? 1 + rn(3) : sy_anim_path_components(path);
+        /* property values in (0, 1) with LINEAR or STEP: valid for every colour, factor, intensity and yfov */
+        uint32_t keys = 1 + rn(5), interp = property ? rn(2) : rn(SY_INTERP_COUNT), per = interp == SY_INTERP_CUBICSPLINE ? 3 : 1;
         float t = rf(-1, 1);
         for (uint32_t k = 0; k < keys; ++k) times[c][k] = t += 0.0625f + fabsf(rf(0.01f, 1)); /* rf may give -0 */
-        for (uint32_t k = 0; k < keys * per * comps; ++k) values[c][k] = rf(-5, 5);
+        for (uint32_t k = 0; k < keys * per * comps; ++k)
+            values[c][k] = property ? 0.05f + 0.9f * (float)rn(257) / 256.0f : rf(-5, 5);
         if (path == SY_ANIM_ROTATION)
             for (uint32_t k = 0; k < keys * per; ++k) values[c][4 * k + 3] = 6.0f; /* never the zero quaternion */
         sd[c] = (sy_anim_sampler_desc){interp, comps, keys, times[c], values[c]};
-        ch[c] = (sy_anim_channel){pick(s, SY_TYPE_NODE), path, c};
+        ch[c] = (sy_anim_channel){target, path, c};
     }
     CHECK_OK(sy_animation_set_clip(s, a, sd, nc, ch, nc, &e), e);
     if (chance(50)) CHECK_OK(sy_scene_set_time(s, chance(50) ? a : (sy_animation){0}, rf(-1, 6), &e), e);
