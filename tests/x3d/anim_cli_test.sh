@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# anim_cli_test.sh — `sy render --at` of an X3D file whose Viewpoint, light and Material are routed
+# (issue 35): for each back-end given, two times give two different images, and the camera the
+# image's metadata names (the sy:camera PNG text chunk, written from the camera node's world matrix
+# at render time) is the Viewpoint's PositionInterpolator value at that time, computed here.
+# Usage: anim_cli_test.sh SY TMP BACKEND...
+SY=$1
+TMP=$2
+shift 2
+fails=0
+fail() {
+    echo "FAIL: $*" >&2
+    fails=$((fails + 1))
+}
+rm -rf "$TMP"
+mkdir -p "$TMP"
+cat >"$TMP/anim.x3d" <<'X3D'
+<X3D><Scene>
+<Viewpoint DEF='Cam' position='0 1 8' fieldOfView='0.8'/>
+<PointLight DEF='Lamp' location='-3 3 3' attenuation='0 0 0.05'/>
+<Transform translation='0 -1 0'><Shape><Appearance><Material diffuseColor='0.8 0.8 0.8'/></Appearance><Box size='10 0.2 10'/></Shape></Transform>
+<Transform DEF='Spin'><Shape><Appearance><Material DEF='Paint' diffuseColor='1 0 0'/></Appearance><Box/></Shape></Transform>
+<TimeSensor DEF='Clock' cycleInterval='2'/>
+<ColorInterpolator DEF='Hue' key='0 1' keyValue='1 0 0 0 0 1'/>
+<PositionInterpolator DEF='Dolly' key='0 1' keyValue='0 1 8 2 2 6'/>
+<PositionInterpolator DEF='Move' key='0 1' keyValue='-3 3 3 3 3 3'/>
+<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Hue' toField='set_fraction'/>
+<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Dolly' toField='set_fraction'/>
+<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Move' toField='set_fraction'/>
+<ROUTE fromNode='Hue' fromField='value_changed' toNode='Paint' toField='diffuseColor'/>
+<ROUTE fromNode='Dolly' fromField='value_changed' toNode='Cam' toField='position'/>
+<ROUTE fromNode='Move' fromField='value_changed' toNode='Lamp' toField='location'/>
+</Scene></X3D>
+X3D
+# t = 0.5 s: fraction 0.25; t = 1.5 s: 0.75 (Dolly: (0 1 8) + f (2 1 -2))
+want_05="at (0.5, 1.25, 7.5)"
+want_15="at (1.5, 1.75, 6.5)"
+for b in "$@"; do
+    extra=()
+    [ "$b" = pathtracer ] && extra=(--spp 4)
+    for t in 0.5 1.5; do
+        if ! "$SY" render "$TMP/anim.x3d" -b "$b" -w 48 -h 32 --at "$t" "${extra[@]}" -o "$TMP/${b}_$t.png" \
+            >"$TMP/out" 2>"$TMP/err"; then
+            fail "$b --at $t: $(cat "$TMP/err")"
+            continue
+        fi
+        want=$want_05
+        [ "$t" = 1.5 ] && want=$want_15
+        grep -aqF "the scene's first camera $want" "$TMP/${b}_$t.png" ||
+            fail "$b --at $t: the image's camera is not the Viewpoint at $t s ($want): $(grep -ao "first camera at ([^)]*)" "$TMP/${b}_$t.png")"
+    done
+    cmp -s "$TMP/${b}_0.5.png" "$TMP/${b}_1.5.png" && fail "$b: --at 0.5 and --at 1.5 give the same image"
+done
+[ "$fails" -eq 0 ] || exit 1
+rm -rf "$TMP"
+echo "ok: $*"
