@@ -13,9 +13,9 @@
  * orientation / caps, as an IndexedFaceSet), Box, Sphere, Cone, Cylinder (tessellated),
  * DirectionalLight, PointLight, SpotLight, Viewpoint, Background / TextureBackground (skyColor[0]),
  * Inline (relative files; each file is loaded once and shared), DEF / USE. TimeSensors with the
- * Position-, Orientation-, Color-, Scalar- and CoordinateInterpolators and ROUTEs they drive become
- * animations (clips) of the scene clock, into Transform, Viewpoint, light and Material fields and
- * (as morph targets and weights) Coordinate points (sy_x3d_anim.c,
+ * Position-, Orientation-, Color-, Scalar-, Coordinate- and NormalInterpolators and ROUTEs they
+ * drive become animations (clips) of the scene clock, into Transform, Viewpoint, light and Material
+ * fields and (as morph targets and weights) Coordinate points and Normal vectors (sy_x3d_anim.c,
  * docs/FORMATS.md); bad ROUTEs (undefined names, differing field types, loops) are dropped with a
  * warning naming the ROUTE's line. Non-visual nodes (WorldInfo, NavigationInfo, EXPORT, IMPORT,
  * metadata) are ignored silently; any other node type is skipped with one warning per type.

@@ -27,7 +27,10 @@
  *                               generates them), and each node showing such a mesh gets a weights
  *                               channel whose key k is the k-th unit vector (LINEAR weights blend
  *                               consecutive keys exactly as X3D interpolates the points; at most
- *                               SY_MORPH_MAX_TARGETS keys); the mirror deforms it for every back-end.
+ *                               SY_MORPH_MAX_TARGETS keys); the mirror deforms it for every back-end;
+ *   NormalInterpolator       -> Normal.vector: the same, as normal deltas (geometry whose every corner
+ *                               has an explicit normal; with a CoordinateInterpolator on the same
+ *                               geometry only when both have the same keys, one channel for both).
  * ROUTEs are read per file, so DEF names resolve in the file's own namespace (an Inline's routes
  * see the Inline's DEFs).
  *
@@ -38,8 +41,8 @@
  * fields' types differ (SFVec3f into SFColor: X3D forbids it); a route that closes a loop of routes
  * (X3D passes one event per route per timestamp, so a loop never runs away; the clock has no event
  * cascade at all, and the route is dropped). What has no target here is reported once per kind:
- * Normal- and PositionInterpolator2D (Normal.vector and TextureTransform are baked into the meshes'
- * vertices and texture coordinates when loading), other
+ * PositionInterpolator2D and CoordinateInterpolator2D (texture coordinates and TextureTransform
+ * are baked into the meshes' vertices when loading), other
  * mapped-but-not-animated fields (Material.shininess, Transform.center, ...), Transforms with a
  * center or scaleOrientation (their node holds a matrix, which the clock does not drive). Bad
  * interpolators (key and keyValue counts that differ, keys that decrease) are dropped with a warning
@@ -105,7 +108,7 @@ static const field_map field_maps[] = {
     {"Material", "specularColor", T_SFCOLOR, W_NONE},
     {"Material", "shininess|ambientIntensity|occlusionStrength|normalScale", T_SFFLOAT, W_NONE},
     {"Coordinate|CoordinateDouble", "point", T_MFVEC3F, W_MORPH},
-    {"Normal", "vector", T_MFVEC3F, W_NONE},
+    {"Normal", "vector", T_MFVEC3F, W_MORPH},
     {"TextureCoordinate", "point", T_MFVEC2F, W_NONE},
     {"TextureTransform", "translation|scale|center", T_SFVEC2F, W_NONE},
     {"TextureTransform", "rotation", T_SFFLOAT, W_NONE},
@@ -122,7 +125,7 @@ static const interp_kind interp_kinds[] = {
     {"PositionInterpolator", T_SFVEC3F, 3, true},    {"OrientationInterpolator", T_SFROTATION, 4, true},
     {"ColorInterpolator", T_SFCOLOR, 3, true},       {"ScalarInterpolator", T_SFFLOAT, 1, true},
     {"PositionInterpolator2D", T_SFVEC2F, 2, false}, {"CoordinateInterpolator", T_MFVEC3F, 3, true},
-    {"NormalInterpolator", T_MFVEC3F, 3, false},     {"CoordinateInterpolator2D", T_MFVEC2F, 2, false},
+    {"NormalInterpolator", T_MFVEC3F, 3, true},     {"CoordinateInterpolator2D", T_MFVEC2F, 2, false},
 };
 
 static const interp_kind *kind_of(const xmlNode *el)
@@ -437,7 +440,7 @@ static int read_one_hot(loader *L, xfile *F, const drive *d, float cycle, sy_ani
     for (size_t k = 0; k < nk; ++k) {
         float raw = key[k], t = raw * cycle;
         if (!isfinite(t) || raw < prev) {
-            x3d_warn(L, "%s:%d: CoordinateInterpolator: key %zu (%g) %s; not played", F->path, x3d_line_of(m->interp), k,
+            x3d_warn(L, "%s:%d: %s: key %zu (%g) %s; not played", F->path, x3d_line_of(m->interp), x3d_ename(m->interp), k,
                      (double)raw, isfinite(t) ? "is less than the key before it" : "is not finite");
             free(key);
             return 0;
@@ -711,6 +714,7 @@ static bool add_targets(loader *L, xfile *F, const route *ro, const xmlNode *sen
                 else other = true;
             }
         if (!m && other) return true;
+        if (m && m->merged && !m->mesh_count) return true; /* the CoordinateInterpolator's channel plays it */
         if (!m || !m->mesh_count) {
             x3d_warn(L, "%s:%d: ROUTE to %s.%s: no Shape shows that %s (line %d) with the interpolator's points; not played",
                      F->path, x3d_line_of(ro->el), x3d_ename(t), ro->tf, x3d_ename(t), x3d_line_of(t));
@@ -948,7 +952,7 @@ static bool scan_collect(scan *sc, const xmlNode *el, unsigned depth)
             continue;
         }
         if (x3d_name_in(n, "ProtoDeclare|ExternProtoDeclare|Script")) continue;
-        if (x3d_name_in(n, "Coordinate|CoordinateDouble|CoordinateInterpolator|TimeSensor")) {
+        if (x3d_name_in(n, "Coordinate|CoordinateDouble|CoordinateInterpolator|Normal|NormalInterpolator|TimeSensor")) {
             char *def = x3d_attr(c, "DEF");
             if (def && !xmlHashLookup(sc->defs, (const xmlChar *)def)) xmlHashAddEntry(sc->defs, (const xmlChar *)def, (void *)c);
             xmlFree(def);
@@ -990,23 +994,24 @@ sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
     }
     /* the interpolators a TimeSensor drives */
     for (size_t i = 0; i < sc.routes.count; ++i) {
-        const xmlNode *ro = sc.routes.items[i], *in = scan_def(&sc, ro, "toNode", "CoordinateInterpolator");
+        const xmlNode *ro = sc.routes.items[i], *in = scan_def(&sc, ro, "toNode", "CoordinateInterpolator|NormalInterpolator");
         if (in && scan_def(&sc, ro, "fromNode", "TimeSensor") && route_fields(ro, "fraction_changed", "fraction"))
             driven[nd++] = in;
     }
-    qsort(driven, nd, sizeof *driven, cmp_ptr_el);
+    if (nd) qsort(driven, nd, sizeof *driven, cmp_ptr_el);
     for (size_t i = 0; i < sc.routes.count && !r; ++i) {
         const xmlNode *ro = sc.routes.items[i];
-        const xmlNode *in = scan_def(&sc, ro, "fromNode", "CoordinateInterpolator");
-        const xmlNode *co = scan_def(&sc, ro, "toNode", "Coordinate|CoordinateDouble");
-        if (!in || !co || !route_fields(ro, "value_changed", "point") || !nd ||
+        const xmlNode *in = scan_def(&sc, ro, "fromNode", "CoordinateInterpolator|NormalInterpolator");
+        bool normals = in && !strcmp(x3d_ename(in), "NormalInterpolator");
+        const xmlNode *co = scan_def(&sc, ro, "toNode", normals ? "Normal" : "Coordinate|CoordinateDouble");
+        if (!in || !co || !route_fields(ro, "value_changed", normals ? "vector" : "point") || !nd ||
             !bsearch(&in, driven, nd, sizeof *driven, cmp_ptr_el))
             continue;
         bool seen = false; /* one interpolator per Coordinate: the first route in the file */
         for (size_t k = 0; k < L->morph_count && !seen; ++k) seen = L->morphs[k].coord == co && L->morphs[k].serial == F->serial;
         if (seen) {
-            x3d_warn(L, "%s:%d: ROUTE: a second CoordinateInterpolator into the Coordinate of line %d; not played",
-                     F->path, x3d_line_of(ro), x3d_line_of(co));
+            x3d_warn(L, "%s:%d: ROUTE: a second %s into the %s of line %d; not played", F->path, x3d_line_of(ro),
+                     x3d_ename(in), x3d_ename(co), x3d_line_of(co));
             continue;
         }
         float *key = NULL, *kv = NULL;
@@ -1015,23 +1020,23 @@ sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
             nk == 0 || nk > SY_MORPH_MAX_TARGETS || nv % nk != 0 || nv / nk == 0) {
             if (L->limit_r) r = L->limit_r, L->err = L->limit_err;
             else
-                x3d_warn(L, "%s:%d: CoordinateInterpolator: %zu keys and %zu key values (1 to %u keys, the same number of "
-                         "points for each); not played", F->path, x3d_line_of(in), nk, nv, SY_MORPH_MAX_TARGETS);
+                x3d_warn(L, "%s:%d: %s: %zu keys and %zu key values (1 to %u keys, the same number of values for "
+                         "each); not played", F->path, x3d_line_of(in), x3d_ename(in), nk, nv, SY_MORPH_MAX_TARGETS);
             free(key), free(kv);
             continue;
         }
-        free(key);
         if (L->morph_count == L->morph_cap) {
             size_t cap = L->morph_cap ? 2 * L->morph_cap : 4;
             morph_src *p = realloc(L->morphs, cap * sizeof *p);
             if (!p) {
-                free(kv);
+                free(kv), free(key);
                 r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
                 break;
             }
             L->morphs = p, L->morph_cap = cap;
         }
-        L->morphs[L->morph_count++] = (morph_src){co, in, F->serial, kv, nk, nv / nk, NULL, 0, 0};
+        L->morphs[L->morph_count++] = (morph_src){.coord = co, .interp = in, .serial = F->serial, .values = kv, .key = key,
+                                                  .keys = nk, .points = nv / nk, .normals = normals};
     }
 done:
     free(driven);
@@ -1042,7 +1047,7 @@ done:
 
 void x3d_free_morphs(loader *L)
 {
-    for (size_t i = 0; i < L->morph_count; ++i) free(L->morphs[i].values), free(L->morphs[i].meshes);
+    for (size_t i = 0; i < L->morph_count; ++i) free(L->morphs[i].values), free(L->morphs[i].key), free(L->morphs[i].meshes);
     free(L->morphs);
     L->morphs = NULL;
     L->morph_count = L->morph_cap = 0;

@@ -77,10 +77,13 @@ typedef struct mat_link {
  * key's points, and normals generated again when the geometry generates them); the mesh is noted
  * for the weights channels (one-hot per key: linear weights blend consecutive keys exactly). */
 typedef struct morph_src {
-    const xmlNode *coord, *interp;
+    const xmlNode *coord, *interp; /* coord: a Coordinate, or a Normal (normals: a NormalInterpolator) */
     uint32_t serial;
     float *values;     /* keys x points x 3 (malloc()ed) */
+    float *key;        /* the interpolator's keys (malloc()ed) */
     size_t keys, points;
+    bool normals;      /* a NormalInterpolator into a Normal */
+    bool merged;       /* normals played by the CoordinateInterpolator of the same geometry (same keys) */
     uint32_t *meshes;  /* the meshes built on it (malloc()ed) */
     size_t mesh_count, mesh_cap;
 } morph_src;
@@ -197,6 +200,7 @@ typedef struct geom_src {
     bool ccw, generate_tc;
     float tt[6]; /* texture transform (2x3 affine, X3D t-up space) */
     const xmlNode *coord_el; /* the Coordinate node the points come from (NULL: generated) */
+    const xmlNode *normal_el; /* the Normal node of the normals (NULL: none) */
 } geom_src;
 
 

@@ -38,39 +38,78 @@ sy_result x3d_budget_vertices(loader *L, const char *file, const xmlNode *el, ui
                             x3d_ename(el), (unsigned long long)n);
 }
 
-/* When g's Coordinate is animated (L->morphs): one morph target per key on the primitive (position
- * deltas of its corners; normal deltas from the key's generated normals when gen, else none), and
- * L->morph_pending names the source. Charged to the load's budget; a key count that does not
- * match the points is warned about and leaves the geometry static. */
+/* The morph source of element el (a Coordinate or Normal) of file F, or NULL. */
+static morph_src *morph_of(loader *L, const xfile *F, const xmlNode *el, bool normals)
+{
+    for (size_t i = 0; el && i < L->morph_count; i++)
+        if (L->morphs[i].coord == el && L->morphs[i].serial == F->serial && L->morphs[i].normals == normals)
+            return &L->morphs[i];
+    return NULL;
+}
+
+/* When g's Coordinate or Normal is animated (L->morphs): one morph target per key on the primitive:
+ * position deltas of its corners (a CoordinateInterpolator), normal deltas from the key's generated
+ * normals (where the geometry generates them) or from the NormalInterpolator's key vectors (where
+ * every corner has an explicit normal; with a CoordinateInterpolator too, only when both have the
+ * same keys: then one weights channel plays both). L->morph_pending names the source whose weights
+ * channel plays the targets. Charged to the load's budget; what does not match is warned about and
+ * left static. */
 static sy_result morph_targets(loader *L, xfile *F, const xmlNode *el, const geom_src *g, const corners *c,
                                const float *pos, const float *nrm, bool gen, sy_primitive *prim)
 {
-    if (!g->coord_el) return SY_OK;
-    morph_src *m = NULL;
-    for (size_t i = 0; i < L->morph_count && !m; i++)
-        if (L->morphs[i].coord == g->coord_el && L->morphs[i].serial == F->serial) m = &L->morphs[i];
-    if (!m) return SY_OK;
-    if (m->points != g->npts) {
+    morph_src *m = morph_of(L, F, g->coord_el, false), *mn = gen ? NULL : morph_of(L, F, g->normal_el, true);
+    if (gen && morph_of(L, F, g->normal_el, true))
+        x3d_warn(L, "%s:%d: NormalInterpolator: %s generates normals for some corners; its normals are not played",
+                 F->path, x3d_line_of(el), x3d_ename(el));
+    if (m && m->points != g->npts) {
         x3d_warn(L, "%s:%d: CoordinateInterpolator (line %d): %zu points per key, the Coordinate (line %d) has %zu; not "
                  "played", F->path, x3d_line_of(el), x3d_line_of(m->interp), m->points, x3d_line_of(m->coord), g->npts);
-        return SY_OK;
+        m = NULL;
     }
+    if (mn && mn->points != g->nnrm) {
+        x3d_warn(L, "%s:%d: NormalInterpolator (line %d): %zu vectors per key, the Normal (line %d) has %zu; not played",
+                 F->path, x3d_line_of(el), x3d_line_of(mn->interp), mn->points, x3d_line_of(mn->coord), g->nnrm);
+        mn = NULL;
+    }
+    if (m && mn) { /* one weights channel for both: the same keys */
+        bool same = m->keys == mn->keys;
+        for (size_t k = 0; same && k < m->keys; k++) same = m->key[k] == mn->key[k];
+        if (!same) {
+            x3d_warn(L, "%s:%d: NormalInterpolator (line %d) and CoordinateInterpolator (line %d) of one geometry with "
+                     "different keys: the normals are not played", F->path, x3d_line_of(el), x3d_line_of(mn->interp),
+                     x3d_line_of(m->interp));
+            mn = NULL;
+        } else {
+            mn->merged = true;
+        }
+    }
+    morph_src *src = m ? m : mn;
+    if (!src) return SY_OK;
     size_t nv = c->tris * 3;
-    sy_result r = sy_budget_charge(&L->budget, (uint64_t)m->keys * nv * (gen ? 2u : 1u), 12, &L->err,
-                                   "%s:%d: %s: morph targets of a CoordinateInterpolator", F->path, x3d_line_of(el),
-                                   x3d_ename(el));
+    bool normals = gen ? m != NULL : mn != NULL;
+    sy_result r = sy_budget_charge(&L->budget, (uint64_t)src->keys * nv * (normals ? 2u : 1u), 12, &L->err,
+                                   "%s:%d: %s: morph targets of an interpolator", F->path, x3d_line_of(el), x3d_ename(el));
     if (r) return r;
-    float *tp = malloc(m->keys * nv * 12), *tn = gen ? malloc(m->keys * nv * 12) : NULL;
-    if (!tp || (gen && !tn)) {
+    float *tp = calloc(src->keys * nv, 12), *tn = normals ? malloc(src->keys * nv * 12) : NULL;
+    if (!tp || (normals && !tn)) {
         free(tp), free(tn);
         return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
     }
-    for (size_t k = 0; k < m->keys; k++) {
-        const float *pk = m->values + k * m->points * 3;
-        float *dk = tp + k * nv * 3;
-        for (size_t i = 0; i < nv; i++)
-            for (int a = 0; a < 3; a++) dk[3 * i + a] = pk[3 * (size_t)c->coord[i] + a] - pos[3 * i + a];
-        if (!gen) continue;
+    for (size_t k = 0; k < src->keys; k++) {
+        const float *pk = m ? m->values + k * m->points * 3 : NULL;
+        for (size_t i = 0; pk && i < nv; i++)
+            for (int a = 0; a < 3; a++) tp[k * nv * 3 + 3 * i + a] = pk[3 * (size_t)c->coord[i] + a] - pos[3 * i + a];
+        if (!normals) continue;
+        if (mn) { /* the key's vectors, normalised as the base normals are */
+            const float *nk = mn->values + k * mn->points * 3;
+            for (size_t i = 0; i < nv; i++) {
+                const float *v = nk + 3 * (size_t)c->normal[i];
+                float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                for (int a = 0; a < 3; a++)
+                    tn[k * nv * 3 + 3 * i + a] = (l > 0 ? v[a] / l : (a == 2 ? 1.0f : 0.0f)) - nrm[3 * i + a];
+            }
+            continue;
+        }
         float *nk = NULL;
         if ((r = sy_corner_normals(pk, m->points, c->coord, c->tris, g->crease, &nk, &L->err))) {
             free(tp), free(tn);
@@ -79,10 +118,10 @@ static sy_result morph_targets(loader *L, xfile *F, const xmlNode *el, const geo
         for (size_t i = 0; i < 3 * nv; i++) tn[k * nv * 3 + i] = nk[i] - nrm[i];
         free(nk);
     }
-    r = x3d_make_blob(L, tp, m->keys * nv * 12, &prim->target_positions);
-    if (!r && tn) r = x3d_make_blob(L, tn, m->keys * nv * 12, &prim->target_normals);
+    r = x3d_make_blob(L, tp, src->keys * nv * 12, &prim->target_positions);
+    if (!r && tn) r = x3d_make_blob(L, tn, src->keys * nv * 12, &prim->target_normals);
     else if (tn && r) free(tn);
-    if (!r) L->morph_pending = (size_t)(m - L->morphs) + 1;
+    if (!r) L->morph_pending = (size_t)(src - L->morphs) + 1;
     return r;
 }
 
@@ -203,6 +242,7 @@ bool x3d_read_sources(loader *L, xfile *F, const xmlNode *el, geom_src *g)
     g->coord_el = n;
     if ((n = x3d_field_child(L, F, el, "Normal", "normal")) && !x3d_get_float_array(L, F, n, "vector", 3, &g->nrm, &g->nnrm))
         return false;
+    g->normal_el = n;
     n = x3d_field_child(L, F, el, "TextureCoordinate|MultiTextureCoordinate|TextureCoordinateGenerator", "texCoord");
     if (n && !strcmp(x3d_ename(n), "MultiTextureCoordinate")) n = x3d_field_child(L, F, n, "TextureCoordinate", "texCoord");
     if (n && !strcmp(x3d_ename(n), "TextureCoordinate") && !x3d_get_float_array(L, F, n, "point", 2, &g->tc, &g->ntc))

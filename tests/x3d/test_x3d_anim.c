@@ -243,8 +243,8 @@ static void test_fields(void)
 /* CoordinateInterpolator -> Coordinate.point: the IndexedFaceSet's primitive gets one morph target
  * per key and every node showing it (two Shapes with the one IndexedFaceSet) a weights channel; base + weights x
  * targets at a time equals X3D's linear interpolation of the key points at each corner, and the
- * generated normals follow (the quad folds up, its normal turns). Two NormalInterpolators: not
- * played, reported once. */
+ * generated normals follow (the quad folds up, its normal turns); a NormalInterpolator into the
+ * explicit normals of a triangle gives normal targets that blend to X3D's halfway normal. */
 static void test_coordinates(void)
 {
     loaded l = load_text("coords.x3d",
@@ -262,7 +262,6 @@ static void test_coordinates(void)
         "</Scene></X3D>\n");
     EXPECT_MSG(l.r == SY_OK, "coords.x3d: %s", l.err.message);
     if (l.r != SY_OK) return unload(&l);
-    EXPECT_MSG(has_warning(&l, "coords.x3d:6: NormalInterpolator: not played", NULL), "NormalInterpolator");
     const float keys[3][12] = {{0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, {0, 0, 0, 1, 0, 0, 1, 1, 1, 0, 1, 1},
                                {0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0}};
     sy_node nodes[2] = {{0}, {0}};
@@ -316,6 +315,39 @@ static void test_coordinates(void)
             EXPECT_MSG(ny < -0.05f && nz > 0.5f, "t %g node %u: corner 0's normal (y %g, z %g) did not tilt", times[ti], n,
                        (double)ny, (double)nz);
         }
+    }
+    unload(&l);
+    /* NormalInterpolator -> Normal.vector of a triangle with explicit normals: normal deltas only;
+     * halfway, the blended normal points along X3D's interpolation on the sphere, (0 1 1) / sqrt 2 */
+    l = load_text("normals.x3d",
+        "<X3D><Scene>\n"
+        "<Shape><IndexedFaceSet coordIndex='0 1 2 -1' normalIndex='0 1 2 -1'>"
+        "<Coordinate point='0 0 0 1 0 0 0 1 0'/><Normal DEF='Nr' vector='0 0 1 0 0 1 0 0 1'/></IndexedFaceSet></Shape>\n"
+        "<TimeSensor DEF='Clock' cycleInterval='2'/>\n"
+        "<NormalInterpolator DEF='N' key='0 1' keyValue='0 0 1 0 0 1 0 0 1  0 1 0 0 1 0 0 1 0'/>\n"
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='N' toField='set_fraction'/>\n"
+        "<ROUTE fromNode='N' fromField='value_changed' toNode='Nr' toField='set_vector'/>\n"
+        "</Scene></X3D>\n");
+    EXPECT_MSG(l.r == SY_OK && sy_scene_count(l.scene, SY_TYPE_ANIMATION) == 1, "normals.x3d: %s", l.err.message);
+    sy_node tri = {0};
+    for (uint32_t id = sy_scene_next(l.scene, SY_TYPE_NODE, 0); l.r == SY_OK && id; id = sy_scene_next(l.scene, SY_TYPE_NODE, id))
+        if (sy_node_get(l.scene, (sy_node){id})->mesh.id) tri = (sy_node){id};
+    md = tri.id ? sy_mesh_get(l.scene, sy_node_get(l.scene, tri)->mesh) : NULL;
+    pr = md && md->primitives.count == 1 ? md->primitives.items : NULL;
+    EXPECT_MSG(pr && pr->target_normals && pr->target_positions, "the triangle has normal (and zero position) targets");
+    if (pr && pr->target_normals) {
+        set_time(&l, 1.0);
+        const sy_node_data *nd = sy_node_get(l.scene, tri);
+        const float *w = nd->weights && sy_blob_size(nd->weights) == 8 ? sy_blob_data(nd->weights) : NULL;
+        EXPECT_MSG(w != NULL, "the triangle's node has 2 weights");
+        const float *b0 = sy_blob_data(pr->normals), *t0 = sy_blob_data(pr->target_normals);
+        nv = sy_blob_size(pr->normals) / 12;
+        float n3[3];
+        for (int a = 0; w && a < 3; ++a) n3[a] = b0[a] + w[0] * t0[a] + w[1] * t0[nv * 3 + a];
+        float len = w ? sqrtf(n3[0] * n3[0] + n3[1] * n3[1] + n3[2] * n3[2]) : 0;
+        EXPECT_MSG(w && len > 0 && fabsf(n3[0] / len) < 1e-5f && fabsf(n3[1] / len - 0.70710678f) < 1e-4f &&
+                       fabsf(n3[2] / len - 0.70710678f) < 1e-4f,
+                   "halfway normal (%g %g %g)", w ? (double)n3[0] : 0.0, w ? (double)n3[1] : 0.0, w ? (double)n3[2] : 0.0);
     }
     unload(&l);
 }
