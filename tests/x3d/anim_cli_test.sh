@@ -2,7 +2,8 @@
 # anim_cli_test.sh — `sy render --at` of an X3D file whose Viewpoint, light and Material are routed
 # (issue 35): for each back-end given, two times give two different images, and the camera the
 # image's metadata names (the sy:camera PNG text chunk, written from the camera node's world matrix
-# at render time) is the Viewpoint's PositionInterpolator value at that time, computed here.
+# at render time) is the Viewpoint's PositionInterpolator value at that time, computed here; a
+# --frames sequence shows the same cameras at the same times.
 # Usage: anim_cli_test.sh SY TMP BACKEND...
 SY=$1
 TMP=$2
@@ -51,6 +52,15 @@ for b in "$@"; do
     done
     cmp -s "$TMP/${b}_0.5.png" "$TMP/${b}_1.5.png" && fail "$b: --at 0.5 and --at 1.5 give the same image"
 done
+# a sequence (--frames 1:3 at 2 fps: 0.5, 1.0 and 1.5 s) through the first back-end: frames 1 and 3
+# show the camera of --at 0.5 and --at 1.5
+b=$1
+if "$SY" render "$TMP/anim.x3d" -b "$b" -w 48 -h 32 --frames 1:3 --fps 2 -o "$TMP/seq_#.png" >"$TMP/out" 2>"$TMP/err"; then
+    grep -aqF "the scene's first camera $want_05" "$TMP/seq_1.png" || fail "$b sequence: frame 1 is not at 0.5 s"
+    grep -aqF "the scene's first camera $want_15" "$TMP/seq_3.png" || fail "$b sequence: frame 3 is not at 1.5 s"
+else
+    fail "$b --frames 1:3: $(cat "$TMP/err")"
+fi
 [ "$fails" -eq 0 ] || exit 1
 rm -rf "$TMP"
 echo "ok: $*"
