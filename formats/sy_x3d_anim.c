@@ -149,11 +149,25 @@ typedef struct drive {
 /* Drives a file may make (each is a channel): beyond it the rest is reported and not played. */
 #define X3D_MAX_DRIVES 65536u
 
+/* A node showing a mesh (x3d_load_animations sorts them by mesh when the file has morphs). */
+typedef struct mesh_node {
+    uint32_t mesh, node;
+} mesh_node;
+
 typedef struct drives {
     drive *items;
     size_t count, cap;
     bool capped;
+    mesh_node *shown; /* the loader's nodes that show a mesh, by mesh (NULL: no morphs) */
+    size_t shown_count;
 } drives;
+
+static int cmp_mesh_node(const void *a, const void *b)
+{
+    const mesh_node *x = a, *y = b;
+    if (x->mesh != y->mesh) return x->mesh < y->mesh ? -1 : 1;
+    return x->node < y->node ? -1 : x->node > y->node;
+}
 
 /* A ROUTE with its ends resolved: from / to elements (NULL: not DEFined), fields, dropped. */
 typedef struct route {
@@ -721,14 +735,17 @@ static bool add_targets(loader *L, xfile *F, const route *ro, const xmlNode *sen
             return true;
         }
         d.path = SY_ANIM_WEIGHTS, d.conv = CONV_ONE_HOT, d.scale_index = (size_t)(m - L->morphs);
-        for (size_t i = 0; i < L->obj_count; ++i) {
-            if (L->objs[i].type != SY_TYPE_NODE) continue;
-            const sy_node_data *nd = sy_node_get(L->scene, (sy_node){L->objs[i].id});
-            bool shows = false;
-            for (size_t k = 0; nd && nd->mesh.id && k < m->mesh_count && !shows; ++k) shows = nd->mesh.id == m->meshes[k];
-            if (!shows) continue;
-            d.target = L->objs[i].id;
-            if (!push(L, F, ds, &d)) return false;
+        for (size_t k = 0; k < m->mesh_count; ++k) { /* the nodes of each mesh: a binary search, then a run */
+            size_t lo = 0, hi = ds->shown_count;
+            while (lo < hi) {
+                size_t mid = lo + (hi - lo) / 2;
+                if (ds->shown[mid].mesh < m->meshes[k]) lo = mid + 1;
+                else hi = mid;
+            }
+            for (; lo < ds->shown_count && ds->shown[lo].mesh == m->meshes[k]; ++lo) {
+                d.target = ds->shown[lo].node;
+                if (!push(L, F, ds, &d)) return false;
+            }
         }
         return true;
     }
@@ -837,6 +854,18 @@ sy_result x3d_load_animations(loader *L, xfile *F, const xmlNode *scene)
         xmlFree(fn), xmlFree(tn);
     }
     if ((r = drop_loops(L, F, rt, rs.count))) goto done;
+    if (L->morph_count) { /* the nodes that show each mesh, for the morph weights channels: O(N log N) once */
+        if (!(ds.shown = malloc((L->obj_count + 1) * sizeof *ds.shown))) {
+            r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+            goto done;
+        }
+        for (size_t i = 0; i < L->obj_count; ++i) {
+            if (L->objs[i].type != SY_TYPE_NODE) continue;
+            const sy_node_data *nd = sy_node_get(L->scene, (sy_node){L->objs[i].id});
+            if (nd && nd->mesh.id) ds.shown[ds.shown_count++] = (mesh_node){nd->mesh.id, L->objs[i].id};
+        }
+        if (ds.shown_count) qsort(ds.shown, ds.shown_count, sizeof *ds.shown, cmp_mesh_node);
+    }
     /* the interpolators' value_changed routes, sorted by where they come from (O(R log R) joins) */
     for (size_t i = 0; i < rs.count; ++i)
         if (!rt[i].dropped && kind_of(rt[i].from) && !strcmp(rt[i].ff, "value_changed")) vr[nv++] = (edge){rt[i].from, i};
@@ -879,6 +908,7 @@ done:
     free(rt);
     free(vr);
     free(ds.items);
+    free(ds.shown);
     free(rs.items);
     return r;
 }
@@ -887,43 +917,48 @@ done:
 
 sy_result x3d_fix_light_animations(loader *L)
 {
-    for (size_t i = 0; i < L->ifix_count; ++i) {
-        const intensity_fix *fx = &L->ifix[i];
-        float mult = 1.0f;
-        for (size_t k = 0; k < L->light_count; ++k)
-            if (L->lights[k].light == fx->light) mult = L->lights[k].mult;
-        if (mult == 1.0f) continue;
-        sy_animation a = {fx->animation};
+    /* build_clip appends a clip's fixes together: one copy and one set_clip per clip */
+    for (size_t i = 0; i < L->ifix_count;) {
+        size_t j = i;
+        while (j < L->ifix_count && L->ifix[j].animation == L->ifix[i].animation) ++j;
+        sy_animation a = {L->ifix[i].animation};
         const sy_animation_data *d = sy_animation_get(L->scene, a);
-        uint32_t ns, nc;
+        uint32_t ns = 0, nc = 0;
         const sy_anim_sampler *sm = d ? sy_animation_samplers(d, &ns) : NULL;
         const sy_anim_channel *ch = d ? sy_animation_channels(d, &nc) : NULL;
-        if (!sm || fx->sampler >= ns) continue;
-        /* a copy of the clip with this sampler's values scaled (its samplers are its own: cmp_by_sampler) */
-        size_t nval = sy_blob_size(d->values) / sizeof(float);
-        float *vals = malloc(nval * sizeof *vals);
-        sy_anim_sampler_desc *sd = malloc(ns * sizeof *sd);
-        sy_anim_channel *cc = malloc(nc * sizeof *cc);
-        sy_result r = SY_OK;
-        if (!vals || !sd || !cc) {
-            r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
-        } else {
+        size_t nval = sm ? sy_blob_size(d->values) / sizeof(float) : 0;
+        float *vals = sm ? malloc(nval * sizeof *vals) : NULL;
+        sy_anim_sampler_desc *sd = sm ? malloc(ns * sizeof *sd) : NULL;
+        sy_anim_channel *cc = sm ? malloc((nc + 1) * sizeof *cc) : NULL;
+        if (sm && (!vals || !sd || !cc)) {
+            free(vals), free(sd), free(cc);
+            return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+        }
+        bool changed = false;
+        if (sm) {
             memcpy(vals, sy_blob_data(d->values), nval * sizeof *vals);
             memcpy(cc, ch, nc * sizeof *cc);
-            const sy_anim_sampler *s = &sm[fx->sampler];
-            for (uint32_t k = 0; k < s->key_count * s->components; ++k) vals[s->values_offset + k] *= mult;
+        }
+        for (size_t f = i; sm && f < j; ++f) { /* each fixed sampler x its light's factor (x3d_finish_lights) */
+            float mult = 1.0f;
+            for (size_t k = 0; k < L->light_count; ++k)
+                if (L->lights[k].light == L->ifix[f].light) mult = L->lights[k].mult;
+            if (mult == 1.0f || L->ifix[f].sampler >= ns) continue;
+            const sy_anim_sampler *smp = &sm[L->ifix[f].sampler]; /* its own sampler (cmp_by_sampler) */
+            for (uint32_t k = 0; k < smp->key_count * smp->components; ++k) vals[smp->values_offset + k] *= mult;
+            changed = true;
+        }
+        if (changed) {
             const float *times = sy_blob_data(d->times);
-            for (uint32_t j = 0; j < ns; ++j)
-                sd[j] = (sy_anim_sampler_desc){sm[j].interpolation, sm[j].components, sm[j].key_count,
-                                               times + sm[j].times_offset, vals + sm[j].values_offset};
+            for (uint32_t k = 0; k < ns; ++k)
+                sd[k] = (sy_anim_sampler_desc){sm[k].interpolation, sm[k].components, sm[k].key_count,
+                                               times + sm[k].times_offset, vals + sm[k].values_offset};
             sy_error e = {0};
             if (sy_animation_set_clip(L->scene, a, sd, ns, cc, nc, &e) != SY_OK)
-                x3d_warn(L, "light intensity animation %s: %s; left unscaled", d->name ? d->name : "", e.message);
+                x3d_warn(L, "light intensity animation: %s; left unscaled", e.message);
         }
-        free(vals);
-        free(sd);
-        free(cc);
-        if (r) return r;
+        free(vals), free(sd), free(cc);
+        i = j;
     }
     return SY_OK;
 }
