@@ -3,7 +3,7 @@
 SY_PACKAGES="cmake ninja-build libavcodec-dev libavformat-dev libswscale-dev gcc g++ pkg-config libembree-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
  libopenexr-dev libpng-dev libxxhash-dev libxml2-dev clang libclang-rt-14-dev
  libglfw3-dev libgl-dev xvfb xauth libosmesa6-dev libegl-dev
- libnng-dev libsodium-dev libzstd-dev iproute2 libfreetype-dev fonts-dejavu-core
+ libnng-dev libsodium-dev libzstd-dev zlib1g-dev iproute2 libfreetype-dev fonts-dejavu-core
  libopenmpi-dev openmpi-bin libimath-dev libcjson-dev doxygen libmeshoptimizer-dev
  libwebsockets-dev libturbojpeg0-dev libassimp-dev assimp-utils assimp-testmodels libdraco-dev libwebp-dev
  chromium nodejs

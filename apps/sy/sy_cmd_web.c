@@ -17,11 +17,11 @@
 
 #ifdef SY_HAVE_WEB
 /* `sy web SCENE`: the view in a web browser (apps/web/sy_web.h, docs/WEB.md). */
-enum { OPT_WEB_LISTEN = 0x300, OPT_WEB_QUALITY, OPT_WEB_CLIENT_RENDER };
+enum { OPT_WEB_LISTEN = 0x300, OPT_WEB_QUALITY, OPT_WEB_CLIENT_RENDER, OPT_WEB_DELAY };
 int sy_cmd_web(int argc, char **argv)
 {
     const char *backend = NULL, *camera = NULL, *listen = NULL, *filter = NULL, *scene = NULL;
-    uint32_t w = 1920, h = 1200, quality = 80;
+    uint32_t w = 1920, h = 1200, quality = 80, delay_ms = 0;
     float threshold = 0.0f;
     double budget = 0; /* 0: the governor's default (33 ms) */
     bool client_render = false;
@@ -29,7 +29,8 @@ int sy_cmd_web(int argc, char **argv)
         {"camera", required_argument, NULL, OPT_CAMERA}, {"listen", required_argument, NULL, OPT_WEB_LISTEN},
         {"quality", required_argument, NULL, OPT_WEB_QUALITY}, {"filter", required_argument, NULL, OPT_FILTER},
         {"threshold", required_argument, NULL, OPT_THRESHOLD}, {"budget", required_argument, NULL, OPT_BUDGET},
-        {"client-render", no_argument, NULL, OPT_WEB_CLIENT_RENDER}, VIEW_OPTIONS, COMMON_OPTIONS};
+        {"client-render", no_argument, NULL, OPT_WEB_CLIENT_RENDER},
+        {"delay-ms", required_argument, NULL, OPT_WEB_DELAY}, VIEW_OPTIONS, COMMON_OPTIONS};
     int c, status = 0;
     optind = 0;
     while ((c = sy_cli_next_sized_option("web", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, 1, &w, &h, &status)) != -1) {
@@ -51,6 +52,9 @@ int sy_cmd_web(int argc, char **argv)
             if (!sy_cli_parse_double(optarg, 1.0, 10000.0, &budget)) return sy_cli_bad_value("--budget", optarg);
             break;
         case OPT_WEB_CLIENT_RENDER: client_render = true; break;
+        case OPT_WEB_DELAY: /* tests only: an added network delay in both directions */
+            if (!sy_cli_parse_u32(optarg, 0, 10000, &delay_ms)) return sy_cli_bad_value("--delay-ms", optarg);
+            break;
         }
     }
     if ((status = sy_cli_scene_operand("web", argc, argv, &scene))) return status;
@@ -60,7 +64,7 @@ int sy_cmd_web(int argc, char **argv)
     if (sy_cli_load(scene, camera, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
     sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,
                      .backend = backend, .listen = listen, .max_width = w, .max_height = h, .quality = (int)quality,
-                     .filter = filter, .threshold = threshold, .budget_ms = budget};
+                     .filter = filter, .threshold = threshold, .budget_ms = budget, .delay_ms = delay_ms};
     sy_web *web = NULL;
     sy_result r = SY_OK;
 #ifdef SY_WEB_HAVE_CULL

@@ -99,6 +99,9 @@ typedef struct sy_web_desc {
                                     answered 503 (default 10000) */
     uint32_t head_timeout_ms;   /**< a connection's request head must arrive within (default 5000) */
     uint32_t max_pending;       /**< connections waiting for their head (default 128; 32 per address) */
+    uint32_t delay_ms;          /**< TESTS ONLY (sy web --delay-ms): every input message is applied and
+                                     every frame sent this much later (0..10000; 0 = none), an added
+                                     network delay in both directions for measuring the page */
     const sy_web_route *routes; /**< extra routes (the array is copied; its strings and user pointers must outlive the server) */
     uint32_t route_count;     /**< how many */
 } sy_web_desc;

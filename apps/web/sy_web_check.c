@@ -363,7 +363,7 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
         cJSON_Delete(m);
         return sy_error_set(err, SY_ERR_PARSE, "not a JSON object with a string \"t\"");
     }
-    double id = 0, btn = 0;
+    double id = 0, btn = 0, ver = 0;
     sy_result r = SY_OK;
     out->has_id = cJSON_GetObjectItemCaseSensitive(m, "id") != NULL;
     const char *type = t->valuestring;
@@ -373,6 +373,9 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
         out->type = SY_WEB_INPUT_SIZE;
         if (!json_num(m, "w", 1, 16384, &out->a) || !json_num(m, "h", 1, 16384, &out->b))
             r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "size: w and h must be 1..16384");
+        else if (cJSON_GetObjectItemCaseSensitive(m, "v") && (!json_num(m, "v", 0, 1000, &ver) || ver != floor(ver)))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "size: v must be a whole number 0..1000");
+        out->version = (uint32_t)ver;
     } else if (!strcmp(type, "drag")) {
         out->type = SY_WEB_INPUT_DRAG;
         if (!json_num(m, "dx", -1e5, 1e5, &out->a) || !json_num(m, "dy", -1e5, 1e5, &out->b))

@@ -128,6 +128,8 @@ typedef struct sy_web_input {
     double a, b;     /**< size: w, h; drag: dx, dy; wheel: steps */
     uint32_t button; /**< drag: 0 orbit, 1 or 2 pan */
     char key;        /**< key: '1'..'9', 'f', '[', ']', 'r' (lower case) */
+    uint32_t version; /**< size: the frame format the page reads ("v", 0..1000; 0 = absent: a page
+                       * older than frame format 2, refused with a status message) */
     bool has_id;
     uint64_t id;
 } sy_web_input;

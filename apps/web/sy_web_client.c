@@ -133,11 +133,12 @@ sy_result sy_web_client_send(sy_web_client *c, const char *text, sy_error *err)
     return SY_OK;
 }
 
-sy_result sy_web_client_next_frame(sy_web_client *c, uint32_t timeout_ms, sy_web_frame_info *info, uint8_t **jpeg,
-                                   size_t *jpeg_len, sy_error *err)
+sy_result sy_web_client_next_frame_depth(sy_web_client *c, uint32_t timeout_ms, sy_web_frame_info *info,
+                                         uint8_t **jpeg, size_t *jpeg_len, float **depth, sy_error *err)
 {
     if (jpeg) *jpeg = NULL;
     if (jpeg_len) *jpeg_len = 0;
+    if (depth) *depth = NULL;
     double end = sy_time_now() + timeout_ms / 1000.0;
     while (!c->head && c->wsi && sy_time_now() < end) lws_service(c->ctx, 0);
     if (!c->head)
@@ -146,24 +147,23 @@ sy_result sy_web_client_next_frame(sy_web_client *c, uint32_t timeout_ms, sy_web
     msg *m = c->head;
     c->head = m->next;
     if (!c->head) c->tail = &c->head;
-    sy_result r = SY_OK;
-    uint32_t u[5];
-    if (m->len < 40 || (memcpy(u, m->data, sizeof u), u[0] != 0x31465953u))
-        r = sy_error_set(err, SY_ERR_PROTOCOL, "web client: a binary message of %zu bytes is no frame", m->len);
-    if (r == SY_OK) {
-        info->width = u[1], info->height = u[2], info->backend = u[3], info->samples = u[4];
-        memcpy(&info->render_ms, m->data + 20, 4);
-        memcpy(&info->seq, m->data + 24, 8);
-        memcpy(&info->input_id, m->data + 32, 8);
-        if (jpeg) {
-            *jpeg = malloc(m->len - 40 + 1);
-            if (!*jpeg) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web client: out of memory");
-            else memcpy(*jpeg, m->data + 40, m->len - 40), *jpeg_len = m->len - 40;
-        }
+    const uint8_t *jp = NULL, *dp = NULL;
+    sy_result r = sy_web_frame_parse(m->data, m->len, info, &jp, &dp, err);
+    if (r == SY_OK && jpeg) {
+        *jpeg = malloc(info->jpeg_len + 1u);
+        if (!*jpeg) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web client: out of memory");
+        else memcpy(*jpeg, jp, info->jpeg_len), *jpeg_len = info->jpeg_len;
     }
+    if (r == SY_OK && depth) r = sy_web_frame_depth(info, dp, depth, err);
     free(m->data);
     free(m);
     return r;
+}
+
+sy_result sy_web_client_next_frame(sy_web_client *c, uint32_t timeout_ms, sy_web_frame_info *info, uint8_t **jpeg,
+                                   size_t *jpeg_len, sy_error *err)
+{
+    return sy_web_client_next_frame_depth(c, timeout_ms, info, jpeg, jpeg_len, NULL, err);
 }
 
 void sy_web_client_close(sy_web_client *c)

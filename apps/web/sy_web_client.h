@@ -9,6 +9,7 @@
 #define SY_WEB_CLIENT_H
 
 #include "sy_common.h"
+#include "sy_web_frame.h" /* sy_web_frame_info */
 
 #ifdef __cplusplus
 extern "C" {
@@ -23,17 +24,6 @@ typedef struct sy_web_client_opts {
                              server's own, host:port, as a page the server served sends it) */
 } sy_web_client_opts;
 
-/** A frame's header (docs/WEB.md). */
-typedef struct sy_web_frame_info {
-    uint32_t width;     /**< frame width */
-    uint32_t height;    /**< frame height */
-    uint32_t backend;   /**< back-end index (registry order, the hello message) */
-    uint32_t samples;   /**< samples per pixel accumulated (progressive back-ends) */
-    float render_ms;    /**< the server's render time */
-    uint64_t seq;       /**< the frame's number */
-    uint64_t input_id;  /**< the newest input of this client it answers */
-} sy_web_frame_info;
-
 /** A client (opaque). */
 typedef struct sy_web_client sy_web_client;
 
@@ -45,9 +35,15 @@ sy_result sy_web_client_connect(const sy_web_client_opts *o, uint32_t timeout_ms
 sy_result sy_web_client_send(sy_web_client *c, const char *text, sy_error *err);
 
 /** Waits up to timeout_ms for the next binary frame (text messages are skipped); *jpeg (may be
- * NULL: not returned) receives its JPEG bytes. SY_ERR_IO on timeout or a closed connection. */
+ * NULL: not returned) receives its JPEG bytes. SY_ERR_IO on timeout or a closed connection,
+ * SY_ERR_PROTOCOL for a message that is no format-2 frame (sy_web_frame_parse). */
 sy_result sy_web_client_next_frame(sy_web_client *c, uint32_t timeout_ms, sy_web_frame_info *info, uint8_t **jpeg,
                                    size_t *jpeg_len, sy_error *err);
+
+/** As sy_web_client_next_frame, and *depth (malloc, width x height floats, +INFINITY where nothing
+ * was hit) receives the frame's decoded depth channel (SY_ERR_PROTOCOL when it has none). */
+sy_result sy_web_client_next_frame_depth(sy_web_client *c, uint32_t timeout_ms, sy_web_frame_info *info,
+                                         uint8_t **jpeg, size_t *jpeg_len, float **depth, sy_error *err);
 
 /** Closes the connection and frees c (NULL-safe). */
 void sy_web_client_close(sy_web_client *c);

@@ -10,14 +10,12 @@
 #include "sy_mediator.h"
 #include "sy_post.h"
 #include "sy_viewport.h"
+#include "sy_web_frame.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-
-#define WEB_FRAME_MAGIC 0x31465953u /* "SYF1" little-endian */
-#define WEB_FRAME_HEADER 40u
 
 typedef struct render_state {
     sy_context_pool *pool;
@@ -43,11 +41,13 @@ static void display_size(const sy_web *w, uint32_t dw, uint32_t dh, uint32_t *ow
     }
 }
 
-/* Renders w x h with the current back-end into an 8-bit image (display chain: ACES + sRGB). */
+/* Renders w x h with the current back-end into an 8-bit image (display chain: ACES + sRGB);
+ * depth (may be NULL) receives the layer's depth plane (malloc, linear view depth). */
 static sy_result render_rgba8(sy_web *w, render_state *rs, sy_window *win, uint32_t width, uint32_t height,
-                              uint32_t samples, float preview, uint8_t **out, sy_error *err)
+                              uint32_t samples, float preview, uint8_t **out, float **depth, sy_error *err)
 {
     *out = NULL;
+    if (depth) *depth = NULL;
     uint32_t cw = 0, ch = 0;
     sy_window_size(win, &cw, &ch);
     sy_result r = (cw != width || ch != height) ? sy_window_resize(win, width, height, err) : SY_OK;
@@ -57,6 +57,7 @@ static sy_result render_rgba8(sy_web *w, render_state *rs, sy_window *win, uint3
                                 .post = sy_post_display()};
     if (r == SY_OK) r = sy_window_render(win, w->d.scene, rs->pool, &ro, &img, err);
     if (r == SY_OK && !(*out = sy_interactive_rgba8(&img, SY_RGBA8_OVER_BLACK))) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
+    if (r == SY_OK && depth) *depth = img.depth, img.depth = NULL; /* taken over: sy_layer_destroy frees the rest */
     sy_layer_destroy(&img);
     return r;
 }
@@ -213,13 +214,24 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
                                     in->filter_version, gf.filter, NULL, &ferr) != SY_OK)
         snprintf(fstatus, sizeof fstatus, "filter: %.200s", ferr.message);
     uint8_t *px = NULL, *jpeg = NULL;
+    float *depth = NULL;
     size_t jlen = 0;
     uint32_t contexts = sy_context_pool_size(rs->pool);
     double t0 = sy_time_now();
-    r = render_rgba8(w, rs, rs->win, gf.width, gf.height, gf.samples, gf.preview, &px, err);
+    r = render_rgba8(w, rs, rs->win, gf.width, gf.height, gf.samples, gf.preview, &px, &depth, err);
     if (r == SY_OK) r = sy_jpeg_encode_rgba8(px, gf.width, gf.height, w->d.quality, &jpeg, &jlen, err);
-    double ms = (sy_time_now() - t0) * 1e3; /* render, display chain, JPEG: the frame's whole cost */
     free(px);
+    /* the frame's camera: what the page warps the frame with (docs/WEB.md, "Binary frames") */
+    sy_web_frame_info fi = {.width = gf.width, .height = gf.height, .backend = bi, .orbit = in->orbit,
+                            .flags = (cls->caps & SY_CAP_PROGRESSIVE) ? SY_WEB_FRAME_PROGRESSIVE : 0};
+    if (r == SY_OK) r = sy_viewport_camera_view(rs->vp, w->d.scene, gf.width, gf.height, &fi.view, err);
+    fi.view.clip_count = 0;
+    uint8_t *buf = NULL;
+    size_t len = 0;
+    if (r == SY_OK) r = sy_web_frame_pack(&fi, jpeg, jlen, depth, LWS_PRE, &buf, &len, err);
+    double ms = (sy_time_now() - t0) * 1e3; /* render, display chain, JPEG, depth: the frame's whole cost */
+    free(jpeg);
+    free(depth);
     if (r != SY_OK) return r;
     /* a frame that translated the scene for a new context says nothing about the next ones */
     sy_interactive_report(rs->ia, &gf, ms, sy_context_pool_size(rs->pool) != contexts);
@@ -228,24 +240,19 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
     if (sy_context_pool_get(rs->pool, w->d.scene, cls->name, NULL, w->d.root.id, &ctx, NULL) == SY_OK)
         sy_context_stats(ctx, &st);
     web_frame *f = calloc(1, sizeof *f);
-    size_t len = WEB_FRAME_HEADER + jlen;
-    if (f) f->buf = malloc(LWS_PRE + len);
-    if (!f || !f->buf) {
-        free(f);
-        free(jpeg);
+    if (!f) {
+        free(buf);
         return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %zu bytes", len);
     }
-    uint8_t *h = f->buf + LWS_PRE;
-    uint32_t u[5] = {WEB_FRAME_MAGIC, gf.width, gf.height, bi,
-                     (uint32_t)(st.samples > UINT32_MAX ? UINT32_MAX : st.samples)};
+    /* the samples and the time are known only now: patched into the packed header */
+    uint8_t *h = buf + LWS_PRE;
+    uint32_t spp = (uint32_t)(st.samples > UINT32_MAX ? UINT32_MAX : st.samples);
     float fms = (float)ms;
-    uint64_t seq = ++rs->seq, zero = 0;
-    memcpy(h, u, sizeof u); /* little-endian hosts (x86-64, arm64) */
+    uint64_t seq = ++rs->seq;
+    memcpy(h + 16, &spp, 4); /* little-endian hosts (x86-64, arm64) */
     memcpy(h + 20, &fms, 4);
     memcpy(h + 24, &seq, 8);
-    memcpy(h + 32, &zero, 8);
-    memcpy(h + WEB_FRAME_HEADER, jpeg, jlen);
-    free(jpeg);
+    f->buf = buf;
     f->refs = 1, f->seq = seq, f->gen = gen, f->len = len;
     publish_frame(w, f);
     set_status(w, fstatus);

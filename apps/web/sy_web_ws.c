@@ -5,6 +5,7 @@
 
 #include "sy_log.h"
 #include "sy_mediator.h"
+#include "sy_web_frame.h"
 
 #include <cjson/cJSON.h>
 
@@ -12,14 +13,40 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define WS_IDS 64    /* inputs remembered per connection: which one a frame answers */
+#define WS_DELAYED 64 /* --delay-ms: input messages held per connection (more are dropped) */
+#define WS_QUEUED 16  /* --delay-ms: frames held per connection (the oldest is dropped beyond) */
+
+/* --delay-ms (test only): an input message held until due, or a frame. */
+typedef struct delayed_msg {
+    double due; /* ms, sy_time_now */
+    char *text;
+    size_t len;
+} delayed_msg;
+typedef struct queued_frame {
+    double due;
+    web_frame *f; /* one reference */
+    uint64_t answered;
+} queued_frame;
+
 /* A WebSocket viewer: the sy-view protocol's per-connection data (network thread only). */
 struct web_conn {
     web_conn *next;
     struct lws *wsi;
     char peer[64];
-    uint64_t sent_seq, sent_status;
-    uint64_t last_id, last_gen, answered_id; /* the newest input id and the generation it got */
+    uint64_t sent_seq, sent_status, queued_seq;
+    /* the client's newest inputs with the generation each got (a ring): a frame answers the newest
+     * one whose generation it includes */
+    uint64_t ids[WS_IDS], gens[WS_IDS];
+    uint32_t ids_n, ids_next;
+    uint64_t answered_id;
     bool hello_sent;
+    bool sized;                  /* frames go to a viewer once it said its size (with "v": 2) */
+    bool old_page, refusal_sent; /* a page that does not read frame format 2 (its size message has no "v") */
+    delayed_msg delayed[WS_DELAYED];
+    uint32_t delayed_head, delayed_n;
+    queued_frame queued[WS_QUEUED];
+    uint32_t queued_head, queued_n;
     uint32_t warned;    /* malformed messages logged */
     char *msg;          /* a text message being assembled (max_message bytes) */
     size_t msg_len;     /* its bytes so far (a binary message's are counted, not kept) */
@@ -51,6 +78,14 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
     switch (in.type) {
     case SY_WEB_INPUT_SIZE:
         input = false;
+        if (in.version < SY_WEB_FRAME_VERSION) { /* an old page: told to reload, never sent frames it cannot read */
+            c->old_page = true;
+            pthread_mutex_unlock(&w->mu);
+            ws_warn(c, "a page that reads frame format 1 (its size message has no \"v\": 2): told to reload", NULL);
+            lws_callback_on_writable(c->wsi);
+            return;
+        }
+        c->old_page = false, c->sized = true;
         w->display_w = (uint32_t)in.a, w->display_h = (uint32_t)in.b;
         w->view_version++;
         break;
@@ -69,10 +104,31 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
     if (input) {
         w->view_version++;
         w->input_gen++;
-        if (in.has_id) c->last_id = in.id, c->last_gen = w->input_gen;
+        if (in.has_id) {
+            c->ids[c->ids_next] = in.id, c->gens[c->ids_next] = w->input_gen;
+            c->ids_next = (c->ids_next + 1) % WS_IDS;
+            if (c->ids_n < WS_IDS) c->ids_n++;
+        }
     }
     pthread_cond_signal(&w->cv);
     pthread_mutex_unlock(&w->mu);
+}
+
+static void delay_timer(sy_web *w, web_conn *c);
+
+/* --delay-ms (test only): the message is held delay_ms before it is applied; at most WS_DELAYED
+ * per connection (copies of at most max_message bytes each), more are dropped and logged. */
+static void delay_message(sy_web *w, web_conn *c)
+{
+    char *t = c->delayed_n < WS_DELAYED ? malloc(c->msg_len + 1) : NULL;
+    if (!t) {
+        ws_warn(c, "--delay-ms: too many messages held", NULL);
+        return;
+    }
+    memcpy(t, c->msg, c->msg_len);
+    delayed_msg *d = &c->delayed[(c->delayed_head + c->delayed_n++) % WS_DELAYED];
+    d->text = t, d->len = c->msg_len, d->due = sy_time_now() * 1e3 + w->d.delay_ms;
+    delay_timer(w, c);
 }
 
 /* The hello: the back-ends of the registry in key order (docs/WEB.md). */
@@ -100,6 +156,42 @@ static int ws_send_hello(struct lws *wsi)
     return r;
 }
 
+/* The newest input of c that frame generation gen includes (inputs arrive in order, so every
+ * earlier one is included too); inputs older than the ring keep the last answer. */
+static uint64_t answered_by(web_conn *c, uint64_t gen)
+{
+    for (uint32_t k = 0; k < c->ids_n; ++k) {
+        uint32_t i = (c->ids_next + WS_IDS - 1 - k) % WS_IDS;
+        if (c->gens[i] <= gen) {
+            if (c->ids[i] > c->answered_id) c->answered_id = c->ids[i];
+            break;
+        }
+    }
+    return c->answered_id;
+}
+
+static int send_frame(sy_web *w, web_conn *c, web_frame *f, uint64_t id)
+{
+    memcpy(f->buf + LWS_PRE + 32, &id, 8); /* the buffer is shared: patched right before each write */
+    size_t len = f->len;
+    int n = lws_write(c->wsi, f->buf + LWS_PRE, len, LWS_WRITE_BINARY);
+    sy_webi_frame_release(w, f); /* f may be gone from here: the render thread may have replaced it */
+    return n < (int)len ? -1 : 0;
+}
+
+/* --delay-ms: the next due time of c's held messages and frames (0: none), as a timer. */
+static void delay_timer(sy_web *w, web_conn *c)
+{
+    double next = 0;
+    if (c->delayed_n) next = c->delayed[c->delayed_head].due;
+    if (c->queued_n && (!next || c->queued[c->queued_head].due < next)) next = c->queued[c->queued_head].due;
+    (void)w;
+    if (next > 0) {
+        double us = (next - sy_time_now() * 1e3) * 1e3;
+        lws_set_timer_usecs(c->wsi, us < 1000 ? 1000 : (lws_usec_t)us);
+    }
+}
+
 static int ws_writeable(sy_web *w, web_conn *c)
 {
     if (!c->hello_sent) {
@@ -108,9 +200,17 @@ static int ws_writeable(sy_web *w, web_conn *c)
         lws_callback_on_writable(c->wsi);
         return 0;
     }
+    if (c->old_page) { /* once: the old page shows it in its heads-up line */
+        if (c->refusal_sent) return 0;
+        c->refusal_sent = true;
+        char m[200];
+        snprintf(m, sizeof m, "{\"t\":\"status\",\"error\":\"this page is older than the server (it reads frame format 1, "
+                              "the server sends format %u): reload it\"}", SY_WEB_FRAME_VERSION);
+        return ws_send_text(c->wsi, m) ? -1 : 0;
+    }
     pthread_mutex_lock(&w->mu);
     web_frame *f = w->latest;
-    bool fresh = f && f->seq != c->sent_seq;
+    bool fresh = f && f->seq != (w->d.delay_ms ? c->queued_seq : c->sent_seq);
     if (fresh) f->refs++;
     char status[300] = "";
     if (w->status_version != c->sent_status) {
@@ -126,22 +226,38 @@ static int ws_writeable(sy_web *w, web_conn *c)
         cJSON_Delete(o);
     }
     pthread_mutex_unlock(&w->mu);
+    if (fresh && !c->sized) sy_webi_frame_release(w, f), fresh = false;
     if (status[0]) {
         if (fresh) sy_webi_frame_release(w, f);
         if (ws_send_text(c->wsi, status)) return -1;
         lws_callback_on_writable(c->wsi);
         return 0;
     }
+    if (w->d.delay_ms) { /* held for delay_ms, then sent in order (the newest WS_QUEUED) */
+        double now = sy_time_now() * 1e3;
+        if (fresh) {
+            if (c->queued_n == WS_QUEUED) {
+                sy_webi_frame_release(w, c->queued[c->queued_head].f);
+                c->queued_head = (c->queued_head + 1) % WS_QUEUED, c->queued_n--;
+            }
+            queued_frame *q = &c->queued[(c->queued_head + c->queued_n++) % WS_QUEUED];
+            q->f = f, q->due = now + w->d.delay_ms, q->answered = answered_by(c, f->gen);
+            c->queued_seq = f->seq;
+        }
+        if (c->queued_n && c->queued[c->queued_head].due <= now) {
+            queued_frame q = c->queued[c->queued_head];
+            c->queued_head = (c->queued_head + 1) % WS_QUEUED, c->queued_n--;
+            c->sent_seq = q.f->seq;
+            if (send_frame(w, c, q.f, q.answered)) return -1;
+            if (c->queued_n) lws_callback_on_writable(c->wsi);
+        }
+        delay_timer(w, c);
+        return 0;
+    }
     if (!fresh) return 0;
     /* the input this frame answers: the client's newest one that reached the mailbox before it */
-    if (c->last_gen && c->last_gen <= f->gen) c->answered_id = c->last_id;
-    uint64_t id = c->answered_id;
-    memcpy(f->buf + LWS_PRE + 32, &id, 8); /* the buffer is shared: patched right before each write */
-    size_t len = f->len;
-    int n = lws_write(c->wsi, f->buf + LWS_PRE, len, LWS_WRITE_BINARY);
     c->sent_seq = f->seq;
-    sy_webi_frame_release(w, f); /* f may be gone from here: the render thread may have replaced it */
-    return n < (int)len ? -1 : 0;
+    return send_frame(w, c, f, answered_by(c, f->gen));
 }
 
 static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
@@ -200,6 +316,10 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
             }
         free(c->msg);
         c->msg = NULL;
+        for (; c->delayed_n; c->delayed_n--, c->delayed_head = (c->delayed_head + 1) % WS_DELAYED)
+            free(c->delayed[c->delayed_head].text);
+        for (; c->queued_n; c->queued_n--, c->queued_head = (c->queued_head + 1) % WS_QUEUED)
+            sy_webi_frame_release(w, c->queued[c->queued_head].f);
         return 0;
     case LWS_CALLBACK_RECEIVE: {
         /* the message's size so far plus what its frame still announces: over the limit closes at
@@ -215,12 +335,24 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
         c->msg_len += len;
         if (lws_is_final_fragment(wsi) && !rest) {
             if (c->msg_binary) ws_warn(c, "binary messages are not part of the protocol", NULL);
+            else if (w->d.delay_ms) delay_message(w, c);
             else ws_message(w, c, c->msg, c->msg_len);
             c->msg_len = 0;
         }
         return 0;
     }
     case LWS_CALLBACK_SERVER_WRITEABLE: return ws_writeable(w, c);
+    case LWS_CALLBACK_TIMER: /* --delay-ms: held messages and frames that are due */
+        for (double now = sy_time_now() * 1e3; c->delayed_n && c->delayed[c->delayed_head].due <= now;) {
+            delayed_msg *d = &c->delayed[c->delayed_head];
+            ws_message(w, c, d->text, d->len);
+            free(d->text);
+            d->text = NULL;
+            c->delayed_head = (c->delayed_head + 1) % WS_DELAYED, c->delayed_n--;
+        }
+        if (c->queued_n) lws_callback_on_writable(wsi);
+        delay_timer(w, c);
+        return 0;
     case LWS_CALLBACK_EVENT_WAIT_CANCELLED: /* a new frame or status: every viewer that can take it */
         if (w) lws_callback_on_writable_all_protocol(ctx, &sy_webi_protocols[1]);
         return 0;

@@ -26,7 +26,11 @@
  *   web_slowloris 100 reconnecting slowloris connections; an honest client's 20 GETs all answered
  *   web_stillbudget  stills queue behind a held render thread: the per-client pixel budget (429),
  *                 another client's own budget, a still whose requester left is not rendered
- *   web_clientfiles  /client/ serves client.html, client.js and vendor/ only, not npm/ */
+ *   web_clientfiles  /client/ serves client.html, client.js and vendor/ only, not npm/
+ *   web_frame     the binary frame (sy_web_frame.h) round-trips: header fields, the depth channel
+ *                 within its 16-bit log step, "nothing" kept; truncated, foreign, format-1 and
+ *                 mismatched frames are refused with the reason; the stream's frames carry the
+ *                 orbit's camera and a depth channel of the frame's size (web_stream) */
 #define _GNU_SOURCE /* strcasestr */
 #include "../support/sy_check.h"
 #include "sy_demo.h"
@@ -34,11 +38,13 @@
 #include "sy_mediators.h"
 #include "sy_web.h"
 #include "sy_web_client.h"
+#include "sy_web_frame.h"
 #ifdef SY_WEB_HAVE_CULL
 #include "sy_web_cull.h"
 #endif
 
 #include <arpa/inet.h>
+#include <math.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <pthread.h>
@@ -344,16 +350,45 @@ static int test_stream(uint16_t port)
     sy_web_client_opts o = {.host = "127.0.0.1", .port = port, .path = "/ws"};
     CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
     CHECK_OK(sy_web_client_connect(&o, 10000, &other, &err), err); /* a second viewer that never reads */
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":80,\"h\":60}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":80,\"h\":60,\"v\":2}", &err), err);
     sy_web_frame_info fi;
     uint8_t *j0 = NULL, *j1 = NULL;
     size_t n0 = 0, n1 = 0;
-    /* the frame at the asked size */
+    /* the frame at the asked size, with its camera (the orbit's matrix) and a depth channel */
+    float *depth = NULL;
     do {
         free(j0);
-        if (next_frame(c, &fi, &j0, &n0)) return 1;
+        free(depth);
+        CHECK_OK(sy_web_client_next_frame_depth(c, 60000, &fi, &j0, &n0, &depth, &err), err);
     } while (fi.width != 80 || fi.height != 60);
     if (check_jpeg(j0, n0, 80, 60)) return 1;
+    sy_mat4 om;
+    sy_orbit_matrix(&fi.orbit, &om);
+    for (int i = 0; i < 16; ++i) CHECK(fabsf(om.m[i] - fi.view.camera_to_world.m[i]) <= 1e-4f * (1 + fabsf(om.m[i])));
+    CHECK(fi.view.window[0] < fi.view.window[1] && fi.view.window[2] < fi.view.window[3] && fi.view.znear > 0);
+    size_t hits = 0;
+    for (size_t i = 0; i < 80 * 60; ++i)
+        if (isfinite(depth[i])) {
+            hits++;
+            CHECK(depth[i] >= fi.depth_min * 0.999f && depth[i] <= fi.depth_max * 1.001f);
+        }
+    CHECK(hits > 80 * 60 / 10 && fi.depth_min > 0); /* the demo fills much of the view */
+    free(depth);
+    /* a page that reads frame format 1 (no "v" in its size message) is told to reload and gets no
+     * frames, while this viewer's input gives it new ones */
+    sy_web_client *old = NULL;
+    CHECK_OK(sy_web_client_connect(&o, 10000, &old, &err), err);
+    CHECK_OK(sy_web_client_send(old, "{\"t\":\"size\",\"w\":40,\"h\":30}", &err), err);
+    for (int k = 0; k < 3; ++k) {
+        char m[96];
+        snprintf(m, sizeof m, "{\"t\":\"drag\",\"dx\":%d,\"dy\":0,\"id\":%d}", k + 1, k + 1);
+        CHECK_OK(sy_web_client_send(c, m, &err), err);
+        do {
+            if (next_frame(c, &fi, NULL, NULL)) return 1;
+        } while (fi.input_id < (uint64_t)k + 1);
+    }
+    CHECK(sy_web_client_next_frame(old, 300, &fi, NULL, NULL, &err) == SY_ERR_IO);
+    sy_web_client_close(old);
     /* malformed input: ignored (logged), the connection keeps working */
     const char *junk[] = {"not json", "[1,2]", "{\"t\":5}", "{\"t\":\"drag\",\"dx\":\"x\",\"dy\":1}",
                           "{\"t\":\"size\",\"w\":0,\"h\":10}", "{\"t\":\"warp\"}", "{\"t\":\"drag\",\"dx\":1e400,\"dy\":0}",
@@ -427,7 +462,7 @@ static int test_progressive(void)
     sy_web_client *c = NULL;
     sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
     CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":48,\"h\":32}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":48,\"h\":32,\"v\":2}", &err), err);
     sy_web_frame_info fi = {0};
     do {
         if (next_frame(c, &fi, NULL, NULL)) return 1;
@@ -872,6 +907,67 @@ static int test_client_files(void)
 #endif
 }
 
+/* web_frame: sy_web_frame_pack / _parse / _depth on a made-up frame, and hostile variants */
+static int test_frame(void)
+{
+    sy_error err = {0};
+    enum { W = 37, H = 23 };
+    float depth[W * H];
+    for (int i = 0; i < W * H; ++i) depth[i] = (i % 7 == 3) ? INFINITY : 0.5f + 0.37f * (float)(i % 211);
+    depth[5] = -1.0f, depth[6] = NAN; /* nothing, too */
+    const uint8_t jpeg[5] = {1, 2, 3, 4, 5};
+    sy_web_frame_info fi = {.width = W, .height = H, .backend = 2, .samples = 9, .render_ms = 12.5f, .seq = 77,
+                            .input_id = 5, .flags = SY_WEB_FRAME_PROGRESSIVE,
+                            .orbit = {.target = {1, 2, 3}, .yaw = 0.5f, .pitch = -0.25f, .dist = 4}};
+    sy_orbit_matrix(&fi.orbit, &fi.view.camera_to_world);
+    fi.view.window[0] = -0.6f, fi.view.window[1] = 0.6f, fi.view.window[2] = -0.4f, fi.view.window[3] = 0.4f;
+    fi.view.znear = 0.01f, fi.view.zfar = 100.0f;
+    uint8_t *buf = NULL;
+    size_t len = 0;
+    CHECK_OK(sy_web_frame_pack(&fi, jpeg, sizeof jpeg, depth, 16, &buf, &len, &err), err);
+    CHECK(len == SY_WEB_FRAME_HEADER + sizeof jpeg + fi.depth_len && fi.depth_len > 0);
+    CHECK(fi.depth_min == 0.5f && fi.depth_max == 0.5f + 0.37f * 210);
+    sy_web_frame_info g;
+    const uint8_t *jp = NULL, *dp = NULL;
+    CHECK_OK(sy_web_frame_parse(buf + 16, len, &g, &jp, &dp, &err), err);
+    CHECK(g.width == W && g.height == H && g.backend == 2 && g.samples == 9 && g.render_ms == 12.5f && g.seq == 77 &&
+          g.input_id == 5 && g.flags == SY_WEB_FRAME_PROGRESSIVE && g.jpeg_len == sizeof jpeg && !memcmp(jp, jpeg, sizeof jpeg));
+    CHECK(!memcmp(&g.view.camera_to_world, &fi.view.camera_to_world, sizeof g.view.camera_to_world) &&
+          g.view.window[1] == 0.6f && g.view.znear == 0.01f && g.view.zfar == 100.0f && g.orbit.target[2] == 3 &&
+          g.orbit.yaw == 0.5f && g.orbit.pitch == -0.25f && g.orbit.dist == 4);
+    float *d = NULL;
+    CHECK_OK(sy_web_frame_depth(&g, dp, &d, &err), err);
+    double step = log(g.depth_max / g.depth_min) / 65534, worst = 0;
+    for (int i = 0; i < W * H; ++i) {
+        bool hit = isfinite(depth[i]) && depth[i] > 0;
+        CHECK(hit == isfinite(d[i]));
+        if (hit) worst = fmax(worst, fabs(log(d[i] / depth[i])));
+    }
+    CHECK(worst <= 0.51 * step + 1e-6); /* half a quantisation step (relative) */
+    free(d);
+    /* hostile: truncated, foreign magic, format 1, a size that does not add up, depth of another size */
+    CHECK(sy_web_frame_parse(buf + 16, len - 1, &g, NULL, NULL, &err) == SY_ERR_PROTOCOL);
+    CHECK(sy_web_frame_parse(buf + 16, 100, &g, NULL, NULL, &err) == SY_ERR_PROTOCOL);
+    uint8_t *bad = malloc(len);
+    memcpy(bad, buf + 16, len);
+    bad[3] = '1';
+    CHECK(sy_web_frame_parse(bad, len, &g, NULL, NULL, &err) == SY_ERR_PROTOCOL && strstr(err.message, "format 1"));
+    bad[0] = 'X', bad[3] = '2';
+    CHECK(sy_web_frame_parse(bad, len, &g, NULL, NULL, &err) == SY_ERR_PROTOCOL);
+    memcpy(bad, buf + 16, len);
+    uint32_t w2 = W + 1;
+    memcpy(bad + 4, &w2, 4); /* the depth no longer matches the size */
+    CHECK_OK(sy_web_frame_parse(bad, len, &g, NULL, &dp, &err), err);
+    CHECK(sy_web_frame_depth(&g, dp, &d, &err) == SY_ERR_PROTOCOL && !d);
+    uint32_t huge = 8192;
+    memcpy(bad + 4, &huge, 4), memcpy(bad + 8, &huge, 4); /* 64 M pixels from a few hundred bytes: refused before allocating */
+    CHECK_OK(sy_web_frame_parse(bad, len, &g, NULL, &dp, &err), err);
+    CHECK(sy_web_frame_depth(&g, dp, &d, &err) == SY_ERR_PROTOCOL && strstr(err.message, "cannot hold"));
+    free(bad);
+    free(buf);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     const char *which = argc > 1 ? argv[1] : "all";
@@ -879,6 +975,11 @@ int main(int argc, char **argv)
     if (sy_mediators_register_builtin(&err) != SY_OK) {
         fprintf(stderr, "%s\n", err.message);
         return 1;
+    }
+    if (!strcmp(which, "frame")) {
+        int f = test_frame();
+        if (!f) printf("web %s: ok\n", which);
+        return f;
     }
     if (!strcmp(which, "clientfiles")) {
         int f = test_client_files();

@@ -1,0 +1,195 @@
+/* sy_web_frame.c — sy web's binary frame, format 2: packing (the server) and reading (clients,
+ * tests); the depth channel's 16-bit log quantisation and deflate (see sy_web_frame.h). */
+#include "sy_web_frame.h"
+
+#include <zlib.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Offsets of the header's fields (docs/WEB.md). */
+enum {
+    OFF_MAGIC = 0, OFF_W = 4, OFF_H = 8, OFF_BACKEND = 12, OFF_SAMPLES = 16, OFF_MS = 20, OFF_SEQ = 24, OFF_INPUT = 32,
+    OFF_HEADER = 40, OFF_JPEG = 44, OFF_DEPTH = 48, OFF_CODING = 52, OFF_DMIN = 56, OFF_DMAX = 60, OFF_C2W = 64,
+    OFF_WINDOW = 128, OFF_PROJ = 144, OFF_ZNEAR = 148, OFF_ZFAR = 152, OFF_TARGET = 156, OFF_YAW = 168,
+    OFF_PITCH = 172, OFF_DIST = 176, OFF_FLAGS = 180
+};
+
+/* The largest frame a reader accepts (pixels): the server's frame cap is 3840 x 2400 by default. */
+#define MAX_PIXELS (8192u * 8192u)
+
+static void put32(uint8_t *p, uint32_t v) { memcpy(p, &v, 4); } /* little-endian hosts (x86-64, arm64) */
+static void putf(uint8_t *p, float v) { memcpy(p, &v, 4); }
+static uint32_t get32(const uint8_t *p)
+{
+    uint32_t v;
+    memcpy(&v, p, 4);
+    return v;
+}
+static float getf(const uint8_t *p)
+{
+    float v;
+    memcpy(&v, p, 4);
+    return v;
+}
+
+static bool hit(float d) { return isfinite(d) && d > 0.0f; }
+
+/* The depth channel: q = 0 where nothing was hit, else 1 + round(65534 x log(d / dmin) / log(dmax /
+ * dmin)); each row's values as differences to the pixel on their left (mod 65536), the low bytes
+ * of the whole image, then the high bytes; deflated (zlib format, level 1). */
+static sy_result pack_depth(const float *depth, uint32_t w, uint32_t h, uint8_t **out, size_t *len, float *dmin,
+                            float *dmax, sy_error *err)
+{
+    size_t n = (size_t)w * h;
+    float lo = INFINITY, hi = 0.0f;
+    for (size_t i = 0; i < n; ++i)
+        if (hit(depth[i])) lo = fminf(lo, depth[i]), hi = fmaxf(hi, depth[i]);
+    if (!(lo <= hi)) lo = hi = 1.0f; /* nothing hit */
+    *dmin = lo, *dmax = hi;
+    double span = log((double)hi / lo), k = span > 0 ? 65534.0 / span : 0.0;
+    uint8_t *planes = malloc(2 * n);
+    uLongf cap = compressBound((uLong)(2 * n));
+    uint8_t *z = malloc(cap);
+    if (!planes || !z) {
+        free(planes);
+        free(z);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a depth channel of %ux%u", w, h);
+    }
+    for (uint32_t y = 0; y < h; ++y) {
+        uint16_t prev = 0;
+        for (uint32_t x = 0; x < w; ++x) {
+            size_t i = (size_t)y * w + x;
+            float d = depth[i];
+            uint16_t q = 0;
+            if (hit(d)) {
+                double v = 1.0 + floor(log((double)d / lo) * k + 0.5);
+                q = (uint16_t)(v < 1 ? 1 : v > 65535 ? 65535 : v);
+            }
+            uint16_t e = (uint16_t)(q - prev);
+            prev = q;
+            planes[i] = (uint8_t)(e & 0xff), planes[n + i] = (uint8_t)(e >> 8);
+        }
+    }
+    int zr = compress2(z, &cap, planes, (uLong)(2 * n), 1);
+    free(planes);
+    if (zr != Z_OK) {
+        free(z);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: deflating a depth channel of %ux%u failed (zlib %d)", w, h, zr);
+    }
+    *out = z, *len = cap;
+    return SY_OK;
+}
+
+sy_result sy_web_frame_pack(sy_web_frame_info *fi, const uint8_t *jpeg, size_t jpeg_len, const float *depth,
+                            size_t prefix, uint8_t **out, size_t *len, sy_error *err)
+{
+    *out = NULL, *len = 0;
+    uint8_t *z = NULL;
+    size_t zlen = 0;
+    fi->depth_coding = 0, fi->depth_min = fi->depth_max = 0.0f;
+    if (depth) {
+        sy_result r = pack_depth(depth, fi->width, fi->height, &z, &zlen, &fi->depth_min, &fi->depth_max, err);
+        if (r != SY_OK) return r;
+        fi->depth_coding = SY_WEB_DEPTH_LOG16_DEFLATE;
+    }
+    if (jpeg_len > UINT32_MAX || zlen > UINT32_MAX) {
+        free(z);
+        return sy_error_set(err, SY_ERR_LIMIT, "web: a frame of %zu + %zu bytes is too large", jpeg_len, zlen);
+    }
+    fi->jpeg_len = (uint32_t)jpeg_len, fi->depth_len = (uint32_t)zlen;
+    size_t total = SY_WEB_FRAME_HEADER + jpeg_len + zlen;
+    uint8_t *buf = calloc(1, prefix + total);
+    if (!buf) {
+        free(z);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %zu bytes", total);
+    }
+    uint8_t *h = buf + prefix;
+    put32(h + OFF_MAGIC, SY_WEB_FRAME_MAGIC);
+    put32(h + OFF_W, fi->width), put32(h + OFF_H, fi->height), put32(h + OFF_BACKEND, fi->backend);
+    put32(h + OFF_SAMPLES, fi->samples), putf(h + OFF_MS, fi->render_ms);
+    memcpy(h + OFF_SEQ, &fi->seq, 8), memcpy(h + OFF_INPUT, &fi->input_id, 8);
+    put32(h + OFF_HEADER, SY_WEB_FRAME_HEADER), put32(h + OFF_JPEG, fi->jpeg_len), put32(h + OFF_DEPTH, fi->depth_len);
+    put32(h + OFF_CODING, fi->depth_coding), putf(h + OFF_DMIN, fi->depth_min), putf(h + OFF_DMAX, fi->depth_max);
+    for (int i = 0; i < 16; ++i) putf(h + OFF_C2W + 4 * i, fi->view.camera_to_world.m[i]);
+    for (int i = 0; i < 4; ++i) putf(h + OFF_WINDOW + 4 * i, fi->view.window[i]);
+    put32(h + OFF_PROJ, fi->view.projection), putf(h + OFF_ZNEAR, fi->view.znear), putf(h + OFF_ZFAR, fi->view.zfar);
+    for (int i = 0; i < 3; ++i) putf(h + OFF_TARGET + 4 * i, fi->orbit.target[i]);
+    putf(h + OFF_YAW, fi->orbit.yaw), putf(h + OFF_PITCH, fi->orbit.pitch), putf(h + OFF_DIST, fi->orbit.dist);
+    put32(h + OFF_FLAGS, fi->flags);
+    if (jpeg_len) memcpy(h + SY_WEB_FRAME_HEADER, jpeg, jpeg_len);
+    if (zlen) memcpy(h + SY_WEB_FRAME_HEADER + jpeg_len, z, zlen);
+    free(z);
+    *out = buf, *len = total;
+    return SY_OK;
+}
+
+sy_result sy_web_frame_parse(const uint8_t *data, size_t len, sy_web_frame_info *fi, const uint8_t **jpeg,
+                             const uint8_t **depth, sy_error *err)
+{
+    memset(fi, 0, sizeof *fi);
+    if (len < 8 || (get32(data) & 0xffffffu) != (SY_WEB_FRAME_MAGIC & 0xffffffu))
+        return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: a binary message of %zu bytes is no frame (magic)", len);
+    if (get32(data) != SY_WEB_FRAME_MAGIC)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: format %c, this client reads format %u", (char)data[3],
+                            SY_WEB_FRAME_VERSION);
+    if (len < SY_WEB_FRAME_HEADER || get32(data + OFF_HEADER) != SY_WEB_FRAME_HEADER)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: a header of %zu bytes, not %u", len, SY_WEB_FRAME_HEADER);
+    fi->width = get32(data + OFF_W), fi->height = get32(data + OFF_H), fi->backend = get32(data + OFF_BACKEND);
+    fi->samples = get32(data + OFF_SAMPLES), fi->render_ms = getf(data + OFF_MS);
+    memcpy(&fi->seq, data + OFF_SEQ, 8), memcpy(&fi->input_id, data + OFF_INPUT, 8);
+    fi->jpeg_len = get32(data + OFF_JPEG), fi->depth_len = get32(data + OFF_DEPTH);
+    fi->depth_coding = get32(data + OFF_CODING), fi->depth_min = getf(data + OFF_DMIN), fi->depth_max = getf(data + OFF_DMAX);
+    for (int i = 0; i < 16; ++i) fi->view.camera_to_world.m[i] = getf(data + OFF_C2W + 4 * i);
+    for (int i = 0; i < 4; ++i) fi->view.window[i] = getf(data + OFF_WINDOW + 4 * i);
+    fi->view.projection = get32(data + OFF_PROJ), fi->view.znear = getf(data + OFF_ZNEAR), fi->view.zfar = getf(data + OFF_ZFAR);
+    for (int i = 0; i < 3; ++i) fi->orbit.target[i] = getf(data + OFF_TARGET + 4 * i);
+    fi->orbit.yaw = getf(data + OFF_YAW), fi->orbit.pitch = getf(data + OFF_PITCH), fi->orbit.dist = getf(data + OFF_DIST);
+    fi->flags = get32(data + OFF_FLAGS);
+    if (!fi->width || !fi->height || (uint64_t)fi->width * fi->height > MAX_PIXELS)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: size %ux%u out of range", fi->width, fi->height);
+    if ((uint64_t)SY_WEB_FRAME_HEADER + fi->jpeg_len + fi->depth_len != len)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: header %u + JPEG %u + depth %u bytes != the message's %zu",
+                            SY_WEB_FRAME_HEADER, fi->jpeg_len, fi->depth_len, len);
+    if (fi->depth_len && fi->depth_coding != SY_WEB_DEPTH_LOG16_DEFLATE)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: unknown depth coding %u", fi->depth_coding);
+    if (jpeg) *jpeg = data + SY_WEB_FRAME_HEADER;
+    if (depth) *depth = fi->depth_len ? data + SY_WEB_FRAME_HEADER + fi->jpeg_len : NULL;
+    return SY_OK;
+}
+
+sy_result sy_web_frame_depth(const sy_web_frame_info *fi, const uint8_t *depth, float **out, sy_error *err)
+{
+    *out = NULL;
+    size_t n = (size_t)fi->width * fi->height;
+    if (!depth || !fi->depth_len || !n || n > MAX_PIXELS)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: no depth channel");
+    /* deflate expands at most ~1032:1: a size the input cannot reach is refused before allocating */
+    if (2 * (uint64_t)n > 1040ull * fi->depth_len + 64)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: %u depth bytes cannot hold %ux%u pixels", fi->depth_len,
+                            fi->width, fi->height);
+    uint8_t *planes = malloc(2 * n + 1);
+    float *d = malloc(n * sizeof *d);
+    uLongf got = (uLongf)(2 * n + 1);
+    int zr = planes && d ? uncompress(planes, &got, depth, fi->depth_len) : Z_MEM_ERROR;
+    if (zr != Z_OK || got != 2 * n) {
+        free(planes);
+        free(d);
+        return sy_error_set(err, zr == Z_MEM_ERROR ? SY_ERR_OUT_OF_MEMORY : SY_ERR_PROTOCOL,
+                            "web frame: the depth channel does not inflate to %zu bytes (zlib %d, %lu bytes)", 2 * n, zr,
+                            (unsigned long)got);
+    }
+    double lo = fi->depth_min, span = fi->depth_max > fi->depth_min ? log((double)fi->depth_max / lo) : 0.0;
+    for (uint32_t y = 0; y < fi->height; ++y) {
+        uint16_t q = 0;
+        for (uint32_t x = 0; x < fi->width; ++x) {
+            size_t i = (size_t)y * fi->width + x;
+            q = (uint16_t)(q + (uint16_t)(planes[i] | planes[n + i] << 8));
+            d[i] = q ? (float)(lo * exp((q - 1) / 65534.0 * span)) : INFINITY;
+        }
+    }
+    free(planes);
+    *out = d;
+    return SY_OK;
+}

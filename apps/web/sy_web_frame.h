@@ -1,0 +1,68 @@
+/** @file
+ * sy_web_frame.h — the binary frame of sy web's stream, format 2 (docs/WEB.md, "Binary frames"):
+ * a 192-byte little-endian header (size, back-end, samples, the frame's camera and orbit, the
+ * depth range), the JPEG, then the depth channel: 16-bit log-quantised view depth, each row
+ * delta-coded, split into a low-byte and a high-byte plane and deflated (zlib format: the page
+ * inflates it with the browser's own DecompressionStream("deflate"); zstd, which the cluster
+ * uses, has no decoder in the browser). The server packs frames with sy_web_frame_pack; clients
+ * (sy_web_client.h, the tests) read them with sy_web_frame_parse and sy_web_frame_depth.
+ *
+ * Ownership: buffers returned are malloc()ed and owned by the caller (free()).
+ * Thread-safety: pure functions on caller-owned data. */
+#ifndef SY_WEB_FRAME_H
+#define SY_WEB_FRAME_H
+
+#include "sy_common.h"
+#include "sy_objects.h" /* before sy_request.h */
+#include "sy_orbit.h"
+#include "sy_request.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SY_WEB_FRAME_MAGIC 0x32465953u /**< "SYF2": "SYF" and the format's digit */
+#define SY_WEB_FRAME_VERSION 2u        /**< the format (the page sends it in its size message: "v") */
+#define SY_WEB_FRAME_HEADER 192u       /**< header bytes */
+#define SY_WEB_DEPTH_LOG16_DEFLATE 1u  /**< the depth coding (header offset 52) */
+#define SY_WEB_FRAME_PROGRESSIVE 1u    /**< flags: the back-end accumulates samples while the view rests */
+
+/** A frame's header (docs/WEB.md). */
+typedef struct sy_web_frame_info {
+    uint32_t width;     /**< frame width */
+    uint32_t height;    /**< frame height */
+    uint32_t backend;   /**< back-end index (registry order, the hello message) */
+    uint32_t samples;   /**< samples per pixel accumulated (progressive back-ends) */
+    float render_ms;    /**< the server's render time */
+    uint64_t seq;       /**< the frame's number */
+    uint64_t input_id;  /**< the newest input of this client it answers */
+    uint32_t jpeg_len;  /**< JPEG bytes after the header */
+    uint32_t depth_len; /**< deflated depth bytes after the JPEG (0: no depth) */
+    uint32_t depth_coding; /**< SY_WEB_DEPTH_LOG16_DEFLATE */
+    float depth_min, depth_max; /**< the nearest and farthest depth of the frame (view units) */
+    sy_camera_view view; /**< camera_to_world, projection, window, znear, zfar (no clip planes) */
+    sy_orbit orbit;      /**< the orbit the frame was rendered from (sy_orbit.h) */
+    uint32_t flags;      /**< SY_WEB_FRAME_PROGRESSIVE */
+} sy_web_frame_info;
+
+/** Packs a frame: prefix bytes of room (LWS_PRE), the header of fi (jpeg_len, depth_len,
+ * depth_coding, depth_min and depth_max are filled in here), the JPEG, then depth (fi->width x
+ * fi->height floats, linear view depth, +INFINITY or <= 0 = nothing; NULL: no depth channel) coded
+ * as SY_WEB_DEPTH_LOG16_DEFLATE. *out (malloc) holds prefix + *len bytes. */
+sy_result sy_web_frame_pack(sy_web_frame_info *fi, const uint8_t *jpeg, size_t jpeg_len, const float *depth,
+                            size_t prefix, uint8_t **out, size_t *len, sy_error *err);
+
+/** Reads a frame's header from len bytes; SY_ERR_PROTOCOL naming the reason for anything that is
+ * not a whole format-2 frame (magic, version, sizes that do not add up to len). *jpeg and *depth
+ * (may be NULL) point into data. */
+sy_result sy_web_frame_parse(const uint8_t *data, size_t len, sy_web_frame_info *fi, const uint8_t **jpeg,
+                             const uint8_t **depth, sy_error *err);
+
+/** Decodes a frame's depth channel into *out (malloc, width x height floats; +INFINITY where
+ * nothing was hit); SY_ERR_PROTOCOL when it does not inflate to exactly 2 x width x height bytes. */
+sy_result sy_web_frame_depth(const sy_web_frame_info *fi, const uint8_t *depth, float **out, sy_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SY_WEB_FRAME_H */
