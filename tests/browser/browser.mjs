@@ -5,6 +5,17 @@
 //     The streamed page (sy web): waits for a frame of the canvas' full size, writes the canvas
 //     pixels to OUTDIR/canvas.png, drags across the canvas, waits for the full-size frame that
 //     answers the drag, writes OUTDIR/dragged.png.
+//   node browser.mjs warp URL OUTDIR WIDTH HEIGHT
+//     The warping page (sy web --delay-ms N): a scripted drag of 40 moves 16 ms apart,
+//     window.sy.stats() after it (input_to_display_ms, frame_ms, ...); a second drag with a
+//     screenshot in its middle (OUTDIR/middrag.png, the page with its badge); then the references held (window.sy.hold) while a 12-pixel drag is warped
+//     (OUTDIR/warped.png), released, and the server's frame of the same view (OUTDIR/true.png);
+//     their mean absolute difference (0..255, RGB) computed in the browser; then a second page
+//     whose WebSocket goes through playwright (routeWebSocket) is sent made-up bad frames after
+//     the server's (duplicate, sizes that do not add up, depth that does not inflate, cameras
+//     not finite or not a rotation, format 3, no JPEG): their counts in sy.stats().bad and
+//     whether the canvas stayed the same. URL?warp=0 gives the same drag without the warp and
+//     without the rest (the comparison).
 //   node browser.mjs client URL OUTDIR WIDTH HEIGHT
 //     The client-render page (sy web --client-render): waits until the client is idle (its last
 //     cull answer drawn), writes the canvas to OUTDIR/canvas.png and what the page fetched to
@@ -14,13 +25,13 @@
 // Prints one line of JSON with what it saw; exits 1 with the reason on any failure (timeouts
 // included), 77 when chromium cannot be started.
 import { chromium } from 'playwright-core';
-import { writeFileSync } from 'node:fs';
+import { readFileSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 
 const [mode, url, outDir, wArg, hArg] = process.argv.slice(2);
 const width = Number(wArg || 480), height = Number(hArg || 360);
-if (!['stream', 'client'].includes(mode) || !url || !outDir) {
-  console.error('usage: node browser.mjs stream|client URL OUTDIR [WIDTH HEIGHT]');
+if (!['stream', 'client', 'warp'].includes(mode) || !url || !outDir) {
+  console.error('usage: node browser.mjs stream|client|warp URL OUTDIR [WIDTH HEIGHT]');
   process.exit(2);
 }
 const executablePath = process.env.SY_CHROMIUM || '/usr/bin/chromium';
@@ -84,6 +95,116 @@ try {
     await canvasPng(page, '#sy-canvas', join(outDir, 'dragged.png'));
     const after = await page.evaluate(() => ({ ...syStats }));
     console.log(JSON.stringify({ before, after, consoleErrors }));
+  } else if (mode === 'warp') {
+    // a full-size, exact frame answering every input sent so far
+    const settled = () => page.waitForFunction(
+      ([w, h]) => window.syStats && window.sy && syStats.frames > 0 && syStats.width === w && syStats.height === h &&
+                  syStats.answeredInput === syStats.lastInput && sy.stats().estimate_share === 0,
+      [width, height], { timeout: TIMEOUT });
+    const pct = (a, q) => { const s = [...a].sort((x, y) => x - y); return s.length ? s[Math.min(s.length - 1, Math.floor(q * s.length))] : null; };
+    const summary = (a) => ({ n: a.length, p50: pct(a, 0.5), p95: pct(a, 0.95), max: a.length ? Math.max(...a) : null });
+    await settled().catch(() => fail('no full-size frame within the timeout'));
+    const before = await page.evaluate(() => sy.stats());
+    const frames0 = before.frames;
+    // the drag: 40 moves of 4 pixels, 16 ms apart (a hand at the display's rate)
+    const x0 = width / 2 - 80, y0 = height / 2;
+    await page.mouse.move(x0, y0);
+    await page.mouse.down();
+    for (let i = 1; i <= 40; i++) {
+      await page.mouse.move(x0 + 4 * i, y0 + (i % 2));
+      await page.waitForTimeout(16);
+    }
+    await page.mouse.up();
+    await settled().catch(() => fail('no full-size frame answered the drag'));
+    const st = await page.evaluate(() => sy.stats());
+    // a look mid-drag (not measured: the screenshot takes a while): the stats, then the page with its badge
+    await page.mouse.move(x0, y0);
+    await page.mouse.down();
+    for (let i = 1; i <= 10; i++) { await page.mouse.move(x0 - 4 * i, y0); await page.waitForTimeout(16); }
+    const mid = await page.evaluate(() => { const s = sy.stats({ holes: true }); return { estimate_share: s.estimate_share, hole_share: s.hole_share }; });
+    await page.screenshot({ path: join(outDir, 'middrag.png') });
+    await page.mouse.up();
+    await settled().catch(() => fail('no full-size frame answered the second drag'));
+    // input events are counted from the drag on
+    const drag = st.input_to_display_ms.slice(-(st.inputs_displayed - before.inputs_displayed));
+    const frameMs = st.frame_ms.slice(-Math.min(st.frame_ms.length, st.display_frames - before.display_frames));
+    // the estimate against the truth: references held at this view, a 12-pixel drag warped
+    let quality = null;
+    if (st.warp) {
+      await page.evaluate(() => sy.hold(true));
+      await page.mouse.move(x0, y0);
+      await page.mouse.down();
+      for (let i = 1; i <= 6; i++) { await page.mouse.move(x0 + 2 * i, y0); await page.waitForTimeout(16); }
+      await page.mouse.up();
+      await page.waitForFunction(() => sy.stats().shown_input === sy.stats().last_input, null, { timeout: TIMEOUT });
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+      const held = await page.evaluate(() => { const s = sy.stats({ holes: true }); return { estimate_share: s.estimate_share, hole_share: s.hole_share }; });
+      await canvasPng(page, '#sy-canvas', join(outDir, 'warped.png'));
+      await page.evaluate(() => sy.hold(false));
+      await settled().catch(() => fail('no full-size frame after the held drag'));
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+      await canvasPng(page, '#sy-canvas', join(outDir, 'true.png'));
+      const a = readFileSync(join(outDir, 'warped.png')).toString('base64'), b = readFileSync(join(outDir, 'true.png')).toString('base64');
+      const mad = await page.evaluate(async ([a, b]) => {
+        const px = async (s) => {
+          const bmp = await createImageBitmap(await (await fetch('data:image/png;base64,' + s)).blob());
+          const c = new OffscreenCanvas(bmp.width, bmp.height), g = c.getContext('2d');
+          g.drawImage(bmp, 0, 0);
+          return g.getImageData(0, 0, bmp.width, bmp.height).data;
+        };
+        const [p, q] = [await px(a), await px(b)];
+        if (p.length !== q.length) return -1;
+        let s = 0;
+        for (let i = 0; i < p.length; i += 4) s += Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) + Math.abs(p[i + 2] - q[i + 2]);
+        return s / (p.length / 4 * 3);
+      }, [a, b]);
+      quality = { mad, held };
+    }
+    // bad frames (a page of its own whose WebSocket goes through the test: the server's messages
+    // passed on, then made-up ones): each refused for its reason, the picture unchanged
+    let badFrames = null;
+    if (st.warp) {
+      const p2 = await browser.newPage({ viewport: { width, height }, deviceScaleFactor: 1 });
+      p2.on('pageerror', (e) => consoleErrors.push(String(e)));
+      let toPage = null, last = null;
+      await p2.routeWebSocket(/\/ws/, (ws) => {
+        const server = ws.connectToServer();
+        toPage = ws;
+        ws.onMessage((m) => server.send(m));
+        server.onMessage((m) => { if (typeof m !== 'string') last = Buffer.from(m); ws.send(m); });
+      });
+      await p2.goto(url, { timeout: TIMEOUT });
+      await p2.waitForFunction(([w, h]) => window.syStats && window.sy && syStats.frames > 0 && syStats.width === w &&
+                                           syStats.height === h && sy.stats().estimate_share === 0, [width, height], { timeout: TIMEOUT })
+        .catch(() => fail('the routed page got no full-size frame'));
+      await p2.waitForTimeout(500);
+      await canvasPng(p2, '#sy-canvas', join(outDir, 'before_bad.png'));
+      const f = last, seq = f.readBigUInt64LE(24), jl = f.readUInt32LE(44);
+      const variant = (k, edit) => { const b = Buffer.from(f); b.writeBigUInt64LE(seq + BigInt(1000 + k), 24); edit(b); return b; };
+      const bads = [
+        Buffer.from(f),                                                   // the same frame again: order
+        variant(1, (b) => b.writeUInt32LE(b.readUInt32LE(4) + 1, 4)).subarray(0, f.length - 7), // sizes that do not add up: size
+        variant(2, (b) => b.fill(0, 192 + jl)),                           // depth that does not inflate: depth
+        variant(3, (b) => b.writeFloatLE(NaN, 64)),                       // a camera that is not finite: camera
+        variant(4, (b) => { b.writeFloatLE(2, 64); }),                    // not a rotation: camera
+        variant(5, (b) => b.writeUInt8(0x33, 3)),                         // format 3: version
+        variant(6, (b) => b.fill(0, 192, 192 + jl)),                      // no JPEG: jpeg
+      ];
+      for (const b of bads) { toPage.send(b); await p2.waitForTimeout(50); }
+      await p2.waitForFunction((n) => Object.values(sy.stats().bad).reduce((a, b) => a + b, 0) >= n, bads.length, { timeout: TIMEOUT })
+        .catch(() => {});
+      await p2.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+      await canvasPng(p2, '#sy-canvas', join(outDir, 'after_bad.png'));
+      const counts = await p2.evaluate(() => sy.stats().bad);
+      const a = readFileSync(join(outDir, 'before_bad.png')), b = readFileSync(join(outDir, 'after_bad.png'));
+      badFrames = { counts, unchanged: a.equals(b) };
+      await p2.close();
+    }
+    console.log(JSON.stringify({ warp: st.warp, stride: st.stride, warp_scale: st.warp_scale, input_to_display_ms: summary(drag), frame_ms: summary(frameMs), adopt_ms: summary(st.adopt_ms),
+                                 by_estimate: (st.inputs_by_estimate - before.inputs_by_estimate) / Math.max(1, drag.length),
+                                 server_fps: st.server_fps, bytes_per_frame: Math.round(st.bytes_per_frame),
+                                 frames_during_drag: st.frames - frames0, mid, quality, bad: st.bad, badFrames, consoleErrors,
+                                 input_to_display_all: drag.map((v) => Math.round(v)) }));
   } else {
     // idle (the last answer's objects all shown) and that state drawn (the page renders on demand)
     await page.waitForFunction(() => window.syClient && syClient.queries > 0 && syClient.idle &&
