@@ -154,6 +154,9 @@ sy_result sy_web_frame_parse(const uint8_t *data, size_t len, sy_web_frame_info 
                             SY_WEB_FRAME_HEADER, fi->jpeg_len, fi->depth_len, len);
     if (fi->depth_len && fi->depth_coding != SY_WEB_DEPTH_LOG16_DEFLATE)
         return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: unknown depth coding %u", fi->depth_coding);
+    if (fi->depth_len && !(isfinite(fi->depth_min) && isfinite(fi->depth_max) && fi->depth_min > 0 && fi->depth_max >= fi->depth_min))
+        return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: depth range %g..%g is not 0 < min <= max", (double)fi->depth_min,
+                            (double)fi->depth_max);
     if (jpeg) *jpeg = data + SY_WEB_FRAME_HEADER;
     if (depth) *depth = fi->depth_len ? data + SY_WEB_FRAME_HEADER + fi->jpeg_len : NULL;
     return SY_OK;

@@ -959,6 +959,13 @@ static int test_frame(void)
     memcpy(bad + 4, &w2, 4); /* the depth no longer matches the size */
     CHECK_OK(sy_web_frame_parse(bad, len, &g, NULL, &dp, &err), err);
     CHECK(sy_web_frame_depth(&g, dp, &d, &err) == SY_ERR_PROTOCOL && !d);
+    memcpy(bad, buf + 16, len);
+    float nan = NAN, neg = -1.0f;
+    memcpy(bad + 56, &neg, 4); /* a depth range that is no range: refused before decoding */
+    CHECK(sy_web_frame_parse(bad, len, &g, NULL, &dp, &err) == SY_ERR_PROTOCOL && strstr(err.message, "depth range"));
+    memcpy(bad + 56, &nan, 4);
+    CHECK(sy_web_frame_parse(bad, len, &g, NULL, &dp, &err) == SY_ERR_PROTOCOL);
+    memcpy(bad, buf + 16, len);
     uint32_t huge = 8192;
     memcpy(bad + 4, &huge, 4), memcpy(bad + 8, &huge, 4); /* 64 M pixels from a few hundred bytes: refused before allocating */
     CHECK_OK(sy_web_frame_parse(bad, len, &g, NULL, &dp, &err), err);
