@@ -48,7 +48,7 @@ typedef struct web_job {
     sy_web_response resp;
 } web_job;
 
-/* The newest frame: LWS_PRE bytes of room, then the 40-byte header and the JPEG. Reference-counted:
+/* The newest frame: LWS_PRE bytes of room, then the frame (sy_web_frame.h: header, JPEG, depth). Reference-counted:
  * the mailbox holds one reference, a connection sending it another (network thread). */
 typedef struct web_frame {
     uint32_t refs; /* under mu */
