@@ -13,10 +13,11 @@
 #   browser_test.sh warp SY PNG_IOU MODULES_DIR SCENE
 #     sy web SCENE -b raster --delay-ms 100 (100 ms added each way): a scripted drag on the
 #     warping page answers at least 75% of its inputs by the estimate, before any server frame
-#     answers them (without the warp none is: the check can fail), sooner than the same drag
-#     with ?warp=0 at the median (the page's own input_to_display_ms), and the page without the
-#     warp needs at least the added round trip, 200 ms (the delay is there). The distributions
-#     are printed; no absolute bound is checked: on two cores shared with the server and other
+#     answers them (without the warp none is: the check can fail; an order of events, not a
+#     time), and the page without the warp (?warp=0) needs at least the added round trip, 200 ms
+#     (the delay is there: a lower bound, which load cannot break). The distributions of both
+#     are printed, never compared (two runs on a shared machine; the brief keeps speed out of
+#     tests); no absolute bound is checked either: on two cores shared with the server and other
 #     work (load average 20-30), SwiftShader's display frames and Chromium's input queue stall
 #     for hundreds of ms now and then (medians with the warp of 108 to 295 ms were measured,
 #     without it 383 to 564 ms). The warped estimate of a 12-pixel drag differs from the
@@ -118,8 +119,6 @@ if [ "$mode" = warp ]; then
       if (!w.warp) errs.push("the page did not warp (no WebGL2?)");
       if (!(w.input_to_display_ms.n >= 30)) errs.push(`only ${w.input_to_display_ms.n} inputs measured`);
       if (!(w.by_estimate >= 0.75)) errs.push(`only ${(100 * w.by_estimate).toFixed(0)}% of the inputs answered by the estimate`);
-      if (!(w.input_to_display_ms.p50 < n.input_to_display_ms.p50))
-        errs.push(`warp: input to display median ${w.input_to_display_ms.p50} ms, not below ${n.input_to_display_ms.p50} without it`);
       if (!(n.input_to_display_ms.p50 >= BOUND)) errs.push(`without warp median ${n.input_to_display_ms.p50} ms < ${BOUND}: the delay is not there`);
       const want = { order: 1, size: 1, depth: 1, camera: 2, version: 1, jpeg: 1, magic: 0 };
       if (!w.badFrames || JSON.stringify(Object.keys(want).map((k) => w.badFrames.counts[k])) !== JSON.stringify(Object.values(want)))
