@@ -69,8 +69,7 @@ static void bounds_union(sy_rt_lt_bounds *out, const sy_rt_lt_bounds *a, const s
     for (int k = 0; k < 3; ++k) r.lo[k] = fminf(a->lo[k], b->lo[k]), r.hi[k] = fmaxf(a->hi[k], b->hi[k]);
     r.power = a->power + b->power;
     cone_union(&r, a, b);
-    bounds_finish(&r);
-    *out = r;
+    *out = r; /* cos_o, sin_o, cos_e: bounds_finish, where the importance will read them */
 }
 
 static float box_area(const sy_rt_lt_bounds *b)
@@ -252,6 +251,7 @@ static void node_fit(sy_rt_lighttree *t, uint32_t x)
     } else {
         bounds_union(&nd->b, &t->nodes[nd->child].b, &t->nodes[nd->child + 1u].b);
     }
+    bounds_finish(&nd->b);
 }
 
 bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uint32_t n, size_t max_bytes, bool *oom)
@@ -319,8 +319,13 @@ bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
         while (sp) {
             build_task k = stack[--sp];
             sy_rt_lt_node *node = &t->nodes[k.node];
+            /* the box only (find_split's extents); node_fit makes the whole bounds at the end */
             node->b = lights[refs[k.begin]].b;
-            for (uint32_t i = k.begin + 1u; i < k.end; ++i) bounds_union(&node->b, &node->b, &lights[refs[i]].b);
+            for (uint32_t i = k.begin + 1u; i < k.end; ++i)
+                for (int a = 0; a < 3; ++a) {
+                    const sy_rt_lt_bounds *b = &lights[refs[i]].b;
+                    node->b.lo[a] = fminf(node->b.lo[a], b->lo[a]), node->b.hi[a] = fmaxf(node->b.hi[a], b->hi[a]);
+                }
             uint32_t cnt = k.end - k.begin;
             if (k.depth + 1u > t->depth) t->depth = k.depth + 1u;
             if (cnt <= SY_RT_LT_LEAF_MAX) {
