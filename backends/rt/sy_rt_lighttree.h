@@ -14,8 +14,9 @@
  *
  * Lights are numbered by the caller (the device: its area triangles, then its punctual lights).
  * Lights with zero, negative or non-finite power, or non-finite bounds, are left out (never
- * picked, pdf 0) and counted in `skipped`. Memory: about 64 bytes per light plus 60 per node
- * (fewer nodes than lights), held in `bytes`; the build's scratch is 16 bytes per light more.
+ * picked, pdf 0) and counted in `skipped`. Memory: 72 bytes per light (its record and maps)
+ * plus 72 per node (about 0.7 nodes per light; 2 n - 1 are allocated during the build), held in
+ * `bytes`: about 120 bytes per light.
  * Not thread-safe to build or update; pick and pdf read only and may run on any number of threads.
  * Internal to backends/rt. */
 #ifndef SY_RT_LIGHTTREE_H
