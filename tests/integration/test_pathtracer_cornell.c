@@ -18,7 +18,12 @@
  * from the noise of the low-sample estimate, and still catch a missing bounce or a wrong light pdf.
  * Also: no non-finite pixel and no dropped sample; the light's interior pixels are exactly its
  * radiance 17 12 4 (it has a black base colour, so nothing is reflected on top); AOVs are
- * consistent (direct + indirect = colour, albedo of the white wall = its base colour). */
+ * consistent (direct + indirect = colour, albedo of the white wall = its base colour).
+ * light_tree (issue 39): the default (auto: 2 emissive triangles, the alias table) renders bit for
+ * bit as light_tree=off (4 spp), and light_tree=on (the light tree) meets the same whole-image mean
+ * limit against the reference at the same spp. (The box's light is one quad whose two triangles
+ * have the same box, cone and power: the tree picks them with probability 1/2 each, as the alias
+ * table does, and the images agree; rt_lighttree compares the two where they differ.) */
 #include "it_util.h"
 #include "sy_exr.h"
 #include "sy_gltf.h"
@@ -44,6 +49,26 @@
 #define THRESH_MEAN 0.01
 #define THRESH_BLOCK_NOISE 1.3
 #define THRESH_BLOCK_ABS 0.005
+
+/* A fresh window and pool render of the Cornell box with params, spp samples (issue 39's light_tree
+ * checks). */
+static void render_params(sy_scene *scene, const sy_gltf_info *info, sy_node cam, const char *params, uint32_t W,
+                          uint32_t spp, sy_layer *out)
+{
+    sy_viewport_desc vd = {.root = info->root, .camera = cam, .backend = "pathtracer", .params = params};
+    sy_window *win = it_window(W, W, &vd, NULL);
+    sy_context_pool *pool;
+    MUST(sy_context_pool_create(&pool, err));
+    MUST(sy_layer_create(W, W, out, err));
+    for (uint32_t done = 0; done < spp;) {
+        uint32_t n = spp - done < 64 ? spp - done : 64;
+        sy_window_render_opts ro = {.sample_count = n};
+        MUST(sy_window_render(win, scene, pool, &ro, out, err));
+        done += n;
+    }
+    sy_context_pool_destroy(pool);
+    sy_window_destroy(win);
+}
 
 static uint32_t env_u32(const char *name, uint32_t def)
 {
@@ -181,6 +206,25 @@ int main(void)
         EXPECT_MSG(fabs(mean_err[c]) < tm, "channel %d: whole-image mean differs by %.3f%% (limit %.2f%%)", c, 100 * mean_err[c],
                    100 * tm);
     EXPECT_MSG(block < tb, "block error %.3f%% (limit %.2f%%)", 100 * block, 100 * tb);
+
+    /* light_tree (issue 39): auto (2 emissive triangles: the alias table) is bit-identical to off;
+     * on (the light tree for the box's light) converges to the same reference (whole-image mean) */
+    sy_layer la, lo, lt;
+    render_params(scene, &info, cam, "max_depth=64,specular=0", W, 4, &la);
+    render_params(scene, &info, cam, "max_depth=64,specular=0,light_tree=off", W, 4, &lo);
+    EXPECT_MSG(!memcmp(la.rgba, lo.rgba, (size_t)W * W * 4 * sizeof(float)), "light_tree=auto and =off differ");
+    render_params(scene, &info, cam, "max_depth=64,specular=0,light_tree=on", W, spp, &lt);
+    double tmean[3] = {0, 0, 0};
+    for (size_t i = 0; i < (size_t)W * W; ++i)
+        for (int c = 0; c < 3; ++c) tmean[c] += lt.rgba[4 * i + (size_t)c];
+    for (int c = 0; c < 3; ++c)
+        EXPECT_MSG(fabs(tmean[c] / rm[c] - 1.0) < tm, "light_tree=on: channel %d's mean differs by %.3f%% (limit %.2f%%)",
+                   c, 100 * (tmean[c] / rm[c] - 1.0), 100 * tm);
+    printf("light_tree=on: mean error R %+.3f%% G %+.3f%% B %+.3f%%\n", 100 * (tmean[0] / rm[0] - 1.0),
+           100 * (tmean[1] / rm[1] - 1.0), 100 * (tmean[2] / rm[2] - 1.0));
+    sy_layer_destroy(&la);
+    sy_layer_destroy(&lo);
+    sy_layer_destroy(&lt);
     sy_exr_image_free(ref);
     sy_layer_destroy(&img);
     sy_context_pool_destroy(pool);
