@@ -735,6 +735,7 @@ sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc 
     in->material = d->material;
     in->flags = flags;
     in->top_id = RTC_INVALID_GEOMETRY_ID;
+    in->area_base = UINT32_MAX; /* not in the area-light list until a commit puts it there */
     memcpy(in->xf, d->transform, sizeof in->xf);
     memcpy(in->nrm, nrm, sizeof in->nrm);
 
