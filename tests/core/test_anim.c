@@ -517,16 +517,6 @@ static int test_properties(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_step_linear_clamp);
-    RUN(test_slerp);
-    RUN(test_cubic);
-    RUN(test_what_channels_leave);
-    RUN(test_validation);
-    RUN(test_round_trip);
-    RUN(test_properties);
-    RUN(test_timing);
-    RUN(test_clock);
-    return sy_check_finish("core_anim");
-}
+SY_CHECK_MAIN("core_anim", SY_TEST(test_step_linear_clamp), SY_TEST(test_slerp), SY_TEST(test_cubic),
+              SY_TEST(test_what_channels_leave), SY_TEST(test_validation), SY_TEST(test_round_trip),
+              SY_TEST(test_properties), SY_TEST(test_timing), SY_TEST(test_clock))

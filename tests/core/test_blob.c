@@ -128,10 +128,4 @@ static int test_store(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_hash);
-    RUN(test_refcount_take);
-    RUN(test_store);
-    return sy_check_finish("test_blob");
-}
+SY_CHECK_MAIN("test_blob", SY_TEST(test_hash), SY_TEST(test_refcount_take), SY_TEST(test_store))

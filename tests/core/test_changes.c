@@ -1148,15 +1148,6 @@ static int test_decoder_fuzz(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_commit_entries);
-    RUN(test_two_consumers);
-    RUN(test_late_consumers);
-    RUN(test_resync_snapshot);
-    RUN(test_round_trip);
-    RUN(test_blob_once);
-    RUN(test_decoder_errors);
-    RUN(test_decoder_fuzz);
-    return sy_check_finish("test_changes");
-}
+SY_CHECK_MAIN("test_changes", SY_TEST(test_commit_entries), SY_TEST(test_two_consumers), SY_TEST(test_late_consumers),
+              SY_TEST(test_resync_snapshot), SY_TEST(test_round_trip), SY_TEST(test_blob_once),
+              SY_TEST(test_decoder_errors), SY_TEST(test_decoder_fuzz))

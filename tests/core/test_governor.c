@@ -390,16 +390,6 @@ static int test_preview(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_settings);
-    RUN(test_converges);
-    RUN(test_fixed_over_budget);
-    RUN(test_still);
-    RUN(test_sizes);
-    RUN(test_noisy);
-    RUN(test_switch);
-    RUN(test_stall);
-    RUN(test_preview);
-    return sy_check_finish("test_governor");
-}
+SY_CHECK_MAIN("test_governor", SY_TEST(test_settings), SY_TEST(test_converges), SY_TEST(test_fixed_over_budget),
+              SY_TEST(test_still), SY_TEST(test_sizes), SY_TEST(test_noisy), SY_TEST(test_switch), SY_TEST(test_stall),
+              SY_TEST(test_preview))

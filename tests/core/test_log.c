@@ -149,11 +149,5 @@ static int test_threads(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_callback_fields);
-    RUN(test_level_filter);
-    RUN(test_default_stderr);
-    RUN(test_threads);
-    return sy_check_finish("test_log");
-}
+SY_CHECK_MAIN("test_log", SY_TEST(test_callback_fields), SY_TEST(test_level_filter), SY_TEST(test_default_stderr),
+              SY_TEST(test_threads))

@@ -214,13 +214,5 @@ static int test_stats(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_resolve);
-    RUN(test_latlong);
-    RUN(test_studio);
-    RUN(test_gradient);
-    RUN(test_world_fields);
-    RUN(test_stats);
-    return sy_check_finish("test_look");
-}
+SY_CHECK_MAIN("test_look", SY_TEST(test_resolve), SY_TEST(test_latlong), SY_TEST(test_studio), SY_TEST(test_gradient),
+              SY_TEST(test_world_fields), SY_TEST(test_stats))

@@ -218,13 +218,5 @@ static int test_look_at(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_look_at);
-    RUN(test_identity_and_mul);
-    RUN(test_trs);
-    RUN(test_invert);
-    RUN(test_finite_equal);
-    RUN(test_bounds);
-    return sy_check_finish("test_math");
-}
+SY_CHECK_MAIN("test_math", SY_TEST(test_look_at), SY_TEST(test_identity_and_mul), SY_TEST(test_trs),
+              SY_TEST(test_invert), SY_TEST(test_finite_equal), SY_TEST(test_bounds))

@@ -85,10 +85,4 @@ static int test_input(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_matrix);
-    RUN(test_round_trip);
-    RUN(test_input);
-    return sy_check_finish("test_orbit");
-}
+SY_CHECK_MAIN("test_orbit", SY_TEST(test_matrix), SY_TEST(test_round_trip), SY_TEST(test_input))

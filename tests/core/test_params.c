@@ -250,11 +250,5 @@ static int test_contexts(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_validation);
-    RUN(test_getters);
-    RUN(test_listing);
-    RUN(test_contexts);
-    return sy_check_finish("core_params");
-}
+SY_CHECK_MAIN("core_params", SY_TEST(test_validation), SY_TEST(test_getters), SY_TEST(test_listing),
+              SY_TEST(test_contexts))

@@ -77,10 +77,4 @@ static int test_anaglyph(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_operators);
-    RUN(test_layer_post);
-    RUN(test_anaglyph);
-    return sy_check_finish("test_post");
-}
+SY_CHECK_MAIN("test_post", SY_TEST(test_operators), SY_TEST(test_layer_post), SY_TEST(test_anaglyph))

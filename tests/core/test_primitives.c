@@ -198,10 +198,4 @@ static int test_deform_validation(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_validation);
-    RUN(test_round_trip);
-    RUN(test_deform_validation);
-    return sy_check_finish("test_primitives");
-}
+SY_CHECK_MAIN("test_primitives", SY_TEST(test_validation), SY_TEST(test_round_trip), SY_TEST(test_deform_validation))

@@ -1081,19 +1081,7 @@ static int test_attachments(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_handles);
-    RUN(test_dirty_noop);
-    RUN(test_validation);
-    RUN(test_camera_clip_range);
-    RUN(test_texture_info_validation);
-    RUN(test_children_validation);
-    RUN(test_world_chain);
-    RUN(test_world_incremental);
-    RUN(test_bounds);
-    RUN(test_dag);
-    RUN(test_walk);
-    RUN(test_attachments);
-    return sy_check_finish("test_scene");
-}
+SY_CHECK_MAIN("test_scene", SY_TEST(test_handles), SY_TEST(test_dirty_noop), SY_TEST(test_validation),
+              SY_TEST(test_camera_clip_range), SY_TEST(test_texture_info_validation), SY_TEST(test_children_validation),
+              SY_TEST(test_world_chain), SY_TEST(test_world_incremental), SY_TEST(test_bounds), SY_TEST(test_dag),
+              SY_TEST(test_walk), SY_TEST(test_attachments))

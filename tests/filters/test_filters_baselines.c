@@ -232,12 +232,5 @@ static int test_position_from_depth(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_position_from_depth);
-    RUN(test_atrous);
-    RUN(test_jbu);
-    RUN(test_adaptive);
-    RUN(test_metrics);
-    return sy_check_finish("filters baselines");
-}
+SY_CHECK_MAIN("filters baselines", SY_TEST(test_position_from_depth), SY_TEST(test_atrous), SY_TEST(test_jbu),
+              SY_TEST(test_adaptive), SY_TEST(test_metrics))

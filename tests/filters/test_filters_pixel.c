@@ -415,17 +415,6 @@ static int test_range_compose(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_params);
-    RUN(test_range_compose);
-    RUN(test_blend_factor);
-    RUN(test_reduction_factor);
-    RUN(test_constant_and_consistency);
-    RUN(test_edges);
-    RUN(test_nan);
-    RUN(test_nan_isolation);
-    RUN(test_threads);
-    RUN(test_quality);
-    return sy_check_finish("filters pixel");
-}
+SY_CHECK_MAIN("filters pixel", SY_TEST(test_params), SY_TEST(test_range_compose), SY_TEST(test_blend_factor),
+              SY_TEST(test_reduction_factor), SY_TEST(test_constant_and_consistency), SY_TEST(test_edges),
+              SY_TEST(test_nan), SY_TEST(test_nan_isolation), SY_TEST(test_threads), SY_TEST(test_quality))

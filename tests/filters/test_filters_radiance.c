@@ -343,13 +343,6 @@ static int test_batched_bsdf(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_batched_bsdf);
-    RUN(test_texture_and_convergence);
-    RUN(test_depth_step);
-    RUN(test_correction_phase);
-    RUN(test_nan_and_params);
-    RUN(test_seed);
-    return sy_check_finish("filters radiance");
-}
+SY_CHECK_MAIN("filters radiance", SY_TEST(test_batched_bsdf), SY_TEST(test_texture_and_convergence),
+              SY_TEST(test_depth_step), SY_TEST(test_correction_phase), SY_TEST(test_nan_and_params),
+              SY_TEST(test_seed))

@@ -145,10 +145,4 @@ static int test_write(void)
     return 0;
 }
 
-int main(void)
-{
-    RUN(test_round_trip);
-    RUN(test_bad_arguments);
-    RUN(test_write);
-    return sy_check_finish("test_jpeg");
-}
+SY_CHECK_MAIN("test_jpeg", SY_TEST(test_round_trip), SY_TEST(test_bad_arguments), SY_TEST(test_write))

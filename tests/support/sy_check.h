@@ -23,7 +23,8 @@
  * returned non-zero or recorded a failed EXPECT failed. main ends with
  * `return sy_check_finish("name");`, which prints the summary and returns 1 when any check failed
  * (either form, counted in sy_check_failures), 0 otherwise. A test with no test functions uses the
- * checks in main directly and ends the same way.
+ * checks in main directly and ends the same way. A test whose main only runs its test functions
+ * writes none: SY_CHECK_MAIN("name", SY_TEST(fn1), SY_TEST(fn2), ...) is that main.
  *
  * A test's ctest fails on its exit status only: never print a failure without counting it. */
 #ifndef SY_TEST_SY_CHECK_H
@@ -133,18 +134,21 @@ static int sy_check_count __attribute__((unused));
 #define EXPECT_NEAR(a, b, eps) SY_CHECK_NEAR_("EXPECT_NEAR", SY_CHECK_GOON_, a, b, #a, #b, eps)
 #define EXPECT_SAYS(e, needle) SY_CHECK_SAYS_("EXPECT_SAYS", SY_CHECK_GOON_, e, needle, #e, #needle)
 
-/* Runs `int fn(void)`; it failed when it returned non-zero or any check failed while it ran. */
-#define RUN(fn)                                                                                     \
-    do {                                                                                            \
-        int sy_check_before_ = sy_check_failures;                                                   \
-        int sy_check_rc_ = (fn)();                                                                  \
-        if (sy_check_rc_ != 0 || sy_check_failures != sy_check_before_) {                           \
-            if (sy_check_failures == sy_check_before_) sy_check_failures++;                         \
-            fprintf(stderr, "FAILED: %s\n", #fn);                                                   \
-        } else {                                                                                    \
-            printf("ok: %s\n", #fn);                                                                \
-        }                                                                                           \
-    } while (0)
+/* Runs `int fn(void)`, printing "ok: name" or "FAILED: name"; it failed when it returned non-zero
+ * or any check failed while it ran. */
+static inline void sy_check_run(const char *name, int (*fn)(void))
+{
+    int before = sy_check_failures;
+    int rc = fn();
+    if (rc != 0 || sy_check_failures != before) {
+        if (sy_check_failures == before) sy_check_failures++;
+        fprintf(stderr, "FAILED: %s\n", name);
+    } else {
+        printf("ok: %s\n", name);
+    }
+}
+
+#define RUN(fn) sy_check_run(#fn, (fn))
 
 /* The end of main: prints "name: N of M check(s) failed" (stderr) or "name: all M checks passed"
  * and returns the exit status, 1 when any check failed. */
@@ -157,5 +161,25 @@ static inline int sy_check_finish(const char *name)
     printf("%s: all %d checks passed\n", name, sy_check_count);
     return 0;
 }
+
+/* A test executable's functions, for SY_CHECK_MAIN: SY_TEST(fn) names `int fn(void)` by itself. */
+typedef struct sy_check_test {
+    const char *name;
+    int (*fn)(void);
+} sy_check_test;
+
+#define SY_TEST(fn) {#fn, (fn)}
+
+/* The whole main of a test executable that only runs its test functions: each in order, as RUN,
+ * then `return sy_check_finish(title)`. Write it at file scope, without a semicolon:
+ *   SY_CHECK_MAIN("test_blob", SY_TEST(test_hash), SY_TEST(test_store)) */
+#define SY_CHECK_MAIN(title, ...)                                                                   \
+    int main(void)                                                                                  \
+    {                                                                                               \
+        static const sy_check_test sy_check_tests_[] = {__VA_ARGS__};                               \
+        for (size_t i = 0; i < sizeof sy_check_tests_ / sizeof sy_check_tests_[0]; i++)            \
+            sy_check_run(sy_check_tests_[i].name, sy_check_tests_[i].fn);                           \
+        return sy_check_finish(title);                                                              \
+    }
 
 #endif /* SY_TEST_SY_CHECK_H */
