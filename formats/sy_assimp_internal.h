@@ -81,20 +81,12 @@ typedef struct asp_loader {
 
 /* >>io (sy_assimp_io.c) ------------------------------------------------------------------------ */
 
-/* Sets L->err to "<path>: <message>" and returns code. */
-sy_result asp_fail(asp_loader *L, sy_result code, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-/* The info struct's warnings (sy_loader_log.h). */
-sy_loader_warnings asp_warnings(sy_assimp_info *info);
-/* A warning "<message>" (at most SY_ASSIMP_MAX_WARNINGS stored, all counted). */
-void asp_warn(asp_loader *L, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
+/* asp_fail(L, code, fmt, ...): sets L->err to "<path>: <message>" and returns code. */
+#define asp_fail(L, code, ...) sy_loader_failf(&(L)->err, (L)->path, (code), __VA_ARGS__)
+/* asp_warnings(info): the info struct's warnings (sy_loader_log.h). */
+#define asp_warnings(info) SY_LOADER_WARNINGS(info, SY_ASSIMP_MAX_WARNINGS)
+/* asp_warn(L, fmt, ...): a warning "<message>" (at most SY_ASSIMP_MAX_WARNINGS stored, all counted). */
+#define asp_warn(L, ...) sy_loader_warnf(asp_warnings((L)->info), __VA_ARGS__)
 /* Creates an object of type t (recorded for the rollback); on failure the message names `what`. */
 sy_result asp_new(asp_loader *L, sy_object_type t, const char *name, const char *what, uint32_t *id);
 /* Destroys every created object, newest first. */

@@ -1,4 +1,5 @@
-/* sy_assimp_io.c — the Assimp loader's ground floor: errors, warnings and the rollback; the file
+/* sy_assimp_io.c — the Assimp loader's ground floor: the rollback (errors and warnings: the macros
+ * asp_fail / asp_warn of sy_assimp_internal.h over sy_loader_log.h); the file
  * system Assimp reads through (the model from memory, every other file confined to the model's
  * folder by sy_path_confine and read within the size limit); Assimp's log into sy_log; and the
  * checks of counts a file declares, made before Assimp allocates for them. */
@@ -18,28 +19,6 @@
 #include <strings.h>
 
 /* >>errors ------------------------------------------------------------------------------------ */
-
-sy_result asp_fail(asp_loader *L, sy_result code, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    sy_result r = sy_loader_fail(&L->err, L->path, code, fmt, ap);
-    va_end(ap);
-    return r;
-}
-
-sy_loader_warnings asp_warnings(sy_assimp_info *info)
-{
-    return (sy_loader_warnings){&info->warnings, &info->warning_count, &info->stored_warning_count, SY_ASSIMP_MAX_WARNINGS};
-}
-
-void asp_warn(asp_loader *L, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    sy_loader_warn(asp_warnings(L->info), fmt, ap);
-    va_end(ap);
-}
 
 const char *asp_str(const struct aiString *s)
 {

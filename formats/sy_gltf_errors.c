@@ -1,5 +1,6 @@
-/* sy_gltf_errors.c — the glTF loader's bookkeeping: errors (named after the file and the place),
- * warnings (stored in sy_gltf_info), the objects it creates (tracked, so that a failed load destroys
+/* sy_gltf_errors.c — the glTF loader's bookkeeping: errors (named after the file and the place; the
+ * failure and warning macros gltf_fail / gltf_warn of sy_gltf_internal.h are sy_loader_log.h's
+ * forms, warnings stored in sy_gltf_info), the objects it creates (tracked, so that a failed load destroys
  * them again: rollback) and overflow-checked allocation. Every other module of the loader builds on
  * this file (sy_gltf_internal.h). */
 #include "sy_gltf_internal.h"
@@ -10,28 +11,6 @@
 #include <string.h>
 
 /* >>errors ------------------------------------------------------------------------------------ */
-
-sy_result gltf_fail(loader *L, sy_result code, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    sy_result r = sy_loader_fail(&L->err, L->path, code, fmt, ap);
-    va_end(ap);
-    return r;
-}
-
-sy_loader_warnings gltf_warnings(sy_gltf_info *info)
-{
-    return (sy_loader_warnings){&info->warnings, &info->warning_count, &info->stored_warning_count, SY_GLTF_MAX_WARNINGS};
-}
-
-void gltf_warn(loader *L, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    sy_loader_warn(gltf_warnings(L->info), fmt, ap);
-    va_end(ap);
-}
 
 /* Adds context to an error that a core call left in L->err. */
 sy_result gltf_context(loader *L, sy_result r, const char *what)

@@ -74,20 +74,13 @@ extern const char *const gltf_supported[];
 
 /* >>errors (sy_gltf_errors.c) ----------------------------------------------------------------- */
 
-/* Sets L->err to "<path>: <message>" and returns code. */
-sy_result gltf_fail(loader *L, sy_result code, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-/* The info struct's warnings (sy_loader_log.h). */
-sy_loader_warnings gltf_warnings(sy_gltf_info *info);
-/* A warning into info->warnings (at most SY_GLTF_MAX_WARNINGS stored, all counted). */
-void gltf_warn(loader *L, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
+/* gltf_fail(L, code, fmt, ...): sets L->err to "<path>: <message>" and returns code. */
+#define gltf_fail(L, code, ...) sy_loader_failf(&(L)->err, (L)->path, (code), __VA_ARGS__)
+/* gltf_warnings(info): the info struct's warnings (sy_loader_log.h). */
+#define gltf_warnings(info) SY_LOADER_WARNINGS(info, SY_GLTF_MAX_WARNINGS)
+/* gltf_warn(L, fmt, ...): a warning into info->warnings (at most SY_GLTF_MAX_WARNINGS stored, all
+ * counted). */
+#define gltf_warn(L, ...) sy_loader_warnf(gltf_warnings((L)->info), __VA_ARGS__)
 /* Adds context to an error that a core call left in L->err. */
 sy_result gltf_context(loader *L, sy_result r, const char *what);
 /* Records a created object for the rollback. */

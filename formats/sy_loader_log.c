@@ -14,6 +14,15 @@ sy_result sy_loader_fail(sy_error *err, const char *file, sy_result code, const 
     return sy_error_set(err, code, "%s: %s", file, msg);
 }
 
+sy_result sy_loader_failf(sy_error *err, const char *file, sy_result code, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    sy_result r = sy_loader_fail(err, file, code, fmt, ap);
+    va_end(ap);
+    return r;
+}
+
 void sy_loader_warn(sy_loader_warnings w, const char *fmt, va_list ap)
 {
     (*w.count)++;
@@ -37,4 +46,12 @@ void sy_loader_warnings_free(sy_loader_warnings w)
     free(*w.list);
     *w.list = NULL;
     *w.stored = 0;
+}
+
+void sy_loader_warnf(sy_loader_warnings w, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    sy_loader_warn(w, fmt, ap);
+    va_end(ap);
 }

@@ -24,11 +24,28 @@ typedef struct sy_loader_warnings {
     uint32_t max;     /**< at most this many kept */
 } sy_loader_warnings;
 
+/** The warnings of a loader's info struct `info`, whose fields are named warnings, warning_count
+ * and stored_warning_count (every loader's are), keeping at most max (C only). */
+#define SY_LOADER_WARNINGS(info, max)                                                                   \
+    ((sy_loader_warnings){&(info)->warnings, &(info)->warning_count, &(info)->stored_warning_count, (max)})
+
 /** Sets err to "<file>: <message>" and returns code. */
 sy_result sy_loader_fail(sy_error *err, const char *file, sy_result code, const char *fmt, va_list ap);
+/** The same with the message's arguments (each loader's fail macro: gltf_fail, asp_fail). */
+sy_result sy_loader_failf(sy_error *err, const char *file, sy_result code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
 
 /** Counts one warning and keeps its message while fewer than max are kept. */
 void sy_loader_warn(sy_loader_warnings w, const char *fmt, va_list ap);
+/** The same with the message's arguments (each loader's warn macro: gltf_warn, x3d_warn, asp_warn). */
+void sy_loader_warnf(sy_loader_warnings w, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
 
 /** Logs the kept warnings (module, item each: e.g. the file; NULL when the messages name it), then
  * "N more warnings not shown" (item: file). */

@@ -1,8 +1,8 @@
-/* sy_x3d_fields.c — the X3D loader's ground floor: its warnings and the objects it creates (tracked
+/* sy_x3d_fields.c — the X3D loader's ground floor: the objects it creates (tracked
  * for the rollback, cached per element), the reading of field values from XML attributes (numbers
  * counted against the value limit before anything is allocated, booleans, arrays, SFRotation) and
  * DEF / USE (names per file, resolved in document order). Everything else in the loader builds on
- * this file (sy_x3d_internal.h). */
+ * this file and on its warning macro x3d_warn (sy_x3d_internal.h, over sy_loader_log.h). */
 #include "sy_x3d_internal.h"
 
 #include <errno.h>
@@ -14,20 +14,6 @@
 #include <string.h>
 
 /* >>state ------------------------------------------------------------------------------------- */
-
-sy_loader_warnings x3d_warnings(sy_x3d_info *info)
-{
-    return (sy_loader_warnings){&info->warnings, &info->warning_count, &info->stored_warning_count, SY_X3D_MAX_WARNINGS};
-}
-
-void x3d_warn(loader *L, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    sy_loader_warn(x3d_warnings(L->info), fmt, ap);
-    va_end(ap);
-}
-
 
 static sy_result track(loader *L, sy_object_type t, uint32_t id)
 {

@@ -125,10 +125,11 @@ static inline const char *x3d_ename(const xmlNode *el) { return (const char *)el
 
 /* >>fields (sy_x3d_fields.c) ------------------------------------------------------------------ */
 
-/* A warning into info->warnings (at most SY_X3D_MAX_WARNINGS stored, all counted). */
-void x3d_warn(loader *L, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-/* The info struct's warnings (sy_loader_log.h). */
-sy_loader_warnings x3d_warnings(sy_x3d_info *info);
+/* x3d_warn(L, fmt, ...): a warning into info->warnings (at most SY_X3D_MAX_WARNINGS stored, all
+ * counted). */
+#define x3d_warn(L, ...) sy_loader_warnf(x3d_warnings((L)->info), __VA_ARGS__)
+/* x3d_warnings(info): the info struct's warnings (sy_loader_log.h). */
+#define x3d_warnings(info) SY_LOADER_WARNINGS(info, SY_X3D_MAX_WARNINGS)
 /* Creates a scene object and tracks it for the rollback. */
 sy_result x3d_new_object(loader *L, sy_object_type t, const char *name, uint32_t *id);
 /* The created objects of element el (+ variant) of file F; NULL when absent (create = false) or out
