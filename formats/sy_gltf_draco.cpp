@@ -2,6 +2,8 @@
 // caller's arrays (sy_gltf_draco.h): Draco's counts checked against the glTF's before any copy.
 #include "sy_gltf_draco.h"
 
+#include "sy_cpp_error.h"
+
 #include <draco/compression/decode.h>
 #include <draco/mesh/mesh.h>
 
@@ -68,11 +70,8 @@ extern "C" sy_result sy_gltf_draco_decode(const uint8_t *data, size_t size, cons
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "sy_gltf_draco_decode: invalid argument");
     try {
         return decode(data, size, req, err);
-    } catch (const std::bad_alloc &) {
-        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory while decoding Draco data");
-    } catch (const std::exception &e) {
-        return sy_error_set(err, SY_ERR_PARSE, "Draco: %s", e.what());
     } catch (...) {
-        return sy_error_set(err, SY_ERR_PARSE, "Draco: unknown exception");
+        return sy_error_from_exception(err, SY_ERR_PARSE, "out of memory while decoding Draco data", "Draco: ",
+                                       "Draco: unknown exception");
     }
 }

@@ -3,6 +3,7 @@
 // Every entry point catches every exception; nothing C++ leaks through the C interface.
 #include "sy_gltf_shim.h"
 
+#include "sy_cpp_error.h"
 #include "sy_file.h"
 #include "sy_gltf_draco.h"
 #include "sy_gltf_meshopt.h"
@@ -1147,15 +1148,10 @@ extern "C" sy_result sy_gltf_shim_parse(const uint8_t *bytes, size_t size, bool 
         }
         *out = &d->doc;
         return SY_OK;
-    } catch (const std::bad_alloc &) {
-        delete d;
-        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory while parsing glTF");
-    } catch (const std::exception &e) {
-        delete d;
-        return sy_error_set(err, SY_ERR_PARSE, "%s", e.what());
     } catch (...) {
         delete d;
-        return sy_error_set(err, SY_ERR_PARSE, "unknown exception while parsing glTF");
+        return sy_error_from_exception(err, SY_ERR_PARSE, "out of memory while parsing glTF", "",
+                                       "unknown exception while parsing glTF");
     }
 }
 
@@ -1176,11 +1172,8 @@ extern "C" sy_result sy_gltf_shim_parse_only(const uint8_t *bytes, size_t size, 
         sy_result r = run_tinygltf(bytes, size, binary, base_dir, limits, &model, &ctx, &twarn, err);
         if (r != SY_OK) return r;
         return SY_OK;
-    } catch (const std::bad_alloc &) {
-        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "out of memory while parsing glTF");
-    } catch (const std::exception &e) {
-        return sy_error_set(err, SY_ERR_PARSE, "%s", e.what());
     } catch (...) {
-        return sy_error_set(err, SY_ERR_PARSE, "unknown exception while parsing glTF");
+        return sy_error_from_exception(err, SY_ERR_PARSE, "out of memory while parsing glTF", "",
+                                       "unknown exception while parsing glTF");
     }
 }

@@ -3,6 +3,8 @@
 // point catches every exception; nothing C++ leaks through the C interface.
 #include "sy_gltf_shim.h"
 
+#include "sy_cpp_error.h"
+
 #include <tiny_gltf.h>
 
 #include <climits>
@@ -357,11 +359,8 @@ extern "C" sy_result sy_gltf_shim_write(const sy_gltf_shim_wdoc *doc, bool binar
         *glb_out = out;
         *len_out = bytes.size();
         return SY_OK;
-    } catch (const std::bad_alloc &) {
-        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "write GLB: out of memory");
-    } catch (const std::exception &e) {
-        return sy_error_set(err, SY_ERR_IO, "write GLB: %s", e.what());
     } catch (...) {
-        return sy_error_set(err, SY_ERR_IO, "write GLB: unknown exception");
+        return sy_error_from_exception(err, SY_ERR_IO, "write GLB: out of memory", "write GLB: ",
+                                       "write GLB: unknown exception");
     }
 }
