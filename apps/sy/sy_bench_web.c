@@ -5,24 +5,11 @@
 
 #include "sy_mediator.h"
 #include "sy_web_client.h"
+#include "sy_web_thread.h"
 
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct bench_server {
-    sy_web *web;
-    sy_error err;
-    sy_result r;
-} bench_server;
-
-static void *server_main(void *p)
-{
-    bench_server *s = p;
-    s->r = sy_web_run(s->web, NULL, &s->err);
-    return NULL;
-}
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -41,16 +28,16 @@ sy_result sy_bench_web(const sy_web_desc *desc, uint32_t width, uint32_t height,
     sy_web_desc d = *desc;
     d.listen = "127.0.0.1:0";
     if (!d.backend) d.backend = sy_mediator_default_name(); /* named in the report; "": sy_web_create says so */
-    bench_server s = {0};
-    sy_result r = sy_web_create(&d, &s.web, err);
+    sy_web *web = NULL;
+    sy_web_thread *th = NULL;
+    sy_result r = sy_web_create(&d, &web, err);
     if (r) return r;
-    pthread_t th;
-    if (pthread_create(&th, NULL, server_main, &s) != 0) {
-        sy_web_destroy(s.web);
-        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench web: cannot start the server thread");
+    if ((r = sy_web_thread_start(web, &th, err))) {
+        sy_web_destroy(web);
+        return r;
     }
     sy_web_client *c = NULL;
-    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(web), .path = "/ws"};
     double *lat = calloc(repeats, sizeof *lat), *render = calloc(repeats, sizeof *render),
            *over = calloc(repeats, sizeof *over), *wid = calloc(repeats, sizeof *wid);
     if (!lat || !render || !over || !wid) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench web: out of memory");
@@ -83,9 +70,9 @@ sy_result sy_bench_web(const sy_web_desc *desc, uint32_t width, uint32_t height,
     }
     if (sy_is_terminal(1)) fprintf(stdout, "\r");
     sy_web_client_close(c);
-    sy_web_stop(s.web);
-    pthread_join(th, NULL);
-    if (r == SY_OK && s.r != SY_OK) *err = s.err, r = s.r;
+    sy_error run_err = {0};
+    sy_result run_r = sy_web_thread_join(th, &run_err);
+    if (r == SY_OK && run_r != SY_OK) *err = run_err, r = run_r;
     if (r == SY_OK && done) {
         qsort(lat, done, sizeof *lat, cmp_double);
         qsort(render, done, sizeof *render, cmp_double);
@@ -107,6 +94,6 @@ sy_result sy_bench_web(const sy_web_desc *desc, uint32_t width, uint32_t height,
     free(render);
     free(over);
     free(wid);
-    sy_web_destroy(s.web);
+    sy_web_destroy(web);
     return r;
 }

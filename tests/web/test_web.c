@@ -39,6 +39,7 @@
 #include "sy_web.h"
 #include "sy_web_client.h"
 #include "sy_web_frame.h"
+#include "sy_web_thread.h"
 #ifdef SY_WEB_HAVE_CULL
 #include "sy_web_cull.h"
 #endif
@@ -151,17 +152,10 @@ static int get(uint16_t port, const char *path, const char *extra, http_answer *
 typedef struct server {
     sy_scene *scene;
     sy_web *web;
-    pthread_t th;
+    sy_web_thread *th;
     sy_result r;
     sy_error err;
 } server;
-
-static void *server_main(void *p)
-{
-    server *s = p;
-    s->r = sy_web_run(s->web, NULL, &s->err);
-    return NULL;
-}
 
 /* a GET route: answers the path, the query and how many nodes the scene has */
 static sy_result route_info(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
@@ -211,13 +205,12 @@ static int start(server *s, const char *listen, const char *backend, sy_error *e
         fprintf(stderr, "start: %s\n", e->message);
         return 1;
     }
-    return pthread_create(&s->th, NULL, server_main, s) != 0;
+    return sy_web_thread_start(s->web, &s->th, e) != SY_OK;
 }
 
 static int stop(server *s)
 {
-    sy_web_stop(s->web);
-    pthread_join(s->th, NULL);
+    s->r = sy_web_thread_join(s->th, &s->err);
     sy_web_destroy(s->web);
     sy_scene_destroy(s->scene);
     if (s->r != SY_OK) fprintf(stderr, "server: %s\n", s->err.message);
@@ -872,7 +865,7 @@ static int test_client_files(void)
                      .listen = "127.0.0.1:0", .routes = routes, .route_count = n};
     CHECK_OK(sy_web_create(&d, &s.web, &err), err);
     sy_web_cull_attach(cull, s.web);
-    CHECK(pthread_create(&s.th, NULL, server_main, &s) == 0);
+    CHECK_OK(sy_web_thread_start(s.web, &s.th, &err), err);
     uint16_t port = sy_web_port(s.web);
     const int want[] = {200, 200, 200, 404, 404, 404};
     for (size_t i = 0; i < sizeof files / sizeof *files; ++i) {
@@ -885,8 +878,7 @@ static int test_client_files(void)
         free(a.body);
     }
     /* the culler after the server, before the scene */
-    sy_web_stop(s.web);
-    pthread_join(s.th, NULL);
+    s.r = sy_web_thread_join(s.th, &s.err);
     sy_web_destroy(s.web);
     sy_web_cull_destroy(cull);
     sy_scene_destroy(s.scene);

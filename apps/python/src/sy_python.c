@@ -39,6 +39,7 @@
 #endif
 #ifdef SY_PY_HAVE_WEB
 #include "sy_web.h"
+#include "sy_web_thread.h"
 #endif
 
 #include <math.h>
@@ -1483,28 +1484,19 @@ typedef struct {
     PyObject_HEAD
     SceneObject *scene;
     sy_web *web;
-    pthread_t thread;
-    int running;        /* the thread was started and not joined yet */
-    sy_result result;   /* what sy_web_run returned */
+    sy_web_thread *thread; /* started and not joined yet (apps/web/sy_web_thread.h) */
+    sy_result result;      /* what sy_web_run returned */
     sy_error err;
 } WebObject;
-
-static void *web_thread(void *arg)
-{
-    WebObject *w = arg;
-    w->result = sy_web_run(w->web, NULL, &w->err);
-    return NULL;
-}
 
 /* Stops the server and frees it; 0, or -1 with an exception when serving had ended with an error. */
 static int web_stop(WebObject *w, int report)
 {
-    if (w->running) {
-        sy_web_stop(w->web);
+    if (w->thread) {
         Py_BEGIN_ALLOW_THREADS
-        pthread_join(w->thread, NULL);
+        w->result = sy_web_thread_join(w->thread, &w->err);
         Py_END_ALLOW_THREADS
-        w->running = 0;
+        w->thread = NULL;
     }
     if (w->web) {
         sy_web_destroy(w->web);
@@ -1568,11 +1560,10 @@ static PyObject *web_new(PyTypeObject *type, PyObject *args, PyObject *kw)
         return raise_sy(r, &err);
     }
     w->scene = (SceneObject *)Py_NewRef(scene);
-    if (pthread_create(&w->thread, NULL, web_thread, w) != 0) {
+    if (sy_web_thread_start(w->web, &w->thread, &err) != SY_OK) {
         Py_DECREF(w); /* destroys the server, the scene is free again */
         return raise_sy(SY_ERR_SYSTEM, &(sy_error){SY_ERR_SYSTEM, "serve: could not start the server's thread"});
     }
-    w->running = 1;
     return (PyObject *)w;
 }
 
