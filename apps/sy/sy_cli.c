@@ -3,6 +3,7 @@
  * text and its errors (exit status 2), numbers and sizes, the error exit (status 1), the default
  * back-end. */
 #include "sy_cli.h"
+#include "sy_cluster_cli.h"
 #include "sy_load.h"
 #include "sy_options.h"
 
@@ -367,6 +368,84 @@ int sy_cli_next_sized_option(const char *cmd, int argc, char **argv, const char 
         if (c != 'w' && c != 'h') return c;
         if (!sy_cli_parse_u32(optarg, min_size, 16384, c == 'w' ? w : h)) {
             *status = sy_cli_bad_value(c == 'w' ? "-w" : "-h", optarg);
+            return OPT_STOP;
+        }
+    }
+}
+
+/* The getopt tables of p (the command's options, then the cluster's, the view options, the common ones)
+ * and its short options; false (a usage error, p->status 2) when they do not fit (a programming
+ * error, named). */
+static bool parser_build(sy_cli_parser *p)
+{
+    static const struct option cluster[] = {SY_CLUSTER_CLI_OPTIONS}, view[] = {VIEW_OPTIONS}, common[] = {COMMON_OPTIONS};
+    size_t n = 0, cap = sizeof p->lo / sizeof p->lo[0], k = 0;
+    char *so = p->shortopts;
+    so[k++] = ':';
+    for (size_t i = 0; i < p->count; ++i) {
+        const sy_cli_opt *o = &p->opts[i];
+        if (o->name && n < cap) p->lo[n++] = (struct option){o->name, o->value ? required_argument : no_argument, NULL, o->code};
+        if (!o->name && k + 3 < sizeof p->shortopts) {
+            so[k++] = (char)o->code;
+            if (o->value) so[k++] = ':';
+        }
+    }
+    if (p->w && k + 5 < sizeof p->shortopts) memcpy(so + k, "w:h:", 4), k += 4;
+    for (size_t i = 0; p->cluster && i < sizeof cluster / sizeof cluster[0] && n < cap; ++i) p->lo[n++] = cluster[i];
+    for (size_t i = 0; p->view && i < sizeof view / sizeof view[0] && n < cap; ++i) p->lo[n++] = view[i];
+    for (size_t i = 0; i < sizeof common / sizeof common[0] && n < cap; ++i) p->lo[n++] = common[i];
+    if (n == cap || k + 3 > sizeof p->shortopts) {
+        fprintf(stderr, "sy %s: error: too many options for the parser's table\n", p->cmd);
+        p->status = 2;
+        return false;
+    }
+    memcpy(so + k, "qv", 3);
+    return true;
+}
+
+/* "--name" or "-c" of a declared option, for messages (a static buffer). */
+static const char *opt_label(const sy_cli_opt *o)
+{
+    static char b[64];
+    if (o->name) snprintf(b, sizeof b, "--%s", o->name);
+    else snprintf(b, sizeof b, "-%c", o->code);
+    return b;
+}
+
+int sy_cli_parse(sy_cli_parser *p)
+{
+    if (!p->started) {
+        if (!parser_build(p)) return OPT_STOP;
+        p->started = true;
+        optind = 0; /* glibc: start over (new arguments, GNU ordering) */
+    }
+    for (;;) {
+        int c = p->w ? sy_cli_next_sized_option(p->cmd, p->argc, p->argv, p->shortopts, p->lo, p->min_size, p->w, p->h,
+                                                &p->status)
+                     : sy_cli_next_option(p->cmd, p->argc, p->argv, p->shortopts, p->lo, &p->status);
+        const sy_cli_opt *o = NULL;
+        for (size_t i = 0; i < p->count && !o; ++i)
+            if (p->opts[i].code == c) o = &p->opts[i];
+        if (!o || o->kind == SY_CLI_CODE) return c; /* -1, OPT_STOP, the command's own, the cluster's */
+        bool ok = true;
+        switch (o->kind) {
+        case SY_CLI_TEXT: *(const char **)o->to = optarg; break;
+        case SY_CLI_FLAG:
+            if (o->to) *(bool *)o->to = true;
+            break;
+        case SY_CLI_UINT: ok = sy_cli_parse_u32(optarg, (uint32_t)o->lo, (uint32_t)o->hi, o->to); break;
+        case SY_CLI_REAL: ok = sy_cli_parse_double(optarg, o->lo, o->hi, o->to); break;
+        case SY_CLI_FLOAT: {
+            char *end = NULL;
+            float v = strtof(optarg, &end);
+            ok = end != optarg && !*end && (o->lo > o->hi || (v >= o->lo && v <= o->hi));
+            if (ok) *(float *)o->to = v;
+            break;
+        }
+        case SY_CLI_CODE: break;
+        }
+        if (!ok) {
+            p->status = sy_cli_bad_value(opt_label(o), optarg);
             return OPT_STOP;
         }
     }

@@ -1,10 +1,13 @@
 /* sy_cli.h — what every sy command shares on its command line (sy_cli.c).
  *
- * Every command parses its options with getopt_long (GNU ordering: options and operands in any
- * order, "--" ends the options, --name=value) through sy_getopt, which refuses abbreviated long
- * options (sy_options.h: "--frame" is no "--frames"). The options every command takes (the world
- * and loader flags, -q / -v, --help) are applied by sy_cli_next_option; a command's own ones come
- * back to it. Exit status: 0 success, 1 failure (sy_cli_fail), 2 usage error (the bad option or
+ * Every command declares its own options in a table of sy_cli_opt (name, kind, where the value
+ * goes, its range) and reads them with sy_cli_parse, which builds the getopt_long table from it and
+ * parses with getopt_long (GNU ordering: options and operands in any order, "--" ends the options,
+ * --name=value) through sy_getopt, which refuses abbreviated long options (sy_options.h: "--frame"
+ * is no "--frames"). The options every command takes (the world and loader flags, -q / -v, --help)
+ * are applied by sy_cli_next_option; a declared option's value is stored where its entry says (a bad
+ * value is a usage error naming the option), and only the options whose meaning is the command's own
+ * (SY_CLI_CODE) come back to it. Exit status: 0 success, 1 failure (sy_cli_fail), 2 usage error (the bad option or
  * value is named), 130 interrupted. Thread-safety: the main thread only (getopt's globals). */
 #ifndef SY_CLI_H
 #define SY_CLI_H
@@ -48,6 +51,66 @@ enum {
     {NULL, 0, NULL, 0}
 /* short options: ':' first (a missing value is told apart from an unknown option), then -q and -v */
 #define SHORT_OPTIONS(own) ":" own "qv"
+
+/* How a declared option is read. */
+typedef enum sy_cli_kind {
+    SY_CLI_CODE, /* its code comes back from sy_cli_parse (the command reads optarg, when it has one) */
+    SY_CLI_TEXT, /* const char *: the value as given */
+    SY_CLI_FLAG, /* bool: true (no value); to NULL: accepted and without effect */
+    SY_CLI_UINT, /* uint32_t: a whole number in lo..hi (sy_cli_parse_u32) */
+    SY_CLI_REAL, /* double: a finite number in lo..hi (sy_cli_parse_double) */
+    SY_CLI_FLOAT, /* float: a number strtof reads whole, in lo..hi (NaN never is); lo > hi: any, NaN and
+                     infinities too (what reads it says why not) */
+} sy_cli_kind;
+
+/* One option of a command, declared: its names, how it is read and where its value goes. */
+typedef struct sy_cli_opt {
+    const char *name; /* the long name without "--"; NULL: a short option only */
+    int code;         /* the short option's letter, or the long option's code (OPT_*) */
+    sy_cli_kind kind;
+    bool value;       /* it takes a value (every kind but FLAG, and CODE as declared) */
+    void *to;         /* where the value goes (the kind's type); NULL for CODE */
+    double lo, hi;    /* UINT, REAL: the accepted range */
+} sy_cli_opt;
+
+#define SY_CLI_OPT_CODE(name, code, has_value) {(name), (code), SY_CLI_CODE, (has_value), NULL, 0, 0}
+#define SY_CLI_OPT_TEXT(name, code, to) {(name), (code), SY_CLI_TEXT, true, (const char **){(to)}, 0, 0}
+#define SY_CLI_OPT_FLAG(name, code, to) {(name), (code), SY_CLI_FLAG, false, (bool *){(to)}, 0, 0}
+#define SY_CLI_OPT_UINT(name, code, to, lo, hi) {(name), (code), SY_CLI_UINT, true, (uint32_t *){(to)}, (lo), (hi)}
+#define SY_CLI_OPT_REAL(name, code, to, lo, hi) {(name), (code), SY_CLI_REAL, true, (double *){(to)}, (lo), (hi)}
+#define SY_CLI_OPT_FLOAT(name, code, to, lo, hi) {(name), (code), SY_CLI_FLOAT, true, (float *){(to)}, (lo), (hi)}
+#define SY_CLI_OPT_FLOAT_ANY(name, code, to) {(name), (code), SY_CLI_FLOAT, true, (float *){(to)}, 1, 0}
+
+/* A command's arguments being read: the fields up to `view` are the command's to set, the first five
+ * with SY_CLI_ARGS, the rest by name; the remaining fields are sy_cli_parse's:
+ *   sy_cli_parser p = {SY_CLI_ARGS("compare", argc, argv, opts), .w = &w, .h = &h, .min_size = 1}; */
+typedef struct sy_cli_parser {
+    const char *cmd;          /* the command as `sy help` names it ("render", "bench sync") */
+    int argc;
+    char **argv;              /* argv[0]: the command's name */
+    const sy_cli_opt *opts;   /* the command's own options */
+    size_t count;             /* how many */
+    uint32_t *w, *h;          /* non-NULL: -w W and -h H, pixels from min_size to 16384 */
+    uint32_t min_size;
+    bool cluster;             /* the cluster options too (SY_CLUSTER_CLI_OPTIONS), whose codes come back
+                                 (for sy_cluster_cli_getopt) */
+    bool view;                /* the camera placement options too (VIEW_OPTIONS) */
+    int status;               /* after OPT_STOP: the command's exit status */
+    /* sy_cli_parse's own */
+    bool started;
+    struct option lo[96];     /* the getopt_long table (for sy_cli_option_name) */
+    char shortopts[48];
+} sy_cli_parser;
+
+/* The next option of p's arguments for the command to handle: the code of a SY_CLI_CODE option or
+ * of a cluster option, -1 after the last option (the operands are argv[optind..argc-1]), or OPT_STOP
+ * with p->status (0 after --help, 2 after a usage error, named on stderr). Every other option is
+ * applied on the way. A command without SY_CLI_CODE options calls it once:
+ * `if (sy_cli_parse(&p) != -1) return p.status;`. */
+int sy_cli_parse(sy_cli_parser *p);
+/* The first fields of a sy_cli_parser: the command, its arguments and its option table (an array). */
+#define SY_CLI_ARGS(cmd_, argc_, argv_, opts_)                                                             \
+    .cmd = (cmd_), .argc = (argc_), .argv = (argv_), .opts = (opts_), .count = sizeof(opts_) / sizeof((opts_)[0])
 
 /* The next option of a command's arguments (argv[0]: the command's name, for messages; cmd: the
  * command as `sy help` names it, NULL for sy's own options). Call with optind = 0 first (glibc's way

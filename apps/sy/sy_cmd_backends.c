@@ -33,15 +33,9 @@ static void jparams(cJSON *o, const sy_mediator_class *m)
 int sy_cmd_backends(int argc, char **argv)
 {
     bool json = false, params = false;
-    static const struct option lo[] = {{"json", no_argument, NULL, OPT_JSON}, {"params", no_argument, NULL, OPT_PARAMS},
-                                       COMMON_OPTIONS};
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_option("backends", argc, argv, SHORT_OPTIONS(""), lo, &status)) != -1) {
-        if (c == OPT_STOP) return status;
-        if (c == OPT_JSON) json = true;
-        if (c == OPT_PARAMS) params = true;
-    }
+    const sy_cli_opt opts[] = {SY_CLI_OPT_FLAG("json", OPT_JSON, &json), SY_CLI_OPT_FLAG("params", OPT_PARAMS, &params)};
+    sy_cli_parser p = {SY_CLI_ARGS("backends", argc, argv, opts)};
+    if (sy_cli_parse(&p) != -1) return p.status;
     if (optind < argc) return sy_cli_usage_of("backends", "sy backends takes no operand");
     static const struct { uint32_t bit; const char *word; } caps[] = {
         {SY_CAP_DEPTH, "depth"}, {SY_CAP_PROGRESSIVE, "progressive"}, {SY_CAP_TILES, "tiles"},

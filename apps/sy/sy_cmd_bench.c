@@ -68,19 +68,10 @@ static int cmd_bench_filters(int argc, char **argv)
 {
     const char *scene = NULL, *sheet = NULL, *reference = NULL;
     uint32_t w = 0, h = 0, repeats = 5;
-    static const struct option lo[] = {{"repeats", required_argument, NULL, OPT_REPEATS},
-                                       {"reference", required_argument, NULL, OPT_REFERENCE}, COMMON_OPTIONS};
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_sized_option("bench filters", argc, argv, SHORT_OPTIONS("w:h:"), lo, 8, &w, &h, &status)) != -1) {
-        switch (c) {
-        case OPT_STOP: return status;
-        case OPT_REPEATS:
-            if (!sy_cli_parse_u32(optarg, 1, 1000, &repeats)) return sy_cli_bad_value("--repeats", optarg);
-            break;
-        case OPT_REFERENCE: reference = optarg; break;
-        }
-    }
+    const sy_cli_opt opts[] = {SY_CLI_OPT_UINT("repeats", OPT_REPEATS, &repeats, 1, 1000),
+                               SY_CLI_OPT_TEXT("reference", OPT_REFERENCE, &reference)};
+    sy_cli_parser p = {SY_CLI_ARGS("bench filters", argc, argv, opts), .w = &w, .h = &h, .min_size = 8};
+    if (sy_cli_parse(&p) != -1) return p.status;
     for (; optind < argc; ++optind) { /* [SCENE] [SHEET.png] */
         const char *a = argv[optind];
         if (sy_cli_ends_with(a, ".png") && !sheet) sheet = a;
@@ -127,36 +118,22 @@ int sy_cmd_bench(int argc, char **argv)
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
     const char *scene = NULL, *params = NULL, *backend = NULL;
     bool memory = !strcmp(cmd, "memory"), instanced = !strcmp(cmd, "instances"), web = !strcmp(cmd, "web");
-    static const struct option lo[] = {{"params", required_argument, NULL, OPT_PARAMS},
-                                       {"nodes", required_argument, NULL, OPT_NODES},
-                                       {"tris", required_argument, NULL, OPT_TRIS},
-                                       {"glb", no_argument, NULL, OPT_GLB},
-                                       {"repeats", required_argument, NULL, OPT_REPEATS}, COMMON_OPTIONS};
     char who[32];
     snprintf(who, sizeof who, "bench %s", cmd);
     bool glb = false;
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_sized_option(who, argc, argv, memory || instanced || web ? SHORT_OPTIONS("w:h:b:") : SHORT_OPTIONS("w:h:"),
-                                  lo, 1, &w, &h, &status)) != -1) {
-        switch (c) {
-        case OPT_STOP: return status;
-        case OPT_PARAMS: params = optarg; break; /* bench raster */
-        case 'b': backend = optarg; break; /* bench memory, bench instances, bench web */
-        case OPT_GLB:
-            if (!memory) return sy_cli_usage_of(who, "--glb is an option of sy bench memory");
-            glb = true;
-            break;
-        case OPT_NODES: /* bench sync: nodes; bench instances: instances */
-            if (!sy_cli_parse_u32(optarg, 1, 1u << 22, &nodes)) return sy_cli_bad_value("--nodes", optarg);
-            break;
-        case OPT_TRIS:
-            if (!sy_cli_parse_u32(optarg, 12, memory || instanced ? 1u << 30 : 1u << 20, &tris)) return sy_cli_bad_value("--tris", optarg);
-            break;
-        case OPT_REPEATS:
-            if (!sy_cli_parse_u32(optarg, 1, 100000, &repeats)) return sy_cli_bad_value("--repeats", optarg);
-            break;
-        }
+    const sy_cli_opt opts[] = {
+        SY_CLI_OPT_TEXT("params", OPT_PARAMS, &params), /* bench raster */
+        SY_CLI_OPT_UINT("nodes", OPT_NODES, &nodes, 1, 1u << 22), /* bench sync: nodes; bench instances: instances */
+        SY_CLI_OPT_UINT("tris", OPT_TRIS, &tris, 12, memory || instanced ? 1u << 30 : 1u << 20),
+        SY_CLI_OPT_CODE("glb", OPT_GLB, false), SY_CLI_OPT_UINT("repeats", OPT_REPEATS, &repeats, 1, 100000),
+        SY_CLI_OPT_TEXT(NULL, 'b', &backend)}; /* last: only bench memory, bench instances, bench web take -b */
+    sy_cli_parser p = {SY_CLI_ARGS(who, argc, argv, opts), .w = &w, .h = &h, .min_size = 1};
+    p.count -= !(memory || instanced || web);
+    int c;
+    while ((c = sy_cli_parse(&p)) != -1) {
+        if (c == OPT_STOP) return p.status;
+        if (c == OPT_GLB && !memory) return sy_cli_usage_of(who, "--glb is an option of sy bench memory");
+        glb = glb || c == OPT_GLB;
     }
     if (argc - optind > 1) return sy_cli_usage_of(who, "at most one SCENE");
     if (optind < argc) scene = argv[optind];

@@ -13,22 +13,12 @@ int sy_cmd_compare(int argc, char **argv)
 {
     const char *scene = NULL, *camera = NULL, *sheet = "compare.png", *only = NULL;
     uint32_t w = 200, h = 150, spp = 256;
-    static const struct option lo[] = {{"spp", required_argument, NULL, OPT_SPP},
-                                       {"camera", required_argument, NULL, OPT_CAMERA},
-                                       {"backends", required_argument, NULL, OPT_BACKENDS}, COMMON_OPTIONS};
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_sized_option("compare", argc, argv, SHORT_OPTIONS("w:h:o:"), lo, 1, &w, &h, &status)) != -1) {
-        switch (c) {
-        case OPT_STOP: return status;
-        case OPT_SPP:
-            if (!sy_cli_parse_u32(optarg, 1, 1u << 20, &spp)) return sy_cli_bad_value("--spp", optarg);
-            break;
-        case 'o': sheet = optarg; break;
-        case OPT_CAMERA: camera = optarg; break;
-        case OPT_BACKENDS: only = optarg; break;
-        }
-    }
+    const sy_cli_opt opts[] = {SY_CLI_OPT_UINT("spp", OPT_SPP, &spp, 1, 1u << 20), SY_CLI_OPT_TEXT(NULL, 'o', &sheet),
+                               SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera),
+                               SY_CLI_OPT_TEXT("backends", OPT_BACKENDS, &only)};
+    sy_cli_parser p = {SY_CLI_ARGS("compare", argc, argv, opts), .w = &w, .h = &h, .min_size = 1};
+    if (sy_cli_parse(&p) != -1) return p.status;
+    int status;
     if ((status = sy_cli_scene_operand("compare", argc, argv, &scene))) return status;
     if (!sy_cli_ends_with(sheet, ".png")) {
         fprintf(stderr, "sy compare: %s: the contact sheet must end in .png\n", sheet);

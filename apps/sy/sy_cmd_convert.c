@@ -15,13 +15,10 @@
 int sy_cmd_convert(int argc, char **argv)
 {
     const char *scene = NULL, *outp = NULL;
-    static const struct option lo[] = {COMMON_OPTIONS};
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_option("convert", argc, argv, SHORT_OPTIONS("o:"), lo, &status)) != -1) {
-        if (c == OPT_STOP) return status;
-        if (c == 'o') outp = optarg;
-    }
+    const sy_cli_opt opts[] = {SY_CLI_OPT_TEXT(NULL, 'o', &outp)};
+    sy_cli_parser p = {SY_CLI_ARGS("convert", argc, argv, opts)};
+    if (sy_cli_parse(&p) != -1) return p.status;
+    int status;
     if ((status = sy_cli_scene_operand("convert", argc, argv, &scene))) return status;
     if (!outp) return sy_cli_usage_of("convert", "-o OUT.glb or OUT.gltf is required");
     sy_error err = {0};

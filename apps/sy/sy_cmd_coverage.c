@@ -17,21 +17,12 @@ int sy_cmd_coverage(int argc, char **argv)
 {
     const char *scene = NULL, *camera = NULL;
     uint32_t w = 512, h = 512, top = 0;
-    static const struct option lo[] = {{"camera", required_argument, NULL, OPT_CAMERA},
-                                       {"top", required_argument, NULL, OPT_TOP},
-                                       {"json", no_argument, NULL, OPT_JSON}, COMMON_OPTIONS};
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_sized_option("coverage", argc, argv, SHORT_OPTIONS("w:h:"), lo, 1, &w, &h, &status)) != -1) {
-        switch (c) {
-        case OPT_STOP: return status;
-        case OPT_CAMERA: camera = optarg; break;
-        case OPT_TOP:
-            if (!sy_cli_parse_u32(optarg, 1, 1u << 30, &top)) return sy_cli_bad_value("--top", optarg);
-            break;
-        case OPT_JSON: break; /* the output is JSON anyway */
-        }
-    }
+    const sy_cli_opt opts[] = {SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera),
+                               SY_CLI_OPT_UINT("top", OPT_TOP, &top, 1, 1u << 30),
+                               SY_CLI_OPT_FLAG("json", OPT_JSON, NULL)}; /* the output is JSON anyway */
+    sy_cli_parser p = {SY_CLI_ARGS("coverage", argc, argv, opts), .w = &w, .h = &h, .min_size = 1};
+    if (sy_cli_parse(&p) != -1) return p.status;
+    int status;
     if ((status = sy_cli_scene_operand("coverage", argc, argv, &scene))) return status;
     sy_error err = {0};
 #ifndef SY_HAVE_EMBREE /* the coverage back-end is one of the Embree ones */

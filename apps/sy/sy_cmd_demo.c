@@ -17,16 +17,9 @@ int sy_cmd_demo(int argc, char **argv)
 {
     const char *dir = "out", *filter = "pixel";
     uint32_t w = 800, h = 450;
-    static const struct option lo[] = {{"filter", required_argument, NULL, OPT_FILTER}, COMMON_OPTIONS};
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_sized_option("demo", argc, argv, SHORT_OPTIONS("o:w:h:"), lo, 1, &w, &h, &status)) != -1) {
-        switch (c) {
-        case OPT_STOP: return status;
-        case 'o': dir = optarg; break;
-        case OPT_FILTER: filter = optarg; break;
-        }
-    }
+    const sy_cli_opt opts[] = {SY_CLI_OPT_TEXT(NULL, 'o', &dir), SY_CLI_OPT_TEXT("filter", OPT_FILTER, &filter)};
+    sy_cli_parser p = {SY_CLI_ARGS("demo", argc, argv, opts), .w = &w, .h = &h, .min_size = 1};
+    if (sy_cli_parse(&p) != -1) return p.status;
     if (optind < argc) return sy_cli_usage_of("demo", "sy demo takes no operand (-o DIR names the folder)");
     if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "sy: error: %s: cannot create directory: %s\n", dir, strerror(errno));

@@ -82,11 +82,9 @@ static void info_log(void *user, sy_log_level level, const char *module, const c
 
 int sy_cmd_info(int argc, char **argv)
 {
-    static const struct option lo[] = {{"json", no_argument, NULL, OPT_JSON}, COMMON_OPTIONS};
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_option("info", argc, argv, SHORT_OPTIONS(""), lo, &status)) != -1)
-        if (c == OPT_STOP) return status; /* --json: the output is JSON anyway */
+    const sy_cli_opt opts[] = {SY_CLI_OPT_FLAG("json", OPT_JSON, NULL)}; /* the output is JSON anyway */
+    sy_cli_parser p = {SY_CLI_ARGS("info", argc, argv, opts)};
+    if (sy_cli_parse(&p) != -1) return p.status;
     if (argc - optind != 1) return sy_cli_usage_of("info", argc == optind ? "a SCENE, IMAGE.exr or IMAGE.png is required" : "one file at a time");
     const char *path = argv[optind];
     sy_file_format fmt = SY_FORMAT_UNKNOWN;

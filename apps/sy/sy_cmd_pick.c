@@ -72,23 +72,14 @@ int sy_cmd_pick(int argc, char **argv)
     uint32_t w = 0, h = 0;
     float planes[SY_CLIP_PLANES_MAX][4];
     uint32_t nplanes = 0;
-    static const struct option lo[] = {{"camera", required_argument, NULL, OPT_CAMERA},
-                                       {"clip", required_argument, NULL, OPT_CLIP},
-                                       {"params", required_argument, NULL, OPT_PARAMS},
-                                       {"json", no_argument, NULL, OPT_JSON}, VIEW_OPTIONS, COMMON_OPTIONS};
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_sized_option("pick", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, 1, &w, &h, &status)) != -1) {
-        switch (c) {
-        case OPT_STOP: return status;
-        case 'b': backend = optarg; break;
-        case OPT_CAMERA: camera = optarg; break;
-        case OPT_PARAMS: params = optarg; break;
-        case OPT_JSON: break; /* the output is JSON anyway */
-        case OPT_CLIP:
-            if (sy_cli_add_clip_plane(optarg, planes, &nplanes)) return 2;
-            break;
-        }
+    const sy_cli_opt opts[] = {SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera),
+                               SY_CLI_OPT_CODE("clip", OPT_CLIP, true), SY_CLI_OPT_TEXT("params", OPT_PARAMS, &params),
+                               SY_CLI_OPT_FLAG("json", OPT_JSON, NULL)}; /* the output is JSON anyway */
+    sy_cli_parser p = {SY_CLI_ARGS("pick", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .view = true};
+    int c;
+    while ((c = sy_cli_parse(&p)) != -1) {
+        if (c == OPT_STOP) return p.status;
+        if (c == OPT_CLIP && sy_cli_add_clip_plane(optarg, planes, &nplanes)) return 2;
     }
     if (optind >= argc) return sy_cli_usage_of("pick", "a SCENE and pixel coordinates X Y are required");
     scene = argv[optind++];

@@ -477,7 +477,6 @@ int sy_cmd_render(int argc, char **argv)
     sy_error perr = {0};
     sy_cluster_cli_opts clo = {0};
     pt_opts po = {0};
-    bool progressive_opts = false; /* --spp / --time / --aov given */
     double at = 0.0;           /* --at: the scene's time in seconds */
     bool at_given = false;
     const char *clip = NULL;   /* --clip NAME|INDEX: one animation; without it every clip plays */
@@ -485,49 +484,31 @@ int sy_cmd_render(int argc, char **argv)
     uint32_t fa = 0, fb = 0, fstep = 1;
     double fps = 24.0;
     bool fps_given = false;
-    static const struct option lo[] = {
-        {"spp", required_argument, NULL, OPT_SPP}, {"time", required_argument, NULL, OPT_TIME},
-        {"aov", no_argument, NULL, OPT_AOV}, {"camera", required_argument, NULL, OPT_CAMERA},
-        {"params", required_argument, NULL, OPT_PARAMS}, {"gl", required_argument, NULL, OPT_GL},
-        {"filter", required_argument, NULL, OPT_FILTER}, {"threshold", required_argument, NULL, OPT_THRESHOLD},
-        {"half", no_argument, NULL, OPT_HALF}, {"exposure", required_argument, NULL, OPT_EXPOSURE},
-        {"tonemap", required_argument, NULL, OPT_TONEMAP}, {"stereo", required_argument, NULL, OPT_STEREO},
-        {"eye-sep", required_argument, NULL, OPT_EYE_SEP}, {"zero-parallax", required_argument, NULL, OPT_ZERO_PARALLAX},
-        {"overlay", required_argument, NULL, OPT_OVERLAY}, {"composite", required_argument, NULL, OPT_COMPOSITE},
-        {"frames", required_argument, NULL, OPT_FRAMES}, {"fps", required_argument, NULL, OPT_FPS}, /* a sequence */
-        {"resume", no_argument, NULL, OPT_RESUME},
-        {"repeat", required_argument, NULL, OPT_REPEAT}, /* cluster: frames through the same window */
-        {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
-        {"at", required_argument, NULL, OPT_AT}, {"clip", required_argument, NULL, OPT_CLIP}, /* the scene clock */
-        SY_CLUSTER_CLI_OPTIONS, VIEW_OPTIONS, COMMON_OPTIONS};
     uint32_t max_memory_mb = 0;
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_sized_option("render", argc, argv, SHORT_OPTIONS("b:o:w:h:"), lo, 1, &w, &h, &status)) != -1) {
-        char *end = NULL;
+    const sy_cli_opt opts[] = {
+        SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT(NULL, 'o', &outp),
+        SY_CLI_OPT_UINT("spp", OPT_SPP, &po.spp, 1, 1u << 24),
+        SY_CLI_OPT_REAL("time", OPT_TIME, &po.time_budget, DBL_TRUE_MIN, DBL_MAX), SY_CLI_OPT_FLAG("aov", OPT_AOV, &po.aov),
+        SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera), SY_CLI_OPT_TEXT("params", OPT_PARAMS, &params),
+        SY_CLI_OPT_TEXT("gl", OPT_GL, &gl_provider),          /* raster: gl=... parameter */
+        SY_CLI_OPT_TEXT("filter", OPT_FILTER, &filter),       /* pathtracer: filter=... */
+        SY_CLI_OPT_TEXT("threshold", OPT_THRESHOLD, &threshold), /* pathtracer: threshold=... */
+        SY_CLI_OPT_FLAG("half", OPT_HALF, &oo.half), SY_CLI_OPT_FLOAT("exposure", OPT_EXPOSURE, &oo.png.exposure_stops, -FLT_MAX, FLT_MAX),
+        SY_CLI_OPT_CODE("tonemap", OPT_TONEMAP, true), SY_CLI_OPT_CODE("stereo", OPT_STEREO, true),
+        SY_CLI_OPT_FLOAT_ANY("eye-sep", OPT_EYE_SEP, &spec.eye_separation), /* the range: sy_compose says why */
+        SY_CLI_OPT_FLOAT_ANY("zero-parallax", OPT_ZERO_PARALLAX, &spec.zero_parallax),
+        SY_CLI_OPT_TEXT("overlay", OPT_OVERLAY, &overlay), SY_CLI_OPT_TEXT("composite", OPT_COMPOSITE, &composite),
+        SY_CLI_OPT_CODE("frames", OPT_FRAMES, true), SY_CLI_OPT_CODE("fps", OPT_FPS, true), /* a sequence */
+        SY_CLI_OPT_FLAG("resume", OPT_RESUME, &resume),
+        SY_CLI_OPT_UINT("repeat", OPT_REPEAT, &clo.frames, 1, 100000000u), /* cluster: frames through the same window */
+        SY_CLI_OPT_UINT("max-memory", OPT_MAX_MEMORY, &max_memory_mb, 1, 1u << 30),
+        SY_CLI_OPT_CODE("at", OPT_AT, true), SY_CLI_OPT_CODE("clip", OPT_CLIP, true)}; /* the scene clock */
+    sy_cli_parser p = {SY_CLI_ARGS("render", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .cluster = true,
+                       .view = true};
+    int c;
+    while ((c = sy_cli_parse(&p)) != -1) {
         switch (c) {
-        case OPT_STOP: return status;
-        case 'b': backend = optarg; break;
-        case OPT_SPP:
-            if (!sy_cli_parse_u32(optarg, 1, 1u << 24, &po.spp)) return sy_cli_bad_value("--spp", optarg);
-            progressive_opts = true;
-            break;
-        case OPT_TIME:
-            if (!sy_cli_parse_double(optarg, DBL_TRUE_MIN, DBL_MAX, &po.time_budget)) return sy_cli_bad_value("--time", optarg);
-            progressive_opts = true;
-            break;
-        case OPT_AOV: po.aov = progressive_opts = true; break;
-        case 'o': outp = optarg; break;
-        case OPT_CAMERA: camera = optarg; break;
-        case OPT_PARAMS: params = optarg; break;
-        case OPT_GL: gl_provider = optarg; break;          /* raster: gl=... parameter */
-        case OPT_FILTER: filter = optarg; break;           /* pathtracer: filter=... */
-        case OPT_THRESHOLD: threshold = optarg; break;     /* pathtracer: threshold=... */
-        case OPT_HALF: oo.half = true; break;
-        case OPT_EXPOSURE:
-            oo.png.exposure_stops = strtof(optarg, &end);
-            if (end == optarg || *end || !isfinite(oo.png.exposure_stops)) return sy_cli_bad_value("--exposure", optarg);
-            break;
+        case OPT_STOP: return p.status;
         case OPT_TONEMAP:
             if (!strcmp(optarg, "aces")) oo.png.tonemap = SY_TONEMAP_ACES;
             else if (!strcmp(optarg, "reinhard")) oo.png.tonemap = SY_TONEMAP_REINHARD;
@@ -537,16 +518,6 @@ int sy_cmd_render(int argc, char **argv)
         case OPT_STEREO:
             if (sy_stereo_mode_parse(optarg, &spec.stereo, &perr) != SY_OK) return sy_cli_fail(&perr);
             break;
-        case OPT_EYE_SEP: /* the range: sy_compose says why */
-            spec.eye_separation = strtof(optarg, &end);
-            if (end == optarg || *end) return sy_cli_bad_value("--eye-sep", optarg);
-            break;
-        case OPT_ZERO_PARALLAX:
-            spec.zero_parallax = strtof(optarg, &end);
-            if (end == optarg || *end) return sy_cli_bad_value("--zero-parallax", optarg);
-            break;
-        case OPT_OVERLAY: overlay = optarg; break;
-        case OPT_COMPOSITE: composite = optarg; break;
         case OPT_FRAMES:
             if (!strchr(optarg, ':')) {
                 fprintf(stderr, "sy render: error: --frames %s: a sequence is --frames A:B[:STEP] (frame numbers); "
@@ -560,13 +531,6 @@ int sy_cmd_render(int argc, char **argv)
             if (!sy_cli_parse_double(optarg, 1e-3, 1e6, &fps)) return sy_cli_bad_value("--fps", optarg);
             fps_given = true;
             break;
-        case OPT_RESUME: resume = true; break;
-        case OPT_REPEAT:
-            if (!sy_cli_parse_u32(optarg, 1, 100000000u, &clo.frames)) return sy_cli_bad_value("--repeat", optarg);
-            break;
-        case OPT_MAX_MEMORY:
-            if (!sy_cli_parse_u32(optarg, 1, 1u << 30, &max_memory_mb)) return sy_cli_bad_value("--max-memory", optarg);
-            break;
         case OPT_AT: /* seconds on the scene clock: finite, from 0 */
             if (!sy_cli_parse_double(optarg, 0.0, 1e9, &at)) return sy_cli_bad_value("--at", optarg);
             at_given = true;
@@ -576,9 +540,10 @@ int sy_cmd_render(int argc, char **argv)
             else if (sy_cli_add_clip_plane(optarg, spec.clip_planes, &spec.clip_count)) return 2;
             break;
         default: /* --cluster ... (sy_cluster_cli.c) */
-            if (!sy_cluster_cli_getopt(c, optarg, &clo)) return sy_cli_bad_value(sy_cli_option_name(lo, c), optarg);
+            if (!sy_cluster_cli_getopt(c, optarg, &clo)) return sy_cli_bad_value(sy_cli_option_name(p.lo, c), optarg);
         }
     }
+    const bool progressive_opts = po.spp || po.time_budget > 0 || po.aov; /* --spp / --time / --aov given */
     for (; optind < argc; ++optind) {
         if (scene) return sy_cli_usage_of("render", "one SCENE at a time");
         scene = argv[optind];

@@ -21,44 +21,22 @@ int sy_cmd_view(int argc, char **argv)
     const char *view_keys = NULL;   /* --keys: scripted key presses (tests) */
     uint32_t w = 960, h = 540, frames = 0;
     sy_cluster_cli_opts clo = {0}; /* --cluster ... (sy_cluster_cli.c; --frames is the viewer's own) */
-    static const struct option lo[] = {
-        {"camera", required_argument, NULL, OPT_CAMERA}, {"overlay", required_argument, NULL, OPT_OVERLAY},
-        {"composite", required_argument, NULL, OPT_COMPOSITE}, {"frames", required_argument, NULL, OPT_FRAMES},
-        {"screenshot", required_argument, NULL, OPT_SCREENSHOT}, {"filter", required_argument, NULL, OPT_FILTER},
-        {"threshold", required_argument, NULL, OPT_THRESHOLD}, {"keys", required_argument, NULL, OPT_KEYS},
-        {"spp", required_argument, NULL, OPT_SPP}, /* cluster: samples per server and frame */
-        {"budget", required_argument, NULL, OPT_BUDGET}, /* the frame-time governor's budget (ms) */
-        SY_CLUSTER_CLI_OPTIONS, VIEW_OPTIONS, COMMON_OPTIONS};
     double budget = 0.0;
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_sized_option("view", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, 16, &w, &h, &status)) != -1) {
-        char *end = NULL;
-        switch (c) {
-        case OPT_STOP: return status;
-        case 'b': backend = optarg; break;
-        case OPT_CAMERA: camera = optarg; break;
-        case OPT_OVERLAY: overlay = optarg; break;
-        case OPT_COMPOSITE: composite = optarg; break;
-        case OPT_FRAMES:
-            if (!sy_cli_parse_u32(optarg, 1, 1000000, &frames)) return sy_cli_bad_value("--frames", optarg);
-            break;
-        case OPT_SCREENSHOT: shot = optarg; break;
-        case OPT_FILTER: view_filter = optarg; break;
-        case OPT_THRESHOLD: /* the range: sy_view_run says why */
-            view_threshold = strtof(optarg, &end);
-            if (end == optarg || *end) return sy_cli_bad_value("--threshold", optarg);
-            break;
-        case OPT_KEYS: view_keys = optarg; break;
-        case OPT_BUDGET:
-            if (!sy_cli_parse_double(optarg, 1.0, 10000.0, &budget)) return sy_cli_bad_value("--budget", optarg);
-            break;
-        case OPT_SPP:
-            if (!sy_cli_parse_u32(optarg, 1, 100000000u, &clo.samples)) return sy_cli_bad_value("--spp", optarg);
-            break;
-        default:
-            if (!sy_cluster_cli_getopt(c, optarg, &clo)) return sy_cli_bad_value(sy_cli_option_name(lo, c), optarg);
-        }
+    const sy_cli_opt opts[] = {
+        SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera),
+        SY_CLI_OPT_TEXT("overlay", OPT_OVERLAY, &overlay), SY_CLI_OPT_TEXT("composite", OPT_COMPOSITE, &composite),
+        SY_CLI_OPT_UINT("frames", OPT_FRAMES, &frames, 1, 1000000), SY_CLI_OPT_TEXT("screenshot", OPT_SCREENSHOT, &shot),
+        SY_CLI_OPT_TEXT("filter", OPT_FILTER, &view_filter),
+        SY_CLI_OPT_FLOAT_ANY("threshold", OPT_THRESHOLD, &view_threshold), /* the range: sy_view_run says why */
+        SY_CLI_OPT_TEXT("keys", OPT_KEYS, &view_keys),
+        SY_CLI_OPT_UINT("spp", OPT_SPP, &clo.samples, 1, 100000000u), /* cluster: samples per server and frame */
+        SY_CLI_OPT_REAL("budget", OPT_BUDGET, &budget, 1.0, 10000.0)}; /* the frame-time governor's budget (ms) */
+    sy_cli_parser p = {SY_CLI_ARGS("view", argc, argv, opts), .w = &w, .h = &h, .min_size = 16, .cluster = true,
+                       .view = true};
+    int c, status;
+    while ((c = sy_cli_parse(&p)) != -1) { /* the cluster's options come back */
+        if (c == OPT_STOP) return p.status;
+        if (!sy_cluster_cli_getopt(c, optarg, &clo)) return sy_cli_bad_value(sy_cli_option_name(p.lo, c), optarg);
     }
     if ((status = sy_cli_scene_operand("view", argc, argv, &scene))) return status;
     sy_error err = {0};

@@ -10,6 +10,7 @@
 #include "sy_web_cull.h"
 #endif
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,38 +26,16 @@ int sy_cmd_web(int argc, char **argv)
     float threshold = 0.0f;
     double budget = 0; /* 0: the governor's default (33 ms) */
     bool client_render = false;
-    static const struct option lo[] = {
-        {"camera", required_argument, NULL, OPT_CAMERA}, {"listen", required_argument, NULL, OPT_WEB_LISTEN},
-        {"quality", required_argument, NULL, OPT_WEB_QUALITY}, {"filter", required_argument, NULL, OPT_FILTER},
-        {"threshold", required_argument, NULL, OPT_THRESHOLD}, {"budget", required_argument, NULL, OPT_BUDGET},
-        {"client-render", no_argument, NULL, OPT_WEB_CLIENT_RENDER},
-        {"delay-ms", required_argument, NULL, OPT_WEB_DELAY}, VIEW_OPTIONS, COMMON_OPTIONS};
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_sized_option("web", argc, argv, SHORT_OPTIONS("b:w:h:"), lo, 1, &w, &h, &status)) != -1) {
-        char *end = NULL;
-        switch (c) {
-        case OPT_STOP: return status;
-        case 'b': backend = optarg; break;
-        case OPT_CAMERA: camera = optarg; break;
-        case OPT_WEB_LISTEN: listen = optarg; break;
-        case OPT_WEB_QUALITY:
-            if (!sy_cli_parse_u32(optarg, 1, 100, &quality)) return sy_cli_bad_value("--quality", optarg);
-            break;
-        case OPT_FILTER: filter = optarg; break;
-        case OPT_THRESHOLD:
-            threshold = strtof(optarg, &end);
-            if (end == optarg || *end || !(threshold >= 0.0f) || !isfinite(threshold)) return sy_cli_bad_value("--threshold", optarg);
-            break;
-        case OPT_BUDGET: /* the frame-time governor's budget (ms) */
-            if (!sy_cli_parse_double(optarg, 1.0, 10000.0, &budget)) return sy_cli_bad_value("--budget", optarg);
-            break;
-        case OPT_WEB_CLIENT_RENDER: client_render = true; break;
-        case OPT_WEB_DELAY: /* tests only: an added network delay in both directions */
-            if (!sy_cli_parse_u32(optarg, 0, 10000, &delay_ms)) return sy_cli_bad_value("--delay-ms", optarg);
-            break;
-        }
-    }
+    const sy_cli_opt opts[] = {
+        SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera),
+        SY_CLI_OPT_TEXT("listen", OPT_WEB_LISTEN, &listen), SY_CLI_OPT_UINT("quality", OPT_WEB_QUALITY, &quality, 1, 100),
+        SY_CLI_OPT_TEXT("filter", OPT_FILTER, &filter), SY_CLI_OPT_FLOAT("threshold", OPT_THRESHOLD, &threshold, 0, FLT_MAX),
+        SY_CLI_OPT_REAL("budget", OPT_BUDGET, &budget, 1.0, 10000.0), /* the frame-time governor's budget (ms) */
+        SY_CLI_OPT_FLAG("client-render", OPT_WEB_CLIENT_RENDER, &client_render),
+        SY_CLI_OPT_UINT("delay-ms", OPT_WEB_DELAY, &delay_ms, 0, 10000)}; /* tests only: added network delay each way */
+    sy_cli_parser p = {SY_CLI_ARGS("web", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .view = true};
+    if (sy_cli_parse(&p) != -1) return p.status;
+    int status;
     if ((status = sy_cli_scene_operand("web", argc, argv, &scene))) return status;
     sy_error err = {0};
     if (!backend && !(backend = sy_cli_default_backend(&err))) return sy_cli_fail(&err);
