@@ -22,13 +22,9 @@ DATA=$2
 TMP=$3
 EXR_EQUAL=$4
 EXR_ERROR=$5
-fails=0
+. "$(dirname "${BASH_SOURCE[0]}")/../support/check.sh" # fail (and $fails)
 rm -rf "$TMP"
 mkdir -p "$TMP"
-fail() {
-    echo "FAIL: $*" >&2
-    fails=$((fails + 1))
-}
 
 # usage errors: status 2 and the option and reason on stderr
 usage() { # WHAT EXPECT ARGS...

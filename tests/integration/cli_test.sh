@@ -41,16 +41,12 @@ SY=$1
 DATA=$2
 TMP=$3
 EXR_EQUAL=${4:-} # tests/support/exr_equal (optional: the --at pixel checks are skipped without it)
-fails=0
 missing=""
+# fail, run NAME CMD..., run_ok LABEL NAME CMD... (and $fails, $rc)
+. "$(dirname "${BASH_SOURCE[0]}")/../support/check.sh"
 
 rm -rf "$TMP"
 mkdir -p "$TMP"
-
-fail() {
-    echo "FAIL: $*" >&2
-    fails=$((fails + 1))
-}
 
 # has PART: this build has the part (SY_TEST_PARTS; unset = the full build)
 has() { [ -z "${SY_TEST_PARTS+x}" ] || [[ " $SY_TEST_PARTS " == *" $1 "* ]]; }
@@ -58,21 +54,6 @@ has() { [ -z "${SY_TEST_PARTS+x}" ] || [[ " $SY_TEST_PARTS " == *" $1 "* ]]; }
 PICTURE=(whitted pathtracer)
 has raster && PICTURE+=(raster)
 for p in raster cluster; do has $p || echo "skip: the checks of '$p' (not in this build: SY_TEST_PARTS='$SY_TEST_PARTS')"; done
-
-# run NAME CMD...: runs a command with stdout/stderr captured in $TMP/NAME.{out,err}; sets $rc.
-run() {
-    local name=$1
-    shift
-    "$@" >"$TMP/$name.out" 2>"$TMP/$name.err"
-    rc=$?
-}
-# run_ok LABEL NAME CMD...: run, and a failure naming LABEL, the status and stderr unless CMD succeeds
-run_ok() {
-    local label=$1
-    shift
-    run "$@"
-    if [ "$rc" -ne 0 ]; then fail "$label: status $rc: $(cat "$TMP/$1.err")"; fi
-}
 
 # magic FILE HEX: the file starts with these bytes
 magic() {

@@ -20,23 +20,8 @@ DATA=$2
 TMP=$3
 EXR_EQUAL=$4
 VIDEO_PROBE=${5:-}
-fails=0
-fail() {
-    echo "FAIL: $*" >&2
-    fails=$((fails + 1))
-}
-run() {
-    local name=$1
-    shift
-    "$@" >"$TMP/$name.out" 2>"$TMP/$name.err"
-    rc=$?
-}
-run_ok() {
-    local label=$1
-    shift
-    run "$@"
-    if [ "$rc" -ne 0 ]; then fail "$label: status $rc: $(cat "$TMP/$1.err")"; fi
-}
+# fail, run NAME CMD..., run_ok LABEL NAME CMD... (and $fails, $rc)
+. "$(dirname "${BASH_SOURCE[0]}")/../support/check.sh"
 rm -rf "$TMP"
 mkdir -p "$TMP"
 

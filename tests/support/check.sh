@@ -1,0 +1,27 @@
+# check.sh — the check kit of the shell tests (sourced; bash): failures counted, commands run with
+# their output captured. The sourcing script sets TMP (a scratch folder) before it calls run, and
+# ends with its own summary on $fails (a non-zero exit when fails > 0; 77 when it skipped parts
+# that need ../shared/testdata).
+#   fail MESSAGE...          prints "FAIL: MESSAGE" on stderr and counts it in $fails
+#   run NAME CMD...          runs CMD, stdout and stderr to $TMP/NAME.out and $TMP/NAME.err; sets $rc
+#   run_ok LABEL NAME CMD... run, then a failure naming LABEL, the status and stderr unless CMD succeeded
+fails=0
+
+fail() {
+    echo "FAIL: $*" >&2
+    fails=$((fails + 1))
+}
+
+run() {
+    local name=$1
+    shift
+    "$@" >"$TMP/$name.out" 2>"$TMP/$name.err"
+    rc=$?
+}
+
+run_ok() {
+    local label=$1
+    shift
+    run "$@"
+    if [ "$rc" -ne 0 ]; then fail "$label: status $rc: $(cat "$TMP/$1.err")"; fi
+}
