@@ -5,10 +5,12 @@
  * parses with getopt_long (GNU ordering: options and operands in any order, "--" ends the options,
  * --name=value) through sy_getopt, which refuses abbreviated long options (sy_options.h: "--frame"
  * is no "--frames"). The options every command takes (the world and loader flags, -q / -v, --help)
- * are applied by sy_cli_next_option; a declared option's value is stored where its entry says (a bad
- * value is a usage error naming the option), and only the options whose meaning is the command's own
- * (SY_CLI_CODE) come back to it. Exit status: 0 success, 1 failure (sy_cli_fail), 2 usage error (the bad option or
- * value is named), 130 interrupted. Thread-safety: the main thread only (getopt's globals). */
+ * are applied by sy_cli_next_option; a declared option's value is stored where its entry says (a
+ * bad value is a usage error naming the option), and only the options whose meaning is the
+ * command's own (SY_CLI_CODE) come back to it. (sy serve and sy bench cull / cluster / governor /
+ * limit, which take none of the common options, read theirs with sy_getopt directly.)
+ * Exit status: 0 success, 1 failure (sy_cli_fail), 2 usage error (the bad option or value is
+ * named), 130 interrupted. Thread-safety: the main thread only (getopt's globals). */
 #ifndef SY_CLI_H
 #define SY_CLI_H
 
@@ -70,7 +72,7 @@ typedef struct sy_cli_opt {
     sy_cli_kind kind;
     bool value;       /* it takes a value (every kind but FLAG, and CODE as declared) */
     void *to;         /* where the value goes (the kind's type); NULL for CODE */
-    double lo, hi;    /* UINT, REAL: the accepted range */
+    double lo, hi;    /* UINT, REAL, FLOAT: the accepted range */
 } sy_cli_opt;
 
 #define SY_CLI_OPT_CODE(name, code, has_value) {(name), (code), SY_CLI_CODE, (has_value), NULL, 0, 0}
