@@ -42,6 +42,20 @@ static sy_result fb_fail(sy_error *err, const sy_filter_report *fe, const char *
     return sy_backend_fail(err, (int)fe->code, "bench filters", what, fe->message);
 }
 
+/* One row of a table: sample count k, the method, its error against ref (relMSE, and relMSE without
+ * a filter over it: the row of FB_NONE, first, sets *base_rel) and its time in ms. */
+static sy_result fb_row(uint32_t k, int m, const float *img, const float *ref, uint32_t width, uint32_t height,
+                        double ms, double *base_rel, sy_error *err)
+{
+    sy_filter_report fe = {0};
+    sy_filter_metrics mt;
+    if (sy_filter_metrics_compute(img, ref, width, height, 4, &mt, &fe)) return fb_fail(err, &fe, "metrics");
+    if (m == FB_NONE) *base_rel = mt.relmse;
+    printf("  %5u %-12s %9.5f %9.5f %7.4f %9.2fx %9.1f\n", k, fb_names[m], mt.rmse, mt.relmse, mt.ssim,
+           mt.relmse > 0 ? *base_rel / mt.relmse : 0.0, ms);
+    return SY_OK;
+}
+
 /* one filter application; pixel filters: a forced pass of *keep (created on first use, as a
  * viewport keeps its filter object between frames) */
 static sy_filter_status fb_apply(int m, const sy_filter_frame *f, uint32_t threads, float *out, sy_filter_pixel **keep,
@@ -240,13 +254,8 @@ sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, co
                 sy_filter_pixel_destroy(once);
                 ms = (sy_time_now() - a) * 1e3;
             }
-            sy_filter_metrics mt;
-            if (r == SY_OK && sy_filter_metrics_compute(img, ref, width, height, 4, &mt, &fe))
-                r = fb_fail(err, &fe, "metrics");
+            if (r == SY_OK) r = fb_row(k, m, img, ref, width, height, ms, &base_rel, err);
             if (r != SY_OK) break;
-            if (m == FB_NONE) base_rel = mt.relmse;
-            printf("  %5u %-12s %9.5f %9.5f %7.4f %9.2fx %9.1f\n", k, fb_names[m], mt.rmse, mt.relmse, mt.ssim,
-                   mt.relmse > 0 ? base_rel / mt.relmse : 0.0, ms);
             for (uint32_t y = 0; sheet && y < th; ++y) /* tile: box-downscaled image */
                 for (uint32_t x = 0; x < tw; ++x)
                     for (int c = 0; c < 4; ++c) {
@@ -408,13 +417,8 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
                     ms = (sy_time_now() - t0) * 1e3;
                     sy_filter_pixel_destroy(once);
                 }
-                sy_filter_metrics mt;
-                if (r == SY_OK && sy_filter_metrics_compute(im, ref, width, height, 4, &mt, &fe))
-                    r = fb_fail(err, &fe, "metrics");
+                if (r == SY_OK) r = fb_row(k, meth, im, ref, width, height, ms, &base_rel, err);
                 if (r != SY_OK) break;
-                if (meth == FB_NONE) base_rel = mt.relmse;
-                printf("  %5u %-12s %9.5f %9.5f %7.4f %9.2fx %9.1f\n", k, fb_names[meth], mt.rmse, mt.relmse, mt.ssim,
-                       mt.relmse > 0 ? base_rel / mt.relmse : 0.0, ms);
                 for (uint32_t y = 0; sheet && y < height; ++y)
                     for (uint32_t x = 0; x < width; ++x) { /* opaque: uncovered background shows black */
                         float *d = sheet + 4 * ((si * (size_t)height + y) * sheet_w + (size_t)mi * width + x);
