@@ -1,0 +1,107 @@
+/** @file
+ * sy_filter_temporal.h — temporal reuse for moving progressive frames (in the spirit of SVGF,
+ * Schied et al. 2017): each call takes the new samples of one frame (a few samples per pixel, the
+ * path tracer's accumulation right after a camera move restarted it) with their feature buffers,
+ * reprojects the history kept from the previous call to this frame's camera, rejects history that
+ * does not belong to the same surface or no longer fits the new samples, blends, and filters the
+ * result with a variance-guided edge-avoiding a-trous filter. The output is an estimate for display
+ * while the view moves; once the camera rests, the caller shows its own accumulation instead
+ * (the path tracer's mediator does), so a still, converged image is never changed.
+ *
+ * Per call, for pixel i with world position p_i (frame.position), all on illumination (colour
+ * demodulated by the albedo, as the a-trous filter does; misses pass through unchanged):
+ *   1. reprojection: the previous frame's pixel of p_i through the previous camera (prev
+ *      world_to_pixel), bilinear over its 4 nearest pixel centres; a tap counts only when its stored
+ *      world position lies within depth_tolerance x depth_i of p_i and its normal within
+ *      normal_tolerance (cosine) of n_i. No valid tap: disocclusion, history length 0. Only the
+ *      camera moves points: a node the scene clock moved is not followed (its history is rejected
+ *      where its surface left the tolerance, or clamped).
+ *   2. neighbourhood clamping: the reprojected history is clamped to the box mean +- clamp_gamma x
+ *      standard deviation of the new samples' 3x3 neighbourhood in YCoCg (0 = no clamping).
+ *   3. exponential moving average: weight max(alpha, 1 / (history length + 1)) for the new samples
+ *      (history length up to max_history), the same for the first and second moments of luminance;
+ *      their difference is the temporal variance, replaced by the 3x3 spatial variance while the
+ *      history is shorter than 4 frames.
+ *   4. a-trous: atrous_iterations passes of a 3x3 B-spline kernel with taps 2^k apart, weights
+ *      exp(-|l_i - l_j| / (sigma_luminance sqrt(blurred variance_i)) - |z_i - z_j| / (sigma_depth
+ *      step |grad z_i|) - sigma_normal (1 - n_i.n_j)), the variance filtered with the squared
+ *      weights; the output of the first pass becomes the next frame's history (as SVGF).
+ * The result is remodulated by the albedo. NaN/Inf inputs are neither read by neighbours nor kept
+ * in the history (the pixel shows its own colour, or 0).
+ *
+ * Inputs (sy_filter_frame): color (3 or 4 channels; alpha passed through), albedo, normal, depth,
+ * position (required: world positions as sy_filter_position_from_depth gives them); variance and
+ * the split are not used. world_to_pixel: the frame's camera as a 4x4 column-major matrix taking a
+ * homogeneous world point to (x w, y w, *, w), where (x, y) are continuous pixel coordinates of this
+ * frame (pixel (x, y) covers [x, x+1) x [y, y+1), row 0 at the top) and w > 0 in front of the
+ * camera (perspective: the camera-axis distance; orthographic: 1). Frames may change size from call
+ * to call (an interactive view's resolution scale): the history is read at its own size.
+ *
+ * Ownership: a sy_filter_temporal is the caller's (create / destroy); it holds the history (about
+ * 100 bytes per pixel). Thread-safety: one thread at a time per object; the passes run on the
+ * process's OpenMP team (sy_filter_parallel_rows); results do not depend on the thread count. */
+#ifndef SY_FILTER_TEMPORAL_H
+#define SY_FILTER_TEMPORAL_H
+
+#include "sy_filter.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Temporal reuse options (sy_filter_temporal_params_default gives the defaults). */
+typedef struct sy_filter_temporal_params {
+    float alpha;            /**< smallest EMA weight of the new samples, (0, 1]; default 0.1 */
+    float alpha_moments;    /**< smallest EMA weight of the luminance moments, (0, 1]; default 0.2 */
+    uint32_t max_history;   /**< longest history counted (frames, 1..1024); default 32 */
+    float clamp_gamma;      /**< YCoCg box half width in standard deviations (0 = no clamping, <= 100); default 2 */
+    float depth_tolerance;  /**< reprojection: largest world distance / depth (> 0); default 0.03 */
+    float normal_tolerance; /**< reprojection: smallest normal cosine [-1, 1]; default 0.8 */
+    uint32_t atrous_iterations; /**< a-trous passes (0..8; 0 = the blended image unfiltered); default 4 */
+    float sigma_luminance;  /**< a-trous luminance edge stop (> 0); default 4 (SVGF) */
+    float sigma_normal;     /**< a-trous normal edge stop (>= 0); default 64 */
+    float sigma_depth;      /**< a-trous depth edge stop (> 0); default 1 (SVGF) */
+    uint32_t threads;       /**< OpenMP team size; 0 = the OpenMP default (sy_filter_parallel_rows) */
+} sy_filter_temporal_params;
+
+/** Per-call statistics (any pointer may be NULL). */
+typedef struct sy_filter_temporal_stats {
+    uint64_t pixels;         /**< pixels of the frame */
+    uint64_t reprojected;    /**< pixels with a valid reprojected history */
+    uint64_t disoccluded;    /**< hits without one (new surface, outside the previous view, rejected) */
+    uint64_t nonfinite;      /**< NaN/Inf input pixels */
+    double mean_history;     /**< mean history length (frames) over the hits after this frame */
+    double seconds;          /**< wall time of the call */
+    double cpu_seconds;      /**< CPU time of the process during the call (all its threads) */
+} sy_filter_temporal_stats;
+
+/** A temporal reuse state (opaque). */
+typedef struct sy_filter_temporal sy_filter_temporal;
+
+/** Fills p with the defaults. */
+void sy_filter_temporal_params_default(sy_filter_temporal_params *p);
+/** Checks every field; the message names the field and the bound. */
+sy_filter_status sy_filter_temporal_params_check(const sy_filter_temporal_params *p, sy_filter_report *err);
+
+/** Creates a state with no history; p NULL = the defaults. */
+sy_filter_status sy_filter_temporal_create(const sy_filter_temporal_params *p, sy_filter_temporal **out,
+                                           sy_filter_report *err);
+/** NULL-safe. */
+void sy_filter_temporal_destroy(sy_filter_temporal *t);
+/** Forgets the history (the next frame starts from its own samples); NULL-safe. */
+void sy_filter_temporal_reset(sy_filter_temporal *t);
+/** New options (checked); the history is kept. */
+sy_filter_status sy_filter_temporal_set_params(sy_filter_temporal *t, const sy_filter_temporal_params *p,
+                                               sy_filter_report *err);
+
+/** One frame: out_rgba (width*height*4 floats) receives the estimate, and the history becomes this
+ * frame's. world_to_pixel as described above (finite). Fails on a bad frame, matrix or memory; the
+ * history is then reset. */
+sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_frame *in, const float world_to_pixel[16],
+                                        float *out_rgba, sy_filter_temporal_stats *stats, sy_filter_report *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SY_FILTER_TEMPORAL_H */

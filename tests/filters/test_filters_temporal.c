@@ -1,0 +1,323 @@
+/* test_filters_temporal.c — temporal reuse (sy_filter_temporal.h) on an analytic scene with a
+ * known answer: a pinhole camera at (cx, 0, 0) looking down -Z at a wall z = -5 and a square
+ * occluder z = -2, |x|, |y| <= 0.5, both facing the camera. Checked: the reprojected history of a
+ * constant-colour wall stays that colour through a pan (and a change of resolution); history and
+ * new samples blend with the documented weight; a disocclusion (wall seen behind the occluder's old
+ * place) is rejected; neighbourhood clamping pulls stale history to the new samples; noise falls
+ * several times over a noisy pan; NaN pixels stay isolated; bad parameters and frames are
+ * refused. */
+#include "sy_filter_temporal.h"
+#include "synth.h"
+
+#include <string.h>
+
+#define YFOV 1.0471976f /* 60 degrees */
+
+typedef struct scene {
+    uint32_t w, h;
+    float cx;
+    bool occluder;
+    float *color, *albedo, *normal, *depth, *position;
+    float m[16]; /* world_to_pixel */
+    uint64_t rng;
+} scene;
+
+/* the pixel's ray from (cx, 0, 0): direction (u, v, -1) */
+static void ray_of(const scene *s, float x, float y, float *u, float *v)
+{
+    float th = tanf(0.5f * YFOV), asp = (float)s->w / (float)s->h;
+    *u = (2.0f * x / (float)s->w - 1.0f) * th * asp;
+    *v = (1.0f - 2.0f * y / (float)s->h) * th;
+}
+
+/* renders the scene at camera x cx: every hit has albedo 0.5, radiance = 0.5 * E with E the wall's
+ * or the occluder's irradiance, times (1 + noise * N(0,1)) when noise > 0 */
+static int scene_render(scene *s, uint32_t w, uint32_t h, float cx, float e_wall, float e_occ, float noise)
+{
+    size_t n = (size_t)w * h;
+    if (n > (size_t)s->w * s->h || !s->color) {
+        free(s->color), free(s->albedo), free(s->normal), free(s->depth), free(s->position);
+        s->color = malloc(4 * n * sizeof(float)), s->albedo = malloc(3 * n * sizeof(float));
+        s->normal = malloc(3 * n * sizeof(float)), s->depth = malloc(n * sizeof(float));
+        s->position = malloc(3 * n * sizeof(float));
+        CHECK(s->color && s->albedo && s->normal && s->depth && s->position);
+    }
+    s->w = w, s->h = h, s->cx = cx;
+    for (uint32_t y = 0; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) {
+            size_t i = (size_t)y * w + x;
+            float u, v;
+            ray_of(s, (float)x + 0.5f, (float)y + 0.5f, &u, &v);
+            bool occ = s->occluder && fabsf(cx + 2.0f * u) <= 0.5f && fabsf(2.0f * v) <= 0.5f;
+            float d = occ ? 2.0f : 5.0f, e = occ ? e_occ : e_wall;
+            float f = noise > 0.0f ? (float)fmax(0.0, 1.0 + noise * synth_gauss(&s->rng)) : 1.0f;
+            s->depth[i] = d;
+            float p[3] = {cx + d * u, d * v, -d};
+            for (int q = 0; q < 3; ++q) {
+                s->position[3 * i + q] = p[q];
+                s->normal[3 * i + q] = q == 2 ? 1.0f : 0.0f;
+                s->albedo[3 * i + q] = 0.5f;
+                s->color[4 * i + q] = 0.5f * e * f;
+            }
+            s->color[4 * i + 3] = 1.0f;
+        }
+    /* world_to_pixel: W = -z_cam = -p.z; x W = sx (p.x - cx) + W th asp sx; y W = -sy p.y + W th sy */
+    float th = tanf(0.5f * YFOV), asp = (float)w / (float)h;
+    float sx = (float)w / (2.0f * th * asp), sy = (float)h / (2.0f * th);
+    memset(s->m, 0, sizeof s->m);
+    s->m[0] = sx, s->m[8] = -th * asp * sx, s->m[12] = -cx * sx; /* row 0 */
+    s->m[5] = -sy, s->m[9] = -th * sy;                           /* row 1 */
+    s->m[10] = -1.0f;                                             /* row 2 (unused) */
+    s->m[11] = -1.0f;                                             /* row 3: w */
+    return 0;
+}
+
+static sy_filter_frame scene_frame(const scene *s)
+{
+    return (sy_filter_frame){.width = s->w, .height = s->h, .color_channels = 4, .variance_channels = 1,
+                             .color = s->color, .albedo = s->albedo, .normal = s->normal, .depth = s->depth,
+                             .position = s->position, .spp_uniform = 1.0f};
+}
+
+static void scene_free(scene *s)
+{
+    free(s->color), free(s->albedo), free(s->normal), free(s->depth), free(s->position);
+}
+
+static sy_filter_temporal_params plain_params(void)
+{
+    sy_filter_temporal_params p;
+    sy_filter_temporal_params_default(&p);
+    p.clamp_gamma = 0.0f, p.atrous_iterations = 0, p.alpha = 0.25f, p.threads = 2;
+    return p;
+}
+
+static int test_constant_pan(void)
+{
+    scene s = {.rng = 7};
+    sy_filter_temporal_params p;
+    sy_filter_temporal_params_default(&p); /* clamping and a-trous on */
+    sy_filter_temporal *t = NULL;
+    sy_filter_report err = {0};
+    CHECK(sy_filter_temporal_create(&p, &t, &err) == SY_FILTER_OK);
+    float *out = malloc(4 * 64 * 48 * sizeof(float));
+    CHECK(out);
+    sy_filter_temporal_stats st = {0};
+    double maxd = 0;
+    for (int k = 0; k < 8; ++k) {
+        uint32_t w = k == 5 ? 32 : 64, h = k == 5 ? 24 : 48; /* one frame at half resolution */
+        CHECK(scene_render(&s, w, h, 0.05f * (float)k, 0.6f, 0.6f, 0.0f) == 0);
+        sy_filter_frame f = scene_frame(&s);
+        CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
+        for (size_t i = 0; i < (size_t)w * h; ++i)
+            for (int q = 0; q < 4; ++q) maxd = fmax(maxd, fabs(out[4 * i + q] - (q == 3 ? 1.0 : 0.3)));
+        if (k > 0) CHECK_MSG(st.reprojected > st.pixels * 8 / 10, "frame %d: %llu of %llu reprojected", k,
+                             (unsigned long long)st.reprojected, (unsigned long long)st.pixels);
+    }
+    printf("constant wall, 8-frame pan (one at half size): max |out - 0.3| = %.2e, mean history %.1f\n", maxd,
+           st.mean_history);
+    CHECK(maxd < 1e-5);
+    CHECK(st.mean_history > 4.0);
+    free(out);
+    sy_filter_temporal_destroy(t);
+    scene_free(&s);
+    return 0;
+}
+
+/* frame 1 radiance 0.5*A everywhere at cx = 0; frame 2 at cx = 0.3 radiance 0.5*B: where the
+ * wall's point was visible in frame 1 the output is the blend (A + B)/2 * 0.5 (history length 1:
+ * weight 1/2); where it was behind the occluder, or outside frame 1, it is 0.5*B */
+static int test_blend_and_disocclusion(void)
+{
+    scene s = {.occluder = true};
+    sy_filter_temporal_params p = plain_params();
+    sy_filter_temporal *t = NULL;
+    sy_filter_report err = {0};
+    CHECK(sy_filter_temporal_create(&p, &t, &err) == SY_FILTER_OK);
+    const uint32_t w = 96, h = 64;
+    float *out = malloc(4 * w * h * sizeof(float));
+    CHECK(out);
+    const float A = 0.4f, B = 0.8f;
+    CHECK(scene_render(&s, w, h, 0.0f, A, A, 0.0f) == 0);
+    sy_filter_frame f = scene_frame(&s);
+    sy_filter_temporal_stats st;
+    CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
+    CHECK(st.reprojected == 0 && st.disoccluded == (uint64_t)w * h);
+    scene prev = {.w = w, .h = h, .cx = 0.0f};
+    CHECK(scene_render(&s, w, h, 0.3f, B, B, 0.0f) == 0);
+    CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
+    float th = tanf(0.5f * YFOV), asp = (float)w / (float)h;
+    uint32_t n_blend = 0, n_disocc = 0, n_outside = 0;
+    for (uint32_t y = 0; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) {
+            size_t i = (size_t)y * w + x;
+            if (s.depth[i] != 5.0f) continue; /* the wall only */
+            const float *P = s.position + 3 * i;
+            /* P seen from camera 1 (origin): pixel coordinates there, and the occluder's silhouette */
+            float u = P[0] / 5.0f, v = P[1] / 5.0f;
+            float px = (u / (th * asp) + 1.0f) * 0.5f * (float)prev.w, py = (1.0f - v / th) * 0.5f * (float)prev.h;
+            float qx = 0.5f / 2.0f / (th * asp) * 0.5f * (float)w, qy = 0.5f / 2.0f / th * 0.5f * (float)h; /* half size */
+            float cx0 = 0.5f * (float)w, cy0 = 0.5f * (float)h;
+            bool inside_occ = fabsf(px - cx0) < qx - 1.5f && fabsf(py - cy0) < qy - 1.5f;
+            bool clear = (fabsf(px - cx0) > qx + 1.5f || fabsf(py - cy0) > qy + 1.5f) && px > 1.5f &&
+                         px < (float)w - 1.5f && py > 1.5f && py < (float)h - 1.5f;
+            bool outside = px > (float)w + 1.0f;
+            float got = out[4 * i];
+            if (inside_occ) {
+                CHECK_MSG(fabsf(got - 0.5f * B) < 1e-6f, "disoccluded (%u,%u): %g, want %g", x, y, got, 0.5f * B);
+                n_disocc++;
+            } else if (clear) {
+                CHECK_MSG(fabsf(got - 0.25f * (A + B)) < 1e-6f, "reprojected (%u,%u): %g, want %g", x, y, got,
+                          0.25f * (A + B));
+                n_blend++;
+            } else if (outside) {
+                CHECK_MSG(fabsf(got - 0.5f * B) < 1e-6f, "new at the edge (%u,%u): %g", x, y, got);
+                n_outside++;
+            }
+        }
+    printf("pan 0.3 with an occluder: %u wall pixels blended, %u disoccluded rejected, %u new at the edge\n", n_blend,
+           n_disocc, n_outside);
+    CHECK(n_blend > 1000 && n_disocc > 50 && n_outside > 50);
+    /* the occluder's own pixels are reprojected too (same surface, moved in the image) */
+    uint32_t occ_blend = 0;
+    for (size_t i = 0; i < (size_t)w * h; ++i)
+        occ_blend += s.depth[i] == 2.0f && fabsf(out[4 * i] - 0.25f * (A + B)) < 1e-6f;
+    CHECK(occ_blend > 100);
+    free(out);
+    sy_filter_temporal_destroy(t);
+    scene_free(&s);
+    return 0;
+}
+
+/* stale history far from the new samples: clamped to their neighbourhood box */
+static int test_clamp(void)
+{
+    scene s = {.rng = 11};
+    sy_filter_temporal_params p = plain_params();
+    p.clamp_gamma = 1.0f;
+    sy_filter_temporal *t = NULL;
+    sy_filter_report err = {0};
+    CHECK(sy_filter_temporal_create(&p, &t, &err) == SY_FILTER_OK);
+    const uint32_t w = 48, h = 32;
+    float *out = malloc(4 * w * h * sizeof(float));
+    CHECK(out);
+    CHECK(scene_render(&s, w, h, 0.0f, 0.1f, 0.1f, 0.0f) == 0);
+    sy_filter_frame f = scene_frame(&s);
+    CHECK(sy_filter_temporal_run(t, &f, s.m, out, NULL, &err) == SY_FILTER_OK);
+    CHECK(scene_render(&s, w, h, 0.0f, 2.0f, 2.0f, 0.05f) == 0);
+    CHECK(sy_filter_temporal_run(t, &f, s.m, out, NULL, &err) == SY_FILTER_OK);
+    double worst = 0;
+    for (size_t i = 0; i < (size_t)w * h; ++i) worst = fmax(worst, fabs(out[4 * i] - 1.0));
+    /* unclamped: (0.05 + 1) / 2 = 0.525; clamped within about 2 standard deviations (0.05) of 1 */
+    printf("clamp: history 0.05 against new samples 1 +- 5%%: worst |out - 1| = %.3f (unclamped 0.475)\n", worst);
+    CHECK(worst < 0.15);
+    free(out);
+    sy_filter_temporal_destroy(t);
+    scene_free(&s);
+    return 0;
+}
+
+static int test_noisy_pan(void)
+{
+    scene s = {.occluder = true, .rng = 5};
+    sy_filter_temporal_params p;
+    sy_filter_temporal_params_default(&p);
+    sy_filter_temporal *t = NULL;
+    sy_filter_report err = {0};
+    CHECK(sy_filter_temporal_create(&p, &t, &err) == SY_FILTER_OK);
+    const uint32_t w = 96, h = 64;
+    size_t n = (size_t)w * h;
+    float *out = malloc(4 * n * sizeof(float)), *last = malloc(4 * n * sizeof(float)), *in_last = malloc(4 * n * sizeof(float));
+    CHECK(out && last && in_last);
+    double e_in = 0, e_out = 0, fl_in = 0, fl_out = 0;
+    uint64_t cnt = 0, fcnt = 0;
+    for (int k = 0; k < 20; ++k) {
+        CHECK(scene_render(&s, w, h, 0.01f * (float)k, 0.6f, 1.0f, 1.0f) == 0); /* relative sd 1: "1 spp" */
+        sy_filter_frame f = scene_frame(&s);
+        CHECK(sy_filter_temporal_run(t, &f, s.m, out, NULL, &err) == SY_FILTER_OK);
+        for (size_t i = 0; i < n && k >= 10; ++i) {
+            double truth = s.depth[i] == 2.0f ? 0.5 : 0.3;
+            e_in += (s.color[4 * i] - truth) * (s.color[4 * i] - truth) / (truth * truth + 0.01);
+            e_out += (out[4 * i] - truth) * (out[4 * i] - truth) / (truth * truth + 0.01);
+            cnt++;
+            /* flicker on the wall away from the occluder's edges (the true value does not change) */
+            if (s.depth[i] == 5.0f && (i % w) > 4 && (i % w) < w - 4 && fabsf(s.position[3 * i]) > 1.5f) {
+                fl_in += fabs(s.color[4 * i] - in_last[4 * i]), fl_out += fabs(out[4 * i] - last[4 * i]), fcnt++;
+            }
+        }
+        memcpy(last, out, 4 * n * sizeof(float));
+        memcpy(in_last, s.color, 4 * n * sizeof(float));
+    }
+    e_in /= (double)cnt, e_out /= (double)cnt, fl_in /= (double)fcnt, fl_out /= (double)fcnt;
+    printf("noisy pan (relative sd 1 per frame): relMSE %.5f -> %.5f (%.1fx), flicker %.4f -> %.4f (%.1fx)\n", e_in,
+           e_out, e_in / e_out, fl_in, fl_out, fl_in / fl_out);
+    CHECK(e_in / e_out > 5.0);
+    CHECK(fl_in / fl_out > 5.0);
+    /* the same frames with a-trous off are noisier: the spatial filter does work */
+    free(out), free(last), free(in_last);
+    sy_filter_temporal_destroy(t);
+    scene_free(&s);
+    return 0;
+}
+
+static int test_bad_input(void)
+{
+    scene s = {0};
+    sy_filter_temporal *t = NULL;
+    sy_filter_report err = {0};
+    CHECK(sy_filter_temporal_create(NULL, &t, &err) == SY_FILTER_OK);
+    const uint32_t w = 32, h = 24;
+    size_t n = (size_t)w * h;
+    float *out = malloc(4 * n * sizeof(float));
+    CHECK(out);
+    CHECK(scene_render(&s, w, h, 0.0f, 0.6f, 0.6f, 0.0f) == 0);
+    s.color[4 * 100] = NAN, s.normal[3 * 200] = INFINITY;
+    sy_filter_frame f = scene_frame(&s);
+    sy_filter_temporal_stats st;
+    for (int k = 0; k < 3; ++k) {
+        CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
+        for (size_t i = 0; i < 4 * n; ++i) CHECK(isfinite(out[i]));
+        CHECK(st.nonfinite == 2);
+        /* neighbours of the bad pixels are untouched by them */
+        CHECK(fabsf(out[4 * 101] - 0.3f) < 1e-5f && fabsf(out[4 * 201] - 0.3f) < 1e-5f);
+    }
+    /* misses pass through */
+    s.depth[50] = INFINITY;
+    s.color[4 * 50] = 7.0f;
+    CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
+    CHECK(out[4 * 50] == 7.0f);
+    float bad[16];
+    memcpy(bad, s.m, sizeof bad);
+    bad[3] = NAN;
+    CHECK(sy_filter_temporal_run(t, &f, bad, out, &st, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT &&
+          strstr(err.message, "world_to_pixel"));
+    f.position = NULL;
+    CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    sy_filter_temporal_params p;
+    sy_filter_temporal_params_default(&p);
+    p.alpha = 0.0f;
+    CHECK(sy_filter_temporal_set_params(t, &p, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT && strstr(err.message, "alpha"));
+    sy_filter_temporal_params_default(&p);
+    p.atrous_iterations = 9;
+    CHECK(sy_filter_temporal_set_params(t, &p, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT &&
+          strstr(err.message, "atrous_iterations"));
+    sy_filter_temporal_params_default(&p);
+    p.max_history = 0;
+    sy_filter_temporal *t2 = NULL;
+    CHECK(sy_filter_temporal_create(&p, &t2, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT && !t2);
+    free(out);
+    sy_filter_temporal_destroy(t);
+    sy_filter_temporal_destroy(NULL);
+    scene_free(&s);
+    return 0;
+}
+
+int main(void)
+{
+    RUN(test_constant_pan);
+    RUN(test_blend_and_disocclusion);
+    RUN(test_clamp);
+    RUN(test_noisy_pan);
+    RUN(test_bad_input);
+    return sy_check_finish("filters temporal");
+}
