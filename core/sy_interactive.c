@@ -21,6 +21,8 @@ struct sy_interactive {
     uint32_t filter_index;
     float filter_threshold;
     bool filter_enabled;
+    bool temporal;         /* temporal reuse on moving frames (sy_interactive_set_temporal) */
+    bool temporal_applied; /* the value last set on filter_ctx */
 };
 
 /* The "filter" parameter of the registered class with SY_CAP_FILTERS (NULL: none). */
@@ -144,6 +146,7 @@ sy_result sy_interactive_create(double budget_ms, sy_interactive **out, sy_error
         free(ia);
         return r;
     }
+    ia->temporal = true;
     *out = ia;
     return SY_OK;
 }
@@ -180,6 +183,11 @@ void sy_interactive_report(sy_interactive *ia, const sy_governor_frame *f, doubl
     if (!new_context) sy_governor_report(ia->gov, f, ms);
 }
 
+void sy_interactive_set_temporal(sy_interactive *ia, bool on)
+{
+    ia->temporal = on;
+}
+
 bool sy_interactive_view_matrix(const sy_interactive *ia, sy_mat4 *camera_to_world)
 {
     if (ia->planned) *camera_to_world = ia->view;
@@ -196,11 +204,15 @@ sy_result sy_interactive_apply_filter(sy_interactive *ia, sy_context_pool *pool,
     sy_result r = sy_context_pool_get(pool, scene, cls->name, NULL, root_id, &ctx, err);
     if (r != SY_OK) return r;
     if (ctx != ia->filter_ctx || version != ia->filter_applied || enabled != ia->filter_enabled ||
-        filter != ia->filter_index || threshold != ia->filter_threshold) {
+        filter != ia->filter_index || threshold != ia->filter_threshold || ia->temporal != ia->temporal_applied) {
         sy_params opts = {0};
         char t[32], name[32];
         snprintf(t, sizeof t, "%g", (double)threshold);
         r = sy_params_set(&opts, "threshold", t, err);
+        /* temporal reuse where the class has it (a live boolean "temporal" parameter) */
+        const sy_param_decl *td = sy_param_find(&cls->param_table, "temporal");
+        if (r == SY_OK && td && td->type == SY_PARAM_BOOL && (td->flags & SY_PARAM_LIVE))
+            r = sy_params_set(&opts, "temporal", ia->temporal ? "1" : "0", err);
         if (r == SY_OK)
             r = sy_context_set_filter(ctx, enabled ? sy_interactive_filter_name(filter, name) : "none", &opts, err);
         if (r != SY_OK) return r;
@@ -208,6 +220,7 @@ sy_result sy_interactive_apply_filter(sy_interactive *ia, sy_context_pool *pool,
         ia->filter_applied = version;
         ia->filter_enabled = enabled;
         ia->filter_index = filter, ia->filter_threshold = threshold;
+        ia->temporal_applied = ia->temporal;
     }
     if (info) sy_context_filter_info(ctx, info);
     return SY_OK;

@@ -104,10 +104,17 @@ void sy_interactive_report(sy_interactive *ia, const sy_governor_frame *f, doubl
 /** The orbit's matrix at the last plan (false before the first). */
 bool sy_interactive_view_matrix(const sy_interactive *ia, sy_mat4 *camera_to_world);
 
+/** Temporal reuse on moving frames (default on): where the back-end's class declares a live
+ * boolean "temporal" parameter (the path tracer: sy_filter_temporal.h), sy_interactive_apply_filter
+ * sets it to `on` with the filter, so a frame whose camera moved shows the reprojected, filtered
+ * history instead of its few noisy samples, and a still view shows the accumulation unchanged. */
+void sy_interactive_set_temporal(sy_interactive *ia, bool on);
+
 /** Applies display filter `filter` (index) at threshold to the back-end's context in pool (made
  * there when missing, for root_id), when the filter, its version or enabled changed or the context is
  * new; enabled false turns it off (the governor does while the view moves). A back-end without
- * SY_CAP_FILTERS: nothing (info->name ""). *info (may be NULL): the context's filter now. */
+ * SY_CAP_FILTERS: nothing (info->name ""). *info (may be NULL): the context's filter now. The
+ * "temporal" parameter goes with it (sy_interactive_set_temporal). */
 sy_result sy_interactive_apply_filter(sy_interactive *ia, sy_context_pool *pool, sy_scene *scene, uint32_t root_id,
                                       const sy_mediator_class *cls, uint32_t filter, float threshold, uint64_t version,
                                       bool enabled, sy_filter_info *info, sy_error *err);

@@ -11,7 +11,7 @@
 # tests/integration/completion_test.sh checks a few.
 
 _sy_commands="info render demo compare convert coverage pick view web bench backends serve help version"
-_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit cull web deform lights"
+_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit cull web deform lights temporal"
 _sy_common="--help -q --quiet -v --verbose --env --env-color --env-intensity --env-hidden --background
             --no-default-light --allow-path --strict --max-scene-mb --variant"
 _sy_cluster="--cluster --cluster-mode --secret-file --tls-ca --timeout-ms --cluster-pixels"
@@ -21,17 +21,17 @@ _sy_with_value=" -b -o -w -h --camera --look-at --orbit --fov --hide --isolate -
   --timeout-ms --cluster-pixels --screenshot --keys --top --backends --repeats --nodes --tris --reference --env
   --env-color --env-intensity --background --allow-path --max-scene-mb --variant --listen --output --port-file --tls-cert --tls-key --name
   --max-sessions --max-lifetime --blob-cache-mb --max-objects --auth-backoff-ms --max-peer-memory-mb
-  --max-frame-kb --max-message-mb --max-unauthenticated --handshake-timeout-ms --coop-frame --budget --quality "
+  --max-frame-kb --max-message-mb --max-unauthenticated --handshake-timeout-ms --coop-frame --budget --quality --png "
 
 # _sy_options COMMAND [BENCH_KIND]: the options of a command
 _sy_options() {
     case "${1:-}" in
     render) echo "-b -o -w -h --camera --look-at --orbit --fov --hide --isolate --select --params --at --clip --max-memory --gl --filter --threshold --half --exposure --tonemap --stereo
-                  --eye-sep --zero-parallax --overlay --composite --frames --fps --resume --repeat --spp --time --aov
+                  --eye-sep --zero-parallax --overlay --composite --frames --fps --resume --repeat --spp --time --aov --temporal
                   $_sy_cluster $_sy_common" ;;
-    view) echo "-b -w -h --camera --look-at --orbit --fov --hide --isolate --select --overlay --composite --frames --screenshot --filter --threshold --keys --spp --budget
+    view) echo "-b -w -h --camera --look-at --orbit --fov --hide --isolate --select --overlay --composite --frames --screenshot --filter --threshold --keys --spp --budget --no-temporal
                 $_sy_cluster $_sy_common" ;;
-    web) echo "-b -w -h --camera --look-at --orbit --fov --hide --isolate --select --listen --quality --filter --threshold --budget --client-render $_sy_common" ;;
+    web) echo "-b -w -h --camera --look-at --orbit --fov --hide --isolate --select --listen --quality --filter --threshold --budget --client-render --no-temporal $_sy_common" ;;
     info) echo "--json $_sy_common" ;;
     compare) echo "-w -h -o --spp --camera --backends $_sy_common" ;;
     convert) echo "-o $_sy_common" ;;
@@ -46,6 +46,7 @@ _sy_options() {
         case "${2:-}" in
         cluster) echo "-w -h --repeats --hostile-only --coop-only --scale --coop-frame --help -q -v" ;;
         filters) echo "-w -h --repeats --reference $_sy_common" ;;
+        temporal) echo "-w -h --frames --spp --png $_sy_common" ;;
         memory) echo "-w -h -b --tris --glb $_sy_common" ;;
         web) echo "-w -h -b --repeats $_sy_common" ;;
         governor) echo "-w -h --budget --frames --tris --trace --help -q -v" ;;

@@ -30,7 +30,7 @@ enum {
     OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
     OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB, OPT_MAX_MEMORY,
     OPT_BUDGET, OPT_AT, OPT_CLIP, OPT_LOOK_AT, OPT_FOV, OPT_ORBIT, OPT_REPEAT, OPT_FPS, OPT_RESUME, OPT_HIDE,
-    OPT_ISOLATE, OPT_SELECT
+    OPT_ISOLATE, OPT_SELECT, OPT_TEMPORAL, OPT_NO_TEMPORAL
 };
 /* getopt_long entries of the camera placement and node visibility options (sy render, pick, view,
  * web), taken by sy_cli_next_option into sy_cli_load_opts.view and .nodes (sy_load.h) */

@@ -21,6 +21,7 @@
 
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 /* sy bench raster [SCENE] [-w W -h H] [--repeats R] [--params k=v]: default 1280x720 on OSMesa. */
@@ -92,12 +93,59 @@ static int cmd_bench_filters(int argc, char **argv)
     return r == SY_OK ? 0 : sy_cli_fail(&err);
 }
 
+/* sy bench temporal [SCENE...] [-w W -h H] [--frames N] [--spp REF] [--png PREFIX] (issue 36):
+ * default the Cornell box of ../shared/testdata (skipped with a note when absent) and the demo. */
+static int cmd_bench_temporal(int argc, char **argv)
+{
+    uint32_t w = 0, h = 0, frames = 60, ref = 256;
+    const char *png = NULL;
+    enum { OPT_PNG = 0x400 };
+    static const struct option lo[] = {{"frames", required_argument, NULL, OPT_FRAMES},
+                                       {"spp", required_argument, NULL, OPT_SPP},
+                                       {"png", required_argument, NULL, OPT_PNG}, COMMON_OPTIONS};
+    int c, status = 0;
+    optind = 0;
+    while ((c = sy_cli_next_sized_option("bench temporal", argc, argv, SHORT_OPTIONS("w:h:"), lo, 8, &w, &h, &status)) != -1) {
+        switch (c) {
+        case OPT_STOP: return status;
+        case OPT_FRAMES:
+            if (!sy_cli_parse_u32(optarg, 2, 100000, &frames)) return sy_cli_bad_value("--frames", optarg);
+            break;
+        case OPT_SPP:
+            if (!sy_cli_parse_u32(optarg, 1, 1u << 20, &ref)) return sy_cli_bad_value("--spp", optarg);
+            break;
+        case OPT_PNG: png = optarg; break;
+        }
+    }
+    static const char *const defaults[] = {"../shared/testdata/cornell/cornell_box.gltf", "demo"};
+    const char *const *scenes = optind < argc ? (const char *const *)argv + optind : defaults;
+    int count = optind < argc ? argc - optind : 2;
+    for (int i = 0; i < count; ++i) {
+        struct stat sst;
+        if (scenes == defaults && i == 0 && stat(scenes[i], &sst) != 0) {
+            printf("%s: absent (../shared/testdata), skipped\n", scenes[i]);
+            continue;
+        }
+        sy_error err = {0};
+        loaded ld;
+        if (sy_cli_load(scenes[i], NULL, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
+        sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .background = ld.background, .backend = "pathtracer"};
+        char prefix[1024];
+        if (png) snprintf(prefix, sizeof prefix, "%s_%d", png, i);
+        sy_result r = sy_bench_temporal(ld.scene, &vd, scenes[i], w ? w : 160, h ? h : 90, frames, ref,
+                                        png ? prefix : NULL, &err);
+        sy_cli_loaded_free(&ld);
+        if (r != SY_OK) return sy_cli_fail(&err);
+    }
+    return 0;
+}
+
 /* sy bench KIND ...: argv[0] is "bench", argv[1] the kind. */
 int sy_cmd_bench(int argc, char **argv)
 {
     static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
                                         "viewports", "load", "cluster",    "memory", "instances", "governor",
-                                        "limit",     "cull", "web", "deform", "lights"};
+                                        "limit",     "cull", "web", "deform", "lights", "temporal"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -111,6 +159,7 @@ int sy_cmd_bench(int argc, char **argv)
     const char *cmd = argv[1]; /* the benchmark */
     argc -= 1, argv += 1; /* argv[0]: the kind */
     if (!strcmp(cmd, "filters")) return cmd_bench_filters(argc, argv);
+    if (!strcmp(cmd, "temporal")) return cmd_bench_temporal(argc, argv);
     if (!strcmp(cmd, "cluster")) return sy_cmd_bench_cluster(argc, argv);
     if (!strcmp(cmd, "governor")) return sy_cmd_bench_governor(argc, argv); /* sy_bench_governor.c */
     if (!strcmp(cmd, "limit")) return sy_cmd_bench_limit(argc, argv); /* apps/sy/sy_bench_limit.c */

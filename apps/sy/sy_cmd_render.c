@@ -470,6 +470,7 @@ int sy_cmd_render(int argc, char **argv)
     const char *scene = NULL, *backend = NULL, *outp = NULL, *camera = NULL, *params = NULL;
     const char *gl_provider = NULL;
     const char *filter = NULL, *threshold = NULL; /* --filter / --threshold (path tracer) */
+    bool temporal = false;                        /* --temporal (path tracer, a sequence) */
     const char *overlay = NULL, *composite = "depth";
     uint32_t w = 0, h = 0;
     out_opts oo = {.png = {.tonemap = SY_TONEMAP_DISPLAY}}; /* the library's display tone map */
@@ -493,6 +494,7 @@ int sy_cmd_render(int argc, char **argv)
         SY_CLI_OPT_TEXT("gl", OPT_GL, &gl_provider),          /* raster: gl=... parameter */
         SY_CLI_OPT_TEXT("filter", OPT_FILTER, &filter),       /* pathtracer: filter=... */
         SY_CLI_OPT_TEXT("threshold", OPT_THRESHOLD, &threshold), /* pathtracer: threshold=... */
+        SY_CLI_OPT_FLAG("temporal", OPT_TEMPORAL, &temporal),     /* pathtracer: temporal=1 (a moving camera's frames) */
         SY_CLI_OPT_FLAG("half", OPT_HALF, &oo.half), SY_CLI_OPT_FLOAT("exposure", OPT_EXPOSURE, &oo.png.exposure_stops, -FLT_MAX, FLT_MAX),
         SY_CLI_OPT_CODE("tonemap", OPT_TONEMAP, true), SY_CLI_OPT_CODE("stereo", OPT_STEREO, true),
         SY_CLI_OPT_FLOAT_ANY("eye-sep", OPT_EYE_SEP, &spec.eye_separation), /* the range: sy_compose says why */
@@ -565,6 +567,7 @@ int sy_cmd_render(int argc, char **argv)
     if (seq && !video && (!outp || !strchr(outp, '#')))
         return sy_cli_usage_of("render", "--frames needs -o with a run of '#' for the frame number (out_####.png)");
     if (seq && clo.frames) return sy_cli_usage_of("render", "--frames and --repeat: one or the other");
+    if (temporal && !seq) return sy_cli_usage_of("render", "--temporal belongs to --frames A:B (a moving camera's frames)");
     if (seq && strlen(outp) > 4000) return sy_cli_usage_of("render", "-o: the frames' path is too long");
     bool frames_mode = clo.cluster && clo.mode && !strcmp(clo.mode, "frames");
     if (frames_mode && !seq)
@@ -589,6 +592,12 @@ int sy_cmd_render(int argc, char **argv)
     if (gl_provider) params = render_gl_params(params, gl_provider, gl_params, sizeof gl_params);
     char filter_params[512];
     if (filter || threshold) params = render_filter_params(params, filter, threshold, filter_params, sizeof filter_params);
+    char temporal_params[540]; /* filter_params + ",temporal=1" */
+    if (temporal) { /* --temporal: the path tracer's temporal=1 (a frame whose camera moved reuses the last) */
+        snprintf(temporal_params, sizeof temporal_params, "%s%stemporal=1", params ? params : "",
+                 params && *params ? "," : "");
+        params = temporal_params;
+    }
     char memory_params[600];
     if (max_memory_mb) { /* --max-memory MB: the back-end's declared memory limit (max_memory_mb) */
         const sy_mediator_class *mc = sy_mediator_find(backend);
@@ -652,6 +661,11 @@ int sy_cmd_render(int argc, char **argv)
         sy_log(SY_LOG_ERROR, "sy", NULL, "--clip: back-end %s%s cannot cut with section planes (sy backends lists those with 'clip')",
                remote, clo.cluster ? " on the cluster" : "");
         return 2;
+    }
+    if (temporal && !(caps & SY_CAP_FILTERS)) {
+        sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--temporal needs a back-end with display filters, such as a "
+                     "local -b pathtracer (got -b %s%s)", remote, clo.cluster ? " with --cluster" : "");
+        return sy_cli_fail(&err);
     }
     if ((filter || threshold) && !(caps & SY_CAP_FILTERS)) {
         sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "--filter and --threshold need a back-end with display filters, "

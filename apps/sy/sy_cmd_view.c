@@ -19,6 +19,7 @@ int sy_cmd_view(int argc, char **argv)
     const char *view_filter = NULL; /* --filter: initial path tracer display filter */
     float view_threshold = 0.0f;    /* --threshold (0 = default) */
     const char *view_keys = NULL;   /* --keys: scripted key presses (tests) */
+    bool no_temporal = false;       /* --no-temporal */
     uint32_t w = 960, h = 540, frames = 0;
     sy_cluster_cli_opts clo = {0}; /* --cluster ... (sy_cluster_cli.c; --frames is the viewer's own) */
     double budget = 0.0;
@@ -30,7 +31,8 @@ int sy_cmd_view(int argc, char **argv)
         SY_CLI_OPT_FLOAT_ANY("threshold", OPT_THRESHOLD, &view_threshold), /* the range: sy_view_run says why */
         SY_CLI_OPT_TEXT("keys", OPT_KEYS, &view_keys),
         SY_CLI_OPT_UINT("spp", OPT_SPP, &clo.samples, 1, 100000000u), /* cluster: samples per server and frame */
-        SY_CLI_OPT_REAL("budget", OPT_BUDGET, &budget, 1.0, 10000.0)}; /* the frame-time governor's budget (ms) */
+        SY_CLI_OPT_REAL("budget", OPT_BUDGET, &budget, 1.0, 10000.0), /* the frame-time governor's budget (ms) */
+        SY_CLI_OPT_FLAG("no-temporal", OPT_NO_TEMPORAL, &no_temporal)}; /* no temporal reuse on moving frames */
     sy_cli_parser p = {SY_CLI_ARGS("view", argc, argv, opts), .w = &w, .h = &h, .min_size = 16, .cluster = true,
                        .view = true};
     int c, status;
@@ -51,6 +53,7 @@ int sy_cmd_view(int argc, char **argv)
     va.filter = view_filter;
     va.threshold = view_threshold;
     va.keys = view_keys;
+    va.no_temporal = no_temporal;
     va.budget_ms = budget;
     va.cluster = clo.cluster ? &clo : NULL;
     va.spec.root = ld.root;

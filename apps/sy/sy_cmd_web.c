@@ -25,13 +25,14 @@ int sy_cmd_web(int argc, char **argv)
     uint32_t w = 1920, h = 1200, quality = 80, delay_ms = 0;
     float threshold = 0.0f;
     double budget = 0; /* 0: the governor's default (33 ms) */
-    bool client_render = false;
+    bool client_render = false, no_temporal = false;
     const sy_cli_opt opts[] = {
         SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera),
         SY_CLI_OPT_TEXT("listen", OPT_WEB_LISTEN, &listen), SY_CLI_OPT_UINT("quality", OPT_WEB_QUALITY, &quality, 1, 100),
         SY_CLI_OPT_TEXT("filter", OPT_FILTER, &filter), SY_CLI_OPT_FLOAT("threshold", OPT_THRESHOLD, &threshold, 0, FLT_MAX),
         SY_CLI_OPT_REAL("budget", OPT_BUDGET, &budget, 1.0, 10000.0), /* the frame-time governor's budget (ms) */
         SY_CLI_OPT_FLAG("client-render", OPT_WEB_CLIENT_RENDER, &client_render),
+        SY_CLI_OPT_FLAG("no-temporal", OPT_NO_TEMPORAL, &no_temporal),
         SY_CLI_OPT_UINT("delay-ms", OPT_WEB_DELAY, &delay_ms, 0, 10000)}; /* tests only: added network delay each way */
     sy_cli_parser p = {SY_CLI_ARGS("web", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .view = true};
     if (sy_cli_parse(&p) != -1) return p.status;
@@ -43,7 +44,8 @@ int sy_cmd_web(int argc, char **argv)
     if (sy_cli_load(scene, camera, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
     sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,
                      .backend = backend, .listen = listen, .max_width = w, .max_height = h, .quality = (int)quality,
-                     .filter = filter, .threshold = threshold, .budget_ms = budget, .delay_ms = delay_ms};
+                     .filter = filter, .threshold = threshold, .budget_ms = budget, .delay_ms = delay_ms,
+                     .no_temporal = no_temporal};
     sy_web *web = NULL;
     sy_result r = SY_OK;
 #ifdef SY_WEB_HAVE_CULL

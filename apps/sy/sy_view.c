@@ -348,6 +348,7 @@ static void *render_main(void *p)
     char fstatus[96] = "";
     sy_interactive *ia = NULL; /* the governor, the display filter (sy_interactive.h) */
     if (sy_interactive_create(a->budget_ms, &ia, &err) != SY_OK) goto fail_unlocked;
+    sy_interactive_set_temporal(ia, !a->no_temporal);
     /* what the last planned frame showed besides the view, back-end and size: a difference is a
      * view change for the governor */
     uint32_t prev_stereo = 0, prev_w = 0;

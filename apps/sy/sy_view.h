@@ -49,6 +49,7 @@ typedef struct sy_view_args {
     const char *filter;     /* initial path tracer display filter (NULL = "none"): none, pixel, atrous,
                                jbu or adaptive; anything else is refused before a window opens */
     float threshold;        /* its initial threshold (0 = the default 0.01; must be >= 0) */
+    bool no_temporal;       /* no temporal reuse on moving frames (sy_interactive_set_temporal) */
     const char *keys;       /* automated runs: keys pressed one at a time through the keyboard handler,
                                each once the frame answering the previous one is shown (letters, digits,
                                [ ], space, .); the heads-up line after each is printed; --frames counts after

@@ -93,6 +93,7 @@ typedef struct sy_web_desc {
     uint32_t idle_timeout_s;  /**< a silent WebSocket is pinged, then closed after twice this (default 30) */
     const char *filter;       /**< initial display filter of a back-end with SY_CAP_FILTERS (NULL: none) */
     float threshold;          /**< its threshold (0: 0.01) */
+    bool no_temporal;         /**< no temporal reuse on moving frames (sy_interactive_set_temporal) */
     uint64_t still_max_pixels; /**< a still's W x H at most (default 4194304, 2048 x 2048), per request
                                     and per client address (its queued and rendering stills together) */
     uint32_t still_deadline_ms; /**< a still not started within this (it waits behind the live view) is

@@ -291,6 +291,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
     if (r == SY_OK) r = sy_window_create(64, 64, &rs.still_win, err);
     if (r == SY_OK) r = sy_window_add_viewport(rs.still_win, &vd, &rs.still_vp, err);
     if (r == SY_OK) r = sy_interactive_create(w->d.budget_ms, &rs.ia, err);
+    if (r == SY_OK) sy_interactive_set_temporal(rs.ia, !w->d.no_temporal);
     rs.backend_applied = w->initial_backend;
     uint64_t seen = 0;
     bool again = false;    /* plan again without waiting for input */

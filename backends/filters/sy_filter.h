@@ -7,8 +7,8 @@
  * The library is standalone: it never includes core/, mediators/, formats/, apps/ or another
  * back-end's headers. Filters: pixel filtering (sy_filter_pixel.h, Schwenk 2013 ch. 3), radiance
  * filtering (sy_filter_radiance.h, ch. 4), edge-avoiding a-trous (sy_filter_atrous.h), joint
- * bilateral upsampling (sy_filter_jbu.h), adaptive-resolution preview (sy_filter_adaptive.h), and
- * image metrics (sy_filter_metrics.h). Implementation notes: ../shared/notes/filters-spec.md.
+ * bilateral upsampling (sy_filter_jbu.h), adaptive-resolution preview (sy_filter_adaptive.h),
+ * temporal reuse for moving frames (sy_filter_temporal.h), and image metrics (sy_filter_metrics.h). Implementation notes: ../shared/notes/filters-spec.md.
  *
  * Conventions (as backends/rt): image row 0 is the top row; colour is linear Rec.709 RGB
  * radiance; RGBA colour is premultiplied (filters treat RGB linearly and pass alpha through);

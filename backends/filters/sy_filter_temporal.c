@@ -24,7 +24,7 @@ typedef struct hist {
     size_t cap;  /* pixels allocated */
     float *illum; /* 3: demodulated indirect part (or colour) after the first a-trous pass */
     float *dir;   /* 3: demodulated direct part (0 without the split) */
-    float *mom;   /* 2: luminance moments */
+    float *mom;   /* 4: luminance moments of the indirect part (or colour), then of the direct part */
     float *len;   /* 1: history length (frames); 0 = nothing to reuse (miss, bad pixel) */
     float *pos;   /* 3: world position */
     float *nrm;   /* 3: normal */
@@ -37,8 +37,13 @@ struct sy_filter_temporal {
     int prev;      /* index of the previous frame's history in h */
     bool have_prev;
     size_t cap;    /* pixels of the working buffers */
-    float *illum, *mod, *lum, *acc, *var, *a, *b, *va, *vb, *zgrad, *vbl, *lacc, *la, *lb;
-    float *dcur, *dacc; /* the direct part: new samples, blended (temporal only, never filtered) */
+    float *illum, *mod, *lum, *zgrad, *vbl;
+    float *dcur; /* the direct part's new samples (0 without the split) */
+    /* the blended part, its variance and luminance, and the a-trous ping-pong buffers: [0] the
+     * indirect part (or the colour), [1] the direct part */
+    struct plane {
+        float *acc, *var, *lacc, *a, *b, *va, *vb, *la, *lb;
+    } pl[2];
     uint8_t *ok, *hit; /* hit: 0 = none (miss, bad pixel), 1 = a hit without a normal, 2 = with one */
 };
 
@@ -98,7 +103,7 @@ static bool hist_reserve(hist *h, size_t n)
 {
     if (n <= h->cap) return true;
     hist_free(h);
-    h->illum = malloc(3 * n * sizeof(float)), h->dir = malloc(3 * n * sizeof(float)), h->mom = malloc(2 * n * sizeof(float));
+    h->illum = malloc(3 * n * sizeof(float)), h->dir = malloc(3 * n * sizeof(float)), h->mom = malloc(4 * n * sizeof(float));
     h->len = malloc(n * sizeof(float)), h->pos = malloc(3 * n * sizeof(float)), h->nrm = malloc(3 * n * sizeof(float));
     if (!h->illum || !h->dir || !h->mom || !h->len || !h->pos || !h->nrm) {
         hist_free(h);
@@ -110,12 +115,15 @@ static bool hist_reserve(hist *h, size_t n)
 
 static void work_free(sy_filter_temporal *t)
 {
-    free(t->illum), free(t->mod), free(t->lum), free(t->acc), free(t->var), free(t->a), free(t->b), free(t->va);
-    free(t->vb), free(t->zgrad), free(t->ok), free(t->hit), free(t->vbl), free(t->lacc), free(t->la), free(t->lb);
-    free(t->dcur), free(t->dacc);
-    t->dcur = t->dacc = NULL;
-    t->illum = t->mod = t->lum = t->acc = t->var = t->a = t->b = t->va = t->vb = t->zgrad = NULL;
-    t->vbl = t->lacc = t->la = t->lb = NULL;
+    free(t->illum), free(t->mod), free(t->lum), free(t->zgrad), free(t->vbl), free(t->dcur);
+    t->illum = t->mod = t->lum = t->zgrad = t->vbl = t->dcur = NULL;
+    for (int k = 0; k < 2; ++k) {
+        struct plane *q = &t->pl[k];
+        free(q->acc), free(q->var), free(q->lacc), free(q->a), free(q->b), free(q->va), free(q->vb), free(q->la);
+        free(q->lb);
+        memset(q, 0, sizeof *q);
+    }
+    free(t->ok), free(t->hit);
     t->ok = t->hit = NULL;
     t->cap = 0;
 }
@@ -125,13 +133,15 @@ static bool work_reserve(sy_filter_temporal *t, size_t n)
     if (n <= t->cap) return true;
     work_free(t);
     size_t f3 = 3 * n * sizeof(float), f1 = n * sizeof(float);
-    t->illum = malloc(f3), t->mod = malloc(f3), t->acc = malloc(f3), t->a = malloc(f3), t->b = malloc(f3);
-    t->lum = malloc(f1), t->var = malloc(f1), t->va = malloc(f1), t->vb = malloc(f1), t->zgrad = malloc(f1);
-    t->vbl = malloc(f1), t->lacc = malloc(f1), t->la = malloc(f1), t->lb = malloc(f1);
-    t->dcur = malloc(f3), t->dacc = malloc(f3);
-    t->ok = malloc(n), t->hit = malloc(n);
-    if (!t->illum || !t->mod || !t->acc || !t->a || !t->b || !t->lum || !t->var || !t->va || !t->vb || !t->zgrad ||
-        !t->ok || !t->hit || !t->vbl || !t->lacc || !t->la || !t->lb || !t->dcur || !t->dacc) {
+    bool ok = (t->illum = malloc(f3)) && (t->mod = malloc(f3)) && (t->dcur = malloc(f3)) && (t->lum = malloc(f1)) &&
+              (t->zgrad = malloc(f1)) && (t->vbl = malloc(f1)) && (t->ok = malloc(n)) && (t->hit = malloc(n));
+    for (int k = 0; k < 2 && ok; ++k) {
+        struct plane *q = &t->pl[k];
+        ok = (q->acc = malloc(f3)) && (q->a = malloc(f3)) && (q->b = malloc(f3)) && (q->var = malloc(f1)) &&
+             (q->lacc = malloc(f1)) && (q->va = malloc(f1)) && (q->vb = malloc(f1)) && (q->la = malloc(f1)) &&
+             (q->lb = malloc(f1));
+    }
+    if (!ok) {
         work_free(t);
         return false;
     }
@@ -185,10 +195,10 @@ typedef struct tctx {
     const hist *prev; /* NULL: no history */
     hist *next;
     /* a-trous pass */
-    const float *src, *vsrc, *lsrc;
+    const float *src, *vsrc, *lsrc, *srcd;
     float *dst, *vdst, *ldst;
     int step;
-    bool keep; /* this pass's output is the next history's colour */
+    float *keep; /* NULL, or where this pass's output goes (the next history's colour) */
     float *out;
 } tctx;
 
@@ -239,7 +249,7 @@ static inline void from_ycocg(const float *y, float *o)
 /* Bilinear reprojection of world point p (normal n, depth z) into the previous history; false when
  * no tap fits. */
 static bool reproject(const sy_filter_temporal *t, const hist *h, const float *p, const float *n, float z,
-                      float illum[3], float dir[3], float mom[2], float *len)
+                      float illum[3], float dir[3], float mom[4], float *len)
 {
     const float *M = h->world_to_pixel;
     float X = M[0] * p[0] + M[4] * p[1] + M[8] * p[2] + M[12];
@@ -251,7 +261,7 @@ static bool reproject(const sy_filter_temporal *t, const hist *h, const float *p
     int x0 = (int)floorf(x), y0 = (int)floorf(y);
     float fx = x - (float)x0, fy = y - (float)y0;
     float tol = t->p.depth_tolerance * z, tol2 = 64.0f * tol * tol;
-    float sw = 0, acc[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    float sw = 0, acc[11] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
     for (int k = 0; k < 4; ++k) {
         int xx = x0 + (k & 1), yy = y0 + (k >> 1);
         if (xx < 0 || yy < 0 || xx >= (int)h->w || yy >= (int)h->h) continue;
@@ -265,12 +275,13 @@ static bool reproject(const sy_filter_temporal *t, const hist *h, const float *p
         float wk = ((k & 1) ? fx : 1.0f - fx) * ((k >> 1) ? fy : 1.0f - fy);
         if (!(wk > 0.0f)) continue;
         for (int q = 0; q < 3; ++q) acc[q] += wk * h->illum[3 * j + q], acc[6 + q] += wk * h->dir[3 * j + q];
-        acc[3] += wk * h->mom[2 * j], acc[4] += wk * h->mom[2 * j + 1], acc[5] += wk * h->len[j];
+        acc[3] += wk * h->mom[4 * j], acc[4] += wk * h->mom[4 * j + 1], acc[5] += wk * h->len[j];
+        acc[9] += wk * h->mom[4 * j + 2], acc[10] += wk * h->mom[4 * j + 3];
         sw += wk;
     }
     if (!(sw > 1e-3f)) return false;
     for (int q = 0; q < 3; ++q) illum[q] = acc[q] / sw, dir[q] = acc[6 + q] / sw;
-    mom[0] = acc[3] / sw, mom[1] = acc[4] / sw, *len = acc[5] / sw;
+    mom[0] = acc[3] / sw, mom[1] = acc[4] / sw, mom[2] = acc[9] / sw, mom[3] = acc[10] / sw, *len = acc[5] / sw;
     return true;
 }
 
@@ -296,22 +307,27 @@ static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
     const sy_filter_temporal_params *P = &t->p;
     int w = (int)in->width, hgt = (int)in->height;
     hist *nx = c->next;
+    struct plane *pi = &t->pl[0], *pd = &t->pl[1];
     for (int y = (int)y0; y < (int)y1; ++y)
         for (int x = 0; x < w; ++x) {
             size_t i = (size_t)y * w + x;
-            float *acc = t->acc + 3 * i;
+            float *acc = pi->acc + 3 * i, *da = pd->acc + 3 * i;
+            const float *cur = t->illum + 3 * i, *dc = t->dcur + 3 * i;
             if (!t->hit[i]) {
-                memcpy(acc, t->illum + 3 * i, 3 * sizeof(float));
-                memcpy(t->dacc + 3 * i, t->dcur + 3 * i, 3 * sizeof(float));
-                t->var[i] = 0.0f, t->zgrad[i] = 0.0f, t->lacc[i] = t->lum[i];
-                nx->len[i] = 0.0f, nx->mom[2 * i] = nx->mom[2 * i + 1] = 0.0f;
+                memcpy(acc, cur, 3 * sizeof(float));
+                memcpy(da, dc, 3 * sizeof(float));
+                pi->var[i] = pd->var[i] = 0.0f, t->zgrad[i] = 0.0f;
+                pi->lacc[i] = t->lum[i], pd->lacc[i] = sy_filter_luminance(dc);
+                nx->len[i] = 0.0f;
+                for (int q = 0; q < 4; ++q) nx->mom[4 * i + q] = 0.0f;
                 for (int q = 0; q < 3; ++q) nx->pos[3 * i + q] = nx->nrm[3 * i + q] = 0.0f;
                 continue;
             }
             float z = in->depth[i];
             const float *p = in->position + 3 * i, *n = in->normal + 3 * i;
-            /* 3x3 neighbourhood of the new samples: YCoCg box, luminance moments, depth gradient */
-            float m1[3] = {0, 0, 0}, m2[3] = {0, 0, 0}, d1[3] = {0, 0, 0}, d2[3] = {0, 0, 0}, l1 = 0, l2 = 0, cnt = 0, zg = 0;
+            /* 3x3 neighbourhood of the new samples: YCoCg boxes, luminance moments, depth gradient */
+            float m1[3] = {0, 0, 0}, m2[3] = {0, 0, 0}, d1[3] = {0, 0, 0}, d2[3] = {0, 0, 0};
+            float l1 = 0, l2 = 0, e1 = 0, e2 = 0, cnt = 0, zg = 0;
             for (int dy = -1; dy <= 1; ++dy) {
                 int yy = y + dy;
                 if (yy < 0 || yy >= hgt) continue;
@@ -325,40 +341,39 @@ static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
                     for (int q = 0; q < 3; ++q) m1[q] += v[q], m2[q] += v[q] * v[q];
                     to_ycocg(t->dcur + 3 * j, v);
                     for (int q = 0; q < 3; ++q) d1[q] += v[q], d2[q] += v[q] * v[q];
-                    l1 += t->lum[j], l2 += t->lum[j] * t->lum[j];
+                    float lj = t->lum[j], ej = sy_filter_luminance(t->dcur + 3 * j);
+                    l1 += lj, l2 += lj * lj, e1 += ej, e2 += ej * ej;
                     cnt += 1.0f;
                     if ((dx == 0) != (dy == 0)) zg = fmx(zg, fabsf(in->depth[j] - z));
                 }
             }
             t->zgrad[i] = zg;
             float ic = 1.0f / cnt;
-            float hi[3] = {0, 0, 0}, hd[3] = {0, 0, 0}, hm[2] = {0, 0}, hl = 0.0f;
+            float hi[3] = {0, 0, 0}, hd[3] = {0, 0, 0}, hm[4] = {0, 0, 0, 0}, hl = 0.0f;
             bool reused = c->prev && reproject(t, c->prev, p, n, z, hi, hd, hm, &hl);
             if (reused && P->clamp_gamma > 0.0f) {
                 clamp_box(hi, m1, m2, ic, P->clamp_gamma);
                 clamp_box(hd, d1, d2, ic, P->clamp_gamma);
             }
-            const float *cur = t->illum + 3 * i;
-            float l = t->lum[i];
             if (!reused) hl = 0.0f;
-            float a = fmx(P->alpha, 1.0f / (hl + 1.0f)), am = fmx(P->alpha_moments, 1.0f / (hl + 1.0f));
-            if (!reused) a = am = 1.0f;
-            const float *dc = t->dcur + 3 * i;
-            float *da = t->dacc + 3 * i;
+            float a = reused ? fmx(P->alpha, 1.0f / (hl + 1.0f)) : 1.0f;
+            float am = reused ? fmx(P->alpha_moments, 1.0f / (hl + 1.0f)) : 1.0f;
             for (int q = 0; q < 3; ++q) {
-                acc[q] = reused ? hi[q] + a * (cur[q] - hi[q]) : cur[q];
-                da[q] = reused ? hd[q] + a * (dc[q] - hd[q]) : dc[q];
+                acc[q] = hi[q] + a * (cur[q] - hi[q]);
+                da[q] = hd[q] + a * (dc[q] - hd[q]);
             }
-            float mo0 = reused ? hm[0] + am * (l - hm[0]) : l;
-            float mo1 = reused ? hm[1] + am * (l * l - hm[1]) : l * l;
+            float l = t->lum[i], e = sy_filter_luminance(dc);
+            float mo[4] = {hm[0] + am * (l - hm[0]), hm[1] + am * (l * l - hm[1]), hm[2] + am * (e - hm[2]),
+                           hm[3] + am * (e * e - hm[3])};
             float len = fmn(hl + 1.0f, (float)P->max_history);
-            nx->mom[2 * i] = mo0, nx->mom[2 * i + 1] = mo1, nx->len[i] = len;
-            t->lacc[i] = sy_filter_luminance(acc);
+            for (int q = 0; q < 4; ++q) nx->mom[4 * i + q] = mo[q];
+            nx->len[i] = len;
+            pi->lacc[i] = sy_filter_luminance(acc), pd->lacc[i] = sy_filter_luminance(da);
             if (len < 4.0f) { /* short history: the spatial variance of the new samples */
-                float mu = l1 * ic;
-                t->var[i] = fmx(0.0f, l2 * ic - mu * mu);
+                float mu = l1 * ic, me = e1 * ic;
+                pi->var[i] = fmx(0.0f, l2 * ic - mu * mu), pd->var[i] = fmx(0.0f, e2 * ic - me * me);
             } else {
-                t->var[i] = fmx(0.0f, mo1 - mo0 * mo0);
+                pi->var[i] = fmx(0.0f, mo[1] - mo[0] * mo[0]), pd->var[i] = fmx(0.0f, mo[3] - mo[2] * mo[2]);
             }
             memcpy(nx->pos + 3 * i, p, 3 * sizeof(float));
             memcpy(nx->nrm + 3 * i, n, 3 * sizeof(float));
@@ -450,7 +465,7 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
                 c->vdst[i] = V * iw * iw;
                 c->ldst[i] = sy_filter_luminance(o);
             }
-            if (c->keep) memcpy(c->next->illum + 3 * i, o, 3 * sizeof(float));
+            if (c->keep) memcpy(c->keep + 3 * i, o, 3 * sizeof(float));
         }
 }
 
@@ -462,7 +477,7 @@ static void remod_rows(void *vc, uint32_t y0, uint32_t y1)
     size_t w = in->width, cc = in->color_channels;
     for (size_t i = (size_t)y0 * w; i < (size_t)y1 * w; ++i) {
         float *o = c->out + 4 * i;
-        for (int q = 0; q < 3; ++q) o[q] = (c->src[3 * i + q] + t->dacc[3 * i + q]) * t->mod[3 * i + q];
+        for (int q = 0; q < 3; ++q) o[q] = (c->src[3 * i + q] + c->srcd[3 * i + q]) * t->mod[3 * i + q];
         o[3] = cc == 4 && isfinite(in->color[4 * i + 3]) ? in->color[4 * i + 3] : 1.0f;
     }
 }
@@ -496,19 +511,31 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
     uint32_t th = t->p.threads, rows = in->height;
     sy_filter_parallel_rows(th, rows, demod_rows, &c);
     sy_filter_parallel_rows(th, rows, integrate_rows, &c);
-    const float *src = t->acc, *vsrc = t->var, *lsrc = t->lacc;
-    if (t->p.atrous_iterations == 0) memcpy(nx->illum, t->acc, 3 * n * sizeof(float));
-    for (uint32_t it = 0; it < t->p.atrous_iterations; ++it) {
-        c.src = src, c.vsrc = vsrc, c.lsrc = lsrc;
-        c.dst = (it & 1) ? t->b : t->a, c.vdst = (it & 1) ? t->vb : t->va, c.ldst = (it & 1) ? t->lb : t->la;
-        c.step = 1 << it, c.keep = it == 0;
-        sy_filter_parallel_rows(th, rows, vblur_rows, &c);
-        sy_filter_parallel_rows(th, rows, atrous_rows, &c);
-        src = c.dst, vsrc = c.vdst, lsrc = c.ldst;
+    /* the a-trous passes: the indirect part (or the colour), then the direct part when split */
+    bool split = in->direct && in->indirect;
+    const float *out_part[2] = {t->pl[0].acc, t->pl[1].acc};
+    float *keep[2] = {nx->illum, nx->dir};
+    for (int k = 0; k < 2; ++k) {
+        struct plane *q = &t->pl[k];
+        const float *src = q->acc, *vsrc = q->var, *lsrc = q->lacc;
+        uint32_t iters = k == 0 || split ? t->p.atrous_iterations : 0;
+        /* the next history: the first pass's output for the indirect part (as SVGF); the direct part's
+         * unfiltered blend (fed back, its filtered output let emitter light creep over their edges
+         * frame after frame: Cornell box relMSE 0.077 against 0.023, `sy bench temporal`, 16 frames) */
+        bool feed = k == 0;
+        if (iters == 0 || !feed) memcpy(keep[k], q->acc, 3 * n * sizeof(float));
+        for (uint32_t it = 0; it < iters; ++it) {
+            c.src = src, c.vsrc = vsrc, c.lsrc = lsrc;
+            c.dst = (it & 1) ? q->b : q->a, c.vdst = (it & 1) ? q->vb : q->va, c.ldst = (it & 1) ? q->lb : q->la;
+            c.step = 1 << it, c.keep = it == 0 && feed ? keep[k] : NULL;
+            sy_filter_parallel_rows(th, rows, vblur_rows, &c);
+            sy_filter_parallel_rows(th, rows, atrous_rows, &c);
+            src = c.dst, vsrc = c.vdst, lsrc = c.ldst;
+        }
+        out_part[k] = src;
     }
-    c.src = src;
+    c.src = out_part[0], c.srcd = out_part[1];
     sy_filter_parallel_rows(th, rows, remod_rows, &c);
-    memcpy(nx->dir, t->dacc, 3 * n * sizeof(float));
     nx->w = in->width, nx->h = in->height;
     memcpy(nx->world_to_pixel, world_to_pixel, sizeof nx->world_to_pixel);
     t->prev = 1 - t->prev;

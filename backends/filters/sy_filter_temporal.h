@@ -4,7 +4,9 @@
  * path tracer's accumulation right after a camera move restarted it) with their feature buffers,
  * reprojects the history kept from the previous call to this frame's camera, rejects history that
  * does not belong to the same surface or no longer fits the new samples, blends, and filters the
- * result with a variance-guided edge-avoiding a-trous filter. The output is an estimate for display
+ * result with a variance-guided edge-avoiding a-trous filter. A pixel without a normal (0, 0, 0:
+ * a specular chain that reached no diffuse surface) is reprojected onto and filtered with such
+ * pixels only. The output is an estimate for display
  * while the view moves; once the camera rests, the caller shows its own accumulation instead
  * (the path tracer's mediator does), so a still, converged image is never changed.
  *
@@ -22,7 +24,7 @@
  *      (history length up to max_history), the same for the first and second moments of luminance;
  *      their difference is the temporal variance, replaced by the 3x3 spatial variance while the
  *      history is shorter than 4 frames.
- *   4. a-trous: atrous_iterations passes of a 3x3 B-spline kernel with taps 2^k apart, weights
+ *   4. a-trous (the indirect part when the split is given): atrous_iterations passes of a 3x3 B-spline kernel with taps 2^k apart, weights
  *      exp(-|l_i - l_j| / (sigma_luminance sqrt(blurred variance_i)) - |z_i - z_j| / (sigma_depth
  *      step |grad z_i|) - sigma_normal (1 - n_i.n_j)), the variance filtered with the squared
  *      weights; the output of the first pass becomes the next frame's history (as SVGF).
@@ -30,15 +32,18 @@
  * in the history (the pixel shows its own colour, or 0).
  *
  * Inputs (sy_filter_frame): color (3 or 4 channels; alpha passed through), albedo, normal, depth,
- * position (required: world positions as sy_filter_position_from_depth gives them); variance and
- * the split are not used. world_to_pixel: the frame's camera as a 4x4 column-major matrix taking a
+ * position (required: world positions as sy_filter_position_from_depth gives them); direct and
+ * indirect (optional, both or neither): then only the indirect part goes through the a-trous filter
+ * and the direct part (emission seen directly and direct light, far less noisy per sample) is
+ * reprojected, clamped and blended but never filtered, so emitters and shadow edges stay sharp;
+ * without them the whole colour is filtered. variance is not used (the moments are the filter's). world_to_pixel: the frame's camera as a 4x4 column-major matrix taking a
  * homogeneous world point to (x w, y w, *, w), where (x, y) are continuous pixel coordinates of this
  * frame (pixel (x, y) covers [x, x+1) x [y, y+1), row 0 at the top) and w > 0 in front of the
  * camera (perspective: the camera-axis distance; orthographic: 1). Frames may change size from call
  * to call (an interactive view's resolution scale): the history is read at its own size.
  *
- * Ownership: a sy_filter_temporal is the caller's (create / destroy); it holds the history (about
- * 100 bytes per pixel). Thread-safety: one thread at a time per object; the passes run on the
+ * Ownership: a sy_filter_temporal is the caller's (create / destroy); it holds two frames of history
+ * and its working buffers (about 240 bytes per pixel). Thread-safety: one thread at a time per object; the passes run on the
  * process's OpenMP team (sy_filter_parallel_rows); results do not depend on the thread count. */
 #ifndef SY_FILTER_TEMPORAL_H
 #define SY_FILTER_TEMPORAL_H

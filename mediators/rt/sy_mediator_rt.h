@@ -120,6 +120,11 @@ typedef struct sy_mediator_rt_filter_info {
     double mean_blend;          /**< pixel: mean blend factor s (1 = unfiltered everywhere); radiance:
                                    share of pixels in the correction phase (plain path tracing) */
     uint32_t last_pass_samples; /**< pixel: sample count of the last filter pass (0 = none yet) */
+    bool temporal;              /**< the "temporal" parameter: reuse on frames whose camera moved */
+    bool temporal_last;         /**< the last render showed the temporal estimate (its camera moved) */
+    uint64_t temporal_frames;   /**< frames that showed the temporal estimate so far */
+    double temporal_seconds;    /**< the last such frame's temporal stage (AOV read + filter), wall time */
+    double temporal_reused;     /**< the last such frame: share of hit pixels with a reprojected history */
 } sy_mediator_rt_filter_info;
 /** Fills *out with the context's filter state. */
 void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out);

@@ -5,7 +5,7 @@
 #include <string.h>
 
 /* >>pathtracer accumulation */
-static bool same_view(const sy_camera_view *a, const sy_camera_view *b)
+bool sy_rti_same_view(const sy_camera_view *a, const sy_camera_view *b)
 {
     return !memcmp(a->camera_to_world.m, b->camera_to_world.m, sizeof a->camera_to_world.m) &&
            a->projection == b->projection && !memcmp(a->window, b->window, sizeof a->window) && a->znear == b->znear &&
@@ -24,7 +24,7 @@ sy_result sy_rti_pt_slot(rt_state *st, const sy_render_request *req, sy_error *e
     for (int i = 0; i < ACCUM_SLOTS; ++i) {
         accum_slot *a = &st->slots[i];
         if (a->acc && a->full_w == req->full_width && a->full_h == req->full_height && !memcmp(a->rect, rect, sizeof rect) &&
-            a->bg == req->background_id && a->seed == req->seed && same_view(&a->camera, &req->camera)) {
+            a->bg == req->background_id && a->seed == req->seed && sy_rti_same_view(&a->camera, &req->camera)) {
             found = i;
             break;
         }

@@ -70,6 +70,10 @@ const sy_param_decl sy_rti_pathtracer_params[] = {
     {"rf_specular_limit", SY_PARAM_FLOAT, 0, 1e9, "4096", NULL, "radiance filter: specular limit", LIVE},
     {"rf_unbiased", SY_PARAM_BOOL, 0, 0, "0", NULL,
      "radiance filter: show the plain path-traced mean in the correction phase", LIVE},
+    {"temporal", SY_PARAM_BOOL, 0, 0, "0", NULL,
+     "temporal reuse while the camera moves (sy_filter_temporal.h): a frame whose camera moved since the last "
+     "one shows the reprojected history blended with its samples and a-trous filtered; a still camera shows the "
+     "accumulation unchanged (sy view and sy web turn it on)", LIVE},
 };
 #undef LIVE
 const sy_param_table sy_rti_whitted_table = SY_PARAM_TABLE(sy_rti_whitted_params);

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel", "atrous", "jbu", "adaptive",
                                                                    "radiance"};
@@ -14,7 +15,8 @@ static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel
 /* >>display filters
  * The path tracer's layer can be filtered for display (backends/filters) from the accumulation's
  * feature buffers. Parameters (creation and sy_mediator_rt_set_filter): filter, threshold, sigma_s,
- * sigma_c, sigma_d, filter_kernel, filter_iterations, filter_start, atrous_iterations, jbu_factor. */
+ * sigma_c, sigma_d, filter_kernel, filter_iterations, filter_start, atrous_iterations, jbu_factor,
+ * temporal (temporal reuse on frames whose camera moved: sy_rti_temporal_layer below). */
 /* Every code a filter returns has core's number (the cast in sy_backend_fail). */
 SY_BACKEND_SAME_CODE(SY_FILTER_ERROR_INVALID_ARGUMENT, SY_ERR_INVALID_ARGUMENT);
 SY_BACKEND_SAME_CODE(SY_FILTER_ERROR_OUT_OF_MEMORY, SY_ERR_OUT_OF_MEMORY);
@@ -115,7 +117,8 @@ sy_result sy_rti_filter_cfg_apply(pt_filter_cfg *base, const char *name, const s
         (r = pt_u32(p, all, "filter_iterations", &c.pixel.iterations, err)) ||
         (r = pt_u32(p, all, "filter_start", &c.pixel.schedule_start, err)) ||
         (r = pt_u32(p, all, "atrous_iterations", &c.atrous.iterations, err)) ||
-        (r = pt_u32(p, all, "jbu_factor", &c.jbu.factor, err)) || (r = radiance_cfg_apply(&c.radiance, p, all, err)))
+        (r = pt_u32(p, all, "jbu_factor", &c.jbu.factor, err)) || (r = radiance_cfg_apply(&c.radiance, p, all, err)) ||
+        (r = pt_bool(p, all, "temporal", &c.temporal, err)))
         return r;
     c.pixel.threshold = c.adaptive.threshold = c.radiance.threshold = threshold;
     c.pixel.kernel = fkernel ? SY_FILTER_PIXEL_BRUTE : SY_FILTER_PIXEL_SEPARABLE;
@@ -165,6 +168,10 @@ sy_result sy_mediator_rt_set_filter(void *state, const char *name, const sy_para
     for (int i = 0; i < ACCUM_SLOTS && rf_changed; ++i)
         if (st->slots[i].radiance && (r = sy_radiance_hook_set_params(st->slots[i].radiance, &c.radiance, err)) != SY_OK)
             return r;
+    if (!c.temporal) { /* off: the next time it is turned on starts from nothing */
+        sy_filter_temporal_reset(st->temporal);
+        st->temporal_have_cam = false;
+    }
     st->filter = c;
     return SY_OK;
 }
@@ -175,6 +182,7 @@ void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out
     *out = st->finfo;
     out->name = pt_filter_names[st->filter.kind];
     out->threshold = st->filter.pixel.threshold;
+    out->temporal = st->filter.temporal;
 }
 
 /* World positions of the first hits of the rectangle's pixels from the camera-axis depth (the
@@ -273,5 +281,88 @@ sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_lay
     st->finfo.mean_blend = fs.mean_blend;
     st->finfo.last_pass_samples = a->pass_samples;
     st->finfo.frames++;
+    return SY_OK;
+}
+
+/* >>temporal reuse
+ * The camera of a render request as sy_filter_temporal's world_to_pixel: a homogeneous world point
+ * to (x w, y w, *, w) with (x, y) continuous pixel coordinates of the request's rectangle (row 0 at
+ * the top) and w the camera-axis distance (perspective) or 1 (orthographic). false when the camera
+ * matrix cannot be inverted or the window is empty. */
+static bool world_to_pixel(const sy_render_request *req, float out[16])
+{
+    const sy_camera_view *v = &req->camera;
+    sy_mat4 inv;
+    if (!sy_mat4_invert(&v->camera_to_world, &inv)) return false;
+    float ww = v->window[1] - v->window[0], wh = v->window[3] - v->window[2];
+    if (!(ww != 0.0f && wh != 0.0f)) return false;
+    float sx = (float)req->full_width / ww, sy = (float)req->full_height / wh;
+    float k0 = -v->window[0] * sx - (float)req->rect_x, k1 = v->window[3] * sy - (float)req->rect_y;
+    bool ortho = v->projection == SY_PROJECTION_ORTHOGRAPHIC;
+    for (int col = 0; col < 4; ++col) {
+        const float *V = inv.m + 4 * col; /* V[r] = row r of the world-to-camera matrix, this column */
+        float wv = ortho ? (col == 3 ? 1.0f : 0.0f) : -V[2];
+        out[4 * col + 0] = sx * V[0] + k0 * wv;
+        out[4 * col + 1] = -sy * V[1] + k1 * wv;
+        out[4 * col + 2] = V[2];
+        out[4 * col + 3] = wv;
+    }
+    for (int k = 0; k < 16; ++k)
+        if (!isfinite(out[k])) return false;
+    return true;
+}
+
+sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint32_t samples, sy_layer *layer,
+                                bool *done, sy_error *err)
+{
+    *done = false;
+    st->finfo.temporal_last = false;
+    if (!st->filter.temporal) return SY_OK;
+    bool moved = st->temporal_have_cam && !sy_rti_same_view(&st->temporal_cam, &req->camera);
+    st->temporal_cam = req->camera;
+    st->temporal_have_cam = true;
+    accum_slot *a = &st->slots[st->last_slot];
+    /* a still camera, or an accumulation that kept earlier samples: the accumulation as it is */
+    if (!moved || sy_rt_accum_samples(a->acc) > samples) return SY_OK;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    float m[16];
+    if (!world_to_pixel(req, m)) { /* a degenerate camera: nothing to reproject with */
+        sy_filter_temporal_reset(st->temporal);
+        return SY_OK;
+    }
+    sy_filter_report fe = {0};
+    if (!st->temporal) {
+        sy_filter_temporal_params p;
+        sy_filter_temporal_params_default(&p);
+        p.threads = st->filter.atrous.threads;
+        if (sy_filter_temporal_create(&p, &st->temporal, &fe)) return filter_fail(err, &fe);
+    }
+    sy_result rd = sy_rti_filter_read_aovs(st, a, req, err);
+    if (rd != SY_OK) return rd;
+    filter_positions(req, st->fbuf[SY_RT_AOV_DEPTH], st->fbuf[SY_RT_AOV_COUNT]);
+    sy_filter_frame f = {
+        .width = req->rect_w,
+        .height = req->rect_h,
+        .color_channels = 4,
+        .variance_channels = 3,
+        .color = st->fbuf[SY_RT_AOV_COLOR],
+        .albedo = st->fbuf[SY_RT_AOV_ALBEDO],
+        .normal = st->fbuf[SY_RT_AOV_NORMAL],
+        .depth = st->fbuf[SY_RT_AOV_DEPTH],
+        .position = st->fbuf[SY_RT_AOV_COUNT],
+        .direct = st->fbuf[SY_RT_AOV_DIRECT],
+        .indirect = st->fbuf[SY_RT_AOV_INDIRECT],
+        .spp_uniform = (float)samples,
+    };
+    sy_filter_temporal_stats ts = {0};
+    if (sy_filter_temporal_run(st->temporal, &f, m, layer->rgba, &ts, &fe)) return filter_fail(err, &fe);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    uint64_t hits = ts.reprojected + ts.disoccluded;
+    st->finfo.temporal_last = true;
+    st->finfo.temporal_frames++;
+    st->finfo.temporal_seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    st->finfo.temporal_reused = hits ? (double)ts.reprojected / (double)hits : 0.0;
+    *done = true;
     return SY_OK;
 }

@@ -27,6 +27,7 @@
 #include "sy_filter_atrous.h"
 #include "sy_filter_jbu.h"
 #include "sy_filter_pixel.h"
+#include "sy_filter_temporal.h"
 #include "sy_radiance_hook.h"
 
 #include <stdbool.h>
@@ -66,6 +67,7 @@ typedef struct pt_filter_cfg {
     sy_filter_jbu_params jbu;
     sy_filter_adaptive_params adaptive;
     sy_filter_radiance_params radiance; /* threshold T_u = the shared threshold */
+    bool temporal;                      /* "temporal": reuse on frames whose camera moved */
 } pt_filter_cfg;
 
 /* The scene mirror (textures, materials, meshes, lights, backgrounds, nodes and placements) is
@@ -103,6 +105,11 @@ typedef struct rt_state {
     float *fbuf[SY_RT_AOV_COUNT + 1]; /* filter inputs: the AOV planes + world positions */
     size_t fbuf_px;                /* pixels the fbuf planes hold */
     sy_mediator_rt_filter_info finfo; /* last filtered frame */
+    /* temporal reuse (filter.temporal): one history per context, fed by every path-traced render
+     * whose camera differs from the previous render's (temporal_cam) */
+    sy_filter_temporal *temporal;
+    sy_camera_view temporal_cam;
+    bool temporal_have_cam;
 } rt_state;
 
 /* --- sy_mediator_rt_base.c --- */
@@ -145,12 +152,20 @@ sy_result sy_rti_pick(void *state, const sy_camera_view *view, uint32_t width, u
 /* --- sy_mediator_rt_accum.c --- */
 sy_result sy_rti_pt_slot(rt_state *st, const sy_render_request *req, sy_error *err);
 void sy_rti_pt_restart(void *state); /* sy_context_restart: every slot restarts at its next request */
+/* true when two camera views are the same (matrix, projection, window, planes) */
+bool sy_rti_same_view(const sy_camera_view *a, const sy_camera_view *b);
 
 /* --- sy_mediator_rt_filter.c --- */
 void sy_rti_filter_cfg_default(pt_filter_cfg *c, uint32_t threads);
 sy_result sy_rti_filter_cfg_apply(pt_filter_cfg *base, const char *name, const sy_params *p_in, bool all, sy_error *err);
 sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_render_request *req, sy_error *err);
 sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err);
+/* Temporal reuse after a path-traced render of `samples` samples into the slot st->last_slot: when
+ * st->filter.temporal is on, the accumulation holds only this render's samples and the camera moved
+ * since the previous render, writes the estimate into layer and sets *done; otherwise leaves the
+ * layer alone (*done false). Records the camera either way. */
+sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint32_t samples, sy_layer *layer,
+                                bool *done, sy_error *err);
 
 /* --- sy_mediator_rt_radiance.c --- */
 sy_result sy_rti_radiance_render(rt_state *st, const sy_render_request *req, const sy_rt_camera *cam,

@@ -9,7 +9,9 @@
  *   - NOT restart after: an attachment change, moving the camera no viewport uses.
  * Switching the viewport to whitted and back resumes the accumulation (cached context, nothing
  * changed). The image after a restart equals a fresh context's image of the changed scene bit for bit (no
- * stale samples), AOVs come back for the viewport rectangle, and nothing is non-finite. */
+ * stale samples), AOVs come back for the viewport rectangle, and nothing is non-finite. With
+ * temporal=1 a panning view shows the temporal estimate (not the accumulation) and a still one the
+ * accumulation bit for bit; temporal=0 shows the plain samples again. */
 #include "it_util.h"
 #include "sy_mediator_rt.h"
 
@@ -198,6 +200,56 @@ int main(void)
     MUST(sy_context_pool_get(fx.pool, s, "whitted", NULL, fx.root.id, &wc, err));
     sy_error e = {0};
     EXPECT(sy_mediator_rt_aovs_get(sy_context_state(wc), &a, &e) != SY_OK && e.message[0]);
+
+    /* temporal reuse ("temporal", sy_filter_temporal.h): a frame whose camera moved shows the
+     * estimate; a still camera shows the accumulation exactly, from its second sample on */
+    {
+        sy_params on = {0}, off = {0};
+        MUST(sy_params_set(&on, "temporal", "1", err));
+        MUST(sy_params_set(&off, "temporal", "0", err));
+        MUST(sy_context_set_filter(ctx, "none", &on, err));
+        size_t bytes = 32 * 24 * 4 * sizeof(float);
+        sy_mediator_rt_filter_info fi;
+        for (int k = 0; k < 4; ++k) { /* a pan: the first frame has nothing to reuse yet */
+            sy_mat4 m = sy_mat4_identity();
+            m.m[12] = 0.3f + 0.02f * (float)k, m.m[14] = 2.9f;
+            sy_viewport_set_view(vp, &m);
+            uint64_t got = render(&fx, 1);
+            EXPECT_MSG(got == 1, "pan frame %d: %llu samples", k, (unsigned long long)got);
+            EXPECT(sy_layer_count_nonfinite(&fx.img) == 0);
+            sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
+            EXPECT_MSG(fi.temporal && fi.temporal_last == (k > 0) && fi.temporal_frames == (uint64_t)k,
+                       "pan frame %d: temporal_last %d, frames %llu", k, fi.temporal_last,
+                       (unsigned long long)fi.temporal_frames);
+            MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
+            bool same = !memcmp(a.planes[0], fx.img.rgba, bytes);
+            EXPECT_MSG(same == (k == 0), "pan frame %d: the layer %s the accumulation", k, same ? "is" : "is not");
+            sy_mediator_rt_aovs_free(&a);
+        }
+        EXPECT(fi.temporal_reused > 0.5);
+        for (uint32_t k = 0; k < 3; ++k) { /* the camera rests: the accumulation, bit for bit */
+            EXPECT(render(&fx, 1) == 2 + k);
+            MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
+            EXPECT_MSG(!memcmp(a.planes[0], fx.img.rgba, bytes), "still frame %u differs from the accumulation", k);
+            sy_mediator_rt_aovs_free(&a);
+            sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
+            EXPECT(!fi.temporal_last && fi.temporal_frames == 3);
+        }
+        MUST(sy_context_set_filter(ctx, "none", &off, err)); /* off: a moving frame is the plain samples */
+        sy_mat4 m = sy_mat4_identity();
+        m.m[14] = 3.2f;
+        sy_viewport_set_view(vp, &m);
+        EXPECT(render(&fx, 1) == 1);
+        MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
+        EXPECT(!memcmp(a.planes[0], fx.img.rgba, bytes));
+        sy_mediator_rt_aovs_free(&a);
+        sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
+        EXPECT(!fi.temporal && !fi.temporal_last);
+        sy_params bad = {0};
+        MUST(sy_params_set(&bad, "temporal", "maybe", err));
+        sy_error be = {0};
+        EXPECT(sy_context_set_filter(ctx, "none", &bad, &be) != SY_OK && strstr(be.message, "temporal"));
+    }
     destroy(&fx);
     return sy_check_finish("integration_pathtracer_sync");
 }
