@@ -24,19 +24,21 @@
  *      (history length up to max_history), the same for the first and second moments of luminance;
  *      their difference is the temporal variance, replaced by the 3x3 spatial variance while the
  *      history is shorter than 4 frames.
- *   4. a-trous (the indirect part when the split is given): atrous_iterations passes of a 3x3 B-spline kernel with taps 2^k apart, weights
+ *   4. a-trous: atrous_iterations passes of a 3x3 B-spline kernel with taps 2^k apart, weights
  *      exp(-|l_i - l_j| / (sigma_luminance sqrt(blurred variance_i)) - |z_i - z_j| / (sigma_depth
  *      step |grad z_i|) - sigma_normal (1 - n_i.n_j)), the variance filtered with the squared
- *      weights; the output of the first pass becomes the next frame's history (as SVGF).
+ *      weights; the output of the first pass becomes the next frame's history (as SVGF; not for
+ *      the direct part, below).
  * The result is remodulated by the albedo. NaN/Inf inputs are neither read by neighbours nor kept
  * in the history (the pixel shows its own colour, or 0).
  *
  * Inputs (sy_filter_frame): color (3 or 4 channels; alpha passed through), albedo, normal, depth,
  * position (required: world positions as sy_filter_position_from_depth gives them); direct and
- * indirect (optional, both or neither): then only the indirect part goes through the a-trous filter
- * and the direct part (emission seen directly and direct light, far less noisy per sample) is
- * reprojected, clamped and blended but never filtered, so emitters and shadow edges stay sharp;
- * without them the whole colour is filtered. variance is not used (the moments are the filter's). world_to_pixel: the frame's camera as a 4x4 column-major matrix taking a
+ * indirect (optional, both or neither): then the two parts go through steps 1-4 separately (each
+ * with its own moments and variance, as SVGF's direct and indirect illumination), except that the
+ * direct part's history is its unfiltered blend (step 3), not its first a-trous pass: fed back,
+ * the filtered direct part let an emitter's light creep over its edge frame after frame; without
+ * the split the whole colour is one part. variance is not used (the moments are the filter's). world_to_pixel: the frame's camera as a 4x4 column-major matrix taking a
  * homogeneous world point to (x w, y w, *, w), where (x, y) are continuous pixel coordinates of this
  * frame (pixel (x, y) covers [x, x+1) x [y, y+1), row 0 at the top) and w > 0 in front of the
  * camera (perspective: the camera-axis distance; orthographic: 1). Frames may change size from call
