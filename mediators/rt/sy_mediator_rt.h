@@ -101,6 +101,12 @@ uint32_t sy_mediator_rt_aov_channels(uint32_t index);  /**< 4, 3, 3, 3, 1, 3, 3 
  *   filter_kernel=separable|brute (default separable), filter_iterations (1..8, default 3),
  *   filter_start (first filter pass at this sample count, a power of two, default 4; then at every
  *   power of two), atrous_iterations (1..10, default 5), jbu_factor (1..64, default 4).
+ *   temporal=0|1 (default 0): temporal reuse on frames whose camera moved (sy_filter_temporal.h):
+ *   a render whose camera differs from the previous render's and whose accumulation restarted
+ *   draws its samples with a seed of its own and returns the reprojected, blended and filtered
+ *   estimate (the display filter does not run on it); a render whose camera did not move returns
+ *   the accumulation (or the display filter's image) as without it. sy view and sy web set it
+ *   (sy_interactive_set_temporal); turning it off forgets the history.
  * sy_mediator_rt_set_filter changes it live: name (NULL = opts' "filter" or unchanged) and the keys
  * present in opts (NULL = none; absent keys keep their values). Only the threshold keeps the pixel
  * filter's filtered buffer; any other change recomputes it at the next frame. On error nothing
@@ -124,6 +130,7 @@ typedef struct sy_mediator_rt_filter_info {
     bool temporal_last;         /**< the last render showed the temporal estimate (its camera moved) */
     uint64_t temporal_frames;   /**< frames that showed the temporal estimate so far */
     double temporal_seconds;    /**< the last such frame's temporal stage (AOV read + filter), wall time */
+    double temporal_filter_cpu_seconds; /**< of it: the filter's CPU time (all threads; sy_filter_temporal_stats) */
     double temporal_reused;     /**< the last such frame: share of hit pixels with a reprojected history */
 } sy_mediator_rt_filter_info;
 /** Fills *out with the context's filter state. */

@@ -362,6 +362,7 @@ sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint
     st->finfo.temporal_last = true;
     st->finfo.temporal_frames++;
     st->finfo.temporal_seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    st->finfo.temporal_filter_cpu_seconds = ts.cpu_seconds;
     st->finfo.temporal_reused = hits ? (double)ts.reprojected / (double)hits : 0.0;
     *done = true;
     return SY_OK;
