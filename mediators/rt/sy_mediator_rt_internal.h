@@ -116,7 +116,7 @@ typedef struct rt_state {
 /* The classes' parameter tables (sy_params.h); the counts are checked where they are defined. */
 #define SY_RTI_WHITTED_PARAM_COUNT 8
 #define SY_RTI_COVERAGE_PARAM_COUNT 5
-#define SY_RTI_PATHTRACER_PARAM_COUNT 26
+#define SY_RTI_PATHTRACER_PARAM_COUNT 27
 #ifndef SY_RTI_DEFINING_PARAMS
 extern const sy_param_decl sy_rti_whitted_params[SY_RTI_WHITTED_PARAM_COUNT];
 extern const sy_param_decl sy_rti_coverage_params[SY_RTI_COVERAGE_PARAM_COUNT];
