@@ -166,11 +166,11 @@ typedef struct sy_rt_stats {
     double light_tree_build_seconds, light_tree_refit_seconds;
     uint32_t light_tree_refit_changed;
     uint64_t light_tree_builds, light_tree_refits; /** @} */
-    /** Emitters the light sampling leaves out (zero-area triangles; lights of zero, negative or
+    /** @{ Emitters the light sampling leaves out (zero-area triangles; lights of zero, negative or
      * non-finite power), counted since the device was created, and the message of the last one
      * (naming the light; "" when none) */
     uint32_t light_warnings;
-    char light_warning[256];
+    char light_warning[256]; /** @} */
 } sy_rt_stats;
 /** Fills *out with the device's live object counts and version. */
 void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out);
@@ -511,7 +511,6 @@ typedef bool (*sy_rt_progress_fn)(const sy_rt_progress *progress, void *user_dat
 /** Accumulation of a progressive render (opaque; see sy_rt_accum_create). */
 typedef struct sy_rt_accum sy_rt_accum;
 
-/** What to render: integrator, image and rectangle, sampling settings. */
 /** Light selection of the integrators. OFF: the alias table over the emissive triangles by power,
  * punctual lights uniformly (PATHTRACER) or every punctual light at every point (WHITTED). ON: the
  * light tree (backends/rt/sy_rt_lighttree.h), one hierarchy over emissive triangles and punctual
@@ -527,6 +526,7 @@ typedef enum sy_rt_light_tree_mode {
 /** AUTO's threshold (lights). */
 #define SY_RT_LIGHT_TREE_AUTO_MIN 64u
 
+/** What to render: integrator, image and rectangle, sampling settings. */
 typedef struct sy_rt_render_desc {
     sy_rt_integrator integrator; /**< which integrator runs */
     /** @{ the full image the camera window maps onto */
