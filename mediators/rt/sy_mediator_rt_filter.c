@@ -229,15 +229,16 @@ sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_re
 }
 
 /* Filters the layer the path tracer just wrote (rectangle of the slot st->last_slot). */
-sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err)
+/* The slot's AOVs read into the scratch planes, world positions made from depth, and the filter
+ * frame over them (every filter, the temporal stage included, reads what it needs of it). */
+static sy_result read_frame(rt_state *st, accum_slot *a, const sy_render_request *req, uint32_t samples,
+                            sy_filter_frame *f, sy_error *err)
 {
-    accum_slot *a = &st->slots[st->last_slot];
     sy_result rd = sy_rti_filter_read_aovs(st, a, req, err);
     if (rd != SY_OK) return rd;
     filter_positions(req, st->fbuf[SY_RT_AOV_DEPTH], st->fbuf[SY_RT_AOV_COUNT]);
-    uint32_t samples = sy_rt_accum_samples(a->acc);
     const float *m = req->camera.camera_to_world.m;
-    sy_filter_frame f = {
+    *f = (sy_filter_frame){
         .width = req->rect_w,
         .height = req->rect_h,
         .color_channels = 4,
@@ -254,6 +255,16 @@ sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_lay
         .has_camera = req->camera.projection != SY_PROJECTION_ORTHOGRAPHIC,
         .camera_position = {m[12], m[13], m[14]},
     };
+    return SY_OK;
+}
+
+sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err)
+{
+    accum_slot *a = &st->slots[st->last_slot];
+    uint32_t samples = sy_rt_accum_samples(a->acc);
+    sy_filter_frame f;
+    sy_result rd = read_frame(st, a, req, samples, &f, err);
+    if (rd != SY_OK) return rd;
     sy_filter_stats fs = {0};
     sy_filter_report fe = {0};
     sy_filter_status s = SY_FILTER_OK;
@@ -338,23 +349,9 @@ sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint
         p.threads = st->filter.atrous.threads;
         if (sy_filter_temporal_create(&p, &st->temporal, &fe)) return filter_fail(err, &fe);
     }
-    sy_result rd = sy_rti_filter_read_aovs(st, a, req, err);
+    sy_filter_frame f;
+    sy_result rd = read_frame(st, a, req, samples, &f, err);
     if (rd != SY_OK) return rd;
-    filter_positions(req, st->fbuf[SY_RT_AOV_DEPTH], st->fbuf[SY_RT_AOV_COUNT]);
-    sy_filter_frame f = {
-        .width = req->rect_w,
-        .height = req->rect_h,
-        .color_channels = 4,
-        .variance_channels = 3,
-        .color = st->fbuf[SY_RT_AOV_COLOR],
-        .albedo = st->fbuf[SY_RT_AOV_ALBEDO],
-        .normal = st->fbuf[SY_RT_AOV_NORMAL],
-        .depth = st->fbuf[SY_RT_AOV_DEPTH],
-        .position = st->fbuf[SY_RT_AOV_COUNT],
-        .direct = st->fbuf[SY_RT_AOV_DIRECT],
-        .indirect = st->fbuf[SY_RT_AOV_INDIRECT],
-        .spp_uniform = (float)samples,
-    };
     sy_filter_temporal_stats ts = {0};
     if (sy_filter_temporal_run(st->temporal, &f, m, layer->rgba, &ts, &fe)) return filter_fail(err, &fe);
     clock_gettime(CLOCK_MONOTONIC, &t1);
