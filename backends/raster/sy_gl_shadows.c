@@ -36,6 +36,37 @@ void sy_gli_scene_bounds(const sy_gl_device *dev, float *c, float *radius)
 }
 
 /* Lights UBO (+ shadow matrices from the scene bounds). One upload. */
+/* An emissive polygon wholly on the removed side of one of the frame's section planes lights
+ * nothing, as in the ray tracers (an emitter point in a removed part is unseen there); one cut
+ * through it keeps it whole (its light from the removed part stays: docs/BACKENDS.md). */
+static bool area_removed(const sy_gl_device *dev, const sy_gl_area_light *a)
+{
+    for (uint32_t c = 0; c < dev->clip_count; ++c) {
+        const float *q = dev->clip_planes[c];
+        uint32_t k = 0;
+        while (k < a->vertex_count &&
+               q[0] * a->vertices[k][0] + q[1] * a->vertices[k][1] + q[2] * a->vertices[k][2] + q[3] < 0.0f)
+            ++k;
+        if (a->vertex_count && k == a->vertex_count) return true;
+    }
+    return false;
+}
+
+/* A polygon's emitted power up to a constant: luminance x area (x 2 when two-sided). */
+static double area_flux(const sy_gl_area_light *a)
+{
+    if (a->vertex_count < 3) return 0.0;
+    float e1[3], e2[3], nrm[3];
+    for (int c = 0; c < 3; ++c) {
+        e1[c] = a->vertices[1][c] - a->vertices[0][c];
+        e2[c] = a->vertices[2][c] - a->vertices[0][c];
+    }
+    sy_gli_cross3(e1, e2, nrm);
+    double area = sqrt((double)sy_gli_dot3f(nrm, nrm)) * (a->vertex_count == 4 ? 1.0 : 0.5);
+    double lum = 0.2126 * a->radiance[0] + 0.7152 * a->radiance[1] + 0.0722 * a->radiance[2];
+    return lum * area * (a->double_sided ? 2.0 : 1.0);
+}
+
 void sy_gli_lights_upload(sy_gl_device *dev, frame_state *fs)
 {
     float blk[LIGHTS_FLOATS];
@@ -119,10 +150,15 @@ void sy_gli_lights_upload(sy_gl_device *dev, frame_state *fs)
     memset(ab, 0, sizeof ab);
     int32_t *aib = (int32_t *)(void *)ab;
     uint32_t ns_punctual = ns;
-    aib[0] = (int32_t)dev->area_count;
+    uint32_t na = 0; /* the polygons uploaded: those not wholly on a removed side of a section plane */
+    double flux_all = 0.0, flux_kept = 0.0; /* the indirect estimate follows the emitters kept */
     for (uint32_t i = 0; i < dev->area_count; ++i) {
         const sy_gl_area_light *a = &dev->areas[i];
-        float *o = ab + 8 + 24 * i, cen[3] = {0, 0, 0}, e1[3], e2[3], nrm[3];
+        double fl = area_flux(a);
+        flux_all += fl;
+        if (area_removed(dev, a)) continue;
+        flux_kept += fl;
+        float *o = ab + 8 + 24 * na++, cen[3] = {0, 0, 0}, e1[3], e2[3], nrm[3];
         for (uint32_t k = 0; k < 4; ++k) {
             const float *v = a->vertices[k < a->vertex_count ? k : a->vertex_count - 1];
             memcpy(o + 4 * k, v, 3 * sizeof(float));
@@ -162,6 +198,9 @@ void sy_gli_lights_upload(sy_gl_device *dev, frame_state *fs)
         o[23] = (float)ns;
         ns++;
     }
+    aib[0] = (int32_t)na;
+    if (na < dev->area_count && flux_all > 0.0)
+        for (int c = 0; c < 3; ++c) blk[5 + c] = (float)(blk[5 + c] * (flux_kept / flux_all));
     for (int c = 0; c < 3; ++c) ab[4 + c] = ab[7] > 0.0f ? ab[4 + c] / ab[7] : 0.0f;
     ab[7] = 0.0f;
     fs->shadow_count = ns;
@@ -177,7 +216,7 @@ void sy_gli_lights_upload(sy_gl_device *dev, frame_state *fs)
     /* a_count.y: the polygons up to the last with a shadow map (the shaders' first loop); z: the
      * shadow taps per polygon (shadow_area's loop bound, a uniform so that it is not unrolled) */
     aib[1] = 0;
-    for (uint32_t i = 0; i < dev->area_count; ++i)
+    for (uint32_t i = 0; i < na; ++i)
         if (ab[8 + 24 * i + 23] >= 0.0f) aib[1] = (int32_t)i + 1;
     aib[2] = 8;
     dev->shadow_count = ns_punctual + fs->cube_count;

@@ -232,6 +232,18 @@ static inline void sy_rt_clip_begin(sy_rt_device *dev, const sy_rt_camera *cam)
     if (n) memcpy(dev->clip_planes, cam->clip_planes, n * sizeof dev->clip_planes[0]);
 }
 
+/* True when the point (x, y, z) (world) lies on a removed side of the call's section planes (a x + b y + c z
+ * + d < 0 for some plane): the context filter drops such hits, and the lights' sampling treats an
+ * emitter point there as unseen (an emitter in a removed part lights nothing). */
+static inline bool sy_rt_clip_removes(const sy_rt_device *dev, float x, float y, float z)
+{
+    for (uint32_t c = 0; c < dev->clip_count; ++c) {
+        const float *q = dev->clip_planes[c];
+        if (q[0] * x + q[1] * y + q[2] * z + q[3] < 0.0f) return true;
+    }
+    return false;
+}
+
 /* Every intersection context of the back-end: Embree's, then which scene is being traced. Filter
  * functions receive &rtc and read the rest (every context comes from sy_rt_context_init). */
 typedef struct sy_rt_ictx {

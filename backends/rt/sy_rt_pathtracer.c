@@ -140,7 +140,8 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
         if (!(pdf_l > 0.0f)) return zero;
         sy_rt_v3 sdir;
         float tmax;
-        sy_rt_v3 tr = sy_rt_segment_to(p_off, q, &sdir, &tmax) ? unoccluded(c, p_off, sdir, tmax, false) : v3(1.0f, 1.0f, 1.0f);
+        sy_rt_v3 tr = sy_rt_clip_removes(dev, q.x, q.y, q.z) ? v3(0.0f, 0.0f, 0.0f) /* an emitter point in a removed part */
+                      : sy_rt_segment_to(p_off, q, &sdir, &tmax) ? unoccluded(c, p_off, sdir, tmax, false) : v3(1.0f, 1.0f, 1.0f);
         if (v3_is_zero(tr)) return zero;
         sy_rt_v3 le = v3_mul(tr, t->textured ? sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv) : t->emission);
         return v3_scale(v3_mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l);

@@ -584,13 +584,7 @@ void sy_rt_context_filter(const struct RTCFilterFunctionNArguments *args)
         if (!dev->clip_count) continue;
         float p[3];
         hit_world_point(in, hu[5 * N + i], hf[3 * N + i], hf[4 * N + i], p);
-        for (uint32_t c = 0; c < dev->clip_count; ++c) {
-            const float *q = dev->clip_planes[c];
-            if (q[0] * p[0] + q[1] * p[1] + q[2] * p[2] + q[3] < 0.0f) {
-                args->valid[i] = 0;
-                break;
-            }
-        }
+        if (sy_rt_clip_removes(dev, p[0], p[1], p[2])) args->valid[i] = 0;
     }
 }
 

@@ -492,7 +492,8 @@ static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bs
         if (v3_is_zero(f)) continue;
         sy_rt_v3 sdir;
         float tmax;
-        sy_rt_v3 tr = sy_rt_segment_to(p_off, q, &sdir, &tmax) ? shadow(c, p_off, sdir, tmax) : v3(1.0f, 1.0f, 1.0f);
+        sy_rt_v3 tr = sy_rt_clip_removes(dev, q.x, q.y, q.z) ? v3(0.0f, 0.0f, 0.0f) /* an emitter point in a removed part */
+                      : sy_rt_segment_to(p_off, q, &sdir, &tmax) ? shadow(c, p_off, sdir, tmax) : v3(1.0f, 1.0f, 1.0f);
         if (v3_is_zero(tr)) continue;
         sy_rt_v3 le = v3_mul(tr, t->textured ? sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv) : t->emission);
         float g = cos_l / d2 * t->area / p_sel;
@@ -653,7 +654,8 @@ static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const
         den = v3_add(den, e);
         sy_rt_v3 sdir;
         float tmax;
-        sy_rt_v3 tr = sy_rt_segment_to(p_off, q, &sdir, &tmax) ? shadow(c, p_off, sdir, tmax) : v3(1.0f, 1.0f, 1.0f);
+        sy_rt_v3 tr = sy_rt_clip_removes(dev, q.x, q.y, q.z) ? v3(0.0f, 0.0f, 0.0f) /* an emitter point in a removed part */
+                      : sy_rt_segment_to(p_off, q, &sdir, &tmax) ? shadow(c, p_off, sdir, tmax) : v3(1.0f, 1.0f, 1.0f);
         num = v3_add(num, v3_mul(e, tr));
     }
     if (depth == 0u && c->cur) {
@@ -759,7 +761,8 @@ static sy_rt_v3 direct_tree(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bs
         if (v3_is_zero(f)) continue;
         sy_rt_v3 sdir, tr;
         if (t) {
-            tr = sy_rt_segment_to(p_off, q, &sdir, &tmax) ? shadow(c, p_off, sdir, tmax) : v3(1.0f, 1.0f, 1.0f);
+            tr = sy_rt_clip_removes(dev, q.x, q.y, q.z) ? v3(0.0f, 0.0f, 0.0f) /* an emitter point in a removed part */
+                 : sy_rt_segment_to(p_off, q, &sdir, &tmax) ? shadow(c, p_off, sdir, tmax) : v3(1.0f, 1.0f, 1.0f);
             if (!v3_is_zero(tr) && t->textured) le = sy_rt_surface_emission(dev, t->inst, t->prim, bu, bv);
         } else {
             tr = shadow(c, p_off, wi, tmax);

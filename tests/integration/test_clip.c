@@ -13,7 +13,9 @@
  *   4. The cut image of every back-end matches the others: DamagedHelmet (skipped with a reason when
  *      absent) cut through the middle of its bounds (x >= centre): coverage IoU >= 0.99 between
  *      every pair of clip-capable back-ends, and the cut removes coverage (IoU with the uncut < 0.8).
- *      test_it_clip --write DIR writes the cut images as EXR for looking at. */
+ *      test_it_clip --write DIR writes the cut images as EXR for looking at.
+ *   5. Emitters in a removed part light nothing: an emissive quad, the only light, over a ground
+ *      quad; the plane that removes it turns the ground black in whitted, pathtracer and raster. */
 #include "it_util.h"
 
 #include "sy_exr.h"
@@ -238,6 +240,54 @@ static void test_shadow(void)
     sy_scene_destroy(s);
 }
 
+/* ---------------------------------------------------------------- 5. emitters in a removed part */
+/* The only light is an emissive quad (two-sided, z = 1) over a ground quad (z = 0); a plane keeping
+ * z <= 0.5 removes the emitter, and with it its light: the ground goes from lit to black in every
+ * back-end (before, the ray tracers' next-event estimation and the rasterizer's polygon lights
+ * still lit it from the removed part: 30 %, 33 % and 40 % of the uncut Cornell box's mean). */
+static void test_removed_emitter(void)
+{
+    sy_scene *s;
+    MUST(sy_scene_create(&s, err));
+    sy_material grey, glow;
+    MUST(sy_material_create(s, "grey", &grey, err));
+    MUST(sy_material_create(s, "glow", &glow, err));
+    sy_material_data d = *sy_material_get(s, glow);
+    d.name = (char *)"glow";
+    d.emissive[0] = d.emissive[1] = d.emissive[2] = 4.0f;
+    d.double_sided = 1;
+    MUST(sy_material_set(s, glow, &d, err));
+    const float ground[1][3] = {{0, 0, 2.0f}}, lamp[1][3] = {{0, 0, 0.3f}};
+    sy_mesh mg = it_quad_mesh(s, "ground", ground, &grey, 1), ml = it_quad_mesh(s, "lamp", lamp, &glow, 1);
+    sy_node g, l;
+    MUST(sy_node_create(s, "ground", &g, err));
+    MUST(sy_node_set_mesh(s, g, mg, err));
+    MUST(sy_node_create(s, "lamp", &l, err));
+    MUST(sy_node_set_mesh(s, l, ml, err));
+    it_set_translation(s, l, 0, 0, 1.0f);
+    MUST(sy_scene_commit(s, NULL, err));
+    sy_mat4 cam = sy_mat4_identity();
+    cam.m[14] = 3.0f;
+    const float cut[1][4] = {{0, 0, -1, 0.5f}}; /* keeps z <= 0.5: the lamp goes, the ground stays */
+    const char *be[3] = {"whitted", "pathtracer", "raster"};
+    for (int i = 0; i < 3; ++i) {
+        const sy_mediator_class *cls = sy_mediator_find(be[i]);
+        if (!cls || !(sy_mediator_class_caps(cls, NULL) & SY_CAP_CLIP)) continue;
+        sy_layer before = {0}, after = {0};
+        render(s, be[i], NULL, &cam, cut, 0, &before);
+        render(s, be[i], NULL, &cam, cut, 1, &after);
+        /* the ground beside the lamp (the lamp hides the ground under it from the camera) */
+        double lb = region_luminance(&before, 3.0f, 0.5f, 1.5f, -0.5f, 0.5f);
+        double la = region_luminance(&after, 3.0f, 0.5f, 1.5f, -0.5f, 0.5f);
+        printf("removed emitter, %s: ground beside the lamp %.4f with it, %.4f with it cut away\n", be[i], lb, la);
+        EXPECT_MSG(lb > 0.02, "%s: the lamp does not light the ground (%.4f)", be[i], lb);
+        EXPECT_MSG(la <= 0.01 * lb, "%s: the removed lamp still lights the ground (%.4f of %.4f)", be[i], la, lb);
+        sy_layer_destroy(&before);
+        sy_layer_destroy(&after);
+    }
+    sy_scene_destroy(s);
+}
+
 /* ---------------------------------------------------------------- 4. a sample cut in every back-end */
 static double iou(const sy_layer *a, const sy_layer *b)
 {
@@ -298,6 +348,7 @@ int main(int argc, char **argv)
     EXPECT_MSG(n >= 2, "fewer than two back-ends cut (%u)", n);
     test_bad_planes();
     test_pick();
+    test_removed_emitter();
     test_shadow();
     if (sy_check_failures) {
         fprintf(stderr, "test_it_clip: %d check(s) failed\n", sy_check_failures);
