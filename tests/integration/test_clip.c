@@ -131,6 +131,23 @@ static void test_bad_planes(void)
     sy_scene_destroy(s);
 }
 
+/* The scenes of 2, 3 and 5: a quad of half size h0 at z = 0 (node name0) and one of half size h1
+ * at z = 1 (node name1), in materials m0 and m1; their node handles in *n0, *n1 (may be NULL). */
+static void two_quads(sy_scene *s, const char *name0, float h0, sy_material m0, const char *name1, float h1,
+                      sy_material m1, sy_node *n0, sy_node *n1)
+{
+    const float q0[1][3] = {{0, 0, h0}}, q1[1][3] = {{0, 0, h1}};
+    sy_mesh a = it_quad_mesh(s, name0, q0, &m0, 1), b = it_quad_mesh(s, name1, q1, &m1, 1);
+    sy_node na, nb;
+    MUST(sy_node_create(s, name0, &na, err));
+    MUST(sy_node_set_mesh(s, na, a, err));
+    MUST(sy_node_create(s, name1, &nb, err));
+    MUST(sy_node_set_mesh(s, nb, b, err));
+    it_set_translation(s, nb, 0, 0, 1.0f);
+    if (n0) *n0 = na;
+    if (n1) *n1 = nb;
+}
+
 /* ---------------------------------------------------------------- 2. picks */
 static void test_pick(void)
 {
@@ -138,14 +155,8 @@ static void test_pick(void)
     MUST(sy_scene_create(&s, err));
     sy_material m;
     MUST(sy_material_create(s, "grey", &m, err));
-    const float qa[1][3] = {{0, 0, 0.8f}}, qb[1][3] = {{0, 0, 0.5f}};
-    sy_mesh ma = it_quad_mesh(s, "mesh-a", qa, &m, 1), mb = it_quad_mesh(s, "mesh-b", qb, &m, 1);
     sy_node a, b;
-    MUST(sy_node_create(s, "A", &a, err));
-    MUST(sy_node_set_mesh(s, a, ma, err));
-    MUST(sy_node_create(s, "B", &b, err));
-    MUST(sy_node_set_mesh(s, b, mb, err));
-    it_set_translation(s, b, 0, 0, 1.0f);
+    two_quads(s, "A", 0.8f, m, "B", 0.5f, m, &a, &b);
     MUST(sy_scene_commit(s, NULL, err));
     sy_mat4 cam = sy_mat4_identity();
     cam.m[14] = 3.0f;
@@ -201,14 +212,8 @@ static void test_shadow(void)
     MUST(sy_scene_create(&s, err));
     sy_material m;
     MUST(sy_material_create(s, "grey", &m, err));
-    const float ground[1][3] = {{0, 0, 2.0f}}, caster[1][3] = {{0, 0, 0.4f}};
-    sy_mesh mg = it_quad_mesh(s, "ground", ground, &m, 1), mc = it_quad_mesh(s, "caster", caster, &m, 1);
-    sy_node g, c, ln;
-    MUST(sy_node_create(s, "ground", &g, err));
-    MUST(sy_node_set_mesh(s, g, mg, err));
-    MUST(sy_node_create(s, "caster", &c, err));
-    MUST(sy_node_set_mesh(s, c, mc, err));
-    it_set_translation(s, c, 0, 0, 1.0f);
+    two_quads(s, "ground", 2.0f, m, "caster", 0.4f, m, NULL, NULL);
+    sy_node ln;
     /* a directional light travelling (-1, 0, -1)/sqrt(2): its -Z turned 45 degrees about Y; the
      * caster's shadow falls on the ground around x = -1 */
     sy_light lamp = it_light(s, "sun", SY_LIGHT_DIRECTIONAL, 3.0f);
@@ -257,14 +262,7 @@ static void test_removed_emitter(void)
     d.emissive[0] = d.emissive[1] = d.emissive[2] = 4.0f;
     d.double_sided = 1;
     MUST(sy_material_set(s, glow, &d, err));
-    const float ground[1][3] = {{0, 0, 2.0f}}, lamp[1][3] = {{0, 0, 0.3f}};
-    sy_mesh mg = it_quad_mesh(s, "ground", ground, &grey, 1), ml = it_quad_mesh(s, "lamp", lamp, &glow, 1);
-    sy_node g, l;
-    MUST(sy_node_create(s, "ground", &g, err));
-    MUST(sy_node_set_mesh(s, g, mg, err));
-    MUST(sy_node_create(s, "lamp", &l, err));
-    MUST(sy_node_set_mesh(s, l, ml, err));
-    it_set_translation(s, l, 0, 0, 1.0f);
+    two_quads(s, "ground", 2.0f, grey, "lamp", 0.3f, glow, NULL, NULL);
     MUST(sy_scene_commit(s, NULL, err));
     sy_mat4 cam = sy_mat4_identity();
     cam.m[14] = 3.0f;
