@@ -189,6 +189,18 @@ static inline sy_result it_render_full(sy_context *ctx, const sy_camera_view *vi
     return r != SY_OK ? r : sy_context_render(ctx, &req, img, err);
 }
 
+/* Coverage IoU of two images (a pixel is covered where alpha > 0.5); 1 when neither covers any. */
+static inline double it_coverage_iou(const sy_layer *a, const sy_layer *b)
+{
+    size_t both = 0, any = 0, n = (size_t)a->width * a->height;
+    for (size_t i = 0; i < n; ++i) {
+        bool ca = a->rgba[4 * i + 3] > 0.5f, cb = b->rgba[4 * i + 3] > 0.5f;
+        both += ca && cb;
+        any += ca || cb;
+    }
+    return any ? (double)both / (double)any : 1.0;
+}
+
 static inline const float *it_px(const sy_layer *l, uint32_t x, uint32_t y) { return l->rgba + 4 * ((size_t)y * l->width + x); }
 
 static inline bool it_px_is(const sy_layer *l, uint32_t x, uint32_t y, float r, float g, float b, float a)

@@ -287,16 +287,6 @@ static void test_removed_emitter(void)
 }
 
 /* ---------------------------------------------------------------- 4. a sample cut in every back-end */
-static double iou(const sy_layer *a, const sy_layer *b)
-{
-    size_t both = 0, any = 0, n = (size_t)a->width * a->height;
-    for (size_t i = 0; i < n; ++i) {
-        bool ca = a->rgba[4 * i + 3] > 0.5f, cb = b->rgba[4 * i + 3] > 0.5f;
-        both += ca && cb;
-        any += ca || cb;
-    }
-    return any ? (double)both / (double)any : 1.0;
-}
 
 static void test_sample(const char *write_dir)
 {
@@ -319,12 +309,12 @@ static void test_sample(const char *write_dir)
             MUST(sy_exr_write_rgba(out, (int)W, (int)H, img[i].rgba, img[i].depth, SY_EXR_PIXEL_FLOAT, err));
         }
     }
-    double cut_vs_uncut = iou(&img[0], &uncut);
+    double cut_vs_uncut = it_coverage_iou(&img[0], &uncut);
     printf("DamagedHelmet cut at x >= %.4f: IoU with the uncut %s image %.4f\n", (double)-cut[0][3], names[0], cut_vs_uncut);
     EXPECT_MSG(cut_vs_uncut < 0.8, "the plane cut little away (IoU with the uncut image %.4f)", cut_vs_uncut);
     for (uint32_t i = 0; i < n; ++i)
         for (uint32_t j = i + 1; j < n; ++j) {
-            double v = iou(&img[i], &img[j]);
+            double v = it_coverage_iou(&img[i], &img[j]);
             printf("  coverage IoU %s / %s: %.4f\n", names[i], names[j], v);
             EXPECT_MSG(v >= 0.99, "%s and %s cut differently (IoU %.4f)", names[i], names[j], v);
         }

@@ -222,16 +222,6 @@ static void test_hide(void)
 }
 
 /* ---------------------------------------------------------------- 2. coverage */
-static double iou(const sy_layer *a, const sy_layer *b)
-{
-    size_t both = 0, any = 0, n = (size_t)a->width * a->height;
-    for (size_t i = 0; i < n; ++i) {
-        bool ca = a->rgba[4 * i + 3] > 0.5f, cb = b->rgba[4 * i + 3] > 0.5f;
-        both += ca && cb;
-        any += ca || cb;
-    }
-    return any ? (double)both / (double)any : 1.0;
-}
 
 static void test_coverage(void)
 {
@@ -264,11 +254,11 @@ static void test_coverage(void)
         view_close(&v);
     }
     for (uint32_t i = 0; i < n; ++i) {
-        double vs_full = iou(&img[i], &full[i]);
+        double vs_full = it_coverage_iou(&img[i], &full[i]);
         printf("coverage with B hidden, %s: IoU with its unhidden image %.4f\n", names[i], vs_full);
         EXPECT_MSG(vs_full < 0.8, "%s: hiding B changed little (IoU %.4f)", names[i], vs_full);
         for (uint32_t j = i + 1; j < n; ++j) {
-            double v = iou(&img[i], &img[j]), u = iou(&full[i], &full[j]);
+            double v = it_coverage_iou(&img[i], &img[j]), u = it_coverage_iou(&full[i], &full[j]);
             printf("  coverage IoU %s / %s: %.4f with B hidden, %.4f without\n", names[i], names[j], v, u);
             EXPECT_MSG(v >= 0.98 && v >= u - 0.005, "%s and %s hide differently (IoU %.4f; %.4f unhidden)", names[i],
                        names[j], v, u);
@@ -523,11 +513,11 @@ static void test_sample(const char *write_dir)
         view_close(&v);
     }
     for (uint32_t i = 0; i < n; ++i) {
-        double v = iou(&img[i], &plain[i]);
+        double v = it_coverage_iou(&img[i], &plain[i]);
         printf("CesiumMilkTruck, %s: rear wheels hidden, front selected: IoU with the plain image %.4f\n", names[i], v);
         EXPECT_MSG(v < 0.995, "%s: hiding the rear wheels changed no coverage (IoU %.4f)", names[i], v);
         for (uint32_t j = i + 1; j < n; ++j) {
-            double w = iou(&img[i], &img[j]);
+            double w = it_coverage_iou(&img[i], &img[j]);
             printf("  coverage IoU %s / %s: %.4f\n", names[i], names[j], w);
             EXPECT_MSG(w >= 0.98, "%s and %s differ (IoU %.4f)", names[i], names[j], w);
         }
