@@ -1,6 +1,7 @@
 /* sy_web_check.c — sy web's checks of untrusted requests and messages as pure functions (see
  * sy_web_check.h): the raw head, the request's decision, the WebSocket input messages. */
 #include "sy_web_check.h"
+#include "sy_web_assets.h"
 
 #include <arpa/inet.h>
 #include <cjson/cJSON.h>
@@ -270,6 +271,14 @@ static bool still_side(const char *query, const char *name, uint32_t max, uint32
     return true;
 }
 
+const sy_web_asset *sy_web_asset_find(const char *path)
+{
+    if (!strcmp(path, "/")) path = "/index.html";
+    for (size_t i = 0; i < sy_web_asset_count; ++i)
+        if (!strcmp(path, sy_web_assets[i].path)) return &sy_web_assets[i];
+    return NULL;
+}
+
 /* A costly or state-changing request: a same-origin Origin, or no Origin and a right token. */
 static bool same_origin_or_token(const sy_web_head *h, const sy_web_verdict *v, bool token_required)
 {
@@ -321,8 +330,8 @@ void sy_web_check_request(const sy_web_policy *p, const sy_web_head *h, sy_web_v
         v->target = SY_WEB_TARGET_ROUTE, v->route = r;
         return;
     }
-    if (!strcmp(path, "/") || !strcmp(path, "/index.html")) {
-        v->target = SY_WEB_TARGET_PAGE;
+    if ((v->asset = sy_web_asset_find(path)) != NULL) {
+        v->target = SY_WEB_TARGET_ASSET;
         return;
     }
     if (!strcmp(path, "/api/frame.jpg")) {

@@ -71,7 +71,7 @@ bool sy_web_cookie_token(const char *cookie, const char **value, size_t *len);
 /** What a request asks for. */
 typedef enum sy_web_target {
     SY_WEB_TARGET_REFUSED, /**< answered with verdict.status */
-    SY_WEB_TARGET_PAGE,    /**< GET / or /index.html */
+    SY_WEB_TARGET_ASSET,   /**< GET of the page or one of its files (verdict.asset) */
     SY_WEB_TARGET_STILL,   /**< GET /api/frame.jpg (size in the verdict) */
     SY_WEB_TARGET_STREAM,  /**< the WebSocket upgrade at /ws */
     SY_WEB_TARGET_ROUTE    /**< a route of the embedding program (verdict.route) */
@@ -107,6 +107,7 @@ typedef struct sy_web_verdict {
     bool token_page;          /**< REFUSED for the token: answer with the page that says why */
     bool token_in_query;      /**< a right token came as ?token= (the server sets the cookie) */
     const sy_web_route *route; /**< ROUTE: which */
+    const struct sy_web_asset *asset; /**< ASSET: which embedded file (sy_web_assets.h) */
     uint32_t still_w, still_h; /**< STILL: the size */
     char reason[200];         /**< REFUSED: why (names the header, argument or limit) */
 } sy_web_verdict;
@@ -115,7 +116,8 @@ typedef struct sy_web_verdict {
  * required, 403); the token (401 missing, 403 wrong); the method (GET or POST, 405); a WebSocket
  * upgrade only at /ws (404) with a same-origin Origin, or without Origin only with a right token
  * (403); POST: a route (404), a same-origin Origin or a right token (403), a JSON Content-Type
- * (415), a Content-Length within max_body (413); GET /, /index.html: the page; GET /api/frame.jpg:
+ * (415), a Content-Length within max_body (413); GET / and the page's files (/index.html,
+ * /view.js, ...): the asset; GET /api/frame.jpg:
  * a same-origin Origin or a right token (403), w and h in 1..still_max_w/h and w x h within
  * still_max_pixels (400, 413); GET routes; else 404. */
 void sy_web_check_request(const sy_web_policy *policy, const sy_web_head *head, sy_web_verdict *verdict);

@@ -191,9 +191,9 @@ static int http_request(sy_web *w, struct lws *wsi, http_pss *p, const char *uri
     }
     p->set_cookie = w->token[0] && v.token_in_query;
     switch (v.target) {
-    case SY_WEB_TARGET_PAGE:
-        p->status = 200, p->ctype = "text/html; charset=utf-8";
-        p->body = (const uint8_t *)sy_web_asset_index_html, p->body_len = sy_web_asset_index_html_len;
+    case SY_WEB_TARGET_ASSET:
+        p->status = 200, p->ctype = v.asset->content_type;
+        p->body = v.asset->bytes, p->body_len = v.asset->len;
         p->responding = true;
         lws_callback_on_writable(wsi);
         return 0;

@@ -222,7 +222,12 @@ static int test_page(uint16_t port)
     http_answer a;
     CHECK(get(port, "/", NULL, &a) == 0);
     CHECK(a.status == 200 && strcasestr(a.head, "content-type: text/html"));
-    CHECK(strstr((char *)a.body, "id=\"sy-canvas\"") && strstr((char *)a.body, "window.syStats"));
+    CHECK(strstr((char *)a.body, "id=\"sy-canvas\"") && strstr((char *)a.body, "<script src=\"view.js\">"));
+    free(a.body);
+    /* the page's script, with its own Content-Type */
+    CHECK(get(port, "/view.js", NULL, &a) == 0);
+    CHECK(a.status == 200 && strcasestr(a.head, "content-type: text/javascript"));
+    CHECK(strstr((char *)a.body, "window.syStats") != NULL);
     free(a.body);
     CHECK(get(port, "/nothing/here", NULL, &a) == 0 && a.status == 404);
     free(a.body);
