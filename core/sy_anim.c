@@ -330,3 +330,51 @@ double sy_clock_advance(sy_clock *c, double dt)
     }
     return c->time;
 }
+
+/* >>shutter (motion blur) */
+
+static bool shutter_number(const char *b, const char *e, double *out)
+{
+    char buf[64];
+    size_t n = (size_t)(e - b);
+    if (n == 0 || n >= sizeof buf) return false;
+    memcpy(buf, b, n);
+    buf[n] = 0;
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(buf, &end);
+    if (end == buf || *end || errno == ERANGE || !isfinite(v)) return false;
+    *out = v;
+    return true;
+}
+
+sy_result sy_shutter_parse(const char *text, sy_shutter *out, sy_error *err)
+{
+    if (!text || !out) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "shutter: no text");
+    const char *comma = strchr(text, ',');
+    double open = 0.0, close = 0.0;
+    bool ok = comma ? shutter_number(text, comma, &open) && shutter_number(comma + 1, comma + 1 + strlen(comma + 1), &close)
+                    : shutter_number(text, text + strlen(text), &close);
+    if (!ok)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "shutter '%s': want OPEN,CLOSE or S, finite seconds", text);
+    if (!(open >= 0.0) || !(close >= 0.0) || open > SY_SHUTTER_MAX || close > SY_SHUTTER_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "shutter '%s': times must lie in [0, %g] seconds", text,
+                            SY_SHUTTER_MAX);
+    if (open > close)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "shutter '%s': it opens (%g s) after it closes (%g s)", text,
+                            open, close);
+    out->open = open;
+    out->close = close;
+    return SY_OK;
+}
+
+bool sy_shutter_blurs(const sy_shutter *s)
+{
+    return s && s->samples > 1 && s->close > s->open;
+}
+
+double sy_shutter_time(const sy_shutter *s, double frame_time, uint32_t i)
+{
+    uint32_t n = s->samples ? s->samples : 1;
+    return frame_time + s->open + ((double)i + 0.5) / (double)n * (s->close - s->open);
+}

@@ -88,6 +88,31 @@ sy_result sy_scene_time_range(const sy_scene *s, sy_animation clip, double *star
  * selector and lists the available clips. */
 sy_result sy_animation_find(const sy_scene *s, const char *selector, sy_animation *out, sy_error *err);
 
+/** A camera shutter on the scene clock (motion blur): the interval [frame time + open, frame time +
+ * close] in seconds of scene time, 0 <= open <= close (both finite, at most SY_SHUTTER_MAX), sampled at
+ * `samples` stratified times (sy_shutter_time). close == open is an instant: no blur. A renderer shows
+ * the mean of the scene over the interval; `sy render --shutter` accumulates one render per time
+ * (docs/CLI.md "Motion blur"). Plain data. */
+typedef struct sy_shutter {
+    double open, close; /**< seconds after the frame's time */
+    uint32_t samples;   /**< time samples across the interval (>= 1) */
+} sy_shutter;
+
+#define SY_SHUTTER_MAX 1e6 /**< the largest open / close accepted, seconds */
+#define SY_SHUTTER_SAMPLES_MAX 4096u /**< the most time samples of one shutter */
+
+/** Parses "OPEN,CLOSE" or "S" (= "0,S") in seconds into out->open / out->close (out->samples is left
+ * alone). Refuses (SY_ERR_INVALID_ARGUMENT, naming the text and the rule) anything but one or two
+ * finite decimal numbers with 0 <= open <= close <= SY_SHUTTER_MAX: a negative, NaN or infinite value,
+ * open > close, trailing text. */
+sy_result sy_shutter_parse(const char *text, sy_shutter *out, sy_error *err);
+/** True when the shutter spans time (close > open): a render blurs. */
+bool sy_shutter_blurs(const sy_shutter *s);
+/** The scene time of time sample i (0 <= i < samples) of a frame at frame_time: the midpoint of the
+ * i-th of `samples` equal strata of [open, close] (stratified, deterministic):
+ * frame_time + open + (i + 0.5) / samples x (close - open). */
+double sy_shutter_time(const sy_shutter *s, double frame_time, uint32_t i);
+
 /** Play state for interactive tools: a time that advances with wall time while playing. */
 typedef struct sy_clock {
     double time;  /**< current time, seconds */

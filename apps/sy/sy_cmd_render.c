@@ -145,6 +145,7 @@ typedef struct pt_opts {
     uint32_t spp;         /* 0 = default (64 unless a time budget is given) */
     double time_budget;   /* seconds, 0 = none */
     bool aov;             /* write feature buffers as extra EXR channels */
+    uint32_t seed;        /* the back-ends' sampling seed (motion blur: one per time sample) */
 } pt_opts;
 
 typedef struct pt_progress {
@@ -189,7 +190,7 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
         uint64_t left = target ? target - pr.done : UINT32_MAX;
         uint32_t n = (uint32_t)(left < chunk ? left : chunk);
         double p0 = sy_time_now();
-        sy_window_render_opts ro = {.sample_count = n};
+        sy_window_render_opts ro = {.sample_count = n, .seed = po->seed};
         sy_layer_destroy(out);
         sy_layer_destroy(out_right);
         r = sy_compose_render(ld->scene, pool, spec, w, h, &ro, out, out_right, err);
@@ -230,6 +231,117 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
         *samples_out = st.samples;
         *ctx_out = ctx;
     }
+    return r;
+}
+
+/* >>motion blur (--shutter, --motion-blur): the mean of the scene over the shutter interval
+
+ * One render per time sample of the shutter (sy_shutter_time: the midpoints of equal strata), the
+ * scene clock set and committed before each (the moved nodes and deformed meshes reach every
+ * back-end as ordinary changes, so every consumer's change lists stay consistent), each render with
+ * its own sampling seed (independent noise), accumulated here for every back-end: the rasterizer's
+ * and Whitted's images are the mean of the sub-frames; the path tracer's samples are split over the
+ * time samples (spp / N each, the remainder to the first ones; a --time budget likewise) and weighted
+ * by the samples each holds, so every pixel sample has one time and the times are stratified. The
+ * depth plane keeps the nearest depth seen during the exposure. The scene is left at the frame's
+ * time. *samples_out: the samples per pixel in all (progressive) or the time samples. */
+static void restart_main(loaded *ld, sy_context_pool *pool, const sy_compose_spec *spec)
+{
+    sy_params rp;
+    sy_context *rc = NULL;
+    sy_error ignore = {0};
+    if (sy_params_parse(spec->params, &rp, &ignore) == SY_OK &&
+        sy_context_pool_get(pool, ld->scene, spec->backend, &rp, ld->root.id, &rc, &ignore) == SY_OK)
+        sy_context_restart(rc);
+}
+
+static void blur_add(sy_layer *acc, const sy_layer *l, float weight)
+{
+    size_t n = (size_t)acc->width * acc->height;
+    for (size_t k = 0; k < 4 * n; ++k) acc->rgba[k] += weight * l->rgba[k];
+    for (size_t k = 0; k < n; ++k)
+        if (l->depth[k] < acc->depth[k]) acc->depth[k] = l->depth[k];
+}
+
+static sy_result render_blurred(loaded *ld, const char *clip, double frame_time, const sy_shutter *sh,
+                                const sy_compose_spec *spec, uint32_t w, uint32_t h, const pt_opts *po,
+                                sy_context_pool *pool, const sy_window_render_opts *ro, sy_layer *out,
+                                sy_layer *out_right, double *seconds, uint64_t *samples_out, sy_context **ctx_out,
+                                sy_error *err)
+{
+    double t0 = sy_time_now();
+    uint32_t n = sh->samples;
+    uint64_t spp = po ? (po->spp ? po->spp : (po->time_budget > 0 ? 0 : 64)) : 0;
+    if (spp && spp < n) n = (uint32_t)spp; /* at least one sample per time */
+    sy_log(SY_LOG_NOTE, "sy", NULL, "motion blur: the mean of %u sub-frames at times %g .. %g s (shutter %g..%g s after "
+           "%g s)%s", n, sy_shutter_time(&(sy_shutter){sh->open, sh->close, n}, frame_time, 0),
+           sy_shutter_time(&(sy_shutter){sh->open, sh->close, n}, frame_time, n - 1), sh->open, sh->close, frame_time,
+           po ? ", the samples split between them" : ", accumulated");
+    sy_layer acc = {0}, acc_right = {0}, sub = {0}, sub_right = {0};
+    double weight_sum = 0.0;
+    uint64_t total = 0;
+    sy_result r = SY_OK;
+    sy_shutter s = *sh;
+    s.samples = n;
+    for (uint32_t i = 0; i < n && r == SY_OK; ++i) {
+        sy_error se = {0};
+        int st = sy_cli_set_time(ld, clip, sy_shutter_time(&s, frame_time, i), &se);
+        if (st) {
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s",
+                             se.message[0] ? se.message : "motion blur: setting the scene's time failed");
+            break;
+        }
+        sy_layer_destroy(&sub);
+        sy_layer_destroy(&sub_right);
+        double weight = 1.0;
+        if (po) {
+            pt_opts pi = *po;
+            pi.seed = i;
+            if (spp) pi.spp = (uint32_t)(spp / n + (i < spp % n ? 1 : 0));
+            if (po->time_budget > 0) pi.time_budget = po->time_budget / n;
+            restart_main(ld, pool, spec);
+            double secs = 0;
+            uint64_t smp = 0;
+            r = render_progressive(ld, spec, w, h, &pi, pool, &sub, &sub_right, &secs, &smp, ctx_out, err);
+            weight = (double)smp;
+            total += smp;
+        } else {
+            sy_window_render_opts o = *ro;
+            o.seed = i;
+            r = sy_compose_render(ld->scene, pool, spec, w, h, &o, &sub, &sub_right, err);
+            total++;
+        }
+        if (r != SY_OK) break;
+        if (!acc.rgba && (r = sy_layer_create(sub.width, sub.height, &acc, err)) != SY_OK) break;
+        if (sub_right.rgba && !acc_right.rgba &&
+            (r = sy_layer_create(sub_right.width, sub_right.height, &acc_right, err)) != SY_OK)
+            break;
+        blur_add(&acc, &sub, (float)weight);
+        if (sub_right.rgba) blur_add(&acc_right, &sub_right, (float)weight);
+        weight_sum += weight;
+        if (sy_signals_interrupted()) break; /* keep the time samples done */
+    }
+    sy_layer_destroy(&sub);
+    sy_layer_destroy(&sub_right);
+    if (r == SY_OK && weight_sum > 0) {
+        float inv = (float)(1.0 / weight_sum);
+        for (size_t k = 0; k < 4 * (size_t)acc.width * acc.height; ++k) acc.rgba[k] *= inv;
+        for (size_t k = 0; acc_right.rgba && k < 4 * (size_t)acc_right.width * acc_right.height; ++k)
+            acc_right.rgba[k] *= inv;
+    }
+    if (r == SY_OK) { /* back to the frame's time: what the image's metadata describes */
+        sy_error se = {0};
+        if (sy_cli_set_time(ld, clip, frame_time, &se)) r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s", se.message);
+    }
+    if (r != SY_OK) {
+        sy_layer_destroy(&acc);
+        sy_layer_destroy(&acc_right);
+    } else {
+        *out = acc;
+        *out_right = acc_right;
+        *samples_out = total;
+    }
+    *seconds = sy_time_now() - t0;
     return r;
 }
 
@@ -486,6 +598,8 @@ int sy_cmd_render(int argc, char **argv)
     double fps = 24.0;
     bool fps_given = false;
     uint32_t max_memory_mb = 0;
+    sy_shutter shutter = {0.0, 0.0, 0}; /* --shutter / --motion-blur / --shutter-samples: motion blur */
+    bool shutter_given = false, motion_blur = false;
     const sy_cli_opt opts[] = {
         SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT(NULL, 'o', &outp),
         SY_CLI_OPT_UINT("spp", OPT_SPP, &po.spp, 1, 1u << 24),
@@ -504,7 +618,9 @@ int sy_cmd_render(int argc, char **argv)
         SY_CLI_OPT_FLAG("resume", OPT_RESUME, &resume),
         SY_CLI_OPT_UINT("repeat", OPT_REPEAT, &clo.frames, 1, 100000000u), /* cluster: frames through the same window */
         SY_CLI_OPT_UINT("max-memory", OPT_MAX_MEMORY, &max_memory_mb, 1, 1u << 30),
-        SY_CLI_OPT_CODE("at", OPT_AT, true), SY_CLI_OPT_CODE("clip", OPT_CLIP, true)}; /* the scene clock */
+        SY_CLI_OPT_CODE("at", OPT_AT, true), SY_CLI_OPT_CODE("clip", OPT_CLIP, true), /* the scene clock */
+        SY_CLI_OPT_CODE("shutter", OPT_SHUTTER, true), SY_CLI_OPT_FLAG("motion-blur", OPT_MOTION_BLUR, &motion_blur),
+        SY_CLI_OPT_UINT("shutter-samples", OPT_SHUTTER_SAMPLES, &shutter.samples, 1, SY_SHUTTER_SAMPLES_MAX)};
     sy_cli_parser p = {SY_CLI_ARGS("render", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .cluster = true,
                        .view = true};
     int c;
@@ -537,6 +653,15 @@ int sy_cmd_render(int argc, char **argv)
             if (!sy_cli_parse_double(optarg, 0.0, 1e9, &at)) return sy_cli_bad_value("--at", optarg);
             at_given = true;
             break;
+        case OPT_SHUTTER: { /* OPEN,CLOSE or S: seconds after the frame's time (sy_shutter_parse) */
+            sy_error se = {0};
+            if (sy_shutter_parse(optarg, &shutter, &se) != SY_OK) {
+                fprintf(stderr, "sy render: error: --shutter: %s\n", se.message);
+                return 2;
+            }
+            shutter_given = true;
+            break;
+        }
         case OPT_CLIP: /* A,B,C,D (a comma): a section plane; else an animation clip */
             if (!sy_cli_is_clip_plane(optarg)) clip = optarg;
             else if (sy_cli_add_clip_plane(optarg, spec.clip_planes, &spec.clip_count)) return 2;
@@ -569,6 +694,15 @@ int sy_cmd_render(int argc, char **argv)
     if (seq && clo.frames) return sy_cli_usage_of("render", "--frames and --repeat: one or the other");
     if (temporal && !seq) return sy_cli_usage_of("render", "--temporal belongs to --frames A:B (a moving camera's frames)");
     if (seq && strlen(outp) > 4000) return sy_cli_usage_of("render", "-o: the frames' path is too long");
+    if (motion_blur && shutter_given) return sy_cli_usage_of("render", "--motion-blur is --shutter 0,0.5/FPS: give one of them");
+    if (shutter.samples && !shutter_given && !motion_blur)
+        return sy_cli_usage_of("render", "--shutter-samples belongs to --shutter or --motion-blur");
+    if (motion_blur) shutter.close = 0.5 / fps, shutter_given = true; /* a 180-degree shutter */
+    if (!shutter.samples) shutter.samples = 16; /* see docs/CLI.md "Motion blur" */
+    bool blur = shutter_given && sy_shutter_blurs(&shutter);
+    if (blur && (clo.cluster || po.aov || temporal))
+        return sy_cli_usage_of("render", "--shutter / --motion-blur: a local render without --cluster, --aov or --temporal");
+    if (shutter_given && !blur) at += shutter.open; /* an instant: the scene at the shutter's time */
     bool frames_mode = clo.cluster && clo.mode && !strcmp(clo.mode, "frames");
     if (frames_mode && !seq)
         return sy_cli_usage_of("render", "--cluster-mode frames renders sequences: give --frames A:B and -o out_####.exr");
@@ -696,12 +830,16 @@ int sy_cmd_render(int argc, char **argv)
     if (sy_cli_load(scene, camera, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
     /* the scene clock (sy_anim.h): after the load, so the camera framed the loaded pose and the same
      * camera shows every time; the moved nodes reach every back-end (and cluster server) as changes */
-    if (at_given || clip) {
+    if (at_given || clip || (shutter_given && at > 0)) {
         int st = sy_cli_set_time(&ld, clip, at, &err);
         if (st) {
             sy_cli_loaded_free(&ld);
             return st == 2 ? 2 : sy_cli_fail(&err);
         }
+    }
+    if (blur && !sy_scene_count(ld.scene, SY_TYPE_ANIMATION)) {
+        sy_log(SY_LOG_NOTE, "sy", NULL, "--shutter: the scene has no animations; nothing moves, so one render");
+        blur = false;
     }
     sy_cli_default_size(&ld, &w, &h);
     if (ld.is_x3d) sy_cli_fit_x3d_cameras(&ld, w, h); /* X3D fieldOfView is the smaller side's angle */
@@ -733,9 +871,11 @@ int sy_cmd_render(int argc, char **argv)
     bool seq_tty = seq && sy_is_terminal(2);
     sy_video *vid = NULL; /* -o anim.mp4|webm: opened at the first frame */
     uint8_t *vid_rgba = NULL;
+    double frame_time = at; /* the scene time of this image (motion blur opens its shutter there) */
     for (uint32_t fi = 0; fi < nseq && r == SY_OK && !interrupted; ++fi) {
     if (seq) {
         uint32_t frame = fa + fi * fstep;
+        frame_time = frame / fps;
         if (!video) frame_path(pattern, frame, frame_out, sizeof frame_out);
         outp = video ? pattern : frame_out;
         struct stat ost;
@@ -766,7 +906,14 @@ int sy_cmd_render(int argc, char **argv)
     double t0 = sy_time_now();
     sy_context *pctx = NULL;
     char samples_str[32], secs_str[32];
-    if (r == SY_OK && progressive) {
+    if (r == SY_OK && blur) {
+        if (progressive)
+            sy_signals_set_graceful("finishing the current pass, then writing the image accumulated so far");
+        r = render_blurred(&ld, clip, frame_time, &shutter, &spec, w, h, progressive ? &po : NULL, pool, &ro, &img,
+                           &img_right, &secs, &samples, &pctx, &err);
+        t0 = sy_time_now() - secs;
+        interrupted = sy_signals_interrupted();
+    } else if (r == SY_OK && progressive) {
         /* the first Ctrl-C ends the render after the pass in progress and keeps its image */
         sy_signals_set_graceful("finishing the current pass, then writing the image accumulated so far");
         r = render_progressive(&ld, &spec, w, h, &po, pool, &img, &img_right, &secs, &samples, &pctx, &err);
@@ -787,9 +934,12 @@ int sy_cmd_render(int argc, char **argv)
     /* the image's metadata (EXR header attributes, PNG text chunks): what made it and how */
     sy_exr_attribute attrs[14];
     sy_png_text texts[14];
-    char renderer[64], size_str[48], camera_str[256], matrix_str[16 * 18] = "", proj_str[64] = "";
+    char renderer[64], size_str[48], camera_str[256], matrix_str[16 * 18] = "", proj_str[64] = "", shutter_str[96] = "";
     if (r == SY_OK) {
-        if (!progressive) { /* what the main back-end accumulated (a single pass: 1) */
+        if (blur)
+            snprintf(shutter_str, sizeof shutter_str, "%.9g,%.9g s after %.9g s, %u time samples", shutter.open,
+                     shutter.close, frame_time, shutter.samples);
+        if (!progressive && !blur) { /* what the main back-end accumulated (a single pass: 1) */
             sy_params mp;
             sy_context *mc = NULL;
             sy_mediator_stats ms = {0};
@@ -826,7 +976,7 @@ int sy_cmd_render(int argc, char **argv)
                                {"sy:camera", camera_str}, {"sy:camera_to_world", matrix_str}, {"sy:projection", proj_str},
                                {"sy:size", size_str}, {"sy:samples", samples_str},
                                {"sy:seconds", secs_str}, {"sy:source", scene},
-                               {"sy:interrupted", interrupted ? "1" : NULL}};
+                               {"sy:shutter", shutter_str}, {"sy:interrupted", interrupted ? "1" : NULL}};
         for (size_t k = 0; k < sizeof kv / sizeof kv[0]; ++k) {
             if (!kv[k][1] || !kv[k][1][0]) continue;
             attrs[oo.attr_count] = (sy_exr_attribute){kv[k][0], kv[k][1]};

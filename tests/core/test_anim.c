@@ -517,6 +517,31 @@ static int test_properties(void)
     return 0;
 }
 
+/* The motion-blur shutter: "OPEN,CLOSE" and "S" parse; negative, NaN, infinite, open > close and
+ * trailing text are refused naming the text; the time samples are the strata's midpoints. */
+static int test_shutter(void)
+{
+    sy_error e = {0};
+    sy_shutter sh = {.samples = 4};
+    CHECK_OK(sy_shutter_parse("0.25,0.5", &sh, &e), e);
+    EXPECT(sh.open == 0.25 && sh.close == 0.5 && sh.samples == 4 && sy_shutter_blurs(&sh));
+    EXPECT_NEAR(sy_shutter_time(&sh, 1.0, 0), 1.28125, 1e-12); /* 1 + 0.25 + 0.5/4 x 0.25 */
+    EXPECT_NEAR(sy_shutter_time(&sh, 1.0, 3), 1.46875, 1e-12);
+    CHECK_OK(sy_shutter_parse("0.02", &sh, &e), e);
+    EXPECT(sh.open == 0.0 && sh.close == 0.02);
+    CHECK_OK(sy_shutter_parse("0", &sh, &e), e);
+    EXPECT(!sy_shutter_blurs(&sh)); /* an instant: no blur */
+    sh = (sy_shutter){0.0, 1.0, 1};
+    EXPECT(!sy_shutter_blurs(&sh)); /* one time sample: no blur */
+    const char *bad[] = {"-0.1", "0.2,0.1", "nan", "0,inf", "0,", ",1", "1x", "", "0,1,2", "-1,0", "2e6"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        EXPECT_MSG(sy_shutter_parse(bad[i], &sh, &e) == SY_ERR_INVALID_ARGUMENT, "'%s' accepted", bad[i]);
+        EXPECT_SAYS(e, "shutter");
+    }
+    EXPECT(sy_shutter_parse("0.2,0.1", &sh, &e) != SY_OK && strstr(e.message, "opens"));
+    return 0;
+}
+
 SY_CHECK_MAIN("core_anim", SY_TEST(test_step_linear_clamp), SY_TEST(test_slerp), SY_TEST(test_cubic),
               SY_TEST(test_what_channels_leave), SY_TEST(test_validation), SY_TEST(test_round_trip),
-              SY_TEST(test_properties), SY_TEST(test_timing), SY_TEST(test_clock))
+              SY_TEST(test_properties), SY_TEST(test_timing), SY_TEST(test_clock), SY_TEST(test_shutter))
