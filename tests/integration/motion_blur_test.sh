@@ -19,6 +19,7 @@
 # blurred mean (R, G, B, A) equals the mean of the sub-frame renders at the four time-sample times
 # within 1e-5 (float rounding of the sums), and the other back-ends' blurred alpha mean (covered
 # area) equals that sub-frame mean within 0.01 (the back-ends' edges differ by anti-aliasing only).
+# A blurred sequence frame equals the blurred --at render of its time, bit for bit.
 # Usage errors (status 2, naming the option): a negative, NaN, infinite or non-numeric shutter, open
 # after close, --shutter with --motion-blur, --shutter-samples alone or 0.
 # Usage: motion_blur_test.sh SY TMP EXR_EQUAL EXR_BLUR BACKEND...
@@ -122,6 +123,18 @@ for b in "$@"; do
         near "$ba" "$ma" 0.01 || fail "$b: blurred covered area $ba differs from the $ref sub-frames' $ma by more than 0.01"
     fi
 done
+
+# a sequence: frame 6 at 24 fps with --motion-blur (0,1/48) equals --at 0.25 with the same shutter, bit
+# for bit (the frame's time opens the shutter; every time sample restarts the accumulation)
+b=$1
+extra=()
+[ "$b" = pathtracer ] && extra=(--spp 8)
+run_ok "$b sequence blur" seq "$SY" render "$TMP/moving.x3d" -b "$b" -w 48 -h 32 "${extra[@]}" --frames 6:7 --motion-blur \
+    --shutter-samples 4 -o "$TMP/seq_#.exr"
+run_ok "$b --at blur" seq_at "$SY" render "$TMP/moving.x3d" -b "$b" -w 48 -h 32 "${extra[@]}" --at 0.25 --motion-blur \
+    --shutter-samples 4 -o "$TMP/seq_at.exr"
+"$EXR_EQUAL" "$TMP/seq_6.exr" "$TMP/seq_at.exr" >/dev/null || fail "$b: a blurred sequence frame differs from --at with the same shutter"
+"$EXR_EQUAL" "$TMP/seq_6.exr" "$TMP/seq_7.exr" >/dev/null && fail "$b: blurred frames 6 and 7 are the same image"
 
 [ "$fails" -eq 0 ] || exit 1
 rm -rf "$TMP"
