@@ -244,7 +244,8 @@ static sy_result render_progressive(loaded *ld, const sy_compose_spec *spec, uin
  * time samples (spp / N each, the remainder to the first ones; a --time budget likewise) and weighted
  * by the samples each holds, so every pixel sample has one time and the times are stratified. The
  * depth plane keeps the nearest depth seen during the exposure. The scene is left at the frame's
- * time. *samples_out: the samples per pixel in all (progressive) or the time samples. */
+ * time. *samples_out: the samples per pixel in all (progressive) or the time samples; sh->samples
+ * becomes spp when a progressive back-end has fewer samples than time samples. */
 static void restart_main(loaded *ld, sy_context_pool *pool, const sy_compose_spec *spec)
 {
     sy_params rp;
@@ -263,7 +264,7 @@ static void blur_add(sy_layer *acc, const sy_layer *l, float weight)
         if (l->depth[k] < acc->depth[k]) acc->depth[k] = l->depth[k];
 }
 
-static sy_result render_blurred(loaded *ld, const char *clip, double frame_time, const sy_shutter *sh,
+static sy_result render_blurred(loaded *ld, const char *clip, double frame_time, sy_shutter *sh,
                                 const sy_compose_spec *spec, uint32_t w, uint32_t h, const pt_opts *po,
                                 sy_context_pool *pool, const sy_window_render_opts *ro, sy_layer *out,
                                 sy_layer *out_right, double *seconds, uint64_t *samples_out, sy_context **ctx_out,
@@ -272,7 +273,7 @@ static sy_result render_blurred(loaded *ld, const char *clip, double frame_time,
     double t0 = sy_time_now();
     uint32_t n = sh->samples;
     uint64_t spp = po ? (po->spp ? po->spp : (po->time_budget > 0 ? 0 : 64)) : 0;
-    if (spp && spp < n) n = (uint32_t)spp; /* at least one sample per time */
+    if (spp && spp < n) n = sh->samples = (uint32_t)spp; /* at least one sample per time (the metadata says so) */
     sy_log(SY_LOG_NOTE, "sy", NULL, "motion blur: the mean of %u sub-frames at times %g .. %g s (shutter %g..%g s after "
            "%g s)%s", n, sy_shutter_time(&(sy_shutter){sh->open, sh->close, n}, frame_time, 0),
            sy_shutter_time(&(sy_shutter){sh->open, sh->close, n}, frame_time, n - 1), sh->open, sh->close, frame_time,
