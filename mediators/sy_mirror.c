@@ -646,7 +646,10 @@ static sy_result deform_node(sy_mirror *st, node_m *n, sy_error *err)
         }
         in.primitive = src;
         sy_bounds b;
-        if (!sy_deform_primitive(&in, pos, nrm, tan, &b)) {
+        double t_deform = sy_time_now();
+        bool deformed = sy_deform_primitive(&in, pos, nrm, tan, &b);
+        st->stats->deform_seconds += sy_time_now() - t_deform;
+        if (!deformed) {
             char item[48];
             snprintf(item, sizeof item, "node %#x primitive %u", n->id, i);
             sy_log(SY_LOG_WARNING, st->name, item, "deformed beyond the coordinate range: not updated");
@@ -670,6 +673,7 @@ static sy_result deform_node(sy_mirror *st, node_m *n, sy_error *err)
         if (bt) q.tangents = bt;
         q.joints = q.weights = q.target_positions = q.target_normals = q.target_tangents = NULL;
         sy_mirror_flat_mesh flat;
+        double t_update = sy_time_now();
         if (q.topology != SY_TOPOLOGY_TRIANGLES) {
             char what[96];
             snprintf(what, sizeof what, "%s: node %#x primitive %u", st->name, n->id, i);
@@ -686,6 +690,7 @@ static sy_result deform_node(sy_mirror *st, node_m *n, sy_error *err)
             sy_mirror_primitive_args a = {m->id, i, &q, &n->dprims[i], &flat};
             r = in_place ? st->cb->primitive_update(st->user, &a, err) : st->cb->primitive_set(st->user, &a, err);
         }
+        st->stats->update_seconds += sy_time_now() - t_update;
         sy_blob_release(bp), sy_blob_release(bn), sy_blob_release(bt); /* back-ends copy what they keep */
         if (r == SY_OK) st->stats->deformed++;
     }

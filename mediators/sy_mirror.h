@@ -155,6 +155,9 @@ typedef struct sy_mirror_sync_stats {
     uint32_t placements;      /**< node placements recomputed */
     uint32_t nodes_destroyed; /**< mirrored nodes removed */
     uint32_t deformed;        /**< primitive instances deformed (skins, morph targets: sy_deform.h) */
+    double deform_seconds;    /**< wall time in sy_deform_primitive (the deformation itself) */
+    double update_seconds;    /**< wall time in the back-end's primitive_update / primitive_set for the
+                               * deformed primitives (the ray tracers' BVH refit, the rasterizer's upload) */
 } sy_mirror_sync_stats;
 
 /** A mirrored background (defaults for fields never set). */

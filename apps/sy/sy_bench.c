@@ -2,7 +2,8 @@
  * rounds, sorting, the resident set. Each benchmark has its file: sy_bench_sync.c, sy_bench_rays.c,
  * sy_bench_viewports.c, sy_bench_raster.c, sy_bench_load.c, sy_bench_memory.c,
  * sy_bench_pathtracer.c, sy_bench_filters.c, sy_bench_limit.c, sy_bench_instances.c,
- * sy_bench_governor.c, sy_bench_cull.c, sy_bench_web.c; sy_cmd_bench.c parses the command line. */
+ * sy_bench_governor.c, sy_bench_cull.c, sy_bench_web.c, sy_bench_deform.c, sy_bench_anim.c;
+ * sy_cmd_bench.c parses the command line. */
 #include "sy_bench.h"
 
 #include <stdio.h>

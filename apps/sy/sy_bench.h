@@ -99,6 +99,13 @@ int sy_cmd_bench_limit(int argc, char **argv);
  * commit + sync against building the scene from scratch, `repeats` frames (sy_bench_deform.c). */
 sy_result sy_bench_deform(uint32_t vertices, uint32_t repeats, sy_error *err);
 
+/* sy bench anim (issue 35, sy_bench_anim.c): a tube of about `vertices` vertices skinned to 16
+ * animated joints and `nodes` animated nodes, each written to a .glb and loaded by sy_gltf_load;
+ * per frame (`frames` of the clip) the clock, commit, change list, the mirror (its deformation)
+ * and, per back-end, the sync (deformation, BVH refit or upload, top-level commit) against
+ * translating the same frame from scratch. */
+sy_result sy_bench_anim(uint32_t vertices, uint32_t nodes, uint32_t frames, sy_error *err);
+
 /* sy bench lights (issue 39, apps/sy/sy_bench_lights.c): a generated many-lights scene (`quads`
  * small emissive quads, `points` point lights of varied power, 30 boxes over a large floor) written
  * to out_dir/many_lights.gltf (NULL: a new temporary directory) and loaded by the normal loader;

@@ -236,6 +236,8 @@ static const char usage_text[] =
             "            (one mesh instanced: 10^3 x 10^6 triangles by default, every picture back-end)\n"
             "  sy bench governor [SCENE] [--budget MS] [--frames N] [-w W] [-h H]   (frame-time governor, orbiting camera)\n"
             "  sy bench deform [--tris VERTICES] [--repeats FRAMES]   (a skinned frame: deform, refit, re-upload)\n"
+            "  sy bench anim [--tris VERTICES] [--nodes NODES] [--repeats FRAMES]   (an animated frame from a .glb, step by\n"
+            "            step: clock, commit, change list, deformation, sync, refit / upload, against from scratch)\n"
             "  sy bench cull [--tris N] [--objects N] [--budget T] [-w W] [-h H] [--frames N] [--write PLANT.glb]\n"
             "  sy coverage SCENE [--camera C] [-w W] [-h H] [--top N]\n"
             "  sy pick SCENE X Y [X Y ...] [-b BACKEND] [-w W] [-h H] [--camera NAME|INDEX] [--params k=v,...]\n"

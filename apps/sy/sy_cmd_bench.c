@@ -145,7 +145,7 @@ int sy_cmd_bench(int argc, char **argv)
 {
     static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
                                         "viewports", "load", "cluster",    "memory", "instances", "governor",
-                                        "limit",     "cull", "web", "deform", "lights", "temporal"};
+                                        "limit",     "cull", "web", "deform", "anim", "lights", "temporal"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -190,6 +190,10 @@ int sy_cmd_bench(int argc, char **argv)
     if (!strcmp(cmd, "deform")) { /* --tris: vertices of the skinned tube */
         if (optind < argc) return sy_cli_usage_of(who, "no SCENE: the skinned tube is generated");
         return sy_bench_deform(tris == 100 ? 100000 : tris, repeats ? repeats : 50, &err) == SY_OK ? 0 : sy_cli_fail(&err);
+    }
+    if (!strcmp(cmd, "anim")) { /* --tris: vertices of the skinned tube; --nodes: animated nodes */
+        if (optind < argc) return sy_cli_usage_of(who, "no SCENE: the animated scenes are generated");
+        return sy_bench_anim(tris == 100 ? 100000 : tris, nodes, repeats ? repeats : 50, &err) == SY_OK ? 0 : sy_cli_fail(&err);
     }
     if (!strcmp(cmd, "lights")) { /* --nodes: emissive quads, --tris: point lights, --repeats: seconds per method */
         if (optind < argc) return sy_cli_usage_of(who, "no SCENE: the many-lights scene is generated");

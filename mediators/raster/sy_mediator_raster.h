@@ -39,6 +39,9 @@ typedef struct sy_mediator_raster_counters {
     uint32_t instances, meshes, materials, textures, lights; /** @} */
     /** @{ placements recomputed and change entries handled by the last sync */
     uint32_t last_sync_placements, last_sync_entries; /** @} */
+    /** @{ of the last sync: the mirror's deformation of skinned / morphed meshes, and the re-upload
+     * of their vertex buffers (sy_gl_mesh_update; sy_mirror_sync_stats) */
+    double last_sync_deform_seconds, last_sync_upload_seconds; /** @} */
     /** @{ uploads of the last frame (vertex and index buffers, their bytes, uniform buffers, textures) */
     uint64_t vertex_buffer_uploads, vertex_bytes, uniform_buffer_uploads, texture_uploads; /** @} */
     uint64_t model_matrix_updates; /**< instance transforms set in the last frame */

@@ -144,6 +144,9 @@ typedef struct sy_mediator_rt_counters {
     uint32_t last_sync_entries;    /**< change entries handled by the last sync */
     double last_sync_top_commit_seconds; /**< of the last sync: Embree's rebuild of the top-level BVH
                                           * (rtcCommitScene over every instance; 0 when not needed) */
+    /** @{ of the last sync: the mirror's deformation of skinned / morphed meshes, and the updates of
+     * their vertices in the device (copy + BVH refit, sy_rt_mesh_update; sy_mirror_sync_stats) */
+    double last_sync_deform_seconds, last_sync_refit_seconds; /** @} */
     uint32_t accum_restarts;       /**< path tracer: accumulations restarted (not counting the first) */
     uint64_t last_render_rays;     /**< path tracer: rays traced by the last render */
     uint32_t warnings;             /**< out-of-range material / light values clamped (each also logged:

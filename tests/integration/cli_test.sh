@@ -18,7 +18,7 @@
 #     directory is found before anything is rendered; --params with a key twice is a usage error
 #   - typed parameters: sy backends --params (text and --json) lists each back-end's table; an unknown
 #     --params key, a value out of range or not in the enum: status 2 naming it (and the valid keys)
-#   - sy bench sync / sy bench rays / sy bench governor / sy bench limit on small sizes: exit 0 and
+#   - sy bench sync / sy bench anim / sy bench rays / sy bench governor / sy bench limit on small sizes: exit 0 and
 #     their result lines (no thresholds; bench limit: no replayed answer differs from the frame's), a bad --spp named
 #   - sy demo -o DIR -w 64 -h 36: demo_whitted.png / .exr written
 #   - -b pathtracer: --spp with --aov (EXR with feature channels), --time; a non-EXR --env fails
@@ -331,6 +331,17 @@ grep -Eq 'ratio full / incremental +[0-9.]+ x' "$TMP/bench_sync.out" || fail "be
 grep -Eq 'placements recomputed +1$' "$TMP/bench_sync.out" || fail "bench sync: a leaf move did not re-place exactly 1"
 grep -Eq '^sy bench sync: 200 nodes' "$TMP/bench_sync.out" || fail "bench sync: wrong node count"
 cat "$TMP/bench_sync.out"
+run_ok "bench anim" bench_anim "$SY" bench anim --tris 2000 --nodes 30 --repeats 3
+grep -Eq 'skinned_tube.glb loaded by sy_gltf_load .* 16 channels; 3 frames' "$TMP/bench_anim.out" ||
+    fail "bench anim: the skinned .glb did not load with its 16 channels"
+grep -Eq 'animated_nodes.glb loaded by sy_gltf_load .* 60 channels; 3 frames' "$TMP/bench_anim.out" ||
+    fail "bench anim: the nodes' .glb did not load with its 60 channels"
+# the skinned scene's mirror deformed something each frame (a time above 0): the skin came through the file
+grep -m1 'of which deformation (sy_deform_primitive)' "$TMP/bench_anim.out" | grep -Eq ' 0\.0*[1-9][0-9]* ms| [1-9][0-9]*\.[0-9]+ ms' ||
+    fail "bench anim: the skinned mesh was not deformed"
+[ "$(grep -Ec 'from scratch \(new context \+ first sync\) +[0-9.]+ ms +frame / scratch [0-9.]+' "$TMP/bench_anim.out")" -ge 2 ] ||
+    fail "bench anim: no frame / scratch ratio per scene"
+cat "$TMP/bench_anim.out"
 run_ok "bench rays" bench_rays "$SY" bench rays demo -w 64 -h 64 --repeats 2
 grep -Eq 'raw Embree rtcIntersect1 +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fail "bench rays: no raw line"
 grep -Eq 'whitted back-end \(primary\) +[0-9.]+ Mrays/s' "$TMP/bench_rays.out" || fail "bench rays: no ours line"
