@@ -20,8 +20,12 @@ void *sy_gli_pool_get(const pool *p, uint32_t id)
 void *sy_gli_pool_alloc(pool *p)
 {
     uint32_t i = 1; /* slot 0 unused, so ids are never 0 */
-    for (; i < p->count; ++i)
-        if (((slot_head *)sy_gli_pool_at(p, i))->id == 0) break;
+    if (p->count && p->live + 1u >= p->count)
+        i = p->count; /* no free slot below count (the usual case while a scene is built): append, O(1);
+                       * searching made building n instances O(n^2): 17 s for 3 x 10^4 nodes */
+    else
+        for (; i < p->count; ++i)
+            if (((slot_head *)sy_gli_pool_at(p, i))->id == 0) break;
     if (i >= IDX_MASK) return NULL;
     if (i >= p->count) {
         if (i >= p->cap) {
