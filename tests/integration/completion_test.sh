@@ -67,6 +67,8 @@ expect "render demo --q" --quiet
 expect "serve --max-l" --max-lifetime
 expect "bench cluster --ho" --hostile-only
 expect "bench gov" governor
+expect "bench an" anim
+expect "bench anim --no" --nodes
 expect "bench governor --bu" --budget
 expect "bench governor --budget 20 --tr" --trace
 expect "view demo --bu" --budget
