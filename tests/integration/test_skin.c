@@ -4,7 +4,8 @@
  * update of the deformed vertices (the ray tracers refit, the rasterizer re-uploads). Their
  * silhouettes (alpha coverage) agree at t = 1 (IoU >= 0.97), and differ from their own t = 0 pose
  * (IoU < 0.95: the walk moved the legs and arms); a pick names the skinned node at the depth the
- * t = 1 image has there, in every back-end. Skipped when the sample is absent. */
+ * t = 1 image has there, in every back-end. Then the view sy render makes without a camera frames
+ * CesiumMan and the Fox whole at five times each (framed_whole). Skipped when a sample is absent. */
 #include "it_util.h"
 #include "sy_anim.h"
 #include "sy_stats.h"
@@ -30,6 +31,47 @@ static sy_result render(sy_context *ctx, const sy_camera_view *view, sy_layer *i
     req.sample_count = 16;
     sy_result r = sy_layer_create(W, H, img, err);
     return r != SY_OK ? r : sy_context_render(ctx, &req, img, err);
+}
+
+/* The view sy render makes without a camera (sy_camera_view_frame_bounds of the root's world bounds,
+ * as core/sy_viewport.c) frames the skinned model whole at each time: whitted's image of it covers
+ * no pixel of the image's border, and some pixel. A framing from bounds that ignored the pose (or
+ * that placed the skinned vertices by the mesh node's own transform, which glTF skins ignore) would
+ * cut a limb off at some time. */
+static void framed_whole(const char *path, const double *times, int n)
+{
+    sy_gltf_info info;
+    sy_scene *s = it_load_gltf(path, &info);
+    sy_context *ctx = NULL;
+    MUST(sy_scene_set_time(s, (sy_animation){0}, times[0], err));
+    MUST(sy_scene_commit(s, NULL, err));
+    MUST(sy_context_create(s, "whitted", NULL, info.root.id, &ctx, err));
+    for (int i = 0; i < n; ++i) {
+        MUST(sy_scene_set_time(s, (sy_animation){0}, times[i], err));
+        MUST(sy_scene_commit(s, NULL, err));
+        MUST(sy_context_sync(ctx, err));
+        sy_bounds b;
+        MUST(sy_node_world_bounds(s, info.root, &b, err));
+        sy_camera_view view = sy_camera_view_frame_bounds(&b, (float)W / (float)H);
+        sy_layer img;
+        MUST(render(ctx, &view, &img, err));
+        uint32_t x0 = W, x1 = 0, y0 = H, y1 = 0, edge = 0;
+        for (uint32_t y = 0; y < H; ++y)
+            for (uint32_t x = 0; x < W; ++x) {
+                if (!isfinite(img.depth[(size_t)y * W + x])) continue;
+                x0 = x < x0 ? x : x0, x1 = x > x1 ? x : x1, y0 = y < y0 ? y : y0, y1 = y > y1 ? y : y1;
+                edge += x == 0 || y == 0 || x == W - 1 || y == H - 1;
+            }
+        printf("%s at t=%.2f, default framing: covered x %u..%u, y %u..%u of %ux%u, %u on the border\n", path, times[i],
+               x0, x1, y0, y1, W, H, edge);
+        EXPECT_MSG(x0 <= x1, "%s at t=%.2f: nothing in the default view", path, times[i]);
+        EXPECT_MSG(edge == 0, "%s at t=%.2f: the default view cuts the model (%u pixels on the border)", path, times[i],
+                   edge);
+        sy_layer_destroy(&img);
+    }
+    sy_context_release(ctx);
+    sy_gltf_info_free(&info);
+    sy_scene_destroy(s);
 }
 
 int main(void)
@@ -90,5 +132,11 @@ int main(void)
     }
     sy_gltf_info_free(&info);
     sy_scene_destroy(s);
+    /* item 3 of issue 35: sy render --at T without a camera frames CesiumMan and the Fox whole */
+    static const double man_t[] = {0.0, 0.5, 1.0, 1.5, 2.0}, fox_t[] = {0.0, 0.4, 0.8, 1.6, 3.0};
+    framed_whole(path, man_t, 5);
+    char fox[1024];
+    it_testdata("gltf/Fox/glTF/Fox.gltf", fox, sizeof fox);
+    framed_whole(fox, fox_t, 5);
     return sy_check_finish("integration_skin");
 }
