@@ -218,6 +218,8 @@ static const char usage_text[] =
             "          [--hide NODE] [--isolate NODE] [--select NODE]   (the start state; as sy render)\n"
             "          [--filter none|pixel|...] [--threshold T] [--budget MS] [--client-render]   (the view in a browser:\n"
             "           open the URL it prints; another address than loopback needs the printed token)\n"
+            "          [--read-only]   (viewers move the camera, pick and take stills, but change no visibility,\n"
+            "           selection, section plane, exposure, filter or back-end)\n"
             "          [--delay-ms N]   (tests only: N ms of added network delay each way)\n"
             "  sy bench web [SCENE] [-b BACKEND] [-w W] [-h H] [--repeats N]   (input-to-frame latency, loopback)\n"
             "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"

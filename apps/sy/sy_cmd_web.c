@@ -18,14 +18,14 @@
 
 #ifdef SY_HAVE_WEB
 /* `sy web SCENE`: the view in a web browser (apps/web/sy_web.h, docs/WEB.md). */
-enum { OPT_WEB_LISTEN = 0x300, OPT_WEB_QUALITY, OPT_WEB_CLIENT_RENDER, OPT_WEB_DELAY };
+enum { OPT_WEB_LISTEN = 0x300, OPT_WEB_QUALITY, OPT_WEB_CLIENT_RENDER, OPT_WEB_DELAY, OPT_WEB_READ_ONLY };
 int sy_cmd_web(int argc, char **argv)
 {
     const char *backend = NULL, *camera = NULL, *listen = NULL, *filter = NULL, *scene = NULL;
     uint32_t w = 1920, h = 1200, quality = 80, delay_ms = 0;
     float threshold = 0.0f;
     double budget = 0; /* 0: the governor's default (33 ms) */
-    bool client_render = false, no_temporal = false;
+    bool client_render = false, no_temporal = false, read_only = false;
     const sy_cli_opt opts[] = {
         SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera),
         SY_CLI_OPT_TEXT("listen", OPT_WEB_LISTEN, &listen), SY_CLI_OPT_UINT("quality", OPT_WEB_QUALITY, &quality, 1, 100),
@@ -33,6 +33,7 @@ int sy_cmd_web(int argc, char **argv)
         SY_CLI_OPT_REAL("budget", OPT_BUDGET, &budget, 1.0, 10000.0), /* the frame-time governor's budget (ms) */
         SY_CLI_OPT_FLAG("client-render", OPT_WEB_CLIENT_RENDER, &client_render),
         SY_CLI_OPT_FLAG("no-temporal", OPT_NO_TEMPORAL, &no_temporal),
+        SY_CLI_OPT_FLAG("read-only", OPT_WEB_READ_ONLY, &read_only), /* viewers look, they do not change the scene */
         SY_CLI_OPT_UINT("delay-ms", OPT_WEB_DELAY, &delay_ms, 0, 10000)}; /* tests only: added network delay each way */
     sy_cli_parser p = {SY_CLI_ARGS("web", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .view = true};
     if (sy_cli_parse(&p) != -1) return p.status;
@@ -45,7 +46,7 @@ int sy_cmd_web(int argc, char **argv)
     sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,
                      .backend = backend, .listen = listen, .max_width = w, .max_height = h, .quality = (int)quality,
                      .filter = filter, .threshold = threshold, .budget_ms = budget, .delay_ms = delay_ms,
-                     .no_temporal = no_temporal};
+                     .no_temporal = no_temporal, .read_only = read_only};
     sy_web *web = NULL;
     sy_result r = SY_OK;
 #ifdef SY_WEB_HAVE_CULL
@@ -67,7 +68,8 @@ int sy_cmd_web(int argc, char **argv)
     if (r == SY_OK) {
         const char *url = sy_web_url(web), *q = strchr(url, '?');
         int host_len = q ? (int)(q - url) : (int)strlen(url);
-        printf("sy web: serving %s with %s; open %.*s%s%s%s\n", argv[optind], backend, host_len, url,
+        printf("sy web: serving %s with %s%s; open %.*s%s%s%s\n", argv[optind], backend, read_only ? " (read-only)" : "",
+               host_len, url,
                client_render ? "client/client.html" : "", q ? q : "",
                strstr(url, "//0.0.0.0:") || strstr(url, "//[::]:") ? " (with this machine's name or address for the host)" : "");
         fflush(stdout);

@@ -87,6 +87,8 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     pthread_cond_init(&w->cv, NULL);
     w->pending_tail = &w->pending;
     w->stills_tail = &w->stills;
+    w->actions_tail = &w->actions;
+    w->replies_tail = &w->replies;
     sy_result r = SY_OK;
     if (w->d.max_width > 16384 || w->d.max_height > 16384 || w->d.max_clients > 1000 || w->d.max_message < 64 ||
         w->d.max_message > (1u << 24) || w->d.quality < 1 || w->d.quality > 100 || w->d.idle_timeout_s > 3600 ||
@@ -244,6 +246,8 @@ void sy_web_destroy(sy_web *w)
     free_jobs(w->finished);
     free_jobs(w->pending);
     free_jobs(w->stills);
+    for (web_action *a = w->actions, *n; a; a = n) n = a->next, free(a);
+    for (web_reply *y = w->replies, *n; y; y = n) n = y->next, free(y->text), free(y);
     while (w->handoffs) {
         web_handoff *h = w->handoffs;
         w->handoffs = h->next;

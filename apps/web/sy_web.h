@@ -9,6 +9,10 @@
  * (a desktop viewport mirrored on a tablet); the render size is the size the most recent page asked
  * for (capped at max_width x max_height), each page scales the frame to its canvas.
  *
+ * Pages may also pick (sy_viewport_pick), show, hide, select and isolate nodes, set section planes
+ * and the exposure, and read the scene's hierarchy (docs/WEB.md, "The WebSocket protocol"); a
+ * read_only server refuses every change but the camera's.
+ *
  * Threads: sy_web_create starts the network thread (the libwebsockets service loop); the thread
  * that calls sy_web_run renders, and is the only one that touches the scene while it runs. The two
  * talk through a mutex-protected mailbox; the render thread wakes the service loop with
@@ -103,6 +107,9 @@ typedef struct sy_web_desc {
     uint32_t delay_ms;          /**< TESTS ONLY (sy web --delay-ms): every input message is applied and
                                      every frame sent this much later (0..10000; 0 = none), an added
                                      network delay in both directions for measuring the page */
+    bool read_only;           /**< viewers look (camera, pick, tree, stills) but cannot change visibility,
+                                   selection, section planes, exposure, display filter or back-end: those
+                                   messages are refused with a log line (sy web --read-only) */
     const sy_web_route *routes; /**< extra routes (the array is copied; its strings and user pointers must outlive the server) */
     uint32_t route_count;     /**< how many */
 } sy_web_desc;
@@ -111,8 +118,9 @@ typedef struct sy_web_desc {
 typedef struct sy_web sy_web;
 
 /** Binds the address (apps/web/sy_web_gate.h takes the connections until their request is whole)
- * and starts the network thread. The scene is only read: the server adds nothing to it and never
- * commits it (the application commits its own changes).
+ * and starts the network thread. The server adds nothing to the scene; it changes only node flags
+ * a page asks for (visibility, selection, isolation; not with read_only) and then commits the scene,
+ * on the render thread between frames (the application commits its own changes).
  * Fails with a message naming the address when it cannot be bound, the back-end when it is not
  * registered, the option when a limit is out of range. */
 sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err);
@@ -131,7 +139,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err);
 /** The view every page shares, as last rendered (a frame or a still; before the first, the
  * camera's pose): its camera-to-world matrix, and (camera, may be NULL) the application's camera
  * node whose camera gives the projection. The server sets the view on its viewports directly
- * (core/sy_interactive.h): it adds no node to the scene and never commits it. Call on the render
+ * (core/sy_interactive.h): it adds no node to the scene. Call on the render
  * thread (a route handler). */
 void sy_web_view(const sy_web *w, sy_mat4 *camera_to_world, sy_node *camera);
 /** The server's counters (any thread): connections (sy_web_gate.h) and stills. */

@@ -283,6 +283,9 @@ const sy_web_asset *sy_web_asset_find(const char *path)
 static bool same_origin_or_token(const sy_web_head *h, const sy_web_verdict *v, bool token_required)
 {
     if (h->origin) return sy_web_origin_is_same(h->origin, h->host);
+    /* a browser's same-origin GET carries no Origin but says Sec-Fetch-Site (no script can set it) */
+    if (h->fetch_site && !strcasecmp(h->fetch_site, "same-origin") && h->method && !strcmp(h->method, "GET") && !h->upgrade)
+        return true;
     return token_required && v->token == 1;
 }
 
@@ -363,6 +366,67 @@ static bool json_num(const cJSON *o, const char *key, double lo, double hi, doub
     return true;
 }
 
+/* An optional boolean (absent: false). */
+static bool json_bool(const cJSON *o, const char *key, bool *out)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+    *out = cJSON_IsTrue(v);
+    return !v || cJSON_IsBool(v);
+}
+
+/* An optional request number "seq" (absent: 0). */
+static bool json_seq(const cJSON *o, uint32_t *out)
+{
+    double s = 0;
+    *out = 0;
+    if (!cJSON_GetObjectItemCaseSensitive(o, "seq")) return true;
+    if (!json_num(o, "seq", 0, 2147483647.0, &s) || s != floor(s)) return false;
+    *out = (uint32_t)s;
+    return true;
+}
+
+/* "planes": an array of at most SY_CLIP_PLANES_MAX arrays of 4 numbers, each plane as
+ * sy_clip_planes_check takes it (finite, within SY_COORD_MAX, a non-zero normal). */
+static sy_result parse_planes(const cJSON *m, sy_web_input *out, sy_error *err)
+{
+    const cJSON *ps = cJSON_GetObjectItemCaseSensitive(m, "planes");
+    if (!cJSON_IsArray(ps)) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "clip: planes must be an array of [a, b, c, d]");
+    int n = cJSON_GetArraySize(ps);
+    if (n > SY_CLIP_PLANES_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "clip: %d planes, at most %d", n, SY_CLIP_PLANES_MAX);
+    for (int i = 0; i < n; ++i) {
+        const cJSON *p = cJSON_GetArrayItem(ps, i);
+        if (!cJSON_IsArray(p) || cJSON_GetArraySize(p) != 4)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "clip: plane %d is not [a, b, c, d]", i);
+        for (int k = 0; k < 4; ++k) {
+            const cJSON *v = cJSON_GetArrayItem(p, k);
+            if (!cJSON_IsNumber(v)) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "clip: plane %d value %d is not a number", i, k);
+            double d = v->valuedouble;
+            /* NaN and infinities (cJSON reads 1e999 as inf) are caught by sy_clip_planes_check */
+            out->planes[i][k] = isfinite(d) && fabs(d) <= 3.4e38 ? (float)d : (float)NAN;
+        }
+    }
+    out->plane_count = (uint32_t)n;
+    sy_error ce = {0};
+    if (sy_clip_planes_check((const float(*)[4])out->planes, out->plane_count, &ce) != SY_OK)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "clip: %.200s", ce.message);
+    return SY_OK;
+}
+
+bool sy_web_input_changes_scene(const sy_web_input *in)
+{
+    switch (in->type) {
+    case SY_WEB_INPUT_VISIBLE:
+    case SY_WEB_INPUT_SELECT:
+    case SY_WEB_INPUT_ISOLATE:
+    case SY_WEB_INPUT_CLIP:
+    case SY_WEB_INPUT_EXPOSURE:
+    case SY_WEB_INPUT_FILTER: return true;
+    case SY_WEB_INPUT_KEY: return in->key != 'r'; /* back-ends and the filter keys; R is the camera */
+    default: return false;
+    }
+}
+
 sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -403,6 +467,46 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
         if (!((key >= '1' && key <= '9') || key == 'f' || key == '[' || key == ']' || key == 'r'))
             r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "key: k must be one of 1-9, f, [, ], r");
         out->key = key;
+    } else if (!strcmp(type, "pick")) {
+        out->type = SY_WEB_INPUT_PICK;
+        /* the canvas point as fractions of its size: [0, 1) each (a pick outside is refused here) */
+        if (!json_num(m, "x", 0, 1, &out->a) || !json_num(m, "y", 0, 1, &out->b) || out->a >= 1 || out->b >= 1)
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "pick: x and y must be fractions of the canvas in [0, 1)");
+        else if (!json_bool(m, "select", &out->on) || !json_seq(m, &out->seq))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "pick: select must be true or false, seq a whole number 0..2^31");
+    } else if (!strcmp(type, "visible") || !strcmp(type, "select") || !strcmp(type, "isolate")) {
+        out->type = type[0] == 'v' ? SY_WEB_INPUT_VISIBLE : type[0] == 's' ? SY_WEB_INPUT_SELECT : SY_WEB_INPUT_ISOLATE;
+        double node = 0;
+        double lo = out->type == SY_WEB_INPUT_VISIBLE ? 1 : 0;
+        if (!json_num(m, "node", lo, SY_WEB_NODE_ID_MAX, &node) || node != floor(node))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: node must be a node id (a whole number %s..%u)", type,
+                             lo ? "1" : "0", SY_WEB_NODE_ID_MAX);
+        else if (out->type != SY_WEB_INPUT_ISOLATE && !json_bool(m, "on", &out->on))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: on must be true or false", type);
+        out->node = (uint32_t)node;
+        if (out->type == SY_WEB_INPUT_VISIBLE && !cJSON_GetObjectItemCaseSensitive(m, "on") && r == SY_OK)
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "visible: on is required");
+    } else if (!strcmp(type, "clip")) {
+        out->type = SY_WEB_INPUT_CLIP;
+        r = parse_planes(m, out, err);
+    } else if (!strcmp(type, "tree")) {
+        out->type = SY_WEB_INPUT_TREE;
+        if (!json_seq(m, &out->seq)) r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "tree: seq must be a whole number 0..2^31");
+    } else if (!strcmp(type, "exposure")) {
+        out->type = SY_WEB_INPUT_EXPOSURE;
+        if (!json_num(m, "stops", -SY_WEB_EXPOSURE_MAX, SY_WEB_EXPOSURE_MAX, &out->a))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "exposure: stops must be a number within +-%g", SY_WEB_EXPOSURE_MAX);
+    } else if (!strcmp(type, "filter")) {
+        out->type = SY_WEB_INPUT_FILTER;
+        const cJSON *f = cJSON_GetObjectItemCaseSensitive(m, "name");
+        size_t n = cJSON_IsString(f) ? strlen(f->valuestring) : 0;
+        bool ok = n >= 1 && n < sizeof out->filter;
+        for (size_t i = 0; ok && i < n; ++i) {
+            char c = f->valuestring[i];
+            ok = (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
+        }
+        if (!ok) r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "filter: name must be 1..31 of a-z, 0-9, '-', '_'");
+        else memcpy(out->filter, f->valuestring, n + 1);
     } else {
         char tn[40];
         snprintf(tn, sizeof tn, "%.32s", type);

@@ -13,6 +13,8 @@
 
 #include "sy_web.h"
 
+#include "sy_request.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -84,6 +86,8 @@ typedef struct sy_web_head {
     size_t path_len;          /**< its length as sent (the copy may be cut: >= SY_WEB_MAX_PATH is refused) */
     const char *query;        /**< the decoded arguments, '&'-separated ("" none) */
     const char *host, *origin, *content_type, *cookie;
+    const char *fetch_site;   /**< Sec-Fetch-Site (a browser's own: "same-origin" stands for a same-origin
+                               *   Origin on a GET, which browsers send without Origin) */
     bool upgrade;             /**< a WebSocket upgrade */
     bool has_length;          /**< Content-Length given */
     uint64_t content_length;  /**< its value */
@@ -118,23 +122,49 @@ typedef struct sy_web_verdict {
  * (403); POST: a route (404), a same-origin Origin or a right token (403), a JSON Content-Type
  * (415), a Content-Length within max_body (413); GET / and the page's files (/index.html,
  * /view.js, ...): the asset; GET /api/frame.jpg:
- * a same-origin Origin or a right token (403), w and h in 1..still_max_w/h and w x h within
+ * a same-origin Origin, Sec-Fetch-Site: same-origin (a page's own fetch) or a right token (403), w and h in 1..still_max_w/h and w x h within
  * still_max_pixels (400, 413); GET routes; else 404. */
 void sy_web_check_request(const sy_web_policy *policy, const sy_web_head *head, sy_web_verdict *verdict);
 
 /** A WebSocket input message (docs/WEB.md). */
-typedef enum sy_web_input_type { SY_WEB_INPUT_SIZE, SY_WEB_INPUT_DRAG, SY_WEB_INPUT_WHEEL, SY_WEB_INPUT_KEY } sy_web_input_type;
+typedef enum sy_web_input_type {
+    SY_WEB_INPUT_SIZE, SY_WEB_INPUT_DRAG, SY_WEB_INPUT_WHEEL, SY_WEB_INPUT_KEY,
+    SY_WEB_INPUT_PICK,     /**< what is under the canvas point (a, b) (fractions 0..1 of the canvas); select: select it */
+    SY_WEB_INPUT_VISIBLE,  /**< show (on) or hide node */
+    SY_WEB_INPUT_SELECT,   /**< select (on) or deselect node; node 0: clear the selection */
+    SY_WEB_INPUT_ISOLATE,  /**< show only node (with its ancestors and subtree); node 0: show every node */
+    SY_WEB_INPUT_CLIP,     /**< the section planes (plane_count of planes; 0: none) */
+    SY_WEB_INPUT_TREE,     /**< asks for the scene's hierarchy (answered with a "tree" message) */
+    SY_WEB_INPUT_EXPOSURE, /**< exposure in stops (a) */
+    SY_WEB_INPUT_FILTER    /**< the display filter by name (filter) */
+} sy_web_input_type;
+
+/** Node ids a page may name: 1..SY_WEB_NODE_ID_MAX (sy_node.id); unknown ones are refused later. */
+#define SY_WEB_NODE_ID_MAX 0xFFFFFFFFu
+/** Exposure a page may set, in stops (+-). */
+#define SY_WEB_EXPOSURE_MAX 16.0
 
 typedef struct sy_web_input {
     sy_web_input_type type;
-    double a, b;     /**< size: w, h; drag: dx, dy; wheel: steps */
+    double a, b;     /**< size: w, h; drag: dx, dy; wheel: steps; pick: x, y in [0, 1) of the canvas; exposure: stops */
     uint32_t button; /**< drag: 0 orbit, 1 or 2 pan */
     char key;        /**< key: '1'..'9', 'f', '[', ']', 'r' (lower case) */
     uint32_t version; /**< size: the frame format the page reads ("v", 0..1000; 0 = absent: a page
                        * older than frame format 2, refused with a status message) */
+    uint32_t node;   /**< visible, select, isolate: the node id (0 only for select / isolate: all) */
+    bool on;         /**< visible: show; select: select; pick: select what is hit */
+    uint32_t seq;    /**< pick, tree: the page's request number, echoed in the answer (0..2^31) */
+    uint32_t plane_count;             /**< clip: planes in use (0..SY_CLIP_PLANES_MAX) */
+    float planes[SY_CLIP_PLANES_MAX][4]; /**< clip: {a, b, c, d}, checked by sy_clip_planes_check */
+    char filter[32];                  /**< filter: the name (letters, digits, '-', '_') */
     bool has_id;
     uint64_t id;
 } sy_web_input;
+
+/** True for the messages that change what other viewers see beyond the camera (visibility,
+ * selection, section planes, exposure, display filter; keys: back-ends and filter keys): refused
+ * by a read-only server (sy_web_desc.read_only). A pick with select is allowed as a plain pick. */
+bool sy_web_input_changes_scene(const sy_web_input *in);
 
 /** Parses one text message (len bytes, not NUL-terminated); SY_ERR_PARSE / SY_ERR_INVALID_ARGUMENT
  * with the reason for a message that is not JSON, lacks "t", or has a field missing or out of range. */

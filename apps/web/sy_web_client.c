@@ -6,6 +6,7 @@
 #include <string.h>
 
 #define CLIENT_MAX_MESSAGE (64u << 20)
+#define CLIENT_MAX_TEXTS 256u
 
 typedef struct msg {
     struct msg *next;
@@ -22,6 +23,8 @@ struct sy_web_client {
     size_t cur_len;
     bool cur_binary;
     msg *head, **tail; /* complete binary messages */
+    msg *texts, **texts_tail; /* complete text messages (the newest CLIENT_MAX_TEXTS) */
+    uint32_t text_count;
     char *out;         /* a text message waiting for the socket */
     size_t out_len;
 };
@@ -45,13 +48,25 @@ static int client_cb(struct lws *wsi, enum lws_callback_reasons reason, void *us
         c->cur = b;
         memcpy(c->cur + c->cur_len, in, len);
         c->cur_len += len;
-        if (lws_is_final_fragment(wsi) && !lws_remaining_packet_payload(wsi) && c->cur_binary) {
+        if (lws_is_final_fragment(wsi) && !lws_remaining_packet_payload(wsi)) {
             msg *m = malloc(sizeof *m);
             if (!m) return -1;
+            c->cur[c->cur_len] = 0; /* text: a C string (room was allocated) */
             m->next = NULL, m->data = c->cur, m->len = c->cur_len;
             c->cur = NULL, c->cur_len = 0;
-            *c->tail = m;
-            c->tail = &m->next;
+            if (c->cur_binary) {
+                *c->tail = m;
+                c->tail = &m->next;
+            } else {
+                *c->texts_tail = m;
+                c->texts_tail = &m->next;
+                if (++c->text_count > CLIENT_MAX_TEXTS) { /* nobody reads them: the oldest goes */
+                    msg *o = c->texts;
+                    c->texts = o->next;
+                    free(o->data), free(o);
+                    c->text_count--;
+                }
+            }
         }
         return 0;
     }
@@ -78,6 +93,7 @@ sy_result sy_web_client_connect(const sy_web_client_opts *o, uint32_t timeout_ms
     sy_web_client *c = calloc(1, sizeof *c);
     if (!c) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web client: out of memory");
     c->tail = &c->head;
+    c->texts_tail = &c->texts;
     struct lws_context_creation_info ci;
     memset(&ci, 0, sizeof ci);
     ci.port = CONTEXT_PORT_NO_LISTEN;
@@ -166,10 +182,45 @@ sy_result sy_web_client_next_frame(sy_web_client *c, uint32_t timeout_ms, sy_web
     return sy_web_client_next_frame_depth(c, timeout_ms, info, jpeg, jpeg_len, NULL, err);
 }
 
+sy_result sy_web_client_next_text(sy_web_client *c, uint32_t timeout_ms, const char *type, char **text, sy_error *err)
+{
+    *text = NULL;
+    char want[80];
+    snprintf(want, sizeof want, "\"t\":\"%.60s\"", type ? type : "");
+    double end = sy_time_now() + timeout_ms / 1000.0;
+    for (;;) {
+        while (c->texts) { /* the oldest first; other types are dropped */
+            msg *m = c->texts;
+            c->texts = m->next;
+            if (!c->texts) c->texts_tail = &c->texts;
+            c->text_count--;
+            if (!type || strstr((char *)m->data, want)) {
+                *text = (char *)m->data;
+                free(m);
+                return SY_OK;
+            }
+            free(m->data), free(m);
+        }
+        double now = sy_time_now();
+        if (!c->wsi || now >= end) break;
+        /* lws_service waits for traffic (its timeout is ignored): a timer ends the wait at the deadline */
+        lws_set_timer_usecs(c->wsi, (lws_usec_t)((end - now) * 1e6) + 1000);
+        lws_service(c->ctx, 0);
+    }
+    return sy_error_set(err, SY_ERR_IO, "web client: no \"%s\" message within %u ms%s", type ? type : "text", timeout_ms,
+                        c->wsi ? "" : " (connection closed)");
+}
+
 void sy_web_client_close(sy_web_client *c)
 {
     if (!c) return;
     if (c->ctx) lws_context_destroy(c->ctx);
+    while (c->texts) {
+        msg *m = c->texts;
+        c->texts = m->next;
+        free(m->data);
+        free(m);
+    }
     while (c->head) {
         msg *m = c->head;
         c->head = m->next;

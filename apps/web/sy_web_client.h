@@ -1,6 +1,6 @@
 /** @file
  * sy_web_client.h — a small blocking WebSocket client of sy web's stream (libwebsockets' client
- * API): connects to /ws, sends input messages, waits for frames. Used by `sy bench web` and the
+ * API): connects to /ws, sends input messages, waits for frames and text answers (pick, tree). Used by `sy bench web` and the
  * tests; also a starting point for a program that watches a sy web server.
  *
  * Ownership: frames returned are malloc()ed and owned by the caller (free()).
@@ -44,6 +44,11 @@ sy_result sy_web_client_next_frame(sy_web_client *c, uint32_t timeout_ms, sy_web
  * was hit) receives the frame's decoded depth channel (SY_ERR_PROTOCOL when it has none). */
 sy_result sy_web_client_next_frame_depth(sy_web_client *c, uint32_t timeout_ms, sy_web_frame_info *info,
                                          uint8_t **jpeg, size_t *jpeg_len, float **depth, sy_error *err);
+
+/** Waits up to timeout_ms for the next text message whose "t" is type (NULL: any); older text
+ * messages of other types are dropped (the newest 256 are kept while nobody asks). *text: the
+ * message, malloc()ed, NUL-terminated, the caller's. SY_ERR_IO on timeout or a closed connection. */
+sy_result sy_web_client_next_text(sy_web_client *c, uint32_t timeout_ms, const char *type, char **text, sy_error *err);
 
 /** Closes the connection and frees c (NULL-safe). */
 void sy_web_client_close(sy_web_client *c);

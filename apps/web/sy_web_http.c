@@ -134,6 +134,8 @@ void sy_webi_read_head(struct lws *wsi, head_bufs *b, sy_web_head *h)
     h->content_type = hdr(wsi, WSI_TOKEN_HTTP_CONTENT_TYPE, b->ctype, (int)sizeof b->ctype);
     h->cookie = hdr(wsi, WSI_TOKEN_HTTP_COOKIE, b->cookie, (int)sizeof b->cookie);
     h->upgrade = lws_hdr_total_length(wsi, WSI_TOKEN_UPGRADE) > 0;
+    static const char site[] = "sec-fetch-site:"; /* lws keeps unknown headers by their lower-case name */
+    if (lws_hdr_custom_copy(wsi, b->site, (int)sizeof b->site, site, (int)sizeof site - 1) > 0) h->fetch_site = b->site;
     if (hdr(wsi, WSI_TOKEN_HTTP_CONTENT_LENGTH, b->cl, (int)sizeof b->cl))
         h->has_length = true, h->content_length = strtoull(b->cl, NULL, 10);
 }

@@ -8,6 +8,7 @@
  *   sy_web_http.c     HTTP on the network thread: page, stills, routes, token, body collection
  *   sy_web_ws.c       WebSocket viewers: input messages in, newest frame out; the protocol table
  *                     and the network thread
+ *   sy_web_scene.c    pages' picks, visibility, selection, planes and tree on the render thread
  *   sy_web_render.c   the render loop on the thread in sy_web_run (frames, stills, routes)
  *   sy_web.c          create / destroy, the accessors and the counters
  *   sy_web_thread.c   sy_web_run on a thread of its own (sy_web_thread.h) */
@@ -17,6 +18,7 @@
 #include "sy_web.h"
 
 #include "sy_interactive.h"
+#include "sy_viewport.h"
 #include "sy_web_check.h"
 #include "sy_web_gate.h"
 
@@ -60,6 +62,27 @@ typedef struct web_frame {
 } web_frame;
 
 typedef struct web_conn web_conn;
+
+/* A page's message that the render thread answers or applies to the scene (pick, visibility,
+ * selection, isolate, section planes, tree): queued under mu with the connection's serial. */
+typedef struct web_action {
+    struct web_action *next;
+    uint64_t conn; /* web_conn.serial of the sender */
+    sy_web_input in;
+    char peer[64];
+} web_action;
+
+/* A text answer for one connection (its serial), from the render thread; sent by the network
+ * thread when the connection can take it, dropped when it has closed. */
+typedef struct web_reply {
+    struct web_reply *next;
+    uint64_t conn;
+    char *text; /* malloc()ed JSON */
+} web_reply;
+
+#define WEB_ACTIONS_MAX 256u /* actions queued, all connections (more are dropped with a log line) */
+#define WEB_REPLIES_MAX 64u  /* answers waiting, all connections (more are dropped with a log line) */
+#define WEB_TREE_MAX 4096u   /* nodes in one "tree" answer (a huge scene's answer says it was cut) */
 
 /* A connection the gate (sy_web_gate.h) hands over with its request: adopted by libwebsockets on
  * the network thread. */
@@ -105,12 +128,20 @@ struct sy_web {
     web_job *stills, **stills_tail;   /* stills: one after each live frame */
     web_job *still_running;
     web_handoff *handoffs;            /* gate -> network thread */
+    web_action *actions, **actions_tail; /* picks, visibility, selection, planes, tree requests */
+    uint32_t action_count;
+    float exposure;                   /* stops (the display chain) */
+    uint64_t conn_serial;             /* the last web_conn.serial given (network thread) */
     sy_web_stats st;                  /* the still counters */
     /* --- under mu: render thread -> network thread --- */
     web_frame *latest;
     web_job *finished;
     char status[256]; /* the last back-end error or filter line, sent to the pages as JSON */
     uint64_t status_version;
+    web_reply *replies, **replies_tail;
+    uint32_t reply_count;
+    uint64_t scene_version; /* visibility or selection changed: pages ask for the tree again */
+    uint64_t look_version;  /* what a frame shows changed beyond the camera (planes, visibility, exposure) */
 };
 
 /* --- sy_web_mailbox.c --- */
@@ -122,6 +153,19 @@ void sy_webi_wake_network(sy_web *w);
 void sy_webi_post_job(sy_web *w, web_job *j);
 void sy_webi_post_still(sy_web *w, web_job *j);
 bool sy_webi_job_abandoned(sy_web *w, const web_job *j);
+
+/* --- sy_web_scene.c --- */
+/* What the render thread lends to the pages' scene requests. */
+typedef struct sy_web_scene_ctx {
+    sy_web *w;
+    sy_context_pool *pool;
+    sy_window *win;          /* the live frames' window (its size: the last frame's) */
+    sy_viewport *vp, *still_vp; /* the live and the still viewport (both get the planes) */
+    uint32_t backend;        /* the live back-end (registry index) */
+} sy_web_scene_ctx;
+/* Runs and frees the actions (picks, visibility, selection, isolate, planes, tree); true when
+ * what frames show changed (the scene was committed or the planes changed). */
+bool sy_webi_scene_actions(const sy_web_scene_ctx *sc, web_action *list);
 
 /* --- sy_web_http.c --- */
 /* An HTTP connection's state (the http protocol's per-session data). */
@@ -144,7 +188,7 @@ typedef struct http_pss {
 
 /* The request's head as sy_web_check_request takes it (h points into b). */
 typedef struct head_bufs {
-    char path[SY_WEB_MAX_PATH], query[512], host[256], origin[256], ctype[128], cookie[1024], cl[32];
+    char path[SY_WEB_MAX_PATH], query[512], host[256], origin[256], ctype[128], cookie[1024], cl[32], site[32];
 } head_bufs;
 
 void sy_webi_read_head(struct lws *wsi, head_bufs *b, sy_web_head *h);

@@ -24,6 +24,8 @@ typedef struct render_state {
     uint32_t backend_applied;
     uint64_t seq;
     sy_interactive *ia; /* the governor, the view on the viewports, the display filter (sy_interactive.h) */
+    float exposure;     /* stops, as the pages set it */
+    bool changed;       /* what frames show changed beyond the camera (sy_interactive_view.changed) */
 } render_state;
 
 /* The display size the governor plans for: what the page asked, capped at max_width x max_height
@@ -46,6 +48,8 @@ static void display_size(const sy_web *w, uint32_t dw, uint32_t dh, uint32_t *ow
 static sy_result render_rgba8(sy_web *w, render_state *rs, sy_window *win, uint32_t width, uint32_t height,
                               uint32_t samples, float preview, uint8_t **out, float **depth, sy_error *err)
 {
+    sy_post_desc post = sy_post_display();
+    post.exposure_stops = rs->exposure;
     *out = NULL;
     if (depth) *depth = NULL;
     uint32_t cw = 0, ch = 0;
@@ -53,8 +57,7 @@ static sy_result render_rgba8(sy_web *w, render_state *rs, sy_window *win, uint3
     sy_result r = (cw != width || ch != height) ? sy_window_resize(win, width, height, err) : SY_OK;
     sy_layer img = {0};
     if (r == SY_OK) r = sy_layer_create(width, height, &img, err);
-    sy_window_render_opts ro = {.sample_count = samples, .preview = preview,
-                                .post = sy_post_display()};
+    sy_window_render_opts ro = {.sample_count = samples, .preview = preview, .post = post};
     if (r == SY_OK) r = sy_window_render(win, w->d.scene, rs->pool, &ro, &img, err);
     if (r == SY_OK && !(*out = sy_interactive_rgba8(&img, SY_RGBA8_OVER_BLACK))) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
     if (r == SY_OK && depth) *depth = img.depth, img.depth = NULL; /* taken over: sy_layer_destroy frees the rest */
@@ -126,7 +129,9 @@ static void run_still(sy_web *w, render_state *rs, web_job *j, const sy_orbit *o
         if (r == SY_OK) r = sy_layer_create(j->w, j->h, &img, &err);
         for (uint32_t done = 0; r == SY_OK && done < spp && !cancelled; ) {
             uint32_t n = spp - done > 4 ? 4 : spp - done;
-            sy_window_render_opts ro = {.sample_count = n, .preview = 1.0f, .post = sy_post_display()};
+            sy_post_desc post = sy_post_display();
+            post.exposure_stops = rs->exposure;
+            sy_window_render_opts ro = {.sample_count = n, .preview = 1.0f, .post = post};
             r = sy_window_render(rs->still_win, w->d.scene, rs->pool, &ro, &img, &err);
             done += n;
             cancelled = sy_webi_job_abandoned(w, j);
@@ -200,7 +205,8 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
     sy_governor_frame gf;
     sy_interactive_view iv = {.orbit = &in->orbit, .viewports = &rs->vp, .viewport_count = 1, .backend = cls,
                               .caps = sy_mediator_class_caps(cls, NULL), .width = pw, .height = ph,
-                              .filter_version = in->filter_version};
+                              .filter_version = in->filter_version, .changed = rs->changed};
+    rs->changed = false;
     /* the view set on the viewport directly: the application's scene is not committed */
     sy_interactive_plan(rs->ia, &iv, sy_time_now() * 1e3, &gf, &w->view);
     if (gf.wait_ms > 0) { /* settling after a moving frame: the refining frame comes next */
@@ -293,13 +299,13 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
     if (r == SY_OK) r = sy_interactive_create(w->d.budget_ms, &rs.ia, err);
     if (r == SY_OK) sy_interactive_set_temporal(rs.ia, !w->d.no_temporal);
     rs.backend_applied = w->initial_backend;
-    uint64_t seen = 0;
+    uint64_t seen = 0, seen_look = 0;
     bool again = false;    /* plan again without waiting for input */
     double wait_until = 0; /* ms (sy_time_now): the governor's settle wait, 0 = none */
     while (r == SY_OK) {
         pthread_mutex_lock(&w->mu);
         for (;;) {
-            if (w->quit || (stop && *stop) || w->pending || w->stills) break;
+            if (w->quit || (stop && *stop) || w->pending || w->stills || w->actions) break;
             /* frames once a page said its size (the page does as it connects) */
             bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
             if (w->clients && w->display_w && (w->view_version != seen || due)) break;
@@ -319,6 +325,10 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         web_job *jobs = w->pending;
         w->pending = NULL, w->pending_tail = &w->pending;
         for (web_job *j = jobs; j; j = j->next) j->state = JOB_RUNNING;
+        web_action *actions = w->actions;
+        w->actions = NULL, w->actions_tail = &w->actions, w->action_count = 0;
+        if (w->look_version != seen_look) rs.changed = true, seen_look = w->look_version;
+        rs.exposure = w->exposure;
         sy_interactive_input in = w->in;
         bool moved = w->view_version != seen;
         seen = w->view_version;
@@ -334,6 +344,11 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
             pthread_mutex_unlock(&w->mu);
             if (gone) sy_webi_job_free(j);
             else run_job(w, j);
+        }
+        if (actions) { /* pages' picks, visibility, selection, planes, tree: before the frame they change */
+            sy_web_scene_ctx sc = {.w = w, .pool = rs.pool, .win = rs.win, .vp = rs.vp, .still_vp = rs.still_vp,
+                                   .backend = rs.backend_applied};
+            if (sy_webi_scene_actions(&sc, actions)) rs.changed = moved = true;
         }
         bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
         if (clients && (moved || due)) render_live(w, &rs, &in, bi, dw, dh, gen, &again, &wait_until);

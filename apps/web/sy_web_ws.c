@@ -33,6 +33,8 @@ typedef struct queued_frame {
 struct web_conn {
     web_conn *next;
     struct lws *wsi;
+    uint64_t serial;             /* names the connection in web_action / web_reply (never reused) */
+    uint64_t sent_scene;         /* the scene_version last announced to it */
     char peer[64];
     uint64_t sent_seq, sent_status, queued_seq;
     /* the client's newest inputs with the generation each got (a ring): a frame answers the newest
@@ -73,9 +75,51 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
         ws_warn(c, err.message, NULL);
         return;
     }
+    if (w->d.read_only && sy_web_input_changes_scene(&in)) { /* viewers look, they do not change */
+        ws_warn(c, "read-only server: refused a change (visibility, selection, planes, exposure, filter or back-end)", NULL);
+        return;
+    }
+    if (w->d.read_only && in.type == SY_WEB_INPUT_PICK) in.on = false; /* a pick tells, it does not select */
     pthread_mutex_lock(&w->mu);
     bool input = true;
     switch (in.type) {
+    case SY_WEB_INPUT_PICK:
+    case SY_WEB_INPUT_VISIBLE:
+    case SY_WEB_INPUT_SELECT:
+    case SY_WEB_INPUT_ISOLATE:
+    case SY_WEB_INPUT_CLIP:
+    case SY_WEB_INPUT_TREE: { /* the render thread owns the scene: queued for it */
+        web_action *a = w->action_count < WEB_ACTIONS_MAX ? calloc(1, sizeof *a) : NULL;
+        if (!a) {
+            pthread_mutex_unlock(&w->mu);
+            ws_warn(c, "too many requests queued: dropped", NULL);
+            return;
+        }
+        a->conn = c->serial, a->in = in;
+        snprintf(a->peer, sizeof a->peer, "%s", c->peer);
+        *w->actions_tail = a, w->actions_tail = &a->next, w->action_count++;
+        input = false;
+        break;
+    }
+    case SY_WEB_INPUT_EXPOSURE:
+        input = false;
+        w->exposure = (float)in.a;
+        w->look_version++, w->view_version++;
+        break;
+    case SY_WEB_INPUT_FILTER: {
+        input = false;
+        uint32_t n = sy_interactive_filter_count(), i = 0;
+        char name[32];
+        while (i < n && strcmp(sy_interactive_filter_name(i, name), in.filter) != 0) i++;
+        if (i == n) {
+            pthread_mutex_unlock(&w->mu);
+            ws_warn(c, "filter: no such display filter", in.filter);
+            return;
+        }
+        w->in.filter = i, w->in.filter_version++;
+        w->view_version++;
+        break;
+    }
     case SY_WEB_INPUT_SIZE:
         input = false;
         if (in.version < SY_WEB_FRAME_VERSION) { /* an old page: told to reload, never sent frames it cannot read */
@@ -131,7 +175,6 @@ static void delay_message(sy_web *w, web_conn *c)
     delay_timer(w, c);
 }
 
-/* The hello: the back-ends of the registry in key order (docs/WEB.md). */
 static int ws_send_text(struct lws *wsi, const char *s)
 {
     size_t n = strlen(s);
@@ -143,11 +186,30 @@ static int ws_send_text(struct lws *wsi, const char *s)
     return r < (int)n ? -1 : 0;
 }
 
-static int ws_send_hello(struct lws *wsi)
+/* The hello: the back-ends (key order), the display filters, whether the server is read-only, and
+ * the exposure now (docs/WEB.md). */
+static int ws_send_hello(sy_web *w, struct lws *wsi)
 {
     cJSON *o = cJSON_CreateObject(), *arr = cJSON_AddArrayToObject(o, "backends");
     cJSON_AddStringToObject(o, "t", "hello");
     for (uint32_t i = 0; i < sy_mediator_count(); ++i) cJSON_AddItemToArray(arr, cJSON_CreateString(sy_mediator_at(i)->name));
+    cJSON *caps = cJSON_AddArrayToObject(o, "caps"); /* per back-end: can it pick, cut */
+    for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
+        cJSON *cc = cJSON_CreateObject();
+        uint32_t k = sy_mediator_at(i)->caps;
+        cJSON_AddBoolToObject(cc, "pick", (k & SY_CAP_PICK) != 0);
+        cJSON_AddBoolToObject(cc, "clip", (k & SY_CAP_CLIP) != 0);
+        cJSON_AddBoolToObject(cc, "filters", (k & SY_CAP_FILTERS) != 0);
+        cJSON_AddItemToArray(caps, cc);
+    }
+    cJSON *fl = cJSON_AddArrayToObject(o, "filters");
+    char name[32];
+    for (uint32_t i = 0; i < sy_interactive_filter_count(); ++i)
+        cJSON_AddItemToArray(fl, cJSON_CreateString(sy_interactive_filter_name(i, name)));
+    cJSON_AddBoolToObject(o, "read_only", w->d.read_only);
+    pthread_mutex_lock(&w->mu);
+    cJSON_AddNumberToObject(o, "exposure", w->exposure);
+    pthread_mutex_unlock(&w->mu);
     char *s = cJSON_PrintUnformatted(o);
     cJSON_Delete(o);
     if (!s) return -1;
@@ -196,7 +258,7 @@ static int ws_writeable(sy_web *w, web_conn *c)
 {
     if (!c->hello_sent) {
         c->hello_sent = true;
-        if (ws_send_hello(c->wsi)) return -1;
+        if (ws_send_hello(w, c->wsi)) return -1;
         lws_callback_on_writable(c->wsi);
         return 0;
     }
@@ -207,6 +269,30 @@ static int ws_writeable(sy_web *w, web_conn *c)
         snprintf(m, sizeof m, "{\"t\":\"status\",\"error\":\"this page is older than the server (it reads frame format 1, "
                               "the server sends format %u): reload it\"}", SY_WEB_FRAME_VERSION);
         return ws_send_text(c->wsi, m) ? -1 : 0;
+    }
+    /* answers to this page's picks and tree requests first, then "the scene changed" */
+    pthread_mutex_lock(&w->mu);
+    web_reply *rep = NULL;
+    for (web_reply **pp = &w->replies; *pp; pp = &(*pp)->next)
+        if ((*pp)->conn == c->serial) {
+            rep = *pp;
+            *pp = rep->next;
+            if (!*pp) w->replies_tail = pp;
+            w->reply_count--;
+            break;
+        }
+    bool scene = !rep && w->scene_version != c->sent_scene;
+    uint64_t sv = w->scene_version;
+    if (scene) c->sent_scene = sv;
+    pthread_mutex_unlock(&w->mu);
+    if (rep || scene) {
+        char m[64];
+        if (scene) snprintf(m, sizeof m, "{\"t\":\"scene\",\"v\":%llu}", (unsigned long long)sv);
+        int e = ws_send_text(c->wsi, rep ? rep->text : m);
+        if (rep) free(rep->text), free(rep);
+        if (e) return -1;
+        lws_callback_on_writable(c->wsi);
+        return 0;
     }
     pthread_mutex_lock(&w->mu);
     web_frame *f = w->latest;
@@ -291,12 +377,14 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
     case LWS_CALLBACK_ESTABLISHED:
         memset(c, 0, sizeof *c);
         c->wsi = wsi;
+        c->serial = ++w->conn_serial;
         lws_get_peer_simple(wsi, c->peer, sizeof c->peer);
         c->msg = malloc(w->d.max_message);
         if (!c->msg) return -1;
         c->next = w->conns;
         w->conns = c;
         pthread_mutex_lock(&w->mu);
+        c->sent_scene = w->scene_version;
         w->clients++;
         w->view_version++; /* a new viewer gets a frame even when the view rests */
         pthread_cond_signal(&w->cv);
@@ -310,6 +398,19 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
                 *pp = c->next;
                 pthread_mutex_lock(&w->mu);
                 w->clients--;
+                /* its answers not sent yet go with it (actions still queued answer nobody) */
+                for (web_reply **rp = &w->replies; *rp;) {
+                    web_reply *y = *rp;
+                    if (y->conn != c->serial) {
+                        rp = &y->next;
+                        continue;
+                    }
+                    *rp = y->next;
+                    free(y->text), free(y);
+                    w->reply_count--;
+                }
+                w->replies_tail = &w->replies;
+                while (*w->replies_tail) w->replies_tail = &(*w->replies_tail)->next;
                 pthread_mutex_unlock(&w->mu);
                 sy_log(SY_LOG_NOTE, "web", c->peer, "viewer left");
                 break;

@@ -5,7 +5,7 @@
  *   web_page      the page is served (the canvas id and the test hook are in it); unknown paths 404;
  *                 a foreign Host is refused (DNS rebinding)
  *   web_still     /api/frame.jpg?w=&h= is a JPEG of that size that is not uniform; bad sizes get 400
- *                 with the reason
+ *                 with the reason; without Origin only Sec-Fetch-Site: same-origin gets it (403 else)
  *   web_routes    a GET route and a POST route run on the render thread (the body arrives whole);
  *                 a body over the limit gets 413; garbage, huge headers and cut-off requests
  *                 leave the server serving
@@ -27,6 +27,19 @@
  *   web_stillbudget  stills queue behind a held render thread: the per-client pixel budget (429),
  *                 another client's own budget, a still whose requester left is not rendered
  *   web_clientfiles  /client/ serves client.html, client.js and vendor/ only, not npm/
+ *   web_messages  the page's scene messages (pick, visible, select, isolate, clip, tree, exposure,
+ *                 filter) are parsed as documented; picks outside the canvas, NaN, zero-normal and
+ *                 infinite planes, 7 planes, node ids that are no whole number, bad names: refused
+ *   web_scene     a viewer asks for the tree (the demo's nodes, their kinds), picks the pixel nearest
+ *                 the centre that the first frame's depth says is covered (the node, its mesh, its
+ *                 distance that of the depth) and selects it (every viewer is told "scene");
+ *                 hides that node: the next frame's depth there changes and a new pick no longer
+ *                 names it; shows it again: the depth comes back; an unknown node is refused with
+ *                 the reason; a plane that keeps nothing empties the pixel and no plane brings it
+ *                 back; bad planes and picks outside are ignored and the stream goes on
+ *   web_readonly  read_only: visibility, selection, isolation, planes and back-end keys are refused
+ *                 (the tree unchanged, no "scene" message), a pick answers without selecting, the
+ *                 camera moves
  *   web_frame     the binary frame (sy_web_frame.h) round-trips: header fields, the depth channel
  *                 within its 16-bit log step, "nothing" kept; truncated, foreign, format-1 and
  *                 mismatched frames are refused with the reason; the stream's frames carry the
@@ -37,6 +50,7 @@
 #include "sy_jpeg.h"
 #include "sy_mediators.h"
 #include "sy_web.h"
+#include "sy_web_check.h"
 #include "sy_web_client.h"
 #include "sy_web_frame.h"
 #include "sy_web_thread.h"
@@ -186,6 +200,8 @@ static sy_result route_echo(void *user, sy_scene *scene, const sy_web_request *r
 static sy_result route_block(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err);
 
 /* the demo scene served on listen by backend from a thread of its own; 1 after printing why not */
+static bool g_read_only; /* web_readonly: the server start() makes is read-only */
+
 static int start(server *s, const char *listen, const char *backend, sy_error *e)
 {
     memset(s, 0, sizeof *s);
@@ -197,7 +213,7 @@ static int start(server *s, const char *listen, const char *backend, sy_error *e
                                               {"GET", "/api/block", route_block, NULL}};
         sy_web_desc d = {.scene = s->scene, .root = demo.root, .camera = demo.camera, .background = demo.background,
                          .backend = backend, .listen = listen, .max_body = 1000, .max_message = 256, .max_clients = 3,
-                         .routes = routes, .route_count = 3,
+                         .routes = routes, .route_count = 3, .read_only = g_read_only,
                          .still_max_pixels = 20000}; /* small stills: fast on a loaded machine */
         failed = sy_web_create(&d, &s->web, e) != SY_OK;
     }
@@ -269,6 +285,17 @@ static int test_still(uint16_t port)
         CHECK(get(port, bad[i], NULL, &a) == 0);
         if (a.status != 400) fprintf(stderr, "%s: %d\n", bad[i], a.status);
         CHECK(a.status == 400 && (strstr((char *)a.body, "size") || strstr((char *)a.body, "missing")));
+        free(a.body);
+    }
+    /* a page's own fetch (the screenshot button): no Origin on a same-origin GET, but
+     * Sec-Fetch-Site: same-origin; cross-site or none: refused */
+    const char *site[] = {"Sec-Fetch-Site: same-origin\r\n", "Sec-Fetch-Site: cross-site\r\n", "Sec-Fetch-Site: same-site\r\n", ""};
+    for (int i = 0; i < 4; ++i) {
+        char req[512];
+        snprintf(req, sizeof req, "GET /api/frame.jpg?w=24&h=16 HTTP/1.1\r\nHost: 127.0.0.1:%u\r\n%sConnection: close\r\n\r\n", port, site[i]);
+        CHECK(http(port, req, NULL, 0, &a) == 0);
+        if (a.status != (i == 0 ? 200 : 403)) fprintf(stderr, "still with '%s': %d\n", site[i], a.status);
+        CHECK(a.status == (i == 0 ? 200 : 403));
         free(a.body);
     }
     return 0;
@@ -972,6 +999,261 @@ static int test_frame(void)
     return 0;
 }
 
+/* >>the page's scene messages (pick, visibility, selection, planes, tree) */
+static int parse_ok(const char *m, sy_web_input *in)
+{
+    sy_error err = {0};
+    sy_result r = sy_web_parse_input(m, strlen(m), in, &err);
+    if (r != SY_OK) fprintf(stderr, "refused %s: %s\n", m, err.message);
+    return r == SY_OK;
+}
+
+static int test_messages(void)
+{
+    sy_web_input in;
+    sy_error err = {0};
+    CHECK(parse_ok("{\"t\":\"pick\",\"x\":0.25,\"y\":0.75,\"select\":true,\"seq\":9}", &in));
+    CHECK(in.type == SY_WEB_INPUT_PICK && in.a == 0.25 && in.b == 0.75 && in.on && in.seq == 9);
+    CHECK(parse_ok("{\"t\":\"pick\",\"x\":0,\"y\":0}", &in) && !in.on && in.seq == 0);
+    CHECK(parse_ok("{\"t\":\"visible\",\"node\":12,\"on\":false}", &in) && in.type == SY_WEB_INPUT_VISIBLE && in.node == 12 && !in.on);
+    CHECK(parse_ok("{\"t\":\"select\",\"node\":0,\"on\":false}", &in) && in.type == SY_WEB_INPUT_SELECT && in.node == 0);
+    CHECK(parse_ok("{\"t\":\"isolate\",\"node\":3}", &in) && in.type == SY_WEB_INPUT_ISOLATE && in.node == 3);
+    CHECK(parse_ok("{\"t\":\"clip\",\"planes\":[[1,0,0,-0.5],[0,-1,0,2]]}", &in) && in.type == SY_WEB_INPUT_CLIP &&
+          in.plane_count == 2 && in.planes[0][3] == -0.5f && in.planes[1][1] == -1.0f);
+    CHECK(parse_ok("{\"t\":\"clip\",\"planes\":[]}", &in) && in.plane_count == 0);
+    CHECK(parse_ok("{\"t\":\"tree\",\"seq\":4}", &in) && in.type == SY_WEB_INPUT_TREE && in.seq == 4);
+    CHECK(parse_ok("{\"t\":\"exposure\",\"stops\":-1.5}", &in) && in.type == SY_WEB_INPUT_EXPOSURE && in.a == -1.5);
+    CHECK(parse_ok("{\"t\":\"filter\",\"name\":\"atrous\"}", &in) && in.type == SY_WEB_INPUT_FILTER && !strcmp(in.filter, "atrous"));
+    /* what a read-only server refuses; the camera, picks and the tree it answers */
+    CHECK(sy_web_input_changes_scene(&in));
+    CHECK(parse_ok("{\"t\":\"key\",\"k\":\"2\"}", &in) && sy_web_input_changes_scene(&in));
+    CHECK(parse_ok("{\"t\":\"key\",\"k\":\"r\"}", &in) && !sy_web_input_changes_scene(&in));
+    CHECK(parse_ok("{\"t\":\"pick\",\"x\":0.5,\"y\":0.5,\"select\":true}", &in) && !sy_web_input_changes_scene(&in));
+    CHECK(parse_ok("{\"t\":\"tree\"}", &in) && !sy_web_input_changes_scene(&in));
+    CHECK(parse_ok("{\"t\":\"drag\",\"dx\":1,\"dy\":2}", &in) && !sy_web_input_changes_scene(&in));
+    const char *bad[] = {
+        "{\"t\":\"pick\",\"x\":1,\"y\":0.5}",           /* outside: [0, 1) */
+        "{\"t\":\"pick\",\"x\":-0.01,\"y\":0.5}",
+        "{\"t\":\"pick\",\"x\":0.5}",
+        "{\"t\":\"pick\",\"x\":0.5,\"y\":1e400}",
+        "{\"t\":\"pick\",\"x\":0.5,\"y\":0.5,\"select\":1}",
+        "{\"t\":\"pick\",\"x\":0.5,\"y\":0.5,\"seq\":-1}",
+        "{\"t\":\"visible\",\"node\":0,\"on\":true}",      /* no node 0 to show */
+        "{\"t\":\"visible\",\"node\":2.5,\"on\":true}",
+        "{\"t\":\"visible\",\"node\":4294967296,\"on\":true}",
+        "{\"t\":\"visible\",\"node\":\"7\",\"on\":true}",
+        "{\"t\":\"visible\",\"node\":7}",
+        "{\"t\":\"visible\",\"node\":7,\"on\":\"no\"}",
+        "{\"t\":\"select\",\"node\":-1,\"on\":true}",
+        "{\"t\":\"isolate\"}",
+        "{\"t\":\"clip\",\"planes\":[[0,0,0,1]]}",         /* zero normal */
+        "{\"t\":\"clip\",\"planes\":[[1,0,0,1e400]]}",     /* infinite */
+        "{\"t\":\"clip\",\"planes\":[[1,0,0,1e30]]}",      /* beyond SY_COORD_MAX */
+        "{\"t\":\"clip\",\"planes\":[[1,0,0]]}",
+        "{\"t\":\"clip\",\"planes\":[[1,0,0,0,0]]}",
+        "{\"t\":\"clip\",\"planes\":[[1,0,\"a\",0]]}",
+        "{\"t\":\"clip\",\"planes\":{}}",
+        "{\"t\":\"clip\",\"planes\":[[1,0,0,0],[1,0,0,0],[1,0,0,0],[1,0,0,0],[1,0,0,0],[1,0,0,0],[1,0,0,0]]}",
+        "{\"t\":\"tree\",\"seq\":2147483648}",
+        "{\"t\":\"exposure\",\"stops\":17}",
+        "{\"t\":\"exposure\"}",
+        "{\"t\":\"filter\",\"name\":\"\"}",
+        "{\"t\":\"filter\",\"name\":\"../x\"}",
+        "{\"t\":\"filter\",\"name\":\"ABC\"}",
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        sy_result r = sy_web_parse_input(bad[i], strlen(bad[i]), &in, &err);
+        if (r == SY_OK) fprintf(stderr, "accepted %s\n", bad[i]);
+        CHECK(r == SY_ERR_INVALID_ARGUMENT && err.message[0]);
+    }
+    const char *zero = "{\"t\":\"clip\",\"planes\":[[0,0,0,1]]}";
+    CHECK(sy_web_parse_input(zero, strlen(zero), &in, &err) == SY_ERR_INVALID_ARGUMENT && strstr(err.message, "clip"));
+    return 0;
+}
+
+/* The number after "key": in a JSON text (0 when absent). */
+static double json_number(const char *text, const char *key)
+{
+    char k[64];
+    snprintf(k, sizeof k, "\"%s\":", key);
+    const char *p = text ? strstr(text, k) : NULL;
+    return p ? strtod(p + strlen(k), NULL) : 0;
+}
+
+/* Frames until one whose depth at pixel (px, py) of an 80 x 60 frame satisfies want (changed from
+ * d0 or equal to it), at most 40 frames; the depth there in *d. */
+static int frame_until(sy_web_client *c, int px, int py, float d0, bool changed, float *d)
+{
+    sy_error err = {0};
+    for (int k = 0; k < 40; ++k) {
+        sy_web_frame_info fi;
+        float *depth = NULL;
+        if (sy_web_client_next_frame_depth(c, 20000, &fi, NULL, NULL, &depth, &err) != SY_OK) {
+            fprintf(stderr, "frame_until: %s\n", err.message);
+            return 1;
+        }
+        if (fi.width != 80 || fi.height != 60) {
+            free(depth);
+            continue;
+        }
+        *d = depth[py * 80 + px];
+        free(depth);
+        bool same = isfinite(*d) == isfinite(d0) && (!isfinite(d0) || fabsf(*d - d0) <= 1e-3f * d0);
+        if (same != changed) return 0;
+    }
+    fprintf(stderr, "frame_until: the depth at %d,%d stayed %s %g\n", px, py, changed ? "at" : "away from", d0);
+    return 1;
+}
+
+/* The first full-size frame (80 x 60) and the covered pixel nearest the centre. */
+static int first_frame(sy_web_client *c, int *px, int *py, float *d)
+{
+    sy_error err = {0};
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":80,\"h\":60,\"v\":2}", &err), err);
+    sy_web_frame_info fi;
+    float *depth = NULL;
+    do {
+        free(depth);
+        depth = NULL;
+        CHECK_OK(sy_web_client_next_frame_depth(c, 60000, &fi, NULL, NULL, &depth, &err), err);
+    } while (fi.width != 80 || fi.height != 60);
+    int best = -1;
+    for (int y = 0; y < 60; ++y)
+        for (int x = 0; x < 80; ++x)
+            if (isfinite(depth[y * 80 + x]) && (best < 0 || abs(x - 40) + abs(y - 30) < abs(best % 80 - 40) + abs(best / 80 - 30)))
+                best = y * 80 + x;
+    CHECK(best >= 0);
+    *px = best % 80, *py = best / 80, *d = depth[best];
+    free(depth);
+    return 0;
+}
+
+static int test_scene(uint16_t port)
+{
+    sy_error err = {0};
+    sy_web_client *c = NULL, *other = NULL;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = port, .path = "/ws"};
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    CHECK_OK(sy_web_client_connect(&o, 10000, &other, &err), err); /* another viewer: told "scene" too */
+    int px, py;
+    float d0, d;
+    if (first_frame(c, &px, &py, &d0)) return 1;
+    char *t = NULL, m[256];
+    /* the tree: the demo's nodes with their kinds, not cut */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":1}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
+    CHECK(json_number(t, "seq") == 1 && json_number(t, "total") >= 2 && strstr(t, "\"truncated\":false"));
+    CHECK(strstr(t, "\"kind\":\"mesh\"") && strstr(t, "\"visible\":true") && strstr(t, "\"min\":[") && strstr(t, "\"planes\":[]"));
+    free(t);
+    /* pick the covered pixel nearest the centre and select it */
+    snprintf(m, sizeof m, "{\"t\":\"pick\",\"x\":%.6f,\"y\":%.6f,\"select\":true,\"seq\":2}", (px + 0.5) / 80.0, (py + 0.5) / 60.0);
+    CHECK_OK(sy_web_client_send(c, m, &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "pick", &t, &err), err);
+    CHECK(strstr(t, "\"hit\":true") && json_number(t, "seq") == 2 && strstr(t, "\"position\":[") && strstr(t, "\"selected\":true"));
+    uint32_t node = (uint32_t)json_number(t, "node");
+    CHECK(node > 0 && strstr(t, "\"mesh\":") && strstr(t, "\"material\":") && json_number(t, "distance") > 0);
+    CHECK(json_number(t, "distance") >= 0.99 * d0 && json_number(t, "distance") <= 1.2 * d0); /* the depth's point, along its ray */
+    free(t);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "scene", &t, &err), err);
+    free(t);
+    CHECK_OK(sy_web_client_next_text(other, 20000, "scene", &t, &err), err);
+    free(t);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":3}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
+    CHECK(strstr(t, "\"selected\":true"));
+    free(t);
+    /* hide it: the frame's depth there changes, a pick there names another node (or nothing) */
+    snprintf(m, sizeof m, "{\"t\":\"visible\",\"node\":%u,\"on\":false}", node);
+    CHECK_OK(sy_web_client_send(c, m, &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "scene", &t, &err), err);
+    free(t);
+    if (frame_until(c, px, py, d0, true, &d)) return 1;
+    snprintf(m, sizeof m, "{\"t\":\"pick\",\"x\":%.6f,\"y\":%.6f,\"seq\":4}", (px + 0.5) / 80.0, (py + 0.5) / 60.0);
+    CHECK_OK(sy_web_client_send(c, m, &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "pick", &t, &err), err);
+    CHECK(json_number(t, "seq") == 4 && (strstr(t, "\"hit\":false") || (uint32_t)json_number(t, "node") != node));
+    free(t);
+    /* show it again: the depth comes back */
+    snprintf(m, sizeof m, "{\"t\":\"visible\",\"node\":%u,\"on\":true}", node);
+    CHECK_OK(sy_web_client_send(c, m, &err), err);
+    if (frame_until(c, px, py, d0, false, &d)) return 1;
+    /* an unknown node: refused with the reason, nothing changes */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"visible\",\"node\":4000000000,\"on\":false}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "refused", &t, &err), err);
+    CHECK(strstr(t, "no node 4000000000") != NULL);
+    free(t);
+    /* a plane that keeps nothing (z >= 1e6): nothing covered; no plane: back */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[[0,0,1,-1000000]]}", &err), err);
+    if (frame_until(c, px, py, d0, true, &d)) return 1;
+    CHECK(!isfinite(d));
+    /* bad planes are ignored (logged): the planes stay as they were, the stream goes on */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[[0,0,0,1]]}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[[1,0,0,1e999]]}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"pick\",\"x\":1.5,\"y\":0.5}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":5}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
+    CHECK(json_number(t, "seq") == 5 && strstr(t, "\"planes\":[[0,0,1,-1000000]]"));
+    free(t);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[]}", &err), err);
+    if (frame_until(c, px, py, d0, false, &d)) return 1;
+    /* deselect every node */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"select\",\"node\":0,\"on\":false}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":6}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
+    CHECK(json_number(t, "seq") == 6 && !strstr(t, "\"selected\":true"));
+    free(t);
+    sy_web_client_close(other);
+    sy_web_client_close(c);
+    return 0;
+}
+
+static int test_readonly(void)
+{
+    sy_error err = {0};
+    server s;
+    g_read_only = true;
+    if (start(&s, "127.0.0.1:0", "whitted", &err)) return 1;
+    sy_web_client *c = NULL;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    char *t = NULL, m[256];
+    CHECK_OK(sy_web_client_next_text(c, 20000, "hello", &t, &err), err);
+    CHECK(strstr(t, "\"read_only\":true"));
+    free(t);
+    int px, py;
+    float d0;
+    if (first_frame(c, &px, &py, &d0)) return 1;
+    /* a pick answers, without selecting */
+    snprintf(m, sizeof m, "{\"t\":\"pick\",\"x\":%.6f,\"y\":%.6f,\"select\":true,\"seq\":1}", (px + 0.5) / 80.0, (py + 0.5) / 60.0);
+    CHECK_OK(sy_web_client_send(c, m, &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "pick", &t, &err), err);
+    CHECK(strstr(t, "\"hit\":true") && strstr(t, "\"selected\":false"));
+    uint32_t node = (uint32_t)json_number(t, "node");
+    free(t);
+    /* hiding, selecting, isolating, planes, back-end keys: refused; nothing changes */
+    snprintf(m, sizeof m, "{\"t\":\"visible\",\"node\":%u,\"on\":false}", node);
+    CHECK_OK(sy_web_client_send(c, m, &err), err);
+    snprintf(m, sizeof m, "{\"t\":\"select\",\"node\":%u,\"on\":true}", node);
+    CHECK_OK(sy_web_client_send(c, m, &err), err);
+    snprintf(m, sizeof m, "{\"t\":\"isolate\",\"node\":%u}", node);
+    CHECK_OK(sy_web_client_send(c, m, &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[[0,0,1,-1000000]]}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"key\",\"k\":\"2\"}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":2}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
+    CHECK(json_number(t, "seq") == 2 && !strstr(t, "\"visible\":false") && !strstr(t, "\"selected\":true") && strstr(t, "\"planes\":[]"));
+    free(t);
+    CHECK(sy_web_client_next_text(c, 500, "scene", &t, &err) == SY_ERR_IO);
+    /* the camera still moves */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"drag\",\"dx\":40,\"dy\":0,\"id\":1}", &err), err);
+    sy_web_frame_info fi;
+    do {
+        if (next_frame(c, &fi, NULL, NULL)) return 1;
+    } while (fi.input_id < 1);
+    sy_web_client_close(c);
+    return stop(&s);
+}
+
 int main(int argc, char **argv)
 {
     const char *which = argc > 1 ? argv[1] : "all";
@@ -979,6 +1261,16 @@ int main(int argc, char **argv)
     if (sy_mediators_register_builtin(&err) != SY_OK) {
         fprintf(stderr, "%s\n", err.message);
         return 1;
+    }
+    if (!strcmp(which, "messages")) {
+        int f = test_messages();
+        if (!f) printf("web %s: ok\n", which);
+        return f;
+    }
+    if (!strcmp(which, "readonly")) {
+        int f = test_readonly();
+        if (!f) printf("web %s: ok\n", which);
+        return f;
     }
     if (!strcmp(which, "frame")) {
         int f = test_frame();
@@ -1006,6 +1298,7 @@ int main(int argc, char **argv)
     if (!strcmp(which, "hostile") || !strcmp(which, "all")) failed |= test_hostile(port);
     if (!strcmp(which, "slowloris") || !strcmp(which, "all")) failed |= test_slowloris(&s, port);
     if (!strcmp(which, "stillbudget") || !strcmp(which, "all")) failed |= test_still_budget(&s, port);
+    if (!strcmp(which, "scene") || !strcmp(which, "all")) failed |= test_scene(port);
     failed |= stop(&s);
     if (!failed) printf("web %s: ok\n", which);
     return failed;

@@ -1,0 +1,320 @@
+/* sy_web_scene.c — what pages ask of the scene, on the render thread (it owns the scene): picks
+ * (sy_viewport_pick, with the view and planes of the live frame), visibility, selection and
+ * isolation (sy_node_set_visible / _selected, sy_scene_isolate, committed so every context sees
+ * them), section planes (sy_viewport_set_clip_planes on the server's viewports) and the scene's
+ * hierarchy, bounded to WEB_TREE_MAX nodes. Answers go back to the asking page as JSON text
+ * through the mailbox (web_reply); unknown nodes and failures are logged and answered with a
+ * "refused" message, never applied (sy_web_internal.h; docs/WEB.md, "The WebSocket protocol"). */
+#include "sy_web_internal.h"
+
+#include "sy_graph.h"
+#include "sy_log.h"
+#include "sy_mediator.h"
+#include "sy_viewport.h"
+
+#include <cjson/cJSON.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Queues the JSON o (deleted here) for connection conn; dropped with a log line when WEB_REPLIES_MAX
+ * answers wait already. */
+static void post_reply(sy_web *w, const web_action *a, cJSON *o)
+{
+    char *s = cJSON_PrintUnformatted(o);
+    cJSON_Delete(o);
+    web_reply *y = s ? calloc(1, sizeof *y) : NULL;
+    if (!y) {
+        free(s);
+        sy_log(SY_LOG_WARNING, "web", a->peer, "out of memory for an answer");
+        return;
+    }
+    y->conn = a->conn, y->text = s;
+    pthread_mutex_lock(&w->mu);
+    bool full = w->reply_count >= WEB_REPLIES_MAX;
+    if (!full) *w->replies_tail = y, w->replies_tail = &y->next, w->reply_count++;
+    pthread_mutex_unlock(&w->mu);
+    if (full) {
+        free(s), free(y);
+        sy_log(SY_LOG_WARNING, "web", a->peer, "%u answers wait already: one dropped", WEB_REPLIES_MAX);
+        return;
+    }
+    sy_webi_wake_network(w);
+}
+
+/* A request that was not applied: logged, and the page is told why. */
+static void refuse(sy_web *w, const web_action *a, const char *what, const char *why)
+{
+    sy_log(SY_LOG_WARNING, "web", a->peer, "ignored %s: %s", what, why);
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "t", "refused");
+    cJSON_AddStringToObject(o, "what", what);
+    cJSON_AddStringToObject(o, "reason", why);
+    if (a->in.seq) cJSON_AddNumberToObject(o, "seq", a->in.seq);
+    post_reply(w, a, o);
+}
+
+static void add_vec3(cJSON *o, const char *key, const float v[3])
+{
+    cJSON *arr = cJSON_AddArrayToObject(o, key);
+    for (int i = 0; i < 3; ++i) cJSON_AddItemToArray(arr, cJSON_CreateNumber(v[i]));
+}
+
+static void add_name(cJSON *o, const char *key, const char *name)
+{
+    char n[128];
+    snprintf(n, sizeof n, "%s", name ? name : "");
+    cJSON_AddStringToObject(o, key, n);
+}
+
+/* Deselects every selected node (but keep, when keep.id != 0). */
+static sy_result clear_selection(sy_scene *s, sy_node keep, sy_error *err)
+{
+    sy_result r = SY_OK;
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id && r == SY_OK; id = sy_scene_next(s, SY_TYPE_NODE, id)) {
+        const sy_node_data *d = sy_node_get(s, (sy_node){id});
+        if (d && (d->flags & SY_NODE_SELECTED) && id != keep.id) r = sy_node_set_selected(s, (sy_node){id}, false, err);
+    }
+    return r;
+}
+
+/* The pick: through the live viewport when its back-end can pick (and cut, with planes), else a
+ * window of its own with the first back-end that can, the same view and planes. (x, y) in the
+ * live window's pixels (the size of the last frame). */
+static sy_result pick(const sy_web_scene_ctx *sc, double fx, double fy, sy_pick_result *p, const char **by, sy_error *err)
+{
+    sy_web *w = sc->w;
+    uint32_t cw = 0, ch = 0, need = SY_CAP_PICK;
+    sy_window_size(sc->win, &cw, &ch);
+    float planes[SY_CLIP_PLANES_MAX][4];
+    uint32_t np = sy_viewport_clip_planes(sc->vp, planes);
+    if (np) need |= SY_CAP_CLIP;
+    double x = fx * cw, y = fy * ch;
+    const sy_mediator_class *cls = sy_mediator_at(sc->backend);
+    if (cls && (cls->caps & need) == need) {
+        *by = cls->name;
+        return sy_viewport_pick(sc->vp, w->d.scene, sc->pool, x, y, p, err);
+    }
+    cls = sy_mediator_with_caps(need);
+    if (!cls) return sy_error_set(err, SY_ERR_UNSUPPORTED, "no back-end can pick%s", np ? " with section planes" : "");
+    *by = cls->name;
+    sy_window *win = NULL;
+    sy_viewport *vp = NULL;
+    sy_viewport_desc vd = {.root = w->d.root, .camera = w->d.camera, .backend = cls->name};
+    sy_result r = sy_window_create(cw, ch, &win, err);
+    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
+    if (r == SY_OK) sy_viewport_set_view(vp, &w->view);
+    if (r == SY_OK && np) r = sy_viewport_set_clip_planes(vp, (const float(*)[4])planes, np, err);
+    if (r == SY_OK) r = sy_viewport_pick(vp, w->d.scene, sc->pool, x, y, p, err);
+    sy_window_destroy(win);
+    return r;
+}
+
+static bool do_pick(const sy_web_scene_ctx *sc, const web_action *a)
+{
+    sy_web *w = sc->w;
+    sy_scene *s = w->d.scene;
+    sy_pick_result p = {0};
+    sy_error err = {0};
+    const char *by = "";
+    if (pick(sc, a->in.a, a->in.b, &p, &by, &err) != SY_OK) {
+        refuse(w, a, "pick", err.message);
+        return false;
+    }
+    bool changed = false;
+    if (a->in.on) { /* select what is hit (only it); nothing hit clears the selection */
+        sy_result r = clear_selection(s, p.hit ? (sy_node){p.node_id} : (sy_node){0}, &err);
+        if (r == SY_OK && p.hit) r = sy_node_set_selected(s, (sy_node){p.node_id}, true, &err);
+        if (r != SY_OK) sy_log(SY_LOG_WARNING, "web", a->peer, "pick: select: %s", err.message);
+        changed = sy_scene_has_pending(s);
+    }
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "t", "pick");
+    cJSON_AddNumberToObject(o, "seq", a->in.seq);
+    cJSON_AddBoolToObject(o, "hit", p.hit);
+    cJSON_AddStringToObject(o, "backend", by);
+    if (p.hit) {
+        const sy_node_data *nd = sy_node_get(s, (sy_node){p.node_id});
+        const sy_mesh_data *md = sy_mesh_get(s, (sy_mesh){p.mesh_id});
+        const sy_material_data *mat = p.material_id ? sy_material_get(s, (sy_material){p.material_id}) : NULL;
+        cJSON_AddNumberToObject(o, "node", p.node_id);
+        add_name(o, "name", nd ? nd->name : NULL);
+        cJSON_AddNumberToObject(o, "mesh", p.mesh_id);
+        add_name(o, "mesh_name", md ? md->name : NULL);
+        cJSON_AddNumberToObject(o, "primitive", p.primitive);
+        cJSON_AddNumberToObject(o, "triangle", p.triangle);
+        cJSON_AddNumberToObject(o, "material", p.material_id);
+        add_name(o, "material_name", mat ? mat->name : p.material_id ? NULL : "default");
+        add_vec3(o, "position", p.position);
+        add_vec3(o, "normal", p.normal);
+        cJSON_AddNumberToObject(o, "distance", p.distance);
+        cJSON_AddBoolToObject(o, "selected", a->in.on);
+    }
+    post_reply(w, a, o);
+    return changed;
+}
+
+/* visible, select, isolate: the node must exist (checked here: the scene may have changed since
+ * the page's tree). */
+static bool do_node(const sy_web_scene_ctx *sc, const web_action *a)
+{
+    sy_web *w = sc->w;
+    sy_scene *s = w->d.scene;
+    sy_node n = {a->in.node};
+    sy_error err = {0};
+    const char *what = a->in.type == SY_WEB_INPUT_VISIBLE ? "visible" : a->in.type == SY_WEB_INPUT_SELECT ? "select" : "isolate";
+    if (n.id && !sy_node_get(s, n)) {
+        char why[64];
+        snprintf(why, sizeof why, "no node %u in the scene", n.id);
+        refuse(w, a, what, why);
+        return false;
+    }
+    sy_result r;
+    if (a->in.type == SY_WEB_INPUT_VISIBLE) r = sy_node_set_visible(s, n, a->in.on, &err);
+    else if (a->in.type == SY_WEB_INPUT_ISOLATE) r = sy_scene_isolate(s, &n, n.id ? 1 : 0, &err);
+    else if (!n.id) r = clear_selection(s, (sy_node){0}, &err);
+    else r = sy_node_set_selected(s, n, a->in.on, &err);
+    if (r != SY_OK) {
+        refuse(w, a, what, err.message);
+        return sy_scene_has_pending(s);
+    }
+    return true;
+}
+
+static bool do_clip(const sy_web_scene_ctx *sc, const web_action *a)
+{
+    sy_error err = {0};
+    const float(*planes)[4] = (const float(*)[4])a->in.planes;
+    sy_result r = sy_viewport_set_clip_planes(sc->vp, planes, a->in.plane_count, &err);
+    if (r == SY_OK) r = sy_viewport_set_clip_planes(sc->still_vp, planes, a->in.plane_count, &err);
+    if (r != SY_OK) {
+        refuse(sc->w, a, "clip", err.message);
+        return false;
+    }
+    const sy_mediator_class *cls = sy_mediator_at(sc->backend);
+    if (a->in.plane_count && cls && !(cls->caps & SY_CAP_CLIP))
+        sy_log(SY_LOG_WARNING, "web", a->peer, "section planes set, but %s cannot cut: it will refuse to render", cls->name);
+    return true;
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static uint32_t index_of(const uint32_t *ids, uint32_t n, uint32_t id)
+{
+    const uint32_t *f = bsearch(&id, ids, n, sizeof *ids, cmp_u32);
+    return f ? (uint32_t)(f - ids) : UINT32_MAX;
+}
+
+/* The hierarchy, depth first from the roots (nodes nobody lists as a child; with w->d.root, that
+ * node), each node once (a node with several parents under the first), at most WEB_TREE_MAX. */
+static void do_tree(const sy_web_scene_ctx *sc, const web_action *a)
+{
+    sy_web *w = sc->w;
+    sy_scene *s = w->d.scene;
+    uint32_t total = sy_scene_count(s, SY_TYPE_NODE), n = 0;
+    uint32_t *ids = malloc((total ? total : 1) * sizeof *ids);
+    uint8_t *state = calloc(total ? total : 1, 1); /* 1: someone's child, 2: listed */
+    uint32_t *stack = malloc((total ? total : 1) * sizeof *stack * 2);
+    cJSON *o = cJSON_CreateObject(), *arr = NULL;
+    if (!ids || !state || !stack || !o) {
+        free(ids), free(state), free(stack), cJSON_Delete(o);
+        sy_log(SY_LOG_WARNING, "web", a->peer, "tree: out of memory");
+        return;
+    }
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id && n < total; id = sy_scene_next(s, SY_TYPE_NODE, id)) ids[n++] = id;
+    qsort(ids, n, sizeof *ids, cmp_u32);
+    for (uint32_t i = 0; i < n; ++i) {
+        uint32_t cn = 0;
+        const sy_node_data *d = sy_node_get(s, (sy_node){ids[i]});
+        const uint32_t *ch = d ? sy_node_children(d, &cn) : NULL;
+        for (uint32_t k = 0; ch && k < cn; ++k) {
+            uint32_t j = index_of(ids, n, ch[k]);
+            if (j != UINT32_MAX) state[j] = 1;
+        }
+    }
+    cJSON_AddStringToObject(o, "t", "tree");
+    cJSON_AddNumberToObject(o, "seq", a->in.seq);
+    cJSON_AddNumberToObject(o, "total", n);
+    arr = cJSON_AddArrayToObject(o, "nodes");
+    uint32_t listed = 0;
+    /* roots, pushed in reverse so they come out in id order; the stack holds (index, depth) */
+    uint32_t sp = 0;
+    if (w->d.root.id) {
+        uint32_t j = index_of(ids, n, w->d.root.id);
+        if (j != UINT32_MAX) stack[sp++] = j, stack[sp++] = 0;
+    } else {
+        for (uint32_t i = n; i-- > 0;)
+            if (state[i] == 0) stack[sp++] = i, stack[sp++] = 0;
+    }
+    while (sp && listed < WEB_TREE_MAX) {
+        uint32_t depth = stack[--sp], i = stack[--sp];
+        if (state[i] == 2) continue;
+        state[i] = 2;
+        const sy_node_data *d = sy_node_get(s, (sy_node){ids[i]});
+        cJSON *e = cJSON_CreateObject();
+        cJSON_AddNumberToObject(e, "id", ids[i]);
+        cJSON_AddNumberToObject(e, "depth", depth);
+        add_name(e, "name", d ? d->name : NULL);
+        uint32_t kind = d && d->mesh.id ? 1 : d && d->light.id ? 2 : d && d->camera.id ? 3 : 0;
+        cJSON_AddStringToObject(e, "kind", kind == 1 ? "mesh" : kind == 2 ? "light" : kind == 3 ? "camera" : "group");
+        cJSON_AddBoolToObject(e, "visible", d && (d->flags & SY_NODE_VISIBLE));
+        cJSON_AddBoolToObject(e, "selected", d && (d->flags & SY_NODE_SELECTED));
+        cJSON_AddItemToArray(arr, e);
+        listed++;
+        uint32_t cn = 0;
+        const uint32_t *ch = d ? sy_node_children(d, &cn) : NULL;
+        /* children pushed in reverse: listed in their order; the stack has room for every node
+         * twice (each index is pushed at most once per parent listing it, and listed once) */
+        for (uint32_t k = cn; ch && k-- > 0;) {
+            uint32_t j = index_of(ids, n, ch[k]);
+            if (j != UINT32_MAX && state[j] != 2 && sp + 2 <= 2 * n) stack[sp++] = j, stack[sp++] = depth + 1;
+        }
+    }
+    cJSON_AddBoolToObject(o, "truncated", listed < n);
+    sy_bounds b = sy_scene_world_bounds(s);
+    if (w->d.root.id) sy_node_world_bounds(s, w->d.root, &b, NULL);
+    add_vec3(o, "min", b.min);
+    add_vec3(o, "max", b.max);
+    float planes[SY_CLIP_PLANES_MAX][4];
+    uint32_t np = sy_viewport_clip_planes(sc->vp, planes);
+    cJSON *pl = cJSON_AddArrayToObject(o, "planes");
+    for (uint32_t i = 0; i < np; ++i) cJSON_AddItemToArray(pl, cJSON_CreateFloatArray(planes[i], 4));
+    free(ids), free(state), free(stack);
+    post_reply(w, a, o);
+}
+
+bool sy_webi_scene_actions(const sy_web_scene_ctx *sc, web_action *list)
+{
+    sy_web *w = sc->w;
+    bool scene = false, look = false;
+    while (list) {
+        web_action *a = list;
+        list = a->next;
+        switch (a->in.type) {
+        case SY_WEB_INPUT_PICK: scene |= do_pick(sc, a); break;
+        case SY_WEB_INPUT_VISIBLE:
+        case SY_WEB_INPUT_SELECT:
+        case SY_WEB_INPUT_ISOLATE: scene |= do_node(sc, a); break;
+        case SY_WEB_INPUT_CLIP: look |= do_clip(sc, a); break;
+        case SY_WEB_INPUT_TREE: do_tree(sc, a); break;
+        default: break;
+        }
+        free(a);
+    }
+    if (scene) { /* the flags are scene changes: committed, so every context (and cluster node) sees them */
+        sy_error err = {0};
+        if (sy_scene_commit(w->d.scene, NULL, &err) != SY_OK) sy_log(SY_LOG_WARNING, "web", NULL, "commit: %s", err.message);
+    }
+    if (scene) { /* every page is told, and asks for the tree again */
+        pthread_mutex_lock(&w->mu);
+        w->scene_version++;
+        pthread_mutex_unlock(&w->mu);
+        sy_webi_wake_network(w);
+    }
+    return scene || look;
+}
