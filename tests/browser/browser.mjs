@@ -16,6 +16,16 @@
 //     not finite or not a rotation, format 3, no JPEG): their counts in sy.stats().bad and
 //     whether the canvas stayed the same. URL?warp=0 gives the same drag without the warp and
 //     without the rest (the comparison).
+//   node browser.mjs tools URL OUTDIR WIDTH HEIGHT
+//     The page's tools (sy web, a canvas wide enough for the panel): finds a covered pixel near
+//     the centre (the server's still of the view), clicks it (pick + select; the properties show
+//     the node), hides that node from the tree (the streamed canvas changes there; a pick there no
+//     longer names it), shows it again (back as it was), adds a section plane (the canvas
+//     changes), measures two covered points, opens the help, takes a screenshot (the download),
+//     pinches and drags with synthetic touch pointers; screenshots OUTDIR/page.png, tree.png,
+//     hidden.png, section.png, measure.png, help.png. URL with readonly=1 (sy web --read-only):
+//     the controls that change the scene are hidden or disabled and a change sent anyway leaves
+//     the tree as it was.
 //   node browser.mjs client URL OUTDIR WIDTH HEIGHT
 //     The client-render page (sy web --client-render): waits until the client is idle (its last
 //     cull answer drawn), writes the canvas to OUTDIR/canvas.png and what the page fetched to
@@ -30,8 +40,8 @@ import { join } from 'node:path';
 
 const [mode, url, outDir, wArg, hArg] = process.argv.slice(2);
 const width = Number(wArg || 480), height = Number(hArg || 360);
-if (!['stream', 'client', 'warp'].includes(mode) || !url || !outDir) {
-  console.error('usage: node browser.mjs stream|client|warp URL OUTDIR [WIDTH HEIGHT]');
+if (!['stream', 'client', 'warp', 'tools'].includes(mode) || !url || !outDir) {
+  console.error('usage: node browser.mjs stream|client|warp|tools URL OUTDIR [WIDTH HEIGHT]');
   process.exit(2);
 }
 const executablePath = process.env.SY_CHROMIUM || '/usr/bin/chromium';
@@ -205,6 +215,155 @@ try {
                                  server_fps: st.server_fps, bytes_per_frame: Math.round(st.bytes_per_frame),
                                  frames_during_drag: st.frames - frames0, mid, quality, bad: st.bad, badFrames, consoleErrors,
                                  input_to_display_all: drag.map((v) => Math.round(v)) }));
+  } else if (mode === 'tools') {
+    // the page's tools (ui.js, tree.js, measure.js, section.js): pick by a click, hide from the
+    // tree, measure, a section plane, the help, the screenshot; screenshots of each state
+    const readOnly = url.includes('readonly=1'); // browser_test.sh's second server: sy web --read-only
+    const settled = () => page.waitForFunction(
+      ([w, h]) => window.syStats && syStats.frames > 0 && syStats.width === w && syStats.height === h &&
+                  syStats.answeredInput === syStats.lastInput && window.sy && sy.ui && sy.ui.tree && sy.ui.tree.version > 0,
+      [width, height], { timeout: TIMEOUT });
+    await settled();
+    const frames = () => page.evaluate(() => syStats.frames);
+    // a few display frames after the newest server frame: it is on the canvas
+    const shown = async (n) => {
+      await page.waitForFunction((k) => syStats.frames > k, n, { timeout: TIMEOUT });
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    };
+    // the covered pixels of the current view: the server's still at the canvas size (its coverage
+    // is the stream's), decoded in the page; the one nearest the centre and one to its right
+    const targets = await page.evaluate(async ([w, h]) => {
+      const r = await fetch(`/api/frame.jpg?w=${w}&h=${h}`);
+      const bmp = await createImageBitmap(await r.blob());
+      const c = new OffscreenCanvas(w, h), g = c.getContext('2d');
+      g.drawImage(bmp, 0, 0);
+      const d = g.getImageData(0, 0, w, h).data, lit = (x, y) => d[4 * (y * w + x)] + d[4 * (y * w + x) + 1] + d[4 * (y * w + x) + 2] > 60;
+      let best = null;
+      for (let y = 0; y < h; y += 2) for (let x = 0; x < w; x += 2)
+        if (lit(x, y) && (!best || Math.hypot(x - w / 2, y - h / 2) < Math.hypot(best[0] - w / 2, best[1] - h / 2))) best = [x, y];
+      let second = null;
+      for (let x = Math.min(w - 1, best[0] + 120); x > best[0] + 10 && !second; x--) if (lit(x, best[1])) second = [x, best[1]];
+      for (let x = Math.max(0, best[0] - 120); x < best[0] - 10 && !second; x++) if (lit(x, best[1])) second = [x, best[1]];
+      return { first: best, second };
+    }, [width, height]);
+    if (!targets.first || !targets.second) fail(`no covered pixels to pick: ${JSON.stringify(targets)}`);
+    const [px, py] = targets.first;
+    // the streamed canvas (overlays hidden) as PNG, base64
+    const canvasB64 = async (name) => { await canvasPng(page, '#sy-canvas', join(outDir, name)); return readFileSync(join(outDir, name)).toString('base64'); };
+    // mean absolute RGB difference of two canvas PNGs in the 9 x 9 box at (x, y), and the share of the canvas that differs by > 40
+    const diff = (a, b, x, y) => page.evaluate(async ([a, b, x, y]) => {
+      const load = async (s) => { const bm = await createImageBitmap(await (await fetch('data:image/png;base64,' + s)).blob());
+        const c = new OffscreenCanvas(bm.width, bm.height), g = c.getContext('2d'); g.drawImage(bm, 0, 0); return g.getImageData(0, 0, bm.width, bm.height); };
+      const A = await load(a), B = await load(b);
+      let box = 0, n = 0, changed = 0;
+      for (let i = 0; i < A.data.length; i += 4) {
+        const e = Math.abs(A.data[i] - B.data[i]) + Math.abs(A.data[i + 1] - B.data[i + 1]) + Math.abs(A.data[i + 2] - B.data[i + 2]);
+        const p = i / 4, u = p % A.width, v = Math.floor(p / A.width);
+        if (e > 40 * 3) changed++;
+        if (Math.abs(u - x) <= 4 && Math.abs(v - y) <= 4) { box += e / 3; n++; }
+      }
+      return { box: box / n, changed: changed / (A.width * A.height) };
+    }, [a, b, x, y]);
+    const before = await canvasB64('before.png');
+    await page.screenshot({ path: join(outDir, 'page.png') });
+    // 1. a click picks and (unless read-only) selects
+    const picks0 = await page.evaluate(() => sy.ui.tree.picks);
+    await page.mouse.click(px, py);
+    await page.waitForFunction((n) => sy.ui.tree.picks > n && sy.ui.tree.lastPick, picks0, { timeout: TIMEOUT });
+    const pick = await page.evaluate(() => sy.ui.tree.lastPick);
+    if (!pick.hit || !(pick.node > 0)) fail(`the click at ${px},${py} picked nothing: ${JSON.stringify(pick)}`);
+    const props = await page.evaluate(() => document.getElementById('sy-props').innerText);
+    if (!props.includes('#' + pick.node) || !props.includes('position')) fail(`the properties do not show the pick: ${props}`);
+    if (!readOnly) await page.waitForFunction((n) => sy.ui.tree.selected === n, pick.node, { timeout: TIMEOUT });
+    await settled();
+    let f0 = await frames();
+    await page.screenshot({ path: join(outDir, 'tree.png') });
+    // 2. hide the picked node from the tree: the streamed image changes where it was
+    const row = page.locator(`#sy-tree [data-node="${pick.node}"] input[type=checkbox]`);
+    const result = { pick: { node: pick.node, name: pick.name, position: pick.position, at: [px, py] }, readOnly };
+    if (readOnly) {
+      result.hidden_controls = await page.evaluate(() => ({ sections: getComputedStyle(document.getElementById('sy-section')).display === 'none',
+        checkbox_disabled: [...document.querySelectorAll('#sy-tree input')].every((c) => c.disabled), badge: !!document.getElementById('sy-readonly'),
+        selected: sy.ui.tree.selected }));
+      // a page that sends a change anyway: refused by the server, the tree unchanged
+      const v0 = await page.evaluate(() => sy.ui.tree.version);
+      await page.evaluate((n) => { sy.send({ t: 'visible', node: n, on: false }); sy.ui.tree.refresh(); }, pick.node);
+      await page.waitForFunction((v) => sy.ui.tree.version > v, v0, { timeout: TIMEOUT });
+      result.still_visible = await page.evaluate((n) => sy.ui.tree.nodes.find((x) => x.id === n).visible, pick.node);
+    } else {
+      await row.click();
+      await page.waitForFunction((n) => { const x = sy.ui.tree.nodes.find((k) => k.id === n); return x && !x.visible; }, pick.node, { timeout: TIMEOUT });
+      await shown(f0);
+      await settled();
+      await page.screenshot({ path: join(outDir, 'hidden.png') });
+      const hidden = await canvasB64('hidden_canvas.png');
+      result.hide = await diff(before, hidden, px, py);
+      // a pick there no longer names it
+      const p1 = await page.evaluate(() => sy.ui.tree.picks);
+      await page.mouse.click(px, py);
+      await page.waitForFunction((n) => sy.ui.tree.picks > n, p1, { timeout: TIMEOUT });
+      result.pick_hidden = await page.evaluate(() => ({ hit: sy.ui.tree.lastPick.hit, node: sy.ui.tree.lastPick.node }));
+      // show it again: back as it was
+      f0 = await frames();
+      await row.click();
+      await page.waitForFunction((n) => { const x = sy.ui.tree.nodes.find((k) => k.id === n); return x && x.visible; }, pick.node, { timeout: TIMEOUT });
+      await shown(f0);
+      await settled();
+      result.show = await diff(before, await canvasB64('shown_canvas.png'), px, py);
+      // 3. a section plane (X, in the middle of the scene): the image changes; removed: back
+      f0 = await frames();
+      await page.click('#sy-plane-add');
+      await shown(f0);
+      await settled();
+      await page.screenshot({ path: join(outDir, 'section.png') });
+      result.section = await diff(before, await canvasB64('section_canvas.png'), px, py);
+      f0 = await frames();
+      await page.locator('#sy-section button[title=remove]').click();
+      await shown(f0);
+      await settled();
+    }
+    // 4. measure two points
+    await page.keyboard.press('m');
+    for (const [x, y] of [targets.first, targets.second]) {
+      const n = await page.evaluate(() => sy.ui.tree.picks);
+      await page.mouse.click(x, y);
+      await page.waitForFunction((k) => sy.ui.tree.picks > k, n, { timeout: TIMEOUT });
+    }
+    await page.waitForFunction(() => sy.ui.measure.points.length === 2 && sy.ui.measure.distance !== null, null, { timeout: TIMEOUT });
+    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    await page.screenshot({ path: join(outDir, 'measure.png') });
+    result.measure = await page.evaluate(() => ({ points: sy.ui.measure.points, distance: sy.ui.measure.distance,
+                                                   text: document.getElementById('sy-measure-out').innerText }));
+    await page.keyboard.press('Escape');
+    // 5. the help overlay
+    await page.keyboard.press('?');
+    await page.waitForFunction(() => sy.ui.helpOpen, null, { timeout: TIMEOUT });
+    await page.screenshot({ path: join(outDir, 'help.png') });
+    result.help = await page.evaluate(() => document.getElementById('sy-help').innerText.length);
+    await page.keyboard.press('Escape');
+    // 6. the screenshot button: a JPEG of the canvas' size, downloaded
+    const download = page.waitForEvent('download', { timeout: TIMEOUT });
+    await page.click('#sy-shot');
+    const dl = await download;
+    await page.waitForFunction(() => sy.ui.shot && sy.ui.shot.state !== 'pending', null, { timeout: TIMEOUT });
+    result.shot = Object.assign(await page.evaluate(() => sy.ui.shot), { file: dl.suggestedFilename() });
+    // 7. touch: a two-finger pinch (synthetic pointer events) zooms, one finger orbits
+    const in0 = await page.evaluate(() => sy.stats().last_input);
+    await page.evaluate(([x, y]) => {
+      const c = document.getElementById('sy-canvas');
+      const ev = (type, id, cx, cy) => c.dispatchEvent(new PointerEvent(type, { pointerId: id, pointerType: 'touch', clientX: cx, clientY: cy,
+                                                                             isPrimary: id === 11, bubbles: true }));
+      ev('pointerdown', 11, x - 20, y); ev('pointerdown', 12, x + 20, y);
+      for (let k = 1; k <= 5; k++) { ev('pointermove', 11, x - 20 - 8 * k, y); ev('pointermove', 12, x + 20 + 8 * k, y); }
+      ev('pointerup', 11, x - 60, y); ev('pointerup', 12, x + 60, y);
+      ev('pointerdown', 13, x, y);
+      for (let k = 1; k <= 5; k++) ev('pointermove', 13, x + 6 * k, y);
+      ev('pointerup', 13, x + 30, y);
+    }, [px, py]);
+    result.touch_inputs = (await page.evaluate(() => sy.stats().last_input)) - in0;
+    await settled();
+    result.consoleErrors = consoleErrors;
+    console.log(JSON.stringify(result));
   } else {
     // idle (the last answer's objects all shown) and that state drawn (the page renders on demand)
     await page.waitForFunction(() => window.syClient && syClient.queries > 0 && syClient.idle &&

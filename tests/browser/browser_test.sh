@@ -10,6 +10,15 @@
 #     service answered (each once, no other), and what it draws covers what `sy render -b raster`
 #     covers for the same (initial) view (IoU >= 0.95); then with a budget of a quarter of the
 #     scene's triangles: again exactly the answer's objects, fewer than all, drawn within it.
+#   browser_test.sh tools SY PNG_IOU MODULES_DIR SCENE
+#     sy web SCENE -b raster, a 960 x 600 page: a click on a covered pixel picks its node (the
+#     properties name it) and selects it; unticking it in the tree changes the streamed canvas
+#     there (mean abs diff > 30 in a 9 x 9 box) and a pick there no longer names it; ticking it
+#     brings the picture back (< 8); a section plane changes > 0.5% of the canvas; two clicks
+#     while measuring give the distance of the two picked points; the help opens; the screenshot
+#     button downloads a JPEG; synthetic touch pinch and drag send inputs. Then sy web
+#     --read-only: the page hides the planes, disables the check boxes, shows its badge; a click
+#     selects nothing; a visibility change sent anyway is refused (logged) and changes nothing.
 #   browser_test.sh warp SY PNG_IOU MODULES_DIR SCENE
 #     sy web SCENE -b raster --delay-ms 100 (100 ms added each way): a scripted drag on the
 #     warping page answers at least 75% of its inputs by the estimate, before any server frame
@@ -31,6 +40,7 @@
 set -u
 mode=$1 SY=$2 PNG_IOU=$3 MODULES=$4 SCENE=$5
 W=480 H=360
+[ "$mode" = tools ] && W=960 H=600 # the panel shows beside the canvas from 600 pixels on
 skip() {
     if [ "${SY_REQUIRE_BROWSER:-0}" = 1 ]; then echo "FAIL: SY_REQUIRE_BROWSER=1 but the test cannot run: $*"; exit 1; fi
     echo "SKIP: $*"
@@ -100,6 +110,49 @@ fetched_check() {
       if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
     ' "$out/client.json" "${1:-}" || fail=1
 }
+
+if [ "$mode" = tools ]; then
+    browse "$url"
+    cp "$out/browser.json" "$out/tools.json"
+    # the same page from a read-only server
+    "$SY" web "$SCENE" -b raster --listen 127.0.0.1:0 --read-only >"$out/log2" 2>"$out/err2" &
+    pid2=$!
+    wait_until $pid2 grep -q 'http://' "$out/log2"
+    url2=$(grep -o 'http://[^ ]*' "$out/log2" 2>/dev/null | head -1)
+    grep -q "(read-only)" "$out/log2" || bad "sy web --read-only does not say so: $(cat "$out/log2")"
+    mkdir -p "$out/ro"
+    SY_CHROMIUM=$CHROMIUM node "$MODULES/browser.mjs" tools "${url2}?readonly=1" "$out/ro" $W $H >"$out/ro.json" || bad "the read-only run failed"
+    cat "$out/ro.json"
+    kill -TERM $pid2 2>/dev/null; wait $pid2 2>/dev/null
+    grep -q "read-only server: refused" "$out/err2" || bad "the read-only server logged no refusal: $(tail -3 "$out/err2")"
+    [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null
+    node -e '
+      const fs = require("fs"), t = JSON.parse(fs.readFileSync(process.argv[1])), r = JSON.parse(fs.readFileSync(process.argv[2]));
+      const errs = [];
+      console.log(`picked node ${t.pick.node} "${t.pick.name}" at ${t.pick.at}; hidden: mean abs diff ${t.hide.box.toFixed(1)} in the 9x9 box, ` +
+                  `${(100 * t.hide.changed).toFixed(1)}% of the canvas changed; shown again: ${t.show.box.toFixed(1)}, ${(100 * t.show.changed).toFixed(2)}%; ` +
+                  `section plane: ${(100 * t.section.changed).toFixed(1)}% changed; measured ${t.measure.distance}; screenshot ${JSON.stringify(t.shot)}; ` +
+                  `touch inputs ${t.touch_inputs}`);
+      if (!(t.hide.box > 30)) errs.push(`hiding the picked node left the canvas where it was (mean abs diff ${t.hide.box})`);
+      if (t.pick_hidden.hit && t.pick_hidden.node === t.pick.node) errs.push("a pick still names the hidden node");
+      if (!(t.show.box < 8)) errs.push(`showing it again did not bring the picture back (mean abs diff ${t.show.box})`);
+      if (!(t.section.changed > 0.005)) errs.push(`the section plane changed ${t.section.changed} of the canvas`);
+      const m = t.measure, d = m.points.length === 2 ? Math.hypot(...[0, 1, 2].map((i) => m.points[1][i] - m.points[0][i])) : NaN;
+      if (!(m.distance > 0 && Math.abs(m.distance - d) <= 1e-9 * (1 + d) && m.text.includes("distance"))) errs.push(`measurement ${JSON.stringify(m)}`);
+      if (!(t.help > 200)) errs.push("no help text");
+      if (t.shot.state !== "done" || t.shot.type !== "image/jpeg" || !(t.shot.bytes > 1000) || !/\.jpg$/.test(t.shot.file)) errs.push(`screenshot ${JSON.stringify(t.shot)}`);
+      if (!(t.touch_inputs >= 6)) errs.push(`touch sent ${t.touch_inputs} inputs`);
+      if (!r.readOnly || !r.hidden_controls.sections || !r.hidden_controls.checkbox_disabled || !r.hidden_controls.badge) errs.push(`read-only page controls ${JSON.stringify(r.hidden_controls)}`);
+      if (r.hidden_controls && r.hidden_controls.selected) errs.push("a read-only click selected a node");
+      if (!r.still_visible) errs.push("a read-only server applied a visibility change");
+      for (const s of [t, r]) if (s.consoleErrors.length) errs.push(`page errors: ${s.consoleErrors}`);
+      if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
+    ' "$out/tools.json" "$out/ro.json" || fail=1
+    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
+    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" "$out/err2" && bad "sy web: $(server_said)"
+    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
+    exit $fail
+fi
 
 if [ "$mode" = warp ]; then
     browse "$url"

@@ -432,8 +432,22 @@
     },
     // tests: keep the references (frames arriving are dropped); released, the page asks for a frame
     hold: function (on) { hold = !!on; if (!hold) sendSize(); },
+    // for the page's other scripts (ui.js, tree.js, ...): send a message, an input (the camera's
+    // are predicted by the warp), listen to the server's text messages, and where a world point
+    // is on the canvas now (CSS pixels; null when behind the camera or before the first frame)
+    send: function (o) { send(o); },
+    input: function (o) { input(o, null); },
+    on: function (f) { listeners.push(f); },
+    project: function (p) {
+      if (!refs.length) return null;
+      const m = rigidInverse(orbitMatrix(sent.length ? localOrbit() : refs[0].orbit)), win = refs[0].win;
+      const q = [0, 1, 2].map((i) => m[i] * p[0] + m[4 + i] * p[1] + m[8 + i] * p[2] + m[12 + i]), z = -q[2];
+      if (!(z > 0)) return null;
+      return [(q[0] / z - win[0]) / (win[1] - win[0]) * canvas.clientWidth, (win[3] - q[1] / z) / (win[3] - win[2]) * canvas.clientHeight];
+    },
   };
 
+  const listeners = []; // window.sy.on: the server's text messages, parsed
   function send(o) {
     if (ws && ws.readyState === 1) ws.send(JSON.stringify(o));
   }
@@ -470,6 +484,7 @@
           const m = JSON.parse(e.data);
           if (m.t === "hello") stats.backends = m.backends;
           if (m.t === "status") { stats.filter = m.filter; if (m.error) hud.textContent = m.error; }
+          for (const f of listeners) try { f(m); } catch (err) { console.error(err); }
         } catch (err) {}
         return;
       }
@@ -479,6 +494,7 @@
   // mouse and touch: one pointer drags (left: orbit, right or shift: pan), the wheel zooms
   let drag = null;
   canvas.addEventListener("pointerdown", function (e) {
+    if (e.pointerType === "touch") return; // touch.js: one finger orbits, two pan and pinch
     canvas.setPointerCapture(e.pointerId); canvas.focus();
     drag = { x: e.clientX, y: e.clientY, b: (e.button === 2 || e.shiftKey) ? 2 : 0 };
   });
@@ -497,6 +513,7 @@
     input({ t: "wheel", steps: e.deltaY < 0 ? 1 : -1 }, e);
   }, { passive: false });
   window.addEventListener("keydown", function (e) {
+    if (e.target && /^(INPUT|SELECT|TEXTAREA)$/.test(e.target.tagName)) return; // typing in the panel
     const k = e.key.length === 1 ? e.key.toLowerCase() : "";
     if (/^[1-9f\[\]r]$/.test(k)) input({ t: "key", k: k }, e);
   });
