@@ -275,6 +275,10 @@ try {
     const props = await page.evaluate(() => document.getElementById('sy-props').innerText);
     if (!props.includes('#' + pick.node) || !props.includes('position')) fail(`the properties do not show the pick: ${props}`);
     if (!readOnly) await page.waitForFunction((n) => sy.ui.tree.selected === n, pick.node, { timeout: TIMEOUT });
+    // for the screenshot: the selection's refined frame (a scene change gives a coarse frame first;
+    // not a check: the wait ends quietly when that frame came before this)
+    const fs0 = await frames();
+    await page.waitForFunction(([k, w]) => syStats.frames > k && syStats.width === w, [fs0, width], { timeout: 20000 }).catch(() => {});
     await settled();
     let f0 = await frames();
     await page.screenshot({ path: join(outDir, 'tree.png') });

@@ -1,6 +1,7 @@
 // measure.js — the measuring tool (docs/WEB.md, "The page"): while it is on (the Measure button or the M key),
 // clicks pick without selecting and the first two picked points give their distance in scene
-// units (glTF: metres) and its X, Y, Z parts; a third click starts again. The points and the line
+// units (glTF: metres) and its X, Y, Z parts, and the last point's distance to each section plane
+// in use; a third click starts again. The points and the line
 // between them are drawn over the canvas where window.sy.project puts them, every display frame.
 "use strict";
 (function () {
@@ -44,6 +45,10 @@
       const d = [0, 1, 2].map((i) => m.points[1][i] - m.points[0][i]);
       rows.push(["distance", fmt(m.distance) + " (scene units)"], ["dx, dy, dz", d.map(fmt).join(", ")]);
     }
+    // the last point's distance to each section plane in use (signed: positive on the kept side)
+    const last = m.points[m.points.length - 1], planes = ui.activePlanes ? ui.activePlanes() : [];
+    m.toPlanes = last ? planes.map((q) => (q[0] * last[0] + q[1] * last[1] + q[2] * last[2] + q[3]) / Math.hypot(q[0], q[1], q[2])) : [];
+    m.toPlanes.forEach(function (d, i) { rows.push(["to plane " + (i + 1), fmt(d)]); });
     for (const [k, v] of rows) { el("span", {}, out, k); el("span", {}, out, v); }
   }
   ui.onPick = function (p) {

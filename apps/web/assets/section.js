@@ -29,6 +29,7 @@
     timer = setTimeout(function () { sy.send({ t: "clip", planes: planes.filter((p) => p.on).map(plane) }); }, 50);
   }
   ui.sendPlanes = send;
+  ui.activePlanes = function () { return planes.filter((p) => p.on).map(plane); }; // measure.js: point-to-plane
   function addPlane(axis, t, flip) {
     if (planes.length >= 6) return null;
     const p = { axis: axis, t: t, flip: flip, on: true };
