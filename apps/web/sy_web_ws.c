@@ -346,6 +346,28 @@ static int ws_writeable(sy_web *w, web_conn *c)
     return send_frame(w, c, f, answered_by(c, f->gen));
 }
 
+/* Answers for connections that closed after asking (the render thread answered a request queued
+ * before the close): freed, so they never fill the answers' queue. */
+static void drop_orphan_replies(sy_web *w)
+{
+    pthread_mutex_lock(&w->mu);
+    for (web_reply **rp = &w->replies; *rp;) {
+        web_reply *y = *rp;
+        const web_conn *c = w->conns;
+        while (c && c->serial != y->conn) c = c->next;
+        if (c) {
+            rp = &y->next;
+            continue;
+        }
+        *rp = y->next;
+        free(y->text), free(y);
+        w->reply_count--;
+    }
+    w->replies_tail = &w->replies;
+    while (*w->replies_tail) w->replies_tail = &(*w->replies_tail)->next;
+    pthread_mutex_unlock(&w->mu);
+}
+
 static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
 {
     struct lws_context *ctx = lws_get_context(wsi);
@@ -454,8 +476,11 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
         if (c->queued_n) lws_callback_on_writable(wsi);
         delay_timer(w, c);
         return 0;
-    case LWS_CALLBACK_EVENT_WAIT_CANCELLED: /* a new frame or status: every viewer that can take it */
-        if (w) lws_callback_on_writable_all_protocol(ctx, &sy_webi_protocols[1]);
+    case LWS_CALLBACK_EVENT_WAIT_CANCELLED: /* a new frame, status or answer: every viewer that can take it */
+        if (w) {
+            drop_orphan_replies(w);
+            lws_callback_on_writable_all_protocol(ctx, &sy_webi_protocols[1]);
+        }
         return 0;
     default: return 0;
     }

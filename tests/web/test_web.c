@@ -36,7 +36,8 @@
  *                 hides that node: the next frame's depth there changes and a new pick no longer
  *                 names it; shows it again: the depth comes back; an unknown node is refused with
  *                 the reason; a plane that keeps nothing empties the pixel and no plane brings it
- *                 back; bad planes and picks outside are ignored and the stream goes on
+ *                 back; bad planes and picks outside are ignored and the stream goes on; 80 pages
+ *                 that ask for the tree and leave at once leave no answers behind
  *   web_readonly  read_only: visibility, selection, isolation, planes and back-end keys are refused
  *                 (the tree unchanged, no "scene" message), a pick answers without selecting, the
  *                 camera moves
@@ -1201,6 +1202,24 @@ static int test_scene(uint16_t port)
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":6}", &err), err);
     CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
     CHECK(json_number(t, "seq") == 6 && !strstr(t, "\"selected\":true"));
+    free(t);
+    /* 80 pages that ask for the tree and leave at once: their answers are dropped, not kept
+     * (64 kept would stop every answer); a page asking afterwards is answered */
+    sy_web_client_close(other);
+    other = NULL;
+    int held = hold_render_thread(port); /* their requests wait until they left */
+    CHECK(held >= 0);
+    for (int k = 0; k < 80; ++k) {
+        sy_web_client *gone = NULL;
+        for (int a = 0; a < 50 && sy_web_client_connect(&o, 10000, &gone, &err) != SY_OK; ++a) {} /* (the last may still count) */
+        CHECK(gone != NULL);
+        CHECK_OK(sy_web_client_send(gone, "{\"t\":\"tree\",\"seq\":1}", &err), err);
+        sy_web_client_close(gone);
+    }
+    release_render_thread(held);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":7}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
+    CHECK(json_number(t, "seq") == 7);
     free(t);
     sy_web_client_close(other);
     sy_web_client_close(c);
