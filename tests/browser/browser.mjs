@@ -338,6 +338,15 @@ try {
     await page.screenshot({ path: join(outDir, 'measure.png') });
     result.measure = await page.evaluate(() => ({ points: sy.ui.measure.points, distance: sy.ui.measure.distance,
                                                    text: document.getElementById('sy-measure-out').innerText }));
+    if (!readOnly) { // a section plane (X, mid-scene): the last point's signed distance to it
+      await page.click('#sy-plane-add');
+      result.to_plane = await page.evaluate(() => {
+        const t = sy.ui.tree, p = sy.ui.measure.points[1];
+        return { shown: sy.ui.measure.toPlanes, want: p[0] - (t.min[0] + t.max[0]) / 2,
+                 text: document.getElementById('sy-measure-out').innerText.includes('to plane 1') };
+      });
+      await page.locator('#sy-section button[title=remove]').click();
+    }
     await page.keyboard.press('Escape');
     // 5. the help overlay
     await page.keyboard.press('?');

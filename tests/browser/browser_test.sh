@@ -15,7 +15,8 @@
 #     properties name it) and selects it; unticking it in the tree changes the streamed canvas
 #     there (mean abs diff > 30 in a 9 x 9 box) and a pick there no longer names it; ticking it
 #     brings the picture back (< 8); a section plane changes > 0.5% of the canvas; two clicks
-#     while measuring give the distance of the two picked points; the help opens; the screenshot
+#     while measuring give the distance of the two picked points (and, with a plane added, the
+#     second point's signed distance to it); the help opens; the screenshot
 #     button downloads a JPEG; synthetic touch pinch and drag send inputs. Then sy web
 #     --read-only: the page hides the planes, disables the check boxes, shows its badge; a click
 #     selects nothing; a visibility change sent anyway is refused (logged) and changes nothing.
@@ -131,7 +132,7 @@ if [ "$mode" = tools ]; then
       const errs = [];
       console.log(`picked node ${t.pick.node} "${t.pick.name}" at ${t.pick.at}; hidden: mean abs diff ${t.hide.box.toFixed(1)} in the 9x9 box, ` +
                   `${(100 * t.hide.changed).toFixed(1)}% of the canvas changed; shown again: ${t.show.box.toFixed(1)}, ${(100 * t.show.changed).toFixed(2)}%; ` +
-                  `section plane: ${(100 * t.section.changed).toFixed(1)}% changed; measured ${t.measure.distance}; screenshot ${JSON.stringify(t.shot)}; ` +
+                  `section plane: ${(100 * t.section.changed).toFixed(1)}% changed; measured ${t.measure.distance}, to the plane ${t.to_plane && t.to_plane.shown}; screenshot ${JSON.stringify(t.shot)}; ` +
                   `touch inputs ${t.touch_inputs}`);
       if (!(t.hide.box > 30)) errs.push(`hiding the picked node left the canvas where it was (mean abs diff ${t.hide.box})`);
       if (t.pick_hidden.hit && t.pick_hidden.node === t.pick.node) errs.push("a pick still names the hidden node");
@@ -139,6 +140,8 @@ if [ "$mode" = tools ]; then
       if (!(t.section.changed > 0.005)) errs.push(`the section plane changed ${t.section.changed} of the canvas`);
       const m = t.measure, d = m.points.length === 2 ? Math.hypot(...[0, 1, 2].map((i) => m.points[1][i] - m.points[0][i])) : NaN;
       if (!(m.distance > 0 && Math.abs(m.distance - d) <= 1e-9 * (1 + d) && m.text.includes("distance"))) errs.push(`measurement ${JSON.stringify(m)}`);
+      if (!(t.to_plane && t.to_plane.text && t.to_plane.shown.length === 1 && Math.abs(t.to_plane.shown[0] - t.to_plane.want) <= 1e-9 * (1 + Math.abs(t.to_plane.want))))
+        errs.push(`point to plane ${JSON.stringify(t.to_plane)}`);
       if (!(t.help > 200)) errs.push("no help text");
       if (t.shot.state !== "done" || t.shot.type !== "image/jpeg" || !(t.shot.bytes > 1000) || !/\.jpg$/.test(t.shot.file)) errs.push(`screenshot ${JSON.stringify(t.shot)}`);
       if (!(t.touch_inputs >= 6)) errs.push(`touch sent ${t.touch_inputs} inputs`);

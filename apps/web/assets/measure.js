@@ -51,6 +51,7 @@
     m.toPlanes.forEach(function (d, i) { rows.push(["to plane " + (i + 1), fmt(d)]); });
     for (const [k, v] of rows) { el("span", {}, out, k); el("span", {}, out, v); }
   }
+  m.refresh = show;
   ui.onPick = function (p) {
     if (!m.active) return false;
     if (!p.hit) { note.textContent = "nothing there: click on the model"; return true; }

@@ -27,6 +27,7 @@
   function send() {
     clearTimeout(timer);
     timer = setTimeout(function () { sy.send({ t: "clip", planes: planes.filter((p) => p.on).map(plane) }); }, 50);
+    if (ui.measure && ui.measure.refresh) ui.measure.refresh(); // its point-to-plane distances
   }
   ui.sendPlanes = send;
   ui.activePlanes = function () { return planes.filter((p) => p.on).map(plane); }; // measure.js: point-to-plane
