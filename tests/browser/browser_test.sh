@@ -126,7 +126,10 @@ if [ "$mode" = tools ]; then
     cat "$out/ro.json"
     kill -TERM $pid2 2>/dev/null; wait $pid2 2>/dev/null
     grep -q "read-only server: refused" "$out/err2" || bad "the read-only server logged no refusal: $(tail -3 "$out/err2")"
-    [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null
+    if [ -n "${SY_BROWSER_KEEP:-}" ]; then
+        cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null
+        for f in "$out"/ro/*.png; do cp "$f" "$SY_BROWSER_KEEP/ro_$(basename "$f")"; done 2>/dev/null
+    fi
     node -e '
       const fs = require("fs"), t = JSON.parse(fs.readFileSync(process.argv[1])), r = JSON.parse(fs.readFileSync(process.argv[2]));
       const errs = [];
