@@ -36,7 +36,8 @@
  *                 hides that node: the next frame's depth there changes and a new pick no longer
  *                 names it; shows it again: the depth comes back; an unknown node is refused with
  *                 the reason; a plane that keeps nothing empties the pixel and no plane brings it
- *                 back; bad planes and picks outside are ignored and the stream goes on; 80 pages
+ *                 back; bad planes and picks outside are ignored and the stream goes on; exposure
+ *                 +2 stops brightens the frame (mean > 1.15 x that at 0); 80 pages
  *                 that ask for the tree and leave at once leave no answers behind
  *   web_readonly  read_only: visibility, selection, isolation, planes and back-end keys are refused
  *                 (the tree unchanged, no "scene" message), a pick answers without selecting, the
@@ -1205,6 +1206,26 @@ static int test_scene(uint16_t port)
     free(t);
     /* 80 pages that ask for the tree and leave at once: their answers are dropped, not kept
      * (64 kept would stop every answer); a page asking afterwards is answered */
+    /* exposure: +2 stops brighten the frame, back to 0 restores it */
+    double mean[2] = {0, 0};
+    for (int k = 0; k < 2; ++k) {
+        CHECK_OK(sy_web_client_send(c, k ? "{\"t\":\"exposure\",\"stops\":0}" : "{\"t\":\"exposure\",\"stops\":2}", &err), err);
+        sy_web_frame_info fi;
+        uint8_t *jp = NULL, *px = NULL;
+        size_t jn = 0;
+        uint32_t jw = 0, jh = 0;
+        do { /* the refined frame after the change (a coarse one may come first) */
+            free(jp);
+            jp = NULL;
+            CHECK_OK(sy_web_client_next_frame(c, 20000, &fi, &jp, &jn, &err), err);
+        } while (fi.width != 80);
+        CHECK_OK(sy_jpeg_decode_rgba8(jp, jn, 0, &px, &jw, &jh, &err), err);
+        for (size_t i = 0; i < (size_t)jw * jh * 4; ++i) if ((i & 3) != 3) mean[k] += px[i];
+        mean[k] /= 3.0 * jw * jh;
+        free(jp), free(px);
+    }
+    printf("exposure: mean %.1f at +2 stops, %.1f at 0\n", mean[0], mean[1]);
+    CHECK(mean[0] > mean[1] * 1.15);
     sy_web_client_close(other);
     other = NULL;
     int held = hold_render_thread(port); /* their requests wait until they left */
