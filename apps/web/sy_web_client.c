@@ -156,7 +156,10 @@ sy_result sy_web_client_next_frame_depth(sy_web_client *c, uint32_t timeout_ms, 
     if (jpeg_len) *jpeg_len = 0;
     if (depth) *depth = NULL;
     double end = sy_time_now() + timeout_ms / 1000.0;
-    while (!c->head && c->wsi && sy_time_now() < end) lws_service(c->ctx, 0);
+    for (double now = sy_time_now(); !c->head && c->wsi && now < end; now = sy_time_now()) {
+        lws_set_timer_usecs(c->wsi, (lws_usec_t)((end - now) * 1e6) + 1000); /* lws_service ignores its timeout */
+        lws_service(c->ctx, 0);
+    }
     if (!c->head)
         return sy_error_set(err, SY_ERR_IO, "web client: no frame within %u ms%s", timeout_ms,
                             c->wsi ? "" : " (connection closed)");
