@@ -94,7 +94,8 @@ sy_result sy_animation_find(const sy_scene *s, const char *selector, sy_animatio
  * the mean of the scene over the interval; `sy render --shutter` accumulates one render per time
  * (docs/CLI.md "Motion blur"). Plain data. */
 typedef struct sy_shutter {
-    double open, close; /**< seconds after the frame's time */
+    double open;        /**< shutter opens: seconds after the frame's time */
+    double close;       /**< shutter closes: seconds after the frame's time (>= open) */
     uint32_t samples;   /**< time samples across the interval (>= 1) */
 } sy_shutter;
 
