@@ -1,6 +1,17 @@
 /* sy_filter_temporal.c — temporal reuse for moving progressive frames: reprojection, history
  * clamping in YCoCg, moving averages of colour and moments, variance-guided a-trous; see
- * sy_filter_temporal.h. */
+ * sy_filter_temporal.h.
+ *
+ * Layout for speed (an interactive frame's budget is a few ms): every per-pixel quantity is a
+ * float plane (structure of arrays), the frame's own values are copied into planes once (misses and
+ * bad pixels as finite zeros, so that a masked neighbour multiplies a finite value by 0), and the
+ * neighbourhood passes (3x3 statistics, variance blur, a-trous) run tap by tap over whole rows: for
+ * one tap (dx, dy) the loop over x has no branch, no division and contiguous loads, and GCC
+ * vectorises it (-ftree-vectorize, CMakeLists.txt; check with -fopt-info-vec). A neighbour of
+ * another class (hit with a normal, hit without one, none) gets weight 0 through a select. Per
+ * pixel, the taps are summed in the order the scalar version summed them (centre, then dy, dx
+ * row-major), so results do not depend on the vector width or the thread count. Only the
+ * reprojection (4 gathered taps of the previous history) stays a scalar per-pixel loop. */
 #include "sy_filter_temporal.h"
 
 #include <math.h>
@@ -8,43 +19,88 @@
 #include <string.h>
 #include <time.h>
 
+/* the helpers of the row loops inline into every clone of them (GCC's early inliner leaves a "cold"
+ * call otherwise, and the loop does not vectorise) */
+#if defined(__GNUC__)
+#define SY_TEMPORAL_INLINE __attribute__((always_inline))
+#else
+#define SY_TEMPORAL_INLINE
+#endif
+
 /* branch-free min / max without the library call GCC emits for fmaxf's NaN rules */
-static inline float fmx(float a, float b)
+static inline SY_TEMPORAL_INLINE float fmx(float a, float b)
 {
     return a > b ? a : b;
 }
-static inline float fmn(float a, float b)
+static inline SY_TEMPORAL_INLINE float fmn(float a, float b)
 {
     return a < b ? a : b;
 }
 
-/* One frame's history: what the next frame reprojects. */
+/* exp(-x) for x >= 0 (NaN counts as large): sy_filter_expneg's polynomial without its branch, so
+ * that it vectorises; x is clamped to xmax (callers pass EXP_MAX: beyond it about 2^-125 instead of
+ * 0, a weight no sum notices). xmax reaches the row loop through memory, not as a constant: with a
+ * constant, GCC folds the clamped case into a branch of its own and then cannot vectorise the AVX2 clone. */
+#define EXP_MAX 87.0f
+static inline SY_TEMPORAL_INLINE float expneg(float x, float xmax)
+{
+    x = fmn(x, xmax);
+    float y = x * 1.44269504f;
+    int32_t k = (int32_t)y;
+    float f = y - (float)k;
+    float p = 1.0f + f * (-0.69314718f + f * (0.24022651f + f * (-0.05550411f + f * (0.00961813f - f * 0.00133336f))));
+    int32_t bits = (127 - k) * (1 << 23);
+    float s;
+    memcpy(&s, &bits, sizeof s);
+    return p * s;
+}
+
+/* One frame's history: what the next frame reprojects. Planes of w*h floats, plane q of a group at
+ * base + q*w*h. */
 typedef struct hist {
     uint32_t w, h;
-    size_t cap;  /* pixels allocated */
-    float *illum; /* 3: demodulated indirect part (or colour) after the first a-trous pass */
-    float *dir;   /* 3: demodulated direct part (0 without the split) */
-    float *mom;   /* 4: luminance moments of the indirect part (or colour), then of the direct part */
-    float *len;   /* 1: history length (frames); 0 = nothing to reuse (miss, bad pixel) */
-    float *pos;   /* 3: world position */
-    float *nrm;   /* 3: normal */
+    size_t cap;   /* pixels allocated */
+    float *illum; /* 3 planes: demodulated indirect part (or colour) after the first a-trous pass */
+    float *dir;   /* 3 planes: demodulated direct part (0 without the split) */
+    float *mom;   /* 4 planes: luminance moments of the indirect part (or colour), then of the direct part */
+    float *len;   /* history length (frames); 0 = nothing to reuse (miss, bad pixel) */
+    float *pos;   /* 3 planes: world position */
+    float *nrm;   /* 3 planes: normal */
     float world_to_pixel[16];
 } hist;
+
+/* the working planes, all of n = width*height floats (see work_reserve for the count) */
+enum {
+    W_CLS,          /* class: 0 none (miss, bad pixel), 1 hit without a normal, 2 hit with one */
+    W_HIT,          /* 1 for a hit (class > 0), else 0 */
+    W_SN,           /* the centre's normal edge stop: sigma_normal for class 2, else 0 */
+    W_Z,            /* depth (0 where no hit) */
+    W_N,            /* 3: normal (0 where no hit) */
+    W_MOD = W_N + 3, /* 3: albedo modulation */
+    W_CUR = W_MOD + 3, /* 6: the new samples demodulated, indirect part (or colour) then direct part */
+    W_LUM = W_CUR + 6, /* 2: their luminance, per part */
+    W_ZG = W_LUM + 2,  /* depth gradient */
+    W_IL,           /* per a-trous pass: 1 / (sigma_l sqrt(blurred variance) + 1e-6) */
+    W_IZ,           /* per a-trous pass: 1 / (sigma_z step zgrad + 1e-6 z + 1e-9) */
+    W_WS,           /* sums of weights */
+    W_PART,         /* per part (2): acc 3, var, lacc, a 3, va, la, b 3, vb, lb = 15 */
+    W_COUNT = W_PART + 2 * 15
+};
+/* offsets inside a part's 15 planes */
+enum { P_ACC = 0, P_VAR = 3, P_LACC = 4, P_A = 5, P_VA = 8, P_LA = 9, P_B = 10, P_VB = 13, P_LB = 14 };
+/* the 3x3 statistics of integrate_rows borrow a part's a-trous planes (free until then): per part
+ * YCoCg sums (3) and sums of squares (3) of the new samples, luminance sum and sum of squares; part 0
+ * also the count of hits and the depth gradient */
+enum { S_COUNT = 17 };
 
 struct sy_filter_temporal {
     sy_filter_temporal_params p;
     hist h[2];
-    int prev;      /* index of the previous frame's history in h */
+    int prev; /* index of the previous frame's history in h */
     bool have_prev;
-    size_t cap;    /* pixels of the working buffers */
-    float *illum, *mod, *lum, *zgrad, *vbl;
-    float *dcur; /* the direct part's new samples (0 without the split) */
-    /* the blended part, its variance and luminance, and the a-trous ping-pong buffers: [0] the
-     * indirect part (or the colour), [1] the direct part */
-    struct plane {
-        float *acc, *var, *lacc, *a, *b, *va, *vb, *la, *lb;
-    } pl[2];
-    uint8_t *ok, *hit; /* hit: 0 = none (miss, bad pixel), 1 = a hit without a normal, 2 = with one */
+    size_t cap;   /* pixels of the working planes */
+    float *work;  /* W_COUNT planes */
+    uint8_t *ok;  /* 1 = finite input */
 };
 
 void sy_filter_temporal_params_default(sy_filter_temporal_params *p)
@@ -82,49 +138,40 @@ sy_filter_status sy_filter_temporal_params_check(const sy_filter_temporal_params
 
 /* A pixel without a normal (0, 0, 0: a specular chain that never reached a diffuse surface) agrees
  * only with another such pixel; two normals agree when their cosine is at least tol. */
-static inline bool has_normal(const float *n)
+static inline bool has_normal(float x, float y, float z)
 {
-    return n[0] * n[0] + n[1] * n[1] + n[2] * n[2] > 0.25f;
-}
-
-static inline bool normals_agree(const float *a, const float *b, float tol)
-{
-    bool ha = has_normal(a), hb = has_normal(b);
-    return ha != hb ? false : !ha || a[0] * b[0] + a[1] * b[1] + a[2] * b[2] >= tol;
+    return x * x + y * y + z * z > 0.25f;
 }
 
 static void hist_free(hist *h)
 {
-    free(h->illum), free(h->dir), free(h->mom), free(h->len), free(h->pos), free(h->nrm);
+    free(h->illum);
     memset(h, 0, sizeof *h);
 }
 
+/* one block of 17 planes: illum 3, dir 3, mom 4, len 1, pos 3, nrm 3 */
 static bool hist_reserve(hist *h, size_t n)
 {
     if (n <= h->cap) return true;
     hist_free(h);
-    h->illum = malloc(3 * n * sizeof(float)), h->dir = malloc(3 * n * sizeof(float)), h->mom = malloc(4 * n * sizeof(float));
-    h->len = malloc(n * sizeof(float)), h->pos = malloc(3 * n * sizeof(float)), h->nrm = malloc(3 * n * sizeof(float));
-    if (!h->illum || !h->dir || !h->mom || !h->len || !h->pos || !h->nrm) {
-        hist_free(h);
-        return false;
-    }
-    h->cap = n;
+    if (n > SIZE_MAX / (17 * sizeof(float))) return false;
+    float *b = malloc(17 * n * sizeof(float));
+    if (!b) return false;
+    h->illum = b, h->cap = n;
     return true;
+}
+
+/* the planes of h for a frame of n pixels */
+static void hist_bind(hist *h, size_t n)
+{
+    h->dir = h->illum + 3 * n, h->mom = h->dir + 3 * n, h->len = h->mom + 4 * n, h->pos = h->len + n;
+    h->nrm = h->pos + 3 * n;
 }
 
 static void work_free(sy_filter_temporal *t)
 {
-    free(t->illum), free(t->mod), free(t->lum), free(t->zgrad), free(t->vbl), free(t->dcur);
-    t->illum = t->mod = t->lum = t->zgrad = t->vbl = t->dcur = NULL;
-    for (int k = 0; k < 2; ++k) {
-        struct plane *q = &t->pl[k];
-        free(q->acc), free(q->var), free(q->lacc), free(q->a), free(q->b), free(q->va), free(q->vb), free(q->la);
-        free(q->lb);
-        memset(q, 0, sizeof *q);
-    }
-    free(t->ok), free(t->hit);
-    t->ok = t->hit = NULL;
+    free(t->work), free(t->ok);
+    t->work = NULL, t->ok = NULL;
     t->cap = 0;
 }
 
@@ -132,16 +179,9 @@ static bool work_reserve(sy_filter_temporal *t, size_t n)
 {
     if (n <= t->cap) return true;
     work_free(t);
-    size_t f3 = 3 * n * sizeof(float), f1 = n * sizeof(float);
-    bool ok = (t->illum = malloc(f3)) && (t->mod = malloc(f3)) && (t->dcur = malloc(f3)) && (t->lum = malloc(f1)) &&
-              (t->zgrad = malloc(f1)) && (t->vbl = malloc(f1)) && (t->ok = malloc(n)) && (t->hit = malloc(n));
-    for (int k = 0; k < 2 && ok; ++k) {
-        struct plane *q = &t->pl[k];
-        ok = (q->acc = malloc(f3)) && (q->a = malloc(f3)) && (q->b = malloc(f3)) && (q->var = malloc(f1)) &&
-             (q->lacc = malloc(f1)) && (q->va = malloc(f1)) && (q->vb = malloc(f1)) && (q->la = malloc(f1)) &&
-             (q->lb = malloc(f1));
-    }
-    if (!ok) {
+    if (n > SIZE_MAX / (W_COUNT * sizeof(float))) return false;
+    t->work = malloc(W_COUNT * n * sizeof(float)), t->ok = malloc(n);
+    if (!t->work || !t->ok) {
         work_free(t);
         return false;
     }
@@ -194,42 +234,113 @@ typedef struct tctx {
     const sy_filter_frame *in;
     const hist *prev; /* NULL: no history */
     hist *next;
-    /* a-trous pass */
-    const float *src, *vsrc, *lsrc, *srcd;
+    size_t n;         /* pixels */
+    float *W;         /* the working planes */
+    /* a-trous pass: src, dst 3 planes each */
+    const float *src, *vsrc, *lsrc;
     float *dst, *vdst, *ldst;
     int step;
-    float *keep; /* NULL, or where this pass's output goes (the next history's colour) */
+    float xmax; /* EXP_MAX, through memory (see expneg) */
+    const float *outp[2]; /* the parts' final planes (remodulation) */
     float *out;
 } tctx;
+
+static inline float *plane(const tctx *c, size_t k)
+{
+    return c->W + k * c->n;
+}
+
+/* the k-th plane (0..S_COUNT-1) of integrate_rows' 3x3 statistics: a part's a-trous planes */
+static inline float *stat_plane(const tctx *c, int k)
+{
+    return plane(c, W_PART + (k < 10 ? P_A + k : 15 + P_A + (k - 10)));
+}
 
 static inline bool finite3(const float *v)
 {
     return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
 }
 
-/* demodulation; validity */
+/* the columns x of a row whose tap x + off lies in [0, w) */
+static inline void tap_span(int w, int off, int *x0, int *x1)
+{
+    *x0 = off < 0 ? -off : 0;
+    *x1 = off > 0 ? w - off : w;
+}
+
+/* demodulation, validity, the frame's planes */
 static void demod_rows(void *vc, uint32_t y0, uint32_t y1)
 {
     tctx *c = vc;
     sy_filter_temporal *t = c->t;
     const sy_filter_frame *in = c->in;
-    size_t w = in->width, cc = in->color_channels;
+    size_t w = in->width, cc = in->color_channels, n = c->n;
+    float *W = c->W, sn = t->p.sigma_normal;
+    bool split = in->direct && in->indirect;
     for (size_t i = (size_t)y0 * w; i < (size_t)y1 * w; ++i) {
-        const float *col = in->color + cc * i, *al = in->albedo + 3 * i;
+        const float *col = in->color + cc * i, *al = in->albedo + 3 * i, *nr = in->normal + 3 * i;
         float d = in->depth[i];
-        bool split = in->direct && in->indirect;
-        bool ok = finite3(col) && finite3(al) && finite3(in->normal + 3 * i) && !isnan(d) && d > -INFINITY &&
+        bool ok = finite3(col) && finite3(al) && finite3(nr) && !isnan(d) && d > -INFINITY &&
                   (!split || (finite3(in->direct + 3 * i) && finite3(in->indirect + 3 * i)));
         bool hit = ok && isfinite(d) && finite3(in->position + 3 * i);
-        t->ok[i] = ok, t->hit[i] = (uint8_t)(hit ? (has_normal(in->normal + 3 * i) ? 2 : 1) : 0);
+        bool hn = hit && has_normal(nr[0], nr[1], nr[2]);
+        t->ok[i] = ok;
+        W[W_CLS * n + i] = hit ? (hn ? 2.0f : 1.0f) : 0.0f;
+        W[W_HIT * n + i] = hit ? 1.0f : 0.0f;
+        W[W_SN * n + i] = hn ? sn : 0.0f;
+        W[W_Z * n + i] = hit ? d : 0.0f;
+        float ci[3], di[3];
         for (int q = 0; q < 3; ++q) {
+            W[(W_N + q) * n + i] = hit ? nr[q] : 0.0f;
             float m = hit && al[q] > 0.01f ? al[q] : 1.0f; /* dark albedo keeps the radiance (as a-trous) */
-            t->mod[3 * i + q] = m;
-            t->illum[3 * i + q] = ok ? (split ? in->indirect[3 * i + q] : col[q]) / m : 0.0f;
-            t->dcur[3 * i + q] = ok && split ? in->direct[3 * i + q] / m : 0.0f;
+            W[(W_MOD + q) * n + i] = m;
+            ci[q] = ok ? (split ? in->indirect[3 * i + q] : col[q]) / m : 0.0f;
+            di[q] = ok && split ? in->direct[3 * i + q] / m : 0.0f;
+            W[(W_CUR + q) * n + i] = ci[q], W[(W_CUR + 3 + q) * n + i] = di[q];
         }
-        t->lum[i] = sy_filter_luminance(t->illum + 3 * i);
+        W[W_LUM * n + i] = sy_filter_luminance(ci), W[(W_LUM + 1) * n + i] = sy_filter_luminance(di);
     }
+}
+
+/* Bilinear reprojection of world point p (normal n, depth z) into the previous history: r = illum 3,
+ * dir 3, mom 4, len; false when no tap fits. */
+static bool reproject(const sy_filter_temporal *t, const hist *h, const float *p, const float *n, float z, float r[11])
+{
+    const float *M = h->world_to_pixel;
+    float X = M[0] * p[0] + M[4] * p[1] + M[8] * p[2] + M[12];
+    float Y = M[1] * p[0] + M[5] * p[1] + M[9] * p[2] + M[13];
+    float Wc = M[3] * p[0] + M[7] * p[1] + M[11] * p[2] + M[15];
+    if (!(Wc > 1e-12f)) return false;
+    float iW = 1.0f / Wc, x = X * iW - 0.5f, y = Y * iW - 0.5f;
+    if (!(x > -1.0f && y > -1.0f && x < (float)h->w && y < (float)h->h)) return false;
+    int x0 = (int)floorf(x), y0 = (int)floorf(y);
+    float fx = x - (float)x0, fy = y - (float)y0;
+    float tol = t->p.depth_tolerance * z, tol2 = 64.0f * tol * tol, ntol = t->p.normal_tolerance;
+    bool hn = has_normal(n[0], n[1], n[2]);
+    size_t hn_ = (size_t)h->w * h->h;
+    float sw = 0, acc[11] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    for (int k = 0; k < 4; ++k) {
+        int xx = x0 + (k & 1), yy = y0 + (k >> 1);
+        if (xx < 0 || yy < 0 || xx >= (int)h->w || yy >= (int)h->h) continue;
+        size_t j = (size_t)yy * h->w + (size_t)xx;
+        if (!(h->len[j] > 0.0f)) continue;
+        float d[3] = {h->pos[j] - p[0], h->pos[hn_ + j] - p[1], h->pos[2 * hn_ + j] - p[2]};
+        float plane_d = fabsf(d[0] * n[0] + d[1] * n[1] + d[2] * n[2]);
+        if (!(plane_d <= tol) || !(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= tol2)) continue;
+        float nj[3] = {h->nrm[j], h->nrm[hn_ + j], h->nrm[2 * hn_ + j]};
+        bool hnj = has_normal(nj[0], nj[1], nj[2]);
+        if (hn != hnj || (hn && !(n[0] * nj[0] + n[1] * nj[1] + n[2] * nj[2] >= ntol))) continue;
+        float wk = ((k & 1) ? fx : 1.0f - fx) * ((k >> 1) ? fy : 1.0f - fy);
+        if (!(wk > 0.0f)) continue;
+        for (int q = 0; q < 3; ++q) acc[q] += wk * h->illum[q * hn_ + j], acc[3 + q] += wk * h->dir[q * hn_ + j];
+        for (int q = 0; q < 4; ++q) acc[6 + q] += wk * h->mom[q * hn_ + j];
+        acc[10] += wk * h->len[j];
+        sw += wk;
+    }
+    if (!(sw > 1e-3f)) return false;
+    float isw = 1.0f / sw;
+    for (int q = 0; q < 11; ++q) r[q] = acc[q] * isw;
+    return true;
 }
 
 static inline void to_ycocg(const float *c, float *o)
@@ -246,45 +357,6 @@ static inline void from_ycocg(const float *y, float *o)
     o[2] = y[0] - y[1] - y[2];
 }
 
-/* Bilinear reprojection of world point p (normal n, depth z) into the previous history; false when
- * no tap fits. */
-static bool reproject(const sy_filter_temporal *t, const hist *h, const float *p, const float *n, float z,
-                      float illum[3], float dir[3], float mom[4], float *len)
-{
-    const float *M = h->world_to_pixel;
-    float X = M[0] * p[0] + M[4] * p[1] + M[8] * p[2] + M[12];
-    float Y = M[1] * p[0] + M[5] * p[1] + M[9] * p[2] + M[13];
-    float W = M[3] * p[0] + M[7] * p[1] + M[11] * p[2] + M[15];
-    if (!(W > 1e-12f)) return false;
-    float x = X / W - 0.5f, y = Y / W - 0.5f;
-    if (!(x > -1.0f && y > -1.0f && x < (float)h->w && y < (float)h->h)) return false;
-    int x0 = (int)floorf(x), y0 = (int)floorf(y);
-    float fx = x - (float)x0, fy = y - (float)y0;
-    float tol = t->p.depth_tolerance * z, tol2 = 64.0f * tol * tol;
-    float sw = 0, acc[11] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
-    for (int k = 0; k < 4; ++k) {
-        int xx = x0 + (k & 1), yy = y0 + (k >> 1);
-        if (xx < 0 || yy < 0 || xx >= (int)h->w || yy >= (int)h->h) continue;
-        size_t j = (size_t)yy * h->w + (size_t)xx;
-        if (!(h->len[j] > 0.0f)) continue;
-        const float *pj = h->pos + 3 * j, *nj = h->nrm + 3 * j;
-        float d[3] = {pj[0] - p[0], pj[1] - p[1], pj[2] - p[2]};
-        float plane = fabsf(d[0] * n[0] + d[1] * n[1] + d[2] * n[2]);
-        if (!(plane <= tol) || !(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= tol2)) continue;
-        if (!normals_agree(n, nj, t->p.normal_tolerance)) continue;
-        float wk = ((k & 1) ? fx : 1.0f - fx) * ((k >> 1) ? fy : 1.0f - fy);
-        if (!(wk > 0.0f)) continue;
-        for (int q = 0; q < 3; ++q) acc[q] += wk * h->illum[3 * j + q], acc[6 + q] += wk * h->dir[3 * j + q];
-        acc[3] += wk * h->mom[4 * j], acc[4] += wk * h->mom[4 * j + 1], acc[5] += wk * h->len[j];
-        acc[9] += wk * h->mom[4 * j + 2], acc[10] += wk * h->mom[4 * j + 3];
-        sw += wk;
-    }
-    if (!(sw > 1e-3f)) return false;
-    for (int q = 0; q < 3; ++q) illum[q] = acc[q] / sw, dir[q] = acc[6 + q] / sw;
-    mom[0] = acc[3] / sw, mom[1] = acc[4] / sw, mom[2] = acc[9] / sw, mom[3] = acc[10] / sw, *len = acc[5] / sw;
-    return true;
-}
-
 /* clamps colour c to the YCoCg box mean +- gamma sd of the sums m1, m2 of count 1/ic */
 static inline void clamp_box(float *c, const float *m1, const float *m2, float ic, float gamma)
 {
@@ -298,6 +370,102 @@ static inline void clamp_box(float *c, const float *m1, const float *m2, float i
     from_ycocg(v, c);
 }
 
+/* The row loops that carry the work, one tap (dx, dy) over columns [x0, x1): restrict parameters
+ * (GCC does not vectorise them through local restrict pointers), no branch, no division. x86-64
+ * GCC: an AVX2 clone beside the SSE2 default, picked at load time (the same operations in the same
+ * order per lane, no FMA contraction in ISO C mode: the same results). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define SY_TEMPORAL_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define SY_TEMPORAL_CLONES
+#endif
+
+/* 3x3 statistics of one part, one tap: YCoCg sums s0-s2 and sums of squares s3-s5 of colour a,
+ * luminance sum s6 and sum of squares s7, over hits (h = 1) */
+SY_TEMPORAL_CLONES
+static void stats_tap(int x0, int x1, const float *restrict h, const float *restrict a0, const float *restrict a1,
+                      const float *restrict a2, const float *restrict l0, float *restrict s0, float *restrict s1,
+                      float *restrict s2, float *restrict s3, float *restrict s4, float *restrict s5, float *restrict s6,
+                      float *restrict s7)
+{
+    for (int x = x0; x < x1; ++x) {
+        float m = h[x];
+        float v0 = 0.25f * a0[x] + 0.5f * a1[x] + 0.25f * a2[x], v1 = 0.5f * a0[x] - 0.5f * a2[x],
+              v2 = -0.25f * a0[x] + 0.5f * a1[x] - 0.25f * a2[x];
+        float l = l0[x];
+        s0[x] += m * v0, s1[x] += m * v1, s2[x] += m * v2;
+        s3[x] += m * (v0 * v0), s4[x] += m * (v1 * v1), s5[x] += m * (v2 * v2);
+        s6[x] += m * l, s7[x] += m * (l * l);
+    }
+}
+
+/* the count of hits, and the depth gradient's max over axial taps (axial 1, else 0) */
+SY_TEMPORAL_CLONES
+static void count_tap(int x0, int x1, float axial, const float *restrict h, const float *restrict z,
+                      const float *restrict cz, float *restrict cnt, float *restrict zg)
+{
+    for (int x = x0; x < x1; ++x) {
+        float m = h[x];
+        cnt[x] += m;
+        zg[x] = fmx(zg[x], (axial * m) * fabsf(z[x] - cz[x]));
+    }
+}
+
+/* a-trous, one tap of kernel weight kk (zd: the diagonal's depth distance factor): neighbour planes
+ * (class, luminance, depth, normal, colour, variance) then the centre's (class, luminance, depth,
+ * normal, normal stop, luminance and depth stops), the sums o (colour), ow (weights), ov (variance);
+ * xmax: EXP_MAX. The class test multiplies: a select there keeps GCC from vectorising the AVX2 clone. */
+SY_TEMPORAL_CLONES
+static void atrous_tap(int x0, int x1, float kk, float zd, const float *restrict cl, const float *restrict l,
+                       const float *restrict z, const float *restrict n0, const float *restrict n1,
+                       const float *restrict n2, const float *restrict c0, const float *restrict c1,
+                       const float *restrict c2, const float *restrict v, const float *restrict ccl,
+                       const float *restrict cL, const float *restrict cZ, const float *restrict cn0,
+                       const float *restrict cn1, const float *restrict cn2, const float *restrict csn,
+                       const float *restrict cil, const float *restrict ciz, float *restrict o0, float *restrict o1,
+                       float *restrict o2, float *restrict ow, float *restrict ov, float xmax)
+{
+    for (int x = x0; x < x1; ++x) {
+        float dn = 1.0f - (cn0[x] * n0[x] + cn1[x] * n1[x] + cn2[x] * n2[x]);
+        float arg = fabsf(cL[x] - l[x]) * cil[x] + fabsf(cZ[x] - z[x]) * ciz[x] * zd + csn[x] * fmx(dn, 0.0f);
+        float k = kk * expneg(arg, xmax) * (float)(cl[x] == ccl[x]); /* e finite: 0 or e exactly */
+        o0[x] += k * c0[x], o1[x] += k * c1[x], o2[x] += k * c2[x];
+        ow[x] += k, ov[x] += k * k * v[x];
+    }
+}
+
+/* the 3x3 statistics of row y's hits' new samples (S planes: per part YCoCg sums 0-2, squares 3-5,
+ * luminance 6, its square 7; part 0 at 0, part 1 at 8; the count of hits at 16) and the depth
+ * gradient (max |z_j - z| over the 4 axial hit neighbours), tap by tap over the row */
+static void stats_row(const tctx *c, int y)
+{
+    int w = (int)c->in->width, hgt = (int)c->in->height;
+    size_t row = (size_t)y * w;
+    float *S[S_COUNT];
+    for (int k = 0; k < S_COUNT; ++k) S[k] = stat_plane(c, k) + row;
+    float *zg = plane(c, W_ZG) + row;
+    for (int k = 0; k < S_COUNT; ++k) memset(S[k], 0, (size_t)w * sizeof(float));
+    memset(zg, 0, (size_t)w * sizeof(float));
+    const float *Z = plane(c, W_Z), *H = plane(c, W_HIT);
+    const float *c0 = plane(c, W_CUR), *c1 = plane(c, W_CUR + 1), *c2 = plane(c, W_CUR + 2);
+    const float *d0 = plane(c, W_CUR + 3), *d1 = plane(c, W_CUR + 4), *d2 = plane(c, W_CUR + 5);
+    const float *L0 = plane(c, W_LUM), *L1 = plane(c, W_LUM + 1);
+    for (int dy = -1; dy <= 1; ++dy) {
+        int yy = y + dy;
+        if (yy < 0 || yy >= hgt) continue;
+        for (int dx = -1; dx <= 1; ++dx) {
+            int x0, x1;
+            tap_span(w, dx, &x0, &x1);
+            size_t o = (size_t)yy * w + (size_t)dx;
+            float axial = (dx == 0) != (dy == 0) ? 1.0f : 0.0f;
+            stats_tap(x0, x1, H + o, c0 + o, c1 + o, c2 + o, L0 + o, S[0], S[1], S[2], S[3], S[4], S[5], S[6], S[7]);
+            stats_tap(x0, x1, H + o, d0 + o, d1 + o, d2 + o, L1 + o, S[8], S[9], S[10], S[11], S[12], S[13], S[14],
+                      S[15]);
+            count_tap(x0, x1, axial, H + o, Z + o, Z + row, S[16], zg);
+        }
+    }
+}
+
 /* depth gradient, reprojection, clamping, moving averages, variance; the next history's geometry */
 static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
 {
@@ -305,179 +473,199 @@ static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
     sy_filter_temporal *t = c->t;
     const sy_filter_frame *in = c->in;
     const sy_filter_temporal_params *P = &t->p;
-    int w = (int)in->width, hgt = (int)in->height;
+    int w = (int)in->width;
+    size_t n = c->n;
     hist *nx = c->next;
-    struct plane *pi = &t->pl[0], *pd = &t->pl[1];
-    for (int y = (int)y0; y < (int)y1; ++y)
+    float *acc = plane(c, W_PART + P_ACC), *da = plane(c, W_PART + 15 + P_ACC);
+    float *var0 = plane(c, W_PART + P_VAR), *var1 = plane(c, W_PART + 15 + P_VAR);
+    float *la0 = plane(c, W_PART + P_LACC), *la1 = plane(c, W_PART + 15 + P_LACC);
+    const float *cur = plane(c, W_CUR), *H = plane(c, W_HIT), *lum = plane(c, W_LUM);
+    float *zg = plane(c, W_ZG);
+    const float *S[S_COUNT];
+    for (int k = 0; k < S_COUNT; ++k) S[k] = stat_plane(c, k);
+    for (int y = (int)y0; y < (int)y1; ++y) {
+        stats_row(c, y);
         for (int x = 0; x < w; ++x) {
             size_t i = (size_t)y * w + x;
-            float *acc = pi->acc + 3 * i, *da = pd->acc + 3 * i;
-            const float *cur = t->illum + 3 * i, *dc = t->dcur + 3 * i;
-            if (!t->hit[i]) {
-                memcpy(acc, cur, 3 * sizeof(float));
-                memcpy(da, dc, 3 * sizeof(float));
-                pi->var[i] = pd->var[i] = 0.0f, t->zgrad[i] = 0.0f;
-                pi->lacc[i] = t->lum[i], pd->lacc[i] = sy_filter_luminance(dc);
+            float ci[3] = {cur[i], cur[n + i], cur[2 * n + i]}, dc[3] = {cur[3 * n + i], cur[4 * n + i], cur[5 * n + i]};
+            if (!(H[i] > 0.0f)) {
+                for (int q = 0; q < 3; ++q) acc[q * n + i] = ci[q], da[q * n + i] = dc[q];
+                var0[i] = var1[i] = 0.0f, zg[i] = 0.0f;
+                la0[i] = lum[i], la1[i] = lum[n + i];
                 nx->len[i] = 0.0f;
-                for (int q = 0; q < 4; ++q) nx->mom[4 * i + q] = 0.0f;
-                for (int q = 0; q < 3; ++q) nx->pos[3 * i + q] = nx->nrm[3 * i + q] = 0.0f;
+                for (int q = 0; q < 4; ++q) nx->mom[q * n + i] = 0.0f;
+                for (int q = 0; q < 3; ++q) nx->pos[q * n + i] = nx->nrm[q * n + i] = 0.0f;
                 continue;
             }
             float z = in->depth[i];
-            const float *p = in->position + 3 * i, *n = in->normal + 3 * i;
-            /* 3x3 neighbourhood of the new samples: YCoCg boxes, luminance moments, depth gradient */
-            float m1[3] = {0, 0, 0}, m2[3] = {0, 0, 0}, d1[3] = {0, 0, 0}, d2[3] = {0, 0, 0};
-            float l1 = 0, l2 = 0, e1 = 0, e2 = 0, cnt = 0, zg = 0;
-            for (int dy = -1; dy <= 1; ++dy) {
-                int yy = y + dy;
-                if (yy < 0 || yy >= hgt) continue;
-                for (int dx = -1; dx <= 1; ++dx) {
-                    int xx = x + dx;
-                    if (xx < 0 || xx >= w) continue;
-                    size_t j = (size_t)yy * w + xx;
-                    if (!t->hit[j]) continue;
-                    float v[3];
-                    to_ycocg(t->illum + 3 * j, v);
-                    for (int q = 0; q < 3; ++q) m1[q] += v[q], m2[q] += v[q] * v[q];
-                    to_ycocg(t->dcur + 3 * j, v);
-                    for (int q = 0; q < 3; ++q) d1[q] += v[q], d2[q] += v[q] * v[q];
-                    float lj = t->lum[j], ej = sy_filter_luminance(t->dcur + 3 * j);
-                    l1 += lj, l2 += lj * lj, e1 += ej, e2 += ej * ej;
-                    cnt += 1.0f;
-                    if ((dx == 0) != (dy == 0)) zg = fmx(zg, fabsf(in->depth[j] - z));
-                }
-            }
-            t->zgrad[i] = zg;
-            float ic = 1.0f / cnt;
-            float hi[3] = {0, 0, 0}, hd[3] = {0, 0, 0}, hm[4] = {0, 0, 0, 0}, hl = 0.0f;
-            bool reused = c->prev && reproject(t, c->prev, p, n, z, hi, hd, hm, &hl);
+            const float *p = in->position + 3 * i, *nr = in->normal + 3 * i;
+            float m1[3] = {S[0][i], S[1][i], S[2][i]}, m2[3] = {S[3][i], S[4][i], S[5][i]};
+            float e1[3] = {S[8][i], S[9][i], S[10][i]}, e2[3] = {S[11][i], S[12][i], S[13][i]};
+            float ic = 1.0f / S[16][i];
+            float r[11] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+            bool reused = c->prev && reproject(t, c->prev, p, nr, z, r);
+            float *hi = r, *hd = r + 3, *hm = r + 6, hl = reused ? r[10] : 0.0f;
             if (reused && P->clamp_gamma > 0.0f) {
                 clamp_box(hi, m1, m2, ic, P->clamp_gamma);
-                clamp_box(hd, d1, d2, ic, P->clamp_gamma);
+                clamp_box(hd, e1, e2, ic, P->clamp_gamma);
             }
-            if (!reused) hl = 0.0f;
             float a = reused ? fmx(P->alpha, 1.0f / (hl + 1.0f)) : 1.0f;
             float am = reused ? fmx(P->alpha_moments, 1.0f / (hl + 1.0f)) : 1.0f;
+            float ai[3], ad[3];
             for (int q = 0; q < 3; ++q) {
-                acc[q] = hi[q] + a * (cur[q] - hi[q]);
-                da[q] = hd[q] + a * (dc[q] - hd[q]);
+                ai[q] = hi[q] + a * (ci[q] - hi[q]);
+                ad[q] = hd[q] + a * (dc[q] - hd[q]);
+                acc[q * n + i] = ai[q], da[q * n + i] = ad[q];
             }
-            float l = t->lum[i], e = sy_filter_luminance(dc);
+            float l = lum[i], e = lum[n + i];
             float mo[4] = {hm[0] + am * (l - hm[0]), hm[1] + am * (l * l - hm[1]), hm[2] + am * (e - hm[2]),
                            hm[3] + am * (e * e - hm[3])};
             float len = fmn(hl + 1.0f, (float)P->max_history);
-            for (int q = 0; q < 4; ++q) nx->mom[4 * i + q] = mo[q];
+            for (int q = 0; q < 4; ++q) nx->mom[q * n + i] = mo[q];
             nx->len[i] = len;
-            pi->lacc[i] = sy_filter_luminance(acc), pd->lacc[i] = sy_filter_luminance(da);
+            la0[i] = sy_filter_luminance(ai), la1[i] = sy_filter_luminance(ad);
             if (len < 4.0f) { /* short history: the spatial variance of the new samples */
-                float mu = l1 * ic, me = e1 * ic;
-                pi->var[i] = fmx(0.0f, l2 * ic - mu * mu), pd->var[i] = fmx(0.0f, e2 * ic - me * me);
+                float mu = S[6][i] * ic, me = S[14][i] * ic;
+                var0[i] = fmx(0.0f, S[7][i] * ic - mu * mu), var1[i] = fmx(0.0f, S[15][i] * ic - me * me);
             } else {
-                pi->var[i] = fmx(0.0f, mo[1] - mo[0] * mo[0]), pd->var[i] = fmx(0.0f, mo[3] - mo[2] * mo[2]);
+                var0[i] = fmx(0.0f, mo[1] - mo[0] * mo[0]), var1[i] = fmx(0.0f, mo[3] - mo[2] * mo[2]);
             }
-            memcpy(nx->pos + 3 * i, p, 3 * sizeof(float));
-            memcpy(nx->nrm + 3 * i, n, 3 * sizeof(float));
+            for (int q = 0; q < 3; ++q) nx->pos[q * n + i] = p[q], nx->nrm[q * n + i] = nr[q];
         }
+    }
 }
 
-/* the variance blurred 3x3 (B-spline, step 1) over pixels of the centre's class: guides the
- * luminance edge stop of an a-trous pass */
+/* the variance blur, one tap of kernel weight kk: neighbour class cl and variance v, centre class ccl;
+ * sums vb (weighted variance) and vw (weights) */
+SY_TEMPORAL_CLONES
+static void vblur_tap(int x0, int x1, float kk, const float *restrict cl, const float *restrict v,
+                      const float *restrict ccl, float *restrict vb, float *restrict vw)
+{
+    for (int x = x0; x < x1; ++x) {
+        float k = kk * (float)(cl[x] == ccl[x]);
+        vb[x] += k * v[x], vw[x] += k;
+    }
+}
+
+/* the edge stops of a row from the blur's sums: il holds the weighted variance and receives
+ * 1 / (sl sqrt(variance) + 1e-6); iz = 1 / (sz zgrad + 1e-6 z + 1e-9) */
+SY_TEMPORAL_CLONES
+static void stops_row(int w, float sl, float sz, const float *restrict vw, const float *restrict g,
+                      const float *restrict z, float *restrict il, float *restrict iz)
+{
+    for (int x = 0; x < w; ++x) {
+        il[x] = 1.0f / (sl * sqrtf(il[x] / vw[x]) + 1e-6f); /* vw > 0: the centre */
+        iz[x] = 1.0f / (sz * g[x] + 1e-6f * z[x] + 1e-9f);
+    }
+}
+
+/* Before an a-trous pass: the variance blurred 3x3 (B-spline, step 1) over pixels of the centre's
+ * class, turned into the pass's luminance edge stop 1 / (sigma_l sqrt(blurred) + 1e-6), and the
+ * depth edge stop 1 / (sigma_z step zgrad + 1e-6 z + 1e-9) */
 static void vblur_rows(void *vc, uint32_t y0, uint32_t y1)
 {
     static const float hk[3] = {0.25f, 0.5f, 0.25f};
     tctx *c = vc;
-    sy_filter_temporal *t = c->t;
+    const sy_filter_temporal_params *P = &c->t->p;
     int w = (int)c->in->width, hgt = (int)c->in->height;
-    const uint8_t *cls = t->hit;
-    for (int y = (int)y0; y < (int)y1; ++y)
-        for (int x = 0; x < w; ++x) {
-            size_t i = (size_t)y * w + x;
-            if (!cls[i]) {
-                t->vbl[i] = 0.0f;
-                continue;
+    const float *cls = plane(c, W_CLS), *V = c->vsrc, *Z = plane(c, W_Z), *G = plane(c, W_ZG);
+    float *IL = plane(c, W_IL), *IZ = plane(c, W_IZ), *WS = plane(c, W_WS);
+    float sl = P->sigma_luminance, sz = P->sigma_depth * (float)c->step;
+    for (int y = (int)y0; y < (int)y1; ++y) {
+        size_t row = (size_t)y * w;
+        float *vb = IL + row, *vw = WS + row;
+        memset(vb, 0, (size_t)w * sizeof(float));
+        memset(vw, 0, (size_t)w * sizeof(float));
+        for (int dy = -1; dy <= 1; ++dy) {
+            int yy = y + dy;
+            if (yy < 0 || yy >= hgt) continue;
+            for (int dx = -1; dx <= 1; ++dx) {
+                int x0, x1;
+                tap_span(w, dx, &x0, &x1);
+                size_t o = (size_t)yy * w + (size_t)dx;
+                vblur_tap(x0, x1, hk[dx + 1] * hk[dy + 1], cls + o, V + o, cls + row, vb, vw);
             }
-            float vb = 0, vw = 0;
-            for (int dy = -1; dy <= 1; ++dy) {
-                int yy = y + dy;
-                if (yy < 0 || yy >= hgt) continue;
-                for (int dx = -1; dx <= 1; ++dx) {
-                    int xx = x + dx;
-                    if (xx < 0 || xx >= w) continue;
-                    size_t j = (size_t)yy * w + xx;
-                    float k = cls[j] == cls[i] ? hk[dx + 1] * hk[dy + 1] : 0.0f;
-                    vb += k * c->vsrc[j], vw += k;
-                }
-            }
-            t->vbl[i] = vb / vw; /* vw > 0: the centre */
         }
+        stops_row(w, sl, sz, vw, G + row, Z + row, IL + row, IZ + row);
+    }
 }
 
-/* one a-trous pass (3x3 B-spline, taps c->step apart) over hits; neighbours only of the centre's
- * class (hit with a normal, hit without one) */
+/* an a-trous row's sums start with the centre's kernel weight k0 */
+SY_TEMPORAL_CLONES
+static void atrous_start(int w, float k0, const float *restrict c0, const float *restrict c1, const float *restrict c2,
+                         const float *restrict v, float *restrict o0, float *restrict o1, float *restrict o2,
+                         float *restrict ow, float *restrict ov)
+{
+    for (int x = 0; x < w; ++x) {
+        o0[x] = k0 * c0[x], o1[x] = k0 * c1[x], o2[x] = k0 * c2[x];
+        ow[x] = k0, ov[x] = k0 * k0 * v[x];
+    }
+}
+
+/* an a-trous row's result: the normalised sums where the centre is a hit (h = 1), the source
+ * (colour c, variance v, luminance l) where not; luminance ol of the result */
+SY_TEMPORAL_CLONES
+static void atrous_end(int w, const float *restrict h, const float *restrict c0, const float *restrict c1,
+                       const float *restrict c2, const float *restrict v, const float *restrict l,
+                       const float *restrict ow, float *restrict o0, float *restrict o1, float *restrict o2,
+                       float *restrict ov, float *restrict ol)
+{
+    for (int x = 0; x < w; ++x) {
+        float m = h[x], k = 1.0f - m, iw = 1.0f / ow[x]; /* ow >= the centre's weight */
+        float r0 = m * (o0[x] * iw) + k * c0[x], r1 = m * (o1[x] * iw) + k * c1[x], r2 = m * (o2[x] * iw) + k * c2[x];
+        o0[x] = r0, o1[x] = r1, o2[x] = r2;
+        ov[x] = m * (ov[x] * iw * iw) + k * v[x];
+        ol[x] = m * (0.2126f * r0 + 0.7152f * r1 + 0.0722f * r2) + k * l[x];
+    }
+}
+
+/* one a-trous pass (3x3 B-spline, taps c->step apart) over hits, tap by tap over each row;
+ * neighbours only of the centre's class (hit with a normal, hit without one); a pixel without a hit
+ * keeps its value */
 static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
 {
     static const float hk[3] = {0.25f, 0.5f, 0.25f};
     tctx *c = vc;
-    sy_filter_temporal *t = c->t;
-    const sy_filter_frame *in = c->in;
-    const sy_filter_temporal_params *P = &t->p;
-    int w = (int)in->width, hgt = (int)in->height, s = c->step;
-    const uint8_t *cls = t->hit;
-    const float *L = c->lsrc, *Z = in->depth, *N = in->normal;
-    for (int y = (int)y0; y < (int)y1; ++y)
-        for (int x = 0; x < w; ++x) {
-            size_t i = (size_t)y * w + x;
-            const float *ci = c->src + 3 * i;
-            float *o = c->dst + 3 * i;
-            uint8_t ki = cls[i];
-            if (!ki) {
-                o[0] = ci[0], o[1] = ci[1], o[2] = ci[2];
-                c->vdst[i] = c->vsrc[i], c->ldst[i] = L[i];
-            } else {
-                float li = L[i], zi = Z[i];
-                const float *ni = N + 3 * i;
-                float sn = ki == 2 ? P->sigma_normal : 0.0f;
-                float inv_l = 1.0f / (P->sigma_luminance * sqrtf(t->vbl[i]) + 1e-6f);
-                float inv_z = 1.0f / (P->sigma_depth * (float)s * t->zgrad[i] + 1e-6f * zi + 1e-9f);
-                float k0 = hk[1] * hk[1]; /* the centre: exactly its kernel weight */
-                float a0 = k0 * ci[0], a1 = k0 * ci[1], a2 = k0 * ci[2], W = k0, V = k0 * k0 * c->vsrc[i];
-                for (int dy = -1; dy <= 1; ++dy) {
-                    int yy = y + dy * s;
-                    if (yy < 0 || yy >= hgt) continue;
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        int xx = x + dx * s;
-                        if ((dx == 0 && dy == 0) || xx < 0 || xx >= w) continue;
-                        size_t j = (size_t)yy * w + xx;
-                        if (cls[j] != ki) continue;
-                        const float *nj = N + 3 * j;
-                        float dn = 1.0f - (ni[0] * nj[0] + ni[1] * nj[1] + ni[2] * nj[2]);
-                        float dl = li - L[j], dz = zi - Z[j];
-                        float arg = (dl < 0 ? -dl : dl) * inv_l + (dz < 0 ? -dz : dz) * inv_z * ((dx && dy) ? 0.70710678f : 1.0f) +
-                                    sn * (dn > 0.0f ? dn : 0.0f);
-                        float k = hk[dx + 1] * hk[dy + 1] * sy_filter_expneg(arg);
-                        const float *cj = c->src + 3 * j;
-                        a0 += k * cj[0], a1 += k * cj[1], a2 += k * cj[2];
-                        W += k, V += k * k * c->vsrc[j];
-                    }
-                }
-                float iw = 1.0f / W;
-                o[0] = a0 * iw, o[1] = a1 * iw, o[2] = a2 * iw;
-                c->vdst[i] = V * iw * iw;
-                c->ldst[i] = sy_filter_luminance(o);
+    size_t n = c->n;
+    int w = (int)c->in->width, hgt = (int)c->in->height, s = c->step;
+    const float *cls = plane(c, W_CLS), *H = plane(c, W_HIT), *L = c->lsrc, *Z = plane(c, W_Z);
+    const float *N0 = plane(c, W_N), *N1 = plane(c, W_N + 1), *N2 = plane(c, W_N + 2);
+    const float *SN = plane(c, W_SN), *IL = plane(c, W_IL), *IZ = plane(c, W_IZ);
+    const float *C0 = c->src, *C1 = c->src + n, *C2 = c->src + 2 * n, *V = c->vsrc;
+    float *WS = plane(c, W_WS);
+    const float k0 = hk[1] * hk[1]; /* the centre: exactly its kernel weight */
+    for (int y = (int)y0; y < (int)y1; ++y) {
+        size_t row = (size_t)y * w;
+        float *o0 = c->dst + row, *o1 = c->dst + n + row, *o2 = c->dst + 2 * n + row;
+        float *ov = c->vdst + row, *ow = WS + row, *ol = c->ldst + row;
+        atrous_start(w, k0, C0 + row, C1 + row, C2 + row, V + row, o0, o1, o2, ow, ov);
+        for (int dy = -1; dy <= 1; ++dy) {
+            int yy = y + dy * s;
+            if (yy < 0 || yy >= hgt) continue;
+            for (int dx = -1; dx <= 1; ++dx) {
+                if (dx == 0 && dy == 0) continue;
+                int x0, x1;
+                tap_span(w, dx * s, &x0, &x1);
+                size_t o = (size_t)yy * w + (size_t)(dx * s);
+                float kk = hk[dx + 1] * hk[dy + 1], zd = (dx && dy) ? 0.70710678f : 1.0f;
+                atrous_tap(x0, x1, kk, zd, cls + o, L + o, Z + o, N0 + o, N1 + o, N2 + o, C0 + o, C1 + o, C2 + o, V + o,
+                           cls + row, L + row, Z + row, N0 + row, N1 + row, N2 + row, SN + row, IL + row, IZ + row, o0,
+                           o1, o2, ow, ov, c->xmax);
             }
-            if (c->keep) memcpy(c->keep + 3 * i, o, 3 * sizeof(float));
         }
+        atrous_end(w, H + row, C0 + row, C1 + row, C2 + row, V + row, L + row, ow, o0, o1, o2, ov, ol);
+    }
 }
 
 static void remod_rows(void *vc, uint32_t y0, uint32_t y1)
 {
     tctx *c = vc;
-    sy_filter_temporal *t = c->t;
     const sy_filter_frame *in = c->in;
-    size_t w = in->width, cc = in->color_channels;
+    size_t w = in->width, cc = in->color_channels, n = c->n;
+    const float *m = plane(c, W_MOD), *a = c->outp[0], *b = c->outp[1];
     for (size_t i = (size_t)y0 * w; i < (size_t)y1 * w; ++i) {
         float *o = c->out + 4 * i;
-        for (int q = 0; q < 3; ++q) o[q] = (c->src[3 * i + q] + c->srcd[3 * i + q]) * t->mod[3 * i + q];
+        for (int q = 0; q < 3; ++q) o[q] = (a[q * n + i] + b[q * n + i]) * m[q * n + i];
         o[3] = cc == 4 && isfinite(in->color[4 * i + 3]) ? in->color[4 * i + 3] : 1.0f;
     }
 }
@@ -507,34 +695,36 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
         return sy_filter_fail(err, SY_FILTER_ERROR_OUT_OF_MEMORY, "temporal: out of memory for %ux%u", in->width,
                               in->height);
     }
-    tctx c = {.t = t, .in = in, .prev = t->have_prev ? &t->h[t->prev] : NULL, .next = nx, .out = out};
+    hist_bind(nx, n);
+    tctx c = {.t = t, .in = in, .prev = t->have_prev ? &t->h[t->prev] : NULL, .next = nx, .n = n, .W = t->work,
+              .xmax = EXP_MAX, .out = out};
     uint32_t th = t->p.threads, rows = in->height;
     sy_filter_parallel_rows(th, rows, demod_rows, &c);
     sy_filter_parallel_rows(th, rows, integrate_rows, &c);
     /* the a-trous passes: the indirect part (or the colour), then the direct part when split */
     bool split = in->direct && in->indirect;
-    const float *out_part[2] = {t->pl[0].acc, t->pl[1].acc};
-    float *keep[2] = {nx->illum, nx->dir};
     for (int k = 0; k < 2; ++k) {
-        struct plane *q = &t->pl[k];
-        const float *src = q->acc, *vsrc = q->var, *lsrc = q->lacc;
+        float *q = plane(&c, W_PART + 15 * (size_t)k);
+        const float *src = q + P_ACC * n, *vsrc = q + P_VAR * n, *lsrc = q + P_LACC * n;
         uint32_t iters = k == 0 || split ? t->p.atrous_iterations : 0;
         /* the next history: the first pass's output for the indirect part (as SVGF); the direct part's
          * unfiltered blend (fed back, its filtered output let emitter light creep over their edges
          * frame after frame: Cornell box relMSE 0.077 against 0.023, `sy bench temporal`, 16 frames) */
         bool feed = k == 0;
-        if (iters == 0 || !feed) memcpy(keep[k], q->acc, 3 * n * sizeof(float));
+        float *keep = k == 0 ? nx->illum : nx->dir;
+        if (iters == 0 || !feed) memcpy(keep, src, 3 * n * sizeof(float));
         for (uint32_t it = 0; it < iters; ++it) {
             c.src = src, c.vsrc = vsrc, c.lsrc = lsrc;
-            c.dst = (it & 1) ? q->b : q->a, c.vdst = (it & 1) ? q->vb : q->va, c.ldst = (it & 1) ? q->lb : q->la;
-            c.step = 1 << it, c.keep = it == 0 && feed ? keep[k] : NULL;
+            c.dst = q + ((it & 1) ? P_B : P_A) * n, c.vdst = q + ((it & 1) ? P_VB : P_VA) * n;
+            c.ldst = q + ((it & 1) ? P_LB : P_LA) * n;
+            c.step = 1 << it;
             sy_filter_parallel_rows(th, rows, vblur_rows, &c);
             sy_filter_parallel_rows(th, rows, atrous_rows, &c);
+            if (it == 0 && feed) memcpy(keep, c.dst, 3 * n * sizeof(float));
             src = c.dst, vsrc = c.vdst, lsrc = c.ldst;
         }
-        out_part[k] = src;
+        c.outp[k] = src;
     }
-    c.src = out_part[0], c.srcd = out_part[1];
     sy_filter_parallel_rows(th, rows, remod_rows, &c);
     nx->w = in->width, nx->h = in->height;
     memcpy(nx->world_to_pixel, world_to_pixel, sizeof nx->world_to_pixel);
@@ -544,9 +734,10 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
         sy_filter_temporal_stats st = {.pixels = n};
         double hsum = 0;
         uint64_t hits = 0;
+        const float *H = plane(&c, W_HIT);
         for (size_t i = 0; i < n; ++i) {
             st.nonfinite += !t->ok[i];
-            if (!t->hit[i]) continue;
+            if (!(H[i] > 0.0f)) continue;
             hits++, hsum += nx->len[i];
             if (nx->len[i] > 1.0f) st.reprojected++;
             else st.disoccluded++;
