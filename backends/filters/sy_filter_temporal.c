@@ -101,6 +101,12 @@ struct sy_filter_temporal {
     size_t cap;   /* pixels of the working planes */
     float *work;  /* W_COUNT planes */
     uint8_t *ok;  /* 1 = finite input */
+    /* the last estimate returned (3 planes of est_w x est_h) and the samples each pixel counts as (a
+     * fourth plane), for sy_filter_temporal_rest */
+    float *est;
+    size_t est_cap;
+    uint32_t est_w, est_h;
+    bool have_est;
 };
 
 void sy_filter_temporal_params_default(sy_filter_temporal_params *p)
@@ -109,7 +115,8 @@ void sy_filter_temporal_params_default(sy_filter_temporal_params *p)
      * sigma_l = 4, sigma_z = 1; alpha 0.1 (SVGF: 0.2) for a lower error at 1 spp] */
     *p = (sy_filter_temporal_params){.alpha = 0.1f, .alpha_moments = 0.2f, .max_history = 32, .clamp_gamma = 2.0f,
                                      .depth_tolerance = 0.03f, .normal_tolerance = 0.8f, .atrous_iterations = 4,
-                                     .sigma_luminance = 4.0f, .sigma_normal = 64.0f, .sigma_depth = 1.0f, .threads = 0};
+                                     .sigma_luminance = 4.0f, .sigma_normal = 64.0f, .sigma_depth = 1.0f, .threads = 0,
+                                     .rest_samples = 64};
 }
 
 sy_filter_status sy_filter_temporal_params_check(const sy_filter_temporal_params *p, sy_filter_report *err)
@@ -130,6 +137,9 @@ sy_filter_status sy_filter_temporal_params_check(const sy_filter_temporal_params
     if ((s = sy_filter_check_positive(p->sigma_luminance, "temporal: sigma_luminance", err))) return s;
     if ((s = sy_filter_check_nonnegative(p->sigma_normal, "temporal: sigma_normal", err))) return s;
     if ((s = sy_filter_check_positive(p->sigma_depth, "temporal: sigma_depth", err))) return s;
+    if (p->rest_samples > 1u << 20)
+        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "temporal: rest_samples = %u: at most %u",
+                              p->rest_samples, 1u << 20);
     if (p->threads > SY_FILTER_MAX_THREADS)
         return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "temporal: threads = %u: at most %u", p->threads,
                               SY_FILTER_MAX_THREADS);
@@ -210,12 +220,13 @@ void sy_filter_temporal_destroy(sy_filter_temporal *t)
     if (!t) return;
     hist_free(&t->h[0]), hist_free(&t->h[1]);
     work_free(t);
+    free(t->est);
     free(t);
 }
 
 void sy_filter_temporal_reset(sy_filter_temporal *t)
 {
-    if (t) t->have_prev = false;
+    if (t) t->have_prev = false, t->have_est = false;
 }
 
 sy_filter_status sy_filter_temporal_set_params(sy_filter_temporal *t, const sy_filter_temporal_params *p,
@@ -242,6 +253,8 @@ typedef struct tctx {
     int step;
     float xmax; /* EXP_MAX, through memory (see expneg) */
     const float *outp[2]; /* the parts' final planes (remodulation) */
+    const float *vout[2]; /* their final variance */
+    const float *var0;    /* the indirect part's (or colour's) variance before the a-trous passes */
     float *out;
 } tctx;
 
@@ -663,9 +676,15 @@ static void remod_rows(void *vc, uint32_t y0, uint32_t y1)
     const sy_filter_frame *in = c->in;
     size_t w = in->width, cc = in->color_channels, n = c->n;
     const float *m = plane(c, W_MOD), *a = c->outp[0], *b = c->outp[1];
+    float *est = c->t->est;
     for (size_t i = (size_t)y0 * w; i < (size_t)y1 * w; ++i) {
         float *o = c->out + 4 * i;
-        for (int q = 0; q < 3; ++q) o[q] = (a[q * n + i] + b[q * n + i]) * m[q * n + i];
+        for (int q = 0; q < 3; ++q) est[q * n + i] = o[q] = (a[q * n + i] + b[q * n + i]) * m[q * n + i];
+        /* the samples the estimate counts as: its history length times the variance reduction of
+         * the a-trous passes (blended variance / filtered variance of the indirect part or colour),
+         * the latter within [1, 64] */
+        float v0 = c->var0[i], v1 = c->vout[0][i], g = v1 > 0.0f ? v0 / v1 : 1.0f;
+        est[3 * n + i] = c->next->len[i] * fmn(fmx(g, 1.0f), 64.0f);
         o[3] = cc == 4 && isfinite(in->color[4 * i + 3]) ? in->color[4 * i + 3] : 1.0f;
     }
 }
@@ -690,7 +709,13 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
                                                         "temporal: world_to_pixel[%d] is not finite", k);
     size_t n = (size_t)in->width * in->height;
     hist *nx = &t->h[1 - t->prev];
-    if (!work_reserve(t, n) || !hist_reserve(nx, n)) {
+    t->have_est = false;
+    if (n > t->est_cap) {
+        free(t->est);
+        t->est = n <= SIZE_MAX / (4 * sizeof(float)) ? malloc(4 * n * sizeof(float)) : NULL;
+        t->est_cap = t->est ? n : 0;
+    }
+    if (!t->est || !work_reserve(t, n) || !hist_reserve(nx, n)) {
         t->have_prev = false;
         return sy_filter_fail(err, SY_FILTER_ERROR_OUT_OF_MEMORY, "temporal: out of memory for %ux%u", in->width,
                               in->height);
@@ -724,12 +749,15 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
             src = c.dst, vsrc = c.vdst, lsrc = c.ldst;
         }
         c.outp[k] = src;
+        c.vout[k] = vsrc;
     }
+    c.var0 = plane(&c, W_PART + P_VAR);
     sy_filter_parallel_rows(th, rows, remod_rows, &c);
     nx->w = in->width, nx->h = in->height;
     memcpy(nx->world_to_pixel, world_to_pixel, sizeof nx->world_to_pixel);
     t->prev = 1 - t->prev;
     t->have_prev = true;
+    t->est_w = in->width, t->est_h = in->height, t->have_est = true;
     if (stats) {
         sy_filter_temporal_stats st = {.pixels = n};
         double hsum = 0;
@@ -750,4 +778,31 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
         *stats = st;
     }
     return SY_FILTER_OK;
+}
+
+bool sy_filter_temporal_rest(sy_filter_temporal *t, uint32_t width, uint32_t height, const float *accum_rgba,
+                             uint32_t samples, float *out_rgba)
+{
+    size_t n = (size_t)width * height;
+    bool blend = t && t->have_est && t->have_prev && accum_rgba && out_rgba && width == t->est_w &&
+                 height == t->est_h && samples < t->p.rest_samples;
+    if (!blend) {
+        if (out_rgba && accum_rgba && out_rgba != accum_rgba) memcpy(out_rgba, accum_rgba, 4 * n * sizeof(float));
+        if (t && samples >= t->p.rest_samples) t->have_est = false; /* converged: never again */
+        return false;
+    }
+    /* the estimate's pixel i counts as its samples (remod_rows) times (1 - samples / rest_samples)^2:
+     * the fade brings the accumulation in smoothly and exactly at rest_samples */
+    const float *est = t->est, *cnt = t->est + 3 * n;
+    float f = 1.0f - (float)samples / (float)t->p.rest_samples, fade = f * f, ns = (float)samples;
+    for (size_t i = 0; i < n; ++i) {
+        float h = cnt[i] * fade, wgt = h / (h + ns); /* 0/0 (no samples, no history): NaN, below */
+        if (!(wgt > 0.0f)) wgt = 0.0f;
+        for (int q = 0; q < 3; ++q) {
+            float a = accum_rgba[4 * i + q];
+            out_rgba[4 * i + q] = a + wgt * (est[q * n + i] - a);
+        }
+        out_rgba[4 * i + 3] = accum_rgba[4 * i + 3];
+    }
+    return true;
 }

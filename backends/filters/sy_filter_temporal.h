@@ -69,6 +69,8 @@ typedef struct sy_filter_temporal_params {
     float sigma_normal;     /**< a-trous normal edge stop (>= 0); default 64 */
     float sigma_depth;      /**< a-trous depth edge stop (> 0); default 1 (SVGF) */
     uint32_t threads;       /**< OpenMP team size; 0 = the OpenMP default (sy_filter_parallel_rows) */
+    uint32_t rest_samples;  /**< sy_filter_temporal_rest: accumulated samples from which the accumulation
+                                 shows alone (0..2^20; 0 = at once); default 64 */
 } sy_filter_temporal_params;
 
 /** Per-call statistics (any pointer may be NULL). */
@@ -106,6 +108,23 @@ sy_filter_status sy_filter_temporal_set_params(sy_filter_temporal *t, const sy_f
  * history is then reset. */
 sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_frame *in, const float world_to_pixel[16],
                                         float *out_rgba, sy_filter_temporal_stats *stats, sy_filter_report *err);
+
+/** When the camera rests after moving frames (the caller accumulates samples of one view again):
+ * out_rgba = the accumulation accum_rgba (`samples` samples per pixel, width x height x 4 floats)
+ * blended with the last estimate sy_filter_temporal_run returned, whose pixel i counts as
+ * h_i = len_i x g_i x (1 - samples / rest_samples)^2 samples: len_i its history length in frames,
+ * g_i the a-trous passes' variance reduction there (the blended variance over the filtered one, of
+ * the indirect part or the colour, within [1, 64]): out = (h_i estimate + samples accumulation) /
+ * (h_i + samples); alpha from the accumulation. So the first still frames show no pop (the
+ * estimate's noise is about that of len_i g_i samples of one frame each, the accumulation's that of
+ * `samples`: the blend's noise does not jump), and from samples >= rest_samples
+ * on out_rgba is the accumulation exactly (a still, converged image is never changed; the estimate
+ * is then dropped). Returns true when it blended; false (out_rgba = the accumulation) without an
+ * estimate of this size, after sy_filter_temporal_reset, or once converged. out_rgba may be
+ * accum_rgba. The caller calls it only for the view of the last estimate (same camera, scene
+ * unchanged since), and resets the state when the scene changes under a still camera. NULL-safe. */
+bool sy_filter_temporal_rest(sy_filter_temporal *t, uint32_t width, uint32_t height, const float *accum_rgba,
+                             uint32_t samples, float *out_rgba);
 
 #ifdef __cplusplus
 }

@@ -105,7 +105,10 @@ uint32_t sy_mediator_rt_aov_channels(uint32_t index);  /**< 4, 3, 3, 3, 1, 3, 3 
  *   a render whose camera differs from the previous render's and whose accumulation restarted
  *   draws its samples with a seed of its own and returns the reprojected, blended and filtered
  *   estimate (the display filter does not run on it); a render whose camera did not move returns
- *   the accumulation (or the display filter's image) as without it. sy view and sy web set it
+ *   the accumulation (or the display filter's image), blended with the last estimate while the
+ *   camera rests after moving frames, until the accumulation takes over alone at 64 samples
+ *   (sy_filter_temporal_rest: no pop when the camera stops; a camera that never moved, or 64
+ *   samples on, is the accumulation bit for bit). sy view and sy web set it
  *   (sy_interactive_set_temporal); turning it off forgets the history.
  * sy_mediator_rt_set_filter changes it live: name (NULL = opts' "filter" or unchanged) and the keys
  * present in opts (NULL = none; absent keys keep their values). Only the threshold keeps the pixel
@@ -132,6 +135,8 @@ typedef struct sy_mediator_rt_filter_info {
     double temporal_seconds;    /**< the last such frame's temporal stage (AOV read + filter), wall time */
     double temporal_filter_cpu_seconds; /**< of it: the filter's CPU time (all threads; sy_filter_temporal_stats) */
     double temporal_reused;     /**< the last such frame: share of hit pixels with a reprojected history */
+    bool temporal_rest_last;    /**< the last render rested after moving frames: the accumulation blended
+                                     with the last estimate (sy_filter_temporal_rest) */
 } sy_mediator_rt_filter_info;
 /** Fills *out with the context's filter state. */
 void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out);

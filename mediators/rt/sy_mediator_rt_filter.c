@@ -295,6 +295,14 @@ sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_lay
     return SY_OK;
 }
 
+void sy_rti_temporal_rest(rt_state *st, const sy_render_request *req, sy_layer *layer)
+{
+    if (!st->temporal_rest || !st->temporal) return;
+    uint32_t n = sy_rt_accum_samples(st->slots[st->last_slot].acc);
+    st->finfo.temporal_rest_last =
+        sy_filter_temporal_rest(st->temporal, req->rect_w, req->rect_h, layer->rgba, n, layer->rgba);
+}
+
 /* >>temporal reuse
  * The camera of a render request as sy_filter_temporal's world_to_pixel: a homogeneous world point
  * to (x w, y w, *, w) with (x, y) continuous pixel coordinates of the request's rectangle (row 0 at
@@ -327,12 +335,19 @@ sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint
                                 bool *done, sy_error *err)
 {
     *done = false;
-    st->finfo.temporal_last = false;
+    st->finfo.temporal_last = false, st->finfo.temporal_rest_last = false;
+    st->temporal_rest = false;
     if (!st->filter.temporal) return SY_OK;
     bool moved = st->temporal_have_cam && !sy_rti_same_view(&st->temporal_cam, &req->camera);
     st->temporal_cam = req->camera;
     st->temporal_have_cam = true;
     accum_slot *a = &st->slots[st->last_slot];
+    if (!moved && st->temporal) {
+        /* a still camera: an accumulation that continues blends with the last estimate; one that
+         * restarted (the scene changed under the camera) makes the history and estimate stale */
+        if (sy_rt_accum_samples(a->acc) > samples) st->temporal_rest = true;
+        else sy_filter_temporal_reset(st->temporal);
+    }
     /* a still camera, or an accumulation that kept earlier samples: the accumulation as it is */
     if (!moved || sy_rt_accum_samples(a->acc) > samples) return SY_OK;
     struct timespec t0, t1;

@@ -110,6 +110,7 @@ typedef struct rt_state {
     sy_filter_temporal *temporal;
     sy_camera_view temporal_cam;
     bool temporal_have_cam;
+    bool temporal_rest; /* this render's camera rests and its accumulation continues: blend (sy_rti_temporal_rest) */
 } rt_state;
 
 /* --- sy_mediator_rt_base.c --- */
@@ -166,6 +167,10 @@ sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_lay
  * layer alone (*done false). Records the camera either way. */
 sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint32_t samples, sy_layer *layer,
                                 bool *done, sy_error *err);
+/* After the display filter of a render that sy_rti_temporal_layer left alone: while the camera rests
+ * after moving frames, the layer (the accumulation) blended with the last temporal estimate until the
+ * accumulation takes over (sy_filter_temporal_rest). */
+void sy_rti_temporal_rest(rt_state *st, const sy_render_request *req, sy_layer *layer);
 
 /* --- sy_mediator_rt_radiance.c --- */
 sy_result sy_rti_radiance_render(rt_state *st, const sy_render_request *req, const sy_rt_camera *cam,

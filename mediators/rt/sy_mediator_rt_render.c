@@ -146,7 +146,11 @@ static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_lay
         sy_result tr = sy_rti_temporal_layer(st, req, d.samples, layer, &done, err);
         if (tr != SY_OK || done) return tr;
     }
-    if (d.accum && st->filter.kind != PT_FILTER_NONE) return sy_rti_filter_layer(st, req, layer, err);
+    if (d.accum && st->filter.kind != PT_FILTER_NONE) {
+        sy_result fr = sy_rti_filter_layer(st, req, layer, err);
+        if (fr != SY_OK) return fr;
+    }
+    if (d.accum) sy_rti_temporal_rest(st, req, layer); /* a resting camera after moving frames */
     return SY_OK;
 }
 

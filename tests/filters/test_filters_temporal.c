@@ -261,6 +261,76 @@ static int test_noisy_pan(void)
     return 0;
 }
 
+/* mean absolute change of the red channel between two RGBA images (the scene is grey) */
+static double mean_change(const float *a, const float *b, size_t n)
+{
+    double d = 0;
+    for (size_t i = 0; i < n; ++i) d += fabs(a[4 * i] - b[4 * i]);
+    return d / (double)n;
+}
+
+/* The camera stops after a noisy pan (sy_filter_temporal_rest): the still frames blend the last
+ * estimate with the accumulation of the resting view. Measured: the mean absolute change from the
+ * last moving frame to the first still one (the pop) against the mean frame-to-frame change while
+ * moving (the flicker the viewer already sees). Threshold 1.5x that flicker: a change at the stop
+ * that stands out from the motion's own flicker is what reads as a pop; the plain accumulation
+ * (2 samples) is checked to jump far beyond it, so the test can fail. No later still frame changes
+ * by more than 1.5x the larger of that flicker and the plain accumulation's own change at that
+ * sample count (what a still progressive image shows anyway): no pop when the fade ends either.
+ * From rest_samples on the output is the accumulation bit for bit. */
+static int test_rest(void)
+{
+    scene s = {.occluder = true, .rng = 11};
+    sy_filter_temporal_params p;
+    sy_filter_temporal_params_default(&p);
+    sy_filter_temporal *t = NULL;
+    sy_filter_report err = {0};
+    CHECK(sy_filter_temporal_create(&p, &t, &err) == SY_FILTER_OK);
+    const uint32_t w = 96, h = 64;
+    size_t n = (size_t)w * h;
+    float *out = malloc(4 * n * sizeof(float)), *last = malloc(4 * n * sizeof(float)), *acc = malloc(4 * n * sizeof(float));
+    float *acc_last = malloc(4 * n * sizeof(float));
+    double *sum = calloc(4 * n, sizeof(double));
+    CHECK(out && last && acc && acc_last && sum);
+    double moving = 0;
+    int counted = 0;
+    const int pan = 24;
+    for (int k = 0; k < pan; ++k) {
+        CHECK(scene_render(&s, w, h, 0.01f * (float)k, 0.6f, 1.0f, 1.0f) == 0); /* relative sd 1: "1 spp" */
+        sy_filter_frame f = scene_frame(&s);
+        CHECK(sy_filter_temporal_run(t, &f, s.m, out, NULL, &err) == SY_FILTER_OK);
+        if (k >= pan - 8) moving += mean_change(out, last, n), counted++;
+        memcpy(last, out, 4 * n * sizeof(float));
+    }
+    moving /= counted;
+    /* the last moving frame's samples start the resting view's accumulation (as the path tracer's) */
+    for (size_t i = 0; i < 4 * n; ++i) sum[i] = s.color[i], acc_last[i] = s.color[i];
+    double pop = 0, pop_plain = 0, later = 0; /* later: the largest change over its bound */
+    for (uint32_t spp = 2; spp <= p.rest_samples; ++spp) {
+        CHECK(scene_render(&s, w, h, 0.01f * (float)(pan - 1), 0.6f, 1.0f, 1.0f) == 0);
+        for (size_t i = 0; i < 4 * n; ++i) sum[i] += s.color[i], acc[i] = (float)(sum[i] / spp);
+        bool blended = sy_filter_temporal_rest(t, w, h, acc, spp, out);
+        CHECK_MSG(blended == (spp < p.rest_samples), "%u samples: blended %d", spp, blended);
+        double ch = mean_change(out, last, n), own = mean_change(acc, acc_last, n);
+        if (spp == 2) pop = ch, pop_plain = mean_change(acc, last, n);
+        else later = fmax(later, ch / (1.5 * fmax(moving, own)));
+        memcpy(last, out, 4 * n * sizeof(float));
+        memcpy(acc_last, acc, 4 * n * sizeof(float));
+    }
+    CHECK(!memcmp(out, acc, 4 * n * sizeof(float))); /* converged: the accumulation exactly */
+    CHECK(!sy_filter_temporal_rest(t, w, h, acc, 3, out) && !memcmp(out, acc, 4 * n * sizeof(float))); /* dropped */
+    printf("camera stops: change at the stop %.5f (plain accumulation %.5f), flicker while moving %.5f; later "
+           "frames' change at most %.2f of their bound\n",
+           pop, pop_plain, moving, later);
+    CHECK(pop <= 1.5 * moving);
+    CHECK(pop_plain > 3.0 * moving);
+    CHECK(later <= 1.0);
+    free(out), free(last), free(acc), free(acc_last), free(sum);
+    sy_filter_temporal_destroy(t);
+    scene_free(&s);
+    return 0;
+}
+
 /* the direct/indirect split: a sharp emitter (direct part 10x brighter than the wall around it)
  * in the direct part stays sharp through a pan while the noisy indirect part is filtered */
 static int test_split(void)
@@ -374,6 +444,7 @@ int main(void)
     RUN(test_blend_and_disocclusion);
     RUN(test_clamp);
     RUN(test_noisy_pan);
+    RUN(test_rest);
     RUN(test_split);
     RUN(test_bad_input);
     return sy_check_finish("filters temporal");

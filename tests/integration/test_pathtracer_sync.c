@@ -10,8 +10,9 @@
  * Switching the viewport to whitted and back resumes the accumulation (cached context, nothing
  * changed). The image after a restart equals a fresh context's image of the changed scene bit for bit (no
  * stale samples), AOVs come back for the viewport rectangle, and nothing is non-finite. With
- * temporal=1 a panning view shows the temporal estimate (not the accumulation) and a still one the
- * accumulation bit for bit; temporal=0 shows the plain samples again. */
+ * temporal=1 a panning view shows the temporal estimate (not the accumulation), a view that rests
+ * after it the accumulation blended with the estimate, and from 64 samples on the accumulation bit
+ * for bit; temporal=0 shows the plain samples again. */
 #include "it_util.h"
 #include "sy_mediator_rt.h"
 
@@ -202,7 +203,7 @@ int main(void)
     EXPECT(sy_mediator_rt_aovs_get(sy_context_state(wc), &a, &e) != SY_OK && e.message[0]);
 
     /* temporal reuse ("temporal", sy_filter_temporal.h): a frame whose camera moved shows the
-     * estimate; a still camera shows the accumulation exactly, from its second sample on */
+     * estimate; a still camera blends the accumulation with it, then shows the accumulation exactly */
     {
         sy_params on = {0}, off = {0};
         MUST(sy_params_set(&on, "temporal", "1", err));
@@ -227,12 +228,17 @@ int main(void)
             sy_mediator_rt_aovs_free(&a);
         }
         EXPECT(fi.temporal_reused > 0.5);
-        for (uint32_t k = 0; k < 3; ++k) { /* the camera rests: the accumulation, bit for bit */
-            EXPECT(render(&fx, 1) == 2 + k);
+        /* the camera rests: the accumulation blended with the last estimate (no pop) until it
+         * takes over alone at 64 samples, bit for bit from then on */
+        for (uint32_t k = 2; k <= 66; ++k) {
+            EXPECT(render(&fx, 1) == k);
             MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
-            EXPECT_MSG(!memcmp(a.planes[0], fx.img.rgba, bytes), "still frame %u differs from the accumulation", k);
+            bool same = !memcmp(a.planes[0], fx.img.rgba, bytes);
             sy_mediator_rt_aovs_free(&a);
             sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
+            EXPECT_MSG(same == (k >= 64) && fi.temporal_rest_last == (k < 64),
+                       "still frame of %u samples: the layer %s the accumulation, rest %d", k, same ? "is" : "is not",
+                       fi.temporal_rest_last);
             EXPECT(!fi.temporal_last && fi.temporal_frames == 3);
         }
         MUST(sy_context_set_filter(ctx, "none", &off, err)); /* off: a moving frame is the plain samples */
