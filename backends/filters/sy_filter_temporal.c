@@ -27,6 +27,16 @@
 #define SY_TEMPORAL_INLINE
 #endif
 
+/* The row loops that carry the work, one tap (dx, dy) over columns [x0, x1): restrict parameters
+ * (GCC does not vectorise them through local restrict pointers), no branch, no division. x86-64
+ * GCC: an AVX2 clone beside the SSE2 default, picked at load time (the same operations in the same
+ * order per lane, no FMA contraction in ISO C mode: the same results). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define SY_TEMPORAL_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define SY_TEMPORAL_CLONES
+#endif
+
 /* branch-free min / max without the library call GCC emits for fmaxf's NaN rules */
 static inline SY_TEMPORAL_INLINE float fmx(float a, float b)
 {
@@ -72,6 +82,7 @@ typedef struct hist {
 /* the working planes, all of n = width*height floats (see work_reserve for the count) */
 enum {
     W_CLS,          /* class: 0 none (miss, bad pixel), 1 hit without a normal, 2 hit with one */
+    W_OK,           /* 1 = finite input, else 0 */
     W_HIT,          /* 1 for a hit (class > 0), else 0 */
     W_SN,           /* the centre's normal edge stop: sigma_normal for class 2, else 0 */
     W_Z,            /* depth (0 where no hit) */
@@ -100,11 +111,12 @@ struct sy_filter_temporal {
     bool have_prev;
     size_t cap;   /* pixels of the working planes */
     float *work;  /* W_COUNT planes */
-    uint8_t *ok;  /* 1 = finite input */
     /* the last estimate returned (3 planes of est_w x est_h) and the samples each pixel counts as (a
      * fourth plane), for sy_filter_temporal_rest */
     float *est;
     size_t est_cap;
+    float *dummy; /* 2 rows of dummy_cap: class -1, then zeros (a-trous rows outside the image) */
+    size_t dummy_cap;
     uint32_t est_w, est_h;
     bool have_est;
 };
@@ -180,8 +192,8 @@ static void hist_bind(hist *h, size_t n)
 
 static void work_free(sy_filter_temporal *t)
 {
-    free(t->work), free(t->ok);
-    t->work = NULL, t->ok = NULL;
+    free(t->work);
+    t->work = NULL;
     t->cap = 0;
 }
 
@@ -190,8 +202,8 @@ static bool work_reserve(sy_filter_temporal *t, size_t n)
     if (n <= t->cap) return true;
     work_free(t);
     if (n > SIZE_MAX / (W_COUNT * sizeof(float))) return false;
-    t->work = malloc(W_COUNT * n * sizeof(float)), t->ok = malloc(n);
-    if (!t->work || !t->ok) {
+    t->work = malloc(W_COUNT * n * sizeof(float));
+    if (!t->work) {
         work_free(t);
         return false;
     }
@@ -220,7 +232,7 @@ void sy_filter_temporal_destroy(sy_filter_temporal *t)
     if (!t) return;
     hist_free(&t->h[0]), hist_free(&t->h[1]);
     work_free(t);
-    free(t->est);
+    free(t->est), free(t->dummy);
     free(t);
 }
 
@@ -281,38 +293,88 @@ static inline void tap_span(int w, int off, int *x0, int *x1)
     *x1 = off > 0 ? w - off : w;
 }
 
-/* demodulation, validity, the frame's planes */
+/* 0 for a finite x, NaN for NaN or an infinity (x * 0: not folded without -ffinite-math-only) */
+static inline SY_TEMPORAL_INLINE float nonfinite0(float x)
+{
+    return x * 0.0f;
+}
+
+/* demodulation, validity, the frame's planes, for pixels [i0, i1): one function per colour channel
+ * count CC (3 or 4) and direct/indirect split SPLIT, so that GCC vectorises each variant's strided
+ * loads (restrict parameters: through an inlined helper it does not) */
+#define SY_DEMOD_VARIANT(NAME, CC, SPLIT)                                                                             \
+    SY_TEMPORAL_CLONES                                                                                               \
+    static void NAME(size_t i0, size_t i1, float sn, const float *restrict col, const float *restrict al,             \
+                     const float *restrict nr, const float *restrict dep, const float *restrict pos,                   \
+                     const float *restrict dir, const float *restrict ind, float *restrict cls, float *restrict okp,   \
+                     float *restrict hitp, float *restrict snp, float *restrict zp, float *restrict n0,                \
+                     float *restrict n1, float *restrict n2, float *restrict m0, float *restrict m1,                   \
+                     float *restrict m2, float *restrict c0, float *restrict c1, float *restrict c2,                   \
+                     float *restrict d0, float *restrict d1, float *restrict d2, float *restrict l0,                   \
+                     float *restrict l1)                                                                               \
+    {                                                                                                                 \
+        const int cc = CC;                                                                                            \
+        const bool split = SPLIT;                                                                                     \
+    for (size_t i = i0; i < i1; ++i) {                                                                                \
+        const float *cl = col + (size_t)cc * i, *a = al + 3 * i, *nn = nr + 3 * i, *p = pos + 3 * i;                  \
+        float d = dep[i];                                                                                             \
+        float bad = nonfinite0(cl[0]) + nonfinite0(cl[1]) + nonfinite0(cl[2]) + nonfinite0(a[0]) + nonfinite0(a[1]) + \
+                    nonfinite0(a[2]) + nonfinite0(nn[0]) + nonfinite0(nn[1]) + nonfinite0(nn[2]);                     \
+        if (split)                                                                                                    \
+            bad += nonfinite0(dir[3 * i]) + nonfinite0(dir[3 * i + 1]) + nonfinite0(dir[3 * i + 2]) +                 \
+                   nonfinite0(ind[3 * i]) + nonfinite0(ind[3 * i + 1]) + nonfinite0(ind[3 * i + 2]);                  \
+        float okf = (float)(bad == 0.0f) * (float)(d == d) * (float)(d > -INFINITY);                                  \
+        float pbad = nonfinite0(p[0]) + nonfinite0(p[1]) + nonfinite0(p[2]);                                          \
+        float hitf = okf * (float)(d < INFINITY) * (float)(pbad == 0.0f);                                             \
+        float hnf = hitf * (float)(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2] > 0.25f); /* has_normal */           \
+        okp[i] = okf, cls[i] = hitf + hnf, hitp[i] = hitf, snp[i] = hnf * sn;                                         \
+        zp[i] = hitf > 0.0f ? d : 0.0f;                                                                               \
+        n0[i] = hitf > 0.0f ? nn[0] : 0.0f, n1[i] = hitf > 0.0f ? nn[1] : 0.0f, n2[i] = hitf > 0.0f ? nn[2] : 0.0f;   \
+        /* dark albedo keeps the radiance (as a-trous) */                                                             \
+        float ma = hitf > 0.0f && a[0] > 0.01f ? a[0] : 1.0f, mb = hitf > 0.0f && a[1] > 0.01f ? a[1] : 1.0f,         \
+              mc = hitf > 0.0f && a[2] > 0.01f ? a[2] : 1.0f;                                                         \
+        m0[i] = ma, m1[i] = mb, m2[i] = mc;                                                                           \
+        float x0 = split ? ind[3 * i] : cl[0], x1 = split ? ind[3 * i + 1] : cl[1], x2 = split ? ind[3 * i + 2] : cl[2];\
+        float r0 = okf > 0.0f ? x0 / ma : 0.0f, r1 = okf > 0.0f ? x1 / mb : 0.0f, r2 = okf > 0.0f ? x2 / mc : 0.0f;   \
+        c0[i] = r0, c1[i] = r1, c2[i] = r2;                                                                           \
+        l0[i] = 0.2126f * r0 + 0.7152f * r1 + 0.0722f * r2;                                                           \
+        float e0 = 0.0f, e1 = 0.0f, e2 = 0.0f;                                                                        \
+        if (split)                                                                                                    \
+            e0 = okf > 0.0f ? dir[3 * i] / ma : 0.0f, e1 = okf > 0.0f ? dir[3 * i + 1] / mb : 0.0f,                   \
+            e2 = okf > 0.0f ? dir[3 * i + 2] / mc : 0.0f;                                                             \
+        d0[i] = e0, d1[i] = e1, d2[i] = e2;                                                                           \
+        l1[i] = 0.2126f * e0 + 0.7152f * e1 + 0.0722f * e2;                                                           \
+    }                                                                                                                 \
+    }
+SY_DEMOD_VARIANT(demod_c3, 3, false)
+SY_DEMOD_VARIANT(demod_c4, 4, false)
+SY_DEMOD_VARIANT(demod_c3_split, 3, true)
+SY_DEMOD_VARIANT(demod_c4_split, 4, true)
+#undef SY_DEMOD_VARIANT
+
 static void demod_rows(void *vc, uint32_t y0, uint32_t y1)
 {
     tctx *c = vc;
-    sy_filter_temporal *t = c->t;
     const sy_filter_frame *in = c->in;
-    size_t w = in->width, cc = in->color_channels, n = c->n;
-    float *W = c->W, sn = t->p.sigma_normal;
+    size_t w = in->width, i0 = (size_t)y0 * w, i1 = (size_t)y1 * w;
+    float sn = c->t->p.sigma_normal;
     bool split = in->direct && in->indirect;
-    for (size_t i = (size_t)y0 * w; i < (size_t)y1 * w; ++i) {
-        const float *col = in->color + cc * i, *al = in->albedo + 3 * i, *nr = in->normal + 3 * i;
-        float d = in->depth[i];
-        bool ok = finite3(col) && finite3(al) && finite3(nr) && !isnan(d) && d > -INFINITY &&
-                  (!split || (finite3(in->direct + 3 * i) && finite3(in->indirect + 3 * i)));
-        bool hit = ok && isfinite(d) && finite3(in->position + 3 * i);
-        bool hn = hit && has_normal(nr[0], nr[1], nr[2]);
-        t->ok[i] = ok;
-        W[W_CLS * n + i] = hit ? (hn ? 2.0f : 1.0f) : 0.0f;
-        W[W_HIT * n + i] = hit ? 1.0f : 0.0f;
-        W[W_SN * n + i] = hn ? sn : 0.0f;
-        W[W_Z * n + i] = hit ? d : 0.0f;
-        float ci[3], di[3];
-        for (int q = 0; q < 3; ++q) {
-            W[(W_N + q) * n + i] = hit ? nr[q] : 0.0f;
-            float m = hit && al[q] > 0.01f ? al[q] : 1.0f; /* dark albedo keeps the radiance (as a-trous) */
-            W[(W_MOD + q) * n + i] = m;
-            ci[q] = ok ? (split ? in->indirect[3 * i + q] : col[q]) / m : 0.0f;
-            di[q] = ok && split ? in->direct[3 * i + q] / m : 0.0f;
-            W[(W_CUR + q) * n + i] = ci[q], W[(W_CUR + 3 + q) * n + i] = di[q];
-        }
-        W[W_LUM * n + i] = sy_filter_luminance(ci), W[(W_LUM + 1) * n + i] = sy_filter_luminance(di);
+    float *W = c->W;
+    size_t n = c->n;
+#define SY_DEMOD_ARGS                                                                                                 \
+    i0, i1, sn, in->color, in->albedo, in->normal, in->depth, in->position, in->direct, in->indirect, W + W_CLS * n,   \
+        W + W_OK * n, W + W_HIT * n, W + W_SN * n, W + W_Z * n, W + W_N * n, W + (W_N + 1) * n, W + (W_N + 2) * n,    \
+        W + W_MOD * n, W + (W_MOD + 1) * n, W + (W_MOD + 2) * n, W + W_CUR * n, W + (W_CUR + 1) * n,                 \
+        W + (W_CUR + 2) * n, W + (W_CUR + 3) * n, W + (W_CUR + 4) * n, W + (W_CUR + 5) * n, W + W_LUM * n,          \
+        W + (W_LUM + 1) * n
+    if (in->color_channels == 4) {
+        if (split) demod_c4_split(SY_DEMOD_ARGS);
+        else demod_c4(SY_DEMOD_ARGS);
+    } else {
+        if (split) demod_c3_split(SY_DEMOD_ARGS);
+        else demod_c3(SY_DEMOD_ARGS);
     }
+#undef SY_DEMOD_ARGS
 }
 
 /* Bilinear reprojection of world point p (normal n, depth z) into the previous history: r = illum 3,
@@ -326,7 +388,7 @@ static bool reproject(const sy_filter_temporal *t, const hist *h, const float *p
     if (!(Wc > 1e-12f)) return false;
     float iW = 1.0f / Wc, x = X * iW - 0.5f, y = Y * iW - 0.5f;
     if (!(x > -1.0f && y > -1.0f && x < (float)h->w && y < (float)h->h)) return false;
-    int x0 = (int)floorf(x), y0 = (int)floorf(y);
+    int x0 = (int)(x + 1.0f) - 1, y0 = (int)(y + 1.0f) - 1; /* floor: x, y > -1 (no libm call) */
     float fx = x - (float)x0, fy = y - (float)y0;
     float tol = t->p.depth_tolerance * z, tol2 = 64.0f * tol * tol, ntol = t->p.normal_tolerance;
     bool hn = has_normal(n[0], n[1], n[2]);
@@ -382,16 +444,6 @@ static inline void clamp_box(float *c, const float *m1, const float *m2, float i
     }
     from_ycocg(v, c);
 }
-
-/* The row loops that carry the work, one tap (dx, dy) over columns [x0, x1): restrict parameters
- * (GCC does not vectorise them through local restrict pointers), no branch, no division. x86-64
- * GCC: an AVX2 clone beside the SSE2 default, picked at load time (the same operations in the same
- * order per lane, no FMA contraction in ISO C mode: the same results). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define SY_TEMPORAL_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define SY_TEMPORAL_CLONES
-#endif
 
 /* 3x3 statistics of one part, one tap: YCoCg sums s0-s2 and sums of squares s3-s5 of colour a,
  * luminance sum s6 and sum of squares s7, over hits (h = 1) */
@@ -632,6 +684,51 @@ static void atrous_end(int w, const float *restrict h, const float *restrict c0,
     }
 }
 
+/* a-trous, the 8 taps of the pixels [x0, x1) of a row at once (every tap column in the image):
+ * rows u (y - s), m (y), d (y + s) of class, luminance, depth, normal, colour and variance (a row
+ * outside the image: class -1, which no centre matches, and zeros), the centre's normal, luminance
+ * and depth stops; the taps in the order of atrous_tap's calls, the sums in registers, then
+ * atrous_end's result (o colour, ov variance, ol luminance; the source where the centre is no hit) */
+#define SY_ROW3(T, name) const T *restrict name##u, const T *restrict name##m, const T *restrict name##d
+SY_TEMPORAL_CLONES
+static void atrous_row8(int x0, int x1, int s, SY_ROW3(float, cl), SY_ROW3(float, l), SY_ROW3(float, z),
+                        SY_ROW3(float, na), SY_ROW3(float, nb), SY_ROW3(float, nc), SY_ROW3(float, ca),
+                        SY_ROW3(float, cb), SY_ROW3(float, cc), SY_ROW3(float, v), const float *restrict sn,
+                        const float *restrict il, const float *restrict iz, float *restrict o0, float *restrict o1,
+                        float *restrict o2, float *restrict ov, float *restrict ol, float xmax)
+{
+    const float kc = 0.25f, ke = 0.125f, kd = 0.0625f, dg = 0.70710678f;
+    for (int x = x0; x < x1; ++x) {
+        float ci = clm[x], li = lm[x], zi = zm[x], n0 = nam[x], n1 = nbm[x], n2 = ncm[x];
+        float si = sn[x], ii = il[x], iz_ = iz[x];
+        float a0 = kc * cam[x], a1 = kc * cbm[x], a2 = kc * ccm[x], W = kc, V = kc * kc * vm[x];
+#define SY_TAP(R, J, KK, ZD)                                                                                          \
+    do {                                                                                                              \
+        int j_ = (J);                                                                                                 \
+        float dn = 1.0f - (n0 * na##R[j_] + n1 * nb##R[j_] + n2 * nc##R[j_]);                                         \
+        float arg = fabsf(li - l##R[j_]) * ii + fabsf(zi - z##R[j_]) * iz_ * (ZD) + si * fmx(dn, 0.0f);              \
+        float k = (KK) * expneg(arg, xmax) * (float)(cl##R[j_] == ci);                                                \
+        a0 += k * ca##R[j_], a1 += k * cb##R[j_], a2 += k * cc##R[j_];                                                \
+        W += k, V += k * k * v##R[j_];                                                                                \
+    } while (0)
+        SY_TAP(u, x - s, kd, dg);
+        SY_TAP(u, x, ke, 1.0f);
+        SY_TAP(u, x + s, kd, dg);
+        SY_TAP(m, x - s, ke, 1.0f);
+        SY_TAP(m, x + s, ke, 1.0f);
+        SY_TAP(d, x - s, kd, dg);
+        SY_TAP(d, x, ke, 1.0f);
+        SY_TAP(d, x + s, kd, dg);
+#undef SY_TAP
+        float h = (float)(ci > 0.0f), k = 1.0f - h, iw = 1.0f / W;
+        float r0 = h * (a0 * iw) + k * cam[x], r1 = h * (a1 * iw) + k * cbm[x], r2 = h * (a2 * iw) + k * ccm[x];
+        o0[x] = r0, o1[x] = r1, o2[x] = r2;
+        ov[x] = h * (V * iw * iw) + k * vm[x];
+        ol[x] = h * (0.2126f * r0 + 0.7152f * r1 + 0.0722f * r2) + k * li;
+    }
+}
+#undef SY_ROW3
+
 /* one a-trous pass (3x3 B-spline, taps c->step apart) over hits, tap by tap over each row;
  * neighbours only of the centre's class (hit with a normal, hit without one); a pixel without a hit
  * keeps its value */
@@ -645,28 +742,54 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
     const float *N0 = plane(c, W_N), *N1 = plane(c, W_N + 1), *N2 = plane(c, W_N + 2);
     const float *SN = plane(c, W_SN), *IL = plane(c, W_IL), *IZ = plane(c, W_IZ);
     const float *C0 = c->src, *C1 = c->src + n, *C2 = c->src + 2 * n, *V = c->vsrc;
+    const float *neg = c->t->dummy, *zero = c->t->dummy + w; /* a row outside the image */
     float *WS = plane(c, W_WS);
     const float k0 = hk[1] * hk[1]; /* the centre: exactly its kernel weight */
+    /* the columns whose taps all lie in the image run fused (atrous_row8); the s columns at either
+     * edge tap by tap */
+    int xa = s < w ? s : w, xb = w - s > xa ? w - s : xa;
     for (int y = (int)y0; y < (int)y1; ++y) {
         size_t row = (size_t)y * w;
         float *o0 = c->dst + row, *o1 = c->dst + n + row, *o2 = c->dst + 2 * n + row;
         float *ov = c->vdst + row, *ow = WS + row, *ol = c->ldst + row;
-        atrous_start(w, k0, C0 + row, C1 + row, C2 + row, V + row, o0, o1, o2, ow, ov);
-        for (int dy = -1; dy <= 1; ++dy) {
-            int yy = y + dy * s;
-            if (yy < 0 || yy >= hgt) continue;
-            for (int dx = -1; dx <= 1; ++dx) {
-                if (dx == 0 && dy == 0) continue;
-                int x0, x1;
-                tap_span(w, dx * s, &x0, &x1);
-                size_t o = (size_t)yy * w + (size_t)(dx * s);
-                float kk = hk[dx + 1] * hk[dy + 1], zd = (dx && dy) ? 0.70710678f : 1.0f;
-                atrous_tap(x0, x1, kk, zd, cls + o, L + o, Z + o, N0 + o, N1 + o, N2 + o, C0 + o, C1 + o, C2 + o, V + o,
-                           cls + row, L + row, Z + row, N0 + row, N1 + row, N2 + row, SN + row, IL + row, IZ + row, o0,
-                           o1, o2, ow, ov, c->xmax);
+        if (xb > xa) {
+            const float *P[10][3]; /* class, luminance, depth, normal 3, colour 3, variance: rows u, m, d */
+            for (int r = 0; r < 3; ++r) {
+                int yy = y + (r - 1) * s;
+                bool in = yy >= 0 && yy < hgt;
+                size_t o = in ? (size_t)yy * w : 0;
+                const float *src[10] = {cls, L, Z, N0, N1, N2, C0, C1, C2, V};
+                for (int q = 0; q < 10; ++q) P[q][r] = in ? src[q] + o : (q == 0 ? neg : zero);
             }
+            atrous_row8(xa, xb, s, P[0][0], P[0][1], P[0][2], P[1][0], P[1][1], P[1][2], P[2][0], P[2][1], P[2][2],
+                        P[3][0], P[3][1], P[3][2], P[4][0], P[4][1], P[4][2], P[5][0], P[5][1], P[5][2], P[6][0],
+                        P[6][1], P[6][2], P[7][0], P[7][1], P[7][2], P[8][0], P[8][1], P[8][2], P[9][0], P[9][1],
+                        P[9][2], SN + row, IL + row, IZ + row, o0, o1, o2, ov, ol, c->xmax);
         }
-        atrous_end(w, H + row, C0 + row, C1 + row, C2 + row, V + row, L + row, ow, o0, o1, o2, ov, ol);
+        for (int e = 0; e < 2; ++e) { /* the edges [0, xa) and [xb, w) */
+            int ea = e ? xb : 0, eb = e ? w : xa;
+            if (eb <= ea) continue;
+            atrous_start(eb - ea, k0, C0 + row + ea, C1 + row + ea, C2 + row + ea, V + row + ea, o0 + ea, o1 + ea,
+                         o2 + ea, ow + ea, ov + ea);
+            for (int dy = -1; dy <= 1; ++dy) {
+                int yy = y + dy * s;
+                if (yy < 0 || yy >= hgt) continue;
+                for (int dx = -1; dx <= 1; ++dx) {
+                    if (dx == 0 && dy == 0) continue;
+                    int x0, x1;
+                    tap_span(w, dx * s, &x0, &x1);
+                    x0 = x0 > ea ? x0 : ea, x1 = x1 < eb ? x1 : eb;
+                    if (x1 <= x0) continue;
+                    size_t o = (size_t)yy * w + (size_t)(dx * s);
+                    float kk = hk[dx + 1] * hk[dy + 1], zd = (dx && dy) ? 0.70710678f : 1.0f;
+                    atrous_tap(x0, x1, kk, zd, cls + o, L + o, Z + o, N0 + o, N1 + o, N2 + o, C0 + o, C1 + o, C2 + o,
+                               V + o, cls + row, L + row, Z + row, N0 + row, N1 + row, N2 + row, SN + row, IL + row,
+                               IZ + row, o0, o1, o2, ow, ov, c->xmax);
+                }
+            }
+            atrous_end(eb - ea, H + row + ea, C0 + row + ea, C1 + row + ea, C2 + row + ea, V + row + ea, L + row + ea,
+                       ow + ea, o0 + ea, o1 + ea, o2 + ea, ov + ea, ol + ea);
+        }
     }
 }
 
@@ -715,7 +838,13 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
         t->est = n <= SIZE_MAX / (4 * sizeof(float)) ? malloc(4 * n * sizeof(float)) : NULL;
         t->est_cap = t->est ? n : 0;
     }
-    if (!t->est || !work_reserve(t, n) || !hist_reserve(nx, n)) {
+    if (in->width > t->dummy_cap) {
+        free(t->dummy);
+        t->dummy = malloc(2 * (size_t)in->width * sizeof(float));
+        t->dummy_cap = t->dummy ? in->width : 0;
+        for (size_t x = 0; x < t->dummy_cap; ++x) t->dummy[x] = -1.0f, t->dummy[t->dummy_cap + x] = 0.0f;
+    }
+    if (!t->est || !t->dummy || !work_reserve(t, n) || !hist_reserve(nx, n)) {
         t->have_prev = false;
         return sy_filter_fail(err, SY_FILTER_ERROR_OUT_OF_MEMORY, "temporal: out of memory for %ux%u", in->width,
                               in->height);
@@ -764,7 +893,7 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
         uint64_t hits = 0;
         const float *H = plane(&c, W_HIT);
         for (size_t i = 0; i < n; ++i) {
-            st.nonfinite += !t->ok[i];
+            st.nonfinite += !(c.W[W_OK * n + i] > 0.0f);
             if (!(H[i] > 0.0f)) continue;
             hits++, hsum += nx->len[i];
             if (nx->len[i] > 1.0f) st.reprojected++;
