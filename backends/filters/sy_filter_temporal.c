@@ -94,12 +94,21 @@ enum {
     W_IL,           /* per a-trous pass: 1 / (sigma_l sqrt(blurred variance) + 1e-6) */
     W_IZ,           /* per a-trous pass: 1 / (sigma_z step zgrad + 1e-6 z + 1e-9) */
     W_WS,           /* sums of weights */
-    W_PART,         /* per part (2): acc 3, var, lacc, a 3, va, la, b 3, vb, lb = 15 */
-    W_COUNT = W_PART + 2 * 15
+    W_R,            /* 11: the reprojected history per pixel (illum 3, dir 3, moments 4, length; 0 = none) */
+    W_RU = W_R + 11, /* 1 where the history was reused, else 0 */
+    W_PART,         /* per part (2): acc 3, var, lacc = 5 */
+    W_SCR = W_PART + 2 * 5, /* per part (2): the a-trous ping-pong planes a 3, va, la, b 3, vb, lb = 10 */
+    W_COUNT = W_SCR + 2 * 10
 };
-/* offsets inside a part's 15 planes */
+/* a part's planes (part_index)  */
 enum { P_ACC = 0, P_VAR = 3, P_LACC = 4, P_A = 5, P_VA = 8, P_LA = 9, P_B = 10, P_VB = 13, P_LB = 14 };
-/* the 3x3 statistics of integrate_rows borrow a part's a-trous planes (free until then): per part
+/* the plane index of part k's plane off (P_*) */
+static inline size_t part_index(int k, int off)
+{
+    return off < P_A ? (size_t)(W_PART + 5 * k + off) : (size_t)(W_SCR + 10 * k + (off - P_A));
+}
+/* the 3x3 statistics of integrate_rows borrow the a-trous ping-pong planes (free until then: W_SCR
+ * on, one group of S_COUNT planes n apart): per part
  * YCoCg sums (3) and sums of squares (3) of the new samples, luminance sum and sum of squares; part 0
  * also the count of hits and the depth gradient */
 enum { S_COUNT = 17 };
@@ -278,7 +287,7 @@ static inline float *plane(const tctx *c, size_t k)
 /* the k-th plane (0..S_COUNT-1) of integrate_rows' 3x3 statistics: a part's a-trous planes */
 static inline float *stat_plane(const tctx *c, int k)
 {
-    return plane(c, W_PART + (k < 10 ? P_A + k : 15 + P_A + (k - 10)));
+    return plane(c, W_SCR + (size_t)k);
 }
 
 static inline bool finite3(const float *v)
@@ -531,7 +540,75 @@ static void stats_row(const tctx *c, int y)
     }
 }
 
-/* depth gradient, reprojection, clamping, moving averages, variance; the next history's geometry */
+/* one YCoCg channel clamped to mean +- gamma sd of the sums m1, m2 (count 1/ic) */
+static inline SY_TEMPORAL_INLINE float clamp1(float v, float m1, float m2, float ic, float gamma)
+{
+    float mu = m1 * ic, var = m2 * ic - mu * mu, sd = sqrtf(fmx(var, 0.0f));
+    return fmx(mu - gamma * sd, fmn(v, mu + gamma * sd));
+}
+
+/* colour c (3) clamped to the YCoCg box of the sums m1 (3 planes n apart) and m2, where u = 1 (else
+ * kept: a blend of finite values), loop-free so that the row loop around it vectorises */
+static inline SY_TEMPORAL_INLINE void clamp3(float *c, const float *m1, const float *m2, size_t n, float ic, float gamma,
+                                             float u)
+{
+    float y = 0.25f * c[0] + 0.5f * c[1] + 0.25f * c[2], o = 0.5f * c[0] - 0.5f * c[2],
+          g = -0.25f * c[0] + 0.5f * c[1] - 0.25f * c[2];
+    y = clamp1(y, m1[0], m2[0], ic, gamma), o = clamp1(o, m1[n], m2[n], ic, gamma);
+    g = clamp1(g, m1[2 * n], m2[2 * n], ic, gamma);
+    float nu = 1.0f - u;
+    c[0] = u * (y + o - g) + nu * c[0], c[1] = u * (y + g) + nu * c[1], c[2] = u * (y - o - g) + nu * c[2];
+}
+
+/* clamping, moving averages and variance of a row's pixels [0, w), after the reprojection: h hit
+ * (1/0), cur (6 planes: the new samples of both parts) and lum (2), S the 3x3 statistics (S_COUNT
+ * planes), R the reprojected history (11 planes, 0 where not reused) and ru (1 where reused); all
+ * grouped planes n apart. Out: the parts' blends a (3) and b (3), variances v0 v1, luminances l0
+ * l1; the depth gradient zg masked to hits; the next history's length and moments (4, n apart).
+ * Branch-free (selects as 0/1 blends of finite values) so that it vectorises. */
+SY_TEMPORAL_CLONES
+static void blend_row(int w, size_t n, float alpha, float alpha_m, float max_hist, float gamma,
+                      const float *restrict h, const float *restrict cur, const float *restrict lum,
+                      const float *restrict S, const float *restrict R, const float *restrict ru, float *restrict a0,
+                      float *restrict a1, float *restrict a2, float *restrict b0, float *restrict b1,
+                      float *restrict b2, float *restrict v0, float *restrict v1, float *restrict l0,
+                      float *restrict l1, float *restrict zg, float *restrict len, float *restrict mom)
+{
+    const float on = gamma > 0.0f ? 1.0f : 0.0f;
+    for (int x = 0; x < w; ++x) {
+        float hx = h[x], u = ru[x];
+        float ic = 1.0f / fmx(S[16 * n + x], 1.0f);
+        float ci[3] = {cur[x], cur[n + x], cur[2 * n + x]}, dc[3] = {cur[3 * n + x], cur[4 * n + x], cur[5 * n + x]};
+        float hi[3] = {R[x], R[n + x], R[2 * n + x]}, hd[3] = {R[3 * n + x], R[4 * n + x], R[5 * n + x]};
+        float hm[4] = {R[6 * n + x], R[7 * n + x], R[8 * n + x], R[9 * n + x]}, hl = R[10 * n + x];
+        /* clamp both parts' history to the YCoCg box of the new samples (where reused; gamma 0: off) */
+        clamp3(hi, S + x, S + 3 * n + x, n, ic, gamma, u * on);
+        clamp3(hd, S + 8 * n + x, S + 11 * n + x, n, ic, gamma, u * on);
+        float al = fmx(alpha, 1.0f / (hl + 1.0f)), am = fmx(alpha_m, 1.0f / (hl + 1.0f)); /* hl = 0: 1 */
+        float ai[3], ad[3];
+        ai[0] = hi[0] + al * (ci[0] - hi[0]), ai[1] = hi[1] + al * (ci[1] - hi[1]), ai[2] = hi[2] + al * (ci[2] - hi[2]);
+        ad[0] = hd[0] + al * (dc[0] - hd[0]), ad[1] = hd[1] + al * (dc[1] - hd[1]), ad[2] = hd[2] + al * (dc[2] - hd[2]);
+        a0[x] = ai[0], a1[x] = ai[1], a2[x] = ai[2], b0[x] = ad[0], b1[x] = ad[1], b2[x] = ad[2];
+        float l = lum[x], e = lum[n + x];
+        float mo0 = hm[0] + am * (l - hm[0]), mo1 = hm[1] + am * (l * l - hm[1]), mo2 = hm[2] + am * (e - hm[2]),
+              mo3 = hm[3] + am * (e * e - hm[3]);
+        float ln = fmn(hl + 1.0f, max_hist);
+        mom[x] = hx * mo0, mom[n + x] = hx * mo1, mom[2 * n + x] = hx * mo2, mom[3 * n + x] = hx * mo3;
+        len[x] = hx * ln;
+        l0[x] = 0.2126f * ai[0] + 0.7152f * ai[1] + 0.0722f * ai[2];
+        l1[x] = 0.2126f * ad[0] + 0.7152f * ad[1] + 0.0722f * ad[2];
+        /* short history (< 4 frames): the spatial variance of the new samples */
+        float mu = S[6 * n + x] * ic, me = S[14 * n + x] * ic, sp = (float)(ln < 4.0f), tp = 1.0f - sp;
+        float vs0 = fmx(0.0f, S[7 * n + x] * ic - mu * mu), vs1 = fmx(0.0f, S[15 * n + x] * ic - me * me);
+        float vt0 = fmx(0.0f, mo1 - mo0 * mo0), vt1 = fmx(0.0f, mo3 - mo2 * mo2);
+        v0[x] = hx * (sp * vs0 + tp * vt0), v1[x] = hx * (sp * vs1 + tp * vt1);
+        zg[x] *= hx;
+    }
+}
+
+/* depth gradient, reprojection, clamping, moving averages, variance; the next history's geometry:
+ * per row the 3x3 statistics (vectorised), the reprojection (scalar: 4 gathered taps per pixel),
+ * then blend_row */
 static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
 {
     tctx *c = vc;
@@ -541,62 +618,29 @@ static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
     int w = (int)in->width;
     size_t n = c->n;
     hist *nx = c->next;
-    float *acc = plane(c, W_PART + P_ACC), *da = plane(c, W_PART + 15 + P_ACC);
-    float *var0 = plane(c, W_PART + P_VAR), *var1 = plane(c, W_PART + 15 + P_VAR);
-    float *la0 = plane(c, W_PART + P_LACC), *la1 = plane(c, W_PART + 15 + P_LACC);
-    const float *cur = plane(c, W_CUR), *H = plane(c, W_HIT), *lum = plane(c, W_LUM);
-    float *zg = plane(c, W_ZG);
-    const float *S[S_COUNT];
-    for (int k = 0; k < S_COUNT; ++k) S[k] = stat_plane(c, k);
+    const float *H = plane(c, W_HIT);
+    float *R = plane(c, W_R), *RU = plane(c, W_RU);
     for (int y = (int)y0; y < (int)y1; ++y) {
+        size_t row = (size_t)y * w;
         stats_row(c, y);
         for (int x = 0; x < w; ++x) {
-            size_t i = (size_t)y * w + x;
-            float ci[3] = {cur[i], cur[n + i], cur[2 * n + i]}, dc[3] = {cur[3 * n + i], cur[4 * n + i], cur[5 * n + i]};
-            if (!(H[i] > 0.0f)) {
-                for (int q = 0; q < 3; ++q) acc[q * n + i] = ci[q], da[q * n + i] = dc[q];
-                var0[i] = var1[i] = 0.0f, zg[i] = 0.0f;
-                la0[i] = lum[i], la1[i] = lum[n + i];
-                nx->len[i] = 0.0f;
-                for (int q = 0; q < 4; ++q) nx->mom[q * n + i] = 0.0f;
-                for (int q = 0; q < 3; ++q) nx->pos[q * n + i] = nx->nrm[q * n + i] = 0.0f;
-                continue;
-            }
-            float z = in->depth[i];
-            const float *p = in->position + 3 * i, *nr = in->normal + 3 * i;
-            float m1[3] = {S[0][i], S[1][i], S[2][i]}, m2[3] = {S[3][i], S[4][i], S[5][i]};
-            float e1[3] = {S[8][i], S[9][i], S[10][i]}, e2[3] = {S[11][i], S[12][i], S[13][i]};
-            float ic = 1.0f / S[16][i];
+            size_t i = row + x;
             float r[11] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
-            bool reused = c->prev && reproject(t, c->prev, p, nr, z, r);
-            float *hi = r, *hd = r + 3, *hm = r + 6, hl = reused ? r[10] : 0.0f;
-            if (reused && P->clamp_gamma > 0.0f) {
-                clamp_box(hi, m1, m2, ic, P->clamp_gamma);
-                clamp_box(hd, e1, e2, ic, P->clamp_gamma);
-            }
-            float a = reused ? fmx(P->alpha, 1.0f / (hl + 1.0f)) : 1.0f;
-            float am = reused ? fmx(P->alpha_moments, 1.0f / (hl + 1.0f)) : 1.0f;
-            float ai[3], ad[3];
-            for (int q = 0; q < 3; ++q) {
-                ai[q] = hi[q] + a * (ci[q] - hi[q]);
-                ad[q] = hd[q] + a * (dc[q] - hd[q]);
-                acc[q * n + i] = ai[q], da[q * n + i] = ad[q];
-            }
-            float l = lum[i], e = lum[n + i];
-            float mo[4] = {hm[0] + am * (l - hm[0]), hm[1] + am * (l * l - hm[1]), hm[2] + am * (e - hm[2]),
-                           hm[3] + am * (e * e - hm[3])};
-            float len = fmn(hl + 1.0f, (float)P->max_history);
-            for (int q = 0; q < 4; ++q) nx->mom[q * n + i] = mo[q];
-            nx->len[i] = len;
-            la0[i] = sy_filter_luminance(ai), la1[i] = sy_filter_luminance(ad);
-            if (len < 4.0f) { /* short history: the spatial variance of the new samples */
-                float mu = S[6][i] * ic, me = S[14][i] * ic;
-                var0[i] = fmx(0.0f, S[7][i] * ic - mu * mu), var1[i] = fmx(0.0f, S[15][i] * ic - me * me);
-            } else {
-                var0[i] = fmx(0.0f, mo[1] - mo[0] * mo[0]), var1[i] = fmx(0.0f, mo[3] - mo[2] * mo[2]);
-            }
-            for (int q = 0; q < 3; ++q) nx->pos[q * n + i] = p[q], nx->nrm[q * n + i] = nr[q];
+            bool hit = H[i] > 0.0f;
+            const float *p = in->position + 3 * i, *nr = in->normal + 3 * i;
+            bool reused = hit && c->prev && reproject(t, c->prev, p, nr, in->depth[i], r);
+            for (int q = 0; q < 11; ++q) R[q * n + i] = reused ? r[q] : 0.0f;
+            RU[i] = reused ? 1.0f : 0.0f;
+            for (int q = 0; q < 3; ++q) nx->pos[q * n + i] = hit ? p[q] : 0.0f, nx->nrm[q * n + i] = hit ? nr[q] : 0.0f;
         }
+        blend_row(w, n, P->alpha, P->alpha_moments, (float)P->max_history, P->clamp_gamma, H + row,
+                  plane(c, W_CUR) + row, plane(c, W_LUM) + row, stat_plane(c, 0) + row, R + row, RU + row,
+                  plane(c, part_index(0, P_ACC)) + row, plane(c, part_index(0, P_ACC + 1)) + row,
+                  plane(c, part_index(0, P_ACC + 2)) + row, plane(c, part_index(1, P_ACC)) + row,
+                  plane(c, part_index(1, P_ACC + 1)) + row, plane(c, part_index(1, P_ACC + 2)) + row,
+                  plane(c, part_index(0, P_VAR)) + row, plane(c, part_index(1, P_VAR)) + row,
+                  plane(c, part_index(0, P_LACC)) + row, plane(c, part_index(1, P_LACC)) + row, plane(c, W_ZG) + row,
+                  nx->len + row, nx->mom + row);
     }
 }
 
@@ -858,8 +902,8 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
     /* the a-trous passes: the indirect part (or the colour), then the direct part when split */
     bool split = in->direct && in->indirect;
     for (int k = 0; k < 2; ++k) {
-        float *q = plane(&c, W_PART + 15 * (size_t)k);
-        const float *src = q + P_ACC * n, *vsrc = q + P_VAR * n, *lsrc = q + P_LACC * n;
+#define Q(off) plane(&c, part_index(k, off))
+        const float *src = Q(P_ACC), *vsrc = Q(P_VAR), *lsrc = Q(P_LACC);
         uint32_t iters = k == 0 || split ? t->p.atrous_iterations : 0;
         /* the next history: the first pass's output for the indirect part (as SVGF); the direct part's
          * unfiltered blend (fed back, its filtered output let emitter light creep over their edges
@@ -869,8 +913,7 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
         if (iters == 0 || !feed) memcpy(keep, src, 3 * n * sizeof(float));
         for (uint32_t it = 0; it < iters; ++it) {
             c.src = src, c.vsrc = vsrc, c.lsrc = lsrc;
-            c.dst = q + ((it & 1) ? P_B : P_A) * n, c.vdst = q + ((it & 1) ? P_VB : P_VA) * n;
-            c.ldst = q + ((it & 1) ? P_LB : P_LA) * n;
+            c.dst = Q((it & 1) ? P_B : P_A), c.vdst = Q((it & 1) ? P_VB : P_VA), c.ldst = Q((it & 1) ? P_LB : P_LA);
             c.step = 1 << it;
             sy_filter_parallel_rows(th, rows, vblur_rows, &c);
             sy_filter_parallel_rows(th, rows, atrous_rows, &c);
@@ -879,8 +922,9 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
         }
         c.outp[k] = src;
         c.vout[k] = vsrc;
+#undef Q
     }
-    c.var0 = plane(&c, W_PART + P_VAR);
+    c.var0 = plane(&c, part_index(0, P_VAR));
     sy_filter_parallel_rows(th, rows, remod_rows, &c);
     nx->w = in->width, nx->h = in->height;
     memcpy(nx->world_to_pixel, world_to_pixel, sizeof nx->world_to_pixel);
