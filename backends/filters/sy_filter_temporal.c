@@ -386,47 +386,6 @@ static void demod_rows(void *vc, uint32_t y0, uint32_t y1)
 #undef SY_DEMOD_ARGS
 }
 
-/* Bilinear reprojection of world point p (normal n, depth z) into the previous history: r = illum 3,
- * dir 3, mom 4, len; false when no tap fits. */
-static bool reproject(const sy_filter_temporal *t, const hist *h, const float *p, const float *n, float z, float r[11])
-{
-    const float *M = h->world_to_pixel;
-    float X = M[0] * p[0] + M[4] * p[1] + M[8] * p[2] + M[12];
-    float Y = M[1] * p[0] + M[5] * p[1] + M[9] * p[2] + M[13];
-    float Wc = M[3] * p[0] + M[7] * p[1] + M[11] * p[2] + M[15];
-    if (!(Wc > 1e-12f)) return false;
-    float iW = 1.0f / Wc, x = X * iW - 0.5f, y = Y * iW - 0.5f;
-    if (!(x > -1.0f && y > -1.0f && x < (float)h->w && y < (float)h->h)) return false;
-    int x0 = (int)(x + 1.0f) - 1, y0 = (int)(y + 1.0f) - 1; /* floor: x, y > -1 (no libm call) */
-    float fx = x - (float)x0, fy = y - (float)y0;
-    float tol = t->p.depth_tolerance * z, tol2 = 64.0f * tol * tol, ntol = t->p.normal_tolerance;
-    bool hn = has_normal(n[0], n[1], n[2]);
-    size_t hn_ = (size_t)h->w * h->h;
-    float sw = 0, acc[11] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
-    for (int k = 0; k < 4; ++k) {
-        int xx = x0 + (k & 1), yy = y0 + (k >> 1);
-        if (xx < 0 || yy < 0 || xx >= (int)h->w || yy >= (int)h->h) continue;
-        size_t j = (size_t)yy * h->w + (size_t)xx;
-        if (!(h->len[j] > 0.0f)) continue;
-        float d[3] = {h->pos[j] - p[0], h->pos[hn_ + j] - p[1], h->pos[2 * hn_ + j] - p[2]};
-        float plane_d = fabsf(d[0] * n[0] + d[1] * n[1] + d[2] * n[2]);
-        if (!(plane_d <= tol) || !(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= tol2)) continue;
-        float nj[3] = {h->nrm[j], h->nrm[hn_ + j], h->nrm[2 * hn_ + j]};
-        bool hnj = has_normal(nj[0], nj[1], nj[2]);
-        if (hn != hnj || (hn && !(n[0] * nj[0] + n[1] * nj[1] + n[2] * nj[2] >= ntol))) continue;
-        float wk = ((k & 1) ? fx : 1.0f - fx) * ((k >> 1) ? fy : 1.0f - fy);
-        if (!(wk > 0.0f)) continue;
-        for (int q = 0; q < 3; ++q) acc[q] += wk * h->illum[q * hn_ + j], acc[3 + q] += wk * h->dir[q * hn_ + j];
-        for (int q = 0; q < 4; ++q) acc[6 + q] += wk * h->mom[q * hn_ + j];
-        acc[10] += wk * h->len[j];
-        sw += wk;
-    }
-    if (!(sw > 1e-3f)) return false;
-    float isw = 1.0f / sw;
-    for (int q = 0; q < 11; ++q) r[q] = acc[q] * isw;
-    return true;
-}
-
 static inline void to_ycocg(const float *c, float *o)
 {
     o[0] = 0.25f * c[0] + 0.5f * c[1] + 0.25f * c[2];
@@ -606,6 +565,74 @@ static void blend_row(int w, size_t n, float alpha, float alpha_m, float max_his
     }
 }
 
+/* one bilinear tap of reproject_row: weight wk (0 when invalid) of history pixel (xx, yy) */
+static inline SY_TEMPORAL_INLINE void reproject_tap(int xx, int yy, float wk, int hw, int hh, size_t hn,
+                                                    const float *restrict base, float p0, float p1, float p2,
+                                                    float n0, float n1, float n2, float hnc, float tol, float tol2,
+                                                    float ntol, float *acc, float *sw)
+{
+    float inb = (float)(xx >= 0) * (float)(yy >= 0) * (float)(xx < hw) * (float)(yy < hh);
+    int xc = xx > 0 ? xx : 0, yc = yy > 0 ? yy : 0;
+    xc = xc < hw - 1 ? xc : hw - 1, yc = yc < hh - 1 ? yc : hh - 1;
+    size_t j = (size_t)yc * (size_t)hw + (size_t)xc;
+    const float *pos = base + 11 * hn, *nrm = base + 14 * hn;
+    float d0 = pos[j] - p0, d1 = pos[hn + j] - p1, d2 = pos[2 * hn + j] - p2;
+    float m0 = nrm[j], m1 = nrm[hn + j], m2 = nrm[2 * hn + j];
+    float hnj = (float)(m0 * m0 + m1 * m1 + m2 * m2 > 0.25f); /* has_normal */
+    float dot = n0 * m0 + n1 * m1 + n2 * m2;
+    float ok = inb * (float)(base[10 * hn + j] > 0.0f) * (float)(fabsf(d0 * n0 + d1 * n1 + d2 * n2) <= tol) *
+               (float)(d0 * d0 + d1 * d1 + d2 * d2 <= tol2) * (float)(hnc == hnj) *
+               fmx(1.0f - hnc, (float)(dot >= ntol));
+    float k = fmx(wk * ok, 0.0f);
+#define SY_ACC(q) acc[q] += k * base[(q) * hn + j]
+    SY_ACC(0), SY_ACC(1), SY_ACC(2), SY_ACC(3), SY_ACC(4), SY_ACC(5), SY_ACC(6), SY_ACC(7), SY_ACC(8), SY_ACC(9), SY_ACC(10);
+#undef SY_ACC
+    *sw += k;
+}
+
+/* Bilinear reprojection of a row's hits into the previous history (reproject's rule, branch-free so
+ * that it vectorises with gathers): the frame's positions pa pb pc, normals na nb nc, depth z
+ * and hit h (planes); M the previous world_to_pixel, base its history (hw x hh, 17 planes hn
+ * apart: illum 3, dir 3, moments 4, length, position 3, normal 3). Out: R (11 planes n apart: the
+ * history, 0 where none fits) and ru (1 where reused). */
+SY_TEMPORAL_CLONES
+static void reproject_row(int w, size_t n, const float *restrict M, int hw, int hh, size_t hn,
+                          const float *restrict base, float dtol, float ntol, const float *restrict pa,
+                          const float *restrict pb, const float *restrict pc, const float *restrict na,
+                          const float *restrict nb, const float *restrict nc, const float *restrict z,
+                          const float *restrict h, float *restrict R, float *restrict ru)
+{
+    float fw = (float)hw, fh = (float)hh;
+    for (int x = 0; x < w; ++x) {
+        float p0 = pa[x], p1 = pb[x], p2 = pc[x], n0 = na[x], n1 = nb[x], n2 = nc[x];
+        float X = M[0] * p0 + M[4] * p1 + M[8] * p2 + M[12], Y = M[1] * p0 + M[5] * p1 + M[9] * p2 + M[13];
+        float Wc = M[3] * p0 + M[7] * p1 + M[11] * p2 + M[15];
+        float iW = 1.0f / fmx(Wc, 1e-12f), fx = X * iW - 0.5f, fy = Y * iW - 0.5f;
+        float valid = h[x] * (float)(Wc > 1e-12f) * (float)(fx > -1.0f) * (float)(fy > -1.0f) * (float)(fx < fw) *
+                      (float)(fy < fh);
+        fx = fmx(-1.0f, fmn(fx, fw)), fy = fmx(-1.0f, fmn(fy, fh)); /* NaN: fw, fh (valid is 0) */
+        int x0 = (int)(fx + 1.0f) - 1, y0 = (int)(fy + 1.0f) - 1; /* floor: > -1 */
+        float ax = fx - (float)x0, ay = fy - (float)y0;
+        float tol = dtol * z[x], tol2 = 64.0f * tol * tol;
+        float hnc = (float)(n0 * n0 + n1 * n1 + n2 * n2 > 0.25f);
+        float acc[11] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}, sw = 0.0f;
+        reproject_tap(x0, y0, valid * (1.0f - ax) * (1.0f - ay), hw, hh, hn, base, p0, p1, p2, n0, n1, n2, hnc, tol,
+                      tol2, ntol, acc, &sw);
+        reproject_tap(x0 + 1, y0, valid * ax * (1.0f - ay), hw, hh, hn, base, p0, p1, p2, n0, n1, n2, hnc, tol, tol2,
+                      ntol, acc, &sw);
+        reproject_tap(x0, y0 + 1, valid * (1.0f - ax) * ay, hw, hh, hn, base, p0, p1, p2, n0, n1, n2, hnc, tol, tol2,
+                      ntol, acc, &sw);
+        reproject_tap(x0 + 1, y0 + 1, valid * ax * ay, hw, hh, hn, base, p0, p1, p2, n0, n1, n2, hnc, tol, tol2, ntol,
+                      acc, &sw);
+        float u = (float)(sw > 1e-3f), isw = u / fmx(sw, 1e-3f);
+#define SY_OUT(q) R[(q) * n + x] = acc[q] * isw
+        SY_OUT(0), SY_OUT(1), SY_OUT(2), SY_OUT(3), SY_OUT(4), SY_OUT(5), SY_OUT(6), SY_OUT(7), SY_OUT(8), SY_OUT(9),
+            SY_OUT(10);
+#undef SY_OUT
+        ru[x] = u;
+    }
+}
+
 /* depth gradient, reprojection, clamping, moving averages, variance; the next history's geometry:
  * per row the 3x3 statistics (vectorised), the reprojection (scalar: 4 gathered taps per pixel),
  * then blend_row */
@@ -623,15 +650,22 @@ static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
     for (int y = (int)y0; y < (int)y1; ++y) {
         size_t row = (size_t)y * w;
         stats_row(c, y);
+        /* the next history's geometry, which is also this row's positions and normals as planes */
         for (int x = 0; x < w; ++x) {
             size_t i = row + x;
-            float r[11] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
             bool hit = H[i] > 0.0f;
             const float *p = in->position + 3 * i, *nr = in->normal + 3 * i;
-            bool reused = hit && c->prev && reproject(t, c->prev, p, nr, in->depth[i], r);
-            for (int q = 0; q < 11; ++q) R[q * n + i] = reused ? r[q] : 0.0f;
-            RU[i] = reused ? 1.0f : 0.0f;
             for (int q = 0; q < 3; ++q) nx->pos[q * n + i] = hit ? p[q] : 0.0f, nx->nrm[q * n + i] = hit ? nr[q] : 0.0f;
+        }
+        if (c->prev) {
+            const hist *hp = c->prev;
+            reproject_row(w, n, hp->world_to_pixel, (int)hp->w, (int)hp->h, (size_t)hp->w * hp->h, hp->illum,
+                          P->depth_tolerance, P->normal_tolerance, nx->pos + row, nx->pos + n + row,
+                          nx->pos + 2 * n + row, nx->nrm + row, nx->nrm + n + row, nx->nrm + 2 * n + row,
+                          plane(c, W_Z) + row, H + row, R + row, RU + row);
+        } else {
+            for (int q = 0; q < 11; ++q) memset(R + q * n + row, 0, (size_t)w * sizeof(float));
+            memset(RU + row, 0, (size_t)w * sizeof(float));
         }
         blend_row(w, n, P->alpha, P->alpha_moments, (float)P->max_history, P->clamp_gamma, H + row,
                   plane(c, W_CUR) + row, plane(c, W_LUM) + row, stat_plane(c, 0) + row, R + row, RU + row,
