@@ -46,7 +46,8 @@
  *
  * Ownership: a sy_filter_temporal is the caller's (create / destroy); it holds two frames of history
  * and its working planes (about 350 bytes per pixel). Thread-safety: one thread at a time per object; the passes run on the
- * process's OpenMP team (sy_filter_parallel_rows); results do not depend on the thread count. */
+ * process's OpenMP team (sy_filter_parallel_rows); results do not depend on the thread count, nor on
+ * the instruction set (the row loops' AVX2 and SSE2 clones do the same operations per pixel). */
 #ifndef SY_FILTER_TEMPORAL_H
 #define SY_FILTER_TEMPORAL_H
 
