@@ -5,8 +5,9 @@
  * also rendered with many samples (the reference). Reported: per-frame relMSE against the reference
  * (mean over the frames after the first, and the ratio), the temporal flicker (mean absolute
  * frame-to-frame change of the displayed luminance on pixels whose reference changes by less than
- * 1 % + 0.002) and the ratio, and the cost of the temporal stage per frame at 640x360 next to one
- * 1-spp pass there. Ratios come from one run; nothing here is a timed test. */
+ * 1 % + 0.002) and the ratio, the change of the display when the camera stops at the path's end
+ * (sy_filter_temporal_rest: no pop), and the cost of the temporal stage per frame at 640x360 next to
+ * one 1-spp pass there. Ratios come from one run; nothing here is a timed test. */
 #include "sy_bench.h"
 #include "sy_interactive.h"
 #include "sy_png.h"
@@ -160,6 +161,42 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
                "plain %.5f, fresh %.5f, temporal %.5f: %.1fx lower than plain, %.1fx than fresh\n",
                100.0 * (double)f_count / ((double)n * counted), fl[0], fl[1], fl[2], fl[0] / fl[2], fl[1] / fl[2]);
         printf("  temporal: %u non-finite values; reference %.1f s per view\n", nonfinite, t_ref / frames);
+    }
+    /* the camera stops at the path's last view (sy_filter_temporal_rest): the change of the display at
+     * the stop (the first still frame against the last moving one) and after it, against the flicker
+     * while moving and against what the plain accumulation (2 samples) would have shown */
+    if (r == SY_OK && counted) {
+        sy_context *tc = NULL;
+        sy_params tp0 = {0};
+        r = sy_params_parse("temporal=1", &tp0, err);
+        if (r == SY_OK) r = sy_context_pool_get(pool, scene, "pathtracer", &tp0, vd->root.id, &tc, err);
+        sy_mat4 m;
+        path_view(&home, frames - 1, &m);
+        double stop = 0, stop_plain = 0, later = 0, s;
+        for (uint32_t k = 0; k < 8 && r == SY_OK; ++k) {
+            r = bench_win_frame(&temporal, &m, scene, pool, 1, 0, &img[2], &s, err);
+            if (r != SY_OK) break;
+            double ch = 0;
+            for (size_t i = 0; i < n; ++i) ch += fabs(lum(img[2].rgba + 4 * i) - lum(prev[2] + 4 * i));
+            ch /= (double)n;
+            if (k == 0) {
+                stop = ch;
+                sy_mediator_rt_aovs acc = {0};
+                r = sy_mediator_rt_aovs_get(sy_context_state(tc), &acc, err);
+                for (size_t i = 0; r == SY_OK && i < n; ++i)
+                    stop_plain += fabs(lum(acc.planes[0] + 4 * i) - lum(prev[2] + 4 * i));
+                stop_plain /= (double)n;
+                sy_mediator_rt_aovs_free(&acc);
+            } else {
+                later = fmax(later, ch);
+            }
+            memcpy(prev[2], img[2].rgba, 4 * n * sizeof(float));
+        }
+        if (r == SY_OK)
+            printf("  camera stops (8 still frames of 1 spp at the last view; mean |change| of luminance, all "
+                   "pixels): at the stop %.5f (the plain 2-spp accumulation would jump %.5f), largest after it "
+                   "%.5f; flicker while moving %.5f\n",
+                   stop, stop_plain, later, fl[2]);
     }
     sy_layer a = {0};
     /* cost at 640x360: the temporal stage of 12 moving frames (median), and one 1-spp pass */
