@@ -167,13 +167,6 @@ sy_filter_status sy_filter_temporal_params_check(const sy_filter_temporal_params
     return SY_FILTER_OK;
 }
 
-/* A pixel without a normal (0, 0, 0: a specular chain that never reached a diffuse surface) agrees
- * only with another such pixel; two normals agree when their cosine is at least tol. */
-static inline bool has_normal(float x, float y, float z)
-{
-    return x * x + y * y + z * z > 0.25f;
-}
-
 static void hist_free(hist *h)
 {
     free(h->illum);
@@ -290,11 +283,6 @@ static inline float *stat_plane(const tctx *c, int k)
     return plane(c, W_SCR + (size_t)k);
 }
 
-static inline bool finite3(const float *v)
-{
-    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
-}
-
 /* the columns x of a row whose tap x + off lies in [0, w) */
 static inline void tap_span(int w, int off, int *x0, int *x1)
 {
@@ -384,33 +372,6 @@ static void demod_rows(void *vc, uint32_t y0, uint32_t y1)
         else demod_c3(SY_DEMOD_ARGS);
     }
 #undef SY_DEMOD_ARGS
-}
-
-static inline void to_ycocg(const float *c, float *o)
-{
-    o[0] = 0.25f * c[0] + 0.5f * c[1] + 0.25f * c[2];
-    o[1] = 0.5f * c[0] - 0.5f * c[2];
-    o[2] = -0.25f * c[0] + 0.5f * c[1] - 0.25f * c[2];
-}
-
-static inline void from_ycocg(const float *y, float *o)
-{
-    o[0] = y[0] + y[1] - y[2];
-    o[1] = y[0] + y[2];
-    o[2] = y[0] - y[1] - y[2];
-}
-
-/* clamps colour c to the YCoCg box mean +- gamma sd of the sums m1, m2 of count 1/ic */
-static inline void clamp_box(float *c, const float *m1, const float *m2, float ic, float gamma)
-{
-    float v[3];
-    to_ycocg(c, v);
-    for (int q = 0; q < 3; ++q) {
-        float mu = m1[q] * ic, var = m2[q] * ic - mu * mu, sd = sqrtf(var > 0.0f ? var : 0.0f);
-        float lo = mu - gamma * sd, up = mu + gamma * sd;
-        v[q] = v[q] < lo ? lo : v[q] > up ? up : v[q];
-    }
-    from_ycocg(v, c);
 }
 
 /* 3x3 statistics of one part, one tap: YCoCg sums s0-s2 and sums of squares s3-s5 of colour a,
