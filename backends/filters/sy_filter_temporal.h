@@ -45,7 +45,7 @@
  * to call (an interactive view's resolution scale): the history is read at its own size.
  *
  * Ownership: a sy_filter_temporal is the caller's (create / destroy); it holds two frames of history
- * and its working planes (about 350 bytes per pixel). Thread-safety: one thread at a time per object; the passes run on the
+ * and its working planes (about 410 bytes per pixel). Thread-safety: one thread at a time per object; the passes run on the
  * process's OpenMP team (sy_filter_parallel_rows); results do not depend on the thread count, nor on
  * the instruction set (the row loops' AVX2 and SSE2 clones do the same operations per pixel). */
 #ifndef SY_FILTER_TEMPORAL_H
