@@ -312,6 +312,17 @@ sy_result sy_clip_planes_check(const float (*planes)[4], uint32_t count, sy_erro
     return SY_OK;
 }
 
+sy_result sy_clip_cap_check(const float rgb[3], sy_error *err)
+{
+    if (!rgb) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "section cap colour: none given");
+    for (int k = 0; k < 3; ++k)
+        if (!(rgb[k] >= 0.0f && rgb[k] <= 1.0f)) /* NaN fails both */
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
+                                "section cap colour (%g, %g, %g): %c = %g is not a colour channel in [0, 1]",
+                                (double)rgb[0], (double)rgb[1], (double)rgb[2], "rgb"[k], (double)rgb[k]);
+    return SY_OK;
+}
+
 /* A view with section planes needs SY_CAP_CLIP of the context's class. */
 static sy_result clip_supported(const sy_context *c, const sy_camera_view *v, sy_error *err)
 {
@@ -335,6 +346,7 @@ sy_result sy_camera_view_check(const sy_camera_view *v, sy_error *err)
     if (!isfinite(v->znear) || !isfinite(v->zfar))
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera clip range %g..%g is not finite", (double)v->znear,
                             (double)v->zfar);
+    if (v->clip_cap && sy_clip_cap_check(v->clip_cap_color, err) != SY_OK) return SY_ERR_INVALID_ARGUMENT;
     return sy_clip_planes_check((const float(*)[4])v->clip_planes, v->clip_count, err);
 }
 

@@ -30,7 +30,19 @@ typedef struct sy_camera_view {
      * ray: primary, reflected, refracted, shadow) only where a*p.x + b*p.y + c*p.z + d >= 0 for every
      * plane in use. Checked by sy_clip_planes_check. */
     float clip_planes[SY_CLIP_PLANES_MAX][4];
+    /** Capping (with clip_count > 0): 1 = the cut faces of closed meshes are filled in clip_cap_color,
+     * 0 = a cut closed mesh shows its inside. A closed mesh is a primitive whose triangles, welded by
+     * position, share every edge with exactly one other triangle in opposite direction. Where a ray
+     * from outside meets such a mesh's back face first and entered the kept region (where every
+     * plane keeps) after its start, it sees the cap: the point where it entered, on the plane it
+     * crossed, in the flat, unlit cap colour (a CAD section fill), facing the ray. */
+    uint32_t clip_cap;
+    float clip_cap_color[3]; /**< linear RGB, each in [0, 1]; checked by sy_clip_cap_check */
 } sy_camera_view;
+
+/** SY_OK when rgb (linear RGB) is finite and each channel within [0, 1]; otherwise
+ * SY_ERR_INVALID_ARGUMENT naming the channel and value. */
+sy_result sy_clip_cap_check(const float rgb[3], sy_error *err);
 
 /** SY_OK when count <= SY_CLIP_PLANES_MAX and every plane's a, b, c, d is finite, within
  * SY_COORD_MAX, with a non-zero normal (a, b, c); otherwise SY_ERR_INVALID_ARGUMENT naming the plane

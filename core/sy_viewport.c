@@ -17,6 +17,8 @@ struct sy_viewport {
     sy_mat4 view;
     uint32_t clip_count; /* sy_viewport_set_clip_planes */
     float clip_planes[SY_CLIP_PLANES_MAX][4];
+    bool clip_cap; /* sy_viewport_set_clip_cap */
+    float clip_cap_color[3];
 };
 
 struct sy_window {
@@ -160,6 +162,28 @@ uint32_t sy_viewport_clip_planes(const sy_viewport *v, float (*planes)[4])
     return v->clip_count;
 }
 
+sy_result sy_viewport_set_clip_cap(sy_viewport *v, const float rgb[3], sy_error *err)
+{
+    if (!rgb) {
+        v->clip_cap = false;
+        return SY_OK;
+    }
+    sy_result r = sy_clip_cap_check(rgb, err);
+    if (r != SY_OK) {
+        sy_error_prefix(err, "viewport");
+        return r;
+    }
+    memcpy(v->clip_cap_color, rgb, sizeof v->clip_cap_color);
+    v->clip_cap = true;
+    return SY_OK;
+}
+
+bool sy_viewport_clip_cap(const sy_viewport *v, float rgb[3])
+{
+    if (v->clip_cap && rgb) memcpy(rgb, v->clip_cap_color, sizeof v->clip_cap_color);
+    return v->clip_cap;
+}
+
 bool sy_viewport_view(const sy_viewport *v, sy_mat4 *camera_to_world)
 {
     if (v->has_view && camera_to_world) *camera_to_world = v->view;
@@ -223,6 +247,8 @@ sy_result sy_viewport_camera_view(const sy_viewport *v, const sy_scene *scene, u
     *out = sy_camera_view_eye(&mono, v->desc.eye, v->desc.eye_separation, v->desc.zero_parallax);
     out->clip_count = v->clip_count;
     memcpy(out->clip_planes, v->clip_planes, sizeof out->clip_planes);
+    out->clip_cap = v->clip_cap && v->clip_count;
+    memcpy(out->clip_cap_color, v->clip_cap_color, sizeof out->clip_cap_color);
     sy_result res = sy_camera_view_check(out, err);
     if (res != SY_OK) {
         if (v->desc.camera.id) sy_error_prefix(err, "viewport: camera node %#x", v->desc.camera.id);
@@ -399,5 +425,32 @@ sy_result sy_window_pick(sy_window *w, sy_scene *scene, sy_context_pool *pool, d
         }
         if (take) *out = here;
     }
+    return SY_OK;
+}
+
+sy_result sy_pick_distance(const sy_pick_result *a, const sy_pick_result *b, double *out, sy_error *err)
+{
+    if (!a || !b || !out) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "pick distance: NULL argument");
+    if (!a->hit || !b->hit)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "pick distance: the %s pick hit nothing", !a->hit ? "first" : "second");
+    double s = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        double d = (double)b->position[k] - (double)a->position[k];
+        s += d * d;
+    }
+    *out = sqrt(s);
+    return SY_OK;
+}
+
+sy_result sy_plane_distance(const float plane[4], const float p[3], double *out, sy_error *err)
+{
+    if (!plane || !p || !out) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "plane distance: NULL argument");
+    sy_result r = sy_clip_planes_check((const float(*)[4])plane, 1, err);
+    if (r != SY_OK) return r;
+    if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "plane distance: the point (%g, %g, %g) is not finite",
+                            (double)p[0], (double)p[1], (double)p[2]);
+    double n = sqrt((double)plane[0] * plane[0] + (double)plane[1] * plane[1] + (double)plane[2] * plane[2]);
+    *out = ((double)plane[0] * p[0] + (double)plane[1] * p[1] + (double)plane[2] * p[2] + plane[3]) / n;
     return SY_OK;
 }

@@ -109,6 +109,14 @@ sy_result sy_viewport_set_clip_planes(sy_viewport *v, const float (*planes)[4], 
 /** The number of section planes set; copies them into planes (may be NULL; room for
  * SY_CLIP_PLANES_MAX). */
 uint32_t sy_viewport_clip_planes(const sy_viewport *v, float (*planes)[4]);
+/** Capping of the section planes: rgb (linear RGB, each channel in [0, 1]; copied) fills the cut
+ * faces of closed meshes in every SY_CAP_CLIP back-end (sy_camera_view.clip_cap); NULL turns capping
+ * off (the default: a cut closed mesh shows its inside). A colour sy_clip_cap_check refuses (not
+ * finite, outside [0, 1]) fails with SY_ERR_INVALID_ARGUMENT, keeping the setting before. Without
+ * section planes it has no effect. */
+sy_result sy_viewport_set_clip_cap(sy_viewport *v, const float rgb[3], sy_error *err);
+/** true when capping is on; its colour into rgb (may be NULL). */
+bool sy_viewport_clip_cap(const sy_viewport *v, float rgb[3]);
 /** true and *camera_to_world (may be NULL) when a view is set directly (sy_viewport_set_view). */
 bool sy_viewport_view(const sy_viewport *v, sy_mat4 *camera_to_world);
 /** The viewport's back-end name (borrowed). */
@@ -134,6 +142,15 @@ sy_camera_view sy_camera_view_eye(const sy_camera_view *mono, uint32_t eye, floa
  * Thread-safety: as sy_window_render (the scene, the pool and the window on one thread). */
 sy_result sy_viewport_pick(sy_viewport *v, sy_scene *scene, sy_context_pool *pool, double x, double y,
                            sy_pick_result *out, sy_error *err);
+/** Measurement: the distance between the world positions of two picks, in scene units (metres: glTF's
+ * unit; the Assimp loader scales a file's units to metres by its UnitScaleFactor on the root, and
+ * X3D's unit is the metre). SY_ERR_INVALID_ARGUMENT when either pick hit nothing (naming which). */
+sy_result sy_pick_distance(const sy_pick_result *a, const sy_pick_result *b, double *out, sy_error *err);
+/** Measurement: the signed distance of world point p from the plane {a, b, c, d} (a x + b y + c z + d
+ * = 0), in scene units: (a p.x + b p.y + c p.z + d) / |(a, b, c)|, positive on the side a section
+ * plane keeps. A plane sy_clip_planes_check refuses (not finite, a zero normal) or a point not
+ * finite: SY_ERR_INVALID_ARGUMENT naming it. */
+sy_result sy_plane_distance(const float plane[4], const float p[3], double *out, sy_error *err);
 /** What is under window point (x, y) in the layer in front: every active viewport whose rectangle
  * holds the point is picked (sy_viewport_pick) and the answers are combined back to front as
  * sy_window_render composites the layers: a REPLACE viewport's answer (hit or miss) replaces those

@@ -5,6 +5,7 @@
 #include "sy_post.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 void sy_mirror_flat_texture_of(const sy_image_info *info, const sy_sampler *sampler, const void *pixels,
@@ -124,6 +125,77 @@ void sy_mirror_flat_mesh_of(const sy_primitive *p, sy_mirror_flat_mesh *out)
         .vertex_count = sy_primitive_vertex_count(p),
         .triangle_count = sy_primitive_triangle_count(p),
     };
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static uint32_t hash_pos(const float *p)
+{
+    uint32_t h = 2166136261u, w[3];
+    memcpy(w, p, sizeof w);
+    for (int k = 0; k < 3; ++k) h = (h ^ (w[k] == 0x80000000u ? 0u : w[k])) * 16777619u; /* -0 welds to +0 */
+    return h ^ (h >> 15);
+}
+
+int sy_mirror_flat_mesh_closed(const sy_mirror_flat_mesh *m)
+{
+    if (!m->positions || !m->triangle_count || m->triangle_count > (1u << 24) || !m->vertex_count) return 0;
+    const uint32_t nv = m->vertex_count, nt = m->triangle_count;
+    uint32_t cap = 1;
+    while (cap < 2u * nv) cap <<= 1;
+    uint32_t *slot = malloc((size_t)cap * sizeof *slot), *weld = malloc((size_t)nv * sizeof *weld);
+    uint64_t *edge = malloc((size_t)nt * 3u * sizeof *edge);
+    bool closed = slot && weld && edge;
+    double vol = 0.0; /* six times the signed volume */
+    if (closed) {
+        memset(slot, 0xff, (size_t)cap * sizeof *slot);
+        for (uint32_t v = 0; v < nv; ++v) { /* weld by exact position: the first vertex at a point names it */
+            const float *p = m->positions + 3u * v;
+            uint32_t h = hash_pos(p) & (cap - 1);
+            for (;; h = (h + 1) & (cap - 1)) {
+                if (slot[h] == UINT32_MAX) {
+                    slot[h] = v;
+                    weld[v] = v;
+                    break;
+                }
+                const float *q = m->positions + 3u * slot[h];
+                if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) {
+                    weld[v] = slot[h];
+                    break;
+                }
+            }
+        }
+        size_t ne = 0;
+        for (uint32_t t = 0; t < nt && closed; ++t) {
+            uint32_t i[3];
+            for (int k = 0; k < 3; ++k) {
+                uint32_t x = m->indices ? m->indices[3u * t + k] : 3u * t + k;
+                if (x >= nv) closed = false;
+                i[k] = closed ? weld[x] : 0;
+            }
+            if (i[0] == i[1] || i[1] == i[2] || i[2] == i[0]) continue; /* degenerate: no area, no edges */
+            for (int k = 0; k < 3; ++k) edge[ne++] = (uint64_t)i[k] << 32 | i[(k + 1) % 3];
+            const float *p0 = m->positions + 3u * i[0], *p1 = m->positions + 3u * i[1], *p2 = m->positions + 3u * i[2];
+            vol += p0[0] * ((double)p1[1] * p2[2] - (double)p1[2] * p2[1]) +
+                   p0[1] * ((double)p1[2] * p2[0] - (double)p1[0] * p2[2]) +
+                   p0[2] * ((double)p1[0] * p2[1] - (double)p1[1] * p2[0]);
+        }
+        closed = closed && ne > 0;
+        if (closed) qsort(edge, ne, sizeof *edge, cmp_u64);
+        for (size_t e = 0; closed && e < ne; ++e) {
+            if (e + 1 < ne && edge[e + 1] == edge[e]) closed = false; /* an edge used twice the same way */
+            uint64_t rev = edge[e] << 32 | edge[e] >> 32;
+            closed = closed && bsearch(&rev, edge, ne, sizeof *edge, cmp_u64) != NULL;
+        }
+    }
+    free(slot);
+    free(weld);
+    free(edge);
+    return !closed || !(vol != 0.0) ? 0 : vol > 0.0 ? 1 : -1;
 }
 
 void sy_mirror_flat_light_of(const sy_light_data *l, const float position[3], const float direction[3],

@@ -165,6 +165,14 @@ void sy_mirror_flat_material_of(const sy_material_data *d, sy_mirror_flat_handle
 /** Describes a triangle primitive (its blobs as arrays, its counts). */
 void sy_mirror_flat_mesh_of(const sy_primitive *p, sy_mirror_flat_mesh *out);
 
+/** Whether the mesh is a closed, consistently wound surface (the solids section caps fill): with
+ * its vertices welded by exact position, every directed edge (a, b) of a non-degenerate triangle
+ * occurs once and its reverse (b, a) once too. 1: closed and wound counter-clockwise seen from
+ * outside (its signed volume is positive), -1: closed and wound the other way, 0: open,
+ * non-manifold, empty, flat (no volume), above 2^24 triangles, or out of memory.
+ * O(triangles log triangles). */
+int sy_mirror_flat_mesh_closed(const sy_mirror_flat_mesh *m);
+
 /** Describes a light at a world position and direction. */
 void sy_mirror_flat_light_of(const sy_light_data *l, const float position[3], const float direction[3],
                              sy_mirror_flat_light *out);

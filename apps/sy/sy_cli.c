@@ -11,6 +11,7 @@
 #include "sy_mediators.h"
 #include "sy_viewport.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -119,7 +120,7 @@ int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *short
             break;
         }
         case OPT_VARIANT: sy_cli_load_opts.variant = optarg; break; /* glTF KHR_materials_variants */
-        case OPT_LOOK_AT: case OPT_FOV: case OPT_ORBIT: /* the camera's placement (sy_load.h) */
+        case OPT_LOOK_AT: case OPT_FOV: case OPT_ORBIT: case OPT_BOOKMARK: /* the camera's placement (sy_load.h) */
             if ((*status = sy_cli_view_option(c, optarg)) != 0) return OPT_STOP;
             break;
         case OPT_HIDE: case OPT_ISOLATE: case OPT_SELECT: /* node visibility and selection (sy_load.h) */
@@ -178,6 +179,7 @@ static const char usage_text[] =
             "             UP each x,y,z, UP default 0,1,0; --orbit: AZ degrees about +y from +z, EL degrees above the\n"
             "             horizon (-90..90), around the bounds' centre, DIST default: the bounds fill the view; --fov:\n"
             "             the vertical field of view in degrees (0..180) of whichever camera is used)\n"
+            "            [--bookmark FILE:N]   (the view sy view saved in slot N of FILE with Ctrl+N; instead of --look-at)\n"
             "            [--hide NODE] [--isolate NODE] [--select NODE]   (repeatable; NODE: a node name, the node id sy\n"
             "             pick prints, or an index in creation order; --isolate hides every other mesh node; --select\n"
             "             highlights it: pixels tinted orange and outlined, in every back-end)\n"
@@ -189,7 +191,9 @@ static const char usage_text[] =
             "            [--at SECONDS] [--clip NAME|INDEX]   (the scene at a time: every clip, or one; sy info lists clips)\n"
             "            [--shutter OPEN,CLOSE|S | --motion-blur] [--shutter-samples N]   (motion blur: the mean of the scene\n"
             "             over seconds OPEN..CLOSE after the frame's time, 0 <= OPEN <= CLOSE; --motion-blur: 0,0.5/FPS;\n"
-            "             N time samples, default 16, each a render accumulated (path tracer: the samples split))\n"            "            [--clip A,B,C,D ...]   (section planes, up to 6: keeps A*x + B*y + C*z + D >= 0, world units)\n"
+            "             N time samples, default 16, each a render accumulated (path tracer: the samples split))\n"
+            "            [--clip A,B,C,D ...]   (section planes, up to 6: keeps A*x + B*y + C*z + D >= 0, world units)\n"
+            "            [--clip-cap RRGGBB]   (fill the cut faces of closed meshes in this sRGB colour, e.g. ff8000)\n"
             "            [--frames A:B[:STEP] [--fps F] [--resume] -o OUT_####.exr|png]   (an image sequence: frames A..B\n"
             "             inclusive at time frame/F, F default 24; #### the zero-padded frame number; --resume skips\n"
             "             frames whose file exists; -o anim.mp4|anim.webm: one H.264 / VP9 video of the frames)\n"
@@ -209,7 +213,13 @@ static const char usage_text[] =
             "          [--keys KEYS]   (automated runs: press these keys one frame after another, e.g. F]F[; * clicks\n"
             "           the window's centre)\n"
             "          (click: pick and select the node, shift-click: add or remove it, click on nothing: clear;\n"
-            "           H hides the selection, I isolates it, U shows every node again)\n"
+            "           H hides the selection, I isolates it, U shows every node again; the title shows the picked\n"
+            "           point, its distance from the previous pick and from the last section plane, in metres)\n"
+            "          [--clip A,B,C,D ...] [--clip-cap RRGGBB]   (start section planes; keys: C adds a plane facing\n"
+            "           the view through the last picked point or the orbit's centre, X removes the last, J / L or\n"
+            "           Page Down / Page Up or Ctrl+wheel move it, N flips it, K turns the caps on and off)\n"
+            "          [--bookmarks FILE]   (saved views: Ctrl+1..9 saves the view, Shift+1..9 recalls it; default\n"
+            "           SCENE.bookmarks beside the scene; sy render --bookmark FILE:N renders one)\n"
             "          [--budget MS]   (frame time while the view moves: the resolution follows it; default 33)\n"
             "          [--cluster URL[,URL...]|FILE.conf [--cluster-mode MODE] [--secret-file F] [--timeout-ms MS]\n"
             "           [--spp SAMPLES_PER_SERVER_AND_FRAME]]   (the same cluster options as sy render)\n"
@@ -247,6 +257,8 @@ static const char usage_text[] =
             "            [--clip A,B,C,D ...] [--hide NODE] [--isolate NODE] [--select NODE]   (as sy render)\n"
             "            (what is under pixel (X, Y) of the view sy render draws, as JSON: node, mesh, primitive,\n"
             "             triangle, barycentrics, position, normal, material, distance; \"hit\": false on a miss)\n"
+            "            [--measure]   (two points X1 Y1 X2 Y2: {\"picks\", \"distance\", \"delta\", \"unit\": \"m\"}, scene units)\n"
+            "            [--plane A,B,C,D]   (each hit's signed distance from the plane: \"plane_distance\")\n"
             "  sy backends [--params] [--json]\n"
             "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
             "  sy render SCENE -b BACKEND -o OUT --cluster URL[,URL...]|FILE.conf\n"
@@ -318,6 +330,24 @@ int sy_cli_bad_value(const char *opt, const char *value)
 
 bool sy_cli_is_clip_plane(const char *value) { return strchr(value, ',') != NULL; }
 
+int sy_cli_parse_cap_color(const char *value, float rgb[3])
+{
+    const char *s = value[0] == '#' ? value + 1 : value;
+    bool ok = strlen(s) == 6;
+    for (int i = 0; ok && i < 6; ++i) ok = isxdigit((unsigned char)s[i]) != 0;
+    if (!ok) {
+        fprintf(stderr, "sy: error: --clip-cap: '%s' is not a colour RRGGBB (six hexadecimal digits, sRGB, e.g. "
+                        "ff8000)\n", value);
+        return 2;
+    }
+    for (int k = 0; k < 3; ++k) {
+        char hex[3] = {s[2 * k], s[2 * k + 1], 0};
+        float c = (float)strtol(hex, NULL, 16) / 255.0f; /* sRGB to linear */
+        rgb[k] = c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+    }
+    return 0;
+}
+
 int sy_cli_add_clip_plane(const char *value, float (*planes)[4], uint32_t *count)
 {
     if (*count >= SY_CLIP_PLANES_MAX) {
@@ -326,13 +356,20 @@ int sy_cli_add_clip_plane(const char *value, float (*planes)[4], uint32_t *count
         return 2;
     }
     float q[4];
+    if (sy_cli_parse_plane("--clip", value, q)) return 2;
+    memcpy(planes[(*count)++], q, sizeof q);
+    return 0;
+}
+
+int sy_cli_parse_plane(const char *opt, const char *value, float q[4])
+{
     const char *s = value;
     for (int k = 0; k < 4; ++k) {
         char *end;
         double d = strtod(s, &end);
         if (end == s || !isfinite(d) || fabs(d) > SY_COORD_MAX || *end != (k < 3 ? ',' : '\0')) {
-            fprintf(stderr, "sy: error: --clip: '%s' is not a section plane A,B,C,D (four finite numbers: "
-                            "A*x + B*y + C*z + D >= 0 is kept)\n", value);
+            fprintf(stderr, "sy: error: %s: '%s' is not a %splane A,B,C,D (four finite numbers: "
+                            "A*x + B*y + C*z + D >= 0 is its kept side)\n", opt, value, strcmp(opt, "--clip") ? "" : "section ");
             return 2;
         }
         q[k] = (float)d;
@@ -340,10 +377,9 @@ int sy_cli_add_clip_plane(const char *value, float (*planes)[4], uint32_t *count
     }
     sy_error e = {0};
     if (sy_clip_planes_check((const float(*)[4])q, 1, &e) != SY_OK) {
-        fprintf(stderr, "sy: error: --clip: '%s': %s\n", value, e.message);
+        fprintf(stderr, "sy: error: %s: '%s': %s\n", opt, value, e.message);
         return 2;
     }
-    memcpy(planes[(*count)++], q, sizeof q);
     return 0;
 }
 

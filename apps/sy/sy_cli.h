@@ -30,14 +30,16 @@ enum {
     OPT_TONEMAP, OPT_STEREO, OPT_EYE_SEP, OPT_ZERO_PARALLAX, OPT_OVERLAY, OPT_COMPOSITE, OPT_FRAMES, OPT_BACKENDS,
     OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB, OPT_MAX_MEMORY,
     OPT_BUDGET, OPT_AT, OPT_CLIP, OPT_LOOK_AT, OPT_FOV, OPT_ORBIT, OPT_REPEAT, OPT_FPS, OPT_RESUME, OPT_HIDE,
-    OPT_ISOLATE, OPT_SELECT, OPT_TEMPORAL, OPT_NO_TEMPORAL, OPT_SHUTTER, OPT_MOTION_BLUR, OPT_SHUTTER_SAMPLES
+    OPT_ISOLATE, OPT_SELECT, OPT_TEMPORAL, OPT_NO_TEMPORAL, OPT_SHUTTER, OPT_MOTION_BLUR, OPT_SHUTTER_SAMPLES,
+    OPT_CLIP_CAP, OPT_BOOKMARK, OPT_BOOKMARKS, OPT_MEASURE, OPT_PLANE
 };
 /* getopt_long entries of the camera placement and node visibility options (sy render, pick, view,
  * web), taken by sy_cli_next_option into sy_cli_load_opts.view and .nodes (sy_load.h) */
 #define VIEW_OPTIONS                                                                                       \
     {"look-at", required_argument, NULL, OPT_LOOK_AT}, {"fov", required_argument, NULL, OPT_FOV},        \
     {"orbit", required_argument, NULL, OPT_ORBIT}, {"hide", required_argument, NULL, OPT_HIDE},          \
-    {"isolate", required_argument, NULL, OPT_ISOLATE}, {"select", required_argument, NULL, OPT_SELECT}
+    {"isolate", required_argument, NULL, OPT_ISOLATE}, {"select", required_argument, NULL, OPT_SELECT},       \
+    {"bookmark", required_argument, NULL, OPT_BOOKMARK}
 /* getopt_long entries of the options of every command, with the table's terminator: the end of
  * every command's table */
 #define COMMON_OPTIONS                                                                                     \
@@ -148,9 +150,15 @@ bool sy_cli_parse_double(const char *s, double lo, double hi, double *out);
  * to planes (room for SY_CLIP_PLANES_MAX) and returns 0; a bad value or a seventh plane: a usage
  * error naming --clip on stderr, returns 2. */
 int sy_cli_add_clip_plane(const char *value, float (*planes)[4], uint32_t *count);
+/* A plane A,B,C,D of option opt (four finite numbers, a non-zero normal) into q and returns 0; else
+ * a usage error naming opt on stderr, returns 2. */
+int sy_cli_parse_plane(const char *opt, const char *value, float q[4]);
 /* true when an --clip value is a section plane (it has a comma) rather than an animation clip's
  * name or index (sy render --clip NAME|INDEX). */
 bool sy_cli_is_clip_plane(const char *value);
+/* --clip-cap RRGGBB (or #RRGGBB): the section cap colour, six hex digits of sRGB, into rgb as
+ * linear RGB and returns 0; anything else: a usage error naming --clip-cap on stderr, returns 2. */
+int sy_cli_parse_cap_color(const char *value, float rgb[3]);
 /* s as a whole number in lo..hi (decimal, nothing after it). */
 bool sy_cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out);
 

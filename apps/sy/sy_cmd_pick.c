@@ -39,7 +39,7 @@ static cJSON *floats(const float *v, int n)
     return a;
 }
 
-static cJSON *pick_json(const sy_scene *s, double x, double y, const sy_pick_result *p)
+static cJSON *pick_json(const sy_scene *s, double x, double y, const sy_pick_result *p, const float *plane)
 {
     static const char *const eyes[3] = {"mono", "left", "right"};
     cJSON *o = cJSON_CreateObject();
@@ -62,6 +62,9 @@ static cJSON *pick_json(const sy_scene *s, double x, double y, const sy_pick_res
     sy_json_add(o, "material", object_ref(s, SY_TYPE_MATERIAL, p->material_id));
     sy_json_add(o, "distance", sy_json_float(p->distance));
     sy_json_add(o, "depth", sy_json_float(p->depth));
+    double pd;
+    sy_error e = {0};
+    if (plane && sy_plane_distance(plane, p->position, &pd, &e) == SY_OK) sy_json_add(o, "plane_distance", sy_json_float((float)pd));
     return o;
 }
 
@@ -70,22 +73,28 @@ int sy_cmd_pick(int argc, char **argv)
 {
     const char *scene = NULL, *camera = NULL, *backend = NULL, *params = NULL;
     uint32_t w = 0, h = 0;
-    float planes[SY_CLIP_PLANES_MAX][4];
+    float planes[SY_CLIP_PLANES_MAX][4], plane[4];
     uint32_t nplanes = 0;
+    bool measure = false, has_plane = false;
     const sy_cli_opt opts[] = {SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera),
                                SY_CLI_OPT_CODE("clip", OPT_CLIP, true), SY_CLI_OPT_TEXT("params", OPT_PARAMS, &params),
-                               SY_CLI_OPT_FLAG("json", OPT_JSON, NULL)}; /* the output is JSON anyway */
+                               SY_CLI_OPT_FLAG("json", OPT_JSON, NULL), /* the output is JSON anyway */
+                               SY_CLI_OPT_FLAG("measure", OPT_MEASURE, &measure), /* two points: their distance */
+                               SY_CLI_OPT_CODE("plane", OPT_PLANE, true)}; /* each hit's distance from a plane */
     sy_cli_parser p = {SY_CLI_ARGS("pick", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .view = true};
     int c;
     while ((c = sy_cli_parse(&p)) != -1) {
         if (c == OPT_STOP) return p.status;
         if (c == OPT_CLIP && sy_cli_add_clip_plane(optarg, planes, &nplanes)) return 2;
+        if (c == OPT_PLANE && sy_cli_parse_plane("--plane", optarg, plane)) return 2;
+        if (c == OPT_PLANE) has_plane = true;
     }
     if (optind >= argc) return sy_cli_usage_of("pick", "a SCENE and pixel coordinates X Y are required");
     scene = argv[optind++];
     int n = argc - optind;
     if (n < 2 || n % 2) return sy_cli_usage_of("pick", "pixel coordinates come in pairs: X Y [X Y ...]");
     int pairs = n / 2;
+    if (measure && pairs != 2) return sy_cli_usage_of("pick", "--measure takes two points: X1 Y1 X2 Y2");
     double *xy = malloc(sizeof *xy * (size_t)n);
     if (!xy) {
         sy_error e = {0};
@@ -146,11 +155,13 @@ int sy_cmd_pick(int argc, char **argv)
     if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
     cJSON *doc = NULL, *list = NULL;
     if (r == SY_OK && pairs > 1) doc = list = cJSON_CreateArray();
+    sy_pick_result two[2];
     for (int i = 0; i < pairs && r == SY_OK; ++i) {
         sy_pick_result p;
         r = sy_window_pick(win, ld.scene, pool, xy[2 * i], xy[2 * i + 1], &p, &err);
         if (r != SY_OK) break;
-        cJSON *o = pick_json(ld.scene, xy[2 * i], xy[2 * i + 1], &p);
+        if (i < 2) two[i] = p;
+        cJSON *o = pick_json(ld.scene, xy[2 * i], xy[2 * i + 1], &p, has_plane ? plane : NULL);
         if (i == 0) { /* what every pick shares, first */
             cJSON *head = cJSON_CreateObject();
             sy_json_add(head, "file", sy_json_str(scene));
@@ -167,6 +178,19 @@ int sy_cmd_pick(int argc, char **argv)
         }
         if (list) sy_json_add(list, NULL, o);
         else doc = o;
+    }
+    double dist = 0.0;
+    if (r == SY_OK && measure && (r = sy_pick_distance(&two[0], &two[1], &dist, &err)) != SY_OK)
+        sy_error_prefix(&err, "sy pick --measure: pixels (%g, %g) and (%g, %g)", xy[0], xy[1], xy[2], xy[3]);
+    if (r == SY_OK && measure) { /* {"picks": [...], "distance": D, "unit": "m"} */
+        cJSON *m = cJSON_CreateObject();
+        sy_json_add(m, "picks", doc);
+        sy_json_add(m, "distance", cJSON_CreateNumber(dist));
+        float delta[3];
+        for (int k = 0; k < 3; ++k) delta[k] = two[1].position[k] - two[0].position[k];
+        sy_json_add(m, "delta", floats(delta, 3));
+        sy_json_add(m, "unit", sy_json_str("m"));
+        doc = m;
     }
     sy_context_pool_destroy(pool);
     sy_window_destroy(win);

@@ -621,7 +621,8 @@ int sy_cmd_render(int argc, char **argv)
         SY_CLI_OPT_UINT("max-memory", OPT_MAX_MEMORY, &max_memory_mb, 1, 1u << 30),
         SY_CLI_OPT_CODE("at", OPT_AT, true), SY_CLI_OPT_CODE("clip", OPT_CLIP, true), /* the scene clock */
         SY_CLI_OPT_CODE("shutter", OPT_SHUTTER, true), SY_CLI_OPT_FLAG("motion-blur", OPT_MOTION_BLUR, &motion_blur),
-        SY_CLI_OPT_UINT("shutter-samples", OPT_SHUTTER_SAMPLES, &shutter.samples, 1, SY_SHUTTER_SAMPLES_MAX)};
+        SY_CLI_OPT_UINT("shutter-samples", OPT_SHUTTER_SAMPLES, &shutter.samples, 1, SY_SHUTTER_SAMPLES_MAX),
+        SY_CLI_OPT_CODE("clip-cap", OPT_CLIP_CAP, true)}; /* section caps (with --clip A,B,C,D) */
     sy_cli_parser p = {SY_CLI_ARGS("render", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .cluster = true,
                        .view = true};
     int c;
@@ -666,6 +667,10 @@ int sy_cmd_render(int argc, char **argv)
         case OPT_CLIP: /* A,B,C,D (a comma): a section plane; else an animation clip */
             if (!sy_cli_is_clip_plane(optarg)) clip = optarg;
             else if (sy_cli_add_clip_plane(optarg, spec.clip_planes, &spec.clip_count)) return 2;
+            break;
+        case OPT_CLIP_CAP:
+            if (sy_cli_parse_cap_color(optarg, spec.clip_cap_color)) return 2;
+            spec.clip_cap = true;
             break;
         default: /* --cluster ... (sy_cluster_cli.c) */
             if (!sy_cluster_cli_getopt(c, optarg, &clo)) return sy_cli_bad_value(sy_cli_option_name(p.lo, c), optarg);
@@ -792,6 +797,10 @@ int sy_cmd_render(int argc, char **argv)
     }
     uint32_t caps = sy_mediator_class_caps(bcls, &bparams);
     const sy_mediator_class *rcls = sy_mediator_find(remote);
+    if (spec.clip_cap && !spec.clip_count) {
+        fprintf(stderr, "sy render: error: --clip-cap: caps fill the cut faces of section planes: give --clip A,B,C,D too\n");
+        return 2;
+    }
     if (spec.clip_count && !(caps & SY_CAP_CLIP)) {
         sy_log(SY_LOG_ERROR, "sy", NULL, "--clip: back-end %s%s cannot cut with section planes (sy backends lists those with 'clip')",
                remote, clo.cluster ? " on the cluster" : "");

@@ -58,6 +58,7 @@ static sy_result add_eye(sy_window *win, const sy_compose_spec *spec, uint32_t e
     if (r == SY_OK) sy_viewport_set_view(vp, spec->view); /* NULL: the camera node's matrix */
     if (r == SY_OK && spec->clip_count)
         r = sy_viewport_set_clip_planes(vp, (const float(*)[4])spec->clip_planes, spec->clip_count, err);
+    if (r == SY_OK && spec->clip_cap) r = sy_viewport_set_clip_cap(vp, spec->clip_cap_color, err);
     if (r != SY_OK || !spec->has_overlay) return r;
     d.root = spec->overlay_root;
     d.background.id = 0; /* transparent around the overlay's geometry */

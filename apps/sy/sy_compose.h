@@ -34,6 +34,8 @@ typedef struct sy_compose_spec {
     float zero_parallax;        /* metres, > 0 (default 2) */
     uint32_t clip_count;        /* section planes on the main viewports (--clip A,B,C,D; sy_viewport_set_clip_planes) */
     float clip_planes[SY_CLIP_PLANES_MAX][4];
+    bool clip_cap;              /* fill the cut faces of closed meshes (--clip-cap; sy_viewport_set_clip_cap) */
+    float clip_cap_color[3];    /* linear RGB */
 } sy_compose_spec;
 
 /* Parses "sbs", "tb", "anaglyph", "separate" (or "none"). */

@@ -6,6 +6,7 @@
 #include "sy_cli.h"
 
 #include "sy_anim.h"
+#include "sy_bookmarks.h"
 #include "sy_demo.h"
 #include "sy_log.h"
 #include "sy_mediators.h"
@@ -94,7 +95,31 @@ int sy_cli_view_option(int c, const char *value)
         v->fov = (float)(deg * 3.14159265358979323846 / 180.0);
         return 0;
     }
-    if (c == OPT_LOOK_AT) {
+    if (c == OPT_BOOKMARK) { /* FILE:N, a saved view of sy view (sy_bookmarks.h): the --look-at it holds */
+        const char *colon = strrchr(value, ':');
+        double slot = 0;
+        if (!colon || colon == value || !sy_cli_parse_double(colon + 1, 1, SY_BOOKMARKS_MAX, &slot) || slot != floor(slot))
+            return view_usage("--bookmark", value, "expected FILE:N, N a saved view 1..9 (sy view: Ctrl+N saves one)");
+        size_t len = (size_t)(colon - value);
+        char *path = malloc(len + 1);
+        if (!path) return view_usage("--bookmark", value, "out of memory");
+        memcpy(path, value, len);
+        path[len] = '\0';
+        sy_bookmark slots[SY_BOOKMARKS_MAX + 1];
+        sy_error e = {0};
+        sy_result r = sy_bookmarks_load(path, slots, &e);
+        free(path);
+        if (r != SY_OK) return view_usage("--bookmark", value, e.message);
+        const sy_bookmark *b = &slots[(int)slot];
+        if (!b->set) return view_usage("--bookmark", value, "the file holds no view in that slot");
+        if (v->look_at || v->bookmark)
+            return view_usage("--bookmark", value, "--look-at and --bookmark both place the camera; give one of them");
+        memcpy(v->eye, b->eye, sizeof v->eye);
+        memcpy(v->target, b->target, sizeof v->target);
+        memcpy(v->up, b->up, sizeof v->up);
+        v->look_at = v->bookmark = true;
+    } else if (c == OPT_LOOK_AT) {
+        if (v->bookmark) return view_usage("--look-at", value, "--look-at and --bookmark both place the camera; give one of them");
         const char *c1 = strchr(value, ':'), *c2 = c1 ? strchr(c1 + 1, ':') : NULL, *end = value + strlen(value);
         if (!c1 || (c2 && strchr(c2 + 1, ':')))
             return view_usage("--look-at", value, "expected EYE:TARGET or EYE:TARGET:UP, each x,y,z (e.g. 0,1,5:0,0,0)");
@@ -137,7 +162,7 @@ int sy_cli_view_option(int c, const char *value)
         v->orbit = true;
     }
     if (v->look_at && v->orbit) {
-        fprintf(stderr, "sy: error: --look-at and --orbit both place the camera; give one of them\n");
+        fprintf(stderr, "sy: error: %s and --orbit both place the camera; give one of them\n", v->bookmark ? "--bookmark" : "--look-at");
         return 2;
     }
     return 0;

@@ -30,10 +30,11 @@ typedef struct loaded {
  * (whatever a loader skips or repairs is an error), --max-scene-mb N (the budget per file,
  * sy_budget.h), --variant NAME (a glTF material variant) and the world flags. */
 #define SY_MAX_ALLOW_PATHS 16
-/* Where the camera is put (sy render, pick, view, web): --look-at EYE:TARGET[:UP], --orbit AZ,EL[,DIST]
- * (exclusive), --fov DEG (the vertical field of view of whichever camera is used). */
+/* Where the camera is put (sy render, pick, view, web): --look-at EYE:TARGET[:UP], --orbit AZ,EL[,DIST],
+ * --bookmark FILE:N (a view sy view saved, sy_bookmarks.h; exclusive), --fov DEG (the vertical field of view of whichever camera is used). */
 typedef struct sy_view_options {
-    bool look_at;                   /* --look-at given */
+    bool look_at;                   /* --look-at given (or --bookmark FILE:N: the saved view's eye, target and up) */
+    bool bookmark;                  /* --bookmark given */
     float eye[3], target[3], up[3]; /* up (0,1,0) when not given */
     bool orbit;                     /* --orbit given */
     float azimuth, elevation, dist; /* degrees, degrees, scene units (0 = frame the bounds) */

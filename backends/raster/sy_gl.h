@@ -228,6 +228,7 @@ typedef struct sy_gl_mesh_desc {
     const uint32_t *indices; /**< 3 x triangle_count or NULL (then vertex_count == 3 x triangle_count) */
     /** @{ vertex and triangle counts */
     uint32_t vertex_count, triangle_count; /** @} */
+    int closed; /**< section caps fill its cut faces: 1 a closed surface wound counter-clockwise seen from outside, -1 the other way, 0 not closed */
 } sy_gl_mesh_desc;
 /** Creates a mesh from desc (uploaded at once). */
 sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *desc, sy_gl_mesh *out);
@@ -438,6 +439,12 @@ typedef struct sy_gl_camera {
      * main (forward and deferred), shadow-map, probe and pick passes alike (gl_ClipDistance). */
     uint32_t clip_count; /**< 0..SY_GL_CLIP_PLANES_MAX; 0 = nothing cut */
     float clip_planes[6][4]; /**< the planes {a, b, c, d}, world coordinates */
+    /** Capping (with clip_count > 0): nonzero fills the cut faces of closed meshes
+     * (sy_gl_mesh_desc.closed) in clip_cap_color (linear RGB, flat, unlit): their back faces seen
+     * through the cut are drawn at the point where the pixel's ray enters the kept region (depth
+     * written there), like the ray tracers' caps. */
+    uint32_t clip_cap;
+    float clip_cap_color[3]; /**< the caps' linear RGB */
 } sy_gl_camera;
 #define SY_GL_CLIP_PLANES_MAX 6 /**< most section planes in a sy_gl_camera */
 /** What to render: the full image and the rectangle to fill. */

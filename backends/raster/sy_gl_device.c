@@ -184,6 +184,7 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         }
         sy_gli_targets_free(dev, &dev->t);
         sy_gli_pick_free(dev);
+        if (dev->cap.prog) gl->DeleteProgram(dev->cap.prog);
         for (int v = 0; v < VAR_COUNT; ++v)
             if (dev->pm[v].prog) gl->DeleteProgram(dev->pm[v].prog);
         for (uint32_t i = 0; i < PM_SPARE; ++i)

@@ -578,13 +578,13 @@ static void draw_gbuf(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const m
  * covers, those that fail the depth test included (its per-sample depth test masks the fragments
  * without skipping the shader, unlike the single-sampled path): TransmissionTest's glass spheres
  * shaded their far halves (16 area lights each) for nothing, 0.3 s of its 1.2 s main pass
- * (issue 32). Masked and blended materials show their far faces; a surface the near plane cuts
- * shows its inside. */
+ * (issue 32). Masked and blended materials show their far faces; a surface the near plane or a
+ * section plane cuts shows its inside. */
 static void cull_hidden_faces(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const mesh_o *m, const mat_o *mt)
 {
     unsigned want = 0;
     int8_t closed = m->lod_closed[in->lod < m->lod_count ? in->lod : 0];
-    if (closed && (!mt || mt->d.alpha_mode == SY_GL_ALPHA_OPAQUE)) {
+    if (closed && !dev->clip_count && (!mt || mt->d.alpha_mode == SY_GL_ALPHA_OPAQUE)) { /* a cut one shows its inside */
         float c[3], scale, r = sy_gli_world_sphere(in, m, c, &scale);
         const float *V = dc->v->view;
         float depth = -(V[2] * c[0] + V[6] * c[1] + V[10] * c[2] + V[14]);
@@ -642,6 +642,79 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
     }
     gl->Uniform1i(dev->pm[pv].mirror, in->mirror);
     dev->tris += sy_gli_draw_mesh_lod(dev, m, in->lod);
+    return SY_GL_OK;
+}
+
+/* Section caps (sy_gl_camera.clip_cap), the rule of the ray tracers' sy_rt_clip_cap so that every
+ * back-end caps the same pixels: where the nearest kept surface of a pixel is a back face of a
+ * closed mesh (the back faces drawn again with the depth test LEQUAL against the main pass's depth,
+ * which holds them where nothing kept is in front: the main pass culls no closed surface while the
+ * view cuts) and the pixel's ray entered the kept region before it (else the eye is inside the
+ * solid: discarded), the pixel shows the cap colour, and its linear depth is the entry point's on
+ * the plane the ray crossed. The depth buffer keeps the back face's depth (a blended surface
+ * between the cap and that face is hidden). */
+static const char *const cap_vs =
+    "#version 330 core\n" SY_GL_CLIP_VS
+    "layout(location=0) in vec3 a_pos; uniform mat4 u_model; uniform mat4 u_mvp; out vec3 v_world;\n"
+    "void main() { vec4 w = u_model * vec4(a_pos, 1.0); v_world = w.xyz; sy_clip(w.xyz);\n"
+    "  gl_Position = u_mvp * vec4(a_pos, 1.0); }\n"; /* as the main pass: the same depth */
+static const char *const cap_fs =
+    "#version 330 core\n"
+    "layout(std140) uniform Clip { vec4 c_planes[6]; };\n"
+    "in vec3 v_world; layout(location=0) out vec4 o_color; layout(location=1) out float o_depth;\n"
+    "uniform mat4 u_viewproj; uniform vec3 u_cam_pos, u_cam_fwd, u_color; uniform int u_ortho;\n"
+    "void main() {\n"
+    "  vec3 org = u_cam_pos, dir = v_world - u_cam_pos; float t_hit = 1.0;\n"
+    "  if (u_ortho != 0) { float d = dot(dir, u_cam_fwd); dir = u_cam_fwd; org = v_world - d * dir; t_hit = d; }\n"
+    "  float te = -1e30;\n"
+    "  for (int i = 0; i < 6; ++i) { float ds = dot(c_planes[i].xyz, dir);\n"
+    "    if (ds > 0.0) te = max(te, -(dot(c_planes[i].xyz, org) + c_planes[i].w) / ds); }\n"
+    "  if (!(te > 0.0 && te < t_hit)) discard;\n"
+    "  vec3 c = org + te * dir; vec4 p = u_viewproj * vec4(c, 1.0);\n"
+    "  if (p.z < -p.w) discard;\n" /* the entry point in front of the near plane: the camera's own cut */
+    "  o_color = vec4(u_color, 1.0); o_depth = dot(c - u_cam_pos, u_cam_fwd); }\n";
+
+static sy_gl_result cap_pass(sy_gl_device *dev, draw_ctx *dc, sy_gl_report *rep)
+{
+    const sy_gl_fns *gl = dev->gl;
+    if (!dev->cap.prog) {
+        sy_gl_result r = sy_gl_program_build(gl, "section cap", cap_vs, cap_fs, NULL, &dev->cap.prog, rep);
+        if (r != SY_GL_OK) return r;
+        dev->cap.model = gl->GetUniformLocation(dev->cap.prog, "u_model");
+        dev->cap.mvp = gl->GetUniformLocation(dev->cap.prog, "u_mvp");
+        dev->cap.viewproj = gl->GetUniformLocation(dev->cap.prog, "u_viewproj");
+        dev->cap.cam_pos = gl->GetUniformLocation(dev->cap.prog, "u_cam_pos");
+        dev->cap.cam_fwd = gl->GetUniformLocation(dev->cap.prog, "u_cam_fwd");
+        dev->cap.ortho = gl->GetUniformLocation(dev->cap.prog, "u_ortho");
+        dev->cap.color = gl->GetUniformLocation(dev->cap.prog, "u_color");
+        sy_gli_bind_clip_block(gl, dev->cap.prog);
+    }
+    gl->UseProgram(dev->cap.prog);
+    dc->bound = -1;
+    gl->UniformMatrix4fv(dev->cap.viewproj, 1, GL_FALSE, dc->viewproj);
+    gl->Uniform3fv(dev->cap.cam_pos, 1, dc->v->cam_pos);
+    gl->Uniform3fv(dev->cap.cam_fwd, 1, dc->v->cam_fwd);
+    gl->Uniform1i(dev->cap.ortho, dc->v->ortho);
+    gl->Uniform3fv(dev->cap.color, 1, dev->clip_cap_color);
+    gl->Enable(GL_CULL_FACE);
+    gl->DepthFunc(GL_LEQUAL);
+    gl->DepthMask(GL_FALSE);
+    for (uint32_t i = 0; i < dev->instances.count; ++i) {
+        const inst_o *in = sy_gli_pool_at(&dev->instances, i);
+        if (!in->h.id || !in->visible) continue;
+        const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
+        if (!m || !m->cap_closed) continue;
+        gl->CullFace((m->cap_closed > 0) != in->mirror ? GL_FRONT : GL_BACK); /* the back faces only */
+        float mvp[16];
+        sy_gli_m4_mul(dc->viewproj, in->model, mvp);
+        gl->UniformMatrix4fv(dev->cap.model, 1, GL_FALSE, in->model);
+        gl->UniformMatrix4fv(dev->cap.mvp, 1, GL_FALSE, mvp);
+        dev->tris += sy_gli_draw_mesh_lod(dev, m, in->lod); /* the level the main pass drew */
+    }
+    gl->DepthMask(GL_TRUE);
+    gl->DepthFunc(GL_LESS);
+    gl->Disable(GL_CULL_FACE);
+    dc->cull = 0;
     return SY_GL_OK;
 }
 
@@ -735,9 +808,14 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
     }
     /* deferred shading in the main pass of a frame without blended instances (they would blend
      * over G-buffer samples) */
-    dc.deferred = !dev->forward && !dev->in_probe_pass && skip == UINT32_MAX && nl[2] == 0;
+    /* section caps: in the main pass, forward (a flat colour, not a G-buffer material), after the
+     * opaque and masked draws and before the blended ones */
+    const bool caps = dev->clip_cap && dev->clip_count && !dev->in_probe_pass && skip == UINT32_MAX;
+    dc.deferred = !dev->forward && !dev->in_probe_pass && skip == UINT32_MAX && nl[2] == 0 && !caps;
     sy_gli_clip_enable(dev, true);
     for (int li = 0; li < 3 && r == SY_GL_OK; ++li) {
+        if (li == 2 && caps) r = cap_pass(dev, &dc, rep);
+        if (r != SY_GL_OK) break;
         float *list = lists + 2 * (size_t)li * cap;
         qsort(list, nl[li], 2 * sizeof(float), li == 2 ? cmp_far_first : cmp_near_first);
         if (li == 2 && nl[li]) {

@@ -107,6 +107,7 @@ typedef struct mesh_o {
      * triangles of opposite direction) wound counter-clockwise seen from outside, -1 wound the other
      * way, 0 not closed or not checked (over CLOSED_MAX_TRIANGLES); see cull_hidden_faces */
     int8_t lod_closed[LOD_MAX];
+    int8_t cap_closed; /* sy_gl_mesh_desc.closed: 1, -1 a closed surface section caps fill (its winding), 0 not */
 } mesh_o;
 /* The most triangles a level may have for the closed-surface check (a sort of 3 edges each). */
 #define CLOSED_MAX_TRIANGLES 131072u
@@ -238,6 +239,14 @@ struct sy_gl_device {
     GLuint clip_ubo;
     uint32_t clip_count;
     float clip_planes[SY_GL_CLIP_PLANES_MAX][4];
+    /* section caps (sy_gl_camera.clip_cap) of the last render: on, their colour; the cap program
+     * (sy_gl_draw.c, cap_pass), made on first use */
+    bool clip_cap;
+    float clip_cap_color[3];
+    struct {
+        GLuint prog;
+        GLint model, mvp, viewproj, cam_pos, cam_fwd, ortho, color;
+    } cap;
     /* deferred shading */
     bool forward; /* sy_gl_device_desc.forward */
     struct { /* the G-buffer pass: perspective, orthographic */

@@ -197,6 +197,7 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     size_t index_count = 0;
     build_lods(d, m, &lods, &index_count);
     check_closed(d, m, lods ? lods : d->indices);
+    m->cap_closed = (int8_t)(d->closed > 0 ? 1 : d->closed < 0 ? -1 : 0);
     gl->GenVertexArrays(1, &m->vao);
     gl->BindVertexArray(m->vao);
     /* one interleaved vertex buffer (present attributes only) + one index buffer */

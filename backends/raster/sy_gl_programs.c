@@ -146,6 +146,8 @@ void sy_gli_clip_set(sy_gl_device *dev, const sy_gl_camera *cam)
         if (n) memcpy(dev->clip_planes, cam->clip_planes, n * sizeof dev->clip_planes[0]);
     }
     gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_CLIP, dev->clip_ubo);
+    dev->clip_cap = n && cam->clip_cap;
+    memcpy(dev->clip_cap_color, cam->clip_cap_color, sizeof dev->clip_cap_color);
 }
 
 void sy_gli_clip_enable(sy_gl_device *dev, bool on)

@@ -197,6 +197,7 @@ typedef struct sy_rt_mesh_desc {
     uint32_t triangle_count; /**< number of triangles */
     void (*release)(void *release_user); /**< NULL: arrays copied; else shared until this is called */
     void *release_user; /**< argument of release */
+    int closed; /**< section caps fill its cut faces: 1 a closed surface wound counter-clockwise seen from outside, -1 the other way, 0 not closed */
 } sy_rt_mesh_desc;
 
 /** Creates a mesh from desc (arrays copied or shared, see sy_rt_mesh_desc). Its BLAS is built when
@@ -484,6 +485,13 @@ typedef struct sy_rt_camera {
      * behind. 0 = nothing cut. */
     uint32_t clip_count;
     float clip_planes[6][4]; /**< the planes {a, b, c, d}, world coordinates */
+    /** Capping (with clip_count > 0): nonzero fills the cut faces of closed meshes
+     * (sy_rt_mesh_desc.closed). A ray whose first kept hit is a back face of a closed mesh and that
+     * entered the kept region (inside every plane) after its start sees, at that entry point on the
+     * plane it crossed, the cap: camera rays the flat colour clip_cap_color (linear RGB, unlit),
+     * every other ray an opaque black surface (so shadows and reflections see the cap). */
+    uint32_t clip_cap;
+    float clip_cap_color[3]; /**< the caps' linear RGB */
 } sy_rt_camera;
 #define SY_RT_CLIP_PLANES_MAX 6 /**< most section planes in a sy_rt_camera */
 

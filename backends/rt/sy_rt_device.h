@@ -35,6 +35,7 @@ typedef struct sy_rt_mesh_data {
     bool refitting;           /* updated by sy_rt_mesh_update: its BLAS is built LOW, its geometry REFIT */
     uint64_t own_bytes, shared_bytes; /* accounting (sy_rt_device_stats) */
     uint32_t vertex_count, triangle_count;
+    int closed;           /* sy_rt_mesh_desc.closed: section caps fill its cut faces (1, -1: its winding) */
     float extent;         /* largest |coordinate| of its positions */
     uint32_t refs;        /* 1 for the live handle + 1 per instance */
     bool filter_on;       /* alpha filter installed on geom */
@@ -118,6 +119,8 @@ struct sy_rt_device {
      * filter sy_rt_context_filter on every hit. */
     uint32_t clip_count;
     float clip_planes[SY_RT_CLIP_PLANES_MAX][4];
+    uint32_t clip_cap;        /* caps on closed meshes (sy_rt_camera.clip_cap), with clip_count > 0 */
+    float clip_cap_color[3];
     sy_rt_instance_data **pending; /* instances with xf_pending */
     uint32_t pending_count, pending_cap;
     bool dyn_dirty;        /* dyn needs rtcCommitScene */
@@ -230,7 +233,17 @@ static inline void sy_rt_clip_begin(sy_rt_device *dev, const sy_rt_camera *cam)
     uint32_t n = cam->clip_count < SY_RT_CLIP_PLANES_MAX ? cam->clip_count : SY_RT_CLIP_PLANES_MAX;
     dev->clip_count = n;
     if (n) memcpy(dev->clip_planes, cam->clip_planes, n * sizeof dev->clip_planes[0]);
+    dev->clip_cap = n && cam->clip_cap;
+    memcpy(dev->clip_cap_color, cam->clip_cap_color, sizeof dev->clip_cap_color);
 }
+
+/* Section caps (sy_rt_camera.clip_cap): true when the nearest kept hit of org + t*dir at t = thit,
+ * triangle prim of instance in, is a back face of a closed mesh and the ray entered the kept region
+ * (inside every plane) at t_enter with tnear < t_enter < thit: between the two nothing is hit, so
+ * the ray is inside the solid where it crosses the plane, and the cut face is there. *t_cap gets
+ * t_enter. false when the call does not cap. Every integrator asks it of every hit it shades. */
+bool sy_rt_clip_cap(const sy_rt_device *dev, const sy_rt_instance_data *in, unsigned prim, sy_rt_v3 org, sy_rt_v3 dir,
+                    float tnear, float thit, float *t_cap);
 
 /* True when the point (x, y, z) (world) lies on a removed side of the call's section planes (a x + b y + c z
  * + d < 0 for some plane): the context filter drops such hits, and the lights' sampling treats an

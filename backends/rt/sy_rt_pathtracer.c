@@ -269,6 +269,21 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
             }
             break;
         }
+        float t_cap;
+        if (sy_rt_clip_cap(dev, in, rh.hit.primID, org, dir, tnear, rh.ray.tfar, &t_cap)) {
+            /* a section cap: camera rays see its flat colour, every other ray an opaque black surface */
+            if (bounce == 0u) {
+                sy_rt_v3 contrib = v3_mul(beta, v3_load(dev->clip_cap_color));
+                L = v3_add(L, contrib);
+                direct = v3_add(direct, contrib);
+            }
+            if (first) {
+                out->alpha = 1.0f;
+                out->depth = v3_dot(v3_sub(v3_madd(org, dir, t_cap), f->cam_pos), f->forward);
+                if (!features) out->albedo = v3_load(dev->clip_cap_color), features = true;
+            }
+            break;
+        }
         sy_rt_surface s;
         sy_rt_surface_fetch(dev, in, rh.hit.primID, rh.hit.u, rh.hit.v, d, &s);
         if (s.mat->desc.alpha_mode == SY_RT_ALPHA_BLEND && s.alpha < 1.0f) {

@@ -71,6 +71,14 @@ void sy_rt_primary_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t 
                     continue;
                 }
                 sy_rt_v3 dir = v3(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]);
+                float t_cap;
+                if (sy_rt_clip_cap(dev, in, rh.hit.primID[k], v3(rh.ray.org_x[k], rh.ray.org_y[k], rh.ray.org_z[k]), dir,
+                                   rh.ray.tnear[k], rh.ray.tfar[k], &t_cap)) { /* a section cap: its flat colour */
+                    memcpy(c, dev->clip_cap_color, 3 * sizeof *c);
+                    c[3] = 1.0f;
+                    if (depth) depth[o] = t_cap * axial[k];
+                    continue;
+                }
                 sy_rt_v3 col = sy_rt_surface_eyelight(dev, in, rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k], dir);
                 c[0] = col.x;
                 c[1] = col.y;

@@ -930,6 +930,13 @@ static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float
         if (t_hit) *t_hit = INFINITY;
         return r;
     }
+    float t_cap;
+    if (sy_rt_clip_cap(c->dev, in, rh.hit.primID, org, dir, tnear, rh.ray.tfar, &t_cap)) {
+        /* a section cap: camera rays see its flat colour, every other ray an opaque black surface */
+        if (t_hit) *t_hit = t_cap;
+        rgba_t r = {camera ? v3_load(c->dev->clip_cap_color) : v3(0.0f, 0.0f, 0.0f), 1.0f};
+        return r;
+    }
     if (t_hit) *t_hit = rh.ray.tfar;
     sy_rt_v3 d = v3_normalize(dir);
     sy_rt_surface s;

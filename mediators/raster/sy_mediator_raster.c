@@ -223,7 +223,7 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
     const sy_primitive *p = a->primitive;
     const sy_mirror_flat_mesh *f = a->flat;
     sy_gl_mesh_desc d = {f->positions, f->normals, {f->uv[0], f->uv[1]}, f->colors, f->indices, f->vertex_count,
-                         f->triangle_count};
+                         f->triangle_count, sy_mirror_flat_mesh_closed(f)};
     sy_gl_mesh h = {0};
     sy_gl_result r = sy_gl_mesh_create(st->dev, &d, &h);
     *a->handle = h.id;
@@ -244,7 +244,7 @@ static sy_result cb_primitive_update(void *user, const sy_mirror_primitive_args 
     raster_state *st = user;
     const sy_mirror_flat_mesh *f = a->flat;
     sy_gl_mesh_desc d = {f->positions, f->normals, {f->uv[0], f->uv[1]}, f->colors, f->indices, f->vertex_count,
-                         f->triangle_count};
+                         f->triangle_count, 0 /* not read: the topology stays */};
     sy_gl_result r = sy_gl_mesh_update(st->dev, (sy_gl_mesh){*a->handle}, &d);
     if (r != SY_GL_OK) return gl_fail(st, err, r, "mesh primitive update");
     emesh *em = sy_mirror_map_get(&st->meshes, *a->handle);
@@ -382,6 +382,8 @@ static void camera_of(const sy_camera_view *v, sy_gl_camera *cam)
     _Static_assert(SY_GL_CLIP_PLANES_MAX == SY_CLIP_PLANES_MAX, "one section plane array");
     cam->clip_count = v->clip_count < SY_CLIP_PLANES_MAX ? v->clip_count : SY_CLIP_PLANES_MAX;
     memcpy(cam->clip_planes, v->clip_planes, sizeof cam->clip_planes);
+    cam->clip_cap = v->clip_count && v->clip_cap;
+    memcpy(cam->clip_cap_color, v->clip_cap_color, sizeof cam->clip_cap_color);
 }
 
 /* >>look: the resolved look -> the device's environment light and background. */

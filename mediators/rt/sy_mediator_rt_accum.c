@@ -10,7 +10,8 @@ bool sy_rti_same_view(const sy_camera_view *a, const sy_camera_view *b)
     return !memcmp(a->camera_to_world.m, b->camera_to_world.m, sizeof a->camera_to_world.m) &&
            a->projection == b->projection && !memcmp(a->window, b->window, sizeof a->window) && a->znear == b->znear &&
            a->zfar == b->zfar && a->clip_count == b->clip_count &&
-           !memcmp(a->clip_planes, b->clip_planes, a->clip_count * sizeof a->clip_planes[0]);
+           !memcmp(a->clip_planes, b->clip_planes, a->clip_count * sizeof a->clip_planes[0]) &&
+           a->clip_cap == b->clip_cap && (!a->clip_cap || !memcmp(a->clip_cap_color, b->clip_cap_color, sizeof a->clip_cap_color));
 }
 
 /* Picks (or recycles) the accumulation slot of a request and restarts it when the scene, the

@@ -125,4 +125,6 @@ void sy_rti_camera_of(const sy_camera_view *v, sy_rt_camera *cam)
     _Static_assert(SY_RT_CLIP_PLANES_MAX == SY_CLIP_PLANES_MAX, "one section plane array");
     cam->clip_count = v->clip_count < SY_CLIP_PLANES_MAX ? v->clip_count : SY_CLIP_PLANES_MAX;
     memcpy(cam->clip_planes, v->clip_planes, sizeof cam->clip_planes);
+    cam->clip_cap = v->clip_count && v->clip_cap;
+    memcpy(cam->clip_cap_color, v->clip_cap_color, sizeof cam->clip_cap_color);
 }

@@ -183,7 +183,7 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
     rt_mesh_blobs *held = malloc(sizeof *held);
     if (!held) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt: mesh primitive: out of memory");
     sy_rt_mesh_desc d = {f->positions, f->normals, {f->uv[0], f->uv[1]}, f->colors, f->indices, f->vertex_count,
-                         f->triangle_count, rt_mesh_blobs_release, held};
+                         f->triangle_count, rt_mesh_blobs_release, held, sy_mirror_flat_mesh_closed(f)};
     sy_blob *const used[6] = {p->positions, p->normals, p->texcoords0, p->texcoords1, p->colors, p->indices};
     for (int k = 0; k < 6; ++k) held->b[k] = sy_blob_retain(used[k]);
     sy_rt_mesh h = {0};

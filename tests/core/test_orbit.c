@@ -1,9 +1,16 @@
 /* test_orbit.c — the orbit camera (core/sy_orbit.h): matrix for hand-checked poses, the round trip
- * matrix -> orbit -> matrix, drag / pan / zoom rules and their limits. */
+ * matrix -> orbit -> matrix, drag / pan / zoom rules and their limits; saved views
+ * (core/sy_bookmarks.h): orbit -> bookmark -> orbit, the file written and read back, bad files
+ * refused naming the line; measurement (sy_pick_distance, sy_plane_distance). */
 #include "../support/sy_check.h"
+#include "sy_bookmarks.h"
 #include "sy_orbit.h"
+#include "sy_viewport.h"
 
 #include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
 
 static int mat_near(const sy_mat4 *a, const sy_mat4 *b, float eps)
 {
@@ -85,4 +92,72 @@ static int test_input(void)
     return 0;
 }
 
-SY_CHECK_MAIN("test_orbit", SY_TEST(test_matrix), SY_TEST(test_round_trip), SY_TEST(test_input))
+static int test_bookmarks(void)
+{
+    const sy_orbit o = {{0.5f, -1, 2}, 0.7f, -0.4f, 3.5f};
+    sy_bookmark b = sy_bookmark_of_orbit(&o);
+    sy_orbit back = sy_orbit_of_bookmark(&b);
+    sy_mat4 m0, m1, m2;
+    sy_orbit_matrix(&o, &m0);
+    sy_orbit_matrix(&back, &m1);
+    CHECK(mat_near(&m0, &m1, 1e-5f));
+    CHECK(sy_bookmark_matrix(&b, &m2) && mat_near(&m0, &m2, 1e-5f)); /* the look-at of the view is the orbit's */
+    char path[64];
+    snprintf(path, sizeof path, "/tmp/sy_test_bookmarks_%d", (int)getpid());
+    sy_bookmark slots[SY_BOOKMARKS_MAX + 1], got[SY_BOOKMARKS_MAX + 1];
+    memset(slots, 0, sizeof slots);
+    slots[2] = b, slots[9] = b;
+    slots[9].up[0] = 0.25f;
+    sy_error e = {0};
+    CHECK(sy_bookmarks_save(path, slots, &e) == SY_OK);
+    CHECK(sy_bookmarks_load(path, got, &e) == SY_OK);
+    CHECK(!got[1].set && got[2].set && got[9].set && !got[5].set);
+    for (int k = 0; k < 3; ++k) {
+        CHECK_NEAR(got[9].eye[k], b.eye[k], 1e-6);
+        CHECK_NEAR(got[2].target[k], b.target[k], 1e-6);
+    }
+    CHECK_NEAR(got[9].up[0], 0.25, 1e-7);
+    static const struct { const char *text, *want; } bad[] = {
+        {"1 0 0 5 0 0 0 0 1\n", ":1: expected"},               /* eight numbers */
+        {"# c\n\n10 0 0 5 0 0 0 0 1 0\n", ":3: slot 10"},     /* slot out of range */
+        {"1 0 0 5 0 0 0 0 1 0 7\n", ":1: expected"},           /* one too many */
+        {"1 0 0 5 0 0 0 0 0 0\n", "up is zero"},               /* zero up */
+        {"1 0 0 nan 0 0 0 0 1 0\n", "not finite"},             /* NaN */
+        {"1 0 0 5 0 0 0 0 1 0\n2 x\n", ":2: expected"},       /* the second line */
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        FILE *f = fopen(path, "w");
+        CHECK(f != NULL);
+        if (!f) break;
+        fputs(bad[i].text, f);
+        fclose(f);
+        got[2].set = true;
+        sy_result r = sy_bookmarks_load(path, got, &e);
+        if (!(r == SY_ERR_PARSE && strstr(e.message, bad[i].want))) fprintf(stderr, "  bad file %zu: %s\n", i, e.message);
+        CHECK(r == SY_ERR_PARSE && strstr(e.message, bad[i].want) != NULL && !got[2].set);
+    }
+    remove(path);
+    CHECK(sy_bookmarks_load(path, got, &e) == SY_ERR_NOT_FOUND);
+    return 0;
+}
+
+static int test_measure(void)
+{
+    sy_pick_result a = {.hit = true, .position = {1, 2, 3}}, b = {.hit = true, .position = {4, 6, 3}}, miss = {0};
+    double d = -1;
+    sy_error e = {0};
+    CHECK(sy_pick_distance(&a, &b, &d, &e) == SY_OK);
+    CHECK_NEAR(d, 5, 1e-12);
+    CHECK(sy_pick_distance(&a, &miss, &d, &e) == SY_ERR_INVALID_ARGUMENT && strstr(e.message, "second pick hit nothing"));
+    const float plane[4] = {0, 2, 0, -2}; /* y = 1, not unit */
+    CHECK(sy_plane_distance(plane, a.position, &d, &e) == SY_OK);
+    CHECK_NEAR(d, 1, 1e-12);
+    const float zero[4] = {0, 0, 0, 1}, nan_plane[4] = {NAN, 1, 0, 0}, far[3] = {INFINITY, 0, 0};
+    CHECK(sy_plane_distance(zero, a.position, &d, &e) == SY_ERR_INVALID_ARGUMENT && strstr(e.message, "normal"));
+    CHECK(sy_plane_distance(nan_plane, a.position, &d, &e) == SY_ERR_INVALID_ARGUMENT && strstr(e.message, "not finite"));
+    CHECK(sy_plane_distance(plane, far, &d, &e) == SY_ERR_INVALID_ARGUMENT && strstr(e.message, "point"));
+    return 0;
+}
+
+SY_CHECK_MAIN("test_orbit", SY_TEST(test_matrix), SY_TEST(test_round_trip), SY_TEST(test_input), SY_TEST(test_bookmarks),
+              SY_TEST(test_measure))

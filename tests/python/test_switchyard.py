@@ -575,3 +575,65 @@ def test_type_stubs_name_every_public_name():
         have = members[cls] | members.get("_Object", set())
         public = {m for m in vars(getattr(switchyard, cls)) if not m.startswith("_")}
         assert public <= have, "%s: %s without a stub" % (cls, sorted(public - have))
+
+
+def _cube_scene():
+    """The cube [-0.5, 0.5]^3 (closed, wound outward) under an orthographic camera looking down -Z."""
+    s = switchyard.Scene()
+    p = numpy.array([[-.5, -.5, -.5], [.5, -.5, -.5], [.5, .5, -.5], [-.5, .5, -.5],
+                     [-.5, -.5, .5], [.5, -.5, .5], [.5, .5, .5], [-.5, .5, .5]], dtype=numpy.float32)
+    i = numpy.array([0, 3, 2, 0, 2, 1, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 3, 7, 6, 3, 6, 2, 0, 4, 7, 0, 7, 3,
+                     1, 2, 6, 1, 6, 5], dtype=numpy.uint32)
+    s.add_mesh(p, i)
+    s.camera = s.add_camera("ortho", projection=switchyard.Camera.ORTHOGRAPHIC, xmag=1.0, ymag=1.0, znear=0.1,
+                            zfar=10.0)
+    s.camera.translation = (0.0, 0.0, 3.0)
+    return s
+
+
+@needs_whitted
+def test_viewport_clip_planes_and_caps():
+    """Viewport.clip_planes and .clip_cap: round trip, bad values refused (the planes before stay),
+    the cut seen in the image, a cut closed cube capped in the cap colour."""
+    s = triangle_scene()
+    with switchyard.Window(s, 32, 32) as w:
+        vp = w.add_viewport("whitted")
+        assert vp.clip_planes == [] and vp.clip_cap is None
+        full = numpy.array(w.render())
+        vp.clip_planes = [(-1.0, 0.0, 0.0, -0.5)]  # keeps x <= -0.5: the left quarter
+        assert vp.clip_planes == [(-1.0, 0.0, 0.0, -0.5)]
+        cut = numpy.array(w.render())
+        covered_full, covered_cut = (full[..., 3] > 0.5).sum(), (cut[..., 3] > 0.5).sum()
+        assert 0 < covered_cut < 0.5 * covered_full, (covered_cut, covered_full)
+        assert (cut[:, 12:, 3] <= 0.5).all(), "the removed half still shows"
+        for bad, what in (([(float("nan"), 0, 0, 0)], "not finite"), ([(0, 0, 0, 1)], "normal"),
+                          ([(1, 0, 0, 0)] * 7, "at most 6")):
+            with pytest.raises(switchyard.InvalidArgumentError, match=what):
+                vp.clip_planes = bad
+            assert vp.clip_planes == [(-1.0, 0.0, 0.0, -0.5)], "a refused plane changed the planes"
+        with pytest.raises(ValueError):
+            vp.clip_planes = [(1, 0, 0)]
+        with pytest.raises(TypeError):
+            vp.clip_planes = [("a", 0, 0, 0)]
+        for bad in ((float("nan"), 0, 0), (2, 0, 0), (-0.5, 0, 0)):
+            with pytest.raises(switchyard.InvalidArgumentError, match="colour"):
+                vp.clip_cap = bad
+        vp.clip_cap = (0.25, 0.5, 1.0)
+        assert vp.clip_cap == (0.25, 0.5, 1.0)
+        vp.clip_cap = None
+        assert vp.clip_cap is None
+        vp.clip_planes = []
+        assert numpy.array_equal(numpy.array(w.render()), full), "removing the planes brings the uncut image back"
+    s.close()
+    s = _cube_scene()
+    with switchyard.Window(s, 32, 32) as w:
+        vp = w.add_viewport("whitted")
+        vp.clip_planes = [(0.0, 0.0, -1.0, 0.0)]  # keeps z <= 0: the camera looks into the cut cube
+        inside = numpy.array(w.render())
+        vp.clip_cap = (0.25, 0.5, 1.0)
+        capped = numpy.array(w.render())
+    s.close()
+    square = capped[10:22, 10:22]  # well inside the cube's square (half the view)
+    assert numpy.allclose(square[..., :3], (0.25, 0.5, 1.0), atol=1e-4), square[0, 0]
+    assert not numpy.allclose(inside[10:22, 10:22, :3], (0.25, 0.5, 1.0), atol=0.05), "capped without clip_cap"
+    assert (inside[10:22, 10:22, 3] > 0.99).all(), "without caps the cube's inside shows"

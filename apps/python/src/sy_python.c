@@ -1792,6 +1792,113 @@ static PyObject *window_set_active(PyObject *self, PyObject *args)
     Py_RETURN_NONE;
 }
 
+/* Reads n floats of a sequence into out; a Python error (naming what) and -1 otherwise. */
+static int floats_of(PyObject *seq, float *out, Py_ssize_t n, const char *what, Py_ssize_t index)
+{
+    Py_ssize_t len = PySequence_Check(seq) ? PySequence_Size(seq) : -1;
+    if (len < 0) {
+        PyErr_Clear();
+        PyErr_Format(PyExc_TypeError, "%s %zd: a sequence of %zd numbers expected", what, index, n);
+        return -1;
+    }
+    if (len != n) {
+        PyErr_Format(PyExc_ValueError, "%s %zd: %zd numbers expected, got %zd", what, index, n, len);
+        return -1;
+    }
+    for (Py_ssize_t k = 0; k < n; ++k) {
+        PyObject *item = PySequence_GetItem(seq, k);
+        double d = item ? PyFloat_AsDouble(item) : -1.0;
+        Py_XDECREF(item);
+        if (d == -1.0 && PyErr_Occurred()) return -1;
+        out[k] = (float)d;
+    }
+    return 0;
+}
+
+/* _set_clip_planes(index, planes): planes a sequence of up to 6 (a, b, c, d); [] removes them.
+ * The library checks them (sy_viewport_set_clip_planes): NaN, infinite, a zero normal, a seventh
+ * plane raise its InvalidArgument error naming the plane; the planes before stay. */
+static PyObject *window_set_clip_planes(PyObject *self, PyObject *args)
+{
+    WindowObject *w = (WindowObject *)self;
+    unsigned int i;
+    PyObject *seq;
+    if (!PyArg_ParseTuple(args, "IO", &i, &seq)) return NULL;
+    sy_viewport *vp = window_vp(w, i);
+    if (!vp) return NULL;
+    Py_ssize_t total = PySequence_Check(seq) ? PySequence_Size(seq) : -1;
+    if (total < 0) {
+        PyErr_Clear();
+        return PyErr_Format(PyExc_TypeError, "clip planes: a sequence of (a, b, c, d) expected");
+    }
+    float planes[SY_CLIP_PLANES_MAX + 1][4];
+    Py_ssize_t n = total > SY_CLIP_PLANES_MAX + 1 ? SY_CLIP_PLANES_MAX + 1 : total; /* the library names the count */
+    for (Py_ssize_t k = 0; k < n; ++k) {
+        PyObject *item = PySequence_GetItem(seq, k);
+        int bad = !item || floats_of(item, planes[k], 4, "clip plane", k);
+        Py_XDECREF(item);
+        if (bad) return NULL;
+    }
+    sy_error err = {0};
+    sy_result r = total > SY_CLIP_PLANES_MAX
+                      ? sy_clip_planes_check((const float(*)[4])planes, (uint32_t)total, &err)
+                      : sy_viewport_set_clip_planes(vp, (const float(*)[4])planes, (uint32_t)n, &err);
+    if (r != SY_OK) return raise_sy(r, &err);
+    Py_RETURN_NONE;
+}
+
+/* _clip_planes(index) -> list of (a, b, c, d) */
+static PyObject *window_clip_planes(PyObject *self, PyObject *args)
+{
+    WindowObject *w = (WindowObject *)self;
+    unsigned int i;
+    if (!PyArg_ParseTuple(args, "I", &i)) return NULL;
+    sy_viewport *vp = window_vp(w, i);
+    if (!vp) return NULL;
+    float planes[SY_CLIP_PLANES_MAX][4];
+    uint32_t n = sy_viewport_clip_planes(vp, planes);
+    PyObject *list = PyList_New((Py_ssize_t)n);
+    for (uint32_t k = 0; list && k < n; ++k) {
+        PyObject *t = Py_BuildValue("(dddd)", (double)planes[k][0], (double)planes[k][1], (double)planes[k][2],
+                                    (double)planes[k][3]);
+        if (!t || PyList_SetItem(list, k, t)) {
+            Py_DECREF(list);
+            return NULL;
+        }
+    }
+    return list;
+}
+
+/* _set_clip_cap(index, rgb or None): the section caps' linear RGB colour, or off */
+static PyObject *window_set_clip_cap(PyObject *self, PyObject *args)
+{
+    WindowObject *w = (WindowObject *)self;
+    unsigned int i;
+    PyObject *rgb;
+    if (!PyArg_ParseTuple(args, "IO", &i, &rgb)) return NULL;
+    sy_viewport *vp = window_vp(w, i);
+    if (!vp) return NULL;
+    float c[3];
+    if (rgb != Py_None && floats_of(rgb, c, 3, "clip cap colour", 0)) return NULL;
+    sy_error err = {0};
+    sy_result r = sy_viewport_set_clip_cap(vp, rgb == Py_None ? NULL : c, &err);
+    if (r != SY_OK) return raise_sy(r, &err);
+    Py_RETURN_NONE;
+}
+
+/* _clip_cap(index) -> (r, g, b) or None */
+static PyObject *window_clip_cap(PyObject *self, PyObject *args)
+{
+    WindowObject *w = (WindowObject *)self;
+    unsigned int i;
+    if (!PyArg_ParseTuple(args, "I", &i)) return NULL;
+    sy_viewport *vp = window_vp(w, i);
+    if (!vp) return NULL;
+    float c[3];
+    if (!sy_viewport_clip_cap(vp, c)) Py_RETURN_NONE;
+    return Py_BuildValue("(ddd)", (double)c[0], (double)c[1], (double)c[2]);
+}
+
 /* _render(spp=0, seed=0, aovs=False, progress=None) -> (rgba, aovs or None, samples of viewport 0).
  * The pool persists: a progressive viewport keeps accumulating while nothing changes. */
 static PyObject *window_render(PyObject *self, PyObject *args, PyObject *kw)
@@ -1837,6 +1944,10 @@ static PyMethodDef window_methods[] = {
     {"_set_backend", window_set_backend, METH_VARARGS, NULL},
     {"_set_active", window_set_active, METH_VARARGS, NULL},
     {"_viewport", window_viewport, METH_VARARGS, NULL},
+    {"_set_clip_planes", window_set_clip_planes, METH_VARARGS, NULL},
+    {"_clip_planes", window_clip_planes, METH_VARARGS, NULL},
+    {"_set_clip_cap", window_set_clip_cap, METH_VARARGS, NULL},
+    {"_clip_cap", window_clip_cap, METH_VARARGS, NULL},
     {"_render", (PyCFunction)(void (*)(void))window_render, METH_VARARGS | METH_KEYWORDS, NULL},
     {NULL, NULL, 0, NULL}};
 

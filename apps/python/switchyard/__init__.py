@@ -679,6 +679,29 @@ class Viewport:
     def active(self, on):
         self.window._c._set_active(self.index, bool(on))
 
+    @property
+    def clip_planes(self):
+        """The section planes (sy_viewport_set_clip_planes): a list of up to 6 (a, b, c, d) in world
+        coordinates; what a*x + b*y + c*z + d >= 0 for every plane keeps is drawn, picked and seen by
+        every ray. Setting [] removes them; NaN, infinite values, a zero normal (a, b, c) or a
+        seventh plane raise InvalidArgumentError (a ValueError) naming the plane, keeping the planes before."""
+        return self.window._c._clip_planes(self.index)
+
+    @clip_planes.setter
+    def clip_planes(self, planes):
+        self.window._c._set_clip_planes(self.index, [] if planes is None else list(planes))
+
+    @property
+    def clip_cap(self):
+        """The section caps' colour (linear RGB, each in [0, 1]) filling the cut faces of closed
+        meshes, or None (the default: a cut closed mesh shows its inside). A colour outside [0, 1]
+        or NaN raises InvalidArgumentError (a ValueError)."""
+        return self.window._c._clip_cap(self.index)
+
+    @clip_cap.setter
+    def clip_cap(self, rgb):
+        self.window._c._set_clip_cap(self.index, None if rgb is None else tuple(rgb))
+
     def __repr__(self):
         return "<Viewport %d of %r>" % (self.index, self.window)
 
