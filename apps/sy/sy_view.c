@@ -3,6 +3,7 @@
 #include "sy_view.h"
 
 #include "sy_anim.h"
+#include "sy_bookmarks.h"
 #include "sy_commit.h"
 #include "sy_interactive.h"
 #include "sy_log.h"
@@ -46,6 +47,21 @@ typedef struct viewer {
     bool pick_add;      /* shift-click: toggle the node in the selection instead of replacing it */
     double pick_x, pick_y;
     int vis_key;        /* 'H' hide the selection, 'I' isolate it, 'U' show every node; 0 none */
+    /* section planes (the input thread edits them: C adds one facing the view through the last
+     * picked point or the orbit's target, X removes the last, J / L or Page Down / Page Up or
+     * Ctrl+wheel move the last along its normal, N flips it, K turns the caps on and off) */
+    uint32_t clip_count;
+    float clip_planes[SY_CLIP_PLANES_MAX][4];
+    bool clip_cap;
+    float cap_color[3];
+    float step;          /* a plane move: 1/50 of the scene's bounding-box diagonal */
+    bool have_pick;      /* the render thread's last pick hit (pick_pos: its world position) */
+    float pick_pos[3];
+    char clip_status[96];
+    /* saved views: Ctrl+1..9 saves the view in slot N (to args->bookmarks), Shift+1..9 recalls it */
+    sy_bookmark marks[SY_BOOKMARKS_MAX + 1];
+    char mark_status[160];
+    bool redraw; /* a key changed what the frame shows besides the view (planes, caps, a status): render again */
     /* render thread -> input thread (under mu) */
     uint8_t *img;
     uint32_t img_w, img_h;
@@ -62,7 +78,7 @@ typedef struct viewer {
     bool governed;    /* local rendering (the governor's scale is in the title) */
     char status[256];
     char filter_status[96];
-    char sel_status[160]; /* the last pick and the selection, for the title */
+    char sel_status[320]; /* the last pick, measurement and the selection, for the title */
     sy_error error;
     bool failed;
 } viewer;
@@ -266,8 +282,9 @@ static uint32_t selected_nodes(const sy_scene *s, sy_node *out, uint32_t max)
 
 static sy_result view_selection(sy_scene *scene, sy_context_pool *pool, const sy_compose_spec *spec, const char *backend,
                                 uint32_t w, uint32_t h, bool pick, double px, double py, bool add, int key, char *status,
-                                size_t len, sy_error *err)
+                                size_t len, sy_pick_result *picked, sy_error *err)
 {
+    picked->hit = false;
     enum { MAX_SEL = 4096 };
     sy_node *sel = malloc(MAX_SEL * sizeof *sel);
     if (!sel) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "view: selection: out of memory");
@@ -289,6 +306,7 @@ static sy_result view_selection(sy_scene *scene, sy_context_pool *pool, const sy
             r = sy_viewport_set_clip_planes(vp, (const float(*)[4])spec->clip_planes, spec->clip_count, err);
         if (r == SY_OK) r = sy_window_pick(win, scene, pool, px, py, &p, err);
         sy_window_destroy(win);
+        if (r == SY_OK) *picked = p;
         bool was = false;
         for (uint32_t i = 0; r == SY_OK && i < n; ++i) {
             if (p.hit && sel[i].id == p.node_id) was = true;
@@ -299,6 +317,7 @@ static sy_result view_selection(sy_scene *scene, sy_context_pool *pool, const sy
         if (r == SY_OK)
             snprintf(status, len, " | picked %s%.60s%s (node %u, triangle %u)", d && d->name ? "'" : "",
                      d && d->name ? d->name : p.hit ? "unnamed" : "nothing", d && d->name ? "'" : "", p.node_id, p.triangle);
+
     } else if (key == 'H') {
         for (uint32_t i = 0; r == SY_OK && i < n; ++i) r = sy_node_set_visible(scene, sel[i], false, err);
         if (r == SY_OK) snprintf(status, len, " | hid %u node%s", n, n == 1 ? "" : "s");
@@ -359,6 +378,8 @@ static void *render_main(void *p)
     double t_start = 0, t_end = 0, wall_last = 0;
     bool was_playing = false;
     bool animated = sy_scene_time_range(a->scene, (sy_animation){0}, &t_start, &t_end, NULL) == SY_OK && t_end > t_start;
+    sy_pick_result prev_pick = {0}; /* the last pick that hit: the measurement's first point */
+    bool have_prev = false;
     sy_clock clock = sy_clock_make(t_start, t_end);
     clock.playing = false;
     for (;;) {
@@ -388,6 +409,12 @@ static void *render_main(void *p)
         double pick_x = v->pick_x, pick_y = v->pick_y;
         int vis_key = v->vis_key;
         v->pick = false, v->vis_key = 0;
+        uint32_t clip_count = v->clip_count;
+        float clip_planes[SY_CLIP_PLANES_MAX][4], cap_color[3];
+        memcpy(clip_planes, v->clip_planes, sizeof clip_planes);
+        memcpy(cap_color, v->cap_color, sizeof cap_color);
+        bool clip_cap = v->clip_cap, redraw = v->redraw;
+        v->redraw = false;
         pthread_mutex_unlock(&v->mu);
         bool time_moved = false;
         if (playing || steps) {
@@ -410,7 +437,7 @@ static void *render_main(void *p)
         if (!cls) cls = sy_mediator_at(0);
         if (cls->caps & SY_CAP_REMOTE) cls = sy_mediator_find(a->backend); /* the cluster is not a choice of its own */
         if (!cls) cls = sy_mediator_at(0);
-        bool changed = stereo != prev_stereo || w != prev_w || overlay != prev_overlay || time_moved;
+        bool changed = stereo != prev_stereo || w != prev_w || overlay != prev_overlay || time_moved || redraw;
         prev_stereo = stereo, prev_w = w, prev_overlay = overlay;
         sy_mat4 view; /* the camera, set on the viewports directly: the scene is not committed */
         sy_orbit_matrix(&in.orbit, &view);
@@ -420,16 +447,38 @@ static void *render_main(void *p)
         spec.view = &view;
         spec.has_overlay = a->spec.has_overlay && overlay;
         spec.stereo = stereo;
+        spec.clip_count = clip_count; /* the planes and caps the keys set (the viewports' own, not the scene's) */
+        memcpy(spec.clip_planes, clip_planes, sizeof spec.clip_planes);
+        spec.clip_cap = clip_cap;
+        memcpy(spec.clip_cap_color, cap_color, sizeof spec.clip_cap_color);
         uint32_t ew = stereo == SY_STEREO_SBS ? (w / 2 ? w / 2 : 1) : w;
         if (pick || vis_key) { /* click: pick and select; H, I, U: visibility (mono picks: the left eye's half) */
-            char sst[160] = "";
+            char sst[sizeof v->sel_status] = "";
             sy_error serr = {0};
             double sx = stereo == SY_STEREO_SBS && pick_x >= ew ? pick_x - ew : pick_x;
+            sy_pick_result picked = {0};
             sy_result sr = view_selection(a->scene, pool, &spec, cls->name, ew, h, pick && sx < ew && pick_y < h, sx,
-                                          pick_y, pick_add, vis_key, sst, sizeof sst, &serr);
+                                          pick_y, pick_add, vis_key, sst, sizeof sst, &picked, &serr);
             if (sr != SY_OK) snprintf(sst, sizeof sst, " | select: %.120s", serr.message);
+            if (sr == SY_OK && picked.hit) { /* measurement: from the previous hit and the last section plane */
+                size_t k = strlen(sst);
+                double dist;
+                if (k < sizeof sst)
+                    k += (size_t)snprintf(sst + k, sizeof sst - k, " | at (%.4g, %.4g, %.4g)", (double)picked.position[0],
+                                          (double)picked.position[1], (double)picked.position[2]);
+                if (have_prev && sy_pick_distance(&prev_pick, &picked, &dist, NULL) == SY_OK && k < sizeof sst)
+                    k += (size_t)snprintf(sst + k, sizeof sst - k, " | %.4g m from the last pick", dist);
+                if (clip_count && k < sizeof sst &&
+                    sy_plane_distance(clip_planes[clip_count - 1], picked.position, &dist, NULL) == SY_OK)
+                    snprintf(sst + k, sizeof sst - k, " | %.4g m from plane %u", dist, clip_count);
+                prev_pick = picked, have_prev = true;
+            }
             pthread_mutex_lock(&v->mu);
             snprintf(v->sel_status, sizeof v->sel_status, "%s", sst);
+            if (sr == SY_OK && pick) {
+                v->have_pick = picked.hit;
+                memcpy(v->pick_pos, picked.position, sizeof v->pick_pos);
+            }
             pthread_mutex_unlock(&v->mu);
             changed = true;
         }
@@ -542,14 +591,94 @@ static void post_request(viewer *v)
     pthread_mutex_unlock(&v->mu);
 }
 
+/* Input thread, under v->mu: the heads-up text of the section planes. */
+static void clip_status_update(viewer *v)
+{
+    if (!v->clip_count) {
+        v->clip_status[0] = '\0';
+        return;
+    }
+    const float *q = v->clip_planes[v->clip_count - 1];
+    snprintf(v->clip_status, sizeof v->clip_status, " | %u plane%s%s, last (%.3g, %.3g, %.3g, %.4g)", v->clip_count,
+             v->clip_count == 1 ? "" : "s", v->clip_cap ? " capped" : "", (double)q[0], (double)q[1], (double)q[2],
+             (double)q[3]);
+}
+
+/* Input thread, under v->mu: the section plane keys (see viewer). true when key was one. */
+static bool clip_key(viewer *v, int key)
+{
+    float *last = v->clip_count ? v->clip_planes[v->clip_count - 1] : NULL;
+    if (key == GLFW_KEY_C) { /* a plane facing the view through the last pick (or the target): the near part goes */
+        if (v->clip_count >= SY_CLIP_PLANES_MAX) {
+            snprintf(v->mark_status, sizeof v->mark_status, " | at most %d section planes", SY_CLIP_PLANES_MAX);
+            return true;
+        }
+        sy_mat4 m;
+        sy_orbit_matrix(&v->in.orbit, &m);
+        const float *p = v->have_pick ? v->pick_pos : v->in.orbit.target;
+        float *q = v->clip_planes[v->clip_count];
+        for (int k = 0; k < 3; ++k) q[k] = -m.m[8 + k]; /* the viewing direction (unit) */
+        q[3] = -(q[0] * p[0] + q[1] * p[1] + q[2] * p[2]);
+        if (sy_clip_planes_check((const float(*)[4])q, 1, NULL) == SY_OK) v->clip_count++;
+    } else if (key == GLFW_KEY_X) {
+        if (v->clip_count) v->clip_count--;
+    } else if (key == GLFW_KEY_J || key == GLFW_KEY_L || key == GLFW_KEY_PAGE_DOWN || key == GLFW_KEY_PAGE_UP) {
+        /* L / Page Up: the plane moves along its normal (more is cut away), J / Page Down: back */
+        if (last) last[3] -= (key == GLFW_KEY_L || key == GLFW_KEY_PAGE_UP ? 1.0f : -1.0f) * v->step;
+    } else if (key == GLFW_KEY_N) {
+        for (int k = 0; last && k < 4; ++k) last[k] = -last[k];
+    } else if (key == GLFW_KEY_K) {
+        v->clip_cap = !v->clip_cap;
+    } else {
+        return false;
+    }
+    clip_status_update(v);
+    return true;
+}
+
+/* Input thread, under v->mu: Ctrl+N saves the view in slot N (and the file), Shift+N recalls it. */
+static void bookmark_key(viewer *v, int slot, bool save)
+{
+    sy_bookmark *b = &v->marks[slot];
+    if (save) {
+        *b = sy_bookmark_of_orbit(&v->in.orbit);
+        sy_error e = {0};
+        if (v->args->bookmarks && sy_bookmarks_save(v->args->bookmarks, v->marks, &e) != SY_OK)
+            snprintf(v->mark_status, sizeof v->mark_status, " | view %d kept here only: %.100s", slot, e.message);
+        else
+            snprintf(v->mark_status, sizeof v->mark_status, " | saved view %d%s%.100s", slot, v->args->bookmarks ? " to " : "",
+                     v->args->bookmarks ? v->args->bookmarks : "");
+    } else if (!b->set) {
+        snprintf(v->mark_status, sizeof v->mark_status, " | no view saved in %d (Ctrl+%d saves one)", slot, slot);
+    } else {
+        v->in.orbit = sy_orbit_of_bookmark(b);
+        snprintf(v->mark_status, sizeof v->mark_status, " | view %d", slot);
+    }
+}
+
 static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
 {
-    (void)scancode, (void)mods;
+    (void)scancode;
     input *in = glfwGetWindowUserPointer(w);
     viewer *v = in->v;
     if (action != GLFW_PRESS) return;
     if (key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(w, GLFW_TRUE);
-    else if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && (uint32_t)(key - GLFW_KEY_1) < sy_mediator_count()) {
+    else if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && (mods & (GLFW_MOD_CONTROL | GLFW_MOD_SHIFT))) {
+        pthread_mutex_lock(&v->mu);
+        bookmark_key(v, key - GLFW_KEY_0, (mods & GLFW_MOD_CONTROL) != 0);
+        v->redraw = true;
+        v->req_version++;
+        pthread_cond_signal(&v->cv);
+        pthread_mutex_unlock(&v->mu);
+    } else if (key == GLFW_KEY_C || key == GLFW_KEY_X || key == GLFW_KEY_J || key == GLFW_KEY_L || key == GLFW_KEY_N ||
+               key == GLFW_KEY_K || key == GLFW_KEY_PAGE_UP || key == GLFW_KEY_PAGE_DOWN) {
+        pthread_mutex_lock(&v->mu);
+        clip_key(v, key);
+        v->redraw = true;
+        v->req_version++;
+        pthread_cond_signal(&v->cv);
+        pthread_mutex_unlock(&v->mu);
+    } else if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && (uint32_t)(key - GLFW_KEY_1) < sy_mediator_count()) {
         pthread_mutex_lock(&v->mu);
         v->backend = (uint32_t)(key - GLFW_KEY_1);
         v->req_version++;
@@ -627,9 +756,17 @@ static void on_scroll(GLFWwindow *w, double dx, double dy)
 {
     (void)dx;
     input *in = glfwGetWindowUserPointer(w);
-    pthread_mutex_lock(&in->v->mu);
-    sy_interactive_wheel(&in->v->in, (float)dy);
-    pthread_mutex_unlock(&in->v->mu);
+    viewer *v = in->v;
+    pthread_mutex_lock(&v->mu);
+    if ((glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS) &&
+        v->clip_count) { /* Ctrl+wheel: the last section plane moves along its normal */
+        if (isfinite(dy)) v->clip_planes[v->clip_count - 1][3] -= (float)dy * v->step;
+        clip_status_update(v);
+        v->redraw = true;
+    } else {
+        sy_interactive_wheel(&v->in, (float)dy);
+    }
+    pthread_mutex_unlock(&v->mu);
     in->changed = true;
 }
 
@@ -683,10 +820,13 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
         sy_error_prefix(err, "view");
         return r;
     }
-    for (const char *k = args->keys; k && *k; ++k)
+    for (const char *k = args->keys; k && *k; ++k) {
+        if ((*k == '^' || *k == '~') && isalnum((unsigned char)k[1])) continue; /* Ctrl, Shift with the next key */
         if (!isalnum((unsigned char)*k) && *k != '[' && *k != ']' && *k != ' ' && *k != '.' && *k != '*')
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "view: --keys: '%c' is not a key (letters, digits, [ ], space, . and * for a click)", *k);
+                                "view: --keys: '%c' is not a key (letters, digits, [ ], space, . and * for a click; ^ "
+                                "or ~ before a letter or digit: with Ctrl or Shift)", *k);
+    }
     if (!glfwInit()) {
         const char *desc = NULL;
         glfwGetError(&desc);
@@ -716,6 +856,26 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
     pthread_condattr_destroy(&ca);
     sy_interactive_backend_index(args->backend, &v.backend, NULL); /* NULL: the registry's default */
     v.overlay = true;
+    v.clip_count = args->spec.clip_count; /* --clip, --clip-cap: the start planes (the keys change them) */
+    memcpy(v.clip_planes, args->spec.clip_planes, sizeof v.clip_planes);
+    v.clip_cap = args->spec.clip_cap;
+    if (args->spec.clip_cap) memcpy(v.cap_color, args->spec.clip_cap_color, sizeof v.cap_color);
+    else v.cap_color[0] = 0.8f, v.cap_color[1] = 0.25f, v.cap_color[2] = 0.02f; /* K's default: orange */
+    {
+        sy_bounds b = sy_scene_world_bounds(args->scene);
+        float diag = 1.0f;
+        if (!sy_bounds_is_empty(&b)) {
+            float dx = b.max[0] - b.min[0], dy = b.max[1] - b.min[1], dz = b.max[2] - b.min[2];
+            diag = sqrtf(dx * dx + dy * dy + dz * dz);
+        }
+        v.step = isfinite(diag) && diag > 0.0f ? diag / 50.0f : 0.02f;
+    }
+    clip_status_update(&v);
+    if (args->bookmarks) { /* the saved views (a missing file: none yet) */
+        sy_error be = {0};
+        sy_result br = sy_bookmarks_load(args->bookmarks, v.marks, &be);
+        if (br != SY_OK && br != SY_ERR_NOT_FOUND) sy_log(SY_LOG_WARNING, "sy", NULL, "view: %s (starting without saved views)", be.message);
+    }
     if (cluster && cluster->mode == SY_CLUSTER_STEREO) v.stereo = SY_STEREO_SBS; /* --cluster-mode stereo */
 
     /* the camera: the application's camera node gives the projection, the orbit the view (set on
@@ -780,10 +940,10 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
                 snprintf(scale, sizeof scale, " | scale %.2f%s", (double)v.img_scale, v.img_moving ? " moving" : "");
             char clock_s[48] = ""; /* the scene clock, when the scene moves */
             if (v.animated) snprintf(clock_s, sizeof clock_s, " | t %.3f s %s", v.anim_time, v.playing ? "playing" : "paused");
-            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms%s | %llu spp%s%s%s%s%s", v.status, v.frame_ms, scale,
-                     (unsigned long long)v.spp, sync,
+            snprintf(title, sizeof title, "sy view | %s | frame %.1f ms%s | %llu spp%s%s%s%s%s%s%s", v.status, v.frame_ms,
+                     scale, (unsigned long long)v.spp, sync,
                      v.stereo == SY_STEREO_SBS ? " | stereo sbs" : v.stereo == SY_STEREO_ANAGLYPH ? " | anaglyph" : "",
-                     v.filter_status, clock_s, v.sel_status);
+                     v.filter_status, clock_s, v.sel_status, v.clip_status, v.mark_status);
             glfwSetWindowTitle(win, title);
         }
         /* a frame counts for --frames once settled, or any frame while the scene clock plays (it never settles) */
@@ -800,6 +960,8 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
             key_last = 0;
         }
         if (answered && keys && *keys) { /* the next scripted key, through the keyboard handler */
+            int kmods = *keys == '^' ? GLFW_MOD_CONTROL : *keys == '~' ? GLFW_MOD_SHIFT : 0;
+            if (kmods) keys++;
             key_last = *keys++;
             if (key_last == '*') { /* a scripted click at the window's centre: pick and select there */
                 pthread_mutex_lock(&v.mu);
@@ -808,7 +970,7 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
                 pthread_cond_signal(&v.cv);
                 pthread_mutex_unlock(&v.mu);
             } else {
-                on_key(win, toupper((unsigned char)key_last), 0, GLFW_PRESS, 0);
+                on_key(win, toupper((unsigned char)key_last), 0, GLFW_PRESS, kmods);
             }
             pthread_mutex_lock(&v.mu);
             key_req = v.req_version;

@@ -52,10 +52,13 @@ typedef struct sy_view_args {
     bool no_temporal;       /* no temporal reuse on moving frames (sy_interactive_set_temporal) */
     const char *keys;       /* automated runs: keys pressed one at a time through the keyboard handler,
                                each once the frame answering the previous one is shown (letters, digits,
-                               [ ], space, .); the heads-up line after each is printed; --frames counts after
+                               [ ], space, ., * a click at the centre; ^ before a key: with Ctrl, ~: with
+                               Shift, e.g. ^1 saves view 1, ~1 recalls it); the heads-up line after each is printed; --frames counts after
                                them (settled frames; while the scene clock plays, every frame) */
     const sy_cluster_cli_opts *cluster; /* non-NULL: render on these servers (sy view --cluster) */
     double budget_ms;       /* the frame-time governor's budget while the view moves (0 = 33 ms; --budget) */
+    const char *bookmarks;  /* the saved views' file (sy_bookmarks.h; Ctrl+1..9 save, Shift+1..9 recall);
+                               NULL: kept in memory only */
 } sy_view_args;
 
 sy_result sy_view_run(const sy_view_args *args, sy_error *err);

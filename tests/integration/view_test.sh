@@ -8,7 +8,8 @@
 # matches sy render's; '.' steps the scene clock and space plays it (BoxAnimated from the test data,
 # the 4th argument); the frame-time governor answers a back-end
 # switch with a moving frame and settles at full size; the visibility keys (H, I, U) on a node
-# selected with --select. Skipped (77) when xvfb-run is not
+# selected with --select; section planes (C, L, K, X), measurement by two clicks and saved views
+# (Ctrl+N, Shift+N: --keys ^N, ~N) against sy render --bookmark. Skipped (77) when xvfb-run is not
 # installed or the viewer was built without GLFW.
 set -u
 . "$(dirname "$0")/view_setup.sh"
@@ -159,4 +160,23 @@ grep -q "after key \*:.*picked .*(node $NID, triangle [0-9]*) | 1 selected" "$W/
 "$CMP" "$W/view_click.png" "$W/render_sel.png" 2 50 || { echo "FAIL: the clicked view is not sy render --select"; exit 1; }
 "$SY" render demo -b whitted -w 160 -h 90 --tonemap aces --select "$NID" --isolate "$NID" -o "$W/render_iso.png" >/dev/null || exit 1
 "$CMP" "$W/view_iso.png" "$W/render_iso.png" 2 50 || { echo "FAIL: the isolated view is not sy render --isolate"; exit 1; }
+# section planes, caps, measurement and saved views (issue 37): a click picks, C adds a plane facing
+# the view through the picked point, a second click measures from the first pick and from the plane,
+# ^3 (Ctrl+3) saves the view in --bookmarks, L moves the plane, K caps, X removes it, ~3 (Shift+3)
+# recalls the view; the saved view renders with sy render --bookmark FILE:3 as the viewer shows it
+rm -f "$W/marks"
+timeout 300 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w 160 -h 90 --bookmarks "$W/marks" \
+    --keys '*C*^3LKX~3' --frames 2 --screenshot "$W/view_mark.png" >"$W/view_sec.out" 2>"$W/view_sec.err" || {
+    echo "FAIL: sy view --keys '*C*^3LKX~3': $(cat "$W/view_sec.err")"; exit 1; }
+for want in "after key C:.* | 1 plane, last (" "after key \*:.* m from the last pick | [-0-9.e]* m from plane 1" \
+            "after key 3:.*saved view 3 to $W/marks" "after key L:.* | 1 plane, last" "after key K:.* | 1 plane capped" \
+            "after key 3:.*| view 3"; do
+    grep -q -- "$want" "$W/view_sec.out" || { echo "FAIL: '$want' not in: $(cat "$W/view_sec.out")"; exit 1; }
+done
+grep "after key X:" "$W/view_sec.out" | grep -q " plane[s capped]*, last (" && { echo "FAIL: X left a plane: $(cat "$W/view_sec.out")"; exit 1; }
+grep -q '^3 ' "$W/marks" || { echo "FAIL: no view 3 in the bookmarks file: $(cat "$W/marks")"; exit 1; }
+"$SY" render demo -b whitted -w 160 -h 90 --tonemap aces --select "$NID" --bookmark "$W/marks:3" -o "$W/render_mark.png" >/dev/null || exit 1
+"$CMP" "$W/view_mark.png" "$W/render_mark.png" 2 50 || { echo "FAIL: the recalled view is not sy render --bookmark"; exit 1; }
+if "$SY" view demo --keys 'C^' --frames 1 2>"$W/badmod.err"; then echo "FAIL: sy view accepted --keys ending in ^"; exit 1; fi
+grep -q "'^' is not a key" "$W/badmod.err" || { echo "FAIL: the --keys error does not name ^: $(cat "$W/badmod.err")"; exit 1; }
 echo "integration_view: ok"
