@@ -204,6 +204,8 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
         w_u32(&w, r->camera.clip_count); /* section planes (protocol 4) */
         for (uint32_t i = 0; i < r->camera.clip_count && i < SY_CLIP_PLANES_MAX; ++i)
             for (int k = 0; k < 4; ++k) w_f32(&w, r->camera.clip_planes[i][k]);
+        w_u32(&w, r->camera.clip_cap ? 1u : 0u); /* section caps (protocol 6): on, linear RGB */
+        for (int k = 0; k < 3; ++k) w_f32(&w, r->camera.clip_cap ? r->camera.clip_cap_color[k] : 0.0f);
         w_f64(&w, r->time); /* the scene clock (protocol 5) */
         w_u32(&w, r->clip_id);
         w_u32(&w, r->tile_count);
@@ -517,6 +519,9 @@ sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, 
             rd_fail(&rd, SY_ERR_LIMIT, "more than 6 section planes");
         for (uint32_t i = 0; !rd.r && i < q->camera.clip_count; ++i)
             for (int k = 0; k < 4; ++k) q->camera.clip_planes[i][k] = rd_f32(&rd);
+        q->camera.clip_cap = rd_u32(&rd); /* section caps (protocol 6); the colour: sy_cluster_camera_check */
+        if (!rd.r && q->camera.clip_cap > 1) rd_fail(&rd, SY_ERR_PARSE, "section cap flag must be 0 or 1");
+        for (int k = 0; k < 3; ++k) q->camera.clip_cap_color[k] = rd_f32(&rd);
         q->time = rd_f64(&rd);
         q->clip_id = rd_u32(&rd);
         if (!rd.r && !(q->time >= 0.0 && q->time <= SY_CLUSTER_MAX_TIME)) /* NaN fails too */

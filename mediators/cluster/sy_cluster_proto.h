@@ -30,8 +30,9 @@ extern "C" {
 #endif
 
 #define SY_CLUSTER_MAGIC 0x50435953u /**< "SYCP" little endian */
-#define SY_CLUSTER_VERSION 5u /**< protocol version this build speaks (4: RENDER carries section planes; 5: RENDER
-                                  carries a scene time and a restart flag, for frames mode) */
+#define SY_CLUSTER_VERSION 6u /**< protocol version this build speaks (4: RENDER carries section planes; 5: RENDER
+                                  carries a scene time and a restart flag, for frames mode; 6: RENDER carries
+                                  the section caps) */
 #define SY_CLUSTER_HEADER_SIZE 24u /**< bytes of a frame header */
 #define SY_CLUSTER_TAG_SIZE 32u /**< bytes of a frame's authentication tag */
 #define SY_CLUSTER_NONCE_SIZE 32u /**< bytes of a handshake nonce */

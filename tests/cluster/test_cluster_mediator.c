@@ -69,6 +69,7 @@ static sy_result add_overlay_root(fixture *fx, sy_error *e)
 /* Section planes set on the main viewports of render_sbs_with (part 7). */
 static uint32_t g_clip_count;
 static float g_clip[SY_CLIP_PLANES_MAX][4];
+static const float *g_cap; /* their caps' colour (protocol 6), NULL = none */
 
 static int render_sbs_with(fixture *fx, const char *backend, const char *params, const char *overlay_backend,
                            const char *overlay_params, uint32_t spp, uint32_t seed, sy_layer *out, uint64_t *samples_out)
@@ -90,6 +91,7 @@ static int render_sbs_with(fixture *fx, const char *backend, const char *params,
         sy_viewport *v = NULL;
         CHECK_OK(sy_window_add_viewport(win, &main, &v, &e), e);
         CHECK_OK(sy_viewport_set_clip_planes(v, (const float(*)[4])g_clip, g_clip_count, &e), e);
+        CHECK_OK(sy_viewport_set_clip_cap(v, g_cap, &e), e);
         CHECK_OK(sy_window_add_viewport(win, &overlay, &v, &e), e);
     }
     sy_context_pool *pool = NULL;
@@ -174,17 +176,22 @@ static int test_clip(fixture *fx)
     g_clip_count = 1;
     g_clip[0][0] = 1.0f, g_clip[0][1] = 0.0f, g_clip[0][2] = 0.0f, g_clip[0][3] = -cx; /* keeps x >= centre */
     sy_layer uncut = {0}, local = {0}, sf = {0}, bal = {0};
+    static const float cap[3] = {1.0f, 0.0f, 1.0f}; /* with caps (protocol 6): the servers cap as the local back-end */
+    g_cap = cap;
     int failed = render_sbs(fx, "whitted", NULL, 0, 0, &local, NULL) || render_sbs(fx, "cluster", "backend=whitted,mode=sort-first", 0, 0, &sf, NULL) ||
                  render_sbs(fx, "cluster", "backend=whitted,mode=balanced", 0, 0, &bal, NULL);
+    g_cap = NULL;
+    sy_layer nocap = {0};
+    failed = failed || render_sbs(fx, "whitted", NULL, 0, 0, &nocap, NULL);
     g_clip_count = 0;
     CHECK(!failed);
     CHECK(render_sbs(fx, "whitted", NULL, 0, 0, &uncut, NULL) == 0);
-    double e1 = rmse(&local, &sf), e2 = rmse(&local, &bal), d = mean_abs_diff(&local, &uncut);
-    printf("section plane x >= %.3f, whitted: sort-first rmse %.3g, balanced rmse %.3g; cut vs uncut mean |diff| %.4f\n",
-           (double)cx, e1, e2, d);
+    double e1 = rmse(&local, &sf), e2 = rmse(&local, &bal), d = mean_abs_diff(&local, &uncut), dc = mean_abs_diff(&local, &nocap);
+    printf("section plane x >= %.3f with caps, whitted: sort-first rmse %.3g, balanced rmse %.3g; cut vs uncut mean |diff| "
+           "%.4f, capped vs uncapped %.4f\n", (double)cx, e1, e2, d, dc);
     CHECK_MSG(e1 <= 1e-6 && e2 <= 1e-6, "the cluster's cut image differs from the local one");
     CHECK_MSG(d > 0.01, "the plane cut nothing away: the comparison would see nothing");
-    sy_layer_destroy(&uncut), sy_layer_destroy(&local), sy_layer_destroy(&sf), sy_layer_destroy(&bal);
+    sy_layer_destroy(&uncut), sy_layer_destroy(&local), sy_layer_destroy(&sf), sy_layer_destroy(&bal), sy_layer_destroy(&nocap);
     return 0;
 }
 

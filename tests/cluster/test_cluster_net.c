@@ -414,7 +414,7 @@ static int test_bad_messages(fixture *fx, server *all)
     CHECK_OK(sy_cluster_encode(&hello, 0, &b, &e), e);
     b.data[4] = 2; /* a version-2 peer */
     if (raw_exchange(s, b.data, b.size, why, sizeof why)) return 1;
-    CHECK_MSG(strstr(why, "version 2, this peer speaks 5"), "%s", why);
+    CHECK_MSG(strstr(why, "version 2, this peer speaks 6"), "%s", why);
     /* requests out of order: RENDER before HELLO; RENDER before any scene; non-snapshot first scene */
     sy_cluster_msg r;
     memset(&r, 0, sizeof r);

@@ -174,9 +174,9 @@ static int test_bad_headers(void)
     CHECK(strstr(e.message, "magic"));
     /* wrong version */
     memcpy(c, b.data, b.size);
-    c[4] = 4; /* a version-4 peer (RENDER without the scene time) */
+    c[4] = 5; /* a version-5 peer (RENDER without the section caps) */
     CHECK_ERR(sy_cluster_decode(c, b.size, NULL, &d, &e), SY_ERR_UNSUPPORTED, e);
-    CHECK(strstr(e.message, "version 4, this peer speaks 5"));
+    CHECK(strstr(e.message, "version 5, this peer speaks 6"));
     /* unknown type, unknown flags */
     memcpy(c, b.data, b.size);
     c[6] = 200;
