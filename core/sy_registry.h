@@ -104,6 +104,12 @@ typedef struct sy_pick_result {
     uint32_t material_id;   /**< the primitive's material (sy_material.id); 0 = the default material */
     float distance;         /**< from the ray's origin (the eye; orthographic: the image plane) to the hit */
     float depth;            /**< along the viewing axis (what the layer's depth plane holds) */
+    /** 0, or 1 + the index of the section plane whose cap the pick hit (a capped view,
+     * sy_viewport_set_clip_cap: the ray met a closed mesh's back face after entering the kept region
+     * through that plane); then position, distance and depth are the cap's point on the plane and
+     * normal is the plane's, facing the eye; node, mesh, primitive and material are the solid's,
+     * triangle and barycentrics the back face's. */
+    uint32_t cap_plane;
 } sy_pick_result;
 
 /** What a class's create receives. */

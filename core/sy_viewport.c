@@ -356,6 +356,49 @@ static bool viewport_pixel(const uint32_t rect[4], double x, double y, uint32_t 
 }
 
 /* Picks pixel (px, py) of an active viewport with a non-empty rectangle. */
+/* A capped view's pick that met a closed mesh's back face after entering the kept region: moved to
+ * the cap (sy_pick_result.cap_plane), the rule every back-end draws caps by. */
+static void pick_on_cap(const sy_scene *scene, const sy_camera_view *view, sy_pick_result *p)
+{
+    const float *m = view->camera_to_world.m, fwd[3] = {-m[8], -m[9], -m[10]}, eye[3] = {m[12], m[13], m[14]};
+    float org[3], d[3]; /* the ray, with the hit at org + d */
+    for (int k = 0; k < 3; ++k) {
+        if (view->projection == SY_PROJECTION_ORTHOGRAPHIC) {
+            float fl = sqrtf(fwd[0] * fwd[0] + fwd[1] * fwd[1] + fwd[2] * fwd[2]);
+            d[k] = fl > 0.0f ? fwd[k] / fl * p->distance : 0.0f;
+        } else {
+            d[k] = p->position[k] - eye[k];
+        }
+        org[k] = p->position[k] - d[k];
+    }
+    float t_enter = -INFINITY, best[3] = {0, 0, 0};
+    uint32_t plane = 0;
+    for (uint32_t i = 0; i < view->clip_count && i < SY_CLIP_PLANES_MAX; ++i) {
+        const float *q = view->clip_planes[i];
+        float s0 = q[0] * org[0] + q[1] * org[1] + q[2] * org[2] + q[3], ds = q[0] * d[0] + q[1] * d[1] + q[2] * d[2];
+        if (ds > 0.0f && -s0 / ds > t_enter) t_enter = -s0 / ds, plane = i + 1, memcpy(best, q, sizeof best);
+    }
+    if (!(t_enter > 0.0f && t_enter < 1.0f)) return;
+    const sy_mesh_data *md = sy_mesh_get(scene, (sy_mesh){p->mesh_id});
+    if (!md || p->primitive >= md->primitives.count) return;
+    const sy_primitive *pr = &md->primitives.items[p->primitive];
+    int closed = sy_mesh_closed(sy_blob_data(pr->positions), sy_primitive_vertex_count(pr), sy_blob_data(pr->indices),
+                                sy_primitive_triangle_count(pr));
+    float facing = (float)closed * (p->normal[0] * d[0] + p->normal[1] * d[1] + p->normal[2] * d[2]);
+    if (!closed || !(facing > 0.0f)) return; /* not closed, or the outside seen */
+    float nl = sqrtf(best[0] * best[0] + best[1] * best[1] + best[2] * best[2]), dl = 0.0f, depth = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+        p->position[k] = org[k] + t_enter * d[k];
+        p->normal[k] = -best[k] / nl; /* the cut face looks back at the eye */
+        dl += d[k] * d[k];
+    }
+    float fl = sqrtf(fwd[0] * fwd[0] + fwd[1] * fwd[1] + fwd[2] * fwd[2]);
+    for (int k = 0; k < 3; ++k) depth += (p->position[k] - eye[k]) * (fl > 0.0f ? fwd[k] / fl : 0.0f);
+    p->distance = t_enter * sqrtf(dl);
+    p->depth = depth;
+    p->cap_plane = plane;
+}
+
 static sy_result viewport_pick_pixel(sy_viewport *v, sy_scene *scene, sy_context_pool *pool, const uint32_t rect[4],
                                      uint32_t px, uint32_t py, sy_pick_result *out, sy_error *err)
 {
@@ -368,6 +411,7 @@ static sy_result viewport_pick_pixel(sy_viewport *v, sy_scene *scene, sy_context
     out->pixel_x = px;
     out->pixel_y = py;
     if (r == SY_OK) r = sy_context_pick(ctx, &view, rect[2], rect[3], px, py, out, err);
+    if (r == SY_OK && out->hit && view.clip_cap && view.clip_count) pick_on_cap(scene, &view, out);
     return r;
 }
 

@@ -127,88 +127,9 @@ void sy_mirror_flat_mesh_of(const sy_primitive *p, sy_mirror_flat_mesh *out)
     };
 }
 
-/* The slot of key in the open-addressed set of 2^bits keys (0 = empty): where it is, or the empty
- * slot where it would go. */
-static size_t edge_slot(const uint64_t *set, unsigned bits, uint64_t key)
-{
-    size_t mask = ((size_t)1 << bits) - 1u, i = (size_t)((key * 0x9E3779B97F4A7C15ull) >> (64u - bits));
-    while (set[i] && set[i] != key) i = (i + 1u) & mask;
-    return i;
-}
-
-static uint32_t hash_pos(const float *p)
-{
-    uint32_t w[3];
-    memcpy(w, p, sizeof w);
-    uint64_t h = 0x9E3779B97F4A7C15ull;
-    for (int k = 0; k < 3; ++k) { /* -0 welds to +0; a 64-bit mix of each word (splitmix64's finalizer) */
-        h ^= w[k] == 0x80000000u ? 0u : w[k];
-        h *= 0xBF58476D1CE4E5B9ull;
-        h ^= h >> 31;
-    }
-    h *= 0x94D049BB133111EBull;
-    return (uint32_t)(h >> 32);
-}
-
 int sy_mirror_flat_mesh_closed(const sy_mirror_flat_mesh *m)
 {
-    if (!m->positions || !m->triangle_count || m->triangle_count > SY_MIRROR_FLAT_CLOSED_MAX || !m->vertex_count) return 0;
-    const uint32_t nv = m->vertex_count, nt = m->triangle_count;
-    uint32_t cap = 1;
-    while (cap < 2u * nv) cap <<= 1;
-    uint32_t *slot = malloc((size_t)cap * sizeof *slot), *weld = malloc((size_t)nv * sizeof *weld);
-    unsigned bits = 4; /* the directed edges' hash set: at least twice their count */
-    while (((size_t)1 << bits) < 6u * (size_t)nt) bits++;
-    uint64_t *edge = calloc((size_t)1 << bits, sizeof *edge);
-    bool closed = slot && weld && edge;
-    double vol = 0.0; /* six times the signed volume */
-    if (closed) {
-        memset(slot, 0xff, (size_t)cap * sizeof *slot);
-        for (uint32_t v = 0; v < nv; ++v) { /* weld by exact position: the first vertex at a point names it */
-            const float *p = m->positions + 3u * v;
-            uint32_t h = hash_pos(p) & (cap - 1);
-            for (;; h = (h + 1) & (cap - 1)) {
-                if (slot[h] == UINT32_MAX) {
-                    slot[h] = v;
-                    weld[v] = v;
-                    break;
-                }
-                const float *q = m->positions + 3u * slot[h];
-                if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) {
-                    weld[v] = slot[h];
-                    break;
-                }
-            }
-        }
-        size_t ne = 0; /* each directed edge once (a key is never 0: its ends differ) */
-        for (uint32_t t = 0; t < nt && closed; ++t) {
-            uint32_t i[3];
-            for (int k = 0; k < 3; ++k) {
-                uint32_t x = m->indices ? m->indices[3u * t + k] : 3u * t + k;
-                if (x >= nv) closed = false;
-                i[k] = closed ? weld[x] : 0;
-            }
-            if (i[0] == i[1] || i[1] == i[2] || i[2] == i[0]) continue; /* degenerate: no area, no edges */
-            for (int k = 0; k < 3 && closed; ++k) {
-                uint64_t key = (uint64_t)i[k] << 32 | i[(k + 1) % 3];
-                size_t at = edge_slot(edge, bits, key);
-                if (edge[at]) closed = false; /* an edge used twice the same way */
-                edge[at] = key;
-                ne++;
-            }
-            const float *p0 = m->positions + 3u * i[0], *p1 = m->positions + 3u * i[1], *p2 = m->positions + 3u * i[2];
-            vol += p0[0] * ((double)p1[1] * p2[2] - (double)p1[2] * p2[1]) +
-                   p0[1] * ((double)p1[2] * p2[0] - (double)p1[0] * p2[2]) +
-                   p0[2] * ((double)p1[0] * p2[1] - (double)p1[1] * p2[0]);
-        }
-        closed = closed && ne > 0;
-        for (size_t e = 0; closed && e < ((size_t)1 << bits); ++e) /* and its reverse present */
-            if (edge[e] && !edge[edge_slot(edge, bits, edge[e] << 32 | edge[e] >> 32)]) closed = false;
-    }
-    free(slot);
-    free(weld);
-    free(edge);
-    return !closed || !(vol != 0.0) ? 0 : vol > 0.0 ? 1 : -1;
+    return sy_mesh_closed(m->positions, m->vertex_count, m->indices, m->triangle_count);
 }
 
 void sy_mirror_flat_light_of(const sy_light_data *l, const float position[3], const float direction[3],

@@ -165,16 +165,7 @@ void sy_mirror_flat_material_of(const sy_material_data *d, sy_mirror_flat_handle
 /** Describes a triangle primitive (its blobs as arrays, its counts). */
 void sy_mirror_flat_mesh_of(const sy_primitive *p, sy_mirror_flat_mesh *out);
 
-/** Whether the mesh is a closed, consistently wound surface (the solids section caps fill): with
- * its vertices welded by exact position, every directed edge (a, b) of a non-degenerate triangle
- * occurs once and its reverse (b, a) once too. 1: closed and wound counter-clockwise seen from
- * outside (its signed volume is positive), -1: closed and wound the other way, 0: open,
- * non-manifold, empty, flat (no volume), above SY_MIRROR_FLAT_CLOSED_MAX triangles, or out of
- * memory. O(triangles): hash sets of the welded positions and the directed edges (at most 64 bytes
- * a triangle while it runs); about 0.3 s of CPU per 10^6 triangles (a closed 2 x 10^6-triangle
- * torus: 0.62 s, where sorting the edges took 0.94 s). The mediators call it once per primitive
- * they create. */
-#define SY_MIRROR_FLAT_CLOSED_MAX (1u << 20) /**< the most triangles sy_mirror_flat_mesh_closed checks */
+/** sy_mesh_closed (core/sy_math.h) of a flat mesh: 1 closed and wound outward, -1 inward, 0 not closed. */
 int sy_mirror_flat_mesh_closed(const sy_mirror_flat_mesh *m);
 
 /** Describes a light at a world position and direction. */

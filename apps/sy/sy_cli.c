@@ -259,6 +259,7 @@ static const char usage_text[] =
             "             triangle, barycentrics, position, normal, material, distance; \"hit\": false on a miss)\n"
             "            [--measure]   (two points X1 Y1 X2 Y2: {\"picks\", \"distance\", \"delta\", \"unit\": \"m\"}, scene units)\n"
             "            [--plane A,B,C,D]   (each hit's signed distance from the plane: \"plane_distance\")\n"
+            "            [--clip-cap RRGGBB]   (with --clip: a pick through a cut closed mesh lands on its cap, \"cap\": N)\n"
             "  sy backends [--params] [--json]\n"
             "  sy serve [--listen tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png] (sy serve --help)\n"
             "  sy render SCENE -b BACKEND -o OUT --cluster URL[,URL...]|FILE.conf\n"

@@ -62,6 +62,7 @@ static cJSON *pick_json(const sy_scene *s, double x, double y, const sy_pick_res
     sy_json_add(o, "material", object_ref(s, SY_TYPE_MATERIAL, p->material_id));
     sy_json_add(o, "distance", sy_json_float(p->distance));
     sy_json_add(o, "depth", sy_json_float(p->depth));
+    if (p->cap_plane) sy_json_add(o, "cap", cJSON_CreateNumber(p->cap_plane)); /* the section plane whose cap was hit */
     double pd;
     sy_error e = {0};
     if (plane && sy_plane_distance(plane, p->position, &pd, &e) == SY_OK) sy_json_add(o, "plane_distance", sy_json_float((float)pd));
@@ -75,12 +76,14 @@ int sy_cmd_pick(int argc, char **argv)
     uint32_t w = 0, h = 0;
     float planes[SY_CLIP_PLANES_MAX][4], plane[4];
     uint32_t nplanes = 0;
-    bool measure = false, has_plane = false;
+    bool measure = false, has_plane = false, cap = false;
+    float cap_rgb[3];
     const sy_cli_opt opts[] = {SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera),
                                SY_CLI_OPT_CODE("clip", OPT_CLIP, true), SY_CLI_OPT_TEXT("params", OPT_PARAMS, &params),
                                SY_CLI_OPT_FLAG("json", OPT_JSON, NULL), /* the output is JSON anyway */
                                SY_CLI_OPT_FLAG("measure", OPT_MEASURE, &measure), /* two points: their distance */
-                               SY_CLI_OPT_CODE("plane", OPT_PLANE, true)}; /* each hit's distance from a plane */
+                               SY_CLI_OPT_CODE("plane", OPT_PLANE, true), /* each hit's distance from a plane */
+                               SY_CLI_OPT_CODE("clip-cap", OPT_CLIP_CAP, true)}; /* picks on the caps */
     sy_cli_parser p = {SY_CLI_ARGS("pick", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .view = true};
     int c;
     while ((c = sy_cli_parse(&p)) != -1) {
@@ -88,6 +91,8 @@ int sy_cmd_pick(int argc, char **argv)
         if (c == OPT_CLIP && sy_cli_add_clip_plane(optarg, planes, &nplanes)) return 2;
         if (c == OPT_PLANE && sy_cli_parse_plane("--plane", optarg, plane)) return 2;
         if (c == OPT_PLANE) has_plane = true;
+        if (c == OPT_CLIP_CAP && sy_cli_parse_cap_color(optarg, cap_rgb)) return 2;
+        if (c == OPT_CLIP_CAP) cap = true;
     }
     if (optind >= argc) return sy_cli_usage_of("pick", "a SCENE and pixel coordinates X Y are required");
     scene = argv[optind++];
@@ -152,6 +157,7 @@ int sy_cmd_pick(int argc, char **argv)
     sy_result r = sy_window_create(w, h, &win, &err);
     if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, &err);
     if (r == SY_OK && nplanes) r = sy_viewport_set_clip_planes(vp, (const float(*)[4])planes, nplanes, &err);
+    if (r == SY_OK && cap) r = sy_viewport_set_clip_cap(vp, cap_rgb, &err);
     if (r == SY_OK) r = sy_context_pool_create(&pool, &err);
     cJSON *doc = NULL, *list = NULL;
     if (r == SY_OK && pairs > 1) doc = list = cJSON_CreateArray();

@@ -304,6 +304,7 @@ static sy_result view_selection(sy_scene *scene, sy_context_pool *pool, const sy
         if (r == SY_OK) sy_viewport_set_view(vp, spec->view);
         if (r == SY_OK && spec->clip_count)
             r = sy_viewport_set_clip_planes(vp, (const float(*)[4])spec->clip_planes, spec->clip_count, err);
+        if (r == SY_OK && spec->clip_cap) r = sy_viewport_set_clip_cap(vp, spec->clip_cap_color, err); /* picks on caps */
         if (r == SY_OK) r = sy_window_pick(win, scene, pool, px, py, &p, err);
         sy_window_destroy(win);
         if (r == SY_OK) *picked = p;

@@ -10,6 +10,7 @@
 #     it is not
 #   - sy pick --measure: the distance equals the length of the printed delta and of the positions'
 #     difference; --plane 0,1,0,0: each hit's plane_distance is its y
+#   - sy pick --clip-cap: a pick through the cut lands on the cap ("cap": 1, on the plane); not without it
 #   - sy render --bookmark FILE:N renders the pixels of --look-at with the file's eye, target and up
 #     (exr_equal)
 # Needs ../shared/testdata (Box): exits 77 (skipped) naming what is missing.
@@ -118,6 +119,18 @@ for p in d["picks"]:
     assert abs(p["plane_distance"] - p["position"][1]) < 1e-6, p
 print("measure: %.6f m between %s and %s" % (d["distance"], a, b))
 EOF
+
+# a pick through the cut cube with --clip-cap lands on the cap: z = 0 (the plane), normal +z, "cap": 1
+run_ok "pick on a cap" pickcap "$SY" pick "$BOX" 32 32 -b whitted -w 64 -h 64 --look-at 0,0,3:0,0,0 --clip 0,0,-1,0 --clip-cap ff00ff
+python3 - "$TMP/pickcap.out" <<'EOF' || fail "pick on a cap: $(cat "$TMP/pickcap.out")"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["hit"] and d.get("cap") == 1, d
+assert abs(d["position"][2]) < 1e-5 and d["normal"][2] > 0.999, d
+print("pick on the cap: %s normal %s" % (d["position"], d["normal"]))
+EOF
+run_ok "pick inside" pickin "$SY" pick "$BOX" 32 32 -b whitted -w 64 -h 64 --look-at 0,0,3:0,0,0 --clip 0,0,-1,0
+grep -q '"cap"' "$TMP/pickin.out" && fail "a pick without --clip-cap names a cap: $(cat "$TMP/pickin.out")"
 
 # a saved view renders as --look-at from its eye, target and up
 printf '# saved\n3 1.5 1 2.5 0 0.1 0 0 1 0\n' >"$TMP/box.bookmarks"

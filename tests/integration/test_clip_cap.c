@@ -15,7 +15,9 @@
  *      >= 0.99 between back-ends), their
  *      depth is the plane's (within 0.5 %); without capping none is (one sees the cube's inside);
  *      a mirrored placement of the cube (scale -1 in x) is capped the same; an open box (the cube
- *      without one triangle) is never capped. test_it_clip_cap --write DIR writes the capped
+ *      without one triangle) is never capped. A pick of the centre pixel lands on the cap (the
+ *      plane, its normal facing the eye, cap_plane 1) with capping, on the inside without.
+ *      test_it_clip_cap --write DIR writes the capped
  *      images as EXR for looking at.
  *   4. Shadows see the caps: a cube cut open over a ground quad, a directional light shining into
  *      the cut: the ground under the cube stays in shadow in whitted and pathtracer (the cap and
@@ -302,6 +304,38 @@ static void test_caps(const char *write_dir)
                    inner_cap_without, inner_covered_without, inner);
         EXPECT_MSG(open_cap == 0, "%s: an open box is capped (%u pixels)", be[i], open_cap);
         if (with.depth) EXPECT_MSG(depth_err < 5e-3, "%s: the cap is not at the plane's depth (%.3g)", be[i], depth_err);
+        /* picks: on the cap (the plane, its normal facing the eye, cap_plane 1) with capping, on the
+         * inside (a back face, no cap) without; the centre pixel sees the cut face */
+        for (int capped = 0; capped < 2 && (sy_mediator_class_caps(cls, NULL) & SY_CAP_PICK); ++capped) {
+            sy_viewport *vp;
+            sy_viewport_desc vd = {.backend = be[i]};
+            sy_window *win = it_window(W, H, &vd, &vp);
+            sy_viewport_set_view(vp, &cam);
+            MUST(sy_viewport_set_clip_planes(vp, cut, 1, err));
+            MUST(sy_viewport_set_clip_cap(vp, capped ? CAP : NULL, err));
+            sy_context_pool *pool;
+            MUST(sy_context_pool_create(&pool, err));
+            sy_pick_result p;
+            MUST(sy_window_pick(win, cube, pool, W / 2 + 0.5, H / 2 + 0.5, &p, err));
+            float o[3], d[3];
+            pixel_ray(&cam, W / 2, H / 2, o, d);
+            float t = (CUT_X - o[0]) / d[0];
+            if (capped) {
+                printf("pick on the cap, %s: (%.5f, %.5f, %.5f) normal (%.3f, %.3f, %.3f) plane %u, depth %.5f (want %.5f)\n",
+                       be[i], (double)p.position[0], (double)p.position[1], (double)p.position[2], (double)p.normal[0],
+                       (double)p.normal[1], (double)p.normal[2], p.cap_plane, (double)p.depth, (double)t);
+                EXPECT_MSG(p.hit && p.cap_plane == 1 && fabsf(p.position[0] - CUT_X) < 1e-4f && p.normal[0] > 0.999f &&
+                               fabsf(p.depth - t) < 1e-3f * t,
+                           "%s: the pick is not on the cap (plane %u, x %g, normal x %g)", be[i], p.cap_plane,
+                           (double)p.position[0], (double)p.normal[0]);
+            } else {
+                EXPECT_MSG(p.hit && p.cap_plane == 0 && p.position[0] < CUT_X - 0.01f,
+                           "%s: without caps the pick should see the inside (plane %u, x %g)", be[i], p.cap_plane,
+                           (double)p.position[0]);
+            }
+            sy_context_pool_destroy(pool);
+            sy_window_destroy(win);
+        }
         nb++;
         sy_layer_destroy(&with);
         sy_layer_destroy(&without);
