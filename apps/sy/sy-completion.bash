@@ -16,7 +16,7 @@ _sy_common="--help -q --quiet -v --verbose --env --env-color --env-intensity --e
             --no-default-light --allow-path --strict --max-scene-mb --variant"
 _sy_cluster="--cluster --cluster-mode --secret-file --tls-ca --timeout-ms --cluster-pixels"
 # options that take a value (the next word)
-_sy_with_value=" -b -o -w -h --camera --look-at --orbit --fov --hide --isolate --select --params --at --clip --max-memory --gl --filter --threshold --exposure --tonemap --stereo --eye-sep
+_sy_with_value=" -b -o -w -h --camera --look-at --orbit --fov --bookmark --bookmarks --clip-cap --plane --hide --isolate --select --params --at --clip --max-memory --gl --filter --threshold --exposure --tonemap --stereo --eye-sep
   --shutter --shutter-samples --zero-parallax --overlay --composite --frames --fps --repeat --spp --time --cluster --cluster-mode --secret-file --tls-ca
   --timeout-ms --cluster-pixels --screenshot --keys --top --backends --repeats --nodes --tris --reference --env
   --env-color --env-intensity --background --allow-path --max-scene-mb --variant --listen --output --port-file --tls-cert --tls-key --name
@@ -26,18 +26,18 @@ _sy_with_value=" -b -o -w -h --camera --look-at --orbit --fov --hide --isolate -
 # _sy_options COMMAND [BENCH_KIND]: the options of a command
 _sy_options() {
     case "${1:-}" in
-    render) echo "-b -o -w -h --camera --look-at --orbit --fov --hide --isolate --select --params --at --clip --max-memory --gl --filter --threshold --half --exposure --tonemap --stereo
+    render) echo "-b -o -w -h --camera --look-at --orbit --fov --bookmark --hide --isolate --select --params --at --clip --clip-cap --max-memory --gl --filter --threshold --half --exposure --tonemap --stereo
                   --eye-sep --zero-parallax --overlay --composite --frames --fps --resume --repeat --spp --time --aov --temporal
                   --shutter --motion-blur --shutter-samples
                   $_sy_cluster $_sy_common" ;;
-    view) echo "-b -w -h --camera --look-at --orbit --fov --hide --isolate --select --overlay --composite --frames --screenshot --filter --threshold --keys --spp --budget --no-temporal
+    view) echo "-b -w -h --camera --look-at --orbit --fov --bookmark --bookmarks --clip --clip-cap --hide --isolate --select --overlay --composite --frames --screenshot --filter --threshold --keys --spp --budget --no-temporal
                 $_sy_cluster $_sy_common" ;;
-    web) echo "-b -w -h --camera --look-at --orbit --fov --hide --isolate --select --listen --quality --filter --threshold --budget --client-render --no-temporal $_sy_common" ;;
+    web) echo "-b -w -h --camera --look-at --orbit --fov --bookmark --hide --isolate --select --listen --quality --filter --threshold --budget --client-render --no-temporal $_sy_common" ;;
     info) echo "--json $_sy_common" ;;
     compare) echo "-w -h -o --spp --camera --backends $_sy_common" ;;
     convert) echo "-o $_sy_common" ;;
     coverage) echo "-w -h --camera --top --json $_sy_common" ;;
-    pick) echo "-b -w -h --camera --look-at --orbit --fov --hide --isolate --select --params --clip --json $_sy_common" ;;
+    pick) echo "-b -w -h --camera --look-at --orbit --fov --bookmark --hide --isolate --select --params --clip --clip-cap --measure --plane --json $_sy_common" ;;
     demo) echo "-o -w -h --filter $_sy_common" ;;
     backends) echo "--json --params $_sy_common" ;;
     serve) echo "--listen --secret-file --output --port-file --tls-cert --tls-key --name --max-sessions
