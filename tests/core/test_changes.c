@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "../support/sy_check.h"
+#include "../support/sy_scene_test.h"
 #include "../support/sy_test_rng.h"
 #include "sy_changes.h"
 #include "sy_fields.h" /* internal to core: generic field compare for deep equality of entries */
@@ -14,17 +15,6 @@ static const float Q0[4] = {0, 0, 0, 1}, S1[3] = {1, 1, 1};
 
 static uint64_t rng_state;
 static uint64_t rnd(void) { return sy_test_splitmix64(&rng_state); }
-
-static sy_blob *blob_of(const void *data, size_t size)
-{
-    sy_blob *b = NULL;
-    sy_error e = {0};
-    if (sy_blob_create_copy(data, size, &b, &e) != SY_OK) {
-        fprintf(stderr, "blob: %s\n", e.message);
-        abort();
-    }
-    return b;
-}
 
 static const sy_change *find_entry(const sy_changes *c, uint32_t type, uint32_t id)
 {
@@ -97,7 +87,7 @@ static int build_rich(sy_scene *s, rich *r)
     CHECK_OK(sy_texture_create(s, NULL, &r->env, &e), e);
     uint8_t px[2 * 3 * 4];
     for (int i = 0; i < 24; ++i) px[i] = (uint8_t)(i * 11);
-    r->pixels = blob_of(px, sizeof px);
+    r->pixels = sy_test_blob(px, sizeof px);
     sy_image_info info = {2, 3, 4, SY_PIXEL_U8_SRGB};
     CHECK_OK(sy_texture_set_image(s, r->tex, &info, r->pixels, &e), e);
     CHECK_OK(sy_texture_set_image(s, r->env, &info, r->pixels, &e), e); /* the same blob twice */
@@ -126,16 +116,16 @@ static int build_rich(sy_scene *s, rich *r)
     const float uv[4][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
     const float col[4][4] = {{1, 0, 0, 1}, {0, 1, 0, 1}, {0, 0, 1, 1}, {1, 1, 1, 0.5f}};
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    r->pos = blob_of(pos, sizeof pos);
-    sy_blob *bn = blob_of(nrm, sizeof nrm), *bt = blob_of(tan, sizeof tan), *buv = blob_of(uv, sizeof uv);
-    sy_blob *bc = blob_of(col, sizeof col), *bi = blob_of(idx, sizeof idx);
-    sy_blob *tri = blob_of(pos, 36);
+    r->pos = sy_test_blob(pos, sizeof pos);
+    sy_blob *bn = sy_test_blob(nrm, sizeof nrm), *bt = sy_test_blob(tan, sizeof tan), *buv = sy_test_blob(uv, sizeof uv);
+    sy_blob *bc = sy_test_blob(col, sizeof col), *bi = sy_test_blob(idx, sizeof idx);
+    sy_blob *tri = sy_test_blob(pos, 36);
     /* skin attributes (4 influences) and two morph targets on the first primitive: version 5 */
     const uint32_t jnt[16] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
     const float wgt[16] = {1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0, 1, 0, 0, 0};
     float dpos[24];
     for (int k = 0; k < 24; ++k) dpos[k] = 0.125f * (float)(k % 5);
-    sy_blob *bj = blob_of(jnt, sizeof jnt), *bw = blob_of(wgt, sizeof wgt), *bdp = blob_of(dpos, sizeof dpos);
+    sy_blob *bj = sy_test_blob(jnt, sizeof jnt), *bw = sy_test_blob(wgt, sizeof wgt), *bdp = sy_test_blob(dpos, sizeof dpos);
     sy_primitive prims[3] = {
         {r->pos, bn, bt, buv, buv, bc, bi, r->mat, SY_TOPOLOGY_TRIANGLES, 0.0f, bj, bw, bdp, bdp, NULL},
         {r->pos, NULL, NULL, NULL, NULL, NULL, bi, {0}, SY_TOPOLOGY_TRIANGLES, 0.0f, NULL, NULL, NULL, NULL, NULL}, /* shares positions and indices */
@@ -194,7 +184,7 @@ static int build_rich(sy_scene *s, rich *r)
     CHECK_OK(sy_node_set_weights(s, r->a, nw, 2, &e), e);
     CHECK_OK(sy_node_set_skin(s, r->a, &r->b, &ibm, 1, r->root, &e), e);
 
-    r->attach_blob = blob_of("volume shader bytes", 19);
+    r->attach_blob = sy_test_blob("volume shader bytes", 19);
     sy_attachment at[5] = {
         {.key = "i", .kind = SY_ATTACH_INT, .value.i = -123456789012345ll},
         {.key = "f", .kind = SY_ATTACH_FLOAT, .value.f = 2.5},
@@ -216,12 +206,9 @@ static void rich_release(rich *r)
 }
 
 /* ------------------------------------------------------------------ commit entries */
-static int test_commit_entries(void)
+SY_SCENE_TEST(test_commit_entries)
 {
     sy_error e = {0};
-    long live0 = sy_blob_live_count();
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     uint32_t con;
     CHECK_OK(sy_scene_consumer_add(s, &con, &e), e);
     sy_changes *c;
@@ -306,8 +293,6 @@ static int test_commit_entries(void)
     /* unknown consumers */
     CHECK_ERR(sy_scene_consumer_pull(s, 0, &c, &e), SY_ERR_INVALID_HANDLE, e);
     CHECK_ERR(sy_scene_consumer_pull(s, 99, &c, &e), SY_ERR_INVALID_HANDLE, e);
-    sy_scene_destroy(s);
-    CHECK(sy_blob_live_count() == live0);
     return 0;
 }
 
@@ -377,12 +362,10 @@ static int check_merged(sy_changes *const *frames, uint32_t nframes, const sy_ch
     return 0;
 }
 
-static int test_two_consumers(void)
+SY_SCENE_TEST(test_two_consumers)
 {
     sy_error e = {0};
-    long live0 = sy_blob_live_count();
-    sy_scene *s, *ra, *rb;
-    CHECK_OK(sy_scene_create(&s, &e), e);
+    sy_scene *ra, *rb;
     CHECK_OK(sy_scene_create(&ra, &e), e);
     CHECK_OK(sy_scene_create(&rb, &e), e);
     uint32_t ca, cb;
@@ -482,22 +465,17 @@ static int test_two_consumers(void)
     CHECK_OK(sy_node_set_flags(s, nodes[nn - 2], 0, &e), e);
     CHECK_OK(sy_scene_commit(s, NULL, &e), e);
     CHECK(sy_scene_log_length(s) == 0);
-    sy_scene_destroy(s);
     sy_scene_destroy(ra);
     sy_scene_destroy(rb);
-    CHECK(sy_blob_live_count() == live0);
     return 0;
 }
 
 /* ------------------------------------------------------------------ snapshots for new consumers */
-static int test_late_consumers(void)
+SY_SCENE_TEST(test_late_consumers)
 {
-    sy_error e = {0};
-    long live0 = sy_blob_live_count();
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     rich r;
     CHECK(build_rich(s, &r) == 0);
+    sy_error e = {0};
     CHECK_OK(sy_scene_commit(s, NULL, &e), e);
     sy_node extra;
     CHECK_OK(sy_node_create(s, "extra", &extra, &e), e);
@@ -585,21 +563,17 @@ static int test_late_consumers(void)
     sy_scene_destroy(rep);
     sy_scene_destroy(rep2);
     sy_scene_destroy(rep3);
-    sy_scene_destroy(s);
     rich_release(&r);
-    CHECK(sy_blob_live_count() == live0);
     return 0;
 }
 
 /* A snapshot applied to a replica that already holds an older state (a consumer resynchronising,
  * e.g. after a commit could not record its frame) must leave the replica equal to the origin:
  * objects the snapshot does not list are gone, listed ones are updated in place. */
-static int test_resync_snapshot(void)
+SY_SCENE_TEST(test_resync_snapshot)
 {
     sy_error e = {0};
-    long live0 = sy_blob_live_count();
-    sy_scene *s, *rep;
-    CHECK_OK(sy_scene_create(&s, &e), e);
+    sy_scene *rep;
     CHECK_OK(sy_scene_create(&rep, &e), e);
     rich r;
     CHECK(build_rich(s, &r) == 0);
@@ -626,20 +600,16 @@ static int test_resync_snapshot(void)
     sy_changes_release(snap1);
     sy_changes_release(snap2);
     sy_scene_destroy(rep);
-    sy_scene_destroy(s);
     rich_release(&r);
-    CHECK(sy_blob_live_count() == live0);
     return 0;
 }
 
 /* ------------------------------------------------------------------ wire format */
 
 /* A change list with creations, updates, destructions and every field kind. */
-static int make_lists(sy_scene **s_out, rich *r, sy_changes **snapshot, sy_changes **update)
+static int make_lists(sy_scene *s, rich *r, sy_changes **snapshot, sy_changes **update)
 {
     sy_error e = {0};
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     uint32_t con;
     CHECK_OK(sy_scene_consumer_add(s, &con, &e), e);
     CHECK(build_rich(s, r) == 0);
@@ -657,15 +627,22 @@ static int make_lists(sy_scene **s_out, rich *r, sy_changes **snapshot, sy_chang
     CHECK_OK(sy_node_add_child(s, r->root, n, &e), e);
     uint8_t big[3000];
     for (size_t i = 0; i < sizeof big; ++i) big[i] = (uint8_t)(i * 7 + 1);
-    sy_blob *bb = blob_of(big, sizeof big);
+    sy_blob *bb = sy_test_blob(big, sizeof big);
     sy_image_info info = {10, 100, 3, SY_PIXEL_U8_LINEAR};
     CHECK_OK(sy_texture_set_image(s, r->env, &info, bb, &e), e);
     sy_blob_release(bb);
     CHECK_OK(sy_scene_commit(s, NULL, &e), e);
     CHECK_OK(sy_scene_consumer_pull(s, con, update, &e), e);
     CHECK(sy_changes_get_stats(*update).destroyed == 2 && sy_changes_get_stats(*update).created == 1);
-    *s_out = s;
     return 0;
+}
+
+/* Releases what make_lists made (the scene is the caller's). */
+static void release_lists(rich *r, sy_changes *snapshot, sy_changes *update)
+{
+    sy_changes_release(snapshot);
+    sy_changes_release(update);
+    rich_release(r);
 }
 
 static int round_trip(const sy_changes *c)
@@ -695,14 +672,12 @@ static int round_trip(const sy_changes *c)
     return 0;
 }
 
-static int test_round_trip(void)
+SY_SCENE_TEST(test_round_trip)
 {
     sy_error e = {0};
-    long live0 = sy_blob_live_count();
-    sy_scene *s;
     rich r;
     sy_changes *snap, *upd;
-    CHECK(make_lists(&s, &r, &snap, &upd) == 0);
+    CHECK(make_lists(s, &r, &snap, &upd) == 0);
     CHECK(round_trip(snap) == 0);
     CHECK(round_trip(upd) == 0);
     sy_changes *empty;
@@ -730,11 +705,7 @@ static int test_round_trip(void)
     CHECK_MSG(sy_scene_equal(s, rep, &e), "%s", e.message);
     sy_blob_store_destroy(store);
     sy_scene_destroy(rep);
-    sy_changes_release(snap);
-    sy_changes_release(upd);
-    sy_scene_destroy(s);
-    rich_release(&r);
-    CHECK(sy_blob_live_count() == live0);
+    release_lists(&r, snap, upd);
     return 0;
 }
 
@@ -750,14 +721,12 @@ static bool send_none(void *user, const sy_blob *b)
     return false;
 }
 
-static int test_blob_once(void)
+SY_SCENE_TEST(test_blob_once)
 {
     sy_error e = {0};
-    long live0 = sy_blob_live_count();
-    sy_scene *s;
     rich r;
     sy_changes *snap, *upd;
-    CHECK(make_lists(&s, &r, &snap, &upd) == 0);
+    CHECK(make_lists(s, &r, &snap, &upd) == 0);
 
     void *full, *lean;
     size_t full_size, lean_size;
@@ -826,11 +795,7 @@ static int test_blob_once(void)
     free(lean);
     sy_blob_store_destroy(recv);
     sy_blob_store_destroy(empty);
-    sy_changes_release(snap);
-    sy_changes_release(upd);
-    sy_scene_destroy(s);
-    rich_release(&r);
-    CHECK(sy_blob_live_count() == live0);
+    release_lists(&r, snap, upd);
     return 0;
 }
 
@@ -961,7 +926,7 @@ static int test_decoder_errors(void)
         sy_texture t;
         CHECK_OK(sy_texture_create(s, NULL, &t, &e), e);
         uint8_t px[4] = {1, 2, 3, 4};
-        sy_blob *b = blob_of(px, 4);
+        sy_blob *b = sy_test_blob(px, 4);
         sy_image_info info = {1, 1, 4, SY_PIXEL_U8_SRGB};
         CHECK_OK(sy_texture_set_image(s, t, &info, b, &e), e);
         CHECK_OK(sy_scene_commit(s, NULL, &e), e);
@@ -1054,14 +1019,12 @@ static int decode_and_use(const void *data, size_t size, const sy_changes *base_
     return 0;
 }
 
-static int test_decoder_fuzz(void)
+SY_SCENE_TEST(test_decoder_fuzz)
 {
-    sy_error e = {0};
-    long live0 = sy_blob_live_count();
-    sy_scene *s;
     rich r;
     sy_changes *snap, *upd;
-    CHECK(make_lists(&s, &r, &snap, &upd) == 0);
+    CHECK(make_lists(s, &r, &snap, &upd) == 0);
+    sy_error e = {0};
     sy_changes *msgs[2] = {snap, upd};
     rng_state = 7;
     long ok = 0, total = 0;
@@ -1140,11 +1103,7 @@ static int test_decoder_fuzz(void)
     }
     printf("decoder fuzz: %ld inputs, %ld decoded to a valid list\n", total, ok);
     CHECK(ok > 0); /* some mutations (in float values) must still decode */
-    sy_changes_release(snap);
-    sy_changes_release(upd);
-    sy_scene_destroy(s);
-    rich_release(&r);
-    CHECK(sy_blob_live_count() == live0);
+    release_lists(&r, snap, upd);
     return 0;
 }
 

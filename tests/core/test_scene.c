@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "../support/sy_check.h"
+#include "../support/sy_scene_test.h"
 #include "sy_changes.h"
 #include "sy_scene.h"
 
@@ -31,23 +32,18 @@ static const sy_change *find_entry(const sy_changes *c, uint32_t type, uint32_t 
     return NULL;
 }
 
-static sy_blob *blob_of(const void *data, size_t size)
+/* Creates one node per name, in order: names[i] into *out[i]. */
+static int create_nodes(sy_scene *s, size_t n, const char *const *names, sy_node *const *out)
 {
-    sy_blob *b = NULL;
     sy_error e = {0};
-    if (sy_blob_create_copy(data, size, &b, &e) != SY_OK) {
-        fprintf(stderr, "blob: %s\n", e.message);
-        abort();
-    }
-    return b;
+    for (size_t i = 0; i < n; ++i) CHECK_OK(sy_node_create(s, names[i], out[i], &e), e);
+    return 0;
 }
 
 /* ------------------------------------------------------------------ handles */
-static int test_handles(void)
+SY_SCENE_TEST(test_handles)
 {
     sy_error e = {0};
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     sy_node a, b;
     CHECK_OK(sy_node_create(s, "a", &a, &e), e);
     CHECK_OK(sy_node_create(s, NULL, &b, &e), e);
@@ -119,18 +115,14 @@ static int test_handles(void)
     CHECK((ids[0] & SY_HANDLE_INDEX_MASK) != (ids[SY_HANDLE_MAX_GENERATION] & SY_HANDLE_INDEX_MASK));
     free(ids);
     CHECK(sy_scene_count(s, SY_TYPE_LIGHT) == 0);
-    sy_scene_destroy(s);
     sy_scene_destroy(NULL);
     return 0;
 }
 
 /* ------------------------------------------------------------------ dirty marks and no-op sets */
-static int test_dirty_noop(void)
+SY_SCENE_TEST(test_dirty_noop)
 {
     sy_error e = {0};
-    long live0 = sy_blob_live_count();
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     uint32_t con;
     CHECK_OK(sy_scene_consumer_add(s, &con, &e), e);
     CHECK(!sy_scene_has_pending(s));
@@ -219,18 +211,13 @@ static int test_dirty_noop(void)
     tr.matrix = sy_mat4_identity();
     CHECK_OK(sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_TRANSFORM, &tr, &e), e);
     CHECK(sy_node_get(s, n)->transform.matrix.m[12] == 4.0f && sy_node_get(s, n)->transform.matrix.m[14] == 6.0f);
-    sy_scene_destroy(s);
-    CHECK(sy_blob_live_count() == live0);
     return 0;
 }
 
 /* ------------------------------------------------------------------ validation */
-static int test_validation(void)
+SY_SCENE_TEST(test_validation)
 {
     sy_error e = {0};
-    long live0 = sy_blob_live_count();
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     sy_node n;
     CHECK_OK(sy_node_create(s, "n", &n, &e), e);
     CHECK_OK(sy_scene_commit(s, NULL, &e), e);
@@ -271,11 +258,11 @@ static int test_validation(void)
     CHECK_OK(sy_mesh_create(s, "m", &m, &e), e);
     const float pos[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     const uint32_t idx_ok[6] = {0, 1, 2, 0, 2, 3}, idx_bad[6] = {0, 1, 2, 0, 2, 4};
-    sy_blob *bpos = blob_of(pos, sizeof pos), *bpos3 = blob_of(pos, 3 * 12), *bodd = blob_of(pos, 13);
-    sy_blob *bidx = blob_of(idx_ok, sizeof idx_ok), *bidx_bad = blob_of(idx_bad, sizeof idx_bad);
-    sy_blob *bidx_part = blob_of(idx_ok, 5 * 4), *bnorm3 = blob_of(pos, 3 * 12), *bnorm4 = blob_of(pos, 4 * 12);
+    sy_blob *bpos = sy_test_blob(pos, sizeof pos), *bpos3 = sy_test_blob(pos, 3 * 12), *bodd = sy_test_blob(pos, 13);
+    sy_blob *bidx = sy_test_blob(idx_ok, sizeof idx_ok), *bidx_bad = sy_test_blob(idx_bad, sizeof idx_bad);
+    sy_blob *bidx_part = sy_test_blob(idx_ok, 5 * 4), *bnorm3 = sy_test_blob(pos, 3 * 12), *bnorm4 = sy_test_blob(pos, 4 * 12);
     float nanpos[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, NAN, 0}};
-    sy_blob *bnan = blob_of(nanpos, sizeof nanpos);
+    sy_blob *bnan = sy_test_blob(nanpos, sizeof nanpos);
     sy_primitive p = {.positions = bpos, .indices = bidx};
     CHECK_OK(sy_mesh_set_primitives(s, m, &p, 1, &e), e);
     p.indices = bidx_bad; /* index 4 with 4 vertices */
@@ -326,7 +313,7 @@ static int test_validation(void)
     CHECK_OK(sy_texture_create(s, "t", &tex, &e), e);
     sy_image_info info = {2, 2, 4, SY_PIXEL_U8_SRGB};
     uint8_t px[16] = {0};
-    sy_blob *bpx = blob_of(px, 16), *bpx15 = blob_of(px, 15);
+    sy_blob *bpx = sy_test_blob(px, 16), *bpx15 = sy_test_blob(px, 15);
     CHECK_OK(sy_texture_set_image(s, tex, &info, bpx, &e), e);
     CHECK_ERR(sy_texture_set_image(s, tex, &info, bpx15, &e), SY_ERR_INVALID_ARGUMENT, e);
     CHECK_ERR(sy_texture_set_image(s, tex, &info, NULL, &e), SY_ERR_INVALID_ARGUMENT, e);
@@ -371,7 +358,9 @@ static int test_validation(void)
     CHECK(sy_material_get(s, (sy_material){0})->roughness == 1.0f); /* {0}: defaults */
 
     sy_light l;
+    sy_camera cam;
     CHECK_OK(sy_light_create(s, "l", &l, &e), e);
+    CHECK_OK(sy_camera_create(s, "c", &cam, &e), e);
     sy_light_data ld = *sy_light_get(s, l);
     ld.intensity = -1;
     CHECK_ERR(sy_light_set(s, l, &ld, &e), SY_ERR_INVALID_ARGUMENT, e);
@@ -380,8 +369,6 @@ static int test_validation(void)
     CHECK_ERR(sy_light_set(s, l, &ld, &e), SY_ERR_INVALID_ARGUMENT, e);
     ld.type = SY_LIGHT_SPOT;
     CHECK_OK(sy_light_set(s, l, &ld, &e), e);
-    sy_camera cam;
-    CHECK_OK(sy_camera_create(s, "c", &cam, &e), e);
     sy_camera_data cd = *sy_camera_get(s, cam);
     cd.yfov = 0;
     CHECK_ERR(sy_camera_set(s, cam, &cd, &e), SY_ERR_INVALID_ARGUMENT, e);
@@ -413,23 +400,15 @@ static int test_validation(void)
 
     sy_blob *all[] = {bpos, bpos3, bodd, bidx, bidx_bad, bidx_part, bnorm3, bnorm4, bnan, bpx, bpx15};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; ++i) sy_blob_release(all[i]);
-    sy_scene_destroy(s);
-    CHECK(sy_blob_live_count() == live0);
     return 0;
 }
 
 /* ------------------------------------------------------------------ children: cycles, duplicates, stale */
-static int test_children_validation(void)
+SY_SCENE_TEST(test_children_validation)
 {
     sy_error e = {0};
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     sy_node a, b, c, d, x;
-    CHECK_OK(sy_node_create(s, "a", &a, &e), e);
-    CHECK_OK(sy_node_create(s, "b", &b, &e), e);
-    CHECK_OK(sy_node_create(s, "c", &c, &e), e);
-    CHECK_OK(sy_node_create(s, "d", &d, &e), e);
-    CHECK_OK(sy_node_create(s, "x", &x, &e), e);
+    CHECK(create_nodes(s, 5, (const char *const[]){"a", "b", "c", "d", "x"}, (sy_node *const[]){&a, &b, &c, &d, &x}) == 0);
     CHECK_OK(sy_node_set_children(s, a, &b, 1, &e), e);
     CHECK_OK(sy_node_add_child(s, b, c, &e), e); /* a -> b -> c */
     CHECK(sy_node_parent_count(s, c) == 1 && sy_node_parent(s, c, 0).id == b.id);
@@ -454,7 +433,7 @@ static int test_children_validation(void)
     CHECK_ERR(sy_node_set_children(s, a, zero, 2, &e), SY_ERR_INVALID_HANDLE, e);
     /* a raw child blob that is not whole ids */
     uint8_t three[3] = {1, 2, 3};
-    sy_blob *b3 = blob_of(three, 3);
+    sy_blob *b3 = sy_test_blob(three, 3);
     CHECK_ERR(sy_object_set_field(s, SY_TYPE_NODE, a.id, SY_NODE_CHILDREN, &b3, &e), SY_ERR_INVALID_ARGUMENT, e);
     sy_blob_release(b3);
     /* nothing of that changed the graph */
@@ -490,20 +469,15 @@ static int test_children_validation(void)
     CHECK_OK(sy_node_add_child(s, a, y, &e), e);
     CHECK(sy_node_parent_count(s, y) == 1);
     CHECK_OK(sy_scene_commit(s, NULL, &e), e);
-    sy_scene_destroy(s);
     return 0;
 }
 
 /* ------------------------------------------------------------------ world matrices */
-static int test_world_chain(void)
+SY_SCENE_TEST(test_world_chain)
 {
     sy_error e = {0};
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     sy_node a, b, c;
-    CHECK_OK(sy_node_create(s, "a", &a, &e), e);
-    CHECK_OK(sy_node_create(s, "b", &b, &e), e);
-    CHECK_OK(sy_node_create(s, "c", &c, &e), e);
+    CHECK(create_nodes(s, 3, (const char *const[]){"a", "b", "c"}, (sy_node *const[]){&a, &b, &c}) == 0);
     const float h = (float)sqrt(0.5);
     const float ta[3] = {10, 0, 0}, tb[3] = {0, 5, 0}, qb[4] = {0, 0, h, h}, sc[3] = {2, 2, 2};
     CHECK_OK(sy_node_set_trs(s, a, ta, Q0, S1, &e), e);
@@ -551,7 +525,6 @@ static int test_world_chain(void)
     CHECK_OK(sy_node_world_matrix(s, c, &w, &e), e);
     CHECK(sy_mat4_equal(&w, mc));
     CHECK(sy_scene_last_commit_world_updates(s) == 1);
-    sy_scene_destroy(s);
     return 0;
 }
 
@@ -564,11 +537,9 @@ static int test_world_chain(void)
  *   |
  *   ll
  */
-static int test_world_incremental(void)
+SY_SCENE_TEST(test_world_incremental)
 {
     sy_error e = {0};
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     sy_node r, m1, m2, l1, l2, k, ll;
     sy_node *all[] = {&r, &m1, &m2, &l1, &l2, &k, &ll};
     for (int i = 0; i < 7; ++i) {
@@ -648,7 +619,6 @@ static int test_world_incremental(void)
     CHECK(sy_node_parent_count(s, k) == 0);
     CHECK_OK(sy_node_world_matrix(s, k, &w, &e), e);
     CHECK(sy_mat4_equal(&w, &sy_node_get(s, k)->transform.matrix));
-    sy_scene_destroy(s);
     return 0;
 }
 
@@ -657,7 +627,7 @@ static int make_tri_mesh(sy_scene *s, sy_mesh *m, const float pos[9])
 {
     sy_error e = {0};
     CHECK_OK(sy_mesh_create(s, "tri", m, &e), e);
-    sy_blob *b = blob_of(pos, 36);
+    sy_blob *b = sy_test_blob(pos, 36);
     sy_primitive p = {.positions = b};
     CHECK_OK(sy_mesh_set_primitives(s, *m, &p, 1, &e), e);
     sy_blob_release(b);
@@ -675,14 +645,11 @@ static int bounds_is(const sy_bounds *b, float x0, float y0, float z0, float x1,
     return 0;
 }
 
-static int test_bounds(void)
+SY_SCENE_TEST(test_bounds)
 {
     sy_error e = {0};
-    long live0 = sy_blob_live_count();
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
-    sy_mesh m;
     const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 2, 0};
+    sy_mesh m;
     CHECK(make_tri_mesh(s, &m, tri) == 0);
     sy_bounds b;
     CHECK_OK(sy_mesh_bounds(s, m, &b, &e), e);
@@ -719,7 +686,7 @@ static int test_bounds(void)
 
     /* changing the mesh data updates every user's bounds */
     const float tri2[9] = {0, 0, -1, 1, 1, 1, 0, 0, 0};
-    sy_blob *b2 = blob_of(tri2, 36);
+    sy_blob *b2 = sy_test_blob(tri2, 36);
     sy_primitive p = {.positions = b2};
     CHECK_OK(sy_mesh_set_primitives(s, m, &p, 1, &e), e);
     sy_blob_release(b2);
@@ -753,24 +720,17 @@ static int test_bounds(void)
     b = sy_scene_world_bounds(s);
     CHECK(sy_bounds_is_empty(&b));
     CHECK_ERR(sy_mesh_bounds(s, m2, &b, &e), SY_ERR_INVALID_HANDLE, e);
-    sy_scene_destroy(s);
-    CHECK(sy_blob_live_count() == live0);
     return 0;
 }
 
-static int test_dag(void)
+SY_SCENE_TEST(test_dag)
 {
     sy_error e = {0};
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     sy_mesh m;
     const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     CHECK(make_tri_mesh(s, &m, tri) == 0);
     sy_node top, p1, p2, shared;
-    CHECK_OK(sy_node_create(s, "top", &top, &e), e);
-    CHECK_OK(sy_node_create(s, "p1", &p1, &e), e);
-    CHECK_OK(sy_node_create(s, "p2", &p2, &e), e);
-    CHECK_OK(sy_node_create(s, "shared", &shared, &e), e);
+    CHECK(create_nodes(s, 4, (const char *const[]){"top", "p1", "p2", "shared"}, (sy_node *const[]){&top, &p1, &p2, &shared}) == 0);
     const float t1[3] = {10, 0, 0}, t2[3] = {-10, 0, 0};
     CHECK_OK(sy_node_set_trs(s, p1, t1, Q0, S1, &e), e);
     CHECK_OK(sy_node_set_trs(s, p2, t2, Q0, S1, &e), e);
@@ -810,7 +770,6 @@ static int test_dag(void)
     CHECK(w.m[12] == -10 && w.m[13] == 5);
     CHECK_OK(sy_node_world_bounds(s, top, &b, &e), e);
     CHECK(bounds_is(&b, -10, 5, 0, -9, 6, 0, 0) == 0);
-    sy_scene_destroy(s);
     return 0;
 }
 
@@ -832,17 +791,11 @@ static sy_result walk_record(void *user, const sy_walk_step *st, sy_error *err)
     return SY_OK;
 }
 
-static int test_walk(void)
+SY_SCENE_TEST(test_walk)
 {
     sy_error e = {0};
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     sy_node top, p1, p2, shared, gone;
-    CHECK_OK(sy_node_create(s, "top", &top, &e), e);
-    CHECK_OK(sy_node_create(s, "p1", &p1, &e), e);
-    CHECK_OK(sy_node_create(s, "p2", &p2, &e), e);
-    CHECK_OK(sy_node_create(s, "shared", &shared, &e), e);
-    CHECK_OK(sy_node_create(s, "gone", &gone, &e), e);
+    CHECK(create_nodes(s, 5, (const char *const[]){"top", "p1", "p2", "shared", "gone"}, (sy_node *const[]){&top, &p1, &p2, &shared, &gone}) == 0);
     const float tt[3] = {0, 0, 1}, t1[3] = {10, 0, 0}, t2[3] = {-10, 0, 0}, ts[3] = {0, 5, 0}, s2[3] = {2, 2, 2};
     CHECK_OK(sy_node_set_trs(s, top, tt, Q0, S1, &e), e);
     CHECK_OK(sy_node_set_trs(s, p1, t1, Q0, S1, &e), e);
@@ -897,17 +850,14 @@ static int test_walk(void)
     memset(&w, 0, sizeof w);
     CHECK_OK(sy_scene_walk(s, gone, NULL, 0, walk_record, &w, &e), e);
     CHECK(w.n == 1 && w.stale[0]);
-    sy_scene_destroy(s);
     return 0;
 }
 
 /* Values every back-end refuses (or misreads) are refused by the core setters, naming the object,
  * the field and the reason (issue 33, item 8). */
-static int test_camera_clip_range(void)
+SY_SCENE_TEST(test_camera_clip_range)
 {
     sy_error e = {0};
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     uint32_t con;
     CHECK_OK(sy_scene_consumer_add(s, &con, &e), e);
     sy_camera cam;
@@ -949,15 +899,12 @@ static int test_camera_clip_range(void)
     sy_changes_release(c);
     CHECK(sy_camera_get(rep, cam)->znear == 200.0f && sy_camera_get(rep, cam)->zfar == 300.0f);
     sy_scene_destroy(rep);
-    sy_scene_destroy(s);
     return 0;
 }
 
-static int test_texture_info_validation(void)
+SY_SCENE_TEST(test_texture_info_validation)
 {
     sy_error e = {0};
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     sy_texture tex;
     CHECK_OK(sy_texture_create(s, "t", &tex, &e), e);
     /* an image with a size needs 1..4 channels (every back-end refuses 0) and a known pixel format
@@ -974,17 +921,14 @@ static int test_texture_info_validation(void)
     /* no image (the default, all zero) stays legal */
     sy_image_info none = {0, 0, 0, 0};
     CHECK_OK(sy_object_set_field(s, SY_TYPE_TEXTURE, tex.id, SY_TEXTURE_INFO, &none, &e), e);
-    sy_scene_destroy(s);
     return 0;
 }
 
 /* ------------------------------------------------------------------ attachments */
-static int test_attachments(void)
+SY_SCENE_TEST(test_attachments)
 {
     sy_error e = {0};
     long live0 = sy_blob_live_count();
-    sy_scene *s;
-    CHECK_OK(sy_scene_create(&s, &e), e);
     uint32_t con;
     CHECK_OK(sy_scene_consumer_add(s, &con, &e), e);
     sy_camera cam;
@@ -992,7 +936,7 @@ static int test_attachments(void)
     sy_changes_release(commit_pull(s, con));
 
     char key[8] = "bbb", val[16] = "volume";
-    sy_blob *blob = blob_of("payload", 7);
+    sy_blob *blob = sy_test_blob("payload", 7);
     sy_attachment a_int = {.key = key, .kind = SY_ATTACH_INT, .value.i = -7};
     sy_attachment a_str = {.key = "aaa", .kind = SY_ATTACH_STRING, .value.s = val};
     sy_attachment a_vec = {.key = "ccc", .kind = SY_ATTACH_VEC4, .value.v = {1, 2, 3, 4}};
@@ -1076,8 +1020,6 @@ static int test_attachments(void)
         CHECK_OK(sy_object_set_attachment(s, t, id, &a_vec, &e), e);
         CHECK(sy_object_find_attachment(s, t, id, "ccc") != NULL);
     }
-    sy_scene_destroy(s);
-    CHECK(sy_blob_live_count() == live0);
     return 0;
 }
 
