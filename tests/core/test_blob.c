@@ -55,8 +55,8 @@ static int test_hash(void)
 
 static int test_refcount_take(void)
 {
-    sy_error e = {0};
     long live0 = sy_blob_live_count();
+    sy_error e = {0};
     uint32_t *data = malloc(64 * sizeof *data);
     CHECK(data);
     for (uint32_t i = 0; i < 64; ++i) data[i] = i * 2654435761u;

@@ -208,7 +208,6 @@ static void rich_release(rich *r)
 /* ------------------------------------------------------------------ commit entries */
 SY_SCENE_TEST(test_commit_entries)
 {
-    sy_error e = {0};
     uint32_t con;
     CHECK_OK(sy_scene_consumer_add(s, &con, &e), e);
     sy_changes *c;
@@ -364,7 +363,6 @@ static int check_merged(sy_changes *const *frames, uint32_t nframes, const sy_ch
 
 SY_SCENE_TEST(test_two_consumers)
 {
-    sy_error e = {0};
     sy_scene *ra, *rb;
     CHECK_OK(sy_scene_create(&ra, &e), e);
     CHECK_OK(sy_scene_create(&rb, &e), e);
@@ -475,7 +473,6 @@ SY_SCENE_TEST(test_late_consumers)
 {
     rich r;
     CHECK(build_rich(s, &r) == 0);
-    sy_error e = {0};
     CHECK_OK(sy_scene_commit(s, NULL, &e), e);
     sy_node extra;
     CHECK_OK(sy_node_create(s, "extra", &extra, &e), e);
@@ -572,7 +569,6 @@ SY_SCENE_TEST(test_late_consumers)
  * objects the snapshot does not list are gone, listed ones are updated in place. */
 SY_SCENE_TEST(test_resync_snapshot)
 {
-    sy_error e = {0};
     sy_scene *rep;
     CHECK_OK(sy_scene_create(&rep, &e), e);
     rich r;
@@ -637,13 +633,34 @@ static int make_lists(sy_scene *s, rich *r, sy_changes **snapshot, sy_changes **
     return 0;
 }
 
-/* Releases what make_lists made (the scene is the caller's). */
-static void release_lists(rich *r, sy_changes *snapshot, sy_changes *update)
+/* The wire-format tests' fixture (SY_FIXTURE_TEST): a scene with make_lists's snapshot and update;
+ * the teardown releases them and checks that no blob outlived the scene. */
+typedef struct lists_fixture {
+    long live0;
+    sy_scene *s;
+    rich r;
+    sy_changes *snap, *upd;
+} lists_fixture;
+
+static int lists_setup(lists_fixture *f)
 {
-    sy_changes_release(snapshot);
-    sy_changes_release(update);
-    rich_release(r);
+    sy_error e = {0};
+    f->live0 = sy_blob_live_count();
+    CHECK_OK(sy_scene_create(&f->s, &e), e);
+    return make_lists(f->s, &f->r, &f->snap, &f->upd);
 }
+
+static void lists_teardown(lists_fixture *f)
+{
+    sy_changes_release(f->snap);
+    sy_changes_release(f->upd);
+    sy_scene_destroy(f->s);
+    rich_release(&f->r);
+    EXPECT_MSG(sy_blob_live_count() == f->live0, "%ld blob(s) alive after the scene, %ld before",
+               sy_blob_live_count(), f->live0);
+}
+
+#define LISTS_TEST(name) SY_FIXTURE_TEST(name, lists_fixture, lists_setup, lists_teardown)
 
 static int round_trip(const sy_changes *c)
 {
@@ -672,16 +689,13 @@ static int round_trip(const sy_changes *c)
     return 0;
 }
 
-SY_SCENE_TEST(test_round_trip)
+LISTS_TEST(test_round_trip)
 {
     sy_error e = {0};
-    rich r;
-    sy_changes *snap, *upd;
-    CHECK(make_lists(s, &r, &snap, &upd) == 0);
-    CHECK(round_trip(snap) == 0);
-    CHECK(round_trip(upd) == 0);
+    CHECK(round_trip(f->snap) == 0);
+    CHECK(round_trip(f->upd) == 0);
     sy_changes *empty;
-    CHECK_OK(sy_scene_consumer_pull(s, 1, &empty, &e), e);
+    CHECK_OK(sy_scene_consumer_pull(f->s, 1, &empty, &e), e);
     CHECK(sy_changes_count(empty) == 0);
     CHECK(round_trip(empty) == 0);
     sy_changes_release(empty);
@@ -691,7 +705,7 @@ SY_SCENE_TEST(test_round_trip)
     CHECK_OK(sy_scene_create(&rep, &e), e);
     sy_blob_store *store;
     CHECK_OK(sy_blob_store_create(&store, &e), e);
-    sy_changes *lists[2] = {snap, upd};
+    sy_changes *lists[2] = {f->snap, f->upd};
     for (int i = 0; i < 2; ++i) {
         void *data;
         size_t size;
@@ -702,10 +716,9 @@ SY_SCENE_TEST(test_round_trip)
         CHECK_OK(sy_scene_apply(rep, d, &e), e);
         sy_changes_release(d);
     }
-    CHECK_MSG(sy_scene_equal(s, rep, &e), "%s", e.message);
+    CHECK_MSG(sy_scene_equal(f->s, rep, &e), "%s", e.message);
     sy_blob_store_destroy(store);
     sy_scene_destroy(rep);
-    release_lists(&r, snap, upd);
     return 0;
 }
 
@@ -721,34 +734,31 @@ static bool send_none(void *user, const sy_blob *b)
     return false;
 }
 
-SY_SCENE_TEST(test_blob_once)
+LISTS_TEST(test_blob_once)
 {
     sy_error e = {0};
-    rich r;
-    sy_changes *snap, *upd;
-    CHECK(make_lists(s, &r, &snap, &upd) == 0);
 
     void *full, *lean;
     size_t full_size, lean_size;
     sy_blob_store *recv;
     CHECK_OK(sy_blob_store_create(&recv, &e), e);
-    CHECK_OK(sy_changes_serialize(snap, send_if_missing, recv, &full, &full_size, &e), e);
+    CHECK_OK(sy_changes_serialize(f->snap, send_if_missing, recv, &full, &full_size, &e), e);
     sy_changes *d;
     CHECK_OK(sy_changes_deserialize(full, full_size, recv, NULL, &d, &e), e);
-    CHECK(lists_equal(snap, d) == 0);
+    CHECK(lists_equal(f->snap, d) == 0);
     sy_changes_release(d);
     size_t stored = sy_blob_store_count(recv), bytes = sy_blob_store_bytes(recv);
     CHECK_MSG(stored == 17, "%zu", stored); /* pixels, pos, normals, tangents, uv, colours, indices, tri, 2 child lists, attach blob,
                                                joints, skin weights, target deltas (twice), mesh and node morph weights, node skin */
     /* the same list again: every payload is already there, none travels */
-    CHECK_OK(sy_changes_serialize(snap, send_if_missing, recv, &lean, &lean_size, &e), e);
+    CHECK_OK(sy_changes_serialize(f->snap, send_if_missing, recv, &lean, &lean_size, &e), e);
     CHECK_MSG(lean_size + bytes == full_size, "lean %zu + payloads %zu != full %zu", lean_size, bytes, full_size);
     CHECK_OK(sy_changes_deserialize(lean, lean_size, recv, NULL, &d, &e), e);
-    CHECK(lists_equal(snap, d) == 0);
+    CHECK(lists_equal(f->snap, d) == 0);
     CHECK(sy_blob_store_count(recv) == stored);
     /* decoded blobs are the store's (shared, not copied) */
-    const sy_change *en = find_entry(d, SY_TYPE_TEXTURE, r.tex.id);
-    CHECK(((const sy_texture_data *)en->data)->pixels == sy_blob_store_get(recv, sy_blob_hash(r.pixels)));
+    const sy_change *en = find_entry(d, SY_TYPE_TEXTURE, f->r.tex.id);
+    CHECK(((const sy_texture_data *)en->data)->pixels == sy_blob_store_get(recv, sy_blob_hash(f->r.pixels)));
     sy_changes_release(d);
     /* a receiver lacking them: SY_ERR_NOT_FOUND naming the hash */
     sy_blob_store *empty;
@@ -759,7 +769,7 @@ SY_SCENE_TEST(test_blob_once)
     bool named = false;
     {
         /* every blob of the list is missing: the message names one of them */
-        sy_blob *cands[] = {r.pixels, r.pos, r.attach_blob};
+        sy_blob *cands[] = {f->r.pixels, f->r.pos, f->r.attach_blob};
         for (int i = 0; i < 3; ++i) {
             char hex[40];
             sy_hash128 h = sy_blob_hash(cands[i]);
@@ -777,15 +787,15 @@ SY_SCENE_TEST(test_blob_once)
     /* the update list: only the new texture payload and the new child list travel */
     void *upd_data;
     size_t upd_size;
-    CHECK_OK(sy_changes_serialize(upd, send_if_missing, recv, &upd_data, &upd_size, &e), e);
+    CHECK_OK(sy_changes_serialize(f->upd, send_if_missing, recv, &upd_data, &upd_size, &e), e);
     CHECK(upd_size > 3000 && upd_size < 3000 + 800);
     CHECK_OK(sy_changes_deserialize(upd_data, upd_size, recv, NULL, &d, &e), e);
-    CHECK(lists_equal(upd, d) == 0);
+    CHECK(lists_equal(f->upd, d) == 0);
     sy_changes_release(d);
     CHECK(sy_blob_store_count(recv) == stored + 2);
     free(upd_data);
     /* send_none against a store that has all: fine */
-    CHECK_OK(sy_changes_serialize(upd, send_none, NULL, &upd_data, &upd_size, &e), e);
+    CHECK_OK(sy_changes_serialize(f->upd, send_none, NULL, &upd_data, &upd_size, &e), e);
     CHECK(upd_size < 800);
     CHECK_OK(sy_changes_deserialize(upd_data, upd_size, recv, NULL, &d, &e), e);
     sy_changes_release(d);
@@ -795,7 +805,6 @@ SY_SCENE_TEST(test_blob_once)
     free(lean);
     sy_blob_store_destroy(recv);
     sy_blob_store_destroy(empty);
-    release_lists(&r, snap, upd);
     return 0;
 }
 
@@ -1019,20 +1028,17 @@ static int decode_and_use(const void *data, size_t size, const sy_changes *base_
     return 0;
 }
 
-SY_SCENE_TEST(test_decoder_fuzz)
+LISTS_TEST(test_decoder_fuzz)
 {
-    rich r;
-    sy_changes *snap, *upd;
-    CHECK(make_lists(s, &r, &snap, &upd) == 0);
-    sy_error e = {0};
-    sy_changes *msgs[2] = {snap, upd};
     rng_state = 7;
+    sy_changes *msgs[2] = {f->snap, f->upd};
+    sy_error e = {0};
     long ok = 0, total = 0;
     for (int mi = 0; mi < 2; ++mi) {
         void *data;
         size_t size;
         CHECK_OK(sy_changes_serialize(msgs[mi], NULL, NULL, &data, &size, &e), e);
-        const sy_changes *base = mi == 1 ? snap : NULL;
+        const sy_changes *base = mi == 1 ? f->snap : NULL;
         unsigned char *buf = malloc(size + 1);
         CHECK(buf);
         /* every truncation is an error */
@@ -1103,7 +1109,6 @@ SY_SCENE_TEST(test_decoder_fuzz)
     }
     printf("decoder fuzz: %ld inputs, %ld decoded to a valid list\n", total, ok);
     CHECK(ok > 0); /* some mutations (in float values) must still decode */
-    release_lists(&r, snap, upd);
     return 0;
 }
 

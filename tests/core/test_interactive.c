@@ -69,31 +69,42 @@ static const sy_mediator_class rec_filtering = {.name = "test_filtering", .caps 
 static const sy_mediator_class rec_plain = {.name = "test_plain", .create = rec_create, .destroy = rec_destroy,
                                             .sync = rec_sync, .render = rec_render, .default_rank = 5};
 
-/* A scene with a camera node 5 in front of a mesh-less root, committed. */
+/* A scene with a camera node 5 in front of a mesh-less root, committed, and a context pool. */
 typedef struct fixture {
     sy_scene *s;
     sy_node root, cam_node;
+    sy_context_pool *pool;
 } fixture;
 
-static int make_scene(fixture *f, sy_error *e)
+static int fixture_init(fixture *f)
 {
+    sy_error e = {0};
     sy_camera cam;
     sy_camera_data cd = {.projection = SY_PROJECTION_PERSPECTIVE, .yfov = 0.8f, .znear = 0.1f, .zfar = 100.0f};
     sy_mat4 m = sy_mat4_identity();
     m.m[14] = 5.0f;
-    CHECK_OK(sy_scene_create(&f->s, e), *e);
-    CHECK_OK(sy_node_create(f->s, "root", &f->root, e), *e);
-    CHECK_OK(sy_camera_create(f->s, "cam", &cam, e), *e);
-    CHECK_OK(sy_camera_set(f->s, cam, &cd, e), *e);
-    CHECK_OK(sy_node_create(f->s, "camera", &f->cam_node, e), *e);
-    CHECK_OK(sy_node_set_camera(f->s, f->cam_node, cam, e), *e);
-    CHECK_OK(sy_node_set_matrix(f->s, f->cam_node, &m, e), *e);
-    CHECK_OK(sy_node_add_child(f->s, f->root, f->cam_node, e), *e);
-    CHECK_OK(sy_scene_commit(f->s, NULL, e), *e);
+    CHECK_OK(sy_scene_create(&f->s, &e), e);
+    CHECK_OK(sy_node_create(f->s, "root", &f->root, &e), e);
+    CHECK_OK(sy_camera_create(f->s, "cam", &cam, &e), e);
+    CHECK_OK(sy_camera_set(f->s, cam, &cd, &e), e);
+    CHECK_OK(sy_node_create(f->s, "camera", &f->cam_node, &e), e);
+    CHECK_OK(sy_node_set_camera(f->s, f->cam_node, cam, &e), e);
+    CHECK_OK(sy_node_set_matrix(f->s, f->cam_node, &m, &e), e);
+    CHECK_OK(sy_node_add_child(f->s, f->root, f->cam_node, &e), e);
+    CHECK_OK(sy_scene_commit(f->s, NULL, &e), e);
+    CHECK_OK(sy_context_pool_create(&f->pool, &e), e);
     return 0;
 }
 
-static int test_filters_keys_backend(void)
+static void fixture_free(fixture *f)
+{
+    sy_context_pool_destroy(f->pool);
+    sy_scene_destroy(f->s);
+}
+
+#define VIEW_TEST(name) SY_FIXTURE_TEST(name, fixture, fixture_init, fixture_free)
+
+VIEW_TEST(test_filters_keys_backend)
 {
     sy_error e = {0};
     char name[32];
@@ -101,13 +112,11 @@ static int test_filters_keys_backend(void)
     CHECK(!strcmp(sy_interactive_filter_name(0, name), "none"));
     CHECK(!strcmp(sy_interactive_filter_name(2, name), "sharp"));
     CHECK(!strcmp(sy_interactive_filter_name(4, name), "soft")); /* modulo the count */
-    fixture f = {0};
-    CHECK(make_scene(&f, &e) == 0);
     sy_interactive_input in;
-    CHECK_ERR(sy_interactive_input_init(f.s, f.root, f.cam_node, 1.0f, "pixel", 0, &in, &e), SY_ERR_INVALID_ARGUMENT, e);
+    CHECK_ERR(sy_interactive_input_init(f->s, f->root, f->cam_node, 1.0f, "pixel", 0, &in, &e), SY_ERR_INVALID_ARGUMENT, e);
     CHECK_SAYS(e, "expected none, soft or sharp");
-    CHECK_ERR(sy_interactive_input_init(f.s, f.root, f.cam_node, 1.0f, NULL, -1.0f, &in, &e), SY_ERR_INVALID_ARGUMENT, e);
-    CHECK_OK(sy_interactive_input_init(f.s, f.root, f.cam_node, 1.0f, "sharp", 0, &in, &e), e);
+    CHECK_ERR(sy_interactive_input_init(f->s, f->root, f->cam_node, 1.0f, NULL, -1.0f, &in, &e), SY_ERR_INVALID_ARGUMENT, e);
+    CHECK_OK(sy_interactive_input_init(f->s, f->root, f->cam_node, 1.0f, "sharp", 0, &in, &e), e);
     CHECK(in.filter == 2 && in.threshold == 0.01f);
     sy_mat4 m;
     sy_orbit_matrix(&in.orbit, &m);
@@ -128,33 +137,28 @@ static int test_filters_keys_backend(void)
     CHECK_OK(sy_interactive_backend_index("test_filtering", &bi, &e), e);
     CHECK(sy_mediator_at(bi) == &rec_filtering);
     CHECK_ERR(sy_interactive_backend_index("nope", &bi, &e), SY_ERR_NOT_FOUND, e);
-    sy_scene_destroy(f.s);
     return 0;
 }
 
-static int test_view_without_commit(void)
+VIEW_TEST(test_view_without_commit)
 {
     sy_error e = {0};
-    fixture f = {0};
-    CHECK(make_scene(&f, &e) == 0);
-    sy_context_pool *pool = NULL;
     sy_window *win = NULL;
     sy_viewport *vp = NULL;
     sy_interactive *ia = NULL;
-    CHECK_OK(sy_context_pool_create(&pool, &e), e);
     CHECK_OK(sy_window_create(32, 24, &win, &e), e);
-    sy_viewport_desc vd = {.root = f.root, .camera = f.cam_node, .backend = "test_plain"};
+    sy_viewport_desc vd = {.root = f->root, .camera = f->cam_node, .backend = "test_plain"};
     CHECK_OK(sy_window_add_viewport(win, &vd, &vp, &e), e);
     CHECK(!sy_viewport_view(vp, NULL));
     CHECK_OK(sy_interactive_create(0, &ia, &e), e);
     sy_interactive_input in;
-    CHECK_OK(sy_interactive_input_init(f.s, f.root, f.cam_node, 32.0f / 24.0f, NULL, 0, &in, &e), e);
+    CHECK_OK(sy_interactive_input_init(f->s, f->root, f->cam_node, 32.0f / 24.0f, NULL, 0, &in, &e), e);
 
     /* the application changes its scene and has not committed yet */
     sy_node extra;
-    CHECK_OK(sy_node_create(f.s, "pending", &extra, &e), e);
-    uint64_t frame = sy_scene_frame(f.s);
-    CHECK(sy_scene_has_pending(f.s));
+    CHECK_OK(sy_node_create(f->s, "pending", &extra, &e), e);
+    uint64_t frame = sy_scene_frame(f->s);
+    CHECK(sy_scene_has_pending(f->s));
 
     /* the user drags: a moving frame */
     sy_interactive_drag(&in, 0, 40, -10);
@@ -170,46 +174,40 @@ static int test_view_without_commit(void)
     CHECK(gf.moving && !gf.idle && gf.width > 0);
     sy_layer img;
     CHECK_OK(sy_layer_create(32, 24, &img, &e), e);
-    CHECK_OK(sy_window_render(win, f.s, pool, NULL, &img, &e), e);
+    CHECK_OK(sy_window_render(win, f->s, f->pool, NULL, &img, &e), e);
     CHECK(g_rec && g_rec->renders == 1);
     CHECK(sy_mat4_equal(&g_rec->last_camera, &want)); /* the render saw the orbit's view */
     /* ... and the scene was not committed: the application's change is still pending */
-    CHECK(sy_scene_has_pending(f.s));
-    CHECK(sy_scene_frame(f.s) == frame);
+    CHECK(sy_scene_has_pending(f->s));
+    CHECK(sy_scene_frame(f->s) == frame);
     sy_mat4 node_world;
-    CHECK_OK(sy_node_world_matrix(f.s, f.cam_node, &node_world, &e), e);
+    CHECK_OK(sy_node_world_matrix(f->s, f->cam_node, &node_world, &e), e);
     CHECK_NEAR(node_world.m[14], 5.0, 1e-6); /* the camera node did not move */
     sy_camera_view cv;
-    CHECK_OK(sy_viewport_camera_view(vp, f.s, 32, 24, &cv, &e), e);
+    CHECK_OK(sy_viewport_camera_view(vp, f->s, 32, 24, &cv, &e), e);
     CHECK(sy_mat4_equal(&cv.camera_to_world, &want));
     CHECK_NEAR(cv.window[3], tan(0.4), 1e-5); /* the camera node's projection (yfov 0.8) */
     CHECK_NEAR(cv.znear, 0.1, 1e-6);
     sy_viewport_set_view(vp, NULL); /* back to the node */
-    CHECK_OK(sy_viewport_camera_view(vp, f.s, 32, 24, &cv, &e), e);
+    CHECK_OK(sy_viewport_camera_view(vp, f->s, 32, 24, &cv, &e), e);
     CHECK_NEAR(cv.camera_to_world.m[14], 5.0, 1e-6);
     /* the application commits when it wants to */
-    CHECK_OK(sy_scene_commit(f.s, NULL, &e), e);
-    CHECK(!sy_scene_has_pending(f.s) && sy_scene_frame(f.s) == frame + 1);
+    CHECK_OK(sy_scene_commit(f->s, NULL, &e), e);
+    CHECK(!sy_scene_has_pending(f->s) && sy_scene_frame(f->s) == frame + 1);
 
     sy_layer_destroy(&img);
     sy_interactive_destroy(ia);
     sy_window_destroy(win);
-    sy_context_pool_destroy(pool);
-    sy_scene_destroy(f.s);
     return 0;
 }
 
-static int test_governor_filter_rgba8(void)
+VIEW_TEST(test_governor_filter_rgba8)
 {
     sy_error e = {0};
-    fixture f = {0};
-    CHECK(make_scene(&f, &e) == 0);
-    sy_context_pool *pool = NULL;
     sy_interactive *ia = NULL;
-    CHECK_OK(sy_context_pool_create(&pool, &e), e);
     CHECK_OK(sy_interactive_create(10, &ia, &e), e);
     sy_interactive_input in;
-    CHECK_OK(sy_interactive_input_init(f.s, f.root, f.cam_node, 1.0f, "soft", 0.5f, &in, &e), e);
+    CHECK_OK(sy_interactive_input_init(f->s, f->root, f->cam_node, 1.0f, "soft", 0.5f, &in, &e), e);
     const sy_mediator_class *cls = sy_mediator_find("test_filtering");
     sy_interactive_view iv = {.orbit = &in.orbit, .backend = cls, .caps = cls->caps, .width = 64, .height = 64};
     sy_governor_frame gf;
@@ -218,21 +216,21 @@ static int test_governor_filter_rgba8(void)
     sy_interactive_report(ia, &gf, 5.0, false);
     /* the filter: off while moving, on when refining, set once per change */
     sy_filter_info fi;
-    CHECK_OK(sy_interactive_apply_filter(ia, pool, f.s, f.root.id, cls, in.filter, in.threshold, in.filter_version,
+    CHECK_OK(sy_interactive_apply_filter(ia, f->pool, f->s, f->root.id, cls, in.filter, in.threshold, in.filter_version,
                                          false, &fi, &e), e);
     CHECK(g_rec && !strcmp(fi.name, "none") && g_rec->filter_calls == 1);
-    CHECK_OK(sy_interactive_apply_filter(ia, pool, f.s, f.root.id, cls, in.filter, in.threshold, in.filter_version,
+    CHECK_OK(sy_interactive_apply_filter(ia, f->pool, f->s, f->root.id, cls, in.filter, in.threshold, in.filter_version,
                                          true, &fi, &e), e);
     CHECK(!strcmp(fi.name, "soft") && g_rec->filter_calls == 2);
-    CHECK_OK(sy_interactive_apply_filter(ia, pool, f.s, f.root.id, cls, in.filter, in.threshold, in.filter_version,
+    CHECK_OK(sy_interactive_apply_filter(ia, f->pool, f->s, f->root.id, cls, in.filter, in.threshold, in.filter_version,
                                          true, &fi, &e), e);
     CHECK(g_rec->filter_calls == 2); /* nothing changed: not set again */
     sy_interactive_key(&in, 'f');
-    CHECK_OK(sy_interactive_apply_filter(ia, pool, f.s, f.root.id, cls, in.filter, in.threshold, in.filter_version,
+    CHECK_OK(sy_interactive_apply_filter(ia, f->pool, f->s, f->root.id, cls, in.filter, in.threshold, in.filter_version,
                                          true, &fi, &e), e);
     CHECK(!strcmp(fi.name, "sharp") && g_rec->filter_calls == 3);
     /* a back-end without filters: nothing, no error */
-    CHECK_OK(sy_interactive_apply_filter(ia, pool, f.s, f.root.id, sy_mediator_find("test_plain"), in.filter, in.threshold,
+    CHECK_OK(sy_interactive_apply_filter(ia, f->pool, f->s, f->root.id, sy_mediator_find("test_plain"), in.filter, in.threshold,
                                          in.filter_version, true, &fi, &e), e);
     CHECK(fi.name[0] == 0);
     /* the view rests: after the settle time the governor refines at full size */
@@ -251,8 +249,6 @@ static int test_governor_filter_rgba8(void)
     free(b);
     sy_layer_destroy(&l);
     sy_interactive_destroy(ia);
-    sy_context_pool_destroy(pool);
-    sy_scene_destroy(f.s);
     return 0;
 }
 

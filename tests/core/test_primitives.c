@@ -4,6 +4,7 @@
  * (serialise, decode, apply to a replica, compare) of a line primitive with an explicit width; skin
  * attributes and morph targets refused when malformed. */
 #include "../support/sy_check.h"
+#include "../support/sy_scene_test.h"
 #include "wire_copy.h"
 #include "sy_changes.h"
 #include "sy_scene.h"
@@ -12,25 +13,16 @@
 #include <stdlib.h>
 #include <string.h>
 
-static sy_blob *blob(const void *d, size_t n)
-{
-    sy_blob *b = NULL;
-    if (sy_blob_create_copy(d, n, &b, NULL) != SY_OK) abort();
-    return b;
-}
 
 static const float POS[] = {0, 0, 0, 3, 0, 0, 3, 4, 0, 0, 4, 0}; /* 3 x 4 rectangle: diagonal 5 */
 
-static int test_validation(void)
+SY_SCENE_TEST(test_validation)
 {
-    sy_scene *s;
-    sy_error e = {0};
-    CHECK_OK(sy_scene_create(&s, &e), e);
     sy_mesh m;
     CHECK_OK(sy_mesh_create(s, "m", &m, &e), e);
     uint32_t odd[] = {0, 1, 2}, pairs[] = {0, 1, 1, 2, 2, 3}, bad[] = {0, 9};
-    sy_blob *bp = blob(POS, sizeof POS), *bodd = blob(odd, sizeof odd), *bpairs = blob(pairs, sizeof pairs);
-    sy_blob *bbad = blob(bad, sizeof bad), *bp3 = blob(POS, 36);
+    sy_blob *bp = sy_test_blob(POS, sizeof POS), *bodd = sy_test_blob(odd, sizeof odd), *bpairs = sy_test_blob(pairs, sizeof pairs);
+    sy_blob *bbad = sy_test_blob(bad, sizeof bad), *bp3 = sy_test_blob(POS, 36);
     sy_primitive p = {.positions = bp, .indices = bodd, .topology = SY_TOPOLOGY_LINES};
     CHECK_ERR(sy_mesh_set_primitives(s, m, &p, 1, &e), SY_ERR_INVALID_ARGUMENT, e);
     CHECK_MSG(strstr(e.message, "primitive 0") && strstr(e.message, "whole line segments"), "message: %s", e.message);
@@ -68,7 +60,7 @@ static int test_validation(void)
     explicit_w.width = 0.25f;
     CHECK_NEAR(sy_primitive_stroke_width(&explicit_w, NULL), 0.25, 0);
     float one[3] = {1, 1, 1};
-    sy_blob *b1 = blob(one, sizeof one);
+    sy_blob *b1 = sy_test_blob(one, sizeof one);
     sy_primitive single = {.positions = b1, .topology = SY_TOPOLOGY_POINTS};
     CHECK_NEAR(sy_primitive_stroke_width(&single, NULL), SY_STROKE_MIN_WIDTH, 0); /* no extent: the floor */
     /* bounds: positions grown by half the larger (point) width */
@@ -84,7 +76,6 @@ static int test_validation(void)
     sy_blob_release(bbad);
     sy_blob_release(bp3);
     sy_blob_release(b1);
-    sy_scene_destroy(s);
     return 0;
 }
 
@@ -97,7 +88,7 @@ static int test_round_trip(void)
     sy_mesh m;
     CHECK_OK(sy_mesh_create(a, "lines", &m, &e), e);
     uint32_t pairs[] = {0, 1, 1, 2, 2, 3, 3, 0};
-    sy_blob *bp = blob(POS, sizeof POS), *bi = blob(pairs, sizeof pairs);
+    sy_blob *bp = sy_test_blob(POS, sizeof POS), *bi = sy_test_blob(pairs, sizeof pairs);
     sy_primitive p = {.positions = bp, .indices = bi, .topology = SY_TOPOLOGY_LINES, .width = 0.125f};
     CHECK_OK(sy_mesh_set_primitives(a, m, &p, 1, &e), e);
     CHECK_OK(sy_scene_commit(a, NULL, &e), e);
@@ -146,18 +137,15 @@ static int test_round_trip(void)
 
 /* Skin attributes and morph targets: sizes, pairing, finiteness and target counts refused naming
  * the primitive; a valid set counted (influences, targets); skins on nodes check their joints. */
-static int test_deform_validation(void)
+SY_SCENE_TEST(test_deform_validation)
 {
-    sy_scene *s;
-    sy_error e = {0};
-    CHECK_OK(sy_scene_create(&s, &e), e);
-    sy_mesh m;
-    CHECK_OK(sy_mesh_create(s, "m", &m, &e), e);
     uint32_t j4[16] = {0}, j3[12] = {0};
     float w4[16] = {0}, dp[24] = {0};
     for (int v = 0; v < 4; ++v) w4[4 * v] = 1.0f;
-    sy_blob *bp = blob(POS, sizeof POS), *bj = blob(j4, sizeof j4), *bw = blob(w4, sizeof w4), *bj3 = blob(j3, sizeof j3);
-    sy_blob *bd2 = blob(dp, sizeof dp), *bd1 = blob(dp, 48);
+    sy_mesh m;
+    CHECK_OK(sy_mesh_create(s, "m", &m, &e), e);
+    sy_blob *bp = sy_test_blob(POS, sizeof POS), *bj = sy_test_blob(j4, sizeof j4), *bw = sy_test_blob(w4, sizeof w4), *bj3 = sy_test_blob(j3, sizeof j3);
+    sy_blob *bd2 = sy_test_blob(dp, sizeof dp), *bd1 = sy_test_blob(dp, 48);
     sy_primitive p = {.positions = bp, .joints = bj, .topology = SY_TOPOLOGY_POINTS};
     CHECK_ERR(sy_mesh_set_primitives(s, m, &p, 1, &e), SY_ERR_INVALID_ARGUMENT, e);
     CHECK_MSG(strstr(e.message, "primitive 0") && strstr(e.message, "joints without weights"), "message: %s", e.message);
@@ -166,7 +154,7 @@ static int test_deform_validation(void)
     CHECK_ERR(sy_mesh_set_primitives(s, m, &p, 1, &e), SY_ERR_INVALID_ARGUMENT, e);
     p.joints = bj;
     w4[5] = NAN;
-    sy_blob *bwn = blob(w4, sizeof w4);
+    sy_blob *bwn = sy_test_blob(w4, sizeof w4);
     p.weights = bwn;
     CHECK_ERR(sy_mesh_set_primitives(s, m, &p, 1, &e), SY_ERR_INVALID_ARGUMENT, e);
     CHECK_MSG(strstr(e.message, "not finite"), "message: %s", e.message);
@@ -194,7 +182,6 @@ static int test_deform_validation(void)
     CHECK(nj == 1 && sj[0].node == j.id && sj[0].inverse_bind.m[0] == 1.0f && sy_node_get(s, n)->skeleton.id == j.id);
     sy_blob *all[] = {bp, bj, bw, bj3, bd2, bd1, bwn};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; ++k) sy_blob_release(all[k]);
-    sy_scene_destroy(s);
     return 0;
 }
 

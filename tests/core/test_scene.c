@@ -43,7 +43,6 @@ static int create_nodes(sy_scene *s, size_t n, const char *const *names, sy_node
 /* ------------------------------------------------------------------ handles */
 SY_SCENE_TEST(test_handles)
 {
-    sy_error e = {0};
     sy_node a, b;
     CHECK_OK(sy_node_create(s, "a", &a, &e), e);
     CHECK_OK(sy_node_create(s, NULL, &b, &e), e);
@@ -122,7 +121,6 @@ SY_SCENE_TEST(test_handles)
 /* ------------------------------------------------------------------ dirty marks and no-op sets */
 SY_SCENE_TEST(test_dirty_noop)
 {
-    sy_error e = {0};
     uint32_t con;
     CHECK_OK(sy_scene_consumer_add(s, &con, &e), e);
     CHECK(!sy_scene_has_pending(s));
@@ -217,7 +215,6 @@ SY_SCENE_TEST(test_dirty_noop)
 /* ------------------------------------------------------------------ validation */
 SY_SCENE_TEST(test_validation)
 {
-    sy_error e = {0};
     sy_node n;
     CHECK_OK(sy_node_create(s, "n", &n, &e), e);
     CHECK_OK(sy_scene_commit(s, NULL, &e), e);
@@ -406,7 +403,6 @@ SY_SCENE_TEST(test_validation)
 /* ------------------------------------------------------------------ children: cycles, duplicates, stale */
 SY_SCENE_TEST(test_children_validation)
 {
-    sy_error e = {0};
     sy_node a, b, c, d, x;
     CHECK(create_nodes(s, 5, (const char *const[]){"a", "b", "c", "d", "x"}, (sy_node *const[]){&a, &b, &c, &d, &x}) == 0);
     CHECK_OK(sy_node_set_children(s, a, &b, 1, &e), e);
@@ -475,7 +471,6 @@ SY_SCENE_TEST(test_children_validation)
 /* ------------------------------------------------------------------ world matrices */
 SY_SCENE_TEST(test_world_chain)
 {
-    sy_error e = {0};
     sy_node a, b, c;
     CHECK(create_nodes(s, 3, (const char *const[]){"a", "b", "c"}, (sy_node *const[]){&a, &b, &c}) == 0);
     const float h = (float)sqrt(0.5);
@@ -539,7 +534,6 @@ SY_SCENE_TEST(test_world_chain)
  */
 SY_SCENE_TEST(test_world_incremental)
 {
-    sy_error e = {0};
     sy_node r, m1, m2, l1, l2, k, ll;
     sy_node *all[] = {&r, &m1, &m2, &l1, &l2, &k, &ll};
     for (int i = 0; i < 7; ++i) {
@@ -647,7 +641,6 @@ static int bounds_is(const sy_bounds *b, float x0, float y0, float z0, float x1,
 
 SY_SCENE_TEST(test_bounds)
 {
-    sy_error e = {0};
     const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 2, 0};
     sy_mesh m;
     CHECK(make_tri_mesh(s, &m, tri) == 0);
@@ -725,7 +718,6 @@ SY_SCENE_TEST(test_bounds)
 
 SY_SCENE_TEST(test_dag)
 {
-    sy_error e = {0};
     sy_mesh m;
     const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     CHECK(make_tri_mesh(s, &m, tri) == 0);
@@ -793,7 +785,6 @@ static sy_result walk_record(void *user, const sy_walk_step *st, sy_error *err)
 
 SY_SCENE_TEST(test_walk)
 {
-    sy_error e = {0};
     sy_node top, p1, p2, shared, gone;
     CHECK(create_nodes(s, 5, (const char *const[]){"top", "p1", "p2", "shared", "gone"}, (sy_node *const[]){&top, &p1, &p2, &shared, &gone}) == 0);
     const float tt[3] = {0, 0, 1}, t1[3] = {10, 0, 0}, t2[3] = {-10, 0, 0}, ts[3] = {0, 5, 0}, s2[3] = {2, 2, 2};
@@ -857,7 +848,6 @@ SY_SCENE_TEST(test_walk)
  * the field and the reason (issue 33, item 8). */
 SY_SCENE_TEST(test_camera_clip_range)
 {
-    sy_error e = {0};
     uint32_t con;
     CHECK_OK(sy_scene_consumer_add(s, &con, &e), e);
     sy_camera cam;
@@ -904,7 +894,6 @@ SY_SCENE_TEST(test_camera_clip_range)
 
 SY_SCENE_TEST(test_texture_info_validation)
 {
-    sy_error e = {0};
     sy_texture tex;
     CHECK_OK(sy_texture_create(s, "t", &tex, &e), e);
     /* an image with a size needs 1..4 channels (every back-end refuses 0) and a known pixel format
@@ -927,7 +916,6 @@ SY_SCENE_TEST(test_texture_info_validation)
 /* ------------------------------------------------------------------ attachments */
 SY_SCENE_TEST(test_attachments)
 {
-    sy_error e = {0};
     long live0 = sy_blob_live_count();
     uint32_t con;
     CHECK_OK(sy_scene_consumer_add(s, &con, &e), e);

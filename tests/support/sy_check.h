@@ -182,4 +182,25 @@ typedef struct sy_check_test {
         return sy_check_finish(title);                                                              \
     }
 
+/* A test function with a fixture (gtest's TEST_F), for RUN / SY_CHECK_MAIN:
+ *   SY_FIXTURE_TEST(test_x, my_fixture, my_setup, my_teardown)
+ *   {
+ *       ... uses `my_fixture *f` ...
+ *       return 0;
+ *   }
+ * defines `int test_x(void)`: a zeroed my_fixture, `int my_setup(my_fixture *)` (0 = ready; its
+ * checks count), the body when it succeeded, then `void my_teardown(my_fixture *)` always (also
+ * after a failed setup or body, so it must accept a partly set-up fixture). */
+#define SY_FIXTURE_TEST(name, type, setup, teardown)                                                \
+    static int name##_body(type *f);                                                                \
+    static int name(void)                                                                           \
+    {                                                                                               \
+        type sy_fixture_ = {0};                                                                     \
+        int sy_fixture_rc_ = (setup)(&sy_fixture_);                                                 \
+        if (sy_fixture_rc_ == 0) sy_fixture_rc_ = name##_body(&sy_fixture_);                        \
+        (teardown)(&sy_fixture_);                                                                   \
+        return sy_fixture_rc_;                                                                      \
+    }                                                                                               \
+    static int name##_body(type *f)
+
 #endif /* SY_TEST_SY_CHECK_H */
