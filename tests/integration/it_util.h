@@ -1,8 +1,10 @@
 /* it_util.h — small helpers shared by the integration tests: the check kit
  * (tests/support/sy_check.h; the tests use its counted EXPECT form, which keeps going, and end with
- * sy_check_finish), MUST, test-data lookup with the "skip = exit 77" rule, scratch
- * directories, and scene-building shortcuts (unlit quads, lights, one-viewport windows, camera
- * views by hand). */
+ * sy_check_finish, or it_finish_last when the last test may skip), MUST, test-data lookup with the
+ * "skip = exit 77" rule, scratch directories, the picture back-ends to compare (it_backends), a
+ * stub back-end for capability tests, and scene-building shortcuts (scenes, pools, unlit quads,
+ * lights, one-viewport windows, camera views by hand) and image measures (coverage IoU, region
+ * means, pixels). */
 #ifndef IT_UTIL_H
 #define IT_UTIL_H
 
@@ -124,6 +126,66 @@ static inline sy_light it_light(sy_scene *s, const char *name, sy_light_type typ
     return l;
 }
 
+/* A stub back-end for the tests of what a capability guards: it renders a cleared layer and counts
+ * its renders in it_stub_renders. A test defines its class with these functions and only the caps
+ * it wants (the capability under test left out), e.g.
+ *   {.name = "test_noclip", .caps = SY_CAP_DEPTH, IT_STUB_FUNCTIONS} */
+static int it_stub_renders __attribute__((unused));
+static inline sy_result it_stub_create(const sy_mediator_create_args *a, void **st, sy_error *e)
+{
+    (void)a, (void)e;
+    *st = malloc(1);
+    return SY_OK;
+}
+static inline void it_stub_destroy(void *st) { free(st); }
+static inline sy_result it_stub_sync(void *st, const sy_changes *c, sy_error *e)
+{
+    (void)st, (void)c, (void)e;
+    return SY_OK;
+}
+static inline sy_result it_stub_render(void *st, const sy_render_request *r, sy_layer *l, sy_error *e)
+{
+    (void)st, (void)r, (void)e;
+    it_stub_renders++;
+    sy_layer_clear(l);
+    return SY_OK;
+}
+#define IT_STUB_FUNCTIONS .create = it_stub_create, .destroy = it_stub_destroy, .sync = it_stub_sync, .render = it_stub_render
+
+/* The end of a main whose last test, last(arg), needs the shared test data and may skip (exit 77 in
+ * it_testdata): checks failed so far end the test first, so a skip cannot hide them; then
+ * sy_check_finish(name). */
+static inline int it_finish_last(const char *name, void (*last)(const char *), const char *arg)
+{
+    if (sy_check_failures) return sy_check_finish(name);
+    last(arg);
+    return sy_check_finish(name);
+}
+
+/* The picture back-ends the integration tests compare (raster where it was built). */
+static const char *const it_backends[] __attribute__((unused)) = {
+#ifdef SY_HAVE_RASTER
+    "raster",
+#endif
+    "whitted", "pathtracer"};
+#define IT_NBACKENDS (sizeof it_backends / sizeof it_backends[0])
+
+/* A new, empty scene (sy_scene_destroy); aborts on failure. */
+static inline sy_scene *it_scene(void)
+{
+    sy_scene *s;
+    MUST(sy_scene_create(&s, err));
+    return s;
+}
+
+/* A new, empty context pool (sy_context_pool_destroy); aborts on failure. */
+static inline sy_context_pool *it_pool(void)
+{
+    sy_context_pool *pool;
+    MUST(sy_context_pool_create(&pool, err));
+    return pool;
+}
+
 /* A w x h window with the one viewport vd (its handle in *vp when vp is not NULL). */
 static inline sy_window *it_window(uint32_t w, uint32_t h, const sy_viewport_desc *vd, sy_viewport **vp)
 {
@@ -222,6 +284,30 @@ static inline bool it_layers_identical(const sy_layer *a, const sy_layer *b)
     size_t n = (size_t)a->width * a->height;
     return a->width == b->width && a->height == b->height && memcmp(a->rgba, b->rgba, n * 4 * sizeof(float)) == 0 &&
            memcmp(a->depth, b->depth, n * sizeof(float)) == 0;
+}
+
+/* Mean RGB over the pixels of img whose image-plane point at distance dist lies in [x0, x1] x
+ * [y0, y1], for a view straight down -Z with a 45-degree yfov and the image's aspect (the framing
+ * view of a scene seen from above); returns the mean's luminance (Rec. 709), -1 when no pixel is in
+ * the region. rgb (the mean) may be NULL. */
+static inline double it_region_mean(const sy_layer *img, float dist, float x0, float x1, float y0, float y1, double rgb[3])
+{
+    const uint32_t w = img->width, h = img->height;
+    const float t = tanf(0.3926991f), a = (float)w / (float)h;
+    double sum[3] = {0, 0, 0}, mean[3];
+    uint32_t count = 0;
+    for (uint32_t py = 0; py < h; ++py)
+        for (uint32_t px = 0; px < w; ++px) {
+            float x = (-t * a + (px + 0.5f) / (float)w * 2.0f * t * a) * dist;
+            float y = (t - (py + 0.5f) / (float)h * 2.0f * t) * dist;
+            if (x < x0 || x > x1 || y < y0 || y > y1) continue;
+            const float *c = it_px(img, px, py);
+            for (int k = 0; k < 3; ++k) sum[k] += c[k];
+            count++;
+        }
+    for (int k = 0; k < 3; ++k) mean[k] = count ? sum[k] / count : 0.0;
+    if (rgb) memcpy(rgb, mean, sizeof mean);
+    return count ? 0.2126 * mean[0] + 0.7152 * mean[1] + 0.0722 * mean[2] : -1.0;
 }
 
 #endif /* IT_UTIL_H */

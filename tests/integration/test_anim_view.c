@@ -26,12 +26,6 @@
 #define W 96
 #define H 64
 
-static const char *const k_backends[] = {
-#ifdef SY_HAVE_RASTER
-    "raster",
-#endif
-    "whitted", "pathtracer"};
-#define NB (sizeof k_backends / sizeof k_backends[0])
 
 static char g_dir[256];
 
@@ -100,7 +94,7 @@ typedef struct rig {
     sy_gltf_info info;
     sy_window *win;
     sy_viewport *vp;
-    sy_context *ctx[NB];
+    sy_context *ctx[IT_NBACKENDS];
 } rig;
 
 static void rig_open(rig *g, const char *name)
@@ -119,15 +113,15 @@ static void rig_open(rig *g, const char *name)
     vd.root = g->info.root;
     vd.backend = "whitted"; /* the viewport gives the camera view; each back-end renders it from its own context */
     g->win = it_window(W, H, &vd, &g->vp);
-    for (size_t b = 0; b < NB; ++b) {
-        MUST(sy_context_create(g->s, k_backends[b], NULL, g->info.root.id, &g->ctx[b], err));
+    for (size_t b = 0; b < IT_NBACKENDS; ++b) {
+        MUST(sy_context_create(g->s, it_backends[b], NULL, g->info.root.id, &g->ctx[b], err));
         MUST(sy_context_sync(g->ctx[b], err));
     }
 }
 
 static void rig_close(rig *g)
 {
-    for (size_t b = 0; b < NB; ++b) sy_context_release(g->ctx[b]);
+    for (size_t b = 0; b < IT_NBACKENDS; ++b) sy_context_release(g->ctx[b]);
     sy_window_destroy(g->win);
     sy_gltf_info_free(&g->info);
     sy_scene_destroy(g->s);
@@ -138,7 +132,7 @@ static sy_camera_view rig_time(rig *g, double t)
 {
     MUST(sy_scene_set_time(g->s, (sy_animation){0}, t, err));
     MUST(sy_scene_commit(g->s, NULL, err));
-    for (size_t b = 0; b < NB; ++b) MUST(sy_context_sync(g->ctx[b], err));
+    for (size_t b = 0; b < IT_NBACKENDS; ++b) MUST(sy_context_sync(g->ctx[b], err));
     sy_camera_view v;
     MUST(sy_viewport_camera_view(g->vp, g->s, W, H, &v, err));
     return v;
@@ -179,12 +173,12 @@ static void test_camera(void)
     rig g;
     rig_open(&g, "camera.gltf");
     const double times[2] = {0.0, 1.0};
-    double width[NB][2];
+    double width[IT_NBACKENDS][2];
     for (int ti = 0; ti < 2; ++ti) {
         sy_camera_view v = rig_time(&g, times[ti]);
         double u = times[ti], cx = -1.0 + 2.0 * u, yfov = 0.8 - 0.2 * u;
         double want = column_of(0.0, cx, 5.0, yfov), want_w = column_of(0.5, cx, 5.0, yfov) - column_of(-0.5, cx, 5.0, yfov);
-        for (size_t bi = 0; bi < NB; ++bi) {
+        for (size_t bi = 0; bi < IT_NBACKENDS; ++bi) {
             sy_layer img;
             render(g.ctx[bi], &v, 16, &img);
             double sum = 0, sx = 0, sy = 0;
@@ -195,11 +189,11 @@ static void test_camera(void)
                 }
             double mx = sum > 0 ? sx / sum : -1, my = sum > 0 ? sy / sum : -1;
             width[bi][ti] = sum > 0 ? sqrt(sum) : 0; /* a square's side in pixels */
-            printf("camera %s t=%g: centroid (%.2f, %.2f), want (%.2f, %.2f); side %.2f px, want %.2f\n", k_backends[bi],
+            printf("camera %s t=%g: centroid (%.2f, %.2f), want (%.2f, %.2f); side %.2f px, want %.2f\n", it_backends[bi],
                    times[ti], mx, my, want, 0.5 * H, width[bi][ti], want_w);
             EXPECT_MSG(fabs(mx - want) < 0.75 && fabs(my - 0.5 * H) < 0.75, "camera %s t=%g: centroid (%.2f, %.2f), want (%.2f, %.2f)",
-                       k_backends[bi], times[ti], mx, my, want, 0.5 * H);
-            EXPECT_MSG(fabs(width[bi][ti] - want_w) < 1.0, "camera %s t=%g: side %.2f px, want %.2f (yfov %g)", k_backends[bi],
+                       it_backends[bi], times[ti], mx, my, want, 0.5 * H);
+            EXPECT_MSG(fabs(width[bi][ti] - want_w) < 1.0, "camera %s t=%g: side %.2f px, want %.2f (yfov %g)", it_backends[bi],
                        times[ti], width[bi][ti], want_w, yfov);
             sy_layer_destroy(&img);
         }
@@ -226,11 +220,11 @@ static void test_light(void)
     rig g;
     rig_open(&g, "light.gltf");
     const double times[2] = {0.0, 1.0};
-    double foot[NB][2];
+    double foot[IT_NBACKENDS][2];
     for (int ti = 0; ti < 2; ++ti) {
         sy_camera_view v = rig_time(&g, times[ti]);
         double lx = -1.5 + 3.0 * times[ti], want = column_of(lx, 0.0, 5.0, 0.8);
-        for (size_t bi = 0; bi < NB; ++bi) {
+        for (size_t bi = 0; bi < IT_NBACKENDS; ++bi) {
             sy_layer img;
             render(g.ctx[bi], &v, 64, &img);
             /* the brightest column of the middle rows (luminance summed over 9 rows) */
@@ -248,17 +242,17 @@ static void test_light(void)
                 for (int x = fx - 1; x <= fx + 1; ++x)
                     if (x >= 0 && x < W) f += img.rgba[((size_t)y * W + (size_t)x) * 4 + 1];
             foot[bi][ti] = f;
-            printf("light %s t=%g: brightest column %d (centre %.1f), want %.2f; foot brightness %.4f\n", k_backends[bi],
+            printf("light %s t=%g: brightest column %d (centre %.1f), want %.2f; foot brightness %.4f\n", it_backends[bi],
                    times[ti], best_x, best_x + 0.5, want, f);
-            EXPECT_MSG(fabs(best_x + 0.5 - want) <= 2.0, "light %s t=%g: brightest column %d, want %.2f", k_backends[bi],
+            EXPECT_MSG(fabs(best_x + 0.5 - want) <= 2.0, "light %s t=%g: brightest column %d, want %.2f", it_backends[bi],
                        times[ti], best_x, want);
             sy_layer_destroy(&img);
         }
     }
-    for (size_t bi = 0; bi < NB; ++bi) {
-        double ratio = foot[bi][0] > 0 ? foot[bi][1] / foot[bi][0] : 0, tol = strcmp(k_backends[bi], "pathtracer") ? 0.1 : 0.2;
-        printf("light %s: foot brightness t=1 / t=0 = %.3f (want 3)\n", k_backends[bi], ratio);
-        EXPECT_MSG(fabs(ratio - 3.0) < 3.0 * tol, "light %s: intensity 10 -> 30 made the foot %.3f x brighter", k_backends[bi],
+    for (size_t bi = 0; bi < IT_NBACKENDS; ++bi) {
+        double ratio = foot[bi][0] > 0 ? foot[bi][1] / foot[bi][0] : 0, tol = strcmp(it_backends[bi], "pathtracer") ? 0.1 : 0.2;
+        printf("light %s: foot brightness t=1 / t=0 = %.3f (want 3)\n", it_backends[bi], ratio);
+        EXPECT_MSG(fabs(ratio - 3.0) < 3.0 * tol, "light %s: intensity 10 -> 30 made the foot %.3f x brighter", it_backends[bi],
                    ratio);
     }
     rig_close(&g);

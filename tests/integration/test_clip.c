@@ -44,8 +44,7 @@ static void render(sy_scene *s, const char *backend, const char *params, const s
     sy_window *win = it_window(W, H, &vd, &vp);
     if (cam) sy_viewport_set_view(vp, cam);
     MUST(sy_viewport_set_clip_planes(vp, planes, nplanes, err));
-    sy_context_pool *pool;
-    MUST(sy_context_pool_create(&pool, err));
+    sy_context_pool *pool = it_pool();
     MUST(sy_layer_create(W, H, out, err));
     sy_window_render_opts ro = {.sample_count = 16, .seed = 1};
     MUST(sy_window_render(win, s, pool, &ro, out, err));
@@ -53,35 +52,28 @@ static void render(sy_scene *s, const char *backend, const char *params, const s
     sy_window_destroy(win);
 }
 
+/* Renders s from (0, 0, 3) in backend without (before) and with (after) the plane keeping z <= 0.5;
+ * false, with nothing rendered, when backend is not built or cannot cut. */
+static bool render_z_cut(sy_scene *s, const char *backend, sy_layer *before, sy_layer *after)
+{
+    const sy_mediator_class *cls = sy_mediator_find(backend);
+    if (!cls || !(sy_mediator_class_caps(cls, NULL) & SY_CAP_CLIP)) return false;
+    sy_mat4 cam = sy_mat4_identity();
+    cam.m[14] = 3.0f;
+    const float cut[1][4] = {{0, 0, -1, 0.5f}};
+    *before = *after = (sy_layer){0};
+    render(s, backend, NULL, &cam, cut, 0, before);
+    render(s, backend, NULL, &cam, cut, 1, after);
+    return true;
+}
+
 /* ---------------------------------------------------------------- 1. bad planes */
 /* A class without SY_CAP_CLIP (it would draw the uncut model): a cut view must not reach it. */
-static int noclip_renders;
-static sy_result noclip_create(const sy_mediator_create_args *a, void **st, sy_error *e)
-{
-    (void)a, (void)e;
-    *st = malloc(1);
-    return SY_OK;
-}
-static void noclip_destroy(void *st) { free(st); }
-static sy_result noclip_sync(void *st, const sy_changes *c, sy_error *e)
-{
-    (void)st, (void)c, (void)e;
-    return SY_OK;
-}
-static sy_result noclip_render(void *st, const sy_render_request *r, sy_layer *l, sy_error *e)
-{
-    (void)st, (void)r, (void)e;
-    noclip_renders++;
-    sy_layer_clear(l);
-    return SY_OK;
-}
-static const sy_mediator_class noclip_class = {.name = "test_noclip", .caps = SY_CAP_DEPTH, .create = noclip_create,
-                                               .destroy = noclip_destroy, .sync = noclip_sync, .render = noclip_render};
+static const sy_mediator_class noclip_class = {.name = "test_noclip", .caps = SY_CAP_DEPTH, IT_STUB_FUNCTIONS};
 
 static void test_bad_planes(void)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_viewport *vp;
     sy_viewport_desc vd = {.backend = "whitted"};
     sy_window *win = it_window(W, H, &vd, &vp);
@@ -112,19 +104,18 @@ static void test_bad_planes(void)
     MUST(sy_mediator_register(&noclip_class, err));
     MUST(sy_viewport_set_clip_planes(vp, good, 1, err));
     MUST(sy_viewport_set_backend(vp, "test_noclip", NULL, err));
-    sy_context_pool *pool;
-    MUST(sy_context_pool_create(&pool, err));
+    sy_context_pool *pool = it_pool();
     sy_layer img = {0};
     MUST(sy_layer_create(W, H, &img, err));
     e = (sy_error){0};
     sy_result r = sy_window_render(win, s, pool, NULL, &img, &e);
     EXPECT_MSG(r == SY_ERR_UNSUPPORTED && strstr(e.message, "test_noclip") && strstr(e.message, "SY_CAP_CLIP") &&
-                   noclip_renders == 0,
-               "a class without SY_CAP_CLIP rendered a cut view: %s (%d renders)", e.message, noclip_renders);
+                   it_stub_renders == 0,
+               "a class without SY_CAP_CLIP rendered a cut view: %s (%d renders)", e.message, it_stub_renders);
     printf("bad planes: refused; test_noclip without SY_CAP_CLIP: %s\n", e.message);
     MUST(sy_viewport_set_clip_planes(vp, NULL, 0, err));
     MUST(sy_window_render(win, s, pool, NULL, &img, err)); /* uncut: fine */
-    EXPECT_MSG(noclip_renders == 1, "the uncut view was not rendered (%d renders)", noclip_renders);
+    EXPECT_MSG(it_stub_renders == 1, "the uncut view was not rendered (%d renders)", it_stub_renders);
     sy_layer_destroy(&img);
     sy_context_pool_destroy(pool);
     sy_window_destroy(win);
@@ -151,8 +142,7 @@ static void two_quads(sy_scene *s, const char *name0, float h0, sy_material m0, 
 /* ---------------------------------------------------------------- 2. picks */
 static void test_pick(void)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_material m;
     MUST(sy_material_create(s, "grey", &m, err));
     sy_node a, b;
@@ -171,8 +161,7 @@ static void test_pick(void)
             sy_window *win = it_window(W, H, &vd, &vp);
             sy_viewport_set_view(vp, &cam);
             MUST(sy_viewport_set_clip_planes(vp, cut, with ? 1 : 0, err));
-            sy_context_pool *pool;
-            MUST(sy_context_pool_create(&pool, err));
+            sy_context_pool *pool = it_pool();
             sy_pick_result p;
             MUST(sy_window_pick(win, s, pool, W / 2 + 0.5, H / 2 + 0.5, &p, err));
             uint32_t want = with ? a.id : b.id;
@@ -188,28 +177,11 @@ static void test_pick(void)
     sy_scene_destroy(s);
 }
 
-/* ---------------------------------------------------------------- 3. shadows */
-static double region_luminance(const sy_layer *img, float dist, float x0, float x1, float y0, float y1)
-{
-    /* the framing view's projection (yfov 45 degrees, the image's aspect), straight down from z = dist */
-    const float t = tanf(0.3926991f), a = (float)W / (float)H;
-    double sum = 0;
-    uint32_t count = 0;
-    for (uint32_t py = 0; py < H; ++py)
-        for (uint32_t px = 0; px < W; ++px) {
-            float x = (-t * a + (px + 0.5f) / W * 2.0f * t * a) * dist, y = (t - (py + 0.5f) / H * 2.0f * t) * dist;
-            if (x < x0 || x > x1 || y < y0 || y > y1) continue;
-            const float *c = it_px(img, px, py);
-            sum += 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-            count++;
-        }
-    return count ? sum / count : -1.0;
-}
 
+/* ---------------------------------------------------------------- 3. shadows */
 static void test_shadow(void)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_material m;
     MUST(sy_material_create(s, "grey", &m, err));
     two_quads(s, "ground", 2.0f, m, "caster", 0.4f, m, NULL, NULL);
@@ -222,20 +194,14 @@ static void test_shadow(void)
     const float t[3] = {0, 0, 3}, q[4] = {0, sinf(0.3926991f), 0, cosf(0.3926991f)}, one[3] = {1, 1, 1};
     MUST(sy_node_set_trs(s, ln, t, q, one, err));
     MUST(sy_scene_commit(s, NULL, err));
-    sy_mat4 cam = sy_mat4_identity();
-    cam.m[14] = 3.0f;
-    const float cut[1][4] = {{0, 0, -1, 0.5f}}; /* keeps z <= 0.5: the caster goes, the ground stays */
     const char *be[3] = {"whitted", "pathtracer", "raster"};
     for (int i = 0; i < 3; ++i) {
-        const sy_mediator_class *cls = sy_mediator_find(be[i]);
-        if (!cls || !(sy_mediator_class_caps(cls, NULL) & SY_CAP_CLIP)) continue;
-        sy_layer before = {0}, after = {0};
-        render(s, be[i], NULL, &cam, cut, 0, &before);
-        render(s, be[i], NULL, &cam, cut, 1, &after);
+        sy_layer before, after;
+        if (!render_z_cut(s, be[i], &before, &after)) continue; /* the caster goes, the ground stays */
         /* the shadow: the caster (half 0.4 at z = 1) moved by -1 in x; lit ground: around x = +1.2 */
-        double sb = region_luminance(&before, 3.0f, -1.3f, -0.7f, -0.3f, 0.3f);
-        double sa = region_luminance(&after, 3.0f, -1.3f, -0.7f, -0.3f, 0.3f);
-        double lit = region_luminance(&before, 3.0f, 1.0f, 1.4f, -0.3f, 0.3f);
+        double sb = it_region_mean(&before, 3.0f, -1.3f, -0.7f, -0.3f, 0.3f, NULL);
+        double sa = it_region_mean(&after, 3.0f, -1.3f, -0.7f, -0.3f, 0.3f, NULL);
+        double lit = it_region_mean(&before, 3.0f, 1.0f, 1.4f, -0.3f, 0.3f, NULL);
         printf("shadow, %s: shadowed region %.4f before the cut, %.4f after; lit ground %.4f\n", be[i], sb, sa, lit);
         EXPECT_MSG(lit > 0.05 && sb < 0.5 * lit, "%s: no shadow before the cut (%.4f vs lit %.4f)", be[i], sb, lit);
         EXPECT_MSG(fabs(sa - lit) <= 0.1 * lit, "%s: the removed caster still shadows (%.4f vs lit %.4f)", be[i], sa, lit);
@@ -252,8 +218,7 @@ static void test_shadow(void)
  * still lit it from the removed part: 30 %, 33 % and 40 % of the uncut Cornell box's mean). */
 static void test_removed_emitter(void)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_material grey, glow;
     MUST(sy_material_create(s, "grey", &grey, err));
     MUST(sy_material_create(s, "glow", &glow, err));
@@ -264,19 +229,13 @@ static void test_removed_emitter(void)
     MUST(sy_material_set(s, glow, &d, err));
     two_quads(s, "ground", 2.0f, grey, "lamp", 0.3f, glow, NULL, NULL);
     MUST(sy_scene_commit(s, NULL, err));
-    sy_mat4 cam = sy_mat4_identity();
-    cam.m[14] = 3.0f;
-    const float cut[1][4] = {{0, 0, -1, 0.5f}}; /* keeps z <= 0.5: the lamp goes, the ground stays */
     const char *be[3] = {"whitted", "pathtracer", "raster"};
     for (int i = 0; i < 3; ++i) {
-        const sy_mediator_class *cls = sy_mediator_find(be[i]);
-        if (!cls || !(sy_mediator_class_caps(cls, NULL) & SY_CAP_CLIP)) continue;
-        sy_layer before = {0}, after = {0};
-        render(s, be[i], NULL, &cam, cut, 0, &before);
-        render(s, be[i], NULL, &cam, cut, 1, &after);
+        sy_layer before, after;
+        if (!render_z_cut(s, be[i], &before, &after)) continue; /* the lamp goes, the ground stays */
         /* the ground beside the lamp (the lamp hides the ground under it from the camera) */
-        double lb = region_luminance(&before, 3.0f, 0.5f, 1.5f, -0.5f, 0.5f);
-        double la = region_luminance(&after, 3.0f, 0.5f, 1.5f, -0.5f, 0.5f);
+        double lb = it_region_mean(&before, 3.0f, 0.5f, 1.5f, -0.5f, 0.5f, NULL);
+        double la = it_region_mean(&after, 3.0f, 0.5f, 1.5f, -0.5f, 0.5f, NULL);
         printf("removed emitter, %s: ground beside the lamp %.4f with it, %.4f with it cut away\n", be[i], lb, la);
         EXPECT_MSG(lb > 0.02, "%s: the lamp does not light the ground (%.4f)", be[i], lb);
         EXPECT_MSG(la <= 0.01 * lb, "%s: the removed lamp still lights the ground (%.4f of %.4f)", be[i], la, lb);
@@ -338,11 +297,5 @@ int main(int argc, char **argv)
     test_pick();
     test_removed_emitter();
     test_shadow();
-    if (sy_check_failures) {
-        fprintf(stderr, "test_it_clip: %d check(s) failed\n", sy_check_failures);
-        return 1;
-    }
-    test_sample(write_dir); /* last: skips (77) without the test data */
-    if (sy_check_failures) fprintf(stderr, "test_it_clip: %d check(s) failed\n", sy_check_failures);
-    return sy_check_failures ? 1 : 0;
+    return it_finish_last("test_it_clip", test_sample, write_dir);
 }

@@ -236,8 +236,7 @@ int main(void)
     EXPECT(info.camera_node_count == 1 && info.camera_nodes[0].id == cam.id);
     MUST(sy_scene_commit(scene, NULL, err));
 
-    sy_context_pool *pool;
-    MUST(sy_context_pool_create(&pool, err));
+    sy_context_pool *pool = it_pool();
     sy_viewport_desc vd = {.root = info.root, .camera = cam, .backend = "whitted"};
     sy_window *win = it_window(W, H, &vd, NULL);
     sy_layer img;

@@ -57,8 +57,7 @@ static void render_params(sy_scene *scene, const sy_gltf_info *info, sy_node cam
 {
     sy_viewport_desc vd = {.root = info->root, .camera = cam, .backend = "pathtracer", .params = params};
     sy_window *win = it_window(W, W, &vd, NULL);
-    sy_context_pool *pool;
-    MUST(sy_context_pool_create(&pool, err));
+    sy_context_pool *pool = it_pool();
     MUST(sy_layer_create(W, W, out, err));
     for (uint32_t done = 0; done < spp;) {
         uint32_t n = spp - done < 64 ? spp - done : 64;
@@ -95,8 +94,7 @@ int main(void)
     MUST(sy_scene_commit(scene, NULL, err));
     sy_viewport_desc vd = {.root = info.root, .camera = cam, .backend = "pathtracer", .params = "max_depth=64,specular=0"};
     sy_window *win = it_window(W, W, &vd, NULL);
-    sy_context_pool *pool;
-    MUST(sy_context_pool_create(&pool, err));
+    sy_context_pool *pool = it_pool();
     sy_layer img;
     MUST(sy_layer_create(W, W, &img, err));
     double t0 = sy_time_now();

@@ -87,16 +87,14 @@ static sy_mat4 cam_at_5(void)
 }
 
 /* A W x H window with one full viewport of backend, the camera at 5 on +z, and that view. */
-static sy_result one_viewport(const char *backend, sy_scene *s, sy_window **win, sy_viewport **vp, sy_camera_view *view,
-                              sy_error *err)
+static sy_window *one_viewport(const char *backend, sy_scene *s, sy_viewport **vp, sy_camera_view *view)
 {
-    sy_result r = sy_window_create(W, H, win, err);
-    if (r != SY_OK) return r;
     sy_viewport_desc vd = {.backend = backend};
-    if ((r = sy_window_add_viewport(*win, &vd, vp, err)) != SY_OK) return r;
+    sy_window *win = it_window(W, H, &vd, vp);
     sy_mat4 cam = cam_at_5();
     sy_viewport_set_view(*vp, &cam);
-    return sy_viewport_camera_view(*vp, s, W, H, view, err);
+    MUST(sy_viewport_camera_view(*vp, s, W, H, view, err));
+    return win;
 }
 
 /* What pixel (px, py) must answer, from the view's window and the quads' definition. */
@@ -179,13 +177,11 @@ static void test_quads(void)
 #endif
     quads q;
     make_quads(&q);
-    sy_context_pool *pool;
-    MUST(sy_context_pool_create(&pool, err));
+    sy_context_pool *pool = it_pool();
     for (uint32_t b = 0; b < n; ++b) {
-        sy_window *win;
         sy_viewport *vp;
         sy_camera_view view;
-        MUST(one_viewport(names[b], q.s, &win, &vp, &view, err));
+        sy_window *win = one_viewport(names[b], q.s, &vp, &view);
         /* a pick leaves no trace in what the context renders next (the rasterizer's GL state) */
         bool progressive = (sy_mediator_class_caps(sy_mediator_find(names[b]), NULL) & SY_CAP_PROGRESSIVE) != 0;
         sy_layer before = {0}, after = {0};
@@ -239,8 +235,7 @@ static void test_dag(void)
 {
     const char *names[16];
     uint32_t n = pick_classes(names);
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_material m = material(s, "m");
     const float qd[1][3] = {{0.0f, 0.0f, 0.4f}};
     sy_mesh mesh = it_quad_mesh(s, "quad", qd, &m, 1);
@@ -254,13 +249,11 @@ static void test_dag(void)
     MUST(sy_node_add_child(s, left, shared, err));
     MUST(sy_node_add_child(s, right, shared, err));
     MUST(sy_scene_commit(s, NULL, err));
-    sy_context_pool *pool;
-    MUST(sy_context_pool_create(&pool, err));
+    sy_context_pool *pool = it_pool();
     for (uint32_t b = 0; b < n; ++b) {
-        sy_window *win;
         sy_viewport *vp;
         sy_camera_view view;
-        MUST(one_viewport(names[b], s, &win, &vp, &view, err));
+        sy_window *win = one_viewport(names[b], s, &vp, &view);
         uint32_t lx, ly, rx, ry;
         const float pl[3] = {-0.6f, 0.1f, 0.0f}, pr[3] = {0.6f, 0.1f, 0.0f};
         float fx, fy;
@@ -281,33 +274,13 @@ static void test_dag(void)
 }
 
 /* ---------------------------------------------------------------- 3. layers and eyes; 4. bad input */
-static sy_result nopick_create(const sy_mediator_create_args *a, void **st, sy_error *e)
-{
-    (void)a, (void)e;
-    *st = malloc(1);
-    return SY_OK;
-}
-static void nopick_destroy(void *st) { free(st); }
-static sy_result nopick_sync(void *st, const sy_changes *c, sy_error *e)
-{
-    (void)st, (void)c, (void)e;
-    return SY_OK;
-}
-static sy_result nopick_render(void *st, const sy_render_request *r, sy_layer *l, sy_error *e)
-{
-    (void)st, (void)r, (void)e;
-    sy_layer_clear(l);
-    return SY_OK;
-}
-static const sy_mediator_class nopick_class = {.name = "test_nopick", .caps = SY_CAP_DEPTH, .create = nopick_create,
-                                               .destroy = nopick_destroy, .sync = nopick_sync, .render = nopick_render};
+static const sy_mediator_class nopick_class = {.name = "test_nopick", .caps = SY_CAP_DEPTH, IT_STUB_FUNCTIONS};
 
 static void test_window(void)
 {
     quads q;
     make_quads(&q);
-    sy_context_pool *pool;
-    MUST(sy_context_pool_create(&pool, err));
+    sy_context_pool *pool = it_pool();
     sy_mat4 cam = cam_at_5();
     /* viewport 0: root A (replace), viewport 1: root B, in each composite mode */
     static const uint32_t modes[3] = {SY_COMPOSITE_DEPTH, SY_COMPOSITE_ALPHA_OVER, SY_COMPOSITE_REPLACE};
@@ -424,8 +397,7 @@ static void agree(const char *path, uint32_t n, uint32_t w, uint32_t h, agreemen
     double size = 0.0;
     for (int k = 0; k < 3; ++k) size += ((double)bb.max[k] - bb.min[k]) * ((double)bb.max[k] - bb.min[k]);
     size = sqrt(size);
-    sy_context_pool *pool;
-    MUST(sy_context_pool_create(&pool, err));
+    sy_context_pool *pool = it_pool();
     sy_window *win[16];
     for (uint32_t b = 0; b < nb; ++b) {
         MUST(sy_window_create(w, h, &win[b], err));

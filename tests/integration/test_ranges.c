@@ -86,8 +86,7 @@ static sy_result load_gltf(sy_scene *s, const char *nodes, const char *roots, co
 
 static void test_gltf_camera_far(void)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_error e = {0};
     sy_result r = load_gltf(s, "{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,1e19]}", "0,1", NULL, &e);
     EXPECT_MSG(r != SY_OK && strstr(e.message, "ranges.gltf") && strstr(e.message, "nodes[1]") &&
@@ -102,8 +101,7 @@ static void test_x3d_viewpoint_far(void)
         "<?xml version=\"1.0\"?><X3D profile=\"Interchange\" version=\"3.3\"><Scene>"
         "<Viewpoint position=\"0 0 1e19\"/>"
         "<Shape><Box/></Shape></Scene></X3D>";
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_error e = {0};
     sy_x3d_info info = {0};
     sy_result r = sy_x3d_load_memory(doc, sizeof doc - 1, "far.x3d", ".", s, NULL, &info, &e);
@@ -124,8 +122,7 @@ static void render_scale(const char *scale, uint32_t covered_out[BACKEND_COUNT])
              "{\"mesh\":0},{\"mesh\":0,\"translation\":[1.5,0,0],\"scale\":%s},"
              "{\"camera\":0,\"translation\":[1,0.5,3]}",
              scale ? scale : "[1,1,1]");
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     MUST(load_gltf(s, nodes, scale ? "0,1,2" : "0,2", NULL, err));
     MUST(sy_scene_commit(s, NULL, err));
     sy_node cam = {0};
@@ -169,8 +166,7 @@ static void test_orbit(void)
     sy_mat4 m;
     sy_orbit_matrix(&o, &m);
     EXPECT_MSG(sy_coords_in_range(m.m, 16), "orbit camera at %g %g %g", (double)m.m[12], (double)m.m[13], (double)m.m[14]);
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     MUST(load_gltf(s, "{\"mesh\":0},{\"camera\":0}", "0,1", NULL, err));
     sy_node cam = {0};
     for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id; id = sy_scene_next(s, SY_TYPE_NODE, id))
@@ -189,8 +185,7 @@ static void test_orbit(void)
  * not. The mesh placed so is not drawn (the rest is); a camera placed so fails the render. */
 static void test_composed(void)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     /* node 1 scales by 1e6, its child 2 sits at 1e11 in its frame: 1e17 in the world */
     MUST(load_gltf(s,
                    "{\"mesh\":0},{\"scale\":[1e6,1e6,1e6],\"children\":[2,3]},{\"mesh\":0,\"translation\":[1e11,0,0]},"
@@ -223,8 +218,7 @@ static void test_composed(void)
  * leaf, which holds the mesh. */
 static sy_scene *diamond(uint32_t levels, sy_node *root_out)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_material mat = it_unlit(s, "m", 0.8f, 0.8f, 0.8f);
     const float quad[1][3] = {{0, 0, 0.5f}};
     sy_mesh mesh = it_quad_mesh(s, "q", quad, &mat, 1);
@@ -282,8 +276,7 @@ static void test_many_children(void)
         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
         "\"nodes\":[{\"mesh\":0,\"extensions\":{\"EXT_mesh_gpu_instancing\":{\"attributes\":{\"TRANSLATION\":1}}}}],"
         "\"scenes\":[{\"nodes\":[0]}],\"scene\":0}";
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_gltf_info info = {0};
     sy_error e = {0};
     sy_result r = sy_gltf_load_memory(doc, sizeof doc - 1, "instances.gltf", ".", s, NULL, &info, &e);
@@ -300,8 +293,7 @@ static void test_many_children(void)
 static void test_budgets(void)
 {
     const uint64_t budget = (uint64_t)512 << 20;
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     /* 64 primitives sharing one 2^24-vertex accessor without a buffer view (zeros): 3.3 KB */
     char *doc = malloc(16384);
     size_t n = (size_t)snprintf(doc, 16384,

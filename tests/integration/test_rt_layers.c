@@ -38,8 +38,7 @@ static void render_mean(sy_scene *s, sy_node root, double out[3])
  * data d and a point light at the eye (0, 0, 4); returns its root. */
 static sy_scene *quad_scene(const sy_material_data *d, float tilt, sy_node *root)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_material m;
     MUST(sy_material_create(s, "layered", &m, err));
     MUST(sy_material_set(s, m, d, err));
@@ -63,8 +62,7 @@ static sy_scene *quad_scene(const sy_material_data *d, float tilt, sy_node *root
 
 static sy_material_data black_dielectric(float roughness, float specular)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_material_data d = *sy_material_get(s, (sy_material){0}); /* the defaults */
     sy_scene_destroy(s);
     d.base_color[0] = d.base_color[1] = d.base_color[2] = 0.0f;

@@ -13,12 +13,6 @@
 #define W 160
 #define H 200
 
-static const char *const k_backends[] = {
-#ifdef SY_HAVE_RASTER
-    "raster",
-#endif
-    "whitted", "pathtracer"};
-#define NB (sizeof k_backends / sizeof k_backends[0])
 
 /* The whole image; a progressive back-end's with 16 samples (its 1-sample edges are jittered). */
 static sy_result render(sy_context *ctx, const sy_camera_view *view, sy_layer *img, sy_error *err)
@@ -87,45 +81,45 @@ int main(void)
     sy_camera_view view = it_view_down_z(3.2f, 0.27f);
     view.camera_to_world.m[13] = 0.72f;
     view.window[0] = -0.27f * (float)W / (float)H, view.window[1] = 0.27f * (float)W / (float)H;
-    sy_context *ctx[NB];
-    sy_layer t0[NB], t1[NB];
-    for (size_t b = 0; b < NB; ++b) {
-        MUST(sy_context_create(s, k_backends[b], NULL, info.root.id, &ctx[b], err));
+    sy_context *ctx[IT_NBACKENDS];
+    sy_layer t0[IT_NBACKENDS], t1[IT_NBACKENDS];
+    for (size_t b = 0; b < IT_NBACKENDS; ++b) {
+        MUST(sy_context_create(s, it_backends[b], NULL, info.root.id, &ctx[b], err));
         MUST(sy_context_sync(ctx[b], err));
         MUST(render(ctx[b], &view, &t0[b], err));
     }
     MUST(sy_scene_set_time(s, (sy_animation){0}, 1.0, err));
     MUST(sy_scene_commit(s, NULL, err));
-    for (size_t b = 0; b < NB; ++b) {
+    for (size_t b = 0; b < IT_NBACKENDS; ++b) {
         MUST(sy_context_sync(ctx[b], err));
         MUST(render(ctx[b], &view, &t1[b], err));
         double iou;
         MUST(sy_layer_coverage_iou(&t0[b], &t1[b], &iou, err));
-        printf("%s: IoU of t=0 and t=1: %.4f\n", k_backends[b], iou);
-        EXPECT_MSG(iou < 0.95, "%s: the pose at t=1 looks like t=0 (IoU %.4f)", k_backends[b], iou);
+        printf("%s: IoU of t=0 and t=1: %.4f\n", it_backends[b], iou);
+        EXPECT_MSG(iou < 0.95, "%s: the pose at t=1 looks like t=0 (IoU %.4f)", it_backends[b], iou);
     }
     /* a pick at the chest names the skinned node and the same deformed point in every back-end (the
      * depth of that pixel in the t = 1 layer, whose vertices were updated in place) */
-    sy_pick_result pk[NB];
-    for (size_t b = 0; b < NB; ++b) {
+    sy_pick_result pk[IT_NBACKENDS];
+    for (size_t b = 0; b < IT_NBACKENDS; ++b) {
         MUST(sy_context_pick(ctx[b], &view, W, H, W / 2, (uint32_t)(0.4 * H), &pk[b], err));
         float d = t1[b].depth[(size_t)(0.4 * H) * W + W / 2];
-        printf("%s: pick node %#x, position (%.4f %.4f %.4f), depth %.4f (layer %.4f)\n", k_backends[b], pk[b].node_id,
+        printf("%s: pick node %#x, position (%.4f %.4f %.4f), depth %.4f (layer %.4f)\n", it_backends[b], pk[b].node_id,
                (double)pk[b].position[0], (double)pk[b].position[1], (double)pk[b].position[2], (double)pk[b].depth, (double)d);
-        EXPECT_MSG(pk[b].hit && pk[b].node_id == pk[0].node_id, "%s: the pick missed the figure", k_backends[b]);
-        EXPECT_MSG(fabsf(pk[b].depth - d) < 2e-3f, "%s: pick depth %.4f, the layer's %.4f", k_backends[b], (double)pk[b].depth,
+        EXPECT_MSG(pk[b].hit && pk[b].node_id == pk[0].node_id, "%s: the pick missed the figure", it_backends[b]);
+        EXPECT_MSG(fabsf(pk[b].depth - d) < 2e-3f, "%s: pick depth %.4f, the layer's %.4f", it_backends[b], (double)pk[b].depth,
                    (double)d);
-        EXPECT_MSG(fabsf(pk[b].depth - pk[0].depth) < 5e-3f, "%s: pick depth %.4f, %s's %.4f", k_backends[b], (double)pk[b].depth,
-                   k_backends[0], (double)pk[0].depth);
+        EXPECT_MSG(fabsf(pk[b].depth - pk[0].depth) < 5e-3f, "%s: pick depth %.4f, %s's %.4f", it_backends[b], (double)pk[b].depth,
+                   it_backends[0], (double)pk[0].depth);
     }
-    for (size_t b = 1; b < NB; ++b)
+    for (size_t b = 1; b < IT_NBACKENDS; ++b)
         for (int t = 0; t < 2; ++t) {
             double iou;
             MUST(sy_layer_coverage_iou(t ? &t1[0] : &t0[0], t ? &t1[b] : &t0[b], &iou, err));
-            printf("t=%d: IoU %s / %s: %.4f\n", t, k_backends[0], k_backends[b], iou);
-            EXPECT_MSG(iou >= 0.97, "t=%d: %s and %s disagree (IoU %.4f)", t, k_backends[0], k_backends[b], iou);
+            printf("t=%d: IoU %s / %s: %.4f\n", t, it_backends[0], it_backends[b], iou);
+            EXPECT_MSG(iou >= 0.97, "t=%d: %s and %s disagree (IoU %.4f)", t, it_backends[0], it_backends[b], iou);
         }
-    for (size_t b = 0; b < NB; ++b) {
+    for (size_t b = 0; b < IT_NBACKENDS; ++b) {
         sy_layer_destroy(&t0[b]);
         sy_layer_destroy(&t1[b]);
         sy_context_release(ctx[b]);

@@ -356,8 +356,7 @@ int main(void)
 
     /* ---- a second context on the same scene: the snapshot path gives the same image ---- */
     {
-        sy_context_pool *pool;
-        MUST(sy_context_pool_create(&pool, err));
+        sy_context_pool *pool = it_pool();
         sy_context *a, *b, *c;
         MUST(sy_context_pool_get(pool, f.s, "whitted", NULL, 0, &a, err));
         MUST(sy_context_pool_get(pool, f.s, "whitted", NULL, 0, &b, err));

@@ -165,8 +165,7 @@ static void pixel_of(const sy_camera_view *v, float x, float y, float z, uint32_
 
 static void test_layered(void)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_material ma = it_unlit(s, "a", 0.9f, 0.2f, 0.1f), mb = it_unlit(s, "b", 0.1f, 0.3f, 0.8f);
     /* A: near (z = 0) square left of centre; B: a second root, farther (z = -1), overlapping A */
     sy_node a = quad_node(s, "A", -0.6f, 0.0f, 0.0f, 0.5f, ma);
@@ -175,8 +174,7 @@ static void test_layered(void)
     MUST(sy_scene_commit(s, NULL, err));
     EXPECT(sy_node_parent_count(s, a) == 0 && sy_node_parent_count(s, b) == 0);
 
-    sy_context_pool *pool;
-    MUST(sy_context_pool_create(&pool, err));
+    sy_context_pool *pool = it_pool();
     sy_window *win;
     sy_viewport *va, *vb;
     MUST(sy_window_create(LW, LH, &win, err));
@@ -343,8 +341,7 @@ static bool centroid(const sy_layer *img, uint32_t x0, uint32_t w, const float c
 
 static void test_stereo_render(void)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     const float cz[3] = {0.9f, 0.9f, 0.1f}, cn[3] = {0.1f, 0.9f, 0.9f};
     sy_material mz = it_unlit(s, "zp", cz[0], cz[1], cz[2]), mn = it_unlit(s, "near", cn[0], cn[1], cn[2]);
     sy_node root;
@@ -368,8 +365,7 @@ static void test_stereo_render(void)
     d.x = half;
     d.eye = SY_EYE_RIGHT;
     MUST(sy_window_add_viewport(win, &d, &vr, err));
-    sy_context_pool *pool;
-    MUST(sy_context_pool_create(&pool, err));
+    sy_context_pool *pool = it_pool();
     sy_layer img;
     MUST(sy_layer_create(2 * half, h, &img, err));
     MUST(sy_window_render(win, s, pool, NULL, &img, err));

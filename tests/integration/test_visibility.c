@@ -99,24 +99,6 @@ static void counters(view *v, sy_scene *s, uint32_t *entries, uint32_t *instance
     }
 }
 
-/* Mean RGB (and luminance) over the pixels whose image-plane point at distance dist, for the
- * view straight down from z = 6 (yfov 45 degrees), lies in [x0, x1] x [y0, y1]. */
-static double region_mean(const sy_layer *img, float dist, float x0, float x1, float y0, float y1, double rgb[3])
-{
-    const float t = tanf(0.3926991f), a = (float)W / (float)H;
-    double sum[3] = {0, 0, 0};
-    uint32_t count = 0;
-    for (uint32_t py = 0; py < H; ++py)
-        for (uint32_t px = 0; px < W; ++px) {
-            float x = (-t * a + (px + 0.5f) / W * 2.0f * t * a) * dist, y = (t - (py + 0.5f) / H * 2.0f * t) * dist;
-            if (x < x0 || x > x1 || y < y0 || y > y1) continue;
-            const float *c = it_px(img, px, py);
-            for (int k = 0; k < 3; ++k) sum[k] += c[k];
-            count++;
-        }
-    for (int k = 0; k < 3; ++k) rgb[k] = count ? sum[k] / count : 0.0;
-    return count ? 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2] : -1.0;
-}
 
 /* The shadow scene of test_clip: a 4 x 4 ground at z = 0, a 0.8 x 0.8 caster at z = 1 (blue,
  * lit), a sun travelling (-1, 0, -1)/sqrt(2): the caster's shadow falls around x = -1. */
@@ -179,11 +161,11 @@ static void test_hide(void)
         view_render(&v, ss.s, &after);
         counters(&v, ss.s, &e1, &i1);
         double cb[3], ca[3], lit_rgb[3], tmp[3];
-        region_mean(&before, 5.0f, -0.3f, 0.3f, -0.3f, 0.3f, cb); /* the caster, at distance 5 */
-        region_mean(&after, 6.0f, -0.4f, 0.4f, -0.4f, 0.4f, ca);  /* the ground under it */
-        double lit = region_mean(&before, 6.0f, 1.0f, 1.4f, -0.3f, 0.3f, lit_rgb);
-        double sb = region_mean(&before, 6.0f, -1.3f, -0.7f, -0.3f, 0.3f, tmp);
-        double sa = region_mean(&after, 6.0f, -1.3f, -0.7f, -0.3f, 0.3f, tmp);
+        it_region_mean(&before, 5.0f, -0.3f, 0.3f, -0.3f, 0.3f, cb); /* the caster, at distance 5 */
+        it_region_mean(&after, 6.0f, -0.4f, 0.4f, -0.4f, 0.4f, ca);  /* the ground under it */
+        double lit = it_region_mean(&before, 6.0f, 1.0f, 1.4f, -0.3f, 0.3f, lit_rgb);
+        double sb = it_region_mean(&before, 6.0f, -1.3f, -0.7f, -0.3f, 0.3f, tmp);
+        double sa = it_region_mean(&after, 6.0f, -1.3f, -0.7f, -0.3f, 0.3f, tmp);
         printf("hide, %s: caster pixels rgb %.3f %.3f %.3f -> %.3f %.3f %.3f; shadow %.4f -> %.4f (lit %.4f); "
                "sync entries %u, instances %u -> %u\n",
                backends[i], cb[0], cb[1], cb[2], ca[0], ca[1], ca[2], sb, sa, lit, e1, i0, i1);
@@ -210,7 +192,7 @@ static void test_hide(void)
                        backends[i]);
         else {
             double cg[3];
-            region_mean(&again, 5.0f, -0.3f, 0.3f, -0.3f, 0.3f, cg);
+            it_region_mean(&again, 5.0f, -0.3f, 0.3f, -0.3f, 0.3f, cg);
             EXPECT_MSG(fabs(cg[2] - cb[2]) < 0.05 * cb[2], "pathtracer: the caster did not come back (%.3f vs %.3f)", cg[2], cb[2]);
         }
         sy_layer_destroy(&before);
@@ -225,8 +207,7 @@ static void test_hide(void)
 
 static void test_coverage(void)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_material m = it_unlit(s, "white", 1, 1, 1);
     const float qa[1][3] = {{-0.53f, 0.02f, 0.47f}}, qb[1][3] = {{0.53f, 0.02f, 0.47f}};
     sy_mesh ma = it_quad_mesh(s, "a", qa, &m, 1), mb = it_quad_mesh(s, "b", qb, &m, 1);
@@ -283,10 +264,10 @@ static void test_select(void)
         MUST(sy_scene_commit(ss.s, NULL, err));
         view_render(&v, ss.s, &sel);
         double cp[3], cs[3], lp[3], ls[3];
-        region_mean(&plain, 5.0f, -0.3f, 0.3f, -0.3f, 0.3f, cp);
-        region_mean(&sel, 5.0f, -0.3f, 0.3f, -0.3f, 0.3f, cs);
-        double lit_p = region_mean(&plain, 6.0f, 1.0f, 1.4f, -0.3f, 0.3f, lp);
-        double lit_s = region_mean(&sel, 6.0f, 1.0f, 1.4f, -0.3f, 0.3f, ls);
+        it_region_mean(&plain, 5.0f, -0.3f, 0.3f, -0.3f, 0.3f, cp);
+        it_region_mean(&sel, 5.0f, -0.3f, 0.3f, -0.3f, 0.3f, cs);
+        double lit_p = it_region_mean(&plain, 6.0f, 1.0f, 1.4f, -0.3f, 0.3f, lp);
+        double lit_s = it_region_mean(&sel, 6.0f, 1.0f, 1.4f, -0.3f, 0.3f, ls);
         uint32_t outline = 0;
         for (uint32_t k = 0; k < (uint32_t)(W * H); ++k) {
             const float *c = sel.rgba + 4 * k;
@@ -356,8 +337,7 @@ static void test_select(void)
 static void test_id_aovs(void)
 {
     if (!have("pathtracer")) return;
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
+    sy_scene *s = it_scene();
     sy_material m = it_unlit(s, "white", 1, 1, 1);
     const float q[1][3] = {{0, 0, 0.3f}};
     sy_mesh mq = it_quad_mesh(s, "q", q, &m, 1);
@@ -536,11 +516,5 @@ int main(int argc, char **argv)
     test_coverage();
     test_select();
     test_id_aovs();
-    if (sy_check_failures) {
-        fprintf(stderr, "test_it_visibility: %d check(s) failed\n", sy_check_failures);
-        return 1;
-    }
-    test_sample(write_dir); /* last: skips (77) without the test data */
-    if (sy_check_failures) fprintf(stderr, "test_it_visibility: %d check(s) failed\n", sy_check_failures);
-    return sy_check_failures ? 1 : 0;
+    return it_finish_last("test_it_visibility", test_sample, write_dir);
 }
