@@ -1,5 +1,6 @@
-/* gltf_files.h — whole-file reading and writing for the glTF tests that write variants of sample
- * files (Draco, meshopt). Test-only; header-only on purpose. */
+/* gltf_files.h — the glTF tests' files: the test-data folder they are given, whole-file reading and
+ * writing for the tests that write variants of sample files (Draco, meshopt). Test-only;
+ * header-only on purpose. */
 #ifndef SY_TEST_GLTF_FILES_H
 #define SY_TEST_GLTF_FILES_H
 
@@ -7,6 +8,17 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+
+/* The test-data folder, the test's one argument (ctest passes ../shared/testdata); without it the
+ * usage line and exit status 2. */
+static inline const char *testdata_arg(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: %s TESTDATA_DIR\n", argv[0]);
+        exit(2);
+    }
+    return argv[1];
+}
 
 /* The whole file (NUL-terminated) through the library's reader (malloc()ed); NULL when it cannot
  * be read. */

@@ -174,18 +174,25 @@ static void check_file(const char *file, uint32_t *models)
     } else {
         (*models)++;
         const sy_gltf_counts *c = &info.counts;
-        expect_count(file, "nodes", c->nodes, e.nodes);
-        expect_count(file, "meshes", c->meshes, e.meshes);
-        expect_count(file, "primitives", c->primitives, e.primitives);
-        expect_count(file, "triangles", c->triangles, e.triangles);
-        expect_count(file, "skipped_primitives", c->skipped_primitives, e.skipped);
-        expect_count(file, "points", c->points, e.points);
-        expect_count(file, "line_segments", c->line_segments, e.segments);
-        expect_count(file, "materials", c->materials, e.materials);
-        expect_count(file, "textures", c->textures, e.textures);
-        expect_count(file, "images", c->images, e.images);
-        expect_count(file, "cameras", c->cameras, e.cameras);
-        expect_count(file, "lights", c->lights, e.lights);
+        const struct {
+            const char *what;
+            uint64_t got, want;
+        } counts[] = {
+            {"nodes", c->nodes, e.nodes},
+            {"meshes", c->meshes, e.meshes},
+            {"primitives", c->primitives, e.primitives},
+            {"triangles", c->triangles, e.triangles},
+            {"skipped_primitives", c->skipped_primitives, e.skipped},
+            {"points", c->points, e.points},
+            {"line_segments", c->line_segments, e.segments},
+            {"materials", c->materials, e.materials},
+            {"textures", c->textures, e.textures},
+            {"images", c->images, e.images},
+            {"cameras", c->cameras, e.cameras},
+            {"lights", c->lights, e.lights},
+        };
+        for (size_t i = 0; i < sizeof counts / sizeof counts[0]; ++i)
+            expect_count(file, counts[i].what, counts[i].got, counts[i].want);
         /* the scene itself: every mesh is created, whether referenced or not */
         uint64_t tris = 0, prims = 0, without_normals = 0, tri_vertices = 0;
         for (uint32_t id = sy_scene_next(scene, SY_TYPE_MESH, 0); id; id = sy_scene_next(scene, SY_TYPE_MESH, id)) {

@@ -164,13 +164,10 @@ static void test_generated_quad(void)
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        fprintf(stderr, "usage: %s TESTDATA_DIR\n", argv[0]);
-        return 2;
-    }
+    const char *testdata = testdata_arg(argc, argv);
     char gpath[1024], bpath[1024];
-    snprintf(gpath, sizeof gpath, "%s/gltf/Box/glTF-Draco/Box.gltf", argv[1]);
-    snprintf(bpath, sizeof bpath, "%s/gltf/Box/glTF-Draco/Box.bin", argv[1]);
+    snprintf(gpath, sizeof gpath, "%s/gltf/Box/glTF-Draco/Box.gltf", testdata);
+    snprintf(bpath, sizeof bpath, "%s/gltf/Box/glTF-Draco/Box.bin", testdata);
     snprintf(g_dir, sizeof g_dir, "/tmp/sy_gltf_draco_XXXXXX");
     if (!mkdtemp(g_dir)) {
         perror("mkdtemp");

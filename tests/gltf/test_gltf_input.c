@@ -130,6 +130,13 @@ static const sy_node_data *node_named(sy_scene *s, const char *name)
     return nd;
 }
 
+/* The node named "moved" exists and its translation has these x and z. */
+static bool moved_to(sy_scene *s, float x, float z)
+{
+    const sy_node_data *nd = node_named(s, "moved");
+    return nd && nd->transform.translation[0] == x && nd->transform.translation[2] == z;
+}
+
 typedef struct outcome {
     sy_result r;
     sy_error err;
@@ -165,6 +172,16 @@ static outcome run(const char *path, const sy_gltf_options *opt, sy_scene **keep
         EXPECT_MSG(sy_blob_live_count() == blobs, "%s: %ld blobs leaked", path, sy_blob_live_count() - blobs);
     }
     return o;
+}
+
+/* Writes json_fmt with buf as file name (write_gltf) and loads it into *s (the caller destroys it);
+ * true when it loaded, a failed check naming the file and the reason otherwise. */
+static bool write_load(const char *name, const char *json_fmt, const void *buf, size_t n, char *path, sy_scene **s)
+{
+    write_gltf(name, json_fmt, buf, n, path);
+    outcome o = run(path, NULL, s);
+    EXPECT_MSG(o.r == SY_OK, "%s: %s", name, o.err.message);
+    return o.r == SY_OK;
 }
 
 static void expect_fail(const char *name, const char *path, const sy_gltf_options *opt, sy_result code, const char *substr)
@@ -434,13 +451,9 @@ static void test_valid(void)
                           "\"animations\":[{\"samplers\":[{\"input\":0,\"output\":1},{\"input\":0,\"output\":2,\"interpolation\":\"CUBICSPLINE\"}],"
                           "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}},"
                           "{\"sampler\":1,\"target\":{\"node\":0,\"path\":\"scale\"}}]}]}";
-        write_gltf("anim.gltf", fmt, data, sizeof data, path);
-        outcome o = run(path, NULL, &s);
-        EXPECT_MSG(o.r == SY_OK, "anim.gltf: %s", o.err.message);
-        if (o.r == SY_OK) {
+        if (write_load("anim.gltf", fmt, data, sizeof data, path, &s)) {
+            EXPECT_MSG(moved_to(s, 1, 3), "first frame translation (1, 2, 3), not the static (7, 7, 7)");
             const sy_node_data *nd = node_named(s, "moved");
-            EXPECT_MSG(nd && nd->transform.translation[0] == 1 && nd->transform.translation[2] == 3,
-                       "first frame translation (1, 2, 3), not the static (7, 7, 7)");
             EXPECT_MSG(nd && nd->transform.scale[0] == 2 && nd->transform.scale[2] == 2, "CUBICSPLINE first value (2, 2, 2)");
         }
         sy_scene_destroy(s);
@@ -466,14 +479,8 @@ static void test_valid(void)
                           "\"nodes\":[{\"name\":\"moved\"}],"
                           "\"animations\":[{\"samplers\":[{\"input\":0,\"output\":1}],"
                           "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]}";
-        write_gltf("anim_output_count.gltf", fmt, data, sizeof data, path);
-        outcome o = run(path, NULL, &s);
-        EXPECT_MSG(o.r == SY_OK, "anim_output_count.gltf: %s", o.err.message);
-        if (o.r == SY_OK) {
-            const sy_node_data *nd = node_named(s, "moved");
-            EXPECT_MSG(nd && nd->transform.translation[0] == 4 && nd->transform.translation[2] == 6,
-                       "anim_output_count: first frame translation (4, 5, 6) from the sparse value");
-        }
+        if (write_load("anim_output_count.gltf", fmt, data, sizeof data, path, &s))
+            EXPECT_MSG(moved_to(s, 4, 6), "anim_output_count: first frame translation (4, 5, 6) from the sparse value");
         sy_scene_destroy(s);
         s = NULL;
     }
@@ -495,10 +502,7 @@ static void test_valid(void)
                           "{\"name\":\"fan\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":6}]},"
                           "{\"name\":\"sparse\",\"primitives\":[{\"attributes\":{\"POSITION\":1}}]}],"
                           "\"nodes\":[{\"mesh\":0},{\"mesh\":1},{\"mesh\":2}]}";
-        write_gltf("modes.gltf", fmt, buf, sizeof buf, path);
-        outcome o = run(path, NULL, &s);
-        EXPECT_MSG(o.r == SY_OK, "modes.gltf: %s", o.err.message);
-        if (o.r == SY_OK) {
+        if (write_load("modes.gltf", fmt, buf, sizeof buf, path, &s)) {
             const uint32_t want_strip[6] = {0, 1, 2, 1, 3, 2}, want_fan[6] = {1, 2, 0, 2, 3, 0};
             EXPECT_MSG(sy_scene_count(s, SY_TYPE_NODE) == 4, "modes.gltf: parentless nodes become roots");
             for (uint32_t id = sy_scene_next(s, SY_TYPE_MESH, 0); id; id = sy_scene_next(s, SY_TYPE_MESH, id)) {
@@ -564,10 +568,7 @@ static void test_valid(void)
                  "\"materials\":[{\"normalTexture\":{\"index\":0}}],\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"%s\"}],"
                  "\"nodes\":[{\"mesh\":0}]," SCENES "}",
                  sizeof cube, k_png_uri);
-        write_gltf("flat_cube.gltf", fmt, &cube, sizeof cube, path);
-        outcome o = run(path, NULL, &s);
-        EXPECT_MSG(o.r == SY_OK, "flat_cube.gltf: %s", o.err.message);
-        if (o.r == SY_OK) {
+        if (write_load("flat_cube.gltf", fmt, &cube, sizeof cube, path, &s)) {
             const sy_mesh_data *m = sy_mesh_get(s, (sy_mesh){sy_scene_next(s, SY_TYPE_MESH, 0)});
             const sy_primitive *p = m && m->primitives.count == 1 ? &m->primitives.items[0] : NULL;
             EXPECT_MSG(p && sy_primitive_vertex_count(p) == 8 && p->indices && sy_blob_size(p->indices) == 36 * sizeof(uint32_t),

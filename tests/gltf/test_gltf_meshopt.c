@@ -248,30 +248,27 @@ static void bad_case(const char *data, const char *label, int view, const char *
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        fprintf(stderr, "usage: %s TESTDATA_DIR\n", argv[0]);
-        return 2;
-    }
+    const char *testdata = testdata_arg(argc, argv);
     char probe[1024];
-    snprintf(probe, sizeof probe, "%s/gltf/Box/glTF/Box.gltf", argv[1]);
+    snprintf(probe, sizeof probe, "%s/gltf/Box/glTF/Box.gltf", testdata);
     if (access(probe, R_OK) != 0) {
         printf("SKIP: %s absent\n", probe);
         return 77;
     }
     snprintf(g_dir, sizeof g_dir, "/tmp/sy_gltf_meshopt_XXXXXX");
     if (!mkdtemp(g_dir)) return 1;
-    check_equal(argv[1], "Box");
-    check_equal(argv[1], "Duck");
+    check_equal(testdata, "Box");
+    check_equal(testdata, "Duck");
     g_triangles = true;
-    check_equal(argv[1], "Duck");
+    check_equal(testdata, "Duck");
     /* Box (TRIANGLES): bufferViews[0] holds the indices, [1] the positions and normals */
-    bad_case(argv[1], "corrupt_attr", 1, NULL, 0, NULL, true, SY_ERR_PARSE, "bufferViews[1]: EXT_meshopt_compression: the compressed data");
-    bad_case(argv[1], "corrupt_index", 0, NULL, 0, NULL, true, SY_ERR_PARSE, "bufferViews[0]: EXT_meshopt_compression");
-    bad_case(argv[1], "count_length", 1, "count", 47, NULL, false, SY_ERR_PARSE, "is not the bufferView's byteLength 576");
-    bad_case(argv[1], "count_huge", 1, "count", 4e8, NULL, false, SY_ERR_PARSE, "is not the bufferView's byteLength");
-    bad_case(argv[1], "stride", 1, "byteStride", 7, NULL, false, SY_ERR_PARSE, "bufferViews[1]: EXT_meshopt_compression");
-    bad_case(argv[1], "mode", 1, NULL, 0, "POINTS", false, SY_ERR_PARSE, "mode 'POINTS'");
-    bad_case(argv[1], "source_range", 1, "byteLength", 1e6, NULL, false, SY_ERR_PARSE, "exceeds buffer 0 length");
+    bad_case(testdata, "corrupt_attr", 1, NULL, 0, NULL, true, SY_ERR_PARSE, "bufferViews[1]: EXT_meshopt_compression: the compressed data");
+    bad_case(testdata, "corrupt_index", 0, NULL, 0, NULL, true, SY_ERR_PARSE, "bufferViews[0]: EXT_meshopt_compression");
+    bad_case(testdata, "count_length", 1, "count", 47, NULL, false, SY_ERR_PARSE, "is not the bufferView's byteLength 576");
+    bad_case(testdata, "count_huge", 1, "count", 4e8, NULL, false, SY_ERR_PARSE, "is not the bufferView's byteLength");
+    bad_case(testdata, "stride", 1, "byteStride", 7, NULL, false, SY_ERR_PARSE, "bufferViews[1]: EXT_meshopt_compression");
+    bad_case(testdata, "mode", 1, NULL, 0, "POINTS", false, SY_ERR_PARSE, "mode 'POINTS'");
+    bad_case(testdata, "source_range", 1, "byteLength", 1e6, NULL, false, SY_ERR_PARSE, "exceeds buffer 0 length");
     char path[512];
     const char *left[] = {"Box.gltf", "Duck.gltf", "c.bin", "DuckCM.png", "corrupt_attr.gltf", "corrupt_index.gltf",
                           "count_length.gltf", "count_huge.gltf", "stride.gltf", "mode.gltf", "source_range.gltf"};

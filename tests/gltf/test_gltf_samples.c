@@ -5,6 +5,7 @@
  * Usage: test_gltf_samples TESTDATA_DIR.
  * Exits 77 (skipped) when the test data is absent. */
 #include "../support/sy_check.h"
+#include "gltf_files.h"
 #include "sy_gltf.h"
 #include "sy_graph.h"
 
@@ -353,12 +354,9 @@ static void test_cornell(const char *root)
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        fprintf(stderr, "usage: %s TESTDATA_DIR\n", argv[0]);
-        return 2;
-    }
+    const char *testdata = testdata_arg(argc, argv);
     char gdir[1024];
-    snprintf(gdir, sizeof gdir, "%s/gltf", argv[1]);
+    snprintf(gdir, sizeof gdir, "%s/gltf", testdata);
     DIR *d = opendir(gdir);
     if (!d) {
         printf("SKIP: test data directory %s is absent\n", gdir);
@@ -429,7 +427,7 @@ int main(int argc, char **argv)
         if (have_first) unload(&first);
         free(models[m]);
     }
-    test_cornell(argv[1]);
+    test_cornell(testdata);
     EXPECT_MSG(sy_blob_live_count() == blobs_before, "blob leak: %ld live, %ld before", sy_blob_live_count(), blobs_before);
     EXPECT_MSG(files >= 30, "only %u sample files found", files);
     EXPECT_MSG(compressed_ok >= 2, "only %u compressed variants found", compressed_ok);
