@@ -8,6 +8,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <unistd.h>
 
 /* The test-data folder, the test's one argument (ctest passes ../shared/testdata); without it the
  * usage line and exit status 2. */
@@ -18,6 +19,17 @@ static inline const char *testdata_arg(int argc, char **argv)
         exit(2);
     }
     return argv[1];
+}
+
+/* A new scratch folder $TMPDIR/NAME_XXXXXX (/tmp without TMPDIR) into buf, which must hold at least
+ * 64 characters more than $TMPDIR; ends the test (exit 1) when it cannot be made. */
+static inline void scratch_dir(const char *name, char *buf, size_t size)
+{
+    snprintf(buf, size, "%s/%s_XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp", name);
+    if (!mkdtemp(buf)) {
+        perror("mkdtemp");
+        exit(1);
+    }
 }
 
 /* The whole file (NUL-terminated) through the library's reader (malloc()ed); NULL when it cannot

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "../support/sy_check.h"
+#include "gltf_files.h"
 #include "sy_anim.h"
 #include "sy_gltf.h"
 
@@ -228,11 +229,7 @@ static int test_bad_samplers(void)
 int main(int argc, char **argv)
 {
     const char *data = argc > 1 ? argv[1] : "../shared/testdata";
-    snprintf(g_dir, sizeof g_dir, "%s/sy_gltf_anim_XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
-    if (!mkdtemp(g_dir)) {
-        perror("mkdtemp");
-        return 1;
-    }
+    scratch_dir("sy_gltf_anim", g_dir, sizeof g_dir);
     RUN(test_bad_samplers);
     rmdir(g_dir);
     int skipped = 0;

@@ -178,18 +178,11 @@ static void check_file(const char *file, uint32_t *models)
             const char *what;
             uint64_t got, want;
         } counts[] = {
-            {"nodes", c->nodes, e.nodes},
-            {"meshes", c->meshes, e.meshes},
-            {"primitives", c->primitives, e.primitives},
-            {"triangles", c->triangles, e.triangles},
-            {"skipped_primitives", c->skipped_primitives, e.skipped},
-            {"points", c->points, e.points},
-            {"line_segments", c->line_segments, e.segments},
-            {"materials", c->materials, e.materials},
-            {"textures", c->textures, e.textures},
-            {"images", c->images, e.images},
-            {"cameras", c->cameras, e.cameras},
-            {"lights", c->lights, e.lights},
+            {"nodes", c->nodes, e.nodes}, {"meshes", c->meshes, e.meshes}, {"primitives", c->primitives, e.primitives},
+            {"triangles", c->triangles, e.triangles}, {"skipped_primitives", c->skipped_primitives, e.skipped},
+            {"points", c->points, e.points}, {"line_segments", c->line_segments, e.segments},
+            {"materials", c->materials, e.materials}, {"textures", c->textures, e.textures}, {"images", c->images, e.images},
+            {"cameras", c->cameras, e.cameras}, {"lights", c->lights, e.lights},
         };
         for (size_t i = 0; i < sizeof counts / sizeof counts[0]; ++i)
             expect_count(file, counts[i].what, counts[i].got, counts[i].want);

@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "../support/sy_check.h"
+#include "gltf_files.h"
 #include "sy_anim.h"
 #include "sy_commit.h"
 #include "sy_deform.h"
@@ -155,7 +156,22 @@ typedef struct rig {
     sy_gltf_info info;
 } rig;
 
-/* Loads a sample into a rig: 1 done, 0 absent (skip printed), -1 failed. */
+/* Loads the file at path (the sample rel) into a rig: 0 done, 1 a check failed. */
+static int rig_make(rig *g, const char *path, const char *rel, const sy_mirror_callbacks *cb)
+{
+    sy_error e = {0};
+    CHECK_OK(sy_scene_create(&g->s, &e), e);
+    CHECK_OK(sy_gltf_load(path, g->s, NULL, &g->info, &e), e);
+    EXPECT_MSG(g->info.warning_count == 0, "%s: %u warnings, the first: %s", rel, g->info.warning_count,
+               g->info.stored_warning_count ? g->info.warnings[0] : "");
+    sy_mirror_desc d = {"test mirror", 0, cb, &g->rec};
+    CHECK_OK(sy_mirror_create(&d, &g->m, &e), e);
+    CHECK_OK(sy_scene_consumer_add(g->s, &g->consumer, &e), e);
+    return 0;
+}
+
+/* 1: the rig on the sample rel (rig_close); 0: the sample is absent; -1: the rig could not be made
+ * (a failed check). */
 static int rig_open(rig *g, const char *rel, const sy_mirror_callbacks *cb)
 {
     memset(g, 0, sizeof *g);
@@ -165,16 +181,16 @@ static int rig_open(rig *g, const char *rel, const sy_mirror_callbacks *cb)
         printf("skip: %s absent\n", path);
         return 0;
     }
-    sy_error e = {0};
-    CHECK_OK(sy_scene_create(&g->s, &e), e);
-    CHECK_OK(sy_gltf_load(path, g->s, NULL, &g->info, &e), e);
-    EXPECT_MSG(g->info.warning_count == 0, "%s: %u warnings, the first: %s", rel, g->info.warning_count,
-               g->info.stored_warning_count ? g->info.warnings[0] : "");
-    sy_mirror_desc d = {"test mirror", 0, cb, &g->rec};
-    CHECK_OK(sy_mirror_create(&d, &g->m, &e), e);
-    CHECK_OK(sy_scene_consumer_add(g->s, &g->consumer, &e), e);
-    return 1;
+    return rig_make(g, path, rel, cb) == 0 ? 1 : -1;
 }
+
+/* rig_open in a test function: returns from it when the sample is absent (counted in g_skipped)
+ * or the rig could not be made (failed). */
+#define RIG_OPEN(g, rel, cb)                                                                        \
+    do {                                                                                            \
+        int rig_o_ = rig_open(&(g), (rel), (cb));                                                   \
+        if (rig_o_ <= 0) return rig_o_ < 0 ? 1 : (g_skipped++, 0);                                  \
+    } while (0)
 
 static void rig_close(rig *g)
 {
@@ -215,8 +231,7 @@ static uint32_t mesh_node(const sy_scene *s)
 static int test_simple_skin(void)
 {
     rig g;
-    int o = rig_open(&g, "SimpleSkin/glTF/SimpleSkin.gltf", &k_rebuild);
-    if (o <= 0) return o < 0 ? 1 : (g_skipped++, 0);
+    RIG_OPEN(g, "SimpleSkin/glTF/SimpleSkin.gltf", &k_rebuild);
     uint32_t n = mesh_node(g.s);
     uint32_t nj;
     const sy_skin_joint *sj = sy_node_skin(sy_node_get(g.s, (sy_node){n}), &nj);
@@ -248,8 +263,7 @@ static int test_simple_skin(void)
 static int test_cesium_man(void)
 {
     rig g;
-    int o = rig_open(&g, "CesiumMan/glTF/CesiumMan.gltf", &k_refit);
-    if (o <= 0) return o < 0 ? 1 : (g_skipped++, 0);
+    RIG_OPEN(g, "CesiumMan/glTF/CesiumMan.gltf", &k_refit);
     uint32_t n = mesh_node(g.s), nj;
     sy_node_skin(sy_node_get(g.s, (sy_node){n}), &nj);
     EXPECT(nj == 19);
@@ -277,8 +291,7 @@ static int test_cesium_man(void)
 static int test_simple_morph(void)
 {
     rig g;
-    int o = rig_open(&g, "SimpleMorph/glTF/SimpleMorph.gltf", &k_refit);
-    if (o <= 0) return o < 0 ? 1 : (g_skipped++, 0);
+    RIG_OPEN(g, "SimpleMorph/glTF/SimpleMorph.gltf", &k_refit);
     uint32_t n = mesh_node(g.s);
     const sy_primitive *pr = &sy_mesh_get(g.s, sy_node_get(g.s, (sy_node){n})->mesh)->primitives.items[0];
     EXPECT(sy_primitive_target_count(pr) == 2);
@@ -357,8 +370,7 @@ static int test_morph_cube_and_primitives(void)
 static int test_rigged_simple(void)
 {
     rig g;
-    int o = rig_open(&g, "RiggedSimple/glTF/RiggedSimple.gltf", &k_rebuild);
-    if (o <= 0) return o < 0 ? 1 : (g_skipped++, 0);
+    RIG_OPEN(g, "RiggedSimple/glTF/RiggedSimple.gltf", &k_rebuild);
     sy_mirror_sync_stats st;
     CHECK(rig_pose(&g, 0.0, &st) == 0);
     sy_bounds b0 = drawn_bounds(&g.rec);
@@ -493,11 +505,7 @@ static int test_threads_agree(void)
 int main(int argc, char **argv)
 {
     g_data = argc > 1 ? argv[1] : "../shared/testdata";
-    snprintf(g_dir, sizeof g_dir, "%s/sy_gltf_deform_XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
-    if (!mkdtemp(g_dir)) {
-        perror("mkdtemp");
-        return 1;
-    }
+    scratch_dir("sy_gltf_deform", g_dir, sizeof g_dir);
     RUN(test_malformed);
     RUN(test_threads_agree);
     RUN(test_simple_skin);
