@@ -7,15 +7,7 @@
 # shared test data): side-by-side stereo with a raster overlay on the cluster equals the local
 # composite (one render path: nothing the local window does is dropped); BoxAnimated at --at 2 on the
 # cluster equals the local render at that time (the moved nodes reach the replicas as changes).
-set -u
-SY=$1; W=$2; DATA=${3:-}; EXR_EQUAL=${4:?exr_equal}
-rm -rf "$W"; mkdir -p "$W"
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; }
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$W"/*.log; do echo "--- $f"; cat "$f"; done >&2; exit 1; }
-
-. "$(dirname "$0")/../support/wait.sh" # wait_until: states, never sleeps (hang guard only)
+. "$(dirname "$0")/servers.sh" # SY W DATA EXR_EQUAL, pids killed on exit, fail, wait_until
 printf 'cli-test-secret\n' > "$W/secret"; chmod 600 "$W/secret"
 start() { # name [extra args]
   local n=$1; shift

@@ -11,14 +11,7 @@
 #     every frame is still written, equal to the local one, and the summary counts the re-queued frame;
 #   - usage: frames mode without --frames, and with a video, is refused (status 2).
 # Servers stop by themselves (--max-lifetime) and are killed on exit; every wait is bounded.
-set -u
-SY=$1; W=$2; DATA=${3:-}; EXR_EQUAL=${4:?exr_equal}
-rm -rf "$W"; mkdir -p "$W"
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; }
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$W"/*.log "$W"/*.err; do [ -f "$f" ] && { echo "--- $f"; tail -20 "$f"; }; done >&2; exit 1; }
-. "$(dirname "$0")/../support/wait.sh" # wait_until: states, never sleeps (hang guard only)
+. "$(dirname "$0")/servers.sh" # SY W DATA EXR_EQUAL, pids killed on exit, fail, wait_until
 
 # usage errors need no servers nor test data
 "$SY" render demo -b whitted -w 16 -h 16 -o "$W/u.exr" --cluster tcp://127.0.0.1:1 --cluster-mode frames 2> "$W/u1.err"

@@ -10,6 +10,7 @@
  * or decoded into in-range fields, never crash, overread, hang or allocate more than the budget.
  * Built only with -DSY_FUZZ=ON (clang); the plain test test_cluster_proto runs random mutations in
  * every build. Seeds: tests/cluster/fuzz_seeds (test_cluster_proto --write-seeds DIR). */
+#include "frame_join.h"
 #include "sy_cluster.h"
 
 #include <stdlib.h>
@@ -58,44 +59,23 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     /* as a stream: the first message under the handshake budget, the rest under a session's
      * (tags are not checked here: a tagged frame's 32 tag bytes are skipped) */
-    const sy_cluster_budget hs = {SY_CLUSTER_HANDSHAKE_MAX_FRAME, SY_CLUSTER_HANDSHAKE_MAX_FRAME, false, false};
-    sy_cluster_budget open = {1u << 16, 1u << 20, true, false};
-    const sy_cluster_budget *b = &hs;
-    uint8_t *body = NULL;
-    size_t so_far = 0, pos = 0;
-    uint32_t type = 0;
-    sy_cluster_header first;
-    memset(&first, 0, sizeof first);
+    frame_join j = frame_join_start(1u << 16, 1u << 20, true);
+    size_t pos = 0;
     while (size - pos >= SY_CLUSTER_HEADER_SIZE) {
-        sy_cluster_header h;
-        size_t follow;
-        if (sy_cluster_parse_header(data + pos, &h, &e) != SY_OK) break;
-        open.tagged = (h.flags & SY_CLUSTER_FLAG_TAGGED) != 0; /* either way, once open */
-        if (sy_cluster_frame_check(&h, b, so_far, type, &follow, &e) != SY_OK) break;
-        pos += SY_CLUSTER_HEADER_SIZE;
-        if (follow > size - pos) break; /* the stream ends inside the frame */
-        uint8_t *nb = realloc(body, so_far + h.body_size + 1);
-        if (!nb) break;
-        body = nb;
-        memcpy(body + so_far, data + pos, h.body_size);
-        pos += follow;
-        if (!type) first = h;
-        type = h.type;
-        so_far += h.body_size;
-        if (h.flags & SY_CLUSTER_FLAG_MORE) continue;
+        int got = frame_join_take(&j, data, size, &pos, &e);
+        if (got < 0) break;
+        if (got == 0) continue;
         /* an exactly-sized copy, so that an overread of the body is caught */
-        uint8_t *exact = malloc(so_far ? so_far : 1);
+        uint8_t *exact = malloc(j.size ? j.size : 1);
         if (!exact) break;
-        memcpy(exact, body, so_far);
-        if (sy_cluster_decode_body(&first, exact, so_far, &lim, &m, &e) == SY_OK) {
+        memcpy(exact, j.body, j.size);
+        if (sy_cluster_decode_body(&j.first, exact, j.size, &lim, &m, &e) == SY_OK) {
             after_decode(&m);
             sy_cluster_msg_free(&m);
         }
         free(exact);
-        so_far = 0;
-        type = 0;
-        b = &open;
+        frame_join_next(&j);
     }
-    free(body);
+    free(j.body);
     return 0;
 }

@@ -105,6 +105,31 @@ static double mean_rgb(const sy_layer *a)
     return s / (double)(n * 3);
 }
 
+/* Destroys the layers given (sy_layer_destroy on each). */
+static void destroy_layers(sy_layer *const *layers, size_t n)
+{
+    for (size_t i = 0; i < n; ++i) sy_layer_destroy(layers[i]);
+}
+#define DESTROY_LAYERS(...)                                                                         \
+    destroy_layers((sy_layer *const[]){__VA_ARGS__}, sizeof((sy_layer *const[]){__VA_ARGS__}) / sizeof(sy_layer *))
+
+/* The first frame of the cooperative tests: a client of the first two servers (*c, the caller's)
+ * renders backend from view at 8 samples a server (the frame in *f) into out (created here); the
+ * two servers' samples make 16. */
+static int cooperative_first(fixture *fx, server *s, const char *backend, const sy_camera_view *view, uint32_t timeout_ms,
+                             sy_cluster_client **c, sy_cluster_frame *f, sy_layer *out, sy_cluster_frame_stats *st)
+{
+    sy_error e = {0};
+    *c = connect_all(fx, s, 2, "s3cret", timeout_ms, &e);
+    CHECK_MSG(*c != NULL, "%s", e.message);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, out, &e), e);
+    *f = make_frame(fx, SY_CLUSTER_COOPERATIVE, backend, view);
+    f->samples = 8;
+    CHECK_OK(sy_cluster_client_render(*c, f, out, st, &e), e);
+    CHECK(st->samples == 16);
+    return 0;
+}
+
 /* The real path tracer: 2 servers x 8 samples merged vs local renders. Same mean within noise, and
  * the merged error against a 64-sample reference is that of 16 samples, not of 8. */
 static int test_cooperative_pathtracer(fixture *fx, server *s)
@@ -119,14 +144,10 @@ static int test_cooperative_pathtracer(fixture *fx, server *s)
     if (local_render_spp(fx, "pathtracer", SY_EYE_MONO, 64, 1000, &ref, &view)) return 1;
     if (local_render_spp(fx, "pathtracer", SY_EYE_MONO, 8, 7, &l8, NULL)) return 1;
     if (local_render_spp(fx, "pathtracer", SY_EYE_MONO, 16, 7, &l16, NULL)) return 1;
-    sy_cluster_client *c = connect_all(fx, s, 2, "s3cret", 60000, &e);
-    CHECK_MSG(c != NULL, "%s", e.message);
-    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
-    sy_cluster_frame f = make_frame(fx, SY_CLUSTER_COOPERATIVE, "pathtracer", &view);
-    f.samples = 8;
+    sy_cluster_client *c = NULL;
+    sy_cluster_frame f;
     sy_cluster_frame_stats st;
-    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
-    CHECK(st.samples == 16);
+    CHECK(cooperative_first(fx, s, "pathtracer", &view, 60000, &c, &f, &out, &st) == 0);
     CHECK(sy_layer_count_nonfinite(&out) == 0);
     double mr = mean_rgb(&ref), mc = mean_rgb(&out);
     double e8 = rms_diff(&l8, &ref), e16 = rms_diff(&l16, &ref), ec = rms_diff(&out, &ref);
@@ -141,10 +162,7 @@ static int test_cooperative_pathtracer(fixture *fx, server *s)
     printf("cooperative pathtracer: second frame %llu samples, rms error %.5f\n", (unsigned long long)st.samples, ec2);
     CHECK(st.samples == 32 && ec2 < ec);
     sy_cluster_client_destroy(c);
-    sy_layer_destroy(&ref);
-    sy_layer_destroy(&l8);
-    sy_layer_destroy(&l16);
-    sy_layer_destroy(&out);
+    DESTROY_LAYERS(&ref, &l8, &l16, &out);
     return 0;
 }
 
@@ -259,11 +277,7 @@ static int test_sort_first_balanced_stereo(fixture *fx, server *s)
     CHECK_MSG(st.scene_bytes > 0 && st.scene_bytes < 3 * 256, "one-transform change cost %llu bytes for 3 servers",
               (unsigned long long)st.scene_bytes);
     sy_cluster_client_destroy(c);
-    sy_layer_destroy(&ref);
-    sy_layer_destroy(&left);
-    sy_layer_destroy(&right);
-    sy_layer_destroy(&out);
-    sy_layer_destroy(&st_out);
+    DESTROY_LAYERS(&ref, &left, &right, &out, &st_out);
     return 0;
 }
 
@@ -272,14 +286,10 @@ static int test_cooperative(fixture *fx, server *s)
     sy_error e = {0};
     sy_layer out = {0};
     sy_camera_view view = sy_camera_view_frame_bounds(&(sy_bounds){{-1, -1, -1}, {1, 1, 1}}, 1.0f);
-    sy_cluster_client *c = connect_all(fx, s, 2, "s3cret", 30000, &e);
-    CHECK_MSG(c != NULL, "%s", e.message);
-    CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
-    sy_cluster_frame f = make_frame(fx, SY_CLUSTER_COOPERATIVE, "coop_test", &view);
-    f.samples = 8;
+    sy_cluster_client *c = NULL;
+    sy_cluster_frame f;
     sy_cluster_frame_stats st;
-    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
-    CHECK(st.samples == 16);
+    CHECK(cooperative_first(fx, s, "coop_test", &view, 30000, &c, &f, &out, &st) == 0);
     /* the merged image is the mean over samples 0..15 of every pixel: disjoint ranges, exact weights */
     double maxerr = 0;
     for (uint32_t y = 0; y < fx->h; ++y)
@@ -476,8 +486,7 @@ static int test_bad_messages(fixture *fx, server *all)
     CHECK(sy_cluster_client_render(c, &f, &out, NULL, &e) != SY_OK);
     CHECK_MSG(strstr(e.message, "no_such_backend"), "%s", e.message);
     sy_cluster_client_destroy(c);
-    sy_layer_destroy(&ref);
-    sy_layer_destroy(&out);
+    DESTROY_LAYERS(&ref, &out);
     return 0;
 }
 
@@ -545,8 +554,7 @@ static int test_blob_cache(fixture *fx, server *s)
     CHECK_OK(sy_cluster_client_render(c, &f, &out, &st2, &e), e);
     CHECK(st2.blob_bytes == 0 && same_region(&out, 0, &ref, fx->w, fx->h));
     sy_cluster_client_destroy(c);
-    sy_layer_destroy(&ref);
-    sy_layer_destroy(&out);
+    DESTROY_LAYERS(&ref, &out);
     return 0;
 }
 
@@ -582,8 +590,7 @@ static int test_blob_eviction(fixture *fx, server *unused)
     CHECK(st[0].blob_bytes > 2 * budget);
     CHECK(st[1].blob_bytes >= st[0].blob_bytes - budget && st[1].blob_bytes < st[0].blob_bytes);
     stop_server(&sv);
-    sy_layer_destroy(&ref);
-    sy_layer_destroy(&out);
+    DESTROY_LAYERS(&ref, &out);
     return 0;
 }
 
@@ -665,8 +672,7 @@ static int test_half_tiles(fixture *fx, server *s)
            maxrel, 0x1p-11, infs, (unsigned long long)sh.bytes_received, (unsigned long long)sf.bytes_received);
     CHECK(maxrel <= 0x1p-11 && sh.bytes_received < sf.bytes_received);
     sy_cluster_client_destroy(c);
-    sy_layer_destroy(&ref);
-    sy_layer_destroy(&out);
+    DESTROY_LAYERS(&ref, &out);
     return 0;
 }
 
@@ -701,8 +707,7 @@ static int test_slot_limit(fixture *fx, server *s)
     CHECK_OK(sy_cluster_client_render(c, &f, &out, NULL, &e), e);
     CHECK(same_region(&out, 0, &ref, fx->w, fx->h));
     sy_cluster_client_destroy(c);
-    sy_layer_destroy(&ref);
-    sy_layer_destroy(&out);
+    DESTROY_LAYERS(&ref, &out);
     return 0;
 }
 
@@ -778,9 +783,7 @@ static int test_several_clients(fixture *fx, server *s)
     sy_cluster_client_destroy(c2);
     close(mute);
     close(fd);
-    sy_layer_destroy(&ref);
-    sy_layer_destroy(&out1);
-    sy_layer_destroy(&out2);
+    DESTROY_LAYERS(&ref, &out1, &out2);
     return 0;
 }
 
@@ -877,8 +880,7 @@ static int test_chunked(fixture *fx, server *unused)
     CHECK(same_region(&out, 0, &ref, big.w, big.h));
     sy_cluster_client_destroy(c);
     stop_server(&sv);
-    sy_layer_destroy(&ref);
-    sy_layer_destroy(&out);
+    DESTROY_LAYERS(&ref, &out);
     return 0;
 }
 
@@ -944,8 +946,7 @@ static int test_faults(fixture *fx, server *s)
     CHECK(sy_cluster_client_render(c, &f, &out, &st, &e) != SY_OK);
     CHECK_MSG(strstr(e.message, "no server") || strstr(e.message, "every server"), "%s", e.message);
     sy_cluster_client_destroy(c);
-    sy_layer_destroy(&ref);
-    sy_layer_destroy(&out);
+    DESTROY_LAYERS(&ref, &out);
     return 0;
 }
 
@@ -973,20 +974,13 @@ int main(int argc, char **argv)
         static const struct {
             const char *name;
             int (*run)(fixture *, server *);
-        } tests[] = {{"sort-first / balanced / stereo", test_sort_first_balanced_stereo},
-                     {"cooperative merge", test_cooperative},
-                     {"cooperative pathtracer", test_cooperative_pathtracer},
-                     {"authentication", test_auth},
-                     {"bad messages", test_bad_messages},
-                     {"blob cache", test_blob_cache},
-                     {"blob eviction", test_blob_eviction},
-                     {"blob requests", test_blob_requests},
-                     {"half tiles", test_half_tiles},
-                     {"replica slot limit", test_slot_limit},
-                     {"several clients", test_several_clients},
-                     {"authentication back-off", test_auth_backoff},
-                     {"chunked transfers", test_chunked},
-                     {"faults", test_faults}};
+        } tests[] = {
+            {"sort-first / balanced / stereo", test_sort_first_balanced_stereo}, {"cooperative merge", test_cooperative},
+            {"cooperative pathtracer", test_cooperative_pathtracer}, {"authentication", test_auth},
+            {"bad messages", test_bad_messages}, {"blob cache", test_blob_cache}, {"blob eviction", test_blob_eviction},
+            {"blob requests", test_blob_requests}, {"half tiles", test_half_tiles},
+            {"replica slot limit", test_slot_limit}, {"several clients", test_several_clients},
+            {"authentication back-off", test_auth_backoff}, {"chunked transfers", test_chunked}, {"faults", test_faults}};
         for (size_t i = 0; i < sizeof tests / sizeof tests[0]; ++i) {
             int r = tests[i].run(&fx, s);
             failed += r;

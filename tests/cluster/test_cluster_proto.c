@@ -4,6 +4,7 @@
  * reject or accept cleanly, never crash, and whatever it accepts must be in range). Runs in every
  * build (the libFuzzer target in fuzz_cluster_decode.c covers the same decoder under SY_FUZZ). */
 #include "../support/sy_check.h"
+#include "frame_join.h"
 #include "scene_msg.h"
 #include "sy_cluster.h"
 
@@ -350,43 +351,22 @@ static int test_bad_headers(void)
 static int stream_messages(const uint8_t *buf, size_t n, sy_cluster_msg *out, uint32_t cap, uint32_t *count,
                            uint8_t **bodies, sy_error *err)
 {
-    const sy_cluster_budget hs = {SY_CLUSTER_HANDSHAKE_MAX_FRAME, SY_CLUSTER_HANDSHAKE_MAX_FRAME, false, false};
-    const sy_cluster_budget open = {1u << 16, 1u << 20, true, false};
-    const sy_cluster_budget *b = &hs;
-    size_t pos = 0, so_far = 0;
-    uint32_t type = 0;
-    uint8_t *body = NULL;
-    sy_cluster_header first = {0};
+    frame_join j = frame_join_start(1u << 16, 1u << 20, false);
+    size_t pos = 0;
     *count = 0;
     while (pos < n) {
-        sy_cluster_header h;
-        size_t follow;
-        if (n - pos < SY_CLUSTER_HEADER_SIZE) return sy_error_set(err, SY_ERR_PARSE, "stream ends inside a header"), 1;
-        if (sy_cluster_parse_header(buf + pos, &h, err) != SY_OK) return 1;
-        if (sy_cluster_frame_check(&h, b, so_far, type, &follow, err) != SY_OK) return 1;
-        pos += SY_CLUSTER_HEADER_SIZE;
-        if (follow > n - pos) return sy_error_set(err, SY_ERR_PARSE, "stream ends inside a frame"), 1;
-        uint8_t *nb = realloc(body, so_far + h.body_size + 1);
-        if (!nb) return 1;
-        body = nb;
-        memcpy(body + so_far, buf + pos, h.body_size);
-        pos += follow;
-        if (!type) first = h;
-        type = h.type;
-        so_far += h.body_size;
-        if (h.flags & SY_CLUSTER_FLAG_MORE) continue;
-        if (*count == cap || sy_cluster_decode_body(&first, body, so_far, NULL, &out[*count], err) != SY_OK) {
-            free(body);
+        int got = frame_join_take(&j, buf, n, &pos, err);
+        if (got == 0) continue;
+        if (got < 0 || *count == cap || sy_cluster_decode_body(&j.first, j.body, j.size, NULL, &out[*count], err) != SY_OK) {
+            free(j.body);
             return 1;
         }
-        bodies[(*count)++] = body;
-        body = NULL;
-        so_far = 0;
-        type = 0;
-        b = &open;
+        bodies[(*count)++] = j.body;
+        j.body = NULL;
+        frame_join_next(&j);
     }
-    free(body);
-    return type ? (sy_error_set(err, SY_ERR_PARSE, "stream ends inside a chunked message"), 1) : 0;
+    free(j.body);
+    return j.type ? (sy_error_set(err, SY_ERR_PARSE, "stream ends inside a chunked message"), 1) : 0;
 }
 
 /* Appends msg to out as frames of at most chunk body bytes (untagged, sequence numbers from *seq). */
