@@ -26,17 +26,13 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
     sy_scene *s;
     if (sy_scene_create(&s, NULL) != SY_OK) return 0;
     sy_assimp_options o = {0};
-    o.max_file_bytes = 1u << 20;
-    o.max_vertices = 1u << 18;
-    o.max_image_pixels = 1u << 18;
-    o.max_scene_bytes = (uint64_t)64 << 20; /* the file budget, small like the other limits */
+    FUZZ_LIMITS(o);
     const char *iso = getenv("SY_FUZZ_ISOLATED");
     o.in_process = !(iso && iso[0] == '1');
     sy_assimp_info info = {0};
     sy_error err = {0};
-    if (sy_assimp_load_memory(data, size, FUZZ_ASSIMP_NAME, fuzz_resource_dir(), s, &o, &info, &err) == SY_OK)
-        sy_scene_commit(s, NULL, NULL);
+    sy_result r = sy_assimp_load_memory(data, size, FUZZ_ASSIMP_NAME, fuzz_resource_dir(), s, &o, &info, &err);
     sy_assimp_info_free(&info);
-    sy_scene_destroy(s);
+    FUZZ_COMMIT_AND_DESTROY(s, r);
     return 0;
 }

@@ -21,6 +21,21 @@ static const char *fuzz_resource_dir(void)
     return dir;
 }
 
+/* The small limits every loader target runs under, set on its options o (the loaders' options
+ * share these field names): 1 MiB files, 2^18 vertices and image pixels, a 64 MiB scene (the file
+ * budget). */
+#define FUZZ_LIMITS(o)                                                                              \
+    ((o).max_file_bytes = 1u << 20, (o).max_vertices = 1u << 18, (o).max_image_pixels = 1u << 18,   \
+     (o).max_scene_bytes = (uint64_t)64 << 20)
+
+/* The end of a loader target: a scene that loaded is committed (its change list built, as an
+ * application's would be), then the scene is destroyed. */
+#define FUZZ_COMMIT_AND_DESTROY(s, loaded)                                                          \
+    do {                                                                                            \
+        if ((loaded) == SY_OK) sy_scene_commit((s), NULL, NULL);                                    \
+        sy_scene_destroy(s);                                                                        \
+    } while (0)
+
 #ifdef SY_FUZZ_GLTF
 #include "sy_gltf.h"
 
@@ -31,18 +46,14 @@ static void fuzz_load_gltf(const unsigned char *data, size_t size, const char *n
     sy_scene *s;
     if (sy_scene_create(&s, NULL) != SY_OK) return;
     sy_gltf_options o = {0};
-    o.max_file_bytes = 1u << 20;
-    o.max_vertices = 1u << 18;
+    FUZZ_LIMITS(o);
     o.max_indices = 1u << 19;
-    o.max_image_pixels = 1u << 18;
     o.max_instances = 1u << 12;
-    o.max_scene_bytes = (uint64_t)64 << 20; /* the file budget, small like the other limits */
     sy_gltf_info info = {0};
     sy_error err = {0};
-    if (sy_gltf_load_memory(data, size, name, fuzz_resource_dir(), s, &o, &info, &err) == SY_OK)
-        sy_scene_commit(s, NULL, NULL);
+    sy_result r = sy_gltf_load_memory(data, size, name, fuzz_resource_dir(), s, &o, &info, &err);
     sy_gltf_info_free(&info);
-    sy_scene_destroy(s);
+    FUZZ_COMMIT_AND_DESTROY(s, r);
 }
 #endif
 

@@ -12,16 +12,12 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
     sy_scene *s;
     if (sy_scene_create(&s, NULL) != SY_OK) return 0;
     sy_x3d_options o = {0};
-    o.max_file_bytes = 1u << 20;
-    o.max_vertices = 1u << 18;
-    o.max_image_pixels = 1u << 18;
+    FUZZ_LIMITS(o);
     o.max_inline_depth = 4;
-    o.max_scene_bytes = (uint64_t)64 << 20; /* the file budget, small like the other limits */
     sy_x3d_info info = {0};
     sy_error err = {0};
-    if (sy_x3d_load_memory(data, size, "fuzz.x3d", fuzz_resource_dir(), s, &o, &info, &err) == SY_OK)
-        sy_scene_commit(s, NULL, NULL);
+    sy_result r = sy_x3d_load_memory(data, size, "fuzz.x3d", fuzz_resource_dir(), s, &o, &info, &err);
     sy_x3d_info_free(&info);
-    sy_scene_destroy(s);
+    FUZZ_COMMIT_AND_DESTROY(s, r);
     return 0;
 }
