@@ -59,64 +59,43 @@ static int sy_check_count __attribute__((unused));
 #define SY_CHECK_FATAL_ return 1
 #define SY_CHECK_GOON_ (void)0
 
-#define SY_CHECK_COND_(kind, then, cond, text)                                                            \
+/* The one place a check is counted and, when `ok` is false, reported (SY_CHECK_REPORT_ with the
+ * printf-style tail) before `then`. The variants below evaluate their operands once, then call it. */
+#define SY_CHECK_IF_(kind, then, ok, text, ...)                                                     \
     do {                                                                                            \
         sy_check_count++;                                                                           \
-        if (!(cond)) {                                                                              \
-            SY_CHECK_REPORT_(kind, text, "%s", "");                                                \
+        if (!(ok)) {                                                                                \
+            SY_CHECK_REPORT_(kind, text, __VA_ARGS__);                                              \
             then;                                                                                   \
         }                                                                                           \
     } while (0)
 
-#define SY_CHECK_COND_MSG_(kind, then, cond, text, ...)                                                   \
-    do {                                                                                            \
-        sy_check_count++;                                                                           \
-        if (!(cond)) {                                                                              \
-            SY_CHECK_REPORT_(kind, text ": ", __VA_ARGS__);                                        \
-            then;                                                                                   \
-        }                                                                                           \
-    } while (0)
+#define SY_CHECK_COND_(kind, then, cond, text) SY_CHECK_IF_(kind, then, cond, text, "%s", "")
+#define SY_CHECK_COND_MSG_(kind, then, cond, text, ...) SY_CHECK_IF_(kind, then, cond, text ": ", __VA_ARGS__)
 
-#define SY_CHECK_OK_(kind, then, call, text, e)                                                           \
+#define SY_CHECK_OK_(kind, then, call, text, e)                                                     \
     do {                                                                                            \
-        sy_check_count++;                                                                           \
         sy_result sy_check_r_ = (call);                                                             \
-        if (sy_check_r_ != SY_OK) {                                                                 \
-            SY_CHECK_REPORT_(kind, text, " -> %s (%s)", sy_result_str(sy_check_r_), (e).message);  \
-            then;                                                                                   \
-        }                                                                                           \
+        SY_CHECK_IF_(kind, then, sy_check_r_ == SY_OK, text, " -> %s (%s)", sy_result_str(sy_check_r_), (e).message); \
     } while (0)
 
-#define SY_CHECK_ERR_(kind, then, call, text, code, e)                                                    \
+#define SY_CHECK_ERR_(kind, then, call, text, code, e)                                              \
     do {                                                                                            \
-        sy_check_count++;                                                                           \
         sy_result sy_check_r_ = (call);                                                             \
-        if (sy_check_r_ != (code)) {                                                                \
-            SY_CHECK_REPORT_(kind, text, " -> %s, expected %s (%s)", sy_result_str(sy_check_r_),   \
-                             sy_result_str(code), sy_check_r_ ? (e).message : "");                  \
-            then;                                                                                   \
-        }                                                                                           \
+        SY_CHECK_IF_(kind, then, sy_check_r_ == (code), text, " -> %s, expected %s (%s)",           \
+                     sy_result_str(sy_check_r_), sy_result_str(code), sy_check_r_ ? (e).message : ""); \
     } while (0)
 
-#define SY_CHECK_NEAR_(kind, then, a, b, ta, tb, eps)                                                       \
+#define SY_CHECK_NEAR_(kind, then, a, b, ta, tb, eps)                                               \
     do {                                                                                            \
-        sy_check_count++;                                                                           \
         double sy_check_a_ = (double)(a), sy_check_b_ = (double)(b);                                \
-        if (!(fabs(sy_check_a_ - sy_check_b_) <= (eps))) {                                          \
-            SY_CHECK_REPORT_(kind, ta " ~ " tb, ": %s = %.9g, %s = %.9g (eps %g)", ta, sy_check_a_, \
-                             tb, sy_check_b_, (double)(eps));                                       \
-            then;                                                                                   \
-        }                                                                                           \
+        SY_CHECK_IF_(kind, then, fabs(sy_check_a_ - sy_check_b_) <= (eps), ta " ~ " tb,             \
+                     ": %s = %.9g, %s = %.9g (eps %g)", ta, sy_check_a_, tb, sy_check_b_, (double)(eps)); \
     } while (0)
 
-#define SY_CHECK_SAYS_(kind, then, e, needle, te, tn)                                                       \
-    do {                                                                                            \
-        sy_check_count++;                                                                           \
-        if (strstr((e).message, (needle)) == NULL) {                                                \
-            SY_CHECK_REPORT_(kind, te " says " tn, ": '%s' lacks '%s'", (e).message, (needle)); \
-            then;                                                                                   \
-        }                                                                                           \
-    } while (0)
+#define SY_CHECK_SAYS_(kind, then, e, needle, te, tn)                                               \
+    SY_CHECK_IF_(kind, then, strstr((e).message, (needle)) != NULL, te " says " tn, ": '%s' lacks '%s'", \
+                 (e).message, (needle))
 
 /* Fatal: the enclosing function returns 1. */
 #define CHECK(cond) SY_CHECK_COND_("CHECK", SY_CHECK_FATAL_, cond, #cond)
