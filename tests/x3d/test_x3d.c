@@ -51,7 +51,7 @@ static void test_concave_and_defaults(void)
         "<Shape><Appearance><Material/></Appearance>\n"
         "<IndexedFaceSet coordIndex='0 1 2 3 4 5 -1'><Coordinate point='0 0 0, 2 0 0, 2 1 0, 1 1 0, 1 2 0, 0 2 0'/>"
         "</IndexedFaceSet></Shape>\n" FTR);
-    EXPECT_MSG(l.r == SY_OK, "concave: %s", l.err.message);
+    expect_loaded(&l, "concave");
     const sy_primitive *p = first_prim(&l);
     EXPECT_MSG(p && sy_primitive_triangle_count(p) == 4, "L shape: 4 triangles, got %u", p ? sy_primitive_triangle_count(p) : 0);
     if (p) EXPECT_MSG(fabs(prim_area(p) - 3.0) < 1e-5, "L shape area %g (expected 3: ear clipping)", prim_area(p));
@@ -124,7 +124,7 @@ static void test_concave_and_defaults(void)
     l = load_text("colors.x3d", HDR
         "<Shape><IndexedFaceSet ccw='false' colorPerVertex='false' coordIndex='0 2 1 -1 0 3 2'>"
         "<Coordinate point='0 0 0 1 0 0 1 1 0 0 1 0'/><Color color='1 0 0 0 0 1'/></IndexedFaceSet></Shape>" FTR);
-    EXPECT_MSG(l.r == SY_OK, "colors: %s", l.err.message);
+    expect_loaded(&l, "colors");
     p = first_prim(&l);
     if (p) {
         EXPECT_MSG(fabs(prim_area(p) - 1.0) < 1e-6, "unit quad");
@@ -224,7 +224,7 @@ static void test_value_limits(void)
 static void test_extrusion(void)
 {
     loaded l = load_text("extrusion.x3d", HDR "<Shape><Appearance><Material/></Appearance><Extrusion/></Shape>" FTR);
-    EXPECT_MSG(l.r == SY_OK, "extrusion: %s", l.err.message);
+    expect_loaded(&l, "extrusion");
     const sy_primitive *p = first_prim(&l);
     EXPECT_MSG(p && sy_primitive_triangle_count(p) == 12, "4 side quads + 2 caps = 12 triangles, got %u",
                p ? sy_primitive_triangle_count(p) : 0);
@@ -321,7 +321,7 @@ static void test_def_use_and_scene_nodes(void)
         "<Transform DEF='Loop'><Group><Transform USE='Loop'/></Group></Transform>\n"
         "<Shape><IndexedFaceSet coordIndex='0 1 7'><Coordinate point='0 0 0 1 0 0 1 1 0'/></IndexedFaceSet></Shape>\n"
         "<FancyNode/><FancyNode/><ProtoInstance name='x'/>\n" FTR);
-    EXPECT_MSG(l.r == SY_OK, "share: %s", l.err.message);
+    expect_loaded(&l, "share");
     dump_warnings(&l);
     EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_MESH) == 2, "sphere shape shared + box: 2 meshes, got %u",
                sy_scene_count(l.scene, SY_TYPE_MESH));
@@ -417,7 +417,7 @@ static void test_inline_css_and_bad_input(void)
         "<Shape><Appearance><ImageTexture url='\"bad.png\"'/></Appearance><Box/></Shape>\n"
         "<Shape><Appearance><ImageTexture url='\"cut.hdr\"'/></Appearance><Box/></Shape>\n"
         "<Inline url='\"dev.fifo\"'/><Shape><Appearance><ImageTexture url='\"dev.fifo\"'/></Appearance><Sphere/></Shape>\n" FTR);
-    EXPECT_MSG(l.r == SY_OK, "inline: %s", l.err.message);
+    expect_loaded(&l, "inline");
     dump_warnings(&l);
     EXPECT_MSG(l.info.counts.inlines == 2, "part.x3d loaded once and shared, self.x3d once: %u", l.info.counts.inlines);
     EXPECT_MSG(has_warning(&l, "includes itself", "self.x3d:3"), "Inline cycle warned with file:line");

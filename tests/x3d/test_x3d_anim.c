@@ -68,8 +68,7 @@ static void test_routes(void)
         "<ROUTE fromNode='Path' fromField='value_changed' toNode='Mover' toField='scale'/>\n"           /* 22 */
         "<ROUTE fromNode='Path' fromField='value_changed' toNode='Nowhere' toField='translation'/>\n"   /* 23 */
         "</Scene></X3D>\n");
-    EXPECT_MSG(l.r == SY_OK, "anim.x3d: %s", l.err.message);
-    if (l.r != SY_OK) return unload(&l);
+    if (!expect_loaded(&l, "anim.x3d")) return unload(&l);
     /* one clip: Clock (Once drives nothing playable: Short and Back are dropped, Tint not played) */
     EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_ANIMATION) == 1 && l.info.counts.animations == 1, "%u clips (want 1)",
                sy_scene_count(l.scene, SY_TYPE_ANIMATION));
@@ -178,8 +177,7 @@ static void test_fields(void)
         "<ROUTE fromNode='Fade' fromField='value_changed' toNode='Rough' toField='set_fraction'/>\n"            /* 42 */
         "<ROUTE fromNode='Rough' fromField='value_changed' toNode='Fade' toField='set_fraction'/>\n"            /* 43 */
         "</Scene></X3D>\n");
-    EXPECT_MSG(l.r == SY_OK, "fields.x3d: %s", l.err.message);
-    if (l.r != SY_OK) return unload(&l);
+    if (!expect_loaded(&l, "fields.x3d")) return unload(&l);
     EXPECT_MSG(sy_scene_count(l.scene, SY_TYPE_ANIMATION) == 1, "%u clips (want 1)", sy_scene_count(l.scene, SY_TYPE_ANIMATION));
     EXPECT_MSG(has_warning(&l, "fields.x3d:38: ROUTE from PositionInterpolator.value_changed (SFVec3f) to "
                            "Material.diffuseColor (SFColor): the types differ; dropped", NULL), "types differ");
@@ -260,8 +258,7 @@ static void test_coordinates(void)
         "<ROUTE fromNode='Fold' fromField='value_changed' toNode='Pts' toField='set_point'/>\n"           /* 8 */
         "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='N' toField='set_fraction'/>\n"      /* 9 */
         "</Scene></X3D>\n");
-    EXPECT_MSG(l.r == SY_OK, "coords.x3d: %s", l.err.message);
-    if (l.r != SY_OK) return unload(&l);
+    if (!expect_loaded(&l, "coords.x3d")) return unload(&l);
     const float keys[3][12] = {{0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, {0, 0, 0, 1, 0, 0, 1, 1, 1, 0, 1, 1},
                                {0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0}};
     sy_node nodes[2] = {{0}, {0}};
@@ -356,18 +353,8 @@ static void test_coordinates(void)
  * four quarter keys */
 static void test_sample(const char *data)
 {
-    if (!data) {
-        printf("skip: HelloX3dTrademark.x3d: no TESTDATA_DIR given\n");
-        return;
-    }
     char p[2048];
-    PATHF(p, "%s/x3d/assimp_debian_testmodels/HelloX3dTrademark.x3d", data);
-    FILE *f = fopen(p, "rb");
-    if (!f) {
-        printf("skip: %s is absent\n", p);
-        return;
-    }
-    fclose(f);
+    if (!sample_path(data, "x3d/assimp_debian_testmodels/HelloX3dTrademark.x3d", p, sizeof p)) return;
     loaded l = load_path(p);
     EXPECT_MSG(l.r == SY_OK && sy_scene_count(l.scene, SY_TYPE_ANIMATION) == 1, "HelloX3dTrademark: %s, %u clips", l.err.message,
                sy_scene_count(l.scene, SY_TYPE_ANIMATION));
@@ -383,13 +370,4 @@ static void test_sample(const char *data)
     unload(&l);
 }
 
-int main(int argc, char **argv)
-{
-    make_scratch_dir(g_dir, sizeof g_dir, "x3d_anim");
-    test_routes();
-    test_fields();
-    test_coordinates();
-    test_sample(argc > 1 ? argv[1] : NULL);
-    remove_scratch_dir(g_dir);
-    return sy_check_finish("x3d_anim");
-}
+X3D_MAIN("x3d_anim", test_sample, test_routes, test_fields, test_coordinates)

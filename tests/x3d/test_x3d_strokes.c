@@ -32,7 +32,7 @@ static void test_strokes(void)
         "  <Coordinate point='0 5 0 1 5 0 2 5 0'/><ColorRGBA color='1 0 0 1 0 1 0 1 0 0 1 0.5'/></IndexedLineSet></Shape>\n"
         "<Shape DEF='LS'><LineSet vertexCount='2 3'><Coordinate point='0 2 0 1 2 0 0 3 0 1 3 0 2 3 0'/></LineSet></Shape>\n"
         "</Scene></X3D>\n");
-    EXPECT_MSG(l.r == SY_OK, "strokes: %s", l.err.message);
+    expect_loaded(&l, "strokes");
     const sy_primitive *p = prim_named(&l, "P");
     EXPECT_MSG(p && p->topology == SY_TOPOLOGY_POINTS && sy_primitive_element_count(p) == 4 && !p->indices &&
                sy_primitive_triangle_count(p) == 0,
@@ -107,7 +107,7 @@ static void test_background(void)
         "<Background skyColor='0 0 1 0 1 0 1 0 0' skyAngle='0.8 1.6' groundColor='0.2 0.2 0.2 0.5 0.5 0.5'"
         " groundAngle='1.5708'/>\n"
         "</Scene></X3D>\n");
-    EXPECT_MSG(l.r == SY_OK, "background: %s", l.err.message);
+    expect_loaded(&l, "background");
     const sy_background_data *bd = sy_background_get(l.scene, l.info.background);
     EXPECT_MSG(bd && bd->color[3] == 0.0f && bd->gradient.sky_count == 3 && bd->gradient.ground_count == 2 &&
                bd->gradient.sky_angle[0] == 0.8f && bd->gradient.sky_angle[1] == 1.6f &&
@@ -210,16 +210,9 @@ static void test_text(void)
 /* Shared sample files with these nodes: counts from the file's own attributes. */
 static void test_samples(const char *data)
 {
-    if (!data) {
-        printf("SKIP samples: no TESTDATA_DIR given\n");
-        return;
-    }
     char p[2048];
-    PATHF(p, "%s/x3d/web3d/X3dForWebAuthors/Chapter02GeometryPrimitives/GeometryPrimitiveNodes.x3d", data);
-    if (access(p, R_OK) != 0) {
-        printf("SKIP samples: %s absent\n", p);
+    if (!sample_path(data, "x3d/web3d/X3dForWebAuthors/Chapter02GeometryPrimitives/GeometryPrimitiveNodes.x3d", p, sizeof p))
         return;
-    }
     sy_scene *s;
     sy_x3d_info info;
     sy_error e;
@@ -235,13 +228,4 @@ static void test_samples(const char *data)
     sy_scene_destroy(s);
 }
 
-int main(int argc, char **argv)
-{
-    make_scratch_dir(g_dir, sizeof g_dir, "x3d_strokes");
-    test_strokes();
-    test_background();
-    test_text();
-    test_samples(argc > 1 ? argv[1] : NULL);
-    remove_scratch_dir(g_dir);
-    return sy_check_finish("x3d_strokes");
-}
+X3D_MAIN("x3d_strokes", test_samples, test_strokes, test_background, test_text)

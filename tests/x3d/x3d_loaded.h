@@ -53,6 +53,29 @@ static void unload(loaded *l)
     sy_scene_destroy(l->scene);
 }
 
+/* The load succeeded: a failed check naming what was loaded and why otherwise. */
+static inline bool expect_loaded(const loaded *l, const char *what)
+{
+    EXPECT_MSG(l->r == SY_OK, "%s: %s", what, l->err.message);
+    return l->r == SY_OK;
+}
+
+/* The shared test-data file rel below data (the test's TESTDATA_DIR argument, NULL without it) into
+ * p; false, with the skip printed, when no folder was given or the file is absent. */
+static inline bool sample_path(const char *data, const char *rel, char *p, size_t n)
+{
+    if (!data) {
+        printf("skip: %s: no TESTDATA_DIR given\n", rel);
+        return false;
+    }
+    snprintf(p, n, "%s/%s", data, rel);
+    if (access(p, R_OK) != 0) {
+        printf("skip: %s is absent\n", p);
+        return false;
+    }
+    return true;
+}
+
 /* a stored warning contains a (and b unless NULL) */
 static bool has_warning(const loaded *l, const char *a, const char *b)
 {
@@ -60,5 +83,20 @@ static bool has_warning(const loaded *l, const char *a, const char *b)
         if (strstr(l->info.warnings[k], a) && (!b || strstr(l->info.warnings[k], b))) return true;
     return false;
 }
+
+/* The main of an X3D test whose sample part may skip (x3d_anim, x3d_strokes): the scratch folder
+ * g_dir (tagged name) made, the tests `void fn(void)` run in order, then samples(the TESTDATA_DIR
+ * argument, NULL without it), the folder removed, and `return sy_check_finish(name)`. Write it at
+ * file scope without a semicolon. */
+#define X3D_MAIN(name, samples, ...)                                                                \
+    int main(int argc, char **argv)                                                                 \
+    {                                                                                               \
+        static void (*const x3d_tests_[])(void) = {__VA_ARGS__};                                    \
+        make_scratch_dir(g_dir, sizeof g_dir, name);                                                \
+        for (size_t i = 0; i < sizeof x3d_tests_ / sizeof x3d_tests_[0]; ++i) x3d_tests_[i]();      \
+        (samples)(argc > 1 ? argv[1] : NULL);                                                       \
+        remove_scratch_dir(g_dir);                                                                  \
+        return sy_check_finish(name);                                                               \
+    }
 
 #endif /* SY_TEST_X3D_LOADED_H */
