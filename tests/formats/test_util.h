@@ -1,9 +1,11 @@
 /* test_util.h — tiny helpers shared by the tests in tests/formats: the check kit
- * (tests/support/sy_check.h; counted EXPECT checks, sy_check_finish), a private scratch directory, and small file utilities. Test-only; header-only on purpose. */
+ * (tests/support/sy_check.h; counted EXPECT checks, sy_check_finish), a private scratch directory
+ * (tests/support/sy_scratch.h), and small file utilities. Test-only; header-only on purpose. */
 #ifndef SY_TEST_UTIL_H
 #define SY_TEST_UTIL_H
 
 #include "../support/sy_check.h"
+#include "../support/sy_scratch.h"
 #include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
@@ -20,34 +22,6 @@
             abort();                                                                     \
         }                                                                                \
     } while (0)
-
-/* Creates a fresh scratch directory under $TMPDIR (or /tmp); path written to buf. */
-static void make_scratch_dir(char *buf, size_t n, const char *tag)
-{
-    const char *base = getenv("TMPDIR");
-    if (!base || !*base) base = "/tmp";
-    if (snprintf(buf, n, "%s/sy_%s_XXXXXX", base, tag) >= (int)n || !mkdtemp(buf)) {
-        fprintf(stderr, "cannot create a scratch directory %s: %s\n", buf, strerror(errno));
-        exit(1);
-    }
-}
-
-/* Removes the plain files in dir, then dir itself (scratch directories are flat). */
-static void remove_scratch_dir(const char *dir)
-{
-    DIR *d = opendir(dir);
-    if (d) {
-        struct dirent *e;
-        char p[4096];
-        while ((e = readdir(d)) != NULL) {
-            if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue;
-            PATHF(p, "%s/%s", dir, e->d_name);
-            if (unlink(p) != 0) rmdir(p);
-        }
-        closedir(d);
-    }
-    rmdir(dir);
-}
 
 /* Number of entries in dir whose name contains needle. */
 static inline int count_entries_containing(const char *dir, const char *needle)

@@ -1,14 +1,15 @@
-/* gltf_files.h — the glTF tests' files: the test-data folder they are given, whole-file reading and
- * writing for the tests that write variants of sample files (Draco, meshopt). Test-only;
+/* gltf_files.h — the glTF tests' files: the test-data folder they are given, scratch folders
+ * (tests/support/sy_scratch.h), whole-file reading and writing for the tests that write variants of
+ * sample files (Draco, meshopt). Test-only;
  * header-only on purpose. */
 #ifndef SY_TEST_GLTF_FILES_H
 #define SY_TEST_GLTF_FILES_H
 
+#include "../support/sy_scratch.h"
 #include "sy_file.h"
 
 #include <stdio.h>
 #include <stdlib.h>
-#include <unistd.h>
 
 /* The test-data folder, the test's one argument (ctest passes ../shared/testdata); without it the
  * usage line and exit status 2. */
@@ -19,17 +20,6 @@ static inline const char *testdata_arg(int argc, char **argv)
         exit(2);
     }
     return argv[1];
-}
-
-/* A new scratch folder $TMPDIR/NAME_XXXXXX (/tmp without TMPDIR) into buf, which must hold at least
- * 64 characters more than $TMPDIR; ends the test (exit 1) when it cannot be made. */
-static inline void scratch_dir(const char *name, char *buf, size_t size)
-{
-    snprintf(buf, size, "%s/%s_XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp", name);
-    if (!mkdtemp(buf)) {
-        perror("mkdtemp");
-        exit(1);
-    }
 }
 
 /* The whole file (NUL-terminated) through the library's reader (malloc()ed); NULL when it cannot

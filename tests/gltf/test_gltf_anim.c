@@ -229,7 +229,7 @@ static int test_bad_samplers(void)
 int main(int argc, char **argv)
 {
     const char *data = argc > 1 ? argv[1] : "../shared/testdata";
-    scratch_dir("sy_gltf_anim", g_dir, sizeof g_dir);
+    make_scratch_dir(g_dir, sizeof g_dir, "gltf_anim");
     RUN(test_bad_samplers);
     rmdir(g_dir);
     int skipped = 0;

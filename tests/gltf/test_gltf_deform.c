@@ -505,7 +505,7 @@ static int test_threads_agree(void)
 int main(int argc, char **argv)
 {
     g_data = argc > 1 ? argv[1] : "../shared/testdata";
-    scratch_dir("sy_gltf_deform", g_dir, sizeof g_dir);
+    make_scratch_dir(g_dir, sizeof g_dir, "gltf_deform");
     RUN(test_malformed);
     RUN(test_threads_agree);
     RUN(test_simple_skin);

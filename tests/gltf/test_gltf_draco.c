@@ -168,11 +168,7 @@ int main(int argc, char **argv)
     char gpath[1024], bpath[1024];
     snprintf(gpath, sizeof gpath, "%s/gltf/Box/glTF-Draco/Box.gltf", testdata);
     snprintf(bpath, sizeof bpath, "%s/gltf/Box/glTF-Draco/Box.bin", testdata);
-    snprintf(g_dir, sizeof g_dir, "/tmp/sy_gltf_draco_XXXXXX");
-    if (!mkdtemp(g_dir)) {
-        perror("mkdtemp");
-        return 1;
-    }
+    make_scratch_dir(g_dir, sizeof g_dir, "gltf_draco");
     test_generated_quad();
     if (access(gpath, R_OK) != 0 || access(bpath, R_OK) != 0) {
         printf("SKIP Box cases: %s absent\n", gpath);

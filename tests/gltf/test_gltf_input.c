@@ -4,6 +4,7 @@
  * fail with a message naming the file and the specific problem, and leave no object in the scene
  * and no blob alive. Needs no shared test data. */
 #include "../support/sy_check.h"
+#include "../support/sy_scratch.h"
 #include "sy_gltf.h"
 
 #include <math.h>
@@ -738,11 +739,7 @@ static void test_variants(void)
 
 int main(void)
 {
-    snprintf(g_dir, sizeof g_dir, "/tmp/sy_gltf_test_XXXXXX");
-    if (!mkdtemp(g_dir)) {
-        perror("mkdtemp");
-        return 1;
-    }
+    make_scratch_dir(g_dir, sizeof g_dir, "gltf_test");
     long blobs = sy_blob_live_count();
     test_bad_json();
     test_bad_data();

@@ -255,8 +255,7 @@ int main(int argc, char **argv)
         printf("SKIP: %s absent\n", probe);
         return 77;
     }
-    snprintf(g_dir, sizeof g_dir, "/tmp/sy_gltf_meshopt_XXXXXX");
-    if (!mkdtemp(g_dir)) return 1;
+    make_scratch_dir(g_dir, sizeof g_dir, "gltf_meshopt");
     check_equal(testdata, "Box");
     check_equal(testdata, "Duck");
     g_triangles = true;

@@ -5,6 +5,7 @@
  * corrupt WebP and one over max_image_pixels load with a warning and no texture (stb_image never
  * sees WebP). A file requiring KHR_texture_basisu is refused naming it. Needs no shared data. */
 #include "../support/sy_check.h"
+#include "../support/sy_scratch.h"
 #include "sy_gltf.h"
 
 #include <webp/encode.h>
@@ -102,8 +103,7 @@ static bool load(const char *name, const sy_gltf_options *opt, sy_result want, c
 
 int main(void)
 {
-    snprintf(g_dir, sizeof g_dir, "/tmp/sy_gltf_webp_XXXXXX");
-    if (!mkdtemp(g_dir)) return 1;
+    make_scratch_dir(g_dir, sizeof g_dir, "gltf_webp");
     const float mesh[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1};
     write_file("m.bin", mesh, sizeof mesh);
     for (int i = 0; i < W * H; i++) {

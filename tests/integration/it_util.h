@@ -9,6 +9,7 @@
 #define IT_UTIL_H
 
 #include "../support/sy_check.h"
+#include "../support/sy_scratch.h"
 #include "sy_mediator.h"
 #include "sy_mediators.h"
 #include "sy_scene.h"

@@ -302,20 +302,11 @@ static void test_bad_pointers(void)
 
 int main(void)
 {
-    snprintf(g_dir, sizeof g_dir, "/tmp/sy_anim_view_XXXXXX");
-    if (!mkdtemp(g_dir)) {
-        perror("mkdtemp");
-        return 1;
-    }
+    make_scratch_dir(g_dir, sizeof g_dir, "anim_view");
     it_register();
     test_camera();
     test_light();
     test_bad_pointers();
-    char p[512];
-    snprintf(p, sizeof p, "%s/camera.gltf", g_dir);
-    remove(p);
-    snprintf(p, sizeof p, "%s/light.gltf", g_dir);
-    remove(p);
-    rmdir(g_dir);
+    remove_scratch_dir(g_dir);
     return sy_check_finish("integration_anim_view");
 }
