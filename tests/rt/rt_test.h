@@ -211,7 +211,7 @@ static inline sy_rt_render_desc rt_desc(sy_rt_integrator integ, uint32_t w, uint
     return d;
 }
 
-/* Renders the desc's rectangle into freshly allocated buffers (caller frees both). */
+/* Renders the desc's rectangle into freshly allocated buffers (the caller frees both: rt_image_free). */
 static inline void rt_render(sy_rt_device *dev, const sy_rt_camera *cam, const sy_rt_render_desc *d, float **rgba,
                              float **depth)
 {
@@ -223,6 +223,13 @@ static inline void rt_render(sy_rt_device *dev, const sy_rt_camera *cam, const s
         exit(1);
     }
     MUST(sy_rt_render(dev, cam, d, *rgba, *depth));
+}
+
+/* Frees rt_render's buffers. */
+static inline void rt_image_free(float *rgba, float *depth)
+{
+    free(rgba);
+    free(depth);
 }
 
 /* Irradiance at a floor point (normal +Z) from a Lambertian square of radiance le, half-size s,

@@ -103,14 +103,12 @@ static void test_depth(void)
         for (int i = 0; i < w * h; ++i)
             if (!(fabsf(depth[i] - dist) < 2e-5f * dist)) bad++;
         EXPECT_MSG(bad == 0, "%s: %d pixels with depth != %g (first %g)", ortho ? "ortho" : "persp", bad, dist, depth[0]);
-        free(rgba);
-        free(depth);
+        rt_image_free(rgba, depth);
         /* Near clip beyond the plane: nothing is seen. */
         cam.near_clip = dist + 0.5f;
         rt_render(dev, &cam, &rd, &rgba, &depth);
         EXPECT_MSG(isinf(depth[0]) && rgba[3] == 0.0f, "near clip: depth %g alpha %g", depth[0], rgba[3]);
-        free(rgba);
-        free(depth);
+        rt_image_free(rgba, depth);
     }
     sy_rt_device_destroy(dev);
 }

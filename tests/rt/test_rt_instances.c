@@ -30,8 +30,7 @@ static double render_centroid(sy_rt_device *dev, int *n)
     float *rgba, *depth;
     rt_render(dev, &cam, &rd, &rgba, &depth);
     double c = green_centroid(rgba, n);
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     return c;
 }
 
@@ -95,8 +94,7 @@ static float floor_centre(sy_rt_device *dev)
     float *rgba, *depth;
     rt_render(dev, &cam, &rd, &rgba, &depth);
     float v = rgba[4 * (4 * 9 + 4)];
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     return v;
 }
 

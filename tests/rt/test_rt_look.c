@@ -110,8 +110,7 @@ static void test_background_never_lights(void)
                 EXPECT_MSG(centre[0] == 0.0f && centre[1] == 0.0f && centre[2] == 0.0f && centre[3] == 1.0f,
                            "mode %d integrator %d: a surface lit by the background alone: %g %g %g %g", mode, integ, centre[0],
                            centre[1], centre[2], centre[3]);
-            free(rgba);
-            free(depth);
+            rt_image_free(rgba, depth);
         }
         sy_rt_device_destroy(dev);
     }
@@ -138,8 +137,7 @@ static void test_environment_is_a_light(void)
             for (int c = 0; c < 3; ++c)
                 EXPECT_MSG(rt_near(centre[c], 1.5 * L[c], 1e-5), "integrator %d: mirror channel %d = %g, expected %g", integ, c,
                            centre[c], 1.5 * L[c]);
-            free(rgba);
-            free(depth);
+            rt_image_free(rgba, depth);
         }
         sy_rt_device_destroy(dev);
     }
@@ -161,8 +159,7 @@ static void test_environment_is_a_light(void)
             for (int c = 0; c < 3; ++c)
                 EXPECT_MSG(rt_near(m[k][c], 0.7 * L[c], 0.01), "integrator %d: floor under the uniform environment, channel %d: "
                            "%.5f, expected %.5f", (int)integ, c, m[k][c], 0.7 * L[c]);
-            free(rgba);
-            free(depth);
+            rt_image_free(rgba, depth);
         }
         printf("uniform environment over a floor: whitted %.4f, pathtracer %.4f (x albedo L)\n", m[0][1] / 0.7 / L[1],
                m[1][1] / 0.7 / L[1]);
@@ -198,8 +195,7 @@ static void test_emission_adds(void)
                        "integrator %d channel %d: emissive surface under a light %.5f, expected emission + reflection %.5f",
                        integ, c, mean[c], expect);
         }
-        free(rgba);
-        free(depth);
+        rt_image_free(rgba, depth);
     }
     sy_rt_device_destroy(dev);
 }
@@ -231,8 +227,7 @@ static void shadow_case(const char *name, const sy_rt_material_desc *bd, const d
         for (int c = 0; c < 3; ++c)
             EXPECT_MSG(rt_near(mean[c], expect[c], 1e-4) || (expect[c] == 0 && mean[c] == 0),
                        "%s, integrator %d, channel %d: floor %.6f, expected %.6f", name, integ, c, mean[c], expect[c]);
-        free(rgba);
-        free(depth);
+        rt_image_free(rgba, depth);
     }
     sy_rt_device_destroy(dev);
 }

@@ -49,8 +49,7 @@ static void test_emitter_exact(void)
         const float *bg = px_at(rgba, 0, 0);
         EXPECT_MSG(bg[0] == 0 && bg[1] == 0 && bg[2] == 0 && bg[3] == 0, "transparent background %g %g %g %g", bg[0], bg[1], bg[2], bg[3]);
         EXPECT_MSG(isinf(depth[0]) && depth[0] > 0, "background depth %g", depth[0]);
-        free(rgba);
-        free(depth);
+        rt_image_free(rgba, depth);
     }
     /* A coloured background is radiance with alpha 1. */
     sy_rt_background bgd = {.mode = SY_RT_BACKGROUND_COLOR, .color = {0.25f, 0.5f, 2.0f}};
@@ -61,8 +60,7 @@ static void test_emitter_exact(void)
     rt_render(dev, &cam, &rd, &rgba, &depth);
     const float *bg = px_at(rgba, 0, 0);
     EXPECT_MSG(bg[0] == 0.25f && bg[1] == 0.5f && bg[2] == 2.0f && bg[3] == 1.0f, "background %g %g %g %g", bg[0], bg[1], bg[2], bg[3]);
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     sy_rt_device_destroy(dev);
 }
 
@@ -124,8 +122,7 @@ static void test_point_and_directional(void)
                 checked++;
             }
         EXPECT_MSG(checked > 40, "only %d pixels checked", checked);
-        free(rgba);
-        free(depth);
+        rt_image_free(rgba, depth);
         sy_rt_device_destroy(dev);
     }
 }
@@ -161,13 +158,11 @@ static void test_area_light(void)
     EXPECT_MSG(rt_near(c[0], expect, 0.01), "area light: centre %.6g, expected %.6g", c[0], expect);
     /* Default 16 samples: still within a few percent, and smooth (no sample noise) pixel to pixel. */
     rd.area_light_samples = 0;
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     rt_render(dev, &cam, &rd, &rgba, &depth);
     c = px_at(rgba, 16, 16);
     EXPECT_MSG(rt_near(c[0], expect, 0.05), "area light (16 samples): centre %.6g, expected %.6g", c[0], expect);
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     sy_rt_device_destroy(dev);
 }
 
@@ -185,8 +180,7 @@ static void test_area_light_grazing(void)
     rt_render(dev, &cam, &rd, &rgba, &depth);
     const float *c = px_at(rgba, W / 2, W / 2);
     EXPECT_MSG(rt_near(c[0], expect, 0.01), "area light at a grazing angle: %.6g, expected %.6g", c[0], expect);
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     sy_rt_device_destroy(dev);
 }
 
@@ -224,8 +218,7 @@ static void test_hard_shadow(void)
             }
         }
     EXPECT_MSG(shadowed > 50 && lit > 500, "shadowed %d lit %d", shadowed, lit);
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     sy_rt_device_destroy(dev);
 }
 
@@ -257,13 +250,11 @@ static void test_mirror(void)
     EXPECT_MSG(fabsf(depth[16 * W + 16] - CAM_Z) < 1e-5f, "mirror depth is the mirror's, got %g", depth[16 * W + 16]);
     /* max_depth 1: no recursion, the mirror is black. */
     rd.max_depth = 1;
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     rt_render(dev, &cam, &rd, &rgba, &depth);
     c = px_at(rgba, 16, 16);
     EXPECT_MSG(c[0] == 0.0f && c[3] == 1.0f, "mirror at max_depth 1: %g alpha %g", c[0], c[3]);
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     sy_rt_device_destroy(dev);
 }
 
@@ -297,13 +288,11 @@ static void test_glass(void)
                "glass %.7g %.7g %.7g, expected %.7g * (1,2,4)", c[0], c[1], c[2], T);
     /* max_depth 2: camera ray + one refraction reach only the back face: black. max_depth 3: (1-F)^2. */
     rd.max_depth = 3;
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     rt_render(dev, &cam, &rd, &rgba, &depth);
     c = px_at(rgba, 16, 16);
     EXPECT_MSG(rt_near(c[0], (1 - F) * (1 - F), 1e-5), "glass depth 3: %.7g expected %.7g", c[0], (1 - F) * (1 - F));
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     sy_rt_device_destroy(dev);
 }
 
@@ -350,8 +339,7 @@ static void test_alpha_mask_and_texture(void)
             EXPECT_MSG(r[0] == 0.0f && r[1] == 0.0f && r[2] == 5.0f, "row %d: cut-out shows the emitter: %g %g %g", row, r[0], r[1], r[2]);
             EXPECT_MSG(fabsf(depth[row * W + 20] - (CAM_Z + 1.0f)) < 1e-5f, "row %d: depth through cut-out %g", row, depth[row * W + 20]);
         }
-        free(rgba);
-        free(depth);
+        rt_image_free(rgba, depth);
     }
     /* Opaque again: the grey right half appears as 128 sRGB * (1, 0.5, 1). */
     md.alpha_mode = SY_RT_ALPHA_OPAQUE;
@@ -363,8 +351,7 @@ static void test_alpha_mask_and_texture(void)
     const float *r = px_at(rgba, 20, 10);
     double g = pow((128 / 255.0 + 0.055) / 1.055, 2.4);
     EXPECT_MSG(rt_near(r[0], g, 1e-6) && rt_near(r[1], 0.5 * g, 1e-6), "opaque grey %g %g expected %g", r[0], r[1], g);
-    free(rgba);
-    free(depth);
+    rt_image_free(rgba, depth);
     sy_rt_device_destroy(dev);
 }
 
@@ -414,8 +401,7 @@ static void test_area_light_analytic(void)
     EXPECT_MSG(worst < 0.003, "analytic area light: a pixel %.4f %% from the exact irradiance", 100.0 * worst);
     EXPECT_MSG(worst_n < 1e-5, "analytic area light: 1 and 256 samples differ by %.3g", worst_n);
     free(one);
-    free(many);
-    free(depth);
+    rt_image_free(many, depth);
     sy_rt_device_destroy(dev);
 }
 
@@ -471,8 +457,7 @@ static void test_rough_sphere_smooth_and_deterministic(void)
     EXPECT_MSG(rough < 5e-3, "rough sphere: grainy, neighbour variance / mean^2 %.3g", rough);
     EXPECT_MSG(memcmp(a, b, sizeof(float) * 4 * S * S) == 0, "two Whitted renders differ");
     free(a);
-    free(b);
-    free(depth);
+    rt_image_free(b, depth);
     sy_rt_device_destroy(dev);
 }
 
