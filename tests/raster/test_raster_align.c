@@ -31,6 +31,16 @@ static void render(sy_scene *scene, const sy_gltf_info *info, sy_node cam, const
     sy_context_pool_destroy(pool);
 }
 
+/* The coverage IoU of a and b is at least 0.99; printed as "PATH IoU x WHAT", a failure says FAILS. */
+static void expect_same_coverage(const char *path, const sy_layer *a, const sy_layer *b, const char *what,
+                                 const char *fails)
+{
+    double iou = 0.0;
+    MUST(sy_layer_coverage_iou(a, b, &iou, err));
+    printf("%-40s IoU %.5f %s\n", path, iou, what);
+    EXPECT_MSG(iou >= 0.99, "%s: %s: IoU %.5f < 0.99", path, fails, iou);
+}
+
 static void check_model(const model *m)
 {
     char buf[1024];
@@ -65,10 +75,7 @@ static void check_model(const model *m)
      * silhouette (issue 32) */
     sy_layer full;
     render(scene, &info, cam, "raster", "msaa=1,shadow_map_size=256,lod=0", &full);
-    double iou_lod = 0.0;
-    MUST(sy_layer_coverage_iou(&a, &full, &iou_lod, err));
-    printf("%-40s IoU %.5f levels of detail against full meshes\n", m->path, iou_lod);
-    EXPECT_MSG(iou_lod >= 0.99, "%s: levels of detail change the silhouette: IoU %.5f < 0.99", m->path, iou_lod);
+    expect_same_coverage(m->path, &a, &full, "levels of detail against full meshes", "levels of detail change the silhouette");
     sy_layer_destroy(&full);
     sy_layer_destroy(&a);
     sy_layer_destroy(&b);
@@ -76,10 +83,7 @@ static void check_model(const model *m)
      * where any sample hits, so the silhouettes still agree */
     render(scene, &info, cam, "raster", "shadow_map_size=256", &a);
     render(scene, &info, cam, "whitted", "light_samples=4,max_depth=1", &b);
-    double iou_aa = 0.0;
-    MUST(sy_layer_coverage_iou(&a, &b, &iou_aa, err));
-    printf("%-40s IoU %.5f with default anti-aliasing\n", m->path, iou_aa);
-    EXPECT_MSG(iou_aa >= 0.99, "%s: anti-aliased silhouette IoU %.5f < 0.99", m->path, iou_aa);
+    expect_same_coverage(m->path, &a, &b, "with default anti-aliasing", "anti-aliased silhouette");
     sy_layer_destroy(&a);
     sy_layer_destroy(&b);
     sy_gltf_info_free(&info);
