@@ -9,16 +9,13 @@
 # A measurement, not a test: it needs Blender (Debian's `blender` package) and skips without it.
 # Usage: tests/cycles/cornell_direct.sh [BUILD_DIR (build)] [OUT_DIR (cornell-direct)] [CYCLES_SPP (1024)]
 set -euo pipefail
-root=$(cd "$(dirname "$0")/../.." && pwd)
+. "$(dirname "$0")/../support/measure.sh" # root, skip_without_blender, skip_without
 build=${1:-$root/build}
 out=${2:-cornell-direct}
 spp=${3:-1024}
 gltf=$root/../shared/testdata/cornell/cornell_box.gltf
-if ! command -v blender >/dev/null 2>&1; then
-    echo "cornell_direct.sh: skipped: Blender is not installed (apt-get install blender)"
-    exit 0
-fi
-[ -f "$gltf" ] || { echo "cornell_direct.sh: skipped: $gltf is absent"; exit 0; }
+skip_without_blender
+skip_without "$gltf"
 mkdir -p "$out"
 sy=$build/apps/sy/sy
 "$sy" render "$gltf" -b raster -w 256 -h 256 -o "$out/raster_direct.exr" --params indirect=0

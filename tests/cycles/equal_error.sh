@@ -17,7 +17,7 @@
 # A measurement, not a test: it needs Blender (Debian's `blender` package) and skips without it.
 # Usage: tests/cycles/equal_error.sh [BUILD_DIR (build)] [OUT_DIR (equal-error)] [SPP (128)] [RUNS (3)]
 set -euo pipefail
-root=$(cd "$(dirname "$0")/../.." && pwd)
+. "$(dirname "$0")/../support/measure.sh" # root, skip_without_blender, skip_without
 build=${1:-$root/build}
 out=${2:-equal-error}
 spp=${3:-128}
@@ -25,11 +25,8 @@ runs=${4:-3}
 data=$root/../shared/testdata/cornell
 gltf=$data/cornell_box.gltf
 ref=$data/cornell_box_cycles_256_4096.exr
-if ! command -v blender >/dev/null 2>&1; then
-    echo "equal_error.sh: skipped: Blender is not installed (apt-get install blender)"
-    exit 0
-fi
-[ -f "$gltf" ] && [ -f "$ref" ] || { echo "equal_error.sh: skipped: $data is absent"; exit 0; }
+skip_without_blender
+skip_without "$gltf" "$ref"
 sy=$build/apps/sy/sy
 err=$build/tests/exr_error
 for tool in "$sy" "$err"; do

@@ -12,7 +12,7 @@
 # without it.
 # Usage: tests/cycles/materials.sh [BUILD_DIR (build)] [OUT_DIR (materials-cycles)] [SPP (1024)] [WxH (160x120)] [MODEL...]
 set -euo pipefail
-root=$(cd "$(dirname "$0")/../.." && pwd)
+. "$(dirname "$0")/../support/measure.sh" # root, skip_without_blender, skip_without
 build=$(cd "${1:-$root/build}" && pwd)
 out=${2:-materials-cycles}
 spp=${3:-1024}
@@ -23,11 +23,8 @@ models=("$@")
     SheenCloth TextureTransformMultiTest AnisotropyRotationTest AnisotropyStrengthTest IridescenceSuzanne ToyCar
     EmissiveStrengthTest)
 data=$root/../shared/testdata/gltf
-if ! command -v blender >/dev/null 2>&1; then
-    echo "materials.sh: skipped: Blender is not installed (apt-get install blender python3-numpy)"
-    exit 0
-fi
-[ -d "$data" ] || { echo "materials.sh: skipped: $data is absent"; exit 0; }
+skip_without_blender blender python3-numpy
+skip_without "$data"
 mkdir -p "$out"
 sy=$build/apps/sy/sy
 err=$build/tests/exr_error

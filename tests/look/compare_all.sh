@@ -7,14 +7,14 @@
 # within 0.67-1.5x of the path tracer); rows outside the targets are marked with '!'.
 # Usage: tests/look/compare_all.sh [BUILD_DIR (build)] [OUT_DIR (compare-all)] [W H SPP (200 150 64)]
 set -uo pipefail
-root=$(cd "$(dirname "$0")/../.." && pwd)
+. "$(dirname "$0")/../support/measure.sh" # root, skip_without_blender, skip_without
 build=${1:-$root/build}
 out=${2:-compare-all}
 w=${3:-200}
 h=${4:-150}
 spp=${5:-64}
 data=$root/../shared/testdata
-[ -d "$data" ] || { echo "compare_all.sh: skipped: $data is absent"; exit 0; }
+skip_without "$data"
 mkdir -p "$out"
 scenes=(demo)
 while IFS= read -r f; do scenes+=("$f"); done < <(cd "$data" && { find cornell gltf -path '*/glTF/*.gltf' -o -name 'cornell_box.gltf'; find x3d -name '*.x3d'; } | sort)
