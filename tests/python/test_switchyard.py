@@ -31,6 +31,12 @@ def sy_render(scene, out, *args):
     return switchyard.read_exr(out)
 
 
+def assert_same_pixels(img, ref):
+    """img (H x W x 4) equals the EXR channels ref (read_exr) bit for bit."""
+    for i, c in enumerate("RGBA"):
+        assert numpy.array_equal(img[..., i], ref[c]), "channel %s differs from sy render" % c
+
+
 def triangle_scene():
     """A triangle over the lower-left half of an orthographic camera's square view."""
     s = switchyard.Scene()
@@ -61,8 +67,7 @@ def test_three_line_render_equals_sy_render(tmp_path):
     assert 0.1 < covered.mean() < 0.9, "the box covers part of the image"
     assert img[..., :3][covered].mean() > 0.05, "the box is lit"
     ref = sy_render(BOX, str(tmp_path / "box.exr"), "-b", "whitted", "-w", "96", "-h", "64")
-    for i, c in enumerate("RGBA"):
-        assert numpy.array_equal(img[..., i], ref[c]), "channel %s differs from sy render" % c
+    assert_same_pixels(img, ref)
 
 
 @needs_whitted
@@ -72,8 +77,7 @@ def test_cornell_whitted_equals_sy_render(tmp_path):
     img = switchyard.render(CORNELL, backend="whitted", width=64, height=48)
     assert (img[..., 3] > 0.5).mean() > 0.5 and img[..., :3].mean() > 0.01, "the box covers most of the view, lit"
     ref = sy_render(CORNELL, str(tmp_path / "cbw.exr"), "-b", "whitted", "-w", "64", "-h", "48")
-    for i, c in enumerate("RGBA"):
-        assert numpy.array_equal(img[..., i], ref[c]), "channel %s differs from sy render" % c
+    assert_same_pixels(img, ref)
 
 
 @needs_pt
@@ -82,8 +86,7 @@ def test_pathtracer_same_seed_and_spp_equals_sy_render(tmp_path):
     need(CORNELL)
     img, aovs = switchyard.render(CORNELL, backend="pathtracer", width=48, height=48, spp=4, aovs=True)
     ref = sy_render(CORNELL, str(tmp_path / "cb.exr"), "-b", "pathtracer", "-w", "48", "-h", "48", "--spp", "4")
-    for i, c in enumerate("RGBA"):
-        assert numpy.array_equal(img[..., i], ref[c]), "channel %s differs from sy render" % c
+    assert_same_pixels(img, ref)
     assert "depth" in aovs and aovs["depth"].shape == (48, 48)
     assert numpy.isfinite(aovs["depth"]).mean() > 0.9, "the closed box is hit nearly everywhere"
     assert set(aovs) - {"depth"}, "the path tracer's feature buffers come along"
@@ -238,8 +241,7 @@ def test_load_world_and_time_options_equal_sy_render(tmp_path):
     ref = sy_render(path, str(tmp_path / "ref.exr"), "-b", "whitted", "-w", "48", "-h", "40", "--at", "0.5",
                     "--background", "0.2,0.3,0.4")
     img = switchyard.render(path, backend="whitted", width=48, height=40, at=0.5, background=(0.2, 0.3, 0.4))
-    for i, c in enumerate("RGBA"):
-        assert numpy.array_equal(img[..., i], ref[c]), c
+    assert_same_pixels(img, ref)
     assert numpy.allclose(img[0, 0], (0.2, 0.3, 0.4, 1.0)), "the background where nothing is hit"
     still = switchyard.render(path, backend="whitted", width=48, height=40)
     assert not numpy.array_equal(img[..., :3] * (img[..., 3:] > 0.99), still[..., :3] * (img[..., 3:] > 0.99))
