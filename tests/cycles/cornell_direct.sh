@@ -9,8 +9,7 @@
 # A measurement, not a test: it needs Blender (Debian's `blender` package) and skips without it.
 # Usage: tests/cycles/cornell_direct.sh [BUILD_DIR (build)] [OUT_DIR (cornell-direct)] [CYCLES_SPP (1024)]
 set -euo pipefail
-. "$(dirname "$0")/../support/measure.sh" # root, skip_without_blender, skip_without
-build=${1:-$root/build}
+. "$(dirname "$0")/../support/measure.sh" # root, build, skip_without_blender, skip_without
 out=${2:-cornell-direct}
 spp=${3:-1024}
 gltf=$root/../shared/testdata/cornell/cornell_box.gltf

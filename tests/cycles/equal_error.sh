@@ -17,8 +17,7 @@
 # A measurement, not a test: it needs Blender (Debian's `blender` package) and skips without it.
 # Usage: tests/cycles/equal_error.sh [BUILD_DIR (build)] [OUT_DIR (equal-error)] [SPP (128)] [RUNS (3)]
 set -euo pipefail
-. "$(dirname "$0")/../support/measure.sh" # root, skip_without_blender, skip_without
-build=${1:-$root/build}
+. "$(dirname "$0")/../support/measure.sh" # root, build, skip_without_blender, skip_without
 out=${2:-equal-error}
 spp=${3:-128}
 runs=${4:-3}

@@ -12,8 +12,7 @@
 # without it.
 # Usage: tests/cycles/materials.sh [BUILD_DIR (build)] [OUT_DIR (materials-cycles)] [SPP (1024)] [WxH (160x120)] [MODEL...]
 set -euo pipefail
-. "$(dirname "$0")/../support/measure.sh" # root, skip_without_blender, skip_without
-build=$(cd "${1:-$root/build}" && pwd)
+. "$(dirname "$0")/../support/measure.sh" # root, build, skip_without_blender, skip_without
 out=${2:-materials-cycles}
 spp=${3:-1024}
 size=${4:-160x120}

@@ -7,8 +7,7 @@
 # within 0.67-1.5x of the path tracer); rows outside the targets are marked with '!'.
 # Usage: tests/look/compare_all.sh [BUILD_DIR (build)] [OUT_DIR (compare-all)] [W H SPP (200 150 64)]
 set -uo pipefail
-. "$(dirname "$0")/../support/measure.sh" # root, skip_without_blender, skip_without
-build=${1:-$root/build}
+. "$(dirname "$0")/../support/measure.sh" # root, build, skip_without_blender, skip_without
 out=${2:-compare-all}
 w=${3:-200}
 h=${4:-150}
