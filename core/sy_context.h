@@ -43,6 +43,20 @@ void *sy_context_state(const sy_context *c);
  * forwards it to its servers with its next frame. Back-ends without the class hook: nothing.
  * Thread-safety: as sy_context_render. */
 void sy_context_restart(sy_context *c);
+/** Motion blur in one render (SY_CAP_MOTION; others: SY_ERR_UNSUPPORTED naming the back-end), for a
+ * shutter from time T0 (open) to T1 (close): commit the scene at T1 and call
+ * sy_context_motion_begin (it syncs), commit the scene at T0 and call sy_context_motion_open (it
+ * syncs: every node moved between T1 and T0 is placed at T0 for ray time 0 and at T1 for ray time
+ * 1, interpolated linearly for each ray's time in [0, 1)); render (each pixel sample at its own
+ * time; time_samples: the fewest samples per pixel of back-ends with a fixed count, 0 = their
+ * default); then sy_context_motion_end (the context stays at T0, sharp). *native false from
+ * _open: the changes hold what the back-end cannot interpolate (deformed skins and morphs, moved
+ * lights; the camera is never interpolated: the request's camera is used for every ray): call
+ * sy_context_motion_end and blur another way (sub-frames). Errors leave the motion ended.
+ * Thread-safety: as sy_context_render. */
+sy_result sy_context_motion_begin(sy_context *c, uint32_t time_samples, sy_error *err);
+sy_result sy_context_motion_open(sy_context *c, bool *native, sy_error *err);
+void sy_context_motion_end(sy_context *c);
 /** Fills out with the mediator's statistics. */
 void sy_context_stats(const sy_context *c, sy_mediator_stats *out);
 /** The instance's capabilities (sy_mediator_caps): the class's, or what caps_of says for its parameters. */

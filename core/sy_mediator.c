@@ -380,6 +380,40 @@ void sy_context_restart(sy_context *c)
     if (c && c->cls->restart) c->cls->restart(c->state);
 }
 
+static sy_result motion_unsupported(const sy_context *c, sy_error *err)
+{
+    return sy_error_set(err, SY_ERR_UNSUPPORTED, "back-end '%s' has no motion blur in one render (SY_CAP_MOTION)",
+                        c->cls->name);
+}
+
+sy_result sy_context_motion_begin(sy_context *c, uint32_t time_samples, sy_error *err)
+{
+    if (!(sy_context_caps(c) & SY_CAP_MOTION) || !c->cls->motion) return motion_unsupported(c, err);
+    sy_result r = sy_context_sync(c, err);
+    if (r == SY_OK) r = c->cls->motion(c->state, SY_MOTION_BEGIN, time_samples, NULL, err);
+    if (r != SY_OK) sy_context_motion_end(c);
+    return r;
+}
+
+sy_result sy_context_motion_open(sy_context *c, bool *native, sy_error *err)
+{
+    bool nat = false;
+    if (native) *native = false;
+    if (!(sy_context_caps(c) & SY_CAP_MOTION) || !c->cls->motion) return motion_unsupported(c, err);
+    sy_result r = sy_context_sync(c, err);
+    if (r == SY_OK) r = c->cls->motion(c->state, SY_MOTION_OPENED, 0, &nat, err);
+    if (r != SY_OK) sy_context_motion_end(c);
+    else if (native) *native = nat;
+    return r;
+}
+
+void sy_context_motion_end(sy_context *c)
+{
+    sy_error ignore = {0};
+    if (c && c->cls->motion && (sy_context_caps(c) & SY_CAP_MOTION))
+        (void)c->cls->motion(c->state, SY_MOTION_END, 0, NULL, &ignore);
+}
+
 void sy_context_stats(const sy_context *c, sy_mediator_stats *out)
 {
     memset(out, 0, sizeof *out);

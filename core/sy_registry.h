@@ -35,6 +35,8 @@ typedef enum sy_mediator_caps {
                                      (a culling service asks it of whichever class offers it) */
     SY_CAP_PICK = 1u << 10,       /**< answers what is under a pixel (node, mesh, primitive, triangle, position,
                                      normal, material): sy_context_pick, sy_viewport_pick */
+    SY_CAP_MOTION = 1u << 12,     /**< motion blur in one render: instances move over the shutter, each ray at its
+                                   * own time (sy_context_motion_begin / _open / _end; the class's motion hook) */
     SY_CAP_CLIP = 1u << 11,       /**< honours the view's section planes (sy_camera_view.clip_planes) in renders,
                                      picks and coverage; a view with planes is refused (SY_ERR_UNSUPPORTED)
                                      by a class without it */
@@ -126,6 +128,13 @@ typedef struct sy_mediator_stats {
     double last_sync_seconds, last_render_seconds; /** @} */
 } sy_mediator_stats;
 
+/** The phases of a motion-blurred render (SY_CAP_MOTION, sy_mediator_class.motion). */
+typedef enum sy_motion_phase {
+    SY_MOTION_BEGIN = 1,  /**< synced at the shutter's close; the next sync is its open */
+    SY_MOTION_OPENED = 2, /**< the sync at the open is done */
+    SY_MOTION_END = 3,    /**< motion off */
+} sy_motion_phase;
+
 /** A mediator class: the vtable and capabilities of one back-end kind (see docs/BACKENDS.md). */
 typedef struct sy_mediator_class {
     const char *name; /**< "whitted", "pathtracer", "raster", ... */
@@ -175,6 +184,15 @@ typedef struct sy_mediator_class {
      * nothing visible changed; back-ends with fast paths for moves (the ray tracers' twin instances)
      * place the next sync's moves as a fresh build does. NULL: nothing to do. */
     void (*restart)(void *state);
+    /** SY_CAP_MOTION (sy_context_motion_begin, _open, _end): phase SY_MOTION_BEGIN: what the instance
+     * has synced is the scene at the shutter's close; the next sync brings the scene at its open, and
+     * every instance it moves is to be placed there at ray time 0 and where it was (the close) at
+     * time 1. SY_MOTION_OPENED: that sync is done; *native (not NULL here) false when it brought
+     * changes the class cannot interpolate (deformed meshes, moved lights: the caller then ends the
+     * motion and blurs by sub-frames). SY_MOTION_END: no motion any more (every instance stays where
+     * the last sync put it; native NULL). time_samples: BEGIN's wish for samples per pixel of the
+     * integrators that take a fixed number (0: the class's default). Optional; appended last. */
+    sy_result (*motion)(void *state, sy_motion_phase phase, uint32_t time_samples, bool *native, sy_error *err);
 } sy_mediator_class;
 
 /** Registry (process-wide; the one piece of global state). The class must outlive the process's

@@ -28,7 +28,7 @@ _sy_options() {
     case "${1:-}" in
     render) echo "-b -o -w -h --camera --look-at --orbit --fov --bookmark --hide --isolate --select --params --at --clip --clip-cap --max-memory --gl --filter --threshold --half --exposure --tonemap --stereo
                   --eye-sep --zero-parallax --overlay --composite --frames --fps --resume --repeat --spp --time --aov --temporal
-                  --shutter --motion-blur --shutter-samples
+                  --shutter --motion-blur --shutter-samples --sub-frames
                   $_sy_cluster $_sy_common" ;;
     view) echo "-b -w -h --camera --look-at --orbit --fov --bookmark --bookmarks --clip --clip-cap --hide --isolate --select --overlay --composite --frames --screenshot --filter --threshold --keys --spp --budget --no-temporal
                 $_sy_cluster $_sy_common" ;;

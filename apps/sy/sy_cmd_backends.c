@@ -41,7 +41,7 @@ int sy_cmd_backends(int argc, char **argv)
         {SY_CAP_DEPTH, "depth"}, {SY_CAP_PROGRESSIVE, "progressive"}, {SY_CAP_TILES, "tiles"},
         {SY_CAP_SAMPLE_RANGES, "sample-ranges"}, {SY_CAP_AOVS, "aovs"}, {SY_CAP_FILTERS, "filters"},
         {SY_CAP_ANALYSIS, "analysis"}, {SY_CAP_REMOTE, "remote"}, {SY_CAP_PREVIEW, "preview"},
-        {SY_CAP_COVERAGE, "coverage"}, {SY_CAP_PICK, "pick"}, {SY_CAP_CLIP, "clip"}};
+        {SY_CAP_COVERAGE, "coverage"}, {SY_CAP_PICK, "pick"}, {SY_CAP_CLIP, "clip"}, {SY_CAP_MOTION, "motion"}};
     cJSON *doc = json ? cJSON_CreateArray() : NULL;
     for (uint32_t i = 0; i < sy_mediator_count(); ++i) {
         const sy_mediator_class *m = sy_mediator_at(i);

@@ -264,13 +264,78 @@ static void blur_add(sy_layer *acc, const sy_layer *l, float weight)
         if (l->depth[k] < acc->depth[k]) acc->depth[k] = l->depth[k];
 }
 
+/* Motion blur in one render (back-ends with SY_CAP_MOTION: whitted, pathtracer): the scene committed
+ * at the shutter's close, synced, then at its open, synced (sy_context_motion_begin / _open): every
+ * instance moved in between is interpolated linearly from open to close by each ray's own time. True
+ * with *ctx_out the main context in motion (the caller renders once, then sy_context_motion_end);
+ * false when the back-end lacks it, or (a note says why) the scene also deforms meshes or moves lights
+ * over the shutter: then the motion is ended and the caller blurs by sub-frames. */
+static bool motion_native_begin(loaded *ld, const char *clip, double frame_time, const sy_shutter *sh,
+                                const sy_compose_spec *spec, sy_context_pool *pool, sy_context **ctx_out)
+{
+    sy_params rp;
+    sy_context *c = NULL;
+    sy_error e = {0};
+    if (sy_params_parse(spec->params, &rp, &e) != SY_OK ||
+        sy_context_pool_get(pool, ld->scene, spec->backend, &rp, ld->root.id, &c, &e) != SY_OK ||
+        !(sy_context_caps(c) & SY_CAP_MOTION))
+        return false;
+    sy_context_restart(c); /* placed as a fresh build places them, accumulation from sample 0 */
+    bool native = false;
+    if (sy_cli_set_time(ld, clip, frame_time + sh->close, &e) == 0 && sy_context_motion_begin(c, sh->samples, &e) == SY_OK &&
+        sy_cli_set_time(ld, clip, frame_time + sh->open, &e) == 0 && sy_context_motion_open(c, &native, &e) == SY_OK &&
+        native) {
+        *ctx_out = c;
+        return true;
+    }
+    sy_context_motion_end(c);
+    sy_context_restart(c);
+    sy_log(SY_LOG_NOTE, "sy", NULL, "motion blur: %s; blurring by sub-frames instead",
+           e.message[0] ? e.message : "the scene deforms meshes or moves lights over the shutter, which the back-end "
+                                      "does not interpolate");
+    return false;
+}
+
 static sy_result render_blurred(loaded *ld, const char *clip, double frame_time, sy_shutter *sh,
                                 const sy_compose_spec *spec, uint32_t w, uint32_t h, const pt_opts *po,
                                 sy_context_pool *pool, const sy_window_render_opts *ro, sy_layer *out,
                                 sy_layer *out_right, double *seconds, uint64_t *samples_out, sy_context **ctx_out,
-                                sy_error *err)
+                                bool sub_frames, bool *native_out, sy_error *err)
 {
     double t0 = sy_time_now();
+    sy_context *mc = NULL;
+    *native_out = false;
+    if (!sub_frames && motion_native_begin(ld, clip, frame_time, sh, spec, pool, &mc)) {
+        char each[64];
+        if (po) snprintf(each, sizeof each, "each pixel sample");
+        else snprintf(each, sizeof each, "each of at least %u samples per pixel", sh->samples);
+        sy_log(SY_LOG_NOTE, "sy", NULL, "motion blur: one render, %s at its own time of the shutter %g..%g s after %g s "
+               "(moving objects interpolated per ray; --sub-frames: the mean of sub-frames instead)", each, sh->open,
+               sh->close, frame_time);
+        sy_result r;
+        uint64_t total = 0;
+        if (po) {
+            double secs = 0;
+            r = render_progressive(ld, spec, w, h, po, pool, out, out_right, &secs, &total, ctx_out, err);
+        } else {
+            r = sy_compose_render(ld->scene, pool, spec, w, h, ro, out, out_right, err);
+            total = sh->samples;
+        }
+        sy_context_motion_end(mc);
+        sy_context_restart(mc);
+        if (r == SY_OK) { /* back to the frame's time: what the image's metadata describes */
+            sy_error se = {0};
+            if (sy_cli_set_time(ld, clip, frame_time, &se)) r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s", se.message);
+        }
+        if (r != SY_OK) {
+            sy_layer_destroy(out);
+            sy_layer_destroy(out_right);
+        }
+        *samples_out = total;
+        *native_out = true;
+        *seconds = sy_time_now() - t0;
+        return r;
+    }
     uint32_t n = sh->samples;
     uint64_t spp = po ? (po->spp ? po->spp : (po->time_budget > 0 ? 0 : 64)) : 0;
     if (spp && spp < n) n = sh->samples = (uint32_t)spp; /* at least one sample per time (the metadata says so) */
@@ -600,7 +665,7 @@ int sy_cmd_render(int argc, char **argv)
     bool fps_given = false;
     uint32_t max_memory_mb = 0;
     sy_shutter shutter = {0.0, 0.0, 0}; /* --shutter / --motion-blur / --shutter-samples: motion blur */
-    bool shutter_given = false, motion_blur = false;
+    bool shutter_given = false, motion_blur = false, sub_frames = false;
     const sy_cli_opt opts[] = {
         SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT(NULL, 'o', &outp),
         SY_CLI_OPT_UINT("spp", OPT_SPP, &po.spp, 1, 1u << 24),
@@ -622,7 +687,8 @@ int sy_cmd_render(int argc, char **argv)
         SY_CLI_OPT_CODE("at", OPT_AT, true), SY_CLI_OPT_CODE("clip", OPT_CLIP, true), /* the scene clock */
         SY_CLI_OPT_CODE("shutter", OPT_SHUTTER, true), SY_CLI_OPT_FLAG("motion-blur", OPT_MOTION_BLUR, &motion_blur),
         SY_CLI_OPT_UINT("shutter-samples", OPT_SHUTTER_SAMPLES, &shutter.samples, 1, SY_SHUTTER_SAMPLES_MAX),
-        SY_CLI_OPT_CODE("clip-cap", OPT_CLIP_CAP, true)}; /* section caps (with --clip A,B,C,D) */
+        SY_CLI_OPT_CODE("clip-cap", OPT_CLIP_CAP, true), /* section caps (with --clip A,B,C,D) */
+        SY_CLI_OPT_FLAG("sub-frames", OPT_SUB_FRAMES, &sub_frames)};
     sy_cli_parser p = {SY_CLI_ARGS("render", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .cluster = true,
                        .view = true};
     int c;
@@ -703,6 +769,8 @@ int sy_cmd_render(int argc, char **argv)
     if (motion_blur && shutter_given) return sy_cli_usage_of("render", "--motion-blur is --shutter 0,0.5/FPS: give one of them");
     if (shutter.samples && !shutter_given && !motion_blur)
         return sy_cli_usage_of("render", "--shutter-samples belongs to --shutter or --motion-blur");
+    if (sub_frames && !shutter_given && !motion_blur)
+        return sy_cli_usage_of("render", "--sub-frames belongs to --shutter or --motion-blur");
     if (motion_blur) shutter.close = 0.5 / fps, shutter_given = true; /* a 180-degree shutter */
     if (!shutter.samples) shutter.samples = 16; /* see docs/CLI.md "Motion blur" */
     bool blur = shutter_given && sy_shutter_blurs(&shutter);
@@ -916,11 +984,12 @@ int sy_cmd_render(int argc, char **argv)
     double t0 = sy_time_now();
     sy_context *pctx = NULL;
     char samples_str[32], secs_str[32];
+    bool blur_native = false; /* the back-end interpolated the motion per ray (SY_CAP_MOTION) */
     if (r == SY_OK && blur) {
         if (progressive)
             sy_signals_set_graceful("finishing the current pass, then writing the image accumulated so far");
         r = render_blurred(&ld, clip, frame_time, &shutter, &spec, w, h, progressive ? &po : NULL, pool, &ro, &img,
-                           &img_right, &secs, &samples, &pctx, &err);
+                           &img_right, &secs, &samples, &pctx, sub_frames, &blur_native, &err);
         t0 = sy_time_now() - secs;
         interrupted = sy_signals_interrupted();
     } else if (r == SY_OK && progressive) {
@@ -946,7 +1015,10 @@ int sy_cmd_render(int argc, char **argv)
     sy_png_text texts[14];
     char renderer[64], size_str[48], camera_str[256], matrix_str[16 * 18] = "", proj_str[64] = "", shutter_str[96] = "";
     if (r == SY_OK) {
-        if (blur)
+        if (blur && blur_native) /* one render, each pixel sample at its own time (SY_CAP_MOTION) */
+            snprintf(shutter_str, sizeof shutter_str, "%.9g,%.9g s after %.9g s, a time per pixel sample", shutter.open,
+                     shutter.close, frame_time);
+        else if (blur)
             snprintf(shutter_str, sizeof shutter_str, "%.9g,%.9g s after %.9g s, %u time samples", shutter.open,
                      shutter.close, frame_time, shutter.samples);
         if (!progressive && !blur) { /* what the main back-end accumulated (a single pass: 1) */

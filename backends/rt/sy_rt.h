@@ -383,6 +383,24 @@ sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst,
 sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, bool visible);
 /** Destroys an instance. */
 sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst);
+/** The instance's transform (time 0) as last set. */
+sy_rt_result sy_rt_instance_get_transform(const sy_rt_device *dev, sy_rt_instance inst, float transform[16]);
+
+/* >>motion blur: each ray has a time in [0, 1): 0 the shutter's open, 1 its close. An instance with
+ * motion is placed by its transform at time 0 and by `close` at time 1, the matrix interpolated
+ * linearly between them for every ray (Embree's time steps: rtcSetGeometryTimeStepCount 2 on the
+ * instance geometry, or on a baked instance's world-space triangles a second vertex buffer; its twin
+ * while it moved likewise) and for shading. While some instance has motion, the path tracer gives
+ * every pixel sample a stratified time (shadow rays share it) and Whitted takes
+ * max(pixel_samples, time_samples) samples per pixel at stratified times and points; without one,
+ * every ray has time 0 and renders are bit for bit those without motion. Not moved over the shutter:
+ * the area lights of emissive instances (their time-0 triangles), the eye-light integrator, picks,
+ * coverage, and section planes' hit test (time 0 placement). */
+/** Gives the instance motion to `close` (object-to-world at time 1, checked like a transform; equal
+ * to its transform or NULL: no motion). Keeps its transform (time 0); sy_rt_commit publishes it. */
+sy_rt_result sy_rt_instance_set_motion(sy_rt_device *dev, sy_rt_instance inst, const float close[16]);
+/** Drops every instance's motion (each stays at its transform); sy_rt_commit publishes it. */
+sy_rt_result sy_rt_motion_clear(sy_rt_device *dev);
 
 /* >>light */
 
@@ -559,6 +577,9 @@ typedef struct sy_rt_render_desc {
                                          * BSDF direction each) per shading point of each pixel
                                          * sample, for the visibility of the closed-form light;
                                          * 0 = 4 */
+    uint32_t time_samples;              /**< while some instance has motion (>>motion blur): the
+                                         * fewest samples per pixel, each at its own stratified
+                                         * time of the shutter; 0 = 16 */
     sy_rt_progress_fn progress;         /**< optional */
     void *progress_user_data; /**< passed to progress */
     /** PATHTRACER only: */

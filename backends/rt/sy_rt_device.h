@@ -69,6 +69,13 @@ typedef struct sy_rt_instance_data {
     unsigned twin_id;          /* its geometry id in dev->dyn */
     uint32_t area_base;        /* committed emissive instance: its triangles' entries in dev->area_map
                                 * start here (UINT32_MAX: none) */
+    /* Motion blur (sy_rt_instance_set_motion): xf is the placement at ray time 0 (shutter open), xf1
+     * at time 1 (shutter close); Embree interpolates the matrices linearly between them (two time
+     * steps on geom, its twin, or a baked instance's second vertex buffer) and shading does the same
+     * (sy_rt_instance_at). */
+    bool motion;
+    float xf1[16];
+    float *baked_positions1;   /* baked with motion: Embree vertex buffer of time step 1 (world space) */
 } sy_rt_instance_data;
 
 typedef struct sy_rt_light_data {
@@ -115,6 +122,7 @@ struct sy_rt_device {
                                     * walks every id up to the largest) */
     uint32_t dyn_map_cap;
     uint32_t stale_count;  /* instances with stale set */
+    uint32_t motion_count; /* instances with motion (sy_rt_instance_set_motion): rays get times */
     /* Section planes of the call in progress (sy_rt_clip_begin: the camera's), read by the context
      * filter sy_rt_context_filter on every hit. */
     uint32_t clip_count;
@@ -262,6 +270,8 @@ static inline bool sy_rt_clip_removes(const sy_rt_device *dev, float x, float y,
 typedef struct sy_rt_ictx {
     struct RTCIntersectContext rtc; /* first member */
     int in_dyn;                     /* tracing dev->dyn: instance ids are dyn ids (dev->dyn_map) */
+    float time;                     /* the time in [0, 1) of the rays cast with it (motion blur: 0 =
+                                     * shutter open, 1 = close; sy_rt_intersect, sy_rt_segment_clear) */
     RTCFilterFunctionN saved;       /* the filter while tracing dev->dyn */
     RTCFilterFunctionN dyn_filter;  /* the filter while tracing dev->dyn: the context filter when the call
                                        cuts with section planes, else none (set by sy_rt_context_init, so
@@ -275,6 +285,7 @@ static inline void sy_rt_context_init(const sy_rt_device *dev, sy_rt_ictx *ctx, 
     rtcInitIntersectContext(&ctx->rtc);
     ctx->rtc.flags = flags;
     ctx->in_dyn = 0;
+    ctx->time = 0.0f;
     ctx->saved = NULL;
     ctx->dyn_filter = dev->clip_count ? sy_rt_context_filter : NULL;
     if (dev->stale_count || dev->clip_count) ctx->rtc.filter = sy_rt_context_filter;
@@ -318,6 +329,29 @@ static inline const sy_rt_instance_data *sy_rt_filter_instance(const sy_rt_devic
 {
     if (((const sy_rt_ictx *)ctx)->in_dyn) inst_id = sy_rt_dyn_to_top(dev, inst_id);
     return sy_rt_hit_instance(dev, geom_id, inst_id);
+}
+
+/* The instance as placed at ray time `time` (motion blur): in itself when it does not move, else
+ * *scratch, a copy with the object-to-world matrix interpolated linearly between xf (time 0) and xf1
+ * (time 1), as Embree interpolates it, and its normal matrix (the inverse transpose of the upper
+ * 3x3; a singular interpolated matrix keeps xf's). Shading reads the returned instance. */
+static inline const sy_rt_instance_data *sy_rt_instance_at(const sy_rt_instance_data *in, float time,
+                                                           sy_rt_instance_data *scratch)
+{
+    if (!in || !in->motion) return in;
+    *scratch = *in;
+    for (int i = 0; i < 16; ++i) scratch->xf[i] = (1.0f - time) * in->xf[i] + time * in->xf1[i];
+    const float *x = scratch->xf; /* column-major: a[r][c] = x[c * 4 + r] */
+    float c00 = x[5] * x[10] - x[9] * x[6], c01 = -(x[1] * x[10] - x[9] * x[2]), c02 = x[1] * x[6] - x[5] * x[2];
+    float c10 = -(x[4] * x[10] - x[8] * x[6]), c11 = x[0] * x[10] - x[8] * x[2], c12 = -(x[0] * x[6] - x[4] * x[2]);
+    float c20 = x[4] * x[9] - x[8] * x[5], c21 = -(x[0] * x[9] - x[8] * x[1]), c22 = x[0] * x[5] - x[4] * x[1];
+    float det = x[0] * c00 + x[4] * c01 + x[8] * c02;
+    if (!(det != 0.0f) || !isfinite(det)) return in;
+    float inv = 1.0f / det;
+    /* row-major inverse transpose: the cofactor matrix / det (normal_matrix in sy_rt_scene.c) */
+    float n[9] = {c00, c01, c02, c10, c11, c12, c20, c21, c22};
+    for (int i = 0; i < 9; ++i) scratch->nrm[i] = n[i] * inv;
+    return scratch;
 }
 
 #endif /* SY_RT_DEVICE_H */

@@ -52,7 +52,7 @@ static inline void sy_rt_intersect_scenes(const sy_rt_device *dev, struct RTCInt
 }
 
 /* Shadow / visibility ray shared by the integrators: true when nothing in the top scene blocks
- * org + t*dir for t in (0, tfar). Alpha-mask filters installed on geometry apply. */
+ * org + t*dir for t in (0, tfar) at the context's time (sy_rt_ictx.time). Alpha-mask filters installed on geometry apply. */
 static inline bool sy_rt_segment_clear(const sy_rt_device *dev, struct RTCIntersectContext *ctx, sy_rt_v3 org,
                                        sy_rt_v3 dir, float tfar)
 {
@@ -61,7 +61,7 @@ static inline bool sy_rt_segment_clear(const sy_rt_device *dev, struct RTCInters
     r.dir_x = dir.x, r.dir_y = dir.y, r.dir_z = dir.z;
     r.tnear = 0.0f;
     r.tfar = tfar;
-    r.time = 0.0f;
+    r.time = ((const sy_rt_ictx *)ctx)->time; /* every context is one (sy_rt_context_init) */
     r.mask = 0xffffffffu;
     r.id = 0;
     r.flags = 0;
@@ -75,8 +75,9 @@ static inline bool sy_rt_segment_clear(const sy_rt_device *dev, struct RTCInters
     return r.tfar >= 0.0f;
 }
 
-/* Nearest hit of org + t*dir, t in [tnear, tfar], in the top scene: fills *rh and returns the
- * instance hit, or NULL for a miss. */
+/* Nearest hit of org + t*dir, t in [tnear, tfar], in the top scene at the context's time
+ * (sy_rt_ictx.time): fills *rh and returns the instance hit (as stored: shading at the ray's time
+ * reads sy_rt_instance_at), or NULL for a miss. */
 static inline const sy_rt_instance_data *sy_rt_intersect(const sy_rt_device *dev, struct RTCIntersectContext *ctx,
                                                          sy_rt_v3 org, sy_rt_v3 dir, float tnear, float tfar,
                                                          struct RTCRayHit *rh)
@@ -85,7 +86,7 @@ static inline const sy_rt_instance_data *sy_rt_intersect(const sy_rt_device *dev
     rh->ray.dir_x = dir.x, rh->ray.dir_y = dir.y, rh->ray.dir_z = dir.z;
     rh->ray.tnear = tnear;
     rh->ray.tfar = tfar;
-    rh->ray.time = 0.0f;
+    rh->ray.time = ((const sy_rt_ictx *)ctx)->time; /* motion blur: the ray's time */
     rh->ray.mask = 0xffffffffu;
     rh->ray.id = 0;
     rh->ray.flags = 0;
@@ -102,6 +103,7 @@ static inline void sy_rt_frame_hit(const sy_rt_frame *f, struct RTCIntersectCont
                                    struct RTCRayHit *rh, float *axial)
 {
     sy_rt_frame_ray(f, px, py, &rh->ray, axial);
+    rh->ray.time = ((const sy_rt_ictx *)ctx)->time;
     rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     sy_rt_intersect_scenes(f->dev, ctx, rh);

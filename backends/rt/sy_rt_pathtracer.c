@@ -204,6 +204,13 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
     float dirs[4], first_bsdf[4];
     sy_rt_sobol_sample4(j->sobol, pseed, 0u, index, dirs);
     sy_rt_sobol_sample4(j->sobol, pseed, 2u, index, first_bsdf);
+    if (dev->motion_count) { /* motion blur: the sample's time, stratified over the pixel's samples (the
+                              * first dimension of a set no bounce uses, scrambled apart); every ray
+                              * of the path, shadow rays too, has it */
+        float tu[4];
+        sy_rt_sobol_sample4(j->sobol, pseed ^ 0x68e31da4u, 0xfffffffu, index, tu);
+        c->ictx.time = tu[0];
+    }
     struct RTCRay ray;
     float axial;
     sy_rt_frame_ray_at(f, (float)px + first_bsdf[1], (float)py + first_bsdf[2], &ray, &axial);
@@ -285,7 +292,7 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
             break;
         }
         sy_rt_surface s;
-        sy_rt_surface_fetch(dev, in, rh.hit.primID, rh.hit.u, rh.hit.v, d, &s);
+        sy_rt_surface_fetch_at(dev, in, c->ictx.time, rh.hit.primID, rh.hit.u, rh.hit.v, d, &s);
         if (s.mat->desc.alpha_mode == SY_RT_ALPHA_BLEND && s.alpha < 1.0f) {
             rng = sy_rt_hash32(rng + 0x9e3779b9u);
             if (sy_rt_u01(rng) >= sy_rt_clampf(s.alpha, 0.0f, 1.0f)) { /* pass through */

@@ -652,14 +652,51 @@ static void pending_remove(sy_rt_device *dev, sy_rt_instance_data *in)
         }
 }
 
+/* Sets an instance geometry's transforms (the top-level one or the twin): one time step, or with
+ * motion two (shutter open and close; Embree interpolates between them by the ray's time). */
+static void set_instance_transforms(RTCGeometry g, const sy_rt_instance_data *in)
+{
+    rtcSetGeometryTimeStepCount(g, in->motion ? 2u : 1u);
+    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, in->xf);
+    if (in->motion) rtcSetGeometryTransform(g, 1, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, in->xf1);
+}
+
+/* A baked instance's world-space vertices of time step 1 (motion), or none (one time step; Embree
+ * drops the buffer with the step). */
+static void bake_motion(sy_rt_instance_data *in)
+{
+    if (!in->motion) {
+        rtcSetGeometryTimeStepCount(in->geom, 1u);
+        in->baked_positions1 = NULL;
+        return;
+    }
+    const sy_rt_mesh_data *m = in->mesh;
+    rtcSetGeometryTimeStepCount(in->geom, 2u);
+    if (!in->baked_positions1)
+        in->baked_positions1 = rtcSetNewGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, 1, RTC_FORMAT_FLOAT3,
+                                                       3 * sizeof(float), m->vertex_count);
+    if (!in->baked_positions1) { /* out of memory (Embree reported it): shown at the open time */
+        rtcSetGeometryTimeStepCount(in->geom, 1u);
+        return;
+    }
+    for (uint32_t i = 0; i < m->vertex_count; ++i) {
+        sy_rt_v3 p = m4_point(in->xf1, v3_load(m->positions + 3u * i));
+        in->baked_positions1[3u * i + 0] = p.x;
+        in->baked_positions1[3u * i + 1] = p.y;
+        in->baked_positions1[3u * i + 2] = p.z;
+    }
+    rtcUpdateGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, 1);
+}
+
 /* Writes the instance's current transform into its top-level geometry (a full rebuild follows). */
 static void apply_top_transform(sy_rt_instance_data *in)
 {
     if (in->flags & SY_RT_INSTANCE_BAKED) {
         bake_positions(in);
         rtcUpdateGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, 0);
+        if (in->motion || in->baked_positions1) bake_motion(in);
     } else {
-        rtcSetGeometryTransform(in->geom, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, in->xf);
+        set_instance_transforms(in->geom, in);
     }
     rtcCommitGeometry(in->geom);
 }
@@ -686,7 +723,7 @@ static sy_rt_result twin_place(sy_rt_device *dev, sy_rt_instance_data *in)
             return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "commit: twin of a moved instance: out of memory");
         }
     }
-    rtcSetGeometryTransform(in->twin, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, in->xf);
+    set_instance_transforms(in->twin, in);
     rtcCommitGeometry(in->twin);
     if (!in->stale) {
         in->stale = true;
@@ -731,6 +768,7 @@ static sy_rt_result commit_moved(sy_rt_device *dev)
 
 static void instance_free(sy_rt_device *dev, sy_rt_instance_data *in)
 {
+    if (in->motion) dev->motion_count--;
     pending_remove(dev, in);
     if (in->geom) {
         if (in->top_id != RTC_INVALID_GEOMETRY_ID) {
@@ -913,6 +951,57 @@ sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst)
     instance_free(dev, in);
     dev->dirty = dev->top_dirty = dev->shadow_dirty = true;
     return sy_rt_check_embree(dev, "instance destroy");
+}
+
+/* >>motion blur: an instance's placement at shutter close (ray time 1) beside its transform (time 0) */
+
+sy_rt_result sy_rt_instance_get_transform(const sy_rt_device *dev, sy_rt_instance inst, float transform[16])
+{
+    if (!dev || !transform) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance get_transform: NULL argument");
+    const sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
+    if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance get_transform: stale handle 0x%08x", inst.id);
+    memcpy(transform, in->xf, sizeof in->xf);
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_instance_set_motion(sy_rt_device *dev, sy_rt_instance inst, const float close[16])
+{
+    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_motion: NULL device");
+    sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
+    if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_motion: stale handle 0x%08x", inst.id);
+    if (close && memcmp(close, in->xf, sizeof in->xf) == 0) close = NULL; /* no motion */
+    if (!close && !in->motion) return SY_RT_OK;
+    if (close) {
+        float nrm[9];
+        double gain;
+        sy_rt_result r = normal_matrix(dev, close, nrm, &gain);
+        if (r != SY_RT_OK || (r = instance_in_range(dev, in->mesh, close)) != SY_RT_OK) return r;
+        if (gain > SY_RT_INSTANCE_GAIN_MAX && !(in->flags & SY_RT_INSTANCE_BAKED))
+            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT,
+                        "instance set_motion: the close transform shrinks by %g (more than SY_RT_INSTANCE_GAIN_MAX %g "
+                        "allows for an instance created unbaked)", 1.0 / gain, (double)SY_RT_INSTANCE_GAIN_MAX);
+    }
+    if (!pending_add(dev, in)) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance set_motion: out of memory");
+    if (close && !in->motion) dev->motion_count++;
+    if (!close && in->motion) dev->motion_count--;
+    in->motion = close != NULL;
+    if (close) memcpy(in->xf1, close, sizeof in->xf1);
+    if (instance_emissive(dev, in)) dev->area_dirty = true;
+    dev->dirty = true;
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_motion_clear(sy_rt_device *dev)
+{
+    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "motion clear: NULL device");
+    for (uint32_t i = 0; dev->motion_count && i < dev->instances.count; ++i) {
+        sy_rt_instance_data *in = dev->instances.items[i];
+        if (in && in->motion) {
+            sy_rt_result r = sy_rt_instance_set_motion(dev, (sy_rt_instance){in->handle}, NULL);
+            if (r != SY_RT_OK) return r;
+        }
+    }
+    return SY_RT_OK;
 }
 
 /* >>light */

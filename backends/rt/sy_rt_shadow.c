@@ -55,7 +55,7 @@ sy_rt_v3 sy_rt_shadow_transmittance(const sy_rt_device *dev, struct RTCIntersect
         bool blend = material_blend(m), trans = transmission && material_transmits(m);
         if (!blend && !trans) return zero;
         sy_rt_surface s;
-        sy_rt_surface_fetch(dev, in, rh.hit.primID, rh.hit.u, rh.hit.v, dir, &s);
+        sy_rt_surface_fetch_at(dev, in, ((const sy_rt_ictx *)ctx)->time, rh.hit.primID, rh.hit.u, rh.hit.v, dir, &s);
         float a = blend ? sy_rt_clampf(s.alpha, 0.0f, 1.0f) : 1.0f; /* opacity */
         sy_rt_v3 pass = v3(1.0f - a, 1.0f - a, 1.0f - a);
         if (trans) {

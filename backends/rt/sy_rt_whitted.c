@@ -90,6 +90,7 @@ typedef struct whitted_job {
     struct apoly *poly; /* area_analytic: the emitters as planar polygons */
     uint32_t n_poly;
     uint32_t spp;    /* camera rays per pixel */
+    bool motion;     /* some instance moves over the shutter: each camera ray has its own time */
     uint32_t spp_max; /* up to this many where the first spp disagree (adaptive refinement) */
     uint32_t n_area; /* area-light samples per shading point */
     uint32_t n_env;  /* environment samples per shading point (0 without an environment) */
@@ -940,7 +941,7 @@ static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float
     if (t_hit) *t_hit = rh.ray.tfar;
     sy_rt_v3 d = v3_normalize(dir);
     sy_rt_surface s;
-    sy_rt_surface_fetch(c->dev, in, rh.hit.primID, rh.hit.u, rh.hit.v, d, &s);
+    sy_rt_surface_fetch_at(c->dev, in, ((const sy_rt_ictx *)ictx)->time, rh.hit.primID, rh.hit.u, rh.hit.v, d, &s);
     return shade(c, &s, d, depth, camera);
 }
 
@@ -1009,6 +1010,9 @@ static void whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
                     sy_rt_sobol_sample4(j->sobol, c.pseed, 0u, k, u);
                     fx = (float)px + u[0];
                     fy = (float)py + u[1];
+                    /* motion blur: the sample's time, the third dimension of the same Sobol set
+                     * (stratified jointly with the point); its shadow and secondary rays share it */
+                    if (j->motion) c.ictx.time = primary_ctx.time = u[2];
                 }
                 c.sample = k;
                 if (ps) {
@@ -1066,6 +1070,14 @@ sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc 
     j->sobol = &f->dev->sobol;
     sy_rt_env_get(f->dev, &j->env);
     j->spp = desc->pixel_samples ? desc->pixel_samples : 1u;
+    /* motion blur: at least time_samples samples per pixel (default 16, as many as the sub-frames
+     * sy render --shutter averages otherwise), each at its own stratified time */
+    j->motion = dev->motion_count > 0;
+    if (j->motion) {
+        uint32_t ts = desc->time_samples ? desc->time_samples : 16u;
+        if (ts < 2u) ts = 2u; /* one stratified time would not blur */
+        if (j->spp < ts) j->spp = ts;
+    }
     j->spp_max = j->spp > 1u && j->spp < REFINE_MAX_SPP ? (j->spp * REFINE_FACTOR < REFINE_MAX_SPP ? j->spp * REFINE_FACTOR : REFINE_MAX_SPP) : j->spp;
     j->n_area = (f->light_samples + j->spp - 1u) / j->spp;
     j->n_env = j->env.mode ? (desc->env_light_samples ? desc->env_light_samples : 4u) : 0u;

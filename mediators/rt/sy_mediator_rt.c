@@ -212,7 +212,7 @@ static void pathtracer_filter_info(void *state, sy_filter_info *out)
 static const sy_mediator_class pathtracer_class = {
     .name = "pathtracer",
     .param_table = SY_PARAM_TABLE(sy_rti_pathtracer_params),
-    .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_SAMPLE_RANGES | SY_CAP_AOVS | SY_CAP_FILTERS | SY_CAP_PICK | SY_CAP_CLIP,
+    .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_SAMPLE_RANGES | SY_CAP_AOVS | SY_CAP_FILTERS | SY_CAP_PICK | SY_CAP_CLIP | SY_CAP_MOTION,
     .create = pathtracer_create,
     .destroy = rt_destroy,
     .sync = sy_rti_sync,
@@ -223,6 +223,7 @@ static const sy_mediator_class pathtracer_class = {
     .filter_info = pathtracer_filter_info,
     .pick = sy_rti_pick,
     .restart = sy_rti_pt_restart,
+    .motion = sy_rti_motion,
 };
 
 const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtracer_class; }
@@ -230,7 +231,7 @@ const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtra
 static const sy_mediator_class whitted_class = {
     .name = "whitted",
     .param_table = SY_PARAM_TABLE(sy_rti_whitted_params),
-    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PREVIEW | SY_CAP_PICK | SY_CAP_CLIP,
+    .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PREVIEW | SY_CAP_PICK | SY_CAP_CLIP | SY_CAP_MOTION,
     .create = whitted_create,
     .destroy = rt_destroy,
     .sync = sy_rti_sync,
@@ -239,6 +240,7 @@ static const sy_mediator_class whitted_class = {
     .default_rank = 10, /* the default back-end without the rasterizer */
     .pick = sy_rti_pick,
     .restart = sy_rti_pt_restart,
+    .motion = sy_rti_motion,
 };
 
 const sy_mediator_class *sy_mediator_rt_whitted_class(void) { return &whitted_class; }

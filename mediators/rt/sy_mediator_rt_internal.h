@@ -111,6 +111,12 @@ typedef struct rt_state {
     sy_camera_view temporal_cam;
     bool temporal_have_cam;
     bool temporal_rest; /* this render's camera rests and its accumulation continues: blend (sy_rti_temporal_rest) */
+    /* motion blur (SY_CAP_MOTION, sy_rti_motion): MOTION_ARMED between BEGIN and OPENED (the sync in
+     * between gives each moved instance its close transform), MOTION_ON until END */
+    enum { MOTION_OFF, MOTION_ARMED, MOTION_ON } motion;
+    uint32_t motion_samples;  /* Whitted's time samples per pixel (sy_rt_render_desc.time_samples) */
+    bool motion_other;        /* the armed sync deformed a mesh or moved a light: not interpolated */
+    uint32_t motion_instances; /* instances given motion by the armed sync */
 } rt_state;
 
 /* --- sy_mediator_rt_base.c --- */
@@ -140,6 +146,8 @@ bool sy_rti_inst_selected(const rt_state *st, uint32_t handle);
 /* Placement of an instance (which of its node's paths; 0 when unknown), as picks report it. */
 uint32_t sy_rti_inst_placement_get(const rt_state *st, uint32_t handle);
 sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err);
+/* SY_CAP_MOTION (sy_mediator_class.motion): the phases of a motion-blurred render. */
+sy_result sy_rti_motion(void *state, sy_motion_phase phase, uint32_t time_samples, bool *native, sy_error *err);
 
 /* --- sy_mediator_rt_coverage.c --- */
 sy_result sy_rti_coverage_render(rt_state *st, const sy_rt_camera *cam, const sy_rt_render_desc *d, sy_layer *layer,

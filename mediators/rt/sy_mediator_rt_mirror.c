@@ -198,6 +198,7 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
 static sy_result cb_primitive_update(void *user, const sy_mirror_primitive_args *a, sy_error *err)
 {
     rt_state *st = user;
+    if (st->motion == MOTION_ARMED) st->motion_other = true; /* deformed over the shutter: not interpolated */
     sy_rt_result r = sy_rt_mesh_update(st->dev, (sy_rt_mesh){*a->handle}, a->flat->positions, a->flat->normals);
     return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "mesh primitive update");
 }
@@ -217,7 +218,14 @@ static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_er
         if (r == SY_RT_OK) inst_node_set(st, h.id, a->node, a->placement), inst_sel_set(st, h.id, a->selected);
         return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "instance");
     }
+    float close[16];
+    bool moving = st->motion == MOTION_ARMED && sy_rt_instance_get_transform(st->dev, h, close) == SY_RT_OK &&
+                  memcmp(close, a->world->m, sizeof close) != 0;
     r = sy_rt_instance_set_transform(st->dev, h, a->world->m);
+    if (r == SY_RT_OK && moving) { /* motion blur: from here (the open) to where it was synced (the close) */
+        r = sy_rt_instance_set_motion(st->dev, h, close);
+        if (r == SY_RT_OK) st->motion_instances++;
+    }
     if (r == SY_RT_OK) r = sy_rt_instance_set_visible(st->dev, h, a->visible);
     if (r == SY_RT_OK) inst_sel_set(st, h.id, a->selected);
     return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "instance transform");
@@ -226,6 +234,7 @@ static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_er
 static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *err)
 {
     rt_state *st = user;
+    if (st->motion == MOTION_ARMED) st->motion_other = true; /* a light moved over the shutter: not interpolated */
     const sy_mirror_flat_light *l = a->flat;
     sy_rt_light_desc d;
     memset(&d, 0, sizeof d);
@@ -271,6 +280,35 @@ const sy_mirror_callbacks sy_rti_mirror_callbacks = {
     .release = cb_release,
     .primitive_update = cb_primitive_update,
 };
+
+/* >>motion blur (SY_CAP_MOTION) */
+sy_result sy_rti_motion(void *state, sy_motion_phase phase, uint32_t time_samples, bool *native, sy_error *err)
+{
+    rt_state *st = state;
+    switch (phase) {
+    case SY_MOTION_BEGIN:
+        st->motion = MOTION_ARMED;
+        st->motion_samples = time_samples;
+        st->motion_other = false;
+        st->motion_instances = 0;
+        return SY_OK;
+    case SY_MOTION_OPENED:
+        if (st->motion != MOTION_ARMED) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion: not begun");
+        st->motion = MOTION_ON;
+        if (native) *native = !st->motion_other;
+        return SY_OK;
+    case SY_MOTION_END: {
+        bool had = st->motion != MOTION_OFF;
+        st->motion = MOTION_OFF;
+        st->motion_samples = 0;
+        if (!had) return SY_OK;
+        sy_rt_result r = sy_rt_motion_clear(st->dev);
+        if (r == SY_RT_OK) r = sy_rt_commit(st->dev); /* a device with staged changes refuses to render */
+        return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "motion end");
+    }
+    }
+    return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion: unknown phase %d", (int)phase);
+}
 
 /* >>sync */
 sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err)

@@ -110,6 +110,7 @@ static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_lay
         .seed = req->seed,
         .pixel_samples = st->pixel_samples,
         .env_light_samples = st->env_samples,
+        .time_samples = st->motion_samples,
         .light_tree = (sy_rt_light_tree_mode)st->light_tree,
         .progress = req->progress ? progress_cb : NULL,
         .progress_user_data = &pb,

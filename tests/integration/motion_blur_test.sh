@@ -3,7 +3,9 @@
 # scene: a 2 m box that a PositionInterpolator moves 2 m along x in 1 s, seen from a fixed Viewpoint.
 # The shutter 0,0.5 after --at 0.25 spans box positions x = -0.5 .. 0.5: it moves half its width, so
 # the region it sweeps is exactly the union of its two end positions (two overlapping squares).
-# For each back-end given:
+# For each back-end given (whitted and pathtracer blur in one render with a time per ray,
+# SY_CAP_MOTION, and with --sub-frames by the sub-frame mean; raster always by sub-frames; a note says
+# which), for both paths:
 #   - the blurred image's coverage (alpha > 0.02: some time sample saw the box there) is wider than one
 #     time's (the mid time, alpha > 0.5; the move is half the box, so about 1.5 times) and matches the
 #     union of the endpoints' coverages (alpha > 0.02 too, so anti-aliased edge pixels count alike) with
@@ -13,15 +15,16 @@
 #     at worst (measured: 0.977 Whitted, 0.998 raster); the path tracer's edges are Monte Carlo: a
 #     pixel a few percent covered shows a hit among the union's 2 x 32 samples more often than among
 #     the streak's 32, so it gets 0.92 (measured 0.941);
-#   - the shutter 0 render equals the render without the option bit for bit;
+#   - the shutter 0 render equals the render without the option bit for bit, and (ray tracers) so
+#     does a shutter over which nothing moves (after the box stopped: one render, nothing moving);
 #   - a scene without animations renders bit for bit as without the option (and says why).
-# The first back-end ("raster" where built, else the first given) also proves the accumulation: its
-# blurred mean (R, G, B, A) equals the mean of the sub-frame renders at the four time-sample times
+# The first back-end ("raster" where built, else the first given, with --sub-frames) also proves the
+# accumulation: its blurred mean (R, G, B, A) equals the mean of the sub-frame renders at the four time-sample times
 # within 1e-5 (float rounding of the sums), and the other back-ends' blurred alpha mean (covered
 # area) equals that sub-frame mean within 0.01 (the back-ends' edges differ by anti-aliasing only).
 # A blurred sequence frame equals the blurred --at render of its time, bit for bit.
 # Usage errors (status 2, naming the option): a negative, NaN, infinite or non-numeric shutter, open
-# after close, --shutter with --motion-blur, --shutter-samples alone or 0.
+# after close, --shutter with --motion-blur, --shutter-samples alone or 0, --sub-frames alone.
 # Usage: motion_blur_test.sh SY TMP EXR_EQUAL EXR_BLUR BACKEND...
 SY=$1
 TMP=$2
@@ -66,6 +69,7 @@ usage "open after close" "opens (0.2 s) after it closes (0.1 s)" --shutter 0.2,0
 usage "--shutter and --motion-blur" "--motion-blur is --shutter 0,0.5/FPS" --shutter 0.1 --motion-blur
 usage "--shutter-samples alone" "--shutter-samples belongs to --shutter" --shutter-samples 4
 usage "--shutter-samples 0" "--shutter-samples" --shutter 0.1 --shutter-samples 0
+usage "--sub-frames alone" "--sub-frames belongs to --shutter" --sub-frames
 
 for b in "$@"; do
     extra=()
@@ -80,16 +84,35 @@ for b in "$@"; do
     r close --at 0.75
     r mid --at 0.5
     r blur --at 0.25 --shutter 0,0.5
-    grep -qF "motion blur: the mean of 16 sub-frames" "$TMP/${b}_blur.err" ||
-        fail "$b: no note on the sub-frames: $(cat "$TMP/${b}_blur.err")"
+    r blur_sub --at 0.25 --shutter 0,0.5 --sub-frames
+    grep -qF "motion blur: the mean of 16 sub-frames" "$TMP/${b}_blur_sub.err" ||
+        fail "$b --sub-frames: no note on the sub-frames: $(cat "$TMP/${b}_blur_sub.err")"
+    if [ "$b" = raster ]; then # no SY_CAP_MOTION: sub-frames
+        grep -qF "motion blur: the mean of 16 sub-frames" "$TMP/${b}_blur.err" ||
+            fail "$b: no note on the sub-frames: $(cat "$TMP/${b}_blur.err")"
+    else # the ray tracers: one render, a time per ray (SY_CAP_MOTION)
+        grep -qF "motion blur: one render, each" "$TMP/${b}_blur.err" ||
+            fail "$b: no note on the one render with per-ray times: $(cat "$TMP/${b}_blur.err")"
+    fi
     one=$("$EXR_BLUR" cover 0.5 "$TMP/${b}_mid.exr")
-    streak=$("$EXR_BLUR" cover 0.02 "$TMP/${b}_blur.exr")
-    iou=$("$EXR_BLUR" iou 0.02 "$TMP/${b}_blur.exr" 0.02 "$TMP/${b}_open.exr" "$TMP/${b}_close.exr")
-    echo "$b: covered pixels: one time $one, blurred $streak; IoU of the streak against the endpoints' union $iou"
-    gt "$streak" "$(awk -v o="$one" 'BEGIN { print o * 1.3 }')" || fail "$b: the streak ($streak px) is not wider than one time ($one px)"
-    min_iou=0.95
-    [ "$b" = pathtracer ] && min_iou=0.92
-    gt "$iou" "$min_iou" || fail "$b: the streak's coverage against the union of the endpoints: IoU $iou < $min_iou"
+    for kind in blur blur_sub; do
+        streak=$("$EXR_BLUR" cover 0.02 "$TMP/${b}_$kind.exr")
+        iou=$("$EXR_BLUR" iou 0.02 "$TMP/${b}_$kind.exr" 0.02 "$TMP/${b}_open.exr" "$TMP/${b}_close.exr")
+        echo "$b $kind: covered pixels: one time $one, blurred $streak; IoU of the streak against the endpoints' union $iou"
+        gt "$streak" "$(awk -v o="$one" 'BEGIN { print o * 1.3 }')" || fail "$b $kind: the streak ($streak px) is not wider than one time ($one px)"
+        min_iou=0.95
+        [ "$b" = pathtracer ] && min_iou=0.92
+        gt "$iou" "$min_iou" || fail "$b $kind: the streak's coverage against the union of the endpoints: IoU $iou < $min_iou"
+    done
+    if [ "$b" != raster ]; then
+        # the box stops at 1 s (the time sensor does not loop): a shutter over which nothing moves takes
+        # the one-render path with no moving instance, bit for bit the render without the option (the
+        # sub-frame mean is not: N renders of other seeds)
+        r still --at 2
+        r still_blur --at 2 --shutter 0,0.5
+        "$EXR_EQUAL" "$TMP/${b}_still.exr" "$TMP/${b}_still_blur.exr" >/dev/null ||
+            fail "$b: a shutter over which nothing moves differs from no shutter"
+    fi
     r instant --at 0.25 --shutter 0
     "$EXR_EQUAL" "$TMP/${b}_open.exr" "$TMP/${b}_instant.exr" >/dev/null || fail "$b: --shutter 0 differs from no shutter"
     run_ok "$b static" "${b}_static" "$SY" render "$TMP/static.x3d" -b "$b" "${size[@]}" "${extra[@]}" -o "$TMP/${b}_static.exr"
@@ -111,6 +134,7 @@ read -r mr mg mb ma <<<"$("$EXR_BLUR" mean "${subs[@]}")"
 for b in "$@"; do
     extra=()
     [ "$b" = pathtracer ] && extra=(--spp 32)
+    [ "$b" = "$ref" ] && extra+=(--sub-frames) # the sub-frames' mean, exactly
     run_ok "$b 4 samples" "${b}_blur4" "$SY" render "$TMP/moving.x3d" -b "$b" "${size[@]}" "${extra[@]}" --at 0.25 \
         --shutter 0,0.5 --shutter-samples 4 -o "$TMP/${b}_blur4.exr"
     read -r br bg bb ba <<<"$("$EXR_BLUR" mean "$TMP/${b}_blur4.exr")"

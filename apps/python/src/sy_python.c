@@ -2094,7 +2094,7 @@ PyMODINIT_FUNC PyInit__switchyard(void)
         PyModule_AddIntConstant(m, "CAP_PROGRESSIVE", SY_CAP_PROGRESSIVE) ||
         PyModule_AddIntConstant(m, "CAP_AOVS", SY_CAP_AOVS) || PyModule_AddIntConstant(m, "CAP_FILTERS", SY_CAP_FILTERS) ||
         PyModule_AddIntConstant(m, "CAP_REMOTE", SY_CAP_REMOTE) || PyModule_AddIntConstant(m, "CAP_PICK", SY_CAP_PICK) ||
-        PyModule_AddIntConstant(m, "CAP_CLIP", SY_CAP_CLIP) ||
+        PyModule_AddIntConstant(m, "CAP_CLIP", SY_CAP_CLIP) || PyModule_AddIntConstant(m, "CAP_MOTION", SY_CAP_MOTION) ||
         PyModule_AddIntConstant(m, "CAP_COVERAGE", SY_CAP_COVERAGE) ||
         PyModule_AddIntConstant(m, "TYPE_NODE", SY_TYPE_NODE) || PyModule_AddIntConstant(m, "TYPE_MESH", SY_TYPE_MESH) ||
         PyModule_AddIntConstant(m, "TYPE_MATERIAL", SY_TYPE_MATERIAL) ||
