@@ -22,7 +22,8 @@
 # accumulation: its blurred mean (R, G, B, A) equals the mean of the sub-frame renders at the four time-sample times
 # within 1e-5 (float rounding of the sums), and the other back-ends' blurred alpha mean (covered
 # area) equals that sub-frame mean within 0.01 (the back-ends' edges differ by anti-aliasing only).
-# A blurred sequence frame equals the blurred --at render of its time, bit for bit.
+# A blurred sequence frame equals the blurred --at render of its time, bit for bit. A mesh deformed
+# over the shutter makes the ray tracers fall back to sub-frames, with a note.
 # Usage errors (status 2, naming the option): a negative, NaN, infinite or non-numeric shutter, open
 # after close, --shutter with --motion-blur, --shutter-samples alone or 0, --sub-frames alone.
 # Usage: motion_blur_test.sh SY TMP EXR_EQUAL EXR_BLUR BACKEND...
@@ -146,6 +147,27 @@ for b in "$@"; do
     else
         near "$ba" "$ma" 0.01 || fail "$b: blurred covered area $ba differs from the $ref sub-frames' $ma by more than 0.01"
     fi
+done
+
+# a mesh deformed over the shutter (a CoordinateInterpolator) is not interpolated per ray: the ray
+# tracers say so and blur by sub-frames
+cat >"$TMP/deform.x3d" <<'EOF'
+<X3D><Scene><Viewpoint position='0 0 12' fieldOfView='0.5'/>
+<Shape><Appearance><Material diffuseColor='0.8 0.4 0.2'/></Appearance>
+<IndexedFaceSet coordIndex='0 1 2 3 -1'><Coordinate DEF='C' point='-1 -1 0 1 -1 0 1 1 0 -1 1 0'/></IndexedFaceSet></Shape>
+<TimeSensor DEF='Clock' cycleInterval='1'/>
+<CoordinateInterpolator DEF='Morph' key='0 1' keyValue='-1 -1 0 1 -1 0 1 1 0 -1 1 0 -2 -1 0 2 -1 0 2 1 0 -2 1 0'/>
+<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Morph' toField='set_fraction'/>
+<ROUTE fromNode='Morph' fromField='value_changed' toNode='C' toField='set_point'/>
+</Scene></X3D>
+EOF
+for b in "$@"; do
+    [ "$b" = raster ] && continue
+    run_ok "$b deforming" "${b}_deform" "$SY" render "$TMP/deform.x3d" -b "$b" -w 32 -h 32 --at 0.25 --shutter 0,0.5 \
+        --shutter-samples 4 -o "$TMP/${b}_deform.exr"
+    grep -qF "deforms meshes or moves lights over the shutter" "$TMP/${b}_deform.err" &&
+        grep -qF "the mean of 4 sub-frames" "$TMP/${b}_deform.err" ||
+        fail "$b: a deforming mesh: no note on the sub-frames it takes: $(cat "$TMP/${b}_deform.err")"
 done
 
 # a sequence: frame 6 at 24 fps with --motion-blur (0,1/48) equals --at 0.25 with the same shutter, bit
