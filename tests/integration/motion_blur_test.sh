@@ -19,8 +19,9 @@
 #     does a shutter over which nothing moves (after the box stopped: one render, nothing moving);
 #   - a scene without animations renders bit for bit as without the option (and says why).
 # The first back-end ("raster" where built, else the first given, with --sub-frames) also proves the
-# accumulation: its blurred mean (R, G, B, A) equals the mean of the sub-frame renders at the four time-sample times
-# within 1e-5 (float rounding of the sums), and the other back-ends' blurred alpha mean (covered
+# accumulation: its blurred mean (R, G, B, A) equals the mean of the sub-frame renders at the four
+# time-sample times within 1e-5 (float rounding of the sums; 2e-4 for Whitted, whose pixel points
+# follow each sub-frame's seed), and the other back-ends' blurred alpha mean (covered
 # area) equals that sub-frame mean within 0.01 (the back-ends' edges differ by anti-aliasing only).
 # A blurred sequence frame equals the blurred --at render of its time, bit for bit. A mesh deformed
 # over the shutter makes the ray tracers fall back to sub-frames, with a note.
@@ -141,8 +142,12 @@ for b in "$@"; do
     read -r br bg bb ba <<<"$("$EXR_BLUR" mean "$TMP/${b}_blur4.exr")"
     echo "$b: blurred mean RGBA $br $bg $bb $ba; mean of the $ref sub-frames $mr $mg $mb $ma"
     if [ "$b" = "$ref" ]; then
+        # the rasterizer's image does not depend on the seed; Whitted's pixel points do (sub-frame i has
+        # seed i, the --at renders seed 0): within 2e-4 then (measured 6e-5)
+        tol=1e-5
+        [ "$ref" = raster ] || tol=2e-4
         for c in "$br $mr" "$bg $mg" "$bb $mb" "$ba $ma"; do
-            near $c 1e-5 || fail "$b: blurred mean $c differs from the sub-frames' mean by more than 1e-5"
+            near $c $tol || fail "$b: blurred mean $c differs from the sub-frames' mean by more than $tol"
         done
     else
         near "$ba" "$ma" 0.01 || fail "$b: blurred covered area $ba differs from the $ref sub-frames' $ma by more than 0.01"
