@@ -268,10 +268,11 @@ static void blur_add(sy_layer *acc, const sy_layer *l, float weight)
  * at the shutter's close, synced, then at its open, synced (sy_context_motion_begin / _open): every
  * instance moved in between is interpolated linearly from open to close by each ray's own time. True
  * with *ctx_out the main context in motion (the caller renders once, then sy_context_motion_end);
- * false when the back-end lacks it, or (a note says why) the scene also deforms meshes or moves lights
- * over the shutter: then the motion is ended and the caller blurs by sub-frames. */
+ * false when the back-end lacks it, or (a note says why) the scene also deforms meshes, moves lights or
+ * moves the camera over the shutter: then the motion is ended and the caller blurs by sub-frames. */
 static bool motion_native_begin(loaded *ld, const char *clip, double frame_time, const sy_shutter *sh,
-                                const sy_compose_spec *spec, sy_context_pool *pool, sy_context **ctx_out)
+                                const sy_compose_spec *spec, uint32_t w, uint32_t h, sy_context_pool *pool,
+                                sy_context **ctx_out)
 {
     sy_params rp;
     sy_context *c = NULL;
@@ -281,18 +282,27 @@ static bool motion_native_begin(loaded *ld, const char *clip, double frame_time,
         !(sy_context_caps(c) & SY_CAP_MOTION))
         return false;
     sy_context_restart(c); /* placed as a fresh build places them, accumulation from sample 0 */
-    bool native = false;
-    if (sy_cli_set_time(ld, clip, frame_time + sh->close, &e) == 0 && sy_context_motion_begin(c, sh->samples, &e) == SY_OK &&
-        sy_cli_set_time(ld, clip, frame_time + sh->open, &e) == 0 && sy_context_motion_open(c, &native, &e) == SY_OK &&
-        native) {
+    bool native = false, camera_moves = false;
+    sy_camera_view v_close, v_open; /* the camera is not interpolated: it must stay put */
+    memset(&v_close, 0, sizeof v_close);
+    memset(&v_open, 0, sizeof v_open);
+    if (sy_cli_set_time(ld, clip, frame_time + sh->close, &e) == 0 &&
+        sy_compose_camera_view(ld->scene, spec, w, h, &v_close, &e) == SY_OK &&
+        sy_context_motion_begin(c, sh->samples, &e) == SY_OK &&
+        sy_cli_set_time(ld, clip, frame_time + sh->open, &e) == 0 &&
+        sy_compose_camera_view(ld->scene, spec, w, h, &v_open, &e) == SY_OK &&
+        !(camera_moves = memcmp(&v_close, &v_open, sizeof v_open) != 0) &&
+        sy_context_motion_open(c, &native, &e) == SY_OK && native) {
         *ctx_out = c;
         return true;
     }
     sy_context_motion_end(c);
     sy_context_restart(c);
     sy_log(SY_LOG_NOTE, "sy", NULL, "motion blur: %s; blurring by sub-frames instead",
-           e.message[0] ? e.message : "the scene deforms meshes or moves lights over the shutter, which the back-end "
-                                      "does not interpolate");
+           e.message[0]  ? e.message
+           : camera_moves ? "the camera moves over the shutter, which the back-end does not interpolate"
+                          : "the scene deforms meshes or moves lights over the shutter, which the back-end does not "
+                            "interpolate");
     return false;
 }
 
@@ -305,7 +315,7 @@ static sy_result render_blurred(loaded *ld, const char *clip, double frame_time,
     double t0 = sy_time_now();
     sy_context *mc = NULL;
     *native_out = false;
-    if (!sub_frames && motion_native_begin(ld, clip, frame_time, sh, spec, pool, &mc)) {
+    if (!sub_frames && motion_native_begin(ld, clip, frame_time, sh, spec, w, h, pool, &mc)) {
         char each[64];
         if (po) snprintf(each, sizeof each, "each pixel sample");
         else snprintf(each, sizeof each, "each of at least %u samples per pixel", sh->samples);

@@ -24,7 +24,7 @@
 # follow each sub-frame's seed), and the other back-ends' blurred alpha mean (covered
 # area) equals that sub-frame mean within 0.01 (the back-ends' edges differ by anti-aliasing only).
 # A blurred sequence frame equals the blurred --at render of its time, bit for bit. A mesh deformed
-# over the shutter makes the ray tracers fall back to sub-frames, with a note.
+# or a camera moved over the shutter makes the ray tracers fall back to sub-frames, with a note.
 # Usage errors (status 2, naming the option): a negative, NaN, infinite or non-numeric shutter, open
 # after close, --shutter with --motion-blur, --shutter-samples alone or 0, --sub-frames alone.
 # Usage: motion_blur_test.sh SY TMP EXR_EQUAL EXR_BLUR BACKEND...
@@ -173,6 +173,25 @@ for b in "$@"; do
     grep -qF "deforms meshes or moves lights over the shutter" "$TMP/${b}_deform.err" &&
         grep -qF "the mean of 4 sub-frames" "$TMP/${b}_deform.err" ||
         fail "$b: a deforming mesh: no note on the sub-frames it takes: $(cat "$TMP/${b}_deform.err")"
+done
+
+# nor is a camera that moves over the shutter (the Viewpoint's position interpolated)
+cat >"$TMP/camera.x3d" <<'EOF'
+<X3D><Scene><Viewpoint DEF='V' position='0 0 12' fieldOfView='0.5'/>
+<Shape><Appearance><Material diffuseColor='0.8 0.4 0.2'/></Appearance><Box size='2 2 2'/></Shape>
+<TimeSensor DEF='Clock' cycleInterval='1'/>
+<PositionInterpolator DEF='Move' key='0 1' keyValue='-1 0 12 1 0 12'/>
+<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Move' toField='set_fraction'/>
+<ROUTE fromNode='Move' fromField='value_changed' toNode='V' toField='position'/>
+</Scene></X3D>
+EOF
+for b in "$@"; do
+    [ "$b" = raster ] && continue
+    run_ok "$b moving camera" "${b}_camera" "$SY" render "$TMP/camera.x3d" -b "$b" -w 32 -h 32 --at 0.25 --shutter 0,0.5 \
+        --shutter-samples 4 -o "$TMP/${b}_camera.exr"
+    grep -qF "the camera moves over the shutter" "$TMP/${b}_camera.err" &&
+        grep -qF "the mean of 4 sub-frames" "$TMP/${b}_camera.err" ||
+        fail "$b: a moving camera: no note on the sub-frames it takes: $(cat "$TMP/${b}_camera.err")"
 done
 
 # a sequence: frame 6 at 24 fps with --motion-blur (0,1/48) equals --at 0.25 with the same shutter, bit
