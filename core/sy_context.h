@@ -55,7 +55,12 @@ void sy_context_restart(sy_context *c);
  * sy_context_motion_end and blur another way (sub-frames). Errors leave the motion ended.
  * Thread-safety: as sy_context_render. */
 sy_result sy_context_motion_begin(sy_context *c, uint32_t time_samples, sy_error *err);
+/** The second step of motion blur (see sy_context_motion_begin): syncs the scene committed at the
+ * shutter's open; *native says whether the back-end interpolates every change. Thread-safety: as
+ * sy_context_render. */
 sy_result sy_context_motion_open(sy_context *c, bool *native, sy_error *err);
+/** Ends motion blur (see sy_context_motion_begin): the context renders sharp again. Thread-safety:
+ * as sy_context_render. */
 void sy_context_motion_end(sy_context *c);
 /** Fills out with the mediator's statistics. */
 void sy_context_stats(const sy_context *c, sy_mediator_stats *out);
