@@ -108,6 +108,20 @@ void *sy_rt_pool_remove(sy_rt_pool *p, uint32_t id)
     return item;
 }
 
+void *sy_rt_pool_find(const sy_rt_device *dev, const sy_rt_pool *p, uint32_t id, const char *what)
+{
+    void *item = sy_rt_pool_get(p, id);
+    if (!item) sy_rt_fail(dev, SY_RT_ERROR_INVALID_HANDLE, "%s: stale handle 0x%08x", what, id);
+    return item;
+}
+
+void *sy_rt_pool_take(const sy_rt_device *dev, sy_rt_pool *p, uint32_t id, const char *what)
+{
+    void *item = sy_rt_pool_remove(p, id);
+    if (!item) sy_rt_fail(dev, SY_RT_ERROR_INVALID_HANDLE, "%s: stale handle 0x%08x", what, id);
+    return item;
+}
+
 void sy_rt_pool_free(sy_rt_pool *p)
 {
     free(p->items);

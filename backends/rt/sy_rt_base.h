@@ -42,6 +42,11 @@ static inline void *sy_rt_pool_get(const sy_rt_pool *p, uint32_t id)
 /* Frees the slot of a valid id (bumps its generation) and returns its object (NULL if invalid). */
 void *sy_rt_pool_remove(sy_rt_pool *p, uint32_t id);
 void sy_rt_pool_free(sy_rt_pool *p);
+/* The calls' side of a pool (dev's error report, "WHAT: ..." messages): sy_rt_pool_find returns
+ * the object for id, sy_rt_pool_take removes and returns it; both report SY_RT_ERROR_INVALID_HANDLE
+ * "WHAT: stale handle 0x..." and return NULL for a zero, stale or foreign id. */
+void *sy_rt_pool_find(const sy_rt_device *dev, const sy_rt_pool *p, uint32_t id, const char *what);
+void *sy_rt_pool_take(const sy_rt_device *dev, sy_rt_pool *p, uint32_t id, const char *what);
 
 /* >>errors */
 

@@ -14,6 +14,15 @@
 
 #define FAIL(r, ...) sy_rt_fail(dev, (r), __VA_ARGS__)
 
+/* Stores a new object (from malloc) in pool, *id its handle; when the pool is full or out of
+ * memory, frees it and reports "WHAT: pool full or out of memory". */
+static sy_rt_result pool_add(sy_rt_device *dev, sy_rt_pool *pool, void *item, uint32_t *id, const char *what)
+{
+    if (sy_rt_pool_insert(pool, item, id)) return SY_RT_OK;
+    free(item);
+    return FAIL(SY_RT_ERROR_LIMIT, "%s: pool full or out of memory", what);
+}
+
 /* >>mesh */
 
 /* Bytes this process could still allocate without swapping (MemAvailable of /proc/meminfo, else
@@ -294,8 +303,8 @@ static sy_rt_result mesh_blas(sy_rt_device *dev, sy_rt_mesh_data *m)
 sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh destroy: NULL device");
-    sy_rt_mesh_data *m = sy_rt_pool_remove(&dev->meshes, mesh.id);
-    if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "mesh destroy: stale handle 0x%08x", mesh.id);
+    sy_rt_mesh_data *m = sy_rt_pool_take(dev, &dev->meshes, mesh.id, "mesh destroy");
+    if (!m) return SY_RT_ERROR_INVALID_HANDLE;
     mesh_unref(dev, m); /* instances keep it alive until they go */
     dev->dirty = true;
     return SY_RT_OK;
@@ -409,10 +418,7 @@ sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc 
     sy_rt_material_data *m = calloc(1, sizeof *m);
     if (!m) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "material: out of memory");
     material_set(m, d);
-    if (!sy_rt_pool_insert(&dev->materials, m, &out->id)) {
-        free(m);
-        return FAIL(SY_RT_ERROR_LIMIT, "material: pool full or out of memory");
-    }
+    if ((r = pool_add(dev, &dev->materials, m, &out->id, "material")) != SY_RT_OK) return r;
     dev->dirty = dev->shadow_dirty = true;
     return SY_RT_OK;
 }
@@ -420,8 +426,8 @@ sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc 
 sy_rt_result sy_rt_material_update(sy_rt_device *dev, sy_rt_material mat, const sy_rt_material_desc *d)
 {
     if (!dev || !d) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material update: NULL argument");
-    sy_rt_material_data *m = sy_rt_pool_get(&dev->materials, mat.id);
-    if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "material update: stale handle 0x%08x", mat.id);
+    sy_rt_material_data *m = sy_rt_pool_find(dev, &dev->materials, mat.id, "material update");
+    if (!m) return SY_RT_ERROR_INVALID_HANDLE;
     sy_rt_result r = validate_material(dev, d);
     if (r != SY_RT_OK) return r;
     bool was_emissive = m->emissive, was_masked = m->masked;
@@ -437,8 +443,8 @@ sy_rt_result sy_rt_material_update(sy_rt_device *dev, sy_rt_material mat, const 
 sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material destroy: NULL device");
-    sy_rt_material_data *m = sy_rt_pool_remove(&dev->materials, mat.id);
-    if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "material destroy: stale handle 0x%08x", mat.id);
+    sy_rt_material_data *m = sy_rt_pool_take(dev, &dev->materials, mat.id, "material destroy");
+    if (!m) return SY_RT_ERROR_INVALID_HANDLE;
     /* Instances using it fall back to the default material, which is neither emissive nor masked. */
     if (m->emissive) dev->area_dirty = true;
     if (m->masked) dev->filters_dirty = true;
@@ -887,8 +893,8 @@ sy_rt_result sy_rt_settle(sy_rt_device *dev)
 sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst, const float transform[16])
 {
     if (!dev || !transform) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_transform: NULL argument");
-    sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
-    if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_transform: stale handle 0x%08x", inst.id);
+    sy_rt_instance_data *in = sy_rt_pool_find(dev, &dev->instances, inst.id, "instance set_transform");
+    if (!in) return SY_RT_ERROR_INVALID_HANDLE;
     float nrm[9];
     double gain;
     sy_rt_result r = normal_matrix(dev, transform, nrm, &gain);
@@ -909,8 +915,8 @@ sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst
 sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst, sy_rt_material material)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_material: NULL device");
-    sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
-    if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_material: stale handle 0x%08x", inst.id);
+    sy_rt_instance_data *in = sy_rt_pool_find(dev, &dev->instances, inst.id, "instance set_material");
+    if (!in) return SY_RT_ERROR_INVALID_HANDLE;
     if (material.id != 0 && !sy_rt_pool_get(&dev->materials, material.id))
         return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_material: material handle 0x%08x is stale", material.id);
     bool was_emissive = instance_emissive(dev, in), was_masked = instance_masked(dev, in);
@@ -924,8 +930,8 @@ sy_rt_result sy_rt_instance_set_material(sy_rt_device *dev, sy_rt_instance inst,
 sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, bool visible)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_visible: NULL device");
-    sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
-    if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_visible: stale handle 0x%08x", inst.id);
+    sy_rt_instance_data *in = sy_rt_pool_find(dev, &dev->instances, inst.id, "instance set_visible");
+    if (!in) return SY_RT_ERROR_INVALID_HANDLE;
     bool is_visible = !(in->flags & SY_RT_INSTANCE_HIDDEN);
     if (is_visible == visible) return SY_RT_OK;
     if (visible) {
@@ -944,8 +950,8 @@ sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, 
 sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance destroy: NULL device");
-    sy_rt_instance_data *in = sy_rt_pool_remove(&dev->instances, inst.id);
-    if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance destroy: stale handle 0x%08x", inst.id);
+    sy_rt_instance_data *in = sy_rt_pool_take(dev, &dev->instances, inst.id, "instance destroy");
+    if (!in) return SY_RT_ERROR_INVALID_HANDLE;
     if (instance_emissive(dev, in)) dev->area_dirty = true;
     if (instance_masked(dev, in)) dev->filters_dirty = true;
     instance_free(dev, in);
@@ -1044,10 +1050,7 @@ sy_rt_result sy_rt_light_create(sy_rt_device *dev, const sy_rt_light_desc *d, sy
     sy_rt_light_data *l = calloc(1, sizeof *l);
     if (!l) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "light: out of memory");
     l->desc = *d;
-    if (!sy_rt_pool_insert(&dev->lights, l, &out->id)) {
-        free(l);
-        return FAIL(SY_RT_ERROR_LIMIT, "light: pool full or out of memory");
-    }
+    if ((r = pool_add(dev, &dev->lights, l, &out->id, "light")) != SY_RT_OK) return r;
     dev->dirty = dev->punctual_dirty = true;
     return SY_RT_OK;
 }
@@ -1055,8 +1058,8 @@ sy_rt_result sy_rt_light_create(sy_rt_device *dev, const sy_rt_light_desc *d, sy
 sy_rt_result sy_rt_light_update(sy_rt_device *dev, sy_rt_light light, const sy_rt_light_desc *d)
 {
     if (!dev || !d) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light update: NULL argument");
-    sy_rt_light_data *l = sy_rt_pool_get(&dev->lights, light.id);
-    if (!l) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "light update: stale handle 0x%08x", light.id);
+    sy_rt_light_data *l = sy_rt_pool_find(dev, &dev->lights, light.id, "light update");
+    if (!l) return SY_RT_ERROR_INVALID_HANDLE;
     sy_rt_result r = validate_light(dev, d);
     if (r != SY_RT_OK) return r;
     l->desc = *d;
@@ -1067,8 +1070,8 @@ sy_rt_result sy_rt_light_update(sy_rt_device *dev, sy_rt_light light, const sy_r
 sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light destroy: NULL device");
-    sy_rt_light_data *l = sy_rt_pool_remove(&dev->lights, light.id);
-    if (!l) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "light destroy: stale handle 0x%08x", light.id);
+    sy_rt_light_data *l = sy_rt_pool_take(dev, &dev->lights, light.id, "light destroy");
+    if (!l) return SY_RT_ERROR_INVALID_HANDLE;
     free(l);
     dev->dirty = dev->punctual_dirty = true;
     return SY_RT_OK;

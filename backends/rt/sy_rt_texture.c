@@ -51,8 +51,8 @@ sy_rt_result sy_rt_texture_create(sy_rt_device *dev, const sy_rt_texture_desc *d
 sy_rt_result sy_rt_texture_destroy(sy_rt_device *dev, sy_rt_texture tex)
 {
     if (!dev) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "texture destroy: NULL device");
-    sy_rt_texture_data *t = sy_rt_pool_remove(&dev->textures, tex.id);
-    if (!t) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_HANDLE, "texture destroy: stale handle 0x%08x", tex.id);
+    sy_rt_texture_data *t = sy_rt_pool_take(dev, &dev->textures, tex.id, "texture destroy");
+    if (!t) return SY_RT_ERROR_INVALID_HANDLE;
     sy_rt_texture_free(t);
     /* Emissive textures shape the area lights only at sample time, so no rebuild is needed. */
     dev->dirty = true;
