@@ -6,6 +6,7 @@
 #include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <time.h>
 
 const char *sy_filter_status_name(sy_filter_status s)
 {
@@ -52,6 +53,21 @@ sy_filter_status sy_filter_check_range(float v, float lo, float hi, const char *
         return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "%s = %g: must lie in [%g, %g]", what,
                               (double)v, (double)lo, (double)hi);
     return SY_FILTER_OK;
+}
+
+sy_filter_status sy_filter_check_threads(uint32_t threads, const char *filter, sy_filter_report *err)
+{
+    if (threads > SY_FILTER_MAX_THREADS)
+        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "%s: threads = %u: at most %u", filter, threads,
+                              SY_FILTER_MAX_THREADS);
+    return SY_FILTER_OK;
+}
+
+double sy_filter_clock(bool cpu)
+{
+    struct timespec ts;
+    clock_gettime(cpu ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 sy_filter_status sy_filter_check_frame(const sy_filter_frame *f, uint32_t need, const char *filter,

@@ -115,6 +115,12 @@ sy_filter_status sy_filter_check_positive(float v, const char *what, sy_filter_r
 sy_filter_status sy_filter_check_nonnegative(float v, const char *what, sy_filter_report *err);
 /** Fails unless v is finite and within [lo, hi]. */
 sy_filter_status sy_filter_check_range(float v, float lo, float hi, const char *what, sy_filter_report *err);
+/** Fails unless threads (a parameter set's thread count; 0 = OpenMP's default) is at most
+ * SY_FILTER_MAX_THREADS; `filter` names the filter in the message. */
+sy_filter_status sy_filter_check_threads(uint32_t threads, const char *filter, sy_filter_report *err);
+/** Seconds on the monotonic clock (CLOCK_MONOTONIC, or CLOCK_PROCESS_CPUTIME_ID when cpu): a filter's
+ * sy_filter_stats.seconds is the difference of two readings. */
+double sy_filter_clock(bool cpu);
 /** Image size and the buffers flagged in `need` (SY_FILTER_NEED_*) present; channel counts valid. */
 enum {
     SY_FILTER_NEED_COLOR = 1u << 0,

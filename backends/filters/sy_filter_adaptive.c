@@ -5,7 +5,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #define MAX_LEVELS 13
 
@@ -25,10 +24,7 @@ sy_filter_status sy_filter_adaptive_params_check(const sy_filter_adaptive_params
     if (p->max_level > MAX_LEVELS - 1)
         return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "adaptive preview: max_level = %u: at most %d",
                               p->max_level, MAX_LEVELS - 1);
-    if (p->threads > SY_FILTER_MAX_THREADS)
-        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "adaptive preview: threads = %u: at most %u",
-                              p->threads, SY_FILTER_MAX_THREADS);
-    return SY_FILTER_OK;
+    return sy_filter_check_threads(p->threads, "adaptive preview", err);
 }
 
 /* texel: sum n*c (3), sum n, sum n^2 var (of the mean) */
@@ -138,8 +134,7 @@ static void out_rows(void *vctx, uint32_t y0, uint32_t y1)
 sy_filter_status sy_filter_adaptive(const sy_filter_adaptive_params *p, const sy_filter_frame *in, float *out,
                                     float *level_out, sy_filter_stats *stats, sy_filter_report *err)
 {
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    double t0 = sy_filter_clock(false);
     sy_filter_adaptive_params d;
     if (!p) sy_filter_adaptive_params_default(&d), p = &d;
     sy_filter_status s = sy_filter_adaptive_params_check(p, err);
@@ -201,9 +196,8 @@ sy_filter_status sy_filter_adaptive(const sy_filter_adaptive_params *p, const sy
     free(ok);
     for (uint32_t l = 0; l < nlev; ++l) free(lv[l].t);
     if (stats && s == SY_FILTER_OK) {
-        clock_gettime(CLOCK_MONOTONIC, &t1);
         *stats = (sy_filter_stats){.nonfinite_samples = bad, .filtered_pixels = n, .filter_pass = true,
-                                   .seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec)};
+                                   .seconds = sy_filter_clock(false) - t0};
     }
     return s;
 }

@@ -5,7 +5,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 void sy_filter_atrous_params_default(sy_filter_atrous_params *p)
 {
@@ -27,10 +26,7 @@ sy_filter_status sy_filter_atrous_params_check(const sy_filter_atrous_params *p,
     if ((s = sy_filter_check_positive(p->sigma_normal, "a-trous: sigma_normal", err))) return s;
     if ((s = sy_filter_check_positive(p->sigma_position, "a-trous: sigma_position", err))) return s;
     if ((s = sy_filter_check_nonnegative(p->sigma_range, "a-trous: sigma_range", err))) return s;
-    if (p->threads > SY_FILTER_MAX_THREADS)
-        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "a-trous: threads = %u: at most %u", p->threads,
-                              SY_FILTER_MAX_THREADS);
-    return SY_FILTER_OK;
+    return sy_filter_check_threads(p->threads, "a-trous", err);
 }
 
 typedef struct actx {
@@ -103,8 +99,7 @@ static void atrous_rows(void *vctx, uint32_t y0, uint32_t y1)
 sy_filter_status sy_filter_atrous(const sy_filter_atrous_params *p, const sy_filter_frame *in, float *out,
                                   sy_filter_stats *stats, sy_filter_report *err)
 {
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    double t0 = sy_filter_clock(false);
     sy_filter_atrous_params d;
     if (!p) sy_filter_atrous_params_default(&d), p = &d;
     sy_filter_status s = sy_filter_atrous_params_check(p, err);
@@ -158,10 +153,9 @@ sy_filter_status sy_filter_atrous(const sy_filter_atrous_params *p, const sy_fil
         }
     free(ok), free(a), free(b), free(mod);
     if (stats && s == SY_FILTER_OK) {
-        clock_gettime(CLOCK_MONOTONIC, &t1);
         *stats = (sy_filter_stats){.nonfinite_samples = bad, .filtered_pixels = n, .filter_pass = true,
                                    .mean_blend = 0.0,
-                                   .seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec)};
+                                   .seconds = sy_filter_clock(false) - t0};
     }
     return s;
 }

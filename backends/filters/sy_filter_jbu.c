@@ -3,7 +3,6 @@
 
 #include <math.h>
 #include <stdlib.h>
-#include <time.h>
 
 #define MISS_DEPTH 1e20f
 
@@ -24,10 +23,7 @@ sy_filter_status sy_filter_jbu_params_check(const sy_filter_jbu_params *p, sy_fi
     if ((s = sy_filter_check_positive(p->sigma_spatial, "jbu: sigma_spatial", err))) return s;
     if ((s = sy_filter_check_positive(p->sigma_depth, "jbu: sigma_depth", err))) return s;
     if ((s = sy_filter_check_positive(p->sigma_normal, "jbu: sigma_normal", err))) return s;
-    if (p->threads > SY_FILTER_MAX_THREADS)
-        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "jbu: threads = %u: at most %u", p->threads,
-                              SY_FILTER_MAX_THREADS);
-    return SY_FILTER_OK;
+    return sy_filter_check_threads(p->threads, "jbu", err);
 }
 
 static float clamp_depth(float d) { return isnan(d) ? MISS_DEPTH : d < MISS_DEPTH ? d : MISS_DEPTH; }
@@ -122,8 +118,7 @@ sy_filter_status sy_filter_jbu_upsample(const sy_filter_jbu_params *p, const flo
 sy_filter_status sy_filter_jbu(const sy_filter_jbu_params *p, const sy_filter_frame *in, float *out,
                                sy_filter_stats *stats, sy_filter_report *err)
 {
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    double t0 = sy_filter_clock(false);
     sy_filter_jbu_params d;
     if (!p) sy_filter_jbu_params_default(&d), p = &d;
     sy_filter_status s = sy_filter_jbu_params_check(p, err);
@@ -188,9 +183,8 @@ sy_filter_status sy_filter_jbu(const sy_filter_jbu_params *p, const sy_filter_fr
         }
     free(ok), free(hv), free(up), free(low), free(ld), free(lnrm);
     if (stats && s == SY_FILTER_OK) {
-        clock_gettime(CLOCK_MONOTONIC, &t1);
         *stats = (sy_filter_stats){.nonfinite_samples = bad, .filtered_pixels = n, .filter_pass = true,
-                                   .seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec)};
+                                   .seconds = sy_filter_clock(false) - t0};
     }
     return s;
 }

@@ -8,7 +8,6 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #define MAX_TAPS 511 /* separable pass window (2R+1), R <= 255 */
 #define MISS_DEPTH 1e18f /* squared differences stay finite in float */
@@ -43,13 +42,6 @@ struct sy_filter_pixel {
     float expt[EXP_TABLE + 2]; /* exp(-x) at x = i / EXP_SCALE: the separable pass's weights */
 };
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 void sy_filter_pixel_params_default(sy_filter_pixel_params *p)
 {
     *p = (sy_filter_pixel_params){
@@ -82,10 +74,7 @@ sy_filter_status sy_filter_pixel_params_check(const sy_filter_pixel_params *p, s
     if ((s = sy_filter_check_nonnegative(p->adaptive_sigma0, "pixel filter: adaptive_sigma0", err))) return s;
     if ((s = sy_filter_check_range(p->spike_c, 1.0f, 1e6f, "pixel filter: spike_c", err))) return s;
     if ((s = sy_filter_check_range(p->headlight_weight, 0.0f, 1.0f, "pixel filter: headlight_weight", err))) return s;
-    if (p->threads > SY_FILTER_MAX_THREADS)
-        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "pixel filter: threads = %u: at most %u",
-                              p->threads, SY_FILTER_MAX_THREADS);
-    return SY_FILTER_OK;
+    return sy_filter_check_threads(p->threads, "pixel filter", err);
 }
 
 bool sy_filter_pixel_scheduled(const sy_filter_pixel_params *p, uint32_t frame)
@@ -925,7 +914,7 @@ static void blend_rows(void *vctx, uint32_t y0, uint32_t y1)
 sy_filter_status sy_filter_pixel_run(sy_filter_pixel *pf, const sy_filter_frame *in, uint32_t frame, bool force_pass,
                                      float *out, sy_filter_stats *stats, sy_filter_report *err)
 {
-    double t0 = now_s();
+    double t0 = sy_filter_clock(false);
     if (!pf) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "pixel filter: object is NULL");
     if (!out) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "pixel filter: output is NULL");
     uint32_t need = SY_FILTER_NEED_COLOR | SY_FILTER_NEED_VARIANCE;
@@ -954,7 +943,7 @@ sy_filter_status sy_filter_pixel_run(sy_filter_pixel *pf, const sy_filter_frame 
         stats->filtered_pixels = pf->have_pass ? n : 0;
         stats->filter_pass = pass;
         stats->mean_blend = pf->have_pass ? ssum / (double)n : 1.0;
-        stats->seconds = now_s() - t0;
+        stats->seconds = sy_filter_clock(false) - t0;
     }
     return SY_FILTER_OK;
 }

@@ -6,7 +6,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #define PI_F 3.14159265358979f
 
@@ -59,10 +58,7 @@ sy_filter_status sy_filter_radiance_params_check(const sy_filter_radiance_params
     if ((s = sy_filter_check_positive(p->grazing_epsilon, "radiance filter: grazing_epsilon", err))) return s;
     if ((s = sy_filter_check_nonnegative(p->glossy_limit, "radiance filter: glossy_limit", err))) return s;
     if ((s = sy_filter_check_nonnegative(p->specular_limit, "radiance filter: specular_limit", err))) return s;
-    if (p->threads > SY_FILTER_MAX_THREADS)
-        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: threads = %u: at most %u",
-                              p->threads, SY_FILTER_MAX_THREADS);
-    return SY_FILTER_OK;
+    return sy_filter_check_threads(p->threads, "radiance filter", err);
 }
 
 static inline float dot3(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -487,8 +483,7 @@ sy_filter_status sy_filter_radiance_seed(sy_filter_radiance *rf, uint32_t width,
 sy_filter_status sy_filter_radiance_frame(sy_filter_radiance *rf, const sy_filter_radiance_input *in, float *out,
                                           sy_filter_stats *stats, sy_filter_report *err)
 {
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    double t0 = sy_filter_clock(false);
     if (!rf || !in || !out) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: NULL argument");
     if (in->width == 0 || in->height == 0 || in->width > SY_FILTER_MAX_SIDE || in->height > SY_FILTER_MAX_SIDE)
         return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "radiance filter: image size %ux%u outside 1..%u",
@@ -530,10 +525,9 @@ sy_filter_status sy_filter_radiance_frame(sy_filter_radiance *rf, const sy_filte
         corr += rf->phase[i];
     }
     if (stats) {
-        clock_gettime(CLOCK_MONOTONIC, &t1);
         *stats = (sy_filter_stats){.nonfinite_samples = bad, .filtered_pixels = n - corr, .filter_pass = true,
                                    .mean_blend = (double)corr / (double)n,
-                                   .seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec)};
+                                   .seconds = sy_filter_clock(false) - t0};
     }
     return SY_FILTER_OK;
 }

@@ -17,7 +17,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 /* the helpers of the row loops inline into every clone of them (GCC's early inliner leaves a "cold"
  * call otherwise, and the loop does not vectorise) */
@@ -161,10 +160,7 @@ sy_filter_status sy_filter_temporal_params_check(const sy_filter_temporal_params
     if (p->rest_samples > 1u << 20)
         return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "temporal: rest_samples = %u: at most %u",
                               p->rest_samples, 1u << 20);
-    if (p->threads > SY_FILTER_MAX_THREADS)
-        return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "temporal: threads = %u: at most %u", p->threads,
-                              SY_FILTER_MAX_THREADS);
-    return SY_FILTER_OK;
+    return sy_filter_check_threads(p->threads, "temporal", err);
 }
 
 static void hist_free(hist *h)
@@ -854,9 +850,8 @@ static void remod_rows(void *vc, uint32_t y0, uint32_t y1)
 sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_frame *in, const float world_to_pixel[16],
                                         float *out, sy_filter_temporal_stats *stats, sy_filter_report *err)
 {
-    struct timespec t0, t1, c0, c1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+    double t0 = sy_filter_clock(false);
+    double c0 = sy_filter_clock(true);
     if (!t) return sy_filter_fail(err, SY_FILTER_ERROR_INVALID_ARGUMENT, "temporal: state is NULL");
     uint32_t need = SY_FILTER_NEED_COLOR | SY_FILTER_NEED_ALBEDO | SY_FILTER_NEED_NORMAL | SY_FILTER_NEED_DEPTH |
                     SY_FILTER_NEED_POSITION;
@@ -939,10 +934,8 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
             else st.disoccluded++;
         }
         st.mean_history = hits ? hsum / (double)hits : 0.0;
-        clock_gettime(CLOCK_MONOTONIC, &t1);
-        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
-        st.cpu_seconds = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
-        st.seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+        st.cpu_seconds = sy_filter_clock(true) - c0;
+        st.seconds = sy_filter_clock(false) - t0;
         *stats = st;
     }
     return SY_FILTER_OK;
