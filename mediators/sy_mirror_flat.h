@@ -147,6 +147,59 @@ typedef struct sy_mirror_flat_light {
                        SY_MIRROR_FLAT_DIRECTIONAL == (int)PREFIX##_LIGHT_DIRECTIONAL,                          \
                    #PREFIX " numbers texel formats and light types like sy_mirror_flat.h")
 
+/** The material fields both back-ends' descriptions (sy_rt_material_desc, sy_gl_material_desc)
+ * name and type like sy_mirror_flat_material and take unchanged, as tables: X(field, ...) for each,
+ * the rest of the arguments passed on. The fields a mediator maps (clamps, scales) or only one
+ * back-end has are not listed. This table: the plain values (copied by assignment). */
+#define SY_MIRROR_FLAT_MATERIAL_VALUES(X, ...)                                                                 \
+    X(normal_scale, __VA_ARGS__) X(ior, __VA_ARGS__) X(double_sided, __VA_ARGS__) X(unlit, __VA_ARGS__)        \
+    X(clearcoat, __VA_ARGS__) X(clearcoat_roughness, __VA_ARGS__) X(clearcoat_normal_scale, __VA_ARGS__)       \
+    X(sheen_roughness, __VA_ARGS__) X(thickness, __VA_ARGS__) X(attenuation_distance, __VA_ARGS__)             \
+    X(iridescence, __VA_ARGS__) X(iridescence_ior, __VA_ARGS__) X(anisotropy, __VA_ARGS__)                     \
+    X(anisotropy_rotation, __VA_ARGS__)
+/** The arrays among them (copied with memcpy; the lengths are checked to be the same). */
+#define SY_MIRROR_FLAT_MATERIAL_ARRAYS(X, ...)                                                                 \
+    X(specular_color, __VA_ARGS__) X(attenuation_color, __VA_ARGS__) X(sheen_color, __VA_ARGS__)               \
+    X(iridescence_thickness, __VA_ARGS__)
+/** The texture references among them (copied through the mediator's texture-reference copy). */
+#define SY_MIRROR_FLAT_MATERIAL_TEXTURES(X, ...)                                                               \
+    X(base_color_texture, __VA_ARGS__) X(metallic_roughness_texture, __VA_ARGS__)                              \
+    X(emissive_texture, __VA_ARGS__) X(normal_texture, __VA_ARGS__) X(specular_texture, __VA_ARGS__)           \
+    X(specular_color_texture, __VA_ARGS__) X(transmission_texture, __VA_ARGS__)                                \
+    X(clearcoat_texture, __VA_ARGS__) X(clearcoat_roughness_texture, __VA_ARGS__)                              \
+    X(clearcoat_normal_texture, __VA_ARGS__) X(sheen_color_texture, __VA_ARGS__)                               \
+    X(sheen_roughness_texture, __VA_ARGS__) X(iridescence_texture, __VA_ARGS__)                                \
+    X(iridescence_thickness_texture, __VA_ARGS__) X(anisotropy_texture, __VA_ARGS__)
+/** Copies the listed fields of the flat material m (a pointer) into the back-end description d (a
+ * pointer), the texture references through TEXREF (a function of const sy_mirror_flat_texture_ref *);
+ * needs <string.h>. */
+#define SY_MIRROR_FLAT_MATERIAL_COPY(d, m, TEXREF)                                                            \
+    do {                                                                                                       \
+        SY_MIRROR_FLAT_MATERIAL_VALUES(SY_MIRROR_FLAT_COPY_VALUE_, d, m, TEXREF)                              \
+        SY_MIRROR_FLAT_MATERIAL_ARRAYS(SY_MIRROR_FLAT_COPY_ARRAY_, d, m, TEXREF)                              \
+        SY_MIRROR_FLAT_MATERIAL_TEXTURES(SY_MIRROR_FLAT_COPY_TEXTURE_, d, m, TEXREF)                          \
+    } while (0)
+/** SY_MIRROR_FLAT_MATERIAL_COPY's step for one value. */
+#define SY_MIRROR_FLAT_COPY_VALUE_(f, d, m, TEXREF) (d)->f = (m)->f;
+/** SY_MIRROR_FLAT_MATERIAL_COPY's step for one array. */
+#define SY_MIRROR_FLAT_COPY_ARRAY_(f, d, m, TEXREF)                                                            \
+    _Static_assert(sizeof (d)->f == sizeof (m)->f, #f " has the flat material's length");                     \
+    memcpy((d)->f, (m)->f, sizeof (d)->f);
+/** SY_MIRROR_FLAT_MATERIAL_COPY's step for one texture reference. */
+#define SY_MIRROR_FLAT_COPY_TEXTURE_(f, d, m, TEXREF) (d)->f = TEXREF(&(m)->f);
+
+/** Defines `static TYPE NAME(const sy_mirror_flat_texture_ref *r)`: the back-end's texture reference
+ * (TYPE: sy_rt_texture_ref, sy_gl_texture_ref; laid out as {handle, texcoord, transformed,
+ * transform[6]}) of a flat one. */
+#define SY_MIRROR_FLAT_TEXREF_FN(NAME, TYPE)                                                                  \
+    static TYPE NAME(const sy_mirror_flat_texture_ref *r)                                                     \
+    {                                                                                                          \
+        TYPE o = {{r->handle}, r->texcoord, r->transformed, {0}};                                              \
+        _Static_assert(sizeof o.transform == sizeof r->transform, #TYPE " has the flat transform's length");    \
+        memcpy(o.transform, r->transform, sizeof o.transform);                                                 \
+        return o;                                                                                              \
+    }
+
 /** Describes a texture whose pixels match info. */
 void sy_mirror_flat_texture_of(const sy_image_info *info, const sy_sampler *sampler, const void *pixels,
                                sy_mirror_flat_texture *out);

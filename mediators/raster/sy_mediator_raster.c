@@ -107,12 +107,7 @@ static void gl_error(void *user, sy_gl_result code, const char *message)
  * enumerations are numbered like the device's, so a cast translates */
 SY_MIRROR_FLAT_SAME_NUMBERS(SY_GL);
 
-static sy_gl_texture_ref texref(const sy_mirror_flat_texture_ref *r)
-{
-    sy_gl_texture_ref o = {{r->handle}, r->texcoord, r->transformed, {0}};
-    memcpy(o.transform, r->transform, sizeof o.transform);
-    return o;
-}
+SY_MIRROR_FLAT_TEXREF_FN(texref, sy_gl_texture_ref)
 
 static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_error *err)
 {
@@ -120,50 +115,18 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     const sy_mirror_flat_material *m = a->flat;
     sy_gl_material_desc d;
     sy_gl_material_desc_init(&d);
+    SY_MIRROR_FLAT_MATERIAL_COPY(&d, m, texref);
     memcpy(d.base_color, m->base_color, sizeof d.base_color);
-    d.base_color_texture = texref(&m->base_color_texture);
     d.metallic = m->metallic;
     d.roughness = m->roughness;
-    d.metallic_roughness_texture = texref(&m->metallic_roughness_texture);
     memcpy(d.emissive, m->emissive, sizeof d.emissive);
-    d.emissive_texture = texref(&m->emissive_texture);
-    d.normal_texture = texref(&m->normal_texture);
-    d.normal_scale = m->normal_scale;
     d.occlusion_texture = texref(&m->occlusion_texture);
     d.occlusion_strength = m->occlusion_strength;
     d.transmission = m->transmission;
-    d.ior = m->ior;
     d.alpha_mode = (sy_gl_alpha_mode)m->alpha_mode;
     d.alpha_cutoff = m->alpha_cutoff;
-    d.double_sided = m->double_sided;
-    d.unlit = m->unlit;
     d.specular = m->specular; /* the extensions (docs/BACKENDS.md, "Material extensions") */
-    memcpy(d.specular_color, m->specular_color, sizeof d.specular_color);
-    d.clearcoat = m->clearcoat;
-    d.clearcoat_roughness = m->clearcoat_roughness;
-    memcpy(d.sheen_color, m->sheen_color, sizeof d.sheen_color);
-    d.sheen_roughness = m->sheen_roughness;
-    d.thickness = m->thickness;
-    d.attenuation_distance = m->attenuation_distance;
-    memcpy(d.attenuation_color, m->attenuation_color, sizeof d.attenuation_color);
-    d.specular_texture = texref(&m->specular_texture);
-    d.specular_color_texture = texref(&m->specular_color_texture);
-    d.clearcoat_texture = texref(&m->clearcoat_texture);
-    d.clearcoat_roughness_texture = texref(&m->clearcoat_roughness_texture);
-    d.clearcoat_normal_texture = texref(&m->clearcoat_normal_texture);
-    d.clearcoat_normal_scale = m->clearcoat_normal_scale;
-    d.sheen_color_texture = texref(&m->sheen_color_texture);
-    d.sheen_roughness_texture = texref(&m->sheen_roughness_texture);
     d.thickness_texture = texref(&m->thickness_texture);
-    d.anisotropy = m->anisotropy;
-    d.anisotropy_rotation = m->anisotropy_rotation;
-    d.anisotropy_texture = texref(&m->anisotropy_texture);
-    d.iridescence = m->iridescence;
-    d.iridescence_ior = m->iridescence_ior;
-    memcpy(d.iridescence_thickness, m->iridescence_thickness, sizeof d.iridescence_thickness);
-    d.iridescence_texture = texref(&m->iridescence_texture);
-    d.iridescence_thickness_texture = texref(&m->iridescence_thickness_texture);
-    d.transmission_texture = texref(&m->transmission_texture);
     sy_gl_material h = {*a->handle};
     sy_gl_result r = h.id ? sy_gl_material_update(st->dev, h, &d)
                           : sy_gl_material_create(st->dev, &d, &h);

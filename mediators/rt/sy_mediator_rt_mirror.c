@@ -81,12 +81,7 @@ static float clamp_warn(rt_state *st, const char *kind, uint32_t id, const char 
 /* the flat enumerations are numbered like the back-end's (sy_mirror_flat.h): a cast translates */
 SY_MIRROR_FLAT_SAME_NUMBERS(SY_RT);
 
-static sy_rt_texture_ref texref(const sy_mirror_flat_texture_ref *r)
-{
-    sy_rt_texture_ref o = {{r->handle}, r->texcoord, r->transformed, {0}};
-    memcpy(o.transform, r->transform, sizeof o.transform);
-    return o;
-}
+SY_MIRROR_FLAT_TEXREF_FN(texref, sy_rt_texture_ref)
 
 static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_error *err)
 {
@@ -94,54 +89,19 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
     const sy_mirror_flat_material *m = a->flat;
     sy_rt_material_desc d;
     sy_rt_material_desc_init(&d);
+    SY_MIRROR_FLAT_MATERIAL_COPY(&d, m, texref);
     static const char *const bc[4] = {"base_color[0]", "base_color[1]", "base_color[2]", "base_color[3] (alpha)"};
     for (int i = 0; i < 4; ++i) d.base_color[i] = clamp_warn(st, "material", a->id, bc[i], m->base_color[i], 0.0f, i == 3 ? 1.0f : INFINITY);
-    d.base_color_texture = texref(&m->base_color_texture);
     d.metallic = clamp_warn(st, "material", a->id, "metallic", m->metallic, 0.0f, 1.0f);
     d.roughness = clamp_warn(st, "material", a->id, "roughness", m->roughness, 0.0f, 1.0f);
-    d.metallic_roughness_texture = texref(&m->metallic_roughness_texture);
     for (int i = 0; i < 3; ++i) {
         float v = m->emissive[i];
         d.emissive[i] = isfinite(v) && v >= 0.0f ? v : clamp_warn(st, "material", a->id, "emission", v, 0.0f, 3.0e38f);
     }
-    d.emissive_texture = texref(&m->emissive_texture);
-    d.normal_texture = texref(&m->normal_texture);
-    d.normal_scale = m->normal_scale;
     d.transmission = clamp_warn(st, "material", a->id, "transmission", m->transmission, 0.0f, 1.0f);
-    d.ior = m->ior;
     d.specular = st->specular * m->specular; /* the mediator's "specular" parameter scales every material's */
-    d.specular_texture = texref(&m->specular_texture);
-    for (int i = 0; i < 3; ++i) {
-        d.specular_color[i] = m->specular_color[i];
-        d.attenuation_color[i] = m->attenuation_color[i];
-    }
-    d.specular_color_texture = texref(&m->specular_color_texture);
-    d.transmission_texture = texref(&m->transmission_texture);
-    d.thickness = m->thickness;
-    d.clearcoat = m->clearcoat;
-    d.clearcoat_texture = texref(&m->clearcoat_texture);
-    d.clearcoat_roughness = m->clearcoat_roughness;
-    d.clearcoat_roughness_texture = texref(&m->clearcoat_roughness_texture);
-    d.clearcoat_normal_texture = texref(&m->clearcoat_normal_texture);
-    d.clearcoat_normal_scale = m->clearcoat_normal_scale;
-    d.attenuation_distance = m->attenuation_distance;
-    for (int i = 0; i < 3; ++i) d.sheen_color[i] = m->sheen_color[i];
-    d.sheen_color_texture = texref(&m->sheen_color_texture);
-    d.sheen_roughness = m->sheen_roughness;
-    d.sheen_roughness_texture = texref(&m->sheen_roughness_texture);
-    d.iridescence = m->iridescence;
-    d.iridescence_texture = texref(&m->iridescence_texture);
-    d.iridescence_ior = m->iridescence_ior;
-    d.iridescence_thickness[0] = m->iridescence_thickness[0];
-    d.iridescence_thickness[1] = m->iridescence_thickness[1];
-    d.iridescence_thickness_texture = texref(&m->iridescence_thickness_texture);
-    d.anisotropy = m->anisotropy;
-    d.anisotropy_rotation = m->anisotropy_rotation;
-    d.anisotropy_texture = texref(&m->anisotropy_texture);
     d.alpha_mode = (sy_rt_alpha_mode)m->alpha_mode;
     d.alpha_cutoff = clamp_warn(st, "material", a->id, "alpha_cutoff", m->alpha_cutoff, 0.0f, 1.0f);
-    d.double_sided = m->double_sided;
-    d.unlit = m->unlit;
     sy_rt_material h = {*a->handle};
     sy_rt_result r = h.id ? sy_rt_material_update(st->dev, h, &d)
                           : sy_rt_material_create(st->dev, &d, &h);
