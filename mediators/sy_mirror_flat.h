@@ -200,6 +200,23 @@ typedef struct sy_mirror_flat_light {
         return o;                                                                                              \
     }
 
+/** Copies the view v (const sy_camera_view *) into the back-end camera cam (sy_rt_camera *,
+ * sy_gl_camera *: camera_to_world, window, near_clip, far_clip, clip_count, clip_planes); PREFIX
+ * (SY_RT, SY_GL) names the back-end's section-plane bound, checked to be core's. The projection
+ * is the mediator's to set (the back-ends name it differently). Needs <string.h>. */
+#define SY_MIRROR_FLAT_VIEW_COPY(cam, v, PREFIX)                                                              \
+    do {                                                                                                       \
+        _Static_assert(PREFIX##_CLIP_PLANES_MAX == SY_CLIP_PLANES_MAX, "one section plane array");            \
+        memcpy((cam)->camera_to_world, (v)->camera_to_world.m, sizeof (cam)->camera_to_world);                \
+        memcpy((cam)->window, (v)->window, sizeof (cam)->window);                                             \
+        (cam)->near_clip = (v)->znear;                                                                         \
+        (cam)->far_clip = (v)->zfar;                                                                           \
+        (cam)->clip_count = (v)->clip_count < SY_CLIP_PLANES_MAX ? (v)->clip_count : SY_CLIP_PLANES_MAX;      \
+        memcpy((cam)->clip_planes, (v)->clip_planes, sizeof (cam)->clip_planes);                              \
+        (cam)->clip_cap = (v)->clip_count && (v)->clip_cap;                                                    \
+        memcpy((cam)->clip_cap_color, (v)->clip_cap_color, sizeof (cam)->clip_cap_color);                     \
+    } while (0)
+
 /** Describes a texture whose pixels match info. */
 void sy_mirror_flat_texture_of(const sy_image_info *info, const sy_sampler *sampler, const void *pixels,
                                sy_mirror_flat_texture *out);

@@ -337,16 +337,8 @@ static sy_result raster_sync(void *state, const sy_changes *changes, sy_error *e
 /* >>render */
 static void camera_of(const sy_camera_view *v, sy_gl_camera *cam)
 {
-    memcpy(cam->camera_to_world, v->camera_to_world.m, sizeof cam->camera_to_world);
+    SY_MIRROR_FLAT_VIEW_COPY(cam, v, SY_GL);
     cam->orthographic = v->projection == SY_PROJECTION_ORTHOGRAPHIC;
-    memcpy(cam->window, v->window, sizeof cam->window);
-    cam->near_clip = v->znear;
-    cam->far_clip = v->zfar;
-    _Static_assert(SY_GL_CLIP_PLANES_MAX == SY_CLIP_PLANES_MAX, "one section plane array");
-    cam->clip_count = v->clip_count < SY_CLIP_PLANES_MAX ? v->clip_count : SY_CLIP_PLANES_MAX;
-    memcpy(cam->clip_planes, v->clip_planes, sizeof cam->clip_planes);
-    cam->clip_cap = v->clip_count && v->clip_cap;
-    memcpy(cam->clip_cap_color, v->clip_cap_color, sizeof cam->clip_cap_color);
 }
 
 /* >>look: the resolved look -> the device's environment light and background. */

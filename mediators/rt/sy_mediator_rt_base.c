@@ -116,15 +116,7 @@ sy_rt_device_desc sy_rti_device_desc(rt_state *st, uint32_t threads, uint64_t ma
 
 void sy_rti_camera_of(const sy_camera_view *v, sy_rt_camera *cam)
 {
-    memcpy(cam->camera_to_world, v->camera_to_world.m, sizeof cam->camera_to_world);
+    SY_MIRROR_FLAT_VIEW_COPY(cam, v, SY_RT);
     cam->projection = v->projection == SY_PROJECTION_ORTHOGRAPHIC ? SY_RT_PROJECTION_ORTHOGRAPHIC
                                                                   : SY_RT_PROJECTION_PERSPECTIVE;
-    memcpy(cam->window, v->window, sizeof cam->window);
-    cam->near_clip = v->znear;
-    cam->far_clip = v->zfar;
-    _Static_assert(SY_RT_CLIP_PLANES_MAX == SY_CLIP_PLANES_MAX, "one section plane array");
-    cam->clip_count = v->clip_count < SY_CLIP_PLANES_MAX ? v->clip_count : SY_CLIP_PLANES_MAX;
-    memcpy(cam->clip_planes, v->clip_planes, sizeof cam->clip_planes);
-    cam->clip_cap = v->clip_count && v->clip_cap;
-    memcpy(cam->clip_cap_color, v->clip_cap_color, sizeof cam->clip_cap_color);
 }
