@@ -424,7 +424,11 @@ int sy_cli_next_sized_option(const char *cmd, int argc, char **argv, const char 
  * error, named). */
 static bool parser_build(sy_cli_parser *p)
 {
-    static const struct option cluster[] = {SY_CLUSTER_CLI_OPTIONS}, view[] = {VIEW_OPTIONS}, common[] = {COMMON_OPTIONS};
+    static const struct option cluster[] = {SY_CLUSTER_CLI_OPTIONS}, view[] = {VIEW_OPTIONS}, all[] = {COMMON_OPTIONS},
+                               own[] = {{"help", no_argument, NULL, OPT_OWN_HELP}, {"quiet", no_argument, NULL, 'q'},
+                                        {"verbose", no_argument, NULL, 'v'}, {NULL, 0, NULL, 0}};
+    const struct option *common = p->usage ? own : all;
+    size_t common_count = p->usage ? sizeof own / sizeof own[0] : sizeof all / sizeof all[0];
     size_t n = 0, cap = sizeof p->lo / sizeof p->lo[0], k = 0;
     char *so = p->shortopts;
     so[k++] = ':';
@@ -439,7 +443,7 @@ static bool parser_build(sy_cli_parser *p)
     if (p->w && k + 5 < sizeof p->shortopts) memcpy(so + k, "w:h:", 4), k += 4;
     for (size_t i = 0; p->cluster && i < sizeof cluster / sizeof cluster[0] && n < cap; ++i) p->lo[n++] = cluster[i];
     for (size_t i = 0; p->view && i < sizeof view / sizeof view[0] && n < cap; ++i) p->lo[n++] = view[i];
-    for (size_t i = 0; i < sizeof common / sizeof common[0] && n < cap; ++i) p->lo[n++] = common[i];
+    for (size_t i = 0; i < common_count && n < cap; ++i) p->lo[n++] = common[i];
     if (n == cap || k + 3 > sizeof p->shortopts) {
         fprintf(stderr, "sy %s: error: too many options for the parser's table\n", p->cmd);
         p->status = 2;
@@ -469,6 +473,11 @@ int sy_cli_parse(sy_cli_parser *p)
         int c = p->w ? sy_cli_next_sized_option(p->cmd, p->argc, p->argv, p->shortopts, p->lo, p->min_size, p->w, p->h,
                                                 &p->status)
                      : sy_cli_next_option(p->cmd, p->argc, p->argv, p->shortopts, p->lo, &p->status);
+        if (c == OPT_OWN_HELP) {
+            fputs(p->usage, stdout);
+            p->status = 0;
+            return OPT_STOP;
+        }
         const sy_cli_opt *o = NULL;
         for (size_t i = 0; i < p->count && !o; ++i)
             if (p->opts[i].code == c) o = &p->opts[i];

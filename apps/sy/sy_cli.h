@@ -7,8 +7,9 @@
  * is no "--frames"). The options every command takes (the world and loader flags, -q / -v, --help)
  * are applied by sy_cli_next_option; a declared option's value is stored where its entry says (a
  * bad value is a usage error naming the option), and only the options whose meaning is the
- * command's own (SY_CLI_CODE) come back to it. (sy serve and sy bench cull / cluster / governor /
- * limit, which take none of the common options, read theirs with sy_getopt directly.)
+ * command's own (SY_CLI_CODE) come back to it. A command that takes none of the common options
+ * (sy serve) gives its own usage text (sy_cli_parser.usage): then only -q, -v and --help are taken
+ * besides its own. (sy bench cull / cluster / governor / limit still read theirs with sy_getopt.)
  * Exit status: 0 success, 1 failure (sy_cli_fail), 2 usage error (the bad option or value is
  * named), 130 interrupted. Thread-safety: the main thread only (getopt's globals). */
 #ifndef SY_CLI_H
@@ -31,7 +32,9 @@ enum {
     OPT_SCREENSHOT, OPT_KEYS, OPT_TOP, OPT_REPEATS, OPT_REFERENCE, OPT_NODES, OPT_TRIS, OPT_JSON, OPT_GLB, OPT_MAX_MEMORY,
     OPT_BUDGET, OPT_AT, OPT_CLIP, OPT_LOOK_AT, OPT_FOV, OPT_ORBIT, OPT_REPEAT, OPT_FPS, OPT_RESUME, OPT_HIDE,
     OPT_ISOLATE, OPT_SELECT, OPT_TEMPORAL, OPT_NO_TEMPORAL, OPT_SHUTTER, OPT_MOTION_BLUR, OPT_SHUTTER_SAMPLES,
-    OPT_CLIP_CAP, OPT_BOOKMARK, OPT_BOOKMARKS, OPT_MEASURE, OPT_PLANE, OPT_SUB_FRAMES
+    OPT_CLIP_CAP, OPT_BOOKMARK, OPT_BOOKMARKS, OPT_MEASURE, OPT_PLANE, OPT_SUB_FRAMES,
+    OPT_OWN_HELP, /* --help of a command with its own usage text (sy_cli_parser.usage) */
+    OPT_OWN_FIRST /* a command may number codes of its own from here (below the cluster's, 0x200) */
 };
 /* getopt_long entries of the camera placement and node visibility options (sy render, pick, view,
  * web), taken by sy_cli_next_option into sy_cli_load_opts.view and .nodes (sy_load.h) */
@@ -99,6 +102,8 @@ typedef struct sy_cli_parser {
     bool cluster;             /* the cluster options too (SY_CLUSTER_CLI_OPTIONS), whose codes come back
                                  (for sy_cluster_cli_getopt) */
     bool view;                /* the camera placement options too (VIEW_OPTIONS) */
+    const char *usage;        /* non-NULL: the command takes none of the common options but -q, -v and
+                                 --help, which prints this text (its own usage) on stdout */
     int status;               /* after OPT_STOP: the command's exit status */
     /* sy_cli_parse's own */
     bool started;

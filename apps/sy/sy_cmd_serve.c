@@ -2,7 +2,6 @@
  * with its options, writing the tiles it is shown to --output (see sy_cluster_cli.h). */
 #include "sy_cluster_cli.h"
 #include "sy_cli.h"
-#include "sy_options.h"
 #include "sy_signals.h"
 
 #include "sy_exr.h"
@@ -53,24 +52,30 @@ int sy_cmd_serve(int argc, char **argv)
     sy_cluster_server_opts o = {0};
     const char *secret_file = NULL, *port_file = NULL;
     present_ctx pc = {0};
-    unsigned long long v = 0;
-    enum { O_LISTEN = 0x100, O_SECRET_FILE, O_OUTPUT, O_PORT_FILE, O_TLS_CERT, O_TLS_KEY, O_NAME, O_MAX_SESSIONS,
+    uint32_t blob_cache_mb = 0, peer_memory_mb = 0, frame_kb = 0, message_mb = 0; /* 0: the server's default */
+    enum { O_LISTEN = OPT_OWN_FIRST, O_SECRET_FILE, O_OUTPUT, O_PORT_FILE, O_TLS_CERT, O_TLS_KEY, O_NAME, O_MAX_SESSIONS,
            O_MAX_LIFETIME, O_BLOB_CACHE, O_MAX_OBJECTS, O_AUTH_BACKOFF, O_PEER_MEMORY, O_FRAME_KB, O_MESSAGE_MB,
-           O_UNAUTH, O_HANDSHAKE, O_HELP };
-    static const struct option lo[] = {
-        {"listen", required_argument, NULL, O_LISTEN}, {"secret-file", required_argument, NULL, O_SECRET_FILE},
-        {"output", required_argument, NULL, O_OUTPUT}, {"port-file", required_argument, NULL, O_PORT_FILE},
-        {"tls-cert", required_argument, NULL, O_TLS_CERT}, {"tls-key", required_argument, NULL, O_TLS_KEY},
-        {"name", required_argument, NULL, O_NAME}, {"max-sessions", required_argument, NULL, O_MAX_SESSIONS},
-        {"max-lifetime", required_argument, NULL, O_MAX_LIFETIME},
-        {"blob-cache-mb", required_argument, NULL, O_BLOB_CACHE}, {"max-objects", required_argument, NULL, O_MAX_OBJECTS},
-        {"auth-backoff-ms", required_argument, NULL, O_AUTH_BACKOFF},
+           O_UNAUTH, O_HANDSHAKE };
+    const sy_cli_opt opts[] = {
+        SY_CLI_OPT_TEXT("listen", O_LISTEN, &o.listen_url),
+        SY_CLI_OPT_TEXT("secret-file", O_SECRET_FILE, &secret_file),
+        SY_CLI_OPT_TEXT("output", O_OUTPUT, &pc.output),
+        SY_CLI_OPT_TEXT("port-file", O_PORT_FILE, &port_file),
+        SY_CLI_OPT_TEXT("tls-cert", O_TLS_CERT, &o.tls_cert_file),
+        SY_CLI_OPT_TEXT("tls-key", O_TLS_KEY, &o.tls_key_file),
+        SY_CLI_OPT_TEXT("name", O_NAME, &o.name),
+        SY_CLI_OPT_UINT("max-sessions", O_MAX_SESSIONS, &o.max_sessions, 1, 65536),
+        SY_CLI_OPT_REAL("max-lifetime", O_MAX_LIFETIME, &o.max_lifetime_s, DBL_TRUE_MIN, DBL_MAX),
+        SY_CLI_OPT_UINT("blob-cache-mb", O_BLOB_CACHE, &blob_cache_mb, 1, 1u << 24),
+        SY_CLI_OPT_UINT("max-objects", O_MAX_OBJECTS, &o.max_objects, 1, 1u << 30),
+        SY_CLI_OPT_UINT("auth-backoff-ms", O_AUTH_BACKOFF, &o.auth_backoff_ms, 0, 3600000),
         /* budgets against hostile peers (docs/PROTOCOL.md, "Budgets and limits") */
-        {"max-peer-memory-mb", required_argument, NULL, O_PEER_MEMORY},
-        {"max-frame-kb", required_argument, NULL, O_FRAME_KB}, {"max-message-mb", required_argument, NULL, O_MESSAGE_MB},
-        {"max-unauthenticated", required_argument, NULL, O_UNAUTH},
-        {"handshake-timeout-ms", required_argument, NULL, O_HANDSHAKE}, {"help", no_argument, NULL, O_HELP},
-        {"quiet", no_argument, NULL, 'q'}, {"verbose", no_argument, NULL, 'v'}, {NULL, 0, NULL, 0}};
+        SY_CLI_OPT_UINT("max-peer-memory-mb", O_PEER_MEMORY, &peer_memory_mb, 1, 1u << 20),
+        SY_CLI_OPT_UINT("max-frame-kb", O_FRAME_KB, &frame_kb, 64, 1u << 20),
+        SY_CLI_OPT_UINT("max-message-mb", O_MESSAGE_MB, &message_mb, 1, 1u << 20),
+        SY_CLI_OPT_UINT("max-unauthenticated", O_UNAUTH, &o.max_unauthenticated, 1, 65536),
+        SY_CLI_OPT_UINT("handshake-timeout-ms", O_HANDSHAKE, &o.handshake_timeout_ms, 100, 600000),
+    };
     static const char usage_text[] =
         "usage: sy serve [--listen tcp://HOST:PORT|tls+tcp://HOST:PORT] [--secret-file F] [--output OUT.exr|png]\n"
         "                [--port-file F] [--tls-cert PEM --tls-key PEM] [--name NAME] [--max-sessions N]\n"
@@ -81,48 +86,12 @@ int sy_cmd_serve(int argc, char **argv)
         "                [--max-unauthenticated N (32)] [--handshake-timeout-ms MS (3000)]\n"
         "                [--max-lifetime SECONDS] [-q | -v]\n"
         "  the secret comes from --secret-file or $SY_CLUSTER_SECRET; without one only loopback is allowed\n";
-    int c;
-    optind = 0; /* glibc: start over (new arguments, GNU ordering) */
-    opterr = 0;
-    while ((c = sy_getopt(argc, argv, ":qv", lo, "sy serve")) != -1) {
-        const char *opt = argv[optind - 1];
-        bool ok = true;
-        switch (c) {
-        case SY_GETOPT_ERROR: return 2; /* an abbreviated long option (named on stderr) */
-        case O_LISTEN: o.listen_url = optarg; break;
-        case O_SECRET_FILE: secret_file = optarg; break;
-        case O_OUTPUT: pc.output = optarg; break;
-        case O_PORT_FILE: port_file = optarg; break;
-        case O_TLS_CERT: o.tls_cert_file = optarg; break;
-        case O_TLS_KEY: o.tls_key_file = optarg; break;
-        case O_NAME: o.name = optarg; break;
-        case O_MAX_SESSIONS: ok = sy_cluster_cli_uint_arg(optarg, 1, 65536, &v), o.max_sessions = (uint32_t)v; break;
-        case O_MAX_LIFETIME: ok = sy_cli_parse_double(optarg, DBL_TRUE_MIN, DBL_MAX, &o.max_lifetime_s); break;
-        case O_BLOB_CACHE: ok = sy_cluster_cli_uint_arg(optarg, 1, 1u << 24, &v), o.blob_cache_bytes = (size_t)v << 20; break;
-        case O_MAX_OBJECTS: ok = sy_cluster_cli_uint_arg(optarg, 1, 1u << 30, &v), o.max_objects = (uint32_t)v; break;
-        case O_AUTH_BACKOFF: ok = sy_cluster_cli_uint_arg(optarg, 0, 3600000, &v), o.auth_backoff_ms = (uint32_t)v; break;
-        case O_PEER_MEMORY: ok = sy_cluster_cli_uint_arg(optarg, 1, 1u << 20, &v), o.max_peer_memory = (size_t)v << 20; break;
-        case O_FRAME_KB: ok = sy_cluster_cli_uint_arg(optarg, 64, 1u << 20, &v), o.max_frame = (size_t)v << 10; break;
-        case O_MESSAGE_MB: ok = sy_cluster_cli_uint_arg(optarg, 1, 1u << 20, &v), o.max_message = (size_t)v << 20; break;
-        case O_UNAUTH: ok = sy_cluster_cli_uint_arg(optarg, 1, 65536, &v), o.max_unauthenticated = (uint32_t)v; break;
-        case O_HANDSHAKE: ok = sy_cluster_cli_uint_arg(optarg, 100, 600000, &v), o.handshake_timeout_ms = (uint32_t)v; break;
-        case 'q': sy_log_set_level(SY_LOG_ERROR); break;
-        case 'v': sy_log_set_level(SY_LOG_DEBUG); break;
-        case O_HELP: fputs(usage_text, stdout); return 0;
-        case ':': fprintf(stderr, "sy serve: error: option '%s' needs a value\n%s", opt, usage_text); return 2;
-        default:
-            if (optopt >= 0x100) fprintf(stderr, "sy serve: error: option '%s' takes no value\n%s", opt, usage_text);
-            else if (optopt) fprintf(stderr, "sy serve: error: unknown option '-%c'\n%s", optopt, usage_text);
-            else fprintf(stderr, "sy serve: error: unknown option '%s'\n%s", opt, usage_text);
-            return 2;
-        }
-        if (!ok) {
-            char name[48];
-            fprintf(stderr, "sy serve: error: %s: '%s' is not an accepted value\n", sy_cluster_cli_opt_label(lo, c, name),
-                    optarg);
-            return 2;
-        }
-    }
+    sy_cli_parser p = {SY_CLI_ARGS("serve", argc, argv, opts), .usage = usage_text};
+    if (sy_cli_parse(&p) != -1) return p.status;
+    o.blob_cache_bytes = (size_t)blob_cache_mb << 20;
+    o.max_peer_memory = (size_t)peer_memory_mb << 20;
+    o.max_frame = (size_t)frame_kb << 10;
+    o.max_message = (size_t)message_mb << 20;
     if (optind < argc) {
         fprintf(stderr, "sy serve: error: unexpected argument '%s' (sy serve takes options only)\n%s", argv[optind], usage_text);
         return 2;
