@@ -5,7 +5,6 @@
 #include "sy_bench_cluster.h"
 #include "sy_cli.h"
 #include "sy_cluster_cli.h"
-#include "sy_options.h"
 
 #include "sy_log.h"
 
@@ -74,66 +73,37 @@ static sy_result bench_half_and_blob_cache(sy_scene *scene, const sy_cluster_cli
 }
 int sy_cmd_bench_cluster(int argc, char **argv)
 {
-    uint32_t w = 1920, h = 1080, rounds = 3;
+    uint32_t w = 0, h = 0, rounds = 3; /* w, h: 0 until -w / -h give them */
     bool hostile_only = false, coop_only = false, scale = false; /* one measurement alone */
     double coop_frame = 1.6; /* cooperative: seconds per frame on one server (each frame costs ~15 ms of sync + merge) */
-    double soak = 0, warmup = -1; /* --soak: seconds of camera changes against one server */
+    uint32_t soak_s = 0, warmup_s = UINT32_MAX; /* --soak: seconds of camera changes against one server; --warmup: none given */
     const char *soak_backend = NULL;
-    bool size_given = false;
     static const char usage_text[] = "usage: sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only | --coop-only] "
                                      "[--coop-frame SECONDS] | --scale\n"
                                      "       sy bench cluster --soak SECONDS [--warmup SECONDS] [-b BACKEND] [-w W] [-h H]"
                                      "   (exit 1 unless every frame came back and the server's RSS, fds and threads grew < 5 %)\n";
-    enum { O_REPEATS = 0x100, O_HOSTILE, O_COOP, O_SCALE, O_COOP_FRAME, O_SOAK, O_WARMUP, O_HELP };
-    static const struct option lo[] = {
-        {"repeats", required_argument, NULL, O_REPEATS}, {"hostile-only", no_argument, NULL, O_HOSTILE},
-        {"coop-only", no_argument, NULL, O_COOP}, {"scale", no_argument, NULL, O_SCALE},
-        {"soak", required_argument, NULL, O_SOAK}, {"warmup", required_argument, NULL, O_WARMUP},
-        {"backend", required_argument, NULL, 'b'},
-        {"coop-frame", required_argument, NULL, O_COOP_FRAME}, {"help", no_argument, NULL, O_HELP},
-        {"quiet", no_argument, NULL, 'q'}, {"verbose", no_argument, NULL, 'v'}, {NULL, 0, NULL, 0}};
-    int opt;
-    unsigned long long v = 0;
-    optind = 0; /* glibc: start over (new arguments, GNU ordering) */
-    opterr = 0;
-    while ((opt = sy_getopt(argc, argv, ":w:h:b:qv", lo, "sy bench cluster")) != -1) {
-        bool ok = true;
-        char *end = NULL;
-        switch (opt) {
-        case SY_GETOPT_ERROR: return 2; /* an abbreviated long option (named on stderr) */
-        case 'w': ok = sy_cluster_cli_uint_arg(optarg, 1, 16384, &v), w = (uint32_t)v, size_given = true; break;
-        case 'h': ok = sy_cluster_cli_uint_arg(optarg, 1, 16384, &v), h = (uint32_t)v, size_given = true; break;
-        case 'b': soak_backend = optarg; break;
-        case O_SOAK: ok = sy_cluster_cli_uint_arg(optarg, 1, 86400, &v), soak = (double)v; break;
-        case O_WARMUP: ok = sy_cluster_cli_uint_arg(optarg, 0, 86400, &v), warmup = (double)v; break;
-        case O_REPEATS: ok = sy_cluster_cli_uint_arg(optarg, 1, 100, &v), rounds = (uint32_t)v; break;
-        case O_HOSTILE: hostile_only = true; break;
-        case O_COOP: coop_only = true; break;
-        case O_SCALE: scale = true; break;
-        case O_COOP_FRAME: coop_frame = strtod(optarg, &end), ok = end != optarg && !*end; break;
-        case 'q': sy_log_set_level(SY_LOG_ERROR); break;
-        case 'v': sy_log_set_level(SY_LOG_DEBUG); break;
-        case O_HELP: fputs(usage_text, stdout); return 0;
-        case ':': fprintf(stderr, "sy bench cluster: error: option '%s' needs a value\n%s", argv[optind - 1], usage_text); return 2;
-        default:
-            fprintf(stderr, "sy bench cluster: error: unknown option '%s'\n%s", argv[optind - 1], usage_text);
-            return 2;
-        }
-        if (!ok) {
-            char name[48];
-            fprintf(stderr, "sy bench cluster: error: %s: '%s' is not an accepted value\n",
-                    sy_cluster_cli_opt_label(lo, opt, name), optarg);
-            return 2;
-        }
-    }
+    enum { O_REPEATS = OPT_OWN_FIRST, O_HOSTILE, O_COOP, O_SCALE, O_COOP_FRAME, O_SOAK, O_WARMUP };
+    const sy_cli_opt opts[] = {
+        SY_CLI_OPT_UINT("repeats", O_REPEATS, &rounds, 1, 100),
+        SY_CLI_OPT_FLAG("hostile-only", O_HOSTILE, &hostile_only),
+        SY_CLI_OPT_FLAG("coop-only", O_COOP, &coop_only),
+        SY_CLI_OPT_FLAG("scale", O_SCALE, &scale),
+        SY_CLI_OPT_UINT("soak", O_SOAK, &soak_s, 1, 86400),
+        SY_CLI_OPT_UINT("warmup", O_WARMUP, &warmup_s, 0, 86400),
+        SY_CLI_OPT_TEXT("backend", 'b', &soak_backend),
+        SY_CLI_OPT_TEXT(NULL, 'b', &soak_backend),
+        SY_CLI_OPT_REAL("coop-frame", O_COOP_FRAME, &coop_frame, 0.05, 60),
+    };
+    sy_cli_parser p = {SY_CLI_ARGS("bench cluster", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .usage = usage_text};
+    if (sy_cli_parse(&p) != -1) return p.status;
     if (optind < argc) {
         fprintf(stderr, "sy bench cluster: error: unexpected argument '%s'\n%s", argv[optind], usage_text);
         return 2;
     }
-    if (w < 1 || h < 1 || w > 16384 || h > 16384 || rounds < 1 || rounds > 100 || !(coop_frame >= 0.05 && coop_frame <= 60)) {
-        fprintf(stderr, "sy bench cluster: error: sizes 1..16384, --repeats 1..100, --coop-frame 0.05..60\n");
-        return 2;
-    }
+    bool size_given = w || h;
+    if (!w) w = 1920;
+    if (!h) h = 1080;
+    double soak = soak_s, warmup = warmup_s == UINT32_MAX ? -1.0 : warmup_s;
     signal(SIGPIPE, SIG_IGN);
     sy_error err = {0};
     sy_scene *scene = NULL;

@@ -8,8 +8,9 @@
  * are applied by sy_cli_next_option; a declared option's value is stored where its entry says (a
  * bad value is a usage error naming the option), and only the options whose meaning is the
  * command's own (SY_CLI_CODE) come back to it. A command that takes none of the common options
- * (sy serve) gives its own usage text (sy_cli_parser.usage): then only -q, -v and --help are taken
- * besides its own. (sy bench cull / cluster / governor / limit still read theirs with sy_getopt.)
+ * (sy serve, sy bench cluster) gives its own usage text (sy_cli_parser.usage): then only -q, -v
+ * and --help are taken besides its own. (sy bench cull / governor / limit still read theirs with
+ * sy_getopt.)
  * Exit status: 0 success, 1 failure (sy_cli_fail), 2 usage error (the bad option or value is
  * named), 130 interrupted. Thread-safety: the main thread only (getopt's globals). */
 #ifndef SY_CLI_H
