@@ -63,6 +63,19 @@ void sy_error_prefix(sy_error *err, const char *fmt, ...)
     err->message[n + 2 + m] = '\0';
 }
 
+bool sy_name_in_list(const char *name, const char *list, char sep)
+{
+    size_t n = strlen(name);
+    for (const char *p = list; *p;) {
+        const char *e = strchr(p, sep);
+        size_t k = e ? (size_t)(e - p) : strlen(p);
+        if (k == n && !strncmp(p, name, n)) return true;
+        if (!e) break;
+        p = e + 1;
+    }
+    return false;
+}
+
 double sy_time_now(void)
 {
     struct timespec ts;

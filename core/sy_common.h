@@ -91,6 +91,10 @@ static inline bool sy_size_mad(size_t a, size_t b, size_t c, size_t *out)
 /** Monotonic wall clock in seconds (for timings and progress only). */
 double sy_time_now(void);
 
+/** true when name is one of the entries of list, separated by sep ("a,b,c" with ','); an empty
+ * list holds nothing. */
+bool sy_name_in_list(const char *name, const char *list, char sep);
+
 /** true when fd refers to a terminal: long jobs print progress only then. */
 bool sy_is_terminal(int fd);
 

@@ -296,20 +296,8 @@ bool x3d_get_int_array(loader *L, xfile *F, const xmlNode *el, const char *name,
     return true;
 }
 
-/* First element child with the given name (or any of the names separated by '|') and, when
- * `field` is given, a matching containerField (or none). */
-bool x3d_name_in(const char *name, const char *list)
-{
-    size_t n = strlen(name);
-    for (const char *p = list; *p;) {
-        const char *e = strchr(p, '|');
-        size_t k = e ? (size_t)(e - p) : strlen(p);
-        if (k == n && !strncmp(p, name, n)) return true;
-        if (!e) break;
-        p = e + 1;
-    }
-    return false;
-}
+/* Whether name is one of the '|'-separated names of list (sy_name_in_list). */
+bool x3d_name_in(const char *name, const char *list) { return sy_name_in_list(name, list, '|'); }
 
 void x3d_clamp01(float *v, int n)
 {

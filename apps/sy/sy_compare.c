@@ -35,19 +35,7 @@ static void draw_text(FT_Face face, float *rgba, uint32_t W, uint32_t H, int x, 
     }
 }
 
-static bool wanted(const char *only, const char *name)
-{
-    if (!only) return true;
-    size_t n = strlen(name);
-    for (const char *p = only; *p;) {
-        const char *e = strchr(p, ',');
-        size_t len = e ? (size_t)(e - p) : strlen(p);
-        if (len == n && !strncmp(p, name, n)) return true;
-        if (!e) break;
-        p = e + 1;
-    }
-    return false;
-}
+static bool wanted(const char *only, const char *name) { return !only || sy_name_in_list(name, only, ','); }
 
 static sy_result render_one(sy_scene *scene, const sy_viewport_desc *vd, const char *backend, uint32_t w, uint32_t h,
                             uint32_t spp, sy_context_pool *pool, sy_layer *out, double *secs, sy_error *err)
