@@ -5,7 +5,7 @@ SY_PACKAGES="cmake ninja-build libavcodec-dev libavformat-dev libswscale-dev gcc
  libglfw3-dev libgl-dev xvfb xauth libosmesa6-dev libegl-dev
  libnng-dev libsodium-dev libzstd-dev zlib1g-dev iproute2 libfreetype-dev fonts-dejavu-core
  libopenmpi-dev openmpi-bin libimath-dev libcjson-dev doxygen libmeshoptimizer-dev
- libwebsockets-dev libturbojpeg0-dev libassimp-dev assimp-utils assimp-testmodels libdraco-dev libwebp-dev
+ libwebsockets-dev libturbojpeg0-dev libvpx-dev libassimp-dev assimp-utils assimp-testmodels libdraco-dev libwebp-dev
  chromium nodejs
  python3-dev python3-numpy python3-pytest python3-setuptools python3-wheel python3-pip"
 # python3-*: the Python package (apps/python: development files, NumPy; pytest for its tests; pip,
