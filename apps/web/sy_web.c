@@ -256,8 +256,7 @@ void sy_web_destroy(sy_web *w)
         free(h);
     }
     if (w->latest) {
-        free(w->latest->buf);
-        free(w->latest);
+        sy_webi_frame_free(w->latest);
     }
     free(w->routes);
     pthread_mutex_destroy(&w->mu);

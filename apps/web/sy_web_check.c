@@ -427,6 +427,35 @@ bool sy_web_input_changes_scene(const sy_web_input *in)
     }
 }
 
+/* A size message's "codecs" (sy_web_input): plain short names are kept, anything else counted. */
+static void ignore_codec(sy_web_input *out, const char *what)
+{
+    if (!out->codecs_ignored++) {
+        size_t n = 0;
+        for (; what[n] && n < sizeof out->codec_ignored - 1; ++n)
+            out->codec_ignored[n] = what[n] >= 0x20 && what[n] < 0x7f && what[n] != '"' && what[n] != '\\' ? what[n] : '?';
+        out->codec_ignored[n] = 0;
+    }
+}
+
+static void parse_codecs(const cJSON *c, sy_web_input *out)
+{
+    if (!c) return;
+    if (!cJSON_IsArray(c)) {
+        ignore_codec(out, "(codecs is no array)");
+        return;
+    }
+    const cJSON *e;
+    cJSON_ArrayForEach(e, c) {
+        const char *s = cJSON_IsString(e) ? e->valuestring : NULL;
+        size_t n = s ? strlen(s) : 0;
+        bool ok = n >= 1 && n < sizeof out->codecs[0] && out->codec_count < SY_WEB_MAX_CODECS;
+        for (size_t i = 0; ok && i < n; ++i) ok = (s[i] >= 'a' && s[i] <= 'z') || (s[i] >= '0' && s[i] <= '9') || s[i] == '.';
+        if (ok) memcpy(out->codecs[out->codec_count++], s, n + 1);
+        else ignore_codec(out, s ? s : "(not a string)");
+    }
+}
+
 sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -449,6 +478,9 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
         else if (cJSON_GetObjectItemCaseSensitive(m, "v") && (!json_num(m, "v", 0, 1000, &ver) || ver != floor(ver)))
             r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "size: v must be a whole number 0..1000");
         out->version = (uint32_t)ver;
+        if (r == SY_OK) parse_codecs(cJSON_GetObjectItemCaseSensitive(m, "codecs"), out);
+    } else if (!strcmp(type, "keyframe")) {
+        out->type = SY_WEB_INPUT_KEYFRAME;
     } else if (!strcmp(type, "drag")) {
         out->type = SY_WEB_INPUT_DRAG;
         if (!json_num(m, "dx", -1e5, 1e5, &out->a) || !json_num(m, "dy", -1e5, 1e5, &out->b))

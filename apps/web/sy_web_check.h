@@ -136,13 +136,16 @@ typedef enum sy_web_input_type {
     SY_WEB_INPUT_CLIP,     /**< the section planes (plane_count of planes; 0: none) */
     SY_WEB_INPUT_TREE,     /**< asks for the scene's hierarchy (answered with a "tree" message) */
     SY_WEB_INPUT_EXPOSURE, /**< exposure in stops (a) */
-    SY_WEB_INPUT_FILTER    /**< the display filter by name (filter) */
+    SY_WEB_INPUT_FILTER,   /**< the display filter by name (filter) */
+    SY_WEB_INPUT_KEYFRAME  /**< {"t":"keyframe"}: the page's video decoder lost its place */
 } sy_web_input_type;
 
 /** Node ids a page may name: 1..SY_WEB_NODE_ID_MAX (sy_node.id); unknown ones are refused later. */
 #define SY_WEB_NODE_ID_MAX 0xFFFFFFFFu
 /** Exposure a page may set, in stops (+-). */
 #define SY_WEB_EXPOSURE_MAX 16.0
+/** The most codec names a size message may list ("codecs"); further ones are ignored. */
+#define SY_WEB_MAX_CODECS 4u
 
 typedef struct sy_web_input {
     sy_web_input_type type;
@@ -157,6 +160,13 @@ typedef struct sy_web_input {
     uint32_t plane_count;             /**< clip: planes in use (0..SY_CLIP_PLANES_MAX) */
     float planes[SY_CLIP_PLANES_MAX][4]; /**< clip: {a, b, c, d}, checked by sy_clip_planes_check */
     char filter[32];                  /**< filter: the name (letters, digits, '-', '_') */
+    /** size: the video codecs the page decodes, best first ("codecs": an array of strings of 1..15
+     * characters, [a-z0-9.]; the names are not judged here). Entries that are not such strings,
+     * beyond SY_WEB_MAX_CODECS, or a "codecs" that is no array are not an error: they are counted
+     * in codecs_ignored (the first one's text, cut and made printable, in codec_ignored) */
+    char codecs[SY_WEB_MAX_CODECS][16];
+    uint32_t codec_count, codecs_ignored;
+    char codec_ignored[24];
     bool has_id;
     uint64_t id;
 } sy_web_input;

@@ -13,7 +13,7 @@ enum {
     OFF_MAGIC = 0, OFF_W = 4, OFF_H = 8, OFF_BACKEND = 12, OFF_SAMPLES = 16, OFF_MS = 20, OFF_SEQ = 24, OFF_INPUT = 32,
     OFF_HEADER = 40, OFF_JPEG = 44, OFF_DEPTH = 48, OFF_CODING = 52, OFF_DMIN = 56, OFF_DMAX = 60, OFF_C2W = 64,
     OFF_WINDOW = 128, OFF_PROJ = 144, OFF_ZNEAR = 148, OFF_ZFAR = 152, OFF_TARGET = 156, OFF_YAW = 168,
-    OFF_PITCH = 172, OFF_DIST = 176, OFF_FLAGS = 180
+    OFF_PITCH = 172, OFF_DIST = 176, OFF_FLAGS = 180, OFF_CODEC = 184, OFF_QUALITY = 188
 };
 
 /* The largest frame a reader accepts (pixels): the server's frame cap is 3840 x 2400 by default. */
@@ -118,11 +118,19 @@ sy_result sy_web_frame_pack(sy_web_frame_info *fi, const uint8_t *jpeg, size_t j
     for (int i = 0; i < 3; ++i) putf(h + OFF_TARGET + 4 * i, fi->orbit.target[i]);
     putf(h + OFF_YAW, fi->orbit.yaw), putf(h + OFF_PITCH, fi->orbit.pitch), putf(h + OFF_DIST, fi->orbit.dist);
     put32(h + OFF_FLAGS, fi->flags);
+    put32(h + OFF_CODEC, (uint32_t)fi->codec), putf(h + OFF_QUALITY, fi->quality);
     if (jpeg_len) memcpy(h + SY_WEB_FRAME_HEADER, jpeg, jpeg_len);
     if (zlen) memcpy(h + SY_WEB_FRAME_HEADER + jpeg_len, z, zlen);
     free(z);
     *out = buf, *len = total;
     return SY_OK;
+}
+
+void sy_web_frame_set_payload(uint8_t *h, const sy_web_frame_info *fi)
+{
+    put32(h + OFF_JPEG, fi->jpeg_len);
+    put32(h + OFF_CODEC, (uint32_t)fi->codec), putf(h + OFF_QUALITY, fi->quality);
+    put32(h + OFF_FLAGS, get32(h + OFF_FLAGS) | fi->flags);
 }
 
 sy_result sy_web_frame_parse(const uint8_t *data, size_t len, sy_web_frame_info *fi, const uint8_t **jpeg,
@@ -147,6 +155,11 @@ sy_result sy_web_frame_parse(const uint8_t *data, size_t len, sy_web_frame_info 
     for (int i = 0; i < 3; ++i) fi->orbit.target[i] = getf(data + OFF_TARGET + 4 * i);
     fi->orbit.yaw = getf(data + OFF_YAW), fi->orbit.pitch = getf(data + OFF_PITCH), fi->orbit.dist = getf(data + OFF_DIST);
     fi->flags = get32(data + OFF_FLAGS);
+    uint32_t codec = get32(data + OFF_CODEC);
+    fi->codec = codec < SY_WEB_CODEC_COUNT ? (sy_web_codec)codec : SY_WEB_CODEC_JPEG;
+    fi->quality = getf(data + OFF_QUALITY);
+    if (codec >= SY_WEB_CODEC_COUNT)
+        return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: unknown payload codec %u", codec);
     if (!fi->width || !fi->height || (uint64_t)fi->width * fi->height > MAX_PIXELS)
         return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: size %ux%u out of range", fi->width, fi->height);
     if ((uint64_t)SY_WEB_FRAME_HEADER + fi->jpeg_len + fi->depth_len != len)

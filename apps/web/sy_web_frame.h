@@ -16,6 +16,7 @@
 #include "sy_objects.h" /* before sy_request.h */
 #include "sy_orbit.h"
 #include "sy_request.h"
+#include "sy_web_video.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -26,6 +27,7 @@ extern "C" {
 #define SY_WEB_FRAME_HEADER 192u       /**< header bytes */
 #define SY_WEB_DEPTH_LOG16_DEFLATE 1u  /**< the depth coding (header offset 52) */
 #define SY_WEB_FRAME_PROGRESSIVE 1u    /**< flags: the back-end accumulates samples while the view rests */
+#define SY_WEB_FRAME_KEYFRAME 2u       /**< flags: a video payload that is a keyframe (decodable alone) */
 
 /** A frame's header (docs/WEB.md). */
 typedef struct sy_web_frame_info {
@@ -36,14 +38,20 @@ typedef struct sy_web_frame_info {
     float render_ms;    /**< the server's render time */
     uint64_t seq;       /**< the frame's number */
     uint64_t input_id;  /**< the newest input of this client it answers */
-    uint32_t jpeg_len;  /**< JPEG bytes after the header */
+    uint32_t jpeg_len;  /**< payload bytes after the header: the JPEG, or the video frame (codec) */
     uint32_t depth_len; /**< deflated depth bytes after the JPEG (0: no depth) */
     uint32_t depth_coding; /**< SY_WEB_DEPTH_LOG16_DEFLATE */
     float depth_min, depth_max; /**< the nearest and farthest depth of the frame (view units) */
     sy_camera_view view; /**< camera_to_world, projection, window, znear, zfar (no clip planes) */
     sy_orbit orbit;      /**< the orbit the frame was rendered from (sy_orbit.h) */
-    uint32_t flags;      /**< SY_WEB_FRAME_PROGRESSIVE */
+    uint32_t flags;      /**< SY_WEB_FRAME_PROGRESSIVE, SY_WEB_FRAME_KEYFRAME */
+    sy_web_codec codec;  /**< the payload: JPEG (0) or a video codec's frame (docs/WEB.md, "The video stream") */
+    float quality;       /**< video: the encoder's PSNR of this frame in dB; JPEG: 0 */
 } sy_web_frame_info;
+
+/** Patches a packed header h (no prefix) for another payload: its length (fi->jpeg_len), codec
+ * and quality, and ORs fi->flags into the flags (a video viewer's copy of a frame). */
+void sy_web_frame_set_payload(uint8_t *h, const sy_web_frame_info *fi);
 
 /** Packs a frame: prefix bytes of room (LWS_PRE), the header of fi (jpeg_len, depth_len,
  * depth_coding, depth_min and depth_max are filled in here), the JPEG, then depth (fi->width x
@@ -53,7 +61,8 @@ sy_result sy_web_frame_pack(sy_web_frame_info *fi, const uint8_t *jpeg, size_t j
                             size_t prefix, uint8_t **out, size_t *len, sy_error *err);
 
 /** Reads a frame's header from len bytes; SY_ERR_PROTOCOL naming the reason for anything that is
- * not a whole format-2 frame (magic, version, sizes that do not add up to len). *jpeg and *depth
+ * not a whole format-2 frame (magic, version, sizes that do not add up to len, an unknown payload
+ * codec). *jpeg and *depth
  * (may be NULL) point into data. */
 sy_result sy_web_frame_parse(const uint8_t *data, size_t len, sy_web_frame_info *fi, const uint8_t **jpeg,
                              const uint8_t **depth, sy_error *err);

@@ -58,7 +58,13 @@ typedef struct web_frame {
     uint32_t refs; /* under mu */
     uint64_t seq, gen; /* gen: the input generation the frame answers */
     uint8_t *buf;
-    size_t len; /* header + JPEG */
+    size_t len; /* header + JPEG + depth */
+    /* for the video viewers (docs/WEB.md, "The video stream"): the frame's pixels (RGBA8, NULL
+     * when no viewer took video as it was rendered), its size, back-end, and where the depth
+     * channel lies in buf (after LWS_PRE + header + jpeg_len) */
+    uint8_t *rgba;
+    uint32_t width, height, backend;
+    size_t jpeg_len, depth_len;
 } web_frame;
 
 typedef struct web_conn web_conn;
@@ -113,6 +119,7 @@ struct sy_web {
     bool net_started;
     volatile int net_quit; /* read by the network thread */
     web_conn *conns;       /* WebSocket viewers (network thread only) */
+    size_t video_reserved; /* network thread: the encoders' memory budget in use (sy_web_video_encoder_bytes) */
 
     pthread_mutex_t mu;
     pthread_cond_t cv;
@@ -124,6 +131,10 @@ struct sy_web {
     uint32_t backend;      /* registry index */
     uint32_t display_w, display_h;
     uint32_t clients;
+    uint32_t video_viewers, jpeg_viewers; /* sized viewers by what they are sent: the render thread
+                                           * keeps a frame's pixels for the first, JPEG for the second */
+    bool need_pixels; /* a video viewer was sent a frame without pixels: the render thread republishes
+                       * the newest frame with them (no new render: a still view keeps its samples) */
     web_job *pending, **pending_tail; /* routes */
     web_job *stills, **stills_tail;   /* stills: one after each live frame */
     web_job *still_running;
@@ -144,8 +155,14 @@ struct sy_web {
     uint64_t look_version;  /* what a frame shows changed beyond the camera (planes, visibility, exposure) */
 };
 
+/* The video encoders of all viewers together take at most this much memory (estimated at the
+ * largest frame, sy_web_video_encoder_bytes); a viewer beyond it is sent JPEG. */
+#define WEB_VIDEO_BUDGET ((size_t)512 << 20)
+
 /* --- sy_web_mailbox.c --- */
 void sy_webi_frame_release(sy_web *w, web_frame *f);
+/* Frees a frame (its last reference is gone). */
+void sy_webi_frame_free(web_frame *f);
 void sy_webi_job_free(web_job *j);
 /* Render thread -> network thread: wake the service loop (it runs EVENT_WAIT_CANCELLED). */
 void sy_webi_wake_network(sy_web *w);

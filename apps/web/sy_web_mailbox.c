@@ -11,10 +11,15 @@ void sy_webi_frame_release(sy_web *w, web_frame *f)
     pthread_mutex_lock(&w->mu);
     bool last = --f->refs == 0;
     pthread_mutex_unlock(&w->mu);
-    if (last) {
-        free(f->buf);
-        free(f);
-    }
+    if (last) sy_webi_frame_free(f);
+}
+
+void sy_webi_frame_free(web_frame *f)
+{
+    if (!f) return;
+    free(f->buf);
+    free(f->rgba);
+    free(f);
 }
 
 void sy_webi_job_free(web_job *j)

@@ -23,6 +23,8 @@ typedef struct render_state {
     sy_viewport *vp, *still_vp;
     uint32_t backend_applied;
     uint64_t seq;
+    uint8_t *last_px; /* the newest frame's pixels (RGBA8), for a video viewer that joins at rest */
+    uint64_t last_px_seq;
     sy_interactive *ia; /* the governor, the view on the viewports, the display filter (sy_interactive.h) */
     float exposure;     /* stops, as the pages set it */
     bool changed;       /* what frames show changed beyond the camera (sy_interactive_view.changed) */
@@ -167,10 +169,7 @@ static void publish_frame(sy_web *w, web_frame *f)
     w->latest = f;
     bool last = old && --old->refs == 0;
     pthread_mutex_unlock(&w->mu);
-    if (last) {
-        free(old->buf);
-        free(old);
-    }
+    if (last) sy_webi_frame_free(old);
     sy_webi_wake_network(w);
 }
 
@@ -223,10 +222,20 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
     float *depth = NULL;
     size_t jlen = 0;
     uint32_t contexts = sy_context_pool_size(rs->pool);
+    /* video viewers get the pixels (each one's encoder runs as its frame is sent); JPEG is made
+     * only while a viewer takes it (or none said yet) */
+    pthread_mutex_lock(&w->mu);
+    bool keep_px = w->video_viewers > 0, want_jpeg = w->jpeg_viewers > 0 || !w->video_viewers;
+    pthread_mutex_unlock(&w->mu);
     double t0 = sy_time_now();
     r = render_rgba8(w, rs, rs->win, gf.width, gf.height, gf.samples, gf.preview, &px, &depth, err);
-    if (r == SY_OK) r = sy_jpeg_encode_rgba8(px, gf.width, gf.height, w->d.quality, &jpeg, &jlen, err);
-    free(px);
+    if (r == SY_OK && want_jpeg) r = sy_jpeg_encode_rgba8(px, gf.width, gf.height, w->d.quality, &jpeg, &jlen, err);
+    /* the render thread keeps the newest pixels (republish_with_pixels); the frame gets a copy */
+    free(rs->last_px);
+    rs->last_px = px, rs->last_px_seq = 0, px = NULL;
+    if (r == SY_OK && keep_px && !(px = malloc((size_t)gf.width * gf.height * 4)))
+        r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %ux%u", gf.width, gf.height);
+    if (px) memcpy(px, rs->last_px, (size_t)gf.width * gf.height * 4);
     /* the frame's camera: what the page warps the frame with (docs/WEB.md, "Binary frames") */
     sy_web_frame_info fi = {.width = gf.width, .height = gf.height, .backend = bi, .orbit = in->orbit,
                             .flags = (cls->caps & SY_CAP_PROGRESSIVE) ? SY_WEB_FRAME_PROGRESSIVE : 0};
@@ -238,7 +247,10 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
     double ms = (sy_time_now() - t0) * 1e3; /* render, display chain, JPEG, depth: the frame's whole cost */
     free(jpeg);
     free(depth);
-    if (r != SY_OK) return r;
+    if (r != SY_OK) {
+        free(px);
+        return r;
+    }
     /* a frame that translated the scene for a new context says nothing about the next ones */
     sy_interactive_report(rs->ia, &gf, ms, sy_context_pool_size(rs->pool) != contexts);
     sy_mediator_stats st = {0};
@@ -248,6 +260,7 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
     web_frame *f = calloc(1, sizeof *f);
     if (!f) {
         free(buf);
+        free(px);
         return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %zu bytes", len);
     }
     /* the samples and the time are known only now: patched into the packed header */
@@ -260,10 +273,41 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
     memcpy(h + 24, &seq, 8);
     f->buf = buf;
     f->refs = 1, f->seq = seq, f->gen = gen, f->len = len;
+    f->rgba = px, f->width = gf.width, f->height = gf.height, f->backend = bi;
+    f->jpeg_len = fi.jpeg_len, f->depth_len = fi.depth_len;
+    rs->last_px_seq = seq;
     publish_frame(w, f);
     set_status(w, fstatus);
     *again = true; /* the governor says what comes next */
     return SY_OK;
+}
+
+/* A video viewer joined a view at rest: the newest frame again under a new number, with its pixels
+ * (the frame as it was: no new render, a progressive back-end keeps its samples). */
+static void republish_with_pixels(sy_web *w, render_state *rs)
+{
+    pthread_mutex_lock(&w->mu);
+    web_frame *cur = w->latest;
+    bool go = cur && !cur->rgba && rs->last_px && rs->last_px_seq == cur->seq;
+    if (go) cur->refs++;
+    pthread_mutex_unlock(&w->mu);
+    if (!go) return;
+    web_frame *f = calloc(1, sizeof *f);
+    uint8_t *buf = f ? malloc(cur->len + LWS_PRE) : NULL, *px = buf ? malloc((size_t)cur->width * cur->height * 4) : NULL;
+    if (!px) {
+        free(f), free(buf);
+        sy_webi_frame_release(w, cur);
+        sy_log(SY_LOG_WARNING, "web", NULL, "out of memory for a frame's pixels: the video viewers wait for the next frame");
+        return;
+    }
+    memcpy(buf, cur->buf, cur->len + LWS_PRE);
+    memcpy(px, rs->last_px, (size_t)cur->width * cur->height * 4);
+    *f = *cur;
+    f->buf = buf, f->rgba = px, f->refs = 1, f->seq = ++rs->seq;
+    memcpy(buf + LWS_PRE + 24, &f->seq, 8);
+    rs->last_px_seq = f->seq;
+    sy_webi_frame_release(w, cur);
+    publish_frame(w, f);
 }
 
 /* The live frame (the governor says its size) and what a failed back-end tells the pages. */
@@ -305,7 +349,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
     while (r == SY_OK) {
         pthread_mutex_lock(&w->mu);
         for (;;) {
-            if (w->quit || (stop && *stop) || w->pending || w->stills || w->actions) break;
+            if (w->quit || (stop && *stop) || w->pending || w->stills || w->actions || w->need_pixels) break;
             /* frames once a page said its size (the page does as it connects) */
             bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
             if (w->clients && w->display_w && (w->view_version != seen || due)) break;
@@ -335,6 +379,8 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         uint32_t bi = w->backend, dw = w->display_w, dh = w->display_h;
         uint64_t gen = w->input_gen;
         bool clients = w->clients > 0 && w->display_w > 0;
+        bool need_pixels = w->need_pixels;
+        w->need_pixels = false;
         pthread_mutex_unlock(&w->mu);
         while (jobs) { /* stills and routes first: they wait on an HTTP connection */
             web_job *j = jobs;
@@ -352,6 +398,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         }
         bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
         if (clients && (moved || due)) render_live(w, &rs, &in, bi, dw, dh, gen, &again, &wait_until);
+        else if (need_pixels) republish_with_pixels(w, &rs);
         /* then one still: stills wait behind the live view */
         pthread_mutex_lock(&w->mu);
         web_job *still = w->stills;
@@ -384,6 +431,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         snprintf(j->resp.content_type, sizeof j->resp.content_type, "text/plain; charset=utf-8");
         finish_job(w, j);
     }
+    free(rs.last_px);
     sy_interactive_destroy(rs.ia);
     sy_window_destroy(rs.win);
     sy_window_destroy(rs.still_win);

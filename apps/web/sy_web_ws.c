@@ -5,7 +5,9 @@
 
 #include "sy_log.h"
 #include "sy_mediator.h"
+#include "sy_jpeg.h"
 #include "sy_web_frame.h"
+#include "sy_web_video.h"
 
 #include <cjson/cJSON.h>
 
@@ -53,7 +55,74 @@ struct web_conn {
     char *msg;          /* a text message being assembled (max_message bytes) */
     size_t msg_len;     /* its bytes so far (a binary message's are counted, not kept) */
     bool msg_binary;
+    /* the video stream (docs/WEB.md, "The video stream"): the codec this viewer is sent (JPEG: none
+     * of those it decodes is available, or the budget is spent), its encoder, made at its first
+     * video frame, and what it has sent */
+    sy_web_codec codec;
+    sy_web_video_encoder *enc;
+    size_t reserved;          /* the encoder's share of WEB_VIDEO_BUDGET */
+    bool want_key;            /* the next video frame is a keyframe (asked, or a new back-end) */
+    uint32_t last_backend;
+    int kind;                 /* counted in w->video_viewers (2), jpeg_viewers (1) or neither (0) */
+    uint64_t v_frames, v_keys, v_bytes;
+    double v_psnr;            /* sum over v_frames */
 };
+
+/* Counts c as a video (2) or JPEG (1) viewer or neither (0): the render thread keeps the pixels
+ * while a video viewer is there and makes JPEG while a JPEG viewer is. Call with w->mu held. */
+static void set_kind(sy_web *w, web_conn *c, int kind)
+{
+    if (c->kind == 2) w->video_viewers--;
+    if (c->kind == 1) w->jpeg_viewers--;
+    c->kind = kind;
+    if (kind == 2) w->video_viewers++;
+    if (kind == 1) w->jpeg_viewers++;
+}
+
+static void video_summary(web_conn *c, const char *when)
+{
+    if (!c->v_frames) return;
+    sy_log(SY_LOG_NOTE, "web", c->peer, "video %s%s: %llu frames (%llu keyframes), %.0f bytes per frame, PSNR %.2f dB",
+           sy_web_codec_name(c->codec), when, (unsigned long long)c->v_frames, (unsigned long long)c->v_keys,
+           (double)c->v_bytes / c->v_frames, c->v_psnr / c->v_frames);
+}
+
+/* The viewer's codec from its size message: the first name it lists that this build encodes, if
+ * the encoders' budget has room for one more at the largest frame; names it does not know are
+ * ignored with a log line; otherwise JPEG as before. Network thread. */
+static void choose_codec(sy_web *w, web_conn *c, const sy_web_input *in)
+{
+    sy_web_codec pick = SY_WEB_CODEC_JPEG;
+    for (uint32_t i = 0; i < in->codec_count; ++i) {
+        sy_web_codec k;
+        if (!sy_web_codec_from_name(in->codecs[i], strlen(in->codecs[i]), &k))
+            sy_log(SY_LOG_WARNING, "web", c->peer, "ignored the codec \"%s\" the page listed: no such codec here", in->codecs[i]);
+        else if (pick == SY_WEB_CODEC_JPEG && sy_web_codec_available(k))
+            pick = k;
+    }
+    if (in->codecs_ignored)
+        sy_log(SY_LOG_WARNING, "web", c->peer, "ignored %u codec entr%s of the size message (\"%s\": not a short name)",
+               in->codecs_ignored, in->codecs_ignored == 1 ? "y" : "ies", in->codec_ignored);
+    if (pick == c->codec) return;
+    video_summary(c, " (switched)");
+    sy_web_video_encoder_destroy(c->enc);
+    c->enc = NULL;
+    w->video_reserved -= c->reserved;
+    c->reserved = 0;
+    c->v_frames = c->v_keys = c->v_bytes = 0, c->v_psnr = 0;
+    if (pick != SY_WEB_CODEC_JPEG) {
+        size_t need = sy_web_video_encoder_bytes(w->d.max_width, w->d.max_height);
+        if (w->video_reserved + need > WEB_VIDEO_BUDGET) {
+            sy_log(SY_LOG_WARNING, "web", c->peer, "%s refused: the video encoders' budget (%zu MiB) is spent: JPEG",
+                   sy_web_codec_name(pick), WEB_VIDEO_BUDGET >> 20);
+            pick = SY_WEB_CODEC_JPEG;
+        } else {
+            w->video_reserved += need, c->reserved = need;
+        }
+    }
+    c->codec = pick, c->want_key = true;
+    sy_log(SY_LOG_NOTE, "web", c->peer, "the viewer is sent %s", sy_web_codec_name(pick));
+}
 
 /* A malformed message: logged with the client's address, the first 10 per connection (a flood
  * does not flood the log). */
@@ -80,6 +149,12 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
         return;
     }
     if (w->d.read_only && in.type == SY_WEB_INPUT_PICK) in.on = false; /* a pick tells, it does not select */
+    if (in.type == SY_WEB_INPUT_KEYFRAME) { /* the page's decoder lost its place: the newest frame again, as a keyframe */
+        c->want_key = true, c->sent_seq = c->queued_seq = 0;
+        lws_callback_on_writable(c->wsi);
+        return;
+    }
+    if (in.type == SY_WEB_INPUT_SIZE && in.version >= SY_WEB_FRAME_VERSION) choose_codec(w, c, &in);
     pthread_mutex_lock(&w->mu);
     bool input = true;
     switch (in.type) {
@@ -130,11 +205,13 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
             return;
         }
         c->old_page = false, c->sized = true;
+        set_kind(w, c, c->codec == SY_WEB_CODEC_JPEG ? 1 : 2);
         w->display_w = (uint32_t)in.a, w->display_h = (uint32_t)in.b;
         w->view_version++;
         break;
     case SY_WEB_INPUT_DRAG: sy_interactive_drag(&w->in, in.button >= 1 ? 1 : 0, (float)in.a, (float)in.b); break;
     case SY_WEB_INPUT_WHEEL: sy_interactive_wheel(&w->in, (float)in.a); break;
+    case SY_WEB_INPUT_KEYFRAME: break; /* handled above */
     case SY_WEB_INPUT_KEY:
         if (in.key >= '1' && in.key <= '9') {
             uint32_t i = (uint32_t)(in.key - '1');
@@ -232,8 +309,90 @@ static uint64_t answered_by(web_conn *c, uint64_t gen)
     return c->answered_id;
 }
 
+/* A video viewer's frame: the header of f with the codec's frame in place of the JPEG, then the
+ * depth channel (docs/WEB.md: payload coding at 184, quality at 188, keyframe flag). The encoder
+ * sees exactly the frames this viewer is sent, in order, so each one predicts from the last. On
+ * an encoder failure the viewer falls back to JPEG. */
+static int send_video(sy_web *w, web_conn *c, web_frame *f, uint64_t id)
+{
+    sy_error err = {0};
+    sy_result r = c->enc ? SY_OK : sy_web_video_encoder_create(c->codec, SY_WEB_VIDEO_QUANTIZER, &c->enc, &err);
+    const uint8_t *pkt = NULL;
+    size_t plen = 0;
+    bool key = false;
+    if (r == SY_OK)
+        r = sy_web_video_encode(c->enc, f->rgba, f->width, f->height, c->want_key || f->backend != c->last_backend, &pkt,
+                                &plen, &key, &err);
+    size_t total = SY_WEB_FRAME_HEADER + plen + f->depth_len;
+    uint8_t *buf = NULL;
+    if (r == SY_OK && !(buf = malloc(LWS_PRE + total)))
+        r = sy_error_set(&err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %zu bytes", total);
+    if (r != SY_OK || !buf) {
+        sy_log(SY_LOG_WARNING, "web", c->peer, "%s failed, the viewer is sent JPEG from now: %s", sy_web_codec_name(c->codec),
+               err.message);
+        video_summary(c, "");
+        sy_web_video_encoder_destroy(c->enc);
+        c->enc = NULL, c->codec = SY_WEB_CODEC_JPEG;
+        w->video_reserved -= c->reserved, c->reserved = 0;
+        pthread_mutex_lock(&w->mu);
+        set_kind(w, c, 1);
+        w->view_version++; /* a frame with JPEG for it */
+        pthread_cond_signal(&w->cv);
+        pthread_mutex_unlock(&w->mu);
+        sy_webi_frame_release(w, f);
+        return 0;
+    }
+    c->want_key = false, c->last_backend = f->backend;
+    uint8_t *h = buf + LWS_PRE;
+    memcpy(h, f->buf + LWS_PRE, SY_WEB_FRAME_HEADER);
+    memcpy(h + SY_WEB_FRAME_HEADER, pkt, plen);
+    memcpy(h + SY_WEB_FRAME_HEADER + plen, f->buf + LWS_PRE + SY_WEB_FRAME_HEADER + f->jpeg_len, f->depth_len);
+    sy_web_frame_info fi = {.jpeg_len = (uint32_t)plen, .codec = c->codec, .quality = (float)sy_web_video_encoder_psnr(c->enc),
+                            .flags = key ? SY_WEB_FRAME_KEYFRAME : 0};
+    sy_web_frame_set_payload(h, &fi);
+    memcpy(h + 32, &id, 8);
+    sy_webi_frame_release(w, f);
+    c->v_frames++, c->v_keys += key, c->v_bytes += plen, c->v_psnr += fi.quality;
+    if (c->v_frames % 600 == 0) video_summary(c, " so far");
+    int n = lws_write(c->wsi, h, total, LWS_WRITE_BINARY);
+    free(buf);
+    return n < (int)total ? -1 : 0;
+}
+
 static int send_frame(sy_web *w, web_conn *c, web_frame *f, uint64_t id)
 {
+    if (c->codec != SY_WEB_CODEC_JPEG && f->rgba) return send_video(w, c, f, id);
+    if (c->codec != SY_WEB_CODEC_JPEG) { /* rendered before this viewer took video: JPEG now, the pixels asked for */
+        pthread_mutex_lock(&w->mu);
+        w->need_pixels = true;
+        pthread_cond_signal(&w->cv);
+        pthread_mutex_unlock(&w->mu);
+    }
+    if (!f->jpeg_len && f->rgba) { /* rendered while every viewer took video: its JPEG made here, for this viewer */
+        uint8_t *jpeg = NULL;
+        size_t jlen = 0;
+        sy_error err = {0};
+        size_t total = 0;
+        uint8_t *buf = NULL;
+        if (sy_jpeg_encode_rgba8(f->rgba, f->width, f->height, w->d.quality, &jpeg, &jlen, &err) == SY_OK &&
+            (buf = malloc(LWS_PRE + (total = SY_WEB_FRAME_HEADER + jlen + f->depth_len)))) {
+            uint8_t *h = buf + LWS_PRE;
+            memcpy(h, f->buf + LWS_PRE, SY_WEB_FRAME_HEADER);
+            memcpy(h + SY_WEB_FRAME_HEADER, jpeg, jlen);
+            memcpy(h + SY_WEB_FRAME_HEADER + jlen, f->buf + LWS_PRE + SY_WEB_FRAME_HEADER, f->depth_len);
+            sy_web_frame_info fi = {.jpeg_len = (uint32_t)jlen};
+            sy_web_frame_set_payload(h, &fi);
+            memcpy(h + 32, &id, 8);
+        } else {
+            sy_log(SY_LOG_WARNING, "web", c->peer, "a JPEG for this viewer failed: %s", err.message[0] ? err.message : "out of memory");
+        }
+        free(jpeg);
+        sy_webi_frame_release(w, f);
+        if (!buf) return 0;
+        int n = lws_write(c->wsi, buf + LWS_PRE, total, LWS_WRITE_BINARY);
+        free(buf);
+        return n < (int)total ? -1 : 0;
+    }
     memcpy(f->buf + LWS_PRE + 32, &id, 8); /* the buffer is shared: patched right before each write */
     size_t len = f->len;
     int n = lws_write(c->wsi, f->buf + LWS_PRE, len, LWS_WRITE_BINARY);
@@ -433,8 +592,13 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
                 }
                 w->replies_tail = &w->replies;
                 while (*w->replies_tail) w->replies_tail = &(*w->replies_tail)->next;
+                set_kind(w, c, 0);
                 pthread_mutex_unlock(&w->mu);
+                video_summary(c, "");
                 sy_log(SY_LOG_NOTE, "web", c->peer, "viewer left");
+                sy_web_video_encoder_destroy(c->enc);
+                c->enc = NULL;
+                w->video_reserved -= c->reserved, c->reserved = 0;
                 break;
             }
         free(c->msg);

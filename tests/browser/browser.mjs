@@ -26,6 +26,13 @@
 //     hidden.png, section.png, measure.png, help.png. URL with readonly=1 (sy web --read-only):
 //     the controls that change the scene are hidden or disabled and a change sent anyway leaves
 //     the tree as it was.
+//   node browser.mjs video URL OUTDIR WIDTH HEIGHT
+//     The video stream: which codecs this chromium's WebCodecs decodes (none: exit 77 with that
+//     reason); for each, a page with URL?video=0 (JPEG) and one with URL?codec=C at the same view,
+//     each waited for until its full-size frame answers every input, their canvases
+//     (OUTDIR/jpeg_C.png, OUTDIR/C.png) and their mean absolute difference (0..255, RGB, computed
+//     in the browser); then a drag of 20 moves on the video page (frames keep coming as delta
+//     frames) and back; sy.stats().video before and after.
 //   node browser.mjs client URL OUTDIR WIDTH HEIGHT
 //     The client-render page (sy web --client-render): waits until the client is idle (its last
 //     cull answer drawn), writes the canvas to OUTDIR/canvas.png and what the page fetched to
@@ -40,8 +47,8 @@ import { join } from 'node:path';
 
 const [mode, url, outDir, wArg, hArg] = process.argv.slice(2);
 const width = Number(wArg || 480), height = Number(hArg || 360);
-if (!['stream', 'client', 'warp', 'tools'].includes(mode) || !url || !outDir) {
-  console.error('usage: node browser.mjs stream|client|warp|tools URL OUTDIR [WIDTH HEIGHT]');
+if (!['stream', 'client', 'warp', 'tools', 'video'].includes(mode) || !url || !outDir) {
+  console.error('usage: node browser.mjs stream|client|warp|tools|video URL OUTDIR [WIDTH HEIGHT]');
   process.exit(2);
 }
 const executablePath = process.env.SY_CHROMIUM || '/usr/bin/chromium';
@@ -62,6 +69,24 @@ async function canvasPng(page, selector, path) {
   }, selector);
   await page.locator(selector).screenshot({ path });
   await page.evaluate(() => { for (const e of document.body.querySelectorAll('*')) e.style.visibility = ''; });
+}
+
+// mean absolute difference (0..255, RGB) of two PNG files of the same size, computed in page p
+async function pngMad(p, fa, fb) {
+  const a = readFileSync(fa).toString('base64'), b = readFileSync(fb).toString('base64');
+  return p.evaluate(async ([a, b]) => {
+    const px = async (s) => {
+      const bmp = await createImageBitmap(await (await fetch('data:image/png;base64,' + s)).blob());
+      const c = new OffscreenCanvas(bmp.width, bmp.height), g = c.getContext('2d');
+      g.drawImage(bmp, 0, 0);
+      return g.getImageData(0, 0, bmp.width, bmp.height).data;
+    };
+    const [p, q] = [await px(a), await px(b)];
+    if (p.length !== q.length) return -1;
+    let s = 0;
+    for (let i = 0; i < p.length; i += 4) s += Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) + Math.abs(p[i + 2] - q[i + 2]);
+    return s / (p.length / 4 * 3);
+  }, [a, b]);
 }
 
 let browser;
@@ -375,6 +400,60 @@ try {
     }, [px, py]);
     result.touch_inputs = (await page.evaluate(() => sy.stats().last_input)) - in0;
     await settled();
+    result.consoleErrors = consoleErrors;
+    console.log(JSON.stringify(result));
+  } else if (mode === 'video') {
+    const codecs = await page.evaluate(() => window.syVideo ? syVideo.ready : []);
+    await page.goto('about:blank'); // no viewer beside the pages below
+    if (!codecs.length) {
+      console.log("SKIP: this chromium's WebCodecs decodes neither vp8 nor vp9 (VideoDecoder.isConfigSupported)");
+      await browser.close();
+      process.exit(77);
+    }
+    const withQuery = (q) => url + (url.includes('?') ? '&' : '?') + q;
+    // a full-size frame answering every input sent so far, shown as it is (of the codec asked)
+    const settled = (p, video) => p.waitForFunction(
+      ([w, h, video]) => window.syStats && window.sy && syStats.frames > 0 && syStats.width === w && syStats.height === h &&
+                         syStats.answeredInput === syStats.lastInput && sy.stats().estimate_share === 0 &&
+                         (!video || (sy.stats().video.codec === video && sy.stats().video.frames > 0)),
+      [width, height, video], { timeout: TIMEOUT });
+    const open = async (q) => {
+      const p = await browser.newPage({ viewport: { width, height }, deviceScaleFactor: 1 });
+      p.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+      p.on('pageerror', (e) => consoleErrors.push(String(e)));
+      await p.goto(withQuery(q), { timeout: TIMEOUT });
+      return p;
+    };
+    const still = (p) => p.waitForTimeout(300).then(() => p.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))));
+    const result = { codecs, runs: [] };
+    for (const codec of codecs) {
+      const pj = await open('video=0');
+      await settled(pj, null).catch(() => fail('the JPEG page got no full-size frame'));
+      await still(pj);
+      await canvasPng(pj, '#sy-canvas', join(outDir, `jpeg_${codec}.png`));
+      const jpegStats = await pj.evaluate(() => sy.stats());
+      await pj.close();
+      const pv = await open('codec=' + codec);
+      await settled(pv, codec).catch(() => fail(`the ${codec} page got no full-size ${codec} frame`));
+      await still(pv);
+      await canvasPng(pv, '#sy-canvas', join(outDir, `${codec}.png`));
+      const before = await pv.evaluate(() => sy.stats());
+      const mad = await pngMad(pv, join(outDir, `jpeg_${codec}.png`), join(outDir, `${codec}.png`));
+      // a drag and back: the stream goes on with delta frames
+      const x0 = width / 2 - 60, y0 = height / 2;
+      for (const dir of [1, -1]) {
+        await pv.mouse.move(x0, y0);
+        await pv.mouse.down();
+        for (let i = 1; i <= 20; i++) { await pv.mouse.move(x0 + dir * 3 * i, y0); await pv.waitForTimeout(16); }
+        await pv.mouse.up();
+        await settled(pv, codec).catch(() => fail(`no full-size ${codec} frame answered the drag`));
+      }
+      const after = await pv.evaluate(() => sy.stats());
+      await pv.close();
+      result.runs.push({ codec, mad, jpeg_bytes_per_frame: Math.round(jpegStats.bytes_per_frame), jpeg_video: jpegStats.video,
+                         before: { video: before.video, bad: before.bad, frames: before.frames },
+                         after: { video: after.video, bad: after.bad, frames: after.frames, bytes_per_frame: Math.round(after.bytes_per_frame) } });
+    }
     result.consoleErrors = consoleErrors;
     console.log(JSON.stringify(result));
   } else {

@@ -33,6 +33,14 @@
 #     without it 383 to 564 ms). The warped estimate of a 12-pixel drag differs from the
 #     server's frame of the same view by a mean absolute difference below 6 (0..255); made-up
 #     bad frames sent to the page are each counted for their reason and leave the canvas as it was.
+#   browser_test.sh video SY PNG_IOU MODULES_DIR SCENE
+#     sy web SCENE -b raster: for each codec this chromium's WebCodecs decodes (none: skipped with
+#     that reason), the video page's canvas matches the JPEG page's at the same view within a mean
+#     absolute difference of 6 (0..255; the bound of the warp's check: both are lossy codings of
+#     the same frame, JPEG at quality 80 and the codec at quantizer 36); its stream is of that
+#     codec, decoded without errors or refused frames, and a drag and back are answered by more
+#     frames, most of them delta frames.
+#   The warp test runs with ?video=0: its made-up bad frames are JPEG frames.
 #
 # MODULES_DIR holds browser.mjs and node_modules/playwright-core. Skipped (77, with the reason)
 # without chromium, node, playwright-core (npm ci failed: no network at build time) or the scene;
@@ -160,7 +168,36 @@ if [ "$mode" = tools ]; then
     exit $fail
 fi
 
+if [ "$mode" = video ]; then
+    browse "$url"
+    [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null
+    node -e '
+      const s = JSON.parse(require("fs").readFileSync(process.argv[1])), errs = [], MAD = 6;
+      for (const r of s.runs) {
+        const b = r.before.video, a = r.after.video;
+        console.log(`${r.codec}: canvas vs JPEG mean abs diff ${r.mad.toFixed(2)}; ${a.frames} video frames (${a.keyframes} keyframes, ` +
+                    `${a.frames - b.frames} during the drags), ${Math.round(a.bytes_per_frame)} bytes per video frame (PSNR ${a.psnr_db.toFixed(1)} dB) ` +
+                    `against ${r.jpeg_bytes_per_frame} per JPEG frame; decode p50 ${[...a.decode_ms].sort((x, y) => x - y)[a.decode_ms.length >> 1]} ms`);
+        if (!(r.mad >= 0 && r.mad < MAD)) errs.push(`${r.codec}: the picture differs from the JPEG one by ${r.mad}`);
+        if (r.jpeg_video.codec !== "jpeg" || r.jpeg_video.frames !== 0) errs.push(`?video=0 was sent video: ${JSON.stringify(r.jpeg_video)}`);
+        if (b.codec !== r.codec || a.codec !== r.codec) errs.push(`${r.codec}: the stream was ${a.codec}`);
+        if (a.errors || a.dropped) errs.push(`${r.codec}: ${a.errors} decoder errors, ${a.dropped} frames dropped`);
+        if (!(a.frames - b.frames >= 2)) errs.push(`${r.codec}: ${a.frames - b.frames} frames during the drags`);
+        if (!(a.keyframes >= 1 && a.keyframes < a.frames)) errs.push(`${r.codec}: ${a.keyframes} keyframes of ${a.frames}`);
+        for (const st of [r.before, r.after]) for (const k in st.bad) if (st.bad[k]) errs.push(`${r.codec}: frames refused: ${JSON.stringify(st.bad)}`);
+      }
+      if (s.consoleErrors.length) errs.push(`page errors: ${s.consoleErrors}`);
+      if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
+    ' "$out/browser.json" || fail=1
+    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
+    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
+    grep -E 'video|sent (vp8|vp9|jpeg)' "$out/err" | head -8
+    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
+    exit $fail
+fi
+
 if [ "$mode" = warp ]; then
+    case $url in *\?*) url="$url&video=0" ;; *) url="$url?video=0" ;; esac # the made-up bad frames below are JPEG frames
     browse "$url"
     cp "$out/browser.json" "$out/warp.json"
     case $url in *\?*) nurl="$url&warp=0" ;; *) nurl="$url?warp=0" ;; esac

@@ -19,7 +19,8 @@
   const wsUrl = (location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws" +
                 (token ? "?token=" + encodeURIComponent(token) : "");
   let ws = null, inputId = 0, decoding = false, pending = null, lastSeq = -1, hold = false;
-  const bad = { magic: 0, version: 0, size: 0, order: 0, camera: 0, depth: 0, jpeg: 0 };
+  const bad = { magic: 0, version: 0, size: 0, order: 0, camera: 0, depth: 0, jpeg: 0, video: 0 };
+  const video = window.syVideo || null; // video.js: the video stream's decoder (docs/WEB.md)
   const hist = { input: [], frame: [], bytes: [], arrivals: [], adopt: [] };
   function keep(a, v, n) { a.push(v); if (a.length > n) a.shift(); }
 
@@ -211,7 +212,7 @@
                 answered: Number(dv.getBigUint64(32, true)), jpegLen: dv.getUint32(44, true), depthLen: dv.getUint32(48, true),
                 coding: dv.getUint32(52, true), dmin: dv.getFloat32(56, true), dmax: dv.getFloat32(60, true),
                 c2w: new Float32Array(buf.slice(64, 128)), win: [0, 1, 2, 3].map((i) => dv.getFloat32(128 + 4 * i, true)),
-                proj: dv.getUint32(144, true), flags: dv.getUint32(180, true), bytes: len,
+                proj: dv.getUint32(144, true), flags: dv.getUint32(180, true), bytes: len, codec: dv.getUint32(184, true),
                 orbit: { target: [0, 1, 2].map((i) => dv.getFloat32(156 + 4 * i, true)), yaw: dv.getFloat32(168, true),
                          pitch: dv.getFloat32(172, true), dist: dv.getFloat32(176, true) } };
     if (!f.w || !f.h || f.w > 16384 || f.h > 16384 || f.w * f.h > 67108864 || HEADER + f.jpegLen + f.depthLen !== len) return { bad: "size" };
@@ -289,12 +290,15 @@
     }
     keep(hist.bytes, f.bytes, 60); keep(hist.arrivals, performance.now(), 120);
     decoding = true;
-    const jpeg = new Blob([new Uint8Array(buf, HEADER, f.jpegLen)], { type: "image/jpeg" });
+    const jpeg = f.codec ? null : new Blob([new Uint8Array(buf, HEADER, f.jpegLen)], { type: "image/jpeg" });
+    const picture = !f.codec ? createImageBitmap(jpeg).catch(() => { throw new Error("jpeg"); })
+      : !video ? Promise.reject(new Error("video")) // a video frame: video.js decoded it as it arrived
+      : video.frame(f.seq).then((vf) => createImageBitmap(vf).finally(() => vf.close())).catch(() => { throw new Error("video"); });
     const depth = f.depthLen ? inflate(new Uint8Array(buf, HEADER + f.jpegLen, f.depthLen)).then((p) => {
       if (p.length !== 2 * f.w * f.h) throw new Error("depth");
       return decodeDepth(p, f.w, f.h, f.dmin, f.dmax);
     }) : Promise.resolve(null);
-    Promise.all([createImageBitmap(jpeg).catch(() => { throw new Error("jpeg"); }), depth.catch(() => { throw new Error("depth"); })])
+    Promise.all([picture, depth.catch(() => { throw new Error("depth"); })])
       .then(function ([bmp, d]) {
         if (bmp.width !== f.w || bmp.height !== f.h) { bmp.close(); throw new Error("size"); }
         if (hold) { bmp.close(); return; } // tests: the references stay as they are
@@ -427,6 +431,7 @@
                server_fps: recent.length / 2, bytes_per_frame: mean(hist.bytes),
                estimate_share: estimate, hole_share: opts && opts.holes ? holeShare() : null, stride: stride, warp_scale: LEVELS[level].scale, warp: warpOn && !!gl,
                bad: Object.assign({}, bad),
+               video: video ? video.stats() : null,
                shown_input: shownInput, last_input: inputId, frames: stats.frames,
                display_frames: frameCount, inputs_displayed: inputCount, inputs_by_estimate: warpAnswered }; // counts: slice the arrays' ends
     },
@@ -463,7 +468,7 @@
     const w = Math.max(1, Math.round(canvas.clientWidth * dpr)), h = Math.max(1, Math.round(canvas.clientHeight * dpr));
     canvas.width = w; canvas.height = h;
     moved = true;
-    send({ t: "size", w: w, h: h, v: FORMAT });
+    send({ t: "size", w: w, h: h, v: FORMAT, codecs: video ? video.codecs : undefined });
   }
   function connect() {
     ws = new WebSocket(wsUrl, "sy-view");
@@ -471,7 +476,8 @@
     ws.onopen = function () {
       stats.connected = true; lastSeq = -1; // a restarted server counts from 1 again
       hud.textContent = gl ? "connected" : "connected (no WebGL2: server frames only)";
-      sendSize();
+      if (video) { video.reset(); video.askKeyframe = function () { send({ t: "keyframe" }); }; }
+      (video ? video.ready : Promise.resolve()).then(sendSize);
     };
     ws.onclose = function (e) {
       stats.connected = false;
@@ -488,6 +494,7 @@
         } catch (err) {}
         return;
       }
+      if (video) video.feed(e.data); // every video frame is decoded, in order, shown or not
       if (decoding) pending = e.data; else show(e.data);
     };
   }
