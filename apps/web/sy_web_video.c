@@ -159,6 +159,7 @@ static sy_result enc_open(sy_web_video_encoder *e, uint32_t w, uint32_t h, sy_er
     cfg.rc_dropframe_thresh = 0;                         /* every frame given is sent */
     cfg.rc_resize_allowed = 0;
     cfg.kf_mode = VPX_KF_DISABLED; /* keyframes when asked (VPX_EFLAG_FORCE_KF) and the first */
+    cfg.kf_min_dist = 0, cfg.kf_max_dist = 1000000; /* VP9 counts its interval (128) even without kf_mode */
     if (vpx_codec_enc_init(&e->ctx, iface, &cfg, VPX_CODEC_USE_PSNR))
         return sy_error_set(err, SY_ERR_BACKEND, "web: %s encoder of %ux%u: %s", sy_web_codec_name(e->codec), w, h,
                             vpx_codec_error(&e->ctx));

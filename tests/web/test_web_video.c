@@ -8,7 +8,8 @@
  *                 libvpx update that shifts its rates a little passes while a broken colour
  *                 conversion or a lost reference frame, 15-25 dB, fails), the delta frames cost
  *                 less than the keyframe, and a
- *                 picture that stays costs under a tenth of its keyframe (inter prediction works);
+ *                 picture that stays costs under a tenth of its keyframe (inter prediction works)
+ *                 and gets no keyframe of libvpx's own in 300 frames;
  *                 keyframes exactly where asked (frame 0, 15, 30) and nowhere else; a smaller
  *                 size goes on (decoded at that size), a larger one restarts the stream with a
  *                 keyframe; a finer quantizer gives a better picture
@@ -143,13 +144,18 @@ static int test_moving(void)
         CHECK_OK(sy_web_video_encoder_create(c, SY_WEB_VIDEO_QUANTIZER, &e, &err), err);
         picture(px, W, H, 5);
         size_t lens[4] = {0};
-        for (int k = 0; k < 4; ++k) {
+        int keys = 0;
+        for (int k = 0; k < 300; ++k) { /* past libvpx's default keyframe interval (VP9: 128) */
             const uint8_t *data = NULL;
             bool key = false;
-            CHECK_OK(sy_web_video_encode(e, px, W, H, false, &data, &lens[k], &key, &err), err);
+            size_t len = 0;
+            CHECK_OK(sy_web_video_encode(e, px, W, H, false, &data, &len, &key, &err), err);
+            if (k < 4) lens[k] = len;
+            keys += key;
         }
         EXPECT_MSG(lens[3] * 10 < lens[0], "%s: a picture that stays: %zu bytes after a keyframe of %zu", sy_web_codec_name(c),
                    lens[3], lens[0]);
+        EXPECT_MSG(keys == 1, "%s: %d keyframes in 300 frames, one asked", sy_web_codec_name(c), keys);
         sy_web_video_encoder_destroy(e);
         free(px);
     }
