@@ -442,7 +442,7 @@ static void parse_codecs(const cJSON *c, sy_web_input *out)
 {
     if (!c) return;
     if (!cJSON_IsArray(c)) {
-        ignore_codec(out, "(codecs is no array)");
+        ignore_codec(out, "codecs is no array");
         return;
     }
     const cJSON *e;
@@ -452,7 +452,7 @@ static void parse_codecs(const cJSON *c, sy_web_input *out)
         bool ok = n >= 1 && n < sizeof out->codecs[0] && out->codec_count < SY_WEB_MAX_CODECS;
         for (size_t i = 0; ok && i < n; ++i) ok = (s[i] >= 'a' && s[i] <= 'z') || (s[i] >= '0' && s[i] <= '9') || s[i] == '.';
         if (ok) memcpy(out->codecs[out->codec_count++], s, n + 1);
-        else ignore_codec(out, s ? s : "(not a string)");
+        else ignore_codec(out, s ? s : "an entry that is no string");
     }
 }
 

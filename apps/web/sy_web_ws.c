@@ -101,7 +101,7 @@ static void choose_codec(sy_web *w, web_conn *c, const sy_web_input *in)
             pick = k;
     }
     if (in->codecs_ignored)
-        sy_log(SY_LOG_WARNING, "web", c->peer, "ignored %u codec entr%s of the size message (\"%s\": not a short name)",
+        sy_log(SY_LOG_WARNING, "web", c->peer, "ignored %u codec entr%s of the size message (the first: %s; a codec is a name of 1..15 of a-z, 0-9 and .)",
                in->codecs_ignored, in->codecs_ignored == 1 ? "y" : "ies", in->codec_ignored);
     if (pick == c->codec) return;
     video_summary(c, " (switched)");
