@@ -398,7 +398,9 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         }
         bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
         if (clients && (moved || due)) render_live(w, &rs, &in, bi, dw, dh, gen, &again, &wait_until);
-        else if (need_pixels) republish_with_pixels(w, &rs);
+        /* after render_live, which may have rendered nothing (a view at rest): a no-op when the
+         * newest frame has its pixels */
+        if (need_pixels) republish_with_pixels(w, &rs);
         /* then one still: stills wait behind the live view */
         pthread_mutex_lock(&w->mu);
         web_job *still = w->stills;

@@ -1334,7 +1334,8 @@ static int test_video_stream(uint16_t port)
     sy_web_client_opts o = {.host = "127.0.0.1", .port = port, .path = "/ws"};
     CHECK_OK(sy_web_client_connect(&o, 10000, &v, &err), err);
     CHECK_OK(sy_web_client_connect(&o, 10000, &j, &err), err);
-    CHECK_OK(sy_web_client_send(j, "{\"t\":\"size\",\"w\":" SW ",\"h\":" SH ",\"v\":2}", &err), err);
+    /* the video viewer first: the JPEG viewer may then be sent a frame made for video only (its
+     * JPEG made on the network thread) */
     CHECK_OK(sy_web_client_send(v, "{\"t\":\"size\",\"w\":" SW ",\"h\":" SH ",\"v\":2,\"codecs\":[\"vp10\",\"VP9\",5,\"vp9\",\"vp8\"]}", &err), err);
     sy_web_frame_info fi;
     uint8_t *pay = NULL, *jp = NULL, *jpx = NULL;
@@ -1347,6 +1348,7 @@ static int test_video_stream(uint16_t port)
     CHECK_MSG(fi.flags & SY_WEB_FRAME_KEYFRAME, "the first VP9 frame is no keyframe (flags %u)", fi.flags);
     CHECK_MSG(fi.quality > 25 && fi.quality < 100, "PSNR %g", (double)fi.quality);
     CHECK(fi.depth_len > 0);
+    CHECK_OK(sy_web_client_send(j, "{\"t\":\"size\",\"w\":" SW ",\"h\":" SH ",\"v\":2}", &err), err);
     sy_web_video_decoder *d = NULL;
     CHECK_OK(sy_web_video_decoder_create(SY_WEB_CODEC_VP9, &d, &err), err);
     const uint8_t *px = NULL;
