@@ -11,7 +11,7 @@
 # tests/integration/completion_test.sh checks a few.
 
 _sy_commands="info render demo compare convert coverage pick view web bench backends serve help version"
-_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit cull web deform anim lights temporal"
+_sy_bench_kinds="sync rays pathtracer filters raster viewports load cluster memory instances governor limit cull web deform anim lights temporal stream"
 _sy_common="--help -q --quiet -v --verbose --env --env-color --env-intensity --env-hidden --background
             --no-default-light --allow-path --strict --max-scene-mb --variant"
 _sy_cluster="--cluster --cluster-mode --secret-file --tls-ca --timeout-ms --cluster-pixels"

@@ -234,6 +234,7 @@ static const char usage_text[] =
             "           selection, section plane, exposure, filter or back-end)\n"
             "          [--delay-ms N]   (tests only: N ms of added network delay each way)\n"
             "  sy bench web [SCENE] [-b BACKEND] [-w W] [-h H] [--repeats N]   (input-to-frame latency, loopback)\n"
+            "  sy bench stream [SCENE] [-b BACKEND] [-w W] [-h H] [--repeats FPS]   (sy web's JPEG vs VP8 / VP9: bytes at equal SSIM, 10 s orbit)\n"
             "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"
             "  sy bench rays [SCENE] [-w W] [-h H] [--repeats R]\n"
             "  sy bench pathtracer [SCENE] [-w W] [-h H] [--repeats PASSES]\n"

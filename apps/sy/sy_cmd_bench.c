@@ -13,6 +13,7 @@
 #include "sy_cluster_cli.h"
 #include "sy_load.h"
 #ifdef SY_HAVE_WEB
+#include "sy_bench_stream.h"
 #include "sy_bench_web.h"
 #include "sy_web.h"
 #endif
@@ -145,7 +146,7 @@ int sy_cmd_bench(int argc, char **argv)
 {
     static const char *const kinds[] = {"sync",      "rays", "pathtracer", "filters", "raster",
                                         "viewports", "load", "cluster",    "memory", "instances", "governor",
-                                        "limit",     "cull", "web", "deform", "anim", "lights", "temporal"};
+                                        "limit",     "cull", "web", "deform", "anim", "lights", "temporal", "stream"};
     bool known = false;
     for (size_t k = 0; argc >= 2 && k < sizeof kinds / sizeof kinds[0]; ++k) known = known || !strcmp(argv[1], kinds[k]);
     if (argc >= 2 && !strcmp(argv[1], "--help")) {
@@ -166,7 +167,7 @@ int sy_cmd_bench(int argc, char **argv)
     if (!strcmp(cmd, "cull")) return SY_BENCH_CULL(argc, argv); /* apps/sy/sy_bench_cull.c */
     uint32_t nodes = 10000, tris = 100, repeats = 0, w = 512, h = 512;
     const char *scene = NULL, *params = NULL, *backend = NULL;
-    bool memory = !strcmp(cmd, "memory"), instanced = !strcmp(cmd, "instances"), web = !strcmp(cmd, "web");
+    bool memory = !strcmp(cmd, "memory"), instanced = !strcmp(cmd, "instances"), web = !strcmp(cmd, "web") || !strcmp(cmd, "stream");
     char who[32];
     snprintf(who, sizeof who, "bench %s", cmd);
     bool glb = false;
@@ -227,6 +228,16 @@ int sy_cmd_bench(int argc, char **argv)
         return sy_bench_load(scene ? scene : "../shared/testdata/gltf", tris == 100 ? 1000000 : tris,
                              repeats ? repeats : 3, &err) == SY_OK ? 0 : sy_cli_fail(&err);
 #ifdef SY_HAVE_WEB
+    if (!strcmp(cmd, "stream")) { /* sy web's JPEG against its video stream on an orbit (apps/sy/sy_bench_stream.c) */
+        loaded ld;
+        if (sy_cli_load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
+        sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .background = ld.background,
+                               .backend = backend ? backend : sy_mediator_default_name()};
+        sy_result r = sy_bench_stream(ld.scene, &vd, scene ? scene : "demo", w == 512 ? 640 : w, h == 512 ? 360 : h,
+                                      repeats ? repeats : 30, &err);
+        sy_cli_loaded_free(&ld);
+        return r == SY_OK ? 0 : sy_cli_fail(&err);
+    }
     if (web) { /* input-to-frame latency of sy web on loopback (apps/sy/sy_bench_web.c) */
         loaded ld;
         if (sy_cli_load(scene ? scene : "demo", NULL, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
