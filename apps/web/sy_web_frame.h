@@ -1,7 +1,8 @@
 /** @file
  * sy_web_frame.h — the binary frame of sy web's stream, format 2 (docs/WEB.md, "Binary frames"):
  * a 192-byte little-endian header (size, back-end, samples, the frame's camera and orbit, the
- * depth range), the JPEG, then the depth channel: 16-bit log-quantised view depth, each row
+ * depth range, the payload's codec), the payload (the JPEG, or a video viewer's VP8 / VP9 frame:
+ * sy_web_video.h), then the depth channel: 16-bit log-quantised view depth, each row
  * delta-coded, split into a low-byte and a high-byte plane and deflated (zlib format: the page
  * inflates it with the browser's own DecompressionStream("deflate"); zstd, which the cluster
  * uses, has no decoder in the browser). The server packs frames with sy_web_frame_pack; clients
