@@ -1,4 +1,4 @@
-# Type stubs of the extension module switchyard._switchyard (apps/python/src/sy_python.c). Users
+# Type stubs of the extension module switchyard._switchyard (apps/python/src/sy_py_*.c). Users
 # call the objects of switchyard/__init__.py; these are their building blocks.
 from typing import Any, Callable, Optional, Sequence
 
