@@ -910,7 +910,7 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
     double last = glfwGetTime();
     uint8_t *img = NULL;
     uint32_t iw = 0, ih = 0;
-    char title[1024] = "sy view";
+    char title[2048] = "sy view"; /* the longest status parts together: 1,415 bytes */
     const char *keys = args->keys; /* scripted key presses, one per answered frame */
     char key_last = 0;
     uint64_t key_req = 0;

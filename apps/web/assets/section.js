@@ -6,7 +6,7 @@
 (function () {
   const sy = window.sy, ui = sy.ui, el = ui.el;
   const sec = ui.section("Section planes", "sy-section");
-  ui.writers.push(sec);
+  ui.writer(sec);
   const rows = el("div", {}, sec);
   const add = ui.button("+ plane", "add a section plane (at most 6)", function () { addPlane("x", 0.5, false); }, sec);
   add.id = "sy-plane-add";

@@ -16,7 +16,7 @@
     if (state.selected) sy.send({ t: "isolate", node: state.selected });
   }, bar);
   const clear = ui.button("deselect", "clear the selection", function () { sy.send({ t: "select", node: 0, on: false }); }, bar);
-  ui.writers.push(showAll, isolate, clear);
+  ui.writer(showAll, isolate, clear);
   const propSec = ui.section("Picked", "sy-props");
   const props = el("div", { class: "kv" }, propSec);
   el("div", { class: "note" }, propSec, "click an object to pick it");

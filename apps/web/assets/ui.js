@@ -54,7 +54,10 @@
   }
   const ui = sy.ui = { el: el, button: button, panel: panel, bar: bar, readOnly: false, hello: null,
                        section: function (title, id) { const s = el("div", { id: id }, panel); el("h3", {}, s, title); return s; },
-                       writers: [] }; // elements a read-only server hides
+                       writers: [], // elements a read-only server hides: add them with ui.writer
+                       writer: function () { // (a script may run after the hello: the state applies at once)
+                         for (const w of arguments) { ui.writers.push(w); w.classList.toggle("sy-hidden", ui.readOnly); }
+                       } };
   button("☰", "the panel: menu, scene tree, properties, measurement, section planes, stats", function () {
     panel.classList.toggle("hidden");
   }).id = "sy-panel-button";
@@ -67,7 +70,7 @@
   const eRange = el("input", { id: "sy-exposure", type: "range", min: "-6", max: "6", step: "0.25", value: "0" }, eLab);
   const eVal = el("span", {}, eLab, "0");
   el("div", { class: "note" }, menu, "Environment: the scene's own (the server offers no other)");
-  ui.writers.push(bSel.parentNode, fLab, eLab);
+  ui.writer(bSel.parentNode, fLab, eLab);
   bSel.addEventListener("change", function () { sy.input({ t: "key", k: String(bSel.selectedIndex + 1) }); bSel.blur(); });
   fSel.addEventListener("change", function () { sy.send({ t: "filter", name: fSel.value }); fSel.blur(); });
   let eTimer = 0;

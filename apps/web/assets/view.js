@@ -442,7 +442,9 @@
     // is on the canvas now (CSS pixels; null when behind the camera or before the first frame)
     send: function (o) { send(o); },
     input: function (o) { input(o, null); },
-    on: function (f) { listeners.push(f); },
+    // a script that subscribes after the server's hello (the page's scripts load one by one while
+    // the socket is open) is handed that hello at once
+    on: function (f) { listeners.push(f); if (lastHello) try { f(lastHello); } catch (err) { console.error(err); } },
     project: function (p) {
       if (!refs.length) return null;
       const m = rigidInverse(orbitMatrix(sent.length ? localOrbit() : refs[0].orbit)), win = refs[0].win;
@@ -453,6 +455,7 @@
   };
 
   const listeners = []; // window.sy.on: the server's text messages, parsed
+  let lastHello = null;
   function send(o) {
     if (ws && ws.readyState === 1) ws.send(JSON.stringify(o));
   }
@@ -488,7 +491,7 @@
       if (typeof e.data === "string") {
         try {
           const m = JSON.parse(e.data);
-          if (m.t === "hello") stats.backends = m.backends;
+          if (m.t === "hello") stats.backends = m.backends, lastHello = m;
           if (m.t === "status") { stats.filter = m.filter; if (m.error) hud.textContent = m.error; }
           for (const f of listeners) try { f(m); } catch (err) { console.error(err); }
         } catch (err) {}
