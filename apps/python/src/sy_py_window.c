@@ -150,6 +150,16 @@ static sy_viewport *window_vp(WindowObject *w, unsigned int i)
     return w->vps[i];
 }
 
+/* The viewport named by a call's one argument (index); *index_out its index. NULL with the
+ * exception set. */
+static sy_viewport *window_vp_arg(PyObject *self, PyObject *args, unsigned int *index_out)
+{
+    unsigned int i;
+    if (!PyArg_ParseTuple(args, "I", &i)) return NULL;
+    *index_out = i;
+    return window_vp((WindowObject *)self, i);
+}
+
 /* _set_backend(index, backend, params=None): switches a live viewport (its old context stays cached) */
 static PyObject *window_set_backend(PyObject *self, PyObject *args)
 {
@@ -177,8 +187,7 @@ static PyObject *window_viewport(PyObject *self, PyObject *args)
 {
     WindowObject *w = (WindowObject *)self;
     unsigned int i;
-    if (!PyArg_ParseTuple(args, "I", &i)) return NULL;
-    sy_viewport *vp = window_vp(w, i);
+    sy_viewport *vp = window_vp_arg(self, args, &i);
     if (!vp) return NULL;
     return Py_BuildValue("{s:s,s:s,s:N}", "backend", sy_viewport_backend(vp), "params", w->params[i], "active",
                          PyBool_FromLong(sy_viewport_active(vp)));
@@ -254,10 +263,8 @@ static PyObject *window_set_clip_planes(PyObject *self, PyObject *args)
 /* _clip_planes(index) -> list of (a, b, c, d) */
 static PyObject *window_clip_planes(PyObject *self, PyObject *args)
 {
-    WindowObject *w = (WindowObject *)self;
     unsigned int i;
-    if (!PyArg_ParseTuple(args, "I", &i)) return NULL;
-    sy_viewport *vp = window_vp(w, i);
+    sy_viewport *vp = window_vp_arg(self, args, &i);
     if (!vp) return NULL;
     float planes[SY_CLIP_PLANES_MAX][4];
     uint32_t n = sy_viewport_clip_planes(vp, planes);
@@ -293,10 +300,8 @@ static PyObject *window_set_clip_cap(PyObject *self, PyObject *args)
 /* _clip_cap(index) -> (r, g, b) or None */
 static PyObject *window_clip_cap(PyObject *self, PyObject *args)
 {
-    WindowObject *w = (WindowObject *)self;
     unsigned int i;
-    if (!PyArg_ParseTuple(args, "I", &i)) return NULL;
-    sy_viewport *vp = window_vp(w, i);
+    sy_viewport *vp = window_vp_arg(self, args, &i);
     if (!vp) return NULL;
     float c[3];
     if (!sy_viewport_clip_cap(vp, c)) Py_RETURN_NONE;
