@@ -579,7 +579,7 @@ static int render_frames_mode(loaded *ld, const sy_compose_spec *spec, const sy_
     sy_error err = {0};
     sy_result r = numbers && times && views ? SY_OK : sy_error_set(&err, SY_ERR_OUT_OF_MEMORY, "out of memory");
     bool animated = sy_scene_count(ld->scene, SY_TYPE_ANIMATION) > 0;
-    sy_animation clip_h = {0};
+    sy_animation clip_h = sy_cli_default_clip(ld); /* the servers' clock plays the same clip */
     if (r == SY_OK && clip && animated && sy_animation_find(ld->scene, clip, &clip_h, &err) != SY_OK) {
         fprintf(stderr, "sy render: error: --clip %s: %s\n", clip, err.message);
         free(numbers), free(times), free(views);

@@ -63,7 +63,8 @@ int sy_cmd_view(int argc, char **argv)
     }
     loaded ld;
     if (sy_cli_load(scene, camera, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
-    sy_view_args va = {.scene = ld.scene, .backend = backend, .width = w, .height = h, .frames = frames, .screenshot = shot};
+    sy_view_args va = {.scene = ld.scene, .backend = backend, .width = w, .height = h, .frames = frames, .screenshot = shot,
+                       .clip = sy_cli_default_clip(&ld)};
     va.filter = view_filter;
     va.threshold = view_threshold;
     va.keys = view_keys;

@@ -419,9 +419,16 @@ sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, l
     return r;
 }
 
-int sy_cli_set_time(loaded *ld, const char *clip, double seconds, sy_error *err)
+sy_animation sy_cli_default_clip(const loaded *ld)
 {
     sy_animation a = {0};
+    if (ld->is_gltf && sy_scene_count(ld->scene, SY_TYPE_ANIMATION) > 1) a.id = sy_scene_next(ld->scene, SY_TYPE_ANIMATION, 0);
+    return a;
+}
+
+int sy_cli_set_time(loaded *ld, const char *clip, double seconds, sy_error *err)
+{
+    sy_animation a = sy_cli_default_clip(ld);
     if (!sy_scene_count(ld->scene, SY_TYPE_ANIMATION)) {
         if (clip) {
             fprintf(stderr, "sy render: error: --clip %s: the scene has no animations\n", clip);
@@ -436,6 +443,11 @@ int sy_cli_set_time(loaded *ld, const char *clip, double seconds, sy_error *err)
             fprintf(stderr, "sy render: error: --clip %s: %s\n", clip, fe.message);
             return 2;
         }
+    } else if (a.id && !ld->clip_noted) {
+        const sy_animation_data *d = sy_animation_get(ld->scene, a);
+        sy_log(SY_LOG_NOTE, "sy", NULL, "playing clip 0 (%s) of %u; --clip NAME|INDEX plays another",
+               d && d->name ? d->name : "unnamed", sy_scene_count(ld->scene, SY_TYPE_ANIMATION));
+        ld->clip_noted = true;
     }
     sy_anim_stats st;
     if (sy_scene_set_time_ex(ld->scene, a, seconds, &st, err) != SY_OK || sy_scene_commit(ld->scene, NULL, err) != SY_OK)

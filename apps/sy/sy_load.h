@@ -23,6 +23,7 @@ typedef struct loaded {
     bool is_x3d;
     sy_assimp_info assimp; /* OBJ, FBX, COLLADA, PLY, STL, ... through Assimp (is_assimp) */
     bool is_assimp;
+    bool clip_noted; /* sy_cli_set_time said which clip plays by default */
 } loaded;
 
 /* Loader options every command shares, taken out of the arguments by sy_cli_next_option:
@@ -86,10 +87,15 @@ sy_result sy_cli_find_nodes(const sy_scene *s, const char *opt, const char *node
  * them; an unknown NODE fails the load naming the option and NODE. On failure *out is empty. */
 sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, loaded *out, sy_error *err);
 void sy_cli_loaded_free(loaded *l);
+/* The clip a scene plays when no --clip is given: a glTF file's animations are alternatives (a
+ * character's walk, run and idle that drive the same joints), so its first one, as glTF viewers
+ * do; an X3D file's TimeSensors all run at once, as X3D says, and so do the clips of other formats
+ * ({0}: every animation; sy_scene_set_time). */
+sy_animation sy_cli_default_clip(const loaded *ld);
 /* --at SECONDS / --clip NAME|INDEX: sets the loaded scene's time (sy_scene_set_time) on that clip, or
- * on every clip without one, and commits. Returns 0; 2 after a usage error (an unknown clip, named
- * with the clips there are, on stderr); 1 with *err when the scene refused a value. A scene without
- * animations is told on the log (a note) and left as it is. */
+ * on sy_cli_default_clip without one (a note says which, once), and commits. Returns 0; 2 after a
+ * usage error (an unknown clip, named with the clips there are, on stderr); 1 with *err when the
+ * scene refused a value. A scene without animations is told on the log (a note) and left as it is. */
 int sy_cli_set_time(loaded *ld, const char *clip, double seconds, sy_error *err);
 /* The image size sy render and sy pick use for *w x *h where the user gave 0: 512 high, the width
  * from the loaded camera's aspect ratio when it has one (either given: the other from the aspect);

@@ -378,7 +378,7 @@ static void *render_main(void *p)
      * a frame whose time moved is a changed view for the governor */
     double t_start = 0, t_end = 0, wall_last = 0;
     bool was_playing = false;
-    bool animated = sy_scene_time_range(a->scene, (sy_animation){0}, &t_start, &t_end, NULL) == SY_OK && t_end > t_start;
+    bool animated = sy_scene_time_range(a->scene, a->clip, &t_start, &t_end, NULL) == SY_OK && t_end > t_start;
     sy_pick_result prev_pick = {0}; /* the last pick that hit: the measurement's first point */
     bool have_prev = false;
     sy_clock clock = sy_clock_make(t_start, t_end);
@@ -427,7 +427,7 @@ static void *render_main(void *p)
                 sy_clock_advance(&clock, 1.0 / 24.0);
             }
             wall_last = now;
-            if (sy_scene_set_time(a->scene, (sy_animation){0}, clock.time, &err) != SY_OK ||
+            if (sy_scene_set_time(a->scene, a->clip, clock.time, &err) != SY_OK ||
                 sy_scene_commit(a->scene, NULL, &err) != SY_OK)
                 goto fail_unlocked;
             time_moved = true;

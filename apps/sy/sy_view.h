@@ -41,6 +41,7 @@
 
 typedef struct sy_view_args {
     sy_scene *scene;        /* owned by the caller; used only by the render thread while running */
+    sy_animation clip;      /* the clip the scene clock plays (space); {0}: every animation */
     sy_compose_spec spec;   /* root, camera, background, overlay (backend is chosen live) */
     const char *backend;    /* initial back-end */
     uint32_t width, height; /* initial window size */

@@ -466,6 +466,24 @@ if [ -f "$BOX" ] && [ -f "$GLB" ]; then
         else
             echo "skip: --at pixel checks (no exr_equal given)"
         fi
+        # a glTF file's clips are alternatives: without --clip the first one plays (the Fox's Survey,
+        # Walk and Run drive the same joints; before, all three played and the last one won)
+        FOX="$DATA/gltf/Fox/glTF/Fox.gltf"
+        if [ -f "$FOX" ] && [ -n "$EXR_EQUAL" ]; then
+            run_ok "render Fox --at 1.5" fox_def "$SY" render "$FOX" -w 48 -h 36 --at 1.5 -o "$TMP/anim/fox.exr"
+            grep -qF "playing clip 0 (Survey) of 3; --clip NAME|INDEX plays another" "$TMP/fox_def.err" ||
+                fail "render Fox: no note naming the clip played: $(cat "$TMP/fox_def.err")"
+            run_ok "render Fox --at 1.5 --clip 0" fox_0 "$SY" render "$FOX" -w 48 -h 36 --at 1.5 --clip 0 \
+                -o "$TMP/anim/fox0.exr"
+            run_ok "render Fox --at 1.5 --clip Run" fox_run "$SY" render "$FOX" -w 48 -h 36 --at 1.5 --clip Run \
+                -o "$TMP/anim/foxrun.exr"
+            "$EXR_EQUAL" "$TMP/anim/fox.exr" "$TMP/anim/fox0.exr" >/dev/null 2>&1 ||
+                fail "render Fox: without --clip the image is not clip 0's"
+            "$EXR_EQUAL" "$TMP/anim/fox.exr" "$TMP/anim/foxrun.exr" >/dev/null 2>&1 &&
+                fail "render Fox: clip 0 and clip Run give the same image"
+        else
+            echo "skip: the default clip (no Fox sample or no exr_equal)"
+        fi
         for bad in -1 nan inf 1e99x; do
             run anim_bad "$SY" render "$BOXANIM" -w 16 -h 16 --at "$bad" -o "$TMP/anim/bad.png"
             [ "$rc" -eq 2 ] && grep -qF -- "--at: '$bad'" "$TMP/anim_bad.err" ||
