@@ -1110,10 +1110,16 @@ int sy_cmd_render(int argc, char **argv)
             if (r == SY_OK && say && progressive && filter && pctx) { /* the display filter's report (issue 7) */
                 sy_filter_info fi;
                 sy_context_filter_info(pctx, &fi);
-                printf("filter %s: threshold %g, last filter %.1f ms, last pass at %u spp, mean blend %.3f, "
-                       "NaN/Inf: %llu pixels, %llu samples\n",
-                       fi.name, (double)fi.threshold, fi.seconds * 1e3, fi.last_pass_samples, fi.mean_blend,
-                       (unsigned long long)fi.nonfinite_pixels, (unsigned long long)fi.nonfinite_samples);
+                /* the pass count and blend mean something for the filters that pass on a schedule
+                 * (pixel: the blend factor, radiance: the share in correction); the others filter
+                 * every frame (last_pass_samples 0) */
+                char pass[96] = "";
+                if (fi.last_pass_samples)
+                    snprintf(pass, sizeof pass, ", last pass at %u spp, mean blend %.3f", fi.last_pass_samples,
+                             fi.mean_blend);
+                printf("filter %s: threshold %g, last filter %.1f ms%s, NaN/Inf: %llu pixels, %llu samples\n", fi.name,
+                       (double)fi.threshold, fi.seconds * 1e3, pass, (unsigned long long)fi.nonfinite_pixels,
+                       (unsigned long long)fi.nonfinite_samples);
             }
         }
     }

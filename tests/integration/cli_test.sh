@@ -581,6 +581,11 @@ run pt_filter "$SY" render demo -b pathtracer --spp 4 -w 32 -h 24 --filter pixel
 [ "$rc" -eq 0 ] && magic "$TMP/pt/filtered.png" 89504e47 &&
     grep -q '^filter pixel: threshold 0.02, .*last pass at 4 spp.*NaN/Inf: 0 pixels' "$TMP/pt_filter.out" ||
     fail "pathtracer --filter pixel: status $rc, $(cat "$TMP/pt_filter.out" "$TMP/pt_filter.err")"
+# a filter that runs every frame has no pass schedule: its report says nothing of one (it said
+# "last pass at 0 spp, mean blend 0.000" before)
+run pt_atrous "$SY" render demo -b pathtracer --spp 4 -w 32 -h 24 --filter atrous -o "$TMP/pt/atrous.png"
+[ "$rc" -eq 0 ] && grep -q '^filter atrous: threshold .*ms, NaN/Inf: 0 pixels' "$TMP/pt_atrous.out" ||
+    fail "pathtracer --filter atrous: status $rc, $(cat "$TMP/pt_atrous.out" "$TMP/pt_atrous.err")"
 expect_error pt_filter_bad bogus "$TMP/o_ptfilter" "$SY" render demo -b pathtracer --spp 1 -w 8 -h 8 \
     --filter bogus -o "$TMP/o_ptfilter/x.png"
 run pt_radiance "$SY" render demo -b pathtracer --spp 4 -w 32 -h 24 --filter radiance --params rf_unbiased=1 \
