@@ -212,7 +212,10 @@ sy_result sy_world_apply(sy_scene *s, sy_background *world, const sy_world_optio
     }
     if (o->env_intensity_set) bd.intensity = o->env_intensity;
     if (o->env_hidden) bd.environment_visible = 0;
-    if (o->has_background) memcpy(bd.color, o->background, sizeof bd.color);
+    if (o->has_background) { /* the user's colour replaces a file's sky / ground gradient too (X3D Background) */
+        memcpy(bd.color, o->background, sizeof bd.color);
+        bd.gradient.sky_count = bd.gradient.ground_count = 0;
+    }
     if (o->no_default_light) bd.default_lighting = 0;
     if (!world->id && (r = sy_background_create(s, "world", world, err)) != SY_OK) return r;
     return sy_background_set(s, *world, &bd, err);

@@ -26,7 +26,7 @@ typedef struct sy_world_options {
     float env_intensity;     /**< multiplier for the environment; 0 is taken as 1 unless env_intensity_set */
     bool env_intensity_set; /**< env_intensity was given (so 0 means 0) */
     bool env_hidden;         /**< camera rays do not see the environment (they see the background) */
-    bool has_background;     /**< what camera rays see where nothing is hit (never a light) */
+    bool has_background;     /**< what camera rays see where nothing is hit (never a light); replaces a file's gradient */
     float background[4];     /**< linear RGBA, premultiplied */
     bool no_default_light;   /**< no studio lighting even when the scene brings no light */
 } sy_world_options;

@@ -3,6 +3,7 @@
  * warned with file:line, and the shared sample files that contain these nodes (their counts
  * computed here from the file's own attributes). Usage: test_x3d_strokes [TESTDATA_DIR]. */
 #include "sy_text.h"
+#include "sy_world.h"
 #include "x3d_loaded.h"
 
 #include <math.h>
@@ -115,6 +116,17 @@ static void test_background(void)
                fabsf(bd->gradient.ground_angle[0] - 1.5707964f) < 1e-7f,
                "gradient: 3 sky / 2 ground colours, 1.5708 taken as pi/2, colour transparent");
     EXPECT_MSG(l.info.warning_count == 0, "no warnings, got %u", l.info.warning_count);
+    /* the user's --background replaces the file's gradient (sy_world_apply): a transparent background
+     * for compositing showed the sky before */
+    sy_world_options wo = {.has_background = true, .background = {0, 0, 0, 0}};
+    sy_background world = l.info.background;
+    sy_error we = {0};
+    EXPECT_MSG(sy_world_apply(l.scene, &world, &wo, &we) == SY_OK, "world: %s", we.message);
+    bd = sy_background_get(l.scene, world);
+    EXPECT_MSG(world.id == l.info.background.id && bd && bd->gradient.sky_count == 0 && bd->gradient.ground_count == 0 &&
+                   bd->color[3] == 0.0f,
+               "--background: the gradient is gone (%u sky, %u ground colours)", bd ? bd->gradient.sky_count : 0,
+               bd ? bd->gradient.ground_count : 0);
     unload(&l);
 
     /* angles out of order, too many colours */
