@@ -43,8 +43,8 @@
  * cascade at all, and the route is dropped). What has no target here is reported once per kind:
  * PositionInterpolator2D and CoordinateInterpolator2D (texture coordinates and TextureTransform
  * are baked into the meshes' vertices when loading), other
- * mapped-but-not-animated fields (Material.shininess, Transform.center, ...), Transforms with a
- * center or scaleOrientation (their node holds a matrix, which the clock does not drive). Bad
+ * mapped-but-not-animated fields (Material.shininess, Transform.center, ...), scale routes to a
+ * Transform with a scaleOrientation (routes to a Transform with a center play: x3d_pivot). Bad
  * interpolators (key and keyValue counts that differ, keys that decrease) are dropped with a warning
  * naming them; equal keys (an X3D jump) become a step one float step later. Several routes into one
  * field at one time: the channels apply in clip order (the last sensor's in the file wins), as the
@@ -64,7 +64,7 @@ enum { T_NONE, T_SFFLOAT, T_SFVEC2F, T_SFVEC3F, T_SFCOLOR, T_SFROTATION, T_MFVEC
 static const char *const type_names[] = {"?", "SFFloat", "SFVec2f", "SFVec3f", "SFColor", "SFRotation", "MFVec3f", "MFVec2f"};
 
 /* What a routed value becomes on the way into its sampler. */
-enum { CONV_NONE, CONV_AXIS_ANGLE, CONV_DIRECTION, CONV_HSV, CONV_ONE_MINUS, CONV_SCALE, CONV_ONE_HOT };
+enum { CONV_NONE, CONV_AXIS_ANGLE, CONV_DIRECTION, CONV_HSV, CONV_ONE_MINUS, CONV_SCALE, CONV_ONE_HOT, CONV_OFFSET };
 
 /* Key intervals of a ColorInterpolator (and of directions) are sampled at this many steps along
  * X3D's path: HSV for colours, the normalised straight line for directions. */
@@ -141,6 +141,7 @@ typedef struct drive {
     uint32_t path, target; /* sy_anim_path, the object's id */
     uint8_t conv;          /* CONV_* */
     float scale;           /* CONV_SCALE */
+    float offset[3];       /* CONV_OFFSET: added to each value (a Transform's center, x3d_pivot) */
     uint32_t fix_light;    /* a point / spot light whose intensity x3d_fix_light_animations scales, else 0 */
     size_t scale_index;    /* CONV_ONE_HOT: the L->morphs entry */
     size_t seq;            /* order found (ties in the sorts below) */
@@ -210,13 +211,15 @@ static int cmp_by_sampler(const void *a, const void *b)
     if (x->scale != y->scale) return x->scale < y->scale ? -1 : 1;
     if (x->fix_light != y->fix_light) return x->fix_light < y->fix_light ? -1 : 1;
     if (x->scale_index != y->scale_index) return x->scale_index < y->scale_index ? -1 : 1;
+    int o = memcmp(x->offset, y->offset, sizeof x->offset);
+    if (o) return o;
     return x->seq < y->seq ? -1 : x->seq > y->seq;
 }
 
 static bool same_sampler(const drive *a, const drive *b)
 {
     return a->interp == b->interp && a->conv == b->conv && a->scale == b->scale && a->fix_light == b->fix_light &&
-           a->scale_index == b->scale_index;
+           a->scale_index == b->scale_index && !memcmp(a->offset, b->offset, sizeof a->offset);
 }
 
 typedef struct elems {
@@ -560,6 +563,9 @@ static int read_sampler(loader *L, xfile *F, const drive *d, float cycle, sy_ani
             case CONV_DIRECTION: x3d_quat_from_neg_z(in, o); break;
             case CONV_ONE_MINUS: o[0] = 1.0f - fmaxf(0.0f, fminf(1.0f, in[0])); break;
             case CONV_SCALE: o[0] = fmaxf(0.0f, in[0]) * d->scale; break;
+            case CONV_OFFSET:
+                for (int a = 0; a < 3; ++a) o[a] = in[a] + d->offset[a];
+                break;
             default: memcpy(o, in, group * sizeof(float));
             }
         }
@@ -693,6 +699,65 @@ static void not_played(loader *L, xfile *F, const route *ro, const char *why)
                  x3d_ename(ro->from), x3d_ename(ro->to), ro->tf, why);
 }
 
+/* A routed Transform with a center c or a scaleOrientation SR: its node held one matrix,
+ * T C R SR S -SR -C, which the clock cannot drive. The first route to it splits it in two: the
+ * Transform's node keeps translation T + c, rotation R and (without SR) scale S as fields the
+ * clock drives, and a new pivot node under it holds the rest (-C, or SR S -SR -C) and the
+ * Transform's children; the static pose is the same matrix product. *c_out gets the center (a
+ * route to translation adds it to its values). Returns 0 (nothing to do), 1 (split: center only),
+ * 2 (split with a scaleOrientation: scale routes are not played), -1 on failure (L->err set). */
+static int x3d_pivot(loader *L, xfile *F, const xmlNode *t, uint32_t node, float c_out[3])
+{
+    float tr[3] = {0, 0, 0}, rot[4] = {0, 0, 1, 0}, sc[3] = {1, 1, 1}, cn[3] = {0, 0, 0}, so[4] = {0, 0, 1, 0};
+    x3d_get_floats(L, F, t, "translation", tr, 3);
+    x3d_get_floats(L, F, t, "rotation", rot, 4);
+    x3d_get_floats(L, F, t, "scale", sc, 3);
+    x3d_get_floats(L, F, t, "center", cn, 3);
+    x3d_get_floats(L, F, t, "scaleOrientation", so, 4);
+    float q[4], sq[4], one[3] = {1, 1, 1}, zero[3] = {0, 0, 0}, idq[4] = {0, 0, 0, 1};
+    x3d_axis_angle_quat(rot, q);
+    x3d_axis_angle_quat(so, sq);
+    bool has_so = sq[3] != 1.0f;
+    if (cn[0] == 0.0f && cn[1] == 0.0f && cn[2] == 0.0f && !has_so) return 0; /* plain TRS (set_transform) */
+    memcpy(c_out, cn, 3 * sizeof(float));
+    created *pc = x3d_cache_get(L, F, t, "pivot", true);
+    if (!pc) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path), -1;
+    if (pc->done) return has_so ? 2 : 1;
+    pc->done = true;
+    const sy_node_data *nd = sy_node_get(L->scene, (sy_node){node});
+    uint32_t nk = 0;
+    const uint32_t *kids = nd ? sy_node_children(nd, &nk) : NULL;
+    sy_node *moved = nk ? malloc(nk * sizeof *moved) : NULL;
+    if (nk && !moved) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path), -1;
+    for (uint32_t k = 0; k < nk; ++k) moved[k].id = kids[k];
+    sy_node p = {0};
+    float tc[3] = {tr[0] + cn[0], tr[1] + cn[1], tr[2] + cn[2]}, nc[3] = {-cn[0], -cn[1], -cn[2]};
+    sy_result r = sy_node_create(L->scene, NULL, &p, &L->err);
+    if (!r) r = sy_node_set_children(L->scene, p, moved, nk, &L->err);
+    free(moved);
+    if (!r) r = sy_node_set_children(L->scene, (sy_node){node}, &p, 1, &L->err);
+    if (!r) r = sy_node_set_flags(L->scene, p, SY_NODE_VISIBLE, &L->err);
+    if (!r && !has_so) {
+        r = sy_node_set_trs(L->scene, (sy_node){node}, tc, q, sc, &L->err);
+        if (!r) r = sy_node_set_trs(L->scene, p, nc, idq, one, &L->err);
+    } else if (!r) { /* SR S -SR -C under T C R */
+        float nsq[4] = {-sq[0], -sq[1], -sq[2], sq[3]};
+        sy_mat4 SR = sy_mat4_from_trs(zero, sq, one), S = sy_mat4_from_trs(zero, idq, sc);
+        sy_mat4 NSR = sy_mat4_from_trs(zero, nsq, one), NC = sy_mat4_from_trs(nc, idq, one);
+        sy_mat4 m = sy_mat4_mul(&SR, &S);
+        m = sy_mat4_mul(&m, &NSR);
+        m = sy_mat4_mul(&m, &NC);
+        r = sy_node_set_trs(L->scene, (sy_node){node}, tc, q, one, &L->err);
+        if (!r) r = sy_node_set_matrix(L->scene, p, &m, &L->err);
+    }
+    if (r) {
+        sy_error_prefix(&L->err, "%s:%d: Transform (its pivot for a ROUTE)", F->path, x3d_line_of(t));
+        return -1;
+    }
+    L->info->counts.nodes++;
+    return has_so ? 2 : 1;
+}
+
 /* The drives of route ro (from interpolator ro->from, of kind ik, driven by sensor): appended to ds;
  * false only when out of memory. */
 static bool add_targets(loader *L, xfile *F, const route *ro, const xmlNode *sensor, const interp_kind *ik, drives *ds)
@@ -786,19 +851,25 @@ static bool add_targets(loader *L, xfile *F, const route *ro, const xmlNode *sen
                  x3d_ename(t), ro->tf, x3d_line_of(t));
         return true;
     }
+    float pivot_c[3] = {0, 0, 0};
     if (!strcmp(x3d_ename(t), "Transform")) {
-        float cn[3] = {0, 0, 0}, so[4] = {0, 0, 1, 0};
-        x3d_get_floats(L, F, t, "center", cn, 3);
-        x3d_get_floats(L, F, t, "scaleOrientation", so, 4);
-        if (cn[0] != 0.0f || cn[1] != 0.0f || cn[2] != 0.0f || (so[3] != 0.0f && fmodf(so[3], 2.0f * PI_F) != 0.0f)) {
-            x3d_warn(L, "%s:%d: ROUTE to the %s of a Transform with a center or scaleOrientation (line %d): not played",
-                     F->path, x3d_line_of(ro->el), ro->tf, x3d_line_of(t));
+        int pv = x3d_pivot(L, F, t, c->node, pivot_c);
+        if (pv < 0) return false;
+        if (pv == 2 && fm->what == W_SCALE) {
+            x3d_warn(L, "%s:%d: ROUTE to the %s of a Transform with a scaleOrientation (line %d): not played", F->path,
+                     x3d_line_of(ro->el), ro->tf, x3d_line_of(t));
             return true;
         }
     }
     d.target = c->node;
     switch (fm->what) {
-    case W_TRANSLATION: d.path = SY_ANIM_TRANSLATION; break;
+    case W_TRANSLATION:
+        d.path = SY_ANIM_TRANSLATION;
+        if (pivot_c[0] != 0.0f || pivot_c[1] != 0.0f || pivot_c[2] != 0.0f) {
+            d.conv = CONV_OFFSET;
+            memcpy(d.offset, pivot_c, sizeof d.offset);
+        }
+        break;
     case W_SCALE: d.path = SY_ANIM_SCALE; break;
     case W_ROTATION: d.path = SY_ANIM_ROTATION, d.conv = CONV_AXIS_ANGLE; break;
     case W_DIRECTION: d.path = SY_ANIM_ROTATION, d.conv = CONV_DIRECTION; break;

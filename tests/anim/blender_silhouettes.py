@@ -12,9 +12,10 @@
 # Blender (x, -z, y), and this script maps back).
 #
 # Which animation plays: Blender's importer makes every glTF animation an NLA track and makes only
-# animations[0] active. Switchyard's `sy render --at T` without --clip evaluates every clip, in file
-# order, the last one winning where two drive one property; so here every object takes the action
-# of the last animation (in file order) that has a track on it, the same rule.
+# animations[0] active. Switchyard's `sy render --at T` without --clip plays every clip when no two
+# drive the same object, else only the first (sy_cli_default_clip); so here, when some object has
+# tracks of two animations, every object takes animations[0]'s action (none: it stays as loaded),
+# and otherwise each object takes the action of its one track, the same rule.
 #
 # Time: the importer keys glTF time t at frame t * fps (scene fps, 24 by default; no offset), so
 # time t is frame t * fps, set with frame_set(whole, subframe=fraction).
@@ -68,16 +69,20 @@ def tracks_of(idblock):
     return ad.nla_tracks if ad else []
 
 
-for obj in list(bpy.data.objects) + [k for k in bpy.data.shape_keys]:
+def track_action(t, name):
+    """The track's action when it is the animation named (the importer may suffix duplicate names)."""
+    return t.strips[0].action if t.strips and (t.name == name or t.name.startswith(name + ".")) else None
+
+
+animated = [o for o in list(bpy.data.objects) + [k for k in bpy.data.shape_keys] if list(tracks_of(o))]
+alternatives = any(len(list(tracks_of(o))) > 1 for o in animated)
+for obj in animated:
     tracks = list(tracks_of(obj))
-    if not tracks:
-        continue
     chosen = None
-    for name in anim_names:  # the importer may suffix duplicate names: match by prefix order
+    if alternatives:  # only animations[0] plays
         for t in tracks:
-            if t.strips and (t.name == name or t.name.startswith(name + ".")):
-                chosen = t.strips[0].action
-    if chosen is None:  # names the importer changed: the last track created is animations[0]
+            chosen = chosen or (track_action(t, anim_names[0]) if anim_names else None)
+    else:
         chosen = tracks[0].strips[0].action if tracks[0].strips else None
     obj.animation_data.action = chosen
 

@@ -4,7 +4,8 @@
  * the X3D interpolation computed here (key x cycleInterval, linear positions, orientations along
  * the shorter arc, looping sensors wrapping), equal keys jump, and what does not map is reported
  * naming the file and line: mismatched key / keyValue counts, decreasing keys, routes to undefined
- * nodes, Transforms with a center. test_fields: Color- and ScalarInterpolators into Material,
+ * nodes; Transforms with a center or scaleOrientation play (the children's world origin at two
+ * times against X3D's T C R SR S -SR -C), a scale route under a scaleOrientation is warned. test_fields: Color- and ScalarInterpolators into Material,
  * PhysicalMaterial, light and Viewpoint fields, positions and orientations into a Viewpoint and
  * a light's direction, at two times against X3D's interpolation computed here (HSV colours,
  * 1 - transparency, intensities scaled as the loader scales the lights); routes whose types differ,
@@ -67,6 +68,12 @@ static void test_routes(void)
         "<ROUTE fromNode='Once' fromField='fraction_changed' toNode='Tint' toField='set_fraction'/>\n"  /* 21 */
         "<ROUTE fromNode='Path' fromField='value_changed' toNode='Mover' toField='scale'/>\n"           /* 22 */
         "<ROUTE fromNode='Path' fromField='value_changed' toNode='Nowhere' toField='translation'/>\n"   /* 23 */
+        "<Transform DEF='Slider' center='0 1 0' translation='3 0 0' rotation='0 0 1 0.5'><Shape><Box/></Shape>"
+        "</Transform>\n"                                                                                 /* 24 */
+        "<ROUTE fromNode='Path' fromField='value_changed' toNode='Slider' toField='translation'/>\n"    /* 25 */
+        "<Transform DEF='Squash' center='1 0 0' scaleOrientation='0 0 1 0.3'><Shape><Box/></Shape></Transform>\n" /* 26 */
+        "<ROUTE fromNode='Path' fromField='value_changed' toNode='Squash' toField='scale'/>\n"         /* 27 */
+        "<ROUTE fromNode='Turn' fromField='value_changed' toNode='Squash' toField='rotation'/>\n"      /* 28 */
         "</Scene></X3D>\n");
     if (!expect_loaded(&l, "anim.x3d")) return unload(&l);
     /* one clip: Clock (Once drives nothing playable: Short and Back are dropped, Tint not played) */
@@ -76,13 +83,16 @@ static void test_routes(void)
     const sy_animation_data *ad = sy_animation_get(l.scene, clip);
     uint32_t nch = 0;
     if (ad) sy_animation_channels(ad, &nch);
-    EXPECT_MSG(ad && ad->name && !strcmp(ad->name, "Clock") && ad->cycle == 4.0f && ad->loop == 1 && nch == 3,
-               "clip Clock, period 4, loop, 3 channels: %s %g %u %u", ad && ad->name ? ad->name : "-",
+    /* Mover's translation and scale, Spinner's, Pivot's and Squash's rotations, Slider's translation */
+    EXPECT_MSG(ad && ad->name && !strcmp(ad->name, "Clock") && ad->cycle == 4.0f && ad->loop == 1 && nch == 6,
+               "clip Clock, period 4, loop, 6 channels: %s %g %u %u", ad && ad->name ? ad->name : "-",
                ad ? (double)ad->cycle : 0.0, ad ? ad->loop : 0, nch);
     EXPECT_MSG(has_warning(&l, "anim.x3d:8: PositionInterpolator: 2 keys and 1 key values", NULL), "Short's counts");
     EXPECT_MSG(has_warning(&l, "anim.x3d:9: PositionInterpolator: key 2 (0.5) is less than the key before it", NULL),
                "Back's keys");
-    EXPECT_MSG(has_warning(&l, "anim.x3d:16:", "center or scaleOrientation"), "Pivot has a center");
+    EXPECT_MSG(!has_warning(&l, "anim.x3d:16:", NULL), "Pivot's center: played, not warned");
+    EXPECT_MSG(has_warning(&l, "anim.x3d:27: ROUTE to the scale of a Transform with a scaleOrientation", NULL),
+               "a scale route under a scaleOrientation is not played (warned)");
     EXPECT_MSG(has_warning(&l, "anim.x3d:23: ROUTE to 'Nowhere'", "not DEFined"), "route to an undefined node");
     sy_node mover = node_named(&l, "Mover"), spinner = node_named(&l, "Spinner");
     /* Path: fraction f = (t mod 4) / 4; 0 -> (0,0,0), 0.5 -> (2,0,0) then the jump to (2,4,0) (one
@@ -104,6 +114,32 @@ static void test_routes(void)
     set_time(&l, 2.0);
     EXPECT_MSG(fabsf(yaw(rot(&l, spinner)) - 1.5f) < 1e-4f && pos(&l, spinner)[0] == 5.0f, "Spinner at t = 2: yaw %g (want 1.5)",
                (double)yaw(rot(&l, spinner)));
+    /* Transforms with a center (their node split in two at the first route, x3d_pivot): the world
+     * matrix is X3D's T C R SR S -SR -C with the routed field at its value of the time; the
+     * origin of the Transform's children lands at T + C + R SR S -SR (-C) */
+    static const struct { const char *name; double t; float o[3]; } pv[] = {
+        {"Pivot", 2.0, {1.0f - cosf(1.5f), 0.0f, sinf(1.5f)}},  /* C R(t) -C, R about y */
+        {"Squash", 2.0, {1.0f - cosf(1.5f), 0.0f, sinf(1.5f)}}, /* the same: SR S -SR = 1 (scale not played) */
+        {"Slider", 1.0, {1.0f + sinf(0.5f), 1.0f - cosf(0.5f), 0.0f}}, /* T(t) C R -C: T(1) = (1, 0, 0), R about z */
+        {"Slider", 3.0, {2.0f + sinf(0.5f), 5.0f - cosf(0.5f), 4.0f}}, /* T(3) = (2, 4, 4) */
+    };
+    for (size_t i = 0; i < sizeof pv / sizeof pv[0]; ++i) {
+        set_time(&l, pv[i].t);
+        sy_error ce = {0};
+        EXPECT_MSG(sy_scene_commit(l.scene, NULL, &ce) == SY_OK, "commit: %s", ce.message); /* world matrices */
+        sy_node n = node_named(&l, pv[i].name);
+        const sy_node_data *nd = sy_node_get(l.scene, n);
+        uint32_t nk = 0;
+        const uint32_t *kids = nd ? sy_node_children(nd, &nk) : NULL;
+        sy_mat4 w = sy_mat4_identity();
+        sy_error e = {0};
+        bool ok = nk == 1 && sy_node_world_matrix(l.scene, (sy_node){kids[0]}, &w, &e) == SY_OK;
+        EXPECT_MSG(ok && fabsf(w.m[12] - pv[i].o[0]) < 1e-4f && fabsf(w.m[13] - pv[i].o[1]) < 1e-4f &&
+                       fabsf(w.m[14] - pv[i].o[2]) < 1e-4f,
+                   "%s at t = %g: children's origin (%g %g %g), want (%g %g %g) (%u pivot children)", pv[i].name,
+                   pv[i].t, (double)w.m[12], (double)w.m[13], (double)w.m[14], (double)pv[i].o[0], (double)pv[i].o[1],
+                   (double)pv[i].o[2], nk);
+    }
     unload(&l);
 }
 
