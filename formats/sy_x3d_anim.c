@@ -721,14 +721,20 @@ static int x3d_pivot(loader *L, xfile *F, const xmlNode *t, uint32_t node, float
     if (cn[0] == 0.0f && cn[1] == 0.0f && cn[2] == 0.0f && !has_so) return 0; /* plain TRS (set_transform) */
     memcpy(c_out, cn, 3 * sizeof(float));
     created *pc = x3d_cache_get(L, F, t, "pivot", true);
-    if (!pc) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path), -1;
+    if (!pc) {
+        sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+        return -1;
+    }
     if (pc->done) return has_so ? 2 : 1;
     pc->done = true;
     const sy_node_data *nd = sy_node_get(L->scene, (sy_node){node});
     uint32_t nk = 0;
     const uint32_t *kids = nd ? sy_node_children(nd, &nk) : NULL;
     sy_node *moved = nk ? malloc(nk * sizeof *moved) : NULL;
-    if (nk && !moved) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path), -1;
+    if (nk && !moved) {
+        sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+        return -1;
+    }
     for (uint32_t k = 0; k < nk; ++k) moved[k].id = kids[k];
     sy_node p = {0};
     float tc[3] = {tr[0] + cn[0], tr[1] + cn[1], tr[2] + cn[2]}, nc[3] = {-cn[0], -cn[1], -cn[2]};
