@@ -14,16 +14,34 @@
 # reaches the same error. Each run prints both and the quotient; the last line the median, min and
 # max over the runs.
 #
+# With MODEL (a glTF sample under ../shared/testdata/gltf, e.g. DamagedHelmet or ToyCar: textured,
+# glossy, not a box of Lambertian walls), the scene is that model at 256x192 under a uniform white
+# environment the camera does not see (--env-color 1,1,1 --env-hidden), 8 bounces, its own camera;
+# Cycles renders it through Blender's own glTF importer from the same view
+# (tests/cycles/materials_cycles.py). The importer's materials are not exactly ours, so each
+# renderer's error is measured against its own reference at REF_SPP (default 4096, rendered once
+# into OUT_DIR and reused): time x relMSE is then each renderer's cost of its own converged image's
+# quality, and the quotient the speed-up at equal error. The references' own noise adds about
+# SPP / REF_SPP of the measured relMSE to both.
+#
 # A measurement, not a test: it needs Blender (Debian's `blender` package) and skips without it.
-# Usage: tests/cycles/equal_error.sh [BUILD_DIR (build)] [OUT_DIR (equal-error)] [SPP (128)] [RUNS (3)]
+# Usage: tests/cycles/equal_error.sh [BUILD_DIR (build)] [OUT_DIR (equal-error)] [SPP (128)] [RUNS (3)] [MODEL]
+#        (environment: REF_SPP, the references' samples in MODEL mode)
 set -euo pipefail
 . "$(dirname "$0")/../support/measure.sh" # root, build, skip_without_blender, skip_without
 out=${2:-equal-error}
 spp=${3:-128}
 runs=${4:-3}
+model=${5:-}
+ref_spp=${REF_SPP:-4096}
 data=$root/../shared/testdata/cornell
 gltf=$data/cornell_box.gltf
 ref=$data/cornell_box_cycles_256_4096.exr
+if [ -n "$model" ]; then
+    gltf=$(ls "$root/../shared/testdata/gltf/$model"/glTF/*.gltf 2>/dev/null | head -1 || true)
+    [ -n "$gltf" ] || gltf=$root/../shared/testdata/gltf/$model/glTF/$model.gltf
+    ref=$gltf # present when the model is; the references are made below
+fi
 skip_without_blender
 skip_without "$gltf" "$ref"
 sy=$build/apps/sy/sy
@@ -32,6 +50,42 @@ for tool in "$sy" "$err"; do
     [ -x "$tool" ] || { echo "equal_error.sh: error: $tool is missing (build first: cmake --build $build)" >&2; exit 1; }
 done
 mkdir -p "$out"
+
+if [ -n "$model" ]; then
+    world=(--env-color 1,1,1 --env-hidden)
+    sy_model() { # SPP OUT.exr LOG: prints the render's seconds
+        "$sy" render "$gltf" -b pathtracer -w 256 -h 192 --spp "$1" --filter none "${world[@]}" -o "$2" >"$3" 2>&1 ||
+            { echo "equal_error.sh: error: sy render failed, see $3" >&2; exit 1; }
+        sed -n 's/.* samples per pixel, \([0-9.]*\) s .*/\1/p' "$3" | head -1
+    }
+    cycles_model() { # SPP SEED OUT.exr LOG: prints the render's seconds
+        blender -b -noaudio --factory-startup -P "$root/tests/cycles/materials_cycles.py" -- --gltf "$gltf" \
+            --like "$out/ref_sy.exr" --spp "$1" --bounces 8 --env 1,1,1 --seed "$2" --out "$3" --sy "$sy" >"$4" 2>&1 ||
+            { echo "equal_error.sh: error: Blender failed, see $4" >&2; exit 1; }
+        sed -n 's/^ *Time: \([0-9]*\):\([0-9.]*\).*/\1 \2/p' "$4" | tail -1 | awk '{ printf "%.3f", $1 * 60 + $2 }'
+    }
+    [ -s "$out/ref_sy.exr" ] || sy_model "$ref_spp" "$out/ref_sy.exr" "$out/ref_sy.log" >/dev/null
+    [ -s "$out/ref_cycles.exr" ] || cycles_model "$ref_spp" 0 "$out/ref_cycles.exr" "$out/ref_cycles.log" >/dev/null
+    echo "$model 256x192, $spp spp, white environment, 8 bounces, $(nproc) threads; each against its own $ref_spp-spp reference"
+    printf '%4s  %9s %10s %10s  %9s %10s %10s  %8s\n' run "Cycles s" relMSE "s x relMSE" "sy s" relMSE "s x relMSE" "speed-up"
+    ratios=()
+    for run in $(seq 1 "$runs"); do
+        tc=$(cycles_model "$spp" "$run" "$out/cycles_$run.exr" "$out/cycles_$run.log")
+        ts=$(sy_model "$spp" "$out/sy_$run.exr" "$out/sy_$run.log")
+        ec=$("$err" "$out/cycles_$run.exr" "$out/ref_cycles.exr" | awk 'NR == 1 { print $2 }')
+        es=$("$err" "$out/sy_$run.exr" "$out/ref_sy.exr" | awk 'NR == 1 { print $2 }')
+        line=$(awk -v r="$run" -v tc="$tc" -v ec="$ec" -v ts="$ts" -v es="$es" 'BEGIN {
+            printf "%4d  %9.2f %10.6f %10.6f  %9.2f %10.6f %10.6f  %7.2fx\n", r, tc, ec, tc * ec, ts, es, ts * es,
+                   (tc * ec) / (ts * es) }')
+        echo "$line"
+        ratios+=("$(echo "$line" | awk '{ sub("x", "", $8); print $8 }')")
+    done
+    echo "references: the means of ours over Cycles' (what the importer's materials change): $("$err" "$out/ref_sy.exr" "$out/ref_cycles.exr" | awk 'NR == 1 { print $8 }')"
+    printf '%s\n' "${ratios[@]}" | sort -g | awk '{ v[NR] = $1 } END {
+        m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
+        printf "equal-error speed-up over Cycles: median %.2fx (min %.2fx, max %.2fx) over %d runs\n", m, v[1], v[NR], NR }'
+    exit 0
+fi
 
 cycles() { # cycles RUN: prints the render's seconds
     local log=$out/cycles_$1.log
