@@ -708,18 +708,11 @@ static void not_played(loader *L, xfile *F, const route *ro, const char *why)
  * 2 (split with a scaleOrientation: scale routes are not played), -1 on failure (L->err set). */
 static int x3d_pivot(loader *L, xfile *F, const xmlNode *t, uint32_t node, float c_out[3])
 {
-    float tr[3] = {0, 0, 0}, rot[4] = {0, 0, 1, 0}, sc[3] = {1, 1, 1}, cn[3] = {0, 0, 0}, so[4] = {0, 0, 1, 0};
-    x3d_get_floats(L, F, t, "translation", tr, 3);
-    x3d_get_floats(L, F, t, "rotation", rot, 4);
-    x3d_get_floats(L, F, t, "scale", sc, 3);
-    x3d_get_floats(L, F, t, "center", cn, 3);
-    x3d_get_floats(L, F, t, "scaleOrientation", so, 4);
-    float q[4], sq[4], one[3] = {1, 1, 1}, zero[3] = {0, 0, 0}, idq[4] = {0, 0, 0, 1};
-    x3d_axis_angle_quat(rot, q);
-    x3d_axis_angle_quat(so, sq);
-    bool has_so = sq[3] != 1.0f;
-    if (cn[0] == 0.0f && cn[1] == 0.0f && cn[2] == 0.0f && !has_so) return 0; /* plain TRS (set_transform) */
-    memcpy(c_out, cn, 3 * sizeof(float));
+    x3d_transform x;
+    x3d_read_transform(L, F, t, &x);
+    if (!x3d_transform_pivoted(&x)) return 0; /* plain TRS (set_transform) */
+    bool has_so = x.so[3] != 1.0f;
+    memcpy(c_out, x.c, 3 * sizeof(float));
     created *pc = x3d_cache_get(L, F, t, "pivot", true);
     if (!pc) {
         sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
@@ -737,25 +730,15 @@ static int x3d_pivot(loader *L, xfile *F, const xmlNode *t, uint32_t node, float
     }
     for (uint32_t k = 0; k < nk; ++k) moved[k].id = kids[k];
     sy_node p = {0};
-    float tc[3] = {tr[0] + cn[0], tr[1] + cn[1], tr[2] + cn[2]}, nc[3] = {-cn[0], -cn[1], -cn[2]};
+    float one[3] = {1, 1, 1}, tc[3] = {x.t[0] + x.c[0], x.t[1] + x.c[1], x.t[2] + x.c[2]};
+    sy_mat4 tail = x3d_transform_tail(&x, has_so); /* -C, or SR S -SR -C */
     sy_result r = sy_node_create(L->scene, NULL, &p, &L->err);
     if (!r) r = sy_node_set_children(L->scene, p, moved, nk, &L->err);
     free(moved);
     if (!r) r = sy_node_set_children(L->scene, (sy_node){node}, &p, 1, &L->err);
     if (!r) r = sy_node_set_flags(L->scene, p, SY_NODE_VISIBLE, &L->err);
-    if (!r && !has_so) {
-        r = sy_node_set_trs(L->scene, (sy_node){node}, tc, q, sc, &L->err);
-        if (!r) r = sy_node_set_trs(L->scene, p, nc, idq, one, &L->err);
-    } else if (!r) { /* SR S -SR -C under T C R */
-        float nsq[4] = {-sq[0], -sq[1], -sq[2], sq[3]};
-        sy_mat4 SR = sy_mat4_from_trs(zero, sq, one), S = sy_mat4_from_trs(zero, idq, sc);
-        sy_mat4 NSR = sy_mat4_from_trs(zero, nsq, one), NC = sy_mat4_from_trs(nc, idq, one);
-        sy_mat4 m = sy_mat4_mul(&SR, &S);
-        m = sy_mat4_mul(&m, &NSR);
-        m = sy_mat4_mul(&m, &NC);
-        r = sy_node_set_trs(L->scene, (sy_node){node}, tc, q, one, &L->err);
-        if (!r) r = sy_node_set_matrix(L->scene, p, &m, &L->err);
-    }
+    if (!r) r = sy_node_set_trs(L->scene, (sy_node){node}, tc, x.r, has_so ? one : x.s, &L->err);
+    if (!r) r = sy_node_set_matrix(L->scene, p, &tail, &L->err);
     if (r) {
         sy_error_prefix(&L->err, "%s:%d: Transform (its pivot for a ROUTE)", F->path, x3d_line_of(t));
         return -1;

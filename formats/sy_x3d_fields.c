@@ -316,6 +316,35 @@ void x3d_axis_angle_quat(const float aa[4], float q[4])
     q[0] = aa[0] * s; q[1] = aa[1] * s; q[2] = aa[2] * s; q[3] = cosf(aa[3] * 0.5f);
 }
 
+void x3d_read_transform(loader *L, xfile *F, const xmlNode *el, x3d_transform *out)
+{
+    float rot[4] = {0, 0, 1, 0}, so[4] = {0, 0, 1, 0};
+    *out = (x3d_transform){.s = {1, 1, 1}};
+    x3d_get_floats(L, F, el, "translation", out->t, 3);
+    x3d_get_floats(L, F, el, "rotation", rot, 4);
+    x3d_get_floats(L, F, el, "scale", out->s, 3);
+    x3d_get_floats(L, F, el, "center", out->c, 3);
+    x3d_get_floats(L, F, el, "scaleOrientation", so, 4);
+    x3d_axis_angle_quat(rot, out->r);
+    x3d_axis_angle_quat(so, out->so);
+}
+
+bool x3d_transform_pivoted(const x3d_transform *x)
+{
+    return x->c[0] != 0.0f || x->c[1] != 0.0f || x->c[2] != 0.0f || x->so[3] != 1.0f;
+}
+
+sy_mat4 x3d_transform_tail(const x3d_transform *x, bool scale)
+{
+    float one[3] = {1, 1, 1}, zero[3] = {0, 0, 0}, idq[4] = {0, 0, 0, 1};
+    float nc[3] = {-x->c[0], -x->c[1], -x->c[2]}, nsq[4] = {-x->so[0], -x->so[1], -x->so[2], x->so[3]};
+    sy_mat4 SR = sy_mat4_from_trs(zero, x->so, one), S = sy_mat4_from_trs(zero, idq, scale ? x->s : one);
+    sy_mat4 NSR = sy_mat4_from_trs(zero, nsq, one), NC = sy_mat4_from_trs(nc, idq, one);
+    sy_mat4 m = sy_mat4_mul(&SR, &S);
+    m = sy_mat4_mul(&m, &NSR);
+    return sy_mat4_mul(&m, &NC);
+}
+
 /* >>DEF/USE ----------------------------------------------------------------------------------- */
 
 /* Resolves USE: returns the DEF'd element (or el itself), NULL when undefined (warned). */

@@ -154,6 +154,16 @@ bool x3d_name_in(const char *name, const char *list);
 void x3d_clamp01(float *v, int n);
 /* SFRotation (axis, angle) -> unit quaternion (identity for a zero axis). */
 void x3d_axis_angle_quat(const float aa[4], float q[4]);
+/* A Transform's fields, X3D's defaults where absent; the rotations as unit quaternions. Its matrix
+ * is T C R SR S -SR -C (x3d_transform_tail: the part after R). */
+typedef struct x3d_transform {
+    float t[3], r[4], s[3], c[3], so[4]; /* translation, rotation, scale, center, scaleOrientation */
+} x3d_transform;
+void x3d_read_transform(loader *L, xfile *F, const xmlNode *el, x3d_transform *out);
+/* Whether the Transform has a center or a scaleOrientation (no TRS of its own). */
+bool x3d_transform_pivoted(const x3d_transform *x);
+/* SR S -SR -C, or with scale false SR -SR -C = -C (the scale left to the node's TRS). */
+sy_mat4 x3d_transform_tail(const x3d_transform *x, bool scale);
 
 /* DEF / USE: the DEF'd element of a USE (or el itself; NULL when undefined, warned), DEF registration,
  * and the child element of an SFNode field (USE resolved, DEFs registered). */

@@ -88,32 +88,17 @@ static void bounds_add_prim(loader *L, const sy_primitive *p, const sy_mat4 *wor
 
 static sy_result set_transform(loader *L, xfile *F, const xmlNode *el, sy_node h, sy_mat4 *local)
 {
-    float t[3] = {0, 0, 0}, rot[4] = {0, 0, 1, 0}, s[3] = {1, 1, 1}, c[3] = {0, 0, 0}, so[4] = {0, 0, 1, 0};
-    x3d_get_floats(L, F, el, "translation", t, 3);
-    x3d_get_floats(L, F, el, "rotation", rot, 4);
-    x3d_get_floats(L, F, el, "scale", s, 3);
-    x3d_get_floats(L, F, el, "center", c, 3);
-    x3d_get_floats(L, F, el, "scaleOrientation", so, 4);
-    float q[4], sq[4], one[3] = {1, 1, 1}, zero[3] = {0, 0, 0}, idq[4] = {0, 0, 0, 1};
-    x3d_axis_angle_quat(rot, q);
-    x3d_axis_angle_quat(so, sq);
+    x3d_transform x;
+    x3d_read_transform(L, F, el, &x);
     sy_result r;
-    if (c[0] == 0 && c[1] == 0 && c[2] == 0 && sq[3] == 1) {
-        *local = sy_mat4_from_trs(t, q, s);
-        r = sy_node_set_trs(L->scene, h, t, q, s, &L->err);
-    } else { /* T C R SR S -SR -C */
-        float nc[3] = {-c[0], -c[1], -c[2]}, nsq[4] = {-sq[0], -sq[1], -sq[2], sq[3]};
-        sy_mat4 T = sy_mat4_from_trs(t, idq, one), C = sy_mat4_from_trs(c, idq, one), R = sy_mat4_from_trs(zero, q, one);
-        sy_mat4 SR = sy_mat4_from_trs(zero, sq, one), S = sy_mat4_from_trs(zero, idq, s);
-        sy_mat4 NSR = sy_mat4_from_trs(zero, nsq, one), NC = sy_mat4_from_trs(nc, idq, one);
-        sy_mat4 m = sy_mat4_mul(&T, &C);
-        m = sy_mat4_mul(&m, &R);
-        m = sy_mat4_mul(&m, &SR);
-        m = sy_mat4_mul(&m, &S);
-        m = sy_mat4_mul(&m, &NSR);
-        m = sy_mat4_mul(&m, &NC);
-        *local = m;
-        r = sy_node_set_matrix(L->scene, h, &m, &L->err);
+    if (!x3d_transform_pivoted(&x)) {
+        *local = sy_mat4_from_trs(x.t, x.r, x.s);
+        r = sy_node_set_trs(L->scene, h, x.t, x.r, x.s, &L->err);
+    } else { /* T C R (SR S -SR -C) */
+        float one[3] = {1, 1, 1}, tc[3] = {x.t[0] + x.c[0], x.t[1] + x.c[1], x.t[2] + x.c[2]};
+        sy_mat4 head = sy_mat4_from_trs(tc, x.r, one), tail = x3d_transform_tail(&x, true);
+        *local = sy_mat4_mul(&head, &tail);
+        r = sy_node_set_matrix(L->scene, h, local, &L->err);
     }
     if (r) sy_error_prefix(&L->err, "%s:%d: Transform", F->path, x3d_line_of(el));
     return r;

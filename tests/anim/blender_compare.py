@@ -97,6 +97,20 @@ def iou(a, b):
     return 1.0 if union == 0 else inter / union, sum(a), sum(b)
 
 
+def finish(rows, worst, failed, out, a):
+    """The summary line and the exit status of a silhouette comparison (this one and
+    view3dscene_compare.py): rows of dicts with "iou"; --json, --min-iou, --check from a."""
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(rows, f, indent=1)
+    below = [r for r in rows if r["iou"] < a.min_iou]
+    print("\n%d comparisons, worst IoU %.4f, %d below %.2f; images in %s" % (len(rows), worst, len(below), a.min_iou,
+                                                                             out))
+    if failed:
+        return 1
+    return 1 if a.check and below else 0
+
+
 def blender_env():
     """The environment without a Python of pyenv's or a virtual environment first on PATH: Blender's
     embedded Python finds its prefix (and the system's numpy, which its glTF importer needs) from the
@@ -218,15 +232,7 @@ def main():
                              "pixels_sy": n_ours, "pixels_blender": n_ref, "png": png})
                 print("%-18s t=%-8g %-8s IoU %.4f  (covered: sy %6d, blender %6d)%s" %
                       (name, t, b, v, n_ours, n_ref, "" if v >= a.min_iou else "   < %.2f" % a.min_iou), flush=True)
-    if a.json:
-        with open(a.json, "w") as f:
-            json.dump(rows, f, indent=1)
-    below = [r for r in rows if r["iou"] < a.min_iou]
-    print("\n%d comparisons, worst IoU %.4f, %d below %.2f; images in %s" % (len(rows), worst, len(below), a.min_iou,
-                                                                             out))
-    if failed:
-        return 1
-    return 1 if a.check and below else 0
+    return finish(rows, worst, failed, out, a)
 
 
 if __name__ == "__main__":

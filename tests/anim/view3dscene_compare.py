@@ -14,7 +14,6 @@ Exit 77 when view3dscene, xvfb-run or the test data is absent; 1 with --check wh
 --min-iou.
 """
 import argparse
-import json
 import os
 import shutil
 import subprocess
@@ -23,7 +22,7 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from blender_compare import iou, png_alpha  # noqa: E402  (one PNG reader and one IoU for both measurements)
+from blender_compare import finish, iou, png_alpha  # noqa: E402  (one PNG reader, IoU and summary for both)
 
 # (scene under ../shared/testdata/x3d, times in seconds of its clock): the IndexedFaceSet example's
 # piston and rocker arms run on one looping 5500 s TimeSensor through Position- and
@@ -100,15 +99,7 @@ def main():
                              "pixels_view3dscene": n_ref, "png": png})
                 print("%-24s t=%-8g %-8s IoU %.4f  (covered: sy %6d, view3dscene %6d)%s" %
                       (name, t, b, v, n_ours, n_ref, "" if v >= a.min_iou else "   < %.2f" % a.min_iou), flush=True)
-    if a.json:
-        with open(a.json, "w") as f:
-            json.dump(rows, f, indent=1)
-    below = [r for r in rows if r["iou"] < a.min_iou]
-    print("\n%d comparisons, worst IoU %.4f, %d below %.2f; images in %s" % (len(rows), worst, len(below), a.min_iou,
-                                                                             out))
-    if failed:
-        return 1
-    return 1 if a.check and below else 0
+    return finish(rows, worst, failed, out, a)
 
 
 if __name__ == "__main__":
