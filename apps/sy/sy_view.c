@@ -973,8 +973,13 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
             } else {
                 on_key(win, toupper((unsigned char)key_last), 0, GLFW_PRESS, kmods);
             }
+            /* a new frame answers every scripted key, even one that changes nothing the render sees
+             * (an unbound letter, H with nothing selected): a back-end that settles (raster) draws no
+             * frame by itself, and the script waited for one forever */
             pthread_mutex_lock(&v.mu);
-            key_req = v.req_version;
+            v.redraw = true;
+            key_req = ++v.req_version;
+            pthread_cond_signal(&v.cv);
             pthread_mutex_unlock(&v.mu);
         }
         if (in.changed) {

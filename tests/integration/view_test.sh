@@ -80,6 +80,14 @@ grep -q '^sy view: key 2 first answered by: scale [0-9.]* moving$' "$W/view_gov.
     echo "FAIL: the frame after a back-end switch is not a moving frame:"; cat "$W/view_gov.out"; exit 1; }
 tail -n 1 "$W/view_gov.out" | grep -q '| scale 1.00 |' || {
     echo "FAIL: the settled frame is not at full size:"; cat "$W/view_gov.out"; exit 1; }
+# a scripted key that changes nothing (an unbound letter) is still answered by a frame: with the
+# rasterizer, which draws nothing once its view settled, the script waited for one forever
+timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b raster -w 64 -h 48 --keys 'ZZ' --frames 1 \
+    >"$W/view_noop.out" 2>"$W/view_noop.err"
+rc=$?
+[ $rc -eq 0 ] && [ "$(grep -c '^sy view: after key Z: ' "$W/view_noop.out")" -eq 2 ] || {
+    echo "FAIL: sy view --keys ZZ -b raster: status $rc (124: it waited for a frame): $(cat "$W/view_noop.out" "$W/view_noop.err")"
+    exit 1; }
 # a budget out of range is a usage error naming the option
 if "$SY" view demo --budget 0 --frames 1 2>"$W/badb.err"; then
     echo "FAIL: sy view accepted --budget 0"
