@@ -3,7 +3,7 @@
  * Sections: >>tables (id-indexed mirrors)  >>textures/materials/meshes  >>nodes and placements
  * >>entries  >>sync  >>lifetime */
 #include "sy_mirror.h"
-#include "sy_deform.h"
+#include "sy_deform_cache.h"
 #include "sy_log.h"
 #include "sy_strokes.h"
 
@@ -116,6 +116,7 @@ struct sy_mirror {
     uint32_t deformer_count, deformer_cap;
     sy_mat4 *joint_scratch;      /* composed joint matrices of the node being deformed */
     uint32_t joint_scratch_cap;
+    uint32_t cache_slot;         /* this mirror's taker slot in the shared poses (sy_deform_cache.h) */
 };
 
 static const sy_mat4 identity_world = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
@@ -636,37 +637,21 @@ static sy_result deform_node(sy_mirror *st, node_m *n, sy_error *err)
     for (uint32_t i = 0; i < count && r == SY_OK; ++i) {
         const sy_primitive *src = &m->src[i];
         if (!m->prims[i].handle) continue; /* nothing the mesh draws either */
-        uint32_t nv = sy_primitive_vertex_count(src);
-        float *pos = malloc(sizeof(float) * 3 * (size_t)nv + 1);
-        float *nrm = src->normals ? malloc(sizeof(float) * 3 * (size_t)nv + 1) : NULL;
-        float *tan = src->tangents ? malloc(sizeof(float) * 4 * (size_t)nv + 1) : NULL;
-        if (!pos || (src->normals && !nrm) || (src->tangents && !tan)) {
-            free(pos), free(nrm), free(tan);
-            return oom(st, err);
-        }
         in.primitive = src;
-        sy_bounds b;
-        double t_deform = sy_time_now();
-        bool deformed = sy_deform_primitive(&in, pos, nrm, tan, &b);
-        st->stats->deform_seconds += sy_time_now() - t_deform;
-        if (!deformed) {
+        sy_deform_pose pose;
+        r = sy_deform_cache_take(&in, st->cache_slot, &pose, err); /* deformed once for every mirror */
+        if (r != SY_OK) return r;
+        st->stats->deform_seconds += pose.seconds;
+        if (!pose.ok) {
             char item[48];
             snprintf(item, sizeof item, "node %#x primitive %u", n->id, i);
             sy_log(SY_LOG_WARNING, st->name, item, "deformed beyond the coordinate range: not updated");
-            free(pos), free(nrm), free(tan);
             continue;
         }
+        if (pose.shared) st->stats->deform_shared++;
+        sy_bounds b = pose.bounds;
         sy_bounds_add_bounds(&n->dbounds, &b);
-        sy_blob *bp = NULL, *bn = NULL, *bt = NULL;
-        if ((r = sy_blob_create_take(pos, sizeof(float) * 3 * (size_t)nv, &bp, err)) ||
-            (nrm && (r = sy_blob_create_take(nrm, sizeof(float) * 3 * (size_t)nv, &bn, err))) ||
-            (tan && (r = sy_blob_create_take(tan, sizeof(float) * 4 * (size_t)nv, &bt, err)))) {
-            if (!bp) free(pos);
-            if (!bn) free(nrm);
-            if (!bt) free(tan);
-            sy_blob_release(bp), sy_blob_release(bn), sy_blob_release(bt);
-            return r;
-        }
+        sy_blob *bp = pose.positions, *bn = pose.normals, *bt = pose.tangents; /* the pose's references */
         sy_primitive q = *src; /* borrowed blobs, the deformed three replaced */
         q.positions = bp;
         if (bn) q.normals = bn;
@@ -1135,6 +1120,7 @@ sy_result sy_mirror_create(const sy_mirror_desc *desc, sy_mirror **out, sy_error
     st->cb = desc->callbacks;
     st->user = desc->user;
     st->placements_max = SY_MIRROR_PLACEMENTS_MAX;
+    sy_deform_cache_attach(&st->cache_slot);
     *out = st;
     return SY_OK;
 }
@@ -1152,6 +1138,7 @@ void sy_mirror_destroy(sy_mirror *st)
     }
     free(st->deformers);
     free(st->joint_scratch);
+    sy_deform_cache_detach(st->cache_slot);
     for (uint32_t i = 0; i < st->light_cap; ++i) free(st->light[i].users);
     for (uint32_t i = 0; i < st->tex_cap; ++i) sy_blob_release(st->tex[i].pixels);
     free(st->tex);

@@ -11,7 +11,9 @@
  * light per visible placement of a node with a light, in the same order for every back-end. A node
  * whose mesh has morph targets or joints gets its own primitives, deformed on the CPU once for
  * every back-end (sy_deform.h) after each sync that changed its weights, skin, mesh or a joint's
- * placement, and updated in place through primitive_update where the back-end has it. Each
+ * placement, and updated in place through primitive_update where the back-end has it; every mirror
+ * of the process takes the poses from one shared cache (sy_deform_cache.h), so the same pose is
+ * deformed once however many mirrors (contexts, back-ends) show it. Each
  * callback gets the object's core fields and its flat description (sy_mirror_flat.h: texture
  * handles resolved, emission, texel format, arrays and counts, light type decided once for every
  * back-end), so a mediator only copies fields into its back-end's descriptors. A back-end without
@@ -21,7 +23,8 @@
  * to the back-end and are released through the release callback (sy_mirror_destroy releases the
  * instances, lights and mesh primitives it still holds, so call it before destroying the device;
  * texture and material handles are left to the device's destruction).
- * Thread-safety: none; one mirror is used by one mediator state at a time. */
+ * Thread-safety: none; one mirror is used by one mediator state at a time (distinct mirrors may sync
+ * on different threads at once: the poses they share are behind sy_deform_cache.h's lock). */
 #ifndef SY_MIRROR_H
 #define SY_MIRROR_H
 
@@ -155,7 +158,8 @@ typedef struct sy_mirror_sync_stats {
     uint32_t placements;      /**< node placements recomputed */
     uint32_t nodes_destroyed; /**< mirrored nodes removed */
     uint32_t deformed;        /**< primitive instances deformed (skins, morph targets: sy_deform.h) */
-    double deform_seconds;    /**< wall time in sy_deform_primitive (the deformation itself) */
+    uint32_t deform_shared;   /**< of them, poses another mirror had already deformed (sy_deform_cache.h) */
+    double deform_seconds;    /**< wall time in sy_deform_primitive (the deformation itself; 0 for shared poses) */
     double update_seconds;    /**< wall time in the back-end's primitive_update / primitive_set for the
                                * deformed primitives (the ray tracers' BVH refit, the rasterizer's upload) */
 } sy_mirror_sync_stats;

@@ -14,8 +14,13 @@
  *     deformation, the deformed vertices' update (the ray tracers: copy + Embree BVH refit; the
  *     rasterizer: vertex buffer re-upload) and the ray tracers' top-level commit; the frame (clock +
  *     commit + sync) against translating the same frame from scratch (a new context and its first
- *     sync at the last frame's time: the BVHs built, the buffers made), as a ratio. */
+ *     sync at the last frame's time: the BVHs built, the buffers made), as a ratio;
+ *   - the skinned mesh with 1 and with 3 contexts on the scene (whitted, pathtracer, raster; those
+ *     that start, the rest whitted again): the deformation per frame summed over the contexts, with
+ *     each mirror deforming its own copy (sharing off, as before sy_deform_cache.h) and with the
+ *     poses shared (one deformation per pose for every context), and the ratio of the two. */
 #include "sy_bench.h"
+#include "sy_deform_cache.h"
 #include "sy_anim.h"
 #include "sy_commit.h"
 #include "sy_file.h"
@@ -295,8 +300,96 @@ static sy_result step_clock(sy_scene *s, sy_animation clip, double t, samples *s
     return r;
 }
 
+/* The last sync's deformation of a context: seconds, primitive instances deformed, of them shared. */
+static void ctx_deform(sy_context *ctx, bool rt, double *sec, uint32_t *deformed, uint32_t *shared)
+{
+    *sec = 0.0, *deformed = *shared = 0;
+#ifdef SY_HAVE_EMBREE
+    if (rt) {
+        sy_mediator_rt_counters rc;
+        sy_mediator_rt_counters_get(sy_context_state(ctx), &rc);
+        *sec = rc.last_sync_deform_seconds, *deformed = rc.last_sync_deformed, *shared = rc.last_sync_deform_shared;
+    }
+#endif
+#ifdef SY_HAVE_RASTER
+    if (!rt) {
+        sy_mediator_raster_counters rc;
+        sy_mediator_raster_counters_get(sy_context_state(ctx), &rc);
+        *sec = rc.last_sync_deform_seconds, *deformed = rc.last_sync_deformed, *shared = rc.last_sync_deform_shared;
+    }
+#endif
+    (void)ctx, (void)rt;
+}
+
+/* 1 and 3 contexts on one scene, the poses shared or not: deformation per frame over all contexts. */
+static sy_result bench_contexts(sy_scene *s, sy_animation clip, uint32_t root, double t0, double t1, samples *sm, sy_error *err)
+{
+    static const char *const want[] = {"whitted", "pathtracer", "raster"};
+    const char *names[3];
+    bool rt[3]; /* a ray tracer's counters (want[0], want[1]) or the rasterizer's */
+    sy_context *ctx[3] = {NULL, NULL, NULL};
+    uint32_t n = 0;
+    sy_result r = sy_scene_set_time(s, clip, t0, err);
+    if (r == SY_OK) r = sy_scene_commit(s, NULL, err);
+    for (size_t k = 0; k < 3 && r == SY_OK; ++k) {
+        bool found = sy_mediator_find(want[k]) != NULL;
+        const char *b = found ? want[k] : "whitted";
+        sy_error e2 = {0};
+        if (!sy_mediator_find(b) || sy_context_create(s, b, NULL, root, &ctx[n], &e2) != SY_OK) continue;
+        rt[n] = !found || k < 2;
+        names[n++] = b;
+    }
+    for (; n && n < 3 && r == SY_OK; ++n) { /* fewer back-ends start here: whitted again */
+        names[n] = "whitted";
+        rt[n] = true;
+        r = sy_context_create(s, "whitted", NULL, root, &ctx[n], err);
+    }
+    if (r != SY_OK || n < 3) {
+        for (uint32_t k = 0; k < 3; ++k) sy_context_release(ctx[k]);
+        if (r == SY_OK) printf("  several contexts: skipped (no ray tracer built)\n");
+        return r;
+    }
+    printf("  contexts on one scene (deformation per frame, summed over the contexts; poses deformed / shared):\n");
+    double base = 0.0, unshared3 = 0.0, shared3 = 0.0;
+    static const struct { uint32_t contexts; bool sharing; const char *what; } runs[3] = {
+        {1, true, "1 context (%s)"}, {3, false, "3 contexts, each deforms its own (sharing off)"},
+        {3, true, "3 contexts, poses shared (sy_deform_cache)"}};
+    for (int run = 0; run < 3 && r == SY_OK; ++run) {
+        sy_deform_cache_set_sharing(runs[run].sharing);
+        uint32_t nc = runs[run].contexts, made = 0, taken = 0;
+        for (uint32_t k = 0; k < nc && r == SY_OK; ++k) r = sy_context_sync(ctx[k], err); /* catch up */
+        for (uint32_t i = 0; i < sm->n && r == SY_OK; ++i) {
+            r = step_clock(s, clip, frame_time(t0, t1, i, sm->n), sm, i, NULL, err);
+            sm->v[S_DEFORM][i] = 0.0;
+            for (uint32_t k = 0; k < nc && r == SY_OK; ++k) {
+                r = sy_context_sync(ctx[k], err);
+                double sec;
+                uint32_t d, sh;
+                ctx_deform(ctx[k], rt[k], &sec, &d, &sh);
+                sm->v[S_DEFORM][i] += sec;
+                made += d - sh, taken += sh;
+            }
+        }
+        if (r != SY_OK) break;
+        char what[96];
+        snprintf(what, sizeof what, runs[run].what, names[0]);
+        row(what, sm, S_DEFORM);
+        printf("      %.2f poses deformed, %.2f shared per frame\n", (double)made / sm->n, (double)taken / sm->n);
+        double m = median_of(sm, S_DEFORM);
+        if (run == 0) base = m;
+        else if (run == 1) unshared3 = m;
+        else shared3 = m;
+    }
+    sy_deform_cache_set_sharing(true);
+    if (r == SY_OK)
+        printf("    3 contexts / 1 context: %.2f sharing off, %.2f shared (shared / off %.3f)\n", unshared3 / base,
+               shared3 / base, shared3 / unshared3);
+    for (uint32_t k = 0; k < 3; ++k) sy_context_release(ctx[k]);
+    return r;
+}
+
 /* One scene (loaded from path): the no-op mirror, then each back-end. */
-static sy_result bench_scene(const char *label, const char *path, uint32_t frames, sy_error *err)
+static sy_result bench_scene(const char *label, const char *path, uint32_t frames, bool contexts, sy_error *err)
 {
     sy_scene *s = NULL;
     sy_gltf_info info = {0};
@@ -414,6 +507,7 @@ static sy_result bench_scene(const char *label, const char *path, uint32_t frame
         printf("    %-46s %9.3f ms   frame / scratch %.4f (x%.0f)\n", "from scratch (new context + first sync)",
                1e3 * scratch, f / scratch, scratch / f);
     }
+    if (r == SY_OK && contexts) r = bench_contexts(s, clip, info.root.id, t0, t1, &sm, err);
     for (int k = 0; k < S_COUNT; ++k) free(sm.v[k]);
     sy_gltf_info_free(&info);
     sy_scene_destroy(s);
@@ -434,12 +528,12 @@ sy_result sy_bench_anim(uint32_t vertices, uint32_t nodes, uint32_t frames, sy_e
     char label[160];
     snprintf(label, sizeof label, "skinned mesh: %u vertices, %u triangles, %u joints (2 influences per vertex)", nv, nt,
              JOINTS);
-    if (r == SY_OK) r = bench_scene(label, skinned, frames, err);
+    if (r == SY_OK) r = bench_scene(label, skinned, frames, true, err);
     unlink(skinned);
     if (r == SY_OK) r = write_nodes_glb(grid, nodes, err);
     snprintf(label, sizeof label, "animated nodes: %u cubes (one shared mesh), a rotation and a translation channel each",
              nodes);
-    if (r == SY_OK) r = bench_scene(label, grid, frames, err);
+    if (r == SY_OK) r = bench_scene(label, grid, frames, false, err);
     unlink(grid);
     rmdir(dir);
     return r;

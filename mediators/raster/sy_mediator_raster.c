@@ -322,6 +322,8 @@ static sy_result raster_sync(void *state, const sy_changes *changes, sy_error *e
     st->counters.last_sync_placements = ms.placements;
     st->counters.last_sync_entries = ms.entries;
     st->counters.last_sync_deform_seconds = ms.deform_seconds;
+    st->counters.last_sync_deformed = ms.deformed;
+    st->counters.last_sync_deform_shared = ms.deform_shared;
     st->counters.last_sync_upload_seconds = ms.update_seconds;
     sy_gl_stats gs;
     sy_gl_device_stats(st->dev, &gs);

@@ -42,6 +42,9 @@ typedef struct sy_mediator_raster_counters {
     /** @{ of the last sync: the mirror's deformation of skinned / morphed meshes, and the re-upload
      * of their vertex buffers (sy_gl_mesh_update; sy_mirror_sync_stats) */
     double last_sync_deform_seconds, last_sync_upload_seconds; /** @} */
+    /** @{ of the last sync: primitive instances given a deformed pose, and of them the poses another
+     * context's mirror had deformed already (shared, not deformed again: sy_deform_cache.h) */
+    uint32_t last_sync_deformed, last_sync_deform_shared; /** @} */
     /** @{ uploads of the last frame (vertex and index buffers, their bytes, uniform buffers, textures) */
     uint64_t vertex_buffer_uploads, vertex_bytes, uniform_buffer_uploads, texture_uploads; /** @} */
     uint64_t model_matrix_updates; /**< instance transforms set in the last frame */

@@ -155,6 +155,9 @@ typedef struct sy_mediator_rt_counters {
     /** @{ of the last sync: the mirror's deformation of skinned / morphed meshes, and the updates of
      * their vertices in the device (copy + BVH refit, sy_rt_mesh_update; sy_mirror_sync_stats) */
     double last_sync_deform_seconds, last_sync_refit_seconds; /** @} */
+    /** @{ of the last sync: primitive instances given a deformed pose, and of them the poses another
+     * context's mirror had deformed already (shared, not deformed again: sy_deform_cache.h) */
+    uint32_t last_sync_deformed, last_sync_deform_shared; /** @} */
     uint32_t accum_restarts;       /**< path tracer: accumulations restarted (not counting the first) */
     uint64_t last_render_rays;     /**< path tracer: rays traced by the last render */
     uint32_t warnings;             /**< out-of-range material / light values clamped (each also logged:

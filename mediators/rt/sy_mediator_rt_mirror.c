@@ -279,6 +279,8 @@ sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err)
     st->counters.last_sync_placements = ms.placements;
     st->counters.last_sync_entries = ms.entries;
     st->counters.last_sync_deform_seconds = ms.deform_seconds;
+    st->counters.last_sync_deformed = ms.deformed;
+    st->counters.last_sync_deform_shared = ms.deform_shared;
     st->counters.last_sync_refit_seconds = ms.update_seconds;
     /* The device tracks what is staged (sy_rt_commit is a no-op on a clean device), so every
      * successful sync ends with a commit: an uncommitted device refuses to render. */

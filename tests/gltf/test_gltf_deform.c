@@ -11,7 +11,11 @@
  *      RiggedSimple's bounds change with time.
  *   2. Malformed skins (a joint index past the skin, a NaN weight): the load and the sync succeed,
  *      a warning names skins[0] / meshes[0].primitives[0], the mesh is drawn in its bind pose.
- *   3. sy_deform_primitive over several threads gives the same floats and bounds as over one. */
+ *   3. sy_deform_primitive over several threads gives the same floats and bounds as over one.
+ *   4. One deformation for every back-end (sy_deform_cache.h): two mirrors on one scene (a generated
+ *      skinned triangle whose joint moves) deform each pose once; the second takes the first's
+ *      (sy_mirror_sync_stats.deform_shared), with the same vertices; a mirror one pose behind gets
+ *      the pose of its own time; with one mirror alone nothing is kept. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,7 +26,7 @@
 #include "gltf_files.h"
 #include "sy_anim.h"
 #include "sy_commit.h"
-#include "sy_deform.h"
+#include "sy_deform_cache.h"
 #include "sy_gltf.h"
 #include "sy_mirror.h"
 
@@ -502,12 +506,119 @@ static int test_threads_agree(void)
     return 0;
 }
 
+/* >>shared deformation: a skinned triangle whose one joint moves up from y = 5 to 6 over 1 s */
+static int write_moving_joint(char *path, size_t size)
+{
+    uint8_t buf[36 + 12 + 48 + 64 + 8 + 24];
+    const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, w[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    const float ibm[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, times[2] = {0, 1}, tr[6] = {0, 5, 0, 0, 6, 0};
+    memcpy(buf, pos, 36);
+    memset(buf + 36, 0, 12);
+    memcpy(buf + 48, w, 48);
+    memcpy(buf + 96, ibm, 64);
+    memcpy(buf + 160, times, 8);
+    memcpy(buf + 168, tr, 24);
+    char bin[600];
+    snprintf(bin, sizeof bin, "%s/moving_joint.bin", g_dir);
+    snprintf(path, size, "%s/moving_joint.gltf", g_dir);
+    FILE *f = fopen(bin, "wb");
+    CHECK(f && fwrite(buf, sizeof buf, 1, f) == 1);
+    fclose(f);
+    const char *json =
+        "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":192,\"uri\":\"moving_joint.bin\"}],"
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":192}],"
+        "\"accessors\":["
+        "{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},"
+        "{\"bufferView\":0,\"byteOffset\":36,\"componentType\":5121,\"count\":3,\"type\":\"VEC4\"},"
+        "{\"bufferView\":0,\"byteOffset\":48,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"},"
+        "{\"bufferView\":0,\"byteOffset\":96,\"componentType\":5126,\"count\":1,\"type\":\"MAT4\"},"
+        "{\"bufferView\":0,\"byteOffset\":160,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},"
+        "{\"bufferView\":0,\"byteOffset\":168,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":1,\"WEIGHTS_0\":2}}]}],"
+        "\"skins\":[{\"joints\":[1],\"inverseBindMatrices\":3}],"
+        "\"nodes\":[{\"mesh\":0,\"skin\":0},{\"name\":\"joint\",\"translation\":[0,5,0]}],"
+        "\"animations\":[{\"samplers\":[{\"input\":4,\"output\":5}],"
+        "\"channels\":[{\"sampler\":0,\"target\":{\"node\":1,\"path\":\"translation\"}}]}],"
+        "\"scenes\":[{\"nodes\":[0,1]}]}";
+    f = fopen(path, "wb");
+    CHECK(f && fwrite(json, strlen(json), 1, f) == 1);
+    fclose(f);
+    return 0;
+}
+
+/* Syncs what mirror m's consumer has not seen yet. */
+static int mirror_pull(sy_scene *s, uint32_t consumer, sy_mirror *m, sy_mirror_sync_stats *st)
+{
+    sy_error e = {0};
+    sy_changes *c;
+    CHECK_OK(sy_scene_consumer_pull(s, consumer, &c, &e), e);
+    sy_result r = sy_mirror_sync(m, c, st, &e);
+    sy_changes_release(c);
+    CHECK_OK(r, e);
+    return 0;
+}
+
+static int test_shared_deformation(void)
+{
+    char path[640];
+    CHECK(write_moving_joint(path, sizeof path) == 0);
+    rig a, b;
+    memset(&b, 0, sizeof b);
+    CHECK(rig_make(&a, path, "moving_joint.gltf", &k_refit) == 0);
+    sy_error e = {0};
+    sy_mirror_desc d = {"test mirror b", 0, &k_refit, &b.rec};
+    sy_deform_cache_stats c0, c1;
+    sy_mirror_sync_stats sa, sb;
+    uint32_t node = mesh_node(a.s);
+    float va[3], vb[3];
+    /* one mirror alone: deformed, nothing kept */
+    CHECK(rig_pose(&a, 0.25, &sa) == 0);
+    sy_deform_cache_stats_get(&c0);
+    EXPECT_MSG(sa.deformed == 1 && sa.deform_shared == 0, "deformed %u, shared %u", sa.deformed, sa.deform_shared);
+    EXPECT_MSG(c0.entries == 0, "%u poses kept with one mirror", c0.entries);
+    /* a second mirror: the pose at 0.5 deformed once, by the first to sync */
+    CHECK_OK(sy_mirror_create(&d, &b.m, &e), e);
+    CHECK_OK(sy_scene_consumer_add(a.s, &b.consumer, &e), e);
+    sy_deform_cache_stats_get(&c0);
+    CHECK(rig_pose(&a, 0.5, &sa) == 0);
+    CHECK(mirror_pull(a.s, b.consumer, b.m, &sb) == 0);
+    sy_deform_cache_stats_get(&c1);
+    EXPECT_MSG(sa.deformed == 1 && sa.deform_shared == 0, "first: deformed %u, shared %u", sa.deformed, sa.deform_shared);
+    EXPECT_MSG(sb.deformed == 1 && sb.deform_shared == 1, "second: deformed %u, shared %u", sb.deformed, sb.deform_shared);
+    EXPECT_MSG(c1.computed - c0.computed == 1, "%llu deformations for one pose in two mirrors",
+               (unsigned long long)(c1.computed - c0.computed));
+    EXPECT_MSG(c1.entries == 0, "%u poses kept after both mirrors took them", c1.entries);
+    CHECK(node_vertex(&a.rec, node, 0, 1, va) && node_vertex(&b.rec, node, 0, 1, vb));
+    EXPECT_VEC(va, 1.0f, 5.5f, 0.0f, 1e-5f);
+    EXPECT_VEC(vb, 1.0f, 5.5f, 0.0f, 1e-5f);
+    /* mirrors at different times: each gets the pose of its own time */
+    CHECK(rig_pose(&a, 0.75, &sa) == 0); /* a at 0.75, b still at 0.5 */
+    CHECK(node_vertex(&a.rec, node, 0, 1, va) && node_vertex(&b.rec, node, 0, 1, vb));
+    EXPECT_VEC(va, 1.0f, 5.75f, 0.0f, 1e-5f);
+    EXPECT_VEC(vb, 1.0f, 5.5f, 0.0f, 1e-5f);
+    CHECK(rig_pose(&a, 0.125, &sa) == 0); /* a at 0.125; b catches up with 0.125 */
+    CHECK(mirror_pull(a.s, b.consumer, b.m, &sb) == 0);
+    EXPECT_MSG(sb.deform_shared == 1, "b at a's time: shared %u", sb.deform_shared);
+    CHECK(node_vertex(&b.rec, node, 0, 1, vb));
+    EXPECT_VEC(vb, 1.0f, 5.125f, 0.0f, 1e-5f);
+    sy_deform_cache_stats_get(&c1);
+    EXPECT_MSG(c1.entries <= 1, "%u poses kept", c1.entries); /* 0.75: b never took it */
+    sy_mirror_destroy(b.m);
+    sy_scene_consumer_remove(a.s, b.consumer);
+    recorder_free(&b.rec);
+    sy_deform_cache_stats_get(&c1);
+    EXPECT_MSG(c1.entries == 0, "%u poses kept with one mirror left", c1.entries);
+    rig_close(&a);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     g_data = argc > 1 ? argv[1] : "../shared/testdata";
     make_scratch_dir(g_dir, sizeof g_dir, "gltf_deform");
     RUN(test_malformed);
     RUN(test_threads_agree);
+    RUN(test_shared_deformation);
     RUN(test_simple_skin);
     RUN(test_cesium_man);
     RUN(test_simple_morph);
