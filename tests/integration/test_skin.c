@@ -4,10 +4,12 @@
  * update of the deformed vertices (the ray tracers refit, the rasterizer re-uploads). Their
  * silhouettes (alpha coverage) agree at t = 1 (IoU >= 0.97), and differ from their own t = 0 pose
  * (IoU < 0.95: the walk moved the legs and arms); a pick names the skinned node at the depth the
- * t = 1 image has there, in every back-end. Then the view sy render makes without a camera frames
+ * t = 1 image has there, in every back-end. The t = 1 pose is deformed once for the three contexts
+ * (sy_deform_cache.h): one deformation per primitive, the other contexts take it. Then the view sy render makes without a camera frames
  * CesiumMan and the Fox whole at five times each (framed_whole). Skipped when a sample is absent. */
 #include "it_util.h"
 #include "sy_anim.h"
+#include "sy_deform_cache.h"
 #include "sy_stats.h"
 
 #define W 160
@@ -90,13 +92,23 @@ int main(void)
     }
     MUST(sy_scene_set_time(s, (sy_animation){0}, 1.0, err));
     MUST(sy_scene_commit(s, NULL, err));
+    sy_deform_cache_stats dc0, dc1;
+    sy_deform_cache_stats_get(&dc0);
     for (size_t b = 0; b < IT_NBACKENDS; ++b) {
         MUST(sy_context_sync(ctx[b], err));
+        if (b + 1 == IT_NBACKENDS) sy_deform_cache_stats_get(&dc1);
         MUST(render(ctx[b], &view, &t1[b], err));
         double iou;
         MUST(sy_layer_coverage_iou(&t0[b], &t1[b], &iou, err));
         printf("%s: IoU of t=0 and t=1: %.4f\n", it_backends[b], iou);
         EXPECT_MSG(iou < 0.95, "%s: the pose at t=1 looks like t=0 (IoU %.4f)", it_backends[b], iou);
+    }
+    {
+        unsigned long long made = dc1.computed - dc0.computed, taken = dc1.shared - dc0.shared;
+        printf("t=1 pose: %llu primitives deformed, %llu taken by the other contexts\n", made, taken);
+        EXPECT_MSG(made >= 1 && taken == made * (IT_NBACKENDS - 1),
+                   "%zu contexts: %llu deformations, %llu shared (want one per primitive, the rest shared)",
+                   (size_t)IT_NBACKENDS, made, taken);
     }
     /* a pick at the chest names the skinned node and the same deformed point in every back-end (the
      * depth of that pixel in the t = 1 layer, whose vertices were updated in place) */
