@@ -49,9 +49,10 @@ void sy_context_restart(sy_context *c);
  * syncs: every node moved between T1 and T0 is placed at T0 for ray time 0 and at T1 for ray time
  * 1, interpolated linearly for each ray's time in [0, 1)); render (each pixel sample at its own
  * time; time_samples: the fewest samples per pixel of back-ends with a fixed count, 0 = their
- * default); then sy_context_motion_end (the context stays at T0, sharp). *native false from
- * _open: the changes hold what the back-end cannot interpolate (deformed skins and morphs, moved
- * lights; the camera is never interpolated: the request's camera is used for every ray): call
+ * default); then sy_context_motion_end (the context stays at T0, sharp). Meshes deformed between T1
+ * and T0 (skins, morphs) are interpolated too, vertex by vertex. *native false from _open: the
+ * changes hold what the back-end cannot interpolate (moved lights, meshes made anew; the camera is
+ * never interpolated: the request's camera is used for every ray): call
  * sy_context_motion_end and blur another way (sub-frames). Errors leave the motion ended.
  * Thread-safety: as sy_context_render. */
 sy_result sy_context_motion_begin(sy_context *c, uint32_t time_samples, sy_error *err);

@@ -268,8 +268,9 @@ static void blur_add(sy_layer *acc, const sy_layer *l, float weight)
  * at the shutter's close, synced, then at its open, synced (sy_context_motion_begin / _open): every
  * instance moved in between is interpolated linearly from open to close by each ray's own time. True
  * with *ctx_out the main context in motion (the caller renders once, then sy_context_motion_end);
- * false when the back-end lacks it, or (a note says why) the scene also deforms meshes, moves lights or
- * moves the camera over the shutter: then the motion is ended and the caller blurs by sub-frames. */
+ * Deformed meshes (skins, morph targets) are interpolated too, vertex by vertex. False when the
+ * back-end lacks it, or (a note says why) the scene also moves lights, makes meshes anew or moves the
+ * camera over the shutter: then the motion is ended and the caller blurs by sub-frames. */
 static bool motion_native_begin(loaded *ld, const char *clip, double frame_time, const sy_shutter *sh,
                                 const sy_compose_spec *spec, uint32_t w, uint32_t h, sy_context_pool *pool,
                                 sy_context **ctx_out)
@@ -301,8 +302,8 @@ static bool motion_native_begin(loaded *ld, const char *clip, double frame_time,
     sy_log(SY_LOG_NOTE, "sy", NULL, "motion blur: %s; blurring by sub-frames instead",
            e.message[0]  ? e.message
            : camera_moves ? "the camera moves over the shutter, which the back-end does not interpolate"
-                          : "the scene deforms meshes or moves lights over the shutter, which the back-end does not "
-                            "interpolate");
+                          : "the scene moves lights or makes meshes anew over the shutter, which the back-end does "
+                            "not interpolate");
     return false;
 }
 
@@ -320,7 +321,7 @@ static sy_result render_blurred(loaded *ld, const char *clip, double frame_time,
         if (po) snprintf(each, sizeof each, "each pixel sample");
         else snprintf(each, sizeof each, "each of at least %u samples per pixel", sh->samples);
         sy_log(SY_LOG_NOTE, "sy", NULL, "motion blur: one render, %s at its own time of the shutter %g..%g s after %g s "
-               "(moving objects interpolated per ray; --sub-frames: the mean of sub-frames instead)", each, sh->open,
+               "(moving objects and deforming meshes interpolated per ray; --sub-frames: the mean of sub-frames instead)", each, sh->open,
                sh->close, frame_time);
         sy_result r;
         uint64_t total = 0;

@@ -399,7 +399,19 @@ sy_rt_result sy_rt_instance_get_transform(const sy_rt_device *dev, sy_rt_instanc
 /** Gives the instance motion to `close` (object-to-world at time 1, checked like a transform; equal
  * to its transform or NULL: no motion). Keeps its transform (time 0); sy_rt_commit publishes it. */
 sy_rt_result sy_rt_instance_set_motion(sy_rt_device *dev, sy_rt_instance inst, const float close[16]);
-/** Drops every instance's motion (each stays at its transform); sy_rt_commit publishes it. */
+/** A deforming mesh's motion: as sy_rt_mesh_update (the same checks), but the vertices (and normals)
+ * the mesh has now become its pose at ray time 1 (the shutter's close) and the given ones its pose
+ * at time 0 (the open); Embree interpolates each vertex linearly by the ray's time (two time steps
+ * on the mesh's geometry, rtcSetGeometryTimeStepCount + vertex buffer slot 1; its BLAS rebuilt as a
+ * motion-blur BVH), and so does shading (position, geometric and shading normal of the hit triangle
+ * at the ray's time; the normals interpolated linearly, then normalised: the pose between the two is
+ * approximated linearly, as Embree does). Texture coordinates and colours do not move. Not moved:
+ * the area lights of an emissive deforming mesh (its time-0 triangles), baked instances of the mesh,
+ * and what the paragraph above lists. A mesh already in motion moves on: its time-0 pose becomes
+ * time 1. sy_rt_commit publishes it. */
+sy_rt_result sy_rt_mesh_update_motion(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals);
+/** Drops every instance's and mesh's motion (each stays at its transform / time-0 pose);
+ * sy_rt_commit publishes it. */
 sy_rt_result sy_rt_motion_clear(sy_rt_device *dev);
 
 /* >>light */

@@ -33,6 +33,13 @@ typedef struct sy_rt_mesh_data {
     bool own_positions;       /* positions is an Embree buffer of its own (a copy, or rewritten by sy_rt_mesh_update) */
     float *updated_normals;   /* a shared mesh's normals rewritten by sy_rt_mesh_update (own; freed with it) */
     bool refitting;           /* updated by sy_rt_mesh_update: its BLAS is built LOW, its geometry REFIT */
+    /* Motion blur of a deforming mesh (sy_rt_mesh_update_motion): positions / normals are its pose at
+     * ray time 0 (the shutter's open), positions1 / normals1 at time 1 (its close); Embree
+     * interpolates the vertices linearly (two time steps on geom), shading likewise
+     * (sy_rt_surface_fetch_at). */
+    bool motion;
+    const float *positions1;  /* Embree's vertex buffer of time step 1 while motion */
+    float *normals1;          /* own, while motion with normals */
     uint64_t own_bytes, shared_bytes; /* accounting (sy_rt_device_stats) */
     uint32_t vertex_count, triangle_count;
     int closed;           /* sy_rt_mesh_desc.closed: section caps fill its cut faces (1, -1: its winding) */

@@ -243,6 +243,47 @@ void sy_rt_alpha_filter(const struct RTCFilterFunctionNArguments *args)
     }
 }
 
+void sy_rt_surface_fetch_at(const sy_rt_device *dev, const sy_rt_instance_data *inst, float time, uint32_t prim, float u,
+                            float v, sy_rt_v3 dir, sy_rt_surface *s)
+{
+    sy_rt_instance_data posed;
+    const sy_rt_instance_data *at = sy_rt_instance_at(inst, time, &posed);
+    const sy_rt_mesh_data *m = inst->mesh;
+    if (!m->motion || !(time > 0.0f)) {
+        sy_rt_surface_fetch(dev, at, prim, u, v, dir, s);
+        s->inst = inst;
+        return;
+    }
+    /* a deforming mesh in motion: the hit triangle alone, its corners at the ray's time (as Embree
+     * interpolates them), in a mesh of one triangle that the fetch reads like any other */
+    sy_rt_mesh_data tri = *m;
+    const uint32_t *ix = m->indices + 3u * prim;
+    static const uint32_t idx[3] = {0, 1, 2};
+    float pos[9], nrm[9], uv[2][6], col[12];
+    for (int c = 0; c < 3; ++c) {
+        size_t k = ix[c];
+        for (int a = 0; a < 3; ++a) {
+            pos[3 * c + a] = (1.0f - time) * m->positions[3 * k + a] + time * m->positions1[3 * k + a];
+            if (m->normals) nrm[3 * c + a] = (1.0f - time) * m->normals[3 * k + a] + time * (m->normals1 ? m->normals1[3 * k + a] : m->normals[3 * k + a]);
+        }
+        for (int set = 0; set < 2; ++set)
+            if (m->uv[set]) uv[set][2 * c] = m->uv[set][2 * k], uv[set][2 * c + 1] = m->uv[set][2 * k + 1];
+        if (m->colors)
+            for (int a = 0; a < 4; ++a) col[4 * c + a] = m->colors[4 * k + a];
+    }
+    tri.positions = pos;
+    tri.indices = idx;
+    tri.normals = m->normals ? nrm : NULL;
+    tri.uv[0] = m->uv[0] ? uv[0] : NULL;
+    tri.uv[1] = m->uv[1] ? uv[1] : NULL;
+    tri.colors = m->colors ? col : NULL;
+    tri.vertex_count = 3, tri.triangle_count = 1;
+    if (at != &posed) posed = *inst;
+    posed.mesh = &tri;
+    sy_rt_surface_fetch(dev, &posed, 0, u, v, dir, s);
+    s->inst = inst;
+}
+
 sy_rt_v3 sy_rt_surface_eyelight(const sy_rt_device *dev, const sy_rt_instance_data *inst, uint32_t prim, float u,
                                 float v, sy_rt_v3 dir)
 {

@@ -39,15 +39,12 @@ void sy_rt_surface_fetch(const sy_rt_device *dev, const sy_rt_instance_data *ins
                          float v, sy_rt_v3 dir, sy_rt_surface *s);
 
 /* sy_rt_surface_fetch of the instance as placed at ray time `time` (motion blur, sy_rt_instance_at):
- * the point and normals where the moving instance is at that time; s->inst is inst itself (the
- * stored instance: identity comparisons and lookups stay valid). */
-static inline void sy_rt_surface_fetch_at(const sy_rt_device *dev, const sy_rt_instance_data *inst, float time,
-                                          uint32_t prim, float u, float v, sy_rt_v3 dir, sy_rt_surface *s)
-{
-    sy_rt_instance_data posed;
-    sy_rt_surface_fetch(dev, sy_rt_instance_at(inst, time, &posed), prim, u, v, dir, s);
-    s->inst = inst;
-}
+ * the point and normals where the moving instance is at that time, and for a deforming mesh in
+ * motion (sy_rt_mesh_update_motion) the hit triangle's vertices and normals interpolated between its
+ * two poses at that time; s->inst is inst itself (the stored instance: identity comparisons and
+ * lookups stay valid). */
+void sy_rt_surface_fetch_at(const sy_rt_device *dev, const sy_rt_instance_data *inst, float time, uint32_t prim, float u,
+                            float v, sy_rt_v3 dir, sy_rt_surface *s);
 
 /* Eye-light colour of the PRIMARY integrator at a hit, bit-identical to shading the full
  * sy_rt_surface_fetch result (emission for emitters, base colour for unlit materials, otherwise

@@ -115,8 +115,9 @@ typedef struct rt_state {
      * between gives each moved instance its close transform), MOTION_ON until END */
     enum { MOTION_OFF, MOTION_ARMED, MOTION_ON } motion;
     uint32_t motion_samples;  /* Whitted's time samples per pixel (sy_rt_render_desc.time_samples) */
-    bool motion_other;        /* the armed sync deformed a mesh or moved a light: not interpolated */
+    bool motion_other;        /* the armed sync made a mesh or moved a light: not interpolated */
     uint32_t motion_instances; /* instances given motion by the armed sync */
+    uint32_t motion_meshes;   /* deformed meshes given motion (two vertex time steps) by the armed sync */
 } rt_state;
 
 /* --- sy_mediator_rt_base.c --- */

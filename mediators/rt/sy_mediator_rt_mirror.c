@@ -138,6 +138,7 @@ static void rt_mesh_blobs_release(void *user)
 static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
 {
     rt_state *st = user;
+    if (st->motion == MOTION_ARMED) st->motion_other = true; /* made at the open: no pose at the close to move from */
     const sy_primitive *p = a->primitive;
     const sy_mirror_flat_mesh *f = a->flat;
     rt_mesh_blobs *held = malloc(sizeof *held);
@@ -154,12 +155,16 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
 }
 
 /* A deformed pose of a primitive made by cb_primitive: its vertices rewritten and its BVH refitted
- * (sy_rt_mesh_update); the blobs cb_primitive holds stay until the mesh goes. */
+ * (sy_rt_mesh_update); the blobs cb_primitive holds stay until the mesh goes. In the sync at a
+ * shutter's open (motion armed) the pose it had (the close's) becomes its pose at ray time 1 and the
+ * new one its pose at time 0: Embree interpolates the vertices per ray (sy_rt_mesh_update_motion). */
 static sy_result cb_primitive_update(void *user, const sy_mirror_primitive_args *a, sy_error *err)
 {
     rt_state *st = user;
-    if (st->motion == MOTION_ARMED) st->motion_other = true; /* deformed over the shutter: not interpolated */
-    sy_rt_result r = sy_rt_mesh_update(st->dev, (sy_rt_mesh){*a->handle}, a->flat->positions, a->flat->normals);
+    sy_rt_mesh h = {*a->handle};
+    sy_rt_result r = st->motion == MOTION_ARMED ? sy_rt_mesh_update_motion(st->dev, h, a->flat->positions, a->flat->normals)
+                                                : sy_rt_mesh_update(st->dev, h, a->flat->positions, a->flat->normals);
+    if (r == SY_RT_OK && st->motion == MOTION_ARMED) st->motion_meshes++;
     return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "mesh primitive update");
 }
 
@@ -251,6 +256,7 @@ sy_result sy_rti_motion(void *state, sy_motion_phase phase, uint32_t time_sample
         st->motion_samples = time_samples;
         st->motion_other = false;
         st->motion_instances = 0;
+        st->motion_meshes = 0;
         return SY_OK;
     case SY_MOTION_OPENED:
         if (st->motion != MOTION_ARMED) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion: not begun");
