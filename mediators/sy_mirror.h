@@ -158,7 +158,8 @@ typedef struct sy_mirror_sync_stats {
     uint32_t placements;      /**< node placements recomputed */
     uint32_t nodes_destroyed; /**< mirrored nodes removed */
     uint32_t deformed;        /**< primitive instances deformed (skins, morph targets: sy_deform.h) */
-    uint32_t deform_shared;   /**< of them, poses another mirror had already deformed (sy_deform_cache.h) */
+    uint32_t deform_shared;   /**< of them, poses taken already deformed (by another mirror, or for another node
+                               * in the same pose: sy_deform_cache.h) */
     double deform_seconds;    /**< wall time in sy_deform_primitive (the deformation itself; 0 for shared poses) */
     double update_seconds;    /**< wall time in the back-end's primitive_update / primitive_set for the
                                * deformed primitives (the ray tracers' BVH refit, the rasterizer's upload) */

@@ -390,7 +390,8 @@ sy_rt_result sy_rt_instance_get_transform(const sy_rt_device *dev, sy_rt_instanc
  * motion is placed by its transform at time 0 and by `close` at time 1, the matrix interpolated
  * linearly between them for every ray (Embree's time steps: rtcSetGeometryTimeStepCount 2 on the
  * instance geometry, or on a baked instance's world-space triangles a second vertex buffer; its twin
- * while it moved likewise) and for shading. While some instance has motion, the path tracer gives
+ * while it moved likewise) and for shading; a deforming mesh likewise gets two vertex time steps
+ * (sy_rt_mesh_update_motion). While some instance or mesh has motion, the path tracer gives
  * every pixel sample a stratified time (shadow rays share it) and Whitted takes
  * max(pixel_samples, time_samples) samples per pixel at stratified times and points; without one,
  * every ray has time 0 and renders are bit for bit those without motion. Not moved over the shutter:

@@ -129,7 +129,7 @@ struct sy_rt_device {
                                     * walks every id up to the largest) */
     uint32_t dyn_map_cap;
     uint32_t stale_count;  /* instances with stale set */
-    uint32_t motion_count; /* instances with motion (sy_rt_instance_set_motion): rays get times */
+    uint32_t motion_count; /* instances and meshes with motion (sy_rt_instance_set_motion, sy_rt_mesh_update_motion): rays get times */
     /* Section planes of the call in progress (sy_rt_clip_begin: the camera's), read by the context
      * filter sy_rt_context_filter on every hit. */
     uint32_t clip_count;

@@ -15,8 +15,10 @@
  *   4. One deformation for every back-end (sy_deform_cache.h): two mirrors on one scene (a generated
  *      skinned triangle whose joint moves) deform each pose once; the second takes the first's
  *      (sy_mirror_sync_stats.deform_shared), with the same vertices; a mirror one pose behind gets
- *      the pose of its own time; with one mirror alone nothing is kept. */
+ *      the pose of its own time; with one mirror alone nothing is kept. Two threads asking for one
+ *      pose at once: one deforms it, the other waits and takes the same blobs. */
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -612,6 +614,58 @@ static int test_shared_deformation(void)
     return 0;
 }
 
+/* >>two threads, one pose: sy_deform_cache_take from two users at once deforms it once */
+typedef struct take_job {
+    const sy_deform_input *in;
+    uint32_t slot;
+    sy_deform_pose pose;
+    sy_result r;
+} take_job;
+
+static void *take_thread(void *arg)
+{
+    take_job *j = arg;
+    sy_error e = {0};
+    j->r = sy_deform_cache_take(j->in, j->slot, &j->pose, &e);
+    return NULL;
+}
+
+static int test_cache_threads(void)
+{
+    const uint32_t nv = 3 * SY_DEFORM_VERTICES_PER_THREAD; /* long enough that the second usually waits */
+    float *pos = malloc(sizeof(float) * 3 * nv), *dp = malloc(sizeof(float) * 3 * nv);
+    CHECK(pos && dp);
+    for (uint32_t k = 0; k < 3 * nv; ++k) pos[k] = (float)(k % 977) * 0.01f, dp[k] = (float)(k % 13) * 0.001f;
+    sy_primitive p = {0};
+    sy_error e = {0};
+    CHECK_OK(sy_blob_create_take(pos, sizeof(float) * 3 * nv, &p.positions, &e), e);
+    CHECK_OK(sy_blob_create_take(dp, sizeof(float) * 3 * nv, &p.target_positions, &e), e);
+    const float w[1] = {0.75f};
+    sy_deform_input in = {&p, w, 1, NULL, 0, 0};
+    take_job j[2] = {{&in, 0, {0}, SY_OK}, {&in, 0, {0}, SY_OK}};
+    sy_deform_cache_attach(&j[0].slot);
+    sy_deform_cache_attach(&j[1].slot);
+    sy_deform_cache_stats c0, c1;
+    sy_deform_cache_stats_get(&c0);
+    pthread_t th[2];
+    for (int k = 0; k < 2; ++k) CHECK(pthread_create(&th[k], NULL, take_thread, &j[k]) == 0);
+    for (int k = 0; k < 2; ++k) pthread_join(th[k], NULL);
+    sy_deform_cache_stats_get(&c1);
+    EXPECT(j[0].r == SY_OK && j[1].r == SY_OK && j[0].pose.ok && j[1].pose.ok);
+    EXPECT_MSG(c1.computed - c0.computed == 1 && c1.shared - c0.shared == 1, "two threads: %llu computed, %llu shared",
+               (unsigned long long)(c1.computed - c0.computed), (unsigned long long)(c1.shared - c0.shared));
+    EXPECT_MSG(j[0].pose.positions == j[1].pose.positions && j[0].pose.shared != j[1].pose.shared,
+               "the two threads did not get one pose's blobs");
+    EXPECT_MSG(c1.entries == 0, "%u poses kept after both took it", c1.entries);
+    const float *q = sy_blob_data(j[0].pose.positions), *p0 = sy_blob_data(p.positions), *d0 = sy_blob_data(p.target_positions);
+    EXPECT(q && fabsf(q[3 * nv - 1] - (p0[3 * nv - 1] + 0.75f * d0[3 * nv - 1])) < 1e-5f);
+    for (int k = 0; k < 2; ++k) sy_deform_pose_release(&j[k].pose);
+    sy_deform_cache_detach(j[0].slot);
+    sy_deform_cache_detach(j[1].slot);
+    sy_primitive_release(&p);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     g_data = argc > 1 ? argv[1] : "../shared/testdata";
@@ -619,6 +673,7 @@ int main(int argc, char **argv)
     RUN(test_malformed);
     RUN(test_threads_agree);
     RUN(test_shared_deformation);
+    RUN(test_cache_threads);
     RUN(test_simple_skin);
     RUN(test_cesium_man);
     RUN(test_simple_morph);
