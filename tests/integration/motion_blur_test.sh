@@ -204,6 +204,18 @@ for b in "$@"; do
         fail "$b deforming: a shutter over which nothing deforms differs from no shutter"
 done
 
+# a blurred sequence of the deforming square: frame 7, after frame 6's motion, equals frame 7 rendered
+# alone, bit for bit (the mesh's motion ends with each frame)
+b=$1
+extra=()
+[ "$b" = pathtracer ] && extra=(--spp 8)
+run_ok "$b deforming sequence" deform_seq "$SY" render "$TMP/deform.x3d" -b "$b" -w 48 -h 32 "${extra[@]}" --frames 6:7 \
+    --motion-blur --shutter-samples 4 -o "$TMP/deform_seq_#.exr"
+run_ok "$b deforming frame 7" deform_seq7 "$SY" render "$TMP/deform.x3d" -b "$b" -w 48 -h 32 "${extra[@]}" --frames 7:7 \
+    --motion-blur --shutter-samples 4 -o "$TMP/deform_one_#.exr"
+"$EXR_EQUAL" "$TMP/deform_seq_7.exr" "$TMP/deform_one_7.exr" >/dev/null ||
+    fail "$b: a deforming sequence's frame 7 differs from frame 7 alone"
+
 # nor is a camera that moves over the shutter (the Viewpoint's position interpolated)
 cat >"$TMP/camera.x3d" <<'EOF'
 <X3D><Scene><Viewpoint DEF='V' position='0 0 12' fieldOfView='0.5'/>
