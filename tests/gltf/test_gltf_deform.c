@@ -565,6 +565,7 @@ static int test_shared_deformation(void)
     char path[640];
     CHECK(write_moving_joint(path, sizeof path) == 0);
     rig a, b;
+    memset(&a, 0, sizeof a);
     memset(&b, 0, sizeof b);
     CHECK(rig_make(&a, path, "moving_joint.gltf", &k_refit) == 0);
     sy_error e = {0};
