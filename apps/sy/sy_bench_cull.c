@@ -10,9 +10,8 @@
 #include "sy_plant.h"
 #include "sy_viewport.h"
 
-#include "sy_options.h"
+#include "sy_cli.h"
 
-#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,36 +25,6 @@ static double now_s(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int bench_usage(const char *why)
-{
-    if (why) {
-        fprintf(stderr, "sy bench cull: error: %s (sy bench cull --help)\n", why);
-        return 2;
-    }
-    fprintf(stdout,
-            "usage: sy bench cull [--tris N] [--objects N] [--budget T] [-w W] [-h H] [--frames N] [--seed S]\n"
-            "                     [--write FILE.glb]\n"
-            "  the culling service on a generated plant (default 10000000 triangles in 10000 objects) along a\n"
-            "  camera path of N views (default 8) at W x H (default 640 x 360) with a budget of T triangles\n"
-            "  (default 2000000): IoU of the culled raster render against the full one, triangles drawn, and\n"
-            "  GLB bytes fetched against JPEG video of the same path. --write: write the plant as GLB and stop\n"
-            "  (serve it with sy web FILE.glb --client-render).\n");
-    return 0;
-}
-
-static bool parse_u64(const char *s, uint64_t lo, uint64_t hi, uint64_t *out)
-{
-    char *end = NULL;
-    if (!s || !*s || *s == '-') return false;
-    unsigned long long v = strtoull(s, &end, 10);
-    /* suffixes k and M for readability: --tris 10M */
-    if (end && (*end == 'k' || *end == 'K')) v *= 1000ull, end++;
-    else if (end && *end == 'M') v *= 1000000ull, end++;
-    if (!end || *end || v < lo || v > hi) return false;
-    *out = v;
-    return true;
 }
 
 /* >>the path: along the plant's free corridor nearest its centre (sy_plant_info.corridor_x), at 8 m
@@ -316,45 +285,28 @@ done:
 
 int sy_cmd_bench_cull(int argc, char **argv)
 {
-    uint64_t tris = 10000000, objects = 10000, budget = 2000000, w = 640, h = 360, frames = 8, seed = 1;
+    uint64_t tris = 10000000, objects = 10000, budget = 2000000;
+    uint32_t w = 640, h = 360, frames = 8, seed = 1;
     const char *write_path = NULL;
-    enum { O_TRIS = 1000, O_OBJECTS, O_BUDGET, O_FRAMES, O_SEED, O_WRITE, O_HELP };
-    static const struct option lo[] = {{"tris", required_argument, NULL, O_TRIS},
-                                       {"objects", required_argument, NULL, O_OBJECTS},
-                                       {"budget", required_argument, NULL, O_BUDGET},
-                                       {"frames", required_argument, NULL, O_FRAMES},
-                                       {"seed", required_argument, NULL, O_SEED},
-                                       {"write", required_argument, NULL, O_WRITE},
-                                       {"help", no_argument, NULL, O_HELP},
-                                       {NULL, 0, NULL, 0}};
-    int c;
-    optind = 0;
-    opterr = 0;
-    while ((c = sy_getopt(argc, argv, ":w:h:", lo, "sy bench cull")) != -1) {
-        bool ok = true;
-        switch (c) {
-        case SY_GETOPT_ERROR: return 2; /* an abbreviated long option (named on stderr) */
-        case O_HELP: return bench_usage(NULL);
-        case O_TRIS: ok = parse_u64(optarg, 1, 1ull << 32, &tris); break;
-        case O_OBJECTS: ok = parse_u64(optarg, 1, 1u << 22, &objects); break;
-        case O_BUDGET: ok = parse_u64(optarg, 0, SY_CULL_MAX_BUDGET, &budget); break;
-        case O_FRAMES: ok = parse_u64(optarg, 1, 100000, &frames); break;
-        case O_SEED: ok = parse_u64(optarg, 0, UINT32_MAX, &seed); break;
-        case O_WRITE: write_path = optarg; break;
-        case 'w': ok = parse_u64(optarg, 1, 16384, &w); break;
-        case 'h': ok = parse_u64(optarg, 1, 16384, &h); break;
-        case ':': return bench_usage("an option needs a value");
-        default: return bench_usage("unknown option");
-        }
-        if (!ok) {
-            const char *name = c == 'w' ? "-w" : c == 'h' ? "-h" : "?";
-            for (const struct option *o = lo; o->name; ++o)
-                if (o->val == c) name = o->name;
-            char why[160];
-            snprintf(why, sizeof why, "bad value '%.60s' for %s%s", optarg, c == 'w' || c == 'h' ? "" : "--", name);
-            return bench_usage(why);
-        }
+    static const char usage_text[] =
+        "usage: sy bench cull [--tris N] [--objects N] [--budget T] [-w W] [-h H] [--frames N] [--seed S]\n"
+        "                     [--write FILE.glb]\n"
+        "  the culling service on a generated plant (default 10000000 triangles in 10000 objects) along a\n"
+        "  camera path of N views (default 8) at W x H (default 640 x 360) with a budget of T triangles\n"
+        "  (default 2000000): IoU of the culled raster render against the full one, triangles drawn, and\n"
+        "  GLB bytes fetched against JPEG video of the same path. --write: write the plant as GLB and stop\n"
+        "  (serve it with sy web FILE.glb --client-render). N and T may end in k or M: --tris 10M\n";
+    enum { O_TRIS = OPT_OWN_FIRST, O_OBJECTS, O_BUDGET, O_FRAMES, O_SEED, O_WRITE };
+    const sy_cli_opt opts[] = {
+        SY_CLI_OPT_COUNT("tris", O_TRIS, &tris, 1, 1ull << 32), SY_CLI_OPT_COUNT("objects", O_OBJECTS, &objects, 1, 1u << 22),
+        SY_CLI_OPT_COUNT("budget", O_BUDGET, &budget, 0, SY_CULL_MAX_BUDGET),
+        SY_CLI_OPT_UINT("frames", O_FRAMES, &frames, 1, 100000), SY_CLI_OPT_UINT("seed", O_SEED, &seed, 0, UINT32_MAX),
+        SY_CLI_OPT_TEXT("write", O_WRITE, &write_path)};
+    sy_cli_parser p = {SY_CLI_ARGS("bench cull", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .usage = usage_text};
+    if (sy_cli_parse(&p) != -1) return p.status;
+    if (optind < argc) {
+        fprintf(stderr, "sy bench cull: error: unexpected argument '%s'\n%s", argv[optind], usage_text);
+        return 2;
     }
-    if (optind < argc) return bench_usage("no operands expected");
-    return run_bench(tris, (uint32_t)objects, budget, (uint32_t)w, (uint32_t)h, (uint32_t)frames, (uint32_t)seed, write_path);
+    return run_bench(tris, (uint32_t)objects, budget, w, h, frames, seed, write_path);
 }

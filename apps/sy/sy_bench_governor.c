@@ -4,17 +4,13 @@
 
 #include "sy_bench.h"
 #include "sy_compose.h"
-#include "sy_demo.h"
 #include "sy_governor.h"
 #include "sy_height_field.h"
 #include "sy_orbit.h"
-#include "sy_gltf.h"
-#include "sy_sniff.h"
-#include "sy_x3d.h"
 
-#include "sy_options.h"
+#include "sy_cli.h"
+#include "sy_load.h"
 
-#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -41,35 +37,6 @@ typedef struct gov_opts {
     uint32_t frames, width, height;
     bool trace; /* --trace: one line per governed frame */
 } gov_opts;
-
-/* A scene file (glTF, GLB, X3D) or "demo" into s; root receives the loader's root. */
-static sy_result gov_load(const char *path, sy_scene *s, sy_node *root, sy_error *err)
-{
-    sy_result r;
-    if (!strcmp(path, "demo")) {
-        sy_demo_info d;
-        r = sy_demo_build(s, &d, err);
-        *root = d.root;
-        return r;
-    }
-    sy_file_format fmt = SY_FORMAT_UNKNOWN;
-    if ((r = sy_sniff_file(path, &fmt, err)) != SY_OK) return r;
-    if (fmt == SY_FORMAT_X3D) {
-        sy_x3d_info xi = {0};
-        r = sy_x3d_load(path, s, NULL, &xi, err);
-        *root = xi.root;
-        sy_x3d_info_free(&xi);
-        return r;
-    }
-    if (fmt != SY_FORMAT_GLTF && fmt != SY_FORMAT_GLB)
-        return sy_error_set(err, SY_ERR_UNSUPPORTED, "%s: %s content, not a scene sy reads (glTF, GLB, X3D)", path,
-                            sy_file_format_name(fmt));
-    sy_gltf_info gi = {0};
-    r = sy_gltf_load(path, s, NULL, &gi, err);
-    *root = gi.root;
-    sy_gltf_info_free(&gi);
-    return r;
-}
 
 /* The orbiting camera: a perspective camera (45 degrees) on a top-level node. */
 static sy_result gov_add_camera(gov_scene *gs, sy_error *err)
@@ -237,42 +204,14 @@ int sy_cmd_bench_governor(int argc, char **argv)
         "  the glTF Duck (" GOV_DUCK ")\n"
         "  and a generated height field of T triangles (default 1000000).\n"
         "  --trace: one line per governed frame (size, samples, time)\n";
-    enum { O_BUDGET = 0x100, O_FRAMES, O_TRIS, O_TRACE, O_HELP };
-    static const struct option lo[] = {{"budget", required_argument, NULL, O_BUDGET},
-                                       {"frames", required_argument, NULL, O_FRAMES},
-                                       {"tris", required_argument, NULL, O_TRIS},
-                                       {"trace", no_argument, NULL, O_TRACE},
-                                       {"help", no_argument, NULL, O_HELP},
-                                       {"quiet", no_argument, NULL, 'q'},
-                                       {"verbose", no_argument, NULL, 'v'},
-                                       {NULL, 0, NULL, 0}};
-    int opt;
-    optind = 0; /* glibc: start over */
-    opterr = 0;
-    while ((opt = sy_getopt(argc, argv, ":w:h:qv", lo, "sy bench governor")) != -1) {
-        if (opt == SY_GETOPT_ERROR) return 2; /* an abbreviated long option (named on stderr) */
-        char *end = NULL;
-        double v = 0;
-        if (opt == 'w' || opt == 'h' || opt == O_BUDGET || opt == O_FRAMES || opt == O_TRIS) v = strtod(optarg, &end);
-        bool ok = !end || (end != optarg && !*end);
-        switch (opt) {
-        case 'w': ok = ok && v >= 1 && v <= 16384 && v == floor(v), o.width = ok ? (uint32_t)v : 0; break;
-        case 'h': ok = ok && v >= 1 && v <= 16384 && v == floor(v), o.height = ok ? (uint32_t)v : 0; break;
-        case O_BUDGET: ok = ok && v >= 1 && v <= 10000, o.budget_ms = v; break;
-        case O_FRAMES: ok = ok && v >= 1 && v <= 100000 && v == floor(v), o.frames = ok ? (uint32_t)v : 0; break;
-        case O_TRIS: ok = ok && v >= 12 && v <= (1u << 30) && v == floor(v), tris = ok ? (uint32_t)v : 0; break;
-        case O_TRACE: o.trace = true; break;
-        case O_HELP: fputs(usage_text, stdout); return 0;
-        case 'q':
-        case 'v': break; /* the log level is sy's */
-        case ':': fprintf(stderr, "sy bench governor: error: option %s needs a value\n", argv[optind - 1]); return 2;
-        default: fprintf(stderr, "sy bench governor: error: unknown option %s\n", argv[optind - 1]); return 2;
-        }
-        if (!ok) {
-            fprintf(stderr, "sy bench governor: error: bad value '%s'\n%s", optarg, usage_text);
-            return 2;
-        }
-    }
+    enum { O_BUDGET = OPT_OWN_FIRST, O_FRAMES, O_TRIS, O_TRACE };
+    const sy_cli_opt opts[] = {SY_CLI_OPT_REAL("budget", O_BUDGET, &o.budget_ms, 1, 10000),
+                               SY_CLI_OPT_UINT("frames", O_FRAMES, &o.frames, 1, 100000),
+                               SY_CLI_OPT_UINT("tris", O_TRIS, &tris, 12, 1u << 30),
+                               SY_CLI_OPT_FLAG("trace", O_TRACE, &o.trace)};
+    sy_cli_parser p = {SY_CLI_ARGS("bench governor", argc, argv, opts), .w = &o.width, .h = &o.height, .min_size = 1,
+                       .usage = usage_text};
+    if (sy_cli_parse(&p) != -1) return p.status;
     if (argc - optind > 1) {
         fprintf(stderr, "sy bench governor: error: at most one SCENE\n%s", usage_text);
         return 2;
@@ -287,25 +226,26 @@ int sy_cmd_bench_governor(int argc, char **argv)
     sy_result r = SY_OK;
     for (int k = 0; k < 2 && r == SY_OK; ++k) {
         gov_scene gs = {0};
+        loaded ld = {0}; /* a scene file or the demo, as every command loads it (sy_load.h) */
         if (scene && k == 1) break;
-        if ((r = sy_scene_create(&gs.scene, &err)) != SY_OK) break;
         if (scene || k == 0) {
             const char *path = scene ? scene : GOV_DUCK;
             gs.label = path;
             if (!scene && access(path, R_OK) != 0) {
                 printf("%s: not found (the shared test data), skipped\n", path);
-                sy_scene_destroy(gs.scene);
                 continue;
             }
-            r = gov_load(path, gs.scene, &gs.root, &err);
-        } else {
+            r = sy_cli_load(path, NULL, false, &ld, &err);
+            gs.scene = ld.scene, gs.root = ld.root;
+        } else if ((r = sy_scene_create(&gs.scene, &err)) == SY_OK) {
             gs.label = "generated height field";
             sy_node hf;
             r = sy_height_field_generate(gs.scene, tris, &hf, &gs.tris, &err);
         }
         if (r == SY_OK) r = gov_add_camera(&gs, &err);
         if (r == SY_OK) r = gov_scene_run(&gs, &o, &err);
-        sy_scene_destroy(gs.scene);
+        if (ld.scene) sy_cli_loaded_free(&ld);
+        else sy_scene_destroy(gs.scene);
     }
     if (r != SY_OK) {
         fprintf(stderr, "sy: error: %s\n", err.message);

@@ -1,17 +1,15 @@
 /* sy_bench_limit.c — `sy bench limit` (issue 19, part 6, "distance to the limit"): the path
  * tracer's rays per second as a share of raw Embree's on exactly the rays of its frame (see
- * sy_bench.h, sy_mediator_rt_bench_limit and backends/rt/sy_rt_limit.h). Parses its own options. */
+ * sy_bench.h, sy_mediator_rt_bench_limit and backends/rt/sy_rt_limit.h), with its own usage text. */
 #include "sy_bench.h"
 
-#include "sy_demo.h"
-#include "sy_gltf.h"
 #ifdef SY_HAVE_EMBREE
 #include "sy_mediator_rt.h"
 #endif
 
-#include "sy_options.h"
+#include "sy_cli.h"
+#include "sy_load.h"
 
-#include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -78,65 +76,17 @@ sy_result sy_bench_limit(sy_scene *scene, const sy_viewport_desc *vd, const char
 #endif
 }
 
-/* The demo (built in code) or a glTF file (its first camera, else a view framing its bounds). */
-static sy_result load_scene(const char *path, sy_scene **scene, sy_viewport_desc *vd, sy_gltf_info *info, sy_error *err)
-{
-    memset(vd, 0, sizeof *vd);
-    sy_result r = sy_scene_create(scene, err);
-    if (r != SY_OK) return r;
-    if (!strcmp(path, "demo")) {
-        sy_demo_info d;
-        r = sy_demo_build(*scene, &d, err);
-        if (r == SY_OK) vd->root = d.root, vd->camera = d.camera, vd->background = d.background;
-    } else {
-        sy_gltf_options go = {0};
-        r = sy_gltf_load(path, *scene, &go, info, err);
-        if (r == SY_OK) {
-            vd->root = info->root;
-            if (info->camera_node_count) vd->camera = info->camera_nodes[0];
-        }
-    }
-    if (r == SY_OK) r = sy_scene_commit(*scene, NULL, err);
-    return r;
-}
-
 int sy_cmd_bench_limit(int argc, char **argv)
 {
     static const char usage_text[] =
         "usage: sy bench limit [SCENE] [-w W] [-h H] [--spp N] [--repeats N]\n"
         "  the path tracer's rays/s as a share of raw Embree's on the same rays (single, packets, streams);\n"
         "  default: the Cornell box (" DEFAULT_CORNELL ") and the demo, 256x256, 1 spp, 5 repeats\n";
-    enum { O_SPP = 0x100, O_REPEATS, O_HELP };
-    static const struct option lo[] = {{"spp", required_argument, NULL, O_SPP},
-                                       {"repeats", required_argument, NULL, O_REPEATS},
-                                       {"help", no_argument, NULL, O_HELP},
-                                       {NULL, 0, NULL, 0}};
     uint32_t w = 256, h = 256, spp = 1, repeats = 5;
-    int opt;
-    optind = 0;
-    opterr = 0;
-    while ((opt = sy_getopt(argc, argv, ":w:h:", lo, "sy bench limit")) != -1) {
-        if (opt == SY_GETOPT_ERROR) return 2; /* an abbreviated long option (named on stderr) */
-        uint32_t *dst = opt == 'w' ? &w : opt == 'h' ? &h : opt == O_SPP ? &spp : opt == O_REPEATS ? &repeats : NULL;
-        unsigned long hi = opt == 'w' || opt == 'h' ? 16384 : opt == O_SPP ? 1024 : 1000;
-        if (opt == O_HELP) {
-            fputs(usage_text, stdout);
-            return 0;
-        }
-        if (!dst) {
-            fprintf(stderr, "sy bench limit: error: %s '%s'\n%s", opt == ':' ? "missing value of" : "unknown option",
-                    argv[optind - 1], usage_text);
-            return 2;
-        }
-        char *end = NULL;
-        unsigned long v = strtoul(optarg, &end, 10);
-        if (!optarg[0] || *end || optarg[0] == '-' || v < 1 || v > hi) {
-            const char *name = opt == 'w' ? "-w" : opt == 'h' ? "-h" : opt == O_SPP ? "--spp" : "--repeats";
-            fprintf(stderr, "sy bench limit: error: %s: '%s' is not in 1..%lu\n", name, optarg, hi);
-            return 2;
-        }
-        *dst = (uint32_t)v;
-    }
+    enum { O_SPP = OPT_OWN_FIRST, O_REPEATS };
+    const sy_cli_opt opts[] = {SY_CLI_OPT_UINT("spp", O_SPP, &spp, 1, 1024), SY_CLI_OPT_UINT("repeats", O_REPEATS, &repeats, 1, 1000)};
+    sy_cli_parser p = {SY_CLI_ARGS("bench limit", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .usage = usage_text};
+    if (sy_cli_parse(&p) != -1) return p.status;
     if (argc - optind > 1) {
         fprintf(stderr, "sy bench limit: error: at most one SCENE\n%s", usage_text);
         return 2;
@@ -144,13 +94,11 @@ int sy_cmd_bench_limit(int argc, char **argv)
     const char *list[2] = {optind < argc ? argv[optind] : DEFAULT_CORNELL, optind < argc ? NULL : "demo"};
     for (int i = 0; i < 2 && list[i]; ++i) {
         sy_error err = {0};
-        sy_scene *scene = NULL;
-        sy_viewport_desc vd;
-        sy_gltf_info info = {0};
-        sy_result r = load_scene(list[i], &scene, &vd, &info, &err);
-        if (r == SY_OK) r = sy_bench_limit(scene, &vd, list[i], w, h, spp, repeats, &err);
-        sy_gltf_info_free(&info);
-        sy_scene_destroy(scene);
+        loaded ld; /* the file's first camera, else a view framing its bounds (sy_bench_limit) */
+        sy_result r = sy_cli_load(list[i], NULL, false, &ld, &err);
+        sy_viewport_desc vd = {.root = ld.root, .camera = ld.camera, .background = ld.background};
+        if (r == SY_OK) r = sy_bench_limit(ld.scene, &vd, list[i], w, h, spp, repeats, &err);
+        sy_cli_loaded_free(&ld);
         if (r != SY_OK) {
             fprintf(stderr, "sy bench limit: error: %s\n", err.message);
             return 1;

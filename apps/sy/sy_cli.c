@@ -1,7 +1,7 @@
-/* sy_cli.c — what every sy command shares on its command line (sy_cli.h): the options of every
- * command (-q / -v, --help, the world and loader flags) taken by sy_cli_next_option, the usage
- * text and its errors (exit status 2), numbers and sizes, the error exit (status 1), the default
- * back-end. */
+/* sy_cli.c — what every sy command shares on its command line (sy_cli.h): the declared options
+ * read by sy_cli_parse, the options of every command (-q / -v, --help, the world and loader flags)
+ * taken on the way, the usage text and its errors (exit status 2), the number parsers, the error
+ * exit (status 1), the default back-end. */
 #include "sy_cli.h"
 #include "sy_cluster_cli.h"
 #include "sy_load.h"
@@ -13,6 +13,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,25 +21,42 @@
 #include <strings.h>
 #include <sys/stat.h>
 
-/* The world flags every command shares (taken out of the arguments in main): --env MAP.exr|.hdr,
- * --env-color R,G,B, --env-intensity X, --env-hidden, --background R,G,B[,A], --no-default-light.
- * *used = arguments consumed (0: not a world flag). Only maps text onto sy_world_options; the
- * meaning is the library's (sy_look.h, sy_world.h). */
-static bool parse_floats(const char *text, float *out, int min_n, int max_n, int *n_out)
+/* getopt_long entries of the camera placement and node visibility options (sy render, pick, view,
+ * web), taken by next_option into sy_cli_load_opts.view and .nodes (sy_load.h) */
+#define VIEW_OPTIONS                                                                                       \
+    {"look-at", required_argument, NULL, OPT_LOOK_AT}, {"fov", required_argument, NULL, OPT_FOV},        \
+    {"orbit", required_argument, NULL, OPT_ORBIT}, {"hide", required_argument, NULL, OPT_HIDE},          \
+    {"isolate", required_argument, NULL, OPT_ISOLATE}, {"select", required_argument, NULL, OPT_SELECT},       \
+    {"bookmark", required_argument, NULL, OPT_BOOKMARK}
+/* getopt_long entries of the options of every command, with the table's terminator: the end of
+ * every command's table */
+#define COMMON_OPTIONS                                                                                     \
+    {"help", no_argument, NULL, OPT_HELP}, {"quiet", no_argument, NULL, 'q'},                              \
+    {"verbose", no_argument, NULL, 'v'}, {"env", required_argument, NULL, OPT_ENV},                        \
+    {"env-color", required_argument, NULL, OPT_ENV_COLOR},                                                 \
+    {"env-intensity", required_argument, NULL, OPT_ENV_INTENSITY},                                         \
+    {"env-hidden", no_argument, NULL, OPT_ENV_HIDDEN}, {"background", required_argument, NULL, OPT_BACKGROUND}, \
+    {"no-default-light", no_argument, NULL, OPT_NO_DEFAULT_LIGHT},                                         \
+    {"allow-path", required_argument, NULL, OPT_ALLOW_PATH}, {"strict", no_argument, NULL, OPT_STRICT},    \
+    {"max-scene-mb", required_argument, NULL, OPT_MAX_SCENE_MB},                                           \
+    {"variant", required_argument, NULL, OPT_VARIANT},                                                     \
+    {NULL, 0, NULL, 0}
+
+bool sy_cli_parse_floats(const char *text, size_t len, int min_n, int max_n, float *out, int *n_out)
 {
+    const char *p = text, *stop = text + len;
     int n = 0;
-    const char *p = text;
-    while (n < max_n) {
+    for (;;) {
         char *end = NULL;
+        if (n == max_n || p >= stop || *p == ',' || isspace((unsigned char)*p)) return false;
         out[n] = strtof(p, &end);
-        if (end == p || !isfinite(out[n])) return false;
-        ++n;
-        if (*end == '\0') break;
-        if (*end != ',') return false;
-        p = end + 1;
+        if (end == p || end > stop || !isfinite(out[n])) return false;
+        ++n, p = end;
+        if (p == stop) break;
+        if (*p++ != ',') return false;
     }
     *n_out = n;
-    return n >= min_n && *p && p[strlen(p) - 1] != ',';
+    return n >= min_n;
 }
 
 /* The world flags (only maps text onto sy_world_options; the meaning is the library's: sy_look.h,
@@ -46,22 +64,23 @@ static bool parse_floats(const char *text, float *out, int min_n, int max_n, int
 static sy_result apply_world_option(int c, const char *v, sy_world_options *w, sy_error *err)
 {
     int n = 0;
+    size_t len = v ? strlen(v) : 0;
     switch (c) {
     case OPT_ENV_HIDDEN: w->env_hidden = true; break;
     case OPT_NO_DEFAULT_LIGHT: w->no_default_light = true; break;
     case OPT_ENV: w->env_path = v; break;
     case OPT_ENV_COLOR:
-        if (!parse_floats(v, w->env_color, 3, 3, &n))
+        if (!sy_cli_parse_floats(v, len, 3, 3, w->env_color, &n))
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--env-color %s: expected R,G,B", v);
         w->has_env_color = true;
         break;
     case OPT_ENV_INTENSITY:
-        if (!parse_floats(v, &w->env_intensity, 1, 1, &n))
+        if (!sy_cli_parse_floats(v, len, 1, 1, &w->env_intensity, &n))
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--env-intensity %s: expected a number", v);
         w->env_intensity_set = true;
         break;
     default: /* OPT_BACKGROUND */
-        if (!parse_floats(v, w->background, 3, 4, &n))
+        if (!sy_cli_parse_floats(v, len, 3, 4, w->background, &n))
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "--background %s: expected R,G,B or R,G,B,A", v);
         if (n == 3) w->background[3] = 1.0f;
         w->has_background = true;
@@ -70,15 +89,15 @@ static sy_result apply_world_option(int c, const char *v, sy_world_options *w, s
 }
 
 /* The next option of a command's arguments (argv[0]: the command's name, for messages; cmd: the
- * command as `sy help` names it, NULL for sy's own options). Call with optind = 0 first (glibc's way
- * to start over with new arguments and a new ordering). Returns the option's code, -1 after the last
- * option (the operands are argv[optind..argc-1]), or OPT_STOP with *status: 0 after --help (the
- * command's usage on stdout), 2 after a usage error (named on stderr). */
-int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *longopts,
+ * command as `sy help` names it, NULL for sy's own options), the options of every command applied on
+ * the way. Call with optind = 0 first (glibc's way to start over with new arguments and a new
+ * ordering). Returns the option's code, -1 after the last option (the operands are
+ * argv[optind..argc-1]), or OPT_STOP with *status: 0 after --help (the command's usage on stdout), 2
+ * after a usage error (named on stderr). */
+static int next_option(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *longopts,
                        int *status)
 {
     opterr = 0; /* the messages are ours */
-    const char *who = cmd ? cmd : "sy";
     char prefix[64];
     snprintf(prefix, sizeof prefix, "sy%s%s", cmd ? " " : "", cmd ? cmd : "");
     for (;;) {
@@ -90,14 +109,14 @@ int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *short
             *status = 2;
             return OPT_STOP;
         case '?':
-            if (optopt >= 0x100) fprintf(stderr, "sy %s: error: option '%s' takes no value", who, bad);
-            else if (optopt) fprintf(stderr, "sy %s: error: unknown option '-%c'", who, optopt);
-            else fprintf(stderr, "sy %s: error: unknown option '%s'", who, bad);
+            if (optopt >= 0x100) fprintf(stderr, "%s: error: option '%s' takes no value", prefix, bad);
+            else if (optopt) fprintf(stderr, "%s: error: unknown option '-%c'", prefix, optopt);
+            else fprintf(stderr, "%s: error: unknown option '%s'", prefix, bad);
             fprintf(stderr, " (sy %s%s--help lists the options)\n", cmd ? cmd : "", cmd ? " " : "");
             *status = 2;
             return OPT_STOP;
         case ':':
-            fprintf(stderr, "sy %s: error: option '%s' needs a value\n", who, bad);
+            fprintf(stderr, "%s: error: option '%s' needs a value\n", prefix, bad);
             *status = 2;
             return OPT_STOP;
         case OPT_HELP:
@@ -108,15 +127,13 @@ int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *short
         case 'v': sy_log_set_level(SY_LOG_DEBUG); break;
         case OPT_STRICT: sy_cli_load_opts.strict = true; break;
         case OPT_MAX_SCENE_MB: { /* the loaders' budget per file, in MiB (sy_budget.h) */
-            char *end = NULL;
-            errno = 0;
-            unsigned long long mb = strtoull(optarg, &end, 10);
-            if (!*optarg || *end || errno || mb < 1 || mb > (1ull << 30)) {
+            uint64_t mb = 0;
+            if (!sy_cli_parse_uint(optarg, 1, 1ull << 30, &mb)) {
                 fprintf(stderr, "sy: error: --max-scene-mb %s: expected a whole number of MiB from 1 to 2^30\n", optarg);
                 *status = 2;
                 return OPT_STOP;
             }
-            sy_cli_load_opts.max_scene_bytes = sy_cli_load_opts.world.max_scene_bytes = (uint64_t)mb << 20;
+            sy_cli_load_opts.max_scene_bytes = sy_cli_load_opts.world.max_scene_bytes = mb << 20;
             break;
         }
         case OPT_VARIANT: sy_cli_load_opts.variant = optarg; break; /* glTF KHR_materials_variants */
@@ -367,17 +384,11 @@ int sy_cli_add_clip_plane(const char *value, float (*planes)[4], uint32_t *count
 
 int sy_cli_parse_plane(const char *opt, const char *value, float q[4])
 {
-    const char *s = value;
-    for (int k = 0; k < 4; ++k) {
-        char *end;
-        double d = strtod(s, &end);
-        if (end == s || !isfinite(d) || fabs(d) > SY_COORD_MAX || *end != (k < 3 ? ',' : '\0')) {
-            fprintf(stderr, "sy: error: %s: '%s' is not a %splane A,B,C,D (four finite numbers: "
-                            "A*x + B*y + C*z + D >= 0 is its kept side)\n", opt, value, strcmp(opt, "--clip") ? "" : "section ");
-            return 2;
-        }
-        q[k] = (float)d;
-        s = end + 1;
+    int n = 0;
+    if (!sy_cli_parse_floats(value, strlen(value), 4, 4, q, &n) || !sy_coords_in_range(q, 4)) {
+        fprintf(stderr, "sy: error: %s: '%s' is not a %splane A,B,C,D (four finite numbers: "
+                        "A*x + B*y + C*z + D >= 0 is its kept side)\n", opt, value, strcmp(opt, "--clip") ? "" : "section ");
+        return 2;
     }
     sy_error e = {0};
     if (sy_clip_planes_check((const float(*)[4])q, 1, &e) != SY_OK) {
@@ -387,36 +398,57 @@ int sy_cli_parse_plane(const char *opt, const char *value, float q[4])
     return 0;
 }
 
-bool sy_cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
+/* s as a whole number in lo..hi; si: k (thousand) or M (million) may follow the digits. */
+static bool parse_whole(const char *s, uint64_t lo, uint64_t hi, bool si, uint64_t *out)
 {
-    char *end;
+    char *end = NULL;
+    if (!isdigit((unsigned char)*s)) return false; /* strtoull would take a sign or spaces */
     errno = 0;
-    unsigned long v = strtoul(s, &end, 10);
-    if (errno || end == s || *end || v < lo || v > hi) return false;
-    *out = (uint32_t)v;
+    unsigned long long v = strtoull(s, &end, 10);
+    uint64_t scale = !si ? 1 : *end == 'k' || *end == 'K' ? 1000 : *end == 'M' ? 1000000 : 1;
+    if (scale > 1) {
+        if (v > UINT64_MAX / scale) return false;
+        v *= scale, end++;
+    }
+    if (errno || *end || v < lo || v > hi) return false;
+    *out = v;
     return true;
 }
+
+bool sy_cli_parse_uint(const char *s, uint64_t lo, uint64_t hi, uint64_t *out) { return parse_whole(s, lo, hi, false, out); }
 
 bool sy_cli_parse_double(const char *s, double lo, double hi, double *out)
 {
     char *end = NULL;
     double v = strtod(s, &end);
-    if (end == s || *end || !(v >= lo && v <= hi)) return false; /* the range refuses NaN and infinities */
+    if (end == s || *end || (lo <= hi && !(v >= lo && v <= hi))) return false; /* the range refuses NaN and infinities */
     *out = v;
     return true;
 }
 
-/* sy_cli_next_option plus -w W / -h H: min_size..16384 pixels. */
-int sy_cli_next_sized_option(const char *cmd, int argc, char **argv, const char *shortopts,
+/* A usage error naming the option and the range its value is not in (a number's); returns 2. */
+static int bad_number(const char *opt, const char *value, double lo, double hi, bool whole)
+{
+    if (whole) fprintf(stderr, "sy: error: %s: '%s' is not in %llu..%llu\n", opt, value, (unsigned long long)lo, (unsigned long long)hi);
+    else if (hi >= DBL_MAX && lo <= DBL_MIN && lo > 0) fprintf(stderr, "sy: error: %s: '%s' is not a number above 0\n", opt, value);
+    else if (lo > hi || hi >= FLT_MAX || lo <= -FLT_MAX) return sy_cli_bad_value(opt, value); /* any number, or unbounded */
+    else fprintf(stderr, "sy: error: %s: '%s' is not in %.10g..%.10g\n", opt, value, lo, hi);
+    return 2;
+}
+
+/* next_option plus -w W / -h H: min_size..16384 pixels. */
+static int next_sized_option(const char *cmd, int argc, char **argv, const char *shortopts,
                              const struct option *longopts, uint32_t min_size, uint32_t *w, uint32_t *h, int *status)
 {
     for (;;) {
-        int c = sy_cli_next_option(cmd, argc, argv, shortopts, longopts, status);
+        int c = next_option(cmd, argc, argv, shortopts, longopts, status);
         if (c != 'w' && c != 'h') return c;
-        if (!sy_cli_parse_u32(optarg, min_size, 16384, c == 'w' ? w : h)) {
-            *status = sy_cli_bad_value(c == 'w' ? "-w" : "-h", optarg);
+        uint64_t v = 0;
+        if (!sy_cli_parse_uint(optarg, min_size, 16384, &v)) {
+            *status = bad_number(c == 'w' ? "-w" : "-h", optarg, min_size, 16384, true);
             return OPT_STOP;
         }
+        *(c == 'w' ? w : h) = (uint32_t)v;
     }
 }
 
@@ -432,6 +464,7 @@ static bool parser_build(sy_cli_parser *p)
     size_t common_count = p->usage ? sizeof own / sizeof own[0] : sizeof all / sizeof all[0];
     size_t n = 0, cap = sizeof p->lo / sizeof p->lo[0], k = 0;
     char *so = p->shortopts;
+    if (!p->cmd) so[k++] = '+'; /* sy's own options end at the command */
     so[k++] = ':';
     for (size_t i = 0; i < p->count; ++i) {
         const sy_cli_opt *o = &p->opts[i];
@@ -446,7 +479,7 @@ static bool parser_build(sy_cli_parser *p)
     for (size_t i = 0; p->view && i < sizeof view / sizeof view[0] && n < cap; ++i) p->lo[n++] = view[i];
     for (size_t i = 0; i < common_count && n < cap; ++i) p->lo[n++] = common[i];
     if (n == cap || k + 3 > sizeof p->shortopts) {
-        fprintf(stderr, "sy %s: error: too many options for the parser's table\n", p->cmd);
+        fprintf(stderr, "sy%s%s: error: too many options for the parser's table\n", p->cmd ? " " : "", p->cmd ? p->cmd : "");
         p->status = 2;
         return false;
     }
@@ -471,9 +504,8 @@ int sy_cli_parse(sy_cli_parser *p)
         optind = 0; /* glibc: start over (new arguments, GNU ordering) */
     }
     for (;;) {
-        int c = p->w ? sy_cli_next_sized_option(p->cmd, p->argc, p->argv, p->shortopts, p->lo, p->min_size, p->w, p->h,
-                                                &p->status)
-                     : sy_cli_next_option(p->cmd, p->argc, p->argv, p->shortopts, p->lo, &p->status);
+        int c = p->w ? next_sized_option(p->cmd, p->argc, p->argv, p->shortopts, p->lo, p->min_size, p->w, p->h, &p->status)
+                     : next_option(p->cmd, p->argc, p->argv, p->shortopts, p->lo, &p->status);
         if (c == OPT_OWN_HELP) {
             fputs(p->usage, stdout);
             p->status = 0;
@@ -484,24 +516,31 @@ int sy_cli_parse(sy_cli_parser *p)
             if (p->opts[i].code == c) o = &p->opts[i];
         if (!o || o->kind == SY_CLI_CODE) return c; /* -1, OPT_STOP, the command's own, the cluster's */
         bool ok = true;
+        uint64_t u = 0;
+        double d = 0;
         switch (o->kind) {
         case SY_CLI_TEXT: *(const char **)o->to = optarg; break;
         case SY_CLI_FLAG:
             if (o->to) *(bool *)o->to = true;
             break;
-        case SY_CLI_UINT: ok = sy_cli_parse_u32(optarg, (uint32_t)o->lo, (uint32_t)o->hi, o->to); break;
-        case SY_CLI_REAL: ok = sy_cli_parse_double(optarg, o->lo, o->hi, o->to); break;
-        case SY_CLI_FLOAT: {
-            char *end = NULL;
-            float v = strtof(optarg, &end);
-            ok = end != optarg && !*end && (o->lo > o->hi || (v >= o->lo && v <= o->hi));
-            if (ok) *(float *)o->to = v;
+        case SY_CLI_UINT: /* hi <= UINT32_MAX */
+        case SY_CLI_COUNT:
+            if ((ok = parse_whole(optarg, (uint64_t)o->lo, (uint64_t)o->hi, o->kind == SY_CLI_COUNT, &u))) {
+                if (o->kind == SY_CLI_UINT) *(uint32_t *)o->to = (uint32_t)u;
+                else *(uint64_t *)o->to = u;
+            }
             break;
-        }
+        case SY_CLI_REAL:
+        case SY_CLI_FLOAT:
+            if ((ok = sy_cli_parse_double(optarg, o->lo, o->hi, &d))) {
+                if (o->kind == SY_CLI_REAL) *(double *)o->to = d;
+                else *(float *)o->to = (float)d;
+            }
+            break;
         case SY_CLI_CODE: break;
         }
         if (!ok) {
-            p->status = sy_cli_bad_value(opt_label(o), optarg);
+            p->status = o->kind == SY_CLI_TEXT ? sy_cli_bad_value(opt_label(o), optarg) : bad_number(opt_label(o), optarg, o->lo, o->hi, o->kind == SY_CLI_UINT || o->kind == SY_CLI_COUNT);
             return OPT_STOP;
         }
     }

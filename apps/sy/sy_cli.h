@@ -1,16 +1,17 @@
 /* sy_cli.h — what every sy command shares on its command line (sy_cli.c).
  *
- * Every command declares its own options in a table of sy_cli_opt (name, kind, where the value
- * goes, its range) and reads them with sy_cli_parse, which builds the getopt_long table from it and
- * parses with getopt_long (GNU ordering: options and operands in any order, "--" ends the options,
- * --name=value) through sy_getopt, which refuses abbreviated long options (sy_options.h: "--frame"
- * is no "--frames"). The options every command takes (the world and loader flags, -q / -v, --help)
- * are applied by sy_cli_next_option; a declared option's value is stored where its entry says (a
- * bad value is a usage error naming the option), and only the options whose meaning is the
- * command's own (SY_CLI_CODE) come back to it. A command that takes none of the common options
- * (sy serve, sy bench cluster) gives its own usage text (sy_cli_parser.usage): then only -q, -v
- * and --help are taken besides its own. (sy bench cull / governor / limit still read theirs with
- * sy_getopt.)
+ * Every command, and sy itself before the command, declares its options in a table of sy_cli_opt
+ * (name, kind, where the value goes, its range) and reads them with sy_cli_parse, which builds the
+ * getopt_long table from it and parses with getopt_long (GNU ordering: options and operands in any
+ * order, "--" ends the options, --name=value) through sy_getopt, which refuses abbreviated long
+ * options (sy_options.h: "--frame" is no "--frames"). The options every command takes (the world and
+ * loader flags, -q / -v, --help) are applied on the way; a declared option's value is stored where
+ * its entry says (a bad value is a usage error naming the option and, for a number, its range), and
+ * only the options whose meaning is the command's own (SY_CLI_CODE) come back to it. A command that
+ * takes none of the common options (sy serve, the benchmarks with their own usage text) gives its own
+ * usage text (sy_cli_parser.usage): then only -q, -v and --help are taken besides its own. Numbers are
+ * read by one parser each: sy_cli_parse_uint (whole numbers), sy_cli_parse_double (one number),
+ * sy_cli_parse_floats (a list X,Y,...).
  * Exit status: 0 success, 1 failure (sy_cli_fail), 2 usage error (the bad option or value is
  * named), 130 interrupted. Thread-safety: the main thread only (getopt's globals). */
 #ifndef SY_CLI_H
@@ -24,7 +25,7 @@
 #include <stdio.h>
 
 enum {
-    OPT_STOP = -2, /* sy_cli_next_option: the command ends with *status (after --help or a usage error) */
+    OPT_STOP = -2, /* sy_cli_parse: the command ends with *status (after --help or a usage error) */
     OPT_HELP = 0x100, OPT_VERSION, OPT_ENV, OPT_ENV_COLOR, OPT_ENV_INTENSITY, OPT_ENV_HIDDEN, OPT_BACKGROUND,
     OPT_NO_DEFAULT_LIGHT, OPT_ALLOW_PATH, OPT_STRICT, OPT_MAX_SCENE_MB, OPT_VARIANT,
     /* the commands' own long options (cluster ones: SY_CLUSTER_OPT_*, sy_cluster_cli.h) */
@@ -37,38 +38,16 @@ enum {
     OPT_OWN_HELP, /* --help of a command with its own usage text (sy_cli_parser.usage) */
     OPT_OWN_FIRST /* a command may number codes of its own from here (below the cluster's, 0x200) */
 };
-/* getopt_long entries of the camera placement and node visibility options (sy render, pick, view,
- * web), taken by sy_cli_next_option into sy_cli_load_opts.view and .nodes (sy_load.h) */
-#define VIEW_OPTIONS                                                                                       \
-    {"look-at", required_argument, NULL, OPT_LOOK_AT}, {"fov", required_argument, NULL, OPT_FOV},        \
-    {"orbit", required_argument, NULL, OPT_ORBIT}, {"hide", required_argument, NULL, OPT_HIDE},          \
-    {"isolate", required_argument, NULL, OPT_ISOLATE}, {"select", required_argument, NULL, OPT_SELECT},       \
-    {"bookmark", required_argument, NULL, OPT_BOOKMARK}
-/* getopt_long entries of the options of every command, with the table's terminator: the end of
- * every command's table */
-#define COMMON_OPTIONS                                                                                     \
-    {"help", no_argument, NULL, OPT_HELP}, {"quiet", no_argument, NULL, 'q'},                              \
-    {"verbose", no_argument, NULL, 'v'}, {"env", required_argument, NULL, OPT_ENV},                        \
-    {"env-color", required_argument, NULL, OPT_ENV_COLOR},                                                 \
-    {"env-intensity", required_argument, NULL, OPT_ENV_INTENSITY},                                         \
-    {"env-hidden", no_argument, NULL, OPT_ENV_HIDDEN}, {"background", required_argument, NULL, OPT_BACKGROUND}, \
-    {"no-default-light", no_argument, NULL, OPT_NO_DEFAULT_LIGHT},                                         \
-    {"allow-path", required_argument, NULL, OPT_ALLOW_PATH}, {"strict", no_argument, NULL, OPT_STRICT},    \
-    {"max-scene-mb", required_argument, NULL, OPT_MAX_SCENE_MB},                                           \
-    {"variant", required_argument, NULL, OPT_VARIANT},                                                     \
-    {NULL, 0, NULL, 0}
-/* short options: ':' first (a missing value is told apart from an unknown option), then -q and -v */
-#define SHORT_OPTIONS(own) ":" own "qv"
-
 /* How a declared option is read. */
 typedef enum sy_cli_kind {
     SY_CLI_CODE, /* its code comes back from sy_cli_parse (the command reads optarg, when it has one) */
     SY_CLI_TEXT, /* const char *: the value as given */
     SY_CLI_FLAG, /* bool: true (no value); to NULL: accepted and without effect */
-    SY_CLI_UINT, /* uint32_t: a whole number in lo..hi (sy_cli_parse_u32) */
+    SY_CLI_UINT, /* uint32_t: a whole number in lo..hi (sy_cli_parse_uint) */
+    SY_CLI_COUNT, /* uint64_t: a whole number in lo..hi, k (thousand) or M (million) after it allowed: 10M */
     SY_CLI_REAL, /* double: a finite number in lo..hi (sy_cli_parse_double) */
-    SY_CLI_FLOAT, /* float: a number strtof reads whole, in lo..hi (NaN never is); lo > hi: any, NaN and
-                     infinities too (what reads it says why not) */
+    SY_CLI_FLOAT, /* float: a number in lo..hi (sy_cli_parse_double); lo > hi: any, NaN and infinities
+                     too (what reads it says why not) */
 } sy_cli_kind;
 
 /* One option of a command, declared: its names, how it is read and where its value goes. */
@@ -85,6 +64,7 @@ typedef struct sy_cli_opt {
 #define SY_CLI_OPT_TEXT(name, code, to) {(name), (code), SY_CLI_TEXT, true, (const char **){(to)}, 0, 0}
 #define SY_CLI_OPT_FLAG(name, code, to) {(name), (code), SY_CLI_FLAG, false, (bool *){(to)}, 0, 0}
 #define SY_CLI_OPT_UINT(name, code, to, lo, hi) {(name), (code), SY_CLI_UINT, true, (uint32_t *){(to)}, (lo), (hi)}
+#define SY_CLI_OPT_COUNT(name, code, to, lo, hi) {(name), (code), SY_CLI_COUNT, true, (uint64_t *){(to)}, (lo), (hi)}
 #define SY_CLI_OPT_REAL(name, code, to, lo, hi) {(name), (code), SY_CLI_REAL, true, (double *){(to)}, (lo), (hi)}
 #define SY_CLI_OPT_FLOAT(name, code, to, lo, hi) {(name), (code), SY_CLI_FLOAT, true, (float *){(to)}, (lo), (hi)}
 #define SY_CLI_OPT_FLOAT_ANY(name, code, to) {(name), (code), SY_CLI_FLOAT, true, (float *){(to)}, 1, 0}
@@ -93,7 +73,8 @@ typedef struct sy_cli_opt {
  * with SY_CLI_ARGS, the rest by name; the remaining fields are sy_cli_parse's:
  *   sy_cli_parser p = {SY_CLI_ARGS("compare", argc, argv, opts), .w = &w, .h = &h, .min_size = 1}; */
 typedef struct sy_cli_parser {
-    const char *cmd;          /* the command as `sy help` names it ("render", "bench sync") */
+    const char *cmd;          /* the command as `sy help` names it ("render", "bench sync"); NULL: sy's own
+                                 options before the command (they end at the first operand, the command) */
     int argc;
     char **argv;              /* argv[0]: the command's name */
     const sy_cli_opt *opts;   /* the command's own options */
@@ -122,20 +103,6 @@ int sy_cli_parse(sy_cli_parser *p);
 #define SY_CLI_ARGS(cmd_, argc_, argv_, opts_)                                                             \
     .cmd = (cmd_), .argc = (argc_), .argv = (argv_), .opts = (opts_), .count = sizeof(opts_) / sizeof((opts_)[0])
 
-/* The next option of a command's arguments (argv[0]: the command's name, for messages; cmd: the
- * command as `sy help` names it, NULL for sy's own options). Call with optind = 0 first (glibc's way
- * to start over with new arguments and a new ordering). Returns the option's code, -1 after the last
- * option (the operands are argv[optind..argc-1]), or OPT_STOP with *status: 0 after --help (the
- * command's usage on stdout), 2 after a usage error (named on stderr). The world and loader flags
- * go to sy_cli_load_opts (sy_load.h). */
-int sy_cli_next_option(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *longopts,
-                       int *status);
-
-/* sy_cli_next_option for a command that renders: -w W and -h H (shortopts names "w:h:") are taken
- * too, as whole numbers of pixels from min_size to 16384, into *w and *h; a bad value is a usage error
- * naming the option (OPT_STOP with *status 2). */
-int sy_cli_next_sized_option(const char *cmd, int argc, char **argv, const char *shortopts,
-                             const struct option *longopts, uint32_t min_size, uint32_t *w, uint32_t *h, int *status);
 /* The one SCENE operand a command takes after its options (argv[optind]) into *scene; returns 0, or 2
  * after a usage error (none or more than one, with cmd's usage on stderr). */
 int sy_cli_scene_operand(const char *cmd, int argc, char **argv, const char **scene);
@@ -150,8 +117,16 @@ int sy_cli_usage_of(const char *cmd, const char *what);
 const char *sy_cli_option_name(const struct option *lo, int c);
 /* A usage error naming the option and the value it did not accept; returns 2. */
 int sy_cli_bad_value(const char *opt, const char *value);
-/* s as a finite number in lo..hi (nothing after it). */
+/* s as a whole decimal number in lo..hi: digits only (no sign, no space), nothing after them. The one
+ * integer parser of the options (and of the numbers in their values). */
+bool sy_cli_parse_uint(const char *s, uint64_t lo, uint64_t hi, uint64_t *out);
+/* s as a finite number in lo..hi (nothing after it); lo > hi: any number strtod reads whole, NaN and
+ * infinities too. The one parser of an option that is a number. */
 bool sy_cli_parse_double(const char *s, double lo, double hi, double *out);
+/* The first len characters of text as a list of min_n..max_n finite numbers X,Y,... into out
+ * (*n_out: how many): each begins right after the comma (no space), none is empty, nothing after the
+ * last. The one parser of an option value that is a list of numbers. */
+bool sy_cli_parse_floats(const char *text, size_t len, int min_n, int max_n, float *out, int *n_out);
 /* --clip A,B,C,D of command cmd: appends the section plane (four finite numbers, a non-zero normal)
  * to planes (room for SY_CLIP_PLANES_MAX) and returns 0; a bad value or a seventh plane: a usage
  * error naming --clip on stderr, returns 2. */
@@ -165,8 +140,6 @@ bool sy_cli_is_clip_plane(const char *value);
 /* --clip-cap RRGGBB (or #RRGGBB): the section cap colour, six hex digits of sRGB, into rgb as
  * linear RGB and returns 0; anything else: a usage error naming --clip-cap on stderr, returns 2. */
 int sy_cli_parse_cap_color(const char *value, float rgb[3]);
-/* s as a whole number in lo..hi (decimal, nothing after it). */
-bool sy_cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out);
 
 /* The error on the log (stderr); returns 1, the exit status of a failure. */
 int sy_cli_fail(const sy_error *e);

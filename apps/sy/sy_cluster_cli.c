@@ -1,45 +1,21 @@
 /* sy_cluster_cli.c — the `--cluster` options of `sy render` and `sy view` (see sy_cluster_cli.h):
  * the options, the cluster configuration file, the cluster mediator class they register and the
- * viewport parameters that select it; and the option helpers the cluster commands share
- * (sy_cmd_serve.c, sy_bench_cluster.c). `--cluster mpi`: sy_cluster_cli_mpi.c. The protocol, the
+ * viewport parameters that select it. `--cluster mpi`: sy_cluster_cli_mpi.c. The protocol, the
  * modes and the cluster mediator live in mediators/cluster/. */
 #include "sy_cluster_cli.h"
+#include "sy_cli.h"
 #include "sy_mediator_cluster.h"
 
 #include "sy_file.h"
 
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* A whole decimal number in [lo, hi] (the option's value); false for anything else. */
-bool sy_cluster_cli_uint_arg(const char *s, unsigned long long lo, unsigned long long hi, unsigned long long *out)
-{
-    char *end = NULL;
-    errno = 0;
-    unsigned long long v = strtoull(s, &end, 10);
-    if (errno || !end || end == s || *end || s[0] == '-' || v < lo || v > hi) return false;
-    *out = v;
-    return true;
-}
-
-/* "-w" or "--name" of option code c in a getopt_long table (for messages). */
-const char *sy_cluster_cli_opt_label(const struct option *lo, int c, char name[48])
-{
-    if (c < 0x100) {
-        snprintf(name, 48, "-%c", c);
-        return name;
-    }
-    while (lo->name && lo->val != c) ++lo;
-    snprintf(name, 48, "--%s", lo->name ? lo->name : "?");
-    return name;
-}
-
 /* ---- sy render --cluster, sy view --cluster ---- */
 bool sy_cluster_cli_getopt(int c, const char *v, sy_cluster_cli_opts *o)
 {
-    unsigned long long n = 0;
+    uint64_t n = 0;
     uint32_t m;
     switch (c) {
     case SY_CLUSTER_OPT_CLUSTER: o->cluster = v; return true;
@@ -47,7 +23,7 @@ bool sy_cluster_cli_getopt(int c, const char *v, sy_cluster_cli_opts *o)
     case SY_CLUSTER_OPT_SECRET_FILE: o->secret_file = v; return true;
     case SY_CLUSTER_OPT_TLS_CA: o->tls_ca = v; return true;
     case SY_CLUSTER_OPT_TIMEOUT_MS:
-        if (!sy_cluster_cli_uint_arg(v, 1, 100000000ull, &n)) return false;
+        if (!sy_cli_parse_uint(v, 1, 100000000u, &n)) return false;
         o->timeout_ms = (uint32_t)n;
         return true;
     case SY_CLUSTER_OPT_PIXELS: /* float (bit-exact) | half (binary16 tiles) */
@@ -63,10 +39,8 @@ static sy_result parse_conf_tile(char **tok, const char *path, uint32_t line, sy
 {
     uint32_t v[4];
     for (int k = 0; k < 4; ++k) {
-        char *end;
-        errno = 0;
-        unsigned long x = strtoul(tok[k], &end, 10);
-        if (errno || *end || end == tok[k] || x > 16384)
+        uint64_t x = 0;
+        if (!sy_cli_parse_uint(tok[k], 0, 16384, &x))
             return sy_error_set(err, SY_ERR_PARSE, "%s:%u: tile values must be 0..16384", path, line);
         v[k] = (uint32_t)x;
     }

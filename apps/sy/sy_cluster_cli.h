@@ -98,11 +98,4 @@ const char *sy_cluster_cli_mode_name(uint32_t mode);
  * cooperative speed-up (--hostile-only: the hostile measurement alone). argv[0] is "cluster". */
 int sy_cmd_bench_cluster(int argc, char **argv);
 
-/* For the cluster commands' own files (sy_cmd_serve.c, sy_bench_cluster.c; defined in
- * sy_cluster_cli.c, absent from a build without the cluster): */
-/* A whole decimal number in [lo, hi] (the option's value); false for anything else. */
-bool sy_cluster_cli_uint_arg(const char *s, unsigned long long lo, unsigned long long hi, unsigned long long *out);
-/* "-w" or "--name" of option code c in a getopt_long table (for messages); returns name. */
-const char *sy_cluster_cli_opt_label(const struct option *lo, int c, char name[48]);
-
 #endif /* SY_CLUSTER_CLI_H */

@@ -100,24 +100,11 @@ static int cmd_bench_temporal(int argc, char **argv)
 {
     uint32_t w = 0, h = 0, frames = 60, ref = 256;
     const char *png = NULL;
-    enum { OPT_PNG = 0x400 };
-    static const struct option lo[] = {{"frames", required_argument, NULL, OPT_FRAMES},
-                                       {"spp", required_argument, NULL, OPT_SPP},
-                                       {"png", required_argument, NULL, OPT_PNG}, COMMON_OPTIONS};
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_sized_option("bench temporal", argc, argv, SHORT_OPTIONS("w:h:"), lo, 8, &w, &h, &status)) != -1) {
-        switch (c) {
-        case OPT_STOP: return status;
-        case OPT_FRAMES:
-            if (!sy_cli_parse_u32(optarg, 2, 100000, &frames)) return sy_cli_bad_value("--frames", optarg);
-            break;
-        case OPT_SPP:
-            if (!sy_cli_parse_u32(optarg, 1, 1u << 20, &ref)) return sy_cli_bad_value("--spp", optarg);
-            break;
-        case OPT_PNG: png = optarg; break;
-        }
-    }
+    enum { O_PNG = OPT_OWN_FIRST };
+    const sy_cli_opt opts[] = {SY_CLI_OPT_UINT("frames", OPT_FRAMES, &frames, 2, 100000),
+                               SY_CLI_OPT_UINT("spp", OPT_SPP, &ref, 1, 1u << 20), SY_CLI_OPT_TEXT("png", O_PNG, &png)};
+    sy_cli_parser p = {SY_CLI_ARGS("bench temporal", argc, argv, opts), .w = &w, .h = &h, .min_size = 8};
+    if (sy_cli_parse(&p) != -1) return p.status;
     static const char *const defaults[] = {"../shared/testdata/cornell/cornell_box.gltf", "demo"};
     const char *const *scenes = optind < argc ? (const char *const *)argv + optind : defaults;
     int count = optind < argc ? argc - optind : 2;

@@ -112,21 +112,15 @@ static void default_output(const char *scene, char *out, size_t out_len)
  * anything else. "N" alone (the cluster's old repeat count, now --repeat) is false too. */
 static bool parse_frame_range(const char *s, uint32_t *a, uint32_t *b, uint32_t *step)
 {
-    char *end = NULL;
-    if (!strchr(s, ':')) return false;
-    errno = 0;
-    unsigned long x = strtoul(s, &end, 10);
-    if (end == s || *end != ':' || s[0] == '-' || x > 100000000ul) return false;
-    const char *q = end + 1;
-    unsigned long y = strtoul(q, &end, 10);
-    if (end == q || q[0] == '-' || y > 100000000ul || y < x) return false;
-    unsigned long z = 1;
-    if (*end == ':') {
-        q = end + 1;
-        z = strtoul(q, &end, 10);
-        if (end == q || q[0] == '-' || z < 1 || z > 100000000ul) return false;
-    }
-    if (*end || errno) return false;
+    char buf[64];
+    char *c1 = strlen(s) < sizeof buf ? strchr(strcpy(buf, s), ':') : NULL, *c2 = c1 ? strchr(c1 + 1, ':') : NULL;
+    if (!c1) return false;
+    *c1 = '\0';
+    if (c2) *c2 = '\0';
+    uint64_t x = 0, y = 0, z = 1;
+    if (!sy_cli_parse_uint(buf, 0, 100000000u, &x) || !sy_cli_parse_uint(c1 + 1, x, 100000000u, &y) ||
+        (c2 && !sy_cli_parse_uint(c2 + 1, 1, 100000000u, &z)))
+        return false;
     *a = (uint32_t)x, *b = (uint32_t)y, *step = (uint32_t)z;
     return true;
 }

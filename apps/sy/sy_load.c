@@ -13,7 +13,6 @@
 #include "sy_viewport.h"
 #include "sy_sniff.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -61,22 +60,11 @@ static sy_result add_defaults(loaded *ld, sy_error *err)
     return sy_scene_commit(s, NULL, err);
 }
 
-/* "x,y,z" (exactly three finite numbers) from text up to end into v. */
+/* "x,y,z" (exactly three finite numbers) from text up to stop into v. */
 static bool parse_vec3(const char *text, const char *stop, float v[3])
 {
-    const char *p = text;
-    for (int i = 0; i < 3; ++i) {
-        char *e = NULL;
-        if (p >= stop || *p == ',' || *p == ':' || *p == ' ') return false;
-        v[i] = strtof(p, &e);
-        if (e == p || e > stop || !isfinite(v[i])) return false;
-        p = e;
-        if (i < 2) {
-            if (p >= stop || *p != ',') return false;
-            p++;
-        }
-    }
-    return p == stop;
+    int n = 0;
+    return sy_cli_parse_floats(text, (size_t)(stop - text), 3, 3, v, &n);
 }
 
 static int view_usage(const char *opt, const char *value, const char *why)
@@ -97,8 +85,8 @@ int sy_cli_view_option(int c, const char *value)
     }
     if (c == OPT_BOOKMARK) { /* FILE:N, a saved view of sy view (sy_bookmarks.h): the --look-at it holds */
         const char *colon = strrchr(value, ':');
-        double slot = 0;
-        if (!colon || colon == value || !sy_cli_parse_double(colon + 1, 1, SY_BOOKMARKS_MAX, &slot) || slot != floor(slot))
+        uint64_t slot = 0;
+        if (!colon || colon == value || !sy_cli_parse_uint(colon + 1, 1, SY_BOOKMARKS_MAX, &slot))
             return view_usage("--bookmark", value, "expected FILE:N, N a saved view 1..9 (sy view: Ctrl+N saves one)");
         size_t len = (size_t)(colon - value);
         char *path = malloc(len + 1);
@@ -141,18 +129,7 @@ int sy_cli_view_option(int c, const char *value)
     } else { /* OPT_ORBIT */
         float a[3] = {0, 0, 0};
         int n = 0;
-        const char *p = value;
-        while (n < 3) {
-            char *e = NULL;
-            if (!*p || *p == ',' || *p == ' ') break;
-            a[n] = strtof(p, &e);
-            if (e == p || !isfinite(a[n])) break;
-            n++;
-            p = e;
-            if (*p != ',') break;
-            p++;
-        }
-        if (n < 2 || *p || p[-1] == ',')
+        if (!sy_cli_parse_floats(value, strlen(value), 2, 3, a, &n))
             return view_usage("--orbit", value, "expected AZ,EL or AZ,EL,DIST (degrees, degrees, scene units; finite numbers)");
         if (!(a[1] >= -90.0f && a[1] <= 90.0f)) return view_usage("--orbit", value, "EL must be from -90 to 90 degrees");
         if (n == 3 && !(a[2] > 0.0f && a[2] <= SY_COORD_MAX))
@@ -187,10 +164,8 @@ sy_result sy_cli_find_nodes(const sy_scene *s, const char *opt, const char *node
                             uint32_t *count_out, sy_error *err)
 {
     *count_out = 0;
-    char *end = NULL;
-    errno = 0;
-    unsigned long long num = *node >= '0' && *node <= '9' ? strtoull(node, &end, 10) : 0;
-    bool is_num = end && !*end && !errno && num <= UINT32_MAX;
+    uint64_t num = 0;
+    bool is_num = sy_cli_parse_uint(node, 0, UINT32_MAX, &num);
     if (is_num && sy_node_get(s, (sy_node){(uint32_t)num})) { /* the id sy pick prints */
         out[(*count_out)++] = (sy_node){(uint32_t)num};
         return SY_OK;

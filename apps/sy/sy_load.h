@@ -1,7 +1,7 @@
 /* sy_load.h — how sy loads a SCENE (sy_load.c): a glTF 2.0, X3D or Assimp-read (OBJ, FBX, COLLADA, PLY,
  * STL, 3MF, 3DS, glTF 1.0, ...) file, recognised by its content,
  * or the word "demo" (the built-in scene), with the loader options and the world flags of every
- * command (sy_cli_load_opts, filled by sy_cli_next_option). Thread-safety: the main thread only. */
+ * command (sy_cli_load_opts, filled by sy_cli_parse). Thread-safety: the main thread only. */
 #ifndef SY_LOAD_H
 #define SY_LOAD_H
 
@@ -26,7 +26,7 @@ typedef struct loaded {
     bool clip_noted; /* sy_cli_set_time said which clip plays by default */
 } loaded;
 
-/* Loader options every command shares, taken out of the arguments by sy_cli_next_option:
+/* Loader options every command shares, taken out of the arguments by sy_cli_parse:
  * --allow-path DIR (repeatable: more folders that a model's external files may lie in), --strict
  * (whatever a loader skips or repairs is an error), --max-scene-mb N (the budget per file,
  * sy_budget.h), --variant NAME (a glTF material variant) and the world flags. */

@@ -66,21 +66,19 @@ int main(int argc, char **argv)
     sy_signals_start();
     sy_testpoint_start(); /* SY_TEST_PHASES / SY_TEST_PAUSE: tests wait for phases (sy_testpoint.h) */
     if (sy_mediators_register_builtin(&err) != SY_OK) return sy_cli_fail(&err);
-    /* sy's own options before the command (stops at the first operand, the command): --version,
+    /* sy's own options before the command (they end at the first operand, the command): --version,
      * --help / -h, -q / -v and the options of every command (world and loader flags) */
-    static const struct option lo[] = {{"version", no_argument, NULL, OPT_VERSION}, COMMON_OPTIONS};
-    int c, status = 0;
-    optind = 0;
-    while ((c = sy_cli_next_option(NULL, argc, argv, "+" SHORT_OPTIONS("h"), lo, &status)) != -1) {
-        if (c == OPT_STOP) return status;
+    const sy_cli_opt opts[] = {SY_CLI_OPT_CODE("version", OPT_VERSION, false), SY_CLI_OPT_CODE(NULL, 'h', false)};
+    sy_cli_parser p = {SY_CLI_ARGS(NULL, argc, argv, opts)};
+    int c;
+    while ((c = sy_cli_parse(&p)) != -1) {
+        if (c == OPT_STOP) return p.status;
         if (c == OPT_VERSION) {
             printf("sy (Switchyard) %s\n", sy_version());
             return 0;
         }
-        if (c == 'h') {
-            sy_cli_usage_to(stdout, NULL);
-            return 0;
-        }
+        sy_cli_usage_to(stdout, NULL); /* -h */
+        return 0;
     }
     if (optind >= argc) {
         fprintf(stderr, "sy: error: no command given\n");

@@ -374,7 +374,7 @@ done
 ! grep -Eq '^  coverage ' "$TMP/bench_governor.out" || fail "bench governor: an analysis back-end was timed"
 cat "$TMP/bench_governor.out"
 run bench_governor_bad "$SY" bench governor demo --budget 0
-[ "$rc" -eq 2 ] && grep -q "bad value '0'" "$TMP/bench_governor_bad.err" ||
+[ "$rc" -eq 2 ] && grep -q -- "--budget: '0' is not in 1..10000" "$TMP/bench_governor_bad.err" ||
     fail "bench governor --budget 0: status $rc, $(cat "$TMP/bench_governor_bad.err")"
 # --max-memory: a scene over the ray tracer's memory limit is refused with the sizes, not killed
 run max_memory "$SY" render demo -b whitted --max-memory 1 -w 16 -h 16 -o "$TMP/max_memory.png"
