@@ -327,51 +327,25 @@ void read_variant_uses(const tinygltf::ExtensionMap &ext, int32_t mesh, int32_t 
     }
 }
 
-/* The material extensions beyond the core set (KHR_materials_specular, _clearcoat, _sheen, _volume,
- * _iridescence, _anisotropy): their factors with the specifications' defaults, their textures. */
+/* The material extensions' members (sy_gltf_shim_ext_members) into c. */
 void read_material_extensions(const tinygltf::ExtensionMap &ext, sy_gltf_shim_material *c)
 {
-    static const double one3[3] = {1, 1, 1}, zero3[3] = {0, 0, 0}, film[2] = {100, 400};
     const tinygltf::Value none;
-    const tinygltf::Value *e = extension(ext, "KHR_materials_specular");
-    const tinygltf::Value &sp = e ? *e : none;
-    c->specular = number(sp, "specularFactor", 1.0);
-    numbers(sp, "specularColorFactor", c->specular_color, 3, one3);
-    c->specular_texture = texinfo_value(member(sp, "specularTexture"));
-    c->specular_color_texture = texinfo_value(member(sp, "specularColorTexture"));
-    e = extension(ext, "KHR_materials_clearcoat");
-    const tinygltf::Value &cc = e ? *e : none;
-    c->clearcoat = number(cc, "clearcoatFactor", 0.0);
-    c->clearcoat_roughness = number(cc, "clearcoatRoughnessFactor", 0.0);
-    c->clearcoat_texture = texinfo_value(member(cc, "clearcoatTexture"));
-    c->clearcoat_roughness_texture = texinfo_value(member(cc, "clearcoatRoughnessTexture"));
-    c->clearcoat_normal_texture = texinfo_value(member(cc, "clearcoatNormalTexture"));
-    if (const tinygltf::Value *n = member(cc, "clearcoatNormalTexture")) c->clearcoat_normal_texture.scale = number(*n, "scale", 1.0);
-    e = extension(ext, "KHR_materials_sheen");
-    const tinygltf::Value &sh = e ? *e : none;
-    numbers(sh, "sheenColorFactor", c->sheen_color, 3, zero3);
-    c->sheen_roughness = number(sh, "sheenRoughnessFactor", 0.0);
-    c->sheen_color_texture = texinfo_value(member(sh, "sheenColorTexture"));
-    c->sheen_roughness_texture = texinfo_value(member(sh, "sheenRoughnessTexture"));
-    e = extension(ext, "KHR_materials_volume");
-    const tinygltf::Value &vo = e ? *e : none;
-    c->thickness = number(vo, "thicknessFactor", 0.0);
-    c->attenuation_distance = number(vo, "attenuationDistance", 0.0);
-    numbers(vo, "attenuationColor", c->attenuation_color, 3, one3);
-    c->thickness_texture = texinfo_value(member(vo, "thicknessTexture"));
-    e = extension(ext, "KHR_materials_iridescence");
-    const tinygltf::Value &ir = e ? *e : none;
-    c->iridescence = number(ir, "iridescenceFactor", 0.0);
-    c->iridescence_ior = number(ir, "iridescenceIor", 1.3);
-    c->iridescence_thickness[0] = number(ir, "iridescenceThicknessMinimum", film[0]);
-    c->iridescence_thickness[1] = number(ir, "iridescenceThicknessMaximum", film[1]);
-    c->iridescence_texture = texinfo_value(member(ir, "iridescenceTexture"));
-    c->iridescence_thickness_texture = texinfo_value(member(ir, "iridescenceThicknessTexture"));
-    e = extension(ext, "KHR_materials_anisotropy");
-    const tinygltf::Value &an = e ? *e : none;
-    c->anisotropy = number(an, "anisotropyStrength", 0.0);
-    c->anisotropy_rotation = number(an, "anisotropyRotation", 0.0);
-    c->anisotropy_texture = texinfo_value(member(an, "anisotropyTexture"));
+    for (size_t i = 0; i < sy_gltf_shim_ext_member_count; i++) {
+        const sy_gltf_shim_ext_member &f = sy_gltf_shim_ext_members[i];
+        const tinygltf::Value *e = extension(ext, f.extension);
+        const tinygltf::Value &v = e ? *e : none;
+        char *to = reinterpret_cast<char *>(c) + f.read;
+        if (f.kind == SY_GLTF_EXT_NUMBER) {
+            *reinterpret_cast<double *>(to) = number(v, f.key, f.def[0]);
+        } else if (f.kind == SY_GLTF_EXT_VEC3) {
+            numbers(v, f.key, reinterpret_cast<double *>(to), 3, f.def);
+        } else {
+            sy_gltf_shim_texinfo &t = *reinterpret_cast<sy_gltf_shim_texinfo *>(to);
+            t = texinfo_value(member(v, f.key));
+            if (const tinygltf::Value *n = (f.flags & SY_GLTF_EXT_SCALE) ? member(v, f.key) : nullptr) t.scale = number(*n, "scale", 1.0);
+        }
+    }
 }
 
 int32_t components_of(int type)
@@ -524,15 +498,8 @@ static void fill_doc(sy_gltf_shim_impl *d)
         c.alpha_cutoff = mat.alphaCutoff;
         c.double_sided = mat.doubleSided;
         c.emissive_strength = 1.0;
-        c.ior = 1.5;
-        c.transmission_texture = texinfo_value(nullptr);
         if (const tinygltf::Value *e = extension(mat.extensions, "KHR_materials_emissive_strength"))
             c.emissive_strength = number(*e, "emissiveStrength", 1.0);
-        if (const tinygltf::Value *e = extension(mat.extensions, "KHR_materials_transmission")) {
-            c.transmission = number(*e, "transmissionFactor", 0.0);
-            c.transmission_texture = texinfo_value(member(*e, "transmissionTexture"));
-        }
-        if (const tinygltf::Value *e = extension(mat.extensions, "KHR_materials_ior")) c.ior = number(*e, "ior", 1.5);
         c.unlit = extension(mat.extensions, "KHR_materials_unlit") != nullptr;
         read_material_extensions(mat.extensions, &c);
         d->materials.push_back(c);

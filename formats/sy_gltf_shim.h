@@ -343,6 +343,30 @@ typedef struct sy_gltf_shim_wmaterial {
     double anisotropy, anisotropy_rotation; sy_gltf_shim_wtexref anisotropy_tex;
 } sy_gltf_shim_wmaterial;
 
+/* >>material extensions: the members of the KHR_materials_* extensions beyond the core material
+ * (transmission, ior, specular, clearcoat, sheen, volume, iridescence, anisotropy), one row each,
+ * the rows of one extension together; both halves of the shim go by it: the reader fills
+ * sy_gltf_shim_material (a member or extension that is absent: the row's default), the writer writes
+ * an extension of a full sy_gltf_shim_wmaterial when one of its SY_GLTF_EXT_KEY members is off its
+ * default (a texture: present), with every member but textures absent and SY_GLTF_EXT_ABOVE ones at
+ * their default. */
+typedef enum sy_gltf_ext_kind { SY_GLTF_EXT_NUMBER, SY_GLTF_EXT_VEC3, SY_GLTF_EXT_TEXTURE } sy_gltf_ext_kind;
+enum {
+    SY_GLTF_EXT_KEY = 1,   /* off its default, the extension is written */
+    SY_GLTF_EXT_ABOVE = 2, /* written only above its default (attenuationDistance: 0 is infinite) */
+    SY_GLTF_EXT_SCALE = 4  /* a texture with a "scale" (a normal texture) */
+};
+typedef struct sy_gltf_shim_ext_member {
+    const char *extension, *key; /* "KHR_materials_clearcoat", "clearcoatFactor" */
+    sy_gltf_ext_kind kind;
+    unsigned flags;
+    double def[3];
+    size_t read;  /* offset in sy_gltf_shim_material of a double or double[3] or sy_gltf_shim_texinfo */
+    size_t write; /* offset in sy_gltf_shim_wmaterial of a double or double[3] or sy_gltf_shim_wtexref */
+} sy_gltf_shim_ext_member;
+extern const sy_gltf_shim_ext_member sy_gltf_shim_ext_members[];
+extern const size_t sy_gltf_shim_ext_member_count;
+
 /* One texture: its PNG bytes (one glTF image, in the buffer) and its sampler (glTF codes). */
 typedef struct sy_gltf_shim_wtexture {
     const char *name; /* may be NULL */

@@ -8,6 +8,7 @@
 #include <tiny_gltf.h>
 
 #include <climits>
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -15,6 +16,56 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+// >>material extensions: the table both halves of the shim go by (sy_gltf_shim.h)
+#define SY_EXT_(ext, key, kind, flags, d0, d1, d2, rd, wr)                                                                 \
+    {ext, key, kind, flags, {d0, d1, d2}, offsetof(sy_gltf_shim_material, rd), offsetof(sy_gltf_shim_wmaterial, wr)}
+#define SY_EXT_NUM(ext, key, flags, def, rd, wr) SY_EXT_(ext, key, SY_GLTF_EXT_NUMBER, flags, def, 0, 0, rd, wr)
+#define SY_EXT_VEC3(ext, key, flags, def, rd, wr) SY_EXT_(ext, key, SY_GLTF_EXT_VEC3, flags, def, def, def, rd, wr)
+#define SY_EXT_TEX(ext, key, flags, rd, wr) SY_EXT_(ext, key, SY_GLTF_EXT_TEXTURE, flags, 0, 0, 0, rd, wr)
+#define KEY SY_GLTF_EXT_KEY
+const sy_gltf_shim_ext_member sy_gltf_shim_ext_members[] = {
+    SY_EXT_NUM("KHR_materials_transmission", "transmissionFactor", KEY, 0.0, transmission, transmission),
+    SY_EXT_TEX("KHR_materials_transmission", "transmissionTexture", KEY, transmission_texture, transmission_tex),
+    SY_EXT_NUM("KHR_materials_ior", "ior", KEY, 1.5, ior, ior),
+    SY_EXT_NUM("KHR_materials_specular", "specularFactor", KEY, 1.0, specular, specular),
+    SY_EXT_VEC3("KHR_materials_specular", "specularColorFactor", KEY, 1.0, specular_color, specular_color),
+    SY_EXT_TEX("KHR_materials_specular", "specularTexture", KEY, specular_texture, specular_tex),
+    SY_EXT_TEX("KHR_materials_specular", "specularColorTexture", KEY, specular_color_texture, specular_color_tex),
+    SY_EXT_NUM("KHR_materials_clearcoat", "clearcoatFactor", KEY, 0.0, clearcoat, clearcoat),
+    SY_EXT_NUM("KHR_materials_clearcoat", "clearcoatRoughnessFactor", 0, 0.0, clearcoat_roughness, clearcoat_roughness),
+    SY_EXT_TEX("KHR_materials_clearcoat", "clearcoatTexture", KEY, clearcoat_texture, clearcoat_tex),
+    SY_EXT_TEX("KHR_materials_clearcoat", "clearcoatRoughnessTexture", 0, clearcoat_roughness_texture, clearcoat_roughness_tex),
+    SY_EXT_TEX("KHR_materials_clearcoat", "clearcoatNormalTexture", SY_GLTF_EXT_SCALE, clearcoat_normal_texture,
+               clearcoat_normal_tex),
+    SY_EXT_VEC3("KHR_materials_sheen", "sheenColorFactor", KEY, 0.0, sheen_color, sheen_color),
+    SY_EXT_NUM("KHR_materials_sheen", "sheenRoughnessFactor", 0, 0.0, sheen_roughness, sheen_roughness),
+    SY_EXT_TEX("KHR_materials_sheen", "sheenColorTexture", KEY, sheen_color_texture, sheen_color_tex),
+    SY_EXT_TEX("KHR_materials_sheen", "sheenRoughnessTexture", 0, sheen_roughness_texture, sheen_roughness_tex),
+    SY_EXT_NUM("KHR_materials_volume", "thicknessFactor", KEY, 0.0, thickness, thickness),
+    SY_EXT_NUM("KHR_materials_volume", "attenuationDistance", KEY | SY_GLTF_EXT_ABOVE, 0.0, attenuation_distance,
+               attenuation_distance),
+    SY_EXT_VEC3("KHR_materials_volume", "attenuationColor", KEY, 1.0, attenuation_color, attenuation_color),
+    SY_EXT_TEX("KHR_materials_volume", "thicknessTexture", KEY, thickness_texture, thickness_tex),
+    SY_EXT_NUM("KHR_materials_iridescence", "iridescenceFactor", KEY, 0.0, iridescence, iridescence),
+    SY_EXT_NUM("KHR_materials_iridescence", "iridescenceIor", 0, 1.3, iridescence_ior, iridescence_ior),
+    SY_EXT_NUM("KHR_materials_iridescence", "iridescenceThicknessMinimum", 0, 100.0, iridescence_thickness[0],
+               iridescence_thickness[0]),
+    SY_EXT_NUM("KHR_materials_iridescence", "iridescenceThicknessMaximum", 0, 400.0, iridescence_thickness[1],
+               iridescence_thickness[1]),
+    SY_EXT_TEX("KHR_materials_iridescence", "iridescenceTexture", KEY, iridescence_texture, iridescence_tex),
+    SY_EXT_TEX("KHR_materials_iridescence", "iridescenceThicknessTexture", 0, iridescence_thickness_texture,
+               iridescence_thickness_tex),
+    SY_EXT_NUM("KHR_materials_anisotropy", "anisotropyStrength", KEY, 0.0, anisotropy, anisotropy),
+    SY_EXT_NUM("KHR_materials_anisotropy", "anisotropyRotation", 0, 0.0, anisotropy_rotation, anisotropy_rotation),
+    SY_EXT_TEX("KHR_materials_anisotropy", "anisotropyTexture", KEY, anisotropy_texture, anisotropy_tex),
+};
+const size_t sy_gltf_shim_ext_member_count = sizeof sy_gltf_shim_ext_members / sizeof sy_gltf_shim_ext_members[0];
+#undef KEY
+#undef SY_EXT_TEX
+#undef SY_EXT_VEC3
+#undef SY_EXT_NUM
+#undef SY_EXT_
 
 // >>GLB writing: a tinygltf model built from the plain description, serialised by tinygltf.
 namespace {
@@ -113,67 +164,34 @@ void put_ext(tinygltf::Material &mt, const char *name, Obj o, std::set<std::stri
 
 bool same3(const double *a, double v) { return a[0] == v && a[1] == v && a[2] == v; }
 
-// The KHR_materials_* extensions of a full material, each unless at its defaults.
+// The KHR_materials_* extensions of a full material (sy_gltf_shim_ext_members), each written when
+// one of its key members is off its default.
 void material_extensions(const sy_gltf_shim_wmaterial &w, tinygltf::Material &mt, std::set<std::string> &used)
 {
-    if (w.transmission != 0 || w.transmission_tex.texture) {
+    const char *base = reinterpret_cast<const char *>(&w);
+    for (size_t i = 0, end; i < sy_gltf_shim_ext_member_count; i = end) {
+        const char *name = sy_gltf_shim_ext_members[i].extension;
+        bool write = false;
+        for (end = i; end < sy_gltf_shim_ext_member_count && !strcmp(sy_gltf_shim_ext_members[end].extension, name); ++end) {
+            const sy_gltf_shim_ext_member &f = sy_gltf_shim_ext_members[end];
+            const double *v = reinterpret_cast<const double *>(base + f.write);
+            if (!(f.flags & SY_GLTF_EXT_KEY)) continue;
+            if (f.kind == SY_GLTF_EXT_TEXTURE) write = write || reinterpret_cast<const sy_gltf_shim_wtexref *>(v)->texture;
+            else for (int k = 0; k < (f.kind == SY_GLTF_EXT_VEC3 ? 3 : 1); ++k) write = write || v[k] != f.def[k];
+        }
+        if (!write) continue;
         Obj o;
-        o["transmissionFactor"] = num(w.transmission);
-        put_tex(o, "transmissionTexture", w.transmission_tex, used);
-        put_ext(mt, "KHR_materials_transmission", o, used);
-    }
-    if (w.ior != 1.5) put_ext(mt, "KHR_materials_ior", Obj{{"ior", num(w.ior)}}, used);
-    if (w.specular != 1 || !same3(w.specular_color, 1) || w.specular_tex.texture || w.specular_color_tex.texture) {
-        Obj o;
-        o["specularFactor"] = num(w.specular);
-        o["specularColorFactor"] = vec(w.specular_color, 3);
-        put_tex(o, "specularTexture", w.specular_tex, used);
-        put_tex(o, "specularColorTexture", w.specular_color_tex, used);
-        put_ext(mt, "KHR_materials_specular", o, used);
-    }
-    if (w.clearcoat != 0 || w.clearcoat_tex.texture) {
-        Obj o;
-        o["clearcoatFactor"] = num(w.clearcoat);
-        o["clearcoatRoughnessFactor"] = num(w.clearcoat_roughness);
-        put_tex(o, "clearcoatTexture", w.clearcoat_tex, used);
-        put_tex(o, "clearcoatRoughnessTexture", w.clearcoat_roughness_tex, used);
-        put_tex(o, "clearcoatNormalTexture", w.clearcoat_normal_tex, used);
-        if (w.clearcoat_normal_tex.texture && w.clearcoat_normal_tex.scale != 1)
-            o["clearcoatNormalTexture"].Get<Obj>()["scale"] = num(w.clearcoat_normal_tex.scale);
-        put_ext(mt, "KHR_materials_clearcoat", o, used);
-    }
-    if (!same3(w.sheen_color, 0) || w.sheen_color_tex.texture) {
-        Obj o;
-        o["sheenColorFactor"] = vec(w.sheen_color, 3);
-        o["sheenRoughnessFactor"] = num(w.sheen_roughness);
-        put_tex(o, "sheenColorTexture", w.sheen_color_tex, used);
-        put_tex(o, "sheenRoughnessTexture", w.sheen_roughness_tex, used);
-        put_ext(mt, "KHR_materials_sheen", o, used);
-    }
-    if (w.thickness != 0 || w.attenuation_distance != 0 || !same3(w.attenuation_color, 1) || w.thickness_tex.texture) {
-        Obj o;
-        o["thicknessFactor"] = num(w.thickness);
-        if (w.attenuation_distance > 0) o["attenuationDistance"] = num(w.attenuation_distance); // 0: infinite
-        o["attenuationColor"] = vec(w.attenuation_color, 3);
-        put_tex(o, "thicknessTexture", w.thickness_tex, used);
-        put_ext(mt, "KHR_materials_volume", o, used);
-    }
-    if (w.iridescence != 0 || w.iridescence_tex.texture) {
-        Obj o;
-        o["iridescenceFactor"] = num(w.iridescence);
-        o["iridescenceIor"] = num(w.iridescence_ior);
-        o["iridescenceThicknessMinimum"] = num(w.iridescence_thickness[0]);
-        o["iridescenceThicknessMaximum"] = num(w.iridescence_thickness[1]);
-        put_tex(o, "iridescenceTexture", w.iridescence_tex, used);
-        put_tex(o, "iridescenceThicknessTexture", w.iridescence_thickness_tex, used);
-        put_ext(mt, "KHR_materials_iridescence", o, used);
-    }
-    if (w.anisotropy != 0 || w.anisotropy_tex.texture) {
-        Obj o;
-        o["anisotropyStrength"] = num(w.anisotropy);
-        o["anisotropyRotation"] = num(w.anisotropy_rotation);
-        put_tex(o, "anisotropyTexture", w.anisotropy_tex, used);
-        put_ext(mt, "KHR_materials_anisotropy", o, used);
+        for (size_t k = i; k < end; ++k) {
+            const sy_gltf_shim_ext_member &f = sy_gltf_shim_ext_members[k];
+            const double *v = reinterpret_cast<const double *>(base + f.write);
+            if (f.kind == SY_GLTF_EXT_VEC3) o[f.key] = vec(v, 3);
+            else if (f.kind == SY_GLTF_EXT_NUMBER && (!(f.flags & SY_GLTF_EXT_ABOVE) || *v > f.def[0])) o[f.key] = num(*v);
+            if (f.kind != SY_GLTF_EXT_TEXTURE) continue;
+            const sy_gltf_shim_wtexref &t = *reinterpret_cast<const sy_gltf_shim_wtexref *>(v);
+            put_tex(o, f.key, t, used);
+            if ((f.flags & SY_GLTF_EXT_SCALE) && t.texture && t.scale != 1) o[f.key].Get<Obj>()["scale"] = num(t.scale);
+        }
+        put_ext(mt, name, o, used);
     }
 }
 
