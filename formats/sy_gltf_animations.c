@@ -167,11 +167,7 @@ static sy_result create_animation(loader *L, size_t ai)
     char where[48];
     snprintf(where, sizeof where, "animations[%zu]", ai);
     sy_animation h;
-    if ((r = sy_animation_create(L->scene, gltf_nonempty(an->name), &h, &L->err))) return gltf_context(L, r, where);
-    if ((r = gltf_track(L, SY_TYPE_ANIMATION, h.id))) {
-        sy_object_destroy(L->scene, SY_TYPE_ANIMATION, h.id, NULL);
-        return r;
-    }
+    if ((r = gltf_create(L, SY_TYPE_ANIMATION, gltf_nonempty(an->name), where, &h.id))) return r;
     L->info->animations[ai] = h;
     L->info->animation_count = (uint32_t)ai + 1;
     anim_sampler *sm = gltf_xcalloc(L, an->sampler_count + 1, sizeof *sm, &r);

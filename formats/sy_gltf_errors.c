@@ -19,17 +19,21 @@ sy_result gltf_context(loader *L, sy_result r, const char *what)
     return r;
 }
 
-sy_result gltf_track(loader *L, sy_object_type type, uint32_t id)
+sy_result gltf_create(loader *L, sy_object_type type, const char *name, const char *where, uint32_t *id)
 {
+    sy_result r = sy_object_create(L->scene, type, name, id, &L->err);
+    if (r != SY_OK) return gltf_context(L, r, where);
     if (L->obj_count == L->obj_cap) {
         size_t cap = L->obj_cap ? L->obj_cap * 2 : 64, bytes;
-        if (!sy_size_mul(cap, sizeof(created_obj), &bytes)) return gltf_fail(L, SY_ERR_OUT_OF_MEMORY, "too many objects");
-        created_obj *n = realloc(L->objs, bytes);
-        if (!n) return gltf_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory");
+        created_obj *n = sy_size_mul(cap, sizeof(created_obj), &bytes) ? realloc(L->objs, bytes) : NULL;
+        if (!n) {
+            sy_object_destroy(L->scene, type, *id, NULL);
+            return gltf_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory");
+        }
         L->objs = n;
         L->obj_cap = cap;
     }
-    L->objs[L->obj_count++] = (created_obj){(uint32_t)type, id};
+    L->objs[L->obj_count++] = (created_obj){(uint32_t)type, *id};
     return SY_OK;
 }
 

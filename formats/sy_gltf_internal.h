@@ -83,8 +83,9 @@ extern const char *const gltf_supported[];
 #define gltf_warn(L, ...) sy_loader_warnf(gltf_warnings((L)->info), __VA_ARGS__)
 /* Adds context to an error that a core call left in L->err. */
 sy_result gltf_context(loader *L, sy_result r, const char *what);
-/* Records a created object for the rollback. */
-sy_result gltf_track(loader *L, sy_object_type type, uint32_t id);
+/* Creates an object of the type, named name (NULL: unnamed), recorded for the rollback; an error
+ * names where. */
+sy_result gltf_create(loader *L, sy_object_type type, const char *name, const char *where, uint32_t *id);
 /* Destroys every tracked object, newest first. */
 void gltf_rollback(loader *L);
 /* calloc of n x size bytes, overflow-checked; NULL with *r set (and L->err) on failure. */

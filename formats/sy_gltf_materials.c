@@ -69,11 +69,7 @@ static sy_result get_texture(loader *L, const sy_gltf_shim_texinfo *ti, int role
         }
         const char *name = gltf_nonempty(tex->name) ? tex->name : gltf_nonempty(im->name);
         sy_texture h;
-        if ((r = sy_texture_create(L->scene, name, &h, &L->err))) return gltf_context(L, r, "textures");
-        if ((r = gltf_track(L, SY_TYPE_TEXTURE, h.id))) {
-            sy_object_destroy(L->scene, SY_TYPE_TEXTURE, h.id, NULL);
-            return r;
-        }
+        if ((r = gltf_create(L, SY_TYPE_TEXTURE, name, "textures", &h.id))) return r;
         sy_image_info info = {im->width, im->height, im->channels,
                               role == ROLE_COLOR ? SY_PIXEL_U8_SRGB : SY_PIXEL_U8_LINEAR};
         if ((r = sy_texture_set_image(L->scene, h, &info, L->image_blobs[tex->source], &L->err)))
@@ -201,11 +197,7 @@ sy_result gltf_create_material(loader *L, size_t i)
     sy_material h;
     char where[48];
     snprintf(where, sizeof where, "materials[%zu]", i);
-    if ((r = sy_material_create(L->scene, md.name, &h, &L->err))) return gltf_context(L, r, where);
-    if ((r = gltf_track(L, SY_TYPE_MATERIAL, h.id))) {
-        sy_object_destroy(L->scene, SY_TYPE_MATERIAL, h.id, NULL);
-        return r;
-    }
+    if ((r = gltf_create(L, SY_TYPE_MATERIAL, md.name, where, &h.id))) return r;
     if ((r = sy_material_set(L->scene, h, &md, &L->err))) return gltf_context(L, r, where);
     L->materials[i] = h;
     return SY_OK;

@@ -493,14 +493,7 @@ sy_result gltf_create_mesh(loader *L, size_t m)
     char where[48];
     snprintf(where, sizeof where, "meshes[%zu]", m);
     sy_mesh h;
-    if ((r = sy_mesh_create(L->scene, gltf_nonempty(mesh->name), &h, &L->err))) {
-        r = gltf_context(L, r, where);
-        goto done;
-    }
-    if ((r = gltf_track(L, SY_TYPE_MESH, h.id))) {
-        sy_object_destroy(L->scene, SY_TYPE_MESH, h.id, NULL);
-        goto done;
-    }
+    if ((r = gltf_create(L, SY_TYPE_MESH, gltf_nonempty(mesh->name), where, &h.id))) goto done;
     if (used_count && (r = sy_mesh_set_primitives(L->scene, h, prims, used_count, &L->err))) {
         r = gltf_context(L, r, where);
         goto done;

@@ -31,11 +31,7 @@ sy_result gltf_create_camera(loader *L, size_t i)
     snprintf(where, sizeof where, "cameras[%zu]", i);
     sy_camera h;
     sy_result r;
-    if ((r = sy_camera_create(L->scene, cd.name, &h, &L->err))) return gltf_context(L, r, where);
-    if ((r = gltf_track(L, SY_TYPE_CAMERA, h.id))) {
-        sy_object_destroy(L->scene, SY_TYPE_CAMERA, h.id, NULL);
-        return r;
-    }
+    if ((r = gltf_create(L, SY_TYPE_CAMERA, cd.name, where, &h.id))) return r;
     if ((r = sy_camera_set(L->scene, h, &cd, &L->err))) return gltf_context(L, r, where);
     L->cameras[i] = h;
     return SY_OK;
@@ -56,11 +52,7 @@ sy_result gltf_create_light(loader *L, size_t i)
     snprintf(where, sizeof where, "KHR_lights_punctual.lights[%zu]", i);
     sy_light h;
     sy_result r;
-    if ((r = sy_light_create(L->scene, ld.name, &h, &L->err))) return gltf_context(L, r, where);
-    if ((r = gltf_track(L, SY_TYPE_LIGHT, h.id))) {
-        sy_object_destroy(L->scene, SY_TYPE_LIGHT, h.id, NULL);
-        return r;
-    }
+    if ((r = gltf_create(L, SY_TYPE_LIGHT, ld.name, where, &h.id))) return r;
     if ((r = sy_light_set(L->scene, h, &ld, &L->err))) return gltf_context(L, r, where);
     L->lights[i] = h;
     return SY_OK;
@@ -71,11 +63,7 @@ sy_result gltf_create_light(loader *L, size_t i)
 static sy_result new_node(loader *L, const char *name, sy_node *out, const char *where)
 {
     sy_result r;
-    if ((r = sy_node_create(L->scene, name, out, &L->err))) return gltf_context(L, r, where);
-    if ((r = gltf_track(L, SY_TYPE_NODE, out->id))) {
-        sy_object_destroy(L->scene, SY_TYPE_NODE, out->id, NULL);
-        return r;
-    }
+    if ((r = gltf_create(L, SY_TYPE_NODE, name, where, &out->id))) return r;
     if ((r = sy_node_set_flags(L->scene, *out, SY_NODE_VISIBLE, &L->err))) return gltf_context(L, r, where);
     return SY_OK;
 }
