@@ -1,10 +1,11 @@
 /* sy_bench.c — what the `sy bench` benchmarks share (sy_bench.h): the spread of a benchmark's
- * rounds, sorting, the resident set. Each benchmark has its file: sy_bench_sync.c, sy_bench_rays.c,
+ * rounds, sorting, the resident set, a timed frame, a back-end that keeps nothing. Each benchmark has its file: sy_bench_sync.c, sy_bench_rays.c,
  * sy_bench_viewports.c, sy_bench_raster.c, sy_bench_load.c, sy_bench_memory.c,
  * sy_bench_pathtracer.c, sy_bench_filters.c, sy_bench_limit.c, sy_bench_instances.c,
  * sy_bench_governor.c, sy_bench_cull.c, sy_bench_web.c, sy_bench_deform.c, sy_bench_anim.c;
  * sy_cmd_bench.c parses the command line. */
 #include "sy_bench.h"
+#include "sy_mirror.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,3 +45,17 @@ sy_result sy_bench_frame(sy_window *win, sy_scene *scene, sy_context_pool *pool,
     *secs = sy_time_now() - t0;
     return r;
 }
+
+/* >>a back-end that keeps nothing (sy_bench_nop_mirror): handles numbered in turn */
+static uint32_t g_next;
+static sy_result nop_set(void *u, const sy_mirror_primitive_args *a, sy_error *e) { (void)u, (void)e; *a->handle = ++g_next; return SY_OK; }
+static sy_result nop_update(void *u, const sy_mirror_primitive_args *a, sy_error *e) { (void)u, (void)a, (void)e; return SY_OK; }
+static sy_result nop_inst(void *u, const sy_mirror_instance_args *a, sy_error *e)
+{
+    (void)u, (void)e;
+    if (!*a->handle) *a->handle = ++g_next;
+    return SY_OK;
+}
+static void nop_release(void *u, const sy_mirror_release_args *a) { (void)u, (void)a; }
+const sy_mirror_callbacks sy_bench_nop_mirror = {.primitive_set = nop_set, .instance_set = nop_inst, .release = nop_release,
+                                                 .primitive_update = nop_update};

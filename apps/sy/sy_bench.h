@@ -131,6 +131,9 @@ long sy_bench_rss_now_kib(void);
  * into *secs (sy bench pathtracer, sy bench filters). */
 sy_result sy_bench_frame(sy_window *win, sy_scene *scene, sy_context_pool *pool, uint32_t samples, sy_layer *out,
                          double *secs, sy_error *err);
+/* Mirror callbacks of a back-end that keeps nothing: the mirror's own cost (primitive_update: the
+ * deformation in place), for sy bench deform and sy bench anim. */
+extern const struct sy_mirror_callbacks sy_bench_nop_mirror;
 /* A .glb with a (grid + 1)^2-vertex grid of 2 * grid^2 triangles: POSITION, NORMAL, TEXCOORD_0,
  * uint32 indices; written through sy_atomic_file (sy bench load, sy bench memory). */
 sy_result sy_bench_write_grid_glb(const char *path, uint32_t grid, sy_error *err);

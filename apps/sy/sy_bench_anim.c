@@ -240,20 +240,6 @@ static sy_result write_nodes_glb(const char *path, uint32_t nodes, sy_error *err
     return r;
 }
 
-/* A back-end that keeps nothing: the mirror's own cost (primitive_update: deformed in place). */
-static uint32_t g_next;
-static sy_result nop_set(void *u, const sy_mirror_primitive_args *a, sy_error *e) { (void)u, (void)e; *a->handle = ++g_next; return SY_OK; }
-static sy_result nop_update(void *u, const sy_mirror_primitive_args *a, sy_error *e) { (void)u, (void)a, (void)e; return SY_OK; }
-static sy_result nop_inst(void *u, const sy_mirror_instance_args *a, sy_error *e)
-{
-    (void)u, (void)e;
-    if (!*a->handle) *a->handle = ++g_next;
-    return SY_OK;
-}
-static void nop_release(void *u, const sy_mirror_release_args *a) { (void)u, (void)a; }
-static const sy_mirror_callbacks k_nop = {.primitive_set = nop_set, .instance_set = nop_inst, .release = nop_release,
-                                          .primitive_update = nop_update};
-
 enum { S_CLOCK, S_COMMIT, S_PULL, S_SYNC, S_DEFORM, S_UPDATE, S_TOP, S_FRAME, S_COUNT };
 
 /* Per-frame samples of one sink (the no-op mirror or a back-end). */
@@ -416,7 +402,7 @@ static sy_result bench_scene(const char *label, const char *path, uint32_t frame
     if (r == SY_OK) {
         sy_mirror *m = NULL;
         uint32_t consumer = 0, entries = 0;
-        sy_mirror_desc d = {"bench mirror", info.root.id, &k_nop, NULL};
+        sy_mirror_desc d = {"bench mirror", info.root.id, &sy_bench_nop_mirror, NULL};
         sy_changes *c = NULL;
         r = sy_mirror_create(&d, &m, err);
         if (r == SY_OK) r = sy_scene_consumer_add(s, &consumer, err);

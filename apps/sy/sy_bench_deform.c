@@ -108,20 +108,6 @@ static void print_row(const char *what, double *v, uint32_t n, double scratch)
     printf("\n");
 }
 
-/* A back-end that keeps nothing: the mirror's own cost. */
-static uint32_t g_next;
-static sy_result nop_set(void *u, const sy_mirror_primitive_args *a, sy_error *e) { (void)u, (void)e; *a->handle = ++g_next; return SY_OK; }
-static sy_result nop_update(void *u, const sy_mirror_primitive_args *a, sy_error *e) { (void)u, (void)a, (void)e; return SY_OK; }
-static sy_result nop_inst(void *u, const sy_mirror_instance_args *a, sy_error *e)
-{
-    (void)u, (void)e;
-    if (!*a->handle) *a->handle = ++g_next;
-    return SY_OK;
-}
-static void nop_release(void *u, const sy_mirror_release_args *a) { (void)u, (void)a; }
-static const sy_mirror_callbacks k_nop = {.primitive_set = nop_set, .instance_set = nop_inst, .release = nop_release,
-                                          .primitive_update = nop_update};
-
 sy_result sy_bench_deform(uint32_t vertices, uint32_t repeats, sy_error *err)
 {
     sy_scene *s;
@@ -170,7 +156,7 @@ sy_result sy_bench_deform(uint32_t vertices, uint32_t repeats, sy_error *err)
     if (r == SY_OK) {
         sy_mirror *m = NULL;
         uint32_t consumer = 0;
-        sy_mirror_desc d = {"bench mirror", t.root.id, &k_nop, NULL};
+        sy_mirror_desc d = {"bench mirror", t.root.id, &sy_bench_nop_mirror, NULL};
         sy_changes *c = NULL;
         r = sy_mirror_create(&d, &m, err);
         if (r == SY_OK) r = sy_scene_consumer_add(s, &consumer, err);
