@@ -530,19 +530,10 @@ static sy_result frames_done(void *user, uint32_t index, const sy_layer *img, ui
     const char *kv[][2] = {{"sy:renderer", renderer}, {"sy:backend", fr->shown}, {"sy:params", fr->params},
                            {"sy:size", size_str},     {"sy:samples", samples_str}, {"sy:source", fr->scene},
                            {"sy:server", server_str}};
-    sy_exr_attribute attrs[8];
-    sy_png_text texts[8];
+    sy_exr_attribute attrs[sizeof kv / sizeof kv[0]];
+    sy_png_text texts[sizeof kv / sizeof kv[0]];
     out_opts o = *fr->oo;
-    o.attr_count = 0;
-    for (size_t k = 0; k < sizeof kv / sizeof kv[0]; ++k) {
-        if (!kv[k][1] || !kv[k][1][0]) continue;
-        attrs[o.attr_count] = (sy_exr_attribute){kv[k][0], kv[k][1]};
-        texts[o.attr_count] = (sy_png_text){kv[k][0], kv[k][1]};
-        o.attr_count++;
-    }
-    o.attrs = attrs;
-    o.png.text = texts;
-    o.png.text_count = o.attr_count;
+    sy_cli_out_metadata(&o, kv, sizeof kv / sizeof kv[0], attrs, texts);
     size_t bad = sy_layer_count_nonfinite(img);
     if (bad) sy_log(SY_LOG_WARNING, "sy", path, "%zu pixels are not finite", bad);
     sy_result r = sy_cli_write_image(path, img, &o, err); /* atomically: --resume trusts what exists */
@@ -1064,15 +1055,8 @@ int sy_cmd_render(int argc, char **argv)
                                {"sy:size", size_str}, {"sy:samples", samples_str},
                                {"sy:seconds", secs_str}, {"sy:source", scene},
                                {"sy:shutter", shutter_str}, {"sy:interrupted", interrupted ? "1" : NULL}};
-        for (size_t k = 0; k < sizeof kv / sizeof kv[0]; ++k) {
-            if (!kv[k][1] || !kv[k][1][0]) continue;
-            attrs[oo.attr_count] = (sy_exr_attribute){kv[k][0], kv[k][1]};
-            texts[oo.attr_count] = (sy_png_text){kv[k][0], kv[k][1]};
-            oo.attr_count++;
-        }
-        oo.attrs = attrs;
-        oo.png.text = texts;
-        oo.png.text_count = oo.attr_count;
+        _Static_assert(sizeof kv / sizeof kv[0] <= sizeof attrs / sizeof attrs[0], "room for every attribute");
+        sy_cli_out_metadata(&oo, kv, sizeof kv / sizeof kv[0], attrs, texts);
     }
     bool say = !seq; /* a sequence: progress on a terminal, one line at the end */
     if (r == SY_OK && clo.cluster && cluster_mode == SY_CLUSTER_MULTI_DISPLAY) {

@@ -32,6 +32,20 @@ void sy_cli_progress_cb(void *user, const sy_progress *p)
     fflush(stderr);
 }
 
+void sy_cli_out_metadata(out_opts *o, const char *(*kv)[2], size_t n, sy_exr_attribute *attrs, sy_png_text *texts)
+{
+    o->attr_count = 0;
+    for (size_t k = 0; k < n; ++k) {
+        if (!kv[k][1] || !kv[k][1][0]) continue;
+        attrs[o->attr_count] = (sy_exr_attribute){kv[k][0], kv[k][1]};
+        texts[o->attr_count] = (sy_png_text){kv[k][0], kv[k][1]};
+        o->attr_count++;
+    }
+    o->attrs = attrs;
+    o->png.text = texts;
+    o->png.text_count = o->attr_count;
+}
+
 bool sy_cli_is_output_path(const char *path)
 {
     return sy_cli_ends_with(path, ".exr") || sy_cli_ends_with(path, ".png") || sy_cli_ends_with(path, ".jpg") || sy_cli_ends_with(path, ".jpeg");

@@ -18,6 +18,9 @@ typedef struct out_opts {
 
 #define OUTPUT_KINDS ".exr, .png, .jpg or .jpeg"
 
+/* The pairs kv[0..n-1] {key, value} as o's EXR header attributes and PNG text chunks, stored in attrs
+ * and texts (room for n each, the caller's; a pair without a value is left out). */
+void sy_cli_out_metadata(out_opts *o, const char *(*kv)[2], size_t n, sy_exr_attribute *attrs, sy_png_text *texts);
 /* path ends in one of OUTPUT_KINDS */
 bool sy_cli_is_output_path(const char *path);
 /* Writes l to path in the format its extension names. */
