@@ -2,6 +2,7 @@
 #include "sy_common.h"
 
 #include <stdarg.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -74,6 +75,19 @@ bool sy_name_in_list(const char *name, const char *list, char sep)
         p = e + 1;
     }
     return false;
+}
+
+bool sy_u32_push(uint32_t **items, uint32_t *count, uint32_t *capacity, uint32_t v)
+{
+    if (*count == *capacity) {
+        uint32_t nc = *capacity ? *capacity * 2 : 4;
+        uint32_t *ni = realloc(*items, sizeof *ni * nc);
+        if (!ni) return false;
+        *items = ni;
+        *capacity = nc;
+    }
+    (*items)[(*count)++] = v;
+    return true;
 }
 
 double sy_time_now(void)

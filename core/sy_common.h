@@ -88,6 +88,10 @@ static inline bool sy_size_mad(size_t a, size_t b, size_t c, size_t *out)
     return sy_size_mul(a, b, &t) && sy_size_add(t, c, out);
 }
 
+/** Appends v to a growing array of uint32_t (ids, indices): *items holds *count of *capacity, which
+ * doubles when full (4 at first). false when out of memory (nothing changed then). */
+bool sy_u32_push(uint32_t **items, uint32_t *count, uint32_t *capacity, uint32_t v);
+
 /** Monotonic wall clock in seconds (for timings and progress only). */
 double sy_time_now(void);
 

@@ -6,31 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-bool sy_sc_list_push(id_list *l, uint32_t v)
-{
-    if (l->count == l->capacity) {
-        uint32_t nc = l->capacity ? l->capacity * 2 : 64;
-        uint32_t *ni = realloc(l->items, sizeof *ni * nc);
-        if (!ni) return false;
-        l->items = ni;
-        l->capacity = nc;
-    }
-    l->items[l->count++] = v;
-    return true;
-}
-
-bool sy_sc_array_push(uint32_t **items, uint32_t *count, uint32_t *capacity, uint32_t v)
-{
-    if (*count == *capacity) {
-        uint32_t nc = *capacity ? *capacity * 2 : 4;
-        uint32_t *ni = realloc(*items, sizeof *ni * nc);
-        if (!ni) return false;
-        *items = ni;
-        *capacity = nc;
-    }
-    (*items)[(*count)++] = v;
-    return true;
-}
+bool sy_sc_list_push(id_list *l, uint32_t v) { return sy_u32_push(&l->items, &l->count, &l->capacity, v); }
 
 void sy_sc_array_remove(uint32_t *items, uint32_t *count, uint32_t v)
 {
@@ -95,7 +71,7 @@ void sy_sc_free_list_push(pool *p, uint32_t idx)
 {
     if (p->slots[idx].in_free_list || p->slots[idx].retired) return;
     uint32_t cnt = p->free_count;
-    if (sy_sc_array_push(&p->free_list, &cnt, &p->free_capacity, idx)) {
+    if (sy_u32_push(&p->free_list, &cnt, &p->free_capacity, idx)) {
         p->free_count = cnt;
         p->slots[idx].in_free_list = 1;
     }

@@ -87,7 +87,6 @@ static inline uint32_t make_id(uint32_t index, uint32_t gen) { return (gen << SY
 
 /* sy_scene.c */
 bool sy_sc_list_push(id_list *l, uint32_t v);
-bool sy_sc_array_push(uint32_t **items, uint32_t *count, uint32_t *capacity, uint32_t v);
 void sy_sc_array_remove(uint32_t *items, uint32_t *count, uint32_t v);
 slot *sy_sc_lookup(const sy_scene *s, uint32_t type, uint32_t id);
 node_extra *sy_sc_nx_of(const sy_scene *s, uint32_t node_id);

@@ -109,7 +109,7 @@ static void children_changed(sy_scene *s, uint32_t id, const sy_blob *oldb, cons
         for (uint32_t i = 0; i < no && !existed; ++i) existed = o[i] == n[j];
         node_extra *cnx = sy_sc_nx_of(s, n[j]);
         if (existed || !cnx) continue;
-        sy_sc_array_push(&cnx->parents, &cnx->parent_count, &cnx->parent_capacity, id);
+        sy_u32_push(&cnx->parents, &cnx->parent_count, &cnx->parent_capacity, id);
         sy_sc_mark_world_dirty(s, n[j]);
     }
     sy_sc_mark_bounds_dirty(s, id);
@@ -119,7 +119,7 @@ static void mesh_users_changed(sy_scene *s, uint32_t node_id, uint32_t old_mesh,
 {
     slot *om = sy_sc_lookup(s, SY_TYPE_MESH, old_mesh), *nm = sy_sc_lookup(s, SY_TYPE_MESH, new_mesh);
     if (om) sy_sc_array_remove(om->users, &om->user_count, node_id);
-    if (nm) sy_sc_array_push(&nm->users, &nm->user_count, &nm->user_capacity, node_id);
+    if (nm) sy_u32_push(&nm->users, &nm->user_count, &nm->user_capacity, node_id);
     sy_sc_mark_bounds_dirty(s, node_id);
 }
 

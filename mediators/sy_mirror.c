@@ -142,20 +142,15 @@ static bool grow(void **arr, uint32_t *cap, size_t elem, uint32_t index)
     return true;
 }
 
-#define LOOKUP(st_, arr_, cap_, id_) ((id_) && IDX(id_) < (st_)->cap_ && (st_)->arr_[IDX(id_)].id == (id_) ? &(st_)->arr_[IDX(id_)] : NULL)
-
-static bool push_u32(uint32_t **items, uint32_t *count, uint32_t *cap, uint32_t v)
+/* The record of id in an array of records indexed by IDX(id), grown (zeroed) to hold it and cleared;
+ * NULL when out of memory. */
+static void *slot_new(void **arr, uint32_t *cap, size_t elem, uint32_t id)
 {
-    if (*count == *cap) {
-        uint32_t nc = *cap ? *cap * 2 : 4;
-        uint32_t *n = realloc(*items, sizeof *n * nc);
-        if (!n) return false;
-        *items = n;
-        *cap = nc;
-    }
-    (*items)[(*count)++] = v;
-    return true;
+    if (!grow(arr, cap, elem, IDX(id))) return NULL;
+    return memset((char *)*arr + elem * IDX(id), 0, elem);
 }
+#define SLOT_NEW(st_, arr_, cap_, id_) slot_new((void **)&(st_)->arr_, &(st_)->cap_, sizeof *(st_)->arr_, (id_))
+#define LOOKUP(st_, arr_, cap_, id_) ((id_) && IDX(id_) < (st_)->cap_ && (st_)->arr_[IDX(id_)].id == (id_) ? &(st_)->arr_[IDX(id_)] : NULL)
 
 static void remove_u32(uint32_t *items, uint32_t *count, uint32_t v)
 {
@@ -168,7 +163,7 @@ static void remove_u32(uint32_t *items, uint32_t *count, uint32_t v)
 
 static void mark_node_dirty(sy_mirror *st, uint32_t id)
 {
-    push_u32(&st->dirty, &st->dirty_count, &st->dirty_capacity, id);
+    sy_u32_push(&st->dirty, &st->dirty_count, &st->dirty_capacity, id);
 }
 
 static void release(sy_mirror *st, sy_mirror_kind kind, uint32_t handle)
@@ -454,7 +449,7 @@ static sy_result replace_dirty(sy_mirror *st, sy_error *err)
         node_m *n = LOOKUP(st, node, node_cap, st->dirty[i]);
         if (!n || n->visit == st->epoch) continue;
         n->visit = st->epoch;
-        if (!push_u32(&set, &count, &cap, n->id)) r = oom(st, err);
+        if (!sy_u32_push(&set, &count, &cap, n->id)) r = oom(st, err);
     }
     for (uint32_t i = 0; i < count && r == SY_OK; ++i) {
         node_m *n = LOOKUP(st, node, node_cap, set[i]);
@@ -462,7 +457,7 @@ static sy_result replace_dirty(sy_mirror *st, sy_error *err)
             node_m *cn = LOOKUP(st, node, node_cap, n->children[c]);
             if (!cn || cn->visit == st->epoch) continue;
             cn->visit = st->epoch;
-            if (!push_u32(&set, &count, &cap, cn->id)) r = oom(st, err);
+            if (!sy_u32_push(&set, &count, &cap, cn->id)) r = oom(st, err);
         }
     }
     /* parents in the set each node waits for */
@@ -481,7 +476,7 @@ static sy_result replace_dirty(sy_mirror *st, sy_error *err)
         node_m *n = LOOKUP(st, node, node_cap, set[i]);
         others -= n->pl_count;
         n->dry_pending = n->pending;
-        if (!n->pending && !push_u32(&ready, &nready, &ready_cap, n->id)) r = oom(st, err);
+        if (!n->pending && !sy_u32_push(&ready, &nready, &ready_cap, n->id)) r = oom(st, err);
     }
     while (nready && r == SY_OK) {
         uint32_t nid = ready[--nready];
@@ -507,14 +502,14 @@ static sy_result replace_dirty(sy_mirror *st, sy_error *err)
         for (uint32_t c = 0; c < n->child_count && r == SY_OK; ++c) {
             node_m *cn = LOOKUP(st, node, node_cap, n->children[c]);
             if (cn && cn->visit == st->epoch && cn->dry_pending && --cn->dry_pending == 0 &&
-                !push_u32(&ready, &nready, &ready_cap, cn->id))
+                !sy_u32_push(&ready, &nready, &ready_cap, cn->id))
                 r = oom(st, err);
         }
     }
     nready = 0;
     for (uint32_t i = 0; i < count && r == SY_OK; ++i) {
         node_m *n = LOOKUP(st, node, node_cap, set[i]);
-        if (!n->pending && !push_u32(&ready, &nready, &ready_cap, n->id)) r = oom(st, err);
+        if (!n->pending && !sy_u32_push(&ready, &nready, &ready_cap, n->id)) r = oom(st, err);
     }
     while (nready && r == SY_OK) {
         uint32_t nid = ready[--nready];
@@ -550,7 +545,7 @@ static sy_result replace_dirty(sy_mirror *st, sy_error *err)
         for (uint32_t c = 0; c < n->child_count && r == SY_OK; ++c) {
             node_m *cn = LOOKUP(st, node, node_cap, n->children[c]);
             if (cn && cn->visit == st->epoch && cn->pending && --cn->pending == 0 &&
-                !push_u32(&ready, &nready, &ready_cap, cn->id))
+                !sy_u32_push(&ready, &nready, &ready_cap, cn->id))
                 r = oom(st, err);
         }
     }
@@ -584,7 +579,7 @@ static sy_result deform_refresh(sy_mirror *st, node_m *n, sy_error *err)
     dprims_free(st, n);
     const mesh_m *m = LOOKUP(st, mesh, mesh_cap, n->mesh);
     bool want = m && m->src;
-    if (want && !n->deformer && !push_u32(&st->deformers, &st->deformer_count, &st->deformer_cap, n->id)) return oom(st, err);
+    if (want && !n->deformer && !sy_u32_push(&st->deformers, &st->deformer_count, &st->deformer_cap, n->id)) return oom(st, err);
     if (!want && n->deformer) remove_u32(st->deformers, &st->deformer_count, n->id);
     n->deformer = want;
     n->deform_dirty = want;
@@ -743,7 +738,7 @@ static void set_children(sy_mirror *st, node_m *n, const uint32_t *ch, uint32_t 
     for (uint32_t i = 0; i < n->child_count; ++i) {
         node_m *c = LOOKUP(st, node, node_cap, n->children[i]);
         if (c) {
-            push_u32(&c->parents, &c->parent_count, &c->parent_capacity, n->id);
+            sy_u32_push(&c->parents, &c->parent_count, &c->parent_capacity, n->id);
             mark_node_dirty(st, c->id);
         }
     }
@@ -751,9 +746,8 @@ static void set_children(sy_mirror *st, node_m *n, const uint32_t *ch, uint32_t 
 
 static node_m *node_add(sy_mirror *st, uint32_t id)
 {
-    if (!grow((void **)&st->node, &st->node_cap, sizeof *st->node, IDX(id))) return NULL;
-    node_m *n = &st->node[IDX(id)];
-    memset(n, 0, sizeof *n);
+    node_m *n = SLOT_NEW(st, node, node_cap, id);
+    if (!n) return NULL;
     n->id = id;
     n->local = sy_mat4_identity();
     n->flags = SY_NODE_VISIBLE;
@@ -773,9 +767,7 @@ static sy_result apply_texture(sy_mirror *st, const sy_change *e, bool destroyed
         return SY_OK;
     }
     if (!t) {
-        if (!grow((void **)&st->tex, &st->tex_cap, sizeof *st->tex, IDX(e->id))) return oom(st, err);
-        t = &st->tex[IDX(e->id)];
-        memset(t, 0, sizeof *t);
+        if (!(t = SLOT_NEW(st, tex, tex_cap, e->id))) return oom(st, err);
         t->id = e->id;
     }
     const sy_texture_data *d = e->data;
@@ -813,9 +805,7 @@ static sy_result apply_material(sy_mirror *st, const sy_change *e, bool destroye
         return SY_OK;
     }
     if (!m) {
-        if (!grow((void **)&st->mat, &st->mat_cap, sizeof *st->mat, IDX(e->id))) return oom(st, err);
-        m = &st->mat[IDX(e->id)];
-        memset(m, 0, sizeof *m);
+        if (!(m = SLOT_NEW(st, mat, mat_cap, e->id))) return oom(st, err);
         m->id = e->id;
     } else if (material_emits(&m->d)) {
         st->emissive_materials--;
@@ -856,9 +846,7 @@ static sy_result apply_mesh(sy_mirror *st, const sy_change *e, bool destroyed, s
         return SY_OK;
     }
     if (!m) {
-        if (!grow((void **)&st->mesh, &st->mesh_cap, sizeof *st->mesh, IDX(e->id))) return oom(st, err);
-        m = &st->mesh[IDX(e->id)];
-        memset(m, 0, sizeof *m);
+        if (!(m = SLOT_NEW(st, mesh, mesh_cap, e->id))) return oom(st, err);
         m->id = e->id;
     }
     if (e->mask & SY_BIT(SY_MESH_WEIGHTS)) {
@@ -902,9 +890,7 @@ static sy_result apply_light(sy_mirror *st, const sy_change *e, bool destroyed, 
         return SY_OK;
     }
     if (!l) {
-        if (!grow((void **)&st->light, &st->light_cap, sizeof *st->light, IDX(e->id))) return oom(st, err);
-        l = &st->light[IDX(e->id)];
-        memset(l, 0, sizeof *l);
+        if (!(l = SLOT_NEW(st, light, light_cap, e->id))) return oom(st, err);
         l->id = e->id;
         l->d = *(const sy_light_data *)sy_object_defaults(SY_TYPE_LIGHT);
     }
@@ -928,9 +914,7 @@ static sy_result apply_background(sy_mirror *st, const sy_change *e, bool destro
         return SY_OK;
     }
     if (!b) {
-        if (!grow((void **)&st->bg, &st->bg_cap, sizeof *st->bg, IDX(e->id))) return oom(st, err);
-        b = &st->bg[IDX(e->id)];
-        memset(b, 0, sizeof *b);
+        if (!(b = SLOT_NEW(st, bg, bg_cap, e->id))) return oom(st, err);
         b->id = e->id;
         b->world = *(const sy_background_data *)sy_object_defaults(SY_TYPE_BACKGROUND);
         b->world.name = NULL;
@@ -986,7 +970,7 @@ static sy_result apply_node(sy_mirror *st, const sy_change *e, bool destroyed, s
     if (e->mask & SY_BIT(SY_NODE_MESH)) {
         mesh_m *om = LOOKUP(st, mesh, mesh_cap, n->mesh), *nm = LOOKUP(st, mesh, mesh_cap, d->mesh.id);
         if (om) remove_u32(om->users, &om->user_count, n->id);
-        if (nm) push_u32(&nm->users, &nm->user_count, &nm->user_capacity, n->id);
+        if (nm) sy_u32_push(&nm->users, &nm->user_count, &nm->user_capacity, n->id);
         n->mesh = d->mesh.id;
         for (uint32_t k = 0; k < n->pl_count; ++k) drop_instances(st, &n->pl[k]); /* force new instances */
         sy_result r = deform_refresh(st, n, err);
@@ -1006,7 +990,7 @@ static sy_result apply_node(sy_mirror *st, const sy_change *e, bool destroyed, s
     if (e->mask & SY_BIT(SY_NODE_LIGHT)) {
         light_m *ol = LOOKUP(st, light, light_cap, n->light), *nl = LOOKUP(st, light, light_cap, d->light.id);
         if (ol) remove_u32(ol->users, &ol->user_count, n->id);
-        if (nl) push_u32(&nl->users, &nl->user_count, &nl->user_capacity, n->id);
+        if (nl) sy_u32_push(&nl->users, &nl->user_count, &nl->user_capacity, n->id);
         n->light = d->light.id;
         dirty = true;
     }
