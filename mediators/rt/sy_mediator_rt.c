@@ -209,20 +209,20 @@ static void pathtracer_filter_info(void *state, sy_filter_info *out)
     out->mean_blend = fi.mean_blend;
 }
 
+/* What the three classes share: one device, one mirror, one way to sync, render, pick and restart. */
+#define RT_CLASS_COMMON                                                                                                \
+    .destroy = rt_destroy, .sync = sy_rti_sync, .render = sy_rti_render, .stats = rt_stats, .pick = sy_rti_pick,     \
+    .restart = sy_rti_pt_restart
+
 static const sy_mediator_class pathtracer_class = {
     .name = "pathtracer",
     .param_table = SY_PARAM_TABLE(sy_rti_pathtracer_params),
     .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_SAMPLE_RANGES | SY_CAP_AOVS | SY_CAP_FILTERS | SY_CAP_PICK | SY_CAP_CLIP | SY_CAP_MOTION,
     .create = pathtracer_create,
-    .destroy = rt_destroy,
-    .sync = sy_rti_sync,
-    .render = sy_rti_render,
-    .stats = rt_stats,
+    RT_CLASS_COMMON,
     .aovs = pathtracer_aovs,
     .set_filter = sy_mediator_rt_set_filter,
     .filter_info = pathtracer_filter_info,
-    .pick = sy_rti_pick,
-    .restart = sy_rti_pt_restart,
     .motion = sy_rti_motion,
 };
 
@@ -233,13 +233,8 @@ static const sy_mediator_class whitted_class = {
     .param_table = SY_PARAM_TABLE(sy_rti_whitted_params),
     .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PREVIEW | SY_CAP_PICK | SY_CAP_CLIP | SY_CAP_MOTION,
     .create = whitted_create,
-    .destroy = rt_destroy,
-    .sync = sy_rti_sync,
-    .render = sy_rti_render,
-    .stats = rt_stats,
+    RT_CLASS_COMMON,
     .default_rank = 10, /* the default back-end without the rasterizer */
-    .pick = sy_rti_pick,
-    .restart = sy_rti_pt_restart,
     .motion = sy_rti_motion,
 };
 
@@ -255,13 +250,8 @@ static const sy_mediator_class coverage_class = {
     .param_table = SY_PARAM_TABLE(sy_rti_coverage_params),
     .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_ANALYSIS | SY_CAP_COVERAGE | SY_CAP_PICK | SY_CAP_CLIP,
     .create = coverage_create,
-    .destroy = rt_destroy,
-    .sync = sy_rti_sync,
-    .render = sy_rti_render,
-    .stats = rt_stats,
+    RT_CLASS_COMMON,
     .coverage = sy_rti_coverage,
-    .pick = sy_rti_pick,
-    .restart = sy_rti_pt_restart,
 };
 
 const sy_mediator_class *sy_mediator_rt_coverage_class(void) { return &coverage_class; }
