@@ -17,6 +17,17 @@ static void normalize3(float *v)
     if (l > 0.0f && isfinite(l)) v[0] /= l, v[1] /= l, v[2] /= l;
 }
 
+/* A direction (normal, tangent) through the 3x3 part of a skinning matrix m (column-major 3x4),
+ * normalised. */
+static void skin_direction(const float m[12], float *a)
+{
+    float ax = a[0], ay = a[1], az = a[2];
+    a[0] = m[0] * ax + m[3] * ay + m[6] * az;
+    a[1] = m[1] * ax + m[4] * ay + m[7] * az;
+    a[2] = m[2] * ax + m[5] * ay + m[8] * az;
+    normalize3(a);
+}
+
 /* One vertex range [v0, v1) of a deformation; false when a position leaves SY_COORD_MAX. */
 typedef struct deform_job {
     const sy_deform_input *in;
@@ -83,20 +94,8 @@ static void deform_range(deform_job *j)
             q[0] = m[0] * x + m[3] * y + m[6] * z + m[9];
             q[1] = m[1] * x + m[4] * y + m[7] * z + m[10];
             q[2] = m[2] * x + m[5] * y + m[8] * z + m[11];
-            if (n0) {
-                float *a = &nrm[3 * v], ax = a[0], ay = a[1], az = a[2];
-                a[0] = m[0] * ax + m[3] * ay + m[6] * az;
-                a[1] = m[1] * ax + m[4] * ay + m[7] * az;
-                a[2] = m[2] * ax + m[5] * ay + m[8] * az;
-                normalize3(a);
-            }
-            if (t0) {
-                float *a = &tan[4 * v], ax = a[0], ay = a[1], az = a[2];
-                a[0] = m[0] * ax + m[3] * ay + m[6] * az;
-                a[1] = m[1] * ax + m[4] * ay + m[7] * az;
-                a[2] = m[2] * ax + m[5] * ay + m[8] * az;
-                normalize3(a);
-            }
+            if (n0) skin_direction(m, &nrm[3 * v]);
+            if (t0) skin_direction(m, &tan[4 * v]);
         }
     }
     j->bounds = sy_bounds_empty();
