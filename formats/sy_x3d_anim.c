@@ -227,18 +227,25 @@ typedef struct elems {
     size_t count, cap;
 } elems;
 
+/* Appends c; false when out of memory. */
+static bool elems_push(elems *rs, const xmlNode *c)
+{
+    if (rs->count == rs->cap) {
+        size_t cap = rs->cap ? 2 * rs->cap : 16;
+        const xmlNode **n = realloc(rs->items, cap * sizeof *n);
+        if (!n) return false;
+        rs->items = n, rs->cap = cap;
+    }
+    rs->items[rs->count++] = c;
+    return true;
+}
+
 static bool collect(elems *rs, const xmlNode *el, unsigned depth)
 {
     for (const xmlNode *c = el->children; c; c = c->next) {
         if (c->type != XML_ELEMENT_NODE) continue;
         if (!strcmp(x3d_ename(c), "ROUTE")) {
-            if (rs->count == rs->cap) {
-                size_t cap = rs->cap ? 2 * rs->cap : 16;
-                const xmlNode **n = realloc(rs->items, cap * sizeof *n);
-                if (!n) return false;
-                rs->items = n, rs->cap = cap;
-            }
-            rs->items[rs->count++] = c;
+            if (!elems_push(rs, c)) return false;
         } else if (depth < 256 && !x3d_name_in(x3d_ename(c), "ProtoDeclare|ExternProtoDeclare|Script")) {
             if (!collect(rs, c, depth + 1)) return false;
         }
@@ -1036,14 +1043,7 @@ static bool scan_collect(scan *sc, const xmlNode *el, unsigned depth)
         if (c->type != XML_ELEMENT_NODE) continue;
         const char *n = x3d_ename(c);
         if (!strcmp(n, "ROUTE")) {
-            elems *rs = &sc->routes;
-            if (rs->count == rs->cap) {
-                size_t cap = rs->cap ? 2 * rs->cap : 16;
-                const xmlNode **p = realloc(rs->items, cap * sizeof *p);
-                if (!p) return false;
-                rs->items = p, rs->cap = cap;
-            }
-            rs->items[rs->count++] = c;
+            if (!elems_push(&sc->routes, c)) return false;
             continue;
         }
         if (x3d_name_in(n, "ProtoDeclare|ExternProtoDeclare|Script")) continue;
