@@ -505,16 +505,16 @@ static int ws_writeable(sy_web *w, web_conn *c)
     return send_frame(w, c, f, answered_by(c, f->gen));
 }
 
-/* Answers for connections that closed after asking (the render thread answered a request queued
- * before the close): freed, so they never fill the answers' queue. */
-static void drop_orphan_replies(sy_web *w)
+/* Frees the answers not sent yet of connection `serial` (from 1), or with serial 0 those of every
+ * connection that closed after asking (the render thread answered a request queued before the
+ * close), so they never fill the answers' queue; w->mu held. */
+static void drop_replies_locked(sy_web *w, uint64_t serial)
 {
-    pthread_mutex_lock(&w->mu);
     for (web_reply **rp = &w->replies; *rp;) {
         web_reply *y = *rp;
         const web_conn *c = w->conns;
-        while (c && c->serial != y->conn) c = c->next;
-        if (c) {
+        while (!serial && c && c->serial != y->conn) c = c->next;
+        if (serial ? y->conn != serial : c != NULL) {
             rp = &y->next;
             continue;
         }
@@ -524,6 +524,12 @@ static void drop_orphan_replies(sy_web *w)
     }
     w->replies_tail = &w->replies;
     while (*w->replies_tail) w->replies_tail = &(*w->replies_tail)->next;
+}
+
+static void drop_orphan_replies(sy_web *w)
+{
+    pthread_mutex_lock(&w->mu);
+    drop_replies_locked(w, 0);
     pthread_mutex_unlock(&w->mu);
 }
 
@@ -579,19 +585,7 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
                 *pp = c->next;
                 pthread_mutex_lock(&w->mu);
                 w->clients--;
-                /* its answers not sent yet go with it (actions still queued answer nobody) */
-                for (web_reply **rp = &w->replies; *rp;) {
-                    web_reply *y = *rp;
-                    if (y->conn != c->serial) {
-                        rp = &y->next;
-                        continue;
-                    }
-                    *rp = y->next;
-                    free(y->text), free(y);
-                    w->reply_count--;
-                }
-                w->replies_tail = &w->replies;
-                while (*w->replies_tail) w->replies_tail = &(*w->replies_tail)->next;
+                drop_replies_locked(w, c->serial); /* its answers go with it (actions still queued answer nobody) */
                 set_kind(w, c, 0);
                 pthread_mutex_unlock(&w->mu);
                 video_summary(c, "");
