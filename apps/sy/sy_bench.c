@@ -7,6 +7,7 @@
 #include "sy_bench.h"
 #include "sy_mirror.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <unistd.h>
@@ -59,3 +60,27 @@ static sy_result nop_inst(void *u, const sy_mirror_instance_args *a, sy_error *e
 static void nop_release(void *u, const sy_mirror_release_args *a) { (void)u, (void)a; }
 const sy_mirror_callbacks sy_bench_nop_mirror = {.primitive_set = nop_set, .instance_set = nop_inst, .release = nop_release,
                                                  .primitive_update = nop_update};
+
+void sy_bench_tube(uint32_t rings, float *pos, float *nrm, uint32_t *j32, uint16_t *j16, float *w, uint32_t *idx)
+{
+    const uint32_t S = SY_BENCH_TUBE_SEGMENTS, J = SY_BENCH_TUBE_JOINTS;
+    float seg = 2.0f / (float)(J - 1);
+    for (uint32_t i = 0; i < rings; ++i)
+        for (uint32_t k = 0; k < S; ++k) {
+            size_t v = (size_t)i * S + k;
+            float a = 6.2831853f * (float)k / (float)S, y = 2.0f * (float)i / (float)(rings - 1);
+            pos[3 * v] = 0.1f * cosf(a), pos[3 * v + 1] = y, pos[3 * v + 2] = 0.1f * sinf(a);
+            nrm[3 * v] = cosf(a), nrm[3 * v + 1] = 0.0f, nrm[3 * v + 2] = sinf(a);
+            uint32_t jj = (uint32_t)(y / seg);
+            if (jj >= J - 1) jj = J - 2;
+            float f = y / seg - (float)jj;
+            if (j32) j32[4 * v] = jj, j32[4 * v + 1] = jj + 1;
+            else j16[4 * v] = (uint16_t)jj, j16[4 * v + 1] = (uint16_t)(jj + 1);
+            w[4 * v] = 1.0f - f, w[4 * v + 1] = f;
+        }
+    for (uint32_t i = 0; i + 1 < rings; ++i)
+        for (uint32_t k = 0; k < S; ++k) {
+            uint32_t a = i * S + k, c = i * S + (k + 1) % S, *q = idx + 6 * ((size_t)i * S + k);
+            q[0] = a, q[1] = a + S, q[2] = c, q[3] = c, q[4] = a + S, q[5] = c + S;
+        }
+}

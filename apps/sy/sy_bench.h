@@ -134,6 +134,14 @@ sy_result sy_bench_frame(sy_window *win, sy_scene *scene, sy_context_pool *pool,
 /* Mirror callbacks of a back-end that keeps nothing: the mirror's own cost (primitive_update: the
  * deformation in place), for sy bench deform and sy bench anim. */
 extern const struct sy_mirror_callbacks sy_bench_nop_mirror;
+/* The skinned tube of sy bench deform and sy bench anim: height 2 along +Y, radius 0.1, `rings` rings
+ * (>= 2) of SY_BENCH_TUBE_SEGMENTS vertices, SY_BENCH_TUBE_JOINTS joints evenly along it (joint k at
+ * height k * 2 / (JOINTS - 1)), two influences per vertex. Fills positions and normals (3 floats a
+ * vertex), joints (4 a vertex: into j32 or j16, the other NULL; zeroed by the caller), weights (4 a
+ * vertex, zeroed by the caller) and triangle indices ((rings - 1) * SEGMENTS * 2 triangles). */
+#define SY_BENCH_TUBE_JOINTS 16u
+#define SY_BENCH_TUBE_SEGMENTS 64u
+void sy_bench_tube(uint32_t rings, float *pos, float *nrm, uint32_t *j32, uint16_t *j16, float *w, uint32_t *idx);
 /* A .glb with a (grid + 1)^2-vertex grid of 2 * grid^2 triangles: POSITION, NORMAL, TEXCOORD_0,
  * uint32 indices; written through sy_atomic_file (sy bench load, sy bench memory). */
 sy_result sy_bench_write_grid_glb(const char *path, uint32_t grid, sy_error *err);

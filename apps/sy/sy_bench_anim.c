@@ -40,8 +40,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#define JOINTS 16u
-#define SEGMENTS 64u
+#define JOINTS SY_BENCH_TUBE_JOINTS
+#define SEGMENTS SY_BENCH_TUBE_SEGMENTS
 #define SKIN_KEYS 25u
 #define NODE_KEYS 5u
 #define DURATION 2.0f
@@ -115,23 +115,7 @@ static sy_result write_skinned_glb(const char *path, uint32_t want_vertices, uin
     uint32_t *idx = (uint32_t *)(b + off[4]);
     float *ibm = (float *)(b + off[5]), *times = (float *)(b + off[6]), *rot = (float *)(b + off[7]);
     float seg = 2.0f / (float)(JOINTS - 1);
-    for (uint32_t i = 0; i < rings; ++i)
-        for (uint32_t k = 0; k < SEGMENTS; ++k) {
-            size_t v = (size_t)i * SEGMENTS + k;
-            float a = 6.2831853f * (float)k / (float)SEGMENTS, y = 2.0f * (float)i / (float)(rings - 1);
-            pos[3 * v] = 0.1f * cosf(a), pos[3 * v + 1] = y, pos[3 * v + 2] = 0.1f * sinf(a);
-            nrm[3 * v] = cosf(a), nrm[3 * v + 1] = 0.0f, nrm[3 * v + 2] = sinf(a);
-            uint32_t jj = (uint32_t)(y / seg);
-            if (jj >= JOINTS - 1) jj = JOINTS - 2;
-            float f = y / seg - (float)jj;
-            jn[4 * v] = (uint16_t)jj, jn[4 * v + 1] = (uint16_t)(jj + 1);
-            w[4 * v] = 1.0f - f, w[4 * v + 1] = f;
-        }
-    for (uint32_t i = 0; i + 1 < rings; ++i)
-        for (uint32_t k = 0; k < SEGMENTS; ++k) {
-            uint32_t a = i * SEGMENTS + k, c = i * SEGMENTS + (k + 1) % SEGMENTS, *q = idx + 6 * ((size_t)i * SEGMENTS + k);
-            q[0] = a, q[1] = a + SEGMENTS, q[2] = c, q[3] = c, q[4] = a + SEGMENTS, q[5] = c + SEGMENTS;
-        }
+    sy_bench_tube(rings, pos, nrm, NULL, jn, w, idx);
     for (uint32_t k = 0; k < JOINTS; ++k) { /* column-major: a translation by -(joint k's height) */
         float *m = ibm + 16 * k;
         m[0] = m[5] = m[10] = m[15] = 1.0f;

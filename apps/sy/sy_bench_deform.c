@@ -21,8 +21,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define JOINTS 16u
-#define SEGMENTS 64u
+#define JOINTS SY_BENCH_TUBE_JOINTS
+#define SEGMENTS SY_BENCH_TUBE_SEGMENTS
 
 typedef struct tube {
     sy_node root, mesh_node, joints[JOINTS];
@@ -40,23 +40,7 @@ static sy_result make_tube(sy_scene *s, uint32_t want_vertices, tube *t, sy_erro
     sy_result r = SY_OK;
     if (!pos || !nrm || !w || !j || !idx) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench deform: out of memory");
     float seg = 2.0f / (float)(JOINTS - 1);
-    for (uint32_t i = 0; i < rings && r == SY_OK; ++i)
-        for (uint32_t k = 0; k < SEGMENTS; ++k) {
-            uint32_t v = i * SEGMENTS + k;
-            float a = 6.2831853f * (float)k / (float)SEGMENTS, y = 2.0f * (float)i / (float)(rings - 1);
-            pos[3 * v] = 0.1f * cosf(a), pos[3 * v + 1] = y, pos[3 * v + 2] = 0.1f * sinf(a);
-            nrm[3 * v] = cosf(a), nrm[3 * v + 1] = 0.0f, nrm[3 * v + 2] = sinf(a);
-            uint32_t jj = (uint32_t)(y / seg);
-            if (jj >= JOINTS - 1) jj = JOINTS - 2;
-            float f = y / seg - (float)jj;
-            j[4 * v] = jj, j[4 * v + 1] = jj + 1;
-            w[4 * v] = 1.0f - f, w[4 * v + 1] = f;
-        }
-    for (uint32_t i = 0; i + 1 < rings && r == SY_OK; ++i)
-        for (uint32_t k = 0; k < SEGMENTS; ++k) {
-            uint32_t a = i * SEGMENTS + k, b = i * SEGMENTS + (k + 1) % SEGMENTS, *q = idx + 6 * ((size_t)i * SEGMENTS + k);
-            q[0] = a, q[1] = a + SEGMENTS, q[2] = b, q[3] = b, q[4] = a + SEGMENTS, q[5] = b + SEGMENTS;
-        }
+    if (r == SY_OK) sy_bench_tube(rings, pos, nrm, j, NULL, w, idx);
     sy_primitive p = {0};
     sy_mesh m;
     if (r == SY_OK) r = sy_blob_create_take(pos, sizeof(float) * 3 * nv, &p.positions, err), pos = NULL;
