@@ -35,19 +35,24 @@ node_extra *sy_sc_nx_of(const sy_scene *s, uint32_t node_id)
     return sl ? sl->nx : NULL;
 }
 
-bool sy_sc_pool_grow(pool *p, uint32_t min_count)
+/* The slot array resized to nc slots (the new ones zeroed); false when out of memory. */
+static bool pool_resize(pool *p, uint32_t nc)
 {
-    if (min_count <= p->capacity) return true;
-    uint32_t nc = p->capacity ? p->capacity : 64;
-    while (nc < min_count) nc *= 2;
-    if (nc > SY_HANDLE_INDEX_MASK + 1) nc = SY_HANDLE_INDEX_MASK + 1;
-    if (nc < min_count) return false;
     slot *ns = realloc(p->slots, sizeof *ns * nc);
     if (!ns) return false;
     memset(ns + p->capacity, 0, sizeof *ns * (nc - p->capacity));
     p->slots = ns;
     p->capacity = nc;
     return true;
+}
+
+bool sy_sc_pool_grow(pool *p, uint32_t min_count)
+{
+    if (min_count <= p->capacity) return true;
+    uint32_t nc = p->capacity ? p->capacity : 64;
+    while (nc < min_count) nc *= 2;
+    if (nc > SY_HANDLE_INDEX_MASK + 1) nc = SY_HANDLE_INDEX_MASK + 1;
+    return nc >= min_count && pool_resize(p, nc);
 }
 
 /* Replica apply: grows the slot array to exactly min_count slots (no doubling), so the memory a
@@ -58,13 +63,7 @@ _Static_assert(sizeof(slot) + sizeof(uint32_t) <= SY_SCENE_SLOT_BYTES,
 bool sy_sc_pool_reserve_exact(pool *p, uint32_t min_count)
 {
     if (min_count <= p->capacity) return true;
-    if (min_count > SY_HANDLE_INDEX_MASK + 1) return false;
-    slot *ns = realloc(p->slots, sizeof *ns * min_count);
-    if (!ns) return false;
-    memset(ns + p->capacity, 0, sizeof *ns * (min_count - p->capacity));
-    p->slots = ns;
-    p->capacity = min_count;
-    return true;
+    return min_count <= SY_HANDLE_INDEX_MASK + 1 && pool_resize(p, min_count);
 }
 
 void sy_sc_free_list_push(pool *p, uint32_t idx)
