@@ -22,6 +22,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -203,6 +204,16 @@ static bool collect_blobs(const sy_changes *c, blob_table *t)
     return true;
 }
 
+/* A primitive's blobs in their order in the format (positions ... target_tangents), for the writer
+ * and the reader. */
+static const size_t prim_blobs[] = {
+    offsetof(sy_primitive, positions),  offsetof(sy_primitive, normals),          offsetof(sy_primitive, tangents),
+    offsetof(sy_primitive, texcoords0), offsetof(sy_primitive, texcoords1),       offsetof(sy_primitive, colors),
+    offsetof(sy_primitive, indices),    offsetof(sy_primitive, joints),           offsetof(sy_primitive, weights),
+    offsetof(sy_primitive, target_positions), offsetof(sy_primitive, target_normals),
+    offsetof(sy_primitive, target_tangents)};
+#define PRIM_BLOBS (sizeof prim_blobs / sizeof prim_blobs[0])
+
 static void w_blobref(writer *w, blob_table *t, const sy_blob *b)
 {
     uint32_t idx = NULL_INDEX;
@@ -258,18 +269,8 @@ sy_result sy_changes_serialize(const sy_changes *c, sy_blob_send_fn send_blob, v
                 w_u32(&w, l->count);
                 for (uint32_t k = 0; k < l->count; ++k) {
                     const sy_primitive *pr = &l->items[k];
-                    w_blobref(&w, &t, pr->positions);
-                    w_blobref(&w, &t, pr->normals);
-                    w_blobref(&w, &t, pr->tangents);
-                    w_blobref(&w, &t, pr->texcoords0);
-                    w_blobref(&w, &t, pr->texcoords1);
-                    w_blobref(&w, &t, pr->colors);
-                    w_blobref(&w, &t, pr->indices);
-                    w_blobref(&w, &t, pr->joints);
-                    w_blobref(&w, &t, pr->weights);
-                    w_blobref(&w, &t, pr->target_positions);
-                    w_blobref(&w, &t, pr->target_normals);
-                    w_blobref(&w, &t, pr->target_tangents);
+                    for (size_t s = 0; s < PRIM_BLOBS; ++s)
+                        w_blobref(&w, &t, *(sy_blob *const *)((const char *)pr + prim_blobs[s]));
                     w_u32(&w, pr->material.id);
                     w_u32(&w, pr->topology);
                     w_bytes(&w, &pr->width, sizeof pr->width);
@@ -548,15 +549,11 @@ sy_result sy_changes_deserialize(const void *data, size_t size, sy_blob_store *s
                 }
                 for (uint32_t k = 0; k < n; ++k) {
                     sy_primitive *pr = &l->items[k];
-                    sy_blob **slots[12] = {&pr->positions,      &pr->normals,        &pr->tangents,
-                                           &pr->texcoords0,     &pr->texcoords1,     &pr->colors,
-                                           &pr->indices,        &pr->joints,         &pr->weights,
-                                           &pr->target_positions, &pr->target_normals, &pr->target_tangents};
                     l->count = k + 1; /* so a failure frees what was retained */
-                    for (int s = 0; s < 12; ++s) {
+                    for (size_t s = 0; s < PRIM_BLOBS; ++s) {
                         sy_blob *b;
                         if (!r_blobref(&r, blobs, nblobs, &b)) goto fail;
-                        *slots[s] = sy_blob_retain(b);
+                        *(sy_blob **)((char *)pr + prim_blobs[s]) = sy_blob_retain(b);
                     }
                     if (!r_u32(&r, &pr->material.id, "primitive material") ||
                         !r_u32(&r, &pr->topology, "primitive topology") ||
