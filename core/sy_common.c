@@ -77,6 +77,18 @@ bool sy_name_in_list(const char *name, const char *list, char sep)
     return false;
 }
 
+bool sy_array_reserve(void *items, size_t count, size_t *capacity, size_t elem, size_t first)
+{
+    if (count < *capacity) return true;
+    size_t nc = *capacity ? *capacity * 2 : first, bytes;
+    void *p;
+    memcpy(&p, items, sizeof p); /* items is a T **: its pointer read and written as bytes */
+    if (nc <= *capacity || !sy_size_mul(nc, elem, &bytes) || !(p = realloc(p, bytes))) return false;
+    memcpy(items, &p, sizeof p);
+    *capacity = nc;
+    return true;
+}
+
 bool sy_u32_push(uint32_t **items, uint32_t *count, uint32_t *capacity, uint32_t v)
 {
     if (*count == *capacity) {

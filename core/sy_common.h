@@ -88,6 +88,11 @@ static inline bool sy_size_mad(size_t a, size_t b, size_t c, size_t *out)
     return sy_size_mul(a, b, &t) && sy_size_add(t, c, out);
 }
 
+/** Room for one more element in a growing array: *(T **)items holds count elements of elem bytes in
+ * *capacity, doubled when full (first when empty). false when out of memory or the size would
+ * overflow (nothing changed then). */
+bool sy_array_reserve(void *items, size_t count, size_t *capacity, size_t elem, size_t first);
+
 /** Appends v to a growing array of uint32_t (ids, indices): *items holds *count of *capacity, which
  * doubles when full (4 at first). false when out of memory (nothing changed then). */
 bool sy_u32_push(uint32_t **items, uint32_t *count, uint32_t *capacity, uint32_t v);

@@ -28,13 +28,8 @@ const char *asp_str(const struct aiString *s)
 
 sy_result asp_new(asp_loader *L, sy_object_type t, const char *name, const char *what, uint32_t *id)
 {
-    if (L->obj_count == L->obj_cap) {
-        size_t cap = L->obj_cap ? L->obj_cap * 2 : 64;
-        asp_created *n = realloc(L->objs, cap * sizeof *n);
-        if (!n) return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", what);
-        L->objs = n;
-        L->obj_cap = cap;
-    }
+    if (!sy_array_reserve(&L->objs, L->obj_count, &L->obj_cap, sizeof *L->objs, 64))
+        return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", what);
     sy_result r = sy_object_create(L->scene, t, name && name[0] ? name : NULL, id, &L->err);
     if (r) {
         sy_error_prefix(&L->err, "%s: %s", L->path, what);

@@ -158,13 +158,8 @@ static sy_result texture_slot_for(asp_loader *L, const char *key, bool srgb, con
             *found = true;
             return SY_OK;
         }
-    if (L->texture_count == L->texture_cap) {
-        size_t cap = L->texture_cap ? L->texture_cap * 2 : 16;
-        asp_texture *n = realloc(L->textures, cap * sizeof *n);
-        if (!n) return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", where);
-        L->textures = n;
-        L->texture_cap = cap;
-    }
+    if (!sy_array_reserve(&L->textures, L->texture_count, &L->texture_cap, sizeof *L->textures, 16))
+        return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", where);
     asp_texture *sl = &L->textures[L->texture_count];
     if (!(sl->key = strdup(key))) return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", where);
     sl->srgb = srgb;

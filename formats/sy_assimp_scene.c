@@ -487,13 +487,7 @@ static void finish_lights(asp_loader *L, const pending_light *pl, size_t n, cons
 
 static sy_result push_extra(asp_loader *L, extra_child **ex, size_t *n, size_t *cap, uint32_t parent, sy_node node)
 {
-    if (*n == *cap) {
-        size_t c = *cap ? *cap * 2 : 16;
-        extra_child *e = realloc(*ex, c * sizeof *e);
-        if (!e) return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory for nodes");
-        *ex = e;
-        *cap = c;
-    }
+    if (!sy_array_reserve(ex, *n, cap, sizeof **ex, 16)) return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory for nodes");
     (*ex)[(*n)++] = (extra_child){parent, node};
     return SY_OK;
 }

@@ -23,15 +23,9 @@ sy_result gltf_create(loader *L, sy_object_type type, const char *name, const ch
 {
     sy_result r = sy_object_create(L->scene, type, name, id, &L->err);
     if (r != SY_OK) return gltf_context(L, r, where);
-    if (L->obj_count == L->obj_cap) {
-        size_t cap = L->obj_cap ? L->obj_cap * 2 : 64, bytes;
-        created_obj *n = sy_size_mul(cap, sizeof(created_obj), &bytes) ? realloc(L->objs, bytes) : NULL;
-        if (!n) {
-            sy_object_destroy(L->scene, type, *id, NULL);
-            return gltf_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory");
-        }
-        L->objs = n;
-        L->obj_cap = cap;
+    if (!sy_array_reserve(&L->objs, L->obj_count, &L->obj_cap, sizeof *L->objs, 64)) {
+        sy_object_destroy(L->scene, type, *id, NULL);
+        return gltf_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory");
     }
     L->objs[L->obj_count++] = (created_obj){(uint32_t)type, *id};
     return SY_OK;

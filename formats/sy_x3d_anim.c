@@ -230,12 +230,7 @@ typedef struct elems {
 /* Appends c; false when out of memory. */
 static bool elems_push(elems *rs, const xmlNode *c)
 {
-    if (rs->count == rs->cap) {
-        size_t cap = rs->cap ? 2 * rs->cap : 16;
-        const xmlNode **n = realloc(rs->items, cap * sizeof *n);
-        if (!n) return false;
-        rs->items = n, rs->cap = cap;
-    }
+    if (!sy_array_reserve(&rs->items, rs->count, &rs->cap, sizeof *rs->items, 16)) return false;
     rs->items[rs->count++] = c;
     return true;
 }
@@ -653,14 +648,9 @@ static sy_result build_clip(loader *L, xfile *F, drive *dv, size_t n)
         L->info->counts.animations++;
         for (uint32_t s = 0; s < ns && !r; ++s) {
             if (!fix[s]) continue;
-            if (L->ifix_count == L->ifix_cap) {
-                size_t cap = L->ifix_cap ? 2 * L->ifix_cap : 8;
-                intensity_fix *p = realloc(L->ifix, cap * sizeof *p);
-                if (!p) {
-                    r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
-                    break;
-                }
-                L->ifix = p, L->ifix_cap = cap;
+            if (!sy_array_reserve(&L->ifix, L->ifix_count, &L->ifix_cap, sizeof *L->ifix, 8)) {
+                r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+                break;
             }
             L->ifix[L->ifix_count++] = (intensity_fix){a.id, s, fix[s]};
         }
@@ -686,12 +676,7 @@ static bool push(loader *L, xfile *F, drives *ds, const drive *d)
         ds->capped = true;
         return true;
     }
-    if (ds->count == ds->cap) {
-        size_t cap = ds->cap ? 2 * ds->cap : 16;
-        drive *p = realloc(ds->items, cap * sizeof *p);
-        if (!p) return false;
-        ds->items = p, ds->cap = cap;
-    }
+    if (!sy_array_reserve(&ds->items, ds->count, &ds->cap, sizeof *ds->items, 16)) return false;
     ds->items[ds->count++] = *d;
     return true;
 }
@@ -1120,15 +1105,10 @@ sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
             free(key), free(kv);
             continue;
         }
-        if (L->morph_count == L->morph_cap) {
-            size_t cap = L->morph_cap ? 2 * L->morph_cap : 4;
-            morph_src *p = realloc(L->morphs, cap * sizeof *p);
-            if (!p) {
-                free(kv), free(key);
-                r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
-                break;
-            }
-            L->morphs = p, L->morph_cap = cap;
+        if (!sy_array_reserve(&L->morphs, L->morph_count, &L->morph_cap, sizeof *L->morphs, 4)) {
+            free(kv), free(key);
+            r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+            break;
         }
         L->morphs[L->morph_count++] = (morph_src){.coord = co, .interp = in, .serial = F->serial, .values = kv, .key = key,
                                                   .keys = nk, .points = nv / nk, .normals = normals};

@@ -365,12 +365,8 @@ sy_result x3d_get_material(loader *L, xfile *F, const xmlNode *app, bool solid, 
         if (!unlit && !stroke && !rgb_replaced) ml.diffuse = SY_ANIM_DIFFUSE;
         if ((unlit || stroke) && !(vcolors && !phys)) ml.emissive = SY_ANIM_DIFFUSE; /* unlit: emissive is the colour */
         else if (!unlit && !stroke) ml.emissive = SY_ANIM_EMISSIVE;
-        if (L->mat_link_count == L->mat_link_cap) {
-            size_t cap = L->mat_link_cap ? 2 * L->mat_link_cap : 16;
-            mat_link *p = realloc(L->mat_links, cap * sizeof *p);
-            if (!p) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
-            L->mat_links = p, L->mat_link_cap = cap;
-        }
+        if (!sy_array_reserve(&L->mat_links, L->mat_link_count, &L->mat_link_cap, sizeof *L->mat_links, 16))
+            return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
         L->mat_links[L->mat_link_count++] = ml;
     }
     c->done = true;

@@ -17,15 +17,9 @@
 
 static sy_result track(loader *L, sy_object_type t, uint32_t id)
 {
-    if (L->obj_count == L->obj_cap) {
-        size_t cap = L->obj_cap ? L->obj_cap * 2 : 64;
-        void *p = realloc(L->objs, cap * sizeof *L->objs);
-        if (!p) {
-            sy_object_destroy(L->scene, t, id, NULL);
-            return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
-        }
-        L->objs = p;
-        L->obj_cap = cap;
+    if (!sy_array_reserve(&L->objs, L->obj_count, &L->obj_cap, sizeof *L->objs, 64)) {
+        sy_object_destroy(L->scene, t, id, NULL);
+        return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
     }
     L->objs[L->obj_count].type = t;
     L->objs[L->obj_count++].id = id;

@@ -71,13 +71,8 @@ sy_result x3d_visit_light(loader *L, xfile *F, const xmlNode *el, const sy_mat4 
     }
     L->info->counts.lights++;
     if (ld.type != SY_LIGHT_DIRECTIONAL) {
-        if (L->light_count == L->light_cap) {
-            size_t cap = L->light_cap ? L->light_cap * 2 : 8;
-            pending_light *p = realloc(L->lights, cap * sizeof *p);
-            if (!p) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
-            L->lights = p;
-            L->light_cap = cap;
-        }
+        if (!sy_array_reserve(&L->lights, L->light_count, &L->light_cap, sizeof *L->lights, 8))
+            return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
         pending_light *pl = &L->lights[L->light_count++];
         pl->light = lid;
         sy_mat4_transform_point(world, loc, pl->pos);

@@ -183,12 +183,8 @@ static sy_result visit_shape(loader *L, xfile *F, const xmlNode *el, const sy_ma
             c->mesh = mid;
             bounds_add_prim(L, &prim, world);
             morph_src *m = morph ? &L->morphs[morph - 1] : NULL;
-            if (m && m->mesh_count == m->mesh_cap) {
-                size_t cap = m->mesh_cap ? 2 * m->mesh_cap : 4;
-                uint32_t *p = realloc(m->meshes, cap * sizeof *p);
-                if (!p) r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
-                else m->meshes = p, m->mesh_cap = cap;
-            }
+            if (m && !sy_array_reserve(&m->meshes, m->mesh_count, &m->mesh_cap, sizeof *m->meshes, 4))
+                r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
             if (m && !r) m->meshes[m->mesh_count++] = mid;
         } else {
             sy_error_prefix(&L->err, "%s:%d: Shape", F->path, x3d_line_of(el));
