@@ -47,6 +47,14 @@ sy_result sy_bench_frame(sy_window *win, sy_scene *scene, sy_context_pool *pool,
     return r;
 }
 
+sy_result sy_bench_move(sy_scene *s, sy_node n, float x, sy_error *err)
+{
+    static const float q[4] = {0, 0, 0, 1}, one[3] = {1, 1, 1};
+    const float t[3] = {x, 0.0f, 0.0f};
+    sy_result r = sy_node_set_trs(s, n, t, q, one, err);
+    return r == SY_OK ? sy_scene_commit(s, NULL, err) : r;
+}
+
 /* >>a back-end that keeps nothing (sy_bench_nop_mirror): handles numbered in turn */
 static uint32_t g_next;
 static sy_result nop_set(void *u, const sy_mirror_primitive_args *a, sy_error *e) { (void)u, (void)e; *a->handle = ++g_next; return SY_OK; }

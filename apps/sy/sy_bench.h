@@ -131,6 +131,9 @@ long sy_bench_rss_now_kib(void);
  * into *secs (sy bench pathtracer, sy bench filters). */
 sy_result sy_bench_frame(sy_window *win, sy_scene *scene, sy_context_pool *pool, uint32_t samples, sy_layer *out,
                          double *secs, sy_error *err);
+/* A transform change: node n placed at (x, 0, 0), unrotated and unscaled, and the scene committed
+ * (sy bench sync, sy bench raster). */
+sy_result sy_bench_move(sy_scene *s, sy_node n, float x, sy_error *err);
 /* Mirror callbacks of a back-end that keeps nothing: the mirror's own cost (primitive_update: the
  * deformation in place), for sy bench deform and sy bench anim. */
 extern const struct sy_mirror_callbacks sy_bench_nop_mirror;

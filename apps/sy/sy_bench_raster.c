@@ -78,11 +78,8 @@ static sy_result bench_raster_scene(const char *label, sy_scene *scene, const sy
     }
     free(tf);
     for (uint32_t i = 0; i < repeats && r == SY_OK; ++i) {
-        static const float q[4] = {0, 0, 0, 1}, one[3] = {1, 1, 1};
-        float tr[3] = {0.001f * (float)(i + 1), 0.0f, 0.0f};
         double a = sy_time_now();
-        r = sy_node_set_trs(scene, moved, tr, q, one, err);
-        if (r == SY_OK) r = sy_scene_commit(scene, NULL, err);
+        r = sy_bench_move(scene, moved, 0.001f * (float)(i + 1), err);
         if (r == SY_OK) r = sy_context_sync(ctx, err);
         if (r == SY_OK) r = sy_context_render(ctx, &rq, &layer, err);
         t[i] = sy_time_now() - a;

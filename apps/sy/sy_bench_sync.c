@@ -42,11 +42,8 @@ static sy_result bench_sync_backend(sy_scene *s, const char *backend, sy_node ro
     if (r == SY_OK) r = sy_context_sync(ctx, err);
     out->full = sy_time_now() - t0;
     for (uint32_t i = 0; i < repeats && r == SY_OK; ++i) {
-        static const float q[4] = {0, 0, 0, 1}, one[3] = {1, 1, 1};
-        float t[3] = {0.01f * (float)(i + 1), 0.0f, 0.0f};
         double a = sy_time_now();
-        r = sy_node_set_trs(s, leaf, t, q, one, err);
-        if (r == SY_OK) r = sy_scene_commit(s, NULL, err);
+        r = sy_bench_move(s, leaf, 0.01f * (float)(i + 1), err);
         double b = sy_time_now();
         if (r == SY_OK && i == 0 && log_bytes) *log_bytes = sy_scene_log_bytes(s); /* the one sealed, unpulled list */
         if (r == SY_OK) r = sy_context_sync(ctx, err);
