@@ -75,7 +75,10 @@ typedef struct sy_filter_report {
  *              the first hit). indirect: 3 ch, the high-variance rest; direct + indirect = colour.
  *   spp        per-pixel sample count (float, may be NULL: then spp_uniform for every pixel).
  *   range      RGBA range buffer ("virtual flash" RGB + depth in A), see sy_filter_range_compose;
- *              NULL: pixel filtering composes it from albedo/normal/depth(/position). */
+ *              NULL: pixel filtering composes it from albedo/normal/depth(/position).
+ *   motion     3 ch: object motion of the position's surface point since the previous frame (its
+ *              world position then minus position; 0 for a still object; NULL = nothing moved but
+ *              the camera). Only the temporal filter reads it (sy_filter_temporal.h). */
 typedef struct sy_filter_frame {
     /** @{ image size in pixels */
     uint32_t width, height; /** @} */
@@ -83,6 +86,7 @@ typedef struct sy_filter_frame {
     uint32_t color_channels, variance_channels; /** @} */
     /** @{ the buffers described above (NULL when unused) */
     const float *color, *variance, *albedo, *normal, *depth, *position, *direct, *indirect, *spp, *range; /** @} */
+    const float *motion; /**< object motion (see above; NULL = none) */
     float spp_uniform; /**< samples per pixel when spp is NULL */
     bool has_camera;           /**< camera_position valid: headlight term of the composed range buffer */
     float camera_position[3];  /**< world-space eye position */

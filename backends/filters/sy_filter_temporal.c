@@ -97,7 +97,8 @@ enum {
     W_RU = W_R + 11, /* 1 where the history was reused, else 0 */
     W_PART,         /* per part (2): acc 3, var, lacc = 5 */
     W_SCR = W_PART + 2 * 5, /* per part (2): the a-trous ping-pong planes a 3, va, la, b 3, vb, lb = 10 */
-    W_COUNT = W_SCR + 2 * 10
+    W_PP = W_SCR + 2 * 10,  /* 3: the hits' world positions at the previous frame (position + motion) */
+    W_COUNT = W_PP + 3
 };
 /* a part's planes (part_index)  */
 enum { P_ACC = 0, P_VAR = 3, P_LACC = 4, P_A = 5, P_VA = 8, P_LA = 9, P_B = 10, P_VB = 13, P_LB = 14 };
@@ -548,7 +549,8 @@ static inline SY_TEMPORAL_INLINE void reproject_tap(int xx, int yy, float wk, in
 }
 
 /* Bilinear reprojection of a row's hits into the previous history (reproject's rule, branch-free so
- * that it vectorises with gathers): the frame's positions pa pb pc, normals na nb nc, depth z
+ * that it vectorises with gathers): the points' previous positions pa pb pc (the frame's, moved back
+ * by the object motion), normals na nb nc, depth z
  * and hit h (planes); M the previous world_to_pixel, base its history (hw x hh, 17 planes hn
  * apart: illum 3, dir 3, moments 4, length, position 3, normal 3). Out: R (11 planes n apart: the
  * history, 0 where none fits) and ru (1 where reused). */
@@ -614,12 +616,25 @@ static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
             const float *p = in->position + 3 * i, *nr = in->normal + 3 * i;
             for (int q = 0; q < 3; ++q) nx->pos[q * n + i] = hit ? p[q] : 0.0f, nx->nrm[q * n + i] = hit ? nr[q] : 0.0f;
         }
+        /* where the surface points were at the previous frame: the positions, moved back by the
+         * object motion (a non-finite motion finds no history) */
+        const float *pp = nx->pos;
+        if (in->motion) {
+            float *PP = plane(c, W_PP);
+            for (int x = 0; x < w; ++x) {
+                size_t i = row + x;
+                bool hit = H[i] > 0.0f;
+                const float *mv = in->motion + 3 * i;
+                for (int q = 0; q < 3; ++q) PP[q * n + i] = hit ? nx->pos[q * n + i] + mv[q] : 0.0f;
+            }
+            pp = PP;
+        }
         if (c->prev) {
             const hist *hp = c->prev;
             reproject_row(w, n, hp->world_to_pixel, (int)hp->w, (int)hp->h, (size_t)hp->w * hp->h, hp->illum,
-                          P->depth_tolerance, P->normal_tolerance, nx->pos + row, nx->pos + n + row,
-                          nx->pos + 2 * n + row, nx->nrm + row, nx->nrm + n + row, nx->nrm + 2 * n + row,
-                          plane(c, W_Z) + row, H + row, R + row, RU + row);
+                          P->depth_tolerance, P->normal_tolerance, pp + row, pp + n + row, pp + 2 * n + row,
+                          nx->nrm + row, nx->nrm + n + row, nx->nrm + 2 * n + row, plane(c, W_Z) + row, H + row,
+                          R + row, RU + row);
         } else {
             for (int q = 0; q < 11; ++q) memset(R + q * n + row, 0, (size_t)w * sizeof(float));
             memset(RU + row, 0, (size_t)w * sizeof(float));

@@ -12,12 +12,14 @@
  *
  * Per call, for pixel i with world position p_i (frame.position), all on illumination (colour
  * demodulated by the albedo, as the a-trous filter does; misses pass through unchanged):
- *   1. reprojection: the previous frame's pixel of p_i through the previous camera (prev
+ *   1. reprojection: the point's previous position q_i = p_i + motion_i (frame.motion, the object
+ *      motion since the previous frame; q_i = p_i without it) through the previous camera (prev
  *      world_to_pixel), bilinear over its 4 nearest pixel centres; a tap counts only when its stored
- *      world position lies within depth_tolerance x depth_i of p_i and its normal within
- *      normal_tolerance (cosine) of n_i. No valid tap: disocclusion, history length 0. Only the
- *      camera moves points: a node the scene clock moved is not followed (its history is rejected
- *      where its surface left the tolerance, or clamped).
+ *      world position lies within depth_tolerance x depth_i of q_i and its normal within
+ *      normal_tolerance (cosine) of n_i (a surface that turned further in one frame starts anew). No
+ *      valid tap: disocclusion, history length 0. Without motion only the camera moves points: a
+ *      node the scene clock moved is not followed (its history is rejected where its surface left
+ *      the tolerance, or clamped: the moving object ghosts).
  *   2. neighbourhood clamping: the reprojected history is clamped to the box mean +- clamp_gamma x
  *      standard deviation of the new samples' 3x3 neighbourhood in YCoCg (0 = no clamping).
  *   3. exponential moving average: weight max(alpha, 1 / (history length + 1)) for the new samples
@@ -33,7 +35,8 @@
  * in the history (the pixel shows its own colour, or 0).
  *
  * Inputs (sy_filter_frame): color (3 or 4 channels; alpha passed through), albedo, normal, depth,
- * position (required: world positions as sy_filter_position_from_depth gives them); direct and
+ * position (required: world positions as sy_filter_position_from_depth gives them); motion
+ * (optional: per-pixel object motion, 3 floats, as sy_filter.h describes); direct and
  * indirect (optional, both or neither): then the two parts go through steps 1-4 separately (each
  * with its own moments and variance, as SVGF's direct and indirect illumination), except that the
  * direct part's history is its unfiltered blend (step 3), not its first a-trous pass: fed back,
@@ -45,7 +48,7 @@
  * to call (an interactive view's resolution scale): the history is read at its own size.
  *
  * Ownership: a sy_filter_temporal is the caller's (create / destroy); it holds two frames of history
- * and its working planes (about 410 bytes per pixel). Thread-safety: one thread at a time per object; the passes run on the
+ * and its working planes (about 420 bytes per pixel). Thread-safety: one thread at a time per object; the passes run on the
  * process's OpenMP team (sy_filter_parallel_rows); results do not depend on the thread count, nor on
  * the instruction set (the row loops' AVX2 and SSE2 clones do the same operations per pixel). */
 #ifndef SY_FILTER_TEMPORAL_H
