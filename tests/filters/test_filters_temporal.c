@@ -447,6 +447,30 @@ static int test_object_motion(void)
     CHECK(cam > 0.0 && obj > 0.0 && wall_cam > 0.0 && wall_obj > 0.0);
     CHECK(cam / obj > 2.0);
     CHECK(wall_obj < 1.1 * wall_cam);
+    /* a non-finite motion finds no history (and nothing non-finite reaches the output); a zero motion
+     * is the camera-only reprojection */
+    scene s = {.occluder = true, .rng = 3};
+    sy_filter_temporal *t = NULL;
+    sy_filter_report err = {0};
+    CHECK(sy_filter_temporal_create(NULL, &t, &err) == SY_FILTER_OK);
+    const uint32_t w = 48, h = 32;
+    size_t n = (size_t)w * h;
+    float *out = malloc(4 * n * sizeof(float)), *mv = malloc(3 * n * sizeof(float));
+    CHECK(out && mv);
+    sy_filter_temporal_stats st = {0};
+    for (int k = 0; k < 3; ++k) {
+        CHECK(scene_render(&s, w, h, 0.02f * (float)k, 0.6f, 1.0f, 0.0f) == 0);
+        for (size_t i = 0; i < 3 * n; ++i) mv[i] = k == 2 ? NAN : 0.0f;
+        sy_filter_frame f = scene_frame(&s);
+        f.motion = mv;
+        CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
+        for (size_t i = 0; i < 4 * n; ++i) CHECK(isfinite(out[i]));
+        if (k == 1) CHECK(st.reprojected > st.pixels * 8 / 10);
+    }
+    CHECK(st.reprojected == 0 && st.nonfinite == 0);
+    free(out), free(mv);
+    sy_filter_temporal_destroy(t);
+    scene_free(&s);
     return 0;
 }
 
