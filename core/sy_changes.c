@@ -192,7 +192,8 @@ static bool collect_blobs(const sy_changes *c, blob_table *t)
                         !bt_add(t, pr->texcoords1, &idx) || !bt_add(t, pr->colors, &idx) ||
                         !bt_add(t, pr->indices, &idx) || !bt_add(t, pr->joints, &idx) ||
                         !bt_add(t, pr->weights, &idx) || !bt_add(t, pr->target_positions, &idx) ||
-                        !bt_add(t, pr->target_normals, &idx) || !bt_add(t, pr->target_tangents, &idx))
+                        !bt_add(t, pr->target_normals, &idx) || !bt_add(t, pr->target_tangents, &idx) ||
+                        !bt_add(t, pr->target_texcoords0, &idx))
                         return false;
                 }
             }
@@ -211,7 +212,7 @@ static const size_t prim_blobs[] = {
     offsetof(sy_primitive, texcoords0), offsetof(sy_primitive, texcoords1),       offsetof(sy_primitive, colors),
     offsetof(sy_primitive, indices),    offsetof(sy_primitive, joints),           offsetof(sy_primitive, weights),
     offsetof(sy_primitive, target_positions), offsetof(sy_primitive, target_normals),
-    offsetof(sy_primitive, target_tangents)};
+    offsetof(sy_primitive, target_tangents), offsetof(sy_primitive, target_texcoords0)};
 #define PRIM_BLOBS (sizeof prim_blobs / sizeof prim_blobs[0])
 
 static void w_blobref(writer *w, blob_table *t, const sy_blob *b)

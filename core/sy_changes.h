@@ -64,7 +64,7 @@ sy_changes_stats sy_changes_get_stats(const sy_changes *c);
 
 /* ---- serialisation ---- */
 #define SY_CHANGES_WIRE_MAGIC 0x4C435953u /**< "SYCL" little endian */
-#define SY_CHANGES_WIRE_VERSION 6u /**< version of the serialised format */
+#define SY_CHANGES_WIRE_VERSION 7u /**< version of the serialised format */
 
 /** Return true to send the payload of this blob inline (the receiver does not have it yet). */
 typedef bool (*sy_blob_send_fn)(void *user, const sy_blob *b);

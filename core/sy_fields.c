@@ -226,10 +226,10 @@ void sy_animation_time_range(const sy_animation_data *d, float *start_out, float
 /* >>generic field operations */
 void sy__primitive_release(sy_primitive *p)
 {
-    sy_blob *blobs[12] = {p->positions, p->texcoords0, p->texcoords1,      p->normals,          p->tangents,
+    sy_blob *blobs[13] = {p->positions, p->texcoords0, p->texcoords1,      p->normals,          p->tangents,
                           p->colors,    p->indices,    p->joints,          p->weights,          p->target_positions,
-                          p->target_normals, p->target_tangents};
-    for (int i = 0; i < 12; ++i) sy_blob_release(blobs[i]);
+                          p->target_normals, p->target_tangents, p->target_texcoords0};
+    for (int i = 0; i < 13; ++i) sy_blob_release(blobs[i]);
     memset(p, 0, sizeof *p);
 }
 
@@ -268,6 +268,7 @@ static bool prims_copy(sy_primitive_list *dst, const sy_primitive_list *src)
         sy_blob_retain(p->target_positions);
         sy_blob_retain(p->target_normals);
         sy_blob_retain(p->target_tangents);
+        sy_blob_retain(p->target_texcoords0);
     }
     dst->count = src->count;
     return true;
@@ -371,7 +372,8 @@ bool sy__field_equal(uint32_t type, uint32_t f, const void *a, const void *b)
                 !blob_same(x->indices, y->indices) || !blob_same(x->joints, y->joints) ||
                 !blob_same(x->weights, y->weights) || !blob_same(x->target_positions, y->target_positions) ||
                 !blob_same(x->target_normals, y->target_normals) ||
-                !blob_same(x->target_tangents, y->target_tangents) || x->material.id != y->material.id ||
+                !blob_same(x->target_tangents, y->target_tangents) ||
+                !blob_same(x->target_texcoords0, y->target_texcoords0) || x->material.id != y->material.id ||
                 x->topology != y->topology || memcmp(&x->width, &y->width, sizeof x->width) != 0)
                 return false;
         }

@@ -189,20 +189,23 @@ typedef struct sy_primitive {
     sy_blob *target_positions; /**< morph targets: float[3] position deltas, vertex_count per target, target after target, or NULL */
     sy_blob *target_normals;   /**< morph targets: float[3] normal deltas (layout as target_positions), or NULL */
     sy_blob *target_tangents;  /**< morph targets: float[3] tangent xyz deltas (layout as target_positions), or NULL */
+    sy_blob *target_texcoords0; /**< morph targets: float[2] texture coordinate (set 0) deltas, vertex_count per
+                                     target, target after target, or NULL (X3D's animated TextureTransform and
+                                     TextureCoordinate: needs texcoords0) */
 } sy_primitive;
 
 /** Skins and morph targets (glTF 2.0 "Skins" and "Morph Targets"). A primitive may carry
  * per-vertex joint indices and weights (joints and weights: `influences` values per vertex, 1 to
  * SY_SKIN_MAX_INFLUENCES: glTF's JOINTS_0/WEIGHTS_0, then JOINTS_1/WEIGHTS_1, interleaved per
- * vertex) and morph target deltas (target_positions / target_normals / target_tangents: the same
- * number of targets in each present blob, at most SY_MORPH_MAX_TARGETS). The setters check sizes,
+ * vertex) and morph target deltas (target_positions / target_normals / target_tangents /
+ * target_texcoords0: the same number of targets in each present blob, at most SY_MORPH_MAX_TARGETS). The setters check sizes,
  * finiteness and counts; joint indices are checked against the skin where it is used (a vertex
  * whose joint index is past its node's skin is drawn in its bind pose, undeformed). The values that
  * drive them are node fields: SY_NODE_SKIN (the joints and their inverse bind matrices) and
  * SY_NODE_WEIGHTS (morph weights; NULL = the mesh's SY_MESH_WEIGHTS; missing weights are 0).
  * The scene mirror deforms (mediators/sy_mirror.h): position = sum_j w_j (J_j x IBM_j) (p + sum_t
- * weight_t dp_t), normals likewise with the inverse transpose, so every back-end draws the same
- * pose. A skinned mesh's node transform is ignored, as glTF says: its joints place it. */
+ * weight_t dp_t), normals likewise with the inverse transpose, texture coordinates (set 0) uv +
+ * sum_t weight_t duv_t, so every back-end draws the same pose. A skinned mesh's node transform is ignored, as glTF says: its joints place it. */
 #define SY_SKIN_MAX_INFLUENCES 8u   /**< joints per vertex (JOINTS_0 + JOINTS_1) */
 #define SY_SKIN_MAX_JOINTS 65536u   /**< joints of one skin */
 #define SY_MORPH_MAX_TARGETS 256u   /**< morph targets of one primitive (= SY_ANIM_MAX_COMPONENTS) */

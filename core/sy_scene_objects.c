@@ -491,6 +491,7 @@ uint32_t sy_primitive_target_count(const sy_primitive *p)
 {
     uint32_t nv = sy_primitive_vertex_count(p);
     const sy_blob *b = p->target_positions ? p->target_positions : p->target_normals ? p->target_normals : p->target_tangents;
+    if (!b && p->target_texcoords0) return nv ? (uint32_t)(sy_blob_size(p->target_texcoords0) / 8 / nv) : 0u;
     return b && nv ? (uint32_t)(sy_blob_size(b) / 12 / nv) : 0u;
 }
 

@@ -286,17 +286,19 @@ static sy_result check_deform(const sy_primitive *p, uint32_t nv, uint32_t i, sy
         if (!blob_finite(p->weights))
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: a skin weight is not finite", i);
     }
-    const sy_blob *tb[3] = {p->target_positions, p->target_normals, p->target_tangents};
-    const char *tn[3] = {"target_positions", "target_normals", "target_tangents"};
+    const sy_blob *tb[4] = {p->target_positions, p->target_normals, p->target_tangents, p->target_texcoords0};
+    const char *tn[4] = {"target_positions", "target_normals", "target_tangents", "target_texcoords0"};
+    if (p->target_texcoords0 && !p->texcoords0)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "mesh primitive %u: target_texcoords0 without texcoords0", i);
     size_t targets = 0;
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < 4; ++k) {
         if (!tb[k]) continue;
-        size_t sz = sy_blob_size(tb[k]), per = 12u * (size_t)nv;
+        size_t sz = sy_blob_size(tb[k]), bytes = k == 3 ? 8u : 12u, per = bytes * (size_t)nv;
         if (nv == 0 || sz % per != 0 || sz / per == 0 || sz / per > SY_MORPH_MAX_TARGETS || (targets && sz / per != targets))
             return sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
-                                "mesh primitive %u: %s holds %zu bytes, not 1 to %u whole targets of %u vertices x 12 "
+                                "mesh primitive %u: %s holds %zu bytes, not 1 to %u whole targets of %u vertices x %zu "
                                 "bytes (the same count in every target blob)",
-                                i, tn[k], sz, SY_MORPH_MAX_TARGETS, nv);
+                                i, tn[k], sz, SY_MORPH_MAX_TARGETS, nv, bytes);
         targets = sz / per;
         const float *f = sy_blob_data(tb[k]);
         for (size_t e = 0; e < sz / 4; ++e)

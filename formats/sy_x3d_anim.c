@@ -30,7 +30,15 @@
  *                               SY_MORPH_MAX_TARGETS keys); the mirror deforms it for every back-end;
  *   NormalInterpolator       -> Normal.vector: the same, as normal deltas (geometry whose every corner
  *                               has an explicit normal; with a CoordinateInterpolator on the same
- *                               geometry only when both have the same keys, one channel for both).
+ *                               geometry only when both have the same keys, one channel for both);
+ *   CoordinateInterpolator2D -> TextureCoordinate.point, and PositionInterpolator2D ->
+ *                               TextureTransform translation / scale / center: the same, as texture
+ *                               coordinate deltas (target_texcoords0, sy_objects.h): each key's
+ *                               coordinates through the TextureTransform (X3D's transform is affine in
+ *                               each of those fields, so LINEAR weights of consecutive keys give exactly
+ *                               the interpolated field's coordinates); polygon geometry only (the
+ *                               primitives Box, Sphere, ... keep theirs), not with moving points on the
+ *                               same geometry; one interpolator per TextureCoordinate / TextureTransform.
  * ROUTEs are read per file, so DEF names resolve in the file's own namespace (an Inline's routes
  * see the Inline's DEFs).
  *
@@ -41,12 +49,11 @@
  * fields' types differ (SFVec3f into SFColor: X3D forbids it); a route that closes a loop of routes
  * (X3D passes one event per route per timestamp, so a loop never runs away; the clock has no event
  * cascade at all, and the route is dropped). What has no target here is reported once per kind:
- * PositionInterpolator2D and CoordinateInterpolator2D (texture coordinates and TextureTransform
- * are baked into the meshes' vertices when loading), other
- * mapped-but-not-animated fields (Material.shininess, Transform.center, ...), scale routes to a
- * Transform with a scaleOrientation (routes to a Transform with a center play: x3d_pivot). Bad
- * interpolators (key and keyValue counts that differ, keys that decrease) are dropped with a warning
- * naming them; equal keys (an X3D jump) become a step one float step later. Several routes into one
+ * mapped-but-not-animated fields (Material.shininess, Transform.center, TextureTransform.rotation,
+ * ...), scale routes to a Transform with a scaleOrientation (routes to a Transform with a center
+ * play: x3d_pivot). Bad interpolators (key and keyValue counts that differ, keys that decrease,
+ * values that are not finite) are dropped with a warning naming them (file, line, type and DEF);
+ * equal keys (an X3D jump) become a step one float step later. Several routes into one
  * field at one time: the channels apply in clip order (the last sensor's in the file wins), as the
  * one-event-per-route rule leaves it to the order events arrive. */
 #include "sy_x3d_internal.h"
@@ -109,8 +116,8 @@ static const field_map field_maps[] = {
     {"Material", "shininess|ambientIntensity|occlusionStrength|normalScale", T_SFFLOAT, W_NONE},
     {"Coordinate|CoordinateDouble", "point", T_MFVEC3F, W_MORPH},
     {"Normal", "vector", T_MFVEC3F, W_MORPH},
-    {"TextureCoordinate", "point", T_MFVEC2F, W_NONE},
-    {"TextureTransform", "translation|scale|center", T_SFVEC2F, W_NONE},
+    {"TextureCoordinate", "point", T_MFVEC2F, W_MORPH},
+    {"TextureTransform", "translation|scale|center", T_SFVEC2F, W_MORPH},
     {"TextureTransform", "rotation", T_SFFLOAT, W_NONE},
 };
 
@@ -124,8 +131,8 @@ typedef struct interp_kind {
 static const interp_kind interp_kinds[] = {
     {"PositionInterpolator", T_SFVEC3F, 3, true},    {"OrientationInterpolator", T_SFROTATION, 4, true},
     {"ColorInterpolator", T_SFCOLOR, 3, true},       {"ScalarInterpolator", T_SFFLOAT, 1, true},
-    {"PositionInterpolator2D", T_SFVEC2F, 2, false}, {"CoordinateInterpolator", T_MFVEC3F, 3, true},
-    {"NormalInterpolator", T_MFVEC3F, 3, true},     {"CoordinateInterpolator2D", T_MFVEC2F, 2, false},
+    {"PositionInterpolator2D", T_SFVEC2F, 2, true},  {"CoordinateInterpolator", T_MFVEC3F, 3, true},
+    {"NormalInterpolator", T_MFVEC3F, 3, true},     {"CoordinateInterpolator2D", T_MFVEC2F, 2, true},
 };
 
 static const interp_kind *kind_of(const xmlNode *el)
@@ -1032,7 +1039,8 @@ static bool scan_collect(scan *sc, const xmlNode *el, unsigned depth)
             continue;
         }
         if (x3d_name_in(n, "ProtoDeclare|ExternProtoDeclare|Script")) continue;
-        if (x3d_name_in(n, "Coordinate|CoordinateDouble|CoordinateInterpolator|Normal|NormalInterpolator|TimeSensor")) {
+        if (x3d_name_in(n, "Coordinate|CoordinateDouble|CoordinateInterpolator|Normal|NormalInterpolator|TimeSensor|"
+                           "TextureCoordinate|TextureTransform|CoordinateInterpolator2D|PositionInterpolator2D")) {
             char *def = x3d_attr(c, "DEF");
             if (def && !xmlHashLookup(sc->defs, (const xmlChar *)def)) xmlHashAddEntry(sc->defs, (const xmlChar *)def, (void *)c);
             xmlFree(def);
@@ -1074,17 +1082,28 @@ sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
     }
     /* the interpolators a TimeSensor drives */
     for (size_t i = 0; i < sc.routes.count; ++i) {
-        const xmlNode *ro = sc.routes.items[i], *in = scan_def(&sc, ro, "toNode", "CoordinateInterpolator|NormalInterpolator");
+        const xmlNode *ro = sc.routes.items[i],
+                      *in = scan_def(&sc, ro, "toNode", "CoordinateInterpolator|NormalInterpolator|CoordinateInterpolator2D|"
+                                                         "PositionInterpolator2D");
         if (in && scan_def(&sc, ro, "fromNode", "TimeSensor") && route_fields(ro, "fraction_changed", "fraction"))
             driven[nd++] = in;
     }
     if (nd) qsort(driven, nd, sizeof *driven, cmp_ptr_el);
     for (size_t i = 0; i < sc.routes.count && !r; ++i) {
         const xmlNode *ro = sc.routes.items[i];
-        const xmlNode *in = scan_def(&sc, ro, "fromNode", "CoordinateInterpolator|NormalInterpolator");
+        const xmlNode *in = scan_def(&sc, ro, "fromNode", "CoordinateInterpolator|NormalInterpolator|CoordinateInterpolator2D|"
+                                                           "PositionInterpolator2D");
         bool normals = in && !strcmp(x3d_ename(in), "NormalInterpolator");
-        const xmlNode *co = scan_def(&sc, ro, "toNode", normals ? "Normal" : "Coordinate|CoordinateDouble");
-        if (!in || !co || !route_fields(ro, "value_changed", normals ? "vector" : "point") || !nd ||
+        bool tc2 = in && !strcmp(x3d_ename(in), "CoordinateInterpolator2D"), pos2 = in && !strcmp(x3d_ename(in), "PositionInterpolator2D");
+        const xmlNode *co = scan_def(&sc, ro, "toNode", normals ? "Normal" : tc2 ? "TextureCoordinate" : pos2 ? "TextureTransform"
+                                                                          : "Coordinate|CoordinateDouble");
+        uint8_t tex = tc2 ? X3D_TEX_POINT : X3D_TEX_NONE;
+        if (pos2)
+            tex = route_fields(ro, "value_changed", "translation") ? X3D_TEX_TRANSLATION
+                  : route_fields(ro, "value_changed", "scale")     ? X3D_TEX_SCALE
+                  : route_fields(ro, "value_changed", "center")    ? X3D_TEX_CENTER
+                                                                   : X3D_TEX_NONE;
+        if (!in || !co || (pos2 ? !tex : !route_fields(ro, "value_changed", normals ? "vector" : "point")) || !nd ||
             !bsearch(&in, driven, nd, sizeof *driven, cmp_ptr_el))
             continue;
         bool seen = false; /* one interpolator per Coordinate: the first route in the file */
@@ -1095,23 +1114,43 @@ sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
             continue;
         }
         float *key = NULL, *kv = NULL;
-        size_t nk = 0, nv = 0;
-        if (!x3d_get_float_array(L, F, in, "key", 1, &key, &nk) || !x3d_get_float_array(L, F, in, "keyValue", 3, &kv, &nv) ||
-            nk == 0 || nk > SY_MORPH_MAX_TARGETS || nv % nk != 0 || nv / nk == 0) {
+        size_t nk = 0, nv = 0, group = tex ? 2 : 3;
+        char *def = x3d_attr(in, "DEF");
+        if (!x3d_get_float_array(L, F, in, "key", 1, &key, &nk) || !x3d_get_float_array(L, F, in, "keyValue", group, &kv, &nv) ||
+            nk == 0 || nk > SY_MORPH_MAX_TARGETS || nv % nk != 0 || nv / nk == 0 || (pos2 && nv != nk)) {
             if (L->limit_r) r = L->limit_r, L->err = L->limit_err;
             else
-                x3d_warn(L, "%s:%d: %s: %zu keys and %zu key values (1 to %u keys, the same number of values for "
-                         "each); not played", F->path, x3d_line_of(in), x3d_ename(in), nk, nv, SY_MORPH_MAX_TARGETS);
-            free(key), free(kv);
+                x3d_warn(L, "%s:%d: %s '%s': %zu keys and %zu key values (1 to %u keys, %s); not played", F->path,
+                         x3d_line_of(in), x3d_ename(in), def ? def : "", nk, nv, SY_MORPH_MAX_TARGETS,
+                         pos2 ? "one value per key" : "the same number of values for each");
+            free(key), free(kv), xmlFree(def);
             continue;
         }
+        size_t bad = (size_t)-1; /* a key or key value that is not finite (NaN, inf): not played */
+        for (size_t k = 0; k < nk && bad == (size_t)-1; ++k)
+            if (!isfinite(key[k])) bad = k;
+        if (bad != (size_t)-1) {
+            x3d_warn(L, "%s:%d: %s '%s': key %zu is not finite; not played", F->path, x3d_line_of(in), x3d_ename(in),
+                     def ? def : "", bad);
+            free(key), free(kv), xmlFree(def);
+            continue;
+        }
+        for (size_t k = 0; k < nv * group && bad == (size_t)-1; ++k)
+            if (!isfinite(kv[k])) bad = k / group;
+        if (bad != (size_t)-1) {
+            x3d_warn(L, "%s:%d: %s '%s': key value %zu is not finite; not played", F->path, x3d_line_of(in), x3d_ename(in),
+                     def ? def : "", bad);
+            free(key), free(kv), xmlFree(def);
+            continue;
+        }
+        xmlFree(def);
         if (!sy_array_reserve(&L->morphs, L->morph_count, &L->morph_cap, sizeof *L->morphs, 4)) {
             free(kv), free(key);
             r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
             break;
         }
         L->morphs[L->morph_count++] = (morph_src){.coord = co, .interp = in, .serial = F->serial, .values = kv, .key = key,
-                                                  .keys = nk, .points = nv / nk, .normals = normals};
+                                                  .keys = nk, .points = nv / nk, .normals = normals, .tex = tex};
     }
 done:
     free(driven);

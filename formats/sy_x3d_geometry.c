@@ -12,21 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* X3D TextureTransform -> 2x3 affine matrix: Tc' = -C x S x R x C x T x Tc. */
 static void texture_transform(loader *L, xfile *F, const xmlNode *tt, float m[6])
 {
-    m[0] = 1; m[1] = 0; m[2] = 0; m[3] = 0; m[4] = 1; m[5] = 0;
-    if (!tt) return;
-    float c[2] = {0, 0}, s[2] = {1, 1}, t[2] = {0, 0};
-    x3d_get_floats(L, F, tt, "center", c, 2);
-    x3d_get_floats(L, F, tt, "scale", s, 2);
-    x3d_get_floats(L, F, tt, "translation", t, 2);
-    float rot = x3d_get_float(L, F, tt, "rotation", 0.0f), cr = cosf(rot), sr = sinf(rot);
-    /* p -> p + T + C -> R -> S -> -C */
-    float a = s[0] * cr, b = -s[0] * sr, d = s[1] * sr, e = s[1] * cr;
-    float ox = t[0] + c[0], oy = t[1] + c[1];
-    m[0] = a; m[1] = b; m[2] = a * ox + b * oy - c[0];
-    m[3] = d; m[4] = e; m[5] = d * ox + e * oy - c[1];
+    x3d_texture_transform(L, F, tt, X3D_TEX_NONE, NULL, m);
 }
 
 /* Output of a stroke geometry node: vertices (positions, optional RGBA colours) and, for lines,
@@ -322,6 +310,7 @@ sy_result x3d_build_geometry(loader *L, xfile *F, const xmlNode *el, const xmlNo
         corners c = {0};
         bool built = false;
         texture_transform(L, F, ttel, g.tt);
+        g.tt_el = ttel;
         if (!x3d_read_sources(L, F, el, &g)) {
             x3d_geom_src_free(&g);
             if (L->limit_r) L->err = L->limit_err;
@@ -331,6 +320,7 @@ sy_result x3d_build_geometry(loader *L, xfile *F, const xmlNode *el, const xmlNo
             x3d_geom_src_free(&g); /* an Extrusion has no Coordinate etc.: its fields build the sources */
             memset(&g, 0, sizeof g);
             texture_transform(L, F, ttel, g.tt);
+            g.tt_el = ttel;
             g.ccw = x3d_get_bool(el, "ccw", true);
             g.crease = x3d_get_float(L, F, el, "creaseAngle", 0.0f);
             r = x3d_build_extrusion(L, F, el, &g, &c, &built);

@@ -76,14 +76,24 @@ typedef struct mat_link {
  * walk, sy_x3d_anim.c): x3d_emit gives the primitives built on it one morph target per key (the
  * key's points, and normals generated again when the geometry generates them); the mesh is noted
  * for the weights channels (one-hot per key: linear weights blend consecutive keys exactly). */
+/* What a morph source animates besides points and normals (morph_src.tex): texture coordinates,
+ * through a CoordinateInterpolator2D into a TextureCoordinate's points or a PositionInterpolator2D
+ * into a TextureTransform's translation, scale or center (the texture coordinates of every key are
+ * the targets: X3D's transform is affine in each of those fields, so blending consecutive keys'
+ * coordinates linearly is exactly the interpolated field's). */
+enum { X3D_TEX_NONE = 0, X3D_TEX_POINT, X3D_TEX_TRANSLATION, X3D_TEX_SCALE, X3D_TEX_CENTER };
+
 typedef struct morph_src {
-    const xmlNode *coord, *interp; /* coord: a Coordinate, or a Normal (normals: a NormalInterpolator) */
+    const xmlNode *coord, *interp; /* coord: a Coordinate, or a Normal (normals: a NormalInterpolator), a
+                                    * TextureCoordinate or TextureTransform (tex) */
     uint32_t serial;
     float *values;     /* keys x points x 3 (malloc()ed) */
     float *key;        /* the interpolator's keys (malloc()ed) */
     size_t keys, points;
     bool normals;      /* a NormalInterpolator into a Normal */
     bool merged;       /* normals played by the CoordinateInterpolator of the same geometry (same keys) */
+    uint8_t tex;       /* X3D_TEX_*: texture coordinates (values: keys x points x 2; a TextureTransform's
+                        * field: points 1) */
     uint32_t *meshes;  /* the meshes built on it (malloc()ed) */
     size_t mesh_count, mesh_cap;
 } morph_src;
@@ -212,7 +222,14 @@ typedef struct geom_src {
     float tt[6]; /* texture transform (2x3 affine, X3D t-up space) */
     const xmlNode *coord_el; /* the Coordinate node the points come from (NULL: generated) */
     const xmlNode *normal_el; /* the Normal node of the normals (NULL: none) */
+    const xmlNode *tc_el;     /* the TextureCoordinate of tc (NULL: none) */
+    const xmlNode *tt_el;     /* the TextureTransform of tt (NULL: none) */
 } geom_src;
+
+/* X3D TextureTransform tt -> 2x3 affine matrix m (Tc' = -C x S x R x C x T x Tc), with field
+ * `which` (X3D_TEX_TRANSLATION, _SCALE, _CENTER; X3D_TEX_NONE: none) taking value[0..1] instead
+ * of the file's (an animated key). tt NULL: the identity. */
+void x3d_texture_transform(loader *L, xfile *F, const xmlNode *tt, int which, const float *value, float m[6]);
 
 
 void x3d_corners_free(corners *c);

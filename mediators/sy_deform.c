@@ -118,6 +118,23 @@ static void *deform_thread(void *arg)
     return NULL;
 }
 
+void sy_deform_texcoords(const sy_deform_input *in, float *uv)
+{
+    const sy_primitive *p = in->primitive;
+    uint32_t nv = sy_primitive_vertex_count(p), nt = sy_primitive_target_count(p);
+    if (!p->texcoords0) return;
+    memcpy(uv, sy_blob_data(p->texcoords0), sizeof(float) * 2 * (size_t)nv);
+    if (!p->target_texcoords0 || !in->weights) return;
+    const float *d = sy_blob_data(p->target_texcoords0);
+    uint32_t use = in->weight_count < nt ? in->weight_count : nt;
+    size_t per = 2 * (size_t)nv;
+    for (uint32_t t = 0; t < use; ++t) {
+        float w = in->weights[t];
+        if (w == 0.0f || !isfinite(w)) continue;
+        for (size_t k = 0; k < per; ++k) uv[k] += w * d[t * per + k];
+    }
+}
+
 bool sy_deform_primitive(const sy_deform_input *in, float *pos, float *nrm, float *tan, sy_bounds *bounds_out)
 {
     uint32_t nv = sy_primitive_vertex_count(in->primitive);

@@ -5,7 +5,8 @@
  *
  * What it computes (glTF 2.0, "Morph Targets" and "Skins"), for each vertex v:
  *   morph:  p = p0 + sum_t w_t dP_t[v]; n = n0 + sum_t w_t dN_t[v]; t.xyz = t0.xyz + sum_t w_t dT_t[v]
- *           (w_t: the weights given; targets beyond them weigh 0);
+ *           (w_t: the weights given; targets beyond them weigh 0); texture coordinates (set 0)
+ *           uv = uv0 + sum_t w_t dUV_t[v] (sy_deform_texcoords);
  *   skin:   M = sum_k s_k J[j_k], J[j] = joint j's world matrix x its inverse bind matrix, the s_k
  *           the vertex's skin weights (influences whose joint index is past the joints given are left
  *           out); p' = M p, n' = normalize(M3x3 n), t'.xyz = normalize(M3x3 t.xyz), t'.w = t.w.
@@ -44,6 +45,13 @@ typedef struct sy_deform_input {
  * when a deformed position is not finite or beyond SY_COORD_MAX (the outputs are then partial); the
  * caller keeps what it had. bounds_out (may be NULL) receives the deformed positions' bounds. */
 bool sy_deform_primitive(const sy_deform_input *in, float *positions, float *normals, float *tangents, sy_bounds *bounds_out);
+
+/** Morphs in->primitive's texture coordinates (set 0) into uv (float[2] x vertices): uv0 + sum_t
+ * w_t dUV_t (target_texcoords0; the weights as sy_deform_primitive's). The primitive must have
+ * texcoords0; without target_texcoords0 or weights uv is a copy of them. O(vertices x targets), on
+ * the caller's thread; no allocation. Texture coordinates are not skinned (they do not move with a
+ * joint). */
+void sy_deform_texcoords(const sy_deform_input *in, float *uv);
 
 /** Whether a primitive has anything to deform (morph targets, or joints and weights). */
 bool sy_deform_has_data(const sy_primitive *p);

@@ -250,9 +250,10 @@ static bool mesh_keep_src(mesh_m *m, const sy_primitive_list *pl)
     for (uint32_t i = 0; i < pl->count; ++i) {
         sy_primitive *q = &m->src[i];
         *q = pl->items[i];
-        sy_blob *bl[12] = {q->positions, q->normals, q->tangents, q->texcoords0, q->texcoords1, q->colors,
-                           q->indices,   q->joints,  q->weights,  q->target_positions, q->target_normals, q->target_tangents};
-        for (int k = 0; k < 12; ++k) sy_blob_retain(bl[k]);
+        sy_blob *bl[13] = {q->positions, q->normals, q->tangents, q->texcoords0, q->texcoords1, q->colors,
+                           q->indices,   q->joints,  q->weights,  q->target_positions, q->target_normals, q->target_tangents,
+                           q->target_texcoords0};
+        for (int k = 0; k < 13; ++k) sy_blob_retain(bl[k]);
     }
     return true;
 }
@@ -618,8 +619,11 @@ static sy_result deform_node(sy_mirror *st, node_m *n, sy_error *err)
     bool skinned = nj > 0;
     uint32_t count = m->src_count < m->prim_count ? m->src_count : m->prim_count;
     bool in_place = st->cb->primitive_update && n->dprims && n->dprim_count == count && skinned == n->skinned;
-    for (uint32_t i = 0; i < count && in_place; ++i) /* triangles only, each made (a pose out of range made none) */
-        in_place = m->src[i].topology == SY_TOPOLOGY_TRIANGLES && (n->dprims[i] || !m->prims[i].handle);
+    /* triangles only, each made (a pose out of range made none); moving texture coordinates are set
+     * anew (primitive_update rewrites positions and normals only) */
+    for (uint32_t i = 0; i < count && in_place; ++i)
+        in_place = m->src[i].topology == SY_TOPOLOGY_TRIANGLES && (n->dprims[i] || !m->prims[i].handle) &&
+                   !m->src[i].target_texcoords0;
     if (!in_place) {
         dprims_free(st, n);
         n->dprims = calloc(count ? count : 1, sizeof *n->dprims);
@@ -647,11 +651,23 @@ static sy_result deform_node(sy_mirror *st, node_m *n, sy_error *err)
         sy_bounds b = pose.bounds;
         sy_bounds_add_bounds(&n->dbounds, &b);
         sy_blob *bp = pose.positions, *bn = pose.normals, *bt = pose.tangents; /* the pose's references */
-        sy_primitive q = *src; /* borrowed blobs, the deformed three replaced */
+        sy_blob *buv = NULL; /* texture coordinates (set 0) morphed: uv + sum_t w_t duv_t (this mirror's own) */
+        if (src->target_texcoords0 && src->texcoords0) {
+            size_t nv = sy_blob_size(src->texcoords0) / (2 * sizeof(float));
+            float *uv = malloc(sizeof(float) * 2 * nv + 1);
+            if (!uv || (r = sy_blob_create_take(uv, sizeof(float) * 2 * nv, &buv, err))) {
+                if (!buv) free(uv);
+                sy_blob_release(bp), sy_blob_release(bn), sy_blob_release(bt);
+                return uv ? r : oom(st, err);
+            }
+            sy_deform_texcoords(&in, (float *)sy_blob_data(buv));
+        }
+        sy_primitive q = *src; /* borrowed blobs, the deformed ones replaced */
         q.positions = bp;
         if (bn) q.normals = bn;
         if (bt) q.tangents = bt;
-        q.joints = q.weights = q.target_positions = q.target_normals = q.target_tangents = NULL;
+        if (buv) q.texcoords0 = buv;
+        q.joints = q.weights = q.target_positions = q.target_normals = q.target_tangents = q.target_texcoords0 = NULL;
         sy_mirror_flat_mesh flat;
         double t_update = sy_time_now();
         if (q.topology != SY_TOPOLOGY_TRIANGLES) {
@@ -671,7 +687,7 @@ static sy_result deform_node(sy_mirror *st, node_m *n, sy_error *err)
             r = in_place ? st->cb->primitive_update(st->user, &a, err) : st->cb->primitive_set(st->user, &a, err);
         }
         st->stats->update_seconds += sy_time_now() - t_update;
-        sy_blob_release(bp), sy_blob_release(bn), sy_blob_release(bt); /* back-ends copy what they keep */
+        sy_blob_release(bp), sy_blob_release(bn), sy_blob_release(bt), sy_blob_release(buv); /* back-ends copy what they keep */
         if (r == SY_OK) st->stats->deformed++;
     }
     if (r == SY_OK && !in_place)

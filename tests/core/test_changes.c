@@ -125,16 +125,21 @@ static int build_rich(sy_scene *s, rich *r)
     const float wgt[16] = {1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0, 1, 0, 0, 0};
     float dpos[24];
     for (int k = 0; k < 24; ++k) dpos[k] = 0.125f * (float)(k % 5);
+    /* and texture coordinate targets (version 7) */
+    float duv[16];
+    for (int k = 0; k < 16; ++k) duv[k] = 0.0625f * (float)(k % 3);
     sy_blob *bj = sy_test_blob(jnt, sizeof jnt), *bw = sy_test_blob(wgt, sizeof wgt), *bdp = sy_test_blob(dpos, sizeof dpos);
+    sy_blob *bduv = sy_test_blob(duv, sizeof duv);
     sy_primitive prims[3] = {
-        {r->pos, bn, bt, buv, buv, bc, bi, r->mat, SY_TOPOLOGY_TRIANGLES, 0.0f, bj, bw, bdp, bdp, NULL},
-        {r->pos, NULL, NULL, NULL, NULL, NULL, bi, {0}, SY_TOPOLOGY_TRIANGLES, 0.0f, NULL, NULL, NULL, NULL, NULL}, /* shares positions and indices */
-        {tri, NULL, NULL, NULL, NULL, NULL, NULL, r->mat, SY_TOPOLOGY_TRIANGLES, 0.0f, NULL, NULL, NULL, NULL, NULL},
+        {r->pos, bn, bt, buv, buv, bc, bi, r->mat, SY_TOPOLOGY_TRIANGLES, 0.0f, bj, bw, bdp, bdp, NULL, bduv},
+        {r->pos, NULL, NULL, NULL, NULL, NULL, bi, {0}, SY_TOPOLOGY_TRIANGLES, 0.0f, NULL, NULL, NULL, NULL, NULL, NULL}, /* shares positions and indices */
+        {tri, NULL, NULL, NULL, NULL, NULL, NULL, r->mat, SY_TOPOLOGY_TRIANGLES, 0.0f, NULL, NULL, NULL, NULL, NULL, NULL},
     };
     CHECK_OK(sy_mesh_set_primitives(s, r->mesh, prims, 3, &e), e);
     sy_blob_release(bj);
     sy_blob_release(bw);
     sy_blob_release(bdp);
+    sy_blob_release(bduv);
     sy_blob_release(bn);
     sy_blob_release(bt);
     sy_blob_release(buv);
@@ -748,8 +753,9 @@ LISTS_TEST(test_blob_once)
     CHECK(lists_equal(f->snap, d) == 0);
     sy_changes_release(d);
     size_t stored = sy_blob_store_count(recv), bytes = sy_blob_store_bytes(recv);
-    CHECK_MSG(stored == 17, "%zu", stored); /* pixels, pos, normals, tangents, uv, colours, indices, tri, 2 child lists, attach blob,
-                                               joints, skin weights, target deltas (twice), mesh and node morph weights, node skin */
+    CHECK_MSG(stored == 18, "%zu", stored); /* pixels, pos, normals, tangents, uv, colours, indices, tri, 2 child lists, attach blob,
+                                               joints, skin weights, target deltas (twice), texture coordinate target deltas,
+                                               mesh and node morph weights, node skin */
     /* the same list again: every payload is already there, none travels */
     CHECK_OK(sy_changes_serialize(f->snap, send_if_missing, recv, &lean, &lean_size, &e), e);
     CHECK_MSG(lean_size + bytes == full_size, "lean %zu + payloads %zu != full %zu", lean_size, bytes, full_size);

@@ -9,10 +9,14 @@
  * PhysicalMaterial, light and Viewpoint fields, positions and orientations into a Viewpoint and
  * a light's direction, at two times against X3D's interpolation computed here (HSV colours,
  * 1 - transparency, intensities scaled as the loader scales the lights); routes whose types differ,
- * that close a loop or come from undefined nodes, and the interpolators whose targets are baked
- * (Normal, PositionInterpolator2D) are warned about, naming the ROUTE's line; test_coordinates:
+ * that close a loop or come from undefined nodes, and the interpolators whose targets are not
+ * animated are warned about, naming the ROUTE's line; test_coordinates:
  * a CoordinateInterpolator becomes morph targets and weights on every node showing the mesh; the
- * shared sample HelloX3dTrademark.x3d (a spinning Earth) turns a quarter every 3 s.
+ * shared sample HelloX3dTrademark.x3d (a spinning Earth) turns a quarter every 3 s; test_textures:
+ * PositionInterpolator2D into TextureTransform translation and scale (about a center) and
+ * CoordinateInterpolator2D into TextureCoordinate.point become texture coordinate morph targets
+ * whose blend at three times is X3D's transformed coordinate; mismatched counts and values that
+ * are not finite are refused, naming the interpolator's DEF.
  * Usage: test_x3d_anim [TESTDATA_DIR]. */
 #include "sy_anim.h"
 #include "x3d_loaded.h"
@@ -385,6 +389,109 @@ static void test_coordinates(void)
     unload(&l);
 }
 
+/* the texture coordinates of the first primitive of node n at the scene's time: uv + sum w_t duv_t
+ * (what the mirror hands every back-end, sy_deform_texcoords), corner v into uv[2] */
+static bool morphed_uv(const loaded *l, sy_node n, size_t v, float uv[2])
+{
+    const sy_node_data *nd = sy_node_get(l->scene, n);
+    const sy_mesh_data *md = nd && nd->mesh.id ? sy_mesh_get(l->scene, nd->mesh) : NULL;
+    const sy_primitive *pr = md && md->primitives.count ? md->primitives.items : NULL;
+    if (!pr || !pr->texcoords0 || !pr->target_texcoords0) return false;
+    size_t nv = sy_blob_size(pr->texcoords0) / 8, nt = sy_blob_size(pr->target_texcoords0) / 8 / nv;
+    const float *b = sy_blob_data(pr->texcoords0), *d = sy_blob_data(pr->target_texcoords0);
+    const float *w = nd->weights ? sy_blob_data(nd->weights) : NULL;
+    size_t nw = nd->weights ? sy_blob_size(nd->weights) / 4 : 0;
+    uv[0] = b[2 * v], uv[1] = b[2 * v + 1];
+    for (size_t t = 0; t < nt && t < nw; ++t) uv[0] += w[t] * d[t * nv * 2 + 2 * v], uv[1] += w[t] * d[t * nv * 2 + 2 * v + 1];
+    return true;
+}
+
+/* PositionInterpolator2D -> TextureTransform.translation / .scale and CoordinateInterpolator2D ->
+ * TextureCoordinate.point: texture coordinate morph targets (one per key) and weights, so that the
+ * coordinates at a time are X3D's (u, 1 - t of the transformed point); bad interpolators are refused
+ * with a warning naming the node */
+static void test_textures(void)
+{
+    loaded l = load_text("tex.x3d",
+        "<X3D><Scene>\n"
+        "<Transform DEF='Slid'><Shape><Appearance><TextureTransform DEF='TT'/></Appearance>"                    /* 2 */
+        "<IndexedFaceSet coordIndex='0 1 2 3 -1' texCoordIndex='0 1 2 3 -1'><Coordinate point='0 0 0 1 0 0 1 1 0 0 1 0'/>"
+        "<TextureCoordinate point='0 0 1 0 1 1 0 1'/></IndexedFaceSet></Shape></Transform>\n"
+        "<Transform DEF='Grown'><Shape><Appearance><TextureTransform DEF='TS' center='0.5 0.5'/></Appearance>"   /* 3 */
+        "<IndexedFaceSet coordIndex='0 1 2 -1'><Coordinate point='0 0 0 1 0 0 1 1 0'/>"
+        "<TextureCoordinate point='0 0 1 0 1 1'/></IndexedFaceSet></Shape></Transform>\n"
+        "<Transform DEF='Waved'><Shape><IndexedFaceSet coordIndex='0 1 2 -1'><Coordinate point='0 0 0 1 0 0 1 1 0'/>" /* 4 */
+        "<TextureCoordinate DEF='TC' point='0 0 1 0 1 1'/></IndexedFaceSet></Shape></Transform>\n"
+        "<TimeSensor DEF='Clock' cycleInterval='2'/>\n"                                                        /* 5 */
+        "<PositionInterpolator2D DEF='Slide' key='0 1' keyValue='0 0 0.5 0.25'/>\n"                           /* 6 */
+        "<PositionInterpolator2D DEF='Grow' key='0 1' keyValue='1 1 3 2'/>\n"                                 /* 7 */
+        "<CoordinateInterpolator2D DEF='Wave' key='0 0.5 1' keyValue='0 0 1 0 1 1  0 0 2 0 2 2  0 0 1 0 1 1'/>\n" /* 8 */
+        "<PositionInterpolator2D DEF='Odd' key='0 1' keyValue='0 0'/>\n"                                      /* 9 */
+        "<PositionInterpolator2D DEF='Huge' key='0 1' keyValue='0 0 1e39 0'/>"                                /* 10 */
+        "<PositionInterpolator2D DEF='NaN' key='0 1' keyValue='0 0 nan 0'/>\n"
+        "<Transform><Shape><Appearance><TextureTransform DEF='TO'/></Appearance><IndexedFaceSet coordIndex='0 1 2 -1'>" /* 11 */
+        "<Coordinate point='0 0 0 1 0 0 1 1 0'/><TextureCoordinate point='0 0 1 0 1 1'/></IndexedFaceSet></Shape></Transform>\n"
+        "<Transform><Shape><Appearance><TextureTransform DEF='TH'/></Appearance><IndexedFaceSet coordIndex='0 1 2 -1'>" /* 12 */
+        "<Coordinate point='0 0 0 1 0 0 1 1 0'/><TextureCoordinate point='0 0 1 0 1 1'/></IndexedFaceSet></Shape></Transform>\n"
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Slide' toField='set_fraction'/>\n"       /* 13 */
+        "<ROUTE fromNode='Slide' fromField='value_changed' toNode='TT' toField='set_translation'/>\n"          /* 14 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Grow' toField='set_fraction'/>\n"        /* 15 */
+        "<ROUTE fromNode='Grow' fromField='value_changed' toNode='TS' toField='scale'/>\n"                     /* 16 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Wave' toField='set_fraction'/>\n"        /* 17 */
+        "<ROUTE fromNode='Wave' fromField='value_changed' toNode='TC' toField='set_point'/>\n"                 /* 18 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Odd' toField='set_fraction'/>\n"         /* 19 */
+        "<ROUTE fromNode='Odd' fromField='value_changed' toNode='TO' toField='translation'/>\n"                /* 20 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Huge' toField='set_fraction'/>\n"        /* 21 */
+        "<ROUTE fromNode='Huge' fromField='value_changed' toNode='TH' toField='translation'/>\n"               /* 22 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='NaN' toField='set_fraction'/>\n"         /* 23 */
+        "<ROUTE fromNode='NaN' fromField='value_changed' toNode='TH' toField='translation'/>\n"                /* 24 */
+        "</Scene></X3D>\n");
+    if (!expect_loaded(&l, "tex.x3d")) return unload(&l);
+    EXPECT_MSG(has_warning(&l, "tex.x3d:9: PositionInterpolator2D 'Odd': 2 keys and 1 key values", NULL), "Odd's counts");
+    /* a value beyond a float (or NaN) is no number to the field parser: the values are refused, then the interpolator */
+    EXPECT_MSG(has_warning(&l, "tex.x3d:10: PositionInterpolator2D.keyValue: not a list of numbers", NULL) &&
+                   has_warning(&l, "tex.x3d:10: PositionInterpolator2D 'Huge': 2 keys and 0 key values", "not played"),
+               "Huge's value");
+    EXPECT_MSG(has_warning(&l, "tex.x3d:10: PositionInterpolator2D 'NaN'", "not played"), "NaN's value");
+    sy_node slid = node_named(&l, "Slid"), grown = node_named(&l, "Grown"), waved = node_named(&l, "Waved");
+    /* Slid's shape is a child node of the Transform: the node showing the mesh */
+    sy_node shows[3] = {{0}, {0}, {0}};
+    const sy_node parents[3] = {slid, grown, waved};
+    for (int k = 0; k < 3; ++k) { /* the Transform's node, or one of its children */
+        const sy_node_data *pd = parents[k].id ? sy_node_get(l.scene, parents[k]) : NULL;
+        if (!pd) continue;
+        if (pd->mesh.id) shows[k] = parents[k];
+        uint32_t nc = 0;
+        const uint32_t *ch = sy_node_children(pd, &nc);
+        for (uint32_t c = 0; c < nc && !shows[k].id; ++c)
+            if (sy_node_get(l.scene, (sy_node){ch[c]})->mesh.id) shows[k] = (sy_node){ch[c]};
+    }
+    EXPECT_MSG(shows[0].id && shows[1].id && shows[2].id, "the three textured shapes");
+    const double times[3] = {0.0, 1.0, 2.0};
+    for (int ti = 0; ti < 3 && shows[0].id && shows[1].id && shows[2].id; ++ti) {
+        set_time(&l, times[ti]);
+        float f = (float)times[ti] / 2.0f, uv[2];
+        /* Slide: T = (0.5 f, 0.25 f); corner 1 is (1, 0): (1 + 0.5 f, 1 - (0 + 0.25 f)) */
+        bool ok = morphed_uv(&l, shows[0], 1, uv);
+        EXPECT_MSG(ok && fabsf(uv[0] - (1.0f + 0.5f * f)) < 1e-5f && fabsf(uv[1] - (1.0f - 0.25f * f)) < 1e-5f,
+                   "t %g: Slid corner 1 uv (%g %g), want (%g %g)", times[ti], (double)uv[0], (double)uv[1],
+                   (double)(1.0f + 0.5f * f), (double)(1.0f - 0.25f * f));
+        /* Grow: S = (1 + 2 f, 1 + f) about C = (0.5, 0.5); corner 1 (1, 0): s' = S (p - C)... X3D: -C S (p + C)
+         * with T = 0: s' = S_x (1 + 0.5) - 0.5, t' = S_y (0 + 0.5) - 0.5 */
+        float sx = 1.0f + 2.0f * f, sy = 1.0f + f;
+        ok = morphed_uv(&l, shows[1], 1, uv);
+        EXPECT_MSG(ok && fabsf(uv[0] - (sx * 1.5f - 0.5f)) < 1e-5f && fabsf(uv[1] - (1.0f - (sy * 0.5f - 0.5f))) < 1e-5f,
+                   "t %g: Grown corner 1 uv (%g %g), want (%g %g)", times[ti], (double)uv[0], (double)uv[1],
+                   (double)(sx * 1.5f - 0.5f), (double)(1.0f - (sy * 0.5f - 0.5f)));
+        /* Wave: point 2 goes (1 1) -> (2 2) -> (1 1) at fractions 0, 0.5, 1 */
+        float p = ti == 1 ? 2.0f : 1.0f;
+        ok = morphed_uv(&l, shows[2], 2, uv);
+        EXPECT_MSG(ok && fabsf(uv[0] - p) < 1e-5f && fabsf(uv[1] - (1.0f - p)) < 1e-5f, "t %g: Waved corner 2 uv (%g %g), want (%g %g)",
+                   times[ti], (double)uv[0], (double)uv[1], (double)p, (double)(1.0f - p));
+    }
+    unload(&l);
+}
+
 /* the shared sample: OrbitalTimeInterval (12 s, loop) turns EarthCoordinateSystem 2 pi about +y in
  * four quarter keys */
 static void test_sample(const char *data)
@@ -406,4 +513,4 @@ static void test_sample(const char *data)
     unload(&l);
 }
 
-X3D_MAIN("x3d_anim", test_sample, test_routes, test_fields, test_coordinates)
+X3D_MAIN("x3d_anim", test_sample, test_routes, test_fields, test_coordinates, test_textures)
