@@ -84,6 +84,12 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     if (!w->d.max_pending) w->d.max_pending = 128;
     w->initial_backend = w->backend = bi;
     pthread_mutex_init(&w->mu, NULL);
+    /* the timeline: the range of every clip together, paused at its start (a page plays it) */
+    double t0 = 0, t1 = 0;
+    w->animated = sy_scene_time_range(desc->scene, (sy_animation){0}, &t0, &t1, NULL) == SY_OK && t1 > t0;
+    w->clock = sy_clock_make(t0, t1);
+    w->clock.playing = false;
+    w->clock_version = w->animated ? 1 : 0;
     pthread_cond_init(&w->cv, NULL);
     w->pending_tail = &w->pending;
     w->stills_tail = &w->stills;

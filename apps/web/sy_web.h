@@ -10,8 +10,10 @@
  * for (capped at max_width x max_height), each page scales the frame to its canvas.
  *
  * Pages may also pick (sy_viewport_pick), show, hide, select and isolate nodes, set section planes
- * and the exposure, and read the scene's hierarchy (docs/WEB.md, "The WebSocket protocol"); a
- * read_only server refuses every change but the camera's.
+ * and the exposure, read the scene's hierarchy (docs/WEB.md, "The WebSocket protocol"), and play,
+ * pause and scrub the scene clock when the scene has animations (the server then sets the scene's
+ * time with sy_scene_set_time and commits, on the render thread; "The timeline"); a read_only
+ * server refuses every change but the camera's and the clock's (view changes).
  *
  * Threads: sy_web_create starts the network thread (the libwebsockets service loop); the thread
  * that calls sy_web_run renders, and is the only one that touches the scene while it runs. The two
@@ -107,7 +109,7 @@ typedef struct sy_web_desc {
     uint32_t delay_ms;          /**< TESTS ONLY (sy web --delay-ms): every input message is applied and
                                      every frame sent this much later (0..10000; 0 = none), an added
                                      network delay in both directions for measuring the page */
-    bool read_only;           /**< viewers look (camera, pick, tree, stills) but cannot change visibility,
+    bool read_only;           /**< viewers look (camera, scene clock, pick, tree, stills) but cannot change visibility,
                                    selection, section planes, exposure, display filter or back-end: those
                                    messages are refused with a log line (sy web --read-only) */
     const sy_web_route *routes; /**< extra routes (the array is copied; its strings and user pointers must outlive the server) */
@@ -119,8 +121,9 @@ typedef struct sy_web sy_web;
 
 /** Binds the address (apps/web/sy_web_gate.h takes the connections until their request is whole)
  * and starts the network thread. The server adds nothing to the scene; it changes only node flags
- * a page asks for (visibility, selection, isolation; not with read_only) and then commits the scene,
- * on the render thread between frames (the application commits its own changes).
+ * a page asks for (visibility, selection, isolation; not with read_only) and, once a page moves the
+ * scene clock, the animated fields (sy_scene_set_time), and then commits the scene, on the render
+ * thread between frames (the application commits its own changes).
  * Fails with a message naming the address when it cannot be bound, the back-end when it is not
  * registered, the option when a limit is out of range. */
 sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err);

@@ -528,6 +528,15 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
         out->type = SY_WEB_INPUT_EXPOSURE;
         if (!json_num(m, "stops", -SY_WEB_EXPOSURE_MAX, SY_WEB_EXPOSURE_MAX, &out->a))
             r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "exposure: stops must be a number within +-%g", SY_WEB_EXPOSURE_MAX);
+    } else if (!strcmp(type, "time")) {
+        out->type = SY_WEB_INPUT_TIME;
+        if (!json_num(m, "s", -SY_WEB_TIME_MAX, SY_WEB_TIME_MAX, &out->a))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "time: s must be a finite number of seconds within +-%g",
+                             SY_WEB_TIME_MAX);
+    } else if (!strcmp(type, "play")) {
+        out->type = SY_WEB_INPUT_PLAY;
+        if (!cJSON_GetObjectItemCaseSensitive(m, "on") || !json_bool(m, "on", &out->on))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "play: on must be true or false");
     } else if (!strcmp(type, "filter")) {
         out->type = SY_WEB_INPUT_FILTER;
         const cJSON *f = cJSON_GetObjectItemCaseSensitive(m, "name");

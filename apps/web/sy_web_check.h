@@ -137,11 +137,15 @@ typedef enum sy_web_input_type {
     SY_WEB_INPUT_TREE,     /**< asks for the scene's hierarchy (answered with a "tree" message) */
     SY_WEB_INPUT_EXPOSURE, /**< exposure in stops (a) */
     SY_WEB_INPUT_FILTER,   /**< the display filter by name (filter) */
-    SY_WEB_INPUT_KEYFRAME  /**< {"t":"keyframe"}: the page's video decoder lost its place */
+    SY_WEB_INPUT_KEYFRAME, /**< {"t":"keyframe"}: the page's video decoder lost its place */
+    SY_WEB_INPUT_TIME,     /**< {"t":"time","s":SECONDS}: the scene clock to that time (a; the range is the server's check) */
+    SY_WEB_INPUT_PLAY      /**< {"t":"play","on":BOOL}: the scene clock plays (on) or pauses */
 } sy_web_input_type;
 
 /** Node ids a page may name: 1..SY_WEB_NODE_ID_MAX (sy_node.id); unknown ones are refused later. */
 #define SY_WEB_NODE_ID_MAX 0xFFFFFFFFu
+/** The scene times a page may name, seconds (+-; the clip's range is checked by the server). */
+#define SY_WEB_TIME_MAX 1e9
 /** Exposure a page may set, in stops (+-). */
 #define SY_WEB_EXPOSURE_MAX 16.0
 /** The most codec names a size message may list ("codecs"); further ones are ignored. */
@@ -149,13 +153,14 @@ typedef enum sy_web_input_type {
 
 typedef struct sy_web_input {
     sy_web_input_type type;
-    double a, b;     /**< size: w, h; drag: dx, dy; wheel: steps; pick: x, y in [0, 1) of the canvas; exposure: stops */
+    double a, b;     /**< size: w, h; drag: dx, dy; wheel: steps; pick: x, y in [0, 1) of the canvas; exposure: stops;
+                      * time: seconds (finite, within +-SY_WEB_TIME_MAX) */
     uint32_t button; /**< drag: 0 orbit, 1 or 2 pan */
     char key;        /**< key: '1'..'9', 'f', '[', ']', 'r' (lower case) */
     uint32_t version; /**< size: the frame format the page reads ("v", 0..1000; 0 = absent: a page
                        * older than frame format 2, refused with a status message) */
     uint32_t node;   /**< visible, select, isolate: the node id (0 only for select / isolate: all) */
-    bool on;         /**< visible: show; select: select; pick: select what is hit */
+    bool on;         /**< visible: show; select: select; pick: select what is hit; play: play (else pause) */
     uint32_t seq;    /**< pick, tree: the page's request number, echoed in the answer (0..2^31) */
     uint32_t plane_count;             /**< clip: planes in use (0..SY_CLIP_PLANES_MAX) */
     float planes[SY_CLIP_PLANES_MAX][4]; /**< clip: {a, b, c, d}, checked by sy_clip_planes_check */
@@ -173,7 +178,8 @@ typedef struct sy_web_input {
 
 /** True for the messages that change what other viewers see beyond the camera (visibility,
  * selection, section planes, exposure, display filter; keys: back-ends and filter keys): refused
- * by a read-only server (sy_web_desc.read_only). A pick with select is allowed as a plain pick. */
+ * by a read-only server (sy_web_desc.read_only). A pick with select is allowed as a plain pick; the
+ * scene clock (time, play) is a view change like the camera's: every page may move it. */
 bool sy_web_input_changes_scene(const sy_web_input *in);
 
 /** Parses one text message (len bytes, not NUL-terminated); SY_ERR_PARSE / SY_ERR_INVALID_ARGUMENT

@@ -18,6 +18,7 @@
 
 #include "sy_web.h"
 
+#include "sy_anim.h"
 #include "sy_interactive.h"
 #include "sy_viewport.h"
 #include "sy_web_check.h"
@@ -143,6 +144,12 @@ struct sy_web {
     web_action *actions, **actions_tail; /* picks, visibility, selection, planes, tree requests */
     uint32_t action_count;
     float exposure;                   /* stops (the display chain) */
+    /* the scene clock the pages steer (docs/WEB.md, "The timeline"): animated when the scene has
+     * clips; the render thread advances a playing clock and applies its time (sy_scene_set_time) */
+    bool animated;
+    sy_clock clock;
+    uint64_t clock_version;           /* played, paused, moved, stopped at an end, or a playing clock's
+                                       * periodic update: sent to every page as a "clock" message */
     uint64_t conn_serial;             /* the last web_conn.serial given (network thread) */
     sy_web_stats st;                  /* the still counters */
     /* --- under mu: render thread -> network thread --- */

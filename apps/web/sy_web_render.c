@@ -12,6 +12,7 @@
 #include "sy_viewport.h"
 #include "sy_web_frame.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,7 +29,46 @@ typedef struct render_state {
     sy_interactive *ia; /* the governor, the view on the viewports, the display filter (sy_interactive.h) */
     float exposure;     /* stops, as the pages set it */
     bool changed;       /* what frames show changed beyond the camera (sy_interactive_view.changed) */
+    /* the timeline (docs/WEB.md): the wall time the playing clock was last advanced at, whether it
+     * played then, the scene time last applied (NAN: none yet: the scene shows what was loaded
+     * until a page moves the clock), when the last periodic "clock" message was due */
+    double clock_wall, clock_applied, clock_sent;
+    bool clock_was_playing, clock_failed;
 } render_state;
+
+#define WEB_CLOCK_TICK 0.02  /* s: a playing clock is advanced (and a frame planned) at most this often */
+#define WEB_CLOCK_REPORT 1.0 /* s: a playing clock's time is sent to the pages this often (they interpolate) */
+
+/* Under w->mu: advances a playing clock to now and says whether the scene's time must change
+ * (*t_out: the time to apply). A clock that stopped at an end, and a playing one every
+ * WEB_CLOCK_REPORT, bump clock_version (sent to the pages with the next frame). */
+static bool clock_step(sy_web *w, render_state *rs, double *t_out)
+{
+    if (!w->animated) return false;
+    double now = sy_time_now();
+    bool playing = w->clock.playing;
+    if (playing && rs->clock_was_playing) sy_clock_advance(&w->clock, now - rs->clock_wall);
+    if (playing && !rs->clock_was_playing) rs->clock_sent = now;
+    if (playing && !w->clock.playing) w->clock_version++; /* stopped at an end (a clock that does not loop) */
+    else if (w->clock.playing && now - rs->clock_sent >= WEB_CLOCK_REPORT) w->clock_version++, rs->clock_sent = now;
+    rs->clock_wall = now;
+    rs->clock_was_playing = w->clock.playing;
+    *t_out = w->clock.time;
+    /* the loaded pose stays until a page touched the clock (clock_version 1: as created) */
+    return w->clock_version > 1 && !(w->clock.time == rs->clock_applied);
+}
+
+/* Sets the scene's time and commits (the moved nodes reach every context as any change does). */
+static void clock_apply(sy_web *w, render_state *rs, double t)
+{
+    sy_error e = {0};
+    rs->clock_applied = t;
+    if (sy_scene_set_time(w->d.scene, (sy_animation){0}, t, &e) == SY_OK) sy_scene_commit(w->d.scene, NULL, &e);
+    if (e.message[0] && !rs->clock_failed) { /* logged once: every later time would say the same */
+        rs->clock_failed = true;
+        sy_log(SY_LOG_WARNING, "web", NULL, "the scene clock at %g s: %s", t, e.message);
+    }
+}
 
 /* The display size the governor plans for: what the page asked, capped at max_width x max_height
  * keeping the aspect. */
@@ -332,7 +372,7 @@ static void render_live(sy_web *w, render_state *rs, const sy_interactive_input 
 
 sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
 {
-    render_state rs = {0};
+    render_state rs = {.clock_applied = NAN};
     sy_viewport_desc vd = {.root = w->d.root, .camera = w->d.camera, .background = w->d.background,
                            .backend = sy_mediator_at(w->initial_backend)->name};
     sy_result r = sy_context_pool_create(&rs.pool, err);
@@ -352,8 +392,11 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
             if (w->quit || (stop && *stop) || w->pending || w->stills || w->actions || w->need_pixels) break;
             /* frames once a page said its size (the page does as it connects) */
             bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
-            if (w->clients && w->display_w && (w->view_version != seen || due)) break;
+            /* a playing scene clock: a frame every WEB_CLOCK_TICK at most */
+            double tick_ms = w->clock.playing && w->animated ? (rs.clock_wall + WEB_CLOCK_TICK - sy_time_now()) * 1e3 : 1e9;
+            if (w->clients && w->display_w && (w->view_version != seen || due || tick_ms <= 0)) break;
             double nap_ms = 100; /* polls *stop ten times a second */
+            if (tick_ms < nap_ms) nap_ms = tick_ms;
             if (wait_until > 0 && wait_until - sy_time_now() * 1e3 < nap_ms) nap_ms = wait_until - sy_time_now() * 1e3;
             if (nap_ms < 0.1) nap_ms = 0.1;
             struct timespec ts;
@@ -373,6 +416,8 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         w->actions = NULL, w->actions_tail = &w->actions, w->action_count = 0;
         if (w->look_version != seen_look) rs.changed = true, seen_look = w->look_version;
         rs.exposure = w->exposure;
+        double clock_t = 0;
+        bool clock_moved = clock_step(w, &rs, &clock_t);
         sy_interactive_input in = w->in;
         bool moved = w->view_version != seen;
         seen = w->view_version;
@@ -382,6 +427,10 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         bool need_pixels = w->need_pixels;
         w->need_pixels = false;
         pthread_mutex_unlock(&w->mu);
+        if (clock_moved) { /* the scene at the clock's time: what frames show changed */
+            clock_apply(w, &rs, clock_t);
+            rs.changed = moved = true;
+        }
         while (jobs) { /* stills and routes first: they wait on an HTTP connection */
             web_job *j = jobs;
             jobs = j->next;

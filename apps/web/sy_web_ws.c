@@ -39,6 +39,7 @@ struct web_conn {
     uint64_t sent_scene;         /* the scene_version last announced to it */
     char peer[64];
     uint64_t sent_seq, sent_status, queued_seq;
+    uint64_t sent_clock;         /* the clock_version last sent to it ("clock" message) */
     /* the client's newest inputs with the generation each got (a ring): a frame answers the newest
      * one whose generation it includes */
     uint64_t ids[WS_IDS], gens[WS_IDS];
@@ -195,6 +196,25 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
         w->view_version++;
         break;
     }
+    case SY_WEB_INPUT_TIME:
+    case SY_WEB_INPUT_PLAY: /* the timeline (docs/WEB.md): a view change, allowed on a read-only server */
+        input = false;
+        if (!w->animated) {
+            pthread_mutex_unlock(&w->mu);
+            ws_warn(c, in.type == SY_WEB_INPUT_TIME ? "time: the scene has no animations" : "play: the scene has no animations", NULL);
+            return;
+        }
+        if (in.type == SY_WEB_INPUT_TIME && !(in.a >= w->clock.start && in.a <= w->clock.end)) {
+            char d[96];
+            snprintf(d, sizeof d, "%g s is outside the scene's clips, %g .. %g s", in.a, w->clock.start, w->clock.end);
+            pthread_mutex_unlock(&w->mu);
+            ws_warn(c, "time", d);
+            return;
+        }
+        if (in.type == SY_WEB_INPUT_TIME) w->clock.time = in.a;
+        else w->clock.playing = in.on;
+        w->clock_version++, w->view_version++;
+        break;
     case SY_WEB_INPUT_SIZE:
         input = false;
         if (in.version < SY_WEB_FRAME_VERSION) { /* an old page: told to reload, never sent frames it cannot read */
@@ -470,8 +490,21 @@ static int ws_writeable(sy_web *w, web_conn *c)
         cJSON_free(s);
         cJSON_Delete(o);
     }
+    char clock[200] = "";
+    if (!status[0] && w->clock_version != c->sent_clock) { /* the timeline's state (docs/WEB.md, "The timeline"), after a status */
+        c->sent_clock = w->clock_version;
+        snprintf(clock, sizeof clock, "{\"t\":\"clock\",\"time\":%.9g,\"start\":%.9g,\"end\":%.9g,\"playing\":%s,"
+                 "\"loop\":%s,\"speed\":%.9g}", w->clock.time, w->clock.start, w->clock.end,
+                 w->clock.playing ? "true" : "false", w->clock.loop ? "true" : "false", w->clock.speed);
+    }
     pthread_mutex_unlock(&w->mu);
     if (fresh && !c->sized) sy_webi_frame_release(w, f), fresh = false;
+    if (clock[0]) {
+        if (fresh) sy_webi_frame_release(w, f);
+        if (ws_send_text(c->wsi, clock)) return -1;
+        lws_callback_on_writable(c->wsi);
+        return 0;
+    }
     if (status[0]) {
         if (fresh) sy_webi_frame_release(w, f);
         if (ws_send_text(c->wsi, status)) return -1;

@@ -33,6 +33,13 @@
 //     (OUTDIR/jpeg_C.png, OUTDIR/C.png) and their mean absolute difference (0..255, RGB, computed
 //     in the browser); then a drag of 20 moves on the video page (frames keep coming as delta
 //     frames) and back; sy.stats().video before and after.
+//   node browser.mjs timeline URL OUTDIR WIDTH HEIGHT
+//     The timeline of an animated scene: waits for it, scrubs to the clips' start, to 16% of
+//     their range and back (BoxAnimated: its inner box half risen; the canvas once steady after each: OUTDIR/t_start.png, t_mid.png,
+//     t_start_again.png, and the mean absolute differences start-mid and start-start again),
+//     presses space (the server's "clock" messages advance), screenshots the page while playing
+//     (OUTDIR/timeline.png), presses space again (paused), then sends bad times (out of range,
+//     not a number) that the server refuses.
 //   node browser.mjs client URL OUTDIR WIDTH HEIGHT
 //     The client-render page (sy web --client-render): waits until the client is idle (its last
 //     cull answer drawn), writes the canvas to OUTDIR/canvas.png and what the page fetched to
@@ -47,8 +54,8 @@ import { join } from 'node:path';
 
 const [mode, url, outDir, wArg, hArg] = process.argv.slice(2);
 const width = Number(wArg || 480), height = Number(hArg || 360);
-if (!['stream', 'client', 'warp', 'tools', 'video'].includes(mode) || !url || !outDir) {
-  console.error('usage: node browser.mjs stream|client|warp|tools|video URL OUTDIR [WIDTH HEIGHT]');
+if (!['stream', 'client', 'warp', 'tools', 'video', 'timeline'].includes(mode) || !url || !outDir) {
+  console.error('usage: node browser.mjs stream|client|warp|tools|video|timeline URL OUTDIR [WIDTH HEIGHT]');
   process.exit(2);
 }
 const executablePath = process.env.SY_CHROMIUM || '/usr/bin/chromium';
@@ -402,6 +409,65 @@ try {
     await settled();
     result.consoleErrors = consoleErrors;
     console.log(JSON.stringify(result));
+  } else if (mode === 'timeline') {
+    // the scene clock from the page: scrub to the start, to the middle and back, play, pause
+    await page.waitForFunction(() => window.syStats && syStats.frames > 0 && window.sy && sy.timeline && sy.timeline().shown,
+      null, { timeout: TIMEOUT }).catch(() => fail('no frame, or no timeline (the scene has no animations?)'));
+    const tl = () => page.evaluate(() => sy.timeline());
+    const first = await tl();
+    // moves the slider as a user does (input, then change) and waits for frames rendered after it
+    const scrub = async (t) => {
+      const n = await page.evaluate(() => syStats.frames);
+      await page.evaluate((v) => {
+        const r = document.getElementById('sy-scrub');
+        r.value = String(v);
+        r.dispatchEvent(new Event('input', { bubbles: true }));
+        r.dispatchEvent(new Event('change', { bubbles: true }));
+      }, t);
+      await page.waitForFunction((n) => syStats.frames >= n + 2, n, { timeout: TIMEOUT }).catch(() => fail(`no frames after scrubbing to ${t}`));
+    };
+    // the canvas once it stopped changing: frames until two in a row are equal (at most 20)
+    const steady = async (name) => {
+      const path = join(outDir, name + '.png'), prev = join(outDir, name + '_prev.png');
+      await canvasPng(page, '#sy-canvas', prev);
+      for (let i = 0; i < 20; i++) {
+        const n = await page.evaluate(() => syStats.frames);
+        await page.waitForFunction((n) => syStats.frames > n, n, { timeout: 5000 }).catch(() => {}); // a still view sends no more
+        await canvasPng(page, '#sy-canvas', path);
+        if ((await pngMad(page, prev, path)) < 0.5) return path;
+        await canvasPng(page, '#sy-canvas', prev);
+      }
+      return path;
+    };
+    const mid = first.start + 0.16 * (first.end - first.start); // BoxAnimated: the inner box half risen (0.59 s)
+    await scrub(first.start);
+    const a = await steady('t_start');
+    await scrub(mid);
+    const b = await steady('t_mid');
+    await scrub(first.start);
+    const c = await steady('t_start_again');
+    const moved = await pngMad(page, a, b), back = await pngMad(page, a, c);
+    const scrubbed = await tl();
+    // play: space on the canvas; the server's clock advances (its "clock" messages say so)
+    await page.locator('#sy-canvas').focus();
+    await page.keyboard.press('Space');
+    const t0 = (await tl()).server_time;
+    await page.waitForFunction((t0) => { const s = sy.timeline(); return s.playing && s.server_time !== t0; }, t0, { timeout: TIMEOUT })
+      .catch(() => fail('play: the server\'s clock did not advance'));
+    const playing = await tl();
+    await page.screenshot({ path: join(outDir, 'timeline.png') });
+    const playedFrames = await page.evaluate(() => syStats.frames);
+    await page.waitForFunction((n) => syStats.frames >= n + 3, playedFrames, { timeout: TIMEOUT })
+      .catch(() => fail('play: no frames while playing'));
+    await page.keyboard.press('Space');
+    await page.waitForFunction(() => !sy.timeline().playing, null, { timeout: TIMEOUT }).catch(() => fail('space did not pause'));
+    const paused = await tl();
+    // bad times: out of the clips' range and not a number (JSON null): refused by the server (logged)
+    await page.evaluate(([lo, hi]) => { sy.send({ t: 'time', s: hi + 100 }); sy.send({ t: 'time', s: NaN }); sy.send({ t: 'time', s: lo - 1 }); },
+      [first.start, first.end]);
+    await page.waitForTimeout(200); // the refusals are only logged: nothing to wait for on the page
+    const after = await tl();
+    console.log(JSON.stringify({ first, scrubbed, playing, paused, after, moved, back, consoleErrors }));
   } else if (mode === 'video') {
     const codecs = await page.evaluate(() => window.syVideo ? syVideo.ready : []);
     await page.goto('about:blank'); // no viewer beside the pages below

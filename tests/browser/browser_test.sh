@@ -40,6 +40,11 @@
 #     the same frame, JPEG at quality 80 and the codec at quantizer 36); its stream is of that
 #     codec, decoded without errors or refused frames, and a drag and back are answered by more
 #     frames, most of them delta frames.
+#   browser_test.sh timeline SY PNG_IOU MODULES_DIR SCENE
+#     sy web SCENE (an animated one) -b raster: the page shows the timeline; scrubbing from the
+#     clips' start to 16% of their range changes the streamed canvas (mean abs diff > 2), scrubbing
+#     back brings it back (< 1.5: the same JPEG of the same pose); space plays (the server's clock
+#     advances) and pauses; times out of range and not numbers are refused with a log line each.
 #   The warp test runs with ?video=0: its made-up bad frames are JPEG frames.
 #
 # MODULES_DIR holds browser.mjs and node_modules/playwright-core. Skipped (77, with the reason)
@@ -49,7 +54,7 @@
 set -u
 mode=$1 SY=$2 PNG_IOU=$3 MODULES=$4 SCENE=$5
 W=480 H=360
-[ "$mode" = tools ] && W=960 H=600 # the panel shows beside the canvas from 600 pixels on
+[ "$mode" = tools ] || [ "$mode" = timeline ] && W=960 H=600 # the panel shows beside the canvas from 600 pixels on
 skip() {
     if [ "${SY_REQUIRE_BROWSER:-0}" = 1 ]; then echo "FAIL: SY_REQUIRE_BROWSER=1 but the test cannot run: $*"; exit 1; fi
     echo "SKIP: $*"
@@ -164,6 +169,30 @@ if [ "$mode" = tools ]; then
     ' "$out/tools.json" "$out/ro.json" || fail=1
     kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
     grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" "$out/err2" && bad "sy web: $(server_said)"
+    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
+    exit $fail
+fi
+
+if [ "$mode" = timeline ]; then
+    case $url in *\?*) url="$url&video=0" ;; *) url="$url?video=0" ;; esac # JPEG: equal poses give equal frames
+    browse "$url"
+    [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null
+    node -e '
+      const s = JSON.parse(require("fs").readFileSync(process.argv[1])), errs = [];
+      console.log(`timeline ${s.first.start}..${s.first.end} s; start vs 16%: mean abs diff ${s.moved.toFixed(2)}, start vs start again ` +
+                  `${s.back.toFixed(2)}; playing: server time ${s.playing.server_time}, paused at ${s.paused.time.toFixed(3)}`);
+      if (!(s.first.shown && s.first.end > s.first.start)) errs.push(`timeline ${JSON.stringify(s.first)}`);
+      if (!(s.moved > 2)) errs.push(`scrubbing did not change the canvas (mean abs diff ${s.moved})`);
+      if (!(s.back >= 0 && s.back < 1.5)) errs.push(`scrubbing back did not bring the picture back (mean abs diff ${s.back})`);
+      if (s.paused.playing) errs.push("space did not pause");
+      if (!(s.after.time >= s.first.start && s.after.time <= s.first.end)) errs.push(`a bad time moved the clock to ${s.after.time}`);
+      if (s.consoleErrors.length) errs.push(`page errors: ${s.consoleErrors}`);
+      if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
+    ' "$out/browser.json" || fail=1
+    wait_until $pid grep -q "outside the scene's clips" "$out/err" || bad "an out-of-range time was not refused: $(tail -3 "$out/err")"
+    wait_until $pid grep -q "time: s must be a finite number" "$out/err" || bad "a time that is no number was not refused: $(tail -3 "$out/err")"
+    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
+    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
     [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
     exit $fail
 fi

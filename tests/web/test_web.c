@@ -28,8 +28,9 @@
  *                 another client's own budget, a still whose requester left is not rendered
  *   web_clientfiles  /client/ serves client.html, client.js and vendor/ only, not npm/
  *   web_messages  the page's scene messages (pick, visible, select, isolate, clip, tree, exposure,
- *                 filter) are parsed as documented; picks outside the canvas, NaN, zero-normal and
- *                 infinite planes, 7 planes, node ids that are no whole number, bad names: refused
+ *                 filter, time, play) are parsed as documented; picks outside the canvas, NaN, zero-normal and
+ *                 infinite planes, 7 planes, node ids that are no whole number, bad names, times
+ *                 that are no finite number: refused
  *   web_scene     a viewer asks for the tree (the demo's nodes, their kinds), picks the pixel nearest
  *                 the centre that the first frame's depth says is covered (the node, its mesh, its
  *                 distance that of the depth) and selects it (every viewer is told "scene");
@@ -1040,7 +1041,21 @@ static int test_messages(void)
     CHECK(parse_ok("{\"t\":\"pick\",\"x\":0.5,\"y\":0.5,\"select\":true}", &in) && !sy_web_input_changes_scene(&in));
     CHECK(parse_ok("{\"t\":\"tree\"}", &in) && !sy_web_input_changes_scene(&in));
     CHECK(parse_ok("{\"t\":\"drag\",\"dx\":1,\"dy\":2}", &in) && !sy_web_input_changes_scene(&in));
+    /* the timeline: a view change (a read-only page may move the clock); the range is the server's */
+    CHECK(parse_ok("{\"t\":\"time\",\"s\":1.25}", &in) && in.type == SY_WEB_INPUT_TIME && in.a == 1.25 &&
+          !sy_web_input_changes_scene(&in));
+    CHECK(parse_ok("{\"t\":\"time\",\"s\":-3}", &in) && in.a == -3);
+    CHECK(parse_ok("{\"t\":\"play\",\"on\":true}", &in) && in.type == SY_WEB_INPUT_PLAY && in.on &&
+          !sy_web_input_changes_scene(&in));
+    CHECK(parse_ok("{\"t\":\"play\",\"on\":false}", &in) && !in.on);
     const char *bad[] = {
+        "{\"t\":\"time\"}",                            /* no time */
+        "{\"t\":\"time\",\"s\":null}",                 /* JSON's NaN (JSON.stringify(NaN)) */
+        "{\"t\":\"time\",\"s\":1e400}",                /* infinite */
+        "{\"t\":\"time\",\"s\":2e9}",                  /* beyond SY_WEB_TIME_MAX */
+        "{\"t\":\"time\",\"s\":\"1\"}",
+        "{\"t\":\"play\"}",
+        "{\"t\":\"play\",\"on\":1}",
         "{\"t\":\"pick\",\"x\":1,\"y\":0.5}",           /* outside: [0, 1) */
         "{\"t\":\"pick\",\"x\":-0.01,\"y\":0.5}",
         "{\"t\":\"pick\",\"x\":0.5}",
