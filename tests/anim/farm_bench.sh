@@ -8,7 +8,10 @@
 # equal, and what the kill cost (frames re-queued, the run's time against the 2-server run).
 #
 #   tests/anim/farm_bench.sh SY EXR_EQUAL [SCENE] [WORKDIR]
-#       env: FRAMES (48), SPP (16), W_PX (160), H_PX (120), SERVERS ("1 2 3"), KILL (1: the kill run)
+#       env: FRAMES (48), SPP (16), W_PX (160), H_PX (120), SERVERS ("1 2 3"), KILL (1: the kill run),
+#            MPI (1: the same sequences through `mpirun -np N+1 ... --cluster mpi`, rank 0 the client,
+#            when mpirun is there and sy was built with MPI; CPU time: mpirun's and its ranks'),
+#            TCP (1: the loopback `sy serve` runs; 0: MPI and the local sequence only)
 #
 # A measurement, not a test of the suite (its numbers depend on the machine and its load: no timed
 # tests). SCENE defaults to ../shared/testdata/gltf/BoxAnimated/glTF-Binary/BoxAnimated.glb next to
@@ -65,7 +68,9 @@ awk -v f="$FRAMES" -v a="$t0" -v b="$t1" -v u="$lu" -v s="$ls" 'BEGIN {
   printf "| local (1 process) | %.1f | %.1f | %.2f | %d |\n", 60 * f / (b - a), 60 * f / (b - a), (u + s) / f, f }' \
   > "$W/table"
 
+TCP=${TCP:-1}
 for n in $SERVERS; do
+  [ "$TCP" = 1 ] || break
   urls="" names=()
   for ((i = 0; i < n; ++i)); do
     start_server "s$n$i"
@@ -89,12 +94,33 @@ for n in $SERVERS; do
   for s in "${names[@]}"; do kill "$(eval echo "\$srv_$s")" 2>/dev/null; done
 done
 
+MPI=${MPI:-1}
+if [ "$MPI" = 1 ] && command -v mpirun > /dev/null; then
+  # root in a container: Open MPI refuses root unless told; oversubscribed: more ranks than cores
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+  for n in $SERVERS; do
+    t0=$(now)
+    if ! /usr/bin/env time -f '%U %S' -o "$W/mpi$n.time" timeout 900 mpirun --oversubscribe -np $((n + 1)) "$SY" render \
+      "$SCENE" "${ARGS[@]}" -o "$W/mpi${n}_####.exr" --cluster mpi --cluster-mode frames > "$W/mpi$n.out" 2> "$W/mpi$n.err"; then
+      grep -q "built without MPI" "$W/mpi$n.err" && { echo "(MPI: sy was built without MPI; skipped)"; break; }
+      fail "MPI, $n servers: $(tail -3 "$W/mpi$n.err")"
+    fi
+    t1=$(now)
+    read -r cu cs < "$W/mpi$n.time"
+    per=$(grep -o 'frames per server [0-9 ]*' "$W/mpi$n.out" | sed 's/frames per server //; s/ *$//; s/ /+/g')
+    awk -v f="$FRAMES" -v n="$n" -v a="$t0" -v b="$t1" -v u="$cu" -v s="$cs" -v p="$per" 'BEGIN {
+      printf "| MPI, %d server rank%s | %.1f | %.1f | %.2f (all ranks) | %s |\n", n, (n > 1 ? "s" : ""), 60 * f / (b - a),
+        60 * f / (b - a) / n, (u + s) / f, p }' >> "$W/table"
+    compare "mpi$n"
+  done
+fi
+
 echo
 echo "| | frames / min | per server | CPU s / frame | frames per server |"
 echo "|---|---|---|---|---|"
 cat "$W/table"
 
-if [ "$KILL" = 1 ]; then
+if [ "$KILL" = 1 ] && [ "$TCP" = 1 ]; then
   start_server ka
   start_server kb
   urls="tcp://127.0.0.1:$(cat "$W/ka.port"),tcp://127.0.0.1:$(cat "$W/kb.port")"
