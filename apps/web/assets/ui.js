@@ -110,7 +110,7 @@
     ["Keys", ""], ["1 - 9", "the back-end at that position of the menu"], ["F", "next display filter"],
     ["[ and ]", "halve / double the filter's threshold"], ["R", "back to the first view"],
     ["M", "measure: click two points, their distance in scene units"], ["Esc", "leave measuring; close this help"],
-    ["?", "this help"],
+    ["?", "this help"], ["space", "play / pause the scene (when it moves: the timeline at the bottom scrubs it)"],
     ["Panel", ""], ["☰", "show / hide the panel"], ["Screenshot", "downloads a JPEG of the view at the canvas' size"],
     ["Measure", "click two points: their distance"], ["tree", "the check box shows / hides a node, a click on its name selects it"],
     ["section planes", "up to 6 cuts along X, Y or Z, each with a slider across the scene and a flip"]];
@@ -120,7 +120,7 @@
     const tr = el("tr", {}, tb);
     el("td", {}, tr, k); el("td", {}, tr, v);
   }
-  el("p", { class: "note" }, hb, "A read-only server (sy web --read-only) lets you move the camera, pick and take " +
+  el("p", { class: "note" }, hb, "A read-only server (sy web --read-only) lets you move the camera and the scene clock, pick and take " +
      "screenshots; visibility, selection, section planes, exposure, filter and back-end stay as they are.");
   function toggleHelp(on) { help.classList.toggle("sy-hidden", on === undefined ? undefined : !on); ui.helpOpen = !help.classList.contains("sy-hidden"); }
   ui.toggleHelp = toggleHelp;
