@@ -157,7 +157,7 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
     }
     if (in.type == SY_WEB_INPUT_SIZE && in.version >= SY_WEB_FRAME_VERSION) choose_codec(w, c, &in);
     pthread_mutex_lock(&w->mu);
-    bool input = true;
+    bool input = true, clock_changed = false;
     switch (in.type) {
     case SY_WEB_INPUT_PICK:
     case SY_WEB_INPUT_VISIBLE:
@@ -214,6 +214,7 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
         if (in.type == SY_WEB_INPUT_TIME) w->clock.time = in.a;
         else w->clock.playing = in.on;
         w->clock_version++, w->view_version++;
+        clock_changed = true;
         break;
     case SY_WEB_INPUT_SIZE:
         input = false;
@@ -253,6 +254,9 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
     }
     pthread_cond_signal(&w->cv);
     pthread_mutex_unlock(&w->mu);
+    /* every page is told the clock's new state now, whether or not a frame follows (the same time
+     * again renders nothing new) */
+    if (clock_changed) lws_callback_on_writable_all_protocol(lws_get_context(c->wsi), &sy_webi_protocols[1]);
 }
 
 static void delay_timer(sy_web *w, web_conn *c);

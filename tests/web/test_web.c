@@ -43,6 +43,11 @@
  *   web_readonly  read_only: visibility, selection, isolation, planes and back-end keys are refused
  *                 (the tree unchanged, no "scene" message), a pick answers without selecting, the
  *                 camera moves
+ *   web_timeline  the scene clock on a read-only server whose demo has a 2 s clip (every mesh
+ *                 shrinks): the "clock" message gives its range, paused; times outside it or null
+ *                 are refused (no clock message); a time of 2 s changes the depth at a covered
+ *                 pixel; play is answered by clock messages whose time advances, pause stops it; a
+ *                 scene without clips sends no clock and refuses times
  *   web_frame     the binary frame (sy_web_frame.h) round-trips: header fields, the depth channel
  *                 within its 16-bit log step, "nothing" kept; truncated, foreign, format-1 and
  *                 mismatched frames are refused with the reason; the stream's frames carry the
@@ -211,12 +216,37 @@ static sy_result route_block(void *user, sy_scene *scene, const sy_web_request *
 
 /* the demo scene served on listen by backend from a thread of its own; 1 after printing why not */
 static bool g_read_only; /* web_readonly: the server start() makes is read-only */
+static bool g_read_only_anim; /* web_timeline: the demo gets a clip (every mesh node shrinks to 1% over 2 s) */
+
+/* A clip "shrink": each node of the scene that shows a mesh, its scale from its own to 1 % of it
+ * over 0..2 s (LINEAR); its samplers' data in static storage (the scene copies it). */
+static sy_result add_shrink_clip(sy_scene *s, sy_error *e)
+{
+    enum { MAXN = 64 };
+    static float times[2] = {0.0f, 2.0f}, values[MAXN][6];
+    sy_anim_sampler_desc sd[MAXN];
+    sy_anim_channel ch[MAXN];
+    uint32_t n = 0;
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_NODE, 0); id && n < MAXN; id = sy_scene_next(s, SY_TYPE_NODE, id)) {
+        const sy_node_data *nd = sy_node_get(s, (sy_node){id});
+        if (!nd->mesh.id || nd->transform.mode != SY_TRANSFORM_TRS) continue;
+        for (int k = 0; k < 3; ++k) values[n][k] = nd->transform.scale[k], values[n][3 + k] = 0.01f * nd->transform.scale[k];
+        sd[n] = (sy_anim_sampler_desc){SY_INTERP_LINEAR, 3, 2, times, values[n]};
+        ch[n] = (sy_anim_channel){id, SY_ANIM_SCALE, n};
+        ++n;
+    }
+    sy_animation a;
+    sy_result r = sy_animation_create(s, "shrink", &a, e);
+    if (r == SY_OK) r = sy_animation_set_clip(s, a, sd, n, ch, n, e);
+    return r;
+}
 
 static int start(server *s, const char *listen, const char *backend, sy_error *e)
 {
     memset(s, 0, sizeof *s);
     sy_demo_info demo;
-    int failed = sy_scene_create(&s->scene, e) || sy_demo_build(s->scene, &demo, e) || sy_scene_commit(s->scene, NULL, e);
+    int failed = sy_scene_create(&s->scene, e) || sy_demo_build(s->scene, &demo, e) ||
+                 (g_read_only_anim && add_shrink_clip(s->scene, e)) || sy_scene_commit(s->scene, NULL, e);
     if (!failed) {
         static const sy_web_route routes[] = {{"GET", "/api/object/", route_info, NULL},
                                               {"POST", "/api/echo", route_echo, NULL},
@@ -1277,6 +1307,85 @@ static int test_scene(uint16_t port)
     return 0;
 }
 
+/* the "time" of a clock message */
+static double clock_time(const char *t) { return json_number(t, "time"); }
+
+/* The scene clock (docs/WEB.md, "The timeline") on a read-only server (a view change: allowed)
+ * whose demo has a 2 s clip: the page is sent its range, paused; a time moves the scene (the
+ * depth at a covered pixel changes within 40 frames); play is answered by clock messages whose
+ * time advances; times outside the range, not numbers or on a scene without clips are refused
+ * (no clock message follows them); pause stops the clock. */
+static int test_timeline(void)
+{
+    sy_error err = {0};
+    server s;
+    g_read_only = g_read_only_anim = true;
+    if (start(&s, "127.0.0.1:0", "whitted", &err)) return 1;
+    sy_web_client *c = NULL;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    char *t = NULL;
+    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
+    CHECK_MSG(clock_time(t) == 0 && json_number(t, "start") == 0 && json_number(t, "end") == 2 && strstr(t, "\"playing\":false"),
+              "%s", t);
+    free(t);
+    int px, py;
+    float d0;
+    if (first_frame(c, &px, &py, &d0)) return 1;
+    /* bad times: refused, no clock message */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":3}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":-0.5}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":null}", &err), err);
+    CHECK(sy_web_client_next_text(c, 500, "clock", &t, &err) == SY_ERR_IO);
+    /* the end of the clip: every mesh at 1 % of its size, the covered pixel shows something else */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":2}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
+    CHECK_MSG(clock_time(t) == 2 && strstr(t, "\"playing\":false"), "%s", t);
+    free(t);
+    bool moved = false;
+    for (int k = 0; k < 40 && !moved; ++k) {
+        sy_web_frame_info fi;
+        float *depth = NULL;
+        CHECK_OK(sy_web_client_next_frame_depth(c, 60000, &fi, NULL, NULL, &depth, &err), err);
+        if (fi.width == 80 && fi.height == 60) moved = !(fabsf(depth[py * 80 + px] - d0) <= 1e-3f * d0);
+        free(depth);
+    }
+    CHECK_MSG(moved, "the depth at (%d, %d) stayed %g at 2 s", px, py, (double)d0);
+    /* play from 0: the clock messages' time advances (one a second while playing) */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":0}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"play\",\"on\":true}", &err), err);
+    double last = 0;
+    bool advanced = false;
+    for (int k = 0; k < 20 && !advanced; ++k) { /* a hang guard: a message a second */
+        CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
+        advanced = strstr(t, "\"playing\":true") && clock_time(t) > 0;
+        last = clock_time(t);
+        free(t);
+    }
+    CHECK_MSG(advanced, "playing: the clock stayed at %g", last);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"play\",\"on\":false}", &err), err);
+    bool paused = false;
+    for (int k = 0; k < 20 && !paused; ++k) {
+        CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
+        paused = strstr(t, "\"playing\":false") != NULL;
+        free(t);
+    }
+    CHECK(paused);
+    sy_web_client_close(c);
+    g_read_only = g_read_only_anim = false;
+    if (stop(&s)) return 1;
+    /* a scene without clips: no clock message, and a time is refused */
+    if (start(&s, "127.0.0.1:0", "whitted", &err)) return 1;
+    o.port = sy_web_port(s.web);
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "hello", &t, &err), err);
+    free(t);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":0}", &err), err);
+    CHECK(sy_web_client_next_text(c, 500, "clock", &t, &err) == SY_ERR_IO);
+    sy_web_client_close(c);
+    return stop(&s);
+}
+
 static int test_readonly(void)
 {
     sy_error err = {0};
@@ -1440,6 +1549,11 @@ int main(int argc, char **argv)
     }
     if (!strcmp(which, "messages")) {
         int f = test_messages();
+        if (!f) printf("web %s: ok\n", which);
+        return f;
+    }
+    if (!strcmp(which, "timeline")) {
+        int f = test_timeline();
         if (!f) printf("web %s: ok\n", which);
         return f;
     }
