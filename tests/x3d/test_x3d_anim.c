@@ -16,7 +16,8 @@
  * PositionInterpolator2D into TextureTransform translation and scale (about a center) and
  * CoordinateInterpolator2D into TextureCoordinate.point become texture coordinate morph targets
  * whose blend at three times is X3D's transformed coordinate; mismatched counts and values that
- * are not finite are refused, naming the interpolator's DEF.
+ * are not finite are refused, naming the interpolator's DEF, and points per key that do not match
+ * the TextureCoordinate's, naming both lines.
  * Usage: test_x3d_anim [TESTDATA_DIR]. */
 #include "sy_anim.h"
 #include "x3d_loaded.h"
@@ -445,6 +446,11 @@ static void test_textures(void)
         "<ROUTE fromNode='Huge' fromField='value_changed' toNode='TH' toField='translation'/>\n"               /* 22 */
         "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='NaN' toField='set_fraction'/>\n"         /* 23 */
         "<ROUTE fromNode='NaN' fromField='value_changed' toNode='TH' toField='translation'/>\n"                /* 24 */
+        "<Shape><IndexedFaceSet coordIndex='0 1 2 -1'><Coordinate point='0 0 0 1 0 0 1 1 0'/>"                /* 25 */
+        "<TextureCoordinate DEF='TC2' point='0 0 1 0 1 1'/></IndexedFaceSet></Shape>\n"
+        "<CoordinateInterpolator2D DEF='Short2' key='0 1' keyValue='0 0 1 0  0 0 2 0'/>\n"                  /* 26 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Short2' toField='set_fraction'/>\n"      /* 27 */
+        "<ROUTE fromNode='Short2' fromField='value_changed' toNode='TC2' toField='point'/>\n"                  /* 28 */
         "</Scene></X3D>\n");
     if (!expect_loaded(&l, "tex.x3d")) return unload(&l);
     EXPECT_MSG(has_warning(&l, "tex.x3d:9: PositionInterpolator2D 'Odd': 2 keys and 1 key values", NULL), "Odd's counts");
@@ -453,6 +459,8 @@ static void test_textures(void)
                    has_warning(&l, "tex.x3d:10: PositionInterpolator2D 'Huge': 2 keys and 0 key values", "not played"),
                "Huge's value");
     EXPECT_MSG(has_warning(&l, "tex.x3d:10: PositionInterpolator2D 'NaN'", "not played"), "NaN's value");
+    EXPECT_MSG(has_warning(&l, "tex.x3d:25: CoordinateInterpolator2D (line 26): 2 points per key, the TextureCoordinate "
+                               "(line 25) has 3; not played", NULL), "Short2's points");
     sy_node slid = node_named(&l, "Slid"), grown = node_named(&l, "Grown"), waved = node_named(&l, "Waved");
     /* Slid's shape is a child node of the Transform: the node showing the mesh */
     sy_node shows[3] = {{0}, {0}, {0}};
