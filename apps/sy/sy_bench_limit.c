@@ -69,6 +69,23 @@ sy_result sy_bench_limit(sy_scene *scene, const sy_viewport_desc *vd, const char
                          note[0] ? "; " : "", (unsigned long long)b.mismatches[f]);
             print_row(b.form_names[f], rays, b.form_seconds[f], b.share[f], note[0] ? note : NULL);
         }
+        /* where the frame's time goes (one pixel in 8 timed, in a frame of its own per repeat) */
+        double total_ns = 0.0;
+        for (int k = 0; k < SY_MEDIATOR_RT_LIMIT_STAGES; ++k) total_ns += b.stage_ns_per_sample[k];
+        printf("  per stage (time stamp counter on 1 pixel in 8, %.0f ticks per read subtracted (%.0f in a tight loop), %llu of %llu spans left "
+               "out as preempted; timed frame %.1f ms = %+.0f %%):\n",
+               b.lap_ticks, b.lap_ticks_tight, (unsigned long long)b.stage_dropped, (unsigned long long)(b.stage_laps + b.stage_dropped),
+               b.timed_frame_seconds * 1e3, 100.0 * (b.timed_frame_seconds / b.frame_seconds[1] - 1.0));
+        for (int k = 0; k < SY_MEDIATOR_RT_LIMIT_STAGES; ++k)
+            printf("    %-32s %5.1f %%  %8.0f ns/sample\n", b.stage_names[k], 100.0 * b.stage_share[k],
+                   b.stage_ns_per_sample[k]);
+        double trav = b.stage_share[b.stage_traversal] + b.stage_share[b.stage_shadow];
+        printf("    %-32s %5.1f %%  %8.0f ns/sample\n", "all", 100.0, total_ns);
+        /* traversal inside the frame (its share of the median frame) against the raw replay */
+        printf("  traversal in the frame: %.1f %% of it = %.1f ms, raw rtcIntersect1/rtcOccluded1 %.1f ms (%.2fx); "
+               "the rest: %.1f ms\n",
+               100.0 * trav, trav * b.frame_seconds[1] * 1e3, b.form_seconds[0][1] * 1e3,
+               trav * b.frame_seconds[1] / b.form_seconds[0][1], (1.0 - trav) * b.frame_seconds[1] * 1e3);
     }
     sy_context_release(ctx);
     sy_window_destroy(win);

@@ -606,6 +606,9 @@ typedef struct sy_rt_render_desc {
                                          * rays, with Embree's answers) is appended to this log, for
                                          * the "distance to the limit" benchmark (backends/rt/
                                          * sy_rt_raylog.h); NULL = off (no cost) */
+    struct sy_rt_stage_times *stage_times; /**< optional: ticks per stage of the path on a sampled
+                                         * subset of the pixels are added here (backends/rt/
+                                         * sy_rt_raylog.h >>stage timers); NULL = off */
 } sy_rt_render_desc;
 
 /** Renders the sub-rectangle. rgba: width*height*4 floats (required); depth: width*height floats

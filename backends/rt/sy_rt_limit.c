@@ -317,10 +317,15 @@ sy_rt_result sy_rt_bench_limit(sy_rt_device *dev, const sy_rt_camera *camera, co
     d.progress = NULL;
     d.progress_user_data = NULL;
     d.records = NULL;
+    d.stage_times = NULL;
+    sy_rt_stage_times *st = calloc(1, sizeof *st);
+    double *t_timed = calloc(repeats, sizeof *t_timed);
+    uint64_t tick_sum = 0;
+    double timed_sum = 0.0;
     sy_rt_ray_log *log = NULL;
     sy_rt_ray_replay *rp[SY_RT_FORM_COUNT] = {0};
     double *t = calloc((size_t)repeats * (2u * SY_RT_FORM_COUNT + 1u), sizeof *t);
-    sy_rt_result r = t ? sy_rt_ray_log_create(dev, &log) : FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "bench limit: out of memory");
+    sy_rt_result r = t && st && t_timed ? sy_rt_ray_log_create(dev, &log) : FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "bench limit: out of memory");
     /* the logged frame (also the warm-up) */
     if (r == SY_RT_OK) {
         d.ray_log = log;
@@ -349,6 +354,17 @@ sy_rt_result sy_rt_bench_limit(sy_rt_device *dev, const sy_rt_camera *camera, co
         t[i] = now_s() - t0;
         for (int f = 0; r == SY_RT_OK && f < SY_RT_FORM_COUNT; ++f)
             t[(size_t)(f + 1) * repeats + i] = sy_rt_ray_replay_run(rp[f], NULL);
+        /* the frame again with the stage timers (its time only says what they cost) */
+        if (r != SY_RT_OK) break;
+        sy_rt_accum_reset(d.accum);
+        d.stage_times = st;
+        uint64_t k0 = sy_rt_stage_tick();
+        t0 = now_s();
+        r = sy_rt_render(dev, camera, &d, NULL, NULL);
+        t_timed[i] = now_s() - t0;
+        tick_sum += sy_rt_stage_tick() - k0;
+        timed_sum += t_timed[i];
+        d.stage_times = NULL;
     }
     if (r == SY_RT_OK) {
         out->width = d.width;
@@ -369,9 +385,31 @@ sy_rt_result sy_rt_bench_limit(sy_rt_device *dev, const sy_rt_camera *camera, co
             spread(share + (size_t)f * repeats, repeats, out->share[f]);
         }
         spread(t, repeats, out->frame_seconds);
+        double spread3[3];
+        spread(t_timed, repeats, spread3);
+        out->timed_frame_seconds = spread3[1];
+        out->lap_ticks_tight = sy_rt_stage_lap_cost();
+        uint64_t null_laps = atomic_load(&st->laps[SY_RT_STAGE_NULL]);
+        out->lap_ticks = null_laps ? (double)atomic_load(&st->ticks[SY_RT_STAGE_NULL]) / (double)null_laps
+                                   : out->lap_ticks_tight;
+        out->stage_samples = atomic_load(&st->samples);
+        out->stage_dropped = atomic_load(&st->dropped);
+        double c[SY_RT_STAGE_COUNT], sum = 0.0, ns_per_tick = tick_sum ? timed_sum * 1e9 / (double)tick_sum : 1.0;
+        for (int k = 0; k < SY_RT_STAGE_COUNT; ++k) {
+            c[k] = (double)atomic_load(&st->ticks[k]) - out->lap_ticks * (double)atomic_load(&st->laps[k]);
+            if (c[k] < 0.0) c[k] = 0.0;
+            out->stage_laps += atomic_load(&st->laps[k]);
+            sum += c[k];
+        }
+        for (int k = 0; k < SY_RT_STAGE_COUNT; ++k) {
+            out->stage_share[k] = sum > 0.0 ? c[k] / sum : 0.0;
+            out->stage_ns_per_sample[k] = out->stage_samples ? c[k] * ns_per_tick / (double)out->stage_samples : 0.0;
+        }
     }
     for (int f = 0; f < SY_RT_FORM_COUNT; ++f) sy_rt_ray_replay_destroy(rp[f]);
     sy_rt_ray_log_destroy(log);
     free(t);
+    free(t_timed);
+    free(st);
     return r;
 }

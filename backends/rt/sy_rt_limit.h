@@ -49,9 +49,19 @@ typedef struct sy_rt_limit_result {
                                                      * tracer's rays/s over the form's), min, median, max */
     uint64_t mismatches[SY_RT_FORM_COUNT];          /* replayed answers that differ from the log */
     bool native[SY_RT_FORM_COUNT];                  /* sy_rt_ray_form_native */
+    /* per stage (sy_rt_raylog.h >>stage timers): one more frame per repeat with the stage timers
+     * on (not in frame_seconds), the counter's own cost per lap subtracted */
+    double stage_share[SY_RT_STAGE_COUNT];          /* share of the timed pixels' ticks, sums to 1 */
+    double stage_ns_per_sample[SY_RT_STAGE_COUNT];  /* ns per timed sample (ticks at the TSC rate measured
+                                                     * over the timed frames) */
+    uint64_t stage_samples;                         /* timed samples, all repeats */
+    uint64_t stage_laps, stage_dropped;             /* spans timed, spans left out (sy_rt_raylog.h) */
+    double lap_ticks;                               /* the counter's cost per lap in the path loop, subtracted */
+    double lap_ticks_tight;                         /* the same in a tight loop (sy_rt_stage_lap_cost) */
+    double timed_frame_seconds;                     /* median of the timed frames (the timers' cost) */
 } sy_rt_limit_result;
-/* desc: a PATHTRACER desc (its accum, samples, max_depth, seed, rectangle; ray_log and progress
- * are ignored); the accum is reset before every frame. The device must be committed. */
+/* desc: a PATHTRACER desc (its accum, samples, max_depth, seed, rectangle; ray_log, stage_times
+ * and progress are ignored); the accum is reset before every frame. The device must be committed. */
 sy_rt_result sy_rt_bench_limit(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
                                uint32_t repeats, sy_rt_limit_result *out);
 

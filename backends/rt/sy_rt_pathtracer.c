@@ -47,6 +47,7 @@ typedef struct pt_job {
     sy_rt_accum *acc;
     sy_rt_pt_record *records; /* optional path records of the rectangle (sy_rt.h >>path records) */
     sy_rt_ray_log *log;       /* optional ray log (sy_rt_raylog.h) */
+    sy_rt_stage_times *stages; /* optional stage timers (sy_rt_raylog.h >>stage timers) */
     uint32_t first, count;
     const sy_rt_sobol *sobol; /* the device's */
     sy_rt_env env;
@@ -62,7 +63,19 @@ typedef struct pt_ctx {
     sy_rt_ictx ictx;
     uint64_t rays;
     sy_rt_ray_buf *log; /* the tile's rays when the job logs them, else NULL */
+    sy_rt_stage_clock *clk; /* the tile's stage clock while a timed pixel runs, else NULL */
 } pt_ctx;
+
+/* Stage changes (sy_rt_raylog.h >>stage timers): LAP in the path loop's timed copy (timed is a
+ * constant there), CLAP in the functions both copies call. */
+#define LAP(st)                                         \
+    do {                                                \
+        if (timed) sy_rt_stage_lap(c->clk, (st));       \
+    } while (0)
+#define CLAP(st)                                        \
+    do {                                                \
+        if (c->clk) sy_rt_stage_lap(c->clk, (st));      \
+    } while (0)
 
 static float maxc(sy_rt_v3 v) { return sy_rt_maxf(v.x, sy_rt_maxf(v.y, v.z)); }
 static float power_heuristic(float a, float b)
@@ -79,7 +92,19 @@ static float power_heuristic(float a, float b)
  * transmittance of sy_rt_shadow.h, as Whitted's do (without it a light behind glass is lost). */
 static sy_rt_v3 unoccluded(pt_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tfar, bool punctual)
 {
-    return sy_rt_shadow_transmittance(c->dev, &c->ictx.rtc, org, dir, tfar, punctual, &c->rays, c->log);
+    CLAP(SY_RT_STAGE_SHADOW);
+    sy_rt_v3 tr = sy_rt_shadow_transmittance(c->dev, &c->ictx.rtc, org, dir, tfar, punctual, &c->rays, c->log);
+    CLAP(SY_RT_STAGE_LIGHT);
+    return tr;
+}
+
+/* The BSDF toward a light sample (its own stage when timed). */
+static sy_rt_v3 eval_toward(pt_ctx *c, const sy_rt_bsdf *b, sy_rt_v3 wo, sy_rt_v3 wi, float *pdf)
+{
+    CLAP(SY_RT_STAGE_BSDF_EVAL);
+    sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, pdf);
+    CLAP(SY_RT_STAGE_LIGHT);
+    return f;
 }
 
 /* One light sample from the shading point: returns f * Le * cos * MIS weight / pdf (visibility
@@ -113,7 +138,7 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
             float tmax;
             if (!sy_rt_punctual_incident(&dev->punctual[li - dev->area_count], s->p, &wi, &e, &tmax)) return zero;
             float pdf_b;
-            sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
+            sy_rt_v3 f = eval_toward(c, b, wo, wi, &pdf_b);
             if (v3_is_zero(f)) return zero;
             sy_rt_v3 tr = unoccluded(c, p_off, wi, tmax, true);
             if (v3_is_zero(tr)) return zero;
@@ -134,7 +159,7 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
         if (t->double_sided) cos_l = fabsf(cos_l);
         if (!(cos_l > 1e-7f)) return zero;
         float pdf_b;
-        sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
+        sy_rt_v3 f = eval_toward(c, b, wo, wi, &pdf_b);
         if (v3_is_zero(f)) return zero;
         float pdf_l = (kind == 3 ? p_tree / t->area : t->pdf_select) * d2 / cos_l * p_cat;
         if (!(pdf_l > 0.0f)) return zero;
@@ -151,7 +176,7 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
         float pdf_l = sy_rt_env_sample(&j->env, ur, u[1], &wi, &le) * p_cat;
         if (!(pdf_l > 0.0f) || v3_is_zero(le)) return zero;
         float pdf_b;
-        sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
+        sy_rt_v3 f = eval_toward(c, b, wo, wi, &pdf_b);
         if (v3_is_zero(f)) return zero;
         sy_rt_v3 tr = unoccluded(c, p_off, wi, INFINITY, false);
         if (v3_is_zero(tr)) return zero;
@@ -164,7 +189,7 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
         float tmax;
         if (!sy_rt_punctual_incident(&dev->punctual[i], s->p, &wi, &e, &tmax)) return zero;
         float pdf_b;
-        sy_rt_v3 f = sy_rt_bsdf_eval(b, wo, wi, &pdf_b);
+        sy_rt_v3 f = eval_toward(c, b, wo, wi, &pdf_b);
         if (v3_is_zero(f)) return zero;
         sy_rt_v3 tr = unoccluded(c, p_off, wi, tmax, true);
         if (v3_is_zero(tr)) return zero;
@@ -193,7 +218,7 @@ static void record_p0(sy_rt_pt_record *rec, const sy_rt_surface *s, const sy_rt_
 __attribute__((always_inline))
 #endif
 static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy_rt_pt_sample *out,
-                         sy_rt_pt_record *rec)
+                         sy_rt_pt_record *rec, const bool timed)
 {
     const sy_rt_frame *f = c->f;
     const sy_rt_device *dev = c->dev;
@@ -244,7 +269,10 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
 
     for (;;) {
         struct RTCRayHit rh;
+        LAP(SY_RT_STAGE_NULL); /* the cost of a change of stage, here */
+        LAP(SY_RT_STAGE_TRAVERSAL);
         const sy_rt_instance_data *in = sy_rt_intersect(dev, &c->ictx.rtc, org, dir, tnear, tfar, &rh);
+        LAP(SY_RT_STAGE_SHADING);
         c->rays++;
         if (c->log) sy_rt_ray_buf_add_hit(c->log, SY_RT_RAY_EXTENSION, org, dir, tnear, tfar, &rh);
         const sy_rt_v3 d = dir;
@@ -292,7 +320,9 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
             break;
         }
         sy_rt_surface s;
+        LAP(SY_RT_STAGE_HIT_FETCH);
         sy_rt_surface_fetch_at(dev, in, c->ictx.time, rh.hit.primID, rh.hit.u, rh.hit.v, d, &s);
+        LAP(SY_RT_STAGE_SHADING);
         if (s.mat->desc.alpha_mode == SY_RT_ALPHA_BLEND && s.alpha < 1.0f) {
             rng = sy_rt_hash32(rng + 0x9e3779b9u);
             if (sy_rt_u01(rng) >= sy_rt_clampf(s.alpha, 0.0f, 1.0f)) { /* pass through */
@@ -340,7 +370,9 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
         if (bounce >= f->max_depth) break;
         sy_rt_v3 wo = v3_scale(d, -1.0f);
         sy_rt_bsdf b;
+        LAP(SY_RT_STAGE_BSDF_INIT);
         sy_rt_bsdf_init(&b, &s, wo);
+        LAP(SY_RT_STAGE_SHADING);
         bool evaluable = sy_rt_bsdf_evaluable(&b);
         if (!features && (evaluable || b.q_metal + b.q_spec + b.q_diff + b.q_trans == 0.0f)) {
             out->albedo = b.base;
@@ -348,6 +380,7 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
             features = true;
         }
         float ul[4], ub[4];
+        LAP(SY_RT_STAGE_RNG);
         sy_rt_sobol_sample4(j->sobol, pseed, 1u + 2u * bounce, index, ul);
         if (bounce == 0u) {
             ub[0] = first_bsdf[0], ub[1] = dirs[0], ub[2] = dirs[1], ub[3] = first_bsdf[3];
@@ -355,14 +388,20 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
             sy_rt_sobol_sample4(j->sobol, pseed, 2u + 2u * bounce, index, ub);
             if (bounce == 1u) ub[1] = dirs[2], ub[2] = dirs[3];
         }
+        LAP(SY_RT_STAGE_SHADING);
         if (evaluable && j->categories) {
-            sy_rt_v3 le = sample_light(c, &b, &s, wo, ul), contrib = v3_mul(beta, le);
+            LAP(SY_RT_STAGE_LIGHT);
+            sy_rt_v3 le = sample_light(c, &b, &s, wo, ul);
+            LAP(SY_RT_STAGE_SHADING);
+            sy_rt_v3 contrib = v3_mul(beta, le);
             L = v3_add(L, contrib);
             if (after_p0) incident = v3_add(incident, v3_mul(beta_s, le));
             if (bounce == 0u) direct = v3_add(direct, contrib);
         }
         sy_rt_bsdf_sample bs;
+        LAP(SY_RT_STAGE_BSDF_SAMPLE);
         if (!sy_rt_bsdf_sample_dir(&b, wo, ub, &bs)) break;
+        LAP(SY_RT_STAGE_SHADING);
         if (after_p0) {
             beta_s = v3_mul(beta_s, bs.weight);
         } else if (rec && !bs.specular) {
@@ -410,20 +449,40 @@ static void pt_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, 
     c.rays = 0;
     sy_rt_ray_buf tile_log = {0};
     c.log = j->log ? &tile_log : NULL;
-    uint64_t bad = 0;
+    c.clk = NULL;
+    sy_rt_stage_clock clk_mem, *clk = NULL;
+    if (j->stages && !j->records) memset(&clk_mem, 0, sizeof clk_mem), clk = &clk_mem;
+    uint64_t bad = 0, timed = 0;
     for (uint32_t py = y0; py < y1; ++py)
         for (uint32_t px = x0; px < x1; ++px) {
             size_t pix = (size_t)(py - f->y) * f->width + (px - f->x);
             float *rec = j->acc->data + pix * SY_RT_ACC_STRIDE;
             sy_rt_pt_record *prec = j->records ? j->records + pix : NULL;
+            if (clk && sy_rt_hash32(px * 0x9e3779b1u ^ sy_rt_hash32(py)) % SY_RT_STAGE_SUBSET == 0u) {
+                /* a timed pixel (records are off while timing) */
+                c.clk = clk;
+                clk->cur = SY_RT_STAGE_RNG;
+                clk->last = sy_rt_stage_tick();
+                for (uint32_t k = 0; k < j->count; ++k) {
+                    sy_rt_pt_sample s;
+                    trace_sample(&c, px, py, j->first + k, &s, NULL, true);
+                    sy_rt_stage_lap(clk, SY_RT_STAGE_ACCUM);
+                    if (!sy_rt_accum_add(rec, j->first + k + 1u, &s)) bad++;
+                    sy_rt_stage_lap(clk, SY_RT_STAGE_RNG);
+                }
+                c.clk = NULL;
+                timed += j->count;
+                continue;
+            }
             for (uint32_t k = 0; k < j->count; ++k) {
                 sy_rt_pt_sample s;
-                if (prec && k + 1u == j->count) trace_sample(&c, px, py, j->first + k, &s, prec);
-                else trace_sample(&c, px, py, j->first + k, &s, NULL);
+                if (prec && k + 1u == j->count) trace_sample(&c, px, py, j->first + k, &s, prec, false);
+                else trace_sample(&c, px, py, j->first + k, &s, NULL, false);
                 if (!sy_rt_accum_add(rec, j->first + k + 1u, &s)) bad++;
             }
         }
     if (bad) atomic_fetch_add(&j->acc->nonfinite, bad);
+    if (clk) sy_rt_stage_times_add(j->stages, clk, timed);
     atomic_fetch_add(&j->acc->rays, c.rays);
     if (c.log) {
         sy_rt_ray_log_append(j->log, c.log);
@@ -447,6 +506,7 @@ sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_de
     j.acc = acc;
     j.records = desc->records;
     j.log = desc->ray_log;
+    j.stages = desc->stage_times;
     j.first = acc->samples;
     j.count = count;
     j.sobol = &f->dev->sobol;

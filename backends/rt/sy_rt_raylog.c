@@ -116,3 +116,47 @@ void sy_rt_ray_log_append(sy_rt_ray_log *log, sy_rt_ray_buf *buf)
     buf->failed = false;
 }
 
+
+/* >>stage timers */
+const char *sy_rt_stage_name(sy_rt_stage s)
+{
+    static const char *const names[SY_RT_STAGE_COUNT] = {
+        "random numbers, camera ray", "traversal (extension rays)", "traversal (shadow rays)",
+        "hit fetch (surface)",        "BSDF set-up",                "shading (emission, MIS, rest)",
+        "light selection + point",
+        "BSDF evaluation (light)",    "BSDF sampling, roulette",    "accumulation"};
+    return (unsigned)s < SY_RT_STAGE_COUNT ? names[s] : "?";
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+double sy_rt_stage_lap_cost(void)
+{
+    enum { RUNS = 9, LAPS = 4096 };
+    uint64_t per[RUNS];
+    for (int r = 0; r < RUNS; ++r) {
+        sy_rt_stage_clock c;
+        memset(&c, 0, sizeof c);
+        c.last = sy_rt_stage_tick();
+        for (int i = 0; i < LAPS; ++i) sy_rt_stage_lap(&c, (sy_rt_stage)(i % SY_RT_STAGE_COUNT));
+        uint64_t sum = 0;
+        for (int s = 0; s < SY_RT_STAGE_COUNT; ++s) sum += c.ticks[s];
+        per[r] = sum;
+    }
+    qsort(per, RUNS, sizeof *per, cmp_u64);
+    return (double)per[RUNS / 2] / LAPS;
+}
+
+void sy_rt_stage_times_add(sy_rt_stage_times *t, const sy_rt_stage_clock *c, uint64_t samples)
+{
+    for (int s = 0; s < SY_RT_STAGE_SLOTS; ++s) {
+        if (c->ticks[s]) atomic_fetch_add(&t->ticks[s], c->ticks[s]);
+        if (c->laps[s]) atomic_fetch_add(&t->laps[s], c->laps[s]);
+    }
+    atomic_fetch_add(&t->samples, samples);
+    if (c->dropped) atomic_fetch_add(&t->dropped, c->dropped);
+}

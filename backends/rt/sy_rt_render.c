@@ -24,6 +24,8 @@ sy_rt_result sy_rt_render(sy_rt_device *dev, const sy_rt_camera *camera, const s
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: path records need the PATHTRACER integrator");
     if (desc->ray_log && desc->integrator != SY_RT_INTEGRATOR_PATHTRACER)
         return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: a ray log needs the PATHTRACER integrator");
+    if (desc->stage_times && desc->integrator != SY_RT_INTEGRATOR_PATHTRACER)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: stage timers need the PATHTRACER integrator");
     if ((desc->integrator == SY_RT_INTEGRATOR_PATHTRACER || desc->integrator == SY_RT_INTEGRATOR_WHITTED) &&
         (r = sy_rt_light_tree_ensure(dev, desc->light_tree)) != SY_RT_OK) /* the light tree, when it is used */
         return r;

@@ -193,6 +193,8 @@ sy_result sy_mediator_rt_bench_rays(void *state, const sy_camera_view *view, uin
  * those rays in each form are timed, interleaved, `repeats` times. Forms, in order:
  * rtcIntersect1/rtcOccluded1, rtcIntersect4/rtcOccluded4, ...8, ...16, rtcIntersect1M/rtcOccluded1M. */
 #define SY_MEDIATOR_RT_LIMIT_FORMS 5
+/** Stages of the path tracer timed by sy_mediator_rt_bench_limit. */
+#define SY_MEDIATOR_RT_LIMIT_STAGES 10
 /** Result of sy_mediator_rt_bench_limit (times in seconds). */
 typedef struct sy_mediator_rt_limit {
     /** @{ frame size, samples per pixel, repeats, render threads (the replay's too) */
@@ -206,6 +208,18 @@ typedef struct sy_mediator_rt_limit {
     uint64_t mismatches[SY_MEDIATOR_RT_LIMIT_FORMS];          /**< replayed answers that differ from the frame's */
     bool native[SY_MEDIATOR_RT_LIMIT_FORMS];                  /**< Embree runs the form natively (not emulated) */
     const char *form_names[SY_MEDIATOR_RT_LIMIT_FORMS];       /**< static storage */
+    /** @{ per stage of the path tracer (issue 39; backends/rt/sy_rt_raylog.h >>stage timers): one
+     * more frame per repeat with timers on one pixel in 8; the share of the timed pixels' time
+     * (sums to 1), thread-nanoseconds per timed sample, static names */
+    double stage_share[SY_MEDIATOR_RT_LIMIT_STAGES];
+    double stage_ns_per_sample[SY_MEDIATOR_RT_LIMIT_STAGES];
+    const char *stage_names[SY_MEDIATOR_RT_LIMIT_STAGES]; /** @} */
+    /** @{ the stages of extension and shadow-ray traversal (indices into the arrays above) */
+    int stage_traversal, stage_shadow; /** @} */
+    double timed_frame_seconds; /**< median time of the timed frames (what the timers cost) */
+    double lap_ticks;           /**< the time stamp counter's own cost per stage change in the path loop, subtracted */
+    double lap_ticks_tight;     /**< the same measured in a tight loop (a lower bound) */
+    uint64_t stage_laps, stage_dropped; /**< spans timed; spans left out as preempted (over ~0.1 ms) */
 } sy_mediator_rt_limit;
 /** Runs the distance-to-the-limit benchmark on a pathtracer context's device for the view at width
  * x height (the look of background_id applied as a render would), `samples` samples per pixel per

@@ -189,5 +189,15 @@ sy_result sy_mediator_rt_bench_limit(void *state, const sy_camera_view *view, ui
         out->native[f] = lim.native[f];
         out->form_names[f] = sy_rt_ray_form_name((sy_rt_ray_form)f);
     }
+    _Static_assert(SY_MEDIATOR_RT_LIMIT_STAGES == SY_RT_STAGE_COUNT, "one entry per stage");
+    for (int k = 0; k < SY_RT_STAGE_COUNT; ++k) {
+        out->stage_share[k] = lim.stage_share[k];
+        out->stage_ns_per_sample[k] = lim.stage_ns_per_sample[k];
+        out->stage_names[k] = sy_rt_stage_name((sy_rt_stage)k);
+    }
+    out->stage_traversal = SY_RT_STAGE_TRAVERSAL, out->stage_shadow = SY_RT_STAGE_SHADOW;
+    out->timed_frame_seconds = lim.timed_frame_seconds;
+    out->lap_ticks = lim.lap_ticks, out->lap_ticks_tight = lim.lap_ticks_tight;
+    out->stage_laps = lim.stage_laps, out->stage_dropped = lim.stage_dropped;
     return SY_OK;
 }

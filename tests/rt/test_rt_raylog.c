@@ -9,7 +9,10 @@
  *     one in a thousand, ties between triangles at the same distance);
  *   - the check can fail: one altered answer in each list is found;
  *   - with an alpha-blended surface, shadow rays become closest-hit steps and are logged as such;
- *   - sy_rt_bench_limit reports consistent counts; a log with another integrator is refused. */
+ *   - the stage timers (sy_rt_raylog.h >>stage timers) change no pixel, time one pixel in about
+ *     SY_RT_STAGE_SUBSET, and see traversal, hit fetch, shading and sampling;
+ *   - sy_rt_bench_limit reports consistent counts and stage shares that sum to 1; a log or stage
+ *     timers with another integrator are refused. */
 #include "rt_test.h"
 #include "sy_rt_limit.h"
 
@@ -60,15 +63,21 @@ static sy_rt_render_desc frame_desc(sy_rt_device *dev)
 }
 
 /* Renders one frame (2 spp, seed 7) with the log (NULL = none) into rgba; returns the rays counted. */
-static uint64_t render(sy_rt_device *dev, const sy_rt_camera *cam, sy_rt_ray_log *log, float *rgba)
+static uint64_t render_timed(sy_rt_device *dev, const sy_rt_camera *cam, sy_rt_ray_log *log, sy_rt_stage_times *st,
+                             float *rgba)
 {
     sy_rt_render_desc d = frame_desc(dev);
     sy_rt_accum *acc = d.accum;
     d.ray_log = log;
+    d.stage_times = st;
     MUST(sy_rt_render(dev, cam, &d, rgba, NULL));
     uint64_t rays = sy_rt_accum_last_rays(acc);
     sy_rt_accum_destroy(acc);
     return rays;
+}
+static uint64_t render(sy_rt_device *dev, const sy_rt_camera *cam, sy_rt_ray_log *log, float *rgba)
+{
+    return render_timed(dev, cam, log, NULL, rgba);
 }
 
 /* Replays the log in every form and checks the answers. */
@@ -124,6 +133,29 @@ int main(void)
     EXPECT_MSG(!memcmp(a, b, W * H * 4 * sizeof(float)), "the image with a ray log differs from the one without");
     EXPECT_MSG(rays_plain == rays_logged, "rays %llu without the log, %llu with it", (unsigned long long)rays_plain,
                (unsigned long long)rays_logged);
+
+    /* stage timers change nothing and see every stage of a lit, bouncing path */
+    sy_rt_stage_times st;
+    memset(&st, 0, sizeof st);
+    uint64_t rays_timed = render_timed(dev, &cam, NULL, &st, b);
+    EXPECT_MSG(!memcmp(a, b, W * H * 4 * sizeof(float)), "the image with stage timers differs from the one without");
+    EXPECT_MSG(rays_timed == rays_plain, "rays %llu with stage timers, %llu without", (unsigned long long)rays_timed,
+               (unsigned long long)rays_plain);
+    uint64_t timed = atomic_load(&st.samples);
+    printf("stage timers: %llu of %d samples timed\n", (unsigned long long)timed, W * H * SPP);
+    EXPECT_MSG(timed >= (uint64_t)W * H * SPP / SY_RT_STAGE_SUBSET / 2u && timed <= (uint64_t)W * H * SPP / SY_RT_STAGE_SUBSET * 2u,
+               "stage timers: %llu of %d samples timed (about 1 in %u expected)", (unsigned long long)timed, W * H * SPP,
+               SY_RT_STAGE_SUBSET);
+    const sy_rt_stage seen[] = {SY_RT_STAGE_RNG,       SY_RT_STAGE_TRAVERSAL, SY_RT_STAGE_SHADOW,      SY_RT_STAGE_HIT_FETCH,
+                                SY_RT_STAGE_BSDF_INIT, SY_RT_STAGE_SHADING,   SY_RT_STAGE_LIGHT,       SY_RT_STAGE_BSDF_EVAL,
+                                SY_RT_STAGE_BSDF_SAMPLE, SY_RT_STAGE_ACCUM};
+    for (size_t i = 0; i < sizeof seen / sizeof seen[0]; ++i)
+        EXPECT_MSG(atomic_load(&st.laps[seen[i]]) > 0 && atomic_load(&st.ticks[seen[i]]) > 0, "stage '%s' never timed",
+                   sy_rt_stage_name(seen[i]));
+    /* every extension ray is one traversal span (spans over SY_RT_STAGE_MAX_LAP are left out) */
+    EXPECT_MSG(atomic_load(&st.laps[SY_RT_STAGE_TRAVERSAL]) + atomic_load(&st.dropped) >= timed,
+               "%llu traversal spans for %llu samples", (unsigned long long)atomic_load(&st.laps[SY_RT_STAGE_TRAVERSAL]),
+               (unsigned long long)timed);
 
     /* the log holds the frame's rays */
     uint64_t total = log->intersect.n + log->occluded.n;
@@ -200,6 +232,11 @@ int main(void)
         EXPECT_MSG(lr.share[f][0] > 0.0 && lr.share[f][0] <= lr.share[f][1] && lr.share[f][1] <= lr.share[f][2] &&
                    lr.form_seconds[f][1] > 0.0,
                    "bench: form %d spread %g %g %g", f, lr.share[f][0], lr.share[f][1], lr.share[f][2]);
+    double share_sum = 0.0;
+    for (int k = 0; k < SY_RT_STAGE_COUNT; ++k) share_sum += lr.stage_share[k];
+    EXPECT_MSG(fabs(share_sum - 1.0) < 1e-9 && lr.stage_share[SY_RT_STAGE_TRAVERSAL] > 0.0 && lr.stage_samples > 0,
+               "bench: stage shares sum to %g, traversal %g, %llu samples", share_sum,
+               lr.stage_share[SY_RT_STAGE_TRAVERSAL], (unsigned long long)lr.stage_samples);
 
     /* a log with another integrator is refused */
     d.integrator = SY_RT_INTEGRATOR_WHITTED;
@@ -208,6 +245,11 @@ int main(void)
     sy_rt_result r = sy_rt_render(dev, &cam, &d, a, NULL);
     EXPECT_MSG(r == SY_RT_ERROR_INVALID_ARGUMENT && strstr(sy_rt_device_error(dev), "ray log"), "whitted with a ray log: %s: %s", sy_rt_result_str(r), sy_rt_device_error(dev));
     sy_rt_ray_log_destroy(log);
+    d.ray_log = NULL;
+    d.stage_times = &st;
+    r = sy_rt_render(dev, &cam, &d, a, NULL);
+    EXPECT_MSG(r == SY_RT_ERROR_INVALID_ARGUMENT && strstr(sy_rt_device_error(dev), "stage timers"),
+               "whitted with stage timers: %s: %s", sy_rt_result_str(r), sy_rt_device_error(dev));
     sy_rt_accum_destroy(acc);
     free(a);
     free(b);
