@@ -12,8 +12,117 @@
 #include <string.h>
 
 
-/* The levels of detail of an indexed mesh of at least SY_GL_LOD_MIN_TRIANGLES: into *out (malloc'd,
- * level 0 first) the mesh's indices followed by each simplified level; m->lod_* describe them.
+/* Levels of meshes above this many triangles are simplified in pieces of SY_GL_LOD_PIECE_TRIANGLES
+ * (issue 39, memory on the user's path): meshopt_simplify's scratch is about 100 bytes per triangle
+ * of what it is given, with per-vertex arrays for every vertex of the mesh (a 10^7-triangle grid
+ * peaked at 1.45 GB, 145 B/triangle, in `sy render -b raster`, of which about 95 in the
+ * simplifier). A piece is a run of triangles in Morton order of their centroids (sorted once,
+ * for level 1; later levels keep that order), with its own vertices and its border locked, so the
+ * pieces fit together; its deviation is its own extent times its relative error, the level's the
+ * largest. Smaller meshes are simplified whole, as before. */
+#define LOD_PIECE_ABOVE (1u << 21)
+#define SY_GL_LOD_PIECE_TRIANGLES (1u << 19)
+
+static uint32_t morton_part(float v) /* v in [0, 1] -> 10 bits spread to every third bit */
+{
+    uint32_t x = (uint32_t)(v * 1023.0f);
+    x = x > 1023u ? 1023u : x;
+    x = (x | (x << 16)) & 0x030000FFu;
+    x = (x | (x << 8)) & 0x0300F00Fu;
+    x = (x | (x << 4)) & 0x030C30C3u;
+    return (x | (x << 2)) & 0x09249249u;
+}
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* One level from the one before (in: n indices) in pieces: into out (room for n) the simplified
+ * triangles, piece after piece; returns their index count (0 without memory) and *err the largest
+ * deviation of a piece (absolute). order: the triangles of `in` in the order to cut them (NULL:
+ * as they are). */
+static size_t simplify_pieces(const sy_gl_mesh_desc *d, const uint32_t *in, size_t n, const uint32_t *order,
+                              uint32_t *out, float *err)
+{
+    const size_t piece = SY_GL_LOD_PIECE_TRIANGLES, tris = n / 3u;
+    uint32_t *local = malloc(sizeof *local * d->vertex_count); /* mesh vertex -> piece vertex, UINT32_MAX = none */
+    uint32_t *glob = malloc(sizeof *glob * 3u * piece);      /* piece vertex -> mesh vertex */
+    uint32_t *idx = malloc(sizeof *idx * 3u * piece), *dst = malloc(sizeof *dst * 3u * piece);
+    float *pos = malloc(sizeof *pos * 9u * piece);
+    size_t used = 0;
+    *err = 0.0f;
+    if (local && glob && idx && dst && pos) {
+        memset(local, 0xff, sizeof *local * d->vertex_count);
+        for (size_t t0 = 0; t0 < tris; t0 += piece) {
+            size_t pt = tris - t0 < piece ? tris - t0 : piece;
+            uint32_t nv = 0;
+            for (size_t t = 0; t < pt; ++t) {
+                size_t tri = order ? order[t0 + t] : t0 + t;
+                for (int k = 0; k < 3; ++k) {
+                    uint32_t v = in[3u * tri + (size_t)k];
+                    if (local[v] == UINT32_MAX) {
+                        local[v] = nv;
+                        glob[nv] = v;
+                        memcpy(pos + 3u * nv, d->positions + 3u * (size_t)v, 3 * sizeof(float));
+                        nv++;
+                    }
+                    idx[3u * t + (size_t)k] = local[v];
+                }
+            }
+            float rel = 0.0f;
+            size_t target = 3u * pt / 4u / 3u * 3u;
+            size_t m = meshopt_simplify(dst, idx, 3u * pt, pos, nv, 3 * sizeof(float), target, 1.0f,
+                                        meshopt_SimplifyLockBorder, &rel);
+            float abs_err = rel * meshopt_simplifyScale(pos, nv, 3 * sizeof(float));
+            if (abs_err > *err) *err = abs_err;
+            for (size_t i = 0; i < m; ++i) out[used + i] = glob[dst[i]];
+            used += m;
+            for (uint32_t v = 0; v < nv; ++v) local[glob[v]] = UINT32_MAX;
+        }
+    }
+    free(local), free(glob), free(idx), free(dst), free(pos);
+    return used;
+}
+
+/* The triangles of the index list in Morton order of their centroids (malloc'd; NULL without
+ * memory). */
+static uint32_t *morton_order(const sy_gl_mesh_desc *d, const uint32_t *in, size_t tris, const float bmin[3],
+                              const float bmax[3])
+{
+    uint64_t *keys = malloc(sizeof *keys * tris);
+    uint32_t *order = keys ? malloc(sizeof *order * tris) : NULL;
+    if (!order) {
+        free(keys);
+        return NULL;
+    }
+    float inv[3];
+    for (int k = 0; k < 3; ++k) inv[k] = bmax[k] > bmin[k] ? 1.0f / (bmax[k] - bmin[k]) : 0.0f;
+    for (size_t t = 0; t < tris; ++t) {
+        float c[3] = {0.0f, 0.0f, 0.0f};
+        for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k) c[k] += d->positions[3u * (size_t)in[3u * t + (size_t)j] + (size_t)k];
+        uint32_t code = 0;
+        for (int k = 0; k < 3; ++k) code |= morton_part((c[k] / 3.0f - bmin[k]) * inv[k]) << k;
+        keys[t] = (uint64_t)code << 32 | (uint64_t)t;
+    }
+    qsort(keys, tris, sizeof *keys, cmp_u64);
+    for (size_t t = 0; t < tris; ++t) order[t] = (uint32_t)keys[t];
+    free(keys);
+    return order;
+}
+
+/* Level k's indices: level 0 is the mesh's own, the others are in `levels` (the index buffer from
+ * index 3 x triangle_count on). */
+static const uint32_t *lod_indices(const sy_gl_mesh_desc *d, const mesh_o *m, const uint32_t *levels, uint32_t k)
+{
+    return k == 0u ? d->indices : levels + (m->lod_first[k] - 3u * (size_t)d->triangle_count);
+}
+
+/* The levels of detail of an indexed mesh of at least SY_GL_LOD_MIN_TRIANGLES: into *out (malloc'd;
+ * NULL when there is none) each simplified level after the other, the index buffer's part after
+ * the mesh's own indices (level 0, not copied: it is uploaded from the mesh's array); m->lod_*
+ * describe them, lod_first counted from the buffer's start; *count_out the buffer's indices.
  * Without memory, or when a level would not shrink the one before by a fifth, the chain stops
  * there (level 0 alone is a valid chain). */
 static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size_t *count_out)
@@ -26,24 +135,30 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
     *out = NULL;
     *count_out = n0;
     if (!d->indices || d->triangle_count < SY_GL_LOD_MIN_TRIANGLES) return;
-    /* the chain: at most n0 * (1 + 4/5 + (4/5)^2 + ...) = 5 n0 indices, 4/3 n0 in practice; each
-     * level first into scratch (meshopt_simplify may need index_count entries) */
-    size_t cap = n0 + n0 / 2u;
+    /* the levels after 0: at most n0 * (4/5 + (4/5)^2 + ...) = 4 n0 indices, n0 / 3 in practice;
+     * each level first into scratch (meshopt_simplify may need index_count entries) */
+    size_t cap = n0 / 2u, used = 0;
     uint32_t *all = malloc(cap * sizeof *all), *scratch = malloc(n0 * sizeof *scratch);
     if (!all || !scratch) {
         free(all), free(scratch);
         return;
     }
-    memcpy(all, d->indices, n0 * sizeof *all);
-    size_t used = n0;
     float scale = meshopt_simplifyScale(d->positions, d->vertex_count, 3 * sizeof(float)), err_sum = 0.0f;
     while (m->lod_count < LOD_MAX) {
         uint32_t k = m->lod_count;
         size_t prev_n = 3u * (size_t)m->lod_tris[k - 1], target = prev_n / 4u / 3u * 3u;
         if (target < 3u * 32u) break;
-        float rel = 0.0f;
-        size_t n = meshopt_simplify(scratch, all + m->lod_first[k - 1], prev_n, d->positions, d->vertex_count,
-                                    3 * sizeof(float), target, 1.0f, 0, &rel);
+        float rel = 0.0f, dev_abs = 0.0f;
+        size_t n;
+        if (m->lod_tris[k - 1] > LOD_PIECE_ABOVE) { /* in pieces (level 1: in Morton order) */
+            uint32_t *order = k == 1u ? morton_order(d, d->indices, prev_n / 3u, m->bmin, m->bmax) : NULL;
+            n = k == 1u && !order ? 0u : simplify_pieces(d, lod_indices(d, m, all, k - 1u), prev_n, order, scratch, &dev_abs);
+            free(order);
+        } else {
+            n = meshopt_simplify(scratch, lod_indices(d, m, all, k - 1u), prev_n, d->positions, d->vertex_count,
+                                 3 * sizeof(float), target, 1.0f, 0, &rel);
+            dev_abs = rel * scale;
+        }
         if (n == 0 || n * 5u > prev_n * 4u) break;
         if (used + n > cap) {
             size_t ncap = used + n + n0 / 4u;
@@ -53,16 +168,17 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
             cap = ncap;
         }
         memcpy(all + used, scratch, n * sizeof *all);
-        err_sum += rel * scale; /* deviation from the level before, relative to the mesh extent */
-        m->lod_first[k] = (uint32_t)used;
+        err_sum += dev_abs; /* deviation from the level before (meshoptimizer's relative error times the extent) */
+        m->lod_first[k] = (uint32_t)(n0 + used);
         m->lod_tris[k] = (uint32_t)(n / 3u);
         m->lod_error[k] = err_sum;
         m->lod_count++;
         used += n;
     }
     free(scratch);
+    if (!used) free(all), all = NULL;
     *out = all;
-    *count_out = used;
+    *count_out = n0 + used;
 }
 
 /* The slot of key in the open-addressed table of 2^bits keys (0 = empty): where it is, or the empty
@@ -104,8 +220,8 @@ static int8_t closed_surface(const sy_gl_mesh_desc *d, const uint32_t *idx, size
     return vol > 0.0 ? 1 : -1;
 }
 
-/* mesh_o.lod_closed for every level of m (index buffer all, NULL for an unindexed mesh). */
-static void check_closed(const sy_gl_mesh_desc *d, mesh_o *m, const uint32_t *all)
+/* mesh_o.lod_closed for every level of m (levels: build_lods' levels after 0). */
+static void check_closed(const sy_gl_mesh_desc *d, mesh_o *m, const uint32_t *levels)
 {
     memset(m->lod_closed, 0, sizeof m->lod_closed);
     if (d->triangle_count > CLOSED_MAX_TRIANGLES) return;
@@ -117,7 +233,8 @@ static void check_closed(const sy_gl_mesh_desc *d, mesh_o *m, const uint32_t *al
         meshopt_generateVertexRemap(weld, NULL, d->vertex_count, d->positions, d->vertex_count, 3 * sizeof(float));
         for (uint32_t k = 0; k < m->lod_count; ++k) {
             memset(table, 0, sizeof *table << bits);
-            m->lod_closed[k] = closed_surface(d, all ? all + m->lod_first[k] : NULL, m->lod_tris[k], weld, table, bits);
+            m->lod_closed[k] = closed_surface(d, d->indices ? lod_indices(d, m, levels, k) : NULL, m->lod_tris[k], weld,
+                                              table, bits);
         }
     }
     free(weld);
@@ -139,25 +256,43 @@ static void set_bounds(mesh_o *m, const float bmin[3], const float bmax[3])
 
 static const int vertex_comps[5] = {3, 3, 2, 2, 4}; /* floats of position, normal, uv0, uv1, colour */
 
-/* The vertex attributes of d present in arrays (position, normal, uv0, uv1, colour; NULL = absent)
- * interleaved into one malloc()ed buffer (the caller frees it): offs the attributes' offsets and
- * *stride the vertex size, in floats; *bytes the buffer's size. NULL without memory. */
-static float *interleave(const sy_gl_mesh_desc *d, const float *const arrays[5], int offs[5], int *stride, size_t *bytes)
+/* The layout of the interleaved vertex buffer of the attributes present in arrays (position, normal,
+ * uv0, uv1, colour; NULL = absent): offs the attributes' offsets and *stride the vertex size, in
+ * floats; returns the buffer's bytes. */
+static size_t interleaved_layout(const sy_gl_mesh_desc *d, const float *const arrays[5], int offs[5], int *stride)
 {
     *stride = 0;
     for (int a = 0; a < 5; ++a) {
         offs[a] = *stride;
         if (arrays[a]) *stride += vertex_comps[a];
     }
-    *bytes = (size_t)d->vertex_count * (size_t)*stride * sizeof(float);
-    float *vb = malloc(*bytes);
-    if (!vb) return NULL;
-    for (uint32_t i = 0; i < d->vertex_count; ++i)
-        for (int a = 0; a < 5; ++a)
-            if (arrays[a])
-                memcpy(vb + (size_t)i * (size_t)*stride + offs[a], arrays[a] + (size_t)i * vertex_comps[a],
-                       vertex_comps[a] * sizeof(float));
-    return vb;
+    return (size_t)d->vertex_count * (size_t)*stride * sizeof(float);
+}
+
+/* Vertices per piece of an interleaved upload. */
+#define UPLOAD_PIECE_VERTICES 65536u
+
+/* Fills the bound GL_ARRAY_BUFFER (already sized) with the interleaved vertices, a piece of
+ * UPLOAD_PIECE_VERTICES at a time (a 10^7-triangle mesh's whole interleaved copy was 16 bytes per
+ * triangle at the peak, issue 39). false without memory. */
+static bool upload_interleaved(const sy_gl_fns *gl, const sy_gl_mesh_desc *d, const float *const arrays[5],
+                               const int offs[5], int stride)
+{
+    uint32_t piece = d->vertex_count < UPLOAD_PIECE_VERTICES ? d->vertex_count : UPLOAD_PIECE_VERTICES;
+    float *vb = malloc((size_t)piece * (size_t)stride * sizeof(float));
+    if (!vb) return false;
+    for (uint32_t first = 0; first < d->vertex_count; first += piece) {
+        uint32_t count = d->vertex_count - first < piece ? d->vertex_count - first : piece;
+        for (uint32_t i = 0; i < count; ++i)
+            for (int a = 0; a < 5; ++a)
+                if (arrays[a])
+                    memcpy(vb + (size_t)i * (size_t)stride + offs[a], arrays[a] + (size_t)(first + i) * vertex_comps[a],
+                           vertex_comps[a] * sizeof(float));
+        gl->BufferSubData(GL_ARRAY_BUFFER, (GLintptr)((size_t)first * (size_t)stride * sizeof(float)),
+                          (GLsizeiptr)((size_t)count * (size_t)stride * sizeof(float)), vb);
+    }
+    free(vb);
+    return true;
 }
 
 sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_gl_mesh *out)
@@ -196,24 +331,25 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     uint32_t *lods = NULL;
     size_t index_count = 0;
     build_lods(d, m, &lods, &index_count);
-    check_closed(d, m, lods ? lods : d->indices);
+    check_closed(d, m, lods);
     m->cap_closed = (int8_t)(d->closed > 0 ? 1 : d->closed < 0 ? -1 : 0);
     gl->GenVertexArrays(1, &m->vao);
     gl->BindVertexArray(m->vao);
     /* one interleaved vertex buffer (present attributes only) + one index buffer */
     const float *arrays[5] = {d->positions, d->normals, d->uv[0], d->uv[1], d->colors};
     int stride, offs[5];
-    size_t bytes;
-    float *vb = interleave(d, arrays, offs, &stride, &bytes);
-    if (!vb) {
-        sy_gli_pool_free(&dev->meshes, m);
-        return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory (%u vertices)", d->vertex_count);
-    }
+    size_t bytes = interleaved_layout(d, arrays, offs, &stride);
     gl->GenBuffers(1, &m->vbo[0]);
     gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
-    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, vb, GL_STATIC_DRAW);
+    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, NULL, GL_STATIC_DRAW);
+    if (!upload_interleaved(gl, d, arrays, offs, stride)) {
+        free(lods);
+        gl->BindVertexArray(0);
+        sy_gl_mesh h = {m->h.id};
+        sy_gl_mesh_destroy(dev, h);
+        return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory (%u vertices)", d->vertex_count);
+    }
     sy_gli_count_buffer(dev, false, bytes);
-    free(vb);
     for (int a = 0; a < 5; ++a) {
         m->has_attr[a] = arrays[a] != NULL;
         if (!arrays[a]) continue;
@@ -226,7 +362,13 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
         size_t bytes = index_count * sizeof(uint32_t);
         gl->GenBuffers(1, &m->ibo);
         gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, m->ibo);
-        gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)bytes, lods ? lods : d->indices, GL_STATIC_DRAW);
+        /* the mesh's indices, then the levels: no copy of the mesh's in between */
+        size_t n0 = 3u * (size_t)d->triangle_count * sizeof(uint32_t);
+        gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)bytes, lods ? NULL : d->indices, GL_STATIC_DRAW);
+        if (lods) {
+            gl->BufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, (GLsizeiptr)n0, d->indices);
+            gl->BufferSubData(GL_ELEMENT_ARRAY_BUFFER, (GLintptr)n0, (GLsizeiptr)(bytes - n0), lods);
+        }
         free(lods);
         sy_gli_count_buffer(dev, false, bytes);
         m->indexed = true;
@@ -266,14 +408,12 @@ sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_m
     sy_gl_result r = sy_gli_current(dev, rep);
     if (r != SY_GL_OK) return r;
     int stride, offs[5];
-    size_t bytes;
-    float *vb = interleave(d, arrays, offs, &stride, &bytes);
-    if (!vb) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh update: out of memory (%u vertices)", d->vertex_count);
+    size_t bytes = interleaved_layout(d, arrays, offs, &stride);
     const sy_gl_fns *gl = dev->gl;
     gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
-    gl->BufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)bytes, vb);
+    bool ok = upload_interleaved(gl, d, arrays, offs, stride);
     gl->BindBuffer(GL_ARRAY_BUFFER, 0);
-    free(vb);
+    if (!ok) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh update: out of memory (%u vertices)", d->vertex_count);
     sy_gli_count_buffer(dev, false, bytes);
     set_bounds(m, bmin, bmax);
     sy_gli_geometry_changed(dev);
