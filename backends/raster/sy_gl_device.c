@@ -170,6 +170,7 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         for (uint32_t i = 0; i < dev->meshes.count; ++i) {
             mesh_o *m = sy_gli_pool_at(&dev->meshes, i);
             if (!m->h.id) continue;
+            free(m->order);
             gl->DeleteBuffers(1, m->vbo);
             gl->DeleteBuffers(1, &m->ibo);
             gl->DeleteVertexArrays(1, &m->vao);

@@ -108,7 +108,15 @@ typedef struct mesh_o {
      * way, 0 not closed or not checked (over CLOSED_MAX_TRIANGLES); see cull_hidden_faces */
     int8_t lod_closed[LOD_MAX];
     int8_t cap_closed; /* sy_gl_mesh_desc.closed: 1, -1 a closed surface section caps fill (its winding), 0 not */
+    /* a mesh with levels of at least LOD_REORDER_VERTICES vertices: the vertex buffer holds the
+     * coarsest level's vertices first, then the next level's new ones, ...: order[i] = the mesh
+     * vertex at buffer position i (malloc'd, freed with the mesh); NULL = the mesh's order */
+    uint32_t *order;
 } mesh_o;
+/* Meshes with levels and at least this many vertices get the vertex order above: llvmpipe shades
+ * every vertex between a draw's smallest and largest index, so a far level of 10^3 triangles of a
+ * 5 x 10^6-vertex mesh shaded (and held) them all. */
+#define LOD_REORDER_VERTICES 65536u
 /* The most triangles a level may have for the closed-surface check (a sort of 3 edges each). */
 #define CLOSED_MAX_TRIANGLES 131072u
 

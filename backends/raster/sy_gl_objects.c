@@ -12,10 +12,12 @@
 #include <string.h>
 
 
-/* Levels of meshes above this many triangles are simplified in pieces of SY_GL_LOD_PIECE_TRIANGLES
- * (issue 39, memory on the user's path): meshopt_simplify's scratch is about 100 bytes per triangle
- * of what it is given, with per-vertex arrays for every vertex of the mesh (a 10^7-triangle grid
- * peaked at 1.45 GB, 145 B/triangle, in `sy render -b raster`, of which about 95 in the
+/* The levels of meshes above this many triangles are simplified in pieces of
+ * SY_GL_LOD_PIECE_TRIANGLES, each with its own vertices (a level that fits in one piece: whole,
+ * with its own vertices and its border free) (issue 39, memory on the user's path):
+ * meshopt_simplify's scratch is about 100 bytes per triangle of what it is given, with per-vertex
+ * arrays for every vertex it is given, even for a small level of a large mesh (a 10^7-triangle grid
+ * peaked at 1.48 GB, 148 B/triangle, in `sy render -b raster`, of which about 95 in the
  * simplifier). A piece is a run of triangles in Morton order of their centroids (sorted once,
  * for level 1; later levels keep that order), with its own vertices and its border locked, so the
  * pieces fit together; its deviation is its own extent times its relative error, the level's the
@@ -73,7 +75,7 @@ static size_t simplify_pieces(const sy_gl_mesh_desc *d, const uint32_t *in, size
             float rel = 0.0f;
             size_t target = 3u * pt / 4u / 3u * 3u;
             size_t m = meshopt_simplify(dst, idx, 3u * pt, pos, nv, 3 * sizeof(float), target, 1.0f,
-                                        meshopt_SimplifyLockBorder, &rel);
+                                        pt < tris ? meshopt_SimplifyLockBorder : 0u, &rel);
             float abs_err = rel * meshopt_simplifyScale(pos, nv, 3 * sizeof(float));
             if (abs_err > *err) *err = abs_err;
             for (size_t i = 0; i < m; ++i) out[used + i] = glob[dst[i]];
@@ -150,7 +152,7 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
         if (target < 3u * 32u) break;
         float rel = 0.0f, dev_abs = 0.0f;
         size_t n;
-        if (m->lod_tris[k - 1] > LOD_PIECE_ABOVE) { /* in pieces (level 1: in Morton order) */
+        if (d->triangle_count > LOD_PIECE_ABOVE) { /* in pieces (level 1: in Morton order) */
             uint32_t *order = k == 1u ? morton_order(d, d->indices, prev_n / 3u, m->bmin, m->bmax) : NULL;
             n = k == 1u && !order ? 0u : simplify_pieces(d, lod_indices(d, m, all, k - 1u), prev_n, order, scratch, &dev_abs);
             free(order);
@@ -276,22 +278,50 @@ static size_t interleaved_layout(const sy_gl_mesh_desc *d, const float *const ar
  * UPLOAD_PIECE_VERTICES at a time (a 10^7-triangle mesh's whole interleaved copy was 16 bytes per
  * triangle at the peak, issue 39). false without memory. */
 static bool upload_interleaved(const sy_gl_fns *gl, const sy_gl_mesh_desc *d, const float *const arrays[5],
-                               const int offs[5], int stride)
+                               const int offs[5], int stride, const uint32_t *order)
 {
     uint32_t piece = d->vertex_count < UPLOAD_PIECE_VERTICES ? d->vertex_count : UPLOAD_PIECE_VERTICES;
     float *vb = malloc((size_t)piece * (size_t)stride * sizeof(float));
     if (!vb) return false;
     for (uint32_t first = 0; first < d->vertex_count; first += piece) {
         uint32_t count = d->vertex_count - first < piece ? d->vertex_count - first : piece;
-        for (uint32_t i = 0; i < count; ++i)
+        for (uint32_t i = 0; i < count; ++i) {
+            size_t v = order ? order[first + i] : first + i;
             for (int a = 0; a < 5; ++a)
                 if (arrays[a])
-                    memcpy(vb + (size_t)i * (size_t)stride + offs[a], arrays[a] + (size_t)(first + i) * vertex_comps[a],
+                    memcpy(vb + (size_t)i * (size_t)stride + offs[a], arrays[a] + v * vertex_comps[a],
                            vertex_comps[a] * sizeof(float));
+        }
         gl->BufferSubData(GL_ARRAY_BUFFER, (GLintptr)((size_t)first * (size_t)stride * sizeof(float)),
                           (GLsizeiptr)((size_t)count * (size_t)stride * sizeof(float)), vb);
     }
     free(vb);
+    return true;
+}
+
+/* The vertex order of a mesh with levels (mesh_o.order): the coarsest level's vertices first, in
+ * the order its indices name them, then each finer level's new ones, then any vertex no triangle
+ * uses. Into *order (malloc'd) and *where (malloc'd, the inverse: a mesh vertex's buffer position);
+ * false without memory. */
+static bool level_vertex_order(const sy_gl_mesh_desc *d, const mesh_o *m, const uint32_t *levels, uint32_t **order,
+                               uint32_t **where)
+{
+    uint32_t *o = malloc(sizeof *o * d->vertex_count), *w = malloc(sizeof *w * d->vertex_count);
+    if (!o || !w) {
+        free(o), free(w);
+        return false;
+    }
+    memset(w, 0xff, sizeof *w * d->vertex_count);
+    uint32_t next = 0;
+    for (uint32_t k = m->lod_count; k-- > 0;) {
+        const uint32_t *idx = lod_indices(d, m, levels, k);
+        for (size_t i = 0; i < 3u * (size_t)m->lod_tris[k]; ++i)
+            if (w[idx[i]] == UINT32_MAX) w[idx[i]] = next, o[next++] = idx[i];
+    }
+    for (uint32_t v = 0; v < d->vertex_count; ++v)
+        if (w[v] == UINT32_MAX) w[v] = next, o[next++] = v;
+    *order = o;
+    *where = w;
     return true;
 }
 
@@ -332,6 +362,9 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     size_t index_count = 0;
     build_lods(d, m, &lods, &index_count);
     check_closed(d, m, lods);
+    uint32_t *where = NULL; /* with m->order: a mesh vertex's buffer position */
+    if (lods && d->vertex_count >= LOD_REORDER_VERTICES && level_vertex_order(d, m, lods, &m->order, &where))
+        for (size_t i = 0; i < index_count - 3u * (size_t)d->triangle_count; ++i) lods[i] = where[lods[i]];
     m->cap_closed = (int8_t)(d->closed > 0 ? 1 : d->closed < 0 ? -1 : 0);
     gl->GenVertexArrays(1, &m->vao);
     gl->BindVertexArray(m->vao);
@@ -342,8 +375,8 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     gl->GenBuffers(1, &m->vbo[0]);
     gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
     gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, NULL, GL_STATIC_DRAW);
-    if (!upload_interleaved(gl, d, arrays, offs, stride)) {
-        free(lods);
+    if (!upload_interleaved(gl, d, arrays, offs, stride, m->order)) {
+        free(lods), free(where);
         gl->BindVertexArray(0);
         sy_gl_mesh h = {m->h.id};
         sy_gl_mesh_destroy(dev, h);
@@ -365,11 +398,21 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
         /* the mesh's indices, then the levels: no copy of the mesh's in between */
         size_t n0 = 3u * (size_t)d->triangle_count * sizeof(uint32_t);
         gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)bytes, lods ? NULL : d->indices, GL_STATIC_DRAW);
-        if (lods) {
+        if (lods && where) { /* level 0 renumbered a piece at a time */
+            uint32_t piece[16384];
+            size_t count = n0 / sizeof(uint32_t);
+            for (size_t first = 0; first < count; first += 16384u) {
+                size_t c = count - first < 16384u ? count - first : 16384u;
+                for (size_t i = 0; i < c; ++i) piece[i] = where[d->indices[first + i]];
+                gl->BufferSubData(GL_ELEMENT_ARRAY_BUFFER, (GLintptr)(first * sizeof(uint32_t)),
+                                  (GLsizeiptr)(c * sizeof(uint32_t)), piece);
+            }
+        } else if (lods) {
             gl->BufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, (GLsizeiptr)n0, d->indices);
-            gl->BufferSubData(GL_ELEMENT_ARRAY_BUFFER, (GLintptr)n0, (GLsizeiptr)(bytes - n0), lods);
         }
+        if (lods) gl->BufferSubData(GL_ELEMENT_ARRAY_BUFFER, (GLintptr)n0, (GLsizeiptr)(bytes - n0), lods);
         free(lods);
+        free(where);
         sy_gli_count_buffer(dev, false, bytes);
         m->indexed = true;
     }
@@ -411,7 +454,7 @@ sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_m
     size_t bytes = interleaved_layout(d, arrays, offs, &stride);
     const sy_gl_fns *gl = dev->gl;
     gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
-    bool ok = upload_interleaved(gl, d, arrays, offs, stride);
+    bool ok = upload_interleaved(gl, d, arrays, offs, stride, m->order);
     gl->BindBuffer(GL_ARRAY_BUFFER, 0);
     if (!ok) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh update: out of memory (%u vertices)", d->vertex_count);
     sy_gli_count_buffer(dev, false, bytes);
@@ -429,6 +472,7 @@ sy_gl_result sy_gl_mesh_destroy(sy_gl_device *dev, sy_gl_mesh mesh)
         dev->gl->DeleteBuffers(1, &m->ibo);
         dev->gl->DeleteVertexArrays(1, &m->vao);
     }
+    free(m->order);
     sy_gli_pool_free(&dev->meshes, m);
     sy_gli_geometry_changed(dev);
     return SY_GL_OK;
