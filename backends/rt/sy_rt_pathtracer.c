@@ -30,7 +30,12 @@
  * pixel point, 8 % less than sets of their own); per bounce k set 1 + 2k = light sample, set 2 + 2k
  * = BSDF lobe choice, direction (from the third bounce on) and roulette; set 2's dimensions 1 and 2,
  * unused by the first bounce, place the camera ray in the pixel. Alpha-blend decisions use a hash
- * of their own. */
+ * of their own.
+ *
+ * Stage timers (desc->stage_times, sy_rt_raylog.h >>stage timers, `sy bench limit`): one pixel in
+ * SY_RT_STAGE_SUBSET runs a second inlined copy of the path loop (trace_sample with timed = true)
+ * that reads the time stamp counter at every change of stage (LAP); the light sample's functions,
+ * shared by both copies, do so when the tile's clock is set (CLAP). The samples are the same. */
 #include "sy_rt_pathtracer.h"
 #include "sy_rt_accum.h"
 #include "sy_rt_bsdf.h"
