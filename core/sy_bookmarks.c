@@ -18,6 +18,8 @@ sy_result sy_bookmark_check(const sy_bookmark *b, sy_error *err)
     sy_mat4 m;
     if (!sy_mat4_look_at(b->eye, b->target, b->up, &m))
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "up is zero or parallel to the viewing direction");
+    if (!(b->fov == 0.0f || (b->fov > 0.0f && b->fov < 3.14159265f)))
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "the field of view is not above 0 and below 180 degrees");
     return SY_OK;
 }
 
@@ -56,10 +58,10 @@ sy_result sy_bookmarks_load(const char *path, sy_bookmark slots[SY_BOOKMARKS_MAX
                 r = sy_error_set(err, SY_ERR_PARSE, "bookmarks %s:%u: a NUL byte: not a text file", path, line_no);
                 break;
             }
-            double v[10];
+            double v[11];
             int k = 0;
             char *e = s;
-            for (; k < 10; ++k) {
+            for (; k < 11; ++k) {
                 char *end;
                 v[k] = strtod(e, &end);
                 if (end == e) break;
@@ -67,14 +69,18 @@ sy_result sy_bookmarks_load(const char *path, sy_bookmark slots[SY_BOOKMARKS_MAX
             }
             while (*e == ' ' || *e == '\t' || *e == '\r') e++;
             if (k < 10 || *e)
-                r = sy_error_set(err, SY_ERR_PARSE, "bookmarks %s:%u: expected \"N EX EY EZ TX TY TZ UX UY UZ\" (a slot "
-                                 "1..9 and nine numbers)", path, line_no);
+                r = sy_error_set(err, SY_ERR_PARSE, "bookmarks %s:%u: expected \"N EX EY EZ TX TY TZ UX UY UZ [FOV]\" (a slot "
+                                 "1..9, nine numbers and the field of view in degrees or nothing)", path, line_no);
+            else if (k == 11 && !(v[10] > 0.0 && v[10] < 180.0))
+                r = sy_error_set(err, SY_ERR_PARSE, "bookmarks %s:%u: field of view %g: not above 0 and below 180 degrees", path,
+                                 line_no, v[10]);
             else if (!(v[0] >= 1 && v[0] <= SY_BOOKMARKS_MAX && v[0] == floor(v[0])))
                 r = sy_error_set(err, SY_ERR_PARSE, "bookmarks %s:%u: slot %g is not one of 1..%d", path, line_no, v[0],
                                  SY_BOOKMARKS_MAX);
             if (r == SY_OK) {
                 sy_bookmark b = {.set = true};
                 for (int i = 0; i < 3; ++i) b.eye[i] = (float)v[1 + i], b.target[i] = (float)v[4 + i], b.up[i] = (float)v[7 + i];
+                if (k == 11) b.fov = (float)(v[10] * 3.14159265358979323846 / 180.0);
                 sy_error e2 = {0};
                 if (sy_bookmark_check(&b, &e2) != SY_OK)
                     r = sy_error_set(err, SY_ERR_PARSE, "bookmarks %s:%u: slot %d: %s", path, line_no, (int)v[0], e2.message);
@@ -101,13 +107,16 @@ sy_result sy_bookmarks_save(const char *path, const sy_bookmark slots[SY_BOOKMAR
         free(tmp);
         return r;
     }
-    fprintf(f, "# sy bookmarks: N eye(x y z) target(x y z) up(x y z); sy view saves with Ctrl+N, recalls with Shift+N\n");
+    fprintf(f, "# sy bookmarks: N eye(x y z) target(x y z) up(x y z) [vertical field of view, degrees]; sy view saves with "
+               "Ctrl+N, recalls with Shift+N\n");
     for (int i = 1; i <= SY_BOOKMARKS_MAX; ++i) {
         const sy_bookmark *b = &slots[i];
         if (!b->set) continue;
-        fprintf(f, "%d %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", i, (double)b->eye[0], (double)b->eye[1],
+        fprintf(f, "%d %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g", i, (double)b->eye[0], (double)b->eye[1],
                 (double)b->eye[2], (double)b->target[0], (double)b->target[1], (double)b->target[2], (double)b->up[0],
                 (double)b->up[1], (double)b->up[2]);
+        if (b->fov > 0.0f) fprintf(f, " %.9g", (double)b->fov * 180.0 / 3.14159265358979323846);
+        fputc('\n', f);
     }
     bool bad = ferror(f) != 0;
     bad |= fclose(f) != 0;

@@ -4,9 +4,11 @@
  * Ctrl+1..9 and recalls them with Shift+1..9; `sy render --bookmark FILE:N` renders one). Turned
  * into an orbit (sy_orbit.h) or a camera-to-world matrix.
  *
- * File format (UTF-8 text, at most SY_BOOKMARKS_FILE_MAX bytes): lines "N EX EY EZ TX TY TZ UX UY UZ"
- * (N 1..9, then eye, target and up, finite numbers), blank lines and lines starting with '#'
- * ignored; a slot given twice keeps the last line.
+ * File format (UTF-8 text, at most SY_BOOKMARKS_FILE_MAX bytes): lines "N EX EY EZ TX TY TZ UX UY UZ
+ * [FOV]" (N 1..9, then eye, target and up, finite numbers, then optionally the vertical field of
+ * view in degrees, above 0 and below 180; a line without it, as files written before it was saved,
+ * keeps the camera's own), blank lines and lines starting with '#' ignored; a slot given twice
+ * keeps the last line.
  *
  * Ownership: the caller's arrays. Thread-safety: pure functions and one file per call. */
 #ifndef SY_BOOKMARKS_H
@@ -28,10 +30,11 @@ typedef struct sy_bookmark {
     float eye[3];    /**< camera position (world) */
     float target[3]; /**< the point looked at (world), not eye */
     float up[3];     /**< up direction, not parallel to target - eye */
+    float fov;       /**< vertical field of view, radians, in (0, pi); 0: not saved (the camera's own) */
 } sy_bookmark;
 
 /** SY_OK when b is a view a camera can take: finite, within SY_COORD_MAX, eye != target, up not
- * zero nor parallel to the viewing direction (sy_mat4_look_at); else SY_ERR_INVALID_ARGUMENT saying
+ * zero nor parallel to the viewing direction (sy_mat4_look_at), fov 0 or in (0, pi); else SY_ERR_INVALID_ARGUMENT saying
  * why. */
 sy_result sy_bookmark_check(const sy_bookmark *b, sy_error *err);
 
@@ -45,7 +48,8 @@ sy_result sy_bookmarks_load(const char *path, sy_bookmark slots[SY_BOOKMARKS_MAX
  * the same folder, so a reader never sees half a file). SY_ERR_IO naming the file when it cannot. */
 sy_result sy_bookmarks_save(const char *path, const sy_bookmark slots[SY_BOOKMARKS_MAX + 1], sy_error *err);
 
-/** The view of an orbit: eye and target, up (0, 1, 0) (an orbit has no roll). */
+/** The view of an orbit: eye and target, up (0, 1, 0) (an orbit has no roll); fov 0 (the caller
+ * sets the camera's). */
 sy_bookmark sy_bookmark_of_orbit(const sy_orbit *o);
 
 /** The orbit looking from b's eye at its target (its up is dropped: orbits keep +Y up; the pitch

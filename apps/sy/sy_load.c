@@ -105,6 +105,7 @@ int sy_cli_view_option(int c, const char *value)
         memcpy(v->eye, b->eye, sizeof v->eye);
         memcpy(v->target, b->target, sizeof v->target);
         memcpy(v->up, b->up, sizeof v->up);
+        if (b->fov > 0 && !(v->fov > 0)) v->fov = b->fov; /* its field of view, unless --fov gives one */
         v->look_at = v->bookmark = true;
     } else if (c == OPT_LOOK_AT) {
         if (v->bookmark) return view_usage("--look-at", value, "--look-at and --bookmark both place the camera; give one of them");

@@ -34,7 +34,8 @@ typedef struct loaded {
 /* Where the camera is put (sy render, pick, view, web): --look-at EYE:TARGET[:UP], --orbit AZ,EL[,DIST],
  * --bookmark FILE:N (a view sy view saved, sy_bookmarks.h; exclusive), --fov DEG (the vertical field of view of whichever camera is used). */
 typedef struct sy_view_options {
-    bool look_at;                   /* --look-at given (or --bookmark FILE:N: the saved view's eye, target and up) */
+    bool look_at;                   /* --look-at given (or --bookmark FILE:N: the saved view's eye, target, up and
+                                     * field of view when it holds one; --fov still wins) */
     bool bookmark;                  /* --bookmark given */
     float eye[3], target[3], up[3]; /* up (0,1,0) when not given */
     bool orbit;                     /* --orbit given */

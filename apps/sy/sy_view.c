@@ -61,6 +61,8 @@ typedef struct viewer {
     /* saved views: Ctrl+1..9 saves the view in slot N (to args->bookmarks), Shift+1..9 recalls it */
     sy_bookmark marks[SY_BOOKMARKS_MAX + 1];
     char mark_status[160];
+    float fov;     /* the camera's vertical field of view (radians; 0: orthographic), saved with a view */
+    float fov_req; /* a recalled view's field of view for the render thread to set on the camera (0: none) */
     bool redraw; /* a key changed what the frame shows besides the view (planes, caps, a status): render again */
     /* render thread -> input thread (under mu) */
     uint8_t *img;
@@ -415,8 +417,22 @@ static void *render_main(void *p)
         memcpy(clip_planes, v->clip_planes, sizeof clip_planes);
         memcpy(cap_color, v->cap_color, sizeof cap_color);
         bool clip_cap = v->clip_cap, redraw = v->redraw;
-        v->redraw = false;
+        float fov_req = v->fov_req;
+        v->redraw = false, v->fov_req = 0.0f;
         pthread_mutex_unlock(&v->mu);
+        if (fov_req > 0.0f) { /* a recalled view's field of view: the camera's, a scene change */
+            const sy_node_data *cnd = sy_node_get(a->scene, a->spec.camera);
+            const sy_camera_data *cd = cnd && cnd->camera.id ? sy_camera_get(a->scene, cnd->camera) : NULL;
+            if (cd) {
+                sy_camera_data nd = *cd;
+                char *name = cd->name ? strdup(cd->name) : NULL; /* the scene's copy is replaced by the set */
+                nd.yfov = fov_req, nd.name = name;
+                sy_result fr = sy_camera_set(a->scene, cnd->camera, &nd, &err);
+                free(name);
+                if (fr != SY_OK || sy_scene_commit(a->scene, NULL, &err) != SY_OK) goto fail_unlocked;
+                redraw = true;
+            }
+        }
         bool time_moved = false;
         if (playing || steps) {
             double now = sy_time_now();
@@ -643,6 +659,7 @@ static void bookmark_key(viewer *v, int slot, bool save)
     sy_bookmark *b = &v->marks[slot];
     if (save) {
         *b = sy_bookmark_of_orbit(&v->in.orbit);
+        b->fov = v->fov; /* the field of view too (0: an orthographic camera's: none) */
         sy_error e = {0};
         if (v->args->bookmarks && sy_bookmarks_save(v->args->bookmarks, v->marks, &e) != SY_OK)
             snprintf(v->mark_status, sizeof v->mark_status, " | view %d kept here only: %.100s", slot, e.message);
@@ -653,6 +670,7 @@ static void bookmark_key(viewer *v, int slot, bool save)
         snprintf(v->mark_status, sizeof v->mark_status, " | no view saved in %d (Ctrl+%d saves one)", slot, slot);
     } else {
         v->in.orbit = sy_orbit_of_bookmark(b);
+        if (b->fov > 0.0f && v->fov > 0.0f && b->fov != v->fov) v->fov_req = v->fov = b->fov; /* the render thread sets it */
         snprintf(v->mark_status, sizeof v->mark_status, " | view %d", slot);
     }
 }
@@ -889,6 +907,10 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: the scene has no camera");
     }
     v.in = in0;
+    {
+        const sy_camera_data *cd = sy_camera_get(args->scene, cn->camera);
+        v.fov = cd && cd->projection == SY_PROJECTION_PERSPECTIVE ? cd->yfov : 0.0f;
+    }
     int fbw, fbh;
     glfwGetFramebufferSize(win, &fbw, &fbh);
     v.w = (uint32_t)fbw, v.h = (uint32_t)fbh;

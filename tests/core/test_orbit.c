@@ -108,6 +108,7 @@ static int test_bookmarks(void)
     memset(slots, 0, sizeof slots);
     slots[2] = b, slots[9] = b;
     slots[9].up[0] = 0.25f;
+    slots[9].fov = 0.5f; /* radians; slot 2 keeps none (the camera's own) */
     sy_error e = {0};
     CHECK(sy_bookmarks_save(path, slots, &e) == SY_OK);
     CHECK(sy_bookmarks_load(path, got, &e) == SY_OK);
@@ -117,10 +118,35 @@ static int test_bookmarks(void)
         CHECK_NEAR(got[2].target[k], b.target[k], 1e-6);
     }
     CHECK_NEAR(got[9].up[0], 0.25, 1e-7);
+    CHECK_NEAR(got[9].fov, 0.5, 1e-6);
+    CHECK(got[2].fov == 0.0f);
+    /* a file of before the field of view (nine numbers a line) loads, its views without one */
+    FILE *old = fopen(path, "w");
+    CHECK(old != NULL);
+    if (old) {
+        fputs("# sy bookmarks: N eye(x y z) target(x y z) up(x y z)\n3 0 0 5 0 0 0 0 1 0\n", old);
+        fclose(old);
+    }
+    CHECK(sy_bookmarks_load(path, got, &e) == SY_OK && got[3].set && got[3].fov == 0.0f && got[3].eye[2] == 5.0f);
+    /* 60 degrees read as radians */
+    old = fopen(path, "w");
+    CHECK(old != NULL);
+    if (old) {
+        fputs("4 0 0 5 0 0 0 0 1 0 60\n", old);
+        fclose(old);
+    }
+    CHECK(sy_bookmarks_load(path, got, &e) == SY_OK && got[4].set);
+    CHECK_NEAR(got[4].fov, 1.0471976, 1e-6);
+    sy_bookmark nofov = got[4];
+    nofov.fov = 3.2f;
+    CHECK(sy_bookmark_check(&nofov, NULL) == SY_ERR_INVALID_ARGUMENT);
     static const struct { const char *text, *want; } bad[] = {
         {"1 0 0 5 0 0 0 0 1\n", ":1: expected"},               /* eight numbers */
         {"# c\n\n10 0 0 5 0 0 0 0 1 0\n", ":3: slot 10"},     /* slot out of range */
-        {"1 0 0 5 0 0 0 0 1 0 7\n", ":1: expected"},           /* one too many */
+        {"1 0 0 5 0 0 0 0 1 0 7 8\n", ":1: expected"},         /* one too many */
+        {"1 0 0 5 0 0 0 0 1 0 180\n", "field of view 180"},    /* the field of view: (0, 180) degrees */
+        {"1 0 0 5 0 0 0 0 1 0 0\n", "field of view 0"},
+        {"1 0 0 5 0 0 0 0 1 0 nan\n", "field of view nan"},
         {"1 0 0 5 0 0 0 0 0 0\n", "up is zero"},               /* zero up */
         {"1 0 0 nan 0 0 0 0 1 0\n", "not finite"},             /* NaN */
         {"1 0 0 5 0 0 0 0 1 0\n2 x\n", ":2: expected"},       /* the second line */

@@ -12,7 +12,8 @@
 #     difference; --plane 0,1,0,0: each hit's plane_distance is its y
 #   - sy pick --clip-cap: a pick through the cut lands on the cap ("cap": 1, on the plane); not without it
 #   - sy render --bookmark FILE:N renders the pixels of --look-at with the file's eye, target and up
-#     (exr_equal)
+#     (exr_equal), and with its field of view those of --look-at --fov (a line without one: the
+#     camera's; --fov given wins); a field of view outside (0, 180) is a usage error
 # Needs ../shared/testdata (Box): exits 77 (skipped) naming what is missing.
 set -u
 SY=$1
@@ -137,6 +138,19 @@ printf '# saved\n3 1.5 1 2.5 0 0.1 0 0 1 0\n' >"$TMP/box.bookmarks"
 run_ok "render --bookmark" bm "$SY" render "$BOX" -b whitted -w 64 -h 48 --bookmark "$TMP/box.bookmarks:3" -o "$TMP/bm.exr"
 run_ok "render --look-at" la "$SY" render "$BOX" -b whitted -w 64 -h 48 --look-at 1.5,1,2.5:0,0.1,0:0,1,0 -o "$TMP/la.exr"
 "$EXR_EQUAL" "$TMP/bm.exr" "$TMP/la.exr" >/dev/null || fail "--bookmark FILE:3 is not --look-at of its view"
+# a saved view with its field of view (the tenth number, degrees) renders as --look-at with --fov;
+# --fov given as well wins; the line without one above stays the camera's (a file of before)
+printf '3 1.5 1 2.5 0 0.1 0 0 1 0 30
+' >"$TMP/fov.bookmarks"
+run_ok "render --bookmark with fov" bmf "$SY" render "$BOX" -b whitted -w 64 -h 48 --bookmark "$TMP/fov.bookmarks:3" -o "$TMP/bmf.exr"
+run_ok "render --look-at --fov 30" laf "$SY" render "$BOX" -b whitted -w 64 -h 48 --look-at 1.5,1,2.5:0,0.1,0:0,1,0 --fov 30 -o "$TMP/laf.exr"
+"$EXR_EQUAL" "$TMP/bmf.exr" "$TMP/laf.exr" >/dev/null || fail "--bookmark FILE:3 with 30 degrees is not --look-at --fov 30"
+"$EXR_EQUAL" "$TMP/bmf.exr" "$TMP/la.exr" >/dev/null 2>&1 && fail "the bookmark's field of view changed nothing"
+run_ok "render --bookmark --fov" bmf2 "$SY" render "$BOX" -b whitted -w 64 -h 48 --fov 30 --bookmark "$TMP/box.bookmarks:3" -o "$TMP/bmf2.exr"
+"$EXR_EQUAL" "$TMP/bmf2.exr" "$TMP/laf.exr" >/dev/null || fail "--fov 30 with a bookmark without one is not --look-at --fov 30"
+printf '3 1.5 1 2.5 0 0.1 0 0 1 0 200
+' >"$TMP/badfov.bookmarks"
+usage "bookmark fov 200" "field of view 200" render "$BOX" -w 16 -h 16 -o "$TMP/u.png" --bookmark "$TMP/badfov.bookmarks:3"
 
 [ $fails -eq 0 ] && echo "integration_section_cli: ok"
 [ $fails -eq 0 ]
