@@ -109,7 +109,8 @@ static void idmap_free(idmap *m)
 
 typedef struct writer {
     const sy_scene *s;
-    bool full; /* sy_gltf_write_scene: textures, tangents, texcoord 1 and every material extension */
+    bool full; /* sy_gltf_write_scene (and placements with opts->textures): textures, tangents, texcoord 1 and every material extension */
+    uint32_t max_side; /* opts->texture_max_side: larger textures are halved until they fit (0: as they are) */
     idmap meshes, materials, textures;
     sy_gltf_shim_wtexture *wtex;
     uint32_t tex_count;
@@ -254,6 +255,39 @@ static sy_result mesh_index(writer *w, sy_mesh m, int32_t *out)
     return SY_OK;
 }
 
+/* The 8-bit image px (w x h, ch channels) halved (2 x 2 box; an odd last row or column is
+ * averaged with itself) until both sides are at most max_side; *w, *h updated. NULL when out of
+ * memory. */
+static uint8_t *halve_to(const uint8_t *px, uint32_t *w, uint32_t *h, uint32_t ch, uint32_t max_side)
+{
+    uint8_t *cur = NULL;
+    const uint8_t *src = px;
+    uint32_t sw = *w, sh = *h;
+    while (sw > max_side || sh > max_side) {
+        uint32_t dw = sw > 1 ? (sw + 1) / 2 : 1, dh = sh > 1 ? (sh + 1) / 2 : 1;
+        uint8_t *dst = malloc((size_t)dw * dh * ch);
+        if (!dst) {
+            free(cur);
+            return NULL;
+        }
+        for (uint32_t y = 0; y < dh; ++y) {
+            uint32_t y0 = sh > 1 ? 2 * y : 0, y1 = y0 + 1 < sh ? y0 + 1 : y0;
+            for (uint32_t x = 0; x < dw; ++x) {
+                uint32_t x0 = sw > 1 ? 2 * x : 0, x1 = x0 + 1 < sw ? x0 + 1 : x0;
+                for (uint32_t c = 0; c < ch; ++c) {
+                    uint32_t v = src[((size_t)y0 * sw + x0) * ch + c] + src[((size_t)y0 * sw + x1) * ch + c] +
+                                 src[((size_t)y1 * sw + x0) * ch + c] + src[((size_t)y1 * sw + x1) * ch + c];
+                    dst[((size_t)y * dw + x) * ch + c] = (uint8_t)((v + 2) / 4);
+                }
+            }
+        }
+        free(cur);
+        cur = dst, src = dst, sw = dw, sh = dh;
+    }
+    *w = sw, *h = sh;
+    return cur;
+}
+
 /* >>textures: one glTF image (PNG, libpng's simplified writer) and sampler per core texture */
 static sy_result texture_index(writer *w, sy_texture t, int32_t *out)
 {
@@ -274,17 +308,30 @@ static sy_result texture_index(writer *w, sy_texture t, int32_t *out)
         sy_log(SY_LOG_WARNING, "gltf", d->name, "texture %u: no image: left out", t.id);
     } else {
         static const png_uint_32 formats[4] = {PNG_FORMAT_GRAY, PNG_FORMAT_GA, PNG_FORMAT_RGB, PNG_FORMAT_RGBA};
-        png_image im = {.version = PNG_IMAGE_VERSION, .width = ii->width, .height = ii->height,
-                        .format = formats[ii->channels - 1]};
+        uint32_t tw = ii->width, th = ii->height;
+        uint8_t *small = NULL; /* the pixels halved to texture_max_side, when asked */
+        const uint8_t *px = sy_blob_data(d->pixels);
+        if (w->max_side && (tw > w->max_side || th > w->max_side)) {
+            small = halve_to(px, &tw, &th, ii->channels, w->max_side);
+            if (!small) return sy_error_set(w->err, SY_ERR_OUT_OF_MEMORY, "write glTF: texture %u: out of memory", t.id);
+            px = small;
+        }
+        png_image im = {.version = PNG_IMAGE_VERSION, .width = tw, .height = th, .format = formats[ii->channels - 1]};
         png_alloc_size_t size = 0;
-        if (!png_image_write_get_memory_size(im, size, 0, sy_blob_data(d->pixels), 0, NULL))
-            return sy_error_set(w->err, SY_ERR_IO, "write glTF: texture %u: %s", t.id, im.message);
-        uint8_t *png = malloc(size ? size : 1);
-        if (!png) return sy_error_set(w->err, SY_ERR_OUT_OF_MEMORY, "write glTF: texture %u: out of memory", t.id);
-        if (!png_image_write_to_memory(&im, png, &size, 0, sy_blob_data(d->pixels), 0, NULL)) {
-            free(png);
+        if (!png_image_write_get_memory_size(im, size, 0, px, 0, NULL)) {
+            free(small);
             return sy_error_set(w->err, SY_ERR_IO, "write glTF: texture %u: %s", t.id, im.message);
         }
+        uint8_t *png = malloc(size ? size : 1);
+        if (!png) {
+            free(small);
+            return sy_error_set(w->err, SY_ERR_OUT_OF_MEMORY, "write glTF: texture %u: out of memory", t.id);
+        }
+        if (!png_image_write_to_memory(&im, png, &size, 0, px, 0, NULL)) {
+            free(png), free(small);
+            return sy_error_set(w->err, SY_ERR_IO, "write glTF: texture %u: %s", t.id, im.message);
+        }
+        free(small);
         sy_gltf_shim_wtexture *nt = realloc(w->wtex, sizeof *nt * (w->tex_count + 1));
         if (!nt) {
             free(png);
@@ -317,7 +364,7 @@ sy_result sy_gltf_write_placements(const sy_scene *s, const sy_gltf_placement *p
 {
     *glb_out = NULL;
     *len_out = 0;
-    writer w = {.s = s, .err = err};
+    writer w = {.s = s, .full = opts && opts->textures, .max_side = opts ? opts->texture_max_side : 0, .err = err};
     sy_gltf_shim_wnode *nodes = calloc(count ? count : 1, sizeof *nodes);
     sy_result r = nodes ? SY_OK : sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "write GLB: out of memory for %u nodes", count);
     for (uint32_t i = 0; r == SY_OK && i < count; ++i) {
@@ -334,6 +381,7 @@ sy_result sy_gltf_write_placements(const sy_scene *s, const sy_gltf_placement *p
         sy_gltf_shim_wdoc doc = {.generator = opts && opts->generator ? opts->generator : "Switchyard",
                                  .materials = w.wmats, .material_count = w.mat_count,
                                  .meshes = w.wmeshes, .mesh_count = w.mesh_count,
+                                 .textures = w.wtex, .texture_count = w.tex_count,
                                  .nodes = nodes, .node_count = count};
         r = sy_gltf_shim_write_glb(&doc, glb_out, len_out, err);
     }
@@ -484,7 +532,7 @@ sy_result sy_gltf_write_scene(const sy_scene *s, sy_node root, const sy_gltf_wri
 {
     *out = NULL;
     *len_out = 0;
-    scene_writer sw = {.w = {.s = s, .full = true, .err = err}};
+    scene_writer sw = {.w = {.s = s, .full = true, .max_side = opts ? opts->texture_max_side : 0, .err = err}};
     const sy_node_data *rd = sy_node_get(s, root);
     sy_result r = rd ? SY_OK : sy_error_set(err, SY_ERR_INVALID_HANDLE, "write glTF: root node %u is stale", root.id);
     int32_t *roots = NULL;

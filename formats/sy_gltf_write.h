@@ -8,7 +8,8 @@
  * min / max), NORMAL, TEXCOORD_0 and COLOR_0 when present, uint16 or uint32 indices, the mode (triangles,
  * lines, points); each material used once as a glTF metallic-roughness material: base colour,
  * metallic, roughness, emissive (+ KHR_materials_emissive_strength), alpha mode / cutoff, double
- * sided, KHR_materials_unlit. Not written: textures (and texture coordinate set 1, tangents),
+ * sided, KHR_materials_unlit; with sy_gltf_write_options.textures every material field and texture
+ * (as sy_gltf_write_scene). Not written by default: textures (and texture coordinate set 1, tangents),
  * lights, cameras, the node hierarchy (placements are flattened to world matrices), stroke widths,
  * animations (sy_gltf_write_scene warns for each; nodes are written in their current pose).
  * sy_gltf_load reads the result back (tests/cull: round trip).
@@ -37,6 +38,13 @@ typedef struct sy_gltf_placement {
 /** Options of the writers. Zero-initialise ({0}) for the defaults. */
 typedef struct sy_gltf_write_options {
     const char *generator; /**< asset.generator; NULL = "Switchyard" */
+    /** sy_gltf_write_placements: the materials in full as sy_gltf_write_scene writes them (every
+     * texture slot as an embedded PNG with its sampler and transform, every extension; tangents and
+     * TEXCOORD_1 of the primitives); false: the factors of the file comment only. */
+    bool textures;
+    /** Textures wider or taller than this are halved (2 x 2 box) until they fit; 0: written as they
+     * are. Bounds what a GLB of textured objects costs (the culling service's /api/object). */
+    uint32_t texture_max_side;
 } sy_gltf_write_options;
 
 /** Limits of sy_gltf_placements_collect: paths through a DAG multiply. */

@@ -414,7 +414,10 @@ sy_result sy_culler_object_glb(sy_culler *c, uint32_t id, uint8_t **glb_out, siz
     if (r != SY_OK) return r;
     const cull_obj *o = obj_find(c, id);
     if (!o) return sy_error_set(err, SY_ERR_NOT_FOUND, "cull: no object %u (ids are those /api/cull lists)", id);
-    sy_gltf_write_options wo = {.generator = "Switchyard culling service"};
+    /* the materials in full with their textures, halved to SY_CULL_TEXTURE_MAX_SIDE at most: the
+     * page draws a textured model as the rasterizer does */
+    sy_gltf_write_options wo = {.generator = "Switchyard culling service", .textures = true,
+                                .texture_max_side = SY_CULL_TEXTURE_MAX_SIDE};
     r = sy_gltf_write_placements(c->scene, c->placements + o->first, o->count, &wo, glb_out, len_out, err);
     if (r != SY_OK) sy_error_prefix(err, "cull: object %u", id);
     return r;

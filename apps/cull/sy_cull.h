@@ -114,7 +114,10 @@ sy_result sy_culler_query_json(sy_culler *c, const char *body, size_t len, char 
 
 /** Triangles of object id; SY_ERR_NOT_FOUND when id is not an object now. */
 sy_result sy_culler_object_triangles(sy_culler *c, uint32_t id, uint64_t *triangles_out, sy_error *err);
-/** Object id as GLB (every placement with its matrix from the root down; extras {"id": id}); *glb_out
+/** The largest side of a texture in an object's GLB: larger ones are halved until they fit. */
+#define SY_CULL_TEXTURE_MAX_SIDE 1024u
+/** Object id as GLB (every placement with its matrix from the root down; extras {"id": id}; the
+ * materials in full with their textures as PNG, at most SY_CULL_TEXTURE_MAX_SIDE a side); *glb_out
  * is malloc()ed. SY_ERR_NOT_FOUND when id is not an object now. */
 sy_result sy_culler_object_glb(sy_culler *c, uint32_t id, uint8_t **glb_out, size_t *len_out, sy_error *err);
 /** Parses an object id from a URL path segment ("123": decimal digits only, 1..2^32-1);

@@ -92,6 +92,18 @@ static void test_boxes(void)
     sy_material_data md = *(const sy_material_data *)sy_object_defaults(SY_TYPE_MATERIAL);
     md.base_color[0] = 0.25f, md.base_color[1] = 0.5f, md.base_color[2] = 0.75f, md.base_color[3] = 1;
     md.metallic = 0.3f, md.roughness = 0.6f, md.emissive[0] = 0.5f, md.emissive[1] = 0.25f, md.emissive_strength = 2;
+    /* a base colour texture larger than SY_CULL_TEXTURE_MAX_SIDE: the GLB carries it halved */
+    enum { TW = 2 * SY_CULL_TEXTURE_MAX_SIDE + 200, TH = 300 };
+    uint8_t *tpx = malloc((size_t)TW * TH * 4);
+    for (size_t i = 0; i < (size_t)TW * TH * 4; ++i) tpx[i] = (uint8_t)(i % 4 == 3 ? 255 : (i / 4) % 251);
+    sy_blob *tblob;
+    MUST(sy_blob_create_take(tpx, (size_t)TW * TH * 4, &tblob, &err));
+    sy_texture tex;
+    const sy_image_info tinfo = {TW, TH, 4, SY_PIXEL_U8_SRGB};
+    MUST(sy_texture_create(s, "pattern", &tex, &err));
+    MUST(sy_texture_set_image(s, tex, &tinfo, tblob, &err));
+    sy_blob_release(tblob);
+    md.base_color_texture.texture = tex;
     sy_material mat;
     MUST(sy_material_create(s, "blue", &mat, &err));
     MUST(sy_material_set(s, mat, &md, &err));
@@ -290,6 +302,22 @@ static void test_boxes(void)
         EXPECT_MSG(fabsf(mb->emissive[0] - 0.5f) < 1e-6f && fabsf(mb->emissive[1] - 0.25f) < 1e-6f && fabsf(mb->emissive_strength - 2) < 1e-6f,
                    "emission %g %g x %g", mb->emissive[0], mb->emissive[1], mb->emissive_strength);
         EXPECT_MSG(sy_primitive_vertex_count(&mdb->primitives.items[0]) == 24 && mdb->primitives.items[0].normals, "24 vertices with normals");
+        /* the texture: halved until it fits SY_CULL_TEXTURE_MAX_SIDE, each texel the mean of its 2 x 2 */
+        const sy_texture_data *tb = mb->base_color_texture.texture.id ? sy_texture_get(back, mb->base_color_texture.texture) : NULL;
+        EXPECT_MSG(tb != NULL, "the base colour texture came back");
+        if (tb) {
+            const uint8_t *q = sy_blob_data(tb->pixels);
+            uint32_t want_w = (TW + 3) / 4, want_h = (TH + 3) / 4; /* halved twice: 2248 -> 1124 -> 562 */
+            EXPECT_MSG(tb->info.width == want_w && tb->info.height == want_h && tb->info.channels == 4,
+                       "texture %ux%u x %u, want %ux%u x 4", tb->info.width, tb->info.height, tb->info.channels, want_w, want_h);
+            const sy_texture_data *ts = sy_texture_get(s, tex);
+            const uint8_t *o = sy_blob_data(ts->pixels);
+            double sum = 0; /* texel (1, 1): the mean of source texels 4..7 x 4..7 (two halvings, each rounded) */
+            for (int y = 4; y < 8; ++y)
+                for (int x = 4; x < 8; ++x) sum += o[((size_t)y * TW + x) * 4];
+            EXPECT_MSG(q && fabs(q[((size_t)1 * want_w + 1) * 4] - sum / 16) <= 1.0, "texel (1, 1): %u, want %.2f",
+                       q ? q[((size_t)1 * want_w + 1) * 4] : 0, sum / 16);
+        }
     }
     sy_gltf_info_free(&info);
     free(glb);
