@@ -20,8 +20,10 @@
  *      test_it_clip_cap --write DIR writes the capped
  *      images as EXR for looking at.
  *   4. Shadows see the caps: a cube cut open over a ground quad, a directional light shining into
- *      the cut: the ground under the cube stays in shadow in whitted and pathtracer (the cap and
- *      the kept far faces block the light), below half the lit ground. */
+ *      the cut: where the kept half's shadow falls the ground stays in shadow in whitted,
+ *      pathtracer and raster (the cap and the kept far faces block the light; the raster's shadow
+ *      maps draw the cut model with both sides), below half the lit ground, capped or not; where
+ *      only the removed half shadowed it is lit (within 10 %). */
 #include "it_util.h"
 
 #include "sy_exr.h"
@@ -357,6 +359,76 @@ static void test_caps(const char *write_dir)
     sy_scene_destroy(open);
 }
 
+/* ---------------------------------------------------------------- 4. shadows see the caps */
+/* The cube (centre z = 1) over a ground quad (z = 0, half 2), a directional light travelling
+ * (-1, 0, -1) / sqrt(2) (the shadow of a point at height z falls z to its -x side), seen from
+ * (0, 0, 3) straight down. The plane keeps z <= 1: the light enters the kept half of the cube
+ * through the cut (the cap, when capping) and the kept far faces block it, so the ground where the
+ * kept half's shadow falls (x in [-1.2, -0.8]) stays dark, with and without capping; where only the
+ * removed half shadowed (x in [-1.9, -1.6]) it is lit after the cut. Every back-end that cuts. */
+static void test_shadow(void)
+{
+    sy_scene *s;
+    MUST(sy_scene_create(&s, err));
+    sy_material m;
+    MUST(sy_material_create(s, "grey", &m, err));
+    sy_primitive p = {0};
+    p.positions = it_blob(CUBE_P, sizeof CUBE_P);
+    p.indices = it_blob(CUBE_I, sizeof CUBE_I);
+    p.material = m;
+    sy_mesh cube;
+    MUST(sy_mesh_create(s, "cube", &cube, err));
+    MUST(sy_mesh_set_primitives(s, cube, &p, 1, err));
+    sy_primitive_release(&p);
+    const float gq[1][3] = {{0, 0, 2.0f}};
+    sy_mesh ground = it_quad_mesh(s, "ground", gq, &m, 1);
+    sy_node nc, ng, ln;
+    MUST(sy_node_create(s, "cube", &nc, err));
+    MUST(sy_node_set_mesh(s, nc, cube, err));
+    it_set_translation(s, nc, 0, 0, 1.0f);
+    MUST(sy_node_create(s, "ground", &ng, err));
+    MUST(sy_node_set_mesh(s, ng, ground, err));
+    sy_light lamp = it_light(s, "sun", SY_LIGHT_DIRECTIONAL, 3.0f);
+    MUST(sy_node_create(s, "sun", &ln, err));
+    MUST(sy_node_set_light(s, ln, lamp, err));
+    const float t[3] = {0, 0, 3}, q[4] = {0, sinf(0.3926991f), 0, cosf(0.3926991f)}, one[3] = {1, 1, 1};
+    MUST(sy_node_set_trs(s, ln, t, q, one, err));
+    MUST(sy_scene_commit(s, NULL, err));
+    sy_mat4 cam = sy_mat4_identity();
+    cam.m[14] = 3.0f;
+    const float cut[1][4] = {{0, 0, -1, 1.0f}};
+    static const char *const be[3] = {"whitted", "pathtracer", "raster"};
+    for (int i = 0; i < 3; ++i) {
+        const sy_mediator_class *cls = sy_mediator_find(be[i]);
+        if (!cls || !(sy_mediator_class_caps(cls, NULL) & SY_CAP_CLIP)) continue;
+        sy_layer uncut = {0}, capped = {0}, open = {0};
+        render(s, be[i], &cam, cut, 0, NULL, &uncut);
+        render(s, be[i], &cam, cut, 1, CAP, &capped);
+        render(s, be[i], &cam, cut, 1, NULL, &open);
+        double lit = it_region_mean(&uncut, 3.0f, 1.0f, 1.4f, -0.3f, 0.3f, NULL);
+        double kept0 = it_region_mean(&uncut, 3.0f, -1.2f, -0.8f, -0.3f, 0.3f, NULL);
+        double gone0 = it_region_mean(&uncut, 3.0f, -1.9f, -1.6f, -0.3f, 0.3f, NULL);
+        const sy_layer *cuts[2] = {&capped, &open};
+        printf("shadow under a cut cube, %s: lit ground %.4f; the kept half's shadow %.4f uncut", be[i], lit, kept0);
+        EXPECT_MSG(lit > 0.05 && kept0 < 0.5 * lit && gone0 < 0.5 * lit, "%s: no shadow of the uncut cube (%.4f, %.4f vs lit %.4f)",
+                   be[i], kept0, gone0, lit);
+        for (int k = 0; k < 2; ++k) {
+            double kept = it_region_mean(cuts[k], 3.0f, -1.2f, -0.8f, -0.3f, 0.3f, NULL);
+            double gone = it_region_mean(cuts[k], 3.0f, -1.9f, -1.6f, -0.3f, 0.3f, NULL);
+            printf(", %s %.4f (the removed half's %.4f)", k ? "open" : "capped", kept, gone);
+            EXPECT_MSG(kept < 0.5 * lit, "%s, %s: the light came through the cut (%.4f vs lit %.4f)", be[i], k ? "open" : "capped",
+                       kept, lit);
+            EXPECT_MSG(fabs(gone - lit) <= 0.1 * lit, "%s, %s: the removed half still shadows (%.4f vs lit %.4f)", be[i],
+                       k ? "open" : "capped", gone, lit);
+        }
+        printf("\n");
+        sy_layer_destroy(&uncut);
+        sy_layer_destroy(&capped);
+        sy_layer_destroy(&open);
+    }
+    sy_scene_destroy(s);
+}
+
 int main(int argc, char **argv)
 {
     it_register();
@@ -364,5 +436,6 @@ int main(int argc, char **argv)
     test_closed();
     test_bad_colours();
     test_caps(write_dir);
+    test_shadow();
     return sy_check_finish("integration_clip_cap");
 }
