@@ -171,7 +171,8 @@ grep -q "after key \*:.*picked .*(node $NID, triangle [0-9]*) | 1 selected" "$W/
 # section planes, caps, measurement and saved views (issue 37): a click picks, C adds a plane facing
 # the view through the picked point, a second click measures from the first pick and from the plane,
 # ^3 (Ctrl+3) saves the view in --bookmarks, L moves the plane, K caps, X removes it, ~3 (Shift+3)
-# recalls the view; the saved view renders with sy render --bookmark FILE:3 as the viewer shows it
+# recalls the view; the saved view (with the camera's field of view) renders with sy render
+# --bookmark FILE:3 as the viewer shows it
 rm -f "$W/marks"
 timeout 300 xvfb-run -a -s "-screen 0 1024x768x24" "$SY" view demo -b whitted -w 160 -h 90 --bookmarks "$W/marks" \
     --keys '*C*^3LKX~3' --frames 2 --screenshot "$W/view_mark.png" >"$W/view_sec.out" 2>"$W/view_sec.err" || {
@@ -183,6 +184,8 @@ for want in "after key C:.* | 1 plane, last (" "after key \*:.* m from the last 
 done
 grep "after key X:" "$W/view_sec.out" | grep -q " plane[s capped]*, last (" && { echo "FAIL: X left a plane: $(cat "$W/view_sec.out")"; exit 1; }
 grep -q '^3 ' "$W/marks" || { echo "FAIL: no view 3 in the bookmarks file: $(cat "$W/marks")"; exit 1; }
+# the saved view holds the camera's field of view (the demo camera's, degrees) after the nine numbers
+awk '$1 == 3 { exit !(NF == 11 && $11 > 0 && $11 < 180) }' "$W/marks" || { echo "FAIL: view 3 has no field of view: $(cat "$W/marks")"; exit 1; }
 "$SY" render demo -b whitted -w 160 -h 90 --tonemap aces --select "$NID" --bookmark "$W/marks:3" -o "$W/render_mark.png" >/dev/null || exit 1
 "$CMP" "$W/view_mark.png" "$W/render_mark.png" 2 50 || { echo "FAIL: the recalled view is not sy render --bookmark"; exit 1; }
 if "$SY" view demo --keys 'C^' --frames 1 2>"$W/badmod.err"; then echo "FAIL: sy view accepted --keys ending in ^"; exit 1; fi
