@@ -144,6 +144,16 @@ void sy_viewport_set_view(sy_viewport *v, const sy_mat4 *camera_to_world)
     if (camera_to_world) v->view = *camera_to_world;
 }
 
+void sy_viewport_set_background(sy_viewport *v, sy_background background)
+{
+    v->desc.background = background;
+}
+
+sy_background sy_viewport_background(const sy_viewport *v)
+{
+    return v->desc.background;
+}
+
 sy_result sy_viewport_set_clip_planes(sy_viewport *v, const float (*planes)[4], uint32_t count, sy_error *err)
 {
     sy_result r = sy_clip_planes_check(planes, count, err);

@@ -98,6 +98,12 @@ void sy_viewport_set_camera(sy_viewport *v, sy_node camera);
  * Nothing in the scene changes (no commit is needed or made). NULL: the camera node's world matrix
  * again. */
 void sy_viewport_set_view(sy_viewport *v, const sy_mat4 *camera_to_world);
+/** Sets the viewport's background (the world: sy_viewport_desc.background; {0}: none), e.g. to switch
+ * environments (sy web's menu). A background object created for it must be committed before the
+ * render that uses it, as any scene change. */
+void sy_viewport_set_background(sy_viewport *v, sy_background background);
+/** The viewport's background ({0}: none). */
+sy_background sy_viewport_background(const sy_viewport *v);
 /** Sets the viewport's section planes (SY_CAP_CLIP back-ends): up to SY_CLIP_PLANES_MAX planes
  * {a, b, c, d} in world coordinates (copied); what a*x + b*y + c*z + d >= 0 for all of them keeps
  * is drawn, picked and seen by every ray, the rest is cut away. count 0 removes them. Planes

@@ -413,6 +413,31 @@ static sy_result parse_planes(const cJSON *m, sy_web_input *out, sy_error *err)
     return SY_OK;
 }
 
+/* "cap" (optional): absent leaves capping as it is; false or null turns it off; [r, g, b] (linear RGB,
+ * each in [0, 1], as sy_clip_cap_check takes it) turns it on in that colour. */
+static sy_result parse_cap(const cJSON *m, sy_web_input *out, sy_error *err)
+{
+    const cJSON *c = cJSON_GetObjectItemCaseSensitive(m, "cap");
+    out->cap = SY_WEB_CAP_KEEP;
+    if (!c) return SY_OK;
+    if (cJSON_IsFalse(c) || cJSON_IsNull(c)) {
+        out->cap = SY_WEB_CAP_OFF;
+        return SY_OK;
+    }
+    if (!cJSON_IsArray(c) || cJSON_GetArraySize(c) != 3)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "clip: cap must be false or [r, g, b] (linear, 0..1)");
+    for (int k = 0; k < 3; ++k) {
+        const cJSON *v = cJSON_GetArrayItem(c, k);
+        if (!cJSON_IsNumber(v)) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "clip: cap value %d is not a number", k);
+        double d = v->valuedouble;
+        out->cap_rgb[k] = isfinite(d) && fabs(d) <= 3.4e38 ? (float)d : (float)NAN;
+    }
+    sy_error ce = {0};
+    if (sy_clip_cap_check(out->cap_rgb, &ce) != SY_OK) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "clip: cap: %.200s", ce.message);
+    out->cap = SY_WEB_CAP_ON;
+    return SY_OK;
+}
+
 bool sy_web_input_changes_scene(const sy_web_input *in)
 {
     switch (in->type) {
@@ -421,6 +446,7 @@ bool sy_web_input_changes_scene(const sy_web_input *in)
     case SY_WEB_INPUT_ISOLATE:
     case SY_WEB_INPUT_CLIP:
     case SY_WEB_INPUT_EXPOSURE:
+    case SY_WEB_INPUT_ENVIRONMENT:
     case SY_WEB_INPUT_FILTER: return true;
     case SY_WEB_INPUT_KEY: return in->key != 'r'; /* back-ends and the filter keys; R is the camera */
     default: return false;
@@ -521,6 +547,7 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
     } else if (!strcmp(type, "clip")) {
         out->type = SY_WEB_INPUT_CLIP;
         r = parse_planes(m, out, err);
+        if (r == SY_OK) r = parse_cap(m, out, err);
     } else if (!strcmp(type, "tree")) {
         out->type = SY_WEB_INPUT_TREE;
         if (!json_seq(m, &out->seq)) r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "tree: seq must be a whole number 0..2^31");
@@ -537,8 +564,8 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
         out->type = SY_WEB_INPUT_PLAY;
         if (!cJSON_GetObjectItemCaseSensitive(m, "on") || !json_bool(m, "on", &out->on))
             r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "play: on must be true or false");
-    } else if (!strcmp(type, "filter")) {
-        out->type = SY_WEB_INPUT_FILTER;
+    } else if (!strcmp(type, "filter") || !strcmp(type, "environment")) {
+        out->type = type[0] == 'f' ? SY_WEB_INPUT_FILTER : SY_WEB_INPUT_ENVIRONMENT;
         const cJSON *f = cJSON_GetObjectItemCaseSensitive(m, "name");
         size_t n = cJSON_IsString(f) ? strlen(f->valuestring) : 0;
         bool ok = n >= 1 && n < sizeof out->filter;
@@ -546,7 +573,7 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
             char c = f->valuestring[i];
             ok = (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
         }
-        if (!ok) r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "filter: name must be 1..31 of a-z, 0-9, '-', '_'");
+        if (!ok) r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: name must be 1..31 of a-z, 0-9, '-', '_'", type);
         else memcpy(out->filter, f->valuestring, n + 1);
     } else {
         char tn[40];

@@ -139,7 +139,8 @@ typedef enum sy_web_input_type {
     SY_WEB_INPUT_FILTER,   /**< the display filter by name (filter) */
     SY_WEB_INPUT_KEYFRAME, /**< {"t":"keyframe"}: the page's video decoder lost its place */
     SY_WEB_INPUT_TIME,     /**< {"t":"time","s":SECONDS}: the scene clock to that time (a; the range is the server's check) */
-    SY_WEB_INPUT_PLAY      /**< {"t":"play","on":BOOL}: the scene clock plays (on) or pauses */
+    SY_WEB_INPUT_PLAY,     /**< {"t":"play","on":BOOL}: the scene clock plays (on) or pauses */
+    SY_WEB_INPUT_ENVIRONMENT /**< the environment by name (filter: "scene", "studio", "none"; judged by the server) */
 } sy_web_input_type;
 
 /** Node ids a page may name: 1..SY_WEB_NODE_ID_MAX (sy_node.id); unknown ones are refused later. */
@@ -150,6 +151,9 @@ typedef enum sy_web_input_type {
 #define SY_WEB_EXPOSURE_MAX 16.0
 /** The most codec names a size message may list ("codecs"); further ones are ignored. */
 #define SY_WEB_MAX_CODECS 4u
+
+/** A clip message's "cap": absent (capping stays as it is), false / null (off), [r, g, b] (on). */
+typedef enum sy_web_cap { SY_WEB_CAP_KEEP = 0, SY_WEB_CAP_OFF, SY_WEB_CAP_ON } sy_web_cap;
 
 typedef struct sy_web_input {
     sy_web_input_type type;
@@ -164,7 +168,9 @@ typedef struct sy_web_input {
     uint32_t seq;    /**< pick, tree: the page's request number, echoed in the answer (0..2^31) */
     uint32_t plane_count;             /**< clip: planes in use (0..SY_CLIP_PLANES_MAX) */
     float planes[SY_CLIP_PLANES_MAX][4]; /**< clip: {a, b, c, d}, checked by sy_clip_planes_check */
-    char filter[32];                  /**< filter: the name (letters, digits, '-', '_') */
+    sy_web_cap cap;                   /**< clip: what "cap" asks (absent: SY_WEB_CAP_KEEP) */
+    float cap_rgb[3];                 /**< clip, SY_WEB_CAP_ON: the caps' linear RGB, checked by sy_clip_cap_check */
+    char filter[32];                  /**< filter, environment: the name (letters, digits, '-', '_') */
     /** size: the video codecs the page decodes, best first ("codecs": an array of strings of 1..15
      * characters, [a-z0-9.]; the names are not judged here). Entries that are not such strings,
      * beyond SY_WEB_MAX_CODECS, or a "codecs" that is no array are not an error: they are counted
@@ -177,9 +183,9 @@ typedef struct sy_web_input {
 } sy_web_input;
 
 /** True for the messages that change what other viewers see beyond the camera (visibility,
- * selection, section planes, exposure, display filter; keys: back-ends and filter keys): refused
- * by a read-only server (sy_web_desc.read_only). A pick with select is allowed as a plain pick; the
- * scene clock (time, play) is a view change like the camera's: every page may move it. */
+ * selection, section planes, exposure, display filter, environment; keys: back-ends and filter
+ * keys): refused by a read-only server (sy_web_desc.read_only). A pick with select is allowed as a
+ * plain pick; the scene clock (time, play) is a view change like the camera's: every page may move it. */
 bool sy_web_input_changes_scene(const sy_web_input *in);
 
 /** Parses one text message (len bytes, not NUL-terminated); SY_ERR_PARSE / SY_ERR_INVALID_ARGUMENT

@@ -91,6 +91,11 @@ typedef struct web_reply {
 #define WEB_ACTIONS_MAX 256u /* actions queued, all connections (more are dropped with a log line) */
 #define WEB_REPLIES_MAX 64u  /* answers waiting, all connections (more are dropped with a log line) */
 #define WEB_TREE_MAX 4096u   /* nodes in one "tree" answer (a huge scene's answer says it was cut) */
+/* The environments the page's menu offers (sy_web_scene.c): "scene" (the world the server started
+ * with: the scene's or the embedding program's), "studio" (the library's neutral studio as the
+ * light, the start world's background kept), "none" (no environment light, no default light). */
+#define SY_WEB_ENVIRONMENTS 3u
+extern const char *const sy_webi_environment_names[SY_WEB_ENVIRONMENTS];
 
 /* A connection the gate (sy_web_gate.h) hands over with its request: adopted by libwebsockets on
  * the network thread. */
@@ -161,6 +166,8 @@ struct sy_web {
     uint32_t reply_count;
     uint64_t scene_version; /* visibility or selection changed: pages ask for the tree again */
     uint64_t look_version;  /* what a frame shows changed beyond the camera (planes, visibility, exposure) */
+    uint32_t environment;   /* the environment in use: an index of sy_webi_environment_names */
+    sy_background env_made[SY_WEB_ENVIRONMENTS]; /* render thread: the worlds made for the menu ({0}: not yet) */
 };
 
 /* The video encoders of all viewers together take at most this much memory (estimated at the
@@ -188,8 +195,8 @@ typedef struct sy_web_scene_ctx {
     sy_viewport *vp, *still_vp; /* the live and the still viewport (both get the planes) */
     uint32_t backend;        /* the live back-end (registry index) */
 } sy_web_scene_ctx;
-/* Runs and frees the actions (picks, visibility, selection, isolate, planes, tree); true when
- * what frames show changed (the scene was committed or the planes changed). */
+/* Runs and frees the actions (picks, visibility, selection, isolate, planes, environment, tree);
+ * true when what frames show changed (the scene was committed or the planes changed). */
 bool sy_webi_scene_actions(const sy_web_scene_ctx *sc, web_action *list);
 
 /* --- sy_web_http.c --- */

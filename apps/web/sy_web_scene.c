@@ -1,7 +1,8 @@
 /* sy_web_scene.c — what pages ask of the scene, on the render thread (it owns the scene): picks
  * (sy_viewport_pick, with the view and planes of the live frame), visibility, selection and
  * isolation (sy_node_set_visible / _selected, sy_scene_isolate, committed so every context sees
- * them), section planes (sy_viewport_set_clip_planes on the server's viewports) and the scene's
+ * them), section planes and their caps (sy_viewport_set_clip_planes / _clip_cap on the server's
+ * viewports) and the scene's
  * hierarchy, bounded to WEB_TREE_MAX nodes. Answers go back to the asking page as JSON text
  * through the mailbox (web_reply); unknown nodes and failures are logged and answered with a
  * "refused" message, never applied (sy_web_internal.h; docs/WEB.md, "The WebSocket protocol"). */
@@ -9,6 +10,7 @@
 
 #include "sy_graph.h"
 #include "sy_log.h"
+#include "sy_look.h"
 #include "sy_mediator.h"
 #include "sy_viewport.h"
 
@@ -106,6 +108,8 @@ static sy_result pick(const sy_web_scene_ctx *sc, double fx, double fy, sy_pick_
     if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
     if (r == SY_OK) sy_viewport_set_view(vp, &w->view);
     if (r == SY_OK && np) r = sy_viewport_set_clip_planes(vp, (const float(*)[4])planes, np, err);
+    float cap[3];
+    if (r == SY_OK && sy_viewport_clip_cap(sc->vp, cap)) r = sy_viewport_set_clip_cap(vp, cap, err); /* a pick lands on a cap */
     if (r == SY_OK) r = sy_viewport_pick(vp, w->d.scene, sc->pool, x, y, p, err);
     sy_window_destroy(win);
     return r;
@@ -188,6 +192,11 @@ static bool do_clip(const sy_web_scene_ctx *sc, const web_action *a)
     const float(*planes)[4] = (const float(*)[4])a->in.planes;
     sy_result r = sy_viewport_set_clip_planes(sc->vp, planes, a->in.plane_count, &err);
     if (r == SY_OK) r = sy_viewport_set_clip_planes(sc->still_vp, planes, a->in.plane_count, &err);
+    if (r == SY_OK && a->in.cap != SY_WEB_CAP_KEEP) { /* the caps' colour (checked by the parser) or off */
+        const float *rgb = a->in.cap == SY_WEB_CAP_ON ? a->in.cap_rgb : NULL;
+        r = sy_viewport_set_clip_cap(sc->vp, rgb, &err);
+        if (r == SY_OK) r = sy_viewport_set_clip_cap(sc->still_vp, rgb, &err);
+    }
     if (r != SY_OK) {
         refuse(sc->w, a, "clip", err.message);
         return false;
@@ -196,6 +205,83 @@ static bool do_clip(const sy_web_scene_ctx *sc, const web_action *a)
     if (a->in.plane_count && cls && !(cls->caps & SY_CAP_CLIP))
         sy_log(SY_LOG_WARNING, "web", a->peer, "section planes set, but %s cannot cut: it will refuse to render", cls->name);
     return true;
+}
+
+const char *const sy_webi_environment_names[SY_WEB_ENVIRONMENTS] = {"scene", "studio", "none"};
+
+/* The world of environment i, made the first time it is chosen (a scene change: committed by the
+ * caller): "studio" keeps the start world's background and lights with the library's studio
+ * (sy_look_studio_pixels, not seen by the camera); "none" keeps the background without any
+ * environment or default light. */
+static sy_result environment_world(sy_web *w, uint32_t i, sy_background *out, bool *made, sy_error *err)
+{
+    *made = false;
+    if (i == 0) {
+        *out = w->d.background;
+        return SY_OK;
+    }
+    if (w->env_made[i].id) {
+        *out = w->env_made[i];
+        return SY_OK;
+    }
+    sy_scene *s = w->d.scene;
+    const sy_background_data *start = w->d.background.id ? sy_background_get(s, w->d.background) : NULL;
+    sy_background_data bd = *(const sy_background_data *)(start ? start : sy_object_defaults(SY_TYPE_BACKGROUND));
+    bd.name = NULL;
+    bd.environment = (sy_texture){0};
+    bd.default_lighting = 0;
+    bd.intensity = 1.0f;
+    sy_result r = SY_OK;
+    if (i == 1) {
+        uint32_t tw = SY_LOOK_STUDIO_WIDTH, th = SY_LOOK_STUDIO_HEIGHT;
+        float *px = malloc((size_t)tw * th * 3 * sizeof *px);
+        sy_blob *blob = NULL;
+        if (!px) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "environment studio: out of memory");
+        sy_look_studio_pixels(tw, th, px);
+        r = sy_blob_create_take(px, (size_t)tw * th * 3 * sizeof *px, &blob, err); /* px is the blob's now */
+        if (r != SY_OK) free(px);
+        sy_image_info info = {tw, th, 3, SY_PIXEL_F32};
+        sy_sampler smp = {SY_WRAP_REPEAT, SY_WRAP_CLAMP, SY_FILTER_LINEAR, SY_FILTER_LINEAR};
+        if (r == SY_OK) r = sy_texture_create(s, "sy web: studio", &bd.environment, err);
+        if (r == SY_OK) r = sy_texture_set_image(s, bd.environment, &info, blob, err);
+        if (r == SY_OK) r = sy_texture_set_sampler(s, bd.environment, &smp, err);
+        sy_blob_release(blob);
+        bd.environment_visible = 0; /* it lights; the camera sees the start world's background */
+    }
+    sy_background b = {0};
+    if (r == SY_OK) r = sy_background_create(s, i == 1 ? "sy web: studio" : "sy web: no environment", &b, err);
+    if (r == SY_OK) r = sy_background_set(s, b, &bd, err);
+    if (r != SY_OK) return r;
+    w->env_made[i] = *out = b;
+    *made = true;
+    return SY_OK;
+}
+
+/* environment: the world of the menu's choice on the live and the still viewport; true when the
+ * scene changed (a world made now: committed by the caller). */
+static bool do_environment(const sy_web_scene_ctx *sc, const web_action *a, bool *look)
+{
+    sy_web *w = sc->w;
+    uint32_t i = 0;
+    while (i < SY_WEB_ENVIRONMENTS && strcmp(sy_webi_environment_names[i], a->in.filter) != 0) i++;
+    if (i == SY_WEB_ENVIRONMENTS) {
+        refuse(w, a, "environment", "no such environment (scene, studio, none)");
+        return false;
+    }
+    sy_background b;
+    bool made = false;
+    sy_error err = {0};
+    if (environment_world(w, i, &b, &made, &err) != SY_OK) {
+        refuse(w, a, "environment", err.message);
+        return sy_scene_has_pending(w->d.scene);
+    }
+    sy_viewport_set_background(sc->vp, b);
+    sy_viewport_set_background(sc->still_vp, b);
+    pthread_mutex_lock(&w->mu);
+    w->environment = i;
+    pthread_mutex_unlock(&w->mu);
+    *look = true;
+    return true; /* every page is told (a "scene" message: its tree answer names the environment) */
 }
 
 static int cmp_u32(const void *a, const void *b)
@@ -284,6 +370,12 @@ static void do_tree(const sy_web_scene_ctx *sc, const web_action *a)
     uint32_t np = sy_viewport_clip_planes(sc->vp, planes);
     cJSON *pl = cJSON_AddArrayToObject(o, "planes");
     for (uint32_t i = 0; i < np; ++i) cJSON_AddItemToArray(pl, cJSON_CreateFloatArray(planes[i], 4));
+    float cap[3];
+    if (sy_viewport_clip_cap(sc->vp, cap)) add_vec3(o, "cap", cap);
+    else cJSON_AddNullToObject(o, "cap");
+    pthread_mutex_lock(&w->mu);
+    cJSON_AddStringToObject(o, "environment", sy_webi_environment_names[w->environment < SY_WEB_ENVIRONMENTS ? w->environment : 0]);
+    pthread_mutex_unlock(&w->mu);
     free(ids), free(state), free(stack);
     post_reply(w, a, o);
 }
@@ -301,6 +393,7 @@ bool sy_webi_scene_actions(const sy_web_scene_ctx *sc, web_action *list)
         case SY_WEB_INPUT_SELECT:
         case SY_WEB_INPUT_ISOLATE: scene |= do_node(sc, a); break;
         case SY_WEB_INPUT_CLIP: look |= do_clip(sc, a); break;
+        case SY_WEB_INPUT_ENVIRONMENT: scene |= do_environment(sc, a, &look); break;
         case SY_WEB_INPUT_TREE: do_tree(sc, a); break;
         default: break;
         }

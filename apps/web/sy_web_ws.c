@@ -146,7 +146,7 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
         return;
     }
     if (w->d.read_only && sy_web_input_changes_scene(&in)) { /* viewers look, they do not change */
-        ws_warn(c, "read-only server: refused a change (visibility, selection, planes, exposure, filter or back-end)", NULL);
+        ws_warn(c, "read-only server: refused a change (visibility, selection, planes, exposure, filter, environment or back-end)", NULL);
         return;
     }
     if (w->d.read_only && in.type == SY_WEB_INPUT_PICK) in.on = false; /* a pick tells, it does not select */
@@ -164,6 +164,7 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
     case SY_WEB_INPUT_SELECT:
     case SY_WEB_INPUT_ISOLATE:
     case SY_WEB_INPUT_CLIP:
+    case SY_WEB_INPUT_ENVIRONMENT:
     case SY_WEB_INPUT_TREE: { /* the render thread owns the scene: queued for it */
         web_action *a = w->action_count < WEB_ACTIONS_MAX ? calloc(1, sizeof *a) : NULL;
         if (!a) {
@@ -307,9 +308,12 @@ static int ws_send_hello(sy_web *w, struct lws *wsi)
     char name[32];
     for (uint32_t i = 0; i < sy_interactive_filter_count(); ++i)
         cJSON_AddItemToArray(fl, cJSON_CreateString(sy_interactive_filter_name(i, name)));
+    cJSON *envs = cJSON_AddArrayToObject(o, "environments"); /* the menu's choices (sy_web_scene.c) */
+    for (uint32_t i = 0; i < SY_WEB_ENVIRONMENTS; ++i) cJSON_AddItemToArray(envs, cJSON_CreateString(sy_webi_environment_names[i]));
     cJSON_AddBoolToObject(o, "read_only", w->d.read_only);
     pthread_mutex_lock(&w->mu);
     cJSON_AddNumberToObject(o, "exposure", w->exposure);
+    cJSON_AddStringToObject(o, "environment", sy_webi_environment_names[w->environment < SY_WEB_ENVIRONMENTS ? w->environment : 0]);
     pthread_mutex_unlock(&w->mu);
     char *s = cJSON_PrintUnformatted(o);
     cJSON_Delete(o);

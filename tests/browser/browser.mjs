@@ -21,9 +21,9 @@
 //     the centre (the server's still of the view), clicks it (pick + select; the properties show
 //     the node), hides that node from the tree (the streamed canvas changes there; a pick there no
 //     longer names it), shows it again (back as it was), adds a section plane (the canvas
-//     changes), measures two covered points, opens the help, takes a screenshot (the download),
+//     changes; with caps on in magenta, the cut faces show magenta), measures two covered points, opens the help, takes a screenshot (the download),
 //     pinches and drags with synthetic touch pointers; screenshots OUTDIR/page.png, tree.png,
-//     hidden.png, section.png, measure.png, help.png. URL with readonly=1 (sy web --read-only):
+//     hidden.png, section.png, cap.png, measure.png, help.png. URL with readonly=1 (sy web --read-only):
 //     the controls that change the scene are hidden or disabled and a change sent anyway leaves
 //     the tree as it was.
 //   node browser.mjs video URL OUTDIR WIDTH HEIGHT
@@ -40,6 +40,11 @@
 //     presses space (the server's "clock" messages advance), screenshots the page while playing
 //     (OUTDIR/timeline.png), presses space again (paused), then sends bad times (out of range,
 //     not a number) that the server refuses.
+//   node browser.mjs first URL OUTDIR WIDTH HEIGHT
+//     Time to first picture (a measurement, not a check): from the navigation's start to the first
+//     display frame after the page adopted a server frame (its size: the governor's coarse first
+//     frame), then to the first full-size frame; OUTDIR/first.png. Prints {picture_ms, width,
+//     height, backend, dom_ms, full_ms}.
 //   node browser.mjs client URL OUTDIR WIDTH HEIGHT
 //     The client-render page (sy web --client-render): waits until the client is idle (its last
 //     cull answer drawn), writes the canvas to OUTDIR/canvas.png and what the page fetched to
@@ -54,8 +59,8 @@ import { join } from 'node:path';
 
 const [mode, url, outDir, wArg, hArg] = process.argv.slice(2);
 const width = Number(wArg || 480), height = Number(hArg || 360);
-if (!['stream', 'client', 'warp', 'tools', 'video', 'timeline'].includes(mode) || !url || !outDir) {
-  console.error('usage: node browser.mjs stream|client|warp|tools|video|timeline URL OUTDIR [WIDTH HEIGHT]');
+if (!['stream', 'client', 'warp', 'tools', 'video', 'timeline', 'first'].includes(mode) || !url || !outDir) {
+  console.error('usage: node browser.mjs stream|client|warp|tools|video|timeline|first URL OUTDIR [WIDTH HEIGHT]');
   process.exit(2);
 }
 const executablePath = process.env.SY_CHROMIUM || '/usr/bin/chromium';
@@ -114,8 +119,32 @@ try {
     const m = /\/api\/object\/(\d+)/.exec(r.url());
     if (m) fetched.push(Number(m[1]));
   });
+  if (mode === 'first') { // from the navigation's start: the first display frame after the first server frame was adopted
+    await page.addInitScript(() => {
+      window.__first = {};
+      const poll = () => {
+        const s = window.syStats, f = window.__first;
+        if (s && s.frames > 0 && !f.picture_ms) { f.picture_ms = performance.now(); f.width = s.width; f.height = s.height; f.backend = s.backend; }
+        if (!f.picture_ms) requestAnimationFrame(poll);
+      };
+      requestAnimationFrame(poll);
+    });
+  }
   await page.goto(url, { timeout: TIMEOUT });
 
+  if (mode === 'first') {
+    // time to first picture (not a test: printed for docs/WEB.md): the page's clock from the navigation start
+    await page.waitForFunction(() => window.__first && window.__first.picture_ms > 0, null, { timeout: TIMEOUT, polling: 50 });
+    const first = await page.evaluate(() => Object.assign({}, window.__first, {
+      dom_ms: performance.getEntriesByType('navigation')[0].domContentLoadedEventEnd }));
+    await page.screenshot({ path: join(outDir, 'first.png') });
+    // the refinement follows: a full-size frame
+    await page.waitForFunction(([w, h]) => syStats.width === w && syStats.height === h, [width, height], { timeout: TIMEOUT });
+    first.full_ms = await page.evaluate(() => performance.now());
+    console.log(JSON.stringify(first));
+    await browser.close();
+    process.exit(0);
+  }
   if (mode === 'stream') {
     // a full-size frame answering every input sent so far
     const settled = () => page.waitForFunction(
@@ -262,6 +291,26 @@ try {
       await page.waitForFunction((k) => syStats.frames > k, n, { timeout: TIMEOUT });
       await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
     };
+    // a change of the server's view settings (planes, caps, environment) is applied once the answer
+    // to a tree request sent after it says so (the render thread takes the requests in order and
+    // renders after each batch); one tree request at a time: the page drops an older one's answer
+    const applied = async (cond, arg) => {
+      for (let k = 0; ; k++) {
+        const v = await page.evaluate(() => { sy.ui.tree.refresh(); return sy.ui.tree.version; });
+        await page.waitForFunction((x) => sy.ui.tree.version > x, v, { timeout: TIMEOUT });
+        if (await page.evaluate(([c, a]) => new Function('a', 'return ' + c)(a), [cond, arg])) break;
+        if (k === 50) fail(`the server did not apply ${cond} (${arg})`);
+      }
+      // then a frame rendered after it: one that answers inputs sent now (a wheel notch in and out:
+      // the same view), at full size
+      // (each its own frame: in and out in one batch would leave the view as it was, and a view
+      // at rest is not rendered again)
+      for (const steps of [1, -1]) {
+        await page.evaluate((n) => sy.input({ t: 'wheel', steps: n }), steps);
+        await settled();
+      }
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    };
     // the covered pixels of the current view: the server's still at the canvas size (its coverage
     // is the stream's), decoded in the page; the one nearest the centre and one to its right
     const targets = await page.evaluate(async ([w, h]) => {
@@ -346,13 +395,50 @@ try {
       await shown(f0);
       await settled();
       result.show = await diff(before, await canvasB64('shown_canvas.png'), px, py);
+      // (for 3b: where the demo's gold box is, before any plane cuts it)
+      const boxPick = await page.evaluate(async () => {
+        const n = sy.ui.tree.picks;
+        sy.send({ t: 'pick', x: 0.458, y: 0.70, select: false, seq: 77 });
+        for (let k = 0; k < 600 && sy.ui.tree.picks === n; k++) await new Promise((r) => setTimeout(r, 100));
+        return sy.ui.tree.lastPick;
+      });
+      if (!boxPick || !boxPick.hit || !/box/.test(boxPick.name)) fail(`no box at 46 %, 70 % of the canvas: ${JSON.stringify(boxPick)}`);
       // 3. a section plane (X, in the middle of the scene): the image changes; removed: back
       f0 = await frames();
       await page.click('#sy-plane-add');
       await shown(f0);
       await settled();
       await page.screenshot({ path: join(outDir, 'section.png') });
-      result.section = await diff(before, await canvasB64('section_canvas.png'), px, py);
+      const sectionB64 = await canvasB64('section_canvas.png');
+      result.section = await diff(before, sectionB64, px, py);
+      // 3b. caps on in magenta: the cut faces of the closed meshes show that colour (ACES and sRGB
+      // keep a magenta's hue: red and blue high, green low), none did before
+      // the plane turned to Z through the demo's gold box (a closed mesh; the spheres are not),
+      // 0.1 behind its front face (a pick at the box, 46 % across and 70 % down the canvas),
+      // keeping the far side: the cut face looks at the camera
+      await page.evaluate((z) => {
+        const p = sy.ui.planes[0], t = sy.ui.tree, lo = t.min[2], hi = t.max[2], pad = (hi - lo) * 0.01 + 1e-6;
+        p.axis = 'z'; p.flip = true; p.row.querySelector('select').value = 'z';
+        p.t = (z - 0.1 - (lo - pad)) / (hi - lo + 2 * pad); p.range.value = String(p.t);
+        sy.ui.sendPlanes();
+      }, boxPick.position[2]);
+      await applied('sy.ui.tree.planes.length === 1 && sy.ui.tree.planes[0][2] === -1', null);
+      const zcutB64 = await canvasB64('zcut_canvas.png');
+      await page.evaluate(() => sy.ui.setCap('#ff00ff'));
+      await applied('sy.ui.tree.cap && sy.ui.tree.cap[0] === 1 && sy.ui.tree.cap[1] === 0', null);
+      await page.evaluate(() => { document.getElementById('sy-section').scrollIntoView(); });
+      await page.screenshot({ path: join(outDir, 'cap.png') });
+      const magenta = (b64) => page.evaluate(async (s) => {
+        const bm = await createImageBitmap(await (await fetch('data:image/png;base64,' + s)).blob());
+        const c = new OffscreenCanvas(bm.width, bm.height), g = c.getContext('2d'); g.drawImage(bm, 0, 0);
+        const d = g.getImageData(0, 0, bm.width, bm.height).data;
+        let n = 0;
+        for (let i = 0; i < d.length; i += 4) if (d[i] > 150 && d[i + 2] > 150 && d[i + 1] < 90) n++;
+        return n / (bm.width * bm.height);
+      }, b64);
+      result.cap = { before: await magenta(zcutB64), after: await magenta(await canvasB64('cap_canvas.png')) };
+      await page.evaluate(() => sy.ui.setCap(null));
+      await applied('sy.ui.tree.cap === null', null);
       f0 = await frames();
       await page.locator('#sy-section button[title=remove]').click();
       await shown(f0);
@@ -386,6 +472,27 @@ try {
     await page.screenshot({ path: join(outDir, 'help.png') });
     result.help = await page.evaluate(() => document.getElementById('sy-help').innerText.length);
     await page.keyboard.press('Escape');
+    // 5b. the environment menu: "none" then the studio (the tree, every page's menu, names it), back to the scene's
+    if (!readOnly) {
+      result.environment = {};
+      await applied('true', null); // the planes of the measuring step gone, refined
+      const envCanvas = {}, envBefore = await canvasB64('env_before_canvas.png');
+      for (const env of ['none', 'studio', 'scene']) {
+        await page.selectOption('#sy-environment', env);
+        await applied('sy.ui.tree.environment === a', env);
+        if (env === 'none') {
+          await page.evaluate(() => { document.getElementById('sy-panel').scrollTop = 0; });
+          await page.screenshot({ path: join(outDir, 'menu.png') });
+        }
+        envCanvas[env] = await canvasB64(`env_${env}_canvas.png`);
+      }
+      result.environment.none = await diff(envBefore, envCanvas.none, px, py);
+      result.environment.studio = await diff(envBefore, envCanvas.studio, px, py);
+      result.environment.scene = await diff(envBefore, envCanvas.scene, px, py);
+      result.environment.options = await page.evaluate(() => [...document.querySelectorAll('#sy-environment option')].map((o) => o.value));
+    } else {
+      result.environment_hidden = await page.evaluate(() => getComputedStyle(document.getElementById('sy-environment').parentNode).display === 'none');
+    }
     // 6. the screenshot button: a JPEG of the canvas' size, downloaded
     const download = page.waitForEvent('download', { timeout: TIMEOUT });
     await page.click('#sy-shot');

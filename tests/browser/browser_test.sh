@@ -10,13 +10,20 @@
 #     service answered (each once, no other), and what it draws covers what `sy render -b raster`
 #     covers for the same (initial) view (IoU >= 0.95); then with a budget of a quarter of the
 #     scene's triangles: again exactly the answer's objects, fewer than all, drawn within it.
+#   browser_test.sh client SY PNG_IOU MODULES_DIR SCENE MIN_IOU LUM
+#     a textured model: the coverage IoU at least MIN_IOU and the canvas' mean luminance within
+#     LUM (relative) of sy render -b raster's (LUM "print": printed, not checked), the objects
+#     fetched as above (no budget run).
 #   browser_test.sh tools SY PNG_IOU MODULES_DIR SCENE
 #     sy web SCENE -b raster, a 960 x 600 page: a click on a covered pixel picks its node (the
 #     properties name it) and selects it; unticking it in the tree changes the streamed canvas
 #     there (mean abs diff > 30 in a 9 x 9 box) and a pick there no longer names it; ticking it
-#     brings the picture back (< 8); a section plane changes > 0.5% of the canvas; two clicks
+#     brings the picture back (< 8); a section plane changes > 0.5% of the canvas; its caps on in
+#     magenta make > 0.2% of the canvas magenta (and 10 x what was before); two clicks
 #     while measuring give the distance of the two picked points (and, with a plane added, the
-#     second point's signed distance to it); the help opens; the screenshot
+#     second point's signed distance to it); the help opens; the environment menu offers scene,
+#     studio and none, none and studio each change > 5% of the canvas and the scene's world again
+#     brings it back (< 1% changed); the screenshot
 #     button downloads a JPEG; synthetic touch pinch and drag send inputs. Then sy web
 #     --read-only: the page hides the planes, disables the check boxes, shows its badge; a click
 #     selects nothing; a visibility change sent anyway is refused (logged) and changes nothing.
@@ -53,6 +60,7 @@
 # instead, so that the browser coverage is never lost silently.
 set -u
 mode=$1 SY=$2 PNG_IOU=$3 MODULES=$4 SCENE=$5
+MIN_IOU=${6:-0.95} LUM=${7:-} # client: the coverage IoU asked for; the mean luminance's relative tolerance (none: not checked)
 W=480 H=360
 [ "$mode" = tools ] || [ "$mode" = timeline ] && W=960 H=600 # the panel shows beside the canvas from 600 pixels on
 skip() {
@@ -148,17 +156,24 @@ if [ "$mode" = tools ]; then
       const errs = [];
       console.log(`picked node ${t.pick.node} "${t.pick.name}" at ${t.pick.at}; hidden: mean abs diff ${t.hide.box.toFixed(1)} in the 9x9 box, ` +
                   `${(100 * t.hide.changed).toFixed(1)}% of the canvas changed; shown again: ${t.show.box.toFixed(1)}, ${(100 * t.show.changed).toFixed(2)}%; ` +
-                  `section plane: ${(100 * t.section.changed).toFixed(1)}% changed; measured ${t.measure.distance}, to the plane ${t.to_plane && t.to_plane.shown}; screenshot ${JSON.stringify(t.shot)}; ` +
+                  `section plane: ${(100 * t.section.changed).toFixed(1)}% changed; caps: ${(100 * t.cap.before).toFixed(2)}% -> ${(100 * t.cap.after).toFixed(2)}% magenta; measured ${t.measure.distance}, to the plane ${t.to_plane && t.to_plane.shown}; screenshot ${JSON.stringify(t.shot)}; ` +
                   `touch inputs ${t.touch_inputs}`);
       if (!(t.hide.box > 30)) errs.push(`hiding the picked node left the canvas where it was (mean abs diff ${t.hide.box})`);
       if (t.pick_hidden.hit && t.pick_hidden.node === t.pick.node) errs.push("a pick still names the hidden node");
       if (!(t.show.box < 8)) errs.push(`showing it again did not bring the picture back (mean abs diff ${t.show.box})`);
       if (!(t.section.changed > 0.005)) errs.push(`the section plane changed ${t.section.changed} of the canvas`);
+      if (!(t.cap && t.cap.after > 0.002 && t.cap.after > 10 * t.cap.before)) errs.push(`caps on in magenta: ${JSON.stringify(t.cap)} of the canvas magenta`);
       const m = t.measure, d = m.points.length === 2 ? Math.hypot(...[0, 1, 2].map((i) => m.points[1][i] - m.points[0][i])) : NaN;
       if (!(m.distance > 0 && Math.abs(m.distance - d) <= 1e-9 * (1 + d) && m.text.includes("distance"))) errs.push(`measurement ${JSON.stringify(m)}`);
       if (!(t.to_plane && t.to_plane.text && t.to_plane.shown.length === 1 && Math.abs(t.to_plane.shown[0] - t.to_plane.want) <= 1e-9 * (1 + Math.abs(t.to_plane.want))))
         errs.push(`point to plane ${JSON.stringify(t.to_plane)}`);
       if (!(t.help > 200)) errs.push("no help text");
+      const env = t.environment;
+      console.log(`environment: none changes ${(100 * env.none.changed).toFixed(1)}% of the canvas, studio ${(100 * env.studio.changed).toFixed(1)}%, back to the scene world ${(100 * env.scene.changed).toFixed(2)}%`);
+      if (JSON.stringify(env.options) !== JSON.stringify(["scene", "studio", "none"])) errs.push(`environment menu ${JSON.stringify(env.options)}`);
+      if (!(env.scene.changed < 0.01)) errs.push(`the scene world again did not bring the picture back (${env.scene.changed} changed)`);
+      if (!(env.none.changed > 0.05 && env.studio.changed > 0.05)) errs.push(`an environment changed nothing: ${JSON.stringify(env)}`);
+      if (!r.environment_hidden) errs.push("a read-only page shows the environment menu");
       if (t.shot.state !== "done" || t.shot.type !== "image/jpeg" || !(t.shot.bytes > 1000) || !/\.jpg$/.test(t.shot.file)) errs.push(`screenshot ${JSON.stringify(t.shot)}`);
       if (!(t.touch_inputs >= 6)) errs.push(`touch sent ${t.touch_inputs} inputs`);
       if (!r.readOnly || !r.hidden_controls.sections || !r.hidden_controls.checkbox_disabled || !r.hidden_controls.badge) errs.push(`read-only page controls ${JSON.stringify(r.hidden_controls)}`);
@@ -269,10 +284,14 @@ browse "$url"
 # a streamed canvas is JPEG (noise around the background): a wider tolerance than WebGL's
 tol=8
 [ "$mode" = stream ] && tol=24
-res=$("$PNG_IOU" "$out/canvas.png" "$out/ref.png" --min 0.95 --tol $tol)
+lum_args=()
+[ -n "$LUM" ] && lum_args=(--lum "$LUM")
+[ "$LUM" = print ] && lum_args=(--lum 1e30) # printed, not checked (yet: see docs/WEB.md)
+res=$("$PNG_IOU" "$out/ref.png" "$out/canvas.png" --min "$MIN_IOU" --tol $tol "${lum_args[@]}")
 rc=$?
 echo "canvas against sy render -b raster: $res"
-[ $rc = 0 ] || bad "the canvas' coverage differs from sy render -b raster (IoU below 0.95)"
+[ $rc = 0 ] || bad "the canvas differs from sy render -b raster (coverage IoU below $MIN_IOU${LUM:+, or mean luminance more than $LUM apart})"
+[ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out/canvas.png" "$SY_BROWSER_KEEP/${mode}_canvas.png" && cp "$out/ref.png" "$SY_BROWSER_KEEP/${mode}_ref.png"
 
 if [ "$mode" = stream ]; then
     res=$("$PNG_IOU" "$out/canvas.png" "$out/dragged.png" --tol $tol)
@@ -281,6 +300,8 @@ if [ "$mode" = stream ]; then
     awk -v v="$iou" 'BEGIN { exit !(v < 0.98) }' || bad "a drag did not change the view (IoU $iou against before)"
 else
     fetched_check
+    # (a textured model's run checks the look only)
+    [ -n "$LUM" ] && { kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"; [ $fail = 0 ] && echo "ok: sy web $mode in chromium"; exit $fail; }
     # a budget of a quarter of the scene's triangles: the page fetches just what the cut answer lists
     total=$(node -e 'console.log(JSON.parse(require("fs").readFileSync(process.argv[1], "utf8")).total_triangles)' "$out/client.json")
     budget=$((total / 4))

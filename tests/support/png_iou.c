@@ -2,9 +2,13 @@
  * against `sy render`). A pixel is covered when it differs from its image's background colour by
  * more than a tolerance in any of R, G, B; the background colour of each image is its top-left
  * pixel (the views these tests use leave the corners empty) unless --bg gives it.
- *   png_iou A.png B.png [--min IOU] [--tol 0..255] [--bg R,G,B]
- * Prints "iou X covered_a A covered_b B"; exit 0 when IoU >= --min (default 0: always), 1 below,
+ * With --lum REL also the mean luminance of each image (Rec. 709 weights of the linearised sRGB
+ * values, over every pixel, 0..1), and B's within REL of A's (|lum_b / lum_a - 1| <= REL) is required.
+ *   png_iou A.png B.png [--min IOU] [--tol 0..255] [--bg R,G,B] [--lum REL]
+ * Prints "iou X covered_a A covered_b B" (with --lum: "lum_a LA lum_b LB"); exit 0 when IoU >=
+ * --min (default 0: always) and the luminances agree, 1 otherwise,
  * 2 on bad input (unreadable file, different sizes, an image with nothing covered). */
+#include <math.h>
 #include "sy_png.h"
 
 #include <stdio.h>
@@ -22,13 +26,14 @@ static int covered(const uint8_t *p, const int bg[3], int tol)
 
 int main(int argc, char **argv)
 {
-    double min_iou = 0.0;
+    double min_iou = 0.0, lum_rel = -1.0;
     int tol = 24, bg[3] = {0, 0, 0}, have_bg = 0;
     const char *path[2] = {NULL, NULL};
     int np = 0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--min") && i + 1 < argc) min_iou = atof(argv[++i]);
         else if (!strcmp(argv[i], "--tol") && i + 1 < argc) tol = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--lum") && i + 1 < argc) lum_rel = atof(argv[++i]);
         else if (!strcmp(argv[i], "--bg") && i + 1 < argc) {
             if (sscanf(argv[++i], "%d,%d,%d", &bg[0], &bg[1], &bg[2]) != 3) {
                 fprintf(stderr, "png_iou: --bg wants R,G,B (0..255), got '%s'\n", argv[i]);
@@ -37,12 +42,12 @@ int main(int argc, char **argv)
             have_bg = 1;
         } else if (np < 2 && argv[i][0] != '-') path[np++] = argv[i];
         else {
-            fprintf(stderr, "usage: png_iou A.png B.png [--min IOU] [--tol 0..255] [--bg R,G,B]\n");
+            fprintf(stderr, "usage: png_iou A.png B.png [--min IOU] [--tol 0..255] [--bg R,G,B] [--lum REL]\n");
             return 2;
         }
     }
     if (np != 2 || tol < 0 || tol > 255) {
-        fprintf(stderr, "usage: png_iou A.png B.png [--min IOU] [--tol 0..255] [--bg R,G,B]\n");
+        fprintf(stderr, "usage: png_iou A.png B.png [--min IOU] [--tol 0..255] [--bg R,G,B] [--lum REL]\n");
         return 2;
     }
     int w[2], h[2];
@@ -77,9 +82,32 @@ int main(int argc, char **argv)
                     ca == 0 ? bga[2] : bgb[2], tol);
         } else {
             double iou = (double)inter / (double)uni;
-            printf("iou %.4f covered_a %zu covered_b %zu\n", iou, ca, cb);
             rc = iou >= min_iou ? 0 : 1;
-            if (rc) fprintf(stderr, "png_iou: IoU %.4f < %.4f\n", iou, min_iou);
+            if (lum_rel >= 0) {
+                double lum[2] = {0, 0};
+                for (int k = 0; k < 2; ++k) {
+                    for (size_t i = 0; i < n; ++i) {
+                        double y = 0;
+                        static const double wt[3] = {0.2126, 0.7152, 0.0722};
+                        for (int c = 0; c < 3; ++c) {
+                            double v = px[k][4 * i + c] / 255.0;
+                            y += wt[c] * (v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4));
+                        }
+                        lum[k] += y;
+                    }
+                    lum[k] /= (double)n;
+                }
+                printf("iou %.4f covered_a %zu covered_b %zu lum_a %.5f lum_b %.5f\n", iou, ca, cb, lum[0], lum[1]);
+                double rel = lum[0] > 0 ? fabs(lum[1] / lum[0] - 1.0) : INFINITY;
+                if (!(rel <= lum_rel)) {
+                    fprintf(stderr, "png_iou: mean luminance %.5f against %.5f: %.1f%% apart, more than %.1f%%\n", lum[1], lum[0],
+                            100 * rel, 100 * lum_rel);
+                    rc = 1;
+                }
+            } else {
+                printf("iou %.4f covered_a %zu covered_b %zu\n", iou, ca, cb);
+            }
+            if (iou < min_iou) fprintf(stderr, "png_iou: IoU %.4f < %.4f\n", iou, min_iou);
         }
     }
     free(px[0]);

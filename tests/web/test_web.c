@@ -1060,9 +1060,16 @@ static int test_messages(void)
     CHECK(parse_ok("{\"t\":\"isolate\",\"node\":3}", &in) && in.type == SY_WEB_INPUT_ISOLATE && in.node == 3);
     CHECK(parse_ok("{\"t\":\"clip\",\"planes\":[[1,0,0,-0.5],[0,-1,0,2]]}", &in) && in.type == SY_WEB_INPUT_CLIP &&
           in.plane_count == 2 && in.planes[0][3] == -0.5f && in.planes[1][1] == -1.0f);
-    CHECK(parse_ok("{\"t\":\"clip\",\"planes\":[]}", &in) && in.plane_count == 0);
+    CHECK(parse_ok("{\"t\":\"clip\",\"planes\":[]}", &in) && in.plane_count == 0 && in.cap == SY_WEB_CAP_KEEP);
+    /* the caps: [r, g, b] on, false / null off, absent as they are */
+    CHECK(parse_ok("{\"t\":\"clip\",\"planes\":[[1,0,0,0]],\"cap\":[1,0.25,0]}", &in) && in.cap == SY_WEB_CAP_ON &&
+          in.cap_rgb[0] == 1.0f && in.cap_rgb[1] == 0.25f && in.cap_rgb[2] == 0.0f);
+    CHECK(parse_ok("{\"t\":\"clip\",\"planes\":[],\"cap\":false}", &in) && in.cap == SY_WEB_CAP_OFF);
+    CHECK(parse_ok("{\"t\":\"clip\",\"planes\":[],\"cap\":null}", &in) && in.cap == SY_WEB_CAP_OFF);
     CHECK(parse_ok("{\"t\":\"tree\",\"seq\":4}", &in) && in.type == SY_WEB_INPUT_TREE && in.seq == 4);
     CHECK(parse_ok("{\"t\":\"exposure\",\"stops\":-1.5}", &in) && in.type == SY_WEB_INPUT_EXPOSURE && in.a == -1.5);
+    CHECK(parse_ok("{\"t\":\"environment\",\"name\":\"studio\"}", &in) && in.type == SY_WEB_INPUT_ENVIRONMENT &&
+          !strcmp(in.filter, "studio") && sy_web_input_changes_scene(&in));
     CHECK(parse_ok("{\"t\":\"filter\",\"name\":\"atrous\"}", &in) && in.type == SY_WEB_INPUT_FILTER && !strcmp(in.filter, "atrous"));
     /* what a read-only server refuses; the camera, picks and the tree it answers */
     CHECK(sy_web_input_changes_scene(&in));
@@ -1107,6 +1114,13 @@ static int test_messages(void)
         "{\"t\":\"clip\",\"planes\":[[1,0,0,0,0]]}",
         "{\"t\":\"clip\",\"planes\":[[1,0,\"a\",0]]}",
         "{\"t\":\"clip\",\"planes\":{}}",
+        "{\"t\":\"clip\",\"planes\":[],\"cap\":[1,0]}",       /* caps: 3 values in [0, 1] */
+        "{\"t\":\"clip\",\"planes\":[],\"cap\":[1,0,2]}",
+        "{\"t\":\"clip\",\"planes\":[],\"cap\":[1,0,-0.1]}",
+        "{\"t\":\"clip\",\"planes\":[],\"cap\":[1,0,1e400]}",
+        "{\"t\":\"clip\",\"planes\":[],\"cap\":[1,\"0\",0]}",
+        "{\"t\":\"clip\",\"planes\":[],\"cap\":true}",
+        "{\"t\":\"clip\",\"planes\":[],\"cap\":\"#ff0000\"}",
         "{\"t\":\"clip\",\"planes\":[[1,0,0,0],[1,0,0,0],[1,0,0,0],[1,0,0,0],[1,0,0,0],[1,0,0,0],[1,0,0,0]]}",
         "{\"t\":\"tree\",\"seq\":2147483648}",
         "{\"t\":\"exposure\",\"stops\":17}",
@@ -1114,6 +1128,8 @@ static int test_messages(void)
         "{\"t\":\"filter\",\"name\":\"\"}",
         "{\"t\":\"filter\",\"name\":\"../x\"}",
         "{\"t\":\"filter\",\"name\":\"ABC\"}",
+        "{\"t\":\"environment\"}",
+        "{\"t\":\"environment\",\"name\":\"../sky\"}",
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         sy_result r = sy_web_parse_input(bad[i], strlen(bad[i]), &in, &err);
@@ -1246,7 +1262,41 @@ static int test_scene(uint16_t port)
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"pick\",\"x\":1.5,\"y\":0.5}", &err), err);
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":5}", &err), err);
     CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
-    CHECK(json_number(t, "seq") == 5 && strstr(t, "\"planes\":[[0,0,1,-1000000]]"));
+    CHECK(json_number(t, "seq") == 5 && strstr(t, "\"planes\":[[0,0,1,-1000000]]") && strstr(t, "\"cap\":null"));
+    free(t);
+    /* caps: on in a colour (the tree says so), a bad colour refused (kept), a clip without "cap"
+     * keeps them, false turns them off */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[[0,0,1,-1000000]],\"cap\":[1,0.5,0]}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[[0,0,1,-1000000]],\"cap\":[2,0,0]}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[[0,0,1,-1000000]]}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":7}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
+    CHECK(json_number(t, "seq") == 7 && strstr(t, "\"cap\":[1,0.5,0]"));
+    free(t);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[[0,0,1,-1000000]],\"cap\":false}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":8}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
+    CHECK(json_number(t, "seq") == 8 && strstr(t, "\"cap\":null") && strstr(t, "\"environment\":\"scene\""));
+    free(t);
+    /* the environment: none, studio, back to the scene's; every page is told ("scene"), the tree
+     * names it; an unknown one is refused */
+    static const char *const envs[3] = {"none", "studio", "scene"};
+    for (int k = 0; k < 3; ++k) {
+        snprintf(m, sizeof m, "{\"t\":\"environment\",\"name\":\"%s\"}", envs[k]);
+        CHECK_OK(sy_web_client_send(c, m, &err), err);
+        CHECK_OK(sy_web_client_next_text(other, 20000, "scene", &t, &err), err);
+        free(t);
+        snprintf(m, sizeof m, "{\"t\":\"tree\",\"seq\":%d}", 20 + k);
+        CHECK_OK(sy_web_client_send(c, m, &err), err);
+        CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
+        char want[64];
+        snprintf(want, sizeof want, "\"environment\":\"%s\"", envs[k]);
+        CHECK(json_number(t, "seq") == 20 + k && strstr(t, want));
+        free(t);
+    }
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"environment\",\"name\":\"sky\"}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "refused", &t, &err), err);
+    CHECK(strstr(t, "no such environment") != NULL);
     free(t);
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[]}", &err), err);
     if (frame_until(c, px, py, d0, false, &d)) return 1;
@@ -1397,7 +1447,8 @@ static int test_readonly(void)
     CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
     char *t = NULL, m[256];
     CHECK_OK(sy_web_client_next_text(c, 20000, "hello", &t, &err), err);
-    CHECK(strstr(t, "\"read_only\":true"));
+    CHECK(strstr(t, "\"read_only\":true") && strstr(t, "\"environments\":[\"scene\",\"studio\",\"none\"]") &&
+          strstr(t, "\"environment\":\"scene\""));
     free(t);
     int px, py;
     float d0;
@@ -1418,9 +1469,11 @@ static int test_readonly(void)
     CHECK_OK(sy_web_client_send(c, m, &err), err);
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[[0,0,1,-1000000]]}", &err), err);
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"key\",\"k\":\"2\"}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"environment\",\"name\":\"none\"}", &err), err);
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":2}", &err), err);
     CHECK_OK(sy_web_client_next_text(c, 20000, "tree", &t, &err), err);
-    CHECK(json_number(t, "seq") == 2 && !strstr(t, "\"visible\":false") && !strstr(t, "\"selected\":true") && strstr(t, "\"planes\":[]"));
+    CHECK(json_number(t, "seq") == 2 && !strstr(t, "\"visible\":false") && !strstr(t, "\"selected\":true") && strstr(t, "\"planes\":[]") &&
+          strstr(t, "\"environment\":\"scene\""));
     free(t);
     CHECK(sy_web_client_next_text(c, 500, "scene", &t, &err) == SY_ERR_IO);
     /* the camera still moves */

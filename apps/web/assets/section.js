@@ -1,7 +1,8 @@
 // section.js — section planes (docs/WEB.md, "The page"): up to 6 axis-aligned cuts, each an axis
 // (X, Y or Z), a slider across the scene's bounds (the tree message's min / max) and a flip of the
 // kept side; sent as one "clip" message (the server sets them on its viewports: every back-end
-// with SY_CAP_CLIP cuts, picks and shadows alike). A read-only server hides them.
+// with SY_CAP_CLIP cuts, picks and shadows alike). "Cap" fills the cut faces of closed meshes in
+// the chosen colour (sent as the message's "cap": linear RGB, or false). A read-only server hides them.
 "use strict";
 (function () {
   const sy = window.sy, ui = sy.ui, el = ui.el;
@@ -12,6 +13,20 @@
   add.id = "sy-plane-add";
   const planes = ui.planes = []; // {axis, t (0..1 across the bounds), flip, on}
   let timer = 0;
+  // the caps: a switch and a colour (sRGB in the picker, linear on the wire)
+  const capRow = el("label", { title: "fill the cut faces of closed meshes" }, sec, "Cap ");
+  const capOn = el("input", { type: "checkbox", id: "sy-cap" }, capRow);
+  const capColor = el("input", { type: "color", id: "sy-cap-color", value: "#d04020" }, capRow);
+  capOn.addEventListener("change", function () { send(); });
+  capColor.addEventListener("input", function () { if (capOn.checked) send(); });
+  function linear(c) { c /= 255; return c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4); }
+  function cap() {
+    if (!capOn.checked) return false;
+    const h = capColor.value, v = [1, 3, 5].map((i) => linear(parseInt(h.substr(i, 2), 16)));
+    return v.every(isFinite) ? v.map((x) => Math.round(x * 1e4) / 1e4) : false;
+  }
+  // tests and scripts: capping on in colour hex ("#rrggbb"), or off (null)
+  ui.setCap = function (hex) { capOn.checked = !!hex; if (hex) capColor.value = hex; send(); };
   function bounds(i) {
     const t = ui.tree || {};
     const lo = t.min && isFinite(t.min[i]) ? t.min[i] : -1, hi = t.max && isFinite(t.max[i]) ? t.max[i] : 1;
@@ -26,7 +41,7 @@
   }
   function send() {
     clearTimeout(timer);
-    timer = setTimeout(function () { sy.send({ t: "clip", planes: planes.filter((p) => p.on).map(plane) }); }, 50);
+    timer = setTimeout(function () { sy.send({ t: "clip", planes: planes.filter((p) => p.on).map(plane), cap: cap() }); }, 50);
     if (ui.measure && ui.measure.refresh) ui.measure.refresh(); // its point-to-plane distances
   }
   ui.sendPlanes = send;

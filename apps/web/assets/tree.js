@@ -63,6 +63,7 @@
       if (m.seq !== treeSeq) return; // an older answer
       state.nodes = m.nodes || []; state.total = m.total; state.truncated = m.truncated;
       state.min = m.min; state.max = m.max; state.planes = m.planes || [];
+      state.cap = m.cap || null; state.environment = m.environment || "scene"; // the server's caps and environment
       const sel = state.nodes.find((n) => n.selected);
       state.selected = sel ? sel.id : 0;
       state.version = (state.version || 0) + 1;

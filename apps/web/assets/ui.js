@@ -1,5 +1,5 @@
 // ui.js — the page's controls around the canvas (docs/WEB.md, "The page"): the tool bar, the side
-// panel and its menu (back-end, display filter, exposure), the help overlay (? key and button), the
+// panel and its menu (back-end, display filter, exposure, environment), the help overlay (? key and button), the
 // screenshot button (the still route at the canvas' size, downloaded) and the stats panel
 // (window.sy.stats()). A read-only server (sy web --read-only) hides what it would refuse.
 // tree.js, measure.js, section.js and touch.js add their parts to the panel through window.sy.ui.
@@ -69,8 +69,10 @@
   const eLab = el("label", {}, menu, "Exposure ");
   const eRange = el("input", { id: "sy-exposure", type: "range", min: "-6", max: "6", step: "0.25", value: "0" }, eLab);
   const eVal = el("span", {}, eLab, "0");
-  el("div", { class: "note" }, menu, "Environment: the scene's own (the server offers no other)");
-  ui.writer(bSel.parentNode, fLab, eLab);
+  // the environments the server offers (hello.environments: the scene's world, the studio, none)
+  const envLab = el("label", {}, menu, "Environment "), envSel = el("select", { id: "sy-environment" }, envLab);
+  ui.writer(bSel.parentNode, fLab, eLab, envLab);
+  envSel.addEventListener("change", function () { sy.send({ t: "environment", name: envSel.value }); envSel.blur(); });
   bSel.addEventListener("change", function () { sy.input({ t: "key", k: String(bSel.selectedIndex + 1) }); bSel.blur(); });
   fSel.addEventListener("change", function () { sy.send({ t: "filter", name: fSel.value }); fSel.blur(); });
   let eTimer = 0;
@@ -113,7 +115,8 @@
     ["?", "this help"], ["space", "play / pause the scene (when it moves: the timeline at the bottom scrubs it)"],
     ["Panel", ""], ["☰", "show / hide the panel"], ["Screenshot", "downloads a JPEG of the view at the canvas' size"],
     ["Measure", "click two points: their distance"], ["tree", "the check box shows / hides a node, a click on its name selects it"],
-    ["section planes", "up to 6 cuts along X, Y or Z, each with a slider across the scene and a flip"]];
+    ["section planes", "up to 6 cuts along X, Y or Z, each with a slider across the scene and a flip; Cap fills the cut faces in a colour"],
+    ["environment", "the menu's light from outside the scene: the scene's own, a studio, none"]];
   const tb = el("table", {}, hb);
   for (const [k, v] of rows) {
     if (!v) { el("h4", {}, el("td", { colspan: "2" }, el("tr", {}, tb)), k); continue; }
@@ -161,9 +164,15 @@
       fSel.textContent = "";
       (m.filters || []).forEach(function (f) { el("option", { value: f }, fSel, f); });
       eRange.value = String(m.exposure || 0); eVal.textContent = eRange.value;
+      envSel.textContent = "";
+      const envTitles = { scene: "the scene's", studio: "studio light", none: "none" };
+      (m.environments || ["scene"]).forEach(function (e) { el("option", { value: e }, envSel, envTitles[e] || e); });
+      envSel.value = m.environment || "scene";
       for (const w of ui.writers) w.classList.toggle("sy-hidden", ui.readOnly);
       document.getElementById("sy-readonly") && document.getElementById("sy-readonly").remove();
       if (ui.readOnly) el("div", { id: "sy-readonly", title: "sy web --read-only" }, document.body, "read-only: look, pick, screenshot");
+    } else if (m.t === "tree" && m.environment && document.activeElement !== envSel) { // another page may have switched it
+      envSel.value = m.environment;
     } else if (m.t === "status") {
       if (m.filter && fSel.value !== m.filter) fSel.value = m.filter;
     }
