@@ -7,14 +7,21 @@
  * frame's SSIM against the float frame (Rec. 709 luma of the display-encoded colour clamped to
  * [0, 1], sy_filter_ssim_gray). Reported per setting: bytes per frame, SSIM mean and minimum,
  * encode time; then the cheapest JPEG whose mean SSIM is >= 0.95 and the cheapest setting of each
- * video codec at least as good, and their ratio of bytes. See sy_bench_stream.h. */
+ * video codec at least as good, and their ratio of bytes. The depth channel that goes with every
+ * moving frame: its bytes and coding time in format 3 (the grid of every second pixel, MED
+ * prediction, deflate 6: apps/web/sy_web_frame.h) beside format 2's coding (every pixel, row
+ * deltas, deflate 1; kept here only for the comparison), and the messages' bytes at the server's
+ * defaults. See sy_bench_stream.h. */
 #include "sy_bench_stream.h"
 
 #include "sy_filter_metrics.h"
 #include "sy_interactive.h"
 #include "sy_jpeg.h"
 #include "sy_post.h"
+#include "sy_web_frame.h"
 #include "sy_web_video.h"
+
+#include <zlib.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -51,6 +58,42 @@ static void luma_f(const float *rgba, size_t n, float *out)
 static void luma_8(const uint8_t *px, size_t n, float *out)
 {
     for (size_t i = 0; i < n; ++i) out[i] = (0.2126f * px[4 * i] + 0.7152f * px[4 * i + 1] + 0.0722f * px[4 * i + 2]) / 255.0f;
+}
+
+/* format 2's depth channel (docs/WEB.md before format 3): every pixel's 16-bit log depth as row
+ * deltas, byte planes, deflate level 1; its bytes (0 on failure) */
+static size_t format2_depth_bytes(const float *depth, uint32_t w, uint32_t h)
+{
+    size_t n = (size_t)w * h;
+    float lo = INFINITY, hi = 0.0f;
+    for (size_t i = 0; i < n; ++i)
+        if (isfinite(depth[i]) && depth[i] > 0) lo = fminf(lo, depth[i]), hi = fmaxf(hi, depth[i]);
+    if (!(lo <= hi)) lo = hi = 1.0f;
+    double span = log((double)hi / lo), k = span > 0 ? 65534.0 / span : 0.0;
+    uint8_t *planes = malloc(2 * n);
+    uLongf cap = compressBound((uLong)(2 * n));
+    uint8_t *z = malloc(cap);
+    size_t out = 0;
+    if (planes && z) {
+        for (uint32_t y = 0; y < h; ++y) {
+            uint16_t prev = 0;
+            for (uint32_t x = 0; x < w; ++x) {
+                size_t i = (size_t)y * w + x;
+                uint16_t q = 0;
+                if (isfinite(depth[i]) && depth[i] > 0) {
+                    double v = 1.0 + floor(log((double)depth[i] / lo) * k + 0.5);
+                    q = (uint16_t)(v < 1 ? 1 : v > 65535 ? 65535 : v);
+                }
+                uint16_t e = (uint16_t)(q - prev);
+                prev = q;
+                planes[i] = (uint8_t)(e & 0xff), planes[n + i] = (uint8_t)(e >> 8);
+            }
+        }
+        if (compress2(z, &cap, planes, (uLong)(2 * n), 1) == Z_OK) out = cap;
+    }
+    free(planes);
+    free(z);
+    return out;
 }
 
 /* one setting on one frame: encode, decode, SSIM */
@@ -146,7 +189,7 @@ sy_result sy_bench_stream(sy_scene *scene, const sy_viewport_desc *vd, const cha
     if (r == SY_OK)
         printf("sy bench stream: %s, back-end %s, %ux%u, %u frames (10 s at %u fps), orbit of 10 degrees per second; "
                "SSIM of each decoded frame against the float frame (luma)\n", label, vd->backend, width, height, frames, fps);
-    double render_s = 0;
+    double render_s = 0, d2_bytes = 0, d3_bytes = 0, d2_s = 0, d3_s = 0;
     /* 10 degrees per second: sy_orbit_rotate turns 0.008 rad per pixel of drag */
     const float dx = (float)(10.0 * 3.14159265358979 / 180.0 / fps / 0.008);
     sy_orbit o = home.orbit;
@@ -162,6 +205,17 @@ sy_result sy_bench_stream(sy_scene *scene, const sy_viewport_desc *vd, const cha
         uint8_t *px = r == SY_OK ? sy_interactive_rgba8(&img, SY_RGBA8_OVER_BLACK) : NULL;
         if (r == SY_OK && !px) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench stream: out of memory");
         if (r == SY_OK) luma_f(img.rgba, n, ref);
+        if (r == SY_OK) { /* the depth channel of this frame, both codings */
+            double t1 = sy_time_now();
+            d2_bytes += (double)format2_depth_bytes(img.depth, width, height);
+            double t2 = sy_time_now();
+            uint8_t *z = NULL;
+            size_t zl = 0;
+            float a = 0, b = 0;
+            r = sy_web_frame_depth_code(img.depth, width, height, &z, &zl, &a, &b, err);
+            d3_s += sy_time_now() - t2, d2_s += t2 - t1, d3_bytes += (double)zl;
+            free(z);
+        }
         for (uint32_t i = 0; i < ncfg && r == SY_OK; ++i) r = run_setting(&cfg[i], px, width, height, ref, tmp, err);
         free(px);
         if (r == SY_OK && (k + 1) % (frames / 10 ? frames / 10 : 1) == 0) {
@@ -178,13 +232,21 @@ sy_result sy_bench_stream(sy_scene *scene, const sy_viewport_desc *vd, const cha
                    s->codec == SY_WEB_CODEC_JPEG ? "Q " : "q ", s->q, s->bytes / frames, s->bytes / frames * fps * 8 / 1e3,
                    s->ssim / frames, s->ssim_min, (unsigned long long)s->keys, s->enc_s / frames * 1e3);
         }
-        /* the server's defaults: JPEG at --quality 80, video at SY_WEB_VIDEO_QUANTIZER */
+        printf("  depth channel per moving frame: format 2 (every pixel, row deltas, deflate 1) %.0f bytes (%.2f ms); "
+               "format 3 (every second pixel, MED, deflate 6) %.0f bytes (%.2f ms): 1/%.1f; a still view's refinements: 0\n",
+               d2_bytes / frames, d2_s / frames * 1e3, d3_bytes / frames, d3_s / frames * 1e3,
+               d3_bytes > 0 ? d2_bytes / d3_bytes : 0.0);
+        /* the server's defaults: JPEG at --quality 80, video at SY_WEB_VIDEO_QUANTIZER; with the
+         * 192-byte header and the depth channel, a moving frame's message in format 2 and 3 */
         for (uint32_t i = 0; i < ncfg; ++i)
             if ((cfg[i].codec == SY_WEB_CODEC_JPEG && cfg[i].q == 80) ||
                 (cfg[i].codec != SY_WEB_CODEC_JPEG && cfg[i].q == (int)SY_WEB_VIDEO_QUANTIZER))
-                printf("  the server's default %s (%s %d): %.0f bytes per frame, SSIM %.4f (min %.4f)\n", sy_web_codec_name(cfg[i].codec),
-                       cfg[i].codec == SY_WEB_CODEC_JPEG ? "Q" : "q", cfg[i].q, cfg[i].bytes / frames, cfg[i].ssim / frames,
-                       cfg[i].ssim_min);
+                printf("  the server's default %s (%s %d): %.0f bytes per frame, SSIM %.4f (min %.4f); "
+                       "message with depth: format 2 %.0f, format 3 %.0f bytes\n",
+                       sy_web_codec_name(cfg[i].codec), cfg[i].codec == SY_WEB_CODEC_JPEG ? "Q" : "q", cfg[i].q,
+                       cfg[i].bytes / frames, cfg[i].ssim / frames, cfg[i].ssim_min,
+                       (cfg[i].bytes + d2_bytes) / frames + SY_WEB_FRAME_HEADER,
+                       (cfg[i].bytes + d3_bytes) / frames + SY_WEB_FRAME_HEADER);
         /* the cheapest JPEG at mean SSIM >= 0.95, then each video codec's cheapest at least as good;
          * the same at the SSIM of JPEG at the server's quality (80) */
         int best_j = -1, j80 = -1;

@@ -43,7 +43,7 @@ sy_result sy_bench_web(const sy_web_desc *desc, uint32_t width, uint32_t height,
     if (!lat || !render || !over || !wid) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench web: out of memory");
     if (r == SY_OK) r = sy_web_client_connect(&o, 5000, &c, err);
     char m[128];
-    snprintf(m, sizeof m, "{\"t\":\"size\",\"w\":%u,\"h\":%u,\"v\":2}", width, height);
+    snprintf(m, sizeof m, "{\"t\":\"size\",\"w\":%u,\"h\":%u,\"v\":3}", width, height);
     if (r == SY_OK) r = sy_web_client_send(c, m, err);
     sy_web_frame_info fi = {0};
     /* the first frame at the asked size (a progressive back-end keeps sending: take the newest) */

@@ -162,7 +162,7 @@ typedef struct sy_web_input {
     uint32_t button; /**< drag: 0 orbit, 1 or 2 pan */
     char key;        /**< key: '1'..'9', 'f', '[', ']', 'r' (lower case) */
     uint32_t version; /**< size: the frame format the page reads ("v", 0..1000; 0 = absent: a page
-                       * older than frame format 2, refused with a status message) */
+                       * older than frame format 3, refused with a status message) */
     uint32_t node;   /**< visible, select, isolate: the node id (0 only for select / isolate: all) */
     bool on;         /**< visible: show; select: select; pick: select what is hit; play: play (else pause) */
     uint32_t seq;    /**< pick, tree: the page's request number, echoed in the answer (0..2^31) */

@@ -27,6 +27,11 @@ struct sy_web_client {
     uint32_t text_count;
     char *out;         /* a text message waiting for the socket */
     size_t out_len;
+    /* the last depth channel received (for the frames that say they have it: SY_WEB_FRAME_SAME_DEPTH),
+     * with the size and range of its frame */
+    uint8_t *depth;
+    uint32_t depth_len, depth_w, depth_h;
+    float depth_min, depth_max;
 };
 
 static int client_cb(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
@@ -173,7 +178,28 @@ sy_result sy_web_client_next_frame_depth(sy_web_client *c, uint32_t timeout_ms, 
         if (!*jpeg) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web client: out of memory");
         else memcpy(*jpeg, jp, info->jpeg_len), *jpeg_len = info->jpeg_len;
     }
-    if (r == SY_OK && depth) r = sy_web_frame_depth(info, dp, depth, err);
+    if (r == SY_OK && info->depth_len) { /* kept for the frames that say they have it */
+        uint8_t *keep = malloc(info->depth_len);
+        if (!keep) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web client: out of memory");
+        else {
+            memcpy(keep, dp, info->depth_len);
+            free(c->depth);
+            c->depth = keep, c->depth_len = info->depth_len, c->depth_w = info->width, c->depth_h = info->height;
+            c->depth_min = info->depth_min, c->depth_max = info->depth_max;
+        }
+    }
+    if (r == SY_OK && depth && (info->flags & SY_WEB_FRAME_SAME_DEPTH)) {
+        if (!c->depth || c->depth_w != info->width || c->depth_h != info->height)
+            r = sy_error_set(err, SY_ERR_PROTOCOL, "web client: a %ux%u frame says it has the last depth channel, which is %s",
+                             info->width, info->height, c->depth ? "of another size" : "none");
+        else {
+            sy_web_frame_info g = *info;
+            g.depth_len = c->depth_len, g.depth_min = c->depth_min, g.depth_max = c->depth_max;
+            g.depth_coding = SY_WEB_DEPTH_HALF_LOG16;
+            r = sy_web_frame_depth(&g, c->depth, depth, err);
+        }
+    } else if (r == SY_OK && depth)
+        r = sy_web_frame_depth(info, dp, depth, err);
     free(m->data);
     free(m);
     return r;
@@ -218,6 +244,7 @@ void sy_web_client_close(sy_web_client *c)
 {
     if (!c) return;
     if (c->ctx) lws_context_destroy(c->ctx);
+    free(c->depth);
     while (c->texts) {
         msg *m = c->texts;
         c->texts = m->next;

@@ -36,12 +36,13 @@ sy_result sy_web_client_send(sy_web_client *c, const char *text, sy_error *err);
 
 /** Waits up to timeout_ms for the next binary frame (text messages are skipped); *jpeg (may be
  * NULL: not returned) receives its JPEG bytes. SY_ERR_IO on timeout or a closed connection,
- * SY_ERR_PROTOCOL for a message that is no format-2 frame (sy_web_frame_parse). */
+ * SY_ERR_PROTOCOL for a message that is no format-3 frame (sy_web_frame_parse). */
 sy_result sy_web_client_next_frame(sy_web_client *c, uint32_t timeout_ms, sy_web_frame_info *info, uint8_t **jpeg,
                                    size_t *jpeg_len, sy_error *err);
 
 /** As sy_web_client_next_frame, and *depth (malloc, width x height floats, +INFINITY where nothing
- * was hit) receives the frame's decoded depth channel (SY_ERR_PROTOCOL when it has none). */
+ * was hit) receives the frame's decoded depth channel: its own, or for a frame that says it has the
+ * last one (SY_WEB_FRAME_SAME_DEPTH) the last one received (SY_ERR_PROTOCOL when there is none). */
 sy_result sy_web_client_next_frame_depth(sy_web_client *c, uint32_t timeout_ms, sy_web_frame_info *info,
                                          uint8_t **jpeg, size_t *jpeg_len, float **depth, sy_error *err);
 

@@ -1,5 +1,6 @@
-/* sy_web_frame.c — sy web's binary frame, format 2: packing (the server) and reading (clients,
- * tests); the depth channel's 16-bit log quantisation and deflate (see sy_web_frame.h). */
+/* sy_web_frame.c — sy web's binary frame, format 3: packing (the server) and reading (clients,
+ * tests); the depth channel's grid, 16-bit log quantisation, prediction and deflate (see
+ * sy_web_frame.h). */
 #include "sy_web_frame.h"
 
 #include <zlib.h>
@@ -36,43 +37,68 @@ static float getf(const uint8_t *p)
 
 static bool hit(float d) { return isfinite(d) && d > 0.0f; }
 
-/* The depth channel: q = 0 where nothing was hit, else 1 + round(65534 x log(d / dmin) / log(dmax /
- * dmin)); each row's values as differences to the pixel on their left (mod 65536), the low bytes
- * of the whole image, then the high bytes; deflated (zlib format, level 1). */
+/* The depth grid of a w x h frame: every second pixel in x and y, plus the last column and row
+ * (docs/WEB.md, depth coding 2): column i holds pixel min(2 i, w - 1), row j pixel min(2 j, h - 1). */
+static uint32_t grid_n(uint32_t n) { return n / 2 + 1; }
+static uint32_t grid_src(uint32_t i, uint32_t n) { return 2 * i < n - 1 ? 2 * i : n - 1; }
+
+/* The MED predictor (LOCO-I) of a grid value from its left (a), upper (b) and upper-left (c)
+ * neighbours; the first row predicts from the left, the first column from above. */
+static uint16_t med(uint32_t i, uint32_t j, const uint16_t *q, uint32_t gw)
+{
+    if (!j) return i ? q[i - 1] : 0;
+    if (!i) return q[(size_t)(j - 1) * gw];
+    int a = q[(size_t)j * gw + i - 1], b = q[(size_t)(j - 1) * gw + i], c = q[(size_t)(j - 1) * gw + i - 1];
+    int mx = a > b ? a : b, mn = a < b ? a : b;
+    return (uint16_t)(c >= mx ? mn : c <= mn ? mx : a + b - c);
+}
+
+/* The depth channel (coding 2): on the depth grid, q = 0 where nothing was hit, else 1 +
+ * round(65534 x log(d / dmin) / log(dmax / dmin)) with dmin, dmax over the grid; each value minus
+ * its MED prediction (mod 65536), the low bytes of the whole grid, then the high bytes; deflated
+ * (zlib format, level 6). */
 static sy_result pack_depth(const float *depth, uint32_t w, uint32_t h, uint8_t **out, size_t *len, float *dmin,
                             float *dmax, sy_error *err)
 {
-    size_t n = (size_t)w * h;
+    uint32_t gw = grid_n(w), gh = grid_n(h);
+    size_t n = (size_t)gw * gh;
     float lo = INFINITY, hi = 0.0f;
-    for (size_t i = 0; i < n; ++i)
-        if (hit(depth[i])) lo = fminf(lo, depth[i]), hi = fmaxf(hi, depth[i]);
+    for (uint32_t j = 0; j < gh; ++j)
+        for (uint32_t i = 0; i < gw; ++i) {
+            float d = depth[(size_t)grid_src(j, h) * w + grid_src(i, w)];
+            if (hit(d)) lo = fminf(lo, d), hi = fmaxf(hi, d);
+        }
     if (!(lo <= hi)) lo = hi = 1.0f; /* nothing hit */
     *dmin = lo, *dmax = hi;
     double span = log((double)hi / lo), k = span > 0 ? 65534.0 / span : 0.0;
+    uint16_t *q = malloc(n * sizeof *q);
     uint8_t *planes = malloc(2 * n);
     uLongf cap = compressBound((uLong)(2 * n));
     uint8_t *z = malloc(cap);
-    if (!planes || !z) {
+    if (!q || !planes || !z) {
+        free(q);
         free(planes);
         free(z);
         return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a depth channel of %ux%u", w, h);
     }
-    for (uint32_t y = 0; y < h; ++y) {
-        uint16_t prev = 0;
-        for (uint32_t x = 0; x < w; ++x) {
-            size_t i = (size_t)y * w + x;
-            float d = depth[i];
-            uint16_t q = 0;
+    for (uint32_t j = 0; j < gh; ++j)
+        for (uint32_t i = 0; i < gw; ++i) {
+            float d = depth[(size_t)grid_src(j, h) * w + grid_src(i, w)];
+            uint16_t v16 = 0;
             if (hit(d)) {
                 double v = 1.0 + floor(log((double)d / lo) * k + 0.5);
-                q = (uint16_t)(v < 1 ? 1 : v > 65535 ? 65535 : v);
+                v16 = (uint16_t)(v < 1 ? 1 : v > 65535 ? 65535 : v);
             }
-            uint16_t e = (uint16_t)(q - prev);
-            prev = q;
-            planes[i] = (uint8_t)(e & 0xff), planes[n + i] = (uint8_t)(e >> 8);
+            q[(size_t)j * gw + i] = v16;
         }
-    }
-    int zr = compress2(z, &cap, planes, (uLong)(2 * n), 1);
+    for (uint32_t j = 0; j < gh; ++j)
+        for (uint32_t i = 0; i < gw; ++i) {
+            size_t x = (size_t)j * gw + i;
+            uint16_t e = (uint16_t)(q[x] - med(i, j, q, gw));
+            planes[x] = (uint8_t)(e & 0xff), planes[n + x] = (uint8_t)(e >> 8);
+        }
+    free(q);
+    int zr = compress2(z, &cap, planes, (uLong)(2 * n), 6);
     free(planes);
     if (zr != Z_OK) {
         free(z);
@@ -82,27 +108,45 @@ static sy_result pack_depth(const float *depth, uint32_t w, uint32_t h, uint8_t 
     return SY_OK;
 }
 
+sy_result sy_web_frame_depth_code(const float *depth, uint32_t width, uint32_t height, uint8_t **out, size_t *len,
+                                  float *dmin, float *dmax, sy_error *err)
+{
+    *out = NULL, *len = 0;
+    if (!width || !height || (uint64_t)width * height > MAX_PIXELS)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "web: a depth channel of %ux%u", width, height);
+    return pack_depth(depth, width, height, out, len, dmin, dmax, err);
+}
+
 sy_result sy_web_frame_pack(sy_web_frame_info *fi, const uint8_t *jpeg, size_t jpeg_len, const float *depth,
                             size_t prefix, uint8_t **out, size_t *len, sy_error *err)
 {
     *out = NULL, *len = 0;
     uint8_t *z = NULL;
     size_t zlen = 0;
-    fi->depth_coding = 0, fi->depth_min = fi->depth_max = 0.0f;
+    float lo = 0.0f, hi = 0.0f;
     if (depth) {
-        sy_result r = pack_depth(depth, fi->width, fi->height, &z, &zlen, &fi->depth_min, &fi->depth_max, err);
+        sy_result r = sy_web_frame_depth_code(depth, fi->width, fi->height, &z, &zlen, &lo, &hi, err);
         if (r != SY_OK) return r;
-        fi->depth_coding = SY_WEB_DEPTH_LOG16_DEFLATE;
     }
+    sy_result r = sy_web_frame_pack_coded(fi, jpeg, jpeg_len, z, zlen, lo, hi, prefix, out, len, err);
+    free(z);
+    return r;
+}
+
+sy_result sy_web_frame_pack_coded(sy_web_frame_info *fi, const uint8_t *jpeg, size_t jpeg_len, const uint8_t *z,
+                                  size_t zlen, float dmin, float dmax, size_t prefix, uint8_t **out, size_t *len,
+                                  sy_error *err)
+{
+    *out = NULL, *len = 0;
+    fi->depth_coding = zlen ? SY_WEB_DEPTH_HALF_LOG16 : 0;
+    fi->depth_min = zlen ? dmin : 0.0f, fi->depth_max = zlen ? dmax : 0.0f;
     if (jpeg_len > UINT32_MAX || zlen > UINT32_MAX) {
-        free(z);
         return sy_error_set(err, SY_ERR_LIMIT, "web: a frame of %zu + %zu bytes is too large", jpeg_len, zlen);
     }
     fi->jpeg_len = (uint32_t)jpeg_len, fi->depth_len = (uint32_t)zlen;
     size_t total = SY_WEB_FRAME_HEADER + jpeg_len + zlen;
     uint8_t *buf = calloc(1, prefix + total);
     if (!buf) {
-        free(z);
         return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %zu bytes", total);
     }
     uint8_t *h = buf + prefix;
@@ -121,7 +165,6 @@ sy_result sy_web_frame_pack(sy_web_frame_info *fi, const uint8_t *jpeg, size_t j
     put32(h + OFF_CODEC, (uint32_t)fi->codec), putf(h + OFF_QUALITY, fi->quality);
     if (jpeg_len) memcpy(h + SY_WEB_FRAME_HEADER, jpeg, jpeg_len);
     if (zlen) memcpy(h + SY_WEB_FRAME_HEADER + jpeg_len, z, zlen);
-    free(z);
     *out = buf, *len = total;
     return SY_OK;
 }
@@ -131,6 +174,12 @@ void sy_web_frame_set_payload(uint8_t *h, const sy_web_frame_info *fi)
     put32(h + OFF_JPEG, fi->jpeg_len);
     put32(h + OFF_CODEC, (uint32_t)fi->codec), putf(h + OFF_QUALITY, fi->quality);
     put32(h + OFF_FLAGS, get32(h + OFF_FLAGS) | fi->flags);
+}
+
+void sy_web_frame_drop_depth(uint8_t *h)
+{
+    put32(h + OFF_DEPTH, 0);
+    put32(h + OFF_FLAGS, get32(h + OFF_FLAGS) | SY_WEB_FRAME_SAME_DEPTH);
 }
 
 sy_result sy_web_frame_parse(const uint8_t *data, size_t len, sy_web_frame_info *fi, const uint8_t **jpeg,
@@ -165,7 +214,10 @@ sy_result sy_web_frame_parse(const uint8_t *data, size_t len, sy_web_frame_info 
     if ((uint64_t)SY_WEB_FRAME_HEADER + fi->jpeg_len + fi->depth_len != len)
         return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: header %u + JPEG %u + depth %u bytes != the message's %zu",
                             SY_WEB_FRAME_HEADER, fi->jpeg_len, fi->depth_len, len);
-    if (fi->depth_len && fi->depth_coding != SY_WEB_DEPTH_LOG16_DEFLATE)
+    if (fi->depth_len && (fi->flags & SY_WEB_FRAME_SAME_DEPTH))
+        return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: %u depth bytes in a frame that says it has the last one's",
+                            fi->depth_len);
+    if (fi->depth_len && fi->depth_coding != SY_WEB_DEPTH_HALF_LOG16)
         return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: unknown depth coding %u", fi->depth_coding);
     if (fi->depth_len && !(isfinite(fi->depth_min) && isfinite(fi->depth_max) && fi->depth_min > 0 && fi->depth_max >= fi->depth_min))
         return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: depth range %g..%g is not 0 < min <= max", (double)fi->depth_min,
@@ -181,31 +233,42 @@ sy_result sy_web_frame_depth(const sy_web_frame_info *fi, const uint8_t *depth, 
     size_t n = (size_t)fi->width * fi->height;
     if (!depth || !fi->depth_len || !n || n > MAX_PIXELS)
         return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: no depth channel");
+    uint32_t gw = grid_n(fi->width), gh = grid_n(fi->height);
+    size_t gn = (size_t)gw * gh;
     /* deflate expands at most ~1032:1: a size the input cannot reach is refused before allocating */
-    if (2 * (uint64_t)n > 1040ull * fi->depth_len + 64)
+    if (2 * (uint64_t)gn > 1040ull * fi->depth_len + 64)
         return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: %u depth bytes cannot hold %ux%u pixels", fi->depth_len,
                             fi->width, fi->height);
-    uint8_t *planes = malloc(2 * n + 1);
+    uint8_t *planes = malloc(2 * gn + 1);
+    uint16_t *q = malloc(gn * sizeof *q);
     float *d = malloc(n * sizeof *d);
-    uLongf got = (uLongf)(2 * n + 1);
-    int zr = planes && d ? uncompress(planes, &got, depth, fi->depth_len) : Z_MEM_ERROR;
-    if (zr != Z_OK || got != 2 * n) {
+    uLongf got = (uLongf)(2 * gn + 1);
+    int zr = planes && q && d ? uncompress(planes, &got, depth, fi->depth_len) : Z_MEM_ERROR;
+    if (zr != Z_OK || got != 2 * gn) {
         free(planes);
+        free(q);
         free(d);
         return sy_error_set(err, zr == Z_MEM_ERROR ? SY_ERR_OUT_OF_MEMORY : SY_ERR_PROTOCOL,
-                            "web frame: the depth channel does not inflate to %zu bytes (zlib %d, %lu bytes)", 2 * n, zr,
+                            "web frame: the depth channel does not inflate to %zu bytes (zlib %d, %lu bytes)", 2 * gn, zr,
                             (unsigned long)got);
     }
+    for (uint32_t j = 0; j < gh; ++j)
+        for (uint32_t i = 0; i < gw; ++i) {
+            size_t x = (size_t)j * gw + i;
+            q[x] = (uint16_t)(med(i, j, q, gw) + (uint16_t)(planes[x] | planes[gn + x] << 8));
+        }
+    free(planes);
+    /* every pixel takes the grid value nearest to it (the last column and row their own) */
     double lo = fi->depth_min, span = fi->depth_max > fi->depth_min ? log((double)fi->depth_max / lo) : 0.0;
     for (uint32_t y = 0; y < fi->height; ++y) {
-        uint16_t q = 0;
+        uint32_t j = y == fi->height - 1 ? gh - 1 : y / 2;
         for (uint32_t x = 0; x < fi->width; ++x) {
-            size_t i = (size_t)y * fi->width + x;
-            q = (uint16_t)(q + (uint16_t)(planes[i] | planes[n + i] << 8));
-            d[i] = q ? (float)(lo * exp((q - 1) / 65534.0 * span)) : INFINITY;
+            uint32_t i = x == fi->width - 1 ? gw - 1 : x / 2;
+            uint16_t v = q[(size_t)j * gw + i];
+            d[(size_t)y * fi->width + x] = v ? (float)(lo * exp((v - 1) / 65534.0 * span)) : INFINITY;
         }
     }
-    free(planes);
+    free(q);
     *out = d;
     return SY_OK;
 }

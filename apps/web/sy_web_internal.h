@@ -67,6 +67,9 @@ typedef struct web_frame {
     uint8_t *rgba;
     uint32_t width, height, backend;
     size_t jpeg_len, depth_len;
+    /* which depth channel the frame carries (0: none): frames with the same key carry the same
+     * bytes, so a viewer sent one of them is sent the others without (SY_WEB_FRAME_SAME_DEPTH) */
+    uint64_t depth_key;
 } web_frame;
 
 typedef struct web_conn web_conn;
@@ -140,6 +143,8 @@ struct sy_web {
     uint32_t clients;
     uint32_t video_viewers, jpeg_viewers; /* sized viewers by what they are sent: the render thread
                                            * keeps a frame's pixels for the first, JPEG for the second */
+    double encode_per_px_ms; /* the network thread's encoders, summed over viewers (ms per pixel of a
+                              * frame, sy_web_cost.h): the render thread adds it to a frame's cost */
     bool need_pixels; /* a video viewer was sent a frame without pixels: the render thread republishes
                        * the newest frame with them (no new render: a still view keeps its samples) */
     web_job *pending, **pending_tail; /* routes */

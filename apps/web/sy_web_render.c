@@ -10,6 +10,7 @@
 #include "sy_mediator.h"
 #include "sy_post.h"
 #include "sy_viewport.h"
+#include "sy_web_cost.h"
 #include "sy_web_frame.h"
 
 #include <math.h>
@@ -34,6 +35,15 @@ typedef struct render_state {
      * until a page moves the clock), when the last periodic "clock" message was due */
     double clock_wall, clock_applied, clock_sent;
     bool clock_was_playing, clock_failed;
+    /* the last coded depth channel (docs/WEB.md, depth coding 2): a progressive back-end's
+     * refinements of that view (same size, back-end and camera, samples counting up) reuse it, and
+     * the network thread leaves it out for a viewer it was sent to already (SY_WEB_FRAME_SAME_DEPTH) */
+    uint8_t *dz;
+    size_t dz_len;
+    float dz_min, dz_max;
+    uint32_t dz_w, dz_h, dz_backend;
+    sy_camera_view dz_view;
+    uint64_t dz_samples, dz_key, dz_keys;
 } render_state;
 
 #define WEB_CLOCK_TICK 0.02  /* s: a playing clock is advanced (and a frame planned) at most this often */
@@ -68,6 +78,13 @@ static void clock_apply(sy_web *w, render_state *rs, double t)
         rs->clock_failed = true;
         sy_log(SY_LOG_WARNING, "web", NULL, "the scene clock at %g s: %s", t, e.message);
     }
+
+
+/* Whether two frames' cameras are the same (matrix, window, projection). */
+static bool same_camera(const sy_camera_view *a, const sy_camera_view *b)
+{
+    return !memcmp(&a->camera_to_world, &b->camera_to_world, sizeof a->camera_to_world) &&
+           !memcmp(a->window, b->window, sizeof a->window) && a->projection == b->projection;
 }
 
 /* The display size the governor plans for: what the page asked, capped at max_width x max_height
@@ -266,6 +283,7 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
      * only while a viewer takes it (or none said yet) */
     pthread_mutex_lock(&w->mu);
     bool keep_px = w->video_viewers > 0, want_jpeg = w->jpeg_viewers > 0 || !w->video_viewers;
+    double encode_per_px = w->encode_per_px_ms;
     pthread_mutex_unlock(&w->mu);
     double t0 = sy_time_now();
     r = render_rgba8(w, rs, rs->win, gf.width, gf.height, gf.samples, gf.preview, &px, &depth, err);
@@ -281,10 +299,27 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
                             .flags = (cls->caps & SY_CAP_PROGRESSIVE) ? SY_WEB_FRAME_PROGRESSIVE : 0};
     if (r == SY_OK) r = sy_viewport_camera_view(rs->vp, w->d.scene, gf.width, gf.height, &fi.view, err);
     fi.view.clip_count = 0;
+    sy_mediator_stats st = {0};
+    sy_context *ctx = NULL;
+    if (r == SY_OK && sy_context_pool_get(rs->pool, w->d.scene, cls->name, NULL, w->d.root.id, &ctx, NULL) == SY_OK)
+        sy_context_stats(ctx, &st);
+    /* the depth channel: the view's coded one again for a refinement, else coded anew */
+    bool reuse = r == SY_OK && depth && (fi.flags & SY_WEB_FRAME_PROGRESSIVE) && rs->dz && rs->dz_w == gf.width &&
+                 rs->dz_h == gf.height && rs->dz_backend == bi && same_camera(&rs->dz_view, &fi.view) &&
+                 st.samples > rs->dz_samples;
+    if (r == SY_OK && !reuse) {
+        free(rs->dz);
+        rs->dz = NULL, rs->dz_len = 0, rs->dz_key = 0;
+        if (depth &&
+            (r = sy_web_frame_depth_code(depth, gf.width, gf.height, &rs->dz, &rs->dz_len, &rs->dz_min, &rs->dz_max, err)) == SY_OK)
+            rs->dz_w = gf.width, rs->dz_h = gf.height, rs->dz_backend = bi, rs->dz_view = fi.view, rs->dz_key = ++rs->dz_keys;
+    }
+    rs->dz_samples = st.samples;
     uint8_t *buf = NULL;
     size_t len = 0;
-    if (r == SY_OK) r = sy_web_frame_pack(&fi, jpeg, jlen, depth, LWS_PRE, &buf, &len, err);
-    double ms = (sy_time_now() - t0) * 1e3; /* render, display chain, JPEG, depth: the frame's whole cost */
+    if (r == SY_OK)
+        r = sy_web_frame_pack_coded(&fi, jpeg, jlen, rs->dz, rs->dz_len, rs->dz_min, rs->dz_max, LWS_PRE, &buf, &len, err);
+    double ms = (sy_time_now() - t0) * 1e3; /* render, display chain, JPEG, depth */
     free(jpeg);
     free(depth);
     if (r != SY_OK) {
@@ -292,11 +327,10 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
         return r;
     }
     /* a frame that translated the scene for a new context says nothing about the next ones */
-    sy_interactive_report(rs->ia, &gf, ms, sy_context_pool_size(rs->pool) != contexts);
-    sy_mediator_stats st = {0};
-    sy_context *ctx = NULL;
-    if (sy_context_pool_get(rs->pool, w->d.scene, cls->name, NULL, w->d.root.id, &ctx, NULL) == SY_OK)
-        sy_context_stats(ctx, &st);
+    /* the governor is told the frame's whole cost: with what the viewers' encoders on the network
+     * thread take for a frame of this size (sy_web_cost.h) */
+    sy_interactive_report(rs->ia, &gf, sy_web_frame_cost_ms(ms, encode_per_px, gf.width, gf.height),
+                          sy_context_pool_size(rs->pool) != contexts);
     web_frame *f = calloc(1, sizeof *f);
     if (!f) {
         free(buf);
@@ -314,7 +348,7 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
     f->buf = buf;
     f->refs = 1, f->seq = seq, f->gen = gen, f->len = len;
     f->rgba = px, f->width = gf.width, f->height = gf.height, f->backend = bi;
-    f->jpeg_len = fi.jpeg_len, f->depth_len = fi.depth_len;
+    f->jpeg_len = fi.jpeg_len, f->depth_len = fi.depth_len, f->depth_key = fi.depth_len ? rs->dz_key : 0;
     rs->last_px_seq = seq;
     publish_frame(w, f);
     set_status(w, fstatus);
@@ -507,6 +541,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         finish_job(w, j);
     }
     free(rs.last_px);
+    free(rs.dz);
     sy_interactive_destroy(rs.ia);
     sy_window_destroy(rs.win);
     sy_window_destroy(rs.still_win);

@@ -2,10 +2,17 @@
  * libvpx, RGBA8 <-> I420 (BT.601, studio range) (see sy_web_video.h). */
 #include "sy_web_video.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 static const char *const codec_names[SY_WEB_CODEC_COUNT] = {"jpeg", "vp8", "vp9"};
+
+uint32_t sy_web_video_quantizer(int quality)
+{
+    double q = floor((double)SY_WEB_VIDEO_QUANTIZER + (80.0 - quality) * 1.6 + 0.5);
+    return (uint32_t)(q < 4 ? 4 : q > 63 ? 63 : q);
+}
 
 const char *sy_web_codec_name(sy_web_codec c) { return (unsigned)c < SY_WEB_CODEC_COUNT ? codec_names[c] : "?"; }
 

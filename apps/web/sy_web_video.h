@@ -42,6 +42,11 @@ bool sy_web_codec_available(sy_web_codec c);
  * mean SSIM against the float frame stays >= 0.95 on the orbits of `sy bench stream` (docs/WEB.md). */
 #define SY_WEB_VIDEO_QUANTIZER 36u
 
+/** The quantizer for the server's quality setting (`--quality`, JPEG's 1..100 scale, which applies
+ * to the video stream too): 80, the default, gives SY_WEB_VIDEO_QUANTIZER; each step of quality
+ * is 1.6 steps of quantizer, within 4..63 (95: 12, 90: 20, 60 and below: 63). */
+uint32_t sy_web_video_quantizer(int quality);
+
 /** The most memory one encoder of w x h takes (an upper estimate: libvpx's reference, source
  * and scratch frames plus the I420 input), for the server's per-viewer budget. */
 size_t sy_web_video_encoder_bytes(uint32_t width, uint32_t height);

@@ -7,6 +7,7 @@
 #include "sy_mediator.h"
 #include "sy_jpeg.h"
 #include "sy_web_frame.h"
+#include "sy_web_cost.h"
 #include "sy_web_video.h"
 
 #include <cjson/cJSON.h>
@@ -46,8 +47,9 @@ struct web_conn {
     uint32_t ids_n, ids_next;
     uint64_t answered_id;
     bool hello_sent;
-    bool sized;                  /* frames go to a viewer once it said its size (with "v": 2) */
-    bool old_page, refusal_sent; /* a page that does not read frame format 2 (its size message has no "v") */
+    bool sized;                  /* frames go to a viewer once it said its size (with "v": 3) */
+    bool old_page, refusal_sent; /* a page that does not read frame format 3 (no "v" in its size message, or a lower one) */
+    uint32_t old_version;        /* the format it reads (1: no "v") */
     delayed_msg delayed[WS_DELAYED];
     uint32_t delayed_head, delayed_n;
     queued_frame queued[WS_QUEUED];
@@ -63,6 +65,9 @@ struct web_conn {
     sy_web_video_encoder *enc;
     size_t reserved;          /* the encoder's share of WEB_VIDEO_BUDGET */
     bool want_key;            /* the next video frame is a keyframe (asked, or a new back-end) */
+    uint64_t depth_key;       /* the depth channel this viewer was sent last (web_frame.depth_key) */
+    sy_web_encode_cost cost;  /* under w->mu: what encoding its frames here costs (sy_web_cost.h), */
+    double cost_in_sum;       /* and its share of w->encode_per_px_ms */
     uint32_t last_backend;
     int kind;                 /* counted in w->video_viewers (2), jpeg_viewers (1) or neither (0) */
     uint64_t v_frames, v_keys, v_bytes;
@@ -73,6 +78,11 @@ struct web_conn {
  * while a video viewer is there and makes JPEG while a JPEG viewer is. Call with w->mu held. */
 static void set_kind(sy_web *w, web_conn *c, int kind)
 {
+    if (kind != c->kind) { /* its encoders' cost starts over (or leaves with it) */
+        w->encode_per_px_ms -= c->cost_in_sum;
+        if (w->encode_per_px_ms < 0) w->encode_per_px_ms = 0;
+        c->cost_in_sum = 0, c->cost = (sy_web_encode_cost){0};
+    }
     if (c->kind == 2) w->video_viewers--;
     if (c->kind == 1) w->jpeg_viewers--;
     c->kind = kind;
@@ -220,9 +230,12 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
     case SY_WEB_INPUT_SIZE:
         input = false;
         if (in.version < SY_WEB_FRAME_VERSION) { /* an old page: told to reload, never sent frames it cannot read */
-            c->old_page = true;
+            c->old_page = true, c->old_version = in.version ? in.version : 1u;
             pthread_mutex_unlock(&w->mu);
-            ws_warn(c, "a page that reads frame format 1 (its size message has no \"v\": 2): told to reload", NULL);
+            char why[120];
+            snprintf(why, sizeof why, "a page that reads frame format %u (this server sends %u): told to reload",
+                     in.version ? in.version : 1u, SY_WEB_FRAME_VERSION);
+            ws_warn(c, why, NULL);
             lws_callback_on_writable(c->wsi);
             return;
         }
@@ -337,6 +350,17 @@ static uint64_t answered_by(web_conn *c, uint64_t gen)
     return c->answered_id;
 }
 
+/* What encoding a frame of width x height for c took since t0 (sy_time_now): counted in the cost
+ * the render thread reports to the governor (sy_web_cost.h). */
+static void count_encode(sy_web *w, web_conn *c, double t0, uint32_t width, uint32_t height)
+{
+    double ms = (sy_time_now() - t0) * 1e3;
+    pthread_mutex_lock(&w->mu);
+    double d = sy_web_encode_cost_add(&c->cost, ms, (uint64_t)width * height);
+    c->cost_in_sum += d, w->encode_per_px_ms += d;
+    pthread_mutex_unlock(&w->mu);
+}
+
 /* A video viewer's frame: the header of f with the codec's frame in place of the JPEG, then the
  * depth channel (docs/WEB.md: payload coding at 184, quality at 188, keyframe flag). The encoder
  * sees exactly the frames this viewer is sent, in order, so each one predicts from the last. On
@@ -344,14 +368,19 @@ static uint64_t answered_by(web_conn *c, uint64_t gen)
 static int send_video(sy_web *w, web_conn *c, web_frame *f, uint64_t id)
 {
     sy_error err = {0};
-    sy_result r = c->enc ? SY_OK : sy_web_video_encoder_create(c->codec, SY_WEB_VIDEO_QUANTIZER, &c->enc, &err);
+    sy_result r = c->enc ? SY_OK
+                         : sy_web_video_encoder_create(c->codec, sy_web_video_quantizer(w->d.quality), &c->enc, &err);
     const uint8_t *pkt = NULL;
     size_t plen = 0;
     bool key = false;
+    double t0 = sy_time_now();
     if (r == SY_OK)
         r = sy_web_video_encode(c->enc, f->rgba, f->width, f->height, c->want_key || f->backend != c->last_backend, &pkt,
                                 &plen, &key, &err);
-    size_t total = SY_WEB_FRAME_HEADER + plen + f->depth_len;
+    if (r == SY_OK) count_encode(w, c, t0, f->width, f->height);
+    bool same_depth = f->depth_key && f->depth_key == c->depth_key; /* the page has it: left out */
+    size_t dlen = same_depth ? 0 : f->depth_len;
+    size_t total = SY_WEB_FRAME_HEADER + plen + dlen;
     uint8_t *buf = NULL;
     if (r == SY_OK && !(buf = malloc(LWS_PRE + total)))
         r = sy_error_set(&err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %zu bytes", total);
@@ -374,10 +403,12 @@ static int send_video(sy_web *w, web_conn *c, web_frame *f, uint64_t id)
     uint8_t *h = buf + LWS_PRE;
     memcpy(h, f->buf + LWS_PRE, SY_WEB_FRAME_HEADER);
     memcpy(h + SY_WEB_FRAME_HEADER, pkt, plen);
-    memcpy(h + SY_WEB_FRAME_HEADER + plen, f->buf + LWS_PRE + SY_WEB_FRAME_HEADER + f->jpeg_len, f->depth_len);
+    memcpy(h + SY_WEB_FRAME_HEADER + plen, f->buf + LWS_PRE + SY_WEB_FRAME_HEADER + f->jpeg_len, dlen);
     sy_web_frame_info fi = {.jpeg_len = (uint32_t)plen, .codec = c->codec, .quality = (float)sy_web_video_encoder_psnr(c->enc),
                             .flags = key ? SY_WEB_FRAME_KEYFRAME : 0};
     sy_web_frame_set_payload(h, &fi);
+    if (same_depth) sy_web_frame_drop_depth(h);
+    c->depth_key = f->depth_key;
     memcpy(h + 32, &id, 8);
     sy_webi_frame_release(w, f);
     c->v_frames++, c->v_keys += key, c->v_bytes += plen, c->v_psnr += fi.quality;
@@ -402,14 +433,21 @@ static int send_frame(sy_web *w, web_conn *c, web_frame *f, uint64_t id)
         sy_error err = {0};
         size_t total = 0;
         uint8_t *buf = NULL;
-        if (sy_jpeg_encode_rgba8(f->rgba, f->width, f->height, w->d.quality, &jpeg, &jlen, &err) == SY_OK &&
-            (buf = malloc(LWS_PRE + (total = SY_WEB_FRAME_HEADER + jlen + f->depth_len)))) {
+        bool same_depth = f->depth_key && f->depth_key == c->depth_key;
+        size_t dlen = same_depth ? 0 : f->depth_len;
+        double t0 = sy_time_now();
+        sy_result jr = sy_jpeg_encode_rgba8(f->rgba, f->width, f->height, w->d.quality, &jpeg, &jlen, &err);
+        if (jr == SY_OK) count_encode(w, c, t0, f->width, f->height);
+        if (jr == SY_OK &&
+            (buf = malloc(LWS_PRE + (total = SY_WEB_FRAME_HEADER + jlen + dlen)))) {
             uint8_t *h = buf + LWS_PRE;
             memcpy(h, f->buf + LWS_PRE, SY_WEB_FRAME_HEADER);
             memcpy(h + SY_WEB_FRAME_HEADER, jpeg, jlen);
-            memcpy(h + SY_WEB_FRAME_HEADER + jlen, f->buf + LWS_PRE + SY_WEB_FRAME_HEADER, f->depth_len);
+            memcpy(h + SY_WEB_FRAME_HEADER + jlen, f->buf + LWS_PRE + SY_WEB_FRAME_HEADER, dlen);
             sy_web_frame_info fi = {.jpeg_len = (uint32_t)jlen};
             sy_web_frame_set_payload(h, &fi);
+            if (same_depth) sy_web_frame_drop_depth(h);
+            c->depth_key = f->depth_key;
             memcpy(h + 32, &id, 8);
         } else {
             sy_log(SY_LOG_WARNING, "web", c->peer, "a JPEG for this viewer failed: %s", err.message[0] ? err.message : "out of memory");
@@ -421,6 +459,21 @@ static int send_frame(sy_web *w, web_conn *c, web_frame *f, uint64_t id)
         free(buf);
         return n < (int)total ? -1 : 0;
     }
+    if (f->depth_key && f->depth_key == c->depth_key) { /* the page has this depth: header and JPEG alone */
+        size_t total = SY_WEB_FRAME_HEADER + f->jpeg_len;
+        uint8_t *buf = malloc(LWS_PRE + total);
+        if (buf) {
+            memcpy(buf + LWS_PRE, f->buf + LWS_PRE, total);
+            sy_web_frame_drop_depth(buf + LWS_PRE);
+            memcpy(buf + LWS_PRE + 32, &id, 8);
+        }
+        sy_webi_frame_release(w, f);
+        if (!buf) return 0;
+        int n = lws_write(c->wsi, buf + LWS_PRE, total, LWS_WRITE_BINARY);
+        free(buf);
+        return n < (int)total ? -1 : 0;
+    }
+    c->depth_key = f->depth_key;
     memcpy(f->buf + LWS_PRE + 32, &id, 8); /* the buffer is shared: patched right before each write */
     size_t len = f->len;
     int n = lws_write(c->wsi, f->buf + LWS_PRE, len, LWS_WRITE_BINARY);
@@ -453,8 +506,8 @@ static int ws_writeable(sy_web *w, web_conn *c)
         if (c->refusal_sent) return 0;
         c->refusal_sent = true;
         char m[200];
-        snprintf(m, sizeof m, "{\"t\":\"status\",\"error\":\"this page is older than the server (it reads frame format 1, "
-                              "the server sends format %u): reload it\"}", SY_WEB_FRAME_VERSION);
+        snprintf(m, sizeof m, "{\"t\":\"status\",\"error\":\"this page is older than the server (it reads frame format %u, "
+                              "the server sends format %u): reload it\"}", c->old_version, SY_WEB_FRAME_VERSION);
         return ws_send_text(c->wsi, m) ? -1 : 0;
     }
     /* answers to this page's picks and tree requests first, then "the scene changed" */

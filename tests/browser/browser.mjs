@@ -6,14 +6,15 @@
 //     pixels to OUTDIR/canvas.png, drags across the canvas, waits for the full-size frame that
 //     answers the drag, writes OUTDIR/dragged.png.
 //   node browser.mjs warp URL OUTDIR WIDTH HEIGHT
-//     The warping page (sy web --delay-ms N): a scripted drag of 40 moves 16 ms apart,
+//     The warping page (sy web --delay-ms N): a scripted drag of 40 moves 16 ms apart (SY_DRAG_MS=N:
+//     moves for N ms; SY_WARP_DRAG_ONLY=1: print the drag's numbers and stop there),
 //     window.sy.stats() after it (input_to_display_ms, frame_ms, ...); a second drag with a
 //     screenshot in its middle (OUTDIR/middrag.png, the page with its badge); then the references held (window.sy.hold) while a 12-pixel drag is warped
 //     (OUTDIR/warped.png), released, and the server's frame of the same view (OUTDIR/true.png);
 //     their mean absolute difference (0..255, RGB) computed in the browser; then a second page
 //     whose WebSocket goes through playwright (routeWebSocket) is sent made-up bad frames after
 //     the server's (duplicate, sizes that do not add up, depth that does not inflate, cameras
-//     not finite or not a rotation, format 3, no JPEG): their counts in sy.stats().bad and
+//     not finite or not a rotation, format 4, no JPEG): their counts in sy.stats().bad and
 //     whether the canvas stayed the same. URL?warp=0 gives the same drag without the warp and
 //     without the rest (the comparison).
 //   node browser.mjs tools URL OUTDIR WIDTH HEIGHT
@@ -45,6 +46,12 @@
 //     display frame after the page adopted a server frame (its size: the governor's coarse first
 //     frame), then to the first full-size frame; OUTDIR/first.png. Prints {picture_ms, width,
 //     height, backend, dom_ms, full_ms}.
+//   node browser.mjs converge URL OUTDIR WIDTH HEIGHT
+//     A still view of the path tracer (sy web -b pathtracer): the canvas of the first full-size
+//     frame (OUTDIR/early.png) and once the server's frames have 16 times its samples, at least 64
+//     (OUTDIR/late.png), each with its noise (mean absolute difference to the mean of the four
+//     neighbours, 0..255, RGB) and the samples the page had before and after the screenshot;
+//     sy.stats() after (bad frames, the depth channel's reuse).
 //   node browser.mjs client URL OUTDIR WIDTH HEIGHT
 //     The client-render page (sy web --client-render): waits until the client is idle (its last
 //     cull answer drawn), writes the canvas to OUTDIR/canvas.png and what the page fetched to
@@ -59,8 +66,8 @@ import { join } from 'node:path';
 
 const [mode, url, outDir, wArg, hArg] = process.argv.slice(2);
 const width = Number(wArg || 480), height = Number(hArg || 360);
-if (!['stream', 'client', 'warp', 'tools', 'video', 'timeline', 'first'].includes(mode) || !url || !outDir) {
-  console.error('usage: node browser.mjs stream|client|warp|tools|video|timeline|first URL OUTDIR [WIDTH HEIGHT]');
+if (!['stream', 'client', 'warp', 'tools', 'video', 'timeline', 'first', 'converge'].includes(mode) || !url || !outDir) {
+  console.error('usage: node browser.mjs stream|client|warp|tools|video|timeline|first|converge URL OUTDIR [WIDTH HEIGHT]');
   process.exit(2);
 }
 const executablePath = process.env.SY_CHROMIUM || '/usr/bin/chromium';
@@ -177,17 +184,31 @@ try {
     await settled().catch(() => fail('no full-size frame within the timeout'));
     const before = await page.evaluate(() => sy.stats());
     const frames0 = before.frames;
-    // the drag: 40 moves of 4 pixels, 16 ms apart (a hand at the display's rate)
-    const x0 = width / 2 - 80, y0 = height / 2;
+    // the drag: 40 moves of 4 pixels, 16 ms apart (a hand at the display's rate); SY_DRAG_MS=N
+    // (measurements): moves for N ms, back and forth over 160 pixels
+    const x0 = width / 2 - 80, y0 = height / 2, dragMs = Number(process.env.SY_DRAG_MS || 0);
     await page.mouse.move(x0, y0);
     await page.mouse.down();
-    for (let i = 1; i <= 40; i++) {
-      await page.mouse.move(x0 + 4 * i, y0 + (i % 2));
+    const tDrag = Date.now();
+    for (let i = 1; dragMs ? Date.now() - tDrag < dragMs : i <= 40; i++) {
+      const k = i % 80;
+      await page.mouse.move(x0 + 4 * (k <= 40 ? k : 80 - k), y0 + (i % 2));
       await page.waitForTimeout(16);
     }
     await page.mouse.up();
     await settled().catch(() => fail('no full-size frame answered the drag'));
     const st = await page.evaluate(() => sy.stats());
+    if (process.env.SY_WARP_DRAG_ONLY) { // measurements: the drag's numbers alone
+      const drag = st.input_to_display_ms.slice(-(st.inputs_displayed - before.inputs_displayed));
+      const frameMs = st.frame_ms.slice(-Math.min(st.frame_ms.length, st.display_frames - before.display_frames));
+      console.log(JSON.stringify({ warp: st.warp, drag_ms: Date.now() - tDrag, input_to_display_ms: summary(drag), frame_ms: summary(frameMs),
+                                   by_estimate: (st.inputs_by_estimate - before.inputs_by_estimate) / Math.max(1, drag.length),
+                                   server_fps: st.server_fps, bytes_per_frame: Math.round(st.bytes_per_frame), depth: st.depth,
+                                   video: st.video && { codec: st.video.codec, bytes_per_frame: Math.round(st.video.bytes_per_frame) },
+                                   frames_during_drag: st.frames - frames0, bad: st.bad, stride: st.stride, warp_scale: st.warp_scale }));
+      await browser.close();
+      process.exit(0);
+    }
     // a look mid-drag (not measured: the screenshot takes a while): the stats, then the page with its badge
     await page.mouse.move(x0, y0);
     await page.mouse.down();
@@ -242,7 +263,8 @@ try {
         const server = ws.connectToServer();
         toPage = ws;
         ws.onMessage((m) => server.send(m));
-        server.onMessage((m) => { if (typeof m !== 'string') last = Buffer.from(m); ws.send(m); });
+        // the newest frame with its own depth channel (a refinement may say it has the last one's)
+        server.onMessage((m) => { if (typeof m !== 'string' && Buffer.from(m).readUInt32LE(48)) last = Buffer.from(m); ws.send(m); });
       });
       await p2.goto(url, { timeout: TIMEOUT });
       await p2.waitForFunction(([w, h]) => window.syStats && window.sy && syStats.frames > 0 && syStats.width === w &&
@@ -258,7 +280,7 @@ try {
         variant(2, (b) => b.fill(0, 192 + jl)),                           // depth that does not inflate: depth
         variant(3, (b) => b.writeFloatLE(NaN, 64)),                       // a camera that is not finite: camera
         variant(4, (b) => { b.writeFloatLE(2, 64); }),                    // not a rotation: camera
-        variant(5, (b) => b.writeUInt8(0x33, 3)),                         // format 3: version
+        variant(5, (b) => b.writeUInt8(0x34, 3)),                         // format 4: version
         variant(6, (b) => b.fill(0, 192, 192 + jl)),                      // no JPEG: jpeg
       ];
       for (const b of bads) { toPage.send(b); await p2.waitForTimeout(50); }
@@ -276,6 +298,39 @@ try {
                                  server_fps: st.server_fps, bytes_per_frame: Math.round(st.bytes_per_frame),
                                  frames_during_drag: st.frames - frames0, mid, quality, bad: st.bad, badFrames, consoleErrors,
                                  input_to_display_all: drag.map((v) => Math.round(v)) }));
+  } else if (mode === 'converge') {
+    // a still view of a progressive back-end: the canvas early (the first full-size frames) and
+    // late (16 times the samples, at least 64): noise, the mean absolute difference of each pixel
+    // to the mean of its four neighbours (0..255, RGB), computed in the browser
+    const snap = async (name) => {
+      const s0 = await page.evaluate(() => syStats.samples);
+      await canvasPng(page, '#sy-canvas', join(outDir, name));
+      const s1 = await page.evaluate(() => syStats.samples);
+      const png = readFileSync(join(outDir, name)).toString('base64');
+      const noise = await page.evaluate(async (s) => {
+        const bmp = await createImageBitmap(await (await fetch('data:image/png;base64,' + s)).blob());
+        const c = new OffscreenCanvas(bmp.width, bmp.height), g = c.getContext('2d');
+        g.drawImage(bmp, 0, 0);
+        const p = g.getImageData(0, 0, bmp.width, bmp.height).data, w = bmp.width, h = bmp.height;
+        let sum = 0, n = 0;
+        for (let y = 1; y < h - 1; y++) for (let x = 1; x < w - 1; x++) for (let k = 0; k < 3; k++) {
+          const i = 4 * (y * w + x) + k;
+          sum += Math.abs(p[i] - (p[i - 4] + p[i + 4] + p[i - 4 * w] + p[i + 4 * w]) / 4); n++;
+        }
+        return sum / n;
+      }, png);
+      return { samples: [s0, s1], noise };
+    };
+    await page.waitForFunction(([w, h]) => window.syStats && syStats.frames > 0 && syStats.width === w && syStats.height === h,
+                               [width, height], { timeout: TIMEOUT }).catch(() => fail('no full-size frame within the timeout'));
+    const early = await snap('early.png');
+    const want = Math.max(64, 16 * early.samples[1]);
+    await page.waitForFunction((n) => syStats.samples >= n, want, { timeout: TIMEOUT })
+      .catch(() => fail(`the still view did not reach ${want} samples`));
+    const late = await snap('late.png');
+    const st = await page.evaluate(() => sy.stats());
+    console.log(JSON.stringify({ early, late, bad: st.bad, frames: st.frames, bytes_per_frame: Math.round(st.bytes_per_frame),
+                                 depth: st.depth, server_fps: st.server_fps, consoleErrors }));
   } else if (mode === 'tools') {
     // the page's tools (ui.js, tree.js, measure.js, section.js): pick by a click, hide from the
     // tree, measure, a section plane, the help, the screenshot; screenshots of each state

@@ -52,6 +52,13 @@
 #     clips' start to 16% of their range changes the streamed canvas (mean abs diff > 2), scrubbing
 #     back brings it back (< 1.5: the same JPEG of the same pose); space plays (the server's clock
 #     advances) and pauses; times out of range and not numbers are refused with a log line each.
+#   browser_test.sh converge SY PNG_IOU MODULES_DIR SCENE
+#     sy web SCENE -b pathtracer, a 320 x 240 page left still: the page shows the server's
+#     accumulated frames (docs/WEB.md, "Warping"), so the canvas converges: its noise (mean
+#     absolute difference to the mean of the four neighbours) once the frames have 16 times the
+#     first full-size frame's samples (at least 64) is below 0.7 of that first frame's; no frame
+#     is refused, and the refinements came without their depth channel (SAME_DEPTH) and were
+#     warpable with the one before.
 #   The warp test runs with ?video=0: its made-up bad frames are JPEG frames.
 #
 # MODULES_DIR holds browser.mjs and node_modules/playwright-core. Skipped (77, with the reason)
@@ -63,6 +70,7 @@ mode=$1 SY=$2 PNG_IOU=$3 MODULES=$4 SCENE=$5
 MIN_IOU=${6:-0.95} LUM=${7:-} # client: the coverage IoU asked for; the mean luminance's relative tolerance (none: not checked)
 W=480 H=360
 [ "$mode" = tools ] || [ "$mode" = timeline ] && W=960 H=600 # the panel shows beside the canvas from 600 pixels on
+[ "$mode" = converge ] && W=320 H=240 # the path tracer on two shared cores
 skip() {
     if [ "${SY_REQUIRE_BROWSER:-0}" = 1 ]; then echo "FAIL: SY_REQUIRE_BROWSER=1 but the test cannot run: $*"; exit 1; fi
     echo "SKIP: $*"
@@ -85,6 +93,7 @@ fail=0
 bad() { echo "FAIL: $*"; fail=1; }
 
 args=(web "$SCENE" -b raster --listen 127.0.0.1:0)
+[ "$mode" = converge ] && args=(web "$SCENE" -b pathtracer --listen 127.0.0.1:0)
 [ "$mode" = client ] && args+=(--client-render)
 [ "$mode" = warp ] && args+=(--delay-ms 100)
 "$SY" "${args[@]}" >"$out/log" 2>"$out/err" &
@@ -236,6 +245,26 @@ if [ "$mode" = video ]; then
     kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
     grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
     grep -E 'video|sent (vp8|vp9|jpeg)' "$out/err" | head -8
+    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
+    exit $fail
+fi
+
+if [ "$mode" = converge ]; then
+    browse "$url"
+    [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null
+    node -e '
+      const s = JSON.parse(require("fs").readFileSync(process.argv[1])), errs = [];
+      console.log(`still path tracer: noise ${s.early.noise.toFixed(2)} at ${s.early.samples.join("-")} spp, ` +
+                  `${s.late.noise.toFixed(2)} at ${s.late.samples.join("-")} spp (ratio ${(s.late.noise / s.early.noise).toFixed(2)}); ` +
+                  `${s.frames} frames, ${s.bytes_per_frame} bytes per frame; depth ${JSON.stringify(s.depth)}`);
+      if (!(s.late.noise < 0.7 * s.early.noise)) errs.push(`the canvas did not converge: noise ${s.early.noise} then ${s.late.noise}`);
+      for (const k in s.bad) if (s.bad[k]) errs.push(`frames refused: ${JSON.stringify(s.bad)}`);
+      if (!(s.depth && s.depth.same > 0)) errs.push(`no refinement came without its depth channel: ${JSON.stringify(s.depth)}`);
+      if (s.consoleErrors.length) errs.push(`page errors: ${s.consoleErrors}`);
+      if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
+    ' "$out/browser.json" || fail=1
+    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
+    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
     [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
     exit $fail
 fi

@@ -47,7 +47,7 @@ static void *viewer(void *arg)
     snprintf(origin, sizeof origin, "127.0.0.1:%u", (unsigned)g_port);
     sy_web_client_opts o = {.host = "127.0.0.1", .port = g_port, .path = "/ws", .origin = origin};
     if (sy_web_client_connect(&o, 30000, &c, &err) != SY_OK ||
-        sy_web_client_send(c, "{\"t\":\"size\",\"w\":480,\"h\":270,\"v\":2}", &err) != SY_OK) {
+        sy_web_client_send(c, "{\"t\":\"size\",\"w\":480,\"h\":270,\"v\":3}", &err) != SY_OK) {
         fprintf(stderr, "web_soak: viewer %u: %s\n", k, err.message);
         atomic_fetch_add(&g_drag_failures, 1);
         sy_web_client_close(c);

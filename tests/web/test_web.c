@@ -13,7 +13,11 @@
  *                 differs from the one before; malformed messages are ignored and serving goes on;
  *                 a message over the limit closes that connection only; foreign Origin and missing
  *                 subprotocol upgrades are refused; a viewer beyond max_clients is refused
- *   web_progressive  the path tracer refines while the view rests and restarts when it moves
+ *   web_encodecost  the frame-time governor counts the encoders' time (sy_web_cost.h): a slow
+ *                 encoder stub makes it pick a smaller moving frame that fits the budget with the
+ *                 encode (simulated clock); --quality's video quantizer
+ *   web_progressive  the path tracer refines while the view rests and restarts when it moves;
+ *                 the refinements leave the depth channel out (SAME_DEPTH) and it decodes as before
  *   web_token     listening on 0.0.0.0: without the token 401 with the page saying it is missing,
  *                 a wrong one 403 (one of 200 characters too), the right one 200 plus a cookie
  *                 that works alone; WebSocket upgrades need it too
@@ -49,7 +53,9 @@
  *                 pixel; play is answered by clock messages whose time advances, pause stops it; a
  *                 scene without clips sends no clock and refuses times
  *   web_frame     the binary frame (sy_web_frame.h) round-trips: header fields, the depth channel
- *                 within its 16-bit log step, "nothing" kept; truncated, foreign, format-1 and
+ *                 (the grid of every second pixel) within its 16-bit log step, "nothing" kept; a
+ *                 tilted plane codes to under a quarter of its grid's 2 bytes per value; a frame
+ *                 without its depth (SAME_DEPTH) parses; truncated, foreign, format-2 and
  *                 mismatched frames are refused with the reason; the stream's frames carry the
  *                 orbit's camera and a depth channel of the frame's size (web_stream)
  *   web_videostream  a viewer listing ["vp10", "VP9", 5, "vp9", "vp8"] is sent VP9 (the bad names
@@ -61,11 +67,13 @@
 #define _GNU_SOURCE /* strcasestr */
 #include "../support/sy_check.h"
 #include "sy_demo.h"
+#include "sy_governor.h"
 #include "sy_jpeg.h"
 #include "sy_mediators.h"
 #include "sy_web.h"
 #include "sy_web_check.h"
 #include "sy_web_client.h"
+#include "sy_web_cost.h"
 #include "sy_web_frame.h"
 #include "sy_web_thread.h"
 #include "sy_web_video.h"
@@ -415,7 +423,7 @@ static int test_stream(uint16_t port)
     sy_web_client_opts o = {.host = "127.0.0.1", .port = port, .path = "/ws"};
     CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
     CHECK_OK(sy_web_client_connect(&o, 10000, &other, &err), err); /* a second viewer that never reads */
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":80,\"h\":60,\"v\":2}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":80,\"h\":60,\"v\":3}", &err), err);
     sy_web_frame_info fi;
     uint8_t *j0 = NULL, *j1 = NULL;
     size_t n0 = 0, n1 = 0;
@@ -439,11 +447,11 @@ static int test_stream(uint16_t port)
         }
     CHECK(hits > 80 * 60 / 10 && fi.depth_min > 0); /* the demo fills much of the view */
     free(depth);
-    /* a page that reads frame format 1 (no "v" in its size message) is told to reload and gets no
-     * frames, while this viewer's input gives it new ones */
+    /* a page that reads frame format 2 (format 1: no "v" in its size message, the same path) is
+     * told to reload and gets no frames, while this viewer's input gives it new ones */
     sy_web_client *old = NULL;
     CHECK_OK(sy_web_client_connect(&o, 10000, &old, &err), err);
-    CHECK_OK(sy_web_client_send(old, "{\"t\":\"size\",\"w\":40,\"h\":30}", &err), err);
+    CHECK_OK(sy_web_client_send(old, "{\"t\":\"size\",\"w\":40,\"h\":30,\"v\":2}", &err), err);
     for (int k = 0; k < 3; ++k) {
         char m[96];
         snprintf(m, sizeof m, "{\"t\":\"drag\",\"dx\":%d,\"dy\":0,\"id\":%d}", k + 1, k + 1);
@@ -527,18 +535,31 @@ static int test_progressive(void)
     sy_web_client *c = NULL;
     sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
     CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":48,\"h\":32,\"v\":2}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":48,\"h\":32,\"v\":3}", &err), err);
     sy_web_frame_info fi = {0};
+    float *d0 = NULL;
     do {
-        if (next_frame(c, &fi, NULL, NULL)) return 1;
+        free(d0);
+        d0 = NULL;
+        CHECK_OK(sy_web_client_next_frame_depth(c, 60000, &fi, NULL, NULL, &d0, &err), err);
     } while (fi.width != 48);
-    uint32_t prev = fi.samples, rising = 0;
+    uint32_t prev = fi.samples, rising = 0, same_depth = 0;
     while (rising < 4) { /* four frames in a row, each with more samples */
-        if (next_frame(c, &fi, NULL, NULL)) return 1;
+        float *d = NULL;
+        CHECK_OK(sy_web_client_next_frame_depth(c, 60000, &fi, NULL, NULL, &d, &err), err);
         CHECK(fi.width == 48 && fi.samples > prev);
+        /* a refinement of the view leaves its depth channel out: the page has it already
+         * (SY_WEB_FRAME_SAME_DEPTH); the client's last one decodes for it */
+        if (fi.flags & SY_WEB_FRAME_SAME_DEPTH) {
+            same_depth++;
+            CHECK(!fi.depth_len && d0 && !memcmp(d, d0, sizeof(float) * 48 * 32));
+        }
+        free(d0);
+        d0 = d;
         prev = fi.samples, rising++;
     }
-    CHECK(prev >= 5);
+    free(d0);
+    CHECK(prev >= 5 && same_depth >= 3);
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"drag\",\"dx\":30,\"dy\":0,\"id\":1}", &err), err);
     do {
         if (next_frame(c, &fi, NULL, NULL)) return 1;
@@ -990,7 +1011,13 @@ static int test_frame(void)
     size_t len = 0;
     CHECK_OK(sy_web_frame_pack(&fi, jpeg, sizeof jpeg, depth, 16, &buf, &len, &err), err);
     CHECK(len == SY_WEB_FRAME_HEADER + sizeof jpeg + fi.depth_len && fi.depth_len > 0);
-    CHECK(fi.depth_min == 0.5f && fi.depth_max == 0.5f + 0.37f * 210);
+    CHECK(fi.depth_coding == SY_WEB_DEPTH_HALF_LOG16);
+    /* the grid: every second pixel and the last column and row (W and H odd: 2 i reaches them) */
+    float lo = INFINITY, hi = 0;
+    for (int y = 0; y < H; y += 2)
+        for (int x = 0; x < W; x += 2)
+            if (isfinite(depth[y * W + x]) && depth[y * W + x] > 0) lo = fminf(lo, depth[y * W + x]), hi = fmaxf(hi, depth[y * W + x]);
+    CHECK(fi.depth_min == lo && fi.depth_max == hi);
     sy_web_frame_info g;
     const uint8_t *jp = NULL, *dp = NULL;
     CHECK_OK(sy_web_frame_parse(buf + 16, len, &g, &jp, &dp, &err), err);
@@ -1002,21 +1029,51 @@ static int test_frame(void)
     float *d = NULL;
     CHECK_OK(sy_web_frame_depth(&g, dp, &d, &err), err);
     double step = log(g.depth_max / g.depth_min) / 65534, worst = 0;
-    for (int i = 0; i < W * H; ++i) {
-        bool hit = isfinite(depth[i]) && depth[i] > 0;
-        CHECK(hit == isfinite(d[i]));
-        if (hit) worst = fmax(worst, fabs(log(d[i] / depth[i])));
-    }
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            /* each pixel has the grid value nearest to it: pixel (x & ~1, y & ~1) */
+            int i = y * W + x, k = (y & ~1) * W + (x & ~1);
+            bool hit = isfinite(depth[k]) && depth[k] > 0;
+            CHECK(hit == isfinite(d[i]));
+            if (hit) worst = fmax(worst, fabs(log(d[i] / depth[k])));
+        }
     CHECK(worst <= 0.51 * step + 1e-6); /* half a quantisation step (relative) */
     free(d);
+    /* a smooth surface (a tilted plane) codes to far fewer bytes than its 2 bytes per grid value */
+    {
+        enum { PW = 320, PH = 180 };
+        float *plane = malloc(sizeof(float) * PW * PH);
+        for (int y = 0; y < PH; ++y)
+            for (int x = 0; x < PW; ++x) plane[y * PW + x] = 2.0f / (0.3f + 0.002f * (float)y + 0.0007f * (float)x);
+        uint8_t *z = NULL;
+        size_t zl = 0;
+        float a = 0, b = 0;
+        CHECK_OK(sy_web_frame_depth_code(plane, PW, PH, &z, &zl, &a, &b, &err), err);
+        printf("web_frame: a tilted plane of %dx%d codes to %zu depth bytes (%d grid values)\n", PW, PH, zl, (PW / 2 + 1) * (PH / 2 + 1));
+        CHECK(zl > 0 && zl < (size_t)(PW / 2 + 1) * (PH / 2 + 1) / 4);
+        free(z);
+        free(plane);
+    }
+    /* a frame that says it has the last depth channel: header and payload only; with depth bytes: refused */
+    {
+        uint8_t *h2 = malloc(len);
+        memcpy(h2, buf + 16, len);
+        sy_web_frame_drop_depth(h2);
+        CHECK_OK(sy_web_frame_parse(h2, SY_WEB_FRAME_HEADER + sizeof jpeg, &g, NULL, &dp, &err), err);
+        CHECK((g.flags & SY_WEB_FRAME_SAME_DEPTH) && !g.depth_len && !dp);
+        uint32_t dl = fi.depth_len;
+        memcpy(h2 + 48, &dl, 4);
+        CHECK(sy_web_frame_parse(h2, len, &g, NULL, &dp, &err) == SY_ERR_PROTOCOL && strstr(err.message, "last one"));
+        free(h2);
+    }
     /* hostile: truncated, foreign magic, format 1, a size that does not add up, depth of another size */
     CHECK(sy_web_frame_parse(buf + 16, len - 1, &g, NULL, NULL, &err) == SY_ERR_PROTOCOL);
     CHECK(sy_web_frame_parse(buf + 16, 100, &g, NULL, NULL, &err) == SY_ERR_PROTOCOL);
     uint8_t *bad = malloc(len);
     memcpy(bad, buf + 16, len);
-    bad[3] = '1';
-    CHECK(sy_web_frame_parse(bad, len, &g, NULL, NULL, &err) == SY_ERR_PROTOCOL && strstr(err.message, "format 1"));
-    bad[0] = 'X', bad[3] = '2';
+    bad[3] = '2';
+    CHECK(sy_web_frame_parse(bad, len, &g, NULL, NULL, &err) == SY_ERR_PROTOCOL && strstr(err.message, "format 2"));
+    bad[0] = 'X', bad[3] = '3';
     CHECK(sy_web_frame_parse(bad, len, &g, NULL, NULL, &err) == SY_ERR_PROTOCOL);
     memcpy(bad, buf + 16, len);
     uint32_t w2 = W + 1;
@@ -1179,7 +1236,7 @@ static int frame_until(sy_web_client *c, int px, int py, float d0, bool changed,
 static int first_frame(sy_web_client *c, int *px, int *py, float *d)
 {
     sy_error err = {0};
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":80,\"h\":60,\"v\":2}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":80,\"h\":60,\"v\":3}", &err), err);
     sy_web_frame_info fi;
     float *depth = NULL;
     do {
@@ -1521,7 +1578,7 @@ static int test_video_stream(uint16_t port)
     CHECK_OK(sy_web_client_connect(&o, 10000, &j, &err), err);
     /* the video viewer first: the JPEG viewer may then be sent a frame made for video only (its
      * JPEG made on the network thread) */
-    CHECK_OK(sy_web_client_send(v, "{\"t\":\"size\",\"w\":" SW ",\"h\":" SH ",\"v\":2,\"codecs\":[\"vp10\",\"VP9\",5,\"vp9\",\"vp8\"]}", &err), err);
+    CHECK_OK(sy_web_client_send(v, "{\"t\":\"size\",\"w\":" SW ",\"h\":" SH ",\"v\":3,\"codecs\":[\"vp10\",\"VP9\",5,\"vp9\",\"vp8\"]}", &err), err);
     sy_web_frame_info fi;
     uint8_t *pay = NULL, *jp = NULL, *jpx = NULL;
     size_t n = 0, jn = 0;
@@ -1533,7 +1590,7 @@ static int test_video_stream(uint16_t port)
     CHECK_MSG(fi.flags & SY_WEB_FRAME_KEYFRAME, "the first VP9 frame is no keyframe (flags %u)", fi.flags);
     CHECK_MSG(fi.quality > 25 && fi.quality < 100, "PSNR %g", (double)fi.quality);
     CHECK(fi.depth_len > 0);
-    CHECK_OK(sy_web_client_send(j, "{\"t\":\"size\",\"w\":" SW ",\"h\":" SH ",\"v\":2}", &err), err);
+    CHECK_OK(sy_web_client_send(j, "{\"t\":\"size\",\"w\":" SW ",\"h\":" SH ",\"v\":3}", &err), err);
     sy_web_video_decoder *d = NULL;
     CHECK_OK(sy_web_video_decoder_create(SY_WEB_CODEC_VP9, &d, &err), err);
     const uint8_t *px = NULL;
@@ -1568,8 +1625,8 @@ static int test_video_stream(uint16_t port)
     printf("the drag: %d frames, %d of them delta frames\n", frames, deltas);
     sy_web_video_decoder_destroy(d);
     /* codecs that are no array, or only unknown names: JPEG */
-    static const char *const jpeg_only[] = {"{\"t\":\"size\",\"w\":" SW ",\"h\":" SH ",\"v\":2,\"codecs\":\"vp8\"}",
-                                            "{\"t\":\"size\",\"w\":" SW ",\"h\":" SH ",\"v\":2,\"codecs\":[\"vp8x\",\"h264\"]}"};
+    static const char *const jpeg_only[] = {"{\"t\":\"size\",\"w\":" SW ",\"h\":" SH ",\"v\":3,\"codecs\":\"vp8\"}",
+                                            "{\"t\":\"size\",\"w\":" SW ",\"h\":" SH ",\"v\":3,\"codecs\":[\"vp8x\",\"h264\"]}"};
     sy_web_client_close(v);
     sy_web_client_close(j);
     v = j = NULL;
@@ -1589,6 +1646,69 @@ static int test_video_stream(uint16_t port)
     free(jp);
     sy_web_client_close(v);
     sy_web_client_close(j);
+    return 0;
+}
+
+/* Moving frames of a 640 x 360 view through the governor as the server drives it: a render stub
+ * (2 ms + 4e-5 ms per pixel: 11.2 ms at full size) and an encoder stub on the "network thread"
+ * (per_px ms per pixel, 0: none) whose cost is known after the frame was sent (sy_web_cost.h)
+ * and added to the next frames' reports; simulated clock, no time measured. The last frame's width. */
+static uint32_t governed_width(double per_px, double *total_ms)
+{
+    sy_error err = {0};
+    sy_governor *g = NULL;
+    if (sy_governor_create(NULL, &g, &err) != SY_OK) return 0;
+    sy_web_encode_cost enc = {0};
+    sy_governor_frame f = {0};
+    double now = 0, sum = 0;
+    for (int i = 0; i < 60; ++i) {
+        sy_governor_plan(g, 640, 360, 0, true, now, &f);
+        double px = (double)f.width * f.height, render = 2.0 + 4e-5 * px, encode = per_px * px;
+        sy_governor_report(g, &f, sy_web_frame_cost_ms(render, enc.per_px_ms, f.width, f.height));
+        if (per_px > 0) sy_web_encode_cost_add(&enc, encode, (uint64_t)px); /* measured as it is sent */
+        sum = render + encode;
+        now += sum + 1.0;
+    }
+    sy_governor_destroy(g);
+    *total_ms = sum;
+    return f.width;
+}
+
+/* encodecost: the governor counts the encoders' time: with a slow encoder stub (1.5e-4 ms per
+ * pixel: 34.6 ms at 640 x 360) it picks a smaller moving frame than without, one whose render and
+ * encode fit the budget (33 ms); the cost per pixel is a weighted mean; --quality maps to the
+ * video quantizer */
+static int test_encode_cost(void)
+{
+    double fast_ms = 0, slow_ms = 0, bad_ms = 0;
+    uint32_t fast = governed_width(0, &fast_ms), slow = governed_width(1.5e-4, &slow_ms);
+    /* the same slow encoder left out of the reports (before this change): the frames overrun */
+    sy_governor *g = NULL;
+    sy_error err = {0};
+    CHECK_OK(sy_governor_create(NULL, &g, &err), err);
+    sy_governor_frame f = {0};
+    double now = 0;
+    for (int i = 0; i < 60; ++i) {
+        sy_governor_plan(g, 640, 360, 0, true, now, &f);
+        double px = (double)f.width * f.height, render = 2.0 + 4e-5 * px;
+        sy_governor_report(g, &f, render);
+        bad_ms = render + 1.5e-4 * px;
+        now += bad_ms + 1.0;
+    }
+    sy_governor_destroy(g);
+    printf("encodecost: without an encoder %u px wide (%.1f ms a frame); a slow encoder counted: %u px (%.1f ms), "
+           "not counted: %u px (%.1f ms)\n",
+           fast, fast_ms, slow, slow_ms, f.width, bad_ms);
+    CHECK(fast == 640 && slow > 0 && slow < fast && slow < f.width);
+    CHECK(slow_ms <= 33.0 && bad_ms > 33.0);
+    sy_web_encode_cost c = {0};
+    CHECK(sy_web_encode_cost_add(&c, 10.0, 1000) == 0.01 && c.frames == 1);
+    sy_web_encode_cost_add(&c, 20.0, 1000);
+    CHECK(fabs(c.per_px_ms - (0.01 + SY_WEB_COST_WEIGHT * 0.01)) < 1e-12 && c.frames == 2);
+    CHECK(sy_web_encode_cost_add(&c, NAN, 1000) == 0 && sy_web_encode_cost_add(&c, 5, 0) == 0 && c.frames == 2);
+    CHECK(sy_web_frame_cost_ms(5.0, 0.001, 100, 10) == 6.0 && sy_web_frame_cost_ms(5.0, NAN, 100, 10) == 5.0);
+    CHECK(sy_web_video_quantizer(80) == SY_WEB_VIDEO_QUANTIZER && sy_web_video_quantizer(95) == 12 &&
+          sy_web_video_quantizer(100) == 4 && sy_web_video_quantizer(1) == 63 && sy_web_video_quantizer(60) == 63);
     return 0;
 }
 
@@ -1617,6 +1737,11 @@ int main(int argc, char **argv)
     }
     if (!strcmp(which, "frame")) {
         int f = test_frame();
+        if (!f) printf("web %s: ok\n", which);
+        return f;
+    }
+    if (!strcmp(which, "encodecost")) {
+        int f = test_encode_cost();
         if (!f) printf("web %s: ok\n", which);
         return f;
     }

@@ -6,7 +6,7 @@
 // offer only that one.
 "use strict";
 (function () {
-  const HEADER = 192, MAGIC = 0x32465953, KEYFRAME = 2;
+  const HEADER = 192, MAGIC = 0x33465953, KEYFRAME = 2; // frame format 3 (docs/WEB.md)
   const NAMES = { 1: "vp8", 2: "vp9" };
   // best first: the server takes the first it encodes. vp9: about half vp8's bytes at the same
   // SSIM, and the governor's smaller moving frames go on in its stream (scaled references) where

@@ -1,8 +1,8 @@
 // view.js — the page of sy web: server frames, the local orbit and the warp (docs/WEB.md, "The page").
 "use strict";
 (function () {
-  // The page of sy web (docs/WEB.md, "The page"): server frames (JPEG + depth + camera, frame
-  // format 2) kept as the last two references; every input moves the local orbit at once (the
+  // The page of sy web (docs/WEB.md, "The page"): server frames (JPEG or video + depth + camera,
+  // frame format 3) kept as the last two references; every input moves the local orbit at once (the
   // maths of core/sy_orbit.c) and each display frame warps the references to it (depth-based 3D
   // warping as point splats, the nearer wins, then a hole fill) until the server's frame for
   // that view arrives. ?warp=0: show server frames only (the comparison).
@@ -10,7 +10,7 @@
   const badge = document.getElementById("sy-estimate");
   const params = new URLSearchParams(location.search);
   const warpOn = params.get("warp") !== "0", showHoles = params.get("holes") === "1";
-  const FORMAT = 2, HEADER = 192, MAGIC = 0x32465953;
+  const FORMAT = 3, HEADER = 192, MAGIC = 0x33465953, SAME_DEPTH = 4;
   // Test hook (browser tests): frames received, the newest input id sent and the one the last
   // frame answers, the frame's size, back-end, samples and render time.
   const stats = window.syStats = { frames: 0, lastInput: 0, answeredInput: 0, width: 0, height: 0,
@@ -21,7 +21,8 @@
   let ws = null, inputId = 0, decoding = false, pending = null, lastSeq = -1, hold = false;
   const bad = { magic: 0, version: 0, size: 0, order: 0, camera: 0, depth: 0, jpeg: 0, video: 0 };
   const video = window.syVideo || null; // video.js: the video stream's decoder (docs/WEB.md)
-  const hist = { input: [], frame: [], bytes: [], arrivals: [], adopt: [] };
+  const hist = { input: [], frame: [], bytes: [], arrivals: [], adopt: [], depth: [] };
+  const depthCount = { own: 0, same: 0, none: 0, mesh_kept: 0 }; // frames shown by where their depth came from
   function keep(a, v, n) { a.push(v); if (a.length > n) a.shift(); }
 
   // ---- the orbit camera: the same rules as core/sy_orbit.c (sy_orbit_rotate, _pan, _zoom) ----
@@ -191,16 +192,47 @@
     const s = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate"));
     return new Uint8Array(await new Response(s).arrayBuffer());
   }
-  function decodeDepth(planes, w, h, dmin, dmax) { // docs/WEB.md: 16-bit log depth, row deltas, byte planes
-    const n = w * h, d = new Float32Array(n), span = dmax > dmin ? Math.log(dmax / dmin) / 65534 : 0;
-    for (let y = 0; y < h; y++) {
-      let q = 0;
-      for (let x = 0, i = y * w; x < w; x++, i++) {
-        q = (q + (planes[i] | planes[n + i] << 8)) & 0xffff;
-        d[i] = q ? dmin * Math.exp((q - 1) * span) : 0;
+  // docs/WEB.md, depth coding 2: the grid of every second pixel (and the last column and row),
+  // 16-bit log depth, each value minus its MED prediction, byte planes; {d, gw, gh} (0: no hit)
+  function decodeDepth(planes, w, h, dmin, dmax) {
+    const gw = (w >> 1) + 1, gh = (h >> 1) + 1, n = gw * gh, q = new Uint16Array(n), d = new Float32Array(n);
+    const span = dmax > dmin ? Math.log(dmax / dmin) / 65534 : 0;
+    for (let j = 0, k = 0; j < gh; j++) for (let i = 0; i < gw; i++, k++) {
+      let p;
+      if (!j) p = i ? q[k - 1] : 0;
+      else if (!i) p = q[k - gw];
+      else {
+        const a = q[k - 1], b = q[k - gw], c = q[k - gw - 1], mx = Math.max(a, b), mn = Math.min(a, b);
+        p = c >= mx ? mn : c <= mn ? mx : a + b - c;
       }
+      const v = q[k] = (p + (planes[k] | planes[n + k] << 8)) & 0xffff;
+      d[k] = v ? dmin * Math.exp((v - 1) * span) : 0;
     }
-    return d;
+    return { d: d, gw: gw, gh: gh };
+  }
+  // where a frame's depth comes from, decided as it arrives (frames arrive in order; the page may
+  // skip some while it is busy): its own channel, or for a frame that says it has the last one
+  // (SAME_DEPTH) the last channel that arrived; decoded once for all the frames that share it
+  let lastDepth = null;
+  function depthSource(buf) {
+    if (buf.byteLength < HEADER) return null;
+    const dv = new DataView(buf);
+    if (dv.getUint32(0, true) !== MAGIC || dv.getUint32(40, true) !== HEADER) return null;
+    const jl = dv.getUint32(44, true), dl = dv.getUint32(48, true);
+    if (dl && HEADER + jl + dl === buf.byteLength)
+      lastDepth = { bytes: new Uint8Array(buf, HEADER + jl, dl), w: dv.getUint32(4, true), h: dv.getUint32(8, true),
+                    dmin: dv.getFloat32(56, true), dmax: dv.getFloat32(60, true), grid: null };
+    return dl ? lastDepth : (dv.getUint32(180, true) & SAME_DEPTH) ? lastDepth : null;
+  }
+  function depthGrid(src) { // a promise of the decoded grid
+    if (!src.grid) {
+      const gn = ((src.w >> 1) + 1) * ((src.h >> 1) + 1);
+      src.grid = inflate(src.bytes).then((p) => {
+        if (p.length !== 2 * gn) throw new Error("depth");
+        return decodeDepth(p, src.w, src.h, src.dmin, src.dmax);
+      });
+    }
+    return src.grid;
   }
   function parse(buf) { // the header (docs/WEB.md) or the reason it is refused
     const dv = new DataView(buf), len = buf.byteLength;
@@ -213,6 +245,7 @@
                 coding: dv.getUint32(52, true), dmin: dv.getFloat32(56, true), dmax: dv.getFloat32(60, true),
                 c2w: new Float32Array(buf.slice(64, 128)), win: [0, 1, 2, 3].map((i) => dv.getFloat32(128 + 4 * i, true)),
                 proj: dv.getUint32(144, true), flags: dv.getUint32(180, true), bytes: len, codec: dv.getUint32(184, true),
+                sameDepth: (dv.getUint32(180, true) & SAME_DEPTH) !== 0,
                 orbit: { target: [0, 1, 2].map((i) => dv.getFloat32(156 + 4 * i, true)), yaw: dv.getFloat32(168, true),
                          pitch: dv.getFloat32(172, true), dist: dv.getFloat32(176, true) } };
     if (!f.w || !f.h || f.w > 16384 || f.h > 16384 || f.w * f.h > 67108864 || HEADER + f.jpegLen + f.depthLen !== len) return { bad: "size" };
@@ -220,7 +253,7 @@
     if (!camOk(f.c2w, f.win) || ![f.orbit.yaw, f.orbit.pitch, f.orbit.dist, ...f.orbit.target].every(isFinite) ||
         !(f.orbit.dist > 0)) return { bad: "camera" };
     f.warpable = f.proj === 0; // an orthographic frame is shown as it is, never warped
-    if (f.depthLen && (f.coding !== 1 || !(f.dmin > 0) || !(f.dmax >= f.dmin) || !isFinite(f.dmax))) return { bad: "depth" };
+    if (f.depthLen && (f.coding !== 2 || f.sameDepth || !(f.dmin > 0) || !(f.dmax >= f.dmin) || !isFinite(f.dmax))) return { bad: "depth" };
     return f;
   }
   // the reference's mesh: grid points every s pixels (camera space: (tx d, ty d, -d, 1), no hit
@@ -233,7 +266,8 @@
     for (let j = 0, n = 0; j < gy; j++) {
       const y = Math.min(j * s, h - 1), ty = win[3] + (win[2] - win[3]) * (y + 0.5) / h;
       for (let i = 0; i < gx; i++, n++) {
-        const x = Math.min(i * s, w - 1), tx = win[0] + (win[1] - win[0]) * (x + 0.5) / w, d = depth[y * w + x];
+        const x = Math.min(i * s, w - 1), tx = win[0] + (win[1] - win[0]) * (x + 0.5) / w;
+        const d = depth.d[(y === h - 1 ? depth.gh - 1 : y >> 1) * depth.gw + (x === w - 1 ? depth.gw - 1 : x >> 1)];
         const o = n * 6;
         if (d > 0) { v[o] = tx * d; v[o + 1] = ty * d; v[o + 2] = -d; v[o + 3] = 1; }
         else { v[o] = tx; v[o + 1] = ty; v[o + 2] = -1; v[o + 3] = 0; }
@@ -262,15 +296,20 @@
   }
   function freeRef(o) {
     gl.deleteTexture(o.color);
-    if (o.mesh) { gl.deleteVertexArray(o.mesh.vao); gl.deleteBuffer(o.mesh.vbo); gl.deleteBuffer(o.mesh.ibo); }
+    if (o.mesh && !o.meshKept) { gl.deleteVertexArray(o.mesh.vao); gl.deleteBuffer(o.mesh.vbo); gl.deleteBuffer(o.mesh.ibo); }
   }
-  function adopt(f, bmp, depth) {
+  function adopt(f, bmp, depth, src) {
     if (gl) {
       const warpable = f.warpable && !!depth && f.w > 1 && f.h > 1;
-      const r = { color: texture(f.w, f.h, bmp), mesh: warpable ? buildMesh(depth, f.w, f.h, f.win, stride) : null,
-                  w: f.w, h: f.h, c2w: f.c2w, win: f.win, orbit: f.orbit, seq: f.seq, answered: f.answered, warpable: warpable };
-      // two views: a frame of the newest one's view (its refinement) replaces it
+      // two views: a frame of the newest one's view (its refinement) replaces it, and keeps its
+      // mesh when the depth is the same (a progressive back-end's samples: SAME_DEPTH)
       const same = refs.length && JSON.stringify(refs[0].orbit) === JSON.stringify(f.orbit);
+      const keepMesh = same && warpable && refs[0].mesh && refs[0].src === src && refs[0].stride === stride;
+      if (keepMesh) { refs[0].meshKept = true; depthCount.mesh_kept++; }
+      const r = { color: texture(f.w, f.h, bmp),
+                  mesh: keepMesh ? refs[0].mesh : warpable ? buildMesh(depth, f.w, f.h, f.win, stride) : null,
+                  src: src, stride: stride,
+                  w: f.w, h: f.h, c2w: f.c2w, win: f.win, orbit: f.orbit, seq: f.seq, answered: f.answered, warpable: warpable };
       if (same) freeRef(refs.shift());
       refs.unshift(r);
       while (refs.length > 2) freeRef(refs.pop());
@@ -281,23 +320,23 @@
     while (sent.length && sent[0].id <= f.answered) sent.shift();
     newFrame = true;
   }
-  function show(buf) {
+  function show(buf, src) {
     const f = parse(buf);
     if (f.bad) {
       bad[f.bad]++;
       if (f.bad === "version") hud.textContent = "the server sends frame format " + f.version + ", this page reads " + FORMAT + ": reload";
       return next();
     }
-    keep(hist.bytes, f.bytes, 60); keep(hist.arrivals, performance.now(), 120);
+    keep(hist.bytes, f.bytes, 60); keep(hist.arrivals, performance.now(), 120); keep(hist.depth, f.depthLen, 60);
     decoding = true;
     const jpeg = f.codec ? null : new Blob([new Uint8Array(buf, HEADER, f.jpegLen)], { type: "image/jpeg" });
     const picture = !f.codec ? createImageBitmap(jpeg).catch(() => { throw new Error("jpeg"); })
       : !video ? Promise.reject(new Error("video")) // a video frame: video.js decoded it as it arrived
       : video.frame(f.seq).then((vf) => createImageBitmap(vf).finally(() => vf.close())).catch(() => { throw new Error("video"); });
-    const depth = f.depthLen ? inflate(new Uint8Array(buf, HEADER + f.jpegLen, f.depthLen)).then((p) => {
-      if (p.length !== 2 * f.w * f.h) throw new Error("depth");
-      return decodeDepth(p, f.w, f.h, f.dmin, f.dmax);
-    }) : Promise.resolve(null);
+    // the frame's depth: its own, or the last one for a frame that says it has it (same size)
+    const depth = f.sameDepth && !src ? Promise.reject(new Error("depth"))
+      : !src || (!f.depthLen && !f.sameDepth) ? Promise.resolve(null)
+      : src.w !== f.w || src.h !== f.h ? Promise.reject(new Error("depth")) : depthGrid(src);
     Promise.all([picture, depth.catch(() => { throw new Error("depth"); })])
       .then(function ([bmp, d]) {
         if (bmp.width !== f.w || bmp.height !== f.h) { bmp.close(); throw new Error("size"); }
@@ -305,7 +344,8 @@
         if (f.seq <= lastSeq) { bmp.close(); throw new Error("order"); }
         lastSeq = f.seq;
         const t0 = performance.now();
-        adopt(f, bmp, d);
+        adopt(f, bmp, d, src);
+        depthCount[f.depthLen ? "own" : f.sameDepth ? "same" : "none"]++;
         keep(hist.adopt, performance.now() - t0, 60);
         bmp.close();
         stats.frames++; stats.width = f.w; stats.height = f.h; stats.answeredInput = f.answered;
@@ -315,7 +355,7 @@
                           (f.samples > 1 ? " | " + f.samples + " spp" : "") + (stats.filter ? " | " + stats.filter : "");
       }).catch(function (e) { bad[e.message in bad ? e.message : "jpeg"]++; }).finally(function () { decoding = false; next(); });
   }
-  function next() { if (pending) { const p = pending; pending = null; show(p); } } // only the newest waiting frame
+  function next() { if (pending) { const p = pending; pending = null; show(p.buf, p.src); } } // only the newest waiting frame
 
   // ---- each display frame: the exact frame, or the references warped to the local orbit ----
   let frameCount = 0, inputCount = 0, warpAnswered = 0, newFrame = false, moved = false, lastT = 0;
@@ -431,6 +471,7 @@
                server_fps: recent.length / 2, bytes_per_frame: mean(hist.bytes),
                estimate_share: estimate, hole_share: opts && opts.holes ? holeShare() : null, stride: stride, warp_scale: LEVELS[level].scale, warp: warpOn && !!gl,
                bad: Object.assign({}, bad),
+               depth: Object.assign({ bytes_per_frame: mean(hist.depth) }, depthCount),
                video: video ? video.stats() : null,
                shown_input: shownInput, last_input: inputId, frames: stats.frames,
                display_frames: frameCount, inputs_displayed: inputCount, inputs_by_estimate: warpAnswered }; // counts: slice the arrays' ends
@@ -498,7 +539,8 @@
         return;
       }
       if (video) video.feed(e.data); // every video frame is decoded, in order, shown or not
-      if (decoding) pending = e.data; else show(e.data);
+      const src = depthSource(e.data);
+      if (decoding) pending = { buf: e.data, src: src }; else show(e.data, src);
     };
   }
   // mouse and touch: one pointer drags (left: orbit, right or shift: pan), the wheel zooms
