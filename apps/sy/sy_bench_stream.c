@@ -8,7 +8,7 @@
  * [0, 1], sy_filter_ssim_gray). Reported per setting: bytes per frame, SSIM mean and minimum,
  * encode time; then the cheapest JPEG whose mean SSIM is >= 0.95 and the cheapest setting of each
  * video codec at least as good, and their ratio of bytes. The depth channel that goes with every
- * moving frame: its bytes and coding time in format 3 (the grid of every second pixel, MED
+ * moving frame: its bytes and coding time in format 3 (the grid of every fourth pixel, 12-bit, MED
  * prediction, deflate 6: apps/web/sy_web_frame.h) beside format 2's coding (every pixel, row
  * deltas, deflate 1; kept here only for the comparison), and the messages' bytes at the server's
  * defaults. See sy_bench_stream.h. */
@@ -233,7 +233,7 @@ sy_result sy_bench_stream(sy_scene *scene, const sy_viewport_desc *vd, const cha
                    s->ssim / frames, s->ssim_min, (unsigned long long)s->keys, s->enc_s / frames * 1e3);
         }
         printf("  depth channel per moving frame: format 2 (every pixel, row deltas, deflate 1) %.0f bytes (%.2f ms); "
-               "format 3 (every second pixel, MED, deflate 6) %.0f bytes (%.2f ms): 1/%.1f; a still view's refinements: 0\n",
+               "format 3 (every fourth pixel, 12-bit, MED, deflate 6) %.0f bytes (%.2f ms): 1/%.1f; a still view's refinements: 0\n",
                d2_bytes / frames, d2_s / frames * 1e3, d3_bytes / frames, d3_s / frames * 1e3,
                d3_bytes > 0 ? d2_bytes / d3_bytes : 0.0);
         /* the server's defaults: JPEG at --quality 80, video at SY_WEB_VIDEO_QUANTIZER; with the

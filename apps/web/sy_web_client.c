@@ -195,7 +195,7 @@ sy_result sy_web_client_next_frame_depth(sy_web_client *c, uint32_t timeout_ms, 
         else {
             sy_web_frame_info g = *info;
             g.depth_len = c->depth_len, g.depth_min = c->depth_min, g.depth_max = c->depth_max;
-            g.depth_coding = SY_WEB_DEPTH_HALF_LOG16;
+            g.depth_coding = SY_WEB_DEPTH_GRID_LOG12;
             r = sy_web_frame_depth(&g, c->depth, depth, err);
         }
     } else if (r == SY_OK && depth)

@@ -1,5 +1,5 @@
 /* sy_web_frame.c — sy web's binary frame, format 3: packing (the server) and reading (clients,
- * tests); the depth channel's grid, 16-bit log quantisation, prediction and deflate (see
+ * tests); the depth channel's grid, 12-bit log quantisation, interpolation, prediction and deflate (see
  * sy_web_frame.h). */
 #include "sy_web_frame.h"
 
@@ -37,10 +37,13 @@ static float getf(const uint8_t *p)
 
 static bool hit(float d) { return isfinite(d) && d > 0.0f; }
 
-/* The depth grid of a w x h frame: every second pixel in x and y, plus the last column and row
- * (docs/WEB.md, depth coding 2): column i holds pixel min(2 i, w - 1), row j pixel min(2 j, h - 1). */
-static uint32_t grid_n(uint32_t n) { return n / 2 + 1; }
-static uint32_t grid_src(uint32_t i, uint32_t n) { return 2 * i < n - 1 ? 2 * i : n - 1; }
+/* The depth grid of a w x h frame: every SY_WEB_DEPTH_STEP-th pixel in x and y, plus the last
+ * column and row (docs/WEB.md, depth coding 2): column i holds pixel min(4 i, w - 1), row j pixel
+ * min(4 j, h - 1); ceil((n - 1) / 4) + 1 of them. */
+#define STEP SY_WEB_DEPTH_STEP
+#define QMAX 4095u /* 12-bit values: 0 = nothing, 1..4095 the log scale */
+static uint32_t grid_n(uint32_t n) { return (n - 1 + STEP - 1) / STEP + 1; }
+static uint32_t grid_src(uint32_t i, uint32_t n) { return STEP * i < n - 1 ? STEP * i : n - 1; }
 
 /* The MED predictor (LOCO-I) of a grid value from its left (a), upper (b) and upper-left (c)
  * neighbours; the first row predicts from the left, the first column from above. */
@@ -54,7 +57,7 @@ static uint16_t med(uint32_t i, uint32_t j, const uint16_t *q, uint32_t gw)
 }
 
 /* The depth channel (coding 2): on the depth grid, q = 0 where nothing was hit, else 1 +
- * round(65534 x log(d / dmin) / log(dmax / dmin)) with dmin, dmax over the grid; each value minus
+ * round(4094 x log(d / dmin) / log(dmax / dmin)) with dmin, dmax over the grid; each value minus
  * its MED prediction (mod 65536), the low bytes of the whole grid, then the high bytes; deflated
  * (zlib format, level 6). */
 static sy_result pack_depth(const float *depth, uint32_t w, uint32_t h, uint8_t **out, size_t *len, float *dmin,
@@ -70,7 +73,7 @@ static sy_result pack_depth(const float *depth, uint32_t w, uint32_t h, uint8_t 
         }
     if (!(lo <= hi)) lo = hi = 1.0f; /* nothing hit */
     *dmin = lo, *dmax = hi;
-    double span = log((double)hi / lo), k = span > 0 ? 65534.0 / span : 0.0;
+    double span = log((double)hi / lo), k = span > 0 ? (QMAX - 1) / span : 0.0;
     uint16_t *q = malloc(n * sizeof *q);
     uint8_t *planes = malloc(2 * n);
     uLongf cap = compressBound((uLong)(2 * n));
@@ -87,7 +90,7 @@ static sy_result pack_depth(const float *depth, uint32_t w, uint32_t h, uint8_t 
             uint16_t v16 = 0;
             if (hit(d)) {
                 double v = 1.0 + floor(log((double)d / lo) * k + 0.5);
-                v16 = (uint16_t)(v < 1 ? 1 : v > 65535 ? 65535 : v);
+                v16 = (uint16_t)(v < 1 ? 1 : v > QMAX ? QMAX : v);
             }
             q[(size_t)j * gw + i] = v16;
         }
@@ -138,7 +141,7 @@ sy_result sy_web_frame_pack_coded(sy_web_frame_info *fi, const uint8_t *jpeg, si
                                   sy_error *err)
 {
     *out = NULL, *len = 0;
-    fi->depth_coding = zlen ? SY_WEB_DEPTH_HALF_LOG16 : 0;
+    fi->depth_coding = zlen ? SY_WEB_DEPTH_GRID_LOG12 : 0;
     fi->depth_min = zlen ? dmin : 0.0f, fi->depth_max = zlen ? dmax : 0.0f;
     if (jpeg_len > UINT32_MAX || zlen > UINT32_MAX) {
         return sy_error_set(err, SY_ERR_LIMIT, "web: a frame of %zu + %zu bytes is too large", jpeg_len, zlen);
@@ -174,6 +177,35 @@ void sy_web_frame_set_payload(uint8_t *h, const sy_web_frame_info *fi)
     put32(h + OFF_JPEG, fi->jpeg_len);
     put32(h + OFF_CODEC, (uint32_t)fi->codec), putf(h + OFF_QUALITY, fi->quality);
     put32(h + OFF_FLAGS, get32(h + OFF_FLAGS) | fi->flags);
+}
+
+/* One axis of the grid: the columns i0, i1 around pixel x and the weight t of i1. */
+static void grid_axis(uint32_t x, uint32_t n, uint32_t gn, uint32_t *i0, uint32_t *i1, float *t)
+{
+    *i0 = x / STEP < gn - 1 ? x / STEP : gn - 1;
+    uint32_t p0 = grid_src(*i0, n);
+    *i1 = *i0, *t = 0.0f;
+    if (p0 == x || *i0 == gn - 1) return;
+    *i1 = *i0 + 1;
+    *t = (float)(x - p0) / (float)(grid_src(*i1, n) - p0);
+}
+
+float sy_web_depth_grid_at(const float *g, uint32_t gw, uint32_t gh, uint32_t width, uint32_t height, uint32_t x, uint32_t y)
+{
+    uint32_t i0, i1, j0, j1;
+    float tx, ty;
+    grid_axis(x, width, gw, &i0, &i1, &tx);
+    grid_axis(y, height, gh, &j0, &j1, &ty);
+    float c[4] = {g[(size_t)j0 * gw + i0], g[(size_t)j0 * gw + i1], g[(size_t)j1 * gw + i0], g[(size_t)j1 * gw + i1]};
+    float w[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
+    float inv = 0.0f;
+    int near = 0;
+    for (int k = 0; k < 4; ++k) {
+        if (w[k] > w[near]) near = k;
+        if (w[k] > 0 && !(c[k] > 0)) inv = -1.0f; /* a corner without a hit: the nearest corner's value */
+        else if (inv >= 0 && w[k] > 0) inv += w[k] / c[k];
+    }
+    return inv > 0 ? 1.0f / inv : c[near];
 }
 
 void sy_web_frame_drop_depth(uint8_t *h)
@@ -217,7 +249,7 @@ sy_result sy_web_frame_parse(const uint8_t *data, size_t len, sy_web_frame_info 
     if (fi->depth_len && (fi->flags & SY_WEB_FRAME_SAME_DEPTH))
         return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: %u depth bytes in a frame that says it has the last one's",
                             fi->depth_len);
-    if (fi->depth_len && fi->depth_coding != SY_WEB_DEPTH_HALF_LOG16)
+    if (fi->depth_len && fi->depth_coding != SY_WEB_DEPTH_GRID_LOG12)
         return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: unknown depth coding %u", fi->depth_coding);
     if (fi->depth_len && !(isfinite(fi->depth_min) && isfinite(fi->depth_max) && fi->depth_min > 0 && fi->depth_max >= fi->depth_min))
         return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: depth range %g..%g is not 0 < min <= max", (double)fi->depth_min,
@@ -258,17 +290,27 @@ sy_result sy_web_frame_depth(const sy_web_frame_info *fi, const uint8_t *depth, 
             q[x] = (uint16_t)(med(i, j, q, gw) + (uint16_t)(planes[x] | planes[gn + x] << 8));
         }
     free(planes);
-    /* every pixel takes the grid value nearest to it (the last column and row their own) */
     double lo = fi->depth_min, span = fi->depth_max > fi->depth_min ? log((double)fi->depth_max / lo) : 0.0;
-    for (uint32_t y = 0; y < fi->height; ++y) {
-        uint32_t j = y == fi->height - 1 ? gh - 1 : y / 2;
-        for (uint32_t x = 0; x < fi->width; ++x) {
-            uint32_t i = x == fi->width - 1 ? gw - 1 : x / 2;
-            uint16_t v = q[(size_t)j * gw + i];
-            d[(size_t)y * fi->width + x] = v ? (float)(lo * exp((v - 1) / 65534.0 * span)) : INFINITY;
+    float *g = malloc(gn * sizeof *g); /* the grid's depths (0: nothing) */
+    if (!g) {
+        free(q);
+        free(d);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web frame: out of memory for a depth channel");
+    }
+    for (size_t k = 0; k < gn; ++k) {
+        if (q[k] > QMAX) { /* no value of the scale */
+            free(q), free(g), free(d);
+            return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: depth value %u beyond the 12-bit scale", q[k]);
         }
+        g[k] = q[k] ? (float)(lo * exp((q[k] - 1) / (double)(QMAX - 1) * span)) : 0.0f;
     }
     free(q);
+    for (uint32_t y = 0; y < fi->height; ++y)
+        for (uint32_t x = 0; x < fi->width; ++x) {
+            float v = sy_web_depth_grid_at(g, gw, gh, fi->width, fi->height, x, y);
+            d[(size_t)y * fi->width + x] = v > 0 ? v : INFINITY;
+        }
+    free(g);
     *out = d;
     return SY_OK;
 }

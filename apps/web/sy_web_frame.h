@@ -2,8 +2,9 @@
  * sy_web_frame.h — the binary frame of sy web's stream, format 3 (docs/WEB.md, "Binary frames"):
  * a 192-byte little-endian header (size, back-end, samples, the frame's camera and orbit, the
  * depth range, the payload's codec), the payload (the JPEG, or a video viewer's VP8 / VP9 frame:
- * sy_web_video.h), then the depth channel: view depth on a grid of every second pixel (what the
- * page's warp mesh samples: a vertex every 2, 4 or 8 pixels), 16-bit log-quantised, each value
+ * sy_web_video.h), then the depth channel: view depth on a grid of every fourth pixel and the last
+ * column and row (the page's warp mesh has a vertex every 2, 4 or 8 pixels: at 4 and 8 exactly the
+ * grid's; between grid points 1 / depth is interpolated), 12-bit log-quantised, each value
  * minus its MED (LOCO-I) prediction, split into a low-byte and a high-byte plane and deflated (zlib
  * format: the page inflates it with the browser's own DecompressionStream("deflate"); zstd, which
  * the cluster uses, has no decoder in the browser). A frame whose depth is the one its viewer was
@@ -29,7 +30,8 @@ extern "C" {
 #define SY_WEB_FRAME_MAGIC 0x33465953u /**< "SYF3": "SYF" and the format's digit */
 #define SY_WEB_FRAME_VERSION 3u        /**< the format (the page sends it in its size message: "v") */
 #define SY_WEB_FRAME_HEADER 192u       /**< header bytes */
-#define SY_WEB_DEPTH_HALF_LOG16 2u     /**< the depth coding (header offset 52): the grid of every second pixel */
+#define SY_WEB_DEPTH_GRID_LOG12 2u     /**< the depth coding (header offset 52): 12-bit log depth on the grid */
+#define SY_WEB_DEPTH_STEP 4u           /**< the grid's step in pixels (and its last column and row) */
 #define SY_WEB_FRAME_PROGRESSIVE 1u    /**< flags: the back-end accumulates samples while the view rests */
 #define SY_WEB_FRAME_KEYFRAME 2u       /**< flags: a video payload that is a keyframe (decodable alone) */
 /** flags: no depth channel in this frame (depth bytes 0): its depth is the last depth channel this
@@ -47,7 +49,7 @@ typedef struct sy_web_frame_info {
     uint64_t input_id;  /**< the newest input of this client it answers */
     uint32_t jpeg_len;  /**< payload bytes after the header: the JPEG, or the video frame (codec) */
     uint32_t depth_len; /**< deflated depth bytes after the JPEG (0: no depth) */
-    uint32_t depth_coding; /**< SY_WEB_DEPTH_HALF_LOG16 */
+    uint32_t depth_coding; /**< SY_WEB_DEPTH_GRID_LOG12 */
     float depth_min, depth_max; /**< the nearest and farthest depth of the frame (view units) */
     sy_camera_view view; /**< camera_to_world, projection, window, znear, zfar (no clip planes) */
     sy_orbit orbit;      /**< the orbit the frame was rendered from (sy_orbit.h) */
@@ -63,7 +65,7 @@ void sy_web_frame_set_payload(uint8_t *h, const sy_web_frame_info *fi);
 /** Packs a frame: prefix bytes of room (LWS_PRE), the header of fi (jpeg_len, depth_len,
  * depth_coding, depth_min and depth_max are filled in here), the JPEG, then depth (fi->width x
  * fi->height floats, linear view depth, +INFINITY or <= 0 = nothing; NULL: no depth channel) coded
- * as SY_WEB_DEPTH_HALF_LOG16 (the grid of every second pixel, see above). *out (malloc) holds
+ * as SY_WEB_DEPTH_GRID_LOG12 (the grid of every fourth pixel, see above). *out (malloc) holds
  * prefix + *len bytes. */
 sy_result sy_web_frame_pack(sy_web_frame_info *fi, const uint8_t *jpeg, size_t jpeg_len, const float *depth,
                             size_t prefix, uint8_t **out, size_t *len, sy_error *err);
@@ -91,10 +93,17 @@ void sy_web_frame_drop_depth(uint8_t *h);
 sy_result sy_web_frame_parse(const uint8_t *data, size_t len, sy_web_frame_info *fi, const uint8_t **jpeg,
                              const uint8_t **depth, sy_error *err);
 
-/** Decodes a frame's depth channel into *out (malloc, width x height floats, each pixel the grid
- * value nearest to it; +INFINITY where nothing was hit); SY_ERR_PROTOCOL when it does not inflate
- * to exactly 2 bytes per grid value ((width / 2 + 1) x (height / 2 + 1)). */
+/** Decodes a frame's depth channel into *out (malloc, width x height floats, each pixel
+ * sy_web_depth_grid_at; +INFINITY where nothing was hit); SY_ERR_PROTOCOL when it does not inflate
+ * to exactly 2 bytes per grid value ((ceil((width - 1) / 4) + 1) x (ceil((height - 1) / 4) + 1))
+ * or holds a value beyond the 12-bit scale. */
 sy_result sy_web_frame_depth(const sy_web_frame_info *fi, const uint8_t *depth, float **out, sy_error *err);
+
+/** The depth of pixel (x, y) of a width x height frame from its grid g (gw x gh depths, 0 =
+ * nothing; docs/WEB.md, depth coding 2), as the page's warp takes it: a grid point's own value;
+ * between grid points 1 / depth interpolated bilinearly from the (up to 4) grid points around it,
+ * or where one of them has nothing, the nearest one's value (0: nothing). */
+float sy_web_depth_grid_at(const float *g, uint32_t gw, uint32_t gh, uint32_t width, uint32_t height, uint32_t x, uint32_t y);
 
 #ifdef __cplusplus
 }

@@ -1011,12 +1011,14 @@ static int test_frame(void)
     size_t len = 0;
     CHECK_OK(sy_web_frame_pack(&fi, jpeg, sizeof jpeg, depth, 16, &buf, &len, &err), err);
     CHECK(len == SY_WEB_FRAME_HEADER + sizeof jpeg + fi.depth_len && fi.depth_len > 0);
-    CHECK(fi.depth_coding == SY_WEB_DEPTH_HALF_LOG16);
-    /* the grid: every second pixel and the last column and row (W and H odd: 2 i reaches them) */
+    CHECK(fi.depth_coding == SY_WEB_DEPTH_GRID_LOG12);
+    /* the grid: every fourth pixel and the last column and row */
+#define ON_GRID(x, y) (((x) % 4 == 0 || (x) == W - 1) && ((y) % 4 == 0 || (y) == H - 1))
     float lo = INFINITY, hi = 0;
-    for (int y = 0; y < H; y += 2)
-        for (int x = 0; x < W; x += 2)
-            if (isfinite(depth[y * W + x]) && depth[y * W + x] > 0) lo = fminf(lo, depth[y * W + x]), hi = fmaxf(hi, depth[y * W + x]);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x)
+            if (ON_GRID(x, y) && isfinite(depth[y * W + x]) && depth[y * W + x] > 0)
+                lo = fminf(lo, depth[y * W + x]), hi = fmaxf(hi, depth[y * W + x]);
     CHECK(fi.depth_min == lo && fi.depth_max == hi);
     sy_web_frame_info g;
     const uint8_t *jp = NULL, *dp = NULL;
@@ -1028,30 +1030,44 @@ static int test_frame(void)
           g.orbit.yaw == 0.5f && g.orbit.pitch == -0.25f && g.orbit.dist == 4);
     float *d = NULL;
     CHECK_OK(sy_web_frame_depth(&g, dp, &d, &err), err);
-    double step = log(g.depth_max / g.depth_min) / 65534, worst = 0;
+    double step = log(g.depth_max / g.depth_min) / 4094, worst = 0;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
-            /* each pixel has the grid value nearest to it: pixel (x & ~1, y & ~1) */
-            int i = y * W + x, k = (y & ~1) * W + (x & ~1);
-            bool hit = isfinite(depth[k]) && depth[k] > 0;
-            CHECK(hit == isfinite(d[i]));
-            if (hit) worst = fmax(worst, fabs(log(d[i] / depth[k])));
+            int i = y * W + x;
+            if (ON_GRID(x, y)) { /* a grid point: its own value, within half a 12-bit step */
+                bool hit = isfinite(depth[i]) && depth[i] > 0;
+                CHECK(hit == isfinite(d[i]));
+                if (hit) worst = fmax(worst, fabs(log(d[i] / depth[i])));
+            } else { /* between: from the grid points around it, so within the range */
+                CHECK(!isfinite(d[i]) || (d[i] >= g.depth_min * 0.999f && d[i] <= g.depth_max * 1.001f));
+            }
         }
     CHECK(worst <= 0.51 * step + 1e-6); /* half a quantisation step (relative) */
     free(d);
-    /* a smooth surface (a tilted plane) codes to far fewer bytes than its 2 bytes per grid value */
+    /* a smooth surface (a tilted plane) codes to far fewer bytes than its 2 bytes per grid value,
+     * and every pixel between grid points comes back within two steps (1 / depth is linear in x
+     * and y on a plane: the interpolation is exact but for the quantisation) */
     {
-        enum { PW = 320, PH = 180 };
+        enum { PW = 322, PH = 181 };
         float *plane = malloc(sizeof(float) * PW * PH);
         for (int y = 0; y < PH; ++y)
             for (int x = 0; x < PW; ++x) plane[y * PW + x] = 2.0f / (0.3f + 0.002f * (float)y + 0.0007f * (float)x);
-        uint8_t *z = NULL;
-        size_t zl = 0;
-        float a = 0, b = 0;
-        CHECK_OK(sy_web_frame_depth_code(plane, PW, PH, &z, &zl, &a, &b, &err), err);
-        printf("web_frame: a tilted plane of %dx%d codes to %zu depth bytes (%d grid values)\n", PW, PH, zl, (PW / 2 + 1) * (PH / 2 + 1));
-        CHECK(zl > 0 && zl < (size_t)(PW / 2 + 1) * (PH / 2 + 1) / 4);
-        free(z);
+        sy_web_frame_info pf = {.width = PW, .height = PH, .seq = 1};
+        uint8_t *pb = NULL;
+        size_t pl = 0;
+        CHECK_OK(sy_web_frame_pack(&pf, jpeg, sizeof jpeg, plane, 0, &pb, &pl, &err), err);
+        size_t grid = (size_t)((PW - 1 + 3) / 4 + 1) * ((PH - 1 + 3) / 4 + 1);
+        printf("web_frame: a tilted plane of %dx%d codes to %u depth bytes (%zu grid values)\n", PW, PH, pf.depth_len, grid);
+        CHECK(pf.depth_len > 0 && pf.depth_len < grid / 4);
+        float *pd = NULL;
+        CHECK_OK(sy_web_frame_parse(pb, pl, &g, NULL, &dp, &err), err);
+        CHECK_OK(sy_web_frame_depth(&g, dp, &pd, &err), err);
+        double pstep = log(g.depth_max / g.depth_min) / 4094, pworst = 0;
+        for (int i = 0; i < PW * PH; ++i) pworst = fmax(pworst, fabs(log(pd[i] / plane[i])));
+        printf("web_frame: the plane's worst relative error %.2g (%.2f steps)\n", pworst, pworst / pstep);
+        CHECK(pworst <= 2 * pstep);
+        free(pd);
+        free(pb);
         free(plane);
     }
     /* a frame that says it has the last depth channel: header and payload only; with depth bytes: refused */

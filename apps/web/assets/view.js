@@ -192,11 +192,12 @@
     const s = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate"));
     return new Uint8Array(await new Response(s).arrayBuffer());
   }
-  // docs/WEB.md, depth coding 2: the grid of every second pixel (and the last column and row),
-  // 16-bit log depth, each value minus its MED prediction, byte planes; {d, gw, gh} (0: no hit)
+  // docs/WEB.md, depth coding 2: the grid of every fourth pixel (and the last column and row),
+  // 12-bit log depth, each value minus its MED prediction, byte planes; {d, gw, gh} (0: no hit)
+  const STEP = 4, gridN = (n) => Math.ceil((n - 1) / STEP) + 1;
   function decodeDepth(planes, w, h, dmin, dmax) {
-    const gw = (w >> 1) + 1, gh = (h >> 1) + 1, n = gw * gh, q = new Uint16Array(n), d = new Float32Array(n);
-    const span = dmax > dmin ? Math.log(dmax / dmin) / 65534 : 0;
+    const gw = gridN(w), gh = gridN(h), n = gw * gh, q = new Uint16Array(n), d = new Float32Array(n);
+    const span = dmax > dmin ? Math.log(dmax / dmin) / 4094 : 0;
     for (let j = 0, k = 0; j < gh; j++) for (let i = 0; i < gw; i++, k++) {
       let p;
       if (!j) p = i ? q[k - 1] : 0;
@@ -206,9 +207,31 @@
         p = c >= mx ? mn : c <= mn ? mx : a + b - c;
       }
       const v = q[k] = (p + (planes[k] | planes[n + k] << 8)) & 0xffff;
+      if (v > 4095) throw new Error("depth"); // beyond the 12-bit scale
       d[k] = v ? dmin * Math.exp((v - 1) * span) : 0;
     }
-    return { d: d, gw: gw, gh: gh };
+    return { d: d, gw: gw, gh: gh, w: w, h: h };
+  }
+  // the depth of pixel (x, y) from the grid (sy_web_depth_grid_at in apps/web/sy_web_frame.c): a
+  // grid point's own; between, 1 / depth bilinear from the grid points around it, or where one of
+  // them has no hit the nearest one's (0: no hit)
+  function gridAxis(x, n, gn) {
+    const i0 = Math.min(Math.floor(x / STEP), gn - 1), p0 = Math.min(STEP * i0, n - 1);
+    if (p0 === x || i0 === gn - 1) return [i0, i0, 0];
+    return [i0, i0 + 1, (x - p0) / (Math.min(STEP * (i0 + 1), n - 1) - p0)];
+  }
+  function depthAt(g, x, y) {
+    const [i0, i1, tx] = gridAxis(x, g.w, g.gw), [j0, j1, ty] = gridAxis(y, g.h, g.gh);
+    if (!tx && !ty) return g.d[j0 * g.gw + i0];
+    const c = [g.d[j0 * g.gw + i0], g.d[j0 * g.gw + i1], g.d[j1 * g.gw + i0], g.d[j1 * g.gw + i1]];
+    const wt = [(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty];
+    let inv = 0, near = 0;
+    for (let k = 0; k < 4; k++) {
+      if (wt[k] > wt[near]) near = k;
+      if (wt[k] > 0 && !(c[k] > 0)) inv = -1;
+      else if (inv >= 0 && wt[k] > 0) inv += wt[k] / c[k];
+    }
+    return inv > 0 ? 1 / inv : c[near];
   }
   // where a frame's depth comes from, decided as it arrives (frames arrive in order; the page may
   // skip some while it is busy): its own channel, or for a frame that says it has the last one
@@ -226,7 +249,7 @@
   }
   function depthGrid(src) { // a promise of the decoded grid
     if (!src.grid) {
-      const gn = ((src.w >> 1) + 1) * ((src.h >> 1) + 1);
+      const gn = gridN(src.w) * gridN(src.h);
       src.grid = inflate(src.bytes).then((p) => {
         if (p.length !== 2 * gn) throw new Error("depth");
         return decodeDepth(p, src.w, src.h, src.dmin, src.dmax);
@@ -267,7 +290,7 @@
       const y = Math.min(j * s, h - 1), ty = win[3] + (win[2] - win[3]) * (y + 0.5) / h;
       for (let i = 0; i < gx; i++, n++) {
         const x = Math.min(i * s, w - 1), tx = win[0] + (win[1] - win[0]) * (x + 0.5) / w;
-        const d = depth.d[(y === h - 1 ? depth.gh - 1 : y >> 1) * depth.gw + (x === w - 1 ? depth.gw - 1 : x >> 1)];
+        const d = depthAt(depth, x, y);
         const o = n * 6;
         if (d > 0) { v[o] = tx * d; v[o + 1] = ty * d; v[o + 2] = -d; v[o + 3] = 1; }
         else { v[o] = tx; v[o + 1] = ty; v[o + 2] = -1; v[o + 3] = 0; }
