@@ -3,8 +3,9 @@
  * and the functions one module calls in another (prefix sy_webi_; none of them is API). The
  * modules, bottom-up (each calls only those before it; tests/core/layers_test.sh checks it), over
  * the request checks (sy_web_check.c), the gate (sy_web_gate.c), the frame format
- * (sy_web_frame.c: header, JPEG, depth; the page's reader mirrors it) and the video encoder
- * (sy_web_video.c: VP8 / VP9 through libvpx, one per viewer):
+ * (sy_web_frame.c: header, JPEG, depth; the page's reader mirrors it), the video encoder
+ * (sy_web_video.c: VP8 / VP9 through libvpx, one per viewer) and the encoders' cost that the
+ * governor is told (sy_web_cost.c):
  *   sy_web_mailbox.c  what the two threads share (under mu): jobs, frames
  *   sy_web_http.c     HTTP on the network thread: page, stills, routes, token, body collection
  *   sy_web_ws.c       WebSocket viewers: input messages in, newest frame out; the protocol table
