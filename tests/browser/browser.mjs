@@ -14,7 +14,8 @@
 //     their mean absolute difference (0..255, RGB) computed in the browser; then a second page
 //     whose WebSocket goes through playwright (routeWebSocket) is sent made-up bad frames after
 //     the server's (duplicate, sizes that do not add up, depth that does not inflate, cameras
-//     not finite or not a rotation, format 4, no JPEG): their counts in sy.stats().bad and
+//     not finite or not a rotation, format 4, no JPEG, two that say they have the last depth
+//     channel wrongly): their counts in sy.stats().bad and
 //     whether the canvas stayed the same. URL?warp=0 gives the same drag without the warp and
 //     without the rest (the comparison).
 //   node browser.mjs tools URL OUTDIR WIDTH HEIGHT
@@ -282,8 +283,17 @@ try {
         variant(4, (b) => { b.writeFloatLE(2, 64); }),                    // not a rotation: camera
         variant(5, (b) => b.writeUInt8(0x34, 3)),                         // format 4: version
         variant(6, (b) => b.fill(0, 192, 192 + jl)),                      // no JPEG: jpeg
+        variant(7, (b) => b.writeUInt32LE(b.readUInt32LE(180) | 4, 180)), // says it has the last depth, carries one: depth
+        variant(8, (b) => { b.writeUInt32LE(b.readUInt32LE(180) | 4, 180); b.writeUInt32LE(0, 48); b.writeUInt32LE(b.readUInt32LE(4) + 4, 4); })
+          .subarray(0, 192 + jl),                                         // the last depth, of another size: depth
       ];
-      for (const b of bads) { toPage.send(b); await p2.waitForTimeout(50); }
+      // one at a time: the page decodes only the newest of the frames that come while it is busy
+      const refused = () => p2.evaluate(() => Object.values(sy.stats().bad).reduce((a, b) => a + b, 0));
+      for (const b of bads) {
+        const n0 = await refused();
+        toPage.send(b);
+        await p2.waitForFunction((n) => Object.values(sy.stats().bad).reduce((a, b) => a + b, 0) > n, n0, { timeout: 20000 }).catch(() => {});
+      }
       await p2.waitForFunction((n) => Object.values(sy.stats().bad).reduce((a, b) => a + b, 0) >= n, bads.length, { timeout: TIMEOUT })
         .catch(() => {});
       await p2.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
