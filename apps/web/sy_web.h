@@ -93,7 +93,8 @@ typedef struct sy_web_desc {
     uint32_t max_clients;     /**< WebSocket viewers at once (default 8) */
     size_t max_body;          /**< largest request body (default 1 MiB): 413 beyond */
     size_t max_message;       /**< largest WebSocket message (default 4096): the connection is closed */
-    int quality;              /**< JPEG quality of streamed frames (default 80; stills: 95) */
+    int quality;              /**< quality of streamed frames, 1..100 (default 80; stills: JPEG 95): JPEG's, and
+                               *   the video stream's quantizer through sy_web_video_quantizer (80: 36) */
     double budget_ms;         /**< frame-time budget of the governor while the view moves (default 33) */
     uint32_t still_samples;   /**< samples per pixel of a progressive back-end's still (default 16) */
     uint32_t idle_timeout_s;  /**< a silent WebSocket is pinged, then closed after twice this (default 30) */

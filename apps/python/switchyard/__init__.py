@@ -624,9 +624,10 @@ def serve(scene, port=8080, host="127.0.0.1", backend=None, token=None, width=19
 
     host: the address to listen on (default loopback, served to this machine only; any other needs
     the access token, generated unless ``token`` is given, and is in ``url``); port: 0 takes a free
-    one; width / height: the largest frame (sy web's -w/-h); quality: JPEG quality; filter /
-    threshold: a display filter of a back-end with filters; budget_ms: the frame-time budget while
-    the view moves (0: 33 ms)."""
+    one; width / height: the largest frame (sy web's -w/-h); quality: the streamed frames' quality
+    (sy web's --quality: JPEG's and the video stream's quantizer); filter / threshold: a display
+    filter of a back-end with filters; budget_ms: the frame-time budget while the view moves (0:
+    33 ms)."""
     owns = not isinstance(scene, Scene)
     if owns:
         scene = load(scene, **load_options)
