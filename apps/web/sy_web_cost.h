@@ -1,10 +1,10 @@
 /** @file
  * sy_web_cost.h — what a streamed frame costs beyond its render (docs/WEB.md, "One view for
- * everyone"): the encoders that run on the network thread (each video viewer's VP8 / VP9 encoder,
- * a JPEG made there for a JPEG viewer) are timed per frame and kept as a cost per pixel; the render
- * thread adds that cost, at the size it rendered, to the time it reports to the frame-time
- * governor (core/sy_governor.h), so a slow encoder makes the governor pick a smaller moving frame
- * just as a slow render does.
+ * everyone"): the encoders that run on the network thread (each video viewer's VP8 / VP9 encoder;
+ * JPEG is made on the render thread, inside the frame's own time) are timed per frame and kept as
+ * a cost per pixel; the render thread adds that cost, at the size it rendered, to the time it
+ * reports to the frame-time governor (core/sy_governor.h), so a slow encoder makes the governor
+ * pick a smaller moving frame just as a slow render does.
  *
  * Ownership: plain values. Thread-safety: none (the server updates and reads them under its mutex). */
 #ifndef SY_WEB_COST_H

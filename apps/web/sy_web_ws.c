@@ -435,10 +435,9 @@ static int send_frame(sy_web *w, web_conn *c, web_frame *f, uint64_t id)
         uint8_t *buf = NULL;
         bool same_depth = f->depth_key && f->depth_key == c->depth_key;
         size_t dlen = same_depth ? 0 : f->depth_len;
-        double t0 = sy_time_now();
-        sy_result jr = sy_jpeg_encode_rgba8(f->rgba, f->width, f->height, w->d.quality, &jpeg, &jlen, &err);
-        if (jr == SY_OK) count_encode(w, c, t0, f->width, f->height);
-        if (jr == SY_OK &&
+        /* not counted in the governor's cost (count_encode): this happens only until the render
+         * thread knows a JPEG viewer is there, then it makes the JPEG itself, in the frame's time */
+        if (sy_jpeg_encode_rgba8(f->rgba, f->width, f->height, w->d.quality, &jpeg, &jlen, &err) == SY_OK &&
             (buf = malloc(LWS_PRE + (total = SY_WEB_FRAME_HEADER + jlen + dlen)))) {
             uint8_t *h = buf + LWS_PRE;
             memcpy(h, f->buf + LWS_PRE, SY_WEB_FRAME_HEADER);
