@@ -299,8 +299,9 @@ sy_result sy_web_frame_depth(const sy_web_frame_info *fi, const uint8_t *depth, 
     }
     for (size_t k = 0; k < gn; ++k) {
         if (q[k] > QMAX) { /* no value of the scale */
+            unsigned v = q[k];
             free(q), free(g), free(d);
-            return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: depth value %u beyond the 12-bit scale", q[k]);
+            return sy_error_set(err, SY_ERR_PROTOCOL, "web frame: depth value %u beyond the 12-bit scale", v);
         }
         g[k] = q[k] ? (float)(lo * exp((q[k] - 1) / (double)(QMAX - 1) * span)) : 0.0f;
     }
