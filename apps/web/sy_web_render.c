@@ -78,7 +78,7 @@ static void clock_apply(sy_web *w, render_state *rs, double t)
         rs->clock_failed = true;
         sy_log(SY_LOG_WARNING, "web", NULL, "the scene clock at %g s: %s", t, e.message);
     }
-
+}
 
 /* Whether two frames' cameras are the same (matrix, window, projection). */
 static bool same_camera(const sy_camera_view *a, const sy_camera_view *b)
