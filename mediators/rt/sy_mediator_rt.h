@@ -219,7 +219,8 @@ typedef struct sy_mediator_rt_limit {
     double timed_frame_seconds; /**< median time of the timed frames (what the timers cost) */
     double lap_ticks;           /**< the time stamp counter's own cost per stage change in the path loop, subtracted */
     double lap_ticks_tight;     /**< the same measured in a tight loop (a lower bound) */
-    uint64_t stage_laps, stage_dropped; /**< spans timed; spans left out as preempted (over ~0.1 ms) */
+    uint64_t stage_laps;    /**< spans timed */
+    uint64_t stage_dropped; /**< spans left out as preempted (over ~0.1 ms) */
 } sy_mediator_rt_limit;
 /** Runs the distance-to-the-limit benchmark on a pathtracer context's device for the view at width
  * x height (the look of background_id applied as a render would), `samples` samples per pixel per
