@@ -122,6 +122,13 @@ void *sy_rt_pool_take(const sy_rt_device *dev, sy_rt_pool *p, uint32_t id, const
     return item;
 }
 
+sy_rt_result sy_rt_pool_add(sy_rt_device *dev, sy_rt_pool *pool, void *item, uint32_t *id, const char *what)
+{
+    if (sy_rt_pool_insert(pool, item, id)) return SY_RT_OK;
+    free(item);
+    return sy_rt_fail(dev, SY_RT_ERROR_LIMIT, "%s: pool full or out of memory", what);
+}
+
 void sy_rt_pool_free(sy_rt_pool *p)
 {
     free(p->items);

@@ -47,6 +47,9 @@ void sy_rt_pool_free(sy_rt_pool *p);
  * "WHAT: stale handle 0x..." and return NULL for a zero, stale or foreign id. */
 void *sy_rt_pool_find(const sy_rt_device *dev, const sy_rt_pool *p, uint32_t id, const char *what);
 void *sy_rt_pool_take(const sy_rt_device *dev, sy_rt_pool *p, uint32_t id, const char *what);
+/* Stores a new object (from malloc) in the pool, *id its handle; when the pool is full or out of
+ * memory, frees it and reports SY_RT_ERROR_LIMIT "WHAT: pool full or out of memory". */
+sy_rt_result sy_rt_pool_add(sy_rt_device *dev, sy_rt_pool *pool, void *item, uint32_t *id, const char *what);
 
 /* >>errors */
 

@@ -114,7 +114,7 @@ sy_rt_result sy_rt_device_create(const sy_rt_device_desc *desc, sy_rt_device **o
     }
     /* The stale filter of moved instances (sy_rt_device.h) runs from the intersection context, so
      * every scene whose geometry it must see carries the flag: the top scene (baked geometry) and
-     * each BLAS (sy_rt_scene.c mesh_blas). The moved instances' scene is small and rebuilt often. */
+     * each BLAS (sy_rt_mesh.c, sy_rt_mesh_blas). The moved instances' scene is small and rebuilt often. */
     rtcSetSceneFlags(dev->top, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(dev->top, RTC_BUILD_QUALITY_MEDIUM);
     rtcSetSceneBuildQuality(dev->dyn, RTC_BUILD_QUALITY_LOW);

@@ -18,7 +18,7 @@
 
 /* >>objects */
 
-/* Meshes of at least this many triangles get a compact, medium-quality BLAS (sy_rt_scene.c). */
+/* Meshes of at least this many triangles get a compact, medium-quality BLAS (sy_rt_mesh.c). */
 #define SY_RT_LARGE_MESH_TRIANGLES (1u << 20)
 
 typedef struct sy_rt_mesh_data {
@@ -69,7 +69,7 @@ typedef struct sy_rt_instance_data {
     float *baked_positions;    /* baked: Embree vertex buffer (world space) */
     bool filter_on;            /* baked: alpha filter installed */
     uint32_t handle;           /* this instance's own handle id (coverage output) */
-    /* Moves without rebuilding the top-level BVH (sy_rt_scene.c, "moved instances"): */
+    /* Moves without rebuilding the top-level BVH (sy_rt_moved.c): */
     bool xf_pending;           /* geom in the top scene still holds an older transform (in dev->pending) */
     bool stale;                /* the top scene's copy is filtered out; `twin` in dev->dyn shows the instance */
     RTCGeometry twin;          /* instance of the mesh's BLAS in dev->dyn, or NULL */
@@ -238,7 +238,7 @@ static inline const sy_rt_material_data *sy_rt_material_lookup(const sy_rt_devic
 
 /* The instance a hit belongs to (instance id for Embree instances, geometry id for baked). */
 /* The context filter of every trace while some instance is stale or the call cuts with section
- * planes (sy_rt_scene.c): it hides the top scene's stale copies of moved instances and rejects hits
+ * planes (sy_rt_clip.c): it hides the top scene's stale copies of moved instances and rejects hits
  * whose world point is on the cut side of a section plane (the exact rule for closed meshes: a ray
  * leaving the kept part across a plane goes on to what is behind). */
 void sy_rt_context_filter(const struct RTCFilterFunctionNArguments *args);
@@ -355,7 +355,7 @@ static inline const sy_rt_instance_data *sy_rt_instance_at(const sy_rt_instance_
     float det = x[0] * c00 + x[4] * c01 + x[8] * c02;
     if (!(det != 0.0f) || !isfinite(det)) return in;
     float inv = 1.0f / det;
-    /* row-major inverse transpose: the cofactor matrix / det (normal_matrix in sy_rt_scene.c) */
+    /* row-major inverse transpose: the cofactor matrix / det (sy_rt_placement_check in sy_rt_placement.c) */
     float n[9] = {c00, c01, c02, c10, c11, c12, c20, c21, c22};
     for (int i = 0; i < 9; ++i) scratch->nrm[i] = n[i] * inv;
     return scratch;
