@@ -11,19 +11,15 @@
 #include <stdlib.h>
 #include <time.h>
 
+static void raw_hit(const sy_rt_frame *f, void *user, size_t o, const struct RTCRayHit *rh, float axial)
+{
+    (void)f;
+    ((float *)user)[o] = rh->hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh->ray.tfar * axial;
+}
+
 static void raw_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
 {
-    float *tbuf = user;
-    sy_rt_ictx ctx;
-    sy_rt_context_init(f->dev, &ctx, RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
-    for (uint32_t py = y0; py < y1; ++py)
-        for (uint32_t px = x0; px < x1; ++px) {
-            struct RTCRayHit rh;
-            float axial;
-            sy_rt_frame_hit(f, &ctx.rtc, px, py, &rh, &axial);
-            tbuf[(size_t)(py - f->y) * f->width + (px - f->x)] =
-                rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar * axial;
-        }
+    sy_rt_frame_tile_hits(f, x0, y0, x1, y1, raw_hit, user);
 }
 
 static double now_s(void)

@@ -7,23 +7,18 @@
 
 #define FAIL(code, ...) sy_rt_fail(dev, code, __VA_ARGS__)
 
+static void coverage_hit(const sy_rt_frame *f, void *user, size_t o, const struct RTCRayHit *rh, float axial)
+{
+    const sy_rt_instance_data *in = rh->hit.geomID == RTC_INVALID_GEOMETRY_ID
+                                        ? NULL
+                                        : sy_rt_hit_instance(f->dev, rh->hit.geomID, rh->hit.instID[0]);
+    ((uint32_t *)user)[o] = in ? in->handle : 0;
+    if (f->depth) f->depth[o] = in ? rh->ray.tfar * axial : INFINITY;
+}
+
 void sy_rt_coverage_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
 {
-    uint32_t *ids = user;
-    sy_rt_ictx ctx;
-    sy_rt_context_init(f->dev, &ctx, RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
-    for (uint32_t py = y0; py < y1; ++py)
-        for (uint32_t px = x0; px < x1; ++px) {
-            struct RTCRayHit rh;
-            float axial;
-            sy_rt_frame_hit(f, &ctx.rtc, px, py, &rh, &axial);
-            size_t o = (size_t)(py - f->y) * f->width + (px - f->x);
-            const sy_rt_instance_data *in = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID
-                                                ? NULL
-                                                : sy_rt_hit_instance(f->dev, rh.hit.geomID, rh.hit.instID[0]);
-            ids[o] = in ? in->handle : 0;
-            if (f->depth) f->depth[o] = in ? rh.ray.tfar * axial : INFINITY;
-        }
+    sy_rt_frame_tile_hits(f, x0, y0, x1, y1, coverage_hit, user);
 }
 
 sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,

@@ -109,6 +109,26 @@ static inline void sy_rt_frame_hit(const sy_rt_frame *f, struct RTCIntersectCont
     sy_rt_intersect_scenes(f->dev, ctx, rh);
 }
 
+/* The nearest hit of every pixel centre of the tile [x0, x1) x [y0, y1) (one coherent context for
+ * the tile): fn gets the pixel's offset in the frame's buffers ((py - f->y) * f->width + px - f->x),
+ * the hit (geomID RTC_INVALID_GEOMETRY_ID on a miss) and its axial factor (depth = tfar * axial).
+ * Inline, so a known fn is inlined into the loop (the ray benchmark and coverage). */
+static inline void sy_rt_frame_tile_hits(const sy_rt_frame *f, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1,
+                                         void (*fn)(const sy_rt_frame *f, void *user, size_t o,
+                                                    const struct RTCRayHit *rh, float axial),
+                                         void *user)
+{
+    sy_rt_ictx ctx;
+    sy_rt_context_init(f->dev, &ctx, RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
+    for (uint32_t py = y0; py < y1; ++py)
+        for (uint32_t px = x0; px < x1; ++px) {
+            struct RTCRayHit rh;
+            float axial;
+            sy_rt_frame_hit(f, &ctx.rtc, px, py, &rh, &axial);
+            fn(f, user, (size_t)(py - f->y) * f->width + (px - f->x), &rh, axial);
+        }
+}
+
 /* Renders one tile: pixels [x0, x1) x [y0, y1) in full-image coordinates. */
 typedef void (*sy_rt_tile_fn)(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1);
 

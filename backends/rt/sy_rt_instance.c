@@ -105,14 +105,9 @@ sy_rt_result sy_rt_instance_set_transform(sy_rt_device *dev, sy_rt_instance inst
     sy_rt_instance_data *in = sy_rt_pool_find(dev, &dev->instances, inst.id, "instance set_transform");
     if (!in) return SY_RT_ERROR_INVALID_HANDLE;
     float nrm[9];
-    double gain;
-    sy_rt_result r = sy_rt_placement_check(dev, in->mesh, transform, nrm, &gain);
+    sy_rt_result r = sy_rt_placement_recheck(dev, in, transform, nrm, "instance set_transform: the transform",
+                                             "; create it again");
     if (r != SY_RT_OK) return r;
-    if (gain > SY_RT_INSTANCE_GAIN_MAX && !(in->flags & SY_RT_INSTANCE_BAKED))
-        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT,
-                    "instance set_transform: the transform shrinks by %g (more than SY_RT_INSTANCE_GAIN_MAX %g allows "
-                    "for an instance created unbaked); create it again",
-                    1.0 / gain, (double)SY_RT_INSTANCE_GAIN_MAX);
     if (!sy_rt_pending_add(dev, in)) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance set_transform: out of memory");
     memcpy(in->xf, transform, sizeof in->xf);
     memcpy(in->nrm, nrm, sizeof in->nrm);

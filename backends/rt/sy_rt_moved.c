@@ -214,13 +214,8 @@ sy_rt_result sy_rt_instance_set_motion(sy_rt_device *dev, sy_rt_instance inst, c
     if (!close && !in->motion) return SY_RT_OK;
     if (close) {
         float nrm[9];
-        double gain;
-        sy_rt_result r = sy_rt_placement_check(dev, in->mesh, close, nrm, &gain);
+        sy_rt_result r = sy_rt_placement_recheck(dev, in, close, nrm, "instance set_motion: the close transform", "");
         if (r != SY_RT_OK) return r;
-        if (gain > SY_RT_INSTANCE_GAIN_MAX && !(in->flags & SY_RT_INSTANCE_BAKED))
-            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT,
-                        "instance set_motion: the close transform shrinks by %g (more than SY_RT_INSTANCE_GAIN_MAX %g "
-                        "allows for an instance created unbaked)", 1.0 / gain, (double)SY_RT_INSTANCE_GAIN_MAX);
     }
     if (!sy_rt_pending_add(dev, in)) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance set_motion: out of memory");
     if (close && !in->motion) dev->motion_count++;

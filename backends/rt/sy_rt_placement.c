@@ -58,6 +58,19 @@ sy_rt_result sy_rt_placement_check(const sy_rt_device *dev, const sy_rt_mesh_dat
     return r != SY_RT_OK ? r : instance_in_range(dev, m, xf);
 }
 
+sy_rt_result sy_rt_placement_recheck(const sy_rt_device *dev, const sy_rt_instance_data *in, const float *xf,
+                                     float nrm[9], const char *what, const char *tail)
+{
+    double gain;
+    sy_rt_result r = sy_rt_placement_check(dev, in->mesh, xf, nrm, &gain);
+    if (r != SY_RT_OK) return r;
+    if (gain > SY_RT_INSTANCE_GAIN_MAX && !(in->flags & SY_RT_INSTANCE_BAKED))
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT,
+                    "%s shrinks by %g (more than SY_RT_INSTANCE_GAIN_MAX %g allows for an instance created unbaked)%s",
+                    what, 1.0 / gain, (double)SY_RT_INSTANCE_GAIN_MAX, tail);
+    return SY_RT_OK;
+}
+
 /* Writes the world-space positions of a baked instance. */
 void sy_rt_bake_positions(sy_rt_instance_data *in)
 {

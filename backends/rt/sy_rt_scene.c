@@ -79,6 +79,18 @@ static void light_warn(sy_rt_device *dev, uint32_t count, const char *what)
              count > 1u ? " (and others: see light_warnings)" : "");
 }
 
+/* Frees the area-light triangles, their CDF and the triangle map (the alias table is
+ * sy_rt_alias_build's). */
+static void area_free(sy_rt_device *dev)
+{
+    free(dev->area);
+    free(dev->area_cdf);
+    free(dev->area_map);
+    dev->area = NULL;
+    dev->area_cdf = NULL;
+    dev->area_map = NULL;
+}
+
 static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
 {
     size_t n = 0;
@@ -87,12 +99,7 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
         if (in) in->area_base = UINT32_MAX;
         if (in && sy_rt_instance_emissive(dev, in)) n += in->mesh->triangle_count;
     }
-    free(dev->area);
-    free(dev->area_cdf);
-    free(dev->area_map);
-    dev->area = NULL;
-    dev->area_cdf = NULL;
-    dev->area_map = NULL;
+    area_free(dev);
     dev->area_count = 0;
     dev->area_power = 0.0f;
     dev->light_tree_dirty = true;
@@ -105,12 +112,7 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
     dev->area_map = malloc(n * sizeof *dev->area_map);
     if (!dev->area || !cdf || !dev->area_cdf || !dev->area_map) {
         free(cdf);
-        free(dev->area);
-        free(dev->area_cdf);
-        free(dev->area_map);
-        dev->area = NULL;
-        dev->area_cdf = NULL;
-        dev->area_map = NULL;
+        area_free(dev);
         return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "commit: cannot allocate the area-light list (%zu triangles)", n);
     }
     uint32_t count = 0, base = 0, degenerate = 0;
@@ -158,12 +160,7 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
     double total = cdf[count];
     if (count == 0 || !(total > 0.0)) {
         free(cdf);
-        free(dev->area);
-        free(dev->area_cdf);
-        free(dev->area_map);
-        dev->area = NULL;
-        dev->area_cdf = NULL;
-        dev->area_map = NULL;
+        area_free(dev);
         return SY_RT_OK;
     }
     for (uint32_t i = 0; i <= count; ++i) dev->area_cdf[i] = (float)(cdf[i] / total);
@@ -173,12 +170,7 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
     bool alias_ok = sy_rt_alias_build(dev, cdf, count);
     free(cdf);
     if (!alias_ok) {
-        free(dev->area);
-        free(dev->area_cdf);
-        free(dev->area_map);
-        dev->area = NULL;
-        dev->area_cdf = NULL;
-        dev->area_map = NULL;
+        area_free(dev);
         return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "commit: cannot allocate the area-light alias table (%u triangles)", count);
     }
     dev->area_count = count;
@@ -260,19 +252,14 @@ void sy_rt_scene_release_all(sy_rt_device *dev)
     dev->pending = NULL;
     dev->pending_count = dev->pending_cap = 0;
     free(dev->punctual);
-    free(dev->area);
-    free(dev->area_cdf);
+    area_free(dev);
     free(dev->area_alias_prob);
     free(dev->area_alias_idx);
-    free(dev->area_map);
-    dev->area_map = NULL;
     dev->area_alias_prob = NULL;
     dev->area_alias_idx = NULL;
     sy_rt_light_tree_free(dev);
     sy_rt_env_free(dev);
     dev->top_map = NULL;
     dev->punctual = NULL;
-    dev->area = NULL;
-    dev->area_cdf = NULL;
 }
 

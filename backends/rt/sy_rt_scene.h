@@ -27,6 +27,11 @@ sy_rt_result sy_rt_punctual_rebuild(sy_rt_device *dev);
  * row-sum norm of the inverse (how much the inverse magnifies a ray's coordinates). */
 sy_rt_result sy_rt_placement_check(const sy_rt_device *dev, const sy_rt_mesh_data *m, const float *xf, float nrm[9],
                                    double *gain);
+/* sy_rt_placement_check of a new transform of instance in (set_transform, set_motion's close one),
+ * which also refuses a transform that shrinks by more than SY_RT_INSTANCE_GAIN_MAX allows for an
+ * instance created unbaked (Embree would see its inverse): "WHAT shrinks by ... unbaked)TAIL". */
+sy_rt_result sy_rt_placement_recheck(const sy_rt_device *dev, const sy_rt_instance_data *in, const float *xf,
+                                     float nrm[9], const char *what, const char *tail);
 /* Writes the world-space positions of a baked instance (time step 0). */
 void sy_rt_bake_positions(sy_rt_instance_data *in);
 /* Geometry id -> instance maps (dev->top_map, dev->dyn_map): grows *map_io to hold id and stores
