@@ -237,20 +237,7 @@ try {
       await settled().catch(() => fail('no full-size frame after the held drag'));
       await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
       await canvasPng(page, '#sy-canvas', join(outDir, 'true.png'));
-      const a = readFileSync(join(outDir, 'warped.png')).toString('base64'), b = readFileSync(join(outDir, 'true.png')).toString('base64');
-      const mad = await page.evaluate(async ([a, b]) => {
-        const px = async (s) => {
-          const bmp = await createImageBitmap(await (await fetch('data:image/png;base64,' + s)).blob());
-          const c = new OffscreenCanvas(bmp.width, bmp.height), g = c.getContext('2d');
-          g.drawImage(bmp, 0, 0);
-          return g.getImageData(0, 0, bmp.width, bmp.height).data;
-        };
-        const [p, q] = [await px(a), await px(b)];
-        if (p.length !== q.length) return -1;
-        let s = 0;
-        for (let i = 0; i < p.length; i += 4) s += Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) + Math.abs(p[i + 2] - q[i + 2]);
-        return s / (p.length / 4 * 3);
-      }, [a, b]);
+      const mad = await pngMad(page, join(outDir, 'warped.png'), join(outDir, 'true.png'));
       quality = { mad, held };
     }
     // bad frames (a page of its own whose WebSocket goes through the test: the server's messages
