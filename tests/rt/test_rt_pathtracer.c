@@ -147,40 +147,43 @@ static void furnace_case(const char *name, const sy_rt_material_desc *md, double
 
 static void test_furnaces(void)
 {
-    sy_rt_material_desc d;
-    sy_rt_material_desc_init(&d);
-    d.metallic = 0.0f;
-    d.specular = 0.0f; /* pure Lambert, albedo 1 */
-    furnace_case("furnace lambert", &d, 0.99, 1.01, false);
-    furnace_case("furnace lambert, environment map", &d, 0.99, 1.01, true);
-    sy_rt_material_desc_init(&d);
-    d.metallic = 1.0f;
-    d.roughness = 0.5f;
-    furnace_case("furnace GGX metal F0=1", &d, 0.86, 0.91, false);
-    sy_rt_material_desc_init(&d);
-    d.metallic = 0.0f;
-    d.roughness = 0.0f;
-    d.transmission = 1.0f;
-    d.ior = 1.5f;
-    furnace_case("furnace smooth glass", &d, 0.99, 1.01, false);
-    /* KHR_materials_iridescence on glass: the film's colour splits reflection and refraction per
-     * channel (chosen by their mean, weighted by colour), which still sums to 1 per channel */
-    d.iridescence = 1.0f;
-    furnace_case("furnace smooth iridescent glass", &d, 0.99, 1.01, false);
-    d.roughness = 0.3f;
-    furnace_case("furnace rough iridescent glass", &d, 0.9, 1.01, false);
-    /* KHR_materials_clearcoat: the coat reflects F_coat(n . wo) and lets 1 - F_coat(n . wo) of the
-     * base through (the specification's albedo scaling): a smooth coat over white Lambert keeps the
-     * furnace's L; a rough one loses what single-scattering GGX loses where the coat's Fresnel is
-     * large (the F0 = 1 metal above loses 11 % at this roughness; weighted by the coat's Fresnel,
-     * whose disk average is 0.086, that is 1 to 5 %), and never gains */
-    sy_rt_material_desc_init(&d);
-    d.metallic = 0.0f;
-    d.specular = 0.0f;
-    d.clearcoat = 1.0f;
-    furnace_case("furnace smooth clearcoat over Lambert", &d, 0.99, 1.01, false);
-    d.clearcoat_roughness = 0.5f;
-    furnace_case("furnace rough clearcoat over Lambert", &d, 0.95, 1.005, false);
+    /* each case: the default material (sy_rt_material_desc_init) with these values */
+    static const struct {
+        const char *name;
+        float metallic, specular, roughness, transmission, iridescence, clearcoat, clearcoat_roughness;
+        double lo, hi;
+        bool env_texture;
+    } cases[] = {
+        /* pure Lambert, albedo 1 */
+        {"furnace lambert", 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.99, 1.01, false},
+        {"furnace lambert, environment map", 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.99, 1.01, true},
+        {"furnace GGX metal F0=1", 1.0f, 1.0f, 0.5f, 0.0f, 0.0f, 0.0f, 0.0f, 0.86, 0.91, false},
+        {"furnace smooth glass", 0.0f, 1.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.99, 1.01, false},
+        /* KHR_materials_iridescence on glass: the film's colour splits reflection and refraction per
+         * channel (chosen by their mean, weighted by colour), which still sums to 1 per channel */
+        {"furnace smooth iridescent glass", 0.0f, 1.0f, 0.0f, 1.0f, 1.0f, 0.0f, 0.0f, 0.99, 1.01, false},
+        {"furnace rough iridescent glass", 0.0f, 1.0f, 0.3f, 1.0f, 1.0f, 0.0f, 0.0f, 0.9, 1.01, false},
+        /* KHR_materials_clearcoat: the coat reflects F_coat(n . wo) and lets 1 - F_coat(n . wo) of the
+         * base through (the specification's albedo scaling): a smooth coat over white Lambert keeps the
+         * furnace's L; a rough one loses what single-scattering GGX loses where the coat's Fresnel is
+         * large (the F0 = 1 metal above loses 11 % at this roughness; weighted by the coat's Fresnel,
+         * whose disk average is 0.086, that is 1 to 5 %), and never gains */
+        {"furnace smooth clearcoat over Lambert", 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.99, 1.01, false},
+        {"furnace rough clearcoat over Lambert", 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 1.0f, 0.5f, 0.95, 1.005, false},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        sy_rt_material_desc d;
+        sy_rt_material_desc_init(&d);
+        d.metallic = cases[i].metallic;
+        d.specular = cases[i].specular;
+        d.roughness = cases[i].roughness;
+        d.transmission = cases[i].transmission;
+        d.ior = 1.5f;
+        d.iridescence = cases[i].iridescence;
+        d.clearcoat = cases[i].clearcoat;
+        d.clearcoat_roughness = cases[i].clearcoat_roughness;
+        furnace_case(cases[i].name, &d, cases[i].lo, cases[i].hi, cases[i].env_texture);
+    }
 }
 
 /* KHR_materials_volume: a smooth glass sphere (IOR 1.5, radius 1) absorbing with attenuation colour
