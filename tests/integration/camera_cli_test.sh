@@ -27,15 +27,7 @@ rm -rf "$TMP"
 mkdir -p "$TMP"
 
 # usage errors: status 2 and the option and reason on stderr
-usage() { # WHAT EXPECT ARGS...
-    local what=$1 expect=$2
-    shift 2
-    "$SY" render demo -w 16 -h 16 -o "$TMP/u.png" "$@" 2>"$TMP/u.err"
-    local rc=$?
-    if [ $rc -ne 2 ] || ! grep -qF -- "$expect" "$TMP/u.err"; then
-        fail "$what: status $rc (want 2), stderr: $(cat "$TMP/u.err")"
-    fi
-}
+usage() { usage_error "$1" "$2" "$SY" render demo -w 16 -h 16 -o "$TMP/u.png" "${@:3}"; } # WHAT EXPECT ARGS...
 usage "look-at without target" "--look-at 0,1,5: expected EYE:TARGET" --look-at 0,1,5
 usage "look-at two parts" "TARGET is not x,y,z" --look-at 0,1,5:0,0
 usage "look-at NaN" "EYE is not x,y,z" --look-at nan,1,5:0,0,0

@@ -61,11 +61,8 @@ near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d
 
 # usage errors need no rendering
 usage() { # usage LABEL EXPECTED-TEXT ARGS...
-    local label=$1 want=$2
-    shift 2
-    run usage "$SY" render "$TMP/moving.x3d" -b whitted -w 8 -h 8 -o "$TMP/usage.exr" "$@"
-    [ "$rc" -eq 2 ] && grep -qF -- "$want" "$TMP/usage.err" || fail "$label: status $rc (want 2), $(cat "$TMP/usage.err")"
-    [ -e "$TMP/usage.exr" ] && fail "$label: wrote an image"
+    usage_error "$1" "$2" "$SY" render "$TMP/moving.x3d" -b whitted -w 8 -h 8 -o "$TMP/usage.exr" "${@:3}"
+    [ -e "$TMP/usage.exr" ] && fail "$1: wrote an image"
 }
 for bad in -0.1 nan inf 0,inf 0.2,0.1 abc 0,1,2 "" 0, -1,0; do
     usage "--shutter '$bad'" "--shutter" --shutter "$bad"
@@ -172,6 +169,19 @@ cat >"$TMP/deform.x3d" <<'EOF'
 <ROUTE fromNode='Morph' fromField='value_changed' toNode='C' toField='set_point'/>
 </Scene></X3D>
 EOF
+# sub_frames STEM LABEL NOTE WHAT BACKENDS...: each ray tracer renders $TMP/STEM.x3d at 0.25 over the
+# shutter 0..0.5 as the mean of 4 sub-frames and says why (NOTE)
+sub_frames() {
+    local stem=$1 label=$2 note=$3 what=$4
+    shift 4
+    for b in "$@"; do
+        [ "$b" = raster ] && continue
+        run_ok "$b $label" "${b}_$stem" "$SY" render "$TMP/$stem.x3d" -b "$b" -w 32 -h 32 --at 0.25 --shutter 0,0.5 \
+            --shutter-samples 4 -o "$TMP/${b}_$stem.exr"
+        grep -qF "$note" "$TMP/${b}_$stem.err" && grep -qF "the mean of 4 sub-frames" "$TMP/${b}_$stem.err" ||
+            fail "$b: $what: no note on the sub-frames it takes: $(cat "$TMP/${b}_$stem.err")"
+    done
+}
 for b in "$@"; do
     [ "$b" = raster ] && continue
     extra=()
@@ -226,14 +236,7 @@ cat >"$TMP/camera.x3d" <<'EOF'
 <ROUTE fromNode='Move' fromField='value_changed' toNode='V' toField='position'/>
 </Scene></X3D>
 EOF
-for b in "$@"; do
-    [ "$b" = raster ] && continue
-    run_ok "$b moving camera" "${b}_camera" "$SY" render "$TMP/camera.x3d" -b "$b" -w 32 -h 32 --at 0.25 --shutter 0,0.5 \
-        --shutter-samples 4 -o "$TMP/${b}_camera.exr"
-    grep -qF "the camera moves over the shutter" "$TMP/${b}_camera.err" &&
-        grep -qF "the mean of 4 sub-frames" "$TMP/${b}_camera.err" ||
-        fail "$b: a moving camera: no note on the sub-frames it takes: $(cat "$TMP/${b}_camera.err")"
-done
+sub_frames camera "moving camera" "the camera moves over the shutter" "a moving camera" "$@"
 
 # a sequence: frame 6 at 24 fps with --motion-blur (0,1/48) equals --at 0.25 with the same shutter, bit
 # for bit (the frame's time opens the shutter; every time sample restarts the accumulation)

@@ -24,15 +24,7 @@ EXR_EQUAL=$4
 rm -rf "$TMP"
 mkdir -p "$TMP"
 
-usage() { # WHAT EXPECT CMD ARGS... (status 2 and EXPECT on stderr)
-    local what=$1 expect=$2
-    shift 2
-    "$SY" "$@" >"$TMP/u.out" 2>"$TMP/u.err"
-    local rc=$?
-    if [ $rc -ne 2 ] || ! grep -qF -- "$expect" "$TMP/u.err"; then
-        fail "$what: status $rc (want 2), stderr: $(cat "$TMP/u.err")"
-    fi
-}
+usage() { usage_error "$1" "$2" "$SY" "${@:3}"; } # WHAT EXPECT CMD ARGS... (status 2 and EXPECT on stderr)
 usage "cap not a colour" "--clip-cap: 'red' is not a colour RRGGBB" render demo -w 16 -h 16 -o "$TMP/u.png" --clip 1,0,0,0 --clip-cap red
 usage "cap of 5 digits" "--clip-cap: '12345' is not a colour" render demo -w 16 -h 16 -o "$TMP/u.png" --clip 1,0,0,0 --clip-cap 12345
 usage "cap without planes" "--clip-cap: caps fill the cut faces of section planes" render demo -w 16 -h 16 -o "$TMP/u.png" --clip-cap ff0000

@@ -27,12 +27,7 @@ mkdir -p "$TMP"
 
 # usage errors need no test data (the built-in demo scene)
 mkdir -p "$TMP/u"
-usage() { # usage LABEL EXPECTED-TEXT ARGS...
-    local label=$1 want=$2
-    shift 2
-    run usage "$SY" render demo -b whitted -w 16 -h 16 "$@"
-    [ "$rc" -eq 2 ] && grep -qF -- "$want" "$TMP/usage.err" || fail "$label: status $rc (want 2), $(cat "$TMP/usage.err")"
-}
+usage() { usage_error "$1" "$2" "$SY" render demo -b whitted -w 16 -h 16 "${@:3}"; } # usage LABEL EXPECTED-TEXT ARGS...
 usage "no #" "--frames needs -o with a run of '#'" --frames 0:2 -o "$TMP/u/x.png"
 usage "--frames N" "the cluster's repeat count is --repeat N" --frames 3 -o "$TMP/u/x_##.png"
 for bad in 5:2 1: a:b 0:4:0 -1:2 0:2:; do

@@ -5,6 +5,8 @@
 #   fail MESSAGE...          prints "FAIL: MESSAGE" on stderr and counts it in $fails
 #   run NAME CMD...          runs CMD, stdout and stderr to $TMP/NAME.out and $TMP/NAME.err; sets $rc
 #   run_ok LABEL NAME CMD... run, then a failure naming LABEL, the status and stderr unless CMD succeeded
+#   usage_error LABEL EXPECT CMD...  run (as $TMP/usage.*), then a failure naming LABEL unless CMD
+#                            refused its usage: status 2 and EXPECT (a fixed string) on stderr
 fails=0
 
 fail() {
@@ -24,4 +26,13 @@ run_ok() {
     shift
     run "$@"
     if [ "$rc" -ne 0 ]; then fail "$label: status $rc: $(cat "$TMP/$1.err")"; fi
+}
+
+usage_error() {
+    local label=$1 expect=$2
+    shift 2
+    run usage "$@"
+    if [ "$rc" -ne 2 ] || ! grep -qF -- "$expect" "$TMP/usage.err"; then
+        fail "$label: status $rc (want 2), stderr: $(cat "$TMP/usage.err")"
+    fi
 }
