@@ -1,9 +1,11 @@
 /* sy_rt_scene.h — internal side of the scene modules of the ray-tracing back-end (meshes, materials,
  * instances, moved instances, lights) and of sy_rt_commit. The public functions are declared in
- * sy_rt.h. The modules, bottom-up (each calls only those above it, so none calls another in a
+ * sy_rt.h. The modules, bottom-up (each calls only those listed before it, so none calls another in a
  * loop): sy_rt_mesh.c, sy_rt_material.c, sy_rt_punctual.c, sy_rt_placement.c, sy_rt_clip.c ->
- * sy_rt_moved.c -> sy_rt_instance.c -> sy_rt_scene.c (sy_rt_commit, teardown). Not thread-safe:
- * the device's single-threaded set-up calls (sy_rt.h) are the only callers. */
+ * sy_rt_moved.c -> sy_rt_instance.c -> sy_rt_scene.c (sy_rt_commit, teardown). The functions
+ * below change the device: they run on the caller's thread between renders, as sy_rt.h's set-up
+ * calls do (not thread-safe). sy_rt_clip.c's context filter and sy_rt_clip_cap (sy_rt_device.h)
+ * run on the render threads and only read. */
 #ifndef SY_RT_SCENE_H
 #define SY_RT_SCENE_H
 
