@@ -222,6 +222,21 @@ static void test_hard_shadow(void)
     sy_rt_device_destroy(dev);
 }
 
+/* Commits dev and renders it with Whitted from the test camera (CAM_Z, TAN) at W x W, max_depth
+ * (0: the default): the centre pixel (16, 16) into c, its depth into *z. */
+static void whitted_centre(sy_rt_device *dev, uint32_t max_depth, float c[4], float *z)
+{
+    MUST(sy_rt_commit(dev));
+    sy_rt_camera cam = rt_camera(CAM_Z, TAN);
+    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
+    rd.max_depth = max_depth;
+    float *rgba, *depth;
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    memcpy(c, px_at(rgba, 16, 16), 4 * sizeof(float));
+    *z = depth[16 * W + 16];
+    rt_image_free(rgba, depth);
+}
+
 static void test_mirror(void)
 {
     sy_rt_device *dev = rt_device();
@@ -240,21 +255,13 @@ static void test_mirror(void)
     float em[16];
     rt_rot_y(em, (float)M_PI, 0.0f, 0.0f, 8.0f);
     rt_place(dev, rt_quad(dev, 20.0f), em, rt_emitter(dev, 2.0f, 3.0f, 4.0f), 0);
-    MUST(sy_rt_commit(dev));
-    sy_rt_camera cam = rt_camera(CAM_Z, TAN);
-    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
-    float *rgba, *depth;
-    rt_render(dev, &cam, &rd, &rgba, &depth);
-    const float *c = px_at(rgba, 16, 16);
+    float c[4], z;
+    whitted_centre(dev, 0, c, &z);
     EXPECT_MSG(c[0] == 0.9f * 2.0f && c[1] == 0.8f * 3.0f && c[2] == 0.7f * 4.0f, "mirror %g %g %g", c[0], c[1], c[2]);
-    EXPECT_MSG(fabsf(depth[16 * W + 16] - CAM_Z) < 1e-5f, "mirror depth is the mirror's, got %g", depth[16 * W + 16]);
+    EXPECT_MSG(fabsf(z - CAM_Z) < 1e-5f, "mirror depth is the mirror's, got %g", z);
     /* max_depth 1: no recursion, the mirror is black. */
-    rd.max_depth = 1;
-    rt_image_free(rgba, depth);
-    rt_render(dev, &cam, &rd, &rgba, &depth);
-    c = px_at(rgba, 16, 16);
+    whitted_centre(dev, 1, c, &z);
     EXPECT_MSG(c[0] == 0.0f && c[3] == 1.0f, "mirror at max_depth 1: %g alpha %g", c[0], c[3]);
-    rt_image_free(rgba, depth);
     sy_rt_device_destroy(dev);
 }
 
@@ -276,23 +283,15 @@ static void test_glass(void)
     rt_place(dev, q, front, glass, 0);
     rt_place(dev, q, back, glass, SY_RT_INSTANCE_BAKED);
     rt_place(dev, rt_quad(dev, 10.0f), em, rt_emitter(dev, 1.0f, 2.0f, 4.0f), 0);
-    MUST(sy_rt_commit(dev));
-    sy_rt_camera cam = rt_camera(CAM_Z, TAN);
-    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
-    float *rgba, *depth;
-    rt_render(dev, &cam, &rd, &rgba, &depth);
+    float c[4], z;
+    whitted_centre(dev, 0, c, &z);
     double F = pow((1.5 - 1.0) / (1.5 + 1.0), 2.0);
     double T = (1 - F) * (1 - F) / (1 - F * F); /* both faces plus inter-reflections */
-    const float *c = px_at(rgba, 16, 16);
     EXPECT_MSG(rt_near(c[0], 1.0 * T, 1e-4) && rt_near(c[1], 2.0 * T, 1e-4) && rt_near(c[2], 4.0 * T, 1e-4),
                "glass %.7g %.7g %.7g, expected %.7g * (1,2,4)", c[0], c[1], c[2], T);
     /* max_depth 2: camera ray + one refraction reach only the back face: black. max_depth 3: (1-F)^2. */
-    rd.max_depth = 3;
-    rt_image_free(rgba, depth);
-    rt_render(dev, &cam, &rd, &rgba, &depth);
-    c = px_at(rgba, 16, 16);
+    whitted_centre(dev, 3, c, &z);
     EXPECT_MSG(rt_near(c[0], (1 - F) * (1 - F), 1e-5), "glass depth 3: %.7g expected %.7g", c[0], (1 - F) * (1 - F));
-    rt_image_free(rgba, depth);
     sy_rt_device_destroy(dev);
 }
 
