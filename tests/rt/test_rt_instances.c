@@ -7,7 +7,9 @@
  * same light (its green mass) centred between its ends, through the top scene, a twin and a baked
  * instance alike; dropping the motion renders bit for bit the sharp image again. A deforming mesh
  * (sy_rt_mesh_update_motion: its vertices slid 2 m between the close and the open) streaks the same
- * way, and clearing the motion renders bit for bit what a plain update to the open pose renders. */
+ * way, and clearing the motion renders bit for bit what a plain update to the open pose renders. A
+ * transform or a close transform that shrinks past SY_RT_INSTANCE_GAIN_MAX is refused with the
+ * reason for an instance created unbaked and taken by a baked one. */
 #include "rt_test.h"
 
 #define W 40
@@ -388,6 +390,28 @@ static void test_motion(uint32_t flags)
     EXPECT(sy_rt_instance_set_motion(dev, (sy_rt_instance){0}, close) == SY_RT_ERROR_INVALID_HANDLE);
     EXPECT(sy_rt_instance_set_motion(dev, inst, NULL) == SY_RT_OK);
     EXPECT(sy_rt_instance_set_motion(dev, inst, open) == SY_RT_OK); /* equal to its transform: no motion */
+    /* a transform that shrinks by more than SY_RT_INSTANCE_GAIN_MAX allows (1e5 > 1e4): refused, with
+     * the reason, for an instance created unbaked (Embree would see its inverse); a baked one takes it */
+    float tiny[16];
+    memcpy(tiny, open, sizeof tiny);
+    tiny[0] = tiny[5] = tiny[10] = 1e-5f;
+    bool unbaked = !(flags & SY_RT_INSTANCE_BAKED);
+    const char *motion_says = "instance set_motion: the close transform shrinks by";
+    const char *move_says = "instance set_transform: the transform shrinks by";
+    sy_rt_result rm = sy_rt_instance_set_motion(dev, inst, tiny);
+    EXPECT_MSG(unbaked ? rm == SY_RT_ERROR_INVALID_ARGUMENT && strstr(rt_test_msg, motion_says) &&
+                             strstr(rt_test_msg, "allows for an instance created unbaked)")
+                       : rm == SY_RT_OK,
+               "flags %u: set_motion of a 1e-5 scale: %s (%s)", flags, sy_rt_result_str(rm), rt_test_msg);
+    sy_rt_result rt = sy_rt_instance_set_transform(dev, inst, tiny);
+    EXPECT_MSG(unbaked ? rt == SY_RT_ERROR_INVALID_ARGUMENT && strstr(rt_test_msg, move_says) &&
+                             strstr(rt_test_msg, "created unbaked); create it again")
+                       : rt == SY_RT_OK,
+               "flags %u: set_transform to a 1e-5 scale: %s (%s)", flags, sy_rt_result_str(rt), rt_test_msg);
+    if (!unbaked) { /* back to where it was */
+        MUST(sy_rt_instance_set_motion(dev, inst, NULL));
+        MUST(sy_rt_instance_set_transform(dev, inst, open));
+    }
     float got[16];
     MUST(sy_rt_instance_get_transform(dev, inst, got));
     EXPECT(memcmp(got, open, sizeof got) == 0);
