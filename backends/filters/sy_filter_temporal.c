@@ -287,6 +287,31 @@ static inline void tap_span(int w, int off, int *x0, int *x1)
     *x1 = off > 0 ? w - off : w;
 }
 
+/* one tap of a row's 3x3 neighbourhood at step s: its direction (dx, dy), the columns [x0, x1) of
+ * the row whose tap lies in the image (tap_span), and o, the offset from a pixel of the row to its
+ * tap in a plane */
+typedef struct tap3 {
+    int dx, dy, x0, x1;
+    size_t o;
+} tap3;
+
+/* the taps of row y's 3x3 neighbourhood at step s whose row lies in [0, hgt), dy then dx from -1
+ * (the order the sums run in); returns how many */
+static int row_taps(int w, int hgt, int y, int s, tap3 t[9])
+{
+    int n = 0;
+    for (int dy = -1; dy <= 1; ++dy) {
+        int yy = y + dy * s;
+        if (yy < 0 || yy >= hgt) continue;
+        for (int dx = -1; dx <= 1; ++dx, ++n) {
+            t[n].dx = dx, t[n].dy = dy;
+            tap_span(w, dx * s, &t[n].x0, &t[n].x1);
+            t[n].o = (size_t)yy * w + (size_t)(dx * s);
+        }
+    }
+    return n;
+}
+
 /* 0 for a finite x, NaN for NaN or an infinity (x * 0: not folded without -ffinite-math-only) */
 static inline SY_TEMPORAL_INLINE float nonfinite0(float x)
 {
@@ -441,19 +466,14 @@ static void stats_row(const tctx *c, int y)
     const float *c0 = plane(c, W_CUR), *c1 = plane(c, W_CUR + 1), *c2 = plane(c, W_CUR + 2);
     const float *d0 = plane(c, W_CUR + 3), *d1 = plane(c, W_CUR + 4), *d2 = plane(c, W_CUR + 5);
     const float *L0 = plane(c, W_LUM), *L1 = plane(c, W_LUM + 1);
-    for (int dy = -1; dy <= 1; ++dy) {
-        int yy = y + dy;
-        if (yy < 0 || yy >= hgt) continue;
-        for (int dx = -1; dx <= 1; ++dx) {
-            int x0, x1;
-            tap_span(w, dx, &x0, &x1);
-            size_t o = (size_t)yy * w + (size_t)dx;
-            float axial = (dx == 0) != (dy == 0) ? 1.0f : 0.0f;
-            stats_tap(x0, x1, H + o, c0 + o, c1 + o, c2 + o, L0 + o, S[0], S[1], S[2], S[3], S[4], S[5], S[6], S[7]);
-            stats_tap(x0, x1, H + o, d0 + o, d1 + o, d2 + o, L1 + o, S[8], S[9], S[10], S[11], S[12], S[13], S[14],
-                      S[15]);
-            count_tap(x0, x1, axial, H + o, Z + o, Z + row, S[16], zg);
-        }
+    tap3 taps[9];
+    for (int k = 0, n = row_taps(w, hgt, y, 1, taps); k < n; ++k) {
+        int x0 = taps[k].x0, x1 = taps[k].x1;
+        size_t o = taps[k].o;
+        float axial = (taps[k].dx == 0) != (taps[k].dy == 0) ? 1.0f : 0.0f;
+        stats_tap(x0, x1, H + o, c0 + o, c1 + o, c2 + o, L0 + o, S[0], S[1], S[2], S[3], S[4], S[5], S[6], S[7]);
+        stats_tap(x0, x1, H + o, d0 + o, d1 + o, d2 + o, L1 + o, S[8], S[9], S[10], S[11], S[12], S[13], S[14], S[15]);
+        count_tap(x0, x1, axial, H + o, Z + o, Z + row, S[16], zg);
     }
 }
 
@@ -691,15 +711,10 @@ static void vblur_rows(void *vc, uint32_t y0, uint32_t y1)
         float *vb = IL + row, *vw = WS + row;
         memset(vb, 0, (size_t)w * sizeof(float));
         memset(vw, 0, (size_t)w * sizeof(float));
-        for (int dy = -1; dy <= 1; ++dy) {
-            int yy = y + dy;
-            if (yy < 0 || yy >= hgt) continue;
-            for (int dx = -1; dx <= 1; ++dx) {
-                int x0, x1;
-                tap_span(w, dx, &x0, &x1);
-                size_t o = (size_t)yy * w + (size_t)dx;
-                vblur_tap(x0, x1, hk[dx + 1] * hk[dy + 1], cls + o, V + o, cls + row, vb, vw);
-            }
+        tap3 taps[9];
+        for (int k = 0, n = row_taps(w, hgt, y, 1, taps); k < n; ++k) {
+            const tap3 *t = &taps[k];
+            vblur_tap(t->x0, t->x1, hk[t->dx + 1] * hk[t->dy + 1], cls + t->o, V + t->o, cls + row, vb, vw);
         }
         stops_row(w, sl, sz, vw, G + row, Z + row, IL + row, IZ + row);
     }
@@ -821,21 +836,17 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
             if (eb <= ea) continue;
             atrous_start(eb - ea, k0, C0 + row + ea, C1 + row + ea, C2 + row + ea, V + row + ea, o0 + ea, o1 + ea,
                          o2 + ea, ow + ea, ov + ea);
-            for (int dy = -1; dy <= 1; ++dy) {
-                int yy = y + dy * s;
-                if (yy < 0 || yy >= hgt) continue;
-                for (int dx = -1; dx <= 1; ++dx) {
-                    if (dx == 0 && dy == 0) continue;
-                    int x0, x1;
-                    tap_span(w, dx * s, &x0, &x1);
-                    x0 = x0 > ea ? x0 : ea, x1 = x1 < eb ? x1 : eb;
-                    if (x1 <= x0) continue;
-                    size_t o = (size_t)yy * w + (size_t)(dx * s);
-                    float kk = hk[dx + 1] * hk[dy + 1], zd = (dx && dy) ? 0.70710678f : 1.0f;
-                    atrous_tap(x0, x1, kk, zd, cls + o, L + o, Z + o, N0 + o, N1 + o, N2 + o, C0 + o, C1 + o, C2 + o,
-                               V + o, cls + row, L + row, Z + row, N0 + row, N1 + row, N2 + row, SN + row, IL + row,
-                               IZ + row, o0, o1, o2, ow, ov, c->xmax);
-                }
+            tap3 taps[9];
+            for (int k = 0, n = row_taps(w, hgt, y, s, taps); k < n; ++k) {
+                int dx = taps[k].dx, dy = taps[k].dy;
+                if (dx == 0 && dy == 0) continue;
+                int x0 = taps[k].x0 > ea ? taps[k].x0 : ea, x1 = taps[k].x1 < eb ? taps[k].x1 : eb;
+                if (x1 <= x0) continue;
+                size_t o = taps[k].o;
+                float kk = hk[dx + 1] * hk[dy + 1], zd = (dx && dy) ? 0.70710678f : 1.0f;
+                atrous_tap(x0, x1, kk, zd, cls + o, L + o, Z + o, N0 + o, N1 + o, N2 + o, C0 + o, C1 + o, C2 + o, V + o,
+                           cls + row, L + row, Z + row, N0 + row, N1 + row, N2 + row, SN + row, IL + row, IZ + row, o0,
+                           o1, o2, ow, ov, c->xmax);
             }
             atrous_end(eb - ea, H + row + ea, C0 + row + ea, C1 + row + ea, C2 + row + ea, V + row + ea, L + row + ea,
                        ow + ea, o0 + ea, o1 + ea, o2 + ea, ov + ea, ol + ea);
