@@ -1,8 +1,10 @@
 /* sy_rt_mesh.c — meshes of the ray-tracing back-end: sy_rt_mesh_create / update / destroy (checked,
  * copied or shared vertex data in an Embree triangle geometry) and each mesh's BLAS, built on first
- * use by an Embree instance or a moved instance's twin (sy_rt_mesh_blas). Calls only sy_rt_base. */
+ * use by an Embree instance or a moved instance's twin (sy_rt_mesh_blas); a deforming mesh's two
+ * poses over a shutter (sy_rt_mesh_update_motion, sy_rt_mesh_motion_off). Calls only sy_rt_base. */
 #include "sy_rt_scene.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,6 +41,8 @@ static void mesh_free(sy_rt_device *dev, sy_rt_mesh_data *m)
     if (m->geom) rtcReleaseGeometry(m->geom);
     if (m->scene) rtcReleaseScene(m->scene);
     free(m->updated_normals);
+    free(m->normals1);
+    if (m->motion) dev->motion_count--;
     if (m->shared) {
         if (m->release) m->release(m->release_user);
     } else {
@@ -293,4 +297,72 @@ sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh)
     sy_rt_mesh_unref(dev, m); /* instances keep it alive until they go */
     dev->dirty = true;
     return SY_RT_OK;
+}
+
+/* >>mesh motion: a deforming mesh's two poses over the shutter (time steps 0 and 1) */
+void sy_rt_mesh_motion_off(sy_rt_device *dev, sy_rt_mesh_data *m)
+{
+    if (!m->motion) return;
+    rtcSetGeometryTimeStepCount(m->geom, 1);
+    rtcCommitGeometry(m->geom);
+    if (m->scene) rtcCommitScene(m->scene);
+    size_t bytes = (size_t)m->vertex_count * 3u * sizeof(float) * (m->normals1 ? 2u : 1u);
+    m->own_bytes -= bytes;
+    dev->mesh_bytes -= bytes;
+    free(m->normals1);
+    m->normals1 = NULL;
+    m->positions1 = NULL;
+    m->motion = false;
+    dev->motion_count--;
+    dev->dirty = dev->top_dirty = dev->shadow_dirty = dev->area_dirty = true;
+}
+
+sy_rt_result sy_rt_mesh_update_motion(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals)
+{
+    if (!dev || !positions) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh update_motion: NULL argument");
+    sy_rt_mesh_data *m = sy_rt_pool_get(&dev->meshes, mesh.id);
+    if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "mesh update_motion: mesh handle 0x%08x is stale", mesh.id);
+    size_t vc = m->vertex_count;
+    /* the pose it has now, kept for time 1 (before the update overwrites it) */
+    float *close = malloc(vc * 3u * sizeof(float) + 1), *close_n = m->normals ? malloc(vc * 3u * sizeof(float) + 1) : NULL;
+    if (!close || (m->normals && !close_n)) {
+        free(close), free(close_n);
+        return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh update_motion: out of memory");
+    }
+    memcpy(close, m->positions, vc * 3u * sizeof(float));
+    if (close_n) memcpy(close_n, m->normals, vc * 3u * sizeof(float));
+    sy_rt_result r = sy_rt_mesh_update(dev, mesh, positions, normals); /* time 0; checks the arguments */
+    if (r != SY_RT_OK) {
+        free(close), free(close_n);
+        return r;
+    }
+    if (!m->motion) {
+        rtcSetGeometryTimeStepCount(m->geom, 2);
+        float *p1 = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, 1, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m->vertex_count);
+        if (!p1) {
+            rtcSetGeometryTimeStepCount(m->geom, 1);
+            free(close), free(close_n);
+            r = sy_rt_check_embree(dev, "mesh update_motion: vertex buffer");
+            return r != SY_RT_OK ? r : FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh update_motion: vertex buffer: out of memory");
+        }
+        m->positions1 = p1;
+        m->motion = true;
+        dev->motion_count++;
+        size_t bytes = vc * 3u * sizeof(float) * (close_n ? 2u : 1u);
+        m->own_bytes += bytes;
+        dev->mesh_bytes += bytes;
+    } else {
+        free(m->normals1);
+    }
+    memcpy((float *)m->positions1, close, vc * 3u * sizeof(float));
+    free(close);
+    m->normals1 = close_n;
+    float extent = m->extent;
+    for (size_t i = 0; i < vc * 3u; ++i) extent = fmaxf(extent, fabsf(m->positions1[i]));
+    m->extent = extent;
+    rtcUpdateGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, 1);
+    rtcCommitGeometry(m->geom);
+    if (m->scene) rtcCommitScene(m->scene);
+    dev->dirty = dev->top_dirty = dev->shadow_dirty = dev->area_dirty = true;
+    return sy_rt_check_embree(dev, "mesh update_motion");
 }

@@ -230,6 +230,10 @@ sy_rt_result sy_rt_instance_set_motion(sy_rt_device *dev, sy_rt_instance inst, c
 sy_rt_result sy_rt_motion_clear(sy_rt_device *dev)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "motion clear: NULL device");
+    for (uint32_t i = 0; dev->motion_count && i < dev->meshes.count; ++i) {
+        sy_rt_mesh_data *m = dev->meshes.items[i];
+        if (m && m->motion) sy_rt_mesh_motion_off(dev, m);
+    }
     for (uint32_t i = 0; dev->motion_count && i < dev->instances.count; ++i) {
         sy_rt_instance_data *in = dev->instances.items[i];
         if (in && in->motion) {

@@ -18,6 +18,9 @@ void sy_rt_mesh_unref(sy_rt_device *dev, sy_rt_mesh_data *m);
 /* The mesh's BLAS (m->scene), built on first use; refused with the sizes when it would not fit
  * in memory or under the device's limit. */
 sy_rt_result sy_rt_mesh_blas(sy_rt_device *dev, sy_rt_mesh_data *m);
+/* Ends a mesh's motion (sy_rt_mesh_update_motion): one time step again, its time-0 pose kept
+ * (Embree drops the slot-1 buffer). */
+void sy_rt_mesh_motion_off(sy_rt_device *dev, sy_rt_mesh_data *m);
 
 /* >>punctual lights (sy_rt_punctual.c) */
 /* Rebuilds dev->punctual, the array of the live lights the integrators read (sy_rt_commit). */
