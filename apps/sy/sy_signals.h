@@ -15,8 +15,8 @@
 #include <stdbool.h>
 
 /* Call once, first thing in main, before any thread is started (threads inherit the blocked
- * mask). Returns false when the waiting thread could not be started (signals then keep their
- * default action). */
+ * mask). Returns once the waiting thread runs (it then holds no lock, so a later fork is safe),
+ * or false when it could not be started (signals then keep their default action). */
 bool sy_signals_start(void);
 
 /* what: what the first interrupt lets the command finish, printed when it comes ("finishing the
