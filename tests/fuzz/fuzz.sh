@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # fuzz.sh TARGET SECONDS [options] — fuzzes one libFuzzer target for a bounded time and prints the
 # totals (executions, exec/s, corpus size) at the end. Targets: gltf glb x3d exr changes web_request
-# web_message cull_query.
+# web_message web_frame cull_query.
 #
 #   tests/fuzz/fuzz.sh x3d 600                 # 10 minutes, one process
 #   tests/fuzz/fuzz.sh gltf 3600 -j 2          # two libFuzzer jobs in parallel
@@ -63,12 +63,13 @@ case $target in
   changes) len=65536; seed_dirs=(); seed_pat=(); res_pat=(); dicts=(wire.dict) ;;
   web_request) len=12288; seed_dirs=(); seed_pat=(); res_pat=(); dicts=(web.dict) ;;
   web_message) len=4096; seed_dirs=(); seed_pat=(); res_pat=(); dicts=(web.dict) ;;
+  web_frame) len=65536; seed_dirs=(); seed_pat=(); res_pat=(); dicts=() ;;
   cull_query) len=65536; seed_dirs=(); seed_pat=(); res_pat=(); dicts=(web.dict) ;;
   assimp_obj|assimp_ply|assimp_stl|assimp_fbx|assimp_dae) # Assimp's test models (assimp-testmodels), in place
         ext=${target#assimp_}; len=65536; testdata=/usr/share/assimp/models; res_pat=('*.mtl' '*.png' '*.jpg')
         case $ext in obj) seed_dirs=(OBJ) ;; ply) seed_dirs=(PLY) ;; stl) seed_dirs=(STL) ;; fbx) seed_dirs=(FBX) ;; dae) seed_dirs=(Collada) ;; esac
         seed_pat=("*.$ext" "*.${ext^^}"); dicts=(assimp.dict) ;;
-  *) echo "fuzz.sh: unknown target '$target' (gltf glb x3d exr changes web_request web_message cull_query)" >&2; exit 2 ;;
+  *) echo "fuzz.sh: unknown target '$target' (gltf glb x3d exr changes web_request web_message web_frame cull_query)" >&2; exit 2 ;;
 esac
 [ -n "$max_len" ] && len=$max_len
 
@@ -142,7 +143,8 @@ echo "fuzz.sh: $target for ${seconds}s x $jobs job(s), max_len $len: $nseed test
      "than max_len), $(ls "$work/generated" | wc -l) generated, $(ls "$here/corpus_regressions/$target" | wc -l) regression inputs"
 
 regress=$here/corpus_regressions/$target
-args=(-max_len="$len" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -dict="$dict" -artifact_prefix="$artifacts/")
+args=(-max_len="$len" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$artifacts/")
+[ -s "$dict" ] && args+=(-dict="$dict") # libFuzzer refuses an empty dictionary (web_frame has none)
 [ "$jobs" -gt 1 ] && args+=(-jobs="$jobs" -workers="$jobs")
 # a smaller ASan quarantine and shorter allocation stacks: ~10% more executions (tinygltf and
 # libxml2 allocate a lot); an ASAN_OPTIONS of the caller wins
