@@ -24,7 +24,9 @@ import struct
 import subprocess
 import sys
 import tempfile
-import zlib
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from png_read import read_png  # noqa: E402  (one PNG decoder for the scripts)
 
 MODELS = ["AnimatedCube", "BoxAnimated", "InterpolationTest", "RiggedFigure", "CesiumMan", "Fox", "SimpleMorph",
           "AnimatedMorphCube"]
@@ -32,63 +34,12 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def png_alpha(path):
-    """(width, height, bytearray of coverage 0/1 per pixel: alpha >= half)."""
-    with open(path, "rb") as f:
-        data = f.read()
-    if data[:8] != b"\x89PNG\r\n\x1a\n":
-        raise ValueError("%s: not a PNG" % path)
-    pos, idat, w = 8, [], None
-    while pos < len(data):
-        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
-        body = data[pos + 8:pos + 8 + n]
-        pos += 12 + n
-        if kind == b"IHDR":
-            w, h, depth, ctype, _, _, interlace = struct.unpack(">IIBBBBB", body)
-            if interlace or depth not in (8, 16) or ctype not in (0, 2, 4, 6):
-                raise ValueError("%s: unsupported PNG (depth %d, colour type %d, interlace %d)" % (path, depth, ctype,
-                                                                                                   interlace))
-        elif kind == b"IDAT":
-            idat.append(body)
-        elif kind == b"IEND":
-            break
-    raw = zlib.decompress(b"".join(idat))
-    channels = {0: 1, 2: 3, 4: 2, 6: 4}[ctype]
-    bpp = channels * depth // 8
-    stride = w * bpp
-    prev = bytearray(stride)
-    cov = bytearray(w * h)
-    i = 0
-    for y in range(h):
-        ft = raw[i]
-        line = bytearray(raw[i + 1:i + 1 + stride])
-        i += 1 + stride
-        if ft == 1:
-            for x in range(bpp, stride):
-                line[x] = (line[x] + line[x - bpp]) & 255
-        elif ft == 2:
-            for x in range(stride):
-                line[x] = (line[x] + prev[x]) & 255
-        elif ft == 3:
-            for x in range(stride):
-                left = line[x - bpp] if x >= bpp else 0
-                line[x] = (line[x] + ((left + prev[x]) >> 1)) & 255
-        elif ft == 4:
-            for x in range(stride):
-                a = line[x - bpp] if x >= bpp else 0
-                b = prev[x]
-                c = prev[x - bpp] if x >= bpp else 0
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        prev = line
-        if ctype in (4, 6):
-            off = (channels - 1) * depth // 8  # the alpha sample's first (most significant) byte
-            for x in range(w):
-                cov[y * w + x] = 1 if line[x * bpp + off] >= 128 else 0
-        else:
-            for x in range(w):
-                cov[y * w + x] = 1
-    return w, h, cov
+    """(width, height, bytearray of coverage 0/1 per pixel: alpha >= half; 1 everywhere without alpha)."""
+    w, h, ch, bps, px = read_png(path)
+    if ch not in (2, 4):
+        return w, h, bytearray([1]) * (w * h)
+    step, off = ch * bps, (ch - 1) * bps  # the alpha sample's first (most significant) byte
+    return w, h, bytearray(1 if px[k * step + off] >= 128 else 0 for k in range(w * h))
 
 
 def iou(a, b):

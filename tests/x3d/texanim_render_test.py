@@ -21,6 +21,9 @@ import sys
 import time
 import zlib
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from png_read import read_png as png_read  # noqa: E402  (one PNG decoder for the scripts)
+
 
 def write_png(path, w, h, rgb):
     raw = b"".join(b"\0" + bytes(rgb[y * w * 3:(y + 1) * w * 3]) for y in range(h))
@@ -35,44 +38,9 @@ def write_png(path, w, h, rgb):
 
 def read_png(path):
     """(w, h, channels, bytearray of 8-bit samples)"""
-    data = open(path, "rb").read()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n", path
-    pos, idat = 8, []
-    while pos < len(data):
-        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
-        body = data[pos + 8:pos + 8 + n]
-        pos += 12 + n
-        if kind == b"IHDR":
-            w, h, depth, ctype, _, _, interlace = struct.unpack(">IIBBBBB", body)
-            assert depth == 8 and ctype in (0, 2, 6) and not interlace, (path, depth, ctype, interlace)
-        elif kind == b"IDAT":
-            idat.append(body)
-    raw = zlib.decompress(b"".join(idat))
-    ch = {0: 1, 2: 3, 6: 4}[ctype]
-    stride = w * ch
-    out = bytearray(h * stride)
-    prev = bytearray(stride)
-    i = 0
-    for y in range(h):
-        ft, line = raw[i], bytearray(raw[i + 1:i + 1 + stride])
-        i += 1 + stride
-        for x in range(stride):
-            a = line[x - ch] if x >= ch else 0
-            b = prev[x]
-            c = prev[x - ch] if x >= ch else 0
-            if ft == 1:
-                line[x] = (line[x] + a) & 255
-            elif ft == 2:
-                line[x] = (line[x] + b) & 255
-            elif ft == 3:
-                line[x] = (line[x] + ((a + b) >> 1)) & 255
-            elif ft == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        out[y * stride:(y + 1) * stride] = line
-        prev = line
-    return w, h, ch, out
+    w, h, ch, bps, px = png_read(path)
+    assert bps == 1, path
+    return w, h, ch, px
 
 
 def gray(img):
