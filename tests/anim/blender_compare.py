@@ -48,6 +48,18 @@ def iou(a, b):
     return 1.0 if union == 0 else inter / union, sum(a), sum(b)
 
 
+def silhouette_args(ap, data_sub, backends):
+    """The options of a silhouette comparison (this one and view3dscene_compare.py): --sy, --data
+    (../shared/testdata/DATA_SUB), --out, --backends, --min-iou, --check, --json."""
+    ap.add_argument("--sy", default="build/apps/sy/sy")
+    ap.add_argument("--data", default=os.path.join(HERE, "..", "..", "..", "shared", "testdata", data_sub))
+    ap.add_argument("--out", default=None, help="keep the images here (default: a temporary directory)")
+    ap.add_argument("--backends", default=backends)
+    ap.add_argument("--min-iou", type=float, default=0.98)
+    ap.add_argument("--check", action="store_true", help="exit 1 when an IoU is below --min-iou")
+    ap.add_argument("--json", default=None, help="write the results here")
+
+
 def finish(rows, worst, failed, out, a):
     """The summary line and the exit status of a silhouette comparison (this one and
     view3dscene_compare.py): rows of dicts with "iou"; --json, --min-iou, --check from a."""
@@ -107,20 +119,14 @@ def times_of(path):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--sy", default="build/apps/sy/sy")
-    ap.add_argument("--data", default=os.path.join(HERE, "..", "..", "..", "shared", "testdata", "gltf"))
-    ap.add_argument("--out", default=None, help="keep the images here (default: a temporary directory)")
+    silhouette_args(ap, "gltf", "whitted,raster")
     ap.add_argument("--size", type=int, default=320)
     ap.add_argument("--fov", type=float, default=40.0)
-    ap.add_argument("--backends", default="whitted,raster")
-    ap.add_argument("--min-iou", type=float, default=0.98)
-    ap.add_argument("--check", action="store_true", help="exit 1 when an IoU is below --min-iou")
     ap.add_argument("--blender", default="blender")
     ap.add_argument("--blender-only", action="store_true", help="only Blender's half (the references)")
     ap.add_argument("--nlerp", action="store_true",
                     help="Blender's own quaternion interpolation (per-component lerp) instead of glTF's slerp")
     ap.add_argument("--times", default=None, help="comma-separated times for every model (default: 4 in range)")
-    ap.add_argument("--json", default=None, help="write the results here")
     ap.add_argument("--reuse", action="store_true",
                     help="keep Blender's images already in --out for the same times (iterating on ours)")
     ap.add_argument("models", nargs="*")

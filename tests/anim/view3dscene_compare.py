@@ -22,7 +22,7 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from blender_compare import finish, iou, png_alpha  # noqa: E402  (one PNG reader, IoU and summary for both)
+from blender_compare import finish, iou, png_alpha, silhouette_args  # noqa: E402  (one PNG reader, IoU and summary for both)
 
 # (scene under ../shared/testdata/x3d, times in seconds of its clock): the IndexedFaceSet example's
 # piston and rocker arms run on one looping 5500 s TimeSensor through Position- and
@@ -39,15 +39,9 @@ SCENES = [
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--sy", default="build/apps/sy/sy")
-    ap.add_argument("--data", default=os.path.join(HERE, "..", "..", "..", "shared", "testdata", "x3d"))
-    ap.add_argument("--out", default=None, help="keep the images here (default: a temporary directory)")
+    silhouette_args(ap, "x3d", "raster,whitted")
     ap.add_argument("--width", type=int, default=320)
     ap.add_argument("--height", type=int, default=240)
-    ap.add_argument("--backends", default="raster,whitted")
-    ap.add_argument("--min-iou", type=float, default=0.98)
-    ap.add_argument("--check", action="store_true", help="exit 1 when an IoU is below --min-iou")
-    ap.add_argument("--json", default=None, help="write the results here")
     a = ap.parse_args()
     for tool in ("view3dscene", "xvfb-run"):
         if not shutil.which(tool):
