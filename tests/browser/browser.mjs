@@ -15,7 +15,7 @@
 //     whose WebSocket goes through playwright (routeWebSocket) is sent made-up bad frames after
 //     the server's (duplicate, sizes that do not add up, depth that does not inflate, cameras
 //     not finite or not a rotation, format 4, no JPEG, two that say they have the last depth
-//     channel wrongly): their counts in sy.stats().bad and
+//     channel wrongly, one four times the size asked for): their counts in sy.stats().bad and
 //     whether the canvas stayed the same. URL?warp=0 gives the same drag without the warp and
 //     without the rest (the comparison).
 //   node browser.mjs tools URL OUTDIR WIDTH HEIGHT
@@ -271,8 +271,9 @@ try {
         variant(5, (b) => b.writeUInt8(0x34, 3)),                         // format 4: version
         variant(6, (b) => b.fill(0, 192, 192 + jl)),                      // no JPEG: jpeg
         variant(7, (b) => b.writeUInt32LE(b.readUInt32LE(180) | 4, 180)), // says it has the last depth, carries one: depth
-        variant(8, (b) => { b.writeUInt32LE(b.readUInt32LE(180) | 4, 180); b.writeUInt32LE(0, 48); b.writeUInt32LE(b.readUInt32LE(4) + 4, 4); })
+        variant(8, (b) => { b.writeUInt32LE(b.readUInt32LE(180) | 4, 180); b.writeUInt32LE(0, 48); b.writeUInt32LE(b.readUInt32LE(4) - 4, 4); })
           .subarray(0, 192 + jl),                                         // the last depth, of another size: depth
+        variant(9, (b) => { b.writeUInt32LE(4 * b.readUInt32LE(4), 4); b.writeUInt32LE(4 * b.readUInt32LE(8), 8); }), // larger than asked: large
       ];
       // one at a time: the page decodes only the newest of the frames that come while it is busy
       const refused = () => p2.evaluate(() => Object.values(sy.stats().bad).reduce((a, b) => a + b, 0));

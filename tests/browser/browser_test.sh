@@ -289,7 +289,7 @@ if [ "$mode" = warp ]; then
       if (!(w.input_to_display_ms.n >= 30)) errs.push(`only ${w.input_to_display_ms.n} inputs measured`);
       if (!(w.by_estimate >= 0.75)) errs.push(`only ${(100 * w.by_estimate).toFixed(0)}% of the inputs answered by the estimate`);
       if (!(n.input_to_display_ms.p50 >= BOUND)) errs.push(`without warp median ${n.input_to_display_ms.p50} ms < ${BOUND}: the delay is not there`);
-      const want = { order: 1, size: 1, depth: 3, camera: 2, version: 1, jpeg: 1, magic: 0 };
+      const want = { order: 1, size: 1, large: 1, depth: 3, camera: 2, version: 1, jpeg: 1, magic: 0 };
       if (!w.badFrames || JSON.stringify(Object.keys(want).map((k) => w.badFrames.counts[k])) !== JSON.stringify(Object.values(want)))
         errs.push(`bad frames counted ${JSON.stringify(w.badFrames && w.badFrames.counts)}, not ${JSON.stringify(want)}`);
       if (!w.badFrames || !w.badFrames.unchanged) errs.push("the bad frames changed the picture");

@@ -19,7 +19,8 @@
   const wsUrl = (location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws" +
                 (token ? "?token=" + encodeURIComponent(token) : "");
   let ws = null, inputId = 0, decoding = false, pending = null, lastSeq = -1, hold = false;
-  const bad = { magic: 0, version: 0, size: 0, order: 0, camera: 0, depth: 0, jpeg: 0, video: 0 };
+  const bad = { magic: 0, version: 0, size: 0, large: 0, order: 0, camera: 0, depth: 0, jpeg: 0, video: 0 };
+  const asked = { w: 0, h: 0 }; // the largest frame size asked for on this connection
   const video = window.syVideo || null; // video.js: the video stream's decoder (docs/WEB.md)
   const hist = { input: [], frame: [], bytes: [], arrivals: [], adopt: [], depth: [] };
   const depthCount = { own: 0, same: 0, none: 0, mesh_kept: 0 }; // frames shown by where their depth came from
@@ -188,9 +189,17 @@
     const det = x[0] * (y[1] * z[2] - y[2] * z[1]) - y[0] * (x[1] * z[2] - x[2] * z[1]) + z[0] * (x[1] * y[2] - x[2] * y[1]);
     return Math.abs(det - 1) < 1e-3 && Math.abs(dot(x, y)) < 1e-3 && Math.abs(dot(y, z)) < 1e-3 && Math.abs(dot(x, z)) < 1e-3;
   }
-  async function inflate(bytes) {
-    const s = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate"));
-    return new Uint8Array(await new Response(s).arrayBuffer());
+  // inflates at most limit bytes: a stream that would give more is refused as it grows, so a few
+  // bytes of deflate never become a large allocation
+  async function inflate(bytes, limit) {
+    const reader = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate")).getReader();
+    const out = new Uint8Array(limit);
+    for (let n = 0; ;) {
+      const { done, value } = await reader.read();
+      if (done) return out.subarray(0, n);
+      if (value.length > limit - n) { reader.cancel().catch(() => {}); throw new Error("depth"); }
+      out.set(value, n); n += value.length;
+    }
   }
   // docs/WEB.md, depth coding 2: the grid of every fourth pixel (and the last column and row),
   // 12-bit log depth, each value minus its MED prediction, byte planes; {d, gw, gh} (0: no hit)
@@ -250,7 +259,7 @@
   function depthGrid(src) { // a promise of the decoded grid
     if (!src.grid) {
       const gn = gridN(src.w) * gridN(src.h);
-      src.grid = inflate(src.bytes).then((p) => {
+      src.grid = inflate(src.bytes, 2 * gn).then((p) => {
         if (p.length !== 2 * gn) throw new Error("depth");
         return decodeDepth(p, src.w, src.h, src.dmin, src.dmax);
       });
@@ -272,6 +281,10 @@
                 orbit: { target: [0, 1, 2].map((i) => dv.getFloat32(156 + 4 * i, true)), yaw: dv.getFloat32(168, true),
                          pitch: dv.getFloat32(172, true), dist: dv.getFloat32(176, true) } };
     if (!f.w || !f.h || f.w > 16384 || f.h > 16384 || f.w * f.h > 67108864 || HEADER + f.jpegLen + f.depthLen !== len) return { bad: "size" };
+    // never larger than this page asked for (the largest size it asked on this connection: frames
+    // of a size asked before a resize may still be on their way): a server cannot make the page
+    // decode more than it shows
+    if (f.w > asked.w || f.h > asked.h) return { bad: "large" };
     if (f.seq <= lastSeq) return { bad: "order" };
     if (!camOk(f.c2w, f.win) || ![f.orbit.yaw, f.orbit.pitch, f.orbit.dist, ...f.orbit.target].every(isFinite) ||
         !(f.orbit.dist > 0)) return { bad: "camera" };
@@ -534,6 +547,7 @@
     const dpr = Math.min(window.devicePixelRatio || 1, 2);
     const w = Math.max(1, Math.round(canvas.clientWidth * dpr)), h = Math.max(1, Math.round(canvas.clientHeight * dpr));
     canvas.width = w; canvas.height = h;
+    asked.w = Math.max(asked.w, w); asked.h = Math.max(asked.h, h);
     moved = true;
     send({ t: "size", w: w, h: h, v: FORMAT, codecs: video ? video.codecs : undefined });
   }
@@ -542,6 +556,7 @@
     ws.binaryType = "arraybuffer";
     ws.onopen = function () {
       stats.connected = true; lastSeq = -1; // a restarted server counts from 1 again
+      asked.w = asked.h = 0;
       hud.textContent = gl ? "connected" : "connected (no WebGL2: server frames only)";
       if (video) { video.reset(); video.askKeyframe = function () { send({ t: "keyframe" }); }; }
       (video ? video.ready : Promise.resolve()).then(sendSize);
