@@ -23,7 +23,7 @@
 //     the centre (the server's still of the view), clicks it (pick + select; the properties show
 //     the node), hides that node from the tree (the streamed canvas changes there; a pick there no
 //     longer names it), shows it again (back as it was), adds a section plane (the canvas
-//     changes; with caps on in magenta, the cut faces show magenta), measures two covered points, opens the help, takes a screenshot (the download),
+//     changes; with caps on in magenta, the cut faces show magenta), measures two covered points (Esc takes them away), opens the help, takes a screenshot (the download),
 //     pinches and drags with synthetic touch pointers; screenshots OUTDIR/page.png, tree.png,
 //     hidden.png, section.png, cap.png, measure.png, help.png. URL with readonly=1 (sy web --read-only):
 //     the controls that change the scene are hidden or disabled and a change sent anyway leaves
@@ -518,7 +518,10 @@ try {
       });
       await page.locator('#sy-section button[title=remove]').click();
     }
-    await page.keyboard.press('Escape');
+    await page.keyboard.press('Escape'); // leaves measuring: the points and the line go
+    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    result.measure_cleared = await page.evaluate(() => ({ points: sy.ui.measure.points.length,
+      drawn: [...document.querySelectorAll('svg line, svg circle')].filter((n) => n.style.display !== 'none').length }));
     // 5. the help overlay
     await page.keyboard.press('?');
     await page.waitForFunction(() => sy.ui.helpOpen, null, { timeout: TIMEOUT });

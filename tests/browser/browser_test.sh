@@ -174,6 +174,8 @@ if [ "$mode" = tools ]; then
       if (!(t.cap && t.cap.after > 0.002 && t.cap.after > 10 * t.cap.before)) errs.push(`caps on in magenta: ${JSON.stringify(t.cap)} of the canvas magenta`);
       const m = t.measure, d = m.points.length === 2 ? Math.hypot(...[0, 1, 2].map((i) => m.points[1][i] - m.points[0][i])) : NaN;
       if (!(m.distance > 0 && Math.abs(m.distance - d) <= 1e-9 * (1 + d) && m.text.includes("distance"))) errs.push(`measurement ${JSON.stringify(m)}`);
+      if (!(t.measure_cleared && t.measure_cleared.points === 0 && t.measure_cleared.drawn === 0))
+        errs.push(`after Esc the measurement stays: ${JSON.stringify(t.measure_cleared)}`);
       if (!(t.to_plane && t.to_plane.text && t.to_plane.shown.length === 1 && Math.abs(t.to_plane.shown[0] - t.to_plane.want) <= 1e-9 * (1 + Math.abs(t.to_plane.want))))
         errs.push(`point to plane ${JSON.stringify(t.to_plane)}`);
       if (!(t.help > 200)) errs.push("no help text");

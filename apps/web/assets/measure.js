@@ -1,7 +1,7 @@
 // measure.js — the measuring tool (docs/WEB.md, "The page"): while it is on (the Measure button or the M key),
 // clicks pick without selecting and the first two picked points give their distance in scene
 // units (glTF: metres) and its X, Y, Z parts, and the last point's distance to each section plane
-// in use; a third click starts again. The points and the line
+// in use; a third click starts again, Esc takes them away. The points and the line
 // between them are drawn over the canvas where window.sy.project puts them, every display frame.
 "use strict";
 (function () {
@@ -36,6 +36,12 @@
     note.textContent = on ? "click two points on the model" : "Measure (or M), then click two points";
   }
   m.setActive = setActive;
+  // Esc: leaves measuring and takes the points and the line away (the button alone keeps them)
+  function clear() {
+    setActive(false);
+    m.points = []; m.distance = null;
+    show();
+  }
   const fmt = (x) => Math.abs(x) >= 1e4 || (Math.abs(x) < 1e-3 && x) ? x.toExponential(4) : x.toFixed(4);
   function show() {
     out.textContent = "";
@@ -65,7 +71,7 @@
   window.addEventListener("keydown", function (e) {
     if (e.target && /^(INPUT|SELECT|TEXTAREA)$/.test(e.target.tagName)) return;
     if (e.key === "m" || e.key === "M") setActive(!m.active);
-    else if (e.key === "Escape") setActive(false);
+    else if (e.key === "Escape") clear();
   });
   // the overlay follows the view every display frame
   function place(node, q, show) { node.style.display = show && q ? "" : "none"; return q; }

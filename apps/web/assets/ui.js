@@ -111,7 +111,7 @@
     ["Touch", ""], ["one finger", "orbit"], ["two fingers", "pan (move together) and zoom (pinch)"], ["tap", "pick"],
     ["Keys", ""], ["1 - 9", "the back-end at that position of the menu"], ["F", "next display filter"],
     ["[ and ]", "halve / double the filter's threshold"], ["R", "back to the first view"],
-    ["M", "measure: click two points, their distance in scene units"], ["Esc", "leave measuring; close this help"],
+    ["M", "measure: click two points, their distance in scene units"], ["Esc", "leave measuring (the points go); close this help"],
     ["?", "this help"], ["space", "play / pause the scene (when it moves: the timeline at the bottom scrubs it)"],
     ["Panel", ""], ["☰", "show / hide the panel"], ["Screenshot", "downloads a JPEG of the view at the canvas' size"],
     ["Measure", "click two points: their distance"], ["tree", "the check box shows / hides a node, a click on its name selects it"],
