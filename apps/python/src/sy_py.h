@@ -82,9 +82,17 @@ typedef struct render_job {
     sy_layer out;
 } render_job;
 
+/* A heap type's spec (spec, a PyType_Spec of the module: switchyard._switchyard.NAME, instances of
+ * OBJ, FLAGS) and its slots, the {Py_..., value} pairs that follow (the end marker added). */
+#define SY_PY_TYPE_SPEC(spec, name, obj, flags, ...)                                                        \
+    static PyType_Slot spec##_slots[] = {__VA_ARGS__, {0, NULL}};                                           \
+    PyType_Spec spec = {"switchyard._switchyard." name, sizeof(obj), 0, flags, spec##_slots}
+
 /* sy_py_module.c */
 /* sy_result -> the switchyard.Error subclass (None result: NULL with the exception set) */
 PyObject *sy_py_raise(sy_result r, const sy_error *e);
+/* SY_OK -> None (a new reference), else sy_py_raise */
+PyObject *sy_py_none_or_raise(sy_result r, const sy_error *e);
 PyObject *sy_py_set_errors(PyObject *self, PyObject *args);
 PyObject *sy_py_set_log(PyObject *self, PyObject *args);
 /* the end of every dealloc of a heap type: free the object, release the type */
@@ -101,6 +109,9 @@ extern PyType_Spec sy_py_blobview_spec;
 
 /* sy_py_scene.c */
 sy_scene *sy_py_scene_use(SceneObject *s);
+/* The scene of a call whose one argument is an object id (*id); NULL with an exception for bad
+ * arguments or a closed scene */
+sy_scene *sy_py_scene_id_arg(PyObject *self, PyObject *args, unsigned int *id);
 PyObject *sy_py_load(PyObject *self, PyObject *args, PyObject *kw);
 int sy_py_get_array(PyObject *obj, const char *what, char code, Py_ssize_t cols, int max_ndim, Py_buffer *view,
                     Py_ssize_t *count);

@@ -49,13 +49,9 @@ static int buffer_get(PyObject *self, Py_buffer *view, int flags)
     return export_view(self, view, b->data, 0, "f", b->ndim, b->shape, b->strides);
 }
 
-static PyType_Slot buffer_slots[] = {
-    {Py_tp_dealloc, buffer_dealloc},
-    {Py_bf_getbuffer, buffer_get},
-    {Py_tp_doc, "float32 pixels owned by the library's allocation (numpy.asarray views it without a copy)"},
-    {0, NULL}};
-PyType_Spec sy_py_buffer_spec = {"switchyard._switchyard._Buffer", sizeof(BufferObject), 0, Py_TPFLAGS_DEFAULT,
-                                  buffer_slots};
+SY_PY_TYPE_SPEC(sy_py_buffer_spec, "_Buffer", BufferObject, Py_TPFLAGS_DEFAULT, {Py_tp_dealloc, buffer_dealloc},
+                {Py_bf_getbuffer, buffer_get},
+                {Py_tp_doc, "float32 pixels owned by the library's allocation (numpy.asarray views it without a copy)"});
 
 /* Takes ownership of data (free()d with the object, or here on failure): rows x cols x channels
  * (channels 1: a 2-D array). */
@@ -111,13 +107,9 @@ static int blobview_get(PyObject *self, Py_buffer *view, int flags)
     return export_view(self, view, (void *)sy_blob_data(b->blob), 1, b->format, b->ndim, b->shape, b->strides);
 }
 
-static PyType_Slot blobview_slots[] = {
-    {Py_tp_dealloc, blobview_dealloc},
-    {Py_bf_getbuffer, blobview_get},
-    {Py_tp_doc, "a read-only view of a mesh's blob (numpy.asarray views it without a copy)"},
-    {0, NULL}};
-PyType_Spec sy_py_blobview_spec = {"switchyard._switchyard._BlobView", sizeof(BlobViewObject), 0, Py_TPFLAGS_DEFAULT,
-                                    blobview_slots};
+SY_PY_TYPE_SPEC(sy_py_blobview_spec, "_BlobView", BlobViewObject, Py_TPFLAGS_DEFAULT, {Py_tp_dealloc, blobview_dealloc},
+                {Py_bf_getbuffer, blobview_get},
+                {Py_tp_doc, "a read-only view of a mesh's blob (numpy.asarray views it without a copy)"});
 
 /* A view of blob as rows of cols 4-byte values (code 'f' or 'I'; cols 1: flat); None for NULL. */
 static PyObject *blobview_of(sy_blob *blob, char code, Py_ssize_t cols)
@@ -139,8 +131,7 @@ static PyObject *blobview_of(sy_blob *blob, char code, Py_ssize_t cols)
 PyObject *sy_py_scene_mesh(PyObject *self, PyObject *args)
 {
     unsigned int id;
-    if (!PyArg_ParseTuple(args, "I", &id)) return NULL;
-    sy_scene *sc = sy_py_scene_use((SceneObject *)self);
+    sy_scene *sc = sy_py_scene_id_arg(self, args, &id);
     if (!sc) return NULL;
     const sy_mesh_data *d = sy_mesh_get(sc, (sy_mesh){id});
     if (!d) return sy_py_stale("mesh", id);

@@ -20,6 +20,12 @@ PyObject *sy_py_raise(sy_result r, const sy_error *e)
     return NULL;
 }
 
+PyObject *sy_py_none_or_raise(sy_result r, const sy_error *e)
+{
+    if (r != SY_OK) return sy_py_raise(r, e);
+    Py_RETURN_NONE;
+}
+
 PyObject *sy_py_set_errors(PyObject *self, PyObject *args)
 {
     (void)self;

@@ -147,15 +147,13 @@ static PyGetSetDef node_getset[] = {
     {"scale", node_get_trs, node_set_trs, "TRS scale (x, y, z)", (void *)2},
     {NULL, NULL, NULL, NULL, NULL}};
 
-static PyType_Slot node_slots[] = {{Py_tp_dealloc, node_dealloc},
-                                   {Py_tp_new, node_new},
-                                   {Py_tp_traverse, node_traverse},
-                                   {Py_tp_clear, node_clear},
-                                   {Py_tp_getset, node_getset},
-                                   {Py_tp_doc, "the C base of switchyard.Node (scene, id, the TRS fields)"},
-                                   {0, NULL}};
-PyType_Spec sy_py_node_spec = {"switchyard._switchyard._Node", sizeof(NodeObject), 0,
-                                Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE | Py_TPFLAGS_HAVE_GC, node_slots};
+SY_PY_TYPE_SPEC(sy_py_node_spec, "_Node", NodeObject, Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE | Py_TPFLAGS_HAVE_GC,
+                {Py_tp_dealloc, node_dealloc},
+                {Py_tp_new, node_new},
+                {Py_tp_traverse, node_traverse},
+                {Py_tp_clear, node_clear},
+                {Py_tp_getset, node_getset},
+                {Py_tp_doc, "the C base of switchyard.Node (scene, id, the TRS fields)"});
 
 /* _bench_trs(scene_c, id, n) -> (wall seconds, thread CPU seconds): n calls of sy_node_set_trs from C (translation x = i), the
  * C side of the call-overhead comparison (apps/python/bench_overhead.py); not a public name. */
@@ -217,16 +215,31 @@ static const field_desc camera_fields[] = {
     SY_PY_FIELD(sy_camera_data, ymag, 'f', 1), {NULL, 0, 0, 0}};
 #undef SY_PY_FIELD
 
-/* The field table and current values (a copy in *data) of a material, light or camera; NULL with an
- * exception for another type or a stale id. */
+/* The field table and current values (a copy in *data) of the material, light or camera that args
+ * (type, id) name, with its scene and type in *sc and *type; NULL with an exception for bad
+ * arguments, a closed scene, another type or a stale id. */
 typedef union object_data {
     sy_material_data material;
     sy_light_data light;
     sy_camera_data camera;
 } object_data;
 
-static const field_desc *object_fields(sy_scene *sc, int type, unsigned id, object_data *data)
+/* An object that a call names: its scene, type, id and a copy of its data */
+typedef struct object_ref {
+    sy_scene *sc;
+    int type;
+    unsigned int id;
+    object_data d;
+} object_ref;
+
+static const field_desc *object_fields(PyObject *self, PyObject *args, object_ref *o)
 {
+    if (!PyArg_ParseTuple(args, "iI", &o->type, &o->id)) return NULL;
+    sy_scene *sc = o->sc = sy_py_scene_use((SceneObject *)self);
+    if (!sc) return NULL;
+    int type = o->type;
+    unsigned int id = o->id;
+    object_data *data = &o->d;
     const void *cur = NULL;
     size_t size = 0;
     const field_desc *t = NULL;
@@ -244,14 +257,10 @@ static const field_desc *object_fields(sy_scene *sc, int type, unsigned id, obje
 /* _get(type, id) -> dict of the fields (and "name") */
 PyObject *sy_py_scene_get_fields(PyObject *self, PyObject *args)
 {
-    int type;
-    unsigned int id;
-    if (!PyArg_ParseTuple(args, "iI", &type, &id)) return NULL;
-    sy_scene *sc = sy_py_scene_use((SceneObject *)self);
-    if (!sc) return NULL;
-    object_data d;
-    const field_desc *t = object_fields(sc, type, id, &d);
+    object_ref o;
+    const field_desc *t = object_fields(self, args, &o);
     if (!t) return NULL;
+    const object_data d = o.d;
     PyObject *dict = Py_BuildValue("{s:z}", "name", *(char *const *)&d); /* every struct starts with its name */
     for (; dict && t->name; ++t) {
         const char *p = (const char *)&d + t->offset;
@@ -268,14 +277,13 @@ PyObject *sy_py_scene_get_fields(PyObject *self, PyObject *args)
  * (which validates: a NaN roughness or a zfar before znear raises InvalidArgumentError) */
 PyObject *sy_py_scene_set_fields(PyObject *self, PyObject *args, PyObject *kw)
 {
-    int type;
-    unsigned int id;
-    if (!PyArg_ParseTuple(args, "iI", &type, &id)) return NULL;
-    sy_scene *sc = sy_py_scene_use((SceneObject *)self);
-    if (!sc) return NULL;
-    object_data d;
-    const field_desc *table = object_fields(sc, type, id, &d);
+    object_ref o;
+    const field_desc *table = object_fields(self, args, &o);
     if (!table) return NULL;
+    object_data d = o.d;
+    sy_scene *sc = o.sc;
+    int type = o.type;
+    unsigned int id = o.id;
     PyObject *key, *value;
     Py_ssize_t pos = 0;
     while (kw && PyDict_Next(kw, &pos, &key, &value)) {
@@ -302,8 +310,7 @@ PyObject *sy_py_scene_set_fields(PyObject *self, PyObject *args, PyObject *kw)
     sy_result r = type == SY_TYPE_MATERIAL ? sy_material_set(sc, (sy_material){id}, &d.material, &err)
                   : type == SY_TYPE_LIGHT  ? sy_light_set(sc, (sy_light){id}, &d.light, &err)
                                            : sy_camera_set(sc, (sy_camera){id}, &d.camera, &err);
-    if (r != SY_OK) return sy_py_raise(r, &err);
-    Py_RETURN_NONE;
+    return sy_py_none_or_raise(r, &err);
 }
 
 /* _info() -> dict(root, camera, background, counts) */
@@ -322,9 +329,8 @@ PyObject *sy_py_scene_info(PyObject *self, PyObject *unused)
 PyObject *sy_py_scene_set_camera(PyObject *self, PyObject *args)
 {
     unsigned int id;
-    if (!PyArg_ParseTuple(args, "I", &id)) return NULL;
     SceneObject *s = (SceneObject *)self;
-    sy_scene *sc = sy_py_scene_use(s);
+    sy_scene *sc = sy_py_scene_id_arg(self, args, &id);
     if (!sc) return NULL;
     const sy_node_data *d = id ? sy_node_get(sc, (sy_node){id}) : NULL;
     if (id && !d) return sy_py_stale("node", id);
@@ -342,6 +348,5 @@ PyObject *sy_py_scene_commit(PyObject *self, PyObject *unused)
     if (!sc) return NULL;
     sy_error err = {0};
     sy_result r = sy_scene_commit(sc, NULL, &err);
-    if (r != SY_OK) return sy_py_raise(r, &err);
-    Py_RETURN_NONE;
+    return sy_py_none_or_raise(r, &err);
 }

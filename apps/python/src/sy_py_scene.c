@@ -21,6 +21,11 @@ sy_scene *sy_py_scene_use(SceneObject *s)
     return s->ld.scene;
 }
 
+sy_scene *sy_py_scene_id_arg(PyObject *self, PyObject *args, unsigned int *id)
+{
+    return PyArg_ParseTuple(args, "I", id) ? sy_py_scene_use((SceneObject *)self) : NULL;
+}
+
 static void scene_dealloc(PyObject *self)
 {
     SceneObject *s = (SceneObject *)self;
@@ -438,8 +443,7 @@ static PyObject *scene_destroy_object(PyObject *self, PyObject *args)
     sy_error err = {0};
     sy_result r = type < 0 || type >= SY_TYPE_COUNT ? sy_error_set(&err, SY_ERR_INVALID_ARGUMENT, "object type %d", type)
                                                     : sy_object_destroy(sc, (sy_object_type)type, id, &err);
-    if (r != SY_OK) return sy_py_raise(r, &err);
-    Py_RETURN_NONE;
+    return sy_py_none_or_raise(r, &err);
 }
 
 /* _ids(type) -> list of live ids; _valid(type, id) -> bool */
@@ -480,8 +484,7 @@ PyObject *sy_py_stale(const char *what, unsigned id)
 static PyObject *scene_node(PyObject *self, PyObject *args)
 {
     unsigned int id;
-    if (!PyArg_ParseTuple(args, "I", &id)) return NULL;
-    sy_scene *sc = sy_py_scene_use((SceneObject *)self);
+    sy_scene *sc = sy_py_scene_id_arg(self, args, &id);
     if (!sc) return NULL;
     const sy_node_data *d = sy_node_get(sc, (sy_node){id});
     if (!d) return sy_py_stale("node", id);
@@ -544,8 +547,7 @@ static PyObject *scene_node_set(PyObject *self, PyObject *args, PyObject *kw)
     SY_PY_ID(flags, sy_node_set_flags(sc, n, (uint32_t)v, &err))
     SY_PY_ID(child, sy_node_add_child(sc, n, (sy_node){(uint32_t)v}, &err))
 #undef SY_PY_ID
-    if (r != SY_OK) return sy_py_raise(r, &err);
-    Py_RETURN_NONE;
+    return sy_py_none_or_raise(r, &err);
 }
 
 static PyObject *scene_set_time(PyObject *self, PyObject *args)
@@ -578,10 +580,8 @@ static PyMethodDef scene_methods[] = {
     {"_render", (PyCFunction)(void (*)(void))sy_py_scene_render, METH_VARARGS | METH_KEYWORDS, NULL},
     {NULL, NULL, 0, NULL}};
 
-static PyType_Slot scene_slots[] = {{Py_tp_dealloc, scene_dealloc},
-                                    {Py_tp_new, scene_new},
-                                    {Py_tp_methods, scene_methods},
-                                    {Py_tp_doc, "the library's sy_scene (switchyard.Scene wraps it)"},
-                                    {0, NULL}};
-PyType_Spec sy_py_scene_spec = {"switchyard._switchyard._Scene", sizeof(SceneObject), 0,
-                                 Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE, scene_slots};
+SY_PY_TYPE_SPEC(sy_py_scene_spec, "_Scene", SceneObject, Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE,
+                {Py_tp_dealloc, scene_dealloc},
+                {Py_tp_new, scene_new},
+                {Py_tp_methods, scene_methods},
+                {Py_tp_doc, "the library's sy_scene (switchyard.Scene wraps it)"});

@@ -119,10 +119,9 @@ static PyMethodDef web_methods[] = {
     {"stop", web_stop_method, METH_NOARGS, "Stops serving, joins the server's thread, frees the server."},
     {"_info", web_info, METH_NOARGS, NULL},
     {NULL, NULL, 0, NULL}};
-static PyType_Slot web_slots[] = {{Py_tp_dealloc, web_dealloc},
-                                  {Py_tp_new, web_new},
-                                  {Py_tp_methods, web_methods},
-                                  {Py_tp_doc, "the web view of a _Scene (sy_web, served by a thread of its own)"},
-                                  {0, NULL}};
-PyType_Spec sy_py_web_spec = {"switchyard._switchyard._Web", sizeof(WebObject), 0, Py_TPFLAGS_DEFAULT, web_slots};
+SY_PY_TYPE_SPEC(sy_py_web_spec, "_Web", WebObject, Py_TPFLAGS_DEFAULT,
+                {Py_tp_dealloc, web_dealloc},
+                {Py_tp_new, web_new},
+                {Py_tp_methods, web_methods},
+                {Py_tp_doc, "the web view of a _Scene (sy_web, served by a thread of its own)"});
 #endif

@@ -83,21 +83,27 @@ static PyObject *window_close(PyObject *self, PyObject *unused)
 /* _add_viewport(backend=None, params=None, x=0, y=0, width=0, height=0, root=-1, camera=-1,
  * background=-1, eye=0, eye_separation=0, zero_parallax=0, composite=0, active=True) -> index.
  * root / camera / background -1: the scene's own (as loaded). */
-/* servers= of a viewport: backend / params become a cluster class over them (cluster_setup, as
- * Scene.render's servers=); the buffers hold the result. 0, or -1 with an exception. */
-static int viewport_cluster(const char *servers, const char *mode, const char *secret_file, const char **backend,
-                            const char **params, char *name, size_t name_len, char *cparams, size_t cparams_len)
+/* The back-end and params of a viewport: with servers= they become a cluster class over them
+ * (cluster_setup, as Scene.render's servers=; the buffers hold the result); either must fit the
+ * window's records (w->backends, w->params). 0, or -1 with an exception. */
+static int viewport_backend(const WindowObject *w, const char *servers, const char *mode, const char *secret_file,
+                            const char **backend, const char **params, char *name, size_t name_len, char *cparams,
+                            size_t cparams_len)
 {
-    if (!servers) return 0;
-    uint64_t unused = 0;
-    const sy_mediator_class *cls;
-    sy_params pp;
-    uint32_t caps;
-    if (sy_py_check_backend(*backend, *params, &pp, &cls, &caps) || /* the back-end the servers run */
-        sy_py_cluster_setup(servers, mode, secret_file, *backend, *params, name, name_len, cparams, cparams_len, &unused))
-        return -1;
-    *backend = name;
-    *params = cparams;
+    if (servers) {
+        uint64_t unused = 0;
+        const sy_mediator_class *cls;
+        sy_params pp;
+        uint32_t caps;
+        if (sy_py_check_backend(*backend, *params, &pp, &cls, &caps) || /* the back-end the servers run */
+            sy_py_cluster_setup(servers, mode, secret_file, *backend, *params, name, name_len, cparams, cparams_len,
+                                &unused))
+            return -1;
+        *backend = name;
+        *params = cparams;
+    }
+    if (strlen(*backend) >= sizeof w->backends[0] || (*params && strlen(*params) >= sizeof w->params[0]))
+        return PyErr_Format(PyExc_ValueError, "backend or params too long"), -1;
     return 0;
 }
 
@@ -120,11 +126,9 @@ static PyObject *window_add_viewport(PyObject *self, PyObject *args, PyObject *k
     if (w->count >= SY_PY_MAX_VIEWPORTS) return PyErr_Format(PyExc_ValueError, "at most %d viewports", SY_PY_MAX_VIEWPORTS);
     if (!backend) backend = sy_mediator_default_name();
     char cname[32], cparams[SY_PY_PARAMS_MAX];
-    if (viewport_cluster(servers, cluster_mode, secret_file, &backend, &params, cname, sizeof cname, cparams,
+    if (viewport_backend(w, servers, cluster_mode, secret_file, &backend, &params, cname, sizeof cname, cparams,
                          sizeof cparams))
         return NULL;
-    if (strlen(backend) >= sizeof w->backends[0] || (params && strlen(params) >= sizeof w->params[0]))
-        return PyErr_Format(PyExc_ValueError, "backend or params too long");
     loaded *ld = &w->scene->ld;
     sy_viewport_desc d = {.x = x, .y = y, .width = vw, .height = vh,
                           .root = {root < 0 ? ld->root.id : (uint32_t)root},
@@ -160,6 +164,15 @@ static sy_viewport *window_vp_arg(PyObject *self, PyObject *args, unsigned int *
     return window_vp((WindowObject *)self, i);
 }
 
+/* The viewport and the value of a setter's call (index, value): *value borrowed. NULL with the
+ * exception set. */
+static sy_viewport *window_vp_value(PyObject *self, PyObject *args, PyObject **value)
+{
+    unsigned int i;
+    if (!PyArg_ParseTuple(args, "IO", &i, value)) return NULL;
+    return window_vp((WindowObject *)self, i);
+}
+
 /* _set_backend(index, backend, params=None): switches a live viewport (its old context stays cached) */
 static PyObject *window_set_backend(PyObject *self, PyObject *args)
 {
@@ -170,11 +183,9 @@ static PyObject *window_set_backend(PyObject *self, PyObject *args)
     sy_viewport *vp = window_vp(w, i);
     if (!vp) return NULL;
     char cname[32], cparams[SY_PY_PARAMS_MAX];
-    if (viewport_cluster(servers, cluster_mode, secret_file, &backend, &params, cname, sizeof cname, cparams,
+    if (viewport_backend(w, servers, cluster_mode, secret_file, &backend, &params, cname, sizeof cname, cparams,
                          sizeof cparams))
         return NULL;
-    if (strlen(backend) >= sizeof w->backends[0] || (params && strlen(params) >= sizeof w->params[0]))
-        return PyErr_Format(PyExc_ValueError, "backend or params too long");
     sy_error err = {0};
     sy_result r = sy_viewport_set_backend(vp, backend, params, &err);
     if (r != SY_OK) return sy_py_raise(r, &err);
@@ -205,39 +216,13 @@ static PyObject *window_set_active(PyObject *self, PyObject *args)
     Py_RETURN_NONE;
 }
 
-/* Reads n floats of a sequence into out; a Python error (naming what) and -1 otherwise. */
-static int floats_of(PyObject *seq, float *out, Py_ssize_t n, const char *what, Py_ssize_t index)
-{
-    Py_ssize_t len = PySequence_Check(seq) ? PySequence_Size(seq) : -1;
-    if (len < 0) {
-        PyErr_Clear();
-        PyErr_Format(PyExc_TypeError, "%s %zd: a sequence of %zd numbers expected", what, index, n);
-        return -1;
-    }
-    if (len != n) {
-        PyErr_Format(PyExc_ValueError, "%s %zd: %zd numbers expected, got %zd", what, index, n, len);
-        return -1;
-    }
-    for (Py_ssize_t k = 0; k < n; ++k) {
-        PyObject *item = PySequence_GetItem(seq, k);
-        double d = item ? PyFloat_AsDouble(item) : -1.0;
-        Py_XDECREF(item);
-        if (d == -1.0 && PyErr_Occurred()) return -1;
-        out[k] = (float)d;
-    }
-    return 0;
-}
-
 /* _set_clip_planes(index, planes): planes a sequence of up to 6 (a, b, c, d); [] removes them.
  * The library checks them (sy_viewport_set_clip_planes): NaN, infinite, a zero normal, a seventh
  * plane raise its InvalidArgument error naming the plane; the planes before stay. */
 static PyObject *window_set_clip_planes(PyObject *self, PyObject *args)
 {
-    WindowObject *w = (WindowObject *)self;
-    unsigned int i;
     PyObject *seq;
-    if (!PyArg_ParseTuple(args, "IO", &i, &seq)) return NULL;
-    sy_viewport *vp = window_vp(w, i);
+    sy_viewport *vp = window_vp_value(self, args, &seq);
     if (!vp) return NULL;
     Py_ssize_t total = PySequence_Check(seq) ? PySequence_Size(seq) : -1;
     if (total < 0) {
@@ -247,8 +232,10 @@ static PyObject *window_set_clip_planes(PyObject *self, PyObject *args)
     float planes[SY_CLIP_PLANES_MAX + 1][4];
     Py_ssize_t n = total > SY_CLIP_PLANES_MAX + 1 ? SY_CLIP_PLANES_MAX + 1 : total; /* the library names the count */
     for (Py_ssize_t k = 0; k < n; ++k) {
+        char what[32];
+        snprintf(what, sizeof what, "clip plane %zd", k);
         PyObject *item = PySequence_GetItem(seq, k);
-        int bad = !item || floats_of(item, planes[k], 4, "clip plane", k);
+        int bad = !item || sy_py_float_seq(item, what, planes[k], 4);
         Py_XDECREF(item);
         if (bad) return NULL;
     }
@@ -256,8 +243,7 @@ static PyObject *window_set_clip_planes(PyObject *self, PyObject *args)
     sy_result r = total > SY_CLIP_PLANES_MAX
                       ? sy_clip_planes_check((const float(*)[4])planes, (uint32_t)total, &err)
                       : sy_viewport_set_clip_planes(vp, (const float(*)[4])planes, (uint32_t)n, &err);
-    if (r != SY_OK) return sy_py_raise(r, &err);
-    Py_RETURN_NONE;
+    return sy_py_none_or_raise(r, &err);
 }
 
 /* _clip_planes(index) -> list of (a, b, c, d) */
@@ -270,8 +256,7 @@ static PyObject *window_clip_planes(PyObject *self, PyObject *args)
     uint32_t n = sy_viewport_clip_planes(vp, planes);
     PyObject *list = PyList_New((Py_ssize_t)n);
     for (uint32_t k = 0; list && k < n; ++k) {
-        PyObject *t = Py_BuildValue("(dddd)", (double)planes[k][0], (double)planes[k][1], (double)planes[k][2],
-                                    (double)planes[k][3]);
+        PyObject *t = sy_py_tuple_of(planes[k], 4);
         if (!t || PyList_SetItem(list, k, t)) {
             Py_DECREF(list);
             return NULL;
@@ -283,18 +268,14 @@ static PyObject *window_clip_planes(PyObject *self, PyObject *args)
 /* _set_clip_cap(index, rgb or None): the section caps' linear RGB colour, or off */
 static PyObject *window_set_clip_cap(PyObject *self, PyObject *args)
 {
-    WindowObject *w = (WindowObject *)self;
-    unsigned int i;
     PyObject *rgb;
-    if (!PyArg_ParseTuple(args, "IO", &i, &rgb)) return NULL;
-    sy_viewport *vp = window_vp(w, i);
+    sy_viewport *vp = window_vp_value(self, args, &rgb);
     if (!vp) return NULL;
     float c[3];
-    if (rgb != Py_None && floats_of(rgb, c, 3, "clip cap colour", 0)) return NULL;
+    if (rgb != Py_None && sy_py_float_seq(rgb, "clip cap colour", c, 3)) return NULL;
     sy_error err = {0};
     sy_result r = sy_viewport_set_clip_cap(vp, rgb == Py_None ? NULL : c, &err);
-    if (r != SY_OK) return sy_py_raise(r, &err);
-    Py_RETURN_NONE;
+    return sy_py_none_or_raise(r, &err);
 }
 
 /* _clip_cap(index) -> (r, g, b) or None */
@@ -305,7 +286,7 @@ static PyObject *window_clip_cap(PyObject *self, PyObject *args)
     if (!vp) return NULL;
     float c[3];
     if (!sy_viewport_clip_cap(vp, c)) Py_RETURN_NONE;
-    return Py_BuildValue("(ddd)", (double)c[0], (double)c[1], (double)c[2]);
+    return sy_py_tuple_of(c, 3);
 }
 
 /* _render(spp=0, seed=0, aovs=False, progress=None) -> (rgba, aovs or None, samples of viewport 0).
@@ -360,10 +341,8 @@ static PyMethodDef window_methods[] = {
     {"_render", (PyCFunction)(void (*)(void))window_render, METH_VARARGS | METH_KEYWORDS, NULL},
     {NULL, NULL, 0, NULL}};
 
-static PyType_Slot window_slots[] = {{Py_tp_dealloc, window_dealloc},
-                                     {Py_tp_new, window_new},
-                                     {Py_tp_methods, window_methods},
-                                     {Py_tp_doc, "the library's sy_window with its own context pool"},
-                                     {0, NULL}};
-PyType_Spec sy_py_window_spec = {"switchyard._switchyard._Window", sizeof(WindowObject), 0,
-                                  Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE, window_slots};
+SY_PY_TYPE_SPEC(sy_py_window_spec, "_Window", WindowObject, Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE,
+                {Py_tp_dealloc, window_dealloc},
+                {Py_tp_new, window_new},
+                {Py_tp_methods, window_methods},
+                {Py_tp_doc, "the library's sy_window with its own context pool"});
