@@ -51,15 +51,23 @@ void sy_context_restart(sy_context *c);
  * time; time_samples: the fewest samples per pixel of back-ends with a fixed count, 0 = their
  * default); then sy_context_motion_end (the context stays at T0, sharp). Meshes deformed between T1
  * and T0 (skins, morphs) are interpolated too, vertex by vertex. *native false from _open: the
- * changes hold what the back-end cannot interpolate (moved lights, meshes made anew; the camera is
- * never interpolated: the request's camera is used for every ray): call
- * sy_context_motion_end and blur another way (sub-frames). Errors leave the motion ended.
- * Thread-safety: as sy_context_render. */
+ * changes hold what the back-end cannot interpolate (moved lights, meshes made anew): call
+ * sy_context_motion_end and blur another way (sub-frames). The request's camera is the open's; a
+ * camera that moves over the shutter is given at its close with sy_context_motion_camera after
+ * _open. Errors leave the motion ended. Thread-safety: as sy_context_render. */
 sy_result sy_context_motion_begin(sy_context *c, uint32_t time_samples, sy_error *err);
 /** The second step of motion blur (see sy_context_motion_begin): syncs the scene committed at the
  * shutter's open; *native says whether the back-end interpolates every change. Thread-safety: as
  * sy_context_render. */
 sy_result sy_context_motion_open(sy_context *c, bool *native, sy_error *err);
+/** A camera that moves over the shutter (after sy_context_motion_open; see sy_context_motion_begin):
+ * open and close are the view at the shutter's open and close; a render request whose camera is open
+ * has each camera ray built at its own time, position and window interpolated linearly, orientation
+ * by slerp, until sy_context_motion_end (requests with another camera, a stereo eye, stay still). SY_ERR_UNSUPPORTED naming the back-end when its class does not interpolate
+ * the camera (then blur another way), SY_ERR_INVALID_ARGUMENT when the motion is not open. On error
+ * the motion stays as it was. Thread-safety: as sy_context_render. */
+sy_result sy_context_motion_camera(sy_context *c, const sy_camera_view *open, const sy_camera_view *close,
+                                  sy_error *err);
 /** Ends motion blur (see sy_context_motion_begin): the context renders sharp again. Thread-safety:
  * as sy_context_render. */
 void sy_context_motion_end(sy_context *c);

@@ -262,12 +262,14 @@ static void blur_add(sy_layer *acc, const sy_layer *l, float weight)
  * at the shutter's close, synced, then at its open, synced (sy_context_motion_begin / _open): every
  * instance moved in between is interpolated linearly from open to close by each ray's own time. True
  * with *ctx_out the main context in motion (the caller renders once, then sy_context_motion_end);
- * Deformed meshes (skins, morph targets) are interpolated too, vertex by vertex. False when the
- * back-end lacks it, or (a note says why) the scene also moves lights, makes meshes anew or moves the
- * camera over the shutter: then the motion is ended and the caller blurs by sub-frames. */
+ * Deformed meshes (skins, morph targets) are interpolated too, vertex by vertex, and a camera that
+ * moves (*motion_camera true: sy_context_motion_camera, each camera ray at its time). False when the
+ * back-end lacks it, or (a note says why) the scene also moves lights, makes meshes anew, or moves the
+ * camera of a stereo render or of a back-end that cannot move it: then the motion is ended and the
+ * caller blurs by sub-frames. */
 static bool motion_native_begin(loaded *ld, const char *clip, double frame_time, const sy_shutter *sh,
                                 const sy_compose_spec *spec, uint32_t w, uint32_t h, sy_context_pool *pool,
-                                sy_context **ctx_out)
+                                sy_context **ctx_out, bool *motion_camera)
 {
     sy_params rp;
     sy_context *c = NULL;
@@ -277,27 +279,35 @@ static bool motion_native_begin(loaded *ld, const char *clip, double frame_time,
         !(sy_context_caps(c) & SY_CAP_MOTION))
         return false;
     sy_context_restart(c); /* placed as a fresh build places them, accumulation from sample 0 */
-    bool native = false, camera_moves = false;
-    sy_camera_view v_close, v_open; /* the camera is not interpolated: it must stay put */
+    bool native = false, camera_moves = false, camera_stays = false;
+    sy_camera_view v_close, v_open; /* the camera's two ends: each camera ray at its own time between them */
     memset(&v_close, 0, sizeof v_close);
     memset(&v_open, 0, sizeof v_open);
+    sy_error ce = {0};
     if (sy_cli_set_time(ld, clip, frame_time + sh->close, &e) == 0 &&
         sy_compose_camera_view(ld->scene, spec, w, h, &v_close, &e) == SY_OK &&
         sy_context_motion_begin(c, sh->samples, &e) == SY_OK &&
         sy_cli_set_time(ld, clip, frame_time + sh->open, &e) == 0 &&
         sy_compose_camera_view(ld->scene, spec, w, h, &v_open, &e) == SY_OK &&
-        !(camera_moves = memcmp(&v_close, &v_open, sizeof v_open) != 0) &&
         sy_context_motion_open(c, &native, &e) == SY_OK && native) {
-        *ctx_out = c;
-        return true;
+        camera_moves = memcmp(&v_close, &v_open, sizeof v_open) != 0;
+        /* a moving camera: the back-end builds each camera ray at its time (the mono view only: stereo
+         * eyes are other views) */
+        if (!camera_moves || (spec->stereo == SY_STEREO_NONE && sy_context_motion_camera(c, &v_open, &v_close, &ce) == SY_OK)) {
+            *motion_camera = camera_moves;
+            *ctx_out = c;
+            return true;
+        }
+        camera_stays = true;
     }
     sy_context_motion_end(c);
     sy_context_restart(c);
     sy_log(SY_LOG_NOTE, "sy", NULL, "motion blur: %s; blurring by sub-frames instead",
-           e.message[0]  ? e.message
-           : camera_moves ? "the camera moves over the shutter, which the back-end does not interpolate"
-                          : "the scene moves lights or makes meshes anew over the shutter, which the back-end does "
-                            "not interpolate");
+           e.message[0] ? e.message
+           : camera_stays
+               ? (spec->stereo != SY_STEREO_NONE ? "the camera moves over the shutter, which stereo eyes do not interpolate"
+                                                 : ce.message[0] ? ce.message : "the camera moves over the shutter")
+               : "the scene moves lights or makes meshes anew over the shutter, which the back-end does not interpolate");
     return false;
 }
 
@@ -310,13 +320,14 @@ static sy_result render_blurred(loaded *ld, const char *clip, double frame_time,
     double t0 = sy_time_now();
     sy_context *mc = NULL;
     *native_out = false;
-    if (!sub_frames && motion_native_begin(ld, clip, frame_time, sh, spec, w, h, pool, &mc)) {
+    bool moving_camera = false;
+    if (!sub_frames && motion_native_begin(ld, clip, frame_time, sh, spec, w, h, pool, &mc, &moving_camera)) {
         char each[64];
         if (po) snprintf(each, sizeof each, "each pixel sample");
         else snprintf(each, sizeof each, "each of at least %u samples per pixel", sh->samples);
         sy_log(SY_LOG_NOTE, "sy", NULL, "motion blur: one render, %s at its own time of the shutter %g..%g s after %g s "
-               "(moving objects and deforming meshes interpolated per ray; --sub-frames: the mean of sub-frames instead)", each, sh->open,
-               sh->close, frame_time);
+               "(moving objects%s and deforming meshes interpolated per ray; --sub-frames: the mean of sub-frames instead)", each, sh->open,
+               sh->close, frame_time, moving_camera ? ", the moving camera" : "");
         sy_result r;
         uint64_t total = 0;
         if (po) {

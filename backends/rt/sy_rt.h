@@ -609,6 +609,14 @@ typedef struct sy_rt_render_desc {
     struct sy_rt_stage_times *stage_times; /**< optional: ticks per stage of the path on a sampled
                                          * subset of the pixels are added here (backends/rt/
                                          * sy_rt_raylog.h >>stage timers); NULL = off */
+    /** WHITTED and PATHTRACER, optional (>>motion blur): the camera at ray time 1 (the shutter's
+     * close; the camera argument is time 0, the open). Each camera ray is built at its own time: the
+     * position, the window (field of view) and the near / far distances interpolated linearly, the
+     * orientation by quaternion slerp (a camera matrix whose axes are not orthogonal: its columns
+     * linearly); every pixel sample then has its own stratified time as with moving instances
+     * (Whitted: at least time_samples samples). Same projection as the camera. NULL, or a camera
+     * equal to the camera: a still camera, bit for bit the render without it. */
+    const sy_rt_camera *camera_close;
 } sy_rt_render_desc;
 
 /** Renders the sub-rectangle. rgba: width*height*4 floats (required); depth: width*height floats

@@ -10,19 +10,76 @@
 
 #define FAIL(r, ...) sy_rt_fail(dev, (r), __VA_ARGS__)
 
-sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_rt_camera *cam,
-                              const sy_rt_render_desc *d, float *rgba, float *depth)
+/* >>camera motion: a rotation as a unit quaternion (x, y, z, w) */
+
+/* The rotation of the camera's axes (columns x, y, z, with their lengths in *scale): false when they
+ * are not orthogonal or not right-handed (then the caller lerps the columns). */
+static bool orientation(sy_rt_v3 x, sy_rt_v3 y, sy_rt_v3 z, float q[4], sy_rt_v3 *scale)
 {
-    memset(f, 0, sizeof *f);
+    *scale = v3(v3_length(x), v3_length(y), v3_length(z));
+    if (!(scale->x > 0.0f) || !(scale->y > 0.0f) || !(scale->z > 0.0f)) return false;
+    sy_rt_v3 a = v3_scale(x, 1.0f / scale->x), b = v3_scale(y, 1.0f / scale->y), c = v3_scale(z, 1.0f / scale->z);
+    if (fabsf(v3_dot(a, b)) > 1e-3f || fabsf(v3_dot(a, c)) > 1e-3f || fabsf(v3_dot(b, c)) > 1e-3f ||
+        v3_dot(v3_cross(a, b), c) < 0.5f)
+        return false;
+    /* the matrix [a b c] (columns) to a quaternion (Shepperd: the largest of the four first) */
+    float m00 = a.x, m11 = b.y, m22 = c.z, tr = m00 + m11 + m22;
+    if (tr > 0.0f) {
+        float s = sqrtf(tr + 1.0f) * 2.0f;
+        q[3] = 0.25f * s, q[0] = (b.z - c.y) / s, q[1] = (c.x - a.z) / s, q[2] = (a.y - b.x) / s;
+    } else if (m00 > m11 && m00 > m22) {
+        float s = sqrtf(1.0f + m00 - m11 - m22) * 2.0f;
+        q[3] = (b.z - c.y) / s, q[0] = 0.25f * s, q[1] = (b.x + a.y) / s, q[2] = (c.x + a.z) / s;
+    } else if (m11 > m22) {
+        float s = sqrtf(1.0f + m11 - m00 - m22) * 2.0f;
+        q[3] = (c.x - a.z) / s, q[0] = (b.x + a.y) / s, q[1] = 0.25f * s, q[2] = (c.y + b.z) / s;
+    } else {
+        float s = sqrtf(1.0f + m22 - m00 - m11) * 2.0f;
+        q[3] = (a.y - b.x) / s, q[0] = (c.x + a.z) / s, q[1] = (c.y + b.z) / s, q[2] = 0.25f * s;
+    }
+    float n = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (int i = 0; i < 4; ++i) q[i] /= n;
+    return true;
+}
+
+/* Spherical linear interpolation of unit quaternions a and b (b on a's hemisphere) at t. */
+static void slerp(const float a[4], const float b[4], float t, float out[4])
+{
+    float d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+    float wa, wb;
+    if (d > 0.9995f) { /* nearly the same: lerp (normalised below) */
+        wa = 1.0f - t, wb = t;
+    } else {
+        float th = acosf(sy_rt_minf(d, 1.0f)), s = sinf(th);
+        wa = sinf((1.0f - t) * th) / s, wb = sinf(t * th) / s;
+    }
+    float n = 0.0f;
+    for (int i = 0; i < 4; ++i) out[i] = wa * a[i] + wb * b[i], n += out[i] * out[i];
+    n = sqrtf(n);
+    for (int i = 0; i < 4; ++i) out[i] /= n;
+}
+
+/* The unit axes (the rotation matrix's columns) of unit quaternion q. */
+static void quat_axes(const float q[4], sy_rt_v3 r[3])
+{
+    float x = q[0], y = q[1], z = q[2], w = q[3];
+    r[0] = v3(1.0f - 2.0f * (y * y + z * z), 2.0f * (x * y + w * z), 2.0f * (x * z - w * y));
+    r[1] = v3(2.0f * (x * y - w * z), 1.0f - 2.0f * (x * x + z * z), 2.0f * (y * z + w * x));
+    r[2] = v3(2.0f * (x * z + w * y), 2.0f * (y * z - w * x), 1.0f - 2.0f * (x * x + y * y));
+}
+
+/* The camera's numbers are usable (which: "" or "shutter close: ", before the messages). */
+static sy_rt_result camera_check(const sy_rt_device *dev, const sy_rt_camera *cam, const char *which)
+{
     for (int i = 0; i < 16; ++i)
         if (!isfinite(cam->camera_to_world[i]))
-            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: camera_to_world[%d] is not finite", i);
+            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: %scamera_to_world[%d] is not finite", which, i);
     if (cam->projection != SY_RT_PROJECTION_PERSPECTIVE && cam->projection != SY_RT_PROJECTION_ORTHOGRAPHIC)
-        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: unknown projection %d", (int)cam->projection);
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: %sunknown projection %d", which, (int)cam->projection);
     for (int i = 0; i < 4; ++i)
-        if (!isfinite(cam->window[i])) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: camera window[%d] is not finite", i);
+        if (!isfinite(cam->window[i])) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: %scamera window[%d] is not finite", which, i);
     if (!(cam->window[0] < cam->window[1]) || !(cam->window[2] < cam->window[3]))
-        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: camera window {%g, %g, %g, %g} needs left < right and bottom < top",
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: %scamera window {%g, %g, %g, %g} needs left < right and bottom < top", which,
                     (double)cam->window[0], (double)cam->window[1], (double)cam->window[2], (double)cam->window[3]);
     /* SY_RT_COORD_MAX: the farthest a camera ray starts (its position, plus the window for an
      * orthographic camera) */
@@ -35,14 +92,26 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
             reach += w * ax;
         }
         if (!(reach <= SY_RT_COORD_MAX))
-            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: camera rays would start up to %g away (camera at %g %g %g), "
-                        "beyond SY_RT_COORD_MAX (%g)", reach, (double)m[12], (double)m[13], (double)m[14],
+            return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: %scamera rays would start up to %g away (camera at %g %g %g), "
+                        "beyond SY_RT_COORD_MAX (%g)", which, reach, (double)m[12], (double)m[13], (double)m[14],
                         (double)SY_RT_COORD_MAX);
     }
     if (!isfinite(cam->near_clip) || cam->near_clip < 0.0f || !isfinite(cam->far_clip) || cam->far_clip < 0.0f ||
         (cam->far_clip > 0.0f && cam->far_clip <= cam->near_clip))
-        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: clip range near %g far %g is invalid (0 <= near < far, far 0 = infinite)",
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: %sclip range near %g far %g is invalid (0 <= near < far, far 0 = infinite)", which,
                     (double)cam->near_clip, (double)cam->far_clip);
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_rt_camera *cam,
+                              const sy_rt_render_desc *d, float *rgba, float *depth)
+{
+    memset(f, 0, sizeof *f);
+    sy_rt_result cr = camera_check(dev, cam, "");
+    if (cr != SY_RT_OK) return cr;
+    if (d->camera_close && (cr = camera_check(dev, d->camera_close, "shutter close: ")) != SY_RT_OK) return cr;
+    if (d->camera_close && d->camera_close->projection != cam->projection)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: the camera at the shutter's close has another projection");
     if (d->integrator != SY_RT_INTEGRATOR_PRIMARY && d->integrator != SY_RT_INTEGRATOR_WHITTED &&
         d->integrator != SY_RT_INTEGRATOR_PATHTRACER && d->integrator != SY_RT_INTEGRATOR_COVERAGE)
         return FAIL(SY_RT_ERROR_UNSUPPORTED, "render: integrator %d is not implemented", (int)d->integrator);
@@ -85,6 +154,26 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
     f->seed = d->seed;
     f->rgba = rgba;
     f->depth = depth;
+    if (d->camera_close && memcmp(d->camera_close->camera_to_world, cam->camera_to_world, sizeof cam->camera_to_world) |
+                               memcmp(d->camera_close->window, cam->window, sizeof cam->window) |
+                               (d->camera_close->near_clip != cam->near_clip) | (d->camera_close->far_clip != cam->far_clip)) {
+        const float *m1 = d->camera_close->camera_to_world;
+        f->cam_motion = true;
+        f->cam_x1 = v3(m1[0], m1[1], m1[2]);
+        f->cam_y1 = v3(m1[4], m1[5], m1[6]);
+        f->cam_z1 = v3(m1[8], m1[9], m1[10]);
+        f->cam_pos1 = v3(m1[12], m1[13], m1[14]);
+        if (v3_is_zero(f->cam_z1)) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: shutter close: camera Z axis is zero");
+        memcpy(f->window1, d->camera_close->window, sizeof f->window1);
+        f->near_clip1 = d->camera_close->near_clip;
+        f->far_clip1 = d->camera_close->far_clip;
+        /* infinite at one end and finite at the other: infinite throughout */
+        if ((f->far_clip1 > 0.0f) != (f->far_clip > 0.0f)) f->far_clip1 = f->far_clip = 0.0f;
+        f->cam_slerp = orientation(f->cam_x, f->cam_y, f->cam_z, f->q0, &f->scale0) &&
+                       orientation(f->cam_x1, f->cam_y1, f->cam_z1, f->q1, &f->scale1);
+        if (f->cam_slerp && f->q0[0] * f->q1[0] + f->q0[1] * f->q1[1] + f->q0[2] * f->q1[2] + f->q0[3] * f->q1[3] < 0.0f)
+            for (int i = 0; i < 4; ++i) f->q1[i] = -f->q1[i]; /* the shorter way round */
+    }
     return SY_RT_OK;
 }
 
@@ -93,29 +182,78 @@ void sy_rt_frame_ray(const sy_rt_frame *f, uint32_t px, uint32_t py, struct RTCR
     sy_rt_frame_ray_at(f, (float)px + 0.5f, (float)py + 0.5f, ray, axial);
 }
 
-void sy_rt_frame_ray_at(const sy_rt_frame *f, float fx, float fy, struct RTCRay *ray, float *axial)
+/* One camera's numbers for its rays (the frame's at time 0, or interpolated at a ray's time). */
+typedef struct cam_basis {
+    const float *window;
+    sy_rt_v3 pos, x, y, z, forward;
+    float near_clip, far_clip;
+} cam_basis;
+
+static inline void basis_ray(const sy_rt_frame *f, const cam_basis *c, float fx, float fy, struct RTCRay *ray,
+                             float *axial)
 {
-    const float *w = f->window;
+    const float *w = c->window;
     float sx = w[0] + fx / (float)f->image_width * (w[1] - w[0]);
     float sy = w[3] - fy / (float)f->image_height * (w[3] - w[2]);
     sy_rt_v3 org, dir;
     if (f->projection == SY_RT_PROJECTION_PERSPECTIVE) {
-        org = f->cam_pos;
-        dir = v3_sub(v3_add(v3_scale(f->cam_x, sx), v3_scale(f->cam_y, sy)), f->cam_z);
+        org = c->pos;
+        dir = v3_sub(v3_add(v3_scale(c->x, sx), v3_scale(c->y, sy)), c->z);
     } else {
-        org = v3_add(f->cam_pos, v3_add(v3_scale(f->cam_x, sx), v3_scale(f->cam_y, sy)));
-        dir = v3_scale(f->cam_z, -1.0f);
+        org = v3_add(c->pos, v3_add(v3_scale(c->x, sx), v3_scale(c->y, sy)));
+        dir = v3_scale(c->z, -1.0f);
     }
-    float a = v3_dot(dir, f->forward);
+    float a = v3_dot(dir, c->forward);
     *axial = a;
     ray->org_x = org.x; ray->org_y = org.y; ray->org_z = org.z;
     ray->dir_x = dir.x; ray->dir_y = dir.y; ray->dir_z = dir.z;
-    ray->tnear = f->near_clip / a;
-    ray->tfar = f->far_clip > 0.0f ? f->far_clip / a : INFINITY;
+    ray->tnear = c->near_clip / a;
+    ray->tfar = c->far_clip > 0.0f ? c->far_clip / a : INFINITY;
     ray->time = 0.0f;
     ray->mask = 0xffffffffu;
     ray->id = 0;
     ray->flags = 0;
+}
+
+void sy_rt_frame_ray_at(const sy_rt_frame *f, float fx, float fy, struct RTCRay *ray, float *axial)
+{
+    cam_basis c = {f->window, f->cam_pos, f->cam_x, f->cam_y, f->cam_z, f->forward, f->near_clip, f->far_clip};
+    basis_ray(f, &c, fx, fy, ray, axial);
+}
+
+static inline float lerpf(float a, float b, float t) { return a + (b - a) * t; }
+static inline sy_rt_v3 v3_lerp(sy_rt_v3 a, sy_rt_v3 b, float t) { return v3_add(a, v3_scale(v3_sub(b, a), t)); }
+
+void sy_rt_frame_ray_time(const sy_rt_frame *f, float fx, float fy, float time, struct RTCRay *ray, float *axial)
+{
+    if (!f->cam_motion || time == 0.0f) {
+        sy_rt_frame_ray_at(f, fx, fy, ray, axial);
+        ray->time = time;
+        return;
+    }
+    float window[4];
+    for (int i = 0; i < 4; ++i) window[i] = lerpf(f->window[i], f->window1[i], time);
+    cam_basis c;
+    c.window = window;
+    c.pos = v3_lerp(f->cam_pos, f->cam_pos1, time);
+    c.near_clip = lerpf(f->near_clip, f->near_clip1, time);
+    c.far_clip = lerpf(f->far_clip, f->far_clip1, time);
+    if (f->cam_slerp) { /* the orientation slerped, the axes' lengths lerped */
+        float q[4];
+        slerp(f->q0, f->q1, time, q);
+        sy_rt_v3 r[3];
+        quat_axes(q, r);
+        sy_rt_v3 s = v3_lerp(f->scale0, f->scale1, time);
+        c.x = v3_scale(r[0], s.x), c.y = v3_scale(r[1], s.y), c.z = v3_scale(r[2], s.z);
+    } else {
+        c.x = v3_lerp(f->cam_x, f->cam_x1, time);
+        c.y = v3_lerp(f->cam_y, f->cam_y1, time);
+        c.z = v3_lerp(f->cam_z, f->cam_z1, time);
+    }
+    c.forward = v3_normalize(v3_scale(c.z, -1.0f));
+    if (v3_is_zero(c.forward)) c.forward = f->forward; /* lerped axes through zero (never with slerp) */
+    basis_ray(f, &c, fx, fy, ray, axial);
+    ray->time = time;
 }
 
 /* >>scheduler */

@@ -21,6 +21,14 @@ typedef struct sy_rt_frame {
     sy_rt_integrator integrator;
     uint32_t max_depth, light_samples, seed;
     float *rgba, *depth;                   /* output, row 0 = top of the rectangle */
+    /* motion blur of the camera (sy_rt_render_desc.camera_close): the camera above at ray time 0,
+     * this one at time 1; cam_motion false when there is none or it equals the camera */
+    bool cam_motion;
+    bool cam_slerp;                        /* both orientations orthogonal: slerp, else the columns lerped */
+    float q0[4], q1[4];                    /* the orientations (x, y, z, w), q1 on q0's hemisphere */
+    sy_rt_v3 scale0, scale1;               /* the columns' lengths */
+    sy_rt_v3 cam_pos1, cam_x1, cam_y1, cam_z1;
+    float window1[4], near_clip1, far_clip1;
 } sy_rt_frame;
 
 /* Validates camera and desc and fills a frame (output pointers included). */
@@ -34,6 +42,10 @@ void sy_rt_frame_ray(const sy_rt_frame *f, uint32_t px, uint32_t py, struct RTCR
 /* The same through an arbitrary full-image point (fx, fy) (pixel (x, y) covers [x, x+1) x [y, y+1));
  * sy_rt_frame_ray(px, py) is sy_rt_frame_ray_at(px + 0.5, py + 0.5). */
 void sy_rt_frame_ray_at(const sy_rt_frame *f, float fx, float fy, struct RTCRay *ray, float *axial);
+/* The same at ray time `time` in [0, 1) (motion blur): the camera interpolated from the open to the
+ * close (f->cam_motion; see sy_rt_render_desc.camera_close), ray->time set; without camera motion
+ * sy_rt_frame_ray_at's ray bit for bit, with ray->time = time. */
+void sy_rt_frame_ray_time(const sy_rt_frame *f, float fx, float fy, float time, struct RTCRay *ray, float *axial);
 
 /* rtcIntersect1 on the top scene, then on the moved instances' scene (sy_rt_device.h); a hit on a
  * twin is reported under its instance's top-level id, so callers never see the difference. */

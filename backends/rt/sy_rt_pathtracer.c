@@ -234,7 +234,7 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
     float dirs[4], first_bsdf[4];
     sy_rt_sobol_sample4(j->sobol, pseed, 0u, index, dirs);
     sy_rt_sobol_sample4(j->sobol, pseed, 2u, index, first_bsdf);
-    if (dev->motion_count) { /* motion blur: the sample's time, stratified over the pixel's samples (the
+    if (dev->motion_count || f->cam_motion) { /* motion blur: the sample's time, stratified over the pixel's samples (the
                               * first dimension of a set no bounce uses, scrambled apart); every ray
                               * of the path, shadow rays too, has it */
         float tu[4];
@@ -243,7 +243,7 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
     }
     struct RTCRay ray;
     float axial;
-    sy_rt_frame_ray_at(f, (float)px + first_bsdf[1], (float)py + first_bsdf[2], &ray, &axial);
+    sy_rt_frame_ray_time(f, (float)px + first_bsdf[1], (float)py + first_bsdf[2], c->ictx.time, &ray, &axial);
     (void)axial;
     /* every segment's direction is a unit vector (the camera's here; BSDF samples are unit), so
      * ray parameters are distances */

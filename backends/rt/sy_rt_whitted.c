@@ -90,7 +90,7 @@ typedef struct whitted_job {
     struct apoly *poly; /* area_analytic: the emitters as planar polygons */
     uint32_t n_poly;
     uint32_t spp;    /* camera rays per pixel */
-    bool motion;     /* some instance moves over the shutter: each camera ray has its own time */
+    bool motion;     /* some instance or the camera moves over the shutter: each camera ray has its own time */
     uint32_t spp_max; /* up to this many where the first spp disagree (adaptive refinement) */
     uint32_t n_area; /* area-light samples per shading point */
     uint32_t n_env;  /* environment samples per shading point (0 without an environment) */
@@ -1023,7 +1023,7 @@ static void whitted_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t
                 }
                 struct RTCRay ray;
                 float axial, t;
-                sy_rt_frame_ray_at(f, fx, fy, &ray, &axial);
+                sy_rt_frame_ray_time(f, fx, fy, primary_ctx.time, &ray, &axial); /* the camera at that time */
                 c.eye = v3(ray.org_x, ray.org_y, ray.org_z);
                 rgba_t r = trace(&c, v3(ray.org_x, ray.org_y, ray.org_z), v3(ray.dir_x, ray.dir_y, ray.dir_z), ray.tnear,
                                  ray.tfar, 0u, true, &primary_ctx.rtc, &t);
@@ -1072,7 +1072,7 @@ sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc 
     j->spp = desc->pixel_samples ? desc->pixel_samples : 1u;
     /* motion blur: at least time_samples samples per pixel (default 16, as many as the sub-frames
      * sy render --shutter averages otherwise), each at its own stratified time */
-    j->motion = dev->motion_count > 0;
+    j->motion = dev->motion_count > 0 || f->cam_motion;
     if (j->motion) {
         uint32_t ts = desc->time_samples ? desc->time_samples : 16u;
         if (ts < 2u) ts = 2u; /* one stratified time would not blur */

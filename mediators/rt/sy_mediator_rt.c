@@ -224,6 +224,7 @@ static const sy_mediator_class pathtracer_class = {
     .set_filter = sy_mediator_rt_set_filter,
     .filter_info = pathtracer_filter_info,
     .motion = sy_rti_motion,
+    .motion_camera = sy_rti_motion_camera,
 };
 
 const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtracer_class; }
@@ -236,6 +237,7 @@ static const sy_mediator_class whitted_class = {
     RT_CLASS_COMMON,
     .default_rank = 10, /* the default back-end without the rasterizer */
     .motion = sy_rti_motion,
+    .motion_camera = sy_rti_motion_camera,
 };
 
 const sy_mediator_class *sy_mediator_rt_whitted_class(void) { return &whitted_class; }

@@ -58,7 +58,8 @@ const sy_mediator_class *sy_mediator_rt_coverage_class(void);
  * sy_context_restart restarts every accumulation at the next request (sample 0), changed or not.
  * Whitted and the path tracer have SY_CAP_MOTION (sy_context_motion_begin / _open / _end): while in
  * motion, each pixel sample has its own time and the instances moved and the meshes deformed between
- * the two syncs are interpolated per ray (docs/BACKENDS.md "Motion blur in one render").
+ * the two syncs are interpolated per ray, and so is a camera given at the close with
+ * sy_context_motion_camera (docs/BACKENDS.md "Motion blur in one render").
  * Parameters: max_depth (bounces, 1..1024, default 64), specular, threads. */
 const sy_mediator_class *sy_mediator_rt_pathtracer_class(void);
 

@@ -118,6 +118,9 @@ typedef struct rt_state {
     bool motion_other;        /* the armed sync made a mesh or moved a light: not interpolated */
     uint32_t motion_instances; /* instances given motion by the armed sync */
     uint32_t motion_meshes;   /* deformed meshes given motion (two vertex time steps) by the armed sync */
+    bool motion_cam;          /* MOTION_ON with a moving camera (sy_rti_motion_camera) */
+    sy_camera_view motion_cam_open; /* a request with this camera (the shutter's open) moves it ... */
+    sy_rt_camera motion_cam_close; /* ... to this one at its close (sy_rt_render_desc.camera_close) */
 } rt_state;
 
 /* --- sy_mediator_rt_base.c --- */
@@ -149,6 +152,8 @@ uint32_t sy_rti_inst_placement_get(const rt_state *st, uint32_t handle);
 sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err);
 /* SY_CAP_MOTION (sy_mediator_class.motion): the phases of a motion-blurred render. */
 sy_result sy_rti_motion(void *state, sy_motion_phase phase, uint32_t time_samples, bool *native, sy_error *err);
+/* SY_CAP_MOTION (sy_mediator_class.motion_camera): the camera at the shutter's close. */
+sy_result sy_rti_motion_camera(void *state, const sy_camera_view *open, const sy_camera_view *close, sy_error *err);
 
 /* --- sy_mediator_rt_coverage.c --- */
 sy_result sy_rti_coverage_render(rt_state *st, const sy_rt_camera *cam, const sy_rt_render_desc *d, sy_layer *layer,

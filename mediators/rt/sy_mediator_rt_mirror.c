@@ -267,6 +267,7 @@ sy_result sy_rti_motion(void *state, sy_motion_phase phase, uint32_t time_sample
         bool had = st->motion != MOTION_OFF;
         st->motion = MOTION_OFF;
         st->motion_samples = 0;
+        st->motion_cam = false;
         if (!had) return SY_OK;
         sy_rt_result r = sy_rt_motion_clear(st->dev);
         if (r == SY_RT_OK) r = sy_rt_commit(st->dev); /* a device with staged changes refuses to render */
@@ -274,6 +275,16 @@ sy_result sy_rti_motion(void *state, sy_motion_phase phase, uint32_t time_sample
     }
     }
     return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion: unknown phase %d", (int)phase);
+}
+
+sy_result sy_rti_motion_camera(void *state, const sy_camera_view *open, const sy_camera_view *close, sy_error *err)
+{
+    rt_state *st = state;
+    if (st->motion != MOTION_ON) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion camera: the motion is not open");
+    st->motion_cam_open = *open;
+    sy_rti_camera_of(close, &st->motion_cam_close); /* checked by the render (sy_rt_frame_init) */
+    st->motion_cam = true;
+    return SY_OK;
 }
 
 /* >>sync */

@@ -114,6 +114,9 @@ static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_lay
         .light_tree = (sy_rt_light_tree_mode)st->light_tree,
         .progress = req->progress ? progress_cb : NULL,
         .progress_user_data = &pb,
+        /* a camera moving over the shutter: each camera ray at its own time (the request's camera is the open) */
+        .camera_close = st->motion == MOTION_ON && st->motion_cam && sy_rti_same_view(&req->camera, &st->motion_cam_open)
+                            ? &st->motion_cam_close : NULL,
     };
     if (st->integrator == SY_RT_INTEGRATOR_WHITTED && req->preview > 0.0f && req->preview < 1.0f) {
         /* an interactive preview (SY_CAP_PREVIEW): the share `preview` of the camera rays and of the

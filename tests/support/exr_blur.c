@@ -5,6 +5,10 @@
  *   exr_blur cover T A.exr                 pixels whose alpha exceeds T
  *   exr_blur iou T BLUR.exr U A.exr B.exr  IoU of {BLUR alpha > T} against {A alpha > U or B alpha > U}
  *                                          (a streak against the union of its endpoints' coverages)
+ *   exr_blur width T A.exr                 the mean over the rows that have any of the pixels whose
+ *                                          alpha exceeds T per row (a horizontal streak's width)
+ *   exr_blur relmse A.exr REF.exr          relative MSE of A's RGB against REF's: the mean over pixels and
+ *                                          channels of (a - r)^2 / (r^2 + 0.01)
  * Prints the numbers on one line; exit 0, or 2 on bad input (unreadable file, no alpha channel,
  * different sizes). */
 #include "sy_exr.h"
@@ -32,7 +36,8 @@ static sy_exr_image *load(const char *path, const sy_exr_image *like)
 
 static int usage(void)
 {
-    fprintf(stderr, "usage: exr_blur mean A.exr [B.exr ...] | cover T A.exr | iou T BLUR.exr U A.exr B.exr\n");
+    fprintf(stderr, "usage: exr_blur mean A.exr [B.exr ...] | cover T A.exr | iou T BLUR.exr U A.exr B.exr |\n"
+                    "       width T A.exr | relmse A.exr REF.exr\n");
     return 2;
 }
 
@@ -72,6 +77,42 @@ int main(int argc, char **argv)
         for (size_t k = 0; k < (size_t)img->width * img->height; ++k) n += a[k] > t;
         printf("%zu\n", n);
         sy_exr_image_free(img);
+        return 0;
+    }
+    if (!strcmp(argv[1], "width") && argc == 4) {
+        sy_exr_image *img = load(argv[3], NULL);
+        if (!img) return 2;
+        float t = strtof(argv[2], NULL);
+        const float *a = sy_exr_image_channel(img, "A");
+        size_t n = 0, rows = 0;
+        for (int y = 0; y < img->height; ++y) {
+            size_t k = 0;
+            for (int x = 0; x < img->width; ++x) k += a[(size_t)y * (size_t)img->width + (size_t)x] > t;
+            n += k, rows += k > 0;
+        }
+        printf("%.4f\n", rows ? (double)n / (double)rows : 0.0);
+        sy_exr_image_free(img);
+        return 0;
+    }
+    if (!strcmp(argv[1], "relmse") && argc == 4) {
+        sy_exr_image *a = load(argv[2], NULL), *r = a ? load(argv[3], a) : NULL;
+        if (!r) {
+            sy_exr_image_free(a);
+            return 2;
+        }
+        static const char *const names[3] = {"R", "G", "B"};
+        size_t n = (size_t)a->width * (size_t)a->height;
+        double sum = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            const float *pa = sy_exr_image_channel(a, names[c]), *pr = sy_exr_image_channel(r, names[c]);
+            for (size_t k = 0; k < n; ++k) {
+                double d = (double)pa[k] - pr[k];
+                sum += d * d / ((double)pr[k] * pr[k] + 0.01);
+            }
+        }
+        printf("%.6g\n", n ? sum / (3.0 * (double)n) : 0.0);
+        sy_exr_image_free(a);
+        sy_exr_image_free(r);
         return 0;
     }
     if (!strcmp(argv[1], "iou") && argc == 7) {
