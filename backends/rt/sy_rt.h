@@ -136,6 +136,15 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev);
  * sequence's frame k equals a fresh render at its time); the commit costs a top-level rebuild. */
 sy_rt_result sy_rt_settle(sy_rt_device *dev);
 
+/** The top-level scene's builder when most instances move (default off): on, a commit that rebuilds
+ * the top level because more than half of the instances (and over 64) moved builds it for frequent
+ * updates (Embree's RTC_SCENE_FLAG_DYNAMIC, RTC_BUILD_QUALITY_LOW; Embree 3 cannot refit a scene of
+ * instances), every other build (and the one after sy_rt_settle) at the MEDIUM quality a new device
+ * builds. Off because it is slower with Embree 3.13: `sy bench anim` (10^4 moving instances) measures
+ * both on the same frames, and the dynamic LOW build took 1.5 to 1.8 times as long as MEDIUM.
+ * Takes effect at the next top-level build. */
+void sy_rt_set_top_fast(sy_rt_device *dev, bool on);
+
 /** Live object counts, for leak diagnostics and tests. */
 typedef struct sy_rt_stats {
     /** @{ live objects of each kind */
@@ -150,6 +159,7 @@ typedef struct sy_rt_stats {
      * (anything structural: instances created, destroyed, shown or hidden; or more than about
      * 64 + instances / 64 instances moved since) folds it back. */
     uint64_t top_builds;
+    uint64_t top_fast_builds; /**< of them: built for frequent updates (sy_rt_set_top_fast on) */
     uint32_t moved_instances; /**< instances shown by twins now (0 after a full build) */
     /** @{ memory: bytes of mesh arrays the back-end allocated itself (copies: shading normals,
      * texture coordinates, colours; not Embree's), bytes of mesh arrays shared with the caller

@@ -166,6 +166,7 @@ void sy_rt_device_stats(const sy_rt_device *dev, sy_rt_stats *out)
     out->version = dev->version;
     out->last_top_commit_seconds = dev->last_top_commit_seconds;
     out->top_builds = dev->top_builds;
+    out->top_fast_builds = dev->top_fast_builds;
     out->moved_instances = dev->stale_count;
     out->mesh_bytes = dev->mesh_bytes;
     out->shared_bytes = dev->shared_bytes;

@@ -140,6 +140,8 @@ struct sy_rt_device {
     uint32_t pending_count, pending_cap;
     bool dyn_dirty;        /* dyn needs rtcCommitScene */
     uint64_t top_builds;   /* rtcCommitScene(top) calls (sy_rt_stats) */
+    uint64_t top_fast_builds; /* of them with top_fast */
+    bool top_fast_on;      /* sy_rt_set_top_fast(dev, true): top_fast when most instances move */
     uint32_t thread_count; /* render threads asked for (sy_rt_device_desc); 0 = OpenMP default */
 
     /* Embree error callback output; read back by the call that triggered it. */
@@ -163,6 +165,10 @@ struct sy_rt_device {
     uint64_t version;    /* commits that published a change */
     bool top_dirty;      /* top scene needs rtcCommitScene */
     bool settle;         /* sy_rt_settle: the next commit moves instances through the top scene, no twins */
+    bool top_fast;       /* the top scene is built for frequent updates (RTC_SCENE_FLAG_DYNAMIC, quality
+                          * LOW): top_fast_on and most instances moved in its last build
+                          * (sy_rt_commit_moved); a fresh build (and sy_rt_settle) gives the usual
+                          * MEDIUM one */
     bool area_dirty;     /* area-light list needs a rebuild */
     bool filters_dirty;  /* alpha filters may need (un)installing */
     bool punctual_dirty; /* punctual light array needs a rebuild */

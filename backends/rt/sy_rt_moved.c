@@ -132,7 +132,8 @@ static sy_rt_result twin_place(sy_rt_device *dev, sy_rt_instance_data *in)
  * stale; otherwise every pending transform goes into the top scene, which is rebuilt. */
 sy_rt_result sy_rt_commit_moved(sy_rt_device *dev)
 {
-    if (dev->settle && dev->pending_count) dev->top_dirty = true; /* sy_rt_settle: no twins this commit */
+    bool fresh = dev->settle;
+    if (dev->settle && (dev->pending_count || dev->top_fast)) dev->top_dirty = true; /* sy_rt_settle: no twins this commit */
     dev->settle = false;
     if (!dev->top_dirty && dev->pending_count) {
         uint32_t stale = dev->stale_count;
@@ -152,6 +153,17 @@ sy_rt_result sy_rt_commit_moved(sy_rt_device *dev)
         }
     }
     if (dev->top_dirty) {
+        /* the top scene's builder (sy_rt_set_top_fast, off by default: slower with Embree 3.13): when
+         * most instances moved (an animation playing: 10^4 nodes each frame) one for frequent
+         * updates (Embree's dynamic scene, LOW quality; Embree 3 cannot refit a scene of
+         * instances); otherwise, and for a fresh build (sy_rt_settle: what a new device would
+         * build), the usual MEDIUM one */
+        bool fast = !fresh && dev->top_fast_on && dev->pending_count > 64u && dev->pending_count > dev->instances.live / 2u;
+        if (fast != dev->top_fast) {
+            rtcSetSceneFlags(dev->top, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION | (fast ? RTC_SCENE_FLAG_DYNAMIC : 0));
+            rtcSetSceneBuildQuality(dev->top, fast ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM);
+            dev->top_fast = fast;
+        }
         while (dev->pending_count) {
             sy_rt_instance_data *in = dev->pending[dev->pending_count - 1];
             apply_top_transform(in);
@@ -178,6 +190,11 @@ bool sy_rt_pending_add(sy_rt_device *dev, sy_rt_instance_data *in)
     return true;
 }
 
+void sy_rt_set_top_fast(sy_rt_device *dev, bool on)
+{
+    if (dev) dev->top_fast_on = on;
+}
+
 sy_rt_result sy_rt_settle(sy_rt_device *dev)
 {
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "settle: NULL device");
@@ -186,7 +203,7 @@ sy_rt_result sy_rt_settle(sy_rt_device *dev)
         sy_rt_instance_data *in = dev->instances.items[i];
         if (in && in->stale && !sy_rt_pending_add(dev, in)) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "settle: out of memory");
     }
-    if (dev->pending_count || dev->stale_count) {
+    if (dev->pending_count || dev->stale_count || dev->top_fast) { /* top_fast: rebuilt as a fresh device builds it */
         dev->top_dirty = true;
         dev->dirty = true;
     }

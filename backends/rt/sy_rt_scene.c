@@ -200,6 +200,7 @@ sy_rt_result sy_rt_commit(sy_rt_device *dev)
     if (dev->top_dirty) {
         rtcCommitScene(dev->top);
         dev->top_builds++;
+        if (dev->top_fast) dev->top_fast_builds++;
         dev->last_top_commit_seconds = sy_rt_seconds() - t0;
         if ((r = sy_rt_check_embree(dev, "commit: top-level scene")) != SY_RT_OK) {
             if (dev->max_memory > 0 && (double)atomic_load(&dev->embree_peak) * 1.25 > (double)dev->max_memory)

@@ -258,6 +258,12 @@ static const sy_mediator_class coverage_class = {
 
 const sy_mediator_class *sy_mediator_rt_coverage_class(void) { return &coverage_class; }
 
+void sy_mediator_rt_set_top_fast(void *state, bool on)
+{
+    rt_state *st = state;
+    sy_rt_set_top_fast(st->dev, on);
+}
+
 void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out)
 {
     rt_state *st = state;

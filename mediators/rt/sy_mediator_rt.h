@@ -177,6 +177,9 @@ typedef struct sy_mediator_rt_counters {
 } sy_mediator_rt_counters;
 /** state is the mediator state of a context whose class is one of this adapter's classes. */
 void sy_mediator_rt_counters_get(void *state, sy_mediator_rt_counters *out);
+/** The top level's dynamic LOW-quality builder when most instances move (sy_rt_set_top_fast; default
+ * off: slower with Embree 3.13; sy bench anim compares it). state as sy_mediator_rt_counters_get. */
+void sy_mediator_rt_set_top_fast(void *state, bool on);
 
 /** Ray throughput of this adapter's device on the given view (see backends/rt/sy_rt_bench.h):
  * our PRIMARY integrator against raw rtcIntersect1 on the same rays, in one run. */
