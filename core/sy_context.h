@@ -56,6 +56,20 @@ void sy_context_restart(sy_context *c);
  * camera that moves over the shutter is given at its close with sy_context_motion_camera after
  * _open. Errors leave the motion ended. Thread-safety: as sy_context_render. */
 sy_result sy_context_motion_begin(sy_context *c, uint32_t time_samples, sy_error *err);
+/** Most time steps of a shutter (sy_context_motion_begin_steps). */
+#define SY_MOTION_STEPS_MAX 9
+/** Curved motion: sy_context_motion_begin for a shutter sampled at `steps` (2 ..
+ * SY_MOTION_STEPS_MAX) equally spaced times T_k = T0 + k / (steps - 1) x (T1 - T0): commit the scene
+ * at T1 (the close) and call this (it syncs), then for k = steps - 2 down to 1 commit it at T_k and
+ * call sy_context_motion_step, then commit it at T0 and call sy_context_motion_open. Every instance
+ * that moves is placed at each step and interpolated linearly between consecutive steps (a turn
+ * becomes steps - 1 chords of its arc); deformed meshes (skins, morphs) stay linear between the
+ * close and the open. steps 2 is sy_context_motion_begin. SY_ERR_UNSUPPORTED (the motion ended)
+ * when the back-end takes only two steps. Thread-safety: as sy_context_render. */
+sy_result sy_context_motion_begin_steps(sy_context *c, uint32_t time_samples, uint32_t steps, sy_error *err);
+/** Syncs the scene committed at an intermediate time step (see sy_context_motion_begin_steps).
+ * Errors leave the motion ended. Thread-safety: as sy_context_render. */
+sy_result sy_context_motion_step(sy_context *c, sy_error *err);
 /** The second step of motion blur (see sy_context_motion_begin): syncs the scene committed at the
  * shutter's open; *native says whether the back-end interpolates every change. Thread-safety: as
  * sy_context_render. */

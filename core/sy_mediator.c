@@ -395,6 +395,27 @@ sy_result sy_context_motion_begin(sy_context *c, uint32_t time_samples, sy_error
     return r;
 }
 
+sy_result sy_context_motion_begin_steps(sy_context *c, uint32_t time_samples, uint32_t steps, sy_error *err)
+{
+    if (steps < 2u || steps > SY_MOTION_STEPS_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion: %u time steps (2 .. %u)", steps, SY_MOTION_STEPS_MAX);
+    sy_result r = sy_context_motion_begin(c, time_samples, err);
+    if (r == SY_OK && steps > 2u) {
+        r = c->cls->motion(c->state, SY_MOTION_STEPS, steps, NULL, err);
+        if (r != SY_OK) sy_context_motion_end(c);
+    }
+    return r;
+}
+
+sy_result sy_context_motion_step(sy_context *c, sy_error *err)
+{
+    if (!(sy_context_caps(c) & SY_CAP_MOTION) || !c->cls->motion) return motion_unsupported(c, err);
+    sy_result r = sy_context_sync(c, err);
+    if (r == SY_OK) r = c->cls->motion(c->state, SY_MOTION_STEP, 0, NULL, err);
+    if (r != SY_OK) sy_context_motion_end(c);
+    return r;
+}
+
 sy_result sy_context_motion_open(sy_context *c, bool *native, sy_error *err)
 {
     bool nat = false;

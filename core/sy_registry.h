@@ -133,6 +133,10 @@ typedef enum sy_motion_phase {
     SY_MOTION_BEGIN = 1,  /**< synced at the shutter's close; the next sync is its open */
     SY_MOTION_OPENED = 2, /**< the sync at the open is done */
     SY_MOTION_END = 3,    /**< motion off */
+    SY_MOTION_STEPS = 4,  /**< right after BEGIN: the shutter has time_samples (3 .. SY_MOTION_STEPS_MAX)
+                           * equally spaced time steps; the syncs until OPENED come from the close
+                           * towards the open, each followed by SY_MOTION_STEP, the last by OPENED */
+    SY_MOTION_STEP = 5,   /**< the sync of an intermediate time step is done; the next is the step before */
 } sy_motion_phase;
 
 /** A mediator class: the vtable and capabilities of one back-end kind (see docs/BACKENDS.md). */
@@ -191,7 +195,10 @@ typedef struct sy_mediator_class {
      * changes the class cannot interpolate (deformed meshes, moved lights: the caller then ends the
      * motion and blurs by sub-frames). SY_MOTION_END: no motion any more (every instance stays where
      * the last sync put it; native NULL). time_samples: BEGIN's wish for samples per pixel of the
-     * integrators that take a fixed number (0: the class's default). Optional; appended last. */
+     * integrators that take a fixed number (0: the class's default). SY_MOTION_STEPS and
+     * SY_MOTION_STEP (curved motion, sy_context_motion_begin_steps / sy_context_motion_step): a
+     * class that does not take more than two steps returns SY_ERR_UNSUPPORTED for STEPS. Optional;
+     * appended last. */
     sy_result (*motion)(void *state, sy_motion_phase phase, uint32_t time_samples, bool *native, sy_error *err);
     /** SY_CAP_MOTION, optional (sy_context_motion_camera): while in motion (after SY_MOTION_OPENED),
      * a request whose camera is open is rendered with each camera ray built at its own time between

@@ -211,6 +211,8 @@ static const char usage_text[] =
             "             --motion-blur: 0,0.5/FPS; whitted/pathtracer: one render, each pixel sample at its own time\n"
             "             (whitted: at least N samples per pixel, default 16); others or --sub-frames: N time samples,\n"
             "             each a render accumulated (path tracer: the samples split))\n"
+            "            [--shutter-steps N]   (whitted/pathtracer: the motion sampled at N equally spaced times of the\n"
+            "             shutter, 2..9, default 2: a turn blurs along N - 1 chords of its arc)\n"
             "            [--clip A,B,C,D ...]   (section planes, up to 6: keeps A*x + B*y + C*z + D >= 0, world units)\n"
             "            [--clip-cap RRGGBB]   (fill the cut faces of closed meshes in this sRGB colour, e.g. ff8000)\n"
             "            [--frames A:B[:STEP] [--fps F] [--resume] -o OUT_####.exr|png]   (an image sequence: frames A..B\n"

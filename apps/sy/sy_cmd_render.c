@@ -268,8 +268,8 @@ static void blur_add(sy_layer *acc, const sy_layer *l, float weight)
  * camera of a stereo render or of a back-end that cannot move it: then the motion is ended and the
  * caller blurs by sub-frames. */
 static bool motion_native_begin(loaded *ld, const char *clip, double frame_time, const sy_shutter *sh,
-                                const sy_compose_spec *spec, uint32_t w, uint32_t h, sy_context_pool *pool,
-                                sy_context **ctx_out, bool *motion_camera)
+                                uint32_t steps, const sy_compose_spec *spec, uint32_t w, uint32_t h,
+                                sy_context_pool *pool, sy_context **ctx_out, bool *motion_camera)
 {
     sy_params rp;
     sy_context *c = NULL;
@@ -284,9 +284,14 @@ static bool motion_native_begin(loaded *ld, const char *clip, double frame_time,
     memset(&v_close, 0, sizeof v_close);
     memset(&v_open, 0, sizeof v_open);
     sy_error ce = {0};
-    if (sy_cli_set_time(ld, clip, frame_time + sh->close, &e) == 0 &&
-        sy_compose_camera_view(ld->scene, spec, w, h, &v_close, &e) == SY_OK &&
-        sy_context_motion_begin(c, sh->samples, &e) == SY_OK &&
+    /* --shutter-steps N: the steps between, from the close towards the open (curved motion) */
+    bool stepped = sy_cli_set_time(ld, clip, frame_time + sh->close, &e) == 0 &&
+                   sy_compose_camera_view(ld->scene, spec, w, h, &v_close, &e) == SY_OK &&
+                   sy_context_motion_begin_steps(c, sh->samples, steps, &e) == SY_OK;
+    for (uint32_t k = steps - 2u; stepped && k >= 1u; --k)
+        stepped = sy_cli_set_time(ld, clip, frame_time + sh->open + (sh->close - sh->open) * k / (steps - 1u), &e) == 0 &&
+                  sy_context_motion_step(c, &e) == SY_OK;
+    if (stepped &&
         sy_cli_set_time(ld, clip, frame_time + sh->open, &e) == 0 &&
         sy_compose_camera_view(ld->scene, spec, w, h, &v_open, &e) == SY_OK &&
         sy_context_motion_open(c, &native, &e) == SY_OK && native) {
@@ -315,13 +320,13 @@ static sy_result render_blurred(loaded *ld, const char *clip, double frame_time,
                                 const sy_compose_spec *spec, uint32_t w, uint32_t h, const pt_opts *po,
                                 sy_context_pool *pool, const sy_window_render_opts *ro, sy_layer *out,
                                 sy_layer *out_right, double *seconds, uint64_t *samples_out, sy_context **ctx_out,
-                                bool sub_frames, bool *native_out, sy_error *err)
+                                bool sub_frames, uint32_t steps, bool *native_out, sy_error *err)
 {
     double t0 = sy_time_now();
     sy_context *mc = NULL;
     *native_out = false;
     bool moving_camera = false;
-    if (!sub_frames && motion_native_begin(ld, clip, frame_time, sh, spec, w, h, pool, &mc, &moving_camera)) {
+    if (!sub_frames && motion_native_begin(ld, clip, frame_time, sh, steps, spec, w, h, pool, &mc, &moving_camera)) {
         char each[64];
         if (po) snprintf(each, sizeof each, "each pixel sample");
         else snprintf(each, sizeof each, "each of at least %u samples per pixel", sh->samples);
@@ -673,6 +678,7 @@ int sy_cmd_render(int argc, char **argv)
     uint32_t max_memory_mb = 0;
     sy_shutter shutter = {0.0, 0.0, 0}; /* --shutter / --motion-blur / --shutter-samples: motion blur */
     bool shutter_given = false, motion_blur = false, sub_frames = false;
+    uint32_t shutter_steps = 0; /* --shutter-steps: time steps of the one-render path (curved motion); 0 = 2 */
     const sy_cli_opt opts[] = {
         SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT(NULL, 'o', &outp),
         SY_CLI_OPT_UINT("spp", OPT_SPP, &po.spp, 1, 1u << 24),
@@ -694,6 +700,7 @@ int sy_cmd_render(int argc, char **argv)
         SY_CLI_OPT_CODE("at", OPT_AT, true), SY_CLI_OPT_CODE("clip", OPT_CLIP, true), /* the scene clock */
         SY_CLI_OPT_CODE("shutter", OPT_SHUTTER, true), SY_CLI_OPT_FLAG("motion-blur", OPT_MOTION_BLUR, &motion_blur),
         SY_CLI_OPT_UINT("shutter-samples", OPT_SHUTTER_SAMPLES, &shutter.samples, 1, SY_SHUTTER_SAMPLES_MAX),
+        SY_CLI_OPT_UINT("shutter-steps", OPT_SHUTTER_STEPS, &shutter_steps, 2, SY_MOTION_STEPS_MAX),
         SY_CLI_OPT_CODE("clip-cap", OPT_CLIP_CAP, true), /* section caps (with --clip A,B,C,D) */
         SY_CLI_OPT_FLAG("sub-frames", OPT_SUB_FRAMES, &sub_frames)};
     sy_cli_parser p = {SY_CLI_ARGS("render", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .cluster = true,
@@ -778,6 +785,9 @@ int sy_cmd_render(int argc, char **argv)
         return sy_cli_usage_of("render", "--shutter-samples belongs to --shutter or --motion-blur");
     if (sub_frames && !shutter_given && !motion_blur)
         return sy_cli_usage_of("render", "--sub-frames belongs to --shutter or --motion-blur");
+    if (shutter_steps && !shutter_given && !motion_blur)
+        return sy_cli_usage_of("render", "--shutter-steps belongs to --shutter or --motion-blur");
+    if (!shutter_steps) shutter_steps = 2; /* linear between the shutter's two ends */
     if (motion_blur) shutter.close = 0.5 / fps, shutter_given = true; /* a 180-degree shutter */
     if (!shutter.samples) shutter.samples = 16; /* see docs/CLI.md "Motion blur" */
     bool blur = shutter_given && sy_shutter_blurs(&shutter);
@@ -996,7 +1006,7 @@ int sy_cmd_render(int argc, char **argv)
         if (progressive)
             sy_signals_set_graceful("finishing the current pass, then writing the image accumulated so far");
         r = render_blurred(&ld, clip, frame_time, &shutter, &spec, w, h, progressive ? &po : NULL, pool, &ro, &img,
-                           &img_right, &secs, &samples, &pctx, sub_frames, &blur_native, &err);
+                           &img_right, &secs, &samples, &pctx, sub_frames, shutter_steps, &blur_native, &err);
         t0 = sy_time_now() - secs;
         interrupted = sy_signals_interrupted();
     } else if (r == SY_OK && progressive) {

@@ -8,7 +8,7 @@
  *             [--params k=v,...] [--half] [--exposure EV] [--tonemap clamp|reinhard|aces]
  *             [--max-memory MB]   (ray tracers: max_memory_mb, a scene whose BVHs need more is refused)
  *             [--at SECONDS] [--clip NAME|INDEX]   the scene at a time on its clock (sy_anim.h)
- *             [--shutter OPEN,CLOSE | --motion-blur] [--shutter-samples N]   motion blur over a shutter
+ *             [--shutter OPEN,CLOSE | --motion-blur] [--shutter-samples N] [--shutter-steps N]   motion blur
  *             [--frames A:B[:STEP] [--fps F] [--resume] -o OUT_####.exr]   an image sequence
  *             with -b pathtracer: [--spp N | --time SECONDS] [--aov]
  *             [--filter none|pixel|atrous|jbu|adaptive|radiance [--threshold T]]

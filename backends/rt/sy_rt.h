@@ -410,6 +410,14 @@ sy_rt_result sy_rt_instance_get_transform(const sy_rt_device *dev, sy_rt_instanc
 /** Gives the instance motion to `close` (object-to-world at time 1, checked like a transform; equal
  * to its transform or NULL: no motion). Keeps its transform (time 0); sy_rt_commit publishes it. */
 sy_rt_result sy_rt_instance_set_motion(sy_rt_device *dev, sy_rt_instance inst, const float close[16]);
+#define SY_RT_MOTION_STEPS_MAX 9 /**< most time steps of a moving instance (sy_rt_instance_set_motion_steps) */
+/** Curved motion: the instance placed at `steps` (2 .. SY_RT_MOTION_STEPS_MAX) equally spaced times
+ * of the shutter, its transform at time 0 and later[k - 1] (16 floats each, checked like a
+ * transform) at time k / (steps - 1), k = 1 .. steps - 1; Embree interpolates the matrix linearly
+ * between consecutive steps (rtcSetGeometryTimeStepCount steps; a baked instance: steps vertex
+ * buffers), so a turn over the shutter is an arc of steps - 1 chords. Every step equal to the
+ * transform: no motion. steps 2 is sy_rt_instance_set_motion(later). sy_rt_commit publishes it. */
+sy_rt_result sy_rt_instance_set_motion_steps(sy_rt_device *dev, sy_rt_instance inst, uint32_t steps, const float *later);
 /** A deforming mesh's motion: as sy_rt_mesh_update (the same checks), but the vertices (and normals)
  * the mesh has now become its pose at ray time 1 (the shutter's close) and the given ones its pose
  * at time 0 (the open); Embree interpolates each vertex linearly by the ray's time (two time steps
@@ -421,6 +429,11 @@ sy_rt_result sy_rt_instance_set_motion(sy_rt_device *dev, sy_rt_instance inst, c
  * and what the paragraph above lists. A mesh already in motion moves on: its time-0 pose becomes
  * time 1. sy_rt_commit publishes it. */
 sy_rt_result sy_rt_mesh_update_motion(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals);
+/** As sy_rt_mesh_update_motion, except that a mesh already in motion keeps its time-1 pose and only
+ * its time-0 pose is replaced: the syncs of a shutter of more than two steps (close, the steps
+ * between, open) give a deforming mesh its close and open poses, linear between them (its
+ * intermediate poses are not kept). */
+sy_rt_result sy_rt_mesh_update_motion_keep(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals);
 /** Drops every instance's and mesh's motion (each stays at its transform / time-0 pose);
  * sy_rt_commit publishes it. */
 sy_rt_result sy_rt_motion_clear(sy_rt_device *dev);

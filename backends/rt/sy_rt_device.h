@@ -76,14 +76,25 @@ typedef struct sy_rt_instance_data {
     unsigned twin_id;          /* its geometry id in dev->dyn */
     uint32_t area_base;        /* committed emissive instance: its triangles' entries in dev->area_map
                                 * start here (UINT32_MAX: none) */
-    /* Motion blur (sy_rt_instance_set_motion): xf is the placement at ray time 0 (shutter open), xf1
-     * at time 1 (shutter close); Embree interpolates the matrices linearly between them (two time
-     * steps on geom, its twin, or a baked instance's second vertex buffer) and shading does the same
-     * (sy_rt_instance_at). */
+    /* Motion blur (sy_rt_instance_set_motion, _set_motion_steps): xf is the placement at ray time 0
+     * (shutter open), xf1 at time 1 (shutter close), xf_mid the steps between (motion_steps > 2:
+     * step k at time k / (motion_steps - 1)); Embree interpolates the matrices linearly between
+     * consecutive steps (time steps on geom, its twin, or a baked instance's further vertex buffers)
+     * and shading does the same (sy_rt_instance_at). */
     bool motion;
+    uint32_t motion_steps;     /* with motion: 2 .. SY_RT_MOTION_STEPS_MAX */
     float xf1[16];
-    float *baked_positions1;   /* baked with motion: Embree vertex buffer of time step 1 (world space) */
+    float *xf_mid;             /* own: (motion_steps - 2) matrices, steps 1 .. motion_steps - 2; or NULL */
+    uint32_t baked_steps;      /* baked with motion: the time steps baked_pos holds buffers for */
+    float *baked_pos[SY_RT_MOTION_STEPS_MAX]; /* baked with motion: Embree vertex buffers of steps 1 ..
+                                               * baked_steps - 1 (world space; [0] unused) */
 } sy_rt_instance_data;
+
+/* Step k (0 .. motion_steps - 1) of a moving instance's placement. */
+static inline const float *sy_rt_instance_step(const sy_rt_instance_data *in, uint32_t k)
+{
+    return k == 0 ? in->xf : k + 1u >= in->motion_steps ? in->xf1 : in->xf_mid + 16u * (k - 1u);
+}
 
 typedef struct sy_rt_light_data {
     sy_rt_light_desc desc;
@@ -346,14 +357,23 @@ static inline const sy_rt_instance_data *sy_rt_filter_instance(const sy_rt_devic
 
 /* The instance as placed at ray time `time` (motion blur): in itself when it does not move, else
  * *scratch, a copy with the object-to-world matrix interpolated linearly between xf (time 0) and xf1
- * (time 1), as Embree interpolates it, and its normal matrix (the inverse transpose of the upper
+ * (time 1), or between the two steps around the time (motion_steps > 2), as Embree interpolates it, and its normal matrix (the inverse transpose of the upper
  * 3x3; a singular interpolated matrix keeps xf's). Shading reads the returned instance. */
 static inline const sy_rt_instance_data *sy_rt_instance_at(const sy_rt_instance_data *in, float time,
                                                            sy_rt_instance_data *scratch)
 {
     if (!in || !in->motion) return in;
     *scratch = *in;
-    for (int i = 0; i < 16; ++i) scratch->xf[i] = (1.0f - time) * in->xf[i] + time * in->xf1[i];
+    if (in->motion_steps <= 2u) {
+        for (int i = 0; i < 16; ++i) scratch->xf[i] = (1.0f - time) * in->xf[i] + time * in->xf1[i];
+    } else { /* the segment the time falls in, as Embree finds it */
+        float s = time * (float)(in->motion_steps - 1u);
+        uint32_t k = s > 0.0f ? (uint32_t)s : 0u;
+        if (k > in->motion_steps - 2u) k = in->motion_steps - 2u;
+        float f = s - (float)k;
+        const float *a = sy_rt_instance_step(in, k), *b = sy_rt_instance_step(in, k + 1u);
+        for (int i = 0; i < 16; ++i) scratch->xf[i] = (1.0f - f) * a[i] + f * b[i];
+    }
     const float *x = scratch->xf; /* column-major: a[r][c] = x[c * 4 + r] */
     float c00 = x[5] * x[10] - x[9] * x[6], c01 = -(x[1] * x[10] - x[9] * x[2]), c02 = x[1] * x[6] - x[5] * x[2];
     float c10 = -(x[4] * x[10] - x[8] * x[6]), c11 = x[0] * x[10] - x[8] * x[2], c12 = -(x[0] * x[6] - x[4] * x[2]);

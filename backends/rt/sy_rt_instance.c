@@ -17,6 +17,7 @@ static bool top_map_set(sy_rt_device *dev, unsigned id, sy_rt_instance_data *in)
 void sy_rt_instance_free(sy_rt_device *dev, sy_rt_instance_data *in)
 {
     if (in->motion) dev->motion_count--;
+    free(in->xf_mid);
     sy_rt_pending_remove(dev, in);
     if (in->geom) {
         if (in->top_id != RTC_INVALID_GEOMETRY_ID) {

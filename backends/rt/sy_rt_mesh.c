@@ -317,6 +317,20 @@ void sy_rt_mesh_motion_off(sy_rt_device *dev, sy_rt_mesh_data *m)
     dev->dirty = dev->top_dirty = dev->shadow_dirty = dev->area_dirty = true;
 }
 
+sy_rt_result sy_rt_mesh_update_motion_keep(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals)
+{
+    const sy_rt_mesh_data *m = dev && positions ? sy_rt_pool_get(&dev->meshes, mesh.id) : NULL;
+    if (!m || !m->motion) return sy_rt_mesh_update_motion(dev, mesh, positions, normals);
+    sy_rt_result r = sy_rt_mesh_update(dev, mesh, positions, normals); /* time 0; time 1 (the close) kept */
+    if (r != SY_RT_OK) return r;
+    sy_rt_mesh_data *mm = sy_rt_pool_get(&dev->meshes, mesh.id);
+    float extent = mm->extent; /* both poses' */
+    for (size_t i = 0; i < (size_t)mm->vertex_count * 3u; ++i) extent = fmaxf(extent, fabsf(mm->positions1[i]));
+    mm->extent = extent;
+    dev->dirty = dev->top_dirty = dev->shadow_dirty = dev->area_dirty = true;
+    return r;
+}
+
 sy_rt_result sy_rt_mesh_update_motion(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals)
 {
     if (!dev || !positions) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh update_motion: NULL argument");

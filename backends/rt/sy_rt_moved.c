@@ -6,6 +6,7 @@
  * and sy_rt_scene.c; calls sy_rt_placement.c and sy_rt_mesh.c (never back). */
 #include "sy_rt_scene.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -48,39 +49,51 @@ void sy_rt_pending_remove(sy_rt_device *dev, sy_rt_instance_data *in)
 }
 
 /* Sets an instance geometry's transforms (the top-level one or the twin): one time step, or with
- * motion two (shutter open and close; Embree interpolates between them by the ray's time). */
+ * motion its steps (shutter open .. close; Embree interpolates between them by the ray's time). */
 static void set_instance_transforms(RTCGeometry g, const sy_rt_instance_data *in)
 {
-    rtcSetGeometryTimeStepCount(g, in->motion ? 2u : 1u);
+    uint32_t n = in->motion ? in->motion_steps : 1u;
+    rtcSetGeometryTimeStepCount(g, n);
     rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, in->xf);
-    if (in->motion) rtcSetGeometryTransform(g, 1, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, in->xf1);
+    for (uint32_t k = 1; k < n; ++k) rtcSetGeometryTransform(g, k, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, sy_rt_instance_step(in, k));
 }
 
-/* A baked instance's world-space vertices of time step 1 (motion), or none (one time step; Embree
- * drops the buffer with the step). */
+/* A baked instance's world-space vertices of time steps 1 .. motion_steps - 1 (motion), or none (one
+ * time step; Embree drops the buffers with the steps). */
 static void bake_motion(sy_rt_instance_data *in)
 {
-    if (!in->motion) {
+    if (!in->motion || in->baked_steps != in->motion_steps) { /* the steps' buffers made anew below */
         rtcSetGeometryTimeStepCount(in->geom, 1u);
-        in->baked_positions1 = NULL;
-        return;
+        memset(in->baked_pos, 0, sizeof in->baked_pos);
+        in->baked_steps = 0;
     }
+    if (!in->motion) return;
     const sy_rt_mesh_data *m = in->mesh;
-    rtcSetGeometryTimeStepCount(in->geom, 2u);
-    if (!in->baked_positions1)
-        in->baked_positions1 = rtcSetNewGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, 1, RTC_FORMAT_FLOAT3,
+    uint32_t n = in->motion_steps;
+    rtcSetGeometryTimeStepCount(in->geom, n);
+    for (uint32_t k = 1; k < n; ++k) {
+        if (!in->baked_pos[k])
+            in->baked_pos[k] = rtcSetNewGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, k, RTC_FORMAT_FLOAT3,
                                                        3 * sizeof(float), m->vertex_count);
-    if (!in->baked_positions1) { /* out of memory (Embree reported it): shown at the open time */
-        rtcSetGeometryTimeStepCount(in->geom, 1u);
-        return;
+        if (!in->baked_pos[k]) { /* out of memory (Embree reported it): shown at the open time */
+            rtcSetGeometryTimeStepCount(in->geom, 1u);
+            memset(in->baked_pos, 0, sizeof in->baked_pos);
+            in->baked_steps = 0;
+            return;
+        }
     }
-    for (uint32_t i = 0; i < m->vertex_count; ++i) {
-        sy_rt_v3 p = m4_point(in->xf1, v3_load(m->positions + 3u * i));
-        in->baked_positions1[3u * i + 0] = p.x;
-        in->baked_positions1[3u * i + 1] = p.y;
-        in->baked_positions1[3u * i + 2] = p.z;
+    in->baked_steps = n;
+    for (uint32_t k = 1; k < n; ++k) {
+        const float *xf = sy_rt_instance_step(in, k);
+        float *out = in->baked_pos[k];
+        for (uint32_t i = 0; i < m->vertex_count; ++i) {
+            sy_rt_v3 p = m4_point(xf, v3_load(m->positions + 3u * i));
+            out[3u * i + 0] = p.x;
+            out[3u * i + 1] = p.y;
+            out[3u * i + 2] = p.z;
+        }
+        rtcUpdateGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, k);
     }
-    rtcUpdateGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, 1);
 }
 
 /* Writes the instance's current transform into its top-level geometry (a full rebuild follows). */
@@ -89,7 +102,7 @@ static void apply_top_transform(sy_rt_instance_data *in)
     if (in->flags & SY_RT_INSTANCE_BAKED) {
         sy_rt_bake_positions(in);
         rtcUpdateGeometryBuffer(in->geom, RTC_BUFFER_TYPE_VERTEX, 0);
-        if (in->motion || in->baked_positions1) bake_motion(in);
+        if (in->motion || in->baked_steps) bake_motion(in);
     } else {
         set_instance_transforms(in->geom, in);
     }
@@ -224,20 +237,45 @@ sy_rt_result sy_rt_instance_get_transform(const sy_rt_device *dev, sy_rt_instanc
 
 sy_rt_result sy_rt_instance_set_motion(sy_rt_device *dev, sy_rt_instance inst, const float close[16])
 {
+    return sy_rt_instance_set_motion_steps(dev, inst, 2u, close);
+}
+
+sy_rt_result sy_rt_instance_set_motion_steps(sy_rt_device *dev, sy_rt_instance inst, uint32_t steps, const float *later)
+{
     if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_motion: NULL device");
     sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
     if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance set_motion: stale handle 0x%08x", inst.id);
-    if (close && memcmp(close, in->xf, sizeof in->xf) == 0) close = NULL; /* no motion */
-    if (!close && !in->motion) return SY_RT_OK;
-    if (close) {
-        float nrm[9];
-        sy_rt_result r = sy_rt_placement_recheck(dev, in, close, nrm, "instance set_motion: the close transform", "");
-        if (r != SY_RT_OK) return r;
+    if (later && (steps < 2u || steps > SY_RT_MOTION_STEPS_MAX))
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance set_motion: %u time steps (2 .. %u)", steps, SY_RT_MOTION_STEPS_MAX);
+    bool moves = false;
+    for (uint32_t k = 0; later && k + 1u < steps && !moves; ++k) moves = memcmp(later + 16u * k, in->xf, sizeof in->xf) != 0;
+    if (!moves) later = NULL; /* no motion */
+    if (!later && !in->motion) return SY_RT_OK;
+    float *mid = NULL;
+    if (later) {
+        for (uint32_t k = 0; k + 1u < steps; ++k) {
+            float nrm[9];
+            char what[64];
+            snprintf(what, sizeof what, k + 2u == steps ? "instance set_motion: the close transform"
+                                                        : "instance set_motion: the transform of step %u", k + 1u);
+            sy_rt_result r = sy_rt_placement_recheck(dev, in, later + 16u * k, nrm, what, "");
+            if (r != SY_RT_OK) return r;
+        }
+        if (steps > 2u && !(mid = malloc((size_t)(steps - 2u) * 16u * sizeof(float))))
+            return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance set_motion: out of memory");
     }
-    if (!sy_rt_pending_add(dev, in)) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance set_motion: out of memory");
+    if (!sy_rt_pending_add(dev, in)) {
+        free(mid);
+        return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance set_motion: out of memory");
+    }
+    const float *close = later ? later + 16u * (steps - 2u) : NULL;
     if (close && !in->motion) dev->motion_count++;
     if (!close && in->motion) dev->motion_count--;
     in->motion = close != NULL;
+    free(in->xf_mid);
+    in->xf_mid = mid;
+    if (mid) memcpy(mid, later, (size_t)(steps - 2u) * 16u * sizeof(float));
+    in->motion_steps = close ? steps : 0u;
     if (close) memcpy(in->xf1, close, sizeof in->xf1);
     if (sy_rt_instance_emissive(dev, in)) dev->area_dirty = true;
     dev->dirty = true;

@@ -31,6 +31,7 @@ static void rt_destroy(void *state)
     sy_filter_temporal_destroy(st->temporal);
     sy_rt_device_destroy(st->dev);
     sy_mirror_map_free(&st->inst_node);
+    sy_mirror_map_free(&st->motion_rec);
     sy_mirror_map_free(&st->inst_sel);
     sy_mirror_map_free(&st->inst_place);
     free(st);
@@ -61,6 +62,8 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     rt_state *st = calloc(1, sizeof *st);
     if (!st) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "rt mediator: out of memory");
     st->inst_node = SY_MIRROR_MAP_INIT(uint32_t);
+    st->motion_rec = SY_MIRROR_MAP_INIT(rt_motion_rec);
+    st->motion_steps = 2;
     st->inst_sel = SY_MIRROR_MAP_INIT(uint8_t);
     st->inst_place = SY_MIRROR_MAP_INIT(uint32_t);
     sy_rt_device_desc dd = sy_rti_device_desc(st, (uint32_t)threads, (uint64_t)max_memory_mb << 20);

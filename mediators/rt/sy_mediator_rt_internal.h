@@ -72,6 +72,12 @@ typedef struct pt_filter_cfg {
 
 /* The scene mirror (textures, materials, meshes, lights, backgrounds, nodes and placements) is
  * mediators/sy_mirror; this adapter turns its callbacks into Embree back-end calls. */
+/* An instance's placement at each time step of a shutter of more than two steps (step 0 the open),
+ * gathered over the armed syncs (sy_rti_motion, cb_instance). */
+typedef struct rt_motion_rec {
+    float xf[SY_MOTION_STEPS_MAX][16];
+} rt_motion_rec;
+
 typedef struct rt_state {
     sy_rt_device *dev;
     /* the message of the device's last failed call: its error callback (sy_rti_device_desc) writes
@@ -118,6 +124,9 @@ typedef struct rt_state {
     bool motion_other;        /* the armed sync made a mesh or moved a light: not interpolated */
     uint32_t motion_instances; /* instances given motion by the armed sync */
     uint32_t motion_meshes;   /* deformed meshes given motion (two vertex time steps) by the armed sync */
+    uint32_t motion_steps;    /* time steps of the shutter (SY_MOTION_STEPS): 2, or 3 .. SY_MOTION_STEPS_MAX */
+    uint32_t motion_k;        /* while armed with more than two steps: the step the coming sync is at */
+    sy_mirror_map motion_rec; /* while armed with more than two steps: instance handle -> rt_motion_rec */
     bool motion_cam;          /* MOTION_ON with a moving camera (sy_rti_motion_camera) */
     sy_camera_view motion_cam_open; /* a request with this camera (the shutter's open) moves it ... */
     sy_rt_camera motion_cam_close; /* ... to this one at its close (sy_rt_render_desc.camera_close) */

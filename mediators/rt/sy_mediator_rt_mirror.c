@@ -162,8 +162,10 @@ static sy_result cb_primitive_update(void *user, const sy_mirror_primitive_args 
 {
     rt_state *st = user;
     sy_rt_mesh h = {*a->handle};
-    sy_rt_result r = st->motion == MOTION_ARMED ? sy_rt_mesh_update_motion(st->dev, h, a->flat->positions, a->flat->normals)
-                                                : sy_rt_mesh_update(st->dev, h, a->flat->positions, a->flat->normals);
+    /* more than two steps: the close kept, each later sync replacing the open */
+    sy_rt_result r = st->motion != MOTION_ARMED ? sy_rt_mesh_update(st->dev, h, a->flat->positions, a->flat->normals)
+                     : st->motion_steps > 2u   ? sy_rt_mesh_update_motion_keep(st->dev, h, a->flat->positions, a->flat->normals)
+                                               : sy_rt_mesh_update_motion(st->dev, h, a->flat->positions, a->flat->normals);
     if (r == SY_RT_OK && st->motion == MOTION_ARMED) st->motion_meshes++;
     return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "mesh primitive update");
 }
@@ -186,6 +188,17 @@ static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_er
     float close[16];
     bool moving = st->motion == MOTION_ARMED && sy_rt_instance_get_transform(st->dev, h, close) == SY_RT_OK &&
                   memcmp(close, a->world->m, sizeof close) != 0;
+    if (moving && st->motion_steps > 2u) { /* curved motion: this step's placement, applied at the open */
+        rt_motion_rec *rec = sy_mirror_map_get(&st->motion_rec, h.id);
+        if (!rec) { /* its first move since the close: where it was until now is every later step */
+            if (!(rec = sy_mirror_map_put(&st->motion_rec, h.id)))
+                return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "motion: out of memory for the steps of %u instances",
+                                    st->motion_rec.live + 1u);
+            for (uint32_t k = st->motion_k + 1u; k < st->motion_steps; ++k) memcpy(rec->xf[k], close, sizeof close);
+        }
+        for (uint32_t k = 0; k <= st->motion_k; ++k) memcpy(rec->xf[k], a->world->m, sizeof close); /* until it moves again */
+        moving = false;
+    }
     r = sy_rt_instance_set_transform(st->dev, h, a->world->m);
     if (r == SY_RT_OK && moving) { /* motion blur: from here (the open) to where it was synced (the close) */
         r = sy_rt_instance_set_motion(st->dev, h, close);
@@ -230,6 +243,7 @@ static void cb_release(void *user, const sy_mirror_release_args *a)
     case SY_MIRROR_INSTANCE:
         inst_node_set(st, a->handle, 0, 0);
         inst_sel_set(st, a->handle, false);
+        sy_mirror_map_del(&st->motion_rec, a->handle); /* gone before the open: no steps to give it */
         sy_rt_instance_destroy(st->dev, (sy_rt_instance){a->handle});
         break;
     case SY_MIRROR_LIGHT: sy_rt_light_destroy(st->dev, (sy_rt_light){a->handle}); break;
@@ -257,9 +271,40 @@ sy_result sy_rti_motion(void *state, sy_motion_phase phase, uint32_t time_sample
         st->motion_other = false;
         st->motion_instances = 0;
         st->motion_meshes = 0;
+        st->motion_steps = 2;
+        st->motion_k = 0;
+        sy_mirror_map_free(&st->motion_rec);
+        return SY_OK;
+    case SY_MOTION_STEPS:
+        if (st->motion != MOTION_ARMED || time_samples < 3u || time_samples > SY_MOTION_STEPS_MAX)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion: %u time steps (3 .. %u, after begin)", time_samples,
+                                SY_MOTION_STEPS_MAX);
+        st->motion_steps = time_samples;
+        st->motion_k = time_samples - 2u; /* the close (step steps - 1) is synced */
+        return SY_OK;
+    case SY_MOTION_STEP:
+        if (st->motion != MOTION_ARMED || st->motion_k == 0)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion: a time step past the open");
+        st->motion_k--;
         return SY_OK;
     case SY_MOTION_OPENED:
         if (st->motion != MOTION_ARMED) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion: not begun");
+        if (st->motion_steps > 2u && st->motion_k != 0)
+            return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion: opened with %u time steps not synced", st->motion_k);
+        /* curved motion: every instance that moved gets its steps (step 0, the open, is its transform) */
+        for (uint32_t s = 0; st->motion_steps > 2u && s < st->motion_rec.cap; ++s) {
+            rt_motion_rec *rec = sy_mirror_map_slot(&st->motion_rec, s);
+            if (!rec) continue;
+            sy_rt_result r = sy_rt_instance_set_motion_steps(st->dev, (sy_rt_instance){st->motion_rec.keys[s]},
+                                                             st->motion_steps, rec->xf[1]);
+            if (r != SY_RT_OK) return sy_rti_fail(st, err, r, "motion open");
+            st->motion_instances++;
+        }
+        sy_mirror_map_free(&st->motion_rec);
+        if (st->motion_steps > 2u) {
+            sy_rt_result r = sy_rt_commit(st->dev);
+            if (r != SY_RT_OK) return sy_rti_fail(st, err, r, "motion open");
+        }
         st->motion = MOTION_ON;
         if (native) *native = !st->motion_other;
         return SY_OK;
@@ -268,6 +313,8 @@ sy_result sy_rti_motion(void *state, sy_motion_phase phase, uint32_t time_sample
         st->motion = MOTION_OFF;
         st->motion_samples = 0;
         st->motion_cam = false;
+        st->motion_steps = 2;
+        sy_mirror_map_free(&st->motion_rec);
         if (!had) return SY_OK;
         sy_rt_result r = sy_rt_motion_clear(st->dev);
         if (r == SY_RT_OK) r = sy_rt_commit(st->dev); /* a device with staged changes refuses to render */
