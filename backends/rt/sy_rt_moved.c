@@ -6,6 +6,7 @@
  * and sy_rt_scene.c; calls sy_rt_placement.c and sy_rt_mesh.c (never back). */
 #include "sy_rt_scene.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -258,6 +259,10 @@ sy_rt_result sy_rt_instance_set_motion_steps(sy_rt_device *dev, sy_rt_instance i
             char what[64];
             snprintf(what, sizeof what, k + 2u == steps ? "instance set_motion: the close transform"
                                                         : "instance set_motion: the transform of step %u", k + 1u);
+            for (int i = 0; i < 16; ++i)
+                if (!isfinite(later[16u * k + (uint32_t)i]))
+                    return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "%s: [%d] = %g is not finite", what, i,
+                                (double)later[16u * k + (uint32_t)i]);
             sy_rt_result r = sy_rt_placement_recheck(dev, in, later + 16u * k, nrm, what, "");
             if (r != SY_RT_OK) return r;
         }

@@ -9,7 +9,8 @@
  * (sy_rt_mesh_update_motion: its vertices slid 2 m between the close and the open) streaks the same
  * way, and clearing the motion renders bit for bit what a plain update to the open pose renders. A
  * transform or a close transform that shrinks past SY_RT_INSTANCE_GAIN_MAX is refused with the
- * reason for an instance created unbaked and taken by a baked one. */
+ * reason for an instance created unbaked and taken by a baked one. Curved motion
+ * (sy_rt_instance_set_motion_steps, 3 steps along a V) streaks along both legs, instance and baked. */
 #include "rt_test.h"
 
 #define W 40
@@ -418,6 +419,73 @@ static void test_motion(uint32_t flags)
     sy_rt_device_destroy(dev);
 }
 
+/* Rows of a W x W Whitted render with any green (the emitter): top .. bottom (row 0 the top). */
+static void green_rows(sy_rt_device *dev, int *top, int *bottom)
+{
+    sy_rt_camera cam = rt_camera(5.0f, 0.5f);
+    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
+    float *rgba, *depth;
+    rt_render(dev, &cam, &rd, &rgba, &depth);
+    *top = W, *bottom = -1;
+    for (int y = 0; y < W; ++y)
+        for (int x = 0; x < W; ++x)
+            if (rgba[4 * (y * W + x) + 1] > 0.0f) {
+                if (y < *top) *top = y;
+                if (y > *bottom) *bottom = y;
+            }
+    free(rgba);
+    free(depth);
+}
+
+/* Curved motion (sy_rt_instance_set_motion_steps): an emitter moving from x = -1 up to (0, 1) and down
+ * to x = 1 over the shutter (3 steps) streaks along the two legs, 8 rows above its straight path's
+ * top (1 m = 8 px), with its mass kept; with the two ends alone it stays in its rows. Bad step counts
+ * and transforms are refused, steps all equal to the transform are no motion. */
+static void test_motion_steps(uint32_t flags)
+{
+    sy_rt_device *dev = rt_device();
+    sy_rt_mesh q = rt_quad(dev, 0.5f);
+    sy_rt_material green = rt_emitter(dev, 0.0f, 1.0f, 0.0f);
+    float open[16], later[2][16];
+    rt_translation(open, -1.0f, 0.0f, 0.0f);
+    rt_translation(later[0], 0.0f, 1.0f, 0.0f);
+    rt_translation(later[1], 1.0f, 0.0f, 0.0f);
+    sy_rt_instance inst = rt_place(dev, q, open, green, flags);
+    MUST(sy_rt_commit(dev));
+    int top0, bottom0, top2, bottom2, top3, bottom3;
+    green_rows(dev, &top0, &bottom0);
+    MUST(sy_rt_instance_set_motion_steps(dev, inst, 2, later[1])); /* = sy_rt_instance_set_motion */
+    MUST(sy_rt_commit(dev));
+    green_rows(dev, &top2, &bottom2);
+    MUST(sy_rt_instance_set_motion_steps(dev, inst, 3, later[0]));
+    MUST(sy_rt_commit(dev));
+    double c;
+    int lo, hi;
+    double m3 = green_mass(dev, &c, &lo, &hi);
+    green_rows(dev, &top3, &bottom3);
+    printf("flags %u: motion steps: rows %d..%d sharp, %d..%d with 2 steps, %d..%d with 3 (mass %g, columns %d..%d)\n",
+           flags, top0, bottom0, top2, bottom2, top3, bottom3, m3, lo, hi);
+    EXPECT_MSG(top2 == top0 && bottom2 == bottom0, "flags %u: 2 steps: rows %d..%d, not the sharp %d..%d", flags, top2,
+               bottom2, top0, bottom0);
+    EXPECT_MSG(top3 <= top0 - 7 && top3 >= top0 - 9 && bottom3 == bottom0 && lo == 8 && hi == 31 && fabs(m3 - 64.0) < 0.05 * 64.0,
+               "flags %u: 3 steps: rows %d..%d (want %d..%d), columns %d..%d, mass %g", flags, top3, bottom3, top0 - 8,
+               bottom0, lo, hi, m3);
+    float same[2][16], bad[2][16];
+    memcpy(same[0], open, sizeof open), memcpy(same[1], open, sizeof open);
+    memcpy(bad, later, sizeof bad);
+    bad[0][13] = NAN;
+    EXPECT(sy_rt_instance_set_motion_steps(dev, inst, 1, later[0]) == SY_RT_ERROR_INVALID_ARGUMENT);
+    EXPECT(sy_rt_instance_set_motion_steps(dev, inst, SY_RT_MOTION_STEPS_MAX + 1, later[0]) == SY_RT_ERROR_INVALID_ARGUMENT);
+    EXPECT_MSG(sy_rt_instance_set_motion_steps(dev, inst, 3, bad[0]) == SY_RT_ERROR_INVALID_ARGUMENT &&
+                   strstr(rt_test_msg, "step 1"),
+               "flags %u: a NaN step: %s", flags, rt_test_msg);
+    MUST(sy_rt_instance_set_motion_steps(dev, inst, 3, same[0])); /* every step at its transform: no motion */
+    MUST(sy_rt_commit(dev));
+    green_rows(dev, &top3, &bottom3);
+    EXPECT_MSG(top3 == top0 && bottom3 == bottom0, "flags %u: steps equal to the transform: rows %d..%d", flags, top3, bottom3);
+    sy_rt_device_destroy(dev);
+}
+
 int main(void)
 {
     test_move_hide_destroy(0);
@@ -426,6 +494,8 @@ int main(void)
     test_moves_match_rebuild();
     test_motion(0);
     test_motion(SY_RT_INSTANCE_BAKED);
+    test_motion_steps(0);
+    test_motion_steps(SY_RT_INSTANCE_BAKED);
     test_mesh_motion();
     return sy_check_finish("test_rt_instances");
 }
