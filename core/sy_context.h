@@ -62,9 +62,10 @@ sy_result sy_context_motion_begin(sy_context *c, uint32_t time_samples, sy_error
  * SY_MOTION_STEPS_MAX) equally spaced times T_k = T0 + k / (steps - 1) x (T1 - T0): commit the scene
  * at T1 (the close) and call this (it syncs), then for k = steps - 2 down to 1 commit it at T_k and
  * call sy_context_motion_step, then commit it at T0 and call sy_context_motion_open. Every instance
- * that moves is placed at each step and interpolated linearly between consecutive steps (a turn
- * becomes steps - 1 chords of its arc); deformed meshes (skins, morphs) stay linear between the
- * close and the open. steps 2 is sy_context_motion_begin. SY_ERR_UNSUPPORTED (the motion ended)
+ * that moves and every mesh that deforms (skins, morphs) is placed at each step and interpolated
+ * linearly between consecutive steps (a turn becomes steps - 1 chords of its arc); a camera given
+ * with sy_context_motion_camera stays linear between its two ends. steps 2 is
+ * sy_context_motion_begin. SY_ERR_UNSUPPORTED (the motion ended)
  * when the back-end takes only two steps. Thread-safety: as sy_context_render. */
 sy_result sy_context_motion_begin_steps(sy_context *c, uint32_t time_samples, uint32_t steps, sy_error *err);
 /** Syncs the scene committed at an intermediate time step (see sy_context_motion_begin_steps).

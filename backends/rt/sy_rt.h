@@ -429,11 +429,15 @@ sy_rt_result sy_rt_instance_set_motion_steps(sy_rt_device *dev, sy_rt_instance i
  * and what the paragraph above lists. A mesh already in motion moves on: its time-0 pose becomes
  * time 1. sy_rt_commit publishes it. */
 sy_rt_result sy_rt_mesh_update_motion(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals);
-/** As sy_rt_mesh_update_motion, except that a mesh already in motion keeps its time-1 pose and only
- * its time-0 pose is replaced: the syncs of a shutter of more than two steps (close, the steps
- * between, open) give a deforming mesh its close and open poses, linear between them (its
- * intermediate poses are not kept). */
-sy_rt_result sy_rt_mesh_update_motion_keep(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals);
+/** Curved deformation: the mesh's pose at step k (0 = the open .. steps - 2) of a shutter of `steps`
+ * (3 .. SY_RT_MOTION_STEPS_MAX) equally spaced times, given from the close towards the open (as
+ * sy_rt_instance_set_motion_steps: the syncs of sy_context_motion_begin_steps). The first call on a
+ * mesh not in motion keeps the pose it has for every step after k (the close's); each call sets its
+ * step and the earlier ones, time 0 (its open pose) last. Embree interpolates the vertices linearly
+ * between consecutive steps (steps time steps on the geometry), and so does shading. sy_rt_commit
+ * publishes it. */
+sy_rt_result sy_rt_mesh_update_steps(sy_rt_device *dev, sy_rt_mesh mesh, uint32_t steps, uint32_t k, const float *positions,
+                                     const float *normals);
 /** Drops every instance's and mesh's motion (each stays at its transform / time-0 pose);
  * sy_rt_commit publishes it. */
 sy_rt_result sy_rt_motion_clear(sy_rt_device *dev);

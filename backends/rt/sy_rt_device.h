@@ -38,8 +38,13 @@ typedef struct sy_rt_mesh_data {
      * interpolates the vertices linearly (two time steps on geom), shading likewise
      * (sy_rt_surface_fetch_at). */
     bool motion;
-    const float *positions1;  /* Embree's vertex buffer of time step 1 while motion */
+    const float *positions1;  /* Embree's vertex buffer of time step 1 while motion (the last step: the close) */
     float *normals1;          /* own, while motion with normals */
+    /* more than two steps (sy_rt_mesh_update_steps): step k at time k / (motion_steps - 1); steps 1 ..
+     * motion_steps - 2 in pos_mid[k] (Embree's vertex buffers) and nrm_mid[k] (own, with normals) */
+    uint32_t motion_steps;    /* with motion: 2 .. SY_RT_MOTION_STEPS_MAX */
+    const float *pos_mid[SY_RT_MOTION_STEPS_MAX];
+    float *nrm_mid[SY_RT_MOTION_STEPS_MAX];
     uint64_t own_bytes, shared_bytes; /* accounting (sy_rt_device_stats) */
     uint32_t vertex_count, triangle_count;
     int closed;           /* sy_rt_mesh_desc.closed: section caps fill its cut faces (1, -1: its winding) */

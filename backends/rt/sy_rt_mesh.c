@@ -42,6 +42,7 @@ static void mesh_free(sy_rt_device *dev, sy_rt_mesh_data *m)
     if (m->scene) rtcReleaseScene(m->scene);
     free(m->updated_normals);
     free(m->normals1);
+    for (uint32_t k = 0; k < SY_RT_MOTION_STEPS_MAX; ++k) free(m->nrm_mid[k]);
     if (m->motion) dev->motion_count--;
     if (m->shared) {
         if (m->release) m->release(m->release_user);
@@ -306,29 +307,76 @@ void sy_rt_mesh_motion_off(sy_rt_device *dev, sy_rt_mesh_data *m)
     rtcSetGeometryTimeStepCount(m->geom, 1);
     rtcCommitGeometry(m->geom);
     if (m->scene) rtcCommitScene(m->scene);
-    size_t bytes = (size_t)m->vertex_count * 3u * sizeof(float) * (m->normals1 ? 2u : 1u);
+    size_t bytes = (size_t)m->vertex_count * 3u * sizeof(float) * (m->normals1 ? 2u : 1u) * (m->motion_steps - 1u);
     m->own_bytes -= bytes;
     dev->mesh_bytes -= bytes;
     free(m->normals1);
     m->normals1 = NULL;
     m->positions1 = NULL;
+    for (uint32_t k = 0; k < SY_RT_MOTION_STEPS_MAX; ++k) free(m->nrm_mid[k]), m->nrm_mid[k] = NULL, m->pos_mid[k] = NULL;
+    m->motion_steps = 0;
     m->motion = false;
     dev->motion_count--;
     dev->dirty = dev->top_dirty = dev->shadow_dirty = dev->area_dirty = true;
 }
 
-sy_rt_result sy_rt_mesh_update_motion_keep(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals)
+sy_rt_result sy_rt_mesh_update_steps(sy_rt_device *dev, sy_rt_mesh mesh, uint32_t steps, uint32_t k, const float *positions,
+                                     const float *normals)
 {
-    const sy_rt_mesh_data *m = dev && positions ? sy_rt_pool_get(&dev->meshes, mesh.id) : NULL;
-    if (!m || !m->motion) return sy_rt_mesh_update_motion(dev, mesh, positions, normals);
-    sy_rt_result r = sy_rt_mesh_update(dev, mesh, positions, normals); /* time 0; time 1 (the close) kept */
+    if (!dev || !positions) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh update_steps: NULL argument");
+    sy_rt_mesh_data *m = sy_rt_pool_get(&dev->meshes, mesh.id);
+    if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "mesh update_steps: mesh handle 0x%08x is stale", mesh.id);
+    if (steps < 3u || steps > SY_RT_MOTION_STEPS_MAX || k + 2u > steps)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh update_steps: step %u of %u (3 .. %u steps, step < steps - 1)", k, steps,
+                    SY_RT_MOTION_STEPS_MAX);
+    size_t vc = m->vertex_count, n3 = vc * 3u * sizeof(float);
+    if (m->motion && m->motion_steps != steps) sy_rt_mesh_motion_off(dev, m); /* another shutter: start over */
+    if (!m->motion) { /* its first deformation since the close: the pose it has is every later step's */
+        float *buf[SY_RT_MOTION_STEPS_MAX] = {0}, *nrm[SY_RT_MOTION_STEPS_MAX] = {0};
+        bool ok = true;
+        for (uint32_t s = 1; s < steps && ok; ++s) ok = !m->normals || (nrm[s] = malloc(n3 + 1)) != NULL;
+        if (ok) rtcSetGeometryTimeStepCount(m->geom, steps);
+        for (uint32_t s = 1; s < steps && ok; ++s)
+            ok = (buf[s] = rtcSetNewGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, s, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                   m->vertex_count)) != NULL;
+        if (!ok) {
+            rtcSetGeometryTimeStepCount(m->geom, 1);
+            for (uint32_t s = 1; s < steps; ++s) free(nrm[s]);
+            sy_rt_result r = sy_rt_check_embree(dev, "mesh update_steps: vertex buffers");
+            return r != SY_RT_OK ? r : FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "mesh update_steps: out of memory for %u steps", steps);
+        }
+        for (uint32_t s = 1; s < steps; ++s) {
+            memcpy(buf[s], m->positions, n3);
+            if (nrm[s]) memcpy(nrm[s], m->normals, n3);
+            rtcUpdateGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, s);
+            if (s + 1u < steps) m->pos_mid[s] = buf[s], m->nrm_mid[s] = nrm[s];
+        }
+        m->positions1 = buf[steps - 1u];
+        m->normals1 = nrm[steps - 1u];
+        m->motion = true;
+        m->motion_steps = steps;
+        dev->motion_count++;
+        size_t bytes = n3 * (m->normals ? 2u : 1u) * (steps - 1u);
+        m->own_bytes += bytes;
+        dev->mesh_bytes += bytes;
+    }
+    sy_rt_result r = sy_rt_mesh_update(dev, mesh, positions, normals); /* time 0; checks the arguments */
     if (r != SY_RT_OK) return r;
-    sy_rt_mesh_data *mm = sy_rt_pool_get(&dev->meshes, mesh.id);
-    float extent = mm->extent; /* both poses' */
-    for (size_t i = 0; i < (size_t)mm->vertex_count * 3u; ++i) extent = fmaxf(extent, fabsf(mm->positions1[i]));
-    mm->extent = extent;
+    for (uint32_t s = 1; s <= k; ++s) { /* steps 1 .. k: this pose until an earlier step moves it on */
+        memcpy((float *)m->pos_mid[s], positions, n3);
+        if (m->nrm_mid[s] && normals) memcpy(m->nrm_mid[s], normals, n3);
+        rtcUpdateGeometryBuffer(m->geom, RTC_BUFFER_TYPE_VERTEX, s);
+    }
+    float extent = m->extent;
+    for (uint32_t s = 1; s < steps; ++s) {
+        const float *p = s + 1u < steps ? m->pos_mid[s] : m->positions1;
+        for (size_t i = 0; i < vc * 3u; ++i) extent = fmaxf(extent, fabsf(p[i]));
+    }
+    m->extent = extent;
+    rtcCommitGeometry(m->geom);
+    if (m->scene) rtcCommitScene(m->scene);
     dev->dirty = dev->top_dirty = dev->shadow_dirty = dev->area_dirty = true;
-    return r;
+    return sy_rt_check_embree(dev, "mesh update_steps");
 }
 
 sy_rt_result sy_rt_mesh_update_motion(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals)
@@ -361,6 +409,7 @@ sy_rt_result sy_rt_mesh_update_motion(sy_rt_device *dev, sy_rt_mesh mesh, const 
         }
         m->positions1 = p1;
         m->motion = true;
+        m->motion_steps = 2;
         dev->motion_count++;
         size_t bytes = vc * 3u * sizeof(float) * (close_n ? 2u : 1u);
         m->own_bytes += bytes;

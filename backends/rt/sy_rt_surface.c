@@ -260,11 +260,22 @@ void sy_rt_surface_fetch_at(const sy_rt_device *dev, const sy_rt_instance_data *
     const uint32_t *ix = m->indices + 3u * prim;
     static const uint32_t idx[3] = {0, 1, 2};
     float pos[9], nrm[9], uv[2][6], col[12];
+    /* the two steps around the time, as Embree finds them (two steps: open and close) */
+    const float *p0 = m->positions, *p1 = m->positions1, *n0 = m->normals, *n1 = m->normals1;
+    float f = time;
+    if (m->motion_steps > 2u) {
+        float st = time * (float)(m->motion_steps - 1u);
+        uint32_t seg = st > 0.0f ? (uint32_t)st : 0u;
+        if (seg > m->motion_steps - 2u) seg = m->motion_steps - 2u;
+        f = st - (float)seg;
+        if (seg > 0u) p0 = m->pos_mid[seg], n0 = m->nrm_mid[seg];
+        if (seg + 2u < m->motion_steps) p1 = m->pos_mid[seg + 1u], n1 = m->nrm_mid[seg + 1u];
+    }
     for (int c = 0; c < 3; ++c) {
         size_t k = ix[c];
         for (int a = 0; a < 3; ++a) {
-            pos[3 * c + a] = (1.0f - time) * m->positions[3 * k + a] + time * m->positions1[3 * k + a];
-            if (m->normals) nrm[3 * c + a] = (1.0f - time) * m->normals[3 * k + a] + time * (m->normals1 ? m->normals1[3 * k + a] : m->normals[3 * k + a]);
+            pos[3 * c + a] = (1.0f - f) * p0[3 * k + a] + f * p1[3 * k + a];
+            if (m->normals) nrm[3 * c + a] = (1.0f - f) * (n0 ? n0 : m->normals)[3 * k + a] + f * (n1 ? n1 : m->normals)[3 * k + a];
         }
         for (int set = 0; set < 2; ++set)
             if (m->uv[set]) uv[set][2 * c] = m->uv[set][2 * k], uv[set][2 * c + 1] = m->uv[set][2 * k + 1];

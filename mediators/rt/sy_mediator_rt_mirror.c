@@ -162,10 +162,11 @@ static sy_result cb_primitive_update(void *user, const sy_mirror_primitive_args 
 {
     rt_state *st = user;
     sy_rt_mesh h = {*a->handle};
-    /* more than two steps: the close kept, each later sync replacing the open */
+    /* more than two steps: this sync's step (the close kept from the first deformation on) */
     sy_rt_result r = st->motion != MOTION_ARMED ? sy_rt_mesh_update(st->dev, h, a->flat->positions, a->flat->normals)
-                     : st->motion_steps > 2u   ? sy_rt_mesh_update_motion_keep(st->dev, h, a->flat->positions, a->flat->normals)
-                                               : sy_rt_mesh_update_motion(st->dev, h, a->flat->positions, a->flat->normals);
+                     : st->motion_steps > 2u
+                         ? sy_rt_mesh_update_steps(st->dev, h, st->motion_steps, st->motion_k, a->flat->positions, a->flat->normals)
+                         : sy_rt_mesh_update_motion(st->dev, h, a->flat->positions, a->flat->normals);
     if (r == SY_RT_OK && st->motion == MOTION_ARMED) st->motion_meshes++;
     return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "mesh primitive update");
 }

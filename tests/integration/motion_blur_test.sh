@@ -28,7 +28,8 @@
 # steps): its streak matches the sub-frames' (IoU >= 0.95, mean alpha within 0.01), and shutter 0 or
 # a shutter over which nothing deforms renders bit for bit as without it. A camera moved over the
 # shutter is interpolated per camera ray too (except in stereo: sub-frames, with a note), and with
-# --shutter-steps 9 a spinning bar's streak follows the arc, not the chord.
+# --shutter-steps a spinning bar's streak (9 steps) and a square deformed along an arc (5 steps) follow
+# the arc, not the chord.
 # Usage errors (status 2, naming the option): a negative, NaN, infinite or non-numeric shutter, open
 # after close, --shutter with --motion-blur, --shutter-samples alone or 0, --sub-frames alone,
 # --shutter-steps alone or outside 2..9.
@@ -374,6 +375,45 @@ for b in "$@"; do
     gt "$(awk -v s="$sa" 'BEGIN { print s * 0.8 }')" "$ca" || fail "$b spinning bar: 2 steps cover $ca, not a chord's less than the arc's $sa"
     near "$aa" "$sa" 0.002 || fail "$b spinning bar: 9 steps cover $aa, not the sub-frames' $sa within 0.002"
     gt "$iou" 0.93 || fail "$b spinning bar: 9 steps against the sub-frames: IoU $iou < 0.93"
+done
+
+# curved deformation: a 0.6 m square whose vertices a CoordinateInterpolator carries a quarter turn
+# round the origin at radius 2 (5 keys: a polyline of 4 chords of the arc) over the shutter 0..1. With
+# the two ends alone the ray tracers slide it along the one chord (covered area, mean alpha, two thirds
+# of the 64 sub-frames': measured 0.0062 Whitted against 0.0093, IoU 0.30); with 5 steps (the keys'
+# times) it follows the polyline the sub-frames sample (mean alpha within 0.0005, measured 0.000005
+# Whitted; IoU of alpha > 0.02 >= 0.9, measured 0.93 Whitted, 0.97 path tracer)
+cat >"$TMP/arc.x3d" <<'EOF'
+<X3D><Scene><Viewpoint position='0 0 12' fieldOfView='0.5'/>
+<Shape><Appearance><Material diffuseColor='0.8 0.4 0.2'/></Appearance>
+<IndexedFaceSet coordIndex='0 1 2 3 -1'><Coordinate DEF='C' point='1.70000 -0.30000 0.00000 2.30000 -0.30000 0.00000 2.30000 0.30000 0.00000 1.70000 0.30000 0.00000'/></IndexedFaceSet></Shape>
+<TimeSensor DEF='Clock' cycleInterval='1'/>
+<CoordinateInterpolator DEF='Morph' key='0 0.25 0.5 0.75 1' keyValue='1.70000 -0.30000 0.00000 2.30000 -0.30000 0.00000 2.30000 0.30000 0.00000 1.70000 0.30000 0.00000 1.68540 0.37340 0.00000 2.23973 0.60301 0.00000 2.01012 1.15734 0.00000 1.45579 0.92773 0.00000 1.41421 0.98995 0.00000 1.83848 1.41421 0.00000 1.41421 1.83848 0.00000 0.98995 1.41421 0.00000 0.92773 1.45579 0.00000 1.15734 2.01012 0.00000 0.60301 2.23973 0.00000 0.37340 1.68540 0.00000 0.30000 1.70000 0.00000 0.30000 2.30000 0.00000 -0.30000 2.30000 0.00000 -0.30000 1.70000 0.00000'/>
+<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Morph' toField='set_fraction'/>
+<ROUTE fromNode='Morph' fromField='value_changed' toNode='C' toField='set_point'/>
+</Scene></X3D>
+EOF
+for b in "$@"; do
+    [ "$b" = raster ] && continue
+    extra=()
+    [ "$b" = pathtracer ] && extra=(--spp 64)
+    a() { # a NAME ARGS...: renders the turning square with back-end $b into $TMP/${b}_arc_NAME.exr
+        local name=$1
+        shift
+        run_ok "$b arc $name" "${b}_arc_$name" "$SY" render "$TMP/arc.x3d" -b "$b" -w 96 -h 96 "${extra[@]}" --at 0 \
+            --shutter 0,1 -o "$TMP/${b}_arc_$name.exr" "$@"
+    }
+    a sub --sub-frames --shutter-samples 64
+    a chord
+    a arc --shutter-steps 5
+    read -r _ _ _ sa <<<"$("$EXR_BLUR" mean "$TMP/${b}_arc_sub.exr")"
+    read -r _ _ _ ca <<<"$("$EXR_BLUR" mean "$TMP/${b}_arc_chord.exr")"
+    read -r _ _ _ aa <<<"$("$EXR_BLUR" mean "$TMP/${b}_arc_arc.exr")"
+    iou=$("$EXR_BLUR" iou 0.02 "$TMP/${b}_arc_arc.exr" 0.02 "$TMP/${b}_arc_sub.exr" "$TMP/${b}_arc_sub.exr")
+    echo "$b deforming along an arc: mean alpha 2 steps $ca, 5 steps $aa, 64 sub-frames $sa; IoU of 5 steps against the sub-frames $iou"
+    gt "$(awk -v s="$sa" 'BEGIN { print s * 0.8 }')" "$ca" || fail "$b deforming arc: 2 steps cover $ca, not a chord's less than $sa"
+    near "$aa" "$sa" 0.0005 || fail "$b deforming arc: 5 steps cover $aa, not the sub-frames' $sa within 0.0005"
+    gt "$iou" 0.9 || fail "$b deforming arc: 5 steps against the sub-frames: IoU $iou < 0.9"
 done
 
 # a sequence: frame 6 at 24 fps with --motion-blur (0,1/48) equals --at 0.25 with the same shutter, bit
