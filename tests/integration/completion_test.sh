@@ -88,8 +88,9 @@ expect "render -w 64 demo --ao" --aov
 expect "render demo --a" --at --aov
 expect "render demo --cl" --clip --cluster
 expect "render demo --at 1.5 --cl" --clip
-# motion blur: --shutter and --shutter-samples take a value, --motion-blur does not
-expect "render demo --sh" --shutter --shutter-samples
+# motion blur: --shutter, --shutter-samples and --shutter-steps take a value, --motion-blur does not
+expect "render demo --sh" --shutter --shutter-samples --shutter-steps
+expect "render demo --shutter-steps 4 --cl" --clip
 expect "render demo --mo" --motion-blur
 expect "render demo --shutter 0.02 --cl" --clip
 # the camera placement: --look-at, --orbit and --fov in render, pick, view and web; they take a value
