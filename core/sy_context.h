@@ -63,9 +63,8 @@ sy_result sy_context_motion_begin(sy_context *c, uint32_t time_samples, sy_error
  * at T1 (the close) and call this (it syncs), then for k = steps - 2 down to 1 commit it at T_k and
  * call sy_context_motion_step, then commit it at T0 and call sy_context_motion_open. Every instance
  * that moves and every mesh that deforms (skins, morphs) is placed at each step and interpolated
- * linearly between consecutive steps (a turn becomes steps - 1 chords of its arc); a camera given
- * with sy_context_motion_camera stays linear between its two ends. steps 2 is
- * sy_context_motion_begin. SY_ERR_UNSUPPORTED (the motion ended)
+ * linearly between consecutive steps (a turn becomes steps - 1 chords of its arc); so is a camera
+ * given at each step with sy_context_motion_camera. steps 2 is sy_context_motion_begin. SY_ERR_UNSUPPORTED (the motion ended)
  * when the back-end takes only two steps. Thread-safety: as sy_context_render. */
 sy_result sy_context_motion_begin_steps(sy_context *c, uint32_t time_samples, uint32_t steps, sy_error *err);
 /** Syncs the scene committed at an intermediate time step (see sy_context_motion_begin_steps).
@@ -76,13 +75,15 @@ sy_result sy_context_motion_step(sy_context *c, sy_error *err);
  * sy_context_render. */
 sy_result sy_context_motion_open(sy_context *c, bool *native, sy_error *err);
 /** A camera that moves over the shutter (after sy_context_motion_open; see sy_context_motion_begin):
- * open and close are the view at the shutter's open and close; a render request whose camera is open
- * has each camera ray built at its own time, position and window interpolated linearly, orientation
- * by slerp, until sy_context_motion_end (requests with another camera, a stereo eye, stay still). SY_ERR_UNSUPPORTED naming the back-end when its class does not interpolate
+ * open is the view at the shutter's open, later[0 .. steps - 2] the views at the equally spaced
+ * times after it (steps 2 .. SY_MOTION_STEPS_MAX; later[steps - 2] the close: steps 2 is the open and
+ * the close alone); a render request whose camera is open has each camera ray built at its own
+ * time, position and window interpolated linearly between the two steps around it, orientation by
+ * slerp, until sy_context_motion_end (requests with another camera, a stereo eye, stay still). SY_ERR_UNSUPPORTED naming the back-end when its class does not interpolate
  * the camera (then blur another way), SY_ERR_INVALID_ARGUMENT when the motion is not open. On error
  * the motion stays as it was. Thread-safety: as sy_context_render. */
-sy_result sy_context_motion_camera(sy_context *c, const sy_camera_view *open, const sy_camera_view *close,
-                                  sy_error *err);
+sy_result sy_context_motion_camera(sy_context *c, const sy_camera_view *open, uint32_t steps,
+                                  const sy_camera_view *later, sy_error *err);
 /** Ends motion blur (see sy_context_motion_begin): the context renders sharp again. Thread-safety:
  * as sy_context_render. */
 void sy_context_motion_end(sy_context *c);

@@ -428,13 +428,15 @@ sy_result sy_context_motion_open(sy_context *c, bool *native, sy_error *err)
     return r;
 }
 
-sy_result sy_context_motion_camera(sy_context *c, const sy_camera_view *open, const sy_camera_view *close,
-                                  sy_error *err)
+sy_result sy_context_motion_camera(sy_context *c, const sy_camera_view *open, uint32_t steps,
+                                  const sy_camera_view *later, sy_error *err)
 {
     if (!(sy_context_caps(c) & SY_CAP_MOTION) || !c->cls->motion || !c->cls->motion_camera)
         return sy_error_set(err, SY_ERR_UNSUPPORTED, "back-end '%s' does not interpolate a moving camera over the shutter",
                             c->cls->name);
-    return c->cls->motion_camera(c->state, open, close, err);
+    if (steps < 2u || steps > SY_MOTION_STEPS_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion camera: %u steps (2 .. %u)", steps, SY_MOTION_STEPS_MAX);
+    return c->cls->motion_camera(c->state, open, steps, later, err);
 }
 
 void sy_context_motion_end(sy_context *c)

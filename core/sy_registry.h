@@ -202,10 +202,12 @@ typedef struct sy_mediator_class {
     sy_result (*motion)(void *state, sy_motion_phase phase, uint32_t time_samples, bool *native, sy_error *err);
     /** SY_CAP_MOTION, optional (sy_context_motion_camera): while in motion (after SY_MOTION_OPENED),
      * a request whose camera is open is rendered with each camera ray built at its own time between
-     * open and close (the shutter's), until SY_MOTION_END; requests with another camera stay still.
-     * NULL: the class does not interpolate the camera (the caller blurs a moving camera by
-     * sub-frames). Appended last. */
-    sy_result (*motion_camera)(void *state, const sy_camera_view *open, const sy_camera_view *close, sy_error *err);
+     * open and later[steps - 2] (the shutter's close) through later[0 .. steps - 3] (the equally
+     * spaced steps between; steps 2 .. SY_MOTION_STEPS_MAX), until SY_MOTION_END; requests with
+     * another camera stay still. NULL: the class does not interpolate the camera (the caller blurs a
+     * moving camera by sub-frames). Appended last. */
+    sy_result (*motion_camera)(void *state, const sy_camera_view *open, uint32_t steps, const sy_camera_view *later,
+                               sy_error *err);
 } sy_mediator_class;
 
 /** Registry (process-wide; the one piece of global state). The class must outlive the process's

@@ -280,25 +280,29 @@ static bool motion_native_begin(loaded *ld, const char *clip, double frame_time,
         return false;
     sy_context_restart(c); /* placed as a fresh build places them, accumulation from sample 0 */
     bool native = false, camera_moves = false, camera_stays = false;
-    sy_camera_view v_close, v_open; /* the camera's two ends: each camera ray at its own time between them */
-    memset(&v_close, 0, sizeof v_close);
+    /* the camera at the open and at each later step (v_later[steps - 2]: the close): each camera ray
+     * at its own time between them */
+    sy_camera_view v_open, v_later[SY_MOTION_STEPS_MAX];
     memset(&v_open, 0, sizeof v_open);
+    memset(v_later, 0, sizeof v_later);
     sy_error ce = {0};
     /* --shutter-steps N: the steps between, from the close towards the open (curved motion) */
     bool stepped = sy_cli_set_time(ld, clip, frame_time + sh->close, &e) == 0 &&
-                   sy_compose_camera_view(ld->scene, spec, w, h, &v_close, &e) == SY_OK &&
+                   sy_compose_camera_view(ld->scene, spec, w, h, &v_later[steps - 2u], &e) == SY_OK &&
                    sy_context_motion_begin_steps(c, sh->samples, steps, &e) == SY_OK;
     for (uint32_t k = steps - 2u; stepped && k >= 1u; --k)
         stepped = sy_cli_set_time(ld, clip, frame_time + sh->open + (sh->close - sh->open) * k / (steps - 1u), &e) == 0 &&
+                  sy_compose_camera_view(ld->scene, spec, w, h, &v_later[k - 1u], &e) == SY_OK &&
                   sy_context_motion_step(c, &e) == SY_OK;
     if (stepped &&
         sy_cli_set_time(ld, clip, frame_time + sh->open, &e) == 0 &&
         sy_compose_camera_view(ld->scene, spec, w, h, &v_open, &e) == SY_OK &&
         sy_context_motion_open(c, &native, &e) == SY_OK && native) {
-        camera_moves = memcmp(&v_close, &v_open, sizeof v_open) != 0;
+        for (uint32_t k = 0; k + 1u < steps; ++k) camera_moves |= memcmp(&v_later[k], &v_open, sizeof v_open) != 0;
         /* a moving camera: the back-end builds each camera ray at its time (the mono view only: stereo
          * eyes are other views) */
-        if (!camera_moves || (spec->stereo == SY_STEREO_NONE && sy_context_motion_camera(c, &v_open, &v_close, &ce) == SY_OK)) {
+        if (!camera_moves ||
+            (spec->stereo == SY_STEREO_NONE && sy_context_motion_camera(c, &v_open, steps, v_later, &ce) == SY_OK)) {
             *motion_camera = camera_moves;
             *ctx_out = c;
             return true;

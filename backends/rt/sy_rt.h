@@ -644,6 +644,12 @@ typedef struct sy_rt_render_desc {
      * (Whitted: at least time_samples samples). Same projection as the camera. NULL, or a camera
      * equal to the camera: a still camera, bit for bit the render without it. */
     const sy_rt_camera *camera_close;
+    /** With camera_close, optional (curved camera motion): camera_steps (3 .. SY_RT_MOTION_STEPS_MAX)
+     * equally spaced cameras in all, camera_mid the camera_steps - 2 between the open and the close
+     * (step k at ray time k / (camera_steps - 1)); each ray interpolates between the two steps around
+     * its time as above. 0 or 2: the open and the close alone. */
+    const sy_rt_camera *camera_mid;
+    uint32_t camera_steps;
 } sy_rt_render_desc;
 
 /** Renders the sub-rectangle. rgba: width*height*4 floats (required); depth: width*height floats

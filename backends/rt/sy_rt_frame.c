@@ -6,6 +6,7 @@
 
 #include <omp.h>
 #include <stdatomic.h>
+#include <stdio.h>
 #include <string.h>
 
 #define FAIL(r, ...) sy_rt_fail(dev, (r), __VA_ARGS__)
@@ -154,25 +155,50 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
     f->seed = d->seed;
     f->rgba = rgba;
     f->depth = depth;
-    if (d->camera_close && memcmp(d->camera_close->camera_to_world, cam->camera_to_world, sizeof cam->camera_to_world) |
-                               memcmp(d->camera_close->window, cam->window, sizeof cam->window) |
-                               (d->camera_close->near_clip != cam->near_clip) | (d->camera_close->far_clip != cam->far_clip)) {
-        const float *m1 = d->camera_close->camera_to_world;
-        f->cam_motion = true;
-        f->cam_x1 = v3(m1[0], m1[1], m1[2]);
-        f->cam_y1 = v3(m1[4], m1[5], m1[6]);
-        f->cam_z1 = v3(m1[8], m1[9], m1[10]);
-        f->cam_pos1 = v3(m1[12], m1[13], m1[14]);
-        if (v3_is_zero(f->cam_z1)) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: shutter close: camera Z axis is zero");
-        memcpy(f->window1, d->camera_close->window, sizeof f->window1);
-        f->near_clip1 = d->camera_close->near_clip;
-        f->far_clip1 = d->camera_close->far_clip;
-        /* infinite at one end and finite at the other: infinite throughout */
-        if ((f->far_clip1 > 0.0f) != (f->far_clip > 0.0f)) f->far_clip1 = f->far_clip = 0.0f;
-        f->cam_slerp = orientation(f->cam_x, f->cam_y, f->cam_z, f->q0, &f->scale0) &&
-                       orientation(f->cam_x1, f->cam_y1, f->cam_z1, f->q1, &f->scale1);
-        if (f->cam_slerp && f->q0[0] * f->q1[0] + f->q0[1] * f->q1[1] + f->q0[2] * f->q1[2] + f->q0[3] * f->q1[3] < 0.0f)
-            for (int i = 0; i < 4; ++i) f->q1[i] = -f->q1[i]; /* the shorter way round */
+    uint32_t steps = d->camera_close ? (d->camera_steps > 2u ? d->camera_steps : 2u) : 0u;
+    if (steps > SY_RT_MOTION_STEPS_MAX || (steps > 2u && !d->camera_mid))
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: %u camera steps (2 .. %u, camera_mid for more than 2)",
+                    d->camera_steps, SY_RT_MOTION_STEPS_MAX);
+    for (uint32_t k = 1; k < steps; ++k) { /* the steps after the open; moving when one differs from it */
+        const sy_rt_camera *ck = k + 1u == steps ? d->camera_close : d->camera_mid + (k - 1u);
+        if (k + 1u < steps) {
+            char which[32];
+            snprintf(which, sizeof which, "camera step %u: ", k);
+            if ((cr = camera_check(dev, ck, which)) != SY_RT_OK) return cr;
+            if (ck->projection != cam->projection)
+                return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: camera step %u has another projection", k);
+        }
+        if (memcmp(ck->camera_to_world, cam->camera_to_world, sizeof cam->camera_to_world) |
+            memcmp(ck->window, cam->window, sizeof cam->window) | (ck->near_clip != cam->near_clip) |
+            (ck->far_clip != cam->far_clip))
+            f->cam_motion = true;
+    }
+    if (f->cam_motion) {
+        f->cam_steps = steps;
+        f->cam_slerp = true;
+        bool finite = f->far_clip > 0.0f, mixed = false;
+        for (uint32_t k = 0; k < steps; ++k) {
+            const sy_rt_camera *ck = k == 0 ? cam : k + 1u == steps ? d->camera_close : d->camera_mid + (k - 1u);
+            const float *m1 = ck->camera_to_world;
+            struct sy_rt_cam_step *c = &f->cam_step[k];
+            c->x = v3(m1[0], m1[1], m1[2]);
+            c->y = v3(m1[4], m1[5], m1[6]);
+            c->z = v3(m1[8], m1[9], m1[10]);
+            c->pos = v3(m1[12], m1[13], m1[14]);
+            if (v3_is_zero(c->z)) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "render: camera step %u: camera Z axis is zero", k);
+            memcpy(c->window, ck->window, sizeof c->window);
+            c->near_clip = ck->near_clip;
+            c->far_clip = ck->far_clip;
+            mixed |= (c->far_clip > 0.0f) != finite;
+            f->cam_slerp = orientation(c->x, c->y, c->z, c->q, &c->scale) && f->cam_slerp;
+            const float *p = k ? f->cam_step[k - 1u].q : NULL;
+            if (p && p[0] * c->q[0] + p[1] * c->q[1] + p[2] * c->q[2] + p[3] * c->q[3] < 0.0f)
+                for (int i = 0; i < 4; ++i) c->q[i] = -c->q[i]; /* the shorter way round */
+        }
+        if (mixed) { /* infinite at one step and finite at another: infinite throughout */
+            f->far_clip = 0.0f;
+            for (uint32_t k = 0; k < steps; ++k) f->cam_step[k].far_clip = 0.0f;
+        }
     }
     return SY_RT_OK;
 }
@@ -231,24 +257,30 @@ void sy_rt_frame_ray_time(const sy_rt_frame *f, float fx, float fy, float time, 
         ray->time = time;
         return;
     }
+    /* the two steps around the time, as Embree finds them for moving instances */
+    float st = time * (float)(f->cam_steps - 1u), t = st;
+    uint32_t k = st > 0.0f ? (uint32_t)st : 0u;
+    if (k > f->cam_steps - 2u) k = f->cam_steps - 2u;
+    t = st - (float)k;
+    const struct sy_rt_cam_step *a = &f->cam_step[k], *b = &f->cam_step[k + 1u];
     float window[4];
-    for (int i = 0; i < 4; ++i) window[i] = lerpf(f->window[i], f->window1[i], time);
+    for (int i = 0; i < 4; ++i) window[i] = lerpf(a->window[i], b->window[i], t);
     cam_basis c;
     c.window = window;
-    c.pos = v3_lerp(f->cam_pos, f->cam_pos1, time);
-    c.near_clip = lerpf(f->near_clip, f->near_clip1, time);
-    c.far_clip = lerpf(f->far_clip, f->far_clip1, time);
+    c.pos = v3_lerp(a->pos, b->pos, t);
+    c.near_clip = lerpf(a->near_clip, b->near_clip, t);
+    c.far_clip = lerpf(a->far_clip, b->far_clip, t);
     if (f->cam_slerp) { /* the orientation slerped, the axes' lengths lerped */
         float q[4];
-        slerp(f->q0, f->q1, time, q);
+        slerp(a->q, b->q, t, q);
         sy_rt_v3 r[3];
         quat_axes(q, r);
-        sy_rt_v3 s = v3_lerp(f->scale0, f->scale1, time);
+        sy_rt_v3 s = v3_lerp(a->scale, b->scale, t);
         c.x = v3_scale(r[0], s.x), c.y = v3_scale(r[1], s.y), c.z = v3_scale(r[2], s.z);
     } else {
-        c.x = v3_lerp(f->cam_x, f->cam_x1, time);
-        c.y = v3_lerp(f->cam_y, f->cam_y1, time);
-        c.z = v3_lerp(f->cam_z, f->cam_z1, time);
+        c.x = v3_lerp(a->x, b->x, t);
+        c.y = v3_lerp(a->y, b->y, t);
+        c.z = v3_lerp(a->z, b->z, t);
     }
     c.forward = v3_normalize(v3_scale(c.z, -1.0f));
     if (v3_is_zero(c.forward)) c.forward = f->forward; /* lerped axes through zero (never with slerp) */

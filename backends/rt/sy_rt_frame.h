@@ -21,14 +21,18 @@ typedef struct sy_rt_frame {
     sy_rt_integrator integrator;
     uint32_t max_depth, light_samples, seed;
     float *rgba, *depth;                   /* output, row 0 = top of the rectangle */
-    /* motion blur of the camera (sy_rt_render_desc.camera_close): the camera above at ray time 0,
-     * this one at time 1; cam_motion false when there is none or it equals the camera */
+    /* motion blur of the camera (sy_rt_render_desc.camera_close, camera_mid): the camera above at ray
+     * time 0 (cam_step[0]), cam_step[k] at time k / (cam_steps - 1); cam_motion false when there is
+     * none or every step equals the camera */
     bool cam_motion;
-    bool cam_slerp;                        /* both orientations orthogonal: slerp, else the columns lerped */
-    float q0[4], q1[4];                    /* the orientations (x, y, z, w), q1 on q0's hemisphere */
-    sy_rt_v3 scale0, scale1;               /* the columns' lengths */
-    sy_rt_v3 cam_pos1, cam_x1, cam_y1, cam_z1;
-    float window1[4], near_clip1, far_clip1;
+    bool cam_slerp;                        /* every orientation orthogonal: slerp, else the columns lerped */
+    uint32_t cam_steps;
+    struct sy_rt_cam_step {
+        sy_rt_v3 pos, x, y, z;             /* camera-to-world columns */
+        float q[4];                        /* the orientation (x, y, z, w), on the previous step's hemisphere */
+        sy_rt_v3 scale;                    /* the columns' lengths */
+        float window[4], near_clip, far_clip;
+    } cam_step[SY_RT_MOTION_STEPS_MAX];
 } sy_rt_frame;
 
 /* Validates camera and desc and fills a frame (output pointers included). */

@@ -130,6 +130,8 @@ typedef struct rt_state {
     bool motion_cam;          /* MOTION_ON with a moving camera (sy_rti_motion_camera) */
     sy_camera_view motion_cam_open; /* a request with this camera (the shutter's open) moves it ... */
     sy_rt_camera motion_cam_close; /* ... to this one at its close (sy_rt_render_desc.camera_close) */
+    uint32_t motion_cam_steps;     /* ... through these between (camera_mid, camera_steps) */
+    sy_rt_camera motion_cam_mid[SY_MOTION_STEPS_MAX];
 } rt_state;
 
 /* --- sy_mediator_rt_base.c --- */
@@ -162,7 +164,8 @@ sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err);
 /* SY_CAP_MOTION (sy_mediator_class.motion): the phases of a motion-blurred render. */
 sy_result sy_rti_motion(void *state, sy_motion_phase phase, uint32_t time_samples, bool *native, sy_error *err);
 /* SY_CAP_MOTION (sy_mediator_class.motion_camera): the camera at the shutter's close. */
-sy_result sy_rti_motion_camera(void *state, const sy_camera_view *open, const sy_camera_view *close, sy_error *err);
+sy_result sy_rti_motion_camera(void *state, const sy_camera_view *open, uint32_t steps, const sy_camera_view *later,
+                               sy_error *err);
 
 /* --- sy_mediator_rt_coverage.c --- */
 sy_result sy_rti_coverage_render(rt_state *st, const sy_rt_camera *cam, const sy_rt_render_desc *d, sy_layer *layer,

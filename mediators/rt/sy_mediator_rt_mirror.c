@@ -325,12 +325,17 @@ sy_result sy_rti_motion(void *state, sy_motion_phase phase, uint32_t time_sample
     return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion: unknown phase %d", (int)phase);
 }
 
-sy_result sy_rti_motion_camera(void *state, const sy_camera_view *open, const sy_camera_view *close, sy_error *err)
+sy_result sy_rti_motion_camera(void *state, const sy_camera_view *open, uint32_t steps, const sy_camera_view *later,
+                               sy_error *err)
 {
     rt_state *st = state;
     if (st->motion != MOTION_ON) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion camera: the motion is not open");
+    if (steps < 2u || steps > SY_MOTION_STEPS_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion camera: %u steps (2 .. %u)", steps, SY_MOTION_STEPS_MAX);
     st->motion_cam_open = *open;
-    sy_rti_camera_of(close, &st->motion_cam_close); /* checked by the render (sy_rt_frame_init) */
+    st->motion_cam_steps = steps;
+    for (uint32_t k = 0; k + 2u < steps; ++k) sy_rti_camera_of(&later[k], &st->motion_cam_mid[k]);
+    sy_rti_camera_of(&later[steps - 2u], &st->motion_cam_close); /* checked by the render (sy_rt_frame_init) */
     st->motion_cam = true;
     return SY_OK;
 }

@@ -117,6 +117,8 @@ static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_lay
         /* a camera moving over the shutter: each camera ray at its own time (the request's camera is the open) */
         .camera_close = st->motion == MOTION_ON && st->motion_cam && sy_rti_same_view(&req->camera, &st->motion_cam_open)
                             ? &st->motion_cam_close : NULL,
+        .camera_mid = st->motion_cam_mid,
+        .camera_steps = st->motion_cam_steps,
     };
     if (st->integrator == SY_RT_INTEGRATOR_WHITTED && req->preview > 0.0f && req->preview < 1.0f) {
         /* an interactive preview (SY_CAP_PREVIEW): the share `preview` of the camera rays and of the
