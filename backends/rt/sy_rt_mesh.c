@@ -384,6 +384,7 @@ sy_rt_result sy_rt_mesh_update_motion(sy_rt_device *dev, sy_rt_mesh mesh, const 
     if (!dev || !positions) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh update_motion: NULL argument");
     sy_rt_mesh_data *m = sy_rt_pool_get(&dev->meshes, mesh.id);
     if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "mesh update_motion: mesh handle 0x%08x is stale", mesh.id);
+    if (m->motion && m->motion_steps > 2u) sy_rt_mesh_motion_off(dev, m); /* from curved motion: two steps anew */
     size_t vc = m->vertex_count;
     /* the pose it has now, kept for time 1 (before the update overwrites it) */
     float *close = malloc(vc * 3u * sizeof(float) + 1), *close_n = m->normals ? malloc(vc * 3u * sizeof(float) + 1) : NULL;
