@@ -58,7 +58,7 @@ void sy_context_restart(sy_context *c);
 sy_result sy_context_motion_begin(sy_context *c, uint32_t time_samples, sy_error *err);
 /** Most time steps of a shutter (sy_context_motion_begin_steps). */
 #define SY_MOTION_STEPS_MAX 9
-/** Curved motion: sy_context_motion_begin for a shutter sampled at `steps` (2 ..
+/** Curved motion: sy_context_motion_begin for a shutter sampled at `steps` (2 to
  * SY_MOTION_STEPS_MAX) equally spaced times T_k = T0 + k / (steps - 1) x (T1 - T0): commit the scene
  * at T1 (the close) and call this (it syncs), then for k = steps - 2 down to 1 commit it at T_k and
  * call sy_context_motion_step, then commit it at T0 and call sy_context_motion_open. Every instance

@@ -649,6 +649,7 @@ typedef struct sy_rt_render_desc {
      * (step k at ray time k / (camera_steps - 1)); each ray interpolates between the two steps around
      * its time as above. 0 or 2: the open and the close alone. */
     const sy_rt_camera *camera_mid;
+    /** The cameras in all with camera_mid (3 .. SY_RT_MOTION_STEPS_MAX); 0 or 2: camera_mid unused. */
     uint32_t camera_steps;
 } sy_rt_render_desc;
 
