@@ -129,6 +129,51 @@ sy_rt_result sy_rt_pool_add(sy_rt_device *dev, sy_rt_pool *pool, void *item, uin
     return sy_rt_fail(dev, SY_RT_ERROR_LIMIT, "%s: pool full or out of memory", what);
 }
 
+/* The pool of kind k in dev (not NULL). */
+static sy_rt_pool *kind_pool(sy_rt_device *dev, const sy_rt_kind *k)
+{
+    return (sy_rt_pool *)((char *)dev + k->pool);
+}
+
+sy_rt_result sy_rt_item_create(sy_rt_device *dev, const sy_rt_kind *k, const void *desc, uint32_t *id)
+{
+    if (!dev || !desc || !id) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "%s: NULL argument", k->what);
+    *id = 0;
+    sy_rt_result r = k->validate(dev, desc);
+    if (r != SY_RT_OK) return r;
+    void *item = calloc(1, k->size);
+    if (!item) return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY, "%s: out of memory", k->what);
+    k->set(dev, item, desc, true);
+    sy_rt_result r2 = sy_rt_pool_add(dev, kind_pool(dev, k), item, id, k->what);
+    if (r2 == SY_RT_OK) k->mark(dev, item, false);
+    return r2;
+}
+
+sy_rt_result sy_rt_item_update(sy_rt_device *dev, const sy_rt_kind *k, uint32_t id, const void *desc)
+{
+    char what[64];
+    snprintf(what, sizeof what, "%s update", k->what);
+    if (!dev || !desc) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "%s: NULL argument", what);
+    void *item = sy_rt_pool_find(dev, kind_pool(dev, k), id, what);
+    if (!item) return SY_RT_ERROR_INVALID_HANDLE;
+    sy_rt_result r = k->validate(dev, desc);
+    if (r != SY_RT_OK) return r;
+    k->set(dev, item, desc, false);
+    return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_item_destroy(sy_rt_device *dev, const sy_rt_kind *k, uint32_t id)
+{
+    char what[64];
+    snprintf(what, sizeof what, "%s destroy", k->what);
+    if (!dev) return sy_rt_fail(dev, SY_RT_ERROR_INVALID_ARGUMENT, "%s: NULL device", what);
+    void *item = sy_rt_pool_take(dev, kind_pool(dev, k), id, what);
+    if (!item) return SY_RT_ERROR_INVALID_HANDLE;
+    k->mark(dev, item, true);
+    free(item);
+    return SY_RT_OK;
+}
+
 void sy_rt_pool_free(sy_rt_pool *p)
 {
     free(p->items);

@@ -1,6 +1,6 @@
 /* sy_rt_base.h — internal to the ray-tracing back-end: the base every rt module builds on (index +
- * generation handle pools, the error report, Embree error capture). Defined in
- * sy_rt_base.c, which calls no other rt module, so the device, scene, texture and light modules
+ * generation handle pools and the create / update frame of pooled kinds, the error report, Embree
+ * error capture). Defined in sy_rt_base.c, which calls no other rt module, so the device, scene, texture and light modules
  * stack on it without calling each other in a loop. Not part of the public API (sy_rt.h). */
 #ifndef SY_RT_BASE_H
 #define SY_RT_BASE_H
@@ -10,6 +10,7 @@
 #include <embree3/rtcore.h>
 #include <stdarg.h>
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 /* >>pool: index + generation handles. id = generation << SY_RT_INDEX_BITS | (index + 1). */
@@ -50,6 +51,45 @@ void *sy_rt_pool_take(const sy_rt_device *dev, sy_rt_pool *p, uint32_t id, const
 /* Stores a new object (from malloc) in the pool, *id its handle; when the pool is full or out of
  * memory, frees it and reports SY_RT_ERROR_LIMIT "WHAT: pool full or out of memory". */
 sy_rt_result sy_rt_pool_add(sy_rt_device *dev, sy_rt_pool *pool, void *item, uint32_t *id, const char *what);
+
+/* A kind of pooled object whose create, update and destroy calls share one frame (materials,
+ * lights): its name in messages, its pool (offsetof(sy_rt_device, ...)), its item's size, the check
+ * of a description (SY_RT_OK or the reported failure), set, which stores a checked description in
+ * the item (fresh: a new, zeroed item) and marks what an update changes for the next commit, and
+ * mark, which marks what a new (gone false) or destroyed (gone true, before it is freed) item
+ * changes. */
+typedef struct sy_rt_kind {
+    const char *what;
+    size_t pool;
+    size_t size;
+    sy_rt_result (*validate)(const sy_rt_device *dev, const void *desc);
+    void (*set)(sy_rt_device *dev, void *item, const void *desc, bool fresh);
+    void (*mark)(sy_rt_device *dev, const void *item, bool gone);
+} sy_rt_kind;
+/* The frame of a create call: dev, desc and id present ("WHAT: NULL argument"), *id zeroed, desc
+ * validated, a zeroed item set from it and added to its pool (*id its handle), then marked. */
+sy_rt_result sy_rt_item_create(sy_rt_device *dev, const sy_rt_kind *k, const void *desc, uint32_t *id);
+/* The frame of an update call: dev and desc present ("WHAT update: NULL argument"), id live
+ * ("WHAT update: stale handle"), desc validated, then set on the item. */
+sy_rt_result sy_rt_item_update(sy_rt_device *dev, const sy_rt_kind *k, uint32_t id, const void *desc);
+/* The frame of a destroy call: dev present ("WHAT destroy: NULL device"), id live ("WHAT destroy:
+ * stale handle"), the item taken from its pool, marked and freed. */
+sy_rt_result sy_rt_item_destroy(sy_rt_device *dev, const sy_rt_kind *k, uint32_t id);
+/* Defines the public calls of kind K that sy_rt.h declares: sy_rt_NAME_create(dev, desc, out),
+ * sy_rt_NAME_update(dev, handle, desc) and sy_rt_NAME_destroy(dev, handle), over the frames above. */
+#define SY_RT_KIND_CALLS(NAME, K)                                                                   \
+    sy_rt_result sy_rt_##NAME##_create(sy_rt_device *dev, const sy_rt_##NAME##_desc *desc, sy_rt_##NAME *out) \
+    {                                                                                               \
+        return sy_rt_item_create(dev, &(K), desc, out ? &out->id : NULL);                           \
+    }                                                                                               \
+    sy_rt_result sy_rt_##NAME##_update(sy_rt_device *dev, sy_rt_##NAME h, const sy_rt_##NAME##_desc *desc) \
+    {                                                                                               \
+        return sy_rt_item_update(dev, &(K), h.id, desc);                                            \
+    }                                                                                               \
+    sy_rt_result sy_rt_##NAME##_destroy(sy_rt_device *dev, sy_rt_##NAME h)                          \
+    {                                                                                               \
+        return sy_rt_item_destroy(dev, &(K), h.id);                                                 \
+    }
 
 /* >>errors */
 

@@ -3,6 +3,7 @@
  * sy_rt_commit rebuilds (area lights for emission, alpha filters for masking, shadow flags). */
 #include "sy_rt_scene.h"
 
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -105,46 +106,39 @@ static void material_set(sy_rt_material_data *m, const sy_rt_material_desc *d)
     m->volume = m->volume && (m->sigma[0] > 0.0f || m->sigma[1] > 0.0f || m->sigma[2] > 0.0f);
 }
 
-sy_rt_result sy_rt_material_create(sy_rt_device *dev, const sy_rt_material_desc *d, sy_rt_material *out)
+static sy_rt_result material_validate(const sy_rt_device *dev, const void *desc)
 {
-    if (!dev || !d || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material: NULL argument");
-    out->id = 0;
-    sy_rt_result r = validate_material(dev, d);
-    if (r != SY_RT_OK) return r;
-    sy_rt_material_data *m = calloc(1, sizeof *m);
-    if (!m) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "material: out of memory");
-    material_set(m, d);
-    if ((r = sy_rt_pool_add(dev, &dev->materials, m, &out->id, "material")) != SY_RT_OK) return r;
-    dev->dirty = dev->shadow_dirty = true;
-    return SY_RT_OK;
+    return validate_material(dev, desc);
 }
 
-sy_rt_result sy_rt_material_update(sy_rt_device *dev, sy_rt_material mat, const sy_rt_material_desc *d)
+/* A new or changed material: the shadow flags are rebuilt at the next commit; a destroyed one
+ * also rebuilds the area lights when it was emissive and the alpha filters when it was masked
+ * (instances using it fall back to the default material, which is neither). */
+static void material_mark(sy_rt_device *dev, const void *item, bool gone)
 {
-    if (!dev || !d) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material update: NULL argument");
-    sy_rt_material_data *m = sy_rt_pool_find(dev, &dev->materials, mat.id, "material update");
-    if (!m) return SY_RT_ERROR_INVALID_HANDLE;
-    sy_rt_result r = validate_material(dev, d);
-    if (r != SY_RT_OK) return r;
+    const sy_rt_material_data *m = item;
+    if (gone && m->emissive) dev->area_dirty = true;
+    if (gone && m->masked) dev->filters_dirty = true;
+    dev->dirty = dev->shadow_dirty = true;
+}
+
+/* An update also rebuilds the area lights when the emission changed and the alpha filters when
+ * masking did. */
+static void material_store(sy_rt_device *dev, void *item, const void *desc, bool fresh)
+{
+    sy_rt_material_data *m = item;
+    const sy_rt_material_desc *d = desc;
     bool was_emissive = m->emissive, was_masked = m->masked;
     bool emission_changed = memcmp(m->desc.emissive, d->emissive, sizeof d->emissive) != 0 ||
                             m->desc.double_sided != d->double_sided;
     material_set(m, d);
+    if (fresh) return;
     if (was_emissive != m->emissive || (m->emissive && emission_changed)) dev->area_dirty = true;
     if (was_masked != m->masked) dev->filters_dirty = true;
-    dev->dirty = dev->shadow_dirty = true;
-    return SY_RT_OK;
+    material_mark(dev, m, false);
 }
 
-sy_rt_result sy_rt_material_destroy(sy_rt_device *dev, sy_rt_material mat)
-{
-    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "material destroy: NULL device");
-    sy_rt_material_data *m = sy_rt_pool_take(dev, &dev->materials, mat.id, "material destroy");
-    if (!m) return SY_RT_ERROR_INVALID_HANDLE;
-    /* Instances using it fall back to the default material, which is neither emissive nor masked. */
-    if (m->emissive) dev->area_dirty = true;
-    if (m->masked) dev->filters_dirty = true;
-    free(m);
-    dev->dirty = dev->shadow_dirty = true;
-    return SY_RT_OK;
-}
+static const sy_rt_kind material_kind = {"material", offsetof(sy_rt_device, materials), sizeof(sy_rt_material_data),
+                                         material_validate, material_store, material_mark};
+
+SY_RT_KIND_CALLS(material, material_kind)

@@ -3,6 +3,7 @@
  * sy_rt_commit (sy_rt_punctual_rebuild). Calls only sy_rt_base. */
 #include "sy_rt_scene.h"
 
+#include <stddef.h>
 #include <stdlib.h>
 
 #define FAIL(r, ...) sy_rt_fail(dev, (r), __VA_ARGS__)
@@ -36,41 +37,28 @@ static sy_rt_result validate_light(const sy_rt_device *dev, const sy_rt_light_de
     return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_light_create(sy_rt_device *dev, const sy_rt_light_desc *d, sy_rt_light *out)
+static sy_rt_result light_validate(const sy_rt_device *dev, const void *desc)
 {
-    if (!dev || !d || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light: NULL argument");
-    out->id = 0;
-    sy_rt_result r = validate_light(dev, d);
-    if (r != SY_RT_OK) return r;
-    sy_rt_light_data *l = calloc(1, sizeof *l);
-    if (!l) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "light: out of memory");
-    l->desc = *d;
-    if ((r = sy_rt_pool_add(dev, &dev->lights, l, &out->id, "light")) != SY_RT_OK) return r;
-    dev->dirty = dev->punctual_dirty = true;
-    return SY_RT_OK;
+    return validate_light(dev, desc);
 }
 
-sy_rt_result sy_rt_light_update(sy_rt_device *dev, sy_rt_light light, const sy_rt_light_desc *d)
+/* A new, changed or destroyed light: the punctual array is rebuilt at the next commit. */
+static void light_mark(sy_rt_device *dev, const void *item, bool gone)
 {
-    if (!dev || !d) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light update: NULL argument");
-    sy_rt_light_data *l = sy_rt_pool_find(dev, &dev->lights, light.id, "light update");
-    if (!l) return SY_RT_ERROR_INVALID_HANDLE;
-    sy_rt_result r = validate_light(dev, d);
-    if (r != SY_RT_OK) return r;
-    l->desc = *d;
+    (void)item, (void)gone;
     dev->dirty = dev->punctual_dirty = true;
-    return SY_RT_OK;
 }
 
-sy_rt_result sy_rt_light_destroy(sy_rt_device *dev, sy_rt_light light)
+static void light_set(sy_rt_device *dev, void *item, const void *desc, bool fresh)
 {
-    if (!dev) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "light destroy: NULL device");
-    sy_rt_light_data *l = sy_rt_pool_take(dev, &dev->lights, light.id, "light destroy");
-    if (!l) return SY_RT_ERROR_INVALID_HANDLE;
-    free(l);
-    dev->dirty = dev->punctual_dirty = true;
-    return SY_RT_OK;
+    ((sy_rt_light_data *)item)->desc = *(const sy_rt_light_desc *)desc;
+    if (!fresh) light_mark(dev, item, false);
 }
+
+static const sy_rt_kind light_kind = {"light", offsetof(sy_rt_device, lights), sizeof(sy_rt_light_data), light_validate,
+                                      light_set, light_mark};
+
+SY_RT_KIND_CALLS(light, light_kind)
 
 sy_rt_result sy_rt_punctual_rebuild(sy_rt_device *dev)
 {
