@@ -188,57 +188,20 @@ static uint32_t packet_load(const void *base, size_t sz, size_t p, uint32_t N, s
     return count;
 }
 
-/* One run (RUN rays from index first) of closest-hit queries; returns mismatches when check. */
-static uint64_t run_hits(const sy_rt_ray_replay *rp, size_t first, bool check)
+/* Whether logged ray r's answer in the replay differs from the log: for a closest-hit query its
+ * geometry, and on a hit its primitive and instance; for an occlusion query (occ) whether it was
+ * blocked (tfar < 0). */
+static bool mismatch(bool occ, const sy_rt_logged_ray *r, uint32_t geom, uint32_t prim, uint32_t inst, float tfar)
 {
-    const sy_rt_ray_buf *b = &rp->log->intersect;
-    run_setup rs;
-    run_begin(rp, b, first, &rs);
-    const size_t end = rs.end;
-    const uint32_t N = rs.N;
-    struct RTCIntersectContext *ctx = &rs.ictx.rtc;
-    RTCScene scene = rs.scene;
-    uint64_t bad = 0;
-    if (rp->form == SY_RT_FORM_1 || rp->form == SY_RT_FORM_STREAM) {
-        const struct RTCRayHit *src = (const struct RTCRayHit *)rp->hits + first;
-        struct RTCRayHit local[RUN];
-        uint32_t n = (uint32_t)(end - first);
-        memcpy(local, src, n * sizeof *local);
-        if (rp->form == SY_RT_FORM_1)
-            for (uint32_t i = 0; i < n; ++i) rtcIntersect1(scene, ctx, &local[i]);
-        else
-            rtcIntersect1M(scene, ctx, local, n, sizeof *local);
-        for (uint32_t i = 0; check && i < n; ++i) {
-            const sy_rt_logged_ray *r = &b->v[first + i];
-            const struct RTCHit *h = &local[i].hit;
-            bool miss = h->geomID == RTC_INVALID_GEOMETRY_ID;
-            if (h->geomID != r->geom || (!miss && (h->primID != r->prim || h->instID[0] != r->inst))) ++bad;
-        }
-        return bad;
-    }
-    size_t sz = hit_size(rp->form);
-    _Alignas(64) unsigned char local[sizeof(struct RTCRayHit16)];
-    for (size_t p = first / N; p * N < end; ++p) {
-        _Alignas(64) int valid[16]; /* Embree loads the mask with aligned SIMD loads */
-        uint32_t count = packet_load(rp->hits, sz, p, N, end, valid, local);
-        if (N == 4u) rtcIntersect4(valid, scene, ctx, (struct RTCRayHit4 *)local);
-        else if (N == 8u) rtcIntersect8(valid, scene, ctx, (struct RTCRayHit8 *)local);
-        else rtcIntersect16(valid, scene, ctx, (struct RTCRayHit16 *)local);
-        const uint32_t *hit = (const uint32_t *)(local + 12u * N * sizeof(float));
-        for (uint32_t k = 0; check && k < count; ++k) {
-            const sy_rt_logged_ray *r = &b->v[p * N + k];
-            uint32_t prim = hit[5 * N + k], geom = hit[6 * N + k], inst = hit[7 * N + k];
-            bool miss = geom == RTC_INVALID_GEOMETRY_ID;
-            if (geom != r->geom || (!miss && (prim != r->prim || inst != r->inst))) ++bad;
-        }
-    }
-    return bad;
+    if (occ) return (tfar < 0.0f) != (r->geom != 0);
+    return geom != r->geom || (geom != RTC_INVALID_GEOMETRY_ID && (prim != r->prim || inst != r->inst));
 }
 
-/* One run of occlusion queries; returns mismatches when check. */
-static uint64_t run_occluded(const sy_rt_ray_replay *rp, size_t first, bool check)
+/* One run (RUN rays from index first) of closest-hit queries, or of occlusion queries when occ;
+ * returns mismatches when check. */
+static uint64_t run_queries(const sy_rt_ray_replay *rp, size_t first, bool check, bool occ)
 {
-    const sy_rt_ray_buf *b = &rp->log->occluded;
+    const sy_rt_ray_buf *b = occ ? &rp->log->occluded : &rp->log->intersect;
     run_setup rs;
     run_begin(rp, b, first, &rs);
     const size_t end = rs.end;
@@ -247,27 +210,40 @@ static uint64_t run_occluded(const sy_rt_ray_replay *rp, size_t first, bool chec
     RTCScene scene = rs.scene;
     uint64_t bad = 0;
     if (rp->form == SY_RT_FORM_1 || rp->form == SY_RT_FORM_STREAM) {
-        const struct RTCRay *src = (const struct RTCRay *)rp->rays + first;
-        struct RTCRay local[RUN];
+        union {
+            struct RTCRayHit hit[RUN];
+            struct RTCRay ray[RUN];
+        } local;
         uint32_t n = (uint32_t)(end - first);
-        memcpy(local, src, n * sizeof *local);
-        if (rp->form == SY_RT_FORM_1)
-            for (uint32_t i = 0; i < n; ++i) rtcOccluded1(scene, ctx, &local[i]);
-        else
-            rtcOccluded1M(scene, ctx, local, n, sizeof *local);
-        for (uint32_t i = 0; check && i < n; ++i) bad += (local[i].tfar < 0.0f) != (b->v[first + i].geom != 0);
+        if (occ) memcpy(local.ray, (const struct RTCRay *)rp->rays + first, n * sizeof *local.ray);
+        else memcpy(local.hit, (const struct RTCRayHit *)rp->hits + first, n * sizeof *local.hit);
+        if (rp->form == SY_RT_FORM_STREAM && occ) rtcOccluded1M(scene, ctx, local.ray, n, sizeof *local.ray);
+        else if (rp->form == SY_RT_FORM_STREAM) rtcIntersect1M(scene, ctx, local.hit, n, sizeof *local.hit);
+        else if (occ) for (uint32_t i = 0; i < n; ++i) rtcOccluded1(scene, ctx, &local.ray[i]);
+        else for (uint32_t i = 0; i < n; ++i) rtcIntersect1(scene, ctx, &local.hit[i]);
+        for (uint32_t i = 0; check && i < n; ++i) {
+            const struct RTCHit *h = &local.hit[i].hit;
+            bad += occ ? mismatch(true, &b->v[first + i], 0, 0, 0, local.ray[i].tfar)
+                       : mismatch(false, &b->v[first + i], h->geomID, h->primID, h->instID[0], 0.0f);
+        }
         return bad;
     }
-    size_t sz = ray_size(rp->form);
-    _Alignas(64) unsigned char local[sizeof(struct RTCRay16)];
+    size_t sz = occ ? ray_size(rp->form) : hit_size(rp->form);
+    _Alignas(64) unsigned char local[sizeof(struct RTCRayHit16)]; /* the larger of the two layouts */
     for (size_t p = first / N; p * N < end; ++p) {
         _Alignas(64) int valid[16]; /* Embree loads the mask with aligned SIMD loads */
-        uint32_t count = packet_load(rp->rays, sz, p, N, end, valid, local);
-        if (N == 4u) rtcOccluded4(valid, scene, ctx, (struct RTCRay4 *)local);
-        else if (N == 8u) rtcOccluded8(valid, scene, ctx, (struct RTCRay8 *)local);
-        else rtcOccluded16(valid, scene, ctx, (struct RTCRay16 *)local);
-        const float *tfar = (const float *)local + 8u * N;
-        for (uint32_t k = 0; check && k < count; ++k) bad += (tfar[k] < 0.0f) != (b->v[p * N + k].geom != 0);
+        uint32_t count = packet_load(occ ? rp->rays : rp->hits, sz, p, N, end, valid, local);
+        if (occ && N == 4u) rtcOccluded4(valid, scene, ctx, (struct RTCRay4 *)local);
+        else if (occ && N == 8u) rtcOccluded8(valid, scene, ctx, (struct RTCRay8 *)local);
+        else if (occ) rtcOccluded16(valid, scene, ctx, (struct RTCRay16 *)local);
+        else if (N == 4u) rtcIntersect4(valid, scene, ctx, (struct RTCRayHit4 *)local);
+        else if (N == 8u) rtcIntersect8(valid, scene, ctx, (struct RTCRayHit8 *)local);
+        else rtcIntersect16(valid, scene, ctx, (struct RTCRayHit16 *)local);
+        const float *tfar = (const float *)local + 8u * N;             /* the ray's tfar (SOA) */
+        const uint32_t *hit = (const uint32_t *)(local + 12u * N * sizeof(float)); /* the hit part */
+        for (uint32_t k = 0; check && k < count; ++k) /* the hit part is read only for closest hits */
+            bad += occ ? mismatch(true, &b->v[p * N + k], 0, 0, 0, tfar[k])
+                       : mismatch(false, &b->v[p * N + k], hit[6 * N + k], hit[5 * N + k], hit[7 * N + k], 0.0f);
     }
     return bad;
 }
@@ -282,7 +258,8 @@ double sy_rt_ray_replay_run(sy_rt_ray_replay *rp, uint64_t *mismatches)
     double t0 = now_s();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (threads > 1) reduction(+ : bad)
     for (long i = 0; i < hit_runs + occ_runs; ++i)
-        bad += i < hit_runs ? run_hits(rp, (size_t)i * RUN, check) : run_occluded(rp, (size_t)(i - hit_runs) * RUN, check);
+        bad += i < hit_runs ? run_queries(rp, (size_t)i * RUN, check, false)
+                            : run_queries(rp, (size_t)(i - hit_runs) * RUN, check, true);
     double t = now_s() - t0;
     if (mismatches) *mismatches = bad;
     return t;
