@@ -90,18 +90,13 @@ sy_gl_result sy_gli_targets_ensure(sy_gl_device *dev, uint32_t w, uint32_t h, sy
 static double nearest_depth(const sy_gl_device *dev, const float pos[3], const float fwd[3])
 {
     double nearest = INFINITY;
-    for (uint32_t i = 0; i < dev->instances.count && nearest > 0.0; ++i) {
-        const inst_o *in = sy_gli_pool_at(&dev->instances, i);
-        if (!in->h.id || !in->visible) continue;
-        const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
-        if (!m) continue;
+    float box[8][3];
+    for (uint32_t i = 0; nearest > 0.0 && sy_gli_next_box(dev, &i, box);)
         for (int k = 0; k < 8; ++k) {
-            float w[3];
-            sy_gli_world_corner(in, m, k, w);
+            const float *w = box[k];
             double d = ((double)w[0] - pos[0]) * fwd[0] + ((double)w[1] - pos[1]) * fwd[1] + ((double)w[2] - pos[2]) * fwd[2];
             if (d < nearest) nearest = d;
         }
-    }
     return isfinite(nearest) && nearest > 0.0 ? nearest : 0.0;
 }
 

@@ -433,12 +433,25 @@ float sy_gli_pixels_per_triangle(const sy_gl_device *dev, const mesh_o *m, uint3
 
 /* sy_gl_shadows.c */
 void sy_gli_scene_bounds(const sy_gl_device *dev, float *c, float *radius);
-/* Corner k (0..7: bit 0 x, 1 y, 2 z at the maximum) of instance in's world box (its mesh m's box
- * transformed). */
-static inline void sy_gli_world_corner(const inst_o *in, const mesh_o *m, int k, float out[3])
+/* The eight corners (k = 0..7: bit 0 x, 1 y, 2 z at the maximum) of the world box (its mesh's box
+ * transformed) of the next visible instance with a mesh from slot *i on; *i moves past it. False
+ * when none is left: `for (uint32_t i = 0; sy_gli_next_box(dev, &i, box);)` visits every one. */
+static inline bool sy_gli_next_box(const sy_gl_device *dev, uint32_t *i, float box[8][3])
 {
-    float p[3] = {k & 1 ? m->bmax[0] : m->bmin[0], k & 2 ? m->bmax[1] : m->bmin[1], k & 4 ? m->bmax[2] : m->bmin[2]};
-    for (int a = 0; a < 3; ++a) out[a] = in->model[a] * p[0] + in->model[4 + a] * p[1] + in->model[8 + a] * p[2] + in->model[12 + a];
+    for (; *i < dev->instances.count; ++*i) {
+        const inst_o *in = sy_gli_pool_at(&dev->instances, *i);
+        if (!in->h.id || !in->visible) continue;
+        const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
+        if (!m) continue;
+        for (int k = 0; k < 8; ++k) {
+            float p[3] = {k & 1 ? m->bmax[0] : m->bmin[0], k & 2 ? m->bmax[1] : m->bmin[1], k & 4 ? m->bmax[2] : m->bmin[2]};
+            for (int a = 0; a < 3; ++a)
+                box[k][a] = in->model[a] * p[0] + in->model[4 + a] * p[1] + in->model[8 + a] * p[2] + in->model[12 + a];
+        }
+        ++*i;
+        return true;
+    }
+    return false;
 }
 void sy_gli_lights_upload(sy_gl_device *dev, frame_state *fs);
 sy_gl_result sy_gli_shadow_maps_make(sy_gl_device *dev, sy_gl_report *rep);

@@ -11,17 +11,10 @@
 void sy_gli_scene_bounds(const sy_gl_device *dev, float *c, float *radius)
 {
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (uint32_t i = 0; i < dev->instances.count; ++i) {
-        const inst_o *in = sy_gli_pool_at(&dev->instances, i);
-        if (!in->h.id || !in->visible) continue;
-        const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
-        if (!m) continue;
-        for (int k = 0; k < 8; ++k) {
-            float v[3];
-            sy_gli_world_corner(in, m, k, v);
-            for (int a = 0; a < 3; ++a) lo[a] = fminf(lo[a], v[a]), hi[a] = fmaxf(hi[a], v[a]);
-        }
-    }
+    float box[8][3];
+    for (uint32_t i = 0; sy_gli_next_box(dev, &i, box);)
+        for (int k = 0; k < 8; ++k)
+            for (int a = 0; a < 3; ++a) lo[a] = fminf(lo[a], box[k][a]), hi[a] = fmaxf(hi[a], box[k][a]);
     if (!(lo[0] <= hi[0])) {
         c[0] = c[1] = c[2] = 0.0f;
         *radius = 1.0f;
