@@ -732,6 +732,20 @@ const char *const sy_gl_floor_fs =
     "void main() { o_color = vec4(0.8, 0.8, 0.8, 1.0); o_depth = v_vz; }\n"
     "#endif\n";
 
+/* Whether shader s compiled (program false) or program s linked (program true); when not, the
+ * object is deleted and its info log is in log (len bytes). */
+static bool built(const sy_gl_fns *gl, GLuint s, bool program, char *log, GLsizei len)
+{
+    GLint ok = 0;
+    if (program) gl->GetProgramiv(s, GL_LINK_STATUS, &ok);
+    else gl->GetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (ok) return true;
+    log[0] = '\0';
+    if (program) gl->GetProgramInfoLog(s, len, NULL, log), gl->DeleteProgram(s);
+    else gl->GetShaderInfoLog(s, len, NULL, log), gl->DeleteShader(s);
+    return false;
+}
+
 static sy_gl_result compile(const sy_gl_fns *gl, const char *name, GLenum stage, const char *src, const char *defines,
                             const char *tail, GLuint *out, sy_gl_report *rep)
 {
@@ -742,15 +756,10 @@ static sy_gl_result compile(const sy_gl_fns *gl, const char *name, GLenum stage,
     GLint lens[4] = {nl ? (GLint)(nl + 1 - src) : -1, -1, -1, -1};
     gl->ShaderSource(s, nl ? 4 : 1, parts, nl ? lens : NULL);
     gl->CompileShader(s);
-    GLint ok = 0;
-    gl->GetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = "";
-        gl->GetShaderInfoLog(s, sizeof log, NULL, log);
-        gl->DeleteShader(s);
+    char log[2048];
+    if (!built(gl, s, false, log, sizeof log))
         return sy_gli_fail(rep, SY_GL_ERROR_GL, "%s shader: %s compile failed: %s", name,
                            stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
-    }
     *out = s;
     return SY_GL_OK;
 }
@@ -777,14 +786,8 @@ sy_gl_result sy_gl_program_build_tail(const sy_gl_fns *gl, const char *name, con
     gl->LinkProgram(p);
     gl->DeleteShader(v);
     gl->DeleteShader(f);
-    GLint ok = 0;
-    gl->GetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = "";
-        gl->GetProgramInfoLog(p, sizeof log, NULL, log);
-        gl->DeleteProgram(p);
-        return sy_gli_fail(rep, SY_GL_ERROR_GL, "%s shader: link failed: %s", name, log);
-    }
+    char log[2048];
+    if (!built(gl, p, true, log, sizeof log)) return sy_gli_fail(rep, SY_GL_ERROR_GL, "%s shader: link failed: %s", name, log);
     *out = p;
     return SY_GL_OK;
 }
