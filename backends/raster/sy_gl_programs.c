@@ -222,6 +222,20 @@ static void variant_defines(int v, uint64_t sig, char *defs, size_t defs_len, ch
     }
 }
 
+/* A uniform a program's struct keeps: where its location goes and its name in the shaders ("u_"
+ * and the field's name). */
+typedef struct uniform_loc {
+    GLint *at;
+    const char *name;
+} uniform_loc;
+#define UNIFORM(s, field) {&(s)->field, "u_" #field}
+
+/* Looks up the n uniforms u of program p. */
+static void uniforms_locate(const sy_gl_fns *gl, GLuint p, const uniform_loc *u, size_t n)
+{
+    for (size_t i = 0; i < n; ++i) *u[i].at = gl->GetUniformLocation(p, u[i].name);
+}
+
 /* The main program for variant bits v, built and cached on first use; 0 (the failure reported to rep) when the
  * driver rejects it. */
 GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep)
@@ -256,16 +270,11 @@ GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep)
     dev->programs_built++;
     dev->pm[v].prog = p;
     dev->pm[v].sig = sig;
-    dev->pm[v].model = gl->GetUniformLocation(p, "u_model");
-    dev->pm[v].normal_mat = gl->GetUniformLocation(p, "u_normal_mat");
-    dev->pm[v].mvp = gl->GetUniformLocation(p, "u_mvp");
-    dev->pm[v].cam_pos = gl->GetUniformLocation(p, "u_cam_pos");
-    dev->pm[v].cam_fwd = gl->GetUniformLocation(p, "u_cam_fwd");
-    dev->pm[v].ortho = gl->GetUniformLocation(p, "u_ortho");
-    dev->pm[v].ortho_z = gl->GetUniformLocation(p, "u_ortho_z");
-    dev->pm[v].mirror = gl->GetUniformLocation(p, "u_mirror");
-    dev->pm[v].has_normals = gl->GetUniformLocation(p, "u_has_normals");
-    dev->pm[v].probe_lod = gl->GetUniformLocation(p, "u_probe_lod");
+    struct main_prog *m = &dev->pm[v];
+    const uniform_loc u[] = {UNIFORM(m, model),   UNIFORM(m, normal_mat), UNIFORM(m, mvp),         UNIFORM(m, cam_pos),
+                             UNIFORM(m, cam_fwd), UNIFORM(m, ortho),      UNIFORM(m, ortho_z),     UNIFORM(m, mirror),
+                             UNIFORM(m, has_normals), UNIFORM(m, probe_lod)};
+    uniforms_locate(gl, p, u, sizeof u / sizeof u[0]);
     dev->pm[v].frame = 0;
     sy_gli_bind_samplers(gl, p);
     return p;
@@ -295,13 +304,10 @@ int sy_gli_deferred_program(sy_gl_device *dev, int v, sy_gl_report *rep)
     dev->dp[i].var = v;
     dev->dp[i].sig = sig;
     dev->dp[i].prog = p;
-    dev->dp[i].unproj = gl->GetUniformLocation(p, "u_unproj");
-    dev->dp[i].inv_view = gl->GetUniformLocation(p, "u_inv_view");
-    dev->dp[i].px = gl->GetUniformLocation(p, "u_px");
-    dev->dp[i].cam_pos = gl->GetUniformLocation(p, "u_cam_pos");
-    dev->dp[i].cam_fwd = gl->GetUniformLocation(p, "u_cam_fwd");
-    dev->dp[i].ortho = gl->GetUniformLocation(p, "u_ortho");
-    dev->dp[i].rects = gl->GetUniformLocation(p, "u_rects");
+    const uniform_loc u[] = {UNIFORM(&dev->dp[i], unproj),  UNIFORM(&dev->dp[i], inv_view), UNIFORM(&dev->dp[i], px),
+                             UNIFORM(&dev->dp[i], cam_pos), UNIFORM(&dev->dp[i], cam_fwd),  UNIFORM(&dev->dp[i], ortho),
+                             UNIFORM(&dev->dp[i], rects)};
+    uniforms_locate(gl, p, u, sizeof u / sizeof u[0]);
     sy_gli_bind_samplers(gl, p); /* the light and environment units and blocks; then its own three */
     gl->Uniform1i(gl->GetUniformLocation(p, "t_gcol"), UNIT_GCOL);
     gl->Uniform1i(gl->GetUniformLocation(p, "t_gdepth"), UNIT_GDEPTH);
