@@ -98,16 +98,32 @@ static sy_filter_temporal_params plain_params(void)
     return p;
 }
 
+/* A test's temporal filter with parameters p (NULL: the defaults); NULL, the failure counted, when
+ * sy_filter_temporal_create refuses them. */
+static sy_filter_temporal *temporal_open(const sy_filter_temporal_params *p)
+{
+    sy_filter_temporal *t = NULL;
+    sy_filter_report err = {0};
+    sy_filter_status r = sy_filter_temporal_create(p, &t, &err);
+    EXPECT_MSG(r == SY_FILTER_OK && t, "sy_filter_temporal_create: %d (%s)", (int)r, err.message);
+    return t;
+}
+
+/* The end of a test: the filter and the scene freed; 0 (passed) for its return. */
+static int temporal_close(sy_filter_temporal *t, scene *s)
+{
+    sy_filter_temporal_destroy(t);
+    scene_free(s);
+    return 0;
+}
+
 static int test_constant_pan(void)
 {
     scene s = {.rng = 7};
-    sy_filter_temporal_params p;
-    sy_filter_temporal_params_default(&p); /* clamping and a-trous on */
-    sy_filter_temporal *t = NULL;
+    sy_filter_temporal *t = temporal_open(NULL); /* the defaults: clamping and a-trous on */
     sy_filter_report err = {0};
-    CHECK(sy_filter_temporal_create(&p, &t, &err) == SY_FILTER_OK);
     float *out = malloc(4 * 64 * 48 * sizeof(float));
-    CHECK(out);
+    CHECK(t && out);
     sy_filter_temporal_stats st = {0};
     double maxd = 0;
     for (int k = 0; k < 8; ++k) {
@@ -125,9 +141,7 @@ static int test_constant_pan(void)
     CHECK(maxd < 1e-5);
     CHECK(st.mean_history > 4.0);
     free(out);
-    sy_filter_temporal_destroy(t);
-    scene_free(&s);
-    return 0;
+    return temporal_close(t, &s);
 }
 
 /* frame 1 radiance 0.5*A everywhere at cx = 0; frame 2 at cx = 0.3 radiance 0.5*B: where the
@@ -137,12 +151,11 @@ static int test_blend_and_disocclusion(void)
 {
     scene s = {.occluder = true};
     sy_filter_temporal_params p = plain_params();
-    sy_filter_temporal *t = NULL;
+    sy_filter_temporal *t = temporal_open(&p);
     sy_filter_report err = {0};
-    CHECK(sy_filter_temporal_create(&p, &t, &err) == SY_FILTER_OK);
     const uint32_t w = 96, h = 64;
     float *out = malloc(4 * w * h * sizeof(float));
-    CHECK(out);
+    CHECK(t && out);
     const float A = 0.4f, B = 0.8f;
     CHECK(scene_render(&s, w, h, 0.0f, A, A, 0.0f) == 0);
     sy_filter_frame f = scene_frame(&s);
@@ -190,9 +203,7 @@ static int test_blend_and_disocclusion(void)
         occ_blend += s.depth[i] == 2.0f && fabsf(out[4 * i] - 0.25f * (A + B)) < 1e-6f;
     CHECK(occ_blend > 100);
     free(out);
-    sy_filter_temporal_destroy(t);
-    scene_free(&s);
-    return 0;
+    return temporal_close(t, &s);
 }
 
 /* stale history far from the new samples: clamped to their neighbourhood box */
@@ -201,12 +212,11 @@ static int test_clamp(void)
     scene s = {.rng = 11};
     sy_filter_temporal_params p = plain_params();
     p.clamp_gamma = 1.0f;
-    sy_filter_temporal *t = NULL;
+    sy_filter_temporal *t = temporal_open(&p);
     sy_filter_report err = {0};
-    CHECK(sy_filter_temporal_create(&p, &t, &err) == SY_FILTER_OK);
     const uint32_t w = 48, h = 32;
     float *out = malloc(4 * w * h * sizeof(float));
-    CHECK(out);
+    CHECK(t && out);
     CHECK(scene_render(&s, w, h, 0.0f, 0.1f, 0.1f, 0.0f) == 0);
     sy_filter_frame f = scene_frame(&s);
     CHECK(sy_filter_temporal_run(t, &f, s.m, out, NULL, &err) == SY_FILTER_OK);
@@ -218,23 +228,18 @@ static int test_clamp(void)
     printf("clamp: history 0.05 against new samples 1 +- 5%%: worst |out - 1| = %.3f (unclamped 0.475)\n", worst);
     CHECK(worst < 0.15);
     free(out);
-    sy_filter_temporal_destroy(t);
-    scene_free(&s);
-    return 0;
+    return temporal_close(t, &s);
 }
 
 static int test_noisy_pan(void)
 {
     scene s = {.occluder = true, .rng = 5};
-    sy_filter_temporal_params p;
-    sy_filter_temporal_params_default(&p);
-    sy_filter_temporal *t = NULL;
+    sy_filter_temporal *t = temporal_open(NULL);
     sy_filter_report err = {0};
-    CHECK(sy_filter_temporal_create(&p, &t, &err) == SY_FILTER_OK);
     const uint32_t w = 96, h = 64;
     size_t n = (size_t)w * h;
     float *out = malloc(4 * n * sizeof(float)), *last = malloc(4 * n * sizeof(float)), *in_last = malloc(4 * n * sizeof(float));
-    CHECK(out && last && in_last);
+    CHECK(t && out && last && in_last);
     double e_in = 0, e_out = 0, fl_in = 0, fl_out = 0;
     uint64_t cnt = 0, fcnt = 0;
     for (int k = 0; k < 20; ++k) {
@@ -261,9 +266,7 @@ static int test_noisy_pan(void)
     CHECK(fl_in / fl_out > 5.0);
     /* the same frames with a-trous off are noisier: the spatial filter does work */
     free(out), free(last), free(in_last);
-    sy_filter_temporal_destroy(t);
-    scene_free(&s);
-    return 0;
+    return temporal_close(t, &s);
 }
 
 /* mean absolute change of the red channel between two RGBA images (the scene is grey) */
@@ -288,9 +291,9 @@ static int test_rest(void)
     scene s = {.occluder = true, .rng = 11};
     sy_filter_temporal_params p;
     sy_filter_temporal_params_default(&p);
-    sy_filter_temporal *t = NULL;
+    sy_filter_temporal *t = temporal_open(&p);
+    CHECK(t);
     sy_filter_report err = {0};
-    CHECK(sy_filter_temporal_create(&p, &t, &err) == SY_FILTER_OK);
     const uint32_t w = 96, h = 64;
     size_t n = (size_t)w * h;
     float *out = malloc(4 * n * sizeof(float)), *last = malloc(4 * n * sizeof(float)), *acc = malloc(4 * n * sizeof(float));
@@ -331,9 +334,7 @@ static int test_rest(void)
     CHECK(pop_plain > 3.0 * moving);
     CHECK(later <= 1.0);
     free(out), free(last), free(acc), free(acc_last), free(sum);
-    sy_filter_temporal_destroy(t);
-    scene_free(&s);
-    return 0;
+    return temporal_close(t, &s);
 }
 
 /* the direct/indirect split: a sharp emitter (direct part 10x brighter than the wall around it)
@@ -344,13 +345,12 @@ static int test_split(void)
     sy_filter_temporal_params p;
     sy_filter_temporal_params_default(&p);
     p.threads = 2;
-    sy_filter_temporal *t = NULL;
+    sy_filter_temporal *t = temporal_open(&p);
     sy_filter_report err = {0};
-    CHECK(sy_filter_temporal_create(&p, &t, &err) == SY_FILTER_OK);
     const uint32_t w = 96, h = 64;
     size_t n = (size_t)w * h;
     float *out = malloc(4 * n * sizeof(float)), *dir = malloc(3 * n * sizeof(float)), *ind = malloc(3 * n * sizeof(float));
-    CHECK(out && dir && ind);
+    CHECK(t && out && dir && ind);
     double e_in = 0, e_out = 0, worst_edge = 0, cnt = 0;
     for (int k = 0; k < 12; ++k) {
         /* the render's colour carries the noise; the split: direct = the noise-free part (the
@@ -386,9 +386,7 @@ static int test_split(void)
     CHECK(e_in / e_out > 5.0);
     CHECK(worst_edge < 0.1);
     free(out), free(dir), free(ind);
-    sy_filter_temporal_destroy(t);
-    scene_free(&s);
-    return 0;
+    return temporal_close(t, &s);
 }
 
 /* object motion (frame.motion): the two-tone occluder slides 0.05 per frame in x in front of the
@@ -450,13 +448,12 @@ static int test_object_motion(void)
     /* a non-finite motion finds no history (and nothing non-finite reaches the output); a zero motion
      * is the camera-only reprojection */
     scene s = {.occluder = true, .rng = 3};
-    sy_filter_temporal *t = NULL;
+    sy_filter_temporal *t = temporal_open(NULL);
     sy_filter_report err = {0};
-    CHECK(sy_filter_temporal_create(NULL, &t, &err) == SY_FILTER_OK);
     const uint32_t w = 48, h = 32;
     size_t n = (size_t)w * h;
     float *out = malloc(4 * n * sizeof(float)), *mv = malloc(3 * n * sizeof(float));
-    CHECK(out && mv);
+    CHECK(t && out && mv);
     sy_filter_temporal_stats st = {0};
     for (int k = 0; k < 3; ++k) {
         CHECK(scene_render(&s, w, h, 0.02f * (float)k, 0.6f, 1.0f, 0.0f) == 0);
@@ -469,21 +466,18 @@ static int test_object_motion(void)
     }
     CHECK(st.reprojected == 0 && st.nonfinite == 0);
     free(out), free(mv);
-    sy_filter_temporal_destroy(t);
-    scene_free(&s);
-    return 0;
+    return temporal_close(t, &s);
 }
 
 static int test_bad_input(void)
 {
     scene s = {0};
-    sy_filter_temporal *t = NULL;
+    sy_filter_temporal *t = temporal_open(NULL);
     sy_filter_report err = {0};
-    CHECK(sy_filter_temporal_create(NULL, &t, &err) == SY_FILTER_OK);
     const uint32_t w = 32, h = 24;
     size_t n = (size_t)w * h;
     float *out = malloc(4 * n * sizeof(float));
-    CHECK(out);
+    CHECK(t && out);
     CHECK(scene_render(&s, w, h, 0.0f, 0.6f, 0.6f, 0.0f) == 0);
     s.color[4 * 100] = NAN, s.normal[3 * 200] = INFINITY;
     sy_filter_frame f = scene_frame(&s);
