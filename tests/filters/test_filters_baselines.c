@@ -54,8 +54,7 @@ static int test_atrous(void)
     p.iterations = 0;
     CHECK(sy_filter_atrous(&p, &f, out, &st, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
     free(out);
-    synth_free(&s);
-    return 0;
+    return synth_free(&s);
 }
 
 static int test_jbu(void)
@@ -128,8 +127,7 @@ static int test_jbu(void)
     printf("jbu 4 spp: relMSE %.5f -> %.5f (%.1fx)\n", b, e, b / e);
     CHECK(e < b / 2);
     free(o4);
-    synth_free(&s);
-    return 0;
+    return synth_free(&s);
 }
 
 static int test_adaptive(void)
@@ -175,8 +173,7 @@ static int test_adaptive(void)
     p.threshold = -1;
     CHECK(sy_filter_adaptive(&p, &f, out, lvl, &st, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT && strstr(err.message, "threshold"));
     free(out), free(lvl);
-    synth_free(&s);
-    return 0;
+    return synth_free(&s);
 }
 
 static int test_metrics(void)

@@ -250,8 +250,7 @@ static int test_nan(void)
     CHECK(out[0] == ref[0]);
     CHECK(fabsf(out[4 * bad] - s.truth[4 * bad]) < 0.3f);
     free(ref), free(out);
-    synth_free(&s);
-    return 0;
+    return synth_free(&s);
 }
 
 /* NaN/Inf isolation, strictly: a bad pixel's contents never reach another pixel. Whatever
@@ -329,8 +328,7 @@ static int test_nan_isolation(void)
         for (int b = 0; b < 3; ++b) CHECK(blend[0][bad[b]] == 0.0f); /* bad pixels: filtered value only */
         for (int v = 0; v < 4; ++v) free(out[v]), free(blend[v]);
     }
-    synth_free(&s);
-    return 0;
+    return synth_free(&s);
 }
 
 /* The worker pool: the result does not depend on the thread count (rows are claimed dynamically),
@@ -366,8 +364,7 @@ static int test_threads(void)
     printf("threads: 1, 2, 3, 8, all, 1 give bit-identical output\n");
     sy_filter_pixel_destroy(pf);
     free(ref);
-    synth_free(&s);
-    return 0;
+    return synth_free(&s);
 }
 
 /* image quality on the analytic surrogate: relMSE reduction >= 4x at 4 spp */
@@ -392,8 +389,7 @@ static int test_quality(void)
         CHECK(base / e >= 4.0);
         free(out);
     }
-    synth_free(&s);
-    return 0;
+    return synth_free(&s);
 }
 
 /* range buffer: albedo x ((1 - w) + w |n . v|), depth in A, misses clamped */

@@ -112,11 +112,13 @@ static int rig_open(rig *r, uint32_t w, uint32_t h, bool step, const sy_filter_r
     return 0;
 }
 
-static void rig_close(rig *r)
+/* The end of a test: the rig freed; 0 (passed) for its return. */
+static int rig_close(rig *r)
 {
     free(r->out);
     sy_filter_radiance_destroy(r->rf);
     scene_free(&r->s);
+    return 0;
 }
 
 static int test_texture_and_convergence(void)
@@ -149,8 +151,7 @@ static int test_texture_and_convergence(void)
     printf("radiance texture edge: red %.4f | %.4f (truth %.4f | %.4f)\n", hi, lo, 0.8 * 0.3, 0.2 * 0.3);
     CHECK(fabs(hi - 0.8 * 0.3) < 0.01 && fabs(lo - 0.2 * 0.3) < 0.005);
     free(pt);
-    rig_close(&r);
-    return 0;
+    return rig_close(&r);
 }
 
 static int test_depth_step(void)
@@ -169,8 +170,7 @@ static int test_depth_step(void)
     left /= r.s.h, lt /= r.s.h;
     printf("radiance depth step: column left of edge %.4f (truth %.4f; right side is 4x brighter)\n", left, lt);
     CHECK(fabs(left - lt) < 0.05 * lt + 0.005);
-    rig_close(&r);
-    return 0;
+    return rig_close(&r);
 }
 
 static int test_correction_phase(void)
@@ -203,8 +203,7 @@ static int test_correction_phase(void)
     CHECK(sy_filter_radiance_frame(r.rf, &r.in, r.out, &st, &r.err) == SY_FILTER_OK);
     CHECK(st.mean_blend == 1.0 && sy_filter_radiance_frame_index(r.rf) == 1);
     free(pt);
-    rig_close(&r);
-    return 0;
+    return rig_close(&r);
 }
 
 static int test_nan_and_params(void)
@@ -231,8 +230,7 @@ static int test_nan_and_params(void)
     sy_filter_radiance_params_default(&p);
     p.warmup_radius = 0.0f;
     CHECK(sy_filter_radiance_params_check(&p, &r.err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
-    rig_close(&r);
-    return 0;
+    return rig_close(&r);
 }
 
 /* Seeded with a converged mean (k = 1000, per-sample variance equal to the frame noise): the next
@@ -264,8 +262,7 @@ static int test_seed(void)
     CHECK(sy_filter_radiance_seed(r.rf, r.s.w, r.s.h, r.s.truth, 4, var, 0, &r.err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
     CHECK(sy_filter_radiance_seed(r.rf, 0, r.s.h, r.s.truth, 4, var, 10, &r.err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
     free(var);
-    rig_close(&r);
-    return 0;
+    return rig_close(&r);
 }
 
 /* The batched BSDF path (default, vectorised Lambert case) equals one single-direction call per
