@@ -27,6 +27,35 @@ static float *run(sy_filter_pixel_params *p, const sy_filter_frame *f, uint32_t 
     return out;
 }
 
+/* A test's own frame buffers, w x h (the synthetic scene of synth.h does not fit): colour (RGBA),
+ * variance (luminance), albedo and depth. planes_alloc: true when all four were allocated;
+ * planes_frame: the frame that reads them at spp samples; planes_free frees them. */
+typedef struct planes {
+    uint32_t w, h;
+    float *col, *var, *alb, *dep;
+} planes;
+
+static bool planes_alloc(planes *o, uint32_t w, uint32_t h)
+{
+    size_t n = (size_t)w * h;
+    o->w = w, o->h = h;
+    o->col = malloc(4 * n * sizeof(float)), o->var = malloc(n * sizeof(float));
+    o->alb = malloc(3 * n * sizeof(float)), o->dep = malloc(n * sizeof(float));
+    return o->col && o->var && o->alb && o->dep;
+}
+
+static sy_filter_frame planes_frame(const planes *o, float spp)
+{
+    return (sy_filter_frame){.width = o->w, .height = o->h, .color_channels = 4, .variance_channels = 1,
+                             .color = o->col, .variance = o->var, .albedo = o->alb, .depth = o->dep,
+                             .spp_uniform = spp};
+}
+
+static void planes_free(planes *o)
+{
+    free(o->col), free(o->var), free(o->alb), free(o->dep);
+}
+
 /* the report's callback: called once per failure with the code and the message the report keeps */
 typedef struct report_count {
     int calls;
@@ -98,24 +127,21 @@ static int test_blend_factor(void)
 /* a noisy constant converges to the constant; at low variance the output IS the unfiltered value */
 static int test_constant_and_consistency(void)
 {
-    const uint32_t w = 64, h = 48;
-    size_t n = (size_t)w * h;
-    float *col = malloc(4 * n * sizeof(float)), *var = malloc(n * sizeof(float)), *alb = malloc(3 * n * sizeof(float)),
-          *dep = malloc(n * sizeof(float));
-    CHECK(col && var && alb && dep);
+    planes o;
+    CHECK(planes_alloc(&o, 64, 48));
+    const size_t n = (size_t)o.w * o.h;
     uint64_t rng = 7;
     for (int kernel = 0; kernel < 2; ++kernel) {
         for (float spp = 4; spp <= 4096; spp *= 8) {
             double sd = 0.5 / sqrt(spp); /* per-sample relative sd 1 around 0.5 */
             for (size_t i = 0; i < n; ++i) {
-                for (int c = 0; c < 3; ++c) col[4 * i + c] = 0.5f + (float)(sd * synth_gauss(&rng));
-                col[4 * i + 3] = 1.0f;
-                var[i] = (float)(sd * sd);
-                alb[3 * i] = alb[3 * i + 1] = alb[3 * i + 2] = 0.6f;
-                dep[i] = 3.0f;
+                for (int c = 0; c < 3; ++c) o.col[4 * i + c] = 0.5f + (float)(sd * synth_gauss(&rng));
+                o.col[4 * i + 3] = 1.0f;
+                o.var[i] = (float)(sd * sd);
+                o.alb[3 * i] = o.alb[3 * i + 1] = o.alb[3 * i + 2] = 0.6f;
+                o.dep[i] = 3.0f;
             }
-            sy_filter_frame f = {.width = w, .height = h, .color_channels = 4, .variance_channels = 1, .color = col,
-                                 .variance = var, .albedo = alb, .depth = dep, .spp_uniform = spp};
+            sy_filter_frame f = planes_frame(&o, spp);
             sy_filter_pixel_params p;
             sy_filter_pixel_params_default(&p);
             p.kernel = (sy_filter_pixel_kernel)kernel;
@@ -126,7 +152,7 @@ static int test_constant_and_consistency(void)
             CHECK(out);
             double e = 0, eu = 0;
             for (size_t i = 0; i < n; ++i) {
-                double d = out[4 * i] - 0.5, du = col[4 * i] - 0.5;
+                double d = out[4 * i] - 0.5, du = o.col[4 * i] - 0.5;
                 e += d * d, eu += du * du;
             }
             e = sqrt(e / n), eu = sqrt(eu / n);
@@ -141,12 +167,12 @@ static int test_constant_and_consistency(void)
             if (spp >= 256) {
                 CHECK(st.mean_blend == 1.0);
                 for (size_t i = 0; i < n; ++i)
-                    for (int c = 0; c < 3; ++c) CHECK(out[4 * i + c] == col[4 * i + c]);
+                    for (int c = 0; c < 3; ++c) CHECK(out[4 * i + c] == o.col[4 * i + c]);
             }
             free(out);
         }
     }
-    free(col), free(var), free(alb), free(dep);
+    planes_free(&o);
     return 0;
 }
 
@@ -184,10 +210,8 @@ static int test_reduction_factor(void)
 static int test_edges(void)
 {
     const uint32_t w = 80, h = 40;
-    size_t n = (size_t)w * h;
-    float *col = malloc(4 * n * sizeof(float)), *var = malloc(n * sizeof(float)), *alb = malloc(3 * n * sizeof(float)),
-          *dep = malloc(n * sizeof(float));
-    CHECK(col && var && alb && dep);
+    planes o;
+    CHECK(planes_alloc(&o, w, h));
     for (int which = 0; which < 2; ++which)
         for (int kernel = 0; kernel < 2; ++kernel) {
             uint64_t rng = 99;
@@ -196,15 +220,14 @@ static int test_edges(void)
                     size_t i = (size_t)y * w + x;
                     bool right = x >= w / 2;
                     float m = right ? 0.8f : 0.1f;
-                    for (int c = 0; c < 3; ++c) col[4 * i + c] = m + 0.3f * m * (float)synth_gauss(&rng);
-                    col[4 * i + 3] = 1;
-                    var[i] = 0.09f * m * m;
+                    for (int c = 0; c < 3; ++c) o.col[4 * i + c] = m + 0.3f * m * (float)synth_gauss(&rng);
+                    o.col[4 * i + 3] = 1;
+                    o.var[i] = 0.09f * m * m;
                     float a = which == 1 && right ? 0.9f : 0.4f; /* albedo step (range colour) */
-                    alb[3 * i] = alb[3 * i + 1] = alb[3 * i + 2] = a;
-                    dep[i] = which == 0 && right ? 8.0f : 2.0f; /* or depth step */
+                    o.alb[3 * i] = o.alb[3 * i + 1] = o.alb[3 * i + 2] = a;
+                    o.dep[i] = which == 0 && right ? 8.0f : 2.0f; /* or depth step */
                 }
-            sy_filter_frame f = {.width = w, .height = h, .color_channels = 4, .variance_channels = 1, .color = col,
-                                 .variance = var, .albedo = alb, .depth = dep, .spp_uniform = 4};
+            sy_filter_frame f = planes_frame(&o, 4);
             sy_filter_pixel_params p;
             sy_filter_pixel_params_default(&p);
             p.kernel = (sy_filter_pixel_kernel)kernel;
@@ -220,7 +243,7 @@ static int test_edges(void)
             CHECK(fabs(left - 0.1) < 0.02 && fabs(rightv - 0.8) < 0.06);
             free(out);
         }
-    free(col), free(var), free(alb), free(dep);
+    planes_free(&o);
     return 0;
 }
 
