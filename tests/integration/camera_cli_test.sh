@@ -19,12 +19,10 @@
 set -u
 SY=$1
 DATA=$2
-TMP=$3
 EXR_EQUAL=$4
 EXR_ERROR=$5
 . "$(dirname "${BASH_SOURCE[0]}")/../support/check.sh" # fail (and $fails)
-rm -rf "$TMP"
-mkdir -p "$TMP"
+fresh_tmp "$3"
 
 # usage errors: status 2 and the option and reason on stderr
 usage() { usage_error "$1" "$2" "$SY" render demo -w 16 -h 16 -o "$TMP/u.png" "${@:3}"; } # WHAT EXPECT ARGS...

@@ -18,11 +18,9 @@
 set -u
 SY=$1
 DATA=$2
-TMP=$3
 EXR_EQUAL=$4
 . "$(dirname "${BASH_SOURCE[0]}")/../support/check.sh" # fail (and $fails)
-rm -rf "$TMP"
-mkdir -p "$TMP"
+fresh_tmp "$3"
 
 usage() { usage_error "$1" "$2" "$SY" "${@:3}"; } # WHAT EXPECT CMD ARGS... (status 2 and EXPECT on stderr)
 usage "cap not a colour" "--clip-cap: 'red' is not a colour RRGGBB" render demo -w 16 -h 16 -o "$TMP/u.png" --clip 1,0,0,0 --clip-cap red
