@@ -141,9 +141,7 @@ static int test_bad_samplers(void)
     char bin[600], gltf[640];
     snprintf(bin, sizeof bin, "%s/anim.bin", g_dir);
     snprintf(gltf, sizeof gltf, "%s/anim.gltf", g_dir);
-    FILE *f = fopen(bin, "wb");
-    CHECK(f && fwrite(buf, sizeof buf, 1, f) == 1);
-    fclose(f);
+    write_all(bin, buf, sizeof buf);
     const char *json =
         "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":100,\"uri\":\"anim.bin\"}],"
         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":100}],"
@@ -172,9 +170,7 @@ static int test_bad_samplers(void)
         "{\"sampler\":0,\"target\":{\"node\":7,\"path\":\"translation\"}},"  /* 6 unknown node */
         "{\"sampler\":0,\"target\":{\"node\":1,\"path\":\"translation\"}},"  /* 7 matrix node */
         "{\"sampler\":9,\"target\":{\"node\":2,\"path\":\"translation\"}}]}]}"; /* 8 no such sampler */
-    f = fopen(gltf, "wb");
-    CHECK(f && fwrite(json, strlen(json), 1, f) == 1);
-    fclose(f);
+    write_all(gltf, json, strlen(json));
     sy_scene *s = NULL;
     sy_error e = {0};
     sy_gltf_info info;

@@ -403,9 +403,7 @@ static int load_bad(const char *name, const uint8_t joints[12], const float weig
     char bin[600], gltf[640];
     snprintf(bin, sizeof bin, "%s/%s.bin", g_dir, name);
     snprintf(gltf, sizeof gltf, "%s/%s.gltf", g_dir, name);
-    FILE *f = fopen(bin, "wb");
-    CHECK(f && fwrite(buf, sizeof buf, 1, f) == 1);
-    fclose(f);
+    write_all(bin, buf, sizeof buf);
     char json[2048];
     snprintf(json, sizeof json,
              "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":160,\"uri\":\"%s.bin\"}],"
@@ -420,9 +418,7 @@ static int load_bad(const char *name, const uint8_t joints[12], const float weig
              "\"nodes\":[{\"mesh\":0,\"skin\":0},{\"name\":\"joint\",\"translation\":[0,5,0]}],"
              "\"scenes\":[{\"nodes\":[0,1]}]}",
              name);
-    f = fopen(gltf, "wb");
-    CHECK(f && fwrite(json, strlen(json), 1, f) == 1);
-    fclose(f);
+    write_all(gltf, json, strlen(json));
     rig g;
     memset(&g, 0, sizeof g);
     sy_error e = {0};
@@ -523,9 +519,7 @@ static int write_moving_joint(char *path, size_t size)
     char bin[600];
     snprintf(bin, sizeof bin, "%s/moving_joint.bin", g_dir);
     snprintf(path, size, "%s/moving_joint.gltf", g_dir);
-    FILE *f = fopen(bin, "wb");
-    CHECK(f && fwrite(buf, sizeof buf, 1, f) == 1);
-    fclose(f);
+    write_all(bin, buf, sizeof buf);
     const char *json =
         "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":192,\"uri\":\"moving_joint.bin\"}],"
         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":192}],"
@@ -542,9 +536,7 @@ static int write_moving_joint(char *path, size_t size)
         "\"animations\":[{\"samplers\":[{\"input\":4,\"output\":5}],"
         "\"channels\":[{\"sampler\":0,\"target\":{\"node\":1,\"path\":\"translation\"}}]}],"
         "\"scenes\":[{\"nodes\":[0,1]}]}";
-    f = fopen(path, "wb");
-    CHECK(f && fwrite(json, strlen(json), 1, f) == 1);
-    fclose(f);
+    write_all(path, json, strlen(json));
     return 0;
 }
 
