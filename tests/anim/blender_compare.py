@@ -60,6 +60,23 @@ def silhouette_args(ap, data_sub, backends):
     ap.add_argument("--json", default=None, help="write the results here")
 
 
+def render_compare(a, cmd, png, ref, name, t, b, ref_name, width):
+    """Runs the `sy render` command line cmd (it writes png) and compares its silhouette with ref (a
+    png_alpha coverage), printing the line of model or scene name at time t in back-end b (name
+    padded to width; ref_name: what made ref); (IoU, pixels covered by sy, by ref), or None when sy
+    render failed (printed). Shared with view3dscene_compare.py."""
+    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if r.returncode != 0:
+        print("%s t=%g %s: sy render failed (exit %d): %s\n  %s" % (name, t, b, r.returncode, r.stdout.strip()[-600:],
+                                                                    " ".join(cmd)))
+        return None
+    _, _, ours = png_alpha(png)
+    v, n_ours, n_ref = iou(ours, ref)
+    print("%-*s t=%-8g %-8s IoU %.4f  (covered: sy %6d, %s %6d)%s" %
+          (width, name, t, b, v, n_ours, ref_name, n_ref, "" if v >= a.min_iou else "   < %.2f" % a.min_iou), flush=True)
+    return v, n_ours, n_ref
+
+
 def finish(rows, worst, failed, out, a):
     """The summary line and the exit status of a silhouette comparison (this one and
     view3dscene_compare.py): rows of dicts with "iou"; --json, --min-iou, --check from a."""
@@ -176,19 +193,13 @@ def main():
                 png = os.path.join(mdir, "sy_%s_%d.png" % (b, i))
                 sy = [a.sy, "render", path, "-b", b, "-w", str(a.size), "-h", str(a.size), "--at", repr(t),
                       "--look-at", look, "--fov", "%.9g" % cam["fov"], "--background", "0,0,0,0", "-o", png]
-                r = subprocess.run(sy, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-                if r.returncode != 0:
-                    print("%s t=%g %s: sy render failed (exit %d): %s\n  %s" % (name, t, b, r.returncode,
-                                                                                r.stdout.strip()[-600:], " ".join(sy)))
+                m = render_compare(a, sy, png, ref, name, t, b, "blender", 18)
+                if m is None:
                     failed = True
                     continue
-                _, _, ours = png_alpha(png)
-                v, n_ours, n_ref = iou(ours, ref)
-                worst = min(worst, v)
-                rows.append({"model": name, "time": t, "frame": cam["frames"][i], "backend": b, "iou": v,
-                             "pixels_sy": n_ours, "pixels_blender": n_ref, "png": png})
-                print("%-18s t=%-8g %-8s IoU %.4f  (covered: sy %6d, blender %6d)%s" %
-                      (name, t, b, v, n_ours, n_ref, "" if v >= a.min_iou else "   < %.2f" % a.min_iou), flush=True)
+                worst = min(worst, m[0])
+                rows.append({"model": name, "time": t, "frame": cam["frames"][i], "backend": b, "iou": m[0],
+                             "pixels_sy": m[1], "pixels_blender": m[2], "png": png})
     return finish(rows, worst, failed, out, a)
 
 

@@ -22,7 +22,7 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from blender_compare import finish, iou, png_alpha, silhouette_args  # noqa: E402  (one PNG reader, IoU and summary for both)
+from blender_compare import finish, png_alpha, render_compare, silhouette_args  # noqa: E402  (one PNG reader, IoU and summary for both)
 
 # (scene under ../shared/testdata/x3d, times in seconds of its clock): the IndexedFaceSet example's
 # piston and rocker arms run on one looping 5500 s TimeSensor through Position- and
@@ -80,19 +80,13 @@ def main():
                 png = os.path.join(sdir, "sy_%s_%d.png" % (b, i))
                 sy = [a.sy, "render", path, "-b", b, "-w", str(rw), "-h", str(rh), "--at", repr(t),
                       "--background", "0,0,0,0", "-o", png]
-                r = subprocess.run(sy, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-                if r.returncode != 0:
-                    print("%s t=%g %s: sy render failed (exit %d): %s\n  %s" % (name, t, b, r.returncode,
-                                                                                r.stdout.strip()[-600:], " ".join(sy)))
+                m = render_compare(a, sy, png, ref, name, t, b, "view3dscene", 24)
+                if m is None:
                     failed = True
                     continue
-                _, _, ours = png_alpha(png)
-                v, n_ours, n_ref = iou(ours, ref)
-                worst = min(worst, v)
-                rows.append({"scene": rel, "time": t, "backend": b, "iou": v, "pixels_sy": n_ours,
-                             "pixels_view3dscene": n_ref, "png": png})
-                print("%-24s t=%-8g %-8s IoU %.4f  (covered: sy %6d, view3dscene %6d)%s" %
-                      (name, t, b, v, n_ours, n_ref, "" if v >= a.min_iou else "   < %.2f" % a.min_iou), flush=True)
+                worst = min(worst, m[0])
+                rows.append({"scene": rel, "time": t, "backend": b, "iou": m[0], "pixels_sy": m[1],
+                             "pixels_view3dscene": m[2], "png": png})
     return finish(rows, worst, failed, out, a)
 
 
