@@ -34,12 +34,24 @@ static bool px_eq(const sy_layer *l, uint32_t x, uint32_t y, float r, float g, f
     return ok;
 }
 
+/* A w x 1 layer of the pixels px[x] = (r g b a | depth). */
+static void make_row(sy_layer *l, uint32_t w, const float (*px)[5])
+{
+    MUST(sy_layer_create(w, 1, l, err));
+    for (uint32_t x = 0; x < w; ++x) set_px(l, x, 0, px[x][0], px[x][1], px[x][2], px[x][3], px[x][4]);
+}
+
+/* Checks row 0 of l against want[x] = (r g b a | depth), x < w. */
+static void expect_row(const sy_layer *l, uint32_t w, const float (*want)[5])
+{
+    for (uint32_t x = 0; x < w; ++x)
+        EXPECT_MSG(px_eq(l, x, 0, want[x][0], want[x][1], want[x][2], want[x][3], want[x][4]), "pixel %u", x);
+}
+
 /* dst 2x1: (0.4 0.4 0.4 1 | 5) and (0.1 0.2 0.3 1 | 2) */
 static void make_dst(sy_layer *dst)
 {
-    MUST(sy_layer_create(2, 1, dst, err));
-    set_px(dst, 0, 0, 0.4f, 0.4f, 0.4f, 1.0f, 5.0f);
-    set_px(dst, 1, 0, 0.1f, 0.2f, 0.3f, 1.0f, 2.0f);
+    make_row(dst, 2, (const float[][5]){{0.4f, 0.4f, 0.4f, 1.0f, 5.0f}, {0.1f, 0.2f, 0.3f, 1.0f, 2.0f}});
 }
 
 static void test_composite_math(void)
@@ -50,30 +62,24 @@ static void test_composite_math(void)
     EXPECT(px_eq(&dst, 2, 1, 0, 0, 0, 0, INFINITY));
     sy_layer_destroy(&dst);
 
-    MUST(sy_layer_create(2, 1, &src, err));
-    set_px(&src, 0, 0, 0.2f, 0.1f, 0.0f, 0.5f, 3.0f); /* half-covering, nearer than dst[0] */
-    set_px(&src, 1, 0, 0.0f, 0.0f, 0.0f, 0.0f, INFINITY); /* empty */
+    /* half-covering, nearer than dst[0]; empty */
+    make_row(&src, 2, (const float[][5]){{0.2f, 0.1f, 0.0f, 0.5f, 3.0f}, {0.0f, 0.0f, 0.0f, 0.0f, INFINITY}});
 
     /* replace: src wins everywhere, depth included (also the empty pixel) */
     make_dst(&dst);
     sy_layer_composite(&dst, &src, 0, 0, SY_COMPOSITE_REPLACE);
-    EXPECT(px_eq(&dst, 0, 0, 0.2f, 0.1f, 0.0f, 0.5f, 3.0f));
-    EXPECT(px_eq(&dst, 1, 0, 0, 0, 0, 0, INFINITY));
+    expect_row(&dst, 2, (const float[][5]){{0.2f, 0.1f, 0.0f, 0.5f, 3.0f}, {0, 0, 0, 0, INFINITY}});
     sy_layer_destroy(&dst);
 
     /* depth: nearer wins (3 < 5), +inf never wins */
     make_dst(&dst);
     sy_layer_composite(&dst, &src, 0, 0, SY_COMPOSITE_DEPTH);
-    EXPECT(px_eq(&dst, 0, 0, 0.2f, 0.1f, 0.0f, 0.5f, 3.0f));
-    EXPECT(px_eq(&dst, 1, 0, 0.1f, 0.2f, 0.3f, 1.0f, 2.0f));
+    expect_row(&dst, 2, (const float[][5]){{0.2f, 0.1f, 0.0f, 0.5f, 3.0f}, {0.1f, 0.2f, 0.3f, 1.0f, 2.0f}});
     /* farther and equal depths keep the destination */
     sy_layer far;
-    MUST(sy_layer_create(2, 1, &far, err));
-    set_px(&far, 0, 0, 1, 1, 1, 1, 3.5f);
-    set_px(&far, 1, 0, 1, 1, 1, 1, 2.0f);
+    make_row(&far, 2, (const float[][5]){{1, 1, 1, 1, 3.5f}, {1, 1, 1, 1, 2.0f}});
     sy_layer_composite(&dst, &far, 0, 0, SY_COMPOSITE_DEPTH);
-    EXPECT(px_eq(&dst, 0, 0, 0.2f, 0.1f, 0.0f, 0.5f, 3.0f));
-    EXPECT(px_eq(&dst, 1, 0, 0.1f, 0.2f, 0.3f, 1.0f, 2.0f));
+    expect_row(&dst, 2, (const float[][5]){{0.2f, 0.1f, 0.0f, 0.5f, 3.0f}, {0.1f, 0.2f, 0.3f, 1.0f, 2.0f}});
     sy_layer_destroy(&far);
     sy_layer_destroy(&dst);
 
@@ -82,12 +88,10 @@ static void test_composite_math(void)
      * the source has coverage; an empty source pixel changes nothing */
     make_dst(&dst);
     sy_layer_composite(&dst, &src, 0, 0, SY_COMPOSITE_ALPHA_OVER);
-    EXPECT(px_eq(&dst, 0, 0, 0.4f, 0.3f, 0.2f, 1.0f, 3.0f));
-    EXPECT(px_eq(&dst, 1, 0, 0.1f, 0.2f, 0.3f, 1.0f, 2.0f));
+    expect_row(&dst, 2, (const float[][5]){{0.4f, 0.3f, 0.2f, 1.0f, 3.0f}, {0.1f, 0.2f, 0.3f, 1.0f, 2.0f}});
     /* a covering source pixel farther than the destination keeps the destination's depth */
     sy_layer over;
-    MUST(sy_layer_create(1, 1, &over, err));
-    set_px(&over, 0, 0, 0.25f, 0.0f, 0.0f, 0.25f, 9.0f);
+    make_row(&over, 1, (const float[][5]){{0.25f, 0.0f, 0.0f, 0.25f, 9.0f}});
     sy_layer_composite(&dst, &over, 1, 0, SY_COMPOSITE_ALPHA_OVER);
     EXPECT(px_eq(&dst, 1, 0, 0.25f + 0.1f * 0.75f, 0.2f * 0.75f, 0.3f * 0.75f, 1.0f, 2.0f));
     /* onto transparent black, alpha-over equals the source */
