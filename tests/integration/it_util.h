@@ -43,6 +43,14 @@ static inline void it_register(void)
     }
 }
 
+/* The start of a test's main: the built-in back-ends registered (it_register); the folder of
+ * `--write DIR` (the test writes its images there), or NULL without it. */
+static inline const char *it_start(int argc, char **argv)
+{
+    it_register();
+    return argc == 3 && !strcmp(argv[1], "--write") ? argv[2] : NULL;
+}
+
 /* Path of a test-data file, or exit 77 (skipped) with the reason when it is absent. */
 static inline const char *it_testdata(const char *rel, char *buf, size_t size)
 {

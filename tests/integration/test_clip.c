@@ -285,8 +285,7 @@ static void test_sample(const char *write_dir)
 
 int main(int argc, char **argv)
 {
-    it_register();
-    const char *write_dir = argc == 3 && !strcmp(argv[1], "--write") ? argv[2] : NULL;
+    const char *write_dir = it_start(argc, argv);
     const char *names[16];
     uint32_t n = clip_classes(names);
     printf("back-ends with SY_CAP_CLIP:");

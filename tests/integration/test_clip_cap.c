@@ -431,8 +431,7 @@ static void test_shadow(void)
 
 int main(int argc, char **argv)
 {
-    it_register();
-    const char *write_dir = argc == 3 && !strcmp(argv[1], "--write") ? argv[2] : NULL;
+    const char *write_dir = it_start(argc, argv);
     test_closed();
     test_bad_colours();
     test_caps(write_dir);
