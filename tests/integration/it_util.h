@@ -135,6 +135,18 @@ static inline sy_light it_light(sy_scene *s, const char *name, sy_light_type typ
     return l;
 }
 
+/* A directional light "sun" of intensity 3 on a new node at (0, 0, 3), its -Z turned 45 degrees
+ * about Y: it travels (-1, 0, -1)/sqrt(2), so a caster's shadow falls towards -x (the clip tests). */
+static inline void it_sun_45(sy_scene *s)
+{
+    sy_light lamp = it_light(s, "sun", SY_LIGHT_DIRECTIONAL, 3.0f);
+    sy_node ln;
+    MUST(sy_node_create(s, "sun", &ln, err));
+    MUST(sy_node_set_light(s, ln, lamp, err));
+    const float t[3] = {0, 0, 3}, q[4] = {0, sinf(0.3926991f), 0, cosf(0.3926991f)}, one[3] = {1, 1, 1};
+    MUST(sy_node_set_trs(s, ln, t, q, one, err));
+}
+
 /* A stub back-end for the tests of what a capability guards: it renders a cleared layer and counts
  * its renders in it_stub_renders. A test defines its class with these functions and only the caps
  * it wants (the capability under test left out), e.g.

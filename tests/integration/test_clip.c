@@ -185,14 +185,7 @@ static void test_shadow(void)
     sy_material m;
     MUST(sy_material_create(s, "grey", &m, err));
     two_quads(s, "ground", 2.0f, m, "caster", 0.4f, m, NULL, NULL);
-    sy_node ln;
-    /* a directional light travelling (-1, 0, -1)/sqrt(2): its -Z turned 45 degrees about Y; the
-     * caster's shadow falls on the ground around x = -1 */
-    sy_light lamp = it_light(s, "sun", SY_LIGHT_DIRECTIONAL, 3.0f);
-    MUST(sy_node_create(s, "sun", &ln, err));
-    MUST(sy_node_set_light(s, ln, lamp, err));
-    const float t[3] = {0, 0, 3}, q[4] = {0, sinf(0.3926991f), 0, cosf(0.3926991f)}, one[3] = {1, 1, 1};
-    MUST(sy_node_set_trs(s, ln, t, q, one, err));
+    it_sun_45(s); /* the caster's shadow falls on the ground around x = -1 */
     MUST(sy_scene_commit(s, NULL, err));
     const char *be[3] = {"whitted", "pathtracer", "raster"};
     for (int i = 0; i < 3; ++i) {
