@@ -196,13 +196,9 @@ static float cap_share(const sy_layer *l, uint32_t x, uint32_t y)
     return f < 0.0f ? 0.0f : f > 1.0f ? 1.0f : f;
 }
 
-/* The scene: the cube (all 12 triangles or 11: open) at the origin, scaled by (sx, 1, 1). */
-static sy_scene *cube_scene(uint32_t tris, float sx)
+/* The cube's mesh in s (all 12 triangles or 11: open) of material m. */
+static sy_mesh cube_mesh(sy_scene *s, uint32_t tris, sy_material m)
 {
-    sy_scene *s;
-    MUST(sy_scene_create(&s, err));
-    sy_material m;
-    MUST(sy_material_create(s, "grey", &m, err));
     sy_primitive p = {0};
     p.positions = it_blob(CUBE_P, sizeof CUBE_P);
     p.indices = it_blob(CUBE_I, tris * 3 * sizeof(uint32_t));
@@ -211,6 +207,17 @@ static sy_scene *cube_scene(uint32_t tris, float sx)
     MUST(sy_mesh_create(s, "cube", &mesh, err));
     MUST(sy_mesh_set_primitives(s, mesh, &p, 1, err));
     sy_primitive_release(&p);
+    return mesh;
+}
+
+/* The scene: the cube (all 12 triangles or 11: open) at the origin, scaled by (sx, 1, 1). */
+static sy_scene *cube_scene(uint32_t tris, float sx)
+{
+    sy_scene *s;
+    MUST(sy_scene_create(&s, err));
+    sy_material m;
+    MUST(sy_material_create(s, "grey", &m, err));
+    sy_mesh mesh = cube_mesh(s, tris, m);
     sy_node n;
     MUST(sy_node_create(s, "cube", &n, err));
     MUST(sy_node_set_mesh(s, n, mesh, err));
@@ -372,14 +379,7 @@ static void test_shadow(void)
     MUST(sy_scene_create(&s, err));
     sy_material m;
     MUST(sy_material_create(s, "grey", &m, err));
-    sy_primitive p = {0};
-    p.positions = it_blob(CUBE_P, sizeof CUBE_P);
-    p.indices = it_blob(CUBE_I, sizeof CUBE_I);
-    p.material = m;
-    sy_mesh cube;
-    MUST(sy_mesh_create(s, "cube", &cube, err));
-    MUST(sy_mesh_set_primitives(s, cube, &p, 1, err));
-    sy_primitive_release(&p);
+    sy_mesh cube = cube_mesh(s, 12, m);
     const float gq[1][3] = {{0, 0, 2.0f}};
     sy_mesh ground = it_quad_mesh(s, "ground", gq, &m, 1);
     sy_node nc, ng;
