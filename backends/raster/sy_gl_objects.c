@@ -7,6 +7,7 @@
 
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -661,6 +662,80 @@ sy_gl_result sy_gl_texture_destroy(sy_gl_device *dev, sy_gl_texture tex)
     return SY_GL_OK;
 }
 
+/* >>kinds: the create / update / destroy frame that materials and lights share: its name in
+ * messages, its pool (offsetof(sy_gl_device, ...)), its description's check, whether its calls
+ * need the device's GL context current, set (stores a checked description; fresh: a new object) and
+ * drop (before the object's slot is freed). */
+typedef struct gl_kind {
+    const char *what;
+    size_t pool;
+    sy_gl_result (*check)(const void *d, sy_gl_report *rep);
+    bool context;
+    void (*set)(sy_gl_device *dev, void *item, const void *d, bool fresh);
+    void (*drop)(sy_gl_device *dev, void *item);
+} gl_kind;
+
+static pool *kind_pool(sy_gl_device *dev, const gl_kind *k)
+{
+    return (pool *)((char *)dev + k->pool);
+}
+
+/* The checks that create and update make before they change anything. */
+static sy_gl_result kind_check(sy_gl_device *dev, const gl_kind *k, const void *d, sy_gl_report *rep)
+{
+    sy_gl_result r = k->check(d, rep);
+    if (r == SY_GL_OK && k->context) r = sy_gli_current(dev, rep);
+    return r;
+}
+
+static sy_gl_result kind_create(sy_gl_device *dev, const gl_kind *k, const void *d, uint32_t *id)
+{
+    sy_gl_report *rep = dev ? dev->report : NULL;
+    *id = 0;
+    sy_gl_result r = kind_check(dev, k, d, rep);
+    if (r != SY_GL_OK) return r;
+    slot_head *h = sy_gli_pool_alloc(kind_pool(dev, k));
+    if (!h) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "%s: out of memory", k->what);
+    k->set(dev, h, d, true);
+    *id = h->id;
+    return SY_GL_OK;
+}
+
+static sy_gl_result kind_update(sy_gl_device *dev, const gl_kind *k, uint32_t id, const void *d)
+{
+    sy_gl_report *rep = dev ? dev->report : NULL;
+    void *item = sy_gli_pool_get(kind_pool(dev, k), id);
+    if (!item) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_HANDLE, "%s update: stale handle %u", k->what, id);
+    sy_gl_result r = kind_check(dev, k, d, rep);
+    if (r != SY_GL_OK) return r;
+    k->set(dev, item, d, false);
+    return SY_GL_OK;
+}
+
+static sy_gl_result kind_destroy(sy_gl_device *dev, const gl_kind *k, uint32_t id)
+{
+    void *item = sy_gli_pool_get(kind_pool(dev, k), id);
+    if (!item) return sy_gli_fail(dev->report, SY_GL_ERROR_INVALID_HANDLE, "sy_gl_%s_destroy: stale handle 0x%08x", k->what, id);
+    k->drop(dev, item);
+    sy_gli_pool_free(kind_pool(dev, k), item);
+    return SY_GL_OK;
+}
+
+/* The public calls sy_gl.h declares for kind K: sy_gl_NAME_create / _update / _destroy. */
+#define KIND_CALLS(NAME, K)                                                                         \
+    sy_gl_result sy_gl_##NAME##_create(sy_gl_device *dev, const sy_gl_##NAME##_desc *d, sy_gl_##NAME *out) \
+    {                                                                                               \
+        return kind_create(dev, &(K), d, &out->id);                                                 \
+    }                                                                                               \
+    sy_gl_result sy_gl_##NAME##_update(sy_gl_device *dev, sy_gl_##NAME h, const sy_gl_##NAME##_desc *d) \
+    {                                                                                               \
+        return kind_update(dev, &(K), h.id, d);                                                     \
+    }                                                                                               \
+    sy_gl_result sy_gl_##NAME##_destroy(sy_gl_device *dev, sy_gl_##NAME h)                          \
+    {                                                                                               \
+        return kind_destroy(dev, &(K), h.id);                                                       \
+    }
+
 /* >>material */
 void sy_gl_material_desc_init(sy_gl_material_desc *d)
 {
@@ -716,47 +791,40 @@ static void material_upload(sy_gl_device *dev, mat_o *m, bool create)
     if (!dev->forward) sy_gli_mtab_set(dev, m->h.id & IDX_MASK, &m->d); /* beyond the table: shaded forward */
 }
 
-sy_gl_result sy_gl_material_create(sy_gl_device *dev, const sy_gl_material_desc *d, sy_gl_material *out)
+static sy_gl_result material_check_any(const void *d, sy_gl_report *rep)
 {
-    sy_gl_report *rep = dev ? dev->report : NULL;
-    out->id = 0;
-    sy_gl_result r = material_check(d, rep);
-    if (r == SY_GL_OK) r = sy_gli_current(dev, rep);
-    if (r != SY_GL_OK) return r;
-    mat_o *m = sy_gli_pool_alloc(&dev->materials);
-    if (!m) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "material: out of memory");
-    m->d = *d;
-    dev->gl->GenBuffers(1, &m->ubo);
-    material_upload(dev, m, true);
-    out->id = m->h.id;
-    return SY_GL_OK;
+    return material_check(d, rep);
 }
 
-sy_gl_result sy_gl_material_update(sy_gl_device *dev, sy_gl_material mat, const sy_gl_material_desc *d)
+/* A new material gets its uniform buffer; a changed one marks the shadow casters when what casts
+ * changed, and the probes (what they see changed). */
+static void material_set(sy_gl_device *dev, void *item, const void *desc, bool fresh)
 {
-    sy_gl_report *rep = dev ? dev->report : NULL;
-    mat_o *m = sy_gli_pool_get(&dev->materials, mat.id);
-    if (!m) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_HANDLE, "material update: stale handle %u", mat.id);
-    sy_gl_result r = material_check(d, rep);
-    if (r == SY_GL_OK) r = sy_gli_current(dev, rep);
-    if (r != SY_GL_OK) return r;
+    mat_o *m = item;
+    const sy_gl_material_desc *d = desc;
+    if (fresh) {
+        m->d = *d;
+        dev->gl->GenBuffers(1, &m->ubo);
+        material_upload(dev, m, true);
+        return;
+    }
     bool shadows = sy_gli_caster_kind(&m->d) != sy_gli_caster_kind(d) || m->d.alpha_mode != SY_GL_ALPHA_OPAQUE ||
                    memcmp(m->d.emissive, d->emissive, sizeof d->emissive) != 0;
     m->d = *d;
     material_upload(dev, m, false);
     if (shadows) sy_gli_geometry_changed(dev); /* shadow casters changed */
     dev->probes_dirty = true;              /* what the probes see changed */
-    return SY_GL_OK;
 }
 
-sy_gl_result sy_gl_material_destroy(sy_gl_device *dev, sy_gl_material mat)
+static void material_drop(sy_gl_device *dev, void *item)
 {
-    mat_o *m = sy_gli_pool_get(&dev->materials, mat.id);
-    if (!m) return sy_gli_fail(dev->report, SY_GL_ERROR_INVALID_HANDLE, "%s: stale handle 0x%08x", __func__, mat.id);
-    if (sy_gli_current(dev, NULL) == SY_GL_OK) dev->gl->DeleteBuffers(1, &m->ubo);
-    sy_gli_pool_free(&dev->materials, m);
-    return SY_GL_OK;
+    if (sy_gli_current(dev, NULL) == SY_GL_OK) dev->gl->DeleteBuffers(1, &((mat_o *)item)->ubo);
 }
+
+static const gl_kind material_kind = {"material", offsetof(sy_gl_device, materials), material_check_any, true,
+                                      material_set, material_drop};
+
+KIND_CALLS(material, material_kind)
 
 /* The normal matrix of an upper 3x3 whose float inverse under- or overflows (a scale of 1e-30):
  * the transposed inverse up to a positive factor, i.e. the cofactor matrix times the sign of the
@@ -880,40 +948,28 @@ static sy_gl_result light_check(const sy_gl_light_desc *d, sy_gl_report *rep)
     return SY_GL_OK;
 }
 
-sy_gl_result sy_gl_light_create(sy_gl_device *dev, const sy_gl_light_desc *d, sy_gl_light *out)
+static sy_gl_result light_check_any(const void *d, sy_gl_report *rep)
 {
-    sy_gl_report *rep = dev ? dev->report : NULL;
-    out->id = 0;
-    sy_gl_result r = light_check(d, rep);
-    if (r != SY_GL_OK) return r;
-    light_o *l = sy_gli_pool_alloc(&dev->lights);
-    if (!l) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "light: out of memory");
-    l->d = *d;
-    dev->lights_dirty = true;
-    out->id = l->h.id;
-    return SY_GL_OK;
+    return light_check(d, rep);
 }
 
-sy_gl_result sy_gl_light_update(sy_gl_device *dev, sy_gl_light light, const sy_gl_light_desc *d)
+/* A new, changed or destroyed light: the Lights block is written again before the next frame. */
+static void light_set(sy_gl_device *dev, void *item, const void *d, bool fresh)
 {
-    sy_gl_report *rep = dev ? dev->report : NULL;
-    light_o *l = sy_gli_pool_get(&dev->lights, light.id);
-    if (!l) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_HANDLE, "light update: stale handle %u", light.id);
-    sy_gl_result r = light_check(d, rep);
-    if (r != SY_GL_OK) return r;
-    l->d = *d;
+    (void)fresh;
+    ((light_o *)item)->d = *(const sy_gl_light_desc *)d;
     dev->lights_dirty = true;
-    return SY_GL_OK;
 }
 
-sy_gl_result sy_gl_light_destroy(sy_gl_device *dev, sy_gl_light light)
+static void light_drop(sy_gl_device *dev, void *item)
 {
-    light_o *l = sy_gli_pool_get(&dev->lights, light.id);
-    if (!l) return sy_gli_fail(dev->report, SY_GL_ERROR_INVALID_HANDLE, "%s: stale handle 0x%08x", __func__, light.id);
-    sy_gli_pool_free(&dev->lights, l);
+    (void)item;
     dev->lights_dirty = true;
-    return SY_GL_OK;
 }
+
+static const gl_kind light_kind = {"light", offsetof(sy_gl_device, lights), light_check_any, false, light_set, light_drop};
+
+KIND_CALLS(light, light_kind)
 
 void sy_gl_set_background(sy_gl_device *dev, sy_gl_background_mode mode, const float color[4], sy_gl_texture texture,
                           float intensity)
