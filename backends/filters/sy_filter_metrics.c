@@ -2,6 +2,7 @@
 #include "sy_filter_metrics.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 
 static float srgb_encode(float v)
@@ -11,10 +12,39 @@ static float srgb_encode(float v)
     return v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
 }
 
+enum { SSIM_R = 5 }; /* the Gaussian window's radius (sigma 1.5) */
+
+/* One pass of the separable Gaussian over w x h pixels, along y when vertical, else along x: out
+ * holds 5 values per pixel, the window's weighted means of the moments a, b, a^2, b^2, ab, taken
+ * at each tap from the images a and b (the first pass, in NULL) or read from in (the second). */
+static void moments_pass(const float *g, uint32_t w, uint32_t h, bool vertical, const float *a, const float *b,
+                         const float *in, float *out)
+{
+    const int R = SSIM_R;
+    for (uint32_t y = 0; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) {
+            double s[5] = {0, 0, 0, 0, 0}, W = 0;
+            for (int k = -R; k <= R; ++k) {
+                int xx = (int)x + (vertical ? 0 : k), yy = (int)y + (vertical ? k : 0);
+                if (xx < 0 || xx >= (int)w || yy < 0 || yy >= (int)h) continue;
+                size_t i = (size_t)yy * w + xx;
+                float wt = g[k + R];
+                if (in) {
+                    for (int q = 0; q < 5; ++q) s[q] += wt * in[5 * i + q];
+                } else {
+                    float va = a[i], vb = b[i];
+                    s[0] += wt * va, s[1] += wt * vb, s[2] += wt * va * va, s[3] += wt * vb * vb, s[4] += wt * va * vb;
+                }
+                W += wt;
+            }
+            for (int q = 0; q < 5; ++q) out[5 * ((size_t)y * w + x) + q] = (float)(s[q] / W);
+        }
+}
+
 double sy_filter_ssim_gray(const float *a, const float *b, uint32_t w, uint32_t h)
 {
-    enum { R = 5 };
-    float g[2 * R + 1];
+    const int R = SSIM_R;
+    float g[2 * SSIM_R + 1];
     for (int k = -R; k <= R; ++k) g[k + R] = expf(-0.5f * (float)(k * k) / (1.5f * 1.5f));
     const double C1 = (0.01 * 1.0) * (0.01 * 1.0), C2 = (0.03 * 1.0) * (0.03 * 1.0);
     size_t n = (size_t)w * h;
@@ -24,31 +54,8 @@ double sy_filter_ssim_gray(const float *a, const float *b, uint32_t w, uint32_t 
         free(tmp), free(mom);
         return NAN;
     }
-    for (uint32_t y = 0; y < h; ++y)
-        for (uint32_t x = 0; x < w; ++x) {
-            double s[5] = {0, 0, 0, 0, 0}, W = 0;
-            for (int k = -R; k <= R; ++k) {
-                int xx = (int)x + k;
-                if (xx < 0 || xx >= (int)w) continue;
-                size_t i = (size_t)y * w + xx;
-                float wt = g[k + R], va = a[i], vb = b[i];
-                s[0] += wt * va, s[1] += wt * vb, s[2] += wt * va * va, s[3] += wt * vb * vb, s[4] += wt * va * vb;
-                W += wt;
-            }
-            for (int q = 0; q < 5; ++q) tmp[5 * ((size_t)y * w + x) + q] = (float)(s[q] / W);
-        }
-    for (uint32_t y = 0; y < h; ++y)
-        for (uint32_t x = 0; x < w; ++x) {
-            double s[5] = {0, 0, 0, 0, 0}, W = 0;
-            for (int k = -R; k <= R; ++k) {
-                int yy = (int)y + k;
-                if (yy < 0 || yy >= (int)h) continue;
-                const float *t = tmp + 5 * ((size_t)yy * w + x);
-                for (int q = 0; q < 5; ++q) s[q] += g[k + R] * t[q];
-                W += g[k + R];
-            }
-            for (int q = 0; q < 5; ++q) mom[5 * ((size_t)y * w + x) + q] = (float)(s[q] / W);
-        }
+    moments_pass(g, w, h, false, a, b, NULL, tmp);
+    moments_pass(g, w, h, true, NULL, NULL, tmp, mom);
     double total = 0;
     for (size_t i = 0; i < n; ++i) {
         const float *m = mom + 5 * i;
