@@ -459,10 +459,8 @@ if [ -f "$BOX" ] && [ -f "$GLB" ]; then
         run_ok "render BoxAnimated --at 2 --clip 0" anim_2 "$SY" render "$BOXANIM" -w 64 -h 48 --at 2 --clip 0 \
             -o "$TMP/anim/t2.exr"
         if [ -n "$EXR_EQUAL" ]; then
-            "$EXR_EQUAL" "$TMP/anim/static.exr" "$TMP/anim/t0.exr" >/dev/null 2>&1 ||
-                fail "render BoxAnimated: --at 0 differs from the static load"
-            "$EXR_EQUAL" "$TMP/anim/t05.exr" "$TMP/anim/t2.exr" >/dev/null 2>&1 &&
-                fail "render BoxAnimated: --at 0.5 and --at 2 give the same image"
+            exr_same "render BoxAnimated: --at 0 differs from the static load" "$TMP/anim/static.exr" "$TMP/anim/t0.exr"
+            exr_differ "render BoxAnimated: --at 0.5 and --at 2 give the same image" "$TMP/anim/t05.exr" "$TMP/anim/t2.exr"
         else
             echo "skip: --at pixel checks (no exr_equal given)"
         fi
@@ -477,10 +475,8 @@ if [ -f "$BOX" ] && [ -f "$GLB" ]; then
                 -o "$TMP/anim/fox0.exr"
             run_ok "render Fox --at 1.5 --clip Run" fox_run "$SY" render "$FOX" -w 48 -h 36 --at 1.5 --clip Run \
                 -o "$TMP/anim/foxrun.exr"
-            "$EXR_EQUAL" "$TMP/anim/fox.exr" "$TMP/anim/fox0.exr" >/dev/null 2>&1 ||
-                fail "render Fox: without --clip the image is not clip 0's"
-            "$EXR_EQUAL" "$TMP/anim/fox.exr" "$TMP/anim/foxrun.exr" >/dev/null 2>&1 &&
-                fail "render Fox: clip 0 and clip Run give the same image"
+            exr_same "render Fox: without --clip the image is not clip 0's" "$TMP/anim/fox.exr" "$TMP/anim/fox0.exr"
+            exr_differ "render Fox: clip 0 and clip Run give the same image" "$TMP/anim/fox.exr" "$TMP/anim/foxrun.exr"
         else
             echo "skip: the default clip (no Fox sample or no exr_equal)"
         fi

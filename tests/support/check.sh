@@ -8,6 +8,9 @@
 #   usage_error LABEL EXPECT CMD...  run (as $TMP/usage.*), then a failure naming LABEL unless CMD
 #                            refused its usage: status 2 and EXPECT (a fixed string) on stderr
 #   fresh_tmp DIR            TMP=DIR, the scratch folder, removed and made again empty: a test's start
+#   exr_same MESSAGE A B     a failure with MESSAGE unless $EXR_EQUAL (tests/support/exr_equal) finds
+#                            the EXR files A and B equal; exr_differ MESSAGE A B: unless it finds them
+#                            different
 fails=0
 
 fail() {
@@ -42,4 +45,12 @@ fresh_tmp() {
     TMP=$1
     rm -rf "$TMP"
     mkdir -p "$TMP"
+}
+
+exr_same() {
+    if ! "$EXR_EQUAL" "$2" "$3" >/dev/null 2>&1; then fail "$1"; fi
+}
+
+exr_differ() {
+    if "$EXR_EQUAL" "$2" "$3" >/dev/null 2>&1; then fail "$1"; fi
 }
