@@ -114,6 +114,20 @@ static double json_number(const char *text, const char *key)
     return p ? strtod(p + strlen(k), NULL) : 0;
 }
 
+/* Sends msg, which the server must refuse: its "refused" answer names reason. 0, or 1 after a
+ * failed check. */
+static int refused(sy_web_client *c, const char *msg, const char *reason)
+{
+    sy_error err = {0};
+    char *t = NULL;
+    CHECK_OK(sy_web_client_send(c, msg, &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "refused", &t, &err), err);
+    bool named = strstr(t, reason) != NULL;
+    free(t);
+    CHECK_MSG(named, "the refusal of %s does not say '%s'", msg, reason);
+    return 0;
+}
+
 /* Frames until one whose depth at pixel (px, py) of an 80 x 60 frame satisfies want (changed from
  * d0 or equal to it), at most 40 frames; the depth there in *d. */
 static int frame_until(sy_web_client *c, int px, int py, float d0, bool changed, float *d)
@@ -212,10 +226,7 @@ int test_scene(uint16_t port)
     CHECK_OK(sy_web_client_send(c, m, &err), err);
     if (frame_until(c, px, py, d0, false, &d)) return 1;
     /* an unknown node: refused with the reason, nothing changes */
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"visible\",\"node\":4000000000,\"on\":false}", &err), err);
-    CHECK_OK(sy_web_client_next_text(c, 20000, "refused", &t, &err), err);
-    CHECK(strstr(t, "no node 4000000000") != NULL);
-    free(t);
+    if (refused(c, "{\"t\":\"visible\",\"node\":4000000000,\"on\":false}", "no node 4000000000")) return 1;
     /* a plane that keeps nothing (z >= 1e6): nothing covered; no plane: back */
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[[0,0,1,-1000000]]}", &err), err);
     if (frame_until(c, px, py, d0, true, &d)) return 1;
@@ -258,10 +269,7 @@ int test_scene(uint16_t port)
         CHECK(json_number(t, "seq") == 20 + k && strstr(t, want));
         free(t);
     }
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"environment\",\"name\":\"sky\"}", &err), err);
-    CHECK_OK(sy_web_client_next_text(c, 20000, "refused", &t, &err), err);
-    CHECK(strstr(t, "no such environment") != NULL);
-    free(t);
+    if (refused(c, "{\"t\":\"environment\",\"name\":\"sky\"}", "no such environment")) return 1;
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"clip\",\"planes\":[]}", &err), err);
     if (frame_until(c, px, py, d0, false, &d)) return 1;
     /* deselect every node */
