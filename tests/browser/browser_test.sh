@@ -120,6 +120,19 @@ browse() { # browse URL: the browser run into $out; exit on failure
     [ $rc = 77 ] && skip "$(cat "$out/browser.json")"
     [ $rc = 0 ] || { echo "FAIL: the browser run failed (exit $rc); sy web said: $(server_said)"; exit 1; }
 }
+# finish [LOG...]: the end of a run: the server still running, no sanitizer's report in its stderr
+# (nor in the LOGs given), the summary line and the exit status
+finish() {
+    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
+    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" "$@" && bad "sy web: $(server_said)"
+    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
+    exit $fail
+}
+# keep: the run's PNG and JSON files into $SY_BROWSER_KEEP when it is set
+keep() {
+    if [ -n "${SY_BROWSER_KEEP:-}" ]; then cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null; fi
+    return 0
+}
 # fetched_check [BUDGET]: what the page fetched is each object of the answer once, nothing else;
 # with BUDGET, the answer is cut at it and leaves objects out
 fetched_check() {
@@ -193,16 +206,13 @@ if [ "$mode" = tools ]; then
       for (const s of [t, r]) if (s.consoleErrors.length) errs.push(`page errors: ${s.consoleErrors}`);
       if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
     ' "$out/tools.json" "$out/ro.json" || fail=1
-    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
-    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" "$out/err2" && bad "sy web: $(server_said)"
-    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
-    exit $fail
+    finish "$out/err2"
 fi
 
 if [ "$mode" = timeline ]; then
     case $url in *\?*) url="$url&video=0" ;; *) url="$url?video=0" ;; esac # JPEG: equal poses give equal frames
     browse "$url"
-    [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null
+    keep
     node -e '
       const s = JSON.parse(require("fs").readFileSync(process.argv[1])), errs = [];
       console.log(`timeline ${s.first.start}..${s.first.end} s; start vs 16%: mean abs diff ${s.moved.toFixed(2)}, start vs start again ` +
@@ -217,15 +227,12 @@ if [ "$mode" = timeline ]; then
     ' "$out/browser.json" || fail=1
     wait_until $pid grep -q "outside the scene's clips" "$out/err" || bad "an out-of-range time was not refused: $(tail -3 "$out/err")"
     wait_until $pid grep -q "time: s must be a finite number" "$out/err" || bad "a time that is no number was not refused: $(tail -3 "$out/err")"
-    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
-    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
-    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
-    exit $fail
+    finish
 fi
 
 if [ "$mode" = video ]; then
     browse "$url"
-    [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null
+    keep
     node -e '
       const s = JSON.parse(require("fs").readFileSync(process.argv[1])), errs = [], MAD = 6;
       for (const r of s.runs) {
@@ -244,16 +251,13 @@ if [ "$mode" = video ]; then
       if (s.consoleErrors.length) errs.push(`page errors: ${s.consoleErrors}`);
       if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
     ' "$out/browser.json" || fail=1
-    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
-    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
     grep -E 'video|sent (vp8|vp9|jpeg)' "$out/err" | head -8
-    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
-    exit $fail
+    finish
 fi
 
 if [ "$mode" = converge ]; then
     browse "$url"
-    [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null
+    keep
     node -e '
       const s = JSON.parse(require("fs").readFileSync(process.argv[1])), errs = [];
       console.log(`still path tracer: noise ${s.early.noise.toFixed(2)} at ${s.early.samples.join("-")} spp, ` +
@@ -265,10 +269,7 @@ if [ "$mode" = converge ]; then
       if (s.consoleErrors.length) errs.push(`page errors: ${s.consoleErrors}`);
       if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
     ' "$out/browser.json" || fail=1
-    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
-    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
-    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
-    exit $fail
+    finish
 fi
 
 if [ "$mode" = warp ]; then
@@ -278,7 +279,7 @@ if [ "$mode" = warp ]; then
     case $url in *\?*) nurl="$url&warp=0" ;; *) nurl="$url?warp=0" ;; esac
     browse "$nurl"
     cp "$out/browser.json" "$out/nowarp.json"
-    [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null
+    keep
     node -e '
       const fs = require("fs"), w = JSON.parse(fs.readFileSync(process.argv[1])), n = JSON.parse(fs.readFileSync(process.argv[2]));
       const errs = [], BOUND = 200, MAD = 6;
@@ -301,10 +302,7 @@ if [ "$mode" = warp ]; then
       for (const s of [w, n]) if (s.consoleErrors.length) errs.push(`page errors: ${s.consoleErrors}`);
       if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
     ' "$out/warp.json" "$out/nowarp.json" || fail=1
-    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
-    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
-    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
-    exit $fail
+    finish
 fi
 
 browse "$url"
@@ -341,7 +339,4 @@ else
     fetched_check $budget
 fi
 # the server must have lived through it all, without a sanitizer's report
-kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
-grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
-[ $fail = 0 ] && echo "ok: sy web $mode in chromium"
-exit $fail
+finish
