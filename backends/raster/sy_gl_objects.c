@@ -326,6 +326,22 @@ static bool level_vertex_order(const sy_gl_mesh_desc *d, const mesh_o *m, const 
     return true;
 }
 
+/* The box of d's positions into bmin / bmax; a position that is not finite fails, "WHAT: position I
+ * is not finite". */
+static sy_gl_result positions_box(const sy_gl_mesh_desc *d, const char *what, float bmin[3], float bmax[3],
+                                  sy_gl_report *rep)
+{
+    for (int k = 0; k < 3; ++k) bmin[k] = INFINITY, bmax[k] = -INFINITY;
+    for (uint32_t i = 0; i < d->vertex_count; ++i)
+        for (int k = 0; k < 3; ++k) {
+            float v = d->positions[3u * i + k];
+            if (!isfinite(v)) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "%s: position %u is not finite", what, i);
+            bmin[k] = fminf(bmin[k], v);
+            bmax[k] = fmaxf(bmax[k], v);
+        }
+    return SY_GL_OK;
+}
+
 sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_gl_mesh *out)
 {
     sy_gl_report *rep = dev ? dev->report : NULL;
@@ -338,20 +354,15 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
         return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT,
                     "mesh: without indices vertex_count (%u) must be 3 x triangle_count (%u)", d->vertex_count,
                     d->triangle_count);
-    float bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (uint32_t i = 0; i < d->vertex_count; ++i)
-        for (int k = 0; k < 3; ++k) {
-            float v = d->positions[3u * i + k];
-            if (!isfinite(v)) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: position %u is not finite", i);
-            bmin[k] = fminf(bmin[k], v);
-            bmax[k] = fmaxf(bmax[k], v);
-        }
+    float bmin[3], bmax[3];
+    sy_gl_result r = positions_box(d, "mesh", bmin, bmax, rep);
+    if (r != SY_GL_OK) return r;
     if (d->indices)
         for (uint32_t i = 0; i < 3u * d->triangle_count; ++i)
             if (d->indices[i] >= d->vertex_count)
                 return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "mesh: index %u = %u is out of range (%u vertices)",
                             i, d->indices[i], d->vertex_count);
-    sy_gl_result r = sy_gli_current(dev, rep);
+    r = sy_gli_current(dev, rep);
     if (r != SY_GL_OK) return r;
     mesh_o *m = sy_gli_pool_alloc(&dev->meshes);
     if (!m) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
@@ -441,15 +452,9 @@ sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_m
     for (int a = 0; a < 5; ++a)
         if (!arrays[a] != !m->has_attr[a])
             return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "mesh update: attribute %d present in one and not the other", a);
-    float bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (uint32_t i = 0; i < d->vertex_count; ++i)
-        for (int k = 0; k < 3; ++k) {
-            float v = d->positions[3u * i + k];
-            if (!isfinite(v)) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "mesh update: position %u is not finite", i);
-            bmin[k] = fminf(bmin[k], v);
-            bmax[k] = fmaxf(bmax[k], v);
-        }
-    sy_gl_result r = sy_gli_current(dev, rep);
+    float bmin[3], bmax[3];
+    sy_gl_result r = positions_box(d, "mesh update", bmin, bmax, rep);
+    if (r == SY_GL_OK) r = sy_gli_current(dev, rep);
     if (r != SY_GL_OK) return r;
     int stride, offs[5];
     size_t bytes = interleaved_layout(d, arrays, offs, &stride);
@@ -721,20 +726,14 @@ static sy_gl_result kind_destroy(sy_gl_device *dev, const gl_kind *k, uint32_t i
     return SY_GL_OK;
 }
 
-/* The public calls sy_gl.h declares for kind K: sy_gl_NAME_create / _update / _destroy. */
-#define KIND_CALLS(NAME, K)                                                                         \
-    sy_gl_result sy_gl_##NAME##_create(sy_gl_device *dev, const sy_gl_##NAME##_desc *d, sy_gl_##NAME *out) \
-    {                                                                                               \
-        return kind_create(dev, &(K), d, &out->id);                                                 \
-    }                                                                                               \
-    sy_gl_result sy_gl_##NAME##_update(sy_gl_device *dev, sy_gl_##NAME h, const sy_gl_##NAME##_desc *d) \
-    {                                                                                               \
-        return kind_update(dev, &(K), h.id, d);                                                     \
-    }                                                                                               \
-    sy_gl_result sy_gl_##NAME##_destroy(sy_gl_device *dev, sy_gl_##NAME h)                          \
-    {                                                                                               \
-        return kind_destroy(dev, &(K), h.id);                                                       \
-    }
+/* The public calls sy_gl.h declares for kind K: sy_gl_NAME_create / _update / _destroy, each the
+ * frame above. */
+#define KIND_CALLS(NAME, K)                                                                                            \
+    sy_gl_result sy_gl_##NAME##_create(sy_gl_device *dev, const sy_gl_##NAME##_desc *d, sy_gl_##NAME *out)             \
+    { return kind_create(dev, &(K), d, &out->id); }                                                                    \
+    sy_gl_result sy_gl_##NAME##_update(sy_gl_device *dev, sy_gl_##NAME h, const sy_gl_##NAME##_desc *d)                \
+    { return kind_update(dev, &(K), h.id, d); }                                                                        \
+    sy_gl_result sy_gl_##NAME##_destroy(sy_gl_device *dev, sy_gl_##NAME h) { return kind_destroy(dev, &(K), h.id); }
 
 /* >>material */
 void sy_gl_material_desc_init(sy_gl_material_desc *d)
