@@ -52,6 +52,58 @@ static sy_result parse_listen(const char *s, char *host, size_t hl, int *port, s
     return SY_OK;
 }
 
+/* A clip's name for the page (a WebSocket text message must be UTF-8): valid UTF-8 sequences that
+ * fit are kept, control characters and other bytes become '?'. */
+static void clip_name(char *out, size_t cap, const char *name)
+{
+    const unsigned char *s = (const unsigned char *)name;
+    size_t o = 0;
+    while (*s && o + 1 < cap) {
+        size_t n = *s < 0x80 ? 1 : (*s & 0xE0) == 0xC0 ? 2 : (*s & 0xF0) == 0xE0 ? 3 : (*s & 0xF8) == 0xF0 ? 4 : 0;
+        bool ok = n == 1 ? *s >= 0x20 && *s != 0x7f : n > 1 && *s >= 0xC2 && *s <= 0xF4;
+        for (size_t k = 1; ok && k < n; ++k) ok = (s[k] & 0xC0) == 0x80;
+        if (ok && n == 3) ok = !(s[0] == 0xE0 && s[1] < 0xA0) && !(s[0] == 0xED && s[1] >= 0xA0); /* overlong, surrogates */
+        if (ok && n == 4) ok = !(s[0] == 0xF0 && s[1] < 0x90) && !(s[0] == 0xF4 && s[1] >= 0x90);
+        if (!ok || o + n >= cap) {
+            if (ok) break; /* a whole character that does not fit: cut before it */
+            out[o++] = '?';
+            ++s;
+            continue;
+        }
+        memcpy(out + o, s, n);
+        o += n, s += n;
+    }
+    out[o] = 0;
+}
+
+/* The clips a page may choose (sy_web_internal.h): the scene's animations in slot order (the
+ * indices sy_animation_find takes), their ranges, then every clip together; w->clip the one chosen
+ * (want; {0}: every clip). A clip without keys has the empty range [0, 0]. */
+static sy_result web_clips(sy_web *w, sy_animation want, sy_error *err)
+{
+    const sy_scene *s = w->d.scene;
+    uint32_t n = sy_scene_count(s, SY_TYPE_ANIMATION);
+    w->clips = calloc(n + 1, sizeof *w->clips);
+    w->clip_range = calloc(n + 1, sizeof *w->clip_range);
+    w->clip_names = calloc(n + 1, sizeof *w->clip_names);
+    if (!w->clips || !w->clip_range || !w->clip_names) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory");
+    for (uint32_t id = sy_scene_next(s, SY_TYPE_ANIMATION, 0); id && w->clip_count < n; id = sy_scene_next(s, SY_TYPE_ANIMATION, id))
+        w->clips[w->clip_count++] = (sy_animation){id};
+    w->clip = w->clip_count;
+    for (uint32_t i = 0; i <= w->clip_count; ++i) {
+        double *rg = w->clip_range[i];
+        if (sy_scene_time_range(s, w->clips[i], &rg[0], &rg[1], NULL) != SY_OK || !(rg[1] >= rg[0])) rg[0] = rg[1] = 0;
+        if (i == w->clip_count) break;
+        if (want.id && w->clips[i].id == want.id) w->clip = i;
+        const sy_animation_data *ad = sy_animation_get(s, w->clips[i]);
+        if (ad && ad->name && ad->name[0]) clip_name(w->clip_names[i], sizeof w->clip_names[i], ad->name);
+        else snprintf(w->clip_names[i], sizeof w->clip_names[i], "clip %u", i);
+    }
+    if (want.id && w->clip == w->clip_count)
+        return sy_error_set(err, SY_ERR_NOT_FOUND, "web: clip %u is not an animation of the scene", want.id);
+    return SY_OK;
+}
+
 sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
 {
     *out = NULL;
@@ -84,9 +136,12 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     if (!w->d.max_pending) w->d.max_pending = 128;
     w->initial_backend = w->backend = bi;
     pthread_mutex_init(&w->mu, NULL);
-    /* the timeline: the range of every clip together, paused at its start (a page plays it) */
+    /* the timeline: the range of desc->clip (every clip together: {0}), paused at its start (a page
+     * plays it, or chooses another clip) */
+    sy_result r = web_clips(w, desc->clip, err);
     double t0 = 0, t1 = 0;
-    w->animated = sy_scene_time_range(desc->scene, (sy_animation){0}, &t0, &t1, NULL) == SY_OK && t1 > t0;
+    if (r == SY_OK) t0 = w->clip_range[w->clip][0], t1 = w->clip_range[w->clip][1];
+    w->animated = r == SY_OK && w->clip_range[w->clip_count][1] > w->clip_range[w->clip_count][0]; /* any clip moves */
     w->clock = sy_clock_make(t0, t1);
     w->clock.playing = false;
     w->clock_version = w->animated ? 1 : 0;
@@ -95,11 +150,10 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     w->stills_tail = &w->stills;
     w->actions_tail = &w->actions;
     w->replies_tail = &w->replies;
-    sy_result r = SY_OK;
-    if (w->d.max_width > 16384 || w->d.max_height > 16384 || w->d.max_clients > 1000 || w->d.max_message < 64 ||
+    if (r == SY_OK && (w->d.max_width > 16384 || w->d.max_height > 16384 || w->d.max_clients > 1000 || w->d.max_message < 64 ||
         w->d.max_message > (1u << 24) || w->d.quality < 1 || w->d.quality > 100 || w->d.idle_timeout_s > 3600 ||
         !(w->d.budget_ms >= 0 && w->d.budget_ms <= 1e5) || w->d.still_max_pixels > (uint64_t)SY_JPEG_MAX_SIDE * SY_JPEG_MAX_SIDE ||
-        w->d.max_pending > 1024 || w->d.head_timeout_ms > 600000 || w->d.still_deadline_ms > 600000 || w->d.delay_ms > 10000)
+        w->d.max_pending > 1024 || w->d.head_timeout_ms > 600000 || w->d.still_deadline_ms > 600000 || w->d.delay_ms > 10000))
         r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
                          "web: a limit is out of range (frame <= 16384, clients <= 1000, message 64..16 MiB, quality "
                          "1..100, idle timeout <= 3600 s, budget 0..1e5 ms, still pixels <= 16384^2, pending "
@@ -265,6 +319,9 @@ void sy_web_destroy(sy_web *w)
         sy_webi_frame_free(w->latest);
     }
     free(w->routes);
+    free(w->clips);
+    free(w->clip_range);
+    free(w->clip_names);
     pthread_mutex_destroy(&w->mu);
     pthread_cond_destroy(&w->cv);
     sodium_memzero(w->token, sizeof w->token);

@@ -113,6 +113,8 @@ typedef struct sy_web_desc {
     bool read_only;           /**< viewers look (camera, scene clock, pick, tree, stills) but cannot change visibility,
                                    selection, section planes, exposure, display filter or back-end: those
                                    messages are refused with a log line (sy web --read-only) */
+    sy_animation clip;        /**< the clip the timeline plays ({0}: every clip together, as sy_scene_set_time;
+                                   sy web: sy_cli_default_clip or --clip); a page may choose another ("anim") */
     const sy_web_route *routes; /**< extra routes (the array is copied; its strings and user pointers must outlive the server) */
     uint32_t route_count;     /**< how many */
 } sy_web_desc;

@@ -560,6 +560,10 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
         if (!json_num(m, "s", -SY_WEB_TIME_MAX, SY_WEB_TIME_MAX, &out->a))
             r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "time: s must be a finite number of seconds within +-%g",
                              SY_WEB_TIME_MAX);
+    } else if (!strcmp(type, "anim")) {
+        out->type = SY_WEB_INPUT_ANIM;
+        if (!json_num(m, "clip", -1, SY_WEB_CLIP_MAX, &out->a) || out->a != floor(out->a))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "anim: clip must be an integer, -1 (every clip) .. %d", SY_WEB_CLIP_MAX);
     } else if (!strcmp(type, "play")) {
         out->type = SY_WEB_INPUT_PLAY;
         if (!cJSON_GetObjectItemCaseSensitive(m, "on") || !json_bool(m, "on", &out->on))

@@ -140,13 +140,17 @@ typedef enum sy_web_input_type {
     SY_WEB_INPUT_KEYFRAME, /**< {"t":"keyframe"}: the page's video decoder lost its place */
     SY_WEB_INPUT_TIME,     /**< {"t":"time","s":SECONDS}: the scene clock to that time (a; the range is the server's check) */
     SY_WEB_INPUT_PLAY,     /**< {"t":"play","on":BOOL}: the scene clock plays (on) or pauses */
-    SY_WEB_INPUT_ENVIRONMENT /**< the environment by name (filter: "scene", "studio", "none"; judged by the server) */
+    SY_WEB_INPUT_ENVIRONMENT, /**< the environment by name (filter: "scene", "studio", "none"; judged by the server) */
+    SY_WEB_INPUT_ANIM      /**< {"t":"anim","clip":N}: the clip the scene clock plays (a: N, an index of the
+                            *   hello's "clips", -1 every clip; the index's range is the server's check) */
 } sy_web_input_type;
 
 /** Node ids a page may name: 1..SY_WEB_NODE_ID_MAX (sy_node.id); unknown ones are refused later. */
 #define SY_WEB_NODE_ID_MAX 0xFFFFFFFFu
 /** The scene times a page may name, seconds (+-; the clip's range is checked by the server). */
 #define SY_WEB_TIME_MAX 1e9
+/** The clip indices a page may name ("anim": -1 = every clip; unknown ones are refused later). */
+#define SY_WEB_CLIP_MAX 65535
 /** Exposure a page may set, in stops (+-). */
 #define SY_WEB_EXPOSURE_MAX 16.0
 /** The most codec names a size message may list ("codecs"); further ones are ignored. */

@@ -159,6 +159,13 @@ struct sy_web {
      * clips; the render thread advances a playing clock and applies its time (sy_scene_set_time) */
     bool animated;
     sy_clock clock;
+    /* the clips a page may choose ("anim"; read at create, touched by no one after): clip_count
+     * handles and their ranges, [clip_count] every clip together; clip: the one the clock plays
+     * (an index into them, clip_count = every clip), under mu */
+    sy_animation *clips;
+    double (*clip_range)[2];
+    char (*clip_names)[64];           /* their names (cut to 63 bytes; "clip N" when unnamed) */
+    uint32_t clip_count, clip;
     uint64_t clock_version;           /* played, paused, moved, stopped at an end, or a playing clock's
                                        * periodic update: sent to every page as a "clock" message */
     uint64_t conn_serial;             /* the last web_conn.serial given (network thread) */

@@ -34,6 +34,7 @@ typedef struct render_state {
      * played then, the scene time last applied (NAN: none yet: the scene shows what was loaded
      * until a page moves the clock), when the last periodic "clock" message was due */
     double clock_wall, clock_applied, clock_sent;
+    uint32_t clip_applied; /* the clip (sy_web_internal.h) clock_applied was applied with */
     bool clock_was_playing, clock_failed;
     /* the last coded depth channel (docs/WEB.md, depth coding 2): a progressive back-end's
      * refinements of that view (same size, back-end and camera, samples counting up) reuse it, and
@@ -51,8 +52,9 @@ typedef struct render_state {
 
 /* Under w->mu: advances a playing clock to now and says whether the scene's time must change
  * (*t_out: the time to apply). A clock that stopped at an end, and a playing one every
- * WEB_CLOCK_REPORT, bump clock_version (sent to the pages with the next frame). */
-static bool clock_step(sy_web *w, render_state *rs, double *t_out)
+ * WEB_CLOCK_REPORT, bump clock_version (sent to the pages with the next frame). *clip_out: the
+ * clip it plays (an index into w->clips; clip_count: every clip). */
+static bool clock_step(sy_web *w, render_state *rs, double *t_out, uint32_t *clip_out)
 {
     if (!w->animated) return false;
     double now = sy_time_now();
@@ -64,16 +66,19 @@ static bool clock_step(sy_web *w, render_state *rs, double *t_out)
     rs->clock_wall = now;
     rs->clock_was_playing = w->clock.playing;
     *t_out = w->clock.time;
+    *clip_out = w->clip;
     /* the loaded pose stays until a page touched the clock (clock_version 1: as created) */
-    return w->clock_version > 1 && !(w->clock.time == rs->clock_applied);
+    return w->clock_version > 1 && !(w->clock.time == rs->clock_applied && w->clip == rs->clip_applied);
 }
 
 /* Sets the scene's time and commits (the moved nodes reach every context as any change does). */
-static void clock_apply(sy_web *w, render_state *rs, double t)
+static void clock_apply(sy_web *w, render_state *rs, double t, uint32_t clip)
 {
     sy_error e = {0};
     rs->clock_applied = t;
-    if (sy_scene_set_time(w->d.scene, (sy_animation){0}, t, &e) == SY_OK) sy_scene_commit(w->d.scene, NULL, &e);
+    rs->clip_applied = clip;
+    sy_animation a = clip < w->clip_count ? w->clips[clip] : (sy_animation){0};
+    if (sy_scene_set_time(w->d.scene, a, t, &e) == SY_OK) sy_scene_commit(w->d.scene, NULL, &e);
     if (e.message[0] && !rs->clock_failed) { /* logged once: every later time would say the same */
         rs->clock_failed = true;
         sy_log(SY_LOG_WARNING, "web", NULL, "the scene clock at %g s: %s", t, e.message);
@@ -475,7 +480,8 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         if (w->look_version != seen_look) rs.changed = true, seen_look = w->look_version;
         rs.exposure = w->exposure;
         double clock_t = 0;
-        bool clock_moved = clock_step(w, &rs, &clock_t);
+        uint32_t clock_clip = 0;
+        bool clock_moved = clock_step(w, &rs, &clock_t, &clock_clip);
         sy_interactive_input in = w->in;
         bool moved = w->view_version != seen;
         seen = w->view_version;
@@ -486,7 +492,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         w->need_pixels = false;
         pthread_mutex_unlock(&w->mu);
         if (clock_moved) { /* the scene at the clock's time: what frames show changed */
-            clock_apply(w, &rs, clock_t);
+            clock_apply(w, &rs, clock_t, clock_clip);
             rs.changed = moved = true;
         }
         while (jobs) { /* stills and routes first: they wait on an HTTP connection */

@@ -227,6 +227,21 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
         w->clock_version++, w->view_version++;
         clock_changed = true;
         break;
+    case SY_WEB_INPUT_ANIM: /* the clip the clock plays (docs/WEB.md, "The timeline"): a view change too */
+        input = false;
+        if (!w->animated || in.a >= (double)w->clip_count) {
+            char d[96];
+            snprintf(d, sizeof d, "clip %g: the scene has %u clip(s) (-1: every clip)", in.a, w->clip_count);
+            pthread_mutex_unlock(&w->mu);
+            ws_warn(c, w->animated ? "anim" : "anim: the scene has no animations", w->animated ? d : NULL);
+            return;
+        }
+        w->clip = in.a < 0 ? w->clip_count : (uint32_t)in.a;
+        w->clock.start = w->clock.time = w->clip_range[w->clip][0]; /* at the clip's start, playing on if it played */
+        w->clock.end = w->clip_range[w->clip][1];
+        w->clock_version++, w->view_version++;
+        clock_changed = true;
+        break;
     case SY_WEB_INPUT_SIZE:
         input = false;
         if (in.version < SY_WEB_FRAME_VERSION) { /* an old page: told to reload, never sent frames it cannot read */
@@ -324,6 +339,10 @@ static int ws_send_hello(sy_web *w, struct lws *wsi)
     cJSON *envs = cJSON_AddArrayToObject(o, "environments"); /* the menu's choices (sy_web_scene.c) */
     for (uint32_t i = 0; i < SY_WEB_ENVIRONMENTS; ++i) cJSON_AddItemToArray(envs, cJSON_CreateString(sy_webi_environment_names[i]));
     cJSON_AddBoolToObject(o, "read_only", w->d.read_only);
+    if (w->animated) { /* the timeline's clip menu: names in the order "anim" indexes them (the clip list is fixed) */
+        cJSON *cl = cJSON_AddArrayToObject(o, "clips");
+        for (uint32_t i = 0; i < w->clip_count; ++i) cJSON_AddItemToArray(cl, cJSON_CreateString(w->clip_names[i]));
+    }
     pthread_mutex_lock(&w->mu);
     cJSON_AddNumberToObject(o, "exposure", w->exposure);
     cJSON_AddStringToObject(o, "environment", sy_webi_environment_names[w->environment < SY_WEB_ENVIRONMENTS ? w->environment : 0]);
@@ -554,8 +573,9 @@ static int ws_writeable(sy_web *w, web_conn *c)
     if (!status[0] && w->clock_version != c->sent_clock) { /* the timeline's state (docs/WEB.md, "The timeline"), after a status */
         c->sent_clock = w->clock_version;
         snprintf(clock, sizeof clock, "{\"t\":\"clock\",\"time\":%.9g,\"start\":%.9g,\"end\":%.9g,\"playing\":%s,"
-                 "\"loop\":%s,\"speed\":%.9g}", w->clock.time, w->clock.start, w->clock.end,
-                 w->clock.playing ? "true" : "false", w->clock.loop ? "true" : "false", w->clock.speed);
+                 "\"loop\":%s,\"speed\":%.9g,\"clip\":%d}", w->clock.time, w->clock.start, w->clock.end,
+                 w->clock.playing ? "true" : "false", w->clock.loop ? "true" : "false", w->clock.speed,
+                 w->clip < w->clip_count ? (int)w->clip : -1);
     }
     pthread_mutex_unlock(&w->mu);
     if (fresh && !c->sized) sy_webi_frame_release(w, f), fresh = false;

@@ -49,7 +49,15 @@ int test_messages(void)
     CHECK(parse_ok("{\"t\":\"play\",\"on\":true}", &in) && in.type == SY_WEB_INPUT_PLAY && in.on &&
           !sy_web_input_changes_scene(&in));
     CHECK(parse_ok("{\"t\":\"play\",\"on\":false}", &in) && !in.on);
+    CHECK(parse_ok("{\"t\":\"anim\",\"clip\":3}", &in) && in.type == SY_WEB_INPUT_ANIM && in.a == 3 &&
+          !sy_web_input_changes_scene(&in));
+    CHECK(parse_ok("{\"t\":\"anim\",\"clip\":-1}", &in) && in.a == -1);
     const char *bad[] = {
+        "{\"t\":\"anim\"}",                            /* no clip */
+        "{\"t\":\"anim\",\"clip\":-2}",              /* -1 is every clip, nothing below */
+        "{\"t\":\"anim\",\"clip\":1.5}",
+        "{\"t\":\"anim\",\"clip\":\"Walk\"}",      /* an index, not a name */
+        "{\"t\":\"anim\",\"clip\":70000}",           /* beyond SY_WEB_CLIP_MAX */
         "{\"t\":\"time\"}",                            /* no time */
         "{\"t\":\"time\",\"s\":null}",                 /* JSON's NaN (JSON.stringify(NaN)) */
         "{\"t\":\"time\",\"s\":1e400}",                /* infinite */
@@ -333,8 +341,11 @@ int test_scene(uint16_t port)
 static double clock_time(const char *t) { return json_number(t, "time"); }
 
 /* The scene clock (docs/WEB.md, "The timeline") on a read-only server (a view change: allowed)
- * whose demo has a 2 s clip: the page is sent its range, paused; a time moves the scene (the
- * depth at a covered pixel changes within 40 frames); play is answered by clock messages whose
+ * whose demo has two clips on the same nodes, shrink (2 s) and hold (4 s, later: with every clip
+ * at once its keys would win), and plays shrink (sy_web_desc.clip): the hello lists both, the page
+ * is sent shrink's range, paused; a time moves the scene (the depth at a covered pixel changes
+ * within 40 frames: shrink alone is applied); "anim" switches to hold (its range, the depth back)
+ * and to every clip, bad clips are refused; play is answered by clock messages whose
  * time advances; times outside the range, not numbers or on a scene without clips are refused
  * (no clock message follows them); pause stops the clock. */
 int test_timeline(void)
@@ -347,9 +358,12 @@ int test_timeline(void)
     sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
     CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
     char *t = NULL;
+    CHECK_OK(sy_web_client_next_text(c, 20000, "hello", &t, &err), err);
+    CHECK_MSG(strstr(t, "\"clips\":[\"shrink\",\"hold\"]"), "%s", t);
+    free(t);
     CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
-    CHECK_MSG(clock_time(t) == 0 && json_number(t, "start") == 0 && json_number(t, "end") == 2 && strstr(t, "\"playing\":false"),
-              "%s", t);
+    CHECK_MSG(clock_time(t) == 0 && json_number(t, "start") == 0 && json_number(t, "end") == 2 && strstr(t, "\"playing\":false") &&
+              strstr(t, "\"clip\":0"), "%s", t);
     free(t);
     int px, py;
     float d0;
@@ -373,6 +387,36 @@ int test_timeline(void)
         free(depth);
     }
     CHECK_MSG(moved, "the depth at (%d, %d) stayed %g at 2 s", px, py, (double)d0);
+    /* the page's clip menu: hold (0..4 s, from its start), then its 2 s: the meshes at their own
+     * size again; bad clips refused (no clock message) */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":2}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":0.5}", &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":-2}", &err), err);
+    CHECK(sy_web_client_next_text(c, 500, "clock", &t, &err) == SY_ERR_IO);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":1}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
+    CHECK_MSG(clock_time(t) == 0 && json_number(t, "end") == 4 && strstr(t, "\"clip\":1"), "%s", t);
+    free(t);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":2}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
+    free(t);
+    bool back = false;
+    for (int k = 0; k < 40 && !back; ++k) {
+        sy_web_frame_info fi;
+        float *depth = NULL;
+        CHECK_OK(sy_web_client_next_frame_depth(c, 60000, &fi, NULL, NULL, &depth, &err), err);
+        if (fi.width == 80 && fi.height == 60) back = fabsf(depth[py * 80 + px] - d0) <= 1e-3f * d0;
+        free(depth);
+    }
+    CHECK_MSG(back, "hold at 2 s: the depth at (%d, %d) is not %g again", px, py, (double)d0);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":-1}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
+    CHECK_MSG(json_number(t, "end") == 4 && strstr(t, "\"clip\":-1"), "%s", t);
+    free(t);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":0}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
+    CHECK_MSG(json_number(t, "end") == 2 && strstr(t, "\"clip\":0"), "%s", t);
+    free(t);
     /* play from 0: the clock messages' time advances (one a second while playing) */
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":0}", &err), err);
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"play\",\"on\":true}", &err), err);

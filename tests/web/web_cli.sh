@@ -1,9 +1,12 @@
 #!/bin/bash
 # web_cli: `sy web` as a user starts it: the URL it prints (loopback: no token), the page and a
-# still through curl, a clean exit on the first SIGTERM; bad options are refused with the reason.
-# Usage: web_cli.sh SY
+# still through curl, a clean exit on the first SIGTERM; bad options are refused with the reason;
+# --clip: a usage error on a scene without it, and (with the test data) the Fox's timeline plays
+# Survey, its first clip, as sy render --at does.
+# Usage: web_cli.sh SY [TESTDATA]
 set -u
 SY=$1
+DATA=${2:-}
 fail=0
 bad() { echo "FAIL: $*"; fail=1; }
 command -v curl >/dev/null || { echo "skip: curl is not installed"; exit 77; }
@@ -16,6 +19,22 @@ trap 'rm -rf "$out"' EXIT
 "$SY" web demo -b no_such_backend --listen 127.0.0.1:0 >/dev/null 2>"$out/err"; rc=$?
 [ $rc = 1 ] && grep -q "no_such_backend" "$out/err" || bad "an unknown back-end: exit $rc, $(cat "$out/err")"
 "$SY" web demo --quality 0 >/dev/null 2>&1; [ $? = 2 ] || bad "--quality 0 is not a usage error"
+"$SY" web demo --clip 1 >/dev/null 2>"$out/err"; rc=$?
+[ $rc = 2 ] && grep -q "clip 1: the scene has no animations" "$out/err" || bad "--clip on the demo: exit $rc, $(cat "$out/err")"
+fox=$DATA/gltf/Fox/glTF/Fox.gltf
+if [ -n "$DATA" ] && [ -f "$fox" ]; then
+    "$SY" web "$fox" --clip Nope >/dev/null 2>"$out/err"; rc=$?
+    [ $rc = 2 ] && grep -q "available: 0:Survey, 1:Walk, 2:Run" "$out/err" || bad "--clip Nope on the Fox: exit $rc, $(cat "$out/err")"
+    "$SY" web "$fox" --listen 127.0.0.1:0 -b whitted >"$out/log" 2>"$out/err" &
+    pid=$!
+    wait_until $pid grep -q 'http://' "$out/log"
+    grep -q "the timeline plays clip 0 (Survey) of 3" "$out/err" || bad "the Fox's timeline: $(cat "$out/err")"
+    kill -TERM $pid
+    wait_gone $pid || kill -9 $pid
+    wait $pid
+else
+    echo "note: the Fox's clip not checked ($fox absent)"
+fi
 
 "$SY" web demo --listen 127.0.0.1:0 -b whitted >"$out/log" 2>"$out/err" &
 pid=$!

@@ -117,14 +117,17 @@ static sy_result route_block(void *user, sy_scene *scene, const sy_web_request *
 
 /* the demo scene served on listen by backend from a thread of its own; 1 after printing why not */
 bool web_read_only; /* web_readonly: the server web_start() makes is read-only */
-bool web_read_only_anim; /* web_timeline: the demo gets a clip (every mesh node shrinks to 1% over 2 s) */
+bool web_read_only_anim; /* web_timeline: the demo gets two clips (shrink, hold), the server plays shrink */
 
-/* A clip "shrink": each node of the scene that shows a mesh, its scale from its own to 1 % of it
- * over 0..2 s (LINEAR); its samplers' data in static storage (the scene copies it). */
-static sy_result add_shrink_clip(sy_scene *s, sy_error *e)
+/* Two clips on the same nodes, as a character's walk and run (the Fox's): "shrink", each node of
+ * the scene that shows a mesh, its scale from its own to 1 % of it over 0..2 s (LINEAR); then
+ * "hold", the same nodes at their own scale over 0..4 s (it comes later: with every clip at once,
+ * its keys win). *shrink: the first one. The samplers' data in static storage (the scene copies it). */
+static sy_result add_shrink_clip(sy_scene *s, sy_animation *shrink, sy_error *e)
 {
     enum { MAXN = 64 };
-    static float times[2] = {0.0f, 2.0f}, values[MAXN][6];
+    static float times[2] = {0.0f, 2.0f}, hold_times[2] = {0.0f, 4.0f}, values[MAXN][6], hold[MAXN][6];
+    sy_anim_sampler_desc hd[MAXN];
     sy_anim_sampler_desc sd[MAXN];
     sy_anim_channel ch[MAXN];
     uint32_t n = 0;
@@ -132,13 +135,17 @@ static sy_result add_shrink_clip(sy_scene *s, sy_error *e)
         const sy_node_data *nd = sy_node_get(s, (sy_node){id});
         if (!nd->mesh.id || nd->transform.mode != SY_TRANSFORM_TRS) continue;
         for (int k = 0; k < 3; ++k) values[n][k] = nd->transform.scale[k], values[n][3 + k] = 0.01f * nd->transform.scale[k];
+        for (int k = 0; k < 3; ++k) hold[n][k] = hold[n][3 + k] = nd->transform.scale[k];
         sd[n] = (sy_anim_sampler_desc){SY_INTERP_LINEAR, 3, 2, times, values[n]};
+        hd[n] = (sy_anim_sampler_desc){SY_INTERP_LINEAR, 3, 2, hold_times, hold[n]};
         ch[n] = (sy_anim_channel){id, SY_ANIM_SCALE, n};
         ++n;
     }
     sy_animation a;
-    sy_result r = sy_animation_create(s, "shrink", &a, e);
-    if (r == SY_OK) r = sy_animation_set_clip(s, a, sd, n, ch, n, e);
+    sy_result r = sy_animation_create(s, "shrink", shrink, e);
+    if (r == SY_OK) r = sy_animation_set_clip(s, *shrink, sd, n, ch, n, e);
+    if (r == SY_OK) r = sy_animation_create(s, "hold", &a, e);
+    if (r == SY_OK) r = sy_animation_set_clip(s, a, hd, n, ch, n, e);
     return r;
 }
 
@@ -146,8 +153,9 @@ int web_start(server *s, const char *listen, const char *backend, sy_error *e)
 {
     memset(s, 0, sizeof *s);
     sy_demo_info demo;
+    sy_animation shrink = {0};
     int failed = sy_scene_create(&s->scene, e) || sy_demo_build(s->scene, &demo, e) ||
-                 (web_read_only_anim && add_shrink_clip(s->scene, e)) || sy_scene_commit(s->scene, NULL, e);
+                 (web_read_only_anim && add_shrink_clip(s->scene, &shrink, e)) || sy_scene_commit(s->scene, NULL, e);
     if (!failed) {
         static const sy_web_route routes[] = {{"GET", "/api/object/", route_info, NULL},
                                               {"POST", "/api/echo", route_echo, NULL},
@@ -155,7 +163,8 @@ int web_start(server *s, const char *listen, const char *backend, sy_error *e)
         sy_web_desc d = {.scene = s->scene, .root = demo.root, .camera = demo.camera, .background = demo.background,
                          .backend = backend, .listen = listen, .max_body = 1000, .max_message = 256, .max_clients = 3,
                          .routes = routes, .route_count = 3, .read_only = web_read_only,
-                         .still_max_pixels = 20000}; /* small stills: fast on a loaded machine */
+                         .still_max_pixels = 20000, /* small stills: fast on a loaded machine */
+                         .clip = shrink}; /* web_timeline: the server's clock plays shrink alone */
         failed = sy_web_create(&d, &s->web, e) != SY_OK;
     }
     if (failed) {

@@ -1,7 +1,9 @@
 // timeline.js — the scene clock's timeline (docs/WEB.md, "The timeline"): shown when the server's
 // scene has animations (it sends "clock" messages: time, range, playing), a play / pause button, a
-// scrub slider over the clips' range and the time and duration; space plays and pauses. The page
-// sends {"t":"time","s":SECONDS} and {"t":"play","on":BOOL}; the server advances the clock, sets
+// scrub slider over the clip's range, the time and duration, and (a scene with several clips: the
+// hello's "clips") a menu of the clips; space plays and pauses. The page sends
+// {"t":"time","s":SECONDS}, {"t":"play","on":BOOL} and {"t":"anim","clip":N} (-1: every clip
+// together; the server starts on its default clip, e.g. the Fox's first); the server advances the clock, sets
 // the scene's time and streams the frames, so every page shows the same moment. Between the
 // server's messages (one a second while playing) the shown time runs on locally. A read-only page
 // may move the clock too: it is a view change, like the camera's.
@@ -18,12 +20,15 @@
     font: 13px sans-serif; padding: 2px 8px; cursor: pointer; min-width: 34px; }
   #sy-timeline input[type=range] { flex: 1; min-width: 60px; }
   #sy-timeline span { font: 12px monospace; white-space: nowrap; color: #ccc; }
+  #sy-timeline select { background: rgba(30,30,30,.85); color: #ddd; border: 1px solid #555; border-radius: 3px; font: 12px sans-serif; max-width: 160px; }
+  #sy-timeline select.hidden { display: none; }
   `;
   el("style", {}, document.head, css);
   const bar = el("div", { id: "sy-timeline" }, document.body);
   const play = el("button", { id: "sy-play", type: "button", title: "play / pause the scene (space)" }, bar, "▶");
   const range = el("input", { id: "sy-scrub", type: "range", min: "0", max: "1", step: "0.001", value: "0", title: "scene time" }, bar);
   const label = el("span", { id: "sy-time" }, bar, "");
+  const menu = el("select", { id: "sy-clip", class: "hidden", title: "the clip the scene plays" }, bar);
   // the clock as the server last said, and when (performance.now) the page heard it
   const clock = { time: 0, start: 0, end: 0, playing: false, loop: true, speed: 1, at: 0, known: false };
   let scrubbing = false, sendTimer = 0, pendingTime = null;
@@ -61,6 +66,7 @@
       show();
     });
   }
+  menu.addEventListener("change", function () { sy.send({ t: "anim", clip: Number(menu.value) }); menu.blur(); });
   play.addEventListener("click", function (e) { e.stopPropagation(); setPlaying(!clock.playing); play.blur(); });
   range.addEventListener("input", function () { scrubbing = true; sendTime(Number(range.value)); label.textContent = fmt(Number(range.value)) + " / " + fmt(clock.end - clock.start); });
   range.addEventListener("change", function () { scrubbing = false; sendTime(Number(range.value)); range.blur(); });
@@ -71,16 +77,24 @@
     setPlaying(!clock.playing);
   });
   sy.on(function (m) {
-    if (m.t === "hello") bar.classList.toggle("ro", !!m.read_only);
+    if (m.t === "hello") {
+      bar.classList.toggle("ro", !!m.read_only);
+      const clips = Array.isArray(m.clips) ? m.clips : [];
+      menu.textContent = "";
+      if (clips.length > 1) el("option", { value: "-1" }, menu, "every clip");
+      clips.forEach(function (n, i) { el("option", { value: String(i) }, menu, String(n)); });
+      menu.classList.toggle("hidden", clips.length < 2);
+    }
     if (m.t !== "clock") return;
     const was = clock.playing;
     Object.assign(clock, { time: m.time, start: m.start, end: m.end, playing: !!m.playing, loop: !!m.loop, speed: m.speed, at: performance.now(), known: true });
     range.min = String(m.start); range.max = String(m.end);
+    if (typeof m.clip === "number") menu.value = String(m.clip);
     range.step = String(Math.max((m.end - m.start) / 1000, 1e-4));
     bar.classList.add("shown");
     show();
     if (clock.playing && !was) requestAnimationFrame(loop);
   });
   // tests and other scripts: the timeline's state
-  sy.timeline = function () { return { shown: bar.classList.contains("shown"), time: now(), start: clock.start, end: clock.end, playing: clock.playing, server_time: clock.time }; };
+  sy.timeline = function () { return { shown: bar.classList.contains("shown"), time: now(), start: clock.start, end: clock.end, playing: clock.playing, server_time: clock.time, clip: Number(menu.value || -1) }; };
 })();
