@@ -36,7 +36,10 @@
  *                               coordinate deltas (target_texcoords0, sy_objects.h): each key's
  *                               coordinates through the TextureTransform (X3D's transform is affine in
  *                               each of those fields, so LINEAR weights of consecutive keys give exactly
- *                               the interpolated field's coordinates); polygon geometry only (the
+ *                               the interpolated field's coordinates); ScalarInterpolator ->
+ *                               TextureTransform.rotation the same way, its keys made dense first
+ *                               (at most X3D_TEX_ROTATION_STEP apart: the blend of two keys'
+ *                               coordinates is a chord of the rotation); polygon geometry only (the
  *                               primitives Box, Sphere, ... keep theirs), not with moving points on the
  *                               same geometry; one interpolator per TextureCoordinate / TextureTransform.
  * ROUTEs are read per file, so DEF names resolve in the file's own namespace (an Inline's routes
@@ -49,8 +52,7 @@
  * fields' types differ (SFVec3f into SFColor: X3D forbids it); a route that closes a loop of routes
  * (X3D passes one event per route per timestamp, so a loop never runs away; the clock has no event
  * cascade at all, and the route is dropped). What has no target here is reported once per kind:
- * mapped-but-not-animated fields (Material.shininess, Transform.center, TextureTransform.rotation,
- * ...), scale routes to a Transform with a scaleOrientation (routes to a Transform with a center
+ * mapped-but-not-animated fields (Material.shininess, Transform.center, ...), scale routes to a Transform with a scaleOrientation (routes to a Transform with a center
  * play: x3d_pivot). Bad interpolators (key and keyValue counts that differ, keys that decrease,
  * values that are not finite) are dropped with a warning naming them (file, line, type and DEF);
  * equal keys (an X3D jump) become a step one float step later. Several routes into one
@@ -118,7 +120,7 @@ static const field_map field_maps[] = {
     {"Normal", "vector", T_MFVEC3F, W_MORPH},
     {"TextureCoordinate", "point", T_MFVEC2F, W_MORPH},
     {"TextureTransform", "translation|scale|center", T_SFVEC2F, W_MORPH},
-    {"TextureTransform", "rotation", T_SFFLOAT, W_NONE},
+    {"TextureTransform", "rotation", T_SFFLOAT, W_MORPH},
 };
 
 /* The interpolators: value type, key value group, and whether the clock plays them. */
@@ -447,21 +449,22 @@ static void hsv_lerp(const float a[3], const float b[3], float u, float out[3])
     hsv_to_rgb(h, out);
 }
 
-/* The weights sampler of a CoordinateInterpolator's morph targets (x3d_scan_morphs read its keys):
- * one weight per key, key k's value the k-th unit vector, so LINEAR blends consecutive keys as X3D
- * interpolates their points. Equal keys jump one float step later, as in read_sampler. */
+/* The weights sampler of a CoordinateInterpolator's morph targets (x3d_scan_morphs read its keys,
+ * m->key: a rotation's made dense there): one weight per key, key k's value the k-th unit vector,
+ * so LINEAR blends consecutive keys as X3D interpolates their points. Equal keys jump one float
+ * step later, as in read_sampler. */
 static int read_one_hot(loader *L, xfile *F, const drive *d, float cycle, sy_anim_sampler_desc *sd, float **times_out,
                         float **values_out)
 {
     const morph_src *m = &L->morphs[d->scale_index];
-    float *key = NULL;
-    size_t nk = 0;
+    size_t nk = m->keys;
     *times_out = *values_out = NULL;
-    if (!x3d_get_float_array(L, F, m->interp, "key", 1, &key, &nk)) return 0;
-    if (nk != m->keys) { /* x3d_scan_morphs counted the same attribute */
-        free(key);
-        return 0;
+    float *key = malloc(nk * sizeof *key);
+    if (!key) {
+        sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+        return -1;
     }
+    memcpy(key, m->key, nk * sizeof *key);
     float prev = -INFINITY;
     for (size_t k = 0; k < nk; ++k) {
         float raw = key[k], t = raw * cycle;
@@ -1040,7 +1043,8 @@ static bool scan_collect(scan *sc, const xmlNode *el, unsigned depth)
         }
         if (x3d_name_in(n, "ProtoDeclare|ExternProtoDeclare|Script")) continue;
         if (x3d_name_in(n, "Coordinate|CoordinateDouble|CoordinateInterpolator|Normal|NormalInterpolator|TimeSensor|"
-                           "TextureCoordinate|TextureTransform|CoordinateInterpolator2D|PositionInterpolator2D")) {
+                           "TextureCoordinate|TextureTransform|CoordinateInterpolator2D|PositionInterpolator2D|"
+                           "ScalarInterpolator")) {
             char *def = x3d_attr(c, "DEF");
             if (def && !xmlHashLookup(sc->defs, (const xmlChar *)def)) xmlHashAddEntry(sc->defs, (const xmlChar *)def, (void *)c);
             xmlFree(def);
@@ -1066,6 +1070,54 @@ static bool route_fields(const xmlNode *route, const char *from, const char *to)
     return ok;
 }
 
+/* A ScalarInterpolator's keys into a TextureTransform's rotation (*key, *kv: nk raw keys and
+ * angles, malloc()ed) made dense: keys added between the file's, linearly in the key and the angle
+ * as X3D interpolates them, so that no two are more than X3D_TEX_ROTATION_STEP apart (with at most
+ * SY_MORPH_MAX_TARGETS keys in all: a larger step beyond); the angles stored as (angle, 0), the
+ * morph sources' texture stride. Keys that decrease are refused later (read_one_hot); here they get
+ * no keys between them. Returns SY_OK with *kv NULL (warned) when the keys are too many, an error
+ * when out of memory (in L->err). */
+static sy_result dense_rotation(loader *L, xfile *F, const xmlNode *in, const char *def, float **key, float **kv, size_t *nk)
+{
+    const float *k0 = *key, *v0 = *kv;
+    size_t n = *nk;
+    double total = 0;
+    for (size_t k = 0; k + 1 < n; ++k) total += k0[k + 1] > k0[k] ? fabs((double)v0[k + 1] - v0[k]) : 0;
+    double step = X3D_TEX_ROTATION_STEP;
+    if (n > 1 && total / step + (double)n > SY_MORPH_MAX_TARGETS) step = total / (double)(SY_MORPH_MAX_TARGETS - n);
+    if (n >= SY_MORPH_MAX_TARGETS && total > 0) {
+        x3d_warn(L, "%s:%d: ScalarInterpolator '%s': %zu keys into a TextureTransform's rotation leave no room for the keys "
+                 "between them (at most %u); not played", F->path, x3d_line_of(in), def ? def : "", n, SY_MORPH_MAX_TARGETS - 1);
+        free(*kv);
+        *kv = NULL;
+        return SY_OK;
+    }
+    size_t out = n;
+    for (size_t k = 0; k + 1 < n; ++k)
+        if (k0[k + 1] > k0[k]) out += (size_t)ceil(fabs((double)v0[k + 1] - v0[k]) / step - 1e-6) - (v0[k + 1] != v0[k]);
+    if (out > SY_MORPH_MAX_TARGETS) out = SY_MORPH_MAX_TARGETS; /* rounding: never reached, a guard */
+    float *nkey = malloc(out * sizeof *nkey), *nkv = calloc(out * 2, sizeof *nkv);
+    if (!nkey || !nkv) {
+        free(nkey), free(nkv);
+        return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);
+    }
+    size_t o = 0;
+    for (size_t k = 0; k < n && o < out; ++k) {
+        nkey[o] = k0[k], nkv[2 * o] = v0[k], ++o;
+        if (k + 1 == n || !(k0[k + 1] > k0[k])) continue;
+        size_t parts = (size_t)ceil(fabs((double)v0[k + 1] - v0[k]) / step - 1e-6);
+        for (size_t j = 1; j < parts && o + (n - k - 1) < out; ++j) {
+            double u = (double)j / (double)parts;
+            nkey[o] = (float)(k0[k] + u * (k0[k + 1] - k0[k]));
+            nkv[2 * o] = (float)(v0[k] + u * (v0[k + 1] - v0[k]));
+            if (nkey[o] > nkey[o - 1] && nkey[o] < k0[k + 1]) ++o; /* keys too close for floats: fewer */
+        }
+    }
+    free(*key), free(*kv);
+    *key = nkey, *kv = nkv, *nk = o;
+    return SY_OK;
+}
+
 sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
 {
     scan sc = {{0}, xmlHashCreate(16)};
@@ -1084,7 +1136,7 @@ sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
     for (size_t i = 0; i < sc.routes.count; ++i) {
         const xmlNode *ro = sc.routes.items[i],
                       *in = scan_def(&sc, ro, "toNode", "CoordinateInterpolator|NormalInterpolator|CoordinateInterpolator2D|"
-                                                         "PositionInterpolator2D");
+                                                         "PositionInterpolator2D|ScalarInterpolator");
         if (in && scan_def(&sc, ro, "fromNode", "TimeSensor") && route_fields(ro, "fraction_changed", "fraction"))
             driven[nd++] = in;
     }
@@ -1092,10 +1144,11 @@ sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
     for (size_t i = 0; i < sc.routes.count && !r; ++i) {
         const xmlNode *ro = sc.routes.items[i];
         const xmlNode *in = scan_def(&sc, ro, "fromNode", "CoordinateInterpolator|NormalInterpolator|CoordinateInterpolator2D|"
-                                                           "PositionInterpolator2D");
+                                                           "PositionInterpolator2D|ScalarInterpolator");
         bool normals = in && !strcmp(x3d_ename(in), "NormalInterpolator");
         bool tc2 = in && !strcmp(x3d_ename(in), "CoordinateInterpolator2D"), pos2 = in && !strcmp(x3d_ename(in), "PositionInterpolator2D");
-        const xmlNode *co = scan_def(&sc, ro, "toNode", normals ? "Normal" : tc2 ? "TextureCoordinate" : pos2 ? "TextureTransform"
+        bool rot = in && !strcmp(x3d_ename(in), "ScalarInterpolator"); /* into a TextureTransform's rotation */
+        const xmlNode *co = scan_def(&sc, ro, "toNode", normals ? "Normal" : tc2 ? "TextureCoordinate" : pos2 || rot ? "TextureTransform"
                                                                           : "Coordinate|CoordinateDouble");
         uint8_t tex = tc2 ? X3D_TEX_POINT : X3D_TEX_NONE;
         if (pos2)
@@ -1103,7 +1156,8 @@ sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
                   : route_fields(ro, "value_changed", "scale")     ? X3D_TEX_SCALE
                   : route_fields(ro, "value_changed", "center")    ? X3D_TEX_CENTER
                                                                    : X3D_TEX_NONE;
-        if (!in || !co || (pos2 ? !tex : !route_fields(ro, "value_changed", normals ? "vector" : "point")) || !nd ||
+        if (rot) tex = route_fields(ro, "value_changed", "rotation") ? X3D_TEX_ROTATION : X3D_TEX_NONE;
+        if (!in || !co || (pos2 || rot ? !tex : !route_fields(ro, "value_changed", normals ? "vector" : "point")) || !nd ||
             !bsearch(&in, driven, nd, sizeof *driven, cmp_ptr_el))
             continue;
         bool seen = false; /* one interpolator per Coordinate: the first route in the file */
@@ -1114,15 +1168,15 @@ sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
             continue;
         }
         float *key = NULL, *kv = NULL;
-        size_t nk = 0, nv = 0, group = tex ? 2 : 3;
+        size_t nk = 0, nv = 0, group = rot ? 1 : tex ? 2 : 3;
         char *def = x3d_attr(in, "DEF");
         if (!x3d_get_float_array(L, F, in, "key", 1, &key, &nk) || !x3d_get_float_array(L, F, in, "keyValue", group, &kv, &nv) ||
-            nk == 0 || nk > SY_MORPH_MAX_TARGETS || nv % nk != 0 || nv / nk == 0 || (pos2 && nv != nk)) {
+            nk == 0 || nk > SY_MORPH_MAX_TARGETS || nv % nk != 0 || nv / nk == 0 || ((pos2 || rot) && nv != nk)) {
             if (L->limit_r) r = L->limit_r, L->err = L->limit_err;
             else
                 x3d_warn(L, "%s:%d: %s '%s': %zu keys and %zu key values (1 to %u keys, %s); not played", F->path,
                          x3d_line_of(in), x3d_ename(in), def ? def : "", nk, nv, SY_MORPH_MAX_TARGETS,
-                         pos2 ? "one value per key" : "the same number of values for each");
+                         pos2 || rot ? "one value per key" : "the same number of values for each");
             free(key), free(kv), xmlFree(def);
             continue;
         }
@@ -1143,7 +1197,15 @@ sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene)
             free(key), free(kv), xmlFree(def);
             continue;
         }
+        if (rot && !(r = dense_rotation(L, F, in, def, &key, &kv, &nk)) && !kv) { /* warned: not played */
+            free(key), xmlFree(def);
+            continue;
+        }
         xmlFree(def);
+        if (r) {
+            free(key), free(kv);
+            break;
+        }
         if (!sy_array_reserve(&L->morphs, L->morph_count, &L->morph_cap, sizeof *L->morphs, 4)) {
             free(kv), free(key);
             r = sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "%s: out of memory", F->path);

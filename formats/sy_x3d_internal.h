@@ -80,8 +80,12 @@ typedef struct mat_link {
  * through a CoordinateInterpolator2D into a TextureCoordinate's points or a PositionInterpolator2D
  * into a TextureTransform's translation, scale or center (the texture coordinates of every key are
  * the targets: X3D's transform is affine in each of those fields, so blending consecutive keys'
- * coordinates linearly is exactly the interpolated field's). */
-enum { X3D_TEX_NONE = 0, X3D_TEX_POINT, X3D_TEX_TRANSLATION, X3D_TEX_SCALE, X3D_TEX_CENTER };
+ * coordinates linearly is exactly the interpolated field's), or a ScalarInterpolator into its
+ * rotation (not affine in the angle: x3d_scan_morphs adds keys between the file's, at most
+ * X3D_TEX_ROTATION_STEP apart, so the blend of two keys' coordinates is within 1 - cos(step / 2)
+ * of the rotated ones). */
+enum { X3D_TEX_NONE = 0, X3D_TEX_POINT, X3D_TEX_TRANSLATION, X3D_TEX_SCALE, X3D_TEX_CENTER, X3D_TEX_ROTATION };
+#define X3D_TEX_ROTATION_STEP 0.1f /* radians: a rotation's keys at most this far apart (0.125 % of a radius) */
 
 typedef struct morph_src {
     const xmlNode *coord, *interp; /* coord: a Coordinate, or a Normal (normals: a NormalInterpolator), a
@@ -93,7 +97,7 @@ typedef struct morph_src {
     bool normals;      /* a NormalInterpolator into a Normal */
     bool merged;       /* normals played by the CoordinateInterpolator of the same geometry (same keys) */
     uint8_t tex;       /* X3D_TEX_*: texture coordinates (values: keys x points x 2; a TextureTransform's
-                        * field: points 1) */
+                        * field: points 1, a rotation's angle as (angle, 0)) */
     uint32_t *meshes;  /* the meshes built on it (malloc()ed) */
     size_t mesh_count, mesh_cap;
 } morph_src;
@@ -227,8 +231,8 @@ typedef struct geom_src {
 } geom_src;
 
 /* X3D TextureTransform tt -> 2x3 affine matrix m (Tc' = -C x S x R x C x T x Tc), with field
- * `which` (X3D_TEX_TRANSLATION, _SCALE, _CENTER; X3D_TEX_NONE: none) taking value[0..1] instead
- * of the file's (an animated key). tt NULL: the identity. */
+ * `which` (X3D_TEX_TRANSLATION, _SCALE, _CENTER: value[0..1]; _ROTATION: value[0]; X3D_TEX_NONE:
+ * none) taking the value instead of the file's (an animated key). tt NULL: the identity. */
 void x3d_texture_transform(loader *L, xfile *F, const xmlNode *tt, int which, const float *value, float m[6]);
 
 

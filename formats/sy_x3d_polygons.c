@@ -50,7 +50,8 @@ void x3d_texture_transform(loader *L, xfile *F, const xmlNode *tt, int which, co
     x3d_get_floats(L, F, tt, "translation", t, 2);
     float *over = which == X3D_TEX_TRANSLATION ? t : which == X3D_TEX_SCALE ? s : which == X3D_TEX_CENTER ? c : NULL;
     if (over && value) over[0] = value[0], over[1] = value[1];
-    float rot = x3d_get_float(L, F, tt, "rotation", 0.0f), cr = cosf(rot), sr = sinf(rot);
+    float rot = which == X3D_TEX_ROTATION && value ? value[0] : x3d_get_float(L, F, tt, "rotation", 0.0f);
+    float cr = cosf(rot), sr = sinf(rot);
     /* p -> p + T + C -> R -> S -> -C */
     float a = s[0] * cr, b = -s[0] * sr, d = s[1] * sr, e = s[1] * cr;
     float ox = t[0] + c[0], oy = t[1] + c[1];
