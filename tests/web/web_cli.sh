@@ -25,10 +25,12 @@ fox=$DATA/gltf/Fox/glTF/Fox.gltf
 if [ -n "$DATA" ] && [ -f "$fox" ]; then
     "$SY" web "$fox" --clip Nope >/dev/null 2>"$out/err"; rc=$?
     [ $rc = 2 ] && grep -q "available: 0:Survey, 1:Walk, 2:Run" "$out/err" || bad "--clip Nope on the Fox: exit $rc, $(cat "$out/err")"
-    "$SY" web "$fox" --listen 127.0.0.1:0 -b whitted >"$out/log" 2>"$out/err" &
+    # (files of its own: a background job's redirections happen after the fork, so the server below
+    # must not find this one's URL in a log it has not truncated yet)
+    "$SY" web "$fox" --listen 127.0.0.1:0 -b whitted >"$out/fox.log" 2>"$out/fox.err" &
     pid=$!
-    wait_until $pid grep -q 'http://' "$out/log"
-    grep -q "the timeline plays clip 0 (Survey) of 3" "$out/err" || bad "the Fox's timeline: $(cat "$out/err")"
+    wait_until $pid grep -q 'http://' "$out/fox.log"
+    grep -q "the timeline plays clip 0 (Survey) of 3" "$out/fox.err" || bad "the Fox's timeline: $(cat "$out/fox.err")"
     kill -TERM $pid
     wait_gone $pid || kill -9 $pid
     wait $pid
