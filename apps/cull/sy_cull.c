@@ -32,6 +32,12 @@ struct sy_culler {
     uint32_t obj_count;
     uint64_t total_triangles;
     sy_bounds bounds; /* of every placement */
+    /* poses (sy_culler_poses_json): the placements as the culler was created (the loaded pose),
+     * sorted as placements; the ids of the objects that have left it since (sorted) */
+    sy_gltf_placement *base;
+    uint32_t base_count;
+    uint32_t *moved;
+    uint32_t moved_count, moved_cap;
 };
 
 static uint64_t mesh_triangles(const sy_scene *s, sy_mesh m)
@@ -132,10 +138,14 @@ sy_result sy_culler_create(sy_scene *scene, sy_context_pool *pool, sy_node root,
         r = sy_context_create(scene, cls->name, NULL, root.id, &c->ctx, err);
     }
     if (r == SY_OK) r = index_build(c, err);
+    if (r == SY_OK && !(c->base = malloc(sizeof *c->base * (c->placement_count ? c->placement_count : 1))))
+        r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cull: out of memory for %u placements", c->placement_count);
     if (r != SY_OK) {
         sy_culler_destroy(c);
         return r;
     }
+    memcpy(c->base, c->placements, sizeof *c->base * c->placement_count);
+    c->base_count = c->placement_count;
     *out = c;
     return SY_OK;
 }
@@ -144,7 +154,7 @@ void sy_culler_destroy(sy_culler *c)
 {
     if (!c) return;
     if (c->ctx) sy_context_release(c->ctx);
-    free(c->placements), free(c->objs), free(c);
+    free(c->placements), free(c->objs), free(c->base), free(c->moved), free(c);
 }
 
 /* >>views */
@@ -375,6 +385,87 @@ sy_result sy_culler_query_json(sy_culler *c, const char *body, size_t len, char 
     cJSON_Delete(doc);
     sy_cull_result_free(&res);
     if (!text) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cull: out of memory writing the answer");
+    *json_out = text;
+    return SY_OK;
+}
+
+/* >>poses */
+/* Whether object o's placements are those of the loaded pose (c->base: the same count, the same
+ * world matrices). */
+static bool at_base(const sy_culler *c, const cull_obj *o)
+{
+    uint32_t lo = 0, hi = c->base_count;
+    while (lo < hi) { /* the first base placement of o's node */
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (c->base[mid].node_id < o->id) lo = mid + 1;
+        else hi = mid;
+    }
+    uint32_t n = 0;
+    while (lo + n < c->base_count && c->base[lo + n].node_id == o->id) ++n;
+    if (n != o->count) return false;
+    for (uint32_t k = 0; k < n; ++k)
+        if (memcmp(c->base[lo + k].world.m, c->placements[o->first + k].world.m, sizeof c->base[0].world.m)) return false;
+    return true;
+}
+
+/* Adds id to the sorted set c->moved (once); false when out of memory. */
+static bool moved_add(sy_culler *c, uint32_t id)
+{
+    uint32_t lo = 0, hi = c->moved_count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (c->moved[mid] < id) lo = mid + 1;
+        else hi = mid;
+    }
+    if (lo < c->moved_count && c->moved[lo] == id) return true;
+    if (c->moved_count == c->moved_cap) {
+        uint32_t cap = c->moved_cap ? c->moved_cap * 2 : 16;
+        uint32_t *m = realloc(c->moved, sizeof *m * cap);
+        if (!m) return false;
+        c->moved = m, c->moved_cap = cap;
+    }
+    memmove(c->moved + lo + 1, c->moved + lo, sizeof *c->moved * (c->moved_count - lo));
+    c->moved[lo] = id;
+    c->moved_count++;
+    return true;
+}
+
+static bool moved_has(const sy_culler *c, uint32_t id)
+{
+    uint32_t lo = 0, hi = c->moved_count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (c->moved[mid] < id) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < c->moved_count && c->moved[lo] == id;
+}
+
+sy_result sy_culler_poses_json(sy_culler *c, char **json_out, sy_error *err)
+{
+    *json_out = NULL;
+    sy_result r = index_build(c, err);
+    if (r != SY_OK) return r;
+    cJSON *doc = cJSON_CreateObject(), *objs = doc ? jadd(doc, "objects", cJSON_CreateArray()) : NULL;
+    bool ok = objs && jadd(doc, "frame", cJSON_CreateNumber((double)c->index_frame));
+    for (uint32_t i = 0; ok && i < c->obj_count; ++i) {
+        const cull_obj *o = &c->objs[i];
+        if (!moved_has(c, o->id)) {
+            if (at_base(c, o)) continue;
+            if (!moved_add(c, o->id)) ok = false;
+        }
+        cJSON *jo = ok ? jadd(objs, NULL, cJSON_CreateObject()) : NULL;
+        cJSON *ms = jo && jadd(jo, "id", cJSON_CreateNumber(o->id)) ? jadd(jo, "matrices", cJSON_CreateArray()) : NULL;
+        ok = ms != NULL;
+        for (uint32_t k = 0; ok && k < o->count; ++k) {
+            cJSON *m = jadd(ms, NULL, cJSON_CreateArray());
+            for (int e = 0; m && e < 16; ++e) m = jadd(m, NULL, cJSON_CreateNumber(c->placements[o->first + k].world.m[e])) ? m : NULL;
+            ok = m != NULL;
+        }
+    }
+    char *text = ok ? cJSON_PrintUnformatted(doc) : NULL;
+    cJSON_Delete(doc);
+    if (!text) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cull: out of memory writing the poses");
     *json_out = text;
     return SY_OK;
 }

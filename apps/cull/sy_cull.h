@@ -120,6 +120,15 @@ sy_result sy_culler_object_triangles(sy_culler *c, uint32_t id, uint64_t *triang
  * materials in full with their textures as PNG, at most SY_CULL_TEXTURE_MAX_SIDE a side); *glb_out
  * is malloc()ed. SY_ERR_NOT_FOUND when id is not an object now. */
 sy_result sy_culler_object_glb(sy_culler *c, uint32_t id, uint8_t **glb_out, size_t *len_out, sy_error *err);
+/** The objects that moved (the scene clock, an application's change) as JSON, for a client that
+ * holds their GLBs: {"frame":F,"objects":[{"id":N,"matrices":[[m0..m15],...]},...]}, each object
+ * whose placements are not (or were not, once, since the culler was created) those of the scene as
+ * the culler was created, with every placement's world matrix (column-major, the order of its GLB's
+ * nodes); F the scene's frame (sy_scene_frame) they are of. Objects that never left the loaded
+ * pose are not listed. Morph weights and skins are not (the GLB holds the undeformed mesh).
+ * *json_out: malloc()ed. */
+sy_result sy_culler_poses_json(sy_culler *c, char **json_out, sy_error *err);
+
 /** Parses an object id from a URL path segment ("123": decimal digits only, 1..2^32-1);
  * SY_ERR_INVALID_ARGUMENT otherwise. */
 sy_result sy_cull_parse_id(const char *text, size_t len, uint32_t *id_out, sy_error *err);

@@ -52,6 +52,17 @@ static sy_result on_cull(void *user, sy_scene *scene, const sy_web_request *req,
     return r == SY_OK ? take_text(json, "application/json", resp, err) : r;
 }
 
+/* GET /api/pose: the moved objects' matrices (sy_culler_poses_json), after the scene clock's time
+ * (the render thread applies it before it runs a route) */
+static sy_result on_pose(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+{
+    (void)scene, (void)req;
+    sy_web_cull *c = user;
+    char *json = NULL;
+    sy_result r = sy_culler_poses_json(c->culler, &json, err);
+    return r == SY_OK ? take_text(json, "application/json", resp, err) : r;
+}
+
 /* GET /api/object/ID */
 static sy_result on_object(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
 {
@@ -212,6 +223,7 @@ sy_result sy_web_cull_create(sy_scene *scene, sy_node root, const char *client_d
     routes[n++] = (sy_web_route){"POST", "/api/cull", on_cull, c};
     routes[n++] = (sy_web_route){"GET", "/api/object/", on_object, c};
     routes[n++] = (sy_web_route){"GET", "/api/view", on_view, c};
+    routes[n++] = (sy_web_route){"GET", "/api/pose", on_pose, c};
     if (client_dir) routes[n++] = (sy_web_route){"GET", "/client/", on_client, c};
     *count = n;
     *out = c;

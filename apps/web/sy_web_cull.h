@@ -8,6 +8,8 @@
  *   GET  /api/view        the server's current view as JSON, in the form /api/cull takes
  *                         ({"position", "orientation", "fov", "target"}): the client page starts
  *                         from the view every other back-end starts from
+ *   GET  /api/pose        the objects that moved since the load (the scene clock: the page's
+ *                         timeline), each placement's world matrix (sy_culler_poses_json)
  *   GET  /client/...      the three.js client page (client.html, client.js, vendor/: the vendored
  *                         three.js; nothing else) from the folder the build made (apps/cull/client),
  *                         when one is given
@@ -28,7 +30,7 @@ extern "C" {
 #endif
 
 /** Routes sy_web_cull_create fills at most. */
-#define SY_WEB_CULL_MAX_ROUTES 4
+#define SY_WEB_CULL_MAX_ROUTES 5
 
 /** The culling routes of one server (opaque). */
 typedef struct sy_web_cull sy_web_cull;

@@ -58,6 +58,11 @@
 //     cull answer drawn), writes the canvas to OUTDIR/canvas.png and what the page fetched to
 //     OUTDIR/client.json (the ids of the answer, the ids fetched over the network, the ids drawn,
 //     triangles drawn and the totals).
+//   node browser.mjs client_timeline URL OUTDIR WIDTH HEIGHT
+//     The client-render page of an animated scene: once settled with its timeline shown, sets the
+//     scene clock (syClient.setTime) to the clip's start and to 16 % of it, waits each time for the
+//     pose asked after the server's clock message and the page idle again, and writes the canvas
+//     to OUTDIR/client_t0.png and client_t1.png and the times to OUTDIR/client_timeline.json.
 //
 // Prints one line of JSON with what it saw; exits 1 with the reason on any failure (timeouts
 // included), 77 when chromium cannot be started.
@@ -67,8 +72,8 @@ import { join } from 'node:path';
 
 const [mode, url, outDir, wArg, hArg] = process.argv.slice(2);
 const width = Number(wArg || 480), height = Number(hArg || 360);
-if (!['stream', 'client', 'warp', 'tools', 'video', 'timeline', 'first', 'converge'].includes(mode) || !url || !outDir) {
-  console.error('usage: node browser.mjs stream|client|warp|tools|video|timeline|first|converge URL OUTDIR [WIDTH HEIGHT]');
+if (!['stream', 'client', 'client_timeline', 'warp', 'tools', 'video', 'timeline', 'first', 'converge'].includes(mode) || !url || !outDir) {
+  console.error('usage: node browser.mjs stream|client|client_timeline|warp|tools|video|timeline|first|converge URL OUTDIR [WIDTH HEIGHT]');
   process.exit(2);
 }
 const executablePath = process.env.SY_CHROMIUM || '/usr/bin/chromium';
@@ -631,6 +636,32 @@ try {
     await page.waitForTimeout(200); // the refusals are only logged: nothing to wait for on the page
     const after = await tl();
     console.log(JSON.stringify({ first, scrubbed, playing, paused, after, moved, back, consoleErrors }));
+  } else if (mode === 'client_timeline') {
+    const settled = () => page.waitForFunction(() => window.syClient && syClient.queries > 0 && syClient.idle &&
+                                                      syClient.requested.length > 0 && !syClient.renderPending, null,
+                                               { timeout: TIMEOUT });
+    await settled().catch(() => fail('the client did not settle'));
+    await page.waitForFunction(() => syClient.timeline().shown, null, { timeout: TIMEOUT })
+      .catch(() => fail('no timeline on the client page (the scene has no animations?)'));
+    const first = await page.evaluate(() => syClient.timeline());
+    // (milliseconds: the server's clock messages print times with 9 digits)
+    const times = [first.start, Math.round((first.start + 0.16 * (first.end - first.start)) * 1000) / 1000];
+    const shots = [];
+    for (let k = 0; k < times.length; k++) {
+      const t = times[k];
+      await page.evaluate((t) => syClient.setTime(t), t);
+      // the pose asked after the server's clock message of t, then the page idle (a cull after it) and drawn
+      await page.waitForFunction((t) => { const s = syClient.timeline(); return s.poseTime !== null && Math.abs(s.poseTime - t) < 1e-6 && !s.playing; }, t, { timeout: TIMEOUT })
+        .catch(async () => fail(`no pose at ${t} s: ${JSON.stringify(await page.evaluate(() => syClient.timeline()))}`));
+      await page.waitForFunction(() => syClient.idle && !syClient.renderPending && syClient.frames > 0, null, { timeout: TIMEOUT })
+        .catch(() => fail(`the client did not settle at ${t} s`));
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+      await canvasPng(page, 'canvas', join(outDir, `client_t${k}.png`));
+      shots.push(await page.evaluate(() => syClient.timeline()));
+    }
+    const errors = await page.evaluate(() => syClient.errors);
+    writeFileSync(join(outDir, 'client_timeline.json'), JSON.stringify({ times, shots, errors, consoleErrors }));
+    console.log(JSON.stringify({ first, times, shots, errors, consoleErrors }));
   } else if (mode === 'video') {
     const codecs = await page.evaluate(() => window.syVideo ? syVideo.ready : []);
     await page.goto('about:blank'); // no viewer beside the pages below

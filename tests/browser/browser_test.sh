@@ -14,6 +14,10 @@
 #     a textured model: the coverage IoU at least MIN_IOU and the canvas' mean luminance within
 #     LUM (relative) of sy render -b raster's (LUM "print": printed, not checked), the objects
 #     fetched as above (no budget run).
+#   browser_test.sh client_timeline SY PNG_IOU MODULES_DIR SCENE
+#     an animated scene's client-render page at two times of the server's clock (the page's
+#     timeline: WebSocket "time", then GET /api/pose): each canvas covers what `sy render -b raster
+#     --at T` covers (IoU >= 0.95), and the two differ (IoU < 0.98).
 #   browser_test.sh tools SY PNG_IOU MODULES_DIR SCENE
 #     sy web SCENE -b raster, a 960 x 600 page: a click on a covered pixel picks its node (the
 #     properties name it) and selects it; unticking it in the tree changes the streamed canvas
@@ -94,7 +98,7 @@ bad() { echo "FAIL: $*"; fail=1; }
 
 args=(web "$SCENE" -b raster --listen 127.0.0.1:0)
 [ "$mode" = converge ] && args=(web "$SCENE" -b pathtracer --listen 127.0.0.1:0)
-[ "$mode" = client ] && args+=(--client-render)
+[ "$mode" = client ] || [ "$mode" = client_timeline ] && args+=(--client-render)
 [ "$mode" = warp ] && args+=(--delay-ms 100)
 "$SY" "${args[@]}" >"$out/log" 2>"$out/err" &
 pid=$!
@@ -207,6 +211,32 @@ if [ "$mode" = tools ]; then
       if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
     ' "$out/tools.json" "$out/ro.json" || fail=1
     finish "$out/err2"
+fi
+
+if [ "$mode" = client_timeline ]; then
+    browse "$url"
+    # each time against sy render -b raster --at that time (the view sy web starts with), and the
+    # two times against each other (the animated object moved)
+    times=$(node -e 'console.log(JSON.parse(require("fs").readFileSync(process.argv[1], "utf8")).times.join(" "))' "$out/client_timeline.json")
+    node -e 'const s = JSON.parse(require("fs").readFileSync(process.argv[1], "utf8")); if (s.errors.length || s.consoleErrors.length) { console.log("page errors: " + s.errors + " " + s.consoleErrors); process.exit(1); }' \
+        "$out/client_timeline.json" || bad "the client page reported errors"
+    k=0
+    for t in $times; do
+        "$SY" render "$SCENE" -b raster -w $W -h $H --at "$t" -o "$out/ref_t$k.png" >/dev/null 2>"$out/render.err" ||
+            { echo "FAIL: sy render --at $t: $(cat "$out/render.err")"; exit 1; }
+        res=$("$PNG_IOU" "$out/ref_t$k.png" "$out/client_t$k.png" --min "$MIN_IOU" --tol 8) || bad "at $t s the client canvas differs from sy render -b raster --at $t (coverage IoU below $MIN_IOU)"
+        echo "at $t s, the client canvas against sy render -b raster --at $t: $res"
+        [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out/client_t$k.png" "$out/ref_t$k.png" "$SY_BROWSER_KEEP"/
+        k=$((k + 1))
+    done
+    res=$("$PNG_IOU" "$out/client_t0.png" "$out/client_t1.png" --tol 8)
+    echo "the client canvas at the two times: $res"
+    iou=$(echo "$res" | awk '{print $2}')
+    awk -v v="$iou" 'BEGIN { exit !(v < 0.98) }' || bad "the client canvas did not change between the two times (IoU $iou)"
+    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
+    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
+    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
+    exit $fail
 fi
 
 if [ "$mode" = timeline ]; then

@@ -1,7 +1,8 @@
 /* test_cull.c — the remote culling service (apps/cull/sy_cull.h): ranking by covered pixels,
  * occlusion, the budget cut, the JSON answer, bad queries naming their field, unknown ids; the
  * coverage capability it asks (sy_context_coverage); the GLB
- * writer (formats/sy_gltf_write.h) round trip through sy_gltf_load; the generated plant's counts. */
+ * writer (formats/sy_gltf_write.h) round trip through sy_gltf_load; the poses of moved objects
+ * (sy_culler_poses_json); the generated plant's counts. */
 #include "../support/sy_check.h"
 #include "sy_cull.h"
 #include "sy_gltf.h"
@@ -324,6 +325,26 @@ static void test_boxes(void)
     sy_scene_destroy(back);
 
     sy_cull_result_free(&full);
+    /* poses: none moved as loaded; side moved (its matrix), then back where it was (still listed:
+     * a client holds it moved) */
+    char *pj = NULL;
+    MUST(sy_culler_poses_json(c, &pj, &err));
+    EXPECT_MSG(pj && strstr(pj, "\"objects\":[]"), "no object moved yet: %s", pj ? pj : "(null)");
+    free(pj);
+    const float q0[4] = {0, 0, 0, 1}, one[3] = {1, 1, 1}, moved_t[3] = {2.2f, 1.5f, 0}, home_t[3] = {2.2f, 0, 0};
+    for (int pass = 0; pass < 2; ++pass) {
+        MUST(sy_node_set_trs(s, side, pass ? home_t : moved_t, q0, one, &err));
+        MUST(sy_scene_commit(s, NULL, &err));
+        MUST(sy_culler_poses_json(c, &pj, &err));
+        cJSON *pd = pj ? cJSON_Parse(pj) : NULL, *po = pd ? cJSON_GetObjectItem(pd, "objects") : NULL;
+        cJSON *first = po && cJSON_GetArraySize(po) == 1 ? cJSON_GetArrayItem(po, 0) : NULL;
+        cJSON *m = first ? cJSON_GetArrayItem(cJSON_GetObjectItem(first, "matrices"), 0) : NULL;
+        EXPECT_MSG(first && (uint32_t)cJSON_GetObjectItem(first, "id")->valuedouble == side.id && cJSON_GetArraySize(m) == 16 &&
+                       fabs(cJSON_GetArrayItem(m, 13)->valuedouble - (pass ? 0.0 : 1.5)) < 1e-6,
+                   "pass %d: side (id %u) alone, its matrix's y translation %g: %s", pass, side.id, pass ? 0.0 : 1.5, pj);
+        cJSON_Delete(pd);
+        free(pj);
+    }
     sy_culler_destroy(c);
     sy_context_pool_destroy(pool);
     sy_scene_destroy(s);

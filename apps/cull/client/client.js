@@ -4,13 +4,22 @@
 // the view changes. The page URL's ?token= is passed on to every request; ?budget=T sets the
 // budget (default 2000000 triangles).
 //
+// An animated scene has a timeline (play / pause, a slider, space): the page joins the server's
+// WebSocket (/ws, without a size: it is sent the hello and the "clock" messages, no frames) and
+// steers the one scene clock every page shares with "time" and "play" (docs/WEB.md, "The
+// timeline"); after each clock message, and every display frame while the clock plays, it asks
+// GET /api/pose for the world matrices of the objects that moved and sets them on the loaded
+// objects' nodes (rigid motion: skins and morph weights are not carried).
+//
 // For tests (a browser driven over the DevTools protocol) the state is window.syClient:
 //   requested: ids of the last answer (what should be drawn), loaded: ids fetched so far,
 //   visible: ids drawn now, triangles: triangles drawn now, fetched_triangles, bytes (GLB bytes),
 //   total_objects, total_triangles, queries (answers received), fetches, errors (messages),
 //   idle (true when no query or fetch is outstanding and the drawing matches the last answer),
 //   lastAnswer (the parsed JSON), cameraJSON() (the view as sent), setView(position, target)
-//   (moves the camera and re-asks), cull() (re-asks now).
+//   (moves the camera and re-asks), cull() (re-asks now), timeline() (shown, time, start, end,
+//   playing, poses applied, poseTime: the paused clock's time the last pose was asked at),
+//   setTime(seconds), play(on).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -264,9 +273,130 @@ controls.addEventListener('change', () => {
 });
 window.addEventListener('resize', resize);
 
+// ---- the timeline: the server's scene clock, the moved objects' poses ----
+const bar = document.getElementById('timeline');
+const playButton = document.getElementById('play');
+const scrub = document.getElementById('scrub');
+const timeLabel = document.getElementById('time');
+const clock = { known: false, time: 0, start: 0, end: 0, playing: false, loop: true, speed: 1, at: 0 };
+const poses = { applied: 0, poseTime: null, inFlight: false, again: false, frame: -1 };
+let ws = null;
+
+function clockNow() { // the server's time, run on locally while it plays (as the streamed page does)
+  if (!clock.playing) return clock.time;
+  let t = clock.time + (performance.now() - clock.at) / 1000 * clock.speed;
+  const len = clock.end - clock.start;
+  if (t > clock.end || t < clock.start) {
+    t = clock.loop && len > 0 ? clock.start + ((((t - clock.start) % len) + len) % len) : Math.min(Math.max(t, clock.start), clock.end);
+  }
+  return t;
+}
+
+function showClock() {
+  const t = clockNow();
+  if (document.activeElement !== scrub) scrub.value = String(t);
+  timeLabel.textContent = `${t.toFixed(2)} s / ${(clock.end - clock.start).toFixed(2)} s`;
+  playButton.textContent = clock.playing ? '❚❚' : '▶';
+}
+
+function applyPose(p) {
+  for (const o of p.objects || []) {
+    const obj = objects.get(o.id);
+    if (!obj) continue; // not loaded: its GLB comes in the pose of its time
+    o.matrices.forEach((m, k) => {
+      const node = obj.children[k]; // one root node per placement, in the answer's order
+      if (node && Array.isArray(m) && m.length === 16) node.matrix.fromArray(m);
+    });
+    obj.updateMatrixWorld(true);
+  }
+  poses.applied++;
+  poses.frame = p.frame;
+  requestRender();
+}
+
+async function requestPose() {
+  if (poses.inFlight) {
+    poses.again = true;
+    return;
+  }
+  poses.inFlight = true;
+  const asked = clock.playing ? null : clock.time;
+  try {
+    const response = await fetch(withToken('/api/pose'));
+    const text = await response.text();
+    if (!response.ok) throw new Error(`pose: ${response.status} ${text}`);
+    applyPose(JSON.parse(text));
+    poses.poseTime = asked;
+  } catch (e) {
+    showError(String(e.message || e));
+  } finally {
+    poses.inFlight = false;
+  }
+  if (poses.again || clock.playing) { // playing: the next pose on the next display frame
+    poses.again = false;
+    requestAnimationFrame(() => { showClock(); requestPose(); });
+  } else {
+    scheduleCull(); // what covers the view may have changed
+  }
+}
+
+function sendClock(message) {
+  if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify(message));
+}
+
+function connectClock() {
+  const url = new URL('/ws', window.location.href);
+  url.protocol = url.protocol === 'https:' ? 'wss:' : 'ws:';
+  url.search = token ? `?token=${encodeURIComponent(token)}` : '';
+  ws = new WebSocket(url, 'sy-view'); // the server's protocol (docs/WEB.md)
+  ws.onmessage = (ev) => {
+    if (typeof ev.data !== 'string') return;
+    let m;
+    try { m = JSON.parse(ev.data); } catch (e) { return; }
+    if (m.t !== 'clock') return;
+    const was = clock.playing;
+    Object.assign(clock, { known: true, time: m.time, start: m.start, end: m.end, playing: !!m.playing, loop: !!m.loop,
+                           speed: m.speed, at: performance.now() });
+    scrub.min = String(m.start);
+    scrub.max = String(m.end);
+    scrub.step = String(Math.max((m.end - m.start) / 1000, 1e-4));
+    bar.classList.add('shown');
+    showClock();
+    if (!was || !clock.playing) requestPose(); // the server applied the time before it answers
+  };
+  ws.onclose = () => { ws = null; };
+}
+
+function setTime(t) {
+  sendClock({ t: 'time', s: t });
+}
+
+function play(on) {
+  clock.time = clockNow();
+  clock.at = performance.now();
+  clock.playing = on;
+  sendClock({ t: 'play', on });
+  showClock();
+  if (on) requestPose();
+}
+
+playButton.addEventListener('click', (e) => { e.stopPropagation(); play(!clock.playing); playButton.blur(); });
+scrub.addEventListener('input', () => setTime(Number(scrub.value)));
+window.addEventListener('keydown', (e) => {
+  if (!clock.known || e.key !== ' ' || e.repeat) return;
+  e.preventDefault();
+  play(!clock.playing);
+});
+
 window.syClient = Object.assign(state, {
   cameraJSON,
   cull,
+  timeline() {
+    return { shown: bar.classList.contains('shown'), time: clockNow(), start: clock.start, end: clock.end, playing: clock.playing,
+             poses: poses.applied, poseTime: poses.poseTime, frame: poses.frame };
+  },
+  setTime,
+  play,
   setView(position, target) {
     camera.position.set(...position);
     controls.target.set(...target);
@@ -285,3 +415,4 @@ try {
   serverView = null;
 }
 resize();
+connectClock();
