@@ -1074,17 +1074,20 @@ static bool route_fields(const xmlNode *route, const char *from, const char *to)
  * angles, malloc()ed) made dense: keys added between the file's, linearly in the key and the angle
  * as X3D interpolates them, so that no two are more than X3D_TEX_ROTATION_STEP apart (with at most
  * SY_MORPH_MAX_TARGETS keys in all: a larger step beyond); the angles stored as (angle, 0), the
- * morph sources' texture stride. Keys that decrease are refused later (read_one_hot); here they get
- * no keys between them. Returns SY_OK with *kv NULL (warned) when the keys are too many, an error
- * when out of memory (in L->err). */
+ * morph sources' texture stride. Keys that decrease are refused later (read_one_hot, naming the
+ * file's key): such keys are left as they are. Returns SY_OK with *kv NULL (warned) when the keys
+ * are too many, an error when out of memory (in L->err). */
 static sy_result dense_rotation(loader *L, xfile *F, const xmlNode *in, const char *def, float **key, float **kv, size_t *nk)
 {
     const float *k0 = *key, *v0 = *kv;
     size_t n = *nk;
+    bool sorted = true;
+    for (size_t k = 0; k + 1 < n && sorted; ++k) sorted = !(k0[k + 1] < k0[k]);
     double total = 0;
     for (size_t k = 0; k + 1 < n; ++k) total += k0[k + 1] > k0[k] ? fabs((double)v0[k + 1] - v0[k]) : 0;
     double step = X3D_TEX_ROTATION_STEP;
     if (n > 1 && total / step + (double)n > SY_MORPH_MAX_TARGETS) step = total / (double)(SY_MORPH_MAX_TARGETS - n);
+    if (!sorted) total = 0; /* nothing added: read_one_hot refuses the keys */
     if (n >= SY_MORPH_MAX_TARGETS && total > 0) {
         x3d_warn(L, "%s:%d: ScalarInterpolator '%s': %zu keys into a TextureTransform's rotation leave no room for the keys "
                  "between them (at most %u); not played", F->path, x3d_line_of(in), def ? def : "", n, SY_MORPH_MAX_TARGETS - 1);
@@ -1093,7 +1096,7 @@ static sy_result dense_rotation(loader *L, xfile *F, const xmlNode *in, const ch
         return SY_OK;
     }
     size_t out = n;
-    for (size_t k = 0; k + 1 < n; ++k)
+    for (size_t k = 0; k + 1 < n && total > 0; ++k)
         if (k0[k + 1] > k0[k]) out += (size_t)ceil(fabs((double)v0[k + 1] - v0[k]) / step - 1e-6) - (v0[k + 1] != v0[k]);
     if (out > SY_MORPH_MAX_TARGETS) out = SY_MORPH_MAX_TARGETS; /* rounding: never reached, a guard */
     float *nkey = malloc(out * sizeof *nkey), *nkv = calloc(out * 2, sizeof *nkv);
@@ -1104,7 +1107,7 @@ static sy_result dense_rotation(loader *L, xfile *F, const xmlNode *in, const ch
     size_t o = 0;
     for (size_t k = 0; k < n && o < out; ++k) {
         nkey[o] = k0[k], nkv[2 * o] = v0[k], ++o;
-        if (k + 1 == n || !(k0[k + 1] > k0[k])) continue;
+        if (k + 1 == n || !(k0[k + 1] > k0[k]) || !(total > 0)) continue;
         size_t parts = (size_t)ceil(fabs((double)v0[k + 1] - v0[k]) / step - 1e-6);
         for (size_t j = 1; j < parts && o + (n - k - 1) < out; ++j) {
             double u = (double)j / (double)parts;
