@@ -502,6 +502,67 @@ static void test_textures(void)
 
 /* the shared sample: OrbitalTimeInterval (12 s, loop) turns EarthCoordinateSystem 2 pi about +y in
  * four quarter keys */
+/* ScalarInterpolator -> TextureTransform.rotation: the texture coordinates at a time are the file's
+ * turned about the center by the interpolated angle (between the file's keys too: the keys made
+ * dense, a blend of two is within 0.125 % of the radius; the two file keys alone would blend 0 and
+ * pi into a point near the center); decreasing keys are refused naming the file's key, and 256 keys
+ * leave no room for more */
+static void test_texture_rotation(void)
+{
+    char many[256 * 2 * 12 + 200], *m = many;
+    m += sprintf(m, "<ScalarInterpolator DEF='Many' key='");
+    for (int k = 0; k < 256; ++k) m += sprintf(m, "%g ", k / 255.0);
+    m += sprintf(m, "' keyValue='");
+    for (int k = 0; k < 256; ++k) m += sprintf(m, "%d ", k);
+    sprintf(m, "'/>\n");
+    char text[16384];
+    snprintf(text, sizeof text,
+        "<X3D><Scene>\n"
+        "<Transform DEF='Turned'><Shape><Appearance><TextureTransform DEF='TR' center='0.5 0.5'/></Appearance>"   /* 2 */
+        "<IndexedFaceSet coordIndex='0 1 2 3 -1' texCoordIndex='0 1 2 3 -1'><Coordinate point='0 0 0 1 0 0 1 1 0 0 1 0'/>"
+        "<TextureCoordinate point='0 0 1 0 1 1 0 1'/></IndexedFaceSet></Shape></Transform>\n"
+        "<TimeSensor DEF='Clock' cycleInterval='2'/>\n"                                                        /* 3 */
+        "<ScalarInterpolator DEF='Spin' key='0 1' keyValue='0 3.14159265'/>\n"                                /* 4 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Spin' toField='set_fraction'/>\n"
+        "<ROUTE fromNode='Spin' fromField='value_changed' toNode='TR' toField='set_rotation'/>\n"
+        "<Shape><Appearance><TextureTransform DEF='TD'/></Appearance><IndexedFaceSet coordIndex='0 1 2 -1'>"     /* 7 */
+        "<Coordinate point='0 0 0 1 0 0 1 1 0'/><TextureCoordinate point='0 0 1 0 1 1'/></IndexedFaceSet></Shape>\n"
+        "<ScalarInterpolator DEF='Down' key='0 0.6 0.3 1' keyValue='0 1 2 3'/>\n"                             /* 8 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Down' toField='set_fraction'/>\n"
+        "<ROUTE fromNode='Down' fromField='value_changed' toNode='TD' toField='rotation'/>\n"
+        "<Shape><Appearance><TextureTransform DEF='TM'/></Appearance><IndexedFaceSet coordIndex='0 1 2 -1'>"     /* 11 */
+        "<Coordinate point='0 0 0 1 0 0 1 1 0'/><TextureCoordinate point='0 0 1 0 1 1'/></IndexedFaceSet></Shape>\n"
+        "%s"                                                                                                     /* 12 */
+        "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Many' toField='set_fraction'/>\n"
+        "<ROUTE fromNode='Many' fromField='value_changed' toNode='TM' toField='rotation'/>\n"
+        "</Scene></X3D>\n", many);
+    loaded l = load_text("rot.x3d", text);
+    if (!expect_loaded(&l, "rot.x3d")) return unload(&l);
+    EXPECT_MSG(has_warning(&l, "rot.x3d:8: ScalarInterpolator: key 2 (0.3) is less than the key before it", "not played"),
+               "Down's keys");
+    EXPECT_MSG(has_warning(&l, "rot.x3d:12: ScalarInterpolator 'Many': 256 keys into a TextureTransform's rotation", "not played"),
+               "Many's keys");
+    sy_node turned = node_named(&l, "Turned"), shows = {0};
+    const sy_node_data *pd = turned.id ? sy_node_get(l.scene, turned) : NULL;
+    uint32_t nc = 0;
+    const uint32_t *ch = pd ? sy_node_children(pd, &nc) : NULL;
+    if (pd && pd->mesh.id) shows = turned;
+    for (uint32_t c = 0; c < nc && !shows.id; ++c)
+        if (sy_node_get(l.scene, (sy_node){ch[c]})->mesh.id) shows = (sy_node){ch[c]};
+    EXPECT_MSG(shows.id, "the turned shape");
+    const double times[4] = {0.0, 0.5, 1.0, 1.3};
+    for (int ti = 0; ti < 4 && shows.id; ++ti) {
+        set_time(&l, times[ti]);
+        /* corner 1 (1, 0) about C (0.5, 0.5): p + C = (1.5, 0.5) turned by a, minus C; uv = (s', 1 - t') */
+        double a = 3.14159265 * times[ti] / 2.0, s = 1.5 * cos(a) - 0.5 * sin(a) - 0.5, t = 1.5 * sin(a) + 0.5 * cos(a) - 0.5;
+        float uv[2];
+        bool ok = morphed_uv(&l, shows, 1, uv);
+        EXPECT_MSG(ok && fabs(uv[0] - s) < 2.5e-3 && fabs(uv[1] - (1.0 - t)) < 2.5e-3, "t %g: corner 1 uv (%g %g), want (%g %g)",
+                   times[ti], (double)uv[0], (double)uv[1], s, 1.0 - t);
+    }
+    unload(&l);
+}
+
 static void test_sample(const char *data)
 {
     char p[2048];
@@ -521,4 +582,4 @@ static void test_sample(const char *data)
     unload(&l);
 }
 
-X3D_MAIN("x3d_anim", test_sample, test_routes, test_fields, test_coordinates, test_textures)
+X3D_MAIN("x3d_anim", test_sample, test_routes, test_fields, test_coordinates, test_textures, test_texture_rotation)
