@@ -39,9 +39,10 @@
  *                               the interpolated field's coordinates); ScalarInterpolator ->
  *                               TextureTransform.rotation the same way, its keys made dense first
  *                               (at most X3D_TEX_ROTATION_STEP apart: the blend of two keys'
- *                               coordinates is a chord of the rotation); polygon geometry only (the
- *                               primitives Box, Sphere, ... keep theirs), not with moving points on the
- *                               same geometry; one interpolator per TextureCoordinate / TextureTransform.
+ *                               coordinates is a chord of the rotation); polygon geometry and (the
+ *                               TextureTransform's fields) the primitives Box, Sphere, Cone, Cylinder
+ *                               (Text keeps its), not with moving points on the same geometry; one
+ *                               interpolator per TextureCoordinate / TextureTransform.
  * ROUTEs are read per file, so DEF names resolve in the file's own namespace (an Inline's routes
  * see the Inline's DEFs).
  *

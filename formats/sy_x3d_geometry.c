@@ -17,6 +17,38 @@ static void texture_transform(loader *L, xfile *F, const xmlNode *tt, float m[6]
     x3d_texture_transform(L, F, tt, X3D_TEX_NONE, NULL, m);
 }
 
+/* A primitive's (Box, Sphere, Cone, Cylinder) texture coordinates under an animated TextureTransform
+ * field (sy_x3d_anim.c: a PositionInterpolator2D into translation / scale / center, a
+ * ScalarInterpolator into rotation): one morph target per key, the nv vertices' coordinates
+ * (src: the tessellator's, before the transform) through the transform with the key's value, minus
+ * uv (the static ones); L->morph_pending names the source. Charged to the load's budget. */
+static sy_result primitive_tex_targets(loader *L, xfile *F, const xmlNode *el, const xmlNode *tt, const float *src,
+                                       const float *uv, size_t nv, sy_primitive *prim)
+{
+    morph_src *m = NULL;
+    for (size_t i = 0; i < L->morph_count && !m; i++)
+        if (L->morphs[i].tex && L->morphs[i].tex != X3D_TEX_POINT && L->morphs[i].coord == tt && L->morphs[i].serial == F->serial)
+            m = &L->morphs[i];
+    if (!m) return SY_OK;
+    sy_result r = sy_budget_charge(&L->budget, (uint64_t)m->keys * nv, 8, &L->err, "%s:%d: %s: texture coordinate morph "
+                                   "targets of an interpolator", F->path, x3d_line_of(el), x3d_ename(el));
+    if (r) return r;
+    float *d = malloc(m->keys * nv * 8 + 1);
+    if (!d) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+    for (size_t k = 0; k < m->keys; k++) {
+        float mk[6];
+        x3d_texture_transform(L, F, tt, m->tex, m->values + 2 * k, mk);
+        for (size_t i = 0; i < nv; i++) {
+            float s = src[2 * i], t = 1.0f - src[2 * i + 1];
+            d[(k * nv + i) * 2] = mk[0] * s + mk[1] * t + mk[2] - uv[2 * i];
+            d[(k * nv + i) * 2 + 1] = 1.0f - (mk[3] * s + mk[4] * t + mk[5]) - uv[2 * i + 1];
+        }
+    }
+    r = x3d_make_blob(L, d, m->keys * nv * 8, &prim->target_texcoords0);
+    if (!r) L->morph_pending = (size_t)(m - L->morphs) + 1;
+    return r;
+}
+
 /* Output of a stroke geometry node: vertices (positions, optional RGBA colours) and, for lines,
  * index pairs. */
 typedef struct stroke_out {
@@ -389,6 +421,10 @@ sy_result x3d_build_geometry(loader *L, xfile *F, const xmlNode *el, const xmlNo
             float s = src[2 * k], t = 1.0f - src[2 * k + 1];
             uv[2 * k] = m[0] * s + m[1] * t + m[2];
             uv[2 * k + 1] = 1.0f - (m[3] * s + m[4] * t + m[5]);
+        }
+        if ((r = primitive_tex_targets(L, F, el, ttel, src, uv, nv, prim))) {
+            free(uv);
+            return r;
         }
         sy_blob *b;
         if ((r = x3d_make_blob(L, uv, nv * 8, &b))) return r;

@@ -16,7 +16,8 @@ by hue with the prediction. A scene passes when at least 97 % of them agree. The
 scenes: a quarter turn about the centre (the texture's appearance turns clockwise: red from the
 top left to the top right), and 30 degrees with a non-uniform scale, a centre and a translation
 (the order of the composition); and routed, a ScalarInterpolator turning the rotation from 0 to pi
-over 2 s, rendered with --at at 0.5, 1 and 1.6 s (a quarter, a half and 0.8 of the turn).
+over 2 s, rendered with --at at 0.5, 1 and 1.6 s (a quarter, a half and 0.8 of the turn), on the
+quad, a Box and a Sphere.
 
 With --reference view3dscene (by hand; needs view3dscene and xvfb-run) the same comparison is
 made of view3dscene's screenshots against the predictions: the independent X3D browser's reading
@@ -236,6 +237,8 @@ SPIN = ("<TimeSensor DEF='Clock' cycleInterval='2' loop='false'/>"
 CASES += [("quad_spin_%s" % at, "quad", "front", "DEF='TT' center='0.5 0.5'", dict(rotation=math.pi * float(at) / 2,
                                                                                  center=(0.5, 0.5)), at)
           for at in ("0.5", "1", "1.6")]
+CASES += [("box_spin_1", "box", "front", "DEF='TT' center='0.5 0.5'", dict(rotation=math.pi / 2, center=(0.5, 0.5)), "1"),
+          ("sphere_spin_0.5", "sphere", "front", "DEF='TT' center='0.5 0.5'", dict(rotation=math.pi / 4, center=(0.5, 0.5)), "0.5")]
 
 
 def scene_text(shape, vname, tt_attrs, routed):
