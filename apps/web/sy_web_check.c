@@ -550,7 +550,15 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
         if (r == SY_OK) r = parse_cap(m, out, err);
     } else if (!strcmp(type, "tree")) {
         out->type = SY_WEB_INPUT_TREE;
+        double node = 0, offset = 0; /* both optional: absent, the scene's roots from the first */
         if (!json_seq(m, &out->seq)) r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "tree: seq must be a whole number 0..2^31");
+        else if (cJSON_GetObjectItemCaseSensitive(m, "node") &&
+                 (!json_num(m, "node", 0, SY_WEB_NODE_ID_MAX, &node) || node != floor(node)))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "tree: node must be a node id (a whole number 0..%u)", SY_WEB_NODE_ID_MAX);
+        else if (cJSON_GetObjectItemCaseSensitive(m, "offset") &&
+                 (!json_num(m, "offset", 0, 2147483647.0, &offset) || offset != floor(offset)))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "tree: offset must be a whole number 0..2^31");
+        out->node = (uint32_t)node, out->offset = (uint32_t)offset;
     } else if (!strcmp(type, "exposure")) {
         out->type = SY_WEB_INPUT_EXPOSURE;
         if (!json_num(m, "stops", -SY_WEB_EXPOSURE_MAX, SY_WEB_EXPOSURE_MAX, &out->a))

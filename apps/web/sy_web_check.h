@@ -134,7 +134,8 @@ typedef enum sy_web_input_type {
     SY_WEB_INPUT_SELECT,   /**< select (on) or deselect node; node 0: clear the selection */
     SY_WEB_INPUT_ISOLATE,  /**< show only node (with its ancestors and subtree); node 0: show every node */
     SY_WEB_INPUT_CLIP,     /**< the section planes (plane_count of planes; 0: none) */
-    SY_WEB_INPUT_TREE,     /**< asks for the scene's hierarchy (answered with a "tree" message) */
+    SY_WEB_INPUT_TREE,     /**< asks for the scene's hierarchy below node (0: its roots) from offset, one page
+                            * (answered with a "tree" message; docs/WEB.md) */
     SY_WEB_INPUT_EXPOSURE, /**< exposure in stops (a) */
     SY_WEB_INPUT_FILTER,   /**< the display filter by name (filter) */
     SY_WEB_INPUT_KEYFRAME, /**< {"t":"keyframe"}: the page's video decoder lost its place */
@@ -167,7 +168,9 @@ typedef struct sy_web_input {
     char key;        /**< key: '1'..'9', 'f', '[', ']', 'r' (lower case) */
     uint32_t version; /**< size: the frame format the page reads ("v", 0..1000; 0 = absent: a page
                        * older than frame format 3, refused with a status message) */
-    uint32_t node;   /**< visible, select, isolate: the node id (0 only for select / isolate: all) */
+    uint32_t node;   /**< visible, select, isolate: the node id (0 only for select / isolate: all);
+                      * tree: the node whose children are listed (0 or absent: the scene's roots) */
+    uint32_t offset; /**< tree: the first of those children (or roots) listed (0..2^31; absent: 0) */
     bool on;         /**< visible: show; select: select; pick: select what is hit; play: play (else pause) */
     uint32_t seq;    /**< pick, tree: the page's request number, echoed in the answer (0..2^31) */
     uint32_t plane_count;             /**< clip: planes in use (0..SY_CLIP_PLANES_MAX) */

@@ -94,7 +94,12 @@ typedef struct web_reply {
 
 #define WEB_ACTIONS_MAX 256u /* actions queued, all connections (more are dropped with a log line) */
 #define WEB_REPLIES_MAX 64u  /* answers waiting, all connections (more are dropped with a log line) */
-#define WEB_TREE_MAX 4096u   /* nodes in one "tree" answer (a huge scene's answer says it was cut) */
+/* One "tree" answer (sy_web_scene.c): at most WEB_TREE_PAGE of the listed node's children (or of
+ * the roots) from the asked offset, each opened (its children listed below it, depth first) while
+ * it has at most WEB_TREE_PAGE children and the answer stays within WEB_TREE_MAX nodes; the others
+ * are sent closed with their child count, and the page asks for them when it is expanded. */
+#define WEB_TREE_MAX 4096u
+#define WEB_TREE_PAGE 512u
 /* The environments the page's menu offers (sy_web_scene.c): "scene" (the world the server started
  * with: the scene's or the embedding program's), "studio" (the library's neutral studio as the
  * light, the start world's background kept), "none" (no environment light, no default light). */

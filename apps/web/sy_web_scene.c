@@ -3,7 +3,8 @@
  * isolation (sy_node_set_visible / _selected, sy_scene_isolate, committed so every context sees
  * them), section planes and their caps (sy_viewport_set_clip_planes / _clip_cap on the server's
  * viewports) and the scene's
- * hierarchy, bounded to WEB_TREE_MAX nodes. Answers go back to the asking page as JSON text
+ * hierarchy, a page at a time (WEB_TREE_PAGE children of a node, opened below while the answer stays
+ * within WEB_TREE_MAX nodes). Answers go back to the asking page as JSON text
  * through the mailbox (web_reply); unknown nodes and failures are logged and answered with a
  * "refused" message, never applied (sy_web_internal.h; docs/WEB.md, "The WebSocket protocol"). */
 #include "sy_web_internal.h"
@@ -296,19 +297,31 @@ static uint32_t index_of(const uint32_t *ids, uint32_t n, uint32_t id)
     return f ? (uint32_t)(f - ids) : UINT32_MAX;
 }
 
-/* The hierarchy, depth first from the roots (nodes nobody lists as a child; with w->d.root, that
- * node), each node once (a node with several parents under the first), at most WEB_TREE_MAX. */
+/* The hierarchy, one page of it: the "level" is the children of node a->in.node (0: the roots,
+ * nodes nobody lists as a child; with w->d.root, that node), from a->in.offset, at most
+ * WEB_TREE_PAGE of them (depth 0); below each, depth first, its children while the node has at
+ * most WEB_TREE_PAGE of them and the answer's nodes (listed and reserved on the stack) stay within
+ * WEB_TREE_MAX ("open": true), else it is sent closed with its child count. Each node once (a node
+ * with several parents under the first). An unknown node is refused; an offset past the end gives
+ * no nodes (the scene may have changed since the page's last answer). */
 static void do_tree(const sy_web_scene_ctx *sc, const web_action *a)
 {
     sy_web *w = sc->w;
     sy_scene *s = w->d.scene;
-    uint32_t total = sy_scene_count(s, SY_TYPE_NODE), n = 0;
+    uint32_t total = sy_scene_count(s, SY_TYPE_NODE), n = 0, parent = a->in.node;
+    if (parent && !sy_node_get(s, (sy_node){parent})) {
+        char why[64];
+        snprintf(why, sizeof why, "no node %u in the scene", parent);
+        refuse(w, a, "tree", why);
+        return;
+    }
     uint32_t *ids = malloc((total ? total : 1) * sizeof *ids);
     uint8_t *state = calloc(total ? total : 1, 1); /* 1: someone's child, 2: listed */
-    uint32_t *stack = malloc((total ? total : 1) * sizeof *stack * 2);
+    uint32_t *level = malloc((total ? total : 1) * sizeof *level);
+    uint32_t *stack = malloc((size_t)(WEB_TREE_MAX + WEB_TREE_PAGE) * 2 * sizeof *stack);
     cJSON *o = cJSON_CreateObject(), *arr = NULL;
-    if (!ids || !state || !stack || !o) {
-        free(ids), free(state), free(stack), cJSON_Delete(o);
+    if (!ids || !state || !level || !stack || !o) {
+        free(ids), free(state), free(level), free(stack), cJSON_Delete(o);
         sy_log(SY_LOG_WARNING, "web", a->peer, "tree: out of memory");
         return;
     }
@@ -323,25 +336,43 @@ static void do_tree(const sy_web_scene_ctx *sc, const web_action *a)
             if (j != UINT32_MAX) state[j] = 1;
         }
     }
+    /* the level: indices into ids, in order */
+    uint32_t count = 0;
+    if (parent) {
+        uint32_t cn = 0;
+        const uint32_t *ch = sy_node_children(sy_node_get(s, (sy_node){parent}), &cn);
+        for (uint32_t k = 0; ch && k < cn && count < n; ++k) {
+            uint32_t j = index_of(ids, n, ch[k]);
+            if (j != UINT32_MAX) level[count++] = j;
+        }
+    } else if (w->d.root.id) {
+        uint32_t j = index_of(ids, n, w->d.root.id);
+        if (j != UINT32_MAX) level[count++] = j;
+    } else {
+        for (uint32_t i = 0; i < n; ++i)
+            if (state[i] == 0) level[count++] = i;
+    }
     cJSON_AddStringToObject(o, "t", "tree");
     cJSON_AddNumberToObject(o, "seq", a->in.seq);
     cJSON_AddNumberToObject(o, "total", n);
+    cJSON_AddNumberToObject(o, "node", parent);
+    cJSON_AddNumberToObject(o, "offset", a->in.offset);
+    cJSON_AddNumberToObject(o, "count", count);
     arr = cJSON_AddArrayToObject(o, "nodes");
-    uint32_t listed = 0;
-    /* roots, pushed in reverse so they come out in id order; the stack holds (index, depth) */
-    uint32_t sp = 0;
-    if (w->d.root.id) {
-        uint32_t j = index_of(ids, n, w->d.root.id);
-        if (j != UINT32_MAX) stack[sp++] = j, stack[sp++] = 0;
-    } else {
-        for (uint32_t i = n; i-- > 0;)
-            if (state[i] == 0) stack[sp++] = i, stack[sp++] = 0;
-    }
-    while (sp && listed < WEB_TREE_MAX) {
+    uint32_t listed = 0, first = a->in.offset < count ? a->in.offset : count;
+    uint32_t last = count - first > WEB_TREE_PAGE ? first + WEB_TREE_PAGE : count;
+    /* the level's page pushed in reverse so it comes out in order; the stack holds (index, depth),
+     * and reserved counts the nodes listed or on it: never above WEB_TREE_MAX + WEB_TREE_PAGE */
+    uint32_t sp = 0, reserved = last - first;
+    for (uint32_t k = last; k-- > first;) stack[sp++] = level[k], stack[sp++] = 0;
+    while (sp) {
         uint32_t depth = stack[--sp], i = stack[--sp];
         if (state[i] == 2) continue;
         state[i] = 2;
         const sy_node_data *d = sy_node_get(s, (sy_node){ids[i]});
+        uint32_t cn = 0;
+        const uint32_t *ch = d ? sy_node_children(d, &cn) : NULL;
+        bool open = cn > 0 && cn <= WEB_TREE_PAGE && reserved + cn <= WEB_TREE_MAX;
         cJSON *e = cJSON_CreateObject();
         cJSON_AddNumberToObject(e, "id", ids[i]);
         cJSON_AddNumberToObject(e, "depth", depth);
@@ -350,15 +381,16 @@ static void do_tree(const sy_web_scene_ctx *sc, const web_action *a)
         cJSON_AddStringToObject(e, "kind", kind == 1 ? "mesh" : kind == 2 ? "light" : kind == 3 ? "camera" : "group");
         cJSON_AddBoolToObject(e, "visible", d && (d->flags & SY_NODE_VISIBLE));
         cJSON_AddBoolToObject(e, "selected", d && (d->flags & SY_NODE_SELECTED));
+        cJSON_AddNumberToObject(e, "children", cn);
+        cJSON_AddBoolToObject(e, "open", open);
         cJSON_AddItemToArray(arr, e);
         listed++;
-        uint32_t cn = 0;
-        const uint32_t *ch = d ? sy_node_children(d, &cn) : NULL;
-        /* children pushed in reverse: listed in their order; the stack has room for every node
-         * twice (each index is pushed at most once per parent listing it, and listed once) */
-        for (uint32_t k = cn; ch && k-- > 0;) {
+        if (!open) continue;
+        reserved += cn;
+        /* children pushed in reverse: listed in their order */
+        for (uint32_t k = cn; k-- > 0;) {
             uint32_t j = index_of(ids, n, ch[k]);
-            if (j != UINT32_MAX && state[j] != 2 && sp + 2 <= 2 * n) stack[sp++] = j, stack[sp++] = depth + 1;
+            if (j != UINT32_MAX && state[j] != 2) stack[sp++] = j, stack[sp++] = depth + 1;
         }
     }
     cJSON_AddBoolToObject(o, "truncated", listed < n);
@@ -376,7 +408,7 @@ static void do_tree(const sy_web_scene_ctx *sc, const web_action *a)
     pthread_mutex_lock(&w->mu);
     cJSON_AddStringToObject(o, "environment", sy_webi_environment_names[w->environment < SY_WEB_ENVIRONMENTS ? w->environment : 0]);
     pthread_mutex_unlock(&w->mu);
-    free(ids), free(state), free(stack);
+    free(ids), free(state), free(level), free(stack);
     post_reply(w, a, o);
 }
 

@@ -53,6 +53,12 @@
  *                 are refused (no clock message); a time of 2 s changes the depth at a covered
  *                 pixel; play is answered by clock messages whose time advances, pause stops it; a
  *                 scene without clips sends no clock and refuses times
+ *   web_tree      the tree of a scene of 18,000 nodes more than the demo, a page at a time: the
+ *                 first answer lists at most 4,096 nodes, "flat" (12,000 children) closed with its
+ *                 count, "deep" open, its groups of 300 open until the answer is full, the rest
+ *                 closed; "flat"'s children in pages of 512 (offset 11,776: the last 224), every
+ *                 child once over the 24 pages; a page past the end is empty; an unknown node and
+ *                 a node or offset that is no whole number are refused
  *   web_frame     the binary frame (sy_web_frame.h) round-trips: header fields, the depth channel
  *                 (the grid of every second pixel) within its 16-bit log step, "nothing" kept; a
  *                 tilted plane codes to under a quarter of its grid's 2 bytes per value; a frame
@@ -84,7 +90,7 @@ int main(int argc, char **argv)
     static const struct {
         const char *name;
         int (*run)(void);
-    } alone[] = {{"messages", test_messages}, {"timeline", test_timeline},     {"readonly", test_readonly},
+    } alone[] = {{"messages", test_messages}, {"timeline", test_timeline}, {"tree", test_tree},     {"readonly", test_readonly},
                  {"frame", test_frame},       {"encodecost", test_encode_cost}, {"clientfiles", test_client_files},
                  {"token", test_token},       {"progressive", test_progressive}};
     for (size_t i = 0; i < sizeof alone / sizeof alone[0]; ++i)

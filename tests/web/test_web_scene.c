@@ -3,6 +3,8 @@
  * visibility, planes and caps, environment, exposure through a viewer), web_readonly (a read-only
  * server refuses edits), web_timeline (the scene clock: range, times, play and pause). */
 #include "web_test.h"
+
+#include <cjson/cJSON.h>
 /* >>the page's scene messages (pick, visibility, selection, planes, tree) */
 static int parse_ok(const char *m, sy_web_input *in)
 {
@@ -30,7 +32,8 @@ int test_messages(void)
           in.cap_rgb[0] == 1.0f && in.cap_rgb[1] == 0.25f && in.cap_rgb[2] == 0.0f);
     CHECK(parse_ok("{\"t\":\"clip\",\"planes\":[],\"cap\":false}", &in) && in.cap == SY_WEB_CAP_OFF);
     CHECK(parse_ok("{\"t\":\"clip\",\"planes\":[],\"cap\":null}", &in) && in.cap == SY_WEB_CAP_OFF);
-    CHECK(parse_ok("{\"t\":\"tree\",\"seq\":4}", &in) && in.type == SY_WEB_INPUT_TREE && in.seq == 4);
+    CHECK(parse_ok("{\"t\":\"tree\",\"seq\":4}", &in) && in.type == SY_WEB_INPUT_TREE && in.seq == 4 && !in.node && !in.offset);
+    CHECK(parse_ok("{\"t\":\"tree\",\"node\":7,\"offset\":512}", &in) && in.node == 7 && in.offset == 512);
     CHECK(parse_ok("{\"t\":\"exposure\",\"stops\":-1.5}", &in) && in.type == SY_WEB_INPUT_EXPOSURE && in.a == -1.5);
     CHECK(parse_ok("{\"t\":\"environment\",\"name\":\"studio\"}", &in) && in.type == SY_WEB_INPUT_ENVIRONMENT &&
           !strcmp(in.filter, "studio") && sy_web_input_changes_scene(&in));
@@ -64,6 +67,10 @@ int test_messages(void)
         "{\"t\":\"time\",\"s\":2e9}",                  /* beyond SY_WEB_TIME_MAX */
         "{\"t\":\"time\",\"s\":\"1\"}",
         "{\"t\":\"play\"}",
+        "{\"t\":\"tree\",\"node\":1.5}",            /* node and offset: whole numbers */
+        "{\"t\":\"tree\",\"node\":-1}",
+        "{\"t\":\"tree\",\"offset\":-2}",
+        "{\"t\":\"tree\",\"offset\":\"3\"}",
         "{\"t\":\"play\",\"on\":1}",
         "{\"t\":\"pick\",\"x\":1,\"y\":0.5}",           /* outside: [0, 1) */
         "{\"t\":\"pick\",\"x\":-0.01,\"y\":0.5}",
@@ -499,5 +506,128 @@ int test_readonly(void)
         if (web_next_frame(c, &fi, NULL, NULL)) return 1;
     } while (fi.input_id < 1);
     sy_web_client_close(c);
+    return web_stop(&s);
+}
+
+/* >>web_tree: a scene beyond WEB_TREE_MAX nodes, a page at a time */
+/* The next "tree" answer, parsed (the caller deletes it); NULL after a failed check. */
+static cJSON *tree_answer(sy_web_client *c, const char *ask)
+{
+    sy_error err = {0};
+    char *t = NULL;
+    if (sy_web_client_send(c, ask, &err) != SY_OK || sy_web_client_next_text(c, 20000, "tree", &t, &err) != SY_OK) {
+        fprintf(stderr, "tree %s: %s\n", ask, err.message);
+        return NULL;
+    }
+    cJSON *o = cJSON_Parse(t);
+    free(t);
+    return o;
+}
+
+static double num(const cJSON *o, const char *k)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, k);
+    return cJSON_IsNumber(v) ? v->valuedouble : -1;
+}
+
+/* The listed node named name (NULL when absent). */
+static const cJSON *named(const cJSON *nodes, const char *name)
+{
+    const cJSON *e;
+    cJSON_ArrayForEach(e, nodes)
+    {
+        const cJSON *n = cJSON_GetObjectItemCaseSensitive(e, "name");
+        if (cJSON_IsString(n) && !strcmp(n->valuestring, name)) return e;
+    }
+    return NULL;
+}
+
+int test_tree(void)
+{
+    sy_error err = {0};
+    server s;
+    web_big_tree = true;
+    if (web_start(&s, "127.0.0.1:0", "whitted", &err)) return 1;
+    sy_web_client *c = NULL;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    /* the first answer: the root's tree, at most WEB_TREE_MAX nodes, depth first */
+    cJSON *a = tree_answer(c, "{\"t\":\"tree\",\"seq\":1}");
+    CHECK(a);
+    const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(a, "nodes");
+    int listed = cJSON_GetArraySize(nodes);
+    double total = num(a, "total");
+    printf("tree: %.0f nodes, %d in the first answer\n", total, listed);
+    CHECK_MSG(total > 18022 && listed <= 4096 && listed > 100 && cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(a, "truncated")),
+              "total %g, listed %d", total, listed);
+    CHECK(num(a, "count") == 1 && num(a, "node") == 0 && num(a, "offset") == 0);
+    const cJSON *flat = named(nodes, "flat"), *deep = named(nodes, "deep");
+    CHECK(flat && deep);
+    CHECK(num(flat, "children") == 12000 && cJSON_IsFalse(cJSON_GetObjectItemCaseSensitive(flat, "open")));
+    CHECK(num(deep, "children") == 20 && cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(deep, "open")));
+    CHECK(!named(nodes, "flat 0"));
+    /* "deep"'s groups: listed, the first ones open (their 300 leaves follow), the last closed */
+    int open = 0, closed = 0;
+    uint32_t closed_id = 0;
+    for (int i = 0; i < 20; ++i) {
+        char nm[32];
+        snprintf(nm, sizeof nm, "leaf %d", i);
+        const cJSON *g = named(nodes, nm);
+        CHECK_MSG(g && num(g, "children") == 300 && num(g, "depth") == num(deep, "depth") + 1, "%s", nm);
+        bool op = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(g, "open"));
+        snprintf(nm, sizeof nm, "leaf %d 299", i);
+        CHECK_MSG(!!named(nodes, nm) == op, "leaf %d: open %d", i, op);
+        open += op, closed += !op;
+        if (!op && !closed_id) closed_id = (uint32_t)num(g, "id");
+    }
+    printf("tree: deep's groups: %d open, %d closed\n", open, closed);
+    CHECK(open >= 5 && closed >= 1);
+    uint32_t flat_id = (uint32_t)num(flat, "id");
+    cJSON_Delete(a);
+    /* "flat"'s children, a page at a time: each child once, in order */
+    char ask[128];
+    int seen = 0, pages = 0;
+    for (uint32_t off = 0; off < 12000; off += 512, ++pages) {
+        snprintf(ask, sizeof ask, "{\"t\":\"tree\",\"seq\":%u,\"node\":%u,\"offset\":%u}", 10 + pages, flat_id, off);
+        a = tree_answer(c, ask);
+        CHECK(a);
+        nodes = cJSON_GetObjectItemCaseSensitive(a, "nodes");
+        int n = cJSON_GetArraySize(nodes);
+        CHECK_MSG(num(a, "count") == 12000 && num(a, "node") == flat_id && num(a, "offset") == off && num(a, "seq") == 10 + pages &&
+                  n == (off + 512 <= 12000 ? 512 : 12000 - (int)off), "offset %u: %d nodes", off, n);
+        const cJSON *e;
+        cJSON_ArrayForEach(e, nodes)
+        {
+            char nm[32];
+            snprintf(nm, sizeof nm, "flat %d", seen++);
+            const cJSON *name = cJSON_GetObjectItemCaseSensitive(e, "name");
+            CHECK_MSG(cJSON_IsString(name) && !strcmp(name->valuestring, nm) && num(e, "depth") == 0 && num(e, "children") == 0,
+                      "%s", nm);
+        }
+        cJSON_Delete(a);
+    }
+    CHECK(seen == 12000 && pages == 24);
+    /* past the end: no nodes */
+    snprintf(ask, sizeof ask, "{\"t\":\"tree\",\"seq\":50,\"node\":%u,\"offset\":12000}", flat_id);
+    a = tree_answer(c, ask);
+    CHECK(a && cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(a, "nodes")) == 0 && num(a, "count") == 12000);
+    cJSON_Delete(a);
+    /* the first closed group of "deep" on its own: its 300 leaves */
+    snprintf(ask, sizeof ask, "{\"t\":\"tree\",\"seq\":60,\"node\":%u}", closed_id);
+    a = tree_answer(c, ask);
+    CHECK(a && num(a, "count") == 300 && cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(a, "nodes")) == 300);
+    cJSON_Delete(a);
+    /* an unknown node: refused with the reason; bad fields: refused by the parser, the stream goes on */
+    char *t = NULL;
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":51,\"node\":4000000000}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "refused", &t, &err), err);
+    CHECK_MSG(strstr(t, "\"what\":\"tree\"") && strstr(t, "no node 4000000000"), "%s", t);
+    free(t);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"tree\",\"seq\":52,\"offset\":0.5}", &err), err);
+    a = tree_answer(c, "{\"t\":\"tree\",\"seq\":53}");
+    CHECK(a && num(a, "seq") == 53); /* the bad one got no answer */
+    cJSON_Delete(a);
+    sy_web_client_close(c);
+    web_big_tree = false;
     return web_stop(&s);
 }

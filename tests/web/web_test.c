@@ -149,13 +149,47 @@ static sy_result add_shrink_clip(sy_scene *s, sy_animation *shrink, sy_error *e)
     return r;
 }
 
+bool web_big_tree;
+
+/* A group named name under parent with count children named "name i", set at once. */
+static sy_result add_group(sy_scene *s, sy_node parent, const char *name, uint32_t count, sy_error *e)
+{
+    sy_node g, *ch = malloc((count ? count : 1) * sizeof *ch);
+    if (!ch) return sy_error_set(e, SY_ERR_OUT_OF_MEMORY, "big tree: out of memory");
+    sy_result r = sy_node_create(s, name, &g, e);
+    for (uint32_t i = 0; r == SY_OK && i < count; ++i) {
+        char nm[64];
+        snprintf(nm, sizeof nm, "%s %u", name, i);
+        r = sy_node_create(s, nm, &ch[i], e);
+    }
+    if (r == SY_OK) r = sy_node_set_children(s, g, ch, count, e);
+    if (r == SY_OK) r = sy_node_add_child(s, parent, g, e);
+    free(ch);
+    return r;
+}
+
+static sy_result add_big_tree(sy_scene *s, sy_node root, sy_error *e)
+{
+    sy_result r = add_group(s, root, "flat", 12000, e);
+    sy_node deep;
+    if (r == SY_OK) r = sy_node_create(s, "deep", &deep, e);
+    if (r == SY_OK) r = sy_node_add_child(s, root, deep, e);
+    for (uint32_t i = 0; r == SY_OK && i < 20; ++i) {
+        char nm[32];
+        snprintf(nm, sizeof nm, "leaf %u", i);
+        r = add_group(s, deep, nm, 300, e);
+    }
+    return r;
+}
+
 int web_start(server *s, const char *listen, const char *backend, sy_error *e)
 {
     memset(s, 0, sizeof *s);
     sy_demo_info demo;
     sy_animation shrink = {0};
     int failed = sy_scene_create(&s->scene, e) || sy_demo_build(s->scene, &demo, e) ||
-                 (web_read_only_anim && add_shrink_clip(s->scene, &shrink, e)) || sy_scene_commit(s->scene, NULL, e);
+                 (web_read_only_anim && add_shrink_clip(s->scene, &shrink, e)) ||
+                 (web_big_tree && add_big_tree(s->scene, demo.root, e)) || sy_scene_commit(s->scene, NULL, e);
     if (!failed) {
         static const sy_web_route routes[] = {{"GET", "/api/object/", route_info, NULL},
                                               {"POST", "/api/echo", route_echo, NULL},

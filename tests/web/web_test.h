@@ -70,6 +70,9 @@ typedef struct server {
 extern bool web_read_only;
 /* web_timeline: the demo gets a clip "shrink" (every mesh node's scale to 1 % over 2 s). */
 extern bool web_read_only_anim;
+/* web_tree: the demo's root gets a group "flat" of 12,000 children and a group "deep" of 20 groups
+ * of 300 children each (18,022 nodes more). */
+extern bool web_big_tree;
 /* The demo scene served on listen by backend from a thread of its own, with the test routes
  * GET /api/object/ (path and query), POST /api/echo (body length and byte sum) and GET /api/block
  * (below); 1 after printing why not. */
@@ -108,5 +111,6 @@ int test_messages(void);
 int test_scene(uint16_t port);
 int test_readonly(void);
 int test_timeline(void);
+int test_tree(void);
 
 #endif /* SY_TEST_WEB_TEST_H */
