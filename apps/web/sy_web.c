@@ -266,6 +266,16 @@ void sy_web_view(const sy_web *w, sy_mat4 *camera_to_world, sy_node *camera)
     if (camera) *camera = w->d.camera;
 }
 
+void sy_web_look(const sy_web *w, sy_background *world, float *exposure_stops)
+{
+    pthread_mutex_t *mu = (pthread_mutex_t *)&w->mu; /* the lock only: nothing of w changes */
+    pthread_mutex_lock(mu);
+    uint32_t env = w->environment;
+    *exposure_stops = w->exposure;
+    pthread_mutex_unlock(mu);
+    *world = env > 0 && env < SY_WEB_ENVIRONMENTS ? w->env_made[env] : w->d.background; /* env_made: the render thread's */
+}
+
 uint16_t sy_web_port(const sy_web *w) { return (uint16_t)w->port; }
 
 const char *sy_web_url(const sy_web *w) { return w->url; }

@@ -148,6 +148,11 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err);
  * (core/sy_interactive.h): it adds no node to the scene. Call on the render
  * thread (a route handler). */
 void sy_web_view(const sy_web *w, sy_mat4 *camera_to_world, sy_node *camera);
+/** What the view is lit and shown with beyond the scene: world, the background object the
+ * server's viewports use now (the environment menu's choice: the start world, or the one the
+ * server made for "studio" / "none"; {0}: none), and exposure_stops, the display chain's exposure
+ * (before ACES tone mapping and sRGB). Call on the render thread (a route handler). */
+void sy_web_look(const sy_web *w, sy_background *world, float *exposure_stops);
 /** The server's counters (any thread): connections (sy_web_gate.h) and stills. */
 typedef struct sy_web_stats {
     /** @{ connections accepted, handed to the HTTP server, refused, evicted and expired while

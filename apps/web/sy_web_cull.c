@@ -1,9 +1,11 @@
 /* sy_web_cull.c — remote culling over sy_web: the route handlers of POST /api/cull, GET
- * /api/object/ID, GET /api/view and GET /client/... (see sy_web_cull.h). */
+ * /api/object/ID, GET /api/view, GET /api/environment and GET /client/... (see sy_web_cull.h). */
 #define _XOPEN_SOURCE 700 /* realpath */
 #include "sy_web_cull.h"
 
+#include "sy_blob.h"
 #include "sy_cull.h"
+#include "sy_look.h"
 #include "sy_orbit.h"
 
 #include <cjson/cJSON.h>
@@ -82,6 +84,87 @@ static sy_result on_object(void *user, sy_scene *scene, const sy_web_request *re
     return SY_OK;
 }
 
+/* The look the server's view has now (sy_look_resolve on the scene as the mirrors count it: a
+ * light placed on a visible node, a material whose emission exceeds 1) and its exposure. */
+static void view_look(const sy_web_cull *c, sy_scene *scene, sy_look *look, float *exposure)
+{
+    sy_background world = {0};
+    sy_web_look(c->server, &world, exposure);
+    const sy_background_data *bd = world.id ? sy_background_get(scene, world) : NULL;
+    const sy_texture_data *env = bd && bd->environment.id ? sy_texture_get(scene, bd->environment) : NULL;
+    sy_look_inputs in = {.world = bd, .world_env_ready = env && env->pixels};
+    for (uint32_t id = sy_scene_next(scene, SY_TYPE_NODE, 0); id; id = sy_scene_next(scene, SY_TYPE_NODE, id)) {
+        const sy_node_data *nd = sy_node_get(scene, (sy_node){id});
+        if (nd && nd->light.id && (nd->flags & SY_NODE_VISIBLE)) in.light_count++;
+    }
+    for (uint32_t id = sy_scene_next(scene, SY_TYPE_MATERIAL, 0); id; id = sy_scene_next(scene, SY_TYPE_MATERIAL, id)) {
+        const sy_material_data *md = sy_material_get(scene, (sy_material){id});
+        for (int k = 0; md && k < 3; ++k)
+            if (md->emissive[k] * md->emissive_strength > 1.0f) {
+                in.emitter_count++;
+                break;
+            }
+    }
+    sy_look_resolve(&in, look);
+}
+
+/* GET /api/environment: the environment light of the view now, as /api/view's "look" describes it:
+ * a lat-long image of little-endian float32 linear RGB, row 0 up (sy_look.h's convention), before
+ * the look's intensity: the library's studio (sy_look_studio_pixels), or the world's texture when it
+ * is float RGB or RGBA; 404 when the view has no environment or one not served. */
+static sy_result on_environment(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+{
+    (void)req;
+    sy_web_cull *c = user;
+    if (!c->server) return sy_error_set(err, SY_ERR_NOT_FOUND, "/api/environment: no server attached");
+    sy_look look;
+    float exposure;
+    view_look(c, scene, &look, &exposure);
+    const sy_texture_data *t = look.env == SY_LOOK_ENV_TEXTURE ? sy_texture_get(scene, (sy_texture){look.env_texture}) : NULL;
+    if (look.env == SY_LOOK_ENV_TEXTURE &&
+        (!t || !t->pixels || t->info.format != SY_PIXEL_F32 || t->info.channels < 3 || !t->info.width || !t->info.height ||
+         sy_blob_size(t->pixels) < (size_t)t->info.width * t->info.height * t->info.channels * sizeof(float)))
+        return sy_error_set(err, SY_ERR_NOT_FOUND, "/api/environment: the world's environment texture is not float RGB(A): not served");
+    if (look.env != SY_LOOK_ENV_STUDIO && look.env != SY_LOOK_ENV_TEXTURE)
+        return sy_error_set(err, SY_ERR_NOT_FOUND, "/api/environment: the view has no environment light");
+    uint32_t w = t ? t->info.width : SY_LOOK_STUDIO_WIDTH, h = t ? t->info.height : SY_LOOK_STUDIO_HEIGHT;
+    float *rgb = malloc((size_t)w * h * 3 * sizeof *rgb);
+    if (!rgb) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "/api/environment: out of memory");
+    if (t) {
+        const float *src = sy_blob_data(t->pixels);
+        for (size_t i = 0; i < (size_t)w * h; ++i)
+            for (int k = 0; k < 3; ++k) rgb[3 * i + k] = src[t->info.channels * i + k];
+    } else {
+        sy_look_studio_pixels(w, h, rgb);
+    }
+    resp->status = 200;
+    snprintf(resp->content_type, sizeof resp->content_type, "application/octet-stream");
+    resp->body = (uint8_t *)rgb; /* x86 and ARM: little-endian */
+    resp->body_len = (size_t)w * h * 3 * sizeof *rgb;
+    return SY_OK;
+}
+
+/* /api/view's "look": what lights the view and how it is shown, for a client that draws it itself:
+ * {"environment": "studio" | "texture" | "none", "width", "height" (GET /api/environment's image),
+ * "intensity", "exposure" (stops), "tonemap": "aces" (sy_post.c's curve), "srgb": true}. */
+static bool add_look(const sy_web_cull *c, sy_scene *scene, cJSON *o)
+{
+    sy_look look;
+    float exposure;
+    view_look(c, scene, &look, &exposure);
+    const sy_texture_data *t = look.env == SY_LOOK_ENV_TEXTURE ? sy_texture_get(scene, (sy_texture){look.env_texture}) : NULL;
+    cJSON *l = cJSON_AddObjectToObject(o, "look");
+    if (!l) return false;
+    const char *env = look.env == SY_LOOK_ENV_STUDIO ? "studio" : look.env == SY_LOOK_ENV_TEXTURE ? "texture" : "none";
+    cJSON_AddStringToObject(l, "environment", env);
+    cJSON_AddNumberToObject(l, "width", t ? t->info.width : look.env == SY_LOOK_ENV_STUDIO ? SY_LOOK_STUDIO_WIDTH : 0);
+    cJSON_AddNumberToObject(l, "height", t ? t->info.height : look.env == SY_LOOK_ENV_STUDIO ? SY_LOOK_STUDIO_HEIGHT : 0);
+    cJSON_AddNumberToObject(l, "intensity", look.env ? look.env_intensity : 0);
+    cJSON_AddNumberToObject(l, "exposure", exposure);
+    cJSON_AddStringToObject(l, "tonemap", "aces");
+    return cJSON_AddBoolToObject(l, "srgb", true) != NULL;
+}
+
 /* GET /api/view: the server's camera as /api/cull takes it, plus the orbit target (sy_orbit's:
  * the root's bounds centre projected on the viewing axis) for a client's orbit controls. */
 static sy_result on_view(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
@@ -126,7 +209,7 @@ static sy_result on_view(void *user, sy_scene *scene, const sy_web_request *req,
     double target[3] = {orbit.target[0], orbit.target[1], orbit.target[2]};
     if (o && cJSON_AddItemToObject(o, "position", cJSON_CreateDoubleArray(pos, 3)) &&
         cJSON_AddItemToObject(o, "orientation", cJSON_CreateDoubleArray(q, 4)) && cJSON_AddNumberToObject(o, "fov", fov) &&
-        cJSON_AddItemToObject(o, "target", cJSON_CreateDoubleArray(target, 3))) {
+        cJSON_AddItemToObject(o, "target", cJSON_CreateDoubleArray(target, 3)) && add_look(c, scene, o)) {
         char *text = cJSON_PrintUnformatted(o);
         cJSON_Delete(o);
         return take_text(text, "application/json", resp, err);
@@ -224,6 +307,7 @@ sy_result sy_web_cull_create(sy_scene *scene, sy_node root, const char *client_d
     routes[n++] = (sy_web_route){"GET", "/api/object/", on_object, c};
     routes[n++] = (sy_web_route){"GET", "/api/view", on_view, c};
     routes[n++] = (sy_web_route){"GET", "/api/pose", on_pose, c};
+    routes[n++] = (sy_web_route){"GET", "/api/environment", on_environment, c};
     if (client_dir) routes[n++] = (sy_web_route){"GET", "/client/", on_client, c};
     *count = n;
     *out = c;

@@ -7,7 +7,11 @@
  *   GET  /api/object/ID   one object's geometry and material as GLB (404 for unknown ids)
  *   GET  /api/view        the server's current view as JSON, in the form /api/cull takes
  *                         ({"position", "orientation", "fov", "target"}): the client page starts
- *                         from the view every other back-end starts from
+ *                         from the view every other back-end starts from; and "look": the
+ *                         environment light (studio, texture, none; the image's size), its
+ *                         intensity, the exposure and the tone mapping the stream applies
+ *   GET  /api/environment that environment as float32 RGB lat-long (row 0 up): the client lights
+ *                         with the light the back-ends use (404 when there is none)
  *   GET  /api/pose        the objects that moved since the load (the scene clock: the page's
  *                         timeline), each placement's world matrix (sy_culler_poses_json)
  *   GET  /client/...      the three.js client page (client.html, client.js, vendor/: the vendored
@@ -30,7 +34,7 @@ extern "C" {
 #endif
 
 /** Routes sy_web_cull_create fills at most. */
-#define SY_WEB_CULL_MAX_ROUTES 5
+#define SY_WEB_CULL_MAX_ROUTES 6
 
 /** The culling routes of one server (opaque). */
 typedef struct sy_web_cull sy_web_cull;

@@ -31,7 +31,10 @@
  *   web_slowloris 100 reconnecting slowloris connections; an honest client's 20 GETs all answered
  *   web_stillbudget  stills queue behind a held render thread: the per-client pixel budget (429),
  *                 another client's own budget, a still whose requester left is not rendered
- *   web_clientfiles  /client/ serves client.html, client.js and vendor/ only, not npm/
+ *   web_clientfiles  /client/ serves client.html, client.js and vendor/ only, not npm/; /api/view's
+ *                 "look" names no environment for the demo (it brings lights; /api/environment:
+ *                 404), the studio's float texture once the menu chose it (/api/environment: its
+ *                 256 x 128 float RGB, the sky row brighter than the floor's)
  *   web_messages  the page's scene messages (pick, visible, select, isolate, clip, tree, exposure,
  *                 filter, time, play) are parsed as documented; picks outside the canvas, NaN, zero-normal and
  *                 infinite planes, 7 planes, node ids that are no whole number, bad names, times

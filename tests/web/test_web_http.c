@@ -161,6 +161,37 @@ int test_client_files(void)
         if (want[i] == 200) CHECK(!strcmp((char *)a.body, files[i]));
         free(a.body);
     }
+    /* the look: what lights the view (/api/view) and its environment's image (/api/environment).
+     * The demo brings lights: no environment (404); the menu's studio: the world the server made,
+     * a float texture of the studio, served as float RGB of the size the look names, its top row
+     * (the sky) brighter than its bottom row (the floor) */
+    http_answer a;
+    CHECK(web_get(port, "/api/view", NULL, &a) == 0 && a.status == 200);
+    const char *look = a.body ? strstr((char *)a.body, "\"look\":{") : NULL;
+    CHECK_MSG(look && strstr(look, "\"environment\":\"none\"") && strstr(look, "\"tonemap\":\"aces\"") &&
+              strstr(look, "\"exposure\":0"), "%s", (char *)a.body);
+    free(a.body);
+    CHECK(web_get(port, "/api/environment", NULL, &a) == 0 && a.status == 404);
+    free(a.body);
+    sy_web_client *c = NULL;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = port, .path = "/ws"};
+    char *t = NULL;
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"environment\",\"name\":\"studio\"}", &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "scene", &t, &err), err);
+    free(t);
+    CHECK(web_get(port, "/api/view", NULL, &a) == 0 && a.status == 200);
+    look = a.body ? strstr((char *)a.body, "\"look\":{") : NULL;
+    CHECK_MSG(look && strstr(look, "\"environment\":\"texture\"") && strstr(look, "\"width\":256") &&
+              strstr(look, "\"height\":128") && strstr(look, "\"intensity\":1,"), "%s", (char *)a.body);
+    free(a.body);
+    CHECK(web_get(port, "/api/environment", NULL, &a) == 0 && a.status == 200 && a.body_len == 256u * 128u * 3u * sizeof(float));
+    const float *env = (const float *)a.body;
+    double top = 0, bottom = 0;
+    for (int i = 0; i < 256 * 3; ++i) top += env[i], bottom += env[127 * 256 * 3 + i];
+    CHECK_MSG(top > 1.5 * bottom && bottom > 0, "rows: top %g, bottom %g", top, bottom);
+    free(a.body);
+    sy_web_client_close(c);
     /* the culler after the server, before the scene */
     s.r = sy_web_thread_join(s.th, &s.err);
     sy_web_destroy(s.web);

@@ -19,12 +19,12 @@
 //   lastAnswer (the parsed JSON), cameraJSON() (the view as sent), setView(position, target)
 //   (moves the camera and re-asks), cull() (re-asks now), timeline() (shown, time, start, end,
 //   playing, poses applied, poseTime: the paused clock's time the last pose was asked at),
-//   setTime(seconds), play(on).
+//   setTime(seconds), play(on), look (/api/view's "look": the server's environment, intensity and
+//   exposure), environment (the one lighting the page: studio, texture, none).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
-import { RoomEnvironment } from 'three/addons/environments/RoomEnvironment.js';
 
 const params = new URLSearchParams(window.location.search);
 const token = params.get('token');
@@ -42,14 +42,51 @@ const overlay = document.getElementById('overlay');
 const renderer = new THREE.WebGLRenderer({ canvas, antialias: true });
 renderer.setPixelRatio(window.devicePixelRatio || 1);
 // The look of every back-end (docs/BACKENDS.md, one scene, one look): the objects come without
-// lights, so they are lit as sy lights a scene that brings none, by a neutral studio environment
-// (three's RoomEnvironment, prefiltered), over the default black background, ACES tone mapping as
-// the streamed view.
-renderer.toneMapping = THREE.ACESFilmicToneMapping;
+// lights, so they are lit as the server's view is, by the environment GET /api/view's "look" names
+// (the library's studio, sy_look_studio_pixels, or the world's float texture: GET /api/environment,
+// prefiltered by three's PMREM) at its intensity, over the default black background; the display
+// chain is the library's (sy_post.c): exposure, its ACES curve (not three's ACESFilmic, a
+// different fit), sRGB.
+THREE.ShaderChunk.tonemapping_pars_fragment = THREE.ShaderChunk.tonemapping_pars_fragment.replace(
+  'vec3 CustomToneMapping( vec3 color ) { return color; }',
+  'vec3 CustomToneMapping( vec3 color ) {\n\tcolor *= toneMappingExposure;\n' +
+  '\treturn saturate( ( color * ( 2.51 * color + 0.03 ) ) / ( color * ( 2.43 * color + 0.59 ) + 0.14 ) );\n}');
+renderer.toneMapping = THREE.CustomToneMapping;
 const scene = new THREE.Scene();
 scene.background = new THREE.Color(0x000000);
-scene.environment = new THREE.PMREMGenerator(renderer).fromScene(new RoomEnvironment(), 0.04).texture;
-scene.environmentIntensity = 0.55; // the studio environment's level: mean luminance within 1 % of sy render -b raster (MetalRoughSpheresNoTextures, ACES)
+
+// The look's environment image (float32 RGB, row 0 up, sy_look.h's lat-long: u = 0.5 + atan2(x, -z)
+// / 2 pi) as three's equirect texture (row 0 down, u = 0.5 + atan2(z, x) / 2 pi: a quarter turn).
+function equirect(rgb, w, h) {
+  const data = new Float32Array(w * h * 4), shift = Math.round(w / 4);
+  for (let j = 0; j < h; j++) {
+    for (let i = 0; i < w; i++) {
+      const s = 3 * ((h - 1 - j) * w + (i + shift) % w), d = 4 * (j * w + i);
+      data[d] = rgb[s]; data[d + 1] = rgb[s + 1]; data[d + 2] = rgb[s + 2]; data[d + 3] = 1;
+    }
+  }
+  const t = new THREE.DataTexture(data, w, h, THREE.RGBAFormat, THREE.FloatType);
+  t.mapping = THREE.EquirectangularReflectionMapping;
+  t.magFilter = t.minFilter = THREE.LinearFilter;
+  t.needsUpdate = true;
+  return t;
+}
+
+async function applyLook(look) {
+  state.look = look;
+  renderer.toneMappingExposure = Math.pow(2, look.exposure || 0);
+  scene.environment = null;
+  if (look.environment === 'none' || !(look.width > 0 && look.height > 0)) return;
+  const response = await fetch(withToken('/api/environment'));
+  if (!response.ok) throw new Error(`environment: ${response.status} ${await response.text()}`);
+  const rgb = new Float32Array(await response.arrayBuffer());
+  if (rgb.length !== look.width * look.height * 3) throw new Error(`environment: ${rgb.length} floats, not ${look.width} x ${look.height} x 3`);
+  const tex = equirect(rgb, look.width, look.height);
+  scene.environment = new THREE.PMREMGenerator(renderer).fromEquirectangular(tex).texture;
+  tex.dispose();
+  scene.environmentIntensity = look.intensity;
+  state.environment = look.environment;
+}
 const camera = new THREE.PerspectiveCamera(60, 1, 0.05, 1e6);
 camera.position.set(0, 0, 10);
 const controls = new OrbitControls(camera, canvas);
@@ -61,7 +98,7 @@ const pending = new Map(); // id -> Promise (being fetched)
 const state = {
   requested: [], loaded: [], visible: [], triangles: 0, fetched_triangles: 0, bytes: 0,
   total_objects: 0, total_triangles: 0, queries: 0, fetches: 0, errors: [], idle: false, lastAnswer: null,
-  frames: 0, renderPending: false,
+  frames: 0, renderPending: false, look: null, environment: 'none',
 };
 const triangleCount = new Map(); // id -> triangles (from the answers)
 let framed = false;
@@ -413,6 +450,12 @@ try {
   if (response.ok) serverView = await response.json();
 } catch (e) {
   serverView = null;
+}
+try {
+  // an older server says nothing of its look: the studio would be a guess, so no environment
+  if (serverView && serverView.look) await applyLook(serverView.look);
+} catch (e) {
+  showError(String(e.message || e));
 }
 resize();
 connectClock();
