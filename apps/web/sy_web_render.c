@@ -361,13 +361,14 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
     return SY_OK;
 }
 
-/* A video viewer joined a view at rest: the newest frame again under a new number, with its pixels
- * (the frame as it was: no new render, a progressive back-end keeps its samples). */
+/* A video viewer joined a view at rest (or took video after its first frames): the newest frame
+ * again under a new number, with its pixels (the frame as it was: no new render, a progressive
+ * back-end keeps its samples). */
 static void republish_with_pixels(sy_web *w, render_state *rs)
 {
     pthread_mutex_lock(&w->mu);
     web_frame *cur = w->latest;
-    bool go = cur && !cur->rgba && rs->last_px && rs->last_px_seq == cur->seq;
+    bool go = cur && rs->last_px && rs->last_px_seq == cur->seq;
     if (go) cur->refs++;
     pthread_mutex_unlock(&w->mu);
     if (!go) return;
@@ -409,27 +410,50 @@ static void render_live(sy_web *w, render_state *rs, const sy_interactive_input 
     }
 }
 
-/* Before the first page: the initial back-end translates the scene (a 16 x 16 frame of the start
- * view, thrown away), so that a page's first picture costs one coarse frame of the governor, not
- * the translation (DamagedHelmet with Whitted: 4.8 s before anything showed). Logged with its time;
- * a failure is only logged (the live frames report it to the pages). */
+/* Before the first page: the initial back-end translates the scene with the governor's first frame
+ * of the start view for the largest display (a quarter of -w x -h, the preview level; thrown away),
+ * so that a page's first picture costs one coarse frame, not the translation (DamagedHelmet with
+ * Whitted: 4.8 s before anything showed), and what a back-end sizes by the frame is made too; then
+ * renders that frame again and reports its time to the governor, so the page's first frame is
+ * planned with a cost model (within the budget) rather than at the quarter size blind (the
+ * rasterizer's 256 x 192 frame of DamagedHelmet took 2.1-3.2 s on the loaded 2-core machine).
+ * Logged with its times; a failure is only logged (the live frames report it to the pages). */
 static void warm_up(sy_web *w, render_state *rs)
 {
     pthread_mutex_lock(&w->mu);
     sy_orbit o = w->in.orbit;
+    uint64_t fv = w->in.filter_version;
     pthread_mutex_unlock(&w->mu);
-    sy_mat4 view;
-    sy_orbit_matrix(&o, &view);
-    sy_viewport_set_view(rs->vp, &view);
-    double t0 = sy_time_now();
-    uint8_t *px = NULL;
+    const sy_mediator_class *cls = sy_mediator_at(rs->backend_applied);
+    const char *name = cls ? cls->name : "?";
     sy_error err = {0};
-    const char *name = sy_mediator_at(rs->backend_applied) ? sy_mediator_at(rs->backend_applied)->name : "?";
-    if (render_rgba8(w, rs, rs->win, 16, 16, 1, SY_GOVERNOR_PREVIEW, &px, NULL, &err) != SY_OK)
+    if (!cls) return;
+    sy_interactive_view iv = {.orbit = &o, .viewports = &rs->vp, .viewport_count = 1, .backend = cls,
+                              .caps = sy_mediator_class_caps(cls, NULL), .width = w->d.max_width,
+                              .height = w->d.max_height, .filter_version = fv};
+    sy_governor_frame gf;
+    sy_interactive_plan(rs->ia, &iv, sy_time_now() * 1e3, &gf, &w->view);
+    uint32_t fw = gf.width > 16 ? gf.width : 16, fh = gf.height > 16 ? gf.height : 16;
+    double t0 = sy_time_now(), ms[2] = {0, 0};
+    sy_result r = SY_OK;
+    for (int k = 0; k < 2 && r == SY_OK; ++k) {
+        uint8_t *px = NULL;
+        float *depth = NULL; /* asked for as the live frames ask for it */
+        double t = sy_time_now();
+        r = render_rgba8(w, rs, rs->win, fw, fh, gf.samples ? gf.samples : 1, gf.preview > 0 ? gf.preview : 1.0f, &px,
+                         &depth, &err);
+        ms[k] = (sy_time_now() - t) * 1e3;
+        free(px);
+        free(depth);
+    }
+    if (r != SY_OK) {
         sy_log(SY_LOG_WARNING, "web", NULL, "warming up %s: %s", name, err.message);
-    else
-        sy_log(SY_LOG_NOTE, "web", NULL, "ready: %s translated the scene in %.0f ms", name, (sy_time_now() - t0) * 1e3);
-    free(px);
+        return;
+    }
+    if (gf.width == fw && gf.height == fh) sy_interactive_report(rs->ia, &gf, ms[1], false);
+    rs->changed = true; /* the page's first frame is a moving one, whatever its size */
+    sy_log(SY_LOG_NOTE, "web", NULL, "ready: %s translated the scene in %.0f ms (a first frame of %ux%u: %.0f ms)", name,
+           (sy_time_now() - t0) * 1e3 - ms[1], fw, fh, ms[1]);
 }
 
 sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
@@ -511,8 +535,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         }
         bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
         if (clients && (moved || due)) render_live(w, &rs, &in, bi, dw, dh, gen, &again, &wait_until);
-        /* after render_live, which may have rendered nothing (a view at rest): a no-op when the
-         * newest frame has its pixels */
+        /* after render_live, which may have rendered nothing (a view at rest) */
         if (need_pixels) republish_with_pixels(w, &rs);
         /* then one still: stills wait behind the live view */
         pthread_mutex_lock(&w->mu);

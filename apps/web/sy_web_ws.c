@@ -132,6 +132,14 @@ static void choose_codec(sy_web *w, web_conn *c, const sy_web_input *in)
         }
     }
     c->codec = pick, c->want_key = true;
+    if (pick != SY_WEB_CODEC_JPEG && c->sized) {
+        /* a page that lists its codecs after its first size (view.js, once video.js knows them),
+         * maybe while the view rests: the newest frame again, with its pixels, under a new number */
+        pthread_mutex_lock(&w->mu);
+        w->need_pixels = true;
+        pthread_cond_signal(&w->cv);
+        pthread_mutex_unlock(&w->mu);
+    }
     sy_log(SY_LOG_NOTE, "web", c->peer, "the viewer is sent %s", sy_web_codec_name(pick));
 }
 
@@ -143,6 +151,29 @@ static void ws_warn(web_conn *c, const char *what, const char *detail)
     c->warned++;
     sy_log(SY_LOG_WARNING, "web", c->peer, "ignored a message: %s%s%.80s%s", what, detail ? ": " : "", detail ? detail : "",
            c->warned == 10 ? " (further ones from this client are not logged)" : "");
+}
+
+static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len);
+
+/* The first size message in the URL (/ws?w=W&h=H&v=V; docs/WEB.md, "The first picture"): the page
+ * that cannot send it yet (its scripts still load) gets its first frame rendered meanwhile. Taken
+ * as that message (sy_web_parse_input judges it); no or a malformed size: the page sends its own. */
+static void size_from_url(sy_web *w, web_conn *c, struct lws *wsi)
+{
+    head_bufs b;
+    sy_web_head h;
+    sy_webi_read_head(wsi, &b, &h);
+    const char *names[3] = {"w", "h", "v"}, *val[3];
+    size_t n[3];
+    for (int i = 0; i < 3; ++i) {
+        if (!h.query || !sy_web_query_arg(h.query, names[i], &val[i], &n[i]) || n[i] < 1 || n[i] > 6) return;
+        for (size_t k = 0; k < n[i]; ++k)
+            if (val[i][k] < '0' || val[i][k] > '9') return;
+    }
+    char m[96];
+    int len = snprintf(m, sizeof m, "{\"t\":\"size\",\"w\":%.*s,\"h\":%.*s,\"v\":%.*s}", (int)n[0], val[0], (int)n[1], val[1],
+                       (int)n[2], val[2]);
+    if (len > 0 && (size_t)len < sizeof m) ws_message(w, c, m, (size_t)len);
 }
 
 /* One input message (JSON text; docs/WEB.md; parsed by sy_web_parse_input). Malformed ones are
@@ -254,10 +285,12 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
             lws_callback_on_writable(c->wsi);
             return;
         }
+        /* a viewer's first size, or another size: frames for it; the same size again (the page
+         * lists its video codecs once it knows them) renders nothing new */
+        if (!c->sized || w->display_w != (uint32_t)in.a || w->display_h != (uint32_t)in.b) w->view_version++;
         c->old_page = false, c->sized = true;
         set_kind(w, c, c->codec == SY_WEB_CODEC_JPEG ? 1 : 2);
         w->display_w = (uint32_t)in.a, w->display_h = (uint32_t)in.b;
-        w->view_version++;
         break;
     case SY_WEB_INPUT_DRAG: sy_interactive_drag(&w->in, in.button >= 1 ? 1 : 0, (float)in.a, (float)in.b); break;
     case SY_WEB_INPUT_WHEEL: sy_interactive_wheel(&w->in, (float)in.a); break;
@@ -690,6 +723,7 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
         pthread_cond_signal(&w->cv);
         pthread_mutex_unlock(&w->mu);
         sy_log(SY_LOG_NOTE, "web", c->peer, "viewer connected");
+        size_from_url(w, c, wsi);
         lws_callback_on_writable(wsi);
         return 0;
     case LWS_CALLBACK_CLOSED:

@@ -44,9 +44,13 @@
 //     not a number) that the server refuses.
 //   node browser.mjs first URL OUTDIR WIDTH HEIGHT
 //     Time to first picture (a measurement, not a check): from the navigation's start to the first
-//     display frame after the page adopted a server frame (its size: the governor's coarse first
-//     frame), then to the first full-size frame; OUTDIR/first.png. Prints {picture_ms, width,
-//     height, backend, dom_ms, full_ms}.
+//     display frame showing a server frame (its size: the governor's coarse first frame), as
+//     index.html's image (image_ms) or on view.js's canvas (canvas_ms), picture_ms the earlier;
+//     then to the first full-size frame; OUTDIR/first.png (what showed first). Prints {picture_ms,
+//     image_ms, canvas_ms, width, height, backend, render_ms, dom_ms, response_ms, marks (the
+//     performance marks sy-connect, -open, -size, -frame-received, -first-image, -frame-adopted), full_ms}.
+//     SY_FIRST_WARM=1: the browser loads a page of the origin (a 404) and makes a WebGL2 context
+//     first (a browser in use), else the page is the fresh browser's first.
 //   node browser.mjs converge URL OUTDIR WIDTH HEIGHT
 //     A still view of the path tracer (sy web -b pathtracer): the canvas of the first full-size
 //     frame (OUTDIR/early.png) and once the server's frames have 16 times its samples, at least 64
@@ -135,22 +139,36 @@ try {
   if (mode === 'first') { // from the navigation's start: the first display frame after the first server frame was adopted
     await page.addInitScript(() => {
       window.__first = {};
+      // the first picture: index.html's image of the first frame (syEarly.picture_ms: the display
+      // frame after it loaded) or view.js's first frame on the canvas, whichever came first
       const poll = () => {
-        const s = window.syStats, f = window.__first;
-        if (s && s.frames > 0 && !f.picture_ms) { f.picture_ms = performance.now(); f.width = s.width; f.height = s.height; f.backend = s.backend; }
-        if (!f.picture_ms) requestAnimationFrame(poll);
+        const s = window.syStats, f = window.__first, e = window.syEarly;
+        if (e && e.picture_ms && !f.image_ms) f.image_ms = e.picture_ms;
+        if (s && s.frames > 0 && !f.canvas_ms) { f.canvas_ms = performance.now(); f.width = s.width; f.height = s.height; f.backend = s.backend; f.render_ms = s.renderMs; }
+        if ((f.image_ms || f.canvas_ms) && !f.picture_ms) f.picture_ms = Math.min(f.image_ms || Infinity, f.canvas_ms || Infinity);
+        if (!f.canvas_ms) requestAnimationFrame(poll);
       };
       requestAnimationFrame(poll);
     });
+  }
+  if (mode === 'first' && process.env.SY_FIRST_WARM) {
+    // a browser that has been used: one page of the origin (a 404) with a WebGL2 context before, so
+    // the renderer and GPU processes (SwiftShader) are up when the page is requested
+    await page.goto(new URL('/warm-up', url).href, { timeout: TIMEOUT });
+    await page.evaluate(() => !!document.createElement('canvas').getContext('webgl2'));
   }
   await page.goto(url, { timeout: TIMEOUT });
 
   if (mode === 'first') {
     // time to first picture (not a test: printed for docs/WEB.md): the page's clock from the navigation start
     await page.waitForFunction(() => window.__first && window.__first.picture_ms > 0, null, { timeout: TIMEOUT, polling: 50 });
-    const first = await page.evaluate(() => Object.assign({}, window.__first, {
-      dom_ms: performance.getEntriesByType('navigation')[0].domContentLoadedEventEnd }));
-    await page.screenshot({ path: join(outDir, 'first.png') });
+    await page.screenshot({ path: join(outDir, 'first.png') }); // what shows first
+    await page.waitForFunction(() => window.__first && window.__first.canvas_ms > 0, null, { timeout: TIMEOUT, polling: 50 });
+    const first = await page.evaluate(() => {
+      const nav = performance.getEntriesByType('navigation')[0], marks = {};
+      for (const m of performance.getEntriesByType('mark')) if (m.name.startsWith('sy-') && !(m.name.slice(3) in marks)) marks[m.name.slice(3)] = Math.round(m.startTime);
+      return Object.assign({}, window.__first, { dom_ms: nav.domContentLoadedEventEnd, response_ms: nav.responseEnd, marks: marks });
+    });
     // the refinement follows: a full-size frame
     await page.waitForFunction(([w, h]) => syStats.width === w && syStats.height === h, [width, height], { timeout: TIMEOUT });
     first.full_ms = await page.evaluate(() => performance.now());

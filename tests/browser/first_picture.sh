@@ -4,7 +4,8 @@
 # BACKEND, wait for its "ready" line (the back-end translated the scene), open the page in headless
 # chromium at W x H (browser.mjs first) and print the page's clock from the navigation's start to
 # the first display frame showing a server frame (its size: the governor's coarse first frame) and
-# to the first full-size frame.
+# to the first full-size frame. SY_FIRST_WARM=1: a browser in use (browser.mjs first: one page of
+# the origin and a WebGL2 context before), else the fresh browser's first page.
 #   first_picture.sh SY MODULES_DIR SCENE [W H [BACKEND...]]   (default 1024 768 raster whitted pathtracer)
 # MODULES_DIR: the build's tests/browser (browser.mjs and node_modules/playwright-core).
 set -u
@@ -23,7 +24,7 @@ for be in "${backends[@]}"; do
     for _ in $(seq 1 600); do grep -q "ready:\|warming up" "$out/err" && break; kill -0 $pid 2>/dev/null || break; sleep 0.1; done
     url=$(grep -o 'http://[^ ]*' "$out/log" | head -1)
     ready=$(grep -o "ready: .*" "$out/err" | head -1)
-    res=$(SY_CHROMIUM=$CHROMIUM node "$MODULES/browser.mjs" first "$url" "$out" "$W" "$H")
+    res=$(SY_CHROMIUM=$CHROMIUM SY_FIRST_WARM=${SY_FIRST_WARM:-} node "$MODULES/browser.mjs" first "$url" "$out" "$W" "$H")
     [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out/first.png" "$SY_BROWSER_KEEP/first_$be.png"
     echo "$be: $res ($ready)"
     kill -TERM $pid 2>/dev/null; wait $pid 2>/dev/null

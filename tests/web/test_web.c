@@ -13,7 +13,9 @@
  *   web_stream    a viewer receives JPEG frames; a drag message gives a frame tagged with its id that
  *                 differs from the one before; malformed messages are ignored and serving goes on;
  *                 a message over the limit closes that connection only; foreign Origin and missing
- *                 subprotocol upgrades are refused; a viewer beyond max_clients is refused
+ *                 subprotocol upgrades are refused; a viewer whose socket URL carries its size
+ *                 (/ws?w=120&h=90&v=3) gets frames without a size message, the first no larger,
+ *                 of that aspect; a viewer beyond max_clients is refused
  *   web_encodecost  the frame-time governor counts the encoders' time (sy_web_cost.h): a slow
  *                 encoder stub makes it pick a smaller moving frame that fits the budget with the
  *                 encode (simulated clock); --quality's video quantizer

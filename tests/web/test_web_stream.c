@@ -90,6 +90,18 @@ int test_stream(uint16_t port)
     evil.origin = own; /* the page's own origin is welcome */
     CHECK_OK(sy_web_client_connect(&evil, 10000, &c, &err), err);
     sy_web_client_close(c);
+    /* the first size in the URL (the page's inline script): frames without a size message, the
+     * first at most that size and of its aspect (the governor's), then the size itself */
+    sy_web_client_opts sized = o;
+    sized.path = "/ws?w=120&h=90&v=3";
+    CHECK_OK(sy_web_client_connect(&sized, 10000, &c, &err), err);
+    uint32_t firstw = 0, firsth = 0;
+    do {
+        CHECK_OK(sy_web_client_next_frame(c, 60000, &fi, NULL, NULL, &err), err);
+        if (!firstw) firstw = fi.width, firsth = fi.height;
+    } while (fi.width != 120 || fi.height != 90);
+    CHECK_MSG(firstw <= 120 && firsth <= 90 && labs((long)firstw * 90 - (long)firsth * 120) <= 120, "first frame %ux%u", firstw, firsth);
+    sy_web_client_close(c);
     char req[512];
     http_answer a;
     snprintf(req, sizeof req,

@@ -107,7 +107,7 @@
       const cb = el("input", { type: "checkbox", title: "visible" }, row);
       cb.checked = n.visible; cb.disabled = ro;
       cb.addEventListener("change", function () { sy.send({ t: "visible", node: n.id, on: cb.checked }); });
-      const icon = { mesh: "▣", light: "☀", camera: "◉", group: "▸" }[n.kind] || "·";
+      const icon = { mesh: "▣", light: "☀", camera: "◉", group: "◇" }[n.kind] || "·"; // ▸ / ▾: the expander
       const name = el("span", { style: "cursor: pointer;" + (n.visible ? "" : " color: #777;") }, row,
                       icon + " " + (n.name || "(node " + n.id + ")"));
       name.title = "node " + n.id + " (" + n.kind + ")";
@@ -118,8 +118,9 @@
       });
     }
     const shown = state.nodes.filter((n) => !n.more).length;
+    const more = state.nodes.some((n) => n.more || (n.children > 0 && !n.open));
     info.textContent = state.total + " node" + (state.total === 1 ? "" : "s") +
-                       (shown < state.total ? ", " + shown + " listed (▸ expands)" : "");
+                       (shown < state.total ? ", " + shown + " listed" + (more ? " (▸ expands)" : "") : "");
   }
   function showPick(m) {
     props.textContent = "";

@@ -385,6 +385,12 @@
         keep(hist.adopt, performance.now() - t0, 60);
         bmp.close();
         stats.frames++; stats.width = f.w; stats.height = f.h; stats.answeredInput = f.answered;
+        mark("sy-frame-adopted");
+        if (stats.frames === 1 && window.syEarly) { // the first picture's image gives way to the canvas
+          window.syEarly.adopted = true;
+          const img = document.getElementById("sy-first");
+          if (img) { img.style.display = "none"; if (img.src) URL.revokeObjectURL(img.src); }
+        }
         stats.samples = f.samples; stats.renderMs = f.renderMs;
         stats.backend = stats.backends[f.bi] || String(f.bi);
         hud.textContent = stats.backend + " | " + f.w + "x" + f.h + " | " + f.renderMs.toFixed(1) + " ms" +
@@ -521,7 +527,10 @@
     input: function (o) { input(o, null); },
     // a script that subscribes after the server's hello (the page's scripts load one by one while
     // the socket is open) is handed that hello at once
-    on: function (f) { listeners.push(f); if (lastHello) try { f(lastHello); } catch (err) { console.error(err); } },
+    on: function (f) { // a script that loads later gets the messages so far (while the page loads), else the hello
+      listeners.push(f);
+      for (const m of document.readyState === "loading" ? early : lastHello ? [lastHello] : []) try { f(m); } catch (err) { console.error(err); }
+    },
     project: function (p) {
       if (!refs.length) return null;
       const m = rigidInverse(orbitMatrix(sent.length ? localOrbit() : refs[0].orbit)), win = refs[0].win;
@@ -533,6 +542,7 @@
 
   const listeners = []; // window.sy.on: the server's text messages, parsed
   let lastHello = null;
+  const early = []; // the server's text messages while the page loads
   function send(o) {
     if (ws && ws.readyState === 1) ws.send(JSON.stringify(o));
   }
@@ -550,36 +560,57 @@
     asked.w = Math.max(asked.w, w); asked.h = Math.max(asked.h, h);
     moved = true;
     send({ t: "size", w: w, h: h, v: FORMAT, codecs: video ? video.codecs : undefined });
+    mark("sy-size");
   }
+  // the first picture's path, as performance marks (once each; tests/browser/first_picture.sh)
+  const marked = {};
+  function mark(name) { if (!marked[name]) { marked[name] = true; try { performance.mark(name); } catch (e) {} } }
+  // the socket: index.html's (window.syEarly: opened before the scripts loaded, its size sent, its
+  // messages so far replayed here), else a new one; the size goes at once (JPEG), again with the
+  // video codecs once video.js knows them (a same size: the server renders nothing new for it)
   function connect() {
-    ws = new WebSocket(wsUrl, "sy-view");
-    ws.binaryType = "arraybuffer";
+    const pre = window.syEarly;
+    if (pre && !pre.taken && !pre.closed) {
+      pre.taken = true;
+      ws = pre.ws;
+    } else {
+      mark("sy-connect");
+      ws = new WebSocket(wsUrl, "sy-view");
+      ws.binaryType = "arraybuffer";
+    }
     ws.onopen = function () {
+      mark("sy-open");
       stats.connected = true; lastSeq = -1; // a restarted server counts from 1 again
       asked.w = asked.h = 0;
       hud.textContent = gl ? "connected" : "connected (no WebGL2: server frames only)";
       if (video) { video.reset(); video.askKeyframe = function () { send({ t: "keyframe" }); }; }
-      (video ? video.ready : Promise.resolve()).then(sendSize);
+      sendSize();
+      if (video) video.ready.then(function () { if (video.codecs.length) sendSize(); });
     };
     ws.onclose = function (e) {
       stats.connected = false;
       hud.textContent = "disconnected (" + e.code + (e.reason ? ": " + e.reason : "") + "), retrying...";
       setTimeout(connect, 2000);
     };
-    ws.onmessage = function (e) {
-      if (typeof e.data === "string") {
-        try {
-          const m = JSON.parse(e.data);
-          if (m.t === "hello") stats.backends = m.backends, lastHello = m;
-          if (m.t === "status") { stats.filter = m.filter; if (m.error) hud.textContent = m.error; }
-          for (const f of listeners) try { f(m); } catch (err) { console.error(err); }
-        } catch (err) {}
-        return;
-      }
-      if (video) video.feed(e.data); // every video frame is decoded, in order, shown or not
-      const src = depthSource(e.data);
-      if (decoding) pending = { buf: e.data, src: src }; else show(e.data, src);
-    };
+    ws.onmessage = onMessage;
+    if (ws.readyState === 1) ws.onopen();
+    if (ws === (pre && pre.ws)) for (const m of pre.queue.splice(0)) onMessage(m);
+  }
+  function onMessage(e) {
+    if (typeof e.data === "string") {
+      try {
+        const m = JSON.parse(e.data);
+        if (m.t === "hello") stats.backends = m.backends, lastHello = m;
+        if (m.t === "status") { stats.filter = m.filter; if (m.error) hud.textContent = m.error; }
+        if (document.readyState === "loading") early.push(m); // for the scripts still to come
+        for (const f of listeners) try { f(m); } catch (err) { console.error(err); }
+      } catch (err) {}
+      return;
+    }
+    mark("sy-frame-received");
+    if (video) video.feed(e.data); // every video frame is decoded, in order, shown or not
+    const src = depthSource(e.data);
+    if (decoding) pending = { buf: e.data, src: src }; else show(e.data, src);
   }
   // mouse and touch: one pointer drags (left: orbit, right or shift: pan), the wheel zooms
   let drag = null;
