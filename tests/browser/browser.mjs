@@ -76,8 +76,8 @@ import { join } from 'node:path';
 
 const [mode, url, outDir, wArg, hArg] = process.argv.slice(2);
 const width = Number(wArg || 480), height = Number(hArg || 360);
-if (!['stream', 'client', 'client_timeline', 'warp', 'tools', 'video', 'timeline', 'first', 'converge'].includes(mode) || !url || !outDir) {
-  console.error('usage: node browser.mjs stream|client|client_timeline|warp|tools|video|timeline|first|converge URL OUTDIR [WIDTH HEIGHT]');
+if (!['stream', 'client', 'client_timeline', 'warp', 'tools', 'video', 'timeline', 'first', 'converge', 'tree'].includes(mode) || !url || !outDir) {
+  console.error('usage: node browser.mjs stream|client|client_timeline|warp|tools|video|timeline|first|converge|tree URL OUTDIR [WIDTH HEIGHT]');
   process.exit(2);
 }
 const executablePath = process.env.SY_CHROMIUM || '/usr/bin/chromium';
@@ -173,6 +173,46 @@ try {
     await page.waitForFunction(([w, h]) => syStats.width === w && syStats.height === h, [width, height], { timeout: TIMEOUT });
     first.full_ms = await page.evaluate(() => performance.now());
     console.log(JSON.stringify(first));
+    await browser.close();
+    process.exit(0);
+  }
+  if (mode === 'tree') {
+    // the scene tree a page at a time (tree.js): browser_test.sh tree's generated scene
+    const rows = () => page.locator('#sy-tree [data-node]').count();
+    const settled = (v) => page.waitForFunction((x) => sy.ui.tree.version > x && !sy.ui.tree.pending, v, { timeout: TIMEOUT });
+    await page.waitForFunction(() => window.sy && sy.ui && sy.ui.tree && sy.ui.tree.version > 0, null, { timeout: TIMEOUT });
+    const res = { total: await page.evaluate(() => sy.ui.tree.total) };
+    const flat = await page.evaluate(() => { const n = sy.ui.tree.nodes.find((x) => x.name === 'flat'); return n && { id: n.id, children: n.children, open: n.open }; });
+    if (!flat || flat.children !== 12000 || flat.open) fail(`the group "flat" is not listed closed with 12000 children: ${JSON.stringify(flat)}`);
+    if (!(res.total > 12000)) fail(`the tree has ${res.total} nodes`);
+    res.rows_closed = await rows();
+    if (res.rows_closed > 20) fail(`${res.rows_closed} rows before expanding`);
+    let v = await page.evaluate(() => sy.ui.tree.version);
+    await page.locator(`#sy-tree [data-node="${flat.id}"] .sy-tree-expand`).click();
+    await settled(v);
+    res.rows_open = await rows();
+    res.more = await page.locator('#sy-tree .sy-tree-more').textContent();
+    if (res.rows_open !== res.rows_closed + 512 || !/11488 more/.test(res.more)) fail(`expanded: ${JSON.stringify(res)}`);
+    await page.screenshot({ path: join(outDir, 'tree_big.png') });
+    v = await page.evaluate(() => sy.ui.tree.version);
+    await page.locator('#sy-tree .sy-tree-more').click();
+    await settled(v);
+    res.rows_more = await rows();
+    res.more2 = await page.locator('#sy-tree .sy-tree-more').textContent();
+    const names = await page.evaluate(() => sy.ui.tree.nodes.filter((n) => /^flat \d+$/.test(n.name || '')).map((n) => n.name));
+    res.in_order = names.length === 1024 && names.every((x, i) => x === `flat ${i}`);
+    if (res.rows_more !== res.rows_open + 512 || !/10976 more/.test(res.more2) || !res.in_order) fail(`the next page: ${JSON.stringify(res)}`);
+    // asked again (as after a visibility change): "flat" stays expanded, its first page listed
+    v = await page.evaluate(() => { const x = sy.ui.tree.version; sy.ui.tree.refresh(); return x; });
+    await page.waitForFunction((x) => sy.ui.tree.version > x + 1 && !sy.ui.tree.pending, v, { timeout: TIMEOUT });
+    res.rows_again = await rows();
+    if (res.rows_again !== res.rows_open) fail(`asked again: ${res.rows_again} rows, not ${res.rows_open}`);
+    await page.locator(`#sy-tree [data-node="${flat.id}"] .sy-tree-expand`).click();
+    res.rows_collapsed = await rows();
+    if (res.rows_collapsed !== res.rows_closed) fail(`collapsed: ${res.rows_collapsed} rows, not ${res.rows_closed}`);
+    res.consoleErrors = consoleErrors;
+    if (consoleErrors.length) fail(`page errors: ${consoleErrors}`);
+    console.log(JSON.stringify(res));
     await browser.close();
     process.exit(0);
   }

@@ -18,6 +18,11 @@
 #     an animated scene's client-render page at two times of the server's clock (the page's
 #     timeline: WebSocket "time", then GET /api/pose): each canvas covers what `sy render -b raster
 #     --at T` covers (IoU >= 0.95), and the two differ (IoU < 0.98).
+#   browser_test.sh tree SY PNG_IOU MODULES_DIR generated
+#     a generated glTF (a triangle and a group "flat" of 12,000 empty nodes), a 960 x 600 page: the
+#     tree lists "flat" closed with its 12,000 children; its ▸ lists the first 512 and a "… 11488
+#     more" row, which lists the next 512; asking the tree again keeps "flat" expanded (its first
+#     page); ▾ closes it (browser.mjs tree checks each step).
 #   browser_test.sh tools SY PNG_IOU MODULES_DIR SCENE
 #     sy web SCENE -b raster, a 960 x 600 page: a click on a covered pixel picks its node (the
 #     properties name it) and selects it; unticking it in the tree changes the streamed canvas
@@ -73,14 +78,14 @@ set -u
 mode=$1 SY=$2 PNG_IOU=$3 MODULES=$4 SCENE=$5
 MIN_IOU=${6:-0.95} LUM=${7:-} # client: the coverage IoU asked for; the mean luminance's relative tolerance (none: not checked)
 W=480 H=360
-[ "$mode" = tools ] || [ "$mode" = timeline ] && W=960 H=600 # the panel shows beside the canvas from 600 pixels on
+[ "$mode" = tools ] || [ "$mode" = timeline ] || [ "$mode" = tree ] && W=960 H=600 # the panel shows beside the canvas from 600 pixels on
 [ "$mode" = converge ] && W=320 H=240 # the path tracer on two shared cores
 skip() {
     if [ "${SY_REQUIRE_BROWSER:-0}" = 1 ]; then echo "FAIL: SY_REQUIRE_BROWSER=1 but the test cannot run: $*"; exit 1; fi
     echo "SKIP: $*"
     exit 77
 }
-[ "$SCENE" = demo ] || [ -f "$SCENE" ] || skip "$SCENE is absent (the test data in ../shared/testdata)"
+[ "$SCENE" = demo ] || [ "$mode" = tree ] || [ -f "$SCENE" ] || skip "$SCENE is absent (the test data in ../shared/testdata)"
 CHROMIUM=${SY_CHROMIUM:-/usr/bin/chromium}
 [ -x "$CHROMIUM" ] || skip "chromium is not installed ($CHROMIUM; apt-get install chromium)"
 command -v node >/dev/null || skip "node is not installed (apt-get install nodejs)"
@@ -96,6 +101,21 @@ trap cleanup EXIT
 fail=0
 bad() { echo "FAIL: $*"; fail=1; }
 
+if [ "$mode" = tree ]; then # a generated scene: a triangle and a group "flat" of 12,000 empty nodes
+    SCENE=$out/bigtree.gltf
+    node -e '
+      const n = 12000, pos = Buffer.from(new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0]).buffer);
+      const nodes = [{ name: "root", children: [1, 2] }, { name: "tri", mesh: 0 },
+                     { name: "flat", children: Array.from({ length: n }, (_, i) => 3 + i) }];
+      for (let i = 0; i < n; i++) nodes.push({ name: "flat " + i, translation: [i * 1e-4, 0, 0] });
+      require("fs").writeFileSync(process.argv[1], JSON.stringify({
+        asset: { version: "2.0" }, scene: 0, scenes: [{ nodes: [0] }], nodes,
+        meshes: [{ primitives: [{ attributes: { POSITION: 0 } }] }],
+        accessors: [{ bufferView: 0, componentType: 5126, count: 3, type: "VEC3", min: [0, 0, 0], max: [1, 1, 0] }],
+        bufferViews: [{ buffer: 0, byteLength: 36 }],
+        buffers: [{ byteLength: 36, uri: "data:application/octet-stream;base64," + pos.toString("base64") }] }));
+    ' "$SCENE" || { echo "FAIL: could not write $SCENE"; exit 1; }
+fi
 args=(web "$SCENE" -b raster --listen 127.0.0.1:0)
 [ "$mode" = converge ] && args=(web "$SCENE" -b pathtracer --listen 127.0.0.1:0)
 [ "$mode" = client ] || [ "$mode" = client_timeline ] && args+=(--client-render)
@@ -233,6 +253,15 @@ if [ "$mode" = client_timeline ]; then
     echo "the client canvas at the two times: $res"
     iou=$(echo "$res" | awk '{print $2}')
     awk -v v="$iou" 'BEGIN { exit !(v < 0.98) }' || bad "the client canvas did not change between the two times (IoU $iou)"
+    kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
+    grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
+    [ $fail = 0 ] && echo "ok: sy web $mode in chromium"
+    exit $fail
+fi
+
+if [ "$mode" = tree ]; then # browser.mjs checks the page's tree itself
+    browse "$url"
+    [ -n "${SY_BROWSER_KEEP:-}" ] && cp "$out"/*.png "$out"/*.json "$SY_BROWSER_KEEP"/ 2>/dev/null
     kill -0 $pid 2>/dev/null || bad "sy web is no longer running: $(server_said)"
     grep -q -E 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$out/err" && bad "sy web: $(server_said)"
     [ $fail = 0 ] && echo "ok: sy web $mode in chromium"

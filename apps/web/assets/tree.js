@@ -24,13 +24,13 @@
   const props = el("div", { class: "kv" }, propSec);
   el("div", { class: "note" }, propSec, "click an object to pick it");
   const state = ui.tree = { nodes: [], total: 0, truncated: false, min: null, max: null, planes: [], selected: 0,
-                            lastPick: null, seq: 0, picks: 0 };
+                            lastPick: null, seq: 0, picks: 0, pending: 0 }; // pending: node pages asked for, not answered
   // requests: seq -> {base: the base request they belong to, at: the row the answer goes after (a
   // node's row, or a "more" row it replaces)}; the base request (no node, offset 0) lists the tree anew
   let treeSeq = 0, baseSeq = 0, pickSeq = 0;
   const asked = new Map();
   const expanded = new Set(), collapsed = new Set(); // the user's choices, kept across answers
-  function askTree() { baseSeq = ++treeSeq; asked.clear(); sy.send({ t: "tree", seq: baseSeq }); }
+  function askTree() { baseSeq = ++treeSeq; asked.clear(); state.pending = 0; sy.send({ t: "tree", seq: baseSeq }); }
   function askBelow(row, node, offset) {
     const seq = ++treeSeq;
     asked.set(seq, { base: baseSeq, at: row });
