@@ -529,7 +529,7 @@
     // the socket is open) is handed that hello at once
     on: function (f) { // a script that loads later gets the messages so far (while the page loads), else the hello
       listeners.push(f);
-      for (const m of document.readyState === "loading" ? early : lastHello ? [lastHello] : []) try { f(m); } catch (err) { console.error(err); }
+      for (const m of pageLoading ? early : lastHello ? [lastHello] : []) try { f(m); } catch (err) { console.error(err); }
     },
     project: function (p) {
       if (!refs.length) return null;
@@ -542,7 +542,11 @@
 
   const listeners = []; // window.sy.on: the server's text messages, parsed
   let lastHello = null;
-  const early = []; // the server's text messages while the page loads
+  // the server's text messages while the page loads: until DOMContentLoaded, which comes after
+  // every (deferred) script ran (readyState is already "interactive" while they run)
+  const early = [];
+  let pageLoading = true;
+  document.addEventListener("DOMContentLoaded", function () { pageLoading = false; early.length = 0; });
   function send(o) {
     if (ws && ws.readyState === 1) ws.send(JSON.stringify(o));
   }
@@ -602,7 +606,7 @@
         const m = JSON.parse(e.data);
         if (m.t === "hello") stats.backends = m.backends, lastHello = m;
         if (m.t === "status") { stats.filter = m.filter; if (m.error) hud.textContent = m.error; }
-        if (document.readyState === "loading") early.push(m); // for the scripts still to come
+        if (pageLoading) early.push(m); // for the scripts still to come
         for (const f of listeners) try { f(m); } catch (err) { console.error(err); }
       } catch (err) {}
       return;
