@@ -39,6 +39,7 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     const sy_gl_fns *gl = dev->gl = sy_gl_context_fns(dev->ctx);
     const char *penv = getenv("SY_GL_PROFILE");
     dev->profile = penv && *penv && strcmp(penv, "0") != 0;
+    dev->profile_var = -1;
     double prof[2];
     sy_gli_profile_mark(dev, true, prof);
     snprintf(dev->info, sizeof dev->info, "OpenGL %s on %s (%s)", (const char *)gl->GetString(GL_VERSION),

@@ -213,7 +213,9 @@ static void draw_rects(sy_gl_device *dev, GLint loc, const float (*r)[4], uint32
     for (uint32_t i = 0; i < n; i += SY_GL_MAX_RECTS) {
         const uint32_t b = n - i < SY_GL_MAX_RECTS ? n - i : SY_GL_MAX_RECTS;
         gl->Uniform4fv(loc, (GLsizei)b, r[i]);
+        double t0 = sy_gli_profile_thread(dev);
         gl->DrawArrays(GL_TRIANGLES, 0, (GLsizei)(6 * b));
+        sy_gli_profile_draw(dev, t0, "rectangles (deferred or resolve)");
     }
 }
 
@@ -223,6 +225,7 @@ static void resolve_pass(sy_gl_device *dev, const float (*r)[4], uint32_t n)
 {
     const sy_gl_fns *gl = dev->gl;
     gl->UseProgram(dev->prog_resolve);
+    dev->profile_var = -1;
     gl->ActiveTexture(GL_TEXTURE0);
     gl->BindTexture(GL_TEXTURE_2D_MULTISAMPLE, dev->t.color);
     gl->ActiveTexture(GL_TEXTURE1);
@@ -308,6 +311,7 @@ static sy_gl_result deferred_pass(sy_gl_device *dev, const view_setup *v, sy_gl_
     else n_shade = 1, n_rest = 0, dev->deferred_pixels = (uint64_t)t->w * t->h;
     if (n_shade) {
         gl->UseProgram(dev->dp[k].prog);
+        dev->profile_var = -1;
         gl->Uniform4fv(dev->dp[k].unproj, 1, unproj);
         gl->UniformMatrix4fv(dev->dp[k].inv_view, 1, GL_FALSE, inv_view);
         gl->Uniform2fv(dev->dp[k].px, 1, px);
@@ -421,18 +425,27 @@ static int material_features(const sy_gl_device *dev, const mat_o *mt)
 }
 
 /* The material_features of every visible instance, once per frame (sy_gl_render): every forward
- * draw of the frame, probe faces included, takes them (draw_instance). */
+ * draw of the frame, probe faces included, takes them (draw_instance). Likewise the mesh
+ * attributes: in a frame with any visible mesh that has a second uv set or colours (not
+ * VAR_LEAN), every forward draw reads them; a lean mesh's draw gives them the constants the
+ * shaders take for absent attributes (uv 0, colour 1: sy_gli_draw_mesh_lod), so it shades as
+ * before, and llvmpipe compiles one program instead of a lean and a full one (issue 32:
+ * TextureTransformMultiTest's layered variant, about 1 s of LLVM each). */
 void sy_gli_frame_features(sy_gl_device *dev)
 {
     int shared = 0;
+    bool full = false;
     const mat_o *last = NULL;
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
         const inst_o *in = sy_gli_pool_at(&dev->instances, i);
         if (!in->h.id || !in->visible) continue;
         const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
         if (mt && mt != last) shared |= material_features(dev, last = mt);
+        const mesh_o *m = full ? NULL : sy_gli_pool_get(&dev->meshes, in->mesh.id);
+        if (m && !sy_gli_mesh_lean(m)) full = true;
     }
     dev->shared_features = shared;
+    dev->shared_full = full;
 }
 
 /* The variant bits for one draw: mesh attributes, material textures and mode, frame lighting,
@@ -455,6 +468,7 @@ static sy_gl_result use_variant(sy_gl_device *dev, draw_ctx *dc, int pv, sy_gl_r
     if (!p) return SY_GL_ERROR_GL;
     gl->UseProgram(p);
     dc->bound = pv;
+    dev->profile_var = pv;
     if (dev->pm[pv].frame != dev->frame_no) {
         dev->pm[pv].frame = dev->frame_no;
         gl->Uniform3fv(dev->pm[pv].cam_pos, 1, dc->v->cam_pos);
@@ -543,6 +557,7 @@ static void draw_gbuf(sy_gl_device *dev, draw_ctx *dc, const inst_o *in, const m
     if (dc->bound != BOUND_GBUF) {
         gl->UseProgram(dev->ug[k].prog);
         dc->bound = BOUND_GBUF;
+        dev->profile_var = -1;
         if (!dc->gbuf_view_set) {
             float unproj[4], px[2];
             view_unproject(dc->v, dev->t.w, dev->t.h, unproj, px);
@@ -614,7 +629,7 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
      * compiled 11 main-pass shaders before, 6 with shared features, 4 since a draw without a probe
      * of its own reads the environment through the probe's unit (sy_gli_draw_scene; issue 32: 8.7 ->
      * 5.3 s cold at 200x150 on llvmpipe, 1.7 -> 1.8 s warm). */
-    pv = sy_gli_variant_normalize(pv | dc->shared);
+    pv = sy_gli_variant_normalize((pv | dc->shared) & ~(dev->shared_full ? VAR_LEAN : 0));
     /* probe faces (16-256 px, seen blurred) shade without normal maps and material layers: a
      * smaller program that llvmpipe compiles in about half the time (docs/BACKENDS.md) */
     if (dev->in_probe_pass) pv = sy_gli_variant_normalize(pv & ~(VAR_NMAP | VAR_LAYERS));
@@ -686,6 +701,7 @@ static sy_gl_result cap_pass(sy_gl_device *dev, draw_ctx *dc, sy_gl_report *rep)
     }
     gl->UseProgram(dev->cap.prog);
     dc->bound = -1;
+    dev->profile_var = -1;
     gl->UniformMatrix4fv(dev->cap.viewproj, 1, GL_FALSE, dc->viewproj);
     gl->Uniform3fv(dev->cap.cam_pos, 1, dc->v->cam_pos);
     gl->Uniform3fv(dev->cap.cam_fwd, 1, dc->v->cam_fwd);

@@ -124,6 +124,7 @@ typedef struct tex_o {
     slot_head h;
     GLuint tex;
     uint32_t width, height; /* level 0 as uploaded */
+    uint8_t wrap_s, wrap_t, nearest, is_float, srgb; /* its sampling (SY_GL_PROFILE's compile lines name it) */
 } tex_o;
 
 typedef struct mat_o {
@@ -240,6 +241,8 @@ struct sy_gl_device {
      * after each pass (glFinish) and prints the passes' wall and CPU times to stderr (sy_gli_profile_mark) */
     bool profile;
     double profile_t[2]; /* the last mark's wall and CPU time */
+    int profile_var;     /* the main variant bound for the next draws (use_variant), -1 another program */
+    uint32_t profile_mat; /* the material bound last (sy_gli_bind_material) */
     targets t;
     bool lights_dirty;
     /* section planes (sy_gl_camera.clip_planes) of the last render or pick: the Clip block's buffer
@@ -311,6 +314,7 @@ struct sy_gl_device {
     float *scratch;
     size_t scratch_len;
     int shared_features; /* material_features of every visible instance (sy_gli_frame_features) */
+    bool shared_full;    /* a visible mesh is not VAR_LEAN: no forward draw is (sy_gli_frame_features) */
 };
 
 static inline float sy_gli_dot3f(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -385,6 +389,12 @@ sy_gl_result sy_gli_gl_check(sy_gl_device *dev, const char *where, sy_gl_report 
  * GL's included) seconds since the last mark (the first mark of a series passes start = true and
  * gets 0); without it, zeros and no wait. */
 void sy_gli_profile_mark(sy_gl_device *dev, bool start, double t[2]);
+/* With dev->profile: the calling thread's CPU seconds (0 without), and, after a draw started at t0,
+ * a line on stderr when the draw took the calling thread more than 20 ms of CPU: llvmpipe compiles
+ * a fragment shader for each program and pipeline state on its first draw, on the thread that draws
+ * (issue 32: which variants a cold first frame compiles, and what each costs). `what` names the pass. */
+double sy_gli_profile_thread(const sy_gl_device *dev);
+void sy_gli_profile_draw(const sy_gl_device *dev, double t0, const char *what);
 sy_gl_result sy_gli_current(sy_gl_device *dev, sy_gl_report *rep);
 void sy_gli_geometry_changed(sy_gl_device *dev);
 void sy_gli_frustum_planes(const float *m, float planes[6][4]);
@@ -392,6 +402,8 @@ float sy_gli_world_sphere(const inst_o *in, const mesh_o *m, float c[3], float *
 bool sy_gli_sphere_outside(const float planes[6][4], const float c[3], float r);
 
 /* sy_gl_programs.c */
+/* The name of main variant v under the lights' current signature ("main TEX LIGHTS ... (2 lights: ...)"). */
+void sy_gli_variant_name(const sy_gl_device *dev, int v, char *name, size_t len);
 GLuint sy_gli_make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], bool srgb);
 void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b);
 /* Whether material d uses a material extension (then it draws with VAR_LAYERS). */

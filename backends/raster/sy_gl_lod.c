@@ -18,10 +18,12 @@ uint32_t sy_gli_draw_mesh_lod(sy_gl_device *dev, const mesh_o *m, uint32_t lod)
     if (!m->has_attr[4]) gl->VertexAttrib4f(4, 1, 1, 1, 1);
     if (lod >= m->lod_count) lod = 0;
     uint32_t tris = m->lod_tris[lod];
+    double t0 = sy_gli_profile_thread(dev);
     if (m->indexed)
         gl->DrawElements(GL_TRIANGLES, (GLsizei)(3u * tris), GL_UNSIGNED_INT,
                          (const void *)((uintptr_t)m->lod_first[lod] * sizeof(uint32_t)));
     else gl->DrawArrays(GL_TRIANGLES, 0, (GLsizei)(3u * tris));
+    sy_gli_profile_draw(dev, t0, "mesh");
     dev->draws++;
     return tris;
 }
@@ -30,6 +32,7 @@ const mat_o *sy_gli_bind_material(sy_gl_device *dev, sy_gl_material id, bool all
 {
     const sy_gl_fns *gl = dev->gl;
     const mat_o *m = sy_gli_pool_get(&dev->materials, id.id);
+    dev->profile_mat = id.id;
     gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_MATERIAL, m ? m->ubo : dev->default_ubo);
     if (!m) return NULL;
     const sy_gl_texture_ref *refs[5] = {&m->d.base_color_texture, &m->d.metallic_roughness_texture,

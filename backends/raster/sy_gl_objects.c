@@ -634,6 +634,11 @@ sy_gl_result sy_gl_texture_create(sy_gl_device *dev, const sy_gl_texture_desc *d
     const sy_gl_fns *gl = dev->gl;
     t->width = w;
     t->height = h;
+    t->wrap_s = (uint8_t)((unsigned)d->wrap_s < 3u ? d->wrap_s : 0);
+    t->wrap_t = (uint8_t)((unsigned)d->wrap_t < 3u ? d->wrap_t : 0);
+    t->nearest = d->nearest ? 1 : 0;
+    t->is_float = is_float ? 1 : 0;
+    t->srgb = srgb ? 1 : 0;
     gl->GenTextures(1, &t->tex);
     gl->BindTexture(GL_TEXTURE_2D, t->tex);
     gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);

@@ -99,6 +99,7 @@ static void id_draw(sy_gl_device *dev, const view_setup *v, GLuint fbo, uint32_t
     gl->ClearBufferfv(GL_COLOR, 0, zero);
     gl->ClearBufferfv(GL_DEPTH, 0, &one);
     gl->UseProgram(dev->pick.prog);
+    dev->profile_var = -1;
     const GLint *u = dev->pick.u;
     gl->UniformMatrix4fv(u[1], 1, GL_FALSE, v->view);
     gl->UniformMatrix4fv(u[2], 1, GL_FALSE, v->proj);

@@ -236,6 +236,13 @@ static void uniforms_locate(const sy_gl_fns *gl, GLuint p, const uniform_loc *u,
     for (size_t i = 0; i < n; ++i) *u[i].at = gl->GetUniformLocation(p, u[i].name);
 }
 
+void sy_gli_variant_name(const sy_gl_device *dev, int v, char *name, size_t len)
+{
+    char defs[1024] = "";
+    snprintf(name, len, "main");
+    variant_defines(v, variant_sig(dev, v), defs, sizeof defs, name, len);
+}
+
 /* The main program for variant bits v, built and cached on first use; 0 (the failure reported to rep) when the
  * driver rejects it. */
 GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep)

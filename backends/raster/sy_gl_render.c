@@ -256,6 +256,7 @@ sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, cons
     sy_gli_begin_target(dev, NULL);
     const int k = lit ? 1 : 0;
     gl->UseProgram(lit ? dev->prog_floor_lit : dev->prog_floor);
+    dev->profile_var = -1;
     gl->UniformMatrix4fv(dev->uf[k].view, 1, GL_FALSE, v.view);
     gl->UniformMatrix4fv(dev->uf[k].proj, 1, GL_FALSE, v.proj);
     float vp[16], planes[6][4];

@@ -237,6 +237,7 @@ static void draw_casters(sy_gl_device *dev, const float *vp)
     gl->Clear(GL_DEPTH_BUFFER_BIT);
     for (int v = 0; v < 2; ++v) {
         gl->UseProgram(dev->ps[v].prog);
+        dev->profile_var = -1;
         gl->UniformMatrix4fv(dev->ps[v].lightvp, 1, GL_FALSE, vp);
         for (uint32_t i = 0; i < dev->instances.count; ++i) {
             const inst_o *in = sy_gli_pool_at(&dev->instances, i);
