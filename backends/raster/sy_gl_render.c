@@ -187,9 +187,14 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         const tex_o *et = sy_gli_pool_get(&dev->textures, dev->env_tex.id);
         dev->env_ready = false;
         if (et) {
+            dev->profile_var = -1;
+            double t0 = sy_gli_profile_thread(dev);
             r = sy_gl_ibl_tables(gl, &dev->ibl, rep);
+            sy_gli_profile_draw(dev, t0, "BRDF and LTC tables");
+            t0 = sy_gli_profile_thread(dev);
             if (r == SY_GL_OK)
                 r = sy_gl_ibl_prefilter(gl, &dev->ibl, et->tex, et->width, et->height, dev->env_intensity, dev->env_side, rep);
+            sy_gli_profile_draw(dev, t0, "environment prefilter");
             if (r != SY_GL_OK) return r;
             dev->env_ready = true;
         }

@@ -55,8 +55,9 @@ while IFS= read -r f; do
   read -r wall cpu rc < <(render "$f" "$err")
   [ -n "$log" ] && cp "$err" "$log/$(echo "$f" | tr / _).log"
   sys=$(sed -n 's/.*, raster, \([0-9.]*\) s$/\1/p' "$err" | tail -1)
-  stats=$(awk -F': ' '/draw took/ { split($2, a, " "); t = a[3] + 0; n++; s += t; if (t > m) { m = t; v = $NF } }
-    END { printf "%d\t%.2f\t%.2f\t%s", n, s, m, (n ? v : "-") }' "$err")
+  stats=$(awk '/draw took/ { t = $0; sub(/.*draw took /, "", t); t += 0; v = $0; sub(/.*shader compile\): /, "", v)
+      n++; s += t; if (t > m) { m = t; w = v } }
+    END { printf "%d\t%.2f\t%.2f\t%s", n, s, m, (n ? w : "-") }' "$err")
   [ "$rc" = 0 ] || stats="$stats (exit $rc: $(tail -1 "$err"))"
   printf '%s\t%s\t%s\t%s\t%s\n' "$f" "$wall" "$cpu" "${sys:--}" "$stats"
   n=$((n + 1))
