@@ -55,7 +55,8 @@ while IFS= read -r f; do
   read -r wall cpu rc < <(render "$f" "$err")
   [ -n "$log" ] && cp "$err" "$log/$(echo "$f" | tr / _).log"
   sys=$(sed -n 's/.*, raster, \([0-9.]*\) s$/\1/p' "$err" | tail -1)
-  stats=$(awk '/draw took/ { t = $0; sub(/.*draw took /, "", t); t += 0; v = $0; sub(/.*shader compile\): /, "", v)
+  stats=$(awk '/draw took/ { t = $0; sub(/.*draw took /, "", t); t += 0; v = $0; sub(/.*shader compile\): /, "", v); sub(/;.*/, "", v)
+      if (v == "another program") { v = $0; sub(/.*raster profile: /, "", v); sub(/ draw took.*/, "", v) }
       n++; s += t; if (t > m) { m = t; w = v } }
     END { printf "%d\t%.2f\t%.2f\t%s", n, s, m, (n ? w : "-") }' "$err")
   [ "$rc" = 0 ] || stats="$stats (exit $rc: $(tail -1 "$err"))"
