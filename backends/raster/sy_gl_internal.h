@@ -39,14 +39,6 @@ enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_
  * colour, clear coat, coat roughness, coat normal, sheen colour, sheen roughness, thickness,
  * anisotropy, iridescence, iridescence thickness, transmission */
 #define LAYER_TEXTURES 12
-/* The layers' textures 0 .. 10 are read through LAYER_SLOTS units (UNIT_LAYER0 + slot): slot 0
- * takes the colour textures (specular colour, sheen colour: sRGB), slots 1 .. 4 the others, one
- * slot per distinct texture, uv set and transform of the material (sy_gli_layer_slots); the
- * transmission texture (11) keeps its unit, UNIT_LAYER0 + 11. llvmpipe's LLVM compiles each
- * texture look-up of a shader: eleven of them, one unit each, were 0.5 to 0.9 s of the 0.9 to
- * 1.6 s that the layered variant took to compile (issue 32); the samples' materials use two at
- * most. A material with more than the slots hold reads the first ones (a warning names it). */
-#define LAYER_SLOTS 5
 #define STANDINS (5 + LAYER_TEXTURES) /* material units with a stand-in: the five base slots, the layers' */
 static inline void sy_gli_layer_refs(const sy_gl_material_desc *d, const sy_gl_texture_ref *r[LAYER_TEXTURES])
 {
@@ -338,11 +330,8 @@ typedef struct mat_block {
      * thickness, attenuation distance), (sheen colour, 0), (attenuation colour, 0) */
     float layers[6][4];  /* ..., (cos, sin of the anisotropy rotation, strength, 0), (iridescence, its ior,
                           * thickness minimum, maximum) */
-    int32_t ltex[3][4];  /* per layer texture (sy_gli_layer_refs) its slot (sy_gli_layer_slots; -1 none); 11, the
-                          * transmission texture's: its uv set */
-    float lxf[2 * LAYER_TEXTURES][4]; /* per slot (rows 0 .. 9) and for the transmission texture (rows 22, 23)
-                                       * the uv transform, two rows each */
-    int32_t lslot[LAYER_SLOTS + 3]; /* per slot its uv set (-1 empty); padded to two ivec4 */
+    int32_t ltex[3][4];  /* the layers' textures' uv sets (-1 none), slots as sy_gli_layer_refs */
+    float lxf[2 * LAYER_TEXTURES][4]; /* and their uv transforms, two rows each */
 } mat_block;
 
 /* std140 Lights block: 16 + 16 + 4*64 + 4*16 + 32*64 bytes, then the cube shadows' parameters
@@ -419,11 +408,6 @@ GLuint sy_gli_make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], boo
 void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b);
 /* Whether material d uses a material extension (then it draws with VAR_LAYERS). */
 bool sy_gli_material_layered(const sy_gl_device *dev, const sy_gl_material_desc *d);
-/* The slots of material d's layer textures 0 .. 10: slot[i] the slot of texture i (-1: none, or
- * no slot left), ref[k] the texture reference slot k reads (NULL: empty); returns the textures
- * that found no slot. */
-int sy_gli_layer_slots(const sy_gl_device *dev, const sy_gl_material_desc *d, int slot[LAYER_TEXTURES - 1],
-                       const sy_gl_texture_ref *ref[LAYER_SLOTS]);
 void sy_gli_bind_samplers(const sy_gl_fns *gl, GLuint prog);
 /* Binds prog's Clip block (SY_GL_CLIP_VS), when it has one, to BIND_CLIP (bind_samplers does too). */
 void sy_gli_bind_clip_block(const sy_gl_fns *gl, GLuint prog);

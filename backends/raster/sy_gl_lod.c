@@ -43,17 +43,12 @@ const mat_o *sy_gli_bind_material(sy_gl_device *dev, sy_gl_material id, bool all
         gl->BindTexture(GL_TEXTURE_2D, t ? t->tex : dev->standin[i]);
     }
     if (!all_textures || !dev->layer_units) return m;
-    /* the layers' slots (sy_gl_shaders_layers.c reads them where m_lt says) and the transmission texture */
-    const sy_gl_texture_ref *sref[LAYER_SLOTS], *lr[LAYER_TEXTURES];
-    int slot[LAYER_TEXTURES - 1];
-    sy_gli_layer_slots(dev, &m->d, slot, sref);
+    const sy_gl_texture_ref *lr[LAYER_TEXTURES];
     sy_gli_layer_refs(&m->d, lr);
-    for (int i = 0; i < LAYER_SLOTS + 1; ++i) {
-        int unit = i < LAYER_SLOTS ? i : LAYER_TEXTURES - 1;
-        const sy_gl_texture_ref *r = i < LAYER_SLOTS ? sref[i] : lr[LAYER_TEXTURES - 1];
-        const tex_o *t = r ? sy_gli_pool_get(&dev->textures, r->texture.id) : NULL;
-        gl->ActiveTexture(GL_TEXTURE0 + UNIT_LAYER0 + (GLenum)unit);
-        gl->BindTexture(GL_TEXTURE_2D, t ? t->tex : dev->standin[5 + unit]);
+    for (int i = 0; i < LAYER_TEXTURES; ++i) { /* the layers' (sy_gl_shaders_layers.c reads them where m_lt says) */
+        const tex_o *t = sy_gli_pool_get(&dev->textures, lr[i]->texture.id);
+        gl->ActiveTexture(GL_TEXTURE0 + UNIT_LAYER0 + (GLenum)i);
+        gl->BindTexture(GL_TEXTURE_2D, t ? t->tex : dev->standin[5 + i]);
     }
     return m;
 }

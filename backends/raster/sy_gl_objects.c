@@ -785,12 +785,6 @@ static sy_gl_result material_check(const sy_gl_material_desc *d, sy_gl_report *r
 
 static void material_upload(sy_gl_device *dev, mat_o *m, bool create)
 {
-    const sy_gl_texture_ref *sref[LAYER_SLOTS];
-    int slot[LAYER_TEXTURES - 1], lost = sy_gli_layer_slots(dev, &m->d, slot, sref);
-    if (lost)
-        sy_gli_warn(dev, "raster: a material's extensions use more distinct textures than the rasterizer reads (%d colour, "
-                         "%d others); %d of them are not read",
-                    1, LAYER_SLOTS - 1, lost);
     mat_block b;
     sy_gli_material_block(dev, &m->d, &b);
     const sy_gl_fns *gl = dev->gl;

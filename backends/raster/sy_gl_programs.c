@@ -63,25 +63,14 @@ void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
     b->layers[5][1] = d->iridescence_ior >= 1.0f ? d->iridescence_ior : 1.0f;
     b->layers[5][2] = fmaxf(d->iridescence_thickness[0], 0.0f);
     b->layers[5][3] = fmaxf(d->iridescence_thickness[1], 0.0f);
-    const sy_gl_texture_ref *lr[LAYER_TEXTURES], *sref[LAYER_SLOTS];
+    const sy_gl_texture_ref *lr[LAYER_TEXTURES];
     sy_gli_layer_refs(d, lr);
-    int slot[LAYER_TEXTURES - 1];
-    sy_gli_layer_slots(dev, d, slot, sref);
-    const float id[6] = {1, 0, 0, 0, 1, 0};
-    for (int i = 0; i < LAYER_TEXTURES - 1; ++i) b->ltex[i / 4][i % 4] = slot[i];
-    for (int k = 0; k < LAYER_SLOTS + 3; ++k) b->lslot[k] = k < LAYER_SLOTS && sref[k] ? (int32_t)(sref[k]->texcoord & 1u) : -1;
-    for (int k = 0; k < LAYER_SLOTS; ++k) {
-        const float *m = sref[k] && sref[k]->transformed ? sref[k]->transform : id;
-        memcpy(b->lxf[2 * k], m, 3 * sizeof(float));
-        memcpy(b->lxf[2 * k + 1], m + 3, 3 * sizeof(float));
-    }
-    { /* the transmission texture: its uv set and transform */
-        const sy_gl_texture_ref *t = lr[LAYER_TEXTURES - 1];
-        bool has = dev->layer_units && sy_gli_pool_get(&dev->textures, t->texture.id);
-        b->ltex[2][3] = has ? (int32_t)(t->texcoord & 1u) : -1;
-        const float *m = t->transformed ? t->transform : id;
-        memcpy(b->lxf[2 * (LAYER_TEXTURES - 1)], m, 3 * sizeof(float));
-        memcpy(b->lxf[2 * (LAYER_TEXTURES - 1) + 1], m + 3, 3 * sizeof(float));
+    for (int i = 0; i < LAYER_TEXTURES; ++i) {
+        bool has = dev->layer_units && sy_gli_pool_get(&dev->textures, lr[i]->texture.id);
+        b->ltex[i / 4][i % 4] = has ? (int32_t)(lr[i]->texcoord & 1u) : -1;
+        const float id[6] = {1, 0, 0, 0, 1, 0}, *m = lr[i]->transformed ? lr[i]->transform : id;
+        memcpy(b->lxf[2 * i], m, 3 * sizeof(float));
+        memcpy(b->lxf[2 * i + 1], m + 3, 3 * sizeof(float));
     }
     const sy_gl_texture_ref *refs[5] = {&d->base_color_texture, &d->metallic_roughness_texture, &d->normal_texture,
                                         &d->occlusion_texture, &d->emissive_texture};
@@ -93,34 +82,6 @@ void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
         memcpy(b->xf[2 * i], m, 3 * sizeof(float));
         memcpy(b->xf[2 * i + 1], m + 3, 3 * sizeof(float));
     }
-}
-
-static bool same_ref(const sy_gl_texture_ref *a, const sy_gl_texture_ref *b)
-{
-    if (a->texture.id != b->texture.id || (a->texcoord & 1u) != (b->texcoord & 1u) || a->transformed != b->transformed)
-        return false;
-    return !a->transformed || memcmp(a->transform, b->transform, sizeof a->transform) == 0;
-}
-
-int sy_gli_layer_slots(const sy_gl_device *dev, const sy_gl_material_desc *d, int slot[LAYER_TEXTURES - 1],
-                       const sy_gl_texture_ref *ref[LAYER_SLOTS])
-{
-    const sy_gl_texture_ref *lr[LAYER_TEXTURES];
-    sy_gli_layer_refs(d, lr);
-    for (int k = 0; k < LAYER_SLOTS; ++k) ref[k] = NULL;
-    int lost = 0;
-    for (int i = 0; i < LAYER_TEXTURES - 1; ++i) {
-        slot[i] = -1;
-        if (!dev->layer_units || !sy_gli_pool_get(&dev->textures, lr[i]->texture.id)) continue;
-        bool colour = i == 1 || i == 5; /* specular colour, sheen colour: slot 0 (sRGB) */
-        int lo = colour ? 0 : 1, hi = colour ? 1 : LAYER_SLOTS;
-        for (int k = lo; k < hi && slot[i] < 0; ++k) {
-            if (!ref[k]) ref[k] = lr[i];
-            if (same_ref(ref[k], lr[i])) slot[i] = k;
-        }
-        if (slot[i] < 0) lost++;
-    }
-    return lost;
 }
 
 bool sy_gli_material_layered(const sy_gl_device *dev, const sy_gl_material_desc *d)

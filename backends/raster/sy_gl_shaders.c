@@ -68,7 +68,7 @@ const char *const sy_gl_main_vs =
     "layout(std140) uniform Material {\n"                                                                    \
     "  vec4 m_base; vec4 m_emissive; vec4 m_mrna; vec4 m_oist; ivec4 m_modes; ivec4 m_tex; ivec4 m_tex2;\n" \
     "  vec4 m_xf[10];\n" /* uv transform rows per slot: base, mr, nrm, occ, emis */                          \
-    "  vec4 m_l0, m_l1, m_l2, m_l3, m_l4, m_l5; ivec4 m_lt0, m_lt1, m_lt2; vec4 m_lxf[24]; ivec4 m_ls0, m_ls1;\n" /* the layers (mat_block, sy_gl_shaders_layers.c) */ \
+    "  vec4 m_l0, m_l1, m_l2, m_l3, m_l4, m_l5; ivec4 m_lt0, m_lt1, m_lt2; vec4 m_lxf[24];\n" /* the layers (mat_block, sy_gl_shaders_layers.c) */ \
     "};\n"                                                                                                   \
     "uniform sampler2D t_base, t_mr, t_nrm, t_occ, t_emis;\n"                                                \
     "#ifdef SY_TRANS\n" "uniform sampler2D t_l11;\n" "#endif\n" /* the transmission texture */             \
@@ -434,15 +434,6 @@ const char *const sy_gl_main_fs =
     "  vec3 tg, bt;\n"
     "  if (uv_frame(t, n, dpx, dpy, tg, bt)) {\n"
     "    vec3 tx = texture(s, t).xyz * 2.0 - 1.0;\n"
-    "    vec3 r = tg * (tx.x * sc) + bt * (tx.y * sc) + n * tx.z;\n"
-    "    if (dot(r, r) > 0.0) n = normalize(r);\n"
-    "  }\n"
-    "  return n; }\n"
-    /* the same with the map's texel already read (the layers' slots, sy_gl_shaders_layers.c) */
-    "vec3 map_normal_texel(vec4 texel, vec2 t, float sc, vec3 n, vec3 dpx, vec3 dpy) {\n"
-    "  vec3 tg, bt;\n"
-    "  if (uv_frame(t, n, dpx, dpy, tg, bt)) {\n"
-    "    vec3 tx = texel.xyz * 2.0 - 1.0;\n"
     "    vec3 r = tg * (tx.x * sc) + bt * (tx.y * sc) + n * tx.z;\n"
     "    if (dot(r, r) > 0.0) n = normalize(r);\n"
     "  }\n"

@@ -40,49 +40,37 @@
 const char *const sy_gl_layers_fs =
     "\n"
     "uniform mat4 u_model;\n" /* the vertex stage's: the instance's scale for the volume */
-    "uniform sampler2D t_l0, t_l1, t_l2, t_l3, t_l4;\n" /* the slots (sy_gli_layer_slots) */
+    "uniform sampler2D t_l0, t_l1, t_l2, t_l3, t_l4, t_l5, t_l6, t_l7, t_l8, t_l9, t_l10;\n"
     "vec4 g_l0, g_l1, g_l2, g_l3, g_l4, g_l5;\n" /* m_l0 .. m_l5 times the textures (layer_init) */
     "vec3 g_at, g_T, g_B;\n" /* the anisotropy direction (world; zero: none); its frame at ns (layer_f0) */
     "bool g_an;\n" /* that frame exists */
     "float g_se;\n" /* the sheen's directional albedo E(n.v) at the sheen roughness (layer_f0) */
     "vec2 ltuv(int k, vec2 t) { vec3 h = vec3(t, 1.0); return vec2(dot(m_lxf[2*k].xyz, h), dot(m_lxf[2*k+1].xyz, h)); }\n"
-    /* the factors times their textures (sy_gli_layer_refs: m_lt0 .. m_lt2 hold each one's slot,
-     * -1 = none) and the coat's normal (the vertex normal n, bent by its own map, flipped to the side
-     * seen); returns the specular texture's factor. Each slot (uv set m_ls0, m_ls1.x, -1 = empty;
-     * transform m_lxf[2k], m_lxf[2k+1]) is read once, and the textures pick their slot's texel by
-     * selects: five look-ups, not eleven (issue 32: LLVM compiles each look-up) */
-    "#define LSEL(k, a, b, c, d, e) ((k) == 0 ? (a) : (k) == 1 ? (b) : (k) == 2 ? (c) : (k) == 3 ? (d) : (e))\n"
+    /* the factors times their textures (slots: sy_gli_layer_refs; uv sets in m_lt0, m_lt1, -1 = none)
+     * and the coat's normal (the vertex normal n, bent by its own map, flipped to the side seen);
+     * returns the specular texture's factor */
     "float layer_init(vec3 n, bool front, vec3 dpx, vec3 dpy) {\n"
     "  g_l0 = m_l0; g_l1 = m_l1; g_l2 = m_l2; g_l3 = m_l3; g_l4 = m_l4; g_l5 = m_l5; float s = 1.0; vec3 nc = n;\n"
     "  g_at = vec3(0.0); g_l5.w = m_l5.w;\n"
     "#ifdef SY_TEX\n"
-    "  vec2 r0 = UVSET(m_ls0.x), r1 = UVSET(m_ls0.y), r2 = UVSET(m_ls0.z), r3 = UVSET(m_ls0.w), r4 = UVSET(m_ls1.x);\n"
-    "  vec2 u0 = ltuv(0, r0), u1 = ltuv(1, r1), u2 = ltuv(2, r2), u3 = ltuv(3, r3), u4 = ltuv(4, r4);\n"
-    "  vec4 s0 = vec4(1.0), s1 = vec4(1.0), s2 = vec4(1.0), s3 = vec4(1.0), s4 = vec4(1.0);\n"
-    "  if (m_ls0.x >= 0) s0 = texture(t_l0, u0);\n"
-    "  if (m_ls0.y >= 0) s1 = texture(t_l1, u1);\n"
-    "  if (m_ls0.z >= 0) s2 = texture(t_l2, u2);\n"
-    "  if (m_ls0.w >= 0) s3 = texture(t_l3, u3);\n"
-    "  if (m_ls1.x >= 0) s4 = texture(t_l4, u4);\n"
-    "#define LS(k) LSEL(k, s0, s1, s2, s3, s4)\n"
-    "  if (m_lt0.x >= 0) s = LS(m_lt0.x).a;\n"
-    "  if (m_lt0.y >= 0) g_l0.rgb *= LS(m_lt0.y).rgb;\n"
-    "  if (m_lt0.z >= 0) g_l0.w *= LS(m_lt0.z).r;\n"
-    "  if (m_lt0.w >= 0) g_l1.x *= LS(m_lt0.w).g;\n"
-    "  if (m_lt1.x >= 0) nc = map_normal_texel(LS(m_lt1.x), LSEL(m_lt1.x, u0, u1, u2, u3, u4), m_l2.w, n, dpx, dpy);\n"
-    "  if (m_lt1.y >= 0) g_l2.rgb *= LS(m_lt1.y).rgb;\n"
-    "  if (m_lt1.z >= 0) g_l1.y *= LS(m_lt1.z).a;\n"
-    "  if (m_lt1.w >= 0) g_l1.z *= LS(m_lt1.w).g;\n"
+    "  if (m_lt0.x >= 0) s = texture(t_l0, ltuv(0, UVSET(m_lt0.x))).a;\n"
+    "  if (m_lt0.y >= 0) g_l0.rgb *= texture(t_l1, ltuv(1, UVSET(m_lt0.y))).rgb;\n"
+    "  if (m_lt0.z >= 0) g_l0.w *= texture(t_l2, ltuv(2, UVSET(m_lt0.z))).r;\n"
+    "  if (m_lt0.w >= 0) g_l1.x *= texture(t_l3, ltuv(3, UVSET(m_lt0.w))).g;\n"
+    "  if (m_lt1.x >= 0) nc = map_normal(t_l4, ltuv(4, UVSET(m_lt1.x)), m_l2.w, n, dpx, dpy);\n"
+    "  if (m_lt1.y >= 0) g_l2.rgb *= texture(t_l5, ltuv(5, UVSET(m_lt1.y))).rgb;\n"
+    "  if (m_lt1.z >= 0) g_l1.y *= texture(t_l6, ltuv(6, UVSET(m_lt1.z))).a;\n"
+    "  if (m_lt1.w >= 0) g_l1.z *= texture(t_l7, ltuv(7, UVSET(m_lt1.w))).g;\n"
     /* anisotropy: the direction (cos, sin of the rotation) or the texture's RG rotated by it, in the
      * uv tangent frame of the texture's set (uv 0 without one) */
     "  if (m_l4.z > 0.0) {\n"
-    "    vec2 t = m_lt2.x >= 0 ? LSEL(m_lt2.x, r0, r1, r2, r3, r4) : v_uv0, dir = m_l4.xy; vec3 tg, bt;\n"
-    "    if (m_lt2.x >= 0) { vec3 a = LS(m_lt2.x).rgb; vec2 d = a.rg * 2.0 - 1.0;\n"
+    "    vec2 t = UVSET(m_lt2.x >= 0 ? m_lt2.x : 0), dir = m_l4.xy; vec3 tg, bt;\n"
+    "    if (m_lt2.x >= 0) { vec3 a = texture(t_l8, ltuv(8, t)).rgb; vec2 d = a.rg * 2.0 - 1.0;\n"
     "      g_l4.z *= a.b; if (dot(d, d) > 0.0) dir = mat2(m_l4.x, m_l4.y, -m_l4.y, m_l4.x) * normalize(d); }\n"
     "    if (uv_frame(t, n, dpx, dpy, tg, bt)) g_at = tg * dir.x + bt * dir.y;\n"
     "  }\n"
-    "  if (m_lt2.y >= 0) g_l5.x *= LS(m_lt2.y).r;\n"
-    "  if (m_lt2.z >= 0) g_l5.w = mix(m_l5.z, m_l5.w, LS(m_lt2.z).g);\n"
+    "  if (m_lt2.y >= 0) g_l5.x *= texture(t_l9, ltuv(9, UVSET(m_lt2.y))).r;\n"
+    "  if (m_lt2.z >= 0) g_l5.w = mix(m_l5.z, m_l5.w, texture(t_l10, ltuv(10, UVSET(m_lt2.z))).g);\n"
     "#endif\n"
     "  g_nc = front ? nc : -nc; return s; }\n"
     "float layer_max3(vec3 c) { return max(c.r, max(c.g, c.b)); }\n"

@@ -164,17 +164,6 @@ int main(int argc, char **argv)
                s1.mean);
     /* the clearcoat texture scales the weight (R): 0 leaves the base, 1 the coat */
     expect_texture_scales("clearcoat", &coat, clearcoat_slot, (stats[2]){s0, s1}, 1e-3f);
-    /* the layers' textures share five units (sy_gli_layer_slots): after two other textures that
-     * leave this material as it is (specular: A 1; thickness: G 0, no volume), the clearcoat texture
-     * reads the third slot and scales the coat as alone */
-    {
-        sy_gl_material_desc busy = coat;
-        busy.specular_texture.texture = texture_r(7);
-        busy.thickness_texture.texture = texture_r(9);
-        expect_texture_scales("clearcoat after two other layer textures", &busy, clearcoat_slot, (stats[2]){s0, s1}, 1e-3f);
-        MUST(sy_gl_texture_destroy(d, busy.specular_texture.texture));
-        MUST(sy_gl_texture_destroy(d, busy.thickness_texture.texture));
-    }
 
     /* 2. specular: 0 removes the dielectric highlight; a red specular colour makes it red */
     sy_gl_material_desc black = dielectric(0.0f, 0.3f), nospec = black, red = black;
