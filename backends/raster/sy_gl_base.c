@@ -263,33 +263,6 @@ double sy_gli_profile_thread(const sy_gl_device *dev)
     return dev->profile ? seconds(CLOCK_THREAD_CPUTIME_ID) : 0.0;
 }
 
-void sy_gli_profile_draw(const sy_gl_device *dev, double t0, const char *what)
-{
-    if (!dev->profile) return;
-    double dt = seconds(CLOCK_THREAD_CPUTIME_ID) - t0;
-    if (dt <= 0.02) return;
-    char name[256] = "another program";
-    if (dev->profile_var >= 0) sy_gli_variant_name(dev, dev->profile_var, name, sizeof name);
-    char tex[512] = "";
-    const mat_o *m = dev->profile_var >= 0 ? sy_gli_pool_get(&dev->materials, dev->profile_mat) : NULL;
-    if (m) { /* what the material's texture units sample: llvmpipe's shader key holds their sampling */
-        const sy_gl_texture_ref *refs[5 + LAYER_TEXTURES] = {&m->d.base_color_texture, &m->d.metallic_roughness_texture,
-                                                             &m->d.normal_texture, &m->d.occlusion_texture,
-                                                             &m->d.emissive_texture};
-        sy_gli_layer_refs(&m->d, refs + 5);
-        size_t n = 0;
-        for (int i = 0; i < 5 + LAYER_TEXTURES && n < sizeof tex; ++i) {
-            const tex_o *t = sy_gli_pool_get(&dev->textures, refs[i]->texture.id);
-            if (t)
-                n += (size_t)snprintf(tex + n, sizeof tex - n, " %s%d:%ux%u%s%s wrap %u,%u", i < 5 ? "t" : "l", i < 5 ? i : i - 5,
-                                      t->width, t->height, t->is_float ? " float" : t->srgb ? " srgb" : "",
-                                      t->nearest ? " nearest" : "", t->wrap_s, t->wrap_t);
-        }
-    }
-    fprintf(stderr, "raster profile: %s draw took %.3f s of the GL thread's CPU (a shader compile): %s;%s\n", what, dt, name,
-            tex[0] ? tex : " no textures");
-}
-
 sy_gl_result sy_gli_current(sy_gl_device *dev, sy_gl_report *rep)
 {
     if (!sy_gl_context_make_current(dev->ctx))

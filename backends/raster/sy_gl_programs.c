@@ -243,6 +243,35 @@ void sy_gli_variant_name(const sy_gl_device *dev, int v, char *name, size_t len)
     variant_defines(v, variant_sig(dev, v), defs, sizeof defs, name, len);
 }
 
+/* A draw that took the GL thread over 20 ms of CPU since t0 (a shader compile): its program and
+ * what the material's texture units sample, on stderr (SY_GL_PROFILE). */
+void sy_gli_profile_draw(const sy_gl_device *dev, double t0, const char *what)
+{
+    if (!dev->profile) return;
+    double dt = sy_gli_profile_thread(dev) - t0;
+    if (dt <= 0.02) return;
+    char name[256] = "another program";
+    if (dev->profile_var >= 0) sy_gli_variant_name(dev, dev->profile_var, name, sizeof name);
+    char tex[512] = "";
+    const mat_o *m = dev->profile_var >= 0 ? sy_gli_pool_get(&dev->materials, dev->profile_mat) : NULL;
+    if (m) { /* what the material's texture units sample: llvmpipe's shader key holds their sampling */
+        const sy_gl_texture_ref *refs[5 + LAYER_TEXTURES] = {&m->d.base_color_texture, &m->d.metallic_roughness_texture,
+                                                             &m->d.normal_texture, &m->d.occlusion_texture,
+                                                             &m->d.emissive_texture};
+        sy_gli_layer_refs(&m->d, refs + 5);
+        size_t n = 0;
+        for (int i = 0; i < 5 + LAYER_TEXTURES && n < sizeof tex; ++i) {
+            const tex_o *t = sy_gli_pool_get(&dev->textures, refs[i]->texture.id);
+            if (t)
+                n += (size_t)snprintf(tex + n, sizeof tex - n, " %s%d:%ux%u%s%s wrap %u,%u", i < 5 ? "t" : "l", i < 5 ? i : i - 5,
+                                      t->width, t->height, t->is_float ? " float" : t->srgb ? " srgb" : "",
+                                      t->nearest ? " nearest" : "", t->wrap_s, t->wrap_t);
+        }
+    }
+    fprintf(stderr, "raster profile: %s draw took %.3f s of the GL thread's CPU (a shader compile): %s;%s\n", what, dt, name,
+            tex[0] ? tex : " no textures");
+}
+
 /* The main program for variant bits v, built and cached on first use; 0 (the failure reported to rep) when the
  * driver rejects it. */
 GLuint sy_gli_main_program(sy_gl_device *dev, int v, sy_gl_report *rep)
