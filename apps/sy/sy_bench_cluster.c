@@ -109,10 +109,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     sy_scene *scene = NULL;
     sy_demo_info d;
     sy_bench_cluster_server srv[2] = {{0}};
-    sy_cluster_client *c = NULL;
-    sy_window *win = NULL;
-    sy_viewport *vp = NULL;
-    sy_layer out = {0};
+    sy_bench_cluster_rig rig = {0};
     sy_changes *snap = NULL;
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     sy_result r = sy_scene_create(&scene, &err);
@@ -184,16 +181,11 @@ int sy_cmd_bench_cluster(int argc, char **argv)
         sy_scene_destroy(scene);
         return r == SY_OK ? 0 : sy_cli_fail(&err);
     }
-    sy_camera_view view = {0};
-    if (r == SY_OK) r = sy_window_create(w, h, &win, &err);
-    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, &err);
-    if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, &err);
-    if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &c, &err);
-    if (r == SY_OK) r = sy_layer_create(w, h, &out, &err);
+    if (r == SY_OK) r = sy_bench_cluster_rig_open(scene, &vd, &co, w, h, &rig, &err);
     sy_cluster_frame f = {.mode = SY_CLUSTER_SORT_FIRST, .backend = backend, .root_id = d.root.id,
-                          .background_id = d.background.id, .camera = view, .width = w, .height = h};
+                          .background_id = d.background.id, .camera = rig.view, .width = w, .height = h};
     sy_cluster_frame_stats s1 = {0}, s2 = {0};
-    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &out, &s1, &err);
+    if (r == SY_OK) r = sy_cluster_client_render(rig.client, &f, &rig.img, &s1, &err);
     /* one transform change */
     if (r == SY_OK) {
         sy_mat4 m;
@@ -202,13 +194,13 @@ int sy_cmd_bench_cluster(int argc, char **argv)
         if (r == SY_OK) r = sy_node_set_matrix(scene, d.camera, &m, &err);
     }
     if (r == SY_OK) r = sy_scene_commit(scene, NULL, &err);
-    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &out, &s2, &err);
+    if (r == SY_OK) r = sy_cluster_client_render(rig.client, &f, &rig.img, &s2, &err);
     /* steady state: frames without changes */
     double over = 0, frame = 0, bytes = 0;
     const int reps = 5;
     for (int i = 0; i < reps && r == SY_OK; ++i) {
         sy_cluster_frame_stats s;
-        r = sy_cluster_client_render(c, &f, &out, &s, &err);
+        r = sy_cluster_client_render(rig.client, &f, &rig.img, &s, &err);
         over += s.seconds - s.max_server_seconds;
         frame += s.seconds;
         bytes += (double)(s.bytes_sent + s.bytes_received);
@@ -236,7 +228,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
         r = sy_layer_create(tf.width, tf.height, &tiny, &err);
         for (int i = -1; i < lat_n && r == SY_OK; ++i) { /* i = -1: warm-up (a new image size) */
             sy_cluster_frame_stats s;
-            r = sy_cluster_client_render(c, &tf, &tiny, &s, &err);
+            r = sy_cluster_client_render(rig.client, &tf, &tiny, &s, &err);
             double l = s.seconds - s.max_server_seconds;
             if (r == SY_OK && i >= 0) {
                 lat_sum += l, frame_sum += s.seconds;
@@ -254,12 +246,12 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     if (r == SY_OK) {
         sy_cluster_buf enc = {0};
         double te = sy_time_now();
-        r = sy_cluster_tile_encode(&out, true, &enc, &err);
+        r = sy_cluster_tile_encode(&rig.img, true, &enc, &err);
         te = sy_time_now() - te;
         sy_cluster_tile t = {{0, 0, w, h}, SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD, 5, (uint64_t)w * h * 20, enc.data,
                              (uint32_t)enc.size};
         double td = sy_time_now();
-        if (r == SY_OK) r = sy_cluster_tile_decode(&t, &out, 0, 0, &err);
+        if (r == SY_OK) r = sy_cluster_tile_decode(&t, &rig.img, 0, 0, &err);
         td = sy_time_now() - td;
         double raw = (double)w * h * 20;
         if (r == SY_OK)
@@ -268,11 +260,9 @@ int sy_cmd_bench_cluster(int argc, char **argv)
                    w, h, raw / 1e6, (double)enc.size / 1e6, raw / (double)enc.size, raw / te / 1e6, raw / td / 1e6);
         sy_cluster_buf_free(&enc);
     }
-    if (r == SY_OK) r = bench_half_and_blob_cache(scene, &co, c, &f, &out, &s1, &err);
+    if (r == SY_OK) r = bench_half_and_blob_cache(scene, &co, rig.client, &f, &rig.img, &s1, &err);
     if (r == SY_OK) r = sy_bench_cluster_hostile(scene, &d, backend, &srv[0], &err);
-    sy_layer_destroy(&out);
-    sy_cluster_client_destroy(c);
-    c = NULL;
+    sy_bench_cluster_rig_close(&rig);
     /* cooperative path tracing: 2 pinned servers vs 1 */
     if (r == SY_OK && sy_mediator_find("pathtracer")) {
         r = sy_bench_cluster_coop(scene, &vd, srv, rounds, ncpu >= 2, coop_frame, &err);
@@ -281,7 +271,6 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     }
     sy_bench_cluster_stop(&srv[0]);
     sy_bench_cluster_stop(&srv[1]);
-    sy_window_destroy(win);
     sy_scene_destroy(scene);
     return r == SY_OK ? 0 : sy_cli_fail(&err);
 }

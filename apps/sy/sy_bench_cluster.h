@@ -1,6 +1,7 @@
 /* sy_bench_cluster.h — what the files of `sy bench cluster` share (the command, sy_cmd_bench_cluster,
  * is in sy_cluster_cli.h; its options and default measurements in sy_bench_cluster.c): the
- * benchmark's `sy serve` child processes (sy_bench_cluster_servers.c) and its other measurements,
+ * benchmark's `sy serve` child processes and the client rig that talks to them
+ * (sy_bench_cluster_servers.c) and its other measurements,
  * one file each: the cooperative speed-up (sy_bench_cluster_coop.c), hostile peers
  * (sy_bench_cluster_hostile.c), the soak (sy_bench_cluster_soak.c) and the scaling model
  * (sy_bench_cluster_scale.c). Built with the cluster only (SY_WITH_CLUSTER). They print what they
@@ -32,6 +33,22 @@ sy_result sy_bench_cluster_spawn(int cpu, sy_bench_cluster_server *out, sy_error
 void sy_bench_cluster_stop(sy_bench_cluster_server *s);
 /* VmRSS (or another "Vm...:" line, or "Threads") of a process in KiB; -1 when unreadable. */
 long sy_bench_cluster_proc_status_kb(pid_t pid, const char *field);
+
+/* A client of the benchmark's servers with what its frames need: a window holding a viewport of vd
+ * (its camera's view at w x h), the client (opts co) and a w x h output layer. */
+typedef struct sy_bench_cluster_rig {
+    sy_window *win;
+    sy_viewport *vp;
+    sy_camera_view view;
+    sy_cluster_client *client;
+    sy_layer img;
+} sy_bench_cluster_rig;
+/* Opens all of it in that order; on failure what was opened stays in *rig for
+ * sy_bench_cluster_rig_close. */
+sy_result sy_bench_cluster_rig_open(sy_scene *scene, const sy_viewport_desc *vd, const sy_cluster_client_opts *co,
+                                    uint32_t w, uint32_t h, sy_bench_cluster_rig *rig, sy_error *err);
+/* Destroys what rig_open opened (the layer, the client, the window) and zeroes *rig. */
+void sy_bench_cluster_rig_close(sy_bench_cluster_rig *rig);
 
 /* Cooperative path tracing, 2 servers (srv[0], srv[1]; pinned: to cores 0 and 1) vs 1 in `rounds`
  * interleaved rounds, frames of about frame_s seconds on one server (sy_bench_cluster_coop.c). */

@@ -45,23 +45,15 @@ static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const
     memset(out, 0, sizeof *out);
     const char *urls[2] = {srv[0].url, n > 1 ? srv[1].url : NULL};
     sy_cluster_client_opts co = {.urls = urls, .url_count = n, .timeout_ms = 120000};
-    sy_cluster_client *c = NULL;
-    sy_window *win = NULL;
-    sy_viewport *vp = NULL;
-    sy_camera_view view = {0};
-    sy_layer out_img = {0};
-    sy_result r = sy_window_create(w, h, &win, err);
-    if (r == SY_OK) r = sy_window_add_viewport(win, vd, &vp, err);
-    if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, err);
-    if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &c, err);
-    if (r == SY_OK) r = sy_layer_create(w, h, &out_img, err);
+    sy_bench_cluster_rig rig;
+    sy_result r = sy_bench_cluster_rig_open(scene, vd, &co, w, h, &rig, err);
     sy_cluster_frame f = {.mode = SY_CLUSTER_COOPERATIVE, .backend = "pathtracer", .root_id = vd->root.id,
-                          .background_id = vd->background.id, .camera = view, .width = w, .height = h, .samples = 4};
+                          .background_id = vd->background.id, .camera = rig.view, .width = w, .height = h, .samples = 4};
     sy_cluster_frame_stats st = {0};
-    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &out_img, &st, err); /* warm-up: snapshot + translation */
+    if (r == SY_OK) r = sy_cluster_client_render(rig.client, &f, &rig.img, &st, err); /* warm-up: snapshot + translation */
     if (r == SY_OK && !*spf) {
         double t = sy_time_now();
-        r = sy_cluster_client_render(c, &f, &out_img, &st, err);
+        r = sy_cluster_client_render(rig.client, &f, &rig.img, &st, err);
         t = sy_time_now() - t;
         double k = t > 0 ? frame_s / t : 256.0;
         *spf = k >= 256.0 ? 1024u : k <= 1.0 ? 4u : (uint32_t)(4.0 * k + 0.5);
@@ -71,7 +63,7 @@ static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const
     double cpu0[2] = {proc_cpu_seconds(srv[0].pid), n > 1 ? proc_cpu_seconds(srv[1].pid) : -1.0};
     double t0 = sy_time_now();
     while (r == SY_OK && (out->frames < 3 || sy_time_now() - t0 < min_seconds)) {
-        r = sy_cluster_client_render(c, &f, &out_img, &st, err);
+        r = sy_cluster_client_render(rig.client, &f, &rig.img, &st, err);
         out->frames++;
         if (r == SY_OK && st.servers_live != n)
             r = sy_error_set(err, SY_ERR_IO, "bench: a server dropped out of the cooperative measurement");
@@ -83,9 +75,7 @@ static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const
         double now = i < n ? proc_cpu_seconds(srv[i].pid) : -1.0;
         out->cpu[i] = now >= 0 && cpu0[i] >= 0 ? now - cpu0[i] : -1.0;
     }
-    sy_layer_destroy(&out_img);
-    sy_cluster_client_destroy(c);
-    sy_window_destroy(win);
+    sy_bench_cluster_rig_close(&rig);
     return r;
 }
 

@@ -31,30 +31,22 @@ static sy_result scale_measure(sy_scene *scene, const sy_demo_info *d, const sy_
 {
     const char *urls[3] = {srv[0].url, srv[1].url, srv[2].url};
     sy_cluster_client_opts co = {.urls = urls, .url_count = n, .timeout_ms = 600000};
-    sy_cluster_client *c = NULL;
-    sy_window *win = NULL;
-    sy_viewport *vp = NULL;
-    sy_camera_view view = {0};
-    sy_layer img = {0};
     bool coop = mode == SY_CLUSTER_COOPERATIVE;
     bool raster = sy_mediator_find("raster") != NULL; /* the picture back-ends measured: raster, else whitted */
     const char *backend = coop ? "pathtracer" : raster ? "raster" : "whitted";
     const char *params = coop ? "threads=1" : raster ? NULL : "spp=1,threads=1"; /* one core per server */
     sy_viewport_desc vd = {.root = d->root, .camera = d->camera, .background = d->background, .backend = backend};
-    sy_result r = sy_window_create(w, h, &win, err);
-    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
-    if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, err);
-    if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &c, err);
-    if (r == SY_OK) r = sy_layer_create(w, h, &img, err);
+    sy_bench_cluster_rig rig;
+    sy_result r = sy_bench_cluster_rig_open(scene, &vd, &co, w, h, &rig, err);
     sy_cluster_frame f = {.mode = mode, .backend = backend, .params = params,
-                          .root_id = d->root.id, .background_id = d->background.id, .camera = view, .width = w,
+                          .root_id = d->root.id, .background_id = d->background.id, .camera = rig.view, .width = w,
                           .height = h, .samples = 1, .samples_total = coop ? n : 0, .depth = true};
     sy_cluster_frame_stats st;
-    if (r == SY_OK) r = sy_cluster_client_render(c, &f, &img, &st, err); /* warm-up: snapshot + translation */
+    if (r == SY_OK) r = sy_cluster_client_render(rig.client, &f, &rig.img, &st, err); /* warm-up: snapshot + translation */
     double fr[16], ov[16], sv[16], back[16], sent[16];
     if (frames > 16) frames = 16;
     for (uint32_t i = 0; i < frames && r == SY_OK; ++i) {
-        r = sy_cluster_client_render(c, &f, &img, &st, err);
+        r = sy_cluster_client_render(rig.client, &f, &rig.img, &st, err);
         fr[i] = st.seconds, sv[i] = st.max_server_seconds, ov[i] = st.seconds - st.max_server_seconds;
         back[i] = (double)st.bytes_received, sent[i] = (double)st.bytes_sent;
         if (r == SY_OK && st.servers_live != n) r = sy_error_set(err, SY_ERR_IO, "bench: a server dropped out");
@@ -67,12 +59,10 @@ static sy_result scale_measure(sy_scene *scene, const sy_demo_info *d, const sy_
         out->bytes_out = sy_bench_spread_of(sent, frames).median;
     }
     if (r == SY_OK && img_out) {
-        *img_out = img;
-        img = (sy_layer){0};
+        *img_out = rig.img;
+        rig.img = (sy_layer){0};
     }
-    sy_layer_destroy(&img);
-    sy_cluster_client_destroy(c);
-    sy_window_destroy(win);
+    sy_bench_cluster_rig_close(&rig);
     return r;
 }
 

@@ -1,6 +1,6 @@
 /* sy_bench_cluster_servers.c — the `sy serve` child processes of `sy bench cluster` (started from
- * this very executable on loopback, pinned to a core where asked) and what /proc says about a
- * process (see sy_bench_cluster.h). */
+ * this very executable on loopback, pinned to a core where asked), the client rig its measurements
+ * talk to them with, and what /proc says about a process (see sy_bench_cluster.h). */
 #define _GNU_SOURCE /* sched_setaffinity for the pinned benchmark servers */
 #include "sy_bench_cluster.h"
 
@@ -75,6 +75,26 @@ void sy_bench_cluster_stop(sy_bench_cluster_server *s)
         waitpid(s->pid, NULL, 0);
         s->pid = 0;
     }
+}
+
+sy_result sy_bench_cluster_rig_open(sy_scene *scene, const sy_viewport_desc *vd, const sy_cluster_client_opts *co,
+                                    uint32_t w, uint32_t h, sy_bench_cluster_rig *rig, sy_error *err)
+{
+    memset(rig, 0, sizeof *rig);
+    sy_result r = sy_window_create(w, h, &rig->win, err);
+    if (r == SY_OK) r = sy_window_add_viewport(rig->win, vd, &rig->vp, err);
+    if (r == SY_OK) r = sy_viewport_camera_view(rig->vp, scene, w, h, &rig->view, err);
+    if (r == SY_OK) r = sy_cluster_client_create(scene, co, &rig->client, err);
+    if (r == SY_OK) r = sy_layer_create(w, h, &rig->img, err);
+    return r;
+}
+
+void sy_bench_cluster_rig_close(sy_bench_cluster_rig *rig)
+{
+    sy_layer_destroy(&rig->img);
+    sy_cluster_client_destroy(rig->client);
+    sy_window_destroy(rig->win);
+    memset(rig, 0, sizeof *rig);
 }
 
 /* VmRSS (or another "Vm...:" line) of a process in KiB; -1 when unreadable. */

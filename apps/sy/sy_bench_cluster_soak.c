@@ -52,23 +52,16 @@ sy_result sy_bench_cluster_soak(sy_scene *scene, const sy_demo_info *d, const ch
 {
     *passed = false;
     sy_bench_cluster_server srv = {0};
-    sy_window *win = NULL;
-    sy_viewport *vp = NULL;
-    sy_cluster_client *c = NULL;
-    sy_layer out = {0};
+    sy_bench_cluster_rig rig = {0};
     sy_mat4 m0;
     sy_result r = sy_bench_cluster_spawn_ex(-1, (int)seconds + 300, false, &srv, err);
     sy_viewport_desc vd = {.root = d->root, .camera = d->camera, .background = d->background, .backend = backend};
     const char *urls[1] = {srv.url};
     sy_cluster_client_opts co = {.urls = urls, .url_count = 1, .timeout_ms = 120000};
-    if (r == SY_OK) r = sy_window_create(w, h, &win, err);
-    if (r == SY_OK) r = sy_window_add_viewport(win, &vd, &vp, err);
     if (r == SY_OK) r = sy_node_world_matrix(scene, d->camera, &m0, err); /* under an identity root: = local */
-    if (r == SY_OK) r = sy_cluster_client_create(scene, &co, &c, err);
-    if (r == SY_OK) r = sy_layer_create(w, h, &out, err);
+    if (r == SY_OK) r = sy_bench_cluster_rig_open(scene, &vd, &co, w, h, &rig, err);
     if (r != SY_OK) {
-        sy_cluster_client_destroy(c);
-        sy_window_destroy(win);
+        sy_bench_cluster_rig_close(&rig);
         sy_bench_cluster_stop(&srv);
         return r;
     }
@@ -117,7 +110,7 @@ sy_result sy_bench_cluster_soak(sy_scene *scene, const sy_demo_info *d, const ch
         sy_camera_view view = {0};
         r = sy_node_set_matrix(scene, d->camera, &m, err);
         if (r == SY_OK) r = sy_scene_commit(scene, NULL, err);
-        if (r == SY_OK) r = sy_viewport_camera_view(vp, scene, w, h, &view, err);
+        if (r == SY_OK) r = sy_viewport_camera_view(rig.vp, scene, w, h, &view, err);
         if (r != SY_OK) break;
         sy_cluster_frame f = {.mode = SY_CLUSTER_SORT_FIRST, .backend = backend, .root_id = d->root.id,
                               .background_id = d->background.id, .camera = view, .width = w, .height = h};
@@ -125,7 +118,7 @@ sy_result sy_bench_cluster_soak(sy_scene *scene, const sy_demo_info *d, const ch
         sy_error fe = {0};
         double ft = sy_time_now();
         sent++;
-        sy_result fr = sy_cluster_client_render(c, &f, &out, &st, &fe);
+        sy_result fr = sy_cluster_client_render(rig.client, &f, &rig.img, &st, &fe);
         ft = sy_time_now() - ft;
         if (fr == SY_OK && st.servers_failed == 0 && st.bytes_received > 0) {
             received++;
@@ -140,9 +133,7 @@ sy_result sy_bench_cluster_soak(sy_scene *scene, const sy_demo_info *d, const ch
         bytes_out += st.bytes_sent;
         bytes_in += st.bytes_received;
     }
-    sy_cluster_client_destroy(c);
-    sy_layer_destroy(&out);
-    sy_window_destroy(win);
+    sy_bench_cluster_rig_close(&rig);
     sy_bench_cluster_stop(&srv);
     if (r != SY_OK) return r;
     double g_rss = growth_pct(base.rss_kb, last.rss_kb), g_fds = growth_pct(base.fds, last.fds),
