@@ -3,11 +3,11 @@
 # Included at the end of formats/CMakeLists.txt.
 pkg_check_modules(SY_ASSIMP REQUIRED IMPORTED_TARGET assimp)
 target_sources(sy_formats PRIVATE
-  ${CMAKE_CURRENT_LIST_DIR}/sy_assimp.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_assimp_io.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_assimp_isolate.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_assimp_materials.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_assimp_scene.c
+  sy_assimp.c
+  sy_assimp_io.c
+  sy_assimp_isolate.c
+  sy_assimp_materials.c
+  sy_assimp_scene.c
 )
 target_link_libraries(sy_formats PRIVATE PkgConfig::SY_ASSIMP)
 list(APPEND sy_formats_pkg "SY_ASSIMP|assimp")

@@ -3,19 +3,19 @@
 # sy_gltf_shim_write.cpp and the Draco decoder sy_gltf_draco.cpp, the only C++ in
 # formats/). Included at the end of formats/CMakeLists.txt.
 target_sources(sy_formats PRIVATE
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_errors.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_validate.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_accessors.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_materials.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_meshes.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_nodes.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_animations.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_variants.c
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_shim.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_shim_write.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_draco.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/sy_gltf_meshopt.c
+  sy_gltf.c
+  sy_gltf_errors.c
+  sy_gltf_validate.c
+  sy_gltf_accessors.c
+  sy_gltf_materials.c
+  sy_gltf_meshes.c
+  sy_gltf_nodes.c
+  sy_gltf_animations.c
+  sy_gltf_variants.c
+  sy_gltf_shim.cpp
+  sy_gltf_shim_write.cpp
+  sy_gltf_draco.cpp
+  sy_gltf_meshopt.c
 )
 # Debian's tinygltf exports TinyGLTF::TinyGLTF; accept the lower-case spelling too.
 if(TARGET TinyGLTF::tinygltf)
