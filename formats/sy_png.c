@@ -47,10 +47,66 @@ void sy_png_encode_over_black(const float *rgba_premultiplied, size_t count, con
     }
 }
 
+/* ---- >>libpng passes: what the writer and the metadata reader share ---- */
+
+/* The head of every job: the stream, and why the pass failed (the first libpng error, or ours). */
+typedef struct png_io {
+    FILE *fp;
+    char msg[256];
+} png_io;
+
+/* libpng's error callback (error pointer: the job's png_io): keeps the first message, longjmps. */
+static void on_png_error(png_structp png, png_const_charp msg)
+{
+    png_io *io = png_get_error_ptr(png);
+    if (io && io->msg[0] == '\0') snprintf(io->msg, sizeof io->msg, "%s", msg ? msg : "libpng error");
+    png_longjmp(png, 1);
+}
+
+static void on_png_warning(png_structp png, png_const_charp msg)
+{
+    (void)png; /* warnings fail neither a write nor a read; nothing to report */
+    (void)msg;
+}
+
+/* Everything of a pass that may longjmp; false with io->msg on failure. */
+typedef bool (*png_body_fn)(png_structp png, png_infop info, png_io *io);
+
+static void png_pass_end(bool writing, png_structp *png, png_infop *info)
+{
+    if (writing) png_destroy_write_struct(png, info);
+    else png_destroy_read_struct(png, info, NULL);
+}
+
+/* One libpng pass (a writer, or a reader): creates the structs, runs body under setjmp (libpng's
+ * errors longjmp back here; no local is modified after it), destroys them. False with io->msg. */
+static bool png_pass(bool writing, png_io *io, png_body_fn body)
+{
+    png_structp png = writing ? png_create_write_struct(PNG_LIBPNG_VER_STRING, io, on_png_error, on_png_warning)
+                              : png_create_read_struct(PNG_LIBPNG_VER_STRING, io, on_png_error, on_png_warning);
+    if (!png) {
+        snprintf(io->msg, sizeof io->msg, "cannot create the libpng %s", writing ? "writer" : "reader");
+        return false;
+    }
+    png_infop info = png_create_info_struct(png);
+    if (!info) {
+        png_pass_end(writing, &png, NULL);
+        snprintf(io->msg, sizeof io->msg, "cannot create the libpng info struct");
+        return false;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_pass_end(writing, &png, &info);
+        return false;
+    }
+    bool ok = body(png, info, io);
+    png_pass_end(writing, &png, &info);
+    return ok;
+}
+
 /* ---- >>writer ---- */
 
 typedef struct png_write_job {
-    FILE *fp;
+    png_io io; /* first: the pass sees the job as its png_io */
     int width, height;
     const float *rgba;
     float scale;
@@ -58,26 +114,13 @@ typedef struct png_write_job {
     uint8_t *row; /* width * 4 bytes */
     const sy_png_text *text;
     int text_count;
-    char msg[256];
 } png_write_job;
 
-static void on_png_error(png_structp png, png_const_charp msg)
+/* Everything that may longjmp after the header is set up (a png_pass body). */
+static bool write_png_body(png_structp png, png_infop info, png_io *io)
 {
-    png_write_job *job = png_get_error_ptr(png);
-    if (job && job->msg[0] == '\0') snprintf(job->msg, sizeof job->msg, "%s", msg ? msg : "libpng error");
-    png_longjmp(png, 1);
-}
-
-static void on_png_warning(png_structp png, png_const_charp msg)
-{
-    (void)png; /* warnings do not fail a write; nothing to report */
-    (void)msg;
-}
-
-/* Everything that may longjmp after the header is set up; called from write_png_stream. */
-static void write_png_body(png_structp png, png_infop info, png_write_job *job)
-{
-    png_init_io(png, job->fp);
+    png_write_job *job = (png_write_job *)io;
+    png_init_io(png, io->fp);
     png_set_IHDR(png, info, (png_uint_32)job->width, (png_uint_32)job->height, 8, PNG_COLOR_TYPE_RGB_ALPHA,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
@@ -99,28 +142,6 @@ static void write_png_body(png_structp png, png_infop info, png_write_job *job)
         png_write_row(png, job->row);
     }
     png_write_end(png, NULL);
-}
-
-/* Returns true on success; on failure job->msg says why. */
-static bool write_png_stream(png_write_job *job)
-{
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, job, on_png_error, on_png_warning);
-    if (!png) {
-        snprintf(job->msg, sizeof job->msg, "cannot create the libpng writer");
-        return false;
-    }
-    png_infop info = png_create_info_struct(png);
-    if (!info) {
-        png_destroy_write_struct(&png, NULL);
-        snprintf(job->msg, sizeof job->msg, "cannot create the libpng info struct");
-        return false;
-    }
-    if (setjmp(png_jmpbuf(png))) {
-        png_destroy_write_struct(&png, &info);
-        return false;
-    }
-    write_png_body(png, info, job);
-    png_destroy_write_struct(&png, &info);
     return true;
 }
 
@@ -166,12 +187,12 @@ sy_result sy_png_write(const char *path, int width, int height, const float *rgb
         free(job.row);
         return rc;
     }
-    job.fp = af.fp;
-    bool ok = write_png_stream(&job);
+    job.io.fp = af.fp;
+    bool ok = png_pass(true, &job.io, write_png_body);
     free(job.row);
     if (!ok) {
         sy_atomic_file_abort(&af);
-        return sy_error_set(err, SY_ERR_IO, "%s: PNG encoding failed: %s", path, job.msg);
+        return sy_error_set(err, SY_ERR_IO, "%s: PNG encoding failed: %s", path, job.io.msg);
     }
     return sy_atomic_file_commit(&af, err);
 }
@@ -234,22 +255,15 @@ sy_result sy_png_read_rgba8(const char *path, int *width_out, int *height_out, u
 /* ---- >>metadata reader ---- */
 
 typedef struct png_info_job {
-    FILE *fp;
+    png_io io; /* first: the pass sees the job as its png_io */
     sy_png_info *out;
-    char msg[256];
 } png_info_job;
 
-static void on_png_read_error(png_structp png, png_const_charp msg)
+/* Everything that may longjmp (a png_pass body). */
+static bool read_info_body(png_structp png, png_infop info, png_io *io)
 {
-    png_info_job *job = png_get_error_ptr(png);
-    if (job && job->msg[0] == '\0') snprintf(job->msg, sizeof job->msg, "%s", msg ? msg : "libpng error");
-    png_longjmp(png, 1);
-}
-
-/* Everything that may longjmp; called from read_info_stream. False with job->msg on failure. */
-static bool read_info_body(png_structp png, png_infop info, png_info_job *job)
-{
-    png_init_io(png, job->fp);
+    png_info_job *job = (png_info_job *)io;
+    png_init_io(png, io->fp);
     png_set_chunk_malloc_max(png, 1u << 20); /* one chunk, zTXt decompressed included */
     png_set_chunk_cache_max(png, 64);        /* ancillary chunks kept */
     png_read_info(png, info);
@@ -264,7 +278,7 @@ static bool read_info_body(png_structp png, png_infop info, png_info_job *job)
         if (!k || !v) {
             free(k);
             free(v);
-            snprintf(job->msg, sizeof job->msg, "out of memory for text chunk '%s'", t[i].key ? t[i].key : "");
+            snprintf(io->msg, sizeof io->msg, "out of memory for text chunk '%s'", t[i].key ? t[i].key : "");
             return false;
         }
         if (t[i].text_length) memcpy(v, t[i].text, t[i].text_length);
@@ -273,28 +287,6 @@ static bool read_info_body(png_structp png, png_infop info, png_info_job *job)
         job->out->values[job->out->text_count++] = v;
     }
     return true;
-}
-
-static bool read_info_stream(png_info_job *job)
-{
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, job, on_png_read_error, on_png_warning);
-    if (!png) {
-        snprintf(job->msg, sizeof job->msg, "cannot create the libpng reader");
-        return false;
-    }
-    png_infop info = png_create_info_struct(png);
-    if (!info) {
-        png_destroy_read_struct(&png, NULL, NULL);
-        snprintf(job->msg, sizeof job->msg, "cannot create the libpng info struct");
-        return false;
-    }
-    if (setjmp(png_jmpbuf(png))) {
-        png_destroy_read_struct(&png, &info, NULL);
-        return false;
-    }
-    bool ok = read_info_body(png, info, job);
-    png_destroy_read_struct(&png, &info, NULL);
-    return ok;
 }
 
 sy_result sy_png_read_info(const char *path, sy_png_info *out, sy_error *err)
@@ -313,12 +305,12 @@ sy_result sy_png_read_info(const char *path, sy_png_info *out, sy_error *err)
         return sy_error_set(err, SY_ERR_PARSE, "%s: not a PNG (no PNG signature)", path);
     }
     rewind(fp);
-    png_info_job job = {.fp = fp, .out = out};
-    bool ok = read_info_stream(&job);
+    png_info_job job = {.io = {.fp = fp}, .out = out};
+    bool ok = png_pass(false, &job.io, read_info_body);
     fclose(fp);
     if (!ok) {
         sy_png_info_free(out);
-        return sy_error_set(err, SY_ERR_PARSE, "%s: not a readable PNG: %s", path, job.msg);
+        return sy_error_set(err, SY_ERR_PARSE, "%s: not a readable PNG: %s", path, job.io.msg);
     }
     return SY_OK;
 }
