@@ -100,9 +100,18 @@ static const char *type_word(uint32_t t)
     return t == SY_TYPE_NODE ? "node" : t == SY_TYPE_MATERIAL ? "material" : t == SY_TYPE_LIGHT ? "light" : "camera";
 }
 
-/* An animation blob of whole records of `elem` bytes, at most `max` of them (NULL = none). */
-static sy_result check_records(const sy_blob *b, size_t elem, uint32_t max, uint32_t id, const char *what, sy_error *err)
+/* An enumeration field (a uint32_t at v) of at most max; else "WHAT VALUE". */
+static sy_result check_enum(const void *v, uint32_t max, const char *what, sy_error *err)
 {
+    uint32_t x = *(const uint32_t *)v;
+    return x <= max ? SY_OK : sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s %u", what, x);
+}
+
+/* An animation blob of whole records of `elem` bytes, at most `max` of them (NULL = none). */
+static sy_result check_records(const sy_blob *b, size_t elem, uint32_t max, uint32_t id, const char *what,
+                                const void **records, size_t *count, sy_error *err)
+{
+    *records = NULL, *count = 0;
     if (!b) return SY_OK;
     size_t n = sy_blob_size(b);
     if (n % elem != 0)
@@ -110,6 +119,7 @@ static sy_result check_records(const sy_blob *b, size_t elem, uint32_t max, uint
                             what, n, elem);
     if (n / elem > max)
         return sy_error_set(err, SY_ERR_LIMIT, "animation %#x: %zu %s (at most %u)", id, n / elem, what, max);
+    *records = sy_blob_data(b), *count = n / elem;
     return SY_OK;
 }
 
@@ -128,12 +138,13 @@ static sy_result check_animation_field(const sy_scene *s, uint32_t id, uint32_t 
         return SY_OK;
     }
     const sy_blob *b = f == SY_ANIMATION_NAME ? NULL : *(sy_blob *const *)v;
+    const void *rec;
+    size_t n;
     sy_result r;
     switch (f) {
     case SY_ANIMATION_SAMPLERS: {
-        if ((r = check_records(b, sizeof(sy_anim_sampler), SY_ANIM_MAX_SAMPLERS, id, "samplers", err))) return r;
-        const sy_anim_sampler *sm = b ? sy_blob_data(b) : NULL;
-        uint32_t n = b ? (uint32_t)(sy_blob_size(b) / sizeof *sm) : 0;
+        if ((r = check_records(b, sizeof(sy_anim_sampler), SY_ANIM_MAX_SAMPLERS, id, "samplers", &rec, &n, err))) return r;
+        const sy_anim_sampler *sm = rec;
         for (uint32_t i = 0; i < n; ++i) {
             if (sm[i].interpolation >= SY_INTERP_COUNT)
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x sampler %u: unknown interpolation %u", id,
@@ -148,9 +159,8 @@ static sy_result check_animation_field(const sy_scene *s, uint32_t id, uint32_t 
         return SY_OK;
     }
     case SY_ANIMATION_CHANNELS: {
-        if ((r = check_records(b, sizeof(sy_anim_channel), SY_ANIM_MAX_CHANNELS, id, "channels", err))) return r;
-        const sy_anim_channel *ch = b ? sy_blob_data(b) : NULL;
-        uint32_t n = b ? (uint32_t)(sy_blob_size(b) / sizeof *ch) : 0;
+        if ((r = check_records(b, sizeof(sy_anim_channel), SY_ANIM_MAX_CHANNELS, id, "channels", &rec, &n, err))) return r;
+        const sy_anim_channel *ch = rec;
         for (uint32_t i = 0; i < n; ++i) {
             if (ch[i].path >= SY_ANIM_PATH_COUNT)
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x channel %u: unknown path %u", id, i,
@@ -166,9 +176,8 @@ static sy_result check_animation_field(const sy_scene *s, uint32_t id, uint32_t 
     case SY_ANIMATION_TIMES:
     case SY_ANIMATION_VALUES: {
         const char *what = f == SY_ANIMATION_TIMES ? "times" : "values";
-        if ((r = check_records(b, sizeof(float), UINT32_MAX, id, what, err))) return r;
-        const float *x = b ? sy_blob_data(b) : NULL;
-        size_t n = b ? sy_blob_size(b) / sizeof(float) : 0;
+        if ((r = check_records(b, sizeof(float), UINT32_MAX, id, what, &rec, &n, err))) return r;
+        const float *x = rec;
         for (size_t i = 0; i < n; ++i)
             if (!isfinite(x[i]))
                 return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "animation %#x: %s[%zu] is not finite", id, what, i);
@@ -552,10 +561,7 @@ sy_result sy_sc_validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_t
         return SY_OK;
     case SY_TYPE_LIGHT:
         if (f == SY_LIGHT_NAME) return SY_OK;
-        if (f == SY_LIGHT_TYPE)
-            return *(const uint32_t *)v <= SY_LIGHT_DIRECTIONAL
-                       ? SY_OK
-                       : sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "light: unknown type %u", *(const uint32_t *)v);
+        if (f == SY_LIGHT_TYPE) return check_enum(v, SY_LIGHT_DIRECTIONAL, "light: unknown type", err);
         {
             const float *fv = v;
             int n = f == SY_LIGHT_COLOR ? 3 : 1;
@@ -575,11 +581,7 @@ sy_result sy_sc_validate_field(sy_scene *s, uint32_t type, uint32_t id, uint32_t
         return SY_OK;
     case SY_TYPE_CAMERA:
         if (f == SY_CAMERA_NAME) return SY_OK;
-        if (f == SY_CAMERA_PROJECTION)
-            return *(const uint32_t *)v <= SY_PROJECTION_ORTHOGRAPHIC
-                       ? SY_OK
-                       : sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "camera: unknown projection %u",
-                                      *(const uint32_t *)v);
+        if (f == SY_CAMERA_PROJECTION) return check_enum(v, SY_PROJECTION_ORTHOGRAPHIC, "camera: unknown projection", err);
         {
             float x = *(const float *)v;
             const char *fn = sy__type_desc(type)->fields[f].name;
