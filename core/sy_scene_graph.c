@@ -52,6 +52,18 @@ const uint32_t *sy_node_children(const sy_node_data *d, uint32_t *count_out)
     return *count_out ? (const uint32_t *)sy_blob_data(d->children) : NULL;
 }
 
+/* Starts a walk from root on s->stack under a fresh epoch when root is still a node whose world
+ * (world: true) or bounds flag is dirty; false: nothing to walk from it. */
+static bool walk_from_dirty(sy_scene *s, uint32_t root, bool world)
+{
+    node_extra *nx = sy_sc_nx_of(s, root);
+    if (!nx || !(world ? nx->world_dirty : nx->bounds_dirty)) return false;
+    s->stack.count = 0;
+    sy_sc_list_push(&s->stack, root);
+    s->epoch++;
+    return true;
+}
+
 /* Recomputes world matrices of every world-dirty node and the part of its subtree placed
  * through it (children whose primary parent it is). Cost: the dirty subtrees only. */
 void sy_sc_update_world(sy_scene *s)
@@ -59,12 +71,7 @@ void sy_sc_update_world(sy_scene *s)
     uint32_t updates = 0;
     id_list *st = &s->stack;
     for (uint32_t i = 0; i < s->world_dirty.count; ++i) {
-        uint32_t root = s->world_dirty.items[i];
-        node_extra *rnx = sy_sc_nx_of(s, root);
-        if (!rnx || !rnx->world_dirty) continue;
-        st->count = 0;
-        sy_sc_list_push(st, root);
-        s->epoch++;
+        if (!walk_from_dirty(s, s->world_dirty.items[i], true)) continue;
         while (st->count) {
             uint32_t id = st->items[--st->count];
             slot *sl = sy_sc_lookup(s, SY_TYPE_NODE, id);
@@ -96,12 +103,7 @@ void sy_sc_update_bounds(sy_scene *s)
 {
     id_list *st = &s->stack;
     for (uint32_t i = 0; i < s->bounds_dirty.count; ++i) {
-        uint32_t root = s->bounds_dirty.items[i];
-        node_extra *rnx = sy_sc_nx_of(s, root);
-        if (!rnx || !rnx->bounds_dirty) continue;
-        st->count = 0;
-        sy_sc_list_push(st, root);
-        s->epoch++;
+        if (!walk_from_dirty(s, s->bounds_dirty.items[i], false)) continue;
         while (st->count) {
             uint32_t id = st->items[st->count - 1];
             slot *sl = sy_sc_lookup(s, SY_TYPE_NODE, id);
