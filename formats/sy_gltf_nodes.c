@@ -11,6 +11,26 @@
 
 /* >>cameras+lights ---------------------------------------------------------------------------- */
 
+typedef sy_result (*object_setter)(sy_scene *s, uint32_t id, const void *data, sy_error *err);
+
+static sy_result set_camera(sy_scene *s, uint32_t id, const void *d, sy_error *err) { return sy_camera_set(s, (sy_camera){id}, d, err); }
+static sy_result set_light(sy_scene *s, uint32_t id, const void *d, sy_error *err) { return sy_light_set(s, (sy_light){id}, d, err); }
+
+/* Creates the object of type `type` that the file's what[i] describes, named name, and sets its data
+ * through set: its id in *id (left alone on failure); errors name what[i]. */
+static sy_result create_set(loader *L, sy_object_type type, const char *what, size_t i, const char *name, const void *data,
+                            object_setter set, uint32_t *id)
+{
+    char where[64];
+    snprintf(where, sizeof where, "%s[%zu]", what, i);
+    uint32_t h;
+    sy_result r = gltf_create(L, type, name, where, &h);
+    if (r != SY_OK) return r;
+    if ((r = set(L->scene, h, data, &L->err))) return gltf_context(L, r, where);
+    *id = h;
+    return SY_OK;
+}
+
 sy_result gltf_create_camera(loader *L, size_t i)
 {
     const sy_gltf_shim_camera *c = &L->doc->cameras[i];
@@ -27,14 +47,7 @@ sy_result gltf_create_camera(loader *L, size_t i)
              gltf_to_float(c->ozfar, &cd.zfar);
     }
     if (!ok) return gltf_fail(L, SY_ERR_PARSE, "cameras[%zu]: value out of float range", i);
-    char where[48];
-    snprintf(where, sizeof where, "cameras[%zu]", i);
-    sy_camera h;
-    sy_result r;
-    if ((r = gltf_create(L, SY_TYPE_CAMERA, cd.name, where, &h.id))) return r;
-    if ((r = sy_camera_set(L->scene, h, &cd, &L->err))) return gltf_context(L, r, where);
-    L->cameras[i] = h;
-    return SY_OK;
+    return create_set(L, SY_TYPE_CAMERA, "cameras", i, cd.name, &cd, set_camera, &L->cameras[i].id);
 }
 
 sy_result gltf_create_light(loader *L, size_t i)
@@ -48,14 +61,7 @@ sy_result gltf_create_light(loader *L, size_t i)
               gltf_to_float(l->range, &ld.range);
     if (ld.type == SY_LIGHT_SPOT) ok = ok && gltf_to_float(l->inner_cone, &ld.inner_cone) && gltf_to_float(l->outer_cone, &ld.outer_cone);
     if (!ok) return gltf_fail(L, SY_ERR_PARSE, "KHR_lights_punctual.lights[%zu]: value out of float range", i);
-    char where[64];
-    snprintf(where, sizeof where, "KHR_lights_punctual.lights[%zu]", i);
-    sy_light h;
-    sy_result r;
-    if ((r = gltf_create(L, SY_TYPE_LIGHT, ld.name, where, &h.id))) return r;
-    if ((r = sy_light_set(L->scene, h, &ld, &L->err))) return gltf_context(L, r, where);
-    L->lights[i] = h;
-    return SY_OK;
+    return create_set(L, SY_TYPE_LIGHT, "KHR_lights_punctual.lights", i, ld.name, &ld, set_light, &L->lights[i].id);
 }
 
 /* >>nodes ------------------------------------------------------------------------------------- */
