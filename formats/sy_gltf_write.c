@@ -66,13 +66,14 @@ typedef struct idmap {
     uint32_t *keys, *vals, cap, count;
 } idmap;
 
-static bool idmap_find(const idmap *m, uint32_t key, uint32_t *val)
+/* The index already given to key, in *val (left alone when there is none). */
+static bool idmap_find(const idmap *m, uint32_t key, int32_t *val)
 {
     if (!m->cap) return false;
     for (uint32_t h = (key * 2654435761u) & (m->cap - 1);; h = (h + 1) & (m->cap - 1)) {
         if (m->keys[h] == 0) return false;
         if (m->keys[h] == key) {
-            *val = m->vals[h];
+            *val = (int32_t)m->vals[h];
             return true;
         }
     }
@@ -166,11 +167,8 @@ static sy_result material_full(writer *w, const sy_material_data *d, sy_gltf_shi
 
 static sy_result material_index(writer *w, sy_material m, int32_t *out)
 {
-    uint32_t key = m.id ? m.id : UINT32_MAX, v;
-    if (idmap_find(&w->materials, key, &v)) {
-        *out = (int32_t)v;
-        return SY_OK;
-    }
+    uint32_t key = m.id ? m.id : UINT32_MAX;
+    if (idmap_find(&w->materials, key, out)) return SY_OK;
     const sy_material_data *d = sy_material_get(w->s, m);
     if (!d) return sy_error_set(w->err, SY_ERR_INVALID_HANDLE, "write GLB: material %u is stale", m.id);
     sy_gltf_shim_wmaterial *nm = realloc(w->wmats, sizeof *nm * (w->mat_count + 1));
@@ -201,11 +199,7 @@ static const void *array_of(const sy_blob *b, size_t count, size_t elem)
 
 static sy_result mesh_index(writer *w, sy_mesh m, int32_t *out)
 {
-    uint32_t v;
-    if (idmap_find(&w->meshes, m.id, &v)) {
-        *out = (int32_t)v;
-        return SY_OK;
-    }
+    if (idmap_find(&w->meshes, m.id, out)) return SY_OK;
     const sy_mesh_data *d = sy_mesh_get(w->s, m);
     if (!d) return sy_error_set(w->err, SY_ERR_INVALID_HANDLE, "write GLB: mesh %u is stale", m.id);
     sy_gltf_shim_wmesh *nm = realloc(w->wmeshes, sizeof *nm * (w->mesh_count + 1));
@@ -291,12 +285,8 @@ static uint8_t *halve_to(const uint8_t *px, uint32_t *w, uint32_t *h, uint32_t c
 /* >>textures: one glTF image (PNG, libpng's simplified writer) and sampler per core texture */
 static sy_result texture_index(writer *w, sy_texture t, int32_t *out)
 {
-    uint32_t v;
     *out = 0;
-    if (idmap_find(&w->textures, t.id, &v)) {
-        *out = (int32_t)v; /* index + 1, 0: left out */
-        return SY_OK;
-    }
+    if (idmap_find(&w->textures, t.id, out)) return SY_OK; /* index + 1, 0: left out */
     const sy_texture_data *d = sy_texture_get(w->s, t);
     if (!d) return sy_error_set(w->err, SY_ERR_INVALID_HANDLE, "write glTF: texture %u is stale", t.id);
     const sy_image_info *ii = &d->info;
@@ -439,37 +429,40 @@ typedef struct scene_writer {
     uint32_t cam_count, light_count;
 } scene_writer;
 
-static sy_result camera_index(scene_writer *sw, sy_camera c, int32_t *out)
+/* The index (1-based) of camera or light id in the file, added on its first use (t: SY_TYPE_CAMERA
+ * or SY_TYPE_LIGHT). */
+static sy_result camera_or_light_index(scene_writer *sw, sy_object_type t, uint32_t id, int32_t *out)
 {
-    uint32_t v;
-    if (idmap_find(&sw->cameras, c.id, &v)) return (*out = (int32_t)v), SY_OK;
-    const sy_camera_data *d = sy_camera_get(sw->w.s, c);
-    if (!d) return sy_error_set(sw->w.err, SY_ERR_INVALID_HANDLE, "write glTF: camera %u is stale", c.id);
-    sy_gltf_shim_wcamera *n = realloc(sw->cams, sizeof *n * (sw->cam_count + 1));
-    if (!n) return sy_error_set(sw->w.err, SY_ERR_OUT_OF_MEMORY, "write glTF: out of memory");
-    sw->cams = n;
-    n[sw->cam_count] = (sy_gltf_shim_wcamera){.name = d->name, .orthographic = d->projection == SY_PROJECTION_ORTHOGRAPHIC,
-                                              .yfov = d->yfov, .aspect = d->aspect, .znear = d->znear, .zfar = d->zfar,
-                                              .xmag = d->xmag, .ymag = d->ymag};
-    *out = (int32_t)++sw->cam_count;
-    return idmap_put(&sw->cameras, c.id, (uint32_t)*out) ? SY_OK : sy_error_set(sw->w.err, SY_ERR_OUT_OF_MEMORY, "write glTF: out of memory");
-}
-
-static sy_result light_index(scene_writer *sw, sy_light l, int32_t *out)
-{
-    uint32_t v;
-    if (idmap_find(&sw->lights, l.id, &v)) return (*out = (int32_t)v), SY_OK;
-    const sy_light_data *d = sy_light_get(sw->w.s, l);
-    if (!d) return sy_error_set(sw->w.err, SY_ERR_INVALID_HANDLE, "write glTF: light %u is stale", l.id);
-    sy_gltf_shim_wlight *n = realloc(sw->lights_out, sizeof *n * (sw->light_count + 1));
-    if (!n) return sy_error_set(sw->w.err, SY_ERR_OUT_OF_MEMORY, "write glTF: out of memory");
-    sw->lights_out = n;
-    static const char *const types[3] = {"point", "spot", "directional"};
-    n[sw->light_count] = (sy_gltf_shim_wlight){.name = d->name, .type = types[d->type < 3 ? d->type : 0],
-                                                .color = {d->color[0], d->color[1], d->color[2]}, .intensity = d->intensity,
-                                                .range = d->range, .inner_cone = d->inner_cone, .outer_cone = d->outer_cone};
-    *out = (int32_t)++sw->light_count;
-    return idmap_put(&sw->lights, l.id, (uint32_t)*out) ? SY_OK : sy_error_set(sw->w.err, SY_ERR_OUT_OF_MEMORY, "write glTF: out of memory");
+    bool cam = t == SY_TYPE_CAMERA;
+    idmap *m = cam ? &sw->cameras : &sw->lights;
+    if (idmap_find(m, id, out)) return SY_OK;
+    const void *obj = sy_object_get(sw->w.s, t, id);
+    if (!obj) return sy_error_set(sw->w.err, SY_ERR_INVALID_HANDLE, "write glTF: %s %u is stale", cam ? "camera" : "light", id);
+    uint32_t *count = cam ? &sw->cam_count : &sw->light_count;
+    bool grown = false;
+    if (cam) {
+        const sy_camera_data *d = obj;
+        sy_gltf_shim_wcamera *n = realloc(sw->cams, sizeof *n * (*count + 1));
+        if ((grown = n != NULL)) {
+            sw->cams = n;
+            n[*count] = (sy_gltf_shim_wcamera){.name = d->name, .orthographic = d->projection == SY_PROJECTION_ORTHOGRAPHIC,
+                                               .yfov = d->yfov, .aspect = d->aspect, .znear = d->znear, .zfar = d->zfar,
+                                               .xmag = d->xmag, .ymag = d->ymag};
+        }
+    } else {
+        const sy_light_data *d = obj;
+        sy_gltf_shim_wlight *n = realloc(sw->lights_out, sizeof *n * (*count + 1));
+        static const char *const types[3] = {"point", "spot", "directional"};
+        if ((grown = n != NULL)) {
+            sw->lights_out = n;
+            n[*count] = (sy_gltf_shim_wlight){.name = d->name, .type = types[d->type < 3 ? d->type : 0],
+                                              .color = {d->color[0], d->color[1], d->color[2]}, .intensity = d->intensity,
+                                              .range = d->range, .inner_cone = d->inner_cone, .outer_cone = d->outer_cone};
+        }
+    }
+    if (grown) *out = (int32_t)++*count;
+    if (grown && idmap_put(m, id, (uint32_t)*out)) return SY_OK;
+    return sy_error_set(sw->w.err, SY_ERR_OUT_OF_MEMORY, "write glTF: out of memory");
 }
 
 /* Node n and its subtree (pre-order); *index_out: its glTF index, -1 when it is left out (hidden).
@@ -506,8 +499,8 @@ static sy_result emit_node(scene_writer *sw, sy_node n, uint32_t depth, int32_t 
     for (int k = 0; k < 4; ++k) o.rotation[k] = t->rotation[k];
     sy_result r = SY_OK;
     if (d->mesh.id) r = mesh_index(&sw->w, d->mesh, &o.mesh);
-    if (r == SY_OK && d->camera.id) r = camera_index(sw, d->camera, &o.camera);
-    if (r == SY_OK && d->light.id) r = light_index(sw, d->light, &o.light);
+    if (r == SY_OK && d->camera.id) r = camera_or_light_index(sw, SY_TYPE_CAMERA, d->camera.id, &o.camera);
+    if (r == SY_OK && d->light.id) r = camera_or_light_index(sw, SY_TYPE_LIGHT, d->light.id, &o.light);
     sw->nodes[me] = o;
     if (r != SY_OK) return r;
     uint32_t nc = 0;
