@@ -64,6 +64,14 @@ static void w_u32(writer *w, uint32_t v)
     for (int i = 0; i < 4; ++i) b[i] = (uint8_t)(v >> (8 * i));
     w_bytes(w, b, 4);
 }
+/* A rectangle on the wire: x, y, w, h. */
+static void w_rect(writer *w, const sy_cluster_rect *r)
+{
+    w_u32(w, r->x);
+    w_u32(w, r->y);
+    w_u32(w, r->w);
+    w_u32(w, r->h);
+}
 static void w_u64(writer *w, uint64_t v)
 {
     uint8_t b[8];
@@ -209,12 +217,7 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
         w_f64(&w, r->time); /* the scene clock (protocol 5) */
         w_u32(&w, r->clip_id);
         w_u32(&w, r->tile_count);
-        for (uint32_t i = 0; i < r->tile_count; ++i) {
-            w_u32(&w, r->tiles[i].x);
-            w_u32(&w, r->tiles[i].y);
-            w_u32(&w, r->tiles[i].w);
-            w_u32(&w, r->tiles[i].h);
-        }
+        for (uint32_t i = 0; i < r->tile_count; ++i) w_rect(&w, &r->tiles[i]);
     } else if (t == SY_CLUSTER_TILES) {
         const __typeof__(msg->u.tiles) *r = &msg->u.tiles;
         if (r->tile_count > SY_CLUSTER_MAX_TILES)
@@ -227,10 +230,7 @@ sy_result sy_cluster_encode(const sy_cluster_msg *msg, uint32_t flags, sy_cluste
         w_u32(&w, r->tile_count);
         for (uint32_t i = 0; i < r->tile_count; ++i) {
             const sy_cluster_tile *tl = &r->tiles[i];
-            w_u32(&w, tl->rect.x);
-            w_u32(&w, tl->rect.y);
-            w_u32(&w, tl->rect.w);
-            w_u32(&w, tl->rect.h);
+            w_rect(&w, &tl->rect);
             w_u32(&w, tl->encoding);
             w_u32(&w, tl->channels);
             w_u64(&w, tl->raw_size);
@@ -301,6 +301,26 @@ static bool rd_fail(reader *rd, sy_result code, const char *reason)
     return false;
 }
 
+/* Room for a list of count records (NULL when count is 0 or the reader has failed), zeroed, elem
+ * bytes each, after checking that they fit in the rest of the body at wire_bytes each; fails the
+ * reader with "truncated LIST" or "out of memory for the LIST". */
+static void *rd_list(reader *rd, uint32_t count, size_t wire_bytes, size_t elem, const char *list)
+{
+    char why[64];
+    if (rd->r || !count) return NULL;
+    if ((size_t)count * wire_bytes > rd->size - rd->pos) {
+        snprintf(why, sizeof why, "truncated %s", list);
+        rd_fail(rd, SY_ERR_PARSE, why);
+        return NULL;
+    }
+    void *p = calloc(count, elem);
+    if (!p) {
+        snprintf(why, sizeof why, "out of memory for the %s", list);
+        rd_fail(rd, SY_ERR_OUT_OF_MEMORY, why);
+    }
+    return p;
+}
+
 static bool rd_bytes(reader *rd, void *out, size_t n)
 {
     if (rd->r) return false;
@@ -320,6 +340,13 @@ static uint32_t rd_u32(reader *rd)
     uint8_t b[4] = {0};
     rd_bytes(rd, b, 4);
     return (uint32_t)b[0] | ((uint32_t)b[1] << 8) | ((uint32_t)b[2] << 16) | ((uint32_t)b[3] << 24);
+}
+static void rd_rect(reader *rd, sy_cluster_rect *r)
+{
+    r->x = rd_u32(rd);
+    r->y = rd_u32(rd);
+    r->w = rd_u32(rd);
+    r->h = rd_u32(rd);
 }
 static uint64_t rd_u64(reader *rd)
 {
@@ -540,19 +567,11 @@ sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, 
                 rd_fail(&rd, SY_ERR_PARSE, ce.message);
             else if (q->tile_count < 1 || q->tile_count > SY_CLUSTER_MAX_TILES)
                 rd_fail(&rd, SY_ERR_LIMIT, "tile count outside 1..4096");
-            else if ((size_t)q->tile_count * 16 > rd.size - rd.pos)
-                rd_fail(&rd, SY_ERR_PARSE, "truncated tile list");
         }
-        if (!rd.r) {
-            q->tiles = calloc(q->tile_count, sizeof *q->tiles);
-            if (!q->tiles) rd_fail(&rd, SY_ERR_OUT_OF_MEMORY, "out of memory for the tile list");
-        }
+        q->tiles = rd_list(&rd, q->tile_count, 16, sizeof *q->tiles, "tile list");
         for (uint32_t i = 0; !rd.r && i < q->tile_count; ++i) {
             sy_cluster_rect *tr = &q->tiles[i];
-            tr->x = rd_u32(&rd);
-            tr->y = rd_u32(&rd);
-            tr->w = rd_u32(&rd);
-            tr->h = rd_u32(&rd);
+            rd_rect(&rd, tr);
             if (!rd.r && !rect_ok(tr, q->full_width, q->full_height)) rd_fail(&rd, SY_ERR_PARSE, "tile outside the image or empty");
         }
     } else if (t == SY_CLUSTER_TILES) {
@@ -567,18 +586,11 @@ sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, 
             if (!isfinite(q->sync_seconds) || !isfinite(q->render_seconds) || q->sync_seconds < 0 || q->render_seconds < 0)
                 rd_fail(&rd, SY_ERR_PARSE, "timings must be finite and non-negative");
             else if (q->tile_count > SY_CLUSTER_MAX_TILES) rd_fail(&rd, SY_ERR_LIMIT, "more than 4096 tiles");
-            else if ((size_t)q->tile_count * 36 > rd.size - rd.pos) rd_fail(&rd, SY_ERR_PARSE, "truncated tile list");
         }
-        if (!rd.r && q->tile_count) {
-            q->tiles = calloc(q->tile_count, sizeof *q->tiles);
-            if (!q->tiles) rd_fail(&rd, SY_ERR_OUT_OF_MEMORY, "out of memory for the tile list");
-        }
+        q->tiles = rd_list(&rd, q->tile_count, 36, sizeof *q->tiles, "tile list");
         for (uint32_t i = 0; !rd.r && i < q->tile_count; ++i) {
             sy_cluster_tile *tl = &q->tiles[i];
-            tl->rect.x = rd_u32(&rd);
-            tl->rect.y = rd_u32(&rd);
-            tl->rect.w = rd_u32(&rd);
-            tl->rect.h = rd_u32(&rd);
+            rd_rect(&rd, &tl->rect);
             tl->encoding = rd_u32(&rd);
             tl->channels = rd_u32(&rd);
             tl->raw_size = rd_u64(&rd);
@@ -611,14 +623,9 @@ sy_result sy_cluster_decode_body(const sy_cluster_header *hp, const void *body, 
         __typeof__(m.u.blobs) *q = &m.u.blobs;
         q->frame = rd_u64(&rd);
         q->count = rd_u32(&rd);
-        if (!rd.r) {
-            if (q->count < 1 || q->count > SY_CLUSTER_MAX_BLOBS) rd_fail(&rd, SY_ERR_LIMIT, "blob count outside 1..1048576");
-            else if ((size_t)q->count * 24 > rd.size - rd.pos) rd_fail(&rd, SY_ERR_PARSE, "truncated blob list");
-        }
-        if (!rd.r) {
-            q->blobs = calloc(q->count, sizeof *q->blobs);
-            if (!q->blobs) rd_fail(&rd, SY_ERR_OUT_OF_MEMORY, "out of memory for the blob list");
-        }
+        if (!rd.r && (q->count < 1 || q->count > SY_CLUSTER_MAX_BLOBS))
+            rd_fail(&rd, SY_ERR_LIMIT, "blob count outside 1..1048576");
+        q->blobs = rd_list(&rd, q->count, 24, sizeof *q->blobs, "blob list");
         for (uint32_t i = 0; !rd.r && i < q->count; ++i) {
             sy_cluster_blob_ref *b = &q->blobs[i];
             b->hash.lo = rd_u64(&rd);
