@@ -99,6 +99,16 @@ static double fb_median(double *v, uint32_t n)
     return v[n / 2];
 }
 
+/* Writes the contact sheet (rows: 1, 4, 16, 64, 256 spp) and says so: lead, then the line naming
+ * the columns. */
+static sy_result fb_sheet_write(const char *path, const float *sheet, size_t w, size_t h, const char *lead,
+                                const char *columns, sy_error *err)
+{
+    sy_result r = sy_png_write(path, (int)w, (int)h, sheet, NULL, err);
+    if (r == SY_OK) printf("%scontact sheet %s: rows = spp 1, 4, 16, 64, 256; columns = %s\n", lead, path, columns);
+    return r;
+}
+
 /* Median wall time of one 1-spp path-tracing pass of the built-in demo scene at width x height (after
  * a warm-up pass that includes the translation): the yardstick the pixel filter's cost is given in. */
 static sy_result fb_pt_pass(uint32_t width, uint32_t height, uint32_t repeats, double *secs, sy_error *err)
@@ -274,12 +284,10 @@ sy_result sy_bench_filters(uint32_t width, uint32_t height, uint32_t repeats, co
                         ref[4 * ((size_t)(y * scale) * width + x * scale) + c];
         ++si;
     }
-    if (r == SY_OK && sheet) {
-        r = sy_png_write(png_path, (int)sheet_w, (int)sheet_h, sheet, NULL, err);
-        if (r == SY_OK)
-            printf("\ncontact sheet %s: rows = spp 1, 4, 16, 64, 256; columns = none, pixel, pixel-brute (blank above\n"
-                   "400k pixels), radiance, atrous, jbu, adaptive, reference\n", png_path);
-    }
+    if (r == SY_OK && sheet)
+        r = fb_sheet_write(png_path, sheet, sheet_w, sheet_h, "\n",
+                           "none, pixel, pixel-brute (blank above\n400k pixels), radiance, atrous, jbu, adaptive, reference",
+                           err);
     sy_filter_pixel_destroy(pf);
     sy_filter_radiance_destroy(rf);
     free(rf_out), free(pix_out), free(sheet), free(out), free(t);
@@ -440,12 +448,9 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
         printf("  radiance filtering: %.1f ms per 1-spp pass with records + filter frame (frame 4: filter %.1f ms = "
                "%.2f x one plain pass)\n", rf_pass_s / spps[NS - 1] * 1e3, t_rf_ms, t_rf_ms / pass_ms);
     }
-    if (r == SY_OK && sheet) {
-        r = sy_png_write(png_path, (int)sheet_w, (int)sheet_h, sheet, NULL, err);
-        if (r == SY_OK)
-            printf("  contact sheet %s: rows = spp 1, 4, 16, 64, 256; columns = none, pixel, pixel-brute, radiance,\n"
-                   "  atrous, jbu, adaptive, reference\n", png_path);
-    }
+    if (r == SY_OK && sheet)
+        r = fb_sheet_write(png_path, sheet, sheet_w, sheet_h, "  ",
+                           "none, pixel, pixel-brute, radiance,\n  atrous, jbu, adaptive, reference", err);
     sy_filter_pixel_destroy(pf);
     free(sheet), free(ref), free(out), free(pos), free(pix_out);
     if (refimg) sy_exr_image_free(refimg);
