@@ -89,6 +89,13 @@ bool sy_array_reserve(void *items, size_t count, size_t *capacity, size_t elem, 
     return true;
 }
 
+int sy_u32_pair_cmp(const void *a, const void *b)
+{
+    const sy_u32_pair *x = a, *y = b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return x->value < y->value ? -1 : x->value > y->value;
+}
+
 bool sy_u32_push(uint32_t **items, uint32_t *count, uint32_t *capacity, uint32_t v)
 {
     if (*count == *capacity) {

@@ -97,6 +97,14 @@ bool sy_array_reserve(void *items, size_t count, size_t *capacity, size_t elem, 
  * doubles when full (4 at first). false when out of memory (nothing changed then). */
 bool sy_u32_push(uint32_t **items, uint32_t *count, uint32_t *capacity, uint32_t v);
 
+/** A key (an id) and what goes with it, sorted with sy_u32_pair_cmp. */
+typedef struct sy_u32_pair {
+    uint32_t key;   /**< what the pairs are sorted by first (an id) */
+    uint32_t value; /**< what goes with it (an index, another id); sorted by second */
+} sy_u32_pair;
+/** qsort order of sy_u32_pair: by key, then by value. */
+int sy_u32_pair_cmp(const void *a, const void *b);
+
 /** Monotonic wall clock in seconds (for timings and progress only). */
 double sy_time_now(void);
 

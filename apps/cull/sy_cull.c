@@ -48,17 +48,6 @@ static uint64_t mesh_triangles(const sy_scene *s, sy_mesh m)
     return t;
 }
 
-typedef struct order_item {
-    uint32_t id, pos;
-} order_item;
-
-static int order_cmp(const void *pa, const void *pb)
-{
-    const order_item *a = pa, *b = pb;
-    if (a->id != b->id) return a->id < b->id ? -1 : 1;
-    return a->pos < b->pos ? -1 : a->pos > b->pos;
-}
-
 static sy_result index_build(sy_culler *c, sy_error *err)
 {
     uint64_t frame = sy_scene_frame(c->scene);
@@ -70,20 +59,20 @@ static sy_result index_build(sy_culler *c, sy_error *err)
         sy_error_prefix(err, "cull");
         return r;
     }
-    order_item *ord = malloc(sizeof *ord * (n ? n : 1));
+    sy_u32_pair *ord = malloc(sizeof *ord * (n ? n : 1));
     sorted = malloc(sizeof *sorted * (n ? n : 1));
     cull_obj *objs = malloc(sizeof *objs * (n ? n : 1));
     if (!ord || !sorted || !objs) {
         free(p), free(ord), free(sorted), free(objs);
         return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cull: out of memory for %u placements", n);
     }
-    for (uint32_t i = 0; i < n; ++i) ord[i] = (order_item){p[i].node_id, i};
-    qsort(ord, n, sizeof *ord, order_cmp);
+    for (uint32_t i = 0; i < n; ++i) ord[i] = (sy_u32_pair){p[i].node_id, i}; /* by node, then placement */
+    qsort(ord, n, sizeof *ord, sy_u32_pair_cmp);
     uint32_t m = 0;
     uint64_t total = 0;
     sy_bounds all = sy_bounds_empty();
     for (uint32_t i = 0; i < n; ++i) {
-        sorted[i] = p[ord[i].pos];
+        sorted[i] = p[ord[i].value];
         sy_bounds mb, wb;
         sy_error ignored = {0};
         if (sy_mesh_bounds(c->scene, sorted[i].mesh, &mb, &ignored) == SY_OK) {

@@ -395,41 +395,29 @@ sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, l
     return r;
 }
 
-/* (target, clip) pairs, by target: two clips drive one object when one target has two clips */
-typedef struct clip_target {
-    uint32_t target, clip;
-} clip_target;
-
-static int cmp_clip_target(const void *a, const void *b)
-{
-    const clip_target *x = a, *y = b;
-    if (x->target != y->target) return x->target < y->target ? -1 : 1;
-    return x->clip < y->clip ? -1 : x->clip > y->clip;
-}
-
 sy_animation sy_cli_default_clip(const loaded *ld)
 {
     sy_animation every = {0}, first = {sy_scene_next(ld->scene, SY_TYPE_ANIMATION, 0)};
     if (!ld->is_gltf || sy_scene_count(ld->scene, SY_TYPE_ANIMATION) < 2) return every;
     size_t n = 0, cap = 0;
-    clip_target *ct = NULL;
+    sy_u32_pair *ct = NULL; /* (target, clip) pairs, by target: two clips drive one object when one target has two */
     for (uint32_t id = first.id; id; id = sy_scene_next(ld->scene, SY_TYPE_ANIMATION, id)) {
         uint32_t nch = 0;
         const sy_anim_channel *ch = sy_animation_channels(sy_animation_get(ld->scene, (sy_animation){id}), &nch);
         if (n + nch > cap) {
             size_t nc = (n + nch) * 2;
-            clip_target *g = realloc(ct, nc * sizeof *g);
+            sy_u32_pair *g = realloc(ct, nc * sizeof *g);
             if (!g) {
                 free(ct);
                 return first; /* out of memory: the safe choice */
             }
             ct = g, cap = nc;
         }
-        for (uint32_t k = 0; k < nch; ++k) ct[n++] = (clip_target){ch[k].node, id};
+        for (uint32_t k = 0; k < nch; ++k) ct[n++] = (sy_u32_pair){ch[k].node, id};
     }
-    qsort(ct, n, sizeof *ct, cmp_clip_target);
+    qsort(ct, n, sizeof *ct, sy_u32_pair_cmp);
     bool shared = false;
-    for (size_t k = 1; k < n && !shared; ++k) shared = ct[k].target == ct[k - 1].target && ct[k].clip != ct[k - 1].clip;
+    for (size_t k = 1; k < n && !shared; ++k) shared = ct[k].key == ct[k - 1].key && ct[k].value != ct[k - 1].value;
     free(ct);
     return shared ? first : every;
 }
