@@ -41,8 +41,14 @@ static const uint8_t *element_ptr(const sy_gltf_doc *d, const sy_gltf_shim_acces
     return d->buffers[v->buffer].data + v->byte_offset + a->byte_offset + i * gltf_accessor_stride(d, a);
 }
 
-/* Sparse substitution: calls back with (target element, pointer to the replacement). */
-static sy_result sparse_index(loader *L, size_t ai, size_t k, size_t *target)
+static const uint8_t *sparse_value_ptr(const sy_gltf_doc *d, const sy_gltf_shim_accessor *a, size_t k)
+{
+    const sy_gltf_shim_view *vv = &d->views[a->sparse_values_view];
+    return d->buffers[vv->buffer].data + vv->byte_offset + (size_t)a->sparse_values_offset + k * gltf_element_size(a);
+}
+
+/* Sparse substitution k of accessor ai: the element it replaces (checked) and its replacement. */
+static sy_result sparse_entry(loader *L, size_t ai, size_t k, size_t *target, const uint8_t **value)
 {
     const sy_gltf_doc *d = L->doc;
     const sy_gltf_shim_accessor *a = &d->accessors[ai];
@@ -53,13 +59,8 @@ static sy_result sparse_index(loader *L, size_t ai, size_t k, size_t *target)
     if ((size_t)idx >= a->count)
         return gltf_fail(L, SY_ERR_PARSE, "accessors[%zu].sparse.indices[%zu]: index %u >= accessor count %zu", ai, k, (unsigned)idx, a->count);
     *target = idx;
+    *value = sparse_value_ptr(d, a, k);
     return SY_OK;
-}
-
-static const uint8_t *sparse_value_ptr(const sy_gltf_doc *d, const sy_gltf_shim_accessor *a, size_t k)
-{
-    const sy_gltf_shim_view *vv = &d->views[a->sparse_values_view];
-    return d->buffers[vv->buffer].data + vv->byte_offset + (size_t)a->sparse_values_offset + k * gltf_element_size(a);
 }
 
 /* Reads accessor ai as floats, out_comps per element (missing components: 0, except a 4th = 1).
@@ -83,19 +84,15 @@ sy_result gltf_read_floats(loader *L, size_t ai, size_t out_comps, float **out)
         for (size_t c = 0; c < comps; c++) dst[c] = p ? load_component(p + c * cs, a->component_type, norm) : 0.0f;
         if (out_comps == 4 && comps < 4) dst[3] = 1.0f;
     }
-    if (a->sparse) {
-        for (size_t k = 0; k < (size_t)a->sparse_count; k++) {
-            size_t t;
-            if ((r = sparse_index(L, ai, k, &t))) {
-                free(f);
-                return r;
-            }
-            const uint8_t *p = sparse_value_ptr(d, a, k);
+    for (size_t k = 0; a->sparse && r == SY_OK && k < (size_t)a->sparse_count; k++) {
+        size_t t;
+        const uint8_t *p;
+        if ((r = sparse_entry(L, ai, k, &t, &p)) == SY_OK)
             for (size_t c = 0; c < comps; c++) f[t * out_comps + c] = load_component(p + c * cs, a->component_type, norm);
-        }
     }
-    *out = f;
-    return SY_OK;
+    if (r == SY_OK) *out = f;
+    else free(f);
+    return r;
 }
 
 /* Element i of accessor ai (i < count) as out_comps floats, sparse substitution applied; allocates
@@ -113,10 +110,10 @@ sy_result gltf_read_element(loader *L, size_t ai, size_t i, size_t out_comps, fl
     if (a->sparse) {
         for (size_t k = 0; k < (size_t)a->sparse_count; k++) {
             size_t t;
-            sy_result r = sparse_index(L, ai, k, &t);
+            const uint8_t *q;
+            sy_result r = sparse_entry(L, ai, k, &t, &q);
             if (r) return r;
             if (t != i) continue;
-            const uint8_t *q = sparse_value_ptr(d, a, k);
             for (size_t c = 0; c < comps; c++) dst[c] = load_component(q + c * cs, a->component_type, norm);
         }
     }
@@ -135,16 +132,12 @@ sy_result gltf_read_uints(loader *L, size_t ai, uint32_t **out)
         const uint8_t *p = element_ptr(d, a, i);
         u[i] = p ? load_uint(p, a->component_type) : 0;
     }
-    if (a->sparse) {
-        for (size_t k = 0; k < (size_t)a->sparse_count; k++) {
-            size_t t;
-            if ((r = sparse_index(L, ai, k, &t))) {
-                free(u);
-                return r;
-            }
-            u[t] = load_uint(sparse_value_ptr(d, a, k), a->component_type);
-        }
+    for (size_t k = 0; a->sparse && r == SY_OK && k < (size_t)a->sparse_count; k++) {
+        size_t t;
+        const uint8_t *p;
+        if ((r = sparse_entry(L, ai, k, &t, &p)) == SY_OK) u[t] = load_uint(p, a->component_type);
     }
-    *out = u;
-    return SY_OK;
+    if (r == SY_OK) *out = u;
+    else free(u);
+    return r;
 }
