@@ -407,6 +407,13 @@ struct sy_gltf_shim_impl {
     std::vector<std::vector<uint8_t>> decoded; // buffers made by decoding compressed meshes
 };
 
+// The C view of a vector: its elements and their count.
+template <typename T> static void expose(const std::vector<T> &v, const T *&items, size_t &count)
+{
+    items = v.data();
+    count = v.size();
+}
+
 static void fill_doc(sy_gltf_shim_impl *d)
 {
     const tinygltf::Model &m = d->model;
@@ -603,27 +610,17 @@ static void fill_doc(sy_gltf_shim_impl *d)
     }
 
     sy_gltf_doc &c = d->doc;
-    c.buffers = d->buffers.data();         c.buffer_count = d->buffers.size();
-    c.views = d->views.data();             c.view_count = d->views.size();
-    c.accessors = d->accessors.data();     c.accessor_count = d->accessors.size();
-    c.meshes = d->meshes.data();           c.mesh_count = d->meshes.size();
-    c.materials = d->materials.data();     c.material_count = d->materials.size();
-    c.textures = d->textures.data();       c.texture_count = d->textures.size();
-    c.samplers = d->samplers.data();       c.sampler_count = d->samplers.size();
-    c.images = d->images.data();           c.image_count = d->images.size();
-    c.cameras = d->cameras.data();         c.camera_count = d->cameras.size();
-    c.lights = d->lights.data();           c.light_count = d->lights.size();
-    c.nodes = d->nodes.data();             c.node_count = d->nodes.size();
-    c.scenes = d->scenes.data();           c.scene_count = d->scenes.size();
+    expose(d->buffers, c.buffers, c.buffer_count);       expose(d->views, c.views, c.view_count);
+    expose(d->accessors, c.accessors, c.accessor_count); expose(d->meshes, c.meshes, c.mesh_count);
+    expose(d->materials, c.materials, c.material_count); expose(d->textures, c.textures, c.texture_count);
+    expose(d->samplers, c.samplers, c.sampler_count);    expose(d->images, c.images, c.image_count);
+    expose(d->cameras, c.cameras, c.camera_count);       expose(d->lights, c.lights, c.light_count);
+    expose(d->nodes, c.nodes, c.node_count);             expose(d->scenes, c.scenes, c.scene_count);
     c.default_scene = m.defaultScene;
-    c.extensions_required = d->ext_required.data();
-    c.extensions_required_count = d->ext_required.size();
-    c.extensions_used = d->ext_used.data();
-    c.extensions_used_count = d->ext_used.size();
-    c.variant_names = d->variant_names.data();
-    c.variant_count = d->variant_names.size();
-    c.variant_uses = d->variant_uses.data();
-    c.variant_use_count = d->variant_uses.size();
+    expose(d->ext_required, c.extensions_required, c.extensions_required_count);
+    expose(d->ext_used, c.extensions_used, c.extensions_used_count);
+    expose(d->variant_names, c.variant_names, c.variant_count);
+    expose(d->variant_uses, c.variant_uses, c.variant_use_count);
     c.skin_count = m.skins.size();
     c.skins = d->skins.data();
     c.animation_count = m.animations.size();
@@ -845,9 +842,9 @@ static sy_result decode_compressed(sy_gltf_shim_impl *d, const sy_gltf_shim_limi
             }
         }
     sy_gltf_doc &c = d->doc; // the vectors may have grown
-    c.buffers = d->buffers.data();     c.buffer_count = d->buffers.size();
-    c.views = d->views.data();         c.view_count = d->views.size();
-    c.accessors = d->accessors.data(); c.accessor_count = d->accessors.size();
+    expose(d->buffers, c.buffers, c.buffer_count);
+    expose(d->views, c.views, c.view_count);
+    expose(d->accessors, c.accessors, c.accessor_count);
     return SY_OK;
 }
 
