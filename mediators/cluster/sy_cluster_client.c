@@ -18,6 +18,14 @@ void sy_clu_conn_close(conn *k)
     k->live = k->session_open = false;
 }
 
+void sy_clu_conn_drop(sy_cluster_client *c, conn *k, const char *what, const char *why)
+{
+    CWARN(c, "%s: %s: %s", k->url, what, why);
+    sy_clu_conn_close(k);
+    if (k->has_consumer) sy_scene_consumer_remove(c->scene, k->consumer);
+    k->has_consumer = false;
+}
+
 /* Bytes a message body may have on this connection (what the server accepts). */
 static uint64_t conn_body_limit(const conn *k)
 {

@@ -220,11 +220,7 @@ static uint32_t run_round(frame_ctx *fc, bool send_scene)
     for (uint32_t i = 0; i < c->n; ++i) {
         if (started[i]) pthread_join(th[i], NULL);
         if (args[i].failed) {
-            conn *k = &c->conns[i];
-            CWARN(c, "%s: dropped for this frame: %s", k->url, k->error);
-            sy_clu_conn_close(k);
-            if (k->has_consumer) sy_scene_consumer_remove(c->scene, k->consumer);
-            k->has_consumer = false;
+            sy_clu_conn_drop(c, &c->conns[i], "dropped for this frame", c->conns[i].error);
             failed++;
         }
     }
@@ -565,10 +561,7 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
                 sy_cluster_msg_free(&rep);
                 free(raw);
             } else {
-                CWARN(c, "%s: swap failed: %s", k->url, e.message);
-                sy_clu_conn_close(k);
-                if (k->has_consumer) sy_scene_consumer_remove(c->scene, k->consumer);
-                k->has_consumer = false;
+                sy_clu_conn_drop(c, k, "swap failed", e.message);
                 st.servers_failed++;
             }
         }

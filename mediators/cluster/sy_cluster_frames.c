@@ -201,11 +201,8 @@ sy_result sy_cluster_client_render_frames(sy_cluster_client *c, const sy_cluster
         for (uint32_t i = 0; i < c->n; ++i) {
             if (started[i]) pthread_join(th[i], NULL);
             if (w[i].failed) {
-                conn *k = &c->conns[i];
-                CWARN(c, "%s: dropped (frames mode; its frame goes back to the queue): %s", k->url, k->error);
-                sy_clu_conn_close(k);
-                if (k->has_consumer) sy_scene_consumer_remove(c->scene, k->consumer);
-                k->has_consumer = false;
+                sy_clu_conn_drop(c, &c->conns[i], "dropped (frames mode; its frame goes back to the queue)",
+                                 c->conns[i].error);
                 st.servers_failed++;
             }
         }

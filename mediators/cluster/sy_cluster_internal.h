@@ -272,6 +272,8 @@ struct sy_cluster_client {
 
 /* sy_cluster_client.c */
 void sy_clu_conn_close(conn *k);
+/* Warns "URL: WHAT: WHY", closes k and forgets its scene consumer (a snapshot when it comes back). */
+void sy_clu_conn_drop(sy_cluster_client *c, conn *k, const char *what, const char *why);
 /* One request/reply exchange within timeout_ms (the handshake's deadline before the session is
  * open). *reply borrows *raw (free it with free() after sy_cluster_msg_free). */
 sy_result sy_clu_conn_call(sy_cluster_client *c, conn *k, sy_cluster_msg *req, const sy_cluster_buf *preencoded,
