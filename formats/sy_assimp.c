@@ -208,16 +208,9 @@ sy_result asp_load_here(const char *path, const void *mem, size_t mem_size, cons
     }
     memcpy(L.model_dir, mem ? base_dir : path, dl);
     strcpy(L.model_dir + dl, add_slash ? "/" : "");
-    if (!mem) {
-        if ((r = sy_file_read_all(path, L.opt.max_file_bytes, &bytes, &L.main_size, &L.err))) goto out;
-        L.main_data = bytes;
-    } else if (mem_size > L.opt.max_file_bytes) {
-        r = asp_fail(&L, SY_ERR_LIMIT, "%zu bytes exceed the file size limit of %zu", mem_size, L.opt.max_file_bytes);
-        goto out;
-    } else {
-        L.main_data = mem;
-        L.main_size = mem_size;
-    }
+    const void *input = NULL;
+    if ((r = sy_loader_input(path, mem, mem_size, L.opt.max_file_bytes, &bytes, &input, &L.main_size, &L.err))) goto out;
+    L.main_data = input;
     if (L.main_size == 0) {
         r = asp_fail(&L, SY_ERR_PARSE, "empty file");
         goto out;

@@ -161,20 +161,13 @@ static sy_result load_common(const char *path, const void *mem, size_t mem_size,
     L.budget = sy_budget_make(path, L.opt.max_scene_bytes);
 
     void *bytes = NULL;
+    const void *input = NULL;
     size_t size = 0;
     sy_gltf_doc *doc = NULL;
-    sy_result r = SY_OK;
-    if (!mem) {
-        r = sy_file_read_all(path, L.opt.max_file_bytes, &bytes, &size, &L.err);
-        if (r) goto out; /* the message names the path already */
-    } else if (mem_size > L.opt.max_file_bytes) {
-        r = gltf_fail(&L, SY_ERR_LIMIT, "%zu bytes exceed the file size limit of %zu", mem_size, L.opt.max_file_bytes);
-        goto out;
-    } else {
-        size = mem_size;
-    }
+    sy_result r = sy_loader_input(path, mem, mem_size, L.opt.max_file_bytes, &bytes, &input, &size, &L.err);
+    if (r) goto out;
 
-    const uint8_t *b = mem ? (const uint8_t *)mem : (const uint8_t *)bytes, *json = b;
+    const uint8_t *b = input, *json = b;
     size_t json_len = size;
     size_t plen = strlen(path);
     bool ext_glb = plen >= 4 && (!strcmp(path + plen - 4, ".glb") || !strcmp(path + plen - 4, ".GLB"));

@@ -1,6 +1,7 @@
-/* sy_loader_log.c — a loader's error naming the file, and its warnings (see sy_loader_log.h). */
+/* sy_loader_log.c — a loader's error naming the file, its warnings and its input (see sy_loader_log.h). */
 #include "sy_loader_log.h"
 
+#include "sy_file.h"
 #include "sy_log.h"
 
 #include <stdio.h>
@@ -21,6 +22,21 @@ sy_result sy_loader_failf(sy_error *err, const char *file, sy_result code, const
     sy_result r = sy_loader_fail(err, file, code, fmt, ap);
     va_end(ap);
     return r;
+}
+
+sy_result sy_loader_input(const char *path, const void *mem, size_t mem_size, size_t max_bytes, void **owned,
+                          const void **data, size_t *size, sy_error *err)
+{
+    *owned = NULL, *data = NULL, *size = 0;
+    if (!mem) {
+        sy_result r = sy_file_read_all(path, max_bytes, owned, size, err); /* the message names the path */
+        *data = *owned;
+        return r;
+    }
+    if (mem_size > max_bytes)
+        return sy_loader_failf(err, path, SY_ERR_LIMIT, "%zu bytes exceed the file size limit of %zu", mem_size, max_bytes);
+    *data = mem, *size = mem_size;
+    return SY_OK;
 }
 
 void sy_loader_warn(sy_loader_warnings w, const char *fmt, va_list ap)

@@ -2,7 +2,8 @@
  * sy_loader_log.h — what a scene loader says, in one form for every loader (glTF, X3D, the Assimp
  * formats): its error names the file ("<file>: <message>"), and its warnings are all counted, the
  * first `max` kept as malloc()ed copies in the loader's info struct, and logged (sy_log.h) after a
- * successful load followed by how many more there were.
+ * successful load followed by how many more there were. Its input, a file or the caller's memory,
+ * comes through sy_loader_input under the same size limit.
  * Ownership: the kept messages belong to the info struct (sy_loader_warnings_free). Thread-safety:
  * none beyond the log's; one list per load, on one thread. */
 #ifndef SY_LOADER_LOG_H
@@ -37,6 +38,13 @@ sy_result sy_loader_failf(sy_error *err, const char *file, sy_result code, const
     __attribute__((format(printf, 4, 5)))
 #endif
     ;
+
+/** A loader's input: the caller's memory when mem is not NULL (borrowed; more than max_bytes:
+ * SY_ERR_LIMIT "<file>: N bytes exceed the file size limit of M"), else the whole file at path
+ * (sy_file_read_all: *owned receives the buffer, the caller's to free(); NULL for memory). *data and
+ * *size: the bytes. */
+sy_result sy_loader_input(const char *path, const void *mem, size_t mem_size, size_t max_bytes, void **owned,
+                          const void **data, size_t *size, sy_error *err);
 
 /** Counts one warning and keeps its message while fewer than max are kept. */
 void sy_loader_warn(sy_loader_warnings w, const char *fmt, va_list ap);
