@@ -165,6 +165,18 @@ typedef struct sy_mirror_sync_stats {
                                * deformed primitives (the ray tracers' BVH refit, the rasterizer's upload) */
 } sy_mirror_sync_stats;
 
+/** Copies what a sync did (ms, a sy_mirror_sync_stats) into a mediator's counters c (a struct with
+ * the fields last_sync_placements, last_sync_entries, last_sync_deform_seconds, last_sync_deformed
+ * and last_sync_deform_shared, as the raster and rt mediators' counters name them). */
+#define SY_MIRROR_SYNC_COUNTERS(c, ms)                                                                  \
+    do {                                                                                                \
+        (c).last_sync_placements = (ms).placements;                                                     \
+        (c).last_sync_entries = (ms).entries;                                                           \
+        (c).last_sync_deform_seconds = (ms).deform_seconds;                                             \
+        (c).last_sync_deformed = (ms).deformed;                                                         \
+        (c).last_sync_deform_shared = (ms).deform_shared;                                               \
+    } while (0)
+
 /** A mirrored background (defaults for fields never set). */
 typedef struct sy_mirror_background {
     uint32_t id; /**< core background id */

@@ -319,11 +319,7 @@ static sy_result raster_sync(void *state, const sy_changes *changes, sy_error *e
     double t_sync = sy_time_now();
     sy_mirror_sync_stats ms;
     sy_result r = sy_mirror_sync(st->mirror, changes, &ms, err);
-    st->counters.last_sync_placements = ms.placements;
-    st->counters.last_sync_entries = ms.entries;
-    st->counters.last_sync_deform_seconds = ms.deform_seconds;
-    st->counters.last_sync_deformed = ms.deformed;
-    st->counters.last_sync_deform_shared = ms.deform_shared;
+    SY_MIRROR_SYNC_COUNTERS(st->counters, ms);
     st->counters.last_sync_upload_seconds = ms.update_seconds;
     sy_gl_stats gs;
     sy_gl_device_stats(st->dev, &gs);

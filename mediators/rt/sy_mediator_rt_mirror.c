@@ -346,11 +346,7 @@ sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err)
     rt_state *st = state;
     sy_mirror_sync_stats ms;
     sy_result r = sy_mirror_sync(st->mirror, changes, &ms, err);
-    st->counters.last_sync_placements = ms.placements;
-    st->counters.last_sync_entries = ms.entries;
-    st->counters.last_sync_deform_seconds = ms.deform_seconds;
-    st->counters.last_sync_deformed = ms.deformed;
-    st->counters.last_sync_deform_shared = ms.deform_shared;
+    SY_MIRROR_SYNC_COUNTERS(st->counters, ms);
     st->counters.last_sync_refit_seconds = ms.update_seconds;
     /* The device tracks what is staged (sy_rt_commit is a no-op on a clean device), so every
      * successful sync ends with a commit: an uncommitted device refuses to render. */
