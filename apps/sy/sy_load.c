@@ -289,6 +289,39 @@ static sy_result report_warnings(const char *path, uint32_t total, sy_error *err
     return SY_OK;
 }
 
+/* A loader's camera selector over its info struct (sy_gltf_find_camera, sy_x3d_find_camera). */
+typedef sy_result (*camera_finder)(const sy_scene *s, const void *info, const char *sel, sy_node *out, sy_error *err);
+static sy_result find_gltf_camera(const sy_scene *s, const void *info, const char *sel, sy_node *out, sy_error *err)
+{
+    return sy_gltf_find_camera(s, info, sel, out, err);
+}
+static sy_result find_x3d_camera(const sy_scene *s, const void *info, const char *sel, sy_node *out, sy_error *err)
+{
+    return sy_x3d_find_camera(s, info, sel, out, err);
+}
+
+/* The confinement and budget options every loader takes alike (sy_gltf_options, sy_x3d_options,
+ * sy_assimp_options name them the same). */
+#define LOADER_OPTIONS                                                                                  \
+    {.allowed_roots = sy_cli_load_opts.roots, .allowed_root_count = sy_cli_load_opts.root_count,        \
+     .max_scene_bytes = sy_cli_load_opts.max_scene_bytes}
+
+/* What each file format's branch does after its loader returned r: the warnings (--strict), the
+ * file's root, and the camera sel names (found by find in info) or else the file's first; errors
+ * after the load name the file. */
+static sy_result loaded_view(loaded *out, const char *path, const char *sel, sy_result r, uint32_t warnings,
+                             sy_node root, const sy_node *cameras, uint32_t camera_count, camera_finder find,
+                             const void *info, sy_error *err)
+{
+    if (r == SY_OK) r = report_warnings(path, warnings, err);
+    if (r != SY_OK) return r;
+    out->root = root;
+    if (sel) r = find(out->scene, info, sel, &out->camera, err);
+    else if (camera_count) out->camera = cameras[0];
+    if (r != SY_OK) sy_error_prefix(err, "%s", path);
+    return r;
+}
+
 /* The scene format of path, from its content (sy_sniff.h): a file of another kind is refused,
  * named for what it is; one that is not recognised goes to the loader its name suggests (which
  * then says what is wrong with it): .x3d to X3D, an extension Assimp reads to Assimp, the rest to
@@ -332,48 +365,30 @@ sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, l
         /* named for what it is: not a scene format the loaders read */
     } else if (assimp) {
         out->is_assimp = true;
-        sy_assimp_options ao = {.allowed_roots = sy_cli_load_opts.roots, .allowed_root_count = sy_cli_load_opts.root_count,
-                                .max_scene_bytes = sy_cli_load_opts.max_scene_bytes};
+        sy_assimp_options ao = LOADER_OPTIONS;
         r = sy_assimp_load(path, out->scene, &ao, &out->assimp, err);
-        if (r == SY_OK) r = report_warnings(path, out->assimp.warning_count, err);
-        if (r == SY_OK) {
-            out->root = out->assimp.root;
-            /* the glTF loader's camera selector over the same list of camera nodes */
-            sy_gltf_info view = {.camera_nodes = out->assimp.camera_nodes, .camera_node_count = out->assimp.camera_node_count};
-            if (camera_sel) r = sy_gltf_find_camera(out->scene, &view, camera_sel, &out->camera, err);
-            else if (out->assimp.camera_node_count) out->camera = out->assimp.camera_nodes[0];
-            if (r != SY_OK) sy_error_prefix(err, "%s", path);
-        }
+        const sy_assimp_info *ai = &out->assimp;
+        /* the glTF loader's camera selector over the same list of camera nodes */
+        sy_gltf_info view = {.camera_nodes = ai->camera_nodes, .camera_node_count = ai->camera_node_count};
+        r = loaded_view(out, path, camera_sel, r, ai->warning_count, ai->root, ai->camera_nodes, ai->camera_node_count,
+                        find_gltf_camera, &view, err);
     } else if (fmt == SY_FORMAT_X3D || (fmt == SY_FORMAT_UNKNOWN && strlen(path) > 4 &&
                                         !strcasecmp(path + strlen(path) - 4, ".x3d"))) {
         out->is_x3d = true;
-        sy_x3d_options xo = {.allowed_roots = sy_cli_load_opts.roots, .allowed_root_count = sy_cli_load_opts.root_count,
-                             .max_scene_bytes = sy_cli_load_opts.max_scene_bytes};
+        sy_x3d_options xo = LOADER_OPTIONS;
         r = sy_x3d_load(path, out->scene, &xo, &out->x3d, err);
-        if (r == SY_OK)
-            r = report_warnings(path, out->x3d.warning_count, err);
-        if (r == SY_OK) {
-            out->root = out->x3d.root;
-            out->background = out->x3d.background;
-            if (camera_sel) r = sy_x3d_find_camera(out->scene, &out->x3d, camera_sel, &out->camera, err);
-            else if (out->x3d.camera_node_count) out->camera = out->x3d.camera_nodes[0];
-            if (r != SY_OK) sy_error_prefix(err, "%s", path);
-        }
+        r = loaded_view(out, path, camera_sel, r, out->x3d.warning_count, out->x3d.root, out->x3d.camera_nodes,
+                        out->x3d.camera_node_count, find_x3d_camera, &out->x3d, err);
+        if (r == SY_OK) out->background = out->x3d.background;
     } else {
         out->is_gltf = true;
-        sy_gltf_options go = {.allowed_roots = sy_cli_load_opts.roots, .allowed_root_count = sy_cli_load_opts.root_count,
-                          .max_scene_bytes = sy_cli_load_opts.max_scene_bytes};
+        sy_gltf_options go = LOADER_OPTIONS;
         r = sy_gltf_load(path, out->scene, &go, &out->gltf, err);
-        if (r == SY_OK)
-            r = report_warnings(path, out->gltf.warning_count, err);
-        if (r == SY_OK) {
-            out->root = out->gltf.root;
-            if (camera_sel) r = sy_gltf_find_camera(out->scene, &out->gltf, camera_sel, &out->camera, err);
-            else if (out->gltf.camera_node_count) out->camera = out->gltf.camera_nodes[0];
-            if (r == SY_OK && sy_cli_load_opts.variant)
-                r = sy_gltf_select_variant(out->scene, &out->gltf, sy_cli_load_opts.variant, err);
-            if (r != SY_OK) sy_error_prefix(err, "%s", path);
-        }
+        r = loaded_view(out, path, camera_sel, r, out->gltf.warning_count, out->gltf.root, out->gltf.camera_nodes,
+                        out->gltf.camera_node_count, find_gltf_camera, &out->gltf, err);
+        if (r == SY_OK && sy_cli_load_opts.variant &&
+            (r = sy_gltf_select_variant(out->scene, &out->gltf, sy_cli_load_opts.variant, err)) != SY_OK)
+            sy_error_prefix(err, "%s", path);
     }
     if (r == SY_OK && sy_cli_load_opts.variant && !out->is_gltf)
         r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: --variant: material variants are a glTF extension "
