@@ -212,17 +212,15 @@ static void pathtracer_filter_info(void *state, sy_filter_info *out)
     out->mean_blend = fi.mean_blend;
 }
 
-/* What the three classes share: one device, one mirror, one way to sync, render, pick and restart. */
-#define RT_CLASS_COMMON                                                                                                \
-    .destroy = rt_destroy, .sync = sy_rti_sync, .render = sy_rti_render, .stats = rt_stats, .pick = sy_rti_pick,     \
-    .restart = sy_rti_pt_restart
+/* A class of this adapter: its name, parameter table and create (the integrator it sets up); what
+ * the three share: one device, one mirror, one way to sync, render, pick and restart. */
+#define RT_CLASS(NAME, PARAMS, CREATE)                                                                                 \
+    .name = NAME, .param_table = SY_PARAM_TABLE(PARAMS), .create = CREATE, .destroy = rt_destroy,                    \
+    .sync = sy_rti_sync, .render = sy_rti_render, .stats = rt_stats, .pick = sy_rti_pick, .restart = sy_rti_pt_restart
 
 static const sy_mediator_class pathtracer_class = {
-    .name = "pathtracer",
-    .param_table = SY_PARAM_TABLE(sy_rti_pathtracer_params),
+    RT_CLASS("pathtracer", sy_rti_pathtracer_params, pathtracer_create),
     .caps = SY_CAP_PROGRESSIVE | SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_SAMPLE_RANGES | SY_CAP_AOVS | SY_CAP_FILTERS | SY_CAP_PICK | SY_CAP_CLIP | SY_CAP_MOTION,
-    .create = pathtracer_create,
-    RT_CLASS_COMMON,
     .aovs = pathtracer_aovs,
     .set_filter = sy_mediator_rt_set_filter,
     .filter_info = pathtracer_filter_info,
@@ -233,11 +231,8 @@ static const sy_mediator_class pathtracer_class = {
 const sy_mediator_class *sy_mediator_rt_pathtracer_class(void) { return &pathtracer_class; }
 
 static const sy_mediator_class whitted_class = {
-    .name = "whitted",
-    .param_table = SY_PARAM_TABLE(sy_rti_whitted_params),
+    RT_CLASS("whitted", sy_rti_whitted_params, whitted_create),
     .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_PREVIEW | SY_CAP_PICK | SY_CAP_CLIP | SY_CAP_MOTION,
-    .create = whitted_create,
-    RT_CLASS_COMMON,
     .default_rank = 10, /* the default back-end without the rasterizer */
     .motion = sy_rti_motion,
     .motion_camera = sy_rti_motion_camera,
@@ -251,11 +246,8 @@ static sy_result coverage_create(const sy_mediator_create_args *args, void **sta
 }
 
 static const sy_mediator_class coverage_class = {
-    .name = "coverage",
-    .param_table = SY_PARAM_TABLE(sy_rti_coverage_params),
+    RT_CLASS("coverage", sy_rti_coverage_params, coverage_create),
     .caps = SY_CAP_DEPTH | SY_CAP_TILES | SY_CAP_ANALYSIS | SY_CAP_COVERAGE | SY_CAP_PICK | SY_CAP_CLIP,
-    .create = coverage_create,
-    RT_CLASS_COMMON,
     .coverage = sy_rti_coverage,
 };
 
