@@ -1,6 +1,7 @@
 /** @file
- * sy_common.h — result codes, error messages and checked arithmetic shared by every Switchyard
- * layer above the back-ends (core, mediators, formats, apps).
+ * sy_common.h — result codes, error messages, checked arithmetic, growing arrays, uint32_t pairs
+ * and the clock, shared by every Switchyard layer above the back-ends (core, mediators, formats,
+ * apps).
  *
  * Error convention: every fallible call returns a sy_result (SY_OK == 0) and, when the caller passed
  * a sy_error*, fills it with the code and a human-readable message naming the object / file / place
