@@ -68,18 +68,8 @@ int main(int argc, char **argv)
         printf("%.9g %.9g %.9g %.9g\n", sum[0] / n, sum[1] / n, sum[2] / n, sum[3] / n);
         return 0;
     }
-    if (!strcmp(argv[1], "cover") && argc == 4) {
-        sy_exr_image *img = load(argv[3], NULL);
-        if (!img) return 2;
-        float t = strtof(argv[2], NULL);
-        const float *a = sy_exr_image_channel(img, "A");
-        size_t n = 0;
-        for (size_t k = 0; k < (size_t)img->width * img->height; ++k) n += a[k] > t;
-        printf("%zu\n", n);
-        sy_exr_image_free(img);
-        return 0;
-    }
-    if (!strcmp(argv[1], "width") && argc == 4) {
+    int cover = !strcmp(argv[1], "cover");
+    if ((cover || !strcmp(argv[1], "width")) && argc == 4) { /* the pixels whose alpha exceeds T: all, or per row */
         sy_exr_image *img = load(argv[3], NULL);
         if (!img) return 2;
         float t = strtof(argv[2], NULL);
@@ -90,7 +80,8 @@ int main(int argc, char **argv)
             for (int x = 0; x < img->width; ++x) k += a[(size_t)y * (size_t)img->width + (size_t)x] > t;
             n += k, rows += k > 0;
         }
-        printf("%.4f\n", rows ? (double)n / (double)rows : 0.0);
+        if (cover) printf("%zu\n", n);
+        else printf("%.4f\n", rows ? (double)n / (double)rows : 0.0);
         sy_exr_image_free(img);
         return 0;
     }
