@@ -13,27 +13,15 @@ pixel for pixel the local one (the targets and weights travel in the change list
 
     texanim_render_test.py SY WORKDIR BACKEND...
 
-Only the Python standard library (PNG written and read here: 8-bit, colour types 0, 2, 6)."""
+Only the Python standard library (PNGs written and read by tests/support/png_write.py and png_read.py)."""
 import os
-import struct
 import subprocess
 import sys
 import time
-import zlib
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from png_read import read_png as png_read  # noqa: E402  (one PNG decoder for the scripts)
-
-
-def write_png(path, w, h, rgb):
-    raw = b"".join(b"\0" + bytes(rgb[y * w * 3:(y + 1) * w * 3]) for y in range(h))
-
-    def chunk(kind, body):
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF)
-
-    with open(path, "wb") as f:
-        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)) +
-                chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+from png_write import write_png  # noqa: E402  (and one encoder)
 
 
 def read_png(path):
