@@ -30,11 +30,9 @@ static sy_result primitive_tex_targets(loader *L, xfile *F, const xmlNode *el, c
         if (L->morphs[i].tex && L->morphs[i].tex != X3D_TEX_POINT && L->morphs[i].coord == tt && L->morphs[i].serial == F->serial)
             m = &L->morphs[i];
     if (!m) return SY_OK;
-    sy_result r = sy_budget_charge(&L->budget, (uint64_t)m->keys * nv, 8, &L->err, "%s:%d: %s: texture coordinate morph "
-                                   "targets of an interpolator", F->path, x3d_line_of(el), x3d_ename(el));
+    float *d;
+    sy_result r = x3d_tex_targets_alloc(L, F, el, m, nv, &d);
     if (r) return r;
-    float *d = malloc(m->keys * nv * 8 + 1);
-    if (!d) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
     for (size_t k = 0; k < m->keys; k++) {
         float mk[6];
         x3d_texture_transform(L, F, tt, m->tex, m->values + 2 * k, mk);
@@ -44,9 +42,7 @@ static sy_result primitive_tex_targets(loader *L, xfile *F, const xmlNode *el, c
             d[(k * nv + i) * 2 + 1] = 1.0f - (mk[3] * s + mk[4] * t + mk[5]) - uv[2 * i + 1];
         }
     }
-    r = x3d_make_blob(L, d, m->keys * nv * 8, &prim->target_texcoords0);
-    if (!r) L->morph_pending = (size_t)(m - L->morphs) + 1;
-    return r;
+    return x3d_tex_targets_finish(L, m, d, nv, prim);
 }
 
 /* Output of a stroke geometry node: vertices (positions, optional RGBA colours) and, for lines,

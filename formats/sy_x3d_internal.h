@@ -243,6 +243,12 @@ sy_result x3d_make_blob(loader *L, void *data, size_t bytes, sy_blob **out);
 /* The budget for n vertices of geometry node el: charge = false checks where a generator sizes its
  * arrays (before it allocates them), charge = true charges once, in emit. */
 sy_result x3d_budget_vertices(loader *L, const char *file, const xmlNode *el, uint64_t n, bool charge);
+/* Texture coordinate morph targets of geometry node el from the morph source m: x3d_tex_targets_alloc
+ * charges the load's budget for m->keys x nv (s, t) pairs and allocates them (*out; the caller owns
+ * it); x3d_tex_targets_finish hands d (filled) to prim->target_texcoords0 (freed on failure) and
+ * notes m in L->morph_pending. */
+sy_result x3d_tex_targets_alloc(loader *L, xfile *F, const xmlNode *el, const morph_src *m, size_t nv, float **out);
+sy_result x3d_tex_targets_finish(loader *L, const morph_src *m, float *d, size_t nv, sy_primitive *prim);
 /* The corners of g as one non-indexed triangle primitive (new blobs in *prim). */
 sy_result x3d_emit(loader *L, xfile *F, const xmlNode *el, const geom_src *g, corners *c, sy_primitive *prim);
 /* Coordinate / Normal / TextureCoordinate / Color children of a geometry node; false: skip it. */

@@ -39,6 +39,23 @@ sy_result x3d_budget_vertices(loader *L, const char *file, const xmlNode *el, ui
                             x3d_ename(el), (unsigned long long)n);
 }
 
+sy_result x3d_tex_targets_alloc(loader *L, xfile *F, const xmlNode *el, const morph_src *m, size_t nv, float **out)
+{
+    sy_result r = sy_budget_charge(&L->budget, (uint64_t)m->keys * nv, 8, &L->err, "%s:%d: %s: texture coordinate morph "
+                                   "targets of an interpolator", F->path, x3d_line_of(el), x3d_ename(el));
+    if (r) return r;
+    *out = malloc(m->keys * nv * 8 + 1);
+    if (!*out) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
+    return SY_OK;
+}
+
+sy_result x3d_tex_targets_finish(loader *L, const morph_src *m, float *d, size_t nv, sy_primitive *prim)
+{
+    sy_result r = x3d_make_blob(L, d, m->keys * nv * 8, &prim->target_texcoords0);
+    if (!r) L->morph_pending = (size_t)(m - L->morphs) + 1;
+    return r;
+}
+
 /* X3D TextureTransform -> 2x3 affine matrix: Tc' = -C x S x R x C x T x Tc (sy_x3d_internal.h). */
 void x3d_texture_transform(loader *L, xfile *F, const xmlNode *tt, int which, const float *value, float m[6])
 {
@@ -185,11 +202,9 @@ static sy_result tex_targets(loader *L, xfile *F, const xmlNode *el, const geom_
         return SY_OK;
     }
     size_t nv = c->tris * 3;
-    sy_result r = sy_budget_charge(&L->budget, (uint64_t)m->keys * nv, 8, &L->err, "%s:%d: %s: texture coordinate morph "
-                                   "targets of an interpolator", F->path, x3d_line_of(el), x3d_ename(el));
+    float *d;
+    sy_result r = x3d_tex_targets_alloc(L, F, el, m, nv, &d);
     if (r) return r;
-    float *d = malloc(m->keys * nv * 8 + 1);
-    if (!d) return sy_error_set(&L->err, SY_ERR_OUT_OF_MEMORY, "out of memory");
     for (size_t k = 0; k < m->keys; k++) {
         float mk[6];
         const float *tt = g->tt;
@@ -208,9 +223,7 @@ static sy_result tex_targets(loader *L, xfile *F, const xmlNode *el, const geom_
             d[k * nv * 2 + 2 * i + 1] = (1.0f - t2) - uv[2 * i + 1];
         }
     }
-    r = x3d_make_blob(L, d, m->keys * nv * 8, &prim->target_texcoords0);
-    if (!r) L->morph_pending = (size_t)(m - L->morphs) + 1;
-    return r;
+    return x3d_tex_targets_finish(L, m, d, nv, prim);
 }
 
 sy_result x3d_emit(loader *L, xfile *F, const xmlNode *el, const geom_src *g, corners *c, sy_primitive *prim)
