@@ -8,31 +8,26 @@
 SY=$1
 TMP=$2
 shift 2
-fails=0
-fail() {
-    echo "FAIL: $*" >&2
-    fails=$((fails + 1))
-}
+# fail (and $fails); x3d_shape, x3d_clock, x3d_drive (the scene's lines)
+. "$(dirname "${BASH_SOURCE[0]}")/../support/check.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/../support/x3d_scene.sh"
 rm -rf "$TMP"
 mkdir -p "$TMP"
-cat >"$TMP/anim.x3d" <<'X3D'
-<X3D><Scene>
-<Viewpoint DEF='Cam' position='0 1 8' fieldOfView='0.8'/>
-<PointLight DEF='Lamp' location='-3 3 3' attenuation='0 0 0.05'/>
-<Transform translation='0 -1 0'><Shape><Appearance><Material diffuseColor='0.8 0.8 0.8'/></Appearance><Box size='10 0.2 10'/></Shape></Transform>
-<Transform DEF='Spin'><Shape><Appearance><Material DEF='Paint' diffuseColor='1 0 0'/></Appearance><Box/></Shape></Transform>
-<TimeSensor DEF='Clock' cycleInterval='2'/>
-<ColorInterpolator DEF='Hue' key='0 1' keyValue='1 0 0 0 0 1'/>
-<PositionInterpolator DEF='Dolly' key='0 1' keyValue='0 1 8 2 2 6'/>
-<PositionInterpolator DEF='Move' key='0 1' keyValue='-3 3 3 3 3 3'/>
-<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Hue' toField='set_fraction'/>
-<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Dolly' toField='set_fraction'/>
-<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Move' toField='set_fraction'/>
-<ROUTE fromNode='Hue' fromField='value_changed' toNode='Paint' toField='diffuseColor'/>
-<ROUTE fromNode='Dolly' fromField='value_changed' toNode='Cam' toField='position'/>
-<ROUTE fromNode='Move' fromField='value_changed' toNode='Lamp' toField='location'/>
-</Scene></X3D>
-X3D
+{
+    echo "<X3D><Scene>"
+    echo "<Viewpoint DEF='Cam' position='0 1 8' fieldOfView='0.8'/>"
+    echo "<PointLight DEF='Lamp' location='-3 3 3' attenuation='0 0 0.05'/>"
+    echo "<Transform translation='0 -1 0'>$(x3d_shape "<Box size='10 0.2 10'/>" "0.8 0.8 0.8")</Transform>"
+    echo "<Transform DEF='Spin'><Shape><Appearance><Material DEF='Paint' diffuseColor='1 0 0'/></Appearance><Box/></Shape></Transform>"
+    x3d_clock 2
+    echo "<ColorInterpolator DEF='Hue' key='0 1' keyValue='1 0 0 0 0 1'/>"
+    echo "<PositionInterpolator DEF='Dolly' key='0 1' keyValue='0 1 8 2 2 6'/>"
+    echo "<PositionInterpolator DEF='Move' key='0 1' keyValue='-3 3 3 3 3 3'/>"
+    x3d_drive Hue Paint diffuseColor
+    x3d_drive Dolly Cam position
+    x3d_drive Move Lamp location
+    echo "</Scene></X3D>"
+} >"$TMP/anim.x3d"
 # t = 0.5 s: fraction 0.25; t = 1.5 s: 0.75 (Dolly: (0 1 8) + f (2 1 -2))
 want_05="at (0.5, 1.25, 7.5)"
 want_15="at (1.5, 1.75, 6.5)"
