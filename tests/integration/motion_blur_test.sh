@@ -39,25 +39,24 @@ TMP=$2
 EXR_EQUAL=$3
 EXR_BLUR=$4
 shift 4
+backends=("$@")
 # fail, run NAME CMD..., run_ok LABEL NAME CMD... (and $fails, $rc)
 . "$(dirname "${BASH_SOURCE[0]}")/../support/check.sh"
+# x3d_shape, x3d_clock, x3d_drive: the scenes' lines
+. "$(dirname "${BASH_SOURCE[0]}")/../support/x3d_scene.sh"
 rm -rf "$TMP"
 mkdir -p "$TMP"
-scene() { # scene FILE ANIMATED(0|1)
+view_scene() { # view_scene FILE LINE...: an X3D scene of the LINEs, seen by the Viewpoint 'V' from 12 m on +z
     {
-        echo "<X3D><Scene><Viewpoint position='0 0 12' fieldOfView='0.5'/>"
-        echo "<Transform DEF='Box'><Shape><Appearance><Material diffuseColor='0.8 0.4 0.2'/></Appearance><Box size='2 2 2'/></Shape></Transform>"
-        if [ "$2" = 1 ]; then
-            echo "<TimeSensor DEF='Clock' cycleInterval='1'/>"
-            echo "<PositionInterpolator DEF='Move' key='0 1' keyValue='-1 0 0 1 0 0'/>"
-            echo "<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Move' toField='set_fraction'/>"
-            echo "<ROUTE fromNode='Move' fromField='value_changed' toNode='Box' toField='translation'/>"
-        fi
+        echo "<X3D><Scene><Viewpoint DEF='V' position='0 0 12' fieldOfView='0.5'/>"
+        printf '%s\n' "${@:2}"
         echo "</Scene></X3D>"
     } >"$1"
 }
-scene "$TMP/moving.x3d" 1
-scene "$TMP/static.x3d" 0
+box=$(x3d_shape "<Box size='2 2 2'/>") # the 2 m box
+view_scene "$TMP/moving.x3d" "<Transform DEF='Box'>$box</Transform>" "$(x3d_clock 1)" \
+    "<PositionInterpolator DEF='Move' key='0 1' keyValue='-1 0 0 1 0 0'/>" "$(x3d_drive Move Box translation)"
+view_scene "$TMP/static.x3d" "<Transform DEF='Box'>$box</Transform>"
 size=(-w 96 -h 64)
 gt() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a > b) }'; } # gt A B: A > B
 near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= t) }'; }
@@ -76,15 +75,32 @@ usage "--shutter-samples alone" "--shutter-samples belongs to --shutter" --shutt
 usage "--shutter-samples 0" "--shutter-samples" --shutter 0.1 --shutter-samples 0
 usage "--sub-frames alone" "--sub-frames belongs to --shutter" --sub-frames
 
+# rend STEM SCENE NAME ARGS...: renders $TMP/SCENE with back-end $b (and the options in the array
+# extra) into $TMP/${b}_STEM_NAME.exr ($TMP/${b}_NAME.exr where STEM is ""), its output beside it
+rend() {
+    local out=${b}_${1:+$1_}$3 scene=$2
+    shift 3
+    run_ok "$b ${out#"${b}_"}" "$out" "$SY" render "$TMP/$scene" -b "$b" "${extra[@]}" -o "$TMP/$out.exr" "$@"
+}
+# for_tracers SPP CHECK: runs the function CHECK for each ray tracer given, the back-end in $b, extra
+# --spp SPP for the path tracer
+for_tracers() {
+    for b in "${backends[@]}"; do
+        [ "$b" = raster ] && continue
+        extra=()
+        [ "$b" = pathtracer ] && extra=(--spp "$1")
+        "$2"
+    done
+}
+mean_alpha() { # mean_alpha FILE: the mean alpha of the EXR render FILE
+    local a
+    read -r _ _ _ a <<<"$("$EXR_BLUR" mean "$1")"
+    echo "$a"
+}
+r() { rend "" moving.x3d "$1" "${size[@]}" "${@:2}"; } # r NAME ARGS...: the moving box
 for b in "$@"; do
     extra=()
     [ "$b" = pathtracer ] && extra=(--spp 32)
-    r() { # r NAME ARGS...: renders the moving box with back-end $b into $TMP/${b}_NAME.exr
-        local name=$1
-        shift
-        run_ok "$b $name" "${b}_$name" "$SY" render "$TMP/moving.x3d" -b "$b" "${size[@]}" "${extra[@]}" \
-            -o "$TMP/${b}_$name.exr" "$@"
-    }
     r open --at 0.25
     r close --at 0.75
     r mid --at 0.5
@@ -162,16 +178,13 @@ done
 # time steps) in one render, and the streak matches the sub-frames' (covered pixels IoU >= 0.95;
 # measured 0.98 Whitted, 0.99 path tracer) and their mean alpha (within 0.01); shutter 0, and a
 # shutter after the morph stopped, render bit for bit as without the option
-cat >"$TMP/deform.x3d" <<'EOF'
-<X3D><Scene><Viewpoint position='0 0 12' fieldOfView='0.5'/>
-<Shape><Appearance><Material diffuseColor='0.8 0.4 0.2'/></Appearance>
-<IndexedFaceSet coordIndex='0 1 2 3 -1'><Coordinate DEF='C' point='-1 -1 0 1 -1 0 1 1 0 -1 1 0'/></IndexedFaceSet></Shape>
-<TimeSensor DEF='Clock' cycleInterval='1'/>
-<CoordinateInterpolator DEF='Morph' key='0 1' keyValue='-1 -1 0 1 -1 0 1 1 0 -1 1 0 1 -1 0 3 -1 0 3 1 0 1 1 0'/>
-<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Morph' toField='set_fraction'/>
-<ROUTE fromNode='Morph' fromField='value_changed' toNode='C' toField='set_point'/>
-</Scene></X3D>
-EOF
+# morph_square FILE POINTS KEYS VALUES: $TMP/FILE.x3d, a quad of the four POINTS (the Coordinate 'C')
+# that the CoordinateInterpolator 'Morph' (KEYS, VALUES) moves over 1 s
+morph_square() {
+    view_scene "$TMP/$1.x3d" "$(x3d_shape "<IndexedFaceSet coordIndex='0 1 2 3 -1'><Coordinate DEF='C' point='$2'/></IndexedFaceSet>")" \
+        "$(x3d_clock 1)" "<CoordinateInterpolator DEF='Morph' key='$3' keyValue='$4'/>" "$(x3d_drive Morph C set_point)"
+}
+morph_square deform '-1 -1 0 1 -1 0 1 1 0 -1 1 0' '0 1' '-1 -1 0 1 -1 0 1 1 0 -1 1 0 1 -1 0 3 -1 0 3 1 0 1 1 0'
 # sub_frames STEM LABEL NOTE WHAT BACKENDS...: each ray tracer renders $TMP/STEM.x3d at 0.25 over the
 # shutter 0..0.5 (and the options in the array SUB_FRAMES_EXTRA) as the mean of 4 sub-frames and says
 # why (NOTE)
@@ -187,16 +200,8 @@ sub_frames() {
             fail "$b: $what: no note on the sub-frames it takes: $(cat "$TMP/${b}_$stem.err")"
     done
 }
-for b in "$@"; do
-    [ "$b" = raster ] && continue
-    extra=()
-    [ "$b" = pathtracer ] && extra=(--spp 32)
-    d() { # d NAME ARGS...: renders the sliding square with back-end $b into $TMP/${b}_deform_NAME.exr
-        local name=$1
-        shift
-        run_ok "$b deforming $name" "${b}_deform_$name" "$SY" render "$TMP/deform.x3d" -b "$b" "${size[@]}" "${extra[@]}" \
-            -o "$TMP/${b}_deform_$name.exr" "$@"
-    }
+d() { rend deform deform.x3d "$1" "${size[@]}" "${@:2}"; } # d NAME ARGS...: the sliding square
+deform_checks() {
     d blur --at 0.25 --shutter 0,0.5
     d sub --at 0.25 --shutter 0,0.5 --sub-frames
     grep -qF "motion blur: one render, each" "$TMP/${b}_deform_blur.err" ||
@@ -217,17 +222,22 @@ for b in "$@"; do
     d still_blur --at 2 --shutter 0,0.5
     "$EXR_EQUAL" "$TMP/${b}_deform_still.exr" "$TMP/${b}_deform_still_blur.exr" >/dev/null ||
         fail "$b deforming: a shutter over which nothing deforms differs from no shutter"
-done
+}
+for_tracers 32 deform_checks
 
 # a blurred sequence of the deforming square: frame 7, after frame 6's motion, equals frame 7 rendered
 # alone, bit for bit (the mesh's motion ends with each frame)
+# seq_render LABEL NAME SCENE OUT ARGS...: the first back-end's 48 x 32 render of $TMP/SCENE blurred
+# by --motion-blur (4 samples; the path tracer at 8 spp) into $TMP/OUT, as run_ok NAME
+seq_render() {
+    local b=${backends[0]} extra=()
+    [ "$b" = pathtracer ] && extra=(--spp 8)
+    run_ok "$b $1" "$2" "$SY" render "$TMP/$3" -b "$b" -w 48 -h 32 "${extra[@]}" --motion-blur --shutter-samples 4 \
+        -o "$TMP/$4" "${@:5}"
+}
 b=$1
-extra=()
-[ "$b" = pathtracer ] && extra=(--spp 8)
-run_ok "$b deforming sequence" deform_seq "$SY" render "$TMP/deform.x3d" -b "$b" -w 48 -h 32 "${extra[@]}" --frames 6:7 \
-    --motion-blur --shutter-samples 4 -o "$TMP/deform_seq_#.exr"
-run_ok "$b deforming frame 7" deform_seq7 "$SY" render "$TMP/deform.x3d" -b "$b" -w 48 -h 32 "${extra[@]}" --frames 7:7 \
-    --motion-blur --shutter-samples 4 -o "$TMP/deform_one_#.exr"
+seq_render "deforming sequence" deform_seq deform.x3d "deform_seq_#.exr" --frames 6:7
+seq_render "deforming frame 7" deform_seq7 deform.x3d "deform_one_#.exr" --frames 7:7
 "$EXR_EQUAL" "$TMP/deform_seq_7.exr" "$TMP/deform_one_7.exr" >/dev/null ||
     fail "$b: a deforming sequence's frame 7 differs from frame 7 alone"
 
@@ -240,34 +250,12 @@ run_ok "$b deforming frame 7" deform_seq7 "$SY" render "$TMP/deform.x3d" -b "$b"
 # 1 m sideways over the shutter streaks the box over the union of its two ends' coverages (IoU as the
 # moving box's); a camera that stopped renders bit for bit as without the shutter; stereo eyes are
 # not interpolated: sub-frames, with a note.
-cat >"$TMP/camera.x3d" <<'EOF'
-<X3D><Scene><Viewpoint DEF='V' position='0 0 12' fieldOfView='0.5'/>
-<Shape><Appearance><Material diffuseColor='0.8 0.4 0.2'/></Appearance><Box size='2 2 2'/></Shape>
-<TimeSensor DEF='Clock' cycleInterval='1'/>
-<PositionInterpolator DEF='Move' key='0 1' keyValue='-1 0 12 1 0 12'/>
-<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Move' toField='set_fraction'/>
-<ROUTE fromNode='Move' fromField='value_changed' toNode='V' toField='position'/>
-</Scene></X3D>
-EOF
-cat >"$TMP/pan.x3d" <<'EOF'
-<X3D><Scene><Viewpoint DEF='V' position='0 0 12' fieldOfView='0.5'/>
-<Shape><Appearance><Material diffuseColor='0.8 0.4 0.2'/></Appearance><Box size='2 2 2'/></Shape>
-<TimeSensor DEF='Clock' cycleInterval='1'/>
-<OrientationInterpolator DEF='Pan' key='0 1' keyValue='0 1 0 -0.1 0 1 0 0.1'/>
-<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Pan' toField='set_fraction'/>
-<ROUTE fromNode='Pan' fromField='value_changed' toNode='V' toField='orientation'/>
-</Scene></X3D>
-EOF
-for b in "$@"; do
-    [ "$b" = raster ] && continue
-    extra=()
-    [ "$b" = pathtracer ] && extra=(--spp 64)
-    c() { # c SCENE NAME ARGS...: renders $TMP/SCENE.x3d with back-end $b into $TMP/${b}_cam_NAME.exr
-        local sc=$1 name=$2
-        shift 2
-        run_ok "$b camera $name" "${b}_cam_$name" "$SY" render "$TMP/$sc.x3d" -b "$b" "${size[@]}" "${extra[@]}" \
-            -o "$TMP/${b}_cam_$name.exr" "$@"
-    }
+view_scene "$TMP/camera.x3d" "$box" "$(x3d_clock 1)" "<PositionInterpolator DEF='Move' key='0 1' keyValue='-1 0 12 1 0 12'/>" \
+    "$(x3d_drive Move V position)"
+view_scene "$TMP/pan.x3d" "$box" "$(x3d_clock 1)" "<OrientationInterpolator DEF='Pan' key='0 1' keyValue='0 1 0 -0.1 0 1 0 0.1'/>" \
+    "$(x3d_drive Pan V orientation)"
+c() { rend cam "$1.x3d" "$2" "${size[@]}" "${@:3}"; } # c SCENE NAME ARGS...: $TMP/SCENE.x3d into ${b}_cam_NAME
+camera_checks() {
     c pan blur --at 0.25 --shutter 0,0.5
     grep -qF "motion blur: one render, each" "$TMP/${b}_cam_blur.err" && grep -qF "the moving camera" "$TMP/${b}_cam_blur.err" ||
         fail "$b: a moving camera: no note on the one render with per-ray times: $(cat "$TMP/${b}_cam_blur.err")"
@@ -298,7 +286,8 @@ for b in "$@"; do
     c pan still_blur --at 2 --shutter 0,0.5
     "$EXR_EQUAL" "$TMP/${b}_cam_still.exr" "$TMP/${b}_cam_still_blur.exr" >/dev/null ||
         fail "$b: a camera that stopped: the shutter changed the image"
-done
+}
+for_tracers 64 camera_checks
 # the same pan as a glTF camera node's rotation channel (LINEAR, quaternions about +Y from -0.1 to
 # 0.1 rad in 1 s) over a 2 m quad 12 m away: the quad's edges blur by 12.6 pixels (12.53 at the centre;
 # measured 12.73 Whitted, 13.0 path tracer), the image the mean of 64 sub-frames within noise
@@ -306,16 +295,8 @@ done
 cat >"$TMP/pan.gltf" <<'EOF'
 {"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1]}],"nodes":[{"mesh":0},{"camera":0,"translation":[0,0,12]}],"cameras":[{"type":"perspective","perspective":{"yfov":0.5,"znear":0.1}}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"material":0}]}],"materials":[{"pbrMetallicRoughness":{"baseColorFactor":[0.8,0.4,0.2,1],"metallicFactor":0}}],"buffers":[{"byteLength":104,"uri":"data:application/octet-stream;base64,AACAvwAAgL8AAAAAAACAPwAAgL8AAAAAAACAPwAAgD8AAAAAAACAvwAAgD8AAAAAAAABAAIAAAACAAMAAAAAAAAAAAAAAIA/AAAAAPW2TL0AAAAAGa5/PwAAAAD1tkw9AAAAABmufz8="}],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":12},{"buffer":0,"byteOffset":64,"byteLength":8},{"buffer":0,"byteOffset":72,"byteLength":32}],"accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[-1,-1,0],"max":[1,1,0]},{"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"},{"bufferView":2,"componentType":5126,"count":2,"type":"SCALAR","min":[0],"max":[1]},{"bufferView":3,"componentType":5126,"count":2,"type":"VEC4"}],"animations":[{"channels":[{"sampler":0,"target":{"node":1,"path":"rotation"}}],"samplers":[{"input":2,"output":3,"interpolation":"LINEAR"}]}]}
 EOF
-for b in "$@"; do
-    [ "$b" = raster ] && continue
-    extra=()
-    [ "$b" = pathtracer ] && extra=(--spp 64)
-    g() { # g NAME ARGS...: renders $TMP/pan.gltf with back-end $b into $TMP/${b}_gltf_NAME.exr
-        local name=$1
-        shift
-        run_ok "$b glTF camera $name" "${b}_gltf_$name" "$SY" render "$TMP/pan.gltf" -b "$b" "${size[@]}" "${extra[@]}" \
-            -o "$TMP/${b}_gltf_$name.exr" "$@"
-    }
+g() { rend gltf pan.gltf "$1" "${size[@]}" "${@:2}"; } # g NAME ARGS...: the glTF camera's pan
+gltf_checks() {
     g blur --at 0.25 --shutter 0,0.5
     grep -qF "the moving camera" "$TMP/${b}_gltf_blur.err" || fail "$b: a glTF camera's pan: no one render: $(cat "$TMP/${b}_gltf_blur.err")"
     g sub --at 0.25 --shutter 0,0.5 --sub-frames --shutter-samples 64
@@ -328,7 +309,8 @@ for b in "$@"; do
     max_rel=0.002
     [ "$b" = pathtracer ] && max_rel=0.01
     gt "$max_rel" "$rel" || fail "$b glTF camera pan: relMSE $rel against the sub-frames' mean >= $max_rel"
-done
+}
+for_tracers 64 gltf_checks
 SUB_FRAMES_EXTRA=(--stereo sbs)
 sub_frames camera "moving camera, stereo" "stereo eyes do not interpolate" "a moving camera in stereo" "$@"
 SUB_FRAMES_EXTRA=()
@@ -340,42 +322,41 @@ SUB_FRAMES_EXTRA=()
 # with 9 steps (8 chords of the arc) the streak matches the sub-frames' (IoU of alpha > 0.02 >= 0.93,
 # measured 0.943 Whitted, 0.969 path tracer; mean alpha within 0.002, measured 0.0006 and 0.0001);
 # --shutter-steps 2 is the default, bit for bit
-cat >"$TMP/spin.x3d" <<'EOF'
-<X3D><Scene><Viewpoint position='0 0 12' fieldOfView='0.5'/>
-<Transform DEF='Bar'><Shape><Appearance><Material diffuseColor='0.8 0.4 0.2'/></Appearance><Box size='4 0.3 0.3'/></Shape></Transform>
-<TimeSensor DEF='Clock' cycleInterval='1'/>
-<OrientationInterpolator DEF='Spin' key='0 0.25 0.5 0.75 1' keyValue='0 0 1 0 0 0 1 1.5707963 0 0 1 3.1415926 0 0 1 4.712389 0 0 1 6.2831853'/>
-<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Spin' toField='set_fraction'/>
-<ROUTE fromNode='Spin' fromField='value_changed' toNode='Bar' toField='rotation'/>
-</Scene></X3D>
-EOF
+view_scene "$TMP/spin.x3d" "<Transform DEF='Bar'>$(x3d_shape "<Box size='4 0.3 0.3'/>")</Transform>" "$(x3d_clock 1)" \
+    "<OrientationInterpolator DEF='Spin' key='0 0.25 0.5 0.75 1' keyValue='0 0 1 0 0 0 1 1.5707963 0 0 1 3.1415926 0 0 1 4.712389 0 0 1 6.2831853'/>" \
+    "$(x3d_drive Spin Bar rotation)"
 usage "--shutter-steps alone" "--shutter-steps belongs to --shutter" --shutter-steps 4
 usage "--shutter-steps 1" "--shutter-steps" --shutter 0.1 --shutter-steps 1
 usage "--shutter-steps 10" "--shutter-steps" --shutter 0.1 --shutter-steps 10
-for b in "$@"; do
-    [ "$b" = raster ] && continue
-    extra=()
-    [ "$b" = pathtracer ] && extra=(--spp 64)
-    s() { # s NAME ARGS...: renders the spinning bar with back-end $b into $TMP/${b}_spin_NAME.exr
-        local name=$1
-        shift
-        run_ok "$b spin $name" "${b}_spin_$name" "$SY" render "$TMP/spin.x3d" -b "$b" -w 96 -h 96 "${extra[@]}" --at 0 \
-            --shutter 0,0.25 -o "$TMP/${b}_spin_$name.exr" "$@"
-    }
-    s sub --sub-frames --shutter-samples 64
-    s chord
-    s two --shutter-steps 2
-    s arc --shutter-steps 9
+# curve STEM SCENE SIZE SHUTTER STEPS SUB-ARGS...: renders $TMP/SCENE (SIZE x SIZE pixels, --at 0 over
+# SHUTTER) into ${b}_STEM_sub (sub-frames, and SUB-ARGS), _chord (two steps, the default) and _arc
+# (STEPS steps), and sets sa, ca and aa (their mean alpha) and iou (arc against sub, alpha > 0.02)
+curve() {
+    local stem=$1 scene=$2 px=$3 shutter=$4 steps=$5
+    shift 5
+    rend "$stem" "$scene" sub -w "$px" -h "$px" --at 0 --shutter "$shutter" --sub-frames "$@"
+    rend "$stem" "$scene" chord -w "$px" -h "$px" --at 0 --shutter "$shutter"
+    rend "$stem" "$scene" arc -w "$px" -h "$px" --at 0 --shutter "$shutter" --shutter-steps "$steps"
+    sa=$(mean_alpha "$TMP/${b}_${stem}_sub.exr")
+    ca=$(mean_alpha "$TMP/${b}_${stem}_chord.exr")
+    aa=$(mean_alpha "$TMP/${b}_${stem}_arc.exr")
+    iou=$("$EXR_BLUR" iou 0.02 "$TMP/${b}_${stem}_arc.exr" 0.02 "$TMP/${b}_${stem}_sub.exr" "$TMP/${b}_${stem}_sub.exr")
+}
+# curve_checks WHAT STEPS SUBS TOL MIN_IOU: after curve, the STEPS steps' mean alpha is the SUBS
+# sub-frames' within TOL and their IoU at least MIN_IOU
+curve_checks() {
+    echo "$b $1: mean alpha 2 steps $ca, $2 steps $aa, $3 sub-frames $sa; IoU of $2 steps against the sub-frames $iou"
+    near "$aa" "$sa" "$4" || fail "$b $1: $2 steps cover $aa, not the sub-frames' $sa within $4"
+    gt "$iou" "$5" || fail "$b $1: $2 steps against the sub-frames: IoU $iou < $5"
+}
+spin_checks() {
+    curve spin spin.x3d 96 0,0.25 9 --shutter-samples 64
+    rend spin spin.x3d two -w 96 -h 96 --at 0 --shutter 0,0.25 --shutter-steps 2
     "$EXR_EQUAL" "$TMP/${b}_spin_chord.exr" "$TMP/${b}_spin_two.exr" >/dev/null || fail "$b: --shutter-steps 2 differs from the default"
-    read -r _ _ _ sa <<<"$("$EXR_BLUR" mean "$TMP/${b}_spin_sub.exr")"
-    read -r _ _ _ ca <<<"$("$EXR_BLUR" mean "$TMP/${b}_spin_chord.exr")"
-    read -r _ _ _ aa <<<"$("$EXR_BLUR" mean "$TMP/${b}_spin_arc.exr")"
-    iou=$("$EXR_BLUR" iou 0.02 "$TMP/${b}_spin_arc.exr" 0.02 "$TMP/${b}_spin_sub.exr" "$TMP/${b}_spin_sub.exr")
-    echo "$b spinning bar: mean alpha 2 steps $ca, 9 steps $aa, 64 sub-frames $sa; IoU of 9 steps against the sub-frames $iou"
     gt "$(awk -v s="$sa" 'BEGIN { print s * 0.8 }')" "$ca" || fail "$b spinning bar: 2 steps cover $ca, not a chord's less than the arc's $sa"
-    near "$aa" "$sa" 0.002 || fail "$b spinning bar: 9 steps cover $aa, not the sub-frames' $sa within 0.002"
-    gt "$iou" 0.93 || fail "$b spinning bar: 9 steps against the sub-frames: IoU $iou < 0.93"
-done
+    curve_checks "spinning bar" 9 64 0.002 0.93
+}
+for_tracers 64 spin_checks
 
 # curved deformation: a 0.6 m square whose vertices a CoordinateInterpolator carries a quarter turn
 # round the origin at radius 2 (5 keys: a polyline of 4 chords of the arc) over the shutter 0..1. With
@@ -383,90 +364,38 @@ done
 # of the 64 sub-frames': measured 0.0062 Whitted against 0.0093, IoU 0.30); with 5 steps (the keys'
 # times) it follows the polyline the sub-frames sample (mean alpha within 0.0005, measured 0.000005
 # Whitted; IoU of alpha > 0.02 >= 0.9, measured 0.93 Whitted, 0.97 path tracer)
-cat >"$TMP/arc.x3d" <<'EOF'
-<X3D><Scene><Viewpoint position='0 0 12' fieldOfView='0.5'/>
-<Shape><Appearance><Material diffuseColor='0.8 0.4 0.2'/></Appearance>
-<IndexedFaceSet coordIndex='0 1 2 3 -1'><Coordinate DEF='C' point='1.70000 -0.30000 0.00000 2.30000 -0.30000 0.00000 2.30000 0.30000 0.00000 1.70000 0.30000 0.00000'/></IndexedFaceSet></Shape>
-<TimeSensor DEF='Clock' cycleInterval='1'/>
-<CoordinateInterpolator DEF='Morph' key='0 0.25 0.5 0.75 1' keyValue='1.70000 -0.30000 0.00000 2.30000 -0.30000 0.00000 2.30000 0.30000 0.00000 1.70000 0.30000 0.00000 1.68540 0.37340 0.00000 2.23973 0.60301 0.00000 2.01012 1.15734 0.00000 1.45579 0.92773 0.00000 1.41421 0.98995 0.00000 1.83848 1.41421 0.00000 1.41421 1.83848 0.00000 0.98995 1.41421 0.00000 0.92773 1.45579 0.00000 1.15734 2.01012 0.00000 0.60301 2.23973 0.00000 0.37340 1.68540 0.00000 0.30000 1.70000 0.00000 0.30000 2.30000 0.00000 -0.30000 2.30000 0.00000 -0.30000 1.70000 0.00000'/>
-<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='Morph' toField='set_fraction'/>
-<ROUTE fromNode='Morph' fromField='value_changed' toNode='C' toField='set_point'/>
-</Scene></X3D>
-EOF
-for b in "$@"; do
-    [ "$b" = raster ] && continue
-    extra=()
-    [ "$b" = pathtracer ] && extra=(--spp 64)
-    a() { # a NAME ARGS...: renders the turning square with back-end $b into $TMP/${b}_arc_NAME.exr
-        local name=$1
-        shift
-        run_ok "$b arc $name" "${b}_arc_$name" "$SY" render "$TMP/arc.x3d" -b "$b" -w 96 -h 96 "${extra[@]}" --at 0 \
-            --shutter 0,1 -o "$TMP/${b}_arc_$name.exr" "$@"
-    }
-    a sub --sub-frames --shutter-samples 64
-    a chord
-    a arc --shutter-steps 5
-    read -r _ _ _ sa <<<"$("$EXR_BLUR" mean "$TMP/${b}_arc_sub.exr")"
-    read -r _ _ _ ca <<<"$("$EXR_BLUR" mean "$TMP/${b}_arc_chord.exr")"
-    read -r _ _ _ aa <<<"$("$EXR_BLUR" mean "$TMP/${b}_arc_arc.exr")"
-    iou=$("$EXR_BLUR" iou 0.02 "$TMP/${b}_arc_arc.exr" 0.02 "$TMP/${b}_arc_sub.exr" "$TMP/${b}_arc_sub.exr")
-    echo "$b deforming along an arc: mean alpha 2 steps $ca, 5 steps $aa, 64 sub-frames $sa; IoU of 5 steps against the sub-frames $iou"
+morph_square arc '1.70000 -0.30000 0.00000 2.30000 -0.30000 0.00000 2.30000 0.30000 0.00000 1.70000 0.30000 0.00000' \
+    '0 0.25 0.5 0.75 1' '1.70000 -0.30000 0.00000 2.30000 -0.30000 0.00000 2.30000 0.30000 0.00000 1.70000 0.30000 0.00000 1.68540 0.37340 0.00000 2.23973 0.60301 0.00000 2.01012 1.15734 0.00000 1.45579 0.92773 0.00000 1.41421 0.98995 0.00000 1.83848 1.41421 0.00000 1.41421 1.83848 0.00000 0.98995 1.41421 0.00000 0.92773 1.45579 0.00000 1.15734 2.01012 0.00000 0.60301 2.23973 0.00000 0.37340 1.68540 0.00000 0.30000 1.70000 0.00000 0.30000 2.30000 0.00000 -0.30000 2.30000 0.00000 -0.30000 1.70000 0.00000'
+arc_checks() {
+    curve arc arc.x3d 96 0,1 5 --shutter-samples 64
     gt "$(awk -v s="$sa" 'BEGIN { print s * 0.8 }')" "$ca" || fail "$b deforming arc: 2 steps cover $ca, not a chord's less than $sa"
-    near "$aa" "$sa" 0.0005 || fail "$b deforming arc: 5 steps cover $aa, not the sub-frames' $sa within 0.0005"
-    gt "$iou" 0.9 || fail "$b deforming arc: 5 steps against the sub-frames: IoU $iou < 0.9"
-done
+    curve_checks "deforming along an arc" 5 64 0.0005 0.9
+}
+for_tracers 64 arc_checks
 
 # a curved camera path: the Viewpoint orbits a quarter turn round the box at 12 m (5 keys of position
 # and orientation) over the shutter 0..1. With its two ends alone the camera cuts the chord (8.5 m
 # from the box half way: the box drawn larger, mean alpha 0.250 against the 16 sub-frames' 0.168);
 # with 5 steps it follows the keys' path (mean alpha within 0.005, IoU of alpha > 0.02 >= 0.95;
 # measured 0.1678 against 0.1679 and 0.974 Whitted, 0.1679 against 0.1680 and 0.976 path tracer)
-cat >"$TMP/orbit.x3d" <<'EOF'
-<X3D><Scene><Viewpoint DEF='V' position='0 0 12' fieldOfView='0.5'/>
-<Shape><Appearance><Material diffuseColor='0.8 0.4 0.2'/></Appearance><Box size='2 2 2'/></Shape>
-<Transform translation='3 0 0'><Shape><Appearance><Material diffuseColor='0.2 0.4 0.8'/></Appearance><Sphere radius='0.5'/></Shape></Transform>
-<TimeSensor DEF='Clock' cycleInterval='1'/>
-<PositionInterpolator DEF='P' key='0 0.25 0.5 0.75 1' keyValue='0.000000 0.000000 12.000000 4.592201 0.000000 11.086554 8.485281 0.000000 8.485281 11.086554 0.000000 4.592201 12.000000 0.000000 0.000000'/>
-<OrientationInterpolator DEF='O' key='0 0.25 0.5 0.75 1' keyValue='0.000000 1.000000 0.000000 0.000000 0.000000 1.000000 0.000000 0.392699 0.000000 1.000000 0.000000 0.785398 0.000000 1.000000 0.000000 1.178097 0.000000 1.000000 0.000000 1.570796'/>
-<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='P' toField='set_fraction'/>
-<ROUTE fromNode='Clock' fromField='fraction_changed' toNode='O' toField='set_fraction'/>
-<ROUTE fromNode='P' fromField='value_changed' toNode='V' toField='position'/>
-<ROUTE fromNode='O' fromField='value_changed' toNode='V' toField='orientation'/>
-</Scene></X3D>
-EOF
-for b in "$@"; do
-    [ "$b" = raster ] && continue
-    extra=()
-    [ "$b" = pathtracer ] && extra=(--spp 32)
-    o() { # o NAME ARGS...: renders the orbiting camera's view with back-end $b into $TMP/${b}_orbit_NAME.exr
-        local name=$1
-        shift
-        run_ok "$b orbit $name" "${b}_orbit_$name" "$SY" render "$TMP/orbit.x3d" -b "$b" -w 64 -h 64 "${extra[@]}" --at 0 \
-            --shutter 0,1 -o "$TMP/${b}_orbit_$name.exr" "$@"
-    }
-    o sub --sub-frames
-    o chord
-    o arc --shutter-steps 5
+view_scene "$TMP/orbit.x3d" "$box" "<Transform translation='3 0 0'>$(x3d_shape "<Sphere radius='0.5'/>" "0.2 0.4 0.8")</Transform>" \
+    "$(x3d_clock 1)" \
+    "<PositionInterpolator DEF='P' key='0 0.25 0.5 0.75 1' keyValue='0.000000 0.000000 12.000000 4.592201 0.000000 11.086554 8.485281 0.000000 8.485281 11.086554 0.000000 4.592201 12.000000 0.000000 0.000000'/>" \
+    "<OrientationInterpolator DEF='O' key='0 0.25 0.5 0.75 1' keyValue='0.000000 1.000000 0.000000 0.000000 0.000000 1.000000 0.000000 0.392699 0.000000 1.000000 0.000000 0.785398 0.000000 1.000000 0.000000 1.178097 0.000000 1.000000 0.000000 1.570796'/>" \
+    "$(x3d_drive P V position)" "$(x3d_drive O V orientation)"
+orbit_checks() {
+    curve orbit orbit.x3d 64 0,1 5
     grep -qF "the moving camera" "$TMP/${b}_orbit_arc.err" || fail "$b orbit: no one render: $(cat "$TMP/${b}_orbit_arc.err")"
-    read -r _ _ _ sa <<<"$("$EXR_BLUR" mean "$TMP/${b}_orbit_sub.exr")"
-    read -r _ _ _ ca <<<"$("$EXR_BLUR" mean "$TMP/${b}_orbit_chord.exr")"
-    read -r _ _ _ aa <<<"$("$EXR_BLUR" mean "$TMP/${b}_orbit_arc.exr")"
-    iou=$("$EXR_BLUR" iou 0.02 "$TMP/${b}_orbit_arc.exr" 0.02 "$TMP/${b}_orbit_sub.exr" "$TMP/${b}_orbit_sub.exr")
-    echo "$b orbiting camera: mean alpha 2 steps $ca, 5 steps $aa, 16 sub-frames $sa; IoU of 5 steps against the sub-frames $iou"
     gt "$ca" "$(awk -v s="$sa" 'BEGIN { print s * 1.2 }')" || fail "$b orbit: 2 steps cover $ca, not a chord's more than $sa"
-    near "$aa" "$sa" 0.005 || fail "$b orbit: 5 steps cover $aa, not the sub-frames' $sa within 0.005"
-    gt "$iou" 0.95 || fail "$b orbit: 5 steps against the sub-frames: IoU $iou < 0.95"
-done
+    curve_checks "orbiting camera" 5 16 0.005 0.95
+}
+for_tracers 32 orbit_checks
 
 # a sequence: frame 6 at 24 fps with --motion-blur (0,1/48) equals --at 0.25 with the same shutter, bit
 # for bit (the frame's time opens the shutter; every time sample restarts the accumulation)
 b=$1
-extra=()
-[ "$b" = pathtracer ] && extra=(--spp 8)
-run_ok "$b sequence blur" seq "$SY" render "$TMP/moving.x3d" -b "$b" -w 48 -h 32 "${extra[@]}" --frames 6:7 --motion-blur \
-    --shutter-samples 4 -o "$TMP/seq_#.exr"
-run_ok "$b --at blur" seq_at "$SY" render "$TMP/moving.x3d" -b "$b" -w 48 -h 32 "${extra[@]}" --at 0.25 --motion-blur \
-    --shutter-samples 4 -o "$TMP/seq_at.exr"
+seq_render "sequence blur" seq moving.x3d "seq_#.exr" --frames 6:7
+seq_render "--at blur" seq_at moving.x3d seq_at.exr --at 0.25
 "$EXR_EQUAL" "$TMP/seq_6.exr" "$TMP/seq_at.exr" >/dev/null || fail "$b: a blurred sequence frame differs from --at with the same shutter"
 "$EXR_EQUAL" "$TMP/seq_6.exr" "$TMP/seq_7.exr" >/dev/null && fail "$b: blurred frames 6 and 7 are the same image"
 
