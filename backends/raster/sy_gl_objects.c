@@ -702,6 +702,7 @@ static sy_gl_result kind_create(sy_gl_device *dev, const gl_kind *k, const void 
 {
     sy_gl_report *rep = dev ? dev->report : NULL;
     *id = 0;
+    if (!dev) return sy_gli_fail(NULL, SY_GL_ERROR_INVALID_ARGUMENT, "%s: no device", k->what);
     sy_gl_result r = kind_check(dev, k, d, rep);
     if (r != SY_GL_OK) return r;
     slot_head *h = sy_gli_pool_alloc(kind_pool(dev, k));
@@ -714,7 +715,7 @@ static sy_gl_result kind_create(sy_gl_device *dev, const gl_kind *k, const void 
 static sy_gl_result kind_update(sy_gl_device *dev, const gl_kind *k, uint32_t id, const void *d)
 {
     sy_gl_report *rep = dev ? dev->report : NULL;
-    void *item = sy_gli_pool_get(kind_pool(dev, k), id);
+    void *item = dev ? sy_gli_pool_get(kind_pool(dev, k), id) : NULL;
     if (!item) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_HANDLE, "%s update: stale handle %u", k->what, id);
     sy_gl_result r = kind_check(dev, k, d, rep);
     if (r != SY_GL_OK) return r;
@@ -724,8 +725,8 @@ static sy_gl_result kind_update(sy_gl_device *dev, const gl_kind *k, uint32_t id
 
 static sy_gl_result kind_destroy(sy_gl_device *dev, const gl_kind *k, uint32_t id)
 {
-    void *item = sy_gli_pool_get(kind_pool(dev, k), id);
-    if (!item) return sy_gli_fail(dev->report, SY_GL_ERROR_INVALID_HANDLE, "sy_gl_%s_destroy: stale handle 0x%08x", k->what, id);
+    void *item = dev ? sy_gli_pool_get(kind_pool(dev, k), id) : NULL;
+    if (!item) return sy_gli_fail(dev ? dev->report : NULL, SY_GL_ERROR_INVALID_HANDLE, "sy_gl_%s_destroy: stale handle 0x%08x", k->what, id);
     k->drop(dev, item);
     sy_gli_pool_free(kind_pool(dev, k), item);
     return SY_GL_OK;

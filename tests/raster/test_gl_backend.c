@@ -318,6 +318,14 @@ int main(int argc, char **argv)
         EXPECT_MSG(sy_gl_instance_destroy(d, fl) == SY_GL_ERROR_INVALID_HANDLE && strstr(e, "stale handle") &&
                        strcmp(e, sy_gl_device_error(d)) == 0,
                    "stale instance: '%s' / '%s'", e, sy_gl_device_error(d));
+        /* no device: refused, never dereferenced */
+        sy_gl_material_desc nd;
+        sy_gl_material_desc_init(&nd);
+        sy_gl_material nm = {0};
+        EXPECT(sy_gl_material_create(NULL, &nd, &nm) == SY_GL_ERROR_INVALID_ARGUMENT && nm.id == 0);
+        EXPECT(sy_gl_material_update(NULL, em, &nd) == SY_GL_ERROR_INVALID_HANDLE);
+        EXPECT(sy_gl_material_destroy(NULL, em) == SY_GL_ERROR_INVALID_HANDLE);
+        EXPECT(sy_gl_light_destroy(NULL, l) == SY_GL_ERROR_INVALID_HANDLE);
     }
     sy_gl_device_destroy(d);
 
