@@ -360,10 +360,8 @@ int test_timeline(void)
     sy_error err = {0};
     server s;
     web_read_only = web_read_only_anim = true;
-    if (web_start(&s, "127.0.0.1:0", "whitted", &err)) return 1;
     sy_web_client *c = NULL;
-    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
-    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    if (web_start_viewer(&s, &c, &err)) return 1;
     char *t = NULL;
     CHECK_OK(sy_web_client_next_text(c, 20000, "hello", &t, &err), err);
     CHECK_MSG(strstr(t, "\"clips\":[\"shrink\",\"hold\"]"), "%s", t);
@@ -448,9 +446,7 @@ int test_timeline(void)
     web_read_only = web_read_only_anim = false;
     if (web_stop(&s)) return 1;
     /* a scene without clips: no clock message, and a time is refused */
-    if (web_start(&s, "127.0.0.1:0", "whitted", &err)) return 1;
-    o.port = sy_web_port(s.web);
-    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    if (web_start_viewer(&s, &c, &err)) return 1;
     CHECK_OK(sy_web_client_next_text(c, 20000, "hello", &t, &err), err);
     free(t);
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":0}", &err), err);
@@ -464,10 +460,8 @@ int test_readonly(void)
     sy_error err = {0};
     server s;
     web_read_only = true;
-    if (web_start(&s, "127.0.0.1:0", "whitted", &err)) return 1;
     sy_web_client *c = NULL;
-    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
-    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    if (web_start_viewer(&s, &c, &err)) return 1;
     char *t = NULL, m[256];
     CHECK_OK(sy_web_client_next_text(c, 20000, "hello", &t, &err), err);
     CHECK(strstr(t, "\"read_only\":true") && strstr(t, "\"environments\":[\"scene\",\"studio\",\"none\"]") &&
@@ -547,10 +541,8 @@ int test_tree(void)
     sy_error err = {0};
     server s;
     web_big_tree = true;
-    if (web_start(&s, "127.0.0.1:0", "whitted", &err)) return 1;
     sy_web_client *c = NULL;
-    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
-    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    if (web_start_viewer(&s, &c, &err)) return 1;
     /* the first answer: the root's tree, at most WEB_TREE_MAX nodes, depth first */
     cJSON *a = tree_answer(c, "{\"t\":\"tree\",\"seq\":1}");
     CHECK(a);

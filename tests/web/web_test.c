@@ -208,6 +208,14 @@ int web_start(server *s, const char *listen, const char *backend, sy_error *e)
     return sy_web_thread_start(s->web, &s->th, e) != SY_OK;
 }
 
+int web_start_viewer(server *s, sy_web_client **c, sy_error *e)
+{
+    if (web_start(s, "127.0.0.1:0", "whitted", e)) return 1;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s->web), .path = "/ws"};
+    CHECK_OK(sy_web_client_connect(&o, 10000, c, e), *e);
+    return 0;
+}
+
 int web_stop(server *s)
 {
     s->r = sy_web_thread_join(s->th, &s->err);

@@ -77,6 +77,9 @@ extern bool web_big_tree;
  * GET /api/object/ (path and query), POST /api/echo (body length and byte sum) and GET /api/block
  * (below); 1 after printing why not. */
 int web_start(server *s, const char *listen, const char *backend, sy_error *e);
+/* web_start(s, "127.0.0.1:0", "whitted", e) and a viewer *c connected to its /ws (10 s at most);
+ * 1 after printing why not (the caller stops the server). */
+int web_start_viewer(server *s, sy_web_client **c, sy_error *e);
 /* Stops the server's thread and frees it all; 1 when the server had failed. */
 int web_stop(server *s);
 /* Sends GET /api/block and waits until the render thread is in it; returns the connection. */
