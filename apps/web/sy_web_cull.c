@@ -112,11 +112,8 @@ static void view_look(const sy_web_cull *c, sy_scene *scene, sy_look *look, floa
  * a lat-long image of little-endian float32 linear RGB, row 0 up (sy_look.h's convention), before
  * the look's intensity: the library's studio (sy_look_studio_pixels), or the world's texture when it
  * is float RGB or RGBA; 404 when the view has no environment or one not served. */
-static sy_result on_environment(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+static sy_result environment_answer(const sy_web_cull *c, sy_scene *scene, sy_web_response *resp, sy_error *err)
 {
-    (void)req;
-    sy_web_cull *c = user;
-    if (!c->server) return sy_error_set(err, SY_ERR_NOT_FOUND, "/api/environment: no server attached");
     sy_look look;
     float exposure;
     view_look(c, scene, &look, &exposure);
@@ -167,11 +164,8 @@ static bool add_look(const sy_web_cull *c, sy_scene *scene, cJSON *o)
 
 /* GET /api/view: the server's camera as /api/cull takes it, plus the orbit target (sy_orbit's:
  * the root's bounds centre projected on the viewing axis) for a client's orbit controls. */
-static sy_result on_view(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+static sy_result view_answer(const sy_web_cull *c, sy_scene *scene, sy_web_response *resp, sy_error *err)
 {
-    (void)req;
-    sy_web_cull *c = user;
-    if (!c->server) return sy_error_set(err, SY_ERR_NOT_FOUND, "/api/view: no server attached");
     sy_node cam;
     sy_mat4 m;
     sy_web_view(c->server, &m, &cam);
@@ -216,6 +210,15 @@ static sy_result on_view(void *user, sy_scene *scene, const sy_web_request *req,
     }
     cJSON_Delete(o);
     return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "/api/view: out of memory");
+}
+
+/* GET /api/view and GET /api/environment: both answer from the attached server's view; 404 without one. */
+static sy_result on_server_view(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+{
+    const sy_web_cull *c = user;
+    bool env = !strcmp(req->path, "/api/environment");
+    if (!c->server) return sy_error_set(err, SY_ERR_NOT_FOUND, "%s: no server attached", env ? "/api/environment" : "/api/view");
+    return env ? environment_answer(c, scene, resp, err) : view_answer(c, scene, resp, err);
 }
 
 static const char *content_type_of(const char *name)
@@ -305,9 +308,9 @@ sy_result sy_web_cull_create(sy_scene *scene, sy_node root, const char *client_d
     uint32_t n = 0;
     routes[n++] = (sy_web_route){"POST", "/api/cull", on_cull, c};
     routes[n++] = (sy_web_route){"GET", "/api/object/", on_object, c};
-    routes[n++] = (sy_web_route){"GET", "/api/view", on_view, c};
+    routes[n++] = (sy_web_route){"GET", "/api/view", on_server_view, c};
     routes[n++] = (sy_web_route){"GET", "/api/pose", on_pose, c};
-    routes[n++] = (sy_web_route){"GET", "/api/environment", on_environment, c};
+    routes[n++] = (sy_web_route){"GET", "/api/environment", on_server_view, c};
     if (client_dir) routes[n++] = (sy_web_route){"GET", "/client/", on_client, c};
     *count = n;
     *out = c;
