@@ -31,8 +31,6 @@ sy_result sy_bench_cluster_spawn_ex(int cpu, int lifetime_s, bool one_core, sy_b
 sy_result sy_bench_cluster_spawn(int cpu, sy_bench_cluster_server *out, sy_error *err);
 /* SIGTERM and wait; nothing when not started (pid 0). */
 void sy_bench_cluster_stop(sy_bench_cluster_server *s);
-/* VmRSS (or another "Vm...:" line, or "Threads") of a process in KiB; -1 when unreadable. */
-long sy_bench_cluster_proc_status_kb(pid_t pid, const char *field);
 
 /* A client of the benchmark's servers with what its frames need: a window holding a viewport of vd
  * (its camera's view at w x h), the client (opts co) and a w x h output layer. */

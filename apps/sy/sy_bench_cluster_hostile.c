@@ -2,6 +2,7 @@
  * a client's frame time while 72 connections that never authenticate trickle and flood it (see
  * sy_bench_cluster.h; alone: --hostile-only). */
 #include "sy_bench_cluster.h"
+#include "sy_bench_os.h"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -114,7 +115,7 @@ sy_result sy_bench_cluster_hostile(sy_scene *scene, const sy_demo_info *d, const
     }
     const char *colon = strrchr(srv->url, ':');
     int port = colon ? atoi(colon + 1) : 0;
-    long rss0 = sy_bench_cluster_proc_status_kb(srv->pid, "VmRSS"), peak = rss0;
+    long rss0 = sy_bench_proc_status_kb(srv->pid, "VmRSS"), peak = rss0;
     atomic_int stop = 0;
     hostile_peer hp[TRICKLERS + FLOODERS];
     pthread_t th[TRICKLERS + FLOODERS];
@@ -136,13 +137,13 @@ sy_result sy_bench_cluster_hostile(sy_scene *scene, const sy_demo_info *d, const
         busy += dt;
         worst = dt > worst ? dt : worst;
         frames++;
-        long kb = sy_bench_cluster_proc_status_kb(srv->pid, "VmRSS");
+        long kb = sy_bench_proc_status_kb(srv->pid, "VmRSS");
         if (kb > peak) peak = kb;
     }
     atomic_store(&stop, 1);
     for (int i = 0; i < started; ++i) pthread_join(th[i], NULL);
     hostile_sleep_ms(300);
-    long rss1 = sy_bench_cluster_proc_status_kb(srv->pid, "VmRSS");
+    long rss1 = sy_bench_proc_status_kb(srv->pid, "VmRSS");
     uint64_t trickled = 0, flooded = 0;
     uint32_t conns = 0;
     for (int i = 0; i < started; ++i) {

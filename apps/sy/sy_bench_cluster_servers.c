@@ -97,20 +97,3 @@ void sy_bench_cluster_rig_close(sy_bench_cluster_rig *rig)
     memset(rig, 0, sizeof *rig);
 }
 
-/* VmRSS (or another "Vm...:" line) of a process in KiB; -1 when unreadable. */
-long sy_bench_cluster_proc_status_kb(pid_t pid, const char *field)
-{
-    char path[64], line[256];
-    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
-    FILE *f = fopen(path, "r");
-    if (!f) return -1;
-    long kb = -1;
-    size_t fl = strlen(field);
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, field, fl) && line[fl] == ':') {
-            kb = strtol(line + fl + 1, NULL, 10);
-            break;
-        }
-    fclose(f);
-    return kb;
-}

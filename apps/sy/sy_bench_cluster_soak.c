@@ -3,6 +3,7 @@
  * (see sy_bench_cluster.h; tests/soak/serve_soak.sh). */
 #define _GNU_SOURCE /* M_PI */
 #include "sy_bench_cluster.h"
+#include "sy_bench_os.h"
 
 #include <dirent.h>
 #include <math.h>
@@ -36,9 +37,9 @@ static long proc_fd_count(pid_t pid)
 
 static soak_sample soak_take(pid_t server, double t)
 {
-    soak_sample s = {t, sy_bench_cluster_proc_status_kb(server, "VmRSS"), proc_fd_count(server),
-                     sy_bench_cluster_proc_status_kb(server, "Threads"),
-                     sy_bench_cluster_proc_status_kb(getpid(), "VmRSS")};
+    soak_sample s = {t, sy_bench_proc_status_kb(server, "VmRSS"), proc_fd_count(server),
+                     sy_bench_proc_status_kb(server, "Threads"),
+                     sy_bench_proc_status_kb(getpid(), "VmRSS")};
     return s;
 }
 

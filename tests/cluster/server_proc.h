@@ -5,10 +5,11 @@
  * the bytes it holds for peers' messages in flight (its --memory-file).
  * The caller sets g_exe (the server executable) and g_dir (a work directory). Every wait is
  * bounded; servers a failed check left running are killed when the test exits. Thread-safety:
- * main thread only (except server_status_kb, any thread). */
+ * main thread only. A server's memory: sy_bench_proc_status_kb (apps/sy/sy_bench_os.h, any thread). */
 #ifndef SY_TEST_SERVER_PROC_H
 #define SY_TEST_SERVER_PROC_H
 
+#include "../../apps/sy/sy_bench_os.h"
 #include "../support/sy_check.h"
 
 #include <fcntl.h>
@@ -212,24 +213,6 @@ static inline bool log_contains(const server *s, const char *needle)
         sleep_ms(50);
     }
     return false;
-}
-
-/* A "VmRSS:" / "VmHWM:" ... line of /proc/PID/status in KiB; -1 when unreadable. */
-static inline long server_status_kb(pid_t pid, const char *field)
-{
-    char path[64], line[256];
-    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
-    FILE *f = fopen(path, "r");
-    if (!f) return -1;
-    long kb = -1;
-    size_t fl = strlen(field);
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, field, fl) && line[fl] == ':') {
-            kb = strtol(line + fl + 1, NULL, 10);
-            break;
-        }
-    fclose(f);
-    return kb;
 }
 
 #endif /* SY_TEST_SERVER_PROC_H */

@@ -272,7 +272,7 @@ static void *sampler_main(void *arg)
 {
     sampler *sm = arg;
     while (!atomic_load(sm->stop)) {
-        long kb = server_status_kb(sm->pid, "VmRSS");
+        long kb = sy_bench_proc_status_kb(sm->pid, "VmRSS");
         if (kb > sm->max_rss_kb) sm->max_rss_kb = kb;
         sleep_ms(50);
     }
@@ -299,7 +299,7 @@ static int test_rss(fixture *fx)
         quiet += now_s() - t0;
         CHECK(same_image(&out, &first));
     }
-    long rss0 = server_status_kb(sv.pid, "VmRSS"), hwm0 = server_status_kb(sv.pid, "VmHWM");
+    long rss0 = sy_bench_proc_status_kb(sv.pid, "VmRSS"), hwm0 = sy_bench_proc_status_kb(sv.pid, "VmHWM");
     CHECK(rss0 > 0 && hwm0 > 0);
     atomic_int stop = 0;
     enum { TRICKLERS = 64, FLOODERS = 8 };
@@ -342,7 +342,7 @@ static int test_rss(fixture *fx)
     for (int i = 0; i < started; ++i) pthread_join(th[i], NULL);
     pthread_join(smt, NULL);
     sleep_ms(300);
-    long rss1 = server_status_kb(sv.pid, "VmRSS"), hwm1 = server_status_kb(sv.pid, "VmHWM");
+    long rss1 = sy_bench_proc_status_kb(sv.pid, "VmRSS"), hwm1 = sy_bench_proc_status_kb(sv.pid, "VmHWM");
     uint64_t trickled = 0, flooded = 0;
     uint32_t conns = 0;
     for (int i = 0; i < started; ++i) {
@@ -440,7 +440,7 @@ static int test_counts(fixture *fx)
     server sv;
     if (start_server(NULL, 0, &sv)) return 1;
     sleep_ms(100);
-    long hwm0 = server_status_kb(sv.pid, "VmHWM");
+    long hwm0 = sy_bench_proc_status_kb(sv.pid, "VmHWM");
     CHECK(hwm0 > 0);
     static uint8_t cl[4096], fr[8192];
     uint32_t type;
@@ -465,7 +465,7 @@ static int test_counts(fixture *fx)
     }
     size_t fn = scene_frame(fr, cl, (uint32_t)n, (uint32_t)n);
     if (raw_session_frame(&sv, fr, fn, &type, why, sizeof why)) return 1;
-    long hwm1 = server_status_kb(sv.pid, "VmHWM");
+    long hwm1 = sy_bench_proc_status_kb(sv.pid, "VmHWM");
     printf("counts: %zu-byte change list creating 7 objects at slot index 1048575: %s '%s'; server VmHWM %+.1f MiB\n",
            n, sy_cluster_msg_type_name(type), why, (hwm1 - hwm0) / 1024.0);
     if (!(type == SY_CLUSTER_ERROR && strstr(why, "slots to this replica's pools"))) {
@@ -523,7 +523,7 @@ static int test_counts(fixture *fx)
     printf("counts: SCENE announcing a 2 GiB change list and carrying 32 bytes: %s '%s'\n",
            sy_cluster_msg_type_name(type), why);
     if (!(type == SY_CLUSTER_ERROR && strstr(why, "truncated"))) bad++;
-    long hwm2 = server_status_kb(sv.pid, "VmHWM");
+    long hwm2 = sy_bench_proc_status_kb(sv.pid, "VmHWM");
     printf("counts: server VmHWM %.1f MiB before, %.1f MiB after every forged message (+%.1f MiB; limit +32 MiB)\n",
            hwm0 / 1024.0, hwm2 / 1024.0, (hwm2 - hwm0) / 1024.0);
     int rendered = still_renders(fx, &sv);
@@ -542,7 +542,7 @@ static int replica_cost(const uint8_t *changes, size_t n, const char *what, doub
     server sv;
     if (start_server(NULL, 0, &sv)) return 1;
     sleep_ms(100);
-    long hwm0 = server_status_kb(sv.pid, "VmHWM");
+    long hwm0 = sy_bench_proc_status_kb(sv.pid, "VmHWM");
     uint8_t *fr = malloc(n + 64);
     CHECK(fr != NULL);
     size_t fn = scene_frame(fr, changes, (uint32_t)n, (uint32_t)n);
@@ -550,7 +550,7 @@ static int replica_cost(const uint8_t *changes, size_t n, const char *what, doub
     char why[SY_CLUSTER_REASON_MAX];
     int rc = raw_session_frame(&sv, fr, fn, &type, why, sizeof why);
     free(fr);
-    long hwm1 = server_status_kb(sv.pid, "VmHWM");
+    long hwm1 = sy_bench_proc_status_kb(sv.pid, "VmHWM");
     stop_server(&sv);
     if (rc) return 1;
     CHECK_MSG(type == SY_CLUSTER_SCENE_ACK, "%s refused: %s", what, why);
