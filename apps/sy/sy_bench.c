@@ -25,18 +25,6 @@ sy_bench_spread sy_bench_spread_of(double *v, uint32_t n)
     return (sy_bench_spread){v[0], med, v[n - 1]};
 }
 
-/* Resident set of this process in KiB (/proc/self/statm), 0 when unknown. */
-long sy_bench_rss_now_kib(void)
-{
-    FILE *f = fopen("/proc/self/statm", "r");
-    long size = 0, res = 0;
-    if (f) {
-        if (fscanf(f, "%ld %ld", &size, &res) != 2) res = 0;
-        fclose(f);
-    }
-    return res * (sysconf(_SC_PAGESIZE) / 1024);
-}
-
 sy_result sy_bench_frame(sy_window *win, sy_scene *scene, sy_context_pool *pool, uint32_t samples, sy_layer *out,
                          double *secs, sy_error *err)
 {

@@ -5,6 +5,7 @@
 #ifndef SY_BENCH_H
 #define SY_BENCH_H
 
+#include "sy_bench_os.h" /* sy_bench_rss_now_kib */
 #include "sy_viewport.h"
 
 /* Generated scene of `nodes` leaf nodes (100 per group) with ~tris triangles each; times building
@@ -125,8 +126,6 @@ sy_bench_spread sy_bench_spread_of(double *v, uint32_t n);
 /* For the benchmarks' own files (sy_bench.c, sy_bench_load.c). */
 /* qsort comparison of doubles, ascending */
 int sy_bench_cmp_double(const void *a, const void *b);
-/* Resident set of this process in KiB (/proc/self/statm), 0 when unknown. */
-long sy_bench_rss_now_kib(void);
 /* One frame of win (samples: per pixel for a progressive back-end, 0 = its default pass) timed
  * into *secs (sy bench pathtracer, sy bench filters). */
 sy_result sy_bench_frame(sy_window *win, sy_scene *scene, sy_context_pool *pool, uint32_t samples, sy_layer *out,

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/types.h>
+#include <unistd.h>
 
 /* A "Field:" line of /proc/PID/status in KiB (VmRSS, VmHWM, Threads, ...); -1 when unreadable. */
 static inline long sy_bench_proc_status_kb(pid_t pid, const char *field)
@@ -26,6 +27,18 @@ static inline long sy_bench_proc_status_kb(pid_t pid, const char *field)
         }
     fclose(f);
     return kb;
+}
+
+/* Resident set of this process in KiB (/proc/self/statm), 0 when unknown. */
+static inline long sy_bench_rss_now_kib(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    long size = 0, res = 0;
+    if (f) {
+        if (fscanf(f, "%ld %ld", &size, &res) != 2) res = 0;
+        fclose(f);
+    }
+    return res * (sysconf(_SC_PAGESIZE) / 1024);
 }
 
 #endif /* SY_BENCH_OS_H */

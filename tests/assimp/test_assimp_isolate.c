@@ -17,6 +17,7 @@
 #include "sy_assimp.h"
 #include "sy_scene.h"
 
+#include "../../apps/sy/sy_bench_os.h"
 #include "../formats/test_util.h"
 #include "assimp_quad.h"
 
@@ -113,17 +114,6 @@ static void *churn(void *arg)
     return NULL;
 }
 
-static long rss_kib(void)
-{
-    FILE *f = fopen("/proc/self/statm", "r");
-    long pages = 0, resident = 0;
-    if (f) {
-        if (fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
-        fclose(f);
-    }
-    return resident * (sysconf(_SC_PAGESIZE) / 1024);
-}
-
 static double now_s(void)
 {
     struct timespec t;
@@ -158,11 +148,11 @@ int main(void)
     if (!path_exists(oom)) printf("SKIP %s: not installed (Debian assimp-testmodels)\n", oom);
     else {
         sy_scene *s = prepared(true);
-        long before = rss_kib();
+        long before = sy_bench_rss_now_kib();
         double t0 = now_s();
         sy_result r = s ? sy_assimp_load(oom, s, NULL, NULL, &e) : SY_ERR_OUT_OF_MEMORY;
         double took = now_s() - t0;
-        long grew = rss_kib() - before;
+        long grew = sy_bench_rss_now_kib() - before;
         printf("OutOfMemory.off: %s (%.2f s, the caller grew %ld KiB)\n", e.message, took, grew);
         EXPECT_MSG(r != SY_OK && strstr(e.message, oom), "OutOfMemory.off must fail naming the file: %s", e.message);
         EXPECT_MSG(grew < 64 * 1024, "the caller grew %ld KiB", grew);
