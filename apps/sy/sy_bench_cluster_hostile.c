@@ -27,21 +27,6 @@ typedef struct hostile_peer {
     uint32_t conns;
 } hostile_peer;
 
-static int hostile_connect(int port)
-{
-    int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-    if (fd < 0) return -1;
-    struct timeval tv = {2, 0};
-    setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
-    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
-    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
-        close(fd);
-        return -1;
-    }
-    return fd;
-}
-
 static bool hostile_send(int fd, const void *p, size_t n)
 {
     while (n) {
@@ -64,7 +49,7 @@ static void *hostile_main(void *arg)
     hostile_peer *h = arg;
     static uint8_t chunk[256 << 10]; /* only ever read: shared by every peer */
     while (!atomic_load(h->stop)) {
-        int fd = hostile_connect(h->port);
+        int fd = sy_bench_loopback_connect(NULL, h->port, 2000);
         if (fd < 0) {
             hostile_sleep_ms(50);
             continue;

@@ -1,13 +1,19 @@
 /* sy_bench_os.h — the operating-system measurements and connections that the benchmarks of
  * `sy bench` and the tests measuring the same things share (header-only, libc and POSIX alone, so a
- * test includes it without linking the sy program): a process's memory from /proc. Every function
- * may be called from any thread; nothing is kept between calls. */
+ * test includes it without linking the sy program): a process's memory from /proc, a TCP connection
+ * on the loopback interface. Every function may be called from any thread; nothing is kept between
+ * calls. */
 #ifndef SY_BENCH_OS_H
 #define SY_BENCH_OS_H
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
+#include <sys/time.h>
 #include <sys/types.h>
 #include <unistd.h>
 
@@ -39,6 +45,34 @@ static inline long sy_bench_rss_now_kib(void)
         fclose(f);
     }
     return res * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+/* A TCP connection from the loopback address `from` (NULL: the kernel's choice, 127.0.0.1) to
+ * 127.0.0.1:port with send / receive timeouts; -1 on failure. Linux routes all of 127/8 to the
+ * loopback interface, so "127.0.0.2" is a second peer address on one machine. */
+static inline int sy_bench_loopback_connect(const char *from, int port, int timeout_ms)
+{
+    int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (fd < 0) return -1;
+    struct timeval tv = {timeout_ms / 1000, (timeout_ms % 1000) * 1000};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
+    int one = 1;
+    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    if (from) {
+        struct sockaddr_in la = {.sin_family = AF_INET, .sin_port = 0};
+        if (inet_pton(AF_INET, from, &la.sin_addr) != 1 || bind(fd, (struct sockaddr *)&la, sizeof la) != 0) {
+            close(fd);
+            return -1;
+        }
+    }
+    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
 }
 
 #endif /* SY_BENCH_OS_H */

@@ -8,6 +8,8 @@
 
 #include "sy_cluster.h"
 
+#include "../../apps/sy/sy_bench_os.h" /* sy_bench_loopback_connect */
+
 #include <arpa/inet.h>
 #include <errno.h>
 #include <netinet/in.h>
@@ -20,38 +22,11 @@
 #include <time.h>
 #include <unistd.h>
 
-/* A TCP connection from the loopback address `from` (NULL: the kernel's choice, 127.0.0.1) to
- * 127.0.0.1:port with send / receive timeouts; -1 on failure. Linux routes all of 127/8 to the
- * loopback interface, so "127.0.0.2" is a second peer address on one machine. */
-static inline int raw_connect_from(const char *from, int port, int timeout_ms)
-{
-    int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-    if (fd < 0) return -1;
-    struct timeval tv = {timeout_ms / 1000, (timeout_ms % 1000) * 1000};
-    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
-    int one = 1;
-    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    if (from) {
-        struct sockaddr_in la = {.sin_family = AF_INET, .sin_port = 0};
-        if (inet_pton(AF_INET, from, &la.sin_addr) != 1 || bind(fd, (struct sockaddr *)&la, sizeof la) != 0) {
-            close(fd);
-            return -1;
-        }
-    }
-    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
-    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
-        close(fd);
-        return -1;
-    }
-    return fd;
-}
-
-/* A TCP connection to 127.0.0.1:port with send / receive timeouts; -1 on failure. */
+/* A TCP connection to 127.0.0.1:port with send / receive timeouts; -1 on failure (from another
+ * loopback address: sy_bench_loopback_connect). */
 static inline int raw_connect(int port, int timeout_ms)
 {
-    return raw_connect_from(NULL, port, timeout_ms);
+    return sy_bench_loopback_connect(NULL, port, timeout_ms);
 }
 
 /* All n bytes through send (writing) or recv; false when the peer closed or the socket timed out

@@ -730,7 +730,7 @@ static int test_ceiling(fixture *fx)
  * before any connection opened after this returns. -1 on failure. */
 static int hello_only(const char *from, int port)
 {
-    int fd = raw_connect_from(from, port, 20000);
+    int fd = sy_bench_loopback_connect(from, port, 20000);
     if (fd < 0) return -1;
     sy_cluster_msg hello = raw_hello(), rep;
     uint8_t *raw = NULL;
