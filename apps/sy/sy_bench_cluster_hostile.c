@@ -2,6 +2,7 @@
  * a client's frame time while 72 connections that never authenticate trickle and flood it (see
  * sy_bench_cluster.h; alone: --hostile-only). */
 #include "sy_bench_cluster.h"
+#include "sy_bench_hostile.h"
 #include "sy_bench_os.h"
 
 #include <arpa/inet.h>
@@ -16,64 +17,7 @@
 #include <time.h>
 #include <unistd.h>
 
-/* >>hostile peers (issue 14): connections that never authenticate. Tricklers announce a 256 MiB
- * message and send 64 KiB every 100 ms; flooders announce 8 MiB and send it as fast as they can;
- * both reconnect whenever the server closes them. Plain sockets, 127.0.0.1 only. */
-typedef struct hostile_peer {
-    int port;
-    bool flood;
-    atomic_int *stop;
-    uint64_t bytes;
-    uint32_t conns;
-} hostile_peer;
-
-static bool hostile_send(int fd, const void *p, size_t n)
-{
-    while (n) {
-        ssize_t k = send(fd, p, n, MSG_NOSIGNAL);
-        if (k <= 0) return false;
-        p = (const uint8_t *)p + k;
-        n -= (size_t)k;
-    }
-    return true;
-}
-
-static void hostile_sleep_ms(int ms)
-{
-    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
-    nanosleep(&ts, NULL);
-}
-
-static void *hostile_main(void *arg)
-{
-    hostile_peer *h = arg;
-    static uint8_t chunk[256 << 10]; /* only ever read: shared by every peer */
-    while (!atomic_load(h->stop)) {
-        int fd = sy_bench_loopback_connect(NULL, h->port, 2000);
-        if (fd < 0) {
-            hostile_sleep_ms(50);
-            continue;
-        }
-        h->conns++;
-        uint8_t hdr[SY_CLUSTER_HEADER_SIZE];
-        sy_cluster_header_write(hdr, SY_CLUSTER_HELLO, 0, h->flood ? 8u << 20 : 256u << 20, 1);
-        if (hostile_send(fd, hdr, sizeof hdr)) {
-            for (uint32_t left = 8u << 20; h->flood && left && !atomic_load(h->stop);) {
-                uint32_t n = left < sizeof chunk ? left : (uint32_t)sizeof chunk;
-                if (!hostile_send(fd, chunk, n)) break;
-                h->bytes += n;
-                left -= n;
-            }
-            while (!h->flood && !atomic_load(h->stop) && hostile_send(fd, chunk, 64 << 10)) {
-                h->bytes += 64 << 10;
-                hostile_sleep_ms(100);
-            }
-        }
-        close(fd);
-        hostile_sleep_ms(h->flood ? 20 : 50);
-    }
-    return NULL;
-}
+/* >>hostile peers (issue 14): sy_bench_hostile.h */
 
 /* Server srv's resident memory before, at the peak of and after 64 tricklers + 8 flooders (5 s),
  * and the frame time of a client of that server alone (320x180 sort-first) before and during. */
@@ -102,17 +46,9 @@ sy_result sy_bench_cluster_hostile(sy_scene *scene, const sy_demo_info *d, const
     int port = colon ? atoi(colon + 1) : 0;
     long rss0 = sy_bench_proc_status_kb(srv->pid, "VmRSS"), peak = rss0;
     atomic_int stop = 0;
-    hostile_peer hp[TRICKLERS + FLOODERS];
+    sy_bench_hostile hp[TRICKLERS + FLOODERS];
     pthread_t th[TRICKLERS + FLOODERS];
-    int started = 0;
-    for (int i = 0; i < TRICKLERS + FLOODERS && r == SY_OK; ++i) {
-        hp[i] = (hostile_peer){port, i >= TRICKLERS, &stop, 0, 0};
-        pthread_attr_t at;
-        pthread_attr_init(&at);
-        pthread_attr_setstacksize(&at, 256 << 10);
-        if (pthread_create(&th[started], &at, hostile_main, &hp[i]) == 0) started++;
-        pthread_attr_destroy(&at);
-    }
+    int started = r == SY_OK ? sy_bench_hostile_start(hp, th, TRICKLERS + FLOODERS, TRICKLERS, port, &stop, NULL) : 0;
     double t_start = sy_time_now(), busy = 0, worst = 0;
     int frames = 0;
     while (r == SY_OK && sy_time_now() - t_start < 5.0) {
@@ -125,9 +61,8 @@ sy_result sy_bench_cluster_hostile(sy_scene *scene, const sy_demo_info *d, const
         long kb = sy_bench_proc_status_kb(srv->pid, "VmRSS");
         if (kb > peak) peak = kb;
     }
-    atomic_store(&stop, 1);
-    for (int i = 0; i < started; ++i) pthread_join(th[i], NULL);
-    hostile_sleep_ms(300);
+    sy_bench_hostile_stop(th, started, &stop);
+    sy_bench_sleep_ms(300);
     long rss1 = sy_bench_proc_status_kb(srv->pid, "VmRSS");
     uint64_t trickled = 0, flooded = 0;
     uint32_t conns = 0;

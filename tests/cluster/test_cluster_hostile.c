@@ -37,6 +37,7 @@
  * protocol 3). Every wait is bounded; servers stop with SIGTERM (SIGKILL after 5 s) and
  * --max-lifetime. */
 #include "../support/sy_check.h"
+#include "../../apps/sy/sy_bench_hostile.h"
 #include "raw_peer.h"
 #include "scene_msg.h"
 #include "server_proc.h"
@@ -221,47 +222,6 @@ static bool same_image(const sy_layer *a, const sy_layer *b)
 }
 
 /* ======================================================================== rss */
-typedef struct hostile {
-    int port;
-    int kind; /* 0: announce 256 MiB, trickle; 1: announce 8 MiB, flood */
-    atomic_int *stop;
-    uint64_t bytes;
-    uint32_t conns;
-} hostile;
-
-static void *hostile_main(void *arg)
-{
-    hostile *h = arg;
-    static uint8_t chunk[256 << 10];
-    memset(chunk, 'A', sizeof chunk);
-    while (!atomic_load(h->stop)) {
-        int fd = raw_connect(h->port, 2000);
-        if (fd < 0) {
-            sleep_ms(50);
-            continue;
-        }
-        h->conns++;
-        if (send_announce(fd, h->kind == 0 ? (256u << 20) : (8u << 20))) {
-            if (h->kind == 0) {
-                while (!atomic_load(h->stop) && raw_write_all(fd, chunk, 64 << 10)) {
-                    h->bytes += 64 << 10;
-                    sleep_ms(100);
-                }
-            } else {
-                for (uint32_t left = 8u << 20; left && !atomic_load(h->stop);) {
-                    uint32_t n = left < sizeof chunk ? left : (uint32_t)sizeof chunk;
-                    if (!raw_write_all(fd, chunk, n)) break;
-                    h->bytes += n;
-                    left -= n;
-                }
-            }
-        }
-        close(fd);
-        sleep_ms(h->kind == 0 ? 50 : 20);
-    }
-    return NULL;
-}
-
 typedef struct sampler {
     pid_t pid;
     atomic_int *stop;
@@ -303,19 +263,11 @@ static int test_rss(fixture *fx)
     CHECK(rss0 > 0 && hwm0 > 0);
     atomic_int stop = 0;
     enum { TRICKLERS = 64, FLOODERS = 8 };
-    hostile hs[TRICKLERS + FLOODERS];
+    sy_bench_hostile hs[TRICKLERS + FLOODERS];
     pthread_t th[TRICKLERS + FLOODERS], smt;
     sampler sm = {sv.pid, &stop, rss0};
     CHECK(pthread_create(&smt, NULL, sampler_main, &sm) == 0);
-    int started = 0;
-    for (int i = 0; i < TRICKLERS + FLOODERS; ++i) {
-        hs[i] = (hostile){sv.port, i < TRICKLERS ? 0 : 1, &stop, 0, 0};
-        pthread_attr_t at;
-        pthread_attr_init(&at);
-        pthread_attr_setstacksize(&at, 256 << 10);
-        if (pthread_create(&th[i], &at, hostile_main, &hs[i]) == 0) started++;
-        pthread_attr_destroy(&at);
-    }
+    int started = sy_bench_hostile_start(hs, th, TRICKLERS + FLOODERS, TRICKLERS, sv.port, &stop, send_announce);
     /* the honest client renders all the while */
     double t_start = now_s(), busy = 0, worst = 0;
     int frames = 0, failed = 0, differ = 0;
@@ -338,8 +290,7 @@ static int test_rss(fixture *fx)
         differ += !same_image(&out, &first);
     }
     double attack_s = now_s() - t_start;
-    atomic_store(&stop, 1);
-    for (int i = 0; i < started; ++i) pthread_join(th[i], NULL);
+    sy_bench_hostile_stop(th, started, &stop);
     pthread_join(smt, NULL);
     sleep_ms(300);
     long rss1 = sy_bench_proc_status_kb(sv.pid, "VmRSS"), hwm1 = sy_bench_proc_status_kb(sv.pid, "VmHWM");
@@ -347,7 +298,7 @@ static int test_rss(fixture *fx)
     uint32_t conns = 0;
     for (int i = 0; i < started; ++i) {
         conns += hs[i].conns;
-        if (hs[i].kind == 0) trickled += hs[i].bytes;
+        if (!hs[i].flood) trickled += hs[i].bytes;
         else flooded += hs[i].bytes;
     }
     printf("rss: %d hostile peers (%d announce 256 MiB and trickle, %d flood 8 MiB), %u connections, %.1f MiB "
