@@ -1,8 +1,9 @@
 /* sy_bench_cluster_servers.c — the `sy serve` child processes of `sy bench cluster` (started from
  * this very executable on loopback, pinned to a core where asked), the client rig its measurements
- * talk to them with, and what /proc says about a process (see sy_bench_cluster.h). */
+ * talk to them with (see sy_bench_cluster.h; a process's memory: sy_bench_os.h). */
 #define _GNU_SOURCE /* sched_setaffinity for the pinned benchmark servers */
 #include "sy_bench_cluster.h"
+#include "sy_bench_os.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -44,12 +45,7 @@ sy_result sy_bench_cluster_spawn_ex(int cpu, int lifetime_s, bool one_core, sy_b
         _exit(127);
     }
     for (int tries = 0; tries < 200; ++tries) { /* bounded: 10 s */
-        FILE *f = fopen(port_file, "r");
-        int port = 0;
-        if (f) {
-            if (fscanf(f, "%d", &port) != 1) port = 0;
-            fclose(f);
-        }
+        int port = sy_bench_read_port_file(port_file);
         if (port > 0) {
             unlink(port_file);
             out->pid = pid;

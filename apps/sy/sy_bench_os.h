@@ -1,7 +1,7 @@
 /* sy_bench_os.h — the operating-system measurements and connections that the benchmarks of
  * `sy bench` and the tests measuring the same things share (header-only, libc and POSIX alone, so a
  * test includes it without linking the sy program): a process's memory from /proc, a TCP connection
- * on the loopback interface. Every function may be called from any thread; nothing is kept between
+ * on the loopback interface, the port a server wrote to its --port-file. Every function may be called from any thread; nothing is kept between
  * calls. */
 #ifndef SY_BENCH_OS_H
 #define SY_BENCH_OS_H
@@ -73,6 +73,19 @@ static inline int sy_bench_loopback_connect(const char *from, int port, int time
         return -1;
     }
     return fd;
+}
+
+/* The port number a server wrote to the file at path (sy serve --port-file); 0 while the file is
+ * absent or holds no number yet. */
+static inline int sy_bench_read_port_file(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    int port = 0;
+    if (f) {
+        if (fscanf(f, "%d", &port) != 1) port = 0;
+        fclose(f);
+    }
+    return port;
 }
 
 #endif /* SY_BENCH_OS_H */

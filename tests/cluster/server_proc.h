@@ -101,12 +101,7 @@ static inline int start_server_args(const char *secret, int port, const char *co
     if (g_nstarted == 0) atexit(kill_leftover_servers);
     if (g_nstarted < (int)(sizeof g_started / sizeof g_started[0])) g_started[g_nstarted++] = pid;
     for (int i = 0; i < 6000; ++i) { /* until the port is written or the server exits; 300 s: a hang guard */
-        FILE *f = fopen(pf, "r");
-        int p = 0;
-        if (f) {
-            if (fscanf(f, "%d", &p) != 1) p = 0;
-            fclose(f);
-        }
+        int p = sy_bench_read_port_file(pf);
         if (p > 0) {
             out->port = p;
             snprintf(out->url, sizeof out->url, "tcp://127.0.0.1:%d", p);
