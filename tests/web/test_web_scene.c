@@ -347,6 +347,32 @@ int test_scene(uint16_t port)
 /* the "time" of a clock message */
 static double clock_time(const char *t) { return json_number(t, "time"); }
 
+/* Sends each of the n messages, which the server must refuse without a clock message (none within
+ * 0.5 s). 0, or 1 after a failed check. */
+static int no_clock(sy_web_client *c, const char *const *msgs, int n)
+{
+    sy_error err = {0};
+    char *t = NULL;
+    for (int i = 0; i < n; ++i) CHECK_OK(sy_web_client_send(c, msgs[i], &err), err);
+    CHECK(sy_web_client_next_text(c, 500, "clock", &t, &err) == SY_ERR_IO);
+    return 0;
+}
+
+/* Sends msg; the clock message that answers it must have the time `time` and the end `end` (NAN:
+ * any) and contain `has`. 0, or 1 after a failed check. */
+static int clock_after(sy_web_client *c, const char *msg, double time, double end, const char *has)
+{
+    sy_error err = {0};
+    char *t = NULL;
+    CHECK_OK(sy_web_client_send(c, msg, &err), err);
+    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
+    bool ok = (isnan(time) || clock_time(t) == time) && (isnan(end) || json_number(t, "end") == end) && strstr(t, has);
+    if (!ok) fprintf(stderr, "after %s: %s\n", msg, t);
+    free(t);
+    CHECK_MSG(ok, "after %s: want time %g, end %g (nan: any), '%s'", msg, time, end, has);
+    return 0;
+}
+
 /* The scene clock (docs/WEB.md, "The timeline") on a read-only server (a view change: allowed)
  * whose demo has two clips on the same nodes, shrink (2 s) and hold (4 s, later: with every clip
  * at once its keys would win), and plays shrink (sy_web_desc.clip): the hello lists both, the page
@@ -374,54 +400,25 @@ int test_timeline(void)
     float d0;
     if (first_frame(c, &px, &py, &d0)) return 1;
     /* bad times: refused, no clock message */
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":3}", &err), err);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":-0.5}", &err), err);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":null}", &err), err);
-    CHECK(sy_web_client_next_text(c, 500, "clock", &t, &err) == SY_ERR_IO);
+    static const char *const bad_times[] = {"{\"t\":\"time\",\"s\":3}", "{\"t\":\"time\",\"s\":-0.5}",
+                                            "{\"t\":\"time\",\"s\":null}"};
+    if (no_clock(c, bad_times, 3)) return 1;
     /* the end of the clip: every mesh at 1 % of its size, the covered pixel shows something else */
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":2}", &err), err);
-    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
-    CHECK_MSG(clock_time(t) == 2 && strstr(t, "\"playing\":false"), "%s", t);
-    free(t);
-    bool moved = false;
-    for (int k = 0; k < 40 && !moved; ++k) {
-        sy_web_frame_info fi;
-        float *depth = NULL;
-        CHECK_OK(sy_web_client_next_frame_depth(c, 60000, &fi, NULL, NULL, &depth, &err), err);
-        if (fi.width == 80 && fi.height == 60) moved = !(fabsf(depth[py * 80 + px] - d0) <= 1e-3f * d0);
-        free(depth);
-    }
-    CHECK_MSG(moved, "the depth at (%d, %d) stayed %g at 2 s", px, py, (double)d0);
+    if (clock_after(c, "{\"t\":\"time\",\"s\":2}", 2, NAN, "\"playing\":false")) return 1;
+    float d;
+    CHECK_MSG(frame_until(c, px, py, d0, true, &d) == 0, "the depth at (%d, %d) stayed %g at 2 s", px, py, (double)d0);
     /* the page's clip menu: hold (0..4 s, from its start), then its 2 s: the meshes at their own
      * size again; bad clips refused (no clock message) */
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":2}", &err), err);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":0.5}", &err), err);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":-2}", &err), err);
-    CHECK(sy_web_client_next_text(c, 500, "clock", &t, &err) == SY_ERR_IO);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":1}", &err), err);
-    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
-    CHECK_MSG(clock_time(t) == 0 && json_number(t, "end") == 4 && strstr(t, "\"clip\":1"), "%s", t);
-    free(t);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":2}", &err), err);
-    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
-    free(t);
-    bool back = false;
-    for (int k = 0; k < 40 && !back; ++k) {
-        sy_web_frame_info fi;
-        float *depth = NULL;
-        CHECK_OK(sy_web_client_next_frame_depth(c, 60000, &fi, NULL, NULL, &depth, &err), err);
-        if (fi.width == 80 && fi.height == 60) back = fabsf(depth[py * 80 + px] - d0) <= 1e-3f * d0;
-        free(depth);
-    }
-    CHECK_MSG(back, "hold at 2 s: the depth at (%d, %d) is not %g again", px, py, (double)d0);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":-1}", &err), err);
-    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
-    CHECK_MSG(json_number(t, "end") == 4 && strstr(t, "\"clip\":-1"), "%s", t);
-    free(t);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"anim\",\"clip\":0}", &err), err);
-    CHECK_OK(sy_web_client_next_text(c, 20000, "clock", &t, &err), err);
-    CHECK_MSG(json_number(t, "end") == 2 && strstr(t, "\"clip\":0"), "%s", t);
-    free(t);
+    static const char *const bad_clips[] = {"{\"t\":\"anim\",\"clip\":2}", "{\"t\":\"anim\",\"clip\":0.5}",
+                                            "{\"t\":\"anim\",\"clip\":-2}"};
+    if (no_clock(c, bad_clips, 3) || clock_after(c, "{\"t\":\"anim\",\"clip\":1}", 0, 4, "\"clip\":1") ||
+        clock_after(c, "{\"t\":\"time\",\"s\":2}", NAN, NAN, ""))
+        return 1;
+    CHECK_MSG(frame_until(c, px, py, d0, false, &d) == 0, "hold at 2 s: the depth at (%d, %d) is not %g again", px, py,
+              (double)d0);
+    if (clock_after(c, "{\"t\":\"anim\",\"clip\":-1}", NAN, 4, "\"clip\":-1") ||
+        clock_after(c, "{\"t\":\"anim\",\"clip\":0}", NAN, 2, "\"clip\":0"))
+        return 1;
     /* play from 0: the clock messages' time advances (one a second while playing) */
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":0}", &err), err);
     CHECK_OK(sy_web_client_send(c, "{\"t\":\"play\",\"on\":true}", &err), err);
@@ -449,8 +446,8 @@ int test_timeline(void)
     if (web_start_viewer(&s, &c, &err)) return 1;
     CHECK_OK(sy_web_client_next_text(c, 20000, "hello", &t, &err), err);
     free(t);
-    CHECK_OK(sy_web_client_send(c, "{\"t\":\"time\",\"s\":0}", &err), err);
-    CHECK(sy_web_client_next_text(c, 500, "clock", &t, &err) == SY_ERR_IO);
+    static const char *const a_time[] = {"{\"t\":\"time\",\"s\":0}"};
+    if (no_clock(c, a_time, 1)) return 1;
     sy_web_client_close(c);
     return web_stop(&s);
 }
