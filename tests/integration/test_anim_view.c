@@ -150,11 +150,53 @@ static void render(sy_context *ctx, const sy_camera_view *view, uint32_t spp, sy
     MUST(sy_context_render(ctx, &req, img, err));
 }
 
+/* Opens the rig of the file `name`, renders it at t = 0 and t = 1 on every back-end (spp samples
+ * a pixel) and hands each image to measure (ti: 0 or 1, bi: the back-end's index); closes the rig. */
+typedef void (*rig_measure)(void *arg, int ti, double t, size_t bi, const sy_layer *img);
+static void rig_sweep(const char *name, uint32_t spp, rig_measure measure, void *arg)
+{
+    rig g;
+    rig_open(&g, name);
+    const double times[2] = {0.0, 1.0};
+    for (int ti = 0; ti < 2; ++ti) {
+        sy_camera_view v = rig_time(&g, times[ti]);
+        for (size_t bi = 0; bi < IT_NBACKENDS; ++bi) {
+            sy_layer img;
+            render(g.ctx[bi], &v, spp, &img);
+            measure(arg, ti, times[ti], bi, &img);
+            sy_layer_destroy(&img);
+        }
+    }
+    rig_close(&g);
+}
+
 /* Pixel column of world x at depth dist in front of a camera at x = cx (yfov, aspect W / H). */
 static double column_of(double x, double cx, double dist, double yfov)
 {
     double half_w = tan(yfov / 2) * (double)W / (double)H;
     return ((x - cx) / dist / half_w + 1.0) * 0.5 * W;
+}
+
+/* The dolly's square: its centroid and side at t against the camera's place and yfov then. */
+static void camera_measure(void *arg, int ti, double t, size_t bi, const sy_layer *img)
+{
+    (void)arg, (void)ti;
+    double u = t, cx = -1.0 + 2.0 * u, yfov = 0.8 - 0.2 * u;
+    double want = column_of(0.0, cx, 5.0, yfov), want_w = column_of(0.5, cx, 5.0, yfov) - column_of(-0.5, cx, 5.0, yfov);
+    double sum = 0, sx = 0, sy = 0;
+    for (uint32_t y = 0; y < H; ++y)
+        for (uint32_t x = 0; x < W; ++x) {
+            double a = img->rgba[((size_t)y * W + x) * 4 + 3];
+            sum += a, sx += a * (x + 0.5), sy += a * (y + 0.5);
+        }
+    double mx = sum > 0 ? sx / sum : -1, my = sum > 0 ? sy / sum : -1;
+    double width = sum > 0 ? sqrt(sum) : 0; /* a square's side in pixels */
+    printf("camera %s t=%g: centroid (%.2f, %.2f), want (%.2f, %.2f); side %.2f px, want %.2f\n", it_backends[bi], t, mx,
+           my, want, 0.5 * H, width, want_w);
+    EXPECT_MSG(fabs(mx - want) < 0.75 && fabs(my - 0.5 * H) < 0.75, "camera %s t=%g: centroid (%.2f, %.2f), want (%.2f, %.2f)",
+               it_backends[bi], t, mx, my, want, 0.5 * H);
+    EXPECT_MSG(fabs(width - want_w) < 1.0, "camera %s t=%g: side %.2f px, want %.2f (yfov %g)", it_backends[bi], t, width,
+               want_w, yfov);
 }
 
 static void test_camera(void)
@@ -170,35 +212,34 @@ static void test_camera(void)
                "\"channels\":[{\"sampler\":0,\"target\":{\"node\":1,\"path\":\"translation\"}},"
                "{\"sampler\":1,\"target\":{\"path\":\"pointer\",\"extensions\":{\"KHR_animation_pointer\":"
                "{\"pointer\":\"/cameras/0/perspective/yfov\"}}}}]}]");
-    rig g;
-    rig_open(&g, "camera.gltf");
-    const double times[2] = {0.0, 1.0};
-    double width[IT_NBACKENDS][2];
-    for (int ti = 0; ti < 2; ++ti) {
-        sy_camera_view v = rig_time(&g, times[ti]);
-        double u = times[ti], cx = -1.0 + 2.0 * u, yfov = 0.8 - 0.2 * u;
-        double want = column_of(0.0, cx, 5.0, yfov), want_w = column_of(0.5, cx, 5.0, yfov) - column_of(-0.5, cx, 5.0, yfov);
-        for (size_t bi = 0; bi < IT_NBACKENDS; ++bi) {
-            sy_layer img;
-            render(g.ctx[bi], &v, 16, &img);
-            double sum = 0, sx = 0, sy = 0;
-            for (uint32_t y = 0; y < H; ++y)
-                for (uint32_t x = 0; x < W; ++x) {
-                    double a = img.rgba[((size_t)y * W + x) * 4 + 3];
-                    sum += a, sx += a * (x + 0.5), sy += a * (y + 0.5);
-                }
-            double mx = sum > 0 ? sx / sum : -1, my = sum > 0 ? sy / sum : -1;
-            width[bi][ti] = sum > 0 ? sqrt(sum) : 0; /* a square's side in pixels */
-            printf("camera %s t=%g: centroid (%.2f, %.2f), want (%.2f, %.2f); side %.2f px, want %.2f\n", it_backends[bi],
-                   times[ti], mx, my, want, 0.5 * H, width[bi][ti], want_w);
-            EXPECT_MSG(fabs(mx - want) < 0.75 && fabs(my - 0.5 * H) < 0.75, "camera %s t=%g: centroid (%.2f, %.2f), want (%.2f, %.2f)",
-                       it_backends[bi], times[ti], mx, my, want, 0.5 * H);
-            EXPECT_MSG(fabs(width[bi][ti] - want_w) < 1.0, "camera %s t=%g: side %.2f px, want %.2f (yfov %g)", it_backends[bi],
-                       times[ti], width[bi][ti], want_w, yfov);
-            sy_layer_destroy(&img);
-        }
+    rig_sweep("camera.gltf", 16, camera_measure, NULL);
+}
+
+/* The lamp's pool of light at t: its brightest column against the lamp's place, the brightness at
+ * its foot into foot[bi][ti] (arg: double foot[IT_NBACKENDS][2]). */
+static void light_measure(void *arg, int ti, double t, size_t bi, const sy_layer *img)
+{
+    double(*foot)[2] = arg;
+    double lx = -1.5 + 3.0 * t, want = column_of(lx, 0.0, 5.0, 0.8);
+    /* the brightest column of the middle rows (luminance summed over 9 rows) */
+    double best = -1;
+    int best_x = -1;
+    for (uint32_t x = 0; x < W; ++x) {
+        double c = 0;
+        for (uint32_t y = H / 2 - 4; y <= H / 2 + 4; ++y) c += img->rgba[((size_t)y * W + x) * 4 + 1];
+        if (c > best) best = c, best_x = (int)x;
     }
-    rig_close(&g);
+    /* the brightness at the foot: the 3 x 3 pixels around the predicted column */
+    double f = 0;
+    int fx = (int)want;
+    for (int y = H / 2 - 1; y <= H / 2 + 1; ++y)
+        for (int x = fx - 1; x <= fx + 1; ++x)
+            if (x >= 0 && x < W) f += img->rgba[((size_t)y * W + (size_t)x) * 4 + 1];
+    foot[bi][ti] = f;
+    printf("light %s t=%g: brightest column %d (centre %.1f), want %.2f; foot brightness %.4f\n", it_backends[bi], t, best_x,
+           best_x + 0.5, want, f);
+    EXPECT_MSG(fabs(best_x + 0.5 - want) <= 2.0, "light %s t=%g: brightest column %d, want %.2f", it_backends[bi], t, best_x,
+               want);
 }
 
 static void test_light(void)
@@ -217,45 +258,14 @@ static void test_light(void)
                "\"channels\":[{\"sampler\":0,\"target\":{\"node\":2,\"path\":\"translation\"}},"
                "{\"sampler\":1,\"target\":{\"path\":\"pointer\",\"extensions\":{\"KHR_animation_pointer\":"
                "{\"pointer\":\"/extensions/KHR_lights_punctual/lights/0/intensity\"}}}}]}]");
-    rig g;
-    rig_open(&g, "light.gltf");
-    const double times[2] = {0.0, 1.0};
     double foot[IT_NBACKENDS][2];
-    for (int ti = 0; ti < 2; ++ti) {
-        sy_camera_view v = rig_time(&g, times[ti]);
-        double lx = -1.5 + 3.0 * times[ti], want = column_of(lx, 0.0, 5.0, 0.8);
-        for (size_t bi = 0; bi < IT_NBACKENDS; ++bi) {
-            sy_layer img;
-            render(g.ctx[bi], &v, 64, &img);
-            /* the brightest column of the middle rows (luminance summed over 9 rows) */
-            double best = -1;
-            int best_x = -1;
-            for (uint32_t x = 0; x < W; ++x) {
-                double c = 0;
-                for (uint32_t y = H / 2 - 4; y <= H / 2 + 4; ++y) c += img.rgba[((size_t)y * W + x) * 4 + 1];
-                if (c > best) best = c, best_x = (int)x;
-            }
-            /* the brightness at the foot: the 3 x 3 pixels around the predicted column */
-            double f = 0;
-            int fx = (int)want;
-            for (int y = H / 2 - 1; y <= H / 2 + 1; ++y)
-                for (int x = fx - 1; x <= fx + 1; ++x)
-                    if (x >= 0 && x < W) f += img.rgba[((size_t)y * W + (size_t)x) * 4 + 1];
-            foot[bi][ti] = f;
-            printf("light %s t=%g: brightest column %d (centre %.1f), want %.2f; foot brightness %.4f\n", it_backends[bi],
-                   times[ti], best_x, best_x + 0.5, want, f);
-            EXPECT_MSG(fabs(best_x + 0.5 - want) <= 2.0, "light %s t=%g: brightest column %d, want %.2f", it_backends[bi],
-                       times[ti], best_x, want);
-            sy_layer_destroy(&img);
-        }
-    }
+    rig_sweep("light.gltf", 64, light_measure, foot);
     for (size_t bi = 0; bi < IT_NBACKENDS; ++bi) {
         double ratio = foot[bi][0] > 0 ? foot[bi][1] / foot[bi][0] : 0, tol = strcmp(it_backends[bi], "pathtracer") ? 0.1 : 0.2;
         printf("light %s: foot brightness t=1 / t=0 = %.3f (want 3)\n", it_backends[bi], ratio);
         EXPECT_MSG(fabs(ratio - 3.0) < 3.0 * tol, "light %s: intensity 10 -> 30 made the foot %.3f x brighter", it_backends[bi],
                    ratio);
     }
-    rig_close(&g);
 }
 
 /* Pointers the clock does not drive: the first named with its channel, the rest counted; the
