@@ -84,15 +84,31 @@ static sy_result load_gltf(sy_scene *s, const char *nodes, const char *roots, co
     return r;
 }
 
+/* An X3D document named name, loaded with the default options. */
+static sy_result load_x3d(sy_scene *s, const char *doc, const char *name, sy_error *e)
+{
+    sy_x3d_info info = {0};
+    sy_result r = sy_x3d_load_memory(doc, strlen(doc), name, ".", s, NULL, &info, e);
+    sy_x3d_info_free(&info);
+    return r;
+}
+
+/* A view placed at 1e19 (what: "a camera", "a Viewpoint") must be refused (r) with a message
+ * naming the file, the item and the coordinate range; frees s. */
+static void expect_far_refused(sy_scene *s, sy_result r, const sy_error *e, const char *file, const char *item,
+                               const char *what)
+{
+    EXPECT_MSG(r != SY_OK && strstr(e->message, file) && strstr(e->message, item) && strstr(e->message, "coordinate range"),
+               "%s at 1e19: %s (%s)", what, e->message, sy_result_str(r));
+    sy_scene_destroy(s);
+}
+
 static void test_gltf_camera_far(void)
 {
     sy_scene *s = it_scene();
     sy_error e = {0};
     sy_result r = load_gltf(s, "{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,1e19]}", "0,1", NULL, &e);
-    EXPECT_MSG(r != SY_OK && strstr(e.message, "ranges.gltf") && strstr(e.message, "nodes[1]") &&
-               strstr(e.message, "coordinate range"),
-               "a camera at 1e19: %s (%s)", e.message, sy_result_str(r));
-    sy_scene_destroy(s);
+    expect_far_refused(s, r, &e, "ranges.gltf", "nodes[1]", "a camera");
 }
 
 static void test_x3d_viewpoint_far(void)
@@ -103,13 +119,8 @@ static void test_x3d_viewpoint_far(void)
         "<Shape><Box/></Shape></Scene></X3D>";
     sy_scene *s = it_scene();
     sy_error e = {0};
-    sy_x3d_info info = {0};
-    sy_result r = sy_x3d_load_memory(doc, sizeof doc - 1, "far.x3d", ".", s, NULL, &info, &e);
-    sy_x3d_info_free(&info);
-    EXPECT_MSG(r != SY_OK && strstr(e.message, "far.x3d") && strstr(e.message, "Viewpoint") &&
-               strstr(e.message, "coordinate range"),
-               "a Viewpoint at 1e19: %s (%s)", e.message, sy_result_str(r));
-    sy_scene_destroy(s);
+    sy_result r = load_x3d(s, doc, "far.x3d", &e);
+    expect_far_refused(s, r, &e, "far.x3d", "Viewpoint", "a Viewpoint");
 }
 
 /* One mesh used by two nodes (so the ray tracer instances it rather than baking a static mesh):
