@@ -95,12 +95,31 @@ int main(int argc, char **argv)
     static const struct {
         const char *name;
         int (*run)(void);
-    } alone[] = {{"messages", test_messages}, {"timeline", test_timeline}, {"tree", test_tree},     {"readonly", test_readonly},
-                 {"frame", test_frame},       {"encodecost", test_encode_cost}, {"clientfiles", test_client_files},
-                 {"token", test_token},       {"progressive", test_progressive}};
+    } alone[] = {{"messages", test_messages},   {"timeline", test_timeline},       {"frame", test_frame},
+                 {"encodecost", test_encode_cost}, {"clientfiles", test_client_files}, {"token", test_token},
+                 {"progressive", test_progressive}};
     for (size_t i = 0; i < sizeof alone / sizeof alone[0]; ++i)
         if (!strcmp(which, alone[i].name)) {
             int f = alone[i].run();
+            if (!f) printf("web %s: ok\n", which);
+            return f;
+        }
+    /* the parts given a viewer of a server of their own (read-only, or with the big tree) */
+    static const struct {
+        const char *name;
+        int (*run)(sy_web_client *c);
+        bool read_only, big_tree;
+    } viewed[] = {{"readonly", test_readonly, true, false}, {"tree", test_tree, false, true}};
+    for (size_t i = 0; i < sizeof viewed / sizeof viewed[0]; ++i)
+        if (!strcmp(which, viewed[i].name)) {
+            web_read_only = viewed[i].read_only;
+            web_big_tree = viewed[i].big_tree;
+            server s;
+            sy_web_client *c = NULL;
+            if (web_start_viewer(&s, &c, &err)) return 1;
+            int f = viewed[i].run(c);
+            sy_web_client_close(c);
+            f |= web_stop(&s);
             if (!f) printf("web %s: ok\n", which);
             return f;
         }

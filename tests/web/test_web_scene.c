@@ -452,13 +452,9 @@ int test_timeline(void)
     return web_stop(&s);
 }
 
-int test_readonly(void)
+int test_readonly(sy_web_client *c)
 {
     sy_error err = {0};
-    server s;
-    web_read_only = true;
-    sy_web_client *c = NULL;
-    if (web_start_viewer(&s, &c, &err)) return 1;
     char *t = NULL, m[256];
     CHECK_OK(sy_web_client_next_text(c, 20000, "hello", &t, &err), err);
     CHECK(strstr(t, "\"read_only\":true") && strstr(t, "\"environments\":[\"scene\",\"studio\",\"none\"]") &&
@@ -496,8 +492,7 @@ int test_readonly(void)
     do {
         if (web_next_frame(c, &fi, NULL, NULL)) return 1;
     } while (fi.input_id < 1);
-    sy_web_client_close(c);
-    return web_stop(&s);
+    return 0;
 }
 
 /* >>web_tree: a scene beyond WEB_TREE_MAX nodes, a page at a time */
@@ -533,13 +528,9 @@ static const cJSON *named(const cJSON *nodes, const char *name)
     return NULL;
 }
 
-int test_tree(void)
+int test_tree(sy_web_client *c)
 {
     sy_error err = {0};
-    server s;
-    web_big_tree = true;
-    sy_web_client *c = NULL;
-    if (web_start_viewer(&s, &c, &err)) return 1;
     /* the first answer: the root's tree, at most WEB_TREE_MAX nodes, depth first */
     cJSON *a = tree_answer(c, "{\"t\":\"tree\",\"seq\":1}");
     CHECK(a);
@@ -616,7 +607,5 @@ int test_tree(void)
     a = tree_answer(c, "{\"t\":\"tree\",\"seq\":53}");
     CHECK(a && num(a, "seq") == 53); /* the bad one got no answer */
     cJSON_Delete(a);
-    sy_web_client_close(c);
-    web_big_tree = false;
-    return web_stop(&s);
+    return 0;
 }

@@ -112,8 +112,9 @@ int test_still_budget(server *s, uint16_t port);
 /* test_web_scene.c */
 int test_messages(void);
 int test_scene(uint16_t port);
-int test_readonly(void);
 int test_timeline(void);
-int test_tree(void);
+/* a viewer of a server web_start_viewer() started (test_web.c sets web_read_only, web_big_tree) */
+int test_readonly(sy_web_client *c);
+int test_tree(sy_web_client *c);
 
 #endif /* SY_TEST_WEB_TEST_H */
