@@ -546,16 +546,27 @@ static int test_mutations(void)
     return 0;
 }
 
+/* Layer a (aw x ah) of random colours, (rnd() % mod) / div + off, and depths d0 + i * step but
+ * infinite at every inf_every-th pixel; layer b (bw x bh) to decode into. 0, or 1 after a failed
+ * check. */
+static int tile_layers(uint32_t aw, uint32_t ah, uint32_t bw, uint32_t bh, uint32_t mod, float div, float off,
+                       size_t inf_every, float d0, float step, sy_layer *a, sy_layer *b)
+{
+    sy_error e = {0};
+    CHECK_OK(sy_layer_create(aw, ah, a, &e), e);
+    CHECK_OK(sy_layer_create(bw, bh, b, &e), e);
+    for (size_t i = 0; i < (size_t)aw * ah; ++i) {
+        for (int c = 0; c < 4; ++c) a->rgba[i * 4 + c] = (float)(rnd() % mod) / div + off;
+        a->depth[i] = (i % inf_every) ? d0 + (float)i * step : INFINITY;
+    }
+    return 0;
+}
+
 static int test_tile_codec(void)
 {
     sy_error e = {0};
     sy_layer a = {0}, b = {0};
-    CHECK_OK(sy_layer_create(13, 7, &a, &e), e);
-    CHECK_OK(sy_layer_create(20, 10, &b, &e), e);
-    for (size_t i = 0; i < 13 * 7; ++i) {
-        for (int c = 0; c < 4; ++c) a.rgba[i * 4 + c] = (float)(rnd() % 1000) / 7.0f - 3.0f;
-        a.depth[i] = (i % 5) ? (float)i * 0.25f : INFINITY;
-    }
+    if (tile_layers(13, 7, 20, 10, 1000, 7.0f, -3.0f, 5, 0.0f, 0.25f, &a, &b)) return 1;
     sy_cluster_buf enc = {0};
     CHECK_OK(sy_cluster_tile_encode(&a, true, &enc, &e), e);
     sy_cluster_tile t = {{0, 0, 13, 7}, SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD, 5, 13 * 7 * 5 * 4, enc.data, (uint32_t)enc.size};
@@ -665,12 +676,7 @@ static int test_half_tile(void)
 {
     sy_error e = {0};
     sy_layer a = {0}, b = {0};
-    CHECK_OK(sy_layer_create(31, 9, &a, &e), e);
-    CHECK_OK(sy_layer_create(31, 9, &b, &e), e);
-    for (size_t i = 0; i < 31 * 9; ++i) {
-        for (int c = 0; c < 4; ++c) a.rgba[i * 4 + c] = (float)(rnd() % 100000) / 3000.0f;
-        a.depth[i] = (i % 7) ? 0.5f + (float)i * 0.01f : INFINITY;
-    }
+    if (tile_layers(31, 9, 31, 9, 100000, 3000.0f, 0.0f, 7, 0.5f, 0.01f, &a, &b)) return 1;
     sy_cluster_buf f32 = {0}, f16 = {0};
     CHECK_OK(sy_cluster_tile_encode(&a, true, &f32, &e), e);
     CHECK_OK(sy_cluster_tile_encode_as(&a, true, SY_CLUSTER_ENC_F16_SHUFFLE_ZSTD, &f16, &e), e);
