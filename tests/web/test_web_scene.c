@@ -144,14 +144,15 @@ static int refused(sy_web_client *c, const char *msg, const char *reason)
 }
 
 /* Frames until one whose depth at pixel (px, py) of an 80 x 60 frame satisfies want (changed from
- * d0 or equal to it), at most 40 frames; the depth there in *d. */
+ * d0 or equal to it), at most 40 frames, each waited for up to 60 s (a loaded machine, ASan); the
+ * depth there in *d. */
 static int frame_until(sy_web_client *c, int px, int py, float d0, bool changed, float *d)
 {
     sy_error err = {0};
     for (int k = 0; k < 40; ++k) {
         sy_web_frame_info fi;
         float *depth = NULL;
-        if (sy_web_client_next_frame_depth(c, 20000, &fi, NULL, NULL, &depth, &err) != SY_OK) {
+        if (sy_web_client_next_frame_depth(c, 60000, &fi, NULL, NULL, &depth, &err) != SY_OK) {
             fprintf(stderr, "frame_until: %s\n", err.message);
             return 1;
         }
