@@ -279,9 +279,21 @@ sy_result x3d_visit_background(loader *L, xfile *F, const xmlNode *el);
 
 /* Loads one X3D document (the main file: parent NULL; an Inline: at / atF name the Inline element)
  * and returns the node of its Scene. */
+/* A growing list of elements (sy_x3d_anim.c, sy_x3d_morphs.c). */
+typedef struct x3d_elems {
+    const xmlNode **items;
+    size_t count, cap;
+} x3d_elems;
+/* Appends c; false when out of memory. */
+bool x3d_elems_push(x3d_elems *rs, const xmlNode *c);
+/* f without X3D's set_ prefix or _changed suffix equals name */
+bool x3d_field_is(const char *f, const char *name);
+/* qsort / bsearch over an array of element pointers (by address) */
+int x3d_cmp_ptr_el(const void *a, const void *b);
 /* The file's TimeSensors, interpolators and ROUTEs as animations (sy_x3d_anim.c); after the walk. */
 sy_result x3d_load_animations(loader *L, xfile *F, const xmlNode *scene);
-/* Before the walk of a file: its Coordinates that CoordinateInterpolators animate (L->morphs). */
+/* Before the walk of a file: its Coordinates that CoordinateInterpolators animate (L->morphs;
+ * sy_x3d_morphs.c). */
 sy_result x3d_scan_morphs(loader *L, xfile *F, const xmlNode *scene);
 /* Frees L->morphs. */
 void x3d_free_morphs(loader *L);
