@@ -26,6 +26,8 @@ static sy_result no_handler(void *u, sy_scene *s, const sy_web_request *q, sy_we
 static const sy_web_route routes[] = {{"POST", "/api/cull", no_handler, NULL},
                                       {"GET", "/api/object/", no_handler, NULL},
                                       {"GET", "/api/view", no_handler, NULL},
+                                      {"GET", "/api/pose", no_handler, NULL},
+                                      {"GET", "/api/environment", no_handler, NULL},
                                       {"GET", "/client/", no_handler, NULL}};
 
 /* the value of header name in the head (a copy in out), NULL when absent */
