@@ -22,7 +22,7 @@
 //     The page's tools (sy web, a canvas wide enough for the panel): finds a covered pixel near
 //     the centre (the server's still of the view), clicks it (pick + select; the properties show
 //     the node), hides that node from the tree (the streamed canvas changes there; a pick there no
-//     longer names it), shows it again (back as it was), adds a section plane (the canvas
+//     longer names it), shows it again (back as it was while selected), adds a section plane (the canvas
 //     changes; with caps on in magenta, the cut faces show magenta), measures two covered points (Esc takes them away), opens the help, takes a screenshot (the download),
 //     pinches and drags with synthetic touch pointers; screenshots OUTDIR/page.png, tree.png,
 //     hidden.png, section.png, cap.png, measure.png, help.png. URL with readonly=1 (sy web --read-only):
@@ -492,6 +492,9 @@ try {
       await page.waitForFunction((v) => sy.ui.tree.version > v, v0, { timeout: TIMEOUT });
       result.still_visible = await page.evaluate((n) => sy.ui.tree.nodes.find((x) => x.id === n).visible, pick.node);
     } else {
+      // the picture with the picked node selected (its highlight): what showing it again must bring back
+      await applied('sy.ui.tree.selected === a', pick.node);
+      const selected = await canvasB64('selected_canvas.png');
       await row.click();
       await page.waitForFunction((n) => { const x = sy.ui.tree.nodes.find((k) => k.id === n); return x && !x.visible; }, pick.node, { timeout: TIMEOUT });
       await shown(f0);
@@ -499,9 +502,11 @@ try {
       await page.screenshot({ path: join(outDir, 'hidden.png') });
       const hidden = await canvasB64('hidden_canvas.png');
       result.hide = await diff(before, hidden, px, py);
-      // a pick there no longer names it
+      // a pick there no longer names it (a pick that does not select: a click would select what is
+      // behind, the floor, whose tint the mirror sphere reflects when it is shown again)
       const p1 = await page.evaluate(() => sy.ui.tree.picks);
-      await page.mouse.click(px, py);
+      await page.evaluate(([x, y]) => { const r = document.getElementById('sy-canvas').getBoundingClientRect();
+        sy.send({ t: 'pick', x: (x - r.left) / r.width, y: (y - r.top) / r.height, select: false, seq: 76 }); }, [px, py]);
       await page.waitForFunction((n) => sy.ui.tree.picks > n, p1, { timeout: TIMEOUT });
       result.pick_hidden = await page.evaluate(() => ({ hit: sy.ui.tree.lastPick.hit, node: sy.ui.tree.lastPick.node }));
       // show it again: back as it was
@@ -510,7 +515,7 @@ try {
       await page.waitForFunction((n) => { const x = sy.ui.tree.nodes.find((k) => k.id === n); return x && x.visible; }, pick.node, { timeout: TIMEOUT });
       await shown(f0);
       await settled();
-      result.show = await diff(before, await canvasB64('shown_canvas.png'), px, py);
+      result.show = await diff(selected, await canvasB64('shown_canvas.png'), px, py);
       // (for 3b: where the demo's gold box is, before any plane cuts it)
       const boxPick = await page.evaluate(async () => {
         const n = sy.ui.tree.picks;

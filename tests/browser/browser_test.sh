@@ -26,8 +26,9 @@
 #   browser_test.sh tools SY PNG_IOU MODULES_DIR SCENE
 #     sy web SCENE -b raster, a 960 x 600 page: a click on a covered pixel picks its node (the
 #     properties name it) and selects it; unticking it in the tree changes the streamed canvas
-#     there (mean abs diff > 30 in a 9 x 9 box) and a pick there no longer names it; ticking it
-#     brings the picture back (< 8); a section plane changes > 0.5% of the canvas; its caps on in
+#     there (mean abs diff > 30 in a 9 x 9 box) and a pick there (one that does not select) no
+#     longer names it; ticking it brings the picture back as it was while selected (< 4; 0.0
+#     measured); a section plane changes > 0.5% of the canvas; its caps on in
 #     magenta make > 0.2% of the canvas magenta (and 10 x what was before); two clicks
 #     while measuring give the distance of the two picked points (and, with a plane added, the
 #     second point's signed distance to it); the help opens; the environment menu offers scene,
@@ -73,7 +74,8 @@
 # MODULES_DIR holds browser.mjs and node_modules/playwright-core. Skipped (77, with the reason)
 # without chromium, node, playwright-core (npm ci failed: no network at build time) or the scene;
 # with SY_REQUIRE_BROWSER=1 in the environment (CI: .ci/run sets it) each of those is a failure
-# instead, so that the browser coverage is never lost silently.
+# instead, so that the browser coverage is never lost silently. SY_KEEP_OUT=DIR keeps a copy of the
+# run's folder (screenshots, canvases, logs) in DIR for a look at a failure.
 set -u
 mode=$1 SY=$2 PNG_IOU=$3 MODULES=$4 SCENE=$5
 MIN_IOU=${6:-0.95} LUM=${7:-} # client: the coverage IoU asked for; the mean luminance's relative tolerance (none: not checked)
@@ -95,7 +97,7 @@ out=$(mktemp -d)
 pid=
 cleanup() {
     [ -n "$pid" ] && kill -TERM "$pid" 2>/dev/null && wait "$pid" 2>/dev/null
-    rm -rf "$out"
+    [ -n "${SY_KEEP_OUT:-}" ] && { cp -r "$out" "$SY_KEEP_OUT"; } ; rm -rf "$out"
 }
 trap cleanup EXIT
 fail=0
@@ -206,7 +208,7 @@ if [ "$mode" = tools ]; then
                   `touch inputs ${t.touch_inputs}`);
       if (!(t.hide.box > 30)) errs.push(`hiding the picked node left the canvas where it was (mean abs diff ${t.hide.box})`);
       if (t.pick_hidden.hit && t.pick_hidden.node === t.pick.node) errs.push("a pick still names the hidden node");
-      if (!(t.show.box < 8)) errs.push(`showing it again did not bring the picture back (mean abs diff ${t.show.box})`);
+      if (!(t.show.box < 4)) errs.push(`showing it again did not bring the picture back (mean abs diff ${t.show.box})`);
       if (!(t.section.changed > 0.005)) errs.push(`the section plane changed ${t.section.changed} of the canvas`);
       if (!(t.cap && t.cap.after > 0.002 && t.cap.after > 10 * t.cap.before)) errs.push(`caps on in magenta: ${JSON.stringify(t.cap)} of the canvas magenta`);
       const m = t.measure, d = m.points.length === 2 ? Math.hypot(...[0, 1, 2].map((i) => m.points[1][i] - m.points[0][i])) : NaN;
