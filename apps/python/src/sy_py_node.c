@@ -215,9 +215,7 @@ static const field_desc camera_fields[] = {
     SY_PY_FIELD(sy_camera_data, ymag, 'f', 1), {NULL, 0, 0, 0}};
 #undef SY_PY_FIELD
 
-/* The field table and current values (a copy in *data) of the material, light or camera that args
- * (type, id) name, with its scene and type in *sc and *type; NULL with an exception for bad
- * arguments, a closed scene, another type or a stale id. */
+/* The data of a material, light or camera. */
 typedef union object_data {
     sy_material_data material;
     sy_light_data light;
@@ -232,6 +230,9 @@ typedef struct object_ref {
     object_data d;
 } object_ref;
 
+/* The field table of the material, light or camera that args (type, id) name, with its scene,
+ * type, id and a copy of its current values in *o; NULL with an exception for bad arguments, a
+ * closed scene, another type or a stale id. */
 static const field_desc *object_fields(PyObject *self, PyObject *args, object_ref *o)
 {
     if (!PyArg_ParseTuple(args, "iI", &o->type, &o->id)) return NULL;
