@@ -212,13 +212,18 @@ static sy_result view_answer(const sy_web_cull *c, sy_scene *scene, sy_web_respo
     return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "/api/view: out of memory");
 }
 
-/* GET /api/view and GET /api/environment: both answer from the attached server's view; 404 without one. */
-static sy_result on_server_view(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+/* GET /api/view and GET /api/environment answer from the attached server's view; 404 without one. */
+static sy_result on_view(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
 {
     const sy_web_cull *c = user;
-    bool env = !strcmp(req->path, "/api/environment");
-    if (!c->server) return sy_error_set(err, SY_ERR_NOT_FOUND, "%s: no server attached", env ? "/api/environment" : "/api/view");
-    return env ? environment_answer(c, scene, resp, err) : view_answer(c, scene, resp, err);
+    return c->server ? view_answer(c, scene, resp, err) : sy_error_set(err, SY_ERR_NOT_FOUND, "%s: no server attached", req->path);
+}
+
+static sy_result on_environment(void *user, sy_scene *scene, const sy_web_request *req, sy_web_response *resp, sy_error *err)
+{
+    const sy_web_cull *c = user;
+    return c->server ? environment_answer(c, scene, resp, err)
+                     : sy_error_set(err, SY_ERR_NOT_FOUND, "%s: no server attached", req->path);
 }
 
 static const char *content_type_of(const char *name)
@@ -308,9 +313,9 @@ sy_result sy_web_cull_create(sy_scene *scene, sy_node root, const char *client_d
     uint32_t n = 0;
     routes[n++] = (sy_web_route){"POST", "/api/cull", on_cull, c};
     routes[n++] = (sy_web_route){"GET", "/api/object/", on_object, c};
-    routes[n++] = (sy_web_route){"GET", "/api/view", on_server_view, c};
+    routes[n++] = (sy_web_route){"GET", "/api/view", on_view, c};
     routes[n++] = (sy_web_route){"GET", "/api/pose", on_pose, c};
-    routes[n++] = (sy_web_route){"GET", "/api/environment", on_server_view, c};
+    routes[n++] = (sy_web_route){"GET", "/api/environment", on_environment, c};
     if (client_dir) routes[n++] = (sy_web_route){"GET", "/client/", on_client, c};
     *count = n;
     *out = c;
