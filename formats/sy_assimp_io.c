@@ -282,7 +282,11 @@ static sy_result precheck_ply(asp_loader *L, const uint8_t *p, size_t n)
         if (i < n) i++;
         char a[64], b[64], c[64], d[64];
         int k = sscanf(line, "%63s %63s %63s %63s", a, b, c, d);
-        if (k >= 1 && !strcmp(a, "end_header")) break;
+        /* the header ends where Assimp's parser sees it end: "end_header" at the start of a line and
+         * followed by a space, tab, CR, form feed or the line's end (its TokenMatch). Another
+         * character (a vertical tab: found by fuzz_assimp_ply) is no end for Assimp, which then
+         * loops for ever at the end of the data, so it is none here either. */
+        if (len >= 10 && !memcmp(line, "end_header", 10) && strchr(" \t\r\f", line[10])) break;
         if (k >= 2 && !strcmp(a, "format")) ascii = !strcmp(b, "ascii");
         if (k >= 3 && !strcmp(a, "element")) {
             /* an element declared twice: Assimp 5.2 fails an assertion in Triangulate and aborts the

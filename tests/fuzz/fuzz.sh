@@ -17,6 +17,8 @@
 #   --seeds-tool PATH  fuzz_seeds (default: next to the fuzz binary)
 #   --testdata DIR     shared test data (default: $SY_TESTDATA_DIR, else <repo>/../shared/testdata)
 #   --max-len N        override the target's maximum input length
+#   --seed N           libFuzzer's random seed (default 0: a new one each run; the ctests pass
+#                      SY_FUZZ_SEED, default 1, so the suite mutates the same way on every machine)
 #   -- ARGS            further libFuzzer arguments
 #
 # Seeds are read in place at fuzz time: the regression corpus tests/fuzz/corpus_regressions/TARGET
@@ -33,11 +35,11 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 repo=$(cd "$here/../.." && pwd)
-usage() { sed -n '2,28p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 2; }
 [ $# -ge 2 ] || usage
 target=$1 seconds=$2
 shift 2
-jobs=1 corpus="" fuzzer="" seeds_tool="" max_len="" extra=()
+jobs=1 corpus="" fuzzer="" seeds_tool="" max_len="" seed=0 extra=()
 testdata=${SY_TESTDATA_DIR:-$repo/../shared/testdata}
 while [ $# -gt 0 ]; do
   case $1 in
@@ -47,6 +49,7 @@ while [ $# -gt 0 ]; do
     --seeds-tool) seeds_tool=$2; shift 2 ;;
     --testdata) testdata=$2; shift 2 ;;
     --max-len) max_len=$2; shift 2 ;;
+    --seed) seed=$2; shift 2 ;;
     --) shift; extra=("$@"); break ;;
     *) usage ;;
   esac
@@ -196,6 +199,7 @@ while :; do
   timer=()
   [ -x /usr/bin/time ] && timer=(/usr/bin/time -a -f '%U %S' -o "$work/cpu")
   (cd "$work" && SY_FUZZ_RESOURCES="$work/resources" "${timer[@]}" "$fuzzer" -max_total_time="$left" "${args[@]}" \
+     -seed=$((seed ? seed + round : 0)) \
      "${extra[@]}" "$corpus" "$regress" "$work/seeds" "$work/generated" >"$work/fuzz-main-$round.log" 2>&1)
   rc=$?
   logs+=("$work/fuzz-main-$round.log")
