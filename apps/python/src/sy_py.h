@@ -101,7 +101,8 @@ extern PyObject *sy_py_errors[SY_ERR_SYSTEM + 1];
 
 /* sy_py_buffer.c */
 PyObject *sy_py_buffer_take(float *data, uint32_t rows, uint32_t cols, uint32_t channels);
-PyObject *sy_py_scene_mesh(PyObject *self, PyObject *args);
+/* the fields of mesh id as _get gives them; NULL with an exception for a stale id */
+PyObject *sy_py_mesh_fields(sy_scene *sc, unsigned int id);
 extern PyTypeObject *sy_py_buffer_type;
 extern PyType_Spec sy_py_buffer_spec;
 extern PyTypeObject *sy_py_blobview_type;
@@ -118,6 +119,8 @@ int sy_py_get_array(PyObject *obj, const char *what, char code, Py_ssize_t cols,
 int sy_py_float_seq(PyObject *o, const char *what, float *out, Py_ssize_t n);
 PyObject *sy_py_tuple_of(const float *v, int n);
 PyObject *sy_py_stale(const char *what, unsigned id);
+/* the fields of node id as _get gives them; NULL with an exception for a stale id */
+PyObject *sy_py_node_fields(sy_scene *sc, unsigned int id);
 extern PyTypeObject *sy_py_scene_type;
 extern PyType_Spec sy_py_scene_spec;
 

@@ -127,12 +127,9 @@ static PyObject *blobview_of(sy_blob *blob, char code, Py_ssize_t cols)
     return (PyObject *)b;
 }
 
-/* _mesh(id) -> {"name": str or None, "primitives": [dict of views, material id, topology]} */
-PyObject *sy_py_scene_mesh(PyObject *self, PyObject *args)
+/* _get(SY_TYPE_MESH, id): {"name": str or None, "primitives": [dict of views, material id, topology]} */
+PyObject *sy_py_mesh_fields(sy_scene *sc, unsigned int id)
 {
-    unsigned int id;
-    sy_scene *sc = sy_py_scene_id_arg(self, args, &id);
-    if (!sc) return NULL;
     const sy_mesh_data *d = sy_mesh_get(sc, (sy_mesh){id});
     if (!d) return sy_py_stale("mesh", id);
     PyObject *prims = PyList_New(d->primitives.count);

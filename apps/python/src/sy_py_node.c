@@ -232,12 +232,16 @@ typedef struct object_ref {
 
 /* The field table of the material, light or camera that args (type, id) name, with its scene,
  * type, id and a copy of its current values in *o; NULL with an exception for bad arguments, a
- * closed scene, another type or a stale id. */
+ * closed scene, another type or a stale id. Nodes and meshes (o->type) have no table: NULL, no
+ * exception, o->sc set. */
 static const field_desc *object_fields(PyObject *self, PyObject *args, object_ref *o)
 {
+    o->sc = NULL;
     if (!PyArg_ParseTuple(args, "iI", &o->type, &o->id)) return NULL;
-    sy_scene *sc = o->sc = sy_py_scene_use((SceneObject *)self);
+    sy_scene *sc = sy_py_scene_use((SceneObject *)self);
     if (!sc) return NULL;
+    if (o->type == SY_TYPE_NODE || o->type == SY_TYPE_MESH) return o->sc = sc, NULL;
+    o->sc = sc;
     int type = o->type;
     unsigned int id = o->id;
     object_data *data = &o->d;
@@ -255,11 +259,14 @@ static const field_desc *object_fields(PyObject *self, PyObject *args, object_re
     return t;
 }
 
-/* _get(type, id) -> dict of the fields (and "name") */
+/* _get(type, id) -> dict of the fields (and "name"): every scene object's fields read one way
+ * (switchyard's objects call it with their type) */
 PyObject *sy_py_scene_get_fields(PyObject *self, PyObject *args)
 {
     object_ref o;
     const field_desc *t = object_fields(self, args, &o);
+    if (!t && !PyErr_Occurred() && o.type == SY_TYPE_NODE) return sy_py_node_fields(o.sc, o.id);
+    if (!t && !PyErr_Occurred() && o.type == SY_TYPE_MESH) return sy_py_mesh_fields(o.sc, o.id);
     if (!t) return NULL;
     const object_data d = o.d;
     PyObject *dict = Py_BuildValue("{s:z}", "name", *(char *const *)&d); /* every struct starts with its name */
@@ -280,6 +287,8 @@ PyObject *sy_py_scene_set_fields(PyObject *self, PyObject *args, PyObject *kw)
 {
     object_ref o;
     const field_desc *table = object_fields(self, args, &o);
+    if (!table && !PyErr_Occurred())
+        return PyErr_Format(PyExc_ValueError, "%s fields are set through their own calls", sy_object_type_name((sy_object_type)o.type));
     if (!table) return NULL;
     object_data d = o.d;
     sy_scene *sc = o.sc;

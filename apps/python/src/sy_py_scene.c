@@ -480,12 +480,9 @@ PyObject *sy_py_stale(const char *what, unsigned id)
     return sy_py_raise(e.code, &e);
 }
 
-/* _node(id) -> dict of the node's fields */
-static PyObject *scene_node(PyObject *self, PyObject *args)
+/* _get(SY_TYPE_NODE, id): dict of the node's fields */
+PyObject *sy_py_node_fields(sy_scene *sc, unsigned int id)
 {
-    unsigned int id;
-    sy_scene *sc = sy_py_scene_id_arg(self, args, &id);
-    if (!sc) return NULL;
     const sy_node_data *d = sy_node_get(sc, (sy_node){id});
     if (!d) return sy_py_stale("node", id);
     uint32_t nc = 0;
@@ -569,8 +566,6 @@ static PyMethodDef scene_methods[] = {
     {"_destroy", scene_destroy_object, METH_VARARGS, NULL},
     {"_ids", scene_ids, METH_VARARGS, NULL},
     {"_valid", scene_valid, METH_VARARGS, NULL},
-    {"_node", scene_node, METH_VARARGS, NULL},
-    {"_mesh", sy_py_scene_mesh, METH_VARARGS, NULL},
     {"_node_set", (PyCFunction)(void (*)(void))scene_node_set, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_get", sy_py_scene_get_fields, METH_VARARGS, NULL},
     {"_set", (PyCFunction)(void (*)(void))sy_py_scene_set_fields, METH_VARARGS | METH_KEYWORDS, NULL},

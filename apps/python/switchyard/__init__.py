@@ -187,7 +187,7 @@ class _Methods:
         self.scene._c._destroy(self._type, self.id)
 
     def _fields(self):
-        raise NotImplementedError
+        return self.scene._c._get(self._type, self.id)
 
     @property
     def name(self):
@@ -217,9 +217,6 @@ class Node(_c._Node, _Methods):
     setting a TRS field is one C call (the call-overhead target; apps/python/bench_overhead.py)."""
     __slots__ = ()
     _type = _c.TYPE_NODE
-
-    def _fields(self):
-        return self.scene._c._node(self.id)
 
     @property
     def matrix(self):
@@ -275,9 +272,6 @@ class Mesh(_Object):
     __slots__ = ()
     _type = _c.TYPE_MESH
 
-    def _fields(self):
-        return self.scene._c._mesh(self.id)
-
     @property
     def primitives(self):
         out = []
@@ -305,9 +299,6 @@ class _Fielded(_Object):
     """An object whose fields the library lists by name (_switchyard's field tables)."""
     __slots__ = ()
     _keys = ()
-
-    def _fields(self):
-        return self.scene._c._get(self._type, self.id)
 
     def __getattr__(self, key):
         if key in type(self)._keys:
