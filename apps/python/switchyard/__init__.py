@@ -559,7 +559,7 @@ def render(scene, backend=None, width=0, height=0, spp=0, seed=0, params=None, a
 # ---------------------------------------------------------------- the web view
 
 
-class Server:
+class Server(_Closing):
     """The web view of a scene, served by a thread of its own (``serve()`` returns it): ``url`` (the
     address to open, with ``?token=`` when one is required), ``port``; ``stop()`` (or ``with``) stops
     serving. While it serves, the server owns the scene: calls on the Scene raise RuntimeError."""
@@ -592,14 +592,7 @@ class Server:
             if self._owns:
                 self.scene.close()
 
-    close = stop
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.stop()
-        return False
+    close = stop  # _Closing's with-block ends in stop()
 
     def __repr__(self):
         return "<Server %s%s>" % (self.url, "" if self._c is not None else " (stopped)")
