@@ -22,6 +22,7 @@ typedef struct scene {
     float ox;     /* the occluder's x offset (object motion) */
     bool stripes; /* the occluder's irradiance in two halves of its own (left 0.4, right 1.6 x e_occ) */
     float *color, *albedo, *normal, *depth, *position;
+    float *out;  /* the filter's output for the frame (4 floats a pixel), sized with it */
     float m[16]; /* world_to_pixel */
     uint64_t rng;
 } scene;
@@ -34,17 +35,23 @@ static void ray_of(const scene *s, float x, float y, float *u, float *v)
     *v = (1.0f - 2.0f * y / (float)s->h) * th;
 }
 
+/* frees the frame's images (the scene's fields stay) */
+static void scene_free(scene *s)
+{
+    free(s->color), free(s->albedo), free(s->normal), free(s->depth), free(s->position), free(s->out);
+}
+
 /* renders the scene at camera x cx: every hit has albedo 0.5, radiance = 0.5 * E with E the wall's
  * or the occluder's irradiance, times (1 + noise * N(0,1)) when noise > 0 */
 static int scene_render(scene *s, uint32_t w, uint32_t h, float cx, float e_wall, float e_occ, float noise)
 {
     size_t n = (size_t)w * h;
     if (n > (size_t)s->w * s->h || !s->color) {
-        free(s->color), free(s->albedo), free(s->normal), free(s->depth), free(s->position);
+        scene_free(s);
         s->color = malloc(4 * n * sizeof(float)), s->albedo = malloc(3 * n * sizeof(float));
         s->normal = malloc(3 * n * sizeof(float)), s->depth = malloc(n * sizeof(float));
-        s->position = malloc(3 * n * sizeof(float));
-        CHECK(s->color && s->albedo && s->normal && s->depth && s->position);
+        s->position = malloc(3 * n * sizeof(float)), s->out = malloc(4 * n * sizeof(float));
+        CHECK(s->color && s->albedo && s->normal && s->depth && s->position && s->out);
     }
     s->w = w, s->h = h, s->cx = cx;
     for (uint32_t y = 0; y < h; ++y)
@@ -85,11 +92,6 @@ static sy_filter_frame scene_frame(const scene *s)
                              .position = s->position, .spp_uniform = 1.0f};
 }
 
-static void scene_free(scene *s)
-{
-    free(s->color), free(s->albedo), free(s->normal), free(s->depth), free(s->position);
-}
-
 static sy_filter_temporal_params plain_params(void)
 {
     sy_filter_temporal_params p;
@@ -122,17 +124,16 @@ static int test_constant_pan(void)
     scene s = {.rng = 7};
     sy_filter_temporal *t = temporal_open(NULL); /* the defaults: clamping and a-trous on */
     sy_filter_report err = {0};
-    float *out = malloc(4 * 64 * 48 * sizeof(float));
-    CHECK(t && out);
+    CHECK(t);
     sy_filter_temporal_stats st = {0};
     double maxd = 0;
     for (int k = 0; k < 8; ++k) {
         uint32_t w = k == 5 ? 32 : 64, h = k == 5 ? 24 : 48; /* one frame at half resolution */
         CHECK(scene_render(&s, w, h, 0.05f * (float)k, 0.6f, 0.6f, 0.0f) == 0);
         sy_filter_frame f = scene_frame(&s);
-        CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
+        CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, &st, &err) == SY_FILTER_OK);
         for (size_t i = 0; i < (size_t)w * h; ++i)
-            for (int q = 0; q < 4; ++q) maxd = fmax(maxd, fabs(out[4 * i + q] - (q == 3 ? 1.0 : 0.3)));
+            for (int q = 0; q < 4; ++q) maxd = fmax(maxd, fabs(s.out[4 * i + q] - (q == 3 ? 1.0 : 0.3)));
         if (k > 0) CHECK_MSG(st.reprojected > st.pixels * 8 / 10, "frame %d: %llu of %llu reprojected", k,
                              (unsigned long long)st.reprojected, (unsigned long long)st.pixels);
     }
@@ -140,7 +141,6 @@ static int test_constant_pan(void)
            st.mean_history);
     CHECK(maxd < 1e-5);
     CHECK(st.mean_history > 4.0);
-    free(out);
     return temporal_close(t, &s);
 }
 
@@ -154,17 +154,16 @@ static int test_blend_and_disocclusion(void)
     sy_filter_temporal *t = temporal_open(&p);
     sy_filter_report err = {0};
     const uint32_t w = 96, h = 64;
-    float *out = malloc(4 * w * h * sizeof(float));
-    CHECK(t && out);
+    CHECK(t);
     const float A = 0.4f, B = 0.8f;
     CHECK(scene_render(&s, w, h, 0.0f, A, A, 0.0f) == 0);
     sy_filter_frame f = scene_frame(&s);
     sy_filter_temporal_stats st;
-    CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
+    CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, &st, &err) == SY_FILTER_OK);
     CHECK(st.reprojected == 0 && st.disoccluded == (uint64_t)w * h);
     scene prev = {.w = w, .h = h, .cx = 0.0f};
     CHECK(scene_render(&s, w, h, 0.3f, B, B, 0.0f) == 0);
-    CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
+    CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, &st, &err) == SY_FILTER_OK);
     float th = tanf(0.5f * YFOV), asp = (float)w / (float)h;
     uint32_t n_blend = 0, n_disocc = 0, n_outside = 0;
     for (uint32_t y = 0; y < h; ++y)
@@ -181,7 +180,7 @@ static int test_blend_and_disocclusion(void)
             bool clear = (fabsf(px - cx0) > qx + 1.5f || fabsf(py - cy0) > qy + 1.5f) && px > 1.5f &&
                          px < (float)w - 1.5f && py > 1.5f && py < (float)h - 1.5f;
             bool outside = px > (float)w + 1.0f;
-            float got = out[4 * i];
+            float got = s.out[4 * i];
             if (inside_occ) {
                 CHECK_MSG(fabsf(got - 0.5f * B) < 1e-6f, "disoccluded (%u,%u): %g, want %g", x, y, got, 0.5f * B);
                 n_disocc++;
@@ -200,9 +199,8 @@ static int test_blend_and_disocclusion(void)
     /* the occluder's own pixels are reprojected too (same surface, moved in the image) */
     uint32_t occ_blend = 0;
     for (size_t i = 0; i < (size_t)w * h; ++i)
-        occ_blend += s.depth[i] == 2.0f && fabsf(out[4 * i] - 0.25f * (A + B)) < 1e-6f;
+        occ_blend += s.depth[i] == 2.0f && fabsf(s.out[4 * i] - 0.25f * (A + B)) < 1e-6f;
     CHECK(occ_blend > 100);
-    free(out);
     return temporal_close(t, &s);
 }
 
@@ -215,19 +213,17 @@ static int test_clamp(void)
     sy_filter_temporal *t = temporal_open(&p);
     sy_filter_report err = {0};
     const uint32_t w = 48, h = 32;
-    float *out = malloc(4 * w * h * sizeof(float));
-    CHECK(t && out);
+    CHECK(t);
     CHECK(scene_render(&s, w, h, 0.0f, 0.1f, 0.1f, 0.0f) == 0);
     sy_filter_frame f = scene_frame(&s);
-    CHECK(sy_filter_temporal_run(t, &f, s.m, out, NULL, &err) == SY_FILTER_OK);
+    CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, NULL, &err) == SY_FILTER_OK);
     CHECK(scene_render(&s, w, h, 0.0f, 2.0f, 2.0f, 0.05f) == 0);
-    CHECK(sy_filter_temporal_run(t, &f, s.m, out, NULL, &err) == SY_FILTER_OK);
+    CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, NULL, &err) == SY_FILTER_OK);
     double worst = 0;
-    for (size_t i = 0; i < (size_t)w * h; ++i) worst = fmax(worst, fabs(out[4 * i] - 1.0));
+    for (size_t i = 0; i < (size_t)w * h; ++i) worst = fmax(worst, fabs(s.out[4 * i] - 1.0));
     /* unclamped: (0.05 + 1) / 2 = 0.525; clamped within about 2 standard deviations (0.05) of 1 */
     printf("clamp: history 0.05 against new samples 1 +- 5%%: worst |out - 1| = %.3f (unclamped 0.475)\n", worst);
     CHECK(worst < 0.15);
-    free(out);
     return temporal_close(t, &s);
 }
 
@@ -238,25 +234,25 @@ static int test_noisy_pan(void)
     sy_filter_report err = {0};
     const uint32_t w = 96, h = 64;
     size_t n = (size_t)w * h;
-    float *out = malloc(4 * n * sizeof(float)), *last = malloc(4 * n * sizeof(float)), *in_last = malloc(4 * n * sizeof(float));
-    CHECK(t && out && last && in_last);
+    float *last = malloc(4 * n * sizeof(float)), *in_last = malloc(4 * n * sizeof(float));
+    CHECK(t && last && in_last);
     double e_in = 0, e_out = 0, fl_in = 0, fl_out = 0;
     uint64_t cnt = 0, fcnt = 0;
     for (int k = 0; k < 20; ++k) {
         CHECK(scene_render(&s, w, h, 0.01f * (float)k, 0.6f, 1.0f, 1.0f) == 0); /* relative sd 1: "1 spp" */
         sy_filter_frame f = scene_frame(&s);
-        CHECK(sy_filter_temporal_run(t, &f, s.m, out, NULL, &err) == SY_FILTER_OK);
+        CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, NULL, &err) == SY_FILTER_OK);
         for (size_t i = 0; i < n && k >= 10; ++i) {
             double truth = s.depth[i] == 2.0f ? 0.5 : 0.3;
             e_in += (s.color[4 * i] - truth) * (s.color[4 * i] - truth) / (truth * truth + 0.01);
-            e_out += (out[4 * i] - truth) * (out[4 * i] - truth) / (truth * truth + 0.01);
+            e_out += (s.out[4 * i] - truth) * (s.out[4 * i] - truth) / (truth * truth + 0.01);
             cnt++;
             /* flicker on the wall away from the occluder's edges (the true value does not change) */
             if (s.depth[i] == 5.0f && (i % w) > 4 && (i % w) < w - 4 && fabsf(s.position[3 * i]) > 1.5f) {
-                fl_in += fabs(s.color[4 * i] - in_last[4 * i]), fl_out += fabs(out[4 * i] - last[4 * i]), fcnt++;
+                fl_in += fabs(s.color[4 * i] - in_last[4 * i]), fl_out += fabs(s.out[4 * i] - last[4 * i]), fcnt++;
             }
         }
-        memcpy(last, out, 4 * n * sizeof(float));
+        memcpy(last, s.out, 4 * n * sizeof(float));
         memcpy(in_last, s.color, 4 * n * sizeof(float));
     }
     e_in /= (double)cnt, e_out /= (double)cnt, fl_in /= (double)fcnt, fl_out /= (double)fcnt;
@@ -265,7 +261,7 @@ static int test_noisy_pan(void)
     CHECK(e_in / e_out > 5.0);
     CHECK(fl_in / fl_out > 5.0);
     /* the same frames with a-trous off are noisier: the spatial filter does work */
-    free(out), free(last), free(in_last);
+    free(last), free(in_last);
     return temporal_close(t, &s);
 }
 
@@ -296,19 +292,19 @@ static int test_rest(void)
     sy_filter_report err = {0};
     const uint32_t w = 96, h = 64;
     size_t n = (size_t)w * h;
-    float *out = malloc(4 * n * sizeof(float)), *last = malloc(4 * n * sizeof(float)), *acc = malloc(4 * n * sizeof(float));
+    float *last = malloc(4 * n * sizeof(float)), *acc = malloc(4 * n * sizeof(float));
     float *acc_last = malloc(4 * n * sizeof(float));
     double *sum = calloc(4 * n, sizeof(double));
-    CHECK(out && last && acc && acc_last && sum);
+    CHECK(last && acc && acc_last && sum);
     double moving = 0;
     int counted = 0;
     const int pan = 24;
     for (int k = 0; k < pan; ++k) {
         CHECK(scene_render(&s, w, h, 0.01f * (float)k, 0.6f, 1.0f, 1.0f) == 0); /* relative sd 1: "1 spp" */
         sy_filter_frame f = scene_frame(&s);
-        CHECK(sy_filter_temporal_run(t, &f, s.m, out, NULL, &err) == SY_FILTER_OK);
-        if (k >= pan - 8) moving += mean_change(out, last, n), counted++;
-        memcpy(last, out, 4 * n * sizeof(float));
+        CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, NULL, &err) == SY_FILTER_OK);
+        if (k >= pan - 8) moving += mean_change(s.out, last, n), counted++;
+        memcpy(last, s.out, 4 * n * sizeof(float));
     }
     moving /= counted;
     /* the last moving frame's samples start the resting view's accumulation (as the path tracer's) */
@@ -317,23 +313,23 @@ static int test_rest(void)
     for (uint32_t spp = 2; spp <= p.rest_samples; ++spp) {
         CHECK(scene_render(&s, w, h, 0.01f * (float)(pan - 1), 0.6f, 1.0f, 1.0f) == 0);
         for (size_t i = 0; i < 4 * n; ++i) sum[i] += s.color[i], acc[i] = (float)(sum[i] / spp);
-        bool blended = sy_filter_temporal_rest(t, w, h, acc, spp, out);
+        bool blended = sy_filter_temporal_rest(t, w, h, acc, spp, s.out);
         CHECK_MSG(blended == (spp < p.rest_samples), "%u samples: blended %d", spp, blended);
-        double ch = mean_change(out, last, n), own = mean_change(acc, acc_last, n);
+        double ch = mean_change(s.out, last, n), own = mean_change(acc, acc_last, n);
         if (spp == 2) pop = ch, pop_plain = mean_change(acc, last, n);
         else later = fmax(later, ch / (1.5 * fmax(moving, own)));
-        memcpy(last, out, 4 * n * sizeof(float));
+        memcpy(last, s.out, 4 * n * sizeof(float));
         memcpy(acc_last, acc, 4 * n * sizeof(float));
     }
-    CHECK(!memcmp(out, acc, 4 * n * sizeof(float))); /* converged: the accumulation exactly */
-    CHECK(!sy_filter_temporal_rest(t, w, h, acc, 3, out) && !memcmp(out, acc, 4 * n * sizeof(float))); /* dropped */
+    CHECK(!memcmp(s.out, acc, 4 * n * sizeof(float))); /* converged: the accumulation exactly */
+    CHECK(!sy_filter_temporal_rest(t, w, h, acc, 3, s.out) && !memcmp(s.out, acc, 4 * n * sizeof(float))); /* dropped */
     printf("camera stops: change at the stop %.5f (plain accumulation %.5f), flicker while moving %.5f; later "
            "frames' change at most %.2f of their bound\n",
            pop, pop_plain, moving, later);
     CHECK(pop <= 1.5 * moving);
     CHECK(pop_plain > 3.0 * moving);
     CHECK(later <= 1.0);
-    free(out), free(last), free(acc), free(acc_last), free(sum);
+    free(last), free(acc), free(acc_last), free(sum);
     return temporal_close(t, &s);
 }
 
@@ -349,8 +345,8 @@ static int test_split(void)
     sy_filter_report err = {0};
     const uint32_t w = 96, h = 64;
     size_t n = (size_t)w * h;
-    float *out = malloc(4 * n * sizeof(float)), *dir = malloc(3 * n * sizeof(float)), *ind = malloc(3 * n * sizeof(float));
-    CHECK(t && out && dir && ind);
+    float *dir = malloc(3 * n * sizeof(float)), *ind = malloc(3 * n * sizeof(float));
+    CHECK(t && dir && ind);
     double e_in = 0, e_out = 0, worst_edge = 0, cnt = 0;
     for (int k = 0; k < 12; ++k) {
         /* the render's colour carries the noise; the split: direct = the noise-free part (the
@@ -365,19 +361,19 @@ static int test_split(void)
         }
         sy_filter_frame f = scene_frame(&s);
         f.direct = dir, f.indirect = ind;
-        CHECK(sy_filter_temporal_run(t, &f, s.m, out, NULL, &err) == SY_FILTER_OK);
+        CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, NULL, &err) == SY_FILTER_OK);
         if (k < 6) continue;
         for (uint32_t y = 1; y + 1 < h; ++y)
             for (uint32_t x = 1; x + 1 < w; ++x) {
                 size_t i = (size_t)y * w + x;
                 double truth = (s.depth[i] == 2.0f ? 5.0 : 0.1) + 0.1;
                 e_in += (s.color[4 * i] - truth) * (s.color[4 * i] - truth) / (truth * truth + 0.01);
-                e_out += (out[4 * i] - truth) * (out[4 * i] - truth) / (truth * truth + 0.01);
+                e_out += (s.out[4 * i] - truth) * (s.out[4 * i] - truth) / (truth * truth + 0.01);
                 cnt += 1;
                 /* wall pixels next to the emitter: no light crept over the edge */
                 bool edge = s.depth[i] == 5.0f && (s.depth[i - 1] == 2.0f || s.depth[i + 1] == 2.0f ||
                                                    s.depth[i - w] == 2.0f || s.depth[i + w] == 2.0f);
-                if (edge) worst_edge = fmax(worst_edge, fabs(out[4 * i] - truth));
+                if (edge) worst_edge = fmax(worst_edge, fabs(s.out[4 * i] - truth));
             }
     }
     e_in /= cnt, e_out /= cnt;
@@ -385,7 +381,7 @@ static int test_split(void)
            e_in, e_out, e_in / e_out, worst_edge);
     CHECK(e_in / e_out > 5.0);
     CHECK(worst_edge < 0.1);
-    free(out), free(dir), free(ind);
+    free(dir), free(ind);
     return temporal_close(t, &s);
 }
 
@@ -403,18 +399,18 @@ static double motion_run(bool with_motion, double *e_wall)
     if (sy_filter_temporal_create(NULL, &t, &err) != SY_FILTER_OK) return -1.0;
     const uint32_t w = 96, h = 64;
     size_t n = (size_t)w * h;
-    float *out = malloc(4 * n * sizeof(float)), *mv = malloc(3 * n * sizeof(float));
+    float *mv = malloc(3 * n * sizeof(float));
     double e = 0, ew = 0;
     uint64_t cnt = 0, cw = 0;
     const float step = 0.05f;
-    for (int k = 0; k < 30 && out && mv; ++k) {
+    for (int k = 0; k < 30 && mv; ++k) {
         s.ox = -0.75f + step * (float)k;
         if (scene_render(&s, w, h, 0.0f, 0.6f, 1.0f, 1.0f)) break;
         for (size_t i = 0; i < n; ++i) /* the occluder was step to the left a frame ago */
             for (int q = 0; q < 3; ++q) mv[3 * i + q] = q == 0 && s.depth[i] == 2.0f ? -step : 0.0f;
         sy_filter_frame f = scene_frame(&s);
         if (with_motion) f.motion = mv;
-        if (sy_filter_temporal_run(t, &f, s.m, out, NULL, &err)) break;
+        if (sy_filter_temporal_run(t, &f, s.m, s.out, NULL, &err)) break;
         for (size_t i = 0; i < n && k >= 10; ++i) {
             float u, v;
             ray_of(&s, (float)(i % w) + 0.5f, (float)(i / w) + 0.5f, &u, &v);
@@ -423,12 +419,12 @@ static double motion_run(bool with_motion, double *e_wall)
                 float lx = 2.0f * u - s.ox;
                 truth = 0.5 * (lx > 0.0f ? 1.6 : 0.4);
             }
-            double d2 = (out[4 * i] - truth) * (out[4 * i] - truth) / (truth * truth + 0.01);
+            double d2 = (s.out[4 * i] - truth) * (s.out[4 * i] - truth) / (truth * truth + 0.01);
             if (s.depth[i] == 2.0f) e += d2, cnt++;
             else ew += d2, cw++;
         }
     }
-    free(out), free(mv);
+    free(mv);
     sy_filter_temporal_destroy(t);
     scene_free(&s);
     *e_wall = cw ? ew / (double)cw : -1.0;
@@ -452,20 +448,20 @@ static int test_object_motion(void)
     sy_filter_report err = {0};
     const uint32_t w = 48, h = 32;
     size_t n = (size_t)w * h;
-    float *out = malloc(4 * n * sizeof(float)), *mv = malloc(3 * n * sizeof(float));
-    CHECK(t && out && mv);
+    float *mv = malloc(3 * n * sizeof(float));
+    CHECK(t && mv);
     sy_filter_temporal_stats st = {0};
     for (int k = 0; k < 3; ++k) {
         CHECK(scene_render(&s, w, h, 0.02f * (float)k, 0.6f, 1.0f, 0.0f) == 0);
         for (size_t i = 0; i < 3 * n; ++i) mv[i] = k == 2 ? NAN : 0.0f;
         sy_filter_frame f = scene_frame(&s);
         f.motion = mv;
-        CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
-        for (size_t i = 0; i < 4 * n; ++i) CHECK(isfinite(out[i]));
+        CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, &st, &err) == SY_FILTER_OK);
+        for (size_t i = 0; i < 4 * n; ++i) CHECK(isfinite(s.out[i]));
         if (k == 1) CHECK(st.reprojected > st.pixels * 8 / 10);
     }
     CHECK(st.reprojected == 0 && st.nonfinite == 0);
-    free(out), free(mv);
+    free(mv);
     return temporal_close(t, &s);
 }
 
@@ -476,31 +472,30 @@ static int test_bad_input(void)
     sy_filter_report err = {0};
     const uint32_t w = 32, h = 24;
     size_t n = (size_t)w * h;
-    float *out = malloc(4 * n * sizeof(float));
-    CHECK(t && out);
+    CHECK(t);
     CHECK(scene_render(&s, w, h, 0.0f, 0.6f, 0.6f, 0.0f) == 0);
     s.color[4 * 100] = NAN, s.normal[3 * 200] = INFINITY;
     sy_filter_frame f = scene_frame(&s);
     sy_filter_temporal_stats st;
     for (int k = 0; k < 3; ++k) {
-        CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
-        for (size_t i = 0; i < 4 * n; ++i) CHECK(isfinite(out[i]));
+        CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, &st, &err) == SY_FILTER_OK);
+        for (size_t i = 0; i < 4 * n; ++i) CHECK(isfinite(s.out[i]));
         CHECK(st.nonfinite == 2);
         /* neighbours of the bad pixels are untouched by them */
-        CHECK(fabsf(out[4 * 101] - 0.3f) < 1e-5f && fabsf(out[4 * 201] - 0.3f) < 1e-5f);
+        CHECK(fabsf(s.out[4 * 101] - 0.3f) < 1e-5f && fabsf(s.out[4 * 201] - 0.3f) < 1e-5f);
     }
     /* misses pass through */
     s.depth[50] = INFINITY;
     s.color[4 * 50] = 7.0f;
-    CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_OK);
-    CHECK(out[4 * 50] == 7.0f);
+    CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, &st, &err) == SY_FILTER_OK);
+    CHECK(s.out[4 * 50] == 7.0f);
     float bad[16];
     memcpy(bad, s.m, sizeof bad);
     bad[3] = NAN;
-    CHECK(sy_filter_temporal_run(t, &f, bad, out, &st, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT &&
+    CHECK(sy_filter_temporal_run(t, &f, bad, s.out, &st, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT &&
           strstr(err.message, "world_to_pixel"));
     f.position = NULL;
-    CHECK(sy_filter_temporal_run(t, &f, s.m, out, &st, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
+    CHECK(sy_filter_temporal_run(t, &f, s.m, s.out, &st, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT);
     sy_filter_temporal_params p;
     sy_filter_temporal_params_default(&p);
     p.alpha = 0.0f;
@@ -513,7 +508,6 @@ static int test_bad_input(void)
     p.max_history = 0;
     sy_filter_temporal *t2 = NULL;
     CHECK(sy_filter_temporal_create(&p, &t2, &err) == SY_FILTER_ERROR_INVALID_ARGUMENT && !t2);
-    free(out);
     sy_filter_temporal_destroy(t);
     sy_filter_temporal_destroy(NULL);
     scene_free(&s);

@@ -51,9 +51,17 @@ typedef struct buf {
     float times[2], keys[6], scal_a[2], scal_b[2];
 } buf;
 
-/* Writes name holding the glTF text; the buffer as a data URI. */
-static void write_gltf(const char *name, const buf *b, const char *rest)
+/* glTF text the tests share: the camera of the views (perspective, yfov 0.8, znear 0.1) and a channel
+ * of sampler S driving the KHR_animation_pointer P */
+#define CAMERA_JSON "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.1}}],\n"
+#define POINTER_CHANNEL(S, P)                                                                                          \
+    "{\"sampler\":" #S ",\"target\":{\"path\":\"pointer\",\"extensions\":{\"KHR_animation_pointer\":{\"pointer\":\"" P     \
+    "\"}}}}"
+
+/* Writes name holding the glTF text; the buffer (make_buf) as a data URI. */
+static void write_gltf(const char *name, buf data, const char *rest)
 {
+    const buf *b = &data;
     char uri[1024], path[512];
     base64((const uint8_t *)b, sizeof *b, uri);
     snprintf(path, sizeof path, "%s/%s", g_dir, name);
@@ -201,17 +209,14 @@ static void camera_measure(void *arg, int ti, double t, size_t bi, const sy_laye
 
 static void test_camera(void)
 {
-    const float k0[3] = {-1, 0, 5}, k1[3] = {1, 0, 5};
-    buf b = make_buf(0.5f, k0, k1, 0.8f, 0.6f, 0, 0);
-    write_gltf("camera.gltf", &b,
+    write_gltf("camera.gltf", make_buf(0.5f, (const float[3]){-1, 0, 5}, (const float[3]){1, 0, 5}, 0.8f, 0.6f, 0, 0),
                "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1]},"
                "\"extensions\":{\"KHR_materials_unlit\":{}}}],\n"
-               "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.1}}],\n"
+               CAMERA_JSON
                "\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[-1,0,5]}],\"scenes\":[{\"nodes\":[0,1]}],\"scene\":0,\n"
                "\"animations\":[{\"name\":\"dolly\",\"samplers\":[{\"input\":3,\"output\":4},{\"input\":3,\"output\":5}],"
                "\"channels\":[{\"sampler\":0,\"target\":{\"node\":1,\"path\":\"translation\"}},"
-               "{\"sampler\":1,\"target\":{\"path\":\"pointer\",\"extensions\":{\"KHR_animation_pointer\":"
-               "{\"pointer\":\"/cameras/0/perspective/yfov\"}}}}]}]");
+               POINTER_CHANNEL(1, "/cameras/0/perspective/yfov") "]}]");
     rig_sweep("camera.gltf", 16, camera_measure, NULL);
 }
 
@@ -244,20 +249,17 @@ static void light_measure(void *arg, int ti, double t, size_t bi, const sy_layer
 
 static void test_light(void)
 {
-    const float k0[3] = {-1.5f, 0, 1}, k1[3] = {1.5f, 0, 1};
-    buf b = make_buf(4.0f, k0, k1, 10, 30, 0, 0);
-    write_gltf("light.gltf", &b,
+    write_gltf("light.gltf", make_buf(4.0f, (const float[3]){-1.5f, 0, 1}, (const float[3]){1.5f, 0, 1}, 10, 30, 0, 0),
                "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1],\"metallicFactor\":0,"
                "\"roughnessFactor\":1},\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":0}}}],\n"
                "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"point\",\"intensity\":10}]}},\n"
-               "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.1}}],\n"
+               CAMERA_JSON
                "\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]},"
                "{\"translation\":[-1.5,0,1],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
                "\"scenes\":[{\"nodes\":[0,1,2]}],\"scene\":0,\n"
                "\"animations\":[{\"name\":\"sweep\",\"samplers\":[{\"input\":3,\"output\":4},{\"input\":3,\"output\":5}],"
                "\"channels\":[{\"sampler\":0,\"target\":{\"node\":2,\"path\":\"translation\"}},"
-               "{\"sampler\":1,\"target\":{\"path\":\"pointer\",\"extensions\":{\"KHR_animation_pointer\":"
-               "{\"pointer\":\"/extensions/KHR_lights_punctual/lights/0/intensity\"}}}}]}]");
+               POINTER_CHANNEL(1, "/extensions/KHR_lights_punctual/lights/0/intensity") "]}]");
     double foot[IT_NBACKENDS][2];
     rig_sweep("light.gltf", 64, light_measure, foot);
     for (size_t bi = 0; bi < IT_NBACKENDS; ++bi) {
@@ -272,18 +274,13 @@ static void test_light(void)
  * file still loads with its good channel. */
 static void test_bad_pointers(void)
 {
-    const float k0[3] = {0, 0, 0}, k1[3] = {1, 1, 1};
-    buf b = make_buf(0.5f, k0, k1, 0.1f, 0.2f, 0, 0);
-    write_gltf("pointers.gltf", &b,
+    write_gltf("pointers.gltf", make_buf(0.5f, (const float[3]){0, 0, 0}, (const float[3]){1, 1, 1}, 0.1f, 0.2f, 0, 0),
                "\"materials\":[{}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0,\n"
                "\"animations\":[{\"samplers\":[{\"input\":3,\"output\":5},{\"input\":3,\"output\":4}],\"channels\":["
-               "{\"sampler\":0,\"target\":{\"path\":\"pointer\",\"extensions\":{\"KHR_animation_pointer\":"
-               "{\"pointer\":\"/materials/0/alphaCutoff\"}}}},"
-               "{\"sampler\":0,\"target\":{\"path\":\"pointer\",\"extensions\":{\"KHR_animation_pointer\":"
-               "{\"pointer\":\"/cameras/3/perspective/yfov\"}}}},"
+               POINTER_CHANNEL(0, "/materials/0/alphaCutoff") ","
+               POINTER_CHANNEL(0, "/cameras/3/perspective/yfov") ","
                "{\"sampler\":0,\"target\":{\"path\":\"pointer\"}},"
-               "{\"sampler\":1,\"target\":{\"path\":\"pointer\",\"extensions\":{\"KHR_animation_pointer\":"
-               "{\"pointer\":\"/nodes/0/translation\"}}}}]}]");
+               POINTER_CHANNEL(1, "/nodes/0/translation") "]}]");
     char path[512];
     snprintf(path, sizeof path, "%s/pointers.gltf", g_dir);
     sy_gltf_info info;
