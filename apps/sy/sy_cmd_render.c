@@ -258,6 +258,93 @@ static void blur_add(sy_layer *acc, const sy_layer *l, float weight)
         if (l->depth[k] < acc->depth[k]) acc->depth[k] = l->depth[k];
 }
 
+/* >>--shutter-steps chosen from the motion (no --shutter-steps given): the largest angle that any node
+ * an animation channel moves (translation, rotation or scale: its world matrix, so a parent's turn
+ * counts for the node it carries, and every node below it turns as much) or the camera turns through
+ * over the shutter, summed over MOTION_PROBES - 1 equal parts of it (the scene committed at each probe
+ * time; a turn of more than half a revolution within one part is undercounted), in chords of at most
+ * MOTION_CHORD_DEG degrees: steps = 1 + ceil(angle / MOTION_CHORD_DEG), 2 to SY_MOTION_STEPS_MAX. A
+ * translation or a deformation turns nothing: 2, the linear protocol, bit for bit. A spinning wheel's
+ * quarter turn: 9 steps, so it blurs along its arc. The scene is left at the last probe (the close):
+ * the caller sets the times it renders. *angle_out: the angle in radians. */
+#define MOTION_PROBES 17u
+#define MOTION_CHORD_DEG 12.0
+/* the rotation of a matrix's upper 3x3, each column normalised (scale removed); false for a degenerate one */
+static bool rotation_of(const sy_mat4 *m, double r[9])
+{
+    for (int c = 0; c < 3; ++c) {
+        double x = m->m[4 * c], y = m->m[4 * c + 1], z = m->m[4 * c + 2], l = sqrt(x * x + y * y + z * z);
+        if (!(l > 1e-12) || !isfinite(l)) return false;
+        r[3 * c] = x / l, r[3 * c + 1] = y / l, r[3 * c + 2] = z / l;
+    }
+    return true;
+}
+/* the angle of the rotation that takes a to b (radians, 0..pi) */
+static double rotation_angle(const double a[9], const double b[9])
+{
+    double tr = 0; /* trace(b a^T) = the element-wise product's sum */
+    for (int k = 0; k < 9; ++k) tr += a[k] * b[k];
+    double c = (tr - 1.0) / 2.0;
+    return acos(c > 1.0 ? 1.0 : c < -1.0 ? -1.0 : c);
+}
+static uint32_t motion_steps_auto(loaded *ld, const char *clip, double frame_time, const sy_shutter *sh,
+                                  const sy_compose_spec *spec, uint32_t w, uint32_t h, double *angle_out)
+{
+    *angle_out = 0.0;
+    size_t n = 0, cap = 0;
+    uint32_t *nodes = NULL; /* the nodes that channels move, then their rotations at the last probe */
+    for (uint32_t id = sy_scene_next(ld->scene, SY_TYPE_ANIMATION, 0); id; id = sy_scene_next(ld->scene, SY_TYPE_ANIMATION, id)) {
+        uint32_t nch = 0;
+        const sy_anim_channel *ch = sy_animation_channels(sy_animation_get(ld->scene, (sy_animation){id}), &nch);
+        for (uint32_t k = 0; k < nch; ++k) {
+            if (sy_anim_path_target(ch[k].path) != SY_TYPE_NODE || ch[k].path == SY_ANIM_WEIGHTS) continue;
+            if (n == cap) {
+                size_t nc = cap ? 2 * cap : 16;
+                uint32_t *g = realloc(nodes, nc * sizeof *g);
+                if (!g) {
+                    free(nodes);
+                    return 2; /* out of memory: the linear protocol */
+                }
+                nodes = g, cap = nc;
+            }
+            nodes[n++] = ch[k].node;
+        }
+    }
+    double *prev = n ? malloc(n * 10 * sizeof *prev) : NULL; /* per node: 9 rotation elements, 1 valid flag */
+    double *swept = n ? calloc(n, sizeof *swept) : NULL;
+    double cam_prev[9], cam_swept = 0.0;
+    bool cam_valid = false;
+    if (n && (!prev || !swept)) n = 0; /* out of memory: the camera alone */
+    for (uint32_t p = 0; p < MOTION_PROBES; ++p) {
+        sy_error e = {0};
+        if (sy_cli_set_time(ld, clip, frame_time + sh->open + (sh->close - sh->open) * p / (MOTION_PROBES - 1u), &e)) break;
+        for (size_t i = 0; i < n; ++i) {
+            sy_mat4 m;
+            double r[9];
+            bool ok = sy_node_world_matrix(ld->scene, (sy_node){nodes[i]}, &m, &e) == SY_OK && rotation_of(&m, r);
+            if (ok && p > 0 && prev[10 * i + 9] > 0) swept[i] += rotation_angle(&prev[10 * i], r);
+            if (ok) memcpy(&prev[10 * i], r, sizeof r);
+            prev[10 * i + 9] = ok;
+        }
+        sy_camera_view v;
+        double r[9];
+        bool ok = sy_compose_camera_view(ld->scene, spec, w, h, &v, &e) == SY_OK && rotation_of(&v.camera_to_world, r);
+        if (ok && cam_valid) cam_swept += rotation_angle(cam_prev, r);
+        if (ok) memcpy(cam_prev, r, sizeof r);
+        cam_valid = ok;
+    }
+    double angle = cam_swept;
+    for (size_t i = 0; i < n; ++i)
+        if (swept[i] > angle) angle = swept[i];
+    free(nodes);
+    free(prev);
+    free(swept);
+    *angle_out = angle;
+    double chords = ceil(angle * (180.0 / 3.14159265358979323846) / MOTION_CHORD_DEG - 1e-9);
+    if (!(chords >= 1.0)) return 2;
+    return chords + 1.0 >= SY_MOTION_STEPS_MAX ? SY_MOTION_STEPS_MAX : (uint32_t)chords + 1u;
+}
+
 /* Motion blur in one render (back-ends with SY_CAP_MOTION: whitted, pathtracer): the scene committed
  * at the shutter's close, synced, then at its open, synced (sy_context_motion_begin / _open): every
  * instance moved in between is interpolated linearly from open to close by each ray's own time. True
@@ -266,7 +353,8 @@ static void blur_add(sy_layer *acc, const sy_layer *l, float weight)
  * moves (*motion_camera true: sy_context_motion_camera, each camera ray at its time). False when the
  * back-end lacks it, or (a note says why) the scene also moves lights, makes meshes anew, or moves the
  * camera of a stereo render or of a back-end that cannot move it: then the motion is ended and the
- * caller blurs by sub-frames. */
+ * caller blurs by sub-frames. steps: the shutter's time steps (--shutter-steps), 0 = chosen from the
+ * motion (motion_steps_auto). */
 static bool motion_native_begin(loaded *ld, const char *clip, double frame_time, const sy_shutter *sh,
                                 uint32_t steps, const sy_compose_spec *spec, uint32_t w, uint32_t h,
                                 sy_context_pool *pool, sy_context **ctx_out, bool *motion_camera)
@@ -279,6 +367,13 @@ static bool motion_native_begin(loaded *ld, const char *clip, double frame_time,
         !(sy_context_caps(c) & SY_CAP_MOTION))
         return false;
     sy_context_restart(c); /* placed as a fresh build places them, accumulation from sample 0 */
+    if (!steps) { /* no --shutter-steps: from the angle the motion turns through */
+        double angle = 0.0;
+        steps = motion_steps_auto(ld, clip, frame_time, sh, spec, w, h, &angle);
+        sy_log(steps > 2u ? SY_LOG_NOTE : SY_LOG_DEBUG, "sy", NULL,
+               "motion blur: %u time steps (the largest turn over the shutter is %.3g degrees; a step per %g degrees at "
+               "most; --shutter-steps N sets them)", steps, angle * (180.0 / 3.14159265358979323846), MOTION_CHORD_DEG);
+    }
     bool native = false, camera_moves = false, camera_stays = false;
     /* the camera at the open and at each later step (v_later[steps - 2]: the close): each camera ray
      * at its own time between them */
@@ -682,7 +777,7 @@ int sy_cmd_render(int argc, char **argv)
     uint32_t max_memory_mb = 0;
     sy_shutter shutter = {0.0, 0.0, 0}; /* --shutter / --motion-blur / --shutter-samples: motion blur */
     bool shutter_given = false, motion_blur = false, sub_frames = false;
-    uint32_t shutter_steps = 0; /* --shutter-steps: time steps of the one-render path (curved motion); 0 = 2 */
+    uint32_t shutter_steps = 0; /* --shutter-steps: time steps of the one-render path (curved motion); 0 = chosen from the motion (motion_steps_auto) */
     const sy_cli_opt opts[] = {
         SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT(NULL, 'o', &outp),
         SY_CLI_OPT_UINT("spp", OPT_SPP, &po.spp, 1, 1u << 24),
@@ -791,7 +886,6 @@ int sy_cmd_render(int argc, char **argv)
         return sy_cli_usage_of("render", "--sub-frames belongs to --shutter or --motion-blur");
     if (shutter_steps && !shutter_given && !motion_blur)
         return sy_cli_usage_of("render", "--shutter-steps belongs to --shutter or --motion-blur");
-    if (!shutter_steps) shutter_steps = 2; /* linear between the shutter's two ends */
     if (motion_blur) shutter.close = 0.5 / fps, shutter_given = true; /* a 180-degree shutter */
     if (!shutter.samples) shutter.samples = 16; /* see docs/CLI.md "Motion blur" */
     bool blur = shutter_given && sy_shutter_blurs(&shutter);

@@ -29,7 +29,8 @@
 # a shutter over which nothing deforms renders bit for bit as without it. A camera moved over the
 # shutter is interpolated per camera ray too (except in stereo: sub-frames, with a note), and with
 # --shutter-steps a spinning bar's streak (9 steps), a square deformed along an arc and a camera
-# orbiting the box (5 steps) follow the arc, not the chord.
+# orbiting the box (5 steps) follow the arc, not the chord; without it the spinning bar gets the 9
+# steps by itself (its quarter turn) and a translation 2.
 # Usage errors (status 2, naming the option): a negative, NaN, infinite or non-numeric shutter, open
 # after close, --shutter with --motion-blur, --shutter-samples alone or 0, --sub-frames alone,
 # --shutter-steps alone or outside 2..9.
@@ -133,6 +134,10 @@ for b in "$@"; do
         r still_blur --at 2 --shutter 0,0.5
         "$EXR_EQUAL" "$TMP/${b}_still.exr" "$TMP/${b}_still_blur.exr" >/dev/null ||
             fail "$b: a shutter over which nothing moves differs from no shutter"
+    fi
+    if [ "$b" != raster ]; then # a translation turns nothing: 2 steps, the linear protocol
+        r blur_two --at 0.25 --shutter 0,0.5 --shutter-steps 2
+        "$EXR_EQUAL" "$TMP/${b}_blur.exr" "$TMP/${b}_blur_two.exr" >/dev/null || fail "$b: a translation's default differs from --shutter-steps 2"
     fi
     r instant --at 0.25 --shutter 0
     "$EXR_EQUAL" "$TMP/${b}_open.exr" "$TMP/${b}_instant.exr" >/dev/null || fail "$b: --shutter 0 differs from no shutter"
@@ -261,6 +266,8 @@ camera_checks() {
         fail "$b: a moving camera: no note on the one render with per-ray times: $(cat "$TMP/${b}_cam_blur.err")"
     c pan sub --at 0.25 --shutter 0,0.5 --sub-frames --shutter-samples 64
     c pan mid --at 0.5
+    c pan two --at 0.25 --shutter 0,0.5 --shutter-steps 2
+    "$EXR_EQUAL" "$TMP/${b}_cam_blur.exr" "$TMP/${b}_cam_two.exr" >/dev/null || fail "$b: a 5.7-degree pan's default differs from --shutter-steps 2"
     wb=$("$EXR_BLUR" width 0.02 "$TMP/${b}_cam_blur.exr")
     ws=$("$EXR_BLUR" width 0.02 "$TMP/${b}_cam_sub.exr")
     wm=$("$EXR_BLUR" width 0.5 "$TMP/${b}_cam_mid.exr")
@@ -320,8 +327,10 @@ SUB_FRAMES_EXTRA=()
 # it shrinks to 0.71 of its length half way, so it misses the discs' rims (covered area, mean alpha,
 # about two thirds of the 64 sub-frames': measured 0.0215 Whitted, 0.0218 path tracer against 0.0327);
 # with 9 steps (8 chords of the arc) the streak matches the sub-frames' (IoU of alpha > 0.02 >= 0.93,
-# measured 0.943 Whitted, 0.969 path tracer; mean alpha within 0.002, measured 0.0006 and 0.0001);
-# --shutter-steps 2 is the default, bit for bit
+# measured 0.943 Whitted, 0.969 path tracer; mean alpha within 0.002, measured 0.0006 and 0.0001).
+# Without --shutter-steps the steps are chosen from the largest turn over the shutter (a step per 12
+# degrees): the quarter turn gets 9, bit for bit the --shutter-steps 9 image (and not the 2 steps'),
+# and a translation (the moving box, the camera's 5.7-degree pan) gets 2, bit for bit --shutter-steps 2
 view_scene "$TMP/spin.x3d" "<Transform DEF='Bar'>$(x3d_shape "<Box size='4 0.3 0.3'/>")</Transform>" "$(x3d_clock 1)" \
     "<OrientationInterpolator DEF='Spin' key='0 0.25 0.5 0.75 1' keyValue='0 0 1 0 0 0 1 1.5707963 0 0 1 3.1415926 0 0 1 4.712389 0 0 1 6.2831853'/>" \
     "$(x3d_drive Spin Bar rotation)"
@@ -329,13 +338,13 @@ usage "--shutter-steps alone" "--shutter-steps belongs to --shutter" --shutter-s
 usage "--shutter-steps 1" "--shutter-steps" --shutter 0.1 --shutter-steps 1
 usage "--shutter-steps 10" "--shutter-steps" --shutter 0.1 --shutter-steps 10
 # curve STEM SCENE SIZE SHUTTER STEPS SUB-ARGS...: renders $TMP/SCENE (SIZE x SIZE pixels, --at 0 over
-# SHUTTER) into ${b}_STEM_sub (sub-frames, and SUB-ARGS), _chord (two steps, the default) and _arc
+# SHUTTER) into ${b}_STEM_sub (sub-frames, and SUB-ARGS), _chord (two steps) and _arc
 # (STEPS steps), and sets sa, ca and aa (their mean alpha) and iou (arc against sub, alpha > 0.02)
 curve() {
     local stem=$1 scene=$2 px=$3 shutter=$4 steps=$5
     shift 5
     rend "$stem" "$scene" sub -w "$px" -h "$px" --at 0 --shutter "$shutter" --sub-frames "$@"
-    rend "$stem" "$scene" chord -w "$px" -h "$px" --at 0 --shutter "$shutter"
+    rend "$stem" "$scene" chord -w "$px" -h "$px" --at 0 --shutter "$shutter" --shutter-steps 2
     rend "$stem" "$scene" arc -w "$px" -h "$px" --at 0 --shutter "$shutter" --shutter-steps "$steps"
     sa=$(mean_alpha "$TMP/${b}_${stem}_sub.exr")
     ca=$(mean_alpha "$TMP/${b}_${stem}_chord.exr")
@@ -351,8 +360,11 @@ curve_checks() {
 }
 spin_checks() {
     curve spin spin.x3d 96 0,0.25 9 --shutter-samples 64
-    rend spin spin.x3d two -w 96 -h 96 --at 0 --shutter 0,0.25 --shutter-steps 2
-    "$EXR_EQUAL" "$TMP/${b}_spin_chord.exr" "$TMP/${b}_spin_two.exr" >/dev/null || fail "$b: --shutter-steps 2 differs from the default"
+    rend spin spin.x3d auto -w 96 -h 96 --at 0 --shutter 0,0.25
+    grep -qF "motion blur: 9 time steps (the largest turn over the shutter is 90 degrees" "$TMP/${b}_spin_auto.err" ||
+        fail "$b spinning bar: no note on the 9 steps chosen: $(cat "$TMP/${b}_spin_auto.err")"
+    "$EXR_EQUAL" "$TMP/${b}_spin_arc.exr" "$TMP/${b}_spin_auto.exr" >/dev/null || fail "$b spinning bar: the default differs from 9 steps"
+    "$EXR_EQUAL" "$TMP/${b}_spin_chord.exr" "$TMP/${b}_spin_auto.exr" >/dev/null && fail "$b spinning bar: the default is the 2 steps' image"
     gt "$(awk -v s="$sa" 'BEGIN { print s * 0.8 }')" "$ca" || fail "$b spinning bar: 2 steps cover $ca, not a chord's less than the arc's $sa"
     curve_checks "spinning bar" 9 64 0.002 0.93
 }
