@@ -74,14 +74,18 @@ sy_result sy_context_motion_step(sy_context *c, sy_error *err);
  * shutter's open; *native says whether the back-end interpolates every change. Thread-safety: as
  * sy_context_render. */
 sy_result sy_context_motion_open(sy_context *c, bool *native, sy_error *err);
+/** Most moving cameras of one motion (sy_context_motion_camera: a stereo pair's two eyes, ...). */
+#define SY_MOTION_CAMERAS_MAX 4
 /** A camera that moves over the shutter (after sy_context_motion_open; see sy_context_motion_begin):
  * open is the view at the shutter's open, later[0 .. steps - 2] the views at the equally spaced
  * times after it (steps 2 .. SY_MOTION_STEPS_MAX; later[steps - 2] the close: steps 2 is the open and
  * the close alone); a render request whose camera is open has each camera ray built at its own
  * time, position and window interpolated linearly between the two steps around it, orientation by
- * slerp, until sy_context_motion_end (requests with another camera, a stereo eye, stay still). SY_ERR_UNSUPPORTED naming the back-end when its class does not interpolate
- * the camera (then blur another way), SY_ERR_INVALID_ARGUMENT when the motion is not open. On error
- * the motion stays as it was. Thread-safety: as sy_context_render. */
+ * slerp, until sy_context_motion_end (requests with another camera stay still). Called again with
+ * another open view it adds that camera (each stereo eye: its own view at each step, one call per
+ * eye; up to SY_MOTION_CAMERAS_MAX), with the same open view it replaces it. SY_ERR_UNSUPPORTED naming the back-end when its class does not interpolate
+ * the camera (then blur another way), SY_ERR_INVALID_ARGUMENT when the motion is not open or holds
+ * SY_MOTION_CAMERAS_MAX others. On error the motion stays as it was. Thread-safety: as sy_context_render. */
 sy_result sy_context_motion_camera(sy_context *c, const sy_camera_view *open, uint32_t steps,
                                   const sy_camera_view *later, sy_error *err);
 /** Ends motion blur (see sy_context_motion_begin): the context renders sharp again. Thread-safety:

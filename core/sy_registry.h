@@ -204,7 +204,8 @@ typedef struct sy_mediator_class {
      * a request whose camera is open is rendered with each camera ray built at its own time between
      * open and later[steps - 2] (the shutter's close) through later[0 .. steps - 3] (the equally
      * spaced steps between; steps 2 .. SY_MOTION_STEPS_MAX), until SY_MOTION_END; requests with
-     * another camera stay still. NULL: the class does not interpolate the camera (the caller blurs a
+     * another camera stay still. Another open adds a camera (stereo eyes; up to SY_MOTION_CAMERAS_MAX,
+     * then SY_ERR_INVALID_ARGUMENT), the same open replaces its steps. NULL: the class does not interpolate the camera (the caller blurs a
      * moving camera by sub-frames). Appended last. */
     sy_result (*motion_camera)(void *state, const sy_camera_view *open, uint32_t steps, const sy_camera_view *later,
                                sy_error *err);

@@ -352,8 +352,8 @@ static uint32_t motion_steps_auto(loaded *ld, const char *clip, double frame_tim
  * Deformed meshes (skins, morph targets) are interpolated too, vertex by vertex, and a camera that
  * moves (*motion_camera true: sy_context_motion_camera, each camera ray at its time). False when the
  * back-end lacks it, or (a note says why) the scene also moves lights, makes meshes anew, or moves the
- * camera of a stereo render or of a back-end that cannot move it: then the motion is ended and the
- * caller blurs by sub-frames. steps: the shutter's time steps (--shutter-steps), 0 = chosen from the
+ * camera of a back-end that cannot move it: then the motion is ended and the caller blurs by
+ * sub-frames. A stereo render's eyes move each with its own views (one moving camera per eye). steps: the shutter's time steps (--shutter-steps), 0 = chosen from the
  * motion (motion_steps_auto). */
 static bool motion_native_begin(loaded *ld, const char *clip, double frame_time, const sy_shutter *sh,
                                 uint32_t steps, const sy_compose_spec *spec, uint32_t w, uint32_t h,
@@ -375,43 +375,52 @@ static bool motion_native_begin(loaded *ld, const char *clip, double frame_time,
                "most; --shutter-steps N sets them)", steps, angle * (180.0 / 3.14159265358979323846), MOTION_CHORD_DEG);
     }
     bool native = false, camera_moves = false, camera_stays = false;
-    /* the camera at the open and at each later step (v_later[steps - 2]: the close): each camera ray
-     * at its own time between them */
-    sy_camera_view v_open, v_later[SY_MOTION_STEPS_MAX];
-    memset(&v_open, 0, sizeof v_open);
+    /* the camera of each eye (mono: one; stereo: left and right, each its own view) at the open and
+     * at each later step (v_later[eye][steps - 2]: the close): each camera ray at its own time between
+     * them */
+    static const uint32_t eyes[2] = {SY_EYE_LEFT, SY_EYE_RIGHT};
+    uint32_t n_eyes = spec->stereo == SY_STEREO_NONE ? 1u : 2u;
+    sy_camera_view v_open[2], v_later[2][SY_MOTION_STEPS_MAX];
+    memset(v_open, 0, sizeof v_open);
     memset(v_later, 0, sizeof v_later);
+#define EYE_VIEWS(out)                                                                                               \
+    (sy_compose_eye_view(ld->scene, spec, n_eyes == 1u ? SY_EYE_MONO : eyes[0], w, h, &(out)[0], &e) == SY_OK &&    \
+     (n_eyes == 1u || sy_compose_eye_view(ld->scene, spec, eyes[1], w, h, &(out)[1], &e) == SY_OK))
+    sy_camera_view at[2];
+    memset(at, 0, sizeof at);
     sy_error ce = {0};
     /* --shutter-steps N: the steps between, from the close towards the open (curved motion) */
-    bool stepped = sy_cli_set_time(ld, clip, frame_time + sh->close, &e) == 0 &&
-                   sy_compose_camera_view(ld->scene, spec, w, h, &v_later[steps - 2u], &e) == SY_OK &&
+    bool stepped = sy_cli_set_time(ld, clip, frame_time + sh->close, &e) == 0 && EYE_VIEWS(at) &&
                    sy_context_motion_begin_steps(c, sh->samples, steps, &e) == SY_OK;
-    for (uint32_t k = steps - 2u; stepped && k >= 1u; --k)
+    for (uint32_t i = 0; stepped && i < n_eyes; ++i) v_later[i][steps - 2u] = at[i];
+    for (uint32_t k = steps - 2u; stepped && k >= 1u; --k) {
         stepped = sy_cli_set_time(ld, clip, frame_time + sh->open + (sh->close - sh->open) * k / (steps - 1u), &e) == 0 &&
-                  sy_compose_camera_view(ld->scene, spec, w, h, &v_later[k - 1u], &e) == SY_OK &&
-                  sy_context_motion_step(c, &e) == SY_OK;
-    if (stepped &&
-        sy_cli_set_time(ld, clip, frame_time + sh->open, &e) == 0 &&
-        sy_compose_camera_view(ld->scene, spec, w, h, &v_open, &e) == SY_OK &&
+                  EYE_VIEWS(at) && sy_context_motion_step(c, &e) == SY_OK;
+        for (uint32_t i = 0; stepped && i < n_eyes; ++i) v_later[i][k - 1u] = at[i];
+    }
+    if (stepped && sy_cli_set_time(ld, clip, frame_time + sh->open, &e) == 0 && EYE_VIEWS(v_open) &&
         sy_context_motion_open(c, &native, &e) == SY_OK && native) {
-        for (uint32_t k = 0; k + 1u < steps; ++k) camera_moves |= memcmp(&v_later[k], &v_open, sizeof v_open) != 0;
-        /* a moving camera: the back-end builds each camera ray at its time (the mono view only: stereo
-         * eyes are other views) */
-        if (!camera_moves ||
-            (spec->stereo == SY_STEREO_NONE && sy_context_motion_camera(c, &v_open, steps, v_later, &ce) == SY_OK)) {
+        for (uint32_t i = 0; i < n_eyes; ++i)
+            for (uint32_t k = 0; k + 1u < steps; ++k) camera_moves |= memcmp(&v_later[i][k], &v_open[i], sizeof v_open[i]) != 0;
+        /* a moving camera: the back-end builds each camera ray at its time, each eye's from its own
+         * views (the request of each eye's viewport has its eye's open view) */
+        bool given = true;
+        for (uint32_t i = 0; camera_moves && given && i < n_eyes; ++i)
+            given = sy_context_motion_camera(c, &v_open[i], steps, v_later[i], &ce) == SY_OK;
+        if (given) {
             *motion_camera = camera_moves;
             *ctx_out = c;
             return true;
         }
         camera_stays = true;
     }
+#undef EYE_VIEWS
     sy_context_motion_end(c);
     sy_context_restart(c);
     sy_log(SY_LOG_NOTE, "sy", NULL, "motion blur: %s; blurring by sub-frames instead",
            e.message[0] ? e.message
-           : camera_stays
-               ? (spec->stereo != SY_STEREO_NONE ? "the camera moves over the shutter, which stereo eyes do not interpolate"
-                                                 : ce.message[0] ? ce.message : "the camera moves over the shutter")
-               : "the scene moves lights or makes meshes anew over the shutter, which the back-end does not interpolate");
+           : camera_stays ? (ce.message[0] ? ce.message : "the camera moves over the shutter")
+                          : "the scene moves lights or makes meshes anew over the shutter, which the back-end does not interpolate");
     return false;
 }
 

@@ -127,11 +127,17 @@ sy_result sy_compose_render(sy_scene *scene, sy_context_pool *pool, const sy_com
 sy_result sy_compose_camera_view(const sy_scene *scene, const sy_compose_spec *spec, uint32_t w, uint32_t h,
                                  sy_camera_view *out, sy_error *err)
 {
+    return sy_compose_eye_view(scene, spec, SY_EYE_MONO, w, h, out, err);
+}
+
+sy_result sy_compose_eye_view(const sy_scene *scene, const sy_compose_spec *spec, uint32_t eye, uint32_t w, uint32_t h,
+                              sy_camera_view *out, sy_error *err)
+{
     sy_window *win = NULL;
     sy_compose_spec mono = *spec;
     mono.has_overlay = false;
     sy_result r = sy_window_create(w, h, &win, err);
-    if (r == SY_OK) r = add_eye(win, &mono, SY_EYE_MONO, 0, 0, w, h, err);
+    if (r == SY_OK) r = add_eye(win, &mono, eye, 0, 0, w, h, err);
     if (r == SY_OK) r = sy_viewport_camera_view(sy_window_viewport(win, 0), scene, w, h, out, err);
     sy_window_destroy(win);
     return r;

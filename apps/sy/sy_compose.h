@@ -54,5 +54,10 @@ sy_result sy_compose_render(sy_scene *scene, sy_context_pool *pool, const sy_com
  * --cluster-mode frames sends it with each frame). */
 sy_result sy_compose_camera_view(const sy_scene *scene, const sy_compose_spec *spec, uint32_t w, uint32_t h,
                                  sy_camera_view *out, sy_error *err);
+/* The main viewport's view for eye (SY_EYE_MONO, _LEFT, _RIGHT: spec's eye separation and zero
+ * parallax) at w x h per eye: the camera a stereo render of spec asks its back-end for in that eye's
+ * viewport (sy render gives each eye's moving camera to the motion: sy_context_motion_camera). */
+sy_result sy_compose_eye_view(const sy_scene *scene, const sy_compose_spec *spec, uint32_t eye, uint32_t w, uint32_t h,
+                              sy_camera_view *out, sy_error *err);
 
 #endif /* SY_COMPOSE_H */

@@ -127,11 +127,13 @@ typedef struct rt_state {
     uint32_t motion_steps;    /* time steps of the shutter (SY_MOTION_STEPS): 2, or 3 .. SY_MOTION_STEPS_MAX */
     uint32_t motion_k;        /* while armed with more than two steps: the step the coming sync is at */
     sy_mirror_map motion_rec; /* while armed with more than two steps: instance handle -> rt_motion_rec */
-    bool motion_cam;          /* MOTION_ON with a moving camera (sy_rti_motion_camera) */
-    sy_camera_view motion_cam_open; /* a request with this camera (the shutter's open) moves it ... */
-    sy_rt_camera motion_cam_close; /* ... to this one at its close (sy_rt_render_desc.camera_close) */
-    uint32_t motion_cam_steps;     /* ... through these between (camera_mid, camera_steps) */
-    sy_rt_camera motion_cam_mid[SY_MOTION_STEPS_MAX];
+    uint32_t motion_cam_count; /* MOTION_ON: the moving cameras given (sy_rti_motion_camera; a stereo pair: 2) */
+    struct rt_motion_cam {
+        sy_camera_view open; /* a request with this camera (the shutter's open) moves it ... */
+        sy_rt_camera close;  /* ... to this one at its close (sy_rt_render_desc.camera_close) */
+        uint32_t steps;      /* ... through these between (camera_mid, camera_steps) */
+        sy_rt_camera mid[SY_MOTION_STEPS_MAX];
+    } motion_cams[SY_MOTION_CAMERAS_MAX];
 } rt_state;
 
 /* --- sy_mediator_rt_base.c --- */

@@ -313,7 +313,7 @@ sy_result sy_rti_motion(void *state, sy_motion_phase phase, uint32_t time_sample
         bool had = st->motion != MOTION_OFF;
         st->motion = MOTION_OFF;
         st->motion_samples = 0;
-        st->motion_cam = false;
+        st->motion_cam_count = 0;
         st->motion_steps = 2;
         sy_mirror_map_free(&st->motion_rec);
         if (!had) return SY_OK;
@@ -332,11 +332,16 @@ sy_result sy_rti_motion_camera(void *state, const sy_camera_view *open, uint32_t
     if (st->motion != MOTION_ON) return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion camera: the motion is not open");
     if (steps < 2u || steps > SY_MOTION_STEPS_MAX)
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion camera: %u steps (2 .. %u)", steps, SY_MOTION_STEPS_MAX);
-    st->motion_cam_open = *open;
-    st->motion_cam_steps = steps;
-    for (uint32_t k = 0; k + 2u < steps; ++k) sy_rti_camera_of(&later[k], &st->motion_cam_mid[k]);
-    sy_rti_camera_of(&later[steps - 2u], &st->motion_cam_close); /* checked by the render (sy_rt_frame_init) */
-    st->motion_cam = true;
+    uint32_t i = 0; /* the same open camera again: replaced; another: one more (a stereo render's eyes) */
+    while (i < st->motion_cam_count && !sy_rti_same_view(&st->motion_cams[i].open, open)) ++i;
+    if (i == SY_MOTION_CAMERAS_MAX)
+        return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "motion camera: more than %u moving cameras", SY_MOTION_CAMERAS_MAX);
+    struct rt_motion_cam *mc = &st->motion_cams[i];
+    mc->open = *open;
+    mc->steps = steps;
+    for (uint32_t k = 0; k + 2u < steps; ++k) sy_rti_camera_of(&later[k], &mc->mid[k]);
+    sy_rti_camera_of(&later[steps - 2u], &mc->close); /* checked by the render (sy_rt_frame_init) */
+    if (i == st->motion_cam_count) st->motion_cam_count++;
     return SY_OK;
 }
 

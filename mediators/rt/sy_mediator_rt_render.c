@@ -97,6 +97,11 @@ static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_lay
     sy_rt_camera cam;
     sy_rti_camera_of(&req->camera, &cam);
     progress_bridge pb = {req->progress, req->progress_user};
+    /* a camera moving over the shutter: each camera ray at its own time (the request's camera is the
+     * open of one of the moving cameras given: the mono view or a stereo eye) */
+    const struct rt_motion_cam *mc = NULL;
+    for (uint32_t i = 0; st->motion == MOTION_ON && i < st->motion_cam_count && !mc; ++i)
+        if (sy_rti_same_view(&req->camera, &st->motion_cams[i].open)) mc = &st->motion_cams[i];
     sy_rt_render_desc d = {
         .integrator = (sy_rt_integrator)st->integrator,
         .image_width = req->full_width,
@@ -114,11 +119,9 @@ static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_lay
         .light_tree = (sy_rt_light_tree_mode)st->light_tree,
         .progress = req->progress ? progress_cb : NULL,
         .progress_user_data = &pb,
-        /* a camera moving over the shutter: each camera ray at its own time (the request's camera is the open) */
-        .camera_close = st->motion == MOTION_ON && st->motion_cam && sy_rti_same_view(&req->camera, &st->motion_cam_open)
-                            ? &st->motion_cam_close : NULL,
-        .camera_mid = st->motion_cam_mid,
-        .camera_steps = st->motion_cam_steps,
+        .camera_close = mc ? &mc->close : NULL,
+        .camera_mid = mc ? mc->mid : NULL,
+        .camera_steps = mc ? mc->steps : 0,
     };
     if (st->integrator == SY_RT_INTEGRATOR_WHITTED && req->preview > 0.0f && req->preview < 1.0f) {
         /* an interactive preview (SY_CAP_PREVIEW): the share `preview` of the camera rays and of the
