@@ -404,9 +404,11 @@ sy_rt_result sy_rt_instance_get_transform(const sy_rt_device *dev, sy_rt_instanc
  * (sy_rt_mesh_update_motion). While some instance or mesh has motion, the path tracer gives
  * every pixel sample a stratified time (shadow rays share it) and Whitted takes
  * max(pixel_samples, time_samples) samples per pixel at stratified times and points; without one,
- * every ray has time 0 and renders are bit for bit those without motion. Not moved over the shutter:
- * the area lights of emissive instances (their time-0 triangles), the eye-light integrator, picks,
- * coverage, and section planes' hit test (time 0 placement). */
+ * every ray has time 0 and renders are bit for bit those without motion. The area lights of
+ * emissive moving instances move too: a light sample (path tracer, Whitted) takes the emitter's
+ * triangle where it is at the ray's time (Whitted then samples such emitters instead of integrating
+ * them in closed form). Not moved over the shutter: the eye-light integrator, picks, coverage, the
+ * light tree's bounds (the open's), and section planes' hit test (time 0 placement). */
 /** Gives the instance motion to `close` (object-to-world at time 1, checked like a transform; equal
  * to its transform or NULL: no motion). Keeps its transform (time 0); sy_rt_commit publishes it. */
 sy_rt_result sy_rt_instance_set_motion(sy_rt_device *dev, sy_rt_instance inst, const float close[16]);
@@ -424,9 +426,9 @@ sy_rt_result sy_rt_instance_set_motion_steps(sy_rt_device *dev, sy_rt_instance i
  * on the mesh's geometry, rtcSetGeometryTimeStepCount + vertex buffer slot 1; its BLAS rebuilt as a
  * motion-blur BVH), and so does shading (position, geometric and shading normal of the hit triangle
  * at the ray's time; the normals interpolated linearly, then normalised: the pose between the two is
- * approximated linearly, as Embree does). Texture coordinates and colours do not move. Not moved:
- * the area lights of an emissive deforming mesh (its time-0 triangles), baked instances of the mesh,
- * and what the paragraph above lists. A mesh already in motion moves on: its time-0 pose becomes
+ * approximated linearly, as Embree does). Texture coordinates and colours do not move; the area
+ * lights of an emissive deforming mesh do (light samples on its triangles at the ray's time, as for
+ * moving instances above). Not moved: baked instances of the mesh, and what the paragraph above lists. A mesh already in motion moves on: its time-0 pose becomes
  * time 1. sy_rt_commit publishes it. */
 sy_rt_result sy_rt_mesh_update_motion(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals);
 /** Curved deformation: the mesh's pose at step k (0 = the open .. steps - 2) of a shutter of `steps`

@@ -77,6 +77,48 @@ float sy_rt_area_pdf(const sy_rt_device *dev, const sy_rt_instance_data *inst)
     return sy_rt_emission_weight(mat) * (mat->desc.double_sided ? 2.0f : 1.0f) / dev->area_power;
 }
 
+/* >>moving emitters (motion blur): an area triangle where its instance and mesh are at a ray's time */
+const sy_rt_area_tri *sy_rt_area_at(const sy_rt_area_tri *t, float time, sy_rt_area_tri *scratch)
+{
+    const sy_rt_instance_data *in = t->inst;
+    if (!(time > 0.0f) || !in || (!in->motion && !in->mesh->motion)) return t;
+    sy_rt_instance_data posed;
+    const sy_rt_instance_data *at = sy_rt_instance_at(in, time, &posed);
+    const sy_rt_mesh_data *m = in->mesh;
+    /* a deforming mesh: the two vertex steps around the time, as Embree finds them (sy_rt_surface_fetch_at) */
+    const float *q0 = m->positions, *q1 = m->positions;
+    float f = 0.0f;
+    if (m->motion) {
+        q1 = m->positions1, f = time;
+        if (m->motion_steps > 2u) {
+            float st = time * (float)(m->motion_steps - 1u);
+            uint32_t seg = st > 0.0f ? (uint32_t)st : 0u;
+            if (seg > m->motion_steps - 2u) seg = m->motion_steps - 2u;
+            f = st - (float)seg;
+            if (seg > 0u) q0 = m->pos_mid[seg];
+            if (seg + 2u < m->motion_steps) q1 = m->pos_mid[seg + 1u];
+        }
+    }
+    const uint32_t *ix = m->indices + 3u * t->prim;
+    sy_rt_v3 o[3], p[3];
+    for (int c = 0; c < 3; ++c) {
+        const float *a = q0 + 3u * ix[c], *b = q1 + 3u * ix[c];
+        o[c] = v3((1.0f - f) * a[0] + f * b[0], (1.0f - f) * a[1] + f * b[1], (1.0f - f) * a[2] + f * b[2]);
+        p[c] = m4_point(at->xf, o[c]);
+    }
+    *scratch = *t;
+    scratch->p0 = p[0];
+    scratch->e1 = v3_sub(p[1], p[0]);
+    scratch->e2 = v3_sub(p[2], p[0]);
+    scratch->normal = v3_normalize(m3_mul(at->nrm, v3_cross(v3_sub(o[1], o[0]), v3_sub(o[2], o[0]))));
+    float area = 0.5f * v3_length(v3_cross(scratch->e1, scratch->e2));
+    if (!(area > 0.0f) || v3_is_zero(scratch->normal)) return t; /* degenerate then: the open's triangle */
+    /* the selection picks the triangle by its open area, the point is uniform on its area now */
+    scratch->pdf_select = t->pdf_select * t->area / area;
+    scratch->area = area;
+    return scratch;
+}
+
 /* >>environment */
 sy_rt_result sy_rt_set_environment(sy_rt_device *dev, sy_rt_texture texture, float intensity)
 {

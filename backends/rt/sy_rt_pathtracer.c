@@ -152,7 +152,8 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
         tree_tri = li; /* a triangle: below */
     }
     if (kind == 0 || kind == 3) {
-        const sy_rt_area_tri *t = &dev->area[kind == 3 ? tree_tri : sy_rt_alias_pick(dev, ur)];
+        sy_rt_area_tri moved; /* a moving emitter: where it is at the path's time (motion blur) */
+        const sy_rt_area_tri *t = sy_rt_area_at(&dev->area[kind == 3 ? tree_tri : sy_rt_alias_pick(dev, ur)], c->ictx.time, &moved);
         float su = sqrtf(u[1]), bu = su * (1.0f - u[2]), bv = su * u[2];
         sy_rt_v3 q = v3_add(t->p0, v3_add(v3_scale(t->e1, bu), v3_scale(t->e2, bv)));
         sy_rt_v3 wi = v3_sub(q, s->p);

@@ -475,7 +475,8 @@ static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bs
         }
         float p_sel = dev->area_cdf[lo + 1u] - dev->area_cdf[lo];
         if (!(p_sel > 0.0f)) continue;
-        const sy_rt_area_tri *t = &dev->area[lo];
+        sy_rt_area_tri moved; /* a moving emitter: where it is at the ray's time (motion blur) */
+        const sy_rt_area_tri *t = sy_rt_area_at(&dev->area[lo], c->ictx.time, &moved);
         float su = sqrtf(u[1]);
         float bu = su * (1.0f - u[2]), bv = su * u[2];
         sy_rt_v3 q = v3_add(t->p0, v3_add(v3_scale(t->e1, bu), v3_scale(t->e2, bv)));
@@ -738,8 +739,9 @@ static sy_rt_v3 direct_tree(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bs
         sy_rt_v3 wi, le, q = s->p;
         float g, tmax = INFINITY, bu = 0.0f, bv = 0.0f;
         const sy_rt_area_tri *t = NULL;
+        sy_rt_area_tri moved; /* a moving emitter: where it is at the ray's time (motion blur) */
         if (li < dev->area_count) {
-            t = &dev->area[li];
+            t = sy_rt_area_at(&dev->area[li], c->ictx.time, &moved);
             float su = sqrtf(u[1]);
             bu = su * (1.0f - u[2]), bv = su * u[2];
             q = v3_add(t->p0, v3_add(v3_scale(t->e1, bu), v3_scale(t->e2, bv)));
@@ -1084,8 +1086,11 @@ sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc 
     j->lt = sy_rt_light_tree_get(dev, desc->light_tree);
     if (j->lt && j->lt->node_count + j->lt->distant_count == 0) j->lt = NULL; /* every light left out */
     j->area_analytic = !j->lt && dev->area_count > 0 && dev->area_count <= ANALYTIC_MAX_TRIANGLES;
+    /* textured emitters, and emitters that move over the shutter (the closed form integrates the
+     * open's polygons; the sampled estimator places each at its ray's time: sy_rt_area_at), take the
+     * sampled estimator */
     for (uint32_t i = 0; j->area_analytic && i < dev->area_count; ++i)
-        if (dev->area[i].textured) j->area_analytic = false;
+        if (dev->area[i].textured || dev->area[i].inst->motion || dev->area[i].inst->mesh->motion) j->area_analytic = false;
     j->poly = NULL;
     j->n_poly = 0;
     if (j->area_analytic && !(j->poly = build_polys(dev, &j->n_poly))) {

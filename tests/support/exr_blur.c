@@ -9,6 +9,8 @@
  *                                          alpha exceeds T per row (a horizontal streak's width)
  *   exr_blur relmse A.exr REF.exr          relative MSE of A's RGB against REF's: the mean over pixels and
  *                                          channels of (a - r)^2 / (r^2 + 0.01)
+ *   exr_blur centroid A.exr                the luminance-weighted mean column and row of A (pixel centres at
+ *                                          x + 0.5, y + 0.5; where a light falls)
  * Prints the numbers on one line; exit 0, or 2 on bad input (unreadable file, no alpha channel,
  * different sizes). */
 #include "sy_exr.h"
@@ -37,7 +39,7 @@ static sy_exr_image *load(const char *path, const sy_exr_image *like)
 static int usage(void)
 {
     fprintf(stderr, "usage: exr_blur mean A.exr [B.exr ...] | cover T A.exr | iou T BLUR.exr U A.exr B.exr |\n"
-                    "       width T A.exr | relmse A.exr REF.exr\n");
+                    "       width T A.exr | relmse A.exr REF.exr | centroid A.exr\n");
     return 2;
 }
 
@@ -83,6 +85,26 @@ int main(int argc, char **argv)
         if (cover) printf("%zu\n", n);
         else printf("%.4f\n", rows ? (double)n / (double)rows : 0.0);
         sy_exr_image_free(img);
+        return 0;
+    }
+    if (!strcmp(argv[1], "centroid") && argc == 3) {
+        sy_exr_image *a = load(argv[2], NULL);
+        if (!a) return 2;
+        const float *r = sy_exr_image_channel(a, "R"), *g = sy_exr_image_channel(a, "G"), *b = sy_exr_image_channel(a, "B");
+        double sum = 0.0, sx = 0.0, sy = 0.0;
+        for (int y = 0; y < a->height; ++y)
+            for (int x = 0; x < a->width; ++x) {
+                size_t k = (size_t)y * a->width + x;
+                double l = 0.2126 * r[k] + 0.7152 * g[k] + 0.0722 * b[k];
+                if (!(l > 0.0)) continue;
+                sum += l, sx += l * (x + 0.5), sy += l * (y + 0.5);
+            }
+        sy_exr_image_free(a);
+        if (!(sum > 0.0)) {
+            fprintf(stderr, "exr_blur: %s: black\n", argv[2]);
+            return 2;
+        }
+        printf("%.4f %.4f\n", sx / sum, sy / sum);
         return 0;
     }
     if (!strcmp(argv[1], "relmse") && argc == 4) {
