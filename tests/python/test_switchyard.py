@@ -233,6 +233,97 @@ def test_serve_the_web_view_over_http():
         srv.scene.nodes
 
 
+def _two_clips_gltf(path):
+    """A glTF of one triangle, a camera and two clips, "slide" (x) and "lift" (y), on the same node."""
+    import base64
+    import json
+    import struct
+    data = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack("<2f", 0, 1) + \
+        struct.pack("<6f", 0, 0, 0, 1, 0, 0) + struct.pack("<6f", 0, 0, 0, 0, 1, 0)
+    views = [(0, 36), (36, 8), (44, 24), (68, 24)]
+    channel = [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+           "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0.5, 0.5, 4]}],
+           "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}],
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+           "buffers": [{"byteLength": len(data),
+                        "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+           "bufferViews": [{"buffer": 0, "byteOffset": o, "byteLength": n} for o, n in views],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0],
+                          "max": [1, 1, 0]},
+                         {"bufferView": 1, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+                         {"bufferView": 2, "componentType": 5126, "count": 2, "type": "VEC3"},
+                         {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"}],
+           "animations": [{"name": "slide", "channels": channel, "samplers": [{"input": 1, "output": 2}]},
+                          {"name": "lift", "channels": channel, "samplers": [{"input": 1, "output": 3}]}]}
+    path.write_text(json.dumps(doc))
+    return str(path)
+
+
+def _ws_message(port, kind, timeout=30):
+    """The first text message of type ``kind`` that a page connected to the server on ``port``
+    (GET /ws, subprotocol sy-view, a same-origin Origin) receives: a minimal WebSocket client."""
+    import base64
+    import json
+    import socket
+    sock = socket.create_connection(("127.0.0.1", port), timeout=timeout)
+    key = base64.b64encode(os.urandom(16)).decode()
+    sock.sendall(("GET /ws HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nOrigin: http://127.0.0.1:%d\r\nUpgrade: websocket\r\n"
+                  "Connection: Upgrade\r\nSec-WebSocket-Key: %s\r\nSec-WebSocket-Version: 13\r\n"
+                  "Sec-WebSocket-Protocol: sy-view\r\n\r\n" % (port, port, key)).encode())
+    buf = b""
+
+    def need(n):
+        nonlocal buf
+        while len(buf) < n:
+            chunk = sock.recv(65536)
+            if not chunk:
+                raise EOFError("the server closed the WebSocket")
+            buf += chunk
+    try:
+        while b"\r\n\r\n" not in buf:
+            need(len(buf) + 1)
+        head, buf = buf.split(b"\r\n\r\n", 1)
+        assert b" 101 " in head.split(b"\r\n")[0], head
+        while True:  # server frames: unmasked, whole messages
+            need(2)
+            op, n, off = buf[0] & 0x0F, buf[1] & 0x7F, 2
+            if n == 126:
+                need(4)
+                n, off = int.from_bytes(buf[2:4], "big"), 4
+            elif n == 127:
+                need(10)
+                n, off = int.from_bytes(buf[2:10], "big"), 10
+            need(off + n)
+            payload, buf = buf[off:off + n], buf[off + n:]
+            if op == 8:
+                raise EOFError("the server closed the WebSocket")
+            if op == 1:
+                msg = json.loads(payload)
+                if msg.get("t") == kind:
+                    return msg
+    finally:
+        sock.close()
+
+
+def test_serve_plays_the_clip_given(tmp_path):
+    """serve(..., clip=NAME|INDEX) is sy web --clip (sy_web_desc.clip): the page's clock plays that
+    clip (its index in hello's clips), every clip together without it; an unknown clip, or a clip of
+    a scene without animations, raises NotFoundError before anything serves."""
+    if not hasattr(switchyard._c, "_Web"):
+        pytest.skip("built without the web view (SY_WITH_WEB)")
+    path = _two_clips_gltf(tmp_path / "clips.gltf")
+    for clip, index in (("lift", 1), (0, 0), ("1", 1), (None, -1)):
+        with switchyard.serve(path, port=0, backend=NAMES[0], clip=clip) as srv:
+            assert _ws_message(srv.port, "hello")["clips"] == ["slide", "lift"]
+            clock = _ws_message(srv.port, "clock")
+            assert clock["clip"] == index and clock["end"] == 1, (clip, clock)
+    with pytest.raises(switchyard.NotFoundError, match="clip walk"):
+        switchyard.serve(path, port=0, clip="walk")
+    with pytest.raises(switchyard.NotFoundError, match="no animations"):
+        switchyard.serve("demo", port=0, clip=0)
+
+
 @needs_whitted
 def test_load_world_and_time_options_equal_sy_render(tmp_path):
     """load()'s world and time options are sy render's --background / --at: the same pixels."""

@@ -50,19 +50,20 @@ static void web_dealloc(PyObject *self)
 }
 
 /* _Web(scene, backend=None, listen=None, token=None, max_width=0, max_height=0, quality=0,
- * filter=None, threshold=0, budget_ms=0): serving starts at once */
+ * filter=None, threshold=0, budget_ms=0, clip=None): serving starts at once; clip (a name or an
+ * index, as sy web --clip: sy_animation_find) is the clip the timeline plays (None: every clip) */
 static PyObject *web_new(PyTypeObject *type, PyObject *args, PyObject *kw)
 {
     static char *kwlist[] = {"scene", "backend", "listen", "token", "max_width", "max_height", "quality", "filter",
-                             "threshold", "budget_ms", NULL};
+                             "threshold", "budget_ms", "clip", NULL};
     PyObject *scene;
-    const char *backend = NULL, *listen = NULL, *token = NULL, *filter = NULL;
+    const char *backend = NULL, *listen = NULL, *token = NULL, *filter = NULL, *clip = NULL;
     unsigned int mw = 0, mh = 0;
     int quality = 0;
     float threshold = 0.0f;
     double budget = 0.0;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "O!|zzzIIizfd", kwlist, sy_py_scene_type, &scene, &backend, &listen, &token,
-                                     &mw, &mh, &quality, &filter, &threshold, &budget))
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O!|zzzIIizfdz", kwlist, sy_py_scene_type, &scene, &backend, &listen, &token,
+                                     &mw, &mh, &quality, &filter, &threshold, &budget, &clip))
         return NULL;
     SceneObject *s = (SceneObject *)scene;
     sy_scene *sc = sy_py_scene_use(s);
@@ -74,11 +75,18 @@ static PyObject *web_new(PyTypeObject *type, PyObject *args, PyObject *kw)
         return sy_py_raise(SY_ERR_INVALID_ARGUMENT,
                         &(sy_error){SY_ERR_INVALID_ARGUMENT, "serve: the scene has no camera (add one: scene.camera = "
                                                              "scene.add_camera(...))"});
+    sy_animation played = {0}; /* every clip together unless clip names one (as sy web --clip) */
+    if (clip && !sy_scene_count(sc, SY_TYPE_ANIMATION))
+        return sy_py_raise(sy_error_set(&err, SY_ERR_NOT_FOUND, "serve: clip %s: the scene has no animations", clip), &err);
+    if (clip && (r = sy_animation_find(sc, clip, &played, &err)) != SY_OK) {
+        sy_error_prefix(&err, "serve: clip %s", clip);
+        return sy_py_raise(r, &err);
+    }
     WebObject *w = (WebObject *)PyType_GenericNew(type, NULL, NULL);
     if (!w) return NULL;
     sy_web_desc d = {.scene = sc, .root = s->ld.root, .camera = s->ld.camera, .background = s->ld.background,
                      .backend = backend, .listen = listen, .token = token, .max_width = mw, .max_height = mh,
-                     .quality = quality, .filter = filter, .threshold = threshold, .budget_ms = budget};
+                     .quality = quality, .filter = filter, .threshold = threshold, .budget_ms = budget, .clip = played};
     s->busy = 1; /* from here the scene belongs to the server (released in web_stop) */
     Py_BEGIN_ALLOW_THREADS
     r = sy_web_create(&d, &w->web, &err);

@@ -599,7 +599,7 @@ class Server(_Closing):
 
 
 def serve(scene, port=8080, host="127.0.0.1", backend=None, token=None, width=1920, height=1200, quality=80,
-          filter=None, threshold=0.0, budget_ms=0.0, **load_options):
+          filter=None, threshold=0.0, budget_ms=0.0, clip=None, **load_options):
     """Serves the web view of a Scene or a file (loaded with load_options) as ``sy web`` does
     (docs/WEB.md): an HTTP + WebSocket server whose page shows ``backend``'s view of the scene,
     streamed as JPEG and steered by the page; stills at ``/api/frame.jpg?w=W&h=H``. Returns a
@@ -611,7 +611,9 @@ def serve(scene, port=8080, host="127.0.0.1", backend=None, token=None, width=19
     one; width / height: the largest frame (sy web's -w/-h); quality: the streamed frames' quality
     (sy web's --quality: JPEG's and the video stream's quantizer); filter / threshold: a display
     filter of a back-end with filters; budget_ms: the frame-time budget while the view moves (0:
-    33 ms)."""
+    33 ms); clip: the clip the page's timeline plays, a name or an index (sy web's --clip; an unknown
+    one raises NotFoundError naming the clips; None: every clip together; the page may choose
+    another)."""
     owns = not isinstance(scene, Scene)
     if owns:
         scene = load(scene, **load_options)
@@ -624,7 +626,8 @@ def serve(scene, port=8080, host="127.0.0.1", backend=None, token=None, width=19
                                "libturbojpeg, libsodium, cJSON)", 6)
     listen = "[%s]:%d" % (host, port) if ":" in host else "%s:%d" % (host, port)
     try:
-        impl = _c._Web(scene._c, backend, listen, token, width, height, quality, filter, threshold, budget_ms)
+        impl = _c._Web(scene._c, backend, listen, token, width, height, quality, filter, threshold, budget_ms,
+                       None if clip is None else str(clip))
     except BaseException:
         if owns:
             scene.close()
