@@ -292,7 +292,7 @@ static uint32_t motion_steps_auto(loaded *ld, const char *clip, double frame_tim
 {
     *angle_out = 0.0;
     size_t n = 0, cap = 0;
-    uint32_t *nodes = NULL; /* the nodes that channels move, then their rotations at the last probe */
+    uint32_t *nodes = NULL; /* the nodes that channels move (once per channel) */
     for (uint32_t id = sy_scene_next(ld->scene, SY_TYPE_ANIMATION, 0); id; id = sy_scene_next(ld->scene, SY_TYPE_ANIMATION, id)) {
         uint32_t nch = 0;
         const sy_anim_channel *ch = sy_animation_channels(sy_animation_get(ld->scene, (sy_animation){id}), &nch);
@@ -345,6 +345,16 @@ static uint32_t motion_steps_auto(loaded *ld, const char *clip, double frame_tim
     return chords + 1.0 >= SY_MOTION_STEPS_MAX ? SY_MOTION_STEPS_MAX : (uint32_t)chords + 1u;
 }
 
+/* The view of each of the n_eyes eyes (1: the mono view; 2: the left and the right eye) of spec's main
+ * viewport at w x h, the scene as committed now, into out[0 .. n_eyes - 1]. */
+static bool eye_views(const loaded *ld, const sy_compose_spec *spec, uint32_t n_eyes, uint32_t w, uint32_t h,
+                      sy_camera_view *out, sy_error *e)
+{
+    if (n_eyes == 1u) return sy_compose_eye_view(ld->scene, spec, SY_EYE_MONO, w, h, &out[0], e) == SY_OK;
+    return sy_compose_eye_view(ld->scene, spec, SY_EYE_LEFT, w, h, &out[0], e) == SY_OK &&
+           sy_compose_eye_view(ld->scene, spec, SY_EYE_RIGHT, w, h, &out[1], e) == SY_OK;
+}
+
 /* Motion blur in one render (back-ends with SY_CAP_MOTION: whitted, pathtracer): the scene committed
  * at the shutter's close, synced, then at its open, synced (sy_context_motion_begin / _open): every
  * instance moved in between is interpolated linearly from open to close by each ray's own time. True
@@ -353,8 +363,8 @@ static uint32_t motion_steps_auto(loaded *ld, const char *clip, double frame_tim
  * moves (*motion_camera true: sy_context_motion_camera, each camera ray at its time). False when the
  * back-end lacks it, or (a note says why) the scene also moves lights, makes meshes anew, or moves the
  * camera of a back-end that cannot move it: then the motion is ended and the caller blurs by
- * sub-frames. A stereo render's eyes move each with its own views (one moving camera per eye). steps: the shutter's time steps (--shutter-steps), 0 = chosen from the
- * motion (motion_steps_auto). */
+ * sub-frames. A stereo render's eyes move each with its own views (one moving camera per eye).
+ * steps: the shutter's time steps (--shutter-steps), 0 = chosen from the motion (motion_steps_auto). */
 static bool motion_native_begin(loaded *ld, const char *clip, double frame_time, const sy_shutter *sh,
                                 uint32_t steps, const sy_compose_spec *spec, uint32_t w, uint32_t h,
                                 sy_context_pool *pool, sy_context **ctx_out, bool *motion_camera)
@@ -378,27 +388,24 @@ static bool motion_native_begin(loaded *ld, const char *clip, double frame_time,
     /* the camera of each eye (mono: one; stereo: left and right, each its own view) at the open and
      * at each later step (v_later[eye][steps - 2]: the close): each camera ray at its own time between
      * them */
-    static const uint32_t eyes[2] = {SY_EYE_LEFT, SY_EYE_RIGHT};
     uint32_t n_eyes = spec->stereo == SY_STEREO_NONE ? 1u : 2u;
     sy_camera_view v_open[2], v_later[2][SY_MOTION_STEPS_MAX];
     memset(v_open, 0, sizeof v_open);
     memset(v_later, 0, sizeof v_later);
-#define EYE_VIEWS(out)                                                                                               \
-    (sy_compose_eye_view(ld->scene, spec, n_eyes == 1u ? SY_EYE_MONO : eyes[0], w, h, &(out)[0], &e) == SY_OK &&    \
-     (n_eyes == 1u || sy_compose_eye_view(ld->scene, spec, eyes[1], w, h, &(out)[1], &e) == SY_OK))
     sy_camera_view at[2];
     memset(at, 0, sizeof at);
     sy_error ce = {0};
     /* --shutter-steps N: the steps between, from the close towards the open (curved motion) */
-    bool stepped = sy_cli_set_time(ld, clip, frame_time + sh->close, &e) == 0 && EYE_VIEWS(at) &&
+    bool stepped = sy_cli_set_time(ld, clip, frame_time + sh->close, &e) == 0 && eye_views(ld, spec, n_eyes, w, h, at, &e) &&
                    sy_context_motion_begin_steps(c, sh->samples, steps, &e) == SY_OK;
     for (uint32_t i = 0; stepped && i < n_eyes; ++i) v_later[i][steps - 2u] = at[i];
     for (uint32_t k = steps - 2u; stepped && k >= 1u; --k) {
         stepped = sy_cli_set_time(ld, clip, frame_time + sh->open + (sh->close - sh->open) * k / (steps - 1u), &e) == 0 &&
-                  EYE_VIEWS(at) && sy_context_motion_step(c, &e) == SY_OK;
+                  eye_views(ld, spec, n_eyes, w, h, at, &e) && sy_context_motion_step(c, &e) == SY_OK;
         for (uint32_t i = 0; stepped && i < n_eyes; ++i) v_later[i][k - 1u] = at[i];
     }
-    if (stepped && sy_cli_set_time(ld, clip, frame_time + sh->open, &e) == 0 && EYE_VIEWS(v_open) &&
+    if (stepped && sy_cli_set_time(ld, clip, frame_time + sh->open, &e) == 0 &&
+        eye_views(ld, spec, n_eyes, w, h, v_open, &e) &&
         sy_context_motion_open(c, &native, &e) == SY_OK && native) {
         for (uint32_t i = 0; i < n_eyes; ++i)
             for (uint32_t k = 0; k + 1u < steps; ++k) camera_moves |= memcmp(&v_later[i][k], &v_open[i], sizeof v_open[i]) != 0;
@@ -414,7 +421,6 @@ static bool motion_native_begin(loaded *ld, const char *clip, double frame_time,
         }
         camera_stays = true;
     }
-#undef EYE_VIEWS
     sy_context_motion_end(c);
     sy_context_restart(c);
     sy_log(SY_LOG_NOTE, "sy", NULL, "motion blur: %s; blurring by sub-frames instead",
@@ -786,7 +792,8 @@ int sy_cmd_render(int argc, char **argv)
     uint32_t max_memory_mb = 0;
     sy_shutter shutter = {0.0, 0.0, 0}; /* --shutter / --motion-blur / --shutter-samples: motion blur */
     bool shutter_given = false, motion_blur = false, sub_frames = false;
-    uint32_t shutter_steps = 0; /* --shutter-steps: time steps of the one-render path (curved motion); 0 = chosen from the motion (motion_steps_auto) */
+    uint32_t shutter_steps = 0; /* --shutter-steps: time steps of the one-render path (curved motion); 0 = chosen
+                                 * from the motion (motion_steps_auto) */
     const sy_cli_opt opts[] = {
         SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT(NULL, 'o', &outp),
         SY_CLI_OPT_UINT("spp", OPT_SPP, &po.spp, 1, 1u << 24),
