@@ -125,10 +125,7 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     dev->sky_inv_vp = gl->GetUniformLocation(dev->prog_sky, "u_inv_vp");
     dev->sky_size_int = gl->GetUniformLocation(dev->prog_sky, "u_size_int");
 
-    static const unsigned char white[4] = {255, 255, 255, 255}, flat[4] = {128, 128, 255, 255};
-    for (int i = 0; i < STANDINS; ++i) /* the layers' slots 4 (coat normal), 1 and 5 (colours, sRGB) */
-        dev->standin[i] = sy_gli_make_standin(gl, i == UNIT_NRM || i == 5 + 4 ? flat : white,
-                                              i == UNIT_BASE || i == UNIT_EMIS || i == 5 + 1 || i == 5 + 5);
+    sy_gli_standins_make(dev);
     sy_gl_material_desc md;
     sy_gl_material_desc_init(&md);
     mat_block mb;

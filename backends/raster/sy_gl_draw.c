@@ -446,6 +446,7 @@ void sy_gli_frame_features(sy_gl_device *dev)
     }
     dev->shared_features = shared;
     dev->shared_full = full;
+    sy_gli_standins_follow(dev);
 }
 
 /* The variant bits for one draw: mesh attributes, material textures and mode, frame lighting,

@@ -225,6 +225,7 @@ struct sy_gl_device {
     } pick; /* sy_gl_pick.c */
     GLuint default_ubo, lights_ubo, empty_vao;
     GLuint standin[STANDINS]; /* per material texture unit, bound where the material has no texture (sy_gli_make_standin) */
+    uint32_t standin_key[STANDINS]; /* how each samples (sy_gli_standin_key; sy_gli_standins_follow) */
     bool layer_units; /* the context has UNIT_COUNT texture units: the layers' textures are read */
     GLuint shadow_tex, shadow_fbo;
     GLuint cube_tex[SY_GL_MAX_CUBE_SHADOWS]; /* point-light depth cube maps, made on first use */
@@ -404,7 +405,21 @@ bool sy_gli_sphere_outside(const float planes[6][4], const float c[3], float r);
 /* sy_gl_programs.c */
 /* The name of main variant v under the lights' current signature ("main TEX LIGHTS ... (2 lights: ...)"). */
 void sy_gli_variant_name(const sy_gl_device *dev, int v, char *name, size_t len);
-GLuint sy_gli_make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], bool srgb);
+/* A stand-in's sampling, as llvmpipe's shader key sees it: bits 0-1 the texel format (0 RGBA8,
+ * 1 sRGB, 2 float), 2-3 and 4-5 the wraps (sy_gl_texture_desc's codes), then the flags below. */
+#define STANDIN_NEAREST (1u << 6)
+#define STANDIN_NPOT_S (1u << 7) /* a side that is not a power of two */
+#define STANDIN_NPOT_T (1u << 8)
+/* A constant stand-in texture of texel rgba that samples as key says. */
+GLuint sy_gli_make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], uint32_t key);
+/* The stand-in key of texture t: a stand-in of that key samples as t does. */
+uint32_t sy_gli_standin_key(const tex_o *t);
+/* Makes the stand-ins with their slots' default keys (sy_gl_device_create). */
+void sy_gli_standins_make(sy_gl_device *dev);
+/* Once per frame (sy_gli_frame_features): each stand-in takes the sampling of the first texture in
+ * its slot among the visible instances' materials (the default where none has one), so that the
+ * draws with and without a texture there run one compiled shader (sy_gli_make_standin). */
+void sy_gli_standins_follow(sy_gl_device *dev);
 void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b);
 /* Whether material d uses a material extension (then it draws with VAR_LAYERS). */
 bool sy_gli_material_layered(const sy_gl_device *dev, const sy_gl_material_desc *d);

@@ -34,19 +34,23 @@ const mat_o *sy_gli_bind_material(sy_gl_device *dev, sy_gl_material id, bool all
     const mat_o *m = sy_gli_pool_get(&dev->materials, id.id);
     dev->profile_mat = id.id;
     gl->BindBufferBase(GL_UNIFORM_BUFFER, BIND_MATERIAL, m ? m->ubo : dev->default_ubo);
-    if (!m) return NULL;
-    const sy_gl_texture_ref *refs[5] = {&m->d.base_color_texture, &m->d.metallic_roughness_texture,
-                                        &m->d.normal_texture, &m->d.occlusion_texture, &m->d.emissive_texture};
+    /* the default material (none) binds the stand-ins: left unbound, a unit samples the GL's own
+     * incomplete-texture stand-in, and llvmpipe compiles the program once more for it */
+    const sy_gl_texture_ref *refs[5] = {NULL};
+    if (m) {
+        refs[0] = &m->d.base_color_texture, refs[1] = &m->d.metallic_roughness_texture, refs[2] = &m->d.normal_texture;
+        refs[3] = &m->d.occlusion_texture, refs[4] = &m->d.emissive_texture;
+    }
     for (int i = 0; i < (all_textures ? 5 : 1); ++i) {
-        const tex_o *t = sy_gli_pool_get(&dev->textures, refs[i]->texture.id);
+        const tex_o *t = m ? sy_gli_pool_get(&dev->textures, refs[i]->texture.id) : NULL;
         gl->ActiveTexture(GL_TEXTURE0 + (GLenum)i);
         gl->BindTexture(GL_TEXTURE_2D, t ? t->tex : dev->standin[i]);
     }
     if (!all_textures || !dev->layer_units) return m;
-    const sy_gl_texture_ref *lr[LAYER_TEXTURES];
-    sy_gli_layer_refs(&m->d, lr);
+    const sy_gl_texture_ref *lr[LAYER_TEXTURES] = {NULL};
+    if (m) sy_gli_layer_refs(&m->d, lr);
     for (int i = 0; i < LAYER_TEXTURES; ++i) { /* the layers' (sy_gl_shaders_layers.c reads them where m_lt says) */
-        const tex_o *t = sy_gli_pool_get(&dev->textures, lr[i]->texture.id);
+        const tex_o *t = m ? sy_gli_pool_get(&dev->textures, lr[i]->texture.id) : NULL;
         gl->ActiveTexture(GL_TEXTURE0 + UNIT_LAYER0 + (GLenum)i);
         gl->BindTexture(GL_TEXTURE_2D, t ? t->tex : dev->standin[5 + i]);
     }

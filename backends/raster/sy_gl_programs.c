@@ -8,24 +8,98 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A material's stand-in for a texture it does not have in one unit (sy_gli_bind_material): a constant 2x2
- * texture with a mipmap, in the unit's format (sRGB for colours) and the sampling of an uploaded
- * texture by default (repeat, trilinear). llvmpipe compiles a fragment shader per state of what it
- * samples (format, filters, wraps, whether there are mip levels), so a stand-in that samples like the
- * real textures lets materials with and without a texture in that unit share one compiled shader
- * (issue 32: the first frame's compile time). A constant texture filters to its value exactly. */
-GLuint sy_gli_make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], bool srgb)
+/* A material's stand-in for a texture it does not have in one unit (sy_gli_bind_material): a constant
+ * texture with a mipmap, sampled as key says (sy_gli_standin_key; the unit's default: the format of
+ * the slot, repeat, trilinear, sides powers of two). llvmpipe compiles a fragment shader per state of
+ * what it samples (format, filters, wraps, whether the sides are powers of two, whether there are
+ * mip levels), so a stand-in that samples like the real textures of its unit lets materials with and
+ * without a texture in that unit share one compiled shader (issue 32: the first frame's compile
+ * time). The shaders never read a stand-in (a material's m_tex says which units hold its textures);
+ * its constant texels filter to their value exactly all the same. */
+GLuint sy_gli_make_standin(const sy_gl_fns *gl, const unsigned char rgba[4], uint32_t key)
 {
-    unsigned char px[16];
-    for (int i = 0; i < 16; ++i) px[i] = rgba[i & 3];
+    static const GLint wraps[3] = {GL_REPEAT, GL_CLAMP_TO_EDGE, GL_MIRRORED_REPEAT};
+    const uint32_t fmt = key & 3u, w = (key & STANDIN_NPOT_S) ? 3u : 2u, h = (key & STANDIN_NPOT_T) ? 3u : 2u;
+    float pxf[36];
+    unsigned char px[36];
+    for (int i = 0; i < 36; ++i) px[i] = rgba[i & 3], pxf[i] = (float)rgba[i & 3] / 255.0f;
+    const GLint internal = fmt == 2u ? GL_RGBA32F : fmt == 1u ? GL_SRGB8_ALPHA8 : GL_RGBA8;
+    const GLenum type = fmt == 2u ? GL_FLOAT : GL_UNSIGNED_BYTE;
+    const void *data = fmt == 2u ? (const void *)pxf : (const void *)px;
     GLuint t;
     gl->GenTextures(1, &t);
     gl->BindTexture(GL_TEXTURE_2D, t);
-    gl->TexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, 2, 2, 0, GL_RGBA, GL_UNSIGNED_BYTE, px);
-    gl->TexImage2D(GL_TEXTURE_2D, 1, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, px);
-    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    gl->TexImage2D(GL_TEXTURE_2D, 0, internal, (GLsizei)w, (GLsizei)h, 0, GL_RGBA, type, data);
+    gl->TexImage2D(GL_TEXTURE_2D, 1, internal, 1, 1, 0, GL_RGBA, type, data);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wraps[(key >> 2) & 3u]);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wraps[(key >> 4) & 3u]);
+    const bool nearest = (key & STANDIN_NEAREST) != 0;
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, nearest ? GL_NEAREST_MIPMAP_LINEAR : GL_LINEAR_MIPMAP_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, nearest ? GL_NEAREST : GL_LINEAR);
     return t;
+}
+
+uint32_t sy_gli_standin_key(const tex_o *t)
+{
+    uint32_t key = t->is_float ? 2u : t->srgb ? 1u : 0u;
+    key |= (uint32_t)(t->wrap_s % 3u) << 2 | (uint32_t)(t->wrap_t % 3u) << 4;
+    if (t->nearest) key |= STANDIN_NEAREST;
+    if (t->width & (t->width - 1u)) key |= STANDIN_NPOT_S;
+    if (t->height & (t->height - 1u)) key |= STANDIN_NPOT_T;
+    return key;
+}
+
+/* Slot i's stand-in texel: a flat normal for the normal maps (the base normal and the coat's),
+ * else white; its default key: sRGB for the colours (base, emission, the layers' slots 1 and 5). */
+static uint32_t standin_default(int i, unsigned char rgba[4])
+{
+    static const unsigned char white[4] = {255, 255, 255, 255}, flat[4] = {128, 128, 255, 255};
+    memcpy(rgba, i == UNIT_NRM || i == 5 + 4 ? flat : white, 4);
+    return i == UNIT_BASE || i == UNIT_EMIS || i == 5 + 1 || i == 5 + 5 ? 1u : 0u;
+}
+
+void sy_gli_standins_make(sy_gl_device *dev)
+{
+    for (int i = 0; i < STANDINS; ++i) {
+        unsigned char rgba[4];
+        dev->standin_key[i] = standin_default(i, rgba);
+        dev->standin[i] = sy_gli_make_standin(dev->gl, rgba, dev->standin_key[i]);
+    }
+}
+
+void sy_gli_standins_follow(sy_gl_device *dev)
+{
+    uint32_t want[STANDINS];
+    bool found[STANDINS] = {false};
+    int left = STANDINS;
+    const mat_o *last = NULL;
+    for (uint32_t n = 0; n < dev->instances.count && left; ++n) {
+        const inst_o *in = sy_gli_pool_at(&dev->instances, n);
+        if (!in->h.id || !in->visible) continue;
+        const mat_o *m = sy_gli_pool_get(&dev->materials, in->material.id);
+        if (!m || m == last) continue;
+        last = m;
+        const sy_gl_texture_ref *refs[STANDINS] = {&m->d.base_color_texture, &m->d.metallic_roughness_texture,
+                                                   &m->d.normal_texture, &m->d.occlusion_texture, &m->d.emissive_texture};
+        sy_gli_layer_refs(&m->d, refs + 5);
+        for (int i = 0; i < (dev->layer_units ? STANDINS : 5); ++i) {
+            if (found[i]) continue;
+            const tex_o *t = sy_gli_pool_get(&dev->textures, refs[i]->texture.id);
+            if (!t) continue;
+            want[i] = sy_gli_standin_key(t);
+            found[i] = true;
+            left--;
+        }
+    }
+    for (int i = 0; i < STANDINS; ++i) {
+        unsigned char rgba[4];
+        uint32_t def = standin_default(i, rgba), key = found[i] ? want[i] : def;
+        if (key == dev->standin_key[i]) continue;
+        dev->gl->DeleteTextures(1, &dev->standin[i]);
+        dev->standin[i] = sy_gli_make_standin(dev->gl, rgba, key);
+        dev->standin_key[i] = key;
+    }
 }
 
 void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b)
@@ -268,8 +342,8 @@ void sy_gli_profile_draw(const sy_gl_device *dev, double t0, const char *what)
                                       t->nearest ? " nearest" : "", t->wrap_s, t->wrap_t);
         }
     }
-    fprintf(stderr, "raster profile: %s draw took %.3f s of the GL thread's CPU (a shader compile): %s;%s\n", what, dt, name,
-            tex[0] ? tex : " no textures");
+    fprintf(stderr, "raster profile: %s draw took %.3f s of the GL thread's CPU (a shader compile): %s;%s%s\n", what, dt, name,
+            tex[0] ? tex : " no textures", m && m->d.alpha_mode == SY_GL_ALPHA_BLEND ? "; blended" : "");
 }
 
 /* The main program for variant bits v, built and cached on first use; 0 (the failure reported to rep) when the
