@@ -5,6 +5,7 @@
 #include "sy_ltc.h"
 #include "sy_gl_shaders.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -61,35 +62,80 @@ static const char *const irr_fs =
     "    sum += src_lod(B * l, PI / (float(n) * max(l.z, 1e-3))); }\n"
     "  o = vec4(sum / float(n) * u_size.z, 1.0); }\n";
 
-static const char *const brdf_fs =
-    "#version 330 core\n" IBL_COMMON
-    "out vec4 o;\n"
-    "void main() { vec2 c = floor(gl_FragCoord.xy) / 31.0; float nv = max(c.x, 1e-3), r = c.y;\n"
-    "  float a = max(r * r, 1e-4), a2 = a * a; vec3 V = vec3(sqrt(1.0 - nv * nv), 0.0, nv);\n"
-    "  float A = 0.0, Bv = 0.0; const uint n = 512u;\n"
-    "  for (uint i = 0u; i < n; ++i) {\n"
-    "    vec3 H = ggx_h(vec2((float(i) + 0.5) / float(n), radinv(i)), a2);\n"
-    "    float vh = dot(V, H); vec3 L = 2.0 * vh * H - V; float nl = L.z; if (nl <= 0.0 || vh <= 0.0) continue;\n"
-    "    float vis = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));\n"
-    "    float gv = vis * 4.0 * nl * vh / max(H.z, 1e-6); float m = 1.0 - vh, fc = m * m * m * m * m;\n"
-    "    A += (1.0 - fc) * gv; Bv += fc * gv; }\n"
-    /* B: the sheen lobe's directional albedo E(n.v, sheen roughness) (KHR_materials_sheen: Charlie
-     * distribution, alpha = roughness^2, Neubelt visibility 1 / (4 (n.l + n.v - n.l n.v))), by
-     * uniform hemisphere sampling (Hammersley points); sy_gl_shaders_layers.c reads it */
-    "  float sa = max(r * r, 1e-4), inv = 1.0 / sa, E = 0.0; const uint m = 256u;\n"
-    "  for (uint i = 0u; i < m; ++i) {\n"
-    "    float cl = (float(i) + 0.5) / float(m), sl = sqrt(max(0.0, 1.0 - cl * cl)), phi = 2.0 * PI * radinv(i);\n"
-    "    vec3 L = vec3(sl * cos(phi), sl * sin(phi), cl); vec3 H = normalize(V + L);\n"
-    "    float s2 = max(1.0 - H.z * H.z, 0.0), D = (2.0 + inv) * pow(s2, 0.5 * inv) / (2.0 * PI);\n"
-    "    E += D * cl / (4.0 * (cl + nv - cl * nv)); }\n"
-    "  o = vec4(A / float(n), Bv / float(n), min(E * 2.0 * PI / float(m), 1.0), 1.0); }\n";
+/* The split-sum BRDF table, on the CPU (it was a fragment shader: llvmpipe compiled it for about
+ * 0.07 s of every first frame with an environment, area lights or material layers, issue 32; this
+ * costs a few milliseconds). Per texel (x, y) of the SY_GL_IBL_BRDF_SIZE square, n.v = max(x / 31,
+ * 1e-3) and roughness r = y / 31, V = (sqrt(1 - nv^2), 0, nv):
+ *  R, G: the GGX lobe's scale A and bias B (height-correlated Smith visibility, Schlick Fresnel), from
+ *  512 Hammersley half-vectors of the GGX distribution (alpha = max(r^2, 1e-4));
+ *  B: the sheen lobe's directional albedo E(n.v, sheen roughness) (KHR_materials_sheen: Charlie
+ *  distribution, alpha = max(r^2, 1e-4), Neubelt visibility 1 / (4 (n.l + n.v - n.l n.v))), by uniform
+ *  hemisphere sampling (256 Hammersley points), at most 1; sy_gl_shaders_layers.c reads it.
+ * The sample directions depend on the sample's index alone: computed once, in float as the shader
+ * did. */
+static float radinv(uint32_t b)
+{
+    b = (b << 16u) | (b >> 16u);
+    b = ((b & 0x55555555u) << 1u) | ((b & 0xAAAAAAAAu) >> 1u);
+    b = ((b & 0x33333333u) << 2u) | ((b & 0xCCCCCCCCu) >> 2u);
+    b = ((b & 0x0F0F0F0Fu) << 4u) | ((b & 0xF0F0F0F0u) >> 4u);
+    b = ((b & 0x00FF00FFu) << 8u) | ((b & 0xFF00FF00u) >> 8u);
+    return (float)b * 2.3283064365386963e-10f;
+}
+
+#define BRDF_GGX_SAMPLES 512u
+#define BRDF_SHEEN_SAMPLES 256u
+
+static void brdf_table(float *out)
+{
+    const float pi = 3.14159265359f;
+    float gcos[BRDF_GGX_SAMPLES], gy[BRDF_GGX_SAMPLES]; /* H.y does not enter: V.y = 0 */
+    float scl[BRDF_SHEEN_SAMPLES], ssl[BRDF_SHEEN_SAMPLES], scos[BRDF_SHEEN_SAMPLES], ssin[BRDF_SHEEN_SAMPLES];
+    for (uint32_t i = 0; i < BRDF_GGX_SAMPLES; ++i) {
+        float phi = 2.0f * pi * (((float)i + 0.5f) / (float)BRDF_GGX_SAMPLES);
+        gcos[i] = cosf(phi), gy[i] = radinv(i);
+    }
+    for (uint32_t i = 0; i < BRDF_SHEEN_SAMPLES; ++i) {
+        float cl = ((float)i + 0.5f) / (float)BRDF_SHEEN_SAMPLES, phi = 2.0f * pi * radinv(i);
+        scl[i] = cl, ssl[i] = sqrtf(fmaxf(0.0f, 1.0f - cl * cl)), scos[i] = cosf(phi), ssin[i] = sinf(phi);
+    }
+    const uint32_t n = SY_GL_IBL_BRDF_SIZE;
+    for (uint32_t y = 0; y < n; ++y)
+        for (uint32_t x = 0; x < n; ++x) {
+            float nv = fmaxf((float)x / (float)(n - 1u), 1e-3f), r = (float)y / (float)(n - 1u);
+            float a = fmaxf(r * r, 1e-4f), a2 = a * a, vx = sqrtf(1.0f - nv * nv), vz = nv;
+            float A = 0.0f, Bv = 0.0f;
+            for (uint32_t i = 0; i < BRDF_GGX_SAMPLES; ++i) {
+                float c = sqrtf((1.0f - gy[i]) / (1.0f + (a2 - 1.0f) * gy[i])), sn = sqrtf(fmaxf(0.0f, 1.0f - c * c));
+                float hx = sn * gcos[i], hz = c;
+                float vh = vx * hx + vz * hz, nl = 2.0f * vh * hz - vz;
+                if (nl <= 0.0f || vh <= 0.0f) continue;
+                float vis = 0.5f / (nl * sqrtf(nv * nv * (1.0f - a2) + a2) + nv * sqrtf(nl * nl * (1.0f - a2) + a2));
+                float gv = vis * 4.0f * nl * vh / fmaxf(hz, 1e-6f), m = 1.0f - vh, fc = m * m * m * m * m;
+                A += (1.0f - fc) * gv;
+                Bv += fc * gv;
+            }
+            float inv = 1.0f / a, E = 0.0f; /* the sheen's alpha: max(r^2, 1e-4), as the GGX's */
+            for (uint32_t i = 0; i < BRDF_SHEEN_SAMPLES; ++i) {
+                float lx = ssl[i] * scos[i], ly = ssl[i] * ssin[i], lz = scl[i];
+                float hx = vx + lx, hy = ly, hz = vz + lz, len = sqrtf(hx * hx + hy * hy + hz * hz);
+                hz /= len;
+                float s2 = fmaxf(1.0f - hz * hz, 0.0f), D = (2.0f + inv) * powf(s2, 0.5f * inv) / (2.0f * pi);
+                E += D * lz / (4.0f * (lz + nv - lz * nv));
+            }
+            float *o = out + 4u * (y * n + x);
+            o[0] = A / (float)BRDF_GGX_SAMPLES;
+            o[1] = Bv / (float)BRDF_GGX_SAMPLES;
+            o[2] = fminf(E * 2.0f * pi / (float)BRDF_SHEEN_SAMPLES, 1.0f);
+            o[3] = 1.0f;
+        }
+}
 
 static sy_gl_result build(const sy_gl_fns *gl, sy_gl_ibl *ibl, sy_gl_report *rep)
 {
     if (ibl->prog_spec) return SY_GL_OK;
     sy_gl_result r = sy_gl_program_build(gl, "IBL specular prefilter", sy_gl_fullscreen_vs, spec_fs, NULL, &ibl->prog_spec, rep);
     if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL irradiance", sy_gl_fullscreen_vs, irr_fs, NULL, &ibl->prog_irr, rep);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL BRDF table", sy_gl_fullscreen_vs, brdf_fs, NULL, &ibl->prog_brdf, rep);
     if (r != SY_GL_OK) return r;
     ibl->spec_face = gl->GetUniformLocation(ibl->prog_spec, "u_face");
     ibl->spec_rough = gl->GetUniformLocation(ibl->prog_spec, "u_rough");
@@ -127,35 +173,16 @@ static sy_gl_result fb_check(const sy_gl_fns *gl, const char *what, sy_gl_report
 sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, sy_gl_report *rep)
 {
     if (ibl->brdf_lut) return SY_GL_OK;
-    float *ltc = malloc(2 * SY_LTC_FLOATS * sizeof *ltc);
-    if (!ltc) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "LTC tables: out of memory");
-    sy_gl_result r = build(gl, ibl, rep);
-    if (r != SY_GL_OK) {
-        free(ltc);
-        return r;
-    }
+    const size_t brdf_floats = 4u * SY_GL_IBL_BRDF_SIZE * SY_GL_IBL_BRDF_SIZE;
+    float *ltc = malloc((2 * SY_LTC_FLOATS + brdf_floats) * sizeof *ltc);
+    if (!ltc) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "LTC and BRDF tables: out of memory");
+    float *brdf = ltc + 2 * SY_LTC_FLOATS;
     sy_ltc_tables(ltc, ltc + SY_LTC_FLOATS);
+    brdf_table(brdf);
     ibl->ltc1 = table_tex(gl, GL_RGBA32F, SY_LTC_SIZE, GL_RGBA, ltc);
     ibl->ltc2 = table_tex(gl, GL_RGBA32F, SY_LTC_SIZE, GL_RGBA, ltc + SY_LTC_FLOATS);
+    ibl->brdf_lut = table_tex(gl, GL_RGBA32F, SY_GL_IBL_BRDF_SIZE, GL_RGBA, brdf);
     free(ltc);
-    GLuint lut = table_tex(gl, GL_RGBA32F, SY_GL_IBL_BRDF_SIZE, GL_RGBA, NULL);
-    gl->BindFramebuffer(GL_FRAMEBUFFER, ibl->fbo);
-    gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, lut, 0);
-    gl->DrawBuffer(GL_COLOR_ATTACHMENT0);
-    if ((r = fb_check(gl, "BRDF table", rep)) != SY_GL_OK) {
-        gl->BindFramebuffer(GL_FRAMEBUFFER, 0);
-        gl->DeleteTextures(1, &lut);
-        return r;
-    }
-    gl->Viewport(0, 0, SY_GL_IBL_BRDF_SIZE, SY_GL_IBL_BRDF_SIZE);
-    gl->Disable(GL_DEPTH_TEST);
-    gl->Disable(GL_BLEND);
-    gl->UseProgram(ibl->prog_brdf);
-    gl->BindVertexArray(ibl->vao);
-    gl->DrawArrays(GL_TRIANGLES, 0, 3);
-    gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, 0, 0);
-    gl->BindFramebuffer(GL_FRAMEBUFFER, 0);
-    ibl->brdf_lut = lut;
     return SY_GL_OK;
 }
 
@@ -238,8 +265,8 @@ sy_gl_result sy_gl_ibl_prefilter(const sy_gl_fns *gl, sy_gl_ibl *ibl, GLuint src
 
 void sy_gl_ibl_free(const sy_gl_fns *gl, sy_gl_ibl *ibl)
 {
-    GLuint progs[3] = {ibl->prog_spec, ibl->prog_irr, ibl->prog_brdf};
-    for (int i = 0; i < 3; ++i)
+    GLuint progs[2] = {ibl->prog_spec, ibl->prog_irr};
+    for (int i = 0; i < 2; ++i)
         if (progs[i]) gl->DeleteProgram(progs[i]);
     GLuint texs[5] = {ibl->brdf_lut, ibl->ltc1, ibl->ltc2, ibl->spec_cube, ibl->irr_cube};
     gl->DeleteTextures(5, texs);

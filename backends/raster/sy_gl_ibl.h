@@ -8,9 +8,9 @@
  *    importance sampling (source mip chosen from the sample's pdf), N = V = R as in the split sum;
  *  - an irradiance cube map (SY_GL_IBL_IRR_SIZE per side) holding the cosine-weighted mean radiance
  *    E(n) / pi, so that Lambert is base x texel;
- * and once per device the split-sum BRDF table (32 x 32, x = n.v, y = roughness; RG = A, B of the
- * height-correlated Smith GGX with Schlick: specular = F0 A + B; B = the sheen lobe's directional
- * albedo, y = sheen roughness) and the LTC tables (backends/ltc/sy_ltc.h).
+ * and once per device, on the CPU, the split-sum BRDF table (32 x 32, x = n.v, y = roughness; RG = A,
+ * B of the height-correlated Smith GGX with Schlick: specular = F0 A + B; B = the sheen lobe's
+ * directional albedo, y = sheen roughness) and the LTC tables (backends/ltc/sy_ltc.h).
  *
  * Ownership: the GL objects belong to the sy_gl_ibl struct (sy_gl_ibl_free). Thread-safety: the
  * caller's GL context must be current. */
@@ -26,7 +26,7 @@
 #define SY_GL_IBL_BRDF_SIZE 32u
 
 typedef struct sy_gl_ibl {
-    GLuint prog_spec, prog_irr, prog_brdf;
+    GLuint prog_spec, prog_irr;
     GLint spec_face, spec_rough, spec_size, spec_src, irr_face, irr_size, irr_src;
     GLuint fbo, vao;
     GLuint brdf_lut, ltc1, ltc2; /* once per device */
@@ -39,7 +39,7 @@ typedef struct sy_gl_ibl {
  * about that many pixels; a 200x150 frame prefilters 128, not 256: four times fewer samples). */
 uint32_t sy_gl_ibl_side(uint32_t w, uint32_t h);
 
-/* Builds the BRDF table and uploads the LTC tables (no-op when done). */
+/* Computes the BRDF table and uploads it with the LTC tables (no-op when done). */
 sy_gl_result sy_gl_ibl_tables(const sy_gl_fns *gl, sy_gl_ibl *ibl, sy_gl_report *rep);
 /* (Re)computes both cube maps from a lat-long RGBA float texture with mipmaps (src_w x src_h at
  * level 0) scaled by intensity, the specular one `side` texels per side (sy_gl_ibl_side). Leaves
