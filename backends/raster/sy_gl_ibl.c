@@ -34,10 +34,21 @@
     "  float texel = u_size.y * max(sqrt(max(0.0, 1.0 - d.y * d.y)), 1e-3);\n"                             \
     "  return textureLod(t_src, latlong(d), max(0.5 * log2(sa / texel) + 1.0, 0.0)).rgb; }\n"
 
-static const char *const spec_fs =
+/* Both cubes in one program (u_rough < 0: the irradiance; else the specular mip of that roughness):
+ * llvmpipe compiles each program on its first draw, one compile less in every first frame with an
+ * environment (issue 32). */
+static const char *const prefilter_fs =
     "#version 330 core\n" IBL_COMMON IBL_CUBE
     "uniform float u_rough; out vec4 o;\n"
+    "vec4 irradiance(vec3 N) {\n"
+    "  mat3 B = basis(N); vec3 sum = vec3(0.0); uint n = uint(u_size.w);\n"
+    "  for (uint i = 0u; i < n; ++i) {\n"
+    "    float u = (float(i) + 0.5) / float(n), v = radinv(i), r = sqrt(v), phi = 2.0 * PI * u;\n"
+    "    vec3 l = vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - v)));\n"
+    "    sum += src_lod(B * l, PI / (float(n) * max(l.z, 1e-3))); }\n"
+    "  return vec4(sum / float(n) * u_size.z, 1.0); }\n"
     "void main() { vec3 N = normalize(face_dir(gl_FragCoord.xy / u_size.x * 2.0 - 1.0));\n"
+    "  if (u_rough < 0.0) { o = irradiance(N); return; }\n"
     "  if (u_rough <= 0.0) {\n"
     "    float texel = u_size.y * max(sqrt(max(0.0, 1.0 - N.y * N.y)), 1e-3);\n"
     "    float lod = max(0.5 * log2(4.0 / (u_size.x * u_size.x) / texel), 0.0);\n"
@@ -50,17 +61,6 @@ static const char *const spec_fs =
     "    float dd = h.z * h.z * (a2 - 1.0) + 1.0; float pdf = a2 / (PI * dd * dd) * 0.25;\n"
     "    sum += src_lod(L, 1.0 / (float(n) * pdf)) * nl; w += nl; }\n"
     "  o = vec4(sum / max(w, 1e-6) * u_size.z, 1.0); }\n";
-
-static const char *const irr_fs =
-    "#version 330 core\n" IBL_COMMON IBL_CUBE
-    "out vec4 o;\n"
-    "void main() { vec3 N = normalize(face_dir(gl_FragCoord.xy / u_size.x * 2.0 - 1.0));\n"
-    "  mat3 B = basis(N); vec3 sum = vec3(0.0); uint n = uint(u_size.w);\n"
-    "  for (uint i = 0u; i < n; ++i) {\n"
-    "    float u = (float(i) + 0.5) / float(n), v = radinv(i), r = sqrt(v), phi = 2.0 * PI * u;\n"
-    "    vec3 l = vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - v)));\n"
-    "    sum += src_lod(B * l, PI / (float(n) * max(l.z, 1e-3))); }\n"
-    "  o = vec4(sum / float(n) * u_size.z, 1.0); }\n";
 
 /* The split-sum BRDF table, on the CPU (it was a fragment shader: llvmpipe compiled it for about
  * 0.07 s of every first frame with an environment, area lights or material layers, issue 32; this
@@ -134,16 +134,12 @@ static void brdf_table(float *out)
 static sy_gl_result build(const sy_gl_fns *gl, sy_gl_ibl *ibl, sy_gl_report *rep)
 {
     if (ibl->prog_spec) return SY_GL_OK;
-    sy_gl_result r = sy_gl_program_build(gl, "IBL specular prefilter", sy_gl_fullscreen_vs, spec_fs, NULL, &ibl->prog_spec, rep);
-    if (r == SY_GL_OK) r = sy_gl_program_build(gl, "IBL irradiance", sy_gl_fullscreen_vs, irr_fs, NULL, &ibl->prog_irr, rep);
+    sy_gl_result r = sy_gl_program_build(gl, "IBL prefilter", sy_gl_fullscreen_vs, prefilter_fs, NULL, &ibl->prog_spec, rep);
     if (r != SY_GL_OK) return r;
     ibl->spec_face = gl->GetUniformLocation(ibl->prog_spec, "u_face");
     ibl->spec_rough = gl->GetUniformLocation(ibl->prog_spec, "u_rough");
     ibl->spec_size = gl->GetUniformLocation(ibl->prog_spec, "u_size");
     ibl->spec_src = gl->GetUniformLocation(ibl->prog_spec, "t_src");
-    ibl->irr_face = gl->GetUniformLocation(ibl->prog_irr, "u_face");
-    ibl->irr_size = gl->GetUniformLocation(ibl->prog_irr, "u_size");
-    ibl->irr_src = gl->GetUniformLocation(ibl->prog_irr, "t_src");
     gl->GenFramebuffers(1, &ibl->fbo);
     gl->GenVertexArrays(1, &ibl->vao);
     return SY_GL_OK;
@@ -236,24 +232,24 @@ sy_gl_result sy_gl_ibl_prefilter(const sy_gl_fns *gl, sy_gl_ibl *ibl, GLuint src
     gl->BindTexture(GL_TEXTURE_2D, src);
     const float texel_sa = 2.0f * 3.14159265f * 3.14159265f / ((float)src_w * (float)src_h);
     for (int pass = 0; pass < 2 && r == SY_GL_OK; ++pass) {
-        GLuint prog = pass ? ibl->prog_irr : ibl->prog_spec, cube = pass ? ibl->irr_cube : ibl->spec_cube;
+        GLuint cube = pass ? ibl->irr_cube : ibl->spec_cube;
         uint32_t levels = pass ? 1u : SY_GL_IBL_SPEC_LEVELS, size0 = pass ? SY_GL_IBL_IRR_SIZE : side;
-        gl->UseProgram(prog);
-        gl->Uniform1i(pass ? ibl->irr_src : ibl->spec_src, 0);
+        gl->UseProgram(ibl->prog_spec);
+        gl->Uniform1i(ibl->spec_src, 0);
         for (uint32_t l = 0; l < levels && r == SY_GL_OK; ++l) {
             uint32_t size = size0 >> l;
-            float rough = pass ? 0.0f : (float)l / (float)(SY_GL_IBL_SPEC_LEVELS - 1);
+            float rough = pass ? -1.0f : (float)l / (float)(SY_GL_IBL_SPEC_LEVELS - 1); /* -1: the irradiance */
             float samples = pass ? 256.0f : l == 1 ? 64.0f : 128.0f;
             const float u_size[4] = {(float)size, texel_sa, intensity, samples};
-            gl->Uniform4fv(pass ? ibl->irr_size : ibl->spec_size, 1, u_size);
-            if (!pass) gl->Uniform1f(ibl->spec_rough, rough);
+            gl->Uniform4fv(ibl->spec_size, 1, u_size);
+            gl->Uniform1f(ibl->spec_rough, rough);
             gl->Viewport(0, 0, (GLsizei)size, (GLsizei)size);
             for (int f = 0; f < 6 && r == SY_GL_OK; ++f) {
                 gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f,
                                          cube, (GLint)l);
                 if (f == 0 && l == 0) r = fb_check(gl, pass ? "irradiance cube" : "specular cube", rep);
                 if (r != SY_GL_OK) break;
-                gl->Uniform1i(pass ? ibl->irr_face : ibl->spec_face, f);
+                gl->Uniform1i(ibl->spec_face, f);
                 gl->DrawArrays(GL_TRIANGLES, 0, 3);
             }
         }
@@ -265,9 +261,7 @@ sy_gl_result sy_gl_ibl_prefilter(const sy_gl_fns *gl, sy_gl_ibl *ibl, GLuint src
 
 void sy_gl_ibl_free(const sy_gl_fns *gl, sy_gl_ibl *ibl)
 {
-    GLuint progs[2] = {ibl->prog_spec, ibl->prog_irr};
-    for (int i = 0; i < 2; ++i)
-        if (progs[i]) gl->DeleteProgram(progs[i]);
+    if (ibl->prog_spec) gl->DeleteProgram(ibl->prog_spec);
     GLuint texs[5] = {ibl->brdf_lut, ibl->ltc1, ibl->ltc2, ibl->spec_cube, ibl->irr_cube};
     gl->DeleteTextures(5, texs);
     if (ibl->fbo) gl->DeleteFramebuffers(1, &ibl->fbo);

@@ -26,8 +26,8 @@
 #define SY_GL_IBL_BRDF_SIZE 32u
 
 typedef struct sy_gl_ibl {
-    GLuint prog_spec, prog_irr;
-    GLint spec_face, spec_rough, spec_size, spec_src, irr_face, irr_size, irr_src;
+    GLuint prog_spec; /* both cubes' (u_rough < 0: the irradiance) */
+    GLint spec_face, spec_rough, spec_size, spec_src;
     GLuint fbo, vao;
     GLuint brdf_lut, ltc1, ltc2; /* once per device */
     GLuint spec_cube, irr_cube;  /* per environment */
