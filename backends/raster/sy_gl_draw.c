@@ -434,18 +434,22 @@ static int material_features(const sy_gl_device *dev, const mat_o *mt)
 void sy_gli_frame_features(sy_gl_device *dev)
 {
     int shared = 0;
-    bool full = false;
+    bool full = false, mask = false;
     const mat_o *last = NULL;
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
         const inst_o *in = sy_gli_pool_at(&dev->instances, i);
         if (!in->h.id || !in->visible) continue;
         const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
-        if (mt && mt != last) shared |= material_features(dev, last = mt);
+        if (mt && mt != last) {
+            shared |= material_features(dev, last = mt);
+            mask = mask || mt->d.alpha_mode == SY_GL_ALPHA_MASK;
+        }
         const mesh_o *m = full ? NULL : sy_gli_pool_get(&dev->meshes, in->mesh.id);
         if (m && !sy_gli_mesh_lean(m)) full = true;
     }
     dev->shared_features = shared;
     dev->shared_full = full;
+    dev->shared_mask = mask;
     sy_gli_standins_follow(dev);
 }
 
@@ -632,8 +636,13 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
      * 5.3 s cold at 200x150 on llvmpipe, 1.7 -> 1.8 s warm). */
     pv = sy_gli_variant_normalize((pv | dc->shared) & ~(dev->shared_full ? VAR_LEAN : 0));
     /* probe faces (16-256 px, seen blurred) shade without normal maps and material layers: a
-     * smaller program that llvmpipe compiles in about half the time (docs/BACKENDS.md) */
-    if (dev->in_probe_pass) pv = sy_gli_variant_normalize(pv & ~(VAR_NMAP | VAR_LAYERS));
+     * smaller program that llvmpipe compiles in about half the time (docs/BACKENDS.md); in a frame
+     * with a masked material, every draw of theirs runs the masked variant (a material that is not
+     * masked has no cutoff: sy_gli_material_block), one compile less (issue 32: TransmissionTest).
+     * The main pass keeps the two: a discard turns llvmpipe's early depth test off, which made warm
+     * frames slower */
+    if (dev->in_probe_pass)
+        pv = sy_gli_variant_normalize((pv & ~(VAR_NMAP | VAR_LAYERS)) | (dev->shared_mask ? VAR_MASK : 0));
     sy_gl_result r = use_variant(dev, dc, pv, rep);
     if (r != SY_GL_OK) return r;
     if (pv & VAR_PROBE) { /* its own probe (the 1-texel mip for roughness 1), or the environment's cube */
