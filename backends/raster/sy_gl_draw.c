@@ -430,11 +430,15 @@ static int material_features(const sy_gl_device *dev, const mat_o *mt)
  * VAR_LEAN), every forward draw reads them; a lean mesh's draw gives them the constants the
  * shaders take for absent attributes (uv 0, colour 1: sy_gli_draw_mesh_lod), so it shades as
  * before, and llvmpipe compiles one program instead of a lean and a full one (issue 32:
- * TextureTransformMultiTest's layered variant, about 1 s of LLVM each). */
+ * TextureTransformMultiTest's layered variant, about 1 s of LLVM each). In the same pass: whether a
+ * visible material is masked (the probe faces' variant) and the sampling the stand-ins follow
+ * (sy_gli_standins_follow). */
 void sy_gli_frame_features(sy_gl_device *dev)
 {
     int shared = 0;
     bool full = false, mask = false;
+    uint32_t want[STANDINS];
+    for (int k = 0; k < STANDINS; ++k) want[k] = STANDIN_ANY;
     const mat_o *last = NULL;
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
         const inst_o *in = sy_gli_pool_at(&dev->instances, i);
@@ -443,6 +447,7 @@ void sy_gli_frame_features(sy_gl_device *dev)
         if (mt && mt != last) {
             shared |= material_features(dev, last = mt);
             mask = mask || mt->d.alpha_mode == SY_GL_ALPHA_MASK;
+            sy_gli_standins_want(dev, mt, want);
         }
         const mesh_o *m = full ? NULL : sy_gli_pool_get(&dev->meshes, in->mesh.id);
         if (m && !sy_gli_mesh_lean(m)) full = true;
@@ -450,7 +455,7 @@ void sy_gli_frame_features(sy_gl_device *dev)
     dev->shared_features = shared;
     dev->shared_full = full;
     dev->shared_mask = mask;
-    sy_gli_standins_follow(dev);
+    sy_gli_standins_follow(dev, want);
 }
 
 /* The variant bits for one draw: mesh attributes, material textures and mode, frame lighting,

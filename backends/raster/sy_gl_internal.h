@@ -419,8 +419,13 @@ uint32_t sy_gli_standin_key(const tex_o *t);
 void sy_gli_standins_make(sy_gl_device *dev);
 /* Once per frame (sy_gli_frame_features): each stand-in takes the sampling of the first texture in
  * its slot among the visible instances' materials (the default where none has one), so that the
- * draws with and without a texture there run one compiled shader (sy_gli_make_standin). */
-void sy_gli_standins_follow(sy_gl_device *dev);
+ * draws with and without a texture there run one compiled shader (sy_gli_make_standin).
+ * sy_gli_standins_want fills the slots of want still STANDIN_ANY from material m's textures (called
+ * for each visible material in turn); sy_gli_standins_follow remakes the stand-ins whose key
+ * changed. */
+#define STANDIN_ANY UINT32_MAX
+void sy_gli_standins_want(const sy_gl_device *dev, const mat_o *m, uint32_t want[STANDINS]);
+void sy_gli_standins_follow(sy_gl_device *dev, const uint32_t want[STANDINS]);
 void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b);
 /* Whether material d uses a material extension (then it draws with VAR_LAYERS). */
 bool sy_gli_material_layered(const sy_gl_device *dev, const sy_gl_material_desc *d);

@@ -68,33 +68,23 @@ void sy_gli_standins_make(sy_gl_device *dev)
     }
 }
 
-void sy_gli_standins_follow(sy_gl_device *dev)
+void sy_gli_standins_want(const sy_gl_device *dev, const mat_o *m, uint32_t want[STANDINS])
 {
-    uint32_t want[STANDINS];
-    bool found[STANDINS] = {false};
-    int left = STANDINS;
-    const mat_o *last = NULL;
-    for (uint32_t n = 0; n < dev->instances.count && left; ++n) {
-        const inst_o *in = sy_gli_pool_at(&dev->instances, n);
-        if (!in->h.id || !in->visible) continue;
-        const mat_o *m = sy_gli_pool_get(&dev->materials, in->material.id);
-        if (!m || m == last) continue;
-        last = m;
-        const sy_gl_texture_ref *refs[STANDINS] = {&m->d.base_color_texture, &m->d.metallic_roughness_texture,
-                                                   &m->d.normal_texture, &m->d.occlusion_texture, &m->d.emissive_texture};
-        sy_gli_layer_refs(&m->d, refs + 5);
-        for (int i = 0; i < (dev->layer_units ? STANDINS : 5); ++i) {
-            if (found[i]) continue;
-            const tex_o *t = sy_gli_pool_get(&dev->textures, refs[i]->texture.id);
-            if (!t) continue;
-            want[i] = sy_gli_standin_key(t);
-            found[i] = true;
-            left--;
-        }
+    const sy_gl_texture_ref *refs[STANDINS] = {&m->d.base_color_texture, &m->d.metallic_roughness_texture,
+                                               &m->d.normal_texture, &m->d.occlusion_texture, &m->d.emissive_texture};
+    sy_gli_layer_refs(&m->d, refs + 5);
+    for (int i = 0; i < (dev->layer_units ? STANDINS : 5); ++i) {
+        if (want[i] != STANDIN_ANY) continue;
+        const tex_o *t = sy_gli_pool_get(&dev->textures, refs[i]->texture.id);
+        if (t) want[i] = sy_gli_standin_key(t);
     }
+}
+
+void sy_gli_standins_follow(sy_gl_device *dev, const uint32_t want[STANDINS])
+{
     for (int i = 0; i < STANDINS; ++i) {
         unsigned char rgba[4];
-        uint32_t def = standin_default(i, rgba), key = found[i] ? want[i] : def;
+        uint32_t def = standin_default(i, rgba), key = want[i] != STANDIN_ANY ? want[i] : def;
         if (key == dev->standin_key[i]) continue;
         dev->gl->DeleteTextures(1, &dev->standin[i]);
         dev->standin[i] = sy_gli_make_standin(dev->gl, rgba, key);
