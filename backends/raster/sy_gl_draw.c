@@ -430,13 +430,12 @@ static int material_features(const sy_gl_device *dev, const mat_o *mt)
  * VAR_LEAN), every forward draw reads them; a lean mesh's draw gives them the constants the
  * shaders take for absent attributes (uv 0, colour 1: sy_gli_draw_mesh_lod), so it shades as
  * before, and llvmpipe compiles one program instead of a lean and a full one (issue 32:
- * TextureTransformMultiTest's layered variant, about 1 s of LLVM each). In the same pass: whether a
- * visible material is masked (the probe faces' variant) and the sampling the stand-ins follow
- * (sy_gli_standins_follow). */
+ * TextureTransformMultiTest's layered variant, about 1 s of LLVM each). In the same pass: the
+ * sampling the stand-ins follow (sy_gli_standins_follow). */
 void sy_gli_frame_features(sy_gl_device *dev)
 {
     int shared = 0;
-    bool full = false, mask = false;
+    bool full = false;
     uint32_t want[STANDINS];
     for (int k = 0; k < STANDINS; ++k) want[k] = STANDIN_ANY;
     const mat_o *last = NULL;
@@ -446,7 +445,6 @@ void sy_gli_frame_features(sy_gl_device *dev)
         const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
         if (mt && mt != last) {
             shared |= material_features(dev, last = mt);
-            mask = mask || mt->d.alpha_mode == SY_GL_ALPHA_MASK;
             sy_gli_standins_want(dev, mt, want);
         }
         const mesh_o *m = full ? NULL : sy_gli_pool_get(&dev->meshes, in->mesh.id);
@@ -454,7 +452,6 @@ void sy_gli_frame_features(sy_gl_device *dev)
     }
     dev->shared_features = shared;
     dev->shared_full = full;
-    dev->shared_mask = mask;
     sy_gli_standins_follow(dev, want);
 }
 
@@ -641,13 +638,8 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
      * 5.3 s cold at 200x150 on llvmpipe, 1.7 -> 1.8 s warm). */
     pv = sy_gli_variant_normalize((pv | dc->shared) & ~(dev->shared_full ? VAR_LEAN : 0));
     /* probe faces (16-256 px, seen blurred) shade without normal maps and material layers: a
-     * smaller program that llvmpipe compiles in about half the time (docs/BACKENDS.md); in a frame
-     * with a masked material, every draw of theirs runs the masked variant (a material that is not
-     * masked has no cutoff: sy_gli_material_block), one compile less (issue 32: TransmissionTest).
-     * The main pass keeps the two: a discard turns llvmpipe's early depth test off, which made warm
-     * frames slower */
-    if (dev->in_probe_pass)
-        pv = sy_gli_variant_normalize((pv & ~(VAR_NMAP | VAR_LAYERS)) | (dev->shared_mask ? VAR_MASK : 0));
+     * smaller program that llvmpipe compiles in about half the time (docs/BACKENDS.md) */
+    if (dev->in_probe_pass) pv = sy_gli_variant_normalize(pv & ~(VAR_NMAP | VAR_LAYERS));
     sy_gl_result r = use_variant(dev, dc, pv, rep);
     if (r != SY_GL_OK) return r;
     if (pv & VAR_PROBE) { /* its own probe (the 1-texel mip for roughness 1), or the environment's cube */

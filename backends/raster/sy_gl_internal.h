@@ -316,7 +316,6 @@ struct sy_gl_device {
     size_t scratch_len;
     int shared_features; /* material_features of every visible instance (sy_gli_frame_features) */
     bool shared_full;    /* a visible mesh is not VAR_LEAN: no forward draw is (sy_gli_frame_features) */
-    bool shared_mask;    /* a visible material is masked: every probe face's draw is VAR_MASK (sy_gli_frame_features) */
 };
 
 static inline float sy_gli_dot3f(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }

@@ -100,9 +100,7 @@ void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
     b->mrna[0] = d->metallic;
     b->mrna[1] = d->roughness;
     b->mrna[2] = d->normal_scale;
-    /* the cutoff only a masked material has: the probe faces draw every material of a frame with
-     * masked ones through the masked variant (sy_gl_draw.c, draw_instance), the others never cut */
-    b->mrna[3] = d->alpha_mode == SY_GL_ALPHA_MASK ? d->alpha_cutoff : -3.0e38f;
+    b->mrna[3] = d->alpha_cutoff;
     b->oist[0] = d->occlusion_strength;
     b->oist[1] = d->ior >= 1.0f ? d->ior : 1.5f;
     b->oist[2] = d->specular;
